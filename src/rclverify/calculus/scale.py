@@ -44,6 +44,7 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode, is_numeric
 from rclverify.lang.walk import free_names, subexpressions
+from rclverify.semantics import wallclock
 
 #: Budget of one optimisation, milliseconds.
 OPTIMIZE_MS = 1000
@@ -92,7 +93,7 @@ def _range(term: z3.ArithRef, facts: Sequence[z3.BoolRef]) -> tuple[Fraction | N
     out: list[Fraction | None] = []
     for maximise in (False, True):
         o = z3.Optimize()
-        o.set("timeout", OPTIMIZE_MS)
+        wallclock.limit(o, OPTIMIZE_MS)  # steps decide, the clock is a net (issue 67)
         o.add(*facts)
         h = o.maximize(term) if maximise else o.minimize(term)
         if o.check() != z3.sat:

@@ -65,6 +65,7 @@ from rclverify.calculus.context import NEGATED, ContextResult, _multi_path
 from rclverify.calculus.premises import node_premises
 from rclverify.calculus.smttext import SORTS, quote, to_smt
 from rclverify.semantics.retry import has_quantifier
+from rclverify.semantics import wallclock
 
 #: Budget of each quantifier elimination and each check of a summary (milliseconds).
 QE_MS = 2_000
@@ -297,7 +298,7 @@ def _implied(ctx: z3.Context, decls: str, premises: Sequence[tuple[str, str]], a
     text = (decls + lits + "".join(f"(assert (=> |s!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
             + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (not {formula}))\n")
     s = z3.Solver(ctx=ctx)
-    s.set("timeout", QE_MS)
+    wallclock.limit(s, QE_MS)  # steps decide, the clock is a net (issue 67)
     s.set("unsat_core", True)
     s.add(z3.parse_smt2_string(text, ctx=ctx))
     lit = [z3.Bool(f"s!{k}", ctx) for k in range(len(premises))]

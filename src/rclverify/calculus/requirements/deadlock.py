@@ -46,6 +46,7 @@ import z3
 from rclverify.semantics.retry import MAX_INSTANCES, expand_finite, finite_values
 from rclverify.semantics.subst import substitute
 from rclverify.calculus.requirements.tsys import Pred, State, TemporalVerdict, TransitionSystem, distinct, trace_of, unroll
+from rclverify.semantics import wallclock
 
 #: The step-by-step search of :func:`find_deadlock` stops (``inconclusive``)
 #: after this many times one query's budget in all.
@@ -88,7 +89,7 @@ def _attempts(timeout_ms: int) -> list[tuple[str, z3.Solver]]:
     mbqi = z3.Solver()
     mbqi.set("smt.ematching", False)
     for s in (qe, plain, mbqi):
-        s.set("timeout", timeout_ms)
+        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
     return [("quantifier elimination", qe), ("default", plain), ("model-based instantiation", mbqi)]
 
 
@@ -119,7 +120,7 @@ def _check(solver: z3.Solver, extra: Sequence[z3.BoolRef], timeout_ms: int) -> t
 
 def _solver(timeout_ms: int) -> z3.Solver:
     s = z3.Solver()
-    s.set("timeout", timeout_ms)
+    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
     return s
 
 

@@ -58,6 +58,7 @@ from rclverify.calculus.requirements.deadlock import find_deadlock
 from rclverify.calculus.requirements.safety import Hint, prove_always
 from rclverify.calculus.requirements.temporal import _ranking_fails, check_always
 from rclverify.calculus.requirements.tsys import Pred, TemporalVerdict, TransitionSystem, fair_loop, trace_of, unroll, with_flag
+from rclverify.semantics import wallclock
 
 #: The bounds N tried, in order, to prove the unbounded response from the bounded one.
 BOUNDS = (0, 1, 2, 4, 8)
@@ -140,7 +141,7 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
     for n in range(1, max_k + 1):
         states, steps = unroll(ts2, n)
         sv = z3.Solver()
-        sv.set("timeout", timeout_ms)
+        wallclock.limit(sv, timeout_ms)  # steps decide, the clock is a net (issue 67)
         loops = [z3.And(*[states[n][v] == states[j][v] for v in ts2.sorts], fair_loop(ts2, states[j:n]),
                         *[st["<pending>"] for st in states[j:n + 1]]) for j in range(n)]
         sv.add(ts2.init(states[0]), *steps, z3.Or(*loops))

@@ -36,6 +36,7 @@ from rclverify.calculus.requirements.houdini import generate, within as assuming
 from rclverify.calculus.requirements.pdr import recheck, shortest_violation, shown, spacer_invariant
 from rclverify.calculus.requirements.temporal import check_always
 from rclverify.calculus.requirements.tsys import Pred, TemporalVerdict, TransitionSystem, trace_of
+from rclverify.semantics import wallclock
 
 #: Spacer's time limit is this many times the per-query limit (it is one query that does the work of many).
 PDR_FACTOR = 3
@@ -72,7 +73,7 @@ def induction_step(ts: TransitionSystem, inside: Pred, timeout_ms: int,
     when Z3 cannot say."""
     a, b = ts.state(0, "cti"), ts.state(1, "cti")
     s = z3.Solver()
-    s.set("timeout", timeout_ms)
+    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
     s.add(inside(a), ts.trans(a, b), z3.Not(inside(b)))
     r = s.check()
     if r == z3.unsat:

@@ -59,6 +59,7 @@ from rclverify.calculus.compose import free_io
 from rclverify.calculus.requirements.published import Publication, publication
 from rclverify.calculus.requirements.temporal import State, TransitionSystem
 from rclverify.calculus.requirements.tsys import Fairness
+from rclverify.semantics import wallclock
 
 
 def _sort(t: Type) -> z3.SortRef:
@@ -128,7 +129,7 @@ class ComposedSystem:
         why = ""
         for n, holds in self.initial.items():
             s = z3.Solver()
-            s.set("timeout", timeout_ms)
+            wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
             s.add(holds(self.ts.state(0, "initially")))
             r = s.check()
             if r == z3.unsat:
