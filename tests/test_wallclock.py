@@ -92,8 +92,8 @@ def test_a_readable_model_cut_short_is_the_first_model(monkeypatch: pytest.Monke
     enc = Encoder(checked.env)
     cn = checked.nodes["N"]
     a, b = enc.io_symbol(cn, "in", "a"), enc.io_symbol(cn, "in", "b")
-    cubes = []  # two sums of cubes: each of the loop's queries takes some 50 ms of an idle core
-    for i in range(2):
+    cubes = []  # three sums of cubes: the loop's queries take some 50 ms of an idle core each
+    for i in range(3):
         u, v = z3.Ints(f"u{i} v{i}")
         cubes += [u * u * u + v * v * v == 32832, u > 4, v > u]
     formulas = [*cubes, 3 * a > b, b * 7 > 2, a < 100]
@@ -101,9 +101,16 @@ def test_a_readable_model_cut_short_is_the_first_model(monkeypatch: pytest.Monke
     ample = nicer_model(formulas, enc, first)
     assert ample.changed and ample.model != first  # rounded to short values
     tiny(monkeypatch)
-    with wallclock.watch() as w:
-        cut = nicer_model(formulas, enc, first)
-    assert w.cut and cut.model == first and not cut.changed  # today's code showed the loop's last model
+    seen = []
+    for _ in range(3):  # Z3's timer on a net of 12 ms fires almost always, not always: until it has
+        with wallclock.watch() as w:
+            cut = nicer_model(formulas, enc, first)
+        seen.append(w.cut)
+        # cut: the first model (today's code showed the loop's last); else what the budget finds
+        assert (cut.model == first and not cut.changed) if w.cut else cut == ample
+        if w.cut:
+            break
+    assert any(seen)
 
 
 #: Not realizable (on with x > 10: y == x breaks y <= 10); its assumption a
