@@ -126,3 +126,25 @@ def _weight(module: str) -> float:
 settings.register_profile("tests", deadline=None,
                           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "tests"))
+
+
+#: ``RCLVERIFY_TEST_CPU=FILE``: append each test's CPU seconds (user + system of the worker and of the
+#: children it waited for, setup to teardown) as ``module<TAB>test<TAB>seconds`` lines to FILE, so the
+#: figures of :data:`SECONDS` can be taken inside a whole run: CPU seconds, unlike pytest's durations,
+#: do not grow with the other workers' load (docs/ci.md, "The test suite").
+_CPU_LOG = os.environ.get("RCLVERIFY_TEST_CPU")
+
+
+if _CPU_LOG:
+    import resource  # deferred: inside a block (only when the figures are asked for)
+
+    def _cpu() -> float:
+        own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+        return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):  # type: ignore[no-untyped-def]
+        start = _cpu()
+        yield
+        with open(_CPU_LOG, "a", encoding="utf-8") as f:
+            f.write(f"{item.path.stem}\t{item.name}\t{_cpu() - start:.3f}\n")
