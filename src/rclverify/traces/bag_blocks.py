@@ -41,6 +41,7 @@ from typing import Any, Iterator, Mapping, Sequence
 import numpy as np
 
 from rclverify.traces.bag import bag_event, open_bag, read_bag, typestore
+from rclverify.traces.bag_open import counted_open_error, open_uncounted
 from rclverify.traces.bag_raw import RawMessages, from_items, raw_blocks
 from rclverify.traces.events import Event, TraceError
 
@@ -79,12 +80,27 @@ class BagTrace:
         standard = get_typestore(Stores.ROS2_HUMBLE).fielddefs
         if any(store.fielddefs.get(t) != standard[t] for t in (FLOAT64, STRING)):
             return None  # the workspace redefines one: its layout is not the one decoded here
-        reader = open_bag(self.path, store)
+        reader = open_uncounted(self.path, store)  # a sqlite3 bag's messages not counted first (bag_open.py)
+        store_asked = store if reader is not None else None
+        if reader is None:
+            reader = open_bag(self.path, store)
         if not reader.is2:
             reader.close()
             return None
         self._events = iter(())
-        return _blocks(self.path, reader, max(rows, 1))
+        return _checked(self.path, _blocks(self.path, reader, max(rows, 1)), store_asked)
+
+
+def _checked(path: Path, blocks: Iterator[BagBlock | list[Event]], store: Any
+             ) -> Iterator[BagBlock | list[Event]]:
+    """``blocks``; where a reader opened without counting (``store`` not ``None``) meets an error, the
+    error of ``rosbags``' own open of the bag instead when that open fails (traces/bag_open.py)."""
+    try:
+        yield from blocks
+    except TraceError:
+        if store is not None and (bad := counted_open_error(path, store)) is not None:
+            raise bad from None
+        raise
 
 
 def _blocks(path: Path, reader: Any, rows: int) -> Iterator[BagBlock | list[Event]]:

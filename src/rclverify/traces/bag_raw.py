@@ -120,7 +120,7 @@ def raw_blocks(reader: Any, rows: int) -> Iterator[RawMessages] | None:
         if top.metadata.compression_mode:
             return None
         parts = [(s, _dir_connmap(top.connections, s)) for s in top.storages]
-    elif type(top) in (McapReader, Sqlite3Reader):
+    elif type(top) is McapReader or isinstance(top, Sqlite3Reader):  # (a subclass: bag_open.py's, not counting)
         parts = [(top, {c.id: c for c in top.connections})]
     else:
         return None
@@ -128,7 +128,7 @@ def raw_blocks(reader: Any, rows: int) -> Iterator[RawMessages] | None:
     for storage, connmap in parts:
         if not connmap:
             continue
-        if type(storage) is Sqlite3Reader:
+        if isinstance(storage, Sqlite3Reader):
             plans.append(("sqlite3", storage, connmap))
         elif type(storage) is McapReader:
             chunks = _mcap_chunks(storage, connmap)
