@@ -157,7 +157,7 @@ class BagBlock:
     (float64 s, the recording's stamps), :meth:`values`, :meth:`typed`, ``block[i]`` (events)."""
 
     __slots__ = ("path", "reader", "raw", "index", "topics", "times", "_made", "_floats", "_is_float",
-                 "_strs", "_is_str")
+                 "_which", "_texts", "_is_str")
 
     def __init__(self, path: Path, reader: Any, raw: RawMessages, index: int) -> None:
         self.path, self.reader, self.raw, self.index = path, reader, raw, index
@@ -169,7 +169,8 @@ class BagBlock:
         self._floats = np.zeros(n, dtype=np.float64)
         self._is_float = np.zeros(n, dtype=bool)
         self._is_str = np.zeros(n, dtype=bool)
-        self._strs = np.zeros(n, dtype="<U1")
+        self._which = np.full(n, -1, dtype=np.int64)  # a String row's text: ``_texts[_which[i]]``
+        self._texts: list[str] = []
 
     @classmethod
     def make(cls, path: Path, reader: Any, raw: RawMessages, index: int,
@@ -234,9 +235,8 @@ class BagBlock:
                     memo[one] = t
         good = np.array([t is not False for t in texts], dtype=bool)[which]
         self._is_str[at[good]] = True
-        values = np.array([t or "" for t in texts])
-        self._strs = np.zeros(len(raw), dtype=values.dtype)
-        self._strs[at] = values[which]
+        self._texts = [t or "" for t in texts]
+        self._which[at] = which
 
     def topic_counts(self) -> dict[str, int]:
         """Messages per topic (leading ``/`` removed) in this block."""
@@ -254,13 +254,13 @@ class BagBlock:
     def values(self, rows: np.ndarray, key: str) -> list[Any]:
         """The value of ``key`` in the messages at ``rows`` (``None`` where a message has none)."""
         out: list[Any] = []
-        floats, strs = self._floats, self._strs
+        floats, which, texts = self._floats, self._which, self._texts
         is_float, is_str = self._is_float, self._is_str
         for i in rows.tolist():
             if is_float[i]:
                 out.append(float(floats[i]) if key == "data" else None)
             elif is_str[i]:
-                out.append(str(strs[i]) if key == "data" else None)
+                out.append(texts[which[i]] if key == "data" else None)
             else:  # decoded whole
                 out.append(self[i].fields.get(key))
         return out
@@ -274,10 +274,8 @@ class BagBlock:
         if kind == "real":
             col = self._floats[rows]
             return self._is_float[rows] & np.isfinite(col), col
-        code = np.full(len(rows), -1, dtype=np.int64)
-        texts = self._strs[rows]
-        for value, k in codes.items():
-            code[texts == value] = k
+        lut = np.array([codes.get(t, -1) for t in self._texts] + [-1], dtype=np.int64)  # (which -1: no text)
+        code = lut[self._which[rows]]
         code[~self._is_str[rows]] = -1
         return code >= 0, code
 
@@ -298,7 +296,7 @@ class BagBlock:
         if not (self._is_float[i] or self._is_str[i]):
             return bag_event(self.reader, self.path, self.index + i, *self.raw.item(i))
         conn, stamp = self.raw.conns[int(self.raw.code[i])], int(self.raw.stamps[i])
-        value = float(self._floats[i]) if self._is_float[i] else str(self._strs[i])
+        value = float(self._floats[i]) if self._is_float[i] else self._texts[self._which[i]]
         return Event(self.index + i, stamp / 1e9, conn.topic.lstrip("/"), {"data": value},
                      f"{self.path.name}: message {self.index + i}")
 
