@@ -159,3 +159,24 @@ def test_damaged_databases_give_read_bags_events_and_error(good: Path, tmp_path:
     # a seeded mistake: the reader's error kept where rosbags' open fails; some damaged bag must then differ
     monkeypatch.setattr(bag_blocks, "counted_open_error", lambda path, store: None)
     assert any(_blocks(b)[1] != w[1] for b, w in zip(bags, wants))
+
+
+def test_a_bag_of_two_storage_files_reads_as_rosbags_reads_it(good: Path, tmp_path: Path) -> None:
+    """A bag directory naming two database files: each opened without counting, read one after the other."""
+    import yaml
+    _write(tmp_path / "second", 11, 150)
+    bag = tmp_path / "split"
+    shutil.copytree(good, bag)
+    shutil.copy(tmp_path / "second/second.db3", bag / "split_1.db3")
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text())
+    meta["rosbag2_bagfile_information"]["relative_file_paths"] = ["good.db3", "split_1.db3"]
+    (bag / "metadata.yaml").write_text(yaml.safe_dump(meta))
+    fast = open_uncounted(bag, typestore([]))
+    assert fast is not None
+    try:
+        assert [type(s).__name__ for s in fast.readers[0].storage.storages] == ["UncountedSqlite3"] * 2
+    finally:
+        fast.close()
+    want = _oracle(bag)
+    assert want[1] is None and len(want[0]) > 1100
+    assert _blocks(bag) == want
