@@ -29,6 +29,7 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
+from rclverify.traces.bag import open_bag
 from rclverify.traces.events import TraceError
 
 # topics' columns by schema version (the rosbag2 sqlite3 schema: 4 from Iron on, 2-3 Foxy to Humble, 1 before)
@@ -128,7 +129,6 @@ def open_uncounted(path: Path, store: Any) -> Any | None:
 
 def counted_open_error(path: Path, store: Any) -> TraceError | None:
     """The error :func:`~.bag.open_bag` gives for the bag at ``path``, ``None`` when it opens it."""
-    from rclverify.traces.bag import open_bag  # (a sibling; imported here: bag.py need not load this module)
     try:
         reader = open_bag(path, store)
     except TraceError as exc:
