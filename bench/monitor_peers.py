@@ -74,8 +74,8 @@ the reading of the log and of the bags and the columns path K times each and kee
 (the run the machine's other load disturbed least; the ratios between them
 are taken from those).
 
-``--compare OLD_SRC`` also runs the rclverify engine and command from an
-older source tree (e.g. ``git worktree add /tmp/old <commit>``, then
+``--compare OLD_SRC`` also runs the rclverify engine and command (on the log
+and, unless ``--no-bags``, on the two bags) from an older source tree (e.g. ``git worktree add /tmp/old <commit>``, then
 ``OLD_SRC=/tmp/old/src``) alternately with this one, and prints old, new
 and new/old: issue 44's "at least 3x today's samples/s" is that ratio, in
 one run on one machine.
@@ -437,6 +437,10 @@ def _measure(args: argparse.Namespace) -> tuple[dict[str, dict[str, Any]], dict[
                         ws, src, f"run_{s}"))
                     rows[f"reading the {storage} bag"] = _best(args.repeat, lambda s=storage: _run_child(
                         "read", args, None, src, ws / f"run_{s}"))
+            if label == "old" and not args.no_bags:  # the older tree's command on the same bags
+                for storage in ("sqlite3", "mcap"):
+                    rows[f"rclverify monitor, {storage} (old)"] = _best(args.repeat, lambda s=storage: _run_command(
+                        ws, src, f"run_{s}"))
             if label == "new":  # the command's start-up: the same command on a log of ten samples
                 tiny = argparse.Namespace(**{**vars(args), "samples": 10})
                 (base / "tiny").mkdir()
@@ -506,6 +510,11 @@ def _print(rows: dict[str, dict[str, Any]], verdicts: dict[str, bytes], args: ar
         new_cmd = rows["rclverify monitor (new)"]["cpu"]
         print(f"engine samples/s new/old: {old / engine:.2f} (aim: at least 3); "
               f"command new/old: {old_cmd / new_cmd:.2f}; old command / old engine: {old_cmd / old:.2f}")
+        for storage in ("sqlite3", "mcap"):
+            if f"rclverify monitor, {storage} (old)" in rows:
+                print(f"command on the {storage} bag, CPU s old / new: "
+                      f"{rows[f'rclverify monitor, {storage} (old)']['cpu']:.2f} / "
+                      f"{rows[f'rclverify monitor, {storage}']['cpu']:.2f}")
 
 
 if __name__ == "__main__":
