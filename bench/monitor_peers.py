@@ -459,17 +459,17 @@ def _print(rows: dict[str, dict[str, Any]], verdicts: dict[str, bytes], args: ar
     n = args.samples
     engine = rows["rclverify engine (new)"]["cpu"]
     batch = rows["rclverify batch"]
-    print(f"{'tool':<28} {'samples/s':>11} {'x engine':>9} {'peak RSS MiB':>13}  verdicts agree with the streaming engine")
+    print(f"{'tool':<33} {'samples/s':>11} {'x engine':>9} {'peak RSS MiB':>13}  verdicts agree with the streaming engine")
     for name, r in rows.items():
         if "skipped" in r:
-            print(f"{name:<28} skipped: {r['skipped']}")
+            print(f"{name:<33} skipped: {r['skipped']}")
             continue
         if name.endswith("10 samples"):
-            print(f"{name:<28} {'':>11} {'':>9} {r['rss']:>13.1f}  (its CPU: {r['cpu']:.2f} s, the start-up)")
+            print(f"{name:<33} {'':>11} {'':>9} {r['rss']:>13.1f}  (its CPU: {r['cpu']:.2f} s, the start-up)")
             continue
         key = name.split("(")[-1].rstrip(")") if name.startswith("rclverify engine") else name
         agree = _agree(verdicts[key], verdicts["new"]) if key in verdicts else "-"
-        print(f"{name:<28} {n / r['cpu']:>11.0f} {engine / r['cpu']:>9.2f} {r['rss']:>13.1f}  {agree}")
+        print(f"{name:<33} {n / r['cpu']:>11.0f} {engine / r['cpu']:>9.2f} {r['rss']:>13.1f}  {agree}")
     counts = dict(rows["rclverify engine (new)"]["counts"])
     evaluation = counts.pop("evaluation", {})
     bcounts = dict(batch["counts"])

@@ -25,6 +25,7 @@ as before.
 """
 from __future__ import annotations
 
+from functools import cache
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any
@@ -38,18 +39,9 @@ _TOPIC_COLUMNS = {4: "id, name, type, serialization_format, offered_qos_profiles
                   1: "id, name, type, serialization_format"}
 
 
+@cache
 def _storage_class() -> Any:
     """:class:`UncountedSqlite3`, made on first use (``rosbags`` loads only when a bag is read)."""
-    global _CLASS
-    if _CLASS is None:
-        _CLASS = _make_class()
-    return _CLASS
-
-
-_CLASS: Any = None
-
-
-def _make_class() -> Any:
     from rosbags.interfaces import Connection, ConnectionExtRosbag2, MessageDefinition, MessageDefinitionFormat  # deferred: start-up (loads rosbags and more only when called)
     from rosbags.rosbag2.errors import ReaderError  # deferred: start-up (loads rosbags and more only when called)
     from rosbags.rosbag2.metadata import ReaderMetadata, parse_qos  # deferred: start-up (loads rosbags and more only when called)
@@ -104,7 +96,8 @@ def _make_class() -> Any:
 def open_uncounted(path: Path, store: Any) -> Any | None:
     """An opened ``AnyReader`` of the bag at ``path`` (type store ``store``) whose sqlite3
     storage was opened by :class:`UncountedSqlite3`; ``None`` where that does not apply or the
-    open fails (the caller opens the bag with :func:`~.bag.open_bag`, which words the error)."""
+    open fails (the caller opens the bag with :func:`~.bag.open_bag`, which words the error).
+    Never raises."""
     try:
         from rosbags.highlevel import AnyReader  # deferred: start-up (loads rosbags and more only when called)
         from rosbags.rosbag2.reader import DirectoryReader  # deferred: start-up (loads rosbags and more only when called)
