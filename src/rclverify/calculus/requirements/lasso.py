@@ -35,6 +35,7 @@ import z3
 
 from rclverify.calculus.health.witness import table_point, table_term
 from rclverify.semantics.query import budgeted_solver
+from rclverify.semantics import wallclock
 from rclverify.lang.types import DataT, EnumT, FuncT, Type
 from rclverify.semantics.values import FiniteFunction, Term
 from rclverify.calculus.requirements.temporal import Pred, State, TransitionSystem
@@ -134,10 +135,12 @@ def find_table_lasso(ts: TransitionSystem, prop: Pred, types: Mapping[str, Type]
                     *[z3.Not(prop(s)) for s in states], z3.Or(*same)]
         ctx = z3.Context()
         solver = budgeted_solver(budget_ms, ctx)
-        r = solver.check(*[f.translate(ctx) for f in formulas])
-        if r == z3.unknown:
+        seen = wallclock.cuts()
+        r = wallclock.check(solver, *[f.translate(ctx) for f in formulas])
+        if r == z3.unknown:  # the budget's reason, or the net's when the clock cut it (never another length)
+            why = wallclock.cut_reason() if wallclock.cuts() != seen else solver.reason_unknown()
             return (f"no lasso of up to {n - 1} steps with {points}-point tables; at {n} steps the solver "
-                    f"answered unknown ({solver.reason_unknown()})")
+                    f"answered unknown ({why})")
         if r == z3.unsat:
             continue
         m = solver.model()
