@@ -95,7 +95,34 @@ def _create_temporary(path: Path) -> tuple[int, str]:
 
 
 def dumps(value: Any) -> str:
-    """Deterministic JSON text: sorted keys, two-space indent, final newline."""
+    """Deterministic JSON text: sorted keys, two-space indent, final newline.
+
+    The text of the reference ``json.dumps(value, sort_keys=True, indent=2,
+    ensure_ascii=False) + "\\n"`` (:func:`reference_dumps`), made faster: the
+    standard library indents in pure Python, so a value is encoded compact
+    by its C encoder (the same numbers, strings and key order) and a long
+    text is indented by ``msgspec.json.format``, which copies every token
+    verbatim and only lays out the whitespace.  A text that is not strict
+    JSON (``NaN``, ``Infinity``) or not UTF-8 (a lone surrogate) is
+    encoded by the reference.  Raises ``TypeError``/``ValueError`` like
+    :func:`json.dumps` for a value JSON cannot hold.
+    """
+    compact = json.dumps(value, sort_keys=True, ensure_ascii=False, separators=(",", ":"))
+    if len(compact) < _FORMAT_FROM:
+        return reference_dumps(value)
+    import msgspec  # noqa: PLC0415 -- 10 ms to import: only a process that writes long records pays it
+    try:
+        return msgspec.json.format(compact, indent=2) + "\n"
+    except (msgspec.DecodeError, UnicodeEncodeError):
+        return reference_dumps(value)
+
+
+#: Compact texts shorter than this are indented by the reference encoder (cheap at that size).
+_FORMAT_FROM = 2048
+
+
+def reference_dumps(value: Any) -> str:
+    """The reference of :func:`dumps`: the standard library's indenting encoder."""
     return json.dumps(value, sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 

@@ -28,6 +28,7 @@ import json
 from pathlib import Path
 from typing import Any, Callable
 
+from rclverify.core.atomic import dumps
 from rclverify.core.cache import Shelf, fingerprint
 
 __all__ = ["FragmentCache", "cached_dumps", "fingerprint"]
@@ -112,7 +113,7 @@ def _leaf(value: Any, cache: FragmentCache, level: int, depth: int) -> str:
     """``value`` indented as at ``level``: from the cache at ``depth`` and
     below when it is a non-empty container, else encoded directly."""
     def render() -> str:
-        return json.dumps(value, sort_keys=True, indent=2, ensure_ascii=False)
+        return dumps(value)[:-1]  # the reference's text (core/atomic.py), its final newline left out
     if level < depth or not isinstance(value, (dict, list, tuple)) or not value:
         text = render()
     else:
