@@ -102,7 +102,7 @@ def dumps(value: Any) -> str:
     standard library indents in pure Python, so a value is encoded compact
     by its C encoder (the same numbers, strings and key order) and the
     text is indented by ``msgspec.json.format``, which copies every token
-    verbatim and only lays out the whitespace (2-5x faster from 100
+    verbatim and only lays out the whitespace (2-7x faster from 100
     characters on).  A text that is not strict JSON (``NaN``,
     ``Infinity``) or not UTF-8 (a lone surrogate) is encoded by the
     reference.  Raises ``TypeError``/``ValueError`` like :func:`json.dumps`
