@@ -117,7 +117,9 @@ def dumps(value: Any) -> str:
 
 
 def reference_dumps(value: Any) -> str:
-    """The reference of :func:`dumps`: the standard library's indenting encoder."""
+    """The reference of :func:`dumps` (the same text, the same errors): the
+    standard library's indenting encoder, sorted keys, two-space indent,
+    non-ASCII kept, final newline; also what :func:`dumps` falls back to."""
     return json.dumps(value, sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 
