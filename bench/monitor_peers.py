@@ -75,8 +75,8 @@ the reading of the log and of the bags and the columns path K times each and kee
 are taken from those).
 
 ``--compare OLD_SRC`` also runs the rclverify engine and command (on the log
-and, unless ``--no-bags``, on the two bags) from an older source tree (e.g. ``git worktree add /tmp/old <commit>``, then
-``OLD_SRC=/tmp/old/src``) alternately with this one, and prints old, new
+and, unless ``--no-bags``, on the two bags) from an older source tree (e.g. ``git worktree add ../old <commit>``, then
+``OLD_SRC=../old/src``) alternately with this one, and prints old, new
 and new/old: issue 44's "at least 3x today's samples/s" is that ratio, in
 one run on one machine.
 
