@@ -32,9 +32,15 @@ other health problems (report/build.py).
 """
 from __future__ import annotations
 
+from typing import Sequence
+
+import z3
+
 from rclverify.calculus.compose import conjuncts, free_io
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.query import prove
+from rclverify.semantics.retry import MBQI, has_quantifier, load_canonical, strategy_solver
+from rclverify.semantics.wallclock import check
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.timing import seconds
@@ -42,6 +48,10 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.calculus.health.finding import Finding
 
 SHAPE_TIMEOUT_MS = 2_000
+#: Budget (Z3 resource steps) of the counterexample looked for first (:func:`_falsified`): the case
+#: study's Agent's conjuncts take 2,000-10,000 steps there, where the default strategy spends its whole
+#: :data:`SHAPE_TIMEOUT_MS` on the first one and decides nothing.
+FALSIFY_RLIMIT = 50_000
 
 
 def _where(l: ast.Loc) -> str:
@@ -86,6 +96,8 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
         if len(parts) > 1:
             others = [enc.formula(x, cn) for kk, jj, x in parts
                       if (kk, jj) != (k, j) and may_imply(n.guarantees[kk - 1], n.guarantees[k - 1])]
+            if _falsified([*assume, *others, *enc.axioms(), z3.Not(enc.formula(c, cn))]):
+                continue  # neither implied by the rest nor valid: what both queries would find (_falsified)
             r = prove(enc.formula(c, cn), assume + others, enc, timeout_ms=timeout_ms,
                       comment=f"health {node}: is conjunct {j} of guarantee {k} implied by the others?")
             if r.status == "refuted":
@@ -96,6 +108,8 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
                                           "the assumption and the other guarantee conjuncts imply it.",
                                           f"`{expr_to_rcl(c)}` adds nothing to the contract; Z3 proved it from the "
                                           "rest.", duration_s=r.duration_s, smt2=r.smt2)
+        elif _falsified([*enc.axioms(), z3.Not(enc.formula(c, cn))]):
+            continue  # not valid on its own (_falsified)
         valid = _tautology(enc, cn, node, k, j, c, timeout_ms)
         if valid is not None:
             implied.pop((k, j), None)  # a tautology is reported as that, not also as redundant
@@ -140,3 +154,30 @@ def _tautology(enc: Encoder, cn: CheckedNode, node: str, k: int, j: int, c: ast.
                    "Z3 proved it valid with no hypothesis: it promises nothing. Check it says what was "
                    "meant (a comparison of a value with itself, a premise that is always false, ...).",
                    duration_s=r.duration_s, smt2=r.smt2)
+
+
+def _falsified(formulas: Sequence[z3.BoolRef]) -> bool:
+    """Do ``formulas`` (a validity query's hypotheses, the encoder's axioms
+    and the negated conjunct, as :func:`~rclverify.semantics.query.prove`
+    asserts them) have a model, found by model-based quantifier
+    instantiation (:data:`rclverify.semantics.retry.MBQI`, in a fresh
+    context from the query's canonical text, so its answer depends on the
+    query alone) within :data:`FALSIFY_RLIMIT` steps?  Asked, before the
+    query itself, only of a quantified query: a quantifier-free one the
+    default strategy decides at once.
+
+    ``True`` decides the check the way the queries would: a model refutes
+    the implication, so the redundancy query cannot answer ``proved`` (Z3 is
+    sound), and it falsifies the conjunct alone with the axioms, so the
+    tautology query cannot either; neither records anything then
+    (:func:`shape_findings` reports only what is proved).  ``False`` (no
+    model within the budget) says nothing: the queries are asked as without
+    it.  On the case study's Agent the first redundancy query spends its
+    whole budget before a retry refutes it (1.3 CPU s); this answers in a
+    few thousand steps."""
+    if not any(has_quantifier(f) for f in formulas):
+        return False
+    s, rewrite = strategy_solver(MBQI)
+    s.set("rlimit", FALSIFY_RLIMIT)
+    load_canonical(s, [rewrite(f) for f in formulas])
+    return bool(check(s) == z3.sat)
