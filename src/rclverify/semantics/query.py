@@ -189,7 +189,7 @@ def smtlib_benchmark(formulas: Sequence[z3.BoolRef], ctx: z3.Context | None = No
 def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | None = None, *,
           timeout_ms: int = DEFAULT_TIMEOUT_MS, comment: str = "", deterministic: bool = False,
           first_ms: float | None = None, likely_sat: Callable[[], bool] | None = None,
-          counterexample: Callable[[], dict[str, str] | None] | None = None) -> QueryResult:
+          counterexample: Callable[[], dict[str, str] | None] | None = None, models: bool = True) -> QueryResult:
     """Is ``hypotheses => goal`` valid?  Checks ``hypotheses and not goal``.
 
     ``enc`` (when given) renders a refuting model in RCL terms and adds its
@@ -201,6 +201,8 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     the calling process's Z3 term ids reach the solver; the model is read
     back through ``enc``'s symbol names, which the text keeps.  Never raises
     on solver trouble: an unknown answer is ``inconclusive`` with Z3's reason.
+    ``models=False``: a refuted query's model is not rendered (``model``
+    is ``None``), for a caller that reads only the verdict.
 
     ``first_ms`` (decide first with what decides, issue 44): the first
     attempt gets only this budget (milliseconds' worth of resource steps);
@@ -228,6 +230,7 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     script = smt2_script(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
     ladder = first_ms is not None and (deterministic or not _SESSIONS)
     q = _Validity(formulas, script, enc, deterministic, timeout_ms)
+    q.models = models
     with ExitStack() as scope:
         if ladder or deterministic:
             s = q.default(first_ms if ladder else None)
@@ -273,6 +276,7 @@ class _Validity:
                  timeout_ms: int) -> None:
         self.formulas, self.script, self.enc = formulas, script, enc
         self.deterministic, self.timeout_ms = deterministic, timeout_ms
+        self.models = True  # render a refuting model (prove's ``models``)
         self.t0 = time.perf_counter()
 
     def elapsed(self) -> float:
@@ -285,7 +289,8 @@ class _Validity:
         if r == z3.unsat:
             return QueryResult("proved", self.script, self.elapsed(), strategy=strategy)
         if r == z3.sat:
-            return QueryResult("refuted", self.script, self.elapsed(), model=render_model(s.model(), self.enc),
+            return QueryResult("refuted", self.script, self.elapsed(),
+                               model=render_model(s.model(), self.enc) if self.models else None,
                                strategy=strategy)
         return None
 

@@ -96,9 +96,10 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
         if len(parts) > 1:
             others = [enc.formula(x, cn) for kk, jj, x in parts
                       if (kk, jj) != (k, j) and may_imply(n.guarantees[kk - 1], n.guarantees[k - 1])]
-            if _falsified([*assume, *others, *enc.axioms(), z3.Not(enc.formula(c, cn))]):
+            goal = enc.formula(c, cn)
+            if _falsified(assume + others, goal, enc):
                 continue  # neither implied by the rest nor valid: what both queries would find (_falsified)
-            r = prove(enc.formula(c, cn), assume + others, enc, timeout_ms=timeout_ms,
+            r = prove(goal, assume + others, enc, timeout_ms=timeout_ms, models=False,
                       comment=f"health {node}: is conjunct {j} of guarantee {k} implied by the others?")
             if r.status == "refuted":
                 continue  # not valid on its own either: its counterexample falsifies the conjunct
@@ -108,7 +109,7 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
                                           "the assumption and the other guarantee conjuncts imply it.",
                                           f"`{expr_to_rcl(c)}` adds nothing to the contract; Z3 proved it from the "
                                           "rest.", duration_s=r.duration_s, smt2=r.smt2)
-        elif _falsified([*enc.axioms(), z3.Not(enc.formula(c, cn))]):
+        elif _falsified([], enc.formula(c, cn), enc):
             continue  # not valid on its own (_falsified)
         valid = _tautology(enc, cn, node, k, j, c, timeout_ms)
         if valid is not None:
@@ -144,7 +145,7 @@ def _tautology(enc: Encoder, cn: CheckedNode, node: str, k: int, j: int, c: ast.
                timeout_ms: int) -> Finding | None:
     """The ``tautology`` finding of conjunct ``j`` of guarantee ``k`` when Z3
     proves it valid with no hypothesis, else ``None``."""
-    r = prove(enc.formula(c, cn), [], enc, timeout_ms=timeout_ms,
+    r = prove(enc.formula(c, cn), [], enc, timeout_ms=timeout_ms, models=False,
               comment=f"health {node}: is conjunct {j} of guarantee {k} valid on its own?")
     if r.status != "proved":
         return None
@@ -156,10 +157,10 @@ def _tautology(enc: Encoder, cn: CheckedNode, node: str, k: int, j: int, c: ast.
                    duration_s=r.duration_s, smt2=r.smt2)
 
 
-def _falsified(formulas: Sequence[z3.BoolRef]) -> bool:
-    """Do ``formulas`` (a validity query's hypotheses, the encoder's axioms
-    and the negated conjunct, as :func:`~rclverify.semantics.query.prove`
-    asserts them) have a model, found by model-based quantifier
+def _falsified(hyps: Sequence[z3.BoolRef], goal: z3.BoolRef, enc: Encoder) -> bool:
+    """Do ``hyps``, ``enc``'s axioms and ``not goal`` (the formulas
+    :func:`~rclverify.semantics.query.prove` asserts to ask whether ``hyps``
+    imply ``goal``) have a model, found by model-based quantifier
     instantiation (:data:`rclverify.semantics.retry.MBQI`, in a fresh
     context from the query's canonical text, so its answer depends on the
     query alone) within :data:`FALSIFY_RLIMIT` steps?  Asked, before the
@@ -175,8 +176,10 @@ def _falsified(formulas: Sequence[z3.BoolRef]) -> bool:
     it.  On the case study's Agent the first redundancy query spends its
     whole budget before a retry refutes it (1.3 CPU s); this answers in a
     few thousand steps."""
-    if not any(has_quantifier(f) for f in formulas):
+    axioms = enc.axioms()
+    if not any(has_quantifier(f) for f in [*hyps, goal, *axioms]):
         return False
+    formulas = [*hyps, *axioms, z3.Not(goal)]
     s, rewrite = strategy_solver(MBQI)
     s.set("rlimit", FALSIFY_RLIMIT)
     load_canonical(s, [rewrite(f) for f in formulas])
