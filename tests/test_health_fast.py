@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 import random
+import re
 
 import pytest
 
@@ -104,3 +105,77 @@ def test_shape_findings_equal_the_reference_path(contracts, monkeypatch):
     slow = {s: _findings(c) for s, c in contracts.items()}
     assert fast == slow
     assert any(fast.values())  # some contract has a redundant or tautological conjunct: the comparison bites
+
+
+# -- the realizer's first synthesis round (calculus/health/realizer.py: _first_model) --------------------------
+
+def _linear(seed: int) -> str:
+    """A random quantifier-free contract over REAL and an enumeration (the realizer's templates apply)."""
+    rnd = random.Random(seed)
+
+    def atom() -> str:
+        return rnd.choice(("out.o >= in.x", "out.o <= in.y + {c}", "out.o == {c}", "in.x <= {c} -> out.o >= {c}",
+                           "out.s == a", "out.s != b or in.x > {c}", "out.o + in.x >= in.y", "out.o * 2 <= in.x",
+                           "0 < out.o and out.o <= {d}", "out.s == b -> out.o > {d}")).format(
+            c=rnd.randint(-3, 3), d=rnd.randint(1, 3))
+    gs = "\n".join(f"  guarantee( {atom()} )" for _ in range(rnd.randint(1, 3)))
+    return ("context { S : {a, b}; }\n"
+            "node N { inputs( x : REAL, y : REAL ) outputs( o : REAL, s : S )\n"
+            f"  assume( 0 <= in.x and in.x <= in.y + {rnd.randint(0, 3)} )\n{gs}\n}}\n")
+
+
+def _let_normal(text: str) -> str:
+    """``text`` with Z3's ``let`` names (``$x34``: a term id, history of the process) renamed in order of
+    first occurrence: the same query whatever Z3 was asked before."""
+    names: dict[str, str] = {}
+    return re.sub(r"[$?]x[0-9]+", lambda m: names.setdefault(m.group(0), f"{m.group(0)[0]}x{len(names) + 1}"), text)
+
+
+def test_the_first_synthesis_model_is_the_empty_solver_s():
+    """Every sort's default in the model made without a check equals the
+    one a check of an empty solver gives."""
+    from rclverify.calculus.health.realizer import _first_model
+    from rclverify.semantics.query import budgeted_solver
+    import z3
+    cmd = z3.Datatype("HealthFastCmd")
+    cmd.declare("go", ("gx", z3.RealSort()), ("gy", z3.IntSort()))
+    cmd.declare("halt")
+    sort = cmd.create()
+    enum, _ = z3.EnumSort("HealthFastEnum", ["p", "q", "r"])
+    params = [z3.Real("r"), z3.Int("i"), z3.Bool("b"), z3.Const("d", sort), z3.Const("e", enum),
+              z3.Const("st", z3.SetSort(z3.IntSort())), z3.Const("sq", z3.SeqSort(z3.RealSort()))]
+    s = budgeted_solver(100)
+    assert s.check() == z3.sat
+    want = [s.model().eval(p, model_completion=True) for p in params]
+    got = [_first_model(params).eval(p, model_completion=True) for p in params]
+    assert [str(x) for x in got] == [str(x) for x in want]
+    assert all(x.eq(y) for x, y in zip(got, want))
+
+
+def test_realizability_findings_equal_the_reference_path(monkeypatch):
+    """The realizability findings (the answer's terms, the status, the
+    conflicting guarantees) of random contracts with the first synthesis
+    round's model made without a check and with it asked of a fresh solver
+    (before issue 67)."""
+    from rclverify.calculus.health import realizer
+    from rclverify.calculus.health.realizable import realizability_findings
+    from rclverify.semantics.query import budgeted_solver
+    import z3
+    texts = [_linear(s) for s in range(30)]
+
+    def run() -> list[list[dict]]:
+        out = []
+        for t in texts:
+            fs = realizability_findings(check([parse_text(t, "t.rcl")]), "N")
+            out.append([{**f.to_json(), "duration_s": 0, "smt2": _let_normal(f.smt2),
+                         "witness_smt2": _let_normal(f.witness_smt2)} for f in fs])
+        return out
+    fast = run()
+
+    def reference(params):
+        s = budgeted_solver(realizer.CHECK_MS)
+        assert s.check() == z3.sat
+        return s.model()
+    monkeypatch.setattr(realizer, "_first_model", reference)
+    assert run() == fast
+    assert sum(1 for fs in fast for f in fs if f.get("witness")) >= 10  # the realizer answered: the comparison bites

@@ -151,11 +151,14 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
     showed it (unsat); ``None`` when the template cannot, or the rounds or
     a check's budget run out."""
     answered = z3.substitute(body, *[(o, _expr(t)) for o, t in zip(outs, terms)])
-    synth = budgeted_solver(CHECK_MS)
+    synth: z3.Solver | None = None  # made when the first input is to be added (_first_model)
     for _ in range(ROUNDS):
-        if check(synth) != z3.sat:
+        if synth is None:
+            m = _first_model(params)
+        elif check(synth) != z3.sat:
             return None
-        m = synth.model()
+        else:
+            m = synth.model()
         values = {p.get_id(): m.eval(p, model_completion=True) for p in params}
         ws = [z3.simplify(z3.substitute(_expr(t), *[(p, values[p.get_id()]) for p in params])) for t in terms]
         query = [*given, z3.Not(z3.substitute(body, *zip(outs, ws)))]
@@ -168,8 +171,23 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
             return None
         cm = v.model()
         point = [(x, cm.eval(x, model_completion=True)) for x in inputs]
+        if synth is None:  # its first check as the first round would have asked it: the same solver state
+            synth = budgeted_solver(CHECK_MS)
+            check(synth)
         synth.add(z3.substitute(answered, *point) if point else answered)
     return None
+
+
+def _first_model(params: Sequence[z3.ExprRef]) -> z3.ModelRef:
+    """The model the first synthesis check gives, made without asking it:
+    before any input is added the synthesis solver holds no assertion, so
+    Z3 answers ``sat`` with the empty model, in which (evaluated with model
+    completion) each parameter takes its sort's default value, the value an
+    empty model made here gives too (the same evaluator).  A fresh solver's
+    check costs about a millisecond, most of a small contract's
+    realizability check (issue 67)."""
+    ctx = params[0].ctx if params else z3.main_ctx()
+    return z3.ModelRef(z3.Z3_mk_model(ctx.ref()), ctx)
 
 
 def _name(x: z3.ExprRef, names: dict[str, str]) -> str:
