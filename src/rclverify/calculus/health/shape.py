@@ -90,13 +90,19 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
     # questions of every conjunct, with half the queries on a healthy contract (docs/scale.md).
     assume = [enc.formula(a.formula, cn) for a in n.assumes] if len(parts) > 1 else []
     implied: dict[tuple[int, int], Finding] = {}
+    encoded: dict[tuple[int, int], z3.BoolRef] = {}  # each conjunct encoded once, when first needed
+
+    def formula(kk: int, jj: int, x: ast.Expr) -> z3.BoolRef:
+        if (kk, jj) not in encoded:
+            encoded[(kk, jj)] = enc.formula(x, cn)
+        return encoded[(kk, jj)]
     for k, j, c in parts:
         if isinstance(c, ast.BoolLit):
             continue
         if len(parts) > 1:
-            others = [enc.formula(x, cn) for kk, jj, x in parts
+            others = [formula(kk, jj, x) for kk, jj, x in parts
                       if (kk, jj) != (k, j) and may_imply(n.guarantees[kk - 1], n.guarantees[k - 1])]
-            goal = enc.formula(c, cn)
+            goal = formula(k, j, c)
             if _falsified(assume + others, goal, enc):
                 continue  # neither implied by the rest nor valid: what both queries would find (_falsified)
             r = prove(goal, assume + others, enc, timeout_ms=timeout_ms, models=False,
@@ -109,9 +115,9 @@ def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEO
                                           "the assumption and the other guarantee conjuncts imply it.",
                                           f"`{expr_to_rcl(c)}` adds nothing to the contract; Z3 proved it from the "
                                           "rest.", duration_s=r.duration_s, smt2=r.smt2)
-        elif _falsified([], enc.formula(c, cn), enc):
+        elif _falsified([], formula(k, j, c), enc):
             continue  # not valid on its own (_falsified)
-        valid = _tautology(enc, cn, node, k, j, c, timeout_ms)
+        valid = _tautology(enc, node, k, j, c, formula(k, j, c), timeout_ms)
         if valid is not None:
             implied.pop((k, j), None)  # a tautology is reported as that, not also as redundant
             out.append(valid)
@@ -141,11 +147,11 @@ def may_imply(source: ast.Clause, target: ast.Clause) -> bool:
     return need is not None and have is not None and have <= need
 
 
-def _tautology(enc: Encoder, cn: CheckedNode, node: str, k: int, j: int, c: ast.Expr,
+def _tautology(enc: Encoder, node: str, k: int, j: int, c: ast.Expr, goal: z3.BoolRef,
                timeout_ms: int) -> Finding | None:
-    """The ``tautology`` finding of conjunct ``j`` of guarantee ``k`` when Z3
-    proves it valid with no hypothesis, else ``None``."""
-    r = prove(enc.formula(c, cn), [], enc, timeout_ms=timeout_ms, models=False,
+    """The ``tautology`` finding of conjunct ``j`` of guarantee ``k`` (``c``,
+    encoded as ``goal``) when Z3 proves it valid with no hypothesis, else ``None``."""
+    r = prove(goal, [], enc, timeout_ms=timeout_ms, models=False,
               comment=f"health {node}: is conjunct {j} of guarantee {k} valid on its own?")
     if r.status != "proved":
         return None
