@@ -181,3 +181,57 @@ def test_realizability_findings_equal_the_reference_path(monkeypatch):
     monkeypatch.setattr(realizer, "FIRST_ROUND_UNASKED", False)
     assert run() == fast
     assert sum(1 for fs in fast for f in fs if f.get("witness")) >= 10  # the realizer answered: the comparison bites
+
+
+# -- one encoding of the node's formulas shared by its checks (calculus/health/shared.py) ----------------------
+
+def test_a_shared_encoding_registers_what_encoding_again_would():
+    """An encoder served from the table another encoder filled (the
+    consistency check's, which encodes the guarantees first) ends with the
+    same symbols, in the same order, the same typing axioms and the same
+    terms as one that encodes the formulas itself, in the shape check's
+    order (the assumption, then each guarantee); on the case study, whose
+    Agent has NATURAL-valued functions (axioms) and nested quantifiers."""
+    from pathlib import Path
+    from rclverify.calculus.health.shared import SharedEncoder
+    from rclverify.lang.typecheck import load
+    checked = load([Path(__file__).resolve().parents[1] / "contracts" / "remote_inspection.rcl"])
+    for name, cn in checked.nodes.items():
+        order = [g.formula for g in cn.node.guarantees] + [a.formula for a in cn.node.assumes]
+        table: dict = {}
+        first = SharedEncoder(checked.env, table)
+        for e in order:
+            first.formula(e, cn)
+        assert len(table) == len({id(e) for e in order})
+        later = [a.formula for a in cn.node.assumes] + [g.formula for g in cn.node.guarantees]
+        shared, plain = SharedEncoder(checked.env, table), Encoder(checked.env)
+        got = [shared.formula(e, cn) for e in later]
+        want = [plain.formula(e, cn) for e in later]
+        assert list(shared.symbols) == list(plain.symbols), name
+        assert [s.display for s in shared.symbols.values()] == [s.display for s in plain.symbols.values()]
+        assert all(x.eq(y) for x, y in zip(got, want)), name
+        assert [a.sexpr() for a in shared.axioms()] == [a.sexpr() for a in plain.axioms()], name
+
+
+def test_shape_findings_from_shared_formulas_equal_their_own(contracts):
+    """shape_findings served from the table the node's other checks
+    filled gives the findings (and the SMT-LIB2 text, up to let names) it
+    gives encoding everything itself."""
+    from rclverify.calculus.health.shared import SharedEncoder
+
+    def run(shared: bool) -> list:
+        out = []
+        for checked in list(contracts.values()) + [check([parse_text(_linear(s), "t.rcl")]) for s in range(8)]:
+            world.fresh()
+            cn = checked.nodes["N"]
+            table: dict = {}
+            if shared:
+                enc = SharedEncoder(checked.env, table)
+                for e in [a.formula for a in cn.node.assumes] + [g.formula for g in cn.node.guarantees]:
+                    enc.formula(e, cn)
+            fs = shape.shape_findings(checked, "N", formulas=table if shared else None)
+            out.append([(f.to_json() | {"duration_s": 0}, _let_normal(f.smt2)) for f in fs])
+        return out
+    got, want = run(True), run(False)
+    assert got == want
+    assert sum(len(x) for x in want) >= 10

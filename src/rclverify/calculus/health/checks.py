@@ -33,7 +33,6 @@ import z3
 
 from rclverify.calculus.refinement import RefinementResult
 from rclverify.semantics import wallclock
-from rclverify.semantics.encode import Encoder
 from rclverify.semantics.query import QueryResult, satisfiable, smt2_script, solver_session
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
@@ -42,6 +41,7 @@ from rclverify.lang.types import NATURAL, Checked, CheckedNode
 from rclverify.calculus.health.finding import Finding as Finding  # re-exported: callers import it from here too
 from rclverify.calculus.health.realizable import realizability_findings
 from rclverify.calculus.health.shape import shape_findings
+from rclverify.calculus.health.shared import SharedEncoder, Table
 from rclverify.calculus.health.witness import Witness, extend, finite_witness, has_tables, points_for
 
 HEALTH_TIMEOUT_MS = 5_000
@@ -73,9 +73,9 @@ def _peel(e: ast.Expr) -> tuple[list[ast.Binding], ast.Expr]:
 
 class _NodeHealth:
     def __init__(self, checked: Checked, node: CheckedNode, facts: Sequence[tuple[ast.Expr, ast.Loc]],
-                 instances: tuple[int, int] | None, timeout_ms: int) -> None:
+                 instances: tuple[int, int] | None, timeout_ms: int, table: Table) -> None:
         self.checked, self.node, self.instances, self.timeout = checked, node, instances, timeout_ms
-        self.enc = Encoder(checked.env)
+        self.enc = SharedEncoder(checked.env, table)  # the node's formulas encoded once for every check (.shared)
         n = node.node
         self.assume = [(f"assumption {k} ({_where(a.loc)})", self.enc.formula(a.formula, node))
                        for k, a in enumerate(n.assumes, 1)]
@@ -192,7 +192,8 @@ def _check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast
                 instances: tuple[int, int] | None, timeout_ms: int, done: Callable[[int], None]) -> list[Finding]:
     """:func:`check_node`'s checks, whatever the wall clock did; ``done(k)``
     is called after each check with the index of its first finding."""
-    h = _NodeHealth(checked, checked.nodes[node], facts, instances, timeout_ms)
+    table: Table = {}
+    h = _NodeHealth(checked, checked.nodes[node], facts, instances, timeout_ms, table)
     out: list[Finding] = []
     n = node
 
@@ -240,10 +241,12 @@ def _check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast
             out.append(f)
         done(len(out) - 1 if f is not None else len(out))
     mark = len(out)
+    # realizability encodes on its own: served from the table, its recorded query's shared subterms got other
+    # term ids, hence other let names (bench/health_equivalence.py); shape, last, records no query of those
     out += realizability_findings(checked, node, facts, instances)
     done(mark)
     mark = len(out)
-    out += shape_findings(checked, node)
+    out += shape_findings(checked, node, formulas=table)
     done(mark)
     return out
 

@@ -46,6 +46,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.timing import seconds
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.calculus.health.finding import Finding
+from rclverify.calculus.health.shared import SharedEncoder, Table
 
 SHAPE_TIMEOUT_MS = 2_000
 #: Budget (Z3 resource steps) of the counterexample looked for first (:func:`_falsified`): the case
@@ -65,14 +66,16 @@ def outputs_mentioned(e: ast.Expr, cn: CheckedNode) -> set[str]:
             if (p == "out" and n in cn.outputs) or (p is None and n in cn.outputs and n not in cn.inputs)}
 
 
-def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEOUT_MS) -> list[Finding]:
+def shape_findings(checked: Checked, node: str, *, timeout_ms: int = SHAPE_TIMEOUT_MS,
+                   formulas: Table | None = None) -> list[Finding]:
     """The three checks above on ``node``; returns only the findings that
-    found something, in guarantee order.  Never raises on
+    found something, in guarantee order (``formulas``: the node's formulas
+    already encoded by its other checks, :mod:`.shared`).  Never raises on
     solver trouble."""
     cn = checked.nodes[node]
     n = cn.node
     out: list[Finding] = []
-    enc = Encoder(checked.env)
+    enc = Encoder(checked.env) if formulas is None else SharedEncoder(checked.env, formulas)
     parts: list[tuple[int, int, ast.Expr]] = [(k, j, c) for k, g in enumerate(n.guarantees, 1)
                                              for j, c in enumerate(conjuncts(g.formula), 1)]
     for k, g in enumerate(n.guarantees, 1):
