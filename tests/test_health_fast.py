@@ -221,7 +221,7 @@ def test_shape_findings_from_shared_formulas_equal_their_own(contracts):
 
     def run(shared: bool) -> list:
         out = []
-        for checked in list(contracts.values()) + [check([parse_text(_linear(s), "t.rcl")]) for s in range(8)]:
+        for checked in list(contracts.values())[:12] + [check([parse_text(_linear(s), "t.rcl")]) for s in range(4)]:
             world.fresh()
             cn = checked.nodes["N"]
             table: dict = {}
