@@ -12,6 +12,7 @@ of its own::
 
     python3 bench/health_equivalence.py --dump OUT.json           # this tree's findings and CPU
     python3 bench/health_equivalence.py --compare OLD_SRC         # OLD_SRC's and this tree's, diffed
+    python3 bench/health_equivalence.py --compare OLD_SRC --repeat 3   # alternately, the least CPU of each
     python3 bench/health_equivalence.py --against SAVED.json      # this tree's against a saved dump
     python3 bench/health_equivalence.py --smoke                   # one example and 3 nodes, both in this tree
 
@@ -146,19 +147,31 @@ def differences(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
     return diffs
 
 
-def cpu_table(old: dict[str, Any], new: dict[str, Any]) -> str:
-    """The health stage's CPU seconds per workspace (and the case study's Agent), old and new."""
+def cpu(dump: dict[str, Any], w: str, node: str | None = None) -> float:
+    """CPU seconds of workspace ``w``'s health stage in ``dump`` (of ``node`` alone when given)."""
+    nodes = dump.get(w, {"nodes": {}})["nodes"]
+    return float(sum(x["cpu_s"] for n, x in nodes.items() if node is None or n == node))
+
+
+def _each(xs: Sequence[float]) -> str:
+    """Every run's figure in brackets, when there were several."""
+    return f" ({', '.join(f'{x:.2f}' for x in xs)})" if len(xs) > 1 else ""
+
+
+def cpu_table(olds: Sequence[dict[str, Any]], news: Sequence[dict[str, Any]]) -> str:
+    """The health stage's CPU seconds per workspace (and the case study's Agent), old and new: the least
+    of the runs (each tree ran as often, alternately), and every run's in brackets."""
     rows = ["| workspace | nodes | old CPU s | new CPU s | new/old | cuts (old, new) |", "| --- | ---: | ---: | ---: | ---: | --- |"]
 
-    def row(name: str, count: int, a: float, b: float, cuts: str) -> None:
-        rows.append(f"| {name} | {count} | {a:.2f} | {b:.2f} | {b / a if a else 0:.2f} | {cuts} |")
-    for w in new:
-        a, b = old.get(w, {"nodes": {}}), new[w]
-        ca = sum(x["cpu_s"] for x in a["nodes"].values())
-        cb = sum(x["cpu_s"] for x in b["nodes"].values())
-        row(w, len(b["nodes"]), ca, cb, f"{a.get('cuts', '-')}, {b['cuts']}")
-        if w == "." and "Agent" in b["nodes"] and "Agent" in a["nodes"]:
-            row(". (Agent)", 1, a["nodes"]["Agent"]["cpu_s"], b["nodes"]["Agent"]["cpu_s"], "")
+    def row(name: str, count: int, w: str, node: str | None, cuts: str) -> None:
+        a, b = [cpu(d, w, node) for d in olds], [cpu(d, w, node) for d in news]
+        rows.append(f"| {name} | {count} | {min(a):.2f}{_each(a)} | {min(b):.2f}{_each(b)} | "
+                    f"{min(b) / min(a) if min(a) else 0:.2f} | {cuts} |")
+    for w in news[0]:
+        cuts = f"{sum(d.get(w, {}).get('cuts', 0) for d in olds)}, {sum(d[w]['cuts'] for d in news)}"
+        row(w, len(news[0][w]["nodes"]), w, None, cuts)
+        if w == "." and "Agent" in news[0][w]["nodes"]:
+            row(". (Agent)", 1, w, "Agent", "")
     return "\n".join(rows)
 
 
@@ -169,6 +182,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--against", metavar="SAVED", help="a saved --dump to diff this tree against")
     ap.add_argument("--synthetic", type=int, default=1000, help="nodes of the synthetic system (0: none)")
     ap.add_argument("--workspaces", nargs="*", default=WORKSPACES)
+    ap.add_argument("--repeat", type=int, default=1, help="run each tree this many times, alternately")
     ap.add_argument("--smoke", action="store_true", help="one small example and a 3-node system, twice in this tree")
     args = ap.parse_args(argv)
     if args.smoke:
@@ -177,15 +191,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         Path(args.dump).write_text(json.dumps(dump(args.workspaces, args.synthetic), indent=1))
         return 0
     this = str(REPO / "src")
+    olds: list[dict[str, Any]] = []
+    news: list[dict[str, Any]] = []
     with tempfile.TemporaryDirectory() as tmp:
-        if args.against:
-            old = json.loads(Path(args.against).read_text())
-        else:
-            old = run_dump(args.compare or this, Path(tmp) / "old.json", args.workspaces, args.synthetic)
-        new = run_dump(this, Path(tmp) / "new.json", args.workspaces, args.synthetic)
+        for k in range(max(1, args.repeat)):
+            if args.against:
+                olds.append(json.loads(Path(args.against).read_text()))
+            else:
+                olds.append(run_dump(args.compare or this, Path(tmp) / f"old{k}.json", args.workspaces, args.synthetic))
+            news.append(run_dump(this, Path(tmp) / f"new{k}.json", args.workspaces, args.synthetic))
     print(f"health stage, CPU seconds (load {os.getloadavg()[0]:.1f} at the end)")
-    print(cpu_table(old, new))
-    diffs = differences(old, new)
+    print(cpu_table(olds, news))
+    old, new = olds[0], news[0]
+    diffs = [d for o, n in zip(olds, news) for d in differences(o, n)] + [
+        f"run {k + 1} of this tree: {d}" for k, n in enumerate(news[1:]) for d in differences(new, n)]
     count = sum(len(n["findings"]) for w in new.values() for n in w["nodes"].values())
     names = renamed(old, new)
     print(f"{count} findings compared, {len(diffs)} differ; {len(names)} SMT-LIB2 scripts differ in let names only")
