@@ -73,9 +73,10 @@ def _peel(e: ast.Expr) -> tuple[list[ast.Binding], ast.Expr]:
 
 class _NodeHealth:
     def __init__(self, checked: Checked, node: CheckedNode, facts: Sequence[tuple[ast.Expr, ast.Loc]],
-                 instances: tuple[int, int] | None, timeout_ms: int, table: Table) -> None:
+                 instances: tuple[int, int] | None, timeout_ms: int, table: Table | None = None) -> None:
         self.checked, self.node, self.instances, self.timeout = checked, node, instances, timeout_ms
-        self.enc = SharedEncoder(checked.env, table)  # the node's formulas encoded once for every check (.shared)
+        # the node's formulas encoded once for every check (.shared); a table of its own when none is shared
+        self.enc = SharedEncoder(checked.env, {} if table is None else table)
         n = node.node
         self.assume = [(f"assumption {k} ({_where(a.loc)})", self.enc.formula(a.formula, node))
                        for k, a in enumerate(n.assumes, 1)]
