@@ -30,6 +30,7 @@ seconds belongs in :data:`SLOW` and here.
 """
 from __future__ import annotations
 
+import gc
 import os
 
 import pytest
@@ -113,6 +114,15 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if module in SLOW:
             item.add_marker(pytest.mark.slow)
     items.sort(key=lambda item: (-_weight(item.path.stem), first[item.path.stem]))
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """Move what collection made (every module of the suite imported, its 2,300 items, the libraries they
+    load) out of the garbage collector's sight: it lives until the worker ends, and without this each
+    full collection of the run walks it again (the figures: docs/ci.md, "The test suite").  What the
+    tests allocate later is collected as before."""
+    gc.collect()
+    gc.freeze()
 
 
 def _weight(module: str) -> float:
