@@ -16,6 +16,7 @@ from typing import Iterator
 
 import pytest
 
+from _restore import restored
 from rclverify.cli.commands import main
 from rclverify.records.published import published_mode, write_published
 
@@ -37,12 +38,22 @@ def fresh(tmp_path: Path) -> Path:
     return root
 
 
-@pytest.fixture()
-def ws(fresh: Path) -> Path:
-    """A verified `rclverify init` workspace."""
-    r = run(fresh, "rclverify.cli.commands", "verify")
+@pytest.fixture(scope="module")
+def verified(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A verified `rclverify init` workspace, made once for the module."""
+    root = tmp_path_factory.mktemp("verified") / "ws"
+    assert main(["init", str(root)]) == 0
+    r = run(root, "rclverify.cli.commands", "verify")
     assert r.returncode == 0, r.stdout + r.stderr
-    return fresh
+    return root
+
+
+@pytest.fixture()
+def ws(verified: Path, tmp_path: Path) -> Iterator[Path]:
+    """The module's verified workspace, put back as verified after the test (tests/_restore.py: in place,
+    since doit's state names its files by absolute path and a copy would run every task again)."""
+    with restored(verified, tmp_path / "before") as root:
+        yield root
 
 
 def edit_contract(ws: Path, k: int) -> None:
