@@ -23,10 +23,16 @@ off (``--no-loadscope-reorder``) and this file sorts the modules by the CPU
 seconds measured for them (:data:`SECONDS`, longest first; Graham's LPT rule),
 the modules not listed after them in their usual order (a live module by its
 wall-clock seconds, :data:`WALL`, when they are longer).  The figures are
-serial CPU seconds of one module (``/usr/bin/time``, user + system, pytest's
-own start-up subtracted) on the 2-core development machine; only their order
+the CPU seconds of each module's tests taken inside a whole run on the 2-core
+development machine (``RCLVERIFY_TEST_CPU``, below); only their order
 matters, so a rough figure is enough, and a module that grows past two
 seconds belongs in :data:`SLOW` and here.
+
+Memory.  Once collection ends, what it made (the suite's modules, their items,
+the libraries they load) is frozen out of the garbage collector's sight
+(:func:`pytest_collection_finish`); a test module keeps what it computes once
+in a module-scoped fixture, never in a cache of the module, so that it goes
+when the module ends instead of being walked by every later collection.
 """
 from __future__ import annotations
 
@@ -46,32 +52,32 @@ LIVE = frozenset({
     "test_ros_master_hostile", "test_services_live_ros1",
 })
 
-#: Serial CPU seconds of each module that costs more than about two (pytest's start-up, about 0.9 s, subtracted);
-#: measured one module at a time on the shared 2-core machine under a load of 7 to 9 (docs/ci.md), so a little high.
+#: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
+#: included, summed within a whole run (``RCLVERIFY_TEST_CPU``, below; three workers on the shared 2-core
+#: machine under a load of about 3.5, so a little high; the import of the module not counted).
 SECONDS: dict[str, float] = {
-    "test_pipeline_e2e": 34.5, "test_bench_smoke_live": 27.9, "test_integrity": 23.6,
-    "test_example_warehouse": 18.8, "test_bench_smoke": 15.2, "test_generate_names_ros2": 12.8,
-    "test_ros2_generated": 12.7, "test_inputs_faults": 12.1, "test_example_delivery": 11.3,
-    "test_temporal_semantics_oracle": 10.6, "test_lsp_server": 9.4, "test_temporal_requirements": 9.0,
-    "test_hardening_greens": 8.4, "test_spin_no_wrong_green": 8.4, "test_generate_names": 8.1,
-    "test_solver_session": 7.8, "test_temporal_pdr": 7.1, "test_ros2_types_record": 6.7,
-    "test_temporal_progress": 6.2, "test_one_evaluator": 6.1, "test_generate_ros2": 6.0,
-    "test_rcl_printer": 6.0, "test_dafny": 5.9, "test_summary_incremental": 5.8, "test_spin": 5.7,
-    "test_response_pattern": 5.5, "test_generate_cpp": 5.5, "test_temporal_oracle": 5.1,
-    "test_property_tests": 4.9, "test_hardening_misc": 4.8, "test_cache_poison": 4.8,
-    "test_browser_report": 4.7, "test_ros_hostile": 4.6, "test_report_problems_roots": 4.3,
-    "test_calculus_summary": 4.3, "test_ros2_silence_deadlines": 4.3, "test_temporal_ranking": 4.3,
-    "test_health": 4.0, "test_property_tests_facts": 3.9, "test_advice": 3.9, "test_monitor_live_ros1": 3.9,
-    "test_spin_oracle": 3.8, "test_diagnosis": 3.8, "test_query_ladder": 3.5, "test_findings_context": 3.4,
-    "test_lsp_fuzz": 3.4, "test_quotient": 3.4, "test_rcl_fuzz": 3.3, "test_jsonl_blocks": 3.2,
-    "test_services_live_ros1": 3.2, "test_monitor_fuzz": 3.1, "test_statistics_plan": 3.1,
-    "test_requirements": 3.0, "test_report_unverified": 3.0, "test_second_solver": 3.0,
-    "test_declarations_verified": 3.0, "test_cli_newuser": 2.9, "test_ros2_services_actions": 2.9,
-    "test_cluster": 2.9, "test_layers": 2.8, "test_trace_fifo": 2.7, "test_ros_diff_live": 2.6,
-    "test_ros2_diff": 2.5, "test_monitor_batch": 2.5, "test_rcl_language": 2.5, "test_evidence": 2.5,
-    "test_calculus_context": 2.4, "test_generate_example": 2.4, "test_straightline": 2.3,
-    "test_experiment": 2.2, "test_realizable": 2.2, "test_ros2_declarations": 2.2,
-    "test_bench_compose_pacti": 2.1,
+    "test_bench_smoke_live": 32.3, "test_pipeline_e2e": 31.6, "test_integrity": 24.8,
+    "test_example_warehouse": 24.8, "test_bench_smoke": 20.8, "test_generate_names_ros2": 16.0,
+    "test_example_delivery": 15.0, "test_ros2_generated": 14.5, "test_inputs_faults": 13.2,
+    "test_lsp_server": 10.8, "test_temporal_requirements": 9.8, "test_hardening_greens": 9.8,
+    "test_generate_names": 8.6, "test_stage_records": 8.1, "test_temporal_semantics_oracle": 8.0,
+    "test_solver_session": 8.0, "test_one_evaluator": 8.0, "test_generate_ros2": 7.1,
+    "test_spin_no_wrong_green": 7.0, "test_spin": 7.0, "test_temporal_pdr": 6.8, "test_ros2_types_record": 6.7,
+    "test_dafny": 6.7, "test_calculus_summary": 6.6, "test_summary_incremental": 6.4,
+    "test_temporal_progress": 6.1, "test_response_pattern": 6.1, "test_property_tests": 6.0,
+    "test_spin_oracle": 5.6, "test_generate_cpp": 5.5, "test_browser_report": 5.4, "test_cluster": 5.4,
+    "test_cache_poison": 5.2, "test_hardening_misc": 5.2, "test_health": 5.2, "test_temporal_oracle": 5.1,
+    "test_rcl_printer": 4.8, "test_diagnosis": 4.7, "test_lsp_fuzz": 4.5, "test_ros_hostile": 4.4,
+    "test_property_tests_facts": 4.4, "test_ros2_silence_deadlines": 4.0, "test_query_ladder": 3.8,
+    "test_services_live_ros1": 3.7, "test_report_problems_roots": 3.7, "test_rooms": 3.7,
+    "test_findings_context": 3.6, "test_rcl_fuzz": 3.6, "test_monitor_live_ros1": 3.5, "test_jsonl_blocks": 3.3,
+    "test_declarations_verified": 3.3, "test_calculus_context": 3.1, "test_ros_diff_live": 3.0,
+    "test_temporal_ranking": 3.0, "test_monitor_batch": 3.0, "test_bag_open": 3.0, "test_advice": 2.9,
+    "test_quotient": 2.9, "test_ros2_services_actions": 2.8, "test_monitor_fuzz": 2.8, "test_rcl_language": 2.7,
+    "test_ros2_diff": 2.6, "test_requirements": 2.6, "test_cli_newuser": 2.6, "test_report_unverified": 2.4,
+    "test_second_solver": 2.4, "test_statistics_plan": 2.3, "test_generate_example": 2.3, "test_experiment": 2.2,
+    "test_generate_cpp_candidates": 2.2, "test_jsonl_columns": 2.2, "test_realizable": 2.1,
+    "test_bench_compose_pacti": 2.1, "test_deterministic_queries": 2.1, "test_findings_health": 2.1,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
