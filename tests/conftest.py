@@ -28,15 +28,17 @@ development machine (``RCLVERIFY_TEST_CPU``, below); only their order
 matters, so a rough figure is enough, and a module that grows past two
 seconds belongs in :data:`SLOW` and here.
 
-Memory.  Once collection ends, what it made (the suite's modules, their items,
-the libraries they load) is frozen out of the garbage collector's sight
-(:func:`pytest_collection_finish`); a test module keeps what it computes once
-in a module-scoped fixture, never in a cache of the module, so that it goes
-when the module ends instead of being walked by every later collection.
+Memory.  A test module keeps what it computes once in a module-scoped
+fixture, never in a cache of the module: a worker runs many modules, and what
+a module cache holds (tests/test_rooms.py held the package's syntax trees, two
+million objects) is walked by every later full garbage collection of the
+worker, and by the five pytest makes at its end.  The suite freezes nothing
+itself: rclverify's own heap handling (``core/cache/heap.py``) freezes and
+gives back the whole heap of a process around an in-process doit run, and
+tests/test_heap.py checks it from an unfrozen start.
 """
 from __future__ import annotations
 
-import gc
 import os
 
 import pytest
@@ -120,15 +122,6 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if module in SLOW:
             item.add_marker(pytest.mark.slow)
     items.sort(key=lambda item: (-_weight(item.path.stem), first[item.path.stem]))
-
-
-def pytest_collection_finish(session: pytest.Session) -> None:
-    """Move what collection made (every module of the suite imported, its 2,300 items, the libraries they
-    load) out of the garbage collector's sight: it lives until the worker ends, and without this each
-    full collection of the run walks it again (the figures: docs/ci.md, "The test suite").  What the
-    tests allocate later is collected as before."""
-    gc.collect()
-    gc.freeze()
 
 
 def _weight(module: str) -> float:
