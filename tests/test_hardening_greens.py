@@ -28,6 +28,7 @@ from pathlib import Path
 
 import pytest
 
+from _restore import restored
 from rclverify.report.bundle import archive
 from rclverify.report.bundle.archive import verify_bundle
 from rclverify.report.bundle.manifest import MANIFEST, BundleError, collect
@@ -189,7 +190,14 @@ def test_3_strict_fails_on_a_formal_requirement_not_met_and_not_on_an_informal_o
 
 def test_4_the_bundle_refuses_a_report_built_from_other_inputs(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], met: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
-    ws = met[0]  # verified as shipped (nothing left to run: the plain run after --strict's does no task)
+    # verified as shipped (nothing left to run: the plain run after --strict's does no task); edited in
+    # place and put back afterwards (tests/_restore.py) for the test of the obligation list below
+    with restored(met[0], tmp_path / "before") as ws:
+        _the_bundle_refuses_a_report_built_from_other_inputs(ws, tmp_path, capsys)
+
+
+def _the_bundle_refuses_a_report_built_from_other_inputs(ws: Path, tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
     assert _doit(ws, "verify").returncode == 0
     out = tmp_path / "b.tar.gz"
     assert main(["bundle", "-w", str(ws), "-o", str(out)]) == 0
@@ -275,8 +283,13 @@ def test_6_bundle_verify_streams_members_and_refuses_a_huge_one_in_one_line(
         verify_bundle(bomb)
 
 
-def test_2_an_obligation_list_altered_outside_rclverify_is_error_and_exported_again(tmp_path: Path) -> None:
-    ws = _copy(tmp_path)
+def test_2_an_obligation_list_altered_outside_rclverify_is_error_and_exported_again(
+        tmp_path: Path, met: tuple[Path, subprocess.CompletedProcess[str]]) -> None:
+    with restored(met[0], tmp_path / "before") as ws:  # the module's verified workspace, put back afterwards
+        _an_obligation_list_altered_outside_rclverify(ws)
+
+
+def _an_obligation_list_altered_outside_rclverify(ws: Path) -> None:
     assert _doit(ws, "verify").returncode == 0
     listed = ws / "artifacts/obligations/SpeedController.json"
     one = ws / "artifacts/obligations/SpeedController/SpeedController.g2.hoare.speed_controller.c1.json"
