@@ -117,8 +117,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             if root.exists():
                 shutil.rmtree(root)
             write_workspace(root, n)
-            # smoke: a tenth of the loop, scaled (an estimate; the figures of a smoke run are not compared)
-            ref = reference_cpu(ITERATIONS // 10) * 10 if a.smoke else reference_cpu()
+            # smoke: a hundredth of the loop, scaled (an estimate; the figures of a smoke run are not compared)
+            ref = reference_cpu(ITERATIONS // 100) * 100 if a.smoke else reference_cpu()
             r = verify(root, Path(a.src) if a.src else SRC)
             if not (root / "reports" / "assurance.json").is_file():
                 print(f"{n:>6}  verify wrote no report (exit {r['rc']}):\n{r['out']}")
