@@ -6,11 +6,14 @@ import os
 import shutil
 import subprocess
 import sys
+from importlib.util import find_spec
 from pathlib import Path
+from typing import Any
 
 import pytest
 
-distributed = pytest.importorskip("dask.distributed")
+# the module needs Dask's distributed scheduler; looked up, not imported, while the suite is collected
+pytestmark = pytest.mark.skipif(find_spec("distributed") is None, reason="dask.distributed is not installed")
 
 CLAMP = """\
 var x, z : REAL;
@@ -89,12 +92,26 @@ def _without_timing_lines(text: str) -> list[str]:
     return [line for line in text.splitlines() if not any(f'"{k}"' in line for k in TIMING)]
 
 
-def test_evidence_from_a_local_cluster_equals_the_local_run(tmp_path: Path) -> None:
-    local = _workspace(tmp_path / "local")
-    r = _verify(local)
+@pytest.fixture(scope="module")
+def distributed() -> Any:
+    """``dask.distributed``, imported when a test of this module first needs it (not when every worker
+    collects the suite: about 0.2 CPU s); skips without it."""
+    return pytest.importorskip("dask.distributed")
+
+
+@pytest.fixture(scope="module")
+def local(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The workspace verified without a cluster, once for the module: the two cluster tests compare their
+    copies' artifacts with its, and only read it."""
+    ws = _workspace(tmp_path_factory.mktemp("cluster") / "local")
+    r = _verify(ws)
     assert r.returncode == 0, r.stdout + r.stderr
+    return ws
+
+
+def test_evidence_from_a_local_cluster_equals_the_local_run(tmp_path: Path, local: Path, distributed: Any) -> None:
     remote = tmp_path / "remote"
-    shutil.copytree(tmp_path / "local", remote, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.db*", ".doit.sqlite*"))
+    shutil.copytree(local, remote, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.db*", ".doit.sqlite*"))
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None, protocol="tcp://",
                                   host="127.0.0.1") as cluster:
         r = _verify(remote, "--cluster", cluster.scheduler_address)
@@ -135,14 +152,11 @@ def _artifact_files(ws: Path) -> dict[str, list[str]]:
             if p.is_file() and not p.relative_to(art).as_posix().startswith(skip) and not p.name.endswith(".lock")}
 
 
-def test_workers_that_cannot_see_the_workspace_run_in_their_own_copy(tmp_path: Path,
-                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+def test_workers_that_cannot_see_the_workspace_run_in_their_own_copy(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                    local: Path, distributed: Any) -> None:
     """Workers in their own processes and working folders, told not to read the submitting machine's
     paths (as on other machines): the workspace's sources go to them, the jobs run in their copy, and
     the evidence and every artifact the jobs wrote equal a local run's."""
-    local = _workspace(tmp_path / "local")
-    r = _verify(local)
-    assert r.returncode == 0, r.stdout + r.stderr
     remote = tmp_path / "remote"
     shutil.copytree(local, remote, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit.db*", ".doit.sqlite*"))
     folder = tmp_path / "worker-folder"
