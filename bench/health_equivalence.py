@@ -48,16 +48,9 @@ WORKSPACES = ["."] + sorted(p.parent.parent.relative_to(REPO).as_posix()
 def node_findings(ws: Any, node: str) -> list[dict[str, Any]]:
     """``node``'s findings as ``stage_health`` records them, ``duration_s``
     left out and the scripts' text in their place."""
-    from rclverify.app.pipeline import replacement_finding
-    from rclverify.calculus.health.checks import check_node
-    from rclverify.semantics import world
-    world.fresh()
-    facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
-    found = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
-    if node in ws.plan.replacements:
-        found.append(replacement_finding(ws, node))
+    from rclverify.app.pipeline import health_findings
     out = []
-    for f in found:
+    for f in health_findings(ws, node):
         j = f.to_json()
         j.pop("duration_s")
         j["smt2"], j["witness_smt2"] = f.smt2, f.witness_smt2

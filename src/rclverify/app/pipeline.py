@@ -135,14 +135,22 @@ def plan_facts(ws: Workspace) -> dict[str, list[Any]]:
     return {n: [f.expr for f in fs] for n, fs in ws.plan.facts.items()}
 
 
-def stage_health(ws: Workspace, node: str) -> list[HealthFinding]:
-    """Run the contract health checks of ``node``; writes its findings JSON."""
+def health_findings(ws: Workspace, node: str) -> list[Any]:
+    """The contract health findings of ``node`` (``calculus.health.finding.Finding``
+    objects, its replacement's refinement finding last), from a fresh Z3 state;
+    writes nothing (:func:`stage_health` records them)."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     from rclverify.calculus.health.checks import check_node  # deferred: start-up (loads lark, yaml and more only when called)
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
-    checked = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
+    found: list[Any] = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
     if node in ws.plan.replacements:
-        checked.append(replacement_finding(ws, node))
+        found.append(replacement_finding(ws, node))
+    return found
+
+
+def stage_health(ws: Workspace, node: str) -> list[HealthFinding]:
+    """Run the contract health checks of ``node``; writes its findings JSON."""
+    checked = health_findings(ws, node)
     findings = []
     for f in checked:
         j = f.to_json()
