@@ -137,3 +137,39 @@ def test_a_cut_health_finding_is_inconclusive_never_another_model(monkeypatch: p
         [cut] = realizability_findings(checked, "C")
     assert w.cut and cut.status == "inconclusive" and cut.model is None and cut.core is None
     assert cut.id == ample.id and "took longer than" in cut.explanation
+
+
+#: A node whose assumption only a search finds a model of (the third taxicab number's cubes:
+#: 87539319 = 167^3 + 436^3 with 100 < u < v): some 0.2 s of an idle core, against a net of 12 ms.
+TAXICAB = """
+node T {
+  inputs( u : INTEGER, v : INTEGER )
+  outputs( y : INTEGER )
+  assume( in.u * in.u * in.u + in.v * in.v * in.v == 87539319 and 100 < in.u and in.u < in.v )
+  guarantee( out.y == in.u )
+}
+"""
+
+
+def test_a_seed_search_the_clock_cut_is_said_never_another_seed(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The property tests' first example under the assumption (and facts): with an ample net the
+    budget's model; with a tiny one either that model or ``SeedingCut`` saying so, never the
+    model of the next table size (today's code went on to it)."""
+    from rclverify.backends.property_tests import seeding
+    checked = check([parse_text(TAXICAB, "t.rcl")])
+    node = checked.nodes["T"]
+    formulas = tuple(a.formula for a in node.node.assumes)
+    monkeypatch.setattr(seeding, "_BASE", {})
+    ample = seeding.Seeder(checked, node, formulas).base()
+    assert ample is not None and (ample["in.u"], ample["in.v"]) == (167, 436)
+    monkeypatch.setattr(seeding, "SAFETY_TIMEOUT_MS", 12)
+    for _ in range(10):  # Z3's 12 ms timer fires almost always, not always: until it has
+        monkeypatch.setattr(seeding, "_BASE", {})
+        try:
+            got = seeding.Seeder(checked, node, formulas).base()
+        except seeding.SeedingCut as exc:
+            assert "took longer than 0.012 s" in str(exc)
+            break
+        assert got == ample
+    else:
+        pytest.fail("the 12 ms net never fired")

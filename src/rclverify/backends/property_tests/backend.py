@@ -34,7 +34,7 @@ from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.timelimit import TimeLimitExceeded, wall_clock_limit
 from rclverify.backends.property_tests.closure import import_closure, outside_versions
 from rclverify.backends.property_tests.declared import declaration_rows, has_declarations
-from rclverify.backends.property_tests.seeding import split_facts
+from rclverify.backends.property_tests.seeding import SeedingCut, split_facts
 from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 import inspect
 
@@ -170,6 +170,10 @@ class PropertyTestsBackend:
             return evidence("inconclusive", f"{cfg.implementation}: the run of guarantee {k} {exc} (timeout_s of "
                             f"the plan entry, {target.config_loc('timeout_s') if 'timeout_s' in target.config else 'default'}"
                             "); does the implementation loop forever?", details={"timeout_s": cfg.timeout_s})
+        except SeedingCut as exc:  # a loaded machine: no other seed in its place (docs/decisions.md)
+            return evidence("inconclusive", f"{cfg.implementation}: the first example of guarantee {k} under the "
+                            f"environment facts was not found: Z3's search for it {exc}",
+                            details={"seeding": str(exc)})
         except ConfigError as exc:
             return evidence("error", f"{target.config_loc(*exc.path)}: error: {exc}")
         except PlanError as exc:  # the implementation no longer imports

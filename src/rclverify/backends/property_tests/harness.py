@@ -303,7 +303,8 @@ class GuaranteeRun:
         return Outcome("error", wrong, self.counts, None, sorted(self.unknown)) if wrong else None
 
     def run(self) -> Outcome:
-        """Run Hypothesis; never raises for a failing, inconclusive or starved run.
+        """Run Hypothesis; never raises for a failing, inconclusive or starved run
+        (raises :class:`.seeding.SeedingCut` when the wall clock cut the search for a first example).
         The outcome carries the valid examples' coverage of the assumption's ranges."""
         outcome = self._run()
         if self.coverage is not None:
