@@ -315,3 +315,17 @@ def test_an_invariant_is_refused_on_a_state_requirement_only(tmp_path: Path) -> 
     with pytest.raises(PlanError) as e:
         Workspace(root).checked
     assert "an invariant is read only for a temporal statement" in str(e.value.diagnostics[0])
+
+
+def test_houdinis_budget_is_steps_the_same_on_any_load() -> None:
+    """Houdini's budget of all its queries counts Z3 resource steps (issue 67: results never depend
+    on the wall clock): an ample budget gives the invariant, a budget of a few steps says it was
+    spent, the same on every run."""
+    ts = _counters(5, ("x", "y"))
+    prop = lambda s: s["x"] <= 5  # noqa: E731
+    ample = generate(ts, prop, 5_000, 10_000)
+    assert not isinstance(ample, str) and ample
+    again = generate(ts, prop, 5_000, 10_000)
+    assert not isinstance(again, str) and [c[0] for c in again] == [c[0] for c in ample]
+    tiny = generate(ts, prop, 5_000, 0.001)  # two steps for all the queries together
+    assert tiny == "the step budget of invariant generation was spent"

@@ -23,7 +23,6 @@ A solver ``unknown`` in any query leaves no invariant (never a guess).
 """
 from __future__ import annotations
 
-import time
 from fractions import Fraction
 from typing import Callable
 
@@ -85,19 +84,29 @@ def _fact(name: str, op: str, val: z3.ExprRef) -> Candidate:
     return shown, holds
 
 
+class _Cut(Exception):
+    """A Houdini query the wall-clock safety net stopped (its text says so)."""
+
+
 def _drop(cands: list[Candidate], query: Callable[[list[Candidate]], tuple[z3.CheckSatResult, z3.ModelRef | None]],
-          at: Callable[[z3.ModelRef, Candidate], bool], deadline: float) -> list[Candidate] | str:
+          at: Callable[[z3.ModelRef, Candidate], bool], spent: Callable[[], bool]) -> list[Candidate] | str:
     """Drop candidates until ``query(cands)`` is unsat: each sat model drops
     the candidates ``at`` says it violates.  A string: the solver's reason
-    for an unknown, or the time limit (``deadline``, a ``perf_counter``)."""
+    for an unknown, the step budget of all the queries spent (``spent()``),
+    or the wall-clock net that cut a query (docs/decisions.md, "Results
+    never depend on the wall clock")."""
     while cands:
-        if time.perf_counter() > deadline:
-            return "the time limit of invariant generation was reached"
-        r, m = query(cands)
+        if spent():
+            return "the step budget of invariant generation was spent"
+        try:
+            r, m = query(cands)
+        except _Cut as exc:
+            return f"a Houdini query {exc}"
         if r == z3.unsat:
             return cands
         if r != z3.sat or m is None:
-            return f"Z3 could not decide a Houdini query ({r})"
+            return ("the step budget of invariant generation was spent" if spent()
+                    else f"Z3 could not decide a Houdini query ({r})")
         keep = [c for c in cands if not at(m, c)]
         if len(keep) == len(cands):  # a model that breaks none: cannot happen for a sound solver
             return "a Houdini query's model breaks no candidate"
@@ -109,29 +118,38 @@ def generate(ts: TransitionSystem, prop: Pred, timeout_ms: int, budget_ms: int) 
     """The largest inductive subset of :func:`candidates` (module
     docstring): every initial state satisfies it and every step from a state
     that satisfies it keeps it.  ``[]``: no candidate survives; a string:
-    why no invariant was generated (a solver ``unknown``, the time limit).
-    ``timeout_ms`` bounds each query, ``budget_ms`` all of them."""
-    deadline = time.perf_counter() + budget_ms / 1000
+    why no invariant was generated (a solver ``unknown``, the budget spent,
+    the wall-clock net).  ``timeout_ms`` bounds each query, ``budget_ms``
+    all of them, both as Z3 resource steps (:func:`.wallclock.steps`: the
+    same queries decide on a loaded machine; issue 67)."""
+    left = [wallclock.steps(budget_ms)]
     a, b = ts.state(0, "hou"), ts.state(1, "hou")
 
-    def initial(cs: list[Candidate]) -> tuple[z3.CheckSatResult, z3.ModelRef | None]:
+    def ask(*formulas: z3.BoolRef) -> tuple[z3.CheckSatResult, z3.ModelRef | None]:
         s = z3.Solver()
-        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        s.add(ts.init(a), z3.Not(z3.And(*[p(a) for _, p in cs])))
-        r = s.check()
+        wallclock.limit(s, timeout_ms, rlimit=max(1, min(wallclock.steps(timeout_ms), left[0])))
+        s.add(*formulas)
+        before = s.statistics().get_key_value("rlimit count")  # the context's counter, before this query
+        seen = wallclock.cuts()
+        r = wallclock.check(s)
+        left[0] -= s.statistics().get_key_value("rlimit count") - before
+        if wallclock.cuts() != seen:
+            raise _Cut(wallclock.cut_reason())
         return r, s.model() if r == z3.sat else None
 
+    def initial(cs: list[Candidate]) -> tuple[z3.CheckSatResult, z3.ModelRef | None]:
+        return ask(ts.init(a), z3.Not(z3.And(*[p(a) for _, p in cs])))
+
     def step(cs: list[Candidate]) -> tuple[z3.CheckSatResult, z3.ModelRef | None]:
-        s = z3.Solver()
-        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        s.add(*[p(a) for _, p in cs], ts.trans(a, b), z3.Not(z3.And(*[p(b) for _, p in cs])))
-        r = s.check()
-        return r, s.model() if r == z3.sat else None
+        return ask(*[p(a) for _, p in cs], ts.trans(a, b), z3.Not(z3.And(*[p(b) for _, p in cs])))
+
+    def spent() -> bool:
+        return left[0] <= 0
     first = _drop(candidates(ts, prop), initial, lambda m, c: z3.is_false(m.eval(c[1](a), model_completion=True)),
-                  deadline)
+                  spent)
     if isinstance(first, str):
         return first
-    last = _drop(first, step, lambda m, c: z3.is_false(m.eval(c[1](b), model_completion=True)), deadline)
+    last = _drop(first, step, lambda m, c: z3.is_false(m.eval(c[1](b), model_completion=True)), spent)
     return last if isinstance(last, str) else tightest(last)
 
 
