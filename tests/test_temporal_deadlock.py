@@ -191,3 +191,21 @@ def test_the_limit_itself_and_leading_zeros_are_accepted(tmp_path: Path) -> None
     w = Workspace(ws)
     bounds = [statement(r, w.checked, w.plan) for r in w.plan.requirements]
     assert [t.bound for t in bounds if isinstance(t, Temporal)] == [MAX_BOUND, 12]
+
+
+def test_the_deadlock_searchs_budget_is_resource_steps_where_it_stops_is_the_same_every_run() -> None:
+    """The step-by-step search's budget for all its queries counts Z3 resource steps (issue 67):
+    a long counter (stops at 400) searched with tiny query budgets stops at the same step with the
+    same words on every run, and says its budget of steps was spent; with ample budgets the stop
+    itself is found."""
+    from rclverify.calculus.requirements.deadlock import find_deadlock
+    seen = []
+    for _ in range(2):
+        fresh()
+        v = find_deadlock(_counter(0, 1, 400), 500, timeout_ms=1)
+        assert v is not None and v.status == "inconclusive"
+        seen.append((v.bound, v.detail, v.deadlock))
+    assert seen[0] == seen[1] and "query budgets of Z3 resource steps" in seen[0][1], seen
+    fresh()
+    found = find_deadlock(_counter(0, 1, 12), 20)
+    assert found is not None and (found.status, found.bound) == ("refuted", 12)
