@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify import __version__
-from rclverify.model.plan.entries import TOOL_KEYS
+from rclverify.model.plan.paths import config_strings
 from rclverify.records.store import EvidenceStore
 
 
@@ -131,17 +131,9 @@ def entry_inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> l
                 seen[v] = (v,)
         return seen[v]
 
-    def walk(v: Any) -> None:
-        if isinstance(v, str) and "/" in v and not os.path.isabs(v):
+    for _, v in config_strings(dict(config)):
+        if "/" in v and not os.path.isabs(v):
             out.update(files(v))
-        elif isinstance(v, dict):
-            for k, x in v.items():
-                if k not in TOOL_KEYS:
-                    walk(x)
-        elif isinstance(v, list):
-            for x in v:
-                walk(x)
-    walk(dict(config))
     return sorted(out)
 
 

@@ -39,7 +39,7 @@ from rclverify.lang.errors import Diagnostic
 from rclverify.model.plan.entries import TOOL_KEYS, TOOL_PATH_KINDS, declared_paths
 from rclverify.model.plan.errors import PlanError, plan_error
 
-__all__ = ["TOOL_KEYS", "check_plan_paths", "escape_reason", "looks_like_path"]
+__all__ = ["TOOL_KEYS", "check_plan_paths", "config_strings", "escape_reason", "looks_like_path"]
 _DRIVE = re.compile(r"^[A-Za-z]:[\\/]")
 
 Path_ = tuple[Any, ...]
@@ -74,16 +74,19 @@ def escape_reason(root: Path, value: str) -> str | None:
     return None
 
 
-def _strings(value: Any, path: Path_) -> Iterator[tuple[Path_, str]]:
+def config_strings(value: Any, path: Path_ = ()) -> Iterator[tuple[Path_, str]]:
+    """Every string of a plan value (an entry's settings, a mapping, a list)
+    with its value path below ``path``, leaving out the values of
+    :data:`TOOL_KEYS` (installed tools, not workspace files)."""
     if isinstance(value, str):
         yield path, value
     elif isinstance(value, Mapping):
         for k, v in value.items():
             if k not in TOOL_KEYS:
-                yield from _strings(v, path + (k,))
+                yield from config_strings(v, path + (k,))
     elif isinstance(value, list):
         for i, v in enumerate(value):
-            yield from _strings(v, path + (i,))
+            yield from config_strings(v, path + (i,))
 
 
 def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any], locs: Mapping[Path_, ast.Loc]) -> None:
@@ -103,7 +106,7 @@ def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any], locs: M
             base = ("nodes", node, "evidence", i)
             declared = {base + p: v for p, v in declared_paths(entry)} if isinstance(entry, Mapping) else {}
             candidates += list(declared.items())
-            candidates += [(p, s) for p, s in _strings(entry, base)
+            candidates += [(p, s) for p, s in config_strings(entry, base)
                            if p not in declared and looks_like_path(root, s)]
             backslashed.update(p for p, v in declared.items() if "\\" in v)
     diags: list[Diagnostic] = []

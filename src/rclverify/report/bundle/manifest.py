@@ -38,7 +38,7 @@ import z3
 
 from rclverify import __version__
 from rclverify.model.plan.load import Plan
-from rclverify.model.plan.paths import TOOL_KEYS, escape_reason, looks_like_path
+from rclverify.model.plan.paths import config_strings, escape_reason, looks_like_path
 from rclverify.model.plan.entries import declared_paths
 
 #: Format tag of the manifest.
@@ -95,16 +95,6 @@ def _named(plan: Plan) -> set[str]:
         for folder, _ in plan.requirements_from:
             out.update(doorstop_files(plan.root, folder) or [folder])
 
-    def walk(v: Any) -> None:
-        if isinstance(v, str) and looks_like_path(plan.root, v):
-            out.add(v)
-        elif isinstance(v, Mapping):
-            for k, x in v.items():
-                if k not in TOOL_KEYS:
-                    walk(x)
-        elif isinstance(v, list):
-            for x in v:
-                walk(x)
     for entries in plan.evidence.values():
         for e in entries:
             # the backend's declared path keys, a "<file>:<callable>" value by its file part (model/plan/entries.py),
@@ -113,7 +103,8 @@ def _named(plan: Plan) -> set[str]:
             declared = dict(declared_paths(entry))
             out.update(declared.values())
             keys = {p[0] for p in declared}
-            walk({k: v for k, v in e.config.items() if k != "backend" and k not in keys})
+            rest = {k: v for k, v in e.config.items() if k != "backend" and k not in keys}
+            out.update(v for _, v in config_strings(rest) if looks_like_path(plan.root, v))
     ros = getattr(plan, "ros", None) or {}  # the software the contracts are grounded in (docs/ros.md)
     for key in ("workspaces", "launch", "bags"):
         out.update(str(v) for v in ros.get(key, []) or [])
