@@ -183,13 +183,12 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     s.set("rlimit", int(rlimit))
     wallclock.note_limit(s, timeout_ms)  # a safety net: its firing is told apart (issue 67)
     s.add(z3.Not(phi))
-    seen = wallclock.cuts()
-    r = wallclock.check(s)
+    r, cut = wallclock.check_cut(s)
     if r == z3.unsat:
         return True, ""
     if r == z3.sat:
         return False, ""
-    return None, wallclock.cut_reason() if wallclock.cuts() != seen else s.reason_unknown() or "unknown"
+    return None, wallclock.why_unknown(s, cut) or "unknown"
 
 
 def false_whatever_the_rest(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,

@@ -113,6 +113,26 @@ def check(s: Any, *assumptions: Any) -> z3.CheckSatResult:
     return r
 
 
+def steps_taken(s: Any) -> int:
+    """Z3's resource counter of solver ``s``'s context: the steps every
+    query of that context has taken so far (read before and after a query,
+    the steps it took; a budget over several queries counts these)."""
+    return int(s.statistics().get_key_value("rlimit count"))
+
+
+def check_cut(s: Any, *assumptions: Any) -> tuple[z3.CheckSatResult, bool]:
+    """:func:`check`, and whether the wall-clock net cut this very check."""
+    seen = _TALLY.cuts
+    r = check(s, *assumptions)
+    return r, _TALLY.cuts != seen
+
+
+def why_unknown(s: Any, cut: bool) -> str:
+    """Why solver ``s`` answered ``unknown``: the net's reason
+    (:func:`cut_reason`) when ``cut``, else Z3's own."""
+    return cut_reason() if cut else str(s.reason_unknown())
+
+
 def cuts() -> int:
     """How many checks of this thread the wall-clock net cut so far."""
     return _TALLY.cuts
@@ -142,4 +162,4 @@ def watch() -> Iterator[Watch]:
     yield Watch(_TALLY.cuts)
 
 
-__all__ = ["MIN_WALL_MS", "SAFETY_FACTOR", "STEPS_PER_MS", "steps", "Watch", "check", "cut_reason", "cuts", "limit", "note_limit", "wall_ms", "watch"]
+__all__ = ["MIN_WALL_MS", "SAFETY_FACTOR", "STEPS_PER_MS", "steps", "Watch", "check", "check_cut", "cut_reason", "cuts", "limit", "note_limit", "steps_taken", "wall_ms", "watch", "why_unknown"]

@@ -210,9 +210,8 @@ class Seeder:
         text = z3.Solver()
         text.add(phi, *side)
         s.add(z3.parse_smt2_string(text.to_smt2(), ctx=ctx))  # by its text: no state carried over
-        seen = wallclock.cuts()
-        r = wallclock.check(s)
-        if wallclock.cuts() != seen:  # the clock, not the budget: the next size's model would be another seed
+        r, cut = wallclock.check_cut(s)
+        if cut:  # the clock, not the budget: the next size's model would be another seed
             raise SeedingCut(wallclock.cut_reason())
         if r != z3.sat:
             return None

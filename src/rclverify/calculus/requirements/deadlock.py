@@ -98,20 +98,19 @@ def _check(solver: z3.Solver, extra: Sequence[z3.BoolRef], timeout_ms: int) -> t
     with ``extra`` (the quantified deadlock condition) each of
     :func:`_attempts` is asked in turn, in a solver of its own, until one
     answers sat or unsat."""
-    seen = wallclock.cuts()
     if not extra:
-        r = wallclock.check(solver)
-        why = (wallclock.cut_reason() if wallclock.cuts() != seen else solver.reason_unknown()) if r == z3.unknown else ""
+        r, cut = wallclock.check_cut(solver)
+        why = wallclock.why_unknown(solver, cut) if r == z3.unknown else ""
         return r, solver.model() if r == z3.sat else None, why
     whys = []
     for name, s in _attempts(timeout_ms):
         s.add(*solver.assertions(), *extra)
         try:
-            r = wallclock.check(s)
+            r, cut = wallclock.check_cut(s)
         except z3.Z3Exception as exc:  # a tactic that refuses the query: that attempt is undecided
             whys.append(f"{name}: {exc}")
             continue
-        if wallclock.cuts() != seen:  # the clock, not the budget: the next attempt may not answer in its place
+        if cut:  # the clock, not the budget: the next attempt may not answer in its place
             return z3.unknown, None, f"{name}: {wallclock.cut_reason()}"
         if r == z3.sat:
             return r, s.model(), ""
@@ -119,12 +118,6 @@ def _check(solver: z3.Solver, extra: Sequence[z3.BoolRef], timeout_ms: int) -> t
             return r, None, ""
         whys.append(f"{name}: {s.reason_unknown()}")
     return z3.unknown, None, "; ".join(whys)
-
-
-def _steps_so_far(s: z3.Solver) -> int:
-    """Z3's resource counter of ``s``'s context: the steps every query of
-    the context has taken so far."""
-    return int(s.statistics().get_key_value("rlimit count"))
 
 
 def _solver(timeout_ms: int) -> z3.Solver:
@@ -158,9 +151,9 @@ def find_deadlock(ts: TransitionSystem, bound: int, *, staying: Pred | None = No
     s.add(ts.init(states[0]))
     # the whole search's budget in Z3 resource steps (the context's counter, read through any of its
     # solvers), so that where it stops does not depend on the machine's load (issue 67)
-    start, total = _steps_so_far(s), wallclock.steps(SEARCH_BUDGET * timeout_ms)
+    start, total = wallclock.steps_taken(s), wallclock.steps(SEARCH_BUDGET * timeout_ms)
     for k in range(bound):
-        if _steps_so_far(s) - start > total:
+        if wallclock.steps_taken(s) - start > total:
             return TemporalVerdict("inconclusive", "deadlock", bound=k,
                                    detail=f"no run stops{what} before step {k}; the search stopped there, after "
                                           f"{SEARCH_BUDGET} query budgets of Z3 resource steps",

@@ -129,11 +129,10 @@ def generate(ts: TransitionSystem, prop: Pred, timeout_ms: int, budget_ms: int) 
         s = z3.Solver()
         wallclock.limit(s, timeout_ms, rlimit=max(1, min(wallclock.steps(timeout_ms), left[0])))
         s.add(*formulas)
-        before = s.statistics().get_key_value("rlimit count")  # the context's counter, before this query
-        seen = wallclock.cuts()
-        r = wallclock.check(s)
-        left[0] -= s.statistics().get_key_value("rlimit count") - before
-        if wallclock.cuts() != seen:
+        before = wallclock.steps_taken(s)  # the context's counter, before this query
+        r, cut = wallclock.check_cut(s)
+        left[0] -= wallclock.steps_taken(s) - before
+        if cut:
             raise _Cut(wallclock.cut_reason())
         return r, s.model() if r == z3.sat else None
 

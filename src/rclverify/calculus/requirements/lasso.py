@@ -135,10 +135,9 @@ def find_table_lasso(ts: TransitionSystem, prop: Pred, types: Mapping[str, Type]
                     *[z3.Not(prop(s)) for s in states], z3.Or(*same)]
         ctx = z3.Context()
         solver = budgeted_solver(budget_ms, ctx)
-        seen = wallclock.cuts()
-        r = wallclock.check(solver, *[f.translate(ctx) for f in formulas])
+        r, cut = wallclock.check_cut(solver, *[f.translate(ctx) for f in formulas])
         if r == z3.unknown:  # the budget's reason, or the net's when the clock cut it (never another length)
-            why = wallclock.cut_reason() if wallclock.cuts() != seen else solver.reason_unknown()
+            why = wallclock.why_unknown(solver, cut)
             return (f"no lasso of up to {n - 1} steps with {points}-point tables; at {n} steps the solver "
                     f"answered unknown ({why})")
         if r == z3.unsat:
