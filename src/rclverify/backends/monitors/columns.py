@@ -43,12 +43,13 @@ import numpy as np
 from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.semantics.operators import COMPARISONS, OPERATORS
 
 _REL = 2.0 ** -52  # relative bound of one rounding (twice the unit roundoff)
 _SLACK_REL = 2.0 ** -48
 _SLACK_ABS = 2.0 ** -1000
-_CMP: Mapping[str, Callable[[Any, Any], Any]] = {
-    "==": np.equal, "!=": np.not_equal, "<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal}
+#: Each comparison's numpy ufunc, as the one operator table names it (semantics/operators.py).
+_CMP: Mapping[str, Callable[[Any, Any], Any]] = {s: getattr(np, str(OPERATORS[s].numpy)) for s in sorted(COMPARISONS)}
 
 
 class Unsupported(Exception):
