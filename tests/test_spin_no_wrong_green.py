@@ -350,9 +350,13 @@ def test_a_compiler_killed_from_outside_records_nothing(tmp_path: Path) -> None:
 def test_no_tool_and_no_build_directory_outlive_rclverify(tmp_path: Path, signum: int) -> None:
     proc, root, cache, oid = _start_run(tmp_path)
     try:
-        _, session = _wait_for_compiler(proc)
+        compiler, session = _wait_for_compiler(proc)
+        # held where it is, so that rclverify is killed while gcc runs even when this test is
+        # descheduled on a loaded machine (else the run could finish and record first)
+        os.kill(compiler, signal.SIGSTOP)
         os.kill(proc.pid, signum)
-        proc.communicate(timeout=60)
+        out, _ = proc.communicate(timeout=60)
+        assert proc.returncode == (-signum if signum == signal.SIGKILL else 128 + signum), out
         deadline = time.monotonic() + 30
         while time.monotonic() < deadline and any(sid == session for _, _, _, sid in _procs()):
             time.sleep(0.05)
