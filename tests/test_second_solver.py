@@ -244,24 +244,38 @@ def test_a_shared_session_answers_and_proves_as_fresh_solvers_do(ws: Path) -> No
         assert (got.answer, got.proof) == (fresh.answer, fresh.proof) == (r["cvc5"]["answer"], got.proof)
 
 
-def test_the_stage_split_over_two_processes_writes_what_the_serial_stage_writes(
-        ws: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_stage_split_over_two_processes_writes_what_the_serial_stage_writes(ws: Path, tmp_path: Path) -> None:
     """The stage decides the second half of many scripts in a forked process
     (issue 67): the same index (but the wall-clock durations) and the same
     proof files as deciding every script in this process, from an index that
-    holds nothing to re-use."""
+    holds nothing to re-use.  Run in a fresh process: the stage forks only a
+    process without other threads, and a test worker may hold threads an
+    earlier module left (a Dask offload thread, asyncio's child watcher)."""
+    import subprocess
+    import sys
+    script = ("import sys; sys.path.insert(0, sys.argv[1]); import test_second_solver as t; "
+              "from pathlib import Path; print(t._split_and_serial(Path(sys.argv[2]), Path(sys.argv[3])))")
+    done = subprocess.run([sys.executable, "-c", script, str(Path(__file__).parent), str(ws), str(tmp_path)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and done.stdout.strip() == "same", done.stdout + done.stderr
+
+
+def _split_and_serial(ws: Path, tmp: Path) -> str:
+    """Run the stage on two copies of ``ws`` under ``tmp``, every script here, then half in a fork;
+    ``"same"`` when both wrote the same index and proofs (AssertionError otherwise)."""
     import shutil
     from rclverify.stages.crosscheck import stage
+    assert threading_count() == 1
     nodes = sorted(p.stem for p in (ws / "artifacts/calculus").glob("*.json"))
     out = {}
     real = stage._decide_block
-    monkeypatch.setattr(stage, "_cpus", lambda: {0, 1})
+    stage._cpus = lambda: {0, 1}  # type: ignore[assignment]
     for mode, split_min in (("serial", 10 ** 9), ("split", 1)):
-        root = tmp_path / mode
+        root = tmp / mode
         shutil.copytree(ws, root)
         shutil.rmtree(root / "artifacts/crosscheck")
         forked: list[int] = []
-        monkeypatch.setattr(stage, "_decide_block", lambda todo: forked.append(len(todo)) or real(todo))
+        stage._decide_block = lambda todo: forked.append(len(todo)) or real(todo)  # type: ignore[assignment]
         index = stage_crosscheck(root, nodes, split_min=split_min)
         # here: every script, or the first half (the child decides the rest in its copy of the process)
         assert forked == [len(index["items"]) if mode == "serial" else len(index["items"]) // 2], forked
@@ -271,3 +285,9 @@ def test_the_stage_split_over_two_processes_writes_what_the_serial_stage_writes(
         out[mode] = (index, proofs)
     assert out["split"] == out["serial"] and out["serial"][1]
     assert out["serial"][0]["counts"] == {"two solvers": len(out["serial"][0]["items"])}
+    return "same"
+
+
+def threading_count() -> int:
+    import threading
+    return threading.active_count()
