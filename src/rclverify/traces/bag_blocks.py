@@ -42,7 +42,7 @@ import numpy as np
 
 from rclverify.traces.bag import bag_event, open_bag, read_bag, typestore
 from rclverify.traces.bag_open import counted_open_error, open_uncounted
-from rclverify.traces.bag_raw import RawMessages, from_items, raw_blocks
+from rclverify.traces.bag_raw import RawMessages, from_items, gather, raw_blocks
 from rclverify.traces.events import Event, TraceError
 
 FLOAT64, STRING = "std_msgs/msg/Float64", "std_msgs/msg/String"
@@ -50,6 +50,7 @@ _WIDE = 64  # a String message longer than this (bytes) is decoded on its own
 _DISTINCT = 64  # distinct String messages a block finds by comparison (the others: one at a time)
 _MASKS = np.array([(1 << (8 * k)) - 1 for k in range(9)], dtype=np.uint64)  # the low k bytes of a word
 _LE = b"\x00\x01"  # CDR little-endian encapsulation (the two bytes rosbags reads; the options after it are not)
+_LE_WORD = int.from_bytes(_LE, "little")  # the same two bytes read as a little-endian uint16
 
 
 class BagTrace:
@@ -181,13 +182,12 @@ class BagBlock:
         block = cls(path, reader, raw, index)
         kinds = np.array([{FLOAT64: 1, STRING: 2}.get(c.msgtype, 0) for c in raw.conns] or [0], dtype=np.int8)
         code = kinds[raw.code]
-        u = np.frombuffer(raw.buf, np.uint8)
         at = np.flatnonzero(code == 1)
         if len(at):
             at = at[raw.stop[at] - raw.start[at] == 12]
-            cells = np.lib.stride_tricks.as_strided(u, shape=(max(len(u) - 11, 0), 12), strides=(1, 1))[raw.start[at]]
-            ok = (cells[:, 0] == 0) & (cells[:, 1] == 1)
-            block._floats[at[ok]] = cells[ok, 4:12].copy().view("<f8").reshape(-1)
+            start = raw.start[at]  # the encapsulation's two bytes, two of options (not read), the double
+            ok = gather(raw.buf, start, "<u2") == _LE_WORD
+            block._floats[at[ok]] = gather(raw.buf, start + 4, "<f8")[ok]
             block._is_float[at[ok]] = True
         at = np.flatnonzero(code == 2)
         if len(at):
@@ -210,20 +210,21 @@ class BagBlock:
         picked: list[bytes] = []
         if width <= _WIDE:
             buf = raw.buf if int((start + width).max()) <= len(raw.buf) else raw.buf + bytes(width)
-            u = np.frombuffer(buf, np.uint8)
-            words = np.lib.stride_tricks.as_strided(u, shape=(len(u) - width + 1, width), strides=(1, 1))[start]
-            words = words.view("<u8")
-            for j in range(width // 8):  # keep each message's own bytes only
-                words[:, j] &= _MASKS[np.clip(size - 8 * j, 0, 8)]
-            left = np.arange(len(at))
-            while len(left) and len(picked) < _DISTINCT:
-                i = int(left[0])
-                same = size[left] == size[i]
-                for j in range(width // 8):
-                    same &= words[left, j] == words[i, j]
-                which[left[same]] = len(picked)
-                picked.append(words[i].tobytes()[:int(size[i])])
-                left = left[~same]
+            # word j of every message (its bytes 8j .. 8j + 7), only the message's own bytes kept
+            words = [gather(buf, start + 8 * j, "<u8") & _MASKS[np.clip(size - 8 * j, 0, 8)]
+                     for j in range(width // 8)]
+            left = np.ones(len(at), dtype=bool)
+            first = 0
+            while len(picked) < _DISTINCT:
+                same = left & (size == size[first])
+                for w in words:
+                    same &= w == w[first]
+                which[same] = len(picked)
+                picked.append(b"".join(int(w[first]).to_bytes(8, "little") for w in words)[:int(size[first])])
+                left &= ~same
+                first = int(left.argmax())
+                if not left[first]:
+                    break
         for i in np.flatnonzero(which < 0).tolist():  # long or too many distinct texts: one at a time
             which[i] = len(picked)
             picked.append(raw.buf[int(start[i]):int(start[i] + size[i])])

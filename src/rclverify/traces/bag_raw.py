@@ -236,9 +236,14 @@ def _mcap_chunk(storage: Any, chunk: Any, connmap: dict[int, Any]) -> RawMessage
     return from_items([(m.connection, m.timestamp, m.data or b"") for m in msgs if m.offset])
 
 
-def _gather(u: np.ndarray, at: np.ndarray, width: int) -> np.ndarray:
-    """``width`` bytes at each offset of ``at`` (rows of a 2-D uint8 array; every ``at + width <= len(u)``)."""
-    got: np.ndarray = np.lib.stride_tricks.as_strided(u, shape=(len(u) - width + 1, width), strides=(1, 1))[at]
+def gather(buf: bytes, at: np.ndarray, dtype: Any) -> np.ndarray:
+    """The value of numpy type ``dtype`` (a fixed-size, byte-order-explicit type such as ``"<u8"``
+    or a structured one) whose bytes begin at each offset of ``at`` in ``buf``, read through one
+    unaligned view of ``buf`` with a stride of one byte (no copy of ``buf``; each value copied once).
+    Every ``at + itemsize`` must be at most ``len(buf)`` (else ``IndexError``)."""
+    dt = np.dtype(dtype)
+    view = np.ndarray((max(len(buf) - dt.itemsize + 1, 0),), dtype=dt, buffer=buf, strides=(1,))
+    got: np.ndarray = view[at]
     return got
 
 
@@ -253,31 +258,30 @@ def _mcap_fast(storage: Any, chunk: Any, connmap: dict[int, Any]) -> RawMessages
     offsets = _index_offsets(storage, chunk)
     if offsets is None:
         return None
-    u = np.frombuffer(data, np.uint8)
     size = len(data)
     o = np.sort(offsets)
-    if not len(o) or (len(o) > 1 and not (np.diff(o) > 0).all()) or int(o[-1]) + 31 > size or \
-            not (u[o] == 5).all():
+    if not len(o) or (len(o) > 1 and not (np.diff(o) > 0).all()) or int(o[-1]) + 31 > size:
         return None
-    length = _gather(u, o + 1, 8).view("<u8").reshape(-1)
-    if not (length >= 22).all() or int(length.max()) > size:
-        return None
+    length = gather(data, o + 1, "<u8")  # a message record (the MCAP specification): opcode 0x05, length,
+    if not (np.frombuffer(data, np.uint8)[o] == 5).all() or not (length >= 22).all() or int(length.max()) > size:
+        return None  # then the channel id (2 bytes), sequence (4), log time (8), publish time (8), data
     nxt = o + 9 + length.astype(np.int64)
-    gaps = [(0, int(o[0]))] + [(int(a), int(b)) for a, b in zip(nxt[:-1][nxt[:-1] != o[1:]].tolist(),
-                                                                  o[1:][nxt[:-1] != o[1:]].tolist())]
+    apart = nxt[:-1] != o[1:]
+    gaps = [(0, int(o[0]))] + list(zip(nxt[:-1][apart].tolist(), o[1:][apart].tolist()))
     gaps.append((int(nxt[-1]), size))
     if not all(_other_records(data, a, b) for a, b in gaps):
         return None
-    channel = _gather(u, o + 9, 2).view("<u2").reshape(-1)
-    stamp = _gather(u, o + 15, 8).view("<u8").reshape(-1)
+    channel, stamp = gather(data, o + 9, "<u2"), gather(data, o + 15, "<u8")
     if (stamp >= 1 << 63).any():
         return None
     stamp = stamp.astype(np.int64)
-    known = np.array(sorted(connmap), dtype=np.int64)
-    keep = (stamp >= chunk.message_start_time) & (stamp < chunk.message_end_time + 1) & np.isin(channel, known)
+    known = np.zeros(1 << 16, dtype=bool)  # a channel id is 16 bits: a table of the known ones
+    known[[c for c in connmap if 0 <= c < 1 << 16]] = True
+    keep = (stamp >= chunk.message_start_time) & (stamp < chunk.message_end_time + 1) & known[channel]
     at = np.flatnonzero(keep)
-    at = at[np.argsort(stamp[at], kind="stable")]
-    ids = np.unique(channel[at]).tolist()
+    if len(at) > 1 and not bool((stamp[at][1:] >= stamp[at][:-1]).all()):  # already in order: as a stable sort keeps it
+        at = at[np.argsort(stamp[at], kind="stable")]
+    ids = np.flatnonzero(np.bincount(channel[at], minlength=1)).tolist()  # the channels present, ascending
     lut = np.zeros(int(channel.max()) + 1, dtype=np.int64)
     lut[ids] = np.arange(len(ids))
     return RawMessages([connmap[c] for c in ids], lut[channel[at]], stamp[at], data, o[at] + 31, nxt[at])
