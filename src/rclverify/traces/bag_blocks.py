@@ -157,15 +157,14 @@ class BagBlock:
     """Messages ``index ..`` of a bag as columns (module docstring): ``topics``, ``times``
     (float64 s, the recording's stamps), :meth:`values`, :meth:`typed`, ``block[i]`` (events)."""
 
-    __slots__ = ("path", "reader", "raw", "index", "topics", "times", "_made", "_floats", "_is_float",
+    __slots__ = ("path", "reader", "raw", "index", "_topics", "times", "_made", "_floats", "_is_float",
                  "_which", "_texts", "_is_str")
 
     def __init__(self, path: Path, reader: Any, raw: RawMessages, index: int) -> None:
         self.path, self.reader, self.raw, self.index = path, reader, raw, index
         self._made: dict[int, Event] = {}
         n = len(raw)
-        names = np.array([c.topic.lstrip("/") for c in raw.conns] or [""], dtype=object)
-        self.topics: list[str] = names[raw.code].tolist()
+        self._topics: list[str] | None = None
         self.times = raw.stamps / 1e9  # as stamp / 1e9, per message
         self._floats = np.zeros(n, dtype=np.float64)
         self._is_float = np.zeros(n, dtype=bool)
@@ -238,6 +237,19 @@ class BagBlock:
         self._is_str[at[good]] = True
         self._texts = [t or "" for t in texts]
         self._which[at] = which
+
+    @property
+    def topics(self) -> list[str]:
+        """Each message's topic (leading ``/`` removed), made when first asked for
+        (the batch path reads :meth:`topic_codes` instead)."""
+        if self._topics is None:
+            codes, names = self.topic_codes()
+            self._topics = np.array(names or [""], dtype=object)[codes].tolist()
+        return self._topics
+
+    def topic_codes(self) -> tuple[np.ndarray, list[str]]:
+        """(each message's topic as an index into the list, the topics' names with their leading ``/`` removed)."""
+        return self.raw.code, [c.topic.lstrip("/") for c in self.raw.conns]
 
     def topic_counts(self) -> dict[str, int]:
         """Messages per topic (leading ``/`` removed) in this block."""

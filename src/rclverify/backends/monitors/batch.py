@@ -194,7 +194,9 @@ class _Run:
         """Judge ``chunk``; returns the events to carry to the next chunk (a last input whose answer may follow)."""
         plan, m = self.plan, self.m
         n = len(chunk)
-        kind = self._kind(chunk.topics)
+        kind = chunk.kinds(self.kinds) if isinstance(chunk, BlockRows) else None  # (from a block's topic codes)
+        if kind is None:
+            kind = self._kind(chunk.topics)
         times = chunk.times
         ok = kind != 0
         unstamped = chunk.unstamped()

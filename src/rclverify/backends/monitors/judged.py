@@ -87,7 +87,8 @@ class Counted:
         heard = self.heard
         for block in blocks:
             counts = getattr(block, "topic_counts", None)  # a bag block counts its connections' codes
-            topics = [ev.topic for ev in block] if isinstance(block, list) else block.topics
+            if counts is None:
+                topics = [ev.topic for ev in block] if isinstance(block, list) else block.topics
             for key, n in (counts() if counts is not None else Counter(topics)).items():
                 key = key.strip("/")
                 heard[key] = heard.get(key, 0) + n

@@ -70,15 +70,35 @@ class EventRows:
 class BlockRows:
     """The events ``head`` carried over, then a log block (module docstring)."""
 
-    __slots__ = ("head", "block", "topics", "times")
+    __slots__ = ("head", "block", "_topics", "times")
 
     def __init__(self, head: list[Event], block: Any) -> None:
         self.head, self.block = head, block
+        self._topics: list[str] | None = None
         if head:
-            self.topics = list(map(_TOPIC, head)) + block.topics
             self.times = np.concatenate([np.fromiter(map(_TIME, head), np.float64, len(head)), block.times])
         else:
-            self.topics, self.times = block.topics, block.times
+            self.times = block.times
+
+    @property
+    def topics(self) -> list[str]:
+        """Each row's topic (made when first asked for: :meth:`kinds` reads a block's topic codes instead)."""
+        if self._topics is None:
+            self._topics = list(map(_TOPIC, self.head)) + self.block.topics if self.head else self.block.topics
+        return self._topics
+
+    def kinds(self, table: Mapping[str, int]) -> np.ndarray | None:
+        """Each row's topic mapped through ``table`` (0 for a topic it does not name) as int8, from
+        the block's topic codes (``topic_codes``: no string a row); ``None`` for a block without them."""
+        codes = getattr(self.block, "topic_codes", None)
+        if codes is None:
+            return None
+        at, names = codes()
+        lut = np.array([table.get(t, 0) for t in names] or [0], dtype=np.int8)
+        kind: np.ndarray = lut[at]
+        if self.head:
+            kind = np.concatenate([np.array([table.get(ev.topic, 0) for ev in self.head], dtype=np.int8), kind])
+        return kind
 
     def __len__(self) -> int:
         return len(self.head) + len(self.block)
