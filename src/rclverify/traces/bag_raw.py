@@ -186,7 +186,7 @@ def _sqlite3(storage: Any, connmap: dict[int, Any], rows: int) -> Iterator[RawMe
                       'FROM messages JOIN topics ON messages.topic_id=topics.id',
                       f'WHERE topics.id IN ({",".join("?" for _ in ids)})', 'ORDER BY timestamp'])
     order = [connmap[i] for i in sorted(ids)]  # rosbags yields its storage's connection, mapped by ``connmap``
-    code = {i: k for k, i in enumerate(sorted(ids))}
+    known = np.array(sorted(ids), dtype=np.int64)  # a row's connection: its topic id's place among them
     cur = storage.dbconn.execute(query, list(ids))
     while True:
         got: list[tuple[int, int, bytes]] = []
@@ -200,8 +200,9 @@ def _sqlite3(storage: Any, connmap: dict[int, Any], rows: int) -> Iterator[RawMe
             raws = list(map(_THIRD, got))
             lens = np.fromiter(map(len, raws), np.int64, n)
             stop = np.cumsum(lens)
-            yield RawMessages(order, np.fromiter(map(code.__getitem__, map(_FIRST, got)), np.int64, n),
-                              np.fromiter(map(_SECOND, got), np.int64, n), b"".join(raws), stop - lens, stop)
+            code = np.searchsorted(known, np.fromiter(map(_FIRST, got), np.int64, n))  # (the query's ids only)
+            yield RawMessages(order, code, np.fromiter(map(_SECOND, got), np.int64, n), b"".join(raws),
+                              stop - lens, stop)
         if error is not None:
             raise error
         if len(got) < rows:
