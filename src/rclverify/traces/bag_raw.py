@@ -260,7 +260,7 @@ def _mcap_fast(storage: Any, chunk: Any, connmap: dict[int, Any]) -> RawMessages
     if offsets is None:
         return None
     size = len(data)
-    o = np.sort(offsets)
+    o = np.sort(offsets, kind="stable")  # (each channel's offsets in order already: merged runs)
     if not len(o) or (len(o) > 1 and not (np.diff(o) > 0).all()) or int(o[-1]) + 31 > size:
         return None
     length = gather(data, o + 1, "<u8")  # a message record (the MCAP specification): opcode 0x05, length,
@@ -279,13 +279,15 @@ def _mcap_fast(storage: Any, chunk: Any, connmap: dict[int, Any]) -> RawMessages
     known = np.zeros(1 << 16, dtype=bool)  # a channel id is 16 bits: a table of the known ones
     known[[c for c in connmap if 0 <= c < 1 << 16]] = True
     keep = (stamp >= chunk.message_start_time) & (stamp < chunk.message_end_time + 1) & known[channel]
-    at = np.flatnonzero(keep)
-    if len(at) > 1 and not bool((stamp[at][1:] >= stamp[at][:-1]).all()):  # already in order: as a stable sort keeps it
-        at = at[np.argsort(stamp[at], kind="stable")]
-    ids = np.flatnonzero(np.bincount(channel[at], minlength=1)).tolist()  # the channels present, ascending
-    lut = np.zeros(int(channel.max()) + 1, dtype=np.int64)
+    if not keep.all():
+        o, nxt, channel, stamp = o[keep], nxt[keep], channel[keep], stamp[keep]
+    if len(stamp) > 1 and not bool((stamp[1:] >= stamp[:-1]).all()):  # already in order: as a stable sort keeps it
+        at = np.argsort(stamp, kind="stable")
+        o, nxt, channel, stamp = o[at], nxt[at], channel[at], stamp[at]
+    ids = np.flatnonzero(np.bincount(channel, minlength=1)).tolist()  # the channels present, ascending
+    lut = np.zeros(ids[-1] + 1 if ids else 1, dtype=np.int64)
     lut[ids] = np.arange(len(ids))
-    return RawMessages([connmap[c] for c in ids], lut[channel[at]], stamp[at], data, o[at] + 31, nxt[at])
+    return RawMessages([connmap[c] for c in ids], lut[channel], stamp, data, o + 31, nxt)
 
 
 def _other_records(data: bytes, a: int, b: int) -> bool:
