@@ -84,6 +84,22 @@ def test_confidence_equals_a_direct_evaluation_of_the_rules(g) -> None:
     assert requirement_claim(True, proof, own[nodes[0]]) == claim([proof, *own[nodes[0]]])
 
 
+@settings(max_examples=200, deadline=None)
+@given(graphs(), st.booleans(), st.lists(st.floats(0.0, 0.3), min_size=15, max_size=15))
+def test_derived_claims_equal_claim_over_each_cone_exactly(g, shared, doubts) -> None:
+    """The per-node fast path (labels all distinct) and the reference (a label shared: every premise
+    through claim()) give the claim of claim() over the sorted cone, float for float (issue 67)."""
+    nodes, edges, own = g
+    it = iter(doubts)  # any doubts, not only the strength table's round ones
+    own = {v: [Premise(p.label, p.kind, next(it)) for p in ps] for v, ps in own.items()}
+    if shared:  # a label in two places sends derived_claims down the reference path
+        own = {v: [Premise(f"p{j}", p.kind, p.doubt) for j, p in enumerate(ps)] for v, ps in own.items()}
+    producers = {v: [a for a, b in edges if b == v] for v in nodes}
+    cone = cones(producers)
+    got = derived_claims(own, producers)
+    assert got == {v: claim(p for m in sorted(cone[v]) for p in own.get(m, ())) for v in nodes}
+
+
 # -- on a verified workspace --------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")

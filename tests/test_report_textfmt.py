@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import re
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from rclverify.report.render import environment
 from rclverify.report.svgfit import readable_svg, smallest_font
 from rclverify.report.textfmt import natural_key, natural_sorted, natural_within, prose
@@ -63,3 +66,20 @@ def test_a_requirement_shows_its_proof_and_its_evidence_apart() -> None:
     html = environment().from_string("{{ req|reqbadges }}").render(
         req={"status": "failed", "verdict": "proved vacuously", "note": "its premise <never> holds"})
     assert 'title="status: failed; its premise &lt;never&gt; holds"' in html
+
+
+_ITEMS = st.lists(st.one_of(st.text(alphabet="ab <=>&|`*_\n(x)", max_size=160), st.integers()), max_size=5)
+
+
+@settings(max_examples=150, deadline=None)
+@given(_ITEMS)
+def test_the_list_filters_equal_the_loops_they_replace(items) -> None:
+    """``formulas`` and ``codes`` (a side condition's hypotheses, each text's markup made once per
+    process: issue 67) give the text of the per-item loops they replaced, in the HTML templates'
+    autoescaped environment and the Markdown ones' plain one; twice, so the cached texts are read."""
+    html, md = environment(), environment().overlay(autoescape=False)
+    html_loop = "{% for h in xs %}{{ h|formula }}{% if not loop.last %}<br>{% endif %}{% else %}none{% endfor %}"
+    md_loop = "{% for h in xs %}{{ h|code }}{% if not loop.last %}<br>{% endif %}{% else %}none{% endfor %}"
+    for _ in range(2):
+        assert html.from_string("{{ xs|formulas }}").render(xs=items) == html.from_string(html_loop).render(xs=items)
+        assert md.from_string("{{ xs|codes }}").render(xs=items) == md.from_string(md_loop).render(xs=items)

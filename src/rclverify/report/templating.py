@@ -130,6 +130,38 @@ def md_code(value: Any, cell: bool = True) -> str:
     return f"{fence}{text}{fence}"
 
 
+@lru_cache(maxsize=1 << 16)
+def _md_code_cell(text: str) -> str:
+    return md_code(text)
+
+
+@lru_cache(maxsize=1 << 16)
+def _formula_html_of(text: str) -> Markup:
+    return formula_html(text)
+
+
+def md_code_list(values: Any, sep: str = "<br>", empty: str = "none") -> str:
+    """The items of ``values`` each as a table-cell code span (:func:`md_code`),
+    joined by ``sep``; ``empty`` when there is none: the text of the loop
+    ``{% for h in values %}{{ h|code }}{% if not loop.last %}<br>{% endif
+    %}{% else %}none{% endfor %}``.  A side condition in context lists every
+    premise of its upstream cone, so along a chain the lists add up to N*N/2
+    items, most of them the same texts (docs/scale.md, issue 67): each
+    text's span is made once per process (a pure function of the text)."""
+    items = [str(v) for v in values]
+    return sep.join(_md_code_cell(t) for t in items) if items else empty
+
+
+def formula_html_list(values: Any, sep: str = "<br>", empty: str = "none") -> Markup:
+    """The items of ``values`` each as :func:`formula_html` (HTML-escaped),
+    joined by ``sep`` (markup); ``empty`` (escaped) when there is none: the
+    text of ``{% for h in values %}{{ h|formula }}{% if not loop.last
+    %}<br>{% endif %}{% else %}none{% endfor %}`` in an autoescaped
+    template, each text's HTML made once per process (:func:`md_code_list`)."""
+    items = [str(v) for v in values]
+    return Markup(sep).join(_formula_html_of(t) for t in items) if items else Markup(escape(empty))
+
+
 def md_fence(value: Any, lang: str = "") -> str:
     """``value`` as a fenced code block (fence longer than any backtick run)."""
     text = str(value).rstrip("\n")
@@ -218,7 +250,8 @@ def environment() -> jinja2.Environment:
     env.filters.update(
         anchor=anchor, badge=html_badge, md=md_text, code=md_code, fence=md_fence,
         mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
-        formula=formula_html, lines=formula_lines, wbr=breakable,
+        formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
+        formulas=formula_html_list,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame

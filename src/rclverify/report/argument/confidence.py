@@ -35,6 +35,7 @@ names it ("REQ2 rests on tested-only evidence for Navigation guarantee 1").
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import chain
 from typing import Iterable, Mapping, Sequence
 
 from rclverify.model.system.cycles import strongly_connected_components
@@ -114,9 +115,28 @@ def node_claims(own: Mapping[str, Sequence[Premise]]) -> dict[str, Claim]:
 
 
 def derived_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str, Iterable[str]]) -> dict[str, Claim]:
-    """C4: each node's derived property, resting on the premises of its cone."""
+    """C4: each node's derived property, resting on the premises of its cone
+    (``own``: node -> its premises; ``producers``: node -> its producer
+    nodes).  Along a chain the cones hold N*N/2 premises in all; when no
+    label is shared (each premise then counts once as it stands), each claim
+    is read from per-node doubts and limits instead of through :func:`claim`:
+    the doubts summed in the same order (the same floating-point sum) and the
+    limit the largest of the nodes' own (``(doubt, label)`` keys are then
+    distinct, so the largest is one premise whatever the order).  Equal to
+    :func:`claim` over the cone (``tests/test_confidence.py``)."""
     cone = cones({n: list(producers.get(n, ())) for n in own})
-    return {n: claim(p for m in sorted(cone[n]) for p in own.get(m, ())) for n in own}
+    labels = [p.label for ps in own.values() for p in ps]
+    if len(set(labels)) != len(labels):
+        return {n: claim(p for m in sorted(cone[n]) for p in own.get(m, ())) for n in own}
+    doubts = {m: tuple(p.doubt for p in ps) for m, ps in own.items()}
+    top = {m: max(ps, key=lambda p: (p.doubt, p.label)) for m, ps in own.items() if ps}
+    out: dict[str, Claim] = {}
+    for n in own:
+        members = sorted(cone[n])
+        doubt = min(1.0, sum(chain.from_iterable(doubts.get(m, ()) for m in members)))
+        limits = max((top[m] for m in members if m in top), key=lambda p: (p.doubt, p.label), default=None)
+        out[n] = Claim(round(doubt, 9), round(1.0 - doubt, 9), limits)
+    return out
 
 
 def requirement_claim(proved: bool, proof: Premise, used: Sequence[Premise]) -> Claim:
