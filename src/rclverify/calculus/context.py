@@ -131,6 +131,25 @@ def link_text(l: Link) -> str:
     return f"{l.from_node}.out.{l.from_var} -> {l.to_node}.in.{l.to_var}"
 
 
+_JOINS: dict[str, Any] = {"model": None, "mask": 0}
+
+
+def single_paths(model: SystemModel, node: str) -> bool:
+    """Whether no node of ``node``'s upstream cone has two or more links
+    into it.  Then every node of the cone has at most one path to ``node``
+    (two paths from one node part somewhere and meet again at a node with
+    two links in, and that node is in the cone), so :func:`_multi_path`
+    over the cone is empty whatever links are cut.  One test of the cone's
+    bit mask (:meth:`SystemModel.upstream_masks`) against the mask of such
+    nodes, made once per model, instead of a walk over the cone: along a
+    chain the walks added up to N*N/2 steps (docs/scale.md, issue 67)."""
+    if _JOINS["model"] is not model:
+        bits = {n: 1 << i for i, n in enumerate(model.nodes)}
+        _JOINS["mask"] = sum(bits[n] for n in model.nodes if len(model.links_into(n)) > 1)
+        _JOINS["model"] = model
+    return int(model.upstream_masks().get(node, 0)) & int(_JOINS["mask"]) == 0
+
+
 def _multi_path(model: SystemModel, node: str, cone: Sequence[str], cut: set[tuple[str, str, str, str]]) -> set[str]:
     """Nodes of ``cone`` with more than one path to ``node`` over the links
     left after opening the loops (counts capped at 2)."""
