@@ -269,7 +269,7 @@ def _split_and_serial(ws: Path, tmp: Path) -> str:
     nodes = sorted(p.stem for p in (ws / "artifacts/calculus").glob("*.json"))
     out = {}
     real = stage._decide_block
-    stage._cpus = lambda: {0, 1}  # type: ignore[assignment]
+    stage._other_cpu_free = lambda: True  # type: ignore[assignment]  # whatever the machine's load
     for mode, split_min in (("serial", 10 ** 9), ("split", 1)):
         root = tmp / mode
         shutil.copytree(ws, root)
@@ -291,3 +291,14 @@ def _split_and_serial(ws: Path, tmp: Path) -> str:
 def threading_count() -> int:
     import threading
     return threading.active_count()
+
+
+def test_the_second_process_waits_for_a_free_cpu(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The stage forks its second process only when another CPU is free (issue 67): two CPUs and a
+    load average that leaves half of one idle; one CPU or a busier machine decide in this process."""
+    from rclverify.stages.crosscheck import stage
+    for cpus, load, free in (({0, 1}, 0.9, True), ({0, 1}, 1.5, True), ({0, 1}, 1.6, False), ({0, 1}, 4.0, False),
+                             ({0}, 0.0, False), ({0, 1, 2, 3}, 3.0, True)):
+        monkeypatch.setattr(stage, "_cpus", lambda c=cpus: c)
+        monkeypatch.setattr(stage.os, "getloadavg", lambda x=load: (x, x, x))
+        assert stage._other_cpu_free() is free, (cpus, load)

@@ -157,7 +157,8 @@ def _finish(root: Path, it: Item, row: dict[str, Any], d: dict[str, Any] | Decis
 def _decide_scripts(todo: list[tuple[str, str, bool]], split_min: int) -> list[Decision]:
     """cvc5's decision of each ``(text, name, every)`` script, in order: in
     this process, or, for ``split_min`` scripts or more on a machine that
-    gives this process two CPUs and can fork, the second half in a forked
+    gives this process two CPUs, one of them free (:func:`_other_cpu_free`),
+    and can fork, the second half in a forked
     child beside the first half here (cvc5's Python API holds the GIL, so a
     thread would not run beside it), unless this process runs other
     threads.  Each half has its own shared solver
@@ -166,7 +167,7 @@ def _decide_scripts(todo: list[tuple[str, str, bool]], split_min: int) -> list[D
     half = len(todo) // 2
     # a process with other threads (the live progress line of a serial run on a terminal) is not forked:
     # a lock one of them holds would stay held in the child (core/cache/workspace.py forks under the same rule)
-    if (len(todo) < max(2, split_min) or len(_cpus()) < 2 or not hasattr(os, "fork")
+    if (len(todo) < max(2, split_min) or not _other_cpu_free() or not hasattr(os, "fork")
             or threading.active_count() > 1):
         return _decide_block(todo)
     import multiprocessing  # deferred: optional or conditional (inside a block)
@@ -175,6 +176,23 @@ def _decide_scripts(todo: list[tuple[str, str, bool]], split_min: int) -> list[D
         second = pool.submit(_in_child, todo[half:])
         first = _decide_block(todo[:half])
         return first + second.result()
+
+
+def _other_cpu_free() -> bool:
+    """Whether a second CPU is free for the forked child: the process may
+    run on two or more, and the load average of the last minute (this
+    process counts 1) leaves at least half of one idle.  On a busy machine
+    the child only waits for a core and costs its fork, its copied pages
+    and its own solver (0.13 CPU s of 1.7 for the 200-node chain's 1,000
+    scripts at load 3, the same wall time: docs/scale.md, issue 67)."""
+    cpus = len(_cpus())
+    if cpus < 2:
+        return False
+    try:
+        load = os.getloadavg()[0]
+    except OSError:  # not known: as before the load was read
+        return True
+    return load <= cpus - 0.5
 
 
 def _cpus() -> set[int]:
