@@ -200,6 +200,7 @@ class RequirementRecord(TypedDict):
     explanation: NotRequired[str]
     reason: NotRequired[str]
     premises: NotRequired[int]
+    premises_of: NotRequired[list[str]]
     smt2: NotRequired[str]
     duration_s: NotRequired[float]
     counterexample: NotRequired[list[dict[str, Any]]]

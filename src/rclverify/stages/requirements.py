@@ -59,7 +59,8 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
 
     from rclverify.semantics.world import fresh  # deferred: start-up (loads rclverify.semantics, rclverify.semantics.world only when called)
     from rclverify.core.cache import code_stamp  # deferred: start-up (loads rclverify.core.cache, fractions and more only when called)
-    from rclverify.calculus.requirements.check import check_requirement, cone_of, fingerprint, state_text, statement_formals  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.calculus.requirements.check import cone_of, fingerprint, state_text, statement_formals  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.calculus.requirements.own_nodes import decide, fingerprint_inputs  # deferred: start-up (loads z3 and more only when called)
     from rclverify.backends.monitors.temporal_evidence import fingerprint_text, requirement_traces, trace_hashes, trace_rows  # deferred: start-up (loads jinja2, lark and more only when called)
     code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan
@@ -83,7 +84,8 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
         # a temporal requirement also reads the state declarations of its cone (plan.states)
         traces = requirement_traces(req, checked, plan)  # recorded runs checked against it (docs/plan.md)
         th = trace_hashes(ws.root, traces)
-        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([fingerprint_text(ws.root, traces)] if traces else []),
+        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([fingerprint_text(ws.root, traces)] if traces else [])
+                         + (fingerprint_inputs(req, checked, model, plan) if formal is not None else []),
                          model_text if formal is not None else "", code)
         rel = record_path(req.id)
         keep.add(rel.rsplit("/", 1)[1])
@@ -92,7 +94,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
             rec, now = old, False
         else:
             fresh()  # each check in the same Z3 state whatever ran before it (semantics/world.py)
-            rec = check_requirement(req, checked, model, plan)
+            rec = decide(req, checked, model, plan)  # its own nodes first (calculus/requirements/own_nodes.py)
             smt2 = rec.pop("smt2", None)
             if smt2 is not None:
                 rec["smt2"] = rel[:-5] + ".smt2"

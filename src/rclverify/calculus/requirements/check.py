@@ -35,6 +35,10 @@ One labelled satisfiability query of ``premises and not R`` decides it:
                   ``R`` mentions, the traced ones first.
 ``inconclusive``  unknown (budget, quantifiers): never proved.
 
+The requirements stage decides a statement over the premises of its own
+nodes first (:mod:`.own_nodes`), and over the whole cone here when they do
+not decide it.
+
 A statement with a temporal operator (``always``, ``eventually``, ...) is
 decided over the runs of the composed contracts instead: the check
 dispatches to :mod:`.temporal_check`, whose record has the same fields plus
@@ -158,6 +162,19 @@ def _io_symbols(e: ast.Expr, cn: CheckedNode, enc: Encoder) -> set[str]:
     return out
 
 
+def _base(req: Requirement) -> dict[str, Any]:
+    """The keys of a requirement's record that come from the plan alone."""
+    return {
+        "id": req.id, "text": req.text, "origin": req.origin,
+        "source": _where(req.formal.loc if req.formal else req.loc),
+        "formal": " ".join(req.formal.text.split()) if req.formal else None,
+        "assuming": [" ".join(a.text.split()) for a in req.assuming],
+        "ranking": " ".join(req.ranking.text.split()) if req.ranking else None,
+        "invariant": " ".join(req.invariant.text.split()) if req.invariant else None,
+        "traced": [{"node": s.node, "guarantee": k} for s in req.support for k in s.guarantees],
+    }
+
+
 @solver_session()
 def check_requirement(req: Requirement, checked: Checked, model: SystemModel, plan: Plan, *,
                       timeout_ms: int = DEFAULT_TIMEOUT_MS, model_ms: int = MODEL_TIMEOUT_MS) -> dict[str, Any]:
@@ -183,15 +200,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
     not check (the plan's ``resolve`` reports those first); never raises on
     solver trouble.
     """
-    base: dict[str, Any] = {
-        "id": req.id, "text": req.text, "origin": req.origin,
-        "source": _where(req.formal.loc if req.formal else req.loc),
-        "formal": " ".join(req.formal.text.split()) if req.formal else None,
-        "assuming": [" ".join(a.text.split()) for a in req.assuming],
-        "ranking": " ".join(req.ranking.text.split()) if req.ranking else None,
-        "invariant": " ".join(req.invariant.text.split()) if req.invariant else None,
-        "traced": [{"node": s.node, "guarantee": k} for s in req.support for k in s.guarantees],
-    }
+    base = _base(req)
     if req.formal is not None and plan is not None:
         from rclverify.calculus.requirements.temporal_check import check_temporal, is_temporal  # deferred: optional or conditional (inside a block)
         if is_temporal(req, checked, plan):  # over the composed system's runs (calculus/requirements/temporal_check.py)
@@ -201,20 +210,8 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return {**base, "verdict": "informal", "cone": [], "used": [], "traced_not_needed": [],
                 "explanation": "No formal statement: the requirement is traced to guarantees, never checked, never met."}
     cone = cone_of([formal, *assuming], model)
-    q = _Query(Encoder(checked.env, model.alias()))
-    q.cone_premises(cone, checked, model, plan)
-    # the statements' variables are named Node.in.x in their pseudo node (model/plan/formal.py); the encoder looks
-    # an input/output up as "<in|out>.<name>", here "in.Node.in.x", and takes the node's own symbol
+    q, symbols, r = _ask(base, cone, formal, assuming, checked, model, plan, timeout_ms)
     enc = q.enc
-    symbols = {f"{p}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
-               for f in (formal, *assuming) for n, p, v in f.mentions}
-    for k, a in enumerate(assuming, 1):
-        q.add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))
-    goal = enc.formula(formal.expr, formal.scope, symbols)
-    q.labelled.append((NEGATED, z3.Not(goal)))
-    head = (f"rclverify requirement {req.id}: {base['formal']}\nsource {base['source']}; "
-            "unsat means the requirement follows from the premises")
-    r = satisfiable(q.labelled, enc, timeout_ms=timeout_ms, comment=head)
     out: dict[str, Any] = {**base, "cone": cone, "premises": len(q.premises), "smt2": r.smt2,
                            "duration_s": r.duration_s}
     traced = [f"{t['node']} guarantee {t['guarantee']}" for t in base["traced"]]
@@ -236,6 +233,28 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return out
     out.update(verdict="inconclusive", reason=r.reason or "unknown")
     return out
+
+
+def _ask(base: dict[str, Any], nodes: Sequence[str], formal: Formal, assuming: Sequence[Formal], checked: Checked,
+         model: SystemModel, plan: Plan, timeout_ms: int,
+         note: str = "") -> tuple["_Query", dict[str, Any], QueryResult]:
+    """The labelled query ``premises of nodes and assuming and not formal``
+    (``base``: the record's plan keys; ``note`` a line added to the script's
+    comment).  Returns the query, the statements' symbols and Z3's answer."""
+    q = _Query(Encoder(checked.env, model.alias()))
+    q.cone_premises(nodes, checked, model, plan)
+    # the statements' variables are named Node.in.x in their pseudo node (model/plan/formal.py); the encoder looks
+    # an input/output up as "<in|out>.<name>", here "in.Node.in.x", and takes the node's own symbol
+    enc = q.enc
+    symbols = {f"{p}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
+               for f in (formal, *assuming) for n, p, v in f.mentions}
+    for k, a in enumerate(assuming, 1):
+        q.add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))
+    goal = enc.formula(formal.expr, formal.scope, symbols)
+    q.labelled.append((NEGATED, z3.Not(goal)))
+    head = (f"rclverify requirement {base['id']}: {base['formal']}\nsource {base['source']}; "
+            "unsat means the requirement follows from the premises" + note)
+    return q, symbols, satisfiable(q.labelled, enc, timeout_ms=timeout_ms, comment=head)
 
 
 class _Query:
