@@ -446,3 +446,34 @@ def test_bad_binding_is_located_at_its_key_in_the_plan(tmp_path: Path) -> None:
     line = text.splitlines()[d.loc.line - 1]
     assert d.loc.file == "contracts/plan.yaml" and line[d.loc.col - 1:].startswith("in.rr:")
     assert "in.rr is not an input of RadiationSensor" in d.message
+
+
+def test_the_export_writes_the_same_in_a_used_z3_context_and_makes_none(tmp_path: Path) -> None:
+    """The node task's export needs no fresh Z3 context of its own (app/pipeline.py,
+    ``stage_export``): exported into a context that other work filled (terms, a
+    solver's model) it writes the same obligation records and artifacts, and a
+    plan whose entries are all Hoare ones leaves the context it found in place."""
+    from rclverify.app.pipeline import Workspace, stage_check, stage_export
+    from rclverify.semantics.world import fresh
+    ws_dir = tmp_path / "stop"
+    shutil.copytree(REPO / "tests" / "data" / "requirements" / "stop", ws_dir)
+    ws = Workspace(ws_dir)
+    stage_check(ws)
+    nodes = ["ObstacleDetector", "SpeedController", "MotorDriver"]
+
+    def written() -> dict[str, str]:
+        return {p.relative_to(ws_dir).as_posix(): p.read_text() for d in ("obligations", "hoare")
+                for p in sorted((ws_dir / "artifacts" / d).rglob("*")) if p.is_file()}
+    fresh()
+    clean = {n: stage_export(ws, n) for n in nodes}
+    files = written()
+    shutil.rmtree(ws_dir / "artifacts" / "hoare")
+    fresh()
+    x, y = z3.Reals("x y")  # other work first: terms, a query and its model in the same context
+    s = z3.Solver()
+    s.add(x + y > 3, x < y, y * y < 17)
+    assert s.check() == z3.sat and s.model() is not None
+    ctx = z3.main_ctx()
+    used = {n: stage_export(ws, n) for n in reversed(nodes)}
+    assert z3.main_ctx() is ctx  # no context of its own
+    assert used == clean and written() == files

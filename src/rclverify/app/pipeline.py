@@ -197,9 +197,17 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
 
 
 def stage_export(ws: Workspace, node: str) -> list[ObligationRecord]:
-    """Export ``node``'s obligations for every evidence entry of the plan."""
-    fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
+    """Export ``node``'s obligations for every evidence entry of the plan.
+
+    The export starts a fresh Z3 context (semantics/world.py) unless every
+    entry's backend says its export reads no Z3 state (``export_reads_z3_state
+    = False``: what it writes follows from the structure of the terms it
+    builds, never from a solver or a term's id; the Hoare backend): then its
+    terms go into the context already there, and a node task saves one of
+    its three contexts (docs/scale.md)."""
     from rclverify.backends import get_backend  # deferred: start-up (loads rclverify.backends, importlib only when called)
+    if any(getattr(get_backend(e.backend), "export_reads_z3_state", True) for e in ws.plan.evidence.get(node, ())):
+        fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     obligations = []
     shared = set(ws.plan.contracts) | {ws.plan.file}
     snapshot = ws.snapshot(node)

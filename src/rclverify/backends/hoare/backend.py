@@ -178,6 +178,14 @@ class HoareBackend:
 
     name = NAME
     kind = KIND
+    #: The export asks no solver: the obligation records (ids, statements, the VC
+    #: ids, which follow the program's loops) and the artifact's text (the triple
+    #: and its proof outline, printed by walking the terms, :mod:`.outline`) follow
+    #: from the structure of the terms alone, which Z3 shares by structure
+    #: (hash-consing) whatever else its context holds; so the export needs no
+    #: fresh Z3 context of its own (app/pipeline.py, ``stage_export``).  Each
+    #: run still rebuilds its triple in a fresh one: its answers are the solver's.
+    export_reads_z3_state = False
 
     def export(self, target: NodeTarget) -> list[Obligation]:
         """Render one artifact per triple under ``target.artifacts``; return the obligations.
