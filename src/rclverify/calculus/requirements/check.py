@@ -210,7 +210,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return {**base, "verdict": "informal", "cone": [], "used": [], "traced_not_needed": [],
                 "explanation": "No formal statement: the requirement is traced to guarantees, never checked, never met."}
     cone = cone_of([formal, *assuming], model)
-    q, symbols, r = _ask(base, cone, formal, assuming, checked, model, plan, timeout_ms)
+    q, symbols, goal, r = _ask(base, cone, formal, assuming, checked, model, plan, timeout_ms)  # goal held: _ask
     enc = q.enc
     out: dict[str, Any] = {**base, "cone": cone, "premises": len(q.premises), "smt2": r.smt2,
                            "duration_s": r.duration_s}
@@ -237,10 +237,14 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
 
 def _ask(base: dict[str, Any], nodes: Sequence[str], formal: Formal, assuming: Sequence[Formal], checked: Checked,
          model: SystemModel, plan: Plan, timeout_ms: int,
-         note: str = "") -> tuple["_Query", dict[str, Any], QueryResult]:
+         note: str = "") -> tuple["_Query", dict[str, Any], z3.BoolRef, QueryResult]:
     """The labelled query ``premises of nodes and assuming and not formal``
     (``base``: the record's plan keys; ``note`` a line added to the script's
-    comment).  Returns the query, the statements' symbols and Z3's answer."""
+    comment).  Returns the query, the statements' symbols, the statement's
+    term and Z3's answer.  The caller holds the term while it reads the
+    answer's scripts and asks its other queries: Z3's printer names (``let``)
+    a term that other references share, and a freed term's id goes to the
+    next new one, so the scripts depend on which terms Python still holds."""
     q = _Query(Encoder(checked.env, model.alias()))
     q.cone_premises(nodes, checked, model, plan)
     # the statements' variables are named Node.in.x in their pseudo node (model/plan/formal.py); the encoder looks
@@ -254,7 +258,7 @@ def _ask(base: dict[str, Any], nodes: Sequence[str], formal: Formal, assuming: S
     q.labelled.append((NEGATED, z3.Not(goal)))
     head = (f"rclverify requirement {base['id']}: {base['formal']}\nsource {base['source']}; "
             "unsat means the requirement follows from the premises" + note)
-    return q, symbols, satisfiable(q.labelled, enc, timeout_ms=timeout_ms, comment=head)
+    return q, symbols, goal, satisfiable(q.labelled, enc, timeout_ms=timeout_ms, comment=head)
 
 
 class _Query:

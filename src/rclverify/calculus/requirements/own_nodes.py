@@ -151,7 +151,7 @@ def _decide_own(req: Requirement, checked: Checked, model: SystemModel, plan: Pl
     base = _base(req)
     note = (f"\npremises: those of {', '.join(own.nodes)} alone, part of its cone (a proof from part of the "
             "premises is a proof from all of them)")
-    q, _, r = _ask(base, own.nodes, own.formal, [], checked, model, plan, timeout_ms, note)
+    q, _, goal, r = _ask(base, own.nodes, own.formal, [], checked, model, plan, timeout_ms, note)  # goal held: _ask
     if r.status != "unsat" or NEGATED not in (r.core or []):
         return None
     out: dict[str, Any] = {**base, "cone": own.cone, "premises_of": own.nodes, "premises": len(q.premises),
