@@ -73,12 +73,31 @@ class Own:
     cone: list[str]
 
 
+#: :func:`own_nodes`'s answers for the last loaded system: ``[(checked, model, plan), {id(req): (req, answer)}]``.
+_OWN: list[Any] = [None, {}]
+
+
 def own_nodes(req: Requirement, checked: Checked, model: SystemModel, plan: Plan) -> Own | None:
     """What step 2 reads (module docstring), or ``None`` when it does not
     apply: an informal or temporal statement, an implication (whether its
     premise can hold is asked of the whole cone: the vacuity query), an
     ``assuming:``, a cone of the statement's own nodes alone (then the two
-    queries are one).  Raises ``RclError`` like :func:`.check.formals_of`."""
+    queries are one).  Kept per requirement and loaded system (parsing a
+    statement reads every node's names: the stage asks twice, for the
+    fingerprint and for the check).  Raises ``RclError`` like
+    :func:`.check.formals_of`."""
+    key = (checked, model, plan)
+    if _OWN[0] is None or any(a is not b for a, b in zip(_OWN[0], key)):
+        _OWN[:] = [key, {}]
+    kept = _OWN[1].get(id(req))
+    if kept is not None and kept[0] is req:
+        return kept[1]  # type: ignore[no-any-return]
+    answer = _own_nodes(req, checked, model, plan)
+    _OWN[1][id(req)] = (req, answer)
+    return answer
+
+
+def _own_nodes(req: Requirement, checked: Checked, model: SystemModel, plan: Plan) -> Own | None:
     if req.formal is None or req.assuming:
         return None
     from rclverify.calculus.requirements.temporal_check import is_temporal  # deferred: optional or conditional (inside a block)
