@@ -290,9 +290,17 @@ def _split_and_serial(ws: Path, tmp: Path) -> str:
 
 
 def test_the_second_process_waits_for_a_free_cpu(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The stage forks its second process only when another CPU is free (issue 67): two CPUs and a
-    load average that leaves half of one idle; one CPU or a busier machine decide in this process."""
+    """The stage forks its second process only when another CPU is free (issue 67): two CPUs, this
+    process's own idle while it sleeps and half of another; one CPU or a busier machine decide in this
+    process.  Where the CPU counters cannot be read, the load average of the last minute decides."""
     from rclverify.stages.crosscheck import stage
+    for cpus, idle, free in (({0, 1}, 2.0, True), ({0, 1}, 1.5, True), ({0, 1}, 1.4, False), ({0, 1}, 0.0, False),
+                             ({0}, 1.0, False), ({0, 1, 2, 3}, 1.6, True)):
+        monkeypatch.setattr(stage, "_cpus", lambda c=cpus: c)
+        monkeypatch.setattr(stage.cpus_now, "idle_cpus", lambda x=idle: x)
+        monkeypatch.setattr(stage.os, "getloadavg", lambda: (0.0, 0.0, 0.0))  # not read: the counters decide
+        assert stage._other_cpu_free() is free, (cpus, idle)
+    monkeypatch.setattr(stage.cpus_now, "idle_cpus", lambda: None)
     for cpus, load, free in (({0, 1}, 0.9, True), ({0, 1}, 1.5, True), ({0, 1}, 1.6, False), ({0, 1}, 4.0, False),
                              ({0}, 0.0, False), ({0, 1, 2, 3}, 3.0, True)):
         monkeypatch.setattr(stage, "_cpus", lambda c=cpus: c)

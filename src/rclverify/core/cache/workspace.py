@@ -31,13 +31,13 @@ from __future__ import annotations
 
 import atexit
 import os
-import threading
 from typing import Any, BinaryIO
 
 from rclverify.core.cache.keys import file_digest, salt
 from rclverify.core.cache.safeload import load
 from rclverify.core.cache.store import open_stream, write_stream
 from rclverify.core.cache.heap import no_collection
+from rclverify.core.forksafe import fork_is_safe
 
 CACHE = "artifacts/cache/workspace.pickle"
 KIND = "workspace"
@@ -162,8 +162,8 @@ def save_in_background(ws: Any) -> None:
     child before it exits, and :func:`restore` first waits for it, so a
     run's cache is complete when the run ends, as with :func:`save`.
     Saves in this process where ``fork`` is missing or other threads run
-    (forking a threaded process is unsafe).  Never raises."""
-    if not hasattr(os, "fork") or threading.active_count() > 1:
+    (forking a threaded process is unsafe: core/forksafe.py).  Never raises."""
+    if not fork_is_safe():
         save(ws)
         return
     wait()

@@ -17,10 +17,11 @@ from __future__ import annotations
 
 import hashlib
 import os
-import threading
 from pathlib import Path
 from typing import Any, Iterable, cast
 
+from rclverify.core import cpus as cpus_now
+from rclverify.core.forksafe import fork_is_safe
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.stage_records import CrosscheckRecord
 from rclverify.records.store import atomic_write_text
@@ -165,10 +166,9 @@ def _decide_scripts(todo: list[tuple[str, str, bool]], split_min: int) -> list[D
     (:class:`~.cvc5_decide.Session`), whose answers and proofs equal a fresh
     solver's, so the decisions are those of the serial path."""
     half = len(todo) // 2
-    # a process with other threads (the live progress line of a serial run on a terminal) is not forked:
-    # a lock one of them holds would stay held in the child (core/cache/workspace.py forks under the same rule)
-    if (len(todo) < max(2, split_min) or not _other_cpu_free() or not hasattr(os, "fork")
-            or threading.active_count() > 1):
+    # a process with other threads (the live progress line of a serial run on a terminal) is not forked: a lock
+    # one of them holds would stay held in the child (core/forksafe.py; a doit -n worker's queue feeder excepted)
+    if len(todo) < max(2, split_min) or not fork_is_safe() or not _other_cpu_free():
         return _decide_block(todo)
     import multiprocessing  # deferred: optional or conditional (inside a block)
     from concurrent.futures import ProcessPoolExecutor  # deferred: optional or conditional (inside a block)
@@ -180,14 +180,21 @@ def _decide_scripts(todo: list[tuple[str, str, bool]], split_min: int) -> list[D
 
 def _other_cpu_free() -> bool:
     """Whether a second CPU is free for the forked child: the process may
-    run on two or more, and the load average of the last minute (this
-    process counts 1) leaves at least half of one idle.  On a busy machine
-    the child only waits for a core and costs its fork, its copied pages
-    and its own solver (0.13 CPU s of 1.7 for the 200-node chain's 1,000
-    scripts at load 3, the same wall time: docs/scale.md, issue 67)."""
+    run on two or more, and over a short window (:func:`~rclverify.core.cpus.idle_cpus`,
+    while this process sleeps) its own CPU and at least half of another
+    were idle.  On a busy machine the child only waits for a core and costs
+    its fork, its copied pages and its own solver (0.13 CPU s of 1.7 for
+    the 200-node chain's 1,000 scripts at load 3, the same wall time:
+    docs/scale.md, issue 67).  Where the CPU counters cannot be read, the
+    load average of the last minute (this process counts 1) must leave half
+    a CPU idle; that figure lags: after a busy phase it keeps a free CPU
+    looking busy for a minute."""
     cpus = len(_cpus())
     if cpus < 2:
         return False
+    idle = cpus_now.idle_cpus()
+    if idle is not None:
+        return idle >= 1.5
     try:
         load = os.getloadavg()[0]
     except OSError:  # not known: as before the load was read
@@ -196,8 +203,7 @@ def _other_cpu_free() -> bool:
 
 
 def _cpus() -> set[int]:
-    getter = getattr(os, "sched_getaffinity", None)
-    return set(getter(0)) if getter is not None else set(range(os.cpu_count() or 1))
+    return cpus_now.allowed_cpus()
 
 
 def _in_child(todo: list[tuple[str, str, bool]]) -> list[Decision]:
