@@ -22,7 +22,10 @@ holds in context (``x_i <= 50 + i``) and none locally; the requirement
 
 Both source trees are byte-compiled first (``compileall``), as an installed
 package is.  ``ratio`` is verify's CPU over Pacti's, ``wall/p`` its wall clock over
-Pacti's CPU seconds (Pacti runs on one core).  Then the growth per
+Pacti's CPU seconds (Pacti runs on one core).  ``--jobs J`` also runs
+``rclverify verify -n J`` (J doit processes: the node tasks and the two
+report parts side by side) and prints its CPU and wall clock, and
+``-n/p`` its wall clock over Pacti's CPU seconds.  Then the growth per
 doubling of each column.  ``--src OLD_SRC`` runs
 ``rclverify verify`` from another source tree as well (a ``git worktree``
 of the old code), ``--repeat K`` takes the median of K runs.
@@ -111,11 +114,13 @@ def whatif(root: Path, off: str) -> float:
     return float(probe["cpu"])
 
 
-def verify(root: Path, src: Path) -> dict[str, Any]:
-    """``rclverify verify`` of ``root`` with the source tree ``src``: CPU and the verdicts."""
+def verify(root: Path, src: Path, jobs: int = 1) -> dict[str, Any]:
+    """``rclverify verify`` of ``root`` with the source tree ``src`` (``jobs`` doit processes, ``-n``): CPU,
+    wall clock and the verdicts."""
     env = dict(os.environ, PYTHONPATH=str(src))
     t0 = time.perf_counter()
-    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-m", "rclverify.cli.commands", "verify", "-w", str(root)],
+    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-m", "rclverify.cli.commands", "verify",
+                        *(["-n", str(jobs)] if jobs > 1 else []), "-w", str(root)],
                        capture_output=True, text=True, env=env)
     wall = time.perf_counter() - t0
     probe = json.loads(p.stdout)
@@ -158,6 +163,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--floor", action="store_true",
                    help="also run verify without fresh Z3 contexts, and without them and the second solver (what-if)")
     p.add_argument("--smoke", action="store_true", help="N = 5, with --floor: seconds (CI)")
+    p.add_argument("--jobs", type=int, default=1, metavar="J",
+                   help="also run `rclverify verify -n J` (J doit processes) and print its CPU and wall clock")
     args = p.parse_args(argv)
     args.floor = args.floor or args.smoke  # the what-if patches name internals: CI keeps them working
     from compose_pacti import _pacti, pacti_chain
@@ -172,16 +179,19 @@ def main(argv: list[str] | None = None) -> int:
     head += f" {'old s':>8}" if args.src else ""
     head += f" {'calc s':>7}" + (f" {'calc full':>9}" if args.full else "")
     head += f" {'no ctx':>7} {'no ctx,cvc5':>11}" if args.floor else ""
-    head += f" {'pacti s':>8} {'ratio':>6} {'wall/p':>6}"
+    head += f" {'-n' + str(args.jobs) + ' s':>7} {'-n' + str(args.jobs) + ' wall':>8}" if args.jobs > 1 else ""
+    head += f" {'pacti s':>8} {'ratio':>6} {'wall/p':>6}" + (f" {'-n/p':>6}" if args.jobs > 1 else "")
     print(head)
     ok, rows = True, []
     for n in sizes:
-        runs, old, calc, full, pac, noctx, bare = [], [], [], [], [], [], []
+        runs, old, calc, full, pac, noctx, bare, par = [], [], [], [], [], [], [], []
         for _ in range(args.repeat):
             with tempfile.TemporaryDirectory() as d:
                 runs.append(verify(workspace(Path(d) / "ws", n), ROOT / "src"))
                 if args.src:
                     old.append(verify(workspace(Path(d) / "old", n), Path(args.src))["cpu"])
+                if args.jobs > 1:
+                    par.append(verify(workspace(Path(d) / "par", n), ROOT / "src", args.jobs))
                 calc.append(calculus(Path(d) / "ws", True))
                 if args.full:
                     full.append(calculus(Path(d) / "ws", False))
@@ -193,19 +203,23 @@ def main(argv: list[str] | None = None) -> int:
                 ok = ok and r["first"] is None
                 pac.append(r["seconds"])
         r = runs[0]
-        ok = ok and r["rc"] == 0 and r["other"] == 0 and r["context"] == n - 1 and r["SYS"].startswith("proved")
+        ok = ok and all(x["rc"] == 0 and x["other"] == 0 and x["context"] == n - 1 and x["SYS"].startswith("proved")
+                        for x in runs[:1] + par[:1])
         row = {"n": n, "verify": statistics.median(x["cpu"] for x in runs), "calc": statistics.median(calc),
                "wall": statistics.median(x["wall"] for x in runs),
                "old": statistics.median(old) if old else None, "full": statistics.median(full) if full else None,
                "pacti": statistics.median(pac) if pac else None,
-               "noctx": statistics.median(noctx) if noctx else None, "bare": statistics.median(bare) if bare else None}
+               "noctx": statistics.median(noctx) if noctx else None, "bare": statistics.median(bare) if bare else None,
+               "par": statistics.median(x["cpu"] for x in par) if par else None,
+               "parwall": statistics.median(x["wall"] for x in par) if par else None}
         rows.append(row)
         line = f"{n:5} {row['verify']:9.2f} {row['wall']:7.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
         line += f" {row['old']:8.2f}" if args.src else ""
         line += f" {row['calc']:7.2f}" + (f" {row['full']:9.2f}" if args.full else "")
         line += f" {row['noctx']:7.2f} {row['bare']:11.2f}" if args.floor else ""
+        line += f" {row['par']:7.2f} {row['parwall']:8.2f}" if par else ""
         line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f} {row['wall'] / row['pacti']:6.2f}"
-                 if row["pacti"] else "  (Pacti not installed)")
+                 + (f" {row['parwall'] / row['pacti']:6.2f}" if par else "") if row["pacti"] else "  (Pacti not installed)")
         print(line, flush=True)
     for a, b in zip(rows, rows[1:]):
         growth = {k: b[k] / a[k] for k in ("verify", "old", "calc", "full", "noctx", "bare", "pacti")
