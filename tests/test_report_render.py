@@ -334,6 +334,28 @@ def test_without_dot_report_embeds_source(monkeypatch: pytest.MonkeyPatch) -> No
     assert "digraph system {" in system and "&#34;Sensor&#34; -&gt; &#34;Agent&#34;" in system
 
 
+def test_a_system_too_large_to_draw_is_not_laid_out(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 67: above diagram.MAX_SYSTEM_LAYOUT_ELEMENTS (nodes, connections, environment inputs) the
+    report runs no `dot` (whose time grows faster than the size: minutes, or its 30 s timeout, at a few
+    thousand nodes, and whether the diagram appeared then depended on the machine's speed); it says
+    why and how to draw it, inlines no source in the HTML, and the Markdown keeps the source."""
+    rep = _report()
+    n = diagram.system_elements(rep["system"])
+    assert diagram.system_layout(rep["system"], "digraph { this is not dot").note  # at the limit: dot runs
+    monkeypatch.setattr(diagram, "MAX_SYSTEM_LAYOUT_ELEMENTS", n - 1)
+    def render_dot(dot: str, *a: Any, **k: Any) -> diagram.Rendering:
+        assert "digraph system {" not in dot, "dot must not run on the system"
+        return NO_DOT  # the argument's diagram
+    monkeypatch.setattr(diagram, "render_dot", render_dot)
+    for html in (render.render_html(rep), render.render_html(rep, rendering=NO_DOT),
+                 (render.render_files(rep, tmp_path, ["assurance.html"])[0]).read_text(encoding="utf-8")):
+        system = _section(html, 'id="system"', "</section>")
+        assert f"No diagram: the system has {len(rep['system']['nodes'])} nodes" in system, system[:2000]
+        assert "<svg" not in system and "<pre>" not in system and "doit graph" in system
+    md = render.render_markdown(rep)
+    assert "too large for the HTML report to draw" in md and "digraph system {" in md
+
+
 @pytest.mark.skipif(shutil.which("dot") is None, reason="graphviz `dot` not installed")
 def test_dot_error_is_explained() -> None:
     result = diagram.render_dot("digraph { this is not dot")

@@ -40,6 +40,13 @@ OTHER_COLOURS = _OTHER_COLOURS
 #: Seconds the ``dot`` program may run before the diagram is given up.
 DOT_TIMEOUT_S = 30.0
 
+#: The largest system diagram (nodes, connections and environment inputs) the report lays out.
+#: ``dot``'s time grows faster than the size: on a system shaped like bench/system_scale.py's (a
+#: chain with joins and loops), 0.3 s at 500 nodes, 1.7 s at 1,000, 10 s at 2,000, 39 s at 3,000
+#: (issue 67, docs/scale.md); a drawing of thousands of boxes is not legible, and past
+#: :data:`DOT_TIMEOUT_S` whether a diagram appeared would depend on the machine's speed.
+MAX_SYSTEM_LAYOUT_ELEMENTS = 2500
+
 INSTALL_HINT = "install graphviz for the diagram (the `dot` program was not found)"
 
 
@@ -168,6 +175,35 @@ class Rendering:
 
     svg: str | None
     note: str
+
+
+def system_elements(system: Mapping[str, Any]) -> int:
+    """How many elements the diagram of ``report["system"]`` draws: its
+    nodes, connections and environment inputs.  Raises ``KeyError`` when a
+    key :func:`system_dot` needs is missing."""
+    return len(system["nodes"]) + len(system["connections"]) + len(system["environment_inputs"])
+
+
+def system_too_large(system: Mapping[str, Any]) -> bool:
+    """More than :data:`MAX_SYSTEM_LAYOUT_ELEMENTS` elements: the report does not lay the system out."""
+    return system_elements(system) > MAX_SYSTEM_LAYOUT_ELEMENTS
+
+
+def system_layout(system: Mapping[str, Any], dot: str) -> Rendering:
+    """The SVG of the system diagram's DOT text ``dot`` (:func:`render_dot`)
+    for ``report["system"]``, or, for a system of more than
+    :data:`MAX_SYSTEM_LAYOUT_ELEMENTS` elements, no SVG and a note saying
+    why and how to draw it anyway (``dot`` is then not run).  Never raises
+    for Graphviz trouble."""
+    if not system_too_large(system):
+        return render_dot(dot)
+    return Rendering(None, f"the system has {len(system['nodes'])} nodes, {len(system['connections'])} connections "
+                           f"and {len(system['environment_inputs'])} environment inputs, more than the "
+                           f"{MAX_SYSTEM_LAYOUT_ELEMENTS} elements the report lays out (Graphviz needs minutes for "
+                           "a few thousand, and a diagram of that size is not legible); its nodes, connections "
+                           "and loops are in the tables below, its Graphviz source in assurance.md; to draw it "
+                           "anyway, run `doit graph` (artifacts/system/model.dot) and "
+                           "dot -Tsvg artifacts/system/model.dot")
 
 
 def render_dot(dot: str, timeout_s: float = DOT_TIMEOUT_S) -> Rendering:

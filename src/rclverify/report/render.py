@@ -109,9 +109,12 @@ def render_html(report: Report, link_prefix: str = "../",
     for a missing inner key.
     """
     dot = _system_dot(report)
-    drawn = rendering if rendering is not None else system if system is not None else diagram.render_dot(dot)
+    too_large = diagram.system_too_large(report["system"])
+    drawn = diagram.system_layout(report["system"], dot) if too_large or (rendering is None and system is None) \
+        else rendering if rendering is not None else system
     return environment().get_template("assurance.html.j2").render(
         **_context(report, link_prefix, fragments), dot=dot, svg=drawn.svg, diagram_note=drawn.note,
+        diagram_too_large=too_large,
         argument=_argument(report, rendering if rendering is not None else argument, fragments),
     )
 
@@ -125,6 +128,8 @@ def render_markdown(report: Report, link_prefix: str = "../", fragments: Fragmen
     """
     dot = _system_dot(report)
     return environment().get_template("assurance.md.j2").render(**_context(report, link_prefix, fragments), dot=dot,
+                                                                 diagram_too_large=diagram.system_too_large(report["system"]),
+                                                                 max_layout=diagram.MAX_SYSTEM_LAYOUT_ELEMENTS,
                                                                  argument=_argument(report, _NO_LAYOUT, fragments))
 
 
@@ -180,7 +185,7 @@ def render_files(report: Report, out_dir: Path, names: Sequence[str] = REPORT_FI
     with ThreadPoolExecutor(max_workers=2, thread_name_prefix="rclverify-dot") as pool:
         layouts: tuple[Future[diagram.Rendering], Future[diagram.Rendering]] | None = None
         if "assurance.html" in names:
-            layouts = (pool.submit(diagram.render_dot, _system_dot(report)),
+            layouts = (pool.submit(diagram.system_layout, report["system"], _system_dot(report)),
                        pool.submit(argument if argument is not None else argument_layout(report, fragments)))
         if "assurance.md" in names:
             texts["assurance.md"] = render_markdown(report, link_prefix, fragments=fragments)
