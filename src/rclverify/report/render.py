@@ -110,8 +110,8 @@ def render_html(report: Report, link_prefix: str = "../",
     """
     dot = _system_dot(report)
     too_large = diagram.system_too_large(report["system"])
-    drawn = diagram.system_layout(report["system"], dot) if too_large or (rendering is None and system is None) \
-        else rendering if rendering is not None else system
+    given = rendering if rendering is not None else system
+    drawn = diagram.system_layout(report["system"], dot) if too_large or given is None else given
     return environment().get_template("assurance.html.j2").render(
         **_context(report, link_prefix, fragments), dot=dot, svg=drawn.svg, diagram_note=drawn.note,
         diagram_too_large=too_large,
