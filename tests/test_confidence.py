@@ -96,8 +96,28 @@ def test_derived_claims_equal_claim_over_each_cone_exactly(g, shared, doubts) ->
         own = {v: [Premise(f"p{j}", p.kind, p.doubt) for j, p in enumerate(ps)] for v, ps in own.items()}
     producers = {v: [a for a, b in edges if b == v] for v in nodes}
     cone = cones(producers)
-    got = derived_claims(own, producers)
-    assert got == {v: claim(p for m in sorted(cone[v]) for p in own.get(m, ())) for v in nodes}
+    want = {v: claim(p for m in sorted(cone[v]) for p in own.get(m, ())) for v in nodes}
+    assert derived_claims(own, producers) == want
+    assert derived_claims(own, producers, vector_from=0) == want  # the bit masks over numpy arrays
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 40), st.data())
+def test_the_bit_mask_path_equals_claim_over_each_cone_on_larger_graphs(n: int, data: st.DataObject) -> None:
+    """Issue 67: the cones as bit masks over numpy arrays (derived_claims from VECTOR_FROM nodes) give
+    claim() over the sorted cone on graphs of up to 40 nodes whose names do not sort as their numbers,
+    with loops, joins, premises-free nodes and producers that have no premises entry at all."""
+    nodes = [f"N{i}" for i in range(n)]
+    extra = ["X", "A0"]  # producers that appear only as producers
+    edges = data.draw(st.lists(st.tuples(st.sampled_from(nodes + extra), st.sampled_from(nodes)), max_size=3 * n))
+    doubts = st.floats(0.0, 0.2, allow_nan=False)
+    own = {v: [Premise(f"{v} p{j}", "tested", data.draw(doubts)) for j in range(data.draw(st.integers(0, 3)))]
+           for v in nodes}
+    producers = {v: [a for a, b in edges if b == v] for v in nodes}
+    cone = cones(producers)
+    want = {v: claim(p for m in sorted(cone[v]) for p in own.get(m, ())) for v in nodes}
+    assert derived_claims(own, producers, vector_from=0) == want
+    assert derived_claims(own, producers, vector_from=10 ** 9) == want
 
 
 # -- on a verified workspace --------------------------------------------------------------------------
