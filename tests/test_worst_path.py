@@ -86,15 +86,22 @@ def test_the_deadline_task_reads_every_node_between_the_ends() -> None:
 def test_nodes_between_cover_every_simple_path_on_random_graphs() -> None:
     """Oracle: every node of every simple path between the ends (brute force over node orders) is
     named, and every node named lies on a walk from the first to the last."""
-    from types import SimpleNamespace
+    import networkx as nx
 
-    from rclverify.calculus.worst_path import nodes_between
+    from rclverify.calculus.worst_path import _between, _graph, nodes_between
+    from rclverify.model.system.model import Link, SystemModel
     rnd = random.Random(4848)
     for _ in range(60):
         names = [f"N{i}" for i in range(rnd.randint(2, 6))]
         edges = {(a, b) for a in names for b in names if a != b and rnd.random() < 0.35}
-        model = SimpleNamespace(nodes=names, links=[SimpleNamespace(from_node=a, to_node=b) for a, b in edges])
+        model = SystemModel(tuple(rnd.sample(names, len(names))),
+                            tuple(Link(a, f"o{k}", b, f"i{k}", "name") for k, (a, b) in enumerate(sorted(edges))), (), ())
         a, b = names[0], names[-1]
+        # issue 67: read off the model's upstream masks, the same nodes in the same order as the networkx search
+        g = _graph(model)
+        assert isinstance(g, nx.DiGraph)
+        between = _between(g, a, b)
+        assert nodes_between(model, [a, b]) == tuple(dict.fromkeys([a, b, *(n for n in model.nodes if n in between)]))
         on_paths: set[str] = set()
         for k in range(len(names) - 1):
             for mid in itertools.permutations([n for n in names if n not in (a, b)], k):

@@ -22,7 +22,7 @@ from fractions import Fraction
 from typing import Any, Sequence
 
 from rclverify.lang.types import Checked
-from rclverify.model.system.model import SystemModel
+from rclverify.model.system.model import SystemModel, names_of
 from rclverify.calculus.deadlines import INCONCLUSIVE, PROVED, REFUTED, _show, chains, decide
 import itertools
 
@@ -73,11 +73,14 @@ def nodes_between(model: SystemModel, path: Sequence[str]) -> tuple[str, ...]:
     depends on their snapshots: an edit of a hop off the named path changes
     the verdict too (issue 48: an incremental run kept a deadline refuted
     that a clean run proved)."""
-    g = _graph(model)
-    if len(path) < 2 or path[0] not in g or path[-1] not in g:
+    masks = model.upstream_masks()  # bit i: model.nodes[i]; a node's mask holds the node and all that reach it
+    if len(path) < 2 or path[0] not in masks or path[-1] not in masks:
         return tuple(path)
-    between = _between(g, path[0], path[-1])
-    return tuple(dict.fromkeys([*path, *(n for n in model.nodes if n in between)]))
+    # read off the last node's upstream cone (the model's masks, built once): the nodes whose own cone holds
+    # the first; a graph built per call cost 0.06 s a deadline at 5000 nodes, 49 deadlines per process
+    first = 1 << model.nodes.index(path[0])
+    between = [n for n in names_of(masks[path[-1]], model.nodes) if masks[n] & first]
+    return tuple(dict.fromkeys([*path, *between]))
 
 
 def with_worst_path(result: Any, checked: Checked, model: SystemModel) -> Any:

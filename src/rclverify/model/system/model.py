@@ -19,7 +19,6 @@ is an error asking for an explicit connection in the plan.
 from __future__ import annotations
 
 import json
-from collections import deque
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -125,48 +124,33 @@ class SystemModel:
         built once per model.
 
         A search per node would cost the sum of the cones' sizes, quadratic
-        along a chain (half a million names at 1000 nodes).  Here each
-        node's mask is its own bit or-ed with its producers' masks, taken
-        in an order that puts producers first (a depth-first post-order over
-        the producer edges), so a system without loops needs one union per
-        link; a loop's nodes are revisited until their masks stop growing
-        (the least fixpoint: exactly the nodes that reach each node)."""
+        along a chain (half a million names at 1000 nodes).  Here the
+        strongly connected components (Tarjan's, over the producer edges)
+        are taken producers first, and each component's mask is its nodes'
+        bits or-ed with the masks of the producers outside it: one union
+        per link, loops included, and exactly the nodes that reach each
+        node (the least fixpoint: the nodes of a loop reach one another)."""
         return MappingProxyType(self._upstream_masks)
 
     @cached_property
     def _upstream_masks(self) -> dict[str, int]:
         index = self._index
-        mask = {n: 1 << i for i, n in enumerate(self.nodes)}
-        order: list[str] = []
-        seen: set[str] = set()
-        for root in self.nodes:  # iterative depth-first post-order over the producer edges
-            if root in seen:
-                continue
-            seen.add(root)
-            stack = [(root, iter(index[root][0]))]
-            while stack:
-                n, producers = stack[-1]
-                for p in producers:
-                    if p not in seen:
-                        seen.add(p)
-                        stack.append((p, iter(index[p][0])))
-                        break
-                else:
-                    stack.pop()
-                    order.append(n)
-        todo, queued = deque(order), set(order)
-        while todo:
-            n = todo.popleft()
-            queued.discard(n)
-            m = mask[n]
-            for p in index[n][0]:
-                m |= mask[p]
-            if m != mask[n]:
-                mask[n] = m
-                for c in index[n][1]:
-                    if c not in queued:
-                        todo.append(c)
-                        queued.add(c)
+        bit = {n: 1 << i for i, n in enumerate(self.nodes)}
+        preds = {n: index[n][0] for n in self.nodes}
+        mask: dict[str, int] = {}
+        # one union per link: each strongly connected component (a loop's nodes reach one another) after every
+        # component it reads from; a worklist fixpoint over a depth-first order re-propagated each loop's growth
+        # down the rest of the system (3 s at 5000 nodes with a loop every tenth node, issue 67)
+        for members in strongly_connected_components(self.nodes, preds):
+            inside = set(members)
+            acc = 0
+            for n in members:
+                acc |= bit[n]
+                for p in preds[n]:
+                    if p not in inside:
+                        acc |= mask[p]
+            for n in members:
+                mask[n] = acc
         return mask
 
     def alias(self) -> Mapping[tuple[str, str, str], str]:
