@@ -90,8 +90,14 @@ def render_tests(target: NodeTarget, cfg: Config, stateful: bool) -> str:
 
 
 def _is_class(target: NodeTarget, cfg: Config) -> bool:
+    return inspect.isclass(_load(target, cfg))
+
+
+def _load(target: NodeTarget, cfg: Config) -> Any:
+    """The implementation of ``cfg``, imported afresh (:func:`load_implementation`); a file that does not
+    import, or lacks the name, is a :class:`~rclverify.model.plan.errors.PlanError` located in the plan."""
     try:
-        return inspect.isclass(load_implementation(target.root, cfg))
+        return load_implementation(target.root, cfg)
     except ConfigError as exc:
         raise target.config_error(str(exc), *exc.path) from None
 
@@ -163,9 +169,10 @@ class PropertyTestsBackend:
             if not 1 <= k <= len(target.node.node.guarantees):
                 return evidence("error", "the contract no longer has this guarantee; export again")
             path = test_file(target)
-            atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
+            impl = _load(target, cfg)  # imported once for the run: the test file's kind and the run itself
+            atomic_write_text(path, render_tests(target, cfg, inspect.isclass(impl)))
             with wall_clock_limit(cfg.timeout_s):
-                outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts)
+                outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts, impl)
         except TimeLimitExceeded as exc:
             return evidence("inconclusive", f"{cfg.implementation}: the run of guarantee {k} {exc} (timeout_s of "
                             f"the plan entry, {target.config_loc('timeout_s') if 'timeout_s' in target.config else 'default'}"

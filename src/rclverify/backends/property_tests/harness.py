@@ -397,13 +397,15 @@ def _example_text(cex: Mapping[str, str]) -> str:
 
 
 def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Config, root: Path,
-                  facts: tuple[ast.Expr, ...] = ()) -> Outcome:
-    """Load the implementation and run guarantee ``guarantee`` (1-based) of ``node``,
+                  facts: tuple[ast.Expr, ...] = (), impl: Any = None) -> Outcome:
+    """Run guarantee ``guarantee`` (1-based) of ``node`` on the implementation
+    ``impl`` (loaded afresh here when ``None``: :func:`load_implementation`),
     inputs drawn under the assumption and the environment ``facts`` (parsed plan facts).
 
     Raises :class:`ConfigError` for an implementation that cannot be loaded.
     """
-    impl = load_implementation(root, cfg)
+    if impl is None:
+        impl = load_implementation(root, cfg)
     return GuaranteeRun(checked, node, guarantee, cfg, impl, facts).run()
 
 
