@@ -88,10 +88,13 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     ``dbm.dumb`` (no gdbm on many systems) opening the store parses one line
     per task with ``ast.literal_eval``, about 0.3 CPU s of a 1000-node no-op
     run when it had 5000 tasks (docs/scale.md).  A workspace that switches store runs
-    every task once, as doit knows no earlier state in the new file."""
+    every task once, as doit knows no earlier state in the new file.  The
+    file checker is doit's md5 checker with one md5 per file state and
+    process (:mod:`rclverify.app.doit_checker`)."""
     from rclverify.app.progress import ProgressReporter  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
+    from rclverify.app.doit_checker import MD5Checker  # deferred: start-up (loads doit.dependency only when called)
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
-            "reporter": ProgressReporter}
+            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker}
 
 
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
