@@ -11,7 +11,10 @@ blocked, recorded in the lists ``B`` of the paper, so no dead end is
 searched twice); then ``s`` is removed and the components of the rest of
 the component are searched the same way.  Time ``O((V + E)(C + 1))`` for
 ``C`` circuits.  Written here so that the pipeline does not import networkx
-(0.15-0.2 s of every cold ``doit`` run) for its one use of it.
+(0.15-0.2 s of every cold ``doit`` run) for its one use of it.  Tarjan's
+components also give every node's upstream cone as a bit mask in one union
+per link (:func:`upstream_bits`), for the system model and the report's
+confidence claims.
 """
 from __future__ import annotations
 
@@ -108,6 +111,34 @@ def _circuits_through(s: N, comp: set[N], succ: dict[N, list[N]]) -> list[list[N
         if found:
             found[-1] = found[-1] or closed
     return out
+
+
+def upstream_bits(nodes: Sequence[N], preds: dict[N, list[N]]) -> dict[N, int]:
+    """Each node's upstream cone as a bit mask (bit ``i`` is ``nodes[i]``):
+    the node and every node with a path to it over ``preds`` (node -> the
+    nodes it reads from; every node of ``nodes`` a key; names outside
+    ``nodes`` are left out).  The strongly connected components are taken
+    producers first (:func:`strongly_connected_components` over ``preds``),
+    each component's mask its nodes' bits or-ed with the masks of the
+    producers outside it: one union per link, loops included (the nodes of
+    a loop reach one another), and exactly the least fixpoint of
+    ``cone(n) = {n} + cone(p)``.  A worklist fixpoint over a depth-first
+    order, as the system model had it, re-propagated each loop's growth down
+    the rest of the system (3 s at 5000 nodes with a loop every tenth node,
+    issue 67)."""
+    bit = {n: 1 << i for i, n in enumerate(nodes)}
+    mask: dict[N, int] = {}
+    for members in strongly_connected_components(nodes, preds):
+        inside = set(members)
+        acc = 0
+        for n in members:
+            acc |= bit[n]
+            for p in preds[n]:
+                if p not in inside and p in bit:
+                    acc |= mask[p]
+        for n in members:
+            mask[n] = acc
+    return mask
 
 
 def elementary_cycles(nodes: Sequence[N], edges: Iterable[tuple[N, N]]) -> list[list[N]]:

@@ -30,7 +30,7 @@ from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import Checked, EmptyT
 from rclverify.model.system.services import peers as service_peers, side_conditions as service_conditions
 from rclverify.model.system.units import connection_diagnostics
-from rclverify.model.system.cycles import elementary_cycles, strongly_connected_components
+from rclverify.model.system.cycles import elementary_cycles, strongly_connected_components, upstream_bits
 
 
 @dataclass(frozen=True)
@@ -135,23 +135,7 @@ class SystemModel:
     @cached_property
     def _upstream_masks(self) -> dict[str, int]:
         index = self._index
-        bit = {n: 1 << i for i, n in enumerate(self.nodes)}
-        preds = {n: index[n][0] for n in self.nodes}
-        mask: dict[str, int] = {}
-        # one union per link: each strongly connected component (a loop's nodes reach one another) after every
-        # component it reads from; a worklist fixpoint over a depth-first order re-propagated each loop's growth
-        # down the rest of the system (3 s at 5000 nodes with a loop every tenth node, issue 67)
-        for members in strongly_connected_components(self.nodes, preds):
-            inside = set(members)
-            acc = 0
-            for n in members:
-                acc |= bit[n]
-                for p in preds[n]:
-                    if p not in inside:
-                        acc |= mask[p]
-            for n in members:
-                mask[n] = acc
-        return mask
+        return upstream_bits(self.nodes, {n: index[n][0] for n in self.nodes})
 
     def alias(self) -> Mapping[tuple[str, str, str], str]:
         """Encoder aliases: each connected input becomes its producer's output

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 from itertools import chain
 from typing import Iterable, Mapping, Sequence
 
-from rclverify.model.system.cycles import strongly_connected_components
+from rclverify.model.system.cycles import upstream_bits
 
 
 @dataclass(frozen=True)
@@ -85,28 +85,19 @@ def claim(premises: Iterable[Premise]) -> Claim:
 def cones(producers: Mapping[str, Iterable[str]]) -> dict[str, frozenset[str]]:
     """C4's cones: for every node of ``producers`` (node -> its producer
     nodes), the least fixpoint ``cone(n) = {n} + cone(p)`` (loops
-    included): the nodes with a path to ``n``, and ``n``.  Computed once
-    per strongly connected component (:func:`rclverify.model.system.cycles.strongly_connected_components`,
-    which gives a component after every component it reads from: a loop's
-    nodes share one cone), each cone the union of its component's nodes and its
-    producer components' cones.  Iterating the fixpoint over the nodes
+    included): the nodes with a path to ``n``, and ``n``.  Read off
+    :func:`rclverify.model.system.cycles.upstream_bits` (one union per link
+    over the strongly connected components; a loop's nodes share one cone).
+    Iterating the fixpoint over the nodes
     until no cone grew took 1.4 CPU s of each report task at 1000 nodes
     (docs/scale.md, issue 67); networkx's condensation does the same in
     0.1 s, plus 0.1 s to import it in every report process."""
     nodes = sorted(set(producers) | {p for ps in producers.values() for p in ps})
-    preds = {n: list(producers.get(n, ())) for n in nodes}
-    cone: dict[str, frozenset[str]] = {}
-    for members in strongly_connected_components(nodes, preds):  # each after every component it reads from
-        inside = set(members)
-        acc = set(inside)
-        for m in members:
-            for q in preds[m]:
-                if q not in inside:
-                    acc |= cone[q]
-        whole = frozenset(acc)
-        for m in members:
-            cone[m] = whole
-    return cone
+    bits = upstream_bits(nodes, {n: list(producers.get(n, ())) for n in nodes})
+    sets: dict[int, frozenset[str]] = {}  # one set per distinct cone: a loop's nodes share theirs
+    for b in set(bits.values()):
+        sets[b] = frozenset(nodes[i] for i in range(b.bit_length()) if b >> i & 1)
+    return {n: sets[bits[n]] for n in nodes}
 
 
 def node_claims(own: Mapping[str, Sequence[Premise]]) -> dict[str, Claim]:
@@ -154,8 +145,8 @@ def derived_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str,
 
 def _vector_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str, Sequence[str]]) -> dict[str, Claim]:
     """:func:`derived_claims` (no label shared) with each cone a bit mask
-    (a Python ``int``, bit ``i`` the ``i``-th node in sorted order) made per
-    strongly connected component as :func:`cones` makes its sets, and each
+    (a Python ``int``, bit ``i`` the ``i``-th node in sorted order:
+    :func:`~rclverify.model.system.cycles.upstream_bits`), and each
     node's premises' doubts a run of one array in that order: a cone's
     doubts are the runs its mask selects, in sorted node order, summed by
     Python's ``sum`` as the per-node path sums them; its limit is the
@@ -164,18 +155,7 @@ def _vector_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str,
     import numpy as np  # deferred: optional or conditional (large systems only: VECTOR_FROM)
     nodes = sorted(set(producers) | {p for ps in producers.values() for p in ps})
     rank = {m: i for i, m in enumerate(nodes)}
-    preds = {m: list(producers.get(m, ())) for m in nodes}
-    bits: dict[str, int] = {}
-    for members in strongly_connected_components(nodes, preds):  # each after every component it reads from
-        inside = set(members)
-        acc = 0
-        for m in members:
-            acc |= 1 << rank[m]
-            for q in preds[m]:
-                if q not in inside:
-                    acc |= bits[q]
-        for m in members:
-            bits[m] = acc
+    bits = upstream_bits(nodes, {m: list(producers.get(m, ())) for m in nodes})
     counts = np.array([len(own.get(m, ())) for m in nodes], dtype=np.int64)
     flat = np.array([p.doubt for m in nodes for p in own.get(m, ())], dtype=np.float64)
     tops = sorted(((max(own[m], key=lambda p: (p.doubt, p.label)), rank[m]) for m in nodes if own.get(m)),
