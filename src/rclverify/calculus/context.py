@@ -50,6 +50,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
+from rclverify.core.cache.memo import last_call
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.nicemodel import nicer_model
 from rclverify.semantics.query import query_solver, render_model, satisfiable, smt2_script, smtlib_benchmark
@@ -131,7 +132,10 @@ def link_text(l: Link) -> str:
     return f"{l.from_node}.out.{l.from_var} -> {l.to_node}.in.{l.to_var}"
 
 
-_JOINS: dict[str, Any] = {"model": None, "mask": 0}
+@last_call  # one model per run: its mask made once
+def _joins(model: SystemModel) -> int:
+    """The bit mask (over ``model.nodes``) of the nodes with two or more links into them."""
+    return sum(1 << i for i, n in enumerate(model.nodes) if len(model.links_into(n)) > 1)
 
 
 def single_paths(model: SystemModel, node: str) -> bool:
@@ -143,11 +147,7 @@ def single_paths(model: SystemModel, node: str) -> bool:
     bit mask (:meth:`SystemModel.upstream_masks`) against the mask of such
     nodes, made once per model, instead of a walk over the cone: along a
     chain the walks added up to N*N/2 steps (docs/scale.md, issue 67)."""
-    if _JOINS["model"] is not model:
-        bits = {n: 1 << i for i, n in enumerate(model.nodes)}
-        _JOINS["mask"] = sum(bits[n] for n in model.nodes if len(model.links_into(n)) > 1)
-        _JOINS["model"] = model
-    return int(model.upstream_masks().get(node, 0)) & int(_JOINS["mask"]) == 0
+    return model.upstream_masks().get(node, 0) & _joins(model) == 0
 
 
 def _multi_path(model: SystemModel, node: str, cone: Sequence[str], cut: set[tuple[str, str, str, str]]) -> set[str]:

@@ -52,14 +52,12 @@ from rclverify.calculus.requirements.check import (MODEL_TIMEOUT_MS, NEGATED, _a
 from rclverify.lang.types import Checked
 from rclverify.model.plan.formal import Formal
 from rclverify.model.plan.model import Plan, Requirement
+from rclverify.core.cache.memo import last_call
 from rclverify.model.system.model import SystemModel
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics import wallclock
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, solver_session
 from rclverify.semantics.world import fresh as fresh_z3
-
-#: The last system whose premises :func:`system_premises` decided: ``(checked, model, plan)`` and the answer.
-_MEMO: list[Any] = []
 
 
 @dataclass(frozen=True)
@@ -73,8 +71,10 @@ class Own:
     cone: list[str]
 
 
-#: :func:`own_nodes`'s answers for the last loaded system: ``[(checked, model, plan), {id(req): (req, answer)}]``.
-_OWN: list[Any] = [None, {}]
+@last_call
+def _own_answers(checked: Checked, model: SystemModel, plan: Plan) -> dict[int, tuple[Requirement, Own | None]]:
+    """:func:`own_nodes`'s answers for one loaded system, by ``id`` of the requirement (kept with it)."""
+    return {}
 
 
 def own_nodes(req: Requirement, checked: Checked, model: SystemModel, plan: Plan) -> Own | None:
@@ -86,14 +86,12 @@ def own_nodes(req: Requirement, checked: Checked, model: SystemModel, plan: Plan
     statement reads every node's names: the stage asks twice, for the
     fingerprint and for the check).  Raises ``RclError`` like
     :func:`.check.formals_of`."""
-    key = (checked, model, plan)
-    if _OWN[0] is None or any(a is not b for a, b in zip(_OWN[0], key)):
-        _OWN[:] = [key, {}]
-    kept = _OWN[1].get(id(req))
+    answers = _own_answers(checked, model, plan)
+    kept = answers.get(id(req))
     if kept is not None and kept[0] is req:
-        return kept[1]  # type: ignore[no-any-return]
+        return kept[1]
     answer = _own_nodes(req, checked, model, plan)
-    _OWN[1][id(req)] = (req, answer)
+    answers[id(req)] = (req, answer)
     return answer
 
 
@@ -129,12 +127,14 @@ def system_premises(checked: Checked, model: SystemModel, plan: Plan, timeout_ms
     module docstring), decided once per ``(checked, model, plan)`` in a
     fresh Z3 context; a fresh context is started after it too, so the
     caller must hold no Z3 object across the call."""
-    if _MEMO and _MEMO[0][0] is checked and _MEMO[0][1] is model and _MEMO[0][2] is plan:
-        return str(_MEMO[1])
+    return _system_answer(checked, model, plan, timeout_ms)
+
+
+@last_call  # once per loaded system (the model and plan compared by equality: the same objects are equal at once)
+def _system_answer(checked: Checked, model: SystemModel, plan: Plan, timeout_ms: int) -> str:
     fresh_z3()
     answer = _decide_system(checked, model, plan, timeout_ms)
     fresh_z3()
-    _MEMO[:] = [(checked, model, plan), answer]
     return answer
 
 
