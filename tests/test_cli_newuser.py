@@ -217,6 +217,24 @@ def test_a_problem_sentence_is_cut_at_a_clause_boundary_or_not_at_all() -> None:
     assert clause_cut("f(a: b; c) " + "x" * 50, 20) == "f(a: b; c) " + "x" * 50
 
 
+def test_the_first_sentence_does_not_end_inside_a_parenthesis_or_a_formula() -> None:
+    """A ``;`` or ``.`` before a capital letter ends the first sentence only outside parentheses and
+    backquotes: the case study's REQ4 sentence names nodes after each ``;`` of its parenthesis, and its
+    terminal line was cut after the first one, mid-parenthesis and with no ``...``."""
+    from rclverify.diagnosis.text import whole_first_sentence
+    from rclverify.report.problems import first_sentence
+    text = ("Requirement REQ4 (`eventually (a; B)`, contracts/plan.yaml:67:7) is refuted by a run in which no node "
+            "accepts its input (Agent.in.at never has a value: Navigation never publishes Navigation.out.at; "
+            "Navigation.in.command never has a value: Agent never publishes Agent.out.command), so none ever "
+            "answers. Declare the initial value.")
+    whole = text[:text.index(" Declare")]
+    assert whole_first_sentence(text) == whole
+    assert first_sentence(text) == whole  # under the row's 400 characters
+    assert first_sentence(text, 100).endswith(" ...") and len(first_sentence(text, 100)) <= 104
+    assert whole_first_sentence("One. Two.") == "One." and whole_first_sentence("one; Two") == "one;"
+    assert whole_first_sentence("no end at all") == "no end at all"
+
+
 # ---------------------------------------------------------------------------
 # item 8: `rclverify check contracts/*.rcl` in the bundled workspace
 # ---------------------------------------------------------------------------

@@ -71,13 +71,22 @@ def explain_lines(d: Mapping[str, Any]) -> list[str]:
     return out
 
 
-_SENTENCE_END = re.compile(r"(?<=[.;])\s+(?=[A-Z])")
-
-
 def whole_first_sentence(text: str) -> str:
-    """The first sentence of ``text`` (up to a ``.`` or ``;`` followed by a
-    capital letter), never cut."""
-    return _SENTENCE_END.split(str(text).strip(), 1)[0]
+    """The first sentence of ``text``, never cut: up to a ``.`` or ``;``
+    followed by white space and a capital letter, outside parentheses,
+    brackets, braces and backquoted formulas (:func:`_boundaries`).  A ``;``
+    inside a parenthesis before a node's name is no sentence end: REQ4's
+    sentence was shown in the terminal cut after its first ``Navigation.out.at;``, inside
+    its parenthesis and without a sign that it was cut."""
+    text = str(text).strip()
+    for k in _boundaries(text):
+        if text[k - 1] in ".;" and _CAPITAL_NEXT.match(text, k):
+            return text[:k]
+    return text
+
+
+#: White space then a capital letter: what starts a sentence after a boundary.
+_CAPITAL_NEXT = re.compile(r"\s+[A-Z]")
 
 
 def _boundaries(text: str) -> list[int]:

@@ -14,6 +14,7 @@ import re
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from rclverify.diagnosis.text import whole_first_sentence
 from rclverify.records.records import SEVERITY
 
 #: Key prefix of a group of outstanding evidence on a node's whole contract from one backend (rule 5).
@@ -128,16 +129,15 @@ def roots(culprits: Sequence[Mapping[str, Any]], places: Places, victim: str | N
     return roots or context
 
 
-_SENTENCE_END = re.compile(r"(?<=[.;])\s+(?=[A-Z])")
 #: Longest sentence a group's row shows (characters); the whole text is in its findings.
 SENTENCE_CHARS = 400
 
 
 def first_sentence(text: str, limit: int = SENTENCE_CHARS) -> str:
-    """The first sentence of ``text`` (up to a ``.`` or ``;`` followed by a
-    capital letter), cut at a word boundary to ``limit`` characters with
-    ``...`` when longer."""
-    s = _SENTENCE_END.split(str(text).strip(), 1)[0]
+    """The first sentence of ``text``
+    (:func:`rclverify.diagnosis.text.whole_first_sentence`), cut at a word
+    boundary to ``limit`` characters with ``...`` when longer."""
+    s = whole_first_sentence(text)
     if len(s) > limit:
         s = s[:limit].rsplit(" ", 1)[0] + " ..."
     return s
