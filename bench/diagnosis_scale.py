@@ -75,7 +75,7 @@ def verify(root: Path, src: Path = SRC) -> dict[str, object]:
     """``rclverify verify`` in ``root`` in a child process: ``{"rc", "out", "cpu"}``."""
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(src)] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
-    cmd = [sys.executable, "-m", "rclverify.cli.commands", "verify", "-w", str(root)]
+    cmd = [sys.executable, "-m", "rclverify.cli.commands", "verify", "-n", "1", "-w", str(root)]  # serial, as measured
     p = subprocess.run([sys.executable, "-c", PROBE, *cmd], capture_output=True, text=True, env=env)
     if p.returncode != 0 or not p.stdout.strip():
         raise RuntimeError(f"the probe failed (exit {p.returncode}): {p.stderr[-2000:]}")

@@ -206,7 +206,7 @@ def doit_verify(root: Path, jobs: int, src: str | None = None) -> Run:
     """Run ``python -m doit [-n jobs] verify`` in ``root``; time, peak memory,
     executed tasks.  ``src``: the rclverify source tree to run (put first on
     ``PYTHONPATH``; default: the installed one)."""
-    cmd = [sys.executable, "-m", "doit"] + (["-n", str(jobs)] if jobs > 1 else []) + ["verify"]
+    cmd = [sys.executable, "-m", "doit"] + ["-n", str(jobs)] + ["verify"]
     env = dict(os.environ)
     if src:
         env["PYTHONPATH"] = os.pathsep.join([str(Path(src).resolve())] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))

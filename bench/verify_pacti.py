@@ -106,7 +106,8 @@ def whatif(root: Path, off: str) -> float:
     """CPU seconds of ``rclverify verify`` of ``root`` with ``off`` (``ctx``,
     ``ctx,cvc5``) switched off (:data:`WHATIF`); raises ``RuntimeError`` when it fails."""
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
-    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-c", WHATIF, off, "verify", "-w", str(root)],
+    p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-c", WHATIF, off, "verify", "-n", "1", "-w",
+                        str(root)],
                        capture_output=True, text=True, env=env)
     probe = json.loads(p.stdout)
     if probe["rc"] != 0:
@@ -120,7 +121,7 @@ def verify(root: Path, src: Path, jobs: int = 1) -> dict[str, Any]:
     env = dict(os.environ, PYTHONPATH=str(src))
     t0 = time.perf_counter()
     p = subprocess.run([sys.executable, "-c", PROBE, sys.executable, "-m", "rclverify.cli.commands", "verify",
-                        *(["-n", str(jobs)] if jobs > 1 else []), "-w", str(root)],
+                        "-n", str(jobs), "-w", str(root)],
                        capture_output=True, text=True, env=env)
     wall = time.perf_counter() - t0
     probe = json.loads(p.stdout)

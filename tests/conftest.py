@@ -137,6 +137,12 @@ settings.register_profile("tests", deadline=None,
                           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "tests"))
 
+# A pipeline run without ``-n`` uses one doit process per CPU (app/jobs.py).  The suite's three
+# workers already fill the two cores, so its runs stay serial unless a test asks for more (``-n 2``,
+# or RCLVERIFY_JOBS in the test's own environment: tests/test_jobs.py): the same CPU seconds, and
+# doit's task lines in their serial order, which several tests read.  Subprocesses inherit it.
+os.environ.setdefault("RCLVERIFY_JOBS", "1")
+
 
 #: ``RCLVERIFY_TEST_CPU=FILE``: append each test's CPU seconds (user + system of the worker and of the
 #: children it waited for, setup to teardown) as ``module<TAB>test<TAB>seconds`` lines to FILE, so the

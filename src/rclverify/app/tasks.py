@@ -90,11 +90,23 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     run when it had 5000 tasks (docs/scale.md).  A workspace that switches store runs
     every task once, as doit knows no earlier state in the new file.  The
     file checker is doit's md5 checker with one md5 per file state and
-    process (:mod:`rclverify.app.doit_checker`)."""
+    process (:mod:`rclverify.app.doit_checker`).
+
+    ``num_process``: the processes of a run without ``-n``
+    (:func:`rclverify.app.jobs.default_jobs`: this machine's CPUs, at most
+    4, or ``RCLVERIFY_JOBS``).  A bad ``RCLVERIFY_JOBS`` prints one
+    ``error:`` line and raises ``SystemExit(1)``, as :func:`build_tasks`
+    does for its faults."""
     from rclverify.app.progress import ProgressReporter  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
     from rclverify.app.doit_checker import MD5Checker  # deferred: start-up (loads doit.dependency only when called)
+    from rclverify.app.jobs import JobsError, default_jobs  # deferred: start-up (loads multiprocessing only when called)
+    try:
+        jobs = default_jobs()
+    except JobsError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
-            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker}
+            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "num_process": jobs}
 
 
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,

@@ -22,7 +22,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    """Run the whole pipeline through doit in ``args.workspace`` (``--strict``: exit 1 unless everything holds; ``-n``: parallel processes; ``--cluster``: backend jobs on Dask); doit's exit code."""
+    """Run the whole pipeline through doit in ``args.workspace`` (``--strict``: exit 1 unless everything holds; ``-n``: doit processes, else :func:`rclverify.app.jobs.default_jobs`; ``--cluster``: backend jobs on Dask); doit's exit code."""
     from rclverify.app.tasks import DEP_FILE, build_tasks, doit_config  # deferred: start-up (loads doit, rclverify.app and more only when called)
     if not Path(args.workspace).is_dir():  # before doit opens its state file there (a sqlite3 traceback)
         print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
@@ -36,10 +36,15 @@ def cmd_verify(args: argparse.Namespace) -> int:
         return int(exc.code) if isinstance(exc.code, int) else 1
     module = type(sys)("rclverify_dodo")
     module.__dict__.update(tasks)
-    module.DOIT_CONFIG = doit_config(str(Path(args.workspace) / DEP_FILE))  # type: ignore[attr-defined]
+    try:  # a bad RCLVERIFY_JOBS: doit_config printed the one-line reason
+        module.DOIT_CONFIG = doit_config(str(Path(args.workspace) / DEP_FILE))  # type: ignore[attr-defined]
+    except SystemExit as exc:
+        from rclverify.core.runlock import release  # deferred: optional or conditional (inside a block)
+        release(Path(args.workspace))
+        return int(exc.code) if isinstance(exc.code, int) else 1
     argv = ["verify"] + (["--strict"] if args.strict else [])
-    if args.jobs > 1:
-        argv = ["-n", str(args.jobs)] + argv
+    if args.jobs is not None:  # else DOIT_CONFIG's num_process (app/jobs.py)
+        argv = ["-n", str(max(1, args.jobs))] + argv
     try:  # SystemExit: a fault while doit saves its state, already reported in one line (doit_patches.guard_dep_writes)
         return run_doit(module, argv, args.cluster)
     except SystemExit as exc:
@@ -77,7 +82,8 @@ def add_verify(add: AddCommand) -> None:
     v = add("verify", cmd_verify, "run the whole pipeline with doit", True)
     v.add_argument("--strict", action="store_true",
                    help="exit 1 unless every obligation, side condition and health check holds")
-    v.add_argument("-n", "--jobs", type=int, default=1, help="parallel doit processes")
+    v.add_argument("-n", "--jobs", type=int, default=None,
+                   help="doit processes (default: this machine's CPUs, at most 4, or RCLVERIFY_JOBS)")
     v.add_argument("--no-wait", action="store_true",
                    help="exit 1 instead of waiting when another run is in progress in the workspace "
                         "(also: RCLVERIFY_NO_WAIT=1)")

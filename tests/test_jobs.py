@@ -1,0 +1,95 @@
+"""How many doit processes a run uses without ``-n`` (app/jobs.py; docs/decisions.md, "Processes"):
+one per CPU of this process, at most four, or ``RCLVERIFY_JOBS``; the number reaches doit
+(tasks run in that many processes), and a bad ``RCLVERIFY_JOBS`` is one plain error."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rclverify.app.jobs import ENV, MAX_DEFAULT, JobsError, default_jobs
+from rclverify.app.tasks import doit_config
+from rclverify.core.cpus import allowed_cpus
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: A dodo.py with the workspace's DOIT_CONFIG and two independent tasks that each write the id of
+#: the process that ran them (and wait a little, so that two processes both take one).
+PIDS_DODO = """\
+import os, time
+from pathlib import Path
+from rclverify.app.tasks import doit_config
+
+DOIT_CONFIG = dict(doit_config(), reporter="console", check_file_uptodate="md5")
+
+
+def _write(name):
+    time.sleep(0.5)
+    Path(name).write_text(str(os.getpid()))
+
+
+def task_a():
+    return {"actions": [(_write, ["a.pid"])], "targets": ["a.pid"], "uptodate": [False]}
+
+
+def task_b():
+    return {"actions": [(_write, ["b.pid"])], "targets": ["b.pid"], "uptodate": [False]}
+
+
+def task_verify():
+    return {"actions": None, "task_dep": ["a", "b"]}
+"""
+
+
+def test_without_the_variable_a_run_uses_every_cpu_up_to_the_most() -> None:
+    assert default_jobs({}) == max(1, min(MAX_DEFAULT, len(allowed_cpus())))
+
+
+@pytest.mark.parametrize("value, expected", [("1", 1), ("3", 3), (" 2 ", 2), ("16", 16)])
+def test_the_variable_sets_the_number(value: str, expected: int) -> None:
+    assert default_jobs({ENV: value}) == expected
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "two", "1.5"])
+def test_a_bad_variable_is_refused_with_its_name_and_value(value: str) -> None:
+    with pytest.raises(JobsError, match=rf"RCLVERIFY_JOBS='{value}': not a whole number"):
+        default_jobs({ENV: value})
+
+
+def test_the_number_is_doits_num_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(ENV, "3")
+    assert doit_config()["num_process"] == 3
+
+
+def _pids(tmp_path: Path, jobs: str) -> set[str]:
+    (tmp_path / "dodo.py").write_text(PIDS_DODO)
+    env = {**os.environ, ENV: jobs, "PYTHONPATH": str(ROOT / "src")}
+    r = subprocess.run([sys.executable, "-m", "doit"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stdout + r.stderr
+    return {(tmp_path / f).read_text() for f in ("a.pid", "b.pid")}
+
+
+def test_the_default_reaches_doit_two_processes_run_two_tasks(tmp_path: Path) -> None:
+    assert len(_pids(tmp_path, "2")) == 2
+
+
+def test_one_process_runs_both_tasks(tmp_path: Path) -> None:
+    assert len(_pids(tmp_path, "1")) == 1
+
+
+def test_verify_with_a_bad_variable_is_one_line_and_frees_the_workspace(tmp_path: Path) -> None:
+    ws = tmp_path / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts" / "plan.yaml").write_text("contracts: []\n")
+    env = {**os.environ, ENV: "many", "PYTHONPATH": str(ROOT / "src")}
+    cmd = [sys.executable, "-m", "rclverify.cli.commands", "verify", "-w", str(ws)]
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr
+    assert r.stderr.strip() == "error: RCLVERIFY_JOBS='many': not a whole number of processes of at least 1"
+    # the run lock was given back: a run with a good value is not told to wait
+    r = subprocess.run(cmd + ["--no-wait"], env={**env, ENV: "1"}, capture_output=True, text=True, timeout=300)
+    assert "run in progress" not in r.stderr and "waiting" not in r.stderr, r.stderr
