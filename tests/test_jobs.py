@@ -4,6 +4,7 @@ one per CPU of this process, at most four, or ``RCLVERIFY_JOBS``; the number rea
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -41,6 +42,43 @@ def task_b():
 
 def task_verify():
     return {"actions": None, "task_dep": ["a", "b"]}
+"""
+
+
+#: A dodo.py with the workspace's DOIT_CONFIG (its reporter too): one task prints 3,000 lines from a
+#: worker while 40 others print 100 lines each from the other worker and the main process announces
+#: each task, as a run's node and evidence tasks do.
+LINES_DODO = """\
+import time
+from rclverify.app.tasks import doit_config
+
+DOIT_CONFIG = dict(doit_config(), check_file_uptodate="md5")
+
+
+def _talk():
+    for k in range(3000):
+        print(f"line {k:04d} " + "x" * 40)
+        if k % 100 == 0:
+            time.sleep(0.01)
+
+
+def _nap(k):
+    for j in range(100):
+        print(f"quiet {k:02d} {j:03d} " + "y" * 30)
+    time.sleep(0.02)
+
+
+def task_talk():
+    return {"actions": [_talk], "uptodate": [False], "verbosity": 2}
+
+
+def task_quiet():
+    for k in range(40):
+        yield {"name": str(k), "actions": [(_nap, [k])], "uptodate": [False], "verbosity": 2}
+
+
+def task_verify():
+    return {"actions": None, "task_dep": ["talk", "quiet"]}
 """
 
 
@@ -93,3 +131,20 @@ def test_verify_with_a_bad_variable_is_one_line_and_frees_the_workspace(tmp_path
     # the run lock was given back: a run with a good value is not told to wait
     r = subprocess.run(cmd + ["--no-wait"], env={**env, ENV: "1"}, capture_output=True, text=True, timeout=300)
     assert "run in progress" not in r.stderr and "waiting" not in r.stderr, r.stderr
+
+
+def test_in_two_processes_every_line_comes_out_whole(tmp_path: Path) -> None:
+    """Without a terminal, the main process's task lines and a worker's prints share the pipe: each
+    line is written whole (app/progress.py's ``whole_lines``), never cut at a buffer's end and
+    joined to another process's line."""
+    (tmp_path / "dodo.py").write_text(LINES_DODO)
+    # unbuffered, as in many CI images: without whole_lines, print's text and newline were two writes
+    env = {**os.environ, ENV: "2", "PYTHONPATH": str(ROOT / "src"), "PYTHONUNBUFFERED": "1"}
+    r = subprocess.run([sys.executable, "-m", "doit"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stdout + r.stderr
+    lines = r.stdout.splitlines()
+    bad = [x for x in lines if not re.fullmatch(r"line \d{4} x{40}|quiet \d\d \d{3} y{30}|\.  (talk|quiet:\d+|verify)", x)]
+    assert not bad, bad[:5]
+    assert sorted(x for x in lines if x.startswith("line ")) == [f"line {k:04d} " + "x" * 40 for k in range(3000)]
+    assert len([x for x in lines if x.startswith("quiet ")]) == 4000

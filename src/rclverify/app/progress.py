@@ -82,6 +82,29 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
+def whole_lines() -> None:
+    """Make standard output and error line-buffered and not write-through
+    (when they are text streams that can be), so that each line goes out in
+    one ``write`` as soon as it ends.  Under ``doit -n N`` (the default on a
+    machine of two CPUs or more, :mod:`rclverify.app.jobs`) the main
+    process's ``.  task`` lines and the workers' prints share one pipe or
+    file.  Block-buffered (no terminal), each process wrote its buffer when
+    8 KiB were full, cutting a line there; unbuffered (``PYTHONUNBUFFERED``,
+    set in many CI images), ``print`` wrote a line's text and its newline in
+    two ``write`` calls.  Either way another process's line landed inside
+    one, e.g. a problem line of the summary followed by ``.  verify`` on the
+    same line (tests/test_jobs.py).  Called before doit forks its workers,
+    which inherit the setting; a line of up to ``PIPE_BUF`` (4096) bytes is
+    written to a pipe whole (pipe(7))."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is not None:
+            try:
+                reconfigure(line_buffering=True, write_through=False)
+            except (ValueError, OSError):  # a closed or detached stream: left as it is
+                pass
+
+
 class PlainFailure(TaskFailed):  # type: ignore[misc]
     """A task failure the user caused or asked for (``verify --strict`` on
     open evidence, a last-run file of another shape): :class:`ProgressReporter`
@@ -138,6 +161,8 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.live.start()
             global _LIVE_ACTIVE
             _LIVE_ACTIVE = True
+        else:
+            whole_lines()
 
     def execute_task(self, task: Any) -> None:
         if not self.live_mode:

@@ -94,7 +94,8 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
 
     ``num_process``: the processes of a run without ``-n``
     (:func:`rclverify.app.jobs.default_jobs`: this machine's CPUs, at most
-    4, or ``RCLVERIFY_JOBS``).  A bad ``RCLVERIFY_JOBS`` prints one
+    4, or ``RCLVERIFY_JOBS``); one is doit's serial runner (``0``), the
+    actions in this process.  A bad ``RCLVERIFY_JOBS`` prints one
     ``error:`` line and raises ``SystemExit(1)``, as :func:`build_tasks`
     does for its faults."""
     from rclverify.app.progress import ProgressReporter  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
@@ -106,7 +107,8 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
         print(f"error: {exc}", file=sys.stderr)
         raise SystemExit(1) from None
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
-            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "num_process": jobs}
+            # doit's serial runner is num_process 0 (1 is one worker process beside the main one)
+            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "num_process": jobs if jobs > 1 else 0}
 
 
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,

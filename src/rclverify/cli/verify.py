@@ -43,8 +43,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
         release(Path(args.workspace))
         return int(exc.code) if isinstance(exc.code, int) else 1
     argv = ["verify"] + (["--strict"] if args.strict else [])
-    if args.jobs is not None:  # else DOIT_CONFIG's num_process (app/jobs.py)
-        argv = ["-n", str(max(1, args.jobs))] + argv
+    if args.jobs is not None:  # else DOIT_CONFIG's num_process (app/jobs.py); 1 or less: doit's serial runner
+        argv = ["-n", str(args.jobs if args.jobs > 1 else 0)] + argv
     try:  # SystemExit: a fault while doit saves its state, already reported in one line (doit_patches.guard_dep_writes)
         return run_doit(module, argv, args.cluster)
     except SystemExit as exc:
