@@ -203,10 +203,10 @@ PROBE = ("import resource, subprocess, sys, json\n"
 
 
 def doit_verify(root: Path, jobs: int, src: str | None = None) -> Run:
-    """Run ``python -m doit [-n jobs] verify`` in ``root``; time, peak memory,
+    """Run ``python -m doit -n jobs verify`` in ``root`` (``-n 0``, doit's serial runner, for one job); time, peak memory,
     executed tasks.  ``src``: the rclverify source tree to run (put first on
     ``PYTHONPATH``; default: the installed one)."""
-    cmd = [sys.executable, "-m", "doit"] + ["-n", str(jobs)] + ["verify"]
+    cmd = [sys.executable, "-m", "doit", "-n", str(jobs if jobs > 1 else 0), "verify"]  # doit's -n 0: serial
     env = dict(os.environ)
     if src:
         env["PYTHONPATH"] = os.pathsep.join([str(Path(src).resolve())] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))

@@ -30,18 +30,17 @@ def cmd_verify(args: argparse.Namespace) -> int:
     if not (Path(args.workspace) / args.plan).is_file():
         # a missing plan: the located error `compose` gives, not doit's DependencyError
         workspace_of(args).plan
+    try:  # a bad RCLVERIFY_JOBS: doit_config printed the one-line reason (before the lock is taken)
+        config = doit_config(str(Path(args.workspace) / DEP_FILE))
+    except SystemExit as exc:
+        return int(exc.code) if isinstance(exc.code, int) else 1
     try:  # takes the workspace's run lock: waits for a run in progress unless --no-wait
         tasks = build_tasks(Path(args.workspace), args.plan, wait=False if args.no_wait else None)
     except SystemExit as exc:  # build_tasks printed the one-line reason
         return int(exc.code) if isinstance(exc.code, int) else 1
     module = type(sys)("rclverify_dodo")
     module.__dict__.update(tasks)
-    try:  # a bad RCLVERIFY_JOBS: doit_config printed the one-line reason
-        module.DOIT_CONFIG = doit_config(str(Path(args.workspace) / DEP_FILE))  # type: ignore[attr-defined]
-    except SystemExit as exc:
-        from rclverify.core.runlock import release  # deferred: optional or conditional (inside a block)
-        release(Path(args.workspace))
-        return int(exc.code) if isinstance(exc.code, int) else 1
+    module.DOIT_CONFIG = config  # type: ignore[attr-defined]
     argv = ["verify"] + (["--strict"] if args.strict else [])
     if args.jobs is not None:  # else DOIT_CONFIG's num_process (app/jobs.py); 1 or less: doit's serial runner
         argv = ["-n", str(args.jobs if args.jobs > 1 else 0)] + argv
