@@ -58,6 +58,13 @@ def default_jobs(env: dict[str, str] | None = None) -> int:
     return max(1, min(MAX_DEFAULT, len(allowed_cpus())))
 
 
+def doit_num_process(jobs: int) -> int:
+    """doit's ``num_process`` for ``jobs`` processes: doit's serial runner
+    (``0``, the actions in the calling process) for one or fewer, else
+    ``jobs`` (doit's ``-n 1`` is one worker process beside the main one)."""
+    return jobs if jobs > 1 else 0
+
+
 def _start_method() -> str:
     """How ``multiprocessing`` (doit's process pool) starts processes here:
     the method set in this process, else the platform's default without
@@ -69,4 +76,4 @@ def _start_method() -> str:
     return "fork" if sys.platform.startswith("linux") and sys.version_info < (3, 14) else "other"
 
 
-__all__ = ["ENV", "MAX_DEFAULT", "JobsError", "default_jobs"]
+__all__ = ["ENV", "MAX_DEFAULT", "JobsError", "default_jobs", "doit_num_process"]

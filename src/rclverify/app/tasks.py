@@ -100,15 +100,14 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     does for its faults."""
     from rclverify.app.progress import ProgressReporter  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
     from rclverify.app.doit_checker import MD5Checker  # deferred: start-up (loads doit.dependency only when called)
-    from rclverify.app.jobs import JobsError, default_jobs  # deferred: start-up (loads multiprocessing only when called)
+    from rclverify.app.jobs import JobsError, default_jobs, doit_num_process  # deferred: start-up (loads multiprocessing only when called)
     try:
         jobs = default_jobs()
     except JobsError as exc:
         print(f"error: {exc}", file=sys.stderr)
         raise SystemExit(1) from None
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
-            # doit's serial runner is num_process 0 (1 is one worker process beside the main one)
-            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "num_process": jobs if jobs > 1 else 0}
+            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "num_process": doit_num_process(jobs)}
 
 
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,

@@ -42,8 +42,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
     module.__dict__.update(tasks)
     module.DOIT_CONFIG = config  # type: ignore[attr-defined]
     argv = ["verify"] + (["--strict"] if args.strict else [])
-    if args.jobs is not None:  # else DOIT_CONFIG's num_process (app/jobs.py); 1 or less: doit's serial runner
-        argv = ["-n", str(args.jobs if args.jobs > 1 else 0)] + argv
+    if args.jobs is not None:  # else DOIT_CONFIG's num_process (app/jobs.py)
+        from rclverify.app.jobs import doit_num_process  # deferred: start-up (loads multiprocessing only when called)
+        argv = ["-n", str(doit_num_process(args.jobs))] + argv
     try:  # SystemExit: a fault while doit saves its state, already reported in one line (doit_patches.guard_dep_writes)
         return run_doit(module, argv, args.cluster)
     except SystemExit as exc:

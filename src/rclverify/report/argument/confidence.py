@@ -126,12 +126,12 @@ def derived_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str,
     report's time at 5000 nodes, issue 67).  Equal to :func:`claim` over the
     cone (``tests/test_confidence.py``)."""
     labels = [p.label for ps in own.values() for p in ps]
+    reads = {n: list(producers.get(n, ())) for n in own}
+    if len(labels) == len(set(labels)) and len(own) >= vector_from:
+        return _vector_claims(own, reads)
+    cone = cones(reads)
     if len(set(labels)) != len(labels):
-        cone = cones({n: list(producers.get(n, ())) for n in own})
         return {n: claim(p for m in sorted(cone[n]) for p in own.get(m, ())) for n in own}
-    if len(own) >= vector_from:
-        return _vector_claims(own, {n: list(producers.get(n, ())) for n in own})
-    cone = cones({n: list(producers.get(n, ())) for n in own})
     doubts = {m: tuple(p.doubt for p in ps) for m, ps in own.items()}
     top = {m: max(ps, key=lambda p: (p.doubt, p.label)) for m, ps in own.items() if ps}
     out: dict[str, Claim] = {}
