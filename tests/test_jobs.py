@@ -25,6 +25,7 @@ from pathlib import Path
 from rclverify.app.tasks import doit_config
 
 DOIT_CONFIG = dict(doit_config(), reporter="console", check_file_uptodate="md5")
+Path("main.pid").write_text(str(os.getpid()))  # doit's own process (the dodo is loaded there)
 
 
 def _write(name):
@@ -102,21 +103,25 @@ def test_the_number_is_doits_num_process(monkeypatch: pytest.MonkeyPatch) -> Non
     assert doit_config()["num_process"] == 3
 
 
-def _pids(tmp_path: Path, jobs: str) -> set[str]:
+def _pids(tmp_path: Path, jobs: str) -> tuple[set[str], str]:
     (tmp_path / "dodo.py").write_text(PIDS_DODO)
     env = {**os.environ, ENV: jobs, "PYTHONPATH": str(ROOT / "src")}
     r = subprocess.run([sys.executable, "-m", "doit"], cwd=tmp_path, env=env, capture_output=True, text=True,
                        timeout=120)
     assert r.returncode == 0, r.stdout + r.stderr
-    return {(tmp_path / f).read_text() for f in ("a.pid", "b.pid")}
+    return {(tmp_path / f).read_text() for f in ("a.pid", "b.pid")}, (tmp_path / "main.pid").read_text()
 
 
 def test_the_default_reaches_doit_two_processes_run_two_tasks(tmp_path: Path) -> None:
-    assert len(_pids(tmp_path, "2")) == 2
+    pids, main = _pids(tmp_path, "2")
+    assert len(pids) == 2 and main not in pids
 
 
-def test_one_process_runs_both_tasks(tmp_path: Path) -> None:
-    assert len(_pids(tmp_path, "1")) == 1
+def test_one_process_is_doits_serial_runner_the_tasks_in_doits_own_process(tmp_path: Path) -> None:
+    """One process is doit's serial runner (``-n 0``), not ``-n 1``'s worker beside the main process: an
+    in-process caller (``rclverify verify`` called from Python) keeps the actions' output."""
+    pids, main = _pids(tmp_path, "1")
+    assert pids == {main}
 
 
 def test_verify_with_a_bad_variable_is_one_line_and_frees_the_workspace(tmp_path: Path) -> None:
