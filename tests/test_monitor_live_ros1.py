@@ -129,9 +129,16 @@ def test_the_injected_fault_is_reported_online_at_once(live_run: dict[str, Any])
     assert first["data"]["guarantee"] == 1
     assert first["data"]["values"]["out.radiationStatus"] == "orange"
     # a wrong answer is violated whatever comes later (docs/semantics.md): reported once the transport skew
-    # passed, well within the response time, not at the next message or at the end
-    delay = first["received"] - first["data"]["time"]
-    assert 0 <= delay < HORIZON, delay
+    # passed, not at the next message or at the end.  Judged in the monitor's own order of events, not by
+    # the wall clock: on a loaded machine (CI) a process may wait a second for a core, which delays the
+    # listener's copy but not the order in which the monitor logged what it heard and what it decided
+    rows = [json.loads(line) for line in (live_run["tmp"] / "live.jsonl").read_text().splitlines()]
+    decided = next(i for i, r in enumerate(rows) if r["topic"] == VERDICT_LOG_TOPIC and r["verdict"] == first["data"])
+    heard = next(i for i, r in enumerate(rows) if r["topic"] == "r" and r["value"] == 300.0)
+    following = [i for i, r in enumerate(rows) if r["topic"] == "r" and i > heard]
+    assert following, "the replay's next reading after 300 was not heard"
+    assert heard < decided < following[0], (heard, decided, following[0])
+    assert first["data"]["decided_at"] < rows[following[0]]["time"]
     # every verdict the log records was published on the topic
     assert len(got) == len(_live_verdicts(live_run["tmp"] / "live.jsonl"))
 
