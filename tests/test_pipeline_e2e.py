@@ -395,12 +395,13 @@ def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(work
         assert evidence and all(t.startswith("evidence:RadiationSensor.") for t in evidence)
         # `ground` too: the grounding of the plan's ros: section reads every contract (its file_dep)
         # `crosscheck`: the second solver decides the changed side conditions and health checks again
-        assert ran - evidence == {"check", "node:RadiationSensor", "node:Agent", "requirements", "ground",
-                                  "crosscheck", "report:html", "report:text", "verify"}
+        # `health:RadiationSensor`, not `health:Agent`: a consumer's health checks read only its own contract
+        assert ran - evidence == {"check", "node:RadiationSensor", "node:Agent", "health:RadiationSensor",
+                                  "requirements", "ground", "crosscheck", "report:html", "report:text", "verify"}
         # the formal requirements whose cone holds RadiationSensor: all four (the loop; REQ4 temporal over the same cone)
         assert "requirements: 4 of 4 checked (REQ1, REQ2, REQ3, REQ4)" in r.stdout
         # in the node tasks, only the stages whose own inputs changed: the consumer's side conditions
-        assert "RadiationSensor: compose, health, export" in r.stdout
+        assert "RadiationSensor: compose, export" in r.stdout and "RadiationSensor: health" in r.stdout
         assert re.search(r"Agent: compose(?!,)", r.stdout)
         # its report tasks rendered with the previous run's pieces (report/fragments.py): the same
         # bytes as a report rendered without any, and each task kept exactly its own files' pieces

@@ -190,6 +190,12 @@ def test_a_node_task_runs_only_the_stages_whose_inputs_changed() -> None:
     assert stages_to_run(deps, ["/w/backends/prog.imp"]) == ["export"]
     assert stages_to_run(deps, ["/w/a/model.json", "/w/backends/prog.imp"]) == ["compose", "export"]
     assert stages_to_run(deps, []) == list(NODE_STAGES)  # no reason by file (forced run): everything
+    # the node task holds compose and export, the health task health (app/task_table.py): each runs its own
+    node_task = {k: v for k, v in deps.items() if k != "health"}
+    assert stages_to_run(node_task, ["/w/a/snap/N.json"]) == ["compose", "export"]
+    assert stages_to_run(node_task, []) == ["compose", "export"]
+    assert stages_to_run({"health": deps["health"]}, []) == ["health"]
+    assert stages_to_run({"health": deps["health"]}, ["/w/backends/prog.imp"]) == []
 
 
 def test_a_plan_edited_after_the_cache_was_read_is_loaded_from_the_file(tmp_path: Path) -> None:

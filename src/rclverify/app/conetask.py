@@ -38,7 +38,7 @@ class ConeUnchanged:
 
     ``cone``: the absolute path of the node's cone digest file;
     ``provenance``: the absolute path of its provenance record
-    (``artifacts/provenance/<Node>.json``); ``cone_rel``: the digest file's
+    (``artifacts/provenance/compose/<Node>.json``); ``cone_rel``: the digest file's
     workspace-relative path, as the provenance record names it."""
 
     KEY = "_cone"

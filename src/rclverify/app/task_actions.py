@@ -94,7 +94,8 @@ def act_graph(root: str) -> Any:
     return None
 
 
-#: The stages of a ``node:<Node>`` task, in the order they run.
+#: The stages of a node, in the order they run: ``compose`` and ``export`` in its ``node:<Node>`` task,
+#: ``health`` in its ``health:<Node>`` task (app/task_table.py).
 NODE_STAGES = ("compose", "health", "export")
 
 
@@ -102,15 +103,16 @@ def stages_to_run(deps: Mapping[str, Sequence[str]], changed: Sequence[str]) -> 
     """The stages of a node task whose own file dependencies are among
     ``changed`` (doit's ``dep_changed``), in :data:`NODE_STAGES` order.
 
-    ``deps`` maps each stage to its file dependencies.  An empty ``changed``
+    ``deps`` maps each of the task's stages (a subset of
+    :data:`NODE_STAGES`) to its file dependencies.  An empty ``changed``
     means doit gave no reason by file (a forced run, ``doit -a``, a changed
-    ``uptodate`` check): every stage runs.  A missing target makes doit list
+    ``uptodate`` check): every stage of the task runs.  A missing target makes doit list
     every dependency as changed, so every stage runs then too.
     """
     if not changed:
-        return list(NODE_STAGES)
+        return [stage for stage in NODE_STAGES if stage in deps]
     hit = set(changed)
-    return [stage for stage in NODE_STAGES if hit.intersection(deps[stage])]
+    return [stage for stage in NODE_STAGES if stage in deps and hit.intersection(deps[stage])]
 
 
 def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str]) -> Any:

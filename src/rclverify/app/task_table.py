@@ -7,7 +7,7 @@ snapshots, the code-version check) and defines the tasks that
 method that doit calls as a task creator (doit accepts bound methods, also
 with ``create_after``).  doit orders the tasks by the line where each
 creator is defined, so the methods stand in the order the tasks run:
-check, graph, node, requirements, deadlines, evidence, crosscheck, ground,
+check, graph, node, health, requirements, deadlines, evidence, crosscheck, ground,
 report, verify.  The actions the tasks run are in
 :mod:`rclverify.app.task_actions`, the ``uptodate`` checks in
 :mod:`rclverify.app.task_checks`.
@@ -102,29 +102,45 @@ class TaskTable:
                 "task_dep": ["check"], "uptodate": [config_changed(shutil.which("dot") or "")], "verbosity": 2}
 
     def task_node(self) -> Iterator[dict[str, Any]]:
-        """One task per node: its calculus, health checks and exported obligations."""
+        """One task per node: its calculus and exported obligations (its health checks are ``health:<Node>``)."""
         from rclverify.app.conetask import ConeUnchanged  # deferred: start-up (loads rclverify.app.conetask only when called)
         index, ws, at, rootp, snap = self.index, self.ws, self.at, self.rootp, self.snap
         assert index is not None  # registered only when ok, i.e. the model was built
         model_json, seen = at(ws.MODEL), dict[str, tuple[str, ...]]()
         yield {"basename": "node", "name": None,
                "doc": "Per node, each when its own inputs changed: apply the calculus (R1-R4, side conditions "
-                      "discharged with Z3), check contract health, export the guarantees as obligations."}
+                      "discharged with Z3), export the guarantees as obligations."}
         for n in self.nodes:
-            repl = index.replacement.get(n)
             deps = {
                 "compose": [snap[n], *(snap[p] for p in index.producers[n]), model_json],
-                "health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else []),
                 "export": [snap[n]] + [at(f) for config in index.entries.get(n, ())
                                        for f in entry_inputs(config, rootp, seen)],
             }
             # the upstream cone: a file the check writes, read by an uptodate check (app/conetask.py), not a
             # file_dep: only a composition that read the cone runs again when the cone changes
-            cone = ConeUnchanged(at(ws.cone(n)), at(ws.provenance(n)), ws.cone(n))
+            cone = ConeUnchanged(at(ws.cone(n)), at(ws.provenance(n, "compose")), ws.cone(n))
             yield {"name": n, "actions": [(act_node, [self.r, n, deps])],
                    "file_dep": sorted({d for ds in deps.values() for d in ds}),
-                   "targets": [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))],
+                   "targets": [at(ws.calculus(n)), at(ws.obligations(n))],
                    "uptodate": [self.code, self.sealed, cone], "verbosity": 2, "clean": True}
+
+    def task_health(self) -> Iterator[dict[str, Any]]:
+        """One task per node: its contract health checks.  A task family of its own, not a stage of
+        ``node:<Node>``: the evidence tasks are created once every ``node`` task ran (they need the
+        exported obligations, not the health findings), so a node's long health checks (the case
+        study's Agent: 4-9 s of vacuity, realizability and repair search) run beside the other nodes'
+        evidence in ``doit -n 2`` instead of keeping every evidence task waiting (docs/scale.md)."""
+        index, ws, at, rootp, snap = self.index, self.ws, self.at, self.rootp, self.snap
+        assert index is not None  # registered only when ok, i.e. the model was built
+        yield {"basename": "health", "name": None,
+               "doc": "Per node, when its contract or replacement changed: check contract health (consistency, "
+                      "vacuity, realizability, refinement of its replacement)."}
+        for n in self.nodes:
+            repl = index.replacement.get(n)
+            deps = {"health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else [])}
+            yield {"name": n, "actions": [(act_node, [self.r, n, deps])], "file_dep": deps["health"],
+                   "targets": [at(ws.health(n))], "uptodate": [self.code, self.sealed], "verbosity": 2,
+                   "clean": True}
 
     def task_requirements(self) -> dict[str, Any]:
         """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
@@ -213,8 +229,11 @@ class TaskTable:
     def task_verify(self) -> dict[str, Any]:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
         # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
-        # they would make report:html wait and report:text run first (their fragment caches expect html first)
-        before = (["requirements"] + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"]
+        # they would make report:html wait and report:text run first (their fragment caches expect html first).
+        # `node` then `health` first: doit dispatches in the order it meets tasks from here, and the health
+        # tasks, reached otherwise only through the report's and crosscheck's file dependencies (both created
+        # after every evidence task), would start after the evidence instead of beside it
+        before = (["node", "health", "requirements"] + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"]
                   + (["ground"] if self.ros_section else []))
         ok = self.ok
         return {"actions": [(act_verify, [self.r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
@@ -229,7 +248,7 @@ class TaskTable:
         ``deadlines`` with an end-to-end deadline)."""
         creators: dict[str, Callable[[], Any]] = {"task_check": self.task_check, "task_verify": self.task_verify}
         if self.ok:
-            creators.update({"task_graph": self.task_graph, "task_node": self.task_node,
+            creators.update({"task_graph": self.task_graph, "task_node": self.task_node, "task_health": self.task_health,
                              "task_requirements": self.task_requirements, "task_evidence": self.task_evidence,
                              "task_report": self.task_report, "task_crosscheck": self.task_crosscheck})
             if self.ros_section:

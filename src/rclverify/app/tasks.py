@@ -8,13 +8,14 @@ Stages and their real file dependencies, per node ``N``:
 ``graph``          model -> model.dot, model.svg (when graphviz is installed); not part of
                    ``verify`` (the report lays out its own diagram, with statuses):
                    ``doit graph`` runs it
-``node:N``         three stages, each run only when one of its own inputs changed:
+``node:N``         two stages, each run only when one of its own inputs changed:
                    compose  snapshot of N and of N's producers + model -> calculus/N.json;
                             run again too when the part of N's cone digest it read changed
                             (app/conetask.py: the whole cone when a side condition was decided in
                             context, the cone's environment assumptions otherwise)
-                   health   snapshot of N (+ replacement contract) -> health/N.json
                    export   snapshot of N + the backend input files -> obligations/N.json
+``health:N``       snapshot of N (+ replacement contract) -> health/N.json (a task of its own,
+                   so that long health checks run beside the evidence: docs/decisions.md)
 ``evidence:ID``     one obligation's record + the files it reads -> its evidence record
                    (created after ``node`` ran, when the obligations are known)
 ``requirements``   plan + model + contract snapshots (+ Doorstop files, recorded runs) ->
@@ -31,11 +32,11 @@ Stages and their real file dependencies, per node ``N``:
                    obligation is discharged
 
 doit compares file contents (md5), so editing one node's contract changes
-only that node's snapshot: its node task (all three stages) and run tasks,
+only that node's snapshot: its node and health tasks and run tasks,
 its consumers' node tasks (the compose stage only: their side conditions), the
 node tasks downstream whose side conditions were decided in context against
 the cone (app/conetask.py)
-and the report re-run.  The three stages share one doit task per node
+and the report re-run.  Compose and export share one doit task per node
 because doit's own cost per task (defining it, checking its dependencies)
 was most of a no-op run of a large system (docs/scale.md); the task's
 action gets doit's list of changed dependencies and runs the stages that

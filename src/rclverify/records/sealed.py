@@ -137,8 +137,9 @@ def _companions(path: str) -> list[str]:
     head, sep, rel = path.rpartition("/artifacts/")
     if not sep:
         return []
-    if rel.startswith("calculus/") and rel.endswith(".json"):
-        return [f"{head}/artifacts/provenance/{rel[len('calculus/'):]}"]
+    for stage, folder in (("compose", "calculus/"), ("health", "health/")):
+        if rel.startswith(folder) and rel.count("/") == 1 and rel.endswith(".json"):
+            return [f"{head}/artifacts/provenance/{stage}/{rel[len(folder):]}"]
     if rel.startswith("obligations/") and rel.count("/") == 1 and rel.endswith(".json"):
         records, problem = obligation_list(path)
         return [f"{head}/artifacts/obligations/{rel[len('obligations/'):-5]}/{o.get('id')}.json"

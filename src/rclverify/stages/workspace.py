@@ -222,9 +222,11 @@ class Workspace:
         return f"artifacts/evidence/{obligation_id}.json"
 
     @staticmethod
-    def provenance(node: str) -> str:
-        """What each of the node's stages was made from (:func:`record_provenance`)."""
-        return f"artifacts/provenance/{node}.json"
+    def provenance(node: str, stage: str) -> str:
+        """What ``stage`` (``compose`` or ``health``) of the node was made from
+        (:func:`record_provenance`): one file a stage, because the two stages
+        are tasks of their own that may run at once in two doit processes."""
+        return f"artifacts/provenance/{stage}/{node}.json"
 
     MODEL = "artifacts/system/model.json"
     #: What ``check`` wrote the snapshots and the model from, and their sha256s (:func:`write_check_index`).
@@ -362,20 +364,19 @@ def state_hashes(ws: Workspace) -> dict[str, str]:
 
 
 def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str]) -> None:
-    """Record in ``artifacts/provenance/<node>.json`` the sha256 of each
-    workspace-relative file in ``inputs``, after ``stage`` of ``node`` wrote
-    its outputs from them (a stage killed before that records nothing).  The report compares them with
+    """Record in ``artifacts/provenance/<stage>/<node>.json`` (``{stage:
+    {path: sha256}}``, sealed) the sha256 of each workspace-relative file in
+    ``inputs``, after ``stage`` of ``node`` wrote its outputs from them (a
+    stage killed before that records nothing).  The report compares them with
     the inputs' current hashes (:func:`stale_stages`), so the side conditions
     or health findings of a contract edited since are shown ``stale``, never
     with the status of the old text (``rclverify report`` runs no stage).
+    Each stage has a file of its own and writes it whole: ``node:<Node>``
+    (compose) and ``health:<Node>`` run at once in ``doit -n 2``, and a
+    shared file read, changed and written by both would lose one's record.
     Raises ``OSError`` when the file cannot be written."""
-    from rclverify.records.sealed import read_sealed, write_sealed  # deferred: start-up (loads rclverify.records.sealed only when called)
-    rel = ws.provenance(node)
-    current, problem = read_sealed(ws.path(rel))
-    if problem or current is None:  # an altered record is not kept: the other stage then reads as stale
-        current = {}
-    current[stage] = hash_inputs(ws.root, list(inputs))
-    write_sealed(ws.path(rel), current)
+    from rclverify.records.sealed import write_sealed  # deferred: start-up (loads rclverify.records.sealed only when called)
+    write_sealed(ws.path(ws.provenance(node, stage)), {stage: hash_inputs(ws.root, list(inputs))})
 
 
 def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) -> list[str]:
@@ -406,12 +407,12 @@ def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
     from rclverify.records.sealed import read_sealed  # deferred: start-up (loads rclverify.records.sealed only when called)
     out: dict[str, set[str]] = {}
     for n in ws.checked.nodes:
-        rec, altered = read_sealed(ws.path(ws.provenance(n)))
-        if altered:  # sealed (records/sealed.py): what an altered record says is not believed
-            rec = None
         for stage, artifact in (("compose", ws.calculus(n)), ("health", ws.health(n))):
             if not os.path.exists(os.path.join(ws.root, artifact)):
                 continue
+            rec, altered = read_sealed(ws.path(ws.provenance(n, stage)))
+            if altered:  # sealed (records/sealed.py): what an altered record says is not believed
+                rec = None
             made = rec.get(stage) if isinstance(rec, dict) else None
             allowed = [set(stage_inputs(ws, n, stage))] + ([set(stage_inputs(ws, n, stage, False))]
                                                            if stage == "compose" else [])
