@@ -377,6 +377,8 @@ def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str
     Raises ``OSError`` when the file cannot be written."""
     from rclverify.records.sealed import write_sealed  # deferred: start-up (loads rclverify.records.sealed only when called)
     write_sealed(ws.path(ws.provenance(node, stage)), {stage: hash_inputs(ws.root, list(inputs))})
+    # the record of both stages that versions before the split wrote: nothing reads it, and a bundle would carry it
+    ws.path(f"artifacts/provenance/{node}.json").unlink(missing_ok=True)
 
 
 def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) -> list[str]:
