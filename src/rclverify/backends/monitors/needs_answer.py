@@ -36,10 +36,6 @@ from __future__ import annotations
 
 from typing import Any, Iterable, Mapping
 
-import z3
-
-from rclverify.semantics.encode import Encoder
-from rclverify.semantics.query import budgeted_solver
 from rclverify.lang import ast
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, EnumT
 
@@ -92,6 +88,9 @@ def answer_decides(checked: Checked, node: CheckedNode, formulas: Iterable[ast.E
 
 
 def _decides(checked: Checked, node: CheckedNode, formulas: list[ast.Expr]) -> bool:
+    import z3  # deferred: start-up (Z3 only for a node whose formulas are in the fragment)
+    from rclverify.semantics.encode import Encoder  # deferred: start-up (loads z3 and the encoder only when called)
+    from rclverify.semantics.query import budgeted_solver  # deferred: start-up (loads z3 only when called)
     try:
         enc = Encoder(checked.env)
         outs = [enc.io_symbol(node, "out", v) for v in sorted(node.outputs)]

@@ -105,7 +105,6 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     Raises :class:`PlanError`.  Call :func:`resolve` once the contracts are
     checked to validate the references into them.
     """
-    from rclverify.lang.parser import parse_formula  # here: a run that reuses the cached workspace loads no plan; deferred: start-up (loads lark, rclverify.core and more only when called)
     data, locs, blocks = _read_plan_source(root, plan_rel)
 
     def loc(*path: Any) -> ast.Loc:
@@ -150,6 +149,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         for i, text in enumerate(spec.get("facts", [])):
             l = loc(*base, i)
             block = blocks.get(tuple(base) + (i,))
+            from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark; only a plan with environment facts parses a formula here)
             try:
                 if block is not None:
                     expr = parse_formula(block[1], plan_rel, block[0], 1)
