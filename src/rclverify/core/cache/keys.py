@@ -95,6 +95,10 @@ def _stats(top: str, suffixes: tuple[str, ...]) -> list[tuple[str, os.stat_resul
     return [(rel, st) for _, rel, st in out]
 
 
+#: The files of a library that :func:`library_stamp` reads: its code, compiled extensions and data.
+_LIBRARY_SUFFIXES = (".py", ".so", ".pyd", ".dylib", ".dll", ".lark", ".json", ".j2", ".txt", ".typed")
+
+
 @lru_cache(maxsize=None)
 def library_stamp(name: str) -> str:
     """``"<name> <hex sha256>"`` of the installed top-level package ``name``
@@ -116,10 +120,6 @@ def library_stamp(name: str) -> str:
         for rel, st in _stats(folder, _LIBRARY_SUFFIXES):
             h.update(f"{rel} {st.st_size} {st.st_mtime_ns}\n".encode())
     return f"{name} {h.hexdigest()}"
-
-
-#: The files of a library that :func:`library_stamp` reads: its code, compiled extensions and data.
-_LIBRARY_SUFFIXES = (".py", ".so", ".pyd", ".dylib", ".dll", ".lark", ".json", ".j2", ".txt", ".typed")
 
 
 @lru_cache(maxsize=None)
