@@ -88,7 +88,10 @@ def _stats(top: str, suffixes: tuple[str, ...]) -> list[tuple[str, os.stat_resul
             here = parts + (e.name,)
             i = e.name.rfind(".")
             if 0 < i < len(e.name) - 1 and e.name[i:] in suffixes:
-                out.append((here, "/".join(here), e.stat()))
+                try:
+                    out.append((here, "/".join(here), e.stat()))
+                except OSError:  # a dangling symbolic link: nothing there to load or to stamp
+                    pass
             if e.is_dir() and not e.is_symlink():
                 stack.append((e.path, here))
     out.sort(key=lambda x: x[0])

@@ -33,7 +33,9 @@ An entry is one file, ``$XDG_CACHE_HOME/rclverify/start-up/<key>.pickle``
 are code and the command only reads a workspace), written atomically in the
 kept-file format (:func:`.store.write_stream`) and read through
 :mod:`.safeload`; a missing, damaged or unwritable file only costs the
-recomputation.  Deleting the folder is always safe.
+recomputation.  Entries are never pruned (each is a few kilobytes, one
+per distinct contract text, plan, formula and node); deleting the folder
+is always safe.
 """
 from __future__ import annotations
 
@@ -60,12 +62,17 @@ class Kept:
         self.misses = 0
 
     def _path(self, part: str, contents: tuple[bytes | str, ...]) -> tuple[Path, str] | None:
+        """The entry's file and its part's salt; ``None`` without a folder or
+        when the salt cannot be taken (an unreadable package file)."""
         if self.folder is None:
             return None
-        keyer = self._keyers.get(part)
-        if keyer is None:  # salted when first used: a run that never asks Z3 never stamps Z3's files
-            keyer = self._keyers[part] = Keyer(salt(f"{KIND}/{part}", (library_stamp(PARTS[part]),)))
-        return self.folder / f"{keyer(part, *contents).hex()}.pickle", keyer.salt
+        try:
+            keyer = self._keyers.get(part)
+            if keyer is None:  # salted when first used: a run that never asks Z3 never stamps Z3's files
+                keyer = self._keyers[part] = Keyer(salt(f"{KIND}/{part}", (library_stamp(PARTS[part]),)))
+            return self.folder / f"{keyer(part, *contents).hex()}.pickle", keyer.salt
+        except OSError:
+            return None
 
     def get(self, part: str, *contents: bytes | str) -> Any | None:
         """The value kept for ``part`` (a key of :data:`PARTS`) computed from
