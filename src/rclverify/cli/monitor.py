@@ -99,11 +99,12 @@ def _report_run(report: list[dict[str, Any]], run: RecordedRun, trace: str, cfg:
     the run did not judge; returns whether a verdict failed."""
     violated = False
     items = run.not_judged
+    versions = tool_versions() if as_json else ""  # only the JSON report shows them (the distributions' search costs start-up)
     for res in run.results:
         status, explanation = verdict_status(res, trace)
         violated = violated or status == "failed"
         entry = {"node": res.node, "status": status, "explanation": explanation,
-                 **monitoring_details(res, trace, run.events, "", tool_versions(), cfg.horizon, cfg.tolerance)}
+                 **monitoring_details(res, trace, run.events, "", versions, cfg.horizon, cfg.tolerance)}
         entry.pop("sha256")
         entry["evaluation"] = dict(res.evaluation)  # debug: which formulas ran as compiled code
         entry["not_judged"] = [i for i in items if i["node"] == res.node]

@@ -10,10 +10,12 @@ from rclverify.cli.common import AddCommand, seconds
 
 def cmd_monitor(args: argparse.Namespace) -> int:
     """Judge recorded runs, or the running system (``--live``), against every node's contract (:func:`rclverify.cli.monitor.monitor_command`)."""
-    from rclverify.cli.monitor import monitor_command  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.cli.monitor import monitor_command  # deferred: start-up (loads numpy, yaml and more only when called)
+    from rclverify.core.cache.startup import keeping  # deferred: start-up (loads rclverify.core.cache.store only when called)
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
-    checked = Workspace(Path(args.workspace), args.plan).checked  # raises RclError, printed located by main
-    return monitor_command(args, checked)
+    with keeping():  # the parsed contracts, the plan's schema check, the compiled formulas: kept by content
+        checked = Workspace(Path(args.workspace), args.plan).checked  # raises RclError, printed located by main
+        return monitor_command(args, checked)
 
 
 def cmd_oracle(args: argparse.Namespace) -> int:

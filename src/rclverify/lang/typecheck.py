@@ -32,7 +32,6 @@ from typing import Iterable, Mapping, Sequence
 
 from rclverify.lang import ast, liveness, timing
 from rclverify.lang.errors import RclError
-from rclverify.lang.parser import parse_files
 from rclverify.lang.typecheck_expr import CheckFailed, ExprChecker
 from rclverify.lang.types import BOOL, Checked, CheckedNode, Env, Type, assignable
 
@@ -201,6 +200,7 @@ def check_node_again(specs: Sequence[ast.Spec], n: ast.Node) -> CheckedNode:
 
 def load(paths: Iterable[str | Path]) -> Checked:
     """Parse and type-check RCL files.  Raises :class:`RclError`."""
+    from rclverify.lang.parser import parse_files  # deferred: start-up (loads lark; checking parsed contracts needs no parser)
     return check(parse_files(paths))
 
 

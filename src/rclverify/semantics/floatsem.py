@@ -65,14 +65,11 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any, Callable, Mapping
 
-import z3
-
 from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.candidate_points import quantify
-from rclverify.semantics.concrete import check_concrete
-from rclverify.semantics.encode import EncodingError
+from rclverify.semantics.symbols import EncodingError
 from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.evaluate import Evaluator, Undecided, evaluate, why_undecided
 from rclverify.semantics.floatsens import float_sensitive
@@ -215,6 +212,8 @@ def judge(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappin
         reason = why_undecided(formula, checked, node, values)
         if "no value for" in reason:  # an I/O value is missing: no semantics can decide
             return Judgement(None, "", reason)
+        import z3  # deferred: start-up (Z3 only for a value the direct evaluation leaves undecided)
+        from rclverify.semantics.concrete import check_concrete  # deferred: start-up (loads z3, the encoder and the type checker only when called)
         try:
             v, reason = check_concrete(formula, checked, node, values)
         except (ValueError, TypeError, KeyError, EncodingError, z3.Z3Exception) as exc:  # a value Z3 cannot take

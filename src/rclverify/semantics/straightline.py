@@ -45,9 +45,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Callable, Mapping, cast
+from typing import TYPE_CHECKING, Any, Callable, Mapping, cast
 
-import jinja2
+from rclverify.core.cache.keys import fingerprint
 
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
@@ -56,6 +56,9 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.values import Term
 from rclverify.semantics.eval_values import Undecided
 from rclverify.semantics.operators import OPERATORS, UNARY
+
+if TYPE_CHECKING:
+    import jinja2
 
 #: Compiled formulas kept (per formula, node and environment); cleared when full.
 CACHE_SIZE = 10_000
@@ -114,7 +117,27 @@ def compile_exact(formula: ast.Expr, checked: Checked, node: CheckedNode) -> Str
     return out
 
 
+def _render(comment: str, loads: list[tuple[str, str]], body: str) -> str:
+    """The template's text for a formula (``comment`` its RCL text, ``loads``
+    its ``(local, key text)`` loads, ``body`` its expression): the same
+    inputs always give the same text, so a process that keeps its start-up
+    (:mod:`rclverify.core.cache.startup`) keeps it, keyed by these inputs
+    (the template is rclverify's code, in the key's salt), and a run whose
+    every formula is kept does not load jinja2."""
+    from rclverify.core.cache.startup import active  # deferred: start-up (loads rclverify.core.cache.store only when called)
+    kept = active()
+    contents = ("rcl_formula", f"RCL: {comment}", fingerprint(loads), body)
+    hit = kept.get("straightline", *contents) if kept is not None else None
+    if isinstance(hit, str):
+        return hit
+    source = _template().render(name=contents[0], comment=contents[1], loads=loads, body=body)
+    if kept is not None:
+        kept.put("straightline", source, *contents)
+    return source
+
+
 def _template() -> jinja2.Template:
+    import jinja2  # deferred: start-up (about 0.03 s; only a formula whose text is not kept is rendered)
     global _TEMPLATE
     if _TEMPLATE is None:
         _TEMPLATE = jinja2.Environment(
@@ -162,8 +185,7 @@ class _Gen(Visitor[str]):
     def function(self, formula: ast.Expr) -> Straight:
         body = self.truth(formula)
         comment = " ".join(expr_to_rcl(formula).split())
-        source = _template().render(name="rcl_formula", comment=f"RCL: {comment}",
-                                    loads=[(local, repr(key)) for key, local in self.loads.items()], body=body)
+        source = _render(comment, [(local, repr(key)) for key, local in self.loads.items()], body)
         code = compile(source, "<rcl formula>", "exec")
         ns = dict(self.ns)
         exec(code, ns)  # noqa: S102 - the source is generated above from the checked formula, no user text

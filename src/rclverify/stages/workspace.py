@@ -43,6 +43,24 @@ if TYPE_CHECKING:
 PLAN = "contracts/plan.yaml"
 
 
+def _parse(text: str, rel: str) -> ast.Spec:
+    """The syntax tree of the contract file ``rel`` whose text is ``text``:
+    kept by a process that keeps its start-up (:mod:`rclverify.core.cache.startup`,
+    keyed by ``rel`` and ``text``), else parsed.  Raises :class:`RclError`
+    on a syntax error (never kept: it is always reported from the text)."""
+    from rclverify.core.cache.startup import active  # deferred: start-up (loads rclverify.core.cache.store only when called)
+    from rclverify.lang.ast import Spec  # deferred: start-up (what a kept entry must be)
+    kept = active()
+    spec = kept.get("contract", rel, text) if kept is not None else None
+    if isinstance(spec, Spec):
+        return spec
+    from rclverify.lang.parser import parse_text  # deferred: start-up (loads lark, rclverify.core.cache and more only when called)
+    spec = parse_text(text, rel)
+    if kept is not None:
+        kept.put("contract", spec, rel, text)
+    return spec
+
+
 @dataclass(frozen=True)
 class TaskIndex:
     """What defining a workspace's doit tasks needs of its loaded plan and
@@ -135,7 +153,6 @@ class Workspace:
     def checked(self) -> Checked:
         self._run_deferred()
         from rclverify.model.plan.load import resolve  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
-        from rclverify.lang.parser import parse_text  # deferred: start-up (loads lark, rclverify.core.cache and more only when called)
         from rclverify.lang.source import read_text as read_source  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.source and more only when called)
         from rclverify.lang.typecheck import check  # deferred: start-up (loads lark, rclverify.core.cache and more only when called)
         plan = self.plan
@@ -152,7 +169,7 @@ class Workspace:
                 specs.append(self.parsed[rel][1])
                 continue
             try:
-                spec = parse_text(text, rel)
+                spec = _parse(text, rel)
             except RclError as exc:
                 diags.extend(exc.diagnostics)
                 continue

@@ -28,8 +28,6 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.verdicts import WEAK as _WEAK, in_all, link_of, names, producers
-import z3
-from rclverify.semantics.concrete import false_whatever_the_rest
 
 
 class Closing:
@@ -282,7 +280,8 @@ class Closing:
                       reason=reason, question=q.event.where)
 
     def _false_whatever_missing(self, k: int, values: Mapping[str, Any]) -> bool:
-
+        import z3  # deferred: start-up (Z3 only for a question whose answer stays incomplete)
+        from rclverify.semantics.concrete import false_whatever_the_rest  # deferred: start-up (loads z3, the encoder and the type checker only when called)
         known = {q: v for q, v in values.items() if v is not None}
         try:
             return false_whatever_the_rest(self.guarantees[k - 1], self.checked, self.node, known)

@@ -34,12 +34,10 @@ with and without on random traces.
 """
 from __future__ import annotations
 
+import io
+import pickle
 from typing import Any, Iterable, Mapping
 
-import z3
-
-from rclverify.semantics.encode import Encoder
-from rclverify.semantics.query import budgeted_solver
 from rclverify.lang import ast
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked, CheckedNode, EnumT
 
@@ -84,14 +82,50 @@ def answer_decides(checked: Checked, node: CheckedNode, formulas: Iterable[ast.E
     hit = _CACHE.get(key)
     if hit is not None and hit[0] is checked:
         return hit[1]
-    answer = _decides(checked, node, formulas)
+    answer = _kept(checked, node, formulas)
     if len(_CACHE) >= 64:
         _CACHE.clear()
     _CACHE[key] = (checked, answer)
     return answer
 
 
+def _kept(checked: Checked, node: CheckedNode, formulas: list[ast.Expr]) -> bool:
+    """:func:`_decides`, kept by a process that keeps its start-up
+    (:mod:`rclverify.core.cache.startup`) under the pickled environment, node
+    and formulas (all the query reads; Z3's files in the key's salt)."""
+    from rclverify.core.cache.startup import active  # deferred: start-up (loads rclverify.core.cache.store only when called)
+    kept = active()
+    if kept is None:
+        return _decides(checked, node, formulas)
+    try:
+        content = _content((checked.env, node, tuple(formulas)))
+    except Exception:  # noqa: BLE001 - a value pickle refuses (or a cycle): asked, not kept
+        return _decides(checked, node, formulas)
+    hit = kept.get("needs-answer", content)
+    if isinstance(hit, bool):
+        return hit
+    answer = _decides(checked, node, formulas)
+    kept.put("needs-answer", answer, content)
+    return answer
+
+
+def _content(value: Any) -> bytes:
+    """``value`` pickled without the memo (pickle's fast mode): every object
+    written in full wherever it occurs, so the bytes are the same whether
+    the contracts were parsed in this process or read back from the cache
+    (which share their strings differently).  Raises ``ValueError`` for a
+    cyclic value, ``pickle.PicklingError`` for one pickle cannot hold."""
+    buf = io.BytesIO()
+    p = pickle.Pickler(buf, protocol=4)
+    p.fast = True
+    p.dump(value)
+    return buf.getvalue()
+
+
 def _decides(checked: Checked, node: CheckedNode, formulas: list[ast.Expr]) -> bool:
+    import z3  # deferred: start-up (Z3 only for a node whose formulas are in the fragment)
+    from rclverify.semantics.encode import Encoder  # deferred: start-up (loads z3 and the encoder only when called)
+    from rclverify.semantics.query import budgeted_solver  # deferred: start-up (loads z3 only when called)
     try:
         enc = Encoder(checked.env)
         outs = [enc.io_symbol(node, "out", v) for v in sorted(node.outputs)]

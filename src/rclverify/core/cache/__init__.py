@@ -29,7 +29,10 @@ file                                   kind                 keyed by
 The files are read by :mod:`.safeload`, which constructs only
 rclverify's own value classes: a poisoned pickle in a cloned workspace is
 a cache miss, never run.  jinja2's compiled templates, which are code, are
-kept in the user's cache (:func:`.keys.user_cache_dir`), not here.
+kept in the user's cache (:func:`.keys.user_cache_dir`), not here; so is
+what ``rclverify monitor`` computes at every start from its inputs'
+content alone (:mod:`.startup`: parsed contracts, the plan's schema check,
+the compiled formulas' sources, Z3's answers), keyed by that content.
 
 Every key also holds the kind's salt: the cache format, the rclverify code
 and the versions of the programs whose output is kept.  Deleting

@@ -79,8 +79,30 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     if not isinstance(data, dict):
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
+    _check_schema(data, locs, plan_rel)
+    return data, locs, blocks
+
+
+def _check_schema(data: dict[str, Any], locs: Mapping[Path_, ast.Loc], plan_rel: str) -> None:
+    """Validate the plan's ``data`` against ``plan.schema.json``; raises
+    :class:`PlanError` with a located diagnostic per violation (``locs``).
+    A pass is kept by a process that keeps its start-up
+    (:mod:`rclverify.core.cache.startup`, keyed by the data, the schema and
+    jsonschema's files): the same data passes again without loading
+    jsonschema; a failure is never kept."""
+    from rclverify.core.cache.keys import fingerprint  # deferred: start-up (loads rclverify.core.cache only when called)
+    from rclverify.core.cache.startup import active  # deferred: start-up (loads rclverify.core.cache.store only when called)
+    kept = active()
+    try:
+        key = fingerprint(data) if kept is not None else None
+    except TypeError:  # a value neither marshal nor JSON holds (a YAML timestamp): validated, not kept
+        key = None
+    if key is not None and kept is not None and kept.get("plan-schema", key) is True:
+        return
     import jsonschema  # here, not at module level: a doit run that reuses the cached workspace never validates; deferred: start-up (loads jsonschema only when called)
     errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
+    if not errors and key is not None and kept is not None:
+        kept.put("plan-schema", True, key)
     if errors:
         diags: list[Diagnostic] = []
         for e in errors:
@@ -96,7 +118,6 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
             where = ".".join(map(str, e.absolute_path)) or "plan"
             diags.extend(plan_error(loc.file, loc.line, loc.col, f"{where}: {e.message}").diagnostics)
         raise PlanError(diags)
-    return data, locs, blocks
 
 
 def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
@@ -105,7 +126,6 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     Raises :class:`PlanError`.  Call :func:`resolve` once the contracts are
     checked to validate the references into them.
     """
-    from rclverify.lang.parser import parse_formula  # here: a run that reuses the cached workspace loads no plan; deferred: start-up (loads lark, rclverify.core and more only when called)
     data, locs, blocks = _read_plan_source(root, plan_rel)
 
     def loc(*path: Any) -> ast.Loc:
@@ -150,6 +170,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         for i, text in enumerate(spec.get("facts", [])):
             l = loc(*base, i)
             block = blocks.get(tuple(base) + (i,))
+            from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark; only a plan with environment facts parses a formula here)
             try:
                 if block is not None:
                     expr = parse_formula(block[1], plan_rel, block[0], 1)
