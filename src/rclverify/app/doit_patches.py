@@ -1,9 +1,10 @@
-"""Two changes rclverify makes to doit's internals, installed once per process by :func:`rclverify.app.tasks.build_tasks`.
+"""Three changes rclverify makes to doit's internals, installed once per process by :func:`rclverify.app.tasks.build_tasks`.
 
 :func:`use_linear_implicit_task_dep` replaces doit's quadratic scan for the
 task dependencies that file dependencies imply (docs/decisions.md, "doit");
 :func:`guard_dep_writes` turns a failed write of doit's task state (a full
-disk) into one plain line.  Each checks the doit method it wraps or replaces
+disk) into one plain line; :func:`release_in_order` makes ``doit -n N``
+start the tasks that waited for one task in the order they began to wait.  Each checks the doit method it wraps or replaces
 (``pyproject.toml`` pins the doit versions it was checked against;
 tests/test_tasks_doit.py holds the replacement equal to doit's own).
 """
@@ -77,3 +78,38 @@ def guard_dep_writes() -> None:
             continue
         if not getattr(method, "_rclverify_guarded", False):
             setattr(SqliteDB, name, guard(method))
+
+
+class _InOrder(dict):  # type: ignore[type-arg]
+    """A set that iterates in the order its items were added (the two
+    operations doit uses on an ``ExecNode``'s ``waiting_me``: ``add`` and
+    iteration; ``in`` and ``len`` as a dict's)."""
+
+    def add(self, item: Any) -> None:
+        self[item] = None
+
+
+def release_in_order() -> None:
+    """Make doit's parallel runner start the tasks that waited for one task
+    in the order they began to wait, i.e. the order of ``verify``'s task
+    dependencies (app/task_table.py: ``node`` first, then ``health``, then
+    the requirements).  doit keeps the tasks waiting for a task in a set of
+    ``ExecNode`` objects (``waiting_me``), so when ``check`` ended the
+    order they started in was that of the objects' hashes (their memory
+    addresses): a run sometimes began with the requirements and one node's
+    long health checks on the two processes while the quick ``node`` tasks,
+    which the evidence tasks are created after, waited 5 s (docs/scale.md,
+    "Round nine").  Installed once per process (idempotent); with a doit
+    whose ``ExecNode`` does not start with an empty set there, nothing is
+    changed (docs/decisions.md, "Where rclverify reaches into doit")."""
+    from doit.control import ExecNode  # deferred: start-up (loads doit only when called)
+    init = ExecNode.__init__
+    if getattr(init, "_rclverify_in_order", False):
+        return
+
+    def ordered_init(self: Any, task: Any, parent: Any) -> None:
+        init(self, task, parent)
+        if type(self.waiting_me) is set and not self.waiting_me:
+            self.waiting_me = _InOrder()
+    ordered_init._rclverify_in_order = True  # type: ignore[attr-defined]
+    ExecNode.__init__ = ordered_init  # type: ignore[method-assign]

@@ -242,11 +242,14 @@ class TaskTable:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
         # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
         # they would make report:html wait and report:text run first (their fragment caches expect html first).
-        # `node` then `health` first: doit dispatches in the order it meets tasks from here, and the health
-        # tasks, reached otherwise only through the report's and crosscheck's file dependencies (both created
-        # after every evidence task), would start after the evidence instead of beside it
-        before = (["node", "health", "requirements"] + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"]
-                  + (["ground"] if self.ros_section else []))
+        # Every node task, then every health task, named one by one before the rest: doit starts the tasks
+        # that waited for `check` in the order they began to wait (app/doit_patches.py, release_in_order),
+        # and a group name (`node`) is expanded only after the tasks named beside it began to wait.  The
+        # node tasks first, since every evidence task is created after them; the health tasks before the
+        # rest, since the report and crosscheck (created after the evidence) are otherwise the only tasks
+        # that reach them, which made them start after the evidence instead of beside it
+        before = ([f"node:{n}" for n in self.nodes] + [f"health:{n}" for n in self.nodes] + ["requirements"]
+                  + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"] + (["ground"] if self.ros_section else []))
         ok = self.ok
         return {"actions": [(act_verify, [self.r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(self.rootp / REPORTS[2])] if ok else [],

@@ -47,7 +47,7 @@ method per task family), run the actions of :mod:`rclverify.app.task_actions`
 (module-level functions with plain arguments, so ``doit -n 2``, parallel
 processes, behaves like a serial run) and are kept up to date by the checks of
 :mod:`rclverify.app.task_checks`; :mod:`rclverify.app.doit_patches` holds the
-two changes made to doit's internals.
+three changes made to doit's internals.
 
 With the environment variable ``RCLVERIFY_CLUSTER=ADDRESS`` the ``evidence``
 tasks send their backend jobs to that Dask scheduler (:mod:`rclverify.app.cluster`);
@@ -62,7 +62,7 @@ from typing import Any, Callable
 from rclverify.core.cache import heap
 from rclverify.core.cache import workspace as wscache
 from rclverify.stages.workspace import TaskIndex, Workspace
-from rclverify.app.doit_patches import guard_dep_writes, use_linear_implicit_task_dep
+from rclverify.app.doit_patches import guard_dep_writes, release_in_order, use_linear_implicit_task_dep
 from rclverify.app.task_actions import (NODE_STAGES, WORKSPACES, act_check, act_report, act_verify,
                                         stages_to_run)
 from rclverify.app.task_checks import entry_inputs
@@ -153,6 +153,7 @@ def _build_tasks(root: str | Path, plan_file: str) -> dict[str, Callable[[], Any
     changed) and seed the actions' workspace with it, then define the run's tasks (:class:`TaskTable`)."""
     use_linear_implicit_task_dep()
     guard_dep_writes()
+    release_in_order()
     rootp = Path(root).resolve()
     r = str(rootp)
     ws = Workspace(rootp, plan_file)
