@@ -60,3 +60,22 @@ def write_chain(root: Path, n: int, *, requirements: Sequence[tuple[str, str]] =
     (root / "contracts/plan.yaml").write_text(chain_plan(requirements, x0_max), encoding="utf-8")
     (root / "dodo.py").write_text(DODO, encoding="utf-8")
     return root
+
+
+#: The plan's evidence for the two-node chain of :func:`write_chain_with_evidence`.
+EVIDENCE_PLAN = """nodes:
+  N1:
+    evidence:
+      - {backend: property_tests, implementation: impl/n1.py:n1, max_examples: 10}
+"""
+
+
+def write_chain_with_evidence(root: Path) -> Path:
+    """The chain of two nodes with property tests of ``N1`` (an implementation adding 1): a workspace
+    with one evidence task, verified in about 3 s."""
+    write_chain(root, 2)
+    (root / "impl").mkdir()
+    (root / "impl" / "n1.py").write_text("def n1(x1: float) -> dict[str, float]:\n    return {'x2': x1 + 1}\n")
+    plan = root / "contracts" / "plan.yaml"
+    plan.write_text(plan.read_text() + EVIDENCE_PLAN)
+    return root

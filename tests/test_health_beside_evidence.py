@@ -16,7 +16,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from _chain import write_chain
+from _chain import write_chain_with_evidence as _workspace
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -45,22 +45,6 @@ pipeline.stage_health = held
 from rclverify.cli.commands import main
 raise SystemExit(main(["verify", "-n", "2", "-w", str(ws)]))
 """
-
-PLAN_TAIL = """nodes:
-  N1:
-    evidence:
-      - {backend: property_tests, implementation: impl/n1.py:n1, max_examples: 10}
-"""
-
-
-def _workspace(root: Path) -> Path:
-    write_chain(root, 2)
-    (root / "impl").mkdir()
-    (root / "impl" / "n1.py").write_text("def n1(x1: float) -> dict[str, float]:\n    return {'x2': x1 + 1}\n")
-    plan = root / "contracts" / "plan.yaml"
-    plan.write_text(plan.read_text() + PLAN_TAIL)
-    return root
-
 
 def _summary(root: Path) -> dict[str, object]:
     report = json.loads((root / "reports" / "assurance.json").read_text())

@@ -5,7 +5,8 @@ files a plan evidence entry names (:func:`entry_inputs`), the files of the
 plan's ``ros:`` section (:func:`ros_fingerprint`), the versions of the code
 and tools that make the results (:func:`z3_version`,
 :func:`tool_fingerprint`), and the ``uptodate`` checks of an evidence
-record (:class:`RecordIntact`) and of ``verify --strict``
+record (:class:`RecordIntact`), of the report's files
+(:class:`TargetsAsWritten`) and of ``verify --strict``
 (:func:`strict_uptodate`).  doit's ``uptodate`` protocol: a callable given
 the task and its saved values, answering whether the task is up to date.
 """
@@ -45,6 +46,40 @@ def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, 
                 st = p.stat()
                 out.append((str(ros[key]), st.st_size, st.st_mtime_ns))
     return out
+
+
+class TargetsAsWritten:
+    """doit ``uptodate`` check of a report task: its files are the ones it
+    wrote last.  ``rclverify report`` renders the same files from the
+    artifacts as they are, without doit; after a record altered by hand it
+    shows that record as ``error``.  When the alteration was then undone
+    (or ``doit verify`` made the record again, byte for byte), the report
+    task's inputs were what it last read, doit called it up to date, and the
+    report kept the ``error`` of a record that was intact again (a false
+    alarm; found by tests/test_hardening_greens.py).  After the task ran the
+    size and modification time of each target are saved with doit's task
+    values; any other write (or a missing file) makes it run again.  A stat
+    a file, no read: nothing on a no-op run."""
+
+    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
+                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+    KEY = "_targets_stat"
+
+    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+        targets = list(task.targets)
+
+        def stat() -> dict[str, Any]:
+            seen = []
+            for target in targets:
+                try:
+                    st = os.stat(target)
+                except OSError:
+                    return {}
+                seen.append([st.st_mtime_ns, st.st_size])
+            return {self.KEY: seen}
+        task.value_savers.append(stat)
+        now = stat()
+        return bool(now) and values.get(self.KEY) == now[self.KEY]
 
 
 class RecordIntact:

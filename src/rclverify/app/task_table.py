@@ -28,8 +28,8 @@ from doit.tools import config_changed
 from rclverify.core.cache import code_stamp
 from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_graph, act_ground, act_node,
                                         act_report, act_requirements, act_run, act_verify)
-from rclverify.app.task_checks import (RecordIntact, entry_inputs, ros_fingerprint, strict_uptodate, tool_fingerprint,
-                                       z3_version)
+from rclverify.app.task_checks import (RecordIntact, TargetsAsWritten, entry_inputs, ros_fingerprint, strict_uptodate,
+                                       tool_fingerprint, z3_version)
 from rclverify.stages.workspace import REPORT_PARTS, TaskIndex, Workspace, check_input_files
 from rclverify.records.sealed import TargetsSealed, obligation_list
 
@@ -240,12 +240,13 @@ class TaskTable:
         yield {"basename": "report", "name": None,
                "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
         deps, at = self._report_inputs(), self.at
+        as_written = TargetsAsWritten()  # the files as the task wrote them, not as `rclverify report` did since
         for part, files in REPORT_PARTS.items():
             # task_dep on crosscheck: both are created after `evidence`, and when the report's loader runs
             # first doit does not yet know which task makes the second solver's index (its file_dep alone
             # then let doit -n 2 render the report beside crosscheck, from no index)
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [self.r, part])],
-                   "file_dep": deps, "task_dep": ["crosscheck"], "uptodate": [self.code, self.sealed],
+                   "file_dep": deps, "task_dep": ["crosscheck"], "uptodate": [self.code, self.sealed, as_written],
                    "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
                    + ([at(self.ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}
