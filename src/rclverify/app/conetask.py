@@ -27,6 +27,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
+from rclverify.app.task_checks import UPTODATE_SIGNATURE
+
 
 def _relevant(text: str, whole: bool) -> str:
     """The part of a cone digest file a composition depended on."""
@@ -42,6 +44,7 @@ class ConeUnchanged:
     workspace-relative path, as the provenance record names it."""
 
     KEY = "_cone"
+    __signature__ = UPTODATE_SIGNATURE
 
     def __init__(self, cone: str, provenance: str, cone_rel: str) -> None:
         self.cone, self.provenance, self.cone_rel = cone, provenance, cone_rel

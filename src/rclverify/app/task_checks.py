@@ -48,6 +48,13 @@ def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, 
     return out
 
 
+#: The signature of an ``uptodate`` callable given doit's task and its saved values.  doit calls
+#: ``inspect.signature`` on every uptodate callable of every task on every run; a class's own
+#: ``__signature__`` (PEP 362) answers it at once.
+UPTODATE_SIGNATURE = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
+                                        inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+
+
 class TargetsAsWritten:
     """doit ``uptodate`` check of a report task: its files are the ones it
     wrote last.  ``rclverify report`` renders the same files from the
@@ -61,8 +68,7 @@ class TargetsAsWritten:
     values; any other write (or a missing file) makes it run again.  A stat
     a file, no read: nothing on a no-op run."""
 
-    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
-                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+    __signature__ = UPTODATE_SIGNATURE
     KEY = "_targets_stat"
 
     def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
@@ -94,8 +100,7 @@ class RecordIntact:
     same the record is not read.  Otherwise its seal is checked
     (:meth:`rclverify.records.store.EvidenceStore.read`)."""
 
-    __signature__ = inspect.Signature([inspect.Parameter("task", inspect.Parameter.POSITIONAL_OR_KEYWORD),
-                                       inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
+    __signature__ = UPTODATE_SIGNATURE
 
     def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
         target = task.targets[0]

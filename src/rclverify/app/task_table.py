@@ -90,8 +90,7 @@ class TaskTable:
         # Every task that makes a result depends on the rclverify code that makes it: another version
         # (an upgrade, a changed module) makes every result again, as a clean run would.
         self.code_version = {"rclverify": code_stamp(), "z3": z3_version()}
-        self.code = _digested(self.code_version)
-        self.code.__signature__ = inspect.signature(self.code)  # answered at once by doit (see task_evidence)
+        self.code = _signed(_digested(self.code_version))
         # Only files that exist are file dependencies (doit refuses a missing one with a DependencyError):
         # a missing plan or contract makes `check` run, and fail with the located message, every time.
         named = [str(self.rootp / plan_file)] + contract_deps
@@ -128,7 +127,6 @@ class TaskTable:
         index, ws, at, rootp, snap = self.index, self.ws, self.at, self.rootp, self.snap
         assert index is not None  # registered only when ok, i.e. the model was built
         model_json, seen = at(ws.MODEL), dict[str, tuple[str, ...]]()
-        cone_signature: inspect.Signature | None = None
         yield {"basename": "node", "name": None,
                "doc": "Per node, each when its own inputs changed: apply the calculus (R1-R4, side conditions "
                       "discharged with Z3), export the guarantees as obligations."}
@@ -141,8 +139,6 @@ class TaskTable:
             # the upstream cone: a file the check writes, read by an uptodate check (app/conetask.py), not a
             # file_dep: only a composition that read the cone runs again when the cone changes
             cone = ConeUnchanged(at(ws.cone(n)), at(ws.provenance(n, "compose")), ws.cone(n))
-            cone_signature = cone_signature or inspect.signature(cone)  # one for every node (_signed)
-            cone.__signature__ = cone_signature  # type: ignore[attr-defined]
             yield {"name": n, "actions": [(act_node, [self.r, n, deps])],
                    "file_dep": sorted({d for ds in deps.values() for d in ds}),
                    "targets": [at(ws.calculus(n)), at(ws.obligations(n))],
@@ -196,9 +192,8 @@ class TaskTable:
         # `__signature__` (PEP 362) answers it at once.
         # One config_changed per task: doit saves every config_changed of a task under one key, so a
         # second one would overwrite the first's value and the task would never be up to date.
-        tools_unchanged = _digested({**tool_fingerprint(), **self.code_version})
-        tools_unchanged.__signature__ = inspect.signature(tools_unchanged)
-        record_intact = _signed(RecordIntact())
+        tools_unchanged = _signed(_digested({**tool_fingerprint(), **self.code_version}))
+        record_intact = RecordIntact()
         input_file: dict[str, str | None] = {}  # input -> its absolute path when it is a file (one stat per input)
         ws, at, r = self.ws, self.at, self.r
 
