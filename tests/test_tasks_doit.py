@@ -2,7 +2,11 @@
 the same task dependencies in the same order as doit's own."""
 from __future__ import annotations
 
+import os
 import random
+import subprocess
+import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 from doit.control import TaskControl
@@ -33,8 +37,6 @@ def test_build_tasks_installs_it(tmp_path) -> None:
 def test_doit_list_with_status_answers_for_verify(tmp_path) -> None:
     """``doit list --all --status`` asks ``verify``'s uptodate check without parsing its options:
     one line per task, no traceback (the check read ``task.options`` as a dict)."""
-    import subprocess
-    import sys
     (tmp_path / "dodo.py").write_text("from pathlib import Path\nfrom rclverify.app.tasks import build_tasks, doit_config\n"
                                       "DOIT_CONFIG = doit_config()\nglobals().update(build_tasks(Path(__file__).parent))\n")
     out = subprocess.run([sys.executable, "-m", "doit", "list", "--all", "--status"], cwd=tmp_path,
@@ -43,13 +45,12 @@ def test_doit_list_with_status_answers_for_verify(tmp_path) -> None:
     assert [line.split()[:2] for line in out.stdout.splitlines()] == [["R", "check"], ["U", "verify"]]
 
 
-#: 16 tasks waiting for one slow task, in two doit processes; ``PATCH`` installs release_in_order.
+#: 16 tasks waiting for one slow task, in two doit processes, with release_in_order installed.
 WAITING_DODO = """\
-import os, time
+import time
+from rclverify.app.doit_patches import release_in_order
 DOIT_CONFIG = {"verbosity": 0, "dep_file": ".doit.db", "backend": "json"}
-if os.environ.get("PATCH"):
-    from rclverify.app.doit_patches import release_in_order
-    release_in_order()
+release_in_order()
 
 
 def _nap(s):
@@ -70,16 +71,11 @@ def task_all():
 """
 
 
-def _dispatched(tmp_path, patch: bool) -> list[str]:
-    """The tasks in the order doit's main process hands them to its two workers (its console
-    reporter's ``.  name`` lines, written when a task is dispatched)."""
-    import os
-    import subprocess
-    import sys
-    from pathlib import Path
+def _started(tmp_path: Path) -> list[str]:
+    """The waiting tasks in the order they started (doit's console reporter's ``.  name`` lines,
+    printed when a worker starts a task)."""
     (tmp_path / "dodo.py").write_text(WAITING_DODO)
-    env = {k: v for k, v in os.environ.items() if k != "PATCH"}
-    env.update(PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"), **({"PATCH": "1"} if patch else {}))
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
     r = subprocess.run([sys.executable, "-m", "doit", "-n", "2", "all"], cwd=tmp_path, env=env, capture_output=True,
                        text=True, timeout=120)
     assert r.returncode == 0, r.stdout + r.stderr
@@ -97,7 +93,7 @@ def test_tasks_that_waited_for_one_start_in_the_order_they_began_to_wait(tmp_pat
     The reporter's line comes when a worker starts its task, so two workers may swap a neighbouring
     pair: at most 4 pairs out of order are allowed (a random order of 16 has 60 on average, and 4 or
     fewer less than once in a billion)."""
-    got = _dispatched(tmp_path, True)
+    got = _started(tmp_path)
     assert sorted(got) == [f"x:{k:02d}" for k in range(16)]
     assert _inversions(got) <= 4, got
 

@@ -36,7 +36,7 @@ from rclverify.lang.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
 # (rclverify.stages.workspace); re-exported here for the stages' callers.
 from rclverify.stages.workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, cone_digests, current_model_hash,  # noqa: F401
-                        current_snapshot_hashes, environment_sha, node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
+                        current_snapshot_hashes, drop_old_provenance, environment_sha, node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
                         write_check_index)
 from rclverify.records.sealed import read_sealed
 
@@ -84,6 +84,7 @@ def stage_check(ws: Workspace) -> CheckRecord:
     atomic_write_text(ws.path(ws.MODEL), text)
     hashes[ws.MODEL] = hashlib.sha256(text.encode("utf-8")).hexdigest()
     write_check_index(ws, hashes)  # the report then needs not make every snapshot again
+    drop_old_provenance(ws)
     return cast("CheckRecord", {"warnings": warnings})
 
 

@@ -55,6 +55,20 @@ UPTODATE_SIGNATURE = inspect.Signature([inspect.Parameter("task", inspect.Parame
                                         inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
 
 
+def _stats(paths: list[str]) -> list[list[int]] | None:
+    """``[mtime_ns, size]`` of each of ``paths``, or ``None`` when one is
+    missing: what an ``uptodate`` check saves with doit's task values after
+    the task ran and compares on the next run, without reading a file."""
+    out = []
+    for path in paths:
+        try:
+            st = os.stat(path)
+        except OSError:
+            return None
+        out.append([st.st_mtime_ns, st.st_size])
+    return out
+
+
 class TargetsAsWritten:
     """doit ``uptodate`` check of a report task: its files are the ones it
     wrote last.  ``rclverify report`` renders the same files from the
@@ -73,19 +87,9 @@ class TargetsAsWritten:
 
     def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
         targets = list(task.targets)
-
-        def stat() -> dict[str, Any]:
-            seen = []
-            for target in targets:
-                try:
-                    st = os.stat(target)
-                except OSError:
-                    return {}
-                seen.append([st.st_mtime_ns, st.st_size])
-            return {self.KEY: seen}
-        task.value_savers.append(stat)
-        now = stat()
-        return bool(now) and values.get(self.KEY) == now[self.KEY]
+        task.value_savers.append(lambda: {self.KEY: _stats(targets)})
+        now = _stats(targets)
+        return now is not None and values.get(self.KEY) == now
 
 
 class RecordIntact:
@@ -104,18 +108,11 @@ class RecordIntact:
 
     def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
         target = task.targets[0]
-
-        def stat() -> dict[str, Any]:
-            try:
-                st = os.stat(target)
-            except OSError:
-                return {}
-            return {"_record_stat": [st.st_mtime_ns, st.st_size]}
-        task.value_savers.append(stat)
-        now = stat()
-        if not now:
+        task.value_savers.append(lambda: {"_record_stat": (_stats([target]) or [None])[0]})
+        now = _stats([target])
+        if now is None:
             return False
-        if values.get("_record_stat") == now["_record_stat"]:
+        if values.get("_record_stat") == now[0]:
             return True
         root, _, name = target.rpartition("/artifacts/evidence/")
         try:

@@ -394,8 +394,17 @@ def record_provenance(ws: Workspace, node: str, stage: str, inputs: Sequence[str
     Raises ``OSError`` when the file cannot be written."""
     from rclverify.records.sealed import write_sealed  # deferred: start-up (loads rclverify.records.sealed only when called)
     write_sealed(ws.path(ws.provenance(node, stage)), {stage: hash_inputs(ws.root, list(inputs))})
-    # the record of both stages that versions before the split wrote: nothing reads it, and a bundle would carry it
-    ws.path(f"artifacts/provenance/{node}.json").unlink(missing_ok=True)
+
+
+def drop_old_provenance(ws: Workspace) -> None:
+    """Remove ``artifacts/provenance/<Node>.json``, the record of both stages
+    that versions before the split into ``node:`` and ``health:`` tasks wrote:
+    nothing reads it, and a bundle would carry it.  Called by the check stage
+    (which an upgrade runs again, its code having changed), not by every
+    stage of every node.  Raises ``OSError`` when a file cannot be removed."""
+    folder = ws.path("artifacts/provenance")
+    for old in (folder.glob("*.json") if folder.is_dir() else ()):
+        old.unlink(missing_ok=True)
 
 
 def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) -> list[str]:
