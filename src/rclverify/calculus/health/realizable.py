@@ -259,8 +259,9 @@ def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, 
     names = [f"guarantee {k + 1} ({_where(n.guarantees[k].loc)})" for k in conflict]
     short = [x.split(" (")[0] for x in names]
     which = short[0] if len(short) == 1 else ", ".join(short[:-1]) + f" and {short[-1]} together"
-    msg = (f"The contract of {node} cannot be implemented: for the input below, which its assumption"
-           + (" and the environment facts admit" if facts else " admits") + f", no output satisfies {which}.")
+    msg = (f"The contract of {node} cannot be implemented: for an input its assumption"
+           + (" and the environment facts admit" if facts else " admits") + f" (the finding's counterexample: "
+           f"`rclverify explain {node}.realizable`), no output satisfies {which}.")
     expl = ("Realizability (forall in. A(in) -> exists out. G(in, out)) fails: Z3 found an admissible input for which "
             "every output violates " + (" and ".join(x.split(" (")[0] for x in names) if len(names) > 1 else names[0])
             + ". An implementation meeting the contract cannot exist; the guarantees ask for incompatible outputs there.")
