@@ -42,7 +42,7 @@ from rclverify.calculus.health.finding import Finding as Finding  # re-exported:
 from rclverify.calculus.health.realizable import realizability_findings
 from rclverify.calculus.health.shape import shape_findings
 from rclverify.calculus.health.shared import SharedEncoder, Table
-from rclverify.calculus.health.witness import Witness, extend, finite_witness, has_tables, points_for
+from rclverify.calculus.health.witness import WITNESS_TIMEOUT_MS, Witness, extend, finite_witness, has_tables, points_for
 
 HEALTH_TIMEOUT_MS = 5_000
 #: Timeout of one per-instance premise query, and how many undecided
@@ -252,8 +252,8 @@ def _check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast
     return out
 
 
-def _table_witness(h: _NodeHealth, comment: str,
-                   extra: Sequence[tuple[str, z3.BoolRef]] = ()) -> QueryResult | None:
+def _table_witness(h: _NodeHealth, comment: str, extra: Sequence[tuple[str, z3.BoolRef]] = (),
+                   budget_ms: int = WITNESS_TIMEOUT_MS) -> QueryResult | None:
     """A witness of the consistency query (with ``extra``: of a
     non-vacuity query) in which each function-typed input is a finite
     table (:mod:`.witness`), asked before the general query when the
@@ -270,7 +270,7 @@ def _table_witness(h: _NodeHealth, comment: str,
     if not has_tables(h.enc):
         return None
     t0 = time.perf_counter()
-    w = finite_witness(h.enc, [f for _, f in h.labelled(extra)], points_for(h.instances))
+    w = finite_witness(h.enc, [f for _, f in h.labelled(extra)], points_for(h.instances), budget_ms)
     if w.status != "sat":
         return None
     if not extra:
@@ -333,11 +333,18 @@ def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding | None:
 
 
 def _scan(h: _NodeHealth, n: str, k: int, budget_ms: int,
-          known: dict[int, QueryResult] | None = None) -> dict[int, QueryResult]:
+          known: dict[int, QueryResult] | None = None, *, witness_first: bool = False) -> dict[int, QueryResult]:
     """Guarantee ``k``'s premise asked at each instance ``lo..hi`` of its
     first NATURAL variable, in order, with ``budget_ms`` each (an instance
     ``known`` decided is not asked again), until :data:`GIVE_UP_AFTER`
-    instances in a row are undecided with none found vacuous before."""
+    instances in a row are undecided with none found vacuous before.
+    ``witness_first``: an instance still undecided is first given to the
+    witnesses of that instance's premise alone (the consistency witness
+    extended, then a finite-table witness within ``budget_ms``: either's
+    ``sat`` is a model of the instance's query, so the instance can fire);
+    only what they leave open is asked with ``budget_ms``.  The case
+    study's Agent, guarantee 1 at ``i = 12``: a witness in 0.3 s where the
+    general query gives up after 2 s."""
     assert h.instances is not None
     v = h.natural_vars(k)[0]
     lo, hi = h.instances
@@ -348,7 +355,9 @@ def _scan(h: _NodeHealth, n: str, k: int, budget_ms: int,
         if got is None or got.status == "inconclusive":
             pe = h.premise(k, {v: x})
             assert pe is not None
-            got = h.sat(pe[0], comment=f"health {n}: premise of guarantee {k} at {v}={x}", timeout_ms=budget_ms)
+            comment = f"health {n}: premise of guarantee {k} at {v}={x}"
+            got = ((_extended(h, comment, pe[0]) or _table_witness(h, comment, pe[0], budget_ms=budget_ms))
+                   if witness_first else None) or h.sat(pe[0], comment=comment, timeout_ms=budget_ms)
         out[x] = got
         streak = streak + 1 if got.status == "inconclusive" else 0
         if streak >= GIVE_UP_AFTER and not any(y.status == "unsat" for y in out.values()):
@@ -385,7 +394,7 @@ def _scan_finding(h: _NodeHealth, n: str, k: int, r: QueryResult, ptext: str,
     assert h.instances is not None
     v = h.natural_vars(k)[0]
     lo, hi = h.instances
-    full = _scan(h, n, k, min(h.timeout, INSTANCE_TIMEOUT_MS), quick)
+    full = _scan(h, n, k, min(h.timeout, INSTANCE_TIMEOUT_MS), quick, witness_first=True)
     per: dict[str, str] = {}
     cores: dict[str, list[str]] = {}
     total = r.duration_s + sum(x.duration_s for x in quick.values()) + sum(
