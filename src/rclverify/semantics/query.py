@@ -84,6 +84,17 @@ def budgeted_solver(timeout_ms: float, ctx: z3.Context | None = None) -> z3.Solv
     return s
 
 
+def tactic_solver(timeout_ms: float, tactics: Sequence[str], ctx: z3.Context | None = None) -> z3.Solver:
+    """A solver in ``ctx`` (default: the process's main context) of the Z3
+    tactics ``tactics`` applied in turn (``z3.Then``: its model is read back
+    through the tactics' model converters), budgeted as
+    :func:`budgeted_solver` budgets one.  The tactics preprocess what is
+    asserted (``add``), not what a check assumes.  Raises
+    ``z3.Z3Exception`` for a tactic name Z3 does not know."""
+    s: z3.Solver = wallclock.limit(z3.Then(*tactics, ctx=ctx).solver(), timeout_ms)
+    return s
+
+
 class _Session:
     """The shared solver of one :func:`solver_session` block and the query
     budget its parameters are set to (set again only when a query asks for

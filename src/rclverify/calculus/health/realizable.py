@@ -61,7 +61,7 @@ import z3
 
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics import wallclock
-from rclverify.semantics.query import render_model, satisfiable, smt2_script
+from rclverify.semantics.query import render_model, satisfiable, smt2_script, tactic_solver
 from rclverify.lang import ast
 from rclverify.semantics.natural import natural_typing
 from rclverify.lang.types import Checked, FuncT
@@ -175,7 +175,7 @@ class _Query:
         """``(sat|unsat|unknown, input model)`` of ``f`` asked of Z3's
         quantifier elimination then its SMT solver, within the query's budget
         (resource steps, as :func:`rclverify.semantics.query.budgeted_solver`)."""
-        s = wallclock.limit(z3.Then("qe", "smt").solver(), REALIZABLE_TIMEOUT_MS)
+        s = tactic_solver(REALIZABLE_TIMEOUT_MS, ("qe", "smt"))
         s.add(*self.enc.axioms(), f)
         try:
             r = wallclock.check(s)

@@ -33,8 +33,8 @@ from typing import Any, Iterator, Sequence
 import z3
 
 from rclverify.semantics.encode import value_to_rcl
-from rclverify.semantics.query import budgeted_solver, render_model
-from rclverify.semantics.wallclock import check, limit
+from rclverify.semantics.query import budgeted_solver, render_model, tactic_solver
+from rclverify.semantics.wallclock import check
 from rclverify.semantics.retry import load_canonical
 
 #: Points of each function table (at least the plan's instances: see :func:`points_for`).
@@ -161,7 +161,7 @@ def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
         all_formulas = [z3.substitute_funs(f, *subs) for f in all_formulas]
     if simplified and len(tables) == sum(isinstance(x.decl, z3.FuncDeclRef) and x.decl.arity() > 0
                                          for x in enc.symbols.values()):
-        s = _tactic_solver(SIMPLIFIED_MS, z3.Context() if deterministic else ctx)
+        s = tactic_solver(SIMPLIFIED_MS, SIMPLIFIED, z3.Context() if deterministic else ctx)
         if deterministic:
             load_canonical(s, all_formulas)
         else:
@@ -181,13 +181,6 @@ def finite_witness(enc: Any, formulas: Sequence[z3.BoolRef], points: int,
             return Witness("inconclusive")
         return Witness("sat", _render(s.model(), enc, tables, points), _found(s.model(), enc, ctx, tables, points))
     return Witness("sat", _render(s.model(), enc, tables, points))
-
-
-def _tactic_solver(budget_ms: int, ctx: z3.Context) -> z3.Solver:
-    """A solver of the tactics :data:`SIMPLIFIED` in ``ctx``, budgeted as
-    :func:`rclverify.semantics.query.budgeted_solver` budgets one."""
-    s: z3.Solver = limit(z3.Then(*SIMPLIFIED, ctx=ctx).solver(), budget_ms)
-    return s
 
 
 def _confirmed(formulas: Sequence[z3.BoolRef], model: z3.ModelRef) -> bool:

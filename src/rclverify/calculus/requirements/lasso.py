@@ -34,7 +34,7 @@ from typing import Any, Callable, Mapping
 import z3
 
 from rclverify.calculus.health.witness import table_point, table_term
-from rclverify.semantics.query import budgeted_solver
+from rclverify.semantics.query import budgeted_solver, tactic_solver
 from rclverify.semantics import wallclock
 from rclverify.lang.types import DataT, EnumT, FuncT, Type
 from rclverify.semantics.values import FiniteFunction, Term
@@ -136,7 +136,7 @@ def _solve(formulas: list[z3.BoolRef], ctx: z3.Context, budget_ms: int) -> tuple
     ``unknown``, with Z3's default strategy and ``budget_ms``.  Returns the
     answer, whether the wall-clock net cut it, and the solver that gave it
     (its ``model()`` when ``sat``)."""
-    tactic: z3.Solver = wallclock.limit(z3.Then(*TACTICS, ctx=ctx).solver(), min(budget_ms, TACTICS_BUDGET_MS))
+    tactic = tactic_solver(min(budget_ms, TACTICS_BUDGET_MS), TACTICS, ctx)
     tactic.add(*formulas)  # asserted, not assumed: the tactics preprocess assertions only
     r, cut = wallclock.check_cut(tactic)
     if r != z3.unknown:
