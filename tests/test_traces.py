@@ -265,3 +265,27 @@ def test_a_workspace_definition_of_a_standard_type_replaces_the_store_s(tmp_path
         w.write(conn, 3_000_000_000, store.serialize_cdr(msg, "sensor_msgs/msg/Range"))
     (ev,) = read_trace(tmp_path / "bag", [tmp_path / "interfaces"])
     assert (ev.topic, ev.fields["range"], ev.fields["variance"]) == ("scan", 1.5, 0.25)
+
+
+def test_the_type_store_is_shared_by_equal_definitions_and_made_again_for_an_edited_one(tmp_path: Path) -> None:
+    """traces/bag.py keeps a process's type stores by the workspace's definitions: the same
+    definitions (in another folder too) give the same store, an edited ``.msg`` a new one carrying
+    the edit, and going back gives the first store again; a bad definition stays an error every time."""
+    from rclverify.traces.bag import typestore
+    from rclverify.traces.events import TraceError
+    a, b = (tmp_path / x / "sensor_msgs" / "msg" for x in ("a", "b"))
+    for d in (a, b):
+        d.mkdir(parents=True)
+        (d / "Range.msg").write_text(NEWER_RANGE)
+    first = typestore([tmp_path / "a"])
+    assert typestore([tmp_path / "b"]) is first and typestore([tmp_path / "a"]) is first
+    (a / "Range.msg").write_text(NEWER_RANGE + "float32 confidence\n")
+    edited = typestore([tmp_path / "a"])
+    assert edited is not first
+    assert [n for n, _ in edited.fielddefs["sensor_msgs/msg/Range"][1]][-2:] == ["variance", "confidence"]
+    (a / "Range.msg").write_text(NEWER_RANGE)
+    assert typestore([tmp_path / "a"]) is first
+    (a / "Range.msg").write_text("float32 range\n@@@ x\n")
+    for _ in range(2):
+        with pytest.raises(TraceError, match="Range.msg:1: error: bad message definition"):
+            typestore([tmp_path / "a"])

@@ -12,23 +12,45 @@ from typing import Any, Iterator, Sequence
 from rclverify.traces.events import Event, TraceError, header_stamp
 
 
+def _definitions(msg_dirs: Sequence[Path]) -> tuple[tuple[str, str, Path], ...]:
+    """``(type name, text, file)`` of every ``<pkg>/msg/<Type>.msg`` under ``msg_dirs``, in the
+    order :func:`custom_types` registers them.  Raises :class:`TraceError` (naming the file) for
+    a file that is not a regular one (a FIFO or device would block the read: traces/guard.py)."""
+    found: list[tuple[str, str, Path]] = []
+    for d in msg_dirs:
+        for f in sorted(d.rglob("*.msg")):
+            if not f.is_file():
+                raise TraceError(f"{f}:1: error: not a regular file (a FIFO, device or socket): not read")
+            found.append((f"{f.parent.parent.name}/msg/{f.stem}", f.read_text(encoding="utf-8"), f))
+    return tuple(found)
+
+
 def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
     """Type definitions parsed from every ``<pkg>/msg/<Type>.msg`` under ``msg_dirs``.
 
     Raises :class:`TraceError` (naming the file) for a definition rosbags rejects.
     """
+    return _parsed(_definitions(msg_dirs))
+
+
+def _parsed(definitions: tuple[tuple[str, str, Path], ...]) -> dict[str, Any]:
     from rosbags.typesys import get_types_from_msg  # deferred: start-up (loads rosbags and more only when called)
     types: dict[str, Any] = {}
-    for d in msg_dirs:
-        for f in sorted(d.rglob("*.msg")):
-            if not f.is_file():  # a FIFO or device would block the read (traces/guard.py)
-                raise TraceError(f"{f}:1: error: not a regular file (a FIFO, device or socket): not read")
-            name = f"{f.parent.parent.name}/msg/{f.stem}"
-            try:
-                types.update(get_types_from_msg(f.read_text(encoding="utf-8"), name))
-            except Exception as exc:  # rosbags raises its own parse errors
-                raise TraceError(f"{f}:1: error: bad message definition: {exc}") from None
+    for name, text, f in definitions:
+        try:
+            types.update(get_types_from_msg(text, name))
+        except Exception as exc:  # rosbags raises its own parse errors
+            raise TraceError(f"{f}:1: error: bad message definition: {exc}") from None
     return types
+
+
+#: The type stores this process made, by the workspace's message definitions (name and text of each
+#: ``.msg``): a store is read, never changed, once made (``AnyReader`` copies its definitions into a
+#: store of its own, and rosbags' per-type decoder cache is a function of the definitions), so the
+#: same definitions give the same store.  Making one registers every standard type again when the
+#: workspace redefines one (about 60 ms), and a pipeline run opens its bags once per monitored node.
+_STORES: dict[tuple[tuple[str, str], ...], Any] = {}
+_STORES_KEPT = 8
 
 
 def typestore(msg_dirs: Sequence[Path]) -> Any:
@@ -39,16 +61,24 @@ def typestore(msg_dirs: Sequence[Path]) -> Any:
     changed it (``sensor_msgs/Range`` gained ``variance`` after Humble), and
     rosbags refuses a second definition of a registered name
     (``TypesysError``), which made every bag of such a workspace unreadable.
-    Raises :class:`TraceError` as :func:`custom_types` does.
+    The store is shared within the process by equal definitions (:data:`_STORES`):
+    callers only read it.  Raises :class:`TraceError` as :func:`custom_types` does.
     """
+    definitions = _definitions(msg_dirs)
+    key = tuple((name, text) for name, text, _ in definitions)
+    if (store := _STORES.get(key)) is not None:
+        return store
     from rosbags.typesys import Stores, get_typestore  # deferred: start-up (loads rosbags and more only when called)
     store = get_typestore(Stores.ROS2_HUMBLE)
-    own = custom_types(msg_dirs)
+    own = _parsed(definitions)
     if any(store.fielddefs.get(name, fields) != fields for name, fields in own.items()):
         standard = {name: fields for name, fields in store.fielddefs.items() if name not in own}
         store = get_typestore(Stores.EMPTY)
         store.register(standard)
     store.register(own)
+    if len(_STORES) >= _STORES_KEPT:
+        _STORES.pop(next(iter(_STORES)))
+    _STORES[key] = store
     return store
 
 
