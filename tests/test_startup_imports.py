@@ -48,3 +48,27 @@ def test_a_bound_still_imports_scipy_when_it_needs_it() -> None:
     from rclverify.records.statistics import upper_bound
     # 1 violation in 10 runs at 95 %: the 0.95 quantile of Beta(2, 9), about 0.3942
     assert abs(upper_bound(1, 10, 0.95) - 0.39416) < 1e-4
+
+
+def test_a_pipeline_run_without_recorded_runs_loads_no_numpy(tmp_path: Path) -> None:
+    """The temporal requirements' stage digests the plan's recorded runs (traces/files.py) without
+    loading the monitors, and with them numpy (about 70 ms of every small pipeline process): a run
+    of a fresh ``rclverify init`` workspace, which records none, does not load numpy, nor Dask or
+    scipy; it does load z3 and cvc5 (the second solver) and decides its requirement."""
+    ws = tmp_path / "ws"
+    env = {**os.environ, "RCLVERIFY_JOBS": "1", "PYTHONPATH": os.pathsep.join([str(SRC)] + (
+        [os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else []))}
+    init = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "init", str(ws)], env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert init.returncode == 0, init.stderr
+    probe = ("import json, runpy, sys\n"
+             "try:\n    sys.argv = ['doit', 'verify']; runpy.run_module('doit', run_name='__main__')\n"
+             "except SystemExit as e:\n    code = e.code\n"
+             "print(json.dumps([code, sorted({m.split('.')[0] for m in sys.modules})]))\n")
+    r = subprocess.run([sys.executable, "-c", probe], cwd=ws, env=env, capture_output=True, text=True, timeout=300)
+    code, loaded = json.loads(r.stdout.strip().splitlines()[-1])
+    assert code in (0, None), r.stdout + r.stderr
+    assert {"z3", "cvc5", "doit"} <= set(loaded), loaded
+    assert not set(loaded) & {"numpy", "scipy", "dask", "distributed", "pandas"}, loaded
+    report = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    assert report["requirements"] and all(r["status"] for r in report["requirements"])

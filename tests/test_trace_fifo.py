@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.backends.monitors.backend import trace_files
+from rclverify.traces.files import trace_files
 from rclverify.traces import TraceError, read_trace
 from rclverify.traces.guard import check_trace_path
 

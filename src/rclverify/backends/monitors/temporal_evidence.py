@@ -38,7 +38,7 @@ from rclverify.model.plan.temporal import Temporal, operands, parse_temporal
 from rclverify.lang.errors import RclError
 from rclverify.lang.types import Checked
 from rclverify.traces import TraceError, read_trace
-from rclverify.backends.monitors.backend import trace_sha256
+from rclverify.traces.files import trace_sha256
 from rclverify.backends.monitors.config import ConfigError, load_mapping
 from rclverify.backends.monitors.temporal_trace import check_temporal_trace
 import hashlib
