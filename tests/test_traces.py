@@ -5,6 +5,7 @@ import json
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from rclverify.lang import types as T
@@ -267,25 +268,43 @@ def test_a_workspace_definition_of_a_standard_type_replaces_the_store_s(tmp_path
     assert (ev.topic, ev.fields["range"], ev.fields["variance"]) == ("scan", 1.5, 0.25)
 
 
-def test_the_type_store_is_shared_by_equal_definitions_and_made_again_for_an_edited_one(tmp_path: Path) -> None:
-    """traces/bag.py keeps a process's type stores by the workspace's definitions: the same
-    definitions (in another folder too) give the same store, an edited ``.msg`` a new one carrying
-    the edit, and going back gives the first store again; a bad definition stays an error every time."""
-    from rclverify.traces.bag import typestore
+def test_equal_definitions_are_registered_once_and_each_caller_gets_its_own_store(tmp_path: Path) -> None:
+    """traces/bag.py registers a workspace's definitions once per process: the same definitions (in
+    another folder too) come from one registration, an edited ``.msg`` is registered again with the
+    edit, and going back finds the first; each call returns a store of its own, so a caller that
+    removes or registers a type changes no other caller's store; a bad definition stays an error."""
+    from rosbags.typesys import get_types_from_msg
+
+    from rclverify.traces import bag
     from rclverify.traces.events import TraceError
     a, b = (tmp_path / x / "sensor_msgs" / "msg" for x in ("a", "b"))
     for d in (a, b):
         d.mkdir(parents=True)
         (d / "Range.msg").write_text(NEWER_RANGE)
-    first = typestore([tmp_path / "a"])
-    assert typestore([tmp_path / "b"]) is first and typestore([tmp_path / "a"]) is first
+    first = bag.typestore([tmp_path / "a"])
+    made = len(bag._STORES)
+    other = bag.typestore([tmp_path / "b"])
+    assert len(bag._STORES) == made and other is not first
+    assert other.types["sensor_msgs/msg/Range"] is first.types["sensor_msgs/msg/Range"]  # one registration
     (a / "Range.msg").write_text(NEWER_RANGE + "float32 confidence\n")
-    edited = typestore([tmp_path / "a"])
-    assert edited is not first
+    edited = bag.typestore([tmp_path / "a"])
     assert [n for n, _ in edited.fielddefs["sensor_msgs/msg/Range"][1]][-2:] == ["variance", "confidence"]
+    assert [n for n, _ in first.fielddefs["sensor_msgs/msg/Range"][1]][-1] == "variance"
     (a / "Range.msg").write_text(NEWER_RANGE)
-    assert typestore([tmp_path / "a"]) is first
+    again = bag.typestore([tmp_path / "a"])
+    assert again.types["sensor_msgs/msg/Range"] is first.types["sensor_msgs/msg/Range"]
+    # a caller's own change: a 16-byte Gid in one store; the next store still has the standard 24
+    mine = bag.typestore([])
+    Gid = mine.types["rmw_dds_common/msg/Gid"]
+    assert len(mine.serialize_cdr(Gid(data=np.zeros(24, dtype=np.uint8)), "rmw_dds_common/msg/Gid")) == 28
+    mine.fielddefs.pop("rmw_dds_common/msg/Gid")
+    mine.types.pop("rmw_dds_common/msg/Gid")
+    mine.register(get_types_from_msg("uint8[16] data", "rmw_dds_common/msg/Gid"))
+    fresh = bag.typestore([])
+    assert fresh.fielddefs["rmw_dds_common/msg/Gid"] != mine.fielddefs["rmw_dds_common/msg/Gid"]
+    Gid = fresh.types["rmw_dds_common/msg/Gid"]
+    assert len(fresh.serialize_cdr(Gid(data=np.zeros(24, dtype=np.uint8)), "rmw_dds_common/msg/Gid")) == 28
     (a / "Range.msg").write_text("float32 range\n@@@ x\n")
     for _ in range(2):
         with pytest.raises(TraceError, match="Range.msg:1: error: bad message definition"):
-            typestore([tmp_path / "a"])
+            bag.typestore([tmp_path / "a"])

@@ -6,6 +6,7 @@ definitions, which cover ROS 1's common types too); the workspace's own
 """
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
@@ -45,12 +46,20 @@ def _parsed(definitions: tuple[tuple[str, str, Path], ...]) -> dict[str, Any]:
 
 
 #: The type stores this process made, by the workspace's message definitions (name and text of each
-#: ``.msg``): a store is read, never changed, once made (``AnyReader`` copies its definitions into a
-#: store of its own, and rosbags' per-type decoder cache is a function of the definitions), so the
-#: same definitions give the same store.  Making one registers every standard type again when the
-#: workspace redefines one (about 60 ms), and a pipeline run opens its bags once per monitored node.
+#: ``.msg``).  Making one registers every standard type again when the workspace redefines one
+#: (about 60 ms), and a pipeline run opens its bags once per monitored node; each caller gets its
+#: own copy (:func:`_copy`), so what one caller registers or removes stays in its copy.
 _STORES: dict[tuple[tuple[str, str], ...], Any] = {}
 _STORES_KEPT = 8
+
+
+def _copy(store: Any) -> Any:
+    """A ``rosbags`` type store with ``store``'s definitions and generated classes in dicts of its own
+    and an empty (de)serialiser cache: registering or removing a type in it changes neither
+    ``store`` nor another copy, and its cache is made from its own definitions."""
+    out = copy.copy(store)
+    out.fielddefs, out.types, out.cache = dict(store.fielddefs), dict(store.types), {}
+    return out
 
 
 def typestore(msg_dirs: Sequence[Path]) -> Any:
@@ -61,13 +70,13 @@ def typestore(msg_dirs: Sequence[Path]) -> Any:
     changed it (``sensor_msgs/Range`` gained ``variance`` after Humble), and
     rosbags refuses a second definition of a registered name
     (``TypesysError``), which made every bag of such a workspace unreadable.
-    The store is shared within the process by equal definitions (:data:`_STORES`):
-    callers only read it.  Raises :class:`TraceError` as :func:`custom_types` does.
+    Equal definitions are registered once per process (:data:`_STORES`); each call
+    returns a copy of its own.  Raises :class:`TraceError` as :func:`custom_types` does.
     """
     definitions = _definitions(msg_dirs)
     key = tuple((name, text) for name, text, _ in definitions)
     if (store := _STORES.get(key)) is not None:
-        return store
+        return _copy(store)
     from rosbags.typesys import Stores, get_typestore  # deferred: start-up (loads rosbags and more only when called)
     store = get_typestore(Stores.ROS2_HUMBLE)
     own = _parsed(definitions)
@@ -79,7 +88,7 @@ def typestore(msg_dirs: Sequence[Path]) -> Any:
     if len(_STORES) >= _STORES_KEPT:
         _STORES.pop(next(iter(_STORES)))
     _STORES[key] = store
-    return store
+    return _copy(store)
 
 
 def flatten(msg: Any) -> dict[str, Any]:
