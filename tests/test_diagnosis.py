@@ -296,6 +296,36 @@ def test_the_agents_guarantee_3_gets_the_successor_restriction(tmp_path: Path) -
     assert (root / "contracts" / "remote_inspection.rcl").read_text() == (REPO / RCL_FILE).read_text()
 
 
+def test_without_instances_the_witness_tables_take_the_contracts_numbers() -> None:
+    """diagnosis/recheck.py: a table of the plan's instances or 4 points first, then one point per whole
+    number up to the largest the formulas write (at most 32), inside quantifiers too."""
+    from rclverify.diagnosis.recheck import MAX_NUMERAL_POINTS, numeral_points
+    i, x = z3.Int("i"), z3.Real("x")
+    f = z3.Function("f", z3.RealSort(), z3.IntSort())
+    assert numeral_points([z3.ForAll([x], z3.And(f(x) <= 12, f(x) >= 0)), i + 1 <= 7]) == 13
+    assert numeral_points([z3.ForAll([x], f(x) == -20)]) == 21 and numeral_points([x <= z3.RealVal("5/2")]) == 1
+    assert numeral_points([i <= 1000]) == MAX_NUMERAL_POINTS and numeral_points([z3.BoolVal(True)]) == 1
+
+
+def test_the_cut_down_rover_without_instances_gets_the_case_studys_guard(tmp_path: Path) -> None:
+    """tests/_incremental.py's rover has no ``instances`` for the Agent, so its witness tables had 4
+    points: the weakest guard, ``i + 1 <= 12``, needs a waypoint numbered 1 to 12 and has a witness only
+    with 13, the general query ran out of its budget (1.2 s) and a stronger guard was offered.  The
+    second table, of the contract's own numbers, finds the witness: the same guard as the case study."""
+    import _incremental as inc
+    from rclverify.diagnosis.repairs import guard_repair
+    root = inc.make_workspace(tmp_path / "ws")
+    ws = Workspace(root)
+    assert "Agent" not in ws.plan.instances
+    before = {"Agent.assumption-satisfiable": "ok", "Agent.contract-consistent": "ok",
+              "Agent.g1.non-vacuous": "ok", "Agent.g2.non-vacuous": "problem", "Agent.g3.non-vacuous": "ok"}
+    r = guard_repair(ws, "Agent", 3, [(2, None)], before)
+    assert r is not None and r["kind"] == "guard"
+    assert r["edit"]["inserted"] == ("i + 1 <= 12 and (in.radiationStatus in {red, orange} or "
+                                     "not exists(x, y in REAL | in.wayP(x, y) == i + 1))")
+    assert {"check": "Agent.g2.non-vacuous", "status": "can fire (Z3: sat, witness found)"} in r["checks"]
+
+
 def test_explain_and_status_read_the_last_run(newcomer: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["status", "-w", str(newcomer)]) == 1  # no report yet: located error
     assert "no report yet" in capsys.readouterr().err

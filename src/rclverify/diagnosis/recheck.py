@@ -106,11 +106,47 @@ def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> 
     """``"sat"`` when Z3 finds a witness of ``h``'s assumption, guarantees,
     facts and ``extra`` in which every function-typed input is a finite
     table of ``points`` points (:func:`rclverify.calculus.health.witness.finite_witness`),
-    else ``"inconclusive"`` (no witness of that shape, which is not a proof
+    or, failing that, of :func:`numeral_points` points when that is more;
+    else ``"inconclusive"`` (no witness of those shapes, which is not a proof
     that there is none).  Asked of Z3's ``simplify`` and ``qe-light``
     tactics first (``simplified``: the case study's Agent, 0.1 s a witness
     instead of 0.3-0.7 s), then as the health stage asks it."""
-    return table_witness(h.enc, [f for _, f in h.labelled(extra)], points, simplified=True).status
+    formulas = [f for _, f in h.labelled(extra)]
+    if table_witness(h.enc, formulas, points, simplified=True).status == "sat":
+        return "sat"
+    wide = numeral_points(formulas)
+    return table_witness(h.enc, formulas, wide, simplified=True).status if wide > points else "inconclusive"
+
+
+#: The most points :func:`numeral_points` gives a table.
+MAX_NUMERAL_POINTS = 32
+
+
+def numeral_points(formulas: list[z3.BoolRef]) -> int:
+    """One more than the largest whole number written in ``formulas`` (at most
+    :data:`MAX_NUMERAL_POINTS`): a table of that many points can take each value
+    from 0 up to it at a point of its own.  Without the plan's ``instances`` a
+    table has :data:`~rclverify.calculus.health.witness.WITNESS_POINTS`; a contract
+    that asks for a function to reach every number up to 12 (the cut-down rover's
+    guard ``i + 1 <= 12`` with "each waypoint has a next one") has a witness only
+    with 13, which the general query does not find within its budget."""
+    seen: set[int] = set()
+    todo: list[z3.ExprRef] = list(formulas)
+    top = 0
+    while todo:
+        e = todo.pop()
+        if e.get_id() in seen:
+            continue
+        seen.add(e.get_id())
+        if z3.is_int_value(e):
+            top = max(top, abs(e.as_long()))
+        elif z3.is_rational_value(e) and e.denominator_as_long() == 1:
+            top = max(top, abs(e.numerator_as_long()))
+        elif z3.is_quantifier(e):
+            todo.append(e.body())
+        elif z3.is_app(e):
+            todo.extend(e.children())
+    return min(top + 1, MAX_NUMERAL_POINTS)
 
 
 def _points(ws: Any, node: str) -> int:
