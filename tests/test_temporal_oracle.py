@@ -321,3 +321,19 @@ def test_the_oracle_sees_runs_that_stop() -> None:
     assert truth["eventually"] and truth["within"] and not truth["always"] and not truth["until"]  # p fails at 0
     m.within = 2
     assert not oracle(m)["within"]
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(systems())
+def test_the_lassos_fairness_terms_built_step_by_step_are_fair_loops(m: System) -> None:
+    """find_lasso builds each constraint's enabled and taken terms once per state
+    (calculus/requirements/temporal.py, ``_fair_loop``): every loop's term is the very term
+    ``tsys.fair_loop`` builds, so the queries, hence the verdicts, are as before."""
+    from rclverify.calculus.requirements.temporal import _fair_loop
+    from rclverify.calculus.requirements.tsys import fair_loop, unroll
+    ts = encode(m)[0]
+    states, _ = unroll(ts, 5)
+    marks = [[(f.enabled(x), f.taken(x)) for x in states] for f in ts.fairness]
+    for n in range(1, 6):
+        for j in range(n):
+            assert _fair_loop(marks, j, n).eq(fair_loop(ts, states[j:n])), (j, n)
