@@ -369,6 +369,42 @@ def test_no_tool_and_no_build_directory_outlive_rclverify(tmp_path: Path, signum
         proc.kill()
 
 
+SIGNAL_IN_FORK = """
+import os, signal, sys, time
+from pathlib import Path
+from rclverify.backends.bounded import run_bounded
+sent = []
+def send():  # in os.fork's after_in_parent callbacks, where Python ignores what a handler raises
+    if not sent:
+        sent.append(1)
+        os.kill(os.getpid(), signal.SIGTERM)
+        for _ in range(1000):  # give the handler a bytecode boundary inside this callback
+            pass
+os.register_at_fork(after_in_parent=send)
+t0 = time.monotonic()
+try:
+    run_bounded(["sleep", "30"], Path(sys.argv[1]), 60)
+except SystemExit as exc:
+    print("exit", exc.code, round(time.monotonic() - t0, 1))
+    raise
+print("went on", round(time.monotonic() - t0, 1))
+"""
+
+
+@needs_proc
+def test_a_sigterm_while_the_tool_starts_still_stops_rclverify(tmp_path: Path) -> None:
+    """A SIGTERM that arrives while ``subprocess.Popen`` forks the tool runs its handler inside a
+    fork callback, where Python ignores the ``SystemExit`` it raises (the whole suite once saw it:
+    rclverify went on waiting for the tool).  The signal is kept and raised once the tool has started
+    (backends/bounded.py): the run exits 143 at once, the tool (``sleep 30``) killed with its group."""
+    r = subprocess.run([sys.executable, "-c", SIGNAL_IN_FORK, str(tmp_path)], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 143, r.stdout + r.stderr
+    word, code, seconds = r.stdout.split()
+    assert (word, code) == ("exit", "143") and float(seconds) < 10, r.stdout
+    assert "Exception ignored" in r.stderr  # the handler's own SystemExit was lost where Python ignores it
+
+
 # -- bounds: deep terms, recursion, explosion, time ---------------------------------------------
 
 ENV_X = {"percepts": ["x"]}

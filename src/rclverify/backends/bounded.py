@@ -147,22 +147,38 @@ def _kill_group(pgid: int) -> None:
 
 
 @contextlib.contextmanager
-def _exit_on_termination() -> Iterator[None]:
+def _exit_on_termination() -> Iterator[list[int]]:
     """In the main thread: SIGTERM and SIGHUP raise ``SystemExit(128 + signal)``
-    while the block runs (previous handlers restored after it)."""
+    while the block runs (previous handlers restored after it).  Yields the
+    signals received: a handler's ``SystemExit`` raised inside a callback whose
+    exceptions Python ignores is lost (``os.fork``'s ``after_in_parent``
+    callbacks, such as ``logging``'s lock release, while ``subprocess.Popen``
+    starts the tool: the whole suite caught a SIGTERM there, and rclverify went
+    on waiting for the tool), so the block checks the list at its own points
+    (:func:`_raise_received`), and a block that ends normally after a signal
+    raises its ``SystemExit`` on leaving."""
+    received: list[int] = []
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield received
         return
 
     def stop(signum: int, frame: Any) -> None:
+        received.append(signum)
         raise SystemExit(128 + signum)
 
     previous = {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP)}
     try:
-        yield
+        yield received
     finally:
         for s, h in previous.items():
             signal.signal(s, h)
+    _raise_received(received)
+
+
+def _raise_received(received: list[int]) -> None:
+    """``SystemExit(128 + signal)`` for the first signal in ``received``, if any."""
+    if received:
+        raise SystemExit(128 + received[0])
 
 
 def run_bounded(cmd: list[str], cwd: Path, timeout_s: float,
@@ -180,13 +196,14 @@ def run_bounded(cmd: list[str], cwd: Path, timeout_s: float,
     through after killing the group.
     """
     t0 = time.perf_counter()
-    with _exit_on_termination():
+    with _exit_on_termination() as received:
         proc = subprocess.Popen(cmd, cwd=cwd, env=None if env is None else dict(env), stdin=subprocess.DEVNULL,
                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
                                 preexec_fn=_PREEXEC)
         _tell("+g", proc.pid)
         code: int | None
         try:
+            _raise_received(received)  # a signal while the tool started (its SystemExit may have been lost)
             out, _ = proc.communicate(timeout=max(timeout_s, 0.1))
             code = proc.returncode
         except subprocess.TimeoutExpired:
