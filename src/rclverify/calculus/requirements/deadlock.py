@@ -13,7 +13,9 @@ asked of Z3 as such:
   quantifiers over finite sorts inside the step relation
   (:func:`rclverify.semantics.retry.expand_finite`; both equivalences), so over
   finite domains the query is quantifier-free;
-* what stays quantified is first eliminated where Z3's ``qe`` tactic can
+* the query is first given to Z3's default solver for a short look
+  (:data:`FIRST_LOOK_MS`); its ``sat`` and ``unsat`` are answers;
+* what it leaves open is first eliminated where Z3's ``qe`` tactic can
   (linear arithmetic: an equivalence), then left to Z3's quantifier
   instantiation, and when that answers ``unknown`` it is asked once more
   with model-based instantiation alone (``smt.ematching=false``);
