@@ -46,6 +46,7 @@ import z3
 
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.query import prove
+from rclverify.semantics.subterms import subterms
 from rclverify.lang import ast
 from rclverify.lang.parser import parse_formula, parse_text
 from rclverify.lang.printer import expr_to_rcl, node_to_rcl
@@ -188,22 +189,11 @@ def _constants(fs: Sequence[z3.ExprRef]) -> dict[str, z3.ExprRef]:
     """The free constants of ``fs`` by name; raises :class:`_Beyond` for a
     free function (a quantifier cannot range over it)."""
     out: dict[str, z3.ExprRef] = {}
-    todo, seen = list(fs), set()
-    while todo:
-        x = todo.pop()
-        if x.get_id() in seen:
-            continue
-        seen.add(x.get_id())
-        if z3.is_quantifier(x):
-            todo.append(x.body())
-            continue
-        if z3.is_app(x):
-            d = x.decl()
-            if d.kind() == z3.Z3_OP_UNINTERPRETED:
-                if d.arity() > 0:
-                    raise _Beyond(f"{d.name()} is a function")
-                out[d.name()] = x
-            todo.extend(x.children())
+    for x in subterms(fs):
+        if z3.is_app(x) and x.decl().kind() == z3.Z3_OP_UNINTERPRETED:
+            if x.decl().arity() > 0:
+                raise _Beyond(f"{x.decl().name()} is a function")
+            out[x.decl().name()] = x
     return out
 
 

@@ -20,6 +20,7 @@ import z3
 
 from rclverify.calculus.health.witness import finite_witness as table_witness, points_for
 from rclverify.semantics import world
+from rclverify.semantics.subterms import subterms
 from rclverify.lang.errors import RclError
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
@@ -130,22 +131,12 @@ def numeral_points(formulas: list[z3.BoolRef]) -> int:
     that asks for a function to reach every number up to 12 (the cut-down rover's
     guard ``i + 1 <= 12`` with "each waypoint has a next one") has a witness only
     with 13, which the general query does not find within its budget."""
-    seen: set[int] = set()
-    todo: list[z3.ExprRef] = list(formulas)
     top = 0
-    while todo:
-        e = todo.pop()
-        if e.get_id() in seen:
-            continue
-        seen.add(e.get_id())
+    for e in subterms(formulas):
         if z3.is_int_value(e):
             top = max(top, abs(e.as_long()))
         elif z3.is_rational_value(e) and e.denominator_as_long() == 1:
             top = max(top, abs(e.numerator_as_long()))
-        elif z3.is_quantifier(e):
-            todo.append(e.body())
-        elif z3.is_app(e):
-            todo.extend(e.children())
     return min(top + 1, MAX_NUMERAL_POINTS)
 
 

@@ -36,6 +36,7 @@ from rclverify.semantics.encode import value_to_rcl
 from rclverify.semantics.query import budgeted_solver, render_model, tactic_solver
 from rclverify.semantics.wallclock import check
 from rclverify.semantics.retry import load_canonical
+from rclverify.semantics.subterms import subterms
 
 #: Points of each function table (at least the plan's instances: see :func:`points_for`).
 WITNESS_POINTS = 4
@@ -239,19 +240,7 @@ def _fixed_left(formulas: Sequence[z3.ExprRef], f: _Found) -> bool:
 def _uninterpreted(formulas: Sequence[z3.ExprRef]) -> Iterator[z3.ExprRef]:
     """The applications of uninterpreted symbols (constants and functions)
     in ``formulas``, quantifier bodies included, each shared term once."""
-    seen: set[int] = set()
-    todo = list(formulas)
-    while todo:
-        e = todo.pop()
-        if e.get_id() in seen:
-            continue
-        seen.add(e.get_id())
-        if z3.is_quantifier(e):
-            todo.append(e.body())
-        elif z3.is_app(e):
-            if e.decl().kind() == z3.Z3_OP_UNINTERPRETED:
-                yield e
-            todo.extend(e.children())
+    return (e for e in subterms(formulas) if z3.is_app(e) and e.decl().kind() == z3.Z3_OP_UNINTERPRETED)
 
 
 def extend(w: Witness, enc: Any, formulas: Sequence[z3.BoolRef], budget_ms: int = EXTEND_TIMEOUT_MS) -> Witness:

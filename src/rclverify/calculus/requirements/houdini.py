@@ -30,6 +30,7 @@ import z3
 
 from rclverify.calculus.requirements.tsys import Pred, State, TransitionSystem
 from rclverify.semantics import wallclock
+from rclverify.semantics.subterms import subterms
 
 #: At most this many numerals of each sort, and this many candidates in all.
 MAX_NUMERALS = 12
@@ -41,19 +42,11 @@ Candidate = tuple[str, Callable[[State], z3.BoolRef]]
 def _numerals(exprs: list[z3.ExprRef]) -> dict[str, set[Fraction]]:
     """The integer and real numerals of ``exprs`` (``{"int": ..., "real": ...}``)."""
     out: dict[str, set[Fraction]] = {"int": {Fraction(0)}, "real": {Fraction(0)}}
-    seen: set[int] = set()
-    todo = list(exprs)
-    while todo:
-        e = todo.pop()
-        if e.get_id() in seen:
-            continue
-        seen.add(e.get_id())
+    for e in subterms(exprs):
         if z3.is_int_value(e):
             out["int"].add(Fraction(e.as_long()))
         elif z3.is_rational_value(e):
             out["real"].add(Fraction(e.as_fraction()))
-        elif z3.is_app(e) or z3.is_quantifier(e):
-            todo.extend(e.children() if z3.is_app(e) else [e.body()])
     return {k: set(sorted(v, key=lambda f: (abs(f), f))[:MAX_NUMERALS]) for k, v in out.items()}
 
 
