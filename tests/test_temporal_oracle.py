@@ -326,14 +326,13 @@ def test_the_oracle_sees_runs_that_stop() -> None:
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(systems())
 def test_the_lassos_fairness_terms_built_step_by_step_are_fair_loops(m: System) -> None:
-    """find_lasso builds each constraint's enabled and taken terms once per state
-    (calculus/requirements/temporal.py, ``_fair_loop``): every loop's term is the very term
-    ``tsys.fair_loop`` builds, so the queries, hence the verdicts, are as before."""
-    from rclverify.calculus.requirements.temporal import _fair_loop
-    from rclverify.calculus.requirements.tsys import fair_loop, unroll
+    """The lasso searches build each state's enabled and taken terms once (tsys.FairLoops): every
+    loop's term is the very term ``tsys.fair_loop`` builds, over one growing unrolling or one made
+    again for each length, so the queries, hence the verdicts, are as before."""
+    from rclverify.calculus.requirements.tsys import FairLoops, fair_loop, unroll
     ts = encode(m)[0]
-    states, _ = unroll(ts, 5)
-    marks = [[(f.enabled(x), f.taken(x)) for x in states] for f in ts.fairness]
+    fair = FairLoops(ts)
     for n in range(1, 6):
+        states, _ = unroll(ts, n)  # made again for each length, as the response's search makes it
         for j in range(n):
-            assert _fair_loop(marks, j, n).eq(fair_loop(ts, states[j:n])), (j, n)
+            assert fair.loop(states, j, n).eq(fair_loop(ts, states[j:n])), (j, n)

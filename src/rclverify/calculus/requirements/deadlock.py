@@ -48,6 +48,7 @@ from rclverify.semantics.retry import MAX_INSTANCES, expand_finite, finite_value
 from rclverify.semantics.subst import substitute
 from rclverify.calculus.requirements.tsys import Pred, State, TemporalVerdict, TransitionSystem, distinct, trace_of, unroll
 from rclverify.semantics import wallclock
+from rclverify.semantics.query import tactic_solver
 
 #: A deadlock query is first asked of Z3's default solver for this many milliseconds' worth of resource
 #: steps: most are answered there in a few ms, where the quantifier elimination that leads
@@ -90,12 +91,10 @@ def no_successor(ts: TransitionSystem, s: State) -> z3.BoolRef:
 
 def _attempts(timeout_ms: int) -> list[tuple[str, z3.Solver]]:
     """The solvers a deadlock query is asked of, in order (module docstring)."""
-    qe = z3.Then("qe", "smt").solver()  # eliminates the successor's quantifier over linear arithmetic
-    plain = z3.Solver()
-    mbqi = z3.Solver()
+    qe = tactic_solver(timeout_ms, ("qe", "smt"))  # eliminates the successor's quantifier over linear arithmetic
+    plain = _solver(timeout_ms)
+    mbqi = _solver(timeout_ms)
     mbqi.set("smt.ematching", False)
-    for s in (qe, plain, mbqi):
-        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
     return [("quantifier elimination", qe), ("default", plain), ("model-based instantiation", mbqi)]
 
 

@@ -39,7 +39,7 @@ from rclverify.semantics import wallclock
 from rclverify.lang.types import DataT, EnumT, FuncT, Type
 from rclverify.semantics.values import FiniteFunction, Term
 from rclverify.calculus.requirements.temporal import Pred, State, TransitionSystem
-from rclverify.calculus.requirements.tsys import fair_loop
+from rclverify.calculus.requirements.tsys import FairLoops
 
 #: Budget of one lasso query (ms worth of Z3 resource steps).
 LASSO_BUDGET_MS = 5_000
@@ -155,11 +155,12 @@ def find_table_lasso(ts: TransitionSystem, prop: Pred, types: Mapping[str, Type]
     model back).  Returns the :class:`TableLasso` of the shortest one found,
     or a sentence saying what was tried (no lasso of that shape up to the
     bound, or the solver's unknown at length n)."""
+    fair = FairLoops(ts)
     for n in range(1, bound + 1):
         steps = [table_state(ts, i, points) for i in range(n + 1)]
         states = [s for s, _ in steps]
         same = [z3.And(*[a == b for v in ts.sorts for a, b in zip(steps[n][1][v], steps[j][1][v])],
-                       fair_loop(ts, states[j:n])) for j in range(n)]
+                       fair.loop(states, j, n)) for j in range(n)]
         formulas = [ts.init(states[0]), *[ts.trans(states[i], states[i + 1]) for i in range(n)],
                     *[z3.Not(prop(s)) for s in states], z3.Or(*same)]
         ctx = z3.Context()

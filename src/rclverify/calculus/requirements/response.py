@@ -57,7 +57,7 @@ from typing import Callable
 from rclverify.calculus.requirements.deadlock import find_deadlock
 from rclverify.calculus.requirements.safety import Hint, prove_always
 from rclverify.calculus.requirements.temporal import _ranking_fails, check_always
-from rclverify.calculus.requirements.tsys import Pred, TemporalVerdict, TransitionSystem, fair_loop, trace_of, unroll, with_flag
+from rclverify.calculus.requirements.tsys import Pred, TemporalVerdict, TransitionSystem, FairLoops, trace_of, unroll, with_flag
 from rclverify.semantics import wallclock
 
 #: The bounds N tried, in order, to prove the unbounded response from the bounded one.
@@ -138,11 +138,12 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
             return TemporalVerdict("proved", "bounded response", k=v.k, bound=n,
                                    detail=f"every trigger is answered within {n} steps (k-induction, k = {v.k})")
         tried.append(f"within {n}: {v.status}")
+    fair = FairLoops(ts2)
     for n in range(1, max_k + 1):
         states, steps = unroll(ts2, n)
         sv = z3.Solver()
         wallclock.limit(sv, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        loops = [z3.And(*[states[n][v] == states[j][v] for v in ts2.sorts], fair_loop(ts2, states[j:n]),
+        loops = [z3.And(*[states[n][v] == states[j][v] for v in ts2.sorts], fair.loop(states, j, n),
                         *[st["<pending>"] for st in states[j:n + 1]]) for j in range(n)]
         sv.add(ts2.init(states[0]), *steps, z3.Or(*loops))
         r = sv.check()

@@ -36,7 +36,7 @@ from typing import Callable
 import z3
 
 from rclverify.calculus.requirements.deadlock import check_deadlock_free, find_deadlock
-from rclverify.calculus.requirements.tsys import (Fairness, Pred, State, TemporalVerdict, Trans, TransitionSystem, distinct, trace_of, unroll,
+from rclverify.calculus.requirements.tsys import (FairLoops, Fairness, Pred, State, TemporalVerdict, Trans, TransitionSystem, distinct, trace_of, unroll,
                    with_flag)
 from rclverify.semantics import wallclock
 
@@ -267,14 +267,6 @@ def _ranking_fails(ts: TransitionSystem, prop: Pred, inv: Pred, ranking: Callabl
     return None
 
 
-def _fair_loop(marks: list[list[tuple[z3.BoolRef, z3.BoolRef]]], j: int, n: int) -> z3.BoolRef:
-    """:func:`.tsys.fair_loop` of the states ``j .. n-1``, from each constraint's
-    ``(enabled, taken)`` terms at each state (``marks[constraint][state]``): the same term."""
-    if not marks:
-        return z3.BoolVal(True)
-    return z3.And(*[z3.Implies(z3.Or(*[e for e, _ in m[j:n]]), z3.Or(*[t for _, t in m[j:n]])) for m in marks])
-
-
 def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
                timeout_ms: int = 10_000) -> TemporalVerdict | None:
     """A counterexample to unbounded ``eventually prop``: a run s0..sn
@@ -286,22 +278,19 @@ def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
     ``lasso``, ``loop = j``).  ``None`` when no such run of up to ``bound``
     steps exists or the solver cannot say.
     """
-    # the unrolling, each state's "prop fails" and each fairness constraint's enabled and taken terms
-    # grow by one step per length instead of being built again for each (the same terms: unroll,
-    # fair_loop), so building the queries up to the bound is quadratic in it, not quartic
+    # the unrolling and each state's "prop fails" grow by one step per length instead of being built
+    # again for each, and each state's fairness terms are built once (the same terms: unroll, fair_loop)
     states, steps = unroll(ts, 0)
     init = ts.init(states[0])
     misses = [z3.Not(prop(states[0]))]
-    marks: list[list[tuple[z3.BoolRef, z3.BoolRef]]] = [[] for _ in ts.fairness]  # states 0 .. n-1
+    fair = FairLoops(ts)
     for n in range(1, bound + 1):
         states.append(ts.state(n))
         steps.append(ts.trans(states[n - 1], states[n]))
         misses.append(z3.Not(prop(states[n])))
-        for f, m in zip(ts.fairness, marks):
-            m.append((f.enabled(states[n - 1]), f.taken(states[n - 1])))
         s = z3.Solver()
         wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        same = [z3.And(*[states[n][v] == states[j][v] for v in ts.sorts], _fair_loop(marks, j, n))
+        same = [z3.And(*[states[n][v] == states[j][v] for v in ts.sorts], fair.loop(states, j, n))
                 for j in range(n)]
         s.add(init, *steps, *misses, z3.Or(*same))
         if s.check() == z3.sat:

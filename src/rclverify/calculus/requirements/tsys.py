@@ -128,3 +128,32 @@ def fair_loop(ts: TransitionSystem, loop: list[State]) -> z3.BoolRef:
     ``enabled`` at no state of the loop or ``taken`` at one of them."""
     return z3.And(*[z3.Implies(z3.Or(*[f.enabled(s) for s in loop]), z3.Or(*[f.taken(s) for s in loop]))
                     for f in ts.fairness]) if ts.fairness else z3.BoolVal(True)
+
+
+class FairLoops:
+    """:func:`fair_loop` for the many loops a lasso search asks about (every
+    loop start j of every length n), each state's ``enabled`` and ``taken``
+    terms built once and kept by the state's terms: the same term as
+    ``fair_loop(ts, states[j:n])``, built in time linear in the loop instead
+    of in the loop times the predicates' size (the searches asked O(n^2)
+    loops of O(n) states each, every predicate built again)."""
+
+    def __init__(self, ts: TransitionSystem) -> None:
+        self.fairness = ts.fairness
+        # by the ids of a state's terms, the terms kept alive beside them (an id is reused once its term is freed)
+        self._marks: dict[tuple[int, ...], tuple[tuple[z3.ExprRef, ...], list[tuple[z3.BoolRef, z3.BoolRef]]]] = {}
+
+    def _of(self, s: State) -> list[tuple[z3.BoolRef, z3.BoolRef]]:
+        key = tuple(x.get_id() for x in s.values())
+        got = self._marks.get(key)
+        if got is None:
+            got = self._marks[key] = (tuple(s.values()), [(f.enabled(s), f.taken(s)) for f in self.fairness])
+        return got[1]
+
+    def loop(self, states: list[State], j: int, n: int) -> z3.BoolRef:
+        """``fair_loop(ts, states[j:n])``."""
+        if not self.fairness:
+            return z3.BoolVal(True)
+        marks = [self._of(s) for s in states[j:n]]
+        return z3.And(*[z3.Implies(z3.Or(*[m[c][0] for m in marks]), z3.Or(*[m[c][1] for m in marks]))
+                        for c in range(len(self.fairness))])
