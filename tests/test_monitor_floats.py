@@ -238,13 +238,17 @@ def _formula(draw: Any) -> tuple[str, Any]:
     text = f" {join} ".join(f"({a[0]})" for a in atoms)
     text = f"not ({text})" if neg else text
 
+    def reads(a: Any) -> bool:
+        """Whether the atom reads a recorded value: a comparison of literals alone stays exact under tolerance."""
+        return "in.r" in a[0] or "out.d" in a[0]
+
     def truth(v: dict[str, float], sem: str, tol: Fraction) -> bool:
         def atom(a: Any) -> bool:
             _, op, le, ld, re_, rd = a
             if sem == "double":
                 return bool(_CMPS[op](ld(v), rd(v)))
             x, y = le(v), re_(v)
-            if sem == "exact":
+            if sem == "exact" or not reads(a):
                 return bool(_CMPS[op](x, y))
             close = abs(x - y) <= tol
             return {"==": close, "!=": not close, "<=": x <= y or close, "<": x < y and not close}[op]
@@ -305,3 +309,19 @@ def test_the_evidence_and_the_report_name_the_semantics(tmp_path: Path) -> None:
     assert clamp["details"]["monitoring"]["tolerance"] == {"abs": 1e-9, "rel": 0.0, "ulps": 0}
     md = (ws / "reports" / "assurance.md").read_text()
     assert "held only in the node's double arithmetic" in md and "held only within the tolerance" in md
+
+
+def test_a_comparison_of_literals_alone_stays_exact_under_a_tolerance() -> None:
+    """``0.3 * 0.3 == 0.1`` reads no recorded value: within an absolute tolerance of 0.01 (exactly the gap)
+    it is still false, since a tolerance covers what a node published, not the contract's own numbers
+    (found by the oracle above, whose first reading applied the tolerance to every comparison)."""
+    c = check([parse_text("node O { inputs( r : REAL ) outputs( d : REAL ) assume( TRUE ) "
+                          "guarantee( ((0.3 * 0.3) == 0.1) and (in.r == in.r) ) }", "o.rcl")])
+    n = c.nodes["O"]
+    j = judge(n.node.guarantees[0].formula, c, n, {"in.r": 0.1, "out.d": 0.3}, Tolerance(abs=Fraction(1, 100)))
+    assert j.truth is False
+    near = check([parse_text("node O { inputs( r : REAL ) outputs( d : REAL ) assume( TRUE ) "
+                             "guarantee( (0.3 * 0.3) == out.d ) }", "o.rcl")])
+    m = near.nodes["O"]
+    k = judge(m.node.guarantees[0].formula, near, m, {"in.r": 0.1, "out.d": 0.1}, Tolerance(abs=Fraction(1, 50)))
+    assert (k.truth, k.semantics) == (True, "tolerance")
