@@ -145,7 +145,8 @@ os.environ.setdefault("RCLVERIFY_JOBS", "1")
 
 
 #: ``RCLVERIFY_TEST_CPU=FILE``: append each test's CPU seconds (user + system of the worker and of the
-#: children it waited for, setup to teardown) as ``module<TAB>test<TAB>seconds`` lines to FILE, so the
+#: children it waited for, setup to teardown) as ``module<TAB>test<TAB>seconds<TAB>end<TAB>worker`` lines
+#: to FILE (``end``: the wall clock when the test ended, Unix seconds, to see the workers' idle tail), so the
 #: figures of :data:`SECONDS` can be taken inside a whole run: CPU seconds, unlike pytest's durations,
 #: do not grow with the other workers' load (docs/ci.md, "The test suite").
 _CPU_LOG = os.environ.get("RCLVERIFY_TEST_CPU")
@@ -153,6 +154,7 @@ _CPU_LOG = os.environ.get("RCLVERIFY_TEST_CPU")
 
 if _CPU_LOG:
     import resource  # deferred: inside a block (only when the figures are asked for)
+    import time
 
     def _cpu() -> float:
         own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -163,7 +165,8 @@ if _CPU_LOG:
         start = _cpu()
         yield
         with open(_CPU_LOG, "a", encoding="utf-8") as f:
-            f.write(f"{item.path.stem}\t{item.name}\t{_cpu() - start:.3f}\n")
+            f.write(f"{item.path.stem}\t{item.name}\t{_cpu() - start:.3f}\t{time.time():.3f}\t"
+                    f"{os.environ.get('PYTEST_XDIST_WORKER', 'main')}\n")
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -150,8 +150,11 @@ class EngineWorker:
                     # clock must not pass them (an obligation they answer would be
                     # closed as violated before its answer is checked)
                     now = min(now, last)
-                live.tick(now)
-                next_tick = _time.monotonic() + self.tick_s
+                if now > -math.inf:
+                    live.tick(now)
+                    next_tick = _time.monotonic() + self.tick_s
+                # else a message arrived as the clock was read and none was pushed before it: no clock
+                # passes nothing queued, so the tick waits until that message is pushed (the next round)
             if done:
                 return
 
