@@ -37,7 +37,8 @@ GOOD = [b'{"topic": "reading", "time": 0.5, "data": 1.5}', b'{"topic": "status",
         b'{"topic": "status", "time": 2.0, "data": "red", "seq": 7}', b'{"topic": "tick", "time": 9.0}',
         b'{"topic": "reading", "time": 1e-320, "data": -0.0}', b'{"topic":"reading","time":2.0,"data":null}',
         b'  {"topic": "reading", "time": 4.0, "data": [1, {"y": 2.5}]}  ', b'{"topic": "status", "time": 5.0, "data": true}',
-        '{"topic": "st\u00e4tus", "time": 6.0, "data": "\u00e9\\ud83d\\ude00"}'.encode()]
+        '{"topic": "st\u00e4tus", "time": 6.0, "data": "\u00e9\\ud83d\\ude00"}'.encode(),
+        b'{"topic": "\\/reading", "time": 6.5, "data": 2.0}', b'{"topic": "\\u002Freading", "time": 7.0, "data": 3.0}']
 ODD = [b'{"topic": "reading", "time": 1.0, "data": 1, "data": "x"}', b'{"topic": "a", "topic": "reading", "time": 2.0}',
        b'{"t\\u006fpic": "reading", "time": 2.0, "data": 3.0}', b'{"topic": "reading", "time": 7, "data": 1.0}',
        b'{"topic": "reading", "time": 8.0, "data": 123456789012345678901234567890}', b'{"topic": "reading", "time": 2.5e308}',
@@ -229,3 +230,15 @@ def test_the_command_prints_the_same_with_and_without_the_fast_path(tmp_path: Pa
             report = json.loads(fast[1][1])
             assert report[0]["node"] == "Classifier" and report[0]["events_read"] > 0
     assert fast_blocks > 14
+
+
+@pytest.mark.parametrize("spelled", [b"/reading", b"\\/reading", b"\\u002freading", b"\\u002F/reading"])
+def test_a_leading_slash_is_removed_however_the_log_spells_it(tmp_path: Path, spelled: bytes) -> None:
+    """A read decoded at once skips looking for a leading ``/`` only when its bytes hold no ``"/`` and
+    no backslash: an escaped slash (``\\/``, ``\\u002f``) still makes the topic ``reading``."""
+    p = tmp_path / "run.jsonl"
+    p.write_bytes(b"".join(b'{"topic": "%s", "time": %d.0, "data": 1.5}\n' % (spelled if k == 3 else b"reading", k)
+                           for k in range(6)))
+    blocks = list(JsonlLog(p).blocks(["data"], 100))
+    assert len(blocks) == 1 and isinstance(blocks[0], LogBlock)
+    assert blocks[0].topics == ["reading"] * 6 == [ev.topic for ev in read_jsonl(p)]
