@@ -67,3 +67,50 @@ def test_doit_saves_our_states_under_its_checkers_name() -> None:
     """doit runs a task again when the saved checker name differs: a workspace verified before keeps its state."""
     assert MD5Checker.__name__ == DoitMD5Checker.__name__
     assert doit_config()["check_file_uptodate"] is MD5Checker
+
+
+def test_stats_are_kept_only_between_two_task_events_of_our_reporter(tmp_path: Path) -> None:
+    """A file dependency's ``stat`` is taken once between two task events while rclverify's reporter
+    runs the run; a task that starts, succeeds or fails forgets them, and without that reporter (or
+    after its run) every call stats the file again, as doit does."""
+    import io
+
+    from rclverify.app.progress import ProgressReporter
+    f = tmp_path / "dep"
+    f.write_text("a")
+
+    def rewrite(text: str) -> None:
+        tmp = tmp_path / "dep.tmp"
+        tmp.write_text(text)
+        os.replace(tmp, f)  # a new inode, as every write of rclverify's
+
+    checker = MD5Checker()
+    first = checker.info(str(f))
+    rewrite("bb")
+    assert checker.info(str(f)).st_ino != first.st_ino  # no reporter: nothing kept
+    reporter = ProgressReporter(io.StringIO(), {})
+    kept = checker.info(str(f))
+    rewrite("ccc")
+    assert checker.info(str(f)) is kept  # no task event since: the same stat
+    from doit.task import Task
+    task = Task("evidence:x", [(lambda: True, [], {})])
+    for event in (reporter.execute_task, reporter.add_success):
+        event(task)
+        now = checker.info(str(f))
+        assert now.st_size == f.stat().st_size and now.st_ino == f.stat().st_ino
+        rewrite(now.st_size * "d" + "d")
+    reporter.add_failure(task, doit_checker_failure())
+    assert checker.info(str(f)).st_ino == f.stat().st_ino
+    with pytest.raises(OSError):
+        checker.info(str(tmp_path / "missing"))  # a missing file is never kept
+    reporter.complete_run()
+    before = checker.info(str(f))
+    rewrite("e")
+    assert checker.info(str(f)).st_ino != before.st_ino  # the run is over: nothing kept
+    MD5Checker()  # a new run's checker starts with nothing kept either
+
+
+def doit_checker_failure() -> object:
+    """A doit task failure, as the runner hands one to the reporter."""
+    from doit.exceptions import TaskFailed
+    return TaskFailed("failed")

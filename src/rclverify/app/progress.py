@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 from doit.exceptions import TaskFailed
 from doit.reporter import ConsoleReporter
 
+from rclverify.app.doit_checker import forget_stats, keep_stats
 from rclverify.app.doitstate import save_finished
 from rclverify.report.summary import is_terminal
 
@@ -136,6 +137,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
         #: The workspace root of a ``verify`` task doit found up to date: its
         #: action (the status and summary) did not run, so :meth:`complete_run` prints them.
         self.verify_root: str | None = None
+        keep_stats(True)  # the task events below forget them (app/doit_checker.py)
 
     # -- doit reporter interface -------------------------------------------------
     def write(self, text: str) -> None:
@@ -165,6 +167,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             whole_lines()
 
     def execute_task(self, task: Any) -> None:
+        forget_stats()
         if not self.live_mode:
             super().execute_task(task)
             return
@@ -179,11 +182,13 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
             self.done.add(task.name)
 
     def add_success(self, task: Any) -> None:
+        forget_stats()
         save_finished()  # doit saved the task's state in memory just before: on disk now (doitstate)
         self._finish(task)
         super().add_success(task)
 
     def add_failure(self, task: Any, fail: Any) -> None:
+        forget_stats()
         save_finished()
         self._finish(task)
         if isinstance(fail, PlainFailure):  # one plain sentence, not doit's header (issue 30)
@@ -204,6 +209,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
         have the process skip the cyclic garbage collection of its whole
         heap when it exits (:mod:`rclverify.core.cache.heap`: the heap frozen for the
         run is given back to the collector, then frozen again at exit)."""
+        keep_stats(False)
         if self.live is not None:
             global _LIVE_ACTIVE
             _LIVE_ACTIVE = False
