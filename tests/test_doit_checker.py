@@ -5,11 +5,16 @@ import os
 import random
 from pathlib import Path
 
+import io
+
 import pytest
 from doit.dependency import MD5Checker as DoitMD5Checker
+from doit.exceptions import TaskFailed
+from doit.task import Task
 
 from rclverify.app import doit_checker
 from rclverify.app.doit_checker import MD5Checker
+from rclverify.app.progress import ProgressReporter
 from rclverify.app.tasks import doit_config
 
 
@@ -73,9 +78,6 @@ def test_stats_are_kept_only_between_two_task_events_of_our_reporter(tmp_path: P
     """A file dependency's ``stat`` is taken once between two task events while rclverify's reporter
     runs the run; a task that starts, succeeds or fails forgets them, and without that reporter (or
     after its run) every call stats the file again, as doit does."""
-    import io
-
-    from rclverify.app.progress import ProgressReporter
     f = tmp_path / "dep"
     f.write_text("a")
 
@@ -92,14 +94,13 @@ def test_stats_are_kept_only_between_two_task_events_of_our_reporter(tmp_path: P
     kept = checker.info(str(f))
     rewrite("ccc")
     assert checker.info(str(f)) is kept  # no task event since: the same stat
-    from doit.task import Task
     task = Task("evidence:x", [(lambda: True, [], {})])
     for event in (reporter.execute_task, reporter.add_success):
         event(task)
         now = checker.info(str(f))
         assert now.st_size == f.stat().st_size and now.st_ino == f.stat().st_ino
         rewrite(now.st_size * "d" + "d")
-    reporter.add_failure(task, doit_checker_failure())
+    reporter.add_failure(task, TaskFailed("failed"))
     assert checker.info(str(f)).st_ino == f.stat().st_ino
     with pytest.raises(OSError):
         checker.info(str(tmp_path / "missing"))  # a missing file is never kept
@@ -107,10 +108,8 @@ def test_stats_are_kept_only_between_two_task_events_of_our_reporter(tmp_path: P
     before = checker.info(str(f))
     rewrite("e")
     assert checker.info(str(f)).st_ino != before.st_ino  # the run is over: nothing kept
-    MD5Checker()  # a new run's checker starts with nothing kept either
-
-
-def doit_checker_failure() -> object:
-    """A doit task failure, as the runner hands one to the reporter."""
-    from doit.exceptions import TaskFailed
-    return TaskFailed("failed")
+    ProgressReporter(io.StringIO(), {})  # a reporter whose run never ended (its process raised) ...
+    fresh = MD5Checker()  # ... and a new run's checker: it starts with nothing kept
+    before = fresh.info(str(f))
+    rewrite("ff")
+    assert fresh.info(str(f)).st_ino != before.st_ino
