@@ -51,6 +51,7 @@ from typing import Any, Callable, Mapping, Sequence
 import z3
 
 from rclverify.core.cache.memo import last_call
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.nicemodel import nicer_model
 from rclverify.semantics.query import query_solver, render_model, satisfiable, smt2_script, smtlib_benchmark
@@ -289,7 +290,7 @@ class ConeContext:
             if parts:
                 self.flags[m] = f"A!{m}"
                 flag = z3.Bool(self.flags[m])
-                self.definitions.append(flag == (z3.And(*parts) if len(parts) > 1 else parts[0]))
+                self.definitions.append(flag == (conj(*parts) if len(parts) > 1 else parts[0]))
                 self.flag_nodes.append(m)
             out += [z3.Implies(flag, g) if flag is not None else g
                     for g in (enc.formula(g.formula, cn) for g in cn.node.guarantees)]
@@ -348,7 +349,7 @@ class ConeContext:
         # unknown: the retries of semantics/retry.py (fresh solvers), which answer without a Z3 model object
         plain = [(lbl, z3.substitute(f, (lit, z3.BoolVal(True)))) for lbl, f, lit in zip(labels, tracked, literals)]
         if self.definitions:
-            plain.append(("definitions", z3.And(*self.definitions)))
+            plain.append(("definitions", conj(*self.definitions)))
         rr = satisfiable(plain, self.enc, timeout_ms=timeout_ms, comment=comment)
         dt = round(time.perf_counter() - t0, 4)
         if rr.status == "unsat":

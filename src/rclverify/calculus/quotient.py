@@ -44,6 +44,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.query import prove
 from rclverify.semantics.subterms import subterms
@@ -106,7 +107,7 @@ class Quotient:
 
 
 def _conj(fs: Sequence[z3.BoolRef]) -> z3.BoolRef:
-    return z3.And(*fs) if len(fs) > 1 else fs[0] if fs else z3.BoolVal(True)
+    return conj(*fs) if len(fs) > 1 else fs[0] if fs else z3.BoolVal(True)
 
 
 class _System:

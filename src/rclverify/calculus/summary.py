@@ -59,6 +59,7 @@ import z3
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import NATURAL, Checked
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.query import query_solver
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.context import NEGATED, ContextResult, _multi_path, single_paths
@@ -235,7 +236,7 @@ def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Seque
     ``Bool``), so the names the bodies mention are bound without walking
     the parsed formula (:func:`_bound`)."""
     fs = z3.parse_smt2_string(decls + "".join(f"(assert {b})\n" for b in bodies), ctx=ctx)
-    body = z3.And(*fs) if len(fs) else z3.BoolVal(True, ctx)
+    body = conj(*fs) if len(fs) else z3.BoolVal(True, ctx)
     if hidden:
         xs = _bound(ctx, fs, bodies, hidden, sorts)
         if xs:

@@ -30,6 +30,7 @@ import z3
 
 from rclverify.calculus.compose import free_io
 from rclverify.semantics import world
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import Encoder, EncodingError
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, FuncT
@@ -71,7 +72,7 @@ def implementable(ws: Any, checked: Checked, node: str) -> tuple[str, dict[str, 
     except (EncodingError, KeyError, ValueError, z3.Z3Exception):
         return "inconclusive", {}
     body += inner.axioms()
-    goal = z3.Exists(list(outs.values()), z3.And(*body)) if outs else z3.And(*body)
+    goal = z3.Exists(list(outs.values()), conj(*body)) if outs else conj(*body)
     r = prove(goal, hyps, enc, timeout_ms=TIMEOUT_MS, comment=f"repair check: is {node} implementable?")
     if r.status == "refuted":
         return "refuted", {k: v for k, v in (r.model or {}).items() if ".in." in k}

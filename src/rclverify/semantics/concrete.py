@@ -22,6 +22,7 @@ import z3
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.values import FiniteFunction, Term, exact
 from rclverify.semantics.encode import Encoder, sort_of, widen
 from rclverify.semantics import wallclock
@@ -85,7 +86,7 @@ def finite_interpretation(value: FiniteFunction, typ: FuncT, enc: Encoder) -> z3
     xs = [z3.Var(k, sort_of(a)) for k, a in enumerate(typ.args)]
     body = to_z3(value.default, typ.result, enc)
     for key, res in sorted(value.table.items(), key=lambda kv: repr(kv[0]), reverse=True):
-        cond = z3.And(*[x == to_z3(k, a, enc) for x, k, a in zip(xs, key, typ.args)])
+        cond = conj(*[x == to_z3(k, a, enc) for x, k, a in zip(xs, key, typ.args)])
         body = z3.If(cond, to_z3(res, typ.result, enc), body)
     return body
 

@@ -22,6 +22,7 @@ from typing import Any
 import z3
 
 from rclverify.lang.types import NATURAL, DataT, SeqT, SetT, TupleT, Type
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.sorts import sort_of
 
 
@@ -50,7 +51,7 @@ def natural_typing(term: z3.ExprRef, t: Type, depth: int = 0, quantified: bool =
             x = z3.Const(f"_nat{depth}", sort_of(t.elem))
             cs, ok = natural_typing(x, t.elem, depth + 1, quantified)
             guard = z3.IsMember(x, term)
-        return ([z3.ForAll([x], z3.Implies(guard, cs[0] if len(cs) == 1 else z3.And(*cs)))] if cs else []), ok
+        return ([z3.ForAll([x], z3.Implies(guard, cs[0] if len(cs) == 1 else conj(*cs)))] if cs else []), ok
     if not isinstance(t, (DataT, TupleT)):
         return [], True
     if depth > 3:
@@ -66,7 +67,7 @@ def natural_typing(term: z3.ExprRef, t: Type, depth: int = 0, quantified: bool =
             parts += cs
             exact = exact and ok
         if parts:
-            both = parts[0] if len(parts) == 1 else z3.And(*parts)
+            both = parts[0] if len(parts) == 1 else conj(*parts)
             out.append(z3.Implies(s.recognizer(k)(term), both) if isinstance(t, DataT) else both)
     return out, exact
 

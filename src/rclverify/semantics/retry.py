@@ -35,6 +35,7 @@ from typing import Callable, Sequence, cast
 
 import z3
 
+from rclverify.semantics.connectives import conj, disj
 from rclverify.semantics.subst import substitute
 from rclverify.semantics.wallclock import note_limit
 
@@ -145,7 +146,7 @@ def _expand_once(e: z3.ExprRef, depth: int, memo: _Memo) -> z3.ExprRef:
                         continue
                     inner = z3.ForAll(bound, inst) if q.is_forall() else z3.Exists(bound, inst)
                     insts.append(_expand(inner, depth + 1, memo) if any(args for _, args in combo) else inner)
-                return z3.And(*insts) if q.is_forall() else z3.Or(*insts)
+                return conj(*insts) if q.is_forall() else disj(*insts)
         if body.eq(opened):
             return e
         return z3.ForAll(names, body) if q.is_forall() else z3.Exists(names, body)

@@ -19,6 +19,7 @@ from rclverify.lang.printer import FLAT_CHAINS, chain_operands, is_type
 from rclverify.lang.typecheck import domain_type
 from rclverify.lang.visit import Visitor
 from rclverify.lang.types import BOOL, NATURAL, CheckedNode, EmptyT, FuncT, Scalar, TupleT, Type, qualified_base
+from rclverify.semantics.connectives import conj, disj
 from rclverify.semantics.sorts import _join_sort, _tuple_fields, apply_operator, coerce, sort_of, tuple_sort, widen
 from rclverify.semantics.symbols import EncodingError, smt_symbol
 
@@ -104,7 +105,7 @@ class _Ctx(Visitor[Any]):
             # chain of any length or shape (also one built by a program,
             # left-nested) encodes without deep recursion.
             parts = [self.enc(o, b) for o in chain_operands(x)]
-            return z3.And(*parts) if x.op == "and" else z3.Or(*parts)
+            return conj(*parts) if x.op == "and" else disj(*parts)
         return apply_operator(x.op, self.enc(x.left, b), self.enc(x.right, b))
 
     def visit_StrLit(self, x: ast.StrLit, b: Mapping[str, Any]) -> Any:
@@ -171,7 +172,7 @@ class _Ctx(Visitor[Any]):
                 near = [v for v in vals[max(k - 1, 0):k + 2] if v is not None]
                 vals[k] = self.empty_literal(cast(ast.SetLit | ast.SeqLit, o), near[0].sort() if near else None)
         parts = [apply_operator(op, l, r) for op, l, r in zip(x.ops, vals, vals[1:])]
-        return parts[0] if len(parts) == 1 else z3.And(*parts)
+        return parts[0] if len(parts) == 1 else conj(*parts)
 
     def member(self, elem: Any, coll: ast.Expr, b: Mapping[str, Any]) -> Any:
         env = self.e.env
@@ -182,7 +183,7 @@ class _Ctx(Visitor[Any]):
         if isinstance(coll, ast.SetLit) or isinstance(coll, ast.SeqLit):
             items = [self.enc(i, b) for i in coll.items]
             eqs = [(lambda p: p[0] == p[1])(coerce(elem, i)) for i in items]
-            return z3.Or(*eqs) if eqs else z3.BoolVal(False)
+            return disj(*eqs) if eqs else z3.BoolVal(False)
         if isinstance(coll, ast.Var) and coll.prefix is None and coll.name not in b and coll.name in ("REAL", "INTEGER", "NATURAL", "BOOL"):
             return self.in_base(elem, coll.name)
         if isinstance(coll, ast.Var) and coll.prefix is None and coll.name not in b and coll.name in env.types \
@@ -203,7 +204,7 @@ class _Ctx(Visitor[Any]):
         if fields is None or len(fields) != len(product.elems):
             raise EncodingError(loc, f"membership in {product} needs a tuple of {len(product.elems)} components")
         acc = cast(z3.DatatypeSortRef, elem.sort()).accessor
-        return z3.And(*[self.in_base(acc(0, k)(elem), cast(Scalar, t).name) for k, t in enumerate(product.elems)])
+        return conj(*[self.in_base(acc(0, k)(elem), cast(Scalar, t).name) for k, t in enumerate(product.elems)])
 
     @staticmethod
     def in_base(elem: Any, base: str) -> Any:
@@ -280,7 +281,7 @@ class _Ctx(Visitor[Any]):
     @staticmethod
     def _close(kind: str, xs: list[z3.ExprRef], guards: list[Any], body: Any) -> Any:
         """The Z3 quantifier ``kind`` over ``xs`` with ``guards`` on them."""
-        guard = z3.And(*guards) if guards else None
+        guard = conj(*guards) if guards else None
         if kind == "forall":
             return z3.ForAll(xs, z3.Implies(guard, body) if guard is not None else body)
         core = z3.And(guard, body) if guard is not None else body
@@ -288,7 +289,7 @@ class _Ctx(Visitor[Any]):
             return z3.Exists(xs, core)
         ys = [z3.Const(str(v) + "_u", v.sort()) for v in xs]
         body_y = z3.substitute(core, *zip(xs, ys))
-        unique = z3.ForAll(ys, z3.Implies(body_y, z3.And(*[y == v for y, v in zip(ys, xs)])))
+        unique = z3.ForAll(ys, z3.Implies(body_y, conj(*[y == v for y, v in zip(ys, xs)])))
         return z3.Exists(xs, z3.And(core, unique))
 
     def _bound_types(self, b: Mapping[str, Any]) -> dict[str, Type]:

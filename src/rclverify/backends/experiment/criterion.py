@@ -21,6 +21,7 @@ from typing import Mapping
 
 import z3
 
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.query import budgeted_solver
 from rclverify.lang import ast
 from rclverify.backends.experiment.figures import Figures, Quantity
@@ -155,7 +156,7 @@ def _to_z3(e: ast.Expr, env: Mapping[str, z3.ArithRef]) -> z3.ExprRef:
     xs = [_to_z3(o, env) for o in e.operands]
     cmp = {"==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
            "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}
-    return z3.And(*[cmp[op](xs[i], xs[i + 1]) for i, op in enumerate(e.ops)])
+    return conj(*[cmp[op](xs[i], xs[i + 1]) for i, op in enumerate(e.ops)])
 
 
 def _val(v: Fraction) -> z3.ArithRef:

@@ -36,6 +36,7 @@ from typing import Any, Mapping
 
 import z3
 
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import Encoder
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
@@ -435,10 +436,10 @@ def encode_triple(c: Conjunct, cfg: HoareConfig, m: ProgramModel, enc: Encoder, 
     for key, var in cfg.outputs.items():
         post_syms[key] = m.consts[var]
     pre_parts, post_prem = precondition_parts(c, cfg.outputs, node)
-    pre = z3.And(*pre_guards, *[_encode(enc, p, node, pre_syms, pre_b) for p in pre_parts])
+    pre = conj(*pre_guards, *[_encode(enc, p, node, pre_syms, pre_b) for p in pre_parts])
     post = _encode(enc, c.conclusion, node, post_syms, post_b)
     if post_prem:
-        post = z3.Implies(z3.And(*[_encode(enc, p, node, post_syms, post_b) for p in post_prem]), post)
+        post = z3.Implies(conj(*[_encode(enc, p, node, post_syms, post_b) for p in post_prem]), post)
     background.extend(enc.axioms())
     names = {s.z3name: s.display.split(".", 1)[1] if s.display.startswith(node.name + ".") else s.display
              for s in enc.symbols.values()}

@@ -37,6 +37,7 @@ from typing import Any
 import z3
 
 from rclverify.semantics.concrete import to_z3
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import Encoder, EncodingError, sort_of
 from rclverify.semantics import wallclock
 from rclverify.semantics.retry import SAFETY_TIMEOUT_MS
@@ -172,7 +173,7 @@ class Seeder:
     def _solve(self, n: int) -> dict[str, Any] | None:
         """Tables of ``n`` entries at fixed distinct keys, results and defaults from Z3."""
         enc = Encoder(self.checked.env)
-        phi = z3.And(*[enc.formula(f, self.node) for f in self.formulas])
+        phi = conj(*[enc.formula(f, self.node) for f in self.formulas])
         side: list[Any] = []
         funcs: list[tuple[z3.FuncDeclRef, z3.ExprRef]] = []
         readback: dict[str, Any] = {}
@@ -192,7 +193,7 @@ class Seeder:
                 xs = [z3.Var(k, sort_of(a)) for k, a in enumerate(t.args)]
                 body: z3.ExprRef = d
                 for key, v in reversed(list(zip(keys, vals))):
-                    body = z3.If(z3.And(*[x == to_z3(k, a, enc) for x, k, a in zip(xs, key, t.args)]), v, body)
+                    body = z3.If(conj(*[x == to_z3(k, a, enc) for x, k, a in zip(xs, key, t.args)]), v, body)
                 funcs.append((decl, body))
                 readback[q] = (t, keys, vals, d)
             else:

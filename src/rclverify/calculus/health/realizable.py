@@ -59,6 +59,7 @@ from typing import Sequence
 
 import z3
 
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics import wallclock
 from rclverify.semantics.query import render_model, satisfiable, smt2_script, tactic_solver
@@ -92,7 +93,7 @@ def _where(l: ast.Loc) -> str:
 def _conj(fs: Sequence[z3.BoolRef]) -> z3.BoolRef:
     """The conjunction of ``fs``: ``True`` when empty (Z3's printer writes an
     empty ``And`` as a bare ``and``, which no SMT-LIB2 reader takes)."""
-    return z3.And(*fs) if len(fs) > 1 else fs[0] if fs else z3.BoolVal(True)
+    return conj(*fs) if len(fs) > 1 else fs[0] if fs else z3.BoolVal(True)
 
 
 class _Query:

@@ -32,6 +32,7 @@ from typing import Any, Iterator, Sequence
 
 import z3
 
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import value_to_rcl
 from rclverify.semantics.query import budgeted_solver, render_model, tactic_solver
 from rclverify.semantics.wallclock import check
@@ -123,7 +124,7 @@ def table_term(args: Sequence[z3.ExprRef], name: str, result: z3.SortRef,
     body: z3.ExprRef = values[-1]
     for j in range(points):
         pt = table_point([a.sort() for a in args], j)
-        body = z3.If(z3.And(*[a == p for a, p in zip(args, pt)]), values[j], body)
+        body = z3.If(conj(*[a == p for a, p in zip(args, pt)]), values[j], body)
     return body, values
 
 
@@ -213,7 +214,7 @@ def _found(model: z3.ModelRef, enc: Any, ctx: z3.Context, tables: dict[str, tupl
         args = [z3.Var(j, d.domain(j)) for j in range(d.arity())]
         for j in range(points):
             pt = table_point([a.sort() for a in args], j)
-            body = z3.If(z3.And(*[a == p for a, p in zip(args, pt)]), values[j], body)
+            body = z3.If(conj(*[a == p for a, p in zip(args, pt)]), values[j], body)
         funcs.append((d, body))
     consts = []
     for name, sym in enc.symbols.items():

@@ -44,6 +44,7 @@ from typing import Sequence
 
 import z3
 
+from rclverify.semantics.connectives import disj
 from rclverify.semantics.retry import MAX_INSTANCES, expand_finite, finite_values
 from rclverify.semantics.subst import substitute
 from rclverify.calculus.requirements.tsys import Pred, State, TemporalVerdict, TransitionSystem, distinct, trace_of, unroll
@@ -81,7 +82,7 @@ def successor_exists(ts: TransitionSystem, s: State) -> z3.BoolRef:
     if not finite or len(combos) > MAX_INSTANCES:
         return z3.Exists(list(t.values()), body)
     cases = [substitute(body, [(t[n], v) for n, v in zip(finite, combo)]) for combo in combos]
-    return z3.Or(*[z3.Exists(rest, c) if rest else c for c in cases])
+    return disj(*[z3.Exists(rest, c) if rest else c for c in cases])
 
 
 def no_successor(ts: TransitionSystem, s: State) -> z3.BoolRef:

@@ -30,6 +30,7 @@ import z3
 
 from rclverify.calculus.requirements.tsys import Pred, State, TransitionSystem
 from rclverify.semantics import wallclock
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.subterms import subterms
 
 #: At most this many numerals of each sort, and this many candidates in all.
@@ -130,10 +131,10 @@ def generate(ts: TransitionSystem, prop: Pred, timeout_ms: int, budget_ms: int) 
         return r, s.model() if r == z3.sat else None
 
     def initial(cs: list[Candidate]) -> tuple[z3.CheckSatResult, z3.ModelRef | None]:
-        return ask(ts.init(a), z3.Not(z3.And(*[p(a) for _, p in cs])))
+        return ask(ts.init(a), z3.Not(conj(*[p(a) for _, p in cs])))
 
     def step(cs: list[Candidate]) -> tuple[z3.CheckSatResult, z3.ModelRef | None]:
-        return ask(*[p(a) for _, p in cs], ts.trans(a, b), z3.Not(z3.And(*[p(b) for _, p in cs])))
+        return ask(*[p(a) for _, p in cs], ts.trans(a, b), z3.Not(conj(*[p(b) for _, p in cs])))
 
     def spent() -> bool:
         return left[0] <= 0
@@ -166,6 +167,6 @@ def within(ts: TransitionSystem, inv: list[Candidate]) -> TransitionSystem:
     """``ts`` with the invariant ``inv`` assumed in every state (the same
     reachable states: ``inv`` holds in all of them)."""
     def holds(s: State) -> z3.BoolRef:
-        return z3.And(*[p(s) for _, p in inv])
-    return TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), holds(s)),
-                            lambda s, t: z3.And(ts.trans(s, t), holds(s), holds(t)), ts.fairness)
+        return conj(*[p(s) for _, p in inv])
+    return TransitionSystem(ts.sorts, lambda s: conj(ts.init(s), holds(s)),
+                            lambda s, t: conj(ts.trans(s, t), holds(s), holds(t)), ts.fairness)

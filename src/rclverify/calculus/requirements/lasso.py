@@ -34,6 +34,7 @@ from typing import Any, Callable, Mapping
 import z3
 
 from rclverify.calculus.health.witness import table_point, table_term
+from rclverify.semantics.connectives import conj, disj
 from rclverify.semantics.query import budgeted_solver, tactic_solver
 from rclverify.semantics import wallclock
 from rclverify.lang.types import DataT, EnumT, FuncT, Type
@@ -159,10 +160,10 @@ def find_table_lasso(ts: TransitionSystem, prop: Pred, types: Mapping[str, Type]
     for n in range(1, bound + 1):
         steps = [table_state(ts, i, points) for i in range(n + 1)]
         states = [s for s, _ in steps]
-        same = [z3.And(*[a == b for v in ts.sorts for a, b in zip(steps[n][1][v], steps[j][1][v])],
+        same = [conj(*[a == b for v in ts.sorts for a, b in zip(steps[n][1][v], steps[j][1][v])],
                        fair.loop(states, j, n)) for j in range(n)]
         formulas = [ts.init(states[0]), *[ts.trans(states[i], states[i + 1]) for i in range(n)],
-                    *[z3.Not(prop(s)) for s in states], z3.Or(*same)]
+                    *[z3.Not(prop(s)) for s in states], disj(*same)]
         ctx = z3.Context()
         r, cut, solver = _solve([f.translate(ctx) for f in formulas], ctx, budget_ms)
         if r == z3.unknown:  # the budget's reason, or the net's when the clock cut it (never another length)

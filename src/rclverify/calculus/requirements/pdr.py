@@ -33,6 +33,7 @@ import z3
 
 from rclverify.calculus.requirements.tsys import Pred, TransitionSystem, trace_of
 from rclverify.semantics import wallclock
+from rclverify.semantics.connectives import conj
 
 #: At most this many characters of a certificate are shown in a verdict's detail.
 SHOWN = 600
@@ -125,9 +126,9 @@ def spacer_invariant(ts: TransitionSystem, prop: Pred, timeout_ms: int) -> HornA
     try:
         h = z3.SolverFor("HORN")
         wallclock.limit(h, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        h.add(z3.ForAll(av, z3.Implies(z3.And(*init), inv(a))))
-        h.add(z3.ForAll(av + bv, z3.Implies(z3.And(inv(a), *trans), inv(b))))
-        h.add(z3.ForAll(av, z3.Implies(z3.And(inv(a), z3.Not(prop(a))), z3.BoolVal(False))))
+        h.add(z3.ForAll(av, z3.Implies(conj(*init), inv(a))))
+        h.add(z3.ForAll(av + bv, z3.Implies(conj(inv(a), *trans), inv(b))))
+        h.add(z3.ForAll(av, z3.Implies(conj(inv(a), z3.Not(prop(a))), z3.BoolVal(False))))
         r = h.check()
         took = time.perf_counter() - t0
         if r == z3.sat:
@@ -153,7 +154,7 @@ def _interpretation(m: z3.ModelRef, rel: z3.FuncDeclRef, args: list[z3.ExprRef])
     body = z3.substitute_vars(fi.else_value(), *args)
     for k in range(fi.num_entries()):
         e = fi.entry(k)
-        body = z3.If(z3.And(*[x == e.arg_value(j) for j, x in enumerate(args)]), e.value(), body)
+        body = z3.If(conj(*[x == e.arg_value(j) for j, x in enumerate(args)]), e.value(), body)
     return body
 
 
@@ -169,9 +170,9 @@ def recheck(ts: TransitionSystem, prop: Pred, inv: z3.BoolRef, timeout_ms: int) 
     Returns ``None`` when all three hold, else which condition fails (or
     could not be decided) in words."""
     a, b = named_state(ts), named_state(ts, prime=True)
-    for cond, what in ((z3.And(ts.init(a), z3.Not(inv)), "an initial state lies outside it"),
-                       (z3.And(inv, ts.trans(a, b), z3.Not(_prime(ts, inv))), "a step leaves it"),
-                       (z3.And(inv, z3.Not(prop(a))), "it does not imply the property")):
+    for cond, what in ((conj(ts.init(a), z3.Not(inv)), "an initial state lies outside it"),
+                       (conj(inv, ts.trans(a, b), z3.Not(_prime(ts, inv))), "a step leaves it"),
+                       (conj(inv, z3.Not(prop(a))), "it does not imply the property")):
         s = z3.Solver()
         wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
         s.add(cond)

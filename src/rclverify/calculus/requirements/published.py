@@ -31,6 +31,8 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import z3
 
+from rclverify.semantics.connectives import conj, disj
+
 State = Any
 
 
@@ -60,28 +62,28 @@ class Publication:
     def ready(self, n: str, s: State) -> z3.BoolRef:
         """Every fed input node ``n`` reads has been heard in state ``s``."""
         flags = [s[f] for f in self.fed.get(n, ())]
-        return z3.And(*flags) if flags else z3.BoolVal(True)
+        return conj(*flags) if flags else z3.BoolVal(True)
 
     def init(self, s: State, answers: Callable[[str, State], z3.BoolRef]) -> z3.BoolRef:
         """Step 0: published iff the node answers there or declares ``initially``; nothing heard."""
         parts = [s[f] == (z3.BoolVal(True) if n in self.initial else answers(n, s))
                  for n, f in self.published.items()]
         parts += [z3.Not(s[f]) for f in self.heard.values()]
-        return z3.And(*parts) if parts else z3.BoolVal(True)
+        return conj(*parts) if parts else z3.BoolVal(True)
 
     def trans(self, s: State, t: State, answers: Callable[[str, State], z3.BoolRef]) -> z3.BoolRef:
         """One step: published stays published and becomes so by an answer;
         an input is heard when its producer had published at the step before."""
-        parts = [t[f] == z3.Or(s[f], answers(n, t)) for n, f in self.published.items()]
+        parts = [t[f] == disj(s[f], answers(n, t)) for n, f in self.published.items()]
         parts += [t[f] == s[self.published[self.producer[c]]] for c, f in self.heard.items()]
-        return z3.And(*parts) if parts else z3.BoolVal(True)
+        return conj(*parts) if parts else z3.BoolVal(True)
 
     def defined(self, mentions: Iterable[tuple[str, str, str]], s: State) -> z3.BoolRef:
         """The values a statement mentions (``(node, "in"|"out"|"state", var)``)
         all published in ``s``: each output's node has published, each fed input
         has been heard; environment inputs and state variables always have one."""
         flags = self.flags_of(mentions)
-        return z3.And(*[s[f] for f in flags]) if flags else z3.BoolVal(True)
+        return conj(*[s[f] for f in flags]) if flags else z3.BoolVal(True)
 
     def flags_of(self, mentions: Iterable[tuple[str, str, str]]) -> list[str]:
         """The flag names :meth:`defined` reads, for a trace's confirmation."""

@@ -59,6 +59,7 @@ from rclverify.calculus.requirements.safety import Hint, prove_always
 from rclverify.calculus.requirements.temporal import _ranking_fails, check_always
 from rclverify.calculus.requirements.tsys import Pred, TemporalVerdict, TransitionSystem, FairLoops, trace_of, unroll, with_flag
 from rclverify.semantics import wallclock
+from rclverify.semantics.connectives import conj, disj
 
 #: The bounds N tried, in order, to prove the unbounded response from the bounded one.
 BOUNDS = (0, 1, 2, 4, 8)
@@ -69,8 +70,8 @@ def with_counter(ts: TransitionSystem, name: str, init: "z3.ArithRef | object",
     """``ts`` with one more integer history variable ``name``: ``init(s)``
     its first value, ``step(s, t)`` its next (it constrains nothing)."""
     sorts = {**ts.sorts, name: z3.IntSort()}
-    return TransitionSystem(sorts, lambda s: z3.And(ts.init(s), s[name] == init(s)),  # type: ignore[operator]
-                            lambda s, t: z3.And(ts.trans(s, t), t[name] == step(s, t)),  # type: ignore[operator]
+    return TransitionSystem(sorts, lambda s: conj(ts.init(s), s[name] == init(s)),  # type: ignore[operator]
+                            lambda s, t: conj(ts.trans(s, t), t[name] == step(s, t)),  # type: ignore[operator]
                             ts.fairness)
 
 
@@ -92,14 +93,14 @@ def check_response(ts: TransitionSystem, trigger: Pred, goal: Pred, within: int 
     n = int(within)
 
     def start(s: dict[str, z3.ExprRef]) -> z3.ArithRef:
-        return z3.If(z3.And(trigger(s), z3.Not(goal(s))), z3.IntVal(0), z3.IntVal(-1))
+        return z3.If(conj(trigger(s), z3.Not(goal(s))), z3.IntVal(0), z3.IntVal(-1))
 
     def step(s: dict[str, z3.ExprRef], t: dict[str, z3.ExprRef]) -> z3.ArithRef:
         age = s["<pending>"]
         grown = z3.If(age + 1 > n, z3.IntVal(n), age + 1)
         return z3.If(goal(t), z3.IntVal(-1), z3.If(age >= 0, grown, start(t)))
     ts2 = with_counter(ts, "<pending>", start, step)
-    inv = lambda s: z3.And(s["<pending>"] >= -1, s["<pending>"] < n)  # noqa: E731
+    inv = lambda s: conj(s["<pending>"] >= -1, s["<pending>"] < n)  # noqa: E731
     max_k = max(max_k, n + 2)
     return always(ts2, inv, "<pending>: the age in steps of the oldest trigger not yet answered, -1 for none")
 
@@ -114,8 +115,8 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
     ``max_k``; ``refuted`` by a lasso of at most ``max_k`` steps with a
     trigger pending around its loop; else ``inconclusive``.  ``timeout_ms``
     bounds each solver call (milliseconds)."""
-    ts2 = with_flag(ts, "<pending>", lambda s: z3.And(trigger(s), z3.Not(goal(s))),
-                    lambda s, t: z3.And(z3.Or(s["<pending>"], trigger(t)), z3.Not(goal(t))))
+    ts2 = with_flag(ts, "<pending>", lambda s: conj(trigger(s), z3.Not(goal(s))),
+                    lambda s, t: conj(disj(s["<pending>"], trigger(t)), z3.Not(goal(t))))
     why = "no ranking function"
     if ranking is not None:
         inv = invariant or (lambda st: z3.BoolVal(True))
@@ -143,9 +144,9 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
         states, steps = unroll(ts2, n)
         sv = z3.Solver()
         wallclock.limit(sv, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        loops = [z3.And(*[states[n][v] == states[j][v] for v in ts2.sorts], fair.loop(states, j, n),
+        loops = [conj(*[states[n][v] == states[j][v] for v in ts2.sorts], fair.loop(states, j, n),
                         *[st["<pending>"] for st in states[j:n + 1]]) for j in range(n)]
-        sv.add(ts2.init(states[0]), *steps, z3.Or(*loops))
+        sv.add(ts2.init(states[0]), *steps, disj(*loops))
         r = sv.check()
         if r == z3.sat:
             m = sv.model()

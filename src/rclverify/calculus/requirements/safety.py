@@ -37,6 +37,7 @@ from rclverify.calculus.requirements.pdr import recheck, shortest_violation, sho
 from rclverify.calculus.requirements.temporal import check_always
 from rclverify.calculus.requirements.tsys import Pred, TemporalVerdict, TransitionSystem, trace_of
 from rclverify.semantics import wallclock
+from rclverify.semantics.connectives import conj
 
 #: Spacer's time limit is this many times the per-query limit (it is one query that does the work of many).
 PDR_FACTOR = 3
@@ -93,7 +94,7 @@ def hint_fails(ts: TransitionSystem, prop: Pred, hint: Hint, *, max_k: int,
     failed, with the step that breaks it, ending in the next step to take,
     and whether the hint alone was proved invariant (by k-induction or
     IC3/PDR, :func:`by_pdr`: a hint false only deep in a run is found so)."""
-    both = lambda s: z3.And(hint.pred(s), prop(s))  # noqa: E731
+    both = lambda s: conj(hint.pred(s), prop(s))  # noqa: E731
     v = check_always(ts, both, max_k=max_k, timeout_ms=timeout_ms)
     if v.status == "proved":
         return TemporalVerdict("proved", "k-induction with invariant", k=v.k, bound=v.bound,
@@ -141,7 +142,7 @@ def by_pdr(ts: TransitionSystem, prop: Pred, *, max_k: int, timeout_ms: int,
     invariant's text; ``pdr with invariant`` with ``within``), ``refuted`` (method ``bmc``, the shortest run found
     from ``max_k`` steps on) or ``inconclusive`` with the reason."""
     sys = ts if within is None else TransitionSystem(
-        ts.sorts, lambda s: z3.And(ts.init(s), within(s)), lambda s, t: z3.And(ts.trans(s, t), within(s), within(t)),
+        ts.sorts, lambda s: conj(ts.init(s), within(s)), lambda s, t: conj(ts.trans(s, t), within(s), within(t)),
         ts.fairness)
     limit = timeout_ms * PDR_FACTOR
     ans = spacer_invariant(sys, prop, limit)

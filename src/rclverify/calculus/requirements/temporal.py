@@ -39,6 +39,7 @@ from rclverify.calculus.requirements.deadlock import check_deadlock_free, find_d
 from rclverify.calculus.requirements.tsys import (FairLoops, Fairness, Pred, State, TemporalVerdict, Trans, TransitionSystem, distinct, trace_of, unroll,
                    with_flag)
 from rclverify.semantics import wallclock
+from rclverify.semantics.connectives import conj, disj
 
 __all__ = ["Fairness", "Pred", "State", "TemporalVerdict", "Trans", "TransitionSystem", "check_always", "check_eventually",
            "check_eventually_within", "check_next", "check_until", "find_lasso", "with_flag"]
@@ -156,8 +157,8 @@ def check_until(ts: TransitionSystem, prop: Pred, goal: Pred, *,
     decides the safety part, default :func:`check_always`).  ``refuted`` when
     either part is; ``proved`` when both are; else ``inconclusive`` with
     both parts' statuses."""
-    ts2 = with_flag(ts, "<G seen>", goal, lambda s, u: z3.Or(s["<G seen>"], goal(u)))
-    safe_prop = lambda s: z3.Or(s["<G seen>"], prop(s))  # noqa: E731
+    ts2 = with_flag(ts, "<G seen>", goal, lambda s, u: disj(s["<G seen>"], goal(u)))
+    safe_prop = lambda s: disj(s["<G seen>"], prop(s))  # noqa: E731
     safe = always(ts2, safe_prop) if always is not None else check_always(ts2, safe_prop, max_k=max_k,
                                                                            timeout_ms=timeout_ms)
     if safe.status == "refuted":
@@ -290,9 +291,9 @@ def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
         misses.append(z3.Not(prop(states[n])))
         s = z3.Solver()
         wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        same = [z3.And(*[states[n][v] == states[j][v] for v in ts.sorts], fair.loop(states, j, n))
+        same = [conj(*[states[n][v] == states[j][v] for v in ts.sorts], fair.loop(states, j, n))
                 for j in range(n)]
-        s.add(init, *steps, *misses, z3.Or(*same))
+        s.add(init, *steps, *misses, disj(*same))
         if s.check() == z3.sat:
             m = s.model()
             loop = next(j for j in range(n) if z3.is_true(m.eval(same[j], model_completion=True)))

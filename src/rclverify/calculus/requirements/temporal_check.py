@@ -53,6 +53,7 @@ from rclverify.model.plan.state import state_types
 from rclverify.model.plan.temporal import Temporal, operands, parse_temporal, shape
 from rclverify.calculus.health.witness import points_for
 from rclverify.lang.types import Checked, EmptyT
+from rclverify.semantics.connectives import conj, disj
 from rclverify.semantics.values import render
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.requirements.deadlock import runs_go_on
@@ -185,7 +186,7 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
     if kind == "always next":
         f = pred(t.args[0].args[0])  # type: ignore[union-attr]
         ts2 = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
-        return prove_always(ts2, lambda s: z3.Or(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms,
+        return prove_always(ts2, lambda s: disj(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms,
                             hint=hint)
     if kind == "next":
         return _exact(check_next(ts, got(t.args[0]), timeout_ms=timeout_ms), hint)
@@ -325,15 +326,15 @@ class _System:
 
     def reach(self, f: Formal) -> Callable[[Any], Any]:  # must be reached: on published values
         raw = self.raw(f)
-        return lambda s: z3.And(self.sys.pub.defined(f.mentions, s), raw(s))
+        return lambda s: conj(self.sys.pub.defined(f.mentions, s), raw(s))
 
     def assume(self) -> None:
         """The requirement's ``assuming`` formulas hold in every state of the system."""
         sys, q = self.sys, self.q
         holds = [self.pred(a) for a in q.assuming]
         ts = sys.ts
-        sys.ts = TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), *[h(s) for h in holds]),
-                                  lambda s, u: z3.And(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
+        sys.ts = TransitionSystem(ts.sorts, lambda s: conj(ts.init(s), *[h(s) for h in holds]),
+                                  lambda s, u: conj(ts.trans(s, u), *[h(s) for h in holds], *[h(u) for h in holds]),
                                   ts.fairness)
         for k, a in enumerate(q.assuming, 1):
             sys.premises.append({"label": f"assuming {k}", "kind": "assuming", "node": None, "index": k,

@@ -48,6 +48,7 @@ from typing import Any, Collection, Sequence
 import z3
 
 from rclverify.calculus.compose import split_assumption
+from rclverify.semantics.connectives import conj, disj
 from rclverify.semantics.encode import Encoder, sort_of
 from rclverify.model.plan.load import Plan
 from rclverify.model.plan.state import parse_state_formula, state_type
@@ -81,7 +82,7 @@ def _typing(v: z3.ExprRef, t: Type) -> z3.BoolRef | None:
             args = t.ctor(ds.constructor(i).name()) or ()
             parts += [z3.Implies(ds.recognizer(i)(v), ds.accessor(i, j)(v) >= 0)
                       for j, a in enumerate(args) if a == NATURAL]
-        return z3.And(*parts) if parts else None
+        return conj(*parts) if parts else None
     if isinstance(t, FuncT) and t.result == NATURAL:
         xs = [z3.Const(f"_t{k}", sort_of(a)) for k, a in enumerate(t.args)]
         return z3.ForAll(xs, z3.Select(v, *xs) >= 0)
@@ -157,9 +158,9 @@ class ComposedSystem:
         subsystem of :meth:`fair_everywhere`'s, and the reading before
         progress could be declared."""
         def eager(s: State) -> z3.BoolRef:
-            return z3.And(*[z3.Implies(f.enabled(s), f.taken(s)) for f in self.everyone])
-        return TransitionSystem(ts.sorts, lambda s: z3.And(ts.init(s), eager(s)),
-                                lambda s, t: z3.And(ts.trans(s, t), eager(s), eager(t)), ts.fairness)
+            return conj(*[z3.Implies(f.enabled(s), f.taken(s)) for f in self.everyone])
+        return TransitionSystem(ts.sorts, lambda s: conj(ts.init(s), eager(s)),
+                                lambda s, t: conj(ts.trans(s, t), eager(s), eager(t)), ts.fairness)
 
     def statement_symbols(self, s: State) -> dict[str, Any]:
         """The encoder's symbols of a requirement statement at state ``s``
@@ -326,7 +327,7 @@ class _Builder:
         return self.enc.formula(e, self.checked.nodes[n], self.node_symbols(n, s))
 
     def assumed(self, n: str, s: State) -> z3.BoolRef:
-        return z3.And(*[self.holds(n, a, s) for a in self.internal[n]]) if self.internal[n] else z3.BoolVal(True)
+        return conj(*[self.holds(n, a, s) for a in self.internal[n]]) if self.internal[n] else z3.BoolVal(True)
 
     def cached(self, tag: int, states_: tuple[State, ...], make: Any) -> z3.BoolRef:
         terms = [st[name] for st in states_ for name in self.sorts]
@@ -345,7 +346,7 @@ class _Builder:
 
     def enabled(self, n: str, s: State) -> z3.BoolRef:
         """The node has a question it owes an answer: every input it reads published, its assumption holding."""
-        return z3.And(self.accepted(n, s), self.pub.ready(n, s))
+        return conj(self.accepted(n, s), self.pub.ready(n, s))
 
     @staticmethod
     def answers_in(n: str, s: State) -> z3.BoolRef:
@@ -359,20 +360,20 @@ class _Builder:
             if f"{n}.accepts" in s:
                 parts.append(s[f"{n}.accepts"] == self.assumed(n, s))
             guarantees = self.guarantees[n]
-            promise = z3.And(*[holds(n, g, s) for g in guarantees]) if guarantees else z3.BoolVal(True)
+            promise = conj(*[holds(n, g, s) for g in guarantees]) if guarantees else z3.BoolVal(True)
             if f"{n}.answers" not in s:  # no output to answer with: its guarantee holds where its assumption does
                 if guarantees:
                     parts.append(z3.Implies(self.assumed(n, s), promise))
                 continue
             answers = s[f"{n}.answers"]
-            parts.append(z3.Implies(answers, z3.And(self.enabled(n, s), promise)))
+            parts.append(z3.Implies(answers, conj(self.enabled(n, s), promise)))
             k = self.bounds[n]
             if k == 0:
                 parts.append(z3.Implies(self.enabled(n, s), answers))
             elif k:
                 w = s[f"{n}.waiting"]
-                parts.append(z3.If(z3.Or(answers, z3.Not(self.enabled(n, s))), w == 0, z3.And(w >= 1, w <= k)))
-        return z3.And(*parts)
+                parts.append(z3.If(disj(answers, z3.Not(self.enabled(n, s))), w == 0, conj(w >= 1, w <= k)))
+        return conj(*parts)
 
     def state_syms(self, sv: Any, s: State, t: State | None) -> dict[str, Any]:
         out = self.node_symbols(sv.node, s) if t is not None else {}
@@ -391,10 +392,10 @@ class _Builder:
         for n in self.answering:
             if self.initially[n]:
                 parts.append(z3.Implies(z3.Not(s[f"{n}.answers"]),
-                                        z3.And(*[self.holds(n, f, s) for f in self.initially[n]])))
+                                        conj(*[self.holds(n, f, s) for f in self.initially[n]])))
             if self.bounds[n]:
                 parts.append(s[f"{n}.waiting"] <= 1)
-        return z3.And(*parts)
+        return conj(*parts)
 
     def trans(self, s: State, t: State) -> z3.BoolRef:
         return self.cached(1, (s, t), lambda: self._trans(s, t))
@@ -405,18 +406,18 @@ class _Builder:
         for n in self.answering:
             outs = [t[f"{n}.out.{v}"] == s[f"{n}.out.{v}"] for v in self.checked.nodes[n].outputs
                     if f"{n}.out.{v}" in s]
-            parts.append(z3.Implies(z3.Not(t[f"{n}.answers"]), z3.And(*outs)))
+            parts.append(z3.Implies(z3.Not(t[f"{n}.answers"]), conj(*outs)))
             if self.bounds[n]:
-                parts.append(z3.Implies(z3.And(z3.Not(t[f"{n}.answers"]), self.enabled(n, t)),
+                parts.append(z3.Implies(conj(z3.Not(t[f"{n}.answers"]), self.enabled(n, t)),
                                         t[f"{n}.waiting"] == s[f"{n}.waiting"] + 1))
         parts += [self.enc.formula(self.parsed[sv][1].expr, self.parsed[sv][1].scope, self.state_syms(sv, s, t))
                   for sv in self.states]
-        return z3.And(*parts)
+        return conj(*parts)
 
     def initial_of(self, n: str) -> Any:
         outs = [f"{n}.out.{v}" for v in self.checked.nodes[n].outputs if f"{n}.out.{v}" in self.sorts]
         types, holds, initially = self.types, self.holds, self.initially
-        return lambda s: z3.And(*[c for c in (_typing(s[o], types[o]) for o in outs) if c is not None],
+        return lambda s: conj(*[c for c in (_typing(s[o], types[o]) for o in outs) if c is not None],
                                 *[holds(n, f, s) for f in initially[n]])
 
     def progress_of(self, n: str) -> Fairness:

@@ -18,6 +18,8 @@ from typing import Any, Callable
 
 import z3
 
+from rclverify.semantics.connectives import conj, disj
+
 State = dict[str, z3.ExprRef]
 Pred = Callable[[State], z3.BoolRef]
 Trans = Callable[[State, State], z3.BoolRef]
@@ -104,7 +106,7 @@ def distinct(states: list[State]) -> list[z3.BoolRef]:
     property contains a simple one that does), and it makes k-induction
     complete on a finite-state system for k beyond its longest simple path
     (Sheeran, Singh, Stalmarck, FMCAD 2000)."""
-    return [z3.Or(*[a[v] != b[v] for v in a]) for i, a in enumerate(states) for b in states[i + 1:]]
+    return [disj(*[a[v] != b[v] for v in a]) for i, a in enumerate(states) for b in states[i + 1:]]
 
 
 def trace_of(model: z3.ModelRef, states: list[State]) -> list[dict[str, str]]:
@@ -118,15 +120,15 @@ def with_flag(ts: TransitionSystem, name: str, init: Callable[[Any], Any],
     value, ``step(s, t)`` its next (a history variable: it constrains
     nothing, and every state of ``ts`` with a successor still has one)."""
     sorts = {**ts.sorts, name: z3.BoolSort()}
-    return TransitionSystem(sorts, lambda s: z3.And(ts.init(s), s[name] == init(s)),
-                            lambda s, t: z3.And(ts.trans(s, t), t[name] == step(s, t)), ts.fairness)
+    return TransitionSystem(sorts, lambda s: conj(ts.init(s), s[name] == init(s)),
+                            lambda s, t: conj(ts.trans(s, t), t[name] == step(s, t)), ts.fairness)
 
 
 def fair_loop(ts: TransitionSystem, loop: list[State]) -> z3.BoolRef:
     """The states ``loop`` (s_j .. s_{n-1} of a lasso whose s_n equals s_j),
     repeated forever, meet every fairness constraint of ``ts``: for each,
     ``enabled`` at no state of the loop or ``taken`` at one of them."""
-    return z3.And(*[z3.Implies(z3.Or(*[f.enabled(s) for s in loop]), z3.Or(*[f.taken(s) for s in loop]))
+    return conj(*[z3.Implies(disj(*[f.enabled(s) for s in loop]), disj(*[f.taken(s) for s in loop]))
                     for f in ts.fairness]) if ts.fairness else z3.BoolVal(True)
 
 
@@ -155,5 +157,5 @@ class FairLoops:
         if not self.fairness:
             return z3.BoolVal(True)
         marks = [self._of(s) for s in states[j:n]]
-        return z3.And(*[z3.Implies(z3.Or(*[m[c][0] for m in marks]), z3.Or(*[m[c][1] for m in marks]))
+        return conj(*[z3.Implies(disj(*[m[c][0] for m in marks]), disj(*[m[c][1] for m in marks]))
                         for c in range(len(self.fairness))])
