@@ -24,6 +24,7 @@ from typing import Mapping, Sequence
 
 import z3
 
+from rclverify.semantics.connectives import conj, disj
 from rclverify.semantics.retry import has_quantifier
 from rclverify.semantics.values import decimal_text
 from rclverify.semantics import wallclock
@@ -55,11 +56,11 @@ def _nnf_clauses(e: z3.BoolRef) -> list[list[z3.BoolRef]] | None:
         if z3.is_not(x):
             return cnf(x.arg(0), not positive)
         if z3.is_and(x) or z3.is_or(x):
-            conj = z3.is_and(x) == positive
+            conjunctive = z3.is_and(x) == positive
             parts = [cnf(c, positive) for c in x.children()]
             if any(p is None for p in parts):
                 return None
-            if conj:
+            if conjunctive:
                 return [c for p in parts for c in p]  # type: ignore[union-attr]
             out: list[list[z3.BoolRef]] = [[]]
             for p in parts:
@@ -123,16 +124,16 @@ def clauses_under(f: z3.BoolRef, context: Sequence[z3.BoolRef] = ()) -> z3.BoolR
         kept_lits = list(c)
         for lit in list(kept_lits):
             rest = [x for x in kept_lits if not x.eq(lit)]
-            if rest and _valid(whole, z3.Or(*rest) if len(rest) > 1 else rest[0]):
+            if rest and _valid(whole, disj(*rest) if len(rest) > 1 else rest[0]):
                 kept_lits = rest
         shrunk.append(kept_lits)
     kept = list(shrunk)
     for c in list(shrunk):
-        others = [z3.Or(*x) if len(x) > 1 else x[0] for x in kept if x is not c]
-        if _valid(ctx + others, z3.Or(*c) if len(c) > 1 else c[0]):
+        others = [disj(*x) if len(x) > 1 else x[0] for x in kept if x is not c]
+        if _valid(ctx + others, disj(*c) if len(c) > 1 else c[0]):
             kept = [x for x in kept if x is not c]
-    parts = [z3.Or(*c) if len(c) > 1 else c[0] for c in kept]
-    return z3.And(*parts) if len(parts) > 1 else parts[0] if parts else z3.BoolVal(True, f.ctx)
+    parts = [disj(*c) if len(c) > 1 else c[0] for c in kept]
+    return conj(*parts) if len(parts) > 1 else parts[0] if parts else z3.BoolVal(True, f.ctx)
 
 
 _CMP = {z3.Z3_OP_LE: "<=", z3.Z3_OP_LT: "<", z3.Z3_OP_GE: ">=", z3.Z3_OP_GT: ">", z3.Z3_OP_EQ: "=="}

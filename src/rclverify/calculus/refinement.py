@@ -42,6 +42,7 @@ from typing import Any, Callable, Mapping, Sequence, TextIO
 import z3
 
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
+from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import EncodingError, Encoder
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
 from rclverify.lang import ast
@@ -264,12 +265,12 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
         for name in group:
             shared[f"{prefix}.{name}"] = enc.io_symbol(a, prefix, name)
     try:
-        def conj(node: CheckedNode, clauses: tuple[ast.Clause, ...]) -> z3.BoolRef:
+        def all_of(node: CheckedNode, clauses: tuple[ast.Clause, ...]) -> z3.BoolRef:
             fs = [enc.formula(c.formula, node, shared) for c in clauses]
-            return z3.And(*fs) if fs else z3.BoolVal(True)
+            return conj(*fs) if fs else z3.BoolVal(True)
 
-        aa, ga = conj(a, a.node.assumes), conj(a, a.node.guarantees)
-        ab, gb = conj(b, b.node.assumes), conj(b, b.node.guarantees)
+        aa, ga = all_of(a, a.node.assumes), all_of(a, a.node.guarantees)
+        ab, gb = all_of(b, b.node.assumes), all_of(b, b.node.guarantees)
         hyps = [enc.formula(f, a, shared) for f in facts] + [enc.formula(c, b, shared) for c in conditions]
         timed = timing_side(a, b, enc, shared, hyps, aa, timeout_ms=timeout_ms)
     except EncodingError as exc:

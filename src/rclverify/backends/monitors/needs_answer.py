@@ -124,13 +124,14 @@ def _content(value: Any) -> bytes:
 
 def _decides(checked: Checked, node: CheckedNode, formulas: list[ast.Expr]) -> bool:
     import z3  # deferred: start-up (Z3 only for a node whose formulas are in the fragment)
+    from rclverify.semantics.connectives import conj  # deferred: start-up (loads z3 only when called)
     from rclverify.semantics.encode import Encoder  # deferred: start-up (loads z3 and the encoder only when called)
     from rclverify.semantics.query import budgeted_solver  # deferred: start-up (loads z3 only when called)
     try:
         enc = Encoder(checked.env)
         outs = [enc.io_symbol(node, "out", v) for v in sorted(node.outputs)]
         encoded = [enc.formula(f, node) for f in formulas]
-        typed = z3.And(*enc.axioms()) if enc.axioms() else z3.BoolVal(True)
+        typed = conj(*enc.axioms()) if enc.axioms() else z3.BoolVal(True)
         for g in encoded:
             for goal in (g, z3.Not(g)):
                 s = budgeted_solver(QUERY_MS)  # resource steps decide, not the clock (issue 67)
