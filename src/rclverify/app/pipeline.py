@@ -114,6 +114,8 @@ def stage_compose(ws: Workspace, node: str) -> CompositionRecord:
     """Apply the calculus to ``node``; writes its JSON and one .smt2 per side condition."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     from rclverify.calculus.compose import compose_node, composition_json  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.calculus import summary  # deferred: start-up (loads z3 only when called)
+    summary.use_directory(ws.path("artifacts/cache/summaries"))  # the other worker's and earlier runs' summaries
     comp = compose_node(ws.checked, ws.model, node, facts=plan_facts(ws))
     paths = []
     for sc in comp.side_conditions:

@@ -49,13 +49,17 @@ its own: a context cost as much as the query.
 """
 from __future__ import annotations
 
+import dataclasses
+import json
 import re
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
+from rclverify.core.cache import Blobs, fingerprint
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import NATURAL, Checked
@@ -93,7 +97,7 @@ class Summary:
     script: str
 
 
-_MEMO: dict[str, Any] = {"key": None, "summaries": {}}
+_MEMO: dict[str, Any] = {"key": None, "summaries": {}, "keys": {}}
 
 
 def _memo(checked: Checked, model: SystemModel, facts: Mapping[str, Sequence[ast.Expr]]) -> dict[str, Any]:
@@ -102,7 +106,8 @@ def _memo(checked: Checked, model: SystemModel, facts: Mapping[str, Sequence[ast
     fp = tuple((n, tuple(expr_to_rcl(f) for f in fs)) for n, fs in sorted(facts.items()))
     key = _MEMO["key"]
     if key is None or key[0] is not checked or key[1] is not model or key[2] != fp:
-        _MEMO["key"], _MEMO["summaries"] = (checked, model, fp), {}
+        _MEMO["key"], _MEMO["summaries"], _MEMO["keys"] = (checked, model, fp), {}, {}
+        _blobs.forget()  # the texts held in memory are the last system's (the files stay)
     return _MEMO["summaries"]
 
 
@@ -160,12 +165,13 @@ def summary_of(checked: Checked, model: SystemModel, node: str,
             stack.pop()
             order.append(v)
     for m in order:
-        memo[m] = _build(checked, model, m, environment, facts, memo)
+        memo[m] = _build(checked, model, m, environment, facts, memo, _MEMO["keys"])
     return memo[node]
 
 
 def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[str], Sequence[ast.Expr]],
-           facts: Mapping[str, Sequence[ast.Expr]], memo: Mapping[str, Summary | None]) -> Summary | None:
+           facts: Mapping[str, Sequence[ast.Expr]], memo: Mapping[str, Summary | None],
+           keys: dict[str, bytes]) -> Summary | None:
     if model.loop_of(m):
         return None
     producers = model.producers(m)
@@ -204,28 +210,105 @@ def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[
         premises.append((label, body or "true"))
     axioms = _naturals(checked, m, symbol)
     decls = "".join(f"(declare-fun {quote(n)} () {s})\n" for n, s in sorted(sorts.items()))
+    own = {label: (text, k) for k, (label, text, _, _, _) in enumerate(d.items)}
+    made = _Made(m, index[m], tuple(top), decls, tuple(premises), tuple(axioms), tuple(sorted(set(sorts) - set(kept))),
+                 tuple(sorted(kept.items())), tuple(sorted(sorts.items())), tuple(own.items()),
+                 tuple(keys[p] for p in top))
+    keys[m] = _blobs.key("summary", fingerprint(dataclasses.astuple(made)))
+    return _kept(made, keys[m], memo)
+
+
+@dataclass(frozen=True)
+class _Made:
+    """Everything a summary is made from (:func:`_make`), as text and numbers:
+    equal inputs make an equal summary, whichever process makes it."""
+
+    node: str
+    index: int
+    top: tuple[str, ...]
+    decls: str
+    premises: tuple[tuple[str, str], ...]
+    axioms: tuple[str, ...]
+    hidden: tuple[str, ...]
+    kept: tuple[tuple[str, str], ...]
+    sorts: tuple[tuple[str, str], ...]
+    own: tuple[tuple[str, tuple[str, int]], ...]
+    producer_keys: tuple[bytes, ...]
+
+
+#: Summaries kept between the processes of a run and between runs (:func:`use_directory`), keyed by
+#: everything :func:`_make` reads (:class:`_Made`: a producer's summary by its own key, which holds
+#: its inputs), the rclverify code and Z3's version.  A file holds the node, the formula, the labels
+#: of the premises Z3's proof used and the proof's script: a few lines, whatever the cone's size.
+_blobs = Blobs(None, "summaries", "json", versions=(f"z3 {z3.get_full_version()}",))
+
+
+def use_directory(path: Path | None) -> None:
+    """Keep the summaries made in this process under ``path`` (one JSON file
+    each, ``<key>.json``) and read those made by another process of the run
+    (the other doit worker) or an earlier run from there; ``None``: in
+    memory only.  A summary is a function of its inputs' text (it is made
+    in a Z3 context of its own, from text alone), so one read equals one
+    made again: incremental equals clean.  Raises nothing here."""
+    _blobs.directory = path
+
+
+def _kept(made: _Made, key: bytes, memo: Mapping[str, Summary | None]) -> Summary | None:
+    """The summary of ``made`` (kept under ``key``): the kept one, else made
+    (:func:`_made`) and kept when there is one.  A kept file that does not
+    read as one of ``made.node`` is made again.  ``memo``: the producers'
+    summaries, whose premises a proof that used them rests on."""
+    def make() -> str | None:
+        got = _made(made)
+        return None if got is None else json.dumps(list(got))
+    text = _blobs.text(key, make)
+    if text is None:
+        return None
+    try:
+        node, formula, used, script = json.loads(text)
+        if node != made.node or not all(isinstance(x, str) for x in (formula, script, *used)):
+            raise ValueError(node)
+        return _summary(made, formula, used, script, memo)
+    except (ValueError, TypeError, KeyError):
+        got = _made(made)
+        return None if got is None else _summary(made, *got[1:], memo)
+
+
+def _made(made: _Made) -> tuple[str, str, list[str], str] | None:
+    """Quantifier elimination of the cone's hidden values, then Z3's proof
+    that the result is implied by the premises (module docstring), in a Z3
+    context of its own: ``(node, formula, labels of the premises the proof
+    used, the proof's script)``, or ``None`` when either fails."""
+    m, premises, axioms, decls = made.node, made.premises, made.axioms, made.decls
     ctx = z3.Context()  # of its own: the text made depends on nothing this process did before
     try:
-        formula = _eliminate(ctx, decls, [b for _, b in premises] + axioms, sorted(set(sorts) - set(kept)), sorts)
+        formula = _eliminate(ctx, decls, [b for _, b in premises] + list(axioms), made.hidden, dict(made.sorts))
         used = (_implied(ctx, decls, premises, axioms, formula)
                 if formula is not None and len(formula) <= MAX_TEXT else None)
     except z3.Z3Exception:
         used = None
     if used is None or formula is None:
         return None
-    own = {label: (text, k) for k, (label, text, _, _, _) in enumerate(d.items)}
+    script = (f"; rclverify summary of the upstream cone of {m}: its premises entail\n; {formula}\n"
+              f"; (summaries of {', '.join(made.top) or 'no producer'}; unsat means implied)\n"
+              + decls + "".join(f"; {label}\n(assert {body})\n" for label, body in premises)
+              + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (not {formula}))\n(check-sat)\n")
+    return m, formula, used, script
+
+
+def _summary(made: _Made, formula: str, used: Sequence[str], script: str,
+             memo: Mapping[str, Summary | None]) -> Summary:
+    """The :class:`Summary` of ``made`` whose proof used the premises labelled
+    ``used``: a producer's summary stands for the premises its own proof used."""
+    own = dict(made.own)
     out: dict[str, tuple[str, str, tuple[int, int]]] = {}
     for label in used:
         if label.endswith(" summary"):
             for u in memo[label[:-len(" summary")]].used:  # type: ignore[union-attr]
                 out[u[0]] = u
         else:
-            out[label] = (label, own[label][0], (index[m], own[label][1]))
-    script = (f"; rclverify summary of the upstream cone of {m}: its premises entail\n; {formula}\n"
-              f"; (summaries of {', '.join(top) or 'no producer'}; unsat means implied)\n"
-              + decls + "".join(f"; {label}\n(assert {body})\n" for label, body in premises)
-              + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (not {formula}))\n(check-sat)\n")
-    return Summary(m, formula, tuple(sorted(kept.items())), tuple(sorted(out.values(), key=lambda u: u[2])), script)
+            out[label] = (label, own[label][0], (made.index, own[label][1]))
+    return Summary(made.node, formula, made.kept, tuple(sorted(out.values(), key=lambda u: u[2])), script)
 
 
 def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Sequence[str],

@@ -18,6 +18,9 @@ file                                   kind                 keyed by
                                                             (:mod:`rclverify.report.fragments`)
 ``layout/<key>.svg``                   ``layout``           the DOT text and the ``dot`` program
                                                             (:mod:`rclverify.report.layoutcache`)
+``summaries/<key>.json``               ``summaries``        a cone summary's inputs as text, its
+                                                            producers' keys, Z3's version
+                                                            (:mod:`rclverify.calculus.summary`)
 ``diagnosis.pickle``                   ``diagnosis``        the problem, the contract and plan files,
                                                             the program (:mod:`rclverify.diagnosis.build`)
 ``ros-scan.pickle``                    ``ros-scan``         sha256 of each scanned source file

@@ -18,8 +18,8 @@ Two shapes of store are built on it, both keyed by
   (``<name>.pickle``): report pieces, contract texts, diagnosis repairs,
   parsed ROS files;
 * :class:`Blobs` -- one file per entry (``<dir>/<key>.<suffix>``), for
-  large entries that several processes may write at once: Graphviz
-  layouts.
+  entries that several processes may write at once: Graphviz layouts,
+  cone summaries.
 
 **The one rule of what is kept**: an entry is found only under the key of
 its inputs and the current code; a run keeps the entries it used (a
