@@ -220,7 +220,7 @@ def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[
 
 @dataclass(frozen=True)
 class _Made:
-    """Everything a summary is made from (:func:`_make`), as text and numbers:
+    """Everything a summary is made from (:func:`_made`), as text and numbers:
     equal inputs make an equal summary, whichever process makes it."""
 
     node: str
@@ -237,7 +237,7 @@ class _Made:
 
 
 #: Summaries kept between the processes of a run and between runs (:func:`use_directory`), keyed by
-#: everything :func:`_make` reads (:class:`_Made`: a producer's summary by its own key, which holds
+#: everything :func:`_made` reads (:class:`_Made`: a producer's summary by its own key, which holds
 #: its inputs), the rclverify code and Z3's version.  A file holds the node, the formula, the labels
 #: of the premises Z3's proof used and the proof's script: a few lines, whatever the cone's size.
 _blobs = Blobs(None, "summaries", "json", versions=(f"z3 {z3.get_full_version()}",))
