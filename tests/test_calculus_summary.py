@@ -190,10 +190,10 @@ def test_verdicts_with_summaries_equal_the_whole_cones(seed: int) -> None:
 @settings(max_examples=25, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 10**6))
 def test_the_hidden_names_read_off_the_text_are_the_walked_constants(seed: int) -> None:
-    """summary._bound's token path (names bare as Z3 prints them, or quoted
+    """summary_qe._bound's token path (names bare as Z3 prints them, or quoted
     as smttext writes them) binds exactly the constants a walk of the parsed
     formulas finds."""
-    from rclverify.calculus import summary as S
+    from rclverify.calculus import summary_qe as S
     bound, seen = S._bound, []
 
     def both(ctx, fs, bodies, hidden, sorts):  # type: ignore[no-untyped-def]

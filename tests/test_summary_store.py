@@ -82,3 +82,18 @@ def test_an_edit_upstream_changes_every_key_downstream(tmp_path: Path) -> None:
         _fresh_process()
     changed = {n for n, k in keys.items() if f"{k.hex()}.json" not in before}
     assert changed == {f"N{i}" for i in range(3, N)}  # N3's guarantee changed: it and all below it
+
+
+def test_the_compose_stage_keeps_its_summaries_in_its_workspace_only(tmp_path: Path) -> None:
+    """The stage reads and writes ``artifacts/cache/summaries`` of its own
+    workspace, and leaves the process keeping summaries in memory only: a
+    later computation never writes into a workspace it was not given."""
+    from _chain import write_chain
+    from rclverify.app.pipeline import stage_check, stage_compose
+    from rclverify.stages.workspace import Workspace
+    ws = Workspace(write_chain(tmp_path / "ws", 4))
+    stage_check(ws)
+    for n in ws.node_names():
+        stage_compose(ws, n)
+    assert summary._blobs.directory is None
+    assert len(list((tmp_path / "ws/artifacts/cache/summaries").glob("*.json"))) == 3  # N0, N1, N2: read by N1-N3

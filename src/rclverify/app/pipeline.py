@@ -116,7 +116,10 @@ def stage_compose(ws: Workspace, node: str) -> CompositionRecord:
     from rclverify.calculus.compose import compose_node, composition_json  # deferred: start-up (loads lark, yaml and more only when called)
     from rclverify.calculus import summary  # deferred: start-up (loads z3 only when called)
     summary.use_directory(ws.path("artifacts/cache/summaries"))  # the other worker's and earlier runs' summaries
-    comp = compose_node(ws.checked, ws.model, node, facts=plan_facts(ws))
+    try:
+        comp = compose_node(ws.checked, ws.model, node, facts=plan_facts(ws))
+    finally:
+        summary.use_directory(None)  # this workspace's only: a later computation in the process keeps its own
     paths = []
     for sc in comp.side_conditions:
         rel = f"artifacts/calculus/{sc.id}.smt2"

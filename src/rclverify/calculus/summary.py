@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -63,17 +62,13 @@ from rclverify.core.cache import Blobs, fingerprint
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import NATURAL, Checked
-from rclverify.semantics.connectives import conj
 from rclverify.semantics.query import query_solver
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.context import NEGATED, ContextResult, _multi_path, single_paths
 from rclverify.calculus.premises import node_premises
 from rclverify.calculus.smttext import SORTS, quote, to_smt
-from rclverify.semantics.retry import has_quantifier
-from rclverify.semantics import wallclock
+from rclverify.calculus.summary_qe import eliminate, implied
 
-#: Budget of each quantifier elimination and each check of a summary (milliseconds).
-QE_MS = 2_000
 #: A summary whose SMT-LIB text is longer is not kept (the full cone is read instead).
 MAX_TEXT = 20_000
 
@@ -282,8 +277,8 @@ def _made(made: _Made) -> tuple[str, str, list[str], str] | None:
     m, premises, axioms, decls = made.node, made.premises, made.axioms, made.decls
     ctx = z3.Context()  # of its own: the text made depends on nothing this process did before
     try:
-        formula = _eliminate(ctx, decls, [b for _, b in premises] + list(axioms), made.hidden, dict(made.sorts))
-        used = (_implied(ctx, decls, premises, axioms, formula)
+        formula = eliminate(ctx, decls, [b for _, b in premises] + list(axioms), made.hidden, dict(made.sorts))
+        used = (implied(ctx, decls, premises, axioms, formula)
                 if formula is not None and len(formula) <= MAX_TEXT else None)
     except z3.Z3Exception:
         used = None
@@ -309,87 +304,6 @@ def _summary(made: _Made, formula: str, used: Sequence[str], script: str,
         else:
             out[label] = (label, own[label][0], (made.index, own[label][1]))
     return Summary(made.node, formula, made.kept, tuple(sorted(out.values(), key=lambda u: u[2])), script)
-
-
-def _eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Sequence[str],
-               sorts: Mapping[str, str] | None = None) -> str | None:
-    """``exists hidden. and(bodies)`` without the quantifier, as SMT-LIB
-    text (Z3 context ``ctx``); ``None`` when ``qe`` leaves a quantifier or
-    gives up.  ``sorts``: each name's SMT-LIB sort (``Real``, ``Int``,
-    ``Bool``), so the names the bodies mention are bound without walking
-    the parsed formula (:func:`_bound`)."""
-    fs = z3.parse_smt2_string(decls + "".join(f"(assert {b})\n" for b in bodies), ctx=ctx)
-    body = conj(*fs) if len(fs) else z3.BoolVal(True, ctx)
-    if hidden:
-        xs = _bound(ctx, fs, bodies, hidden, sorts)
-        if xs:
-            body = z3.Exists(xs, body)
-    for qe in ("qe2", "qe"):  # model-based projection first: a clean conjunction, and faster (docs/calculus.md)
-        g = z3.Goal(ctx=ctx)
-        g.add(body)
-        try:
-            out = z3.TryFor(z3.Then("simplify", qe, "simplify", ctx=ctx), QE_MS, ctx=ctx)(g).as_expr()
-        except z3.Z3Exception:
-            continue
-        if not has_quantifier(out):
-            return " ".join(out.sexpr().split())  # one line: the scripts quote it in a comment
-    return None
-
-
-#: The Z3 sort of each SMT-LIB sort name of :data:`.smttext.SORTS`.
-_Z3_SORTS = {"Real": z3.RealSort, "Int": z3.IntSort, "Bool": z3.BoolSort}
-
-
-def _bound(ctx: z3.Context, fs: Sequence[z3.ExprRef], bodies: Sequence[str], hidden: Sequence[str],
-           sorts: Mapping[str, str] | None) -> list[z3.ExprRef]:
-    """The constants of ``hidden`` that ``bodies`` mention, in ``hidden``'s
-    order: read off the text's tokens when every name is a simple SMT-LIB
-    symbol of a sort in ``sorts`` (the same constants Z3 parsed: a constant
-    is its name and sort), else found by walking the parsed ``fs`` (walking
-    the terms through Z3's Python objects was a tenth of a summary)."""
-    if sorts is not None and all(sorts.get(h) in _Z3_SORTS and not any(c in h for c in " \t\n()|") for h in hidden):
-        # a name is one token, bare (as Z3 prints it in a summary) or quoted (as smttext writes it)
-        tokens = set(_TOKEN.findall(" ".join(bodies)))
-        return [z3.Const(h, _Z3_SORTS[sorts[h]](ctx)) for h in hidden if h in tokens or quote(h) in tokens]
-    consts = {str(c): c for f in fs for c in _constants(f)}
-    return [consts[h] for h in hidden if h in consts]
-
-
-#: An SMT-LIB2 token that is not a parenthesis: a simple symbol, numeral or keyword.
-_TOKEN = re.compile(r"[^\s()]+")
-
-
-def _constants(f: z3.ExprRef) -> list[z3.ExprRef]:
-    out, todo, seen = [], [f], set()
-    while todo:
-        x = todo.pop()
-        if x.get_id() in seen:
-            continue
-        seen.add(x.get_id())
-        if z3.is_const(x) and x.decl().kind() == z3.Z3_OP_UNINTERPRETED:
-            out.append(x)
-        elif z3.is_app(x):
-            todo.extend(x.children())
-    return out
-
-
-def _implied(ctx: z3.Context, decls: str, premises: Sequence[tuple[str, str]], axioms: Sequence[str],
-             formula: str) -> list[str] | None:
-    """The labels of ``premises`` an unsat core of ``premises and axioms
-    and not formula`` uses (Z3 context ``ctx``), or ``None`` unless Z3
-    answers unsat."""
-    lits = "".join(f"(declare-fun |s!{k}| () Bool)\n" for k in range(len(premises)))
-    text = (decls + lits + "".join(f"(assert (=> |s!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
-            + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (not {formula}))\n")
-    s = z3.Solver(ctx=ctx)
-    wallclock.limit(s, QE_MS)  # steps decide, the clock is a net (issue 67)
-    s.set("unsat_core", True)
-    s.add(z3.parse_smt2_string(text, ctx=ctx))
-    lit = [z3.Bool(f"s!{k}", ctx) for k in range(len(premises))]
-    if s.check(*lit) != z3.unsat:
-        return None
-    core = {str(c) for c in s.unsat_core()}
-    return [label for k, (label, _) in enumerate(premises) if f"s!{k}" in core]
 
 
 def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
