@@ -126,3 +126,45 @@ def test_a_shelf_that_keeps_earlier_entries_is_not_rewritten_when_nothing_change
     again = Shelf(path, "t", keep=5)
     assert again.get(again.key("e", "a")) == "a"
     assert not again.save()  # used one, keeps all three: the file already holds them
+
+
+_MAKER = """
+import sys, time
+from pathlib import Path
+from rclverify.core.cache import Blobs
+d, log = Path(sys.argv[1]), Path(sys.argv[2])
+b = Blobs(d, "summaries", "json")
+def make():
+    with log.open("a") as f:
+        f.write("made\\n")
+    time.sleep(0.4)  # long enough that the other process finds the claim
+    return "the entry"
+print(b.text(b.key("x", "same inputs"), make, wait_s=10))
+"""
+
+
+def test_claimed_blobs_are_made_once_by_two_processes(tmp_path: Path) -> None:
+    """Two processes asking for the same entry at once: one makes it, the
+    other waits for its file; no claim is left."""
+    log = tmp_path / "log"
+    procs = [subprocess.Popen([sys.executable, "-c", _MAKER, str(tmp_path / "b"), str(log)],
+                              stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=60)[0].strip() for p in procs]
+    assert outs == ["the entry", "the entry"]
+    assert log.read_text() == "made\n"
+    assert sorted(f.suffix for f in (tmp_path / "b").iterdir()) == [".json"]
+
+
+def test_a_claim_left_behind_or_given_up_only_costs_the_wait(tmp_path: Path) -> None:
+    """A claim whose process died is waited on for ``wait_s`` only; a claim
+    whose maker failed (no file, claim removed) is made again at once."""
+    b = Blobs(tmp_path / "b", "summaries", "json")
+    k = b.key("x", "inputs")
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / f"{k.hex()}.claim").touch()  # a killed process's
+    assert b.text(k, lambda: "made here", wait_s=0.2) == "made here"
+    other = Blobs(tmp_path / "b", "summaries", "json")
+    assert other.text(k, lambda: "not made", wait_s=0.2) == "made here"  # read from the file
+    k2 = b.key("x", "other inputs")
+    assert b.text(k2, lambda: None, wait_s=5) is None  # failed: nothing kept, no claim left
+    assert not list((tmp_path / "b").glob(f"{k2.hex()}.*"))

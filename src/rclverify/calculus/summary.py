@@ -238,6 +238,11 @@ class _Made:
 _blobs = Blobs(None, "summaries", "json", versions=(f"z3 {z3.get_full_version()}",))
 
 
+#: Seconds a process waits for the summary another one is making (its two Z3 steps are bounded by
+#: :data:`.summary_qe.QE_MS` each), before making it itself.
+WAIT_S = 5.0
+
+
 def use_directory(path: Path | None) -> None:
     """Keep the summaries made in this process under ``path`` (one JSON file
     each, ``<key>.json``) and read those made by another process of the run
@@ -256,7 +261,7 @@ def _kept(made: _Made, key: bytes, memo: Mapping[str, Summary | None]) -> Summar
     def make() -> str | None:
         got = _made(made)
         return None if got is None else json.dumps(list(got))
-    text = _blobs.text(key, make)
+    text = _blobs.text(key, make, wait_s=WAIT_S)
     if text is None:
         return None
     try:

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import os
 import pickle
+import time
 from pathlib import Path
 from typing import Any, BinaryIO, Callable, Iterable
 
@@ -198,28 +199,91 @@ class Blobs:
         self.key = Keyer(salt(kind, versions))
         self._memory: dict[bytes, str] = {}
 
-    def text(self, k: bytes, make: Callable[[], str | None]) -> str | None:
+    def text(self, k: bytes, make: Callable[[], str | None], wait_s: float = 0.0) -> str | None:
         """The text kept under ``k``, else ``make()`` (the text, or ``None``
         on failure: nothing kept) kept under it.  A file that cannot be
-        read or written only costs time."""
+        read or written only costs time.
+
+        ``wait_s`` > 0: the entry is made by one process at a time.  Before
+        making it, this process claims it (``<key hex>.claim``, created
+        exclusively, removed when the entry is written or ``make`` failed);
+        a process that finds it claimed waits up to ``wait_s`` seconds for
+        the other's file instead of making the same entry beside it, and
+        makes it itself when none comes (the other failed, or was killed
+        and left its claim)."""
         hit = self._memory.get(k)
-        if hit is None and self.directory is not None:
-            try:
-                hit = (self.directory / f"{k.hex()}.{self.suffix}").read_text(encoding="utf-8")
-            except (OSError, UnicodeDecodeError):
-                hit = None
+        if hit is None:
+            hit = self._read(k)
+        claim: Path | None = None
+        if hit is None and wait_s > 0 and self.directory is not None:
+            mine, claim = self._claim(k)
+            if not mine:
+                hit = self._await(k, wait_s)
         if hit is not None:
             self._memory[k] = hit
             return hit
-        made = make()
-        if made is not None:
-            self._memory[k] = made
-            if self.directory is not None:
+        try:
+            made = make()
+            if made is not None:
+                self._memory[k] = made
+                if self.directory is not None:
+                    try:
+                        atomic_write_bytes(self.directory / f"{k.hex()}.{self.suffix}", made.encode("utf-8"))
+                    except OSError:
+                        pass
+        finally:
+            if claim is not None:
                 try:
-                    atomic_write_bytes(self.directory / f"{k.hex()}.{self.suffix}", made.encode("utf-8"))
+                    os.unlink(claim)
                 except OSError:
                     pass
         return made
+
+    def _read(self, k: bytes) -> str | None:
+        if self.directory is None:
+            return None
+        try:
+            return (self.directory / f"{k.hex()}.{self.suffix}").read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            return None
+
+    def _claim(self, k: bytes) -> tuple[bool, Path | None]:
+        """``(True, its path)``: this process now holds the claim on ``k``;
+        ``(False, None)``: another process holds it; ``(True, None)``: no
+        claim could be made for another reason (a read-only directory), so
+        this process goes on without one."""
+        path = self.directory / f"{k.hex()}.claim"  # type: ignore[operator]
+        for attempt in (0, 1):
+            try:
+                os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644))
+                return True, path
+            except FileExistsError:
+                return False, None
+            except FileNotFoundError:
+                if attempt:
+                    break
+                try:
+                    path.parent.mkdir(parents=True, exist_ok=True)
+                except OSError:
+                    break
+            except OSError:
+                break
+        return True, None
+
+    def _await(self, k: bytes, wait_s: float) -> str | None:
+        """The entry another process is making, once written; ``None`` when its
+        claim goes without a file or ``wait_s`` seconds pass."""
+        claim = self.directory / f"{k.hex()}.claim"  # type: ignore[operator]
+        deadline = time.monotonic() + wait_s
+        pause = 0.0002
+        while True:
+            hit = self._read(k)
+            if hit is not None or not claim.exists():
+                return hit if hit is not None else self._read(k)
+            if time.monotonic() >= deadline:
+                return None
+            time.sleep(pause)
+            pause = min(pause * 2, 0.005)
 
     def forget(self) -> None:
         """Drop what this object holds in memory (the files stay)."""
