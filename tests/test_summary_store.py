@@ -27,18 +27,24 @@ def _fresh_process() -> None:
     summary._blobs.forget()
 
 
-def _summaries(directory: Path | None) -> dict[str, summary.Summary | None]:
-    checked = check([parse_text(chain_rcl(N, bound=300), "sys.rcl")])
+def _computed(directory: Path | None, **chain: object) -> tuple[dict[str, summary.Summary | None], dict[str, bytes]]:
+    """The summaries of the chain (``chain``: :func:`chain_rcl`'s options) and
+    their keys, made as a new process makes them, kept in ``directory``."""
+    checked = check([parse_text(chain_rcl(N, bound=300, **chain), "sys.rcl")])  # type: ignore[arg-type]
     model = build(checked)
     summary.use_directory(directory)
     _fresh_process()
     try:
         env = lambda n: environment_conjuncts(checked, model, n)  # noqa: E731
         summary.summary_of(checked, model, f"N{N - 1}", env, X0)
-        return dict(summary._MEMO["summaries"])
+        return dict(summary._MEMO["summaries"]), dict(summary._MEMO["keys"])
     finally:
         summary.use_directory(None)
         _fresh_process()
+
+
+def _summaries(directory: Path | None) -> dict[str, summary.Summary | None]:
+    return _computed(directory)[0]
 
 
 @pytest.fixture(scope="module")
@@ -69,17 +75,7 @@ def test_a_damaged_file_is_made_again(tmp_path: Path, reference, damage: str) ->
 def test_an_edit_upstream_changes_every_key_downstream(tmp_path: Path) -> None:
     _summaries(tmp_path)
     before = {f.name for f in tmp_path.glob("*.json")}
-    checked = check([parse_text(chain_rcl(N, bound=300, weak={3: 70}), "sys.rcl")])
-    model = build(checked)
-    summary.use_directory(tmp_path)
-    _fresh_process()
-    try:
-        env = lambda n: environment_conjuncts(checked, model, n)  # noqa: E731
-        summary.summary_of(checked, model, f"N{N - 1}", env, X0)
-        keys = dict(summary._MEMO["keys"])
-    finally:
-        summary.use_directory(None)
-        _fresh_process()
+    _, keys = _computed(tmp_path, weak={3: 70})
     changed = {n for n, k in keys.items() if f"{k.hex()}.json" not in before}
     assert changed == {f"N{i}" for i in range(3, N)}  # N3's guarantee changed: it and all below it
 
