@@ -161,10 +161,24 @@ def test_a_claim_left_behind_or_given_up_only_costs_the_wait(tmp_path: Path) -> 
     b = Blobs(tmp_path / "b", "summaries", "json")
     k = b.key("x", "inputs")
     (tmp_path / "b").mkdir()
-    (tmp_path / "b" / f"{k.hex()}.claim").touch()  # a killed process's
+    (tmp_path / "b" / f"{k.hex()}.claim").touch()  # one being written, or not rclverify's: waited on
     assert b.text(k, lambda: "made here", wait_s=0.2) == "made here"
     other = Blobs(tmp_path / "b", "summaries", "json")
     assert other.text(k, lambda: "not made", wait_s=0.2) == "made here"  # read from the file
     k2 = b.key("x", "other inputs")
     assert b.text(k2, lambda: None, wait_s=5) is None  # failed: nothing kept, no claim left
     assert not list((tmp_path / "b").glob(f"{k2.hex()}.*"))
+
+
+def test_a_claim_whose_process_is_gone_is_not_waited_on(tmp_path: Path, monkeypatch) -> None:
+    """A claim names its process; a waiter that finds the process gone makes
+    the entry at once, without sleeping."""
+    import rclverify.core.cache.store as store
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    b = Blobs(tmp_path / "b", "summaries", "json")
+    k = b.key("x", "inputs")
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / f"{k.hex()}.claim").write_text(str(gone.pid))
+    monkeypatch.setattr(store.time, "sleep", lambda s: pytest.fail("waited on a dead process's claim"))
+    assert b.text(k, lambda: "made here", wait_s=60) == "made here"

@@ -210,7 +210,8 @@ class Blobs:
         a process that finds it claimed waits up to ``wait_s`` seconds for
         the other's file instead of making the same entry beside it, and
         makes it itself when none comes (the other failed, or was killed
-        and left its claim)."""
+        and left its claim: a claim names its process, and one whose
+        process is gone is not waited on)."""
         hit = self._memory.get(k)
         if hit is None:
             hit = self._read(k)
@@ -255,7 +256,11 @@ class Blobs:
         path = self.directory / f"{k.hex()}.claim"  # type: ignore[operator]
         for attempt in (0, 1):
             try:
-                os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644))
+                fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+                try:
+                    os.write(fd, str(os.getpid()).encode())  # who holds it: a waiter stops when it is gone
+                finally:
+                    os.close(fd)
                 return True, path
             except FileExistsError:
                 return False, None
@@ -280,7 +285,7 @@ class Blobs:
             hit = self._read(k)
             if hit is not None or not claim.exists():
                 return hit if hit is not None else self._read(k)
-            if time.monotonic() >= deadline:
+            if time.monotonic() >= deadline or not _alive(claim):
                 return None
             time.sleep(pause)
             pause = min(pause * 2, 0.005)
@@ -288,6 +293,27 @@ class Blobs:
     def forget(self) -> None:
         """Drop what this object holds in memory (the files stay)."""
         self._memory.clear()
+
+
+def _alive(claim: Path) -> bool:
+    """Whether the process named in ``claim`` (its pid, written by
+    :meth:`Blobs._claim`) still runs on this machine; ``True`` when that
+    cannot be told (a claim being written, another user's process), so the
+    waiter waits its time.  A claim left by a killed process is then not
+    waited on."""
+    try:
+        pid = int(claim.read_text(encoding="ascii") or "0")
+    except (OSError, ValueError):
+        return True
+    if pid <= 0:
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
 
 
 def kept_files(root: Path) -> list[dict[str, Any]]:
