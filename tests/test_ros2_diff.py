@@ -203,8 +203,9 @@ OTHERS = """\
 
 
 #: ROS 2's own view of the graph (rclpy's graph API over rmw_dds_common's graph cache), as JSON on stdout once
-#: every node of ``want`` is seen (at most 15 s): per node its publishers, subscribers, service servers and
-#: clients, action servers and clients, each ``[name, [types]]``
+#: every node of ``want`` is seen and the view has stayed the same for 1.5 s (at most 20 s in all: a node's
+#: endpoints are discovered after the node, later on a loaded machine): per node its publishers,
+#: subscribers, service servers and clients, action servers and clients, each ``[name, [types]]``
 PROBE = """\
     import json, sys, time
     import rclpy
@@ -213,22 +214,26 @@ PROBE = """\
     want = set(sys.argv[1:])
     rclpy.init()
     me = rclpy.create_node('_graph_probe')
-    end = time.monotonic() + 15
-    while time.monotonic() < end:
-        rclpy.spin_once(me, timeout_sec=0.1)
+
+    def view():
         nodes = [(n, ns) for n, ns in me.get_node_names_and_namespaces() if n != '_graph_probe']
-        if want <= {(ns.rstrip('/') + '/' + n) for n, ns in nodes}:
-            time.sleep(1.0)  # the endpoints after the nodes
-            rclpy.spin_once(me, timeout_sec=0.1)
-            break
-    out = {}
-    for n, ns in sorted(set(nodes)):
-        out[ns.rstrip('/') + '/' + n] = {
+        return {ns.rstrip('/') + '/' + n: {
             'pub': me.get_publisher_names_and_types_by_node(n, ns),
             'sub': me.get_subscriber_names_and_types_by_node(n, ns),
             'service_servers': me.get_service_names_and_types_by_node(n, ns),
             'service_clients': me.get_client_names_and_types_by_node(n, ns),
             'action_servers': aservers(me, n, ns), 'action_clients': aclients(me, n, ns)}
+            for n, ns in sorted(set(nodes))}
+
+    end = time.monotonic() + 20
+    out, since = view(), time.monotonic()
+    while time.monotonic() < end:
+        rclpy.spin_once(me, timeout_sec=0.1)
+        now = view()
+        if now != out:
+            out, since = now, time.monotonic()
+        elif want <= set(out) and time.monotonic() - since >= 1.5:
+            break
     print(json.dumps(out), flush=True)
     """
 
@@ -270,7 +275,7 @@ def diff(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True)
         procs.append(probe)
         ours = _read_running(env)  # rclverify's reading of the same graph, meanwhile
-        seen = json.loads(probe.communicate(timeout=30)[0] or b"{}")
+        seen = json.loads(probe.communicate(timeout=40)[0] or b"{}")
         yield {"code": code, "json": json.loads(out.read_text()), "log": log.read_text(), "domain": env["ROS_DOMAIN_ID"],
                "ros2": seen, "ours": ours}
     finally:
