@@ -70,6 +70,9 @@ def test_a_damaged_file_is_made_again(tmp_path: Path, reference, damage: str) ->
                 "not text": json.dumps([node, 1, used, script])}[damage]
         f.write_text(text)
     assert _summaries(tmp_path) == reference
+    for f in tmp_path.glob("*.json"):  # each damaged file replaced by the summary made again
+        node, formula, used, script = json.loads(f.read_text())
+        assert reference[node] is not None and reference[node].formula == formula and reference[node].script == script
 
 
 def test_an_edit_upstream_changes_every_key_downstream(tmp_path: Path) -> None:

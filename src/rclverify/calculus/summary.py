@@ -256,7 +256,7 @@ def use_directory(path: Path | None) -> None:
 def _kept(made: _Made, key: bytes, memo: Mapping[str, Summary | None]) -> Summary | None:
     """The summary of ``made`` (kept under ``key``): the kept one, else made
     (:func:`_made`) and kept when there is one.  A kept file that does not
-    read as one of ``made.node`` is made again.  ``memo``: the producers'
+    read as one of ``made.node`` is made again and replaced.  ``memo``: the producers'
     summaries, whose premises a proof that used them rests on."""
     def make() -> str | None:
         got = _made(made)
@@ -271,7 +271,10 @@ def _kept(made: _Made, key: bytes, memo: Mapping[str, Summary | None]) -> Summar
         return _summary(made, formula, used, script, memo)
     except (ValueError, TypeError, KeyError):
         got = _made(made)
-        return None if got is None else _summary(made, *got[1:], memo)
+        if got is None:
+            return None
+        _blobs.put(key, json.dumps(list(got)))  # the damaged file replaced, for the processes after this one
+        return _summary(made, *got[1:], memo)
 
 
 def _made(made: _Made) -> tuple[str, str, list[str], str] | None:

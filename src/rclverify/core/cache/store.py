@@ -226,12 +226,7 @@ class Blobs:
         try:
             made = make()
             if made is not None:
-                self._memory[k] = made
-                if self.directory is not None:
-                    try:
-                        atomic_write_bytes(self.directory / f"{k.hex()}.{self.suffix}", made.encode("utf-8"))
-                    except OSError:
-                        pass
+                self.put(k, made)
         finally:
             if claim is not None:
                 try:
@@ -239,6 +234,17 @@ class Blobs:
                 except OSError:
                     pass
         return made
+
+    def put(self, k: bytes, text: str) -> None:
+        """Keep ``text`` under ``k``, in memory and (atomically) in its file,
+        replacing what was there: an entry its reader found damaged and made
+        again.  A file that cannot be written only costs time."""
+        self._memory[k] = text
+        if self.directory is not None:
+            try:
+                atomic_write_bytes(self.directory / f"{k.hex()}.{self.suffix}", text.encode("utf-8"))
+            except OSError:
+                pass
 
     def _read(self, k: bytes) -> str | None:
         if self.directory is None:
