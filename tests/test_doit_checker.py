@@ -1,11 +1,10 @@
 """app/doit_checker.py: doit's md5 checker, each file hashed once per file state (issue 67)."""
 from __future__ import annotations
 
+import io
 import os
 import random
 from pathlib import Path
-
-import io
 
 import pytest
 from doit.dependency import MD5Checker as DoitMD5Checker

@@ -42,7 +42,10 @@ premises of its cone that Z3's unsat core used to establish it
 (:attr:`Summary.used`), and a proof's ``used`` is its own core with each
 summary replaced by those.  Everything kept is text (no Z3 object), made in
 a Z3 context of its own from text alone, so it is the same whichever node
-task of whichever process made it (incremental equals clean).  The query
+task of whichever process made it (incremental equals clean); a summary is
+also kept as a file keyed by that text (:func:`use_directory`), which the
+other doit worker and later runs read instead of making it again: the
+proof that it is implied was made when it was, by this code and this Z3.  The query
 over the summaries (:func:`decide`) is a scope of the caller's solver
 session (one node's calculus, asked in a fixed order), not a context of
 its own: a context cost as much as the query.
@@ -206,9 +209,8 @@ def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[
     axioms = _naturals(checked, m, symbol)
     decls = "".join(f"(declare-fun {quote(n)} () {s})\n" for n, s in sorted(sorts.items()))
     own = {label: (text, k) for k, (label, text, _, _, _) in enumerate(d.items)}
-    made = _Made(m, index[m], tuple(top), decls, tuple(premises), tuple(axioms), tuple(sorted(set(sorts) - set(kept))),
-                 tuple(sorted(kept.items())), tuple(sorted(sorts.items())), tuple(own.items()),
-                 tuple(keys[p] for p in top))
+    made = _Made(m, index[m], tuple(top), decls, tuple(premises), tuple(axioms), tuple(sorted(kept.items())),
+                 tuple(sorted(sorts.items())), tuple(own.items()), tuple(keys[p] for p in top))
     keys[m] = _blobs.key("summary", fingerprint(dataclasses.astuple(made)))
     return _kept(made, keys[m], memo)
 
@@ -224,7 +226,6 @@ class _Made:
     decls: str
     premises: tuple[tuple[str, str], ...]
     axioms: tuple[str, ...]
-    hidden: tuple[str, ...]
     kept: tuple[tuple[str, str], ...]
     sorts: tuple[tuple[str, str], ...]
     own: tuple[tuple[str, tuple[str, int]], ...]
@@ -258,10 +259,7 @@ def _kept(made: _Made, key: bytes, memo: Mapping[str, Summary | None]) -> Summar
     (:func:`_made`) and kept when there is one.  A kept file that does not
     read as one of ``made.node`` is made again and replaced.  ``memo``: the producers'
     summaries, whose premises a proof that used them rests on."""
-    def make() -> str | None:
-        got = _made(made)
-        return None if got is None else json.dumps(list(got))
-    text = _blobs.text(key, make, wait_s=WAIT_S)
+    text = _blobs.text(key, lambda: _text(_made(made)), wait_s=WAIT_S)
     if text is None:
         return None
     try:
@@ -273,8 +271,13 @@ def _kept(made: _Made, key: bytes, memo: Mapping[str, Summary | None]) -> Summar
         got = _made(made)
         if got is None:
             return None
-        _blobs.put(key, json.dumps(list(got)))  # the damaged file replaced, for the processes after this one
+        _blobs.put(key, _text(got))  # the damaged file replaced, for the processes after this one
         return _summary(made, *got[1:], memo)
+
+
+def _text(got: tuple[str, str, list[str], str] | None) -> str | None:
+    """What a summary's file holds (:func:`_made`'s result as JSON), ``None`` for none."""
+    return None if got is None else json.dumps(list(got))
 
 
 def _made(made: _Made) -> tuple[str, str, list[str], str] | None:
@@ -285,7 +288,8 @@ def _made(made: _Made) -> tuple[str, str, list[str], str] | None:
     m, premises, axioms, decls = made.node, made.premises, made.axioms, made.decls
     ctx = z3.Context()  # of its own: the text made depends on nothing this process did before
     try:
-        formula = eliminate(ctx, decls, [b for _, b in premises] + list(axioms), made.hidden, dict(made.sorts))
+        hidden = sorted({n for n, _ in made.sorts} - {n for n, _ in made.kept})
+        formula = eliminate(ctx, decls, [b for _, b in premises] + list(axioms), hidden, dict(made.sorts))
         used = (implied(ctx, decls, premises, axioms, formula)
                 if formula is not None and len(formula) <= MAX_TEXT else None)
     except z3.Z3Exception:

@@ -242,15 +242,18 @@ class Blobs:
         self._memory[k] = text
         if self.directory is not None:
             try:
-                atomic_write_bytes(self.directory / f"{k.hex()}.{self.suffix}", text.encode("utf-8"))
+                atomic_write_bytes(self._file(k, self.suffix), text.encode("utf-8"))
             except OSError:
                 pass
+
+    def _file(self, k: bytes, suffix: str) -> Path:
+        return self.directory / f"{k.hex()}.{suffix}"  # type: ignore[operator]
 
     def _read(self, k: bytes) -> str | None:
         if self.directory is None:
             return None
         try:
-            return (self.directory / f"{k.hex()}.{self.suffix}").read_text(encoding="utf-8")
+            return self._file(k, self.suffix).read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError):
             return None
 
@@ -259,7 +262,7 @@ class Blobs:
         ``(False, None)``: another process holds it; ``(True, None)``: no
         claim could be made for another reason (a read-only directory), so
         this process goes on without one."""
-        path = self.directory / f"{k.hex()}.claim"  # type: ignore[operator]
+        path = self._file(k, "claim")
         for attempt in (0, 1):
             try:
                 fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
@@ -284,7 +287,7 @@ class Blobs:
     def _await(self, k: bytes, wait_s: float) -> str | None:
         """The entry another process is making, once written; ``None`` when its
         claim goes without a file or ``wait_s`` seconds pass."""
-        claim = self.directory / f"{k.hex()}.claim"  # type: ignore[operator]
+        claim = self._file(k, "claim")
         deadline = time.monotonic() + wait_s
         pause = 0.0002
         while True:
