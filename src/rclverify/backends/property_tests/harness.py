@@ -28,11 +28,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator, Mapping
 
-import hypothesis
 import z3
-from hypothesis import HealthCheck, Phase, Verbosity, given, settings
-from hypothesis import strategies as st
-from hypothesis.errors import FailedHealthCheck, Unsatisfiable
+
+from rclverify.backends.property_tests.hypothesis_lib import (FailedHealthCheck, HealthCheck, Phase, Unsatisfiable,
+                                                             Verbosity, given, hypothesis, settings, st)
 
 from rclverify.semantics.concrete import check_concrete
 from rclverify.semantics.decide import decide

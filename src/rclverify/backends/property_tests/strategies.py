@@ -28,8 +28,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Callable, Iterable, Mapping, cast
 
-from hypothesis import strategies as st
-
+from rclverify.backends.property_tests.hypothesis_lib import st
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode, DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 from rclverify.semantics.values import FiniteFunction, Term

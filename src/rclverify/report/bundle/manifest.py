@@ -191,10 +191,10 @@ def tool_versions() -> dict[str, str]:
     (found and identified like the Dafny backend does), Hypothesis, Python,
     Graphviz and doit.  A tool that is absent is ``"not installed"``."""
     import doit  # deferred: start-up (loads doit only when called)
-    try:
-        import hypothesis  # deferred: optional or conditional (inside a block)
-        hyp = str(hypothesis.__version__)
-    except ImportError:
+    from importlib import metadata  # deferred: start-up (loads importlib.metadata only when called)
+    try:  # the installed distribution's version (hypothesis.__version__) without importing it
+        hyp = metadata.version("hypothesis")
+    except metadata.PackageNotFoundError:
         hyp = "not installed"
     return {"rclverify": __version__, "z3": z3.get_version_string(), "dafny": _dafny_version(),
             "hypothesis": hyp, "python": platform.python_version(), "graphviz": _dot_version(),
