@@ -46,6 +46,7 @@ def _ws(root: str, plan_file: str | None = None) -> Workspace:
     default plan otherwise).
     """
     heap.freeze_inherited()  # a doit -n worker: its inherited heap stays live (rclverify.core.cache.heap)
+    heap.executing()  # a task executes here: full collections again (rclverify.core.cache.heap)
     ws = WORKSPACES.get(root)
     if ws is None or (plan_file is not None and ws.plan_file != plan_file):
         ws = Workspace(Path(root), plan_file or "contracts/plan.yaml")
@@ -204,6 +205,7 @@ def act_deadlines(root: str) -> Any:
 def act_crosscheck(root: str, nodes: list[str]) -> Any:
     """Decide every discharging query again with cvc5 (:mod:`rclverify.stages.crosscheck.stage`, issue 50)."""
     from rclverify.stages.crosscheck.stage import stage_crosscheck  # deferred: start-up (loads rclverify.stages.crosscheck, rclverify.stages.requirements and more only when called)
+    heap.executing()  # a task executes here (the other actions: _ws)
     try:
         index = stage_crosscheck(Path(root), nodes)
     except OSError as exc:
@@ -234,6 +236,7 @@ def act_verify(root: str, strict: bool) -> Any:
     unless every item holds."""
     from rclverify.app.progress import PlainFailure  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
     from rclverify.report.summary import print_last_run, strict_sentence  # deferred: start-up (loads rclverify.report, rclverify.report.summary only when called)
+    heap.executing()  # a task executes here (the other actions: _ws)
     try:
         data = print_last_run(Path(root))
     except RclError as exc:  # the last run's summary is missing or of another shape: one located line
