@@ -91,7 +91,8 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     run when it had 5000 tasks (docs/scale.md).  A workspace that switches store runs
     every task once, as doit knows no earlier state in the new file.  The
     file checker is doit's md5 checker with one md5 per file state and
-    process (:mod:`rclverify.app.doit_checker`).
+    process (:mod:`rclverify.app.doit_checker`); the store's codec writes
+    doit's JSON and reads it with msgspec (:mod:`rclverify.app.doit_codec`).
 
     ``num_process``: the processes of a run without ``-n``
     (:func:`rclverify.app.jobs.default_jobs`: this machine's CPUs, at most
@@ -101,6 +102,7 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     does for its faults."""
     from rclverify.app.progress import ProgressReporter  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
     from rclverify.app.doit_checker import MD5Checker  # deferred: start-up (loads doit.dependency only when called)
+    from rclverify.app.doit_codec import StateCodec  # deferred: start-up (loads msgspec only when called)
     from rclverify.app.jobs import JobsError, default_jobs, doit_num_process  # deferred: start-up (loads multiprocessing only when called)
     try:
         jobs = default_jobs()
@@ -108,7 +110,8 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
         print(f"error: {exc}", file=sys.stderr)
         raise SystemExit(1) from None
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
-            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "num_process": doit_num_process(jobs)}
+            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "codec_cls": StateCodec,
+            "num_process": doit_num_process(jobs)}
 
 
 def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
