@@ -59,18 +59,21 @@ def test_only_a_forked_worker_freezes_its_inherited_heap() -> None:
 
 
 def test_a_run_makes_no_full_collection_until_a_task_executes_here() -> None:
-    """freeze_for_run: full collections off (the third threshold), young ones as before;
-    executing() or release_after_run() gives back the thresholds as they were."""
+    """no_full_collections: full collections off (the third threshold), young ones as before;
+    executing() or release_after_run() gives back the thresholds as they were.  Freezing the
+    heap alone (build_tasks, which a process may call without running doit) leaves them."""
     heap.release_after_run()
     before = gc.get_threshold()
     heap.freeze_for_run()
     try:
+        assert gc.get_threshold() == before
+        heap.no_full_collections()
         assert gc.get_threshold() == (before[0], before[1], heap.NO_FULL)
         heap.executing()
         assert gc.get_threshold() == before
         heap.executing()  # twice: nothing more
         assert gc.get_threshold() == before
-        heap.freeze_for_run()
+        heap.no_full_collections()
         heap.release_after_run()
         assert gc.get_threshold() == before
     finally:
@@ -88,6 +91,7 @@ def test_a_forked_worker_collects_fully_once_it_executes() -> None:
     heap.release_after_run()
     before = gc.get_threshold()
     heap.freeze_for_run()
+    heap.no_full_collections()
     try:
         ctx = multiprocessing.get_context("fork")
         queue: "multiprocessing.Queue[tuple[int, int, int]]" = ctx.Queue()

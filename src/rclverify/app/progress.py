@@ -150,9 +150,11 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
     def initialize(self, tasks: Mapping[str, Any], selected_tasks: Any) -> None:
         """Remember doit's task table (it grows when delayed tasks are created),
         and freeze doit's task objects for the run with the workspace
-        (:func:`rclverify.core.cache.heap.freeze_for_run`)."""
-        from rclverify.core.cache.heap import freeze_for_run  # deferred: start-up (loads rclverify.core, rclverify.core.cache and more only when called)
+        (:func:`rclverify.core.cache.heap.freeze_for_run`), with no full
+        collection until a task executes here (:func:`~rclverify.core.cache.heap.no_full_collections`)."""
+        from rclverify.core.cache.heap import freeze_for_run, no_full_collections  # deferred: start-up (loads rclverify.core, rclverify.core.cache and more only when called)
         freeze_for_run()
+        no_full_collections()  # until a task executes in this process, or the run ends (complete_run)
         self.tasks = tasks
         if self.live_mode:
             from rich.console import Console  # deferred: optional or conditional (inside a block)

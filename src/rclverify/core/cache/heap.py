@@ -19,9 +19,9 @@ objects that cannot be garbage yet:
   collector's permanent generation (``gc.freeze``) for the run, and
   :func:`release_after_run` gives it back when doit completes the run (a
   test session that runs doit in-process gets its objects back);
-* :func:`freeze_for_run` also turns the process's full collections off
-  until a task executes in it (:func:`executing`, called by every task
-  action): a process that only dispatches (the main one of ``doit -n 2``,
+* :func:`no_full_collections` -- a run's reporter turns the process's full
+  collections off until a task executes in it (:func:`executing`, called by
+  every task action) or the run ends: a process that only dispatches (the main one of ``doit -n 2``,
   and any no-op run) makes doit's task objects, checks their state and
   keeps both to the end, so a full collection there walks only what is
   live.  A no-op run of a 1000-node system made two, 60 and 87 ms, and
@@ -86,28 +86,35 @@ def freeze_for_live() -> None:
 def freeze_for_run() -> None:
     """Freeze the heap of a process about to run doit's tasks (the loaded
     workspace and the task definitions), until :func:`release_after_run`;
-    no full collection of this process until it executes a task
-    (:func:`executing`); and :func:`keep_freed_memory`."""
+    and :func:`keep_freed_memory`."""
     gc.freeze()
     _RUN[:] = [True]
+    keep_freed_memory()
+
+
+def no_full_collections() -> None:
+    """A doit run starts in this process (its reporter's ``initialize``): no
+    full collection here until a task executes in it (:func:`executing`) or
+    the run ends (:func:`release_after_run`, the reporter's ``complete_run``).
+    Only a run that will end calls it: a process that defines the tasks
+    without running them (``doit list``, a test) keeps its collector as it was."""
     if not _THRESHOLD:
         _THRESHOLD[:] = [gc.get_threshold()]
         young, middle, _old = _THRESHOLD[0]
         gc.set_threshold(young, middle, NO_FULL)
-    keep_freed_memory()
 
 
-#: The collector's third threshold while a run's process only dispatches (:func:`freeze_for_run`): the
+#: The collector's third threshold while a run's process only dispatches (:func:`no_full_collections`): the
 #: number of middle-generation collections before a full one, larger than any run makes.
 NO_FULL = 1 << 30
-#: The thresholds :func:`freeze_for_run` replaced, until :func:`executing` or :func:`release_after_run`.
+#: The thresholds :func:`no_full_collections` replaced, until :func:`executing` or :func:`release_after_run`.
 _THRESHOLD: list[tuple[int, int, int]] = []
 
 
 def executing() -> None:
     """A task of the run is about to execute in this process (the main one of
     a serial run, or a ``doit -n`` worker forked from it): full collections
-    as before :func:`freeze_for_run`, since a task's work may leave cycles
+    as before :func:`no_full_collections`, since a task's work may leave cycles
     behind.  Nothing when they were never turned off."""
     if _THRESHOLD:
         gc.set_threshold(*_THRESHOLD[0])
@@ -147,7 +154,8 @@ def keep_freed_memory() -> bool:
 
 def release_after_run() -> None:
     """Give the heap frozen by :func:`freeze_for_run` back to the collector
-    (nothing when none was frozen)."""
+    (nothing when none was frozen), and full collections as they were
+    (:func:`no_full_collections`)."""
     executing()
     if _RUN:
         _RUN.clear()
