@@ -334,3 +334,34 @@ def test_houdinis_budget_is_steps_the_same_on_any_load() -> None:
     assert not isinstance(again, str) and [c[0] for c in again] == [c[0] for c in ample]
     tiny = generate(ts, prop, 5_000, 0.001)  # two steps for all the queries together
     assert tiny == "the step budget of invariant generation was spent"
+
+
+def _fill_context(n: int) -> None:
+    """Earlier work in the caller's context: terms and decided queries that have nothing to do with the system."""
+    s = z3.Solver()
+    xs = [z3.Int(f"junk{k}") for k in range(n)]
+    for k in range(0, n - 2, 3):
+        s.add(xs[k] + 2 * xs[k + 1] <= xs[k + 2] * 3 + k)
+        s.check()
+
+
+def test_spacer_answers_the_same_whatever_the_context_held_before() -> None:
+    """Spacer works in a context of its own (calculus/requirements/pdr.py): the certificate it gives
+    after the caller's context was filled by other work is the one it gives in a fresh world."""
+    rng = __import__("random").Random(7)
+    certificates = []
+    for _ in range(12):
+        init = set(rng.sample(STATES, 2))
+        succ = {s: set(rng.sample(STATES, rng.randrange(3))) for s in STATES}
+        reach = _reachable(init, succ)
+        bad = set(rng.sample([s for s in STATES if s not in reach] or STATES, 1))
+        answers = []
+        for filled in (False, True):
+            fresh()
+            if filled:
+                _fill_context(600)
+            ts = _system(init, succ)
+            ans = spacer_invariant(ts, lambda s: z3.Not(z3.Or(*[_is(s, b) for b in bad])), 5_000)
+            answers.append((ans.status, None if ans.invariant is None else ans.invariant.sexpr()))
+        certificates.append(answers)
+    assert all(a == b for a, b in certificates), [c for c in certificates if c[0] != c[1]]

@@ -17,6 +17,15 @@ answers ``sat`` with an interpretation of ``Inv``, ``unsat`` when no
 invariant exists (a run reaches ``not prop``), or ``unknown`` (time limit,
 a theory it does not handle: then nothing is concluded).
 
+Spacer works in a Z3 context of its own: the clauses are translated into a
+new context, and the interpretation back into the caller's.  Its search
+depended on what the caller's context held before: in a context that
+earlier queries had filled, it spent its whole budget on a system whose one
+reachable state has no successor, which it proves at once in a fresh
+context (tests/test_temporal_pdr.py).  A requirement's decision asks
+k-induction, the hint and Houdini first, in the caller's context; they no
+longer change what Spacer answers.
+
 The interpretation is a **certificate**, never trusted as it comes:
 :func:`recheck` asks a plain Z3 solver the three conditions again on it
 (each ``unsat`` needed), and only a certificate that passes proves the
@@ -117,22 +126,24 @@ def spacer_invariant(ts: TransitionSystem, prop: Pred, timeout_ms: int) -> HornA
     a, b = named_state(ts), named_state(ts, prime=True)
     if not names:  # a property of no variable: the clauses over every variable (a relation needs one)
         names, init, trans = list(ts.sorts), [ts.init(a)], [ts.trans(a, b)]
-    rel = z3.Function("Inv", *[ts.sorts[n] for n in names], z3.BoolSort())
-
-    def inv(s: dict[str, z3.ExprRef]) -> z3.BoolRef:
-        return rel(*[s[n] for n in names])
-    av, bv = [a[n] for n in names], [b[n] for n in names]
+    home = a[names[0]].ctx
+    own = z3.Context()  # Spacer's own (module docstring)
+    rel = z3.Function("Inv", *[ts.sorts[n].translate(own) for n in names], z3.BoolSort(own))
+    av, bv = [a[n].translate(own) for n in names], [b[n].translate(own) for n in names]
+    init_own = [f.translate(own) for f in init]
+    trans_own = [f.translate(own) for f in trans]
+    bad_own = z3.Not(prop(a)).translate(own)
     t0 = time.perf_counter()
     try:
-        h = z3.SolverFor("HORN")
+        h = z3.SolverFor("HORN", ctx=own)
         wallclock.limit(h, timeout_ms)  # steps decide, the clock is a net (issue 67)
-        h.add(z3.ForAll(av, z3.Implies(conj(*init), inv(a))))
-        h.add(z3.ForAll(av + bv, z3.Implies(conj(inv(a), *trans), inv(b))))
-        h.add(z3.ForAll(av, z3.Implies(conj(inv(a), z3.Not(prop(a))), z3.BoolVal(False))))
+        h.add(z3.ForAll(av, z3.Implies(conj(*init_own) if init_own else z3.BoolVal(True, own), rel(*av))))
+        h.add(z3.ForAll(av + bv, z3.Implies(conj(rel(*av), *trans_own), rel(*bv))))
+        h.add(z3.ForAll(av, z3.Implies(conj(rel(*av), bad_own), z3.BoolVal(False, own))))
         r = h.check()
         took = time.perf_counter() - t0
         if r == z3.sat:
-            return HornAnswer("invariant", invariant=_interpretation(h.model(), rel, av), seconds=took)
+            return HornAnswer("invariant", invariant=_interpretation(h.model(), rel, av).translate(home), seconds=took)
         if r == z3.unsat:
             return HornAnswer("reachable", seconds=took)
         return HornAnswer("unknown", reason=(h.reason_unknown().strip().splitlines() or ["unknown"])[0].rstrip(": "),
@@ -150,7 +161,7 @@ def _interpretation(m: z3.ModelRef, rel: z3.FuncDeclRef, args: list[z3.ExprRef])
     ``True`` for such an interpretation, which :func:`recheck` caught)."""
     fi = m[rel]
     if fi is None:  # Spacer left it unconstrained: any relation will do, the weakest is checked
-        return z3.BoolVal(True)
+        return z3.BoolVal(True, rel.ctx)
     body = z3.substitute_vars(fi.else_value(), *args)
     for k in range(fi.num_entries()):
         e = fi.entry(k)
