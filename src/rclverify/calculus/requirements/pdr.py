@@ -126,13 +126,13 @@ def spacer_invariant(ts: TransitionSystem, prop: Pred, timeout_ms: int) -> HornA
     a, b = named_state(ts), named_state(ts, prime=True)
     if not names:  # a property of no variable: the clauses over every variable (a relation needs one)
         names, init, trans = list(ts.sorts), [ts.init(a)], [ts.trans(a, b)]
-    home = a[names[0]].ctx
-    own = z3.Context()  # Spacer's own (module docstring)
+    bad = z3.Not(prop(a))
+    home, own = bad.ctx, z3.Context()  # the caller's context, and Spacer's own (module docstring)
     rel = z3.Function("Inv", *[ts.sorts[n].translate(own) for n in names], z3.BoolSort(own))
     av, bv = [a[n].translate(own) for n in names], [b[n].translate(own) for n in names]
     init_own = [f.translate(own) for f in init]
     trans_own = [f.translate(own) for f in trans]
-    bad_own = z3.Not(prop(a)).translate(own)
+    bad_own = bad.translate(own)
     t0 = time.perf_counter()
     try:
         h = z3.SolverFor("HORN", ctx=own)
