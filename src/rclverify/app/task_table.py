@@ -322,7 +322,8 @@ class TaskTable:
         # themselves, not only the snapshots they give. An edit that changes none of the snapshots (a comment
         # after the last node) left the report naming the old files' sha256, and the bundle then refused a
         # report `doit verify` called up to date.
-        deps += [d for d in (at(f) for f in check_input_files(ws)) if d not in deps and os.path.isfile(d)]
+        have = set(deps)  # a set: the list holds a snapshot per node (quadratic at 5000 nodes, 0.2 s a run)
+        deps += [d for d in (at(f) for f in check_input_files(ws)) if d not in have and os.path.isfile(d)]
         for n in self.nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in self.exported()]
