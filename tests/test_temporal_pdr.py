@@ -11,6 +11,7 @@ one-node planner whose cycle counter has a defensive branch no run takes
 from __future__ import annotations
 
 import json
+import random
 import shutil
 from pathlib import Path
 
@@ -348,7 +349,7 @@ def _fill_context(n: int) -> None:
 def test_spacer_answers_the_same_whatever_the_context_held_before() -> None:
     """Spacer works in a context of its own (calculus/requirements/pdr.py): the certificate it gives
     after the caller's context was filled by other work is the one it gives in a fresh world."""
-    rng = __import__("random").Random(7)
+    rng = random.Random(7)
     certificates = []
     for _ in range(12):
         init = set(rng.sample(STATES, 2))
