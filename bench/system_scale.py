@@ -59,6 +59,7 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from _scratch import describe  # noqa: E402
 from pipeline_scale import CLAMP, DODO, doit_verify, evidence, has_property_tests, topology  # noqa: E402
 
 #: Service calls and deadline requirements: every how many nodes (defaults).
@@ -219,6 +220,7 @@ def main(argv: Sequence[str] | None = None) -> int:
           f"{args.property_tests}th")
     header = (f"{'nodes':>6} {'svc':>4} {'ddl':>4} {'mode':>9} {'cold s':>7} {'(cpu)':>7} {'wrk cpu':>7} {'MB':>5} "
               f"{'no-op s':>7} {'ran':>3} {'copy MB':>7}  verdicts")
+    print(describe(base))
     print(header)
     print("-" * len(header))
     try:
@@ -249,8 +251,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                     print(f"{n:>6}  the verdicts differ from the local run's: {seen}")
                     return 1
                 seen = got
-                if not args.keep:
-                    shutil.rmtree(root, ignore_errors=True)
+                # kept until the bench ends: a run timed right after deleting the last one's ~27 files a node
+                # would pay for that deletion on some file systems (bench/_scratch.py)
     finally:
         if not args.keep:
             shutil.rmtree(base, ignore_errors=True)

@@ -61,7 +61,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
@@ -69,6 +69,8 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "bench"))
 
 from _chain import write_chain  # noqa: E402
+from _scratch import describe, scratch  # noqa: E402
+from compose_pacti import pacti_chain  # noqa: E402
 
 BOUND = 1000
 #: The child process: runs its arguments and prints their CPU seconds (with their children).
@@ -168,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
                    help="also run `rclverify verify -n J` (J doit processes) and print its CPU and wall clock")
     args = p.parse_args(argv)
     args.floor = args.floor or args.smoke  # the what-if patches name internals: CI keeps them working
-    from compose_pacti import _pacti, pacti_chain
+    from compose_pacti import _pacti
     pc = _pacti()
     for tree in [ROOT / "src"] + ([Path(args.src)] if args.src else []):
         # byte-compiled first: where PYTHONDONTWRITEBYTECODE is set, a tree without its .pyc files compiles every
@@ -176,6 +178,7 @@ def main(argv: list[str] | None = None) -> int:
         compileall.compile_dir(str(tree), quiet=1)
     sizes = [5] if args.smoke else [int(x) for x in args.sizes.split(",")]
     print(f"CPU seconds, medians of {args.repeat}; {os.cpu_count()} CPU(s); chain with every x_i <= {BOUND}")
+    print(describe(Path(tempfile.gettempdir())))
     head = f"{'N':>5} {'verify s':>9} {'wall s':>7} {'cvc5 s':>7} {'local':>5} {'ctx':>5} {'summ':>5} {'SYS':>8}"
     head += f" {'old s':>8}" if args.src else ""
     head += f" {'calc s':>7}" + (f" {'calc full':>9}" if args.full else "")
@@ -184,49 +187,59 @@ def main(argv: list[str] | None = None) -> int:
     head += f" {'pacti s':>8} {'ratio':>6} {'wall/p':>6}" + (f" {'-n/p':>6}" if args.jobs > 1 else "")
     print(head)
     ok, rows = True, []
-    for n in sizes:
-        runs, old, calc, full, pac, noctx, bare, par = [], [], [], [], [], [], [], []
-        for _ in range(args.repeat):
-            with tempfile.TemporaryDirectory() as d:
-                runs.append(verify(workspace(Path(d) / "ws", n), ROOT / "src"))
-                if args.src:
-                    old.append(verify(workspace(Path(d) / "old", n), Path(args.src))["cpu"])
-                if args.jobs > 1:
-                    par.append(verify(workspace(Path(d) / "par", n), ROOT / "src", args.jobs))
-                calc.append(calculus(Path(d) / "ws", True))
-                if args.full:
-                    full.append(calculus(Path(d) / "ws", False))
-                if args.floor:
-                    noctx.append(whatif(workspace(Path(d) / "noctx", n), "ctx"))
-                    bare.append(whatif(workspace(Path(d) / "bare", n), "ctx,cvc5"))
-            if pc is not None:
-                r = pacti_chain(pc, n, None, BOUND)
-                ok = ok and r["first"] is None
-                pac.append(r["seconds"])
-        r = runs[0]
-        ok = ok and all(x["rc"] == 0 and x["other"] == 0 and x["context"] == n - 1 and x["SYS"].startswith("proved")
-                        for x in runs[:1] + par[:1])
-        row = {"n": n, "verify": statistics.median(x["cpu"] for x in runs), "calc": statistics.median(calc),
-               "wall": statistics.median(x["wall"] for x in runs),
-               "old": statistics.median(old) if old else None, "full": statistics.median(full) if full else None,
-               "pacti": statistics.median(pac) if pac else None,
-               "noctx": statistics.median(noctx) if noctx else None, "bare": statistics.median(bare) if bare else None,
-               "par": statistics.median(x["cpu"] for x in par) if par else None,
-               "parwall": statistics.median(x["wall"] for x in par) if par else None}
-        rows.append(row)
-        line = f"{n:5} {row['verify']:9.2f} {row['wall']:7.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
-        line += f" {row['old']:8.2f}" if args.src else ""
-        line += f" {row['calc']:7.2f}" + (f" {row['full']:9.2f}" if args.full else "")
-        line += f" {row['noctx']:7.2f} {row['bare']:11.2f}" if args.floor else ""
-        line += f" {row['par']:7.2f} {row['parwall']:8.2f}" if par else ""
-        line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f} {row['wall'] / row['pacti']:6.2f}"
-                 + (f" {row['parwall'] / row['pacti']:6.2f}" if par else "") if row["pacti"] else "  (Pacti not installed)")
-        print(line, flush=True)
+    with scratch() as folders:
+        for n in sizes:
+            ok = _size(args, pc, n, folders, rows) and ok
     for a, b in zip(rows, rows[1:]):
         growth = {k: b[k] / a[k] for k in ("verify", "old", "calc", "full", "noctx", "bare", "pacti")
                   if a.get(k) and b.get(k)}
         print(f"growth {a['n']} -> {b['n']}: " + ", ".join(f"{k} {v:.2f}x" for k, v in growth.items()))
     return 0 if ok else 1
+
+
+def _size(args: argparse.Namespace, pc: Any, n: int, folders: Iterator[Path], rows: list[dict[str, Any]]) -> bool:
+    """Time every figure of one chain length ``n`` (each run in a new folder of ``folders``, none deleted
+    before the bench ends: bench/_scratch.py), print its row and append it to ``rows``; ``False`` when a
+    verdict is wrong."""
+    ok = True
+    runs, old, calc, full, pac, noctx, bare, par = [], [], [], [], [], [], [], []
+    for _ in range(args.repeat):
+        d = next(folders)
+        runs.append(verify(workspace(d / "ws", n), ROOT / "src"))
+        if args.src:
+            old.append(verify(workspace(d / "old", n), Path(args.src))["cpu"])
+        if args.jobs > 1:
+            par.append(verify(workspace(d / "par", n), ROOT / "src", args.jobs))
+        calc.append(calculus(d / "ws", True))
+        if args.full:
+            full.append(calculus(d / "ws", False))
+        if args.floor:
+            noctx.append(whatif(workspace(d / "noctx", n), "ctx"))
+            bare.append(whatif(workspace(d / "bare", n), "ctx,cvc5"))
+        if pc is not None:
+            r = pacti_chain(pc, n, None, BOUND)
+            ok = ok and r["first"] is None
+            pac.append(r["seconds"])
+    r = runs[0]
+    ok = ok and all(x["rc"] == 0 and x["other"] == 0 and x["context"] == n - 1 and x["SYS"].startswith("proved")
+                    for x in runs[:1] + par[:1])
+    row = {"n": n, "verify": statistics.median(x["cpu"] for x in runs), "calc": statistics.median(calc),
+           "wall": statistics.median(x["wall"] for x in runs),
+           "old": statistics.median(old) if old else None, "full": statistics.median(full) if full else None,
+           "pacti": statistics.median(pac) if pac else None,
+           "noctx": statistics.median(noctx) if noctx else None, "bare": statistics.median(bare) if bare else None,
+           "par": statistics.median(x["cpu"] for x in par) if par else None,
+           "parwall": statistics.median(x["wall"] for x in par) if par else None}
+    rows.append(row)
+    line = f"{n:5} {row['verify']:9.2f} {row['wall']:7.2f} {r['cvc5']:7.2f} {r['local']:5} {r['context']:5} {r['summaries']:5} {r['SYS'].split(',')[0]:>8}"
+    line += f" {row['old']:8.2f}" if args.src else ""
+    line += f" {row['calc']:7.2f}" + (f" {row['full']:9.2f}" if args.full else "")
+    line += f" {row['noctx']:7.2f} {row['bare']:11.2f}" if args.floor else ""
+    line += f" {row['par']:7.2f} {row['parwall']:8.2f}" if par else ""
+    line += (f" {row['pacti']:8.2f} {row['verify'] / row['pacti']:6.2f} {row['wall'] / row['pacti']:6.2f}"
+             + (f" {row['parwall'] / row['pacti']:6.2f}" if par else "") if row["pacti"] else "  (Pacti not installed)")
+    print(line, flush=True)
+    return ok
 
 
 if __name__ == "__main__":
