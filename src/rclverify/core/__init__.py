@@ -3,5 +3,6 @@
 ``faults`` (machine faults worded as one line), ``atomic`` (atomic file
 writes, deterministic JSON), ``runlock`` (one run of a workspace at a
 time), ``cache/`` (everything kept between runs: one keying function, one
-file format).  Imports only the standard library and third-party packages.
+file format), ``numeric`` (numpy and scipy loaded with one OpenBLAS
+thread).  Imports only the standard library and third-party packages.
 """

@@ -50,8 +50,8 @@ def upper_bound(k: int, n: int, level: float) -> float:
         return 1.0
     if k == 0:  # closed form, exact in floating point where beta.ppf rounds
         return 1.0 - math.pow(1.0 - level, 1.0 / n)
-    from scipy.special import betaincinv  # here, not at import: scipy costs every plan load 0.3 s (issue 67)
-    return float(betaincinv(k + 1, n - k, level))  # Beta(k+1, n-k)'s quantile at level
+    from rclverify.core.numeric import scipy_special  # here, not at import: scipy costs every plan load 0.3 s (issue 67)
+    return float(scipy_special().betaincinv(k + 1, n - k, level))  # Beta(k+1, n-k)'s quantile at level
 
 
 def lower_bound(k: int, n: int, level: float) -> float:
@@ -61,8 +61,8 @@ def lower_bound(k: int, n: int, level: float) -> float:
         return 0.0
     if k >= n:
         return math.pow(1.0 - level, 1.0 / n)
-    from scipy.special import betaincinv  # deferred: start-up (loads scipy only when called)
-    return float(betaincinv(k, n - k + 1, 1.0 - level))  # Beta(k, n-k+1)'s quantile at 1 - level
+    from rclverify.core.numeric import scipy_special  # deferred: start-up (loads numpy and scipy only when called)
+    return float(scipy_special().betaincinv(k, n - k + 1, 1.0 - level))  # Beta(k, n-k+1)'s quantile at 1 - level
 
 
 def runs_needed(k: int, n: int, target: float, level: float) -> int | None:

@@ -38,7 +38,7 @@ from itertools import islice
 from pathlib import Path
 from typing import Any, Iterator, Mapping, Sequence
 
-import numpy as np
+from rclverify.core.numeric import np
 
 from rclverify.traces.bag import bag_event, open_bag, read_bag, typestore
 from rclverify.traces.bag_open import counted_open_error, open_uncounted

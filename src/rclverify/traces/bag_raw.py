@@ -49,7 +49,7 @@ from itertools import islice
 from operator import itemgetter
 from typing import Any, Iterator, Sequence
 
-import numpy as np
+from rclverify.core.numeric import np
 
 _EMPTY = np.zeros(0, dtype=np.int64)
 _FIRST, _SECOND, _THIRD = itemgetter(0), itemgetter(1), itemgetter(2)

@@ -59,7 +59,7 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence, Union
 
 import msgspec
-import numpy as np
+from rclverify.core.numeric import np
 
 from rclverify.traces.events import FLAT_STAMPS, Event, taken
 from rclverify.traces.jsonl import line_event, read_jsonl, read_lines

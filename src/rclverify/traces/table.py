@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from typing import Any, Iterator, Mapping, Sequence
 
-import numpy as np
+from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event
 

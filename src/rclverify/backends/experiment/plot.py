@@ -15,6 +15,8 @@ from rclverify.backends.experiment.figures import BASE, Figures, Quantity
 def render_svg(fig: Figures, constants: Mapping[str, Quantity], title: str) -> str:
     """The SVG text: per-trial values (or, for a summary, best/mean +- std/worst)
     with a horizontal line for every constant of the measured dimension."""
+    from rclverify.core.numeric import import_numpy  # deferred: start-up (numpy, matplotlib's, with one BLAS thread)
+    import_numpy()
     import matplotlib  # deferred: start-up (loads matplotlib only when called)
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # deferred: start-up (loads matplotlib and more only when called)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Any, Iterator
 
-import numpy as np
+from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question

@@ -39,7 +39,7 @@ import gc
 from itertools import repeat
 from typing import Any, Callable, Iterable, Mapping
 
-import numpy as np
+from rclverify.core.numeric import np
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode

@@ -38,7 +38,7 @@ from itertools import repeat
 from operator import is_, itemgetter
 from typing import Any, Callable, Mapping
 
-import numpy as np
+from rclverify.core.numeric import np
 
 from rclverify.lang import ast
 from rclverify.lang import types as T

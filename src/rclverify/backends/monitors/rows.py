@@ -19,7 +19,7 @@ from itertools import repeat
 from operator import attrgetter, is_
 from typing import Any, Iterable, Iterator, Mapping, Sequence
 
-import numpy as np
+from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event, taken
 from rclverify.backends.monitors.columns import column, field_values

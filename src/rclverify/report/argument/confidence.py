@@ -152,7 +152,7 @@ def _vector_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str,
     Python's ``sum`` as the per-node path sums them; its limit is the
     greatest ``(doubt, label)`` of its nodes' own, found as the highest
     rank of the nodes' tops sorted once."""
-    import numpy as np  # deferred: optional or conditional (large systems only: VECTOR_FROM)
+    from rclverify.core.numeric import np  # deferred: optional or conditional (large systems only: VECTOR_FROM)
     nodes = sorted(set(producers) | {p for ps in producers.values() for p in ps})
     rank = {m: i for i, m in enumerate(nodes)}
     bits = upstream_bits(nodes, {m: list(producers.get(m, ())) for m in nodes})

@@ -1,0 +1,64 @@
+"""numpy and scipy, loaded with one OpenBLAS thread.
+
+numpy's wheel and scipy's each bundle OpenBLAS, which starts one thread
+per CPU when the library loads; the extra threads busy-wait for work
+before they sleep.  rclverify's arrays are elementwise (monitor columns,
+trace blocks, the statistics of recorded runs) and make no BLAS call, so
+those threads only spend CPU.  Measured on a 2-core machine (CPU seconds
+of a process that only imports): ``import numpy`` 0.33 -> 0.24, ``from
+scipy.special import betaincinv`` 0.70 -> 0.51 (docs/scale.md, round
+sixteen).
+
+OpenBLAS reads ``OPENBLAS_NUM_THREADS`` once, when it loads (OpenBLAS's
+documentation, "Setting the number of threads using environment
+variables").  The variable is set to ``1`` only while :func:`import_numpy`
+or :func:`scipy_special` imports, and removed afterwards, so every process
+rclverify starts (the user's nodes, property-test processes) inherits the
+environment the user gave it.  A value the user set is kept, and a numpy
+loaded before rclverify's first import keeps its threads.  rclverify
+imports numpy and scipy through this module only
+(``tests/test_numeric.py``).
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+from types import ModuleType
+from typing import Iterator
+
+#: The variable OpenBLAS reads when it loads.
+VARIABLE = "OPENBLAS_NUM_THREADS"
+
+
+@contextlib.contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """While the block runs, ``OPENBLAS_NUM_THREADS=1`` unless the user set
+    it; afterwards the environment is as before.  Never raises by itself."""
+    if VARIABLE in os.environ:
+        yield
+        return
+    os.environ[VARIABLE] = "1"
+    try:
+        yield
+    finally:
+        os.environ.pop(VARIABLE, None)
+
+
+def import_numpy() -> ModuleType:
+    """The ``numpy`` module, its OpenBLAS loaded with one thread (see the
+    module's docstring).  Raises ``ImportError`` when numpy is missing."""
+    with one_blas_thread():
+        import numpy  # deferred: only here, inside the variable's scope
+    return numpy
+
+
+def scipy_special() -> ModuleType:
+    """The ``scipy.special`` module, numpy's and scipy's OpenBLAS loaded
+    with one thread.  Raises ``ImportError`` when scipy is missing."""
+    import_numpy()
+    with one_blas_thread():
+        import scipy.special  # deferred: 0.3 s, only where a statistic is computed
+    return scipy.special
+
+
+np = import_numpy()
