@@ -162,9 +162,14 @@ class Cluster:
             if self.isolated:  # the worker processes inherit it: they never run a job in the workspace's folder
                 os.environ["RCLVERIFY_CLUSTER_ISOLATED"] = "1"
             extra = {"local_directory": str(self.folder)} if self.folder is not None else {}
+            given = dict(os.environ)
             self.cluster = distributed.LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
                                                     dashboard_address=None, host="127.0.0.1", protocol="tcp://",
                                                     **extra)
+            # Dask's nanny writes its workers' environment (OMP_NUM_THREADS, MALLOC_TRIM_THRESHOLD_,
+            # PYTHONHASHSEED, ...) into this process's: the doit runs timed next must not inherit it
+            os.environ.clear()
+            os.environ.update(given)
             os.environ.pop("RCLVERIFY_CLUSTER_ISOLATED", None)
             self.client = distributed.Client(self.cluster)
             os.environ["RCLVERIFY_CLUSTER"] = self.cluster.scheduler_address

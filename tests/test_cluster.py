@@ -99,6 +99,18 @@ def distributed() -> Any:
     return pytest.importorskip("dask.distributed")
 
 
+@pytest.fixture(autouse=True)
+def _environment_given_back() -> Any:
+    """Each test's process environment restored after it: Dask's nanny writes its workers' environment
+    (``OMP_NUM_THREADS=1``, ``OPENBLAS_NUM_THREADS=1``, ``MALLOC_TRIM_THRESHOLD_``, ``PYTHONHASHSEED``)
+    into the process that starts a ``LocalCluster``, and the tests the same pytest worker runs later,
+    and the processes they start, would inherit it."""
+    given = dict(os.environ)
+    yield
+    os.environ.clear()
+    os.environ.update(given)
+
+
 @pytest.fixture(scope="module")
 def local(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The workspace verified without a cluster, once for the module: the two cluster tests compare their

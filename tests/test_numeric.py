@@ -24,7 +24,8 @@ print(json.dumps({{"threads": len(os.listdir("/proc/self/task")), "env": os.envi
 
 
 def _probe(body: str, **env: str) -> dict:
-    full = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    # OpenBLAS also reads GOTO_NUM_THREADS and OMP_NUM_THREADS when its own variable is not set
+    full = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")}
     full.update(env)
     out = subprocess.run([sys.executable, "-c", PROBE.format(body=body)], capture_output=True, text=True,
                          env=full, timeout=120, check=True).stdout
