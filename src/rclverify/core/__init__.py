@@ -4,5 +4,5 @@
 writes, deterministic JSON), ``runlock`` (one run of a workspace at a
 time), ``cache/`` (everything kept between runs: one keying function, one
 file format), ``numeric`` (numpy and scipy loaded with one OpenBLAS
-thread).  Imports only the standard library and third-party packages.
+thread), ``environ`` (a variable set only while a library imports).  Imports only the standard library and third-party packages.
 """

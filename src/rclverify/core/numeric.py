@@ -21,27 +21,19 @@ imports numpy and scipy through this module only
 """
 from __future__ import annotations
 
-import contextlib
-import os
+from contextlib import AbstractContextManager
 from types import ModuleType
-from typing import Iterator
+
+from rclverify.core.environ import variable_during
 
 #: The variable OpenBLAS reads when it loads.
 VARIABLE = "OPENBLAS_NUM_THREADS"
 
 
-@contextlib.contextmanager
-def one_blas_thread() -> Iterator[None]:
+def one_blas_thread() -> AbstractContextManager[None]:
     """While the block runs, ``OPENBLAS_NUM_THREADS=1`` unless the user set
-    it; afterwards the environment is as before.  Never raises by itself."""
-    if VARIABLE in os.environ:
-        yield
-        return
-    os.environ[VARIABLE] = "1"
-    try:
-        yield
-    finally:
-        os.environ.pop(VARIABLE, None)
+    it; afterwards the environment is as before (:mod:`.environ`)."""
+    return variable_during(VARIABLE, "1", override=False)
 
 
 def import_numpy() -> ModuleType:

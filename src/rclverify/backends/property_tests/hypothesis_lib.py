@@ -21,21 +21,13 @@ Hypothesis in rclverify goes through this module (tests/test_property_tests_plug
 """
 from __future__ import annotations
 
-import os
+from rclverify.core.environ import variable_during
 
-_KEY = "HYPOTHESIS_NO_PLUGINS"
-_before = os.environ.get(_KEY)
-os.environ[_KEY] = "1"
-try:
+with variable_during("HYPOTHESIS_NO_PLUGINS", "1", override=True):
     import hypothesis
     from hypothesis import HealthCheck, Phase, Verbosity, given, settings
     from hypothesis import strategies as st
     from hypothesis.errors import FailedHealthCheck, Unsatisfiable
-finally:
-    if _before is None:
-        os.environ.pop(_KEY, None)
-    else:
-        os.environ[_KEY] = _before
 
 __all__ = ["hypothesis", "HealthCheck", "Phase", "Verbosity", "given", "settings", "st", "FailedHealthCheck",
            "Unsatisfiable"]
