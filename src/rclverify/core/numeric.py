@@ -21,6 +21,8 @@ imports numpy and scipy through this module only
 """
 from __future__ import annotations
 
+import importlib
+import sys
 from contextlib import AbstractContextManager
 from types import ModuleType
 
@@ -39,18 +41,25 @@ def one_blas_thread() -> AbstractContextManager[None]:
 def import_numpy() -> ModuleType:
     """The ``numpy`` module, its OpenBLAS loaded with one thread (see the
     module's docstring).  Raises ``ImportError`` when numpy is missing."""
-    with one_blas_thread():
-        import numpy  # deferred: only here, inside the variable's scope
-    return numpy
+    return _loaded("numpy")
 
 
 def scipy_special() -> ModuleType:
     """The ``scipy.special`` module, numpy's and scipy's OpenBLAS loaded
     with one thread.  Raises ``ImportError`` when scipy is missing."""
-    import_numpy()
-    with one_blas_thread():
-        import scipy.special  # deferred: 0.3 s, only where a statistic is computed
-    return scipy.special
+    _loaded("numpy")
+    return _loaded("scipy.special")  # 0.3 s, only where a statistic is computed
+
+
+def _loaded(name: str) -> ModuleType:
+    """The module ``name``, imported inside :func:`one_blas_thread` the first
+    time only: once loaded, the environment is not touched again (it is the
+    whole process's)."""
+    module = sys.modules.get(name)
+    if module is None:
+        with one_blas_thread():
+            module = importlib.import_module(name)
+    return module
 
 
 np = import_numpy()

@@ -92,6 +92,13 @@ def freeze_for_run() -> None:
     keep_freed_memory()
 
 
+#: The collector's third threshold while a run's process only dispatches (:func:`no_full_collections`): the
+#: number of middle-generation collections before a full one, larger than any run makes.
+NO_FULL = 1 << 30
+#: The thresholds :func:`no_full_collections` replaced, until :func:`executing` or :func:`release_after_run`.
+_THRESHOLD: list[tuple[int, int, int]] = []
+
+
 def no_full_collections() -> None:
     """A doit run starts in this process (its reporter's ``initialize``): no
     full collection here until a task executes in it (:func:`executing`) or
@@ -102,13 +109,6 @@ def no_full_collections() -> None:
         _THRESHOLD[:] = [gc.get_threshold()]
         young, middle, _old = _THRESHOLD[0]
         gc.set_threshold(young, middle, NO_FULL)
-
-
-#: The collector's third threshold while a run's process only dispatches (:func:`no_full_collections`): the
-#: number of middle-generation collections before a full one, larger than any run makes.
-NO_FULL = 1 << 30
-#: The thresholds :func:`no_full_collections` replaced, until :func:`executing` or :func:`release_after_run`.
-_THRESHOLD: list[tuple[int, int, int]] = []
 
 
 def executing() -> None:
