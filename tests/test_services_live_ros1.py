@@ -49,7 +49,9 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     procs: list[subprocess.Popen[bytes]] = []
     log = tmp / "monitor.jsonl"
     with LocalMaster(tmp / "ros") as env:
-        env = {**env, "PYTHONPATH": str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+        (tmp / "scratch").mkdir()  # the processes' $TMPDIR: what they leave behind
+        env = {**env, "PYTHONPATH": str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""),
+               "TMPDIR": str(tmp / "scratch")}
         try:
             base = _start([str(NODES), "base", "--serve", "/estop_real", "--late-call", "2", "--delay", "0.4"],
                           env, tmp / "base.out")
@@ -132,3 +134,9 @@ def test_the_calls_reach_the_node_monitors_live(live_log: dict[str, Any]) -> Non
     # the goal's feedback and result, each judged when it answers the goal (one heard before the goal answers none)
     assert 1 <= nodes["Mover"]["counts"]["satisfied"] <= 2 and nodes["Mover"]["counts"]["violated"] == 0, nodes["Mover"]
     assert nodes["Base"]["status"] == nodes["Mover"]["status"] == "discharged"
+
+
+def test_the_generated_action_messages_do_not_outlive_the_processes(live_log: dict[str, Any]) -> None:
+    # the monitor's proxy and the mover each write the action's expanded .msg files to make rospy's
+    # classes; the classes live on in memory, the files go with the class generation
+    assert not [p.name for p in (live_log["tmp"] / "scratch").iterdir()]

@@ -308,7 +308,9 @@ def _start_run(tmp_path: Path) -> tuple[subprocess.Popen[str], Path, Path, str]:
     ws = pipeline.Workspace(root)
     oid = next(o["id"] for o in pipeline.stage_export(ws, "Agent") if o["guarantee"] == 2)
     cache = tmp_path / "cache"
-    env = {**os.environ, "XDG_CACHE_HOME": str(cache), "PYTHONPATH": str(REPO / "src")}
+    (tmp_path / "tmp").mkdir()  # the run's $TMPDIR: what a killed compiler would leave there
+    env = {**os.environ, "XDG_CACHE_HOME": str(cache), "PYTHONPATH": str(REPO / "src"),
+           "TMPDIR": str(tmp_path / "tmp")}
     proc = subprocess.Popen([sys.executable, "-c", RUN_ONE, str(root), oid], env=env, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     return proc, root, cache, oid
@@ -342,6 +344,7 @@ def test_a_compiler_killed_from_outside_records_nothing(tmp_path: Path) -> None:
     assert proc.returncode == 3, out
     assert "gcc was stopped by SIGKILL from outside rclverify" in out and "contracts/plan.yaml:" in out
     assert not (root / "artifacts/evidence" / f"{oid}.json").exists()  # the next run checks it again
+    assert not list((tmp_path / "tmp").iterdir())  # the killed compiler's files went with its build
 
 
 @needs_spin
@@ -364,6 +367,7 @@ def test_no_tool_and_no_build_directory_outlive_rclverify(tmp_path: Path, signum
         while time.monotonic() < deadline and list(cache.glob("rclverify/spin/.build-*")):
             time.sleep(0.05)
         assert not list(cache.glob("rclverify/spin/.build-*"))
+        assert not list((tmp_path / "tmp").iterdir())  # nor gcc's intermediate files
         assert not (root / "artifacts/evidence" / f"{oid}.json").exists()
     finally:
         proc.kill()

@@ -76,7 +76,8 @@ def main() -> int:
             print(f"called: success={resp.success}", flush=True)
             time.sleep(a.every)
     else:
-        cls = action_classes("rclverify_examples/Move", INTERFACES, Path(tempfile.mkdtemp(prefix="move-")))
+        with tempfile.TemporaryDirectory(prefix="move-") as gen:  # the classes live on without their files
+            cls = action_classes("rclverify_examples/Move", INTERFACES, Path(gen))
         if a.role == "mover":
             fb_pub = rospy.Publisher("/move/feedback", cls["feedback"], queue_size=10)
             res_pub = rospy.Publisher("/move/result", cls["result"], queue_size=10)

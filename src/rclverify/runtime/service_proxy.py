@@ -146,8 +146,8 @@ def start_proxy(rospy: Any, checked: Any, forwards: Mapping[str, str], dirs: Seq
     if missing:
         raise ProxyUsage(f"say where {', '.join(missing)} is served: --forward /{missing[0].lstrip('/')}=/REAL")
     svc_classes = {s: service_class(lk.ros_type, list(dirs)) for s, lk in services.items()}
-    gen = Path(tempfile.mkdtemp(prefix="rclverify-actions-"))
-    act_classes = {a: action_classes(lk.ros_type, list(dirs), gen) for a, lk in actions.items()}
+    with tempfile.TemporaryDirectory(prefix="rclverify-actions-") as gen:  # the classes live on without their files
+        act_classes = {a: action_classes(lk.ros_type, list(dirs), Path(gen)) for a, lk in actions.items()}
     keep: list[Any] = []
     for name, cls in svc_classes.items():
         real = forwards["/" + name.lstrip("/")]

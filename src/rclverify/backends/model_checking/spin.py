@@ -42,6 +42,7 @@ import shutil
 import stat
 import tempfile
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -132,12 +133,13 @@ def _version(cmd: list[str], pattern: str, fmt: str) -> str:
     return fmt.format(*m.groups()) if m else (out.strip().splitlines() or ["unknown"])[0]
 
 
-def _run(cmd: list[str], cwd: Path, timeout_s: float, where: Loc | None, tool: str
-         ) -> tuple[str, int | None, float]:
-    """Run ``cmd``; returns (stdout+stderr, exit code or None on timeout, seconds).
-    Raises :class:`~rclverify.backends.bounded.ToolInterrupted` (located at
+def _run(cmd: list[str], cwd: Path, timeout_s: float, where: Loc | None, tool: str,
+         env: Mapping[str, str] | None = None) -> tuple[str, int | None, float]:
+    """Run ``cmd`` (in ``env``, default rclverify's own environment); returns
+    (stdout+stderr, exit code or None on timeout, seconds).  Raises
+    :class:`~rclverify.backends.bounded.ToolInterrupted` (located at
     ``where``) when the tool was stopped from outside."""
-    return run_bounded(cmd, cwd, timeout_s, where=where, tool=tool)
+    return run_bounded(cmd, cwd, timeout_s, env, where=where, tool=tool)
 
 
 def cache_dir() -> Path:
@@ -202,7 +204,10 @@ def compile_model(tools: Tools, text: str, cache: Path | None = None, timeout_s:
         if code != 0 or not (tmp / "pan.c").is_file():
             raise CompileError("spin -a model.pml " + (f"did not finish within the time limit of {timeout_s:g} s"
                                                        if code is None else f"failed:\n{out}"), code is None)
-        out2, code2, _ = _run([tools.gcc, *CFLAGS, "-o", "pan", "pan.c"], tmp, timeout_s, where, "gcc")
+        # gcc's intermediate files (cc*.s, cc*.o) go in the build directory, which goes when the build
+        # ends or rclverify is killed: in $TMPDIR a killed compiler would leave them behind
+        out2, code2, _ = _run([tools.gcc, *CFLAGS, "-o", "pan", "pan.c"], tmp, timeout_s, where, "gcc",
+                              {**os.environ, "TMPDIR": str(tmp)})
         if code2 != 0:
             raise CompileError("gcc pan.c " + (f"did not finish within the time limit of {timeout_s:g} s"
                                                if code2 is None else f"failed:\n{out2}"), code2 is None)
