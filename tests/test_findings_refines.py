@@ -71,3 +71,17 @@ def test_cli_states_the_condition(tmp_path: Path):
     code = refines_main(f"{tmp_path}/a.rcl:S", f"{tmp_path}/b.rcl:S", out=out, err=err, assumes=["in.offset >= 0"])
     assert code == 0, err.getvalue()
     assert "under the conditions:" in out.getvalue() and "wherever these conditions hold" in out.getvalue()
+
+
+def test_the_refuted_finding_points_to_its_counterexample():
+    from rclverify.calculus.health.checks import refinement_finding
+    a = check([parse_text(ORIGINAL, "a.rcl")])
+    weaker = check([parse_text(ORIGINAL.replace("in.r > 10", "in.r > 20"), "b.rcl")])
+    r = check_refinement(a.nodes["S"], weaker.nodes["S"], merge_envs(a, weaker))
+    f = refinement_finding("S", "b.rcl", r)
+    # as the realizability finding does: the row says where its counterexample is printed
+    assert f.status == "problem" and f.model
+    assert f.message.endswith("its guarantee side fails (the finding's counterexample: "
+                              "`rclverify explain S.replacement-refines`).")
+    same = refinement_finding("S", "a.rcl", check_refinement(a.nodes["S"], a.nodes["S"], merge_envs(a, a)))
+    assert same.status == "ok" and "explain" not in same.message

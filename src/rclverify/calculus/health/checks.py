@@ -440,7 +440,9 @@ def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
     if r.verdict == "refines":
         status, msg = "ok", f"The replacement contract {spec} refines {node}: it may replace it."
     elif failed is not None:
-        status, msg = "problem", f"The replacement contract {spec} does not refine {node}: its {failed.name} side fails."
+        shown = (f" (the finding's counterexample: `rclverify explain {node}.replacement-refines`)"
+                 if failed.model is not None else "")
+        status, msg = "problem", f"The replacement contract {spec} does not refine {node}: its {failed.name} side fails{shown}."
     else:
         why = "; ".join(f"{x.name} side: {x.reason}" for x in (r.assumption, r.guarantee)
                         if x.status == "inconclusive" and x.reason)
