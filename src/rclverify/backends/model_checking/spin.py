@@ -205,9 +205,10 @@ def compile_model(tools: Tools, text: str, cache: Path | None = None, timeout_s:
             raise CompileError("spin -a model.pml " + (f"did not finish within the time limit of {timeout_s:g} s"
                                                        if code is None else f"failed:\n{out}"), code is None)
         # gcc's intermediate files (cc*.s, cc*.o) go in the build directory, which goes when the build
-        # ends or rclverify is killed: in $TMPDIR a killed compiler would leave them behind
+        # ends or rclverify is killed: in $TMPDIR a killed compiler would leave them behind (absolute: gcc runs
+        # inside it, and ignores a TMPDIR that is not a directory)
         out2, code2, _ = _run([tools.gcc, *CFLAGS, "-o", "pan", "pan.c"], tmp, timeout_s, where, "gcc",
-                              {**os.environ, "TMPDIR": str(tmp)})
+                              {**os.environ, "TMPDIR": os.path.abspath(tmp)})
         if code2 != 0:
             raise CompileError("gcc pan.c " + (f"did not finish within the time limit of {timeout_s:g} s"
                                                if code2 is None else f"failed:\n{out2}"), code2 is None)
