@@ -202,3 +202,18 @@ def test_the_warehouse_counterexamples_read_well(tmp_path: Path) -> None:
     assert sc.status == "failed" and sc.model is not None
     assert all(short(Fraction(v)) for v in sc.model.values()), sc.model  # 0.0305 and 30.5 on main: 1 and 1000 exist
     assert 1000 * Fraction(sc.model["LidarDriver.in.range"]) == Fraction(sc.model["LidarDriver.out.obstacle"]) > 30
+
+
+def test_a_short_model_without_assumptions_costs_no_query(monkeypatch: pytest.MonkeyPatch) -> None:
+    # the in-context step's local counterexample (every chain node's): nothing to move inside, nothing to shorten
+    import rclverify.semantics.nicemodel as nm
+    asked: list[int] = []
+    real_check = nm.check
+    monkeypatch.setattr(nm, "check", lambda s: asked.append(1) or real_check(s))
+    x, y = z3.Real("x"), z3.Real("y")
+    model = {"N0.in.x0": "1000", "N0.out.x1": "1001"}
+    nice = nicer_model([x <= 1000, y <= x + 1, z3.Not(y <= 1000)], _Enc((x, "N0.in.x0"), (y, "N0.out.x1")), model)
+    assert (nice.model, nice.changed, nice.within, asked) == (model, False, None, [])
+    # a long value still gets its search (and only then its queries)
+    nice = nicer_model([3 * x > 7, x < 3], _Enc((x, "A.in.x")), {"A.in.x": "22/9"})
+    assert nice.changed and nice.model["A.in.x"] == "2.4" and asked

@@ -161,7 +161,9 @@ def _nicer(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, str],
         within: bool | None = None
         outside: list[str] = []
         kept = [f for _, f in assumptions]
-        as_is = _check(base + kept + pins, ctx) == z3.sat  # the caller's model (within the assumptions)
+        # the caller's model within the assumptions: asked only when there are some (without them the answer
+        # changes nothing below: nothing to keep, and the search starts from the caller's values anyway)
+        as_is = bool(assumptions) and _check(base + kept + pins, ctx) == z3.sat
         if assumptions and as_is:
             within = True
         elif assumptions:
