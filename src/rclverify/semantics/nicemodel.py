@@ -164,7 +164,7 @@ def _nicer(formulas: Sequence[z3.BoolRef], enc: Any, model: Mapping[str, str],
         # the caller's model within the assumptions: asked only when there are some (without them the answer
         # changes nothing below: nothing to keep, and the search starts from the caller's values anyway)
         as_is = bool(assumptions) and _check(base + kept + pins, ctx) == z3.sat
-        if assumptions and as_is:
+        if as_is:
             within = True
         elif assumptions:
             r = _check(base + kept, ctx)
