@@ -112,4 +112,4 @@ def release_in_order() -> None:
         if type(self.waiting_me) is set and not self.waiting_me:
             self.waiting_me = _InOrder()
     ordered_init._rclverify_in_order = True  # type: ignore[attr-defined]
-    ExecNode.__init__ = ordered_init  # type: ignore[method-assign]
+    ExecNode.__init__ = ordered_init

@@ -96,7 +96,7 @@ def stage_ground(ws: Any) -> GroundingRecord:
     graph_json = g.to_json()
     counts = {"error": sum(f.severity == "error" for f in findings),
               "warning": sum(f.severity == "warning" for f in findings)}
-    data = {
+    data: dict[str, Any] = {
         "findings": [f.to_json() for f in findings],
         "counts": counts,
         "graph": {"nodes": [{"name": n["name"], "publishes": [e["topic"] for e in n["publishes"]],

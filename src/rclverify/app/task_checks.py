@@ -108,7 +108,11 @@ class RecordIntact:
 
     def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
         target = task.targets[0]
-        task.value_savers.append(lambda: {"_record_stat": (_stats([target]) or [None])[0]})
+
+        def saved() -> dict[str, list[int] | None]:
+            stats = _stats([target])
+            return {"_record_stat": stats[0] if stats else None}
+        task.value_savers.append(saved)
         now = _stats([target])
         if now is None:
             return False

@@ -34,7 +34,7 @@ from rclverify.stages.workspace import REPORT_PARTS, TaskIndex, Workspace, check
 from rclverify.records.sealed import TargetsSealed, obligation_list
 
 _F = TypeVar("_F", bound=Callable[..., Any])
-_C = TypeVar("_C")
+_C = TypeVar("_C", bound=Callable[..., Any])
 
 #: One exported obligation: its node and its JSON object (artifacts/obligations/<Node>.json).
 Exported = list[tuple[str, dict[str, Any]]]

@@ -57,7 +57,7 @@ import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence, TypedDict, overload
 
 import z3
 
@@ -95,10 +95,19 @@ class Summary:
     script: str
 
 
-_MEMO: dict[str, Any] = {"key": None, "summaries": {}, "keys": {}}
+class _Memo(TypedDict):
+    """The summaries of the last system: ``key`` its (checked, model, facts as text),
+    ``summaries`` and the ``keys`` of their stored texts by node."""
+
+    key: tuple[Checked, SystemModel, tuple[tuple[str, tuple[str, ...]], ...]] | None
+    summaries: dict[str, Summary | None]
+    keys: dict[str, bytes]
 
 
-def _memo(checked: Checked, model: SystemModel, facts: Mapping[str, Sequence[ast.Expr]]) -> dict[str, Any]:
+_MEMO: _Memo = {"key": None, "summaries": {}, "keys": {}}
+
+
+def _memo(checked: Checked, model: SystemModel, facts: Mapping[str, Sequence[ast.Expr]]) -> dict[str, Summary | None]:
     """The summaries of the last (checked, model, facts) (summaries are
     data: nothing of Z3 is kept)."""
     fp = tuple((n, tuple(expr_to_rcl(f) for f in fs)) for n, fs in sorted(facts.items()))
@@ -203,8 +212,8 @@ def _build(checked: Checked, model: SystemModel, m: str, environment: Callable[[
         if prefix == "out" and any(bit[r] & outside for r in model.readers(u, var)):
             kept[name] = sort
     premises: list[tuple[str, str]] = [(f"{p} summary", memo[p].formula) for p in top]  # type: ignore[union-attr]
-    for label, _, kind, _, t in d.items:
-        body = f"(=> {d.assumption} {t})" if kind == "guarantee" and d.assumption is not None else t
+    for label, _, kind, _, term in d.items:
+        body = f"(=> {d.assumption} {term})" if kind == "guarantee" and d.assumption is not None else term
         premises.append((label, body or "true"))
     axioms = _naturals(checked, m, symbol)
     decls = "".join(f"(declare-fun {quote(n)} () {s})\n" for n, s in sorted(sorts.items()))
@@ -273,6 +282,14 @@ def _kept(made: _Made, key: bytes, memo: Mapping[str, Summary | None]) -> Summar
             return None
         _blobs.put(key, _text(got))  # the damaged file replaced, for the processes after this one
         return _summary(made, *got[1:], memo)
+
+
+@overload
+def _text(got: tuple[str, str, list[str], str]) -> str: ...
+
+
+@overload
+def _text(got: None) -> None: ...
 
 
 def _text(got: tuple[str, str, list[str], str] | None) -> str | None:

@@ -227,16 +227,17 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
     if len(mentioned) != 1:
         return []
     n = mentioned[0]
+    assert req.formal is not None  # formals_of parsed a formal statement
     extra = re.sub(rf"(?<![\w.]){re.escape(n)}\.(in|out)\.", r"\1.", " ".join(req.formal.text.split()))
     for k, _g in enumerate(ws.checked.nodes[n].node.guarantees, 1):
         if trials >= MAX_TRIALS:
             break
         trials += 1
-        edit = conclusion_edit(ws, n, k, extra)
-        system = recheck.edited_system(ws, edit) if edit is not None else None
+        added = conclusion_edit(ws, n, k, extra)
+        system = recheck.edited_system(ws, added) if added is not None else None
         impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
         if impl:
-            found.append({"node": n, "guarantee": k, "edit": edit, "how": "conclusion", "old": "", "new": extra,
+            found.append({"node": n, "guarantee": k, "edit": added, "how": "conclusion", "old": "", "new": extra,
                           "implementable": impl})
     return found
 

@@ -354,7 +354,8 @@ def document_frame(sources: Sequence[str] = ()) -> tuple[str, str]:
     :func:`to_latex`'s."""
     frame = _env().get_template("document.tex.j2").module
     names = ", ".join(s for s in (_source_name(str(x)) for x in sources) if s)
-    return str(frame.header(names)) + str(frame.begin()), str(frame.end())
+    header, begin, end = (getattr(frame, m) for m in ("header", "begin", "end"))  # the template's macros
+    return str(header(names)) + str(begin()), str(end())
 
 
 _TEX_SPECIAL = {"\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&", "#": r"\#",

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Callable, Mapping
+from typing import Callable, Mapping, cast
 
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
@@ -199,8 +199,8 @@ class UnitChecker:
             return UNKNOWN
         if isinstance(e, ast.Compare):
             qs = [self.term(o, node, bound) for o in e.operands]
-            for op, a, (b, bq) in zip(e.ops, qs, zip(e.operands[1:], qs[1:])):
-                self.same(a, bq, b.loc, f"'{op}'")
+            for op, a, (right, bq) in zip(e.ops, qs, zip(e.operands[1:], qs[1:])):
+                self.same(a, bq, right.loc, f"'{op}'")
             return UNKNOWN
         if isinstance(e, ast.Member):
             q = self.term(e.elem, node, bound)
@@ -214,8 +214,8 @@ class UnitChecker:
                 acc = self.same(acc, self.term(it, node, bound), it.loc, "a collection's items")
             return Q(acc.kind, acc.unit, e) if acc.kind != "number" else acc
         if isinstance(e, ast.Apply):
-            for a in e.args:
-                self.term(a, node, bound)
+            for arg in e.args:
+                self.term(arg, node, bound)
             return UNKNOWN
         if isinstance(e, ast.TupleLit):
             for it in e.items:
@@ -227,15 +227,15 @@ class UnitChecker:
             return UNKNOWN
         if isinstance(e, ast.Quant):
             inner = set(bound)
-            for b in e.bindings:
-                if not _is_type(b.domain):
-                    self.term(b.domain, node, bound)  # type: ignore[arg-type]
-                inner.update(b.names)
+            for binding in e.bindings:
+                if not _is_type(binding.domain):
+                    self.term(cast(ast.Expr, binding.domain), node, bound)
+                inner.update(binding.names)
             self.term(e.body, node, frozenset(inner))
             return UNKNOWN
         if isinstance(e, ast.TupleQuant):
             if not _is_type(e.domain):
-                self.term(e.domain, node, bound)  # type: ignore[arg-type]
+                self.term(cast(ast.Expr, e.domain), node, bound)
             self.term(e.body, node, bound | frozenset(e.names))
             return UNKNOWN
         return UNKNOWN

@@ -25,7 +25,8 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from rclverify.lang.units import _NAMES, Unit, _scale_text, parse_unit, ratio, short_decimal  # noqa: F401 (short_decimal: re-exported)
+from rclverify.lang.units import _NAMES, Dims, Unit, _scale_text, parse_unit, ratio
+from rclverify.lang.units import short_decimal as short_decimal  # re-exported
 
 #: Compound units a contract may declare, besides the symbols and prefixed symbols of the table.
 _COMPOUND = ("m/s", "km/h", "mm/s", "cm/s", "m/s^2", "rad/s", "deg/s", "rad/s^2", "deg/s^2", "m/min", "km/s")
@@ -39,7 +40,7 @@ USUAL: dict[Fraction, str] = {Fraction(18, 5): "3.6", Fraction(3048, 10000): "0.
 
 
 def _targets() -> list[Unit]:
-    out: dict[tuple, Unit] = {}
+    out: dict[tuple[Dims, Fraction, int, Fraction | None], Unit] = {}
     for key, name in sorted(_NAMES.items(), key=lambda kv: (len(kv[1]), kv[1])):
         dims, f, pi, off = key
         if off is None:

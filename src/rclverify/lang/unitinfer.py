@@ -122,10 +122,10 @@ class Inference:
 Value = Any
 
 
-def _num(e: ast.Expr) -> Fraction | None:
+def _num(e: ast.NumLit) -> Fraction | None:
     try:
-        return e.value  # type: ignore[attr-defined, no-any-return]
-    except (ValueError, ZeroDivisionError, AttributeError):
+        return e.value
+    except (ValueError, ZeroDivisionError):
         return None
 
 
@@ -266,8 +266,8 @@ def infer_units(checked: Checked, links: Iterable[Any]) -> Inference:
     for a contract that type-checked; a term it cannot read gives nothing."""
     inf = Inference()
     for name, cn in checked.nodes.items():
-        for key, u in cn.units.items():
-            prefix, var = key.split(".", 1)
+        for qualified, u in cn.units.items():
+            prefix, var = qualified.split(".", 1)
             inf.declared[(name, prefix, var)] = u
     eqs = _equations(checked)
     feeds = [((l.from_node, "out", l.from_var), (l.to_node, "in", l.to_var)) for l in links

@@ -305,11 +305,11 @@ class _Reader:
         start = self.i
         if c == "(":
             self.i += 1
-            u = self.unit()
+            inner = self.unit()
             if self.peek() != ")":
                 raise UnitError("missing ')' in unit", self.i)
             self.i += 1
-            return u
+            return inner
         if c == "%":
             self.i += 1
             return SYMBOLS["%"].unit

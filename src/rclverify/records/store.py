@@ -8,9 +8,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-from json.decoder import scanstring
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Iterable, Mapping
+
+if TYPE_CHECKING:  # the stubs type the scanner in _json; json.decoder holds it at run time (C or Python)
+    from _json import scanstring
+else:
+    from json.decoder import scanstring
 
 from rclverify.core.atomic import atomic_write_bytes, atomic_write_text, dumps, read_json, write_json
 from rclverify.records.records import Evidence, Obligation, hash_inputs

@@ -231,7 +231,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop.set())
     run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in deadline_nodes(checked)], Path(args.log))
-    now = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
+    now: Callable[[], float] = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
     bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)  # a master that hangs holds nothing (ros1.py)
 
     def register() -> Any:

@@ -117,7 +117,7 @@ def finite_table(model: z3.ModelRef, d: z3.FuncDeclRef, else_body: z3.ExprRef,
 
     elsewhere = at(tuple(None for _ in range(arity)))
     rows: list[tuple[str, str]] = []
-    options = [sorted(p) + [None] for p in per]  # type: ignore[type-var]
+    options = [sorted(p) + [None] for p in per]
     for point in itertools.product(*options):
         v = at(point)
         if v.eq(elsewhere):

@@ -41,6 +41,6 @@ def fresh() -> None:
     z3mod = sys.modules.get("z3.z3")
     if z3mod is None:
         return
-    z3mod._main_ctx = None  # z3.main_ctx() creates the next one on demand
+    setattr(z3mod, "_main_ctx", None)  # z3.main_ctx() creates the next one on demand
     for clear in _CLEARERS:
         clear()

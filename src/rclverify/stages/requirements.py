@@ -154,7 +154,8 @@ def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict
     index, problem = read_sealed(ws.root / INDEX, "requirement index")
     if index is None:
         return {}
-    ids = index.get("records") if isinstance(index.get("records"), dict) else {}
+    records = index.get("records")
+    ids = records if isinstance(records, dict) else {}
     out: dict[str, dict[str, Any]] = {}
     for rid in ids:
         rec, why = read_sealed(ws.root / record_path(rid), "requirement record")

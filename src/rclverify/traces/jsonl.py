@@ -23,7 +23,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any, Iterable, Iterator, cast
 
 import msgspec
 
@@ -144,7 +144,8 @@ def _slow(path: Path, lineno: int, raw: bytes) -> dict[str, Any] | None:
         else:
             rest = len(line) - end
             if not rest or (rest == 1 and line[-1] == "\n") or not line[end:].strip(_JSON_SPACE):
-                return obj  # else more than JSON whitespace after the object: json.loads says what
+                return cast("dict[str, Any]", obj)  # a line that starts with "{" scans to an object
+            # else more than JSON whitespace after the object: json.loads says what
     if not line.strip():
         return None
     try:

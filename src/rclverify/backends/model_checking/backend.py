@@ -96,8 +96,8 @@ def read_spin_config(target: NodeTarget) -> SpinConfig:
         try:
             from rclverify.backends.model_checking.environment import environment_from_plan  # stage one; deferred: optional or conditional (inside a block)
         except ImportError:  # an installation without stage one: its evidence says so (run_spin)
-            environment_from_plan = None
-        if environment_from_plan is not None:
+            pass
+        else:
             env = environment_from_plan(cfg["environment"], lambda *p: target.config_loc("environment", *p))
     elif checker == "spin":
         raise target.config_error("model_checker spin needs an 'environment': the percepts the verification "

@@ -64,7 +64,7 @@ class Var:
     name: str
 
 
-Term = Union[psl.Sym, psl.Num, psl.Wild, psl.Compound, Var]
+Term = Union[psl.Sym, psl.Num, psl.Wild, "psl.Compound[Term]", Var]
 
 
 @dataclass(frozen=True)
@@ -179,7 +179,8 @@ def _syntax_error(exc: UnexpectedInput, text: str, file: str) -> GwendolenError:
         lines = text.splitlines() or [""]
         return located(file, len(lines), len(lines[-1]) + 1, "unexpected end of the program")
     if isinstance(exc, UnexpectedCharacters):
-        return located(file, line, col, f"unexpected character {text[exc.pos_in_stream]!r}")
+        pos = cast(int, exc.pos_in_stream)  # the lexer's position: set for an unexpected character
+        return located(file, line, col, f"unexpected character {text[pos]!r}")
     tok = exc.token if isinstance(exc, UnexpectedToken) else None
     shown = repr(str(tok)) if tok is not None else "input"
     expected = sorted({_terminal_text(name) for name in getattr(exc, "expected", ()) or ()})
@@ -221,13 +222,13 @@ class _Builder:
         if len(agents) > 1:
             raise self._unsupported(agents[1], "a second agent in one file (multi-agent systems)")
         agent = agents[0]
-        name = str(agent.children[0].children[0])
+        name = str(_tree(agent.children[0]).children[0])
         beliefs: list[Term] = []
         rules: list[Rule] = []
         goals: list[tuple[Term, str]] = []
         plans: list[Plan] = []
-        for sec in agent.children[1:]:
-            items = [c for c in sec.children if isinstance(c, Tree) or c.type not in (
+        for sec in map(_tree, agent.children[1:]):
+            items = [_tree(c) for c in sec.children if isinstance(c, Tree) or c.type not in (
                 "BELIEFS_HDR", "RULES_HDR", "GOALS_HDR", "PLANS_HDR")]
             if sec.data == "beliefs":
                 for node in items:
@@ -236,8 +237,8 @@ class _Builder:
                 rules.extend(self.rule(node) for node in items)
             elif sec.data == "goals":
                 for node in items:
-                    term = self._ground(node.children[0], "an initial goal")
-                    gtype = self.goal_type(node.children[1]) if len(node.children) > 1 else DEFAULT_GOAL_TYPE
+                    term = self._ground(_tree(node.children[0]), "an initial goal")
+                    gtype = self.goal_type(_tree(node.children[1])) if len(node.children) > 1 else DEFAULT_GOAL_TYPE
                     goals.append((term, gtype))
             else:
                 plans.extend(self.plan(node, len(plans) + i) for i, node in enumerate(items))
@@ -258,21 +259,21 @@ class _Builder:
     def rule(self, node: Tree[Token]) -> Rule:
         head = self.term(node.children[0])
         body = []
-        for lit in node.children[1:]:
+        for lit in map(_tree, node.children[1:]):
             positive = not (isinstance(lit.children[0], Token) and lit.children[0].type == "NEG")
             body.append((positive, self.term(lit.children[-1])))
         return Rule(head, tuple(body), _pos(node)[0])
 
     def plan(self, node: Tree[Token], index: int) -> Plan:
-        trig_node = node.children[0]
+        trig_node = _tree(node.children[0])
         trigger = self.trigger(trig_node)
         guard: tuple[GuardLit, ...] = ()
         body: tuple[Deed, ...] = ()
-        for part in node.children[1:]:
+        for part in map(_tree, node.children[1:]):
             if part.data == "guard":
-                guard = tuple(self.guard_lit(g) for g in part.children)
+                guard = tuple(self.guard_lit(_tree(g)) for g in part.children)
             else:
-                body = tuple(self.deed(d) for d in part.children)
+                body = tuple(self.deed(_tree(d)) for d in part.children)
         return Plan(trigger, guard, body, _pos(node)[0], index)
 
     def trigger(self, node: Tree[Token]) -> Trigger:
@@ -281,7 +282,7 @@ class _Builder:
             raise self._unsupported(node, f"{kids[0]}{kids[1]} (as a plan trigger)")
         sign = str(kids[0])
         if node.data == "goal_trigger":
-            gtype = self.goal_type(kids[2]) if len(kids) > 2 else DEFAULT_GOAL_TYPE
+            gtype = self.goal_type(_tree(kids[2])) if len(kids) > 2 else DEFAULT_GOAL_TYPE
             return Trigger(sign, self.term(kids[1]), True, gtype)
         return Trigger(sign, self.term(kids[1]))
 
@@ -308,7 +309,7 @@ class _Builder:
         if node.data == "query_deed":
             raise self._unsupported(node, "?b (test goal)")
         if node.data == "goal_deed":
-            gtype = self.goal_type(kids[2]) if len(kids) > 2 else DEFAULT_GOAL_TYPE
+            gtype = self.goal_type(_tree(kids[2])) if len(kids) > 2 else DEFAULT_GOAL_TYPE
             return Deed(f"{kids[0]}!", self.term(kids[1]), line, col, gtype)
         if node.data == "belief_deed":
             return Deed(f"{kids[0]}b", self.term(kids[1]), line, col)
@@ -329,10 +330,16 @@ class _Builder:
             return psl.Num(str(tok))
         if kind == "string":
             return psl.Sym(str(tok))
-        args = node.children[1].children if len(node.children) > 1 else []
+        args = _tree(node.children[1]).children if len(node.children) > 1 else []
         if not args:
             return psl.Sym(str(tok))
         return psl.Compound(str(tok), tuple(self.term(a, depth + 1) for a in args))
+
+
+def _tree(node: Tree[Token] | Token) -> Tree[Token]:
+    """``node``, a child the grammar makes a rule's tree (a section, a
+    term, a goal type, a plan's parts), never a token."""
+    return cast("Tree[Token]", node)
 
 
 def _pos(node: Tree[Token] | Token) -> tuple[int, int]:

@@ -15,12 +15,15 @@ the engine reads it (a question left unanswered, ``closing.py``).
 """
 from __future__ import annotations
 
-from typing import Any, Iterator
+from typing import TYPE_CHECKING, Any, Iterator, Mapping, Union
 
 from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.rows import BlockRows, EventRows
 
 
 class AnsweredRun:
@@ -33,7 +36,8 @@ class AnsweredRun:
 
     __slots__ = ("chunk", "at", "where", "seed")
 
-    def __init__(self, chunk: list[Event], at: np.ndarray, where: dict[str, np.ndarray], seed: dict[str, Any]) -> None:
+    def __init__(self, chunk: EventRows | BlockRows, at: np.ndarray, where: dict[str, np.ndarray],
+                 seed: dict[str, Any]) -> None:
         self.chunk, self.at, self.where, self.seed = chunk, at, where, seed
 
     def question(self, j: int, run: Any) -> Question:
@@ -72,7 +76,7 @@ class RecentOutput:
 
     __slots__ = ("rows", "i", "stamp", "key", "field")
 
-    def __init__(self, rows: Any, i: int, stamp: float, key: str, field: str) -> None:
+    def __init__(self, rows: EventRows | BlockRows, i: int, stamp: float, key: str, field: str) -> None:
         self.rows, self.i, self.stamp, self.key, self.field = rows, i, stamp, key, field
 
     def __getitem__(self, k: int) -> Any:
@@ -91,4 +95,8 @@ class RecentOutput:
 
 _EMPTY: dict[str, Any] = {}
 
-__all__ = ["AnsweredRun", "RecentOutput"]
+#: An entry of the engine's ``_recent`` (and ``_released``) outputs: the tuple
+#: ``engine.py`` appends, or a :class:`RecentOutput` of a batch run.
+Recent = Union[tuple[Event, float, dict[str, Any], Mapping[str, Any]], RecentOutput]
+
+__all__ = ["AnsweredRun", "Recent", "RecentOutput"]

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import gc
 from itertools import repeat
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping, cast
 
 from rclverify.core.numeric import np
 
@@ -45,7 +45,7 @@ from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
-from rclverify.traces.questions import KEPT, Question
+from rclverify.traces.questions import KEPT, Question, QuestionStream
 from rclverify.backends.monitors.answered import AnsweredRun, RecentOutput
 from rclverify.backends.monitors.columns import ColumnCompiler, Unsupported, io_kind, seed
 from rclverify.backends.monitors.engine import NodeMonitor
@@ -153,6 +153,12 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
     return count, m.finish()
 
 
+def _kept(stream: QuestionStream) -> list[Question | None]:
+    """The questions ``stream`` keeps as a batch run leaves them: ``None`` for
+    a ghost's question, made when the engine may look it up (``_materialise``)."""
+    return cast("list[Question | None]", stream._questions)
+
+
 class _Run:
     """The batch path over one trace: the shared engine and the chunk loop."""
 
@@ -177,7 +183,7 @@ class _Run:
 
     def _materialise(self) -> None:
         """Make every question the stream keeps as ``None`` (the latest ghosts, in order)."""
-        qs = self.m.stream._questions
+        qs = _kept(self.m.stream)
         left = qs.count(None)
         made: list[Question] = []
         for g in reversed(self.ghosts):
@@ -359,18 +365,19 @@ class _Run:
         drop = max(0, old + len(tail) - keptn)
         # an output held for the skew: its release reads the questions within the skew after it, so they are made
         made = [ghost.question(j, self) for j in range(len(tail) - 1)] if m._held else [None] * (len(tail) - 1)
-        stream._questions = (stream._questions + made + [newest])[drop:]
+        stream._questions = (_kept(stream) + made + [newest])[drop:]  # type: ignore[assignment]  # None: made later
         stream._stamps = (stream._stamps + times[tail].tolist())[drop:]
         if drop or len(tail) < n:
             stream.forgot = True
         stream.latest = newest
         if len(tail) > 1 and not m._held:
             self.ghosts.append(ghost)
-            left = stream._questions.count(None)  # the ghosts the stream still keeps: the latest of them
+            left = _kept(stream).count(None)  # the ghosts the stream still keeps: the latest of them
             while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
                 del self.ghosts[0]
         # the answers' entries (the skew's, late.py's), each event made if the engine reads it (answered.py)
         recent = m._recent
+        assert recent.maxlen is not None  # the engine keeps a bounded deque
         outs = at[-recent.maxlen:] + 1
         recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
                           repeat(ofield)))

@@ -29,12 +29,15 @@ from rclverify.traces.events import Event, to_ns
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.verdicts import WEAK as _WEAK, in_all, link_of, names, producers
 
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.answered import Recent
+
 
 class Closing:
     """The once-per-question parts of :class:`~.engine.NodeMonitor` (module docstring)."""
 
     if TYPE_CHECKING:  # the engine's state and helpers the mixin reads, declared for the type checker only
-        _recent: deque[tuple[Event, float, dict[str, Any], Mapping[str, Any]]]
+        _recent: deque[Recent]
 
         def __getattr__(self, name: str) -> Any: ...
 

@@ -36,7 +36,7 @@ from __future__ import annotations
 from fractions import Fraction
 from itertools import repeat
 from operator import is_, itemgetter
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, TypeVar
 
 from rclverify.core.numeric import np
 
@@ -50,6 +50,9 @@ _SLACK_REL = 2.0 ** -48
 _SLACK_ABS = 2.0 ** -1000
 #: Each comparison's numpy ufunc, as the one operator table names it (semantics/operators.py).
 _CMP: Mapping[str, Callable[[Any, Any], Any]] = {s: getattr(np, str(OPERATORS[s].numpy)) for s in sorted(COMPARISONS)}
+
+
+_R = TypeVar("_R")  # what a constant's definition compiles to (a formula or a term)
 
 
 class Unsupported(Exception):
@@ -159,8 +162,8 @@ class ColumnCompiler:
         if isinstance(e, ast.NumLit):
             exact = e.value
             v = float(exact)
-            b = 0.0 if Fraction(v) == exact else abs(v) * _REL + _SLACK_ABS
-            return lambda c: (v, b)
+            bound = 0.0 if Fraction(v) == exact else abs(v) * _REL + _SLACK_ABS
+            return lambda c: (v, bound)
         if isinstance(e, ast.Var):
             if e.prefix is None and e.name in self.env.constants:
                 return self._constant(e.name, self._num)
@@ -177,7 +180,7 @@ class ColumnCompiler:
                     "*": lambda c: _mul(a(c), b(c))}[e.op]
         raise Unsupported(f"a {type(e).__name__} {getattr(e, 'op', '')} as a term")
 
-    def _constant(self, name: str, how: Callable[[Any], Any]) -> Any:
+    def _constant(self, name: str, how: Callable[[Any], _R]) -> _R:
         if name in self._expanding:
             raise Unsupported(f"the constant {name} defined through itself")
         self._expanding.add(name)

@@ -33,7 +33,7 @@ outputs waiting for the skew to pass and a bounded evaluation cache.
 from __future__ import annotations
 
 from collections import deque
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from rclverify.semantics.floatsem import Judgement, Tolerance
 from rclverify.semantics.judges import FormulaJudge
@@ -48,6 +48,9 @@ from rclverify.backends.monitors.late import Late
 from rclverify.backends.monitors.needs_answer import answer_decides
 from rclverify.backends.monitors.outcome import Outcome, combine, skew_reason
 from rclverify.backends.monitors.verdicts import LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.answered import Recent
 
 _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
@@ -155,12 +158,12 @@ class NodeMonitor(Judging, Closing, Late):
         skew = getattr(rules, "skew", None) or 0.0
         self.stream = QuestionStream(skew if self.has_inputs else 0.0, horizon)
         #: outputs judged at once, for a question within the skew after them that gets no answer of its own
-        self._recent: deque[tuple[Event, float, dict[str, Any], Mapping[str, Any]]] = deque(maxlen=64)
+        self._recent: deque[Recent] = deque(maxlen=64)
         #: outputs false for the question at their stamp, waiting for the questions within the skew after them:
         #: (event, stamp, that question, outputs of the answer, state outputs, output-only outcome, its reading)
         self._held: deque[tuple[Any, ...]] = deque()
         #: outputs held for the skew and judged since, kept as ``_recent`` keeps those judged at once (late.py)
-        self._released: deque[tuple[Event, float, dict[str, Any], Mapping[str, Any]]] = deque(maxlen=64)
+        self._released: deque[Recent] = deque(maxlen=64)
         #: input -> (stamp, why) of its latest unreadable message (a NaN) until a message stamped after it maps
         self._unread: dict[str, tuple[float, str]] = {}
         #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late

@@ -122,10 +122,12 @@ class BlockRows:
         """As :meth:`EventRows.values`."""
         h = len(self.head)
         if not h:
-            return self.block.values(rows, field)
+            got: list[Any] = self.block.values(rows, field)
+            return got
         cut = int(np.searchsorted(rows, h))
-        return field_values(list(map(_FIELDS, self.head)), rows[:cut], field) + \
-            self.block.values(rows[cut:] - h, field)
+        carried = field_values(list(map(_FIELDS, self.head)), rows[:cut], field)
+        rest: list[Any] = self.block.values(rows[cut:] - h, field)
+        return carried + rest
 
     def typed(self, rows: np.ndarray, field: str, kind: str, codes: Mapping[str, int]) -> tuple[np.ndarray, np.ndarray]:
         """As :meth:`EventRows.typed`; a block that holds its values as arrays

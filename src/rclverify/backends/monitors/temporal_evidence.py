@@ -32,7 +32,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from rclverify.model.plan.load import Plan, Requirement
+from rclverify.model.plan.model import Plan, Requirement
 from rclverify.model.plan.state import state_types
 from rclverify.model.plan.temporal import Temporal, operands, parse_temporal
 from rclverify.lang.errors import RclError
@@ -100,7 +100,7 @@ def fingerprint_text(root: Path, traces: list[tuple[str, str | None]]) -> str:
 def trace_rows(req: Requirement, checked: Checked, plan: Plan, root: Path) -> list[dict[str, Any]]:
     """One row per trace of ``req`` (module table); never raises for a
     user-caused problem (an unreadable trace or mapping is an ``error`` row)."""
-    rows = []
+    rows: list[dict[str, Any]] = []
     traces = requirement_traces(req, checked, plan)
     if not traces:
         return rows

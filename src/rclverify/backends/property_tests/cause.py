@@ -26,7 +26,7 @@ import inspect
 import os
 import sys
 from types import FrameType
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence, cast
 import dis
 import linecache
 
@@ -35,7 +35,8 @@ def implementation_file(impl: Any) -> str | None:
     """The source file of ``impl`` (a function or a class), as its code objects name it; ``None`` when unknown."""
     code = getattr(impl, "__code__", None)
     if code is not None:
-        return os.path.abspath(code.co_filename)
+        filename: str = code.co_filename
+        return os.path.abspath(filename)
     try:
         f = inspect.getsourcefile(impl)
     except TypeError:
@@ -153,10 +154,11 @@ def cause_line(impl: Any, example: Mapping[str, Any] | Sequence[Mapping[str, Any
     if file is None:
         return None
     if inspect.isclass(impl):
-        steps = list(example)[: step or len(list(example))]  # type: ignore[arg-type]
+        runs = cast("Sequence[Mapping[str, Any]]", example)  # a class's example is its steps
+        steps = list(runs)[: step or len(list(runs))]
         if not steps:
             return None
-        machine = impl()
+        machine: Any = impl()
         for inputs in steps[:-1]:
             try:
                 machine.step(**_kwargs(inputs))
@@ -164,7 +166,8 @@ def cause_line(impl: Any, example: Mapping[str, Any] | Sequence[Mapping[str, Any
                 return None
         line = last_line(lambda: machine.step(**_kwargs(steps[-1])), file)
     else:
-        line = last_line(lambda: impl(**_kwargs(example)), file)  # type: ignore[arg-type]
+        inputs = cast("Mapping[str, Any]", example)  # a function's example is its inputs
+        line = last_line(lambda: impl(**_kwargs(inputs)), file)
     return f"{shown_file}:{line}" if line is not None else None
 
 

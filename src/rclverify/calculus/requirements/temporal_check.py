@@ -42,7 +42,7 @@ anything, and is reported ``consistency: inconsistent``.
 from __future__ import annotations
 
 import time
-from typing import Any, Callable, Collection
+from typing import Any, Callable, Collection, cast
 
 import z3
 
@@ -84,6 +84,7 @@ def is_temporal(req: Requirement, checked: Checked, plan: Plan) -> bool:
 
 def statement(req: Requirement, checked: Checked, plan: Plan) -> Temporal:
     """The parsed temporal statement of ``req`` (raises :class:`RclError`)."""
+    assert req.formal is not None  # a temporal requirement has a formal statement (is_temporal)
     t = parse_temporal(req.formal, checked, f"{req.id} formal", state_types(plan.states, checked))
     assert isinstance(t, Temporal)
     return t
@@ -173,31 +174,33 @@ def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[
         gaps.update(found)
         return v
     if kind == "always":
-        return prove_always(ts, pred(t.args[0]), max_k=bound, timeout_ms=timeout_ms, hint=hint)
+        return prove_always(ts, pred(cast(Formal, t.args[0])), max_k=bound, timeout_ms=timeout_ms, hint=hint)
     if kind == "response":  # always (P -> eventually[<= N] Q) / always (P -> next Q): calculus/requirements/response.py
         from rclverify.calculus.requirements.response import check_response, check_unbounded_response  # deferred: optional or conditional (inside a block)
-        p, r = t.args[0].args  # type: ignore[union-attr]
-        if r.op == "eventually" and r.bound is None:  # type: ignore[union-attr]
-            return check_unbounded_response(ts, got(p), got(r.args[0]), max_k=bound,  # type: ignore[arg-type, union-attr]
+        left, right = cast(Temporal, t.args[0]).args  # the shape: P -> eventually[<= N] Q or P -> next Q
+        p, r = cast(Formal, left), cast(Temporal, right)
+        if r.op == "eventually" and r.bound is None:
+            return check_unbounded_response(ts, got(p), got(cast(Formal, r.args[0])), max_k=bound,
                                             timeout_ms=timeout_ms, ranking=ranking, invariant=invariant)
-        within = r.bound if r.op == "eventually" else None  # type: ignore[union-attr]
-        return check_response(ts, got(p), got(r.args[0]), within, max_k=bound,  # type: ignore[arg-type, union-attr]
+        within = r.bound if r.op == "eventually" else None
+        return check_response(ts, got(p), got(cast(Formal, r.args[0])), within, max_k=bound,
                               timeout_ms=timeout_ms, hint=hint)
     if kind == "always next":
-        f = pred(t.args[0].args[0])  # type: ignore[union-attr]
+        f = pred(cast(Formal, cast(Temporal, t.args[0]).args[0]))
         ts2 = with_flag(ts, "<started>", lambda s: z3.BoolVal(False), lambda s, u: z3.BoolVal(True))
         return prove_always(ts2, lambda s: disj(z3.Not(s["<started>"]), f(s)), max_k=bound, timeout_ms=timeout_ms,
                             hint=hint)
     if kind == "next":
-        return _exact(check_next(ts, got(t.args[0]), timeout_ms=timeout_ms), hint)
+        return _exact(check_next(ts, got(cast(Formal, t.args[0])), timeout_ms=timeout_ms), hint)
     if kind == "eventually":
-        f = got(t.args[0])
+        f = got(cast(Formal, t.args[0]))
         if t.bound is not None:
             v = check_eventually_within(ts, f, t.bound, timeout_ms=timeout_ms)
             return _exact(TemporalVerdict("proved", v.method, bound=v.bound, detail=v.detail,
                                           deadlock=v.deadlock) if v.status == "met" else v, hint)
-        return eventually(t.args[0])  # type: ignore[arg-type]
-    return check_until(ts, pred(t.args[0]), got(t.args[1]), eventually=lambda: eventually(t.args[1]),  # type: ignore[arg-type]
+        return eventually(cast(Formal, t.args[0]))
+    held, goal = cast(Formal, t.args[0]), cast(Formal, t.args[1])  # until: two formulas (the shape)
+    return check_until(ts, pred(held), got(goal), eventually=lambda: eventually(goal),
                        max_k=bound, timeout_ms=timeout_ms,
                        always=lambda ts2, p: prove_always(ts2, p, max_k=bound, timeout_ms=timeout_ms, hint=hint))
 

@@ -35,7 +35,7 @@ import pickle
 import re
 from fractions import Fraction
 from functools import lru_cache
-from typing import Any, BinaryIO, Callable
+from typing import Any, BinaryIO, Callable, TypeGuard
 
 _RATIONAL = re.compile(r"-?\d{1,4300}(/\d{1,4300})?")
 
@@ -86,7 +86,7 @@ EXTRA: dict[tuple[str, str], Callable[[], Any]] = {
 }
 
 
-def _is_value_class(obj: Any) -> bool:
+def _is_value_class(obj: object) -> TypeGuard[type]:
     return (isinstance(obj, type) and not issubclass(obj, BaseException)
             and (dataclasses.is_dataclass(obj) or issubclass(obj, enum.Enum)
                  or (issubclass(obj, tuple) and hasattr(obj, "_fields"))))

@@ -57,7 +57,9 @@ class Temporal:
 def _blank(text: str, start: int, end: int) -> str:
     """``text`` with everything outside [start, end) replaced by spaces
     (newlines kept), so offsets inside are unchanged."""
-    keep = lambda s: re.sub(r"[^\n]", " ", s)  # noqa: E731
+    def keep(s: str) -> str:
+        return re.sub(r"[^\n]", " ", s)
+
     return keep(text[:start]) + text[start:end] + keep(text[end:])
 
 

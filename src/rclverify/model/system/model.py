@@ -25,7 +25,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Iterable, Mapping, Sequence
 
-from rclverify.model.plan.load import Connection
+from rclverify.model.plan.model import Connection
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import Checked, EmptyT
 from rclverify.model.system.services import peers as service_peers, side_conditions as service_conditions

@@ -153,6 +153,7 @@ def connection_diagnostics(checked: Checked, links: Iterable[Any]) -> list[Diagn
             out.append(error(pd.loc, f"{what} (the reader's declaration: {cd.loc})", m.code))
             out.append(error(cd.loc, f"{what} (the writer's declaration: {pd.loc})", m.code))
         elif up is None:
+            assert uc is not None  # one of the two declares a unit (tested above)
             out.append(warning(pd.loc, f"{writer} declares no unit but feeds {reader}, which is {describe(uc)} "
                                        f"({conn}): declare the unit {l.from_node} publishes so the connection is "
                                        "checked", "W-unit-missing"))

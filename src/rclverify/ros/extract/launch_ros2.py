@@ -35,7 +35,7 @@ def _callee(c: ast.Call) -> str:
 
 
 #: the variables ``generate_launch_description()`` assigns, while one file is read
-_ENV: dict[str, ast.AST] = {}
+_ENV: dict[str, ast.expr] = {}
 #: the variables it assigns more than once (chosen at run time): name -> lines
 _TWICE: dict[str, list[int]] = {}
 _HERE = [""]  # the launch file's name
@@ -76,7 +76,7 @@ def _value(e: ast.AST, depth: int = 0) -> str:
     raise _Unres(f"'{ast.unparse(e)}' (not a literal or a known substitution)")
 
 
-def _kw(c: ast.Call, name: str) -> ast.AST | None:
+def _kw(c: ast.Call, name: str) -> ast.expr | None:
     return next((k.value for k in c.keywords if k.arg == name), None)
 
 
@@ -133,10 +133,10 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
             return El(tag, {}, kids, src)
         if name == "DeclareLaunchArgument":
             n = c.args[0] if c.args else _kw(c, "name")
-            d = _kw(c, "default_value")
+            default = _kw(c, "default_value")
             attrs = {"name": _value(n)} if n is not None else {}
-            if d is not None:
-                attrs["default"] = _value(d)
+            if default is not None:
+                attrs["default"] = _value(default)
             return El("arg", attrs, [], src)
         if name == "PushRosNamespace":
             n = c.args[0] if c.args else _kw(c, "namespace")
@@ -231,7 +231,7 @@ def _read(fn: ast.FunctionDef | None, shown: str, notes: list[Note]) -> tuple[El
     if fn is None:
         return None, [Note(Src(shown), "no generate_launch_description() function", "ROS-PARSE", "error")]
     kids: list[El] = []
-    assigned: dict[str, ast.AST] = {}
+    assigned: dict[str, ast.expr] = {}
     counts: dict[str, list[int]] = {}
     for st in ast.walk(fn):
         if isinstance(st, ast.Assign) and len(st.targets) == 1 and isinstance(st.targets[0], ast.Name):

@@ -153,17 +153,18 @@ def expand_each(eps: list[Endpoint], array: Callable[[str], Any], notes: list[No
     ``notes`` (the list of sources is read at run time)."""
     out: list[Endpoint] = []
     for e in eps:
-        m = _EACH.search(e.param or "")
+        param = e.param or ""
+        m = _EACH.search(param)
         if m is None:
             out.append(e)
             continue
         got = array(m.group(1))
         if not isinstance(got, tuple):
-            notes.append(Note(e.src, f"name of {e.kind} comes from parameter {e.param.replace(m.group(0), '<source>')} "
+            notes.append(Note(e.src, f"name of {e.kind} comes from parameter {param.replace(m.group(0), '<source>')} "
                                      f"of each source listed in parameter {m.group(1)}, which has no list value in "
                                      f"the launch files or the package's parameter files: not resolved statically"))
             continue
         for x in got:
-            out.append(dataclasses.replace(e, param=e.param.replace(m.group(0), x),
+            out.append(dataclasses.replace(e, param=param.replace(m.group(0), x),
                                            topic=e.topic.replace(m.group(0), x) if e.topic else e.topic))
     return out

@@ -25,14 +25,13 @@ def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note
     warnings = [Note(Src(shown), _entry_message(w, path, "warning"), "ROS-PARSE", "warning") for w in skipped]
     try:
         with AnyReader([path]) as reader:
-            topics = [{"name": c.topic if c.topic.startswith("/") else "/" + c.topic,
-                       "type": canon_type(c.msgtype), "count": int(c.msgcount)}
+            topics = [(c.topic if c.topic.startswith("/") else "/" + c.topic, canon_type(c.msgtype), int(c.msgcount))
                       for c in reader.connections]
     except Exception as exc:  # rosbags raises its own reader errors on bad files
         return None, [Note(Src(shown), f"cannot read bag: {' '.join(str(exc).split())[:300]}", "ROS-PARSE", "error")]
-    merged: dict[tuple[str, str], int] = {}
-    for t in topics:
-        merged[(t["name"], t["type"])] = merged.get((t["name"], t["type"]), 0) + t["count"]
+    merged: dict[tuple[str, str | None], int] = {}
+    for name, ty, count in topics:
+        merged[(name, ty)] = merged.get((name, ty), 0) + count
     return {"path": shown, "topics": [{"name": n, "type": ty, "count": c}
                                       for (n, ty), c in sorted(merged.items())]}, warnings
 

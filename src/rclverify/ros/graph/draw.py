@@ -47,7 +47,8 @@ def grounding_dot(checked: Any, graph_json: Mapping[str, Any], findings: list[Ma
         for (n, t), r in list(worst_topic.items()):
             if n == c:
                 worst_topic[(gname, t)] = max(worst_topic.get((gname, t), 0), r)
-    c_nodes, c_topics, c_edges = [], {}, []
+    c_nodes, c_edges = [], []
+    c_topics: dict[str, int] = {}
     c_links: dict[tuple[str, str], int] = {}
     l_edges: list[dict[str, str]] = []
     for name, cn in checked.nodes.items():
@@ -66,7 +67,8 @@ def grounding_dot(checked: Any, graph_json: Mapping[str, Any], findings: list[Ma
             l_edges.append({"src": b, "dst": a, "colour": _COLOUR[col], "style": style} if lk.role == "serves"
                            else {"src": a, "dst": b, "colour": _COLOUR[col], "style": style})
     r_links: dict[tuple[str, str], int] = {}
-    r_nodes, r_topics, r_edges = [], {}, []
+    r_nodes, r_edges = [], []
+    r_topics: dict[str, int] = {}
     for n in graph_json["nodes"]:
         r_nodes.append({"name": _q(n["name"]), "colour": _COLOUR[worst_node.get(n["name"], 0)]})
         for kind in ("publishes", "subscribes"):

@@ -139,7 +139,7 @@ def _expected(typ: T.Type) -> list[T.Type | str]:
     if isinstance(typ, T.FuncT):
         res = typ.result
         tail = [] if isinstance(res, T.Scalar) and res.name == "BOOL" else [res]
-        return list(typ.args) + tail
+        return [*typ.args, *tail]
     if isinstance(typ, T.DataT):
         return ["ctor"]
     return []
@@ -290,6 +290,7 @@ class Grounder:
                                                            if graph_types else ""),
                          rcl_loc, type_src, node.name, tp.field)
                 continue
+            assert ctype is not None  # the table knows no type without a name
             differs = sorted(t for t in graph_types if t != ctype)
             if differs:
                 self.add("ROS-TYPE-DIFFERS", f"topic '{tp.field}' carries {', '.join(short_type(t) for t in differs)} "

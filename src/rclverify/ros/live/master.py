@@ -51,14 +51,14 @@ def import_rosgraph() -> Any:
 
     Raises :class:`MasterError` when neither has it."""
     try:
-        import rosgraph  # type: ignore[import-not-found]; deferred: optional or conditional (inside a block)
+        import rosgraph  # deferred: optional or conditional (inside a block)
         return rosgraph
     except ImportError:
         pass
     if DEBIAN_DIST not in sys.path:
         sys.path.append(DEBIAN_DIST)
     try:
-        import rosgraph  # type: ignore[import-not-found]  # noqa: F811; deferred: optional or conditional (inside a block)
+        import rosgraph  # noqa: F811  # deferred: optional or conditional (inside a block)
         return rosgraph
     except ImportError as exc:
         raise MasterError(f"rosgraph is not installed (apt-get install python3-rosgraph): {exc}") from None

@@ -86,11 +86,11 @@ def recheck_members(members: dict[str, bytes]) -> Recheck:
                 problems.append(f"{name}: {bad}")
     with tempfile.TemporaryDirectory() as tmp:  # the records only, to read them as the stage does
         root = Path(tmp)
-        for name, data in members.items():
+        for name, content in members.items():
             if name.startswith("artifacts/") and name.endswith(".json"):
                 p = root / name
                 p.parent.mkdir(parents=True, exist_ok=True)
-                p.write_bytes(data)
+                p.write_bytes(content)
         nodes = sorted(p.stem for p in (root / "artifacts/calculus").glob("*.json"))
         items = discharging_items(root, nodes)
     has_cvc5 = bool(version())

@@ -342,10 +342,10 @@ def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: lis
         written.append(dst)
         for lf in launch:
             try:
-                rel = lf.resolve().relative_to(pkg.root.resolve())
+                inside = lf.resolve().relative_to(pkg.root.resolve())
             except ValueError:
                 continue
-            launch_rel.append(f"ros/{pkg.name}/{rel.as_posix()}")
+            launch_rel.append(f"ros/{pkg.name}/{inside.as_posix()}")
     files: dict[str, str] = {"dodo.py": scaffold_env().get_template("dodo.py.j2").render(name=name)}
     for n in nodes:
         files[n.file] = _ENV.get_template("skeleton.rcl.j2").render(node=n)

@@ -6,7 +6,7 @@ PSL's own, not copies of RCL's: docs/semantics.md, "One formula core".
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterator, Union
+from typing import Generic, Iterator, TypeVar, Union
 
 # ---------------------------------------------------------------------------
 # Terms
@@ -32,15 +32,20 @@ class Wild:
     """``_``: matches any value."""
 
 
+_A = TypeVar("_A", covariant=True)  # the type of a compound's arguments
+
+
 @dataclass(frozen=True)
-class Compound:
-    """``name(arg, ...)`` with at least one argument."""
+class Compound(Generic[_A]):
+    """``name(arg, ...)`` with at least one argument.  A PSL term's arguments
+    are PSL terms (``Compound[Term]``); the Gwendolen interpreter's terms
+    also hold its variables (:mod:`rclverify.backends.model_checking.gwendolen`)."""
 
     name: str
-    args: tuple["Term", ...]
+    args: tuple[_A, ...]
 
 
-Term = Union[Sym, Num, Wild, Compound]
+Term = Union[Sym, Num, Wild, "Compound[Term]"]
 
 # ---------------------------------------------------------------------------
 # Formulas
