@@ -148,7 +148,11 @@ def _run_here(root: str, plan_file: str, key: str, node: str, obligation_id: str
 def _client(addr: str) -> Any:
     client = _CLIENTS.get(addr)
     if client is None:
-        from dask.distributed import Client  # deferred: optional or conditional (inside a block)
+        try:
+            from dask.distributed import Client  # deferred: optional or conditional (inside a block)
+        except ImportError:
+            from rclverify.core.extras import missing_message  # deferred: optional or conditional (inside a block)
+            raise ClusterError(missing_message("dask", "verification on a Dask cluster")) from None
         try:
             client = Client(addr, timeout=CONNECT_TIMEOUT_S, set_as_default=False)  # type: ignore[no-untyped-call]
         except (OSError, TimeoutError, ValueError) as exc:

@@ -11,12 +11,14 @@ fault (:mod:`rclverify.core.faults`); it never lets a traceback through.
 """
 from __future__ import annotations
 
+import functools
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence, TypeVar
 
 from doit.exceptions import TaskFailed
 
 from rclverify.core.cache import heap
+from rclverify.core.extras import MissingExtra
 from rclverify.stages.workspace import Workspace
 from rclverify.lang.errors import RclError
 from rclverify.app.pipeline import stage_check, stage_graph, stage_run, stage_report, stage_requirements, stage_deadlines
@@ -55,6 +57,21 @@ def _ws(root: str, plan_file: str | None = None) -> Workspace:
     return ws
 
 
+
+_A = TypeVar("_A", bound=Callable[..., Any])
+
+
+def _extras_said(action: _A) -> _A:
+    """``action`` with a missing optional part (:class:`MissingExtra`) turned
+    into a doit failure of one line naming the extra, never a traceback."""
+    @functools.wraps(action)
+    def run(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return action(*args, **kwargs)
+        except MissingExtra as exc:
+            return TaskFailed(f"error: {exc}")
+    return run  # type: ignore[return-value]  # functools.wraps keeps the signature doit reads
+
 def _fail(exc: RclError) -> TaskFailed:
     return TaskFailed("\n".join(str(d) for d in exc.diagnostics))
 
@@ -67,6 +84,7 @@ def _io_fail(exc: OSError, root: str, place: str = "artifacts/") -> TaskFailed:
     return TaskFailed(describe_os_error(exc, Path(root), place=place))
 
 
+@_extras_said
 def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
     try:
         out = stage_check(_ws(root, plan_file))
@@ -79,6 +97,7 @@ def act_check(root: str, plan_file: str = "contracts/plan.yaml") -> Any:
     return None
 
 
+@_extras_said
 def act_graph(root: str) -> Any:
     from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.report and more only when called)
     try:
@@ -116,6 +135,7 @@ def stages_to_run(deps: Mapping[str, Sequence[str]], changed: Sequence[str]) -> 
     return [stage for stage in NODE_STAGES if stage in deps and hit.intersection(deps[stage])]
 
 
+@_extras_said
 def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str]) -> Any:
     """Run the stages of ``node`` whose inputs changed (:func:`stages_to_run`).
 
@@ -133,6 +153,7 @@ def act_node(root: str, node: str, deps: dict[str, list[str]], changed: list[str
     return None
 
 
+@_extras_said
 def act_run(root: str, node: str, obligation_id: str) -> Any:
     from rclverify.app import cluster  # deferred: start-up (loads rclverify.app.cluster only when called)
     addr = cluster.address()  # RCLVERIFY_CLUSTER: the backend job runs on that Dask cluster
@@ -156,6 +177,7 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
 _REPORTS: dict[str, tuple[Workspace, Report]] = {}
 
 
+@_extras_said
 def act_report(root: str, part: str) -> Any:
     """Write one part of the report (:mod:`rclverify.report.parts`).  The
     parts run after every backend, from the same artifacts, so a process
@@ -178,6 +200,7 @@ def act_report(root: str, part: str) -> Any:
     return None
 
 
+@_extras_said
 def act_requirements(root: str) -> Any:
     """Check the requirements whose inputs changed (:mod:`rclverify.stages.requirements`)."""
     try:
@@ -190,6 +213,7 @@ def act_requirements(root: str) -> Any:
     return None
 
 
+@_extras_said
 def act_deadlines(root: str) -> Any:
     """Decide the end-to-end deadlines (rule D3, :mod:`rclverify.stages.deadlines`)."""
     try:
@@ -202,6 +226,7 @@ def act_deadlines(root: str) -> Any:
     return None
 
 
+@_extras_said
 def act_crosscheck(root: str, nodes: list[str]) -> Any:
     """Decide every discharging query again with cvc5 (:mod:`rclverify.stages.crosscheck.stage`, issue 50)."""
     from rclverify.stages.crosscheck.stage import stage_crosscheck  # deferred: start-up (loads rclverify.stages.crosscheck, rclverify.stages.requirements and more only when called)
@@ -216,6 +241,7 @@ def act_crosscheck(root: str, nodes: list[str]) -> Any:
     return None
 
 
+@_extras_said
 def act_ground(root: str) -> Any:
     """The grounding stage (docs/ros.md): scan the plan's ``ros:`` section,
     hold the contracts against it; findings go to the report, never to a verdict."""
@@ -230,6 +256,7 @@ def act_ground(root: str) -> Any:
 
 
 
+@_extras_said
 def act_verify(root: str, strict: bool) -> Any:
     """The ``verify`` task: print the run's status, problems and summary table
     (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail

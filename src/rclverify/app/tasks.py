@@ -145,8 +145,13 @@ def build_tasks(root: str | Path, plan_file: str = "contracts/plan.yaml", *,
     except OSError as exc:
         print(describe_os_error(exc, rootp.resolve(), "cannot take the run lock in"), file=sys.stderr)
         raise SystemExit(1) from None
+    from rclverify.core.extras import MissingExtra  # deferred: start-up (loads rclverify.core.extras only when called)
     with heap.no_collection():
-        creators = _build_tasks(root, plan_file)
+        try:
+            creators = _build_tasks(root, plan_file)
+        except MissingExtra as exc:  # the workspace needs an optional part: one line naming the extra
+            print(f"error: {exc}", file=sys.stderr)
+            raise SystemExit(1) from None
         heap.freeze_for_run()  # before collecting again: what was made while loading is not looked at
     return creators
 

@@ -32,7 +32,7 @@ MAX_PATHS = 200
 
 def _graph(model: SystemModel) -> Any:
     """The links of ``model`` as a networkx ``DiGraph`` over its nodes."""
-    import networkx as nx  # deferred: start-up (loads networkx only when called)
+    import networkx as nx  # deferred: start-up (loads networkx when called)
     g = nx.DiGraph()
     g.add_nodes_from(model.nodes)
     g.add_edges_from((lk.from_node, lk.to_node) for lk in model.links)
@@ -42,7 +42,8 @@ def _graph(model: SystemModel) -> Any:
 def _between(g: Any, first: str, last: str) -> set[str]:
     """The nodes of ``g`` reachable from ``first`` that reach ``last`` (both included)."""
     import networkx as nx  # deferred: start-up (loads networkx only when called)
-    return (nx.descendants(g, first) | {first}) & (nx.ancestors(g, last) | {last})
+    both: set[str] = (nx.descendants(g, first) | {first}) & (nx.ancestors(g, last) | {last})
+    return both
 
 
 def other_paths(model: SystemModel, path: Sequence[str]) -> tuple[list[tuple[str, ...]], bool]:

@@ -39,6 +39,7 @@ from typing import Any, Callable, Sequence
 
 from rclverify.cli import bundle, calculus, contracts, explain, requirements, runs, verify, workspace
 from rclverify.cli.common import AddCommand, print_diags
+from rclverify.core.extras import MissingExtra
 from rclverify.lang.errors import RclError
 
 
@@ -127,6 +128,9 @@ def _run(args: argparse.Namespace) -> int:
         return _reader_left()
     except RclError as exc:
         return print_diags(exc)
+    except MissingExtra as exc:  # an optional part not installed: one line naming the extra (core/extras.py)
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
     except RunInProgress as exc:  # report/bundle --no-wait while a run holds the workspace
         print(f"{args.workspace}: error: {exc}", file=sys.stderr)
         return 1

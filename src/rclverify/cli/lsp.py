@@ -31,5 +31,8 @@ def cmd_lsp(args: argparse.Namespace) -> int:
     if args.workspace and not Path(args.workspace).is_dir():
         print(f"{args.workspace}: error: no such workspace directory", file=sys.stderr)
         return 2
+    from rclverify.core.extras import require  # deferred: start-up (only for this command)
+    require("pygls", "the RCL language server")  # MissingExtra: one line (cli/commands.py)
+    require("lsprotocol", "the RCL language server")
     from rclverify.tools.lsp.server import serve  # deferred: start-up (loads lsprotocol, pygls and more only when called)
     return serve(Path(args.workspace) if args.workspace else None, args.plan)

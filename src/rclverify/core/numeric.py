@@ -25,6 +25,7 @@ import importlib
 import sys
 from contextlib import AbstractContextManager
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 from rclverify.core.environ import variable_during
 
@@ -47,8 +48,15 @@ def import_numpy() -> ModuleType:
 def scipy_special() -> ModuleType:
     """The ``scipy.special`` module, numpy's and scipy's OpenBLAS loaded
     with one thread (numpy is loaded with this module).  Raises
-    ``ImportError`` when scipy is missing."""
-    return _loaded("scipy.special")  # 0.3 s, only where a statistic is computed
+    :class:`~rclverify.core.extras.MissingExtra` (an ``ImportError``) when
+    scipy, the ``stats`` extra, is missing."""
+    try:
+        return _loaded("scipy.special")  # 0.3 s, only where a statistic is computed
+    except ImportError as exc:
+        from rclverify.core.extras import MissingExtra, installed  # deferred: only when scipy is missing
+        if installed("scipy"):
+            raise
+        raise MissingExtra("scipy", "the exact Clopper-Pearson bound") from exc
 
 
 def _loaded(name: str) -> ModuleType:
@@ -62,4 +70,9 @@ def _loaded(name: str) -> ModuleType:
     return module
 
 
-np = import_numpy()
+if TYPE_CHECKING:  # the type checker reads numpy's own annotations (np.ndarray, dtypes)
+    import numpy
+
+    np = numpy  # a module alias, exported to the modules that import ``np`` from here
+else:
+    np = import_numpy()

@@ -25,6 +25,9 @@ The rules assume the runs are independent and representative of the
 operating conditions they are tagged with; nothing here can check that
 (docs/statistics.md says what the plan must state).  Standard library and
 scipy only: this sits with the evidence records, below every stage.
+scipy is the ``stats`` extra (docs/install.md): without it a bound with
+``k > 0`` cannot be computed, :func:`trivial_or_exact` gives the trivial
+bound 1 with the reason, and :func:`decide` says ``inconclusive``.
 """
 from __future__ import annotations
 
@@ -52,6 +55,18 @@ def upper_bound(k: int, n: int, level: float) -> float:
         return 1.0 - math.pow(1.0 - level, 1.0 / n)
     from rclverify.core.numeric import scipy_special  # here, not at import: scipy costs every plan load 0.3 s (issue 67)
     return float(scipy_special().betaincinv(k + 1, n - k, level))  # Beta(k+1, n-k)'s quantile at level
+
+
+def trivial_or_exact(k: int, n: int, level: float) -> tuple[float, str]:
+    """``(upper_bound(k, n, level), "")``, or ``(1.0, why)`` when the exact
+    bound needs scipy and the ``stats`` extra is not installed: 1 bounds
+    every probability, so the figure stays true, and ``why`` is the one
+    line naming the extra (:mod:`rclverify.core.extras`)."""
+    from rclverify.core.extras import MissingExtra  # deferred: start-up (the module is small; only where a bound is computed)
+    try:
+        return upper_bound(k, n, level), ""
+    except MissingExtra as exc:
+        return 1.0, str(exc)
 
 
 def lower_bound(k: int, n: int, level: float) -> float:
@@ -212,6 +227,15 @@ def decide(counts: Mapping[str, Any], target: TargetLike) -> dict[str, Any]:
     clean), or ``pending`` (``runs_needed`` further clean runs would)."""
     n, k, unsure = trials(counts, target.per)
     worst = k + unsure
+    from rclverify.core.extras import MissingExtra  # deferred: start-up (only where a target is decided)
+    try:
+        upper_bound(worst, n, target.level)
+    except MissingExtra as exc:  # no bound without scipy: nothing decided, said so
+        unit = "run" if target.per == "run" else "answer"
+        return {"n": n, "k": k, "undecided": unsure, "bound": 1.0, "bound_without_undecided": 1.0,
+                "level": target.level, "target": target.to_json(), "runs_needed": None,
+                "sprt": sprt(worst, n, target.bound, target.level).to_json(), "status": "inconclusive",
+                "explanation": f"{k} violating {unit}(s) in {n}: the bound is not computed ({exc})"}
     bound = upper_bound(worst, n, target.level)
     best = upper_bound(k, n, target.level)
     test = sprt(worst, n, target.bound, target.level)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping, TypedDict
 
-from rclverify.records.statistics import count_runs, decide, upper_bound
+from rclverify.records.statistics import count_runs, decide, trivial_or_exact
 from rclverify.model.plan.model import Plan
 from rclverify.model.plan.targets import UNSTATED, entry_environment, entry_origin
 
@@ -57,9 +57,9 @@ def _group_row(node: str, env: str, origin: str, rows: list[Mapping[str, Any]]) 
     counted = origin != "harness" and n > 0
     return {"node": node, "environment": env, "origin": origin, "kind": "runs",
             "counts": {key: v for key, v in counts.items() if key != "digests"}, "recorded": recorded,
-            "level": LEVEL, "bound": upper_bound(k, n, LEVEL) if counted else None,
-            "note": "" if counted else ("driven by a test harness: not operation, no bound" if origin == "harness"
-                                        else "no judged run: no bound")}
+            "level": LEVEL, "bound": trivial_or_exact(k, n, LEVEL)[0] if counted else None,
+            "note": trivial_or_exact(k, n, LEVEL)[1] if counted else (
+                "driven by a test harness: not operation, no bound" if origin == "harness" else "no judged run: no bound")}
 
 
 def _target_row(e: Mapping[str, Any]) -> dict[str, Any]:
@@ -102,7 +102,9 @@ def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[s
         row: dict[str, Any] = {"environment": env, "origin": origin,
                                "counts": {k: v for k, v in counts.items() if k != "digests"}}
         level = target.level if target is not None else LEVEL
-        row["bound"] = upper_bound(counts["violating_runs"] + counts["undecided_runs"], counts["runs"], level)
+        row["bound"], why = trivial_or_exact(counts["violating_runs"] + counts["undecided_runs"], counts["runs"], level)
+        if why:
+            row["note"] = why
         row["level"] = level
         if target is not None:
             d = decide(counts, target)

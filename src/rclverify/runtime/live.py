@@ -49,7 +49,7 @@ from rclverify.runtime.logchecks import LogChecks
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.runtime.worker import EngineWorker
 import warnings
-from rclverify.records.statistics import upper_bound
+from rclverify.records.statistics import trivial_or_exact
 from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
 
 VERDICT_LOG_TOPIC = "rclverify/verdict"
@@ -257,7 +257,8 @@ def running_bound(res: NodeResult) -> str:
     n = c.get("satisfied", 0) + c.get("violated", 0) + c.get("inconclusive", 0)
     if not n:
         return ""
-    return f"; {n} answer(s) counted, 95 % bound {upper_bound(n - c.get('satisfied', 0), n, 0.95):.3g} per answer"
+    bound, why = trivial_or_exact(n - c.get('satisfied', 0), n, 0.95)
+    return f"; {n} answer(s) counted, 95 % bound {bound:.3g} per answer" + (f" ({why})" if why else "")
 
 
 def live_counts(res: NodeResult, sha: str, seconds: float) -> dict[str, Any]:

@@ -36,8 +36,15 @@ def read_trace(path: Path, msg_dirs: Sequence[Path] = (), *, streams: bool = Fal
         if on_warning is not None:
             on_warning(w)
     if not path.is_dir() and path.suffix in LOG_SUFFIXES:
+        from rclverify.core.extras import installed  # deferred: optional or conditional (inside a block)
+        if not installed("numpy"):  # no batch path without the fast extra: the events one by one
+            from rclverify.traces.jsonl import read_jsonl  # deferred: optional or conditional (inside a block)
+            return read_jsonl(path)
         from rclverify.traces.jsonl_blocks import JsonlLog  # deferred: optional or conditional (inside a block)
         return JsonlLog(path)  # its events, as read_jsonl reads them, or its blocks for the batch path
+    from rclverify.core.extras import installed, missing_message  # deferred: start-up (only for a bag)
+    if not installed("rosbags"):
+        raise TraceError(f"{path}: error: {missing_message('rosbags', 'reading a bag')}")
     from rclverify.traces.bag_blocks import BagTrace  # deferred: start-up (loads numpy, rclverify.traces.bag and more only when called)
     return BagTrace(path, msg_dirs)  # read_bag's events, or its blocks for the batch path (a ROS 2 bag)
 

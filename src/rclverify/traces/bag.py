@@ -29,13 +29,18 @@ def _definitions(msg_dirs: Sequence[Path]) -> tuple[tuple[str, str, Path], ...]:
 def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
     """Type definitions parsed from every ``<pkg>/msg/<Type>.msg`` under ``msg_dirs``.
 
-    Raises :class:`TraceError` (naming the file) for a definition rosbags rejects.
+    Raises :class:`TraceError` (naming the file) for a definition rosbags rejects,
+    :class:`~rclverify.core.extras.MissingExtra` when there are definitions
+    and rosbags, the ``ros`` extra, is not installed.
     """
     return _parsed(_definitions(msg_dirs))
 
 
 def _parsed(definitions: tuple[tuple[str, str, Path], ...]) -> dict[str, Any]:
-    from rosbags.typesys import get_types_from_msg  # deferred: start-up (loads rosbags and more only when called)
+    if not definitions:
+        return {}
+    from rclverify.core.extras import require  # deferred: start-up (loads rosbags and more only when called)
+    get_types_from_msg = require("rosbags.typesys", "reading the workspace's .msg definitions").get_types_from_msg
     types: dict[str, Any] = {}
     for name, text, f in definitions:
         try:

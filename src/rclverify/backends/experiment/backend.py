@@ -35,6 +35,7 @@ from rclverify.backends.experiment.consistency import check, figures_json
 from rclverify.backends.experiment.criterion import evaluate
 from rclverify.backends.experiment.figures import format_value
 from rclverify.backends.experiment.plot import render_svg
+from rclverify.core.extras import MissingExtra
 from rclverify.backends.experiment.target import run_target, target_obligations
 
 NAME = "experiment"
@@ -105,7 +106,12 @@ class ExperimentBackend:
         flags = check(cfg.figures)
         svg_path = target.artifacts / f"{obligation.id}.svg"
         title = f"{target.node.name}: {cfg.criterion_text}"
-        atomic_write_text(svg_path, render_svg(cfg.figures, cfg.constants, title))
+        try:
+            atomic_write_text(svg_path, render_svg(cfg.figures, cfg.constants, title))
+            plot, plot_note = target.rel(svg_path), ""
+        except MissingExtra as exc:  # the plot illustrates; the verdict below does not rest on it
+            svg_path.unlink(missing_ok=True)
+            plot, plot_note = None, f"; no plot drawn: {exc}"
         figures = ", ".join(f"{k} {v}" for k, v in _figure_rows(cfg))
         details: dict[str, Any] = {
             "criterion": cfg.criterion_text, "file": cfg.file, "figures": figures_json(cfg.figures),
@@ -113,11 +119,12 @@ class ExperimentBackend:
             "criterion_holds": verdict.holds, "flags": flags, "per_trial": verdict.per_trial,
             "failing_trials": list(verdict.failing),
             "figures_table": _figure_rows(cfg) + [[f"flag: {f['bound']}", f["explanation"]] for f in flags],
-            "plot": target.rel(svg_path),
+            "plot": plot,
         }
         log = "\n".join([f"criterion: {cfg.criterion_text}", f"figures: {figures}",
                          f"criterion holds: {verdict.holds}"] + [f"flag: {f['bound']}: {f['explanation']}" for f in flags])
-        kw: dict[str, Any] = dict(log=log, artifacts=(target.rel(svg_path),), details=details)
+        log += plot_note.replace("; ", "\n", 1)
+        kw: dict[str, Any] = dict(log=log, artifacts=(plot,) if plot else (), details=details)
         flag_text = ("; the summary statistics cannot all be true together: "
                      + "; ".join(f"{f['bound']}: {f['explanation']}" for f in flags)) if flags else ""
         if verdict.holds is False:

@@ -14,10 +14,13 @@ from rclverify.backends.experiment.figures import BASE, Figures, Quantity
 
 def render_svg(fig: Figures, constants: Mapping[str, Quantity], title: str) -> str:
     """The SVG text: per-trial values (or, for a summary, best/mean +- std/worst)
-    with a horizontal line for every constant of the measured dimension."""
+    with a horizontal line for every constant of the measured dimension.
+    Raises :class:`~rclverify.core.extras.MissingExtra` without matplotlib
+    (the ``plots`` extra)."""
     from rclverify.core.numeric import import_numpy  # deferred: start-up (numpy, matplotlib's, with one BLAS thread)
     import_numpy()
-    import matplotlib  # deferred: start-up (loads matplotlib only when called)
+    from rclverify.core.extras import require  # deferred: start-up (only where a plot is drawn)
+    matplotlib = require("matplotlib", "the experiment's plot")  # raises MissingExtra (core/extras.py)
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # deferred: start-up (loads matplotlib and more only when called)
     unit = BASE.get(fig.dim, "")

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from typing import Callable, Iterable, Mapping
 
+from rclverify.core.extras import installed
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
-from rclverify.backends.monitors.batch import check_batch
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.verdicts import LINK_TOPICS, VERDICTS, NodeResult, Verdict, link_of, producers
 
@@ -39,11 +39,13 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     One node whose contract the batch path takes (:mod:`.batch`: quantifier-free
     REAL/enumeration contracts, one output topic, no state, trigger or link) is
     judged by it, unless ``batch`` is false: the same verdicts, in the same
-    order, the same result (tests/test_monitor_batch.py).  A live monitor never
-    comes here: it feeds :class:`NodeMonitor` itself.
+    order, the same result (tests/test_monitor_batch.py).  Without numpy (the
+    ``fast`` extra) every node is streamed.  A live monitor never comes here:
+    it feeds :class:`NodeMonitor` itself.
     """
     nodes = list(nodes)
-    if len(nodes) == 1 and batch:
+    if len(nodes) == 1 and batch and installed("numpy"):
+        from rclverify.backends.monitors.batch import check_batch  # deferred: optional or conditional (numpy, the fast extra)
         done = check_batch(checked, nodes[0], events, rules, horizon, on_verdict, tolerance, end)
         if done is not None:  # eligible: the same verdicts, in batches (batch.py)
             return done[0], [done[1]]

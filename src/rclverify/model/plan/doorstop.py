@@ -105,9 +105,10 @@ def read_requirements(root: Path, folder: str, loc: ast.Loc) -> tuple[Any, ...]:
                                                       f".doorstop.yml) under {folder!r}", "E-io")
     try:
         from doorstop.core.document import Document  # deferred: optional or conditional (inside a block)
-    except ImportError:  # pragma: no cover - a dependency of rclverify
-        raise plan_error(loc.file, loc.line, loc.col, "requirements_from: the 'doorstop' package is not installed "
-                                                      "(pip install doorstop)", "E-io") from None
+    except ImportError:  # the doorstop extra (core/extras.py)
+        from rclverify.core.extras import missing_message  # deferred: optional or conditional (inside a block)
+        raise plan_error(loc.file, loc.line, loc.col,
+                         "requirements_from: " + missing_message("doorstop", "reading a Doorstop tree"), "E-io") from None
     out = []
     for d in docs:
         try:

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 from itertools import chain
 from typing import Iterable, Mapping, Sequence
 
+from rclverify.core.extras import installed
 from rclverify.model.system.cycles import upstream_bits
 
 
@@ -123,11 +124,12 @@ def derived_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str,
     ``vector_from`` nodes on, the cones are bit masks over the nodes in
     sorted order and each cone's doubts are gathered in that order by numpy
     (:func:`_vector_claims`: sorting each cone's names was most of the
-    report's time at 5000 nodes, issue 67).  Equal to :func:`claim` over the
+    report's time at 5000 nodes; without numpy, the ``fast`` extra, the
+    per-node path).  Equal to :func:`claim` over the
     cone (``tests/test_confidence.py``)."""
     labels = [p.label for ps in own.values() for p in ps]
     reads = {n: list(producers.get(n, ())) for n in own}
-    if len(labels) == len(set(labels)) and len(own) >= vector_from:
+    if len(labels) == len(set(labels)) and len(own) >= vector_from and installed("numpy"):
         return _vector_claims(own, reads)
     cone = cones(reads)
     if len(set(labels)) != len(labels):

@@ -28,9 +28,14 @@ import base64
 import hashlib
 from pathlib import Path
 
-from cryptography.exceptions import InvalidSignature
-from cryptography.hazmat.primitives import serialization
-from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
+from rclverify.core.extras import MissingExtra
+
+try:
+    from cryptography.exceptions import InvalidSignature
+    from cryptography.hazmat.primitives import serialization
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
+except ModuleNotFoundError as _missing:  # the sign extra: one line where a signature is made or checked
+    raise MissingExtra("cryptography", "signing or checking a bundle's signature") from _missing
 
 from rclverify.records.store import atomic_write_bytes
 from rclverify.report.bundle.manifest import BundleError

@@ -222,8 +222,9 @@ class TypeTable:
 
     def _fallback(self, name: str) -> TypeInfo | None:
         if self._store is None:
-            from rosbags.typesys import Stores, get_typestore  # deferred: optional or conditional (inside a block)
-            self._store = get_typestore(Stores.ROS2_HUMBLE)
+            from rclverify.core.extras import require  # deferred: optional or conditional (inside a block)
+            typesys = require("rosbags.typesys", "reading the standard ROS message types")  # MissingExtra: the ros extra
+            self._store = typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
         fd = self._store.fielddefs.get(name)
         if fd is None:
             return None

@@ -63,10 +63,13 @@ def find_manifests(paths: list[Path], skipped: list[str] | None = None) -> list[
 
 def read_package(manifest: Path, shown: str) -> tuple[Package | None, list[Note]]:
     """The package ``manifest`` describes, or ``None`` and a located error."""
-    from catkin_pkg.package import InvalidPackage, parse_package_string  # deferred: start-up (loads catkin_pkg and more only when called)
+    from rclverify.core.extras import require  # deferred: start-up (loads catkin_pkg and more only when called)
+    catkin = require("catkin_pkg.package", "reading package.xml")
+    InvalidPackage, parse_package_string = catkin.InvalidPackage, catkin.parse_package_string
     root, note = parse_xml(manifest, shown)
     if note is not None:
         return None, [note]
+    assert root is not None  # parse_xml gives the root when it gives no note
     deps = sum(1 for el in root.iter() if isinstance(el.tag, str) and el.tag.endswith("depend"))
     if deps > MAX_DEPENDS:
         return None, [Note(Src(shown), f"package.xml has {deps} dependency elements, more than {MAX_DEPENDS}: "

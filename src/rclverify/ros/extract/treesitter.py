@@ -10,18 +10,18 @@ _PARSERS: dict[str, Any] = {}
 
 def parser(language: str) -> Any:
     """The ``tree_sitter.Parser`` of ``language`` ("cpp" or "python"), built on
-    first use. Raises ``ImportError`` when that grammar package is not installed,
-    ``KeyError`` for another language."""
+    first use. Raises :class:`~rclverify.core.extras.MissingExtra` (an
+    ``ImportError``) when tree-sitter or that grammar package, the ``ros``
+    extra, is not installed, ``KeyError`` for another language."""
     p = _PARSERS.get(language)
     if p is None:
-        from tree_sitter import Language, Parser  # deferred: optional or conditional (inside a block)
-        if language == "cpp":
-            import tree_sitter_cpp as grammar  # deferred: optional or conditional (inside a block)
-        elif language == "python":
-            import tree_sitter_python as grammar  # type: ignore[no-redef]; deferred: optional or conditional (inside a block)
-        else:
+        if language not in ("cpp", "python"):
             raise KeyError(language)
-        p = _PARSERS[language] = Parser(Language(grammar.language()))
+        from rclverify.core.extras import require  # deferred: optional or conditional (inside a block)
+        purpose = "reading the robot's C++ sources" if language == "cpp" else "reading the robot's Python sources"
+        ts = require("tree_sitter", purpose)
+        grammar = require(f"tree_sitter_{language}", purpose)
+        p = _PARSERS[language] = ts.Parser(ts.Language(grammar.language()))
     return p
 
 

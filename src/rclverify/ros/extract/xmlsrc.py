@@ -13,7 +13,8 @@ from rclverify.ros.extract.model import Note, Src
 def parse_xml(path: Path, shown: str) -> tuple[Any | None, Note | None]:
     """The root element of ``path``, or ``(None, note)`` with a located
     ``ROS-PARSE`` error when the file is not well-formed XML or unreadable."""
-    from lxml import etree  # deferred: start-up (loads lxml only when called)
+    from rclverify.core.extras import require  # deferred: start-up (loads lxml only when called)
+    etree = require("lxml.etree", "reading launch files and manifests")
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False, remove_comments=True)
     try:
         data = safefs.read_bytes(path)

@@ -68,8 +68,10 @@ def import_cyclonedds() -> Any:
         import cyclonedds.domain  # noqa: F401  (loads the C library: fails here when it cannot); deferred: optional or conditional (inside a block)
         return cyclonedds
     except ImportError as exc:
-        raise DdsUnavailable(f"the cyclonedds Python binding is not installed ({exc}); pip install "
-                             "'cyclonedds>=11,<12'") from None
+        from rclverify.core.extras import installed, missing_message  # deferred: optional or conditional (inside a block)
+        if not installed("cyclonedds"):
+            raise DdsUnavailable(missing_message("cyclonedds", "ROS 2 over DDS")) from None
+        raise DdsUnavailable(f"the cyclonedds Python binding does not load ({exc})") from None
 
 
 def domain_id(env: Mapping[str, str] | None = None) -> int:
