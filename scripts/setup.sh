@@ -3,9 +3,14 @@
 #   - Debian packages (below): Dafny, graphviz, ROS 1 and Chromium; each
 #     optional, their evidence is pending, the diagram replaced by DOT
 #     source, or the live tests skipped with the reason when missing;
-#   - the rclverify package itself with its Python dependencies and pytest (among them
-#     cyclonedds, whose wheel carries Cyclone DDS's C library: ROS 2 live, over DDS);
-#   - with --tests, the test modules' bytecode as pytest rewrites it (below).
+#   - a virtual environment, .venv/ beside the project, made by python3 (or
+#     $PYTHON): a Debian or Ubuntu python3 is externally managed (PEP 668) and
+#     refuses pip, so nothing is ever installed into it;
+#   - rclverify in that environment with every optional extra (docs/install.md),
+#     pinned by constraints.txt where it was resolved for this Python;
+#   - with --tests, the test extras (pytest, mypy) and the test modules' bytecode
+#     as pytest rewrites it (below); with --tests or --ros2, ROS 2's PyPI wheels in .venv-ros2/.
+# Afterwards: .venv/bin/rclverify verify (or `. .venv/bin/activate` and doit verify).
 # Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -47,11 +52,44 @@ else
 fi
 
 PY=${PYTHON:-python3}
-echo "setup: installing rclverify and its Python dependencies"
-"$PY" -m pip install --quiet --disable-pip-version-check -e '.[test]'
+if ! "$PY" -c 'import sys; sys.exit(sys.version_info < (3, 10))' 2>/dev/null; then
+  echo "setup: rclverify needs Python 3.10 or newer; $PY is $("$PY" -V 2>&1 || echo missing)" >&2
+  exit 1
+fi
+
+# The virtual environment.  Debian and Ubuntu ship venv's pip (ensurepip) apart, in python3-venv
+# (python3.X-venv): installed here when this Python lacks it.  A .venv made by another Python, or
+# broken, is made anew.
+VENV=.venv
+want=$("$PY" -c 'import sys; print(sys.version.split()[0])')
+if [ -x "$VENV/bin/python" ] && [ "$("$VENV/bin/python" -c 'import sys; print(sys.version.split()[0])' 2>/dev/null)" != "$want" ]; then
+  echo "setup: $VENV was made by another Python; making it anew with $PY ($want)"
+  rm -rf "$VENV"
+fi
+if [ ! -x "$VENV/bin/python" ] || ! "$VENV/bin/python" -m pip --version >/dev/null 2>&1; then
+  rm -rf "$VENV"
+  if ! "$PY" -m venv "$VENV" >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1; then
+    rm -rf "$VENV"
+    minor=$("$PY" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')
+    echo "setup: installing Debian's python$minor-venv (venv's pip for $PY)"
+    as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "python$minor-venv" >/dev/null 2>&1 \
+      || as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv >/dev/null 2>&1 || true
+  fi
+  [ -x "$VENV/bin/python" ] && "$VENV/bin/python" -m pip --version >/dev/null 2>&1 \
+    || { rm -rf "$VENV"; "$PY" -m venv "$VENV"; } \
+    || { echo "setup: $PY cannot make a virtual environment (install python3-venv)" >&2; exit 1; }
+fi
+VPY=$VENV/bin/python
+
+# constraints.txt pins what the lock resolved (scripts/lock.sh, docs/install.md); its markers
+# keep each pin to the Pythons it was resolved for.
+extras=all
+if [ "${1:-}" = "--tests" ]; then extras=all,test,dev; fi
+echo "setup: installing rclverify[$extras] into $VENV"
+"$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[$extras]"
 # The package's bytecode, compiled once here: an editable install compiles nothing, and a shell
 # with PYTHONDONTWRITEBYTECODE set would otherwise compile every module in every doit process.
-"$PY" -m compileall -q src/rclverify >/dev/null || true
+"$VPY" -m compileall -q src/rclverify >/dev/null || true
 
 # ROS 2 (Kilted) from PyPI in a venv beside the project (.venv-ros2/, docs/ros2.md): real rclpy nodes on
 # ROS 2's default middleware (rmw_fastrtps_cpp, Fast DDS) for the real-ROS 2 test tier and benches, and
@@ -80,6 +118,6 @@ fi
 # here whether or not it may write.
 if [ "${1:-}" = "--tests" ]; then
   echo "setup: compiling the test modules"
-  env -u PYTHONDONTWRITEBYTECODE "$PY" -m pytest --collect-only -q -n 0 -p no:cacheprovider >/dev/null \
+  env -u PYTHONDONTWRITEBYTECODE "$VPY" -m pytest --collect-only -q -n 0 -p no:cacheprovider >/dev/null \
     || echo "setup: the test modules did not all collect; pytest will say why"
 fi
