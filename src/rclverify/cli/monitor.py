@@ -101,7 +101,7 @@ def _report_run(report: list[dict[str, Any]], run: RecordedRun, trace: str, cfg:
     items = run.not_judged
     versions = tool_versions() if as_json else ""  # only the JSON report shows them (the distributions' search costs start-up)
     for res in run.results:
-        status, explanation = verdict_status(res, trace)
+        status, explanation = run.verdict(res, trace)
         violated = violated or status == "failed"
         entry = {"node": res.node, "status": status, "explanation": explanation,
                  **monitoring_details(res, trace, run.events, "", versions, cfg.horizon, cfg.tolerance)}

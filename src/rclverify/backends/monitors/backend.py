@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping
 
@@ -37,6 +38,7 @@ from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judg
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
 from rclverify.backends.monitors.rml import Spec, rml_id, translate
+from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
 
@@ -181,30 +183,18 @@ class MonitorsBackend:
         except Exception as exc:
             return evidence("error", f"the plan entry no longer loads: {exc}")
         trace = str(obligation.data.get("trace", ""))
-        # one read of the run feeds the untimed check, the deadlines and the periods
-        beside = _Beside()
-        if has_deadlines(target.node):
-            beside.add("deadlines", lambda: DeadlineMonitor(target.checked, target.node, cfg.rules,
-                                                            horizon=cfg.horizon, tolerance=cfg.tolerance))
-        if has_periods(target.node):  # periodic outputs on the same run (periods.py)
-            beside.add("periods", lambda: PeriodMonitor(target.node))
-        if has_declarations(target.node):  # initially, progress, periodic judged on the same run (declarations.py)
-            beside.add("declarations", lambda: DeclarationMonitor(target.checked, target.node, cfg.rules,
-                                                                  tolerance=cfg.tolerance))
-        # a live log's service calls and action goals, judged as the live run judged them (log_calls.py)
-        calls = LogCalls(target.checked, [target.node], cfg.rules, cfg.horizon, trace)
+        note = ""
         try:
-            span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
-            heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
-            source = read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs])
-            events, results = check_trace(target.checked, [target.node], Counted(span.tap(beside.tap(
-                calls.tap(source) if calls.active else source)), heard), cfg.rules, cfg.horizon,
-                tolerance=cfg.tolerance)
-            summary = calls.finish()
+            read = _judge(target, cfg, trace, None)
+            if read.watch.count:  # messages recorded out of stamp order: one clock, the stamps (stamp_order.py)
+                note = read.watch.note()
+                read = _judge(target, cfg, trace, read.watch.lag)
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
         except Exception as exc:  # a recorded run is user input: whatever the checker meets is this record's error
             return evidence("error", f"the trace could not be checked: {type(exc).__name__}: {exc}", log=str(exc))
+        beside, calls, span, heard = read.beside, read.calls, read.span, read.heard
+        events, results, summary = read.events, read.results, read.summary
         res = results[0]
         details = monitoring_details(res, trace, events, trace_sha256(target.root, trace), versions, cfg.horizon,
                                      cfg.tolerance, duration_s=span.seconds)
@@ -240,11 +230,54 @@ class MonitorsBackend:
                                                  {dl.node: dl.counts} if dl is not None else {}, f"in {trace}")
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
-        explanation = entry["explanation"]
+        explanation = entry["explanation"] + (f"; {note}" if note else "")
+        if note:
+            details["stamp_order"] = note
         extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))
+
+
+@dataclass
+class _Read:
+    """One pass of the monitors over a run (:func:`_judge`)."""
+
+    beside: "_Beside"
+    calls: LogCalls
+    span: "TraceSpan"
+    heard: dict[str, int]
+    watch: StampWatch
+    events: int
+    results: list[Any]
+    summary: dict[str, Any] | None
+
+
+def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None) -> _Read:
+    """One read of the run at ``trace`` feeding the untimed check, the deadlines, the periods, the
+    declarations and a live log's calls; in stamp order when ``lag`` (s, :func:`.stamp_order.in_stamp_order`)
+    is given.  Raises what the readers and the checkers raise (the caller reports it)."""
+    beside = _Beside()
+    if has_deadlines(target.node):
+        beside.add("deadlines", lambda: DeadlineMonitor(target.checked, target.node, cfg.rules,
+                                                        horizon=cfg.horizon, tolerance=cfg.tolerance))
+    if has_periods(target.node):  # periodic outputs on the same run (periods.py)
+        beside.add("periods", lambda: PeriodMonitor(target.node))
+    if has_declarations(target.node):  # initially, progress, periodic judged on the same run (declarations.py)
+        beside.add("declarations", lambda: DeclarationMonitor(target.checked, target.node, cfg.rules,
+                                                              tolerance=cfg.tolerance))
+    # a live log's service calls and action goals, judged as the live run judged them (log_calls.py)
+    calls = LogCalls(target.checked, [target.node], cfg.rules, cfg.horizon, trace)
+    span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
+    heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
+    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
+    source: Iterable[Any] = read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs])
+    if lag is not None:
+        source = in_stamp_order(source, lag)
+    events, results = check_trace(target.checked, [target.node], Counted(span.tap(beside.tap(
+        calls.tap(source) if calls.active else source)), heard, watch), cfg.rules, cfg.horizon,
+        tolerance=cfg.tolerance)
+    return _Read(beside, calls, span, heard, watch, events, results, calls.finish())
 
 
 class _Beside:

@@ -29,11 +29,13 @@ the live runs (:mod:`.live`, :mod:`.dds_live`).
 """
 from __future__ import annotations
 
+import functools
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Iterator, Mapping
 
 from rclverify.lang.types import CheckedNode
+from rclverify.backends.monitors.stamp_order import StampWatch
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 REASONS = ("nothing heard", "type refused", "not decoded", "not paired", "no answer", "no verdict")
@@ -60,21 +62,31 @@ class Heard:
     publishers: Mapping[str, int] | None = None
 
 
+def _where(block: Any, row: int) -> str:
+    """Where row ``row`` of a columnar block was read."""
+    return str(block[row].where)
+
+
 class Counted:
     """A recorded run's events passed on unchanged, counted per topic into
     ``heard`` (topic without ``/`` -> events) as they are read.  A log the
     batch path reads in blocks (``events.blocks``, rows.py) keeps that path:
     its blocks are passed on and counted by their ``topics`` column, so
-    counting never turns the columnar reading into one event at a time."""
+    counting never turns the columnar reading into one event at a time.
+    ``watch`` (a :class:`.stamp_order.StampWatch`) sees every event's place
+    on the run's clock, a columnar block by its first and last time."""
 
-    def __init__(self, events: Iterable[Any], heard: dict[str, int]) -> None:
-        self.events, self.heard = events, heard
+    def __init__(self, events: Iterable[Any], heard: dict[str, int], watch: StampWatch | None = None) -> None:
+        self.events, self.heard, self.watch = events, heard, watch
 
     def __iter__(self) -> Iterator[Any]:
         heard = self.heard
+        see = self.watch.see if self.watch is not None else None
         for ev in self.events:
             key = ev.topic.strip("/")
             heard[key] = heard.get(key, 0) + 1
+            if see is not None:
+                see(ev)
             yield ev
 
     def blocks(self, fields: Any, rows: int) -> Iterator[Any] | None:
@@ -85,7 +97,14 @@ class Counted:
 
     def _counted(self, blocks: Iterator[Any]) -> Iterator[Any]:
         heard = self.heard
+        watch = self.watch
         for block in blocks:
+            if watch is not None:
+                if isinstance(block, list):
+                    for ev in block:
+                        watch.see(ev)
+                else:  # a columnar block: unstamped messages, their times
+                    watch.see_times(block.times, functools.partial(_where, block))
             counts = getattr(block, "topic_counts", None)  # a bag block counts its connections' codes
             if counts is None:
                 topics = [ev.topic for ev in block] if isinstance(block, list) else block.topics

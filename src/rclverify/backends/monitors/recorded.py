@@ -22,6 +22,7 @@ from rclverify.backends.monitors.declarations import (DeclarationMonitor, Declar
 from rclverify.backends.monitors.judged import Counted, Heard, not_judged
 from rclverify.backends.monitors.log_calls import LogCalls
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
+from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, stale_reason
 from rclverify.backends.monitors.summary import verdict_status
 from rclverify.backends.monitors.verdicts import NodeResult
 
@@ -34,7 +35,10 @@ class RecordedRun:
     them); ``calls``: a live ROS 2 log's call summary (``None``: no call
     lines), with its per-node call ``call_entries`` and
     ``deadline_entries`` and ``missed`` ``(missed, judged)`` call
-    deadlines; ``not_judged``: the items the run did not judge."""
+    deadlines; ``not_judged``: the items the run did not judge;
+    ``stamp_order``: how a run recorded out of stamp order was judged
+    (``""``: in the order read); ``stale``: why a run that could not be read
+    again in stamp order gives no green (:mod:`.stamp_order`)."""
 
     events: int
     results: list[NodeResult]
@@ -46,6 +50,15 @@ class RecordedRun:
     deadline_entries: list[dict[str, Any]]
     missed: tuple[int, int]
     not_judged: list[dict[str, str]]
+    stamp_order: str = ""
+    stale: str = ""
+
+    def verdict(self, res: NodeResult, trace: str) -> tuple[str, str]:
+        """``(status, explanation)`` of node result ``res`` on this run: its
+        verdict (:func:`.summary.verdict_status`), inconclusive when the run
+        is :attr:`stale`, with how the run was ordered said."""
+        status, text = _unless_stale(verdict_status(res, trace), self.stale)
+        return status, text + (f"; {self.stamp_order}" if self.stamp_order else "")
 
 
 def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
@@ -56,6 +69,56 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
     the reader's warnings.  Raises :class:`rclverify.traces.TraceError` for
     a run that cannot be read, and whatever a malformed run makes the
     readers raise (the caller reports either, located)."""
+    one = _pass(checked, nodes, cfg, root, trace, on_warning, None)
+    stale = ""
+    if one.watch.count:  # messages recorded out of stamp order: one clock, the stamps (stamp_order.py)
+        if _readable_again(Path(trace)):
+            note = one.watch.note()
+            one = _pass(checked, nodes, cfg, root, trace, on_warning, one.watch.lag)
+            one.note = note
+        else:
+            stale = stale_reason(one.watch, trace)
+    dmons, pmons, decl, calls, heard, events, results = (one.dmons, one.pmons, one.decl, one.calls, one.heard,
+                                                         one.events, one.results)
+    dres = [m.finish() for m in dmons]
+    pres = [p.finish() for p in pmons]
+    decl_res = [add_periods(dm.finish(), dm.node, next((p for p in pres if p.node == dm.node.name), None))
+                for dm in decl]
+    summary = calls.finish()
+    statuses = {res.node: [_unless_stale(verdict_status(res, trace), stale)] for res in results}
+    centries, dentries = calls.entries(), calls.deadline_entries()
+    for c in centries:
+        statuses.setdefault(c["node"], []).append((c["status"], c["explanation"]))
+    dcounts = {d.node: dict(d.counts) for d in dres}
+    for r in calls.deadlines():  # the topic and the call deadlines summed, as the live run does
+        total = dcounts.setdefault(r.node, {})
+        for v, k in r.counts.items():
+            total[v] = total.get(v, 0) + k
+    items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
+                       f"in {trace}")
+    return RecordedRun(events, results, dres, pres, decl_res, summary, centries, dentries,
+                       calls.missed() if summary is not None else (0, 0), items, one.note, stale)
+
+
+@dataclass
+class _Pass:
+    """The monitors of one read of a run and what the untimed check returned."""
+
+    dmons: list[DeadlineMonitor]
+    pmons: list[PeriodMonitor]
+    decl: list[DeclarationMonitor]
+    calls: LogCalls
+    heard: dict[str, int]
+    watch: StampWatch
+    events: int
+    results: list[NodeResult]
+    note: str = ""
+
+
+def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
+          on_warning: Callable[[str], None], lag: float | None) -> _Pass:
+    """One read of the run feeding every monitor; in stamp order when ``lag`` is given
+    (:func:`.stamp_order.in_stamp_order`)."""
     dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
              for n in nodes if has_deadlines(n)]
     pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
@@ -72,26 +135,25 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
             for dm in decl:
                 dm.feed(ev)
             yield ev
-    run = read_trace(Path(trace), [root / d for d in cfg.msg_dirs], streams=True, on_warning=on_warning)
+    run: Iterable[Any] = read_trace(Path(trace), [root / d for d in cfg.msg_dirs], streams=True, on_warning=on_warning)
+    if lag is not None:
+        run = in_stamp_order(run, lag)
     source = tap(run) if dmons or pmons or decl else run  # untapped, a log keeps its columnar reading (batch path)
     source = calls.tap(source) if calls.active else source  # only nodes with links: never the batch path
-    events, results = check_trace(checked, nodes, Counted(source, heard), cfg.rules, cfg.horizon,
+    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
+    events, results = check_trace(checked, nodes, Counted(source, heard, watch), cfg.rules, cfg.horizon,
                                   tolerance=cfg.tolerance)
-    dres = [m.finish() for m in dmons]
-    pres = [p.finish() for p in pmons]
-    decl_res = [add_periods(dm.finish(), dm.node, next((p for p in pres if p.node == dm.node.name), None))
-                for dm in decl]
-    summary = calls.finish()
-    statuses = {res.node: [verdict_status(res, trace)] for res in results}
-    centries, dentries = calls.entries(), calls.deadline_entries()
-    for c in centries:
-        statuses.setdefault(c["node"], []).append((c["status"], c["explanation"]))
-    dcounts = {d.node: dict(d.counts) for d in dres}
-    for r in calls.deadlines():  # the topic and the call deadlines summed, as the live run does
-        total = dcounts.setdefault(r.node, {})
-        for v, k in r.counts.items():
-            total[v] = total.get(v, 0) + k
-    items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
-                       f"in {trace}")
-    return RecordedRun(events, results, dres, pres, decl_res, summary, centries, dentries,
-                       calls.missed() if summary is not None else (0, 0), items)
+    return _Pass(dmons, pmons, decl, calls, heard, watch, events, results)
+
+
+def _readable_again(path: Path) -> bool:
+    """Whether the run at ``path`` can be read a second time (a regular file or a bag folder, not a stream)."""
+    return path.is_dir() or path.is_file()
+
+
+def _unless_stale(status: tuple[str, str], stale: str) -> tuple[str, str]:
+    """``status``, or ``inconclusive`` with ``stale`` (the reason) for a pass that would otherwise
+    discharge on a run judged out of stamp order (:func:`.stamp_order.stale_reason`)."""
+    if stale and status[0] in ("discharged", "pending"):
+        return "inconclusive", f"{stale}; in recording order: {status[1]}"
+    return status

@@ -1,0 +1,126 @@
+"""One clock per recorded run: the run judged in its messages' stamp order.
+
+Every engine that judges a recorded run (the response engine, the deadline,
+period and declaration monitors, a live log's calls) reads one pass over the
+run.  A message's time on the run's clock is its ``header.stamp`` when it has
+one, else the time the trace gives it (the recording or receipt time): the
+deadline monitor's clock (:func:`.deadlines.event_stamp`) and the live
+monitor's, which releases messages from its reorder buffer in that order
+(docs/monitors.md, "Ordering and time").  A bag or a log records messages
+in arrival order, and a message may arrive after one stamped later (a
+sensor driver stamps at acquisition and publishes after processing; a
+question recorded late but stamped early).  Judged in recording order, the
+response engine would pair a question with an answer stamped before it and
+miss the answer stamped right after it, while the deadline monitor reads the
+stamps: two clocks, two answers.
+
+:class:`StampWatch` sees the run's events as they are read (in
+:class:`.judged.Counted`, which every offline path has) and counts the
+messages stamped more than the transport skew (:mod:`.skew`; the engine
+already judges both readings within it) before the latest stamp heard,
+keeping the largest such lag.  A run with none was judged on one clock.  A
+run with some is read again through :func:`in_stamp_order`: a reorder
+buffer whose window is the largest lag the first pass measured releases
+every message in stamp order (no later message can be stamped before the
+latest stamp heard less that lag), each with its stamp as its time, and
+every engine judges that order.  A run that cannot be read again (a FIFO
+named on the command line) keeps the first pass's verdicts, which are then
+inconclusive with the reason (:func:`stale_reason`): never a silent green.
+"""
+from __future__ import annotations
+
+import heapq
+import math
+from typing import Any, Callable, Iterable, Iterator
+
+from rclverify.traces.events import Event, header_stamp
+
+
+def run_clock(ev: Event) -> float:
+    """The event's time on the run's clock (s): its ``header.stamp``, else
+    the time the trace gives it (module docstring)."""
+    s = header_stamp(ev.fields) if ev.fields else None
+    return ev.time if s is None else s
+
+
+class StampWatch:
+    """Counts the messages of a run, in the order read, stamped more than
+    ``skew`` seconds before the latest stamp already heard (``count``; the
+    largest such ``lag`` in seconds; ``first``: where the first was read)."""
+
+    __slots__ = ("skew", "latest", "count", "lag", "first")
+
+    def __init__(self, skew: float) -> None:
+        self.skew = skew
+        self.latest = -math.inf
+        self.count = 0
+        self.lag = 0.0
+        self.first = ""
+
+    def see(self, ev: Event) -> None:
+        """Note event ``ev``'s place on the run's clock."""
+        t = run_clock(ev)
+        latest = self.latest
+        if t >= latest:
+            self.latest = t
+        elif latest - t > self.skew:
+            self.count += 1
+            if latest - t > self.lag:
+                self.lag = latest - t
+            if not self.first:
+                self.first = ev.where
+
+    def see_times(self, times: Any, where: Callable[[int], str]) -> None:
+        """Note a columnar block of unstamped messages, ``times`` (a numpy
+        array, s) in the order read, as :meth:`see` of each (``where(i)``
+        says where row ``i`` was read)."""
+        if not len(times):
+            return
+        from rclverify.core.numeric import np  # deferred: optional or conditional (columnar blocks exist with numpy only)
+        ahead = np.maximum(np.maximum.accumulate(times), self.latest)  # the latest time heard up to each row
+        behind = ahead - times
+        late = behind > self.skew
+        if late.any():
+            self.count += int(late.sum())
+            self.lag = max(self.lag, float(behind.max()))
+            self.first = self.first or where(int(late.argmax()))
+        self.latest = float(ahead[-1])
+
+    def note(self) -> str:
+        """``""`` for a run read in stamp order, else the sentence saying how it was judged."""
+        if not self.count:
+            return ""
+        return (f"judged in stamp order: {self.count} message(s) were recorded after one stamped up to "
+                f"{self.lag * 1e3:.1f} ms later (the first at {self.first}; transport skew {self.skew * 1e3:g} ms)")
+
+
+def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
+    """``events`` in the order of their stamps on the run's clock (ties in
+    the order read), each with that stamp as its ``time`` and its index in
+    the new order; ``lag`` (s) is the largest lag a :class:`StampWatch`
+    measured on the same run, which bounds what the buffer holds."""
+    heap: list[tuple[float, int, Event]] = []
+    latest = -math.inf
+    out = 0
+    for k, ev in enumerate(events):
+        t = run_clock(ev)
+        latest = max(latest, t)
+        heapq.heappush(heap, (t, k, ev))
+        while heap and heap[0][0] < latest - lag:
+            t0, _, e0 = heapq.heappop(heap)
+            yield Event(out, t0, e0.topic, e0.fields, e0.where)
+            out += 1
+    while heap:
+        t0, _, e0 = heapq.heappop(heap)
+        yield Event(out, t0, e0.topic, e0.fields, e0.where)
+        out += 1
+
+
+def stale_reason(watch: StampWatch, trace: str) -> str:
+    """Why the first pass's verdicts on a run that cannot be read again are not given."""
+    return (f"{trace} cannot be read a second time in stamp order (a stream): {watch.count} message(s) were "
+            f"recorded after one stamped up to {watch.lag * 1e3:.1f} ms later (the first at {watch.first}), so "
+            "the verdicts judged in recording order may not hold on the run's clock")
+
+
+__all__ = ["StampWatch", "in_stamp_order", "run_clock", "stale_reason"]
