@@ -214,6 +214,7 @@ class RequirementRecord(TypedDict):
     inconsistent_core: NotRequired[list[Premise]]
     vacuity: NotRequired[str]
     vacuity_core: NotRequired[list[Premise]]
+    vacuity_reason: NotRequired[str]
     vacuity_duration_s: NotRequired[float]
     vacuity_smt2: NotRequired[str]
 

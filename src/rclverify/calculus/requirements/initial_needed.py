@@ -38,8 +38,10 @@ def initially_not_needed(premises: Sequence[Mapping[str, Any]],
     ``premises``: the proof's premises (``{"kind", "node", ...}``, kind
     ``"initial value"`` for an ``initially`` clause); ``proved_without(nodes)``
     decides the statement again on the system built without the
-    ``initially`` of ``nodes`` and says whether it is still proved (an
-    ``inconclusive`` is not proved: the declaration then stays needed).
+    ``initially`` of ``nodes`` and says whether it is still proved and
+    exercised by some run (an ``inconclusive``, or a proof no run
+    exercises, :mod:`.exercised`, is not proved: the declaration then stays
+    needed).
     Returns the node names (empty when none can go)."""
     nodes = list(dict.fromkeys(str(p["node"]) for p in premises if p.get("kind") == "initial value"))
     if not nodes:

@@ -85,6 +85,29 @@ class Publication:
         flags = self.flags_of(mentions)
         return conj(*[s[f] for f in flags]) if flags else z3.BoolVal(True)
 
+    def silent(self) -> list[str]:
+        """The answering nodes that publish on no run, in :attr:`published`'s order.
+
+        A node publishes at some step only if it declares ``initially`` or
+        answers, and it answers only once every fed input it reads was heard,
+        that is once each producer of those inputs had published (module
+        docstring).  The nodes that can publish are the least set holding
+        every node with ``initially`` or with no fed input it reads, and
+        every node whose fed inputs' producers are all in it; the rest never
+        publish, whatever the contracts say (each has a silent producer, so
+        following producers ends in a loop of nodes each waiting on another
+        and none declaring an initial value).  The set is decided on the
+        connections alone: a node outside it may still never publish (its
+        assumption never holding), which only a query over the runs shows."""
+        by_flag = {f: self.producer[c] for c, f in self.heard.items()}
+        can = {n for n in self.published if n in self.initial or not self.fed.get(n)}
+        grew = True
+        while grew:
+            more = {n for n in self.published if n not in can and all(by_flag[f] in can for f in self.fed.get(n, ()))}
+            can |= more
+            grew = bool(more)
+        return [n for n in self.published if n not in can]
+
     def flags_of(self, mentions: Iterable[tuple[str, str, str]]) -> list[str]:
         """The flag names :meth:`defined` reads, for a trace's confirmation."""
         out: list[str] = []

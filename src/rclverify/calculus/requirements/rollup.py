@@ -14,6 +14,9 @@ verdict (``check``)                what the proof rests on      status shown (``
 ``proved``, premises inconsistent  (anything)                   ``proved from an inconsistency`` /
                                                                 ``failed``
 ``proved``, premise never holds    (anything)                   ``proved vacuously`` / ``failed``
+``proved``, no run exercises it    (temporal: a value it reads  ``proved vacuously`` / ``failed``
+                                   is never published, or its
+                                   premise holds on no run)
 ``proved``, consistency undecided  (anything)                   ``inconclusive`` / ``inconclusive``
 ``proved``, vacuity undecided      (anything)                   ``inconclusive`` / ``inconclusive``
                                    (Z3 could not say whether
@@ -172,6 +175,16 @@ def declaration_evidence(record: Mapping[str, Any] | None, d_status: DeclStatus 
     return out
 
 
+def _vacuous_note(record: Mapping[str, Any]) -> str:
+    """The note of a requirement proved vacuously: its premise and the premises that exclude it (a state
+    requirement, :mod:`.check`), or the reason no run exercises a temporal proof (:mod:`.exercised`)."""
+    if record.get("vacuity_reason"):
+        return f"proved only because it never applies: {record['vacuity_reason']}"
+    core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
+    why = f"together with the premises of its cone ({core})" if core else "(it contradicts itself)"
+    return f"the requirement's premise can never hold {why}: it is proved only because it never applies"
+
+
 def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
             traced_status: str, d_status: DeclStatus | None = None) -> tuple[str, str, str]:
     """``(verdict, status, note)`` of one requirement.
@@ -234,9 +247,7 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         return INCONSISTENT, "failed", (f"the premises the proof used contradict each other ({core}): the "
                                         "requirement follows vacuously, not because the system meets it")
     if record.get("vacuity") == "vacuous":
-        core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
-        why = f"together with the premises of its cone ({core})" if core else "(it contradicts itself)"
-        return VACUOUS, "failed", f"the requirement's premise can never hold {why}: it is proved only because it never applies"
+        return VACUOUS, "failed", _vacuous_note(record)
     statuses = _premise_statuses(record, g_status, sc_status, d_status)
     ev = worst(list(statuses.values()), empty="discharged")
     if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it

@@ -37,7 +37,12 @@ every premise of the cone (there is no unsat core of an induction), so
 one exception: a node's ``initially`` that the proof also holds without
 (:mod:`.initial_needed`) is traced, not needed; a
 system with no run at all (its premises contradict each other) proves
-anything, and is reported ``consistency: inconsistent``.
+anything, and is reported ``consistency: inconsistent``; a proof from
+consistent premises that no run exercises (a value it reads is never
+published, its premise holds on no run: :mod:`.exercised`) is reported
+``vacuity: vacuous`` with ``vacuity_reason``, as a state requirement's
+premise that never holds is (docs/requirements.md, "A proof no run
+exercises").
 """
 from __future__ import annotations
 
@@ -63,6 +68,7 @@ from rclverify.calculus.requirements.temporal import (TemporalVerdict, Transitio
 from rclverify.calculus.requirements.lasso import find_table_lasso
 from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
 from rclverify.calculus.requirements.initial_needed import initially_not_needed
+from rclverify.calculus.requirements.exercised import NON_VACUOUS, vacuity
 from rclverify.calculus.requirements.progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
 from rclverify.calculus.requirements.transition import ComposedSystem, build_system, variable_types
 from rclverify.semantics.encode import Encoder
@@ -283,9 +289,15 @@ def _proved(out: dict[str, Any], sys: ComposedSystem, ctx: _Question) -> None:
         out.update(consistency="inconsistent", inconsistent_core=used)
     elif r == z3.sat and not why:
         out.update(consistency="consistent")
-        spare = initially_not_needed(sys.premises, lambda nodes: ctx.solve(nodes)[1].status in ("proved", "met"))
-        out.update(used=[p for p in used if not (p["kind"] == "initial value" and p["node"] in spare)],
-                   traced_not_needed=[p for p in used if p["kind"] == "initial value" and p["node"] in spare])
+        vac = ctx.exercised(sys)  # a proof no run exercises is vacuous (.exercised)
+        silent = vac.pop("never_publish", None)
+        out.update(vac)
+        if silent:
+            out["temporal"]["never_publish"] = silent
+        if vac.get("vacuity") in (None, NON_VACUOUS):
+            spare = initially_not_needed(sys.premises, ctx.proved_without)
+            out.update(used=[p for p in used if not (p["kind"] == "initial value" and p["node"] in spare)],
+                       traced_not_needed=[p for p in used if p["kind"] == "initial value" and p["node"] in spare])
     else:
         out.update(consistency="undecided", consistency_reason=s.reason_unknown() if r != z3.sat else why)
 
@@ -305,6 +317,23 @@ class _Question:
     def solve(self, without: Collection[str] = ()) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
         """The system of the cone (the nodes of ``without`` built with no ``initially``) and its verdict."""
         return _System(self, without).decide()
+
+    def exercised(self, sys: ComposedSystem) -> dict[str, Any]:
+        """The vacuity fields of the statement proved over ``sys`` (:func:`.exercised.vacuity`)."""
+        enc = Encoder(self.checked.env)
+
+        def raw(f: Formal) -> Callable[[Any], Any]:
+            return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
+        hint = Hint(raw(self.inv), " ".join(self.req.invariant.text.split()) if self.req.invariant is not None
+                    else "invariant:") if self.inv is not None else None
+        return vacuity(self.t, sys.ts, sys.pub, raw, max_k=self.bound, timeout_ms=self.timeout_ms, hint=hint)
+
+    def proved_without(self, nodes: Collection[str]) -> bool:
+        """Whether the statement is still proved, and exercised by a run, on the system built without the
+        ``initially`` of ``nodes`` (:func:`.initial_needed.initially_not_needed`): a loop only an initial value
+        starts proves an ``always`` without it, vacuously, so the declaration stays needed."""
+        sys, v, _ = self.solve(nodes)
+        return v.status in ("proved", "met") and self.exercised(sys).get("vacuity") in (None, NON_VACUOUS)
 
 
 class _System:
