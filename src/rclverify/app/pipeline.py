@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any, Sequence, cast
 from rclverify.records.records import Evidence, Obligation
 from rclverify.records.sealed import write_sealed
 from rclverify.records.store import EvidenceStore, atomic_write_text, dumps, write_obligations
+from rclverify.records.ties import tie_query
 from rclverify.semantics.world import fresh as fresh_z3
 from rclverify.lang.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
@@ -120,12 +121,10 @@ def stage_compose(ws: Workspace, node: str) -> CompositionRecord:
         comp = compose_node(ws.checked, ws.model, node, facts=plan_facts(ws))
     finally:
         summary.use_directory(None)  # this workspace's only: a later computation in the process keeps its own
-    paths = []
-    for sc in comp.side_conditions:
-        rel = f"artifacts/calculus/{sc.id}.smt2"
-        atomic_write_text(ws.path(rel), sc.smt2)
-        paths.append(rel)
+    paths = [f"artifacts/calculus/{sc.id}.smt2" for sc in comp.side_conditions]
     out = composition_json(comp, paths)
+    for sc, rel, row in zip(comp.side_conditions, paths, out["side_conditions"]):
+        atomic_write_text(ws.path(rel), tie_query(sc.smt2, "side-condition", sc.id, row))  # records/ties.py
     write_sealed(ws.path(ws.calculus(node)), out)
     # after: a killed stage records nothing; the cone is an input of what it wrote only when a side
     # condition was decided in context (the doit task re-runs on any change of the cone: derived property)
@@ -162,10 +161,11 @@ def stage_health(ws: Workspace, node: str) -> list[HealthFinding]:
         j = f.to_json()
         if f.smt2:
             j["smt2"] = f"artifacts/health/{f.id}.smt2"
-            atomic_write_text(ws.path(j["smt2"]), f.smt2)
         if f.witness_smt2:  # the quantifier-free query the second solver decides (calculus/health/realizer.py)
             j["witness_smt2"] = f"artifacts/health/{f.id}.witness.smt2"
-            atomic_write_text(ws.path(j["witness_smt2"]), f.witness_smt2)
+        for key, text in (("smt2", f.smt2), ("witness_smt2", f.witness_smt2)):
+            if text:  # each ends naming the finding it decides (records/ties.py)
+                atomic_write_text(ws.path(j[key]), tie_query(text, "health", f.id, j))
         findings.append(j)
     write_sealed(ws.path(ws.health(node)), {"node": node, "findings": findings})
     record_provenance(ws, node, "health", stage_inputs(ws, node, "health"))

@@ -37,8 +37,8 @@ def cmd_bundle(args: argparse.Namespace) -> int:
         signed = (f"; signed by the pinned key {manifest['signed']}" if manifest["signed"] else
                   "; no key pinned (--key AUTHOR.pub): the seals prove the records unchanged since sealing, not "
                   "who sealed them")
-        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json; every record's seal holds"
-              + signed)
+        print(f"{args.verify}: {len(manifest['files'])} file(s) match MANIFEST.json; every record's seal holds; "
+              "every kept query and proof is tied to what it decides" + signed)
         return 0
     ws = workspace_of(args)
     with run_lock(args):  # the report and the evidence it is checked against, as one run left them

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.store import atomic_write_text, dumps
+from rclverify.records.ties import tie_query
 from rclverify.calculus.deadlines import DeadlineResult, decide_plan
 from rclverify.calculus.worst_path import nodes_between, with_worst_path
 
@@ -54,17 +55,16 @@ def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list[dict[st
     keep = {"index.json"}
     for r in results:
         rec = r.to_json()
-        rec["smt2"] = ""
-        if r.smt2:
-            rec["smt2"] = smt2_path(r.requirement)
-            atomic_write_text(ws.path(rec["smt2"]), r.smt2)
-            keep.add(rec["smt2"].rsplit("/", 1)[1])
+        rec["smt2"] = smt2_path(r.requirement) if r.smt2 else ""
         inputs = {}
         for n in nodes_between(ws.model, r.path):  # every node the worst path may take, as the task's inputs
             p = ws.path(ws.snapshot(n))
             inputs[ws.snapshot(n)] = hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else ""
         inputs[ws.MODEL] = model_hash
         rec["inputs"] = inputs
+        if r.smt2:  # it ends naming the statement it decides (records/ties.py)
+            atomic_write_text(ws.path(rec["smt2"]), tie_query(r.smt2, "deadline", r.requirement, rec))
+            keep.add(rec["smt2"].rsplit("/", 1)[1])
         records.append(rec)
     write_sealed(ws.path(INDEX), {"results": records})
     for old in ws.path(DIR).glob("*"):

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.store import atomic_write_text, dumps
+from rclverify.records.ties import tie_query
 
 if TYPE_CHECKING:
     from rclverify.stages.workspace import Workspace
@@ -95,21 +96,19 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
         else:
             fresh()  # each check in the same Z3 state whatever ran before it (semantics/world.py)
             rec = decide(req, checked, model, plan)  # its own nodes first (calculus/requirements/own_nodes.py)
-            smt2 = rec.pop("smt2", None)
-            if smt2 is not None:
-                rec["smt2"] = rel[:-5] + ".smt2"
-                atomic_write_text(ws.root / rec["smt2"], smt2)
-                keep.add(rec["smt2"].rsplit("/", 1)[1])
-            for side in SIDE_QUERIES:  # the consistency and vacuity queries, for the second solver
-                text = rec.pop(f"{side}_smt2", None)
+            queries: dict[str, tuple[str, str]] = {}  # record key -> (kind, text)
+            for kind, key, suffix in (("requirement", "smt2", ""), *((s, f"{s}_smt2", f".{s}") for s in SIDE_QUERIES)):
+                text = rec.pop(key, None)  # the proof's query, then the consistency and vacuity queries
                 if text is not None:
-                    rec[f"{side}_smt2"] = rel[:-5] + f".{side}.smt2"
-                    atomic_write_text(ws.root / rec[f"{side}_smt2"], text)
+                    rec[key] = rel[:-5] + f"{suffix}.smt2"
+                    queries[key] = (kind, text)
             rec["fingerprint"] = fp
             rec["inputs"] = input_hashes(ws, cone, snap, model_hash) if formal is not None else {}
             if traces:
                 rec["traces"] = trace_rows(req, checked, plan, ws.root)
                 rec["inputs"].update(th)
+            for key, (kind, text) in queries.items():  # each ends naming the statement it decides (records/ties.py)
+                atomic_write_text(ws.root / rec[key], tie_query(text, kind, req.id, rec))
             write_sealed(ws.root / rel, rec)
             now = True
         for key in ("smt2", *(f"{side}_smt2" for side in SIDE_QUERIES)):

@@ -28,6 +28,7 @@ import z3
 
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
+from rclverify.records.ties import tie_query
 from rclverify.semantics.encode import EncodingError, Encoder
 from rclverify.lang.errors import RclError, error
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
@@ -244,7 +245,9 @@ class HoareBackend:
                             p.triple.observe_final, p.triple.names)
         except z3.Z3Exception as exc:
             return evidence("error", f"Z3 failed: {exc}", log=str(exc), artifacts=tuple(artifacts))
-        atomic_write_text(p.smt2, render_queries(target, p, res))
+        # it ends naming the obligation it decides (records/ties.py), read back by `bundle --verify`
+        atomic_write_text(p.smt2, tie_query(render_queries(target, p, res), "hoare", obligation.id,
+                                            {"id": obligation.id, "statement": obligation.statement}))
         artifacts.append(target.rel(p.smt2))
         assert rendered.lines is not None
         outline = outline_text(rendered.lines)

@@ -27,6 +27,8 @@ from rclverify.model.plan.load import Plan
 from rclverify.report.bundle.manifest import MANIFEST, BundleError, build_manifest, collect, tool_versions
 from rclverify.records.sealed import is_sealed_path, check_text
 from rclverify.records.store import SEAL
+from rclverify.stages.crosscheck.stage import INDEX
+from rclverify.stages.crosscheck.ties import TAIL_BYTES, bundle_items, index_rows, is_tied, tie_problems
 
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 
@@ -188,30 +190,35 @@ def must_be_sealed(name: str) -> bool:
         or is_sealed_path(name)
 
 
-def _hash_stream(name: str, fh: Any, limit: int, keep: bool = False) -> tuple[str, int, bytes | None]:
-    """``(sha256 hex, size, bytes or None)`` of the stream ``fh`` read in
-    chunks of :data:`_CHUNK`: memory stays bounded whatever the member's
-    size.  The bytes are kept only for :data:`MANIFEST` and for records
-    (:func:`is_record`, or any member when ``keep``) of at most
-    :data:`MAX_RECORD_BYTES`, whose seals are checked.  Raises :class:`BundleError` when more than ``limit`` bytes
-    come out (a zip member whose header understates its size)."""
+def _hash_stream(name: str, fh: Any, limit: int, keep: bool = False) -> tuple[str, int, bytes | None, bytes]:
+    """``(sha256 hex, size, bytes or None, last bytes)`` of the stream ``fh``
+    read in chunks of :data:`_CHUNK`: memory stays bounded whatever the
+    member's size.  The bytes are kept only for :data:`MANIFEST` and for
+    records (:func:`is_record`, or any member when ``keep``) of at most
+    :data:`MAX_RECORD_BYTES`, whose seals are checked; the last bytes are
+    the last :data:`TAIL_BYTES` (a kept query's or proof's tie line).
+    Raises :class:`BundleError` when more than ``limit`` bytes come out (a
+    zip member whose header understates its size)."""
     h = hashlib.sha256()
     size = 0
+    tail = b""
     kept: list[bytes] | None = [] if name == MANIFEST or is_record(name) or keep else None
     while chunk := fh.read(_CHUNK):
         size += len(chunk)
         if size > limit:
             raise BundleError([f"{name}: more than {limit} bytes, the most a bundle member may have; not checked"])
         h.update(chunk)
+        tail = (tail + chunk[-TAIL_BYTES:])[-TAIL_BYTES:]
         if kept is not None:
             kept.append(chunk)
             if name != MANIFEST and size > MAX_RECORD_BYTES:
                 kept = None
-    return h.hexdigest(), size, b"".join(kept) if kept is not None else None
+    return h.hexdigest(), size, b"".join(kept) if kept is not None else None, tail
 
 
 def scan_members(path: Path, seals: list[str] | None = None, kept: dict[str, bytes] | None = None,
-                 signature: dict[str, bytes] | None = None) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
+                 signature: dict[str, bytes] | None = None, ties: dict[str, bytes] | None = None
+                 ) -> tuple[bytes | None, dict[str, tuple[str, int]]]:
     """``(MANIFEST.json bytes or None, {member: (sha256, size)})`` of the
     archive at ``path`` (tar.gz or zip), every member streamed and hashed in
     chunks (bounded memory), nothing extracted to disk.  When ``seals`` is
@@ -220,7 +227,10 @@ def scan_members(path: Path, seals: list[str] | None = None, kept: dict[str, byt
     is a dict, the bytes of every member under ``artifacts/`` (records and
     stored queries) of at most :data:`MAX_RECORD_BYTES` are put in it, by
     name (``bundle --recheck``); ``signature``, when a dict, gets the
-    bytes of ``MANIFEST.sig`` (:mod:`.signature`) if the archive has it.
+    bytes of ``MANIFEST.sig`` (:mod:`.signature`) if the archive has it;
+    ``ties``, when a dict, the bytes of every record (:func:`is_record`, of
+    at most :data:`MAX_RECORD_BYTES`) and the last :data:`TAIL_BYTES` of
+    every kept query and proof (:func:`rclverify.stages.crosscheck.ties.is_tied`).
 
     Raises :class:`BundleError` for an unreadable or corrupt archive, for
     members that are links, devices, absolute or ``..`` paths, or repeated,
@@ -247,8 +257,12 @@ def scan_members(path: Path, seals: list[str] | None = None, kept: dict[str, byt
     def record(name: str, fh: Any, limit: int) -> None:
         nonlocal manifest
         keep = (kept is not None and name.startswith("artifacts/")) or (signature is not None and name == "MANIFEST.sig")
-        digest, size, data = _hash_stream(name, fh, limit, keep)
+        digest, size, data, tail = _hash_stream(name, fh, limit, keep)
         out[name] = (digest, size)
+        if ties is not None and is_tied(name):
+            ties[name] = tail
+        elif ties is not None and is_record(name) and data is not None:
+            ties[name] = data
         if name == "MANIFEST.sig" and signature is not None and data is not None:
             signature[name] = data
         elif keep and data is not None and kept is not None:
@@ -289,6 +303,20 @@ def seal_problem(name: str, data: bytes | None) -> str:
     return f"{name}: seal broken: {problem}" if problem else ""
 
 
+def _tie_problems(ties: Mapping[str, bytes], members: Mapping[str, Any]) -> list[str]:
+    """Each kept query of the bundle not tied to its item's statement and
+    each kept proof not tied to its query, one sentence naming the item
+    (:func:`rclverify.stages.crosscheck.ties.tie_problems`); ``ties`` as
+    :func:`scan_members` fills it, ``members`` the bundle's member names.
+    Raises :class:`BundleError` when the records cannot be read back."""
+    try:
+        items = bundle_items(ties)
+    except OSError as exc:
+        raise BundleError([f"cannot read the bundle's records back: {exc}"]) from None
+    rows, _ = index_rows(ties.get(INDEX))  # an index whose seal does not hold is named with the seals
+    return tie_problems(items, rows, members, ties)[0]
+
+
 def verify_bundle(path: Path, kept: dict[str, bytes] | None = None, key: Any = None) -> dict[str, Any]:
     """Check the archive at ``path`` against its ``MANIFEST.json``, and
     every record in it against its own seal.
@@ -300,7 +328,10 @@ def verify_bundle(path: Path, kept: dict[str, bytes] | None = None, key: Any = N
     record edited before it was packed, or in the archive with the manifest
     edited to match, says what rclverify never recorded), and a missing or
     malformed manifest, and a member too large to check
-    (:func:`scan_members`).  Members are streamed: memory stays bounded
+    (:func:`scan_members`), and each kept query not tied to the statement
+    its sealed record states and each kept proof not tied to its query
+    (:func:`rclverify.stages.crosscheck.ties.tie_problems`: a query borrowed
+    from another item, two proofs swapped).  Members are streamed: memory stays bounded
     whatever their size.  ``kept``: as :func:`scan_members` (the records'
     bytes, for ``--recheck``).  ``key``: the author's pinned Ed25519 public
     key; then ``MANIFEST.sig`` must be its signature of the manifest
@@ -311,7 +342,8 @@ def verify_bundle(path: Path, kept: dict[str, bytes] | None = None, key: Any = N
     from rclverify.report.bundle.signature import SIGNATURE, check, fingerprint  # deferred: start-up (loads cryptography, rclverify.report.bundle and more only when called)
     seals: list[str] = []
     signature: dict[str, bytes] = {}
-    manifest_bytes, members = scan_members(path, seals, kept, signature)
+    ties: dict[str, bytes] = {}
+    manifest_bytes, members = scan_members(path, seals, kept, signature, ties)
     if manifest_bytes is None:
         raise BundleError([f"{MANIFEST}: missing from the archive"])
     members.pop(MANIFEST, None)
@@ -329,6 +361,7 @@ def verify_bundle(path: Path, kept: dict[str, bytes] | None = None, key: Any = N
             problems.append(f"{name}: changed (sha256 {h}, manifest says {listed[name]})")
     problems += [f"{name}: in the archive but not in the manifest" for name in sorted(set(members) - set(listed))]
     problems += sorted(seals)
+    problems += _tie_problems(ties, members)
     if key is not None and (why := check(manifest_bytes, signature.get(SIGNATURE), key)):
         problems.append(why)
     if problems:

@@ -32,8 +32,8 @@ items (Dafny's own Boogie/Z3 run is the evidence).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Iterable
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Mapping
 
 from rclverify.records.sealed import read_sealed
 from rclverify.stages.requirements import record_path
@@ -70,6 +70,8 @@ class Item:
     #: what the script is when it is not the verdict's own query: ``witness`` (a realizable contract's
     #: witness query, whose unsat implies the verdict's; calculus/health/realizer.py)
     via: str = ""
+    #: the record row that states what the script decides (its statement: rclverify.records.ties)
+    row: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False, repr=False)
 
 
 def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
@@ -82,31 +84,32 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
         body, why = read_sealed(root / f"artifacts/calculus/{n}.json", "side-condition record")
         for sc in _rows(body, why, "side_conditions"):
             if sc.get("status") == "discharged" and _path(sc.get("smt2")):
-                out.append(Item("side-condition", str(sc.get("id")), sc["smt2"], "discharged", "unsat"))
+                out.append(Item("side-condition", str(sc.get("id")), sc["smt2"], "discharged", "unsat", row=sc))
         body, why = read_sealed(root / f"artifacts/health/{n}.json", "contract health record")
         for f in _rows(body, why, "findings"):
             witness = witness_query(f)
             if f.get("status") == "ok" and witness is not None:
                 # the witness's quantifier-free query, which implies realizability (calculus/health/realizer.py)
-                out.append(Item("health", str(f.get("id")), witness, "ok", "unsat", every=True, via=WITNESS))
+                out.append(Item("health", str(f.get("id")), witness, "ok", "unsat", every=True, via=WITNESS, row=f))
             elif f.get("status") == "ok" and _path(f.get("smt2")):
                 proof = f.get("check") in PROOF_CHECKS  # both sides of a replacement (joined by a reset) must hold
-                out.append(Item("health", str(f.get("id")), f["smt2"], "ok", "unsat" if proof else "sat", every=proof))
+                out.append(Item("health", str(f.get("id")), f["smt2"], "ok", "unsat" if proof else "sat", every=proof,
+                                row=f))
     index, why = read_sealed(root / "artifacts/requirements/index.json", "requirement index")
     records = index.get("records") if isinstance(index, dict) and not why else None
     for rid in sorted(records) if isinstance(records, dict) else []:
         rec, why = read_sealed(root / record_path(rid), "requirement record")
         if rec and not why and rec.get("verdict") == "proved" and _path(rec.get("smt2")):
-            out.append(Item("requirement", rid, rec["smt2"], "proved", "unsat"))
+            out.append(Item("requirement", rid, rec["smt2"], "proved", "unsat", row=rec))
             for side, answers in SIDE_ANSWERS.items():
                 verdict = rec.get(side)
                 if verdict in answers and _path(rec.get(f"{side}_smt2")):
-                    out.append(Item(side, rid, rec[f"{side}_smt2"], str(verdict), answers[verdict]))
+                    out.append(Item(side, rid, rec[f"{side}_smt2"], str(verdict), answers[verdict], row=rec))
     out.extend(_hoare_items(root, nodes))
     body, why = read_sealed(root / "artifacts/deadlines/index.json", "deadline record")
     for d in sorted(_rows(body, why, "results"), key=lambda d: str(d.get("requirement"))):
         if d.get("status") == "proved" and _path(d.get("smt2")):
-            out.append(Item("deadline", str(d.get("requirement")), d["smt2"], "proved", "unsat"))
+            out.append(Item("deadline", str(d.get("requirement")), d["smt2"], "proved", "unsat", row=d))
     return out
 
 
@@ -144,5 +147,5 @@ def _hoare_items(root: Any, nodes: Iterable[str]) -> list[Item]:
                 continue
             for a in ev.artifacts:
                 if _path(a):
-                    out.append(Item("hoare", ev.obligation, a, "discharged", "unsat", every=True))
+                    out.append(Item("hoare", ev.obligation, a, "discharged", "unsat", every=True, row=o))
     return out

@@ -9,6 +9,9 @@ sha256, and each query's SMT-LIB2 text is in the archive.  For each item:
 
 * the query in the archive must be the one that was decided (its sha256
   is the record's): an edited query is named;
+* the query must be tied to the statement the sealed record states, and
+  each kept proof to its query (:mod:`.ties`): a query borrowed from
+  another item, or two proofs swapped, are named;
 * Z3 (from the text, a fresh solver, the query budget) must give the
   answer the record's verdict rests on, and cvc5 the answer it recorded:
   an opposite answer is named;
@@ -21,14 +24,12 @@ re-established within the budget here) but is not a contradiction.
 from __future__ import annotations
 
 import hashlib
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
 from rclverify.records.sealed import check_text, is_sealed_path
 from rclverify.stages.crosscheck.cvc5_decide import Session, decide, version
-from rclverify.stages.crosscheck.items import discharging_items
 from rclverify.stages.crosscheck.stage import INDEX
+from rclverify.stages.crosscheck.ties import TAIL_BYTES, bundle_items, index_rows, is_tied, tie_problems
 
 #: Z3's budget per query in the re-check, in resource steps (as the query module's 10 s budget).
 Z3_RLIMIT = 20_000_000
@@ -69,41 +70,34 @@ def z3_answer(text: str, every: bool = False) -> str:
 
 def recheck_members(members: dict[str, bytes]) -> Recheck:
     """Re-decide the items of an archive's ``members`` (name -> bytes, as
-    :func:`rclverify.report.bundle.archive.verify_bundle` keeps them)."""
+    :func:`rclverify.report.bundle.archive.verify_bundle` keeps them).
+    Raises ``OSError`` when the records cannot be read back (a private
+    temporary folder, :func:`.ties.bundle_items`)."""
     problems: list[str] = []
     notes: list[str] = []
-    raw = members.get(INDEX)
-    if raw is None:
-        return Recheck(0, [f"{INDEX}: not in the bundle: no second-solver record to re-check against"], [])
-    index, why = check_text(raw.decode("utf-8", "replace"), "second-solver record")
-    if why or index is None:
-        return Recheck(0, [f"{INDEX}: {why or 'unreadable'}"], [])
-    rows = {(str(r.get("kind")), str(r.get("id"))): r for r in index.get("items", []) if isinstance(r, dict)}
+    rows, why = index_rows(members.get(INDEX))
+    if rows is None:
+        return Recheck(0, [f"{INDEX}: {why}" if why else
+                           f"{INDEX}: not in the bundle: no second-solver record to re-check against"], [])
     for name in sorted(members):  # a verdict edited in a sealed record: its seal no longer holds
         if is_sealed_path(name):
             _, bad = check_text(members[name].decode("utf-8", "replace"), "record")
             if bad:
                 problems.append(f"{name}: {bad}")
-    with tempfile.TemporaryDirectory() as tmp:  # the records only, to read them as the stage does
-        root = Path(tmp)
-        for name, content in members.items():
-            if name.startswith("artifacts/") and name.endswith(".json"):
-                p = root / name
-                p.parent.mkdir(parents=True, exist_ok=True)
-                p.write_bytes(content)
-        nodes = sorted(p.stem for p in (root / "artifacts/calculus").glob("*.json"))
-        items = discharging_items(root, nodes)
+    items = bundle_items(members)
+    # each query tied to the statement it claims to decide, each proof to its query (stages/crosscheck/ties.py)
+    tied, untied = tie_problems(items, rows, members, {n: b[-TAIL_BYTES:] for n, b in members.items() if is_tied(n)})
+    problems += tied
     has_cvc5 = bool(version())
     session = Session() if has_cvc5 else None
-    for it in items:
+    for i, it in enumerate(items):
         label = f"{it.kind} {it.id}"
         row = rows.get((it.kind, it.id))
         if row is None:
             problems.append(f"{label}: recorded {it.verdict} but not in {INDEX}: never decided by the second solver")
             continue
         data = members.get(it.smt2)
-        if data is None:
-            problems.append(f"{label}: its query {it.smt2} is not in the bundle")
+        if i in untied or data is None:
             continue
         if hashlib.sha256(data).hexdigest() != row.get("sha256") or row.get("smt2") != it.smt2:
             problems.append(f"{label}: its query {it.smt2} was edited after it was decided "

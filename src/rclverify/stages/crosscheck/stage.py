@@ -7,7 +7,9 @@ Writes (docs/second-solver.md):
   recorded verdict and answer, cvc5's answer (version, reason, duration),
   the path of its checked proof and the :func:`agreement`;
 * ``artifacts/crosscheck/proofs/<sha256>.proof``: cvc5's proof of each
-  ``unsat`` answer, in cvc5's CPC format, checked by cvc5's proof checker.
+  ``unsat`` answer, in cvc5's CPC format, checked by cvc5's proof checker,
+  its last line naming the sha256 of the query it proves
+  (:func:`rclverify.records.ties.tie_proof`).
 
 Answers are keyed by the script's sha256, cvc5's version and the budget
 (:data:`.cvc5_decide.RLIMIT`, deterministic), and re-used from the last
@@ -25,6 +27,7 @@ from rclverify.core.forksafe import fork_is_safe
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.stage_records import CrosscheckRecord
 from rclverify.records.store import atomic_write_text
+from rclverify.records.ties import proof_tie, tie_proof
 from rclverify.stages.crosscheck.cvc5_decide import RLIMIT, Decision, Session, decide, version
 from rclverify.stages.crosscheck.items import WITNESS, Item, discharging_items
 
@@ -127,9 +130,23 @@ def _lookup(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]]
     key = f"{sha}:{ver}:{RLIMIT}" + (":every" if it.every else "")
     row.update(sha256=sha, key=key)
     d = cache.get(key) if ver else None
-    if d is not None and d.get("proof") and not (root / f"{DIR}/proofs/{sha}.proof").is_file():
-        d = None  # its proof is gone: decide again
+    if d is not None and d.get("proof") and not proof_tied(root / f"{DIR}/proofs/{sha}.proof", sha):
+        d = None  # its proof is gone, or does not name its query (written by an earlier rclverify): decide again
     return it, row, text, d
+
+
+def proof_tied(path: Path, query_sha256: str) -> bool:
+    """Whether the proof file ``path`` exists and its last line names the
+    query ``query_sha256`` (:func:`rclverify.records.ties.proof_tie`); only
+    its last bytes are read."""
+    line = proof_tie(query_sha256).encode("utf-8")
+    try:
+        with open(path, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            f.seek(max(0, f.tell() - len(line) - 2))
+            return f.read().rstrip(b"\r\n").endswith(b"\n" + line)
+    except OSError:
+        return False
 
 
 def _finish(root: Path, it: Item, row: dict[str, Any], d: dict[str, Any] | Decision | None,
@@ -142,7 +159,7 @@ def _finish(root: Path, it: Item, row: dict[str, Any], d: dict[str, Any] | Decis
         dec, d = d, d.row()
         if dec.proof:
             proof_rel = f"{DIR}/proofs/{row['sha256']}.proof"
-            atomic_write_text(root / proof_rel, dec.proof)
+            atomic_write_text(root / proof_rel, tie_proof(dec.proof, row["sha256"]))
             d["proof"] = proof_rel
     if d is not None and d.get("proof"):
         keep.add(Path(d["proof"]).name)
