@@ -223,8 +223,10 @@ def decide(counts: Mapping[str, Any], target: TargetLike) -> dict[str, Any]:
     "undecided", "bound", "bound_without_undecided", "level", "target",
     "runs_needed", "sprt"}`` where ``status`` is ``discharged`` (the bound
     meets the target), ``failed`` (the SPRT says the rate is at least the
-    target), ``inconclusive`` (it would meet it were the undecided ones
-    clean), or ``pending`` (``runs_needed`` further clean runs would)."""
+    target from the decided violations alone, the undecided ones counted
+    clean), ``inconclusive`` (it would meet it were the undecided ones
+    clean, or it is missed only if they are violations: undecided is never
+    failed), or ``pending`` (``runs_needed`` further clean runs would)."""
     n, k, unsure = trials(counts, target.per)
     worst = k + unsure
     from rclverify.core.extras import MissingExtra  # deferred: start-up (only where a target is decided)
@@ -252,9 +254,13 @@ def decide(counts: Mapping[str, Any], target: TargetLike) -> dict[str, Any]:
     elif bound <= target.bound:
         out.update(status="discharged", explanation=f"{seen}: the {pct} upper bound {bound:.3g} meets "
                                                     f"{target.words()}")
-    elif test.decision == "reject":
+    elif test.decision == "reject" and sprt(k, n, target.bound, target.level).decision == "reject":
         out.update(status="failed", explanation=f"{seen}: the SPRT says the rate is at least {target.bound:g} "
                                                 f"(upper bound {bound:.3g}): stop, the target is missed")
+    elif test.decision == "reject":  # missed only if the undecided ones are violations: nothing decided it
+        out.update(status="inconclusive", explanation=f"{seen}: the target is missed only if the {unsure} "
+                                                      f"undecided {unit}(s) are violations (the SPRT rejects with "
+                                                      f"them, not with the {k} decided violation(s) alone)")
     elif unsure and best <= target.bound:
         out.update(status="inconclusive", explanation=f"{seen}: the target is met only if the {unsure} undecided "
                                                       f"{unit}(s) are clean (upper bound {best:.3g} without them, "

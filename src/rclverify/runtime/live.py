@@ -242,7 +242,8 @@ class LiveRun:
             total = counts.setdefault(r["node"], {})
             for v, k in r["counts"].items():
                 total[v] = total.get(v, 0) + k
-        items = not_judged(self.nodes, heard, statuses, counts, "during the live run")
+        decided = {n["node"]: int((n.get("statistics") or {}).get("answers", 0)) for n in record["nodes"]}
+        items = not_judged(self.nodes, heard, statuses, counts, "during the live run", decided)
         for entry in record["nodes"]:  # a pending node says why itself
             explain(entry, items)
         return items

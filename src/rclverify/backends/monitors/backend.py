@@ -227,7 +227,9 @@ class MonitorsBackend:
         extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
                                                                       dict(calls.orphans)),
                                                  {res.node: [(status, explanation)]},
-                                                 {dl.node: dl.counts} if dl is not None else {}, f"in {trace}")
+                                                 {dl.node: dl.counts} if dl is not None else {}, f"in {trace}",
+                                                 {res.node: int(res.counts.get("satisfied", 0))
+                                                  + int(res.counts.get("violated", 0))})
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
         explanation = entry["explanation"] + (f"; {note}" if note else "")

@@ -129,7 +129,8 @@ def count_call_line(obj: Mapping[str, Any], messages: dict[str, int], orphans: d
 
 
 def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str, Iterable[tuple[str, str]]],
-               deadlines: Mapping[str, Mapping[str, int]], where: str) -> list[dict[str, str]]:
+               deadlines: Mapping[str, Mapping[str, int]], where: str,
+               decided: Mapping[str, int] | None = None) -> list[dict[str, str]]:
     """The items of ``nodes``' contracts the run did not judge (module docstring).
 
     ``statuses``: node name -> its ``(status, explanation)`` pairs (the
@@ -139,6 +140,10 @@ def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str
     call deadline monitors; a node absent has none); a node's deadlines are
     judged when one trigger got ``true`` or ``false``.  ``where``: the run, as
     the details say it (``"in run.jsonl"``, ``"during the live run"``).
+    ``decided``: node name -> its answers decided satisfied or violated; a
+    node with none, no deadline decided and only ``inconclusive`` (or
+    ``pending``) statuses decided nothing: an item "nothing decided"
+    (every message undecided, a NaN on every input: never green).
     Returns the records in contract order: nodes, then topics, links and
     deadlines, each item once."""
     nodes = list(nodes)
@@ -153,6 +158,11 @@ def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str
                                  f"no message on {', '.join('/' + t for t in keys) or 'its topics (none)'} {where}"))
             else:
                 out.append(_item("node", n.name, n.name, "no verdict", pairs[0][1]))
+        elif decided is not None and pairs and all(s in ("pending", "inconclusive") for s, _ in pairs):
+            dl = deadlines.get(n.name, {})
+            if not decided.get(n.name, 0) and not dl.get("true", 0) and not dl.get("false", 0):
+                why = next(e for s, e in pairs if s == "inconclusive")
+                out.append(_item("node", n.name, n.name, "nothing decided", why))
     seen: set[str] = set()
     for n in nodes:
         for t in n.node.topics:

@@ -95,7 +95,7 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
         for v, k in r.counts.items():
             total[v] = total.get(v, 0) + k
     items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
-                       f"in {trace}")
+                       f"in {trace}", {r.node: _decided(r) for r in results})
     return RecordedRun(events, results, dres, pres, decl_res, summary, centries, dentries,
                        calls.missed() if summary is not None else (0, 0), items, one.note, stale)
 
@@ -144,6 +144,11 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     events, results = check_trace(checked, nodes, Counted(source, heard, watch), cfg.rules, cfg.horizon,
                                   tolerance=cfg.tolerance)
     return _Pass(dmons, pmons, decl, calls, heard, watch, events, results)
+
+
+def _decided(res: NodeResult) -> int:
+    """The answers of ``res`` decided satisfied or violated."""
+    return int(res.counts.get("satisfied", 0)) + int(res.counts.get("violated", 0))
 
 
 def _readable_again(path: Path) -> bool:

@@ -53,10 +53,22 @@ def recorded_as(root: Path, trace: str) -> str:
 
 
 def run_digest(root: Path, trace: str) -> str:
-    """The run's identity: sha256 over its contents only (a bag directory's
-    files by their names inside it), so one run copied under two names is
-    one run."""
+    """The run's identity: sha256 over what it carries, so one run copied
+    under two names, or written again in another form, is one run.  A
+    ROSMonitoring log: each line's JSON object in canonical form (keys
+    sorted, no spacing; blank lines skipped), so key order, spacing and blank
+    lines do not make another run.  A bag: each message's topic, type,
+    recording time and serialized bytes in the bag's order (the storage,
+    sqlite3 or MCAP, and its compression are not the run).  A file either
+    reader refuses: its bytes (a bag directory's files by their names)."""
     p = root / trace
+    try:
+        if p.is_file() and p.suffix not in BAG_SUFFIXES:
+            return _log_digest(p)
+        if p.is_dir() or p.suffix in BAG_SUFFIXES:
+            return _bag_digest(p)
+    except Exception:  # noqa: BLE001 - unreadable as a run: identified by its bytes; the check reports why
+        pass
     h = hashlib.sha256()
     files = sorted(f for f in p.rglob("*") if f.is_file()) if p.is_dir() else [p]
     for f in files:
@@ -65,6 +77,32 @@ def run_digest(root: Path, trace: str) -> str:
         with f.open("rb") as fh:
             for block in iter(lambda: fh.read(1 << 20), b""):
                 h.update(block)
+    return h.hexdigest()
+
+
+def _log_digest(path: Path) -> str:
+    """sha256 over a log's lines as canonical JSON (:func:`run_digest`)."""
+    import msgspec  # deferred: start-up (only where a run is counted)
+    h = hashlib.sha256()
+    decode, encode = msgspec.json.decode, msgspec.json.Encoder(order="sorted").encode
+    with path.open("rb") as fh:
+        for line in fh:
+            if line.strip():
+                h.update(encode(decode(line)) + b"\n")
+    return h.hexdigest()
+
+
+def _bag_digest(path: Path) -> str:
+    """sha256 over a bag's messages (:func:`run_digest`)."""
+    from rclverify.traces.bag import open_bag, typestore  # deferred: start-up (loads rosbags only when called)
+    reader = open_bag(path, typestore([]))
+    h = hashlib.sha256()
+    try:
+        for conn, stamp, raw in reader.messages():
+            h.update(f"{conn.topic}\0{conn.msgtype}\0{stamp}\0{len(raw)}\0".encode())
+            h.update(bytes(raw))
+    finally:
+        reader.close()
     return h.hexdigest()
 
 
