@@ -155,6 +155,7 @@ def test_a_changed_flagged_text_raises_the_warning_again(gain_ws):
                                                     encoding="utf-8")
     try:
         rc, report = _verify(gain_ws, PLAN + ACKS + """  - warning: W-implication-precedence
+    file: contracts/gain.rcl
     text: "a -> b -> c"
     reason: an old slip of the contract since repaired
 """, strict=True)
@@ -183,7 +184,8 @@ def test_only_a_warning_can_be_acknowledged_and_lint_binds_by_clause_text():
     acks = [Acknowledgement("Gain.g1.tautology", "it is meant", at, text="out.y >= in.x and out.y >= 0"),
             Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL | out.y <= in.x + 10)",
                             file="contracts/other.rcl"),
-            Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL |  out.y <= in.x + 10)")]
+            Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL |  out.y <= in.x + 10)",
+                            file="./contracts/gain.rcl")]
     got = apply_acknowledgements(acks, [problem], [lint], checked)
     assert [a["status"] for a in got] == ["error", "stale", "ok"]  # refused; another file; white space is no change
     assert "not a warning" in got[0]["message"] and not problem.get("acknowledged")
@@ -207,3 +209,95 @@ def test_a_malformed_acknowledgement_is_one_located_error(tmp_path, entry, where
         load_plan(tmp_path)
     [d] = e.value.diagnostics
     assert f"{d.loc.line}:{d.loc.col}" == where and said in d.message
+
+
+# ---------------------------------------------------------------------------
+# An acknowledgement answers one finding: its file, its node and its text
+# ---------------------------------------------------------------------------
+
+BOUND = "  guarantee( forall(k in NATURAL | out.y <= in.x + 10) )\n"
+NODE = "node {name} {{\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n  assume( TRUE )\n" + BOUND + "}}\n"
+TWO_PLAN = """name: two
+contracts: [contracts/gov.rcl, contracts/other.rcl]
+nodes:
+  Gov: {{evidence: [{{backend: property_tests, implementation: impl/gain.py:gain, max_examples: 5}}]}}
+  Other: {{evidence: [{{backend: property_tests, implementation: impl/gain.py:gain, max_examples: 5}}]}}
+acknowledged:
+  - warning: W-unused-bound
+{where}    text: "forall(k in NATURAL | out.y <= in.x + 10)"
+    reason: the bound variable stays until the per-step table of the next release
+"""
+
+
+def _two(tmp_path: Path, other: str) -> Path:
+    (tmp_path / "contracts").mkdir(exist_ok=True)
+    (tmp_path / "impl").mkdir(exist_ok=True)
+    (tmp_path / "impl" / "gain.py").write_text(IMPL, encoding="utf-8")
+    (tmp_path / "contracts" / "gov.rcl").write_text(NODE.format(name="Gov"), encoding="utf-8")
+    (tmp_path / "contracts" / "other.rcl").write_text(other, encoding="utf-8")
+    return tmp_path
+
+
+def _lint_acks(report: dict[str, Any]) -> dict[str, bool]:
+    return {x["location"]: bool(x.get("acknowledged")) for x in report["lint"] if x["code"] == "W-unused-bound"}
+
+
+def test_a_lint_acknowledgement_for_one_file_leaves_the_same_warning_in_another_file(tmp_path):
+    ws = _two(tmp_path, NODE.format(name="Other"))
+    rc, report = _verify(ws, TWO_PLAN.format(where="    file: contracts/gov.rcl\n"), strict=True)
+    assert _lint_acks(report) == {"contracts/gov.rcl:5:21": True, "contracts/other.rcl:5:21": False}
+    assert rc == 1 and not report["meta"]["strict_ok"]  # Other's warning is not answered
+    assert [a["matched"] for a in report["acknowledgements"]] == [["contracts/gov.rcl:5:21:W-unused-bound"]]
+    # written without file: it answered both nodes' warnings and --strict passed; now refused before any check
+    (ws / "contracts" / "plan.yaml").write_text(TWO_PLAN.format(where=""), encoding="utf-8")
+    assert main(["verify", "-w", str(ws), "--strict"]) == 1
+
+
+def test_the_acknowledgement_for_gov_still_accepts_govs_own_warning(tmp_path):
+    ws = _two(tmp_path, "node Other {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n  assume( TRUE )\n"
+                        "  guarantee( out.y >= in.x )\n}\n")
+    rc, report = _verify(ws, TWO_PLAN.format(where="    file: contracts/gov.rcl\n"), strict=True)
+    assert _lint_acks(report) == {"contracts/gov.rcl:5:21": True}
+    assert rc == 0 and report["meta"]["strict_ok"]
+
+
+@pytest.mark.parametrize("other, where, at, said", [
+    (NODE.format(name="Other"), "", "7:5", "give the contract file"),
+    (NODE.format(name="Other") + NODE.format(name="Third"), "    file: contracts/other.rcl\n", "7:5",
+     "holds the nodes Other, Third"),
+    (NODE.format(name="Other"), "    file: contracts/gov.rcl\n    node: Other\n", "9:11", "has no node Other"),
+    (NODE.format(name="Other"), "    file: contracts/none.rcl\n", "8:11", "no contract file"),
+])
+def test_an_acknowledgement_that_cannot_be_tied_to_one_finding_is_a_located_plan_error(tmp_path, capsys, other,
+                                                                                        where, at, said):
+    ws = _two(tmp_path, other)
+    (ws / "contracts" / "plan.yaml").write_text(TWO_PLAN.format(where=where), encoding="utf-8")
+    assert main(["compose", "-w", str(ws)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"contracts/plan.yaml:{at}: error: acknowledged[0] (W-unused-bound): ") and said in err
+    assert "Traceback" not in err
+
+
+def test_node_names_the_one_node_of_a_file_that_holds_several(tmp_path):
+    ws = _two(tmp_path, NODE.format(name="Other") + NODE.format(name="Third"))
+    plan = TWO_PLAN.format(where="    file: contracts/other.rcl\n    node: Third\n")
+    rc, report = _verify(ws, plan, strict=True)
+    assert _lint_acks(report) == {"contracts/gov.rcl:5:21": False, "contracts/other.rcl:5:21": False,
+                                  "contracts/other.rcl:11:21": True}
+    assert rc == 1
+
+
+def test_a_health_acknowledgement_names_its_own_node_file():
+    from rclverify.model.plan.acknowledged import Acknowledgement, apply_acknowledgements
+    from rclverify.lang import ast
+    checked = check([parse_text(GAIN, "contracts/gain.rcl")])
+    at = ast.Loc("contracts/plan.yaml", 3, 5)
+    rows = [{"id": "Gain.g1.c2.redundant", "status": "warning", "message": "implied"}]
+    acks = [Acknowledgement("Gain.g1.c2.redundant", "kept for the reader", at, text="out.y >= 0",
+                            file="contracts/other.rcl")]
+    assert [a["status"] for a in apply_acknowledgements(acks, rows, [], checked)] == ["stale"]
+    assert not rows[0].get("acknowledged")
+    acks = [Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL | out.y <= in.x + 10)")]
+    lint = [{"location": "contracts/gain.rcl:6:21", "code": "W-unused-bound", "severity": "warning", "message": "k"}]
+    assert [a["status"] for a in apply_acknowledgements(acks, [], lint, checked)] == ["error"]  # no file: no finding
+    assert not lint[0].get("acknowledged")

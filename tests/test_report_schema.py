@@ -50,6 +50,8 @@ connections:
   - {from: Gain.y, to: Clamp.y}
 acknowledged:
   - warning: W-no-such-warning
+    file: contracts/chain.rcl
+    node: Gain
     sha256: 0123456789abcdef
     reason: a warning this run does not raise
 nodes:

@@ -1,8 +1,10 @@
 """``rclverify generate ros2 -w WS -o DIR`` (docs/generate.md).
 
-Exit codes: 0 the tree was written; 1 the contracts do not check (located
-``file:line:col: error:`` diagnostics, printed by ``rclverify``'s main) or
-the mapping or a write failed (``DIR: error: ...``); 2 usage errors.
+Exit codes: 0 the tree was written; 1 the contracts do not check, or a name
+the tree would carry breaks ROS 2's or the file system's rules (located
+``file:line:col: error:`` diagnostics, printed by ``rclverify``'s main;
+tools/generate/rosnames.py), or the mapping or a write failed (``DIR:
+error: ...``; a new ``DIR`` is then not left behind); 2 usage errors.
 """
 from __future__ import annotations
 

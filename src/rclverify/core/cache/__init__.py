@@ -10,7 +10,8 @@ format and one rule of what is kept (:mod:`.store`):
 =====================================  ===================  ==========================================
 file                                   kind                 keyed by
 =====================================  ===================  ==========================================
-``workspace.pickle``                   ``workspace``        sha256 of the plan and each contract file
+``workspace.pickle``                   ``workspace``        sha256 of the plan and each contract file,
+                                                            what each plan path resolves to
                                                             (:mod:`.workspace`)
 ``contract-texts.pickle``              ``contract-texts``   sha256 of each contract file's parsed text
                                                             (:mod:`rclverify.report.contract_texts`)

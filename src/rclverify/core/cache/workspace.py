@@ -8,6 +8,10 @@ result is therefore kept in ``artifacts/cache/workspace.pickle`` and reused
 when nothing it was computed from changed:
 
 * the sha256 of the plan file and of every contract file it lists,
+* what every path the plan names resolves to (every symbolic link followed:
+  the plan's ``path_targets``, :mod:`rclverify.model.plan.paths`), resolved
+  again on every run, so a link retargeted since (outside the workspace,
+  say) loads and checks the plan anew, as a clean run does,
 * the workspace's absolute path and the plan's path,
 * the rclverify code (the salt of the kind ``workspace``,
   :func:`rclverify.core.cache.keys.salt`: name, size and modification time of
@@ -33,7 +37,7 @@ import atexit
 import os
 from typing import Any, BinaryIO
 
-from rclverify.core.cache.keys import file_digest, salt
+from rclverify.core.cache.keys import file_digest, resolved_paths, salt
 from rclverify.core.cache.safeload import load
 from rclverify.core.cache.store import open_stream, write_stream
 from rclverify.core.cache.heap import no_collection
@@ -43,15 +47,29 @@ CACHE = "artifacts/cache/workspace.pickle"
 KIND = "workspace"
 
 
-def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = None) -> dict[str, Any]:
+def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = None,
+            paths: Any = None) -> dict[str, Any]:
     """What ``ws``'s (a :class:`rclverify.stages.workspace.Workspace`) cache was
     computed from.  ``known`` gives sha256s of contract files already taken
-    in this run (by :func:`restore`, before the files were parsed)."""
+    in this run (by :func:`restore`, before the files were parsed).
+    ``paths``: the plan paths whose targets are kept (a mapping of them, or
+    their names): each resolved now (:func:`_resolved`)."""
     known = known or {}
     root = str(ws.root.resolve())
     return {"root": root, "plan_file": ws.plan_file,
             "plan": file_digest(f"{root}/{ws.plan_file}"),
-            "contracts": {c: known[c] if c in known else file_digest(f"{root}/{c}") for c in contracts}}
+            "contracts": {c: known[c] if c in known else file_digest(f"{root}/{c}") for c in contracts},
+            "paths": _resolved(root, paths)}
+
+
+def _resolved(root: str, paths: Any) -> dict[str, str] | None:
+    """What each path of ``paths`` (a mapping or a collection of
+    workspace-relative strings) leads to now (:func:`~.keys.resolved_paths`),
+    or ``None`` when ``paths`` is not one (a cache that kept none: never
+    equal to a plan's)."""
+    if not isinstance(paths, (dict, list, tuple)) or not all(isinstance(v, str) for v in paths):
+        return None
+    return resolved_paths(root, paths)
 
 
 def _open(ws: Any) -> BinaryIO | None:
@@ -88,7 +106,7 @@ def restore(ws: Any) -> bool:
             kept = load(fh)
             if not isinstance(kept, dict):
                 return False
-            now = _inputs(ws, tuple(kept.get("contracts", ())))
+            now = _inputs(ws, tuple(kept.get("contracts", ())), paths=kept.get("paths"))
             ws.cache_shas = now["contracts"]  # taken before any file is parsed: save() reuses them
             if any(kept.get(k) != now[k] for k in ("root", "plan_file")):
                 return False
@@ -102,7 +120,8 @@ def restore(ws: Any) -> bool:
     except Exception:  # a damaged or foreign cache is simply not used  # noqa: BLE001
         return False
     ws.parsed.update(parsed)  # re-validated per file by Workspace.checked
-    if kept.get("plan") == now["plan"] and all((ws.root / c).is_file() for c in plan.contracts):
+    same_paths = now["paths"] is not None and kept.get("paths") == now["paths"]
+    if kept.get("plan") == now["plan"] and same_paths and all((ws.root / c).is_file() for c in plan.contracts):
         ws.__dict__["plan"] = plan
     return False
 
@@ -143,6 +162,7 @@ def save(ws: Any) -> None:
     parsed again next time), or taken now."""
     try:
         kept = _inputs(ws, tuple(ws.plan.contracts), ws.cache_shas)
+        kept["paths"] = dict(ws.plan.path_targets)  # as resolved when the plan's paths were checked
         write_stream(ws.root / CACHE, KIND, salt(KIND), [kept, ws.index, (ws.plan, ws.parsed)])
     except Exception:  # noqa: BLE001
         pass

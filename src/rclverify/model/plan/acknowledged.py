@@ -9,6 +9,14 @@ of status ``warning`` such as a redundant conjunct) may be acknowledged in
         text: "out.arrived -> out.progress >= 0"  # the flagged text (or sha256: its digest)
         reason: kept for the reader of the action's contract
 
+An acknowledgement answers one finding: its file, its node and its text.  A
+health finding's id names its node (and so its file); a lint code is raised
+wherever the same slip is written, so a lint acknowledgement names the
+contract ``file:`` of its finding, and ``node:`` when that file holds more
+than one node (:func:`read_acknowledgements`, :func:`check_acknowledgements`:
+one written wider is a located plan error).  A finding of another file or
+node is never accepted by it.
+
 The acknowledgement is bound to the *flagged text* (:func:`flagged_text`:
 the conjunct, guarantee or clause the warning is about), as a review answer
 is bound to its ``conjunct:`` text (docs/integrity.md): when that text
@@ -23,11 +31,13 @@ Format and decisions: docs/plan.md, "Acknowledged warnings".
 from __future__ import annotations
 
 import hashlib
+import posixpath
 import re
 from dataclasses import dataclass
 from typing import Any, Iterable, Mapping, MutableMapping
 
 from rclverify.lang import ast
+from rclverify.lang.errors import Diagnostic, error
 from rclverify.lang.types import Checked
 from rclverify.model.plan.errors import plan_error
 from rclverify.lang.printer import to_rcl, expr_to_rcl
@@ -41,7 +51,8 @@ class Acknowledgement:
     """One ``acknowledged:`` entry of the plan.
 
     ``warning`` is a health finding's id (``Mover.g2.c1.redundant``) or a
-    lint code (``W-unused-bound``, optionally narrowed to ``file``);
+    lint code (``W-unused-bound``, with the contract ``file`` of its finding
+    and, in a file of several nodes, the ``node`` whose span holds it);
     ``text`` the flagged text as written, ``sha256`` its digest (hex, a
     prefix of at least 12 digits; one of the two is given); ``reason`` the
     user's justification; ``loc`` the entry's place in the plan."""
@@ -52,6 +63,7 @@ class Acknowledgement:
     text: str | None = None
     sha256: str | None = None
     file: str | None = None
+    node: str | None = None
 
     def binds(self, flagged: str) -> bool:
         """Is this acknowledgement bound to ``flagged`` (the finding's flagged text now)?"""
@@ -70,12 +82,22 @@ def digest(text: str) -> str:
     return hashlib.sha256(normal(text).encode("utf-8")).hexdigest()
 
 
+def health_node(warning: str) -> str | None:
+    """The node a health finding's id ``warning`` names (``Mover`` of
+    ``Mover.g2.c1.redundant``); ``None`` for a lint code (``W-unused-bound``)."""
+    m = _HEALTH_ID.match(warning)
+    return m["node"] if m else None
+
+
 def read_acknowledgements(data: Mapping[str, Any], locs: Mapping[Any, ast.Loc], plan_rel: str) -> tuple[Acknowledgement, ...]:
     """The plan's ``acknowledged:`` entries (schema-checked: each has
     ``warning`` and ``reason``).  Raises :class:`~.errors.PlanError`, located
     at the entry, for an entry that gives neither or both of ``text`` and
-    ``sha256``, or whose reason is no sentence (fewer than three words of
-    letters: ``reason: "..."`` says nothing a reviewer can weigh)."""
+    ``sha256``, a lint code without ``file:`` (it would answer the same
+    warning in every file), a ``node:`` other than the node a health id
+    names, or a reason that is no sentence (fewer than three words of
+    letters: ``reason: "..."`` says nothing a reviewer can weigh).  Rule:
+    docs/plan.md, "Acknowledged warnings"."""
     out = []
     for i, a in enumerate(data.get("acknowledged") or ()):
         at = locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1))
@@ -88,10 +110,56 @@ def read_acknowledgements(data: Mapping[str, Any], locs: Mapping[Any, ast.Loc], 
             raise plan_error(plan_rel, r.line, r.col, f"acknowledged[{i}] ({a['warning']}): the reason must say why "
                              f"the warning is accepted, in words a reviewer can weigh, not {a['reason']!r}",
                              "E-acknowledged")
+        owner = health_node(str(a["warning"]))
+        if owner is None and "file" not in a:
+            raise plan_error(plan_rel, at.line, at.col, f"acknowledged[{i}] ({a['warning']}): a lint code is raised "
+                             "wherever the same text is written, so this would answer it in every file; give the "
+                             "contract file of the one warning it answers as file: (and node: when that file holds "
+                             "more than one node)", "E-acknowledged")
+        if owner is not None and a.get("node", owner) != owner:
+            n = locs.get(("acknowledged", i, "node"), at)
+            raise plan_error(plan_rel, n.line, n.col, f"acknowledged[{i}] ({a['warning']}): node: {a['node']} is not "
+                             f"the node the finding's id names ({owner})", "E-acknowledged")
         out.append(Acknowledgement(str(a["warning"]), normal(a["reason"]),
                                    locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1)),
-                                   a.get("text"), a.get("sha256"), a.get("file")))
+                                   a.get("text"), a.get("sha256"), a.get("file"), a.get("node")))
     return tuple(out)
+
+
+def _path(file: str) -> str:
+    """``file`` as a normal relative path (``./contracts//a.rcl`` is ``contracts/a.rcl``)."""
+    return posixpath.normpath(str(file).replace("\\", "/"))
+
+
+def check_acknowledgements(acks: Iterable[Acknowledgement], locs: Mapping[Any, ast.Loc],
+                           checked: Checked) -> list[Diagnostic]:
+    """Located errors (``E-acknowledged``, at the entry's ``file:``/``node:``
+    or the entry) of acknowledgements that cannot be tied to one node of one
+    contract file of ``checked``: a ``file:`` that is no contract file, a
+    node (``node:``, or the node a health id names) the file does not hold,
+    or a lint acknowledgement without ``node:`` whose file holds several
+    nodes.  ``locs``: the plan's value locations.  Rule: docs/plan.md,
+    "Acknowledged warnings"."""
+    files: dict[str, list[str]] = {}
+    for spec in checked.specs:
+        files.setdefault(_path(spec.file), []).extend(n.name for n in spec.nodes)
+    diags = []
+    for i, a in enumerate(acks):
+        if a.file is None:
+            continue  # a health id (its node names its file); a lint code without file: is refused on reading
+        where = f"acknowledged[{i}] ({a.warning})"
+        node, nodes = a.node or health_node(a.warning), files.get(_path(a.file))
+        if nodes is None:
+            diags.append(error(locs.get(("acknowledged", i, "file"), a.loc), f"{where}: file: {a.file} is no contract "
+                               f"file of the plan (they are: {', '.join(files)})", "E-acknowledged"))
+        elif node is not None and node not in nodes:
+            l = locs.get(("acknowledged", i, "node" if a.node else "file"), a.loc)
+            diags.append(error(l, f"{where}: {a.file} has no node {node} (it holds: {', '.join(nodes) or 'none'})",
+                               "E-acknowledged"))
+        elif node is None and len(nodes) > 1:
+            diags.append(error(a.loc, f"{where}: {a.file} holds the nodes {', '.join(nodes)}; name the one whose "
+                               "warning it answers as node:", "E-acknowledged"))
+    return diags
 
 
 def _within(loc: ast.Loc, line: int, col: int) -> bool:
@@ -131,6 +199,34 @@ def conjuncts(e: ast.Expr) -> list[ast.Expr]:
     if isinstance(e, ast.Binary) and e.op == "and":
         return conjuncts(e.left) + conjuncts(e.right)
     return [e]
+
+
+def _lint_place(row: Mapping[str, Any], checked: Checked) -> tuple[str, str | None]:
+    """``(file, node)`` of a lint row: its file as :func:`_path` writes it and
+    the node whose span holds its location (``None``: outside every node)."""
+    file, line, col = _where(row)
+    for spec in checked.specs:
+        if _path(spec.file) == _path(file):
+            for n in spec.nodes:
+                if _within(n.loc, line, col):
+                    return _path(file), n.name
+    return _path(file), None
+
+
+def _answers(a: Acknowledgement, kind: str, row: Mapping[str, Any], checked: Checked) -> bool:
+    """Does ``a`` name the finding ``row``: its id (health) or its code, file
+    and node (lint)?  Its text is compared by :meth:`Acknowledgement.binds`."""
+    if kind == "health":
+        if row.get("id") != a.warning:
+            return False
+        owner = health_node(a.warning)
+        cn = checked.nodes.get(owner or "")
+        return (a.node is None or a.node == owner) and (
+            a.file is None or (cn is not None and _path(cn.node.loc.file) == _path(a.file)))
+    if str(row.get("code", "")) != a.warning or a.file is None:
+        return False
+    file, node = _lint_place(row, checked)
+    return file == _path(a.file) and (a.node is None or node == a.node)
 
 
 def _where(row: Mapping[str, Any]) -> tuple[str, int, int]:
@@ -184,7 +280,11 @@ def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[M
     ``{"warning", "reason", "at", "status", "message", "matched"}`` with
     ``status`` ``ok`` (it acknowledges the ``matched`` warnings), ``stale``
     (it matches no warning, or the flagged text changed: the warning is
-    raised again) or ``error`` (it names an item that is not a warning)."""
+    raised again) or ``error`` (it names an item that is not a warning, or
+    it cannot be tied to one finding: a lint code without ``file``, or one
+    binding warnings of several nodes; it then accepts none).  A finding is
+    matched by its id (health; with ``file``, the node's file too) or by its
+    code, file and node (lint), then by its flagged text."""
     rows: list[tuple[str, MutableMapping[str, Any]]] = (
         [("health", f) for f in findings] + [("lint", x) for x in lint_rows])
     for kind, r in rows:
@@ -195,12 +295,16 @@ def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[M
             r["sha256"] = digest(r["flagged"])
     out = []
     for a in acks:
-        cands = [(k, r) for k, r in rows if (r.get("id") == a.warning if k == "health" else
-                                             str(r.get("code", "")) == a.warning
-                                             and (a.file is None or str(r.get("location", "")).startswith(a.file + ":")))]
+        cands = [(k, r) for k, r in rows if _answers(a, k, r, checked)]
         warns = [(k, r) for k, r in cands if _is_warning(k, r)]
         bound = [(k, r) for k, r in warns if a.binds(str(r["flagged"]))]
+        owners = {_lint_place(r, checked)[1] for k, r in bound if k == "lint"}
         at = f"{a.loc.file}:{a.loc.line}:{a.loc.col}"
+        wide = _too_wide(a, owners)
+        if wide:
+            out.append({"warning": a.warning, "reason": a.reason, "at": at, "status": "error", "message": wide,
+                        "matched": []})
+            continue
         for _, r in bound:
             r["acknowledged"] = {"reason": a.reason, "at": at}
         if bound:
@@ -221,8 +325,23 @@ def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[M
     return out
 
 
+def _too_wide(a: Acknowledgement, owners: set[str | None]) -> str:
+    """Why ``a`` cannot be tied to one finding ('' when it can): a lint code
+    without a file, or one binding warnings of several nodes (``owners``)."""
+    if a.file is None and health_node(a.warning) is None:
+        return (f"{a.warning} is a lint code with no file: it would answer the warning in every file; give the "
+                "contract file (and node:) of the one warning it answers")
+    if len(owners) > 1:
+        names = ", ".join(sorted(str(o) for o in owners))
+        return f"{a.warning} binds warnings of several nodes ({names}); name the one it answers as node:"
+    return ""
+
+
 def hint(kind: str, row: Mapping[str, Any]) -> str:
     """The plan entry that would acknowledge the warning ``row`` (one YAML
     flow mapping; ``reason`` left for the user to write)."""
     name = row["id"] if kind == "health" else row.get("code", "")
-    return f'- {{warning: {name}, sha256: {str(row.get("sha256", ""))[:16]}, reason: "..."}}'
+    where = ""
+    if kind == "lint":  # a lint code is tied to its file (node: too when the file holds several nodes)
+        where = f"file: {_where(row)[0]}, "
+    return f'- {{warning: {name}, {where}sha256: {str(row.get("sha256", ""))[:16]}, reason: "..."}}'

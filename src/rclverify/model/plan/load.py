@@ -29,7 +29,7 @@ from rclverify.model.plan.yamlguard import KEY, Blocks, compose_guarded, read_ya
 from rclverify.model.plan.model import Connection, DeadlineSpec, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
 from rclverify.model.plan.paths import check_plan_paths
 from rclverify.model.plan.state import read_state, state_types, check_states
-from rclverify.model.plan.acknowledged import read_acknowledgements
+from rclverify.model.plan.acknowledged import check_acknowledgements, read_acknowledgements
 from rclverify.lang.timing import UNITS, parse_duration
 from rclverify.model.plan.formal import parse_formal
 from rclverify.model.plan.ranking import parse_hints
@@ -131,7 +131,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     def loc(*path: Any) -> ast.Loc:
         return locs.get(tuple(path), ast.Loc(plan_rel, 1, 1))
 
-    check_plan_paths(root, plan_rel, data, locs)
+    targets = check_plan_paths(root, plan_rel, data, locs)
     contracts = tuple(data["contracts"])
     for i, c in enumerate(contracts):
         if not (root / c).is_file():
@@ -196,7 +196,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     states = read_state(data, locs, blocks, plan_rel)
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
                 str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
-                read_acknowledgements(data, locs, plan_rel))
+                read_acknowledgements(data, locs, plan_rel), targets)
 
 
 def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:
@@ -313,6 +313,7 @@ def resolve(plan: Plan, checked: Checked) -> None:
     # the plan imports no backend code.
     # expected verdicts: a malformed entry is an error here, not a report row
     diags.extend(check_expected(plan, checked))
+    diags.extend(check_acknowledgements(plan.acknowledged, plan.locs, checked))  # one finding each (docs/plan.md)
     if diags:
         raise PlanError(diags)
 

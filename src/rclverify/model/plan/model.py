@@ -130,3 +130,6 @@ class Plan:
     states: tuple[StateVar, ...] = ()
     #: warnings answered with a reason (``acknowledged:``, :mod:`.acknowledged`)
     acknowledged: tuple[Acknowledgement, ...] = ()
+    #: every path the plan names, checked to lie inside the workspace, and what it resolved to then
+    #: (``{value: absolute path}``, :func:`.paths.check_plan_paths`): a reuse of this plan resolves them again
+    path_targets: Mapping[str, str] = field(default_factory=dict)

@@ -22,7 +22,14 @@ separator for these checks (``..\\..\\evil.py`` climbs out), and a
 declared path with a backslash is refused even inside the workspace: plan
 paths are written with ``/`` (docs/plan.md, "Paths").  Each is a
 :class:`~rclverify.model.plan.errors.PlanError` located at the value in the plan
-(``plan.yaml:line:col``).  The files the plan's files name (review records'
+(``plan.yaml:line:col``).
+
+What each checked path resolves to is kept with the loaded plan
+(:func:`~rclverify.core.cache.keys.resolved_paths`, ``Plan.path_targets``): a run that reuses a loaded
+plan (the workspace cache, :mod:`rclverify.core.cache.workspace`) resolves
+every one of them again and loads the plan anew, with this check, when one
+leads elsewhere (a symbolic link retargeted since), so an incremental run
+refuses what a clean run refuses (docs/integrity.md).  The files the plan's files name (review records'
 ``files:``, a trace mapping's ``msg_dirs``) are checked with
 :func:`escape_reason` by their backends' check-time validation, located in
 those files.
@@ -34,6 +41,7 @@ import re
 from pathlib import Path, PurePosixPath
 from typing import Any, Iterator, Mapping
 
+from rclverify.core.cache.keys import resolved_paths
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic
 from rclverify.model.plan.entries import TOOL_KEYS, TOOL_PATH_KINDS, declared_paths
@@ -89,10 +97,13 @@ def config_strings(value: Any, path: Path_ = ()) -> Iterator[tuple[Path_, str]]:
             yield from config_strings(v, path + (i,))
 
 
-def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any], locs: Mapping[Path_, ast.Loc]) -> None:
+def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any],
+                     locs: Mapping[Path_, ast.Loc]) -> dict[str, str]:
     """Check every path in the schema-valid plan ``data`` (see the module docstring).
 
-    ``locs`` maps value paths to their locations in ``plan_rel``.  Raises
+    ``locs`` maps value paths to their locations in ``plan_rel``.  Returns
+    ``{value: absolute path it leads to}`` of every path checked
+    (:func:`~rclverify.core.cache.keys.resolved_paths`).  Raises
     :class:`PlanError` listing every path that leaves the workspace.
     """
     candidates: list[tuple[Path_, str]] = [(("contracts", i), c) for i, c in enumerate(data.get("contracts") or [])]
@@ -130,6 +141,7 @@ def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any], locs: M
                         diags.extend(plan_error(l.file, l.line, l.col, f"{key}: {why}", "E-tool").diagnostics)
     if diags:
         raise PlanError(diags)
+    return resolved_paths(root, [value for _, value in candidates])
 
 
 def tool_path_problem(root: Path, value: Any, kind: str) -> str | None:

@@ -5,6 +5,9 @@ check the contracts first, then produce the message type definitions and the
 node skeletons from them.  Modules by job: :mod:`.typemap` (RCL types to ROS
 interface fields), :mod:`.interfaces` (the interface packages),
 :mod:`.nodes` (one ament_python package per node and the launch files),
+:mod:`.names` and :mod:`.namecheck` (generated names and their check),
+:mod:`.rosnames` (ROS 2's rules for node, namespace, topic, service and
+action names),
 :mod:`.writer` (rendering and writing, generated-every-time versus
 generated-once files), :mod:`.cli` (the command).
 """

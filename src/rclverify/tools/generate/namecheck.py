@@ -4,9 +4,11 @@
 this module checks, before anything is rendered, that the result is a tree
 that builds and means what the contracts say:
 
-* a node, topic, service or action name is a ROS name (no prime: rmw's
-  validation of node names and topic name tokens, ROS 2 design article
-  "Topic and Service name mapping to DDS");
+* a node name, and every fully qualified name the generated node creates
+  (its topics, services and actions, its verdict topic and parameter
+  services, :func:`.rosnames.graph_names`), follows ROS 2's rules
+  (:mod:`.rosnames`: rmw's and rcl's validation: the characters, no leading
+  digit, no ``//``, the lengths), located at the RCL name it comes from;
 * a non-standard interface package and type named by a contract can be
   generated: the package matches rosidl's package pattern and is no Python or
   C++ keyword (it is ``from pkg.msg import`` and ``pkg::msg::``), the type
@@ -28,8 +30,8 @@ import re
 
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
-from rclverify.lang.types import Checked, DataT, EnumT
-from rclverify.tools.generate import names
+from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT
+from rclverify.tools.generate import names, rosnames
 from rclverify.tools.generate.typemap import STANDARD_PACKAGES
 from rclverify.tools.generate.cpp_common import enum_const
 from rclverify.tools.generate.cpp_values import term_struct
@@ -65,16 +67,14 @@ def check_names(checked: Checked, system: str) -> None:
     packages.claim(f"{names.snake(system)}_bringup", f"system {system}", ast.Loc("<command line>", 0, 0))
     for cn in checked.nodes.values():
         node = cn.node
-        _ros_name(diags, cn.name, "node", node.loc)
+        _graph_names(diags, cn)
         packages.claim(names.package_name(cn.name), f"node {cn.name}", node.loc)
         ends = _Scope(f"node {cn.name}'s end", diags)
         for t in node.topics:
-            _ros_name(diags, t.field, "topic", t.loc)
             _interface(diags, packages, t.msg_type, t.loc)
             if t.match is not None and t.match.prefix in ("in", "out"):
                 ends.claim(f"{'sub' if t.match.prefix == 'in' else 'pub'}_{names.snake(t.field)}", t.field, t.loc)
         for link in node.links:
-            _ros_name(diags, link.name, link.kind, link.loc)
             _interface(diags, packages, link.ros_type, link.loc)
             role = f"{link.kind}_{'server' if link.role == 'serves' else 'client'}"
             ends.claim(f"{role}_{names.snake(link.name)}", link.name, link.loc)
@@ -90,11 +90,40 @@ def check_names(checked: Checked, system: str) -> None:
         raise RclError(diags)
 
 
-def _ros_name(diags: list[Diagnostic], name: str, what: str, loc: ast.Loc) -> None:
-    why = names.ros_name_problem(name)
-    if why:
-        diags.append(error(loc, f"{what} name {name} cannot be a ROS 2 {what} name: {why}; the monitors and "
-                                f"'ros diff' find it by this name, so it is not renamed: rename it", _CODE))
+def short_name(name: str) -> str:
+    """``name`` as a message shows it: a long one by its first characters and its length."""
+    return name if len(name) <= 56 else f"{name[:24]}...{name[-24:]} ({len(name)} characters)"
+
+
+def _graph_names(diags: list[Diagnostic], cn: CheckedNode) -> None:
+    """The ROS names node ``cn``'s generated code creates, each by ROS 2's rules (:mod:`.rosnames`):
+    its node name, its private namespace and what is in it, its topics, services and actions; one
+    error per RCL name, located where it is declared."""
+    node, keep = cn.node, "the monitors and 'ros diff' find it by this name, so it is not renamed: rename it"
+    bad_node = rosnames.node_name_problem(cn.name)
+    if bad_node:
+        diags.append(error(node.loc, f"node name {short_name(cn.name)} cannot be a ROS 2 node name: {bad_node} (rmw); "
+                                     f"{keep}", _CODE))
+    ends = [("topic", t.field, t.loc) for t in node.topics] + [(lk.kind, lk.name, lk.loc) for lk in node.links]
+    private = [(f"/{cn.name}", "namespace", -1)] if not bad_node else []
+    said: set[int] = set()
+    for fqn, what, i in private + rosnames.graph_names(cn.name, [(k, n) for k, n, _ in ends]):
+        if i in said or (i < 0 and bad_node):
+            continue
+        why = rosnames.namespace_problem(fqn) if what == "namespace" else rosnames.full_name_problem(fqn, what)
+        if not why:
+            continue
+        said.add(i)
+        if i < 0:
+            diags.append(error(node.loc, f"node name {short_name(cn.name)} gives the {what} {short_name(fqn)}, which "
+                                         f"cannot be a ROS 2 {what} name: {why} (rmw; the node's private namespace "
+                                         f"holds its verdict topic and the parameter services of every rclpy and "
+                                         f"rclcpp node); {keep}", _CODE))
+            continue
+        kind, name, loc = ends[i]
+        gives = "" if fqn == f"/{name}" else f" gives the {what} {short_name(fqn)}, which"
+        diags.append(error(loc, f"{kind} name {short_name(name)}{gives} cannot be a ROS 2 {what} name: {why} (rmw); "
+                                f"{keep}", _CODE))
 
 
 def _interface(diags: list[Diagnostic], packages: _Scope, ros_type: str, loc: ast.Loc) -> None:
@@ -142,4 +171,4 @@ def _context(checked: Checked, diags: list[Diagnostic]) -> None:
             cpp.claim(f"show_{names.snake(t.name)}", f"constructor set {t.name}", loc)
 
 
-__all__ = ["check_names"]
+__all__ = ["check_names", "short_name"]

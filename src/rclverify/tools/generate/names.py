@@ -32,9 +32,8 @@ in it:
 * :func:`constant_name`: a rosidl constant (``^[A-Z]([A-Z0-9_]?[A-Z0-9]+)*$``):
   upper-case words; a C macro name (``NULL``, ``EOF``) takes ``_VALUE``.
 * ROS node, topic, service and action names are the RCL names themselves (the
-  monitors and ``ros diff`` find them by that name); one with a prime is no
-  ROS name (rmw's validation: ``[A-Za-z0-9_]`` tokens) and is refused
-  (:mod:`.namecheck`).
+  monitors and ``ros diff`` find them by that name); one that breaks ROS 2's
+  rules (a prime, a length: :mod:`.rosnames`) is refused (:mod:`.namecheck`).
 
 Two RCL names that give one generated name (``x'`` and ``x_prime``) are
 refused by :mod:`.namecheck` with a located error naming both: no rule here
@@ -174,14 +173,6 @@ def constant_name(*parts: str) -> str:
     return s + "_VALUE" if s in C_MACROS_UPPER else s
 
 
-def ros_name_problem(name: str) -> str:
-    """Why ``name`` cannot be a ROS node, topic, service or action name token (rmw's validation:
-    letters, digits and ``_``, not starting with a digit), ``""`` when it can."""
-    if "'" in name:
-        return "a prime is not allowed in a ROS name (rmw: letters, digits and '_' only)"
-    return ""
-
-
 __all__ = ["CPP_KEYWORDS", "FIELD_RESERVED", "PACKAGE_RESERVED", "PY_RESERVED", "constant_name", "cpp_local",
-           "ctor_field", "field_name", "msg_name", "package_name", "primes", "py_name", "ros_name_problem",
+           "ctor_field", "field_name", "msg_name", "package_name", "primes", "py_name",
            "snake", "words"]
