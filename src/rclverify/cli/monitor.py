@@ -21,7 +21,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping, Sequence
 
 from rclverify.lang.errors import RclError
 from rclverify.lang.types import Checked
@@ -89,7 +89,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         unjudged += run.not_judged
         violated = _report_run(report, run, trace, cfg, args.json) or violated
     _emit(report, args.json)
-    return 1 if violated else _strict(args, unjudged)
+    return 1 if violated else _strict(args, unjudged, _undecided(report))
 
 
 def _report_run(report: list[dict[str, Any]], run: RecordedRun, trace: str, cfg: Any, as_json: bool) -> bool:
@@ -165,13 +165,26 @@ def _print_not_judged(items: list[dict[str, str]], prefix: str) -> None:
         print(f"{prefix}not judged: {i['kind']} {i['name']} ({i['node']}): {i['reason']}: {i['detail']}")
 
 
-def _strict(args: argparse.Namespace, unjudged: list[dict[str, str]]) -> int:
+def _strict(args: argparse.Namespace, unjudged: list[dict[str, str]],
+            undecided: Sequence[Mapping[str, Any]] = ()) -> int:
     """The exit code of a run with no violation: 1 under ``--strict`` when
-    an item went unjudged (``unjudged``, the first named on stderr), else 0."""
-    if not unjudged or not getattr(args, "strict", False):
+    an item went unjudged (``unjudged``, the first named on stderr) or a
+    verdict stayed undecided (``undecided``: the ``inconclusive`` entries, as
+    ``doit verify --strict`` fails on what is not discharged), else 0."""
+    if not getattr(args, "strict", False) or not (unjudged or undecided):
         return 0
-    print(strict_line(unjudged), file=sys.stderr)
+    if unjudged:
+        print(strict_line(unjudged), file=sys.stderr)
+    else:
+        first = undecided[0]
+        print(f"rclverify monitor: --strict: {len(undecided)} verdict(s) undecided; the first: {first['node']}: "
+              f"{first['explanation']}", file=sys.stderr)
     return 1
+
+
+def _undecided(report: list[dict[str, Any]]) -> list[Mapping[str, Any]]:
+    """The entries of ``report`` whose status is ``inconclusive``."""
+    return [e for e in report if e.get("status") == "inconclusive"]
 
 
 def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -> int:
@@ -307,7 +320,10 @@ def _live_exit(args: argparse.Namespace, record_: dict[str, Any]) -> int:
     calls_failed = any(n["status"] == "failed" for n in record_.get("calls", {}).get("nodes", []))
     if late or calls_failed or any(n["status"] == "failed" for n in record_["nodes"]):
         return 1
-    return _strict(args, list(record_.get("not_judged", [])))
+    undecided = [d for d in record_["nodes"] + record_.get("calls", {}).get("nodes", [])
+                 + record_.get("topic_deadlines", []) + record_.get("periods", []) + record_.get("declarations", [])
+                 if d.get("status") == "inconclusive"]
+    return _strict(args, list(record_.get("not_judged", [])), undecided)
 
 
 def oracle_command(args: argparse.Namespace, checked: Checked) -> int:

@@ -444,8 +444,10 @@ def _ms_ns(ns: int) -> str:
 def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
     """Evidence status and explanation of one node's deadline verdicts on a
     trace: any ``false`` -> ``failed`` (the first named with its stamps);
-    only ``currently_false`` -> ``inconclusive``; else ``discharged``, or
-    ``pending`` when no trigger event was seen."""
+    any ``currently_false`` (a trigger unanswered and within its deadline
+    when the run ended: not decided, as an untimed question still open at
+    the end) -> ``inconclusive``; else ``discharged``, or ``pending`` when
+    no trigger event was seen."""
     c = res.counts
     f = res.first_false
     u = res.unaccepted
@@ -466,11 +468,10 @@ def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
     if u["undecided"]:
         return "inconclusive", (f"{u['undecided']} trigger event(s) could not be judged against the assumption"
                                 f"{refused}")
-    if c["currently_false"] and not c["true"]:
+    if c["currently_false"]:
+        met = f"; {c['true']} other(s) were answered within their deadline" if c["true"] else ""
         return "inconclusive", (f"{c['currently_false']} trigger event(s) were unanswered and within their "
-                                f"deadline when {trace} ended{refused}")
+                                f"deadline when {trace} ended: not decided{met}{refused}")
     if not c["true"]:
         return "pending", f"{trace} has no accepted trigger event of {res.node}'s timed guarantees: nothing was checked{refused}"
-    extra = (f"; {c['currently_false']} more still within their deadline when the run ended"
-             if c["currently_false"] else "")
-    return "discharged", f"all {c['true']} accepted trigger event(s) were answered within their deadline{extra}{refused}"
+    return "discharged", f"all {c['true']} accepted trigger event(s) were answered within their deadline{refused}"
