@@ -32,7 +32,8 @@ from rclverify.model.plan.errors import PlanError
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.timelimit import TimeLimitExceeded, wall_clock_limit
-from rclverify.backends.property_tests.closure import import_closure, outside_versions
+from rclverify.backends.property_tests.closure import import_closure, outside_versions, resolve_closure
+from rclverify.backends.property_tests.importpath import on_harness_path
 from rclverify.backends.property_tests.declared import declaration_rows, has_declarations
 from rclverify.backends.property_tests.seeding import SeedingCut, split_facts
 from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
@@ -106,12 +107,13 @@ def _declarations(outcome: Outcome, cfg: Config, target: NodeTarget, k: int) -> 
     """The declaration rows of guarantee ``k``'s run and the record's status
     and message with them: an initial value outside ``initially`` fails the
     record of guarantee 1 (:mod:`.declared`)."""
-    try:
-        impl = load_implementation(target.root, cfg) if target.node.node.initially else None
+    try:  # no initial values from code the evidence does not hash
+        impl = load_implementation(target.root, cfg) if target.node.node.initially and not outcome.unhashed else None
     except ConfigError:
         impl = None
-    rows = declaration_rows(target.checked, target.node, impl, outcome.status, outcome.counterexample,
-                            outcome.counts.valid)
+    with on_harness_path(target.root, cfg.file):  # the initial values are read as the run calls the code
+        rows = declaration_rows(target.checked, target.node, impl, outcome.status, outcome.counterexample,
+                                outcome.counts.valid)
     bad = [r for r in rows if r["verdict"] == "false" and r["premise"] == "initial value"]
     if bad and k == 1 and outcome.status != "failed":
         r = bad[0]
@@ -169,6 +171,10 @@ class PropertyTestsBackend:
             if not 1 <= k <= len(target.node.node.guarantees):
                 return evidence("error", "the contract no longer has this guarantee; export again")
             path = test_file(target)
+            runs = sorted(set(resolve_closure(target.root, cfg.file).files) - set(obligation.inputs))
+            if runs:  # the evidence would not hash them
+                return evidence("inconclusive", f"{cfg.implementation} now imports {', '.join(runs)}, which the "
+                                "obligation does not list as inputs: export again (`doit verify` does)")
             impl = _load(target, cfg)  # imported once for the run: the test file's kind and the run itself
             atomic_write_text(path, render_tests(target, cfg, inspect.isclass(impl)))
             with wall_clock_limit(cfg.timeout_s):
@@ -206,6 +212,8 @@ class PropertyTestsBackend:
             details["unknown_reasons"] = outcome.unknown_reasons
         if outcome.health:
             details["health_check"] = outcome.health
+        if outcome.unhashed:
+            details["imports_not_hashed"] = outcome.unhashed
         log = "; ".join(f"{a} {b}" for a, b in outcome.counts.as_dict().items())
         cex = outcome.counterexample
         if cex is not None:

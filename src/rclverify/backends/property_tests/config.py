@@ -111,18 +111,26 @@ def _forget_bytecode(files: set[Path]) -> None:
 def load_implementation(root: Path, cfg: Config) -> Any:
     """Import the implementation's file afresh, with every workspace module of
     its import closure (:mod:`.closure`) that this process imported before,
-    and return the named callable or class.
+    and return the named callable or class.  The import runs with the
+    harness's folders first on ``sys.path``
+    (:func:`~.importpath.on_harness_path`, the path the closure resolves
+    imports with); every module name the closure finds in the workspace is
+    imported again, whatever file this process loaded under that name
+    before (another implementation's ``helper``).
 
     Raises :class:`ConfigError` when the file does not import or lacks the name.
     """
     path = (root / cfg.file).resolve()
-    from rclverify.backends.property_tests.closure import import_closure  # deferred: start-up (loads rclverify.backends.property_tests, ast only when called)
-    closure = {(root / f).resolve() for f in import_closure(root, cfg.file)[0]}
+    from rclverify.backends.property_tests.closure import resolve_closure  # deferred: start-up (loads rclverify.backends.property_tests, ast only when called)
+    from rclverify.backends.property_tests.importpath import on_harness_path  # deferred: start-up (as the closure)
+    found = resolve_closure(root, cfg.file)
+    closure = {(root / f).resolve() for f in found.files}
     names = {p.name for p in closure}
+    again = set(found.modules)
     for name, mod in list(sys.modules.items()):  # the workspace modules it imports, afresh too (a long-lived process)
         where = getattr(mod, "__file__", None)
         # the file name first: resolving every loaded module's path cost seconds per run
-        if where and os.path.basename(where) in names and Path(where).resolve() in closure:
+        if name in again or (where and os.path.basename(where) in names and Path(where).resolve() in closure):
             del sys.modules[name]
     modname = f"rclverify_impl_{abs(hash(str(path)))}"
     spec = importlib.util.spec_from_file_location(modname, path)
@@ -134,7 +142,8 @@ def load_implementation(root: Path, cfg: Config) -> Any:
     dont_write = sys.dont_write_bytecode
     sys.dont_write_bytecode = True
     try:
-        spec.loader.exec_module(module)
+        with on_harness_path(root, cfg.file):
+            spec.loader.exec_module(module)
     except Exception as exc:  # the user's file: any error is theirs
         raise ConfigError(f"importing {cfg.file} failed: {type(exc).__name__}: {exc}", "implementation") from None
     finally:

@@ -46,6 +46,8 @@ from rclverify.backends.property_tests.coverage import Coverage
 from rclverify.backends.property_tests.constants import boundary_constants, constant_values
 from rclverify.backends.property_tests.strategies import assumption_bounds, conjuncts, input_space
 from rclverify.backends.property_tests.config import Config, ConfigError, load_implementation, read_config
+from rclverify.backends.property_tests.closure import resolve_closure
+from rclverify.backends.property_tests.importpath import on_harness_path
 
 # The plan entry's reading lives in .config; its names stay importable from here (the backend, replay, the tests
 # and the benchmark import them with the run).
@@ -97,6 +99,8 @@ class Outcome:
     health: str = ""
     #: per input, how much of the assumption's range the valid examples covered (:mod:`.coverage`)
     coverage: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: ``file:line: why`` of each import whose code is not hashed (:class:`.closure.Closure`); then no run
+    unhashed: list[str] = field(default_factory=list)
 
 
 class _Violation(AssertionError):
@@ -399,13 +403,24 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
                   facts: tuple[ast.Expr, ...] = (), impl: Any = None) -> Outcome:
     """Run guarantee ``guarantee`` (1-based) of ``node`` on the implementation
     ``impl`` (loaded afresh here when ``None``: :func:`load_implementation`),
-    inputs drawn under the assumption and the environment ``facts`` (parsed plan facts).
+    inputs drawn under the assumption and the environment ``facts`` (parsed plan facts),
+    with the harness's folders first on ``sys.path`` (:func:`.importpath.on_harness_path`).
+
+    An import closure (:func:`.closure.resolve_closure`) with an import that
+    cannot be followed gives an ``inconclusive`` outcome naming each, with no
+    run: code that is not hashed would decide it (docs/property-tests.md,
+    "What runs is what is hashed").
 
     Raises :class:`ConfigError` for an implementation that cannot be loaded.
     """
+    unhashed = list(resolve_closure(root, cfg.file).unresolved)
+    if unhashed:
+        return Outcome("inconclusive", f"{cfg.implementation}: not run, since code it imports would not be hashed "
+                       f"with the evidence: {'; '.join(unhashed)}", Counts(), unhashed=unhashed)
     if impl is None:
         impl = load_implementation(root, cfg)
-    return GuaranteeRun(checked, node, guarantee, cfg, impl, facts).run()
+    with on_harness_path(root, cfg.file):
+        return GuaranteeRun(checked, node, guarantee, cfg, impl, facts).run()
 
 
 def versions() -> str:
