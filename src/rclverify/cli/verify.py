@@ -58,6 +58,11 @@ def run_doit(module: object, argv: list[str], cluster: str | None) -> int:
     """Run doit's ``argv`` on the tasks of ``module``, with the Dask scheduler ``cluster`` named to the evidence tasks when given; doit's exit code."""
     from doit.cmd_base import ModuleTaskLoader  # deferred: start-up (loads doit and more only when called)
     from doit.doit_cmd import DoitMain  # deferred: start-up (loads doit and more only when called)
+    # doit's default output is the sys.stdout of the moment doit was imported; an in-process caller's
+    # stream may have been another since (and closed): doit writes to today's
+    config = getattr(module, "DOIT_CONFIG", None)
+    if isinstance(config, dict):
+        config["outfile"] = sys.stdout
     if not cluster:
         return int(DoitMain(ModuleTaskLoader(module)).run(argv))
     from rclverify.app.cluster import CLUSTER_ENV  # read by the evidence tasks, also in doit's worker processes; deferred: start-up (loads rclverify.app, rclverify.app.cluster and more only when called)
