@@ -243,6 +243,9 @@ class LiveRun:
             for v, k in r["counts"].items():
                 total[v] = total.get(v, 0) + k
         decided = {n["node"]: int((n.get("statistics") or {}).get("answers", 0)) for n in record["nodes"]}
+        for n in record.get("calls", {}).get("nodes", []):  # a node judged by its calls decided them
+            c = n.get("counts") or {}
+            decided[n["node"]] = decided.get(n["node"], 0) + int(c.get("satisfied", 0)) + int(c.get("violated", 0))
         items = not_judged(self.nodes, heard, statuses, counts, "during the live run", decided)
         for entry in record["nodes"]:  # a pending node says why itself
             explain(entry, items)

@@ -35,6 +35,7 @@ from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
 from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
 from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judged
+from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
 from rclverify.backends.monitors.rml import Spec, rml_id, translate
@@ -228,8 +229,7 @@ class MonitorsBackend:
                                                                       dict(calls.orphans)),
                                                  {res.node: [(status, explanation)]},
                                                  {dl.node: dl.counts} if dl is not None else {}, f"in {trace}",
-                                                 {res.node: int(res.counts.get("satisfied", 0))
-                                                  + int(res.counts.get("violated", 0))})
+                                                 decided_of([res], calls.entries() if summary is not None else []))
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
         explanation = entry["explanation"] + (f"; {note}" if note else "")

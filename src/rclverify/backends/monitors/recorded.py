@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator, Sequence
+from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces import read_trace
@@ -95,7 +95,7 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
         for v, k in r.counts.items():
             total[v] = total.get(v, 0) + k
     items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
-                       f"in {trace}", {r.node: _decided(r) for r in results})
+                       f"in {trace}", decided_of(results, centries))
     return RecordedRun(events, results, dres, pres, decl_res, summary, centries, dentries,
                        calls.missed() if summary is not None else (0, 0), items, one.note, stale)
 
@@ -149,6 +149,16 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
 def _decided(res: NodeResult) -> int:
     """The answers of ``res`` decided satisfied or violated."""
     return int(res.counts.get("satisfied", 0)) + int(res.counts.get("violated", 0))
+
+
+def decided_of(results: Iterable[NodeResult], call_entries: Iterable[Mapping[str, Any]]) -> dict[str, int]:
+    """Node name -> its answers decided on its topics (``results``) and its calls (``call_entries``:
+    :meth:`.log_calls.LogCalls.entries`), for :func:`.judged.not_judged`."""
+    out = {r.node: _decided(r) for r in results}
+    for e in call_entries:
+        c = (e.get("calls") or {}).get("counts") or {}
+        out[e["node"]] = out.get(e["node"], 0) + int(c.get("satisfied", 0)) + int(c.get("violated", 0))
+    return out
 
 
 def _readable_again(path: Path) -> bool:
