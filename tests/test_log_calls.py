@@ -100,7 +100,8 @@ def test_the_offline_command_judges_a_live_logs_calls_as_the_live_book(wrong: bo
     # the nodes judged by their calls are judged: no not-judged item names them or their links
     items = [i for e in report if e.get("not_judged") for i in e["not_judged"]]
     assert items == [], items
-    assert _offline(log, "--strict")[0] == code
+    # --strict fails on an undecided verdict too (Base's unpaired call: inconclusive, never a guess)
+    assert _offline(log, "--strict")[0] == 1
 
 
 def test_the_offline_text_says_the_calls_as_the_live_run_does(tmp_path: Path,

@@ -131,6 +131,15 @@ def _path(file: str) -> str:
     return posixpath.normpath(str(file).replace("\\", "/"))
 
 
+def _same(contract: str, file: str) -> bool:
+    """Is the contract file ``contract`` (as the checker names it: relative to
+    the workspace, or absolute when the contracts were named so) the plan's
+    ``file:`` (relative to the workspace)?"""
+    c, f = _path(contract), _path(file)
+    return c == f or (posixpath.isabs(c) and not posixpath.isabs(f) and not f.startswith("../")
+                      and c.endswith("/" + f))
+
+
 def check_acknowledgements(acks: Iterable[Acknowledgement], locs: Mapping[Any, ast.Loc],
                            checked: Checked) -> list[Diagnostic]:
     """Located errors (``E-acknowledged``, at the entry's ``file:``/``node:``
@@ -148,7 +157,8 @@ def check_acknowledgements(acks: Iterable[Acknowledgement], locs: Mapping[Any, a
         if a.file is None:
             continue  # a health id (its node names its file); a lint code without file: is refused on reading
         where = f"acknowledged[{i}] ({a.warning})"
-        node, nodes = a.node or health_node(a.warning), files.get(_path(a.file))
+        matched = [names for f, names in files.items() if _same(f, a.file)]
+        node, nodes = a.node or health_node(a.warning), (matched[0] if len(matched) == 1 else None)
         if nodes is None:
             diags.append(error(locs.get(("acknowledged", i, "file"), a.loc), f"{where}: file: {a.file} is no contract "
                                f"file of the plan (they are: {', '.join(files)})", "E-acknowledged"))
@@ -206,7 +216,7 @@ def _lint_place(row: Mapping[str, Any], checked: Checked) -> tuple[str, str | No
     the node whose span holds its location (``None``: outside every node)."""
     file, line, col = _where(row)
     for spec in checked.specs:
-        if _path(spec.file) == _path(file):
+        if _same(spec.file, file) or _same(file, spec.file):
             for n in spec.nodes:
                 if _within(n.loc, line, col):
                     return _path(file), n.name
@@ -222,11 +232,11 @@ def _answers(a: Acknowledgement, kind: str, row: Mapping[str, Any], checked: Che
         owner = health_node(a.warning)
         cn = checked.nodes.get(owner or "")
         return (a.node is None or a.node == owner) and (
-            a.file is None or (cn is not None and _path(cn.node.loc.file) == _path(a.file)))
+            a.file is None or (cn is not None and _same(cn.node.loc.file, a.file)))
     if str(row.get("code", "")) != a.warning or a.file is None:
         return False
     file, node = _lint_place(row, checked)
-    return file == _path(a.file) and (a.node is None or node == a.node)
+    return _same(file, a.file) and (a.node is None or node == a.node)
 
 
 def _where(row: Mapping[str, Any]) -> tuple[str, int, int]:
