@@ -39,7 +39,7 @@ from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
 from rclverify.backends.monitors.rml import Spec, rml_id, translate
-from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order
+from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, stale_reason
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
 
@@ -184,10 +184,12 @@ class MonitorsBackend:
         except Exception as exc:
             return evidence("error", f"the plan entry no longer loads: {exc}")
         trace = str(obligation.data.get("trace", ""))
-        note = ""
+        note = stale = ""
         try:
             read = _judge(target, cfg, trace, None)
-            if read.watch.count:  # messages recorded out of stamp order: one clock, the stamps (stamp_order.py)
+            if read.watch.count and read.watch.two_clocks():  # no one order of the run (stamp_order.py)
+                stale = stale_reason(read.watch, trace)
+            elif read.watch.count:  # messages recorded out of stamp order: one clock, the stamps (stamp_order.py)
                 note = read.watch.note()
                 read = _judge(target, cfg, trace, read.watch.lag)
         except TraceError as exc:
@@ -233,6 +235,8 @@ class MonitorsBackend:
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
         explanation = entry["explanation"] + (f"; {note}" if note else "")
+        if stale and status in ("discharged", "pending"):
+            status, explanation = "inconclusive", f"{stale}; in recording order: {explanation}"
         if note:
             details["stamp_order"] = note
         extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)

@@ -72,7 +72,7 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
     one = _pass(checked, nodes, cfg, root, trace, on_warning, None)
     stale = ""
     if one.watch.count:  # messages recorded out of stamp order: one clock, the stamps (stamp_order.py)
-        if _readable_again(Path(trace)):
+        if _readable_again(Path(trace)) and not one.watch.two_clocks():
             note = one.watch.note()
             one = _pass(checked, nodes, cfg, root, trace, on_warning, one.watch.lag)
             one.note = note

@@ -81,15 +81,28 @@ def run_digest(root: Path, trace: str) -> str:
 
 
 def _log_digest(path: Path) -> str:
-    """sha256 over a log's lines as canonical JSON (:func:`run_digest`)."""
+    """sha256 over a log's lines as canonical JSON (:func:`run_digest`): keys
+    sorted, no spacing, and a number by its value (``1``, ``1.0`` and
+    ``1e0`` are one number, as JSON gives them one meaning)."""
     import msgspec  # deferred: start-up (only where a run is counted)
     h = hashlib.sha256()
     decode, encode = msgspec.json.decode, msgspec.json.Encoder(order="sorted").encode
     with path.open("rb") as fh:
         for line in fh:
             if line.strip():
-                h.update(encode(decode(line)) + b"\n")
+                h.update(encode(_numbers_by_value(decode(line))) + b"\n")
     return h.hexdigest()
+
+
+def _numbers_by_value(v: Any) -> Any:
+    """``v`` with every float that is an integer written as that integer."""
+    if isinstance(v, float):
+        return int(v) if v.is_integer() else v
+    if isinstance(v, dict):
+        return {k: _numbers_by_value(x) for k, x in v.items()}
+    if isinstance(v, list):
+        return [_numbers_by_value(x) for x in v]
+    return v
 
 
 def _bag_digest(path: Path) -> str:

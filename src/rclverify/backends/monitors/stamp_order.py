@@ -48,7 +48,7 @@ class StampWatch:
     ``skew`` seconds before the latest stamp already heard (``count``; the
     largest such ``lag`` in seconds; ``first``: where the first was read)."""
 
-    __slots__ = ("skew", "latest", "count", "lag", "first")
+    __slots__ = ("skew", "latest", "count", "lag", "first", "stamped", "plain")
 
     def __init__(self, skew: float) -> None:
         self.skew = skew
@@ -56,10 +56,19 @@ class StampWatch:
         self.count = 0
         self.lag = 0.0
         self.first = ""
+        #: the smallest and largest header stamp, and trace time of a message without one (s)
+        self.stamped = [math.inf, -math.inf]
+        self.plain = [math.inf, -math.inf]
 
     def see(self, ev: Event) -> None:
         """Note event ``ev``'s place on the run's clock."""
-        t = run_clock(ev)
+        s = header_stamp(ev.fields) if ev.fields else None
+        t = ev.time if s is None else s
+        span = self.plain if s is None else self.stamped
+        if t < span[0]:
+            span[0] = t
+        if t > span[1]:
+            span[1] = t
         latest = self.latest
         if t >= latest:
             self.latest = t
@@ -77,6 +86,7 @@ class StampWatch:
         if not len(times):
             return
         from rclverify.core.numeric import np  # deferred: optional or conditional (columnar blocks exist with numpy only)
+        self.plain = [min(self.plain[0], float(times.min())), max(self.plain[1], float(times.max()))]
         ahead = np.maximum(np.maximum.accumulate(times), self.latest)  # the latest time heard up to each row
         behind = ahead - times
         late = behind > self.skew
@@ -85,6 +95,17 @@ class StampWatch:
             self.lag = max(self.lag, float(behind.max()))
             self.first = self.first or where(int(late.argmax()))
         self.latest = float(ahead[-1])
+
+    def two_clocks(self) -> bool:
+        """Whether the header stamps and the times of the messages without one
+        read two clocks: both kinds present, and the gap between their ranges
+        longer than a minute and than either range (simulated time in the
+        stamps, the wall clock in the recording: no one order of the run)."""
+        (s0, s1), (p0, p1) = self.stamped, self.plain
+        if s0 > s1 or p0 > p1:
+            return False
+        gap = max(p0 - s1, s0 - p1)
+        return gap > max(60.0, s1 - s0, p1 - p0)
 
     def note(self) -> str:
         """``""`` for a run read in stamp order, else the sentence saying how it was judged."""
@@ -117,10 +138,18 @@ def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
 
 
 def stale_reason(watch: StampWatch, trace: str) -> str:
-    """Why the first pass's verdicts on a run that cannot be read again are not given."""
-    return (f"{trace} cannot be read a second time in stamp order (a stream): {watch.count} message(s) were "
-            f"recorded after one stamped up to {watch.lag * 1e3:.1f} ms later (the first at {watch.first}), so "
-            "the verdicts judged in recording order may not hold on the run's clock")
+    """Why the first pass's verdicts are not given: the run cannot be read
+    again in stamp order (a stream), or its stamps and its other messages'
+    times read two clocks (:meth:`StampWatch.two_clocks`)."""
+    late = (f"{watch.count} message(s) were recorded after one stamped up to {watch.lag * 1e3:.1f} ms later (the "
+            f"first at {watch.first})")
+    if watch.two_clocks():
+        (s0, s1), (p0, p1) = watch.stamped, watch.plain
+        return (f"{trace} reads two clocks: header stamps from {s0:.3f} s to {s1:.3f} s, the messages without one "
+                f"from {p0:.3f} s to {p1:.3f} s (simulated time beside the wall clock?), and {late}: no one order "
+                "of the run decides which question an answer answers")
+    return (f"{trace} cannot be read a second time in stamp order (a stream): {late}, so the verdicts judged in "
+            "recording order may not hold on the run's clock")
 
 
 __all__ = ["StampWatch", "in_stamp_order", "run_clock", "stale_reason"]
