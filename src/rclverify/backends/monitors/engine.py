@@ -231,11 +231,19 @@ class NodeMonitor(Judging, Closing, Late):
                 values[key] = mapper(fields, values.get(key))
             except MappingError as exc:
                 # the value in force is stale now: a gate holds back what reads it (dds_enforce.py)
-                self.invalid[key] = f"the latest message at {ev.where} does not map ({exc})"
-                self._unread[key] = (ev.stamped, self.invalid[key])  # a message heard late does not clear it (late.py)
+                self.invalid[key] = why = f"the latest message at {ev.where} does not map ({exc})"
+                trig = self._topic_io[ev.topic][0]
+                if key in trig and self.has_inputs and values.get(key) is not None:
+                    # the input changed to a value that does not map: the question before it is superseded by an
+                    # undecided one (its verdict says why), so no later answer is judged on the value before the
+                    # NaN (docs/semantics.md, "Values")
+                    self._input(ev, trig)
+                else:
+                    self._verdict("inconclusive", ev, reason=f"{key}: {exc}")
+                self.invalid[key] = why
+                self._unread[key] = (ev.stamped, why)  # a message heard late does not clear it (late.py)
                 if ev.stamped > self._hi:
                     self._hi = ev.stamped
-                self._verdict("inconclusive", ev, reason=f"{key}: {exc}")
                 return
             if self.invalid:
                 self.invalid.pop(key, None)
