@@ -15,29 +15,10 @@ from pathlib import Path
 
 import pytest
 
+from _blocked import cli_without
 from rclverify.core.extras import EXTRA_OF, MissingExtra, missing_message, require
 
 ROOT = Path(__file__).resolve().parents[1]
-
-#: A prelude that makes the packages named in argv[1] (comma-separated) unimportable, then runs the CLI.
-BLOCKED = """
-import importlib.abc, sys
-blocked = set(sys.argv[1].split(","))
-class Refuse(importlib.abc.MetaPathFinder):
-    def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in blocked:
-            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
-        return None
-sys.meta_path.insert(0, Refuse())
-from rclverify.cli.commands import main
-sys.exit(main(sys.argv[2:]))
-"""
-
-
-def _cli_without(packages: str, *args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-c", BLOCKED, packages, *args], cwd=cwd, capture_output=True,
-                          text=True, timeout=120, stdin=subprocess.DEVNULL)
-
 
 def test_every_optional_module_belongs_to_an_extra_of_the_distribution() -> None:
     extras = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["optional-dependencies"]
@@ -70,7 +51,7 @@ def test_an_import_error_inside_an_installed_package_is_not_hidden(tmp_path: Pat
 
 
 def test_the_language_server_without_its_extra_says_so_in_one_line() -> None:
-    r = _cli_without("pygls,lsprotocol", "lsp")
+    r = cli_without("pygls,lsprotocol", "lsp")
     assert r.returncode == 1, r.stderr
     assert r.stderr.strip().splitlines() == [
         "error: the RCL language server needs rclverify's [lsp] extra (pygls is not installed): "
@@ -80,7 +61,7 @@ def test_the_language_server_without_its_extra_says_so_in_one_line() -> None:
 def test_a_workspace_that_needs_the_ros_extra_says_so_in_one_line(tmp_path: Path) -> None:
     ws = tmp_path / "ws"
     shutil.copytree(ROOT / "examples" / "warehouse", ws, ignore=shutil.ignore_patterns("artifacts", "reports"))
-    r = _cli_without("rosbags", "verify", cwd=ws)
+    r = cli_without("rosbags", "verify", cwd=ws)
     assert r.returncode == 1, r.stderr
     assert r.stderr.strip().splitlines()[-1].startswith("error: reading the standard ROS message types needs "
                                                           "rclverify's [ros] extra"), r.stderr

@@ -4,13 +4,12 @@ green or an unlocated failure before its fix, each with its control."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from _blocked import cli_without
 from rclverify.backends.monitors import recorded
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.backends.monitors.runset import run_digest
@@ -19,20 +18,6 @@ from rclverify.lang.typecheck import check
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "safety_stop"
 WALL = 1_700_000_000.0
-
-BLOCKED = """
-import importlib.abc, sys
-blocked = set(sys.argv[1].split(","))
-class Refuse(importlib.abc.MetaPathFinder):
-    def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in blocked:
-            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
-        return None
-sys.meta_path.insert(0, Refuse())
-from rclverify.cli.commands import main
-sys.exit(main(sys.argv[2:]))
-"""
-
 
 def _stamp(t: float) -> dict[str, Any]:
     return {"header": {"stamp": {"secs": int(t), "nsecs": round((t % 1) * 1e9)}}}
@@ -83,8 +68,7 @@ def test_a_missing_extra_on_the_command_line_is_one_line(tmp_path: Path, blocked
     bag = tmp_path / "run.mcap"
     bag.write_bytes(b"\x89MCAP0\r\n")
     args = [str(bag) if a == "BAG" else str(tmp_path / "key") if a == "KEY" else a for a in args]
-    r = subprocess.run([sys.executable, "-c", BLOCKED, blocked, *args], capture_output=True, text=True, timeout=120,
-                       cwd=tmp_path)
+    r = cli_without(blocked, *args, cwd=tmp_path)
     assert r.returncode in (1, 2) and "Traceback" not in r.stderr, r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and words in lines[0], r.stderr

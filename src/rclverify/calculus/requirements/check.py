@@ -54,6 +54,7 @@ from typing import Any, Sequence
 
 import z3
 
+from rclverify.calculus.requirements.exercised import antecedent as _premise  # the condition a requirement demands under
 from rclverify.calculus.compose import split_assumption
 from rclverify.semantics.encode import Encoder
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
@@ -370,19 +371,6 @@ def _model_query(labelled: list[tuple[str, z3.BoolRef]], enc: Encoder, model_ms:
             return QueryResult("sat", r.script, round(time.perf_counter() - t0, 4), model=w.model)
     r = satisfiable(labelled, enc, timeout_ms=model_ms, comment=comment)
     return replace(r, duration_s=round(time.perf_counter() - t0, 4))
-
-
-def _premise(e: ast.Expr) -> ast.Expr | None:
-    """``exists(bs | P)`` for a requirement ``forall(bs | P -> Q)`` (or ``P``
-    for ``P -> Q``): the condition under which it demands something; ``None``
-    for a requirement of another shape."""
-    bindings: list[ast.Binding] = []
-    while isinstance(e, ast.Quant) and e.kind == "forall":
-        bindings.extend(e.bindings)
-        e = e.body
-    if not (isinstance(e, ast.Binary) and e.op == "->"):
-        return None
-    return ast.Quant("exists", tuple(bindings), e.left, e.loc) if bindings else e.left
 
 
 def _counterexample(model: dict[str, str], cone: Sequence[str], checked: Checked, enc: Encoder) -> list[dict[str, Any]]:
