@@ -47,8 +47,9 @@ from typing import Any
 
 import z3
 
-from rclverify.calculus.requirements.check import (MODEL_TIMEOUT_MS, NEGATED, _ask, _base, _points, _premise, _proved,
+from rclverify.calculus.requirements.check import (MODEL_TIMEOUT_MS, NEGATED, _ask, _base, _points, _proved,
                                                    _Query, check_requirement, cone_of, formals_of)
+from rclverify.calculus.requirements.exercised import antecedent as _premise
 from rclverify.lang.types import Checked
 from rclverify.model.plan.formal import Formal
 from rclverify.model.plan.model import Plan, Requirement
