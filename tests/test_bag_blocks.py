@@ -134,7 +134,9 @@ def test_batch_on_bag_blocks_equals_streaming(bags: dict[str, Path], storage: st
                 runs.append((None, None, seen, str(exc)))
         assert repr(runs[1]) == repr(runs[0]), name
         assert (runs[0][3] is not None) == name.endswith("bad")
-        assert len(runs[0][2]) > 20
+        # verdicts came (the bad bag stops at its undecodable message; a NaN reading supersedes the question
+        # in force with an undecided one: one verdict, not one per output that follows)
+        assert len(runs[0][2]) > (15 if name.endswith("bad") else 20)
     assert "cannot decode std_msgs/msg/" in str(runs[0][3])  # a string that is not UTF-8 comes first
 
 

@@ -225,7 +225,10 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         if enforcing is None:
             return 2
         run_class = enforcing
-    factory = partial(run_class, checked, nodes, cfg.rules, cfg.horizon, log,
+    from rclverify.backends.monitors.widths import at_carried_widths, carried_widths  # deferred: start-up (only live)
+    dirs = [root / d for d in cfg.msg_dirs]  # the contract's constants as the fields carry them, as offline
+    judged = [at_carried_widths(n, carried_widths(n, cfg.rules, dirs)) for n in nodes]
+    factory = partial(run_class, checked, judged, cfg.rules, cfg.horizon, log,
                       reorder_window=args.reorder_window, silence_s=args.silence, **extra)
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):

@@ -39,6 +39,7 @@ from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
 from rclverify.backends.monitors.rml import Spec, rml_id, translate
+from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, stale_reason
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
@@ -263,24 +264,27 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     """One read of the run at ``trace`` feeding the untimed check, the deadlines, the periods, the
     declarations and a live log's calls; in stamp order when ``lag`` (s, :func:`.stamp_order.in_stamp_order`)
     is given.  Raises what the readers and the checkers raise (the caller reports it)."""
+    # the contract's constants compared as the fields carry them (widths.py)
+    node = at_carried_widths(target.node, carried_widths(target.node, cfg.rules,
+                                                         [target.root / d for d in cfg.msg_dirs]))
     beside = _Beside()
-    if has_deadlines(target.node):
-        beside.add("deadlines", lambda: DeadlineMonitor(target.checked, target.node, cfg.rules,
+    if has_deadlines(node):
+        beside.add("deadlines", lambda: DeadlineMonitor(target.checked, node, cfg.rules,
                                                         horizon=cfg.horizon, tolerance=cfg.tolerance))
-    if has_periods(target.node):  # periodic outputs on the same run (periods.py)
-        beside.add("periods", lambda: PeriodMonitor(target.node))
-    if has_declarations(target.node):  # initially, progress, periodic judged on the same run (declarations.py)
-        beside.add("declarations", lambda: DeclarationMonitor(target.checked, target.node, cfg.rules,
+    if has_periods(node):  # periodic outputs on the same run (periods.py)
+        beside.add("periods", lambda: PeriodMonitor(node))
+    if has_declarations(node):  # initially, progress, periodic judged on the same run (declarations.py)
+        beside.add("declarations", lambda: DeclarationMonitor(target.checked, node, cfg.rules,
                                                               tolerance=cfg.tolerance))
     # a live log's service calls and action goals, judged as the live run judged them (log_calls.py)
-    calls = LogCalls(target.checked, [target.node], cfg.rules, cfg.horizon, trace)
+    calls = LogCalls(target.checked, [node], cfg.rules, cfg.horizon, trace)
     span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
     heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
     watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
     source: Iterable[Any] = read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs])
     if lag is not None:
         source = in_stamp_order(source, lag)
-    events, results = check_trace(target.checked, [target.node], Counted(span.tap(beside.tap(
+    events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(
         calls.tap(source) if calls.active else source)), heard, watch), cfg.rules, cfg.horizon,
         tolerance=cfg.tolerance)
     return _Read(beside, calls, span, heard, watch, events, results, calls.finish())

@@ -24,6 +24,7 @@ from rclverify.backends.monitors.log_calls import LogCalls
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, stale_reason
 from rclverify.backends.monitors.summary import verdict_status
+from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
 from rclverify.backends.monitors.verdicts import NodeResult
 
 
@@ -118,7 +119,9 @@ class _Pass:
 def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
           on_warning: Callable[[str], None], lag: float | None) -> _Pass:
     """One read of the run feeding every monitor; in stamp order when ``lag`` is given
-    (:func:`.stamp_order.in_stamp_order`)."""
+    (:func:`.stamp_order.in_stamp_order`); each node's constants compared as its fields carry them (widths.py)."""
+    dirs = [root / d for d in cfg.msg_dirs]
+    nodes = [at_carried_widths(n, carried_widths(n, cfg.rules, dirs)) for n in nodes]
     dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
              for n in nodes if has_deadlines(n)]
     pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
