@@ -125,3 +125,40 @@ def test_a_slip_at_a_decimal_threshold_is_found_and_the_correct_code_is_green(tm
     # the control below the threshold: both codes say low; above it, neither
     assert main([*args, str(_bag(tmp_path / "below", msg_type, 0.1875, True))]) == 0
     assert main([*args, str(_bag(tmp_path / "above", msg_type, 0.25, False))]) == 0
+
+
+BATTERY = """
+node Battery {
+  inputs( level : REAL )
+  outputs( p : REAL, low : BOOL )
+  topics( std_msgs/Float64 level matches(in.level), std_msgs/Float32 battery matches(out.p),
+          std_msgs/Bool low matches(out.low) )
+  assume( 0 <= in.level and in.level <= 1 )
+  guarantee( out.low <=> out.p <= 0.2 )
+}
+"""
+def _property_run(tmp: Path, code: str) -> Any:
+    from rclverify.backends.property_tests.config import read_config
+    from rclverify.backends.property_tests.harness import run_guarantee
+    from rclverify.lang.typecheck import check
+    (tmp / "impl.py").write_text(code)
+    (tmp / "backends" / "monitors").mkdir(parents=True)
+    (tmp / "backends" / "monitors" / "mapping.yaml").write_text("topics:\n  battery: {fields: [data]}\n")
+    checked = check([parse_text(BATTERY, "b.rcl")])
+    cn = checked.nodes["Battery"]
+    cfg = read_config({"implementation": "impl.py:battery", "max_examples": 200}, cn, tmp)
+    return run_guarantee(checked, cn, 1, cfg, tmp)
+
+
+def test_property_tests_find_the_slip_at_the_carried_threshold(tmp_path: Path) -> None:
+    """The flag decided at the field's width: `<=` is correct, `<` the slip, found only on the carried 0.2
+    (the double 0.2 is not a float32: before, the slip's flag agreed with the decimal reading there)."""
+    correct = "import struct\n\ndef battery(level):\n    p = struct.unpack('<f', struct.pack('<f', level))[0]\n" \
+              "    return {'p': p, 'low': p <= struct.unpack('<f', struct.pack('<f', 0.2))[0]}\n"
+    slip = correct.replace("p <= struct", "p < struct")
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    assert _property_run(tmp_path / "a", correct).status == "discharged"
+    out = _property_run(tmp_path / "b", slip)
+    assert out.status == "failed", out.message
+    assert out.counterexample is not None and out.counterexample["out.p"].startswith("0.2000000029")

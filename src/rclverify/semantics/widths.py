@@ -25,9 +25,11 @@ before).
 from __future__ import annotations
 
 import dataclasses
+import math
+import struct
 from decimal import Decimal
 from fractions import Fraction
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping
 
 from rclverify.lang import ast
 
@@ -57,6 +59,44 @@ def nearest_at_width(q: Fraction, width: str) -> Fraction | None:
     if v > (2 - Fraction(2) ** (1 - bits)) * Fraction(2) ** emax:
         return None
     return v if q > 0 else -v
+
+
+def narrow(value: Any, width: str) -> Any:
+    """``value`` as a field of IDL type ``width`` carries it: a Python
+    ``float`` rounded to binary32 for ``float32`` (round to nearest, ties to
+    even: the conversion a publisher's message makes); anything else, and
+    every value of another width, as it is.  A value beyond binary32's range
+    becomes an infinity, as it does on the wire."""
+    if width != "float32" or not isinstance(value, float):
+        return value
+    try:
+        return float(struct.unpack("<f", struct.pack("<f", value))[0])
+    except OverflowError:
+        return math.copysign(math.inf, value)
+
+
+def edges_at_width(constants: Iterable[Fraction], width: str) -> list[Fraction]:
+    """For each constant, the value of ``width`` nearest to it and that
+    value's two neighbours of the same width: the thresholds as the field
+    carries them, for the property tests to draw (docs/property-tests.md)."""
+    out: set[Fraction] = set()
+    for c in constants:
+        v = nearest_at_width(c, width)
+        if v is None:
+            continue
+        out.add(v)
+        if width == "float32":
+            bits = struct.unpack("<i", struct.pack("<f", float(v)))[0]
+            for b in (bits - 1, bits + 1):
+                try:
+                    f = struct.unpack("<f", struct.pack("<i", b))[0]
+                except struct.error:
+                    continue
+                if math.isfinite(f):
+                    out.add(Fraction(f))
+        else:
+            out.update(Fraction(math.nextafter(float(v), d)) for d in (-math.inf, math.inf))
+    return sorted(out)
 
 
 def _constant(e: ast.Expr) -> Fraction | None:
@@ -120,4 +160,4 @@ def _walk(e: Any, widths: Mapping[str, str]) -> Any:
     return dataclasses.replace(e, **changes) if changes else e  # type: ignore[type-var]  # an AST node: a dataclass instance
 
 
-__all__ = ["FLOAT_WIDTHS", "at_widths", "nearest_at_width"]
+__all__ = ["FLOAT_WIDTHS", "at_widths", "edges_at_width", "narrow", "nearest_at_width"]

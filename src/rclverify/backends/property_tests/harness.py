@@ -48,6 +48,8 @@ from rclverify.backends.property_tests.strategies import assumption_bounds, conj
 from rclverify.backends.property_tests.config import Config, ConfigError, load_implementation, read_config
 from rclverify.backends.property_tests.closure import resolve_closure
 from rclverify.backends.property_tests.importpath import on_harness_path
+from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
+from rclverify.semantics.widths import edges_at_width, narrow
 
 # The plan entry's reading lives in .config; its names stay importable from here (the backend, replay, the tests
 # and the benchmark import them with the run).
@@ -138,6 +140,9 @@ class GuaranteeRun:
     _used_facts: tuple[ast.Expr, ...] | None = field(default=None, repr=False)
     #: the valid examples' coverage of the assumption's ranges (set up with the strategy)
     coverage: Coverage | None = field(default=None, repr=False)
+    #: the width each input and output's field carries ("in.x" -> "float32"; semantics/widths.py): inputs are
+    #: passed and outputs judged as they travel, the thresholds drawn as the fields carry them
+    widths: Mapping[str, str] = field(default_factory=dict)
 
     @property
     def stateful(self) -> bool:
@@ -184,8 +189,10 @@ class GuaranteeRun:
         # every threshold the contract or the code compares with, drawn with its neighbours (.constants);
         # a named constant bounds an input as a literal does
         named = constant_values(self.checked, self.node)
-        space = input_space(self.node, self.cfg.bounds, seed, boundary_constants(self.checked, self.node, self.impl),
-                            named)
+        constants = boundary_constants(self.checked, self.node, self.impl)
+        for width in sorted(set(self.widths.values())):  # the thresholds as the fields carry them, and their neighbours
+            constants = sorted(set(constants) | set(edges_at_width(constants, width)))
+        space = input_space(self.node, self.cfg.bounds, seed, constants, named)
         self.coverage = Coverage(self.node, space.bounds, assumption_bounds(self.node, named))
         one = space.inputs().filter(self.assumption_holds)
         if self.stateful:
@@ -218,6 +225,9 @@ class GuaranteeRun:
         self.counts.steps += 1
         if self.coverage is not None:
             self.coverage.add(inputs)
+        widths = self.widths
+        if widths:  # each input as its field carries it to the node
+            inputs = {k: narrow(v, widths[k]) if k in widths else v for k, v in inputs.items()}
         kwargs = {k.removeprefix("in."): v for k, v in inputs.items()}
         try:
             result = impl(**kwargs)
@@ -239,6 +249,8 @@ class GuaranteeRun:
             if why:
                 return self._fail(inputs, None, f"output out.{name} is not a value of its type {t}: {why}", None, step)
         values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
+        if widths:  # each output as its field carries it (the value a subscriber and a monitor read)
+            values = {k: narrow(v, widths[k]) if k in widths else v for k, v in values.items()}
         g = self.node.node.guarantees[self.guarantee - 1]
         for c in conjuncts(g.formula):
             judged = judge(c, self.checked, self.node, values)
@@ -419,8 +431,20 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
                        f"with the evidence: {'; '.join(unhashed)}", Counts(), unhashed=unhashed)
     if impl is None:
         impl = load_implementation(root, cfg)
+    widths = _widths(root, node)
     with on_harness_path(root, cfg.file):
-        return GuaranteeRun(checked, node, guarantee, cfg, impl, facts).run()
+        return GuaranteeRun(checked, at_carried_widths(node, widths), guarantee, cfg, impl, facts, widths=widths).run()
+
+
+def _widths(root: Path, node: CheckedNode) -> dict[str, str]:
+    """The widths ``node``'s fields carry, read with the workspace's monitor mapping (its rules and
+    message folders; backends/monitors/widths.py); ``{}`` when the mapping does not load."""
+    from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (loads yaml and the mapping only when called)
+    try:
+        mapping = load_mapping(root, None)
+    except Exception:  # noqa: BLE001 - the monitors backend reports a mapping that does not load; no width here
+        return {}
+    return carried_widths(node, mapping.rules, [root / d for d in mapping.msg_dirs])
 
 
 def versions() -> str:
