@@ -21,6 +21,10 @@ Which rule applies depends on the RCL variable's type:
 * **Constructor** (a constructor set such as ``CommandSet``): the first
   string field names the constructor; its arguments are the next fields of
   the argument types, in order.
+* **Sequence** (``seq(T)`` of a scalar or enumeration ``T``): the first
+  array field (a ROS array or sequence, bounded or not: ``LaserScan.ranges``),
+  each item read as the scalar rule reads a field; a NaN or an infinity
+  among the items is no RCL number (the message does not map).
 
 Which fields a topic's messages contribute, and in which order, is the
 plan's ``fields`` list for the topic (all top-level fields in message order
@@ -80,6 +84,26 @@ class _Fields:
                 self.used.add(k)
                 return got
         raise MappingError(f"no field left for {what} of type {want}")
+
+    def take_seq(self, want: T.SeqT, what: str) -> tuple[Any, ...]:
+        """The next array field (a list or tuple: a ROS array or sequence, bounded or
+        not) as an RCL sequence of ``want.elem`` values, item by item as :meth:`take`
+        reads a scalar; a NaN or an infinity among the items is no RCL number."""
+        for k, (name, v) in enumerate(self.items):
+            if k in self.used or not isinstance(v, (list, tuple)):
+                continue
+            items = []
+            for i, x in enumerate(v):
+                if isinstance(x, float) and not math.isfinite(x):
+                    raise MappingError(f"item {i} of field {name!r} is {x!r}, not a finite number, for {what} "
+                                       f"of type {want}")
+                got = _scalar(x, want.elem)
+                if got is _NO:
+                    raise MappingError(f"item {i} of field {name!r} is {x!r}, not a value of type {want.elem}")
+                items.append(got)
+            self.used.add(k)
+            return tuple(items)
+        raise MappingError(f"no array field left for {what} of type {want}")
 
 
 _NO = object()
@@ -187,6 +211,8 @@ def map_value(typ: T.Type, fields: Mapping[str, Any], rule: TopicRule, previous:
     fs = _Fields(field_items(fields, rule))
     if isinstance(typ, (T.Scalar, T.EnumT)):
         return fs.take(typ, "the value")
+    if isinstance(typ, T.SeqT) and isinstance(typ.elem, (T.Scalar, T.EnumT)):
+        return fs.take_seq(typ, "the sequence")
     if isinstance(typ, T.DataT):
         name = fs.take(T.EnumT("constructor", ()), "the constructor name")
         args = typ.ctor(name)

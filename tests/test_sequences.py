@@ -1,0 +1,81 @@
+"""Sequences on the wire: `sensor_msgs/LaserScan.ranges` (an unbounded float32
+sequence) into a `seq(REAL)` input, judged offline from a ROS 2 bag and from
+a log (traces/mapping.py, the sequence rule).  Before, every message read
+"no mapping rule for a variable of type seq(REAL)": every check of a scan
+node inconclusive.  A right and a wrong minimum over the ranges; an infinity
+among them (a beam with no return) is no RCL number: undecided, with the
+reason."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from rclverify.cli.commands import main
+
+SCAN = """
+node Scan {
+  inputs( ranges : seq(REAL) )
+  outputs( closest : REAL )
+  topics( sensor_msgs/LaserScan scan matches(in.ranges), std_msgs/Float64 closest matches(out.closest) )
+  assume( TRUE )
+  guarantee( out.closest in in.ranges and forall(r in in.ranges | out.closest <= r) )
+}
+"""
+
+
+def _ws(tmp: Path) -> Path:
+    (tmp / "contracts").mkdir()
+    (tmp / "contracts" / "c.rcl").write_text(SCAN)
+    (tmp / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
+    (tmp / "mapping.yaml").write_text("topics:\n  scan: {fields: [ranges]}\n  closest: {fields: [data]}\n")
+    return tmp
+
+
+def _bag(path: Path, ranges: list[float], closest: float) -> Path:
+    import numpy as np
+    from rosbags.rosbag2 import Writer
+
+    from rclverify.traces.bag import typestore
+    s = typestore([])
+    t = s.types
+    header = t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="")
+    scan = t["sensor_msgs/msg/LaserScan"](header=header, angle_min=0.0, angle_max=1.0, angle_increment=0.1,
+                                          time_increment=0.0, scan_time=0.1, range_min=0.1, range_max=30.0,
+                                          ranges=np.array(ranges, dtype=np.float32),
+                                          intensities=np.array([], dtype=np.float32))
+    with Writer(path, version=9) as w:
+        a = w.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=s)
+        b = w.add_connection("/closest", "std_msgs/msg/Float64", typestore=s)
+        w.write(a, 1_000_000_000, s.serialize_cdr(scan, "sensor_msgs/msg/LaserScan"))
+        w.write(b, 1_010_000_000, s.serialize_cdr(t["std_msgs/msg/Float64"](data=closest), "std_msgs/msg/Float64"))
+    return path
+
+
+def _monitor(ws: Path, run: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    code = main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1", str(run)])
+    return code, capsys.readouterr().out
+
+
+def test_a_right_and_a_wrong_minimum_over_laserscan_ranges(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ws = _ws(tmp_path)
+    code, out = _monitor(ws, _bag(tmp_path / "right", [3.0, 2.5, 4.0], 2.5), capsys)
+    assert code == 0 and "1 satisfied" in out
+    code, out = _monitor(ws, _bag(tmp_path / "wrong", [3.0, 2.5, 4.0], 3.0), capsys)
+    assert code == 1 and "1 violated" in out
+
+
+def test_a_log_with_an_array_field(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ws = _ws(tmp_path)
+    run = tmp_path / "run.jsonl"
+    run.write_text(json.dumps({"topic": "scan", "time": 1.0, "ranges": [1.5, 0.75]}) + "\n"
+                   + json.dumps({"topic": "closest", "time": 1.01, "data": 0.75}) + "\n")
+    assert _monitor(ws, run, capsys)[0] == 0
+
+
+def test_an_infinite_range_is_undecided_with_the_reason(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ws = _ws(tmp_path)
+    code, out = _monitor(ws, _bag(tmp_path / "inf", [3.0, math.inf, 4.0], 3.0), capsys)
+    assert code == 0 and "inconclusive" in out and "item 1 of field 'ranges' is inf" in out
