@@ -88,6 +88,10 @@ class _Count:
     accepted: int = 0
     answered: int = 0
     broken: str = ""
+    #: whether an answering output was heard yet: judging starts at the first one (its reader matched by then)
+    heard: bool = False
+    #: accepted steps before the first answering output was heard (not counted against the node)
+    before: int = 0
 
 
 @dataclass
@@ -134,6 +138,11 @@ class DeclarationMonitor:
                  tolerance: Tolerance | None = None) -> None:
         self.checked, self.node, self.rules = checked, node, rules
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
+        #: inputs within the transport skew of a step's first, with no output between, are that step (skew.py)
+        self.skew = getattr(rules, "skew", None) or 0.0
+        self._step_at: float | None = None
+        self._step_accepted = False
+        self._step_topics: set[str] = set()
         self.bindings = topic_bindings(node)
         self.assumption = tuple(c.formula for c in node.node.assumes)
         mentioned: set[str] = set()
@@ -183,6 +192,9 @@ class DeclarationMonitor:
             if outs and (not c.outs or c.outs & outs):
                 c.answered += 1 if c.row else 0
                 c.row = 0
+                c.heard = True
+        if outs:
+            self._step_at = None  # an output ends the instant: the next input is a step of its own
         if any(k in self.read for k in changed):
             self._step(ev)
         if not self.first_input and any(k.startswith("in.") for k in changed):
@@ -210,15 +222,37 @@ class DeclarationMonitor:
 
     def _step(self, ev: Event) -> None:
         """An input event: the previous step ends (a row over its bound is
-        broken), and a new step starts, accepted or not."""
+        broken), and a new step starts, accepted or not.  Inputs within the
+        transport skew of the step's first input, with no output between,
+        are one step (docs/semantics.md, "Steps"); before an answering output
+        was first heard, an accepted step is counted apart (``before``)."""
+        t = ev.stamped
+        topic = ev.topic.strip("/")
+        if self._step_at is not None and t - self._step_at < self.skew and topic not in self._step_topics:
+            self._step_topics.add(topic)  # another input of the same instant (a topic not yet heard in it)
+            if self._step_accepted or not self._accepts():
+                return  # the same instant: one step
+            self._step_accepted = True  # the step's inputs are now all there and accepted: counted once, below
+            self._count_step(ev, True)
+            return
+        self._step_at, self._step_topics = t, {topic}
+        self._step_accepted = accepted = self._accepts()
+        self._end_rows(ev)
+        self._count_step(ev, accepted)
+
+    def _end_rows(self, ev: Event) -> None:
         for c in self.counts:
             if c.bound is not None and c.row > c.bound and not c.broken:
                 c.broken = (f"{c.row} accepted steps in a row unanswered (at most {c.bound} allowed): no "
                             f"{self._answer_words(c)} came between the input at {c.first_open} and the input at "
                             f"{ev.where}")
-        accepted = self._accepts()
+
+    def _count_step(self, ev: Event, accepted: bool) -> None:
         for c in self.counts:
-            if accepted:
+            if accepted and not c.heard:
+                c.accepted += 1
+                c.before += 1
+            elif accepted:
                 c.accepted += 1
                 if c.row == 0:
                     c.first_open = ev.where
@@ -294,11 +328,17 @@ class DeclarationMonitor:
             return "false", c.broken
         if not c.accepted:
             return "pending", "no input event the node's assumption accepts: nothing to answer"
+        if not c.heard:
+            return "inconclusive", (f"{c.accepted} accepted input event(s) came and no {self._answer_words(c)} was "
+                                    "heard: judging starts at the first one (its reader may have matched after the "
+                                    "inputs; a node that never answers is not green either)")
+        before = (f"; {c.before} accepted input event(s) before the first {self._answer_words(c)} was heard were "
+                  "not counted (its reader may have matched after them)") if c.before else ""
         if c.bound is None and c.row:
             return "inconclusive", (f"the run ends with the accepted input at {c.first_open} not answered yet "
-                                    f"(a finite run never refutes 'eventually')")
+                                    f"(a finite run never refutes 'eventually'){before}")
         return "true", (f"{c.accepted} accepted input events, none left unanswered for more than "
-                        + (f"{c.bound} steps" if c.bound is not None else "the run"))
+                        + (f"{c.bound} steps" if c.bound is not None else "the run") + before)
 
 
 def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> dict[str, Any]:
