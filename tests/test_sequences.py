@@ -79,3 +79,28 @@ def test_an_infinite_range_is_undecided_with_the_reason(tmp_path: Path, capsys: 
     ws = _ws(tmp_path)
     code, out = _monitor(ws, _bag(tmp_path / "inf", [3.0, math.inf, 4.0], 3.0), capsys)
     assert code == 0 and "inconclusive" in out and "item 1 of field 'ranges' is inf" in out
+
+
+def test_a_plan_statement_quantifies_over_a_sequence_and_its_counterexample_reads_as_rcl(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`forall(r in Scan.in.ranges | ...)` in a requirement: before, "unknown type or set '__q0____'"
+    (the binder's domain was read as a type); the counterexample printed Z3's `seq.unit(2)`."""
+    ws = _ws(tmp_path)
+    (ws / "contracts" / "plan.yaml").write_text(
+        "contracts: [contracts/c.rcl]\nrequirements:\n  - id: R1\n    text: the closest range is positive\n"
+        "    formal: \"forall(r in Scan.in.ranges | r > 0) -> Scan.out.closest > 1\"\n")
+    main(["requirements", "-w", str(ws)])  # the statement checks, and Z3 decides it
+    out = capsys.readouterr().out
+    assert "R1: refuted" in out and "in.ranges = <" in out and "seq." not in out, out
+
+
+def test_a_sequence_model_value_is_written_as_a_sequence_literal() -> None:
+    import z3
+
+    from rclverify.semantics.modeltext import value_to_rcl
+    s = z3.Solver()
+    x = z3.Const("x", z3.SeqSort(z3.RealSort()))
+    s.add(z3.Length(x) == 3, x[0] == 1.5, x[1] == 2, x[2] == 0.25)
+    assert s.check() == z3.sat
+    assert value_to_rcl(s.model()[x]) == "<1.5, 2, 0.25>"
+    assert value_to_rcl(z3.Empty(z3.SeqSort(z3.IntSort()))) == "<>"

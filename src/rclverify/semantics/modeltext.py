@@ -58,6 +58,14 @@ def _value_parts(v: z3.ExprRef) -> _Parts:
         return "TRUE", (), None
     if z3.is_false(v):
         return "FALSE", (), None
+    if z3.is_app(v):  # a sequence in RCL's literal notation, <a, b> (docs/values.md), never seq.unit/seq.++
+        k = v.decl().kind()
+        if k == z3.Z3_OP_SEQ_EMPTY:
+            return "<>", (), None
+        if k == z3.Z3_OP_SEQ_UNIT:
+            return None, v.children(), lambda xs: f"<{xs[0]}>"
+        if k == z3.Z3_OP_SEQ_CONCAT:
+            return None, v.children(), lambda xs: "<" + ", ".join(x[1:-1] for x in xs if x != "<>") + ">"
     if z3.is_app(v) and v.num_args() > 0:
         name = v.decl().name()
         return None, v.children(), lambda xs: f"{name}(" + ", ".join(xs) + ")"

@@ -199,6 +199,8 @@ def _rename(e: Any, names: Mapping[str, str]) -> Any:
     (recursive over the AST's dataclass fields; the parser bounds nesting)."""
     if isinstance(e, ast.Var):
         return dataclasses.replace(e, name=names[e.name]) if e.name in names else e
+    if isinstance(e, ast.TName) and e.name in names:  # a binder's domain `r in Node.in.xs`: the variable, not a type
+        return ast.Var(names[e.name], None, e.loc)
     if isinstance(e, tuple):
         return tuple(_rename(x, names) for x in e)
     if not dataclasses.is_dataclass(e) or isinstance(e, (ast.Loc, type)):
