@@ -13,8 +13,10 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 git clone --quiet . "$work/rclverify"
 cd "$work/rclverify"
-echo "quickstart: $cmd   (python3 is $(PATH="$bindir:$PATH" command -v python3), $(PATH="$bindir:$PATH" python3 -V))"
-env -u VIRTUAL_ENV PATH="$bindir:$PATH" bash -c "$cmd" >"$work/quickstart.log" 2>&1 || {
+# the given directory first, and no pyenv shim or version manager anywhere on PATH
+path="$bindir:$(printf '%s' "$PATH" | tr ':' '\n' | grep -v -e pyenv -e '\.venv' | paste -sd: -)"
+echo "quickstart: $cmd   (python3 is $(PATH="$path" command -v python3), $(PATH="$path" python3 -V))"
+env -u VIRTUAL_ENV -u PYENV_VERSION PATH="$path" bash -c "$cmd" >"$work/quickstart.log" 2>&1 || {
   tail -30 "$work/quickstart.log"; echo "quickstart: the README's first command failed" >&2; exit 1; }
 test -s reports/assurance.html || { echo "quickstart: no reports/assurance.html" >&2; exit 1; }
 echo "quickstart: exit 0, $(grep -c . "$work/quickstart.log") lines of output, reports/assurance.html written"
