@@ -162,3 +162,47 @@ def test_property_tests_find_the_slip_at_the_carried_threshold(tmp_path: Path) -
     out = _property_run(tmp_path / "b", slip)
     assert out.status == "failed", out.message
     assert out.counterexample is not None and out.counterexample["out.p"].startswith("0.2000000029")
+
+
+GUARD = """
+node Guard {
+  inputs( ranges : seq(REAL) )
+  outputs( stop : BOOL )
+  topics( sensor_msgs/LaserScan scan matches(in.ranges), std_msgs/Bool stop matches(out.stop) )
+  assume( TRUE )
+  guarantee( out.stop <=> exists(r in in.ranges | r <= 0.2) )
+}
+"""
+
+
+def _scan_bag(path: Path, ranges: list[float], stop: bool) -> Path:
+    import numpy as np
+    from rosbags.rosbag2 import Writer
+
+    from rclverify.traces.bag import typestore
+    s = typestore([])
+    t = s.types
+    header = t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="")
+    scan = t["sensor_msgs/msg/LaserScan"](header=header, angle_min=0.0, angle_max=1.0, angle_increment=0.1,
+                                          time_increment=0.0, scan_time=0.1, range_min=0.1, range_max=30.0,
+                                          ranges=np.array(ranges, dtype=np.float32),
+                                          intensities=np.array([], dtype=np.float32))
+    with Writer(path, version=9) as w:
+        a = w.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=s)
+        b = w.add_connection("/stop", "std_msgs/msg/Bool", typestore=s)
+        w.write(a, 1_000_000_000, s.serialize_cdr(scan, "sensor_msgs/msg/LaserScan"))
+        w.write(b, 1_010_000_000, s.serialize_cdr(t["std_msgs/msg/Bool"](data=stop), "std_msgs/msg/Bool"))
+    return path
+
+
+def test_a_threshold_over_the_items_of_a_float32_sequence(tmp_path: Path) -> None:
+    """`exists(r in in.ranges | r <= 0.2)` over LaserScan.ranges (float32 items): a beam at the carried 0.2
+    stops the robot with the correct `<=`; the `<` slip does not, and is found."""
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "c.rcl").write_text(GUARD)
+    (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
+    (tmp_path / "mapping.yaml").write_text("topics:\n  scan: {fields: [ranges]}\n  stop: {fields: [data]}\n")
+    args = ["monitor", "-w", str(tmp_path), "--mapping", "mapping.yaml", "--horizon", "1"]
+    assert main([*args, str(_scan_bag(tmp_path / "correct", [3.0, 0.2], True))]) == 0
+    assert main([*args, str(_scan_bag(tmp_path / "slip", [3.0, 0.2], False))]) == 1
+    assert main([*args, str(_scan_bag(tmp_path / "clear", [3.0, 0.25], False))]) == 0

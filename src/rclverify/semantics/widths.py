@@ -121,8 +121,9 @@ def _literal(v: Fraction, like: ast.Expr) -> ast.Expr:
 def at_widths(e: ast.Expr, widths: Mapping[str, str]) -> ast.Expr:
     """``e`` with every constant compared directly with an input or output of
     known width (``widths``: ``"in.x"``/``"out.y"`` -> ``float32`` or
-    ``float64``) replaced by its nearest value of that width (module
-    docstring); ``e`` itself when nothing changes."""
+    ``float64``; for a sequence, its items' width, which a variable bound by
+    ``r in in.xs`` carries) replaced by its nearest value of that width
+    (module docstring); ``e`` itself when nothing changes."""
     if not widths:
         return e
     out: ast.Expr = _walk(e, widths)
@@ -130,12 +131,24 @@ def at_widths(e: ast.Expr, widths: Mapping[str, str]) -> ast.Expr:
 
 
 def _walk(e: Any, widths: Mapping[str, str]) -> Any:
+    if isinstance(e, ast.Quant):  # `r in in.ranges`: r carries the sequence's item width; another binder shadows
+        inner = dict(widths)
+        for b in e.bindings:
+            d = b.domain
+            w = widths.get(d.qualified) if isinstance(d, ast.Var) and d.prefix else None
+            for n in b.names:
+                if w is not None:
+                    inner[n] = w
+                else:
+                    inner.pop(n, None)
+        body = _walk(e.body, inner)
+        return dataclasses.replace(e, body=body) if body is not e.body else e
     if isinstance(e, ast.Compare):
         ops = list(e.operands)
         for i in range(len(ops) - 1):
             for var_at, const_at in ((i, i + 1), (i + 1, i)):
                 var, const = e.operands[var_at], e.operands[const_at]
-                width = widths.get(var.qualified) if isinstance(var, ast.Var) and var.prefix else None
+                width = widths.get(var.qualified) if isinstance(var, ast.Var) else None
                 c = _constant(const) if width else None
                 if width is None or c is None:
                     continue

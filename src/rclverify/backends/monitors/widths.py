@@ -64,6 +64,20 @@ def _field_type(defs: Mapping[str, Any], msg: str, path: str) -> str | None:
     return str(name) if isinstance(name, str) else None
 
 
+def _first_array_items(defs: Mapping[str, Any], msg: str, names: Sequence[str]) -> str | None:
+    """The IDL type of the items of the first array field among ``names`` (top-level fields; the mapping's
+    sequence rule takes the first array), ``None`` when it is not an array of a primitive type."""
+    fields = dict(defs.get(msg, ((), ()))[1])
+    for name in names:
+        kind = fields.get(name)
+        if kind is None:
+            return None
+        if kind[0].name in ("ARRAY", "SEQUENCE"):
+            item = kind[1][0]
+            return str(item[1][0]) if item[0].name == "BASE" and isinstance(item[1][0], str) else None
+    return None
+
+
 def _first_numeric(defs: Mapping[str, Any], msg: str, names: Sequence[str]) -> str | None:
     """The IDL type of the first numeric field among ``names`` (a field that is a message or a string is
     passed over, as the mapping passes over it); ``None`` when one of them cannot be told."""
@@ -82,8 +96,9 @@ def _first_numeric(defs: Mapping[str, Any], msg: str, names: Sequence[str]) -> s
 
 def carried_widths(node: CheckedNode, rules: Mapping[str, TopicRule], msg_dirs: Sequence[Path]) -> dict[str, str]:
     """``"in.x"``/``"out.y"`` -> ``float32`` or ``float64`` for each ``REAL``
-    input and output of ``node`` whose field's width the definitions tell
-    (module docstring); ``{}`` without the ``ros`` extra."""
+    input and output of ``node`` whose field's width the definitions tell, and
+    for each ``seq(REAL)`` one its array's items' width (module docstring);
+    ``{}`` without the ``ros`` extra."""
     if not node.node.topics or not installed("rosbags"):
         return {}
     from rclverify.traces.bag import typestore  # deferred: start-up (loads rosbags only when called)
@@ -98,14 +113,15 @@ def carried_widths(node: CheckedNode, rules: Mapping[str, TopicRule], msg_dirs: 
             continue
         key = var.qualified
         typ = (node.inputs if var.prefix == "in" else node.outputs).get(var.name)
-        if not (isinstance(typ, T.Scalar) and typ.name == "REAL"):
+        seq = isinstance(typ, T.SeqT) and isinstance(typ.elem, T.Scalar) and typ.elem.name == "REAL"
+        if not (seq or isinstance(typ, T.Scalar) and typ.name == "REAL"):
             continue
         msg = _store_name(t.msg_type)
         if msg not in defs:
             continue
         rule = rule_for(rules, t.field.strip("/"), key)
         names = list(rule.fields) or [n for n, _ in defs[msg][1]]
-        width = _first_numeric(defs, msg, names)
+        width = _first_array_items(defs, msg, names) if seq else _first_numeric(defs, msg, names)
         width = {"double": "float64", "float": "float32"}.get(width or "", width)
         if width in FLOAT_WIDTHS:
             out[key] = width
