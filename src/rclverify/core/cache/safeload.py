@@ -83,7 +83,20 @@ EXTRA: dict[tuple[str, str], Callable[[], Any]] = {
     ("fractions", "Fraction"): lambda: _fraction,
     ("markupsafe", "Markup"): _markup,
     ("rosbags.interfaces", "Nodetype"): _nodetype,  # the kind of a parsed message field (ros-scan)
+    ("builtins", "getattr"): lambda: _enum_member,  # an enum member as Python 3.11.0-3.11.3 pickle it
 }
+
+
+def _enum_member(cls: Any, name: Any) -> Any:
+    """``cls[name]`` for an enumeration a kept file may name: how Python 3.11.0
+    to 3.11.3 pickle an enum member (``getattr(cls, name)``, Debian 12's
+    Python; later versions pickle it by value).  Raises
+    ``pickle.UnpicklingError`` for anything else, so ``getattr`` reaches no
+    other attribute of any object."""
+    if not (isinstance(cls, type) and issubclass(cls, enum.Enum) and isinstance(name, str)
+            and name in cls.__members__):
+        raise pickle.UnpicklingError("getattr in a kept file names no member of an enumeration")
+    return cls[name]
 
 
 def _is_value_class(obj: object) -> TypeGuard[type]:
