@@ -32,6 +32,7 @@ from fractions import Fraction
 from typing import Any, Iterable, Mapping
 
 from rclverify.lang import ast
+from rclverify.lang.visit import Transformer
 
 #: IDL floating-point types -> (significand bits with the hidden one, smallest normal exponent, largest exponent).
 FLOAT_WIDTHS: dict[str, tuple[int, int, int]] = {"float32": (24, -126, 127), "float64": (53, -1022, 1023)}
@@ -126,13 +127,16 @@ def at_widths(e: ast.Expr, widths: Mapping[str, str]) -> ast.Expr:
     (module docstring); ``e`` itself when nothing changes."""
     if not widths:
         return e
-    out: ast.Expr = _walk(e, widths)
+    out: ast.Expr = _AtWidths().visit(e, widths)
     return out
 
 
-def _walk(e: Any, widths: Mapping[str, str]) -> Any:
-    if isinstance(e, ast.Quant):  # `r in in.ranges`: r carries the sequence's item width; another binder shadows
-        inner = dict(widths)
+class _AtWidths(Transformer):
+    """:func:`at_widths` as a :class:`~rclverify.lang.visit.Transformer`: comparisons and binders
+    are its own; every other node is rebuilt only where something below it changed."""
+
+    def visit_Quant(self, e: ast.Quant, widths: Mapping[str, str]) -> ast.Expr:
+        inner = dict(widths)  # `r in in.ranges`: r carries the sequence's item width; another binder shadows
         for b in e.bindings:
             d = b.domain
             w = widths.get(d.qualified) if isinstance(d, ast.Var) and d.prefix else None
@@ -141,36 +145,20 @@ def _walk(e: Any, widths: Mapping[str, str]) -> Any:
                     inner[n] = w
                 else:
                     inner.pop(n, None)
-        body = _walk(e.body, inner)
+        body = self.visit(e.body, inner)
         return dataclasses.replace(e, body=body) if body is not e.body else e
-    if isinstance(e, ast.Compare):
-        ops = list(e.operands)
+
+    def visit_Compare(self, e: ast.Compare, widths: Mapping[str, str]) -> ast.Expr:
+        ops = [self.visit(o, widths) for o in e.operands]
         for i in range(len(ops) - 1):
             for var_at, const_at in ((i, i + 1), (i + 1, i)):
-                var, const = e.operands[var_at], e.operands[const_at]
+                var = e.operands[var_at]
                 width = widths.get(var.qualified) if isinstance(var, ast.Var) else None
-                c = _constant(const) if width else None
-                if width is None or c is None:
-                    continue
-                v = nearest_at_width(c, width)
+                c = _constant(e.operands[const_at]) if width else None
+                v = nearest_at_width(c, width) if width and c is not None else None
                 if v is not None and v != c:
-                    ops[const_at] = _literal(v, const)
-        rest = [_walk(o, widths) if not isinstance(o, (ast.NumLit, ast.Var)) else o for o in ops]
-        return dataclasses.replace(e, operands=tuple(rest)) if rest != list(e.operands) else e
-    if not dataclasses.is_dataclass(e) or isinstance(e, (ast.Var, ast.NumLit, ast.Loc)):
-        return e
-    changes: dict[str, Any] = {}
-    for f in dataclasses.fields(e):
-        v = getattr(e, f.name)
-        if isinstance(v, tuple):
-            new = tuple(_walk(x, widths) for x in v)
-            if any(a is not b for a, b in zip(new, v)):
-                changes[f.name] = new
-        elif dataclasses.is_dataclass(v) and not isinstance(v, type):
-            new_v = _walk(v, widths)
-            if new_v is not v:
-                changes[f.name] = new_v
-    return dataclasses.replace(e, **changes) if changes else e  # type: ignore[type-var]  # an AST node: a dataclass instance
+                    ops[const_at] = _literal(v, e.operands[const_at])
+        return dataclasses.replace(e, operands=tuple(ops)) if any(a is not b for a, b in zip(ops, e.operands)) else e
 
 
 __all__ = ["FLOAT_WIDTHS", "at_widths", "edges_at_width", "narrow", "nearest_at_width"]
