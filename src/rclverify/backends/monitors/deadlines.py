@@ -59,7 +59,7 @@ from rclverify.lang.walk import subexpressions
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
 from rclverify.traces.questions import Question, QuestionStream
-from rclverify.backends.monitors.online import header_stamp, header_stamp_ns
+from rclverify.backends.monitors.online import header_stamp_ns
 from rclverify.backends.monitors.verdicts import LINK_TOPICS, names
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
@@ -126,12 +126,6 @@ class DeadlineResult:
         return {"node": self.node, "counts": dict(self.counts),
                 "first_false": None if self.first_false is None else self.first_false.to_json(),
                 "unaccepted": dict(self.unaccepted), "first_unaccepted": self.first_unaccepted}
-
-
-def event_stamp(ev: Event) -> float:
-    """The event's time on the stamps' clock (module docstring, "Clock")."""
-    s = header_stamp(ev.fields)
-    return ev.time if s is None else s
 
 
 def event_stamp_ns(ev: Event) -> int:

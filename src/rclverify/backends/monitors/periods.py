@@ -5,7 +5,7 @@ initial values and periodic outputs") says the node refreshes ``out.y`` at
 least once per period: a rate, a watchdog's heartbeat.  On a recorded run
 the messages that carry ``out.y`` (the topic ``topics(...)`` binds to it,
 :func:`.deadlines.topic_bindings`) are stamped as the deadline monitor
-stamps them (:func:`.deadlines.event_stamp`: the header's stamp, else the
+stamps them (:func:`.stamp_order.run_clock`: the header's stamp, else the
 trace's time), and:
 
 * every gap between two consecutive messages of ``out.y`` is at most the
@@ -33,7 +33,8 @@ from typing import Any, Iterable
 from rclverify.lang.liveness import period_seconds
 from rclverify.lang.types import CheckedNode
 from rclverify.traces.events import Event
-from rclverify.backends.monitors.deadlines import event_stamp, topic_bindings
+from rclverify.backends.monitors.deadlines import topic_bindings
+from rclverify.backends.monitors.stamp_order import run_clock
 
 
 #: The slack of a gap against its period (s): the resolution of an epoch stamp read as a float.
@@ -84,7 +85,7 @@ class PeriodMonitor:
 
     def feed(self, ev: Event) -> None:
         res = self.result
-        stamp = event_stamp(ev)
+        stamp = run_clock(ev)
         res.end = stamp if res.end is None else max(res.end, stamp)
         for key in self.topics.get(ev.topic.lstrip("/"), ()):
             res.messages[key] = res.messages.get(key, 0) + 1

@@ -4,7 +4,7 @@ Every engine that judges a recorded run (the response engine, the deadline,
 period and declaration monitors, a live log's calls) reads one pass over the
 run.  A message's time on the run's clock is its ``header.stamp`` when it has
 one, else the time the trace gives it (the recording or receipt time): the
-deadline monitor's clock (:func:`.deadlines.event_stamp`) and the live
+deadline monitor's clock (it reads :func:`run_clock`) and the live
 monitor's, which releases messages from its reorder buffer in that order
 (docs/monitors.md, "Ordering and time").  A bag or a log records messages
 in arrival order, and a message may arrive after one stamped later (a
