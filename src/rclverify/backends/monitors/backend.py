@@ -40,7 +40,7 @@ from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
 from rclverify.backends.monitors.rml import Spec, rml_id, translate
 from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
-from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, stale_reason
+from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
 
@@ -185,14 +185,11 @@ class MonitorsBackend:
         except Exception as exc:
             return evidence("error", f"the plan entry no longer loads: {exc}")
         trace = str(obligation.data.get("trace", ""))
-        note = stale = ""
         try:
             read = _judge(target, cfg, trace, None)
-            if read.watch.count and read.watch.two_clocks():  # no one order of the run (stamp_order.py)
-                stale = stale_reason(read.watch, trace)
-            elif read.watch.count:  # messages recorded out of stamp order: one clock, the stamps (stamp_order.py)
-                note = read.watch.note()
-                read = _judge(target, cfg, trace, read.watch.lag)
+            lag, note, stale = second_read(read.watch, trace, True)  # one clock, the stamps (stamp_order.py)
+            if lag is not None:
+                read = _judge(target, cfg, trace, lag)
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
         except Exception as exc:  # a recorded run is user input: whatever the checker meets is this record's error
@@ -235,9 +232,7 @@ class MonitorsBackend:
                                                  decided_of([res], calls.entries() if summary is not None else []))
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
-        explanation = entry["explanation"] + (f"; {note}" if note else "")
-        if stale and status in ("discharged", "pending"):
-            status, explanation = "inconclusive", f"{stale}; in recording order: {explanation}"
+        status, explanation = unless_stale((status, entry["explanation"] + (f"; {note}" if note else "")), stale)
         if note:
             details["stamp_order"] = note
         extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)

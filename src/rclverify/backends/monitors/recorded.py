@@ -22,7 +22,7 @@ from rclverify.backends.monitors.declarations import (DeclarationMonitor, Declar
 from rclverify.backends.monitors.judged import Counted, Heard, not_judged
 from rclverify.backends.monitors.log_calls import LogCalls
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
-from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, stale_reason
+from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.summary import verdict_status
 from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
 from rclverify.backends.monitors.verdicts import NodeResult
@@ -58,7 +58,7 @@ class RecordedRun:
         """``(status, explanation)`` of node result ``res`` on this run: its
         verdict (:func:`.summary.verdict_status`), inconclusive when the run
         is :attr:`stale`, with how the run was ordered said."""
-        status, text = _unless_stale(verdict_status(res, trace), self.stale)
+        status, text = unless_stale(verdict_status(res, trace), self.stale)
         return status, text + (f"; {self.stamp_order}" if self.stamp_order else "")
 
 
@@ -71,14 +71,10 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
     a run that cannot be read, and whatever a malformed run makes the
     readers raise (the caller reports either, located)."""
     one = _pass(checked, nodes, cfg, root, trace, on_warning, None)
-    stale = ""
-    if one.watch.count:  # messages recorded out of stamp order: one clock, the stamps (stamp_order.py)
-        if _readable_again(Path(trace)) and not one.watch.two_clocks():
-            note = one.watch.note()
-            one = _pass(checked, nodes, cfg, root, trace, on_warning, one.watch.lag)
-            one.note = note
-        else:
-            stale = stale_reason(one.watch, trace)
+    lag, note, stale = second_read(one.watch, trace, _readable_again(Path(trace)))  # one clock (stamp_order.py)
+    if lag is not None:
+        one = _pass(checked, nodes, cfg, root, trace, on_warning, lag)
+        one.note = note
     dmons, pmons, decl, calls, heard, events, results = (one.dmons, one.pmons, one.decl, one.calls, one.heard,
                                                          one.events, one.results)
     dres = [m.finish() for m in dmons]
@@ -86,7 +82,7 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
     decl_res = [add_periods(dm.finish(), dm.node, next((p for p in pres if p.node == dm.node.name), None))
                 for dm in decl]
     summary = calls.finish()
-    statuses = {res.node: [_unless_stale(verdict_status(res, trace), stale)] for res in results}
+    statuses = {res.node: [unless_stale(verdict_status(res, trace), stale)] for res in results}
     centries, dentries = calls.entries(), calls.deadline_entries()
     for c in centries:
         statuses.setdefault(c["node"], []).append((c["status"], c["explanation"]))
@@ -167,11 +163,3 @@ def decided_of(results: Iterable[NodeResult], call_entries: Iterable[Mapping[str
 def _readable_again(path: Path) -> bool:
     """Whether the run at ``path`` can be read a second time (a regular file or a bag folder, not a stream)."""
     return path.is_dir() or path.is_file()
-
-
-def _unless_stale(status: tuple[str, str], stale: str) -> tuple[str, str]:
-    """``status``, or ``inconclusive`` with ``stale`` (the reason) for a pass that would otherwise
-    discharge on a run judged out of stamp order (:func:`.stamp_order.stale_reason`)."""
-    if stale and status[0] in ("discharged", "pending"):
-        return "inconclusive", f"{stale}; in recording order: {status[1]}"
-    return status

@@ -152,4 +152,25 @@ def stale_reason(watch: StampWatch, trace: str) -> str:
             "recording order may not hold on the run's clock")
 
 
-__all__ = ["StampWatch", "in_stamp_order", "run_clock", "stale_reason"]
+def second_read(watch: StampWatch, trace: str, readable: bool) -> tuple[float | None, str, str]:
+    """After a first read that ``watch`` saw: ``(lag, note, stale)``.  ``lag``
+    is the window to read the run again in stamp order with (``None``: no
+    second read), ``note`` says so for the evidence, ``stale`` is why the
+    first read's greens are not given (two clocks, or a run that cannot be
+    read again: ``readable`` false); all empty for a run read in stamp order."""
+    if not watch.count:
+        return None, "", ""
+    if watch.two_clocks() or not readable:
+        return None, "", stale_reason(watch, trace)
+    return watch.lag, watch.note(), ""
+
+
+def unless_stale(status: tuple[str, str], stale: str) -> tuple[str, str]:
+    """``(status, explanation)``, or ``inconclusive`` with ``stale`` (the reason)
+    where it would otherwise be ``discharged`` or ``pending``."""
+    if stale and status[0] in ("discharged", "pending"):
+        return "inconclusive", f"{stale}; in recording order: {status[1]}"
+    return status
+
+
+__all__ = ["StampWatch", "in_stamp_order", "run_clock", "second_read", "stale_reason", "unless_stale"]
