@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+from functools import lru_cache
 from types import ModuleType
 
 #: The extra that installs each optional top-level module (pyproject.toml).
@@ -59,8 +60,10 @@ def require(module: str, purpose: str) -> ModuleType:
         raise
 
 
+@lru_cache(maxsize=None)
 def installed(module: str) -> bool:
-    """Whether the top-level package of ``module`` can be imported (nothing is imported)."""
+    """Whether the top-level package of ``module`` can be imported (nothing is
+    imported); asked once per process (every trace read asks it)."""
     try:
         return importlib.util.find_spec(module.split(".")[0]) is not None
     except (ImportError, ValueError):

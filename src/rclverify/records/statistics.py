@@ -231,14 +231,13 @@ def decide(counts: Mapping[str, Any], target: TargetLike) -> dict[str, Any]:
     worst = k + unsure
     from rclverify.core.extras import MissingExtra  # deferred: start-up (only where a target is decided)
     try:
-        upper_bound(worst, n, target.level)
+        bound = upper_bound(worst, n, target.level)
     except MissingExtra as exc:  # no bound without scipy: nothing decided, said so
         unit = "run" if target.per == "run" else "answer"
         return {"n": n, "k": k, "undecided": unsure, "bound": 1.0, "bound_without_undecided": 1.0,
                 "level": target.level, "target": target.to_json(), "runs_needed": None,
                 "sprt": sprt(worst, n, target.bound, target.level).to_json(), "status": "inconclusive",
                 "explanation": f"{k} violating {unit}(s) in {n}: the bound is not computed ({exc})"}
-    bound = upper_bound(worst, n, target.level)
     best = upper_bound(k, n, target.level)
     test = sprt(worst, n, target.bound, target.level)
     needed = runs_needed(worst, n, target.bound, target.level)

@@ -55,11 +55,12 @@ def _group_row(node: str, env: str, origin: str, rows: list[Mapping[str, Any]]) 
         recorded[str(r.get("recorded", "unknown"))] = recorded.get(str(r.get("recorded", "unknown")), 0) + 1
     n, k = counts["runs"], counts["violating_runs"] + counts["undecided_runs"]
     counted = origin != "harness" and n > 0
+    bound, why = trivial_or_exact(k, n, LEVEL) if counted else (None, "")
     return {"node": node, "environment": env, "origin": origin, "kind": "runs",
             "counts": {key: v for key, v in counts.items() if key != "digests"}, "recorded": recorded,
-            "level": LEVEL, "bound": trivial_or_exact(k, n, LEVEL)[0] if counted else None,
-            "note": trivial_or_exact(k, n, LEVEL)[1] if counted else (
-                "driven by a test harness: not operation, no bound" if origin == "harness" else "no judged run: no bound")}
+            "level": LEVEL, "bound": bound,
+            "note": why if counted else ("driven by a test harness: not operation, no bound" if origin == "harness"
+                                         else "no judged run: no bound")}
 
 
 def _target_row(e: Mapping[str, Any]) -> dict[str, Any]:
