@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from _scan import scan_bag
 from rclverify.cli.commands import main
 
 SCAN = """
@@ -35,23 +36,7 @@ def _ws(tmp: Path) -> Path:
 
 
 def _bag(path: Path, ranges: list[float], closest: float) -> Path:
-    import numpy as np
-    from rosbags.rosbag2 import Writer
-
-    from rclverify.traces.bag import typestore
-    s = typestore([])
-    t = s.types
-    header = t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="")
-    scan = t["sensor_msgs/msg/LaserScan"](header=header, angle_min=0.0, angle_max=1.0, angle_increment=0.1,
-                                          time_increment=0.0, scan_time=0.1, range_min=0.1, range_max=30.0,
-                                          ranges=np.array(ranges, dtype=np.float32),
-                                          intensities=np.array([], dtype=np.float32))
-    with Writer(path, version=9) as w:
-        a = w.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=s)
-        b = w.add_connection("/closest", "std_msgs/msg/Float64", typestore=s)
-        w.write(a, 1_000_000_000, s.serialize_cdr(scan, "sensor_msgs/msg/LaserScan"))
-        w.write(b, 1_010_000_000, s.serialize_cdr(t["std_msgs/msg/Float64"](data=closest), "std_msgs/msg/Float64"))
-    return path
+    return scan_bag(path, ranges, "closest", "Float64", closest)
 
 
 def _monitor(ws: Path, run: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:

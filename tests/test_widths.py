@@ -16,6 +16,7 @@ from typing import Any
 
 import pytest
 
+from _scan import scan_bag
 from rclverify.cli.commands import main
 from rclverify.lang.parser import parse_text
 from rclverify.lang.printer import expr_to_rcl
@@ -176,23 +177,7 @@ node Guard {
 
 
 def _scan_bag(path: Path, ranges: list[float], stop: bool) -> Path:
-    import numpy as np
-    from rosbags.rosbag2 import Writer
-
-    from rclverify.traces.bag import typestore
-    s = typestore([])
-    t = s.types
-    header = t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="")
-    scan = t["sensor_msgs/msg/LaserScan"](header=header, angle_min=0.0, angle_max=1.0, angle_increment=0.1,
-                                          time_increment=0.0, scan_time=0.1, range_min=0.1, range_max=30.0,
-                                          ranges=np.array(ranges, dtype=np.float32),
-                                          intensities=np.array([], dtype=np.float32))
-    with Writer(path, version=9) as w:
-        a = w.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=s)
-        b = w.add_connection("/stop", "std_msgs/msg/Bool", typestore=s)
-        w.write(a, 1_000_000_000, s.serialize_cdr(scan, "sensor_msgs/msg/LaserScan"))
-        w.write(b, 1_010_000_000, s.serialize_cdr(t["std_msgs/msg/Bool"](data=stop), "std_msgs/msg/Bool"))
-    return path
+    return scan_bag(path, ranges, "stop", "Bool", stop)
 
 
 def test_a_threshold_over_the_items_of_a_float32_sequence(tmp_path: Path) -> None:
