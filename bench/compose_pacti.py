@@ -48,6 +48,8 @@ tools disagree (or the smoke run's own checks fail), so CI can run
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import sys
 import tempfile

@@ -14,6 +14,8 @@ so a wrong figure cannot hide a wrong answer.  Printed, never asserted::
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import sys
 import time

@@ -9,6 +9,8 @@ microseconds per evaluation.
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import random
 import sys
 import time

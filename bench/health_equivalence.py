@@ -26,6 +26,8 @@ check the wall-clock safety net cut (a loaded machine:
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import json
 import os

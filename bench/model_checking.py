@@ -20,6 +20,8 @@ run (exit 0).
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import os
 import shutil

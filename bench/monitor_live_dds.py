@@ -24,6 +24,8 @@ are printed, not asserted.
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import json
 import os
 import random

@@ -89,6 +89,8 @@ Usage::
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import json
 import os

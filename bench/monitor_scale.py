@@ -32,6 +32,8 @@ asserted.  Usage::
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import importlib.util
 import resource

@@ -35,6 +35,8 @@ Wall-clock and CPU seconds are printed, not asserted.
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import resource
 import shutil

@@ -36,6 +36,8 @@ truth file ``ros_heldout4_NAME.json`` (no upstream code is kept here).
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import json
 import time

@@ -46,6 +46,8 @@ minutes and 2 GiB on 2 cores, a no-op re-run within 2 s).
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import json
 import os

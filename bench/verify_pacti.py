@@ -51,6 +51,8 @@ SYS not proved, Pacti not composing the chain).
 """
 from __future__ import annotations
 
+import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+
 import argparse
 import compileall
 import json
