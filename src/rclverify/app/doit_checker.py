@@ -6,7 +6,7 @@ every task, and computes the md5 again for each task that names the file
 ran).  Every node task of a run depends on the system model
 (``artifacts/system/model.json``, 1.15 MB at 5000 nodes): doit's process
 hashed it 5000 times, about 10 CPU s of a cold run, quadratic in the
-system's size (issue 67).  :class:`MD5Checker` gives doit's states and
+system's size.  :class:`MD5Checker` gives doit's states and
 answers, with the md5 of a file kept while the file's ``stat`` (modification
 time in nanoseconds, size, inode, device) is unchanged; every write of
 rclverify's is a rename of a new file, so a rewritten file has a new inode

@@ -62,7 +62,7 @@ def stage_check(ws: Workspace) -> CheckRecord:
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]
     # units across connections: a missing unit (warning), a mismatch (an error row at the producer's end, the run
-    # going on: issue 48)
+    # going on)
     from rclverify.model.system.units import producer_diagnostics  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.printer and more only when called)
     warnings += [d.to_json() for d in producer_diagnostics(checked, model.links)]
     from rclverify.model.system.services import unserved  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.types and more only when called)

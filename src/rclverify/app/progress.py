@@ -193,7 +193,7 @@ class ProgressReporter(ConsoleReporter):  # type: ignore[misc]
         forget_stats()
         save_finished()
         self._finish(task)
-        if isinstance(fail, PlainFailure):  # one plain sentence, not doit's header (issue 30)
+        if isinstance(fail, PlainFailure):  # one plain sentence, not doit's header
             self.write(fail.message.rstrip("\n") + "\n")
             return
         super().add_failure(task, fail)

@@ -132,7 +132,7 @@ def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:
     """``rclverify ros check``: print each finding, a count line; exit 1 when
     any grounding error is found (or the plan/contract cannot be read), else 0.
     ``strict`` is kept for older command lines and changes nothing: an error is
-    never a pass (issue 65: 26 errors with exit 0 was a wrong green)."""
+    never a pass (26 errors with exit 0 was a wrong green)."""
     from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     ws = Workspace(root, plan)

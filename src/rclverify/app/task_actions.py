@@ -228,7 +228,7 @@ def act_deadlines(root: str) -> Any:
 
 @_extras_said
 def act_crosscheck(root: str, nodes: list[str]) -> Any:
-    """Decide every discharging query again with cvc5 (:mod:`rclverify.stages.crosscheck.stage`, issue 50)."""
+    """Decide every discharging query again with cvc5 (:mod:`rclverify.stages.crosscheck.stage`)."""
     from rclverify.stages.crosscheck.stage import stage_crosscheck  # deferred: start-up (loads rclverify.stages.crosscheck, rclverify.stages.requirements and more only when called)
     heap.executing()  # a task executes here (the other actions: _ws)
     try:
@@ -269,5 +269,5 @@ def act_verify(root: str, strict: bool) -> Any:
     except RclError as exc:  # the last run's summary is missing or of another shape: one located line
         return PlainFailure("\n".join(str(d) for d in exc.diagnostics))
     if strict and not data["meta"]["strict_ok"]:
-        return PlainFailure(strict_sentence(data))  # one sentence naming why (issue 30)
+        return PlainFailure(strict_sentence(data))  # one sentence naming why
     return None

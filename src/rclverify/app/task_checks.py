@@ -157,7 +157,7 @@ def entry_inputs(config: Any, root: Path, seen: dict[str, tuple[str, ...]]) -> l
             py = v.rsplit(":", 1)[0] if ":" in v else v
             if py.endswith(".py") and (root / py).is_file():
                 # a Python implementation (`file.py:callable`): the file and every workspace module it imports,
-                # so that a changed helper exports the obligations, and their inputs, again (issue 63, row 2)
+                # so that a changed helper exports the obligations, and their inputs, again
                 from rclverify.backends.property_tests.closure import import_closure  # deferred: optional or conditional (inside a block)
                 k = "\0" + py  # the closure is the file's, whatever callable follows the colon (one walk per file)
                 if k not in seen:

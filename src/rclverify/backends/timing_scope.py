@@ -1,4 +1,4 @@
-"""What a backend's evidence covers of a timed guarantee (issue 33).
+"""What a backend's evidence covers of a timed guarantee.
 
 A guarantee ``G(phi) triggered by in.x within d`` has an untimed part (``phi``
 at every step, what rules R1-R4 use) and a timing part (the output follows

@@ -147,7 +147,7 @@ def single_paths(model: SystemModel, node: str) -> bool:
     over the cone is empty whatever links are cut.  One test of the cone's
     bit mask (:meth:`SystemModel.upstream_masks`) against the mask of such
     nodes, made once per model, instead of a walk over the cone: along a
-    chain the walks added up to N*N/2 steps (docs/scale.md, issue 67)."""
+    chain the walks added up to N*N/2 steps (docs/scale.md)."""
     return model.upstream_masks().get(node, 0) & _joins(model) == 0
 
 
@@ -340,7 +340,7 @@ class ConeContext:
                     shown = render_model(m, self.enc)
                     violated = tuple(n for n, d in zip(self.flag_nodes, self.definitions)
                                      if z3.is_false(m.eval(d.arg(0), model_completion=True)))
-                # short values where Z3 finds them, the same nodes' assumptions violated, re-checked (issue 48)
+                # short values where Z3 finds them, the same nodes' assumptions violated, re-checked
                 same = [d.arg(0) == z3.BoolVal(n not in violated, d.ctx) for n, d in zip(self.flag_nodes, self.definitions)]
                 shown = nicer_model([*background, *tracked, *literals, *same], self.enc, shown).model
                 return ContextResult("refuted", script(), dt, model=shown, violated=violated)

@@ -93,7 +93,7 @@ def _negate(a: z3.BoolRef) -> z3.BoolRef:
 
 def _valid(hyps: Sequence[z3.BoolRef], goal: z3.BoolRef) -> bool:
     s = z3.Solver(ctx=goal.ctx)
-    wallclock.limit(s, STEP_MS)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, STEP_MS)  # steps decide, the clock is a net
     s.add(*hyps)
     s.add(z3.Not(goal))
     return bool(s.check() == z3.unsat)

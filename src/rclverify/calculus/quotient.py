@@ -220,7 +220,7 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
     where the in-context side conditions open the loop at its back edges
     (:mod:`.context`), and a note says so.
 
-    ``confirm``: the second solver (issue 50; docs/second-solver.md), a
+    ``confirm``: the second solver (docs/second-solver.md), a
     callable from a proved re-check's SMT-LIB2 script to ``(agreement,
     why)``; a re-check it does not confirm (``disagree``,
     ``inconclusive``) is not proved, so the contract does not re-check.
@@ -338,7 +338,7 @@ def _no_answer(sysm: _System, a: z3.BoolRef, g: z3.BoolRef, outs: Sequence[z3.Ex
     facts = sysm.env(sysm.node, sysm.enc)
     body = _conj([g] + facts)
     s = z3.Solver()
-    wallclock.limit(s, 20_000)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, 20_000)  # steps decide, the clock is a net
     s.add(a, z3.ForAll(list(outs), z3.Not(body)) if outs else z3.Not(body))
     if s.check() != z3.sat:
         return

@@ -281,7 +281,7 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
         raise RclError([error(_io_loc(b, "in", extra[0]), f"input {extra[0]!r} of {b.name} is not an input of {a.name} "
                                                           "and no condition mentions it; give one with --assume",
                               "E-refines-interface")])
-    # decide first with what decides (issue 44): each side's first attempt gets a small budget; when it
+    # decide first with what decides: each side's first attempt gets a small budget; when it
     # cannot decide, a finite-table counterexample (calculus/health/witness.py) refutes the side with that model
     # (the case study's guarantee side: 0.2 s, where MBQI after simplification took 1.2 s to build a
     # model whose wayP was a 200 kB if-then-else); else the retries of semantics/retry.py
@@ -379,7 +379,7 @@ def refines_main(spec_a: str, spec_b: str, *, out: TextIO | None = None, err: Te
     ``assumes``: RCL formulas over B's inputs (``--assume``), conditions
     under which the replacement is checked (they let B read extra inputs).
 
-    ``confirm``: the second solver (issue 50), a callable from a side's
+    ``confirm``: the second solver, a callable from a side's
     SMT-LIB2 text to ``(agreement, why)`` (:func:`rclverify.stages.crosscheck.stage.agreement`
     of cvc5's answer); a proved side it does not confirm makes the verdict
     inconclusive (docs/second-solver.md).

@@ -25,7 +25,7 @@ not both declare a unit (declared units are checked exactly,
   the producer's values would fit.  A factor of 10 is left out: ``<= 1``
   against ``<= 10`` is an ordinary margin far more often than a unit;
 * else, the same rule with one of the usual conversions that are no power
-  of ten (:data:`CONVERSIONS`, issue 48: degrees and radians, 180/pi; km/h
+  of ten (:data:`CONVERSIONS`: degrees and radians, 180/pi; km/h
   and m/s, 3.6; feet and metres, 0.3048; mph and m/s, 0.44704; miles and
   kilometres, 1.609344; inches and centimetres, 2.54), within 0.5 %.
 
@@ -93,7 +93,7 @@ def _range(term: z3.ArithRef, facts: Sequence[z3.BoolRef]) -> tuple[Fraction | N
     out: list[Fraction | None] = []
     for maximise in (False, True):
         o = z3.Optimize()
-        wallclock.limit(o, OPTIMIZE_MS)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(o, OPTIMIZE_MS)  # steps decide, the clock is a net
         o.add(*facts)
         h = o.maximize(term) if maximise else o.minimize(term)
         if o.check() != z3.sat:

@@ -3,7 +3,7 @@
 The in-context check (:mod:`.context`; docs/calculus.md, "Side conditions
 in context") decides a conjunct of node ``n``'s assumption against the
 premises ``P(n)`` of ``n``'s whole upstream cone.  Along a chain of N nodes
-the cones add up to N*N/2 contracts (issue 51).  Rule R1's derived
+the cones add up to N*N/2 contracts.  Rule R1's derived
 property (paper lines 564-590) is what a node's cone establishes about its
 outputs; here it is made exact and finite: the **summary** of node ``m`` is
 

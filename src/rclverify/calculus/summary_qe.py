@@ -7,8 +7,7 @@ arithmetic).  :func:`implied`: Z3's proof that a formula is implied by the
 premises it was made from, with the labels of the premises its unsat core
 used.  Both run in the Z3 context the caller gives (a fresh one of the
 summary's own, so the text made depends on nothing the process did before),
-each bounded by :data:`QE_MS` (Z3's steps decide; the clock is a net,
-issue 67).
+each bounded by :data:`QE_MS` (Z3's steps decide; the clock is a net).
 """
 from __future__ import annotations
 
@@ -97,7 +96,7 @@ def implied(ctx: z3.Context, decls: str, premises: Sequence[tuple[str, str]], ax
     text = (decls + lits + "".join(f"(assert (=> |s!{k}| {b}))\n" for k, (_, b) in enumerate(premises))
             + "".join(f"(assert {a})\n" for a in axioms) + f"(assert (not {formula}))\n")
     s = z3.Solver(ctx=ctx)
-    wallclock.limit(s, QE_MS)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, QE_MS)  # steps decide, the clock is a net
     s.set("unsat_core", True)
     s.add(z3.parse_smt2_string(text, ctx=ctx))
     lit = [z3.Bool(f"s!{k}", ctx) for k in range(len(premises))]

@@ -1,4 +1,4 @@
-"""The worst timing path of an end-to-end deadline (issue 48).
+"""The worst timing path of an end-to-end deadline.
 
 A requirement's ``deadline: {path: [A, ..., B], within: d}`` names one path
 of nodes; rule D3 (:mod:`.deadlines`) sums the timed guarantees along it.
@@ -72,7 +72,7 @@ def nodes_between(model: SystemModel, path: Sequence[str]) -> tuple[str, ...]:
     links, a superset of the nodes on the simple paths
     :func:`with_worst_path` may take as the slowest.  The ``deadlines`` task
     depends on their snapshots: an edit of a hop off the named path changes
-    the verdict too (issue 48: an incremental run kept a deadline refuted
+    the verdict too (an incremental run kept a deadline refuted
     that a clean run proved)."""
     masks = model.upstream_masks()  # bit i: model.nodes[i]; a node's mask holds the node and all that reach it
     if len(path) < 2 or path[0] not in masks or path[-1] not in masks:

@@ -76,7 +76,7 @@ def _bundle_recheck(archive: str) -> int:
     from rclverify.report.bundle.manifest import BundleError  # deferred: start-up (loads yaml, z3 and more only when called)
     from rclverify.stages.crosscheck.recheck import recheck_members  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     records: dict[str, bytes] = {}
-    try:  # streamed under --verify's limits and member-name rules; only the records kept (issue 63, row 8)
+    try:  # streamed under --verify's limits and member-name rules; only the records kept
         scan_members(Path(archive), None, records)
         out = recheck_members(records)
     except BundleError as exc:

@@ -57,7 +57,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     except ConfigError as exc:
         print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify monitor'}: error: {exc}", file=sys.stderr)
         return 2
-    from rclverify.backends.monitors.shared_topics import shared_topic_errors  # two variables on one topic read distinct fields (issue 64); deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.backends.monitors.shared_topics import shared_topic_errors  # two variables on one topic read distinct fields; deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     shared = [d for n in checked.nodes for d in shared_topic_errors(checked, n, cfg.rules, cfg.mapping or
                                                                    "backends/monitors/mapping.yaml")]
     if shared:
@@ -124,7 +124,7 @@ def _report_run(report: list[dict[str, Any]], run: RecordedRun, trace: str, cfg:
                   + ("; no verdict: " + ", ".join(f"{n} {v}" for v, n in d.unaccepted.items() if n)
                      if any(d.unaccepted.values()) else ""))
             print(f"  {status}: {explanation}")
-    # periods, then the declarations (initially, progress, periods: declarations.py, issue 64): one row each
+    # periods, then the declarations (initially, progress, periods: declarations.py): one row each
     judged: list[tuple[str, Any, Any, Any]] = [("periods", pr, period_status(pr, trace), pr.to_json())
                                                for pr in run.periods]
     judged += [("declarations", dr, declaration_status(dr, trace), dr.rows()) for dr in run.declarations]

@@ -65,7 +65,7 @@ def cmd_review(args: argparse.Namespace) -> int:
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     root = Path(args.workspace)
     out_rel = ""
-    if args.output:  # the record this command writes may be the one the plan names and misses (issue 48)
+    if args.output:  # the record this command writes may be the one the plan names and misses
         try:
             out_rel = Path(args.output).resolve().relative_to(root.resolve()).as_posix()
         except ValueError:

@@ -7,7 +7,7 @@ for a core and costs its fork and its own solver.  The one-minute load
 average answers that late: at the end of a ``doit -n 2`` run's evidence
 phase it still reads about 2 while the other doit process already waits
 idle, and the 1000-node system's second solver then ran on one core for
-13 s (issue 67).  :func:`idle_cpus` reads the kernel's per-CPU time
+13 s.  :func:`idle_cpus` reads the kernel's per-CPU time
 counters (``/proc/stat``, proc(5)) twice, a short window apart, and says
 how many of this process's CPUs were idle in between.
 """

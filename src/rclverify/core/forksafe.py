@@ -9,7 +9,7 @@ no other thread runs, with one exception: the feeder threads of
 (doit's result queue).  ``multiprocessing`` resets such a queue's thread
 state in every child it starts (its after-fork hooks), and a child of
 rclverify's never uses doit's queues; without the exception the second
-solver of a ``doit -n 2`` run never split (issue 67: 13 s on one core of
+solver of a ``doit -n 2`` run never split (13 s on one core of
 the 1000-node system, the other core idle).
 """
 from __future__ import annotations

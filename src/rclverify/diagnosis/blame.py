@@ -254,7 +254,7 @@ def _summands(e: Any) -> list[ast.NumLit]:
 
 def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[str, Any]]:
     """The guarantees of ``cone`` to blame for the refuted temporal
-    requirement ``req_id`` whose run meets every contract (issue 64: an
+    requirement ``req_id`` whose run meets every contract (an
     off-by-one names the node with the slip): a guarantee is named when one
     edit of it by one value -- a threshold's strictness where the statement
     names the threshold (as :func:`requirement_culprits`), or an index

@@ -357,7 +357,7 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
                     f"; {mon.get('counts', {}).get('violated', '?')} message(s) of the run violate the contract (each: `rclverify explain OBLIGATION#N`).")
         cul = [{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
                {"what": f"guarantee {gk} of {node}", "source": gsrc, "text": gtext}]
-        h = _generated_handler(ws, node, mon)  # generated code: the logic.py handler that published it (issue 64)
+        h = _generated_handler(ws, node, mon)  # generated code: the logic.py handler that published it
         if h is not None:
             said = "".join([f"; it returns early at line {', '.join(map(str, h.early))}" if h.early else "",
                             f"; it publishes at line {', '.join(map(str, h.publishes))}" if h.publishes else ""])
@@ -376,7 +376,7 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
     if backend == "property_tests" and isinstance(e.get("counterexample"), dict):
         cex = {kk: v for kk, v in e["counterexample"].items() if kk not in _META_KEYS}
         impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
-        cause = e["counterexample"].get("cause")  # the implementation line the example takes (issue 48)
+        cause = e["counterexample"].get("cause")  # the implementation line the example takes
         sentence = (f"Hypothesis found inputs on which {impl} "
                     f"violates {where}" + (f"; the implementation line that computed the failing output is {cause}"
                                            if cause else "") + f"; replay: `{e['counterexample'].get('replay', '')}`.")
@@ -403,7 +403,7 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
     prog_consts: list[str] = []
     try:
         prog = lang.parse_program(ws.path(program).read_text(encoding="utf-8"), program)
-        # the thresholds its conditions compare with, in line order: no assigned constant's line (issue 48)
+        # the thresholds its conditions compare with, in line order: no assigned constant's line
         compared = compared_constants(prog)
         prog_consts = [f"{program}:{n.loc.line}: {n.text}" for n in compared]
         prog_texts = list(dict.fromkeys(n.text for n in compared))
@@ -422,7 +422,7 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
                 f"guarantee uses {'/'.join(conj_nums) or 'other constants'}; on {inputs or 'the counterexample'} the "
                 f"program gives {outputs or 'another output'}, which the conjunct `{conj}` ({conj_src}) rules out.")
     assigned = [] if (conj_nums and prog_consts) else _breaking_assignments(ws, program, cex, data, conj)
-    if assigned:  # no threshold disagrees: the assignment whose value breaks the conjunct (issue 64)
+    if assigned:  # no threshold disagrees: the assignment whose value breaks the conjunct
         prog_consts = [f"{program}:{a.line}: {a.text}" for a in assigned]
         sentence = (f"On {inputs or 'the counterexample'} {program} runs "
                     + ", then ".join(f"`{a.text}` ({program}:{a.line})" for a in assigned)

@@ -1,4 +1,4 @@
-"""The handler of a generated node that produced a violating message (issue 64).
+"""The handler of a generated node that produced a violating message.
 
 A node written with ``rclverify generate ros2`` has two Python modules
 (docs/generate.md): ``node.py``, generated and rewritten by every run, whose

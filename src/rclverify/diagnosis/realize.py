@@ -39,7 +39,7 @@ from rclverify.semantics import wallclock
 from rclverify.semantics.query import prove
 
 #: Budget of each query (milliseconds' worth of Z3 resource steps; the wall
-#: clock is only a safety net whose firing gives no answer: issue 67).
+#: clock is only a safety net whose firing gives no answer).
 TIMEOUT_MS = 3000
 
 
@@ -100,7 +100,7 @@ def extreme(ws: Any, checked: Checked, node: str, output: str, largest: bool) ->
         return None
     if isinstance(target, z3.FuncDeclRef) or not (z3.is_int(target) or z3.is_real(target)):
         return None
-    opt = wallclock.limit(z3.Optimize(), TIMEOUT_MS)  # resource steps decide; the clock only cuts (issue 67)
+    opt = wallclock.limit(z3.Optimize(), TIMEOUT_MS)  # resource steps decide; the clock only cuts
     opt.add(*parts, *enc.axioms())
     h = opt.maximize(target) if largest else opt.minimize(target)
     try:

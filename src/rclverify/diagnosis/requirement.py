@@ -40,13 +40,13 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
             lambda: progress_repairs(ws, q, check["temporal"])) or [])
         if rec["culprits"]:
             return rec
-        # a run that meets every contract: the guarantee an edit by one value fixes (an off-by-one; issue 64)
+        # a run that meets every contract: the guarantee an edit by one value fixes (an off-by-one)
         slips = cache.get(["temporal-culprits", q["id"], check.get("formal"), cone],
                           lambda: _slips(ws, report, q, guarantee_source)) or []
         return _with_slips(rec, q, check, slips) if slips else rec
 
     causes = _causes(ws, report, q, cone, cache)
-    if causes:  # refuted only because a side condition fails: that problem's row, its culprit (issue 64)
+    if causes:  # refuted only because a side condition fails: that problem's row, its culprit
         return _consequence_record(report, q, check, causes, guarantee_source)
 
     found = cache.get(["requirement", q["id"], check.get("formal"), cone],
@@ -63,7 +63,7 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
     sentence = _refuted(q, check, found[0] if found else None, cex)
     through = _passes_through(ws, report, q, cone)
-    if through:  # the counterexample runs through another node's refuted side condition: say so (issue 64)
+    if through:  # the counterexample runs through another node's refuted side condition: say so
         sentence += " Its counterexample passes through " + "; ".join(
             f"the failed side condition {sc['id']} ({sc['node']}'s assumption `{sc['conjunct']}`, {sc['source']}, "
             "is false there)" for sc in through) + "."

@@ -36,7 +36,7 @@ instead, so a unit never suppresses the safe repair.  When the consumer's
 assumption stems from a requirement (a formal statement reads the linked
 value, or names the constant of its bound), weakening it is never the first
 repair: alone, it is withdrawn into ``not_offered`` with the reason
-(issue 64).
+.
 
 Every repair is returned only when Z3 discharged the side condition on the
 edited contracts and the edited node stays consistent; that is what its
@@ -175,7 +175,7 @@ def _stems_from(ws: Any, sc: Mapping[str, Any], pairs: Sequence[tuple[str, str, 
 
 def _requirement_guard(out: dict[str, Any], sc: Mapping[str, Any], reqs: Sequence[str]) -> None:
     """Weakening a consumer's assumption that stems from a requirement is
-    never the first repair (issue 64): when it would be the only one it is
+    never the first repair: when it would be the only one it is
     withdrawn into ``not_offered`` with the reason; after a safe repair it
     stays, saying which requirement its bound stems from."""
     if not reqs:
@@ -249,7 +249,7 @@ def _normal(c: ast.Expr, prefix: str | None, name: str,
     """``(op, bound)`` when ``c`` is ``<prefix>.<name> op N`` (or ``N op
     <prefix>.<name>``, mirrored) with an ordering ``op``; ``N`` a numeral,
     or, with ``constants`` (the context's, name -> (type, defining
-    expression)), a named constant whose value is a numeral (issue 48: one
+    expression)), a named constant whose value is a numeral (one
     first repair also when the bound is a named constant)."""
     if not (isinstance(c, ast.Compare) and len(c.ops) == 1 and c.ops[0] in _UPPER):
         return None
@@ -284,7 +284,7 @@ def _inplace(ws: Any, p: str, ov: str, target: ast.Expr) -> tuple[Edit, int, str
     there is none.  ``N`` and ``B`` are compared in one unit, each read in
     the unit written after it or else in its variable's declared unit
     (:func:`.units.literal_si`); ``B`` is written in ``N``'s unit, or as the
-    consumer's named constant (issue 64: a unit on the bound no longer
+    consumer's named constant (a unit on the bound no longer
     suppresses the safe repair)."""
     consts = ws.checked.env.constants
     mine = next(((v, _normal(target, pre, v.name, consts)) for pre in ("in", None) for v in subexpressions(target)

@@ -4,7 +4,7 @@ A repair candidate (:mod:`.recheck`) is the workspace's contracts with one
 edit.  Parsing every contract file again and type-checking the whole
 system for each candidate made the diagnosis quadratic in the system: on a
 chain of N nodes whose side conditions all fail there are O(N) candidates,
-each O(N) to parse and check (issue 44: 0.2 s at 10 nodes, 101.6 s at 200).
+each O(N) to parse and check (0.2 s at 10 nodes, 101.6 s at 200).
 
 When the edit lies inside one node's text and leaves that node's interface
 as it was, the system the full path would build differs from the checked

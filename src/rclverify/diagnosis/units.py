@@ -1,4 +1,4 @@
-"""One diagnosis per unit mismatch on a connection, joining what follows from it (issue 48).
+"""One diagnosis per unit mismatch on a connection, joining what follows from it.
 
 The driver publishes degrees where the localiser reads radians: the
 connection's unit mismatch (:func:`rclverify.model.system.units.mismatches`,
@@ -188,7 +188,7 @@ def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
 
 # ---------------------------------------------------------------------------
 # Bounds in one unit: the in-place tightening of a bound written with a unit
-# (``45 [N]`` tightened to ``40 [N]``, issue 64) compares and writes numbers
+# (``45 [N]`` tightened to ``40 [N]``) compares and writes numbers
 # in a common unit
 # ---------------------------------------------------------------------------
 

@@ -1,4 +1,4 @@
-"""Type rules of progress, initial values and periodic outputs (issue 40).
+"""Type rules of progress, initial values and periodic outputs.
 
 A node may declare, after its clauses (docs/rcl-language.md, "Progress,
 initial values and periodic outputs"):

@@ -1,4 +1,4 @@
-"""Type rules of services, actions, triggers and deadlines (issue 33).
+"""Type rules of services, actions, triggers and deadlines.
 
 The rules (docs/rcl-language.md, "Services, actions and deadlines"):
 

@@ -48,7 +48,7 @@ class LimitedBy(TypedDict):
 
 
 class CulpritOf(TypedDict):
-    """A problem row an item is the culprit of (``$defs/culprit_of``, issue 64)."""
+    """A problem row an item is the culprit of (``$defs/culprit_of``)."""
     sentence: str
     status: EvidenceStatus
 

@@ -1,4 +1,4 @@
-"""Statistical guarantees from counted runs (issue 68; docs/statistics.md).
+"""Statistical guarantees from counted runs (docs/statistics.md).
 
 What a set of monitored runs or experiment trials says about the
 probability that a run (or a judged answer) violates a guarantee:
@@ -53,7 +53,7 @@ def upper_bound(k: int, n: int, level: float) -> float:
         return 1.0
     if k == 0:  # closed form, exact in floating point where beta.ppf rounds
         return 1.0 - math.pow(1.0 - level, 1.0 / n)
-    from rclverify.core.numeric import scipy_special  # here, not at import: scipy costs every plan load 0.3 s (issue 67)
+    from rclverify.core.numeric import scipy_special  # here, not at import: scipy costs every plan load 0.3 s
     return float(scipy_special().betaincinv(k + 1, n - k, level))  # Beta(k+1, n-k)'s quantile at level
 
 

@@ -30,7 +30,7 @@ def with_statistics(report: Mapping[str, Any], part: StatisticsPart) -> dict[str
 
 def with_solvers(report: Mapping[str, Any], counts: Mapping[str, int], problem: str) -> dict[str, Any]:
     """``report`` with ``summary.solvers`` (how many items two solvers, one
-    solver, ... decided; issue 50) and the second solver's record's
+    solver, ... decided) and the second solver's record's
     ``problem`` ('' when none) among the problems."""
     problems = list(report["summary"]["problems"]) + ([f"Second-solver record: {problem}"] if problem else [])
     return {**report, "summary": {**report["summary"], "problems": problems, "solvers": dict(counts)}}

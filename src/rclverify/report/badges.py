@@ -3,7 +3,7 @@
 A requirement's status (:mod:`rclverify.calculus.requirements.rollup`) rolls its Z3
 verdict up with the evidence its proof rests on, so one red ``failed``
 stood beside "proved vacuously" and beside "proved, evidence outstanding"
-alike (issue 30, item 6).  :func:`requirement_badges` shows the two apart:
+alike.  :func:`requirement_badges` shows the two apart:
 the proof as one badge in words (``proved``, ``proved vacuously`` in the
 warning colour, ``refuted``, ...) and, where the evidence decides the
 status, ``evidence: <status>`` as a second.

@@ -155,11 +155,11 @@ def build_report(ws: Workspace) -> Report:
     docs/assurance.schema.json publishes.  The passes, in order: the rows
     (:func:`_rows`), the summary around them, the statistics table
     (report/statistics.py, docs/statistics.md), the second solver's counts,
-    strength and confidence (report/confidence_rows.py, issue 50), the
+    strength and confidence (report/confidence_rows.py), the
     ``--strict`` gate with every severity (report/severity.py), one
     diagnosis per problem with repairs checked by Z3 (docs/diagnosis.md),
     the problems grouped by root cause (report/problems.py) and the
-    culprit nodes marked (report/culprits.py, issue 64)."""
+    culprit nodes marked (report/culprits.py)."""
     inp = read_inputs(ws)
     report = _first_report(ws, inp, *_rows(ws, inp))
     plan = ws.plan

@@ -1,4 +1,4 @@
-"""Counterexamples cut to the cone that matters (issue 48).
+"""Counterexamples cut to the cone that matters.
 
 The records keep every value Z3 gave (a side condition decided in context
 holds a model of its whole upstream cone; a temporal requirement's lasso
@@ -99,7 +99,7 @@ def side_condition_view(sc: Mapping[str, Any]) -> Mapping[str, Any]:
     left out.  Unchanged without a model or links, or when nothing would be
     left; unchanged, too, for a side condition that failed *in context*: its
     counterexample is traced back through the upstream cone whose premises
-    allowed it (issue 51), every value of which is part of why it fails."""
+    allowed it, every value of which is part of why it fails."""
     model = sc.get("model")
     if not isinstance(model, dict) or not sc.get("links") or sc.get("variant") == "in context":
         return sc

@@ -1,4 +1,4 @@
-"""Evidence strength and confidence on the report's rows (issue 50).
+"""Evidence strength and confidence on the report's rows.
 
 What :func:`confidence_part` gives the rows of the report
 :func:`rclverify.report.build.build_report` makes (report/assemble.py puts

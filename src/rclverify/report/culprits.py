@@ -1,4 +1,4 @@
-"""Which nodes the problems blame (issue 48: the first screen names the culprit, not its victims).
+"""Which nodes the problems blame (the first screen names the culprit, not its victims).
 
 A problem by root cause (:mod:`.problems`) names its culprits by id: ``guarantee:Node:k``,
 ``contract:Node``, ``assumption:Node:k``, a program line.  The nodes whose guarantee or contract is a
@@ -14,7 +14,7 @@ from rclverify.records.records import SEVERITY, worst
 def culprit_nodes(groups: Iterable[Any]) -> set[str]:
     """The nodes a problem's culprit (``groups``: the problems by root cause)
     is a guarantee, the contract or a line of the code of (``guarantee:Node:k``,
-    ``contract:Node``, a ``line:`` with its ``node``; issue 48: the dashboard marks them, so that the first
+    ``contract:Node``, a ``line:`` with its ``node``: the dashboard marks them, so that the first
     screen blames the culprit, not its victims)."""
     out = set()
     for g in groups:
@@ -65,7 +65,7 @@ def _marked(row: Mapping[str, Any], blame: Mapping[str, str]) -> dict[str, Any]:
 
 def marked_nodes(nodes: Sequence[Mapping[str, Any]], problems: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """``nodes`` (the report's node rows) with every node and guarantee a
-    problem blames given the status of that problem (issue 64: a culprit
+    problem blames given the status of that problem (a culprit
     never reads "discharged"; its own evidence may all hold, the problem it
     causes does not).  For each row of ``problems``
     (:func:`rclverify.report.problems.group_problems`) and each culprit

@@ -30,7 +30,7 @@ the requirement's own verdict (an informal requirement stays informal:
 its text is not checked).  ``--strict`` fails unless every deadline is
 proved from a chain whose evidence is discharged, each hop's deadline
 measured on a run (a hop whose guarantee only a property test or a proof
-covers is ``pending``: they check its formula, not its time; issue 64)
+covers is ``pending``: they check its formula, not its time)
 (:func:`strict_ok`, :func:`strict_reason`).  SARIF
 (``RCL-DEADLINE-REFUTED``, ``RCL-DEADLINE-INCONCLUSIVE``) and JUnit (a
 ``deadlines`` test suite) are laid out here too.
@@ -118,7 +118,7 @@ def _timing_measured(hop: dict[str, Any]) -> None:
     formula (a property test, a proof: backends/timing_scope.py) while no
     run timed it (no monitors' deadline record of its node with a ``true``
     verdict and no ``false`` one) is ``pending``: the deadline the sum rests
-    on was measured by nothing (issue 64: a proved deadline is no green tick
+    on was measured by nothing (a proved deadline is no green tick
     on an unmeasured hop).  ``hop["timing"]`` says so."""
     if hop["status"] != "discharged":
         return

@@ -43,7 +43,7 @@ DOT_TIMEOUT_S = 30.0
 #: The largest system diagram (nodes, connections and environment inputs) the report lays out.
 #: ``dot``'s time grows faster than the size: on a system shaped like bench/system_scale.py's (a
 #: chain with joins and loops), 0.3 s at 500 nodes, 1.7 s at 1,000, 10 s at 2,000, 39 s at 3,000
-#: (issue 67, docs/scale.md); a drawing of thousands of boxes is not legible, and past
+#:; a drawing of thousands of boxes is not legible, and past
 #: :data:`DOT_TIMEOUT_S` whether a diagram appeared would depend on the machine's speed.
 MAX_SYSTEM_LAYOUT_ELEMENTS = 2500
 
@@ -111,7 +111,7 @@ def system_dot(system: Mapping[str, Any], title: str = "system model", culprits:
     contract, :mod:`.culprits`) has a thick red border and "culprit" in its
     label; a connection in ``failing`` (``(producer, consumer)`` of a side
     condition that is not discharged) is drawn red and dashed: the failing
-    edge (issue 48: the diagram blames the culprit, not only its victims).
+    edge (the diagram blames the culprit, not only its victims).
     Everything is sorted, so equal inputs give byte-equal output.
     Raises ``KeyError`` when a required key is missing.
     """

@@ -26,7 +26,7 @@ class EvidencePart(TypedDict):
     ``obligations``/``evidence``/``pending``: the report's rows;
     ``status``: obligation id -> its current status; ``declared``: node ->
     ``(record status, declaration rows)`` per record that judged the node's
-    declarations (issue 64); ``altered``: one problem sentence per record
+    declarations; ``altered``: one problem sentence per record
     that cannot be read as rclverify wrote it; ``inputs``: obligation id ->
     the input sha256s its evidence was made from (``None``: no record)."""
     obligations: list[ObligationRow]
@@ -86,7 +86,7 @@ def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: dic
                            "facts": d.get("facts", []), "coverage": d.get("coverage") or {}}
     if isinstance(d, dict) and d.get("monitoring"):
         row["monitoring"] = d["monitoring"]
-    if isinstance(d, dict) and isinstance(d.get("statistics"), dict):  # runs counted (issue 68)
+    if isinstance(d, dict) and isinstance(d.get("statistics"), dict):  # runs counted
         row["statistics"] = compact_statistics(d["statistics"])
     return cast(EvidenceRow, row)  # built as a dict for the optional keys
 
@@ -120,7 +120,7 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
                 part["pending"].append({"obligation": o.id, "backend": o.backend,
                                         "reason": "no evidence record yet: run `doit verify`"})
             continue
-        if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged (issue 64)
+        if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged
             part["declared"].setdefault(o.node, []).append((status, ev.details["declarations"]))
         part["evidence"].append(evidence_row(ws, ev, status, altered, solvers))
         if status == "pending":

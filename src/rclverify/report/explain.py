@@ -56,7 +56,7 @@ def requirement_lines(r: Mapping[str, Any]) -> list[str]:
     if r.get("note"):
         out.append(f"  {r['note']}")
     t = c.get("temporal") or {}
-    if t.get("method"):  # how a temporal statement was decided; an IC3/PDR proof's certificate (issue 64)
+    if t.get("method"):  # how a temporal statement was decided; an IC3/PDR proof's certificate
         out.append(f"  temporal check: {t.get('status')} by {t['method']}" + (f"; {t['detail']}" if t.get("detail") else ""))
         if t.get("certificate"):
             out.append(f"    certificate (inductive invariant, re-checked): {t['certificate']}")
@@ -277,7 +277,7 @@ class _Index:
         k = g["index"]
         obs = [x for kind, x in self.items.values() if kind == "obligation" and x["node"] == node and x.get("guarantee") == k]
         status = "unverified" if not obs and not g.get("obligations") else g["status"]  # no obligation covers it
-        if g.get("culprit_of"):  # a problem's culprit reads that problem's status (report/culprits.py, issue 64)
+        if g.get("culprit_of"):  # a problem's culprit reads that problem's status (report/culprits.py)
             status = g["status"]
         out = [f"{indent}{node}.g{k} [{status}] (guarantee {k} of {node}, {g.get('source', '')})",
                f"{indent}  {g['text']}"]
@@ -332,7 +332,7 @@ class _Index:
         problems = [d for d in natural_sorted(list(self.diagnoses)) if d.split(".", 1)[0] == node]
         out.append(f"  problems: {', '.join(problems)} (`rclverify explain ID`)" if problems else "  problems: none")
         out += [f"  culprit of a problem [{c['status']}]: {clause_cut(c['sentence'], 300)}"
-                for c in n.get("culprit_of") or ()]  # report/culprits.py (issue 64)
+                for c in n.get("culprit_of") or ()]  # report/culprits.py
         for f in (g for fs in self.ros.values() for g in fs):
             if f.get("node") == node:
                 out.append(f"  ROS grounding {f.get('severity')}: {f.get('message')} ({f.get('code')})")

@@ -7,7 +7,7 @@ and ``reports/assurance.json`` (:func:`rclverify.report.build.build_report`).
 Both are written by rclverify, but a user can edit, truncate or replace
 them; a file of another shape (``[]``, ``null``, a string, a missing key, a
 list where an object belongs) is a located ``E-io`` error naming the first
-place that differs, never a traceback (issue 35 item 10).
+place that differs, never a traceback.
 """
 from __future__ import annotations
 

@@ -180,8 +180,8 @@ class _Grouping:
             if d["kind"] in pp.CONTRACT_DEFECTS and victim and roots and victim not in roots:
                 self.explains.setdefault(victim, [])
                 self.explains[victim] += [r for r in roots if r not in self.explains[victim]]
-        ps.join_by_first_repair(self.members, self.by_id)  # several consumers, one too loose producer: one row (issue 48)
-        pc.join_consequences(self.members, self.by_id)  # refuted only because of another problem: its row (issue 64)
+        ps.join_by_first_repair(self.members, self.by_id)  # several consumers, one too loose producer: one row
+        pc.join_consequences(self.members, self.by_id)  # refuted only because of another problem: its row
         pc.join_implementation_findings(self.members, self.by_id)  # a test and a run of one guarantee: the handler's row
 
     def requirement_members(self) -> None:
@@ -268,7 +268,7 @@ class _Grouping:
             g = groups.get(key)
             if g is None:
                 g = groups[key] = {"key": list(key), "status": m["status"], "sentence": first_sentence(m["sentence"]),
-                                   # in natural order: a program's line 9 before its line 13 (issue 48); what
+                                   # in natural order: a program's line 9 before its line 13; what
                                    # to repair before the assumptions it fails (the producer, then its victims)
                                    "culprits": [pp.culprit(r, self.places, self.anchor)
                                                 for r in producer_first(natural_sorted(key)) if r in self.places.info],

@@ -1,4 +1,4 @@
-"""Problems that follow from another problem, in its row (issue 64: one row
+"""Problems that follow from another problem, in its row (one row
 per cause, its consequences listed under it; docs/reading-the-report.md).
 
 Helpers of :func:`rclverify.report.problems.group_problems`, each changing
@@ -24,7 +24,7 @@ def join_consequences(members: list[tuple[dict[str, Any], list[str]]], by_id: Ma
     """A problem whose diagnosis is ``consequence_of`` other problems (a
     requirement refuted only because a side condition fails, Z3 proving it
     once that side condition is discharged: diagnosis/requirement.py) takes
-    their root culprits and is marked ``consequence_of`` (issue 64: one row
+    their root culprits and is marked ``consequence_of`` (one row
     per cause, its consequences listed under it).  Changes ``members``
     (``(member, roots)``) in place; a cause that is not a member changes
     nothing."""
@@ -40,7 +40,7 @@ def join_implementation_findings(members: list[tuple[dict[str, Any], list[str]]]
     """A property test or run that names only the guarantee it found
     violated joins the row of another such finding of the same guarantee
     that names implementation lines (``line:...``: the handler of a
-    generated node's logic.py that published the message, issue 64): one
+    generated node's logic.py that published the message): one
     implementation defect, found by a test and by a run, is one row.
     Changes ``members`` in place."""
     def victim(mid: str) -> tuple[Any, Any]:
@@ -67,7 +67,7 @@ def assumption_violations(report: Mapping[str, Any], members: list[tuple[dict[st
     condition names -- is a consequence of that side condition: the run's
     member (added when the run is not a problem of its own, e.g. pending)
     takes the side condition's root culprits and is marked
-    ``consequence_of`` (issue 64).  Changes ``members`` in place."""
+    ``consequence_of``.  Changes ``members`` in place."""
     roots_of = {m["id"]: roots for m, roots in members}
     failed = [sc for sc in report.get("side_conditions") or () if sc.get("status") == "failed"
               and str(sc["id"]) in roots_of]

@@ -1,4 +1,4 @@
-"""Model-checking evidence in the problems by root cause (issue 30's rule:
+"""Model-checking evidence in the problems by root cause (the rule:
 "group only findings that share a culprit proved to cause both").
 
 A property instance that SPIN or AJPF decides (backend ``ajpf``,

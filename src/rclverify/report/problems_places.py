@@ -97,7 +97,7 @@ class Places:
 def join_requirements_to_side_conditions(members: list[tuple[dict[str, Any], list[str]]]) -> None:
     """A refuted requirement whose culprits are all culprits of one failed
     side condition has that side condition's root cause: both rows read one
-    problem, with one first repair (issue 48: a service answering up to 64
+    problem, with one first repair (a service answering up to 64
     waypoints to a client whose buffer holds ``RouteBuffer = 50`` gave a
     side-condition row and a requirement row with two different first
     repairs).  Changes ``members`` (``(member, roots)``) in place."""

@@ -1,4 +1,4 @@
-"""Failed side conditions of several consumers with one first repair are one problem (issue 48).
+"""Failed side conditions of several consumers with one first repair are one problem.
 
 A producer whose guarantee is too loose for every node that reads its
 output (the MissionPlanner's ``out.dest_id <= 501`` read by a Navigator and
@@ -66,6 +66,6 @@ def producer_first(roots: Sequence[str]) -> list[str]:
     consumers' assumptions (``assumption:Node:k``) after everything else,
     each part in its order: a failed side condition's row names the
     producer's guarantee, the place of its first repair, before the
-    assumptions of the victims it fails (issue 48: the first screen blamed
+    assumptions of the victims it fails (the first screen blamed
     the victims)."""
     return [r for r in roots if not r.startswith("assumption:")] + [r for r in roots if r.startswith("assumption:")]

@@ -1,4 +1,4 @@
-"""A unit mismatch's row of the problem list: the findings it explains join it (issue 48).
+"""A unit mismatch's row of the problem list: the findings it explains join it.
 
 A diagnosis record of kind ``unit`` (:mod:`rclverify.diagnosis.units`)
 names in ``joins`` the findings that follow from one unit mismatch on a

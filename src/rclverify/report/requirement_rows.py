@@ -15,7 +15,7 @@ from rclverify.calculus.requirements.rollup import declaration_evidence, declara
 from rclverify.model.plan.load import all_requirements
 from rclverify.records.records import worst
 from rclverify.records.report_schema import RequirementRow, SupportRow
-from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters (issue 48)
+from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters
 from rclverify.report.contract_rows import GuaranteeStatuses
 from rclverify.report.contract_texts import ContractTexts
 from rclverify.stages.workspace import Workspace
@@ -57,7 +57,7 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
     ``note`` and the check's details (:mod:`rclverify.calculus.requirements.rollup`)."""
     verdict, status, note = roll_up(record, g_status, sc_status, traced_status, d_status)
     details = dict(with_trace_view({k: (record or {}).get(k) for k in _CHECK_FIELDS}))
-    details["declarations"] = declaration_evidence(record, d_status)  # the declarations it used, with their evidence (issue 64)
+    details["declarations"] = declaration_evidence(record, d_status)  # the declarations it used, with their evidence
     return {"status": status, "verdict": verdict, "note": note, "check": details}
 
 

@@ -220,7 +220,7 @@ def _obligation_results(report: Report) -> list[dict[str, Any]]:
         res = _result(rule, _level("obligation", str(o["status"])), " ".join(words), str(o["source"]),
                       f"obligation:{o['id']}", props)
         cause = (ev.get("counterexample") or {}).get("cause") if ev is not None else None
-        if isinstance(cause, str) and _location(f"{cause}:0"):  # at the implementation's line (issue 48)
+        if isinstance(cause, str) and _location(f"{cause}:0"):  # at the implementation's line
             rel = _location(str(o["source"]))
             for loc in rel:
                 loc.update(id=0, message={"text": "the guarantee the example violates"})
@@ -427,7 +427,7 @@ def _at_the_culprit(res: dict[str, Any], d: Mapping[str, Any]) -> None:
     """A failed side condition is located at the guarantee its diagnosis blames
     (a producer that publishes what the consumer does not accept), so that a CI
     annotation lands on the node to repair; the consumer's assumption it fails
-    becomes a related location (issue 48; SARIF 2.1.0 §3.27.22)."""
+    becomes a related location (SARIF 2.1.0 §3.27.22)."""
     guarantee = next((c for c in d.get("culprits") or () if isinstance(c, Mapping)
                       and str(c.get("what", "")).startswith("guarantee") and c.get("source")), None)
     if guarantee is None:

@@ -1,4 +1,4 @@
-"""Statistical guarantees in the report (issue 68; docs/statistics.md).
+"""Statistical guarantees in the report (docs/statistics.md).
 
 * :func:`compact` - an evidence record's ``details["statistics"]`` as the
   report row carries it (the run set's list of runs left in the record);

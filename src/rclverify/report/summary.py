@@ -124,7 +124,7 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
                           for d in report.get("deadlines") or ()],
             "problems": [{"status": g["status"], "sentence": group_sentence(g),
                           "culprits": [_culprit(c) for c in g.get("culprits", [])], "where": g.get("where", ""),
-                          # a consequence says of what (issue 64: one row per cause, its consequences under it)
+                          # a consequence says of what (one row per cause, its consequences under it)
                           "members": [m["id"] + (f" (a consequence of {', '.join(m['consequence_of'])})"
                                                  if m.get("consequence_of") else "") for m in g.get("members", [])],
                           "repairs": len(g.get("repairs", []))}
@@ -271,7 +271,7 @@ def summary_table(report: Mapping[str, Any], colour: bool, rows: list[dict[str, 
         table.add_column(head, footer=foot, overflow="fold", no_wrap=head in ("node", "status"))
     for r in shown:
         st = f"[{_COLOUR.get(r['status'], 'red')}]{r['status']}[/]" if colour else r["status"]
-        # a node whose guarantee or contract is a problem's culprit: where the repair goes (issue 48)
+        # a node whose guarantee or contract is a problem's culprit: where the repair goes
         cells = [r["node"] + (" (culprit)" if r.get("culprit") else ""), st, _counts(r["obligations"], colour),
                  f"{r['sc_proved']}/{r['sc_total']} proved" if r["sc_total"] else "-", _health(r)]
         if gaps:

@@ -3,7 +3,7 @@
 The HTML report fits a drawing into the page width (``max-width: 100%``),
 which is right for a small one; the assurance argument of the case study is
 2,500 by 3,800 points with 9-point labels, and fitted into 1,200 px its text
-was about 4 px tall (issue 30, item 6).  :func:`readable_svg` gives such a
+was about 4 px tall.  :func:`readable_svg` gives such a
 drawing a fixed size at which its smallest text is at least
 :data:`MIN_TEXT_PX` CSS pixels; the page shows it in a box that scrolls
 (``div.diagram.scroll``), so the page itself stays as tall as before.

@@ -146,7 +146,7 @@ def md_code_list(values: Any, sep: str = "<br>", empty: str = "none") -> str:
     ``{% for h in values %}{{ h|code }}{% if not loop.last %}<br>{% endif
     %}{% else %}none{% endfor %}``.  A side condition in context lists every
     premise of its upstream cone, so along a chain the lists add up to N*N/2
-    items, most of them the same texts (docs/scale.md, issue 67): each
+    items, most of them the same texts (docs/scale.md): each
     text's span is made once per process (a pure function of the text)."""
     items = [str(v) for v in values]
     return sep.join(_md_code_cell(t) for t in items) if items else empty

@@ -4,7 +4,7 @@ The messages of the report dict (explanations, reasons, diagnosis
 sentences, repair summaries) are written once for every format and mark
 RCL text as Markdown code spans: ``guard it with `i + 1 <= 12```.  The
 Markdown report keeps the backticks; the HTML report shows each span as
-``<code>`` (:func:`prose`), never a literal backtick (issue 30, item 6).
+``<code>`` (:func:`prose`), never a literal backtick.
 
 Ids are shown in natural order, their digit runs compared as numbers
 (``p1_i0 < p2_i1 < p10_i9``; :func:`natural_key`), wherever the HTML report

@@ -1,5 +1,5 @@
 """Layer 7, ros: the ROS computation graph read from a robot's software, and
-contracts grounded in it (issue 22; docs/ros.md).
+contracts grounded in it (docs/ros.md).
 
 Four folders, lowest first, each importing only those before it:
 ``extract/`` (code, launch files, packages read into graph records),

@@ -18,7 +18,7 @@ guarantee and the values), and so does a guarantee that cannot be decided
 or an input the guarantee reads that has not been received yet, or whose
 latest message did not map (a NaN or an infinity, which no guarantee can
 be judged on: the value in force before it is stale, and judging against
-it released 0.9 after ``limit = NaN`` before issue 47) (``inconclusive``,
+it released 0.9 after ``limit = NaN``) (``inconclusive``,
 ``incomplete input``): a filter lets through what is shown to hold, not what
 is not shown to fail (it fails closed).  The policy is per topic:
 ``--enforce /cmd@open`` releases what cannot be decided (it still blocks

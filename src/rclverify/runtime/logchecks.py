@@ -1,4 +1,4 @@
-"""The checks a live run makes as the offline command reads its log (issue 62: live = offline).
+"""The checks a live run makes as the offline command reads its log (live = offline).
 
 ``rclverify monitor LOG`` feeds every line of a log, in order, to the
 deadline monitors of the nodes with timed guarantees
@@ -51,7 +51,7 @@ class LogChecks:
         self.deadlines = [DeadlineMonitor(checked, n, rules, self._verdict, horizon=horizon)
                           for n in nodes if has_deadlines(n)]
         self.periods = [PeriodMonitor(n) for n in nodes if has_periods(n)]
-        #: initially, progress and periods judged as offline (declarations.py, issue 64)
+        #: initially, progress and periods judged as offline (declarations.py)
         self.declarations = [DeclarationMonitor(checked, n, rules) for n in nodes if has_declarations(n)]
         self.active = bool(self.deadlines or self.periods or self.declarations)
         self.deadline_results: list[DeadlineResult] = []

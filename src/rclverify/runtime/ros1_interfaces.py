@@ -1,5 +1,5 @@
 """ROS 1 service and action classes generated from a workspace's ``.srv`` and
-``.action`` files (issue 33), for the service proxy and example nodes.
+``.action`` files, for the service proxy and example nodes.
 
 Debian ships few interface packages (no ``std_srvs``, no ``actionlib``), so
 as :func:`~.ros1.message_class` does for ``.msg`` files, the classes are

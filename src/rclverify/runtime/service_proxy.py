@@ -1,4 +1,4 @@
-"""The live ROS 1 monitor of services and actions (issue 33).
+"""The live ROS 1 monitor of services and actions.
 
 ``python3 -m rclverify.runtime.service_proxy --contracts FILE ...
 --forward /estop=/estop_real --log run.jsonl`` starts a rospy node that
@@ -55,7 +55,7 @@ class ProxyRun:
     fields, stamp)`` receives every observed message too (``rclverify
     monitor --live``: the live engine, whose node monitors then check each
     call's response against the server's guarantees and the client's
-    assumption, issue 40)."""
+    assumption)."""
 
     def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
                  write: Callable[[dict[str, Any]], None] | None = None,

@@ -182,7 +182,7 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
         return False, ""
     s = z3.Solver()
     s.set("rlimit", int(rlimit))
-    wallclock.note_limit(s, timeout_ms)  # a safety net: its firing is told apart (issue 67)
+    wallclock.note_limit(s, timeout_ms)  # a safety net: its firing is told apart
     s.add(z3.Not(phi))
     r, cut = wallclock.check_cut(s)
     if r == z3.unsat:

@@ -7,7 +7,7 @@ others' and cast, about a dozen calls through the C API an argument (about
 temporal checks build such connectives by the thousand (a lasso search asks
 about every loop of every length: :mod:`rclverify.calculus.requirements.tsys`),
 and the coercion was the largest cost of their checks after the solver
-(issue 67: about a sixth of the warehouse example's whole run).
+(about a sixth of the warehouse example's whole run).
 
 :func:`conj` and :func:`disj` take the same arguments and return the same
 term.  When every argument is a ``z3.BoolRef`` of one context (the case of

@@ -252,7 +252,7 @@ def holds_in(semantics: str, formula: ast.Expr, checked: Checked, node: CheckedN
     """Does ``formula`` hold of ``values`` in the one arithmetic ``semantics``
     (``exact``, ``double``, ``tolerance``), ``None`` when undecided there?
     The monitor judges every guarantee of one message in one arithmetic
-    (issue 47, docs/monitors.md "Numbers on the wire"): a message whose
+   : a message whose
     guarantees hold only in different arithmetics holds in none."""
     if semantics == "exact":
         j = judge(formula, checked, node, values)

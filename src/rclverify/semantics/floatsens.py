@@ -1,4 +1,4 @@
-"""Which formulas the float semantics of recorded runs can change (issue 40).
+"""Which formulas the float semantics of recorded runs can change.
 
 :func:`rclverify.semantics.floatsem.judge` evaluates a formula again in the
 node's double arithmetic (or within a tolerance) only when that could give

@@ -1,5 +1,5 @@
 """One formula of one node judged on recorded values, compiled once: the
-monitors' fast path to :func:`rclverify.semantics.floatsem.judge` (issue 44).
+monitors' fast path to :func:`rclverify.semantics.floatsem.judge`.
 
 :class:`FormulaJudge` answers exactly what ``judge(formula, checked, node,
 values, tolerance)`` answers (the same truth, the same ``semantics``, the

@@ -1,4 +1,4 @@
-"""Counterexamples a person can read (issue 48): a Z3 model asked again for
+"""Counterexamples a person can read: a Z3 model asked again for
 inputs within their nodes' assumptions and for integers and short decimals.
 
 Z3 hands back the first model it finds: ``dest_id = 501`` where the node
@@ -25,7 +25,7 @@ solver; otherwise (or on any ``unknown``) the caller's model is returned
 unchanged, so a shown counterexample is always one.  A model already within
 the assumptions and already short is returned as it was (the same text).
 
-Only the budget of steps decides (issue 67): when the wall-clock safety net
+Only the budget of steps decides: when the wall-clock safety net
 of any of these queries fires (:mod:`.wallclock`: a loaded machine), the
 caller's model, the one the deterministic query found, is returned
 unchanged, never the intermediate model a loop cut short had reached.

@@ -7,7 +7,7 @@ Every query:
   the machine's load; its wall-clock safety net (:mod:`.wallclock`), when
   it fires first, gives ``inconclusive`` with the reason "took longer than
   N s", and no retry is asked in its place (a retry's model would differ
-  from the one the budget finds: issue 67);
+  from the one the budget finds);
 * maps Z3's answer to the tool's verdicts without ever upgrading an
   ``unknown``: validity -> ``proved`` (negation unsat) / ``refuted`` (sat,
   with a model) / ``inconclusive`` (unknown or timeout); satisfiability ->
@@ -71,7 +71,7 @@ class QueryResult:
 # STEPS_PER_MS and steps() (a budget in milliseconds' worth of Z3 resource
 # steps) and SAFETY_FACTOR (the wall-clock safety net, a multiple of the
 # budget) live in rclverify.semantics.wallclock, which also tells the net's
-# firing apart (issue 67); STEPS_PER_MS and steps are re-exported here.
+# firing apart; STEPS_PER_MS and steps are re-exported here.
 
 
 def budgeted_solver(timeout_ms: float, ctx: z3.Context | None = None) -> z3.Solver:
@@ -215,7 +215,7 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     ``models=False``: a refuted query's model is not rendered (``model``
     is ``None``), for a caller that reads only the verdict.
 
-    ``first_ms`` (decide first with what decides, issue 44): the first
+    ``first_ms`` (decide first with what decides): the first
     attempt gets only this budget (milliseconds' worth of resource steps);
     a query it decides gets the answer the whole budget would give (a
     resource-bounded search with a smaller bound is a prefix of the same

@@ -186,7 +186,7 @@ def bounded_solver(*tactics: str, rlimit: int = RETRY_RLIMIT) -> z3.Solver:
     mapped back to the query's symbols).  Its wall-clock safety net,
     :data:`SAFETY_TIMEOUT_MS`, is registered with
     :func:`.wallclock.note_limit`: a check it cuts counts as cut, never
-    as the budget's ``unknown`` (issue 67)."""
+    as the budget's ``unknown``."""
     ctx = z3.Context()
     s = z3.Then(*tactics, ctx=ctx).solver() if len(tactics) > 1 else z3.Solver(ctx=ctx)
     s.set("rlimit", rlimit)
@@ -269,7 +269,7 @@ def retry_order(formulas: Sequence[z3.BoolRef], *, ladder: bool, models_first: b
     (when there is a quantifier).
 
     With ``ladder`` (the first attempt had only a small first budget:
-    decide first with what decides, issue 44): finite instantiation first,
+    decide first with what decides): finite instantiation first,
     an equivalent query over the finite domains written out; then the two
     MBQI variants; the default strategy with its whole budget
     (:data:`DEFAULT`) last: it is more of the search that just gave up,

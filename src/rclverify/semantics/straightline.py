@@ -1,7 +1,7 @@
 """One RCL formula of one node compiled into a straight-line Python function
 that evaluates it in exact arithmetic on concrete values, as the direct
 evaluator does (:func:`rclverify.semantics.evaluate.evaluate`), for the
-monitors' hot path (issue 44: "compile each guarantee once into
+monitors' hot path ("compile each guarantee once into
 straight-line Python").
 
 The function (:attr:`Straight.fn`) takes the values (``"in.r"`` -> value,

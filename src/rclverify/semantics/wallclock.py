@@ -1,5 +1,5 @@
 """The wall-clock safety net of every Z3 query, and how its firing is told
-apart from the deterministic budget (issue 67; docs/decisions.md,
+apart from the deterministic budget (docs/decisions.md,
 "Results never depend on the wall clock").
 
 A query's budget is Z3's resource counter (``rlimit``): the same steps on

@@ -146,7 +146,7 @@ class Workspace:
             entries={n: tuple(e.config for e in es) for n, es in plan.evidence.items()},
             requirement_dirs=tuple(d for d, _ in plan.requirements_from),
             ros=dict(getattr(plan, "ros", None) or {}),
-            # every node between a deadline's ends: the slowest path may leave the named one (issue 48)
+            # every node between a deadline's ends: the slowest path may leave the named one
             deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))))
 
     @cached_property

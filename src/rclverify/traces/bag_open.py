@@ -1,4 +1,4 @@
-"""A ROS 2 sqlite3 bag opened through ``rosbags`` without counting its messages (issue 67).
+"""A ROS 2 sqlite3 bag opened through ``rosbags`` without counting its messages.
 
 Opening a sqlite3 bag, ``rosbags`` (0.11) asks the database for each
 topic's message count (a ``LEFT JOIN`` of ``topics`` and ``messages``

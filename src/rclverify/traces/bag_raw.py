@@ -1,4 +1,4 @@
-"""A ROS 2 bag's messages as raw columns, in ``rosbags``' own order, without its generators (issue 67).
+"""A ROS 2 bag's messages as raw columns, in ``rosbags``' own order, without its generators.
 
 :func:`~.bag.read_bag` takes a bag's messages from ``rosbags``' high-level
 reader (``AnyReader.messages()``), which hands over one ``(connection,

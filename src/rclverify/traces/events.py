@@ -42,7 +42,7 @@ class Event:
                  stamp: float | None = None) -> None:
         # Frozen: each attribute is set once, here, in the instance's dict (the dataclass's own
         # __init__ goes through object.__setattr__ per field, twice as slow, and a run has
-        # millions of events: issue 44)
+        # millions of events)
         d = self.__dict__
         d["index"], d["time"], d["topic"], d["fields"], d["where"], d["stamp"] = index, time, topic, fields, where, stamp
 

@@ -83,7 +83,7 @@ def read_lines(path: Path, chunks: Iterable[bytes], lineno: int = 0, index: int 
                     obj: Any = fast(raw)
                 except fast_error:
                     obj = None
-                except RecursionError:  # a value nested deeper than any reader goes (issue 63, row 12)
+                except RecursionError:  # a value nested deeper than any reader goes
                     raise TraceError(f"{path}:{lineno}:1: error: the line nests arrays or objects too deeply to "
                                      "read (thousands of levels); no message is that deep") from None
                 if type(obj) is not dict:  # what msgspec rejects, a blank line, or a value that is no object

@@ -1,4 +1,4 @@
-"""ROSMonitoring's log read a block of lines at a time, as columns (the offline batch path, issue 51).
+"""ROSMonitoring's log read a block of lines at a time, as columns (the offline batch path).
 
 :func:`~.jsonl.read_jsonl` makes an :class:`~.events.Event` per line; the
 offline batch path (``backends/monitors/batch.py``) needs, for most lines,
@@ -31,7 +31,7 @@ most :data:`MAX_KEYS`) for the next blocks.  Lines are split as the exact
 reader splits them: after ``\\n``, and at a bare ``\\r``.
 
 Before that, a whole read (:data:`BLOCK_BYTES`, cut after its last
-``\\n``) is tried **at once** (issue 67): one msgspec ``decode_lines``
+``\\n``) is tried **at once**: one msgspec ``decode_lines``
 call into a *flat* struct (the same keys, every value but the topic and
 the time a JSON scalar: string, number, boolean or null; the time a
 number), taken only when the read has no ``\\r``, every line begins with

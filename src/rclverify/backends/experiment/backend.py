@@ -141,7 +141,7 @@ class ExperimentBackend:
             return evidence("inconclusive", f"the criterion {cfg.criterion_text} holds on the reported figures "
                             f"({figures}), but they establish nothing{flag_text}", **kw)
         text = expr_to_rcl(target.node.node.guarantees[cfg.guarantee - 1].formula)
-        if cfg.answers is None:  # bound to a number only: the text may have changed under it (issue 63)
+        if cfg.answers is None:  # bound to a number only: the text may have changed under it
             return evidence("pending", f"the criterion {cfg.criterion_text} holds on the data in {cfg.file} "
                             f"({figures}), but the plan entry does not say which text of guarantee {cfg.guarantee} "
                             f"the experiments support: add answers: \"{text}\" if they support it", **kw)

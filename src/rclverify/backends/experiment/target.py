@@ -1,4 +1,4 @@
-"""An experiment entry's statistical target (issue 68; docs/statistics.md).
+"""An experiment entry's statistical target (docs/statistics.md).
 
 With ``target: violation probability <= 5e-2 at 95 %`` an experiment entry
 exports a second obligation beside its criterion's: "the trials bound the

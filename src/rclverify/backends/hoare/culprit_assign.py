@@ -1,4 +1,4 @@
-"""The assignment a refuted Hoare triple blames (issue 64): the statement
+"""The assignment a refuted Hoare triple blames: the statement
 whose value breaks the post-condition.
 
 A triple refuted with a counterexample has Z3's initial values of the

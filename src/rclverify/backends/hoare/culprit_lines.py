@@ -1,4 +1,4 @@
-"""The program lines a refuted Hoare triple blames (issue 48): the numeric
+"""The program lines a refuted Hoare triple blames: the numeric
 constants its conditions compare with, in source order.
 
 A triple refuted on a threshold is the program comparing with another

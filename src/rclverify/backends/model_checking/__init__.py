@@ -1,4 +1,4 @@
-"""Program model checking of Gwendolen agents with SPIN (issue 31).
+"""Program model checking of Gwendolen agents with SPIN.
 
 Two stages, as AJPF does when it exports to SPIN (Dennis, Fisher, Webster,
 "Two-stage agent program verification"): stage one explores the agent

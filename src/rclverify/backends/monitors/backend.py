@@ -142,7 +142,7 @@ class MonitorsBackend:
         out = []
         names = [Path(t).name for t in cfg.traces]
         for trace in cfg.traces:
-            # the file's name, or its whole path where two traces share a name (issue 63, row 12)
+            # the file's name, or its whole path where two traces share a name
             stem = (Path(trace).name if names.count(Path(trace).name) == 1 else trace).replace(".", "_").replace("/", "_")
             oid = make_obligation_id(node.name, 0, NAME, stem)
             statement = (f"the run recorded in {trace} satisfies the contract of {node.name}: every input event "

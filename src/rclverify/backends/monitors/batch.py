@@ -1,6 +1,6 @@
 """The offline batch path: one node's contract judged on a whole recorded trace, column-wise.
 
-Offline, a run is a batch (issue 51): most of it is a node answering each
+Offline, a run is a batch: most of it is a node answering each
 input message with one output message, every formula far from its
 boundaries.  This module reads the trace in chunks (:data:`CHUNK` events;
 :mod:`.rows`: a list of events, or a block of a ROSMonitoring log read as

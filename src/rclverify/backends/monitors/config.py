@@ -131,7 +131,7 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
         if not (root / str(t)).exists():
             raise ConfigError(f"no such trace: {t}", "traces", k)
         norm = posixpath.normpath(str(t))
-        if norm in seen:  # one run, two obligations of one id: refused where it is written (issue 63, row 12)
+        if norm in seen:  # one run, two obligations of one id: refused where it is written
             raise ConfigError(f"trace {t} is listed twice (also as traces[{seen[norm]}])", "traces", k)
         seen[norm] = k
     try:

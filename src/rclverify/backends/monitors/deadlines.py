@@ -1,4 +1,4 @@
-"""Deadlines of timed guarantees checked against message stamps (issue 33).
+"""Deadlines of timed guarantees checked against message stamps.
 
 A guarantee ``G(phi) triggered by in.x within d`` (rule D1,
 docs/decisions.md) is monitored per trigger event: the event on ``in.x``
@@ -16,7 +16,7 @@ ROSMonitoring's terms:
 * ``currently_false``: not answered yet and the deadline not yet expired (a
   run that ends then, or a live query before the deadline).
 
-**Only accepted inputs are obligations** (issue 40): the node's assumption
+**Only accepted inputs are obligations**: the node's assumption
 is judged on the trigger's inputs; a trigger whose inputs violate it (or
 whose inputs are not all observed yet, or whose assumption cannot be
 decided) gets no deadline verdict and is counted apart

@@ -1,4 +1,4 @@
-"""A node's declarations judged on a recorded run (issue 64).
+"""A node's declarations judged on a recorded run.
 
 A node's ``initially( F )``, ``progress( ... )`` and ``periodic( out.y, P )``
 (docs/rcl-language.md, "Progress, initial values and periodic outputs") are

@@ -1,4 +1,4 @@
-"""What a monitoring run was asked to judge and did not (issue 62: silence is never green).
+"""What a monitoring run was asked to judge and did not (silence is never green).
 
 ``rclverify monitor`` (a recorded run or ``--live``) is asked to judge the
 monitored contracts' **items**: each node, each topic its ``topics(...)``

@@ -5,7 +5,7 @@ docs/semantics.md: an output answers the question in force **at its stamp**
 them in.  A recorded log holds messages in the order its logger got them,
 and a live monitor's reorder window (``online.py``) bounds only how late a
 message may be to be put in its place; so an input may be heard after an
-output stamped after it was judged (issue 63, row 3: a reading stamped 1.2 s
+output stamped after it was judged (a reading stamped 1.2 s
 logged after the status stamped 1.5 s, which was judged against the reading
 at 1.0 s: "satisfied", a wrong green).  :meth:`Late._late_input` puts the
 input at its stamp:

@@ -1,4 +1,4 @@
-"""A live run's service calls and action goals judged again from its log (issue 62: live = offline).
+"""A live run's service calls and action goals judged again from its log (live = offline).
 
 ``rclverify monitor --live --ros2`` judges each call and each goal as a
 trace of its own (:mod:`.dds_calls`) and writes every call part, pairing

@@ -5,7 +5,7 @@ The monitor evaluates a question's guarantees when the question comes
 the state outputs, before any answer: a guarantee whose inputs alone decide
 it (``in.on -> ...`` with ``in.on`` false) is ``satisfied`` or failed there.
 For most guarantees the evaluation only meets a missing output, and that
-costs about a fifth of the engine's time on a classifier (issue 44).
+costs about a fifth of the engine's time on a classifier.
 
 :func:`answer_decides` asks Z3 once per node whether **no** value of the
 inputs decides a guarantee without the outputs: neither ``forall out. G``
@@ -134,7 +134,7 @@ def _decides(checked: Checked, node: CheckedNode, formulas: list[ast.Expr]) -> b
         typed = conj(*enc.axioms()) if enc.axioms() else z3.BoolVal(True)
         for g in encoded:
             for goal in (g, z3.Not(g)):
-                s = budgeted_solver(QUERY_MS)  # resource steps decide, not the clock (issue 67)
+                s = budgeted_solver(QUERY_MS)  # resource steps decide, not the clock
                 s.add(z3.ForAll(outs, z3.Implies(typed, goal)) if outs else goal)
                 if s.check() != z3.unsat:  # a value of the inputs decides it (or Z3 cannot say)
                     return False

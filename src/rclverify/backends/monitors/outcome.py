@@ -5,7 +5,7 @@ An output message is judged against the question it answers and on its own
 more than one question (docs/semantics.md, "Transport skew").  Each reading
 gives an :class:`Outcome`; :func:`combine` gives the message's verdict: a
 verdict is given only where every reading agrees, never ``satisfied`` where
-one reading finds the output false (no wrong green, issue 39), never
+one reading finds the output false (no wrong green), never
 ``violated`` where one reading finds it right (no false alarm).
 """
 from __future__ import annotations

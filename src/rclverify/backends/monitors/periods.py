@@ -1,4 +1,4 @@
-"""Periodic outputs checked against message stamps (issue 40).
+"""Periodic outputs checked against message stamps.
 
 A node's ``periodic( out.y, 100 ms )`` (docs/rcl-language.md, "Progress,
 initial values and periodic outputs") says the node refreshes ``out.y`` at

@@ -1,4 +1,4 @@
-"""The bounded response pattern on a recorded run (issue 48).
+"""The bounded response pattern on a recorded run.
 
 ``always (P -> eventually[<= N] Q)`` and ``always (P -> next Q)`` read step
 by step, with the finite-trace verdicts of :mod:`.temporal_trace`: a

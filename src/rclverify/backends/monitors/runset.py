@@ -1,4 +1,4 @@
-"""Monitored runs counted, and a plan's statistical target judged on them (issue 68; docs/statistics.md).
+"""Monitored runs counted, and a plan's statistical target judged on them (docs/statistics.md).
 
 * :func:`run_counts` - what one run's evidence saw (``details["statistics"]``
   of every monitors record): the run's digest, how it was recorded

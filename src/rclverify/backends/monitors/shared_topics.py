@@ -1,4 +1,4 @@
-"""One topic, several variables: distinct fields or a located error (issue 64).
+"""One topic, several variables: distinct fields or a located error.
 
 A node may map two of its variables to one topic (``topics(geometry_msgs/Point
 target matches(in.x), geometry_msgs/Point target matches(in.y))``).  The

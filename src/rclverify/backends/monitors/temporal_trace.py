@@ -26,7 +26,7 @@ values when it cannot, then the nodes' double arithmetic and the mapping's
 tolerance, docs/monitors.md "Numbers on the wire"; a witness of an operand
 that held only there names the semantics).  A variable not observed yet has
 no value, and an operand reading one is not evaluated at that step (the one
-stream model, docs/semantics.md, issue 47): ``always F`` constrains
+stream model, docs/semantics.md): ``always F`` constrains
 published values only, ``eventually F`` (``next``, the right of ``until``)
 needs ``F`` on published values; a declared state variable without a value
 leaves what reads it undecided.

@@ -130,7 +130,7 @@ def solve_value(sf: StateFormula, checked: Checked, target: str, values: Mapping
         if funcs:
             phi = z3.substitute_funs(phi, *funcs)
         s = z3.Solver()
-        wallclock.limit(s, TIMEOUT_MS)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(s, TIMEOUT_MS)  # steps decide, the clock is a net
         s.add(phi)
         if s.check() != z3.sat:
             return None
@@ -185,7 +185,7 @@ class TraceStates:
         self.steps = 0
         self.problem = ""
         #: scope keys (``"in.Node.in.x"``) whose last message could not be read (a string for a REAL, NaN, a
-        #: bool): no value, and what reads them is undecided, never judged on the value before (issue 63, row 5)
+        #: bool): no value, and what reads them is undecided, never judged on the value before
         self.unreadable: dict[str, str] = {}
 
     def _node_values(self, n: str) -> dict[str, Any]:

@@ -1,4 +1,4 @@
-"""A failing example shown at the boundary the contract names (issue 48).
+"""A failing example shown at the boundary the contract names.
 
 Hypothesis shrinks a failure to a minimal example in its own order, which
 for a number is often one that draws the eye to rounding

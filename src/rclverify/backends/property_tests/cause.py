@@ -1,11 +1,11 @@
-"""The implementation line a failing example takes (issue 48).
+"""The implementation line a failing example takes.
 
 A property-test failure is the implementation's, not the contract's: the
 place to look is the line of the implementation that produced the wrong
 output (the branch taken), not the guarantee it violates.  The failing
 example is run once more under :func:`sys.settrace`, tracing only the
 frames of the implementation's own file.  The cause is the statement that
-computed the value returned (issue 64): the tracer follows the entry
+computed the value returned: the tracer follows the entry
 frame's bytecode (``f_trace_opcodes``) and records the line of each store
 of a local variable, and the line that last assigned a local the ``return``
 statement reads and the returned output

@@ -1,4 +1,4 @@
-"""Every constant a node's contract or code compares with (issue 64).
+"""Every constant a node's contract or code compares with.
 
 An off-by-one threshold (``<`` where the guarantee says ``<=``) shows only
 at the threshold itself, and a random float lands on it almost never; so
@@ -108,7 +108,7 @@ def _compared_in(source: str) -> tuple[tuple[Fraction, ...], frozenset[str]] | N
     not parse), once per text and process: a run imports its implementation
     afresh, but a module shared by many nodes' entries was parsed and walked
     again by each of their runs (65 ms a run for the 5000-node system's
-    30 KB module, issue 67); the result is a function of the text alone."""
+    30 KB module); the result is a function of the text alone."""
     try:
         tree = pyast.parse(source)
     except (SyntaxError, ValueError):

@@ -1,5 +1,5 @@
-"""How much of the assumption's ranges a property-test run covered (issue 50;
-docs/confidence.md, "tested").
+"""How much of the assumption's ranges a property-test run covered
+(docs/confidence.md, "tested").
 
 For each input of the node, over the valid examples only (those the
 assumption and the facts admitted, which the implementation ran on):

@@ -1,4 +1,4 @@
-"""A node's declarations checked on its implementation (issue 64).
+"""A node's declarations checked on its implementation.
 
 The property tests call the implementation on inputs drawn under the
 node's assumption (docs/property-tests.md), and each call must return every

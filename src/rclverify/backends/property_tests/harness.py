@@ -333,7 +333,7 @@ class GuaranteeRun:
                 test()
         except _Violation:
             assert self.last_failure is not None
-            from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line (issue 48); deferred: optional or conditional (inside a block)
+            from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line; deferred: optional or conditional (inside a block)
             moved = readable_failure(self, _Violation)
             unconfirmed = self._unconfirmed()
             if unconfirmed is not None:

@@ -1,4 +1,4 @@
-"""A property-test failure as a person reads it (issue 48): the example at
+"""A property-test failure as a person reads it: the example at
 the boundary the contract names (:mod:`.boundary`) and the implementation
 line it takes (:mod:`.cause`), folded into the harness's counterexample."""
 from __future__ import annotations

@@ -50,7 +50,7 @@ HEALTH_TIMEOUT_MS = 5_000
 INSTANCE_TIMEOUT_MS = 2_000
 GIVE_UP_AFTER = 3
 #: With an instance range, the first budgets of the general non-vacuity query
-#: and of each instance (issue 44, "decide first with what decides"; see
+#: and of each instance ("decide first with what decides"; see
 #: :func:`_non_vacuity`).  The case study's instances each take about 25,000
 #: Z3 steps (0.2 of :data:`INSTANCE_FIRST_MS`); its guarantee 1's general
 #: query takes its whole budget and decides nothing.
@@ -172,7 +172,7 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     are ``inconclusive`` ("took longer than N s", :func:`_cut_short`): the
     cut changed the path (the next instance of a scan, another subset of
     guarantees) and the state of the shared solver, so their models and
-    cores could differ from what the budget alone decides (issue 67)."""
+    cores could differ from what the budget alone decides."""
     with wallclock.watch() as w:
         cuts: list[int] = []
         out = _check_node(checked, node, facts, instances, timeout_ms, lambda k: cuts.append(k) if w.cut else None)
@@ -315,7 +315,7 @@ def _non_vacuity(h: _NodeHealth, n: str, k: int) -> Finding | None:
         return _noted(replace(_premise_finding(h, n, k, r, ptext), smt2=r.smt2), r)
     # With an instance range the scan decides where the general query cannot; the retries of
     # semantics/retry.py are not tried (the Agent's guarantee 1: 4 CPU s of retries that all give up).
-    # Decide first with what decides (issue 44): the general query with a small budget (what it decides
+    # Decide first with what decides: the general query with a small budget (what it decides
     # there, its whole budget decides the same way), then each instance with a small budget; the general
     # query gets its whole budget only when no instance was found vacuous.
     r = h.sat(extra, comment=comment, retry=False, timeout_ms=min(h.timeout, SCAN_FIRST_MS))

@@ -201,7 +201,7 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
     ``inconclusive`` ("took longer than N s"), never the model of the path
     the cut led to: the search for the conflicting guarantees moves on to
     the next subset when one is undecided, so a cut would show another
-    input and other guarantees than the budget finds (issue 67)."""
+    input and other guarantees than the budget finds."""
     with wallclock.watch() as w:
         found = _realizability(checked, node, facts, instances)
     if not w.cut:

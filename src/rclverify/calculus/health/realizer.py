@@ -153,7 +153,7 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
     showed it (unsat); ``None`` when the template cannot, or the rounds or
     a check's budget run out."""
     answered = z3.substitute(body, *[(o, _expr(t)) for o, t in zip(outs, terms)])
-    # made when the first input is to be added (_first_model); made first, as before issue 67, without
+    # made when the first input is to be added (_first_model); made first, as before, without
     # FIRST_ROUND_UNASKED (the reference path of tests/test_health_fast.py)
     synth: z3.Solver | None = None if FIRST_ROUND_UNASKED else budgeted_solver(CHECK_MS)
     for _ in range(ROUNDS):
@@ -189,7 +189,7 @@ def _first_model(params: Sequence[z3.ExprRef]) -> z3.ModelRef:
     completion) each parameter takes its sort's default value, the value an
     empty model made here gives too (the same evaluator).  A fresh solver's
     check costs about a millisecond, most of a small contract's
-    realizability check (issue 67)."""
+    realizability check."""
     ctx = params[0].ctx if params else z3.main_ctx()
     return z3.ModelRef(z3.Z3_mk_model(ctx.ref()), ctx)
 

@@ -3,7 +3,7 @@
 The consistency and vacuity checks (:mod:`.checks`) and the shape checks
 (:mod:`.shape`) each keep an encoder of their own: its symbol table
 decides their typing axioms and the symbols a model shows.  Each encoded
-the node's assumption and guarantees again (issue 67: with
+the node's assumption and guarantees again (with
 realizability's, a fifth of a small node's health stage; realizability
 keeps encoding on its own, see :func:`.checks.check_node`'s comment).
 :class:`SharedEncoder` keeps that

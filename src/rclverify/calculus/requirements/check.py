@@ -79,7 +79,7 @@ NEGATED = "negated requirement"
 #: first attempt hands over to them sooner (an unknown is never upgraded).
 MODEL_TIMEOUT_MS = 1_000
 #: The budget of the general query's first look at the consistency and
-#: vacuity queries (decide first with what decides, issue 44): an unsat
+#: vacuity queries (decide first with what decides): an unsat
 #: answer (a vacuous requirement, an inconsistent proof) comes at once;
 #: what it does not decide goes to a finite-table witness (function-typed
 #: inputs), then to the general query with :data:`MODEL_TIMEOUT_MS` and its
@@ -227,7 +227,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         mentioned = {enc.symbol_name(n, p, v) for f in (formal,) for n, p, v in f.mentions}
         hit = [lbl for lbl, syms in q.g_symbols.items() if syms & mentioned]
         first = [l for l in hit if l in traced] or hit
-        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values (issue 48); deferred: optional or conditional (inside a block); deferred: optional or conditional (inside a block)
+        from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values; deferred: optional or conditional (inside a block); deferred: optional or conditional (inside a block)
         shown, note = readable_counterexample(q.labelled, r.model or {}, cone, checked, model, enc)
         out.update(verdict="refuted", counterexample=_counterexample(shown, cone, checked, enc),
                    failed_to_prevent=[q.by_label[l] for l in first], **note)

@@ -53,7 +53,7 @@ from rclverify.semantics.query import tactic_solver
 
 #: A deadlock query is first asked of Z3's default solver for this many milliseconds' worth of resource
 #: steps: most are answered there in a few ms, where the quantifier elimination that leads
-#: :func:`_attempts` takes about 100 ms whatever the query (issue 67).  Its ``sat`` (a model Z3's
+#: :func:`_attempts` takes about 100 ms whatever the query.  Its ``sat`` (a model Z3's
 #: model-based instantiation checked) and ``unsat`` are answers; its ``unknown`` goes to the ladder.
 FIRST_LOOK_MS = 250
 #: The step-by-step search of :func:`find_deadlock` stops (``inconclusive``)
@@ -139,7 +139,7 @@ def _check(solver: z3.Solver, extra: Sequence[z3.BoolRef], timeout_ms: int) -> t
 
 def _solver(timeout_ms: int) -> z3.Solver:
     s = z3.Solver()
-    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
     return s
 
 
@@ -167,7 +167,7 @@ def find_deadlock(ts: TransitionSystem, bound: int, *, staying: Pred | None = No
     states = [ts.state(0)]
     s.add(ts.init(states[0]))
     # the whole search's budget in Z3 resource steps (the context's counter, read through any of its
-    # solvers), so that where it stops does not depend on the machine's load (issue 67)
+    # solvers), so that where it stops does not depend on the machine's load
     start, total = wallclock.steps_taken(s), wallclock.steps(SEARCH_BUDGET * timeout_ms)
     for k in range(bound):
         if wallclock.steps_taken(s) - start > total:

@@ -1,4 +1,4 @@
-"""Declarations that follow from the node's other declarations (issue 64).
+"""Declarations that follow from the node's other declarations.
 
 A declaration a requirement's proof uses needs evidence (calculus/requirements/rollup.py);
 where it follows from other declarations of the same node, their evidence is

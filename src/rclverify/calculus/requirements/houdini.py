@@ -115,7 +115,7 @@ def generate(ts: TransitionSystem, prop: Pred, timeout_ms: int, budget_ms: int) 
     why no invariant was generated (a solver ``unknown``, the budget spent,
     the wall-clock net).  ``timeout_ms`` bounds each query, ``budget_ms``
     all of them, both as Z3 resource steps (:func:`.wallclock.steps`: the
-    same queries decide on a loaded machine; issue 67)."""
+    same queries decide on a loaded machine)."""
     left = [wallclock.steps(budget_ms)]
     a, b = ts.state(0, "hou"), ts.state(1, "hou")
 

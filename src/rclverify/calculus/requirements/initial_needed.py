@@ -1,4 +1,4 @@
-"""Which ``initially`` declarations a temporal proof needs (issue 64).
+"""Which ``initially`` declarations a temporal proof needs.
 
 A temporal proof over the composed system uses every premise of its cone
 (:mod:`.temporal_check`: an induction has no unsat core), and the roll-up

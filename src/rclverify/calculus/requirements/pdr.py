@@ -136,7 +136,7 @@ def spacer_invariant(ts: TransitionSystem, prop: Pred, timeout_ms: int) -> HornA
     t0 = time.perf_counter()
     try:
         h = z3.SolverFor("HORN", ctx=own)
-        wallclock.limit(h, timeout_ms)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(h, timeout_ms)  # steps decide, the clock is a net
         h.add(z3.ForAll(av, z3.Implies(conj(*init_own) if init_own else z3.BoolVal(True, own), rel(*av))))
         h.add(z3.ForAll(av + bv, z3.Implies(conj(rel(*av), *trans_own), rel(*bv))))
         h.add(z3.ForAll(av, z3.Implies(conj(rel(*av), bad_own), z3.BoolVal(False, own))))
@@ -185,7 +185,7 @@ def recheck(ts: TransitionSystem, prop: Pred, inv: z3.BoolRef, timeout_ms: int) 
                        (conj(inv, ts.trans(a, b), z3.Not(_prime(ts, inv))), "a step leaves it"),
                        (conj(inv, z3.Not(prop(a))), "it does not imply the property")):
         s = z3.Solver()
-        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
         s.add(cond)
         r = s.check()
         if r == z3.sat:

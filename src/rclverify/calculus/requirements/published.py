@@ -1,4 +1,4 @@
-"""Published values in the composed transition system (issue 47).
+"""Published values in the composed transition system.
 
 docs/semantics.md, "Temporal requirements": the temporal checker reads the
 stream model every monitor reads.  A topic holds no value until its first

@@ -1,4 +1,4 @@
-"""A refuted requirement's counterexample as a person reads it (issue 48).
+"""A refuted requirement's counterexample as a person reads it.
 
 The requirement's query (:mod:`.check`) holds the cone's guarantees and its
 environment assumptions, not the internal conjuncts of the assumptions

@@ -1,4 +1,4 @@
-"""The bounded response pattern over the composed system (issue 48).
+"""The bounded response pattern over the composed system.
 
 ``always (P -> eventually[<= N] Q)``, FRET's "whenever P, within N steps
 Q" (Giannakopoulou et al., "Generation of formal requirements from
@@ -143,7 +143,7 @@ def check_unbounded_response(ts: TransitionSystem, trigger: Pred, goal: Pred, *,
     for n in range(1, max_k + 1):
         states, steps = unroll(ts2, n)
         sv = z3.Solver()
-        wallclock.limit(sv, timeout_ms)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(sv, timeout_ms)  # steps decide, the clock is a net
         loops = [conj(*[states[n][v] == states[j][v] for v in ts2.sorts], fair.loop(states, j, n),
                         *[st["<pending>"] for st in states[j:n + 1]]) for j in range(n)]
         sv.add(ts2.init(states[0]), *steps, disj(*loops))

@@ -32,7 +32,7 @@ node never answers                 progress is named)
 =================================  ==========================  ==================================
 
 A declaration the proof uses (``progress``, ``initially``, a period in
-steps) is evidenced like a guarantee (issue 64): the ``monitors`` backend
+steps) is evidenced like a guarantee: the ``monitors`` backend
 judges it on every recorded run of its node and the ``property_tests``
 backend on the node's implementation, each record carrying a row per
 declaration (``details.declarations``, backends/monitors/declarations.py);
@@ -238,7 +238,7 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     if v != "proved" and record.get("recorded_verdict") == "proved" and isinstance(record.get("solvers"), dict):
         return "inconclusive", "inconclusive", (f"Z3 proved it, but the second solver does not confirm it "
                                                 f"({record['solvers'].get('why')}): not proved (docs/second-solver.md)")
-    if v != "proved" and record.get("temporal"):  # the detail says what was tried and the next step (issue 64)
+    if v != "proved" and record.get("temporal"):  # the detail says what was tried and the next step
         return "inconclusive", "inconclusive", f"not proved: {record.get('reason', 'undecided')}"
     if v != "proved":
         return "inconclusive", "inconclusive", f"Z3 could not decide it ({record.get('reason', 'unknown')}); not proved"

@@ -74,7 +74,7 @@ def induction_step(ts: TransitionSystem, inside: Pred, timeout_ms: int,
     when Z3 cannot say."""
     a, b = ts.state(0, "cti"), ts.state(1, "cti")
     s = z3.Solver()
-    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
     s.add(inside(a), ts.trans(a, b), z3.Not(inside(b)))
     r = s.check()
     if r == z3.unsat:

@@ -58,7 +58,7 @@ def check_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10,
     for k in range(1, max_k + 1):
         states, steps = unroll(ts, k - 1)
         base = z3.Solver()
-        wallclock.limit(base, timeout_ms)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(base, timeout_ms)  # steps decide, the clock is a net
         base.add(ts.init(states[0]), *steps)
         base.add(z3.Not(prop(states[-1])))
         r = base.check()
@@ -71,7 +71,7 @@ def check_always(ts: TransitionSystem, prop: Pred, *, max_k: int = 10,
                                    detail=f"solver: {base.reason_unknown()}")
         states, steps = unroll(ts, k)
         ind = z3.Solver()
-        wallclock.limit(ind, timeout_ms)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(ind, timeout_ms)  # steps decide, the clock is a net
         ind.add(*steps, *[prop(s) for s in states[:-1]], *distinct(states))
         ind.add(z3.Not(prop(states[-1])))
         if ind.check() == z3.unsat:
@@ -93,7 +93,7 @@ def check_eventually_within(ts: TransitionSystem, prop: Pred, bound: int, *,
     """
     states, steps = unroll(ts, bound)
     s = z3.Solver()
-    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
     s.add(ts.init(states[0]), *steps, *[z3.Not(prop(st)) for st in states])
     r = s.check()
     if r == z3.sat:
@@ -130,7 +130,7 @@ def check_next(ts: TransitionSystem, prop: Pred, *, timeout_ms: int = 10_000) ->
     unknown."""
     a, b = ts.state(0), ts.state(1)
     s = z3.Solver()
-    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
     s.add(ts.init(a), ts.trans(a, b), z3.Not(prop(b)))
     r = s.check()
     if r == z3.sat:
@@ -252,7 +252,7 @@ def _ranking_fails(ts: TransitionSystem, prop: Pred, inv: Pred, ranking: Callabl
     for cond, text in ((ranking(a) >= 0, "is not >= 0"),
                        (ranking(b) < ranking(a), "does not decrease on every step")):
         s = z3.Solver()
-        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
         s.add(inv(a), z3.Not(prop(a)), ts.trans(a, b), z3.Not(cond))
         r = s.check()
         if r != z3.unsat:
@@ -290,7 +290,7 @@ def find_lasso(ts: TransitionSystem, prop: Pred, bound: int, *,
         steps.append(ts.trans(states[n - 1], states[n]))
         misses.append(z3.Not(prop(states[n])))
         s = z3.Solver()
-        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+        wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
         same = [conj(*[states[n][v] == states[j][v] for v in ts.sorts], fair.loop(states, j, n))
                 for j in range(n)]
         s.add(init, *steps, *misses, disj(*same))

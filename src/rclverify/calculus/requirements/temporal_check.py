@@ -114,7 +114,7 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
     verdict ``v`` on an unbounded ``eventually F`` over ``ts`` is
     inconclusive (the finite-table lasso search of :func:`check_temporal`);
     with ``tables_first`` (the system has function-typed variables, over
-    which Z3's general bounded query seldom decides: issue 44, "decide first
+    which Z3's general bounded query seldom decides: "decide first
     with what decides") it is asked first, on the system in which every node
     answers what it accepts, and a confirmed lasso there is the verdict
     without the general query;
@@ -276,7 +276,7 @@ def _proved(out: dict[str, Any], sys: ComposedSystem, ctx: _Question) -> None:
     met), and the ``initially`` declarations the proof does not need."""
     a, b = sys.ts.state(0), sys.ts.state(1)
     s = z3.Solver()
-    wallclock.limit(s, ctx.timeout_ms)  # steps decide, the clock is a net (issue 67)
+    wallclock.limit(s, ctx.timeout_ms)  # steps decide, the clock is a net
     s.add(sys.ts.init(a), sys.ts.trans(a, b))
     r = s.check()
     used = sys.premises

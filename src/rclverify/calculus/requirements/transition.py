@@ -130,7 +130,7 @@ class ComposedSystem:
         why = ""
         for n, holds in self.initial.items():
             s = z3.Solver()
-            wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net (issue 67)
+            wallclock.limit(s, timeout_ms)  # steps decide, the clock is a net
             s.add(holds(self.ts.state(0, "initially")))
             r = s.check()
             if r == z3.unsat:

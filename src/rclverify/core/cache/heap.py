@@ -46,7 +46,7 @@ tables are blocks large enough for glibc's ``malloc`` to map them with
 ``mmap`` and hand them back with ``munmap`` (measured in a doit run of a
 200-node chain, not in a small process), so each context paid page faults
 for the memory it touched: 8 ms instead of 0.7 ms, and a quarter of
-``rclverify verify``'s CPU seconds there (issue 51; docs/scale.md).
+``rclverify verify``'s CPU seconds there (docs/scale.md).
 """
 from __future__ import annotations
 

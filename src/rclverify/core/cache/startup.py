@@ -1,5 +1,5 @@
 """What ``rclverify monitor`` computes at every start from its inputs' content alone, kept between
-runs in the user's cache (issue 67: the command's start-up, docs/scale.md).
+runs in the user's cache (the command's start-up, docs/scale.md).
 
 Before it reads a trace the command parsed the contracts (lark), checked
 the plan against its JSON schema (jsonschema), rendered each monitored

@@ -1,4 +1,4 @@
-"""A liveness requirement's ``ranking:`` and ``invariant:`` (issue 34).
+"""A liveness requirement's ``ranking:`` and ``invariant:``.
 
 An unbounded ``eventually P`` (or the liveness part of ``F until P``) is
 proved only through a ranking function the user supplies
@@ -15,7 +15,7 @@ proved only through a ranking function the user supplies
 declared state variables, :mod:`.state`).  They are read like ``formal:``:
 every diagnostic lands on the plan's line and column.
 
-Since issue 64 ``invariant:`` is also read for every other temporal
+``invariant:`` is also read for every other temporal
 statement: it strengthens the k-induction that proves ``always F``, the
 response patterns and ``until``'s safety part (docs/requirements.md,
 "Proofs a user can finish").
@@ -87,7 +87,7 @@ def parse_hints(ranking: Source | None, invariant: Source | None, statement: "Te
     :class:`RclError` with every located error: ``E-temporal`` at a
     ``ranking:`` given on a statement that is not liveness (:func:`is_liveness`), else
     the errors of :func:`parse_ranking` and :func:`.formal.parse_formal`.
-    An ``invariant:`` is read for every temporal statement (issue 64: it
+    An ``invariant:`` is read for every temporal statement (it
     strengthens the induction that proves a safety pattern, and is the
     ranking function's domain for a liveness one), never for a state
     requirement (``E-temporal``)."""

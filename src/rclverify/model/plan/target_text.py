@@ -1,4 +1,4 @@
-"""A statistical target as the plan writes it (issue 68; docs/statistics.md):
+"""A statistical target as the plan writes it (docs/statistics.md):
 ``violation probability <= 1e-3 at 95 % per run``.  Below the plan's
 values (:mod:`.model`) and its checks (:mod:`.targets`), which both use it;
 the numbers are decided by :mod:`rclverify.records.statistics`.

@@ -1,4 +1,4 @@
-"""Statistical targets, environment tags and run origins in the plan (issue 68; docs/statistics.md).
+"""Statistical targets, environment tags and run origins in the plan (docs/statistics.md).
 
 A ``monitors`` or ``experiment`` evidence entry may state
 

@@ -124,8 +124,7 @@ def upstream_bits(nodes: Sequence[N], preds: dict[N, list[N]]) -> dict[N, int]:
     a loop reach one another), and exactly the least fixpoint of
     ``cone(n) = {n} + cone(p)``.  A worklist fixpoint over a depth-first
     order, as the system model had it, re-propagated each loop's growth down
-    the rest of the system (3 s at 5000 nodes with a loop every tenth node,
-    issue 67)."""
+    the rest of the system (3 s at 5000 nodes with a loop every tenth node)."""
     bit = {n: 1 << i for i, n in enumerate(nodes)}
     mask: dict[N, int] = {}
     for members in strongly_connected_components(nodes, preds):

@@ -217,7 +217,7 @@ def build(checked: Checked, connections: Sequence[Connection] = ()) -> SystemMod
     Raises :class:`RclError` (located at the input's declaration) when an
     input could be fed by several nodes and the plan does not say which.
     A connection whose two ends disagree on the unit of measure does not
-    stop the build (issue 48): :func:`unit_diagnostics` and the check stage
+    stop the build: :func:`unit_diagnostics` and the check stage
     report it (:mod:`.units`).
     """
     nodes = list(checked.nodes)

@@ -22,7 +22,7 @@ so both ends must read it in one unit:
 * neither end declares one: nothing here (the calculus' probable scale
   mismatch, :mod:`rclverify.calculus.scale`, looks at their ranges).
 
-A unit mismatch does not stop a run (issue 48): :func:`rclverify.model.system.model.build`
+A unit mismatch does not stop a run: :func:`rclverify.model.system.model.build`
 builds the model whatever the units, ``rclverify check`` prints the errors
 (both ends of a declared mismatch) and fails, and the check stage records
 each mismatch once, at the producer's end (:func:`producer_diagnostics`), as

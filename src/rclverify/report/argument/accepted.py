@@ -1,4 +1,4 @@
-"""Accepted risks in the argument (issue 64): a warning the plan
+"""Accepted risks in the argument: a warning the plan
 acknowledges with a reason (model/plan/acknowledged.py) stands beside the claim it
 bears on as a GSN *assumption* (``A``), in the context of that claim.
 

@@ -126,7 +126,7 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
 
 def _declaration_goal(b: "_Builder", d: Mapping[str, Any]) -> str:
     """The goal that a declaration a proof used holds of its node's
-    implementation (issue 64), supported by its evidence as the roll-up
+    implementation, supported by its evidence as the roll-up
     reads it (requirements/rollup.declaration_evidence): the monitors' runs,
     the property tests, or the declarations it follows from."""
     label = str(d["label"])
@@ -319,7 +319,7 @@ class _Goals:
         b, rid = self.b, str(r["id"])
         if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
             gid = _requirement_goal(b, own_check(r), self.guarantee_goal, self.sides, self.j_calc)
-            # its deadline (rule D3) and its recorded runs' bounds and targets (statistics.py, issue 68)
+            # its deadline (rule D3) and its recorded runs' bounds and targets (statistics.py)
             return with_statistics(b.els, with_deadline(b.els, gid, r, self.guarantee_goal), r)
         kids: list[str] = []
         nodes_used: list[str] = []

@@ -1,4 +1,4 @@
-"""Assurance claim points (issue 50): where the argument's confidence is
+"""Assurance claim points: where the argument's confidence is
 argued, marked in the form of the GSN Community Standard v3's confidence
 argument extension as gsn2x reads it (jonasthewolf/gsn2x,
 doc/src/ext_confidence.md): an element's ``acp`` maps an ACP name to the

@@ -1,4 +1,4 @@
-"""Confidence over a mixed-method argument (issue 50; docs/confidence.md).
+"""Confidence over a mixed-method argument (docs/confidence.md).
 
 The paper leaves open "the level of confidence we can have in a system
 that has been verified using a mixture of methods; particularly how
@@ -91,7 +91,7 @@ def cones(producers: Mapping[str, Iterable[str]]) -> dict[str, frozenset[str]]:
     over the strongly connected components; a loop's nodes share one cone).
     Iterating the fixpoint over the nodes
     until no cone grew took 1.4 CPU s of each report task at 1000 nodes
-    (docs/scale.md, issue 67); networkx's condensation does the same in
+    (docs/scale.md); networkx's condensation does the same in
     0.1 s, plus 0.1 s to import it in every report process."""
     nodes = sorted(set(producers) | {p for ps in producers.values() for p in ps})
     bits = upstream_bits(nodes, {n: list(producers.get(n, ())) for n in nodes})

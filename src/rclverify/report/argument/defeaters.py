@@ -1,4 +1,4 @@
-"""Counter-evidence in the argument (issue 50): defeaters as the GSN
+"""Counter-evidence in the argument: defeaters as the GSN
 Community Standard v3's dialectic extension draws them (a counter solution
 ``CSn`` that ``challenges`` a claim; the claim marked ``defeated`` where the
 counter-evidence refutes it), in the form gsn2x reads.
@@ -22,7 +22,7 @@ a problem's culprit, failed or error             the guarantee's or the node's  
 
 A defeated claim is never better than what defeats it
 (:func:`.model.propagate`): a culprit guarantee whose own evidence holds
-reads the status of the problem it causes (issue 64).
+reads the status of the problem it causes.
 """
 from __future__ import annotations
 
@@ -68,7 +68,7 @@ def add_defeaters(els: dict[str, Element], report: Mapping[str, Any], ident: Any
             challenge(ident("CSn", "solvers", sc["id"]), ident("G", "sc", sc["id"]),
                       f"The second solver does not confirm {sc['id']}: {s.get('why', '')}", "inconclusive", True,
                       str(s.get("smt2") or ""))
-    for n in report.get("nodes", []):  # a problem's culprit (issue 64): its goal is never "discharged"
+    for n in report.get("nodes", []):  # a problem's culprit: its goal is never "discharged"
         name = str(n["name"])
         for g in [*n.get("guarantees", []), n]:
             target = ident("G", name, f"g{g['index']}") if g is not n else ident("G", name)

@@ -168,7 +168,7 @@ def propagate(arg: Argument) -> Argument:
     their status; contexts and assumptions get ``None``.  A goal marked
     ``defeated`` is never better than the counter solutions that challenge
     it (a culprit guarantee whose own evidence holds reads its problem's
-    status, issue 64).  Raises
+    status).  Raises
     :class:`ArgumentError` via :func:`validate`.
     """
     validate(arg)
@@ -194,7 +194,7 @@ def propagate(arg: Argument) -> Argument:
         else:
             kids = [status(x) for x in e.supported_by]
             s = worst([k for k in kids if k is not None], empty=UNDEVELOPED_STATUS)
-        if e.defeated and s is not None:  # never better than what defeats it (a problem's culprit: issue 64)
+        if e.defeated and s is not None:  # never better than what defeats it (a problem's culprit)
             s = worst([s, *(str(els[c].status) for c in defeaters.get(i, ()) if els[c].status is not None)])
         memo[i] = s
         return s

@@ -1,5 +1,5 @@
 """A requirement's recorded runs as quantified support in the assurance
-argument (issue 68; docs/statistics.md, docs/argument.md).
+argument (docs/statistics.md, docs/argument.md).
 
 Under the goal of a requirement whose recorded runs the report counted
 (``requirements[i]["statistics"]``, :mod:`rclverify.report.statistics`),

@@ -1,4 +1,4 @@
-"""Typed evidence strength (issue 50; docs/confidence.md).
+"""Typed evidence strength (docs/confidence.md).
 
 Every evidence record and side condition of the report carries a
 ``strength``: ``{"kind", "detail", "doubt"}``.
@@ -72,7 +72,7 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
     kind = BACKEND_KIND.get(backend, "assumed")
     detail, doubt = "", DOUBT[kind]
     stats = row.get("statistics") if isinstance(row.get("statistics"), Mapping) else None
-    if stats is not None and "decision" in stats:  # a target's record: its bound is the doubt (issue 68)
+    if stats is not None and "decision" in stats:  # a target's record: its bound is the doubt
         return target_strength(row, stats)
     if backend == "hoare":
         two = (row.get("solvers") or {}).get("agreement") == "two solvers"
@@ -105,7 +105,7 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
             detail += f" over {m['duration_s']:g} s of trace time"
         group = stats.get("group") if stats is not None else None
         if stats is not None and isinstance(group, Mapping) and isinstance(group.get("bound"), (int, float)):
-            # the runs of its node and environment, counted: their bound replaces the convention (issue 68)
+            # the runs of its node and environment, counted: their bound replaces the convention
             doubt = float(group["bound"])
             detail += (f"; {group.get('runs')} run(s) under {stats.get('environment')}: a one-sided "
                        f"{float(group.get('level', 0.95)) * 100:g} % bound of {doubt:.3g} on the probability "

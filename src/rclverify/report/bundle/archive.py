@@ -100,7 +100,7 @@ def _unsafe(name: str) -> bool:
     """Whether member ``name`` may not be believed as a path: absolute, with
     ``..``, a backslash, or not in normal form (``./``, ``//``, a trailing
     ``/``: ``artifacts/./requirements/R.json`` names the same file as a
-    listed member and would shadow it when unpacked; issue 63, row 6)."""
+    listed member and would shadow it when unpacked)."""
     p = PurePosixPath(name)
     return p.is_absolute() or ".." in p.parts or "\\" in name or posixpath.normpath(name) != name \
         or name.startswith("./")

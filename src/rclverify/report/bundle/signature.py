@@ -3,7 +3,7 @@
 The manifest lists every member's sha256 and every record carries its own
 seal, but a seal is a digest anyone can compute again: a bundle whose
 record was swapped and whose seals and manifest were made again passes
-``--verify`` (issue 63, row 7).  A signature binds the manifest to its
+``--verify``.  A signature binds the manifest to its
 author: ``rclverify bundle --sign KEY`` adds the member ``MANIFEST.sig``,
 the Ed25519 signature (RFC 8032) of the exact bytes of ``MANIFEST.json``,
 and ``rclverify bundle --verify FILE --key AUTHOR.pub`` checks it against

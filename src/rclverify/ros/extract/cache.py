@@ -1,4 +1,4 @@
-"""Parsed ROS source files, kept between scans (issue 22: incremental re-scan).
+"""Parsed ROS source files, kept between scans (incremental re-scan).
 
 A :class:`~rclverify.core.cache.store.Shelf` of kind ``ros-scan``
 (``artifacts/cache/ros-scan.pickle``) maps ``(parser, sha256 of the file)``

@@ -1,5 +1,5 @@
 """Node base classes as C++ constructors initialise them (docs/ros.md,
-"Reading real code"; issue 53).
+"Reading real code").
 
 A ROS 2 node class names its node in its constructor's initialiser list, by
 initialising its base class: ``Node("talker")``,

@@ -92,12 +92,12 @@ class CallReader:
             return
         if recv is not None and last.startswith("create_") and s.is_handle(args[0]):
             # rclcpp's node methods never take a node first: a user's method of the same name
-            # (bus.create_publisher(node, "t")), followed by the linker into its body (issue 65)
+            # (bus.create_publisher(node, "t")), followed by the linker into its body
             self.user_create(n, full, args)
             return
         if recv is None and "::" in full and not self.rclcpp_like(full, args, n):
             # ns::create_subscription<T>(topic, ...): no node is given and ns is no rclcpp class:
-            # a workspace's function, followed by the linker into its body, else a note (issue 65)
+            # a workspace's function, followed by the linker into its body, else a note
             self.user_create(n, full, args, "is a function of another namespace than rclcpp's, given no node")
             return
         handle = s.value(recv) if recv is not None else None

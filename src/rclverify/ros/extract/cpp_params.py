@@ -15,7 +15,7 @@
   ``declare_parameter_if_not_declared(node, "n", value)``).  A ROS 2 key
   computed in the code (``source_name_ + ".topic"``) is known by its text
   (:func:`key_text`) and read by its value where the program gives it
-  (:mod:`cpp_values`, :mod:`link_values`; issue 53).
+  (:mod:`cpp_values`, :mod:`link_values`).
 
 Source of the name rules: ROS 1 wiki "Names" and "Parameter Server"; ROS 2
 design "Parameters".

@@ -137,7 +137,7 @@ class CppScope:
         for n in nodes:
             if n.type == "declaration":
                 self._declaration(n)
-            elif n.type == "for_range_loop":  # for (auto & s : sources): s is each element (issue 53)
+            elif n.type == "for_range_loop":  # for (auto & s : sources): s is each element
                 nm, fn = _declarator_name(n.child_by_field_name("declarator")), self.fn_of(n)
                 if nm is not None and fn is not None and n.child_by_field_name("right") is not None:
                     self.ltypes[(fn.nid, _T(nm))] = _T(n.child_by_field_name("type"))
@@ -172,7 +172,7 @@ class CppScope:
     def _out_args(self, n: Any) -> None:
         """``getParameters(topic)`` where this file's ``getParameters(std::string & t)``
         reads a parameter into ``t``: the caller's local ``topic`` holds what ``t`` is
-        given (an out-parameter; issue 53)."""
+        given (an out-parameter)."""
         f = n.child_by_field_name("function")
         a = n.child_by_field_name("arguments")
         fn = self.fn_of(n)
@@ -226,7 +226,7 @@ class CppScope:
             fn.defaults.append(p.child_by_field_name("default_value"))
         if key.endswith("::" + unit.split("::")[-1]) and any(f.key == key and len(f.params) != len(fn.params)
                                                                  for f in self.fns.values()):
-            # a constructor overload: keyed by its arity, the linker runs only the one called (issue 65)
+            # a constructor overload: keyed by its arity, the linker runs only the one called
             fn.key = f"{key}#{len(fn.params)}"
         self.fns[n.id] = fn
 
@@ -236,7 +236,7 @@ class CppScope:
         info = self.classes.setdefault(name, {"members": {}, "bases": []})
         tpl = n.parent.child_by_field_name("parameters") if n.parent is not None and \
             n.parent.type == "template_declaration" else None
-        if tpl is not None:  # template<typename ServiceT> class Caller: read where it is made (issue 65)
+        if tpl is not None:  # template<typename ServiceT> class Caller: read where it is made
             info["tparams"] = [_T(x.child_by_field_name("name") or next(
                 (c for c in x.named_children if c.type == "type_identifier"), x)) for x in tpl.named_children]
         for c in n.children:

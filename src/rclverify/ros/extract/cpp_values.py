@@ -263,7 +263,7 @@ class CppValues(CppScope):
         """A local variable's value from its bindings in order.  A parameter read
         into it (``get_parameter("t", topic)``, ``getParam``) leaves it unchanged
         when the parameter is not set: what it held before is the read's default
-        (issue 65: "no default" was said where the code assigns one first)."""
+        ("no default" was said where the code assigns one first)."""
         reads = [i for i, b in enumerate(binds) if isinstance(b, tuple) and b and b[0] == "read"]
         if not reads or reads[-1] == 0:
             return self._one([self._bound(fn, b, depth) for b in binds])

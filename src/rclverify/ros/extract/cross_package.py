@@ -1,5 +1,5 @@
 """A C++ program's code in the workspace's other packages (docs/ros.md,
-"Reading real code"; issue 53).
+"Reading real code").
 
 A node of one package is often built on a helper library of another package
 of the same workspace: its base class (``pkg_util::LifecycleNode``), a twist

@@ -128,7 +128,7 @@ def _parse_one(kind: str, text: str, name: str) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for part, suf in zip(parts, suffixes):
         # parsed as pkg/msg/...: a field type without a package is pkg/msg/T, the
-        # same package's message (rosidl's rule), never pkg/srv/msg/T (issue 65)
+        # same package's message (rosidl's rule), never pkg/srv/msg/T
         for k, v in get_types_from_msg(part, f"{pkg}/msg/{base}{suf}").items():
             out[k.replace(f"{pkg}/msg/{base}{suf}", f"{pkg}/{kind}/{base}{suf}")] = v
     return out
@@ -182,7 +182,7 @@ class TypeTable:
         """Read the interface files of the package at ``root``: those in ``msg/``,
         ``srv/``, ``action/`` and every path ``rosidl_generate_interfaces`` names
         in its ``CMakeLists.txt`` (``srvs/Pause.srv``: rosidl takes any path
-        relative to the package; issue 65)."""
+        relative to the package)."""
         seen: set[Path] = set()
         for sub in ("msg", "srv", "action"):
             d = root / sub

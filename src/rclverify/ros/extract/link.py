@@ -59,7 +59,7 @@ class Linked:
     files: list[str] = field(default_factory=list)
 
 
-#: why an endpoint of a class nothing constructs is not in the graph (docs/ros.md; issue 65)
+#: why an endpoint of a class nothing constructs is not in the graph (docs/ros.md)
 UNBUILT = ("nothing this program runs is read to construct the class (a construction through a container's "
            "emplace_back/push_back or a factory the scan does not follow is not read): not in the graph")
 
@@ -364,7 +364,7 @@ class Linker(LinkMembers, Values, Returns):
                                 note(Note(src, "node name is not a string literal: not resolved statically"))
                                 continue
                             bad = names.node_name_problem(t)
-                            if bad is not None:  # never the node '/' (issue 65): its endpoints stay off the graph
+                            if bad is not None:  # never the node '/': its endpoints stay off the graph
                                 note(Note(src, f"node name {bad}: not resolved statically; its endpoints are "
                                                f"not in the graph"))
                                 continue
@@ -416,7 +416,7 @@ class Linker(LinkMembers, Values, Returns):
         argtype = cb if isinstance(cb, tuple) and cb[:1] == ("argtype",) else None
         got: list[Endpoint] = []
         for env in self.contexts(fkey):
-            if argtype is not None:  # a Python helper's type parameter, read at each call site (issue 65)
+            if argtype is not None:  # a Python helper's type parameter, read at each call site
                 types = [_py_typed(v, e.kind) for v in self.eval(("arg", argtype[1], argtype[2]), env, fkey)] or [None]
                 t = types[0] if all(types) else None
             for n in self.eval(name, env, fkey):

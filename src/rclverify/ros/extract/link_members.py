@@ -69,7 +69,7 @@ class LinkMembers:
         stands for: the template argument of each construction of the class
         (``make_unique<Caller<pkg::srv::T>>(...)``, a derived template's base
         initialiser ``ClientBase<ServiceT>(...)`` followed to its own
-        constructions), in call order; ``[]`` when none is found (issue 65)."""
+        constructions), in call order; ``[]`` when none is found."""
         tps = self.units.get(unit or "", {}).get("tparams", [])
         if param not in tps or depth > 4:
             return []

@@ -1,5 +1,5 @@
 """What a workspace function returns, read at its call (docs/ros.md, "Reading
-real code"; issue 65).
+real code").
 
 A C++ value ``("ret", callee, unit, args)`` (:mod:`symbols`) is a call of a
 function the workspace may define: a free function or template in a header

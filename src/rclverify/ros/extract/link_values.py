@@ -116,7 +116,7 @@ class Values:
             c = rec.get("consts", {}).get(hit[1]) if hit else None
             if c is None and hit is None and isinstance(v[1], str) and (".msg." in v[1] or ".srv." in v[1]
                                                                         or ".action." in v[1]):
-                return [v]  # an interface class (std_srvs.srv.Trigger): a type a helper is given (issue 65)
+                return [v]  # an interface class (std_srvs.srv.Trigger): a type a helper is given
             return self.eval(c, {}, None, depth + 1) if c is not None else [None]
         if k == "param":
             keys = [v[1]] if isinstance(v[1], str) else [

@@ -15,7 +15,7 @@ SCHEMA_ID = "rclverify-ros-graph/1"
 
 #: topics every ROS 2 node's client library makes (rcl: ``/rosout`` for logging,
 #: ``/parameter_events`` for parameter changes; ROS 2 design "Parameters"): the
-#: library's, never a contract's inputs or outputs (docs/ros.md, issue 53)
+#: library's, never a contract's inputs or outputs (docs/ros.md)
 LIBRARY_TOPICS = frozenset({"/parameter_events", "/rosout"})
 
 #: message and service types that libraries' helpers, not a node's own code, put on
@@ -37,7 +37,7 @@ def library_of(topic: str, msg_type: str | None) -> str | None:
     """The library an endpoint is made by (``tf``, ``bond``, ``diagnostics``, ...)
     when its topic or type is one of :data:`LIBRARY_TOPICS`/:data:`LIBRARY_TYPES`,
     else ``None``: such endpoints are listed apart from a skeleton's inputs and
-    outputs (issue 65) and a contract need not name them."""
+    outputs and a contract need not name them."""
     if topic in LIBRARY_TOPICS:
         return "client library"
     return LIBRARY_TYPES.get(canon_type(msg_type) or "") if msg_type else None

@@ -44,7 +44,7 @@ def node_name_problem(name: str) -> str | None:
     node names: letters, digits and underscores, not starting with a digit,
     never empty) and ROS 1's (names are tokens joined by ``/``; a node's own
     name holds no ``~``).  An empty or ``~`` name would otherwise be read as
-    the node ``/`` (issue 65)."""
+    the node ``/``."""
     if not name.strip("/"):
         return "is empty"
     if not _NODE_NAME.match(name):

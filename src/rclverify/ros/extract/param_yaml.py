@@ -1,6 +1,6 @@
 """A package's ROS 2 parameter files (``config/*.yaml``): the values they give
 each node's parameters, used when no launch file is given (docs/ros.md,
-"Real ROS 2 code, round three"; issue 53).
+"Real ROS 2 code, round three").
 
 The format is rcl's parameter file (ROS 2 docs, "Understanding parameters",
 ``--params-file``; rcl_yaml_param_parser)::

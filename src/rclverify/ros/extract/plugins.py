@@ -1,6 +1,6 @@
 """ROS 2 pluginlib plugins read statically: which node loads a plugin class, and
 the endpoints the plugin makes on that node's handle (docs/ros.md, "Real ROS 2
-code, round three"; issue 53, idiom 5).
+code, round three").
 
 A plugin is a C++ class a node loads by name at run time through
 ``pluginlib::ClassLoader<base::Iface>`` (a costmap layer, a controller, a

@@ -241,7 +241,7 @@ class _File(CallReader, MemberReader):
         """Whether expression ``n`` is declared with a template parameter of its
         function or class (``template<typename NodeT> C(const NodeT & parent)``):
         given first to a stack's ``ns::create_subscription<T>(parent, topic, ...)``,
-        it stands for the node of any kind the template is made with (issue 65)."""
+        it stands for the node of any kind the template is made with."""
         t = self.scope.type_of(n) if n.type == "identifier" else None
         if not t:
             return False
@@ -260,7 +260,7 @@ class _File(CallReader, MemberReader):
         values returned, per parameter: whether it may take a string literal)``
         per definition (overloads apart) that returns a value
         the linker may read: a ``("ret", ...)`` call of it is read from these
-        (a ``declare_parameter`` wrapper; issue 65).  A lambda's ``return`` is not
+        (a ``declare_parameter`` wrapper).  A lambda's ``return`` is not
         its enclosing function's."""
         s, got = self.scope, {}  # type: ignore[var-annotated]
         self.nodes_by_id = {n.id: n for n in self.nodes if n.type == "function_definition"}

@@ -19,7 +19,7 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
 * ``("ret", callee, unit, args)``: what a workspace function returns, called
   as ``callee`` (its text as written) from unit ``unit`` with argument values
   ``args``: the linker reads the callee's ``return`` statements with those
-  arguments (a wrapper of ``declare_parameter``; issue 65);
+  arguments (a wrapper of ``declare_parameter``);
 * ``("nh", segments)``: a node handle (roscpp ``ros::NodeHandle``, an rclcpp
   node or sub-node): what it adds to the node's namespace, in order, each
   ``("ns", value)`` (a namespace: ``"~"`` private, ``"left"`` relative) or
@@ -33,14 +33,14 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
 * ``("each", param)``: one element of the string-array ROS 2 parameter
   ``param`` (``~observation_sources``), a C++ range-for's variable over it;
   its text is ``[~observation_sources]``, which the graph expands with the
-  parameter's value (:func:`rclverify.ros.extract.param_yaml.expand_each`; issue 53);
+  parameter's value (:func:`rclverify.ros.extract.param_yaml.expand_each`);
 * ``("info", image)``: the ``camera_info`` topic image_transport pairs with
   image topic ``image`` (its namespace + ``camera_info``), for an image topic
   only the linker can read (a member, a parameter of the function);
 * ``("runtime", origin)``: a name only the running program knows, and where
   it comes from (``from argv``, ``from argparse option --topic``,
   ``discovered at run time (get_topic_names_and_types())``): never read, its
-  located note says the origin (issue 53).
+  located note says the origin.
 
 ``None`` is a value nobody can read statically (a computed string).
 Source of the naming rules: ROS 1 wiki "Names" and roscpp's ``NodeHandle``

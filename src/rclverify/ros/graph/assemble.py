@@ -42,7 +42,7 @@ class Assembly:
         self.progs = {p: programs(self.codes[p], targets[p]) for p in sorted(pkgs)}
         self.targets = targets
         self._linked: dict[int, Linked] = {}
-        # a program's code in the workspace's other packages (helper libraries, issue 53)
+        # a program's code in the workspace's other packages (helper libraries)
         self._views: dict[int, PackageCode] = {}
         used: dict[str, set[str]] = {}
         for pk in sorted(self.progs):
@@ -153,7 +153,7 @@ class Assembly:
         return prog
 
     def controller_nodes(self, add_node: Callable[..., None], entries: dict[str, list[Any]], g: Graph) -> None:
-        """ros2_control controllers as nodes of their own (issue 65): each instance a
+        """ros2_control controllers as nodes of their own: each instance a
         controller manager's parameter file names (:func:`plugins.controller_instances`)
         is a lifecycle node of that name whose code is the controller class, linked
         with the instance's name; a controller whose class no scanned source

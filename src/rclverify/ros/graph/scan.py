@@ -271,7 +271,7 @@ class _Scan:
                 self.asm.launch_node(ln, self.add_node, g)
         else:
             self.asm.source_nodes(self.add_node, g)
-            self.asm.controller_nodes(self.add_node, self.pfiles.entries, g)  # ros2_control controllers (issue 65)
+            self.asm.controller_nodes(self.add_node, self.pfiles.entries, g)  # ros2_control controllers
         g.notes.extend(self.asm.unloaded_plugins())
 
     def add_node(self, full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,

@@ -1,5 +1,5 @@
 """Grounding: the plan's contracts held against the computation graph of its
-``ros:`` section (issue 22; docs/ros.md "Grounding").
+``ros:`` section (docs/ros.md "Grounding").
 
 Every finding is located at both ends: the RCL line (the ``topics(...)``
 clause, the node, or the plan) and the source, launch or ``.msg`` line it
@@ -207,7 +207,7 @@ class Grounder:
         (or its ``ros.nodes`` entry ``want``) asks for (kept apart by their
         executables, ``/gripper@pkg.exe``), add one finding naming every
         candidate with its package, executable and where it is declared
-        (issue 64), and return ``True``; else ``False``."""
+       , and return ``True``; else ``False``."""
         def base(g: str) -> str:
             return g.split("@", 1)[0]
         if want:

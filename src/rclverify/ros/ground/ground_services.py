@@ -1,4 +1,4 @@
-"""Grounding of a contract's services and actions (issue 33; docs/ros.md,
+"""Grounding of a contract's services and actions (docs/ros.md,
 "Grounding services and actions").
 
 A contract links inputs and outputs to a ROS service or action

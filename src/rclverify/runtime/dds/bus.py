@@ -15,7 +15,7 @@ located warning, once per publisher and reason, never silence:
   contract's type): ``FILE:LINE:COL: warning: /scan: node /lidar publishes
   sensor_msgs::msg::dds_::Imu_, the contract's type is ...; not heard``;
 * a publisher of a type with the contract's type name but another layout
-  (issue 47; :mod:`.dds_layout` compares the type objects, or the ROS 2 type
+  (:mod:`.dds_layout` compares the type objects, or the ROS 2 type
   hashes, never the bare XTypes identifiers): named, with the field that
   differs where its type object says it, never counted as heard, and its
   samples dropped if they reach the reader (Fast DDS's writers are matched

@@ -1,4 +1,4 @@
-"""What a live DDS run's evidence cannot vouch for (issue 47, runtime hardening).
+"""What a live DDS run's evidence cannot vouch for.
 
 A verdict of the live monitor rests on having heard every message the node
 exchanged and on being the only voice on the topics it speaks for.  Three

@@ -1,3 +1,3 @@
 """The second solver: every query whose answer discharges something is
 decided again by cvc5 from its SMT-LIB2 text, its proof produced and
-checked (docs/second-solver.md; issue 50)."""
+checked (docs/second-solver.md)."""

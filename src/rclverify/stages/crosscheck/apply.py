@@ -5,7 +5,7 @@ reads gets ``solvers``: ``{"agreement", "why", "cvc5", "proof", "smt2"}``
 from the sealed ``artifacts/crosscheck/index.json``
 (:mod:`.stage`).  Where the two solvers disagree, or cvc5 answered
 ``unknown`` to what Z3 proved, the item reads ``inconclusive`` with both
-answers, never discharged or proved (issue 50; docs/second-solver.md).
+answers, never discharged or proved (docs/second-solver.md).
 An item the stage did not see (it ran before the item was decided, or its
 record is altered) reads ``one solver`` with the reason.
 """

@@ -1,5 +1,5 @@
 """``rclverify bundle --recheck ARCHIVE``: every stored query decided again
-from the bundle alone, by both solvers (issue 50; docs/second-solver.md).
+from the bundle alone, by both solvers (docs/second-solver.md).
 
 Nothing of a workspace is read and no contract is parsed: the archive's
 sealed records name the items that discharge something

@@ -202,7 +202,7 @@ def _other_cpu_free() -> bool:
     were idle.  On a busy machine the child only waits for a core and costs
     its fork, its copied pages and its own solver (0.13 CPU s of 1.7 for
     the 200-node chain's 1,000 scripts at load 3, the same wall time:
-    docs/scale.md, issue 67).  Where the CPU counters cannot be read, the
+    docs/scale.md).  Where the CPU counters cannot be read, the
     load average of the last minute (this process counts 1) must leave half
     a CPU idle; that figure lags: after a busy phase it keeps a free CPU
     looking busy for a minute."""

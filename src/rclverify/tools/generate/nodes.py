@@ -68,7 +68,7 @@ class NodePackage:
     #: ``step``'s parameter per input, RCL name -> Python name (``x'`` -> ``x_prime``: :func:`.names.py_name`)
     params: dict[str, str] = field(default_factory=dict)
     #: ``(variable, topic)`` of each further variable on a topic an end already carries: the end carries its
-    #: first variable only; the generated mapping says so (planfrag.py, issue 64)
+    #: first variable only; the generated mapping says so (planfrag.py)
     unwired: list[tuple[str, str]] = field(default_factory=list)
 
     @property

@@ -47,7 +47,7 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
     to the field of the variable's own name when it has one
     (:func:`_field_named`); else ``omitted`` lists ``{"topic", "type",
     "var", "why"}`` for the variable, and the mapping file says so in a
-    comment, naming the entry to write (issue 64)."""
+    comment, naming the entry to write."""
     per: dict[str, dict[str, str]] = {}
     omitted: list[dict[str, str]] = []
     for np in nodes:

@@ -1,7 +1,7 @@
 """A node's contract as data the generated Python package carries (``<pkg>/contract_eval.py``).
 
 A generated node must judge its contract in any ROS 2 Python, where
-rclverify is not installed (issue 62).  Its package therefore carries the
+rclverify is not installed.  Its package therefore carries the
 judgement itself: ``contract_eval.py`` (from ``templates/contract_eval.py.j2``)
 is a small evaluator with rclverify's three readings of a formula on
 recorded values (exact, the node's IEEE-754 doubles, the declared tolerance;

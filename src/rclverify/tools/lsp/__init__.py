@@ -1,4 +1,4 @@
-"""``rclverify lsp``: the RCL language server (issue 52, docs/editor.md).
+"""``rclverify lsp``: the RCL language server.
 
 A Language Server Protocol server over stdio, built on pygls and
 lsprotocol, for the ``.rcl`` files of a workspace and its plan

@@ -125,7 +125,7 @@ class _Node:
     context: list[dict[str, str]] = field(default_factory=list)
     services: list[str] = field(default_factory=list)
     actions: list[str] = field(default_factory=list)
-    apart: list[str] = field(default_factory=list)  # endpoints left out, each with its reason (issue 65)
+    apart: list[str] = field(default_factory=list)  # endpoints left out, each with its reason
 
 
 _ROLE_WORDS = {"pub": "publishes", "sub": "subscribes to", "service_servers": "serves",
@@ -314,7 +314,7 @@ def build_skeletons(res: ScanResult, library: bool = False
     external = sorted({e.topic for n in g.nodes.values() for e in n.subscribes
                        if e.msg_type and (library and library_of(e.topic, e.msg_type) != "client library"
                                           or library_of(e.topic, e.msg_type) is None)} - published - LIBRARY_TOPICS)
-    for kind in ("service", "action"):  # called, served by no scanned node: another system's (issue 65)
+    for kind in ("service", "action"):  # called, served by no scanned node: another system's
         served = {e.topic for n in g.nodes.values() for e in n.edges_of(f"{kind}_servers")}
         external += sorted({e.topic for n in g.nodes.values() for e in n.edges_of(f"{kind}_clients")
                             if e.msg_type and library_of(e.topic, e.msg_type) is None} - served - set(external))
