@@ -61,3 +61,29 @@ def test_a_press_still_within_its_deadline_at_the_end_is_not_green(tmp_path: Pat
 def test_the_control_every_press_answered_stays_green(tmp_path: Path) -> None:
     ws, run = _ws(tmp_path, ANSWERED)
     assert main(["monitor", "--strict", "-w", str(ws), "--mapping", "mapping.yaml", str(run)]) == 0
+
+
+GATE = """
+node Gate {
+  inputs( a : BOOL, t : BOOL )
+  outputs( y : BOOL )
+  topics( std_msgs/Bool a matches(in.a), std_msgs/Bool t matches(in.t), std_msgs/Bool y matches(out.y) )
+  assume( TRUE )
+  guarantee( in.a -> out.y ) triggered by in.t within 200 ms
+}
+"""
+
+
+@pytest.mark.parametrize("rcl, rows", [
+    # two presses in one millisecond, answered by no stop: both presses' deadlines fail
+    (STOPPER, [("b", 1.0, True), ("b", 1.0005, True), ("stop", 1.05, False), ("b", 1.5, False),
+               ("stop", 1.55, False)]),
+    # a trigger whose guarantee reads another input: a = TRUE at the trigger, answered y = FALSE
+    (GATE, [("a", 0.5, True), ("t", 1.0, True), ("y", 1.05, False), ("a", 1.1, False), ("y", 1.15, False)]),
+], ids=["two-presses-in-one-ms", "trigger-reads-another-input"])
+def test_round_seven_deadline_rows_fail(tmp_path: Path, rcl: str, rows: list[tuple[str, float, bool]]) -> None:
+    """Round seven's two other deadline rows (already failed on this round's main; kept as regressions)."""
+    ws, run = _ws(tmp_path, rows)
+    (ws / "contracts" / "c.rcl").write_text(rcl)
+    (ws / "mapping.yaml").write_text("topics:\n" + "".join(f"  {t}: {{fields: [data]}}\n" for t in "b stop a t y".split()))
+    assert main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", str(run)]) == 1
