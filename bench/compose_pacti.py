@@ -48,7 +48,8 @@ tools disagree (or the smoke run's own checks fail), so CI can run
 """
 from __future__ import annotations
 
-import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+if __name__ == "__main__":  # run as a script: a Python without the dependencies runs again under .venv/
+    import _venv  # noqa: F401
 
 import argparse
 import sys

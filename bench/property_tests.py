@@ -28,7 +28,8 @@ Usage::
 """
 from __future__ import annotations
 
-import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+if __name__ == "__main__":  # run as a script: a Python without the dependencies runs again under .venv/
+    import _venv  # noqa: F401
 
 import argparse
 import time

@@ -46,7 +46,8 @@ minutes and 2 GiB on 2 cores, a no-op re-run within 2 s).
 """
 from __future__ import annotations
 
-import _venv  # noqa: F401  (first: a Python without the dependencies runs again under .venv/)
+if __name__ == "__main__":  # run as a script: a Python without the dependencies runs again under .venv/
+    import _venv  # noqa: F401
 
 import argparse
 import json
