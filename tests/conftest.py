@@ -50,8 +50,8 @@ LIVE = frozenset({
     "test_lsp_fuzz", "test_lsp_hostile", "test_lsp_invalid", "test_lsp_nvim", "test_lsp_server",
     "test_monitor_live_dds", "test_monitor_live_hostile", "test_monitor_live_ros1", "test_monitor_oracle",
     "test_ros2_diff", "test_ros2_generated", "test_ros2_services_actions", "test_ros2_silence_deadlines",
-    "test_ros2_declarations", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
-    "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy",
+    "test_ros2_declarations", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
+    "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_ros2_calls_paired", "test_ros2_carried",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children

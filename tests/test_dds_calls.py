@@ -202,8 +202,82 @@ def test_the_order_pairs_only_what_it_makes_certain() -> None:
     p.request(Pending(("w", "a", 5), 6.0, "call 5"))
     assert p.reply(6.5, b"S").answers is not None  # certain again once the pool is spent
     p.request(Pending(("w", "a", 6), 7.0, "call 6"))
-    other = p.reply(7.5, b"T")  # a second server: each answers every request
-    assert other.answers is None and len(other.undecided) == 1 and "2 servers answer /estop" in other.reason
+    # a second server's reply before discovery told it: it was not sent the calls heard before: an orphan,
+    # counted and named, never dropped and never taken from the first server's call
+    assert p.reply(7.5, b"T").orphan
+    assert p.reply(7.6, b"S").answers == Pending(("w", "a", 6), 7.0, "call 6")
+
+
+def test_each_discovered_server_answers_each_call() -> None:
+    """Two servers of one service: each request is one call per server, each server's reply paired with its
+    own; a server that leaves leaves its calls undecided, with the reason."""
+    from rclverify.runtime.dds.order import OrderPairer, Pending
+    p = OrderPairer("/dual", who=lambda g: g.decode())
+    assert p.discovered([b"A", b"B"], 0.5) == []
+    calls = p.request(Pending(("w", "c", 1), 1.0, "dual call c#1", b"c"))
+    assert [c.key for c in calls] == [("w", "c", 1, b"A".hex()), ("w", "c", 1, b"B".hex())]
+    assert calls[1].label == "dual call c#1 answered by B"
+    assert p.reply(1.1, b"B").answers == calls[1]  # the slower server's reply first: still its own call
+    assert p.reply(1.2, b"A").answers == calls[0]
+    later = p.request(Pending(("w", "c", 2), 2.0, "dual call c#2", b"c"))
+    (left,) = p.discovered([b"A"], 2.5)  # B left before answering
+    assert left[0] == later[1] and "B, a server of /dual, left" in left[1]
+    assert p.reply(2.6, b"A").answers == later[0]
+
+
+def test_a_reply_in_a_clients_start_up_window_is_undecided() -> None:
+    """A request written before the monitor heard its writer is not heard; its reply, within the window
+    (the horizon) after the writer began to be heard, could look like the answer of a request heard."""
+    from rclverify.runtime.dds.order import OrderPairer, Pending
+    p = OrderPairer("/estop", window=1.0, who=lambda g: g.decode())
+    p.discovered([b"S"], 0.0)
+    p.hearing(b"c", 10.0)
+    q = p.request(Pending(("w", "c", 1), 10.2, "call 1", b"c"))[0]
+    young = p.reply(10.3, b"S")
+    assert young.answers is None and young.undecided == (q,) and "began hearing the requests of c" in young.reason
+    q2 = p.request(Pending(("w", "c", 2), 11.5, "call 2", b"c"))[0]
+    assert p.reply(11.6, b"S").answers == q2  # past the window: certain
+    # requests heard before any server was: undecided when the server appears (their replies may be unheard)
+    r = OrderPairer("/late", who=lambda g: g.decode())
+    early = r.request(Pending(("w", "c", 1), 1.0, "call 1", b"c"))[0]
+    ((undecided, why),) = r.discovered([b"S"], 2.0)
+    assert undecided == early and "before the monitor heard S" in why
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_order_pairs_only_what_every_history_agrees_on(seed: int) -> None:
+    """Oracle: on small random histories of one server (requests and replies in stamp order, each reply the
+    answer of a distinct earlier request), every reply the pairer pairs is paired so in EVERY complete
+    matching of replies to earlier requests (brute force), and it calls a reply an orphan only where no
+    request can be its."""
+    import itertools
+    import random
+    from rclverify.runtime.dds.order import OrderPairer, Pending
+    rnd = random.Random(seed)
+    seq: list[str] = []
+    opened = answered = 0
+    for _ in range(rnd.randint(2, 7)):
+        if opened > answered and rnd.random() < 0.5:
+            seq.append("rep")
+            answered += 1
+        else:
+            seq.append("req")
+            opened += 1
+    reqs = [i for i, x in enumerate(seq) if x == "req"]
+    reps = [i for i, x in enumerate(seq) if x == "rep"]
+    matchings = [m for m in itertools.permutations(reqs, len(reps)) if all(q < r for q, r in zip(m, reps))]
+    assert matchings  # every prefix has no more replies than requests
+    p = OrderPairer("/s")
+    p.discovered([b"S"], -1.0)
+    for i, x in enumerate(seq):
+        if x == "req":
+            p.request(Pending((i,), float(i), f"call {i}"))
+            continue
+        out = p.reply(float(i), b"S")
+        k = reps.index(i)
+        if out.answers is not None:
+            assert {m[k] for m in matchings} == {out.answers.key[0]}, (seq, i)
+        assert not out.orphan  # a request is always left for it in these histories
 
 
 def test_an_unpaired_call_is_inconclusive_and_replays() -> None:
@@ -244,6 +318,9 @@ def test_plain_samples_are_taken_in_stamp_order_and_checked_by_vendor() -> None:
     rep = types.struct("std_srvs/srv/SetBool_Response")
     assert taps.specs["call:/estop:request"][1] is req  # the plain layout: Fast DDS's
     server, client = FAST[:-2] + b"\x13\x03", FAST
+    # the monitor has heard the client's request writer since long before (its reader matched at 10 s: the
+    # bus tells it, :meth:`CallTaps._discover`): no earlier request of it can be unheard
+    taps._pairer("/estop").hearing(client, 10.0)
     # the reply is handed on before its request (two topics, two readers): the stamps put them in order
     taps.handle("call:/estop:reply", rep(success=False, message="").serialize(), 20.05, 20.06, server)
     taps.handle("call:/estop:request", req(data=True).serialize(), 20.0, 20.07, client)
@@ -268,8 +345,8 @@ def test_introspection_events_pair_concurrent_calls_exactly() -> None:
     ev = event_struct(types, "std_srvs/SetBool")
     server, client = FAST[:-2] + b"\x13\x03", b"\x01\x0f" + bytes(range(10)) + b"\x00\x00\x14\x03"
     taps.taps = {"call:/estop:event": SimpleNamespace(heard={server[:-2] + b"\x15\x03"}),
-                 "call:/estop:reply": SimpleNamespace(heard={server}),
-                 "call:/estop:request": SimpleNamespace(heard={client})}
+                 "call:/estop:reply": SimpleNamespace(heard={server}, reader_changes=0, dds_topic="rr/estopReply"),
+                 "call:/estop:request": SimpleNamespace(heard={client}, reader_changes=0)}
 
     def event(kind: int, seq: int, stamp: float, **parts: Any) -> None:
         s = types.build(ev, {"info": {"event_type": kind, "client_gid": list(client), "sequence_number": seq},
@@ -300,8 +377,8 @@ def test_introspection_that_begins_mid_call_leaves_that_call_unpaired() -> None:
     taps, types = _taps(lines)
     server = FAST[:-2] + b"\x13\x03"
     event = SimpleNamespace(heard=set())
-    taps.taps = {"call:/estop:event": event, "call:/estop:reply": SimpleNamespace(heard={server}),
-                 "call:/estop:request": SimpleNamespace(heard={FAST})}
+    taps.taps = {"call:/estop:event": event, "call:/estop:reply": SimpleNamespace(heard={server}, reader_changes=0, dds_topic="rr/estopReply"),
+                 "call:/estop:request": SimpleNamespace(heard={FAST}, reader_changes=0)}
     req = types.struct("std_srvs/srv/SetBool_Request")
     taps.handle("call:/estop:request", req(data=True).serialize(), 40.0, 40.0, FAST)
     taps.tick(41.0)

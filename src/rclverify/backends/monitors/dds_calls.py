@@ -125,9 +125,11 @@ class CallBook:
 
     # -- input -------------------------------------------------------------------------------
     def open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, Any], stamp: float,
-             part: str = "request") -> None:
+             part: str = "request", count: bool = True) -> None:
         """A request (``part`` ``request``) or a goal (``goal``) of link ``name``
-        with identity ``key``, stamped ``stamp`` (s)."""
+        with identity ``key``, stamped ``stamp`` (s).  ``count`` false: the
+        same request's call with another of the service's servers (counted
+        once, as the first; its log line says ``"also": true``)."""
         name = name.strip("/")
         views = self.links.get(name)
         if not views or key in self.calls:
@@ -138,9 +140,10 @@ class CallBook:
         bound = max([self.horizon] + [t[4] for d in deadlines for t in d.timed])
         call = _Call(key, name, label, stamp, bound, monitors, deadlines)
         self.calls[key] = call
-        self.counts["goals" if part == "goal" else "calls"] += 1
+        if count:
+            self.counts["goals" if part == "goal" else "calls"] += 1
         call.first = self.index
-        self._feed(call, part, fields, stamp)
+        self._feed(call, part, fields, stamp, {} if count else {"also": True})
         while len(self.calls) > self.max_calls:
             self._close(next(iter(self.calls)), evicted=True)
 
@@ -213,12 +216,13 @@ class CallBook:
         """A line for the log about a call (a status change) that no monitor reads."""
         self._log(obj)
 
-    def _feed(self, call: _Call, part: str, fields: Mapping[str, Any], stamp: float) -> None:
+    def _feed(self, call: _Call, part: str, fields: Mapping[str, Any], stamp: float,
+              extra: Mapping[str, Any] | None = None) -> None:
         topic = f"{call.name}/{part}"
         ev = Event(self.index, stamp, topic, dict(fields), f"{call.label} {part}")
         self.index += 1
         self._log({"index": ev.index, "link": call.name, "part": part, "time": stamp, "key": _key(call.key),
-                   "where": ev.where, "fields": dict(fields)})
+                   "where": ev.where, "fields": dict(fields), **(extra or {})})
         for m in call.monitors:
             m.advance(stamp)
             m.feed(ev)
@@ -328,7 +332,8 @@ def replay_line(book: CallBook, x: Mapping[str, Any]) -> None:
     elif "index" in x:
         name, key = str(x["link"]), tuple(x["key"])
         if part in ("request", "goal"):
-            book.open(name, key, str(x["where"]).rsplit(" ", 1)[0], x["fields"], float(x["time"]), part)
+            book.open(name, key, str(x["where"]).rsplit(" ", 1)[0], x["fields"], float(x["time"]), part,
+                      not x.get("also"))
         else:
             book.answer(key, part, x["fields"], float(x["time"]), part != "feedback", name)
     elif x.get("orphan") and str(x.get("link", "")).strip("/") in book.links:

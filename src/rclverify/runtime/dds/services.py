@@ -49,7 +49,7 @@ from rclverify.runtime.dds.bus import NAME_GRACE_S
 from rclverify.backends.monitors.dds_calls import CallBook
 from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, event_side, event_struct
 from rclverify.runtime.dds.order import OrderPairer, Pending
-from rclverify.runtime.dds.shadow import REPLY_OF, Shadows
+from rclverify.runtime.dds.shadow import REPLY_OF, SHADOW, Shadows
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
 from rclverify.runtime.dds.wire import framed_rmw, has_header, vendor
 from rclverify.runtime.dds.types import DdsTypeError
@@ -95,6 +95,8 @@ class CallTaps:
         #: tap key -> (link, the struct read, the header struct or None, part)
         self.specs: dict[str, tuple[str, Any, Any, str]] = {}
         self.plan: list[tuple[str, str, Any, str]] = []  # (tap key, dds topic, struct, where)
+        #: pairer name -> (its request tap key, its reply tap key): the readers discovery is read from
+        self._pair_taps: dict[str, tuple[str, str]] = {}
         seen: set[str] = set()
         for _node, lk in links:
             name = "/" + lk.name.strip("/")
@@ -122,6 +124,7 @@ class CallTaps:
         self._pairers: dict[str, OrderPairer] = {}
         self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
+        self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
         self.last = float("-inf")  # the stamp of the last sample taken
         #: samples taken after a later-stamped one (``late``), of a writer no longer known or of the other
         #: wire form (:mod:`.dds_wire`), events without contents, request/reply samples left to the
@@ -137,6 +140,7 @@ class CallTaps:
             self._add(name, "request", request_topic(name), t.struct(f"{pkg}/srv/{rest}_Request"), req, lk)
             self._add(name, "reply", reply_topic(name), t.struct(f"{pkg}/srv/{rest}_Response"), rep, lk)
             self._add(name, "event", topic_name(name + EVENT_SUFFIX), event_struct(t, lk.ros_type), None, lk)
+            self._pair_taps[name] = (f"call:{name}:request", f"call:{name}:reply")
             return
         a = t.action(lk.ros_type)
         pkg, _, rest = lk.ros_type.replace("/action/", "/").partition("/")
@@ -147,6 +151,8 @@ class CallTaps:
             self._add(name, f"{part}_request", request_topic(base + svc), t.struct(f"{plain}_{kind}_Request"), hreq,
                       lk)
             self._add(name, f"{part}_reply", reply_topic(base + svc), t.struct(f"{plain}_{kind}_Response"), hrep, lk)
+        for svc, part in (("send_goal", "goal"), ("get_result", "result")):
+            self._pair_taps[f"{name}/_action/{svc}"] = (f"call:{name}:{part}_request", f"call:{name}:{part}_reply")
         self._add(name, "feedback", topic_name(base + "feedback"), a.feedback, None, lk)
         self._add(name, "status", topic_name(base + "status"), a.status, None, lk)
         cq, cr, hq, hr = _cancel_types(t)
@@ -212,6 +218,7 @@ class CallTaps:
         """Take the samples whose time has come, in their stamps' order; answers
         that waited :data:`EARLY_S` s for their call count as answers without
         one; the book's clock moves to ``now - max(window, SETTLE_S)``."""
+        self._discover(now)
         self._take(lambda stamp, got: stamp <= now - SETTLE_S or got <= now - LATE_S)
         if now - self._checked >= 0.5:
             self._checked = now
@@ -274,23 +281,58 @@ class CallTaps:
         assert writer is not None
         k = self._asked[writer] = self._asked.get(writer, 0) + 1
         key, label = ("w", writer.hex(), k), f"{name.strip('/')} call {writer.hex()}#{k}"
-        self._open(name, key, label, to_fields(s), stamp)
-        self._pairer(name).request(Pending(key, stamp, label))
+        fields = to_fields(s)
+        for i, p in enumerate(self._pairer(name).request(Pending(key, stamp, label, writer))):
+            self._open(name, p.key, p.label, fields, stamp, count=i == 0)
 
     def _ordered_reply(self, name: str, s: Any, stamp: float, writer: bytes | None) -> None:
         out = self._pairer(name).reply(stamp, writer)
         if out.answers is not None:
             self.book.answer(out.answers.key, "response", to_fields(s), stamp, True, name)
-        elif out.orphan:
-            self.book.answer(("w", "", 0), "response", to_fields(s), stamp, True, name)
+        elif out.orphan:  # counted and logged with its server: an answer no heard request can be its
+            self.book.answer(("w", "", 0, writer.hex() if writer else ""), "response", to_fields(s), stamp, True,
+                             name)
         for p in out.undecided:
             self.book.unpaired(p.key, stamp, out.reason)
 
     def _pairer(self, name: str) -> OrderPairer:
         p = self._pairers.get(name)
         if p is None:
-            p = self._pairers[name] = OrderPairer(name)
+            p = self._pairers[name] = OrderPairer(name, self.book.horizon, self._who)
         return p
+
+    def _who(self, guid: bytes) -> str:
+        node = self._node_of(guid) if guid else None
+        return f"node {node} (writer {guid.hex()})" if node else f"writer {guid.hex() or 'unknown'}"
+
+    def _discover(self, now: float) -> None:
+        """Tell each pairer the request writers its reader hears and the servers (reply writers, never a
+        monitor's shadow) it matches; the calls a change leaves undecided are unpaired with the reason."""
+        for pname, (rq_key, rr_key) in self._pair_taps.items():
+            rq, rr = self.taps.get(rq_key), self.taps.get(rr_key)
+            if rq is None or rr is None:
+                continue
+            pairer = self._pairer(pname)
+            changes = (rq.reader_changes, rr.reader_changes)
+            if self._changes.get(pname) != changes:  # a reader made (again): from now on, everything heard
+                self._changes[pname] = changes
+                for w in rq.heard:
+                    pairer.hearing(w, now)
+            for w in rq.heard:
+                if w not in pairer.heard_since:
+                    pairer.hearing(w, now)
+            if not rr.heard and not pairer.servers:
+                continue
+            try:
+                shadows = {p.guid for p in self._disc.publishers(rr.dds_topic) if SHADOW in p.qos.user_data} \
+                    if self._disc is not None else set()
+            except RuntimeError:  # discovery changed under us (the DDS thread): next time
+                continue
+            servers = (set(rr.heard) - shadows) | {g for g in pairer.servers if g not in rr.heard and not g}
+            if servers == set(pairer.servers):
+                continue
+            for p, why in pairer.discovered(servers, now):
+                self.book.unpaired(p.key, now, why)
 
     def _side(self, name: str, stamp: float) -> str | None:
         """Which side's introspection events pair the calls of service ``name``
@@ -332,10 +374,10 @@ class CallTaps:
                 writer: bytes | None) -> None:
         if part == "goal_request":
             gid = bytes(s.goal_id.uuid).hex()
-            self._ask(name, "send_goal", s, gid, stamp, framed)
+            self._ask(name, "send_goal", s, gid, stamp, framed, writer)
             self._open(name, (gid,), f"{name.strip('/')} goal {gid}", to_fields(s.goal), stamp, "goal")
         elif part == "result_request":
-            self._ask(name, "get_result", s, bytes(s.goal_id.uuid).hex(), stamp, framed)
+            self._ask(name, "get_result", s, bytes(s.goal_id.uuid).hex(), stamp, framed, writer)
         elif part == "goal_reply":
             self._goal_reply(name, s, stamp, framed, writer)
         elif part == "result_reply":
@@ -357,14 +399,15 @@ class CallTaps:
             self.book.note({"link": name.strip("/"), "part": "canceling", "time": stamp, "return_code":
                             int(s.return_code), "key": [bytes(g.goal_id.uuid).hex() for g in s.goals_canceling]})
 
-    def _ask(self, name: str, svc: str, s: Any, gid: str, stamp: float, framed: bool) -> None:
+    def _ask(self, name: str, svc: str, s: Any, gid: str, stamp: float, framed: bool,
+             writer: bytes | None = None) -> None:
         """A send-goal or get-result request about goal ``gid``: remember which goal its reply is about."""
         if framed:
             self._goal_of[request_id(s)] = gid
             while len(self._goal_of) > 10_000:
                 self._goal_of.pop(next(iter(self._goal_of)))
         else:
-            self._pairer(f"{name}/_action/{svc}").request(Pending((gid,), stamp, f"goal {gid}"))
+            self._pairer(f"{name}/_action/{svc}").request(Pending((gid,), stamp, f"goal {gid}", writer))
 
     def _told(self, name: str, svc: str, s: Any, stamp: float, framed: bool,
               writer: bytes | None) -> tuple[str, list[str], str]:
@@ -392,8 +435,8 @@ class CallTaps:
 
     # -- the book --------------------------------------------------------------------------------
     def _open(self, name: str, key: tuple[Any, ...], label: str, fields: dict[str, Any], stamp: float,
-              part: str = "request") -> None:
-        self.book.open(name, key, label, fields, stamp, part)
+              part: str = "request", count: bool = True) -> None:
+        self.book.open(name, key, label, fields, stamp, part, count)
         for apart, afields, astamp, final, _t, aname in self._early.pop(key, ()):
             self.book.answer(key, apart, afields, astamp, final, aname)
 

@@ -1,0 +1,287 @@
+"""A ROS 2 run judged as the robot carries it: real rclpy nodes on Fast DDS,
+a monitor started AFTER the publishers (docs/semantics.md, "Widths" and
+"Steps"; docs/ros2.md, "Judged as the robot carries it").
+
+One rclpy process runs for the module; it publishes for about 1.5 s before
+the monitor starts, and for about 4 s after:
+
+* **float32 at a decimal threshold**: ``BatteryState.percentage`` (float32)
+  cycles through 0.5, 0.2, 0.1; ``battery`` answers ``home`` comparing with
+  0.2 as the field carries it (``<=``), ``slip`` with ``<`` (the slip).  On
+  the wire 0.2 is 0.2000000030: the contract's 0.2 is judged at float32, so
+  ``battery`` is green and ``slip`` violated at the 0.2 messages, live, on
+  the log offline and on the bag;
+* **LaserScan.ranges** (an unbounded float32 sequence) into ``seq(REAL)``:
+  ``guard`` stops when any range is below 0.5, ``blind`` forgets the last
+  beam: violated where only the last beam is near;
+* **start-up**: ``echo`` answers every ``/x``, ``progress( within 0 steps
+  )``; its inputs heard before its answers were (the monitor's readers
+  match one by one) are not counted against it;
+* **one instant, one step**: ``upstream`` publishes ``/fa`` and ``/fb`` at
+  once, ``fuse`` answers their sum once: ``progress( within 0 steps )`` holds;
+* **transient-local**: ``config`` publishes ``/limit`` once, latched, long
+  before the monitor starts; ``clamp`` answers each ``/cmd`` with at most
+  the limit.  The monitor's reader is transient-local as the publisher
+  offers, so the latched limit is delivered as ROS 2 delivers it to a late
+  subscriber, and every answer is judged (none undecided for want of it);
+* **nothing decided**: ``probe`` publishes only NaN on ``/nan`` and
+  ``sink`` echoes it; a second monitor of that node alone, under
+  ``--strict``, exits 1 and says that nothing was decided.
+"""
+from __future__ import annotations
+
+import json
+import signal
+import time
+from typing import Any, Iterator
+
+import pytest
+from _procs import stop, wait_for
+from _ros2 import rclverify, ros2_env, ros2_python, start_node
+
+from rclverify.cli.commands import main
+
+RCL = """\
+node Battery {
+  inputs( p : REAL )
+  outputs( home : BOOL )
+  topics( sensor_msgs/BatteryState battery matches(in.p), std_msgs/Bool home matches(out.home) )
+  assume( 0 <= in.p and in.p <= 1 )
+  guarantee( out.home == (in.p <= 0.2) )
+}
+
+node Slip {
+  inputs( p : REAL )
+  outputs( home : BOOL )
+  topics( sensor_msgs/BatteryState battery matches(in.p), std_msgs/Bool slip_home matches(out.home) )
+  assume( 0 <= in.p and in.p <= 1 )
+  guarantee( out.home == (in.p <= 0.2) )
+}
+
+node Guard {
+  inputs( ranges : seq(REAL) )
+  outputs( stop : BOOL )
+  topics( sensor_msgs/LaserScan scan matches(in.ranges), std_msgs/Bool stop matches(out.stop) )
+  assume( TRUE )
+  guarantee( out.stop == exists(r in in.ranges | r < 0.5) )
+}
+
+node Blind {
+  inputs( ranges : seq(REAL) )
+  outputs( stop : BOOL )
+  topics( sensor_msgs/LaserScan scan matches(in.ranges), std_msgs/Bool blind_stop matches(out.stop) )
+  assume( TRUE )
+  guarantee( out.stop == exists(r in in.ranges | r < 0.5) )
+}
+
+node Echo {
+  inputs( x : INTEGER )
+  outputs( y : INTEGER )
+  topics( std_msgs/Int64 x matches(in.x), std_msgs/Int64 y matches(out.y) )
+  assume( TRUE )
+  guarantee( out.y == in.x )
+  progress( within 0 steps )
+}
+
+node Fuse {
+  inputs( a : INTEGER, b : INTEGER )
+  outputs( s : INTEGER )
+  topics( std_msgs/Int64 fa matches(in.a), std_msgs/Int64 fb matches(in.b), std_msgs/Int64 fs matches(out.s) )
+  assume( TRUE )
+  guarantee( out.s == in.a + in.b )
+  progress( within 0 steps )
+}
+
+node Clamp {
+  inputs( limit : INTEGER, v : INTEGER )
+  outputs( c : INTEGER )
+  topics( std_msgs/Int64 limit matches(in.limit), std_msgs/Int64 cmd matches(in.v),
+          std_msgs/Int64 clamped matches(out.c) )
+  assume( TRUE )
+  guarantee( out.c <= in.limit )
+}
+
+node Sink {
+  inputs( v : REAL )
+  outputs( w : REAL )
+  topics( std_msgs/Float64 nan matches(in.v), std_msgs/Float64 nan_out matches(out.w) )
+  assume( TRUE )
+  guarantee( out.w == in.v )
+}
+"""
+MAPPING = """\
+topics:
+  battery: {fields: [percentage]}
+  scan: {fields: [ranges]}
+  limit: {state: true}
+"""
+
+SYSTEM = """\
+import math, struct, time
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, DurabilityPolicy, ReliabilityPolicy
+from sensor_msgs.msg import BatteryState, LaserScan
+from std_msgs.msg import Bool, Float64, Int64
+
+rclpy.init()
+n = Node("robot")
+LIMIT = struct.unpack("f", struct.pack("f", 0.2))[0]  # 0.2 as a float32 field carries it
+pubs = {k: n.create_publisher(t, k, 10) for k, t in (
+    ("battery", BatteryState), ("home", Bool), ("slip_home", Bool), ("scan", LaserScan), ("stop", Bool),
+    ("blind_stop", Bool), ("x", Int64), ("y", Int64), ("fa", Int64), ("fb", Int64), ("fs", Int64),
+    ("cmd", Int64), ("clamped", Int64), ("nan", Float64), ("nan_out", Float64))}
+latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
+limit_pub = n.create_publisher(Int64, "limit", latched)
+limit_pub.publish(Int64(data=7))  # once, before anyone listens
+
+n.create_subscription(BatteryState, "battery", lambda m: (
+    pubs["home"].publish(Bool(data=m.percentage <= LIMIT)),
+    pubs["slip_home"].publish(Bool(data=m.percentage < LIMIT))), 10)
+n.create_subscription(LaserScan, "scan", lambda m: (
+    pubs["stop"].publish(Bool(data=any(r < 0.5 for r in m.ranges))),
+    pubs["blind_stop"].publish(Bool(data=any(r < 0.5 for r in m.ranges[:-1])))), 10)
+n.create_subscription(Int64, "x", lambda m: pubs["y"].publish(Int64(data=m.data)), 10)
+got = {}
+def fused(k, m):
+    got[k] = m.data
+    if len(got) == 2:
+        pubs["fs"].publish(Int64(data=got["a"] + got["b"]))
+        got.clear()
+n.create_subscription(Int64, "fa", lambda m: fused("a", m), 10)
+n.create_subscription(Int64, "fb", lambda m: fused("b", m), 10)
+limit = [None]
+n.create_subscription(Int64, "limit", lambda m: limit.__setitem__(0, m.data), latched)
+n.create_subscription(Int64, "cmd", lambda m: pubs["clamped"].publish(Int64(data=min(m.data, limit[0]))), 10)
+n.create_subscription(Float64, "nan", lambda m: pubs["nan_out"].publish(Float64(data=m.data)), 10)
+ex = SingleThreadedExecutor()
+ex.add_node(n)
+
+def spin(seconds):
+    until = time.monotonic() + seconds
+    while time.monotonic() < until:
+        ex.spin_once(timeout_sec=0.005)
+
+spin(0.5)
+print("ready", flush=True)
+levels = [0.5, 0.2, 0.1]
+scans = [[1.0, 2.0, 3.0], [1.0, 0.3, 3.0], [1.0, 2.0, 0.3]]
+for k in range(90):  # 0.07 s apart: about 6 s, the monitor starting after about 1.5 s
+    pubs["battery"].publish(BatteryState(percentage=levels[k % 3]))
+    pubs["scan"].publish(LaserScan(ranges=scans[k % 3]))
+    pubs["x"].publish(Int64(data=k))
+    pubs["fa"].publish(Int64(data=k))
+    pubs["fb"].publish(Int64(data=2 * k))  # at the same instant as fa: one question
+    pubs["cmd"].publish(Int64(data=k % 12))
+    pubs["nan"].publish(Float64(data=math.nan))
+    spin(0.07)
+print("done", flush=True)
+while True:
+    ex.spin_once(timeout_sec=0.1)
+"""
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    ros2_python()  # skips, with the reason, without a ROS 2 Python
+    tmp = tmp_path_factory.mktemp("carried")
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/sys.rcl").write_text(RCL)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
+    (ws / "mapping.yaml").write_text(MAPPING)
+    env = ros2_env(tmp)
+    system = monitor = nan = None
+    common = ["--live", "--ros2", "--mapping", "mapping.yaml", "--horizon", "0.5", "--status", "0",
+              "--duration", "60"]
+    try:
+        system = start_node(tmp, "system", SYSTEM, env)
+        time.sleep(1.5)  # the publishers run before any monitor
+        monitor = rclverify(["monitor", "-w", str(ws), *common, "--strict", "--log", str(tmp / "live.jsonl"),
+                             "--record", str(tmp / "bag"), "--evidence", str(tmp / "live.json")],
+                            env, tmp, tmp / "monitor.out")
+        nan = rclverify(["monitor", "-w", str(ws), *common, "--node", "Sink", "--strict", "--verdict-topic",
+                         "/nan/verdict", "--evidence", str(tmp / "nan.json")], env, tmp, tmp / "nan.out")
+        wait_for(tmp / "system.log", "done", 40)
+        time.sleep(1.0)
+        stop(monitor, signal.SIGINT)
+        stop(nan, signal.SIGINT)
+        yield {"tmp": tmp, "ws": ws, "code": monitor.returncode, "out": (tmp / "monitor.out").read_text(),
+               "log": [json.loads(x) for x in (tmp / "live.jsonl").read_text().splitlines()],
+               "record": json.loads((tmp / "live.json").read_text()),
+               "nan": {"code": nan.returncode, "out": (tmp / "nan.out").read_text(),
+                       "record": json.loads((tmp / "nan.json").read_text())}}
+    finally:
+        for p in (system, monitor, nan):
+            if p is not None:
+                stop(p)
+
+
+def _verdicts(run: dict[str, Any], node: str) -> list[dict[str, Any]]:
+    return [x["verdict"] for x in run["log"] if x.get("topic") == "rclverify/verdict" and "kind" not in x
+            and x["verdict"].get("node") == node]
+
+
+def _inputs(run: dict[str, Any], topic: str, field: str) -> dict[int, Any]:
+    return {i: x[field] for i, x in enumerate(run["log"]) if x.get("topic") == topic}
+
+
+def test_float32_at_a_decimal_threshold_live(run: dict[str, Any]) -> None:
+    battery, slip = _verdicts(run, "Battery"), _verdicts(run, "Slip")
+    assert battery and {v["verdict"] for v in battery} == {"satisfied"}, battery
+    bad = [v for v in slip if v["verdict"] == "violated"]
+    assert bad and {v["verdict"] for v in slip} == {"satisfied", "violated"}, slip
+    # every violation answers a battery message at 0.2 (float32 on the wire: 0.2000000030)
+    assert all(v["values"]["in.p"].startswith("0.2000000") for v in bad), bad
+
+
+def test_laserscan_ranges_judged_live(run: dict[str, Any]) -> None:
+    guard, blind = _verdicts(run, "Guard"), _verdicts(run, "Blind")
+    assert guard and {v["verdict"] for v in guard} == {"satisfied"}, guard
+    bad = [v for v in blind if v["verdict"] == "violated"]
+    assert bad and all(v["values"]["out.stop"] == "FALSE" for v in bad), blind
+    # only the last beam near, as the float32 field carries 0.3
+    assert all(v["values"]["in.ranges"] == "<1.0, 2.0, 0.30000001192092896>" for v in bad), bad
+
+
+def test_a_monitor_started_after_the_publishers_blames_no_one(run: dict[str, Any]) -> None:
+    decl = {d["node"]: d for d in run["record"]["declarations"]}
+    for node in ("Echo", "Fuse"):
+        assert decl[node]["status"] == "discharged", decl[node]
+    # what was heard before the readers all matched is at worst undecided (an input alone, an input
+    # superseded before any answer was heard), never violated
+    for node in ("Echo", "Fuse"):
+        verdicts = {v["verdict"] for v in _verdicts(run, node)}
+        assert "satisfied" in verdicts and not verdicts & {"violated", "inconclusive"}, (node, verdicts)
+
+
+def test_a_latched_input_is_delivered_as_ros2_delivers_it(run: dict[str, Any]) -> None:
+    limits = [x for x in run["log"] if x.get("topic") == "limit"]
+    assert len(limits) == 1 and limits[0]["data"] == 7  # published once, before the monitor joined
+    clamp = _verdicts(run, "Clamp")
+    # the latched limit is the state every later command is judged with: never "incomplete input"; it came
+    # before any answer, so it asks nothing itself (superseded, docs/semantics.md "Steps")
+    assert clamp and {v["verdict"] for v in clamp} <= {"satisfied", "superseded"}, clamp
+    assert sum(v["verdict"] == "satisfied" for v in clamp) >= 30
+
+
+def test_the_verdicts_are_the_same_offline_and_in_the_bag(run: dict[str, Any],
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    for source in ("live.jsonl", "bag"):
+        code = main(["monitor", "-w", str(run["ws"]), "--mapping", "mapping.yaml", "--horizon", "0.5",
+                     "--node", "Slip", "--node", "Battery", "--node", "Guard", "--node", "Blind",
+                     str(run["tmp"] / source)])
+        out = capsys.readouterr().out
+        assert code == 1, out
+        for node in ("Slip", "Blind"):
+            n = sum(v["verdict"] == "violated" for v in _verdicts(run, node))
+            assert f"{n} violated" in out.split(f"{node}:")[0].rsplit("\n", 2)[-1] + out, (node, out)
+    assert run["code"] == 1, run["out"]
+
+
+def test_a_live_run_that_decided_nothing_fails_strict(run: dict[str, Any]) -> None:
+    nan = run["nan"]
+    assert nan["code"] == 1, nan["out"]
+    assert "nothing" in nan["out"] and "Sink" in nan["out"], nan["out"]
+    assert nan["record"]["not_judged"], nan["record"]
