@@ -51,7 +51,8 @@ def add_parsers(sub: Any) -> None:
     c = rs.add_parser("check", help="check the plan's contracts against the graph of its ros: section")
     c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
     c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
-    c.add_argument("--strict", action="store_true", help="accepted for older command lines: ros check always exits 1 on a grounding error")
+    c.add_argument("--strict", action="store_true", help="also exit 1 when a program the packages declare is no node "
+                   "of the graph (each is listed either way); any grounding error always exits 1")
     c.add_argument("--json", metavar="FILE", help="write the findings as JSON")
     c.set_defaults(fn=cmd_check)
 
@@ -208,9 +209,17 @@ def init_from_ros(args: argparse.Namespace) -> int:
         if not Path(p).exists():
             print(f"{p}: error: no such file or directory", file=sys.stderr)
             return 2
-    res = scan([Path(p) for p in args.from_ros], [Path(p) for p in args.launch])
+    res = scan([Path(p) for p in args.from_ros], [Path(p) for p in args.launch], base=_shown_base(
+        [Path(p) for p in list(args.from_ros) + [str(Path(lf).parent) for lf in args.launch]]))
     for n in res.graph.notes:
         print(n, file=sys.stderr)
+    missing = unaccounted_lines(res.graph.programs)
+    for line in missing:
+        print(line, file=sys.stderr)
+    if missing and getattr(args, "strict", False):
+        print(f"{args.from_ros[0]}: error: {len(missing) - 1} declared program(s) are no node of the graph "
+              f"(--strict); nothing written", file=sys.stderr)
+        return 1
     if not res.graph.nodes:
         print(f"{args.from_ros[0]}: error: no ROS node found (no launch file node, no source naming its node)",
               file=sys.stderr)
@@ -227,6 +236,54 @@ def init_from_ros(args: argparse.Namespace) -> int:
     return 0
 
 
+def _shown_base(paths: list[Path]) -> Path | None:
+    """Where the scan's locations are shown from: the current directory when it
+    holds every path (as ``ros scan`` does), else the directory above the paths'
+    common one, so that no absolute path of this machine goes into the skeletons'
+    comments (``robot_driver/src/driver.cpp:12``); ``None`` for the current one."""
+    import os  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    real = [os.path.realpath(p) for p in paths]
+    here = os.path.realpath(os.getcwd())
+    if all(r == here or r.startswith(here.rstrip(os.sep) + os.sep) for r in real):
+        return None
+    common = os.path.commonpath(real)
+    parent = os.path.dirname(common)
+    return Path(parent) if parent and parent != os.sep else Path(common)
+
+
+def unaccounted_lines(programs: list[dict[str, Any]]) -> list[str]:
+    """One ``file:line:col: unaccounted: ...`` line per declared program that is no
+    node of the graph (the scan's ``programs``, ros/graph/accounting.py), then a count."""
+    out = []
+    for p in programs:
+        if p.get("unaccounted"):
+            d = p["declared"]
+            out.append(f"{d['file']}:{d['line']}:{d['col']}: unaccounted: {p['kind']} {p['name']} of package "
+                       f"{p['package']}: {p['unaccounted']}")
+    if out:
+        out.append(f"programs: {len(out)} of {len(programs)} declared are no node of the graph")
+    return out
+
+
 def cmd_check(args: argparse.Namespace) -> int:
-    from rclverify.app.ros_stage import run_check  # deferred: start-up (loads rclverify.app, rclverify.app.ros_stage and more only when called)
-    return run_check(Path(args.workspace), args.plan, args.strict, args.json)
+    """``rclverify ros check``: the grounding (exit 1 on any grounding error), then the
+    declared programs that are no node of the graph, listed; with ``--strict`` any
+    such program is exit 1 too."""
+    from rclverify.app.ros_stage import GRAPH, run_check  # deferred: start-up (loads rclverify.app, rclverify.app.ros_stage and more only when called)
+    import time  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    start = time.time()
+    rc = run_check(Path(args.workspace), args.plan, args.strict, args.json)
+    path = Path(args.workspace) / GRAPH
+    try:
+        if path.stat().st_mtime < start - 1:
+            return rc  # no graph written by this run: the plan could not be read (already said)
+        graph = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return rc
+    missing = unaccounted_lines(graph.get("programs", []) if isinstance(graph, dict) else [])
+    for line in missing:
+        print(line)
+    if missing and args.strict:
+        print(f"ros check --strict: {len(missing) - 1} declared program(s) are no node of the graph", file=sys.stderr)
+        return 1
+    return rc

@@ -105,6 +105,9 @@ def add_init(add: AddCommand) -> None:
     i.add_argument("--library-endpoints", action="store_true",
                    help="with --from-ros: also make the libraries' endpoints (tf, bond, diagnostics, interactive "
                         "markers) contract inputs and outputs; by default they are listed apart")
+    i.add_argument("--strict", action="store_true",
+                   help="with --from-ros: exit 1 when a program the packages declare is no node of the graph "
+                        "(each listed; docs/ros.md, \"Every program accounted for\")")
 
 
 def add_review(add: AddCommand) -> None:

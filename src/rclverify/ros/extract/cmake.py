@@ -4,7 +4,8 @@ The CMake language (cmake-language(7)): a file is a sequence of command
 invocations ``name(arg ...)``; ``#`` comments (and ``#[[ ]]`` bracket
 comments) are dropped; an argument is unquoted, ``"quoted"`` or a
 ``[[bracket]]`` argument; ``${VAR}`` references are substituted from
-``set(VAR value...)`` in order (``${PROJECT_NAME}`` is the package name).
+``set(VAR value...)`` in order (``${PROJECT_NAME}`` is the package name); ``include(file.cmake)`` of a package
+file runs that file's commands in place.
 
 ``function(name params...)`` / ``macro(name params...)`` bodies are recorded
 and each call of them is replaced by the body with ``${param}``, ``${ARGV}``,
@@ -133,17 +134,43 @@ def _block(seq: list[tuple[str, list[str], int]], i: int, opener: str, closer: s
 _Cmd = tuple[str, list[str], int]
 
 
-def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = None) -> list[tuple[str, list[str], int]]:
+def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = None,
+           read: Callable[[str], str | None] | None = None) -> list[tuple[str, list[str], int]]:
     """The commands ``text`` runs, with variables substituted, ``foreach`` loops
     unrolled and calls of the file's own ``function``/``macro`` definitions
     replaced by their bodies (arguments substituted); each keeps the line of
     the top-level call.  Arguments holding ``;`` lists are split, as CMake does
     for unquoted ones.  ``glob(pattern, recurse)`` lists the package files a
-    ``file(GLOB ...)`` pattern matches (relative paths); without it globs are empty."""
-    defs, top = _definitions(commands_of(text))
+    ``file(GLOB ...)`` pattern matches (relative paths); without it globs are empty.
+    ``read(path)`` gives the text of a package file an ``include(path.cmake)`` names
+    (``None`` when it cannot): its commands, its functions and macros included, run
+    where the ``include`` is, at its line."""
+    defs, top = _definitions(_included(commands_of(text), read, 0))
     runner = _Runner(defs, glob)
     runner.run(top, {"PROJECT_NAME": pkg, "CMAKE_CURRENT_SOURCE_DIR": ".", "PROJECT_SOURCE_DIR": "."}, 0, None)
     return runner.out
+
+
+MAX_INCLUDES = 4  # nested include() of package .cmake files
+
+
+def _included(cmds: list[_Cmd], read: Callable[[str], str | None] | None, depth: int) -> list[_Cmd]:
+    """``cmds`` with each ``include(file.cmake)`` of the package replaced by that
+    file's commands (at the ``include``'s line); a module name (``include(CTest)``)
+    or a file that cannot be read stays as it is."""
+    out: list[_Cmd] = []
+    for name, args, line in cmds:
+        if name == "include" and read is not None and args and depth < MAX_INCLUDES \
+                and args[0].endswith(".cmake"):
+            path = args[0]
+            for var in ("${CMAKE_CURRENT_SOURCE_DIR}/", "${PROJECT_SOURCE_DIR}/", "${CMAKE_CURRENT_LIST_DIR}/"):
+                path = path.replace(var, "")
+            text = read(path) if "${" not in path else None
+            if text is not None:
+                out += [(n, a, line) for n, a, _l in _included(commands_of(text), read, depth + 1)]
+                continue
+        out.append((name, args, line))
+    return out
 
 
 def _definitions(cmds: list[_Cmd]) -> tuple[dict[str, tuple[list[str], list[_Cmd]]], list[_Cmd]]:

@@ -51,7 +51,7 @@ class CallReader:
             return
         if full.endswith("Node::make_shared") and args:
             self.node(s.value(args[0]), n, s.value(args[1]) if len(args) > 1 else None,
-                      "lifecycle" if "LifecycleNode" in full else None)
+                      "lifecycle" if "LifecycleNode" in full else None, args)
             return
         if full.endswith("Options::create") or (last == "init" and recv is not None and targs):
             return  # options: read where subscribe(ops) / advertise(ops) uses them

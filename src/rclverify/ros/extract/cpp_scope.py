@@ -17,6 +17,8 @@ Local variables are scoped by function; members by class.
 """
 from __future__ import annotations
 
+import re
+
 from typing import Any
 
 from rclverify.ros.extract import symbols, treesitter
@@ -70,7 +72,21 @@ def is_node_type(type_text: str) -> bool:
     ``rclcpp::Node::SharedPtr``, ``rclcpp_lifecycle::LifecycleNode *``,
     ``std::shared_ptr<rclcpp::Node>`` ...)."""
     t = type_text.replace(" ", "")
+    if "NodeOptions" in t:  # rclcpp::NodeOptions: a node's settings, not a node
+        return False
     return "NodeHandle" in t or "rclcpp::Node" in t or "LifecycleNode" in t or t.split("<")[0].endswith("Node")
+
+
+def _untemplated(name: str) -> str:
+    """A function's declarator name without template argument lists:
+    ``RosFilter<T>::initialize`` -> ``RosFilter::initialize`` (an out-of-line member
+    of a class template), ``make<T>`` -> ``make``."""
+    for _ in range(8):
+        new = re.sub(r"<[^<>()]*>", "", name)
+        if new == name:
+            break
+        name = new
+    return name.split("<")[0]
 
 
 def base_name(type_text: str) -> str:
@@ -139,7 +155,17 @@ class CppScope:
                 self._declaration(n)
             elif n.type == "for_range_loop":  # for (auto & s : sources): s is each element
                 nm, fn = _declarator_name(n.child_by_field_name("declarator")), self.fn_of(n)
-                if nm is not None and fn is not None and n.child_by_field_name("right") is not None:
+                d = n.child_by_field_name("declarator")
+                while d is not None and d.type in ("reference_declarator", "pointer_declarator"):
+                    d = next((c for c in d.named_children if c.type == "structured_binding_declarator"), None) \
+                        or d.child_by_field_name("declarator")
+                nm = d if d is not None and d.type == "structured_binding_declarator" else nm
+                if nm is not None and nm.type == "structured_binding_declarator" and fn is not None \
+                        and n.child_by_field_name("right") is not None:  # for (auto & [key, topic] : topics)
+                    for i, part in enumerate(c for c in nm.named_children if c.type == "identifier"):
+                        self.locals.setdefault((fn.nid, _T(part)), []).append(
+                            ("each", n.child_by_field_name("right"), i))
+                elif nm is not None and fn is not None and n.child_by_field_name("right") is not None:
                     self.ltypes[(fn.nid, _T(nm))] = _T(n.child_by_field_name("type"))
                     self.locals.setdefault((fn.nid, _T(nm)), []).append(("each", n.child_by_field_name("right")))
             elif n.type == "assignment_expression" and n.child_by_field_name("operator") is not None:
@@ -160,6 +186,10 @@ class CppScope:
                     self._bind(r[2], ("read", n), n)
                 f = n.child_by_field_name("function")
                 self._mutation(n, f)
+                if f is not None and f.type == "field_expression" and _T(f.child_by_field_name("field")) == \
+                        "arguments" and n.child_by_field_name("arguments") is not None and any(
+                        a.type == "initializer_list" for a in n.child_by_field_name("arguments").named_children):
+                    self._bind(f.child_by_field_name("argument"), n, n)  # options.arguments({"name"}): set in place
                 if f is not None and f.type == "field_expression" and f.child_by_field_name("field") is not None \
                         and f.child_by_field_name("field").type == "template_method" \
                         and _T(f.child_by_field_name("field").child_by_field_name("name")) == "init":
@@ -201,7 +231,7 @@ class CppScope:
             fd = fd.child_by_field_name("declarator")
         if fd is None:
             return
-        name = _T(fd.child_by_field_name("declarator")).split("<")[0].replace(" ", "")
+        name = _untemplated(_T(fd.child_by_field_name("declarator")).replace(" ", ""))
         nss, cls = namespaces_of(n)
         pre = "::".join(nss + cls)
         key = f"{pre}::{name}" if pre else name
@@ -302,8 +332,10 @@ class CppScope:
                 self.locals.setdefault(key, []).append(("nhargs", list(v.named_children) if v is not None else []))
             elif v is not None and v.type not in ("argument_list", "initializer_list"):
                 self.locals.setdefault(key, []).append(v)
-            elif v is not None and len(v.named_children) == 1:
+            elif v is not None and len(v.named_children) == 1 and v.named_children[0].type != "initializer_list":
                 self.locals.setdefault(key, []).append(v.named_children[0])
+            elif v is not None and v.type == "initializer_list" or v is not None and len(v.named_children) == 1:
+                self.locals.setdefault(key, []).append(("elems", v))  # a container of literals, iterated
             else:
                 self.locals.setdefault(key, [])
 

@@ -36,6 +36,12 @@ _LIBRARY = ("std::", "ros::", "rclcpp", "boost::", "tf2", "Eigen::", "rcutils_",
 #: (rclcpp >= Humble) and ``rclcpp::expand_topic_or_service_name`` (name, node name, namespace).
 _RESOLVERS = ("resolve_topic_or_service_name", "expand_topic_or_service_name")
 
+#: rclcpp::NodeOptions' setters, each returning the options (rclcpp/node_options.hpp)
+_OPTION_SETTERS = ("use_intra_process_comms", "use_global_arguments", "enable_rosout", "start_parameter_services",
+                   "start_parameter_event_publisher", "allow_undeclared_parameters", "parameter_overrides",
+                   "append_parameter_override", "automatically_declare_parameters_from_overrides", "context",
+                   "enable_topic_statistics", "use_clock_thread")
+
 _OPTIONS = {"SubscribeOptions": "sub", "AdvertiseOptions": "pub", "AdvertiseServiceOptions": "service_servers"}
 
 
@@ -85,7 +91,28 @@ class CppValues(CppScope):
             return self._name_value(n, depth)
         if t == "subscript_expression" and _T(n.child_by_field_name("argument")) == "argv":
             return ("runtime", "from argv")  # main's argv[i]: the command line (symbols)
+        if t == "subscript_expression":  # options.arguments()[0]
+            idx = n.child_by_field_name("indices") or n.child_by_field_name("index")
+            if idx is not None and idx.type == "subscript_argument_list" and idx.named_children:
+                idx = idx.named_children[0]
+            return self._option_arg(n.child_by_field_name("argument"), idx, depth)
         return None
+
+    def _option_arg(self, recv: Any, idx: Any, depth: int) -> symbols.Val:
+        """``("optarg", options, i)`` for ``options.arguments()[i]`` (``.at(i)``,
+        ``.front()`` when ``idx`` is ``None``): a node name passed in
+        ``rclcpp::NodeOptions::arguments`` and read back in the constructor."""
+        if recv is None or recv.type != "call_expression":
+            return None
+        f = recv.child_by_field_name("function")
+        if f is None or f.type != "field_expression" or _T(f.child_by_field_name("field")) != "arguments":
+            return None
+        try:
+            i = int(_T(idx)) if idx is not None else 0
+        except ValueError:
+            return None
+        opts = self.value(f.child_by_field_name("argument"), depth + 1)
+        return ("optarg", opts, i) if opts is not None else None
 
     def _call_value(self, n: Any, depth: int) -> symbols.Val:
         fn = n.child_by_field_name("function")
@@ -123,6 +150,14 @@ class CppValues(CppScope):
             if not args and recv is not None and recv.type == "call_expression":
                 inner = self.value(recv, depth + 1)  # get_parameter("t").as_string(), wrapper(node, "t").get<T>()
                 if inner is not None and inner[0] in ("param", "ret"):
+                    return inner
+            if method == "arguments" and len(args) == 1 and args[0].type == "initializer_list":
+                return ("opts", tuple(self.value(x, depth + 1) for x in args[0].named_children))  # NodeOptions
+            if method in ("at", "front") and len(args) <= 1 and recv is not None:
+                return self._option_arg(recv, args[0] if args else None, depth)
+            if method in _OPTION_SETTERS and recv is not None:  # NodeOptions().arguments(...).use_...(true)
+                inner = self.value(recv, depth + 1)
+                if inner is not None and inner[0] == "opts":
                     return inner
             if method == "create_sub_node" and len(args) == 1:
                 return ("nh", (("h", self.value(recv, depth + 1)), ("ns", self.value(args[0], depth + 1))))
@@ -239,6 +274,12 @@ class CppValues(CppScope):
                 return ("nh", ())
             return self.value(n.named_children[-1], depth + 1) if n.named_children else None
         if t == "field_expression":
+            part = _T(n.child_by_field_name("field"))
+            if part in ("first", "second") and _T(n.child_by_field_name("argument")) != "this":
+                pairs = self.value(n.child_by_field_name("argument"), depth + 1)  # kv.second over a map
+                if pairs is not None and pairs[0] == "any" and all(x[0] == "pair" for x in pairs[1]):
+                    return ("any", tuple(x[1][part == "second"] for x in pairs[1]))
+                return None
             if _T(n.child_by_field_name("argument")) != "this" or fn is None:
                 return None
             return self._member(fn, _T(n.child_by_field_name("field")), depth)
@@ -290,6 +331,10 @@ class CppValues(CppScope):
                                   for x in self.locals.get((callee.nid, b[2]), [])]) if depth < MAX_DEPTH else None
             if b[0] == "nhargs":
                 return self.handle(b[1], depth + 1)
+            if b[0] == "elems":  # a container, not a name
+                return None
+            if b[0] == "each" and (len(b) > 2 or self._elements(b[1], depth) is not None):
+                return self._element(b, depth)
             if b[0] == "each":  # an element of a string-array parameter (symbols.each)
                 arr = self.value(b[1], depth + 1)
                 return ("each", arr[1]) if arr is not None and arr[0] == "param" and isinstance(arr[1], str) \
@@ -303,6 +348,40 @@ class CppValues(CppScope):
                 return self.handle(b[1], depth + 1)
             return b
         return self.value(b, depth + 1)
+
+    def _elements(self, n: Any, depth: int) -> list[Any] | None:
+        """The element expressions of a container of literals a range-for iterates:
+        ``{"a", "b"}`` itself, or a local bound once to one (``std::vector<std::string>
+        names{"a", "b"}``, ``std::map<std::string, std::string> m{{"k", "t"}}``);
+        ``None`` for anything else."""
+        if n is None or depth > MAX_DEPTH:
+            return None
+        if n.type == "initializer_list":
+            return list(n.named_children)
+        f = self.fn_of(n) if n.type == "identifier" else None
+        binds = self.locals.get((f.nid, _T(n)), []) if f is not None else []
+        if len(binds) == 1 and isinstance(binds[0], tuple) and binds[0][0] == "elems":
+            inner = binds[0][1]
+            kids = list(inner.named_children)
+            if len(kids) == 1 and kids[0].type == "initializer_list" and all(
+                    k.type == "initializer_list" for k in kids[0].named_children):
+                kids = list(kids[0].named_children)  # m{{{"k", "t"}, ...}} written with one more brace
+            return kids
+        return None
+
+    def _element(self, b: tuple[Any, ...], depth: int) -> symbols.Val:
+        """A range-for variable over a container of literals (:meth:`_elements`):
+        ``("any", values)`` of its elements, or of part ``b[2]`` of each pair (a
+        structured binding ``[key, topic]``); a pair element is ``("pair", (k, v))``."""
+        elems = self._elements(b[1], depth) or []
+        vals: list[symbols.Val] = []
+        for el in elems:
+            if el.type == "initializer_list" and len(el.named_children) == 2:
+                pair = tuple(self.value(x, depth + 1) for x in el.named_children)
+                vals.append(pair[b[2]] if len(b) > 2 and b[2] < 2 else ("pair", pair))
+            else:
+                vals.append(self.value(el, depth + 1) if len(b) == 2 else None)
+        return ("any", tuple(vals)) if vals and all(v is not None for v in vals) else None
 
     @staticmethod
     def _one(vals: list[symbols.Val]) -> symbols.Val:

@@ -6,8 +6,9 @@ of the same workspace: its base class (``pkg_util::LifecycleNode``), a twist
 subscriber or publisher wrapper, an odometry smoother, a service client
 wrapper, each creating endpoints with the names its caller passes.  The
 linker (:mod:`link`) reads such names across a program's files; this module
-adds the files of the other packages that a program includes, so the
-linker follows calls into them as it does within one package.
+adds the files of the other packages that a program includes (C++) or
+imports (Python), so the linker follows calls into them as it does within
+one package.
 
 Rules (the ament layout of a C++ package, ROS 2 "Developer Guide: Code style
 and language versions", and REP 122's ``include/<package>/`` headers):
@@ -53,34 +54,53 @@ def _implementations(code: PackageCode, header: str) -> list[str]:
 
 
 def extend(prog: Program, codes: dict[str, PackageCode]) -> dict[str, str]:
-    """Add to C++ program ``prog`` (in place, to ``prog.files``) the files of other
-    packages it includes (see the module docstring).
+    """Add to program ``prog`` (in place, to ``prog.files``) the files of other
+    packages it includes (C++) or imports (Python: ``from other_pkg.module import
+    Node``, a package's modules importable by its name, ament_python's layout),
+    transitively (see the module docstring).
 
     ``codes``: every scanned package's code by name.  Returns ``{file: package}``
-    of the files added (empty for a Python program, or one that includes no other
-    package).  Never raises."""
+    of the files added (empty for one that takes in no other package).  Never raises."""
     own = codes.get(prog.package)
-    if own is None or any(own.records.get(f, {}).get("lang") == "py" for f in prog.entry):
+    if own is None:
         return {}
+    python = any(own.records.get(f, {}).get("lang") == "py" for f in prog.entry)
     added: dict[str, str] = {}
     todo = list(prog.files)
     seen = set(todo)
     while todo and len(added) < MAX_FILES:
         f = todo.pop(0)
         pkg_of_f = added.get(f, prog.package)
-        rec = codes[pkg_of_f].records.get(f, {})
-        for inc in rec.get("includes", []):
-            hit = _other(inc, pkg_of_f, codes)
-            if hit is None or hit[0] == prog.package or hit[1] in seen:
-                continue
-            pkg, header = hit
-            for g in _closure(codes[pkg], [header] + _implementations(codes[pkg], header), set()):
+        for pkg, start in (_imported if python else _included)(codes, pkg_of_f, f, prog.package):
+            for g in _closure(codes[pkg], start, set()):
                 if g not in seen:
                     seen.add(g)
                     added[g] = pkg
                     todo.append(g)
     prog.files.extend(added)
     return added
+
+
+def _included(codes: dict[str, PackageCode], pkg_of_f: str, f: str, own: str) -> list[tuple[str, list[str]]]:
+    """``[(package, files to start from)]``: the other packages' headers C++ file ``f``
+    includes, each with its implementation."""
+    out = []
+    for inc in codes[pkg_of_f].records.get(f, {}).get("includes", []):
+        hit = _other(inc, pkg_of_f, codes)
+        if hit is not None and hit[0] != own:
+            out.append((hit[0], [hit[1]] + _implementations(codes[hit[0]], hit[1])))
+    return out
+
+
+def _imported(codes: dict[str, PackageCode], pkg_of_f: str, f: str, own: str) -> list[tuple[str, list[str]]]:
+    """``[(package, [module file])]``: the other packages' modules Python file ``f`` imports."""
+    out = []
+    for origin in codes[pkg_of_f].records.get(f, {}).get("imports", []):
+        pkg = origin.split(".", 1)[0]
+        hit = codes[pkg].module(origin) if pkg in codes and pkg != own else None
+        if hit is not None:
+            out.append((pkg, [hit[0]]))
+    return out
 
 
 def view(prog: Program, codes: dict[str, PackageCode], added: dict[str, str]) -> PackageCode:

@@ -62,6 +62,23 @@ class Targets:
     nodelets: dict[str, tuple[str, str | None]] = field(default_factory=dict)
     pluginlib: list[PluginClass] = field(default_factory=list)
     plugin_notes: list[Note] = field(default_factory=list)
+    declared: list[Declared] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Declared:
+    """One program a package's build files declare (docs/ros.md, "Every program
+    accounted for"): ``kind`` (``executable``, ``component``, ``entry point``),
+    its ``name`` (an executable's, or a component's class), the build ``file``
+    and ``line`` declaring it, the ``sources`` it names as written, and whether
+    they all exist (``found``)."""
+
+    kind: str
+    name: str
+    file: Path
+    line: int
+    sources: tuple[str, ...] = ()
+    found: bool = True
 
 
 MAX_GLOB_DIRS = 2000  # directories one file(GLOB) pattern may visit
@@ -92,6 +109,23 @@ def _glob(root: Path):  # type: ignore[no-untyped-def]
     return g
 
 
+def _reader(root: Path, here: Path):  # type: ignore[no-untyped-def]
+    """``read(path)`` for :func:`cmake.expand`'s ``include()``: the text of a file of
+    the package at ``root`` (relative to ``here``), ``None`` outside it or unreadable."""
+    real_root = os.path.realpath(root)
+
+    def read(rel: str) -> str | None:
+        f = here / rel
+        real = os.path.realpath(f)
+        if not real.startswith(real_root + os.sep):
+            return None
+        try:
+            return safefs.read_text(f)
+        except OSError:
+            return None
+    return read
+
+
 MAX_SUBDIRS = 32  # CMakeLists.txt files read per package (add_subdirectory)
 
 
@@ -106,12 +140,16 @@ def targets(root: Path, pkg: str) -> Targets:
         here = todo.pop(0)
         seen += 1
         try:
-            cmds = expand(safefs.read_text(here / "CMakeLists.txt"), pkg, _glob(here))
+            cmds = expand(safefs.read_text(here / "CMakeLists.txt"), pkg, _glob(here), _reader(root, here))
         except OSError:
             continue
         _read(cmds, here, t, auto_libs, todo)
     for exe, srcs in setup_py_executables(root).items():
         t.programs.setdefault(exe, srcs)
+    for d in entry_points(root):
+        t.declared.append(d)
+        if d.found:
+            t.programs.setdefault(d.name, [root / d.sources[0]])
     t.nodelets = plugin_classes(root)
     t.pluginlib, t.plugin_notes = described(root)
     for cls, lib in t.nodelets.values():
@@ -126,6 +164,11 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
     def files(srcs: list[str]) -> list[Path]:
         return [root / s for s in srcs if s not in _KEYWORDS and (root / s).is_file()]
 
+    def declare(kind: str, name: str, line: int, srcs: list[str]) -> None:
+        named = tuple(x for x in srcs if x not in _KEYWORDS and not x.startswith("$<"))
+        t.declared.append(Declared(kind, name, root / "CMakeLists.txt", line, named,
+                                   all((root / x).is_file() for x in named)))
+
     for name, args, line in cmds:
         if not args:
             continue
@@ -134,6 +177,7 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
             subdirs.append(root / args[0])
         elif name in _EXE and "IMPORTED" not in args and "ALIAS" not in args:
             t.executables.setdefault(args[0], []).extend(files(args[1:]))
+            declare("executable", args[0], line, args[1:])
             if name == "ament_auto_add_executable":
                 t.links.setdefault(args[0], []).extend(auto_libs)
         elif name in _LIB and "IMPORTED" not in args and "ALIAS" not in args and "INTERFACE" not in args[1:2]:
@@ -152,10 +196,12 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
                 t.plugins[cls] = args[0]
                 if "EXECUTABLE" in args and args.index("EXECUTABLE") + 1 < len(args):
                     t.components[args[args.index("EXECUTABLE") + 1]] = (cls, line)
+                declare("component", cls, line, [])
         elif name == "rclcpp_components_register_nodes" and len(args) > 1:
             for a in args[1:]:
                 if "::" in a:
                     t.plugins[a.lstrip(":")] = args[0]
+                    declare("component", a.lstrip(":"), line, [])
         elif name in ("catkin_install_python", "install") and "PROGRAMS" in args:
             k = args.index("PROGRAMS") + 1
             while k < len(args) and args[k] not in ("DESTINATION", "PERMISSIONS", "CONFIGURATIONS", "COMPONENT",
@@ -197,6 +243,37 @@ def setup_py_executables(root: Path) -> dict[str, list[Path]]:
                     out.setdefault(p.name, [p])
                     out.setdefault(p.stem, [p])
     return out
+
+
+def entry_points(root: Path) -> list[Declared]:
+    """The ``console_scripts`` entry points ``setup.py`` and ``setup.cfg`` declare
+    (``exe = pkg.module:main``), each with its line and module file (setuptools'
+    "Entry points" specification); ``found`` is false when the module file is not
+    in the package.  Read as text, never run."""
+    out: list[Declared] = []
+    for name in ("setup.py", "setup.cfg"):
+        f = root / name
+        try:
+            text = safefs.read_text(f)
+        except OSError:
+            continue
+        in_scripts = name == "setup.py"
+        for i, line in enumerate(text.splitlines(), 1):
+            if name == "setup.cfg" and line.strip().startswith("console_scripts"):
+                in_scripts = True
+                line = line.split("=", 1)[1] if "=" in line else ""
+            elif name == "setup.cfg" and line[:1] not in (" ", "\t", ""):
+                in_scripts = False
+            if not in_scripts:
+                continue
+            for m in _ENTRY_IN.finditer(line):
+                mod = m.group(2).replace(".", "/") + ".py"
+                if not any(d.name == m.group(1) for d in out):
+                    out.append(Declared("entry point", m.group(1), f, i, (mod,), (root / mod).is_file()))
+    return out
+
+
+_ENTRY_IN = re.compile(r"(?:^|[\"'\s])([A-Za-z0-9_.\-]+)\s*=\s*([A-Za-z_][A-Za-z0-9_.]*)\s*:\s*[A-Za-z_][A-Za-z0-9_]*")
 
 
 def executables(root: Path, pkg: str, py_nodes: list[Path]) -> dict[str, list[Path]]:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from rclverify.ros.extract import safefs
 
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +28,12 @@ from rclverify.ros.extract.model import Note, Src
 from rclverify.ros.extract.cmake import expand
 
 DEBIAN_SHARE = Path("/usr/share")
+
+
+def ament_prefixes() -> list[Path]:
+    """The install prefixes of a sourced ROS 2 (``AMENT_PREFIX_PATH``, in order;
+    ament_index's search path), those that exist."""
+    return [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p and Path(p).is_dir()]
 BASE_TYPES = {"bool", "byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
               "uint64", "float32", "float64", "string", "wstring", "time", "duration", "octet"}
 _COMMENT = re.compile(r"#.*$")
@@ -220,11 +227,51 @@ class TypeTable:
         self.notes = [n for n in self.notes if n.severity != "error" or not n.src.file.split("/")[0] in found]
         return found
 
-    def _fallback(self, name: str) -> TypeInfo | None:
+    def add_ament_index(self, cache: ParseCache | None, prefixes: Iterable[Path]) -> list[str]:
+        """Register the interface packages an installed ROS 2 lists in the ament
+        resource index of each prefix (``AMENT_PREFIX_PATH``'s entries:
+        ``share/ament_index/resource_index/rosidl_interfaces/<pkg>`` names the
+        package's interface files, found under ``share/<pkg>/``; ament_index's
+        layout).  A package the scan already has (a workspace package, an earlier
+        prefix) is not read again; of a package rosbags' ROS 2 store has messages
+        of, only its services and actions are read, so that a scan's messages do
+        not change with the installed distribution.  Returns the packages read."""
+        found: list[str] = []
+        have = {p.split("/")[0] for p in self.types}
+        for prefix in prefixes:
+            index = Path(prefix) / "share" / "ament_index" / "resource_index" / "rosidl_interfaces"
+            if not index.is_dir():
+                continue
+            for entry in sorted(index.iterdir()):
+                pkg = entry.name
+                if pkg in have or not entry.is_file():
+                    continue
+                have.add(pkg)
+                in_store = any(k.startswith(pkg + "/") for k in self._store_names())
+                try:
+                    listed = re.split(r"[;\n]", safefs.read_text(entry))  # one file a line (older: ';')
+                except OSError:
+                    continue
+                share = Path(prefix) / "share" / pkg
+                for rel in sorted({x.strip() for x in listed if x.strip().endswith((".msg", ".srv", ".action"))}):
+                    if in_store and rel.endswith(".msg"):
+                        continue
+                    f = share / rel
+                    if f.is_file():
+                        self.add_file(f, pkg, f"{pkg}/{rel}", "ament", cache)
+                found.append(pkg)
+        return found
+
+    def _store_names(self) -> Iterable[str]:
+        """The type names of rosbags' ROS 2 store (loaded once)."""
         if self._store is None:
             from rclverify.core.extras import require  # deferred: optional or conditional (inside a block)
             typesys = require("rosbags.typesys", "reading the standard ROS message types")  # MissingExtra: the ros extra
             self._store = typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
+        return self._store.fielddefs.keys()  # type: ignore[no-any-return]
+
+    def _fallback(self, name: str) -> TypeInfo | None:
+        self._store_names()
         fd = self._store.fielddefs.get(name)
         if fd is None:
             return None

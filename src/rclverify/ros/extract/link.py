@@ -38,6 +38,7 @@ from rclverify.ros.extract.cpp_types import split_template
 from rclverify.ros.extract.model import Endpoint, Note, Src
 from rclverify.ros.extract.link_members import LinkMembers
 from rclverify.ros.extract.link_returns import Returns
+from rclverify.ros.extract.link_types import Instances
 from rclverify.ros.extract.link_values import MAX_DEPTH, MAX_VALUES, Values
 from rclverify.ros.extract.programs import PackageCode, Program
 from rclverify.ros.extract.unit_names import canonical
@@ -64,7 +65,7 @@ UNBUILT = ("nothing this program runs is read to construct the class (a construc
            "emplace_back/push_back or a factory the scan does not follow is not read): not in the graph")
 
 
-class Linker(LinkMembers, Values, Returns):
+class Linker(LinkMembers, Values, Returns, Instances):
     """Link one program of a package (see the module docstring); ``known(t)`` says
     whether the scan's type table defines message type ``t``."""
 
@@ -88,6 +89,8 @@ class Linker(LinkMembers, Values, Returns):
         self.classes = [] if self.py else sorted(self.units)
         self.entry = prog.units if prog.units is not None else entry_units
         self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
+        self.site_targs: dict[str, list[tuple[list[str], str | None]]] = {}
+        self._targ_seen: dict[tuple[str, str | None, str | None, int], int] = {}
         # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
         self.edges: dict[str, set[str]] = {}
         self._link_calls(prog)
@@ -156,12 +159,18 @@ class Linker(LinkMembers, Values, Returns):
                 if here is not None:
                     self._edge(here, f"F:{k}")
                 self.sites.setdefault(k, []).append((args, kwargs, fkey))
+                self.record_site(k, callee, fkey, kind, unit, len(args))
         for k, (unit, *_rest) in self.fns.items():  # an overload's class made where no call is read: all run
-            if ("#" in k or k in overloaded) and not any(s.split("#")[0] == k.split("#")[0] for s in self.sites):
+            base = k.split("#")[0]
+            # a delegating constructor's call (Sensor(o) : Sensor("sensor", o)) is no construction read
+            outside = any(s.split("#")[0] == base and any((c or "").split("#")[0] != base for _a, _k, c in sites)
+                          for s, sites in self.sites.items())
+            if ("#" in k or k in overloaded) and not outside:
                 self._edge(f"U:{unit}", f"F:{k}")
         if prog.instance is not None:  # a plugin's methods its loader calls, given the instance's name
             for k, got in plugins.entry_sites(self.fns, set(prog.units or ()), set(self.sites), prog.instance).items():
                 self.sites[k] = list(got)
+                self.site_targs[k] = [([], None)] * len(got)
         for u, info in self.units.items():
             for ty in list(info["members"].values()) + info["bases"]:
                 for ident in _IDENT.findall(ty):
@@ -176,6 +185,12 @@ class Linker(LinkMembers, Values, Returns):
         if not t:
             return None
         cands = [u for u in self.classes if u == t or u.endswith("::" + t)]
+        for _ in range(4):  # using Filter = ns::FilterNode<Ekf>; make_shared<Filter>(...), or ns::Filter
+            alias = self.aliases.get(t) or self.aliases.get(t.split("::")[-1])
+            if cands or alias is None:
+                break
+            t = split_template(alias.replace(" ", ""))[0].strip(":")
+            cands = [u for u in self.classes if u == t or u.endswith("::" + t)]
         if not cands:
             return None
         if len(cands) > 1 and caller:
@@ -315,7 +330,12 @@ class Linker(LinkMembers, Values, Returns):
                     continue
                 raw.append((f, e))
         named = self.named(note, out)
-        for e in unbuilt if named else []:
+        unused = self.prog.exe is None and self.prog.units is None and not named and \
+            all(f.rsplit(".", 1)[-1] in ("h", "hh", "hpp", "hxx") for f in self.prog.entry)
+        # said even when the program names no node (never a silent miss), but for a plugin, whose
+        # loader makes it (plugins.py says so at each endpoint)
+        plugin = self.prog.plugin is not None or self.prog.instance is not None
+        for e in unbuilt if named or not (unused or plugin) else []:
             note(Note(e.src, f"{emit.WHAT[e.kind]} of class {e.unit}: {UNBUILT}"))
         self.user_creates(note)
         out.nodes = [(n, s, ns) for n, s, ns, _u, _p in named]
@@ -323,8 +343,6 @@ class Linker(LinkMembers, Values, Returns):
         got: list[tuple[Endpoint, int]] = []
         # a header no program of the package includes: its classes are for other packages to
         # make, with the names they give; what they leave open is not this package's to say
-        unused = self.prog.exe is None and self.prog.units is None and not named and \
-            all(f.rsplit(".", 1)[-1] in ("h", "hh", "hpp", "hxx") for f in self.prog.entry)
         say = (lambda n: None) if unused else note
         for (f, e), own in zip(raw, self.owners(units, [e for _f, e in raw])):
             # one class made as several nodes (each call site its own name): each instance
@@ -348,7 +366,8 @@ class Linker(LinkMembers, Values, Returns):
         class constructed twice) is read site by site, ``pins`` naming the site."""
         named: list[tuple[str, Src, str | None, str | None, dict[str, int]]] = []
         for f, r in self.recs.items():
-            for v, src, unit, fkey, ns, *kind in r.get("node_names", []):
+            for v, src, unit, fkey, ns, *more in r.get("node_names", []):
+                kind, opts = (more + [None, None])[:2]
                 if (unit is not None or fkey is not None) and not self.runs(unit, fkey) \
                         or unit is None and fkey is None and f not in self.prog.entry:
                     continue
@@ -358,7 +377,8 @@ class Linker(LinkMembers, Values, Returns):
                 for pins in [{fkey: i} for i in live] if pinned and fkey else [{}]:
                     self.pin(pins)
                     for env in self.contexts(fkey):
-                        for name in self.eval(v, env, fkey):
+                        remap = self.remapped(opts, ns, env, fkey)
+                        for name in self.eval(v, env, fkey) if remap[0] is None else [symbols.lit(remap[0])]:
                             t = symbols.text(name) if name is not None and name[0] in ("str", "cat") else None
                             if t is None:
                                 note(Note(src, "node name is not a string literal: not resolved statically"))
@@ -368,8 +388,10 @@ class Linker(LinkMembers, Values, Returns):
                                 note(Note(src, f"node name {bad}: not resolved statically; its endpoints are "
                                                f"not in the graph"))
                                 continue
-                            nsv = self.eval(ns, env, fkey)[0] if ns is not None else None
-                            if ns is not None and (nsv is None or symbols.text(nsv) is None):
+                            nsv = self.eval(ns, env, fkey)[0] if ns is not None and not remap[2] else None
+                            if remap[1] is not None:  # NodeOptions' __ns:= remap
+                                nsv = symbols.lit(remap[1])
+                            elif ns is not None and (nsv is None or symbols.text(nsv) is None) and not remap[2]:
                                 note(Note(src, f"namespace of node '{t}' is not a string literal: not resolved "
                                                f"statically (the root namespace is shown unless a launch file "
                                                f"gives one)"))
@@ -378,7 +400,7 @@ class Linker(LinkMembers, Values, Returns):
                             item = (t, src, (symbols.text(nsv) or None) if nsv is not None else None, unit, pins)
                             if not any(x[0] == t and x[2] == item[2] for x in named):
                                 named.append(item)
-                                out.kinds.append(kind[0] if kind else None)
+                                out.kinds.append(kind)
                             if f not in out.files:
                                 out.files.append(f)
         self.pin({})
@@ -409,10 +431,13 @@ class Linker(LinkMembers, Values, Returns):
         name, handle, cb, fkey, written, nsrc = e.pending
         t = e.msg_type if e.msg_type is not None else self.cb_type(e.kind, cb)
         types: list[str | None] = [t]
-        if t is None and isinstance(cb, tuple) and cb[:1] == ("type",):  # a class template's parameter
-            types = [self.cb_type(e.kind, ("type", x)) for x in self.template_types(e.unit, cb[1])
-                     or self.fn_template_types(e.func, cb[1])] or [None]
-            t = types[0] if all(types) else None
+        ambiguous = False
+        if t is None and isinstance(cb, tuple) and cb[:1] == ("type",):  # a template's type parameter
+            each = self.per_instance(e, note)
+            if each is not None:
+                return each
+            types, ambiguous = self.template_candidates(e, note)
+            t = types[0]
         argtype = cb if isinstance(cb, tuple) and cb[:1] == ("argtype",) else None
         got: list[Endpoint] = []
         for env in self.contexts(fkey):
@@ -429,7 +454,7 @@ class Linker(LinkMembers, Values, Returns):
                             note(bad)
                         if x is not None and x not in got:
                             got.append(x)
-        if got and t is None:
+        if got and t is None and not ambiguous:
             note(emit.type_note(got[0]))
         return got
 

@@ -75,6 +75,8 @@ class LinkMembers:
             return []
         i, out = tps.index(param), []
         for kind, callee, _args, _fkey, cunit, *_rest in self.calls:
+            if kind == "member":  # a member initialised in a constructor: its declared type's arguments
+                callee = self.units.get(cunit or "", {}).get("members", {}).get(callee, callee)
             targs = split_template(callee.replace(" ", ""))[1] if kind in ("ctor", "member") else []
             if len(targs) <= i or self.match(callee, cunit) != unit:
                 continue

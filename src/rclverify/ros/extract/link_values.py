@@ -57,6 +57,20 @@ class Values:
         def returned(self, v: Any, env: dict[int, Any], fkey: str | None, depth: int) -> list[Any]:
             ...
 
+    def remapped(self, opts: Any, ns: Any, env: dict[int, Any], fkey: str | None) -> tuple[str | None, str | None,
+                                                                                           bool]:
+        """``(name, namespace, ns is options)``: the node name and namespace the remap
+        rules of the ``NodeOptions`` a node is made with give (``-r __node:=n``,
+        ``__ns:=/x``; rcl applies them over the code's name), ``None`` where they
+        give none; the third is true when the value read as the namespace is
+        those options (``Node(name, options)``)."""
+        got = [x for x in (self.eval(opts, env, fkey) if opts is not None else []) if x is not None and x[0] == "opts"]
+        nsv = [x for x in (self.eval(ns, env, fkey) if ns is not None else []) if x is not None and x[0] == "opts"]
+        rules = [symbols.node_remaps(x) for x in got + nsv]
+        name = next((r[0] for r in rules if r[0]), None)
+        space = next((r[1] for r in rules if r[1]), None)
+        return name, space, bool(nsv) or (ns is not None and ns == opts)
+
     def contexts(self, fkey: str | None, depth: int = 0) -> list[dict[int, Any]]:
         """The parameter values each call site of ``fkey`` gives (``[{}]``: none known)."""
         if fkey is None or fkey not in self.fns:
@@ -91,6 +105,16 @@ class Values:
         k = v[0]
         if k in ("str", "node", "each", "runtime"):
             return [v]
+        if k == "any":  # a range-for over literals: each element
+            return limit([y for x in v[1] for y in self.eval(x, env, fkey, depth + 1)])
+        if k == "opts":  # NodeOptions' arguments, each read
+            items: list[tuple[Any, ...]] = [()]
+            for x in v[1]:
+                items = limit([p + (y,) for p in items for y in self.eval(x, env, fkey, depth + 1)])
+            return [("opts", p) for p in items]
+        if k == "optarg":  # options.arguments()[i]
+            return limit([y[1][v[2]] if y is not None and y[0] == "opts" and v[2] < len(y[1]) else None
+                          for y in self.eval(v[1], env, fkey, depth + 1)])
         homes = {h for h in _homes(v) if h != fkey and h in self.fns}
         if len(homes) == 1 and k != "arg":
             # the parts of one function's parameters are read together, call site by call site
@@ -193,5 +217,9 @@ def _homes(v: Any) -> set[str]:
     if v[0] == "ops":
         return _homes(v[2])
     if v[0] == "info":
+        return _homes(v[1])
+    if v[0] in ("opts", "any"):
+        return set().union(*(_homes(x) for x in v[1]))
+    if v[0] == "optarg":
         return _homes(v[1])
     return set()

@@ -201,6 +201,13 @@ class Graph:
     notes: list[Note] = field(default_factory=list)
     files: dict[str, str] = field(default_factory=dict)  # path -> sha256
     bags: list[dict[str, Any]] = field(default_factory=list)
+    # every declared program and what it is in the graph (ros/graph/accounting.py): package,
+    # kind, name, declared, nodes, unaccounted (why it is no node, or null)
+    programs: list[dict[str, Any]] = field(default_factory=list)
+
+    def unaccounted(self) -> list[dict[str, Any]]:
+        """The :attr:`programs` that are no node of the graph."""
+        return [p for p in self.programs if p.get("unaccounted")]
 
     def topics(self) -> dict[str, dict[str, Any]]:
         """``{topic: {"types": [...], "publishers": [...], "subscribers": [...]}}``."""
@@ -251,6 +258,7 @@ class Graph:
             "unresolved": [n.to_json() for n in self.notes],
             "bags": self.bags,
             "files": [{"path": k, "sha256": v} for k, v in sorted(self.files.items())],
+            "programs": self.programs,
         }
 
     def edges(self, with_services: bool = False) -> set[tuple[str, str, str, str | None]]:

@@ -142,7 +142,11 @@ class _File(CallReader, MemberReader):
         for kind, v, t, h in specs:
             self.emit(kind, None, t, at, h, name=v)
 
-    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None, kind: str | None = None) -> None:
+    def node(self, v: symbols.Val, at: Any, ns: symbols.Val = None, kind: str | None = None,
+             args: list[Any] | None = None) -> None:
+        """A node named ``v`` (in namespace ``ns``) at ``at``; ``args``: the node
+        constructor's arguments, whose last (after the name) may be the
+        ``NodeOptions`` whose remaps rename it (read by the linker)."""
         fn = self.scope.fn_of(at)
         unit = fn.unit if fn is not None else None
         t = symbols.text(v)
@@ -151,7 +155,10 @@ class _File(CallReader, MemberReader):
             if fn is not None and fn.in_class:
                 self.out["classes"].setdefault(fn.unit, {"nodes": [], "endpoints": []})["nodes"].append(
                     (t, self.src(at)))
-        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns, kind))
+        opts = self.scope.value(args[-1]) if args is not None and len(args) >= 2 else None
+        if opts is not None and opts[0] in ("str", "cat"):
+            opts = None
+        self.out["node_names"].append((v, self.src(at), unit, fn.key if fn else None, ns, kind, opts))
 
     def record(self, kind: str, callee: str, args: list[Any], at: Any) -> None:
         fn = self.scope.fn_of(at)
@@ -165,7 +172,7 @@ class _File(CallReader, MemberReader):
         base = head.split("::")[-1]
         if base in _NODE_TYPES and ("rclcpp" in head or head == base) and args:
             self.node(self.scope.value(args[0]), at, self.scope.value(args[1]) if len(args) > 1 else None,
-                      "lifecycle" if base == "LifecycleNode" else None)
+                      "lifecycle" if base == "LifecycleNode" else None, args)
             return
         if base in _ACTIONLIB and targs and "actionlib" in head + type_text:
             self.actionlib(_ACTIONLIB[base], targs[0], args, at)
@@ -294,7 +301,7 @@ class _File(CallReader, MemberReader):
             a = args.named_children
             self.node(self.scope.value(a[0]), n, self.scope.value(a[1]) if len(a) > 1 and
                       self.scope.value(a[1]) is not None and self.scope.value(a[1])[0] == "str" else None,
-                      "lifecycle" if kind == "lifecycle" else None)
+                      "lifecycle" if kind == "lifecycle" else None, list(a))
             if "::" in h and "rclcpp" not in h:  # a workspace base (pkg_util::LifecycleNode): the linker runs it too
                 self.record("member", h, list(args.named_children), n)
             return

@@ -37,6 +37,15 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
 * ``("info", image)``: the ``camera_info`` topic image_transport pairs with
   image topic ``image`` (its namespace + ``camera_info``), for an image topic
   only the linker can read (a member, a parameter of the function);
+* ``("opts", arguments)``: an ``rclcpp::NodeOptions`` given command-line
+  ``arguments`` (``NodeOptions().arguments({"--ros-args", "-r",
+  "__node:=fusion"})``), a tuple of values; the node it makes takes the name
+  and namespace their remaps give (:func:`node_remaps`);
+* ``("optarg", options, i)``: the ``i``-th of those arguments read back
+  (``options.arguments()[0]``, ``.at(0)``, ``.front()``);
+* ``("any", values)``: one of ``values`` each time (a range-for's variable
+  over a container of literals, ``for (auto & [key, topic] : topics)``): one
+  endpoint per value; ``("pair", (a, b))`` is one element of a map;
 * ``("runtime", origin)``: a name only the running program knows, and where
   it comes from (``from argv``, ``from argparse option --topic``,
   ``discovered at run time (get_topic_names_and_types())``): never read, its
@@ -97,9 +106,13 @@ def is_concrete(v: Val) -> bool:
     if v is None:
         return True
     k = v[0]
-    if k in ("arg", "field", "ext", "ret"):
+    if k in ("arg", "field", "ext", "ret", "any"):
         return False
     if k == "info":
+        return is_concrete(v[1])
+    if k == "opts":
+        return all(is_concrete(x) for x in v[1])
+    if k == "optarg":
         return is_concrete(v[1])
     if k == "param":
         return is_concrete(v[3]) and (isinstance(v[1], str) or is_concrete(v[1])) and \
@@ -172,3 +185,28 @@ def param_name(pname: str, handle: list[str] | None) -> str:
     """A parameter's name read through a handle: ``param_name("rate", ["~"])`` is
     ``~rate`` (roscpp resolves parameter names like topic names)."""
     return under(handle or [], pname)
+
+
+#: the remap names rcl reads for a node's name and namespace (rcl/src/rcl/arguments.c, ROS 2
+#: design "Remapping Names": ``__node:=`` and its older spelling ``__name:=``, ``__ns:=``)
+_NODE_KEYS, _NS_KEYS = ("__node:=", "__name:="), ("__ns:=",)
+
+
+def node_remaps(opts: Val) -> tuple[str | None, str | None]:
+    """``(name, namespace)`` the remap rules of an ``("opts", arguments)`` value
+    give the node it makes (``-r __node:=n``, ``--remap __ns:=/x``, ``-r
+    n:__node:=m`` is left out: it targets another node), ``None`` for each not
+    given; the last rule wins, as rcl applies them."""
+    name = ns = None
+    if opts is None or opts[0] != "opts":
+        return None, None
+    for x in opts[1]:
+        t = text(x) if x is not None else None
+        if t is None:
+            continue
+        for key in _NODE_KEYS:
+            if t.startswith(key):
+                name = t[len(key):]
+        if t.startswith(_NS_KEYS[0]):
+            ns = t[len(_NS_KEYS[0]):]
+    return name, ns

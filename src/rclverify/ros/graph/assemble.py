@@ -19,13 +19,14 @@ from pathlib import Path
 import dataclasses
 from typing import Any, Callable
 
-from rclverify.ros.extract import cross_package, names, nodelets, plugins
+from rclverify.ros.extract import cross_package, emit, names, nodelets, plugins
 from rclverify.ros.extract.executables import Targets
 from rclverify.ros.extract.launch import LaunchNode
 from rclverify.ros.extract.link import Linked, Linker
 from rclverify.ros.extract.model import Endpoint, Graph, Note, Src
 from rclverify.ros.extract.packages import Package
 from rclverify.ros.extract.programs import PackageCode, Program, programs
+from rclverify.ros.graph.accounting import Ledger
 
 
 class Assembly:
@@ -59,6 +60,7 @@ class Assembly:
         self.plugin_progs = {p.plugin: p for pk in sorted(self.progs) for p in self.progs[pk] if p.plugin}
         self.plugins_loaded: set[str] = set()
         self._instances: dict[tuple[str, str], Program] = {}
+        self.ledger = Ledger(show)  # what each program gave (accounting.py)
 
     def linked(self, prog: Program) -> Linked:
         """``prog`` linked (once)."""
@@ -213,22 +215,44 @@ class Assembly:
                     g.notes.extend(got.notes)
                     eps = [e for e, _o in got.endpoints]
                     add_node("/" + name, "/", pkg, prog.nodelet, _files(prog, got, eps, None), at, eps, [], "source")
+                    self.ledger.gave(pkg, _keys(prog), "/" + name)
                     continue
                 if not got.nodes:
-                    if got.endpoints:
-                        first = min((e for e, _o in got.endpoints), key=lambda e: (e.src.file, e.src.line))
-                        g.notes.append(Note(first.src, "publishers/subscribers in a file that names no node and is "
-                                                       "started by no launch file: not in the graph",
-                                            "ROS-UNRESOLVED"))
-                    g.notes.extend(got.notes)
+                    self._nameless(pkg, prog, got, g)
                     continue
                 g.notes.extend(got.notes)
                 for i, (name, src, ns) in enumerate(got.nodes):
                     eps = [e for e, o in got.endpoints if o == i]
                     full = names.join(names.join("/", ns or ""), name)
+                    self.ledger.gave(pkg, _keys(prog), full)
                     files = _files(prog, got, eps, src.file)
                     add_node(full, names.split(full)[0], pkg, prog.exe, files, src, eps, [], "source",
                              lifecycle=got.kinds[i] == "lifecycle" if i < len(got.kinds) else False)
+
+    def _nameless(self, pkg: str, prog: Program, got: Linked, g: Graph) -> None:
+        """A program that names no node the scan reads: a located note at each of its
+        endpoints (never a silent miss) and why, for its account (accounting.py)."""
+        said = {n.src for n in g.notes}
+        what = f"program {prog.exe}" if prog.exe else "a file that"
+        for e, _o in sorted(got.endpoints, key=lambda x: (x[0].src.file, x[0].src.line, x[0].src.col)):
+            if e.src not in said:
+                said.add(e.src)
+                g.notes.append(Note(e.src, f"{emit.WHAT[e.kind]} '{e.topic or e.param or '?'}' of {what} names no "
+                                           f"node and is started by no launch file: not in the graph",
+                                    "ROS-UNRESOLVED"))
+        g.notes.extend(got.notes)
+        unread = next((n for n in got.notes if n.message.startswith("node name")), None)
+        if unread is not None:
+            why = f"its node name is not read statically (at {unread.src})"
+        elif got.endpoints:
+            why = "its code names no node the scan reads (no Node construction, node class or init call is " \
+                  f"followed from its entry); its {len(got.endpoints)} endpoint(s) are not in the graph, each noted"
+        elif prog.files:
+            why = f"no node is constructed in the code it runs ({', '.join(prog.files[:3])}" + \
+                  (", ..." if len(prog.files) > 3 else "") + ")"
+        else:
+            why = "no source file of it is read"
+        self.ledger.none(pkg, _keys(prog), why)
 
     def launch_node(self, ln: LaunchNode, add_node: Callable[..., None], g: Graph) -> None:
         """The node launch element ``ln`` starts (see the module docstring)."""
@@ -265,6 +289,10 @@ class Assembly:
                 g.notes.append(Note(ln.src, f"executable '{ln.exe}' of package '{ln.pkg}' has no source found "
                                             f"(CMakeLists.txt add_executable, setup.py console_scripts, scripts/); "
                                             f"its topics are unknown", "ROS-LAUNCH"))
+        if prog is None:
+            said = next((n for n in reversed(g.notes) if n.src == ln.src), None)
+            self.ledger.launch_missing(ln.pkg or "?", ln.exe or plugin or "?", ln.src,
+                                       said.message if said is not None else "its program is not read")
         got = self.linked(prog) if prog is not None else Linked()
         g.notes.extend(got.notes)
         if ln.name is None and len({n for n, _s, _ns in got.nodes}) > 1 and prog is not None:
@@ -292,6 +320,11 @@ class Assembly:
         files = _files(prog, got, eps, None) if prog is not None else []
         add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params,
                  lifecycle="lifecycle" in got.kinds)
+
+
+def _keys(prog: Program) -> list[str]:
+    """The names a declaration may give program ``prog``: its executable, aliases, classes."""
+    return [k for k in [prog.exe, *prog.aliases, *sorted(prog.units or ())] if k]
 
 
 def _files(prog: Program, got: Linked, eps: list[Endpoint], named_in: str | None) -> list[str]:

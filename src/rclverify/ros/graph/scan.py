@@ -35,7 +35,7 @@ from rclverify.ros.extract.param_yaml import PackageParams, expand_each
 from rclverify.ros.extract.packages import Package, find_manifests, read_package
 from rclverify.ros.extract.sources_cpp import scan_cpp
 from rclverify.ros.extract.sources_py import scan_python
-from rclverify.ros.extract.interfaces import DEBIAN_SHARE
+from rclverify.ros.extract.interfaces import DEBIAN_SHARE, ament_prefixes
 
 _CPP = {".cpp", ".cc", ".cxx", ".hpp", ".h", ".hh"}
 _SKIP_DIRS = {"build", "devel", "install", "log", "test", "tests", "launch", "msg", "srv", "action", "__pycache__"}
@@ -123,7 +123,7 @@ def scan(paths: Sequence[Path], launch: Sequence[Path] = (), launch_args: dict[s
     # Reads are confined to the workspace (``base``, else the scanned paths
     # and entry launch files as given): links leaving it are skipped (docs/ros.md).
     tops = [base] if base is not None else [*paths, *(Path(lf).parent for lf in launch)]
-    with safefs.confined([*tops, DEBIAN_SHARE]):
+    with safefs.confined([*tops, DEBIAN_SHARE, *(p / "share" for p in ament_prefixes())]):
         return _scan(paths, launch, launch_args, bags, cache_path, base, standard)
 
 
@@ -204,6 +204,7 @@ class _Scan:
             table.add_debian_standard(cache)
         elif standard:  # rosbags' ROS 2 store has messages only: services of message-less packages (std_srvs)
             table.add_debian_standard(cache, services_only=True)
+            table.add_ament_index(cache, ament_prefixes())  # a sourced ROS 2's services and actions (rcl_interfaces)
         for tname, fname, missing in table.unknown_refs():
             info = table.types[tname]
             g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
@@ -273,6 +274,9 @@ class _Scan:
             self.asm.source_nodes(self.add_node, g)
             self.asm.controller_nodes(self.add_node, self.pfiles.entries, g)  # ros2_control controllers
         g.notes.extend(self.asm.unloaded_plugins())
+        accounts = self.asm.ledger.accounts({p: self.tgts[p].declared for p in self.tgts}, bool(launch))
+        g.programs = [a.to_json() for a in accounts]
+        g.notes.extend(a.note() for a in accounts if a.why is not None and a.kind != "launch node")
 
     def add_node(self, full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
                  eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,

@@ -10,9 +10,11 @@ rules, lines 535-548), for a topic's message:
   ``bool`` BOOL, ``string`` STRING;
 * one integer field with constants of its type (``uint8 RED=2``): an
   enumeration of the constants' names in lower case (Collection rule);
-* several base fields (nested messages flattened to three levels, arrays,
+* several base fields (nested messages flattened to five levels, arrays,
   ``time``/``duration`` and ``header`` left out): a predicate over them,
   ``T1 x ... x Tn --> BOOL`` (Function rule: the message asserts the tuple);
+  a message with no other field reads its times' ``sec``/``nanosec`` and its
+  fixed-size arrays' elements (``kp[0]`` ...), so a present type is not ``{}``;
 * no base field: the empty type ``{}``.
 
 The fields chosen are written to the plan's ``ros.fields`` so the grounding
@@ -70,19 +72,34 @@ def rcl_scalar(ros_type: str) -> str | None:
     return None
 
 
-def _base_fields(table: TypeTable, msg: str, prefix: str = "", depth: int = 0) -> list[tuple[str, str]]:
+MAX_DEPTH = 5  # nested messages flattened (a service request wrapping a PoseWithCovarianceStamped: 5)
+MAX_FIXED = 16  # elements of a fixed-size array read one by one when nothing else is
+
+
+def _base_fields(table: TypeTable, msg: str, prefix: str = "", depth: int = 0,
+                 whole: bool = False) -> list[tuple[str, str]]:
+    """The base fields of ``msg`` as ``(path, ROS type)``: nested messages flattened,
+    arrays, ``header``/``stamp`` and times left out; with ``whole`` (a message
+    nothing else would type, so that a present type is never ``{}``) times
+    (``sec``, ``nanosec``) and fixed-size arrays of base types (``x[0]`` ...) too."""
     info = table.get(msg)
-    if info is None or depth > 3:
+    if info is None or depth > MAX_DEPTH:
         return []
     out: list[tuple[str, str]] = []
     for name, desc in info.fields:
         t, arr = elem_type(desc)
-        if arr or name in _SKIP_FIELDS:
+        if name in _SKIP_FIELDS:
+            continue
+        if arr:
+            size = desc[1][1] if whole and isinstance(desc, tuple) and len(desc) > 1 and isinstance(
+                desc[1], tuple) and len(desc[1]) > 1 and isinstance(desc[1][1], int) else 0
+            if rcl_scalar(t) and 0 < size <= MAX_FIXED:  # float64[3]: one field per element
+                out.extend((f"{prefix}{name}[{i}]", t) for i in range(size))
             continue
         if rcl_scalar(t):
             out.append((prefix + name, t))
-        elif "/" in t and not t.startswith("builtin_interfaces/"):
-            out.extend(_base_fields(table, t, f"{prefix}{name}.", depth + 1))
+        elif "/" in t and (whole or not t.startswith("builtin_interfaces/")):
+            out.extend(_base_fields(table, t, f"{prefix}{name}.", depth + 1, whole))
     return out
 
 
@@ -194,7 +211,7 @@ def _var_type(table: TypeTable, msg: str | None, var: str,
     taken = {} if taken is None else taken
     if msg is None or table.get(msg) is None:
         return "{}", [], None
-    fields = _base_fields(table, msg)
+    fields = _base_fields(table, msg) or _base_fields(table, msg, whole=True)
     info = table.get(msg)
     assert info is not None
     if len(fields) == 1:
