@@ -191,3 +191,4 @@ def test_a_threshold_over_the_items_of_a_float32_sequence(tmp_path: Path) -> Non
     assert main([*args, str(_scan_bag(tmp_path / "correct", [3.0, 0.2], True))]) == 0
     assert main([*args, str(_scan_bag(tmp_path / "slip", [3.0, 0.2], False))]) == 1
     assert main([*args, str(_scan_bag(tmp_path / "clear", [3.0, 0.25], False))]) == 0
+

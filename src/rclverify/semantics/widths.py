@@ -21,6 +21,14 @@ the carried constant, so a ``<``/``<=`` slip at the threshold is found in
 each of them.  A constant beyond the width's largest finite value is left as
 written (the field cannot carry it; the comparison is then decided as
 before).
+
+Every other primitive keeps its width and kind (rosidl's type mapping; the
+ranges of OMG IDL 4.2, table 7-13: :data:`INT_RANGES`): a constant compared
+with an integer field keeps its exact value (every value of the field is an
+integer, compared exactly); what a field carries (:class:`Carried`: the
+primitive, a ``string<=N`` bound, a ``T[<=N]`` or ``T[N]`` sequence) bounds
+what the property tests draw (:func:`int_edges`) and decides whether a
+value can travel at all (:func:`carried_fault`: ``uint8 cannot carry 300``).
 """
 from __future__ import annotations
 
@@ -36,6 +44,23 @@ from rclverify.lang.visit import Transformer
 
 #: IDL floating-point types -> (significand bits with the hidden one, smallest normal exponent, largest exponent).
 FLOAT_WIDTHS: dict[str, tuple[int, int, int]] = {"float32": (24, -126, 127), "float64": (53, -1022, 1023)}
+
+#: IDL integer types -> (least, greatest) value: the ranges of OMG IDL 4.2 clause 7.4.1.4.4.2.1 (table 7-13,
+#: integers of 8 to 64 bits; ``octet`` 0 to 255).  ``.msg``'s ``byte`` is IDL ``octet`` and its ``char`` IDL
+#: ``uint8`` (rosidl_adapter's ``MSG_TYPE_TO_IDL``); both carry 0 to 255 (rclpy's setters assert it).
+INT_RANGES: dict[str, tuple[int, int]] = {
+    "int8": (-2 ** 7, 2 ** 7 - 1), "uint8": (0, 2 ** 8 - 1), "int16": (-2 ** 15, 2 ** 15 - 1),
+    "uint16": (0, 2 ** 16 - 1), "int32": (-2 ** 31, 2 ** 31 - 1), "uint32": (0, 2 ** 32 - 1),
+    "int64": (-2 ** 63, 2 ** 63 - 1), "uint64": (0, 2 ** 64 - 1), "byte": (0, 255), "octet": (0, 255),
+    "char": (0, 255)}
+
+#: rosidl's IDL names of ``.msg`` primitives (``float``, ``double``, ``boolean``) -> the ``.msg`` names used here.
+IDL_ALIASES: dict[str, str] = {"float": "float32", "double": "float64", "boolean": "bool"}
+
+
+def idl_name(name: str) -> str:
+    """The ``.msg`` name of an IDL primitive (``double`` -> ``float64``); others as they are."""
+    return IDL_ALIASES.get(name, name)
 
 
 def nearest_at_width(q: Fraction, width: str) -> Fraction | None:
@@ -66,8 +91,11 @@ def narrow(value: Any, width: str) -> Any:
     """``value`` as a field of IDL type ``width`` carries it: a Python
     ``float`` rounded to binary32 for ``float32`` (round to nearest, ties to
     even: the conversion a publisher's message makes); anything else, and
-    every value of another width, as it is.  A value beyond binary32's range
-    becomes an infinity, as it does on the wire."""
+    every value of another width, as it is; a sequence (a ``tuple``) item by
+    item.  A value beyond binary32's range becomes an infinity, as it does
+    on the wire."""
+    if width == "float32" and isinstance(value, tuple):
+        return tuple(narrow(v, width) for v in value)
     if width != "float32" or not isinstance(value, float):
         return value
     try:
@@ -98,6 +126,121 @@ def edges_at_width(constants: Iterable[Fraction], width: str) -> list[Fraction]:
         else:
             out.update(Fraction(math.nextafter(float(v), d)) for d in (-math.inf, math.inf))
     return sorted(out)
+
+
+def int_edges(constants: Iterable[Fraction], width: str) -> list[int]:
+    """The integers an input of IDL integer type ``width`` is drawn at beside
+    arbitrary ones: the range's least and greatest value, 0, and for each
+    constant ``c`` the values where a comparison with it changes its truth
+    (``c - 1``, ``c``, ``c + 1`` for an integer ``c``; the integers either
+    side of any other), those in the range; sorted.  Raises ``KeyError`` for
+    a ``width`` not in :data:`INT_RANGES`.  The constants keep their exact
+    value (docs/semantics.md, "Widths")."""
+    lo, hi = INT_RANGES[width]
+    out = {lo, hi, 0}
+    for c in constants:
+        k = c.numerator // c.denominator
+        out.update((k - 1, k, k + 1) if c.denominator == 1 else (k, k + 1))
+    return sorted(v for v in out if lo <= v <= hi)
+
+
+@dataclasses.dataclass(frozen=True)
+class Width:
+    """One primitive field's IDL type as ``.msg`` names it (``float32``,
+    ``uint8``, ``char``, ``bool``, ``string``; :func:`idl_name`) and, for a
+    bounded string (``string<=N``), its bound ``N`` in characters (0: none)."""
+
+    idl: str
+    bound: int = 0
+
+    def __str__(self) -> str:
+        return f"{self.idl}<={self.bound}" if self.bound else self.idl
+
+
+@dataclasses.dataclass(frozen=True)
+class Carried:
+    """How a message carries one RCL value: ``items`` the primitive of a
+    scalar or of a sequence's items (one :class:`Width`), or of each
+    component of a sequence of tuples (one per component, in order);
+    ``seq`` whether the value is a sequence (an array field, or a path
+    through the items of one: ``poses[*].position.x``), ``max_len`` its
+    bound (``T[<=N]``, ``T[N]``: ``N``; ``None`` unbounded), ``fixed``
+    whether it holds exactly ``max_len`` items (``T[N]``)."""
+
+    items: tuple[Width, ...]
+    seq: bool = False
+    max_len: int | None = None
+    fixed: bool = False
+
+    def __str__(self) -> str:
+        item = str(self.items[0]) if len(self.items) == 1 else "(" + ", ".join(map(str, self.items)) + ")"
+        if not self.seq:
+            return item
+        return f"{item}[{'' if self.max_len is None else ('' if self.fixed else '<=') + str(self.max_len)}]"
+
+
+def _number_text(v: Any) -> str:
+    if isinstance(v, Fraction):
+        return str(v.numerator) if v.denominator == 1 else str(float(v)) if float(v) == v else str(v)
+    return repr(v)
+
+
+def width_fault(value: Any, width: Width) -> str | None:
+    """Why a field of primitive type ``width`` cannot carry ``value`` (an RCL
+    value: ``int``, ``float``, ``Fraction``, ``bool``, ``str``), ``None``
+    when it can.  The rule is rclpy's: its generated setters
+    (rosidl_generator_py) assert an integer field's Python ``int`` within the
+    type's range (:data:`INT_RANGES`), a floating field's ``float`` within
+    its finite range (beyond it, IEEE 754's round-to-nearest overflows: a
+    ``float32`` cannot carry 1e39), a ``bool`` field's ``bool`` and a
+    bounded string's length.  Without the checks (Kilted's default) the
+    conversion to C raises, wraps an integer (300 is heard as 44) or reads an
+    ``int`` in a floating field as another number (3 as 5e-324), as
+    tests/test_widths_ints.py measures; C++ would wrap the integer too, so
+    the value the node computed never reaches a subscriber either way."""
+    name = width.idl
+    if name in INT_RANGES:
+        lo, hi = INT_RANGES[name]
+        if isinstance(value, bool) or not isinstance(value, int):
+            return f"{name} cannot carry {_number_text(value)}: not an integer"
+        return None if lo <= value <= hi else f"{name} cannot carry {value} (its values are {lo} to {hi})"
+    if name in FLOAT_WIDTHS:
+        if not isinstance(value, float):  # measured on Kilted: an int 3 in a float64 field is heard as 5e-324
+            return (f"{name} cannot carry {_number_text(value)}: a Python {type(value).__name__}, not a float "
+                    f"(rclpy's setter refuses it; unchecked, rclpy publishes another number)")
+        if not math.isfinite(value):
+            return None  # rclpy lets an infinity or NaN through; the mapping refuses it (no RCL number)
+        if nearest_at_width(Fraction(value), name) is None:
+            return f"{name} cannot carry {_number_text(value)} (beyond its largest finite value)"
+        return None
+    if name == "bool":
+        return None if isinstance(value, bool) else f"bool cannot carry {_number_text(value)}"
+    if name == "string" and width.bound and isinstance(value, str) and len(value) > width.bound:
+        return f"{width} cannot carry {value!r} ({len(value)} characters)"
+    return None
+
+
+def carried_fault(value: Any, carried: Carried) -> str | None:
+    """Why a field carrying ``carried`` cannot hold ``value`` (a scalar, or a
+    sequence as a tuple of items, each a tuple of components for a sequence of
+    tuples), ``None`` when it can: :func:`width_fault` of the scalar or of
+    each item, and a sequence's length against its bound (rclpy asserts
+    ``len(value) <= N`` for ``T[<=N]`` and ``== N`` for ``T[N]``)."""
+    if not carried.seq:
+        return width_fault(value, carried.items[0])
+    if not isinstance(value, (tuple, list)):
+        return None
+    n, bound = len(value), carried.max_len
+    if bound is not None and (n != bound if carried.fixed else n > bound):
+        return f"{carried} cannot carry {n} item(s) ({'exactly' if carried.fixed else 'at most'} {bound})"
+    for i, item in enumerate(value):
+        parts = item if len(carried.items) > 1 and isinstance(item, tuple) else (item,)
+        for k, (p, w) in enumerate(zip(parts, carried.items)):
+            why = width_fault(p, w)
+            if why:
+                where = f"item {i}" + (f", component {k + 1}" if len(carried.items) > 1 else "")
+                return f"{where}: {why}"
+    return None
 
 
 def _constant(e: ast.Expr) -> Fraction | None:
@@ -154,11 +297,12 @@ class _AtWidths(Transformer):
             for var_at, const_at in ((i, i + 1), (i + 1, i)):
                 var = e.operands[var_at]
                 width = widths.get(var.qualified) if isinstance(var, ast.Var) else None
-                c = _constant(e.operands[const_at]) if width else None
-                v = nearest_at_width(c, width) if width and c is not None else None
+                c = _constant(e.operands[const_at]) if width in FLOAT_WIDTHS else None
+                v = nearest_at_width(c, width) if width and c is not None else None  # an integer width: exact
                 if v is not None and v != c:
                     ops[const_at] = _literal(v, e.operands[const_at])
         return dataclasses.replace(e, operands=tuple(ops)) if any(a is not b for a, b in zip(ops, e.operands)) else e
 
 
-__all__ = ["FLOAT_WIDTHS", "at_widths", "edges_at_width", "narrow", "nearest_at_width"]
+__all__ = ["FLOAT_WIDTHS", "IDL_ALIASES", "INT_RANGES", "Carried", "Width", "at_widths", "carried_fault",
+           "edges_at_width", "idl_name", "int_edges", "narrow", "nearest_at_width", "width_fault"]

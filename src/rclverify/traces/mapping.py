@@ -22,16 +22,21 @@ Which rule applies depends on the RCL variable's type:
   string field names the constructor; its arguments are the next fields of
   the argument types, in order.
 * **Sequence** (``seq(T)`` of a scalar or enumeration ``T``): the first
-  array field (a ROS array or sequence, bounded or not: ``LaserScan.ranges``),
-  each item read as the scalar rule reads a field; a NaN or an infinity
-  among the items is no RCL number (the message does not map).
+  array field (a ROS array or sequence, bounded or not: ``LaserScan.ranges``;
+  or a path through every item of an array of messages,
+  ``poses[*].position.x``), each item read as the scalar rule reads a field;
+  a NaN or an infinity among the items is no RCL number (the message does
+  not map).  A sequence of tuples (``seq((REAL, REAL))``) takes one such
+  array per component, in order, zipped item by item
+  (``fields: ["poses[*].position.x", "poses[*].position.y"]``).
 
 Which fields a topic's messages contribute, and in which order, is the
 plan's ``fields`` list for the topic (all top-level fields in message order
 otherwise): bespoke rules in the paper's sense.  A field may be a **path**
 into nested messages and arrays, as the ROS grounding reads them
 (``linear.x`` of a ``geometry_msgs/Twist``, ``pose.pose.position.x``,
-``ranges[0]``, ``ranges[-1]`` the last element): :func:`field_value`.
+``ranges[0]``, ``ranges[-1]`` the last element, ``poses[*].position.x``
+every item's): :func:`field_value`.
 
 A topic may be declared a **state** (``state: true``, e.g. a latched pose):
 only then may a node's output on it that was current before an input event
@@ -105,6 +110,17 @@ class _Fields:
             return tuple(items)
         raise MappingError(f"no array field left for {what} of type {want}")
 
+    def take_tuples(self, want: T.SeqT, elems: tuple[T.Type, ...], what: str) -> tuple[Any, ...]:
+        """A sequence of tuples: the next ``len(elems)`` array fields (each a ROS array, or a path through
+        the items of one, ``poses[*].position.x``), one per component in order, zipped item by item; the
+        arrays must have as many items each."""
+        parts = [self.take_seq(T.SeqT(e), f"component {k} of {what}") for k, e in enumerate(elems, 1)]
+        if len({len(p) for p in parts}) > 1:
+            sizes = ", ".join(str(len(p)) for p in parts)
+            raise MappingError(f"the arrays of the components of {what} of type {want} have different lengths "
+                               f"({sizes}): no item is a tuple")
+        return tuple(zip(*parts))
+
 
 _NO = object()
 
@@ -128,8 +144,10 @@ def _scalar(v: Any, t: T.Type) -> Any:
 
 
 _NAME = r"[A-Za-z_][A-Za-z0-9_]*"
-_PATH = re.compile(rf"{_NAME}(?:\[-?\d+\])*(?:\.{_NAME}(?:\[-?\d+\])*)*")
-_INDEX = re.compile(r"\[(-?\d+)\]")
+_PATH = re.compile(rf"{_NAME}(?:\[(?:-?\d+|\*)\])*(?:\.{_NAME}(?:\[(?:-?\d+|\*)\])*)*")
+_INDEX = re.compile(r"\[(-?\d+|\*)\]")
+#: The step of a path that reads every item of an array (written ``[*]``): ``poses[*].position.x``.
+EVERY = "*"
 
 
 def is_path(name: str) -> bool:
@@ -139,15 +157,18 @@ def is_path(name: str) -> bool:
 
 def parse_path(text: str) -> tuple[str | int, ...] | None:
     """``pose.pose.position.x`` -> ``("pose", "pose", "position", "x")``,
-    ``ranges[-1]`` -> ``("ranges", -1)``; ``None`` when ``text`` is not a
+    ``ranges[-1]`` -> ``("ranges", -1)``, ``poses[*].position.x`` ->
+    ``("poses", EVERY, "position", "x")``; ``None`` when ``text`` is not a
     path (field names joined by ``.``, each followed by any number of
-    integer indexes ``[k]``, negative counting from the end)."""
-    if not _PATH.fullmatch(text):
+    integer indexes ``[k]``, negative counting from the end, and at most one
+    ``[*]`` in the whole path: every item of that array, docs/monitors.md
+    "Sequences of messages")."""
+    if not _PATH.fullmatch(text) or text.count("[*]") > 1:
         return None
     steps: list[str | int] = []
     for part in text.split("."):
         steps.append(part.split("[", 1)[0])
-        steps.extend(int(k) for k in _INDEX.findall(part))
+        steps.extend(EVERY if k == EVERY else int(k) for k in _INDEX.findall(part))
     return tuple(steps)
 
 
@@ -163,9 +184,18 @@ def field_value(fields: Mapping[str, Any], name: str) -> Any:
     steps = parse_path(name) if is_path(name) else None
     if steps is None:
         raise MappingError(f"the message has no field {name}")
+    return _follow(fields, steps, name)
+
+
+def _follow(fields: Any, steps: Sequence[str | int], name: str, done: str = "") -> Any:
+    """The value at ``steps`` below ``fields`` (``done``: the path read so far, for the errors); an
+    :data:`EVERY` step gives the list of what the rest of the path reads in each item."""
     cur: Any = fields
-    done = ""
-    for step in steps:
+    for at, step in enumerate(steps):
+        if step == EVERY:
+            if not isinstance(cur, (list, tuple)):
+                raise MappingError(f"the message has no field {name}: {done} is not an array")
+            return [_follow(item, steps[at + 1:], name, f"{done}[{i}]") for i, item in enumerate(cur)]
         if isinstance(step, int):
             if not isinstance(cur, (list, tuple, bytes, bytearray)):
                 raise MappingError(f"the message has no field {name}: {done} is not an array")
@@ -213,6 +243,9 @@ def map_value(typ: T.Type, fields: Mapping[str, Any], rule: TopicRule, previous:
         return fs.take(typ, "the value")
     if isinstance(typ, T.SeqT) and isinstance(typ.elem, (T.Scalar, T.EnumT)):
         return fs.take_seq(typ, "the sequence")
+    if isinstance(typ, T.SeqT) and isinstance(typ.elem, T.TupleT) \
+            and all(isinstance(e, (T.Scalar, T.EnumT)) for e in typ.elem.elems):
+        return fs.take_tuples(typ, typ.elem.elems, "the sequence")
     if isinstance(typ, T.DataT):
         name = fs.take(T.EnumT("constructor", ()), "the constructor name")
         args = typ.ctor(name)
@@ -385,5 +418,6 @@ def _check_fields(topic: str, fields: Any, var: tuple[Any, ...]) -> None:
     for k, f in enumerate(fields):
         if isinstance(f, str) and is_path(f) and parse_path(f) is None:
             raise RuleError(f"topic {topic}{whose}: {f!r} is not a field path (write names joined by '.', each "
-                            f"with optional integer indexes: linear.x, pose.pose.position.x, ranges[0], "
-                            f"ranges[-1])", "topics", topic, "fields", *var, k)
+                            f"with optional integer indexes, and at most one [*] for every item of an array: "
+                            f"linear.x, pose.pose.position.x, ranges[0], ranges[-1], poses[*].position.x)",
+                            "topics", topic, "fields", *var, k)

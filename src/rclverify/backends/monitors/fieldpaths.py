@@ -9,8 +9,11 @@ the type is known (the mapping's ``msg_dirs``, or the standard types of
 rosbags' store, which the bag reader uses too), every entry is followed
 through the definitions (:func:`rclverify.ros.extract.interfaces.field_path`, the
 ROS grounding's reader): a field that does not exist, a message where a
-number is read, or an array read without an index is one located error at
-the entry in the mapping file (``mapping.yaml:7:22: error: topic cmd_vel:
+number is read, an array read without an index (unless the topic sets a
+``seq(T)`` variable, which the array fills) or a path through every item
+(``poses[*].position.x``, read as the grounding's ``poses[].position.x``)
+on a topic whose variable is not a sequence is one located error at the
+entry in the mapping file (``mapping.yaml:7:22: error: topic cmd_vel:
 field 'linar.x' of geometry_msgs/Twist: ...``), before any run is read.
 An unknown type is left to the run (its events are then ``inconclusive``
 with the reason when a field is missing).
@@ -23,7 +26,7 @@ from typing import Any, Mapping, Sequence
 from rclverify.model.plan.errors import plan_error
 from rclverify.model.plan.yamlguard import load_located, read_yaml_text
 from rclverify.lang.errors import Diagnostic
-from rclverify.lang.types import Checked
+from rclverify.lang.types import Checked, SeqT
 from rclverify.ros.extract.interfaces import BASE_TYPES, TypeTable, field_path
 from rclverify.ros.extract.model import canon_type, short_type
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
@@ -75,6 +78,7 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
     if not isinstance(topics, Mapping):
         return []
     types = topic_types(checked)
+    seqs = _sequence_topics(checked)
     table: TypeTable | None = None
     out: list[Diagnostic] = []
     for topic, spec in topics.items():
@@ -87,7 +91,7 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
         if table.get(typ) is None:
             continue  # a type this workspace does not define: the run decides
         for k, f in enumerate(fields):
-            why = _why(table, typ, str(f))
+            why = _why(table, typ, str(f), str(topic).lstrip("/") in seqs)
             if why is None:
                 continue
             at = locs.get(("topics", topic, "fields", k)) or locs.get(("topics", topic, "fields"))
@@ -97,11 +101,30 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
     return out
 
 
-def _why(table: TypeTable, typ: str, name: str) -> str | None:
-    rt, err, arr = field_path(table, typ, name)
+def _sequence_topics(checked: Checked) -> set[str]:
+    """The topics (no leading ``/``) that set a ``seq(T)`` variable: an array fills it whole."""
+    out: set[str] = set()
+    for node in checked.nodes.values():
+        for t in node.node.topics:
+            v = t.match
+            typ = (node.inputs if v.prefix == "in" else node.outputs).get(v.name) if v is not None else None
+            if isinstance(typ, SeqT):
+                out.add(t.field.lstrip("/"))
+    return out
+
+
+def _why(table: TypeTable, typ: str, name: str, sequence: bool = False) -> str | None:
+    """What is wrong with field ``name`` of ``typ`` (``None``: nothing); ``sequence``: the topic sets a
+    ``seq(T)`` variable, which an array, or a path through every item of one (``poses[*].position.x``), fills."""
+    every = "[*]" in name
+    rt, err, arr = field_path(table, typ, name.replace("[*]", "[]"))  # the grounding's reader writes every item []
     if err is not None:
         return err
-    if arr:
+    if every and not sequence:
+        return "every item ([*]) fills a sequence; the topic's variable is not a seq(T)"
+    if every and arr:
+        return "an array in every item: a sequence of sequences is not mapped"
+    if arr and not sequence:
         return f"an array ({short_type(rt)}[]) cannot fill a single value; index it ({name}[0], {name}[-1])"
     if (rt or "").split("<=")[0] not in BASE_TYPES:
         return f"a message ({short_type(rt)}); name one of its fields ({name}.<field>)"

@@ -17,6 +17,7 @@ from rclverify.semantics.floatsem import Judgement, holds_in, judge
 from rclverify.semantics.values import render
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
+from rclverify.traces.typed_text import render_as
 from rclverify.backends.monitors.outcome import Outcome
 from rclverify.backends.monitors.verdicts import WEAK as _WEAK
 
@@ -60,7 +61,8 @@ class Judging:
             if hit is None or hit[0] is not v:
                 if len(self._renders) >= 256:
                     self._renders.clear()
-                hit = self._renders[id(v)] = (v, render(v))
+                typ = (self.node.inputs if k.startswith("in.") else self.node.outputs).get(k.split(".", 1)[-1])
+                hit = self._renders[id(v)] = (v, render_as(v, typ) if isinstance(v, tuple) else render(v))  # <a, b>
             out[k] = hit[1]
         return out
 

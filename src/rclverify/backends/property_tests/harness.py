@@ -48,8 +48,10 @@ from rclverify.backends.property_tests.strategies import assumption_bounds, conj
 from rclverify.backends.property_tests.config import Config, ConfigError, load_implementation, read_config
 from rclverify.backends.property_tests.closure import resolve_closure
 from rclverify.backends.property_tests.importpath import on_harness_path
-from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
-from rclverify.semantics.widths import edges_at_width, narrow
+from rclverify.backends.monitors.widths import at_carried_widths
+from rclverify.backends.property_tests.at_width import carried_in, input_strategies
+from rclverify.semantics.widths import Carried, carried_fault, edges_at_width, narrow
+from rclverify.traces.typed_text import render_as
 
 # The plan entry's reading lives in .config; its names stay importable from here (the backend, replay, the tests
 # and the benchmark import them with the run).
@@ -143,6 +145,9 @@ class GuaranteeRun:
     #: the width each input and output's field carries ("in.x" -> "float32"; semantics/widths.py): inputs are
     #: passed and outputs judged as they travel, the thresholds drawn as the fields carry them
     widths: Mapping[str, str] = field(default_factory=dict)
+    #: what each input and output's field carries ("in.x" -> uint8, float32[<=4], ...): inputs drawn within
+    #: it, an output it cannot carry a counterexample (backends/property_tests/at_width.py)
+    carried: Mapping[str, Carried] = field(default_factory=dict)
 
     @property
     def stateful(self) -> bool:
@@ -193,6 +198,7 @@ class GuaranteeRun:
         for width in sorted(set(self.widths.values())):  # the thresholds as the fields carry them, and their neighbours
             constants = sorted(set(constants) | set(edges_at_width(constants, width)))
         space = input_space(self.node, self.cfg.bounds, seed, constants, named)
+        space.carried = input_strategies(space, dict(self.carried))
         self.coverage = Coverage(self.node, space.bounds, assumption_bounds(self.node, named))
         one = space.inputs().filter(self.assumption_holds)
         if self.stateful:
@@ -203,9 +209,9 @@ class GuaranteeRun:
               conjunct: ast.Expr | None, step: int | None) -> None:
         self.counts.failures += 1
         g = self.node.node.guarantees[self.guarantee - 1]
-        cex = {k: render(v) for k, v in sorted(inputs.items())}
+        cex = {k: render_as(v, self.node.inputs.get(k.removeprefix("in."))) for k, v in sorted(inputs.items())}
         if outputs is not None:
-            cex.update({f"out.{k}": render(v) for k, v in sorted(outputs.items())})
+            cex.update({f"out.{k}": render_as(v, self.node.outputs.get(k)) for k, v in sorted(outputs.items())})
         cex["guarantee"] = f"{self.node.name} guarantee {self.guarantee}"
         cex["source"] = _source(conjunct.loc if conjunct is not None else g.loc)
         if conjunct is not None:
@@ -248,6 +254,11 @@ class GuaranteeRun:
             why = conforms(outputs[name], t)
             if why:
                 return self._fail(inputs, None, f"output out.{name} is not a value of its type {t}: {why}", None, step)
+            carry = self.carried.get(f"out.{name}")
+            why = carried_fault(outputs[name], carry) if carry is not None else None
+            if why:  # rclpy's message refuses it, C++ wraps or cuts it: no subscriber reads the computed value
+                return self._fail(inputs, outputs, f"output out.{name}: {why}, so the robot cannot publish it",
+                                  None, step)
         values = {**inputs, **{f"out.{k}": v for k, v in outputs.items()}}
         if widths:  # each output as its field carries it (the value a subscriber and a monitor read)
             values = {k: narrow(v, widths[k]) if k in widths else v for k, v in values.items()}
@@ -431,20 +442,10 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
                        f"with the evidence: {'; '.join(unhashed)}", Counts(), unhashed=unhashed)
     if impl is None:
         impl = load_implementation(root, cfg)
-    widths = _widths(root, node)
+    widths, carried = carried_in(root, node)
     with on_harness_path(root, cfg.file):
-        return GuaranteeRun(checked, at_carried_widths(node, widths), guarantee, cfg, impl, facts, widths=widths).run()
-
-
-def _widths(root: Path, node: CheckedNode) -> dict[str, str]:
-    """The widths ``node``'s fields carry, read with the workspace's monitor mapping (its rules and
-    message folders; backends/monitors/widths.py); ``{}`` when the mapping does not load."""
-    from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (loads yaml and the mapping only when called)
-    try:
-        mapping = load_mapping(root, None)
-    except Exception:  # noqa: BLE001 - the monitors backend reports a mapping that does not load; no width here
-        return {}
-    return carried_widths(node, mapping.rules, [root / d for d in mapping.msg_dirs])
+        return GuaranteeRun(checked, at_carried_widths(node, widths), guarantee, cfg, impl, facts, widths=widths,
+                            carried=carried).run()
 
 
 def versions() -> str:

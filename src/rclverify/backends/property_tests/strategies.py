@@ -16,6 +16,9 @@ constrained by the node's assumption (docs/property-tests.md, "Strategies").
   of argument tuples per argument type, drawn once per example, so two
   functions over the same domain (the Agent's ``at`` and ``wayP``) share
   their points; values inside tables are small (NATURAL 0..5, INTEGER -5..5).
+* Inputs whose field's IDL type the message definitions tell are drawn as
+  the field carries them (:mod:`.at_width`, handed in as
+  :attr:`InputSpace.carried`): integer ranges, bounded sequences.
 * What the bounds do not capture is enforced by filtering with the whole
   assumption, checked by :func:`~rclverify.semantics.decide.decide` (direct evaluation, Z3 where
   it cannot decide).
@@ -152,6 +155,8 @@ class InputSpace:
     seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
     point_cache: dict[tuple[Any, ...], st.SearchStrategy[tuple[Any, ...]]] = field(default_factory=dict)
     misc_cache: dict[tuple[Any, ...], Any] = field(default_factory=dict)
+    #: input name -> its strategy as its field carries it (:mod:`.at_width`), used instead of its type's
+    carried: dict[str, st.SearchStrategy[Any]] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
@@ -299,6 +304,9 @@ class InputSpace:
             for n, t in self.node.inputs.items():
                 q = f"in.{n}"
                 if q in seeded:
+                    continue
+                if n in self.carried:
+                    drawn[q] = draw(self.carried[n])
                     continue
                 drawn[q] = self.table(draw, t) if isinstance(t, FuncT) else draw(self.value(t, self.bounds.get(n)))
             for q, base in seeded.items():
