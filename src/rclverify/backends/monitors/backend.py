@@ -30,6 +30,7 @@ from rclverify.traces import TraceError, read_trace
 from rclverify.traces.bag import custom_types
 from rclverify.traces.files import trace_files, trace_sha256
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
@@ -39,7 +40,7 @@ from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
 from rclverify.backends.monitors.rml import Spec, rml_id, translate
-from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
+from rclverify.backends.monitors.widths import at_carried_widths, carried_fields, float_widths, refuse_out_of_range
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
@@ -209,6 +210,9 @@ class MonitorsBackend:
                                 log=str(err))
         if summary is not None:  # the node's calls beside its topics; their deadlines with its topics' ones
             status, explanation, extra = with_calls(calls.entries(), summary, status, explanation)
+            if extra["calls"].get("first_violation") and not details.get("first_violation"):
+                # a call's violation is the node's first one: the report's row names its guarantee
+                details["first_violation"] = extra["calls"]["first_violation"]
             (cdl,) = calls.deadlines() or (None,)
             merged = merge_deadlines(finished.get("deadlines"), cdl)
             if merged is not None:
@@ -230,6 +234,8 @@ class MonitorsBackend:
                                                  {res.node: [(status, explanation)]},
                                                  {dl.node: dl.counts} if dl is not None else {}, f"in {trace}",
                                                  decided_of([res], calls.entries() if summary is not None else []))
+        if read.bag is not None:  # a bag without a link's call topics: say what it lacks (bag_calls.py)
+            read.bag.explain(items)
         entry = {"node": res.node, "status": status, "explanation": explanation}
         explain(entry, items)  # a pending record says why itself
         status, explanation = unless_stale((status, entry["explanation"] + (f"; {note}" if note else "")), stale)
@@ -253,6 +259,7 @@ class _Read:
     events: int
     results: list[Any]
     summary: dict[str, Any] | None
+    bag: BagCalls | None = None
 
 
 def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None) -> _Read:
@@ -260,8 +267,8 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     declarations and a live log's calls; in stamp order when ``lag`` (s, :func:`.stamp_order.in_stamp_order`)
     is given.  Raises what the readers and the checkers raise (the caller reports it)."""
     # the contract's constants compared as the fields carry them (widths.py)
-    node = at_carried_widths(target.node, carried_widths(target.node, cfg.rules,
-                                                         [target.root / d for d in cfg.msg_dirs]))
+    fields = carried_fields(target.node, cfg.rules, [target.root / d for d in cfg.msg_dirs])
+    node = at_carried_widths(target.node, float_widths(target.node, fields))
     beside = _Beside()
     if has_deadlines(node):
         beside.add("deadlines", lambda: DeadlineMonitor(target.checked, node, cfg.rules,
@@ -276,13 +283,18 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
     heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
     watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
-    source: Iterable[Any] = read_trace(target.root / trace, [target.root / d for d in cfg.msg_dirs])
+    dirs = [target.root / d for d in cfg.msg_dirs]
+    path = target.root / trace
+    source: Iterable[Any] = read_trace(path, dirs)
+    bag = BagCalls([node], calls, trace, bag_connections(path, dirs)) \
+        if calls.active and is_ros2_bag(path) else None  # a bag's recorded calls, as `monitor BAG` reads them
+    source = refuse_out_of_range(source, path, fields.items())  # a value no field carries
     if lag is not None:
         source = in_stamp_order(source, lag)
-    events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(
-        calls.tap(source) if calls.active else source)), heard, watch), cfg.rules, cfg.horizon,
-        tolerance=cfg.tolerance)
-    return _Read(beside, calls, span, heard, watch, events, results, calls.finish())
+    inner = bag.tap(source) if bag is not None else calls.tap(source) if calls.active else source
+    events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(inner)), heard, watch),
+                                  cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
+    return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag)
 
 
 class _Beside:
@@ -355,7 +367,9 @@ def with_deadlines(target: NodeTarget, res: DeadlineResult, trace: str, status: 
     # guarantee is timed (it then evaluated each one on each answer); else the worse of the two wins.
     all_timed = all(c.trigger is not None for c in target.node.node.guarantees)
     worse = dstatus if (status == "pending" and all_timed) or rank.get(dstatus, 0) > rank.get(status, 0) else status
-    return worse, f"deadlines: {dexpl}; untimed: {explanation}", {"deadlines": res.to_json()}
+    said = (f"untimed: {explanation}; deadlines: {dexpl}" if worse == status != dstatus else
+            f"deadlines: {dexpl}; untimed: {explanation}")  # what decided the status first
+    return worse, said, {"deadlines": res.to_json()}
 
 
 class TraceSpan:

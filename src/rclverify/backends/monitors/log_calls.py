@@ -14,10 +14,11 @@ could not pair stays ``inconclusive`` with its reason), the same clock
 ticks, hence the same call verdicts and call deadlines.
 
 Used by ``rclverify monitor LOG`` (:mod:`.cli`) and by the ``monitors``
-backend (``doit verify``, :mod:`.backend`).  A log without call lines (a
-recorded bag, a ROS 1 log whose proxy wrote its call parts as topics) gives
-nothing here: :meth:`LogCalls.finish` returns ``None`` and the offline check
-is what it was.
+backend (``doit verify``, :mod:`.backend`); ``rclverify monitor BAG`` feeds
+it the lines a ROS 2 bag's recorded calls give back (:mod:`.bag_calls`).  A
+log without call lines (a ROS 1 log whose proxy wrote its call parts as
+topics) gives nothing here: :meth:`LogCalls.finish` returns ``None`` and the
+offline check is what it was.
 """
 from __future__ import annotations
 

@@ -19,12 +19,13 @@ from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, has_deadlines
 from rclverify.backends.monitors.declarations import (DeclarationMonitor, DeclarationResult, add_periods,
                                                       has_declarations)
+from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
 from rclverify.backends.monitors.judged import Counted, Heard, not_judged
 from rclverify.backends.monitors.log_calls import LogCalls
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.summary import verdict_status
-from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
+from rclverify.backends.monitors.widths import at_carried_widths, carried_fields, float_widths, refuse_out_of_range
 from rclverify.backends.monitors.verdicts import NodeResult
 
 
@@ -93,6 +94,8 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
             total[v] = total.get(v, 0) + k
     items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
                        f"in {trace}", decided_of(results, centries))
+    if one.bag is not None:  # a bag without a link's call topics: say what it lacks (bag_calls.py)
+        one.bag.explain(items)
     return RecordedRun(events, results, dres, pres, decl_res, summary, centries, dentries,
                        calls.missed() if summary is not None else (0, 0), items, one.note, stale)
 
@@ -110,6 +113,7 @@ class _Pass:
     events: int
     results: list[NodeResult]
     note: str = ""
+    bag: BagCalls | None = None
 
 
 def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
@@ -117,7 +121,9 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     """One read of the run feeding every monitor; in stamp order when ``lag`` is given
     (:func:`.stamp_order.in_stamp_order`); each node's constants compared as its fields carry them (widths.py)."""
     dirs = [root / d for d in cfg.msg_dirs]
-    nodes = [at_carried_widths(n, carried_widths(n, cfg.rules, dirs)) for n in nodes]
+    fields = [carried_fields(n, cfg.rules, dirs) for n in nodes]
+    sources = [(k, s) for f in fields for k, s in f.items()]
+    nodes = [at_carried_widths(n, float_widths(n, f)) for n, f in zip(nodes, fields)]
     dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
              for n in nodes if has_deadlines(n)]
     pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
@@ -135,14 +141,20 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
                 dm.feed(ev)
             yield ev
     run: Iterable[Any] = read_trace(Path(trace), [root / d for d in cfg.msg_dirs], streams=True, on_warning=on_warning)
+    bag = BagCalls(nodes, calls, trace, bag_connections(Path(trace), dirs)) \
+        if calls.active and is_ros2_bag(Path(trace)) else None  # a bag's recorded calls (bag_calls.py)
+    run = refuse_out_of_range(run, Path(trace), sources)  # a hand-made log's value no field carries (widths.py)
     if lag is not None:
         run = in_stamp_order(run, lag)
     source = tap(run) if dmons or pmons or decl else run  # untapped, a log keeps its columnar reading (batch path)
-    source = calls.tap(source) if calls.active else source  # only nodes with links: never the batch path
+    if bag is not None:
+        source = bag.tap(source)
+    elif calls.active:
+        source = calls.tap(source)  # only nodes with links: never the batch path
     watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
     events, results = check_trace(checked, nodes, Counted(source, heard, watch), cfg.rules, cfg.horizon,
                                   tolerance=cfg.tolerance)
-    return _Pass(dmons, pmons, decl, calls, heard, watch, events, results)
+    return _Pass(dmons, pmons, decl, calls, heard, watch, events, results, bag=bag)
 
 
 def _decided(res: NodeResult) -> int:

@@ -12,6 +12,12 @@ the workspace's ``.msg`` files and rosbags' store (the types the monitor
 decoded with).  So ``rclverify monitor BAG`` checks exactly the messages the
 live run checked, at the same times, and gives the same verdicts
 (tests/test_monitor_live_dds.py).
+
+The linked services' and actions' calls go to the bag too, as ROS 2 records
+them (``<service>/_service_event`` ...), with the live call book's pairing
+(:mod:`.bag_calls`): their connections carry the definitions and type
+hashes :mod:`.bag_types` makes, so ``rclverify monitor BAG`` judges the calls
+as the live run did (tests/test_ros2_bag_calls.py).
 """
 from __future__ import annotations
 
@@ -40,8 +46,10 @@ def storage_of(path: Path, storage: str | None) -> str:
 
 class BagRecorder:
     """Write raw messages of ``topics`` (contract topic without ``/`` ->
-    ``pkg/msg/T``) to a new ROS 2 bag directory ``path``.  Raises
-    :class:`BagError` when the bag cannot be created.
+    ``pkg/msg/T``) and of ``calls`` (call topic without ``/`` -> ``(type,
+    ros2idl definition, type hash)``, :mod:`.bag_calls`) to a new ROS 2 bag
+    directory ``path``.  Raises :class:`BagError` when the bag cannot be
+    created.
 
     Threads: rosbags' writer is opened, written and closed in one thread of
     its own (``rclverify-bag``; SQLite allows a connection only in the thread
@@ -50,7 +58,8 @@ class BagRecorder:
     queued message is written and the bag is finished."""
 
     def __init__(self, path: Path, storage: str, topics: Mapping[str, str], msg_dirs: Sequence[Path],
-                 open_timeout_s: float = 30.0) -> None:
+                 open_timeout_s: float = 30.0,
+                 calls: Mapping[str, tuple[str, str | None, str | None]] | None = None) -> None:
         self.path = Path(path)
         if self.path.suffix == ".mcap":  # a bag is a directory: name it without the suffix
             self.path = self.path.with_suffix("")
@@ -61,7 +70,10 @@ class BagRecorder:
         except TraceError as exc:
             raise BagError(str(exc)) from None
         self.storage, self.topics = storage, {t.strip("/"): ty for t, ty in topics.items()}
-        self.count = self.failed = 0
+        #: the call topics (:mod:`.bag_calls`): topic -> (type, ros2idl definition, type hash), or
+        #: (type, None, None) for a type rosbags' store describes
+        self.calls = {t.strip("/"): d for t, d in (calls or {}).items()}
+        self.count = self.call_count = self.failed = 0
         self.error = ""
         self._queue: queue.SimpleQueue[tuple[str, int, bytes] | None] = queue.SimpleQueue()
         self._opened = threading.Event()
@@ -88,6 +100,13 @@ class BagRecorder:
                 writer.close()
                 wide = " (rosbags has no wide string: a wstring cannot be stored)" if "wstring" in str(exc) else ""
                 raise RuntimeError(f"topic /{topic} ({msg_type}): {exc}{wide}") from None
+        for topic, (msg_type, msgdef, digest) in self.calls.items():
+            try:
+                connections[topic] = writer.add_connection("/" + topic, msg_type, msgdef=msgdef, rihs01=digest,
+                                                           typestore=self._store)
+            except Exception as exc:  # rosbags: a definition it refuses
+                writer.close()
+                raise RuntimeError(f"topic /{topic} ({msg_type}): {exc}") from None
         return writer, connections
 
     def _run(self) -> None:
@@ -106,7 +125,10 @@ class BagRecorder:
                 topic, time_ns, raw = item
                 try:
                     writer.write(connections[topic], time_ns, raw)
-                    self.count += 1
+                    if topic in self.topics:
+                        self.count += 1
+                    else:
+                        self.call_count += 1
                 except Exception as exc:  # noqa: BLE001 - one message lost, said in close()'s record
                     self.failed += 1
                     self.error = f"{type(exc).__name__}: {exc}"
@@ -114,10 +136,12 @@ class BagRecorder:
             writer.close()
 
     def write(self, topic: str, time_ns: int, raw: bytes) -> None:
-        """Queue one message of ``topic`` received at ``time_ns`` (ns since the
-        epoch); a topic not recorded, or data that are not bytes, is ignored
-        (counted in ``failed`` for the latter: nothing malformed reaches the bag)."""
-        if topic not in self.topics:
+        """Queue one message of ``topic`` (a contract topic or a call topic, no
+        leading ``/``) at ``time_ns`` (ns since the epoch: a contract topic's
+        receipt, a call topic's time in the call book, :mod:`.bag_calls`); a
+        topic not recorded, or data that are not bytes, is ignored (counted in
+        ``failed`` for the latter: nothing malformed reaches the bag)."""
+        if topic not in self.topics and topic not in self.calls:
             return
         if not isinstance(raw, (bytes, bytearray, memoryview)) or not isinstance(time_ns, int) or time_ns < 0:
             self.failed += 1
@@ -126,12 +150,15 @@ class BagRecorder:
 
     def close(self, timeout_s: float = 60.0) -> dict[str, Any]:
         """Write what is queued, finish the bag (idempotent); returns what the evidence says of it
-        (``failed``: messages not written, ``error``: the last writer error)."""
+        (``messages``: contract topics' messages written, ``call_messages``: call topics' messages
+        written, ``failed``: messages not written, ``error``: the last writer error)."""
         if self._thread.is_alive():
             self._queue.put(None)
             self._thread.join(timeout_s)
         out: dict[str, Any] = {"path": str(self.path), "messages": self.count,
                                "topics": sorted("/" + t for t in self.topics)}
+        if self.calls:
+            out.update(call_messages=self.call_count, call_topics=sorted("/" + t for t in self.calls))
         if self.failed or self._thread.is_alive():
             out["failed"] = self.failed
             out["error"] = self.error or f"the bag was not finished within {timeout_s:g} s"
