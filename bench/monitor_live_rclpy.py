@@ -20,6 +20,10 @@ configuration, ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), a random
   listener on ``/rclverify/verdict`` (bench/monitor_live_dds.py's), p50 and
   p99 in ms, over the verdicts decided on arrival.
 
+``--source dds|rclpy|both`` (default both): the monitor hears the
+publisher through its own Cyclone DDS participant, through rclpy (its agent
+in the ROS 2 Python, docs/ros2.md "Two sources"), or each in turn.
+
 Prints the figures, the load average and the core count; asserts nothing.
 ``--smoke`` (the test suite's): 1 s at 300 and 200 messages/s; without a
 ROS 2 Python it says why and exits 0.
@@ -105,9 +109,10 @@ def _workspace(ws: Path) -> None:
                                                            for t, (_typ, f, _n) in TOPICS.items()))
 
 
-def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool) -> dict[str, Any]:
+def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool,
+         source: str = "dds") -> dict[str, Any]:
     from _live import cpu_seconds, stop, wait_text
-    tag = f"{'lat' if latency else 'loss'}{int(rate)}"
+    tag = f"{'lat' if latency else 'loss'}{int(rate)}{source}"
     procs: list[subprocess.Popen[bytes]] = []
 
     def start(args: list[str], name: str) -> subprocess.Popen[bytes]:
@@ -123,7 +128,8 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
             wait_text(tmp / f"listener{tag}.out", "listening", 30)
         mon = start([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
                      "--mapping", "mapping.yaml", "--horizon", "1.0", "--reorder-window", "0", "--status", "0",
-                     "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json")],
+                     "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json"),
+                     "--source", source, "--ros2-python", str(ros2)],
                     f"monitor{tag}.out")
         wait_text(tmp / f"monitor{tag}.out", "monitoring", 30)
         (tmp / "publisher.py").write_text(PUBLISHER)
@@ -149,12 +155,17 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
     return res
 
 
-def bench(total_rate: float, latency_rate: float, seconds: float) -> None:
-    """The benchmark (module docstring)."""
+def bench(total_rate: float, latency_rate: float, seconds: float, sources: tuple[str, ...] = ("dds", "rclpy")) -> None:
+    """The benchmark (module docstring), once per source."""
     ros2, why = ros2_python()
     if ros2 is None:
         print(f"rclpy: skipped: {why}")
         return
+    for source in sources:
+        _bench(ros2, total_rate, latency_rate, seconds, source)
+
+
+def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, source: str) -> None:
     from _live import p99
     load = f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)"
     with tempfile.TemporaryDirectory() as d:
@@ -165,27 +176,28 @@ def bench(total_rate: float, latency_rate: float, seconds: float) -> None:
         env.update(PYTHONPATH=str(ROOT / "src"), CYCLONEDDS_URI=(tmp / "cyclonedds.xml").as_uri(),
                    ROS_DOMAIN_ID=str(random.SystemRandom().randint(1, 230)), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                    RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp / "ros_log"), PYTHONUNBUFFERED="1")
-        res = _run(tmp, {**env, "PYTHONPATH": str(ROOT / "src")}, ros2, total_rate, seconds, latency=False)
+        res = _run(tmp, {**env, "PYTHONPATH": str(ROOT / "src")}, ros2, total_rate, seconds, latency=False,
+                   source=source)
         sent, rec = res["sent"]["sent"], res["record"]
         per = {t: sum(1 for topic, _t in sent if topic == t) for t in TOPICS}
         heard = {t: rec["qos"][t]["samples"] for t in TOPICS}
         lost = len(sent) - rec["events"]
-        print(f"rclpy: loss: {total_rate:.0f} msg/s asked over {len(TOPICS)} topics: published {len(sent)} in "
+        print(f"rclpy publisher, {source} source: loss: {total_rate:.0f} msg/s asked over {len(TOPICS)} topics: published {len(sent)} in "
               f"{res['sent']['elapsed']:.2f} s ({len(sent) / res['sent']['elapsed']:.0f} msg/s); heard "
               f"{sum(heard.values())} ({', '.join(f'/{t} {heard[t]}/{per[t]}' for t in TOPICS)}); checked "
               f"{rec['events']}; lost {lost}; decode errors {sum(rec['decode_errors'].values())}; {load}")
         if res["cpu"] is not None:
-            print(f"rclpy: loss: monitor CPU {res['cpu'] / max(1, len(sent)) * 1e6:.0f} us per message "
+            print(f"rclpy publisher, {source} source: loss: monitor CPU {res['cpu'] / max(1, len(sent)) * 1e6:.0f} us per message "
                   f"(start-up included), engine thread {rec.get('engine_cpu_us_per_message', 0):.0f} us")
-        res = _run(tmp, env, ros2, latency_rate, seconds, latency=True)
+        res = _run(tmp, env, ros2, latency_rate, seconds, latency=True, source=source)
         lat = _latency(res)
         if lat:
-            print(f"rclpy: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
+            print(f"rclpy publisher, {source} source: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
                   f"verdict(s) decided on arrival: p50 {statistics.median(lat):.2f} ms, p99 {p99(lat):.2f} ms, "
                   f"max {lat[-1]:.2f} ms; checked {res['record']['events']} of {len(res['sent']['sent'])}; "
                   f"load average {os.getloadavg()[0]:.1f}")
         else:
-            print(f"rclpy: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
+            print(f"rclpy publisher, {source} source: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
                   f"(checked {res['record']['events']} of {len(res['sent']['sent'])})")
 
 
@@ -196,11 +208,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--latency-rate", type=float, default=1000.0, help="messages/s of the latency run")
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--smoke", action="store_true", help="CI: 1 s at 300 and 200 messages/s")
+    p.add_argument("--source", choices=("dds", "rclpy", "both"), default="both",
+                   help="how the monitor hears the robot (default: each in turn)")
     a = p.parse_args(argv)
+    sources = ("dds", "rclpy") if a.source == "both" else (a.source,)
     if a.smoke:
-        bench(300.0, 200.0, 1.0)
+        bench(300.0, 200.0, 1.0, sources)
     else:
-        bench(a.total_rate, a.latency_rate, a.seconds)
+        bench(a.total_rate, a.latency_rate, a.seconds, sources)
     return 0
 
 

@@ -90,9 +90,10 @@ def test_input_before_the_first_real_output_is_answered_not_a_crash(cruise_ws: P
                     '{"topic": "distance", "time": 6.0, "data": 0.2}\n')
     rc = main(["monitor", "-w", str(cruise_ws), "--json", str(lone)])
     out = json.loads(capsys.readouterr().out)
+    # (before any output was heard, the first is not counted against the node: docs/semantics.md, "Steps")
     assert rc == 0 and out[0]["status"] == "inconclusive"
-    assert out[0]["counts"]["inconclusive"] == 1 and out[0]["counts"]["open"] == 1
-    assert "unanswered" in out[0]["first_inconclusive"]["reason"]
+    assert out[0]["counts"]["before first answer"] == 1 and out[0]["counts"]["open"] == 1
+    assert "no output of" in out[0]["explanation"] and "question(s) came before any answer" in out[0]["explanation"]
     # a wrong answer, never corrected within the horizon, violates guarantee 1, shown with the values
     wrong = cruise_ws / "wrong.jsonl"
     wrong.write_text(TWO_LINES.replace("0.05", "0.5") + '{"topic": "distance", "time": 6.0, "data": 2.0}\n')

@@ -153,23 +153,33 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
     (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text("bool data\n---\nbool success\nstring message\n")
     env = ros2_env(tmp)
-    monitor = system = None
+    monitor = system = deaf = None
     try:
+        # the rclpy source hears a call only through introspection events, which these servers do not publish:
+        # it must say so and never be green (docs/ros2.md, "Two sources")
+        deaf = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--strict",
+                          "--node", "Base", "--source", "rclpy", "--ros2-python", str(ros2_python()),
+                          "--verdict-topic", "/deaf/verdict", "--status", "0", "--duration", "60", "--evidence",
+                          str(tmp / "deaf.json")], env, tmp, tmp / "deaf.out")
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--strict",
                              "--horizon", "1.0", "--reorder-window", "0", "--status", "0", "--duration", "60",
                              "--log", str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json")],
                             env, tmp, tmp / "monitor.out")
         wait_for(tmp / "monitor.out", "monitoring", 30)
+        wait_for(tmp / "deaf.out", "monitoring", 30)
         system = start_node(tmp, "system", SYSTEM, env)
         wait_for(tmp / "system.log", "done", 40)
         time.sleep(1.6)  # the horizon (1 s) and the monitor's settle (0.3 s) pass
         stop(monitor, signal.SIGINT)
+        stop(deaf, signal.SIGINT)
         yield {"ws": ws, "code": monitor.returncode, "out": (tmp / "monitor.out").read_text(),
+               "deaf": {"code": deaf.returncode, "out": (tmp / "deaf.out").read_text(),
+                        "record": json.loads((tmp / "deaf.json").read_text())},
                "system": (tmp / "system.log").read_text(),
                "log": [json.loads(x) for x in (tmp / "live.jsonl").read_text().splitlines()],
                "record": json.loads((tmp / "live.json").read_text())}
     finally:
-        for p in (system, monitor):
+        for p in (system, monitor, deaf):
             if p is not None:
                 stop(p)
 
@@ -232,3 +242,11 @@ def test_strict_exit_and_the_replay(run: dict[str, Any]) -> None:
     assert summary["counts"] == run["record"]["calls"]["counts"]
     assert {r["node"]: r["counts"] for r in summary["nodes"]} == \
         {n["node"]: n["counts"] for n in run["record"]["calls"]["nodes"]}
+
+
+def test_the_rclpy_source_says_it_cannot_hear_calls_without_introspection(run: dict[str, Any]) -> None:
+    deaf = run["deaf"]
+    assert deaf["record"]["source"] == "rclpy" and deaf["record"]["unseen"], deaf["record"].get("unseen")
+    assert "hears this link's calls only through introspection events" in deaf["out"], deaf["out"]
+    assert any(i.get("item", "").endswith("/estop") or "/estop" in json.dumps(i) for i in deaf["record"]["not_judged"])
+    assert deaf["code"] == 1, deaf["out"]  # nothing judged of Base: never green under --strict

@@ -4,7 +4,8 @@
 
 A live ROS 2 run's log named as a TRACE has its service calls and action
 goals judged as the live run judged them (its call lines replayed through
-the live call book, :mod:`.log_calls`).
+the live call book, :mod:`.log_calls`), and so has its ``--record`` bag
+(the calls recorded as ROS 2 records them, :mod:`.bag_calls`).
 
 Exit status: 0 when no contract is violated, 1 when one is (a message, a
 call, a deadline), 2 for a trace
@@ -205,6 +206,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     from rclverify.runtime.live import LiveRun, run_ros1  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
     from rclverify.runtime.ros1 import RosUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     if args.traces:
         print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
         return 2
@@ -245,18 +247,39 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
             from rclverify.runtime.dds.live import run_dds  # deferred: optional or conditional (inside a block)
             msg_dirs = [root / d for d in cfg.msg_dirs]
             rec = (Path(record), storage_of(Path(record), getattr(args, "record_storage", None))) if record else None
+            bus_factory = _source(args, bool(enforce_items))
+            if bus_factory is False:
+                return 2
             record_ = run_dds(factory, checked, nodes, msg_dirs + interfaces, **common,
                               enforce=extra.get("guarded"), record=rec, msg_dirs=msg_dirs,
-                              reorder_window=args.reorder_window)
+                              reorder_window=args.reorder_window, bus_factory=bus_factory)
         else:
             proxy = proxy_factory(checked, nodes, getattr(args, "forward", []), interfaces)
             record_ = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
-    except (RosUnavailable, DdsUnavailable, ProxyUsage) as exc:
+    except (RosUnavailable, DdsUnavailable, ProxyUsage, RclpyUnavailable) as exc:
         text = str(exc)
         print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
         return 2
     _print_live(log, record_)
     return _live_exit(args, record_)
+
+
+def _source(args: argparse.Namespace, enforce: bool) -> Any:
+    """The bus factory of the ROS 2 source ``--source`` asks for (docs/ros2.md, "Two sources"): the rclpy
+    source's, ``None`` for the DDS source, ``False`` after printing why it cannot be had (exit 2). Says
+    which source on the first line."""
+    from functools import partial  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+
+    from rclverify.runtime.rclpy_source.bus import RclpyBus  # deferred: optional or conditional (only --ros2)
+    from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (only --ros2)
+    try:
+        source, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None),
+                                      "--enforce" if enforce else None)
+    except ValueError as exc:
+        print(f"rclverify monitor --live --ros2: error: {exc}", file=sys.stderr)
+        return False
+    print(f"source: {source} ({why})", flush=True)
+    return partial(RclpyBus, py) if source == "rclpy" and py else None
 
 
 def _live_usage(args: argparse.Namespace, ros: str, ros2_only: bool) -> str | None:

@@ -60,7 +60,14 @@ def _live_options(lv: argparse._ArgumentGroup) -> None:
     lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
     lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")
     lv.add_argument("--ros2", dest="ros", action="store_const", const="2",
-                    help="ROS 2 over DDS (Cyclone DDS; ROS_DOMAIN_ID, CYCLONEDDS_URI): same as --ros 2")
+                    help="ROS 2 (ROS_DOMAIN_ID; over DDS: CYCLONEDDS_URI): same as --ros 2")
+    lv.add_argument("--source", choices=("auto", "rclpy", "dds"), default="auto",
+                    help="ROS 2: hear the robot through rclpy (any middleware; calls through introspection "
+                         "events) or a DDS participant of the monitor's own (calls also by their order); auto: "
+                         "rclpy where rclverify's Python imports it, else dds")
+    lv.add_argument("--ros2-python", metavar="PYTHON",
+                    help="ROS 2: the Python with rclpy the rclpy source runs in (default: $RCLVERIFY_ROS2_PYTHON, "
+                         "else this one)")
     lv.add_argument("--enforce", action="append", default=[], metavar="TOPIC[:=PRIVATE][@open]",
                     help="ROS 2: republish TOPIC only when the guarantee holds; the node publishes on PRIVATE "
                          "(default TOPIC_unchecked); TOPIC@open also releases what cannot be decided, which is "

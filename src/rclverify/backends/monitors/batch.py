@@ -387,6 +387,7 @@ class _Run:
             m.invalid.pop(k, None)
         values[okey] = newest.answer[okey]
         m.invalid.pop(okey, None)
+        m.heard_answer = True  # the pairs' outputs were heard (engine.py: judging starts at the first one)
         m._open, m._due = newest, newest.due
         last_out = float(times[at[-1] + 1])
         if last_out > m.now:

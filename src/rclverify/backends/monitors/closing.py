@@ -214,6 +214,12 @@ class Closing:
         if end:
             self._verdict("open", q.event, reason=f"unanswered when the run ended, within {self.horizon} s")
             return
+        if not self.heard_answer:
+            self._verdict("before first answer", q.event, reason=f"unanswered within {self.horizon} s, before any "
+                          "output of the node was heard: the monitor's readers of its outputs may have matched "
+                          "after this question (a monitor started after the publishers, a latched input delivered "
+                          "on matching); not counted (docs/semantics.md, \"Steps\")")
+            return
         self._verdict("inconclusive", q.event, reason=f"unanswered: no output within {self.horizon} s of the "
                       f"question at {q.event.where} (a finite run cannot show the answer never comes; a deadline "
                       "`triggered by ... within` would fail)")

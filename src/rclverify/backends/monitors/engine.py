@@ -168,6 +168,9 @@ class NodeMonitor(Judging, Closing, Late):
         self._unread: dict[str, tuple[float, str]] = {}
         #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late
         self._hi = float("-inf")
+        #: whether an output of the node was heard yet: a question closed unanswered before it is not counted
+        #: (its readers may have matched after it: docs/semantics.md, "Steps")
+        self.heard_answer = False
         #: before the first question: input -> the (stamp, value, event) of the messages that set it (the last 64)
         self._in_force: dict[str, list[tuple[float, Any, Event]]] = {}
         #: the one question whose horizon is watched: the latest owed one (an earlier one was followed by a
@@ -249,6 +252,7 @@ class NodeMonitor(Judging, Closing, Late):
                 self.invalid.pop(key, None)
         trig, changed = self._topic_io[ev.topic]
         if changed:
+            self.heard_answer = True
             self._output(ev, changed)
         if trig:
             self._input(ev, trig)

@@ -92,6 +92,10 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
                           f"violation is at {v.get('where')} (t = {v.get('time')} s): {which}: {v.get('reason')}"
                           + (f" (every violation: `rclverify explain OBLIGATION#N`, N = 1..{len(res.violations)})"
                              if len(res.violations) > 1 else ""))
+    if c["before first answer"] and not c["satisfied"]:
+        return "inconclusive", (f"no output of {res.node} was heard in {trace}: {c['before first answer']} "
+                                "question(s) came before any answer, and a node that never answers and a reader "
+                                f"that never matched look the same (docs/semantics.md, \"Steps\"){blame}")
     if c["inconclusive"]:
         i = res.first_inconclusive or {}
         return "inconclusive", (f"{c['inconclusive']} event(s) could not be decided; first at {i.get('where')}: "

@@ -17,10 +17,12 @@ from rclverify.model.system.services import peers
 #: Verdicts of one node's events: per output message (``satisfied``,
 #: ``violated``, ``inconclusive``), per question (``assumption violated``,
 #: ``incomplete input``, ``superseded``, ``inconclusive`` when unanswered
-#: within the horizon, ``open`` when the run ended first; ``satisfied`` or
-#: ``violated`` when its inputs alone decide the guarantees).
+#: within the horizon, ``before first answer`` when that was before any
+#: output of the node was heard (not counted: docs/semantics.md, "Steps"),
+#: ``open`` when the run ended first; ``satisfied`` or ``violated`` when its
+#: inputs alone decide the guarantees).
 VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusive", "incomplete input",
-            "superseded")
+            "superseded", "before first answer")
 #: Topic suffixes of a service's or action's parts, in the order of ``Link.parts``
 #: (a service ``s`` is observed as ``s/request`` and ``s/response`` events, an
 #: action ``a`` as actionlib's ``a/goal``, ``a/feedback`` and ``a/result``).

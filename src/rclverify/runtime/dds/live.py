@@ -16,7 +16,8 @@ messages in and verdicts out over DDS (:mod:`rclverify.ros.live.dds`):
   node's latest on ``rt/rclverify/<Node>/last_verdict``, reliable and
   transient-local, depth 1 (ROS 2's latching);
 * with ``enforce``, republishes the guarded topics (:mod:`.dds_enforce`);
-  with ``record``, writes the run to a ROS 2 bag (:mod:`.dds_bag`).
+  with ``record``, writes the run to a ROS 2 bag (:mod:`.dds_bag`), its
+  calls as ROS 2 records them (:mod:`.bag_calls`).
 
 Threads: Cyclone's own (C, no GIL), the bus thread (takes raw samples,
 queues them), the engine thread (decodes, checks, logs, publishes, runs
@@ -40,6 +41,7 @@ from rclverify.ros.live.dds import DdsUnavailable, domain_id, make_participant, 
 from rclverify.ros.live.dds_qos import writer_profile
 from rclverify.backends.monitors.summary import verdict_status
 from rclverify.runtime.dds.bag import BagRecorder
+from rclverify.runtime.dds.bag_calls import CallRecorder
 from rclverify.backends.monitors.dds_calls import CallBook
 from rclverify.runtime.dds.services import CallTaps
 from rclverify.runtime.dds.types import DdsTypeError, TypeBook, to_fields
@@ -87,32 +89,39 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
             type_dirs: list[Path], *, verdict_topic: str, last_prefix: str, duration: float | None, tick_s: float,
             status_s: float, evidence: Path | None, stop: Any, out: Callable[[str], None],
             enforce: Mapping[str, str] | None = None, record: tuple[Path, str] | None = None,
-            msg_dirs: list[Path] | None = None, reorder_window: float = 0.0, **_ignored: Any) -> dict[str, Any]:
+            msg_dirs: list[Path] | None = None, reorder_window: float = 0.0,
+            bus_factory: Callable[..., Any] | None = None, **_ignored: Any) -> dict[str, Any]:
     """Monitor the ROS 2 system on the DDS domain until ``stop`` is set or
     ``duration`` s passed; returns the evidence record (written to
     ``evidence`` too).  ``type_dirs``: directories of ``<pkg>/msg|srv|action``
     (the mapping's message directories and ``--interfaces``); ``enforce``:
     guarded contract topic -> private ROS name (``run_factory`` makes an
     :class:`~.dds_enforce.EnforcingRun` then); ``record``: ``(bag path,
-    storage)``.  Raises :class:`~rclverify.ros.live.dds.DdsUnavailable` (the
-    binding, the domain, a type that cannot be made, a bag that cannot be
-    created: one message)."""
+    storage)``; ``bus_factory(on_sample, warn, on_reader=, type_hash=)``: the
+    bus of another source with the DDS bus's face (the rclpy source,
+    :mod:`rclverify.runtime.rclpy_source.bus`), else a Cyclone DDS participant
+    of the monitor's own.  Raises
+    :class:`~rclverify.ros.live.dds.DdsUnavailable` (the binding, the domain,
+    a type that cannot be made, a bag that cannot be created, the rclpy agent
+    that cannot start: one message)."""
     run = _DdsRun(checked, nodes, type_dirs, dict(enforce or {}), out)
     run.open_recorder(record, msg_dirs)
-    dp = make_participant()
-    run.join(dp, run_factory, verdict_topic, last_prefix)
+    dp = make_participant() if bus_factory is None else None
+    run.join(dp, run_factory, verdict_topic, last_prefix, bus_factory)
     worker = EngineWorker(_Sink(run.live, run.book, run.calls, reorder_window), run.decode, _time.time,
                           tick_s=tick_s)
     run.worker_box.append(worker.start())
     run.bus.start()
+    via = f"through rclpy on {run.source_rmw()}" if dp is None else f"on DDS domain {domain_id()}"
     out(f"monitoring {len(run.structs)} topic(s) and {len(run.calls.specs) if run.calls else 0} service/action "
-        f"topic(s) for {len(nodes)} node(s) on DDS domain {domain_id()}; verdicts on {verdict_topic}")
+        f"topic(s) for {len(nodes)} node(s) {via}; verdicts on {verdict_topic}")
     try:
         run.wait(worker, stop, duration, tick_s, status_s)
     finally:
         record_ = run.finish(worker, evidence)
         run.bus.close()
-        dp.__del__()
+        if dp is not None:
+            dp.__del__()
     return record_
 
 
@@ -146,6 +155,7 @@ class _DdsRun:
                 raise DdsUnavailable(f"{lk.loc.file}:{lk.loc.line}:{lk.loc.col}: error: {lk.kind} {lk.name} "
                                      f"({lk.ros_type}): {exc}") from None
         self.recorder: BagRecorder | None = None
+        self.call_recorder: CallRecorder | None = None
         self.warnings: list[str] = []
         self.decode_errors: dict[str, int] = {}
         self.worker_box: list[EngineWorker] = []
@@ -153,16 +163,22 @@ class _DdsRun:
         self.book: CallBook | None = None
         self.calls: CallTaps | None = None
         self.call_counts: dict[tuple[str, str], int] = {}
+        self.bus: Any = None  # the DDS bus, or the rclpy source's (join)
 
     def open_recorder(self, record: tuple[Path, str] | None, msg_dirs: list[Path] | None) -> None:
-        """The bag the run is written to, when ``record`` names one."""
+        """The bag the run is written to, when ``record`` names one: the contract topics'
+        messages, and the linked services' and actions' calls as ROS 2 records them (:mod:`.bag_calls`)."""
         if record is None:
             return
         try:
+            self.call_recorder = CallRecorder(self.types, self.links) if self.links else None
             self.recorder = BagRecorder(record[0], record[1], {t.strip("/"): ty for t, ty in self.topics.items()},
-                                        msg_dirs if msg_dirs is not None else self.type_dirs)
-        except BagError as exc:
+                                        msg_dirs if msg_dirs is not None else self.type_dirs,
+                                        calls=self.call_recorder.plan if self.call_recorder else None)
+        except (BagError, DdsTypeError) as exc:
             raise DdsUnavailable(str(exc)) from None
+        if self.call_recorder is not None:
+            self.call_recorder.write = self.recorder.write
 
     def warn(self, text: str) -> None:
         self.warnings.append(text)
@@ -175,14 +191,28 @@ class _DdsRun:
         if tap.key in self.enforce and tap.key not in self.republish:
             self.republish[tap.key] = self.bus.writer(topic_name(tap.key), self.structs[tap.key], publishers[0].qos)
 
-    def join(self, dp: Any, run_factory: Callable[..., LiveRun], verdict_topic: str, last_prefix: str) -> None:
-        """The bus on participant ``dp``, the verdict writers, the run, the
-        call book, and a tap on every contract topic and linked call."""
+    def join(self, dp: Any, run_factory: Callable[..., LiveRun], verdict_topic: str, last_prefix: str,
+             bus_factory: Callable[..., Any] | None = None) -> None:
+        """The bus on participant ``dp`` (or the one ``bus_factory`` makes:
+        :func:`run_dds`), the verdict writers, the run, the call book, and a
+        tap on every contract topic and linked call."""
         string, enforce = self.string, self.enforce
         writers = WriterIds()  # a service sample's writer tells its wire form (dds_wire.py)
-        self.bus = bus = Bus(dp, lambda tap, raw, info, rns: self.worker_box[0].offer(tap.key, (
-            raw, info.source_timestamp, rns, writers.of(tap.reader, info) if tap.key.startswith("call:") else None),
-            rns / 1e9), self.warn, on_reader=self.on_reader, type_hash=self.types.type_hash)
+        bus: Any  # the DDS bus, or the rclpy source's with its face
+
+        def writer_of(tap: Any, info: Any) -> bytes | None:
+            if not tap.key.startswith("call:"):
+                return None
+            guid = getattr(info, "writer_guid", None)  # the rclpy source hands the publisher's GID over
+            return (bytes(guid) or None) if guid is not None else writers.of(tap.reader, info)
+
+        def on_sample(tap: Any, raw: bytes, info: Any, rns: int) -> None:
+            self.worker_box[0].offer(tap.key, (raw, info.source_timestamp, rns, writer_of(tap, info)), rns / 1e9)
+        if bus_factory is not None:
+            self.bus = bus = bus_factory(on_sample, self.warn, on_reader=self.on_reader,
+                                         type_hash=self.types.type_hash)
+        else:
+            self.bus = bus = Bus(dp, on_sample, self.warn, on_reader=self.on_reader, type_hash=self.types.type_hash)
         user = type_hash_user_data("std_msgs/msg/String")
         self.pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
         latched = writer_profile(transient_local=True, depth=1)
@@ -197,9 +227,17 @@ class _DdsRun:
             lasts[node].write(string(data=text))
         self.live = run_factory(publish=self.send, publish_last=send_last, **extra)
         if self.links:
+            rec, note = self.call_recorder, self.live.note
+
+            def on_line(obj: dict[str, Any]) -> None:  # the log's call line, and the bag's events (bag_calls.py)
+                note(obj)
+                if rec is not None:
+                    rec.line(obj)
             self.book = CallBook(self.checked, self.links, self.live.engine.rules, self.live.engine.horizon,
-                                 self.on_call_verdict, self.on_deadline, self.live.note)
+                                 self.on_call_verdict, self.on_deadline, on_line)
             self.calls = CallTaps(self.book, self.types, self.links)
+            if rec is not None:
+                rec.specs = self.calls.specs
         for t, struct in self.structs.items():
             bus.tap(t, topic_name(enforce.get(t, t)), struct, self.where.get(t, t))
         for t in enforce:  # only the gate may write a guarded topic, only the monitor the verdict topic (dds_trust.py)
@@ -207,6 +245,16 @@ class _DdsRun:
         bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
         if self.calls is not None:
             self.calls.attach(bus, self.warn)
+        for lk_name, where in sorted({(t.key.split(":")[1], t.where) for t in getattr(bus, "deaf", [])}):
+            self.warn(f"{where}: warning: {lk_name}: the rclpy source hears this link's calls only through "
+                      f"introspection events ({lk_name}/_service_event, and an action's own services'), never "
+                      "its request and reply topics: enable introspection on its server or clients "
+                      "(docs/ros2.md), or monitor with --source dds")
+
+    def source_rmw(self) -> str:
+        """The middleware the rclpy agent runs on (its hello), or ``DDS``."""
+        hello = getattr(self.bus, "hello", {})
+        return str(hello.get("rmw", "DDS"))
 
     def send(self, text: str) -> None:
         self.pub.write(self.string(data=text))
@@ -231,6 +279,8 @@ class _DdsRun:
         calls = self.calls
         try:
             if calls is not None and key.startswith("call:"):
+                if self.call_recorder is not None:
+                    self.call_recorder.sample(key, raw, source_ns, payload[3])
                 calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9, payload[3])
                 return None
             fields: Mapping[str, Any] = to_fields(self.structs[key].deserialize(raw))
@@ -277,8 +327,20 @@ class _DdsRun:
             record_["bus_error"] = bus_error
             for n in record_["nodes"]:
                 n["status"], n["explanation"] = "error", f"the DDS reader thread stopped: {bus_error}"
-        record_.update(middleware=f"DDS domain {domain_id()} ({_version()})", warnings=self.warnings,
-                       decode_errors=self.decode_errors, qos={t.key: t.to_json() for t in bus.taps})
+        hello = getattr(bus, "hello", None)
+        if hello is not None:  # the rclpy source: its middleware, and what it cannot hear (rclpy_source/bus.py)
+            record_.update(source="rclpy", rmw=hello.get("rmw", ""),
+                           middleware=f"rclpy {hello.get('rclpy', '')} on {hello.get('rmw', '')} (ROS 2 Python "
+                                      f"{hello.get('python', '')}, domain {domain_id()})",
+                           unseen=sorted({f"{t.key.split(':')[1]}: request and reply topics (only introspection "
+                                          "events are heard)" for t in bus.deaf}))
+        else:
+            record_.update(source="dds", rmw="DDS participant (Cyclone DDS)",
+                           middleware=f"DDS domain {domain_id()} ({_version()})", unseen=[])
+        qos = {t.key: t.to_json() for t in bus.taps}
+        for key, n in getattr(bus, "before", {}).items():
+            qos[key]["published_before_heard"] = n
+        record_.update(warnings=self.warnings, decode_errors=self.decode_errors, qos=qos)
         if summary is not None and book is not None:
             record_["calls"] = _calls_record(summary, book, calls)
             record_["deadlines"] = {"results": summary["deadlines"], "false": summary["false"]}
@@ -291,6 +353,8 @@ class _DdsRun:
                   bypass, {t.key: t.reader_changes for t in bus.taps})
         if self.recorder is not None:
             record_["bag"] = self.recorder.close()
+            if self.call_recorder is not None and self.call_recorder.failed:
+                record_["bag"]["calls_failed"] = self.call_recorder.failed
         record_["not_judged"] = live.not_judged(record_)  # silence is never green (judged.py)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")

@@ -1,0 +1,228 @@
+"""The live monitor's rclpy agent: run in a ROS 2 Python, it hears the
+robot through rclpy on whatever middleware the robot runs (Fast DDS,
+Cyclone DDS, Zenoh) and hands the monitor what it hears.
+
+Run as a script (``python agent.py``) by :mod:`.bus`; it imports rclpy
+and the standard library only (and :mod:`wire`, beside it), never
+rclverify, so any ROS 2 Python can run it: a sourced apt installation's
+``python3`` or a venv with ROS 2's PyPI wheels.
+
+* **Taps** (``{"op": "tap", "id", "topic", "type"}``): a subscription
+  of the topic's type that hands over each message serialized, exactly as
+  rmw received it (``raw=True``; CDR with its encapsulation header), with
+  rmw's message info: the source and receipt stamps, the publisher's GID,
+  the writer's sequence number.  The subscription is made once a publisher
+  of that type is in the graph, with the QoS every publisher can match
+  (reliable only when all are, transient-local when all are: a latched
+  message is delivered to it as to any late ROS 2 subscriber), and made
+  again when a publisher appears that it cannot match.
+* **The graph**: the nodes, and each tapped or watched topic's publishers
+  (GID, node, namespace, type, type hash, reliability, durability) as the
+  ROS 2 graph API reports them, sent when they change.  The agent's node is
+  hidden (``_rclverify_monitor_<pid>``) and its own endpoints are left out.
+* **Writers** (``writer``, ``write``): publishers of the monitor (its
+  verdicts), written with serialized messages the monitor made.
+
+SIGINT is ignored (the monitor stops the agent when it stops: ``stop`` or
+the end of stdin), so a Ctrl-C in a terminal does not cut the stream short.
+"""
+from __future__ import annotations
+
+import base64
+import importlib
+import json
+import os
+import queue
+import signal
+import sys
+import threading
+import time
+from typing import Any
+
+from importlib.metadata import version
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from rclpy.utilities import get_rmw_implementation_identifier
+
+import wire  # type: ignore[import-not-found]  # beside this script (module docstring)
+
+GRAPH_PERIOD_S = 0.1
+
+
+def _emit(frame: bytes) -> None:
+    view = memoryview(frame)
+    while view:
+        view = view[os.write(1, view):]
+
+
+def _class(type_name: str) -> Any:
+    pkg, kind, name = type_name.strip("/").split("/")
+    return getattr(importlib.import_module(f"{pkg}.{kind}"), name)
+
+
+def _commands(q: queue.Queue[dict[str, Any] | None], wake: Any) -> None:
+    """Queue each command line, and wake the executor (a guard condition) so it is done at once."""
+    for line in sys.stdin:
+        if line.strip():
+            q.put(json.loads(line))
+            wake.trigger()
+    q.put(None)
+    wake.trigger()
+
+
+class Agent:
+    """The agent's state: its node, taps and writers (module docstring)."""
+
+    def __init__(self) -> None:
+        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+        self.name = f"_rclverify_monitor_{os.getpid()}"
+        self.node = Node(self.name)
+        self.ex = SingleThreadedExecutor()
+        self.ex.add_node(self.node)
+        self.taps: dict[int, dict[str, Any]] = {}
+        self.watched: set[str] = set()
+        self.writers: dict[int, Any] = {}
+        self.last_graph: Any = None
+
+    def hello(self) -> None:
+        try:
+            rclpy_version = version("rclpy")
+        except Exception:  # noqa: BLE001 - an apt installation has no distribution metadata
+            rclpy_version = ""
+        _emit(wire.json_frame({"what": "hello", "rmw": get_rmw_implementation_identifier(),
+                               "distro": os.environ.get("ROS_DISTRO", ""), "rclpy": rclpy_version,
+                               "python": sys.version.split()[0], "node": self.name}))
+
+    # -- commands ------------------------------------------------------------------------------
+    def command(self, c: dict[str, Any]) -> None:
+        op = c.get("op")
+        if op == "tap":
+            try:
+                cls = _class(c["type"])
+            except Exception as exc:  # noqa: BLE001 - said to the monitor, the tap stays deaf
+                _emit(wire.json_frame({"what": "error", "id": c["id"], "text": f"{type(exc).__name__}: {exc}"}))
+                cls = None
+            self.taps[int(c["id"])] = {"topic": c["topic"], "type": c["type"], "cls": cls, "sub": None,
+                                       "qos": None, "changes": 0, "heard": []}
+        elif op == "watch":
+            self.watched.add(c["topic"])
+        elif op == "writer":
+            qos = QoSProfile(depth=int(c.get("depth", 10)),
+                             reliability=ReliabilityPolicy.RELIABLE if c.get("reliable", True)
+                             else ReliabilityPolicy.BEST_EFFORT,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL if c.get("transient_local")
+                             else DurabilityPolicy.VOLATILE)
+            self.writers[int(c["id"])] = self.node.create_publisher(_class(c["type"]), c["topic"], qos)
+        elif op == "write":
+            self.writers[int(c["id"])].publish(base64.b64decode(c["raw"]))
+
+    # -- the graph -----------------------------------------------------------------------------
+    def _publishers(self, topic: str) -> list[Any]:
+        return [p for p in self.node.get_publishers_info_by_topic(topic)
+                if not (p.node_name == self.name and p.node_namespace == "/")]
+
+    def update(self) -> None:
+        """Make or remake each tap's subscription for the publishers in the graph; report changes."""
+        topics: dict[str, list[dict[str, Any]]] = {}
+        for t in sorted({t["topic"] for t in self.taps.values()} | self.watched):
+            topics[t] = [{"gid": bytes(p.endpoint_gid[:wire.GID_BYTES]).hex(), "node": p.node_name,
+                          "ns": p.node_namespace, "type": p.topic_type, "hash": str(p.topic_type_hash),
+                          "reliable": p.qos_profile.reliability == ReliabilityPolicy.RELIABLE,
+                          "durability": "transient_local"
+                          if p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL else "volatile"}
+                         for p in self._publishers(t)]
+        graph = {"what": "graph", "nodes": sorted(self.node.get_node_names_and_namespaces()), "topics": topics}
+        if graph != self.last_graph:
+            self.last_graph = graph
+            _emit(wire.json_frame(graph))
+        for k, tap in self.taps.items():
+            same = [p for p in topics.get(tap["topic"], []) if p["type"] == tap["type"]]
+            if not same or tap["cls"] is None:
+                continue
+            want = (all(p["reliable"] for p in same), all(p["durability"] == "transient_local" for p in same))
+            heard = sorted(p["gid"] for p in same)
+            if tap["sub"] is not None and _matches(tap["qos"], same):
+                if heard != tap["heard"]:
+                    tap["heard"] = heard
+                    self._said(k, tap)
+                continue
+            if tap["sub"] is not None:
+                self.node.destroy_subscription(tap["sub"])
+                tap["changes"] += 1
+            qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
+                             reliability=ReliabilityPolicy.RELIABLE if want[0] else ReliabilityPolicy.BEST_EFFORT,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL if want[1] else DurabilityPolicy.VOLATILE)
+            tap["sub"] = self.node.create_subscription(tap["cls"], tap["topic"], _handler(k), qos, raw=True)
+            tap["qos"], tap["heard"] = want, heard
+            self._said(k, tap)
+
+    def _said(self, k: int, tap: dict[str, Any]) -> None:
+        _emit(wire.json_frame({"what": "tap", "id": k, "reliable": tap["qos"][0],
+                               "durability": "transient_local" if tap["qos"][1] else "volatile",
+                               "heard": tap["heard"], "changes": tap["changes"]}))
+
+    def close(self) -> None:
+        self.node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def _matches(qos: tuple[bool, bool] | None, pubs: list[dict[str, Any]]) -> bool:
+    """Whether a subscription of ``qos`` (reliable, transient-local) matches every publisher of ``pubs``."""
+    if qos is None:
+        return False
+    reliable, latched = qos
+    return all((p["reliable"] or not reliable) and (p["durability"] == "transient_local" or not latched)
+               for p in pubs)
+
+
+def _handler(k: int) -> Any:
+    def on_message(raw: bytes, info: dict[str, Any]) -> None:
+        gid = (info.get("publisher_gid") or {}).get("data") or b""
+        received = int(info.get("received_timestamp") or 0) or time.time_ns()
+        _emit(wire.sample_frame(k, int(info.get("source_timestamp") or 0), received,
+                                int(info.get("publication_sequence_number") or 0), bytes(gid), raw))
+    return on_message
+
+
+def main() -> int:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    q: queue.Queue[dict[str, Any] | None] = queue.Queue()
+    try:
+        agent = Agent()
+    except Exception as exc:  # noqa: BLE001 - said to the monitor as one line
+        _emit(wire.json_frame({"what": "error", "text": f"rclpy could not start: {type(exc).__name__}: {exc}"}))
+        return 1
+    wake = agent.node.create_guard_condition(lambda: None)  # a command ends the executor's wait at once
+    threading.Thread(target=_commands, args=(q, wake), daemon=True).start()
+    agent.hello()
+    started = False
+    next_graph = 0.0
+    try:
+        while True:
+            try:
+                while True:
+                    c = q.get_nowait() if started else q.get(timeout=0.05)
+                    if c is None or c.get("op") == "stop":
+                        return 0
+                    if c.get("op") == "start":
+                        started = True
+                    agent.command(c)
+            except queue.Empty:
+                pass
+            if not started:
+                continue
+            now = time.monotonic()
+            if now >= next_graph:
+                agent.update()
+                next_graph = now + GRAPH_PERIOD_S
+            agent.ex.spin_once(timeout_sec=GRAPH_PERIOD_S)
+    finally:
+        agent.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,325 @@
+"""The live monitor's bus with rclpy as the source: what the robot carries,
+heard through the ROS client library on whatever middleware it runs.
+
+:class:`RclpyBus` has the face of the DDS bus (:class:`~rclverify.runtime.dds.bus.Bus`:
+``tap``, ``writer``, ``watch_writers``, ``discovery``, ``taps``,
+``bypass``, ``start``, ``stop``, ``close``), so the run, the engine, the
+call book, the log and the bag are the DDS path's, unchanged; only where
+the bytes come from differs.  Its data come from an agent process
+(:mod:`.agent`) run in a ROS 2 Python (:func:`.python.ros2_python`), over a
+pipe (:mod:`.wire`):
+
+* each tap becomes a raw subscription of the topic's ROS name and type
+  (``rt/scan`` -> ``/scan``, ``sensor_msgs::msg::dds_::LaserScan_`` ->
+  ``sensor_msgs/msg/LaserScan``), its samples the serialized bytes rmw
+  received, decoded by the monitor as the DDS path decodes them (every field
+  at its width);
+* discovery is rclpy's graph API: each publisher's GID, node, type, ROS 2
+  type hash (REP-2011) and QoS; a publisher of another type or of another
+  type hash than the contract's is named in a located warning and never
+  heard;
+* a sample carries its writer's GID and sequence number: the messages a
+  publisher wrote before the monitor heard it are counted
+  (``published_before_heard``);
+* **what rclpy cannot hear** is said, never silent: a service's requests
+  and replies travel on the middleware's own request and reply topics,
+  which only the middleware's client and server see; rclpy hears a call
+  through the service's introspection events (``<service>/_service_event``)
+  and nowhere else.  Each request or reply tap is deaf here (``deaf``), and
+  the run warns once per service (docs/ros2.md).
+
+Errors: :class:`RclpyUnavailable` (no ROS 2 Python, the agent could not
+start): one message.
+"""
+from __future__ import annotations
+
+import base64
+import json
+import subprocess
+import threading
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any, Callable, IO
+
+from rclverify.ros.live.dds_discovery import EndpointInfo
+from rclverify.ros.live.dds_qos import QosProfile
+from rclverify.runtime.dds.bus import Tap
+from rclverify.runtime.rclpy_source.wire import parse_sample, read_frame
+
+AGENT = Path(__file__).with_name("agent.py")
+#: seconds the agent has to say hello (rclpy's start-up)
+HELLO_TIMEOUT_S = 30.0
+
+
+class RclpyUnavailable(Exception):
+    """The rclpy source cannot run; ``str`` says why in one line."""
+
+
+def ros_name(dds_topic: str) -> str | None:
+    """The ROS name of a DDS topic of ROS 2's conventions (``rt/a/b`` -> ``/a/b``),
+    ``None`` for a service's request or reply topic (``rq/``, ``rr/``: rclpy cannot read them)."""
+    if dds_topic.startswith("rt/"):
+        return "/" + dds_topic[3:]
+    return None
+
+
+def ros_type(struct: type) -> str:
+    """``pkg/msg/T`` of a contract struct (``pkg::msg::dds_::T_``)."""
+    parts = [p for p in struct.__idl_typename__.split("::") if p != "dds_"]  # type: ignore[attr-defined]
+    return "/".join(parts[:-1] + [parts[-1].rstrip("_")])
+
+
+class _Discovery:
+    """The graph as the agent reports it, with the DDS discovery's face."""
+
+    def __init__(self) -> None:
+        self.topics: dict[str, list[dict[str, Any]]] = {}
+        self.nodes: list[tuple[str, str]] = []
+        self._node: dict[bytes, str] = {}
+        self.pending = False
+
+    def update(self, graph: dict[str, Any]) -> None:
+        self.topics = graph.get("topics", {})
+        self.nodes = [(str(n[0]), str(n[1])) for n in graph.get("nodes", [])]
+        self._node = {bytes.fromhex(p["gid"]): (p["ns"].rstrip("/") + "/" + p["node"])
+                      for ps in self.topics.values() for p in ps}
+
+    def publishers(self, dds_topic: str) -> list[EndpointInfo]:
+        """The publishers on ``dds_topic`` (its ROS name), by GID."""
+        name = ros_name(dds_topic)
+        out = [EndpointInfo(bytes.fromhex(p["gid"]), bytes.fromhex(p["gid"])[:12], dds_topic, p["type"],
+                            QosProfile(reliable=p["reliable"], durability=p["durability"]))
+               for p in self.topics.get(name or "", [])]
+        return sorted(out, key=lambda e: e.guid)
+
+    def node_of(self, guid: bytes) -> str | None:
+        """The ROS node (``/ns/name``) of a publisher's GID, or ``None``."""
+        return self._node.get(guid)
+
+    def who(self, e: EndpointInfo) -> str:
+        n = self.node_of(e.guid)
+        return f"node {n}" if n else f"publisher {e.guid.hex()}"
+
+    def hash_of(self, dds_topic: str, guid: bytes) -> str:
+        name = ros_name(dds_topic) or ""
+        return next((p["hash"] for p in self.topics.get(name, []) if bytes.fromhex(p["gid"]) == guid), "")
+
+
+class _Writer:
+    """A publisher of the monitor's, in the agent: ``write(sample)`` publishes it serialized."""
+
+    def __init__(self, bus: RclpyBus, wid: int) -> None:
+        self.bus, self.wid = bus, wid
+
+    def write(self, sample: Any) -> None:
+        raw = sample.serialize(use_version_2=False)  # plain CDR, as rmw writes ROS 2 messages
+        self.bus._send({"op": "write", "id": self.wid, "raw": base64.b64encode(raw).decode()})
+
+    def __del__(self) -> None:
+        pass
+
+
+class RclpyBus:
+    """The taps, writers and discovery of one live run over rclpy (module
+    docstring).  ``python``: the ROS 2 Python the agent runs in;
+    ``on_sample(tap, raw, info, received_ns)`` is called in the bus thread
+    for each sample (``info.source_timestamp`` ns, ``info.writer_guid``
+    16 bytes, ``info.sequence``); ``type_hash(struct)`` the ROS 2 type hash of
+    a contract struct."""
+
+    def __init__(self, python: Path, on_sample: Callable[[Tap, bytes, Any, int], None],
+                 warn: Callable[[str], None], on_reader: Callable[[Tap, list[Any]], None] | None = None,
+                 type_hash: Callable[[type], str | None] | None = None) -> None:
+        self.python, self.on_sample, self.warn, self.on_reader = python, on_sample, warn, on_reader
+        self.type_hash = type_hash or (lambda struct: None)
+        self.discovery = _Discovery()
+        self.taps: list[Tap] = []
+        self.deaf: list[Tap] = []
+        self.watched: dict[str, tuple[str, str, str]] = {}
+        self.bypass: dict[str, set[str]] = {}
+        self.error: BaseException | None = None
+        self.hello: dict[str, Any] = {}
+        self.before: dict[str, int] = {}  # tap key -> messages its publishers wrote before the monitor heard them
+        self._first: dict[tuple[int, bytes], int] = {}
+        self._warned: set[tuple[str, bytes, str]] = set()
+        self._admitted: dict[tuple[int, bytes], bool] = {}
+        self._writers = 0
+        self._proc: subprocess.Popen[bytes] | None = None
+        self._thread = threading.Thread(target=self._run, name="rclverify-rclpy", daemon=True)
+        self._hello = threading.Event()
+        self._lock = threading.Lock()
+        self._start()
+
+    # -- the face of the DDS bus ---------------------------------------------------------------
+    def tap(self, key: str, dds_topic: str, struct: type, where: str) -> Tap:
+        """Ask to hear ``dds_topic`` (before :meth:`start`); a request or reply topic stays deaf."""
+        t = Tap(key, dds_topic, struct, where)
+        self.taps.append(t)
+        name = ros_name(dds_topic)
+        if name is None:
+            self.deaf.append(t)
+        else:
+            self._send({"op": "tap", "id": len(self.taps) - 1, "topic": name, "type": ros_type(struct)})
+        return t
+
+    def watch_writers(self, dds_topic: str, key: str, where: str, role: str) -> None:
+        """Warn about every other publisher on ``dds_topic`` (the verdict topic, a guarded topic)."""
+        self.watched[dds_topic] = (key, where, role)
+        self.bypass.setdefault(key, set())
+        name = ros_name(dds_topic)
+        if name is not None:
+            self._send({"op": "watch", "topic": name})
+
+    def writer(self, dds_topic: str, struct: type, qos: QosProfile, user_data: bytes = b"") -> _Writer:
+        """A publisher of the monitor on ``dds_topic``."""
+        self._writers += 1
+        self._send({"op": "writer", "id": self._writers, "topic": ros_name(dds_topic) or dds_topic,
+                    "type": ros_type(struct), "reliable": qos.reliable,
+                    "transient_local": qos.durability == "transient_local", "depth": qos.depth})
+        return _Writer(self, self._writers)
+
+    def writer_of(self, tap: Tap, info: Any) -> bytes | None:
+        """The GID of the publisher of the sample ``info`` describes."""
+        return bytes(info.writer_guid) or None
+
+    def start(self) -> RclpyBus:
+        self._send({"op": "start"})
+        self._thread.start()
+        return self
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """Stop the agent (after it handed over what it had); re-raise what the reading thread died of."""
+        self._send({"op": "stop"})
+        proc = self._proc
+        if proc is not None:
+            try:
+                proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(5)
+        self._thread.join(timeout)
+        if self.error is not None:
+            raise self.error
+
+    def close(self) -> None:
+        if self._proc is not None and self._proc.poll() is None:
+            self._proc.kill()
+            self._proc.wait(5)
+
+    # -- the agent -----------------------------------------------------------------------------
+    def _start(self) -> None:
+        try:
+            self._proc = subprocess.Popen([str(self.python), str(AGENT)], stdin=subprocess.PIPE,
+                                          stdout=subprocess.PIPE, start_new_session=True)
+        except OSError as exc:
+            raise RclpyUnavailable(f"the ROS 2 Python {self.python} cannot run: {exc}") from None
+        assert self._proc.stdout is not None
+        first = read_frame(self._proc.stdout)
+        if first is None or first[0] != b"J":
+            raise RclpyUnavailable(f"the rclpy agent in {self.python} stopped before it started")
+        obj = json.loads(first[1])
+        if obj.get("what") != "hello":
+            self.close()
+            raise RclpyUnavailable(f"{obj.get('text', 'the rclpy agent could not start')} (in {self.python})")
+        self.hello = obj
+
+    def _send(self, obj: dict[str, Any]) -> None:
+        proc = self._proc
+        if proc is None or proc.stdin is None or proc.poll() is not None:
+            return
+        with self._lock:
+            try:
+                proc.stdin.write((json.dumps(obj) + "\n").encode())
+                proc.stdin.flush()
+            except (BrokenPipeError, ValueError):
+                pass
+
+    def _run(self) -> None:
+        proc = self._proc
+        assert proc is not None and proc.stdout is not None
+        stream: IO[bytes] = proc.stdout
+        try:
+            while True:
+                frame = read_frame(stream)
+                if frame is None:
+                    break
+                kind, body = frame
+                if kind == b"S":
+                    self._sample(body)
+                else:
+                    self._json(json.loads(body))
+            if proc.wait() not in (0, None):
+                raise RclpyUnavailable(f"the rclpy agent exited with status {proc.returncode}")
+        except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead reader must be said
+            self.error = exc
+
+    def _sample(self, body: bytes) -> None:
+        k, source_ns, received_ns, seq, gid, raw = parse_sample(body)
+        t = self.taps[k]
+        ok = self._admitted.get((k, gid))
+        if ok is None:
+            ok = self._admitted[(k, gid)] = self._admit(t, gid)
+        if not ok:
+            t.dropped += 1
+            return
+        if seq and (k, gid) not in self._first:
+            self._first[(k, gid)] = seq
+            self.before[t.key] = self.before.get(t.key, 0) + seq - 1
+        t.samples += 1
+        self.on_sample(t, raw, SimpleNamespace(source_timestamp=source_ns, writer_guid=gid, sequence=seq),
+                       received_ns)
+
+    def _admit(self, t: Tap, gid: bytes) -> bool:
+        """Whether publisher ``gid`` writes the contract's layout: its ROS 2 type hash against the
+        contract type's (REP-2011); a publisher whose hash is not known is taken at its type name."""
+        theirs, ours = self.discovery.hash_of(t.dds_topic, gid), self.type_hash(t.struct)
+        if not theirs or not ours or theirs == ours:
+            return True
+        self._warn_once(t.key, gid, "layout", f"{t.where}: warning: {t.key}: publisher {gid.hex()} of "
+                        f"{ros_type(t.struct)} has the type hash {theirs}, the contract's type {ours}: another "
+                        "layout; its messages are not heard")
+        return False
+
+    def _json(self, obj: dict[str, Any]) -> None:
+        what = obj.get("what")
+        if what == "graph":
+            self.discovery.update(obj)
+            self._check_graph()
+        elif what == "tap":
+            t = self.taps[int(obj["id"])]
+            first = t.reader is None
+            t.reader, t.reader_changes = True, int(obj["changes"])
+            t.qos = QosProfile(reliable=bool(obj["reliable"]), durability=str(obj["durability"]), depth=1000)
+            t.heard = {bytes.fromhex(g) for g in obj["heard"]}
+            if first and self.on_reader is not None:
+                self.on_reader(t, self.discovery.publishers(t.dds_topic))
+        elif what == "error":
+            k = obj.get("id")
+            where = f"{self.taps[int(k)].where}: warning: {self.taps[int(k)].key}: " if k is not None else "warning: "
+            self.warn(f"{where}the rclpy source cannot subscribe ({obj.get('text')}): the ROS 2 Python "
+                      f"{self.python} lacks the message package; its messages are not heard")
+
+    def _check_graph(self) -> None:
+        """Warn about publishers of another type on a tapped topic and other writers on a watched one."""
+        for t in self.taps:
+            want = ros_type(t.struct)
+            for p in self.discovery.publishers(t.dds_topic):
+                if p.type_name != want:
+                    self._warn_once(t.key, p.guid, "type", f"{t.where}: warning: {t.key}: "
+                                    f"{self.discovery.who(p)} publishes {p.type_name}, the contract's type is "
+                                    f"{want}; its messages are not heard")
+        for dds_topic, (key, where, role) in self.watched.items():
+            for p in self.discovery.publishers(dds_topic):
+                who = self.discovery.who(p)
+                if who not in self.bypass[key]:
+                    self.bypass[key].add(who)
+                    self.warn(f"{where}: warning: /{key}: {who} writes on the {role} beside the monitor; what "
+                              "it writes is not checked, and the evidence is not discharged while it does")
+
+    def _warn_once(self, key: str, gid: bytes, why: str, text: str) -> None:
+        if (key, gid, why) not in self._warned:
+            self._warned.add((key, gid, why))
+            self.warn(text)
+
+
+__all__ = ["AGENT", "RclpyBus", "RclpyUnavailable", "ros_name", "ros_type"]

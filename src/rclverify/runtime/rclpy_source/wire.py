@@ -1,0 +1,76 @@
+"""The frames between the live monitor and its rclpy agent (standard library only).
+
+The agent (:mod:`.agent`) runs in a ROS 2 Python and imports this module as
+a top-level module (its folder is the script's); the monitor imports it as
+``rclverify.runtime.rclpy_source.wire``.  Both directions are byte streams
+(the agent's stdout and stdin):
+
+* **agent -> monitor**: frames of a one-byte kind, a ``uint32`` length (big
+  endian) and the payload.  ``S``: a sample, :data:`SAMPLE` (tap id,
+  source and receipt stamps in ns since the epoch, the writer's sequence
+  number, 0 unknown) then the 16-byte publisher GID, then the serialized
+  message as rmw handed it over (CDR with its encapsulation header, as on
+  the wire and in a bag); ``J``: a JSON object (``hello``, ``graph``,
+  ``tap``, ``error``: its ``what`` key says which).
+* **monitor -> agent**: JSON lines (``op``: ``tap``, ``watch``,
+  ``writer``, ``write``, ``start``, ``stop``).
+"""
+from __future__ import annotations
+
+import json
+import struct
+from typing import IO, Any
+
+#: the header of every frame: kind (1 byte), payload length
+HEADER = struct.Struct(">cI")
+#: a sample's fixed part: tap id, source stamp (ns), receipt stamp (ns), publication sequence number
+SAMPLE = struct.Struct(">IqqQ")
+GID_BYTES = 16
+
+
+def sample_frame(tap: int, source_ns: int, received_ns: int, seq: int, gid: bytes, raw: bytes) -> bytes:
+    """One ``S`` frame (module docstring); ``gid`` is cut or padded to 16 bytes."""
+    body = SAMPLE.pack(tap, source_ns, received_ns, seq) + gid[:GID_BYTES].ljust(GID_BYTES, b"\0") + raw
+    return HEADER.pack(b"S", len(body)) + body
+
+
+def json_frame(obj: dict[str, Any]) -> bytes:
+    """One ``J`` frame holding ``obj``."""
+    body = json.dumps(obj, separators=(",", ":")).encode()
+    return HEADER.pack(b"J", len(body)) + body
+
+
+def read_frame(stream: IO[bytes]) -> tuple[bytes, bytes] | None:
+    """The next frame's kind and payload, ``None`` at the end of the stream.
+    Raises ``ValueError`` for a stream cut inside a frame."""
+    head = _read(stream, HEADER.size)
+    if not head:
+        return None
+    if len(head) < HEADER.size:
+        raise ValueError("the agent's stream ended inside a frame header")
+    kind, size = HEADER.unpack(head)
+    body = _read(stream, size)
+    if len(body) < size:
+        raise ValueError("the agent's stream ended inside a frame")
+    return kind, body
+
+
+def parse_sample(body: bytes) -> tuple[int, int, int, int, bytes, bytes]:
+    """An ``S`` frame's payload: (tap id, source ns, received ns, sequence number, gid, raw)."""
+    tap, source_ns, received_ns, seq = SAMPLE.unpack_from(body)
+    gid = body[SAMPLE.size:SAMPLE.size + GID_BYTES]
+    return tap, source_ns, received_ns, seq, gid, body[SAMPLE.size + GID_BYTES:]
+
+
+def _read(stream: IO[bytes], n: int) -> bytes:
+    parts = []
+    while n > 0:
+        chunk = stream.read(n)
+        if not chunk:
+            break
+        parts.append(chunk)
+        n -= len(chunk)
+    return b"".join(parts)
+
+
+__all__ = ["GID_BYTES", "HEADER", "SAMPLE", "json_frame", "parse_sample", "read_frame", "sample_frame"]
