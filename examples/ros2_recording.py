@@ -111,21 +111,27 @@ def stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
 
 
 def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: list[str], script: str,
-           monitor: list[str], driver: str = "scenario", timeout: float = 30.0, until_done: bool = False) -> float:
+           monitor: list[str], driver: str = "scenario", timeout: float = 30.0, until_done: bool = False,
+           scripts: dict[str, Path] | None = None, env: dict[str, str] | None = None) -> float:
     """Run the monitor (extra arguments ``monitor``), one ROS 2 process of
     ``script`` (relative to ``here``) per node of ``nodes`` and then the
-    ``driver``; the monitor's log is ``tmp/run.jsonl`` (and whatever else
-    ``monitor`` asks it to write).  The run ends when the driver exits, or
+    ``driver`` (``script ROLE``; with ``scripts``, the program ``scripts[ROLE]``
+    with no argument instead: one program per node); the monitor's log is
+    ``tmp/run.jsonl`` (and whatever else ``monitor`` asks it to write).
+    ``env`` is the processes' environment when given (it must keep them on
+    loopback in a domain of their own), else this one's with :data:`CYCLONE`,
+    localhost discovery, Fast DDS and a random domain.  The run ends when the driver exits, or
     with ``until_done`` when it prints ``done`` (its nodes are then stopped
     at once, so that timers do not add messages).  Returns the seconds it
     took; raises :class:`Failed` (the scenario or the monitor failed, or not
     within ``timeout`` seconds).  Every process started is stopped."""
     t0 = time.monotonic()
-    (tmp / "cyclonedds.xml").write_text(CYCLONE)
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
-    env.update(CYCLONEDDS_URI=(tmp / "cyclonedds.xml").as_uri(), ROS_DOMAIN_ID=str(random.randint(1, 230)),
-               ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RMW_IMPLEMENTATION="rmw_fastrtps_cpp",
-               PYTHONUNBUFFERED="1", ROS_LOG_DIR=str(tmp / "ros_log"))
+    if env is None:
+        (tmp / "cyclonedds.xml").write_text(CYCLONE)
+        env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
+        env.update(CYCLONEDDS_URI=(tmp / "cyclonedds.xml").as_uri(), ROS_DOMAIN_ID=str(random.randint(1, 230)),
+                   ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RMW_IMPLEMENTATION="rmw_fastrtps_cpp",
+                   PYTHONUNBUFFERED="1", ROS_LOG_DIR=str(tmp / "ros_log"))
     nenv = build(py, env, here, interfaces)
     procs: list[subprocess.Popen[bytes]] = []
     try:
@@ -135,11 +141,12 @@ def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: lis
                     env, tmp / "monitor.out", here)
         procs.append(mon)
         wait_for(tmp / "monitor.out", "monitoring", 15, mon)
+        command = (lambda role: [str(py), str(scripts[role])]) if scripts else (lambda role: [str(py), script, role])
         for name in nodes:
-            procs.append(start([str(py), script, name], nenv, tmp / f"{name}.out", here))
+            procs.append(start(command(name), nenv, tmp / f"{name}.out", here))
         for name, p in zip(nodes, procs[1:]):
             wait_for(tmp / f"{name}.out", "ready", 15, p)
-        drv = start([str(py), script, driver], nenv, tmp / "driver.out", here)
+        drv = start(command(driver), nenv, tmp / "driver.out", here)
         procs.append(drv)
         left = max(1.0, timeout - (time.monotonic() - t0))
         if until_done:
