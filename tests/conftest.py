@@ -52,6 +52,7 @@ LIVE = frozenset({
     "test_ros2_diff", "test_ros2_generated", "test_ros2_services_actions", "test_ros2_silence_deadlines",
     "test_ros2_declarations", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_ros2_calls_paired", "test_ros2_carried",
+    "test_ros2_bag_calls",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -81,7 +82,7 @@ SECONDS: dict[str, float] = {
     "test_generate_cpp_candidates": 2.2, "test_jsonl_columns": 2.2, "test_realizable": 2.1,
     "test_bench_compose_pacti": 2.1, "test_deterministic_queries": 2.1, "test_findings_health": 2.1,
     "test_health_fast": 3.3, "test_requirements_own_nodes": 2.0, "test_bundle_ties": 3.0,
-    "test_paths_rechecked": 3.5,
+    "test_paths_rechecked": 3.5, "test_ros2_bag_calls": 7.0,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -95,7 +96,7 @@ WALL: dict[str, float] = {
     "test_services_live_ros1": 10.0, "test_ros2_silence_deadlines": 8.6, "test_ros_live": 6.7,
     "test_ros2_declarations": 25.4, "test_monitor_live_dds": 6.1, "test_lsp_hostile": 5.0,
     "test_ros_master_hostile": 5.0, "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
-    "test_ros_names_rclpy": 3.2,
+    "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
@@ -108,6 +109,7 @@ PIPELINE = frozenset({
     "test_blame_line", "test_deadline_timing_measured", "test_example_fleet_trials", "test_mapping_hygiene",
     "test_one_row_per_cause", "test_repairs_units", "test_report_hygiene", "test_report_schema",
     "test_example_safety_stop", "test_init", "test_stage_records", "test_what_runs_is_hashed",
+    "test_example_ros2_robot",  # its one live test is marked in the module (the rest is offline)
 })
 
 #: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.
