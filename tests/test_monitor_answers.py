@@ -433,7 +433,9 @@ def reference(checked: Any, rows: list[tuple[float, str, Any]], horizon: float,
         for p in verdicts:
             got[p] += 1
         if not answered and not verdicts:
-            got[(k, "inconclusive" if closed else "open")] += 1
+            # closed unanswered before any output of the node was heard: not counted (docs/semantics.md, "Steps")
+            heard = any(evs[m].topic in out_key for m in range(cut))
+            got[(k, "open" if not closed else "inconclusive" if heard else "before first answer")] += 1
     return got
 
 
