@@ -22,7 +22,9 @@ configuration, ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``), a random
 
 ``--source dds|rclpy|both`` (default both): the monitor hears the
 publisher through its own Cyclone DDS participant, through rclpy (its agent
-in the ROS 2 Python, docs/ros2.md "Two sources"), or each in turn.
+in the ROS 2 Python, docs/ros2.md "Two sources"), or each in turn;
+``--listener dds|rclpy``: the latency run's verdicts heard by a Cyclone DDS
+reader (default) or by an rclpy subscriber, as a ROS 2 user hears them.
 
 Prints the figures, the load average and the core count; asserts nothing.
 ``--smoke`` (the test suite's): 1 s at 300 and 200 messages/s; without a
@@ -51,6 +53,25 @@ from monitor_live_dds import CONFIG, _latency  # noqa: E402  (the loopback confi
 
 TOPICS = {"a": ("std_msgs/Float64", "data", "A"), "b": ("sensor_msgs/JointState", "position[0]", "B"),
           "c": ("geometry_msgs/PoseWithCovarianceStamped", "pose.pose.position.x", "C")}
+#: the verdicts as a ROS 2 user hears them: an rclpy subscriber of /rclverify/verdict (in the ROS 2 Python)
+RCLPY_LISTENER = """\
+import json, signal, sys, time
+import rclpy
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from std_msgs.msg import String
+rclpy.init()
+n = Node("verdict_listener")
+got = []
+n.create_subscription(String, "/rclverify/verdict", lambda m: got.append((time.time(), m.data)),
+                      QoSProfile(depth=100000, reliability=ReliabilityPolicy.RELIABLE))
+stop = []
+signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+print("listening", flush=True)
+while not stop:
+    rclpy.spin_once(n, timeout_sec=0.05)
+open(sys.argv[1], "w").write(json.dumps(got))
+"""
 PUBLISHER = """\
 import json, sys, time
 sys.path.insert(0, sys.argv[4])
@@ -110,7 +131,7 @@ def _workspace(ws: Path) -> None:
 
 
 def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool,
-         source: str = "dds") -> dict[str, Any]:
+         source: str = "dds", listener: str = "dds") -> dict[str, Any]:
     from _live import cpu_seconds, stop, wait_text
     tag = f"{'lat' if latency else 'loss'}{int(rate)}{source}"
     procs: list[subprocess.Popen[bytes]] = []
@@ -122,7 +143,11 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
         return p
     try:
         lis = None
-        if latency:
+        if latency and listener == "rclpy":
+            (tmp / "listener.py").write_text(RCLPY_LISTENER)
+            lis = start([str(ros2), str(tmp / "listener.py"), str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
+            wait_text(tmp / f"listener{tag}.out", "listening", 30)
+        elif latency:
             lis = start([sys.executable, str(ROOT / "bench" / "monitor_live_dds.py"), "--listener",
                          str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
             wait_text(tmp / f"listener{tag}.out", "listening", 30)
@@ -155,17 +180,19 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
     return res
 
 
-def bench(total_rate: float, latency_rate: float, seconds: float, sources: tuple[str, ...] = ("dds", "rclpy")) -> None:
+def bench(total_rate: float, latency_rate: float, seconds: float, sources: tuple[str, ...] = ("dds", "rclpy"),
+          listener: str = "dds") -> None:
     """The benchmark (module docstring), once per source."""
     ros2, why = ros2_python()
     if ros2 is None:
         print(f"rclpy: skipped: {why}")
         return
     for source in sources:
-        _bench(ros2, total_rate, latency_rate, seconds, source)
+        _bench(ros2, total_rate, latency_rate, seconds, source, listener)
 
 
-def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, source: str) -> None:
+def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, source: str,
+           listener: str = "dds") -> None:
     from _live import p99
     load = f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)"
     with tempfile.TemporaryDirectory() as d:
@@ -189,15 +216,15 @@ def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, s
         if res["cpu"] is not None:
             print(f"rclpy publisher, {source} source: loss: monitor CPU {res['cpu'] / max(1, len(sent)) * 1e6:.0f} us per message "
                   f"(start-up included), engine thread {rec.get('engine_cpu_us_per_message', 0):.0f} us")
-        res = _run(tmp, env, ros2, latency_rate, seconds, latency=True, source=source)
+        res = _run(tmp, env, ros2, latency_rate, seconds, latency=True, source=source, listener=listener)
         lat = _latency(res)
         if lat:
-            print(f"rclpy publisher, {source} source: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
+            print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
                   f"verdict(s) decided on arrival: p50 {statistics.median(lat):.2f} ms, p99 {p99(lat):.2f} ms, "
                   f"max {lat[-1]:.2f} ms; checked {res['record']['events']} of {len(res['sent']['sent'])}; "
                   f"load average {os.getloadavg()[0]:.1f}")
         else:
-            print(f"rclpy publisher, {source} source: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
+            print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
                   f"(checked {res['record']['events']} of {len(res['sent']['sent'])})")
 
 
@@ -210,12 +237,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--smoke", action="store_true", help="CI: 1 s at 300 and 200 messages/s")
     p.add_argument("--source", choices=("dds", "rclpy", "both"), default="both",
                    help="how the monitor hears the robot (default: each in turn)")
+    p.add_argument("--listener", choices=("dds", "rclpy"), default="dds",
+                   help="who hears the verdicts in the latency run: a Cyclone DDS reader, or an rclpy subscriber")
     a = p.parse_args(argv)
     sources = ("dds", "rclpy") if a.source == "both" else (a.source,)
     if a.smoke:
-        bench(300.0, 200.0, 1.0, sources)
+        bench(300.0, 200.0, 1.0, sources, a.listener)
     else:
-        bench(a.total_rate, a.latency_rate, a.seconds, sources)
+        bench(a.total_rate, a.latency_rate, a.seconds, sources, a.listener)
     return 0
 
 
