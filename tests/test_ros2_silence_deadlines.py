@@ -24,6 +24,11 @@ its own process with its own verdict topic:
 
 The offline checks of the echo run's log under ``--strict`` close it: a
 trace with no event of a node (Ghost) exits 1 and says so.
+
+The whole module runs twice, the monitors hearing the system through each
+source (``--source dds`` and ``--source rclpy``, docs/ros2.md "Two
+sources"): the same verdicts and exit codes; each record must name the
+source asked.
 """
 from __future__ import annotations
 
@@ -131,10 +136,11 @@ MONITORS = {"echo": ["--node", "Echo", "--strict"], "ghost": ["--node", "Ghost",
             "ghost_lax": ["--node", "Ghost"], "base": ["--node", "Base", "--strict"]}
 
 
-@pytest.fixture(scope="module")
-def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
-    ros2_python()  # skips, with the reason, without a ROS 2 Python
-    tmp = tmp_path_factory.mktemp("silence")
+@pytest.fixture(scope="module", params=["dds", "rclpy"])
+def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    """The run heard through each source (docs/ros2.md, "Two sources"): the same verdicts and exit codes."""
+    py = ros2_python()  # skips, with the reason, without a ROS 2 Python
+    tmp = tmp_path_factory.mktemp(f"silence-{request.param}")
     ws = tmp / "ws"
     (ws / "contracts").mkdir(parents=True)
     (ws / "contracts/sys.rcl").write_text(RCL)
@@ -150,7 +156,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                 ["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--horizon", "1.0",
                  "--reorder-window", "0", "--status", "0", "--duration", "60", "--verdict-topic",
                  f"/{name}/verdict", "--log", str(tmp / f"{name}.jsonl"), "--evidence", str(tmp / f"{name}.json"),
-                 *extra], env, tmp, tmp / f"{name}.out")
+                 "--source", request.param, "--ros2-python", str(py), *extra], env, tmp, tmp / f"{name}.out")
         for name in MONITORS:
             wait_for(tmp / f"{name}.out", "monitoring", 30)
         system = start_node(tmp, "system", SYSTEM, env)
@@ -160,7 +166,9 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         for name, p in procs.items():
             stop(p, signal.SIGINT)
             codes[name] = p.returncode
-        yield {"tmp": tmp, "ws": ws, "codes": codes,
+        assert {r["source"] for r in (json.loads((tmp / f"{n}.json").read_text()) for n in MONITORS)} == \
+            {request.param}  # never a silent fall-back to the other source
+        yield {"source": request.param, "tmp": tmp, "ws": ws, "codes": codes,
                "out": {n: (tmp / f"{n}.out").read_text() for n in MONITORS},
                "record": {n: json.loads((tmp / f"{n}.json").read_text()) for n in MONITORS},
                "system": (tmp / "system.log").read_text()}
