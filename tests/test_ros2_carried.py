@@ -104,6 +104,14 @@ node Clamp {
   guarantee( out.c <= in.limit )
 }
 
+node Limiter {
+  inputs( cap : REAL )
+  outputs( speed : REAL )
+  topics( std_msgs/Float64 cap matches(in.cap), std_msgs/Float64 speed matches(out.speed) )
+  assume( TRUE )
+  guarantee( out.speed <= in.cap )
+}
+
 node Sink {
   inputs( v : REAL )
   outputs( w : REAL )
@@ -137,7 +145,8 @@ LIMIT = struct.unpack("f", struct.pack("f", 0.2))[0]  # 0.2 as a float32 field c
 pubs = {k: n.create_publisher(t, k, 10) for k, t in (
     ("battery", BatteryState), ("home", Bool), ("slip_home", Bool), ("scan", LaserScan), ("stop", Bool),
     ("blind_stop", Bool), ("x", Int64), ("y", Int64), ("fa", Int64), ("fb", Int64), ("fs", Int64),
-    ("cmd", Int64), ("clamped", Int64), ("nan", Float64), ("nan_out", Float64))}
+    ("cmd", Int64), ("clamped", Int64), ("nan", Float64), ("nan_out", Float64), ("cap", Float64),
+    ("speed_unchecked", Float64))}
 latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
 limit_pub = n.create_publisher(Int64, "limit", latched)
 limit_pub.publish(Int64(data=7))  # once, before anyone listens
@@ -163,6 +172,8 @@ n.create_subscription(Int64, "cmd", lambda m: pubs["clamped"].publish(Int64(data
 n.create_subscription(Float64, "nan", lambda m: pubs["nan_out"].publish(Float64(data=m.data)), 10)
 from std_msgs.msg import String
 import json as _json
+released = []  # what the gate lets through on /speed (--enforce /speed: the node writes /speed_unchecked)
+n.create_subscription(Float64, "speed", lambda m: released.append(m.data), 100)
 heard = []  # the monitor's verdicts, as a ROS 2 subscriber decodes them
 n.create_subscription(String, "/rclverify/verdict", lambda m: heard.append(_json.loads(m.data)), 1000)
 ex = SingleThreadedExecutor()
@@ -194,6 +205,8 @@ def publish_all(k):
     pubs["fb"].publish(Int64(data=2 * k))  # at the same instant as fa: one question
     pubs["cmd"].publish(Int64(data=k % 12))
     pubs["nan"].publish(Float64(data=math.nan))
+    pubs["cap"].publish(Float64(data=5.0))
+    pubs["speed_unchecked"].publish(Float64(data=[1.0, 7.0, 4.0][k % 3]))  # 7.0 breaks the cap
 
 for k in range(20):  # about 1.4 s before any monitor
     publish_all(k)
@@ -204,6 +217,7 @@ for k in range(20, 65):
     publish_all(k)
     spin(0.1)
 spin(0.5)
+print("released", sorted(set(released)), len(released), flush=True)
 print("done", len(heard), len([v for v in heard if v.get("verdict") == "violated"]), flush=True)
 while True:
     ex.spin_once(timeout_sec=0.1)
@@ -228,7 +242,8 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
     try:
         system = start_node(tmp, "system", SYSTEM, env)
         wait_for(tmp / "system.log", "before", 30)  # the publishers ran before any monitor
-        monitor = rclverify(["monitor", "-w", str(ws), *common, "--strict", "--log", str(tmp / "live.jsonl"),
+        monitor = rclverify(["monitor", "-w", str(ws), *common, "--strict", "--enforce", "/speed",
+                             "--log", str(tmp / "live.jsonl"),
                              "--record", str(tmp / "bag"), "--evidence", str(tmp / "live.json")],
                             env, tmp, tmp / "monitor.out")
         nan = rclverify(["monitor", "-w", str(ws), *common, "--node", "Sink", "--strict", "--verdict-topic",
@@ -346,3 +361,13 @@ def test_every_correct_node_is_green_and_every_slip_red(run: dict[str, Any]) -> 
         ("Battery", "Guard", "Echo", "Fuse", "Clamp"), "discharged"), run["out"]
     assert status["Slip"] == status["Blind"] == "failed"
     assert [i["node"] for i in run["record"]["not_judged"]] == ["Sink"], run["record"]["not_judged"]
+
+
+def test_the_gate_releases_only_what_holds(run: dict[str, Any]) -> None:
+    """--enforce /speed through either source: Limiter writes /speed_unchecked; the gate republishes on /speed
+    exactly the messages within the cap, byte for byte, and a ROS 2 subscriber of /speed hears only those."""
+    line = run["system"].split("released ")[1].splitlines()[0]
+    values, count = line.rsplit(" ", 1)
+    assert values == "[1.0, 4.0]" and int(count) >= 20, line  # 7.0 never released
+    gate = run["record"]["enforce"]["speed"]
+    assert gate["blocked"] >= 10 and gate["released"] >= int(count), gate

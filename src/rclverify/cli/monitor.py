@@ -247,7 +247,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
             from rclverify.runtime.dds.live import run_dds  # deferred: optional or conditional (inside a block)
             msg_dirs = [root / d for d in cfg.msg_dirs]
             rec = (Path(record), storage_of(Path(record), getattr(args, "record_storage", None))) if record else None
-            bus_factory = _source(args, bool(enforce_items))
+            bus_factory = _source(args)
             if bus_factory is False:
                 return 2
             record_ = run_dds(factory, checked, nodes, msg_dirs + interfaces, **common,
@@ -264,7 +264,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     return _live_exit(args, record_)
 
 
-def _source(args: argparse.Namespace, enforce: bool) -> Any:
+def _source(args: argparse.Namespace) -> Any:
     """The bus factory of the ROS 2 source ``--source`` asks for (docs/ros2.md, "Two sources"): the rclpy
     source's, ``None`` for the DDS source, ``False`` after printing why it cannot be had (exit 2). Says
     which source on the first line."""
@@ -273,8 +273,7 @@ def _source(args: argparse.Namespace, enforce: bool) -> Any:
     from rclverify.runtime.rclpy_source.bus import RclpyBus  # deferred: optional or conditional (only --ros2)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (only --ros2)
     try:
-        source, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None),
-                                      "--enforce" if enforce else None)
+        source, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None))
     except ValueError as exc:
         print(f"rclverify monitor --live --ros2: error: {exc}", file=sys.stderr)
         return False

@@ -112,7 +112,11 @@ class _Writer:
         self.bus, self.wid = bus, wid
 
     def write(self, sample: Any) -> None:
-        raw = sample.serialize(use_version_2=False)  # plain CDR, as rmw writes ROS 2 messages
+        self.write_raw(sample.serialize(use_version_2=False))  # plain CDR, as rmw writes ROS 2 messages
+
+    def write_raw(self, raw: bytes) -> None:
+        """Publish serialized bytes (encapsulation header included) as they are: the gate's release of a
+        message it held back (``--enforce``), byte for byte."""
         self.bus._send({"op": "write", "id": self.wid, "raw": base64.b64encode(raw).decode()})
 
     def __del__(self) -> None:

@@ -31,20 +31,14 @@ def ros2_python(named: str | None = None) -> Path | None:
     return None
 
 
-def pick_source(source: str, named: str | None = None, dds_only: str | None = None) -> tuple[str, Path | None, str]:
+def pick_source(source: str, named: str | None = None) -> tuple[str, Path | None, str]:
     """``(source, ros2 python, why)`` for the asked ``source`` (:data:`SOURCES`):
     ``auto`` is ``rclpy`` where this Python imports rclpy, else ``dds``;
-    ``why`` says in one clause why that source.  ``dds_only`` names an option
-    only the DDS source serves (``--enforce``: the gate republishes the
-    bytes it held back, through a writer of its own).  Raises ``ValueError``
-    (one line) for ``rclpy`` without a ROS 2 Python, or with ``dds_only``."""
+    ``why`` says in one clause why that source.  Raises ``ValueError`` (one
+    line) for ``rclpy`` without a ROS 2 Python."""
     py = ros2_python(named)
     if source == "dds":
         return "dds", None, "asked (--source dds)"
-    if dds_only:
-        if source == "rclpy":
-            raise ValueError(f"{dds_only} runs on the DDS source only (--source dds)")
-        return "dds", None, f"{dds_only} runs on the DDS source only"
     if source == "rclpy":
         if py is None:
             raise ValueError("--source rclpy needs a Python with rclpy: source your ROS 2 installation's "
