@@ -271,12 +271,21 @@ def diff(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                        "--wait", "2", "--json", str(out)], env, tmp / "ws", log)
         procs.append(p)
         code = p.wait(60)
+        # the same diff with the graph read through rclpy's graph API (docs/ros2.md, "Two sources")
+        out_r, log_r = tmp / "diff_rclpy.json", tmp / "diff_rclpy.log"
+        pr = rclverify(["ros", "diff", "src", "--launch", "src/demo_pkg/launch/demo.launch.py", "--ros2",
+                        "--source", "rclpy", "--ros2-python", str(ros2_python()), "--wait", "2", "--json",
+                        str(out_r)], env, tmp / "ws", log_r)
+        procs.append(pr)
+        code_r = pr.wait(90)
         probe = subprocess.Popen([str(ros2_python()), "-c", textwrap.dedent(PROBE), *RUNNING], cwd=tmp, env=env,
                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True)
         procs.append(probe)
         ours = _read_running(env)  # rclverify's reading of the same graph, meanwhile
         seen = json.loads(probe.communicate(timeout=40)[0] or b"{}")
         yield {"code": code, "json": json.loads(out.read_text()), "log": log.read_text(), "domain": env["ROS_DOMAIN_ID"],
+               "rclpy": {"code": code_r, "json": json.loads(out_r.read_text()) if out_r.exists() else None,
+                         "log": log_r.read_text()},
                "ros2": seen, "ours": ours}
     finally:
         for p in procs:
@@ -496,3 +505,16 @@ def test_a_namespace_computed_at_run_time_is_a_located_warning(tmp_path: Path) -
     notes = [str(n) for n in g.graph.notes if "namespace of node 'camera'" in n.message]
     assert notes == ["src/demo_pkg/demo_pkg/camera.py:8:12: warning: namespace of node 'camera' is not a string "
                      "literal: not resolved statically (the root namespace is shown unless a launch file gives one)"]
+
+
+def test_the_rclpy_source_reads_the_same_diff(diff: dict[str, Any]) -> None:
+    """``ros diff --ros2 --source rclpy``: the running graph read through rclpy's graph API gives the same
+    missing and extra items (topics, services, the QoS conflict, the code's QoS) and exit code as DDS."""
+    r = diff["rclpy"]
+    assert "source: rclpy" in r["log"] and r["json"] is not None, r["log"]
+
+    def items(d: dict[str, Any]) -> list[tuple[Any, ...]]:
+        return sorted((side, i["category"], str(i.get("node")), str(i.get("name")), str(i.get("type")))
+                      for side in ("missing", "extra") for i in d[side])
+    assert items(r["json"]) == items(diff["json"]), (r["json"], diff["json"])
+    assert r["code"] == diff["code"] == 1

@@ -42,6 +42,11 @@ def add_parsers(sub: Any) -> None:
                    help=f"seconds each call to the master may take (default {MASTER_TIMEOUT_S:g})")
     d.add_argument("--ros2", action="store_true", help="the running ROS 2 system: its DDS domain (ROS_DOMAIN_ID, "
                    "CYCLONEDDS_URI), nodes from ros_discovery_info, endpoints and QoS from DDS discovery")
+    d.add_argument("--source", choices=("auto", "rclpy", "dds"), default="auto",
+                   help="--ros2: read the graph through rclpy's graph API (any middleware) or a DDS participant of "
+                        "rclverify's own; auto: rclpy where rclverify's Python imports it")
+    d.add_argument("--ros2-python", metavar="PYTHON",
+                   help="--ros2 --source rclpy: the Python with rclpy (default: $RCLVERIFY_ROS2_PYTHON, else this one)")
     d.add_argument("--wait", type=float, default=2.0, metavar="S",
                    help="--ros2: seconds to listen to discovery before comparing (default 2), then up to 6 s "
                         "more while a ROS 2 participant's node list or endpoints are still on their way")
@@ -163,20 +168,10 @@ def cmd_diff(args: argparse.Namespace) -> int:
             print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
         result = diff_master(res.graph, running, args.master)
     elif getattr(args, "ros2", False):
-        from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
-        from rclverify.ros.live.diff_dds import diff_dds, qos_conflicts, read_dds_graph  # deferred: optional or conditional (inside a block)
-        try:
-            running, disc, source, dp = read_dds_graph(max(0.0, args.wait))
-        except DdsUnavailable as exc:
-            print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
+        got = _diff_ros2(args, res.graph)
+        if got is None:
             return 1
-        try:
-            for n in running.notes:
-                print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
-            result = diff_dds(res.graph, running, source, qos_conflicts(disc), disc)
-        finally:
-            disc.close()
-            dp.__del__()
+        result = got
     else:
         bag, notes = bag_topics(Path(args.bag), args.bag)
         if bag is None:
@@ -194,6 +189,43 @@ def cmd_diff(args: argparse.Namespace) -> int:
             return 1
     errors = any(n.severity == "error" for n in res.graph.notes)
     return 0 if result.equal and not errors else 1
+
+
+def _diff_ros2(args: argparse.Namespace, static: Any) -> Any:
+    """``ros diff --ros2``: the running graph through the source ``--source`` picks (docs/ros2.md, "Two
+    sources": rclpy's graph API in the ROS 2 Python, or a DDS participant of rclverify's own), compared with
+    ``static``; ``None`` after printing why it cannot be read."""
+    from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
+    from rclverify.ros.live.diff_dds import diff_dds, graph_of, qos_conflicts, read_dds_graph  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.graph import read_rclpy_graph  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
+    try:
+        source_kind, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None))
+    except ValueError as exc:
+        print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
+        return None
+    print(f"source: {source_kind} ({why})", file=sys.stderr)
+    if source_kind == "rclpy" and py is not None:
+        try:
+            rdisc = read_rclpy_graph(py, max(0.0, args.wait))
+        except RclpyUnavailable as exc:
+            print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
+            return None
+        source = f"rclpy on {rdisc.rmw}"
+        return diff_dds(static, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc)  # type: ignore[arg-type]
+    try:
+        running, disc, source, dp = read_dds_graph(max(0.0, args.wait))
+    except DdsUnavailable as exc:
+        print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
+        return None
+    try:
+        for n in running.notes:
+            print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
+        return diff_dds(static, running, source, qos_conflicts(disc), disc)
+    finally:
+        disc.close()
+        dp.__del__()
 
 
 def init_from_ros(args: argparse.Namespace) -> int:

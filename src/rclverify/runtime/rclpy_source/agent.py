@@ -191,7 +191,60 @@ def _handler(k: int) -> Any:
     return on_message
 
 
+def graph_dump(wait_s: float, settle_s: float = 6.0, quiet_s: float = 0.5) -> dict[str, Any]:
+    """The whole graph as rclpy's graph API reports it, once it is settled:
+    after ``wait_s`` seconds of discovery, and on (up to ``settle_s`` more)
+    until it has not changed for ``quiet_s``.  Each node with its publishers,
+    subscribers, service servers and clients (hidden names included: an
+    action's services), and each topic's publishers and subscriptions (GID,
+    node, type, reliability, durability)."""
+    rclpy.init()
+    name = f"_rclverify_graph_{os.getpid()}"
+    node = Node(name)
+
+    def snapshot() -> dict[str, Any]:
+        nodes = []
+        for n, ns in sorted(node.get_node_names_and_namespaces()):
+            if n == name:
+                continue
+            nodes.append({"name": n, "ns": ns,
+                          "pubs": node.get_publisher_names_and_types_by_node(n, ns),
+                          "subs": node.get_subscriber_names_and_types_by_node(n, ns),
+                          "servers": node.get_service_names_and_types_by_node(n, ns),
+                          "clients": node.get_client_names_and_types_by_node(n, ns)})
+        ends: dict[str, Any] = {}
+        for topic, _types in node.get_topic_names_and_types():
+            ends[topic] = {role: [{"gid": bytes(p.endpoint_gid[:wire.GID_BYTES]).hex(), "node": p.node_name,
+                                   "ns": p.node_namespace, "type": p.topic_type,
+                                   "reliable": p.qos_profile.reliability == ReliabilityPolicy.RELIABLE,
+                                   "durability": "transient_local"
+                                   if p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL else "volatile"}
+                                  for p in infos if p.node_name != name]
+                           for role, infos in (("pubs", node.get_publishers_info_by_topic(topic)),
+                                               ("subs", node.get_subscriptions_info_by_topic(topic)))}
+        return {"nodes": nodes, "endpoints": ends}
+
+    start = time.monotonic()
+    last, since = None, start
+    while True:
+        rclpy.spin_once(node, timeout_sec=0.1)
+        now = time.monotonic()
+        if now - start < wait_s:
+            continue
+        snap = snapshot()
+        if snap != last:
+            last, since = snap, now
+        if now - since >= quiet_s or now - start >= wait_s + settle_s:
+            break
+    node.destroy_node()
+    rclpy.try_shutdown()
+    return {"what": "graph_all", "rmw": get_rmw_implementation_identifier(), **(last or {})}
+
+
 def main() -> int:
+    if len(sys.argv) == 3 and sys.argv[1] == "--graph":  # ``ros diff --ros2 --source rclpy``: one dump, then exit
+        _emit(wire.json_frame(graph_dump(float(sys.argv[2]))))
+        return 0
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     q: queue.Queue[dict[str, Any] | None] = queue.Queue()
     try:
