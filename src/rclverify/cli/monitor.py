@@ -323,10 +323,7 @@ def _print_live(log: Path, record_: dict[str, Any]) -> None:
         judged = sum(r["counts"]["true"] + r["counts"]["false"] for r in record_["deadlines"]["results"])
         print(f"deadlines: {record_['deadlines']['false']} of {judged} judged call(s) or goal(s) missed their "
               f"deadline")
-    by_calls = {r["node"] for r in record_.get("deadlines", {}).get("results", [])}
     for d in record_.get("topic_deadlines", []):
-        if d["status"] == "pending" and d["node"] in by_calls:
-            continue  # its timed guarantees are triggered through its services or actions: judged with the calls
         print(f"deadlines: {d['node']}: {d['status']}: {d['explanation']}")
     for d in record_.get("periods", []):
         print(f"periods: {d['node']}: {d['status']}: {d['explanation']}")

@@ -125,6 +125,8 @@ class CallTaps:
         self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
+        #: pairer name -> (the reply reader's writers, the pairer's servers) when discovery was last read
+        self._servers_seen: dict[str, tuple[frozenset[bytes], frozenset[bytes]]] = {}
         self.last = float("-inf")  # the stamp of the last sample taken
         #: samples taken after a later-stamped one (``late``), of a writer no longer known or of the other
         #: wire form (:mod:`.dds_wire`), events without contents, request/reply samples left to the
@@ -323,16 +325,19 @@ class CallTaps:
                     pairer.hearing(w, now)
             if not rr.heard and not pairer.servers:
                 continue
+            seen = (frozenset(rr.heard), frozenset(pairer.servers))
+            if self._servers_seen.get(pname) == seen:
+                continue  # nothing changed since the last look: discovery is not read again at every tick
             try:
                 shadows = {p.guid for p in self._disc.publishers(rr.dds_topic) if SHADOW in p.qos.user_data} \
                     if self._disc is not None else set()
             except RuntimeError:  # discovery changed under us (the DDS thread): next time
                 continue
             servers = (set(rr.heard) - shadows) | {g for g in pairer.servers if g not in rr.heard and not g}
-            if servers == set(pairer.servers):
-                continue
-            for p, why in pairer.discovered(servers, now):
-                self.book.unpaired(p.key, now, why)
+            if servers != set(pairer.servers):
+                for p, why in pairer.discovered(servers, now):
+                    self.book.unpaired(p.key, now, why)
+            self._servers_seen[pname] = (frozenset(rr.heard), frozenset(pairer.servers))
 
     def _side(self, name: str, stamp: float) -> str | None:
         """Which side's introspection events pair the calls of service ``name``
