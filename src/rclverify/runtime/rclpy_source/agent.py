@@ -16,7 +16,7 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   (reliable only when all are, transient-local when all are: a latched
   message is delivered to it as to any late ROS 2 subscriber), and made
   again when a publisher appears that it cannot match.
-* **The graph**: the nodes, and each tapped or watched topic's publishers
+* **The graph**: each tapped or watched topic's publishers
   (GID, node, namespace, type, type hash, reliability, durability) as the
   ROS 2 graph API reports them, sent when they change.  The agent's node is
   hidden (``_rclverify_monitor_<pid>``) and its own endpoints are left out.
@@ -129,13 +129,8 @@ class Agent:
         """Make or remake each tap's subscription for the publishers in the graph; report changes."""
         topics: dict[str, list[dict[str, Any]]] = {}
         for t in sorted({t["topic"] for t in self.taps.values()} | self.watched):
-            topics[t] = [{"gid": bytes(p.endpoint_gid[:wire.GID_BYTES]).hex(), "node": p.node_name,
-                          "ns": p.node_namespace, "type": p.topic_type, "hash": str(p.topic_type_hash),
-                          "reliable": p.qos_profile.reliability == ReliabilityPolicy.RELIABLE,
-                          "durability": "transient_local"
-                          if p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL else "volatile"}
-                         for p in self._publishers(t)]
-        graph = {"what": "graph", "nodes": sorted(self.node.get_node_names_and_namespaces()), "topics": topics}
+            topics[t] = [_endpoint(p) for p in self._publishers(t)]
+        graph = {"what": "graph", "topics": topics}
         if graph != self.last_graph:
             self.last_graph = graph
             _emit(wire.json_frame(graph))
@@ -168,6 +163,15 @@ class Agent:
     def close(self) -> None:
         self.node.destroy_node()
         rclpy.try_shutdown()
+
+
+def _endpoint(p: Any) -> dict[str, Any]:
+    """One endpoint of rclpy's graph (a ``TopicEndpointInfo``) as the monitor reads it."""
+    return {"gid": bytes(p.endpoint_gid[:wire.GID_BYTES]).hex(), "node": p.node_name, "ns": p.node_namespace,
+            "type": p.topic_type, "hash": str(p.topic_type_hash),
+            "reliable": p.qos_profile.reliability == ReliabilityPolicy.RELIABLE,
+            "durability": "transient_local" if p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
+            else "volatile"}
 
 
 def _matches(qos: tuple[bool, bool] | None, pubs: list[dict[str, Any]]) -> bool:
@@ -214,12 +218,7 @@ def graph_dump(wait_s: float, settle_s: float = 6.0, quiet_s: float = 0.5) -> di
                           "clients": node.get_client_names_and_types_by_node(n, ns)})
         ends: dict[str, Any] = {}
         for topic, _types in node.get_topic_names_and_types():
-            ends[topic] = {role: [{"gid": bytes(p.endpoint_gid[:wire.GID_BYTES]).hex(), "node": p.node_name,
-                                   "ns": p.node_namespace, "type": p.topic_type,
-                                   "reliable": p.qos_profile.reliability == ReliabilityPolicy.RELIABLE,
-                                   "durability": "transient_local"
-                                   if p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL else "volatile"}
-                                  for p in infos if p.node_name != name]
+            ends[topic] = {role: [_endpoint(p) for p in infos if p.node_name != name]
                            for role, infos in (("pubs", node.get_publishers_info_by_topic(topic)),
                                                ("subs", node.get_subscriptions_info_by_topic(topic)))}
         return {"nodes": nodes, "endpoints": ends}

@@ -74,13 +74,10 @@ class _Discovery:
 
     def __init__(self) -> None:
         self.topics: dict[str, list[dict[str, Any]]] = {}
-        self.nodes: list[tuple[str, str]] = []
         self._node: dict[bytes, str] = {}
-        self.pending = False
 
     def update(self, graph: dict[str, Any]) -> None:
         self.topics = graph.get("topics", {})
-        self.nodes = [(str(n[0]), str(n[1])) for n in graph.get("nodes", [])]
         self._node = {bytes.fromhex(p["gid"]): (p["ns"].rstrip("/") + "/" + p["node"])
                       for ps in self.topics.values() for p in ps}
 
@@ -118,9 +115,6 @@ class _Writer:
         """Publish serialized bytes (encapsulation header included) as they are: the gate's release of a
         message it held back (``--enforce``), byte for byte."""
         self.bus._send({"op": "write", "id": self.wid, "raw": base64.b64encode(raw).decode()})
-
-    def __del__(self) -> None:
-        pass
 
 
 class RclpyBus:
