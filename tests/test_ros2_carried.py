@@ -277,16 +277,17 @@ def _inputs(run: dict[str, Any], topic: str, field: str) -> dict[int, Any]:
 def test_float32_at_a_decimal_threshold_live(run: dict[str, Any]) -> None:
     battery, slip = _verdicts(run, "Battery"), _verdicts(run, "Slip")
     # an input heard before the monitor heard any answer is superseded (docs/semantics.md, "Steps")
-    assert "satisfied" in {v["verdict"] for v in battery} <= {"satisfied", "superseded"}, battery
+    quiet = {"satisfied", "superseded", "before first answer"}  # what a correct node may get at start-up
+    assert "satisfied" in {v["verdict"] for v in battery} <= quiet, battery
     bad = [v for v in slip if v["verdict"] == "violated"]
-    assert bad and {v["verdict"] for v in slip} <= {"satisfied", "violated", "superseded"}, slip
+    assert bad and {v["verdict"] for v in slip} <= quiet | {"violated"}, slip
     # every violation answers a battery message at 0.2 (float32 on the wire: 0.2000000030)
     assert all(v["values"]["in.p"].startswith("0.2000000") for v in bad), bad
 
 
 def test_laserscan_ranges_judged_live(run: dict[str, Any]) -> None:
     guard, blind = _verdicts(run, "Guard"), _verdicts(run, "Blind")
-    assert "satisfied" in {v["verdict"] for v in guard} <= {"satisfied", "superseded"}, guard
+    assert "satisfied" in {v["verdict"] for v in guard} <= {"satisfied", "superseded", "before first answer"}, guard
     bad = [v for v in blind if v["verdict"] == "violated"]
     assert bad and all(v["values"]["out.stop"] == "FALSE" for v in bad), blind
     # only the last beam near, as the float32 field carries 0.3
@@ -327,7 +328,8 @@ def test_the_verdicts_are_the_same_offline_and_in_the_bag(run: dict[str, Any],
         assert code == 1, out
         for node in ("Slip", "Blind"):
             n = sum(v["verdict"] == "violated" for v in _verdicts(run, node))
-            assert f"{n} violated" in out.split(f"{node}:")[0].rsplit("\n", 2)[-1] + out, (node, out)
+            (line,) = [x for x in out.splitlines() if f": {node}: " in x and "deadlines" not in x]
+            assert f"{n} violated" in line, (node, line)  # the same count as live, for this node
     assert run["code"] == 1, run["out"]
 
 

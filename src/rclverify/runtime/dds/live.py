@@ -69,27 +69,6 @@ class _Sink:
             self.taps.tick(now, self.window)  # the book's clock as far behind as the topic engine's, or more
 
 
-#: ns: a source timestamp older than this at receipt is not taken for the message's time (another host's clock)
-SOURCE_AGE_NS = 1_000_000_000
-
-
-def published_at(source_ns: int, received_ns: int) -> int:
-    """The time (ns) a topic message is judged at: its publisher's DDS source
-    timestamp when that is plausible on this host's clock (not after its
-    receipt, at most :data:`SOURCE_AGE_NS` before it), else its receipt.  The
-    monitor takes messages in batches, topic by topic; under load one batch
-    holds several of a publisher's rounds, whose receipt times are then
-    nearly equal and whose order across topics is the batch's, not the
-    robot's: an answer would be read as coming after the next round's
-    inputs (docs/semantics.md, "Steps").  The source timestamp is the moment
-    the robot published; the log and the bag record this time, so the
-    offline check judges the same.  (A call's samples keep their source
-    stamps as before: :mod:`.services`.)"""
-    if 0 < source_ns <= received_ns and received_ns - source_ns <= SOURCE_AGE_NS:
-        return source_ns
-    return received_ns
-
-
 def _status(live: LiveRun, calls: Mapping[tuple[str, str], int]) -> str:
     """The topic engine's status line, then the calls' verdicts per node."""
     line = live.status_line()
@@ -228,7 +207,6 @@ class _DdsRun:
             return (bytes(guid) or None) if guid is not None else writers.of(tap.reader, info)
 
         def on_sample(tap: Any, raw: bytes, info: Any, rns: int) -> None:
-            rns = published_at(int(info.source_timestamp), rns)
             self.worker_box[0].offer(tap.key, (raw, info.source_timestamp, rns, writer_of(tap, info)), rns / 1e9)
         if bus_factory is not None:
             self.bus = bus = bus_factory(on_sample, self.warn, on_reader=self.on_reader,
