@@ -158,3 +158,42 @@ def test_doit_verifys_monitors_evidence_judges_a_live_logs_calls(wrong: bool, tm
         assert status == {"Base": "failed", "Teleop": "discharged", "Mover": "failed"}, status
     else:  # Base's unpaired call is inconclusive, never guessed; Mover's rejected goal was left open, as live
         assert status == {"Base": "inconclusive", "Teleop": "discharged", "Mover": "inconclusive"}, status
+
+
+def test_the_source_a_live_log_names_is_in_the_evidence_and_the_report(tmp_path: Path) -> None:
+    """A live log's origin lines (run_origin.py: the source, its middleware, the links it could not hear)
+    reach the monitors evidence (``details["monitoring"]["source"]``) and the report's evidence part; a log
+    without them claims no source."""
+    from rclverify.backends.monitors.run_origin import origin_line, unseen_line
+    from rclverify.report.evidence_rows import evidence_row
+    from rclverify.report.fragments import FragmentCache
+    from rclverify.report.render import part_renderer
+    ws = tmp_path / "ws"
+    shutil.copytree(WS, ws)
+    log, _live_summary = _live(ws, False)
+    body = log.read_text()
+    unseen = ["/move: no introspection event of its own services was heard"]
+    log.write_text(dumps(origin_line(9.0, "rclpy", "rmw_zenoh_cpp", "rclpy 9.1.2 on rmw_zenoh_cpp")) + "\n" + body
+                   + dumps(unseen_line(16.0, unseen)) + "\n")
+    bare = ws / "bare.jsonl"
+    bare.write_text(body)
+    checked = load([ws / "contracts" / "dds.rcl"])
+    got = {}
+    for trace in (log.name, bare.name):
+        t = NodeTarget(root=ws, checked=checked, node=checked.nodes["Base"],
+                       config={"backend": "monitors", "horizon": 1.0, "traces": [trace]},
+                       contract_files=("contracts/dds.rcl",), plan_file="contracts/plan.yaml",
+                       artifacts=ws / "artifacts" / "monitors" / "Base")
+        (ob,) = MonitorsBackend().export(t)
+        got[trace] = MonitorsBackend().run(ob, t)
+    ev, plain = got[log.name], got[bare.name]
+    assert ev.details["monitoring"]["source"] == {"source": "rclpy", "rmw": "rmw_zenoh_cpp",
+                                                  "middleware": "rclpy 9.1.2 on rmw_zenoh_cpp", "unseen": unseen}
+    assert "source" not in plain.details["monitoring"] and ev.status == plain.status  # the lines judge nothing
+    part = part_renderer(FragmentCache(), "../")
+    row = {"record": evidence_row(None, ev, ev.status, "", None), "anchor": "ev-x"}  # no plot: no workspace read
+    md = part("evidence.md", rows=[row])
+    assert "Heard through: rclpy on rmw\\_zenoh\\_cpp" in md or "Heard through: rclpy on rmw_zenoh_cpp" in md, md
+    assert "not heard: /move: no introspection event" in md
+    html = str(part("evidence.html", rows=[row]))
+    assert "<th>Heard through</th><td>rclpy on rmw_zenoh_cpp" in html, html

@@ -350,6 +350,9 @@ def test_the_source_is_the_one_asked_and_said(run: dict[str, Any]) -> None:
         assert rec["qos"]["x"]["published_before_heard"] > 0, rec["qos"]["x"]
     else:
         assert "on DDS domain" in run["out"] and rec["unseen"] == []
+    # the log says it too, in its first line, for the evidence and the report (run_origin.py)
+    first = json.loads((run["tmp"] / "live.jsonl").read_text().splitlines()[0])
+    assert first["topic"] == "rclverify/run" and (first["source"], first["rmw"]) == (rec["source"], rec["rmw"])
     # the verdicts reach a ROS 2 subscriber on /rclverify/verdict, decoded (std_msgs/String JSON), either way
     heard, violated = (int(x) for x in run["system"].split("done ")[1].split()[:2])
     assert heard > 50 and violated > 0, run["system"]

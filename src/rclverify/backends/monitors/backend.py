@@ -32,6 +32,7 @@ from rclverify.traces.files import trace_files, trace_sha256
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
 from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.run_origin import RunOrigin
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
 from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
@@ -241,6 +242,8 @@ class MonitorsBackend:
         status, explanation = unless_stale((status, entry["explanation"] + (f"; {note}" if note else "")), stale)
         if note:
             details["stamp_order"] = note
+        if read.origin is not None:
+            details["source"] = read.origin
         extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
@@ -260,6 +263,7 @@ class _Read:
     results: list[Any]
     summary: dict[str, Any] | None
     bag: BagCalls | None = None
+    origin: dict[str, Any] | None = None
 
 
 def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None) -> _Read:
@@ -292,9 +296,11 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     if lag is not None:
         source = in_stamp_order(source, lag)
     inner = bag.tap(source) if bag is not None else calls.tap(source) if calls.active else source
-    events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(inner)), heard, watch),
-                                  cfg.rules, cfg.horizon, tolerance=cfg.tolerance)
-    return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag)
+    origin = RunOrigin()  # the source and middleware a live log says it was heard through (run_origin.py)
+    events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(origin.tap(inner))), heard,
+                                                                  watch), cfg.rules, cfg.horizon,
+                                  tolerance=cfg.tolerance)
+    return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag, origin.origin)
 
 
 class _Beside:

@@ -64,7 +64,7 @@ from rclverify.backends.monitors.bag_calls import (DECISIONS, REQUEST_SENT, RESP
                                                    topic_type)
 from rclverify.runtime.dds.bag_types import definition
 from rclverify.runtime.dds.introspection import event_struct
-from rclverify.runtime.dds.services import _cancel_types
+from rclverify.runtime.dds.call_plan import cancel_types
 from rclverify.runtime.dds.types import DdsTypeError, TypeBook, to_fields
 
 #: entries kept per table of identities (the oldest forgotten beyond it)
@@ -138,7 +138,7 @@ class CallRecorder:
             event_struct(t, lk.ros_type)
         else:
             t.action(lk.ros_type)
-            _cancel_types(t)
+            cancel_types(t)
             for role in ("send_goal", "get_result", "cancel_goal"):
                 _event_type(t, topic_type(lk.ros_type, role)[: -len("_Event")])
         for topic, role in link_topics(lk.kind, link).items():

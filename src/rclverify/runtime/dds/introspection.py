@@ -44,11 +44,15 @@ _INFO = "service_msgs/msg/ServiceEventInfo"
 
 def event_struct(types: TypeBook, srv_type: str) -> type:
     """The struct of ``<pkg>/srv/<Srv>_Event`` for service type ``pkg/Srv`` (or
-    ``pkg/srv/Srv``): ``info``, ``request[<=1]``, ``response[<=1]`` (module
+    ``pkg/srv/Srv``), or ``<pkg>/action/<A>_<Svc>_Event`` for an action's own
+    service ``pkg/action/A_SendGoal`` or ``A_GetResult``: ``info``, ``request[<=1]``, ``response[<=1]`` (module
     docstring).  Raises :class:`~.dds_types.DdsTypeError` for a service the
     interface files do not define."""
-    pkg, _, rest = srv_type.replace("/srv/", "/").partition("/")
-    base = f"{pkg}/srv/{rest}"
+    if "/action/" in srv_type:  # an action's own service (``pkg/action/T_SendGoal``)
+        base = srv_type
+    else:
+        pkg, _, rest = srv_type.replace("/srv/", "/").partition("/")
+        base = f"{pkg}/srv/{rest}"
     for part in ("Request", "Response"):
         types.struct(f"{base}_{part}", srv_type)
     types._synth(_INFO, [("event_type", (1, ("uint8", 0))), ("stamp", (2, "builtin_interfaces/msg/Time")),
@@ -67,13 +71,21 @@ def event_side(event_writers: Iterable[bytes], reply_writers: Iterable[bytes], r
     its participant (the GUID prefix: every node of one process shares it)."""
     def who(g: bytes) -> str:
         return owner(bytes(g)) or bytes(g[:12]).hex()
-    pubs = {who(g) for g in event_writers}
-    if not pubs:
+    return side_of({who(g) for g in event_writers}, {who(g) for g in reply_writers},
+                   {who(g) for g in request_writers})
+
+
+def side_of(publishers: set[str], servers: set[str], clients: set[str]) -> str | None:
+    """:func:`event_side` on names: ``publishers`` of the event topic, the
+    service's (or action's) ``servers`` and ``clients``, each named by its
+    node (``/ns/name``; the rclpy source reads them from the graph API) or
+    its participant.  ``"server"`` when a server is among the publishers,
+    ``"client"`` when every client is, else ``None``."""
+    if not publishers:
         return None
-    if any(who(g) in pubs for g in reply_writers):
+    if servers & publishers:
         return "server"
-    clients = {who(g) for g in request_writers}
-    return "client" if clients and clients <= pubs else None
+    return "client" if clients and clients <= publishers else None
 
 
 def event_key(sample: Any) -> tuple[str, int]:
@@ -82,4 +94,4 @@ def event_key(sample: Any) -> tuple[str, int]:
 
 
 __all__ = ["EVENT_SUFFIX", "REQUEST_RECEIVED", "REQUEST_SENT", "RESPONSE_RECEIVED", "RESPONSE_SENT", "SIDES",
-           "event_key", "event_side", "event_struct"]
+           "event_key", "event_side", "event_struct", "side_of"]

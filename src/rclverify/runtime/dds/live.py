@@ -37,6 +37,7 @@ from typing import Any, Callable, Mapping
 
 from rclverify.records.store import atomic_write_text
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.backends.monitors.run_origin import origin_line, unseen_line
 from rclverify.ros.live.dds import DdsUnavailable, domain_id, make_participant, topic_name, type_hash_user_data, write_raw
 from rclverify.ros.live.dds_qos import writer_profile
 from rclverify.backends.monitors.summary import verdict_status
@@ -108,6 +109,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     run.open_recorder(record, msg_dirs)
     dp = make_participant() if bus_factory is None else None
     run.join(dp, run_factory, verdict_topic, last_prefix, bus_factory)
+    run.live.note(origin_line(_time.time(), *run.origin()))  # the log says which source heard it (run_origin.py)
     worker = EngineWorker(_Sink(run.live, run.book, run.calls, reorder_window), run.decode, _time.time,
                           tick_s=tick_s)
     run.worker_box.append(worker.start())
@@ -237,7 +239,7 @@ class _DdsRun:
                     rec.line(obj)
             self.book = CallBook(self.checked, self.links, self.live.engine.rules, self.live.engine.horizon,
                                  self.on_call_verdict, self.on_deadline, on_line)
-            self.calls = CallTaps(self.book, self.types, self.links)
+            self.calls = CallTaps(self.book, self.types, self.links, events=getattr(bus, "events_only", False))
             if rec is not None:
                 rec.specs = self.calls.specs
         for t, struct in self.structs.items():
@@ -247,11 +249,18 @@ class _DdsRun:
         bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
         if self.calls is not None:
             self.calls.attach(bus, self.warn)
-        for lk_name, where in sorted({(t.key.split(":")[1], t.where) for t in getattr(bus, "deaf", [])}):
-            self.warn(f"{where}: warning: {lk_name}: the rclpy source hears this link's calls only through "
-                      f"introspection events ({lk_name}/_service_event, and an action's own services'), never "
-                      "its request and reply topics: enable introspection on its server or clients "
-                      "(docs/ros2.md), or monitor with --source dds")
+        if self.calls is not None and self.calls.events:
+            self.out(f"the rclpy source hears the calls of {', '.join(sorted(self.calls.kinds))} through their "
+                     "introspection events only, never their request and reply topics (docs/ros2.md)")
+
+    def origin(self) -> tuple[str, str, str]:
+        """``(source, rmw, middleware)`` of this run: ``rclpy`` with the agent's
+        middleware, or ``dds`` with the monitor's own participant."""
+        hello = getattr(self.bus, "hello", None)
+        if hello is not None:
+            return ("rclpy", str(hello.get("rmw", "")), f"rclpy {hello.get('rclpy', '')} on {hello.get('rmw', '')} "
+                    f"(ROS 2 Python {hello.get('python', '')}, domain {domain_id()})")
+        return "dds", "DDS participant (Cyclone DDS)", f"DDS domain {domain_id()} ({_version()})"
 
     def source_rmw(self) -> str:
         """The middleware the rclpy agent runs on (its hello), or ``DDS``."""
@@ -323,22 +332,22 @@ class _DdsRun:
             worker.stop()
         except Exception:  # noqa: BLE001 - stop_and_record stops it again and records the error
             pass
+        unheard = calls.unheard() if calls is not None else {}  # the rclpy source: links it heard nothing of
+        for name, why in unheard.items():
+            self.warn(f"{calls.where[name] if calls is not None else name}: warning: {name}: the rclpy source hears "
+                      f"calls through introspection events only, and {why}: enable introspection on its server "
+                      "(docs/ros2.md), or monitor with --source dds")
+        if unheard:
+            live.note(unseen_line(_time.time(), [f"{name}: {why}" for name, why in unheard.items()]))
         summary = calls.finish() if calls is not None else None  # while the log is open
         record_ = stop_and_record(worker, live, None, self.out)
         if bus_error:
             record_["bus_error"] = bus_error
             for n in record_["nodes"]:
                 n["status"], n["explanation"] = "error", f"the DDS reader thread stopped: {bus_error}"
-        hello = getattr(bus, "hello", None)
-        if hello is not None:  # the rclpy source: its middleware, and what it cannot hear (rclpy_source/bus.py)
-            record_.update(source="rclpy", rmw=hello.get("rmw", ""),
-                           middleware=f"rclpy {hello.get('rclpy', '')} on {hello.get('rmw', '')} (ROS 2 Python "
-                                      f"{hello.get('python', '')}, domain {domain_id()})",
-                           unseen=sorted({f"{t.key.split(':')[1]}: request and reply topics (only introspection "
-                                          "events are heard)" for t in bus.deaf}))
-        else:
-            record_.update(source="dds", rmw="DDS participant (Cyclone DDS)",
-                           middleware=f"DDS domain {domain_id()} ({_version()})", unseen=[])
+        source, rmw, middleware = self.origin()
+        record_.update(source=source, rmw=rmw, middleware=middleware,
+                       unseen=[f"{name}: {why}" for name, why in unheard.items()])
         qos = {t.key: t.to_json() for t in bus.taps}
         for key, n in getattr(bus, "before", {}).items():
             qos[key]["published_before_heard"] = n
@@ -363,6 +372,9 @@ class _DdsRun:
             if self.call_recorder is not None and self.call_recorder.failed:
                 record_["bag"]["calls_failed"] = self.call_recorder.failed
         record_["not_judged"] = live.not_judged(record_)  # silence is never green (judged.py)
+        for item in record_["not_judged"]:  # what the source could not hear says why
+            if item["kind"] in ("service", "action") and item["name"] in unheard:
+                item["detail"] += f" (the rclpy source: {unheard[item['name']]})"
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
         self.out(_status(live, self.call_counts))

@@ -2,14 +2,10 @@
 :class:`~.dds_calls.CallBook`.
 
 For every link a monitored contract declares (``services(...)``,
-``actions(...)``), :class:`CallTaps` asks the bus (:mod:`.dds_bus`) for:
-
-* a service ``/s`` of type ``pkg/T``: ``rq/sRequest`` and ``rr/sReply``
-  (``pkg::srv::dds_::T_Request_`` / ``T_Response_``) and its introspection
-  events ``rt/s/_service_event`` (:mod:`.dds_introspection`);
-* an action ``/a``: ``rq``/``rr`` of ``/a/_action/send_goal``,
-  ``/a/_action/get_result`` and ``/a/_action/cancel_goal``, and
-  ``rt/a/_action/feedback`` and ``rt/a/_action/status``.
+``actions(...)``), :class:`CallTaps` asks the bus (:mod:`.dds_bus`) for the
+topics :mod:`.call_plan` names: a service's request and reply topics and
+its introspection events; an action's send-goal, get-result and
+cancel-goal request and reply topics, its feedback and status.
 
 The request and reply readers are of the wire form ``RMW_IMPLEMENTATION``
 names (:mod:`.dds_wire`); a sample whose writer is of the other vendor is
@@ -29,6 +25,18 @@ counted, not decoded:
   unjudged; status changes, cancel requests and the goals a cancel reply
   names (goal ids in both: no pairing needed) are logged.
 
+**Events only** (``events``: the rclpy source, which cannot read a
+service's request and reply topics): a service's calls come from its
+introspection events alone, and an action's goals, results, refusals and
+cancels from the introspection events of its own three services
+(``<a>/_action/send_goal/_service_event``, ``get_result``'s, ``cancel_goal``'s;
+the goal id in each request names the goal, the event's client gid and
+sequence number name the reply), its feedback and status from their
+topics.  Whose events are read (the server's, else every client's) is
+decided from the serving and calling nodes the graph API reports
+(:func:`~.introspection.side_of`).  A link none of whose nodes publish
+events is not heard, and is said so.
+
 Samples are taken in the order of their DDS source timestamps: each waits
 :data:`SETTLE_S` seconds after its stamp (so that a request taken after its
 reply, the two travelling on different topics, still comes first), and the
@@ -44,15 +52,15 @@ from typing import Any, Iterable
 
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode
-from rclverify.ros.live.dds import ACTION_INFIX, reply_topic, request_topic, topic_name
+from rclverify.ros.live.dds import ACTION_INFIX
 from rclverify.runtime.dds.bus import NAME_GRACE_S
 from rclverify.backends.monitors.dds_calls import CallBook
-from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, event_side, event_struct
+from rclverify.runtime.dds.call_plan import CallPlan
+from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, event_side, side_of
 from rclverify.runtime.dds.order import OrderPairer, Pending
 from rclverify.runtime.dds.shadow import REPLY_OF, SHADOW, Shadows
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
 from rclverify.runtime.dds.wire import framed_rmw, has_header, vendor
-from rclverify.runtime.dds.types import DdsTypeError
 
 #: seconds an answer waits for its request (or goal) to be heard
 EARLY_S = 2.0
@@ -65,50 +73,24 @@ GOAL_STATUS = {0: "unknown", 1: "accepted", 2: "executing", 3: "canceling", 4: "
                6: "aborted"}
 
 
-def _cancel_types(t: TypeBook) -> tuple[type, type, type, type]:
-    """The plain and the framed request and reply of ``action_msgs/srv/CancelGoal``
-    (ROS 2 design "Actions": the request a ``GoalInfo``, goal id and stamp;
-    the reply a return code and the ``GoalInfo`` of each goal now canceling),
-    defined here when the interface files do not (rosbags' store has no
-    services)."""
-    info = (2, "action_msgs/msg/GoalInfo")
-    req, rep = "action_msgs/srv/CancelGoal_Request", "action_msgs/srv/CancelGoal_Response"
-    t._synth(req, [("goal_info", info)])
-    t._synth(rep, [("return_code", (1, ("int8", 0))), ("goals_canceling", (4, (info, 0)))])
-    return t.struct(req), t.struct(rep), t.struct(req, header=True), t.struct(rep, header=True)
-
-
-def _where(link: ast.Link) -> str:
-    return f"{link.loc.file}:{link.loc.line}:{link.loc.col}"
-
-
 class CallTaps:
     """The taps of every monitored link and the decoding of their samples
     (module docstring).  Raises :class:`~.dds_types.DdsTypeError` (with the
     link's location) for a link type the interface files do not define."""
 
     def __init__(self, book: CallBook, types: TypeBook, links: Iterable[tuple[CheckedNode, ast.Link]],
-                 framed: bool | None = None) -> None:
+                 framed: bool | None = None, events: bool = False) -> None:
         self.book, self.types = book, types
         #: the services' samples carry rmw_cyclonedds' request header (default: by RMW_IMPLEMENTATION)
         self.framed = framed_rmw() if framed is None else framed
-        #: tap key -> (link, the struct read, the header struct or None, part)
-        self.specs: dict[str, tuple[str, Any, Any, str]] = {}
-        self.plan: list[tuple[str, str, Any, str]] = []  # (tap key, dds topic, struct, where)
-        #: pairer name -> (its request tap key, its reply tap key): the readers discovery is read from
-        self._pair_taps: dict[str, tuple[str, str]] = {}
-        seen: set[str] = set()
-        for _node, lk in links:
-            name = "/" + lk.name.strip("/")
-            if name in seen:
-                continue
-            seen.add(name)
-            try:
-                self._plan(name, lk)
-            except DdsTypeError as exc:
-                raise DdsTypeError(f"{_where(lk)}: error: {lk.kind} {name} ({lk.ros_type}): {exc}") from None
+        #: calls heard through introspection events only (module docstring: the rclpy source)
+        self.events = events
+        plan = CallPlan(types, links, self.framed, events)  # which topics, read as which structs (call_plan.py)
+        self.kinds, self.where, self.specs, self.plan = plan.kinds, plan.where, plan.specs, plan.plan
+        self._pair_taps = plan.pair_taps
         self.taps: dict[str, Any] = {}  # tap key -> the bus's Tap (attach)
         self._node_of: Any = lambda guid: None  # a writer's ROS node (the bus's discovery, attach)
+        self._ends: Any = None  # name -> (serving nodes, calling nodes): the graph API's (the rclpy bus, attach)
         self._disc: Any = None
         self._warn: Any = None
         self._warned: set[bytes] = set()
@@ -116,13 +98,14 @@ class CallTaps:
         self._said: set[str] = set()
         self._checked = float("-inf")
         self.shadows: Shadows | None = None  # reply writers that keep services visible to clients (attach)
-        self._goal_of: dict[tuple[int, int], str] = {}  # send-goal/get-result request id -> goal id
+        self._goal_of: dict[tuple[Any, ...], str] = {}  # send-goal/get-result request id (or event key) -> goal id
         self._status: dict[str, int] = {}
         self._early: dict[tuple[Any, ...], list[tuple[str, dict[str, Any], float, bool, float, str]]] = {}
         self._queue: list[tuple[float, int, float, str, bytes, bytes | None]] = []
         self._n = 0
         self._pairers: dict[str, OrderPairer] = {}
         self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
+        self.sided: set[str] = set()  # the links some of whose calls an introspection side paired
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
         #: pairer name -> (the reply reader's writers, the pairer's servers) when discovery was last read
@@ -134,38 +117,6 @@ class CallTaps:
         self.counts = {"late": 0, "unknown_writer": 0, "other_form": 0, "no_contents": 0, "introspected": 0,
                        "undecodable": 0}
 
-    def _plan(self, name: str, lk: ast.Link) -> None:
-        t = self.types
-        if lk.kind == "service":
-            req, rep = t.service(lk.ros_type)
-            pkg, _, rest = lk.ros_type.replace("/srv/", "/").partition("/")
-            self._add(name, "request", request_topic(name), t.struct(f"{pkg}/srv/{rest}_Request"), req, lk)
-            self._add(name, "reply", reply_topic(name), t.struct(f"{pkg}/srv/{rest}_Response"), rep, lk)
-            self._add(name, "event", topic_name(name + EVENT_SUFFIX), event_struct(t, lk.ros_type), None, lk)
-            self._pair_taps[name] = (f"call:{name}:request", f"call:{name}:reply")
-            return
-        a = t.action(lk.ros_type)
-        pkg, _, rest = lk.ros_type.replace("/action/", "/").partition("/")
-        plain = f"{pkg}/action/{rest}"
-        base = name + ACTION_INFIX
-        for svc, part, (hreq, hrep) in (("send_goal", "goal", a.send_goal), ("get_result", "result", a.get_result)):
-            kind = "SendGoal" if svc == "send_goal" else "GetResult"
-            self._add(name, f"{part}_request", request_topic(base + svc), t.struct(f"{plain}_{kind}_Request"), hreq,
-                      lk)
-            self._add(name, f"{part}_reply", reply_topic(base + svc), t.struct(f"{plain}_{kind}_Response"), hrep, lk)
-        for svc, part in (("send_goal", "goal"), ("get_result", "result")):
-            self._pair_taps[f"{name}/_action/{svc}"] = (f"call:{name}:{part}_request", f"call:{name}:{part}_reply")
-        self._add(name, "feedback", topic_name(base + "feedback"), a.feedback, None, lk)
-        self._add(name, "status", topic_name(base + "status"), a.status, None, lk)
-        cq, cr, hq, hr = _cancel_types(t)
-        self._add(name, "cancel_request", request_topic(base + "cancel_goal"), cq, hq, lk)
-        self._add(name, "cancel_reply", reply_topic(base + "cancel_goal"), cr, hr, lk)
-
-    def _add(self, name: str, part: str, dds_topic: str, plain: Any, header: Any, lk: ast.Link) -> None:
-        key = f"call:{name}:{part}"
-        self.specs[key] = (name, header if self.framed and header is not None else plain, header, part)
-        self.plan.append((key, dds_topic, header if self.framed and header is not None else plain, _where(lk)))
-
     def attach(self, bus: Any, warn: Any = None) -> None:
         """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan;
         ``warn(line)`` is told of each writer of the other wire form (:meth:`check_forms`); the
@@ -173,6 +124,10 @@ class CallTaps:
         for key, dds_topic, struct, where in self.plan:
             self.taps[key] = bus.tap(key, dds_topic, struct, where)
         self._node_of = bus.discovery.node_of
+        self._ends = getattr(bus, "service_nodes", None)
+        if self._ends is not None:
+            for name, kind in self.kinds.items():
+                bus.watch_service(name, kind == "action")
         self._disc, self._warn = bus.discovery, warn
         self.shadows = Shadows(bus, [(self.taps[k], self.taps[k.rsplit(":", 1)[0] + ":" + REPLY_OF[part]])
                                      for k, (_n, _s, _h, part) in self.specs.items() if part in REPLY_OF])
@@ -261,6 +216,8 @@ class CallTaps:
         s = struct.deserialize(raw)
         if part == "event":
             self._event(name, s, stamp, now)
+        elif part.endswith("_event"):
+            self._action_event(name, part, s, stamp, now)
         elif part in ("request", "reply"):
             if self._side(name, stamp) is not None:
                 self.counts["introspected"] += 1
@@ -273,6 +230,23 @@ class CallTaps:
                 self._ordered_reply(name, s, stamp, writer)
         else:
             self._action(name, part, s, stamp, now, framed, writer)
+
+    def unheard(self) -> dict[str, str]:
+        """Events only (module docstring): each link (``/s``) no introspection
+        event of which was heard from its server or from every client, with
+        what that left unheard; ``{}`` on the DDS source."""
+        if not self.events:
+            return {}
+        out = {}
+        for name, kind in sorted(self.kinds.items()):
+            if name in self.sided:
+                continue
+            out[name] = (f"no introspection event of its server or of every client was heard "
+                         f"({name}{EVENT_SUFFIX}): none of its calls was heard" if kind == "service" else
+                         f"no introspection event of its own services was heard ({name}{ACTION_INFIX}send_goal"
+                         f"{EVENT_SUFFIX}, get_result's, cancel_goal's): none of its goals or results was heard "
+                         "(its feedback and status topics are)")
+        return out
 
     # -- services ------------------------------------------------------------------------------
     def _request(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
@@ -339,22 +313,34 @@ class CallTaps:
                     self.book.unpaired(p.key, now, why)
             self._servers_seen[pname] = (frozenset(rr.heard), frozenset(pairer.servers))
 
-    def _side(self, name: str, stamp: float) -> str | None:
-        """Which side's introspection events pair the calls of service ``name``
-        (:func:`event_side`) at the sample stamped ``stamp``.  When that changes
-        (an event writer discovered after calls began, or gone), the calls the
-        other source opened can no longer be answered by it: they are unpaired."""
-        ev, rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("event", "reply", "request"))
-        side = None if ev is None or rep is None or req is None else \
-            event_side(ev.heard, rep.heard, req.heard, self._node_of)
-        if self._sides.setdefault(name, side) == side:
+    def _side(self, name: str, stamp: float, part: str = "event") -> str | None:
+        """Which side's introspection events (tap ``part``) pair the calls of
+        service or action ``name`` (:func:`event_side`; with the graph API's
+        nodes, :func:`side_of`) at the sample stamped ``stamp``.  When that
+        changes (an event writer discovered after calls began, or gone), the
+        calls the other source opened can no longer be answered by it: they
+        are unpaired."""
+        ev = self.taps.get(f"call:{name}:{part}")
+        if ev is None:
+            side = None
+        elif self._ends is not None:
+            side = side_of({self._node_of(bytes(g)) or bytes(g[:12]).hex() for g in ev.heard}, *self._ends(name))
+        else:
+            rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("reply", "request"))
+            side = None if rep is None or req is None else event_side(ev.heard, rep.heard, req.heard, self._node_of)
+        memo = f"{name}:{part}"
+        if side is not None:
+            self.sided.add(name)
+        if self._sides.setdefault(memo, side) == side:
             return side
-        was, self._sides[name] = self._sides[name], side
+        was, self._sides[memo] = self._sides[memo], side
         why = (f"{name}'s introspection events {'began' if was is None else 'changed or stopped'} while this call "
                "was open: its answer may come through the other source, and the two cannot be matched")
-        keys = [k for k, c in self.book.calls.items() if c.name == name.strip("/") and k and k[0] in ("ev", "w")]
+        link = name.strip("/")
+        keys = [k for k, c in self.book.calls.items()
+                if c.name == link and k and (part != "event" or k[0] in ("ev", "w"))]
         for k in keys:
-            self.book.unpaired(k, stamp, why)
+            self.book.unpaired(k, stamp, why, "response" if part == "event" else "result")
         self._pairers.pop(name, None)
         return side
 
@@ -375,6 +361,41 @@ class CallTaps:
             self._answer(key, "response", to_fields(s.response[0]), stamp, True, name, now)
 
     # -- actions -------------------------------------------------------------------------------
+    def _action_event(self, name: str, part: str, s: Any, stamp: float, now: float) -> None:
+        """An introspection event of one of action ``name``'s own services (module docstring, events only)."""
+        side = self._side(name, stamp, part)
+        if side is None:
+            return
+        asked, told = SIDES[side]
+        kind, key = int(s.info.event_type), ("ev", *event_key(s))
+        body = s.request if kind == asked else s.response if kind == told else None
+        if body is None:
+            return
+        if not body:
+            self.counts["no_contents"] += 1
+            return  # introspection without CONTENTS: nothing to judge (docs/ros2.md)
+        r, link = body[0], name.strip("/")
+        if part == "cancel_event":
+            self.book.note({"link": link, "part": "cancel", "time": stamp,
+                            "key": [bytes(r.goal_info.goal_id.uuid).hex()]} if kind == asked else
+                           {"link": link, "part": "canceling", "time": stamp, "return_code": int(r.return_code),
+                            "key": [bytes(g.goal_id.uuid).hex() for g in r.goals_canceling]})
+        elif kind == asked:
+            gid = self._goal_of[key] = bytes(r.goal_id.uuid).hex()
+            while len(self._goal_of) > 10_000:
+                self._goal_of.pop(next(iter(self._goal_of)))
+            if part == "goal_event":
+                self._open(name, (gid,), f"{link} goal {gid}", to_fields(r.goal), stamp, "goal")
+        else:
+            gid = self._goal_of.pop(key, "")
+            if not gid:
+                self.counts["unknown_writer"] += 1  # its request's event was not heard: which goal, unknown
+            elif part == "goal_event" and not r.accepted:
+                self.book.reject((gid,), stamp)
+            elif part == "result_event":
+                self._answer((gid,), "result", to_fields(r.result), stamp, True, name, now)
+                self._note_status(name, gid, int(r.status), stamp)
+
     def _action(self, name: str, part: str, s: Any, stamp: float, now: float, framed: bool,
                 writer: bytes | None) -> None:
         if part == "goal_request":

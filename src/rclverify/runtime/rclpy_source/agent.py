@@ -20,6 +20,12 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   (GID, node, namespace, type, type hash, reliability, durability) as the
   ROS 2 graph API reports them, sent when they change.  The agent's node is
   hidden (``_rclverify_monitor_<pid>``) and its own endpoints are left out.
+* **Services and actions** (``{"op": "service", "name", "action"}``): the
+  nodes that serve and that call each one (``/ns/name``), from the graph
+  API (``get_service_names_and_types_by_node`` and its client twin;
+  rclpy.action's for actions), sent with the graph every
+  :data:`SERVICE_PERIOD_S`: the monitor reads from them whose introspection
+  events pair a call (the server's, else every client's).
 * **Writers** (``writer``, ``write``): publishers of the monitor (its
   verdicts), written with serialized messages the monitor made.
 
@@ -42,6 +48,7 @@ from typing import Any
 from importlib.metadata import version
 
 import rclpy
+from rclpy.action import graph as action_graph
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -51,6 +58,8 @@ from rclpy.utilities import get_rmw_implementation_identifier
 import wire  # type: ignore[import-not-found]  # beside this script (module docstring)
 
 GRAPH_PERIOD_S = 0.1
+#: seconds between two readings of the services' and actions' servers and clients (one query per node each)
+SERVICE_PERIOD_S = 0.5
 
 
 def _emit(frame: bytes) -> None:
@@ -60,8 +69,14 @@ def _emit(frame: bytes) -> None:
 
 
 def _class(type_name: str) -> Any:
+    """The message class of ``pkg/kind/Name``; an action's feedback message
+    (``pkg/action/A_FeedbackMessage``) is ``A.Impl.FeedbackMessage`` in rosidl's Python."""
     pkg, kind, name = type_name.strip("/").split("/")
-    return getattr(importlib.import_module(f"{pkg}.{kind}"), name)
+    module = importlib.import_module(f"{pkg}.{kind}")
+    if not hasattr(module, name) and kind == "action" and "_" in name:
+        base, _, part = name.rpartition("_")
+        return getattr(getattr(module, base).Impl, part)
+    return getattr(module, name)
 
 
 def _commands(q: queue.Queue[dict[str, Any] | None], wake: Any) -> None:
@@ -85,6 +100,9 @@ class Agent:
         self.ex.add_node(self.node)
         self.taps: dict[int, dict[str, Any]] = {}
         self.watched: set[str] = set()
+        self.services: dict[str, bool] = {}  # service or action name -> whether an action
+        self.ends: dict[str, dict[str, list[str]]] = {}
+        self.next_ends = 0.0
         self.writers: dict[int, Any] = {}
         self.last_graph: Any = None
 
@@ -110,6 +128,8 @@ class Agent:
                                        "qos": None, "changes": 0, "heard": []}
         elif op == "watch":
             self.watched.add(c["topic"])
+        elif op == "service":
+            self.services[c["name"]] = bool(c.get("action"))
         elif op == "writer":
             qos = QoSProfile(depth=int(c.get("depth", 10)),
                              reliability=ReliabilityPolicy.RELIABLE if c.get("reliable", True)
@@ -130,7 +150,10 @@ class Agent:
         topics: dict[str, list[dict[str, Any]]] = {}
         for t in sorted({t["topic"] for t in self.taps.values()} | self.watched):
             topics[t] = [_endpoint(p) for p in self._publishers(t)]
-        graph = {"what": "graph", "topics": topics}
+        if self.services and time.monotonic() >= self.next_ends:
+            self.ends = self._service_ends()
+            self.next_ends = time.monotonic() + SERVICE_PERIOD_S
+        graph = {"what": "graph", "topics": topics, "services": self.ends}
         if graph != self.last_graph:
             self.last_graph = graph
             _emit(wire.json_frame(graph))
@@ -154,6 +177,27 @@ class Agent:
             tap["sub"] = self.node.create_subscription(tap["cls"], tap["topic"], _handler(k), qos, raw=True)
             tap["qos"], tap["heard"] = want, heard
             self._said(k, tap)
+
+    def _service_ends(self) -> dict[str, dict[str, list[str]]]:
+        """Each watched service's or action's serving and calling nodes (``/ns/name``)."""
+        ends: dict[str, dict[str, set[str]]] = {n: {"servers": set(), "clients": set()} for n in self.services}
+        for name, ns in self.node.get_node_names_and_namespaces():
+            if name == self.name and ns == "/":
+                continue
+            full = ns.rstrip("/") + "/" + name
+            try:
+                served = {s for s, _ in self.node.get_service_names_and_types_by_node(name, ns)}
+                called = {s for s, _ in self.node.get_client_names_and_types_by_node(name, ns)}
+                acts = {s for s, _ in action_graph.get_action_server_names_and_types_by_node(self.node, name, ns)}
+                acts_c = {s for s, _ in action_graph.get_action_client_names_and_types_by_node(self.node, name, ns)}
+            except Exception:  # noqa: BLE001 - a node that left between the two calls: read again next time
+                continue
+            for svc, is_action in self.services.items():
+                if svc in (acts if is_action else served):
+                    ends[svc]["servers"].add(full)
+                if svc in (acts_c if is_action else called):
+                    ends[svc]["clients"].add(full)
+        return {n: {k: sorted(v) for k, v in e.items()} for n, e in ends.items()}
 
     def _said(self, k: int, tap: dict[str, Any]) -> None:
         _emit(wire.json_frame({"what": "tap", "id": k, "reliable": tap["qos"][0],

@@ -25,8 +25,12 @@ pipe (:mod:`.wire`):
   and replies travel on the middleware's own request and reply topics,
   which only the middleware's client and server see; rclpy hears a call
   through the service's introspection events (``<service>/_service_event``)
-  and nowhere else.  Each request or reply tap is deaf here (``deaf``), and
-  the run warns once per service (docs/ros2.md).
+  and a goal through its action's own services' events, and nowhere else.
+  Each request or reply tap is deaf here (``deaf``), and the run warns once
+  per link (docs/ros2.md);
+* the nodes that serve and call each service or action
+  (:meth:`RclpyBus.service_nodes`) come from the graph API: they tell whose
+  events pair a call (the server's, else every client's).
 
 Errors: :class:`RclpyUnavailable` (no ROS 2 Python, the agent could not
 start): one message.
@@ -74,10 +78,12 @@ class _Discovery:
 
     def __init__(self) -> None:
         self.topics: dict[str, list[dict[str, Any]]] = {}
+        self.services: dict[str, dict[str, list[str]]] = {}
         self._node: dict[bytes, str] = {}
 
     def update(self, graph: dict[str, Any]) -> None:
         self.topics = graph.get("topics", {})
+        self.services = graph.get("services", {})
         self._node = {bytes.fromhex(p["gid"]): (p["ns"].rstrip("/") + "/" + p["node"])
                       for ps in self.topics.values() for p in ps}
 
@@ -125,6 +131,9 @@ class RclpyBus:
     16 bytes, ``info.sequence``); ``type_hash(struct)`` the ROS 2 type hash of
     a contract struct."""
 
+    #: calls are heard through introspection events only (module docstring; :mod:`~rclverify.runtime.dds.services`)
+    events_only = True
+
     def __init__(self, python: Path, on_sample: Callable[[Tap, bytes, Any, int], None],
                  warn: Callable[[str], None], on_reader: Callable[[Tap, list[Any]], None] | None = None,
                  type_hash: Callable[[type], str | None] | None = None) -> None:
@@ -167,6 +176,16 @@ class RclpyBus:
         name = ros_name(dds_topic)
         if name is not None:
             self._send({"op": "watch", "topic": name})
+
+    def watch_service(self, name: str, action: bool) -> None:
+        """Follow which nodes serve and call service (or action) ``name`` (``/s``): :meth:`service_nodes`."""
+        self._send({"op": "service", "name": name, "action": action})
+
+    def service_nodes(self, name: str) -> tuple[set[str], set[str]]:
+        """``(servers, clients)`` of service or action ``name``: their nodes (``/ns/name``), as the graph
+        API last reported them (empty sets before the first report)."""
+        ends = self.discovery.services.get(name, {})
+        return set(ends.get("servers", [])), set(ends.get("clients", []))
 
     def writer(self, dds_topic: str, struct: type, qos: QosProfile, user_data: bytes = b"") -> _Writer:
         """A publisher of the monitor on ``dds_topic``."""
