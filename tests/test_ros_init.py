@@ -70,22 +70,24 @@ def test_init_from_a_robot_driver_matches_its_endpoints_and_grounds_clean(tmp_pa
     assert main(["init", str(ws), "--from-ros", str(DRIVER),
                  "--launch", str(DRIVER / "src/rover_driver/launch/driver.launch")]) == 0
     driver = (ws / "contracts/rover_driver.rcl").read_text().split("node RoverDriver {\n", 1)[1].split("  //")[0]
+    # names as the code writes them, each / written _ (the base handle's base/cmd_vel, imu/raw)
     assert driver == (
-        "  inputs( cmdVel : Twist, wheelTicks : WheelTicks, resetOdometryReq : {}, enableMotorsReq : BOOL )\n"
-        "  outputs( wheelTicks_ : WheelTicks, battery : BatteryState, raw : Imu, odom : Odometry, "
+        "  inputs( baseCmdVel : Twist, baseWheelTicks : WheelTicks, resetOdometryReq : {}, enableMotorsReq : BOOL )\n"
+        "  outputs( baseWheelTicks_ : WheelTicks, battery : BatteryState, imuRaw : Imu, odom : Odometry, "
         "resetOdometryRes : TriggerResponse, enableMotorsRes : SetBoolResponse )\n"
-        "  topics( geometry_msgs/Twist cmd_vel matches(in.cmdVel),\n"
-        "          rover_driver/WheelTicks wheel_ticks matches(in.wheelTicks),\n"
-        "          rover_driver/WheelTicks wheel_ticks matches(out.wheelTicks_),\n"
+        "  topics( geometry_msgs/Twist base_cmd_vel matches(in.baseCmdVel),\n"
+        "          rover_driver/WheelTicks base_wheel_ticks matches(in.baseWheelTicks),\n"
+        "          rover_driver/WheelTicks base_wheel_ticks matches(out.baseWheelTicks_),\n"
         "          sensor_msgs/BatteryState battery matches(out.battery),\n"
-        "          sensor_msgs/Imu raw matches(out.raw),\n"
+        "          sensor_msgs/Imu imu_raw matches(out.imuRaw),\n"
         "          nav_msgs/Odometry odom matches(out.odom) )\n"
         "  services( std_srvs/Trigger reset_odometry serves(in.resetOdometryReq, out.resetOdometryRes),\n"
         "            std_srvs/SetBool enable_motors serves(in.enableMotorsReq, out.enableMotorsRes) )\n")
     # the tf broadcaster's /tf is the tf library's: listed apart with its reason (issue 65), not an output
     assert "//   publishes /tf (tf2_msgs/TFMessage) (" in (ws / "contracts/rover_driver.rcl").read_text()
     guard = (ws / "contracts/battery_guard.rcl").read_text()
-    assert "services( std_srvs/SetBool enable_motors calls(out.enableMotorsReq, in.enableMotorsRes) )" in guard
+    assert ("services( std_srvs/SetBool rover_driver_enable_motors calls(out.roverDriverEnableMotorsReq, "
+            "in.roverDriverEnableMotorsRes) )") in guard  # written 'rover_driver/enable_motors'
     assert "    - /rover/base/cmd_vel\n" in (ws / "contracts/plan.yaml").read_text()
     # the first `doit verify`, as a new user runs it (its own process: doit's reporter owns the streams)
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1] / "src")}

@@ -2,7 +2,9 @@
 
 Exit codes: 0 the graph (or the findings) was written; 1 an input file could
 not be read (``ROS-PARSE`` error, the graph is still written from the rest),
-or for ``check`` any grounding error; 2 usage errors.
+or for ``check`` any grounding error, and with ``--strict`` (``check``, ``init
+--from-ros``) a declared program that is no node of the graph or an absent
+interface package (:func:`strict_failures`); 2 usage errors.
 """
 from __future__ import annotations
 
@@ -15,6 +17,9 @@ from typing import Any
 #: Seconds each call to a master may take by default (ros/live/master_rpc.py MASTER_TIMEOUT_S; not imported
 #: here, so that building the command line does not load the XML-RPC client)
 MASTER_TIMEOUT_S = 10.0
+#: the code of the scan's note on an absent interface package (ros/graph/absent.py CODE; not imported here,
+#: so that building the command line does not load the scan)
+ABSENT = "ROS-INTERFACE-ABSENT"
 
 
 def add_parsers(sub: Any) -> None:
@@ -57,7 +62,8 @@ def add_parsers(sub: Any) -> None:
     c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
     c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
     c.add_argument("--strict", action="store_true", help="also exit 1 when a program the packages declare is no node "
-                   "of the graph (each is listed either way); any grounding error always exits 1")
+                   "of the graph or an interface package is neither scanned nor installed (each is listed either "
+                   "way); any grounding error always exits 1")
     c.add_argument("--json", metavar="FILE", help="write the findings as JSON")
     c.set_defaults(fn=cmd_check)
 
@@ -248,9 +254,9 @@ def init_from_ros(args: argparse.Namespace) -> int:
     missing = unaccounted_lines(res.graph.programs)
     for line in missing:
         print(line, file=sys.stderr)
-    if missing and getattr(args, "strict", False):
-        print(f"{args.from_ros[0]}: error: {len(missing) - 1} declared program(s) are no node of the graph "
-              f"(--strict); nothing written", file=sys.stderr)
+    refused = strict_failures(missing, [n.to_json() for n in res.graph.notes]) if getattr(args, "strict", False) else []
+    if refused:
+        print(f"{args.from_ros[0]}: error: {' and '.join(refused)} (--strict); nothing written", file=sys.stderr)
         return 1
     if not res.graph.nodes:
         print(f"{args.from_ros[0]}: error: no ROS node found (no launch file node, no source naming its node)",
@@ -297,25 +303,43 @@ def unaccounted_lines(programs: list[dict[str, Any]]) -> list[str]:
     return out
 
 
+def strict_failures(unaccounted: list[str], notes: list[Any]) -> list[str]:
+    """What ``--strict`` fails on, one phrase each: declared programs that are no
+    node of the graph (``unaccounted``: :func:`unaccounted_lines`, its last line the
+    count) and absent interface packages (``notes``: the scan's notes as JSON, each
+    a ``ROS-INTERFACE-ABSENT`` one per package); ``[]`` when neither."""
+    out = []
+    if unaccounted:
+        out.append(f"{len(unaccounted) - 1} declared program(s) are no node of the graph")
+    absent = sum(1 for n in notes if isinstance(n, dict) and n.get("code") == ABSENT)
+    if absent:
+        out.append(f"{absent} interface package(s) are in neither the scanned tree nor an installed ROS")
+    return out
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """``rclverify ros check``: the grounding (exit 1 on any grounding error), then the
     declared programs that are no node of the graph, listed; with ``--strict`` any
-    such program is exit 1 too."""
+    such program, or an absent interface package (a located ``ROS-SCAN`` warning of
+    the grounding), is exit 1 too."""
     from rclverify.app.ros_stage import GRAPH, run_check  # deferred: start-up (loads rclverify.app, rclverify.app.ros_stage and more only when called)
     import time  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     start = time.time()
     rc = run_check(Path(args.workspace), args.plan, args.strict, args.json)
     path = Path(args.workspace) / GRAPH
     try:
-        if path.stat().st_mtime < start - 1:
-            return rc  # no graph written by this run: the plan could not be read (already said)
+        # exit 0 comes only after the grounding ran; a graph the run found unchanged keeps its time
+        if rc != 0 and path.stat().st_mtime < start - 1:
+            return rc  # no graph written by this run: the plan has no ros: section (already said)
         graph = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return rc
-    missing = unaccounted_lines(graph.get("programs", []) if isinstance(graph, dict) else [])
+    if not isinstance(graph, dict):
+        return rc
+    missing = unaccounted_lines(graph.get("programs", []))
     for line in missing:
         print(line)
-    if missing and args.strict:
-        print(f"ros check --strict: {len(missing) - 1} declared program(s) are no node of the graph", file=sys.stderr)
-        return 1
-    return rc
+    refused = strict_failures(missing, graph.get("unresolved", [])) if args.strict else []
+    for why in refused:
+        print(f"ros check --strict: {why}", file=sys.stderr)
+    return 1 if refused else rc

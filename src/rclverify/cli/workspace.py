@@ -106,8 +106,9 @@ def add_init(add: AddCommand) -> None:
                    help="with --from-ros: also make the libraries' endpoints (tf, bond, diagnostics, interactive "
                         "markers) contract inputs and outputs; by default they are listed apart")
     i.add_argument("--strict", action="store_true",
-                   help="with --from-ros: exit 1 when a program the packages declare is no node of the graph "
-                        "(each listed; docs/ros.md, \"Every program accounted for\")")
+                   help="with --from-ros: exit 1, writing nothing, when a program the packages declare is no node "
+                        "of the graph or an interface package is neither scanned nor installed (each listed; "
+                        "docs/ros.md, \"Every program accounted for\", \"Absent interface packages\")")
 
 
 def add_review(add: AddCommand) -> None:

@@ -6,7 +6,10 @@
   package resolves in its own package (ROS 1 and 2 ``.msg`` rule);
 * standard packages (std_msgs, geometry_msgs, sensor_msgs, nav_msgs ...):
   from Debian's ``ros-*-msgs`` packages (``/usr/share/<pkg>/msg``) where
-  installed, otherwise from rosbags' own store (ROS 2 Humble's definitions).
+  installed, otherwise from rosbags' own store (ROS 2 Humble's definitions);
+* types of an *absent* interface package (:meth:`TypeTable.mark_absent`: in
+  neither the scanned tree nor an installed ROS, ``ros/graph/absent.py``):
+  known by name only, with origin :data:`ABSENT` and no field read.
 
 Types are named ``pkg/msg/Type`` (rosbags' form).  A field is
 ``(name, (nodetype, detail))`` as rosbags gives it: nodetype 1 base
@@ -37,6 +40,8 @@ def ament_prefixes() -> list[Path]:
 BASE_TYPES = {"bool", "byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
               "uint64", "float32", "float64", "string", "wstring", "time", "duration", "octet"}
 _COMMENT = re.compile(r"#.*$")
+#: the origin of a type known by name only: its package is absent (docs/ros.md, "Absent interface packages")
+ABSENT = "absent"
 
 
 @dataclass
@@ -148,6 +153,9 @@ class TypeTable:
         self.types: dict[str, TypeInfo] = {}
         self.notes: list[Note] = []
         self._store: Any = None
+        #: package -> the kinds (``msg``, ``srv``, ``action``) of it no definition is available of
+        self.absent: dict[str, set[str]] = {}
+        self._opaque: dict[str, TypeInfo] = {}
 
     def add_file(self, path: Path, pkg: str, shown: str, origin: str, cache: ParseCache | None,
                  files: dict[str, str] | None = None) -> None:
@@ -281,10 +289,32 @@ class TypeTable:
 
     def get(self, name: str | None) -> TypeInfo | None:
         """The type ``name`` (canonical ``pkg/msg/Type``), from the workspace,
-        Debian, then rosbags' store; ``None`` when unknown."""
+        Debian, then rosbags' store; for a type of an absent package
+        (:meth:`mark_absent`) a :class:`TypeInfo` of origin :data:`ABSENT`
+        without fields (known by name, its fields unknown); ``None`` when unknown."""
         if not name:
             return None
-        return self.types.get(name) or self._fallback(name)
+        return self.types.get(name) or self._fallback(name) or self._absent_type(name)
+
+    def defines(self, pkg: str, kind: str) -> bool:
+        """Whether any definition of package ``pkg``'s ``kind`` (``msg``, ``srv``,
+        ``action``) is available: a package read from the workspace, Debian or an
+        ament index has all its kinds; rosbags' store has messages only.  Raises
+        ``MissingExtra`` without rosbags (the ``ros`` extra), as :meth:`get` does."""
+        if any(k.startswith(pkg + "/") and v.origin != "rosbags" for k, v in self.types.items()):
+            return True
+        return kind == "msg" and any(k.startswith(f"{pkg}/msg/") for k in self._store_names())
+
+    def mark_absent(self, pkg: str, kind: str) -> None:
+        """Record that no definition of ``pkg``'s ``kind`` is available: its types are
+        then known by name only (:meth:`get`)."""
+        self.absent.setdefault(pkg, set()).add(kind)
+
+    def _absent_type(self, name: str) -> TypeInfo | None:
+        parts = name.split("/")
+        if len(parts) != 3 or parts[1] not in self.absent.get(parts[0], ()):
+            return None
+        return self._opaque.setdefault(name, TypeInfo([], [], ABSENT))
 
     def closure(self, names: Iterable[str]) -> dict[str, TypeInfo]:
         """The types ``names`` and every type their fields use, transitively (known ones only)."""
@@ -295,7 +325,7 @@ class TypeTable:
             if n in out:
                 continue
             info = self.get(n)
-            if info is None:
+            if info is None or info.origin == ABSENT:
                 continue
             out[n] = info
             for _f, desc in info.fields:
@@ -334,6 +364,9 @@ def field_path(table: TypeTable, msg_type: str, path: str) -> tuple[str | None, 
         info = table.get(cur)
         if info is None:
             return None, f"{cur} is not a message type with fields", False
+        if info.origin == ABSENT:
+            return None, (f"the fields of {cur} are unknown: its interface package {cur.split('/')[0]} is in "
+                          f"neither the scanned tree nor an installed ROS"), False
         desc = dict(info.fields).get(fname)
         if desc is None:
             have = ", ".join(n for n, _ in info.fields) or "no fields"

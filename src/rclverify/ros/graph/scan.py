@@ -23,6 +23,7 @@ from typing import Any, Sequence
 
 from rclverify.ros.extract import names
 from rclverify.ros.extract import namespaces
+from rclverify.ros.graph.absent import absent_interfaces
 from rclverify.ros.graph.assemble import Assembly
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.executables import Targets, targets
@@ -155,6 +156,7 @@ class _Scan:
         self.tgts: dict[str, Targets] = {}
         self.launch_params: dict[str, tuple[str, Src]] = {}
         self.by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
+        self.standard = True  # whether the standard (installed) interface packages are read (read_types)
 
     def read_packages(self, paths: Sequence[Path]) -> None:
         """The packages under ``paths`` (one per name; a second is a note)."""
@@ -193,8 +195,9 @@ class _Scan:
 
     def read_types(self, standard: bool) -> None:
         """The message, service and action types of the packages and, with
-        ``standard``, of the standard packages; a field of an unknown type is a note."""
+        ``standard``, of the standard packages."""
         g, table, pkgs, cache = self.g, self.table, self.pkgs, self.cache
+        self.standard = standard
         for name in sorted(pkgs):
             table.add_package_dir(pkgs[name].root, name, self.show, "workspace", cache, g.files)
         # Debian's ros-*-msgs packages are ROS 1 (Noetic) definitions: used unless
@@ -205,12 +208,7 @@ class _Scan:
         elif standard:  # rosbags' ROS 2 store has messages only: services of message-less packages (std_srvs)
             table.add_debian_standard(cache, services_only=True)
             table.add_ament_index(cache, ament_prefixes())  # a sourced ROS 2's services and actions (rcl_interfaces)
-        for tname, fname, missing in table.unknown_refs():
-            info = table.types[tname]
-            g.notes.append(Note(Src(info.file or tname, info.lines.get(fname, 1)),
-                                f"field '{fname}' of {tname} has type {missing}, which no scanned package "
-                                f"or standard package defines", "ROS-TYPE"))
-        g.notes.extend(table.notes)
+        g.notes.extend(table.notes)  # a field of an unknown type: noted in finish (absent.py)
 
     def read_sources(self) -> None:
         """Each package's build targets and the record of each of its source
@@ -360,14 +358,17 @@ class _Scan:
             lst.append(edge)
 
     def finish(self, bags: Sequence[Path]) -> None:
-        """The notes once each, the recorded runs' topics, the types the
-        graph uses, and the parse cache saved."""
+        """The notes once each, the absent interface packages (:mod:`absent`),
+        the recorded runs' topics, the types the graph uses, and the parse cache saved."""
         g, res = self.g, self.res
         for shown, r in sorted(res.sources.items()):
             g.notes.extend(r["notes"])
         g.notes = list(dict.fromkeys(g.notes))  # a note given by several programs (a shared header) once
         made = {e.src for n in g.nodes.values() for r in ("pub", "sub") + SERVICE_ROLES for e in n.edges_of(r)}
         g.notes = [n for n in g.notes if not (n.message.endswith(UNBUILT) and n.src in made)]  # another program makes it
+        # types nothing defines: one note per absent package, its types known by name from here on
+        # (without the standard packages read, nothing can be said absent: only the fields are noted)
+        g.notes.extend(absent_interfaces(g, self.table, set(self.pkgs), self.standard))
         for b in bags:
             from rclverify.ros.graph.bag import bag_topics  # deferred: optional or conditional (inside a block)
             recorded, notes = bag_topics(Path(b), self.show(Path(b)))

@@ -45,7 +45,7 @@ from rclverify.ros.extract import names
 from rclverify.ros.graph.scan import ScanResult
 from rclverify.ros.ground.ground_services import RULES as SERVICE_RULES
 from rclverify.ros.ground.ground_services import folded, ground_links
-from rclverify.ros.extract.interfaces import BASE_TYPES, TypeTable, field_path
+from rclverify.ros.extract.interfaces import ABSENT, BASE_TYPES, TypeTable, field_path
 from rclverify.ros.extract.model import GraphEdge, GraphNode, Src, canon_type, library_of, short_type
 from rclverify.ros.ground.lifecycle import implicit
 
@@ -309,6 +309,8 @@ class Grounder:
     def _fields(self, cn: Any, tp: ast.Topic, var: ast.Var, ctype: str, rcl_loc: ast.Loc) -> None:
         info = self.table.get(ctype)
         assert info is not None
+        if info.origin == ABSENT:  # its package's one ROS-INTERFACE-ABSENT warning says what it leaves unchecked
+            return
         msg_src = Src(info.file or short_type(ctype), 1)
         typ = cn.io_type(var)
         if typ is None:

@@ -17,6 +17,13 @@ rules, lines 535-548), for a topic's message:
   fixed-size arrays' elements (``kp[0]`` ...), so a present type is not ``{}``;
 * no base field: the empty type ``{}``.
 
+Which fields are read is :mod:`.fields`'s; every field left out is listed,
+with its type and why, in a comment of the node's skeleton, and ``init
+--from-ros`` prints one line per node that has any.  A topic, service or
+action is named by its whole name as the code writes it, each ``/`` written
+``_`` (:func:`_identifier`).  A type of an absent interface package
+(``ros/graph/absent.py``) keeps its name and is ``{}``, said in the comment.
+
 The fields chosen are written to the plan's ``ros.fields`` so the grounding
 check and the reader agree: keyed by the topic's field name when every
 contract using that name reads one message type, else by
@@ -30,77 +37,27 @@ import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import jinja2
 
 from rclverify.records.store import atomic_write_text
 from rclverify.ros.graph.scan import ScanResult
-from rclverify.ros.extract.interfaces import TypeTable, elem_type
+from rclverify.ros.extract.interfaces import ABSENT, TypeTable
 from rclverify.ros.extract.model import LIBRARY_TOPICS, GraphEdge, GraphNode, library_of, short_type
+from rclverify.tools.scaffold.fields import SIGNED, UNSIGNED, read_fields, rcl_scalar
 from rclverify.tools.scaffold.safecopy import copy_package
 from rclverify.tools.scaffold import EMPTY_DIRS, _env as scaffold_env
+
+__all__ = ["TYPES_FILE", "build_skeletons", "ident", "rcl_scalar", "write_from_ros"]
 
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.tools.scaffold", "templates"), autoescape=False,
                           undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
                           keep_trailing_newline=True)
-_UNSIGNED = {"uint8", "uint16", "uint32", "uint64", "byte", "char", "octet"}
-_SIGNED = {"int8", "int16", "int32", "int64"}
 _RCL_WORDS = {"node", "context", "inputs", "outputs", "topics", "assume", "guarantee", "forall", "exists",
               "exists_unique", "and", "or", "not", "in", "out", "TRUE", "FALSE", "REAL", "INTEGER", "NATURAL",
               "BOOL", "STRING", "matches", "set", "seq"}
-# rosidl's placeholder of an empty message (``std_msgs/Empty``: ``uint8
-# structure_needs_at_least_one_member``, ROS 2 IDL mapping) is no field of it
-_SKIP_FIELDS = {"header", "stamp", "structure_needs_at_least_one_member"}
 #: the context declarations shared by every skeleton (one RCL type per message type)
 TYPES_FILE = "contracts/ros_types.rcl"
-
-
-def rcl_scalar(ros_type: str) -> str | None:
-    """The RCL scalar for a ROS base type, ``None`` for others."""
-    t = ros_type.split("<=")[0]
-    if t in ("float32", "float64"):
-        return "REAL"
-    if t in _SIGNED:
-        return "INTEGER"
-    if t in _UNSIGNED:
-        return "NATURAL"
-    if t == "bool":
-        return "BOOL"
-    if t in ("string", "wstring"):
-        return "STRING"
-    return None
-
-
-MAX_DEPTH = 5  # nested messages flattened (a service request wrapping a PoseWithCovarianceStamped: 5)
-MAX_FIXED = 16  # elements of a fixed-size array read one by one when nothing else is
-
-
-def _base_fields(table: TypeTable, msg: str, prefix: str = "", depth: int = 0,
-                 whole: bool = False) -> list[tuple[str, str]]:
-    """The base fields of ``msg`` as ``(path, ROS type)``: nested messages flattened,
-    arrays, ``header``/``stamp`` and times left out; with ``whole`` (a message
-    nothing else would type, so that a present type is never ``{}``) times
-    (``sec``, ``nanosec``) and fixed-size arrays of base types (``x[0]`` ...) too."""
-    info = table.get(msg)
-    if info is None or depth > MAX_DEPTH:
-        return []
-    out: list[tuple[str, str]] = []
-    for name, desc in info.fields:
-        t, arr = elem_type(desc)
-        if name in _SKIP_FIELDS:
-            continue
-        if arr:
-            size = desc[1][1] if whole and isinstance(desc, tuple) and len(desc) > 1 and isinstance(
-                desc[1], tuple) and len(desc[1]) > 1 and isinstance(desc[1][1], int) else 0
-            if rcl_scalar(t) and 0 < size <= MAX_FIXED:  # float64[3]: one field per element
-                out.extend((f"{prefix}{name}[{i}]", t) for i in range(size))
-            continue
-        if rcl_scalar(t):
-            out.append((prefix + name, t))
-        elif "/" in t and (whole or not t.startswith("builtin_interfaces/")):
-            out.extend(_base_fields(table, t, f"{prefix}{name}.", depth + 1, whole))
-    return out
 
 
 def ident(text: str, camel: bool = False) -> str:
@@ -143,6 +100,17 @@ class _Node:
     services: list[str] = field(default_factory=list)
     actions: list[str] = field(default_factory=list)
     apart: list[str] = field(default_factory=list)  # endpoints left out, each with its reason
+    # message (pkg/Type) -> (the variables reading it, its fields left out: (path, ROS type, why))
+    left: dict[str, tuple[list[str], list[tuple[str, str, str]]]] = field(default_factory=dict)
+    named: dict[str, str] = field(default_factory=dict)  # RCL name of a topic, service or action -> its ROS name
+
+    def left_groups(self) -> list[tuple[str, list[str], list[tuple[str, str, str]]]]:
+        """``(message, variables, fields left out)`` for the skeleton's comment, in order of use."""
+        return [(msg, refs, fields) for msg, (refs, fields) in self.left.items()]
+
+    def left_count(self) -> int:
+        """How many message fields (counted once per message) the node's RCL types leave out."""
+        return sum(len(fields) for _refs, fields in self.left.values())
 
 
 _ROLE_WORDS = {"pub": "publishes", "sub": "subscribes to", "service_servers": "serves",
@@ -172,10 +140,15 @@ def _kept(n: _Node, role: str, edges: list[GraphEdge], table: TypeTable, library
         elif not e.msg_type:
             _left_out(n, role, e, "its type is not read statically (the scan's note at that line says why)")
         else:
-            if table.get(e.msg_type if role in ("pub", "sub") else f"{e.msg_type}_Request" if role.startswith(
-                    "service") else f"{e.msg_type}_Goal") is None:
+            info = table.get(e.msg_type if role in ("pub", "sub") else f"{e.msg_type}_Request" if role.startswith(
+                "service") else f"{e.msg_type}_Goal")
+            if info is None:
                 _left_out(n, role, e, f"kept, but {short_type(e.msg_type)} is defined by no scanned or standard "
                                       f"package: its values are {{}}")
+            elif info.origin == ABSENT:
+                _left_out(n, role, e, f"kept with its type name, untyped: its interface package "
+                                      f"{e.msg_type.split('/')[0]} is in neither the scanned tree nor an installed "
+                                      f"ROS (the scan's ROS-INTERFACE-ABSENT warning): its values are {{}}")
             out.append(e)
     return out
 
@@ -204,20 +177,23 @@ def _value(tname: str, const: str, taken: dict[str, str]) -> str:
     return v
 
 
-def _var_type(table: TypeTable, msg: str | None, var: str,
-              taken: dict[str, str] | None = None) -> tuple[str, list[str], dict[str, str] | None]:
-    """(RCL type text, field paths, context declaration or None); types are named
-    after their message (:func:`_type_name`), so one message has one RCL type."""
-    taken = {} if taken is None else taken
-    if msg is None or table.get(msg) is None:
-        return "{}", [], None
-    fields = _base_fields(table, msg) or _base_fields(table, msg, whole=True)
+def _var_type(n: _Node, table: TypeTable, msg: str | None, ref: str,
+              taken: dict[str, str]) -> tuple[str, list[str], dict[str, str] | None]:
+    """(RCL type text, field paths, context declaration or None) of variable ``ref``
+    (``out.odom``) reading message ``msg``; types are named after their message
+    (:func:`_type_name`), so one message has one RCL type.  The fields the type
+    leaves out are recorded in ``n.left`` (:func:`fields.read_fields`)."""
     info = table.get(msg)
-    assert info is not None
+    if msg is None or info is None:
+        return "{}", [], None
+    reading = read_fields(table, msg)
+    fields = reading.kept
+    if reading.left:
+        n.left.setdefault(short_type(msg), ([], reading.left))[0].append(ref)
     if len(fields) == 1:
         path, t = fields[0]
-        consts = [n for n, ct, _ in info.consts if ct == t] if "." not in path else []
-        if consts and t in _UNSIGNED | _SIGNED:
+        consts = [c for c, ct, _ in info.consts if ct == t] if "." not in path else []
+        if consts and t in UNSIGNED | SIGNED:
             tname = _type_name(msg, taken) + ident(path, camel=True)
             return tname, [path], {"name": tname, "type": "{" + ", ".join(_value(tname, c, taken) for c in consts) + "}"}
         return rcl_scalar(t) or "{}", [path], None
@@ -228,17 +204,24 @@ def _var_type(table: TypeTable, msg: str | None, var: str,
     return tname, [p for p, _ in fields], {"name": tname, "type": sig}
 
 
-def _identifier(written: str, others: list[str]) -> str:
-    """The RCL name a contract gives an endpoint written ``written`` (``~status``,
-    ``base/cmd_vel``): its last segment when no other endpoint of the node (written
-    ``others``) ends in it, else the whole name with ``_`` for ``/`` and ``~``
-    (``base_cmd_vel``), the form the grounding matches (docs/ros.md)."""
-    def last(w: str) -> str:
-        return w.rstrip("/").rsplit("/", 1)[-1].lstrip("~")
-    base = last(written)
-    if sum(1 for o in others if last(o) == base and o.strip("/~") != written.strip("/~")) > 0:
-        base = written.strip("/~").replace("/", "_").replace("~", "")
-    return base if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", base) and base not in _RCL_WORDS else ident(base)
+def _identifier(n: _Node, e: GraphEdge, group: str) -> str:
+    """The RCL name a contract gives endpoint ``e`` of node ``n``: the whole name as
+    the code writes it, each ``/`` written ``_`` (an RCL name holds no ``/``), a
+    leading ``/`` or ``~`` dropped (``/robot/arm/cmd`` -> ``robot_arm_cmd``,
+    ``~/status`` -> ``status``): the form the grounding matches (docs/ros.md,
+    "Names in skeletons").  Two ROS names of the node that read alike
+    (``a/b_c``, ``a_b/c``) as the same ``group`` (``topic``, ``service``, ``action``)
+    are said in ``n.apart``: the grounding cannot tell them apart."""
+    written = e.written or e.topic
+    base = written.strip("/~").replace("/", "_").replace("~", "")
+    name = base if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", base) and base not in _RCL_WORDS else ident(base)
+    first = n.named.setdefault(f"{group} {name}", e.topic)
+    if first != e.topic:
+        line = (f"{e.topic} and {first} both read `{name}` (an RCL name holds no /: each / is written _): "
+                f"the grounding cannot tell them apart and reports one undocumented; rename one in the code")
+        if line not in n.apart:
+            n.apart.append(line)
+    return name
 
 
 def _links(n: "_Node", gn: GraphNode, table: TypeTable, taken: dict[str, str], context: dict[str, dict[str, str]],
@@ -251,25 +234,24 @@ def _links(n: "_Node", gn: GraphNode, table: TypeTable, taken: dict[str, str], c
                         ("action", (("Goal", "Goal"), ("Feedback", "Feedback"), ("Result", "Result")))):
         for role in ("servers", "clients"):
             edges = _kept(n, f"{kind}_{role}", gn.edges_of(f"{kind}_{role}"), table, library)
-            written = [e.written or e.topic for e in edges]
             done: set[str] = set()
             for e in sorted(edges, key=lambda e: e.topic):
                 if e.topic in done or not e.msg_type:
                     continue
                 done.add(e.topic)
-                name = _identifier(e.written or e.topic, written)
+                name = _identifier(n, e, kind)
                 refs = []
                 for k, (part, suffix) in enumerate(parts):
                     var = ident(name) + suffix
                     while var in seen:
                         var += "_"
                     seen.add(var)
-                    typ, _paths, ctx = _var_type(table, f"{e.msg_type}_{part}", var, taken)
+                    incoming = (k == 0) == (role == "servers")
+                    refs.append(f"{'in' if incoming else 'out'}.{var}")
+                    typ, _paths, ctx = _var_type(n, table, f"{e.msg_type}_{part}", refs[-1], taken)
                     if ctx is not None:
                         context.setdefault(ctx["name"], ctx)
-                    incoming = (k == 0) == (role == "servers")
                     (n.inputs if incoming else n.outputs).append(f"{var} : {typ}")
-                    refs.append(f"{'in' if incoming else 'out'}.{var}")
                 verb = "serves" if role == "servers" else "calls"
                 getattr(n, f"{kind}s").append(f"{short_type(e.msg_type)} {name} {verb}({', '.join(refs)})")
 
@@ -299,19 +281,18 @@ def build_skeletons(res: ScanResult, library: bool = False
         # the client library's own topics (/parameter_events, /rosout) are no contract's
         pubs, subs = (_kept(n, role, es, table, library) for role, es in (("pub", gn.publishes),
                                                                             ("sub", gn.subscribes)))
-        written = [e.written or e.topic for e in pubs + subs]
         for kind, edges in (("in", subs), ("out", pubs)):
             done: set[str] = set()
             for e in sorted(edges, key=lambda e: e.topic):
                 if e.topic in done:
                     continue
                 done.add(e.topic)
-                topic_name = _identifier(e.written or e.topic, written)
+                topic_name = _identifier(n, e, "topic")
                 var = ident(topic_name)
                 while var in seen:
                     var += "_"
                 seen.add(var)
-                typ, paths, ctx = _var_type(table, e.msg_type, var, taken)
+                typ, paths, ctx = _var_type(n, table, e.msg_type, f"{kind}.{var}", taken)
                 if ctx is not None:
                     context.setdefault(ctx["name"], ctx)
                 (n.inputs if kind == "in" else n.outputs).append(f"{var} : {typ}")
@@ -348,6 +329,9 @@ def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: lis
     for n in nodes:
         for line in n.apart:
             print(f"{n.file}: {line}", file=sys.stderr)
+        if n.left:
+            print(f"{n.file}: its RCL types leave out {n.left_count()} message field(s), each listed in its "
+                  f"comment with why", file=sys.stderr)
     written: list[Path] = []
     name = root.resolve().name or "workspace"
     ros_dir = root / "ros"
