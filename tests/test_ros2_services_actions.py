@@ -272,9 +272,10 @@ def via(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     writer in 2 of 3 runs measured (docs/ros2.md, "Not covered"), so the two sources do not share a domain."""
     tmp = tmp_path_factory.mktemp("calls-rclpy")
     ws = _workspace(tmp)
-    codes = _watched(tmp, {"via": (_args(ws, tmp, "via", "--source", "rclpy", "--ros2-python", str(ros2_python())),
-                                   ros2_env(tmp))})
+    codes = _watched(tmp, {"via": (_args(ws, tmp, "via", "--source", "rclpy", "--ros2-python", str(ros2_python()),
+                                         "--record", str(tmp / "via_bag")), ros2_env(tmp))})
     return {"code": codes["via"], "out": (tmp / "via.out").read_text(), "system": (tmp / "system.log").read_text(),
+            "ws": ws, "bag": tmp / "via_bag",
             "log": [json.loads(x) for x in (tmp / "via.jsonl").read_text().splitlines()],
             "record": json.loads((tmp / "via.json").read_text())}
 
@@ -465,3 +466,26 @@ def test_the_rclpy_source_says_which_calls_it_cannot_hear(run: dict[str, Any], v
     assert set(items) == {"/estop", "/brake"} and all("the rclpy source: no introspection event" in d
                                                       for d in items.values()), items
     assert via["code"] == run["code"] == 1, via["out"]
+
+
+def test_the_rclpy_sources_bag_judges_the_calls_as_its_live_run(via: dict[str, Any]) -> None:
+    """``--record`` through the rclpy source: ``rclverify monitor BAG`` gives the live run's call verdicts per
+    node, its items not judged (the unheard links among them) and its exit code."""
+    import contextlib
+    import io
+
+    from rclverify.cli.commands import main
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(["monitor", "-w", str(via["ws"]), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json",
+                     str(via["bag"])])
+    report = json.loads(out.getvalue())
+    record = via["record"]
+    assert not record["bag"].get("calls_failed"), record["bag"]
+    calls = {e["node"]: e for e in report if "calls" in e}
+    assert {n: e["calls"]["counts"] for n, e in calls.items()} == \
+        {n["node"]: n["counts"] for n in record["calls"]["nodes"]}, err.getvalue()
+    assert {n: e["status"] for n, e in calls.items()} == {n["node"]: n["status"] for n in record["calls"]["nodes"]}
+    items = {(i["kind"], i["name"]) for e in report for i in e.get("not_judged", [])}
+    assert {("service", "/estop"), ("service", "/brake")} <= items, items
+    assert code == via["code"] == 1, err.getvalue()
