@@ -88,7 +88,11 @@ def _term(e: ast.Expr, node: CheckedNode, symbol: Mapping[tuple[str, str], str],
         return _io(e, node, symbol, used)
     if isinstance(e, ast.Unary):
         inner = _term(e.operand, node, symbol, used)
-        return f"(not {inner})" if e.op == "not" else f"(- {inner})"
+        if e.op == "not":
+            return f"(not {inner})"
+        if e.op == "-":
+            return f"(- {inner})"
+        ast.unhandled(e.op)
     if isinstance(e, ast.Binary):
         op = _OPS.get(e.op)
         if op is None:

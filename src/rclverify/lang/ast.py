@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Literal, Union
+from typing import Literal, NoReturn, Union
 
 
 @dataclass(frozen=True, slots=True)
@@ -230,6 +230,16 @@ class Apply:
 
 
 UnaryOp = Literal["not", "-"]
+
+
+def unhandled(op: NoReturn) -> NoReturn:
+    """The end of an operator dispatch that handled every operator: the type
+    checker (mypy strict) rejects a call it can reach with an operator value
+    left, so an operator added to :data:`UnaryOp` (or another operator set)
+    is listed at every translation that must give it a meaning; at run time
+    (an unchecked caller) raises ``AssertionError`` naming it, never a silent
+    reading as another operator."""
+    raise AssertionError(f"operator {op!r} is not handled here")
 
 
 @dataclass(frozen=True)

@@ -155,7 +155,9 @@ class _Tex:
         if isinstance(e, ast.Unary):
             if e.op == "not":
                 return r"\lnot " + self.expr(e.operand, NOT_LEVEL, open_right)
-            return "-" + self.expr(e.operand, MINUS_LEVEL, open_right)
+            if e.op == "-":
+                return "-" + self.expr(e.operand, MINUS_LEVEL, open_right)
+            ast.unhandled(e.op)
         if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
             ops = chain_operands(e)
             lv = BINARY_LEVEL[e.op]

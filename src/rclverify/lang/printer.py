@@ -59,7 +59,11 @@ def level(e: ast.Expr) -> int:
     if isinstance(e, ast.Binary):
         return BINARY_LEVEL[e.op]
     if isinstance(e, ast.Unary):
-        return NOT_LEVEL if e.op == "not" else MINUS_LEVEL
+        if e.op == "not":
+            return NOT_LEVEL
+        if e.op == "-":
+            return MINUS_LEVEL
+        ast.unhandled(e.op)
     if isinstance(e, (ast.Compare, ast.Member)):
         return COMPARE_LEVEL
     return ATOM_LEVEL
@@ -249,8 +253,10 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
     if isinstance(e, ast.Unary):
         if e.op == "not":
             return "not " + p.wrap(e.operand, NOT_LEVEL)
-        inner = p.wrap(e.operand, MINUS_LEVEL)
-        return "-" + inner if not inner.startswith("-") else "- " + inner
+        if e.op == "-":
+            inner = p.wrap(e.operand, MINUS_LEVEL)
+            return "-" + inner if not inner.startswith("-") else "- " + inner
+        ast.unhandled(e.op)
     if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
         ops = chain_operands(e)
         if len(ops) > EXACT_CHAIN_MAX or is_balanced_chain(e, len(ops)):

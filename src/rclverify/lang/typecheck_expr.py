@@ -207,10 +207,12 @@ class ExprChecker:
         if e.op == "not":
             self.expect_bool(e.operand, t, "not")
             return BOOL
-        if not is_numeric(t):
-            self.err(e.operand.loc, f"unary '-' needs a number, found {t}")
-            raise CheckFailed
-        return REAL if t == REAL else INTEGER
+        if e.op == "-":
+            if not is_numeric(t):
+                self.err(e.operand.loc, f"unary '-' needs a number, found {t}")
+                raise CheckFailed
+            return REAL if t == REAL else INTEGER
+        ast.unhandled(e.op)
 
     def _binary(self, e: ast.Binary, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
         lt, rt = self.infer(e.left, node, bound), self.infer(e.right, node, bound)

@@ -188,7 +188,11 @@ class UnitChecker:
             return self.var(e, node, bound)
         if isinstance(e, ast.Unary):
             q = self.term(e.operand, node, bound)
-            return Q(q.kind, q.unit, e) if e.op == "-" else UNKNOWN
+            if e.op == "-":
+                return Q(q.kind, q.unit, e)
+            if e.op == "not":
+                return UNKNOWN
+            ast.unhandled(e.op)
         if isinstance(e, ast.Binary):
             a, b = self.term(e.left, node, bound), self.term(e.right, node, bound)
             if e.op in ("+", "-"):

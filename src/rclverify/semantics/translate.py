@@ -97,7 +97,11 @@ class _Ctx(Visitor[Any]):
 
     def visit_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:
         v = self.enc(x.operand, b)
-        return z3.Not(v) if x.op == "not" else -v
+        if x.op == "not":
+            return z3.Not(v)
+        if x.op == "-":
+            return -v
+        ast.unhandled(x.op)
 
     def visit_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
         if x.op in FLAT_CHAINS:

@@ -191,7 +191,9 @@ class Translator:
             s, t = self.tr(e.operand, scope)
             if e.op == "not":
                 return f"!{wrap(s)}", BOOL
-            return f"(-{wrap(s)})", (REAL if t == REAL else INTEGER)
+            if e.op == "-":
+                return f"(-{wrap(s)})", (REAL if t == REAL else INTEGER)
+            ast.unhandled(e.op)
         if isinstance(e, ast.Binary):
             return self.binary(e, scope)
         if isinstance(e, ast.Compare):

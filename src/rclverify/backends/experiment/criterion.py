@@ -76,7 +76,12 @@ def dimension(expr: ast.Expr, dims: Mapping[str, str]) -> str:
             return dims[e.name]
         if isinstance(e, ast.Unary):
             inner = d(e.operand)
-            want = "bool" if e.op == "not" else inner
+            if e.op == "not":
+                want = "bool"
+            elif e.op == "-":
+                want = inner
+            else:
+                ast.unhandled(e.op)
             if (e.op == "not") != (inner == "bool"):
                 raise CriterionError(e.loc, f"'{e.op}' applied to a {'number' if inner != 'bool' else 'formula'}")
             return want
@@ -145,7 +150,11 @@ def _to_z3(e: ast.Expr, env: Mapping[str, z3.ArithRef]) -> z3.ExprRef:
         return env[e.name]
     if isinstance(e, ast.Unary):
         x = _to_z3(e.operand, env)
-        return z3.Not(x) if e.op == "not" else -x
+        if e.op == "not":
+            return z3.Not(x)
+        if e.op == "-":
+            return -x
+        ast.unhandled(e.op)
     if isinstance(e, ast.Binary):
         l, r = _to_z3(e.left, env), _to_z3(e.right, env)
         ops = {"and": lambda: z3.And(l, r), "or": lambda: z3.Or(l, r), "->": lambda: z3.Implies(l, r),

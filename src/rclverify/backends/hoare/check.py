@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from typing import Iterable, Mapping
 
 from rclverify.lang import ast as rast
-from rclverify.lang.ast import Loc
+from rclverify.lang.ast import Loc, unhandled
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.types import (BOOL, INTEGER, NATURAL, REAL, DataT, EnumT, Env, FuncT, Scalar, Type, assignable,
                           comparable, is_numeric, numeric_join)
@@ -164,10 +164,12 @@ class _Checker:
             if e.op == "not":
                 self.expect_bool(e.operand, t, "not")
                 return BOOL
-            if not is_numeric(t):
-                self.err(e.operand.loc, f"unary '-' needs a number, found {t}")
-                raise _Fail
-            return REAL if t == REAL else INTEGER
+            if e.op == "-":
+                if not is_numeric(t):
+                    self.err(e.operand.loc, f"unary '-' needs a number, found {t}")
+                    raise _Fail
+                return REAL if t == REAL else INTEGER
+            unhandled(e.op)
         lt, rt = self.infer(e.left), self.infer(e.right)
         if e.op in lang.CONNECTIVES:
             self.expect_bool(e.left, lt, e.op)

@@ -39,7 +39,7 @@ from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
 
 from rclverify.lang import ast as rast
-from rclverify.lang.ast import Loc
+from rclverify.lang.ast import Loc, unhandled
 from rclverify.lang.parser import describe_terminal, lark_cache_file
 from rclverify.lang.errors import RclError, error
 
@@ -338,7 +338,11 @@ def _prec(e: Expr) -> int:
     if isinstance(e, Binary):
         return _PREC[e.op]
     if isinstance(e, Unary):
-        return _PREC["not"] if e.op == "not" else _PREC["neg"]
+        if e.op == "not":
+            return _PREC["not"]
+        if e.op == "-":
+            return _PREC["neg"]
+        unhandled(e.op)
     return _ATOM
 
 
@@ -358,7 +362,12 @@ def expr_text(e: Expr, context: int = 0) -> str:
     elif isinstance(e, Call):
         s = f"{e.func}(" + ", ".join(expr_text(a) for a in e.args) + ")"
     elif isinstance(e, Unary):
-        s = ("not " if e.op == "not" else "-") + expr_text(e.operand, p)
+        if e.op == "not":
+            s = "not " + expr_text(e.operand, p)
+        elif e.op == "-":
+            s = "-" + expr_text(e.operand, p)
+        else:
+            unhandled(e.op)
     elif e.op == "->":
         s = f"{expr_text(e.left, p + 1)} -> {expr_text(e.right, p)}"
     elif e.op in COMPARISONS:

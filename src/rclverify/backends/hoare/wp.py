@@ -37,7 +37,7 @@ import z3
 from z3.z3 import _to_expr_ref  # the typed wrapper of a raw term (ArithRef, BoolRef ...)
 
 from rclverify.semantics.encode import apply_operator, widen
-from rclverify.lang.ast import Loc
+from rclverify.lang.ast import Loc, unhandled
 from rclverify.lang.types import NATURAL, Type
 from rclverify.backends.hoare import lang
 from rclverify.backends.hoare.check import ProgramTypes, expr_type
@@ -94,7 +94,11 @@ class ProgramModel:
             return f(*[widen(self.term(a), f.domain(k)) for k, a in enumerate(e.args)])
         if isinstance(e, lang.Unary):
             v = self.term(e.operand)
-            return z3.Not(v) if e.op == "not" else -v
+            if e.op == "not":
+                return z3.Not(v)
+            if e.op == "-":
+                return -v
+            unhandled(e.op)
         return apply_operator(e.op, self.term(e.left), self.term(e.right))
 
     def formula(self, e: lang.Expr) -> z3.BoolRef:

@@ -102,9 +102,11 @@ class CppTranslator(Visitor[tuple[str, str]]):
         text = cast(str, UNARY[e.op].cpp)
         if e.op == "not":
             return text.format(x=self._bool(code, kind)), "bool"
-        if kind not in ("int", "double"):
-            raise Untranslatable(f"unary minus on {kind}")
-        return text.format(x=code), kind
+        if e.op == "-":
+            if kind not in ("int", "double"):
+                raise Untranslatable(f"unary minus on {kind}")
+            return text.format(x=code), kind
+        ast.unhandled(e.op)
 
     def visit_Binary(self, e: ast.Binary) -> tuple[str, str]:
         return self.binary(e)

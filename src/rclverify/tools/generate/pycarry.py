@@ -62,7 +62,7 @@ class _Tree:
         if isinstance(e, ast.Var):
             return self.var(e, scope)
         if isinstance(e, ast.Unary):
-            return ["not" if e.op == "not" else "neg", self.expr(e.operand, scope)]
+            return [self.unary(e.op), self.expr(e.operand, scope)]
         if isinstance(e, ast.Binary):
             return ["bin", e.op, self.expr(e.left, scope), self.expr(e.right, scope)]
         if isinstance(e, ast.Compare):
@@ -72,6 +72,15 @@ class _Tree:
         if isinstance(e, ast.Quant):
             return self.quant(e, scope)
         return self.unsupported(e, f"{type(e).__name__} ({_what(e)})")
+
+    @staticmethod
+    def unary(op: ast.UnaryOp) -> str:
+        """The carried evaluator's tag of unary operator ``op`` (``not``, ``neg``)."""
+        if op == "not":
+            return "not"
+        if op == "-":
+            return "neg"
+        ast.unhandled(op)
 
     def var(self, v: ast.Var, scope: frozenset[str]) -> list[Any]:
         """A name, resolved as the evaluator resolves it (bound, enumeration value, constant, I/O)."""
