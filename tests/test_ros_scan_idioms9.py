@@ -26,6 +26,7 @@ from pathlib import Path
 
 import pytest
 
+from rclverify.ros.extract.interfaces import ABSENT
 from rclverify.ros.graph.scan import scan
 
 PKG = ('<?xml version="1.0"?>\n<package format="3"><name>{name}</name><version>0.1.0</version>'
@@ -300,7 +301,8 @@ def test_interfaces_of_a_sourced_ros2_come_from_its_ament_index(tmp_path: Path,
         f.write_text(text)
     monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
     unknown = scan([ws], base=tmp_path)
-    assert unknown.table.get("rig_core/srv/Halt_Request") is None
+    absent = unknown.table.get("rig_core/srv/Halt_Request")  # known by name only: its package is absent
+    assert absent is not None and absent.origin == ABSENT and absent.fields == []
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(prefix))
     got = scan([ws], base=tmp_path)
     assert [n for n, _d in got.table.get("rig_core/srv/Halt_Response").fields] == ["done", "why"]
