@@ -92,6 +92,8 @@ def _term(e: ast.Expr, node: CheckedNode, symbol: Mapping[tuple[str, str], str],
             return f"(not {inner})"
         if e.op == "-":
             return f"(- {inner})"
+        if e.op == "abs":  # SMT-LIB's abs is of the Ints theory only: one ite for both sorts
+            return f"(ite (>= {inner} 0) {inner} (- {inner}))"
         ast.unhandled(e.op)
     if isinstance(e, ast.Binary):
         op = _OPS.get(e.op)

@@ -229,7 +229,7 @@ class Apply:
     loc: Loc = _loc()
 
 
-UnaryOp = Literal["not", "-"]
+UnaryOp = Literal["not", "-", "abs"]
 
 
 def unhandled(op: NoReturn) -> NoReturn:
@@ -244,7 +244,7 @@ def unhandled(op: NoReturn) -> NoReturn:
 
 @dataclass(frozen=True)
 class Unary:
-    """``not f`` or ``- t``."""
+    """``not f``, ``- t`` or ``abs(t)`` (the absolute value)."""
 
     op: UnaryOp
     operand: "Expr"

@@ -318,6 +318,9 @@ class ToAst(Transformer[Token, Any]):
     def minus(self, c: list[Any]) -> ast.Unary:
         return ast.Unary("-", c[1], self._span(c))
 
+    def abs_value(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("abs", c[2], self._span(c))
+
     def compare(self, c: list[Any]) -> ast.Compare:
         ops = cast("tuple[ast.CompareOp, ...]", tuple(str(t) for t in c[1::2]))
         return ast.Compare(ops, tuple(c[0::2]), self._span(c))

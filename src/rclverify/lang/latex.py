@@ -157,6 +157,8 @@ class _Tex:
                 return r"\lnot " + self.expr(e.operand, NOT_LEVEL, open_right)
             if e.op == "-":
                 return "-" + self.expr(e.operand, MINUS_LEVEL, open_right)
+            if e.op == "abs":
+                return r"\lvert " + self.expr(e.operand, 0, False) + r" \rvert"
             ast.unhandled(e.op)
         if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
             ops = chain_operands(e)

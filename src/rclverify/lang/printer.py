@@ -63,6 +63,8 @@ def level(e: ast.Expr) -> int:
             return NOT_LEVEL
         if e.op == "-":
             return MINUS_LEVEL
+        if e.op == "abs":
+            return ATOM_LEVEL
         ast.unhandled(e.op)
     if isinstance(e, (ast.Compare, ast.Member)):
         return COMPARE_LEVEL
@@ -256,6 +258,8 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
         if e.op == "-":
             inner = p.wrap(e.operand, MINUS_LEVEL)
             return "-" + inner if not inner.startswith("-") else "- " + inner
+        if e.op == "abs":
+            return f"abs({p.wrap(e.operand, 0)})"
         ast.unhandled(e.op)
     if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
         ops = chain_operands(e)

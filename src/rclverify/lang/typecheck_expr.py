@@ -207,9 +207,9 @@ class ExprChecker:
         if e.op == "not":
             self.expect_bool(e.operand, t, "not")
             return BOOL
-        if e.op == "-":
+        if e.op == "-" or e.op == "abs":
             if not is_numeric(t):
-                self.err(e.operand.loc, f"unary '-' needs a number, found {t}")
+                self.err(e.operand.loc, f"{'unary -' if e.op == '-' else 'abs'} needs a number, found {t}")
                 raise CheckFailed
             return REAL if t == REAL else INTEGER
         ast.unhandled(e.op)

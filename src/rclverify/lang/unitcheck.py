@@ -188,7 +188,7 @@ class UnitChecker:
             return self.var(e, node, bound)
         if isinstance(e, ast.Unary):
             q = self.term(e.operand, node, bound)
-            if e.op == "-":
+            if e.op == "-" or e.op == "abs":
                 return Q(q.kind, q.unit, e)
             if e.op == "not":
                 return UNKNOWN

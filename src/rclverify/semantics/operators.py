@@ -1,7 +1,8 @@
 """The semantics table: one entry per RCL operator giving its meaning.
 
 RCL's operators (docs/rcl-language.md; the connectives and arithmetic of
-the paper's EBNF, shared/reference lines 499-555) are ``not``, unary ``-``,
+the paper's EBNF, shared/reference lines 499-555) are ``not``, unary ``-``
+and ``abs(t)`` (an extension: the absolute value),
 ``and or -> <=>``, ``== != < <= > >=`` and ``+ - * /``.  Each has ONE
 :class:`Operator` entry in :data:`OPERATORS` (binary) or :data:`UNARY`;
 every evaluator and compiler reads its operator's meaning from that entry
@@ -173,6 +174,10 @@ UNARY: Mapping[str, Operator] = {
                     cpp="(!{x})", z3="Not", numpy="logical_not", smtlib="not"),
     "-": Operator("-", "unary minus", "arithmetic", 1, operator.neg, operator.neg, python="(-{x})",
                   cpp="(-{x})", z3="__neg__", numpy="negative", smtlib="-"),
+    # |x|: exact in both readings (the sign bit cleared; abs(NaN) is NaN, which compares false);
+    # SMT-LIB's ``abs`` is of the Ints theory only, so the solvers get ``ite`` (smttext.py, translate.py)
+    "abs": Operator("abs", "absolute value", "arithmetic", 1, abs, abs, python="abs({x})",
+                    cpp="std::abs({x})", z3=None, numpy="absolute", smtlib=None),
 }
 
 CONNECTIVES = frozenset(s for s, o in OPERATORS.items() if o.kind == "connective")

@@ -101,6 +101,8 @@ class _Ctx(Visitor[Any]):
             return z3.Not(v)
         if x.op == "-":
             return -v
+        if x.op == "abs":
+            return z3.If(v >= 0, v, -v)
         ast.unhandled(x.op)
 
     def visit_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:

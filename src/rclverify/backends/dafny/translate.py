@@ -193,6 +193,9 @@ class Translator:
                 return f"!{wrap(s)}", BOOL
             if e.op == "-":
                 return f"(-{wrap(s)})", (REAL if t == REAL else INTEGER)
+            if e.op == "abs":
+                zero = "0.0" if t == REAL else "0"
+                return f"(if {wrap(s)} >= {zero} then {wrap(s)} else -{wrap(s)})", (REAL if t == REAL else INTEGER)
             ast.unhandled(e.op)
         if isinstance(e, ast.Binary):
             return self.binary(e, scope)

@@ -78,7 +78,7 @@ def dimension(expr: ast.Expr, dims: Mapping[str, str]) -> str:
             inner = d(e.operand)
             if e.op == "not":
                 want = "bool"
-            elif e.op == "-":
+            elif e.op == "-" or e.op == "abs":
                 want = inner
             else:
                 ast.unhandled(e.op)
@@ -154,6 +154,8 @@ def _to_z3(e: ast.Expr, env: Mapping[str, z3.ArithRef]) -> z3.ExprRef:
             return z3.Not(x)
         if e.op == "-":
             return -x
+        if e.op == "abs":
+            return z3.If(x >= 0, x, -x)
         ast.unhandled(e.op)
     if isinstance(e, ast.Binary):
         l, r = _to_z3(e.left, env), _to_z3(e.right, env)

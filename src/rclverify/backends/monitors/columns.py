@@ -174,6 +174,9 @@ class ColumnCompiler:
         if isinstance(e, ast.Unary) and e.op == "-":
             f = self._num(e.operand)
             return lambda c: _neg(f(c))
+        if isinstance(e, ast.Unary) and e.op == "abs":  # | |a| - |b| | <= |a - b|: the error bound is kept
+            g = self._num(e.operand)
+            return lambda c: _abs(g(c))
         if isinstance(e, ast.Binary) and e.op in ("+", "-", "*"):
             a, b = self._num(e.left), self._num(e.right)
             return {"+": lambda c: _add(a(c), b(c)), "-": lambda c: _add(a(c), _neg(b(c))),
@@ -215,6 +218,10 @@ def _iff(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray]) -> 
 
 def _neg(a: tuple[Any, Any]) -> tuple[Any, Any]:
     return -a[0], a[1]
+
+
+def _abs(a: tuple[Any, Any]) -> tuple[Any, Any]:
+    return np.abs(a[0]), a[1]
 
 
 def _add(a: tuple[Any, Any], b: tuple[Any, Any]) -> tuple[Any, Any]:

@@ -80,6 +80,20 @@ def _input(e: ast.Expr, node: CheckedNode) -> str | None:
     return None
 
 
+def _abs_input(e: ast.Expr, node: CheckedNode) -> str | None:
+    """The input ``x`` of a term ``abs(in.x)``, else ``None``."""
+    return _input(e.operand, node) if isinstance(e, ast.Unary) and e.op == "abs" else None
+
+
+def _abs_bound(out: dict[str, Bound], op: str, name: str | None, v: Fraction | None) -> None:
+    """``abs(in.x) op v`` with ``op`` ``<`` or ``<=``: the bounds ``-v`` and ``v`` of ``x``."""
+    if name is None or v is None or op not in ("<", "<="):
+        return
+    bd = out.setdefault(name, Bound())
+    bd.lower(-v, op == "<")
+    bd.upper(v, op == "<")
+
+
 def _term(name: str, args: tuple[Any, ...]) -> Term:
     return Term(name, tuple(args))
 
@@ -107,6 +121,9 @@ def assumption_bounds(node: CheckedNode, named: Mapping[str, Fraction] | None = 
                     name, v = _input(a, node), _num(b, named)
                     if name is None:
                         name, v, op = _input(b, node), _num(a, named), _FLIP[cop]
+                    if name is None:  # abs(in.x) <= c: -c <= x <= c
+                        _abs_bound(out, cop, _abs_input(a, node), _num(b, named))
+                        _abs_bound(out, _FLIP[cop], _abs_input(b, node), _num(a, named))
                     if name is None or v is None:
                         continue
                     bd = out.setdefault(name, Bound())

@@ -102,9 +102,9 @@ class CppTranslator(Visitor[tuple[str, str]]):
         text = cast(str, UNARY[e.op].cpp)
         if e.op == "not":
             return text.format(x=self._bool(code, kind)), "bool"
-        if e.op == "-":
+        if e.op == "-" or e.op == "abs":
             if kind not in ("int", "double"):
-                raise Untranslatable(f"unary minus on {kind}")
+                raise Untranslatable(f"{UNARY[e.op].name} on {kind}")
             return text.format(x=code), kind
         ast.unhandled(e.op)
 

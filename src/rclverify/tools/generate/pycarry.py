@@ -17,7 +17,7 @@ inputs and outputs each clause reads (``backends/monitors/verdicts``).
 The tree's nodes (lists, first item the kind):
 ``["num", numerator, denominator]``, ``["lit", value]`` (a boolean, an
 enumeration value's name, a string), ``["io", "in.x"]``, ``["bound", name]``,
-``["not", e]``, ``["neg", e]``, ``["bin", op, l, r]``,
+``["not", e]``, ``["neg", e]``, ``["abs", e]``, ``["bin", op, l, r]``,
 ``["cmp", [ops], [operands], reads_io]``, ``["member", negated, elem, [items]]``
 (a literal set), ``["quant", kind, [[name, domain], ...], body]`` with a domain
 ``["bool"]``, ``["vals", [..]]``, ``["setlit", [items]]``, ``["range", [ints]]``,
@@ -75,11 +75,13 @@ class _Tree:
 
     @staticmethod
     def unary(op: ast.UnaryOp) -> str:
-        """The carried evaluator's tag of unary operator ``op`` (``not``, ``neg``)."""
+        """The carried evaluator's tag of unary operator ``op`` (``not``, ``neg``, ``abs``)."""
         if op == "not":
             return "not"
         if op == "-":
             return "neg"
+        if op == "abs":
+            return "abs"
         ast.unhandled(op)
 
     def var(self, v: ast.Var, scope: frozenset[str]) -> list[Any]:
