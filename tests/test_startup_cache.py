@@ -136,7 +136,7 @@ def test_the_code_stamp_is_the_digest_of_the_package_walked_by_pathlib() -> None
     pkg = Path(keys.__file__).resolve().parents[2]
     h = hashlib.sha256(f"{keys.FORMAT} {sys.version}".encode())
     for p in sorted(pkg.rglob("*")):
-        if p.suffix in (".py", ".lark", ".json", ".j2"):
+        if p.suffix in (".py", ".lark", ".json", ".j2", ".yaml"):
             st = p.stat()
             h.update(f"{p.relative_to(pkg)} {st.st_size} {st.st_mtime_ns}\n".encode())
     assert keys.code_stamp() == h.hexdigest()

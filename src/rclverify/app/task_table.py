@@ -324,6 +324,7 @@ class TaskTable:
         # report `doit verify` called up to date.
         have = set(deps)  # a set: the list holds a snapshot per node (quadratic at 5000 nodes, 0.2 s a run)
         deps += [d for d in (at(f) for f in check_input_files(ws)) if d not in have and os.path.isfile(d)]
+        deps += [at(f) for f in getattr(ws.index, "profiles", ())]  # the plan's own standard profiles (docs/standards.md)
         for n in self.nodes:
             deps += [at(ws.calculus(n)), at(ws.health(n)), at(ws.obligations(n))]
         deps += [at(ws.evidence(o["id"])) for _, o in self.exported()]

@@ -368,6 +368,8 @@ class Report(TypedDict):
     deadlines: list[DeadlineRow]
     acknowledgements: list[AcknowledgementRow]
     statistics: list[dict[str, Any]]
+    #: the evidence mapped onto the plan's standard profiles (report/standards_rows.py, docs/standards.md)
+    standards: list[dict[str, Any]]
     diagnoses: list[DiagnosisRow]
     problems: list[ProblemRow]
 

@@ -14,6 +14,7 @@ from typing import Any, Mapping, Sequence
 
 from rclverify.records.report_schema import Report, as_report
 from rclverify.report.confidence_rows import ConfidencePart
+from rclverify.report.standards_rows import StandardsPart
 from rclverify.report.statistics import StatisticsPart
 
 
@@ -62,6 +63,13 @@ def with_confidence(report: Mapping[str, Any], part: ConfidencePart) -> dict[str
         "derived_properties": [{**d, **part["derived"].get(d["node"], {})} for d in report["derived_properties"]],
         "requirements": [{**rq, **part["requirements"].get(str(rq["id"]), {})} for rq in report["requirements"]],
     }
+
+
+def with_standards(report: Mapping[str, Any], part: StandardsPart) -> dict[str, Any]:
+    """``report`` with the ``standards`` rows (report/standards_rows.py) and
+    their problem sentences (a highly recommended item not covered)."""
+    summary = {**report["summary"], "problems": list(report["summary"]["problems"]) + part["problems"]}
+    return {**report, "summary": summary, "standards": part["rows"]}
 
 
 def with_strict(report: Mapping[str, Any], strict_ok: bool) -> dict[str, Any]:

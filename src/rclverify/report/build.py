@@ -42,6 +42,7 @@ from rclverify.report.problems import group_problems
 from rclverify.report.records import inputs_sha256, node_obligations
 from rclverify.report.requirement_rows import requirement_rows
 from rclverify.report.severity import blocking
+from rclverify.report.standards_rows import standards_part
 from rclverify.report.statistics import statistics_part
 from rclverify.report.summary_rows import grounding_problems, headline, problem_sentences, status_counts, strict_gate
 from rclverify.report.templating import anchor
@@ -155,7 +156,8 @@ def build_report(ws: Workspace) -> Report:
     docs/assurance.schema.json publishes.  The passes, in order: the rows
     (:func:`_rows`), the summary around them, the statistics table
     (report/statistics.py, docs/statistics.md), the second solver's counts,
-    strength and confidence (report/confidence_rows.py), the
+    strength and confidence (report/confidence_rows.py), the evidence
+    mapped onto the plan's standards (report/standards_rows.py), the
     ``--strict`` gate with every severity (report/severity.py), one
     diagnosis per problem with repairs checked by Z3 (docs/diagnosis.md),
     the problems grouped by root cause (report/problems.py) and the
@@ -168,9 +170,12 @@ def build_report(ws: Workspace) -> Report:
     confidence = confidence_part(report, [(l.from_node, l.to_node) for l in ws.model.links],
                                  {r.id: r.strength for r in all_requirements(plan) if r.strength})
     report = assemble.with_confidence(report, confidence)
+    standards = standards_part(plan.standards, report["evidence"])  # docs/standards.md
+    report = assemble.with_standards(report, standards)
     # one severity per finding: --strict fails on every error and warning, health and lint warnings included
     report = assemble.with_strict(report, bool(report["meta"]["strict_ok"]) and confidence["ok"]
-                                  and not inp.second.problem and not blocking(report))
+                                  and not inp.second.problem and not blocking(report)
+                                  and standards["ok"])
     report = assemble.with_diagnoses(report, diagnose(ws, report))
     problems = group_problems(report, problem_items(report), anchor)
     return assemble.finished(report, problems, marked_nodes(report["nodes"], problems))

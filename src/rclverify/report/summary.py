@@ -210,8 +210,10 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     if rq:
         out.append(f"{len(rq)} formal requirement{'s are' if len(rq) != 1 else ' is'} not met ("
                    + ", ".join(rq[:4]) + (", ..." if len(rq) > 4 else "") + ")")
+    from rclverify.report.standards_rows import strict_reason as standards_reason  # deferred: start-up (loads the standard profiles' modules only when --strict failed)
     from rclverify.report.deadlines import strict_reason  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     out += strict_reason(report)  # end-to-end deadlines not proved
+    out += standards_reason(report)  # highly recommended items of the plan's standards not covered
     g = _grounding(report.get("grounding"))
     if g and g["error"]:
         out.append(f"{g['error']} ROS grounding error{'s' if g['error'] != 1 else ''} (`rclverify ros check`)")

@@ -89,6 +89,8 @@ class TaskIndex:
     #: ends (the worst path, :func:`rclverify.calculus.worst_path.nodes_between`): their snapshots are the
     #: inputs of the ``deadlines`` task; empty: the plan has no deadline and there is no such task.
     deadline_nodes: tuple[str, ...] = ()
+    #: The workspace's own standard profile files the plan names (docs/standards.md): inputs of ``report``.
+    profiles: tuple[str, ...] = ()
 
 
 @dataclass
@@ -147,7 +149,8 @@ class Workspace:
             requirement_dirs=tuple(d for d, _ in plan.requirements_from),
             ros=dict(getattr(plan, "ros", None) or {}),
             # every node between a deadline's ends: the slowest path may leave the named one
-            deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))))
+            deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))),
+            profiles=tuple(c.profile.file for c in plan.standards if not c.profile.file.startswith("rclverify/")))
 
     @cached_property
     def checked(self) -> Checked:

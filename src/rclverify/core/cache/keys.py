@@ -54,14 +54,14 @@ _ENCODE = json.JSONEncoder(sort_keys=True, separators=(",", ":"), ensure_ascii=F
 
 
 #: The files of the package whose change changes :func:`code_stamp`.
-_CODE_SUFFIXES = (".py", ".lark", ".json", ".j2")
+_CODE_SUFFIXES = (".py", ".lark", ".json", ".j2", ".yaml")  # .yaml: the standard profiles (docs/standards.md)
 
 
 @lru_cache(maxsize=1)
 def code_stamp() -> str:
     """Hex sha256 that changes whenever a file of the installed rclverify
     package changes (the name, size and modification time of every ``.py``,
-    ``.lark``, ``.json`` and ``.j2`` file) or the Python version does.
+    ``.lark``, ``.json``, ``.j2`` and ``.yaml`` file) or the Python version does.
     Taken once per process: a run's code does not change under it."""
     pkg = Path(__file__).resolve().parents[2]  # the rclverify package (this file is core/cache/keys.py)
     h = hashlib.sha256(f"{FORMAT} {sys.version}".encode())

@@ -7,7 +7,8 @@ reading and parsing -- the whole budget of a no-op run.  The
 result is therefore kept in ``artifacts/cache/workspace.pickle`` and reused
 when nothing it was computed from changed:
 
-* the sha256 of the plan file and of every contract file it lists,
+* the sha256 of the plan file, of every contract file it lists and of
+  the workspace's own standard profiles it names (docs/standards.md),
 * what every path the plan names resolves to (every symbolic link followed:
   the plan's ``path_targets``, :mod:`rclverify.model.plan.paths`), resolved
   again on every run, so a link retargeted since (outside the workspace,
@@ -60,6 +61,14 @@ def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = 
             "plan": file_digest(f"{root}/{ws.plan_file}"),
             "contracts": {c: known[c] if c in known else file_digest(f"{root}/{c}") for c in contracts},
             "paths": _resolved(root, paths)}
+
+
+def _own_profiles(plan: Any) -> tuple[str, ...]:
+    """The workspace's own standard profile files the plan read (``standards:``, docs/standards.md):
+    hashed with the contract files, so an edited profile loads the plan anew; the built-in ones are
+    package data (``rclverify/...``), covered by the code's salt."""
+    return tuple(str(c.profile.file) for c in getattr(plan, "standards", ())
+                 if not str(c.profile.file).startswith("rclverify/"))
 
 
 def _resolved(root: str, paths: Any) -> dict[str, str] | None:
@@ -121,7 +130,9 @@ def restore(ws: Any) -> bool:
         return False
     ws.parsed.update(parsed)  # re-validated per file by Workspace.checked
     same_paths = now["paths"] is not None and kept.get("paths") == now["paths"]
-    if kept.get("plan") == now["plan"] and same_paths and all((ws.root / c).is_file() for c in plan.contracts):
+    same_profiles = all(kept.get("contracts", {}).get(f) == now["contracts"].get(f) for f in _own_profiles(plan))
+    if kept.get("plan") == now["plan"] and same_paths and same_profiles \
+            and all((ws.root / c).is_file() for c in plan.contracts):
         ws.__dict__["plan"] = plan
     return False
 
@@ -161,7 +172,7 @@ def save(ws: Any) -> None:
     process, before the files were parsed (a file edited since is then
     parsed again next time), or taken now."""
     try:
-        kept = _inputs(ws, tuple(ws.plan.contracts), ws.cache_shas)
+        kept = _inputs(ws, tuple(ws.plan.contracts) + _own_profiles(ws.plan), ws.cache_shas)
         kept["paths"] = dict(ws.plan.path_targets)  # as resolved when the plan's paths were checked
         write_stream(ws.root / CACHE, KIND, salt(KIND), [kept, ws.index, (ws.plan, ws.parsed)])
     except Exception:  # noqa: BLE001

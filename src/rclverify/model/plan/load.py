@@ -36,6 +36,7 @@ from rclverify.model.plan.ranking import parse_hints
 from rclverify.model.plan.temporal import Temporal, parse_temporal, shape
 from rclverify.model.plan.expected import check_expected
 from rclverify.model.plan.entries import BACKEND_NAMES, unknown_key_messages
+from rclverify.model.plan.standards.choice import read_standards
 
 __all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]
 
@@ -196,7 +197,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     states = read_state(data, locs, blocks, plan_rel)
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
                 str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
-                read_acknowledgements(data, locs, plan_rel), targets)
+                read_acknowledgements(data, locs, plan_rel), targets, read_standards(root, data, locs, plan_rel))
 
 
 def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:

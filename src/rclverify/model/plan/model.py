@@ -15,6 +15,7 @@ from rclverify.lang import ast
 from rclverify.model.plan.acknowledged import Acknowledgement
 from rclverify.model.plan.formal import Source
 from rclverify.model.plan.state import StateVar
+from rclverify.model.plan.standards.choice import StandardChoice
 
 Path_ = tuple[Any, ...]
 
@@ -133,3 +134,5 @@ class Plan:
     #: every path the plan names, checked to lie inside the workspace, and what it resolved to then
     #: (``{value: absolute path}``, :func:`.paths.check_plan_paths`): a reuse of this plan resolves them again
     path_targets: Mapping[str, str] = field(default_factory=dict)
+    #: the safety standards the evidence is mapped onto (``standards:``, docs/standards.md)
+    standards: tuple[StandardChoice, ...] = ()

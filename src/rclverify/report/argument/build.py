@@ -44,6 +44,7 @@ from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
 from rclverify.report.textfmt import natural_key
 from rclverify.report.argument.defeaters import add_defeaters
+from rclverify.report.argument.standards import add_standard_links
 from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
 
@@ -178,6 +179,7 @@ def build_argument(report: Report) -> Argument:
     add_defeaters(b.els, report, ident)
     add_accepted_risks(b.els, report, ident, top)
     add_claim_points(b.els, report, ident)
+    add_standard_links(b.els, report, ident)  # strategies -> the standard clauses they address
     return propagate(Argument(top, b.els))
 
 

@@ -12,8 +12,9 @@ Collected (workspace-relative POSIX paths, sorted):
   compiled executable (ELF, Mach-O) under ``artifacts/`` -- rclverify
   builds executables in the user's cache only, and an assessor is never
   handed one to run);
-* the plan, its contract files and replacement contracts, and the
-  Doorstop folders it reads requirements from (``requirements_from``);
+* the plan, its contract files and replacement contracts, the
+  Doorstop folders it reads requirements from (``requirements_from``) and
+  its own standard profiles (``standards:``, docs/standards.md);
 * every file the plan's evidence entries name (a directory contributes the
   files under it; the same paths :mod:`rclverify.model.plan.paths` checks), and
   every input an evidence record was hashed over;
@@ -40,6 +41,7 @@ from rclverify import __version__
 from rclverify.model.plan.load import Plan
 from rclverify.model.plan.paths import config_strings, escape_reason, looks_like_path
 from rclverify.model.plan.entries import declared_paths
+from rclverify.model.plan.standards.profiles import BUILTIN_DIR
 
 #: Format tag of the manifest.
 FORMAT = "rclverify-bundle/1"
@@ -110,6 +112,8 @@ def _named(plan: Plan) -> set[str]:
         out.update(str(v) for v in ros.get(key, []) or [])
     if ros.get("mapping"):
         out.add(str(ros["mapping"]))
+    # a workspace's own standard profile (the built-in ones are package data, docs/standards.md)
+    out.update(c.profile.file for c in getattr(plan, "standards", ()) if not c.profile.file.startswith(BUILTIN_DIR))
     return out
 
 
@@ -209,16 +213,21 @@ def build_manifest(root: Path, plan: Plan, files: list[str], missing: list[str],
     ``workspace``, ``plan``, ``files`` (path -> ``{"sha256", "bytes"}``),
     ``missing``, ``tools``, ``reproduce`` (the command to run in the
     unpacked archive, and the one that checks it), ``verdict`` (the
-    report's overall status and headline, when the report exists).
+    report's overall status and headline, when the report exists) and,
+    when the plan names standards, ``standards`` (each one's clauses with
+    their status and supporting obligations, docs/standards.md).
     """
     verdict: dict[str, Any] = {}
+    standards: list[dict[str, Any]] = []
     if "reports/assurance.json" in contents:
         try:
-            summary = json.loads(contents["reports/assurance.json"].decode("utf-8"))["summary"]
+            report = json.loads(contents["reports/assurance.json"].decode("utf-8"))
+            summary = report["summary"]
             verdict = {"status": summary["status"], "headline": summary["headline"]}
-        except (ValueError, KeyError, TypeError):
-            verdict = {}
-    return {
+            standards = [_standard_brief(row) for row in report.get("standards") or ()]
+        except (ValueError, KeyError, TypeError, AttributeError):
+            verdict, standards = {}, []
+    out: dict[str, Any] = {
         "format": FORMAT,
         "workspace": plan.name or root.resolve().name,
         "plan": plan.file,
@@ -229,3 +238,16 @@ def build_manifest(root: Path, plan: Plan, files: list[str], missing: list[str],
                       "check_bundle": "rclverify bundle --verify <this archive>"},
         "verdict": verdict,
     }
+    if standards:  # the evidence mapped onto the plan's standards (docs/standards.md): a traceability aid
+        out["standards"] = standards
+    return out
+
+
+def _standard_brief(row: Mapping[str, Any]) -> dict[str, Any]:
+    """A report ``standards[]`` row as the manifest carries it: the profile,
+    its level, and each clause's id, status and supporting obligations."""
+    return {"profile": str(row["profile"]), "edition": str(row["edition"]), "level": row.get("level"),
+            "clauses": {str(c["id"]): {"status": str(c["status"]), "recommendation": str(c["recommendation"]),
+                                       "evidence": sorted({str(e["obligation"]) for e in c["evidence"]})}
+                        for c in row["clauses"]},
+            "required_not_covered": [str(x) for x in row.get("required_not_covered") or ()]}

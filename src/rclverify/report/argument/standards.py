@@ -1,0 +1,62 @@
+"""The argument's strategies linked to the standard clauses they address (docs/standards.md).
+
+For each standard the plan names (the report's ``standards`` rows,
+report/standards_rows.py), every clause with supporting evidence becomes
+one GSN *context* (``C``) naming the standard, the clause, its own short
+title, its recommendation at the chosen level and its status.  A strategy
+addresses a clause when a solution under it (through ``supported_by``)
+stands for an evidence row that supports the clause; the strategy then
+carries the clause's context in ``in_context_of``.  Contexts have no
+status: the links are a traceability aid and change no status.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, Mapping
+
+from rclverify.report.argument.model import Element
+
+
+def _solutions_under(els: Mapping[str, Element], start: str) -> set[str]:
+    """The ``ref`` of every solution reachable from ``start`` through ``supported_by`` (iterative)."""
+    seen, out, stack = {start}, set(), [start]
+    while stack:
+        e = els.get(stack.pop())
+        if e is None:
+            continue
+        if e.type == "solution":
+            out.add(e.ref)
+        for child in e.supported_by:
+            if child not in seen:
+                seen.add(child)
+                stack.append(child)
+    return out
+
+
+def add_standard_links(els: dict[str, Element], report: Mapping[str, Any], ident: Any) -> None:
+    """Add one context per standard clause with supporting evidence to ``els``
+    (changed in place) and put it in the context of every strategy that
+    addresses the clause (the module docstring); ``ident`` makes element
+    ids.  A report without ``standards`` rows changes nothing."""
+    clauses: list[tuple[str, set[str]]] = []
+    for row in report.get("standards") or ():
+        level = f" {str(row['level_name']).upper()} {row['level']}" if row.get("level") is not None else ""
+        for c in row["clauses"]:
+            obligations = {str(e["obligation"]) for e in c["evidence"]}
+            if not obligations:
+                continue
+            cid = ident("C", "std", row["profile"], c["id"])
+            els[cid] = Element(cid, "context", f"{row['edition']}{level}, {c['id']}: {c['title']} "
+                               f"(recommendation {c['recommendation']}; {c['status']}; a traceability aid, "
+                               "not a compliance claim)", ref=f"{row['profile']}:{c['id']}")
+            clauses.append((cid, obligations))
+    if not clauses:
+        return
+    for sid in [i for i, e in els.items() if e.type == "strategy"]:
+        under = _solutions_under(els, sid)
+        links = tuple(cid for cid, obligations in clauses if obligations & under)
+        if links:
+            els[sid] = replace(els[sid], in_context_of=(*els[sid].in_context_of, *links))
+
+
+__all__ = ["add_standard_links"]

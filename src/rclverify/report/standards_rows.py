@@ -1,0 +1,81 @@
+"""The report's ``standards`` part: the evidence rows mapped onto the plan's standard profiles (docs/standards.md).
+
+One row per ``standards:`` entry of the plan, each with its clause rows
+(:func:`rclverify.model.plan.standards.mapping.clause_rows`) over the
+report's evidence rows once the confidence pass has given them their
+strength.  ``--strict`` fails while a clause recommended HR at the chosen
+level is not covered (:func:`strict_reason` names them).  The mapping is a
+traceability aid, not a compliance claim.
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence, TypedDict
+
+from rclverify.model.plan.standards.choice import StandardChoice
+from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
+
+
+class StandardRow(TypedDict):
+    """One chosen standard (``standards[]`` of the report)."""
+    profile: str
+    title: str
+    edition: str
+    level_name: str
+    level: str | None
+    source: str
+    clauses: list[ClauseRow]
+    open: list[str]
+    counts: dict[str, int]
+    required_not_covered: list[str]
+
+
+class StandardsPart(TypedDict):
+    """What the pass gives the report: the rows, one problem sentence per
+    standard with an HR clause not covered, and whether none has one."""
+    rows: list[StandardRow]
+    problems: list[str]
+    ok: bool
+
+
+def _label(row: Mapping[str, Any]) -> str:
+    level = f" {str(row['level_name']).upper()} {row['level']}" if row.get("level") is not None else ""
+    return f"{row['edition']}{level}"
+
+
+def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[Mapping[str, Any]]) -> StandardsPart:
+    """The ``standards`` part of the plan's ``choices`` over the report's
+    ``evidence`` rows (``obligation``, ``backend``, ``kind``, ``status``,
+    ``strength``).  Pure; raises nothing."""
+    rows: list[StandardRow] = []
+    problems: list[str] = []
+    for c in choices:
+        clauses = clause_rows(c.profile, c.level, evidence)
+        missing = not_covered(clauses)
+        row: StandardRow = {
+            "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,
+            "level_name": c.profile.level_name, "level": c.level,
+            "source": f"{c.loc.file}:{c.loc.line}:{c.loc.col}", "clauses": clauses,
+            "open": [x["id"] for x in clauses if x["status"] == "open"],
+            "counts": {s: sum(1 for x in clauses if x["status"] == s) for s in CLAUSE_STATUSES},
+            "required_not_covered": missing}
+        rows.append(row)
+        if missing:
+            problems.append(f"Standard {_label(row)}: {len(missing)} highly recommended item"
+                            f"{'s' if len(missing) != 1 else ''} not covered by discharged evidence: "
+                            + ", ".join(missing))
+    return {"rows": rows, "problems": problems, "ok": not problems}
+
+
+def strict_reason(report: Mapping[str, Any]) -> list[str]:
+    """Why the chosen standards fail ``--strict`` on ``report``: one clause
+    per standard naming its HR items not covered (empty when none)."""
+    out = []
+    for row in report.get("standards") or ():
+        missing = list(row.get("required_not_covered") or ())
+        if missing:
+            out.append(f"{_label(row)}: highly recommended item{'s' if len(missing) != 1 else ''} not covered ("
+                       + ", ".join(missing) + ")")
+    return out
+
+
+__all__ = ["StandardRow", "StandardsPart", "standards_part", "strict_reason"]

@@ -1,0 +1,93 @@
+"""The mapping of a report's evidence rows onto a profile's clauses (model/plan/standards/mapping.py,
+docs/standards.md): hand-made rows, then each clause's status against a brute-force reading of random rows,
+and the profiles shipped as package data (pyproject.toml's globs cover them)."""
+from __future__ import annotations
+
+import fnmatch
+import random
+import tomllib
+from pathlib import Path
+
+from rclverify.model.plan.standards.mapping import SUPPORTS, clause_rows, kinds_of, not_covered
+from rclverify.model.plan.standards.profiles import builtin_names, load_builtin, parse_profile
+from rclverify.records.statuses import EVIDENCE_KINDS, RECORD_STATUSES
+
+ROOT = Path(__file__).resolve().parents[1]
+PROFILE = parse_profile("""id: t
+title: T
+edition: T 1
+level_name: sil
+levels: ["1", "2"]
+items:
+  - {id: P, title: proved, evidence: [proof], strength: proof, recommendation: {"1": R, "2": HR}}
+  - {id: M, title: watched, evidence: [runtime-monitoring, run-statistics], strength: observed, recommendation: HR}
+  - {id: X, title: tried, evidence: [experiment], strength: tested, recommendation: {"1": HR, "2": "---"}}
+""", "t.yaml")
+
+
+def _row(ob: str, backend: str, kind: str, status: str, strength: str | None = None) -> dict[str, object]:
+    row: dict[str, object] = {"obligation": ob, "backend": backend, "kind": kind, "status": status}
+    if strength:
+        row["strength"] = {"kind": strength, "doubt": 0.1}
+    return row
+
+
+def test_hand_made_rows() -> None:
+    rows = [_row("A.g1.hoare", "hoare", "proof", "discharged", "proof"),
+            _row("A.g2.monitors", "monitors", "monitoring", "failed", "observed"),
+            _row("B.g1.property_tests", "property_tests", "testing", "discharged", "tested")]
+    out = {r["id"]: r for r in clause_rows(PROFILE, "2", rows)}
+    assert out["P"]["status"] == "covered" and out["P"]["recommendation"] == "HR"
+    assert out["P"]["evidence"] == [{"obligation": "A.g1.hoare", "backend": "hoare", "kind": "proof",
+                                     "status": "discharged"}]
+    assert out["M"]["status"] == "partial" and [e["status"] for e in out["M"]["evidence"]] == ["failed"]
+    assert out["X"]["status"] == "open" and out["X"]["evidence"] == [] and out["X"]["recommendation"] == "---"
+    assert not_covered(list(out.values())) == ["M"]
+    # a failed row beside a discharged one: partial, never covered (a pass does not hide a failure)
+    both = clause_rows(PROFILE, "2", rows + [_row("C.g1.dafny", "dafny", "proof", "failed", "proof")])
+    assert both[0]["status"] == "partial" and len(both[0]["evidence"]) == 2
+    at1 = clause_rows(PROFILE, "1", rows)
+    assert [r["recommendation"] for r in at1] == ["R", "HR", "HR"] and not_covered(at1) == ["M", "X"]
+
+
+def test_statistical_strength_supports_run_statistics() -> None:
+    row = _row("A.g1.monitors", "monitors", "monitoring", "discharged", "statistical")
+    assert kinds_of(row) == {"runtime-monitoring", "run-statistics"}
+    assert kinds_of(_row("x", "review", "review", "pending")) == {"review"}
+
+
+def test_every_record_kind_is_in_the_one_table() -> None:
+    assert {v for (f, v) in SUPPORTS if f == "kind"} == set(EVIDENCE_KINDS)
+
+
+def test_status_equals_a_brute_force_reading() -> None:
+    rnd = random.Random(1)
+    kinds = list(EVIDENCE_KINDS)
+    profiles = [load_builtin(n) for n in builtin_names()] + [PROFILE]
+    for _ in range(300):
+        rows = [_row(f"N.g{i}", "b", rnd.choice(kinds), rnd.choice(RECORD_STATUSES),
+                     rnd.choice([None, "proof", "statistical", "tested"])) for i in range(rnd.randrange(0, 6))]
+        p = rnd.choice(profiles)
+        level = rnd.choice(p.levels) if p.levels else None
+        for item, got in zip(p.items, clause_rows(p, level, rows)):
+            supporting = []
+            for r in rows:  # brute force: does any (field, value) of the table match and name an accepted kind?
+                hits = [k for (f, v), k in SUPPORTS.items()
+                        if (r.get(f) if f == "kind" else (r.get("strength") or {}).get("kind")) == v]  # type: ignore[union-attr]
+                if set(hits) & set(item.evidence):
+                    supporting.append(r)
+            want = ("covered" if supporting and all(r["status"] == "discharged" for r in supporting)
+                    else "partial" if supporting else "open")
+            assert got["status"] == want and len(got["evidence"]) == len(supporting)
+            assert got["recommendation"] == item.at(level)
+
+
+def test_the_profiles_are_package_data() -> None:
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    globs = data["tool"]["setuptools"]["package-data"]["rclverify"]
+    folder = ROOT / "src" / "rclverify" / "model" / "plan" / "standards"
+    files = [p for p in folder.rglob("*") if p.is_file() and p.suffix in (".yaml", ".json")]
+    assert len(files) >= 5
+    for p in files:
+        rel = p.relative_to(ROOT / "src" / "rclverify").as_posix()
+        assert any(fnmatch.fnmatch(rel, g) and rel.count("/") == g.count("/") for g in globs), rel

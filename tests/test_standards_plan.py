@@ -1,0 +1,72 @@
+"""The plan's ``standards:`` key (model/plan/standards/choice.py, docs/standards.md): a profile and its
+level read, and each mistake one located error naming what there is."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.load import load_plan
+
+PLAN = "contracts/plan.yaml"
+HEAD = "name: s\ncontracts: [contracts/a.rcl]\n"
+RCL = "node A {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n  guarantee( out.y >= 0 )\n}\n"
+
+
+def _load(tmp_path: Path, tail: str) -> object:
+    (tmp_path / "contracts").mkdir(exist_ok=True)
+    (tmp_path / "contracts" / "a.rcl").write_text(RCL, encoding="utf-8")
+    (tmp_path / PLAN).write_text(HEAD + tail, encoding="utf-8")
+    return load_plan(tmp_path, PLAN)
+
+
+def _error(tmp_path: Path, tail: str) -> str:
+    with pytest.raises(PlanError) as info:
+        _load(tmp_path, tail)
+    assert len(info.value.diagnostics) == 1
+    return str(info.value.diagnostics[0])
+
+
+def test_profiles_and_levels_are_read(tmp_path: Path) -> None:
+    plan = _load(tmp_path, "standards:\n  - {profile: iec61508-3, sil: 2}\n  - {profile: ul4600}\n"
+                           "  - {profile: do-333, level: B}\n")
+    got = [(c.profile.id, c.level) for c in plan.standards]  # type: ignore[attr-defined]
+    assert got == [("iec61508-3", "2"), ("ul4600", None), ("do-333", "B")]
+
+
+def test_no_standards_is_none(tmp_path: Path) -> None:
+    assert _load(tmp_path, "").standards == ()  # type: ignore[attr-defined]
+
+
+def test_unknown_profile_names_the_profiles(tmp_path: Path) -> None:
+    msg = _error(tmp_path, "standards:\n  - {profile: iec61508-9, sil: 2}\n")
+    assert msg.startswith(f"{PLAN}:4:15: error: unknown standard profile 'iec61508-9'; the profiles are: ")
+    assert "iec61508-3" in msg and "ul4600" in msg
+
+
+def test_a_level_outside_the_profile(tmp_path: Path) -> None:
+    msg = _error(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 5\n")
+    assert msg.startswith(f"{PLAN}:5:10: error:") and "the levels are 1, 2, 3, 4" in msg
+
+
+def test_a_missing_level_and_a_foreign_key(tmp_path: Path) -> None:
+    assert "needs one level, 'sil: ' one of 1, 2, 3, 4" in _error(tmp_path, "standards:\n  - {profile: iec61508-3}\n")
+    msg = _error(tmp_path, "standards:\n  - profile: ul4600\n    sil: 2\n")
+    assert msg.startswith(f"{PLAN}:5:5: error:") and "it has no levels" in msg
+
+
+def test_a_profile_chosen_twice(tmp_path: Path) -> None:
+    assert "chosen twice" in _error(tmp_path, "standards:\n  - {profile: ul4600}\n  - {profile: ul4600}\n")
+
+
+def test_a_user_profile_file(tmp_path: Path) -> None:
+    (tmp_path / "std").mkdir()
+    (tmp_path / "std" / "mine.yaml").write_text(
+        "id: mine\ntitle: Mine\nedition: In-house 1\nitems:\n"
+        "  - {id: M1, title: proved, evidence: [proof], strength: proof, recommendation: HR}\n", encoding="utf-8")
+    plan = _load(tmp_path, "standards:\n  - {profile: std/mine.yaml}\n")
+    assert plan.standards[0].profile.id == "mine"  # type: ignore[attr-defined]
+    (tmp_path / "std" / "mine.yaml").write_text("id: mine\ntitle: Mine\nedition: x\nitems: []\n", encoding="utf-8")
+    assert _error(tmp_path, "standards:\n  - {profile: std/mine.yaml}\n").startswith("std/mine.yaml:4:8: error:")
+    assert "inside the workspace" in _error(tmp_path, "standards:\n  - {profile: ../x.yaml}\n")
