@@ -39,6 +39,7 @@ from rclverify.app.pipeline import (
     stage_report,
 )
 from rclverify.report.render import render_files
+from rclverify.report.templating import anchor
 from rclverify.report.textfmt import natural_key
 
 REPO = Path(__file__).resolve().parents[1]
@@ -357,3 +358,36 @@ def test_the_warehouse_first_screen_says_what_to_fix(tmp_path: Path, driver: Any
                                     ".map(t => t.textContent)")
     assert any("LidarDriver" in t and "Controller" in t for t in failing), failing
     _screenshot(driver, tmp_path, "assurance-warehouse-first-screen.png")
+
+
+def test_the_standards_section_maps_every_clause_of_the_case_study(tmp_path: Path, driver: Any) -> None:
+    """The case study's plan maps its evidence onto IEC 61508-3 at SIL 2 and UL 4600 (docs/standards.md):
+    in the browser, one table per standard, one row per clause of its profile, each showing its
+    supporting evidence (folded, every record linked to the evidence it names) or that it is open,
+    and a status that is never "covered" while one of its records is not discharged."""
+    with gzip.open(REPO / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
+        report = json.load(f)
+    report.pop("problems", None)
+    out = tmp_path / "reports"
+    out.mkdir()
+    render_files(report, out, ("assurance.html",))
+    driver.get((out / "assurance.html").as_uri())
+    standards = {s["profile"]: s for s in report["standards"]}
+    assert set(standards) == {"iec61508-3", "ul4600"} and standards["iec61508-3"]["level"] == "2"
+    for profile, s in standards.items():
+        rows = driver.find_elements("css selector", f"#{anchor('standard', profile)} + p + table.standard tr[id]")
+        assert len(rows) == len(s["clauses"]) > 0, profile
+        for row, clause in zip(rows, s["clauses"]):
+            cells = row.find_elements("tag name", "td")
+            assert cells[0].text == clause["id"]
+            links = cells[5].find_elements("css selector", "a")
+            if clause["evidence"]:
+                assert len(links) == len(clause["evidence"]) and "record" in cells[5].text
+            else:
+                assert clause["status"] == "open" and "open: no evidence" in cells[5].text
+            statuses = {e["status"] for e in clause["evidence"]}
+            assert cells[6].text == clause["status"]
+            assert clause["status"] != "covered" or statuses == {"discharged"}
+    assert driver.execute_script(_BROKEN_LINKS, "table.standard a") == []
+    driver.execute_script(f"document.getElementById('{anchor('standard', 'iec61508-3')}').scrollIntoView()")
+    _screenshot(driver, tmp_path, "assurance-standards.png")
