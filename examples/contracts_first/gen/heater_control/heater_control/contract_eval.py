@@ -113,6 +113,8 @@ class Reading:
             return not self.eval(t[1], b)
         if kind == 'neg':
             return -self.eval(t[1], b)
+        if kind == 'abs':
+            return abs(self.eval(t[1], b))
         if kind == 'bin':
             return self.binary(t, b)
         if kind == 'cmp':
