@@ -70,3 +70,17 @@ def test_a_user_profile_file(tmp_path: Path) -> None:
     (tmp_path / "std" / "mine.yaml").write_text("id: mine\ntitle: Mine\nedition: x\nitems: []\n", encoding="utf-8")
     assert _error(tmp_path, "standards:\n  - {profile: std/mine.yaml}\n").startswith("std/mine.yaml:4:8: error:")
     assert "inside the workspace" in _error(tmp_path, "standards:\n  - {profile: ../x.yaml}\n")
+
+
+def test_strict_is_true_or_false(tmp_path: Path) -> None:
+    """``strict:`` opts a standard into the --strict gate; anything but a boolean is one located error."""
+    from rclverify.model.plan.standards.choice import read_standards
+    from rclverify.model.plan.errors import PlanError
+    from rclverify.lang.ast import Loc
+    (choice,) = read_standards(tmp_path, {"standards": [{"profile": "ul4600", "strict": True}]},
+                               {("standards", 0): Loc("plan.yaml", 3, 5)}, "plan.yaml")
+    assert choice.strict is True
+    (plain,) = read_standards(tmp_path, {"standards": [{"profile": "ul4600"}]}, {}, "plan.yaml")
+    assert plain.strict is False
+    with pytest.raises(PlanError, match="'strict' is true or false"):
+        read_standards(tmp_path, {"standards": [{"profile": "ul4600", "strict": "yes"}]}, {}, "plan.yaml")

@@ -28,7 +28,7 @@ RCL = """node Gain {
 PLAN = """name: standards
 contracts: [contracts/gain.rcl]
 standards:
-  - {profile: iec61508-3, sil: 2}
+  - {profile: iec61508-3, sil: 2, strict: true}
   - {profile: ul4600}
 nodes:
   Gain:
@@ -82,13 +82,17 @@ def test_strict_names_the_items(ws: Path, capsys: pytest.CaptureFixture[str]) ->
     assert main(["verify", "-w", str(ws), "--strict"]) != 0
     out = "".join(capsys.readouterr())
     assert "IEC 61508-3:2010 SIL 2: highly recommended items not covered (" in out and "B.8 6c" in out
+    assert "UL 4600" not in out.split("--strict")[-1] or "UL 4600, 3rd edition (2023): highly" not in out  # not strict
 
 
 def test_the_part_without_a_pipeline() -> None:
-    choice = StandardChoice(load_builtin("do-333"), "D", Loc("p.yaml", 3, 5))
+    choice = StandardChoice(load_builtin("do-333"), "D", Loc("p.yaml", 3, 5), strict=True)
     rows = [{"obligation": "A.g1.review", "backend": "review", "kind": "review", "status": "discharged"}]
     part = standards_part([choice], rows)
     assert part["ok"] is False and part["rows"][0]["required_not_covered"] == ["FM.A-6"]
+    # without strict: true the item is shown and named in the summary's problems, and --strict does not fail on it
+    shown = standards_part([StandardChoice(load_builtin("do-333"), "D", Loc("p.yaml", 3, 5))], rows)
+    assert shown["ok"] is True and len(shown["problems"]) == 1 and strict_reason({"standards": shown["rows"]}) == []
     assert strict_reason({"standards": part["rows"]}) == [
         "RTCA DO-333 (2011) DAL D: highly recommended item not covered (FM.A-6)"]
     assert standards_part([], rows) == {"rows": [], "problems": [], "ok": True}
@@ -132,7 +136,8 @@ def test_an_edited_own_profile_is_read_again(tmp_path: Path) -> None:
     root = tmp_path / "ws"
     profile = ("id: mine\ntitle: Mine\nedition: In-house 1\nitems:\n"
                "  - {id: M1, title: TITLE, evidence: [property-tests], strength: tested, recommendation: HR}\n")
-    plan = PLAN.replace("  - {profile: iec61508-3, sil: 2}\n  - {profile: ul4600}\n", "  - {profile: std/mine.yaml}\n")
+    plan = PLAN.replace("  - {profile: iec61508-3, sil: 2, strict: true}\n  - {profile: ul4600}\n",
+                        "  - {profile: std/mine.yaml}\n")
     for rel, text in {"contracts/gain.rcl": RCL, "contracts/plan.yaml": plan, "impl/gain.py": IMPL,
                       "std/mine.yaml": profile.replace("TITLE", "first title")}.items():
         (root / rel).parent.mkdir(parents=True, exist_ok=True)

@@ -3,8 +3,9 @@
 One row per ``standards:`` entry of the plan, each with its clause rows
 (:func:`rclverify.model.plan.standards.mapping.clause_rows`) over the
 report's evidence rows once the confidence pass has given them their
-strength.  ``--strict`` fails while a clause recommended HR at the chosen
-level is not covered (:func:`strict_reason` names them).  The mapping is a
+strength.  A clause recommended HR at the chosen level and not covered is
+a sentence of the summary's problems; ``--strict`` fails on it for a
+standard chosen with ``strict: true`` (:func:`strict_reason` names them).  The mapping is a
 traceability aid, not a compliance claim.
 """
 from __future__ import annotations
@@ -27,6 +28,7 @@ class StandardRow(TypedDict):
     open: list[str]
     counts: dict[str, int]
     required_not_covered: list[str]
+    strict: bool
 
 
 class StandardsPart(TypedDict):
@@ -48,6 +50,7 @@ def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[Mapping
     ``strength``).  Pure; raises nothing."""
     rows: list[StandardRow] = []
     problems: list[str] = []
+    ok = True
     for c in choices:
         clauses = clause_rows(c.profile, c.level, evidence)
         missing = not_covered(clauses)
@@ -57,22 +60,24 @@ def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[Mapping
             "source": f"{c.loc.file}:{c.loc.line}:{c.loc.col}", "clauses": clauses,
             "open": [x["id"] for x in clauses if x["status"] == "open"],
             "counts": {s: sum(1 for x in clauses if x["status"] == s) for s in CLAUSE_STATUSES},
-            "required_not_covered": missing}
+            "required_not_covered": missing, "strict": c.strict}
         rows.append(row)
+        ok = ok and not (missing and c.strict)
         if missing:
             problems.append(f"Standard {_label(row)}: {len(missing)} highly recommended item"
                             f"{'s' if len(missing) != 1 else ''} not covered by discharged evidence: "
                             + ", ".join(missing))
-    return {"rows": rows, "problems": problems, "ok": not problems}
+    return {"rows": rows, "problems": problems, "ok": ok}
 
 
 def strict_reason(report: Mapping[str, Any]) -> list[str]:
     """Why the chosen standards fail ``--strict`` on ``report``: one clause
-    per standard naming its HR items not covered (empty when none)."""
+    per standard chosen with ``strict: true`` naming its HR items not
+    covered (empty when none)."""
     out = []
     for row in report.get("standards") or ():
         missing = list(row.get("required_not_covered") or ())
-        if missing:
+        if missing and row.get("strict"):
             out.append(f"{_label(row)}: highly recommended item{'s' if len(missing) != 1 else ''} not covered ("
                        + ", ".join(missing) + ")")
     return out

@@ -1,10 +1,12 @@
 """The plan's ``standards:`` entries: which profiles the evidence is mapped onto, at which level.
 
-An entry is ``{profile: NAME, <level key>: LEVEL}``: ``NAME`` a built-in
+An entry is ``{profile: NAME, <level key>: LEVEL, strict: BOOL}``: ``NAME`` a built-in
 profile (:func:`.profiles.builtin_names`) or a workspace-relative YAML file of
 the same shape (``*.yaml``/``*.yml``); the level key is the profile's
 ``level_name`` (``sil``, ``dal``, ``pl``) or ``level``, absent for a profile
-without levels.  Every mistake is one located
+without levels; ``strict: true`` makes ``--strict`` fail while an item
+recommended HR at that level is not covered (default ``false``: the items
+are shown, and named in the summary, without failing it).  Every mistake is one located
 :class:`~rclverify.model.plan.errors.PlanError` in the plan (docs/standards.md).
 """
 from __future__ import annotations
@@ -21,10 +23,12 @@ from rclverify.model.plan.standards.profiles import Profile, builtin_names, load
 
 @dataclass(frozen=True)
 class StandardChoice:
-    """A profile chosen by the plan at ``level`` (``None``: the profile has no levels), written at ``loc``."""
+    """A profile chosen by the plan at ``level`` (``None``: the profile has no levels), written at ``loc``;
+    ``strict``: ``--strict`` requires its highly recommended items covered."""
     profile: Profile
     level: str | None
     loc: ast.Loc
+    strict: bool = False
 
 
 def _profile(root: Path, name: str, at: ast.Loc) -> Profile:
@@ -47,11 +51,15 @@ def _level(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Path
 
     allowed = {p.level_name, "level"} if p.levels else set()
     for key in entry:
-        if key != "profile" and key not in allowed:
+        if key not in ("profile", "strict") and key not in allowed:
             l = at(key)
             say = f"its level key is {p.level_name!r} ({', '.join(p.levels)})" if p.levels else "it has no levels"
             raise plan_error(l.file, l.line, l.col, f"standards: {key!r} is not a key of profile {p.id!r}: {say}",
                              "E-profile")
+    if "strict" in entry and not isinstance(entry["strict"], bool):
+        l = at("strict")
+        raise plan_error(l.file, l.line, l.col, f"standards: 'strict' is true or false, not {entry['strict']!r}",
+                         "E-profile")
     given = [k for k in entry if k in allowed]
     if not p.levels:
         return None
@@ -81,7 +89,8 @@ def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast
         p = _profile(root, str(entry["profile"]), at)
         if any(c.profile.id == p.id for c in out):
             raise plan_error(at.file, at.line, at.col, f"standards: profile {p.id!r} is chosen twice", "E-profile")
-        out.append(StandardChoice(p, _level(p, entry, base, locs, file), locs.get(base, at)))
+        out.append(StandardChoice(p, _level(p, entry, base, locs, file), locs.get(base, at),
+                                  bool(entry.get("strict", False))))
     return tuple(out)
 
 
