@@ -239,7 +239,7 @@ def _handler(k: int) -> Any:
     return on_message
 
 
-def graph_dump(wait_s: float, settle_s: float = 6.0, quiet_s: float = 0.5) -> dict[str, Any]:
+def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> dict[str, Any]:
     """The whole graph as rclpy's graph API reports it, once it is settled:
     after ``wait_s`` seconds of discovery, and on (up to ``settle_s`` more)
     until it has not changed for ``quiet_s``.  Each node with its publishers,
