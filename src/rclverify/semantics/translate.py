@@ -28,6 +28,20 @@ def _is_empty_literal(x: ast.Expr) -> bool:
     return isinstance(x, (ast.SetLit, ast.SeqLit)) and not x.items
 
 
+def unary_z3(op: ast.UnaryOp, v: Any) -> Any:
+    """The Z3 term of unary operator ``op`` applied to ``v`` (a ``z3`` Bool for
+    ``not``, an arithmetic term otherwise): ``Not``, ``-v``, ``If(v >= 0, v, -v)``
+    (docs/rcl-language.md; the one Z3 reading of a unary operator, the
+    experiment criterion's too)."""
+    if op == "not":
+        return z3.Not(v)
+    if op == "-":
+        return -v
+    if op == "abs":
+        return z3.If(v >= 0, v, -v)
+    ast.unhandled(op)
+
+
 class _Ctx(Visitor[Any]):
     def __init__(self, enc: Any, node: CheckedNode, symbols: dict[str, Any]) -> None:
         self.e, self.node, self.symbols = enc, node, symbols
@@ -96,14 +110,7 @@ class _Ctx(Visitor[Any]):
         raise EncodingError(x.loc, f"{f.qualified} cannot be applied")
 
     def visit_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:
-        v = self.enc(x.operand, b)
-        if x.op == "not":
-            return z3.Not(v)
-        if x.op == "-":
-            return -v
-        if x.op == "abs":
-            return z3.If(v >= 0, v, -v)
-        ast.unhandled(x.op)
+        return unary_z3(x.op, self.enc(x.operand, b))
 
     def visit_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
         if x.op in FLAT_CHAINS:

@@ -23,6 +23,7 @@ import z3
 
 from rclverify.semantics.connectives import conj
 from rclverify.semantics.query import budgeted_solver
+from rclverify.semantics.translate import unary_z3
 from rclverify.lang import ast
 from rclverify.backends.experiment.figures import Figures, Quantity
 
@@ -149,14 +150,7 @@ def _to_z3(e: ast.Expr, env: Mapping[str, z3.ArithRef]) -> z3.ExprRef:
     if isinstance(e, ast.Var):
         return env[e.name]
     if isinstance(e, ast.Unary):
-        x = _to_z3(e.operand, env)
-        if e.op == "not":
-            return z3.Not(x)
-        if e.op == "-":
-            return -x
-        if e.op == "abs":
-            return z3.If(x >= 0, x, -x)
-        ast.unhandled(e.op)
+        return unary_z3(e.op, _to_z3(e.operand, env))
     if isinstance(e, ast.Binary):
         l, r = _to_z3(e.left, env), _to_z3(e.right, env)
         ops = {"and": lambda: z3.And(l, r), "or": lambda: z3.Or(l, r), "->": lambda: z3.Implies(l, r),
