@@ -30,12 +30,11 @@ from typing import Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, CheckedNode, Type
+from rclverify.semantics.operators import OPERATORS
 
 #: The RCL types of the fragment and their SMT-LIB sorts.
 SORTS: Mapping[Type, str] = {BOOL: "Bool", INTEGER: "Int", NATURAL: "Int", REAL: "Real"}
 
-_OPS = {"and": "and", "or": "or", "->": "=>", "<=>": "=", "+": "+", "-": "-", "*": "*", "/": "/"}
-_CMP = {"==": "=", "<": "<", "<=": "<=", ">": ">", ">=": ">="}
 
 
 class Outside(Exception):
@@ -96,15 +95,14 @@ def _term(e: ast.Expr, node: CheckedNode, symbol: Mapping[tuple[str, str], str],
             return f"(ite (>= {inner} 0) {inner} (- {inner}))"
         ast.unhandled(e.op)
     if isinstance(e, ast.Binary):
-        op = _OPS.get(e.op)
+        op = OPERATORS[e.op].smtlib  # the semantics table's SMT-LIB symbol (semantics/operators.py)
         if op is None:
             raise Outside
         return f"({op} {_term(e.left, node, symbol, used)} {_term(e.right, node, symbol, used)})"
     if isinstance(e, ast.Compare):
         xs = [_term(o, node, symbol, used) for o in e.operands]
-        if any(op != "!=" and op not in _CMP for op in e.ops):
-            raise Outside
-        parts = [(f"(not (= {a} {b}))" if op == "!=" else f"({_CMP[op]} {a} {b})")
+        # != has no SMT-LIB symbol of its own (the table's is None): the negated equality
+        parts = [(f"(not (= {a} {b}))" if op == "!=" else f"({OPERATORS[op].smtlib} {a} {b})")
                  for op, a, b in zip(e.ops, xs, xs[1:])]
         return parts[0] if len(parts) == 1 else "(and " + " ".join(parts) + ")"
     raise Outside
