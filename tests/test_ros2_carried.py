@@ -4,7 +4,8 @@ a monitor started AFTER the publishers (docs/semantics.md, "Widths" and
 
 One rclpy process runs for each source; it publishes for about 1.5 s
 before the monitors start, goes on publishing until their verdict writers
-are in the graph, and publishes 45 more rounds after (about 4.5 s).  The run
+are in the graph, and publishes 45 more rounds after (150 ms apart, about
+6.8 s: an answer later than that is heard after the next round's question).  The run
 is heard through each source, rclpy and DDS (docs/ros2.md, "Two sources"),
 with the same verdicts:
 
@@ -121,7 +122,7 @@ node Sink {
 }
 """
 # the stated transport skew: fa and fb, published together, may arrive tens of milliseconds apart on a loaded
-# machine (the suite runs three workers on two cores); rounds are 100 ms apart
+# machine (the suite runs three workers on two cores); rounds are 150 ms apart
 MAPPING = """\
 skew: 0.05
 topics:
@@ -215,7 +216,7 @@ wait_monitors()
 spin(1.0)  # the monitors' readers match their publishers one by one
 for k in range(20, 65):
     publish_all(k)
-    spin(0.1)
+    spin(0.15)
 spin(0.5)
 print("released", sorted(set(released)), len(released), flush=True)
 print("done", len(heard), len([v for v in heard if v.get("verdict") == "violated"]), flush=True)
@@ -312,8 +313,10 @@ def test_a_latched_input_is_delivered_as_ros2_delivers_it(run: dict[str, Any]) -
     # the latched limit is the state every later command is judged with: a command is "incomplete input" only
     # if it was heard before the limit (the monitor's readers match one by one); the limit came before any
     # answer, so it asks nothing itself (superseded, docs/semantics.md "Steps")
-    assert clamp and {v["verdict"] for v in clamp} <= {"satisfied", "superseded", "incomplete input",
-                                                       "before first answer"}, clamp
+    # (an answer heard within the stated skew of the next command is inconclusive, never guessed: the load)
+    skewed = [v for v in clamp if v["verdict"] == "inconclusive" and "before the question" in v.get("reason", "")]
+    assert clamp and {v["verdict"] for v in clamp if v not in skewed} <= {
+        "satisfied", "superseded", "incomplete input", "before first answer"}, clamp
     assert all(v["time"] <= limits[0]["time"] for v in clamp if v["verdict"] == "incomplete input"), clamp
     assert sum(v["verdict"] == "satisfied" for v in clamp) >= 30
 
