@@ -23,7 +23,7 @@ from rclverify.lang.types import BOOL, Checked
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.formal import Source
 from rclverify.model.plan.targets import check_targets, requirement_target
-from rclverify.model.plan.yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, to_data
+from rclverify.model.plan.yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, schema_error_loc, to_data
 
 # The plan's values live in model/plan/model.py (below this loader and what it calls); re-exported here.
 from rclverify.model.plan.model import Connection, DeadlineSpec, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
@@ -107,15 +107,7 @@ def _check_schema(data: dict[str, Any], locs: Mapping[Path_, ast.Loc], plan_rel:
     if errors:
         diags: list[Diagnostic] = []
         for e in errors:
-            path = tuple(e.absolute_path)
-            if e.validator == "additionalProperties" and isinstance(e.instance, dict):
-                allowed = set(e.schema.get("properties", {})) if isinstance(e.schema, dict) else set()
-                extra = [k for k in e.instance if k not in allowed]
-                if extra and path + (extra[0], KEY) in locs:
-                    path = path + (extra[0], KEY)
-            while path and path not in locs:
-                path = path[:-1]
-            loc = locs.get(path, ast.Loc(plan_rel, 1, 1))
+            loc = schema_error_loc(e, locs, plan_rel)
             where = ".".join(map(str, e.absolute_path)) or "plan"
             diags.extend(plan_error(loc.file, loc.line, loc.col, f"{where}: {e.message}").diagnostics)
         raise PlanError(diags)

@@ -267,3 +267,21 @@ def read_yaml_text(path: Path, file: str) -> str:
         return decode_text(data, file)
     except RclError as exc:
         raise PlanError(exc.diagnostics) from None
+
+
+def schema_error_loc(error: Any, locs: dict[Path_, ast.Loc] | Any, file: str) -> ast.Loc:
+    """Where a ``jsonschema`` validation ``error`` of YAML data read by
+    :func:`load_located` is written: the unexpected key itself for an
+    ``additionalProperties`` error, else the value's path, or its nearest
+    written ancestor (``file:1:1`` when none is)."""
+    path: Path_ = tuple(error.absolute_path)
+    if error.validator == "additionalProperties" and isinstance(error.instance, dict):
+        allowed = set(error.schema.get("properties", {})) if isinstance(error.schema, dict) else set()
+        extra = [k for k in error.instance if k not in allowed]
+        if extra and path + (extra[0], KEY) in locs:
+            path = path + (extra[0], KEY)
+    while path and path not in locs:
+        path = path[:-1]
+    loc: ast.Loc = locs.get(path, ast.Loc(file, 1, 1))
+    return loc
+

@@ -21,7 +21,7 @@ import yaml
 
 from rclverify.lang import ast
 from rclverify.model.plan.errors import PlanError, plan_error
-from rclverify.model.plan.yamlguard import KEY, Path_, load_located, read_yaml_text
+from rclverify.model.plan.yamlguard import Path_, load_located, read_yaml_text, schema_error_loc
 
 #: The recommendation codes, strongest first (IEC 61508-3's: highly recommended, recommended, no
 #: recommendation, not recommended).
@@ -111,14 +111,9 @@ def _check_schema(data: object, locs: Mapping[Path_, ast.Loc], file: str) -> Non
                     key=lambda e: list(map(str, e.absolute_path)))
     if errors:
         e = errors[0]
-        path = tuple(e.absolute_path)
-        if e.validator == "additionalProperties" and isinstance(e.instance, dict):
-            allowed = set(e.schema.get("properties", {})) if isinstance(e.schema, dict) else set()
-            extra = [k for k in e.instance if k not in allowed]
-            if extra and path + (extra[0], KEY) in locs:
-                path = path + (extra[0], KEY)
+        l = schema_error_loc(e, locs, file)
         where = ".".join(map(str, e.absolute_path)) or "profile"
-        raise _bad(locs, path, file, f"standard profile: {where}: {e.message}")
+        raise plan_error(l.file, l.line, l.col, f"standard profile: {where}: {e.message}", "E-profile")
 
 
 def parse_profile(text: str, file: str) -> Profile:
