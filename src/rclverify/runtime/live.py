@@ -45,6 +45,7 @@ from rclverify.backends.monitors.summary import monitoring_details, summary_line
 from rclverify.backends.monitors.check import NodeResult, Verdict
 from rclverify.backends.monitors.deadlines import DeadlineVerdict
 from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
+from rclverify.backends.monitors.run_origin import unseen_links
 from rclverify.runtime.logchecks import LogChecks
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.runtime.worker import EngineWorker
@@ -232,7 +233,7 @@ class LiveRun:
         heard = Heard({**{t: s.received for t, s in self.engine.topics.items()}, **self.calls_heard},
                       dict(self.orphans), dict(record.get("decode_errors") or {}), list(record.get("warnings") or ()),
                       {k: int(v.get("publishers_heard", 0)) for k, v in record["qos"].items()}
-                      if isinstance(record.get("qos"), dict) else None)
+                      if isinstance(record.get("qos"), dict) else None, unseen_links(record))
         statuses: dict[str, list[tuple[str, str]]] = {}
         for n in [*record["nodes"], *record.get("calls", {}).get("nodes", [])]:
             statuses.setdefault(n["node"], []).append((n["status"], n["explanation"]))

@@ -32,7 +32,7 @@ from rclverify.traces.files import trace_files, trace_sha256
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
 from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.run_origin import RunOrigin
+from rclverify.backends.monitors.run_origin import RunOrigin, unseen_links
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
 from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
@@ -231,7 +231,8 @@ class MonitorsBackend:
         dl = finished.get("deadlines")
         # silence is never green: what the run did not judge, with the reason, beside the status
         extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
-                                                                      dict(calls.orphans)),
+                                                                      dict(calls.orphans),
+                                                                      unseen=unseen_links(read.origin)),
                                                  {res.node: [(status, explanation)]},
                                                  {dl.node: dl.counts} if dl is not None else {}, f"in {trace}",
                                                  decided_of([res], calls.entries() if summary is not None else []))

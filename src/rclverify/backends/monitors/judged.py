@@ -53,13 +53,16 @@ class Heard:
     (or a tap's key naming the link) -> messages that did not decode;
     ``warnings``: the live bus's warning lines (a refused publisher names
     its topic); ``publishers``: topic -> publishers the live reader matched
-    (``None`` offline)."""
+    (``None`` offline); ``unseen``: link name (``"/estop"``) -> what the
+    run's source could not hear of it (the rclpy source without
+    introspection events: run_origin.py), added to its item's detail."""
 
     messages: dict[str, int] = field(default_factory=dict)
     orphans: dict[str, int] = field(default_factory=dict)
     decode_errors: Mapping[str, int] = field(default_factory=dict)
     warnings: Iterable[str] = ()
     publishers: Mapping[str, int] | None = None
+    unseen: Mapping[str, str] = field(default_factory=dict)
 
 
 def _where(block: Any, row: int) -> str:
@@ -231,7 +234,14 @@ def _silent_topic(key: str, typ: str, heard: Heard, warnings: list[str], where: 
 
 
 def _silent_link(key: str, kind: str, heard: Heard, where: str) -> tuple[str, str] | None:
-    """Why link ``key`` was not judged, ``None`` when a call of it was answered."""
+    """Why link ``key`` was not judged, ``None`` when a call of it was answered;
+    with what the run's source could not hear of it (``heard.unseen``)."""
+    found = _link_reason(key, kind, heard, where)
+    why = heard.unseen.get("/" + key)
+    return found if found is None or not why else (found[0], f"{found[1]} (the rclpy source: {why})")
+
+
+def _link_reason(key: str, kind: str, heard: Heard, where: str) -> tuple[str, str] | None:
     parts = LINK_TOPICS[kind]
     opened = sum(heard.messages.get(f"{key}/{p}", 0) for p in parts if p in _OPENS)
     answered = sum(heard.messages.get(f"{key}/{p}", 0) for p in parts if p in _ANSWERS)

@@ -30,6 +30,7 @@ from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC, CallBook, replay_line
 from rclverify.backends.monitors.deadlines import DeadlineResult, deadline_status
 from rclverify.backends.monitors.judged import count_call_line
+from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC, RunOrigin
 from rclverify.backends.monitors.summary import verdict_status
 from rclverify.backends.monitors.verdicts import NodeResult
 
@@ -54,6 +55,8 @@ class LogCalls:
         self.messages: dict[str, int] = {}
         self.orphans: dict[str, int] = {}
         self.summary: dict[str, Any] | None = None
+        #: the source the live run says it heard through, and what it could not hear (run_origin.py)
+        self.origin = RunOrigin()
 
     @property
     def active(self) -> bool:
@@ -66,6 +69,8 @@ class LogCalls:
         for ev in events:
             if ev.topic == CALL_LOG_TOPIC:
                 self.feed(ev)
+            elif ev.topic == ORIGIN_TOPIC:
+                self.origin.take(ev.fields)
             yield ev
 
     def feed(self, ev: Event) -> None:

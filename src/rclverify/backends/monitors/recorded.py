@@ -27,6 +27,7 @@ from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, 
 from rclverify.backends.monitors.summary import verdict_status
 from rclverify.backends.monitors.widths import at_carried_widths, carried_fields, float_widths, refuse_out_of_range
 from rclverify.backends.monitors.verdicts import NodeResult
+from rclverify.backends.monitors.run_origin import unseen_links
 
 
 @dataclass
@@ -92,7 +93,8 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
         total = dcounts.setdefault(r.node, {})
         for v, k in r.counts.items():
             total[v] = total.get(v, 0) + k
-    items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans)), statuses, dcounts,
+    items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans),
+                                    unseen=unseen_links(calls.origin.origin)), statuses, dcounts,
                        f"in {trace}", decided_of(results, centries))
     if one.bag is not None:  # a bag without a link's call topics: say what it lacks (bag_calls.py)
         one.bag.explain(items)

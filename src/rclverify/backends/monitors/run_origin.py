@@ -57,4 +57,14 @@ class RunOrigin:
             self.origin["unseen"] = [str(u) for u in fields.get("unseen") or ()]
 
 
-__all__ = ["ORIGIN_TOPIC", "RunOrigin", "origin_line", "unseen_line"]
+def unseen_links(origin: Mapping[str, Any] | None) -> dict[str, str]:
+    """Link name (``"/estop"``) -> what the source could not hear of it, from
+    an origin's ``unseen`` sentences (``"/estop: no introspection event ..."``)."""
+    out: dict[str, str] = {}
+    for line in (origin or {}).get("unseen") or ():
+        name, _, why = str(line).partition(": ")
+        out[name] = why
+    return out
+
+
+__all__ = ["ORIGIN_TOPIC", "RunOrigin", "origin_line", "unseen_line", "unseen_links"]

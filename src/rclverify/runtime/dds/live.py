@@ -371,10 +371,7 @@ class _DdsRun:
             record_["bag"] = self.recorder.close()
             if self.call_recorder is not None and self.call_recorder.failed:
                 record_["bag"]["calls_failed"] = self.call_recorder.failed
-        record_["not_judged"] = live.not_judged(record_)  # silence is never green (judged.py)
-        for item in record_["not_judged"]:  # what the source could not hear says why
-            if item["kind"] in ("service", "action") and item["name"] in unheard:
-                item["detail"] += f" (the rclpy source: {unheard[item['name']]})"
+        record_["not_judged"] = live.not_judged(record_)  # silence is never green (judged.py; record's unseen too)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
         self.out(_status(live, self.call_counts))
