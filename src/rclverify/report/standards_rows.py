@@ -64,10 +64,23 @@ def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[Mapping
         rows.append(row)
         ok = ok and not (missing and c.strict)
         if missing:
-            problems.append(f"Standard {_label(row)}: {len(missing)} highly recommended item"
-                            f"{'s' if len(missing) != 1 else ''} not covered by discharged evidence: "
-                            + ", ".join(missing))
+            problems.append(_missing_sentence(row, [x for x in clauses if x["id"] in missing]))
     return {"rows": rows, "problems": problems, "ok": ok}
+
+
+def _missing_sentence(row: StandardRow, missing: Sequence[ClauseRow]) -> str:
+    """The summary's sentence for a standard's HR items not covered: each with
+    its title and why (no evidence of the kinds it accepts, or some of its
+    records not discharged), and where to read them."""
+    def why(c: ClauseRow) -> str:
+        if not c["evidence"]:
+            return f"no {' or '.join(c['accepts'])} evidence"
+        bad = sum(1 for e in c["evidence"] if e["status"] != "discharged")
+        return f"{bad} of its {len(c['evidence'])} records not discharged"
+    items = "; ".join(f"{c['id']} {c['title'].lower()} ({why(c)})" for c in missing)
+    return (f"Standard {_label(row)}: {len(missing)} highly recommended item{'s' if len(missing) != 1 else ''} "
+            f"not covered by discharged evidence: {items}; the report's section Safety standards lists each "
+            f"item's records")
 
 
 def strict_reason(report: Mapping[str, Any]) -> list[str]:
