@@ -81,7 +81,7 @@ def test_every_evaluator_and_z3_agree_with_the_oracle(spec: Any) -> None:
 
 
 def test_smtlib_text_means_the_absolute_value(spec: Any) -> None:
-    from rclverify.calculus.smttext import to_smt
+    from rclverify.targets.smtlib import to_smt
     _p, _checked, node, formula = spec
     used: dict[str, str] = {}
     text = to_smt(formula, node, {("in", "a"): "a", ("in", "b"): "b", ("out", "y"): "y"}, used)
@@ -102,7 +102,7 @@ def test_the_column_monitors_agree_with_the_row_engine() -> None:
     are sure, they give the oracle's truth."""
     import numpy as np
 
-    from rclverify.backends.monitors.columns import ColumnCompiler
+    from rclverify.targets.columns import ColumnCompiler
     parsed = parse_text(SPEC.replace("a : INTEGER", "a : REAL").replace("abs(-in.a) == 3", "abs(-in.a) >= 3"),
                         "cols.rcl")
     checked = check([parsed])
@@ -130,8 +130,8 @@ def test_the_experiment_criterion_reads_it() -> None:
 
 
 def test_cpp_and_dafny_text(spec: Any) -> None:
-    from rclverify.backends.dafny.translate import Translator
-    from rclverify.tools.generate.cpp_expr import CppTranslator
+    from rclverify.targets.dafny.translate import Translator
+    from rclverify.targets.cpp.expr import CppTranslator
     _p, checked, node, formula = spec
     assert "std::abs(" in CppTranslator(checked, node).translate(formula)
     dafny = Translator(checked.env, node, {"in.a": "a", "in.b": "b", "out.y": "y"}).formula(formula)

@@ -22,7 +22,7 @@ import pytest
 
 from _classifier import CLASSIFIER
 from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.columns import column
+from rclverify.targets.columns import column
 from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace
 from rclverify.traces.bag import read_bag, typestore

@@ -191,7 +191,7 @@ def test_verdicts_with_summaries_equal_the_whole_cones(seed: int) -> None:
 @given(seed=st.integers(0, 10**6))
 def test_the_hidden_names_read_off_the_text_are_the_walked_constants(seed: int) -> None:
     """summary_qe._bound's token path (names bare as Z3 prints them, or quoted
-    as smttext writes them) binds exactly the constants a walk of the parsed
+    as targets/smtlib.py writes them) binds exactly the constants a walk of the parsed
     formulas finds."""
     from rclverify.calculus import summary_qe as S
     bound, seen = S._bound, []

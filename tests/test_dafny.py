@@ -17,8 +17,8 @@ from rclverify.backends.dafny import DafnyBackend
 from rclverify.backends.dafny.implementation import scan_implementation
 from rclverify.backends.dafny.runner import find_dafny, parse_output
 from rclverify.backends.dafny.stubgen import clause_lines
-from rclverify.backends.dafny.text import real_literal
-from rclverify.backends.dafny.translate import Translator
+from rclverify.targets.dafny.text import real_literal
+from rclverify.targets.dafny.translate import Translator
 from rclverify.calculus.refinement import check_refinement, merge_envs, refines_main
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang.parser import parse_formula
@@ -473,3 +473,40 @@ def test_strings_ranges_and_tuple_binders_translate_to_dafny_that_resolves(tmp_p
     assert tool is not None
     out = subprocess.run(verify_argv(tool, [str(src)], 60), capture_output=True, text=True, timeout=300)
     assert "0 errors" in out.stdout, out.stdout
+
+
+@needs_dafny
+def test_each_operator_s_dafny_spelling_means_the_table_entry(tmp_path: Path) -> None:
+    """The ``dafny`` field of every binary entry of the semantics table, held to the entry's
+    exact meaning by Dafny itself: one assertion per operator and operand pair, on reals (and
+    on truth values for the connectives), and one deliberately false assertion that must fail
+    (so a Dafny that checks nothing cannot pass)."""
+    import subprocess
+    from fractions import Fraction
+
+    from rclverify.backends.dafny.runner import detect, verify_argv
+    from rclverify.semantics.operators import OPERATORS
+
+    lines: list[str] = []
+    for op, entry in sorted(OPERATORS.items()):
+        assert entry.dafny, op
+        if entry.kind == "connective":
+            for a in (False, True):
+                for b in (False, True):
+                    want = entry.exact(a, b)
+                    lines.append(f"  assert ({str(a).lower()} {entry.dafny} {str(b).lower()}) == {str(want).lower()};")
+            continue
+        for x, y in [(3, 2), (2, 3), (2, 2), (-1, 4)]:
+            want = entry.exact(Fraction(x), Fraction(y))
+            q = Fraction(want)
+            shown = str(want).lower() if isinstance(want, bool) else f"({q.numerator}.0 / {q.denominator}.0)"
+            lines.append(f"  assert ({x}.0 {entry.dafny} {y}.0) == {shown};")
+    ok, bad = tmp_path / "ok.dfy", tmp_path / "bad.dfy"
+    ok.write_text("method M() {\n" + "\n".join(lines) + "\n}\n")
+    bad.write_text(f"method M() {{\n  assert (3.0 {OPERATORS['<'].dafny} 2.0) == true;\n}}\n")
+    tool = detect(str(find_dafny()))
+    assert tool is not None
+    good = subprocess.run(verify_argv(tool, [str(ok)], 60), capture_output=True, text=True, timeout=300)
+    assert "0 errors" in good.stdout, good.stdout
+    wrong = subprocess.run(verify_argv(tool, [str(bad)], 60), capture_output=True, text=True, timeout=300)
+    assert "1 error" in wrong.stdout, wrong.stdout

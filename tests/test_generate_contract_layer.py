@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from rclverify.cli.commands import main
-from rclverify.tools.generate.pycarry import NOT_CARRIED
+from rclverify.targets.python.carry import NOT_CARRIED
 from rclverify.semantics.concrete import check_concrete
 from rclverify.app.pipeline import Workspace
 from rclverify.lang.types import BOOL, EmptyT, FuncT, Scalar
@@ -339,7 +339,7 @@ def test_the_stream_agrees_with_the_monitor_engine_on_every_case_study_node(tree
 
 
 def _snake(name: str) -> str:
-    from rclverify.tools.generate.typemap import snake
+    from rclverify.targets.typemap import snake
     return snake(name)
 
 

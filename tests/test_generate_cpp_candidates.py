@@ -1,5 +1,5 @@
 """The generated C++ checks decide quantifiers over unbounded numeric domains at the same candidate
-points as rclverify's double reading (``semantics/candidates.py``, ``tools/generate/cpp_candidates.py``): the
+points as rclverify's double reading (``semantics/candidates.py``, ``targets/cpp/candidates.py``): the
 contract of ``test_candidates.py`` (function tables, a constructor term, nested quantifiers,
 ``exists_unique`` over REAL, INTEGER and NATURAL, three clauses outside the fragment) compiled with
 ``g++ -std=c++17 -Wall -Wextra -Werror``, each clause's C++ truth on random tables equal to

@@ -1,7 +1,7 @@
 """``generate ros2`` and hostile RCL names (issue 63 row 10; docs/generate.md, "Names").
 
 An RCL identifier may end in primes (``x'``) and may be a Python or C++ keyword (``class``,
-``delete``, ``lambda``, ``None``, ``namespace``, ``int``).  Before tools/generate/names.py the tree
+``delete``, ``lambda``, ``None``, ``namespace``, ``int``).  Before targets/names.py the tree
 of such a contract did not compile (``def step(x', class)``, ``double delete{};``) and the
 command said 0.  Here:
 
@@ -31,7 +31,7 @@ import yaml
 
 from _ros2 import ros2_python
 from rclverify.cli.commands import main
-from rclverify.tools.generate.names import constant_name, field_name, msg_name, package_name, py_name
+from rclverify.targets.names import constant_name, field_name, msg_name, package_name, py_name
 from rclverify.ros.extract.treesitter import parser, walk
 from _rclcpp_stub import write_stubs
 

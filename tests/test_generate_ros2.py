@@ -335,7 +335,7 @@ def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | N
         if w not in trees:
             trees[w] = tmp_path / f"out{len(trees)}"
             assert main(["generate", "ros2", "-w", str(w), "-o", str(trees[w])]) == 0
-        from rclverify.tools.generate.typemap import snake
+        from rclverify.targets.typemap import snake
         path = trees[w] / snake(node) / snake(node) / "contract.py"
         spec = importlib.util.spec_from_file_location(f"diff_{node}_{bool(tolerance)}", path)
         assert spec is not None and spec.loader is not None

@@ -47,6 +47,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("semantics", ("rclverify.semantics",)),
     ("traces", ("rclverify.traces",)),
     ("model", ("rclverify.model",)),
+    ("targets", ("rclverify.targets",)),
     ("ros/extract", ("rclverify.ros", "rclverify.ros.extract")),
     ("ros/graph", ("rclverify.ros.graph",)),
     ("ros/live", ("rclverify.ros.live",)),

@@ -21,7 +21,7 @@ import pytest
 from _classifier import CLASSIFIER_NODE
 from rclverify.backends.monitors.batch import batch_plan, check_batch
 from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.columns import ColumnCompiler
+from rclverify.targets.columns import ColumnCompiler
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.semantics.floatsem import judge, parse_tolerance

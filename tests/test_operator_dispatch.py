@@ -24,11 +24,11 @@ SRC = Path(__file__).resolve().parent.parent / "src"
 #: each place that gives a unary operator its meaning in another language, by dispatch on the operator
 DISPATCHES = {
     "rclverify/semantics/translate.py": 1,  # Z3
-    "rclverify/calculus/smttext.py": 1,  # SMT-LIB text
-    "rclverify/backends/dafny/translate.py": 1,  # Dafny
+    "rclverify/targets/smtlib.py": 1,  # SMT-LIB text
+    "rclverify/targets/dafny/translate.py": 1,  # Dafny
     "rclverify/backends/experiment/criterion.py": 1,  # the experiment criterion's sort (its Z3 is unary_z3)
-    "rclverify/tools/generate/cpp_expr.py": 1,  # C++
-    "rclverify/tools/generate/pycarry.py": 1,  # the evaluator carried into generated packages
+    "rclverify/targets/cpp/expr.py": 1,  # C++
+    "rclverify/targets/python/carry.py": 1,  # the evaluator carried into generated packages
     "rclverify/lang/printer.py": 2,  # RCL text and its precedence
     "rclverify/lang/latex.py": 1,  # LaTeX
     "rclverify/lang/typecheck_expr.py": 1,  # types

@@ -1,7 +1,7 @@
 """The in-context query as SMT-LIB text (:mod:`.context`): the declarations
 of a cone's symbols, flags and premise literals, one script from the
 parsed premises and Z3's printing of the rest, and a model of
-:mod:`.smttext`'s fragment read back from Z3's text (SMT-LIB 2.6,
+:mod:`rclverify.targets.smtlib`'s fragment read back from Z3's text (SMT-LIB 2.6,
 ``define-fun`` of constants) without one Z3 object per value.
 """
 from __future__ import annotations
@@ -11,12 +11,12 @@ from fractions import Fraction
 from typing import Any, Mapping
 
 from rclverify.semantics.values import decimal_text
-from rclverify.calculus.smttext import SORTS, quote
+from rclverify.targets.smtlib import SORTS, quote
 
 
 def sort_of_symbol(cn: Any, prefix: str, var: str) -> str:
     """The SMT-LIB sort of I/O ``prefix.var`` of checked node ``cn``
-    (``KeyError`` outside :mod:`.smttext`'s sorts)."""
+    (``KeyError`` outside :mod:`rclverify.targets.smtlib`'s sorts)."""
     t = (cn.inputs if prefix == "in" else cn.outputs)[var]
     return SORTS[t]
 

@@ -58,7 +58,7 @@ from rclverify.semantics.query import query_solver, render_model, satisfiable, s
 from rclverify.lang import ast
 from rclverify.lang.types import Checked
 from rclverify.model.system.model import Link, SystemModel
-from rclverify.calculus.smttext import quote
+from rclverify.targets.smtlib import quote
 from rclverify.calculus.premises import node_premises
 from rclverify.calculus.cone_script import declare, merge, read_model, sort_of_symbol
 
@@ -195,7 +195,7 @@ class ConeContext:
     (the calculus's own split, :func:`.compose.split_assumption`, passed in:
     this module sits below it); ``facts`` the plan's environment facts per
     node (RCL formulas over that node's I/O); ``fast``: read the formulas of
-    :mod:`.smttext`'s fragment from their SMT-LIB text (``False``: encode
+    :mod:`rclverify.targets.smtlib`'s fragment from their SMT-LIB text (``False``: encode
     every formula with the encoder; the verdicts are the same, tests).
 
     Each premise ``k`` is asserted as ``l!k -> premise`` and the query is

@@ -19,7 +19,7 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked
 from rclverify.model.system.model import SystemModel
-from rclverify.calculus.smttext import to_smt
+from rclverify.targets.smtlib import to_smt
 
 
 @dataclass(frozen=True)
@@ -29,7 +29,7 @@ class NodePremises:
     kind, index, SMT-LIB text or None)`` with kind ``guarantee``,
     ``environment`` or ``fact``; ``assumption``: the SMT-LIB text of the
     node's assumption (``None``: none or ``TRUE``); ``smt``: every formula
-    of the node is in :mod:`.smttext`'s fragment; ``symbols``: ``{symbol
+    of the node is in :mod:`rclverify.targets.smtlib`'s fragment; ``symbols``: ``{symbol
     name: (prefix, var)}`` of the I/O the texts mention."""
 
     items: tuple[tuple[str, str, str, int, str | None], ...]

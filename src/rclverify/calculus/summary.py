@@ -29,7 +29,7 @@ Soundness first:
   has a loop (rule R4 opens loops per consumer, lines 741-743), its
   maximal producers' cones overlap (a reconverging join: the projection
   would forget that the two branches share a value), a formula leaves
-  :mod:`.smttext`'s fragment, or ``qe`` fails within its budget;
+  :mod:`rclverify.targets.smtlib`'s fragment, or ``qe`` fails within its budget;
 * :func:`decide` answers only ``proved``, and only when the query over the
   summaries is unsat *and* its premises are satisfiable (exact summaries:
   then so is ``P(n)``, and the full cone's verdict is ``proved`` too).
@@ -69,7 +69,7 @@ from rclverify.semantics.query import query_solver
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.context import NEGATED, ContextResult, _multi_path, single_paths
 from rclverify.calculus.premises import node_premises
-from rclverify.calculus.smttext import SORTS, quote, to_smt
+from rclverify.targets.smtlib import SORTS, quote, to_smt
 from rclverify.calculus.summary_qe import eliminate, implied
 
 #: A summary whose SMT-LIB text is longer is not kept (the full cone is read instead).

@@ -16,7 +16,7 @@ from typing import Mapping, Sequence
 
 import z3
 
-from rclverify.calculus.smttext import quote
+from rclverify.targets.smtlib import quote
 from rclverify.semantics import wallclock
 from rclverify.semantics.connectives import conj
 from rclverify.semantics.retry import has_quantifier
@@ -50,7 +50,7 @@ def eliminate(ctx: z3.Context, decls: str, bodies: Sequence[str], hidden: Sequen
     return None
 
 
-#: The Z3 sort of each SMT-LIB sort name of :data:`.smttext.SORTS`.
+#: The Z3 sort of each SMT-LIB sort name of :data:`rclverify.targets.smtlib.SORTS`.
 _Z3_SORTS = {"Real": z3.RealSort, "Int": z3.IntSort, "Bool": z3.BoolSort}
 
 
@@ -62,7 +62,7 @@ def _bound(ctx: z3.Context, fs: Sequence[z3.ExprRef], bodies: Sequence[str], hid
     is its name and sort), else found by walking the parsed ``fs`` (walking
     the terms through Z3's Python objects was a tenth of a summary)."""
     if sorts is not None and all(sorts.get(h) in _Z3_SORTS and not any(c in h for c in " \t\n()|") for h in hidden):
-        # a name is one token, bare (as Z3 prints it in a summary) or quoted (as smttext writes it)
+        # a name is one token, bare (as Z3 prints it in a summary) or quoted (as targets/smtlib.py writes it)
         tokens = set(_TOKEN.findall(" ".join(bodies)))
         return [z3.Const(h, _Z3_SORTS[sorts[h]](ctx)) for h in hidden if h in tokens or quote(h) in tokens]
     consts = {str(c): c for f in fs for c in _constants(f)}

@@ -9,6 +9,7 @@ domains that are types are not (see :func:`rclverify.lang.printer.is_type`).
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, Callable, Iterable, Iterator, Union
 
 from rclverify.lang import ast
@@ -94,3 +95,33 @@ def free_names(e: Union[ast.Expr, ast.TypeExpr], *, heads: bool = True, type_nam
     for c in children(e):  # type: ignore[arg-type]
         found |= free_names(c, heads=heads, type_names=type_names)
     return found
+
+
+def reads(e: Any, out: set[str]) -> None:
+    """Every name a formula mentions: each :class:`ast.Var`'s qualified and bare
+    name, anywhere in the tree (quantifier domains included); a superset of
+    the I/O variables it reads."""
+    if isinstance(e, ast.Var):
+        out.add(e.qualified)
+        out.add(e.name)
+        return
+    if isinstance(e, tuple):
+        for x in e:
+            reads(x, out)
+        return
+    if dataclasses.is_dataclass(e) and not isinstance(e, (type, ast.Loc)):
+        for f in dataclasses.fields(e):
+            reads(getattr(e, f.name), out)
+
+
+def names(e: Any, out: set[str]) -> None:
+    """Add to ``out`` the qualified name of every :class:`ast.Var` reachable through an
+    expression's operands (quantifier domains and bodies included; binding names not)."""
+    if isinstance(e, ast.Var):
+        out.add(e.qualified)
+    for name in ("args", "operand", "left", "right", "operands", "elem", "collection", "items", "body", "func"):
+        c = getattr(e, name, None)
+        if c is None:
+            continue
+        for x in (c if isinstance(c, tuple) else (c,)):
+            names(x, out)

@@ -41,7 +41,7 @@ adjacent doubles), below and above the ends ``s - 1``/``s + 1`` (the next double
 rounds back).  ``INTEGER``/``NATURAL`` points are the floor and ceiling of each breakpoint
 (``NATURAL`` >= 0) and ``s - 1``, ``s + 1``; an integer breakpoint ``s`` splits nothing
 between ``floor(s)`` and ``ceil(s)``.  The generated C++ checks make the same points in the
-same order (``tools/generate/cpp_candidates.py``).  This module reads the body (:func:`analyse`);
+same order (``targets/cpp/candidates.py``).  This module reads the body (:func:`analyse`);
 :mod:`rclverify.semantics.candidate_points` makes the points and decides the quantifier.
 """
 from __future__ import annotations

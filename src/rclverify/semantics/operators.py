@@ -27,7 +27,7 @@ instead of restating it:
   must call a helper, e.g. exact arithmetic in Python, division in C++),
   :attr:`Operator.z3` (the ``z3.ArithRef`` method, or the Z3 function of a
   connective), :attr:`Operator.numpy` (the numpy ufunc's name for the
-  column evaluation of recorded runs), :attr:`Operator.smtlib`.
+  column evaluation of recorded runs), :attr:`Operator.smtlib`, :attr:`Operator.dafny`.
 * :attr:`Operator.identity` is the neutral element (``and`` TRUE, ``+`` 0, ...)
   when there is one; :attr:`Operator.converse` and :attr:`Operator.negation`
   relate the comparisons (``a < b`` is ``b > a`` and ``not (a >= b)``).
@@ -70,6 +70,7 @@ class Operator:
     z3: str | None = None
     numpy: str | None = None
     smtlib: str | None = None
+    dafny: str | None = None
     identity: Any = None
     decisive: bool | None = None
     decided: bool | None = None
@@ -121,28 +122,28 @@ def _double_cmp(raw: Callable[[Any, Any], bool]) -> Callable[[Any, Any], bool]:
 
 
 def _connective(symbol: str, name: str, truth: Callable[[bool, bool], bool], *, python: str, cpp: str,
-                z3: str, smtlib: str, identity: bool | None, decisive: bool | None,
+                z3: str, smtlib: str, dafny: str, identity: bool | None, decisive: bool | None,
                 decided: bool | None) -> Operator:
     return Operator(symbol, name, "connective", 2, truth, truth, python=python, cpp=cpp, z3=z3, smtlib=smtlib,
-                    identity=identity, decisive=decisive, decided=decided)
+                    dafny=dafny, identity=identity, decisive=decisive, decided=decided)
 
 
 def _comparison(symbol: str, name: str, raw: Callable[[Any, Any], bool], *, z3: str, numpy: str,
                 smtlib: str | None, converse: str, negation: str) -> Operator:
     return Operator(symbol, name, "comparison", 2, raw, _double_cmp(raw), python=f"({{l}} {symbol} {{r}})",
-                    cpp=f"({{l}} {symbol} {{r}})", z3=z3, numpy=numpy, smtlib=smtlib, converse=converse,
+                    cpp=f"({{l}} {symbol} {{r}})", z3=z3, numpy=numpy, smtlib=smtlib, dafny=symbol, converse=converse,
                     negation=negation)
 
 
 _ENTRIES = (
     _connective("and", "conjunction", lambda a, b: a and b, python="({l} and {r})", cpp="({l} && {r})",
-                z3="And", smtlib="and", identity=True, decisive=False, decided=False),
+                z3="And", smtlib="and", dafny="&&", identity=True, decisive=False, decided=False),
     _connective("or", "disjunction", lambda a, b: a or b, python="({l} or {r})", cpp="({l} || {r})",
-                z3="Or", smtlib="or", identity=False, decisive=True, decided=True),
+                z3="Or", smtlib="or", dafny="||", identity=False, decisive=True, decided=True),
     _connective("->", "implication", lambda a, b: (not a) or b, python="((not {l}) or {r})",
-                cpp="(!{l} || {r})", z3="Implies", smtlib="=>", identity=None, decisive=False, decided=True),
+                cpp="(!{l} || {r})", z3="Implies", smtlib="=>", dafny="==>", identity=None, decisive=False, decided=True),
     _connective("<=>", "equivalence", lambda a, b: a == b, python="({l} == {r})", cpp="({l} == {r})",
-                z3="__eq__", smtlib="=", identity=True, decisive=None, decided=None),
+                z3="__eq__", smtlib="=", dafny="<==>", identity=True, decisive=None, decided=None),
     _comparison("==", "equality", operator.eq, z3="__eq__", numpy="equal", smtlib="=", converse="==",
                 negation="!="),
     _comparison("!=", "disequality", operator.ne, z3="__ne__", numpy="not_equal", smtlib=None, converse="!=",
@@ -156,13 +157,13 @@ _ENTRIES = (
     _comparison(">=", "at least", operator.ge, z3="__ge__", numpy="greater_equal", smtlib=">=", converse="<=",
                 negation="<"),
     Operator("+", "addition", "arithmetic", 2, _exact_arith(operator.add), _double_arith(operator.add),
-             cpp="({l} + {r})", z3="__add__", numpy="add", smtlib="+", identity=0),
+             cpp="({l} + {r})", z3="__add__", numpy="add", smtlib="+", dafny="+", identity=0),
     Operator("-", "subtraction", "arithmetic", 2, _exact_arith(operator.sub), _double_arith(operator.sub),
-             cpp="({l} - {r})", z3="__sub__", numpy="subtract", smtlib="-"),
+             cpp="({l} - {r})", z3="__sub__", numpy="subtract", smtlib="-", dafny="-"),
     Operator("*", "multiplication", "arithmetic", 2, _exact_arith(operator.mul), _double_arith(operator.mul),
-             cpp="({l} * {r})", z3="__mul__", numpy="multiply", smtlib="*", identity=1),
+             cpp="({l} * {r})", z3="__mul__", numpy="multiply", smtlib="*", dafny="*", identity=1),
     Operator("/", "division", "arithmetic", 2, _exact_div, _double_div, cpp=None, z3="__truediv__",
-             numpy="true_divide", smtlib="/", zero_divisor="undecided"),
+             numpy="true_divide", smtlib="/", dafny="/", zero_divisor="undecided"),
 )
 
 #: binary operator symbol -> its entry
@@ -175,7 +176,7 @@ UNARY: Mapping[str, Operator] = {
     "-": Operator("-", "unary minus", "arithmetic", 1, operator.neg, operator.neg, python="(-{x})",
                   cpp="(-{x})", z3="__neg__", numpy="negative", smtlib="-"),
     # |x|: exact in both readings (the sign bit cleared; abs(NaN) is NaN, which compares false);
-    # SMT-LIB's ``abs`` is of the Ints theory only, so the solvers get ``ite`` (smttext.py, translate.py)
+    # SMT-LIB's ``abs`` is of the Ints theory only, so the solvers get ``ite`` (targets/smtlib.py, semantics/translate.py)
     "abs": Operator("abs", "absolute value", "arithmetic", 1, abs, abs, python="abs({x})",
                     cpp="std::abs({x})", z3=None, numpy="absolute", smtlib=None),
 }

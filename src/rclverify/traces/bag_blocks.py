@@ -280,7 +280,7 @@ class BagBlock:
 
     def typed(self, rows: np.ndarray, key: str, kind: str, codes: Mapping[str, int]
               ) -> tuple[np.ndarray, np.ndarray] | None:
-        """``key`` at ``rows`` as :func:`~rclverify.backends.monitors.columns.column` reads
+        """``key`` at ``rows`` as :func:`~rclverify.targets.columns.column` reads
         it, from the decoded columns; ``None`` when a row's message was decoded whole."""
         if key != "data" or not (self._is_float[rows] | self._is_str[rows]).all():
             return None  # a message decoded whole (its event's fields hold its value)

@@ -149,7 +149,7 @@ class ColumnBlock:
 
     def typed(self, rows: np.ndarray, key: str, kind: str, codes: Mapping[str, int]
               ) -> tuple[np.ndarray, np.ndarray] | None:
-        """``key`` at ``rows`` as :func:`~rclverify.backends.monitors.columns.column`
+        """``key`` at ``rows`` as :func:`~rclverify.targets.columns.column`
         reads it ((mapped, column): a finite float for ``kind`` ``"real"``, an
         enumeration value's code for ``"enum"``), from the arrays themselves;
         ``None`` when a topic's values are not a float64 or string array."""

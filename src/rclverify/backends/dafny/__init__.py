@@ -2,8 +2,8 @@
 verified in Dafny, showing implementations are interchangeable under the
 node's contract).
 
-Modules: :mod:`.types` (RCL type -> Dafny type), :mod:`.translate` (RCL
-formula -> Dafny expression), :mod:`.stubgen` (the ``abstract module``
+Modules (the translation of RCL types and formulas to Dafny is
+:mod:`rclverify.targets.dafny`): :mod:`.stubgen` (the ``abstract module``
 contract stub), :mod:`.runner` (find, identify, run Dafny and read its
 output), :mod:`.backend` (:class:`DafnyBackend`, name ``dafny``, kind
 ``proof``).

@@ -44,8 +44,8 @@ import jinja2
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import CheckedNode, DataT, EnumT, Env, Type
-from rclverify.backends.dafny.translate import Translator
-from rclverify.backends.dafny.types import dafny_ident, dafny_type, datatype_decl, datatypes_in
+from rclverify.targets.dafny.translate import Translator
+from rclverify.targets.dafny.types import dafny_ident, dafny_type, datatype_decl, datatypes_in
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,8 @@ about every trial.  Allowed: numbers, ``+ - * /``, comparisons, ``and``,
 are added or compared).
 
 Evaluation is exact: every figure is a rational, the criterion becomes a Z3
-formula, and Z3 decides it; a per-trial standard deviation (irrational in
+formula (each operator's Z3 reading from the semantics table, :func:`rclverify.semantics.sorts.apply_operator`
+and :func:`rclverify.semantics.translate.unary_z3`), and Z3 decides it; a per-trial standard deviation (irrational in
 general) is the non-negative root of its exact variance.
 """
 from __future__ import annotations
@@ -23,6 +24,7 @@ import z3
 
 from rclverify.semantics.connectives import conj
 from rclverify.semantics.query import budgeted_solver
+from rclverify.semantics.sorts import apply_operator
 from rclverify.semantics.translate import unary_z3
 from rclverify.lang import ast
 from rclverify.backends.experiment.figures import Figures, Quantity
@@ -152,16 +154,10 @@ def _to_z3(e: ast.Expr, env: Mapping[str, z3.ArithRef]) -> z3.ExprRef:
     if isinstance(e, ast.Unary):
         return unary_z3(e.op, _to_z3(e.operand, env))
     if isinstance(e, ast.Binary):
-        l, r = _to_z3(e.left, env), _to_z3(e.right, env)
-        ops = {"and": lambda: z3.And(l, r), "or": lambda: z3.Or(l, r), "->": lambda: z3.Implies(l, r),
-               "<=>": lambda: l == r, "+": lambda: l + r, "-": lambda: l - r, "*": lambda: l * r,
-               "/": lambda: l / r}
-        return ops[e.op]()
+        return apply_operator(e.op, _to_z3(e.left, env), _to_z3(e.right, env))
     assert isinstance(e, ast.Compare)
     xs = [_to_z3(o, env) for o in e.operands]
-    cmp = {"==": lambda a, b: a == b, "!=": lambda a, b: a != b, "<": lambda a, b: a < b,
-           "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}
-    return conj(*[cmp[op](xs[i], xs[i + 1]) for i, op in enumerate(e.ops)])
+    return conj(*[apply_operator(op, xs[i], xs[i + 1]) for i, op in enumerate(e.ops)])
 
 
 def _val(v: Fraction) -> z3.ArithRef:

@@ -2,7 +2,7 @@
 from the contracts, and offline checking of recorded runs (paper lines
 791-980; docs/monitors.md).
 
-:mod:`.rml` translates guarantees to RML, :mod:`.config` reads the plan
+:mod:`rclverify.targets.rml` translates guarantees to RML, :mod:`.config` reads the plan
 entry and the mapping file, :mod:`.check` checks a trace against a node's
 contract, :mod:`.backend` is the plug-in (export, run).
 """

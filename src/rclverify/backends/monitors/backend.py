@@ -40,7 +40,7 @@ from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judg
 from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
-from rclverify.backends.monitors.rml import Spec, rml_id, translate
+from rclverify.targets.rml import Spec, rml_id, translate
 from rclverify.backends.monitors.widths import at_carried_widths, carried_fields, float_widths, refuse_out_of_range
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations

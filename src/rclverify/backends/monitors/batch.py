@@ -47,7 +47,7 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
 from rclverify.traces.questions import KEPT, Question, QuestionStream
 from rclverify.backends.monitors.answered import AnsweredRun, RecentOutput
-from rclverify.backends.monitors.columns import ColumnCompiler, Unsupported, io_kind, seed
+from rclverify.targets.columns import ColumnCompiler, Unsupported, io_kind, seed
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
 from rclverify.backends.monitors.verdicts import NodeResult, Verdict

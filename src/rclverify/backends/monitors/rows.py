@@ -22,7 +22,7 @@ from typing import Any, Iterable, Iterator, Mapping, Sequence
 from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event, taken
-from rclverify.backends.monitors.columns import column, field_values
+from rclverify.targets.columns import column, field_values
 
 _TOPIC, _TIME, _STAMP, _FIELDS = attrgetter("topic"), attrgetter("time"), attrgetter("stamp"), attrgetter("fields")
 

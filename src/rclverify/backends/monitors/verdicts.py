@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from rclverify.lang import ast
+from rclverify.lang.walk import names, reads  # re-exported: the engine and its mixins import them from here
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.model.system.services import peers
 
@@ -31,34 +32,6 @@ WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 #: Violations kept per node and run (each a few hundred bytes; the count is exact beyond it).
 KEPT_VIOLATIONS = 200
 LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
-
-
-def reads(e: Any, out: set[str]) -> None:
-    """Every name a formula mentions: each :class:`ast.Var`'s qualified and bare
-    name, anywhere in the tree (quantifier domains included); a superset of
-    the I/O variables it reads."""
-    if isinstance(e, ast.Var):
-        out.add(e.qualified)
-        out.add(e.name)
-        return
-    if isinstance(e, tuple):
-        for x in e:
-            reads(x, out)
-        return
-    if dataclasses.is_dataclass(e) and not isinstance(e, (type, ast.Loc)):
-        for f in dataclasses.fields(e):
-            reads(getattr(e, f.name), out)
-
-
-def names(e: Any, out: set[str]) -> None:
-    if isinstance(e, ast.Var):
-        out.add(e.qualified)
-    for name in ("args", "operand", "left", "right", "operands", "elem", "collection", "items", "body", "func"):
-        c = getattr(e, name, None)
-        if c is None:
-            continue
-        for x in (c if isinstance(c, tuple) else (c,)):
-            names(x, out)
 
 
 @dataclass(frozen=True)

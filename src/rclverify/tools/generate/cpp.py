@@ -2,7 +2,7 @@
 ROS-free C++17 header (docs/generate.md, "C++ nodes").
 
 Per node ``<pkg>``: ``src/<pkg>_node.cpp`` (every end of the contract with its name, type and
-QoS; generated), ``include/<pkg>/contract_checks.hpp`` (the checks, :mod:`.cpp_expr`;
+QoS; generated), ``include/<pkg>/contract_checks.hpp`` (the checks, :mod:`rclverify.targets.cpp.expr`;
 generated), ``include/<pkg>/contract_driver.hpp`` and ``test/contract_driver.cpp`` (a driver
 reading steps and printing verdicts; generated), ``include/<pkg>/logic.hpp`` and
 ``src/logic.cpp`` (the node's logic, created once), ``CMakeLists.txt`` and ``package.xml``.
@@ -20,12 +20,12 @@ from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.semantics.candidate_points import MAX_CANDIDATE_STEPS
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT
-from rclverify.tools.generate.cpp_common import Untranslatable, enum_const
-from rclverify.tools.generate.cpp_expr import CppTranslator, cpp_type
-from rclverify.tools.generate.cpp_values import data_types, parse_code, table_parse, term_fields
+from rclverify.targets.cpp.common import Untranslatable, enum_const
+from rclverify.targets.cpp.expr import CppTranslator, cpp_type
+from rclverify.targets.cpp.values import data_types, parse_code, table_parse, term_fields
 from rclverify.tools.generate.nodes import NodePackage
-from rclverify.tools.generate import names
-from rclverify.tools.generate.typemap import camel, snake
+from rclverify.targets import names
+from rclverify.targets.typemap import camel, snake
 from rclverify.tools.generate.wiring import wires
 
 
@@ -140,7 +140,7 @@ def _one_line(text: str) -> str:
 
 def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tolerance | None = None) -> Checks:
     """The checks of node ``cn``: struct fields for every input and output a C++ field can hold,
-    every clause translated (:class:`.cpp_expr.CppTranslator`; an untranslatable clause keeps
+    every clause translated (:class:`rclverify.targets.cpp.expr.CppTranslator`; an untranslatable clause keeps
     its reason), the enumerations they use.  ``tolerance``: the monitors' declared one."""
     c = Checks(cn.name, namespace, cn.node.loc.file, f"{namespace.upper()}__CONTRACT_CHECKS_HPP_")
     enums: dict[str, EnumT] = {}

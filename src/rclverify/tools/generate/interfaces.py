@@ -17,8 +17,8 @@ from rclverify.lang import ast
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import Checked, CheckedNode, Type
 from rclverify.lang.units import Unit
-from rclverify.tools.generate import names
-from rclverify.tools.generate.typemap import STANDARD_PACKAGES, Section, TypeMapper
+from rclverify.targets import names
+from rclverify.targets.typemap import STANDARD_PACKAGES, Section, TypeMapper
 
 
 @dataclass

@@ -31,10 +31,11 @@ import re
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT
-from rclverify.tools.generate import names, rosnames
-from rclverify.tools.generate.typemap import STANDARD_PACKAGES
-from rclverify.tools.generate.cpp_common import enum_const
-from rclverify.tools.generate.cpp_values import term_struct
+from rclverify.targets import names
+from rclverify.tools.generate import rosnames
+from rclverify.targets.typemap import STANDARD_PACKAGES
+from rclverify.targets.cpp.common import enum_const
+from rclverify.targets.cpp.values import term_struct
 
 _MSG = re.compile(r"^[A-Z][A-Za-z0-9]*$")
 _PKG = re.compile(r"^(?!.*__)(?!.*_$)[a-z][a-z0-9_]*$")

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.tools.generate.interfaces import split_type
-from rclverify.tools.generate.names import msg_name, package_name, py_name, snake
+from rclverify.targets.names import msg_name, package_name, py_name, snake
 
 #: names node.py defines or imports at module level (an interface class of such a name is aliased)
 NODE_PY_NAMES = frozenset({"threading", "rclpy", "MutuallyExclusiveCallbackGroup", "ReentrantCallbackGroup",

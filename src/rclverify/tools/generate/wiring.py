@@ -19,7 +19,7 @@ from typing import Any, Mapping
 
 from rclverify.tools.generate.interfaces import is_standard
 from rclverify.tools.generate.nodes import NodePackage
-from rclverify.tools.generate.names import field_name
+from rclverify.targets.names import field_name
 from rclverify.traces.mapping import rule_for
 
 #: std_msgs messages holding one value in field ``data``

@@ -13,7 +13,7 @@ whole:
   declared tolerance (``abs``, ``rel``, ``ulps``), only when one is declared (``fs_tol``).
 
 A formula is false only when false in every reading that applies; undecided (``None``) with
-the reason otherwise.  A clause is a JSON tree (tools/generate/pycarry.py in rclverify names its
+the reason otherwise.  A clause is a JSON tree (targets/python/carry.py in rclverify names its
 nodes); what the tree marks ``unsupported`` (function tables, constructor terms, sets as
 values, and quantifiers over an unbounded number) is undecided here, with the reason, where
 rclverify's monitor has more means (its candidate values and Z3): never a guessed verdict."""

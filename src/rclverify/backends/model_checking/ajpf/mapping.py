@@ -49,10 +49,10 @@ from rclverify.lang.printer import expr_to_rcl, is_type
 from rclverify.lang.errors import RclError
 from rclverify.lang.parser import parse_formula
 from rclverify.backends.model_checking.ajpf import psl
-from rclverify.backends.model_checking.ajpf.canon import (Canon, FAnd, FConst, FLit, FOr, Form, FQuant, Item,
+from rclverify.targets.ajpf.canon import (Canon, FAnd, FConst, FLit, FOr, Form, FQuant, Item,
                                                           dnf, eval_bool, eval_int, expr_vars, form_vars,
                                                           miniscope, subst)
-from rclverify.backends.model_checking.ajpf.match import MatchContext, State, match_expr, match_form
+from rclverify.targets.ajpf.match import MatchContext, State, match_expr, match_form
 
 # ---------------------------------------------------------------------------
 # Rows

@@ -17,9 +17,9 @@ from typing import Any
 
 from rclverify.semantics.candidates import Source
 from rclverify.lang import ast
-from rclverify.tools.generate.cpp_common import Untranslatable
-from rclverify.tools.generate.cpp_values import kind_of, term_struct
-from rclverify.tools.generate.names import ctor_field
+from rclverify.targets.cpp.common import Untranslatable
+from rclverify.targets.cpp.values import kind_of, term_struct
+from rclverify.targets.names import ctor_field
 
 _NUMERIC = ("int", "double")
 

@@ -1,10 +1,10 @@
-"""Names the C++ translation modules share (:mod:`.cpp_expr`, :mod:`.cpp_quant`): the error a
+"""Names the C++ translation modules share (:mod:`.expr`, :mod:`.quant`): the error a
 formula outside the translated fragment raises, the C++ constant of an enumeration value and the
 C++ type of an RCL scalar."""
 from __future__ import annotations
 
 from rclverify.lang.types import EnumT
-from rclverify.tools.generate.typemap import snake
+from rclverify.targets.typemap import snake
 
 
 #: RCL scalar -> C++ type of a struct field (a table's or term's NATURAL is signed: :mod:`.cpp_values`)

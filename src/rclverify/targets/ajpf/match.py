@@ -14,7 +14,7 @@ from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 from rclverify.lang import ast
 from rclverify.lang.visit import Visitor
-from rclverify.backends.model_checking.ajpf.canon import FAnd, FConst, FLit, FOr, Form, FQuant, eval_int
+from rclverify.targets.ajpf.canon import FAnd, FConst, FLit, FOr, Form, FQuant, eval_int
 
 @dataclass(frozen=True)
 class State:

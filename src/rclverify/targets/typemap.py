@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError, error
-from rclverify.tools.generate import names
+from rclverify.targets import names
 from rclverify.lang.types import DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 
 #: RCL scalar name -> ROS 2 primitive type

@@ -31,7 +31,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from rclverify.backends.monitors.verdicts import names, reads
+import jinja2
+
+from rclverify.lang.walk import names, reads
 from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.floatsens import float_sensitive
 from rclverify.lang import ast
@@ -202,3 +204,13 @@ def carried(checked: Checked, node: CheckedNode) -> dict[str, Any]:
     return {"assumes": [clause(c) for c in node.node.assumes],
             "guarantees": [clause(c) for c in node.node.guarantees],
             "ins": ins, "per": per, "enums": enums}
+
+
+_ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.targets.python", "templates"),
+                          keep_trailing_newline=True, autoescape=False, undefined=jinja2.StrictUndefined)
+
+
+def evaluator_text(marker: str) -> str:
+    """The text of ``contract_eval.py``, the evaluator a generated Python package carries
+    (module docstring), headed by the comment ``marker`` (what rewrites the file)."""
+    return _ENV.get_template("contract_eval.py.j2").render(marker=marker)

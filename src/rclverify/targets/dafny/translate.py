@@ -43,6 +43,7 @@ from typing import Any, Mapping, cast
 
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
+from rclverify.semantics.operators import OPERATORS
 from rclverify.lang.errors import error
 from rclverify.lang.printer import is_type
 from rclverify.lang.typecheck import domain_type
@@ -65,12 +66,11 @@ from rclverify.lang.types import (
     numeric_join,
     qualified_base,
 )
-from rclverify.backends.dafny.text import dafny_string, real_literal, strip_parens, value_join, wrap
-from rclverify.backends.dafny.types import dafny_ident, dafny_type
+from rclverify.targets.dafny.text import dafny_string, real_literal, strip_parens, value_join, wrap
+from rclverify.targets.dafny.types import dafny_ident, dafny_type
 
 _BASE_NAMES = {"REAL": REAL, "INTEGER": INTEGER, "NATURAL": NATURAL, "BOOL": BOOL}
 _INT_LIT = re.compile(r"\A(\(?)(-?\d+)(\)?)\Z")
-_LOGIC = {"and": "&&", "or": "||", "->": "==>", "<=>": "<==>"}
 #: Largest number of instances a quantifier over literal collections is expanded into.
 _EXPANSION_LIMIT = 64
 #: Most items a literal range `<a upto b>` is spelled out to.
@@ -320,15 +320,16 @@ class Translator:
 
     def binary(self, e: ast.Binary, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
         (ls, lt), (rs, rt) = self.tr(e.left, scope), self.tr(e.right, scope)
-        if e.op in _LOGIC:
-            return f"({ls} {_LOGIC[e.op]} {rs})", BOOL
+        entry = OPERATORS[e.op]
+        if entry.kind == "connective":
+            return f"({ls} {entry.dafny} {rs})", BOOL
         if e.op == "/":
-            return f"({self.conv(ls, lt, REAL)} / {self.conv(rs, rt, REAL)})", REAL
+            return f"({self.conv(ls, lt, REAL)} {entry.dafny} {self.conv(rs, rt, REAL)})", REAL
         j = numeric_join(lt, rt)
         if j is None:
             raise self._err(e.loc, f"'{e.op}' needs numbers, found {lt} and {rt}")
         t: Type = INTEGER if (e.op == "-" and j == NATURAL) else j
-        return f"({self.conv(ls, lt, j)} {e.op} {self.conv(rs, rt, j)})", t
+        return f"({self.conv(ls, lt, j)} {entry.dafny} {self.conv(rs, rt, j)})", t
 
     def compare(self, e: ast.Compare, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
         vals = [self.tr(o, scope) for o in e.operands]
@@ -337,7 +338,7 @@ class Translator:
             j = value_join(at, bt)
             if j is not None:
                 a, b = self.conv(a, at, j), self.conv(b, bt, j)
-            parts.append(f"({a} {op} {b})")
+            parts.append(f"({a} {OPERATORS[op].dafny} {b})")
         return (parts[0] if len(parts) == 1 else "(" + " && ".join(parts) + ")"), BOOL
 
     def _type_name(self, c: ast.Expr, scope: Mapping[str, _Bound]) -> Type | None:

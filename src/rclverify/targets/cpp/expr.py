@@ -39,10 +39,10 @@ from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from rclverify.lang.visit import Visitor
 from rclverify.semantics.operators import OPERATORS, UNARY
-from rclverify.tools.generate.cpp_common import CPP_SCALARS, Untranslatable, enum_const
-from rclverify.tools.generate.cpp_quant import quantifier
-from rclverify.tools.generate.cpp_values import kind_of, table_type, term_struct
-from rclverify.tools.generate.names import field_name, snake
+from rclverify.targets.cpp.common import CPP_SCALARS, Untranslatable, enum_const
+from rclverify.targets.cpp.quant import quantifier
+from rclverify.targets.cpp.values import kind_of, table_type, term_struct
+from rclverify.targets.names import field_name, snake
 
 def cpp_type(t: Type) -> str | None:
     """The C++ field type of an RCL type, ``None`` when the header cannot hold it."""

@@ -18,8 +18,8 @@ from __future__ import annotations
 from typing import Any
 
 from rclverify.lang.types import DataT, EnumT, FuncT, Scalar, Type
-from rclverify.tools.generate.cpp_common import CPP_SCALARS, camel_words
-from rclverify.tools.generate.names import ctor_field, snake
+from rclverify.targets.cpp.common import CPP_SCALARS, camel_words
+from rclverify.targets.names import ctor_field, snake
 
 #: RCL scalar -> C++ type inside a table or a term: a field's, but INTEGER and NATURAL both std::int64_t (module docstring)
 _INNER = {**CPP_SCALARS, "NATURAL": "std::int64_t"}

@@ -33,9 +33,9 @@ from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.floatsem import MAX_ENUMERATION
 from rclverify.lang import ast
 from rclverify.lang.types import EnumT, Scalar
-from rclverify.tools.generate.cpp_candidates import candidate_code
-from rclverify.tools.generate.names import cpp_local
-from rclverify.tools.generate.cpp_common import Untranslatable, enum_const
+from rclverify.targets.cpp.candidates import candidate_code
+from rclverify.targets.names import cpp_local
+from rclverify.targets.cpp.common import Untranslatable, enum_const
 
 
 class _Undecided(Exception):
@@ -49,7 +49,7 @@ def cpp_ident(name: str) -> str:
 
 def quantifier(tr: Any, e: ast.Quant) -> tuple[str, str]:
     """``(code, "bool")`` for quantifier ``e`` under translator ``tr`` (a
-    :class:`.cpp_expr.CppTranslator`: its ``expr``, its bound variables in ``tr.bound``, its
+    :class:`.expr.CppTranslator`: its ``expr``, its bound variables in ``tr.bound``, its
     ``notes``); raises :class:`.cpp_common.Untranslatable`."""
     loops: list[tuple[str, str, Any]] = []  # (C++ name, kind, domain: ("values", [code]) | ("range", lo, hi))
     size = 1

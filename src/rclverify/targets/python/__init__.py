@@ -1,0 +1,1 @@
+"""The evaluator and contract data that generated Python packages carry."""
