@@ -28,7 +28,6 @@ DISPATCHES = {
     "rclverify/targets/dafny/translate.py": 1,  # Dafny
     "rclverify/backends/experiment/criterion.py": 1,  # the experiment criterion's sort (its Z3 is unary_z3)
     "rclverify/targets/cpp/expr.py": 1,  # C++
-    "rclverify/targets/python/carry.py": 1,  # the evaluator carried into generated packages
     "rclverify/lang/printer.py": 2,  # RCL text and its precedence
     "rclverify/lang/latex.py": 1,  # LaTeX
     "rclverify/lang/typecheck_expr.py": 1,  # types

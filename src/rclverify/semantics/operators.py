@@ -25,6 +25,8 @@ instead of restating it:
   in, where it maps one to one: :attr:`Operator.python` and :attr:`Operator.cpp`
   (format strings over ``{l}`` and ``{r}``; ``None`` where the generator
   must call a helper, e.g. exact arithmetic in Python, division in C++),
+  :attr:`Operator.python_reading` (arithmetic on operands already in one
+  reading: the evaluator generated packages carry),
   :attr:`Operator.z3` (the ``z3.ArithRef`` method, or the Z3 function of a
   connective), :attr:`Operator.numpy` (the numpy ufunc's name for the
   column evaluation of recorded runs), :attr:`Operator.smtlib`, :attr:`Operator.dafny`.
@@ -71,6 +73,9 @@ class Operator:
     numpy: str | None = None
     smtlib: str | None = None
     dafny: str | None = None
+    #: the Python text over two operands already in one reading (both ``Fraction`` for the exact
+    #: reading, ``float``/``int`` for the double one), where the value's type carries the reading
+    python_reading: str | None = None
     identity: Any = None
     decisive: bool | None = None
     decided: bool | None = None
@@ -157,13 +162,16 @@ _ENTRIES = (
     _comparison(">=", "at least", operator.ge, z3="__ge__", numpy="greater_equal", smtlib=">=", converse="<=",
                 negation="<"),
     Operator("+", "addition", "arithmetic", 2, _exact_arith(operator.add), _double_arith(operator.add),
-             cpp="({l} + {r})", z3="__add__", numpy="add", smtlib="+", dafny="+", identity=0),
+             cpp="({l} + {r})", z3="__add__", numpy="add", smtlib="+",
+             dafny="+", python_reading="({l} + {r})", identity=0),
     Operator("-", "subtraction", "arithmetic", 2, _exact_arith(operator.sub), _double_arith(operator.sub),
-             cpp="({l} - {r})", z3="__sub__", numpy="subtract", smtlib="-", dafny="-"),
+             cpp="({l} - {r})", z3="__sub__", numpy="subtract", smtlib="-",
+             dafny="-", python_reading="({l} - {r})"),
     Operator("*", "multiplication", "arithmetic", 2, _exact_arith(operator.mul), _double_arith(operator.mul),
-             cpp="({l} * {r})", z3="__mul__", numpy="multiply", smtlib="*", dafny="*", identity=1),
+             cpp="({l} * {r})", z3="__mul__", numpy="multiply", smtlib="*",
+             dafny="*", python_reading="({l} * {r})", identity=1),
     Operator("/", "division", "arithmetic", 2, _exact_div, _double_div, cpp=None, z3="__truediv__",
-             numpy="true_divide", smtlib="/", dafny="/", zero_divisor="undecided"),
+             numpy="true_divide", smtlib="/", dafny="/", python_reading="({l} / {r})", zero_divisor="undecided"),
 )
 
 #: binary operator symbol -> its entry

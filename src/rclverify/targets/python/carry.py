@@ -17,7 +17,7 @@ inputs and outputs each clause reads (``backends/monitors/verdicts``).
 The tree's nodes (lists, first item the kind):
 ``["num", numerator, denominator]``, ``["lit", value]`` (a boolean, an
 enumeration value's name, a string), ``["io", "in.x"]``, ``["bound", name]``,
-``["not", e]``, ``["neg", e]``, ``["abs", e]``, ``["bin", op, l, r]``,
+``["unary", op, e]``, ``["bin", op, l, r]``,
 ``["cmp", [ops], [operands], reads_io]``, ``["member", negated, elem, [items]]``
 (a literal set), ``["quant", kind, [[name, domain], ...], body]`` with a domain
 ``["bool"]``, ``["vals", [..]]``, ``["setlit", [items]]``, ``["range", [ints]]``,
@@ -29,13 +29,14 @@ in.x" first when a value it reads is missing), never a guess.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Mapping
 
 import jinja2
 
 from rclverify.lang.walk import names, reads
 from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.floatsens import float_sensitive
+from rclverify.semantics.operators import OPERATORS, UNARY, Operator
 from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
@@ -64,7 +65,7 @@ class _Tree:
         if isinstance(e, ast.Var):
             return self.var(e, scope)
         if isinstance(e, ast.Unary):
-            return [self.unary(e.op), self.expr(e.operand, scope)]
+            return ["unary", e.op, self.expr(e.operand, scope)]
         if isinstance(e, ast.Binary):
             return ["bin", e.op, self.expr(e.left, scope), self.expr(e.right, scope)]
         if isinstance(e, ast.Compare):
@@ -74,17 +75,6 @@ class _Tree:
         if isinstance(e, ast.Quant):
             return self.quant(e, scope)
         return self.unsupported(e, f"{type(e).__name__} ({_what(e)})")
-
-    @staticmethod
-    def unary(op: ast.UnaryOp) -> str:
-        """The carried evaluator's tag of unary operator ``op`` (``not``, ``neg``, ``abs``)."""
-        if op == "not":
-            return "not"
-        if op == "-":
-            return "neg"
-        if op == "abs":
-            return "abs"
-        ast.unhandled(op)
 
     def var(self, v: ast.Var, scope: frozenset[str]) -> list[Any]:
         """A name, resolved as the evaluator resolves it (bound, enumeration value, constant, I/O)."""
@@ -210,7 +200,27 @@ _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.targets.python"
                           keep_trailing_newline=True, autoescape=False, undefined=jinja2.StrictUndefined)
 
 
-def evaluator_text(marker: str) -> str:
+_ENV.filters["py"] = repr
+
+
+def evaluator_text(marker: str, operators: Mapping[str, Operator] = OPERATORS,
+                   unary: Mapping[str, Operator] = UNARY) -> str:
     """The text of ``contract_eval.py``, the evaluator a generated Python package carries
-    (module docstring), headed by the comment ``marker`` (what rewrites the file)."""
-    return _ENV.get_template("contract_eval.py.j2").render(marker=marker)
+    (module docstring), headed by the comment ``marker`` (what rewrites the file).
+
+    Its operators are written from the semantics table ``operators`` (binary) and ``unary``
+    (:mod:`rclverify.semantics.operators`): each entry's Python text, the connectives'
+    short circuit and what a zero divisor does, so an operator added to the table reaches
+    generated packages with no edit here.  Raises ``ValueError`` naming an entry that lacks
+    the Python text the evaluator needs (``python``, or ``python_reading`` for arithmetic)."""
+    need = [(o, "python") for o in unary.values()] + [
+        (o, "python_reading" if o.kind == "arithmetic" else "python") for o in operators.values()]
+    missing = [f"{o.symbol!r} ({field})" for o, field in need if not getattr(o, field)]
+    if missing:
+        raise ValueError(f"the semantics table gives no Python text for {', '.join(missing)}: "
+                         "the carried evaluator cannot be written")
+    by_kind = {k: [o for _, o in sorted(operators.items()) if o.kind == k]
+               for k in ("connective", "comparison", "arithmetic")}
+    return _ENV.get_template("contract_eval.py.j2").render(
+        marker=marker, unary=[o for _, o in sorted(unary.items())], connectives=by_kind["connective"],
+        comparisons=by_kind["comparison"], arithmetic=by_kind["arithmetic"])

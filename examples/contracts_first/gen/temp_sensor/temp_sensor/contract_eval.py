@@ -30,8 +30,39 @@ class Undecided(Exception):
     """The clause cannot be decided here (the reason in ``str``)."""
 
 
-_CMP = {'==': lambda a, b: a == b, '!=': lambda a, b: a != b, '<': lambda a, b: a < b,
-        '<=': lambda a, b: a <= b, '>': lambda a, b: a > b, '>=': lambda a, b: a >= b}
+# The operators, written from rclverify's semantics table (semantics/operators.py) when this
+# package was generated: each one's Python text, the connectives' short circuit, which
+# divisors of zero leave a formula undecided.
+_UNARY = {
+    '-': lambda x: (-x),
+    'abs': lambda x: abs(x),
+    'not': lambda x: (not x),
+}
+_CMP = {
+    '!=': lambda l, r: (l != r),
+    '<': lambda l, r: (l < r),
+    '<=': lambda l, r: (l <= r),
+    '==': lambda l, r: (l == r),
+    '>': lambda l, r: (l > r),
+    '>=': lambda l, r: (l >= r),
+}
+_ARITH = {
+    '*': lambda l, r: (l * r),
+    '+': lambda l, r: (l + r),
+    '-': lambda l, r: (l - r),
+    '/': lambda l, r: (l / r),
+}
+#: connective -> its truth on two truth values
+_TRUTH = {
+    '->': lambda l, r: ((not l) or r),
+    '<=>': lambda l, r: (l == r),
+    'and': lambda l, r: (l and r),
+    'or': lambda l, r: (l or r),
+}
+#: connective -> (decisive, decided): a left operand of truth ``decisive`` decides ``decided``
+_SHORT = {'->': (False, True), 'and': (False, False), 'or': (True, True)}
+#: operators whose zero divisor leaves the formula undecided
+_ZERO_UNDECIDED = frozenset({'/'})
 
 
 def ulp_distance(a, b):
@@ -109,12 +140,8 @@ class Reading:
             return v
         if kind == 'bound':
             return b[t[1]]
-        if kind == 'not':
-            return not self.eval(t[1], b)
-        if kind == 'neg':
-            return -self.eval(t[1], b)
-        if kind == 'abs':
-            return abs(self.eval(t[1], b))
+        if kind == 'unary':
+            return _UNARY[t[1]](self.eval(t[2], b))
         if kind == 'bin':
             return self.binary(t, b)
         if kind == 'cmp':
@@ -130,29 +157,20 @@ class Reading:
 
     def binary(self, t, b):
         op, left, right = t[1], t[2], t[3]
-        if op == 'and':
-            return bool(self.eval(left, b)) and bool(self.eval(right, b))
-        if op == 'or':
-            return bool(self.eval(left, b)) or bool(self.eval(right, b))
-        if op == '->':
-            return (not self.eval(left, b)) or bool(self.eval(right, b))
-        if op == '<=>':
-            return bool(self.eval(left, b)) == bool(self.eval(right, b))
+        if op in _TRUTH:
+            x = bool(self.eval(left, b))
+            short = _SHORT.get(op)
+            if short is not None and x is short[0]:
+                return short[1]
+            return bool(_TRUTH[op](x, bool(self.eval(right, b))))
         x, y = self.eval(left, b), self.eval(right, b)
         if self.mode == 'double':
             x, y = _double(x), _double(y)
         else:
-            x = Fraction(x) if type(x) is float else x
-            y = Fraction(y) if type(y) is float else y
-        if op == '+':
-            return x + y
-        if op == '-':
-            return x - y
-        if op == '*':
-            return x * y
-        if y == 0:
+            x, y = Fraction(x), Fraction(y)
+        if op in _ZERO_UNDECIDED and y == 0:
             raise Undecided('division by zero')
-        return x / y if self.mode == 'double' else Fraction(x) / Fraction(y)
+        return _ARITH[op](x, y)
 
     def compare(self, op, x, y, reads_io):
         if self.mode == 'double':
