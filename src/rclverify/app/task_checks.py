@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify import __version__
+from rclverify.model.plan.declarations import DECLARATIONS
 from rclverify.model.plan.paths import config_strings
 from rclverify.records.store import EvidenceStore
 
@@ -189,8 +190,13 @@ def z3_version() -> str:
 
 
 def tool_fingerprint() -> dict[str, Any]:
-    """The tools the backends run, as found now: rclverify's version and the paths of ``dafny``, MCAPL
-    (``MCAPL_HOME`` or ``AJPF_HOME``), ``dot`` and ``spin`` (``None`` when absent); another value makes every
-    evidence record again (the evidence tasks' ``config_changed``)."""
-    return {"rclverify": __version__, "dafny": shutil.which("dafny"), "mcapl": os.environ.get("MCAPL_HOME") or os.environ.get("AJPF_HOME"),
-            "dot": shutil.which("dot"), "spin": shutil.which("spin")}
+    """The tools the backends run, as found now: rclverify's version, the path of ``dot``, and each
+    tool the backends' declarations name (``tools[]``: a command's path on ``PATH``, or the first set
+    of its environment variables; ``None`` when absent).  Another value makes every evidence record
+    again (the evidence tasks' ``config_changed``)."""
+    found: dict[str, Any] = {"rclverify": __version__, "dot": shutil.which("dot")}
+    for d in DECLARATIONS.values():
+        for t in d.tools:
+            found[t.name] = shutil.which(t.which) if t.which else next(
+                (os.environ[v] for v in t.env if os.environ.get(v)), None)
+    return found

@@ -1,5 +1,9 @@
 """Verification backends, registered by the name a plan uses for them.
 
+Each backend's folder holds its code and its ``declaration.yaml`` (name,
+implementation, evidence kind and strength, plan entry schema, tools); the one
+registry that lists them is :data:`rclverify.model.plan.declarations.REGISTRY`.
+
 Implemented: ``hoare`` (Z3), ``dafny`` (Dafny), ``ajpf`` (AJPF/MCAPL
 property instances), ``property_tests`` (Hypothesis, every example checked
 by Z3), ``experiment`` (experiment figures against an acceptance
@@ -11,18 +15,14 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING, cast
 
+from rclverify.model.plan.declarations import DECLARATIONS
+
 if TYPE_CHECKING:
     from rclverify.backends.base import Backend
 
-IMPLEMENTED = {
-    "hoare": ("rclverify.backends.hoare.backend", "HoareBackend"),
-    "dafny": ("rclverify.backends.dafny.backend", "DafnyBackend"),
-    "ajpf": ("rclverify.backends.model_checking.ajpf.backend", "AjpfBackend"),
-    "property_tests": ("rclverify.backends.property_tests.backend", "PropertyTestsBackend"),
-    "experiment": ("rclverify.backends.experiment.backend", "ExperimentBackend"),
-    "review": ("rclverify.backends.review.backend", "ReviewBackend"),
-    "monitors": ("rclverify.backends.monitors.backend", "MonitorsBackend"),
-}
+#: Backend name -> (module, class) of its implementation, from each backend's ``declaration.yaml``
+#: (:mod:`rclverify.model.plan.declarations`, the one registry of backends).
+IMPLEMENTED = {name: tuple(d.implementation.split(":", 1)) for name, d in DECLARATIONS.items()}
 KNOWN = tuple(IMPLEMENTED)
 
 

@@ -27,8 +27,10 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from rclverify.model.plan.declarations import DECLARATIONS
+
 #: Backends whose evidence is a model checker's verdict on a property instance.
-MC_BACKENDS = ("ajpf",)
+MC_BACKENDS = tuple(n for n, d in DECLARATIONS.items() if d.evidence_kind == "model checking")
 FAILED_PREFIX = "model-checking:"
 OUTSTANDING_PREFIX = "outstanding:model-checking:"
 _TRAIL = re.compile(r"Gwendolen lines? ([\d, ]+) of (\S+)")

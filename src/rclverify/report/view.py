@@ -13,6 +13,7 @@ import re
 from collections import defaultdict
 from typing import Any, Callable, Mapping, Sequence, TypeVar
 
+from rclverify.model.plan.declarations import BACKEND_NAMES
 from rclverify.records.records import SEVERITY
 from rclverify.report.culprits import culprit_nodes
 from rclverify.report.problems import group_problems
@@ -172,8 +173,7 @@ def problem_groups(report: Mapping[str, Any]) -> list[dict[str, Any]]:
 #: The techniques of the dashboard's columns, in order: contract health, the
 #: calculus' side conditions, then the backends (docs/reading-the-report.md).
 #: A backend outside this list gets a column after them when it has evidence.
-TECHNIQUES: tuple[str, ...] = ("health", "side conditions", "hoare", "dafny", "ajpf", "property_tests",
-                               "monitors", "experiment", "review")
+TECHNIQUES: tuple[str, ...] = ("health", "side conditions", *BACKEND_NAMES)
 
 
 #: A contract health status as the evidence status the dashboard ranks it by.

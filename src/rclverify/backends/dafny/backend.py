@@ -43,6 +43,7 @@ from typing import Any, Mapping
 
 import jinja2
 
+from rclverify.model.plan.declarations import declared_in
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
 
@@ -99,8 +100,8 @@ class _Config:
 class DafnyBackend:
     """Backend ``dafny`` (kind ``proof``); see the module docstring."""
 
-    name = "dafny"
-    kind = "proof"
+    name = declared_in(__file__).name
+    kind = declared_in(__file__).evidence_kind
 
     # -- export -------------------------------------------------------------------------
     def stub_path(self, target: NodeTarget) -> Path:

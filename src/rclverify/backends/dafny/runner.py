@@ -323,3 +323,14 @@ def filter_log(text: str) -> tuple[str, list[str]]:
              f"parameters: this Dafny sets the Z3 option {opt}, which the installed Z3 no longer has; it only "
              "affects how models are printed" for opt, n in sorted(removed.items())]
     return "\n".join(out) + ("\n" if text.endswith("\n") else ""), notes
+
+
+def installed_version() -> str:
+    """The version of the Dafny on ``PATH`` as the backend identifies it (:func:`detect`):
+    ``"4.9.1"``, ``"not installed"``, or ``"unidentified (<path>)"``; the bundle's tool versions
+    call it through the backend's declaration (``tools[].version``)."""
+    exe = find_dafny()
+    if exe is None:
+        return "not installed"
+    tool = detect(exe)
+    return tool.version if tool else f"unidentified ({exe})"

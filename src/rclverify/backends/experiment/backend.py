@@ -24,6 +24,7 @@ from typing import Any
 
 import z3
 
+from rclverify.model.plan.declarations import declared_in
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
 from rclverify.model.plan.errors import PlanError
@@ -38,8 +39,8 @@ from rclverify.backends.experiment.plot import render_svg
 from rclverify.core.extras import MissingExtra
 from rclverify.backends.experiment.target import run_target, target_obligations
 
-NAME = "experiment"
-KIND = "experiment"
+#: this backend's name and evidence kind, as its declaration.yaml states them
+NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
 
 
 def load(target: NodeTarget) -> ExperimentConfig:

@@ -26,6 +26,7 @@ from typing import Any
 import jinja2
 import z3
 
+from rclverify.model.plan.declarations import declared_in
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
 from rclverify.records.ties import tie_query
@@ -37,8 +38,8 @@ from rclverify.backends.hoare.outline import OutlineLine, outline_text, render_o
 from rclverify.backends.hoare.solve import TripleResult, check_all
 from rclverify.backends.hoare.wp import VC, WP, ProgramModel, main_vc, wp
 
-NAME = "hoare"
-KIND = "proof"
+#: this backend's name and evidence kind, as its declaration.yaml states them
+NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
 
 
 @lru_cache(maxsize=1)  # one environment per process: jinja2 then compiles each template once

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
+from rclverify.model.plan.declarations import DECLARATIONS
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
 from rclverify.lang.ast import Loc
@@ -133,12 +134,13 @@ def extra_obligations(target: NodeTarget, cfg: SpinConfig, agent: str, model: st
     ``<Node>.g0.ajpf.<file stem>_<label>`` (guarantee 0: not derived from a
     guarantee).  Raises a located :class:`PlanError` for a bad file."""
     out = []
+    declared = DECLARATIONS["ajpf"]  # the model-checking backend's declaration (model_checking/ajpf/)
     for k, rel in enumerate(cfg.properties):
         stem = Path(rel).stem
         for p in read_psl_file(target.root, rel):
             out.append(Obligation(
-                id=make_obligation_id(target.node.name, 0, "ajpf", f"{stem}_{p.label}"), node=target.node.name,
-                guarantee=0, backend="ajpf", kind="model checking", statement=f"{p.label}: {p.text}",
+                id=make_obligation_id(target.node.name, 0, declared.name, f"{stem}_{p.label}"),
+                node=target.node.name, guarantee=0, backend=declared.name, kind=declared.evidence_kind, statement=f"{p.label}: {p.text}",
                 source=SourceRef(rel, p.line, p.col), instance=f"{stem}:{p.label}", artifact=rel,
                 inputs=(model, rel),
                 data={"agent": agent, "psl": psl.to_text(p.formula), "property_file": rel, "label": p.label,

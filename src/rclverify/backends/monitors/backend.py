@@ -22,6 +22,7 @@ from typing import Any, Callable, Iterable, Iterator, Mapping
 
 import jinja2
 
+from rclverify.model.plan.declarations import declared_in
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
 from rclverify.lang.printer import expr_to_rcl
@@ -46,8 +47,8 @@ from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, 
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
 
-NAME = "monitors"
-KIND = "monitoring"
+#: this backend's name and evidence kind, as its declaration.yaml states them
+NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
 #: The reorder window ROSMonitoring's monitors are configured with (ms); the
 #: same default as ``rclverify monitor --live --reorder-window``.
 REORDER_WINDOW_MS = 50

@@ -26,6 +26,7 @@ from typing import Any, Callable
 
 import jinja2
 
+from rclverify.model.plan.declarations import declared_in
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
 from rclverify.model.plan.errors import PlanError
@@ -39,8 +40,8 @@ from rclverify.backends.property_tests.seeding import SeedingCut, split_facts
 from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 import inspect
 
-NAME = "property_tests"
-KIND = "testing"
+#: this backend's name and evidence kind, as its declaration.yaml states them
+NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
 
 
 @lru_cache(maxsize=1)

@@ -18,6 +18,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from rclverify.model.plan.declarations import declared_in
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.paths import escape_reason
@@ -27,8 +28,8 @@ from rclverify.lang.errors import Diagnostic
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.review.record import Question, RecordError, ReviewRecord, assumption_text, checklist, judge, parse_record
 
-NAME = "review"
-KIND = "review"
+#: this backend's name and evidence kind, as its declaration.yaml states them
+NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
 
 
 def read_record(root: Path, config: Any, loc: Any) -> tuple[str, ReviewRecord]:

@@ -1,6 +1,7 @@
-"""The registry of evidence-entry schemas: which backends exist and what their plan entries hold.
+"""The evidence-entry schemas: what each backend's plan entries hold.
 
-Each backend declares here, as data, the schema of its plan entry
+Each backend declares, in its ``declaration.yaml`` (read by :mod:`.declarations`,
+the one registry of backends), the schema of its plan entry
 (``nodes.<Node>.evidence[k]``, docs/plan.md "Evidence entries"):
 
 ``keys``        every key of the backend's own configuration (besides the
@@ -14,17 +15,16 @@ Each backend declares here, as data, the schema of its plan entry
                 workspace file, so never refused for lying outside the
                 workspace and never a doit file dependency.
 
-The registry sits below both the plan and the backends (layers:
-rcl -> plan -> ... -> backends): the plan validates an entry against these
-declarations without importing any backend's code, and
-:mod:`rclverify.backends` checks that its implementations and this table name
-the same backends (``tests/test_inputs_layers.py``).
+The declarations are read as data, below both the plan and the backends: the
+plan validates an entry against them without importing any backend's code.
 """
 from __future__ import annotations
 
 import difflib
 from dataclasses import dataclass
 from typing import Any, Iterator, Mapping
+
+from rclverify.model.plan.declarations import BACKEND_NAMES, DECLARATIONS
 
 #: Keys every entry may have, whatever its backend.
 COMMON_KEYS: tuple[str, ...] = ("backend", "expected")
@@ -42,28 +42,10 @@ class EntrySchema:
     qualified_keys: frozenset[str] = frozenset()
 
 
-#: Backend name -> schema, in the order docs/plan.md lists them (and error messages name them).
-SCHEMAS: dict[str, EntrySchema] = {s.name: s for s in (
-    EntrySchema("hoare", ("program", "binding", "timeout_ms"), path_keys=frozenset({"program"})),
-    EntrySchema("dafny", ("implementation", "executable", "time_limit", "timeout", "dafny", "options"),
-                path_keys=frozenset({"implementation"}), tool_keys=frozenset({"dafny", "options"})),
-    EntrySchema("ajpf", ("agent", "model", "domains", "mapping", "environment_class", "mcapl_home", "timeout_s",
-                         "results", "log_info", "model_checker", "environment", "max_states", "max_depth",
-                         "properties"),
-                path_keys=frozenset({"model", "results", "properties"}), tool_keys=frozenset({"mcapl_home"})),
-    EntrySchema("property_tests", ("implementation", "max_examples", "seed", "deadline_ms", "steps", "bounds",
-                                   "timeout_s"),
-                path_keys=frozenset({"implementation"}), qualified_keys=frozenset({"implementation"})),
-    EntrySchema("experiment", ("guarantee", "answers", "summary", "data", "column", "unit", "better", "constants",
-                               "criterion", "timeout_ms", "target", "environment"),
-                path_keys=frozenset({"summary", "data"})),
-    EntrySchema("review", ("record",), path_keys=frozenset({"record"})),
-    EntrySchema("monitors", ("traces", "mapping", "horizon", "tolerance", "target", "environment", "origin"),
-                path_keys=frozenset({"traces", "mapping"})),
-)}
-
-#: The backends a plan may name, in registry order.
-BACKEND_NAMES: tuple[str, ...] = tuple(SCHEMAS)
+#: Backend name -> schema, in registry order (each backend's ``declaration.yaml``, :mod:`.declarations`).
+SCHEMAS: dict[str, EntrySchema] = {
+    d.name: EntrySchema(d.name, d.plan.keys, d.plan.path_keys, d.plan.tool_keys, d.plan.qualified_keys)
+    for d in DECLARATIONS.values()}
 
 #: Every key, of any backend, that names a tool rather than a workspace file.
 TOOL_KEYS: frozenset[str] = frozenset(k for s in SCHEMAS.values() for k in s.tool_keys)
@@ -72,7 +54,7 @@ TOOL_KEYS: frozenset[str] = frozenset(k for s in SCHEMAS.values() for k in s.too
 #: ``executable`` file or ``directory`` (relative paths from the workspace root).  A bare
 #: command name (``dafny: dafny``) is looked up on ``PATH`` when the backend runs, and a
 #: missing one leaves the evidence ``pending`` with the command to run.
-TOOL_PATH_KINDS: dict[str, str] = {"dafny": "executable", "mcapl_home": "directory"}
+TOOL_PATH_KINDS: dict[str, str] = {k: v for d in DECLARATIONS.values() for k, v in d.plan.tool_paths.items()}
 
 
 def allowed_keys(backend: str) -> tuple[str, ...]:

@@ -19,6 +19,7 @@ from typing import Any, Mapping
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, error
 from rclverify.lang.types import Checked
+from rclverify.model.plan.declarations import DECLARATIONS
 from rclverify.model.plan.model import Plan
 from rclverify.model.plan.yamlguard import KEY
 
@@ -31,7 +32,7 @@ KEYS = ("guarantee", "instance", "verdict", "reason")
 #: Backends whose obligations cover a node's whole contract (guarantee 0 in
 #: the obligation id, ``<Node>.g0.dafny.contract``): their expectations say
 #: ``guarantee: 0``.
-WHOLE_CONTRACT_BACKENDS = ("dafny", "monitors")
+WHOLE_CONTRACT_BACKENDS = tuple(n for n, d in DECLARATIONS.items() if d.whole_contract)
 
 
 def _item_problems(item: Any, n_guarantees: int, node: str,

@@ -35,7 +35,8 @@ from rclverify.model.plan.formal import parse_formal
 from rclverify.model.plan.ranking import parse_hints
 from rclverify.model.plan.temporal import Temporal, parse_temporal, shape
 from rclverify.model.plan.expected import check_expected
-from rclverify.model.plan.entries import BACKEND_NAMES, unknown_key_messages
+from rclverify.model.plan.declarations import BACKEND_NAMES
+from rclverify.model.plan.entries import unknown_key_messages
 from rclverify.model.plan.standards.choice import read_standards
 
 __all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]

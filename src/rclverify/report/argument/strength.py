@@ -34,18 +34,18 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
+from rclverify.model.plan.declarations import DECLARATIONS, STRENGTHS
+
 #: The kinds, strongest first (the report orders and compares by this).
-KINDS = ("proof", "bounded", "statistical", "tested", "observed", "reviewed", "assumed")
+KINDS = STRENGTHS
 
 #: Doubt of a discharged claim per kind (docs/confidence.md gives the reasons).  ``proof`` is split by
 #: how many independent solvers decided it; ``statistical`` uses its data's bound where there is one.
 DOUBT: Mapping[str, float] = {"proof2": 1e-4, "proof": 1e-3, "bounded": 1e-2, "statistical": 5e-2,
                               "tested": 5e-2, "observed": 1e-1, "reviewed": 1e-1, "assumed": 2e-1}
 
-#: The strength of each backend's evidence (a test enumerates the backends of ``rclverify.backends``).
-BACKEND_KIND: Mapping[str, str] = {"hoare": "proof", "dafny": "proof", "ajpf": "bounded",
-                                   "experiment": "statistical",
-                                   "property_tests": "tested", "monitors": "observed", "review": "reviewed"}
+#: The strength of each backend's evidence, as its ``declaration.yaml`` states it.
+BACKEND_KIND: Mapping[str, str] = {n: d.strength for n, d in DECLARATIONS.items()}
 
 
 def one_sided_bound(n: int, level: float = 0.95) -> float:
@@ -78,8 +78,8 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
         two = (row.get("solvers") or {}).get("agreement") == "two solvers"
         detail = f"Z3{' and cvc5' if two else ' (one solver)'} on the verification conditions"
         doubt = DOUBT["proof2" if two else "proof"]
-    elif backend == "dafny":
-        detail = "Dafny (Boogie and Z3; one solver)"
+    elif backend in DECLARATIONS and DECLARATIONS[backend].strength_detail:
+        detail = str(DECLARATIONS[backend].strength_detail)
     elif kind == "bounded":
         partial = "PARTIAL COVERAGE" in str(row.get("explanation", ""))
         detail = f"{row.get('tool') or backend} over an abstraction" + ("; partial coverage" if partial else "")

@@ -34,10 +34,12 @@ import shutil
 import subprocess
 from pathlib import Path
 from typing import Any, Iterable, Mapping
+from importlib import import_module
 
 import z3
 
 from rclverify import __version__
+from rclverify.model.plan.declarations import DECLARATIONS
 from rclverify.model.plan.load import Plan
 from rclverify.model.plan.paths import config_strings, escape_reason, looks_like_path
 from rclverify.model.plan.entries import declared_paths
@@ -170,13 +172,15 @@ def collect(root: Path, plan: Plan) -> tuple[list[str], list[str]]:
     return sorted(files), sorted(missing)
 
 
-def _dafny_version() -> str:
-    from rclverify.backends.dafny.runner import detect, find_dafny  # deferred: start-up (loads rclverify.backends, rclverify.backends.bounded and more only when called)
-    exe = find_dafny()
-    if exe is None:
-        return "not installed"
-    tool = detect(exe)
-    return tool.version if tool else f"unidentified ({exe})"
+def _declared_versions() -> dict[str, str]:
+    """Each backend tool's version, from the ``version`` function its backend's declaration names."""
+    out: dict[str, str] = {}
+    for d in DECLARATIONS.values():
+        for t in d.tools:
+            if t.version:
+                module, _, function = t.version.partition(":")
+                out[t.name] = str(getattr(import_module(module), function)())
+    return out
 
 
 def _dot_version() -> str:
@@ -191,16 +195,17 @@ def _dot_version() -> str:
 
 
 def tool_versions() -> dict[str, str]:
-    """Versions of the tools the evidence depends on: rclverify, Z3, Dafny
-    (found and identified like the Dafny backend does), Hypothesis, Python,
-    Graphviz and doit.  A tool that is absent is ``"not installed"``."""
+    """Versions of the tools the evidence depends on: rclverify, Z3, each backend
+    tool whose declaration names a version function (Dafny, identified as its
+    backend does), Hypothesis, Python, Graphviz and doit.  A tool that is absent
+    is ``"not installed"``."""
     import doit  # deferred: start-up (loads doit only when called)
     from importlib import metadata  # deferred: start-up (loads importlib.metadata only when called)
     try:  # the installed distribution's version (hypothesis.__version__) without importing it
         hyp = metadata.version("hypothesis")
     except metadata.PackageNotFoundError:
         hyp = "not installed"
-    return {"rclverify": __version__, "z3": z3.get_version_string(), "dafny": _dafny_version(),
+    return {"rclverify": __version__, "z3": z3.get_version_string(), **_declared_versions(),
             "hypothesis": hyp, "python": platform.python_version(), "graphviz": _dot_version(),
             "doit": ".".join(map(str, doit.__version__))}
 

@@ -53,6 +53,7 @@ from typing import Any, Mapping, Sequence
 
 from jinja2 import Environment, PackageLoader, StrictUndefined
 
+from rclverify.model.plan.declarations import declared_in
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.store import atomic_write_text
 from rclverify.model.plan.errors import PlanError
@@ -212,8 +213,8 @@ class _Property:
 class AjpfBackend:
     """Model checking of Gwendolen agents with AJPF (``backend: ajpf``)."""
 
-    name = "ajpf"
-    kind = "model checking"
+    name = declared_in(__file__).name
+    kind = declared_in(__file__).evidence_kind
 
     def __init__(self) -> None:
         self._runs: dict[tuple[str, str], tuple[runner.RunOutcome, AjpfResult, str]] = {}
