@@ -19,6 +19,7 @@ from rclverify.model.plan.entries import SCHEMAS, TOOL_PATH_KINDS
 from rclverify.model.plan.expected import WHOLE_CONTRACT_BACKENDS
 from rclverify.report.argument.strength import BACKEND_KIND
 from rclverify.report.problems_mc import MC_BACKENDS
+from rclverify.records.statuses import EVIDENCE_KINDS
 from rclverify.report.view import TECHNIQUES
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "rclverify" / "backends"
@@ -44,6 +45,8 @@ def test_every_table_is_read_from_the_declarations() -> None:
     for name, d in DECLARATIONS.items():
         assert SCHEMAS[name].keys == d.plan.keys and BACKEND_KIND[name] == d.strength
     assert {t.name for d in DECLARATIONS.values() for t in d.tools} <= set(tool_fingerprint())
+    # the evidence kinds the report's schema publishes are exactly the declared ones
+    assert {d.evidence_kind for d in DECLARATIONS.values()} == set(EVIDENCE_KINDS)
 
 
 GOOD = """\

@@ -3,7 +3,8 @@
 These are the static reading of ``docs/assurance.schema.json`` (JSON Schema
 draft 2020-12), the published shape of ``reports/assurance.json``; the
 status words are the Literal types of :mod:`rclverify.records.statuses`.
-A key the schema lists as optional is ``NotRequired`` here.  Records whose
+A key the schema lists as optional is ``NotRequired`` here; the two are held
+to one shape key by key, both ways, by ``tests/test_report_types_schema.py``.  Records whose
 inner shape belongs to a tool (a requirement's check record, a monitoring
 summary, a counterexample, the grounding) are ``dict[str, Any]``, as the
 schema leaves them open.
@@ -15,10 +16,10 @@ a report that lacks a part.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import Any, Mapping, NotRequired, TypedDict, cast
+from typing import Any, Literal, Mapping, NotRequired, TypedDict, cast
 
-from rclverify.records.statuses import (AcknowledgementStatus, Agreement, DeadlineVerdict, Derivation, EvidenceKind,
-                                        EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
+from rclverify.records.statuses import (AcknowledgementStatus, Agreement, AnyStatus, DeadlineVerdict, Derivation,
+                                        EvidenceKind, EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
                                         SideConditionVerdict, EVIDENCE_STATUSES)
 
 
@@ -104,7 +105,7 @@ class DiagnosisRow(TypedDict):
     """One problem explained, with its repairs checked by Z3 (``diagnoses[]``; docs/diagnosis.md)."""
     id: str
     kind: str
-    status: str
+    status: AnyStatus
     node: str
     guarantee: int | None
     sentence: str
@@ -331,7 +332,7 @@ class UnverifiedRow(TypedDict):
     guarantee: int
     text: str
     source: str
-    status: EvidenceStatus
+    status: Literal["unverified"]
     reason: str
     message: str
 

@@ -118,6 +118,10 @@ Agreement = Literal["two solvers", "one solver", "disagree", "inconclusive"]
 #: Whether a second SMT solver confirmed a verdict (crosscheck/).
 AGREEMENTS: tuple[Agreement, ...] = get_args(Agreement)
 
+#: A status of any kind of item (``$defs/any_status``: a problem row's member keeps its item's own word).
+AnyStatus = EvidenceStatus | HealthStatus | SideConditionVerdict | Derivation | RequirementVerdict | DeadlineVerdict \
+    | AcknowledgementStatus | Severity
+
 EvidenceKind = Literal["proof", "model checking", "testing", "experiment", "review", "monitoring"]
 #: The kinds of evidence an obligation asks for and a record gives (obligations' and evidence rows' ``kind``).
 EVIDENCE_KINDS: tuple[EvidenceKind, ...] = get_args(EvidenceKind)
