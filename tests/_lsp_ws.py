@@ -36,7 +36,6 @@ def make_workspace(root: Path) -> Path:
 def run_pipeline(root: Path, nodes: tuple[str, ...] = ()) -> None:
     """The stages of a run on ``root`` (every node's health, or ``nodes``'), then the report files."""
     from rclverify.app.pipeline import Workspace, stage_check, stage_compose, stage_health, stage_report, stage_requirements
-    from rclverify.report.build import build_report
     ws = Workspace(root)
     stage_check(ws)
     for n in ws.node_names():
@@ -44,7 +43,7 @@ def run_pipeline(root: Path, nodes: tuple[str, ...] = ()) -> None:
         if not nodes or n in nodes:
             stage_health(ws, n)
     stage_requirements(ws)
-    stage_report(ws, report=build_report(ws))
+    stage_report(ws)  # the diagnosis stage first, then the report
 
 
 async def wait_diagnostics(client, u: str, want, timeout: float):  # type: ignore[no-untyped-def]

@@ -198,7 +198,7 @@ def test_strict_ends_in_one_sentence_naming_why(grounded: tuple[Path, subprocess
 
 
 def test_a_problem_sentence_is_cut_at_a_clause_boundary_or_not_at_all() -> None:
-    from rclverify.diagnosis.text import clause_cut
+    from rclverify.report.diagnosis_text import clause_cut
     from rclverify.report.problems import first_sentence
     from rclverify.report.summary import group_sentence
     whole = ("backends/hoare/rs.imp and guarantee 1 of RadiationSensor (contracts/r.rcl:86:3) disagree on their "
@@ -221,7 +221,7 @@ def test_the_first_sentence_does_not_end_inside_a_parenthesis_or_a_formula() -> 
     """A ``;`` or ``.`` before a capital letter ends the first sentence only outside parentheses and
     backquotes: the case study's REQ4 sentence names nodes after each ``;`` of its parenthesis, and its
     terminal line was cut after the first one, mid-parenthesis and with no ``...``."""
-    from rclverify.diagnosis.text import whole_first_sentence
+    from rclverify.report.diagnosis_text import whole_first_sentence
     from rclverify.report.problems import first_sentence
     text = ("Requirement REQ4 (`eventually (a; B)`, contracts/plan.yaml:67:7) is refuted by a run in which no node "
             "accepts its input (Agent.in.at never has a value: Navigation never publishes Navigation.out.at; "

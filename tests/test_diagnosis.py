@@ -18,9 +18,8 @@ from rclverify.cli.commands import main
 from rclverify.diagnosis.build import CACHE, diagnose
 from rclverify.diagnosis.table import counterexample_table, decimals, function_table
 from rclverify.semantics.values import decimal_text
-from rclverify.diagnosis.text import natural_sorted
-from rclverify.app.pipeline import Workspace, stage_check, stage_compose, stage_export, stage_health, stage_run
-from rclverify.report.build import build_report
+from rclverify.report.diagnosis_text import natural_sorted
+from rclverify.app.pipeline import Workspace, diagnosed, stage_check, stage_compose, stage_export, stage_health, stage_run
 from rclverify.report.sarif import sarif_log
 
 REPO = Path(__file__).resolve().parents[1]
@@ -29,7 +28,8 @@ RCL_FILE = "contracts/remote_inspection.rcl"
 
 
 def _run(root: Path) -> tuple[Workspace, dict[str, Any]]:
-    """Check, compose, health, export and run every obligation of ``root``; the report dict."""
+    """Check, compose, health, export and run every obligation of ``root``; the report dict (the
+    orchestrator's: the diagnosis stage run for it)."""
     ws = Workspace(root)
     stage_check(ws)
     for n in ws.node_names():
@@ -37,7 +37,7 @@ def _run(root: Path) -> tuple[Workspace, dict[str, Any]]:
         stage_health(ws, n)
         for o in stage_export(ws, n):
             stage_run(ws, n, o["id"])
-    return ws, build_report(ws)
+    return ws, diagnosed(ws)
 
 
 @pytest.fixture()
@@ -363,8 +363,8 @@ def test_a_broken_checker_shows_no_guard(vacuous: Path, monkeypatch: pytest.Monk
 
 
 def test_parallel_report_tasks_diagnose_one_at_a_time(newcomer: Path) -> None:
-    """doit -n 2 builds the report dict in two processes: the second waits on the diagnosis lock,
-    then finds the first's repairs in the cache instead of computing them again."""
+    """Two processes diagnosing one workspace (the diagnosis task and `rclverify report`): the second
+    waits on the diagnosis lock, then finds the first's repairs in the cache instead of computing them again."""
     import fcntl
     import threading
     from rclverify.diagnosis.build import LOCK

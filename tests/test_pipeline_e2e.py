@@ -397,7 +397,7 @@ def test_editing_one_contract_reruns_that_node_its_consumers_and_the_report(work
         # `crosscheck`: the second solver decides the changed side conditions and health checks again
         # `health:RadiationSensor`, not `health:Agent`: a consumer's health checks read only its own contract
         assert ran - evidence == {"check", "node:RadiationSensor", "node:Agent", "health:RadiationSensor",
-                                  "requirements", "ground", "crosscheck", "report:html", "report:text", "verify"}
+                                  "requirements", "ground", "crosscheck", "diagnosis", "report:html", "report:text", "verify"}
         # the formal requirements whose cone holds RadiationSensor: all four (the loop; REQ4 temporal over the same cone)
         assert "requirements: 4 of 4 checked (REQ1, REQ2, REQ3, REQ4)" in r.stdout
         # in the node tasks, only the stages whose own inputs changed: the consumer's side conditions

@@ -9,7 +9,7 @@ import re
 from pathlib import Path
 
 from _drone_ws import copy, verify
-from rclverify.diagnosis.text import status_lines
+from rclverify.report.diagnosis_text import status_lines
 from rclverify.report.summary import summary_data
 
 FULL_ID = re.compile(r"^(\w+\.(g\d+(\.[\w.-]+)?|sc\d+|derived)|REQ\d+)$")
@@ -154,6 +154,6 @@ def test_a_stored_report_without_where_or_unverified_still_renders() -> None:
 
 
 def test_the_terminal_writes_a_file_once_for_culprits_on_several_of_its_lines() -> None:
-    from rclverify.diagnosis.text import same_file_lines
+    from rclverify.report.diagnosis_text import same_file_lines
     assert same_file_lines(["a.gwen:72", "a.gwen:74", "b.imp:15", "guarantee 3 of Agent (x.rcl:72:3)", "b.imp:18"]) \
         == ["a.gwen:72, 74", "b.imp:15", "guarantee 3 of Agent (x.rcl:72:3)", "b.imp:18"]

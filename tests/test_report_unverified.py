@@ -11,7 +11,7 @@ from pathlib import Path
 import jsonschema
 
 from _drone_ws import DATA, copy, set_nodes, verify
-from rclverify.diagnosis.text import status_lines
+from rclverify.report.diagnosis_text import status_lines
 from rclverify.report.summary import print_summary, summary_data
 from rclverify.app.tasks import act_verify
 

@@ -227,7 +227,7 @@ def test_upstream_masks_are_the_upstream_cones_also_through_loops() -> None:
 
 
 def test_the_task_definitions_name_the_stage_records_the_stages_write() -> None:
-    """app/tasks.py names the deadlines' and the second solver's records as
+    """app/tasks.py names the deadlines', the second solver's and the diagnosis's records as
     text, so that defining the tasks (every doit run, the no-op included)
     imports neither stage (issue 67: the deadline stage's import loaded Z3):
     the same paths."""
@@ -235,3 +235,6 @@ def test_the_task_definitions_name_the_stage_records_the_stages_write() -> None:
     from rclverify.stages.crosscheck.stage import INDEX as crosscheck
     from rclverify.stages.deadlines import INDEX as deadlines
     assert (tasks.DEADLINES_INDEX, tasks.CROSSCHECK_INDEX) == (deadlines, crosscheck)
+    from rclverify.app.task_table import DIAGNOSIS_INDEX
+    from rclverify.stages.diagnoses import INDEX as diagnoses
+    assert DIAGNOSIS_INDEX == diagnoses

@@ -2,7 +2,7 @@
 
 The case study's stages run once on a copy of the repository root's workspace (contracts, backends'
 inputs, the robot's code): check, compose, health, export per node, deadlines, requirements, the second
-solver and the ROS grounding; the deadlines on a copy of examples/safety_stop (the rover has none).  Each record a stage returned, and each record it sealed on disk, is walked
+solver, the ROS grounding and the diagnosis; the deadlines on a copy of examples/safety_stop (the rover has none).  Each record a stage returned, and each record it sealed on disk, is walked
 against its TypedDict: no key the type does not declare, every required key present, each value of its
 JSON type (nested TypedDicts, lists, dicts and unions walked).
 """
@@ -118,6 +118,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]
     out["requirements"] = [rec for rec, _ in pipeline.stage_requirements(ws)]
     out["crosscheck"] = stage_crosscheck(root, nodes)
     out["ground"] = stage_ground(ws)
+    out["diagnosis"] = pipeline.stage_diagnosis(ws)  # the report's problems, from every record above
     return root, out
 
 
@@ -143,6 +144,9 @@ def test_the_returned_records_are_their_types(run: tuple[Path, dict[str, Any]]) 
     _check(out["requirements"], list[sr.RequirementRecord], "requirements")
     _check(out["crosscheck"], sr.CrosscheckRecord, "crosscheck")
     _check(out["ground"], sr.GroundingRecord, "ground")
+    kinds = {d["kind"] for d in out["diagnosis"]["diagnoses"]}
+    assert {"requirement", "vacuity", "refinement"} <= kinds, kinds  # EXTRA-REFUTED among them
+    _check(out["diagnosis"], sr.DiagnosisRecord, "diagnosis")
 
 
 def test_the_sealed_records_are_their_types(run: tuple[Path, dict[str, Any]]) -> None:
@@ -165,6 +169,7 @@ def test_the_sealed_records_are_their_types(run: tuple[Path, dict[str, Any]]) ->
         _check(_sealed(root, f"artifacts/requirements/{p.name}"), sr.RequirementRecord, p.name)
     _check(_sealed(root, "artifacts/crosscheck/index.json"), sr.CrosscheckRecord, "crosscheck")
     _check(_sealed(root, "artifacts/ros/grounding.json"), sr.GroundingRecord, "grounding")
+    _check(_sealed(root, "artifacts/diagnosis/index.json"), sr.DiagnosisRecord, "diagnosis")
 
 
 def test_the_deadline_records_are_their_type(tmp_path: Path) -> None:

@@ -19,6 +19,8 @@ Artifact layout (workspace-relative)::
     artifacts/requirements/<ID>.json     a requirement's Z3 check (proved/refuted/...)
     artifacts/deadlines/index.json       the end-to-end deadlines decided by rule D3 (sealed),
                                          each query as artifacts/deadlines/<ID>.smt2
+    artifacts/diagnosis/index.json       one diagnosis per problem of the report, repairs checked
+                                         by Z3, with the digest of the report they explain (sealed)
 """
 from __future__ import annotations
 
@@ -44,8 +46,8 @@ from rclverify.records.sealed import read_sealed
 if TYPE_CHECKING:
     from rclverify.calculus.health.checks import Finding
     from rclverify.records.report_schema import Report
-    from rclverify.records.stage_records import (CheckRecord, CompositionRecord, DeadlineRecord, HealthFinding,
-                                                 ObligationRecord, RequirementRecord)
+    from rclverify.records.stage_records import (CheckRecord, CompositionRecord, DeadlineRecord, DiagnosisRecord,
+                                                 HealthFinding, ObligationRecord, RequirementRecord)
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached
@@ -282,9 +284,47 @@ def stage_deadlines(ws: Workspace) -> list[DeadlineRecord]:
     return cast("list[DeadlineRecord]", run(ws)[1])
 
 
+def stage_diagnosis(ws: Workspace, report: dict[str, Any] | None = None) -> DiagnosisRecord:
+    """The diagnosis stage: explain every problem of the report dict without
+    diagnoses (``report``, else built now:
+    :func:`rclverify.report.build.undiagnosed_report`) with repairs checked
+    by Z3 (:func:`rclverify.diagnosis.build.diagnose`) and write the sealed
+    record ``artifacts/diagnosis/index.json``
+    (:mod:`rclverify.stages.diagnoses`).  Returns the record.  Raises
+    ``RclError`` for contracts or a plan that do not check, ``OSError``
+    when the record cannot be written."""
+    from rclverify.diagnosis.build import diagnose  # deferred: start-up (loads z3, lark and more only when called)
+    from rclverify.report.build import undiagnosed_report  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.stages.diagnoses import report_digest, write_diagnoses  # deferred: start-up (loads rclverify.stages.diagnoses only when called)
+    if report is None:
+        report = undiagnosed_report(ws)
+    digest = report_digest(report)  # taken first: the records explain the report as it was given
+    return write_diagnoses(ws, digest, diagnose(ws, report))
+
+
+def diagnosed(ws: Workspace, report: dict[str, Any] | None = None) -> Report:
+    """The report dict of ``ws``: ``report`` (the report without diagnoses,
+    else built now) with the diagnosis stage's record for it, the stage run
+    first when that record is missing, altered or made from another report
+    (:func:`rclverify.stages.diagnoses.read_diagnoses`): every report the
+    orchestrator builds explains its problems.  Raises as
+    :func:`stage_diagnosis`."""
+    from rclverify.report.build import diagnosed_report, undiagnosed_report  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.stages.diagnoses import read_diagnoses  # deferred: start-up (loads rclverify.stages.diagnoses only when called)
+    if report is None:
+        report = undiagnosed_report(ws)
+    diagnoses, _ = read_diagnoses(ws, report)
+    if diagnoses is None:
+        diagnoses = cast("list[dict[str, Any]]", stage_diagnosis(ws, report)["diagnoses"])
+    return diagnosed_report(report, diagnoses)
+
+
 def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
-                 report: Report | None = None) -> tuple[Report, list[Path]]:
-    """Build the report dict of ``ws`` (unless ``report`` gives it) and write
+                 report: Report | None = None, undiagnosed: dict[str, Any] | None = None) -> tuple[Report, list[Path]]:
+    """Build the report dict of ``ws`` (unless ``report`` gives it: from
+    ``undiagnosed``, the report without diagnoses, when given, with the
+    diagnosis stage's record, the stage run first when it is not current:
+    :func:`diagnosed`) and write
     the files of ``parts`` under ``reports/`` (:mod:`rclverify.report.parts`:
     ``html`` is ``assurance.{html,json}``, the CI formats and the argument's
     SVG; ``text`` is ``assurance.md`` and the rest of the argument).  Graphviz
@@ -295,13 +335,12 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
     not check, ``KeyError`` for an unknown part and ``OSError`` when a file
     cannot be written."""
     from rclverify.report import layoutcache  # deferred: start-up (loads rclverify.core.cache, rclverify.report and more only when called)
-    from rclverify.report.build import build_report  # deferred: start-up (loads jinja2, lark and more only when called)
     from rclverify.report.fragments import FragmentCache  # deferred: start-up (loads rclverify.core.cache, rclverify.report and more only when called)
     from rclverify.report.parts import FRAGMENTS, write_part  # deferred: start-up (loads jinja2, markupsafe and more only when called)
     from rclverify.core.cache.keys import user_cache_dir  # deferred: start-up (loads rclverify.core.cache and more only when called)
     from rclverify.report.render import use_bytecode_cache  # deferred: start-up (loads jinja2, markupsafe and more only when called)
     if report is None:
-        report = build_report(ws)
+        report = diagnosed(ws, undiagnosed)
     layoutcache.use_directory(ws.path("artifacts/cache/layout"))
     use_bytecode_cache(user_cache_dir("templates"))  # compiled code: never in the workspace (docs/scale.md)
     out = ws.path("reports")

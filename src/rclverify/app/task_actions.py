@@ -175,6 +175,28 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
 #: The report dict built by the first report part of a run, for the other parts the same process
 #: runs (a serial run): keyed by workspace root, valid for the workspace object of that run.
 _REPORTS: dict[str, tuple[Workspace, Report]] = {}
+#: The report dict without diagnoses the diagnosis task built, for the report part the same process runs
+#: next (a serial run: no task between them changes an artifact the report reads); as :data:`_REPORTS`.
+_UNDIAGNOSED: dict[str, tuple[Workspace, dict[str, Any]]] = {}
+
+
+@_extras_said
+def act_diagnosis(root: str) -> Any:
+    """Explain every problem of the report, repairs checked by Z3, into the
+    sealed record ``artifacts/diagnosis/index.json`` (:func:`rclverify.app.pipeline.stage_diagnosis`)."""
+    from rclverify.report.build import undiagnosed_report  # deferred: start-up (loads jinja2, lark and more only when called)
+    try:
+        ws = _ws(root)
+        report = undiagnosed_report(ws)
+        record = pipeline.stage_diagnosis(ws, report)
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    _UNDIAGNOSED[root] = (ws, report)
+    rows = record["diagnoses"]
+    print(f"diagnosis: {len(rows)} problem(s) explained, {sum(len(d['repairs']) for d in rows)} repair(s) checked")
+    return None
 
 
 @_extras_said
@@ -187,7 +209,9 @@ def act_report(root: str, part: str) -> Any:
     try:
         ws = _ws(root)
         kept = _REPORTS.get(root)
-        report, _ = stage_report(ws, (part,), kept[1] if kept is not None and kept[0] is ws else None)
+        pre = _UNDIAGNOSED.pop(root, None)
+        report, _ = stage_report(ws, (part,), kept[1] if kept is not None and kept[0] is ws else None,
+                                 pre[1] if pre is not None and pre[0] is ws else None)
     except RclError as exc:
         return _fail(exc)
     except OSError as exc:

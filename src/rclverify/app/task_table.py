@@ -8,7 +8,7 @@ method that doit calls as a task creator (doit accepts bound methods, also
 with ``create_after``).  doit orders the tasks by the line where each
 creator is defined, so the methods stand in the order the tasks run:
 check, graph, node, health, requirements, deadlines, evidence, crosscheck, ground,
-report, verify.  The actions the tasks run are in
+diagnosis, report, verify.  The actions the tasks run are in
 :mod:`rclverify.app.task_actions`, the ``uptodate`` checks in
 :mod:`rclverify.app.task_checks`.
 """
@@ -26,8 +26,8 @@ from doit import create_after as _create_after
 from doit.tools import config_changed
 
 from rclverify.core.cache import code_stamp
-from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_graph, act_ground, act_node,
-                                        act_report, act_requirements, act_run, act_verify)
+from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_diagnosis, act_graph, act_ground,
+                                        act_node, act_report, act_requirements, act_run, act_verify)
 from rclverify.app.task_checks import (RecordIntact, TargetsAsWritten, entry_inputs, ros_fingerprint, strict_uptodate,
                                        tool_fingerprint, z3_version)
 from rclverify.stages.workspace import REPORT_PARTS, TaskIndex, Workspace, check_input_files
@@ -68,6 +68,8 @@ REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.
 #: named here so that defining the tasks imports neither stage (tests/test_scale.py holds them equal).
 DEADLINES_INDEX = "artifacts/deadlines/index.json"
 CROSSCHECK_INDEX = "artifacts/crosscheck/index.json"
+#: The diagnosis stage's record (stages/diagnoses.py: ``INDEX``), named here for the same reason.
+DIAGNOSIS_INDEX = "artifacts/diagnosis/index.json"
 
 
 class TaskTable:
@@ -101,6 +103,7 @@ class TaskTable:
         self.deadline_nodes = list(index.deadline_nodes) if index is not None else []
         self.ros_section = dict(index.ros) if index is not None else {}  # from the index: a no-op run loads no contract
         self._exported: Exported | None = None
+        self._report_deps: list[str] | None = None
 
     def at(self, rel: str) -> str:
         """The absolute path of a workspace-relative artifact path (string
@@ -230,18 +233,27 @@ class TaskTable:
                 "task_dep": ["check"], "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")
+    def task_diagnosis(self) -> dict[str, Any]:
+        """Explain every problem of the report, repairs checked by Z3, as a sealed record the report reads
+        (docs/diagnosis.md).  It reads what the report reads (the same file dependencies): the report dict
+        without diagnoses is what it explains."""
+        return {"actions": [(act_diagnosis, [self.r])], "file_dep": self._report_inputs(),
+                "task_dep": ["crosscheck"], "targets": [self.at(DIAGNOSIS_INDEX)],
+                "uptodate": [self.code, self.sealed], "verbosity": 2, "clean": True}
+
+    @create_after(executed="evidence")
     def task_report(self) -> Iterator[dict[str, Any]]:
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
         yield {"basename": "report", "name": None,
                "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
-        deps, at = self._report_inputs(), self.at
+        deps, at = self._report_inputs() + [self.at(DIAGNOSIS_INDEX)], self.at
         as_written = TargetsAsWritten()  # the files as the task wrote them, not as `rclverify report` did since
         for part, files in REPORT_PARTS.items():
             # task_dep on crosscheck: both are created after `evidence`, and when the report's loader runs
             # first doit does not yet know which task makes the second solver's index (its file_dep alone
             # then let doit -n 2 render the report beside crosscheck, from no index)
             yield {"name": part, "doc": "reports/" + ", ".join(files), "actions": [(act_report, [self.r, part])],
-                   "file_dep": deps, "task_dep": ["crosscheck"], "uptodate": [self.code, self.sealed, as_written],
+                   "file_dep": deps, "task_dep": ["crosscheck", "diagnosis"], "uptodate": [self.code, self.sealed, as_written],
                    "targets": [at(f"reports/{f}") for f in files if f != "argument.svg"]
                    + ([at(self.ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}
@@ -257,7 +269,7 @@ class TaskTable:
         # rest, since the report and crosscheck (created after the evidence) are otherwise the only tasks
         # that reach them, which made them start after the evidence instead of beside it
         before = ([f"node:{n}" for n in self.nodes] + [f"health:{n}" for n in self.nodes] + ["requirements"]
-                  + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"] + (["ground"] if self.ros_section else []))
+                  + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"] + (["ground"] if self.ros_section else []) + ["diagnosis"])
         ok = self.ok
         return {"actions": [(act_verify, [self.r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(self.rootp / REPORTS[2])] if ok else [],
@@ -273,7 +285,8 @@ class TaskTable:
         if self.ok:
             creators.update({"task_graph": self.task_graph, "task_node": self.task_node, "task_health": self.task_health,
                              "task_requirements": self.task_requirements, "task_evidence": self.task_evidence,
-                             "task_report": self.task_report, "task_crosscheck": self.task_crosscheck})
+                             "task_report": self.task_report, "task_crosscheck": self.task_crosscheck,
+                             "task_diagnosis": self.task_diagnosis})
             if self.ros_section:
                 creators["task_ground"] = self.task_ground
             if self.deadline_nodes:
@@ -313,7 +326,13 @@ class TaskTable:
         return extra
 
     def _report_inputs(self) -> list[str]:
-        """The file dependencies of both report parts: every artifact the report reads."""
+        """The file dependencies of the diagnosis task and both report parts: every artifact the report
+        reads (made once per run: a new list each call)."""
+        if self._report_deps is None:
+            self._report_deps = self._report_files()
+        return list(self._report_deps)
+
+    def _report_files(self) -> list[str]:
         ws, at, rootp = self.ws, self.at, self.rootp
         # The plan itself: the report shows its name, requirements and their tracing, which no
         # other artifact holds (a plan edit that changes only those re-renders the report).

@@ -57,7 +57,7 @@ def cmd_compose(args: argparse.Namespace) -> int:
                     print(f"      producer: {h}")
             if sc["model"]:
                 from rclverify.diagnosis.table import counterexample_table  # deferred: optional or conditional (inside a block)
-                from rclverify.diagnosis.text import table_lines  # deferred: optional or conditional (inside a block)
+                from rclverify.report.diagnosis_text import table_lines  # deferred: optional or conditional (inside a block)
                 print("      counterexample:")
                 print("\n".join(table_lines(counterexample_table(sc["model"], n), "        ")))
             bad += sc["status"] != "discharged"

@@ -44,7 +44,7 @@ def cmd_explain(args: argparse.Namespace) -> int:
         raise located(root / "reports/assurance.json", f"not an rclverify report: cannot read it ({exc!r}); "
                       "run `rclverify verify` (or `doit verify`) to write it again") from None
     if lines is None:  # an unverified guarantee, a derived property: a finding with no record of its own
-        from rclverify.diagnosis.text import finding_lines  # deferred: optional or conditional (inside a block)
+        from rclverify.report.diagnosis_text import finding_lines  # deferred: optional or conditional (inside a block)
         lines = finding_lines(report, args.id) or None
     if lines is not None:
         print("\n".join(lines))

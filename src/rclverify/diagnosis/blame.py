@@ -42,7 +42,8 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.diagnosis import realize, recheck
 from rclverify.diagnosis.bounds import FLIP, bound_literals, thresholds, value
 from rclverify.diagnosis.edits import Edit
-from rclverify.diagnosis.repairs import link_pairs, _numbers, _peel, _rename
+from rclverify.diagnosis.links import link_pairs
+from rclverify.diagnosis.repairs import _numbers, _peel, _rename
 from rclverify.model.plan.load import all_requirements
 from rclverify.calculus.requirements.check import check_requirement, formals_of
 from rclverify.lang.walk import subexpressions

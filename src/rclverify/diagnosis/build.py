@@ -1,7 +1,10 @@
 """One diagnosis record per problem of the report dict.
 
-:func:`diagnose` reads the report dict (:func:`rclverify.report.build.build_report`)
-and the workspace and returns ``[record, ...]``, each::
+:func:`diagnose` reads the report dict without diagnoses
+(:func:`rclverify.report.build.undiagnosed_report`) and the workspace and
+returns ``[record, ...]``, each (the diagnosis stage seals them into
+``artifacts/diagnosis/index.json``, :mod:`rclverify.stages.diagnoses`, and
+the report reads them from there)::
 
     {"id": problem id (finding, side condition or obligation id),
      "kind": "vacuity" | "inconsistency" | "unsatisfiable-assumption" | "refinement"
@@ -44,6 +47,7 @@ from rclverify.diagnosis.deadline import budget_repairs, deadline_record
 from rclverify.diagnosis.requirement import requirement_record
 from rclverify.diagnosis.sidecond import side_condition_repairs
 from rclverify.diagnosis.culprits import culprits, parse_core, plan_facts
+from rclverify.diagnosis.links import link_pairs
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
 
@@ -104,11 +108,12 @@ def _one_at_a_time(ws: Any) -> Iterator[None]:
     """Hold an exclusive lock on ``artifacts/diagnosis.lock`` (POSIX
     ``flock``; released when the block ends or the process dies).
 
-    ``doit -n 2`` builds the report dict in two processes at once (one per
-    report part, :mod:`rclverify.report.parts`); without the lock both
-    computed every repair of a cold run (the case study: about 4 CPU
-    seconds each, 11 before the repair search got faster).  With it the
-    second waits, then finds the first's repairs in the cache.  Where the
+    Two processes may diagnose the same workspace at once (the diagnosis
+    task of ``doit -n 2`` and an ``rclverify report``, or two report parts
+    that both found the stage's record stale, :func:`rclverify.app.pipeline.diagnosed`);
+    without the lock both computed every repair of a cold run (the case
+    study: about 4 CPU seconds each).  With it the second waits, then finds
+    the first's repairs in the cache.  Where the
     lock cannot be taken (no ``fcntl``, a read-only workspace) the block
     runs unlocked: the lock only saves work."""
     try:
@@ -245,7 +250,7 @@ def _and(items: list[str]) -> str:
 
 def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], cache: _Cache,
                     sc_before: Mapping[str, str]) -> dict[str, Any]:
-    pairs = rep.link_pairs(sc)
+    pairs = link_pairs(sc)
     cul = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
     said = []
     # a producer guarantee is named only when strengthening it discharges the side condition (blame.py)

@@ -340,17 +340,6 @@ def _numeric_vars(ws: Any, cn: Any, formula: ast.Expr) -> dict[str, str]:
     return out
 
 
-def link_pairs(sc: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
-    """``(producer, out var, consumer, in var)`` of a side condition's links
-    (``Planner.out.speed -> Controller.in.speed (via name)``)."""
-    out = []
-    for l in sc.get("links", []):
-        m = re.match(r"^(\w+)\.out\.(\w+) -> (\w+)\.in\.(\w+)", l)
-        if m:
-            out.append((m.group(1), m.group(2), m.group(3), m.group(4)))
-    return out
-
-
 def _rename(text: str, pairs: Sequence[tuple[str, str]]) -> str:
     for a, b in pairs:
         text = re.sub(rf"(?<![\w.']){re.escape(a)}(?![\w'])", b, text)

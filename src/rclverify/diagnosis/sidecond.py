@@ -56,7 +56,8 @@ from rclverify.lang.walk import subexpressions
 from rclverify.diagnosis import realize, recheck
 from rclverify.diagnosis.bounds import coefficient_literals, number_text, power_of_ten, value
 from rclverify.diagnosis.edits import Edit
-from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, link_pairs, _record, _rename
+from rclverify.diagnosis.links import link_pairs
+from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, _record, _rename
 from rclverify.model.plan.errors import PlanError
 from rclverify.model.plan.load import all_requirements
 from rclverify.diagnosis.units import declared_unit, literal_si, literal_in

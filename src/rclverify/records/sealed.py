@@ -8,7 +8,7 @@ same treatment here: requirement checks (``artifacts/requirements/``),
 contract health findings (``artifacts/health/``), side conditions and
 derived properties (``artifacts/calculus/``), stage provenance
 (``artifacts/provenance/``), exported obligations (``artifacts/obligations/``:
-each node's list and each obligation's own file), lint diagnostics, the
+each node's list and each obligation's own file), the diagnoses, lint diagnostics, the
 grounding and the last run's summary.
 
 A record is a JSON object.  :func:`write_sealed` adds the seal;
@@ -31,7 +31,7 @@ from rclverify.records.store import SEAL, _sealed_text, atomic_write_text, seal_
 
 #: Workspace-relative directories and files whose JSON records are sealed (:func:`is_sealed_path`).
 SEALED_DIRS = ("artifacts/requirements/", "artifacts/health/", "artifacts/calculus/", "artifacts/provenance/",
-               "artifacts/obligations/", "artifacts/deadlines/", "artifacts/crosscheck/")
+               "artifacts/obligations/", "artifacts/deadlines/", "artifacts/crosscheck/", "artifacts/diagnosis/")
 SEALED_FILES = ("artifacts/check/diagnostics.json", "artifacts/report/summary.json", "artifacts/ros/grounding.json",
                 "artifacts/check/index.json")
 

@@ -16,7 +16,8 @@ records/records.py ``Obligation.to_json``; ``deadlines``
 calculus/deadlines.py ``DeadlineResult.to_json`` with stages/deadlines.py;
 ``requirements`` calculus/requirements/check.py, temporal_check.py and
 stages/requirements.py; ``crosscheck`` stages/crosscheck/stage.py;
-``ground`` app/ros_stage.py.  tests/test_stage_records.py checks every
+``ground`` app/ros_stage.py; ``diagnosis`` diagnosis/build.py with
+stages/diagnoses.py.  tests/test_stage_records.py checks every
 record the case study's stages return against these types.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
@@ -248,6 +249,37 @@ class CrosscheckRecord(TypedDict):
     items: list[CrosscheckRow]
 
 
+class DiagnosisEntry(TypedDict):
+    """One problem of the report explained (diagnosis/build.py ``diagnose``; docs/diagnosis.md): the
+    culprits by source location, the counterexample as a table, the repairs Z3 checked; ``not_offered``
+    the repairs Z3 showed do not work (side conditions), ``joins`` and ``lint`` the findings a unit
+    mismatch explains, ``passes_through`` and ``consequence_of`` the side conditions and problems a
+    refuted requirement rests on, ``requirement`` the requirement of a deadline's record."""
+    id: str
+    kind: str
+    node: str
+    status: str
+    sentence: str
+    culprits: list[dict[str, Any]]
+    counterexample: list[dict[str, Any]]
+    repairs: list[dict[str, Any]]
+    guarantee: int | None
+    related: list[str]
+    not_offered: NotRequired[list[str]]
+    joins: NotRequired[list[str]]
+    lint: NotRequired[str]
+    passes_through: NotRequired[list[str]]
+    consequence_of: NotRequired[list[str]]
+    requirement: NotRequired[str]
+
+
+class DiagnosisRecord(TypedDict):
+    """``artifacts/diagnosis/index.json``: the diagnoses of the report dict whose digest is ``report_sha256``
+    (stages/diagnoses.py)."""
+    report_sha256: str
+    diagnoses: list[DiagnosisEntry]
+
+
 class GroundingFinding(TypedDict):
     """One finding of grounding the contracts in the ROS graph (ros/ground/ground.py ``Finding``)."""
     code: str
@@ -270,5 +302,5 @@ class GroundingRecord(TypedDict):
     inputs: dict[str, str]
 
 
-__all__ = ["CheckRecord", "CompositionRecord", "CrosscheckRecord", "DeadlineRecord", "GroundingRecord",
+__all__ = ["CheckRecord", "CompositionRecord", "CrosscheckRecord", "DeadlineRecord", "DiagnosisRecord", "GroundingRecord",
            "HealthFinding", "ObligationRecord", "RequirementRecord"]

@@ -2,7 +2,7 @@
 the functions here put a part in, giving a new report.
 
 A pass reads the report as the parts before it made it and returns what
-it adds (report/statistics.py, report/confidence_rows.py, diagnosis/,
+it adds (report/statistics.py, report/confidence_rows.py, the diagnosis stage's record,
 report/problems.py, report/culprits.py); nothing a pass returned is
 changed afterwards: a row that gains keys is a new row, the rows it does
 not touch are shared.  The last step, :func:`finished`, checks the whole

@@ -24,7 +24,6 @@ from typing import Any, Callable, NamedTuple
 import z3
 
 from rclverify import __version__
-from rclverify.diagnosis.build import diagnose
 from rclverify.model.plan.load import all_requirements
 from rclverify.model.system.model import cycles_kept
 from rclverify.records.records import Obligation, worst
@@ -49,6 +48,7 @@ from rclverify.report.templating import anchor
 from rclverify.report.unverified import unverified_guarantees
 from rclverify.report.view import problem_items
 from rclverify.stages.crosscheck.apply import SecondSolver, load as load_second_solver
+from rclverify.stages.diagnoses import read_diagnoses
 from rclverify.stages.requirements import read_records
 from rclverify.stages.workspace import Workspace, current_snapshot_hashes, stale_stages
 
@@ -150,18 +150,16 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
     }
 
 
-def build_report(ws: Workspace) -> Report:
-    """Read every artifact of ``ws`` and return the report (see render.py):
-    a :class:`~rclverify.records.report_schema.Report`, the shape
-    docs/assurance.schema.json publishes.  The passes, in order: the rows
-    (:func:`_rows`), the summary around them, the statistics table
+def undiagnosed_report(ws: Workspace) -> dict[str, Any]:
+    """Read every artifact of ``ws`` and return the report dict up to its
+    diagnoses (what the diagnosis stage explains,
+    :func:`rclverify.app.pipeline.stage_diagnosis`).  The passes, in order:
+    the rows (:func:`_rows`), the summary around them, the statistics table
     (report/statistics.py, docs/statistics.md), the second solver's counts,
     strength and confidence (report/confidence_rows.py), the evidence
     mapped onto the plan's standards (report/standards_rows.py), the
-    ``--strict`` gate with every severity (report/severity.py), one
-    diagnosis per problem with repairs checked by Z3 (docs/diagnosis.md),
-    the problems grouped by root cause (report/problems.py) and the
-    culprit nodes marked (report/culprits.py)."""
+    ``--strict`` gate with every severity (report/severity.py).  Raises
+    ``RclError`` for contracts or a plan that do not check."""
     inp = read_inputs(ws)
     report = _first_report(ws, inp, *_rows(ws, inp))
     plan = ws.plan
@@ -173,9 +171,36 @@ def build_report(ws: Workspace) -> Report:
     standards = standards_part(plan.standards, report["evidence"])  # docs/standards.md
     report = assemble.with_standards(report, standards)
     # one severity per finding: --strict fails on every error and warning, health and lint warnings included
-    report = assemble.with_strict(report, bool(report["meta"]["strict_ok"]) and confidence["ok"]
-                                  and not inp.second.problem and not blocking(report)
-                                  and standards["ok"])
-    report = assemble.with_diagnoses(report, diagnose(ws, report))
+    return assemble.with_strict(report, bool(report["meta"]["strict_ok"]) and confidence["ok"]
+                                and not inp.second.problem and not blocking(report)
+                                and standards["ok"])
+
+
+def diagnosed_report(report: dict[str, Any], diagnoses: list[dict[str, Any]] | None, why: str = "") -> Report:
+    """The finished report: ``report`` (:func:`undiagnosed_report`) with
+    ``diagnoses`` (the diagnosis stage's records for it,
+    :func:`rclverify.stages.diagnoses.read_diagnoses`), the problems grouped
+    by root cause (report/problems.py) and the culprit nodes marked
+    (report/culprits.py).  ``diagnoses`` is ``None`` when they are not
+    current: the report then explains no problem and ``why`` (one
+    sentence) is among ``summary.problems``."""
+    if diagnoses is None:
+        summary = {**report["summary"], "problems": list(report["summary"]["problems"]) + [f"Diagnoses: {why}"]}
+        report = {**report, "summary": summary}
+    report = assemble.with_diagnoses(report, list(diagnoses or []))
     problems = group_problems(report, problem_items(report), anchor)
     return assemble.finished(report, problems, marked_nodes(report["nodes"], problems))
+
+
+def build_report(ws: Workspace) -> Report:
+    """Read every artifact of ``ws`` and return the report (see render.py):
+    a :class:`~rclverify.records.report_schema.Report`, the shape
+    docs/assurance.schema.json publishes: :func:`undiagnosed_report` with
+    the diagnosis stage's sealed record (artifacts/diagnosis/index.json)
+    when it was made from that report, else with no diagnosis and a
+    sentence saying why among ``summary.problems`` (the report diagnoses
+    nothing itself: :func:`rclverify.app.pipeline.stage_report` runs the
+    stage first).  Raises ``RclError`` for contracts or a plan that do not
+    check."""
+    report = undiagnosed_report(ws)
+    return diagnosed_report(report, *read_diagnoses(ws, report))

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence, TypedDict, cast
 
-from rclverify.diagnosis.text import natural_sorted  # p1 < p2 < p10
+from rclverify.report.diagnosis_text import natural_sorted  # p1 < p2 < p10
 from rclverify.records.records import Obligation, worst
 from rclverify.records.report_schema import DerivedPropertyRow, GuaranteeRow, NodeRow, SideConditionRow
 from rclverify.records.statuses import EvidenceStatus, HealthStatus

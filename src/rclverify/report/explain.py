@@ -20,7 +20,7 @@ import re
 from typing import Any, Iterable, Mapping, Sequence
 
 from rclverify.diagnosis.table import counterexample_table
-from rclverify.diagnosis.text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
+from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
 from rclverify.records.records import SEVERITY
 from rclverify.report.summary import group_sentence
 

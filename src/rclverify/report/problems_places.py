@@ -14,7 +14,7 @@ import re
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from rclverify.diagnosis.text import whole_first_sentence
+from rclverify.report.diagnosis_text import whole_first_sentence
 from rclverify.records.records import SEVERITY
 
 #: Key prefix of a group of outstanding evidence on a node's whole contract from one backend (rule 5).
@@ -135,7 +135,7 @@ SENTENCE_CHARS = 400
 
 def first_sentence(text: str, limit: int = SENTENCE_CHARS) -> str:
     """The first sentence of ``text``
-    (:func:`rclverify.diagnosis.text.whole_first_sentence`), cut at a word
+    (:func:`rclverify.report.diagnosis_text.whole_first_sentence`), cut at a word
     boundary to ``limit`` characters with ``...`` when longer."""
     s = whole_first_sentence(text)
     if len(s) > limit:

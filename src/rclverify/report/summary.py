@@ -138,8 +138,8 @@ def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
 def group_sentence(group: Mapping[str, Any]) -> str:
     """The first sentence of a problem group, whole: the report's row
     (report/problems.py) cuts it to a length; the terminal cuts it only at
-    a clause boundary (:func:`rclverify.diagnosis.text.clause_cut`)."""
-    from rclverify.diagnosis.text import whole_first_sentence  # deferred: start-up (loads rclverify.diagnosis, rclverify.diagnosis.text only when called)
+    a clause boundary (:func:`rclverify.report.diagnosis_text.clause_cut`)."""
+    from rclverify.report.diagnosis_text import whole_first_sentence  # deferred: start-up (loads rclverify.report.diagnosis_text only when called)
     short = str(group.get("sentence", ""))
     stem = short[:-4] if short.endswith(" ...") else None
     for m in group.get("members", []):
@@ -231,10 +231,10 @@ def strict_sentence(data: Mapping[str, Any]) -> str:
 
 def status_text(data: Mapping[str, Any]) -> list[str]:
     """The overall line and the problems of the summary ``data``
-    (:func:`rclverify.diagnosis.text.status_lines`), with the ROS grounding
+    (:func:`rclverify.report.diagnosis_text.status_lines`), with the ROS grounding
     errors: counted on the overall line and listed one a line (they change
     no verdict, docs/ros.md, but fail ``--strict``)."""
-    from rclverify.diagnosis.text import status_lines  # deferred: start-up (loads rclverify.diagnosis, rclverify.diagnosis.text only when called)
+    from rclverify.report.diagnosis_text import status_lines  # deferred: start-up (loads rclverify.report.diagnosis_text only when called)
     g = data.get("grounding") or {}
     errors = int(g.get("error", 0) or 0)
     if errors:  # listed below one a line, not as the report's one summary problem
@@ -356,7 +356,7 @@ def read_summary(root: Path) -> dict[str, Any]:
 def print_last_run(root: Path) -> dict[str, Any]:
     """Print what ``doit verify`` ends with, from the last run's files in the
     workspace ``root``: the overall line and the problems by root cause
-    (:func:`rclverify.diagnosis.text.status_lines`), the requirements line
+    (:func:`rclverify.report.diagnosis_text.status_lines`), the requirements line
     and the summary table.  Read from ``artifacts/report/summary.json``
     (written with the report), else from ``reports/assurance.json``.
     Returns the summary data (:func:`summary_data`).  Raises

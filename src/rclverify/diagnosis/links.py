@@ -1,0 +1,17 @@
+"""The links of a side-condition record read back as names: which producer's output feeds which consumer's input."""
+from __future__ import annotations
+
+import re
+from typing import Any, Mapping
+
+
+def link_pairs(sc: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
+    """``(producer, out var, consumer, in var)`` of each of a side condition
+    record's ``links`` (``Planner.out.speed -> Controller.in.speed (via
+    name)``), in order; a link of another shape is left out."""
+    out = []
+    for l in sc.get("links", []):
+        m = re.match(r"^(\w+)\.out\.(\w+) -> (\w+)\.in\.(\w+)", l)
+        if m:
+            out.append((m.group(1), m.group(2), m.group(3), m.group(4)))
+    return out
