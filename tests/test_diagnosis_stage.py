@@ -137,3 +137,15 @@ def test_doit_runs_the_stage_as_a_task_again_only_when_its_inputs_change(newcome
     assert "diagnosis: " in third
     edited = json.loads((newcomer / "reports" / "assurance.json").read_text(encoding="utf-8"))
     assert "1.25" in json.dumps(edited["diagnoses"]) and not _problems(edited)
+
+
+def test_the_digest_leaves_out_when_and_how_long_a_run_took() -> None:
+    """Two runs of the same inputs differ only in their timings: one digest (a clean run's record is an
+    incremental run's); a changed status is another report."""
+    from rclverify.stages.diagnoses import report_digest
+    one = {"evidence": [{"id": "N.g1.hoare", "status": "discharged", "duration_s": 0.06,
+                         "started": "2026-11-27T05:17:25+00:00"}], "meta": {"inputs_sha256": {"a.rcl": "ab"}}}
+    two = {"evidence": [{"id": "N.g1.hoare", "status": "discharged", "duration_s": 0.005,
+                         "started": "2026-11-27T05:17:23+00:00"}], "meta": {"inputs_sha256": {"a.rcl": "ab"}}}
+    failed = {**two, "evidence": [{**two["evidence"][0], "status": "failed"}]}
+    assert report_digest(one) == report_digest(two) != report_digest(failed)

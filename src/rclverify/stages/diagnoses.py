@@ -32,16 +32,30 @@ INDEX = f"{DIR}/index.json"
 _RUN = "run `doit verify` or `rclverify report` to explain them again"
 
 
+#: Keys of the report that say when and how long a record's run took: no diagnosis reads them, and
+#: two runs of the same inputs differ in them, so the digest leaves them out (incremental equals clean).
+TIMING_KEYS = frozenset({"duration_s", "started"})
+
+
+def _without_timing(value: object) -> object:
+    if isinstance(value, dict):
+        return {k: _without_timing(v) for k, v in value.items() if k not in TIMING_KEYS}
+    if isinstance(value, list):
+        return [_without_timing(v) for v in value]
+    return value
+
+
 def report_digest(report: Mapping[str, Any]) -> str:
     """The sha256 (hex) of the compact JSON of ``report`` (the report dict
-    without diagnoses), keys sorted: encoded by msgspec (5x faster than the
-    standard library, the same bytes for the report's values), by
-    :func:`json.dumps` for a value msgspec does not encode.  Raises
-    ``TypeError`` for a value JSON cannot hold."""
+    without diagnoses) less its :data:`TIMING_KEYS`, keys sorted: encoded by
+    msgspec (5x faster than the standard library, the same bytes for the
+    report's values), by :func:`json.dumps` for a value msgspec does not
+    encode.  Raises ``TypeError`` for a value JSON cannot hold."""
+    stable = _without_timing(dict(report))
     try:
-        data = msgspec.json.encode(report, order="sorted")
+        data = msgspec.json.encode(stable, order="sorted")
     except (TypeError, msgspec.EncodeError):
-        data = json.dumps(report, sort_keys=True, ensure_ascii=False, separators=(",", ":")).encode("utf-8", "surrogatepass")
+        data = json.dumps(stable, sort_keys=True, ensure_ascii=False, separators=(",", ":")).encode("utf-8", "surrogatepass")
     return hashlib.sha256(data).hexdigest()
 
 
