@@ -148,8 +148,8 @@ def make_evidence(
     explanation: str = "",
     log: str = "",
     artifacts: tuple[str, ...] = (),
-    counterexample: Mapping[str, Any] | None = None,
-    details: Mapping[str, Any] | None = None,
+    counterexample: Mapping[str, object] | None = None,
+    details: Mapping[str, object] | None = None,
 ) -> Evidence:
     """Build an :class:`Evidence` record for ``obligation``, hashing its inputs now.
 

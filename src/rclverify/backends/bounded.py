@@ -41,6 +41,7 @@ import sys
 import tempfile
 import threading
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
@@ -71,21 +72,31 @@ class ToolInterrupted(RclError):
 # -- the reaper ----------------------------------------------------------------
 
 _LOCK = threading.Lock()
-_REAPER: dict[str, Any] = {"pid": None, "proc": None}
+
+
+@dataclass
+class _Reaper:
+    """The reaper process of the process ``pid`` that started it (``proc``: ``None`` when it is gone)."""
+
+    pid: int | None = None
+    proc: subprocess.Popen[bytes] | None = None
+
+
+_REAPER = _Reaper()
 
 
 def _reaper() -> subprocess.Popen[bytes] | None:
     """This process's reaper, started at the first call (again after a ``fork``);
     ``None`` when it cannot be started (then only the other safeguards hold)."""
-    if _REAPER["pid"] == os.getpid() and _REAPER["proc"] is not None and _REAPER["proc"].poll() is None:
-        return _REAPER["proc"]  # type: ignore[no-any-return]
+    if _REAPER.pid == os.getpid() and _REAPER.proc is not None and _REAPER.proc.poll() is None:
+        return _REAPER.proc
     try:
         proc = subprocess.Popen([sys.executable, "-I", "-S", str(Path(__file__).with_name("_reaper.py"))],
                                 stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                 start_new_session=True, close_fds=True)
     except OSError:
         proc = None
-    _REAPER.update(pid=os.getpid(), proc=proc)
+    _REAPER.pid, _REAPER.proc = os.getpid(), proc
     return proc
 
 
@@ -98,7 +109,7 @@ def _tell(op: str, arg: int | str) -> None:
             proc.stdin.write((json.dumps([op, arg]) + "\n").encode())
             proc.stdin.flush()
         except OSError:  # the reaper is gone: the other safeguards remain
-            _REAPER["proc"] = None
+            _REAPER.proc = None
 
 
 @contextlib.contextmanager

@@ -9,7 +9,7 @@ for a timed guarantee says so in its explanation and in
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.lang.types import CheckedNode
 
@@ -34,7 +34,7 @@ def timing_of(node: CheckedNode | None, guarantee: int) -> str:
 
 
 def scope(backend: str, node: CheckedNode | None, guarantee: int, explanation: str,
-          details: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
+          details: Mapping[str, object]) -> tuple[str, dict[str, object]]:
     """The explanation and details of an evidence record of ``backend`` for
     guarantee ``guarantee`` of ``node``, with the untimed-only note added when
     the guarantee is timed and the backend does not check time.  Returns

@@ -55,11 +55,12 @@ from __future__ import annotations
 import dataclasses
 
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping, Sequence, TypedDict
 
 import z3
 
 from rclverify.semantics.encode import Encoder
+from rclverify.records.stage_records import RuleInstance
 from rclverify.semantics.nicemodel import nicer_model
 from rclverify.calculus.context import ConeContext
 from rclverify.calculus.side_condition import (IN_CONTEXT as IN_CONTEXT, STATUS as STATUS,
@@ -123,7 +124,7 @@ class NodeComposition:
     producers: tuple[str, ...]
     side_conditions: tuple[SideCondition, ...]
     environment_assumptions: tuple[dict[str, str], ...]
-    instances: tuple[dict[str, Any], ...]
+    instances: tuple[RuleInstance, ...]
     derived_property: str
     cone: tuple[str, ...]
     loop_assumption: str | None = None
@@ -181,7 +182,19 @@ def split_assumption(checked: Checked, model: SystemModel, node: str) -> tuple[l
     return internal, env
 
 
-_ENV_TEXTS: dict[str, Any] = {"key": None, "texts": {}}
+class _EnvKey(TypedDict):
+    """The (checked, model) pair the environment texts are remembered for, and the texts by node."""
+    key: tuple[Checked, SystemModel] | None
+    texts: dict[str, tuple[str, ...]]
+
+
+class _EnvCache(_EnvKey, total=False):
+    """:class:`_EnvKey` with the environment conjuncts by node and the pair they were made for."""
+    exprs: dict[str, tuple[ast.Expr, ...]]
+    exprs_key: tuple[Checked, SystemModel] | None
+
+
+_ENV_TEXTS: _EnvCache = {"key": None, "texts": {}}
 
 
 def _environment_texts(checked: Checked, model: SystemModel, node: str) -> tuple[str, ...]:
@@ -339,7 +352,7 @@ def _in_context_step(checked: Checked, model: SystemModel, node: str, c: ast.Exp
 
 
 def _instances(checked: Checked, model: SystemModel, node: str, rule: str, a_text: str, g_text: str,
-               any_side_condition: bool) -> list[dict[str, Any]]:
+               any_side_condition: bool) -> list[RuleInstance]:
     """The rule instance of ``node`` (none without producers): its rule,
     premises (each producer's contract, the node's, a branch's other
     readers, the side condition), conclusion and graph shape."""

@@ -13,7 +13,7 @@ cone summaries (:mod:`.summary`) read the same premises.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping, Sequence, TypedDict
 
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
@@ -38,7 +38,13 @@ class NodePremises:
     symbols: tuple[tuple[str, str, str], ...]
 
 
-_CACHE: dict[str, Any] = {"key": None, "nodes": {}}
+class _Cache(TypedDict):
+    """The premises remembered for the last (checked, model) pair, by node, role, facts and symbols."""
+    key: tuple[Checked, SystemModel] | None
+    nodes: dict[Any, NodePremises]
+
+
+_CACHE: _Cache = {"key": None, "nodes": {}}
 
 
 def node_premises(checked: Checked, model: SystemModel, m: str, consumer: bool,

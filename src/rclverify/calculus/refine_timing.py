@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import z3
 
@@ -71,7 +71,7 @@ def _text(p: TimedPromise) -> str:
     return f"{expr_to_rcl(p.formula)} triggered by in.{p.trigger}{within}"
 
 
-def timing_side(a: CheckedNode, b: CheckedNode, enc: Encoder, shared: Mapping[str, Any],
+def timing_side(a: CheckedNode, b: CheckedNode, enc: Encoder, shared: Mapping[str, z3.AstRef],
                 hyps: Sequence[z3.BoolRef], assumption: z3.BoolRef, *,
                 timeout_ms: int = DEFAULT_TIMEOUT_MS) -> tuple[str, str, QueryResult | None, str] | None:
     """The timing side of "B refines A": ``(statement, status, query, reason)``.

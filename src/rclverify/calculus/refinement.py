@@ -260,7 +260,7 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
     check_interface(a, b, extra_inputs_ok=bool(conditions) or bool(facts))
     points = points_for(instances)
     enc = Encoder(env)
-    shared: dict[str, Any] = {}
+    shared: dict[str, z3.AstRef] = {}
     for prefix, group in (("in", a.inputs), ("out", a.outputs)):
         for name in group:
             shared[f"{prefix}.{name}"] = enc.io_symbol(a, prefix, name)

@@ -45,6 +45,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode, is_numeric
 from rclverify.lang.walk import free_names, subexpressions
 from rclverify.semantics import wallclock
+from rclverify.calculus.shapes import ScaleMismatch
 
 #: Budget of one optimisation, milliseconds.
 OPTIMIZE_MS = 1000
@@ -176,7 +177,7 @@ def named_conversion(producer: tuple[Fraction | None, Fraction | None],
 
 
 def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: str,
-                        conjunct: ast.Expr) -> tuple[dict[str, Any], ...]:
+                        conjunct: ast.Expr) -> tuple[ScaleMismatch, ...]:
     """The probable scale mismatches behind one side condition of ``node``:
     ``conjunct`` is the assumption conjunct, ``links`` the connections into
     ``node`` (:meth:`~rclverify.model.system.model.SystemModel.links_into`),
@@ -191,7 +192,7 @@ def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: 
     Never raises for solver trouble (nothing is found then)."""
     cn = checked.nodes[node]
     read = _inputs_read(conjunct, cn)
-    out: list[dict[str, Any]] = []
+    out: list[ScaleMismatch] = []
     for l in links:
         if l.to_var not in read or l.from_node not in checked.nodes:
             continue
@@ -244,7 +245,7 @@ def scale_findings(side_conditions: Iterable[Mapping[str, Any]]) -> list[dict[st
     or inconclusive (a stale or altered record gives none): check
     ``probable-scale-mismatch``, id ``<side condition>.scale``, the
     consumer's node."""
-    out = []
+    out: list[dict[str, Any]] = []
     for sc in side_conditions:
         if sc.get("status") not in ("failed", "inconclusive"):
             continue

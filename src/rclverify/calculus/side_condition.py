@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 from rclverify.calculus.context import ConeContext, ContextResult
+from rclverify.calculus.shapes import ContextRecord, LocalVerdict, ScaleMismatch
 from rclverify.semantics.query import QueryResult
 
 STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive"}
@@ -50,9 +51,9 @@ class SideCondition:
     #: (its size), ``used`` (premises of the proof), ``used_nodes``, ``opened`` (links opened, rule R4),
     #: ``violated`` (nodes whose assumption the counterexample violates), ``joins``, ``local`` (the
     #: local verdict: ``status``, ``variant``, ``model``)
-    context: dict[str, Any] | None = None
+    context: ContextRecord | None = None
     #: probable scale mismatches behind a side condition that is not discharged (:mod:`.scale`)
-    scale: tuple[dict[str, Any], ...] = ()
+    scale: tuple[ScaleMismatch, ...] = ()
 
     def to_json(self, smt2_path: str) -> dict[str, Any]:
         return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
@@ -117,12 +118,14 @@ def in_context(sc: SideCondition, cr: ContextResult, ctx: ConeContext | ConeView
     of the producers of the inputs the conjunct reads: the values traced
     back to their sources, not a sibling branch feeding another input)."""
     node = sc.node
-    local = {"status": sc.status, "variant": sc.variant, "model": sc.model}
+    local: LocalVerdict = {"status": sc.status, "variant": sc.variant, "model": sc.model}
     size = len(ctx.cone)
-    record: dict[str, Any] = {"cone": size, "used": [u.split(":", 1)[0] for u in cr.used],
-                              "used_nodes": list(cr.used_nodes),
-                              "opened": list(ctx.cut), "violated": list(cr.violated), "joins": list(cr.joins),
-                              "local": local, **({"summaries": list(cr.summaries)} if cr.summaries else {})}
+    record: ContextRecord = {"cone": size, "used": [u.split(":", 1)[0] for u in cr.used],
+                             "used_nodes": list(cr.used_nodes),
+                             "opened": list(ctx.cut), "violated": list(cr.violated), "joins": list(cr.joins),
+                             "local": local}
+    if cr.summaries:
+        record["summaries"] = list(cr.summaries)
     opened = ("; the loop of its cone is opened at " + ", ".join(ctx.cut) + " (rule R4, paper lines 717-768: "
               "the value read there is taken as arbitrary, so no guarantee is used to discharge its own premise)"
               if ctx.cut else "")

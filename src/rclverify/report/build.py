@@ -94,7 +94,7 @@ class Facts(NamedTuple):
     node_status: dict[str, str]
     altered: list[str]
     checks: dict[str, Any]
-    evidence_inputs: dict[str, Any]
+    evidence_inputs: dict[str, object]
     deadlines_ok: bool
     guarantees_discharged: Callable[[], bool]
 
@@ -188,7 +188,8 @@ def diagnosed_report(report: dict[str, Any], diagnoses: list[dict[str, Any]] | N
         summary = {**report["summary"], "problems": list(report["summary"]["problems"]) + [f"Diagnoses: {why}"]}
         report = {**report, "summary": summary}
     report = assemble.with_diagnoses(report, list(diagnoses or []))
-    problems = group_problems(report, problem_items(report), anchor)
+    draft = assemble.finished(report, [], report["nodes"])  # every part but the problems, checked as a Report
+    problems = group_problems(draft, problem_items(draft), anchor)
     return assemble.finished(report, problems, marked_nodes(report["nodes"], problems))
 
 

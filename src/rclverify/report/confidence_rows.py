@@ -18,7 +18,10 @@ from __future__ import annotations
 
 from typing import Any, Mapping, TypedDict
 
-from rclverify.report.argument.confidence import Premise, derived_claims, guarantee_premise, node_claims, requirement_claim
+from rclverify.records.report_schema import Strength
+from rclverify.report.shapes import Confidence, RequirementConfidence
+from rclverify.report.argument.confidence import (Claim, Premise, derived_claims, guarantee_premise, node_claims,
+                                                  requirement_claim)
 from rclverify.report.argument.strength import DOUBT, KINDS, evidence_strength, side_condition_strength
 from rclverify.calculus.requirements.rollup import MET, OUTSTANDING
 
@@ -47,12 +50,12 @@ class ConfidencePart(TypedDict):
     sentence per requirement short of its required strength; ``confidence``:
     the least confidence of the formal requirements (``None``: none);
     ``ok``: no requirement is short of its required strength."""
-    evidence: list[dict[str, Any]]
-    side_conditions: list[dict[str, Any]]
-    guarantees: dict[str, list[dict[str, Any]]]
-    nodes: dict[str, dict[str, Any]]
-    derived: dict[str, dict[str, Any]]
-    requirements: dict[str, dict[str, Any]]
+    evidence: list[Strength]
+    side_conditions: list[Strength]
+    guarantees: dict[str, list[Strength]]
+    nodes: dict[str, Confidence]
+    derived: dict[str, Confidence]
+    requirements: dict[str, RequirementConfidence]
     problems: list[str]
     confidence: float | None
     ok: bool
@@ -68,7 +71,7 @@ def confidence_part(report: Mapping[str, Any], links: list[tuple[str, str]],
     ``ok`` false (then ``--strict`` fails) and is one of ``problems``."""
     part: ConfidencePart = {"evidence": [], "side_conditions": [], "guarantees": {}, "nodes": {}, "derived": {},
                             "requirements": {}, "problems": [], "confidence": None, "ok": True}
-    by_ob: dict[str, list[dict[str, Any]]] = {}
+    by_ob: dict[str, list[Strength]] = {}
     for e in report.get("evidence", []):
         part["evidence"].append(evidence_strength(e))
         by_ob.setdefault(str(e.get("obligation")), []).append(part["evidence"][-1])
@@ -120,7 +123,7 @@ def _requirement(rq: Mapping[str, Any], guarantee: Mapping[tuple[str, int], Prem
         else:
             used.append(Premise(str(p.get("label", p.get("kind"))), "assumed", DOUBT["assumed"]))
     c = requirement_claim(rq.get("verdict") in _PROVED, proof, used)
-    row: dict[str, Any] = {}
+    row: RequirementConfidence = {}
     if need in KINDS:
         short = [g for g in rests if g.doubt >= 1.0 or g.kind not in KINDS or KINDS.index(g.kind) > KINDS.index(need)]
         row["required_strength"] = need
@@ -129,11 +132,13 @@ def _requirement(rq: Mapping[str, Any], guarantee: Mapping[tuple[str, int], Prem
             part["ok"] = False
             part["problems"].append(f"Requirement {rq['id']} requires {need} evidence; " + ", ".join(
                 f"{g.label} rests on {g.kind if g.doubt < 1.0 else 'no discharged'} evidence" for g in short))
-    row.update(_put(c))
-    if rq.get("verdict") not in _PROVED:
-        row["limited_by"]["sentence"] = f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it"
-    elif c.limits is not None:
-        row["limited_by"]["sentence"] = limit_sentence(rq["id"], c.limits)
+    conf = _put(c)
+    row["confidence"] = conf["confidence"]
+    row["limited_by"] = limited = conf["limited_by"]
+    if limited is not None and rq.get("verdict") not in _PROVED:  # a claim always has its proof as a premise
+        limited["sentence"] = f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it"
+    elif limited is not None and c.limits is not None:
+        limited["sentence"] = limit_sentence(rq["id"], c.limits)
     part["requirements"][str(rq["id"])] = row
     return float(c.confidence)
 
@@ -142,7 +147,7 @@ def _requirement(rq: Mapping[str, Any], guarantee: Mapping[tuple[str, int], Prem
 _DEFEATING = ("failed", "error")
 
 
-def _legs(obligations: list[str], by_ob: dict[str, list[dict[str, Any]]],
+def _legs(obligations: list[str], by_ob: dict[str, list[Strength]],
           status: dict[str, str]) -> list[tuple[str, float]]:
     """A guarantee's legs (C1): its obligations grouped by evidence entry (the
     obligation id up to its entry, ``Node.g1.hoare.prog``), each leg's doubt
@@ -154,12 +159,12 @@ def _legs(obligations: list[str], by_ob: dict[str, list[dict[str, Any]]],
     for o in obligations:
         parts = o.split(".")
         leg = ".".join(parts[:4])
-        strengths = by_ob.get(o) or [{"kind": "assumed", "doubt": 1.0}]
+        strengths: list[Strength] = by_ob.get(o) or [{"kind": "assumed", "doubt": 1.0}]
         legs.setdefault(leg, []).extend((s["kind"], s["doubt"]) for s in strengths)
     return [(ps[0][0], min(1.0, sum(d for _, d in ps))) for ps in legs.values()]
 
 
-def _put(c: Any) -> dict[str, Any]:
+def _put(c: Claim) -> Confidence:
     """A claim's ``confidence`` and ``limited_by`` (the premise with the largest doubt) as row keys."""
     return {"confidence": c.confidence,
             "limited_by": None if c.limits is None else {"label": c.limits.label, "kind": c.limits.kind,

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 from rclverify.core.cache import Shelf
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl, to_rcl, type_to_rcl, unit_to_rcl
+from rclverify.report.shapes import FileTexts, NodeTexts
 
 if TYPE_CHECKING:
     from rclverify.stages.workspace import Workspace
@@ -32,7 +33,7 @@ if TYPE_CHECKING:
 CACHE = "artifacts/cache/contract-texts.pickle"
 
 
-def node_texts(node: ast.Node) -> dict[str, Any]:
+def node_texts(node: ast.Node) -> NodeTexts:
     """The texts of one node: ``{"rcl": the node as RCL (the snapshot's
     text), "latex": its LaTeX block (:func:`rclverify.lang.latex.node_latex`:
     no preamble, its real file name), "inputs"/"outputs": [[name, type as RCL with its unit, ``REAL [m]``],
@@ -68,19 +69,19 @@ class ContractTexts:
         ws.checked  # fills ws.parsed with the sha256 of each file's parsed text
         self.path: Path = ws.path(CACHE)
         self._shelf = Shelf(self.path, "contract-texts")
-        self._files: dict[str, dict[str, Any]] = {}
+        self._files: dict[str, FileTexts] = {}
         for rel, (sha, _) in ws.parsed.items():
             self._files[rel] = self._shelf.get_or_make(self._shelf.key("file", rel, sha), lambda: {"nodes": {}})
 
-    def _entry(self, rel: str) -> dict[str, Any]:
+    def _entry(self, rel: str) -> FileTexts:
         entry = self._files.get(rel)
         if entry is None:  # not a parsed file of the workspace: kept for this object only
             entry = self._files[rel] = {"nodes": {}}
         return entry
 
-    def node(self, node: ast.Node) -> dict[str, Any]:
+    def node(self, node: ast.Node) -> NodeTexts:
         """:func:`node_texts` of ``node`` (a node of ``ws.checked``)."""
-        got: dict[str, Any] | None = self._entry(node.loc.file)["nodes"].get(node.name)
+        got: NodeTexts | None = self._entry(node.loc.file)["nodes"].get(node.name)
         if got is None:
             got = self._entry(node.loc.file)["nodes"][node.name] = node_texts(node)
             self._shelf.changed()

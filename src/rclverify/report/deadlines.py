@@ -40,6 +40,8 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence
 
+from rclverify.records.report_schema import DeadlineRow, ObligationRow, Report
+from rclverify.report.shapes import SarifResult
 from rclverify.records.records import worst
 from rclverify.records.statuses import DEADLINE_STATUS
 from rclverify.stages.workspace import Workspace
@@ -62,7 +64,7 @@ def _spec_of(rec: Mapping[str, Any], spec: Any) -> bool:
 
 
 def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[[str, int], str],
-                  ob_rows: Sequence[Mapping[str, Any]], second: Any = None) -> list[dict[str, Any]]:
+                  ob_rows: Sequence[ObligationRow], second: Any = None) -> list[dict[str, Any]]:
     """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
     docstring).  ``current``: path -> sha256 of the current snapshots and
     model (:func:`rclverify.stages.workspace.current_snapshot_hashes`);
@@ -130,7 +132,7 @@ def _timing_measured(hop: dict[str, Any]) -> None:
                          "guarantee's formula only (a monitors entry on a recorded or live run times it)")
 
 
-def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[Mapping[str, Any]],
+def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationRow],
                       nodes: set[str]) -> dict[str, list[dict[str, Any]]]:
     """node -> the deadline verdicts of its monitors' evidence records
     (``details["deadlines"]``, backends/monitors/deadlines.py):
@@ -199,7 +201,7 @@ def strict_ok(rows: Sequence[Mapping[str, Any]]) -> bool:
     return all(r["verdict"] == "proved" and r.get("status", "discharged") == "discharged" for r in rows)
 
 
-def strict_reason(report: Mapping[str, Any]) -> list[str]:
+def strict_reason(report: Report) -> list[str]:
     """The clause ``verify --strict`` names for deadlines that are not
     proved (``[]`` when every one is): "1 end-to-end deadline is refuted
     (STOP)"."""
@@ -218,7 +220,7 @@ def strict_reason(report: Mapping[str, Any]) -> list[str]:
     return out
 
 
-def _chain_text(row: Mapping[str, Any]) -> str:
+def _chain_text(row: DeadlineRow) -> str:
     return " -> ".join(f"{h['node']} guarantee {h['guarantee']} ({h['trigger']} -> {', '.join(h['outputs'])} "
                        f"within {h['within']}, {h['loc']})" for h in row["chain"]) or "no chain"
 
@@ -234,7 +236,7 @@ SARIF_RULES = (
 )
 
 
-def sarif_results(report: Mapping[str, Any], result: Callable[..., dict[str, Any]]) -> list[dict[str, Any]]:
+def sarif_results(report: Report, result: Callable[..., SarifResult]) -> list[SarifResult]:
     """One SARIF result per deadline that is not proved, at the plan's
     ``deadline:`` entry; ``result(rule, level, text, where, key, props)``
     is report/sarif.py's result maker."""
@@ -267,7 +269,7 @@ def float_text(fraction: Any) -> str:
         return str(fraction)
 
 
-def junit_suite(report: Mapping[str, Any], case: Callable[..., ET.Element],
+def junit_suite(report: Report, case: Callable[..., ET.Element],
                 outcome: Callable[..., str]) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``deadlines`` ``<testsuite>``: one ``<testcase>`` per deadline
     (``classname`` ``deadline``, name the requirement id, at the plan's

@@ -35,7 +35,7 @@ class EvidencePart(TypedDict):
     status: dict[str, str]
     declared: dict[str, list[tuple[str, Any]]]
     altered: list[str]
-    inputs: dict[str, Any]
+    inputs: dict[str, object]
 
 
 def evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:

@@ -11,15 +11,17 @@ from typing import Any, Mapping, Sequence, cast
 from rclverify.calculus.scale import scale_findings
 from rclverify.model.plan.acknowledged import apply_acknowledgements
 from rclverify.records.report_schema import AcknowledgementRow, FindingRow, LintRow
+from rclverify.records.stage_records import HealthFinding
 from rclverify.report.records import diagnostics as read_diagnostics, grounding as read_grounding
 from rclverify.stages.workspace import Workspace
 
 
 def finding_rows(nodes: Sequence[str], health: Mapping[str, Sequence[Mapping[str, Any]]],
-                 side_conditions: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+                 side_conditions: Sequence[Mapping[str, Any]]) -> list[dict[str, Any] | HealthFinding]:
     """The health findings of ``nodes`` in their order, then the side
     conditions whose ranges lie a power of ten apart (a warning, calculus/scale.py)."""
-    return [dict(f) for n in nodes for f in health[n]] + list(scale_findings(list(side_conditions)))
+    rows: list[dict[str, Any] | HealthFinding] = [dict(f) for n in nodes for f in health[n]]
+    return rows + scale_findings(list(side_conditions))
 
 
 def lint_rows(ws: Workspace) -> list[dict[str, Any]]:

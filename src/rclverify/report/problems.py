@@ -69,6 +69,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from rclverify.records.report_schema import Report
+from rclverify.report.shapes import AttentionItem
 from rclverify.report import problems_causes as pc
 from rclverify.report import problems_mc as mc
 from rclverify.report import problems_places as pp
@@ -82,7 +84,7 @@ from rclverify.report.textfmt import natural_sorted
 Member = tuple[dict[str, Any], list[str]]  # a problem of the report and its root culprit ids
 
 
-def group_problems(report: Mapping[str, Any], items: Sequence[Mapping[str, Any]],
+def group_problems(report: Report, items: Sequence[AttentionItem],
                    anchor: Callable[..., str]) -> list[dict[str, Any]]:
     """The problems of ``report`` grouped by root cause (module docstring).
 
@@ -134,7 +136,7 @@ class _Grouping:
     grouped only by the culprits they name (``direct``), and the rows of
     unit mismatches; each method is one step of the module docstring's rules."""
 
-    def __init__(self, report: Mapping[str, Any], items: Sequence[Mapping[str, Any]],
+    def __init__(self, report: Report, items: Sequence[AttentionItem],
                  anchor: Callable[..., str]) -> None:
         self.report, self.items, self.anchor = report, items, anchor
         self.places = pp.Places(report)
@@ -203,7 +205,7 @@ class _Grouping:
                                   "anchor": self.anchor("req", q["id"]), "diagnosis": False}, roots))
         pp.join_requirements_to_side_conditions(self.members)
 
-    def _item_roots(self, it: Mapping[str, Any], ref: str, roots_of: Mapping[str, list[str]]) -> tuple[str, list[str]]:
+    def _item_roots(self, it: AttentionItem, ref: str, roots_of: Mapping[str, list[str]]) -> tuple[str, list[str]]:
         """``(member id, roots)`` of the attention item ``it`` no diagnosis covers (rules 4 and 5)."""
         o = self.obligation.get(ref)
         roots = [f"guarantee:{o['node']}:{o['guarantee']}"] if o is not None and o.get("guarantee") else []
@@ -301,7 +303,7 @@ class _Grouping:
             d = next((self.by_id[m["id"]] for m in g["members"]
                       if m["id"] in self.by_id and self.by_id[m["id"]]["kind"] == "deadline"), None)
             g["culprits"] = []
-            for c in (d or {}).get("culprits") or ():
+            for c in (d.get("culprits") or () if d is not None else ()):
                 rid = self.places.locate(str(c.get("source", "")))
                 if rid is not None and rid in self.places.info:
                     g["culprits"].append({**pp.culprit(rid, self.places, self.anchor), "what": str(c["what"])})
@@ -316,11 +318,16 @@ class _Grouping:
     def line_owners(self, groups: Mapping[tuple[str, ...], dict[str, Any]]) -> None:
         """A program line (a handler, an assignment) is the code of its findings' node, when they have one."""
         for g in groups.values():
-            owners = {str((self.by_id.get(m["id"]) or {}).get("node") or "") for m in g["members"]}
+            owners = {str(self.by_id[m["id"]].get("node") or "") if m["id"] in self.by_id else "" for m in g["members"]}
             if len(owners) == 1 and "" not in owners:
                 for c in g["culprits"]:
                     if str(c["id"]).startswith("line:"):
                         c["node"] = next(iter(owners))
+
+    def _counterexample(self, ident: str) -> list[Any]:
+        """The counterexample rows of the diagnosis ``ident`` (``[]`` without one)."""
+        d = self.by_id.get(ident)
+        return (d.get("counterexample") or []) if d is not None else []
 
     def sentence_and_repairs(self, g: dict[str, Any]) -> None:
         """The row's sentence, from the diagnosis that says most about the cause (TELLING), the
@@ -329,9 +336,10 @@ class _Grouping:
         told = [m for m in worst if m["diagnosis"]] or worst
         best = min(told, key=lambda m: (pp.TELLING.get(m["kind"], pp.LEAST_TELLING), len(first_sentence(m["sentence"]))))
         g["sentence"] = first_sentence(best["sentence"])
-        diffs: set[str] = set()
+        diffs: set[object] = set()
         for m in g["members"]:
-            for k, rep in enumerate((self.by_id.get(m["id"]) or {}).get("repairs", []) if m["diagnosis"] else []):
+            dg = self.by_id.get(m["id"])
+            for k, rep in enumerate(dg.get("repairs", []) if dg is not None and m["diagnosis"] else []):
                 if rep.get("diff") not in diffs:
                     diffs.add(rep.get("diff"))
                     g["repairs"].append({"diagnosis": m["id"], "index": k})
@@ -342,7 +350,7 @@ class _Grouping:
                                            SENTENCE_CHARS // 2)  # a summary: each finding holds its whole text
         if g["key"][0].startswith((mc.FAILED_PREFIX, mc.OUTSTANDING_PREFIX)):
             cex = next((str(r.get("value", "")) for m in g["members"]
-                        for r in (self.by_id.get(m["id"]) or {}).get("counterexample") or [] if r.get("variable") == "lasso"), "")
+                        for r in self._counterexample(m["id"]) if r.get("variable") == "lasso"), "")
             g["sentence"] = first_sentence(mc.row_sentence(g["key"][0], g["members"],
                                                            first_sentence(g["members"][0]["sentence"]), cex))
 

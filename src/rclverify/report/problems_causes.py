@@ -18,6 +18,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from rclverify.records.report_schema import Report
+
 
 
 def join_consequences(members: list[tuple[dict[str, Any], list[str]]], by_id: Mapping[str, Any]) -> None:
@@ -59,7 +61,7 @@ def _producers(sc: Mapping[str, Any]) -> set[str]:
     return {str(link).split(".", 1)[0] for link in sc.get("links") or () if ".out." in str(link)}
 
 
-def assumption_violations(report: Mapping[str, Any], members: list[tuple[dict[str, Any], list[str]]],
+def assumption_violations(report: Report, members: list[tuple[dict[str, Any], list[str]]],
                           anchor: Callable[..., str]) -> None:
     """A recorded run of a node whose first assumption violation is a failed
     side condition of that node -- the violated assumption contains the

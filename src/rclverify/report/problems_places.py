@@ -14,6 +14,7 @@ import re
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from rclverify.records.report_schema import Report
 from rclverify.report.diagnosis_text import whole_first_sentence
 from rclverify.records.records import SEVERITY
 
@@ -55,7 +56,7 @@ def severity(status: str) -> int:
 class Places:
     """Source locations of the contract members of ``report["nodes"]``."""
 
-    def __init__(self, report: Mapping[str, Any]) -> None:
+    def __init__(self, report: Report) -> None:
         self.by_file: dict[str, list[tuple[int, str, dict[str, Any]]]] = {}
         for n in report["nodes"]:
             name = str(n["name"])
@@ -143,7 +144,7 @@ def first_sentence(text: str, limit: int = SENTENCE_CHARS) -> str:
     return s
 
 
-def cone_side_conditions(report: Mapping[str, Any], node: str) -> list[str]:
+def cone_side_conditions(report: Report, node: str) -> list[str]:
     """The ids of the side conditions not discharged in the cone of ``node``:
     of the node and every node upstream of it along the system's
     connections (the cone a derived property rests on, paper section 4)."""
@@ -160,14 +161,15 @@ def cone_side_conditions(report: Mapping[str, Any], node: str) -> list[str]:
             if str(sc["node"]) in cone and sc["status"] != "discharged"]
 
 
-def sources(report: Mapping[str, Any]) -> dict[str, str]:
+def sources(report: Report) -> dict[str, str]:
     """``{problem id: file:line:col}`` of the report's items: a side
     condition's conjunct, an obligation's clause, a health finding's
     guarantee (else its node), a requirement's statement, a derived
     property's node (``Node.derived``), a lint error's location."""
     out: dict[str, str] = {}
     node_src = {str(n["name"]): str(n.get("source", "")) for n in report.get("nodes", [])}
-    g_src = {(str(n["name"]), g["index"]): str(g.get("source", "")) for n in report.get("nodes", [])
+    g_src: dict[tuple[str, int | None], str] = {(str(n["name"]), g["index"]): str(g.get("source", ""))
+                                                 for n in report.get("nodes", [])
              for g in n.get("guarantees", [])}
     for sc in report.get("side_conditions", []):
         out[str(sc["id"])] = str(sc.get("source", ""))

@@ -16,6 +16,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from rclverify.records.report_schema import Report
+
 #: The kind of a unit mismatch's diagnosis record.
 KIND = "unit"
 
@@ -31,7 +33,7 @@ def joins(diagnoses: Sequence[Mapping[str, Any]]) -> dict[str, str]:
     return out
 
 
-def extra_members(report: Mapping[str, Any], diagnoses: Sequence[Mapping[str, Any]], covered: set[str],
+def extra_members(report: Report, diagnoses: Sequence[Mapping[str, Any]], covered: set[str],
                   anchor: Callable[..., str]) -> list[tuple[dict[str, Any], str]]:
     """The joined findings not yet among the row's members, each
     ``(member, unit record id)``: a lint row (by location), a health

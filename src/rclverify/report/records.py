@@ -17,6 +17,7 @@ from typing import Any, Iterable, Mapping
 
 from rclverify.records.records import Obligation, SourceRef
 from rclverify.records.sealed import obligation_list, read_sealed
+from rclverify.records.stage_records import LintWarning
 from rclverify.stages.workspace import Workspace
 from rclverify.records.store import dumps
 from rclverify.stages.workspace import check_inputs
@@ -73,7 +74,7 @@ def node_obligations(ws: Workspace, node: str) -> tuple[list[Obligation], str]:
     return [Obligation.from_json(d) for d in records or []], ""
 
 
-def diagnostics(ws: Workspace) -> list[dict[str, Any]]:
+def diagnostics(ws: Workspace) -> list[LintWarning]:
     """The lint warnings rows of ``artifacts/check/diagnostics.json`` (its
     ``warnings``); when its seal does not hold, one ``error`` row saying so
     in their place."""
@@ -107,8 +108,8 @@ def grounding(ws: Workspace, rel: str) -> dict[str, Any] | None:
     return body
 
 
-def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: Mapping[str, Any],
-                  checks: Mapping[str, Mapping[str, Any]]) -> str:
+def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: Mapping[str, object],
+                  checks: Mapping[str, Mapping[str, object]]) -> str:
     """One sha256 over what a report is built from, recorded in its
     ``meta.inputs_sha256``: the sha256 of the plan, contract and replacement
     files (:func:`rclverify.stages.workspace.check_inputs`), of the contract

@@ -32,13 +32,15 @@ The decisions behind the mapping are in ``docs/ci.md``.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
-from rclverify.records.report_schema import Report
+from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, FindingRow, LintRow, Report
 from rclverify.report.severity import of
 from rclverify.diagnosis.edits import sarif_fix
+from rclverify.report.shapes import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
+                                     SarifSuppression)
 
 #: The SARIF version written and the schema it validates against.
 SARIF_VERSION = "2.1.0"
@@ -175,24 +177,24 @@ def split_location(text: str) -> tuple[str, int, int] | None:
     return parts[0], int(parts[1]), int(parts[2])
 
 
-def _location(text: str) -> list[dict[str, Any]]:
+def _location(text: str) -> list[SarifLocation]:
     loc = split_location(text)
     if loc is None or loc[0].startswith("<"):
         return []
     file, line, col = loc
-    region: dict[str, Any] = {"startLine": max(1, line)}
+    region: SarifRegion = {"startLine": max(1, line)}
     if col >= 1:
         region["startColumn"] = col
     return [{"physicalLocation": {"artifactLocation": {"uri": file, "uriBaseId": SRCROOT}, "region": region}}]
 
 
-def _result(rule: str, level: str, text: str, where: str, key: str, props: Mapping[str, Any]) -> dict[str, Any]:
+def _result(rule: str, level: str, text: str, where: str, key: str, props: Mapping[str, object]) -> SarifResult:
     return {"ruleId": rule, "level": level, "message": {"text": text}, "locations": _location(where),
             "partialFingerprints": {"rclverifyItem/v1": key}, "properties": dict(props)}
 
 
-def _obligation_results(report: Report) -> list[dict[str, Any]]:
-    evidence: dict[str, Mapping[str, Any]] = {}
+def _obligation_results(report: Report) -> list[SarifResult]:
+    evidence: dict[str, EvidenceRow] = {}
     for row in report["evidence"]:
         evidence[str(row["obligation"])] = row
     reasons: dict[str, str] = {}
@@ -211,19 +213,21 @@ def _obligation_results(report: Report) -> list[dict[str, Any]]:
             words.append(expl)
         if ev is not None and ev.get("counterexample"):
             words.append(f"Counterexample: {model_text(ev['counterexample'])}.")
-        props = {"obligation": o["id"], "node": o["node"], "guarantee": o["guarantee"], "backend": o["backend"],
-                 "status": o["status"]}
-        if ev is not None and ev.get("counterexample"):
-            props["counterexample"] = dict(ev["counterexample"])
+        props: dict[str, object] = {"obligation": o["id"], "node": o["node"], "guarantee": o["guarantee"],
+                                    "backend": o["backend"], "status": o["status"]}
+        cex = ev.get("counterexample") if ev is not None else None
+        if cex:
+            props["counterexample"] = dict(cex)
         if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
             props["strength"] = dict(ev["strength"])
         res = _result(rule, _level("obligation", str(o["status"])), " ".join(words), str(o["source"]),
                       f"obligation:{o['id']}", props)
-        cause = (ev.get("counterexample") or {}).get("cause") if ev is not None else None
+        cause = (cex or {}).get("cause")
         if isinstance(cause, str) and _location(f"{cause}:0"):  # at the implementation's line
             rel = _location(str(o["source"]))
             for loc in rel:
-                loc.update(id=0, message={"text": "the guarantee the example violates"})
+                loc["id"] = 0
+                loc["message"] = {"text": "the guarantee the example violates"}
             res["locations"] = _location(f"{cause}:0")
             res["locations"][0]["message"] = {"text": "the implementation's last line the failing example runs"}
             if rel:
@@ -232,7 +236,7 @@ def _obligation_results(report: Report) -> list[dict[str, Any]]:
     return out
 
 
-def _unverified_results(report: Report) -> list[dict[str, Any]]:
+def _unverified_results(report: Report) -> list[SarifResult]:
     """One result per guarantee no obligation covers, at the guarantee (report/unverified.py)."""
     rule = RULES["RCL-GUARANTEE-UNVERIFIED"]
     return [_result(rule.id, _level("guarantee", "unverified"), f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
@@ -241,7 +245,7 @@ def _unverified_results(report: Report) -> list[dict[str, Any]]:
             for u in report.get("unverified") or ()]
 
 
-def _side_condition_results(report: Report) -> list[dict[str, Any]]:
+def _side_condition_results(report: Report) -> list[SarifResult]:
     out = []
     for sc in report["side_conditions"]:
         status = str(sc["status"])
@@ -256,7 +260,7 @@ def _side_condition_results(report: Report) -> list[dict[str, Any]]:
             words.append(str(sc["explanation"]))
         if sc.get("model"):
             words.append(f"Counterexample: {model_text(sc['model'])}.")
-        props: dict[str, Any] = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status,
+        props: dict[str, object] = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status,
                                  "verdict": verdict}
         if sc.get("strength"):
             props["strength"] = dict(sc["strength"])
@@ -272,7 +276,7 @@ def _side_condition_results(report: Report) -> list[dict[str, Any]]:
     return out
 
 
-def _requirement_results(report: Report) -> list[dict[str, Any]]:
+def _requirement_results(report: Report) -> list[SarifResult]:
     """One result per requirement that is not met, at its formal statement
     (the plan, or the Doorstop item's file); a refuted one carries the
     counterexample node by node and the guarantees that did not prevent it."""
@@ -299,7 +303,7 @@ def _requirement_results(report: Report) -> list[dict[str, Any]]:
     return out
 
 
-def _finding_location(report: Report, f: Mapping[str, Any]) -> str:
+def _finding_location(report: Report, f: FindingRow) -> str:
     for n in report["nodes"]:
         if n["name"] == f["node"]:
             for g in n["guarantees"]:
@@ -309,7 +313,7 @@ def _finding_location(report: Report, f: Mapping[str, Any]) -> str:
     return ""
 
 
-def _finding_results(report: Report) -> list[dict[str, Any]]:
+def _finding_results(report: Report) -> list[SarifResult]:
     out = []
     for f in report["findings"]:
         if f["status"] == "ok":
@@ -330,13 +334,13 @@ def _finding_results(report: Report) -> list[dict[str, Any]]:
     return out
 
 
-def _suppressed(res: dict[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
+def _suppressed(res: SarifResult, row: FindingRow | LintRow) -> SarifResult:
     """``res`` with a SARIF ``suppressions`` entry (kind ``external``, status
     ``accepted``, the reason as ``justification``, SARIF 2.1.0 section
     3.35) when the plan acknowledges the warning ``row`` (model/plan/acknowledged.py)."""
     ack = row.get("acknowledged")
     if ack:
-        sup: dict[str, Any] = {"kind": "external", "status": "accepted", "justification": str(ack["reason"])}
+        sup: SarifSuppression = {"kind": "external", "status": "accepted", "justification": str(ack["reason"])}
         where = _location(str(ack["at"]))
         if where:
             sup["location"] = where[0]  # the plan entry (SARIF 2.1.0 section 3.35.6: one location)
@@ -344,7 +348,7 @@ def _suppressed(res: dict[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
     return res
 
 
-def _acknowledgement_results(report: Report) -> list[dict[str, Any]]:
+def _acknowledgement_results(report: Report) -> list[SarifResult]:
     """Stale or refused plan acknowledgements, at their plan entry."""
     return [_result("RCL-ACK-STALE", _level("acknowledgement", str(a["status"])),
                     f"Acknowledgement of {a['warning']} is {a['status']}: {a['message']}", str(a["at"]),
@@ -352,8 +356,8 @@ def _acknowledgement_results(report: Report) -> list[dict[str, Any]]:
             for a in report.get("acknowledgements") or () if a.get("status") != "ok"]
 
 
-def _lint_results(report: Report) -> tuple[list[dict[str, Any]], list[Rule]]:
-    out: list[dict[str, Any]] = []
+def _lint_results(report: Report) -> tuple[list[SarifResult], list[Rule]]:
+    out: list[SarifResult] = []
     rules: dict[str, Rule] = {}
     for k, d in enumerate(report["lint"]):
         rid = lint_rule_id(str(d.get("code", "")))
@@ -365,7 +369,7 @@ def _lint_results(report: Report) -> tuple[list[dict[str, Any]], list[Rule]]:
     return out, sorted(rules.values(), key=lambda r: r.id)
 
 
-def _grounding_results(report: Report) -> tuple[list[dict[str, Any]], list[Rule]]:
+def _grounding_results(report: Report) -> tuple[list[SarifResult], list[Rule]]:
     """Grounding findings (docs/ros.md): located at the RCL line, with the
     software line it contradicts as a related location."""
     g = report.get("grounding")
@@ -392,12 +396,12 @@ def _grounding_results(report: Report) -> tuple[list[dict[str, Any]], list[Rule]
     return out, rules
 
 
-def _attach_diagnoses(report: Report, results: Sequence[dict[str, Any]]) -> None:
+def _attach_diagnoses(report: Report, results: Sequence[SarifResult]) -> None:
     """Give each result its diagnosis (``properties.diagnosis``: the
     sentence naming the culprit) and its repairs as SARIF ``fix`` objects
     (§3.55; each repair was checked by Z3 before it entered the report,
     docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
-    by_key: dict[str, Mapping[str, Any]] = {}
+    by_key: dict[str, DiagnosisRow] = {}
     for dg in report.get("diagnoses", []):
         if dg.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
             by_key[f"unit:{dg.get('lint')}"] = dg
@@ -423,7 +427,7 @@ def _attach_diagnoses(report: Report, results: Sequence[dict[str, Any]]) -> None
             res["fixes"] = fixes
 
 
-def _at_the_culprit(res: dict[str, Any], d: Mapping[str, Any]) -> None:
+def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
     """A failed side condition is located at the guarantee its diagnosis blames
     (a producer that publishes what the consumer does not accept), so that a CI
     annotation lands on the node to repair; the consumer's assumption it fails
@@ -444,12 +448,12 @@ def _at_the_culprit(res: dict[str, Any], d: Mapping[str, Any]) -> None:
         res["relatedLocations"] = rel
 
 
-def _descriptor(r: Rule) -> dict[str, Any]:
+def _descriptor(r: Rule) -> SarifDescriptor:
     return {"id": r.id, "name": r.name, "shortDescription": {"text": r.text},
             "defaultConfiguration": {"level": r.level}}
 
 
-def sarif_log(report: Report) -> dict[str, Any]:
+def sarif_log(report: Report) -> SarifLog:
     """The SARIF 2.1.0 log (a JSON-serialisable dict) of ``report``.
 
     ``report`` is the :class:`~rclverify.records.report_schema.Report` of
@@ -471,7 +475,7 @@ def sarif_log(report: Report) -> dict[str, Any]:
     for res in results:
         res["ruleIndex"] = index[res["ruleId"]]
     meta = report["meta"]
-    run = {
+    run: SarifRun = {
         "tool": {"driver": {"name": "rclverify", "version": str(meta["version"]),
                             "rules": [_descriptor(r) for r in rules]}},
         "originalUriBaseIds": {SRCROOT: {"description": {"text": "the root of the rclverify workspace"}}},

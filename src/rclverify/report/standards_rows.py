@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence, TypedDict
 
+from rclverify.records.report_schema import EvidenceRow, Report
 from rclverify.model.plan.standards.choice import StandardChoice
 from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
 
@@ -44,7 +45,7 @@ def _label(row: Mapping[str, Any]) -> str:
     return f"{row['edition']}{level}"
 
 
-def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[Mapping[str, Any]]) -> StandardsPart:
+def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[EvidenceRow]) -> StandardsPart:
     """The ``standards`` part of the plan's ``choices`` over the report's
     ``evidence`` rows (``obligation``, ``backend``, ``kind``, ``status``,
     ``strength``).  Pure; raises nothing."""
@@ -83,7 +84,7 @@ def _missing_sentence(row: StandardRow, missing: Sequence[ClauseRow]) -> str:
             f"item's records")
 
 
-def strict_reason(report: Mapping[str, Any]) -> list[str]:
+def strict_reason(report: Report) -> list[str]:
     """Why the chosen standards fail ``--strict`` on ``report``: one clause
     per standard chosen with ``strict: true`` naming its HR items not
     covered (empty when none)."""

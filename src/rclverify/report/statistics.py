@@ -18,6 +18,9 @@ from __future__ import annotations
 
 from typing import Any, Mapping, TypedDict
 
+from rclverify.records.report_schema import EvidenceRow
+from rclverify.report.shapes import RequirementRuns, RequirementRunsRow, RunGroupBound, RunGroupRow, TargetRow
+
 from rclverify.records.statistics import count_runs, decide, trivial_or_exact
 from rclverify.model.plan.model import Plan
 from rclverify.model.plan.targets import UNSTATED, entry_environment, entry_origin
@@ -48,7 +51,7 @@ def _node(obligation: str) -> str:
     return obligation.split(".", 1)[0]
 
 
-def _group_row(node: str, env: str, origin: str, rows: list[Mapping[str, Any]]) -> dict[str, Any]:
+def _group_row(node: str, env: str, origin: str, rows: list[dict[str, Any]]) -> RunGroupRow:
     counts = count_runs(rows)
     recorded: dict[str, int] = {}
     for r in rows:
@@ -63,12 +66,12 @@ def _group_row(node: str, env: str, origin: str, rows: list[Mapping[str, Any]]) 
                                          else "no judged run: no bound")}
 
 
-def _target_row(e: Mapping[str, Any]) -> dict[str, Any]:
+def _target_row(e: EvidenceRow) -> TargetRow:
     s = e["statistics"]
     d = s.get("decision") or {}
     return {"node": _node(str(e.get("obligation"))), "environment": s.get("environment", UNSTATED),
-            "origin": s.get("origin", "operation"), "kind": "target", "obligation": e.get("obligation"),
-            "backend": e.get("backend"), "status": e.get("status"), "target": (s.get("target") or {}).get("text"),
+            "origin": s.get("origin", "operation"), "kind": "target", "obligation": e["obligation"],
+            "backend": e["backend"], "status": e["status"], "target": (s.get("target") or {}).get("text"),
             "counts": s.get("counts"), "recorded": s.get("recorded", {}), "level": d.get("level"),
             "bound": d.get("bound"), "runs_needed": d.get("runs_needed"),
             "sprt": (d.get("sprt") or {}).get("decision")}
@@ -85,7 +88,7 @@ def _trace_environments(plan: Plan) -> dict[str, tuple[str, str]]:
     return out
 
 
-def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[str, tuple[str, str]]) -> list[dict[str, Any]]:
+def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[str, tuple[str, str]]) -> list[RequirementRuns]:
     """A requirement's runs (its record's ``traces``) grouped by environment
     tag: one row each with the counts, the bound (at the target's level, else
     95 %) and, with a ``target``, its decision."""
@@ -97,20 +100,21 @@ def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[s
         groups.setdefault((env, origin), []).append({
             "sha256": t.get("sha256"), "status": status, "violations": int(status == "failed"),
             "inconclusive": int(status == "inconclusive"), "answers": 1})
-    out = []
+    out: list[RequirementRuns] = []
     for (env, origin), rows in sorted(groups.items()):
         counts = count_runs([] if origin == "harness" else rows)
-        row: dict[str, Any] = {"environment": env, "origin": origin,
-                               "counts": {k: v for k, v in counts.items() if k != "digests"}}
         level = target.level if target is not None else LEVEL
-        row["bound"], why = trivial_or_exact(counts["violating_runs"] + counts["undecided_runs"], counts["runs"], level)
+        bound, why = trivial_or_exact(counts["violating_runs"] + counts["undecided_runs"], counts["runs"], level)
+        row: RequirementRuns = {"environment": env, "origin": origin,
+                                "counts": {k: v for k, v in counts.items() if k != "digests"}, "bound": bound,
+                                "level": level}
         if why:
             row["note"] = why
-        row["level"] = level
         if target is not None:
             d = decide(counts, target)
-            row.update(target=target.text, status=d["status"], explanation=f"under {env}: {d['explanation']}",
-                       runs_needed=d["runs_needed"], sprt=d["sprt"]["decision"])
+            row["target"], row["status"] = target.text, d["status"]
+            row["explanation"] = f"under {env}: {d['explanation']}"
+            row["runs_needed"], row["sprt"] = d["runs_needed"], d["sprt"]["decision"]
         out.append(row)
     return out
 
@@ -119,21 +123,26 @@ class StatisticsPart(TypedDict):
     """The statistics pass's part: the report's ``statistics`` table;
     ``groups``: index of a per-run evidence row -> its ``statistics.group``;
     ``requirements``: requirement id -> its ``statistics`` rows."""
-    table: list[dict[str, Any]]
-    groups: dict[int, dict[str, Any]]
-    requirements: dict[str, list[dict[str, Any]]]
+    table: list[RunGroupRow | TargetRow | RequirementRunsRow]
+    groups: dict[int, RunGroupBound]
+    requirements: dict[str, list[RequirementRuns]]
 
 
-def _per_run(e: Mapping[str, Any]) -> bool:
+def _per_run(e: EvidenceRow) -> bool:
     """``e`` (an evidence row) is a believed monitored run of a run set (not a target's decision)."""
     s = e.get("statistics")
     return isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s \
         and e.get("status") not in _UNBELIEVED
 
 
-def _group_key(e: Mapping[str, Any]) -> tuple[str, str, str]:
+def _group_key(e: EvidenceRow) -> tuple[str, str, str]:
     s = e["statistics"]
     return _node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation"))
+
+
+def _requirement_row(rid: str, runs: RequirementRuns) -> RequirementRunsRow:
+    """``runs`` as a row of the ``statistics`` table, with its requirement ``rid``."""
+    return {"requirement": rid, "kind": "requirement", **runs}
 
 
 def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str, Any]) -> StatisticsPart:
@@ -142,8 +151,8 @@ def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str,
     report is read, not changed (report/assemble.py puts the part in).
     ``targets``: requirement id -> its
     :class:`~rclverify.records.statistics.Target` (or ``None``)."""
-    groups: dict[tuple[str, str, str], list[Mapping[str, Any]]] = {}
-    decisions: list[dict[str, Any]] = []
+    groups: dict[tuple[str, str, str], list[dict[str, Any]]] = {}
+    decisions: list[RunGroupRow | TargetRow | RequirementRunsRow] = []
     for e in report.get("evidence", []):
         if isinstance(e.get("statistics"), dict) and "decision" in e["statistics"]:
             decisions.append(_target_row(e))
@@ -161,7 +170,7 @@ def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str,
         rows = requirement_statistics(rq, targets.get(str(rq.get("id"))), where)
         if rows:
             part["requirements"][str(rq["id"])] = rows
-            part["table"].extend({"requirement": rq["id"], "kind": "requirement", **r} for r in rows)
+            part["table"].extend(_requirement_row(rq["id"], r) for r in rows)
     return part
 
 

@@ -10,14 +10,23 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, Mapping, Sequence
+from typing import IO, TYPE_CHECKING, Any, Literal, Mapping, Sequence, TypeGuard, TypeVar
 
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
+from rclverify.records.report_schema import (FindingRow, ObligationRow, Report, SideConditionRow,
+                                             UnverifiedRow)
+from rclverify.report.shapes import GroundingBrief, NodeSummaryRow, SummaryData
 from rclverify.records.records import SEVERITY
 
 #: At most this many node rows (worst first); the rest are summed in one row.
 MAX_ROWS = 15
+
+#: A report row that names its node (an obligation, side condition, health finding, unverified guarantee).
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingRow, UnverifiedRow)
+
+#: The counts of a node's summary row that a merged row sums.
+_Count = Literal["sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"]
 
 _COLOUR = {"discharged": "green", "pending": "yellow", "unverified": "dark_orange", "inconclusive": "yellow",
            "stale": "magenta", "error": "red", "failed": "red"}
@@ -27,23 +36,24 @@ def _rank(status: str) -> int:
     return SEVERITY.get(status, SEVERITY["error"])
 
 
-def node_rows(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def node_rows(report: Report) -> list[NodeSummaryRow]:
     """One row per node of ``report``: ``{"node", "status", "obligations"
     (status -> count), "sc_proved", "sc_total", "health_problems",
     "health_open", "health_total", "health_warnings", "unverified" (``["g<k>"]``: the node's
     guarantees no obligation covers), "culprit" (its guarantee or contract is a problem's culprit,
     :mod:`.culprits`)}``, worst status first, then report order."""
-    def by_node(items: list[Mapping[str, Any]]) -> dict[Any, list[Mapping[str, Any]]]:
+    def by_node(items: Sequence[_Row]) -> dict[str, list[_Row]]:
         # one pass per kind: a scan of every item per node was quadratic in the system size
-        out: dict[Any, list[Mapping[str, Any]]] = {}
+        out: dict[str, list[_Row]] = {}
         for it in items:
             out.setdefault(it["node"], []).append(it)
         return out
-    obligations, sides, findings = (by_node(report[k]) for k in ("obligations", "side_conditions", "findings"))
+    obligations, sides, findings = by_node(report["obligations"]), by_node(report["side_conditions"]), \
+        by_node(report["findings"])
     unverified = by_node(list(report.get("unverified") or ()))
     from rclverify.report.culprits import culprit_nodes  # deferred: start-up (loads rclverify.report.culprits only when called)
     blamed = culprit_nodes(report.get("problems") or ())
-    rows = []
+    rows: list[NodeSummaryRow] = []
     for k, n in enumerate(report["nodes"]):
         name = n["name"]
         obs: dict[str, int] = {}
@@ -72,7 +82,7 @@ def _counts(obs: Mapping[str, int], colour: bool) -> str:
     return ", ".join(parts)
 
 
-def _health(r: Mapping[str, Any]) -> str:
+def _health(r: NodeSummaryRow) -> str:
     if not r["health_total"]:
         return "-"
     words = []
@@ -88,12 +98,15 @@ def _health(r: Mapping[str, Any]) -> str:
     return ", ".join(words) or f"{r['health_total']} ok"
 
 
-def _merge(rows: list[dict[str, Any]], label: str) -> dict[str, Any]:
-    out: dict[str, Any] = {"node": label, "status": max((r["status"] for r in rows), key=_rank, default="discharged"),
-                           "obligations": {}}
-    for key in ("sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"):
-        out[key] = sum(int(r.get(key, 0) or 0) for r in rows)
-    out["unverified"] = [f"{r['node']}.{g}" for r in rows for g in r.get("unverified", [])]
+def _merge(rows: list[NodeSummaryRow], label: str) -> NodeSummaryRow:
+    def total(key: _Count) -> int:
+        return sum(int(r.get(key, 0) or 0) for r in rows)
+    out: NodeSummaryRow = {
+        "node": label, "status": max((r["status"] for r in rows), key=_rank, default="discharged"), "obligations": {},
+        "sc_proved": total("sc_proved"), "sc_total": total("sc_total"), "health_problems": total("health_problems"),
+        "health_open": total("health_open"), "health_total": total("health_total"),
+        "health_warnings": total("health_warnings"),
+        "unverified": [f"{r['node']}.{g}" for r in rows for g in r.get("unverified", [])]}
     for r in rows:
         for s, c in r["obligations"].items():
             out["obligations"][s] = out["obligations"].get(s, 0) + c
@@ -106,7 +119,7 @@ def _culprit(c: Mapping[str, Any]) -> str:
     return f"{what} ({source})" if what and source else what or source or "?"
 
 
-def summary_data(report: Mapping[str, Any]) -> dict[str, Any]:
+def summary_data(report: Report) -> SummaryData:
     """What ``doit verify`` prints at its end, taken from ``report``:
     ``{"meta": {"workspace", "strict_ok"}, "summary": report["summary"],
     "rows": node_rows(report), "requirements": [[id, verdict, status], ...],
@@ -149,7 +162,7 @@ def group_sentence(group: Mapping[str, Any]) -> str:
     return short
 
 
-def _grounding(g: Any) -> dict[str, Any] | None:
+def _grounding(g: object) -> GroundingBrief | None:
     """The ROS grounding (docs/ros.md) as the terminal shows it: ``{"error":
     n, "warning": m, "errors": ["file:line:col: message (CODE)", ...]}``;
     ``None`` when the plan has no ``ros:`` section."""
@@ -165,7 +178,7 @@ def _grounding(g: Any) -> dict[str, Any] | None:
     return {"error": int(counts.get("error", len(errors))), "warning": int(counts.get("warning", 0)), "errors": errors}
 
 
-def strict_reasons(report: Mapping[str, Any]) -> list[str]:
+def strict_reasons(report: Report) -> list[str]:
     """Why ``verify --strict`` fails on ``report``, as clauses (empty when
     ``report["meta"]["strict_ok"]``): obligations not discharged by status,
     guarantees no obligation covers, side conditions not proved, health
@@ -220,7 +233,7 @@ def strict_reasons(report: Mapping[str, Any]) -> list[str]:
     return out
 
 
-def strict_sentence(data: Mapping[str, Any]) -> str:
+def strict_sentence(data: SummaryData) -> str:
     """The one sentence a failed ``verify --strict`` ends with, from the
     summary ``data`` (:func:`summary_data`): its ``strict`` reasons."""
     reasons = list(data.get("strict") or [])
@@ -229,14 +242,14 @@ def strict_sentence(data: Mapping[str, Any]) -> str:
     return f"--strict failed: {why} (reports/assurance.html)."
 
 
-def status_text(data: Mapping[str, Any]) -> list[str]:
+def status_text(data: SummaryData) -> list[str]:
     """The overall line and the problems of the summary ``data``
     (:func:`rclverify.report.diagnosis_text.status_lines`), with the ROS grounding
     errors: counted on the overall line and listed one a line (they change
     no verdict, docs/ros.md, but fail ``--strict``)."""
     from rclverify.report.diagnosis_text import status_lines  # deferred: start-up (loads rclverify.report.diagnosis_text only when called)
-    g = data.get("grounding") or {}
-    errors = int(g.get("error", 0) or 0)
+    g = data.get("grounding")
+    errors = int(g.get("error", 0) or 0) if g is not None else 0
     if errors:  # listed below one a line, not as the report's one summary problem
         data = {**data, "summary": {**data["summary"], "problems": [
             p for p in data["summary"]["problems"] if not str(p).startswith("Grounding: ")]}}
@@ -246,17 +259,25 @@ def status_text(data: Mapping[str, Any]) -> list[str]:
         lines[0] = lines[0].rstrip(".") + f"; {errors} ROS grounding error{plural}."
         lines.append(f"{errors} ROS grounding error{plural}: the contracts do not match the ROS software "
                      f"(no verdict changes; `--strict` fails; `rclverify ros check`, docs/ros.md):")
-        lines += [f"  {e}" for e in g.get("errors", [])]
+        lines += [f"  {e}" for e in (g.get("errors", []) if g is not None else [])]
     return lines
 
 
-def summary_table(report: Mapping[str, Any], colour: bool, rows: list[dict[str, Any]] | None = None) -> Table:
+def _is_report(data: Report | SummaryData) -> TypeGuard[Report]:
+    """Whether ``data`` is a report (it has ``nodes``), not the summary made of one (:func:`summary_data`)."""
+    return "nodes" in data
+
+
+def summary_table(report: Report | SummaryData, colour: bool, rows: list[NodeSummaryRow] | None = None) -> Table:
     """The summary table of ``report`` (at most :data:`MAX_ROWS` node rows +
     total); ``rows`` are its :func:`node_rows` when already made."""
     from rich import box  # deferred: start-up (loads rich only when called)
     from rich.markup import escape  # deferred: start-up (loads rich and more only when called)
     from rich.table import Table  # deferred: start-up (loads rich and more only when called)
-    rows = node_rows(report) if rows is None else rows
+    if rows is None:  # a summary's rows are given (print_last_run); a report is made into them
+        if not _is_report(report):
+            raise KeyError("nodes")
+        rows = node_rows(report)
     shown, rest = rows[:MAX_ROWS], rows[MAX_ROWS:]
     if rest:
         shown = shown + [_merge(rest, f"(+{len(rest)} more nodes)")]
@@ -289,8 +310,8 @@ def is_terminal() -> bool:
     return bool(out is not None and out.isatty())
 
 
-def print_summary(report: Mapping[str, Any], report_path: str, file: IO[str] | None = None,
-                  terminal: bool | None = None, rows: list[dict[str, Any]] | None = None) -> None:
+def print_summary(report: Report | SummaryData, report_path: str, file: IO[str] | None = None,
+                  terminal: bool | None = None, rows: list[NodeSummaryRow] | None = None) -> None:
     """Print the summary table of ``report`` and the report's path to ``file``
     (default: the current ``sys.stdout``).  ``terminal`` (default
     :func:`is_terminal`) selects colours and box drawing; otherwise plain
@@ -328,7 +349,7 @@ def deadlines_line(rows: Sequence[Sequence[str]]) -> str:
     return "deadlines: " + ", ".join(parts)
 
 
-def read_summary(root: Path) -> dict[str, Any]:
+def read_summary(root: Path) -> SummaryData:
     """What ``status`` and ``verify`` print, from the workspace ``root``:
     ``artifacts/report/summary.json`` when it is there (of any shape: a
     broken one is an error, not silently replaced), else made from
@@ -344,7 +365,7 @@ def read_summary(root: Path) -> dict[str, Any]:
         _, problem = read_sealed(path, "summary record")
         if problem:
             raise located(path, f"{problem}; run `rclverify verify` (or `doit verify`) to write it again")
-        data: dict[str, Any] = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
+        data: SummaryData = read_checked(path, SUMMARY_SHAPE, "an rclverify summary")
         return data
     report = read_checked(root / "reports/assurance.json", SUMMARY_SOURCE_SHAPE, "an rclverify report")
     try:
@@ -353,7 +374,7 @@ def read_summary(root: Path) -> dict[str, Any]:
         raise located(root / "reports/assurance.json", f"not an rclverify report: cannot summarise it ({exc!r})") from None
 
 
-def print_last_run(root: Path) -> dict[str, Any]:
+def print_last_run(root: Path) -> SummaryData:
     """Print what ``doit verify`` ends with, from the last run's files in the
     workspace ``root``: the overall line and the problems by root cause
     (:func:`rclverify.report.diagnosis_text.status_lines`), the requirements line

@@ -11,8 +11,12 @@ from __future__ import annotations
 
 import re
 from collections import defaultdict
-from typing import Any, Callable, Mapping, Sequence, TypeVar
+from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
+from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceRow, FindingRow, ObligationRow, ProblemRow,
+                                             Report, SideConditionRow)
+from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
+                                     EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
 from rclverify.model.plan.declarations import BACKEND_NAMES
 from rclverify.records.records import SEVERITY
 from rclverify.report.culprits import culprit_nodes
@@ -21,6 +25,7 @@ from rclverify.report.templating import COUNT_ORDER, anchor, rank
 from rclverify.report.textfmt import natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
+_Row = TypeVar("_Row", DerivedPropertyRow, SideConditionRow, FindingRow)
 
 #: Top-level keys every report dict carries.
 REPORT_KEYS: tuple[str, ...] = (
@@ -30,7 +35,7 @@ REPORT_KEYS: tuple[str, ...] = (
 )
 
 
-def validate(report: Mapping[str, Any]) -> None:
+def validate(report: Report) -> None:
     """Check the top-level shape of ``report``.
 
     Raises ``ValueError`` naming every missing top-level key (the templates
@@ -41,14 +46,14 @@ def validate(report: Mapping[str, Any]) -> None:
         raise ValueError("report dict lacks key(s): " + ", ".join(missing))
 
 
-def _by(items: Sequence[Mapping[str, Any]], key: str) -> dict[str, list[Mapping[str, Any]]]:
-    out: dict[str, list[Mapping[str, Any]]] = defaultdict(list)
+def _by(items: Sequence[_Row], key: Literal["node"]) -> dict[str, list[_Row]]:
+    out: dict[str, list[_Row]] = defaultdict(list)
     for it in items:
         out[str(it[key])].append(it)
     return out
 
 
-def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+def _attention(report: Report, ev_anchor: Sequence[str]) -> tuple[list[AttentionItem], list[AttentionItem]]:
     """Items needing attention: (problems, outstanding).
 
     Problems are everything worse than pending (failed, error, stale,
@@ -59,7 +64,7 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
     (``formula`` is RCL text to show as code, or ''); both lists
     are sorted worst first, then by kind and reference.
     """
-    items: list[dict[str, Any]] = []
+    items: list[AttentionItem] = []
 
     def add(status: str, kind: str, ref: str, anchor_id: str, where: str, message: str,
             formula: str = "") -> None:
@@ -124,14 +129,14 @@ def _attention(report: Mapping[str, Any], ev_anchor: Sequence[str]) -> tuple[lis
 _NUMBERS = re.compile(r"\d+")
 
 
-def group_items(items: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+def group_items(items: Sequence[AttentionItem]) -> list[AttentionGroup]:
     """Attention items grouped when they say the same thing: equal status,
     kind and backend (``where``), and a message that is equal once its
     numbers are left out (39 AJPF instances pending for one reason are one
     group).  Each group is ``{"status", "kind", "where", "message" (the
     first item's), "items" (in order)}``; groups keep the order of their
     first items."""
-    groups: dict[tuple[str, str, str, str], dict[str, Any]] = {}
+    groups: dict[tuple[str, str, str, str], AttentionGroup] = {}
     for it in items:
         key = (it["status"], it["kind"], it["where"], _NUMBERS.sub("#", it["message"]))
         g = groups.get(key)
@@ -142,7 +147,7 @@ def group_items(items: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     return list(groups.values())
 
 
-def evidence_anchors(report: Mapping[str, Any]) -> list[str]:
+def evidence_anchors(report: Report) -> list[str]:
     """One fragment id per evidence record of ``report``, in order:
     ``ev-<obligation>``, then ``ev-<obligation>-2`` ... for further records
     of the same obligation."""
@@ -155,13 +160,13 @@ def evidence_anchors(report: Mapping[str, Any]) -> list[str]:
     return out
 
 
-def problem_items(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def problem_items(report: Report) -> list[AttentionItem]:
     """The attention items of ``report`` that are problems (worse than
     pending), worst first (see :func:`_attention`)."""
     return _attention(report, evidence_anchors(report))[0]
 
 
-def problem_groups(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def problem_groups(report: Report) -> list[ProblemRow] | list[dict[str, Any]]:
     """The report's problems grouped by root cause
     (:func:`rclverify.report.problems.group_problems`): the report dict's
     ``problems`` when it has them, else computed from ``report``."""
@@ -183,8 +188,8 @@ TECHNIQUES: tuple[str, ...] = ("health", "side conditions", *BACKEND_NAMES)
 _HEALTH_AS: Mapping[str, str] = {"ok": "discharged", "problem": "failed", "unknown": "inconclusive"}
 
 
-def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tuple[str, Any]]],
-              groups: Sequence[Mapping[str, Any]] | None = None) -> dict[str, Any]:
+def dashboard(report: Report, evidence_of: Mapping[str, Sequence[tuple[str, object]]],
+              groups: Sequence[object] | None = None) -> Dashboard:
     """The dashboard's matrix of nodes (rows) against techniques (columns).
 
     Each cell is the WORST status of the node's items of that technique
@@ -221,10 +226,10 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
     extra = sorted({b for _, b in items} - set(TECHNIQUES) - {"no evidence"})
     extra += ["no evidence"] if any(b == "no evidence" for _, b in items) else []
     columns = [*TECHNIQUES, *extra]
-    rows = []
+    rows: list[DashboardRow] = []
     for n in report["nodes"]:
         name = str(n["name"])
-        cells: list[dict[str, Any] | None] = []
+        cells: list[DashboardCell | None] = []
         for col in columns:
             got = items.get((name, col))
             if not got:
@@ -244,15 +249,15 @@ def dashboard(report: Mapping[str, Any], evidence_of: Mapping[str, Sequence[tupl
 
 
 
-def _trace(report: Mapping[str, Any], obligation: Mapping[str, Mapping[str, Any]],
-           evidence_of: Mapping[str, list[tuple[str, Mapping[str, Any]]]]) -> list[dict[str, Any]]:
+def _trace(report: Report, obligation: Mapping[str, ObligationRow],
+           evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> list[TraceEntry]:
     """The traceability rows: per requirement, its supporting guarantees with
     each obligation's status and evidence (``rowspan``: rows it spans)."""
-    trace = []
+    trace: list[TraceEntry] = []
     for req in report["requirements"]:
-        rows = []
+        rows: list[TraceSupport] = []
         for sup in req["support"]:
-            obs = []
+            obs: list[TraceObligation] = []
             for oid in sup["obligations"]:
                 o = obligation.get(str(oid))
                 obs.append({
@@ -267,14 +272,14 @@ def _trace(report: Mapping[str, Any], obligation: Mapping[str, Mapping[str, Any]
     return trace
 
 
-def _sections(report: Mapping[str, Any], obligation: Mapping[str, Mapping[str, Any]]) -> list[dict[str, Any]]:
+def _sections(report: Report, obligation: Mapping[str, ObligationRow]) -> list[Section]:
     """Per node (then per name only the calculus knows): the node, its derived
     property, side conditions, findings and ``ob_status`` (the status of each
     obligation its guarantees list)."""
     derived = _by(report["derived_properties"], "node")
     sides = _by(natural_sorted(report["side_conditions"], key=lambda sc: sc["id"]), "node")
     findings = _by(natural_sorted(report["findings"], key=lambda f: f["id"]), "node")
-    sections: list[dict[str, Any]] = []
+    sections: list[Section] = []
     named = [str(n["name"]) for n in report["nodes"]]
     for n in report["nodes"]:
         name = str(n["name"])
@@ -284,24 +289,25 @@ def _sections(report: Mapping[str, Any], obligation: Mapping[str, Mapping[str, A
         sections.append({"name": name, "node": None, "derived": derived.get(name, []),
                          "side": sides.get(name, []), "findings": findings.get(name, [])})
     for sec in sections:
-        ids = [str(oid) for g in (sec["node"] or {}).get("guarantees", []) for oid in g["obligations"]]
+        node = sec["node"]
+        ids = [str(oid) for g in (node.get("guarantees", []) if node else []) for oid in g["obligations"]]
         sec["ob_status"] = {oid: obligation[oid]["status"] for oid in ids if oid in obligation}
     return sections
 
 
-def _pending_groups(report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _pending_groups(report: Report) -> list[PendingGroup]:
     """The pending rows grouped by backend and reason (the same reason, numbers aside: one row)."""
-    groups: dict[tuple[str, str], dict[str, Any]] = {}
+    groups: dict[tuple[str, str], PendingGroup] = {}
     for p in natural_sorted(report["pending"], key=lambda p: p["obligation"]):
         key = (str(p["backend"]), _NUMBERS.sub("#", str(p["reason"])))
         groups.setdefault(key, {"backend": p["backend"], "reason": p["reason"], "items": []})["items"].append(p)
     return list(groups.values())
 
 
-def _table_runs(report: Mapping[str, Any], ev_anchor: Sequence[str], obligation: Mapping[str, Mapping[str, Any]],
-                evidence_of: Mapping[str, list[tuple[str, Mapping[str, Any]]]]) -> dict[str, Any]:
+def _table_runs(report: Report, ev_anchor: Sequence[str], obligation: Mapping[str, ObligationRow],
+                evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> TableRuns:
     """``finding_runs``, ``obligation_runs`` and ``evidence_runs`` of :func:`view`."""
-    def node_of_evidence(item: Mapping[str, Any]) -> str:
+    def node_of_evidence(item: EvidenceRun) -> str:
         o = obligation.get(str(item["record"]["obligation"]))
         return str(o["node"]) if o is not None else ""
 
@@ -316,7 +322,7 @@ def _table_runs(report: Mapping[str, Any], ev_anchor: Sequence[str], obligation:
     }
 
 
-def view(report: Mapping[str, Any]) -> dict[str, Any]:
+def view(report: Report) -> ReportView:
     """Derived lookups the templates need (pure function of ``report``).
 
     Keys: ``dashboard`` (:func:`dashboard`), ``problem_groups`` (the
@@ -336,7 +342,7 @@ def view(report: Mapping[str, Any]) -> dict[str, Any]:
     """
     validate(report)
     ev_anchor = evidence_anchors(report)
-    evidence_of: dict[str, list[tuple[str, Mapping[str, Any]]]] = defaultdict(list)
+    evidence_of: dict[str, list[tuple[str, EvidenceRow]]] = defaultdict(list)
     for aid, ev in zip(ev_anchor, report["evidence"]):
         evidence_of[str(ev["obligation"])].append((aid, ev))
     obligation = {str(o["id"]): o for o in report["obligations"]}

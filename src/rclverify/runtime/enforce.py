@@ -47,6 +47,7 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
 from rclverify.semantics.values import render
 from rclverify.runtime.live import LiveRun, dumps
+from rclverify.runtime.shapes import BlockVerdict, GateCounts
 
 BLOCKED_LOG_TOPIC = "rclverify/blocked"
 
@@ -89,7 +90,7 @@ def _reads(formula: ast.Expr) -> set[str]:
 
 
 def judge(monitors: Sequence[Any], checked: Any, ev: Event,
-          rules: Mapping[str, TopicRule]) -> tuple[bool, dict[str, Any]]:
+          rules: Mapping[str, TopicRule]) -> tuple[bool, BlockVerdict]:
     """Whether message ``ev`` of a guarded topic may pass (module docstring),
     on the node monitors' state before it; returns ``(release, verdict)``,
     the verdict a dict (``node``, ``verdict``, ``guarantee``, ``formula``,
@@ -151,9 +152,7 @@ class EnforcingRun(LiveRun):
         self.guarded, self.release = dict(guarded), release
         self.open_topics = open_topics
         self._raw: dict[int, bytes] = {}
-        self.gate_counts: dict[str, dict[str, Any]] = {
-            t: {"private": p, "released": 0, "blocked": 0, "policy": "open" if t in open_topics else "closed",
-                **({"released_undecided": 0} if t in open_topics else {})} for t, p in self.guarded.items()}
+        self.gate_counts: dict[str, GateCounts] = {t: _gate(p, t in open_topics) for t, p in self.guarded.items()}
         super().__init__(*args, **kw)
 
     def stash(self, fields: Any, raw: bytes) -> None:
@@ -176,11 +175,19 @@ class EnforcingRun(LiveRun):
                 counts["released_undecided"] += 1
             return
         counts["blocked"] += 1
-        why: dict[str, Any] = verdict or {"verdict": "inconclusive", "reason": "its bytes were lost"}
+        why: BlockVerdict = verdict or {"verdict": "inconclusive", "reason": "its bytes were lost"}
         self._log.write(dumps({"topic": BLOCKED_LOG_TOPIC, "time": ev.time, "kind": "blocked", "guarded": ev.topic,
                                "where": ev.where, "verdict": why}) + "\n")
         if self.publish is not None:
             self.publish(dumps({"kind": "blocked", "topic": ev.topic, "where": ev.where, "time": ev.time, **why}))
+
+
+def _gate(private: str, open_gate: bool) -> GateCounts:
+    """A gate's counts before its first message (an open gate also counts what it released undecided)."""
+    counts: GateCounts = {"private": private, "released": 0, "blocked": 0, "policy": "open" if open_gate else "closed"}
+    if open_gate:
+        counts["released_undecided"] = 0
+    return counts
 
 
 __all__ = ["BLOCKED_LOG_TOPIC", "EnforceUsage", "EnforcingRun", "fail_open", "judge", "parse_enforce"]

@@ -47,6 +47,7 @@ from rclverify.backends.monitors.deadlines import DeadlineVerdict
 from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
 from rclverify.backends.monitors.run_origin import unseen_links
 from rclverify.runtime.logchecks import LogChecks
+from rclverify.runtime.shapes import LiveCounts, SilenceNote
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.runtime.worker import EngineWorker
 import warnings
@@ -94,7 +95,7 @@ class LiveRun:
         self.publish, self.publish_last = publish, publish_last
         self.lock = threading.Lock()
         self.started = datetime.now(timezone.utc).isoformat(timespec="seconds")
-        self.silences: list[dict[str, Any]] = []
+        self.silences: list[SilenceNote] = []
         self.verdicts = 0
         nodes = list(nodes)
         self.nodes = nodes
@@ -132,7 +133,7 @@ class LiveRun:
         self._last[v.node] = text
 
     def _silence(self, topic: str, seconds: float, silent: bool) -> None:
-        note = {"topic": topic, "silent": silent, "for_s": round(seconds, 3),
+        note: SilenceNote = {"topic": topic, "silent": silent, "for_s": round(seconds, 3),
                 "time": self.engine.monitors[0].now if self.engine.monitors else 0.0}
         if silent:
             self.silences.append(note)
@@ -141,7 +142,7 @@ class LiveRun:
                                 "silent_for_s": round(seconds, 3), "time": note["time"]}))
 
     # -- input ---------------------------------------------------------------------
-    def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None:
+    def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
         """One message from the middleware (receipt time in seconds)."""
         with self.lock:
             if self.results is None:
@@ -156,7 +157,7 @@ class LiveRun:
                 self._flush_last()
                 self._log.flush()
 
-    def note(self, obj: Mapping[str, Any]) -> None:
+    def note(self, obj: Mapping[str, object]) -> None:
         """One more line of the log (the service proxy's events and deadline
         verdicts, :mod:`.service_proxy`); dropped once the run stopped."""
         with self.lock:
@@ -165,7 +166,7 @@ class LiveRun:
                 self.checks.line(obj)
                 self._heard_call(obj)
 
-    def _heard_call(self, obj: Mapping[str, Any]) -> None:
+    def _heard_call(self, obj: Mapping[str, object]) -> None:
         """Count a call event of the log (the ROS 1 proxy's ``kind: "event"``
         lines, the DDS call book's ``kind: "call"`` ones) for :mod:`.judged`."""
         if obj.get("kind") == "event" and isinstance(obj.get("topic"), str):
@@ -266,7 +267,7 @@ def running_bound(res: NodeResult) -> str:
     return f"; {n} answer(s) counted, 95 % bound {bound:.3g} per answer" + (f" ({why})" if why else "")
 
 
-def live_counts(res: NodeResult, sha: str, seconds: float) -> dict[str, Any]:
+def live_counts(res: NodeResult, sha: str, seconds: float) -> LiveCounts:
     """What a live run counted of one node, as a run's evidence counts it
     (:func:`.runset.run_counts`): the log's content sha256 (its identity: the
     same log named twice in a plan is one run), judged answers, violations,
@@ -392,15 +393,15 @@ def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_nam
         raise
 
 
-def _decoder(classes: Mapping[str, Any], decode_errors: dict[str, int]) -> Callable[[str, Any], Mapping[str, Any] | None]:
+def _decoder(classes: Mapping[str, type], decode_errors: dict[str, int]) -> Callable[[str, Any], Mapping[str, object] | None]:
     """The engine thread's decoding of a ``rospy.AnyMsg``: with the class of
     its connection's type, else the contract's; undecodable bytes are counted
     per topic in ``decode_errors``."""
-    by_type = {c._type: c for c in classes.values()}
+    by_type: dict[str, type] = {getattr(c, "_type"): c for c in classes.values()}
 
-    def decode(topic: str, raw: Any) -> Mapping[str, Any] | None:
+    def decode(topic: str, raw: Any) -> Mapping[str, object] | None:
         typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
-        cls = by_type.get(typ, classes[topic])
+        cls: Any = by_type.get(typ, classes[topic])
         try:
             msg = cls().deserialize(raw._buff)
         except Exception:  # a publisher of another type on a contract topic: counted, never a crash

@@ -36,6 +36,7 @@ from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict, deadline_status, has_deadlines
 from rclverify.backends.monitors.declarations import DeclarationMonitor, DeclarationResult, add_periods, declaration_status, has_declarations
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods, period_status
+from rclverify.runtime.shapes import LogChecksPart
 
 
 class LogChecks:
@@ -73,7 +74,7 @@ class LogChecks:
         for m in self.declarations:
             m.feed(ev)
 
-    def line(self, obj: Mapping[str, Any], deadline: bool = False) -> None:
+    def line(self, obj: Mapping[str, object], deadline: bool = False) -> None:
         """Any other log line (``topic``, ``time``, its fields) after it was
         written; ``deadline``: a deadline verdict's own line."""
         if not self.active:
@@ -109,10 +110,10 @@ class LogChecks:
         return [f"{d.node.name} deadlines: " + ", ".join(f"{n} {v}" for v, n in d.result.counts.items() if n)
                 for d in self.deadlines if any(d.result.counts.values())]
 
-    def record(self, log: str) -> dict[str, Any]:
+    def record(self, log: str) -> LogChecksPart:
         """The record's ``topic_deadlines``, ``periods`` and ``declarations``: per node its status,
         explanation and result, as ``rclverify monitor LOG`` reports them."""
-        out: dict[str, Any] = {"topic_deadlines": [], "periods": [], "declarations": []}
+        out: LogChecksPart = {"topic_deadlines": [], "periods": [], "declarations": []}
         for res in self.deadline_results:
             status, explanation = deadline_status(res, log)
             out["topic_deadlines"].append({"node": res.node, "status": status, "explanation": explanation,

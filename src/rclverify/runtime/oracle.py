@@ -50,6 +50,7 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.check import Verdict
 from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.runtime.shapes import OracleReply
 
 ORACLE_VERDICTS = ("currently_true", "currently_false", "true", "false", "unknown")
 
@@ -97,7 +98,7 @@ class OracleRun:
         self.undecided = False
         self.events = 0
 
-    def answer(self, text: str | bytes) -> dict[str, Any]:
+    def answer(self, text: str | bytes) -> OracleReply:
         """The reply (a JSON-ready dict) to one event message.  Never raises
         for what a client sends: JSON nested deeper than
         :data:`MAX_EVENT_DEPTH` is refused before it is decoded (``unknown``
@@ -137,7 +138,7 @@ class OracleRun:
         return {"verdict": verdict, "rclverify": decided}
 
 
-def encode(reply: Mapping[str, Any]) -> bytes:
+def encode(reply: Mapping[str, object]) -> bytes:
     """A reply as compact UTF-8 JSON (a NaN or an infinity, which JSON has no
     number for, is written as its string, ``"nan"``)."""
     try:
@@ -220,7 +221,7 @@ def _unread(transport: Any) -> int:
     return n
 
 
-def _answer(run: OracleRun, message: Any) -> dict[str, Any]:
+def _answer(run: OracleRun, message: Any) -> OracleReply:
     """``run.answer(message)``; an error the engine did not foresee is
     answered ``unknown`` with its reason instead of closing the connection."""
     try:

@@ -202,7 +202,7 @@ def flatten(msg: Any) -> Any:
     return msg
 
 
-def build_message(cls: type, fields: Mapping[str, Any]) -> Any:
+def build_message(cls: type, fields: Mapping[str, object]) -> Any:
     """An instance of ``cls`` with the given fields (those it has; others ignored)."""
     slots = set(getattr(cls, "__slots__", ()))
     return cls(**{k: v for k, v in fields.items() if k in slots})

@@ -24,7 +24,7 @@ from rclverify.runtime.ros1 import RosUnavailable, import_rospy
 import sys
 from rclverify.runtime.ros1 import message_class
 
-_CACHE: dict[str, Any] = {}
+_CACHE: dict[str, dict[str, type]] = {}
 
 
 def _search(dirs: Sequence[Path], extra: dict[str, list[str]] | None = None) -> dict[str, list[str]]:
@@ -90,13 +90,13 @@ def action_texts(pkg: str, name: str, text: str) -> dict[str, str]:
     }
 
 
-def action_classes(action_type: str, dirs: Sequence[Path], out_dir: Path) -> dict[str, Any]:
+def action_classes(action_type: str, dirs: Sequence[Path], out_dir: Path) -> dict[str, type]:
     """``{"goal", "feedback", "result"}`` -> the rospy classes of the
     ``<action>/goal``, ``/feedback`` and ``/result`` topics of ``pkg/Name``,
     from ``<dir>/pkg/action/Name.action``; the expanded ``.msg`` files are
     written under ``out_dir``.  Raises :class:`RosUnavailable`."""
     if action_type in _CACHE:
-        return _CACHE[action_type]  # type: ignore[no-any-return]
+        return _CACHE[action_type]
     pkg, _, name = action_type.partition("/")
     path = next((Path(d) / pkg / "action" / f"{name}.action" for d in dirs
                  if (Path(d) / pkg / "action" / f"{name}.action").is_file()), None)

@@ -42,6 +42,7 @@ from rclverify.traces.events import Event
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineVerdict
 from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
 from rclverify.runtime.ros1_interfaces import action_classes, service_class
+from rclverify.runtime.shapes import DeadlineSummary
 from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, bound_master_calls, check_master, finish_within, run_bounded
 
 
@@ -58,16 +59,16 @@ class ProxyRun:
     assumption)."""
 
     def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
-                 write: Callable[[dict[str, Any]], None] | None = None,
+                 write: Callable[[Mapping[str, object]], None] | None = None,
                  publish: Callable[[str], None] | None = None,
-                 forward: Callable[[str, dict[str, Any], float], None] | None = None) -> None:
+                 forward: Callable[[str, Mapping[str, object], float], None] | None = None) -> None:
         self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
         for m in monitors:
             m.on_verdict = self._verdict
         self.fh = log.open("w", encoding="utf-8") if log is not None else None
         self.sink, self.publish, self.forward = write, publish, forward
 
-    def _write(self, obj: dict[str, Any]) -> None:
+    def _write(self, obj: Mapping[str, object]) -> None:
         if self.sink is not None:
             self.sink(obj)
         if self.fh is not None:
@@ -80,7 +81,7 @@ class ProxyRun:
         if self.publish is not None:
             self.publish(json.dumps({"kind": "deadline", **v.to_json()}, sort_keys=True))
 
-    def event(self, topic: str, fields: dict[str, Any], stamp: float) -> None:
+    def event(self, topic: str, fields: Mapping[str, object], stamp: float) -> None:
         """One observed message; ``stamp`` (s) is set as its header stamp when it has none."""
         if "header" not in fields:
             secs = int(stamp)
@@ -99,10 +100,10 @@ class ProxyRun:
             for m in self.monitors:
                 m.advance(now)
 
-    def close(self) -> dict[str, Any]:
+    def close(self) -> DeadlineSummary:
         with self.lock:
             results = [m.finish().to_json() for m in self.monitors]
-            summary = {"kind": "summary", "results": results, "false": self.false}
+            summary: DeadlineSummary = {"kind": "summary", "results": results, "false": self.false}
             self._write(summary)
             if self.fh is not None:
                 self.fh.close()

@@ -43,7 +43,7 @@ from rclverify.core.cache.heap import freeze_for_live
 class Sink(Protocol):
     """What the worker feeds: :class:`~.live.LiveRun` (push a message, run the timer)."""
 
-    def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None: ...
+    def push(self, topic: str, fields: Mapping[str, object], received: float) -> None: ...
 
     def tick(self, now: float) -> None: ...
 
@@ -64,7 +64,7 @@ class EngineWorker:
     seconds (set when it ends).
     """
 
-    def __init__(self, live: Sink, decode: Callable[[str, Any], Mapping[str, Any] | None],
+    def __init__(self, live: Sink, decode: Callable[[str, Any], Mapping[str, object] | None],
                  now: Callable[[], float], tick_s: float = 0.02, batch: int = 256,
                  max_queue: int = 100_000) -> None:
         self.live, self.decode, self.now = live, decode, now

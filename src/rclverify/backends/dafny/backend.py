@@ -52,6 +52,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.dafny import implementation, runner
 from rclverify.backends.dafny.stubgen import ClauseRef, Stub, build_stub, clause_lines, snake
+from rclverify.backends.shapes import DafnyDetails, DafnyError, DafnyPlace, DafnyScan
 
 DEFAULT_TIME_LIMIT_S = 60
 DEFAULT_TIMEOUT_S = 600
@@ -191,8 +192,8 @@ class DafnyBackend:
         except (OSError, UnicodeDecodeError) as exc:
             return ev("error", f"cannot read {cfg.implementation}: {exc}", tool.version)
         scan = implementation.scan_implementation(text, stub.module, stub.method)
-        scan_details = {"refining_modules": [{"module": m, "line": ln} for m, ln in scan.refining],
-                        "unsound_constructs": [{"line": ln, "construct": c} for ln, c in scan.unsound]}
+        scan_details: DafnyScan = {"refining_modules": [{"module": m, "line": ln} for m, ln in scan.refining],
+                                    "unsound_constructs": [{"line": ln, "construct": c} for ln, c in scan.unsound]}
         if not scan.refining:
             return ev("error", f"{cfg.implementation}:1:1: no module refines {stub.module}; write "
                                f"`module {stub.method}Impl refines {stub.module} {{ ... }}`", tool.version,
@@ -220,7 +221,8 @@ class DafnyBackend:
         clauses = clause_lines(stub.text)
         status, explanation, details = _judge(res, out, clauses, stub_rel, cfg, scan, tool,
                                               len(target.node.node.guarantees), target)
-        details.update(scan_details)
+        details["refining_modules"] = scan_details["refining_modules"]
+        details["unsound_constructs"] = scan_details["unsound_constructs"]
         details["command"] = shown
         if log_notes:
             details["log_filtered"] = log_notes
@@ -246,34 +248,34 @@ def _clause_of(msg: runner.Message, clauses: Mapping[int, ClauseRef], stub_rel: 
 
 def _judge(res: runner.RunOutput, out: runner.Output, clauses: Mapping[int, ClauseRef], stub_rel: str,
            cfg: _Config, scan: implementation.ImplementationScan, tool: runner.DafnyTool, n_guarantees: int,
-           target: NodeTarget) -> tuple[str, str, dict[str, Any]]:
+           target: NodeTarget) -> tuple[str, str, DafnyDetails]:
     """Status, explanation and details of one Dafny run."""
-    errors: list[dict[str, Any]] = []
+    errors: list[DafnyError] = []
     per: dict[str, list[str]] = {}
     for m in out.messages:
         if m.severity == "warning":
             continue
         c = _clause_of(m, clauses, stub_rel, target.root)
-        e: dict[str, Any] = {"severity": m.severity, "file": m.at.file, "line": m.at.line, "col": m.at.col,
+        e: DafnyError = {"severity": m.severity, "file": m.at.file, "line": m.at.line, "col": m.at.col,
                              "message": m.message, "code": m.code,
                              "related": [{"file": p.file, "line": p.line, "col": p.col, "message": t}
                                          for p, t in m.related]}
         if c is not None:
-            e.update(clause=c.label, role=c.role, index=c.index, rcl=c.source)
+            e["clause"], e["role"], e["index"], e["rcl"] = c.label, c.role, c.index, c.source
             if c.role == "guarantee":
                 e["guarantee"] = c.index
                 per.setdefault(str(c.index), []).append(m.severity)
         errors.append(e)
-    warnings = [{"file": m.at.file, "line": m.at.line, "col": m.at.col, "message": m.message}
+    warnings: list[DafnyPlace] = [{"file": m.at.file, "line": m.at.line, "col": m.at.col, "message": m.message}
                 for m in out.messages if m.severity == "warning"]
-    details: dict[str, Any] = {
+    details: DafnyDetails = {
         "verified": out.verified, "errors": errors, "error_count": out.errors, "timeouts": out.timeouts,
         "other_outcomes": out.other, "warnings": warnings, "exit_code": res.returncode,
         "parse_errors": out.parse_errors, "resolution_errors": out.resolution_errors,
         "prover_messages": out.prover_messages[:5], "cli": "legacy" if tool.legacy else "verify",
     }
 
-    def located(e: dict[str, Any]) -> str:
+    def located(e: DafnyError) -> str:
         where = f"{e['file']}({e['line']},{e['col']})"
         rcl = f" [{e['clause']} at {e['rcl']}]" if "clause" in e else ""
         return f"{where}: {e['message']}{rcl}"

@@ -38,6 +38,7 @@ from rclverify.backends.experiment.figures import format_value
 from rclverify.backends.experiment.plot import render_svg
 from rclverify.core.extras import MissingExtra
 from rclverify.backends.experiment.target import run_target, target_obligations
+from rclverify.backends.shapes import ExperimentDetails
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
 NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
@@ -114,7 +115,7 @@ class ExperimentBackend:
             svg_path.unlink(missing_ok=True)
             plot, plot_note = None, f"; no plot drawn: {exc}"
         figures = ", ".join(f"{k} {v}" for k, v in _figure_rows(cfg))
-        details: dict[str, Any] = {
+        details: ExperimentDetails = {
             "criterion": cfg.criterion_text, "file": cfg.file, "figures": figures_json(cfg.figures),
             "constants": {k: q.show() for k, q in sorted(cfg.constants.items())},
             "criterion_holds": verdict.holds, "flags": flags, "per_trial": verdict.per_trial,
@@ -125,7 +126,7 @@ class ExperimentBackend:
         log = "\n".join([f"criterion: {cfg.criterion_text}", f"figures: {figures}",
                          f"criterion holds: {verdict.holds}"] + [f"flag: {f['bound']}: {f['explanation']}" for f in flags])
         log += plot_note.replace("; ", "\n", 1)
-        kw: dict[str, Any] = dict(log=log, artifacts=(plot,) if plot else (), details=details)
+        kw: dict[str, object] = dict(log=log, artifacts=(plot,) if plot else (), details=details)
         flag_text = ("; the summary statistics cannot all be true together: "
                      + "; ".join(f"{f['bound']}: {f['explanation']}" for f in flags)) if flags else ""
         if verdict.holds is False:

@@ -22,10 +22,10 @@ comparisons are exact (squares of rationals, no square roots).
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Any
 
 from rclverify.backends.experiment.figures import Figures
 from rclverify.backends.experiment.figures import BASE, UNITS
+from rclverify.backends.shapes import FigureJson
 
 
 def _display_unit(text: str, dim: str) -> tuple[str, Fraction]:
@@ -105,7 +105,7 @@ def check(fig: Figures) -> list[dict[str, str]]:
     return flags
 
 
-def figures_json(fig: Figures) -> dict[str, Any]:
+def figures_json(fig: Figures) -> dict[str, FigureJson]:
     """The figures as JSON: each statistic as written and in base units."""
     return {k: {"as_written": q.show(), "base_value": str(q.value) if not (fig.derived and k == "std") else None,
                 "dimension": q.dim} for k, q in fig.stats.items()}

@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 import jinja2
 import z3
@@ -37,6 +37,7 @@ from rclverify.backends.hoare.obligations import Conjunct, EncodedTriple, HoareC
 from rclverify.backends.hoare.outline import OutlineLine, outline_text, render_outline, term_printer
 from rclverify.backends.hoare.solve import TripleResult, check_all
 from rclverify.backends.hoare.wp import VC, WP, ProgramModel, main_vc, wp
+from rclverify.backends.shapes import HoareData, HoareDetails
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
 NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
@@ -199,7 +200,7 @@ class HoareBackend:
             r = render(target, p)
             atomic_write_text(p.artifact, r.text)
             inputs = tuple(sorted({p.config.program, *target.contract_files, target.plan_file}))
-            data: dict[str, Any] = {
+            data: HoareData = {
                 "program": p.config.program, "guarantee": p.conjunct.guarantee, "conjunct": p.conjunct.index,
                 "conjunct_rcl": p.conjunct.conjunct_text, "binding": dict(sorted(p.config.binding_text.items())),
                 "conjunct_source": str(p.conjunct.loc), "timeout_ms": p.config.timeout_ms,
@@ -252,7 +253,7 @@ class HoareBackend:
         artifacts.append(target.rel(p.smt2))
         assert rendered.lines is not None
         outline = outline_text(rendered.lines)
-        details: dict[str, Any] = {
+        details: HoareDetails = {
             "outline": outline if len(outline) <= 8000 else outline[:8000] + "...\n",
             "vcs": {r.vc.id: r.status for r in res.results},
             "program": p.config.program,
@@ -276,6 +277,6 @@ class HoareBackend:
                         f"within {p.config.timeout_ms} ms", log=log, artifacts=tuple(artifacts), details=details)
 
 
-def _cex_text(cex: dict[str, Any]) -> str:
+def _cex_text(cex: Mapping[str, object]) -> str:
     return ", ".join(f"{k} = {v}" for k, v in cex.items())
 

@@ -61,7 +61,7 @@ def _value(v: Any) -> Any:
     raise _CannotRun(f"value {v!r}")
 
 
-def _eval(e: Any, env: Mapping[str, Any], start: Mapping[str, Any]) -> Any:
+def _eval(e: Any, env: Mapping[str, object], start: Mapping[str, object]) -> Any:
     if isinstance(e, Num):
         return _number(e.text)
     if isinstance(e, BoolConst):
@@ -83,7 +83,7 @@ def _eval(e: Any, env: Mapping[str, Any], start: Mapping[str, Any]) -> Any:
     raise _CannotRun(f"{type(e).__name__} cannot be evaluated")  # an extern function applied
 
 
-def run(program: Program, initial: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Assign]]:
+def run(program: Program, initial: Mapping[str, object]) -> tuple[dict[str, object], dict[str, Assign]]:
     """``(final values, last assignment per variable)`` of ``program`` run
     from ``initial`` (variable -> value: numbers, numeric strings or
     booleans).  Raises ``ValueError`` when the run cannot be made (module
@@ -118,7 +118,7 @@ def run(program: Program, initial: Mapping[str, Any]) -> tuple[dict[str, Any], d
     return env, last
 
 
-def breaking_assignments(program: Program, counterexample: Mapping[str, Any], outputs: Mapping[str, str],
+def breaking_assignments(program: Program, counterexample: Mapping[str, object], outputs: Mapping[str, str],
                          source: str) -> list[Culprit]:
     """The last assignment to each output variable the run on
     ``counterexample`` executes (module docstring).  ``counterexample``:

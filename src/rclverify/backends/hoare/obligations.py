@@ -371,7 +371,7 @@ class EncodedTriple:
     names: Mapping[str, str] = field(default_factory=dict)
 
 
-def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any],
+def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, object],
             bound: Mapping[str, z3.ExprRef]) -> z3.BoolRef:
     """Encode ``e`` with its free bound-variable names given by ``bound``."""
     return enc.formula(e, node, symbols, bound=bound)
@@ -423,8 +423,8 @@ def encode_triple(c: Conjunct, cfg: HoareConfig, m: ProgramModel, enc: Encoder, 
             for nm in b.names:
                 member = ast.Member(ast.Var(nm), b.domain)  # type: ignore[arg-type]
                 pre_guards.append(_encode(enc, member, node, {}, pre_b))
-    pre_syms: dict[str, Any] = {}
-    post_syms: dict[str, Any] = {}
+    pre_syms: dict[str, object] = {}
+    post_syms: dict[str, object] = {}
     observe: dict[str, z3.ExprRef] = dict(fixed)
     for key, expr in cfg.inputs.items():
         if isinstance(expr, lang.Name) and expr.name in m.funcs:

@@ -56,7 +56,7 @@ class TripleResult:
     status: str
     results: tuple[VCResult, ...]
     failed: VCResult | None = None
-    counterexample: dict[str, Any] | None = None
+    counterexample: dict[str, object] | None = None
     notes: tuple[str, ...] = field(default=())
 
 
@@ -156,7 +156,7 @@ def _assigned(body: tuple[lang.Stmt, ...]) -> list[str]:
 
 def counterexample(res: VCResult, m: ProgramModel, observe: Mapping[str, z3.ExprRef] | None = None,
                    observe_final: Mapping[str, str] | None = None,
-                   names: Mapping[str, str] | None = None) -> tuple[dict[str, Any], list[str]]:
+                   names: Mapping[str, str] | None = None) -> tuple[dict[str, object], list[str]]:
     """Concrete values behind a refuted VC.
 
     Returns ``(values, notes)``: ``values`` maps the program variables the VC
@@ -172,7 +172,7 @@ def counterexample(res: VCResult, m: ProgramModel, observe: Mapping[str, z3.Expr
     assert res.model is not None
     model = res.model
     formulas = [*res.vc.hyps, res.vc.goal]
-    out: dict[str, Any] = {}
+    out: dict[str, object] = {}
     for n in m.variables_in(formulas):
         out[n] = json_value(model.eval(m.consts[n], model_completion=True))
     for n in m.olds_in(formulas):

@@ -49,6 +49,7 @@ from rclverify.backends.model_checking.ltl import Propositions, parse_psl_text, 
 from rclverify.backends.model_checking.promela import Claim, PromelaModel, build_model
 from rclverify.backends.model_checking.trail import counterexample, read_replay, summary
 from rclverify.backends.model_checking.vacuity import antecedents, check_vacuity, temporal_checks
+from rclverify.backends.shapes import SpinDetails
 
 if TYPE_CHECKING:
     from rclverify.backends.model_checking.environment import Environment
@@ -119,7 +120,7 @@ def read_spin_config(target: NodeTarget) -> SpinConfig:
     return SpinConfig(env, cfg.get("environment"), bounds["max_states"], bounds["max_depth"], tuple(props))
 
 
-def chosen_checker(config: Mapping[str, Any], environ: Mapping[str, str] | None = None) -> str:
+def chosen_checker(config: Mapping[str, object], environ: Mapping[str, str] | None = None) -> str:
     """``spin`` or ``ajpf`` for an entry (see the module docstring for the default)."""
     checker = config.get("model_checker")
     if checker in CHECKERS:
@@ -193,7 +194,7 @@ def _graph(target: NodeTarget, model: str, cfg: SpinConfig, time_limit_s: float,
     return key, *_GRAPHS[key]
 
 
-def spin_timeout(config: Mapping[str, Any]) -> float:
+def spin_timeout(config: Mapping[str, object]) -> float:
     """The entry's ``timeout_s`` (checked by the ajpf backend's read_config), else
     :data:`spin.DEFAULT_TIMEOUT_S`: the limit of each tool run and of the exploration."""
     v = config.get("timeout_s")
@@ -263,7 +264,7 @@ def _vacuity_claims(claims: list[Claim]) -> list[Claim]:
 _Say = Callable[..., Evidence]
 
 
-def _not_run(graph: StateGraph, mine: Claim, percepts: tuple[psl.Term, ...], details: dict[str, Any]) -> str | None:
+def _not_run(graph: StateGraph, mine: Claim, percepts: tuple[psl.Term, ...], details: SpinDetails) -> str | None:
     """Why SPIN is not run on ``graph`` for the claim ``mine`` (the evidence is
     inconclusive): the exploration was cut, or the claim names an identifier
     value; ``None`` when it is run."""
@@ -282,7 +283,7 @@ def _not_run(graph: StateGraph, mine: Claim, percepts: tuple[psl.Term, ...], det
 
 
 def _violated(evidence: _Say, target: NodeTarget, graph: StateGraph, mine: Claim, res: spin.CheckResult,
-              trail_path: Path, arts: list[str], details: dict[str, Any]) -> Evidence:
+              trail_path: Path, arts: list[str], details: SpinDetails) -> Evidence:
     """SPIN's violation of ``mine`` mapped back to a lasso of ``graph``, its
     steps written to ``trail_path``: failed evidence with the counterexample."""
     props = Propositions([mine.formula])
@@ -301,7 +302,7 @@ def _violated(evidence: _Say, target: NodeTarget, graph: StateGraph, mine: Claim
 
 def _holds(evidence: _Say, graph: StateGraph, graph_key: str, pml: PromelaModel, mine: Claim,
            run: Callable[[str], spin.CheckResult], res: spin.CheckResult, arts: list[str],
-           details: dict[str, Any]) -> Evidence:
+           details: SpinDetails) -> Evidence:
     """The claim holds on every path: discharged unless an antecedent never
     holds (vacuous) or whether it ever holds was not decided (inconclusive)."""
     memo = _MEMO.setdefault(graph_key, {})
@@ -357,7 +358,7 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
     what = (f"{WHAT} {graph.source} under its verification environment ({len(graph.states)} states, "
             f"{len(graph.transitions)} transitions; bounds max_states={bounds[0]}, max_depth={bounds[1]}, "
             f"timeout_s={timeout_s:g})")
-    details: dict[str, Any] = {
+    details: SpinDetails = {
         "model_checker": "spin", "claim": claim, "psl": psl.to_text(mine.formula), "states": len(graph.states),
         "transitions": len(graph.transitions), "complete": graph.complete, "cut": graph.cut, "depth": graph.depth,
         "max_states": bounds[0], "max_depth": bounds[1], "timeout_s": timeout_s, "explore_s": explore_s,
@@ -393,9 +394,9 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
         return _RESULTS[(mkey, name)]
 
     res = run(claim)
-    details.update({"spin_verdict": res.verdict, "spin_states_stored": res.stored, "build_s": build_s,
-                    "pan_s": res.duration_s, "promela": target.rel(spin_dir / "model.pml"),
-                    "propositions": dict(pml.props)})
+    details["spin_verdict"], details["spin_states_stored"], details["build_s"] = res.verdict, res.stored, build_s
+    details["pan_s"], details["promela"] = res.duration_s, target.rel(spin_dir / "model.pml")
+    details["propositions"] = dict(pml.props)
     arts = [target.rel(spin_dir / "model.pml")]
     if res.verdict == "violated":
         return _violated(evidence, target, graph, mine, res, spin_dir / f"{claim}.trail.txt", arts, details)

@@ -103,7 +103,7 @@ def _has_wild(term: psl.Term) -> bool:
     return isinstance(term, psl.Compound) and any(_has_wild(a) for a in term.args)
 
 
-def environment_from_plan(raw: Mapping[str, Any], locate: Locate | None = None) -> Environment:
+def environment_from_plan(raw: Mapping[str, object], locate: Locate | None = None) -> Environment:
     """The :class:`Environment` of a plan entry's ``environment`` mapping.
 
     ``locate(*path)`` gives the plan location of the value at ``path`` inside

@@ -40,13 +40,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 from jinja2 import Environment, PackageLoader, StrictUndefined
 
 from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.model_checking.graph import StateGraph
 from rclverify.backends.model_checking.ltl import Propositions, atom_text, to_spin
+from rclverify.backends.shapes import PromelaBranch, PromelaLeaf, PromelaSplit
 
 #: Most states of one ``if`` inside a transition's ``d_step``.
 LEAF = 16
@@ -144,7 +145,7 @@ def build_model(graph: StateGraph, claims: Sequence[Claim]) -> PromelaModel:
     degree = {k: len(v) for k, v in out.items()}
     ranks = []
     for r in range(max(degree.values(), default=0)):
-        branches = []
+        branches: list[PromelaBranch] = []
         for src in sorted(k for k, d in degree.items() if d > r):
             t = out[src][r]
             dst = graph.transitions[t].dst
@@ -172,7 +173,7 @@ def _comment(c: Claim) -> str:
     return (c.comment + ": " if c.comment else "") + psl.to_text(c.formula)
 
 
-def _tree(branches: list[dict[str, Any]]) -> dict[str, Any]:
+def _tree(branches: list[PromelaBranch]) -> PromelaLeaf | PromelaSplit:
     """A binary search tree over ``branches`` (sorted by ``src``)."""
     if len(branches) <= LEAF:
         return {"leaf": branches}

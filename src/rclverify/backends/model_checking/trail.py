@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Sequence
 
 from rclverify.backends.model_checking.graph import StateGraph
 from rclverify.backends.model_checking.ltl import Propositions, atom_text
+from rclverify.backends.shapes import Lasso, LassoStep
 
 _STEP = re.compile(r"^\s*@([TS])\s+(\d+)\s*$")
 CYCLE_MARK = "START OF CYCLE"
@@ -48,7 +49,7 @@ def read_replay(text: str) -> Replay:
     return Replay(tuple(steps), start)
 
 
-def counterexample(graph: StateGraph, replay: Replay, props: Propositions | None = None) -> dict[str, Any]:
+def counterexample(graph: StateGraph, replay: Replay, props: Propositions | None = None) -> Lasso:
     """The replay as a JSON-ready lasso over ``graph`` (evidence ``details["lasso"]``).
 
     ``{"kind": "lasso" | "prefix", "source": file, "initial": {state...},
@@ -69,7 +70,7 @@ def counterexample(graph: StateGraph, replay: Replay, props: Propositions | None
             memo[state] = [atom_text(a) for a in atoms if graph.holds(state, a)]
         return memo[state]
 
-    steps: list[dict[str, Any]] = []
+    steps: list[LassoStep] = []
     at = 0
     for kind, k in replay.steps:
         if kind == "T":
@@ -98,7 +99,7 @@ def counterexample(graph: StateGraph, replay: Replay, props: Propositions | None
             "initial": {"state": 0, "holds": holds(0)}, "prefix": prefix, "cycle": cycle, "trace": trace}
 
 
-def _line(st: dict[str, Any]) -> str:
+def _line(st: LassoStep) -> str:
     where = f" [{st['where']}, stage {st['stage']}]" if st["where"] else (
         f" [stage {st['stage']}]" if st["stage"] else "")
     true = ", ".join(st["holds"]) or "no proposition holds"
@@ -107,10 +108,10 @@ def _line(st: dict[str, Any]) -> str:
     return f"{st['from']} -> {st['to']}: {st['label']}{where}; then {true}"
 
 
-def summary(cex: dict[str, Any]) -> str:
+def summary(cex: Lasso) -> str:
     """One sentence: the lasso's size and the source lines it passes through."""
-    steps: Sequence[dict[str, Any]] = [*cex["prefix"], *cex["cycle"]]
-    lines = sorted({s["line"] for s in steps if s.get("line")})
+    steps: Sequence[LassoStep] = [*cex["prefix"], *cex["cycle"]]
+    lines = sorted({ln for s in steps if (ln := s.get("line"))})
     where = (f"; Gwendolen line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))} of {cex['source']}"
              if lines else "")
     if cex["kind"] == "lasso":

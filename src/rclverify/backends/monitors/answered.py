@@ -37,7 +37,7 @@ class AnsweredRun:
     __slots__ = ("chunk", "at", "where", "seed")
 
     def __init__(self, chunk: EventRows | BlockRows, at: np.ndarray, where: dict[str, np.ndarray],
-                 seed: dict[str, Any]) -> None:
+                 seed: dict[str, object]) -> None:
         self.chunk, self.at, self.where, self.seed = chunk, at, where, seed
 
     def question(self, j: int, run: Any) -> Question:
@@ -88,15 +88,15 @@ class RecentOutput:
     def __len__(self) -> int:
         return 4
 
-    def _entry(self) -> tuple[Event, float, dict[str, Any], dict[str, Any]]:
+    def _entry(self) -> tuple[Event, float, dict[str, object], dict[str, object]]:
         ev = self.rows[self.i]
         return ev, self.stamp, {self.key: ev.fields[self.field]}, _EMPTY
 
 
-_EMPTY: dict[str, Any] = {}
+_EMPTY: dict[str, object] = {}
 
 #: An entry of the engine's ``_recent`` (and ``_released``) outputs: the tuple
 #: ``engine.py`` appends, or a :class:`RecentOutput` of a batch run.
-Recent = Union[tuple[Event, float, dict[str, Any], Mapping[str, Any]], RecentOutput]
+Recent = Union[tuple[Event, float, dict[str, object], Mapping[str, object]], RecentOutput]
 
 __all__ = ["AnsweredRun", "Recent", "RecentOutput"]

@@ -34,6 +34,7 @@ from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.run_origin import RunOrigin, unseen_links
+from rclverify.backends.monitors.shapes import DeadlinesPart, RunSource
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
 from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
@@ -220,15 +221,15 @@ class MonitorsBackend:
             if merged is not None:
                 finished["deadlines"] = merged
         if "deadlines" in finished:
-            status, explanation, more = with_deadlines(target, finished["deadlines"], trace, status, explanation)
-            extra.update(more)
+            status, explanation, dpart = with_deadlines(target, finished["deadlines"], trace, status, explanation)
+            extra.update(dpart)
         if "periods" in finished:
-            status, explanation, more = with_periods(finished["periods"], trace, status, explanation)
-            extra.update(more)
+            status, explanation, ppart = with_periods(finished["periods"], trace, status, explanation)
+            extra.update(ppart)
         if "declarations" in finished:
-            status, explanation, more = with_declarations(
+            status, explanation, cpart = with_declarations(
                 add_periods(finished["declarations"], target.node, finished.get("periods")), trace, status, explanation)
-            extra.update(more)
+            extra.update(cpart)
         dl = finished.get("deadlines")
         # silence is never green: what the run did not judge, with the reason, beside the status
         extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
@@ -265,7 +266,7 @@ class _Read:
     results: list[Any]
     summary: dict[str, Any] | None
     bag: BagCalls | None = None
-    origin: dict[str, Any] | None = None
+    origin: RunSource | None = None
 
 
 def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None) -> _Read:
@@ -365,7 +366,7 @@ def with_calls(entries: list[dict[str, Any]], summary: dict[str, Any], status: s
 
 
 def with_deadlines(target: NodeTarget, res: DeadlineResult, trace: str, status: str,
-                   explanation: str) -> tuple[str, str, dict[str, Any]]:
+                   explanation: str) -> tuple[str, str, DeadlinesPart]:
     """The untimed verdict combined with the node's deadline verdicts ``res``
     on the same trace (:mod:`.deadlines`): the worse status wins; returns
     ``(status, explanation, {"deadlines": ...})``."""

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import gc
 from itertools import repeat
-from typing import Any, Callable, Iterable, Mapping, cast
+from typing import Callable, Iterable, Mapping, cast
 
 from rclverify.core.numeric import np
 
@@ -54,7 +54,7 @@ from rclverify.backends.monitors.verdicts import NodeResult, Verdict
 
 #: Events read per chunk: the columns held at once.
 CHUNK = 16384
-_EMPTY: Mapping[str, Any] = {}
+_EMPTY: Mapping[str, int] = {}
 
 
 class BatchPlan:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import Any, Mapping
 
 from rclverify.semantics.floatsem import Judgement
 from rclverify.lang import ast
@@ -28,20 +28,14 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.verdicts import WEAK as _WEAK, in_all, link_of, names, producers
+from rclverify.backends.monitors.shapes import Violation
+from rclverify.backends.monitors.engine_state import EngineState
 
-if TYPE_CHECKING:
-    from rclverify.backends.monitors.answered import Recent
 
-
-class Closing:
+class Closing(EngineState):
     """The once-per-question parts of :class:`~.engine.NodeMonitor` (module docstring)."""
 
-    if TYPE_CHECKING:  # the engine's state and helpers the mixin reads, declared for the type checker only
-        _recent: deque[Recent]
-
-        def __getattr__(self, name: str) -> Any: ...
-
-    def _assumption_violated(self, ev: Event, formula: ast.Expr, inputs: Mapping[str, Any], judged: Judgement) -> None:
+    def _assumption_violated(self, ev: Event, formula: ast.Expr, inputs: Mapping[str, object], judged: Judgement) -> None:
         mentioned: set[str] = set()
         names(formula, mentioned)
         read = [k for k in inputs if k in mentioned or k[3:] in mentioned]
@@ -58,7 +52,7 @@ class Closing:
                       reason=f"assumption {expr_to_rcl(formula)} is false; blamed on the {blame}",
                       semantics=judged.semantics)
 
-    def _accept(self, ev: Event, inputs: dict[str, Any]) -> tuple[bool, str, str]:
+    def _accept(self, ev: Event, inputs: dict[str, object]) -> tuple[bool, str, str]:
         """Whether the node owes question ``inputs`` (raised by ``ev``) an answer:
         (owed, the arithmetic its assumption held in, why it is undecided or ``""``);
         a false assumption is reported ``assumption violated`` here."""
@@ -83,9 +77,9 @@ class Closing:
                 self._note_inexact(ev, judged, f"assumption {expr_to_rcl(formula)}", inputs)
         return owed, accepted, refusal
 
-    def _violation(self, ev: Event, k: int, values: Mapping[str, Any], reason: str, semantics: str,
+    def _violation(self, ev: Event, k: int, values: Mapping[str, object], reason: str, semantics: str,
                    trigger: Event | None) -> None:
-        record: dict[str, Any] = {"event": ev.index, "time": ev.time, "where": ev.where, "guarantee": k,
+        record: Violation = {"event": ev.index, "time": ev.time, "where": ev.where, "guarantee": k,
                                   "formula": self._texts.get(k, ""), "values": self._rendered(values),
                                   "reason": reason, "semantics": semantics}
         if trigger is not None:
@@ -149,7 +143,7 @@ class Closing:
         cands = self._early(qb)
         if not cands:
             return
-        outs: dict[str, Any] = {}
+        outs: dict[str, object] = {}
         ks: list[int] = []
         for ev, _, mine, _ in cands:
             outs.update(mine)
@@ -243,7 +237,7 @@ class Closing:
                 self._early_part(q, k, values)
         q.waiting.clear()
 
-    def _early_part(self, q: Question, k: int, values: Mapping[str, Any]) -> None:
+    def _early_part(self, q: Question, k: int, values: Mapping[str, object]) -> None:
         """Guarantee ``k`` of question ``q`` waited for outputs ``q`` got no
         message of before a newer question followed it.  Outputs stamped within
         the transport skew before ``q`` were taken as (part of) the answer to the
@@ -256,7 +250,7 @@ class Closing:
         cands = self._early(q)
         if not cands:
             return
-        early: dict[str, Any] = {}
+        early: dict[str, object] = {}
         for _, _, mine, _ in cands:
             early.update(mine)
         completed = {**early, **values}  # its own answer first; the early outputs fill what it lacks
@@ -272,7 +266,7 @@ class Closing:
                              f"is false; taken for the question at its stamp, it left that answer incomplete; the "
                              f"two readings disagree (docs/semantics.md, \"Transport skew\")", question=q.event.where)
 
-    def _partial(self, q: Question, k: int, ev: Event, why: str, outs: Mapping[str, Any], end: bool) -> None:
+    def _partial(self, q: Question, k: int, ev: Event, why: str, outs: Mapping[str, object], end: bool) -> None:
         """A partial answer: guarantee ``k`` waited for an output that never came
         after the question; false whatever it is -> ``violated``, else undecided."""
         values = {**q.inputs, **outs}  # outs: the state outputs at its horizon and the answer
@@ -288,7 +282,7 @@ class Closing:
         self._verdict("open" if end else "inconclusive", ev, guarantee=k, values=self._rendered(values),
                       reason=reason, question=q.event.where)
 
-    def _false_whatever_missing(self, k: int, values: Mapping[str, Any]) -> bool:
+    def _false_whatever_missing(self, k: int, values: Mapping[str, object]) -> bool:
         import z3  # deferred: start-up (Z3 only for a question whose answer stays incomplete)
         from rclverify.semantics.concrete import false_whatever_the_rest  # deferred: start-up (loads z3, the encoder and the type checker only when called)
         known = {q: v for q, v in values.items() if v is not None}

@@ -124,7 +124,7 @@ class CallBook:
                        "rejected": 0, "unpaired": 0}
 
     # -- input -------------------------------------------------------------------------------
-    def open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, Any], stamp: float,
+    def open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, object], stamp: float,
              part: str = "request", count: bool = True) -> None:
         """A request (``part`` ``request``) or a goal (``goal``) of link ``name``
         with identity ``key``, stamped ``stamp`` (s).  ``count`` false: the
@@ -149,7 +149,7 @@ class CallBook:
         while len(self.calls) > self.max_calls:
             self._close(next(iter(self.calls)), evicted=True)
 
-    def answer(self, key: tuple[Any, ...], part: str, fields: Mapping[str, Any], stamp: float,
+    def answer(self, key: tuple[Any, ...], part: str, fields: Mapping[str, object], stamp: float,
                final: bool = True, name: str = "") -> bool:
         """A reply (``response``), feedback or result of the call ``key``;
         ``final`` for the reply or the result (the call is then answered).
@@ -218,8 +218,8 @@ class CallBook:
         """A line for the log about a call (a status change) that no monitor reads."""
         self._log(obj)
 
-    def _feed(self, call: _Call, part: str, fields: Mapping[str, Any], stamp: float,
-              extra: Mapping[str, Any] | None = None) -> None:
+    def _feed(self, call: _Call, part: str, fields: Mapping[str, object], stamp: float,
+              extra: Mapping[str, object] | None = None) -> None:
         topic = f"{call.name}/{part}"
         ev = Event(self.index, stamp, topic, dict(fields), f"{call.label} {part}")
         self.index += 1

@@ -48,7 +48,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping
+from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance, judge
 from rclverify.lang import ast
@@ -61,6 +61,7 @@ from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_fo
 from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.online import header_stamp_ns
 from rclverify.backends.monitors.verdicts import LINK_TOPICS, names
+from rclverify.backends.monitors.shapes import DeadlineResultJson, DeadlineVerdictJson, Unaccepted
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
 #: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).
@@ -86,7 +87,7 @@ class DeadlineVerdict:
     #: the arithmetic the answer's formula held in (``exact``, ``double``, ``tolerance``; ``""``: no answer)
     semantics: str = ""
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> DeadlineVerdictJson:
         return {"node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
                 "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
                 "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
@@ -99,9 +100,9 @@ class _Pending:
     trigger: Event
     stamp: float
     due: float
-    inputs: dict[str, Any]
+    inputs: dict[str, object]
     #: the outputs published after the trigger (stamp at or after it): only they answer it
-    outs: dict[str, Any] = field(default_factory=dict)
+    outs: dict[str, object] = field(default_factory=dict)
     #: the last output after the trigger that did not satisfy the guarantee (where, why)
     rejected: str = ""
     #: the trigger's stamp and its deadline in integer nanoseconds: what the deadline is compared in
@@ -120,9 +121,9 @@ class DeadlineResult:
     counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in DEADLINE_VERDICTS})
     first_false: DeadlineVerdict | None = None
     unaccepted: dict[str, int] = field(default_factory=lambda: {v: 0 for v in UNACCEPTED})
-    first_unaccepted: dict[str, Any] | None = None
+    first_unaccepted: Unaccepted | None = None
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> DeadlineResultJson:
         return {"node": self.node, "counts": dict(self.counts),
                 "first_false": None if self.first_false is None else self.first_false.to_json(),
                 "unaccepted": dict(self.unaccepted), "first_unaccepted": self.first_unaccepted}
@@ -198,7 +199,7 @@ class DeadlineMonitor:
         self.needed = sorted(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
         #: the node's questions: an answer is judged on the latest at its stamp (a superseded trigger is carried)
         self.stream = QuestionStream()
-        self.values: dict[str, Any] = {}
+        self.values: dict[str, object] = {}
         #: keys whose latest message did not map (NaN, a missing field): key -> why; their stale value never
         #: stands in (docs/semantics.md, "Values")
         self.invalid: dict[str, str] = {}
@@ -206,7 +207,7 @@ class DeadlineMonitor:
         self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
         #: the last outputs heard: (stamp ns, event, outputs it set, their values): a trigger heard after them
         #: but stamped before them is answered by them
-        self.heard: deque[tuple[int, Event, set[str], dict[str, Any]]] = deque(maxlen=64)
+        self.heard: deque[tuple[int, Event, set[str], dict[str, object]]] = deque(maxlen=64)
         self.now = float("-inf")
         self.now_ns: int | None = None
         self.result = DeadlineResult(node.name)
@@ -284,7 +285,7 @@ class DeadlineMonitor:
                 self.result.first_unaccepted = {"guarantee": k, "where": ev.where, "stamp": stamp, "why": why,
                                                 "reason": reason}
 
-    def _refused(self, inputs: Mapping[str, Any]) -> tuple[str, str] | None:
+    def _refused(self, inputs: Mapping[str, object]) -> tuple[str, str] | None:
         """Why the node's assumption does not accept ``inputs`` (``(kind,
         reason)``, kind one of :data:`UNACCEPTED`), ``None`` when it does."""
         for formula in self.assumption:
@@ -352,7 +353,7 @@ class DeadlineMonitor:
             return False
         return judge(cl.formula, self.checked, self.node, self._visible(p, ns / 1e9), self.tolerance).truth is True
 
-    def _visible(self, p: _Pending, stamp: float | None = None) -> dict[str, Any]:
+    def _visible(self, p: _Pending, stamp: float | None = None) -> dict[str, object]:
         """What obligation ``p`` is judged on for an output stamped ``stamp``:
         the inputs of the latest question at that stamp (the trigger's own, or
         the accepted question that superseded it: docs/semantics.md), with the
@@ -447,7 +448,7 @@ def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
     u = res.unaccepted
     refused = ""
     if any(u.values()):
-        first = res.first_unaccepted or {}
+        first: Mapping[str, object] = res.first_unaccepted or {}
         words = {"assumption violated": "whose inputs violated the assumption",
                  "incomplete input": "with inputs not all observed yet", "undecided": "whose assumption was undecided"}
         refused = ("; no deadline verdict for " + ", ".join(f"{n} trigger event(s) {words[k]}"

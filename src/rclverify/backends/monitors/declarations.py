@@ -63,6 +63,8 @@ from rclverify.backends.monitors.deadlines import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
 from rclverify.backends.monitors.periods import PeriodResult
 from rclverify.backends.monitors.verdicts import names
+from rclverify.backends.monitors.shapes import DeclarationsPart
+from rclverify.backends.shapes import DeclarationRow
 
 #: a first value that did not map (a missing field, NaN): an ``initially`` on it is undecided
 _UNMAPPED = object()
@@ -110,13 +112,13 @@ class DeclarationResult:
     """The verdict rows of one node's declarations on one run."""
 
     node: str
-    declarations: list[dict[str, Any]] = field(default_factory=list)
+    declarations: list[DeclarationRow] = field(default_factory=list)
 
-    def rows(self) -> list[dict[str, Any]]:
+    def rows(self) -> list[DeclarationRow]:
         """``[{"declaration", "premise", "index", "source", "verdict", "status", "reason"}]``:
         ``premise`` the kind of premise the requirement check makes of it
         (``"initial value"``, ``"progress"``, ``""`` for a period in time)."""
-        return [dict(r) for r in self.declarations]
+        return [r.copy() for r in self.declarations]
 
 
 def has_declarations(node: CheckedNode) -> bool:
@@ -157,7 +159,7 @@ class DeclarationMonitor:
             names(c.formula, mentioned)
         #: the inputs the contract reads: an event carrying one of them is a step of the node
         self.read = frozenset(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
-        self.values: dict[str, Any] = {}
+        self.values: dict[str, object] = {}
         self.first: dict[str, tuple[Any, str]] = {}
         self.first_input = ""  # where the first input event was (an output message after it may be an answer)
         self.initials = [_Initial(k, c.formula, _src(c.loc), frozenset(
@@ -342,7 +344,7 @@ class DeclarationMonitor:
                         + (f"{c.bound} steps" if c.bound is not None else "the run") + before)
 
 
-def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> dict[str, Any]:
+def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> DeclarationRow:
     return {"declaration": label, "premise": premise, "index": index, "source": source, "text": text,
             "verdict": verdict, "status": STATUS[verdict], "reason": reason}
 
@@ -391,7 +393,7 @@ def declaration_status(res: DeclarationResult, trace: str) -> tuple[str, str]:
 
 
 def with_declarations(res: DeclarationResult, trace: str, status: str,
-                      explanation: str) -> tuple[str, str, dict[str, Any]]:
+                      explanation: str) -> tuple[str, str, DeclarationsPart]:
     """The monitor's verdict combined with the node's declarations on the
     same run: a false declaration fails the evidence (it is a claim of the
     node's contract), otherwise the verdict stands with a note.  Returns

@@ -56,7 +56,7 @@ _NO_RULE = TopicRule()  # the rule of a topic the mapping does not name
 _NEVER = float("inf")
 _NO_TRIGGERS: frozenset[str] = frozenset()
 _NONE = Outcome("none")
-_EMPTY: Mapping[str, Any] = {}
+_EMPTY: Mapping[str, object] = {}
 _SATISFIED = {sem: Outcome("satisfied", semantics=sem) for sem in ("exact", "double", "tolerance")}
 
 
@@ -89,7 +89,7 @@ class NodeMonitor(Judging, Closing, Late):
                                for key, typ, _ in vs] for topic, vs in self.topics.items()}
         self._topic_io = {topic: (frozenset(k for k, _, inp in vs if inp), [k for k, _, inp in vs if not inp])
                           for topic, vs in self.topics.items()}
-        self.values: dict[str, Any] = {}
+        self.values: dict[str, object] = {}
         #: variables whose latest message did not map (NaN, infinity, a missing field): key -> why
         self.invalid: dict[str, str] = {}
         for topic, vs in self.topics.items():
@@ -273,7 +273,7 @@ class NodeMonitor(Judging, Closing, Late):
         q = self._open
         return bool(self._held) or (q is not None and bool(q.waiting or not (q.answered or q.settled or q.reported)))
 
-    def _state(self) -> dict[str, Any]:
+    def _state(self) -> dict[str, object]:
         values = self.values
         return {k: values[k] for k in self._state_outs if values[k] is not None}
 
@@ -411,7 +411,7 @@ class NodeMonitor(Judging, Closing, Late):
             self._released.append((ev, stamped, {k: outs[k] for k in self._topic_io[ev.topic][1] if k in outs}, state))
 
     def _decide(self, ev: Event, q: Question | None, others: list[Question], alone: Outcome,
-                outs: Mapping[str, Any], first: Outcome | None = None, state: Mapping[str, Any] | None = None) -> None:
+                outs: Mapping[str, object], first: Outcome | None = None, state: Mapping[str, object] | None = None) -> None:
         """One output message's verdict: its output-only guarantees (``alone``)
         and the question(s) it may answer (``first``: the reading of ``q``,
         the question at its stamp; ``others``: those within the skew after

@@ -117,7 +117,7 @@ class Counted:
             yield block
 
 
-def count_call_line(obj: Mapping[str, Any], messages: dict[str, int], orphans: dict[str, int]) -> None:
+def count_call_line(obj: Mapping[str, object], messages: dict[str, int], orphans: dict[str, int]) -> None:
     """Count one call line of a live log (``kind`` ``"call"``, the DDS call
     book's) as the live run counts what it heard: a paired part (a line with
     an ``index``) into ``messages``, an answer heard without its call

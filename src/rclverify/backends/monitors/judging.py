@@ -11,7 +11,7 @@ it (docs/semantics.md).
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from typing import Any, Callable, Mapping
 
 from rclverify.semantics.floatsem import Judgement, holds_in, judge
 from rclverify.semantics.values import render
@@ -20,19 +20,17 @@ from rclverify.traces.questions import Question
 from rclverify.traces.typed_text import render_as
 from rclverify.backends.monitors.outcome import Outcome
 from rclverify.backends.monitors.verdicts import WEAK as _WEAK
+from rclverify.backends.monitors.engine_state import EngineState
 
 
 def _always(k: int) -> bool:
     return True
 
 
-class Judging:
+class Judging(EngineState):
     """The judging part of :class:`~.engine.NodeMonitor` (module docstring)."""
 
-    if TYPE_CHECKING:  # the engine's state and helpers the mixin reads, declared for the type checker only
-        def __getattr__(self, name: str) -> Any: ...
-
-    def _judge(self, k: Any, values: Mapping[str, Any]) -> Judgement:
+    def _judge(self, k: Any, values: Mapping[str, object]) -> Judgement:
         """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
         ``values``: the compiled code where it decides alone, else
         :func:`~rclverify.semantics.floatsem.judge`, remembered per (formula,
@@ -52,7 +50,7 @@ class Judging:
             self._cache[ck] = j
         return j
 
-    def _rendered(self, values: Mapping[str, Any]) -> dict[str, str]:
+    def _rendered(self, values: Mapping[str, object]) -> dict[str, str]:
         out = {}
         for k, v in sorted(values.items()):
             if v is None:
@@ -66,7 +64,7 @@ class Judging:
             out[k] = hit[1]
         return out
 
-    def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, Any]) -> None:
+    def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, object]) -> None:
         if self.result.first_inexact is None:
             self.result.first_inexact = {"event": ev.index, "time": ev.time, "where": ev.where,
                                          "semantics": judged.semantics, "formula": what,
@@ -83,7 +81,7 @@ class Judging:
         values = {k: v for k, v in self.values.items() if v is not None}
         return self._outcome(ks, values, lambda k: True, None, ev)
 
-    def _outcome(self, ks: list[int], values: Mapping[str, Any], owed: Callable[[int], bool],
+    def _outcome(self, ks: list[int], values: Mapping[str, object], owed: Callable[[int], bool],
                  q: Question | None, ev: Event, weakest: str = "exact") -> Outcome:
         """Guarantees ``ks`` (those ``owed``) judged on ``values``: the first
         false one, else undecided, else satisfied, else ``none``."""
@@ -138,8 +136,8 @@ class Judging:
             return Outcome("satisfied", semantics=weakest)
         return Outcome("none")
 
-    def _question_outcome(self, q: Question | None, ev: Event, ks: list[int], outs: Mapping[str, Any],
-                          state: Mapping[str, Any], keep: bool = True) -> Outcome:
+    def _question_outcome(self, q: Question | None, ev: Event, ks: list[int], outs: Mapping[str, object],
+                          state: Mapping[str, object], keep: bool = True) -> Outcome:
         """Output ``ev`` judged against question ``q``; ``keep``: it is the
         question ``ev`` answered (not another reading within the skew), whose
         decided and waiting guarantees it updates."""

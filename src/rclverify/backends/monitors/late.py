@@ -46,17 +46,15 @@ judged) for this; the rest runs only for a message heard late.
 from __future__ import annotations
 
 import bisect
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
+from rclverify.backends.monitors.engine_state import EngineState
 
 
-class Late:
+class Late(EngineState):
     """The late-input part of :class:`~.engine.NodeMonitor` (module docstring)."""
-
-    if TYPE_CHECKING:  # the engine's state and helpers the mixin reads, declared for the type checker only
-        def __getattr__(self, name: str) -> Any: ...
 
     def _late_input(self, ev: Event, trig: frozenset[str], stamp: float) -> None:
         """Input ``ev`` (it set the inputs ``trig``), stamped ``stamp`` (s), heard after a
@@ -100,12 +98,12 @@ class Late:
             self._place(e, t, got, kinds, [], completed[j + 1][:2] if j + 1 < len(completed) else None)
         self.invalid.update(unread)
 
-    def _inputs_at(self, stamp: float) -> dict[str, Any]:
+    def _inputs_at(self, stamp: float) -> dict[str, object]:
         """Before the first question: the inputs as the messages stamped at or before ``stamp`` set them."""
         got = {k: _at(h, stamp) for k, h in self._in_force.items()}
         return {k: v for k, v in got.items() if v is not None}
 
-    def _place(self, ev: Event, stamp: float, inputs: dict[str, Any], trig: frozenset[str],
+    def _place(self, ev: Event, stamp: float, inputs: dict[str, object], trig: frozenset[str],
                tainted: list[Question], upto: tuple[float, Event] | None = None) -> None:
         """The question ``ev`` raises at ``stamp`` with ``inputs`` (those in force at its
         stamp): the latest when none is stamped after it, else kept at its place; the
@@ -139,7 +137,7 @@ class Late:
                                  f"{gap:.9g} s after it, before any output answered it" +
                                  ("" if gap <= self.horizon else f" and after its horizon of {self.horizon} s"))
 
-    def _completed(self, stamp: float, first: float) -> list[tuple[float, Event, dict[str, Any], frozenset[str]]]:
+    def _completed(self, stamp: float, first: float) -> list[tuple[float, Event, dict[str, object], frozenset[str]]]:
         """A message stamped ``stamp``, before the first question (stamped ``first``),
         was heard late.  The messages stamped after it and before that question,
         counted ``incomplete input`` when heard, may have every input at their
@@ -152,14 +150,14 @@ class Late:
             for t, _, e in h:
                 if stamp < t < first:
                     later[id(e)] = (t, e)
-        out: list[tuple[float, Event, dict[str, Any], frozenset[str]]] = []
+        out: list[tuple[float, Event, dict[str, object], frozenset[str]]] = []
         for t, e in sorted(later.values(), key=lambda x: (x[0], x[1].index)):
             inputs = self._inputs_at(t)
             if all(k in inputs for k in self.needed_inputs):
                 out.append((t, e, inputs, frozenset(k for k, h in self._in_force.items() if any(x[2] is e for x in h))))
         return out
 
-    def _tainted(self, ev: Event, stamp: float, mine: dict[str, Any]) -> tuple[list[Question], bool]:
+    def _tainted(self, ev: Event, stamp: float, mine: dict[str, object]) -> tuple[list[Question], bool]:
         """The kept questions stamped after ``stamp`` that read an input ``ev`` changes
         (before the next message of ``ev``'s topic): they were raised without it (their
         inputs now take its values); and whether a question of ``ev``'s topic stamped
@@ -229,7 +227,7 @@ class Late:
             i -= 1
         return qs[i - 1] if i else None
 
-    def _retold(self, ev: Event, qa: Question, out_ev: Event, outs: dict[str, Any], state: Any) -> None:
+    def _retold(self, ev: Event, qa: Question, out_ev: Event, outs: dict[str, object], state: Any) -> None:
         """Output ``out_ev`` was judged against ``qa``, whose inputs lacked ``ev``'s
         values (now set): judged again on them where the assumption still holds
         of them, else ``inconclusive`` (the verdict given was on other inputs)."""
@@ -244,7 +242,7 @@ class Late:
         got = self._question_outcome(qa, out_ev, self._touch[out_ev.topic][0], outs, dict(state or {}), False)
         self._late_verdict(out_ev, qa.event, got, why)
 
-    def _answers_late(self, ev: Event, q: Question, out_ev: Event, outs: dict[str, Any], state: Any) -> None:
+    def _answers_late(self, ev: Event, q: Question, out_ev: Event, outs: dict[str, object], state: Any) -> None:
         """Output ``out_ev`` (judged before ``ev`` was heard) answers ``q``, ``ev``'s question:
         judged again against it; a false or undecided reading is a verdict of its own."""
         if not q.owed:

@@ -77,7 +77,7 @@ class OnlineEngine:
     late: int = field(init=False, default=0)
     max_late_s: float = field(init=False, default=0.0)
     released: int = field(init=False, default=0)
-    _heap: list[tuple[float, int, str, Mapping[str, Any], str]] = field(init=False, default_factory=list)
+    _heap: list[tuple[float, int, str, Mapping[str, object], str]] = field(init=False, default_factory=list)
     _seq: Any = field(init=False, default_factory=itertools.count)
     _clock: float = field(init=False, default=-math.inf)
 
@@ -87,7 +87,7 @@ class OnlineEngine:
         self.topics = {t: TopicStatus() for m in self.monitors for t in m.topics}
 
     # -- input -------------------------------------------------------------------
-    def push(self, topic: str, fields: Mapping[str, Any], received: float, where: str = "") -> None:
+    def push(self, topic: str, fields: Mapping[str, object], received: float, where: str = "") -> None:
         """One message as received: ``topic`` (with or without ``/``), its fields,
         the receipt time (s).  Ordered by its header stamp when it has one."""
         topic = topic.lstrip("/")

@@ -11,7 +11,7 @@ one reading finds the output false (no wrong green), never
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Sequence
 
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
@@ -32,7 +32,7 @@ class Outcome:
     kind: str
     guarantee: int = 0
     semantics: str = ""
-    values: dict[str, Any] = field(default_factory=dict)
+    values: dict[str, object] = field(default_factory=dict)
     reason: str = ""
 
 

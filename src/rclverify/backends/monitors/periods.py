@@ -28,13 +28,14 @@ in time is a guarantee's deadline (``triggered by in.x within 200 ms``,
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Iterable
 
 from rclverify.lang.liveness import period_seconds
 from rclverify.lang.types import CheckedNode
 from rclverify.traces.events import Event
 from rclverify.backends.monitors.deadlines import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
+from rclverify.backends.monitors.shapes import PeriodGapJson, PeriodResultJson, PeriodsPart
 
 
 #: The slack of a gap against its period (s): the resolution of an epoch stamp read as a float.
@@ -51,10 +52,10 @@ class PeriodResult:
     node: str
     periods: dict[str, float] = field(default_factory=dict)
     messages: dict[str, int] = field(default_factory=dict)
-    late: dict[str, dict[str, Any]] = field(default_factory=dict)
+    late: dict[str, PeriodGapJson] = field(default_factory=dict)
     end: float | None = None
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> PeriodResultJson:
         return {"node": self.node, "periods": dict(self.periods), "messages": dict(self.messages),
                 "late": dict(self.late), "end": self.end}
 
@@ -129,7 +130,7 @@ def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
                                    for k in res.periods)
 
 
-def with_periods(res: PeriodResult, trace: str, status: str, explanation: str) -> tuple[str, str, dict[str, Any]]:
+def with_periods(res: PeriodResult, trace: str, status: str, explanation: str) -> tuple[str, str, PeriodsPart]:
     """The monitor's verdict combined with the node's periods on the same run
     (``res``, :class:`PeriodMonitor`): a failed period fails the evidence,
     otherwise the verdict stands (a period that saw no message adds a note).

@@ -17,18 +17,20 @@ from __future__ import annotations
 
 from typing import Any, Iterable, Iterator, Mapping
 
+from rclverify.backends.monitors.shapes import OriginLine, RunSource, UnseenLine
+
 #: the log topic of a run's origin lines
 ORIGIN_TOPIC = "rclverify/run"
 
 
-def origin_line(time: float, source: str, rmw: str, middleware: str) -> dict[str, Any]:
+def origin_line(time: float, source: str, rmw: str, middleware: str) -> OriginLine:
     """The first line of a live log: ``time`` (s, the run's start), ``source``
     (``rclpy`` or ``dds``), ``rmw`` and ``middleware`` (module docstring)."""
     return {"topic": ORIGIN_TOPIC, "time": time, "kind": "run", "source": source, "rmw": rmw,
             "middleware": middleware}
 
 
-def unseen_line(time: float, unseen: list[str]) -> dict[str, Any]:
+def unseen_line(time: float, unseen: list[str]) -> UnseenLine:
     """The line a live run writes before it stops: ``unseen``, one sentence per link it could not hear."""
     return {"topic": ORIGIN_TOPIC, "time": time, "kind": "unseen", "unseen": list(unseen)}
 
@@ -38,7 +40,7 @@ class RunOrigin:
 
     def __init__(self) -> None:
         #: ``{"source", "rmw", "middleware", "unseen"}`` once an origin line was read, else ``None``
-        self.origin: dict[str, Any] | None = None
+        self.origin: RunSource | None = None
 
     def tap(self, events: Iterable[Any]) -> Iterator[Any]:
         """``events`` unchanged; each origin line is kept (its ``fields``) first."""
@@ -47,21 +49,30 @@ class RunOrigin:
                 self.take(ev.fields)
             yield ev
 
-    def take(self, fields: Mapping[str, Any]) -> None:
+    def take(self, fields: Mapping[str, object]) -> None:
         """One origin line's keys (module docstring); other kinds are ignored."""
         kind = fields.get("kind")
         if kind == "run":
             self.origin = {"source": str(fields.get("source", "")), "rmw": str(fields.get("rmw", "")),
                            "middleware": str(fields.get("middleware", "")), "unseen": []}
         elif kind == "unseen" and self.origin is not None:
-            self.origin["unseen"] = [str(u) for u in fields.get("unseen") or ()]
+            self.origin["unseen"] = [str(u) for u in _items(fields.get("unseen"))]
 
 
-def unseen_links(origin: Mapping[str, Any] | None) -> dict[str, str]:
+def _items(value: object) -> Iterable[object]:
+    """A JSON list's items (``()`` for ``None``, ``[]`` or another false value)."""
+    if not value:
+        return ()
+    if not isinstance(value, Iterable):
+        raise TypeError(f"'{type(value).__name__}' object is not iterable")
+    return value
+
+
+def unseen_links(origin: Mapping[str, object] | None) -> dict[str, str]:
     """Link name (``"/estop"``) -> what the source could not hear of it, from
     an origin's ``unseen`` sentences (``"/estop: no introspection event ..."``)."""
     out: dict[str, str] = {}
-    for line in (origin or {}).get("unseen") or ():
+    for line in _items((origin or {}).get("unseen")):
         name, _, why = str(line).partition(": ")
         out[name] = why
     return out

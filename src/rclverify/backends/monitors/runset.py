@@ -30,6 +30,7 @@ from rclverify.records.statistics import count_runs, decide
 from rclverify.model.plan.targets import entry_environment, entry_origin, entry_target
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.verdicts import NodeResult
+from rclverify.backends.monitors.shapes import RunCounts
 
 #: The suffixes of a bag file (a directory is a ROS 2 bag too).
 BAG_SUFFIXES = (".bag", ".mcap", ".db3")
@@ -120,7 +121,7 @@ def _bag_digest(path: Path) -> str:
 
 
 def run_counts(root: Path, config: Any, trace: str, sha: str, res: NodeResult, status: str,
-               seconds: float | None) -> dict[str, Any]:
+               seconds: float | None) -> RunCounts:
     """One run's counts (module docstring).  A run that failed or stayed
     inconclusive on its deadlines, periods or calls alone counts one
     violation or one undecided answer, so the run's verdict and its counts

@@ -80,13 +80,13 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
     c = res.counts
     blame = ""
     if c["assumption violated"]:
-        a = res.first_assumption_violation or {}
+        a: Mapping[str, object] = res.first_assumption_violation or {}
         blame = (f"; the assumption monitor's verdict is violated: {c['assumption violated']} question(s) "
                  f"violated the assumption (first at {a.get('where')}, blamed on the {a.get('blame')}), so the node "
                  f"is not at fault for them")
     blame += semantics_note(res)
     if c["violated"]:
-        v: Mapping[str, Any] = res.first_violation or {}
+        v: Mapping[str, object] = res.first_violation or {}
         which = f"guarantee {v['guarantee']} ({v.get('formula', '')})" if v.get("guarantee") else "the guarantees"
         return "failed", (f"{c['violated']} message(s) of {trace} violated {res.node}'s contract; the first "
                           f"violation is at {v.get('where')} (t = {v.get('time')} s): {which}: {v.get('reason')}"
@@ -97,7 +97,7 @@ def verdict_status(res: NodeResult, trace: str) -> tuple[str, str]:
                                 "question(s) came before any answer, and a node that never answers and a reader "
                                 f"that never matched look the same (docs/semantics.md, \"Steps\"){blame}")
     if c["inconclusive"]:
-        i = res.first_inconclusive or {}
+        i: Mapping[str, object] = res.first_inconclusive or {}
         return "inconclusive", (f"{c['inconclusive']} event(s) could not be decided; first at {i.get('where')}: "
                                 f"{i.get('reason')}{blame}")
     if c["open"]:

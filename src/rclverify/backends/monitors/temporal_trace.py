@@ -72,6 +72,7 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
 from rclverify.semantics.values import render
 from rclverify.lang.printer import expr_to_rcl
+from rclverify.backends.monitors.shapes import StepPlace, TraceVerdictJson, Witness
 
 VERDICTS = ("true", "false", "currently_false", "inconclusive")
 
@@ -92,15 +93,15 @@ class TraceVerdict:
     step: int | None = None
     time: float | None = None
     where: str = ""
-    witness: list[dict[str, Any]] = field(default_factory=list)
+    witness: list[Witness] = field(default_factory=list)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> TraceVerdictJson:
         return {"verdict": self.verdict, "steps": self.steps, "reason": self.reason, "step": self.step,
                 "time": self.time, "where": self.where, "witness": self.witness}
 
 
 
-def _truth(f: Formal, checked: Checked, values: Mapping[str, Any], tolerance: Any = None,
+def _truth(f: Formal, checked: Checked, values: Mapping[str, object], tolerance: Any = None,
            semantics: dict[int, str] | None = None) -> bool | None:
     """Operand ``f``'s truth on the step's values, judged as the node monitors
     judge (:func:`rclverify.semantics.floatsem.judge`: exact, then the nodes'
@@ -117,7 +118,7 @@ def _truth(f: Formal, checked: Checked, values: Mapping[str, Any], tolerance: An
     return j.truth
 
 
-def _published(f: Formal, values: Mapping[str, Any]) -> bool:
+def _published(f: Formal, values: Mapping[str, object]) -> bool:
     """Whether every input and output operand ``f`` mentions has been
     published on this trace (docs/semantics.md: a state formula over a value
     never published is not evaluated; a state variable without a value stays
@@ -128,7 +129,7 @@ def _published(f: Formal, values: Mapping[str, Any]) -> bool:
     return True
 
 
-def _shown(f: Formal, values: Mapping[str, Any]) -> dict[str, str]:
+def _shown(f: Formal, values: Mapping[str, object]) -> dict[str, str]:
     names = {f"{n}.{p}.{v}" for n, p, v in f.mentions}
     return {k.partition(".")[2]: render(v) for k, v in sorted(values.items()) if k.partition(".")[2] in names}
 
@@ -148,10 +149,10 @@ class _Run:
     tol: Any
     tracker: ResponseTracker | None = None
     sems: dict[int, str] = field(default_factory=dict)
-    undecided: dict[str, Any] | None = None
+    undecided: Witness | None = None
     i: int = -1
     last: Event | None = None
-    vals: Mapping[str, Any] = field(default_factory=dict)
+    vals: Mapping[str, object] = field(default_factory=dict)
 
     def decide(self, f: Formal, unpublished: bool | None) -> bool | None:
         """``f``'s truth at this step: undecided when a value it reads was unreadable in its last message,
@@ -160,11 +161,11 @@ class _Run:
             return None
         return _truth(f, self.checked, self.vals, self.tol, self.sems) if _published(f, self.vals) else unpublished
 
-    def wit(self, f: Formal, holds: bool | None) -> dict[str, Any]:
+    def wit(self, f: Formal, holds: bool | None) -> Witness:
         """The witness of operand ``f`` at this step."""
         ev = self.last
         assert ev is not None
-        out = {"step": self.i, "time": ev.time, "where": ev.where, "operand": f.expr and _text(f),
+        out: Witness = {"step": self.i, "time": ev.time, "where": ev.where, "operand": _text(f),
                "holds": holds, "values": _shown(f, self.vals)}
         bad = [self.st.unreadable[k] for n, p, v in f.mentions if (k := f"{p}.{n}.{p}.{v}") in self.st.unreadable]
         if bad:
@@ -173,7 +174,7 @@ class _Run:
             out["semantics"] = self.sems[id(f)]
         return out
 
-    def at(self, verdict: str, why: str, w: list[dict[str, Any]]) -> TraceVerdict:
+    def at(self, verdict: str, why: str, w: list[Witness]) -> TraceVerdict:
         """The verdict decided at this step."""
         ev = self.last
         assert ev is not None
@@ -305,7 +306,7 @@ def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
     """The verdict when the trace ended undecided (module table)."""
     ops, tracker, undecided, last = r.ops, r.tracker, r.undecided, r.last
     n = r.i + 1
-    end: dict[str, Any] = {"step": r.i if n else None, "time": last.time if last else None,
+    end: StepPlace = {"step": r.i if n else None, "time": last.time if last else None,
                            "where": last.where if last else ""}
     if n == 0:
         return TraceVerdict("inconclusive", 0, "the trace has no message on the topics of "

@@ -63,7 +63,7 @@ def _numbers(v: Any, out: set[Any]) -> None:
         _numbers(v.args, out)
 
 
-def _function_value(m: z3.ModelRef, decl: z3.FuncDeclRef, t: FuncT, values: Mapping[str, Any],
+def _function_value(m: z3.ModelRef, decl: z3.FuncDeclRef, t: FuncT, values: Mapping[str, object],
                     enc: Encoder) -> FiniteFunction | None:
     """A candidate finite table for function ``decl`` in model ``m``: its
     value at every point built from the numbers of ``values`` and at one
@@ -95,7 +95,7 @@ def _function_value(m: z3.ModelRef, decl: z3.FuncDeclRef, t: FuncT, values: Mapp
     return FiniteFunction(table, default, 1)
 
 
-def solve_value(sf: StateFormula, checked: Checked, target: str, values: Mapping[str, Any]) -> Any:
+def solve_value(sf: StateFormula, checked: Checked, target: str, values: Mapping[str, object]) -> Any:
     """The one value of ``target`` (``"state.v"`` for ``init``, ``"next.v"``
     for ``next``) that makes ``sf`` true with every other variable at its
     value in ``values`` (keyed ``"in.x"``, ``"out.y"``, ``"state.v"``).
@@ -166,7 +166,7 @@ class TraceStates:
         self.checked, self.rules = checked, rules
         self.nodes = list(nodes)
         self.topics: dict[str, list[tuple[str, str, Type]]] = {}  # topic -> [(node, "in.x", type)]
-        self.io: dict[str, dict[str, Any]] = {n: {} for n in self.nodes}
+        self.io: dict[str, dict[str, object]] = {n: {} for n in self.nodes}
         for n in self.nodes:
             cn = checked.nodes[n]
             for t in cn.node.topics:
@@ -188,7 +188,7 @@ class TraceStates:
         #: bool): no value, and what reads them is undecided, never judged on the value before
         self.unreadable: dict[str, str] = {}
 
-    def _node_values(self, n: str) -> dict[str, Any]:
+    def _node_values(self, n: str) -> dict[str, object]:
         out = {k: v for k, v in self.io[n].items() if v is not None}
         out.update({f"state.{v}": x for (m, v), x in self.state.items() if m == n and x is not None})
         return out
@@ -220,9 +220,9 @@ class TraceStates:
         self.steps += 1
         return True
 
-    def values(self) -> dict[str, Any]:
+    def values(self) -> dict[str, object]:
         """The state of the current step, keyed for a statement's scope."""
-        out: dict[str, Any] = {}
+        out: dict[str, object] = {}
         for n in self.nodes:
             for k, v in self.io[n].items():
                 if v is not None:

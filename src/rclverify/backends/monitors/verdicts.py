@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.walk import names, reads  # re-exported: the engine and its mixins import them from here
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.model.system.services import peers
+from rclverify.backends.monitors.shapes import (AssumptionVerdict, AssumptionViolation, Inconclusive, Inexact,
+                                                 NodeResultJson, VerdictJson, Violation)
 
 #: Verdicts of one node's events: per output message (``satisfied``,
 #: ``violated``, ``inconclusive``), per question (``assumption violated``,
@@ -65,12 +67,15 @@ class Verdict:
     semantics: str = ""
     question: str = ""
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> VerdictJson:
         """A JSON-ready dict (the live monitor's verdict message)."""
-        return {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
-                "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
-                "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason,
-                "semantics": self.semantics, **({"question": self.question} if self.question else {})}
+        out: VerdictJson = {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
+                            "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
+                            "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason,
+                            "semantics": self.semantics}
+        if self.question:
+            out["question"] = self.question
+        return out
 
 
 @dataclass
@@ -99,15 +104,15 @@ class NodeResult:
     node: str
     counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in VERDICTS})
     events: int = 0
-    first_violation: dict[str, Any] | None = None
-    first_assumption_violation: dict[str, Any] | None = None
-    first_inconclusive: dict[str, Any] | None = None
+    first_violation: Violation | None = None
+    first_assumption_violation: AssumptionViolation | None = None
+    first_inconclusive: Inconclusive | None = None
     accepted: int = 0
     semantics: dict[str, int] = field(default_factory=lambda: {"exact": 0, "double": 0, "tolerance": 0})
-    first_inexact: dict[str, Any] | None = None
+    first_inexact: Inexact | None = None
     unowed: int = 0
     unasked: int = 0
-    violations: list[dict[str, Any]] = field(default_factory=list)
+    violations: list[Violation] = field(default_factory=list)
     violations_dropped: int = 0
     #: a debug field, in no evidence record: how each formula was evaluated
     #: (``assumption 1`` / ``guarantee 2`` -> ``compiled``, or why the
@@ -115,7 +120,7 @@ class NodeResult:
     evaluation: dict[str, str] = field(default_factory=dict, compare=False)
 
     @property
-    def assumption(self) -> dict[str, Any]:
+    def assumption(self) -> AssumptionVerdict:
         """The assumption monitor's verdict on the run: ``violated`` when an
         input event violated it (the node is not at fault: the blame names the
         producer), ``held`` when every evaluated input event met it, ``not
@@ -125,7 +130,7 @@ class NodeResult:
         return {"verdict": verdict, "violations": n, "accepted": self.accepted,
                 "first": self.first_assumption_violation}
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> NodeResultJson:
         return {"node": self.node, "counts": dict(self.counts), "events": self.events,
                 "first_violation": self.first_violation,
                 "first_assumption_violation": self.first_assumption_violation,
@@ -134,7 +139,7 @@ class NodeResult:
                 "unasked": self.unasked, "violations": list(self.violations),
                 "violations_dropped": self.violations_dropped}
 
-    def add_violation(self, record: dict[str, Any]) -> None:
+    def add_violation(self, record: Violation) -> None:
         """Keep ``record`` (one ``violated`` verdict) in :attr:`violations`
         (bounded) and as :attr:`first_violation` when it is the first."""
         if self.first_violation is None:

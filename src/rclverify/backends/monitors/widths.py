@@ -239,8 +239,8 @@ def at_carried_widths(node: CheckedNode, widths: Mapping[str, str]) -> CheckedNo
 
     def clauses(cs: tuple[ast.Clause, ...]) -> tuple[ast.Clause, ...]:
         return tuple(dataclasses.replace(c, formula=at_widths(c.formula, widths)) for c in cs)
-    changes: dict[str, Any] = {"assumes": clauses(n.assumes), "guarantees": clauses(n.guarantees)}
-    return dataclasses.replace(node, node=dataclasses.replace(n, **changes))
+    return dataclasses.replace(node, node=dataclasses.replace(n, assumes=clauses(n.assumes),
+                                                              guarantees=clauses(n.guarantees)))
 
 
 def _bounded(c: Carried) -> bool:

@@ -39,6 +39,7 @@ from rclverify.backends.property_tests.declared import declaration_rows, has_dec
 from rclverify.backends.property_tests.seeding import SeedingCut, split_facts
 from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 import inspect
+from rclverify.backends.shapes import DeclarationRow, PropertyTestDetails
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
 NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
@@ -104,7 +105,7 @@ def _load(target: NodeTarget, cfg: Config) -> Any:
         raise target.config_error(str(exc), *exc.path) from None
 
 
-def _declarations(outcome: Outcome, cfg: Config, target: NodeTarget, k: int) -> tuple[str, str, list[dict[str, Any]]]:
+def _declarations(outcome: Outcome, cfg: Config, target: NodeTarget, k: int) -> tuple[str, str, list[DeclarationRow]]:
     """The declaration rows of guarantee ``k``'s run and the record's status
     and message with them: an initial value outside ``initially`` fails the
     record of guarantee 1 (:mod:`.declared`)."""
@@ -197,7 +198,7 @@ class PropertyTestsBackend:
     @staticmethod
     def _evidence(evidence: Callable[..., Evidence], outcome: Outcome, cfg: Config, target: NodeTarget, path: Path, k: int) -> Evidence:
         replay = f"python3 -m pytest {target.rel(path)}::test_guarantee_{k}"
-        details: dict[str, Any] = {
+        details: PropertyTestDetails = {
             "examples": outcome.counts.as_dict(), "seed": cfg.seed, "max_examples": cfg.max_examples,
             "implementation": cfg.implementation, "deadline_ms": cfg.deadline_ms, "replay": replay,
         }

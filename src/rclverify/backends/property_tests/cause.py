@@ -132,7 +132,7 @@ def _leaves(value: Any) -> list[Any]:
     return out
 
 
-def _computing_line(value: Any, assigned: Mapping[str, int], final: Mapping[str, Any]) -> int | None:
+def _computing_line(value: Any, assigned: Mapping[str, int], final: Mapping[str, object]) -> int | None:
     """The line that last assigned a local (``assigned``: name -> line,
     ``final``: the locals at the return) whose value is one the returned
     ``value`` carries (the same object; a bare constant is no evidence);
@@ -142,7 +142,7 @@ def _computing_line(value: Any, assigned: Mapping[str, int], final: Mapping[str,
     return max(lines) if lines else None
 
 
-def cause_line(impl: Any, example: Mapping[str, Any] | Sequence[Mapping[str, Any]], step: int | None,
+def cause_line(impl: Any, example: Mapping[str, object] | Sequence[Mapping[str, object]], step: int | None,
                shown_file: str) -> str | None:
     """``"<shown_file>:<line>"``: the implementation line the failing
     ``example`` takes last (module docstring), ``None`` when it cannot be
@@ -154,7 +154,7 @@ def cause_line(impl: Any, example: Mapping[str, Any] | Sequence[Mapping[str, Any
     if file is None:
         return None
     if inspect.isclass(impl):
-        runs = cast("Sequence[Mapping[str, Any]]", example)  # a class's example is its steps
+        runs = cast("Sequence[Mapping[str, object]]", example)  # a class's example is its steps
         steps = list(runs)[: step or len(list(runs))]
         if not steps:
             return None
@@ -166,10 +166,10 @@ def cause_line(impl: Any, example: Mapping[str, Any] | Sequence[Mapping[str, Any
                 return None
         line = last_line(lambda: machine.step(**_kwargs(steps[-1])), file)
     else:
-        inputs = cast("Mapping[str, Any]", example)  # a function's example is its inputs
+        inputs = cast("Mapping[str, object]", example)  # a function's example is its inputs
         line = last_line(lambda: impl(**_kwargs(inputs)), file)
     return f"{shown_file}:{line}" if line is not None else None
 
 
-def _kwargs(inputs: Mapping[str, Any]) -> dict[str, Any]:
+def _kwargs(inputs: Mapping[str, object]) -> dict[str, object]:
     return {k.removeprefix("in."): v for k, v in inputs.items()}

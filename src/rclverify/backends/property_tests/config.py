@@ -50,14 +50,14 @@ class Config:
     timeout_s: float = 600.0
 
 
-def _positive(raw: Mapping[str, Any], key: str, default: int) -> int:
+def _positive(raw: Mapping[str, object], key: str, default: int) -> int:
     v = raw.get(key, default)
     if isinstance(v, bool) or not isinstance(v, int) or v < 1:
         raise ConfigError(f"{key} must be a positive integer", key)
     return v
 
 
-def read_config(raw: Mapping[str, Any], node: CheckedNode, root: Path) -> Config:
+def read_config(raw: Mapping[str, object], node: CheckedNode, root: Path) -> Config:
     """Validate a plan entry.  Raises :class:`ConfigError` (with the key path)."""
     impl = raw.get("implementation")
     if not isinstance(impl, str) or ":" not in impl:

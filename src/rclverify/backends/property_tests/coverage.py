@@ -31,6 +31,7 @@ from typing import Any, Mapping
 
 from rclverify.lang.types import CheckedNode, EnumT, Scalar
 from rclverify.backends.property_tests.strategies import Bound
+from rclverify.backends.shapes import InputCoverage
 
 #: Buckets a bounded numeric range is cut into.
 BUCKETS = 10
@@ -86,7 +87,7 @@ class Coverage:
         self.low: dict[str, Fraction] = {}
         self.high: dict[str, Fraction] = {}
 
-    def add(self, inputs: Mapping[str, Any]) -> None:
+    def add(self, inputs: Mapping[str, object]) -> None:
         """Count one valid example's ``inputs`` (``in.x`` or ``x`` -> value)."""
         for key, v in inputs.items():
             name = key.removeprefix("in.")
@@ -115,11 +116,11 @@ class Coverage:
             return 0
         return min(n - 1, int((x - lo) * n / (hi - lo)))
 
-    def as_dict(self) -> dict[str, dict[str, Any]]:
+    def as_dict(self) -> dict[str, InputCoverage]:
         """Per input ``in.x``: ``range`` (text), ``drawn`` (least..greatest, or
         the values drawn), ``buckets``, ``covered``, ``fraction`` (module
         docstring; ``None`` where not measured)."""
-        out: dict[str, dict[str, Any]] = {}
+        out: dict[str, InputCoverage] = {}
         for name, (kind, spec) in self.kinds.items():
             key = f"in.{name}"
             if kind == "finite":

@@ -41,6 +41,7 @@ from rclverify.lang.liveness import STEP_WORDS
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.values import conforms, render
+from rclverify.backends.shapes import DeclarationRow
 
 #: the words of a counterexample's reason that say the implementation gave no answer (harness.check_step)
 NO_ANSWER = ("the implementation raised", "the implementation returned", "the implementation's outputs do not match")
@@ -51,7 +52,7 @@ def _src(loc: ast.Loc) -> str:
     return f"{loc.file}:{loc.line}:{loc.col}"
 
 
-def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> dict[str, Any]:
+def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> DeclarationRow:
     return {"declaration": label, "premise": premise, "index": index, "source": source, "text": text,
             "verdict": verdict, "status": STATUS[verdict], "reason": reason}
 
@@ -74,7 +75,7 @@ def progress_verdict(status: str, counterexample: Mapping[str, str] | None, vali
     return "inconclusive", f"the run ended {status}, not on a missing answer: not every input drawn was tried"
 
 
-def initial_outputs(impl: Any) -> tuple[Mapping[str, Any] | None, str]:
+def initial_outputs(impl: Any) -> tuple[Mapping[str, object] | None, str]:
     """The implementation's initial outputs (module docstring) and, when
     there are none or they cannot be read, why (``(None, why)``)."""
     try:
@@ -96,14 +97,14 @@ def initial_outputs(impl: Any) -> tuple[Mapping[str, Any] | None, str]:
 
 
 def initial_row(checked: Checked, node: CheckedNode, k: int, clause: ast.Clause,
-                initial: Mapping[str, Any] | None, why: str) -> dict[str, Any]:
+                initial: Mapping[str, object] | None, why: str) -> DeclarationRow:
     """The row of ``initially`` number ``k`` on the initial outputs ``initial``."""
     text = f"initially( {expr_to_rcl(clause.formula)} )"
     src = _src(clause.loc)
     if initial is None:
         failed = why.startswith(("reading", "the initial outputs are"))
         return _row(f"initially {k}", "initial value", k, src, text, "false" if failed else "pending", why)
-    values: dict[str, Any] = {}
+    values: dict[str, object] = {}
     for name, t in node.outputs.items():
         if name in initial:
             bad = conforms(initial[name], t)
@@ -124,7 +125,7 @@ def initial_row(checked: Checked, node: CheckedNode, k: int, clause: ast.Clause,
 
 
 def declaration_rows(checked: Checked, node: CheckedNode, impl: Any, status: str,
-                     counterexample: Mapping[str, str] | None, valid: int) -> list[dict[str, Any]]:
+                     counterexample: Mapping[str, str] | None, valid: int) -> list[DeclarationRow]:
     """The rows of ``node``'s declarations from one guarantee's run (its
     ``status``, ``counterexample`` and valid example count) and the
     implementation ``impl`` (``None``: it could not be loaded; the initial

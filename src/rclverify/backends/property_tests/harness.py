@@ -52,6 +52,7 @@ from rclverify.backends.monitors.widths import at_carried_widths
 from rclverify.backends.property_tests.at_width import carried_in, input_strategies
 from rclverify.semantics.widths import Carried, carried_fault, edges_at_width, narrow
 from rclverify.traces.typed_text import render_as
+from rclverify.backends.shapes import InputCoverage
 
 # The plan entry's reading lives in .config; its names stay importable from here (the backend, replay, the tests
 # and the benchmark import them with the run).
@@ -102,7 +103,7 @@ class Outcome:
     unknown_reasons: list[str] = field(default_factory=list)
     health: str = ""
     #: per input, how much of the assumption's range the valid examples covered (:mod:`.coverage`)
-    coverage: dict[str, dict[str, Any]] = field(default_factory=dict)
+    coverage: dict[str, InputCoverage] = field(default_factory=dict)
     #: ``file:line: why`` of each import whose code is not hashed (:class:`.closure.Closure`); then no run
     unhashed: list[str] = field(default_factory=list)
 
@@ -133,7 +134,7 @@ class GuaranteeRun:
     counts: Counts = field(default_factory=Counts)
     last_failure: dict[str, str] | None = None
     #: the values, outputs and conjunct of ``last_failure`` (for the Z3 confirmation)
-    last_values: tuple[dict[str, Any], dict[str, Any] | None, ast.Expr | None] | None = None
+    last_values: tuple[dict[str, object], dict[str, object] | None, ast.Expr | None] | None = None
     unknown: set[str] = field(default_factory=set)
     #: the first check that held only in double arithmetic: (conjunct text, rendered values)
     first_double: tuple[str, str] | None = None
@@ -153,7 +154,7 @@ class GuaranteeRun:
     def stateful(self) -> bool:
         return inspect.isclass(self.impl)
 
-    def assumption_holds(self, values: Mapping[str, Any]) -> bool:
+    def assumption_holds(self, values: Mapping[str, object]) -> bool:
         self.counts.drawn += 1
         for clause in self.node.node.assumes:
             ok, why = decide(clause.formula, self.checked, self.node, values)
@@ -205,7 +206,7 @@ class GuaranteeRun:
             return st.lists(one, min_size=1, max_size=self.cfg.steps)
         return one
 
-    def _fail(self, inputs: Mapping[str, Any], outputs: Mapping[str, Any] | None, reason: str,
+    def _fail(self, inputs: Mapping[str, object], outputs: Mapping[str, object] | None, reason: str,
               conjunct: ast.Expr | None, step: int | None) -> None:
         self.counts.failures += 1
         g = self.node.node.guarantees[self.guarantee - 1]
@@ -226,7 +227,7 @@ class GuaranteeRun:
         if self.stop_at_failure:
             raise _Violation(reason)
 
-    def check_step(self, impl: Callable[..., Any], inputs: Mapping[str, Any], step: int | None) -> None:
+    def check_step(self, impl: Callable[..., Any], inputs: Mapping[str, object], step: int | None) -> None:
         """Call the implementation on one input and check its outputs (raises on a violation)."""
         self.counts.steps += 1
         if self.coverage is not None:

@@ -150,7 +150,7 @@ def min_entries(formulas: tuple[ast.Expr, ...]) -> int:
 #: Z3 state: it is kept across rclverify.semantics.world.fresh() (a clean run and
 #: an incremental one draw from the same model; the Agent's three guarantees
 #: share one instead of solving it three times).
-_BASE: dict[tuple[Any, ...], dict[str, Any] | None] = {}
+_BASE: dict[tuple[Any, ...], dict[str, object] | None] = {}
 
 
 class SeedingCut(Exception):
@@ -170,7 +170,7 @@ class Seeder:
     node: CheckedNode
     formulas: tuple[ast.Expr, ...]
 
-    def _solve(self, n: int) -> dict[str, Any] | None:
+    def _solve(self, n: int) -> dict[str, object] | None:
         """Tables of ``n`` entries at fixed distinct keys, results and defaults from Z3."""
         enc = Encoder(self.checked.env)
         phi = conj(*[enc.formula(f, self.node) for f in self.formulas])
@@ -225,7 +225,7 @@ class Seeder:
             if v is None:  # not in the model: any value will do; take the sort's first
                 v = m.eval(z3.FreshConst(x.sort().translate(ctx)), model_completion=True)
             return _from_z3(v, t)
-        out: dict[str, Any] = {}
+        out: dict[str, object] = {}
         for q, (t, keys, vals, d) in readback.items():
             if keys is None:
                 out[q] = value(vals, t)
@@ -234,7 +234,7 @@ class Seeder:
                 out[q] = FiniteFunction(table, value(d, t.result), len(t.args))
         return out
 
-    def base(self) -> dict[str, Any] | None:
+    def base(self) -> dict[str, object] | None:
         """A model of the formulas with the fewest table entries in :data:`EXTRA_SIZES`
         (cached per node and formulas; ``None``: none found)."""
         key = (self.node.name, tuple((k, str(t)) for k, t in self.node.inputs.items()),

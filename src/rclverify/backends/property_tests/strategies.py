@@ -169,7 +169,7 @@ class InputSpace:
     constants: list[Fraction]
     pools: dict[tuple[Type, ...], list[tuple[Any, ...]]] = field(default_factory=dict)
     cache: dict[tuple[Type, int, bool], st.SearchStrategy[Any]] = field(default_factory=dict)
-    seed: Mapping[str, Any] | None = None  # a Z3 model of the assumption and facts (.seeding)
+    seed: Mapping[str, object] | None = None  # a Z3 model of the assumption and facts (.seeding)
     point_cache: dict[tuple[Any, ...], st.SearchStrategy[tuple[Any, ...]]] = field(default_factory=dict)
     misc_cache: dict[tuple[Any, ...], Any] = field(default_factory=dict)
     #: input name -> its strategy as its field carries it (:mod:`.at_width`), used instead of its type's
@@ -303,7 +303,7 @@ class InputSpace:
             self.point_cache[args] = st.tuples(*[self.value(a) for a in args])
         return self.point_cache[args]
 
-    def inputs(self) -> st.SearchStrategy[dict[str, Any]]:
+    def inputs(self) -> st.SearchStrategy[dict[str, object]]:
         """One example: qualified input name -> value.
 
         A function-typed input with a seeded table (a Z3 model of the
@@ -315,9 +315,9 @@ class InputSpace:
                   if isinstance(base, FiniteFunction) and self._args_of(q) is not None}
 
         @st.composite
-        def draw_inputs(draw: Callable[..., Any]) -> dict[str, Any]:
+        def draw_inputs(draw: Callable[..., Any]) -> dict[str, object]:
             self.pools = {}
-            drawn: dict[str, Any] = {}
+            drawn: dict[str, object] = {}
             for n, t in self.node.inputs.items():
                 q = f"in.{n}"
                 if q in seeded:
@@ -406,7 +406,7 @@ class InputSpace:
 
 
 def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | None, Fraction | None]],
-                seed: Mapping[str, Any] | None = None, constants: Iterable[Fraction] = (),
+                seed: Mapping[str, object] | None = None, constants: Iterable[Fraction] = (),
                 named: Mapping[str, Fraction] | None = None) -> InputSpace:
     """The :class:`InputSpace` of ``node``; ``plan_bounds`` maps input names
     (without ``in.``) to the plan's ``[lo, hi]`` (closed); ``seed`` maps

@@ -37,6 +37,7 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import CheckedNode
 from rclverify.model.plan.yamlguard import safe_load_guarded
+from rclverify.backends.shapes import ReviewDetails
 
 
 class RecordError(ValueError):
@@ -182,7 +183,7 @@ def sha256_of(path: Path) -> str | None:
 
 
 def judge(record: ReviewRecord, questions: list[Question], root: Path,
-          assumption: str | None = None) -> tuple[str, str, dict[str, Any]]:
+          assumption: str | None = None) -> tuple[str, str, ReviewDetails]:
     """(status, explanation, details) of ``record`` for the ``questions`` of one guarantee;
     ``assumption``: the node's assumption text now (:func:`assumption_text`).
 
@@ -195,7 +196,7 @@ def judge(record: ReviewRecord, questions: list[Question], root: Path,
     * an unanswered question, no verdict, or no reviewed file -> ``pending``;
     * otherwise ``discharged``.
     """
-    details: dict[str, Any] = {"reviewer": record.reviewer, "date": record.date, "scope": record.scope,
+    details: ReviewDetails = {"reviewer": record.reviewer, "date": record.date, "scope": record.scope,
                                "files": [{"path": p, "sha256": h} for p, h in record.files], "verdict": record.verdict,
                                "checklist": [{"id": q.id, "question": q.question, "location": q.location,
                                               "answer": record.answers.get(q.id), "note": record.notes.get(q.id, "")}

@@ -9,7 +9,8 @@ so neither imports the other's module to get it (docs/decisions.md,
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+
+from rclverify.records.stage_records import HealthFinding
 
 
 @dataclass(frozen=True)
@@ -46,10 +47,10 @@ class Finding:
     witness: dict[str, str] | None = None
     witness_smt2: str = field(default="", compare=False)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> HealthFinding:
         """The finding as a JSON object (every field but the two scripts;
         ``witness`` only when there is one)."""
-        out = {"id": self.id, "node": self.node, "check": self.check, "guarantee": self.guarantee,
+        out: HealthFinding = {"id": self.id, "node": self.node, "check": self.check, "guarantee": self.guarantee,
                "status": self.status, "message": self.message, "explanation": self.explanation,
                "model": self.model, "core": self.core, "duration_s": self.duration_s,
                "instances": self.instances}

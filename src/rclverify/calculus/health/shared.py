@@ -46,7 +46,7 @@ class SharedEncoder(Encoder):
             self._touched.append(self.symbol_name(node.name, prefix, var))
         return super().io_symbol(node, prefix, var)
 
-    def formula(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None,
+    def formula(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, z3.AstRef] | None = None,
                 bound: Mapping[str, z3.ExprRef] | None = None) -> z3.BoolRef:
         """:meth:`Encoder.formula`, from the table when ``e`` was encoded
         before for ``node`` (its symbols registered here as encoding it would)."""

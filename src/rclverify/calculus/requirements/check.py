@@ -56,6 +56,7 @@ import z3
 
 from rclverify.calculus.requirements.exercised import antecedent as _premise  # the condition a requirement demands under
 from rclverify.calculus.compose import split_assumption
+from rclverify.calculus.shapes import RequirementBase, TraceNode
 from rclverify.semantics.encode import Encoder
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, satisfiable, solver_session
@@ -163,7 +164,7 @@ def _io_symbols(e: ast.Expr, cn: CheckedNode, enc: Encoder) -> set[str]:
     return out
 
 
-def _base(req: Requirement) -> dict[str, Any]:
+def _base(req: Requirement) -> RequirementBase:
     """The keys of a requirement's record that come from the plan alone."""
     return {
         "id": req.id, "text": req.text, "origin": req.origin,
@@ -236,9 +237,9 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
     return out
 
 
-def _ask(base: dict[str, Any], nodes: Sequence[str], formal: Formal, assuming: Sequence[Formal], checked: Checked,
+def _ask(base: RequirementBase, nodes: Sequence[str], formal: Formal, assuming: Sequence[Formal], checked: Checked,
          model: SystemModel, plan: Plan, timeout_ms: int,
-         note: str = "") -> tuple["_Query", dict[str, Any], z3.BoolRef, QueryResult]:
+         note: str = "") -> tuple["_Query", dict[str, z3.AstRef], z3.BoolRef, QueryResult]:
     """The labelled query ``premises of nodes and assuming and not formal``
     (``base``: the record's plan keys; ``note`` a line added to the script's
     comment).  Returns the query, the statements' symbols, the statement's
@@ -373,12 +374,12 @@ def _model_query(labelled: list[tuple[str, z3.BoolRef]], enc: Encoder, model_ms:
     return replace(r, duration_s=round(time.perf_counter() - t0, 4))
 
 
-def _counterexample(model: dict[str, str], cone: Sequence[str], checked: Checked, enc: Encoder) -> list[dict[str, Any]]:
+def _counterexample(model: dict[str, str], cone: Sequence[str], checked: Checked, enc: Encoder) -> list[TraceNode]:
     """The model's values of every I/O variable of the cone, node by node in
     the cone's order: ``[{"node": N, "values": {"in.x": value, "out.y": value}}]``
     (a consumer's input shows the value of the producer's output it reads)."""
     shown = {s.z3name: s.display for s in enc.symbols.values()}
-    out: list[dict[str, Any]] = []
+    out: list[TraceNode] = []
     for n in cone:
         cn = checked.nodes[n]
         row: dict[str, str] = {}

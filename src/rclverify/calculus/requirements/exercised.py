@@ -56,6 +56,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.model.plan.formal import Formal
 from rclverify.model.plan.temporal import Temporal, shape
 from rclverify.semantics.connectives import conj
+from rclverify.calculus.shapes import Vacuity
 
 NON_VACUOUS, VACUOUS, UNDECIDED = "non-vacuous", "vacuous", "undecided"
 
@@ -126,7 +127,7 @@ def silent_words(nodes: Sequence[str], value: str) -> str:
 
 
 def vacuity(t: Temporal, ts: TransitionSystem, pub: Publication, raw: Callable[[Formal], Pred], *, max_k: int,
-            timeout_ms: int, hint: Hint | None = None) -> dict[str, Any]:
+            timeout_ms: int, hint: Hint | None = None) -> Vacuity:
     """The vacuity fields of a proved statement ``t`` over ``ts`` (module
     docstring): ``{}`` for a shape that reaches its goal, else ``vacuity``
     (``non-vacuous``/``vacuous``/``undecided``) with, when not

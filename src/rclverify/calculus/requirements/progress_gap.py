@@ -40,13 +40,14 @@ from rclverify.lang.liveness import progress_words
 from rclverify.lang.types import Checked
 from rclverify.calculus.requirements.transition import ComposedSystem
 from rclverify.calculus.requirements.tsys import TemporalVerdict, TransitionSystem
+from rclverify.calculus.shapes import Gaps, IdleNode, MissingProgress, StuckProducer
 
 _TRUE = ("True", "TRUE", "true")
 #: What a lasso found with every node answering what it accepts adds to its detail.
 EVEN_SO = "every node that accepts its input in the loop answers there: the goal is missed even with progress"
 
 
-def idle_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: ComposedSystem) -> list[dict[str, Any]]:
+def idle_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: ComposedSystem) -> list[IdleNode]:
     """The nodes of ``sys`` that accept their input at some step of the
     lasso's loop (steps ``loop`` .. ``len(trace) - 2``; the last state is
     the loop state again) and answer at none: ``[{"node", "accepted_at":
@@ -54,7 +55,7 @@ def idle_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Comp
     ``{variable: text}`` per step)."""
     if loop is None or not trace:
         return []
-    out = []
+    out: list[IdleNode] = []
     ring = range(loop, len(trace) - 1) or range(loop, loop + 1)
     for n in sys.cone:
         if f"{n}.answers" not in sys.variables:
@@ -67,7 +68,7 @@ def idle_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Comp
 
 
 def stuck_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: ComposedSystem,
-                  checked: Checked) -> list[dict[str, Any]]:
+                  checked: Checked) -> list[StuckProducer]:
     """The producers that keep a lasso stuck (module docstring): a node
     whose assumption fails at every step of the loop reads an input whose
     producer answers at no step of the whole run and declares no
@@ -82,7 +83,7 @@ def stuck_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Com
                 and all(str(trace[i].get(f)) in _TRUE for f in sys.pub.fed.get(n, ())))
     stuck = {n for n in sys.cone if (f"{n}.accepts" in sys.variables or sys.pub.fed.get(n))
              and not any(enabled(n, i) for i in ring)}
-    out: list[dict[str, Any]] = []
+    out: list[StuckProducer] = []
     seen: set[str] = set()
     for consumer, producer in sys.links:
         c_node, p_node = consumer.split(".", 1)[0], producer.split(".", 1)[0]
@@ -102,7 +103,7 @@ def stuck_in_loop(trace: Sequence[Mapping[str, str]], loop: int | None, sys: Com
     return sorted(out, key=lambda r: order.get(r["node"], 0))
 
 
-def stuck_words(stuck: Sequence[Mapping[str, Any]]) -> str:
+def stuck_words(stuck: Sequence[StuckProducer]) -> str:
     """The stuck lasso in one sentence, naming each producer's initial value to declare."""
     parts = [(f"{r['consumer']} never has a value: {r['node']} never publishes {r['node']}.{r['output']}"
               if r["value"].startswith("none") else
@@ -114,11 +115,11 @@ def stuck_words(stuck: Sequence[Mapping[str, Any]]) -> str:
               "(initially( out.y == ... ), a value its readers accept) if the node has one before its first answer")
 
 
-def missing_progress(idle: Sequence[Mapping[str, Any]], checked: Checked) -> list[dict[str, Any]]:
+def missing_progress(idle: Sequence[IdleNode], checked: Checked) -> list[MissingProgress]:
     """The record's ``missing_progress`` for the ``idle`` nodes: ``[{"node",
     "source" (the node's header, file:line:col), "declared" (what it
     declares, ``none``), "accepted_at", "fix"}]``."""
-    out = []
+    out: list[MissingProgress] = []
     for r in idle:
         node = checked.nodes[r["node"]].node
         declared = progress_words(node)
@@ -129,7 +130,7 @@ def missing_progress(idle: Sequence[Mapping[str, Any]], checked: Checked) -> lis
     return out
 
 
-def words(gaps: Sequence[Mapping[str, Any]]) -> str:
+def words(gaps: Sequence[MissingProgress]) -> str:
     """The missing progress in one sentence: ``"Base never answers in the
     loop although its assumption holds there (steps 1, 2): declare progress(
     ... ) on Base if it does"``."""
@@ -145,7 +146,7 @@ def words(gaps: Sequence[Mapping[str, Any]]) -> str:
 
 def explain_idle(v: TemporalVerdict, sys: ComposedSystem, ts: TransitionSystem, checked: Checked,
                  search: Callable[[TransitionSystem], TemporalVerdict | None], *, tried_sync: bool = False
-                 ) -> tuple[TemporalVerdict, dict[str, list[dict[str, Any]]]]:
+                 ) -> tuple[TemporalVerdict, Gaps]:
     """The verdict to report for lasso ``v`` found over ``ts`` (module
     docstring) and what it says is missing: ``{"missing_progress": [...],
     "missing_initially": [...]}`` (empty lists when nothing is).
@@ -153,7 +154,7 @@ def explain_idle(v: TemporalVerdict, sys: ComposedSystem, ts: TransitionSystem, 
     (``None``: none found or undecided); ``tried_sync``: the synchronous
     system was searched already (and had none).  Any other verdict is
     returned unchanged."""
-    none: dict[str, list[dict[str, Any]]] = {"missing_progress": [], "missing_initially": []}
+    none: Gaps = {"missing_progress": [], "missing_initially": []}
     if v.status != "refuted" or v.method != "lasso":
         return v, none
     idle = idle_in_loop(v.trace, v.loop, sys)

@@ -51,6 +51,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.records.records import worst
 from rclverify.records.statuses import REQUIREMENT_VERDICTS
+from rclverify.calculus.shapes import DeclarationEvidence
 
 MET = "met"
 OUTSTANDING = "proved, evidence outstanding"
@@ -158,13 +159,13 @@ def _premise_statuses(record: Mapping[str, Any], g_status: Callable[[str, int], 
     return statuses
 
 
-def declaration_evidence(record: Mapping[str, Any] | None, d_status: DeclStatus | None) -> list[dict[str, Any]]:
+def declaration_evidence(record: Mapping[str, Any] | None, d_status: DeclStatus | None) -> list[DeclarationEvidence]:
     """The declarations a requirement's proof used, each with its evidence:
     ``[{"label", "node", "kind", "index", "text", "source", "status",
     "words"}]`` (``d_status`` as for :func:`roll_up`; ``[]`` without a
     record).  The report carries them in the requirement's ``check`` and
     the argument makes a goal of each (report/argument/build.py)."""
-    out = []
+    out: list[DeclarationEvidence] = []
     for p in (record or {}).get("used") or []:
         if p.get("kind") in ("progress", "initial value"):
             st, words = d_status(p["node"], p["kind"], int(p.get("index", 0))) if d_status is not None else (

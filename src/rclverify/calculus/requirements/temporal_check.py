@@ -74,6 +74,7 @@ from rclverify.calculus.requirements.transition import ComposedSystem, build_sys
 from rclverify.semantics.encode import Encoder
 from rclverify.lang.types import FuncT
 from rclverify.semantics import wallclock
+from rclverify.calculus.shapes import Gaps, RequirementBase, TraceStep, Vacuity
 
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
 DEFAULT_BOUND = 10
@@ -103,7 +104,7 @@ Tables = Callable[[Formal, TemporalVerdict, TransitionSystem], TemporalVerdict]
 def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], *,
            bound: int = DEFAULT_BOUND, timeout_ms: int = 10_000, tables: Tables | None = None,
            ranking: Callable[[Any], Any] | None = None, invariant: Callable[[Any], Any] | None = None,
-           checked: Checked | None = None, gaps: dict[str, Any] | None = None,
+           checked: Checked | None = None, gaps: Gaps | None = None,
            tables_first: bool = False, reach: Callable[[Formal], Callable[[Any], Any]] | None = None,
            hint_text: str = "") -> TemporalVerdict:
     """Decide statement ``t`` over ``sys`` (module table); ``pred(F)`` is
@@ -134,7 +135,7 @@ def decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[
 def _decide(t: Temporal, sys: ComposedSystem, pred: Callable[[Formal], Callable[[Any], Any]], bound: int,
             timeout_ms: int, tables: Tables | None,
             ranking: Callable[[Any], Any] | None, invariant: Callable[[Any], Any] | None,
-            checked: Checked | None, gaps: dict[str, Any], tables_first: bool = False,
+            checked: Checked | None, gaps: Gaps, tables_first: bool = False,
             reach: Callable[[Formal], Callable[[Any], Any]] | None = None, hint: Hint | None = None) -> TemporalVerdict:
     kind = shape(t, None)
     got = reach or pred
@@ -220,9 +221,9 @@ def _exact(v: TemporalVerdict, hint: Hint | None) -> TemporalVerdict:
     return v
 
 
-def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[dict[str, Any]]:
+def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[TraceStep]:
     """A trace as steps x nodes: ``[{"step": i, "nodes": [{"node", "values"}]}]``."""
-    out = []
+    out: list[TraceStep] = []
     for i, st in enumerate(trace):
         rows: dict[str, dict[str, str]] = {}
         for name, value in st.items():
@@ -233,7 +234,7 @@ def _steps(trace: list[dict[str, str]], sys: ComposedSystem) -> list[dict[str, A
     return out
 
 
-def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan: Plan, base: dict[str, Any],
+def check_temporal(req: Requirement, checked: Checked, model: SystemModel, plan: Plan, base: RequirementBase,
                    *, bound: int = DEFAULT_BOUND, timeout_ms: int = TIMEOUT_MS) -> dict[str, Any]:
     """The record of temporal requirement ``req`` (module docstring);
     ``base`` the fields :func:`.check.check_requirement` fills for every
@@ -307,18 +308,18 @@ class _Question:
     decide it shares (:meth:`solve` builds one, with some nodes' ``initially``
     left out to ask whether the proof needs them)."""
 
-    def __init__(self, req: Requirement, checked: Checked, model: SystemModel, plan: Plan, base: dict[str, Any],
+    def __init__(self, req: Requirement, checked: Checked, model: SystemModel, plan: Plan, base: RequirementBase,
                  t: Any, assuming: list[Formal], rank: Any, inv: Formal | None, cone: list[str],
                  bound: int, timeout_ms: int) -> None:
         self.req, self.checked, self.model, self.plan, self.base = req, checked, model, plan, base
         self.t, self.assuming, self.rank, self.inv, self.cone = t, assuming, rank, inv, cone
         self.bound, self.timeout_ms = bound, timeout_ms
 
-    def solve(self, without: Collection[str] = ()) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
+    def solve(self, without: Collection[str] = ()) -> tuple[ComposedSystem, TemporalVerdict, Gaps]:
         """The system of the cone (the nodes of ``without`` built with no ``initially``) and its verdict."""
         return _System(self, without).decide()
 
-    def exercised(self, sys: ComposedSystem) -> dict[str, Any]:
+    def exercised(self, sys: ComposedSystem) -> Vacuity:
         """The vacuity fields of the statement proved over ``sys`` (:func:`.exercised.vacuity`)."""
         enc = Encoder(self.checked.env)
 
@@ -397,11 +398,11 @@ class _System:
                                       f"(found with every function a {points}-point table, confirmed on the "
                                       f"trace's values)")
 
-    def decide(self) -> tuple[ComposedSystem, TemporalVerdict, dict[str, Any]]:
+    def decide(self) -> tuple[ComposedSystem, TemporalVerdict, Gaps]:
         q, sys, enc, rank = self.q, self.sys, self.enc, self.q.rank
         ranking = (lambda s: enc.term(rank.expr, rank.scope, sys.statement_symbols(s))) if rank is not None else None
         inv_pred = self.raw(q.inv) if q.inv is not None else None
-        missing: dict[str, Any] = {}
+        missing: Gaps = {}
         v = decide(q.t, sys, self.pred, bound=q.bound, timeout_ms=q.timeout_ms, tables=self.tables, ranking=ranking,
                    invariant=inv_pred, checked=q.checked, gaps=missing,
                    tables_first=any(isinstance(ty, FuncT) for ty in self.types.values()), reach=self.reach,

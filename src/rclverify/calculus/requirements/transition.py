@@ -59,7 +59,7 @@ from rclverify.model.system.model import SystemModel
 from rclverify.calculus.compose import free_io
 from rclverify.calculus.requirements.published import Publication, publication
 from rclverify.calculus.requirements.temporal import State, TransitionSystem
-from rclverify.calculus.requirements.tsys import Fairness
+from rclverify.calculus.requirements.tsys import Fairness, Pred
 from rclverify.semantics import wallclock
 
 
@@ -117,7 +117,7 @@ class ComposedSystem:
     links: list[tuple[str, str]] = field(default_factory=list)
     bounds: dict[str, int | None] = field(default_factory=dict)
     #: per node that declares ``initially``: its outputs' types and initial values over one state
-    initial: dict[str, Any] = field(default_factory=dict)
+    initial: dict[str, Pred] = field(default_factory=dict)
     #: which values are published at each step (:mod:`.published`; docs/semantics.md)
     pub: Publication = field(default_factory=Publication)
 
@@ -162,7 +162,7 @@ class ComposedSystem:
         return TransitionSystem(ts.sorts, lambda s: conj(ts.init(s), eager(s)),
                                 lambda s, t: conj(ts.trans(s, t), eager(s), eager(t)), ts.fairness)
 
-    def statement_symbols(self, s: State) -> dict[str, Any]:
+    def statement_symbols(self, s: State) -> dict[str, z3.ExprRef]:
         """The encoder's symbols of a requirement statement at state ``s``
         (:mod:`rclverify.model.plan.formal` names ``Node.in.x`` an input of its
         pseudo node, so the key is ``"in.Node.in.x"``)."""
@@ -318,7 +318,7 @@ class _Builder:
                              " ".join(src.text.split()), f"{src.file}:{src.loc.line}:{src.loc.col}")
 
     # -- the encodings ----------------------------------------------------------------------
-    def node_symbols(self, n: str, s: State) -> dict[str, Any]:
+    def node_symbols(self, n: str, s: State) -> dict[str, z3.ExprRef]:
         cn = self.checked.nodes[n]
         return {**{f"in.{v}": s[f"{n}.in.{v}"] for v in cn.inputs if f"{n}.in.{v}" in s},
                 **{f"out.{v}": s[f"{n}.out.{v}"] for v in cn.outputs if f"{n}.out.{v}" in s}}
@@ -375,7 +375,7 @@ class _Builder:
                 parts.append(z3.If(disj(answers, z3.Not(self.enabled(n, s))), w == 0, conj(w >= 1, w <= k)))
         return conj(*parts)
 
-    def state_syms(self, sv: Any, s: State, t: State | None) -> dict[str, Any]:
+    def state_syms(self, sv: Any, s: State, t: State | None) -> dict[str, z3.ExprRef]:
         out = self.node_symbols(sv.node, s) if t is not None else {}
         for o in self.states:
             if o.node == sv.node:
@@ -414,7 +414,7 @@ class _Builder:
                   for sv in self.states]
         return conj(*parts)
 
-    def initial_of(self, n: str) -> Any:
+    def initial_of(self, n: str) -> Pred:
         outs = [f"{n}.out.{v}" for v in self.checked.nodes[n].outputs if f"{n}.out.{v}" in self.sorts]
         types, holds, initially = self.types, self.holds, self.initially
         return lambda s: conj(*[c for c in (_typing(s[o], types[o]) for o in outs) if c is not None],

@@ -19,6 +19,7 @@ from typing import Any, Callable
 import z3
 
 from rclverify.semantics.connectives import conj, disj
+from rclverify.calculus.shapes import TemporalVerdictJson
 
 State = dict[str, z3.ExprRef]
 Pred = Callable[[State], z3.BoolRef]
@@ -87,7 +88,7 @@ class TemporalVerdict:
     deadlock: str = ""
     certificate: str = ""
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> TemporalVerdictJson:
         """The record fields (a JSON-ready dict)."""
         return {"status": self.status, "method": self.method, "k": self.k, "bound": self.bound,
                 "trace": self.trace, "detail": self.detail, "loop": self.loop, "deadlock": self.deadlock, "certificate": self.certificate}

@@ -36,9 +36,10 @@ from __future__ import annotations
 import hashlib
 
 import re
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping, TypeVar
 
-from rclverify.records.report_schema import Report
+from rclverify.records.report_schema import (EnvironmentAssumptionRow, FindingRow, NodeRow, ObligationRow, Report,
+                                             RequirementRow, SideConditionRow)
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
@@ -47,6 +48,9 @@ from rclverify.report.argument.defeaters import add_defeaters
 from rclverify.report.argument.standards import add_standard_links
 from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
+
+#: A report row that names its node.
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingRow, EnvironmentAssumptionRow)
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -84,7 +88,7 @@ _PROOF_STATUS = {"met": "discharged", "proved, evidence outstanding": "discharge
 
 
 def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mapping[tuple[str, int], str],
-                      sides: Mapping[str, list[Mapping[str, Any]]], j_calc: str) -> str:
+                      sides: Mapping[str, list[SideConditionRow]], j_calc: str) -> str:
     """The goal of a requirement the report's requirement check decided
     (its ``verdict``): an informal one is an undeveloped goal; a formal one is
     supported by a formal-entailment strategy whose children are the Z3
@@ -183,8 +187,8 @@ def build_argument(report: Report) -> Argument:
     return propagate(Argument(top, b.els))
 
 
-def _by_node(rows: Any) -> dict[str, list[Mapping[str, Any]]]:
-    out: dict[str, list[Mapping[str, Any]]] = {}
+def _by_node(rows: Iterable[_Row]) -> dict[str, list[_Row]]:
+    out: dict[str, list[_Row]] = {}
     for r in rows:
         out.setdefault(str(r["node"]), []).append(r)
     return out
@@ -238,7 +242,7 @@ class _Goals:
                                                              str(text)))
                 self.loop_of[str(d["node"])] = self.loop_ids[text]
 
-    def _evidence(self, o: Mapping[str, Any]) -> str:
+    def _evidence(self, o: ObligationRow) -> str:
         """The solution of obligation ``o`` (its evidence record), or an undeveloped goal without one."""
         oid = str(o["id"])
         ev = self.ev_of.get(oid)
@@ -271,7 +275,7 @@ class _Goals:
                     url=str(f.get("smt2") or ""))))
         return kids
 
-    def side_goal(self, sc: Mapping[str, Any]) -> str:
+    def side_goal(self, sc: SideConditionRow) -> str:
         """The goal of side condition ``sc`` with its Z3 query as solution (in context: the weaker claim)."""
         b, sid = self.b, str(sc["id"])
         verdict = str(sc.get("verdict") or sc["status"])
@@ -294,7 +298,7 @@ class _Goals:
                                    f"{sc['conjunct']} of {sc['node']}'s assumption follows from its producers' guarantees"),
                              supported_by=(sn,), ref=sid))
 
-    def contract_goal(self, n: Mapping[str, Any]) -> str:
+    def contract_goal(self, n: NodeRow) -> str:
         """The goal that node ``n`` meets its contract: its guarantees' goals and its side conditions'."""
         b, name = self.b, str(n["name"])
         g_ids = []
@@ -316,7 +320,7 @@ class _Goals:
             f"eventually an output satisfying its guarantees (paper lines 462-495)",
             supported_by=tuple(g_ids + sc_ids), in_context_of=tuple(ctx), ref=name))
 
-    def requirement_goal(self, r: Mapping[str, Any]) -> str:
+    def requirement_goal(self, r: RequirementRow) -> str:
         """The goal of requirement ``r``: Z3's entailment when it was checked, else the calculus over its support."""
         b, rid = self.b, str(r["id"])
         if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped

@@ -32,6 +32,7 @@ import re
 from dataclasses import replace
 from typing import Any, Callable, Mapping
 
+from rclverify.records.report_schema import Report
 from rclverify.report.argument.model import Element
 
 _GUARANTEE = re.compile(r"^(?P<node>\S+) guarantee (?P<k>\d+)$")
@@ -68,7 +69,7 @@ def _linked(e: Element, target: str) -> bool:
     return target in e.supported_by or target in e.in_context_of
 
 
-def add_claim_points(els: dict[str, Element], report: Mapping[str, Any], ident: Callable[..., str]) -> None:
+def add_claim_points(els: dict[str, Element], report: Report, ident: Callable[..., str]) -> None:
     """Mark the assurance claim points of ``report``'s argument in ``els``
     (element id -> element, changed in place; the module docstring says
     where).  ``ident`` makes element ids (:func:`.build.ident`).  Every
@@ -81,7 +82,8 @@ def add_claim_points(els: dict[str, Element], report: Mapping[str, Any], ident: 
         if gid not in els:
             continue
         goal, name = els[gid], ident("ACP", rid)
-        conf, lim = r.get("confidence"), r.get("limited_by") or {}
+        conf = r.get("confidence")
+        lim: Mapping[str, object] = r.get("limited_by") or {}
         if conf is None:
             why = ("informal: no formal statement to compute a confidence for" if r.get("verdict") == "informal"
                    else "no confidence computed: the calculus's requirements are argued by their guarantees' goals")
@@ -114,19 +116,19 @@ def add_claim_points(els: dict[str, Element], report: Mapping[str, Any], ident: 
     _challenged(els, report, ident)
 
 
-def _challenged(els: dict[str, Element], report: Mapping[str, Any], ident: Callable[..., str]) -> None:
+def _challenged(els: dict[str, Element], report: Report, ident: Callable[..., str]) -> None:
     """A claim point on every claim a counter solution challenges (on the
     claim itself), with the confidence the calculus gives that claim."""
     confidence: dict[str, tuple[float, str]] = {}  # goal id -> (confidence, rule)
     for n in report.get("nodes", []):
         for g in n.get("guarantees", []):
-            s = g.get("strength") or {}
-            if "doubt" in s:
+            s = g.get("strength")
+            if s is not None and "doubt" in s:
                 confidence[ident("G", n["name"], f"g{g['index']}")] = (
                     1.0 - float(s["doubt"]), "C0" if s.get("kind") == "defeated" else "C1")
     for sc in report.get("side_conditions", []):
-        s = sc.get("strength") or {}
-        if "doubt" in s:
+        s = sc.get("strength")
+        if s is not None and "doubt" in s:
             confidence[ident("G", "sc", sc["id"])] = (1.0 - float(s["doubt"]),
                                                       "C0" if float(s["doubt"]) >= 1.0 else "strength")
     for r in report.get("requirements", []):

@@ -29,6 +29,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Mapping
 
+from rclverify.records.report_schema import Report
 from rclverify.report.argument.model import Element
 
 
@@ -36,7 +37,7 @@ def _clip(text: str, n: int = 300) -> str:
     return text if len(text) <= n else text[:n - 3] + "..."
 
 
-def add_defeaters(els: dict[str, Element], report: Mapping[str, Any], ident: Any) -> None:
+def add_defeaters(els: dict[str, Element], report: Report, ident: Any) -> None:
     """Add a counter solution per piece of counter-evidence of ``report`` to
     ``els`` (element id -> element, changed in place) and mark the claims
     it defeats; ``ident`` makes element ids (:func:`.build.ident`).  A
@@ -63,19 +64,20 @@ def add_defeaters(els: dict[str, Element], report: Mapping[str, Any], ident: Any
             challenge(ident("CSn", "ev", oid), target, f"Partial coverage {oid}: {ev.get('explanation', '')}",
                       st, False, url)
     for sc in report.get("side_conditions", []):
-        s = sc.get("solvers") or {}
+        s: Mapping[str, object] = sc.get("solvers") or {}
         if s.get("agreement") in ("disagree", "inconclusive"):
             challenge(ident("CSn", "solvers", sc["id"]), ident("G", "sc", sc["id"]),
                       f"The second solver does not confirm {sc['id']}: {s.get('why', '')}", "inconclusive", True,
                       str(s.get("smt2") or ""))
     for n in report.get("nodes", []):  # a problem's culprit: its goal is never "discharged"
         name = str(n["name"])
-        for g in [*n.get("guarantees", []), n]:
-            target = ident("G", name, f"g{g['index']}") if g is not n else ident("G", name)
-            for k, row in enumerate(g.get("culprit_of") or (), 1):
+        for index, culprit_of in [*((g["index"], g.get("culprit_of") or []) for g in n.get("guarantees", [])),
+                                  (None, n.get("culprit_of") or [])]:  # the guarantees, then the contract
+            target = ident("G", name, f"g{index}") if index is not None else ident("G", name)
+            for k, row in enumerate(culprit_of, 1):
                 if row["status"] not in ("failed", "error"):
                     continue  # outstanding evidence is no counter-evidence: the goal reads it already
-                what = f"guarantee {g['index']} of {name}" if g is not n else f"the contract of {name}"
+                what = f"guarantee {index} of {name}" if index is not None else f"the contract of {name}"
                 challenge(ident("CSn", "culprit", target, k), target,
                           f"Problem caused by {what}: {row['sentence']}", str(row["status"]),
                           row["status"] == "failed")

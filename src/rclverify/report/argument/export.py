@@ -136,7 +136,7 @@ def to_gsn_yaml(arg: Argument, title: str = "assurance argument", link_prefix: s
     ``link_prefix`` (the path from the YAML file's directory to the
     workspace root) is prepended to each element's ``url``; ``fragments``
     keeps each element's text between runs (same text)."""
-    def element(e: Element) -> dict[str, Any]:
+    def element(e: Element) -> dict[str, object]:
         return {"id": e.id, "text": _with_status(e), "supported_by": e.supported_by,
                 "in_context_of": e.in_context_of, "undeveloped": e.undeveloped,
                 "challenges": e.challenges, "defeated": e.defeated, "acp": e.acp,
@@ -196,14 +196,14 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
     workspace-relative ``url`` of an element (its record) to make a link.
     ``fragments`` keeps each element's node and edge lines between runs
     (same text)."""
-    def node(e: Element) -> dict[str, Any]:
+    def node(e: Element) -> dict[str, object]:
         shape, style = _SHAPES[e.type]
         fill, border = diagram.NODE_COLOURS.get(e.status or "", diagram.OTHER_COLOURS)
         return {"id": diagram.dot_string(e.id), "label": _label(e), "tooltip": diagram.dot_string(_clip(plain(e.text), MAX_TOOLTIP_CHARS)),
                 "shape": shape, "style": style, "fill": fill, "border": border,
                 "url": diagram.dot_string(link_prefix + e.url) if e.url else ""}
 
-    def edges(e: Element) -> list[dict[str, Any]]:
+    def edges(e: Element) -> list[dict[str, object]]:
         out = [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False} for x in e.supported_by]
         out += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": True} for x in e.in_context_of]
         out += [{"src": diagram.dot_string(e.id), "dst": diagram.dot_string(x), "context": False, "challenges": True}

@@ -17,7 +17,9 @@ status (``None``): they are what the argument rests on, not what it shows.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Mapping
+
+from rclverify.report.shapes import ArgumentJson, ElementJson
 
 from rclverify.records.records import SEVERITY, worst
 
@@ -69,18 +71,18 @@ class Element:
     #: reference being the element itself or one of its ``supported_by`` / ``in_context_of`` targets
     acp: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
-    def to_json(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"id": self.id, "type": self.type, "text": self.text, "status": self.status,
+    def to_json(self) -> ElementJson:
+        out: ElementJson = {"id": self.id, "type": self.type, "text": self.text, "status": self.status,
                                "supported_by": list(self.supported_by), "in_context_of": list(self.in_context_of),
                                "undeveloped": self.undeveloped, "ref": self.ref, "url": self.url}
         if self.challenges or self.defeated:
-            out.update(challenges=list(self.challenges), defeated=self.defeated)
+            out["challenges"], out["defeated"] = list(self.challenges), self.defeated
         if self.acp:
             out["acp"] = {name: list(refs) for name, refs in self.acp}
         return out
 
     @staticmethod
-    def from_json(d: Mapping[str, Any]) -> "Element":
+    def from_json(d: ElementJson) -> "Element":
         return Element(id=d["id"], type=d["type"], text=d["text"], status=d.get("status"),
                        supported_by=tuple(d.get("supported_by", ())), in_context_of=tuple(d.get("in_context_of", ())),
                        undeveloped=bool(d.get("undeveloped", False)), ref=d.get("ref", ""), url=d.get("url", ""),
@@ -96,12 +98,12 @@ class Argument:
     top: str
     elements: Mapping[str, Element] = field(default_factory=dict)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> ArgumentJson:
         """``{"top": id, "elements": [element JSON, ...]}`` in element order."""
         return {"top": self.top, "elements": [e.to_json() for e in self.elements.values()]}
 
     @staticmethod
-    def from_json(d: Mapping[str, Any]) -> "Argument":
+    def from_json(d: ArgumentJson) -> "Argument":
         return Argument(d["top"], {e["id"]: Element.from_json(e) for e in d["elements"]})
 
     def status(self, element_id: str) -> str | None:

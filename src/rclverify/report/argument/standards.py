@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Mapping
 
+from rclverify.records.report_schema import Report
 from rclverify.report.argument.model import Element
 
 
@@ -33,7 +34,7 @@ def _solutions_under(els: Mapping[str, Element], start: str) -> set[str]:
     return out
 
 
-def add_standard_links(els: dict[str, Element], report: Mapping[str, Any], ident: Any) -> None:
+def add_standard_links(els: dict[str, Element], report: Report, ident: Any) -> None:
     """Add one context per standard clause with supporting evidence to ``els``
     (changed in place) and put it in the context of every strategy that
     addresses the clause (the module docstring); ``ident`` makes element

@@ -35,6 +35,7 @@ import math
 from typing import Any, Mapping
 
 from rclverify.model.plan.declarations import DECLARATIONS, STRENGTHS
+from rclverify.records.report_schema import Strength
 
 #: The kinds, strongest first (the report orders and compares by this).
 KINDS = STRENGTHS
@@ -63,7 +64,7 @@ def _figure(row: Mapping[str, Any], name: str) -> str | None:
     return None
 
 
-def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
+def evidence_strength(row: Mapping[str, Any]) -> Strength:
     """The strength of one evidence row of the report (``backend``,
     ``status``, and the backend's figures: ``examples``, ``monitoring``,
     ``figures``).  Returns ``{"kind", "detail", "doubt"}``; an unknown
@@ -118,7 +119,7 @@ def evidence_strength(row: Mapping[str, Any]) -> dict[str, Any]:
     return {"kind": kind, "detail": detail, "doubt": doubt}
 
 
-def target_strength(row: Mapping[str, Any], stats: Mapping[str, Any]) -> dict[str, Any]:
+def target_strength(row: Mapping[str, Any], stats: Mapping[str, Any]) -> Strength:
     """The strength of a target's record (a run set's or an experiment's,
     docs/statistics.md): ``statistical``, its detail the counts and the
     bound at the target's level, its doubt that bound when ``discharged``
@@ -152,7 +153,7 @@ def coverage_text(cov: Mapping[str, Any]) -> str:
     return "; ".join(parts)
 
 
-def side_condition_strength(sc: Mapping[str, Any]) -> dict[str, Any]:
+def side_condition_strength(sc: Mapping[str, Any]) -> Strength:
     """The strength of a side-condition row: a ``proof`` by one or two
     solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``.  One
     discharged from its producers' cone summaries (``context.summaries``,

@@ -24,11 +24,15 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable
+from typing import TYPE_CHECKING, Any, Iterable
 
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.model import Note, Src
 from rclverify.ros.extract.cmake import expand
+from rclverify.ros.extract.shapes import FieldJson, TypeField, TypeJson
+
+if TYPE_CHECKING:
+    from rosbags.interfaces.typing import Typesdict
 
 DEBIAN_SHARE = Path("/usr/share")
 
@@ -56,17 +60,25 @@ class TypeInfo:
     file: str | None = None
     lines: dict[str, int] = field(default_factory=dict)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> TypeJson:
         return {
             "origin": self.origin, "file": self.file,
-            "fields": [{"name": n, **describe(d), **({"line": self.lines[n]} if n in self.lines else {})}
-                       for n, d in self.fields],
+            "fields": [_field(n, d, self.lines.get(n)) for n, d in self.fields],
             "constants": [{"name": n, "type": t, "value": v if isinstance(v, (int, float, str, bool)) else str(v)}
                           for n, t, v in self.consts],
         }
 
 
-def describe(desc: Any) -> dict[str, Any]:
+def _field(name: str, desc: Any, line: int | None) -> TypeField:
+    """One field's JSON: its name, :func:`describe`'s keys, and its line when known."""
+    d = describe(desc)
+    out: TypeField = {"name": name, "type": d["type"], "array": d["array"]}
+    if line is not None:
+        out["line"] = line
+    return out
+
+
+def describe(desc: Any) -> FieldJson:
     """A rosbags field description as JSON: ``{"type": ..., "array": None|"[]"|"[N]"|"[<=N]"}``."""
     kind, detail = desc
     kind = int(kind)
@@ -126,7 +138,7 @@ def generated_interfaces(root: Path, pkg: str) -> list[Path]:
     return out
 
 
-def _parse_one(kind: str, text: str, name: str) -> dict[str, Any]:
+def _parse_one(kind: str, text: str, name: str) -> Typesdict:
     from rosbags.typesys import get_types_from_idl, get_types_from_msg  # deferred: start-up (loads rosbags and more only when called)
     if kind == "idl":
         return dict(get_types_from_idl(text))
@@ -137,7 +149,7 @@ def _parse_one(kind: str, text: str, name: str) -> dict[str, Any]:
     suffixes = ("_Request", "_Response") if kind == "srv" else ("_Goal", "_Result", "_Feedback")
     if len(parts) != len(suffixes):
         raise ValueError(f"a .{kind} file has {len(suffixes)} parts separated by '---', this one has {len(parts)}")
-    out: dict[str, Any] = {}
+    out: Typesdict = {}
     for part, suf in zip(parts, suffixes):
         # parsed as pkg/msg/...: a field type without a package is pkg/msg/T, the
         # same package's message (rosidl's rule), never pkg/srv/msg/T

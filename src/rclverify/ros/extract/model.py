@@ -8,7 +8,12 @@ and C++'s ``pkg::msg::Type`` to it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from rclverify.records.stage_records import SourceRef
+    from rclverify.ros.extract.shapes import (BagJson, EdgeJson, GraphJson, NodeJson, NoteJson, PackageJson,
+                                              ServiceJson, TopicJson, TypeJson)
 
 SCHEMA_ID = "rclverify-ros-graph/1"
 
@@ -53,7 +58,7 @@ class Src:
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.col}"
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> SourceRef:
         return {"file": self.file, "line": self.line, "col": self.col}
 
 
@@ -109,7 +114,7 @@ class Note:
     def __str__(self) -> str:
         return f"{self.src}: {self.severity}: {self.message}"
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> NoteJson:
         return {**self.src.to_json(), "severity": self.severity, "message": self.message, "code": self.code}
 
 
@@ -125,8 +130,8 @@ class GraphEdge:
     param: str | None = None  # the parameter the code takes the name from (resolved), if any
     param_set_at: Src | None = None  # the launch file's value of that parameter, when it sets one
 
-    def to_json(self) -> dict[str, Any]:
-        d: dict[str, Any] = {"topic": self.topic, "type": self.msg_type, "as_written": self.written or self.topic,
+    def to_json(self) -> EdgeJson:
+        d: EdgeJson = {"topic": self.topic, "type": self.msg_type, "as_written": self.written or self.topic,
                              "at": self.src.to_json()}
         if self.remapped_at is not None:
             d["remapped_at"] = self.remapped_at.to_json()
@@ -172,19 +177,22 @@ class GraphNode:
         lst: list[GraphEdge] = getattr(self, kind)
         return lst
 
-    def to_json(self) -> dict[str, Any]:
-        d: dict[str, Any] = {
+    def to_json(self) -> NodeJson:
+        d: NodeJson = {
             "name": self.name, "namespace": self.namespace, "package": self.package,
             "executable": self.executable, "sources": list(self.sources), "origin": self.origin,
             "declared_at": self.declared_at.to_json() if self.declared_at else None,
-            "publishes": [e.to_json() for e in sorted(self.publishes, key=_ek)],
-            "subscribes": [e.to_json() for e in sorted(self.subscribes, key=_ek)],
+            "publishes": _edges(self.publishes), "subscribes": _edges(self.subscribes),
+            "service_servers": _edges(self.service_servers), "service_clients": _edges(self.service_clients),
+            "action_servers": _edges(self.action_servers), "action_clients": _edges(self.action_clients),
         }
-        for role in SERVICE_ROLES:
-            d[role] = [e.to_json() for e in sorted(getattr(self, role), key=_ek)]
         if self.lifecycle:
             d["lifecycle"] = True
         return d
+
+
+def _edges(edges: list[GraphEdge]) -> list[EdgeJson]:
+    return [e.to_json() for e in sorted(edges, key=_ek)]
 
 
 def _ek(e: GraphEdge) -> tuple[str, str]:
@@ -195,12 +203,12 @@ def _ek(e: GraphEdge) -> tuple[str, str]:
 class Graph:
     """The whole recovered graph; see docs/ros.md for each part."""
 
-    packages: dict[str, dict[str, Any]] = field(default_factory=dict)
+    packages: dict[str, PackageJson] = field(default_factory=dict)
     nodes: dict[str, GraphNode] = field(default_factory=dict)
-    types: dict[str, dict[str, Any]] = field(default_factory=dict)
+    types: dict[str, TypeJson] = field(default_factory=dict)
     notes: list[Note] = field(default_factory=list)
     files: dict[str, str] = field(default_factory=dict)  # path -> sha256
-    bags: list[dict[str, Any]] = field(default_factory=list)
+    bags: list[BagJson] = field(default_factory=list)
     # every declared program and what it is in the graph (ros/graph/accounting.py): package,
     # kind, name, declared, nodes, unaccounted (why it is no node, or null)
     programs: list[dict[str, Any]] = field(default_factory=list)
@@ -209,17 +217,18 @@ class Graph:
         """The :attr:`programs` that are no node of the graph."""
         return [p for p in self.programs if p.get("unaccounted")]
 
-    def topics(self) -> dict[str, dict[str, Any]]:
+    def topics(self) -> dict[str, TopicJson]:
         """``{topic: {"types": [...], "publishers": [...], "subscribers": [...]}}``."""
-        out: dict[str, dict[str, Any]] = {}
+        out: dict[str, TopicJson] = {}
         for n in sorted(self.nodes.values(), key=lambda n: n.name):
             for kind, edges in (("publishers", n.publishes), ("subscribers", n.subscribes)):
                 for e in edges:
                     t = out.setdefault(e.topic, {"types": [], "publishers": [], "subscribers": []})
                     if e.msg_type and e.msg_type not in t["types"]:
                         t["types"].append(e.msg_type)
-                    if n.name not in t[kind]:
-                        t[kind].append(n.name)
+                    names = t["publishers"] if kind == "publishers" else t["subscribers"]
+                    if n.name not in names:
+                        names.append(n.name)
         for b in self.bags:
             for bt in b["topics"]:
                 t = out.setdefault(bt["name"], {"types": [], "publishers": [], "subscribers": []})
@@ -230,23 +239,24 @@ class Graph:
             t["types"].sort()
         return dict(sorted(out.items()))
 
-    def services(self, kind: str = "service") -> dict[str, dict[str, Any]]:
+    def services(self, kind: str = "service") -> dict[str, ServiceJson]:
         """``{name: {"types": [...], "servers": [...], "clients": [...]}}`` of the graph's
         services (``kind="service"``) or actions (``kind="action"``), node names sorted."""
-        out: dict[str, dict[str, Any]] = {}
+        out: dict[str, ServiceJson] = {}
         for n in sorted(self.nodes.values(), key=lambda n: n.name):
             for role in ("servers", "clients"):
                 for e in getattr(n, f"{kind}_{role}"):
                     t = out.setdefault(e.topic, {"types": [], "servers": [], "clients": []})
                     if e.msg_type and e.msg_type not in t["types"]:
                         t["types"].append(e.msg_type)
-                    if n.name not in t[role]:
-                        t[role].append(n.name)
+                    names = t["servers"] if role == "servers" else t["clients"]
+                    if n.name not in names:
+                        names.append(n.name)
         for t in out.values():
             t["types"].sort()
         return dict(sorted(out.items()))
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> GraphJson:
         return {
             "schema": SCHEMA_ID,
             "packages": [self.packages[k] for k in sorted(self.packages)],

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rclverify.ros.extract.model import Note, Src
+from rclverify.ros.extract.shapes import PackageJson
 from rclverify.ros.extract.xmlsrc import parse_xml
 
 _SKIP_DIRS = {"build", "devel", "install", "log", ".git", "__pycache__"}
@@ -32,7 +33,7 @@ class Package:
     root: Path
     manifest: Path
 
-    def to_json(self, shown: str) -> dict[str, object]:
+    def to_json(self, shown: str) -> PackageJson:
         return {"name": self.name, "version": self.version, "build_type": self.build_type,
                 "ros": self.ros, "manifest": shown}
 

@@ -3,9 +3,12 @@ the text of a syntax node (py-tree-sitter's ``Parser``/``Language`` API; grammar
 from the ``tree-sitter-cpp`` and ``tree-sitter-python`` packages)."""
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-_PARSERS: dict[str, Any] = {}
+if TYPE_CHECKING:
+    from tree_sitter import Parser
+
+_PARSERS: dict[str, Parser] = {}
 
 
 def parser(language: str) -> Any:

@@ -3,14 +3,17 @@ or a ROS 2 bag (directory or ``.mcap``), through ``rosbags``' AnyReader."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from rclverify.ros.extract.model import Note, Src, canon_type
 from rclverify.traces.events import TraceError
 from rclverify.traces.guard import check_trace_path
 
+if TYPE_CHECKING:
+    from rclverify.ros.extract.shapes import BagJson
 
-def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note]]:
+
+def bag_topics(path: Path, shown: str) -> tuple[BagJson | None, list[Note]]:
     """``{"path", "topics": [{"name", "type", "count"}]}`` or a located error note.
     Only regular files are opened (:func:`rclverify.traces.guard.check_trace_path`):
     a bag that is, or whose reader would open, a FIFO, device or socket is an
@@ -25,11 +28,11 @@ def bag_topics(path: Path, shown: str) -> tuple[dict[str, Any] | None, list[Note
     warnings = [Note(Src(shown), _entry_message(w, path, "warning"), "ROS-PARSE", "warning") for w in skipped]
     try:
         with AnyReader([path]) as reader:
-            topics = [(c.topic if c.topic.startswith("/") else "/" + c.topic, canon_type(c.msgtype), int(c.msgcount))
+            topics = [(c.topic if c.topic.startswith("/") else "/" + c.topic, canon_type(c.msgtype) or c.msgtype, int(c.msgcount))
                       for c in reader.connections]
     except Exception as exc:  # rosbags raises its own reader errors on bad files
         return None, [Note(Src(shown), f"cannot read bag: {' '.join(str(exc).split())[:300]}", "ROS-PARSE", "error")]
-    merged: dict[tuple[str, str | None], int] = {}
+    merged: dict[tuple[str, str], int] = {}
     for name, ty, count in topics:
         merged[(name, ty)] = merged.get((name, ty), 0) + count
     return {"path": shown, "topics": [{"name": n, "type": ty, "count": c}

@@ -6,9 +6,12 @@ client -> service -> server.  The DOT text comes from
 ``templates/grounding.dot.j2``."""
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import jinja2
+
+from rclverify.records.stage_records import GroundingFinding
+from rclverify.ros.extract.shapes import EdgeJson, GraphJson, NodeJson
 
 _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.ros.graph", "templates"), autoescape=False,
                           keep_trailing_newline=True)
@@ -26,7 +29,7 @@ _ROLES = (("service_servers", "service", True), ("service_clients", "service", F
           ("action_servers", "action", True), ("action_clients", "action", False))
 
 
-def grounding_dot(checked: Any, graph_json: Mapping[str, Any], findings: list[Mapping[str, Any]],
+def grounding_dot(checked: Any, graph_json: GraphJson, findings: Sequence[GroundingFinding],
                   pairs: Mapping[str, str]) -> str:
     """DOT text: contract nodes, topics, services and actions (``checked``), graph nodes,
     topics, services and actions (``graph_json``, the JSON graph of docs/ros-graph.schema.json),
@@ -37,10 +40,11 @@ def grounding_dot(checked: Any, graph_json: Mapping[str, Any], findings: list[Ma
     worst_topic: dict[tuple[str, str], int] = {}
     for f in findings:
         r = _RANK.get(str(f["severity"]), 0)
-        if f.get("node"):
-            worst_node[f["node"]] = max(worst_node.get(f["node"], 0), r)
-            if f.get("topic"):
-                worst_topic[(f["node"], f["topic"])] = max(worst_topic.get((f["node"], f["topic"]), 0), r)
+        node, topic = f.get("node"), f.get("topic")
+        if node:
+            worst_node[node] = max(worst_node.get(node, 0), r)
+            if topic:
+                worst_topic[(node, topic)] = max(worst_topic.get((node, topic), 0), r)
     for c, gname in pairs.items():  # the graph side is coloured by its contract's findings too
         if c in worst_node:
             worst_node[gname] = max(worst_node.get(gname, 0), worst_node[c])
@@ -69,22 +73,22 @@ def grounding_dot(checked: Any, graph_json: Mapping[str, Any], findings: list[Ma
     r_links: dict[tuple[str, str], int] = {}
     r_nodes, r_edges = [], []
     r_topics: dict[str, int] = {}
-    for n in graph_json["nodes"]:
-        r_nodes.append({"name": _q(n["name"]), "colour": _COLOUR[worst_node.get(n["name"], 0)]})
-        for kind in ("publishes", "subscribes"):
-            for e in n[kind]:
-                col = worst_topic.get((n["name"], e.get("as_written", e["topic"])), 0)
-                r_topics[e["topic"]] = max(r_topics.get(e["topic"], 0), col)
-                a, b = f"r:{_q(n['name'])}", f"rt:{_q(e['topic'])}"
+    for gn in graph_json["nodes"]:
+        r_nodes.append({"name": _q(gn["name"]), "colour": _COLOUR[worst_node.get(gn["name"], 0)]})
+        for kind, edges in (("publishes", gn["publishes"]), ("subscribes", gn["subscribes"])):
+            for ge in edges:
+                col = worst_topic.get((gn["name"], ge.get("as_written", ge["topic"])), 0)
+                r_topics[ge["topic"]] = max(r_topics.get(ge["topic"], 0), col)
+                a, b = f"r:{_q(gn['name'])}", f"rt:{_q(ge['topic'])}"
                 r_edges.append({"src": a, "dst": b, "colour": _COLOUR[col]} if kind == "publishes"
                                else {"src": b, "dst": a, "colour": _COLOUR[col]})
         for role, lkind, serves in _ROLES:
             pre, _shape, style = _LINK[lkind]
-            for e in n.get(role, []):
-                col = max(worst_topic.get((n["name"], e.get("as_written", e["topic"])), 0),
-                          worst_topic.get((n["name"], e["topic"]), 0))
-                r_links[(lkind, e["topic"])] = max(r_links.get((lkind, e["topic"]), 0), col)
-                a, b = f"r:{_q(n['name'])}", f"r{pre}:{_q(e['topic'])}"
+            for ge in _role_edges(gn, role):
+                col = max(worst_topic.get((gn["name"], ge.get("as_written", ge["topic"])), 0),
+                          worst_topic.get((gn["name"], ge["topic"]), 0))
+                r_links[(lkind, ge["topic"])] = max(r_links.get((lkind, ge["topic"]), 0), col)
+                a, b = f"r:{_q(gn['name'])}", f"r{pre}:{_q(ge['topic'])}"
                 l_edges.append({"src": b, "dst": a, "colour": _COLOUR[col], "style": style} if serves
                                else {"src": a, "dst": b, "colour": _COLOUR[col], "style": style})
 
@@ -99,6 +103,12 @@ def grounding_dot(checked: Any, graph_json: Mapping[str, Any], findings: list[Ma
         ros_edges=_once(r_edges),  # a topic created at several call sites of a node is one line
         contract_links=link_nodes("c", c_links), ros_links=link_nodes("r", r_links), link_edges=_once(l_edges),
         matches=[{"contract": _q(c), "ros": _q(r)} for c, r in pairs.items()])
+
+
+def _role_edges(n: NodeJson, role: str) -> list[EdgeJson]:
+    """The edges of graph node ``n`` in its service or action list ``role`` (one of :data:`_ROLES`)."""
+    return {"service_servers": n["service_servers"], "service_clients": n["service_clients"],
+            "action_servers": n["action_servers"], "action_clients": n["action_clients"]}[role]
 
 
 def _once(edges: list[dict[str, str]]) -> list[dict[str, str]]:

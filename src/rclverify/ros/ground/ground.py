@@ -48,6 +48,7 @@ from rclverify.ros.ground.ground_services import folded, ground_links
 from rclverify.ros.extract.interfaces import ABSENT, BASE_TYPES, TypeTable, field_path
 from rclverify.ros.extract.model import GraphEdge, GraphNode, Src, canon_type, library_of, short_type
 from rclverify.ros.ground.lifecycle import implicit
+from rclverify.records.stage_records import GroundingFinding
 
 _INT = {"int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64", "byte", "char", "octet"}
 _FLOAT = {"float32", "float64"}
@@ -88,7 +89,7 @@ class Finding:
         other = f" [{self.ros}]" if self.rcl and self.ros else ""
         return f"{where}: {self.severity}: {self.message}{other} ({self.code})"
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> GroundingFinding:
         return {"code": self.code, "severity": self.severity, "message": self.message, "node": self.node,
                 "topic": self.topic,
                 "rcl": {"file": self.rcl.file, "line": self.rcl.line, "col": self.rcl.col} if self.rcl else None,

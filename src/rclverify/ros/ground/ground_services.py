@@ -23,13 +23,14 @@ from __future__ import annotations
 
 import copy
 import difflib
-from typing import Any, Callable, Mapping
+from typing import Callable, Mapping
 
 from rclverify.lang import ast
 from rclverify.ros.extract import names
 from rclverify.ros.extract.interfaces import TypeTable
 from rclverify.ros.extract.model import Graph, GraphEdge, GraphNode, Src, canon_type, short_type
 from rclverify.ros.ground.lifecycle import implicit
+from rclverify.ros.extract.shapes import LinkJson
 
 #: rule id -> (severity, description), merged into ``ground.RULES`` (SARIF rules)
 RULES: dict[str, tuple[str, str]] = {}
@@ -153,6 +154,6 @@ def _closest(edges: list[GraphEdge], name: str) -> GraphEdge | None:
     return next((e for e in edges if close and e.written == close[0]), None)
 
 
-def link_json(node: ast.Node) -> list[dict[str, Any]]:
+def link_json(node: ast.Node) -> list[LinkJson]:
     """The links of contract ``node`` for the drawing: ``{kind, name, role}``."""
     return [{"kind": lk.kind, "name": lk.name, "role": lk.role} for lk in node.links]

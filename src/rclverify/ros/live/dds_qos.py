@@ -26,6 +26,8 @@ from dataclasses import dataclass, field, replace
 from fnmatch import fnmatchcase
 from typing import Any, Iterable
 
+from rclverify.ros.extract.shapes import QosJson
+
 INFINITE_NS = 0x7FFFFFFFFFFFFFFF
 DURABILITY = ("volatile", "transient_local", "transient", "persistent")
 LIVELINESS = ("automatic", "manual_by_participant", "manual_by_topic")
@@ -69,7 +71,7 @@ class QosProfile:
             parts.append("partitions " + ",".join(self.partitions))
         return ", ".join(parts)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> QosJson:
         return {"reliability": "reliable" if self.reliable else "best_effort", "durability": self.durability,
                 "history": "keep_all" if self.depth is None else f"keep_last({self.depth})",
                 "deadline_ns": self.deadline_ns, "liveliness": self.liveliness, "lease_ns": self.lease_ns,

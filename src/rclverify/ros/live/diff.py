@@ -25,10 +25,11 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Iterable
 
 from rclverify.ros.extract.model import Graph, GraphEdge, GraphNode, Src, short_type
 from rclverify.ros.live.master import ACTION_TOPICS, INFRA_TOPICS, fold_actions
+from rclverify.ros.extract.shapes import BagJson, BagTopic, DiffItemJson, DiffJson
 
 SCHEMA_ID = "rclverify-ros-diff/1"
 
@@ -67,7 +68,7 @@ class Item:
     def __str__(self) -> str:
         return f"{self.where()}: {self.message}"
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> DiffItemJson:
         return {"category": self.category, "name": self.name, "node": self.node, "type": self.msg_type,
                 "observed_type": self.observed_type, "at": self.src.to_json() if self.src else None,
                 "observed": self.observed, "message": self.message}
@@ -91,7 +92,7 @@ class DiffResult:
     def equal(self) -> bool:
         return not self.missing and not self.extra and not self.incomplete
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> DiffJson:
         """The documented JSON shape (docs/ros.md, "Expected against observed")."""
         return {"schema": SCHEMA_ID, "observed": {"kind": self.kind, "source": self.source},
                 "equal": self.equal, "compared": list(self.compared), "not_compared": list(self.not_compared),
@@ -175,7 +176,7 @@ def diff_master(static: Graph, running: Graph, uri: str) -> DiffResult:
     return res
 
 
-def bag_actions(topics: list[dict[str, Any]]) -> tuple[dict[str, str | None], set[str]]:
+def bag_actions(topics: list[BagTopic]) -> tuple[dict[str, str | None], set[str]]:
     """``({action: pkg/action/T}, {its topics})`` of the actionlib topic groups a bag
     recorded: a topic ``P/goal`` whose type ends in ``ActionGoal`` (the rule of
     :mod:`rclverify.ros.live.master`)."""
@@ -189,7 +190,7 @@ def bag_actions(topics: list[dict[str, Any]]) -> tuple[dict[str, str | None], se
     return acts, parts
 
 
-def diff_bag(static: Graph, bag: dict[str, Any]) -> DiffResult:
+def diff_bag(static: Graph, bag: BagJson) -> DiffResult:
     """Compare the code's graph ``static`` with a recorded run (``bag`` as
     :func:`rclverify.ros.graph.bag.bag_topics` returns it): topics the code publishes that the
     bag lacks, topics the bag has that the code names nowhere, actions, and types."""
@@ -200,9 +201,9 @@ def diff_bag(static: Graph, bag: dict[str, Any]) -> DiffResult:
     topics = [t for t in bag["topics"] if t["name"] not in INFRA_TOPICS]
     acts, act_topics = bag_actions(topics)
     recorded: dict[str, set[str]] = {}
-    for t in topics:
-        if t["name"] not in act_topics:
-            recorded.setdefault(t["name"], set()).update([t["type"]] if t.get("type") else [])
+    for bt in topics:
+        if bt["name"] not in act_topics:
+            recorded.setdefault(bt["name"], set()).update([bt["type"]] if bt.get("type") else [])
     pubs: dict[str, list[tuple[str, GraphEdge]]] = {}
     named: dict[str, list[tuple[str, GraphEdge]]] = {}
     for n in sorted(static.nodes.values(), key=lambda n: n.name):

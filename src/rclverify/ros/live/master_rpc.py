@@ -102,7 +102,7 @@ def in_thread(fn: Callable[[], Any], seconds: float, name: str,
     (a daemon: it never keeps the process alive).  The one way every call
     to a ROS 1 master is bounded (``within``, the live monitor's
     registration and shutdown)."""
-    box: dict[str, Any] = {}
+    box: dict[str, object] = {}
 
     def run() -> None:
         try:

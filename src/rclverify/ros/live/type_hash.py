@@ -27,6 +27,8 @@ import hashlib
 import json
 from typing import Any, Callable, Sequence
 
+from rclverify.ros.extract.shapes import FieldDescription, TypeDescription
+
 _IDS = {"int8": 2, "uint8": 3, "int16": 4, "uint16": 5, "int32": 6, "uint32": 7, "int64": 8, "uint64": 9,
         "float32": 10, "float64": 11, "float128": 12, "char": 3, "wchar": 14, "bool": 15, "byte": 16,
         "octet": 16, "string": 17, "wstring": 18}
@@ -55,7 +57,7 @@ def _element(desc: Any, visit: Callable[[str], None]) -> tuple[int, int, str]:
     return 1, 0, name
 
 
-def _field(name: str, desc: Any, visit: Callable[[str], None]) -> dict[str, Any]:
+def _field(name: str, desc: Any, visit: Callable[[str], None]) -> FieldDescription:
     kind = int(desc[0])
     increment = capacity = 0
     elem = desc
@@ -75,7 +77,7 @@ def rihs01(name: str, fields_of: Callable[[str], Fields | None]) -> str:
     (node kind, detail))``, kinds 1 base, 2 named, 3 array, 4 sequence) or
     ``None`` when it is unknown.  Raises :class:`UnknownType` naming a type
     that is not defined."""
-    described: dict[str, dict[str, Any]] = {}
+    described: dict[str, TypeDescription] = {}
     todo = [name]
 
     def visit(t: str) -> None:

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 from rclverify.traces.bag import typestore
 from rclverify.traces.events import TraceError
+from rclverify.runtime.shapes import BagSummary
 
 STORAGES = ("sqlite3", "mcap")
 
@@ -148,17 +149,18 @@ class BagRecorder:
             return
         self._queue.put((topic, time_ns, bytes(raw)))
 
-    def close(self, timeout_s: float = 60.0) -> dict[str, Any]:
+    def close(self, timeout_s: float = 60.0) -> BagSummary:
         """Write what is queued, finish the bag (idempotent); returns what the evidence says of it
         (``messages``: contract topics' messages written, ``call_messages``: call topics' messages
         written, ``failed``: messages not written, ``error``: the last writer error)."""
         if self._thread.is_alive():
             self._queue.put(None)
             self._thread.join(timeout_s)
-        out: dict[str, Any] = {"path": str(self.path), "messages": self.count,
-                               "topics": sorted("/" + t for t in self.topics)}
+        out: BagSummary = {"path": str(self.path), "messages": self.count,
+                           "topics": sorted("/" + t for t in self.topics)}
         if self.calls:
-            out.update(call_messages=self.call_count, call_topics=sorted("/" + t for t in self.calls))
+            out["call_messages"] = self.call_count
+            out["call_topics"] = sorted("/" + t for t in self.calls)
         if self.failed or self._thread.is_alive():
             out["failed"] = self.failed
             out["error"] = self.error or f"the bag was not finished within {timeout_s:g} s"

@@ -20,9 +20,13 @@ the Kilted wheels (``std_srvs/srv/SetBool_Event``:
 from __future__ import annotations
 
 from functools import cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rclverify.runtime.dds.types import DdsTypeError, TypeBook
+from rclverify.runtime.shapes import IdlMember, IdlStruct, IdlTypedef
+
+if TYPE_CHECKING:
+    from rosbags.interfaces.typing import Typesdict
 
 #: rosidl's IDL name of each ``.msg`` primitive type
 _IDL = {"bool": "boolean", "byte": "octet", "octet": "octet", "char": "uint8", "float32": "float",
@@ -38,7 +42,7 @@ def _template() -> Any:
     return env.get_template("definition.idl.j2")
 
 
-def _idl_type(desc: Any, owner: str, typedefs: list[dict[str, Any]]) -> str:
+def _idl_type(desc: Any, owner: str, typedefs: list[IdlTypedef]) -> str:
     """The IDL type of a field description (rosbags' form), its arrays' typedefs added to ``typedefs``."""
     kind, detail = int(desc[0]), desc[1]
     if kind == 1:
@@ -78,7 +82,7 @@ def definition(types: TypeBook, name: str) -> tuple[str, str]:
     :class:`~.types.DdsTypeError` for a type the book does not define or a
     field a bag cannot describe (a ``wstring``)."""
     from rosbags.typesys import Stores, get_typestore, get_types_from_idl  # deferred: start-up (only when recording)
-    structs: list[dict[str, Any]] = []
+    structs: list[IdlStruct] = []
     seen: set[str] = set()
     todo = [name]
     while todo:
@@ -89,15 +93,15 @@ def definition(types: TypeBook, name: str) -> tuple[str, str]:
         info = types.table.get(t)
         if info is None:
             raise DdsTypeError(f"{name}: type {t} is neither in the workspace's interface files nor a standard type")
-        typedefs: list[dict[str, Any]] = []
-        members = [{"type": _idl_type(desc, t, typedefs), "name": f} for f, desc in info.fields] or \
+        typedefs: list[IdlTypedef] = []
+        members: list[IdlMember] = [{"type": _idl_type(desc, t, typedefs), "name": f} for f, desc in info.fields] or \
             [{"type": "uint8", "name": "structure_needs_at_least_one_member"}]
         pkg, ns, short = t.split("/")
         structs.append({"full": t, "pkg": pkg, "ns": ns, "name": short, "typedefs": typedefs, "members": members})
         todo += [n for _f, desc in info.fields for n in _nested(desc)]
     text = _template().render(structs=structs).lstrip("\n")
     store = get_typestore(Stores.EMPTY)
-    parsed: dict[str, Any] = {}
+    parsed: Typesdict = {}
     for chunk in text.split("=" * 80 + "\n")[1:]:
         parsed.update(get_types_from_idl(chunk.split("\n", 1)[1]))
     store.register(parsed)

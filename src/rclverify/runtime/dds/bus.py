@@ -48,6 +48,7 @@ from rclverify.ros.live.dds import take_raw
 from rclverify.ros.live.dds_discovery import Discovery
 from rclverify.ros.live.dds_qos import QosProfile, from_dds, mismatches, reader_for, to_dds
 from rclverify.runtime.dds.layout import OTHER, PENDING, LayoutJudge
+from rclverify.runtime.shapes import TapJson
 
 #: Seconds a warning about a publication waits for ros_discovery_info to name its node (a ROS 2 node
 #: announces itself after its endpoints are discovered); past it, the participant's id is named.
@@ -74,7 +75,7 @@ class Tap:
     admitted: dict[int, bool] = field(default_factory=dict)
     dropped: int = 0  # samples of a publisher of another layout, not handed on
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> TapJson:
         return {"topic": self.dds_topic, "samples": self.samples, "reader_changes": self.reader_changes,
                 "qos": self.qos.to_json() if self.qos is not None else None, "publishers_heard": len(self.heard),
                 "other_layout_samples": self.dropped}

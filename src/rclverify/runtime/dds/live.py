@@ -61,7 +61,7 @@ class _Sink:
     def __init__(self, live: LiveRun, book: CallBook | None, taps: CallTaps | None, window: float) -> None:
         self.live, self.book, self.taps, self.window = live, book, taps, window
 
-    def push(self, topic: str, fields: Mapping[str, Any], received: float) -> None:
+    def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
         self.live.push(topic, fields, received)
 
     def tick(self, now: float) -> None:
@@ -283,7 +283,7 @@ class _DdsRun:
         self.live.note({"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()})
         self.send(dumps({"kind": "deadline", **v.to_json()}))
 
-    def decode(self, key: str, payload: Any) -> Mapping[str, Any] | None:
+    def decode(self, key: str, payload: Any) -> Mapping[str, object] | None:
         """One sample's fields (engine thread); a call sample goes to the call
         taps, bytes that are not the contract's type are counted."""
         raw, source_ns, received_ns = payload[:3]
@@ -294,7 +294,7 @@ class _DdsRun:
                     self.call_recorder.sample(key, raw, source_ns, payload[3])
                 calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9, payload[3])
                 return None
-            fields: Mapping[str, Any] = to_fields(self.structs[key].deserialize(raw))
+            fields: Mapping[str, object] = to_fields(self.structs[key].deserialize(raw))
         except Exception:  # bytes that are not the contract's type: counted, never a crash
             self.decode_errors[key] = self.decode_errors.get(key, 0) + 1
             return None
@@ -378,7 +378,7 @@ class _DdsRun:
         return record_
 
 
-def _calls_record(summary: Mapping[str, Any], book: CallBook, calls: CallTaps | None) -> dict[str, Any]:
+def _calls_record(summary: Mapping[str, object], book: CallBook, calls: CallTaps | None) -> dict[str, Any]:
     """The record's ``calls``: the counts of the call-by-call verdicts, each
     node's status over its calls, and the samples heard per call topic."""
     out: dict[str, Any] = {"counts": summary["counts"], "nodes": [], "samples": calls.counts if calls is not None else {}}

@@ -48,12 +48,12 @@ from __future__ import annotations
 
 import heapq
 import os
-from typing import Any, Iterable
+from typing import Any, Iterable, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode
 from rclverify.ros.live.dds import ACTION_INFIX
-from rclverify.runtime.dds.bus import NAME_GRACE_S
+from rclverify.runtime.dds.bus import NAME_GRACE_S, Tap
 from rclverify.backends.monitors.dds_calls import CallBook
 from rclverify.runtime.dds.call_plan import CallPlan
 from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, event_side, side_of
@@ -88,7 +88,7 @@ class CallTaps:
         plan = CallPlan(types, links, self.framed, events)  # which topics, read as which structs (call_plan.py)
         self.kinds, self.where, self.specs, self.plan = plan.kinds, plan.where, plan.specs, plan.plan
         self._pair_taps = plan.pair_taps
-        self.taps: dict[str, Any] = {}  # tap key -> the bus's Tap (attach)
+        self.taps: dict[str, Tap] = {}  # tap key -> the bus's Tap (attach)
         self._node_of: Any = lambda guid: None  # a writer's ROS node (the bus's discovery, attach)
         self._ends: Any = None  # name -> (serving nodes, calling nodes): the graph API's (the rclpy bus, attach)
         self._disc: Any = None
@@ -100,7 +100,7 @@ class CallTaps:
         self.shadows: Shadows | None = None  # reply writers that keep services visible to clients (attach)
         self._goal_of: dict[tuple[Any, ...], str] = {}  # send-goal/get-result request id (or event key) -> goal id
         self._status: dict[str, int] = {}
-        self._early: dict[tuple[Any, ...], list[tuple[str, dict[str, Any], float, bool, float, str]]] = {}
+        self._early: dict[tuple[Any, ...], list[tuple[str, Mapping[str, object], float, bool, float, str]]] = {}
         self._queue: list[tuple[float, int, float, str, bytes, bytes | None]] = []
         self._n = 0
         self._pairers: dict[str, OrderPairer] = {}
@@ -460,13 +460,13 @@ class CallTaps:
                                f"{why or 'its request is one of several unanswered'}", "result")
 
     # -- the book --------------------------------------------------------------------------------
-    def _open(self, name: str, key: tuple[Any, ...], label: str, fields: dict[str, Any], stamp: float,
+    def _open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, object], stamp: float,
               part: str = "request", count: bool = True) -> None:
         self.book.open(name, key, label, fields, stamp, part, count)
         for apart, afields, astamp, final, _t, aname in self._early.pop(key, ()):
             self.book.answer(key, apart, afields, astamp, final, aname)
 
-    def _answer(self, key: tuple[Any, ...], part: str, fields: dict[str, Any], stamp: float, final: bool,
+    def _answer(self, key: tuple[Any, ...], part: str, fields: Mapping[str, object], stamp: float, final: bool,
                 name: str, now: float) -> None:
         if key in self.book.calls:
             self.book.answer(key, part, fields, stamp, final, name)

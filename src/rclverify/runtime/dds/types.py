@@ -105,7 +105,7 @@ class TypeBook:
         self._structs: dict[str, type] = {}
         #: per struct: field -> nested struct class (a message or a sequence/array of them), for building
         self.nested: dict[type, dict[str, type]] = {}
-        self._hints: dict[type, dict[str, Any]] = {}
+        self._hints: dict[type, dict[str, object]] = {}
 
     def _add_debian_services(self, share: Path = Path("/usr/share")) -> None:
         """Debian's ``/usr/share/<pkg>/srv`` and ``action`` files for packages the
@@ -163,7 +163,7 @@ class TypeBook:
         from cyclonedds.idl import make_idl_struct  # deferred: start-up (loads cyclonedds and more only when called)
         from cyclonedds.idl import types as T  # deferred: start-up (loads cyclonedds and more only when called)
         info = self._info(name, used_by)
-        fields: dict[str, Any] = {}
+        fields: dict[str, object] = {}
         nested: dict[str, type] = {}
         if header:
             fields[HEADER_FIELDS[0]] = T.uint64

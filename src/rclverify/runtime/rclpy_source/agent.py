@@ -43,7 +43,7 @@ import signal
 import sys
 import threading
 import time
-from typing import Any
+from typing import Any, TypedDict
 
 from importlib.metadata import version
 
@@ -79,7 +79,45 @@ def _class(type_name: str) -> Any:
     return getattr(module, name)
 
 
-def _commands(q: queue.Queue[dict[str, Any] | None], wake: Any) -> None:
+class _Command(TypedDict, total=False):
+    """One command line of the monitor (module docstring): ``op`` and the keys of that op."""
+    op: str
+    id: int
+    topic: str
+    type: str
+    name: str
+    action: bool
+    depth: int
+    reliable: bool
+    transient_local: bool
+    raw: str
+
+
+class _Endpoint(TypedDict):
+    """One endpoint of rclpy's graph as the monitor reads it (:func:`_endpoint`)."""
+    gid: str
+    node: str
+    ns: str
+    type: str
+    hash: str
+    reliable: bool
+    durability: str
+
+
+class _Tap(TypedDict):
+    """A tap's state: its topic and type, the message class (``None``: not importable), the
+    subscription and its QoS (reliable, transient-local) once made, how often it was remade,
+    and the publishers' GIDs it hears."""
+    topic: str
+    type: str
+    cls: Any
+    sub: Any
+    qos: tuple[bool, bool] | None
+    changes: int
+    heard: list[str]
+
+
+def _commands(q: queue.Queue[_Command | None], wake: Any) -> None:
     """Queue each command line, and wake the executor (a guard condition) so it is done at once."""
     for line in sys.stdin:
         if line.strip():
@@ -98,7 +136,7 @@ class Agent:
         self.node = Node(self.name)
         self.ex = SingleThreadedExecutor()
         self.ex.add_node(self.node)
-        self.taps: dict[int, dict[str, Any]] = {}
+        self.taps: dict[int, _Tap] = {}
         self.watched: set[str] = set()
         self.services: dict[str, bool] = {}  # service or action name -> whether an action
         self.ends: dict[str, dict[str, list[str]]] = {}
@@ -116,7 +154,7 @@ class Agent:
                                "python": sys.version.split()[0], "node": self.name}))
 
     # -- commands ------------------------------------------------------------------------------
-    def command(self, c: dict[str, Any]) -> None:
+    def command(self, c: _Command) -> None:
         op = c.get("op")
         if op == "tap":
             try:
@@ -147,7 +185,7 @@ class Agent:
 
     def update(self) -> None:
         """Make or remake each tap's subscription for the publishers in the graph; report changes."""
-        topics: dict[str, list[dict[str, Any]]] = {}
+        topics: dict[str, list[_Endpoint]] = {}
         for t in sorted({t["topic"] for t in self.taps.values()} | self.watched):
             topics[t] = [_endpoint(p) for p in self._publishers(t)]
         if self.services and time.monotonic() >= self.next_ends:
@@ -199,9 +237,11 @@ class Agent:
                     ends[svc]["clients"].add(full)
         return {n: {k: sorted(v) for k, v in e.items()} for n, e in ends.items()}
 
-    def _said(self, k: int, tap: dict[str, Any]) -> None:
-        _emit(wire.json_frame({"what": "tap", "id": k, "reliable": tap["qos"][0],
-                               "durability": "transient_local" if tap["qos"][1] else "volatile",
+    def _said(self, k: int, tap: _Tap) -> None:
+        qos = tap["qos"]
+        assert qos is not None  # said only once the subscription is made
+        _emit(wire.json_frame({"what": "tap", "id": k, "reliable": qos[0],
+                               "durability": "transient_local" if qos[1] else "volatile",
                                "heard": tap["heard"], "changes": tap["changes"]}))
 
     def close(self) -> None:
@@ -209,7 +249,7 @@ class Agent:
         rclpy.try_shutdown()
 
 
-def _endpoint(p: Any) -> dict[str, Any]:
+def _endpoint(p: Any) -> _Endpoint:
     """One endpoint of rclpy's graph (a ``TopicEndpointInfo``) as the monitor reads it."""
     return {"gid": bytes(p.endpoint_gid[:wire.GID_BYTES]).hex(), "node": p.node_name, "ns": p.node_namespace,
             "type": p.topic_type, "hash": str(p.topic_type_hash),
@@ -218,7 +258,7 @@ def _endpoint(p: Any) -> dict[str, Any]:
             else "volatile"}
 
 
-def _matches(qos: tuple[bool, bool] | None, pubs: list[dict[str, Any]]) -> bool:
+def _matches(qos: tuple[bool, bool] | None, pubs: list[_Endpoint]) -> bool:
     """Whether a subscription of ``qos`` (reliable, transient-local) matches every publisher of ``pubs``."""
     if qos is None:
         return False
@@ -239,7 +279,7 @@ def _handler(k: int) -> Any:
     return on_message
 
 
-def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> dict[str, Any]:
+def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> dict[str, object]:
     """The whole graph as rclpy's graph API reports it, once it is settled:
     after ``wait_s`` seconds of discovery, and on (up to ``settle_s`` more)
     until it has not changed for ``quiet_s``.  Each node with its publishers,
@@ -250,7 +290,7 @@ def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> di
     name = f"_rclverify_graph_{os.getpid()}"
     node = Node(name)
 
-    def snapshot() -> dict[str, Any]:
+    def snapshot() -> dict[str, object]:
         nodes = []
         for n, ns in sorted(node.get_node_names_and_namespaces()):
             if n == name:
@@ -260,7 +300,7 @@ def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> di
                           "subs": node.get_subscriber_names_and_types_by_node(n, ns),
                           "servers": node.get_service_names_and_types_by_node(n, ns),
                           "clients": node.get_client_names_and_types_by_node(n, ns)})
-        ends: dict[str, Any] = {}
+        ends: dict[str, dict[str, list[_Endpoint]]] = {}
         for topic, _types in node.get_topic_names_and_types():
             ends[topic] = {role: [_endpoint(p) for p in infos if p.node_name != name]
                            for role, infos in (("pubs", node.get_publishers_info_by_topic(topic)),
@@ -289,7 +329,7 @@ def main() -> int:
         _emit(wire.json_frame(graph_dump(float(sys.argv[2]))))
         return 0
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    q: queue.Queue[dict[str, Any] | None] = queue.Queue()
+    q: queue.Queue[_Command | None] = queue.Queue()
     try:
         agent = Agent()
     except Exception as exc:  # noqa: BLE001 - said to the monitor as one line

@@ -43,7 +43,7 @@ import subprocess
 import threading
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Any, Callable, IO
+from typing import Any, Callable, IO, Mapping
 
 from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.live.dds_qos import QosProfile
@@ -240,7 +240,7 @@ class RclpyBus:
             raise RclpyUnavailable(f"{obj.get('text', 'the rclpy agent could not start')} (in {self.python})")
         self.hello = obj
 
-    def _send(self, obj: dict[str, Any]) -> None:
+    def _send(self, obj: Mapping[str, object]) -> None:
         proc = self._proc
         if proc is None or proc.stdin is None or proc.poll() is not None:
             return

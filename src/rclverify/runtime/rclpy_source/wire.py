@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import json
 import struct
-from typing import IO, Any
+from typing import IO, Mapping
 
 #: the header of every frame: kind (1 byte), payload length
 HEADER = struct.Struct(">cI")
@@ -34,7 +34,7 @@ def sample_frame(tap: int, source_ns: int, received_ns: int, seq: int, gid: byte
     return HEADER.pack(b"S", len(body)) + body
 
 
-def json_frame(obj: dict[str, Any]) -> bytes:
+def json_frame(obj: Mapping[str, object]) -> bytes:
     """One ``J`` frame holding ``obj``."""
     body = json.dumps(obj, separators=(",", ":")).encode()
     return HEADER.pack(b"J", len(body)) + body

@@ -65,6 +65,7 @@ from rclverify.backends.model_checking.ajpf import psl, runner
 from rclverify.backends.model_checking.ajpf.instantiate import Instance, Translator
 from rclverify.backends.model_checking.ajpf.mapping import Row, RowError, build_row
 from rclverify.backends.model_checking.ajpf.results import AjpfResult, parse_log
+from rclverify.backends.shapes import AjpfData
 
 TOOL = "AJPF (MCAPL)"
 DEFAULT_ENV = "ail.mas.DefaultEnvironment"
@@ -290,7 +291,7 @@ class AjpfBackend:
         node = target.node.name
         values = "_".join(f"{k}{v}" for k, v in inst.values)
         file, line, col = self._src_parts(target, clause.loc)
-        data: dict[str, Any] = {
+        data: AjpfData = {
             "instance": dict(inst.values), "rows": list(inst.rows), "notes": list(inst.notes),
             "unmapped": list(inst.unmapped), "guarantee_unmapped": list(g_unmapped), "agent": cfg.agent,
         }
@@ -307,10 +308,10 @@ class AjpfBackend:
         n = numbers[text]
         jpf_rel = target.rel(target.artifacts / f"agent_{n}.jpf")
         log_rel = self._log_rel(cfg, target, n)
-        data.update({"property": n, "psl": text, "trivial": inst.trivial, "jpf": jpf_rel, "ail": ail_rel,
-                     "log": log_rel, "command": runner.user_command(jpf_rel, log_rel)})
+        data["property"], data["psl"], data["trivial"], data["jpf"] = n, text, inst.trivial, jpf_rel
+        data["ail"], data["log"], data["command"] = ail_rel, log_rel, runner.user_command(jpf_rel, log_rel)
         if partial:
-            data.update({"coverage": "partial", "coverage_notes": list(partial)})
+            data["coverage"], data["coverage_notes"] = "partial", list(partial)
         return Obligation(
             id=make_obligation_id(node, g, self.name, f"p{n}_{values}" if values else f"p{n}"),
             node=node, guarantee=g, backend=self.name, kind=self.kind, statement=f"{n}: {text}",

@@ -30,7 +30,8 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Any
+
+from rclverify.backends.shapes import AcceptingPath
 
 _SECTION = re.compile(r"^={6,}\s*(\S.*?)\s*$")
 _SUT = re.compile(r'AJPF_w_AIL\.main\((.*)\)')
@@ -86,7 +87,7 @@ class AjpfResult:
             parts.append(f"JPF {self.jpf_version}")
         return ", ".join(parts) or "unknown"
 
-    def counterexample(self) -> dict[str, Any] | None:
+    def counterexample(self) -> AcceptingPath | None:
         """JSON-ready counterexample for a ``violated`` result, else ``None``.
 
         ``{"accepting_path": ["MS 0, BS 2, UN 0", ...], "trace": ["state 0", "state 1: jackal done move(..)", ...]}``

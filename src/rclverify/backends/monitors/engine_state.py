@@ -1,0 +1,103 @@
+"""The state of :class:`~.engine.NodeMonitor` that its parts share, as types.
+
+The engine is split by job over :mod:`.judging`, :mod:`.closing` and
+:mod:`.late` (each a mixin of :class:`~.engine.NodeMonitor`); each part
+reads the engine's state and calls the others' helpers.  :class:`EngineState`
+is their typed base: the attributes :class:`~.engine.NodeMonitor` sets (in
+its ``__init__`` and the methods it calls there) and, for the type checker
+only, the helpers one part calls of another, with their signatures.  It
+holds no value and no behaviour of its own.
+"""
+from __future__ import annotations
+
+from collections import deque
+from typing import TYPE_CHECKING, Any, Mapping
+
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.semantics.floatsem import Judgement, Tolerance
+from rclverify.semantics.judges import FormulaJudge
+from rclverify.traces.events import Event
+from rclverify.traces.questions import Question, QuestionStream
+from rclverify.backends.monitors.verdicts import NodeResult
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.answered import Recent
+    from rclverify.backends.monitors.outcome import Outcome
+
+
+class EngineState:
+    """The engine's state its parts read (module docstring); set by :class:`~.engine.NodeMonitor`."""
+
+    # the contract and the run (engine.py ``__init__``, ``_read_contract``)
+    checked: Checked
+    node: CheckedNode
+    horizon: float
+    tolerance: Tolerance | None
+    result: NodeResult
+    values: dict[str, object]
+    invalid: dict[str, str]
+    assumption: tuple[ast.Expr, ...]
+    guarantees: tuple[ast.Expr, ...]
+    needed_inputs: list[str]
+    unbound: list[str]
+    cache_size: int
+    _topic_io: dict[str, tuple[frozenset[str], list[str]]]
+    _trigger: dict[int, str]
+    _triggers: frozenset[str]
+    _texts: dict[int, str]
+    _renders: dict[int, tuple[Any, str]]
+    # which formula reads what (``_sort_guarantees``)
+    _deps: dict[Any, tuple[str, ...]]
+    _asked: list[int]
+    _need: list[int]
+    _reads_out: dict[int, bool]
+    _state_outs: list[str]
+    _touch: dict[str, tuple[list[int], list[int]]]
+    # the questions' stream and what the engine remembers of the run (``_start_stream``)
+    stream: QuestionStream
+    heard_answer: bool
+    _recent: deque[Recent]
+    _held: deque[tuple[Any, ...]]
+    _released: deque[Recent]
+    _unread: dict[str, tuple[float, str]]
+    _in_force: dict[str, list[tuple[float, Any, Event]]]
+    _open: Question | None
+    _due: float
+    _lost: set[int]
+    # the judges (``_make_judges``)
+    _cache: dict[tuple[Any, tuple[Any, ...]], Judgement]
+    _assumed: list[tuple[tuple[str, int], ast.Expr]]
+    _guaranteed: dict[int, ast.Expr]
+    _judges: dict[Any, FormulaJudge]
+
+    if TYPE_CHECKING:  # the helpers one part calls of another (defined in engine.py and the parts)
+        def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
+                     reason: str = "", semantics: str = "", question: str = "") -> None: ...
+
+        def _state(self) -> dict[str, object]: ...
+
+        def _raise(self, ev: Event, q: Question, trig: frozenset[str], refusal: str) -> None: ...
+
+        def _judge(self, k: Any, values: Mapping[str, object]) -> Judgement: ...
+
+        def _rendered(self, values: Mapping[str, object]) -> dict[str, str]: ...
+
+        def _note_inexact(self, ev: Event, judged: Judgement, what: str, values: Mapping[str, object]) -> None: ...
+
+        def _owes(self, q: Question, k: int) -> bool: ...
+
+        def _question_outcome(self, q: Question | None, ev: Event, ks: list[int], outs: Mapping[str, object],
+                              state: Mapping[str, object], keep: bool = True) -> Outcome: ...
+
+        def _accept(self, ev: Event, inputs: dict[str, object]) -> tuple[bool, str, str]: ...
+
+        def _violation(self, ev: Event, k: int, values: Mapping[str, object], reason: str, semantics: str,
+                       trigger: Event | None) -> None: ...
+
+        def _unbound_note(self, reason: str) -> str: ...
+
+        def _at_due(self, t: float, due: float) -> bool: ...
+
+
+__all__ = ["EngineState"]

@@ -1,0 +1,142 @@
+"""The calculus's own JSON records and Python-side rows, as TypedDicts.
+
+What a temporal requirement's record says is missing from the contracts
+(:class:`Gaps`: the progress a node should declare, the initial values a
+producer should declare; calculus/requirements/progress_gap.py), a node
+idle in a lasso's loop (:class:`IdleNode`).  The sealed stage records
+themselves are :mod:`rclverify.records.stage_records`.
+"""
+# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
+# annotations (with string annotations every key would count as required).
+from typing import NotRequired, TypedDict
+
+from rclverify.records.stage_records import Premise, Traced
+
+
+class IdleNode(TypedDict):
+    """A node that accepts its input in a lasso's loop (``accepted_at``: steps) and never answers there."""
+    node: str
+    accepted_at: list[int]
+
+
+class MissingProgress(TypedDict):
+    """A progress declaration a lasso shows missing: the node, its header (``file:line:col``),
+    what it declares (``none``), the steps it accepted at, and the fix."""
+    node: str
+    source: str
+    declared: str
+    accepted_at: list[int]
+    fix: str
+
+
+class StuckProducer(TypedDict):
+    """A producer that keeps a lasso stuck: its header, the output and the value it keeps (or
+    ``none: never published``), and the consumer's input (``Node.in.x``)."""
+    node: str
+    source: str
+    output: str
+    value: str
+    consumer: str
+
+
+class Gaps(TypedDict, total=False):
+    """What a lasso says is missing (``missing_progress``, ``missing_initially``); filled as found."""
+    missing_progress: list[MissingProgress]
+    missing_initially: list[StuckProducer]
+
+
+class Vacuity(TypedDict, total=False):
+    """The vacuity fields of a proved temporal statement (calculus/requirements/exercised.py
+    ``vacuity``): none for a shape that reaches its goal; ``never_publish`` the silent nodes
+    when the connections decided it."""
+    vacuity: str
+    vacuity_core: list[Premise]
+    vacuity_reason: str
+    never_publish: list[str]
+
+
+class TraceNode(TypedDict):
+    """One node's values at one step of a temporal trace (RCL text)."""
+    node: str
+    values: dict[str, str]
+
+
+class TraceStep(TypedDict):
+    """One step of a temporal trace, node by node (the record's ``temporal.trace``)."""
+    step: int
+    nodes: list[TraceNode]
+
+
+class DeclarationEvidence(TypedDict):
+    """A declaration a requirement's proof used, with its evidence (calculus/requirements/rollup.py)."""
+    label: str
+    node: str
+    kind: str
+    index: int
+    text: str
+    source: str
+    status: str
+    words: str
+
+
+class RequirementBase(TypedDict):
+    """The keys of a requirement's record that come from the plan alone (calculus/requirements/check.py
+    ``_base``): ``source`` ``file:line:col``, the statements as RCL text."""
+    id: str
+    text: str
+    origin: str
+    source: str
+    formal: str | None
+    assuming: list[str]
+    ranking: str | None
+    invariant: str | None
+    traced: list[Traced]
+
+
+class LocalVerdict(TypedDict):
+    """A side condition's local verdict, kept when it is decided again in context."""
+    status: str
+    variant: str
+    model: dict[str, str] | None
+
+
+class ContextRecord(TypedDict):
+    """How a side condition's in-context check went (calculus/side_condition.py ``in_context``):
+    the cone's size, the premises and nodes the proof used, the links opened (rule R4), the nodes
+    whose assumption the counterexample violates, the joins read, the local verdict, and the
+    producers whose cone summaries the proof read."""
+    cone: int
+    used: list[str]
+    used_nodes: list[str]
+    opened: list[str]
+    violated: list[str]
+    joins: list[str]
+    local: LocalVerdict
+    summaries: NotRequired[list[str]]
+
+
+class ScaleMismatch(TypedDict):
+    """A probable scale mismatch behind a side condition (calculus/scale.py): both ends and their
+    ranges (text, ``-oo``/``+oo`` unbounded), the power of ten (0: a named conversion), the factor
+    and the sentence."""
+    producer: str
+    consumer: str
+    producer_range: list[str]
+    consumer_range: list[str]
+    power: int
+    factor: str
+    message: str
+
+
+class TemporalVerdictJson(TypedDict):
+    """A temporal statement's verdict as its record keeps it (calculus/requirements/tsys.py
+    ``TemporalVerdict.to_json``): ``trace`` one ``{variable: text}`` per step."""
+    status: str
+    method: str
+    k: int | None
+    bound: int | None
+    trace: list[dict[str, str]]
+    detail: str
+    loop: int | None
+    deadlock: str
+    certificate: str

@@ -1,0 +1,407 @@
+"""The shapes of what report/ writes beside the report itself, as types: one TypedDict per record.
+
+The report's own rows are :mod:`rclverify.records.report_schema`'s and the
+stages' sealed records :mod:`rclverify.records.stage_records`'s; this module
+holds only what report/ builds on top of them: the SARIF log's objects
+(report/sarif.py, SARIF 2.1.0), the views the templates and the terminal
+read (report/view.py, report/summary.py), the statistics table
+(report/statistics.py).  A key written only in some cases is ``NotRequired``.
+A value only passed on to JSON (a result's ``properties``) is ``object``.
+"""
+# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
+# annotations (with string annotations every key would count as required).
+from typing import Any, NotRequired, Sequence, TypedDict
+
+from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceRow, FindingRow, NodeRow,
+                                             LimitedBy, ObligationRow, PendingRow, ProblemRow, RequirementRow, SideConditionRow,
+                                             Summary, SupportRow)
+
+
+class SarifText(TypedDict):
+    """A SARIF ``message`` (§3.11): plain text."""
+    text: str
+
+
+class SarifArtifactLocation(TypedDict):
+    """A file relative to the workspace root (§3.4)."""
+    uri: str
+    uriBaseId: str
+
+
+class SarifRegion(TypedDict):
+    """A place in a file (§3.30): 1-based line, the column when known."""
+    startLine: int
+    startColumn: NotRequired[int]
+
+
+class SarifPhysicalLocation(TypedDict):
+    """A file and a place in it (§3.29)."""
+    artifactLocation: SarifArtifactLocation
+    region: SarifRegion
+
+
+class SarifLocation(TypedDict):
+    """A result's location (§3.28); ``id`` and ``message`` only for a related location."""
+    physicalLocation: SarifPhysicalLocation
+    id: NotRequired[int]
+    message: NotRequired[SarifText]
+
+
+class SarifSuppression(TypedDict):
+    """A plan acknowledgement of a result (§3.35): ``kind`` external, ``status`` accepted."""
+    kind: str
+    status: str
+    justification: str
+    location: NotRequired[SarifLocation]
+
+
+class SarifResult(TypedDict):
+    """One SARIF ``result`` (§3.27); ``partialFingerprints`` holds the item's stable key,
+    ``properties`` the item's fields (JSON values, only written), ``fixes`` the checked repairs."""
+    ruleId: str
+    level: str
+    message: SarifText
+    locations: list[SarifLocation]
+    partialFingerprints: dict[str, str]
+    properties: dict[str, object]
+    relatedLocations: NotRequired[list[SarifLocation]]
+    suppressions: NotRequired[list[SarifSuppression]]
+    fixes: NotRequired[Sequence[object]]
+    ruleIndex: NotRequired[int]
+
+
+class SarifLevel(TypedDict):
+    """A rule's ``defaultConfiguration`` (§3.50)."""
+    level: str
+
+
+class SarifDescriptor(TypedDict):
+    """A rule as the driver lists it (§3.49, ``reportingDescriptor``)."""
+    id: str
+    name: str
+    shortDescription: SarifText
+    defaultConfiguration: SarifLevel
+
+
+class SarifDriver(TypedDict):
+    """The tool that made the log (§3.19): rclverify, its version and every rule it may report."""
+    name: str
+    version: str
+    rules: list[SarifDescriptor]
+
+
+class SarifTool(TypedDict):
+    """A run's ``tool`` (§3.18)."""
+    driver: SarifDriver
+
+
+class SarifRun(TypedDict):
+    """The one run of the log (§3.14); ``properties`` the report's workspace, plan, status and gate."""
+    tool: SarifTool
+    originalUriBaseIds: dict[str, object]
+    columnKind: str
+    results: list[SarifResult]
+    properties: dict[str, object]
+
+
+#: ``reports/assurance.sarif`` (§3.13): the schema, the version and one run.
+SarifLog = TypedDict("SarifLog", {"$schema": str, "version": str, "runs": list[SarifRun]})
+
+
+class NodeSummaryRow(TypedDict):
+    """A node's row of the terminal summary (report/summary.py ``node_rows``): ``obligations`` status ->
+    count, side conditions proved of all, health checks by outcome, ``unverified`` the guarantees
+    (``g<k>``) no obligation covers; ``order`` its place in the report and ``culprit`` (a problem's
+    culprit is in it) only for a node's own row, not for a merged one."""
+    node: str
+    status: str
+    obligations: dict[str, int]
+    sc_proved: int
+    sc_total: int
+    health_problems: int
+    health_open: int
+    health_total: int
+    health_warnings: int
+    unverified: list[str]
+    order: NotRequired[int]
+    culprit: NotRequired[bool]
+
+
+class SummaryMeta(TypedDict):
+    """The report's ``meta`` as the summary keeps it."""
+    workspace: str
+    strict_ok: bool
+
+
+class ProblemBrief(TypedDict):
+    """A problem group as the terminal shows it: culprits as ``what (file:line:col)``, the finding ids
+    behind it, how many repairs Z3 checked."""
+    status: str
+    sentence: str
+    culprits: list[str]
+    where: str
+    members: list[str]
+    repairs: int
+
+
+class GroundingBrief(TypedDict):
+    """The ROS grounding as the terminal shows it: error and warning counts, each error one line."""
+    error: int
+    warning: int
+    errors: list[str]
+
+
+class SummaryData(TypedDict):
+    """``artifacts/report/summary.json`` (report/summary.py ``summary_data``): what ``verify`` prints.
+    ``requirements`` rows are ``[id, verdict, status]``, ``deadlines`` rows ``[requirement, verdict,
+    total, bound, evidence status]``; ``strict`` the clauses a failed ``--strict`` names."""
+    meta: SummaryMeta
+    summary: Summary
+    rows: list[NodeSummaryRow]
+    unverified: list[str]
+    requirements: list[list[str]]
+    deadlines: list[list[str]]
+    problems: list[ProblemBrief]
+    grounding: GroundingBrief | None
+    strict: list[str]
+    acknowledged: list[str]
+
+
+class AttentionItem(TypedDict):
+    """An item that needs attention (report/view.py ``_attention``): ``formula`` RCL text shown as code, or ''."""
+    status: str
+    kind: str
+    ref: str
+    anchor: str
+    where: str
+    message: str
+    formula: str
+
+
+class AttentionGroup(TypedDict):
+    """Attention items that say the same thing, numbers aside (report/view.py ``group_items``)."""
+    status: str
+    kind: str
+    where: str
+    message: str
+    items: list[AttentionItem]
+
+
+class PendingGroup(TypedDict):
+    """The pending rows of one backend with one reason, numbers aside."""
+    backend: str
+    reason: str
+    items: list[PendingRow]
+
+
+class DashboardCell(TypedDict):
+    """A node's items of one technique: the worst status, how many have it of ``total``, the
+    ``counts`` ``[(status, n)]`` worst first, the fragment id of the first worst item."""
+    status: str
+    worst: int
+    total: int
+    counts: list[tuple[str, int]]
+    anchor: str
+
+
+class DashboardRow(TypedDict):
+    """A node's row of the dashboard: one cell per technique (``None``: no item of it)."""
+    node: str
+    status: str
+    cells: list[DashboardCell | None]
+    culprit: bool
+
+
+class Dashboard(TypedDict):
+    """The dashboard's matrix (report/view.py ``dashboard``): techniques against nodes."""
+    columns: list[str]
+    rows: list[DashboardRow]
+
+
+class TraceObligation(TypedDict):
+    """An obligation a supporting guarantee lists, with its status and evidence ``[(anchor, record)]``."""
+    id: str
+    known: bool
+    status: str
+    backend: str
+    evidence: list[tuple[str, EvidenceRow]]
+
+
+class TraceSupport(TypedDict):
+    """A guarantee that supports a requirement, with its obligations."""
+    support: SupportRow
+    obligations: list[TraceObligation]
+
+
+class TraceEntry(TypedDict):
+    """A requirement's traceability rows; ``rowspan`` the rows it spans."""
+    req: RequirementRow
+    rows: list[TraceSupport]
+    rowspan: int
+
+
+class Section(TypedDict):
+    """A node's section (``node`` ``None`` for a name only the calculus knows); ``ob_status`` the status of
+    each obligation its guarantees list."""
+    name: str
+    node: NodeRow | None
+    derived: list[DerivedPropertyRow]
+    side: list[SideConditionRow]
+    findings: list[FindingRow]
+    ob_status: NotRequired[dict[str, str]]
+
+
+class ObligationRun(TypedDict):
+    """An obligation's row of the obligations table: the fragment ids of its evidence records."""
+    obligation: ObligationRow
+    evidence: list[str]
+
+
+class EvidenceRun(TypedDict):
+    """An evidence record with its fragment id."""
+    anchor: str
+    record: EvidenceRow
+
+
+class TableRuns(TypedDict):
+    """The health, obligations and evidence tables' rows cut into runs of one node each."""
+    finding_runs: list[list[FindingRow]]
+    obligation_runs: list[list[ObligationRun]]
+    evidence_runs: list[list[EvidenceRun]]
+
+
+class ReportView(TableRuns):
+    """What the templates read beside the report (report/view.py ``view``); ``problem_groups`` the problems
+    by root cause (the report's rows, or grouped now), ``diagnosis`` id -> record, ``counts``
+    ``[(status, n)]`` worst first, ``evidence_of`` obligation id -> ``[(anchor, record)]``."""
+    dashboard: Dashboard
+    problem_groups: list[ProblemRow] | list[dict[str, Any]]
+    diagnosis: dict[str, DiagnosisRow]
+    counts: list[tuple[str, int]]
+    problems: list[AttentionItem]
+    outstanding: list[AttentionItem]
+    outstanding_groups: list[AttentionGroup]
+    pending_groups: list[PendingGroup]
+    unmet_requirements: list[RequirementRow]
+    ev_anchor: list[str]
+    evidence_of: dict[str, list[tuple[str, EvidenceRow]]]
+    obligation: dict[str, ObligationRow]
+    trace: list[TraceEntry]
+    sections: list[Section]
+    lint_errors: int
+
+
+class RunGroupRow(TypedDict):
+    """A row of the report's ``statistics`` table: the monitored runs of a node under one environment tag and
+    origin, counted once each, with the one-sided bound at ``level`` (``None``: no judged run)."""
+    node: str
+    environment: str
+    origin: str
+    kind: str
+    counts: dict[str, int]
+    recorded: dict[str, int]
+    level: float
+    bound: float | None
+    note: str
+
+
+class TargetRow(TypedDict):
+    """A row of the ``statistics`` table: a target's decision as its evidence record gives it."""
+    node: str
+    environment: str
+    origin: str
+    kind: str
+    obligation: str
+    backend: str
+    status: str
+    target: str | None
+    counts: dict[str, int] | None
+    recorded: dict[str, int]
+    level: float | None
+    bound: float | None
+    runs_needed: int | None
+    sprt: str | None
+
+
+class RequirementRuns(TypedDict):
+    """A requirement's runs under one environment tag and origin (``requirements[].statistics[]``), decided
+    against its target when it states one."""
+    environment: str
+    origin: str
+    counts: dict[str, int]
+    bound: float
+    note: NotRequired[str]
+    level: float
+    target: NotRequired[str]
+    status: NotRequired[str]
+    explanation: NotRequired[str]
+    runs_needed: NotRequired[int | None]
+    sprt: NotRequired[str | None]
+
+
+class RequirementRunsRow(RequirementRuns):
+    """:class:`RequirementRuns` as a row of the ``statistics`` table: with its requirement."""
+    requirement: str
+    kind: str
+
+
+class RunGroupBound(TypedDict):
+    """A per-run evidence row's ``statistics.group``: its group's runs and bound at ``level``."""
+    runs: int
+    bound: float | None
+    level: float
+
+
+class Confidence(TypedDict):
+    """A claim's confidence (docs/confidence.md) as the row keys it adds; ``limited_by`` ``None`` without premises."""
+    confidence: float
+    limited_by: LimitedBy | None
+
+
+class RequirementConfidence(TypedDict, total=False):
+    """What the confidence pass adds to a formal requirement's row: :class:`Confidence`'s keys and, when the
+    plan asks a least strength of its proof's guarantees, that strength and the guarantees short of it."""
+    required_strength: str
+    strength_shortfall: list[str]
+    confidence: float
+    limited_by: LimitedBy | None
+
+
+class ElementJson(TypedDict):
+    """A GSN element as ``reports/argument.json`` holds it (report/argument/model.py ``Element.to_json``):
+    ``challenges`` and ``defeated`` only for counter-evidence, ``acp`` name -> references only with claim points."""
+    id: str
+    type: str
+    text: str
+    status: str | None
+    supported_by: list[str]
+    in_context_of: list[str]
+    undeveloped: bool
+    ref: str
+    url: str
+    challenges: NotRequired[list[str]]
+    defeated: NotRequired[bool]
+    acp: NotRequired[dict[str, list[str]]]
+
+
+class ArgumentJson(TypedDict):
+    """``reports/argument.json``: the top goal's id and every element in order."""
+    top: str
+    elements: list[ElementJson]
+
+
+class NodeTexts(TypedDict):
+    """The texts of one node (report/contract_texts.py ``node_texts``): its RCL and LaTeX, its ports as
+    ``[name, type with unit]`` and its assumptions and guarantees as ``[formula, "file:line:col"]``."""
+    rcl: str
+    latex: str
+    inputs: list[list[str]]
+    outputs: list[list[str]]
+    assumptions: list[list[str]]
+    guarantees: list[list[str]]
+
+
+class FileTexts(TypedDict):
+    """One contract file's kept texts: node name -> :class:`NodeTexts`, and its lint warnings' JSON once made."""
+    nodes: dict[str, NodeTexts]
+    lint: NotRequired[list[dict[str, Any]]]
