@@ -11,7 +11,7 @@ what was deleted nearby in the last minutes: on the 2-core machine of
 docs/scale.md, 32 µs a file in a fresh folder, 160 µs after 1,000
 deletions in the same folder, 505 µs after 4,000.  A bench that removed
 one run's workspace and then timed the next one in the same folder
-charged that run for its own clean-up (docs/scale.md, round sixteen).
+charged that run for its own clean-up (docs/scale.md, "Measuring").
 
 :func:`scratch` therefore keeps every workspace of a bench until the bench
 ends, and :func:`describe` names the file system in the bench's header, so

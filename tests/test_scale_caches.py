@@ -1,4 +1,4 @@
-"""The speed-ups of docs/scale.md ("Second round") keep their outputs: the
+"""The caches of docs/scale.md ("What is kept between runs") keep their outputs: the
 outline printer's text, and Graphviz layouts reused from the cache."""
 from __future__ import annotations
 

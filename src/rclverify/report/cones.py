@@ -35,7 +35,7 @@ class ConeEvidence:
 
     The cones of a 1000-node chain hold half a million names; grouping them
     name by name took 0.3-0.5 s of every report build (docs/scale.md,
-    seventh round).  Here a cone is a bit mask over the system's nodes
+    "The 1000-node system").  Here a cone is a bit mask over the system's nodes
     (``order``; :meth:`rclverify.model.system.model.SystemModel.upstream_masks`)
     and so is each status, so a cone's count per status is a popcount and
     the first :data:`CONE_NAMES` names of a status are its lowest bits.

@@ -4,7 +4,7 @@ The check stage and the report print every node of the system again on
 every run: its RCL text (the snapshot), the RCL text of each assumption and
 guarantee, its LaTeX, and each file's lint warnings.  For a 1000-node
 system that was 0.2 s of the check task and 0.2-0.3 s of each report task
-after a one-contract edit (docs/scale.md, seventh round), although only the
+after a one-contract edit (docs/scale.md, "What is kept between runs"), although only the
 edited file's texts can differ.  They are pure functions of a file's text,
 so they are kept in ``artifacts/cache/contract-texts.pickle``, a
 :class:`~rclverify.core.cache.store.Shelf` of kind ``contract-texts``, per

@@ -4,7 +4,7 @@ Every file under ``reports/`` is a rendering of one report dict
 (:func:`rclverify.report.build.build_report`).  Rendering them one after
 the other was the longest serial stretch of a run: on a 1000-node system,
 about 9 s after every backend had finished, with the second core idle
-(docs/scale.md, sixth round).  The files fall into two parts of about the
+(docs/scale.md, "Where the time goes").  The files fall into two parts of about the
 same cost, which ``doit -n 2`` renders at once in two processes (each
 builds the report dict from the same artifacts; a serial run builds it
 once, :func:`rclverify.app.tasks.act_report`):
