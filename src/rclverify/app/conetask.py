@@ -62,10 +62,10 @@ class ConeUnchanged:
             return True
         return self.cone_rel in rec["compose"]
 
-    def _save(self) -> dict[str, Any]:
+    def _save(self) -> dict[str, str]:
         return {self.KEY: _relevant(self._read(), self._used_cone())}
 
-    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+    def __call__(self, task: Any, values: Mapping[str, object]) -> bool:
         task.value_savers.append(self._save)
         saved = values.get(self.KEY)
         if not isinstance(saved, str):

@@ -28,7 +28,7 @@ import hashlib
 
 import dataclasses
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Sequence, cast
+from typing import TYPE_CHECKING, Any, Mapping, Sequence, TypeGuard, cast
 
 from rclverify.records.records import Evidence, Obligation
 from rclverify.records.sealed import write_sealed
@@ -45,6 +45,7 @@ from rclverify.records.sealed import read_sealed
 
 if TYPE_CHECKING:
     from rclverify.calculus.health.checks import Finding
+    from rclverify.model.plan.model import EvidenceEntry
     from rclverify.records.report_schema import Report
     from rclverify.records.stage_records import (CheckRecord, CompositionRecord, DeadlineRecord, DiagnosisRecord,
                                                  HealthFinding, ObligationRecord, RequirementRecord)
@@ -125,6 +126,8 @@ def stage_compose(ws: Workspace, node: str) -> CompositionRecord:
         summary.use_directory(None)  # this workspace's only: a later computation in the process keeps its own
     paths = [f"artifacts/calculus/{sc.id}.smt2" for sc in comp.side_conditions]
     out = composition_json(comp, paths)
+    if not _is_composition(out):
+        raise ValueError(f"the composition of {node} has no node or side conditions")
     for sc, rel, row in zip(comp.side_conditions, paths, out["side_conditions"]):
         atomic_write_text(ws.path(rel), tie_query(sc.smt2, "side-condition", sc.id, row))  # records/ties.py
     write_sealed(ws.path(ws.calculus(node)), out)
@@ -132,7 +135,12 @@ def stage_compose(ws: Workspace, node: str) -> CompositionRecord:
     # condition was decided in context (the doit task re-runs on any change of the cone: derived property)
     record_provenance(ws, node, "compose", stage_inputs(ws, node, "compose",
                                                         any(sc.context for sc in comp.side_conditions)))
-    return cast("CompositionRecord", out)
+    return out
+
+
+def _is_composition(record: Mapping[str, object]) -> TypeGuard[CompositionRecord]:
+    """Does ``record`` (calculus/compose.py ``composition_json``) name its node and list its side conditions?"""
+    return isinstance(record.get("node"), str) and isinstance(record.get("side_conditions"), list)
 
 
 def plan_facts(ws: Workspace) -> dict[str, list[Any]]:
@@ -219,7 +227,7 @@ def stage_export(ws: Workspace, node: str) -> list[ObligationRecord]:
     obligations = []
     shared = set(ws.plan.contracts) | {ws.plan.file}
     snapshot = ws.snapshot(node)
-    first_entry: dict[str, Any] = {}  # obligation id -> the entry that gave it
+    first_entry: dict[str, EvidenceEntry] = {}  # obligation id -> the entry that gave it
     for entry in ws.plan.evidence.get(node, ()):
         backend = get_backend(entry.backend)
         for o in backend.export(ws.target(node, entry.index)):
@@ -245,7 +253,7 @@ def stage_export(ws: Workspace, node: str) -> list[ObligationRecord]:
     for old in ws.path(f"artifacts/obligations/{node}").glob("*.json"):
         if old.name not in keep:
             old.unlink()
-    return cast("list[ObligationRecord]", [o.to_json() for o in obligations])
+    return [o.to_json() for o in obligations]
 
 
 def ast_loc(rel: str) -> Any:
@@ -274,17 +282,17 @@ def stage_run(ws: Workspace, node: str, obligation_id: str) -> Evidence:
 def stage_requirements(ws: Workspace, *, force: bool = False) -> list[tuple[RequirementRecord, bool]]:
     """Check every requirement with Z3; see :mod:`rclverify.stages.requirements`."""
     from rclverify.stages.requirements import stage_requirements as run  # deferred: start-up (loads rclverify.stages.requirements only when called)
-    return cast("list[tuple[RequirementRecord, bool]]", run(ws, force=force))
+    return run(ws, force=force)
 
 
 def stage_deadlines(ws: Workspace) -> list[DeadlineRecord]:
     """Decide every end-to-end deadline with Z3 (rule D3); see
     :mod:`rclverify.stages.deadlines`.  Returns the records written."""
     from rclverify.stages.deadlines import stage_deadlines as run  # deferred: start-up (loads yaml, z3 and more only when called)
-    return cast("list[DeadlineRecord]", run(ws)[1])
+    return run(ws)[1]
 
 
-def stage_diagnosis(ws: Workspace, report: dict[str, Any] | None = None) -> DiagnosisRecord:
+def stage_diagnosis(ws: Workspace, report: Mapping[str, object] | None = None) -> DiagnosisRecord:
     """The diagnosis stage: explain every problem of the report dict without
     diagnoses (``report``, else built now:
     :func:`rclverify.report.build.undiagnosed_report`) with repairs checked
@@ -294,12 +302,13 @@ def stage_diagnosis(ws: Workspace, report: dict[str, Any] | None = None) -> Diag
     ``RclError`` for contracts or a plan that do not check, ``OSError``
     when the record cannot be written."""
     from rclverify.diagnosis.build import diagnose  # deferred: start-up (loads z3, lark and more only when called)
+    from rclverify.diagnosis.shapes import report_rows  # deferred: start-up (loads rclverify.diagnosis only when called)
     from rclverify.report.build import undiagnosed_report  # deferred: start-up (loads jinja2, lark and more only when called)
     from rclverify.stages.diagnoses import report_digest, write_diagnoses  # deferred: start-up (loads rclverify.stages.diagnoses only when called)
     if report is None:
         report = undiagnosed_report(ws)
     digest = report_digest(report)  # taken first: the records explain the report as it was given
-    return write_diagnoses(ws, digest, diagnose(ws, report))
+    return write_diagnoses(ws, digest, diagnose(ws, report_rows(report)))
 
 
 def diagnosed(ws: Workspace, report: dict[str, Any] | None = None) -> Report:

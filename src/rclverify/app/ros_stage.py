@@ -15,10 +15,10 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path, PurePosixPath
-from typing import Any, cast
+from typing import Any
 
 from rclverify.lang import ast
-from rclverify.records.stage_records import GroundingRecord
+from rclverify.records.stage_records import GroundedNode, GroundingContext, GroundingRecord
 from rclverify.model.plan.errors import plan_error
 from rclverify.ros.extract import names
 from rclverify.ros.graph.inputs import input_files
@@ -96,16 +96,14 @@ def stage_ground(ws: Any) -> GroundingRecord:
     graph_json = g.to_json()
     counts = {"error": sum(f.severity == "error" for f in findings),
               "warning": sum(f.severity == "warning" for f in findings)}
-    data: dict[str, Any] = {
-        "findings": [f.to_json() for f in findings],
-        "counts": counts,
-        "graph": {"nodes": [{"name": n["name"], "publishes": [e["topic"] for e in n["publishes"]],
-                             "subscribes": [e["topic"] for e in n["subscribes"]]} for n in graph_json["nodes"]]},
-        "context": {
-            "packages": [{"name": p["name"], "version": p["version"]} for p in graph_json["packages"]],
-            "files": graph_json["files"],
-            "launch": [str(p.relative_to(ws.root)) for p in launch],
-        },
+    found = [f.to_json() for f in findings]
+    graph: dict[str, list[GroundedNode]] = {
+        "nodes": [{"name": n["name"], "publishes": [e["topic"] for e in n["publishes"]],
+                   "subscribes": [e["topic"] for e in n["subscribes"]]} for n in graph_json["nodes"]]}
+    context: GroundingContext = {
+        "packages": [{"name": p["name"], "version": p["version"]} for p in graph_json["packages"]],
+        "files": graph_json["files"],
+        "launch": [str(p.relative_to(ws.root)) for p in launch],
     }
     from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.core and more only when called)
     from rclverify.ros.graph.draw import grounding_dot  # deferred: start-up (loads jinja2, rclverify.ros and more only when called)
@@ -113,19 +111,19 @@ def stage_ground(ws: Any) -> GroundingRecord:
     ignore = {names.normalise(n) for n in ros.get("ignore", []) or []}
     pairs = match_nodes(ws.checked.nodes, {k: v for k, v in g.nodes.items() if k not in ignore},
                         dict(ros.get("nodes", {}) or {}))
-    dot = grounding_dot(ws.checked, graph_json, data["findings"], pairs)
+    dot = grounding_dot(ws.checked, graph_json, found, pairs)
     svg = dot_to_svg(dot)
-    data["drawing"] = {"dot": DOT, "svg": SVG if svg is not None else None}
-    data["matched"] = dict(pairs)
     atomic_write_text(ws.path(DOT), dot)
     if svg is not None:
         atomic_write_text(ws.path(SVG), svg)
     atomic_write_text(ws.path(GRAPH), json.dumps(graph_json, indent=2) + "\n")
     from rclverify.records.records import hash_inputs  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
     from rclverify.records.sealed import write_sealed  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
-    data["inputs"] = hash_inputs(ws.root, input_files(ws))
+    data: GroundingRecord = {"findings": found, "counts": counts, "graph": graph, "context": context,
+                             "drawing": {"dot": DOT, "svg": SVG if svg is not None else None}, "matched": dict(pairs),
+                             "inputs": hash_inputs(ws.root, input_files(ws))}
     write_sealed(ws.path(GROUNDING), data)  # sealed: the report reads it (records/sealed.py)
-    return cast(GroundingRecord, data)
+    return data
 
 
 def run_check(root: Path, plan: str, strict: bool, json_out: str | None) -> int:

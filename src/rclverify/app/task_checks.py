@@ -86,7 +86,7 @@ class TargetsAsWritten:
     __signature__ = UPTODATE_SIGNATURE
     KEY = "_targets_stat"
 
-    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+    def __call__(self, task: Any, values: Mapping[str, object]) -> bool:
         targets = list(task.targets)
         task.value_savers.append(lambda: {self.KEY: _stats(targets)})
         now = _stats(targets)
@@ -107,7 +107,7 @@ class RecordIntact:
 
     __signature__ = UPTODATE_SIGNATURE
 
-    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+    def __call__(self, task: Any, values: Mapping[str, object]) -> bool:
         target = task.targets[0]
 
         def saved() -> dict[str, list[int] | None]:
@@ -189,12 +189,12 @@ def z3_version() -> str:
         return "-"
 
 
-def tool_fingerprint() -> dict[str, Any]:
+def tool_fingerprint() -> dict[str, str | None]:
     """The tools the backends run, as found now: rclverify's version, the path of ``dot``, and each
     tool the backends' declarations name (``tools[]``: a command's path on ``PATH``, or the first set
     of its environment variables; ``None`` when absent).  Another value makes every evidence record
     again (the evidence tasks' ``config_changed``)."""
-    found: dict[str, Any] = {"rclverify": __version__, "dot": shutil.which("dot")}
+    found: dict[str, str | None] = {"rclverify": __version__, "dot": shutil.which("dot")}
     for d in DECLARATIONS.values():
         for t in d.tools:
             found[t.name] = shutil.which(t.which) if t.which else next(

@@ -20,7 +20,7 @@ import json
 import os
 import shutil
 from pathlib import Path
-from typing import Any, Callable, Iterator, TypeVar, cast
+from typing import Any, Callable, Iterator, Mapping, TypeVar, cast
 
 from doit import create_after as _create_after
 from doit.tools import config_changed
@@ -28,6 +28,7 @@ from doit.tools import config_changed
 from rclverify.core.cache import code_stamp
 from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_diagnosis, act_graph, act_ground,
                                         act_node, act_report, act_requirements, act_run, act_verify)
+from rclverify.app.shapes import DoitTask
 from rclverify.app.task_checks import (RecordIntact, TargetsAsWritten, entry_inputs, ros_fingerprint, strict_uptodate,
                                        tool_fingerprint, z3_version)
 from rclverify.stages.workspace import REPORT_PARTS, TaskIndex, Workspace, check_input_files
@@ -48,7 +49,7 @@ def _signed(check: _C) -> _C:
     return check
 
 
-def _digested(config: dict[str, Any]) -> config_changed:
+def _digested(config: Mapping[str, object]) -> config_changed:
     """doit's ``config_changed(config)`` given the digest doit would take of
     ``config`` (the md5 of its JSON, keys sorted: doit 0.36-0.37's
     ``_calc_digest``), so the same value is stored and compared, but the
@@ -110,7 +111,7 @@ class TaskTable:
         joining: ``pathlib`` cost 0.3 s of a 1000-node no-op run)."""
         return f"{self.r}/{rel}"
 
-    def task_check(self) -> dict[str, Any]:
+    def task_check(self) -> DoitTask:
         """Parse and type-check the contracts, check the plan, lint, build the system model."""
         ws, at = self.ws, self.at
         return {"actions": [(act_check, [self.r, self.plan_file])], "file_dep": self.check_deps,
@@ -118,13 +119,13 @@ class TaskTable:
                 + [str(self.rootp / p) for p in (ws.MODEL, ws.DIAGNOSTICS)],
                 "verbosity": 2, "clean": True, "uptodate": self.check_uptodate}
 
-    def task_graph(self) -> dict[str, Any]:
+    def task_graph(self) -> DoitTask:
         """Write the system model as DOT and, with graphviz, draw it as SVG (doit graph)."""
         return {"actions": [(act_graph, [self.r])], "file_dep": [str(self.rootp / self.ws.MODEL)],
                 "targets": [str(self.rootp / self.ws.DOT)],
                 "task_dep": ["check"], "uptodate": [config_changed(shutil.which("dot") or "")], "verbosity": 2}
 
-    def task_node(self) -> Iterator[dict[str, Any]]:
+    def task_node(self) -> Iterator[DoitTask]:
         """One task per node: its calculus and exported obligations (its health checks are ``health:<Node>``)."""
         from rclverify.app.conetask import ConeUnchanged  # deferred: start-up (loads rclverify.app.conetask only when called)
         index, ws, at, rootp, snap = self.index, self.ws, self.at, self.rootp, self.snap
@@ -147,7 +148,7 @@ class TaskTable:
                    "targets": [at(ws.calculus(n)), at(ws.obligations(n))],
                    "uptodate": [self.code, self.sealed, cone], "verbosity": 2, "clean": True}
 
-    def task_health(self) -> Iterator[dict[str, Any]]:
+    def task_health(self) -> Iterator[DoitTask]:
         """One task per node: its contract health checks.  A task family of its own, not a stage of
         ``node:<Node>``: the evidence tasks are created once every ``node`` task ran (they need the
         exported obligations, not the health findings), so a node's long health checks (the case
@@ -165,7 +166,7 @@ class TaskTable:
                    "targets": [at(ws.health(n))], "uptodate": [self.code, self.sealed], "verbosity": 2,
                    "clean": True}
 
-    def task_requirements(self) -> dict[str, Any]:
+    def task_requirements(self) -> DoitTask:
         """Check each requirement's formal statement with Z3 from the guarantees of its cone.  Defined before
         the evidence and report tasks: doit orders tasks by where their creators are defined, and the
         report parts must run in their usual order after it (their fragment caches, report/fragments.py)."""
@@ -175,7 +176,7 @@ class TaskTable:
                 + sorted(set(self._requirement_inputs())),
                 "targets": [self.at(INDEX)], "uptodate": [self.code, self.sealed], "verbosity": 2, "clean": True}
 
-    def task_deadlines(self) -> dict[str, Any]:
+    def task_deadlines(self) -> DoitTask:
         """Decide each requirement's end-to-end deadline with Z3 (rule D3: deadlines add along its path)."""
         # the record's path as text: importing the deadline stage for it loaded Z3 and the deadline rules in
         # every doit run, the no-op included (0.08 s)
@@ -186,7 +187,7 @@ class TaskTable:
                 "verbosity": 2, "clean": True}
 
     @create_after(executed="node")
-    def task_evidence(self) -> Iterator[dict[str, Any]]:
+    def task_evidence(self) -> Iterator[DoitTask]:
         """Run the backends: one task per obligation, one evidence record each."""
         yield {"basename": "evidence", "name": None, "doc": "Run each backend on its obligations and record evidence."}
         # One check for every evidence task: the tools found on PATH (searched once, not per
@@ -213,7 +214,7 @@ class TaskTable:
                    "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")
-    def task_crosscheck(self) -> dict[str, Any]:
+    def task_crosscheck(self) -> DoitTask:
         """Decide every discharging Z3 query again with cvc5 from its SMT-LIB2 text (docs/second-solver.md)."""
         ws, at, nodes = self.ws, self.at, self.nodes
         deps = [at(ws.calculus(n)) for n in nodes] + [at(ws.health(n)) for n in nodes]
@@ -225,7 +226,7 @@ class TaskTable:
         return {"actions": [(act_crosscheck, [self.r, list(nodes)])], "file_dep": deps,
                 "targets": [at(CROSSCHECK_INDEX)], "uptodate": [self.code, self.sealed], "verbosity": 2, "clean": True}
 
-    def task_ground(self) -> dict[str, Any]:
+    def task_ground(self) -> DoitTask:
         """Ground the contracts in the ROS software of the plan's ros: section (docs/ros.md)."""
         return {"actions": [(act_ground, [self.r])], "file_dep": [str(self.rootp / self.plan_file)] + self.contract_deps,
                 "uptodate": [config_changed({"files": ros_fingerprint(self.rootp, self.ros_section)}), self.sealed],
@@ -233,7 +234,7 @@ class TaskTable:
                 "task_dep": ["check"], "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")
-    def task_diagnosis(self) -> dict[str, Any]:
+    def task_diagnosis(self) -> DoitTask:
         """Explain every problem of the report, repairs checked by Z3, as a sealed record the report reads
         (docs/diagnosis.md).  It reads what the report reads (the same file dependencies): the report dict
         without diagnoses is what it explains."""
@@ -242,7 +243,7 @@ class TaskTable:
                 "uptodate": [self.code, self.sealed], "verbosity": 2, "clean": True}
 
     @create_after(executed="evidence")
-    def task_report(self) -> Iterator[dict[str, Any]]:
+    def task_report(self) -> Iterator[DoitTask]:
         """Roll everything up into the report files: two parts, rendered at once by doit -n 2."""
         yield {"basename": "report", "name": None,
                "doc": "Roll everything up into reports/ (assurance.{html,md,json}, the CI formats, the argument)."}
@@ -258,7 +259,7 @@ class TaskTable:
                    + ([at(self.ws.SUMMARY)] if part == "html" else []),
                    "verbosity": 2, "clean": True}
 
-    def task_verify(self) -> dict[str, Any]:
+    def task_verify(self) -> DoitTask:
         """The whole pipeline: check, compose, health, export, run, report.  --strict fails on any open evidence."""
         # `requirements` (and `ground`) before `report`: reached only through the report's file dependencies,
         # they would make report:html wait and report:text run first (their fragment caches expect html first).

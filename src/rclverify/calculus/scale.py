@@ -46,6 +46,7 @@ from rclverify.lang.types import Checked, CheckedNode, is_numeric
 from rclverify.lang.walk import free_names, subexpressions
 from rclverify.semantics import wallclock
 from rclverify.calculus.shapes import ScaleMismatch
+from rclverify.records.stage_records import HealthFinding
 
 #: Budget of one optimisation, milliseconds.
 OPTIMIZE_MS = 1000
@@ -238,14 +239,14 @@ def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: 
     return tuple(out)
 
 
-def scale_findings(side_conditions: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
+def scale_findings(side_conditions: Iterable[Mapping[str, Any]]) -> list[HealthFinding]:
     """Report findings (the shape of a contract-health finding,
     :class:`~rclverify.calculus.health.finding.Finding`, status ``warning``) for the
     probable scale mismatches recorded on side conditions that are failed
     or inconclusive (a stale or altered record gives none): check
     ``probable-scale-mismatch``, id ``<side condition>.scale``, the
     consumer's node."""
-    out: list[dict[str, Any]] = []
+    out: list[HealthFinding] = []
     for sc in side_conditions:
         if sc.get("status") not in ("failed", "inconclusive"):
             continue

@@ -8,9 +8,11 @@ themselves are :mod:`rclverify.records.stage_records`.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import NotRequired, TypedDict
+from typing import TypedDict
 
 from rclverify.records.stage_records import Premise, Traced
+# sealed in the compose stage's record, so defined with it (records/ is below calculus/)
+from rclverify.records.stage_records import ContextRecord as ContextRecord, LocalVerdict as LocalVerdict, ScaleMismatch as ScaleMismatch
 
 
 class IdleNode(TypedDict):
@@ -77,55 +79,6 @@ class DeclarationEvidence(TypedDict):
     source: str
     status: str
     words: str
-
-
-class RequirementBase(TypedDict):
-    """The keys of a requirement's record that come from the plan alone (calculus/requirements/check.py
-    ``_base``): ``source`` ``file:line:col``, the statements as RCL text."""
-    id: str
-    text: str
-    origin: str
-    source: str
-    formal: str | None
-    assuming: list[str]
-    ranking: str | None
-    invariant: str | None
-    traced: list[Traced]
-
-
-class LocalVerdict(TypedDict):
-    """A side condition's local verdict, kept when it is decided again in context."""
-    status: str
-    variant: str
-    model: dict[str, str] | None
-
-
-class ContextRecord(TypedDict):
-    """How a side condition's in-context check went (calculus/side_condition.py ``in_context``):
-    the cone's size, the premises and nodes the proof used, the links opened (rule R4), the nodes
-    whose assumption the counterexample violates, the joins read, the local verdict, and the
-    producers whose cone summaries the proof read."""
-    cone: int
-    used: list[str]
-    used_nodes: list[str]
-    opened: list[str]
-    violated: list[str]
-    joins: list[str]
-    local: LocalVerdict
-    summaries: NotRequired[list[str]]
-
-
-class ScaleMismatch(TypedDict):
-    """A probable scale mismatch behind a side condition (calculus/scale.py): both ends and their
-    ranges (text, ``-oo``/``+oo`` unbounded), the power of ten (0: a named conversion), the factor
-    and the sentence."""
-    producer: str
-    consumer: str
-    producer_range: list[str]
-    consumer_range: list[str]
-    power: int
-    factor: str
-    message: str
 
 
 class TemporalVerdictJson(TypedDict):

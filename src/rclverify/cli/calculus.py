@@ -43,10 +43,11 @@ def cmd_compose(args: argparse.Namespace) -> int:
             verdict = sc.get("verdict") or sc["status"]
             variant = f" ({sc['variant']})" if verdict == "discharged" and sc.get("variant") else ""
             print(f"  side condition {sc['id']} [{verdict}]{variant}: {sc['conjunct']}  ({sc['source']})")
-            ctx = sc.get("context") or {}
+            ctx = sc.get("context")
             if verdict == "discharged in context":
-                print(f"      upstream guarantees used: {', '.join(ctx.get('used_nodes') or []) or 'none'} "
-                      f"(cone of {ctx.get('cone')} nodes)")
+                used = ctx.get("used_nodes") if ctx else None
+                print(f"      upstream guarantees used: {', '.join(used or []) or 'none'} "
+                      f"(cone of {ctx.get('cone') if ctx else None} nodes)")
             elif ctx and sc["status"] != "discharged":
                 print(f"      checked in context too (cone of {ctx.get('cone')} nodes)"
                       + (f"; assumption violated upstream in the counterexample: {', '.join(ctx['violated'])}"

@@ -75,7 +75,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
         return 2
     violated = False
     unjudged: list[dict[str, str]] = []
-    report: list[dict[str, Any]] = []
+    report: list[Mapping[str, object]] = []
     for trace in args.traces:
         try:
             run = check_recorded(checked, nodes, cfg, root, trace, lambda w: print(w, file=sys.stderr))
@@ -93,7 +93,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     return 1 if violated else _strict(args, unjudged, _undecided(report))
 
 
-def _report_run(report: list[dict[str, Any]], run: RecordedRun, trace: str, cfg: Any, as_json: bool) -> bool:
+def _report_run(report: list[Mapping[str, object]], run: RecordedRun, trace: str, cfg: Any, as_json: bool) -> bool:
     """Add the verdicts of the recorded run ``run`` (at path ``trace``) to
     ``report`` and print them unless ``as_json``: per node its messages,
     deadlines, periods and declarations, then a live log's calls and what
@@ -143,18 +143,19 @@ def _report_run(report: list[dict[str, Any]], run: RecordedRun, trace: str, cfg:
     return violated
 
 
-def _report_calls(report: list[dict[str, Any]], entries: list[dict[str, Any]], summary: dict[str, Any],
-                  missed: tuple[int, int], trace: str, as_json: bool) -> bool:
-    """Add a live log's call verdicts per node and its call deadlines to
+def _report_calls(report: list[Mapping[str, object]], entries: Sequence[Mapping[str, object]],
+                  summary: Mapping[str, object], missed: tuple[int, int], trace: str, as_json: bool) -> bool:
+    """Add a live log's call verdicts per node and its call deadlines
+    (``entries``, each with the log's ``call_counts`` from ``summary``) to
     ``report`` and print them as the live run does; returns whether one
     failed (a violated call, a missed call deadline)."""
     failed = False
     for e in entries:
-        e["call_counts"] = summary["counts"]
-        failed = failed or e["status"] == "failed"
-        report.append(e)
-        if not as_json and "calls" in e:
-            print(f"{trace}: calls: {e['node']}: {e['status']}: {e['explanation']}")
+        entry = {**e, "call_counts": summary["counts"]}
+        failed = failed or entry["status"] == "failed"
+        report.append(entry)
+        if not as_json and "calls" in entry:
+            print(f"{trace}: calls: {entry['node']}: {entry['status']}: {entry['explanation']}")
     if not as_json:
         print(f"{trace}: deadlines: {missed[0]} of {missed[1]} judged call(s) or goal(s) missed their deadline")
     return failed or missed[0] > 0
@@ -167,7 +168,7 @@ def _print_not_judged(items: list[dict[str, str]], prefix: str) -> None:
 
 
 def _strict(args: argparse.Namespace, unjudged: list[dict[str, str]],
-            undecided: Sequence[Mapping[str, Any]] = ()) -> int:
+            undecided: Sequence[Mapping[str, object]] = ()) -> int:
     """The exit code of a run with no violation: 1 under ``--strict`` when
     an item went unjudged (``unjudged``, the first named on stderr) or a
     verdict stayed undecided (``undecided``: the ``inconclusive`` entries, as
@@ -183,7 +184,7 @@ def _strict(args: argparse.Namespace, unjudged: list[dict[str, str]],
     return 1
 
 
-def _undecided(report: list[dict[str, Any]]) -> list[Mapping[str, Any]]:
+def _undecided(report: list[Mapping[str, object]]) -> list[Mapping[str, object]]:
     """The entries of ``report`` whose status is ``inconclusive``."""
     return [e for e in report if e.get("status") == "inconclusive"]
 
@@ -391,7 +392,7 @@ def oracle_command(args: argparse.Namespace, checked: Checked) -> int:
     return 0
 
 
-def _emit(report: list[dict[str, Any]], as_json: bool) -> None:
+def _emit(report: list[Mapping[str, object]], as_json: bool) -> None:
     if as_json:
         print(json.dumps(report, indent=2, sort_keys=True))
 

@@ -12,6 +12,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 #: Seconds each call to a master may take by default (ros/live/master_rpc.py MASTER_TIMEOUT_S; not imported
@@ -289,13 +290,17 @@ def _shown_base(paths: list[Path]) -> Path | None:
     return Path(parent) if parent and parent != os.sep else Path(common)
 
 
-def unaccounted_lines(programs: list[dict[str, Any]]) -> list[str]:
+def unaccounted_lines(programs: Sequence[Mapping[str, object]]) -> list[str]:
     """One ``file:line:col: unaccounted: ...`` line per declared program that is no
-    node of the graph (the scan's ``programs``, ros/graph/accounting.py), then a count."""
+    node of the graph (the scan's ``programs``, ros/graph/accounting.py ``Account.to_json``:
+    ``package``, ``kind``, ``name``, ``declared`` ``{"file", "line", "col"}``, ``unaccounted``
+    why), then a count.  Raises ``TypeError`` for a ``declared`` that is no JSON object."""
     out = []
     for p in programs:
         if p.get("unaccounted"):
             d = p["declared"]
+            if not isinstance(d, Mapping):
+                raise TypeError(f"a program's declared place is no JSON object: {d!r}")
             out.append(f"{d['file']}:{d['line']}:{d['col']}: unaccounted: {p['kind']} {p['name']} of package "
                        f"{p['package']}: {p['unaccounted']}")
     if out:

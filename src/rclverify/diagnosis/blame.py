@@ -33,7 +33,7 @@ Every check is made on an edited copy of the contract text
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 from rclverify.semantics import world
@@ -43,6 +43,8 @@ from rclverify.diagnosis import realize, recheck
 from rclverify.diagnosis.bounds import FLIP, bound_literals, thresholds, value
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.links import link_pairs
+from rclverify.diagnosis.shapes import ReportRows, Strengthening
+from rclverify.records.report_schema import SideConditionRow
 from rclverify.diagnosis.repairs import _numbers, _peel, _rename
 from rclverify.model.plan.load import all_requirements
 from rclverify.calculus.requirements.check import check_requirement, formals_of
@@ -82,7 +84,7 @@ def conclusion_edit(ws: Any, node: str, k: int, extra: str) -> Edit | None:
     return Edit(g.loc.file, *span, f"({old}) and ({extra})")
 
 
-def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[str, int]], int]:
+def side_condition_culprits(ws: Any, sc: SideConditionRow) -> tuple[list[tuple[str, int]], int]:
     """``([(producer, guarantee index)], undecided)`` of the failed side
     condition ``sc`` (a report row with ``id``, ``node``, ``conjunct``,
     ``links``): the producer guarantees on the linked outputs whose
@@ -116,7 +118,7 @@ def side_condition_culprits(ws: Any, sc: Mapping[str, Any]) -> tuple[list[tuple[
     return out, undecided
 
 
-def fixed_side_condition(ws: Any, sc: Mapping[str, Any], producer: str, k: int) -> Edit | None:
+def fixed_side_condition(ws: Any, sc: SideConditionRow, producer: str, k: int) -> Edit | None:
     """The edit that discharges the failed side condition ``sc`` through
     guarantee ``k`` of ``producer`` (one of :func:`side_condition_culprits`):
     its conclusion strengthened by the consumer's conjunct in the producer's
@@ -174,7 +176,7 @@ def threshold_edit(ws: Any, cmp: ast.Compare) -> tuple[Edit, str, str] | None:
     return edit, Edit(f, *whole, "").deleted(source), new
 
 
-def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[str, Any]]:
+def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Strengthening]:
     """The guarantees of ``cone`` (node names) to blame for the refuted
     requirement ``req_id`` (module docstring), each ``{"node", "guarantee",
     "edit": Edit, "how": "bound" | "threshold" | "conclusion", "old", "new"}`` with the
@@ -187,7 +189,7 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
     if formal is None:
         return []
     consts = list(dict.fromkeys(n.text for n in _numbers(formal.expr)))
-    found: list[dict[str, Any]] = []
+    found: list[Strengthening] = []
     trials = 0
     values = {value(c) for c in consts} - {None}
     for n in cone:
@@ -237,7 +239,7 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict
         added = conclusion_edit(ws, n, k, extra)
         system = recheck.edited_system(ws, added) if added is not None else None
         impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
-        if impl:
+        if impl and added is not None:
             found.append({"node": n, "guarantee": k, "edit": added, "how": "conclusion", "old": "", "new": extra,
                           "implementable": impl})
     return found
@@ -253,7 +255,7 @@ def _summands(e: Any) -> list[ast.NumLit]:
     return out
 
 
-def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[str, Any]]:
+def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Strengthening]:
     """The guarantees of ``cone`` to blame for the refuted temporal
     requirement ``req_id`` whose run meets every contract (an
     off-by-one names the node with the slip): a guarantee is named when one
@@ -268,7 +270,7 @@ def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[st
     if req is None or req.formal is None:
         return []
     values = {value(t) for t in re.findall(r"(?<![\w.])\d+(?:\.\d+)?(?![\w.])", req.formal.text)} - {None}
-    found: list[dict[str, Any]] = []
+    found: list[Strengthening] = []
     trials = 0
 
     def holds(edit: Edit, n: str) -> str:
@@ -298,7 +300,7 @@ def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[dict[st
     return found
 
 
-def cost(ws: Any, report: Mapping[str, Any], node: str, edit: Edit) -> list[dict[str, str]]:
+def cost(ws: Any, report: ReportRows, node: str, edit: Edit) -> list[dict[str, str]]:
     """What else changes status when ``edit`` strengthens a guarantee of
     ``node``: the side conditions of the nodes it feeds and ``node``'s own
     health checks, asked before and after the edit the same way

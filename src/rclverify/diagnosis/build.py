@@ -35,7 +35,7 @@ import os
 import re
 from contextlib import contextmanager
 from functools import partial
-from typing import Any, Callable, Iterator, Mapping
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 import z3
 
@@ -50,6 +50,9 @@ from rclverify.diagnosis.culprits import culprits, parse_core, plan_facts
 from rclverify.diagnosis.links import link_pairs
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
+from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows
+from rclverify.records.report_schema import EvidenceRow, FindingRow, ObligationRow, SideConditionRow
+from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 
 CACHE = "artifacts/cache/diagnosis.pickle"
 #: Taken while diagnosing (:func:`_one_at_a_time`); beside the run lock, not a kept result.
@@ -95,9 +98,9 @@ class _Cache:
             pass  # a pure speed-up
 
 
-def _guarantee_source(report: Mapping[str, Any], node: str, k: int) -> tuple[str, str]:
+def _guarantee_source(report: ReportRows, node: str, k: int | None) -> tuple[str, str]:
     for n in report["nodes"]:
-        if n["name"] == node and 1 <= k <= len(n["guarantees"]):
+        if n["name"] == node and k is not None and 1 <= k <= len(n["guarantees"]):
             g = n["guarantees"][k - 1]
             return g["text"], g["source"]
     return "", ""
@@ -134,7 +137,7 @@ def _one_at_a_time(ws: Any) -> Iterator[None]:
         os.close(fd)  # releases the lock
 
 
-def diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
     """The diagnosis records of every problem of ``report`` (see the module
     docstring), in the order of the report's problems list: health
     findings, side conditions, evidence.  One process at a time per
@@ -144,25 +147,26 @@ def diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
         return _diagnose(ws, report)
 
 
-def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
+def _diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
     cache = _Cache(ws)
-    out: list[dict[str, Any]] = []
+    out: list[DiagnosisEntry] = []
     health_by_node: dict[str, dict[str, str]] = {}
     for f in report["findings"]:
         health_by_node.setdefault(f["node"], {})[f["id"]] = f["status"]
     # which guarantees of a node each culprit guarantee makes vacuous (one guard repair for all of them)
     victims: dict[tuple[str, int], list[tuple[int, int | None]]] = {}
     for f in report["findings"]:
-        if f["status"] == "problem" and f["check"] == "non-vacuous":
+        fk = f.get("guarantee")
+        if f["status"] == "problem" and f["check"] == "non-vacuous" and fk is not None:  # a guarantee's check
             vac = sorted(int(x) for x, st in (f.get("instances") or {}).items() if st == "vacuous")
-            victim = (f["guarantee"], vac[0] if vac else None)  # where it was vacuous
-            for m in culprits(parse_core(f.get("core")), f["guarantee"]):
+            victim = (fk, vac[0] if vac else None)  # where it was vacuous
+            for m in culprits(parse_core(f.get("core")), fk):
                 if m.kind == "guarantee" and victim not in victims.setdefault((f["node"], m.index), []):
                     victims[(f["node"], m.index)].append(victim)
 
-    def guard(node: str, c: int) -> dict[str, Any] | None:
+    def guard(node: str, c: int) -> Repair | None:
         vs = sorted(victims.get((node, c), []), key=lambda v: v[0])
-        found: dict[str, Any] | None = cache.get(["guard", node, c, vs, health_by_node.get(node, {})],
+        found: Repair | None = cache.get(["guard", node, c, vs, health_by_node.get(node, {})],
                                                  lambda: rep.guard_repair(ws, node, c, vs,
                                                                           health_by_node.get(node, {})))
         return found
@@ -184,15 +188,16 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
             out.append(requirement_record(ws, report, q, cache, _guarantee_source))
     for row in report.get("deadlines") or ():
         if row.get("verdict") in ("refuted", "inconclusive"):
-            key = ["deadline", row["requirement"], row.get("path"), row.get("within"), row.get("chain") and
-                   [[h["node"], h["guarantee"], h["within_s"]] for h in row["chain"]]]
-            reps: list[dict[str, Any]] = ((cache.get(key, partial(budget_repairs, ws, row)) or [])
-                                          if row["verdict"] == "refuted" else [])
+            chain = row.get("chain")
+            key = ["deadline", row["requirement"], row.get("path"), row.get("within"),
+                   [[h["node"], h["guarantee"], h["within_s"]] for h in chain] if chain else chain]
+            reps: list[Repair] = ((cache.get(key, partial(budget_repairs, ws, row)) or [])
+                                  if row["verdict"] == "refuted" else [])
             out.append(deadline_record(ws, report, row, reps))
     obligations = {o["id"]: o for o in report["obligations"]}
     for e in report["evidence"]:
         if e["status"] in ("failed", "error"):
-            out.append(_evidence(ws, report, e, obligations.get(e["obligation"], {}), cache))
+            out.append(_evidence(ws, report, e, obligations.get(e["obligation"]), cache))
     # the same node and guarantee found by several techniques: each record names the others
     by_key: dict[tuple[str, Any], list[str]] = {}
     for d in out:
@@ -203,13 +208,17 @@ def _diagnose(ws: Any, report: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def _record(id: str, kind: str, node: str, status: str, sentence: str, **kw: Any) -> dict[str, Any]:
+def _record(id: str, kind: str, node: str, status: str, sentence: str, *, culprits: list[Culprit] | None = None,
+            counterexample: list[CexRow] | None = None, repairs: Sequence[Repair | None] = (),
+            guarantee: int | None = None) -> DiagnosisEntry:
+    """A diagnosis record (module docstring); ``related`` is filled in by :func:`_diagnose`."""
     return {"id": id, "kind": kind, "node": node, "status": status, "sentence": sentence,
-            "culprits": kw.get("culprits", []), "counterexample": kw.get("counterexample", []),
-            "repairs": [r for r in kw.get("repairs", []) if r], "guarantee": kw.get("guarantee")}
+            "culprits": culprits if culprits is not None else [],
+            "counterexample": counterexample if counterexample is not None else [],
+            "repairs": [r for r in repairs if r], "guarantee": guarantee, "related": []}
 
 
-def _finding(ws: Any, report: Mapping[str, Any], f: Mapping[str, Any], guard: Callable[[str, int], Any]) -> dict[str, Any]:
+def _finding(ws: Any, report: ReportRows, f: FindingRow, guard: Callable[[str, int], Repair | None]) -> DiagnosisEntry:
     node, k = f["node"], f["guarantee"]
     facts = plan_facts(ws, node)
     members = parse_core(f.get("core"), facts)
@@ -248,17 +257,18 @@ def _and(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], cache: _Cache,
-                    sc_before: Mapping[str, str]) -> dict[str, Any]:
+def _side_condition(ws: Any, report: ReportRows, sc: SideConditionRow, cache: _Cache,
+                    sc_before: Mapping[str, str]) -> DiagnosisEntry:
     pairs = link_pairs(sc)
-    cul = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
+    cul: list[Culprit] = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
     said = []
     # a producer guarantee is named only when strengthening it discharges the side condition (blame.py)
-    def find() -> dict[str, Any]:
+    def find() -> ProducerCulprits:
         found, undecided = blame.side_condition_culprits(ws, sc)
         return {"culprits": [list(x) for x in found], "undecided": undecided}
-    shown = (cache.get(["sc-culprits", sc["id"], sc["conjunct"]], find) if sc["status"] == "failed" else None) \
-        or {"culprits": [], "undecided": 1}
+    got: ProducerCulprits | None = \
+        cache.get(["sc-culprits", sc["id"], sc["conjunct"]], find) if sc["status"] == "failed" else None
+    shown: ProducerCulprits = got or {"culprits": [], "undecided": 1}
     blamed = {(str(p), int(k)) for p, k in shown["culprits"]}
     for p, ov, _, _ in pairs:
         for n in report["nodes"]:
@@ -296,21 +306,21 @@ def _side_condition(ws: Any, report: Mapping[str, Any], sc: Mapping[str, Any], c
     return rec
 
 
-def _computed_line(report: Mapping[str, Any], node: str, k: Any, file: str) -> str:
+def _computed_line(report: ReportRows, node: str, k: object, file: str) -> str:
     """``file:line`` a failed property test of guarantee ``k`` of ``node``
     names as computing the failing output, when it is a line of ``file``
     (the generated node's logic.py); ``""`` otherwise."""
     obligations = {str(o["id"]): o for o in report.get("obligations") or ()}
     for e in report.get("evidence") or ():
-        o = obligations.get(str(e["obligation"])) or {}
+        o = obligations.get(str(e["obligation"]))
         cause = str((e.get("counterexample") or {}).get("cause") or "") if isinstance(e.get("counterexample"), dict) else ""
-        if e.get("backend") == "property_tests" and e.get("status") == "failed" and o.get("node") == node \
-                and o.get("guarantee") == k and cause.rsplit(":", 1)[0] == file:
+        if e.get("backend") == "property_tests" and e.get("status") == "failed" and o is not None and o["node"] == node \
+                and o["guarantee"] == k and cause.rsplit(":", 1)[0] == file:
             return cause
     return ""
 
 
-def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, Any]) -> Any:
+def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, object]) -> Any:
     """The handler of ``node``'s generated logic.py that published the first
     violating message (:func:`rclverify.diagnosis.handlers.violating_handler`),
     ``None`` for a node without generated code or a run it cannot place."""
@@ -319,14 +329,14 @@ def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, Any]) -> Any
     return violating_handler(ws.root, node, entries, monitoring)
 
 
-def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, Any], data: Mapping[str, Any],
+def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, object], binding: Mapping[str, object],
                           conj: str) -> list[Any]:
     """The last assignments to the outputs ``conj`` reads in the program's
     run on the counterexample (:func:`rclverify.backends.hoare.culprit_assign.breaking_assignments`);
     ``[]`` when the program no longer reads or the run cannot be made."""
     from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
     from rclverify.backends.hoare.culprit_assign import breaking_assignments  # deferred: start-up (loads jinja2, z3 and more only when called)
-    outs = {k: str(v) for k, v in (data.get("binding") or {}).items()
+    outs = {k: str(v) for k, v in binding.items()
             if k.startswith("out.") and re.search(rf"(?<![\w.]){re.escape(k)}(?!\w)", conj)}
     try:
         text = ws.path(program).read_text(encoding="utf-8")
@@ -344,13 +354,14 @@ def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
     return {}
 
 
-def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[str, Any],
-              cache: _Cache) -> dict[str, Any]:
-    node, k = o.get("node", e["obligation"].split(".", 1)[0]), o.get("guarantee", 0)
+def _evidence(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow | None,
+              cache: _Cache) -> DiagnosisEntry:
+    node = o["node"] if o is not None else e["obligation"].split(".", 1)[0]
+    k = o["guarantee"] if o is not None else 0
     backend = e["backend"]
-    text, src = _guarantee_source(report, node, k) if k else ("", o.get("source", ""))
-    where = f"guarantee {k} of {node} ({src})" if k else f"the contract of {node} ({o.get('source', '')})"
-    if backend == "hoare" and e["status"] == "failed":
+    text, src = _guarantee_source(report, node, k) if k else ("", o["source"] if o is not None else "")
+    where = f"guarantee {k} of {node} ({src})" if k else f"the contract of {node} ({o['source'] if o is not None else ''})"
+    if backend == "hoare" and e["status"] == "failed" and o is not None:
         return _hoare(ws, report, e, o, cache)
     mon = e.get("monitoring") or {}
     fv = mon.get("first_violation") if isinstance(mon, dict) else None
@@ -360,7 +371,7 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
         sentence = (f"In {mon.get('trace', 'the trace')}, the output at {fv.get('where')} (t = {fv.get('time')} s) "
                     f"answering the input at {fv.get('trigger_where')} violates guarantee {gk} of {node} ({gsrc})"
                     f"; {mon.get('counts', {}).get('violated', '?')} message(s) of the run violate the contract (each: `rclverify explain OBLIGATION#N`).")
-        cul = [{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
+        cul: list[Culprit] = [{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
                {"what": f"guarantee {gk} of {node}", "source": gsrc, "text": gtext}]
         h = _generated_handler(ws, node, mon)  # generated code: the logic.py handler that published it
         if h is not None:
@@ -378,13 +389,14 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
                                "source": computed, "text": ""})
         return _record(e["obligation"], "monitor", node, e["status"], sentence, culprits=cul,
                        counterexample=counterexample_table(fv.get("values"), node), guarantee=gk)
-    if backend == "property_tests" and isinstance(e.get("counterexample"), dict):
-        cex = {kk: v for kk, v in e["counterexample"].items() if kk not in _META_KEYS}
+    ce = e.get("counterexample")
+    if backend == "property_tests" and isinstance(ce, dict):
+        cex = {kk: v for kk, v in ce.items() if kk not in _META_KEYS}
         impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
-        cause = e["counterexample"].get("cause")  # the implementation line the example takes
+        cause = ce.get("cause")  # the implementation line the example takes
         sentence = (f"Hypothesis found inputs on which {impl} "
                     f"violates {where}" + (f"; the implementation line that computed the failing output is {cause}"
-                                           if cause else "") + f"; replay: `{e['counterexample'].get('replay', '')}`.")
+                                           if cause else "") + f"; replay: `{ce.get('replay', '')}`.")
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
                        culprits=[{"what": where, "source": src, "text": text}],
                        counterexample=counterexample_table(cex, node), guarantee=k)
@@ -397,7 +409,7 @@ def _evidence(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mappi
                    guarantee=k)
 
 
-def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
+def _hoare(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow, cache: _Cache) -> DiagnosisEntry:
     from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
     from rclverify.backends.hoare.culprit_lines import compared_constants  # deferred: start-up (loads jinja2, z3 and more only when called)
     node, k = o["node"], o["guarantee"]
@@ -426,7 +438,7 @@ def _hoare(ws: Any, report: Mapping[str, Any], e: Mapping[str, Any], o: Mapping[
                 f"compares with {'/'.join(prog_texts) or 'other constants'} (" + ", ".join(prog_consts) + ") where the "
                 f"guarantee uses {'/'.join(conj_nums) or 'other constants'}; on {inputs or 'the counterexample'} the "
                 f"program gives {outputs or 'another output'}, which the conjunct `{conj}` ({conj_src}) rules out.")
-    assigned = [] if (conj_nums and prog_consts) else _breaking_assignments(ws, program, cex, data, conj)
+    assigned = [] if (conj_nums and prog_consts) else _breaking_assignments(ws, program, cex, data.get("binding") or {}, conj)
     if assigned:  # no threshold disagrees: the assignment whose value breaks the conjunct
         prog_consts = [f"{program}:{a.line}: {a.text}" for a in assigned]
         sentence = (f"On {inputs or 'the counterexample'} {program} runs "

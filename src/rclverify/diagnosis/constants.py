@@ -19,6 +19,7 @@ from rclverify.diagnosis.bounds import bound_literals
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import MAX_CANDIDATES, _record
 from rclverify.lang.ast import Loc
+from rclverify.records.stage_records import Repair
 
 _ORDERING = ("<", "<=", ">", ">=")
 
@@ -50,7 +51,7 @@ def _num_value(text: str) -> float:
 
 
 def hoare_repair(ws: Any, node: str, guarantee: int, program: str,
-                 before: Mapping[str, str]) -> dict[str, Any] | None:
+                 before: Mapping[str, str]) -> Repair | None:
     """The change of program constants (to constants of guarantee
     ``guarantee`` of ``node``) under which every triple of the plan entry of
     ``program`` is discharged, fewest changes first; ``None`` when none

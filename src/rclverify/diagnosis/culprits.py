@@ -44,7 +44,7 @@ class Member:
             out += f" `{self.text}`" + (f" ({self.note})" if self.note else "")
         return out
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> dict[str, str | int]:
         return {"kind": self.kind, "index": self.index, "source": self.source, "at": self.at,
                 "text": self.text, "note": self.note, "name": self.name()}
 

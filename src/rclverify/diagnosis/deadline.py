@@ -28,6 +28,9 @@ from rclverify.calculus.deadlines import chains, decide, show_seconds
 from rclverify.lang.timing import UNITS
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.bounds import number_text
+from rclverify.diagnosis.shapes import ReportRows
+from rclverify.records.report_schema import DeadlineRow
+from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
 
@@ -66,7 +69,7 @@ def _decide_all(ws: Any, checked: Any, model: Any) -> dict[str, str]:
             for d in ws.plan.deadlines}
 
 
-def budget_repairs(ws: Any, row: Mapping[str, Any]) -> list[dict[str, Any]]:
+def budget_repairs(ws: Any, row: DeadlineRow) -> list[Repair]:
     """The repairs of the refuted deadline ``row`` (a report row of
     :func:`rclverify.report.deadlines.deadline_rows`), each checked by Z3
     (module docstring), in the order shown."""
@@ -81,8 +84,8 @@ def budget_repairs(ws: Any, row: Mapping[str, Any]) -> list[dict[str, Any]]:
         return []
     req = str(row["requirement"])
     before = _decide_all(ws, ws.checked, ws.model)
-    out: list[dict[str, Any]] = []
-    single: list[tuple[Fraction, dict[str, Any]]] = []
+    out: list[Repair] = []
+    single: list[tuple[Fraction, Repair]] = []
     for h, b in zip(hops, bounds):
         if b <= excess:
             continue  # this hop alone cannot absorb the excess
@@ -115,7 +118,7 @@ def budget_repairs(ws: Any, row: Mapping[str, Any]) -> list[dict[str, Any]]:
 
 
 def _split(ws: Any, req: str, hops: Sequence[Mapping[str, Any]], bounds: Sequence[Fraction], total: Fraction,
-           budget: Fraction, before: Mapping[str, str]) -> dict[str, Any] | None:
+           budget: Fraction, before: Mapping[str, str]) -> Repair | None:
     """Every hop scaled by ``budget / total``, rounded down (module docstring)."""
     clauses = [_hop_clause(ws, h) for h in hops]
     if any(c.deadline is None or not c.deadline.loc.end_line for c in clauses):
@@ -180,8 +183,8 @@ def break_node(ws: Any, path: Sequence[str]) -> str | None:
     return None
 
 
-def deadline_record(ws: Any, report: Mapping[str, Any], row: Mapping[str, Any],
-                    repairs: Sequence[dict[str, Any]]) -> dict[str, Any]:
+def deadline_record(ws: Any, report: ReportRows, row: DeadlineRow,
+                    repairs: Sequence[Repair]) -> DiagnosisEntry:
     """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the
     refuted or inconclusive deadline ``row``: id ``<REQ>.deadline``, kind
     ``deadline``; the sentence names the chain, each hop's bound and the
@@ -193,7 +196,7 @@ def deadline_record(ws: Any, report: Mapping[str, Any], row: Mapping[str, Any],
     head = f"The end-to-end deadline of {req} ({row['within']} along {path}, {row['source']})"
     g_text = {(str(n["name"]), int(g["index"])): str(g["text"]) for n in report["nodes"] for g in n["guarantees"]}
     hops = list(row.get("chain") or [])
-    culprits = [{"what": f"guarantee {h['guarantee']} of {h['node']}: within {h['within']}", "source": str(h["loc"]),
+    culprits: list[Culprit] = [{"what": f"guarantee {h['guarantee']} of {h['node']}: within {h['within']}", "source": str(h["loc"]),
                  "text": g_text.get((str(h["node"]), int(h["guarantee"])), "")} for h in hops]
     if row["verdict"] == "refuted":
         spec = _spec(ws, req)
@@ -210,11 +213,11 @@ def deadline_record(ws: Any, report: Mapping[str, Any], row: Mapping[str, Any],
             culprits = [{"what": f"the contract of {broken}", "source": src, "text": ""}]
         sentence = f"{head} is not decided: {row['reason']}."
         status = "inconclusive"
-    stamps = [{"node": str(s["event"]).split(".", 1)[0], "variable": str(s["event"]).split(".", 1)[-1],
+    stamps: list[CexRow] = [{"node": str(s["event"]).split(".", 1)[0], "variable": str(s["event"]).split(".", 1)[-1],
                "value": f"t0 + {_seconds_text(s['t_s'])} s", "table": None} for s in row.get("stamps") or []]
     return {"id": f"{req}.deadline", "kind": "deadline", "node": "", "status": status, "sentence": sentence,
             "culprits": culprits, "counterexample": stamps, "repairs": list(repairs), "guarantee": None,
-            "requirement": req}
+            "related": [], "requirement": req}
 
 
 def _seconds_text(t: Any) -> str:

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import difflib
 from dataclasses import dataclass
-from typing import Any
+
+from rclverify.records.sarif import SarifFix
+from rclverify.records.stage_records import EditJson
 
 
 @dataclass(frozen=True)
@@ -43,12 +45,12 @@ class Edit:
         return "".join(difflib.unified_diff(source.splitlines(keepends=True), new.splitlines(keepends=True),
                                             f"a/{self.file}", f"b/{self.file}"))
 
-    def to_json(self, source: str) -> dict[str, Any]:
+    def to_json(self, source: str) -> EditJson:
         return {"file": self.file, "line": self.line, "col": self.col, "end_line": self.end_line,
                 "end_col": self.end_col, "inserted": self.text, "deleted": self.deleted(source)}
 
 
-def sarif_fix(description: str, edit: dict[str, Any]) -> dict[str, Any]:
+def sarif_fix(description: str, edit: EditJson) -> SarifFix:
     """A SARIF 2.1.0 ``fix`` object (§3.55) for an edit in its JSON form
     (:meth:`Edit.to_json`): one ``artifactChange`` (§3.56) with one
     ``replacement`` (§3.57)."""

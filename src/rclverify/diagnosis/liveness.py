@@ -23,11 +23,11 @@ says so.
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+from rclverify.calculus.shapes import Gaps
+from rclverify.records.stage_records import Culprit
 
 
-def liveness_culprits(temporal: Mapping[str, Any]) -> tuple[str, list[dict[str, Any]], str]:
+def liveness_culprits(temporal: Gaps) -> tuple[str, list[Culprit], str]:
     """``(node, culprits, sentence)`` of a refuted temporal record's
     ``temporal`` field: the first culprit node (``""``: none), the culprits
     as diagnosis records name them (``{"what", "source", "text"}``, the
@@ -36,7 +36,7 @@ def liveness_culprits(temporal: Mapping[str, Any]) -> tuple[str, list[dict[str, 
     gaps = list(temporal.get("missing_progress") or [])
     stuck = list(temporal.get("missing_initially") or [])
     if gaps:
-        culprits = [{"what": f"the contract of {g['node']}: no progress declared", "source": str(g["source"]),
+        culprits: list[Culprit] = [{"what": f"the contract of {g['node']}: no progress declared", "source": str(g["source"]),
                      "text": f"declares {g['declared']}"} for g in gaps]
         names = ", ".join(str(g["node"]) for g in gaps)
         steps = ", ".join(str(i) for i in gaps[0].get("accepted_at") or [])

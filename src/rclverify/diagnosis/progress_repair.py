@@ -22,13 +22,15 @@ implementation, which no backend checks yet (the requirement stays
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import Any
 
 from rclverify.semantics import world
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
+from rclverify.calculus.shapes import Gaps
+from rclverify.records.report_schema import RequirementRow
+from rclverify.records.stage_records import Repair
 from rclverify.model.plan.load import all_requirements
 from rclverify.calculus.requirements.check import check_requirement
 
@@ -66,7 +68,7 @@ def _declaration_edit(ws: Any, node: Any, k: int) -> Edit | None:
     return Edit(node.loc.file, end_line, 1, end_line, 1, f"  {text}\n")
 
 
-def progress_repairs(ws: Any, q: Mapping[str, Any], temporal: Mapping[str, Any]) -> list[dict[str, Any]]:
+def progress_repairs(ws: Any, q: RequirementRow, temporal: Gaps) -> list[Repair]:
     """The repairs (:func:`.repairs._record` dicts, kind
     ``declare-progress``) for the refuted temporal requirement ``q`` (a
     report row) whose record ``temporal`` names ``missing_progress``: for

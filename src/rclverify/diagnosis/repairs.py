@@ -41,6 +41,7 @@ from rclverify.lang.walk import free_names, subexpressions
 from rclverify.semantics import world
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
+from rclverify.records.stage_records import Repair
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.query import prove
 from rclverify.lang.parser import parse_formula
@@ -65,7 +66,7 @@ def _peel(e: ast.Expr) -> tuple[list[str], ast.Expr]:
 
 
 def _record(kind: str, summary: str, edit: Edit, source: str, checks: list[dict[str, str]],
-            cost: list[dict[str, str]], proves: str = "", not_shown: str = "") -> dict[str, Any]:
+            cost: list[dict[str, str]], proves: str = "", not_shown: str = "") -> Repair:
     """One repair: ``kind``, ``summary`` (what to change and why), the
     ``edit`` (JSON, :meth:`Edit.to_json`) and its unified ``diff``, the
     ``checks`` Z3 answered, the ``cost`` (status changes), ``proves``
@@ -204,7 +205,7 @@ def _weakest_first(ws: Any, node: str, guards: list[str], var_types: Mapping[str
 
 
 def guard_repair(ws: Any, node: str, culprit: int, victims: Sequence[tuple[int, int | None]],
-                 before: Mapping[str, str]) -> dict[str, Any] | None:
+                 before: Mapping[str, str]) -> Repair | None:
     """A guard for guarantee ``culprit`` of ``node`` under which each
     victim ``(k, at)`` -- guarantee ``k``, at the instance ``at`` of its
     first NATURAL variable where it was vacuous, or ``None`` -- can fire and
@@ -303,7 +304,7 @@ def _guarded_health(ws: Any, node: str, edit: Edit, victims: Sequence[tuple[int,
 
 
 def _guard_record(node: str, culprit: int, victims: Sequence[tuple[int, int | None]], guard: str, why: str,
-                  edit: Edit, source: str, before: Mapping[str, str], after: dict[str, str]) -> dict[str, Any]:
+                  edit: Edit, source: str, before: Mapping[str, str], after: dict[str, str]) -> Repair:
     """The repair record of the guard Z3 accepted (``why``: why this one)."""
     checks = [{"check": f"{node}.contract-consistent", "status": "consistent (Z3: sat, witness found)"}]
     checks += [{"check": f"{node}.g{k}.non-vacuous" + (f" at {at}" if at is not None else ""),

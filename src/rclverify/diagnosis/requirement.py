@@ -17,13 +17,19 @@ from rclverify.diagnosis.repairs import _record as _repair
 from fractions import Fraction
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.calculus.compose import conjuncts
+from rclverify.diagnosis.shapes import CulpritRow, ProducerCulprits, ReportRows, Strengthening
+from rclverify.records.report_schema import RequirementRow, SideConditionRow
+from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
+
+#: ``guarantee_source(report, node, k)``: a guarantee's (text, source) (diagnosis/build.py).
+GuaranteeSource = Callable[[ReportRows, str, int], tuple[str, str]]
 
 #: The repair kind of each way a culprit was found (:func:`blame.requirement_culprits`).
 _KIND = {"bound": "tighten-bound", "threshold": "move-threshold", "conclusion": "strengthen-guarantee"}
 
 
-def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cache: Any,
-                       guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> dict[str, Any]:
+def requirement_record(ws: Any, report: ReportRows, q: RequirementRow, cache: Any,
+                       guarantee_source: GuaranteeSource) -> DiagnosisEntry:
     """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the refuted
     requirement ``q`` (a report row): the guarantees Z3 showed a
     strengthening of proves it (:func:`blame.requirement_culprits`), each
@@ -49,16 +55,16 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     if causes:  # refuted only because a side condition fails: that problem's row, its culprit
         return _consequence_record(report, q, check, causes, guarantee_source)
 
-    found = cache.get(["requirement", q["id"], check.get("formal"), cone],
-                      lambda: _culprit_rows(ws, report, q, cone, guarantee_source)) or []
-    cul = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],
+    found: list[CulpritRow] = cache.get(["requirement", q["id"], check.get("formal"), cone],
+                                        lambda: _culprit_rows(ws, report, q, cone, guarantee_source)) or []
+    cul: list[Culprit] = [{"what": f"guarantee {f['guarantee']} of {f['node']}: `{f['text']}`", "source": f["source"],
             "text": f["text"]} for f in found]
     mentioned = {str(r["node"]) for r in check.get("counterexample") or []
                  if re.search(rf"(?<![\w.]){re.escape(str(r['node']))}\.(in|out)\.", str(check.get("formal") or ""))}
     blamed = {str(f["node"]) for f in found}
     involved = mentioned | blamed | _between(report, blamed, mentioned)
-    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
-             for r in check.get("counterexample") or [] if not involved or str(r["node"]) in involved
+    table: list[CexRow] = [{"node": r["node"], "variable": v, "value": x, "table": None}
+                           for r in check.get("counterexample") or [] if not involved or str(r["node"]) in involved
              for v, x in r["values"].items()]
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
     sentence = _refuted(q, check, found[0] if found else None, cex)
@@ -69,15 +75,15 @@ def requirement_record(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
             "is false there)" for sc in through) + "."
     return {"id": str(q["id"]), "kind": "requirement", "node": found[0]["node"] if found else "", "status": "failed",
             "sentence": sentence, "culprits": cul, "counterexample": table,
-            "repairs": [f["repair"] for f in found], "guarantee": None,
+            "repairs": [f["repair"] for f in found], "guarantee": None, "related": [],
             "passes_through": [str(sc["id"]) for sc in through]}
 
 
-def _culprit_rows(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list[str],
-                  guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> list[dict[str, Any]]:
+def _culprit_rows(ws: Any, report: ReportRows, q: RequirementRow, cone: list[str],
+                  guarantee_source: GuaranteeSource) -> list[CulpritRow]:
     """One row per guarantee whose strengthening Z3 showed proves ``q``
     (:func:`blame.requirement_culprits`), with that strengthening as a repair."""
-    rows = []
+    rows: list[CulpritRow] = []
     for f in blame.requirement_culprits(ws, str(q["id"]), cone):
         source = recheck.source_text(ws, f["edit"].file)
         text, src = guarantee_source(report, f["node"], f["guarantee"])
@@ -99,7 +105,7 @@ def _culprit_rows(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone
     return rows
 
 
-def _summary(f: Mapping[str, Any], q: Mapping[str, Any], src: str) -> str:
+def _summary(f: Strengthening, q: RequirementRow, src: str) -> str:
     """The repair's one-paragraph summary for culprit ``f`` (``src`` its guarantee's location)."""
     what = f"guarantee {f['guarantee']} of {f['node']}"
     if f["how"] == "bound":
@@ -115,7 +121,7 @@ def _summary(f: Mapping[str, Any], q: Mapping[str, Any], src: str) -> str:
             f"{f['node']}'s evidence must then establish it.")
 
 
-def _refuted(q: Mapping[str, Any], check: Mapping[str, Any], f: Mapping[str, Any] | None, cex: str) -> str:
+def _refuted(q: RequirementRow, check: Mapping[str, object], f: CulpritRow | None, cex: str) -> str:
     """The record's sentence: why ``q`` is refuted, naming the first culprit
     ``f`` (``None``: no single strengthening proves it) and the counterexample."""
     if f is not None:
@@ -132,8 +138,8 @@ def _refuted(q: Mapping[str, Any], check: Mapping[str, Any], f: Mapping[str, Any
             + (f". Z3's counterexample: {cex}" if cex else "") + ".")
 
 
-def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list[str],
-            cache: Any) -> list[tuple[Mapping[str, Any], str, int]]:
+def _causes(ws: Any, report: ReportRows, q: RequirementRow, cone: list[str],
+            cache: Any) -> list[tuple[SideConditionRow, str, int]]:
     """``[(side condition row, producer, guarantee index)]``: the failed side
     conditions of ``q``'s cone whose discharge alone proves ``q`` -- each
     producer guarantee that discharges it when strengthened by the
@@ -142,17 +148,17 @@ def _causes(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any], cone: list
     proves ``q`` from consistent premises (:func:`blame.proved_with`).  The
     requirement is then a consequence of that problem, not a problem of its
     own (docs/diagnosis.md, "One row per cause")."""
-    out: list[tuple[Mapping[str, Any], str, int]] = []
+    out: list[tuple[SideConditionRow, str, int]] = []
     check = q.get("check") or {}
     for sc in report.get("side_conditions") or ():
         if sc.get("status") != "failed" or str(sc.get("node")) not in cone:
             continue
-        def producers(sc: Mapping[str, Any] = sc) -> dict[str, Any]:  # as diagnosis/build.py keeps them
+        def producers(sc: SideConditionRow = sc) -> ProducerCulprits:  # as diagnosis/build.py keeps them
             found, undecided = blame.side_condition_culprits(ws, sc)
             return {"culprits": [list(x) for x in found], "undecided": undecided}
-        shown = cache.get(["sc-culprits", sc["id"], sc["conjunct"]], producers) or {}
-        for p, k in shown.get("culprits") or ():
-            def proves(p: str = str(p), k: int = int(k), sc: Mapping[str, Any] = sc) -> bool:
+        shown: ProducerCulprits | None = cache.get(["sc-culprits", sc["id"], sc["conjunct"]], producers)
+        for p, k in (shown.get("culprits") or []) if shown else ():
+            def proves(p: str = str(p), k: int = int(k), sc: SideConditionRow = sc) -> bool:
                 edit = blame.fixed_side_condition(ws, sc, p, k)
                 return edit is not None and blame.proved_with(ws, str(q["id"]), edit)
             if cache.get(["consequence", q["id"], check.get("formal"), cone, sc["id"], sc["conjunct"], p, k], proves):
@@ -172,8 +178,8 @@ def _cex_value(text: Any) -> Any:
         return None
 
 
-def _passes_through(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
-                    cone: list[str]) -> list[Mapping[str, Any]]:
+def _passes_through(ws: Any, report: ReportRows, q: RequirementRow,
+                    cone: list[str]) -> list[SideConditionRow]:
     """The failed side conditions of ``q``'s cone whose conjunct is false on
     the consumer's values in ``q``'s counterexample (decided by the
     monitors' evaluator, :func:`rclverify.semantics.decide.decide`): the
@@ -198,27 +204,28 @@ def _passes_through(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     return out
 
 
-def _consequence_record(report: Mapping[str, Any], q: Mapping[str, Any], check: Mapping[str, Any],
-                        causes: list[tuple[Mapping[str, Any], str, int]],
-                        guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> dict[str, Any]:
+def _consequence_record(report: ReportRows, q: RequirementRow, check: Mapping[str, Any],
+                        causes: list[tuple[SideConditionRow, str, int]],
+                        guarantee_source: GuaranteeSource) -> DiagnosisEntry:
     """The diagnosis record of a requirement refuted only because of the
     failed side conditions ``causes`` (:func:`_causes`): its culprits are
     theirs (the consumer's assumption and the producer's guarantee), its
     ``consequence_of`` their ids; no repair of its own (the side condition's
     repairs are the row's)."""
-    cul: list[dict[str, Any]] = []
+    cul: list[Culprit] = []
     said: list[str] = []
     for sc, p, k in causes:
         text, src = guarantee_source(report, p, k)
-        for c in ({"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"],
-                   "text": sc["conjunct"]},
-                  {"what": f"guarantee {k} of {p}: `{text}`", "source": src, "text": text}):
+        both: list[Culprit] = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"],
+                                "text": sc["conjunct"]},
+                               {"what": f"guarantee {k} of {p}: `{text}`", "source": src, "text": text}]
+        for c in both:
             if c not in cul:
                 cul.append(c)
         said.append(f"side condition {sc['id']} ({sc['node']} assumes `{sc['conjunct']}`, {sc['source']}) fails "
                     f"through guarantee {k} of {p} ({src}) `{text}`")
-    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
-             for r in check.get("counterexample") or [] for v, x in r["values"].items()]
+    table: list[CexRow] = [{"node": r["node"], "variable": v, "value": x, "table": None}
+                           for r in check.get("counterexample") or [] for v, x in r["values"].items()]
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
     ids = list(dict.fromkeys(str(sc["id"]) for sc, _, _ in causes))
     sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted only because "
@@ -227,16 +234,16 @@ def _consequence_record(report: Mapping[str, Any], q: Mapping[str, Any], check: 
                 + (f". Z3's counterexample: {cex}" if cex else "") + ".")
     return {"id": str(q["id"]), "kind": "requirement", "node": causes[0][1], "status": "failed",
             "sentence": sentence, "culprits": cul, "counterexample": table, "repairs": [], "guarantee": None,
-            "consequence_of": ids}
+            "related": [], "consequence_of": ids}
 
 
-def _slips(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
-           guarantee_source: Callable[[Mapping[str, Any], str, int], tuple[str, str]]) -> list[dict[str, Any]]:
+def _slips(ws: Any, report: ReportRows, q: RequirementRow,
+           guarantee_source: GuaranteeSource) -> list[CulpritRow]:
     """The guarantees :func:`blame.temporal_culprits` names for the refuted
     temporal requirement ``q``, each ``{"node", "guarantee", "how", "old",
     "new", "text", "source", "repair"}`` (its edit as a repair Z3 checked)."""
     check = q.get("check") or {}
-    rows = []
+    rows: list[CulpritRow] = []
     for f in blame.temporal_culprits(ws, str(q["id"]), [str(n) for n in check.get("cone") or []]):
         text, src = guarantee_source(report, f["node"], f["guarantee"])
         what = f"guarantee {f['guarantee']} of {f['node']}"
@@ -258,8 +265,8 @@ def _slips(ws: Any, report: Mapping[str, Any], q: Mapping[str, Any],
     return rows
 
 
-def _with_slips(rec: dict[str, Any], q: Mapping[str, Any], check: Mapping[str, Any],
-                slips: list[dict[str, Any]]) -> dict[str, Any]:
+def _with_slips(rec: DiagnosisEntry, q: RequirementRow, check: Mapping[str, object],
+                slips: list[CulpritRow]) -> DiagnosisEntry:
     """``rec`` (a temporal record without a culprit) naming the guarantees of ``slips`` (:func:`_slips`)."""
     f = slips[0]
     head = rec["sentence"].split(" The state it repeats: ")[0].split(" that meets every contract")[0]
@@ -274,7 +281,7 @@ def _with_slips(rec: dict[str, Any], q: Mapping[str, Any], check: Mapping[str, A
             "repairs": [x["repair"] for x in slips]}
 
 
-def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> set[str]:
+def _between(report: ReportRows, sources: set[str], sinks: set[str]) -> set[str]:
     """The nodes on a path of the system's connections from a node of
     ``sources`` to a node of ``sinks`` (both excluded)."""
     down: dict[str, set[str]] = {}
@@ -296,8 +303,8 @@ def _between(report: Mapping[str, Any], sources: set[str], sinks: set[str]) -> s
     return (reach(sources, down) & reach(sinks, up)) - sources - sinks
 
 
-def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any],
-                     repairs: Callable[[], list[dict[str, Any]]]) -> dict[str, Any]:
+def _temporal_record(q: RequirementRow, check: Mapping[str, Any],
+                     repairs: Callable[[], list[Repair]]) -> DiagnosisEntry:
     """The diagnosis of a refuted temporal requirement: its counterexample
     run (docs/requirements.md, "Temporal requirements"), the state it loops
     through shown node by node.  A lasso that rests on a node that never
@@ -312,8 +319,8 @@ def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any],
     trace = t.get("shown") or t.get("trace") or []  # cut to what matters (report/cex_cone.py)
     loop = t.get("loop")
     shown = trace[loop] if loop is not None and 0 <= loop < len(trace) else (trace[-1] if trace else {"nodes": []})
-    table = [{"node": r["node"], "variable": v, "value": x, "table": None}
-             for r in shown.get("nodes", []) for v, x in r["values"].items()]
+    table: list[CexRow] = [{"node": r["node"], "variable": v, "value": x, "table": None}
+                           for r in shown.get("nodes", []) for v, x in r["values"].items()]
     run = (f"a run of {len(trace)} states whose last returns to step {loop} and repeats forever"
            if loop is not None else f"a run of {len(trace)} states")
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
@@ -328,4 +335,4 @@ def _temporal_record(q: Mapping[str, Any], check: Mapping[str, Any],
                     "a guarantee that forces progress, or an assuming: that excludes the run, is needed.")
     fixes = repairs() if t.get("missing_progress") else []
     return {"id": str(q["id"]), "kind": "requirement", "node": node, "status": "failed", "sentence": sentence,
-            "culprits": culprits, "counterexample": table, "repairs": fixes, "guarantee": None}
+            "culprits": culprits, "counterexample": table, "repairs": fixes, "guarantee": None, "related": []}

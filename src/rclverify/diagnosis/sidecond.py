@@ -51,6 +51,7 @@ from typing import Any, Mapping, Sequence
 
 from rclverify.calculus.compose import conjuncts
 from rclverify.lang import ast
+from rclverify.lang.types import Type
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.walk import subexpressions
 from rclverify.diagnosis import realize, recheck
@@ -58,6 +59,9 @@ from rclverify.diagnosis.bounds import coefficient_literals, number_text, power_
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.links import link_pairs
 from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, _record, _rename
+from rclverify.diagnosis.shapes import SideConditionRepairs
+from rclverify.records.report_schema import SideConditionRow
+from rclverify.records.stage_records import Repair
 from rclverify.model.plan.errors import PlanError
 from rclverify.model.plan.load import all_requirements
 from rclverify.diagnosis.units import declared_unit, literal_si, literal_in
@@ -87,15 +91,15 @@ def _implementable_check(status: str, node: str) -> dict[str, str]:
         "inconclusive": "not decided (Z3 could not say in its budget)"}.get(status, status)}
 
 
-def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[str, str],
-                           consumer_evidence: Sequence[str] = ()) -> dict[str, Any]:
+def side_condition_repairs(ws: Any, sc: SideConditionRow, before_sc: Mapping[str, str],
+                           consumer_evidence: Sequence[str] = ()) -> SideConditionRepairs:
     """The repairs of the failed side condition ``sc`` (a report row), in
     the order of the module docstring: ``{"repairs": [repair records],
     "not_offered": [sentences]}``.  ``before_sc`` maps every side condition
     id of the system to its status before the edit; ``consumer_evidence``
     names the consumer's evidence (``"Controller.g1.hoare.c1 (discharged)"``)
     that a weakened assumption invalidates."""
-    out: dict[str, Any] = {"repairs": [], "not_offered": []}
+    out: SideConditionRepairs = {"repairs": [], "not_offered": []}
     pairs = link_pairs(sc)
     if not pairs:
         return out
@@ -153,7 +157,7 @@ def side_condition_repairs(ws: Any, sc: Mapping[str, Any], before_sc: Mapping[st
     return out
 
 
-def _stems_from(ws: Any, sc: Mapping[str, Any], pairs: Sequence[tuple[str, str, str, str]],
+def _stems_from(ws: Any, sc: SideConditionRow, pairs: Sequence[tuple[str, str, str, str]],
                 target: ast.Expr) -> list[str]:
     """The ids of the plan's requirements the consumer's assumption ``target``
     stems from: a formal statement that reads the linked value
@@ -174,7 +178,7 @@ def _stems_from(ws: Any, sc: Mapping[str, Any], pairs: Sequence[tuple[str, str, 
     return out
 
 
-def _requirement_guard(out: dict[str, Any], sc: Mapping[str, Any], reqs: Sequence[str]) -> None:
+def _requirement_guard(out: SideConditionRepairs, sc: SideConditionRow, reqs: Sequence[str]) -> None:
     """Weakening a consumer's assumption that stems from a requirement is
     never the first repair: when it would be the only one it is
     withdrawn into ``not_offered`` with the reason; after a safe repair it
@@ -197,8 +201,8 @@ def _requirement_guard(out: dict[str, Any], sc: Mapping[str, Any], reqs: Sequenc
                          "it is never the first repair.")
 
 
-def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
-                not_offered: list[str], inplace: tuple[Edit, int, str] | None = None) -> list[dict[str, Any]]:
+def _strengthen(ws: Any, sc: SideConditionRow, p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
+                not_offered: list[str], inplace: tuple[Edit, int, str] | None = None) -> list[Repair]:
     """1. the consumer's conjunct as a new guarantee of ``p``, or a bound of
     ``p`` tightened to it in place (``inplace``: :func:`_inplace`; module docstring)."""
     pn = ws.checked.nodes[p].node
@@ -246,7 +250,7 @@ def _strengthen(ws: Any, sc: Mapping[str, Any], p: str, new_g: str, cost_of: Any
 
 
 def _normal(c: ast.Expr, prefix: str | None, name: str,
-            constants: Mapping[str, Any] | None = None) -> tuple[str, ast.Expr] | None:
+            constants: Mapping[str, tuple[Type, ast.Expr]] | None = None) -> tuple[str, ast.Expr] | None:
     """``(op, bound)`` when ``c`` is ``<prefix>.<name> op N`` (or ``N op
     <prefix>.<name>``, mirrored) with an ordering ``op``; ``N`` a numeral,
     or, with ``constants`` (the context's, name -> (type, defining
@@ -267,7 +271,7 @@ def _normal(c: ast.Expr, prefix: str | None, name: str,
     return None
 
 
-def _const_value(e: ast.Expr, constants: Mapping[str, Any] | None) -> Fraction | None:
+def _const_value(e: ast.Expr, constants: Mapping[str, tuple[Type, ast.Expr]] | None) -> Fraction | None:
     """The value of a numeral, or of a named constant defined by one."""
     if isinstance(e, ast.NumLit):
         return value(e.text)
@@ -331,8 +335,8 @@ def _trigger_of(node: ast.Node, outs: set[str]) -> str:
     return ""
 
 
-def _rescale(ws: Any, sc: Mapping[str, Any], p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,
-             discharged: dict[str, str]) -> list[dict[str, Any]]:
+def _rescale(ws: Any, sc: SideConditionRow, p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,
+             discharged: dict[str, str]) -> list[Repair]:
     """2. a coefficient of ``p``'s guarantees on ``out.ov`` divided by ``10**k`` (module docstring)."""
     factor = Fraction(10) ** k
     for g in ws.checked.nodes[p].node.guarantees:
@@ -395,10 +399,10 @@ def _conjunct_after(target: ast.Expr, edit: Edit, source: str) -> str:
     return Edit(edit.file, loc.line, loc.col, loc.end_line, loc.end_col + delta, "").deleted(edit.apply(source))
 
 
-def _weaken(ws: Any, sc: Mapping[str, Any], target: ast.Expr, shape: tuple[str, bool, ast.NumLit] | None,
+def _weaken(ws: Any, sc: SideConditionRow, target: ast.Expr, shape: tuple[str, bool, ast.NumLit] | None,
             extreme: Fraction | None, scale: int | None, producers: Sequence[str],
             to_consumer: Sequence[tuple[str, str]], cost_of: Any, discharged: dict[str, str],
-            consumer_evidence: Sequence[str]) -> list[dict[str, Any]]:
+            consumer_evidence: Sequence[str]) -> list[Repair]:
     """3. the consumer's conjunct widened to what the producers guarantee, last (module docstring)."""
     consumer = str(sc["node"])
     cons = ws.checked.nodes[consumer].node

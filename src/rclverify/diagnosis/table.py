@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import re
 from fractions import Fraction
-from typing import Any, Mapping
+from typing import Mapping
 
+from rclverify.records.stage_records import CexRow, FunctionTable
 from rclverify.semantics.values import decimal_text
 
 #: Most rows of one function table; the rest are counted ("... and 40 more points").
@@ -89,7 +90,7 @@ def _point(cond: str, params: list[str]) -> str:
     return "(" + ", ".join(args) + ")"
 
 
-def function_table(text: str, max_rows: int = MAX_ROWS) -> dict[str, Any] | None:
+def function_table(text: str, max_rows: int = MAX_ROWS) -> FunctionTable | None:
     """The finite table of a function value written as ``{(a, b) -> v, ...,
     else -> w}`` or ``{(p1, p2) -> (if (...) then v else ...)}``: ``{"rows":
     [[args, value], ...], "more": n, "else": w}``; ``None`` when ``text`` is
@@ -185,13 +186,13 @@ def _short(text: str) -> str:
     return text[:MAX_VALUE].rsplit(" ", 1)[0] + f" ... ({len(text):,} characters in all)"
 
 
-def counterexample_table(model: Mapping[str, Any] | None, default_node: str = "") -> list[dict[str, Any]]:
+def counterexample_table(model: Mapping[str, object] | None, default_node: str = "") -> list[CexRow]:
     """The rows of a model: ``{"node", "variable", "value", "table"}`` per
     symbol, ``table`` the finite table of a function value (else ``None``).
     ``Agent.in.wayP`` gives node ``Agent``, variable ``in.wayP``; a name
     without a node part is given ``default_node``.  Values are cut at
     :data:`MAX_VALUE` characters; rationals are decimals where exact."""
-    rows: list[dict[str, Any]] = []
+    rows: list[CexRow] = []
     for name, value in (model or {}).items():
         node, var = default_node, str(name)
         parts = var.split(".")

@@ -32,16 +32,19 @@ from rclverify.diagnosis.links import link_pairs
 from rclverify.diagnosis.repairs import _record
 from rclverify.lang.printer import level, expr_to_rcl
 from rclverify.lang import ast
+from rclverify.lang.types import Type
 from rclverify.lang.units import UnitError, parse_unit
 from fractions import Fraction
 from rclverify.diagnosis.bounds import number_text
+from rclverify.diagnosis.shapes import ReportRows
+from rclverify.records.stage_records import Culprit, DiagnosisEntry, Repair
 
 
 def _loc(loc: Any) -> str:
     return f"{loc.file}:{loc.line}:{loc.col}"
 
 
-def _joins(report: Mapping[str, Any], m: Mismatch) -> list[str]:
+def _joins(report: ReportRows, m: Mismatch) -> list[str]:
     """The ids of the report's findings that the mismatch ``m`` explains
     (module docstring), in the report's order."""
     (p, _, v), (c, _, w) = m.writer, m.reader
@@ -56,13 +59,14 @@ def _joins(report: Mapping[str, Any], m: Mismatch) -> list[str]:
     obligations = {str(o["id"]): o for o in report.get("obligations") or ()}
     for e in report.get("evidence") or ():
         first = (e.get("monitoring") or {}).get("first_assumption_violation") if isinstance(e.get("monitoring"), dict) else None
-        node = (obligations.get(str(e.get("obligation"))) or {}).get("node")
+        o = obligations.get(str(e.get("obligation")))
+        node = o["node"] if o is not None else None
         if first and node == c and re.search(rf"\b{re.escape(p)}\b", str(first.get("blame", ""))):
             out.append(str(e["obligation"]))
     return list(dict.fromkeys(out))
 
 
-def _sentence(m: Mismatch, joined: list[str], report: Mapping[str, Any]) -> str:
+def _sentence(m: Mismatch, joined: list[str], report: ReportRows) -> str:
     writer, reader = ".".join(m.writer), ".".join(m.reader)
     p, c = m.writer[0], m.reader[0]
     whence = (f"its unit inferred from guarantee {m.inferred.guarantee} `{m.inferred.clause}` ({_loc(m.inferred.loc)})"
@@ -75,17 +79,18 @@ def _sentence(m: Mismatch, joined: list[str], report: Mapping[str, Any]) -> str:
             f"{m.reader_unit} ({_loc(m.reader_decl)}){factor}{seen}. Convert in {p}.")
 
 
-def unit_records(ws: Any, report: Mapping[str, Any], cached: Callable[[Any, Callable[[], Any]], Any]) -> list[dict[str, Any]]:
+def unit_records(ws: Any, report: ReportRows, cached: Callable[[Any, Callable[[], Any]], Any]) -> list[DiagnosisEntry]:
     """One record per unit mismatch of the workspace ``ws`` (module
     docstring), in link order: ``{"id": "<P>.out.<v>.unit", "kind": "unit",
     "node": P, "status": "failed", "sentence", "culprits", "counterexample":
     [], "repairs", "guarantee", "joins": [ids], "lint": the location of its
     lint row}``.  ``cached(key, make)`` keeps the repairs between runs (the
     diagnosis cache).  Never raises for a system that type-checked."""
-    out = []
+    out: list[DiagnosisEntry] = []
     for m in mismatches(ws.checked, ws.model.links):
         joined = _joins(report, m)
         p = m.writer[0]
+        culprit: Culprit
         if m.inferred is not None:
             culprit = {"what": f"guarantee {m.inferred.guarantee} of {p}", "source": _loc(m.inferred.loc),
                        "text": m.inferred.clause}
@@ -97,7 +102,7 @@ def unit_records(ws: Any, report: Mapping[str, Any], cached: Callable[[Any, Call
                     "sentence": _sentence(m, joined, report), "culprits": [culprit], "counterexample": [],
                     "repairs": [r for r in reps if r],
                     "guarantee": m.inferred.guarantee if m.inferred is not None else None,
-                    "joins": joined, "lint": _loc(m.at)})
+                    "related": [], "joins": joined, "lint": _loc(m.at)})
     return out
 
 
@@ -122,7 +127,7 @@ def _wrap(text: str) -> str:
     return f"({text})" if any(ch in text for ch in "*/") else text
 
 
-def conversion_repair(ws: Any, m: Mismatch) -> list[dict[str, Any]]:
+def conversion_repair(ws: Any, m: Mismatch) -> list[Repair]:
     """The conversion in the producer as a repair record
     (:func:`rclverify.diagnosis.repairs._record`, kind ``convert-unit``):
     the right side ``E`` of the equation the writer's unit was inferred
@@ -213,7 +218,7 @@ def _unit_of(ann: Any) -> Unit | None:
     return u if u.offset is None and u.pi == 0 else None  # affine (degC) and pi-scaled units: not compared
 
 
-def literal_si(lit: Any, constants: Mapping[str, Any], declared: Any) -> tuple[Any, Any] | None:
+def literal_si(lit: Any, constants: Mapping[str, tuple[Type, ast.Expr]], declared: Any) -> tuple[Any, Any] | None:
     """``(value in the coherent SI unit, dimensions)`` of a bound: a numeral
     read in the unit written after it (``45 [N]``), else in ``declared`` (the
     compared variable's ``UnitAnn``: a bare number takes the unit of what it

@@ -129,7 +129,7 @@ class Transformer(Visitor[Any]):
     nothing below it changed."""
 
     def generic_visit(self, node: Any, *args: Any) -> Any:
-        changes: dict[str, Any] = {}
+        changes: dict[str, object] = {}
         for name in _FIELDS[type(node)]:
             value = getattr(node, name)
             if _is_node(value):

@@ -25,12 +25,13 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 #: Severity order used by every roll-up; larger is worse (defined with the vocabulary).
 from rclverify.records.statuses import RECORD_STATUSES, SEVERITY as SEVERITY
+from rclverify.records.stage_records import ObligationRecord
 
 #: Roll-up status for a parent with no evidence at all.
 MISSING = "pending"
@@ -104,14 +105,14 @@ class Obligation:
     inputs: tuple[str, ...] = ()
     data: Mapping[str, Any] = field(default_factory=dict)
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> ObligationRecord:
         # dataclasses.asdict's mapping without its deep copy of ``data``, which the shallow copy replaced
         # (a fifth of writing a 1000-node system's obligations); the fields in their order, as asdict gives
-        d: dict[str, Any] = {f.name: getattr(self, f.name) for f in fields(self)}
-        d["source"] = asdict(self.source)
-        d["inputs"] = list(self.inputs)
-        d["data"] = dict(self.data)
-        return d
+        return {"id": self.id, "node": self.node, "guarantee": self.guarantee, "backend": self.backend,
+                "kind": self.kind, "statement": self.statement,
+                "source": {"file": self.source.file, "line": self.source.line, "col": self.source.col},
+                "instance": self.instance, "artifact": self.artifact, "inputs": list(self.inputs),
+                "data": dict(self.data)}
 
     @staticmethod
     def from_json(d: Mapping[str, Any]) -> "Obligation":

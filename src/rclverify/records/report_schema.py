@@ -146,6 +146,27 @@ class Summary(TypedDict):
     confidence: NotRequired[float]
 
 
+class InputRow(TypedDict):
+    """An input variable of a node (``nodes[].inputs[]``); ``producer`` ``Node.var``, ``None`` from the environment."""
+    name: str
+    type: str
+    producer: str | None
+
+
+class OutputRow(TypedDict):
+    """An output variable of a node (``nodes[].outputs[]``); ``consumers`` the linked inputs ``Node.var``."""
+    name: str
+    type: str
+    consumers: list[str]
+
+
+class AssumptionRow(TypedDict):
+    """An assumption of a node (``nodes[].assumptions[]``); ``environment``: no node's guarantee discharges it."""
+    text: str
+    source: str
+    environment: bool
+
+
 class GuaranteeRow(TypedDict):
     """A guarantee of a node (``nodes[].guarantees[]``); ``index`` is 1-based."""
     index: int
@@ -162,9 +183,9 @@ class NodeRow(TypedDict):
     name: str
     source: str
     status: EvidenceStatus
-    inputs: list[dict[str, Any]]
-    outputs: list[dict[str, Any]]
-    assumptions: list[dict[str, Any]]
+    inputs: list[InputRow]
+    outputs: list[OutputRow]
+    assumptions: list[AssumptionRow]
     guarantees: list[GuaranteeRow]
     latex: str
     confidence: NotRequired[float]
@@ -337,6 +358,24 @@ class UnverifiedRow(TypedDict):
     message: str
 
 
+class ProblemMember(TypedDict):
+    """An item of a problem row (``problems[].members[]``); ``consequence_of`` the ids of the items whose
+    failure it follows from."""
+    id: str
+    kind: str
+    status: AnyStatus
+    sentence: str
+    anchor: str
+    diagnosis: bool
+    consequence_of: NotRequired[list[str]]
+
+
+class RepairRef(TypedDict):
+    """A repair by reference (``problems[].repairs[]``): the diagnosis's id and the 0-based index of its repair."""
+    diagnosis: str
+    index: int
+
+
 class ProblemRow(TypedDict):
     """Problems grouped by one root cause (``problems[]``)."""
     key: list[str]
@@ -344,8 +383,8 @@ class ProblemRow(TypedDict):
     status: EvidenceStatus
     where: str
     culprits: list[dict[str, Any]]
-    members: list[dict[str, Any]]
-    repairs: list[dict[str, Any]]
+    members: list[ProblemMember]
+    repairs: list[RepairRef]
 
 
 class Report(TypedDict):

@@ -41,13 +41,13 @@ def is_sealed_path(rel: str) -> bool:
     return rel.endswith(".json") and (rel in SEALED_FILES or rel.startswith(SEALED_DIRS))
 
 
-def sealed(record: Mapping[str, Any]) -> dict[str, Any]:
+def sealed(record: Mapping[str, object]) -> dict[str, object]:
     """``record`` (a JSON object, without a seal) with its seal added."""
     body = {k: v for k, v in record.items() if k != SEAL}
     return {**body, SEAL: seal_of(body)}
 
 
-def write_sealed(path: Path, record: Mapping[str, Any], *, durable: bool = False) -> bool:
+def write_sealed(path: Path, record: Mapping[str, object], *, durable: bool = False) -> bool:
     """Write ``record`` sealed, atomically (the text of :func:`.store.write_json`
     of :func:`sealed`, encoded once: :func:`.store.sealed_dumps`); returns
     ``True`` when the file changed.  Raises ``OSError``."""
@@ -169,7 +169,7 @@ class TargetsSealed:
 
     KEY = "_sealed_stat"
 
-    def __call__(self, task: Any, values: Mapping[str, Any]) -> bool:
+    def __call__(self, task: Any, values: Mapping[str, object]) -> bool:
         def sealed_targets() -> list[str]:
             out = []
             for t in task.targets:
@@ -178,7 +178,7 @@ class TargetsSealed:
                     out.append(str(t))
             return out
 
-        def stat_of(f: str) -> list[Any]:
+        def stat_of(f: str) -> list[str | int | None]:
             try:
                 st = os.stat(f)
                 return [f, st.st_mtime_ns, st.st_size]
@@ -188,7 +188,7 @@ class TargetsSealed:
         def files() -> list[str]:
             return [g for t in sealed_targets() for g in (t, *_companions(t))]
 
-        def stat() -> dict[str, Any]:
+        def stat() -> dict[str, list[list[str | int | None]]]:
             return {self.KEY: [stat_of(f) for f in files()]}
         task.value_savers.append(stat)
         targets = sealed_targets()

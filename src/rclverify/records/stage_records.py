@@ -5,9 +5,13 @@ one JSON record under ``artifacts/`` (records/sealed.py seals it) and
 returns it; these TypedDicts are the static reading of those records, key
 by key, with each key's JSON type.  A key a producer writes only in some
 cases is ``NotRequired``.  The inner shape of a record that belongs to one
-tool (an obligation's backend ``data``, a health finding's Z3 ``model``, a
-temporal requirement's run, cvc5's answer) stays ``dict[str, Any]``, as in
-:mod:`rclverify.records.report_schema`.
+tool (an obligation's backend ``data``, a temporal requirement's run, a
+deadline's counterexample) stays ``dict[str, Any]``, as in
+:mod:`rclverify.records.report_schema`.  The parts several folders share are
+here too (the diagnoses' culprits, counterexample rows and repairs; a side
+condition's in-context record; cvc5's answer; a temporal requirement's
+verdict on a recorded run), since records/ is below every folder that
+writes or reads them.
 
 Producers: ``check`` app/pipeline.py ``stage_check``; ``compose``
 calculus/compose.py ``composition_json`` and calculus/side_condition.py;
@@ -55,6 +59,41 @@ class RuleInstance(TypedDict):
     conclusion: str
 
 
+class LocalVerdict(TypedDict):
+    """A side condition's local verdict, kept when it is decided again in context."""
+    status: str
+    variant: str
+    model: dict[str, str] | None
+
+
+class ContextRecord(TypedDict):
+    """How a side condition's in-context check went (calculus/side_condition.py ``in_context``):
+    the cone's size, the premises and nodes the proof used, the links opened (rule R4), the nodes
+    whose assumption the counterexample violates, the joins read, the local verdict, and the
+    producers whose cone summaries the proof read."""
+    cone: int
+    used: list[str]
+    used_nodes: list[str]
+    opened: list[str]
+    violated: list[str]
+    joins: list[str]
+    local: LocalVerdict
+    summaries: NotRequired[list[str]]
+
+
+class ScaleMismatch(TypedDict):
+    """A probable scale mismatch behind a side condition (calculus/scale.py): both ends and their
+    ranges (text, ``-oo``/``+oo`` unbounded), the power of ten (0: a named conversion), the factor
+    and the sentence."""
+    producer: str
+    consumer: str
+    producer_range: list[str]
+    consumer_range: list[str]
+    power: int
+    factor: str
+    message: str
+
+
 class SideCondition(TypedDict):
     """One side condition and its Z3 verdict (calculus/side_condition.py); ``duration_s`` in seconds."""
     id: str
@@ -71,8 +110,8 @@ class SideCondition(TypedDict):
     variant: str
     links: list[str]
     verdict: str
-    context: dict[str, Any] | None
-    scale_mismatch: NotRequired[list[dict[str, Any]]]
+    context: ContextRecord | None
+    scale_mismatch: NotRequired[list[ScaleMismatch]]
 
 
 class CompositionRecord(TypedDict):
@@ -147,8 +186,9 @@ class DeadlineStamp(TypedDict):
     t_s: str
 
 
-class DeadlineRecord(TypedDict):
-    """One end-to-end deadline decided with Z3 (rule D3; ``artifacts/deadlines/index.json``)."""
+class DeadlineCheck(TypedDict):
+    """One end-to-end deadline decided with Z3 (rule D3), as its decision gives it
+    (calculus/deadlines.py ``DeadlineResult.to_json``): :class:`DeadlineRecord` without the stage's keys."""
     requirement: str
     path: list[str]
     within_s: str
@@ -161,15 +201,21 @@ class DeadlineRecord(TypedDict):
     stamps: list[DeadlineStamp]
     worst_path: list[str]
     loc: str
+
+
+class DeadlineRecord(DeadlineCheck):
+    """One end-to-end deadline decided with Z3 (rule D3; ``artifacts/deadlines/index.json``): its decision
+    with the query's path (``smt2``, ``""`` without one) and the sha256 of its ``inputs`` (stages/deadlines.py)."""
     smt2: str
     inputs: dict[str, str]
 
 
 class Premise(TypedDict):
-    """A premise a requirement's check used (a guarantee, an assumption, a fact, an initial value)."""
+    """A premise a requirement's check used (a guarantee, an assumption, a fact, an initial value);
+    ``node`` ``None`` for a premise of the requirement's own ``assuming``."""
     label: str
     kind: str
-    node: str
+    node: str | None
     index: int
     text: str
     source: str
@@ -181,8 +227,49 @@ class Traced(TypedDict):
     guarantee: int
 
 
-class RequirementRecord(TypedDict):
-    """One requirement decided from the composed contracts (``artifacts/requirements/``)."""
+class Witness(TypedDict):
+    """One operand of a temporal statement at one step of a trace."""
+    step: int
+    time: float
+    where: str
+    operand: str
+    holds: bool | None
+    values: dict[str, str]
+    unreadable: NotRequired[list[str]]
+    semantics: NotRequired[str]
+
+
+class TraceVerdictJson(TypedDict):
+    """A temporal statement's verdict on one trace (backends/monitors/temporal_trace.py ``TraceVerdict``)."""
+    verdict: str
+    steps: int
+    reason: str
+    step: int | None
+    time: float | None
+    where: str
+    witness: list[Witness]
+
+
+class TraceFailure(TypedDict):
+    """A trace that could not be checked: ``verdict`` ``error`` and the located message."""
+    verdict: str
+    reason: str
+
+
+class TraceRow(TypedDict):
+    """One recorded run checked against a temporal requirement (backends/monitors/temporal_evidence.py
+    ``trace_rows``): the trace, its mapping (``None``: the default), its sha256, the evidence status
+    and the verdict on it."""
+    trace: str
+    mapping: str | None
+    sha256: str
+    status: str
+    verdict: TraceVerdictJson | TraceFailure
+
+
+class RequirementBase(TypedDict):
+    """The keys of a requirement's record that come from the plan alone (calculus/requirements/check.py
+    ``_base``): ``source`` ``file:line:col``, the statements as RCL text."""
     id: str
     text: str
     origin: str
@@ -192,12 +279,16 @@ class RequirementRecord(TypedDict):
     ranking: str | None
     invariant: str | None
     traced: list[Traced]
+
+
+class RequirementCheck(RequirementBase):
+    """A requirement decided from the composed contracts, as its check gives it
+    (calculus/requirements/check.py ``check_requirement``): :class:`RequirementRecord` without
+    what the stage adds (``smt2`` and the side queries' ``*_smt2`` are then the scripts' text)."""
     verdict: str
     cone: list[str]
     used: list[Premise]
     traced_not_needed: list[Premise]
-    fingerprint: str
-    inputs: dict[str, str]
     explanation: NotRequired[str]
     reason: NotRequired[str]
     premises: NotRequired[int]
@@ -207,7 +298,7 @@ class RequirementRecord(TypedDict):
     counterexample: NotRequired[list[dict[str, Any]]]
     failed_to_prevent: NotRequired[list[dict[str, Any]]]
     temporal: NotRequired[dict[str, Any]]
-    traces: NotRequired[list[dict[str, Any]]]
+    traces: NotRequired[list[TraceRow]]
     consistency: NotRequired[str]
     consistency_reason: NotRequired[str]
     consistency_duration_s: NotRequired[float]
@@ -220,11 +311,31 @@ class RequirementRecord(TypedDict):
     vacuity_smt2: NotRequired[str]
 
 
+class RequirementRecord(RequirementCheck):
+    """One requirement decided from the composed contracts (``artifacts/requirements/``): its check with the
+    ``fingerprint`` it was made from and the sha256 of its ``inputs`` (stages/requirements.py); ``smt2`` and
+    the side queries' ``*_smt2`` name the scripts kept beside it."""
+    fingerprint: str
+    inputs: dict[str, str]
+
+
 class SecondSolver(TypedDict):
     """The second solver that decided the scripts again (cvc5; docs/second-solver.md)."""
     name: str
     version: str
     rlimit: int
+
+
+class Cvc5Answer(TypedDict):
+    """cvc5's answer to one script (stages/crosscheck/cvc5_decide.py ``Decision.row``): ``sat``/``unsat``/
+    ``unknown``/``error``, the reason, whether its proof checked, its version, the time in seconds, and the
+    proof's path (``""`` without one)."""
+    answer: str
+    reason: str
+    proof_checked: bool
+    version: str
+    duration_s: float
+    proof: str
 
 
 class CrosscheckRow(TypedDict):
@@ -236,7 +347,7 @@ class CrosscheckRow(TypedDict):
     z3: str
     sha256: str
     key: str
-    cvc5: dict[str, Any] | None
+    cvc5: Cvc5Answer | None
     agreement: str
     why: str
     via: NotRequired[str]
@@ -247,6 +358,52 @@ class CrosscheckRecord(TypedDict):
     solver: SecondSolver | None
     counts: dict[str, int]
     items: list[CrosscheckRow]
+
+
+#: A function value's finite table (diagnosis/table.py ``function_table``): ``rows`` ``[args, value]``,
+#: ``more`` the rows left out, ``else`` the value elsewhere.
+FunctionTable = TypedDict("FunctionTable", {"rows": list[list[str]], "more": int, "else": str})
+
+
+class CexRow(TypedDict):
+    """One symbol of a counterexample as a diagnosis shows it (diagnosis/table.py ``counterexample_table``)."""
+    node: str
+    variable: str
+    value: str
+    table: FunctionTable | None
+
+
+class Culprit(TypedDict):
+    """What a diagnosis names to repair: ``what`` in words, ``source`` ``file:line:col``, ``text`` as written."""
+    what: str
+    source: str
+    text: str
+
+
+class EditJson(TypedDict):
+    """A repair's edit of one file (diagnosis/edits.py ``Edit.to_json``): 1-based span, the text put in and taken out."""
+    file: str
+    line: int
+    col: int
+    end_line: int
+    end_col: int
+    inserted: str
+    deleted: str
+
+
+class Repair(TypedDict):
+    """One repair Z3 checked (diagnosis/repairs.py ``_record``): the ``edit`` and its unified ``diff``, the
+    ``checks`` Z3 answered and the ``cost`` (status changes), each ``{"check"/"item", "status", ...}``."""
+    kind: str
+    summary: str
+    file: str
+    edit: EditJson
+    diff: str
+    checks: list[dict[str, str]]
+    cost: list[dict[str, str]]
+    proves: str
+    not_shown: str
+    checked_by: str
 
 
 class DiagnosisEntry(TypedDict):
@@ -260,9 +417,9 @@ class DiagnosisEntry(TypedDict):
     node: str
     status: str
     sentence: str
-    culprits: list[dict[str, Any]]
-    counterexample: list[dict[str, Any]]
-    repairs: list[dict[str, Any]]
+    culprits: list[Culprit]
+    counterexample: list[CexRow]
+    repairs: list[Repair]
     guarantee: int | None
     related: list[str]
     not_offered: NotRequired[list[str]]
@@ -291,12 +448,39 @@ class GroundingFinding(TypedDict):
     ros: SourceRef | None
 
 
+class GroundedNode(TypedDict):
+    """A node of the computation graph and the topics it publishes and subscribes to."""
+    name: str
+    publishes: list[str]
+    subscribes: list[str]
+
+
+class PackageVersion(TypedDict):
+    """A scanned package and its version."""
+    name: str
+    version: str
+
+
+class FileDigest(TypedDict):
+    """A file the graph was read from and its sha256."""
+    path: str
+    sha256: str
+
+
+class GroundingContext(TypedDict):
+    """What the graph was read from, for the GSN argument: the packages, the files, the launch files."""
+    packages: list[PackageVersion]
+    files: list[FileDigest]
+    launch: list[str]
+
+
 class GroundingRecord(TypedDict):
-    """``artifacts/ros/grounding.json``: the contracts grounded in the computation graph."""
+    """``artifacts/ros/grounding.json``: the contracts grounded in the computation graph (``graph``:
+    ``{"nodes": [...]}``)."""
     findings: list[GroundingFinding]
     counts: dict[str, int]
-    graph: dict[str, list[dict[str, Any]]]
-    context: dict[str, list[Any]]
+    graph: dict[str, list[GroundedNode]]
+    context: GroundingContext
     drawing: dict[str, str | None]
     matched: dict[str, str]
     inputs: dict[str, str]

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Iterable, Mapping, Protocol
+from typing import Any, Iterable, Mapping, Protocol, TypedDict
 
 #: What a target counts: a whole run with any violation, or one judged answer.
 PER = ("run", "answer")
@@ -104,6 +104,42 @@ def runs_needed(k: int, n: int, target: float, level: float) -> int | None:
     return hi
 
 
+class SprtJson(TypedDict):
+    """:class:`Sprt` as JSON (``llr`` and the thresholds rounded to 6 places)."""
+    llr: float
+    accept_at: float
+    reject_at: float
+    p_good: float
+    p_bad: float
+    decision: str
+    clean_runs_to_accept: int
+
+
+class TargetJson(TypedDict):
+    """A statistical target as JSON (model/plan/target_text.py ``TargetText.to_json``)."""
+    bound: float
+    level: float
+    per: str
+    text: str
+    guarantee: int
+
+
+class TargetDecision(TypedDict):
+    """What :func:`decide` gives: the trials, the bounds, the target, the runs still needed, the SPRT
+    and the verdict (``status`` and ``explanation``)."""
+    n: int
+    k: int
+    undecided: int
+    bound: float
+    bound_without_undecided: float
+    level: float
+    target: TargetJson
+    runs_needed: int | None
+    sprt: SprtJson
+    status: str
+    explanation: str
+
+
 @dataclass(frozen=True)
 class Sprt:
     """Wald's SPRT state: ``llr`` the log likelihood ratio of the good rate
@@ -121,7 +157,7 @@ class Sprt:
     decision: str
     clean_runs_to_accept: int
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> SprtJson:
         return {"llr": round(self.llr, 6), "accept_at": round(self.accept_at, 6), "reject_at": round(self.reject_at, 6),
                 "p_good": self.p_good, "p_bad": self.p_bad, "decision": self.decision,
                 "clean_runs_to_accept": self.clean_runs_to_accept}
@@ -162,7 +198,7 @@ class TargetLike(Protocol):
 
     def words(self) -> str: ...
 
-    def to_json(self) -> dict[str, Any]: ...
+    def to_json(self) -> TargetJson: ...
 
 
 #: The fields of one run row that :func:`count_runs` adds up.
@@ -216,7 +252,7 @@ def trials(counts: Mapping[str, Any], per: str) -> tuple[int, int, int]:
     return int(counts["runs"]), int(counts["violating_runs"]), int(counts["undecided_runs"])
 
 
-def decide(counts: Mapping[str, Any], target: TargetLike) -> dict[str, Any]:
+def decide(counts: Mapping[str, Any], target: TargetLike) -> TargetDecision:
     """The target's verdict on ``counts`` (:func:`count_runs`).  Undecided
     runs or answers count as violations for the bound (never a guess in the
     target's favour).  Returns ``{"status", "explanation", "n", "k",
@@ -243,32 +279,29 @@ def decide(counts: Mapping[str, Any], target: TargetLike) -> dict[str, Any]:
     needed = runs_needed(worst, n, target.bound, target.level)
     unit = "run" if target.per == "run" else "answer"
     seen = f"{k} violating {unit}(s) in {n}" + (f" and {unsure} undecided" if unsure else "")
-    out: dict[str, Any] = {"n": n, "k": k, "undecided": unsure, "bound": bound, "bound_without_undecided": best,
-                           "level": target.level, "target": target.to_json(), "runs_needed": needed,
-                           "sprt": test.to_json()}
     pct = f"{target.level * 100:g} %"
     if n == 0:
-        out.update(status="pending", explanation=f"no judged {unit} yet: {needed} clean {unit}(s) would meet "
-                                                 f"{target.words()}")
+        status, explanation = "pending", f"no judged {unit} yet: {needed} clean {unit}(s) would meet {target.words()}"
     elif bound <= target.bound:
-        out.update(status="discharged", explanation=f"{seen}: the {pct} upper bound {bound:.3g} meets "
-                                                    f"{target.words()}")
+        status, explanation = "discharged", f"{seen}: the {pct} upper bound {bound:.3g} meets {target.words()}"
     elif test.decision == "reject" and sprt(k, n, target.bound, target.level).decision == "reject":
-        out.update(status="failed", explanation=f"{seen}: the SPRT says the rate is at least {target.bound:g} "
-                                                f"(upper bound {bound:.3g}): stop, the target is missed")
+        status, explanation = "failed", (f"{seen}: the SPRT says the rate is at least {target.bound:g} "
+                                         f"(upper bound {bound:.3g}): stop, the target is missed")
     elif test.decision == "reject":  # missed only if the undecided ones are violations: nothing decided it
-        out.update(status="inconclusive", explanation=f"{seen}: the target is missed only if the {unsure} "
-                                                      f"undecided {unit}(s) are violations (the SPRT rejects with "
-                                                      f"them, not with the {k} decided violation(s) alone)")
+        status, explanation = "inconclusive", (f"{seen}: the target is missed only if the {unsure} "
+                                               f"undecided {unit}(s) are violations (the SPRT rejects with "
+                                               f"them, not with the {k} decided violation(s) alone)")
     elif unsure and best <= target.bound:
-        out.update(status="inconclusive", explanation=f"{seen}: the target is met only if the {unsure} undecided "
-                                                      f"{unit}(s) are clean (upper bound {best:.3g} without them, "
-                                                      f"{bound:.3g} with them)")
+        status, explanation = "inconclusive", (f"{seen}: the target is met only if the {unsure} undecided "
+                                               f"{unit}(s) are clean (upper bound {best:.3g} without them, "
+                                               f"{bound:.3g} with them)")
     else:
-        out.update(status="pending", explanation=f"{seen}: the {pct} upper bound {bound:.3g} misses "
-                                                 f"{target.words()}; {needed} further clean {unit}(s) would meet it "
-                                                 f"(SPRT: {test.decision})")
-    return out
+        status, explanation = "pending", (f"{seen}: the {pct} upper bound {bound:.3g} misses "
+                                          f"{target.words()}; {needed} further clean {unit}(s) would meet it "
+                                          f"(SPRT: {test.decision})")
+    return {"n": n, "k": k, "undecided": unsure, "bound": bound, "bound_without_undecided": best,
+            "level": target.level, "target": target.to_json(), "runs_needed": needed, "sprt": test.to_json(),
+            "status": status, "explanation": explanation}
 
 
 __all__ = ["PER", "Sprt", "TargetLike", "count_runs", "decide", "lower_bound", "runs_needed", "sprt", "trials",

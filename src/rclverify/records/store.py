@@ -26,14 +26,14 @@ __all__ = ["atomic_write_bytes", "atomic_write_text", "dumps", "read_json", "wri
 SEAL = "record_sha256"
 
 
-def seal_of(record: Mapping[str, Any]) -> str:
+def seal_of(record: Mapping[str, object]) -> str:
     """The seal of an evidence record (its JSON mapping): the sha256 of
     :func:`dumps` of every key but :data:`SEAL` itself, hex."""
     body = {k: v for k, v in record.items() if k != SEAL}
     return hashlib.sha256(dumps(body).encode("utf-8")).hexdigest()
 
 
-def sealed_dumps(record: Mapping[str, Any]) -> str:
+def sealed_dumps(record: Mapping[str, object]) -> str:
     """:func:`dumps` of ``record`` with its seal (:data:`SEAL`,
     :func:`seal_of`) added, the record encoded once: the seal is the
     sha256 of :func:`dumps` of the other keys, and the sealed text is that

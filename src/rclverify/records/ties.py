@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.records.store import dumps
 
@@ -51,7 +51,7 @@ _QUERY = "; rclverify: decides "
 _PROOF = "; rclverify: proof of the query with sha256 "
 
 
-def statement_sha256(kind: str, item_id: str, row: Mapping[str, Any]) -> str:
+def statement_sha256(kind: str, item_id: str, row: Mapping[str, object]) -> str:
     """The sha256 (hex) of :func:`.store.dumps` of ``{"kind", "id",
     "statement"}``, the statement being ``row``'s :data:`STATEMENT_FIELDS`
     of ``kind``.  Raises ``KeyError`` for a kind not in the table."""
@@ -59,13 +59,13 @@ def statement_sha256(kind: str, item_id: str, row: Mapping[str, Any]) -> str:
     return hashlib.sha256(dumps({"kind": kind, "id": item_id, "statement": statement}).encode("utf-8")).hexdigest()
 
 
-def query_tie(kind: str, item_id: str, row: Mapping[str, Any]) -> str:
+def query_tie(kind: str, item_id: str, row: Mapping[str, object]) -> str:
     """The last line (without its newline) of the query of item ``kind``
     ``item_id`` whose record row is ``row`` (module docstring)."""
     return f"{_QUERY}{kind} {json.dumps(item_id)}, statement sha256 {statement_sha256(kind, item_id, row)}"
 
 
-def tie_query(text: str, kind: str, item_id: str, row: Mapping[str, Any]) -> str:
+def tie_query(text: str, kind: str, item_id: str, row: Mapping[str, object]) -> str:
     """``text`` (an SMT-LIB2 script) with :func:`query_tie` as its last line."""
     return _end(text) + query_tie(kind, item_id, row) + "\n"
 

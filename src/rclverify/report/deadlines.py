@@ -41,7 +41,7 @@ import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.records.report_schema import DeadlineRow, ObligationRow, Report
-from rclverify.report.shapes import SarifResult
+from rclverify.records.sarif import SarifResult
 from rclverify.records.records import worst
 from rclverify.records.statuses import DEADLINE_STATUS
 from rclverify.stages.workspace import Workspace

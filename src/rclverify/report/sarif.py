@@ -39,7 +39,7 @@ from rclverify.report.templating import model_text
 from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, FindingRow, LintRow, Report
 from rclverify.report.severity import of
 from rclverify.diagnosis.edits import sarif_fix
-from rclverify.report.shapes import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
+from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
                                      SarifSuppression)
 
 #: The SARIF version written and the schema it validates against.

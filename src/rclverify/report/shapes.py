@@ -2,110 +2,21 @@
 
 The report's own rows are :mod:`rclverify.records.report_schema`'s and the
 stages' sealed records :mod:`rclverify.records.stage_records`'s; this module
-holds only what report/ builds on top of them: the SARIF log's objects
-(report/sarif.py, SARIF 2.1.0), the views the templates and the terminal
+holds only what report/ builds on top of them (the SARIF log's objects are
+:mod:`rclverify.records.sarif`'s): the views the templates and the terminal
 read (report/view.py, report/summary.py), the statistics table
 (report/statistics.py).  A key written only in some cases is ``NotRequired``.
 A value only passed on to JSON (a result's ``properties``) is ``object``.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import Any, NotRequired, Sequence, TypedDict
+from typing import Any, NotRequired, TypedDict
 
 from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceRow, FindingRow, NodeRow,
                                              LimitedBy, ObligationRow, PendingRow, ProblemRow, RequirementRow, SideConditionRow,
                                              Summary, SupportRow)
 
 
-class SarifText(TypedDict):
-    """A SARIF ``message`` (§3.11): plain text."""
-    text: str
-
-
-class SarifArtifactLocation(TypedDict):
-    """A file relative to the workspace root (§3.4)."""
-    uri: str
-    uriBaseId: str
-
-
-class SarifRegion(TypedDict):
-    """A place in a file (§3.30): 1-based line, the column when known."""
-    startLine: int
-    startColumn: NotRequired[int]
-
-
-class SarifPhysicalLocation(TypedDict):
-    """A file and a place in it (§3.29)."""
-    artifactLocation: SarifArtifactLocation
-    region: SarifRegion
-
-
-class SarifLocation(TypedDict):
-    """A result's location (§3.28); ``id`` and ``message`` only for a related location."""
-    physicalLocation: SarifPhysicalLocation
-    id: NotRequired[int]
-    message: NotRequired[SarifText]
-
-
-class SarifSuppression(TypedDict):
-    """A plan acknowledgement of a result (§3.35): ``kind`` external, ``status`` accepted."""
-    kind: str
-    status: str
-    justification: str
-    location: NotRequired[SarifLocation]
-
-
-class SarifResult(TypedDict):
-    """One SARIF ``result`` (§3.27); ``partialFingerprints`` holds the item's stable key,
-    ``properties`` the item's fields (JSON values, only written), ``fixes`` the checked repairs."""
-    ruleId: str
-    level: str
-    message: SarifText
-    locations: list[SarifLocation]
-    partialFingerprints: dict[str, str]
-    properties: dict[str, object]
-    relatedLocations: NotRequired[list[SarifLocation]]
-    suppressions: NotRequired[list[SarifSuppression]]
-    fixes: NotRequired[Sequence[object]]
-    ruleIndex: NotRequired[int]
-
-
-class SarifLevel(TypedDict):
-    """A rule's ``defaultConfiguration`` (§3.50)."""
-    level: str
-
-
-class SarifDescriptor(TypedDict):
-    """A rule as the driver lists it (§3.49, ``reportingDescriptor``)."""
-    id: str
-    name: str
-    shortDescription: SarifText
-    defaultConfiguration: SarifLevel
-
-
-class SarifDriver(TypedDict):
-    """The tool that made the log (§3.19): rclverify, its version and every rule it may report."""
-    name: str
-    version: str
-    rules: list[SarifDescriptor]
-
-
-class SarifTool(TypedDict):
-    """A run's ``tool`` (§3.18)."""
-    driver: SarifDriver
-
-
-class SarifRun(TypedDict):
-    """The one run of the log (§3.14); ``properties`` the report's workspace, plan, status and gate."""
-    tool: SarifTool
-    originalUriBaseIds: dict[str, object]
-    columnKind: str
-    results: list[SarifResult]
-    properties: dict[str, object]
-
-
-#: ``reports/assurance.sarif`` (§3.13): the schema, the version and one run.
-SarifLog = TypedDict("SarifLog", {"$schema": str, "version": str, "runs": list[SarifRun]})
 
 
 class NodeSummaryRow(TypedDict):

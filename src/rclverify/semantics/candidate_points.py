@@ -8,7 +8,7 @@ from fractions import Fraction
 from typing import Any, Iterator, Mapping
 
 from rclverify.lang import ast
-from rclverify.semantics.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term, Value
 from rclverify.semantics.candidates import NotInFragment, Source, analyse
 from rclverify.semantics.eval_values import Undecided
 
@@ -22,7 +22,7 @@ def _is_number(x: Any) -> bool:
     return not isinstance(x, bool) and isinstance(x, (int, float, Fraction))
 
 
-def breakpoints(ev: Any, sources: tuple[Source, ...], b: Mapping[str, Any], numeric: str) -> list[Any]:
+def breakpoints(ev: Any, sources: tuple[Source, ...], b: Mapping[str, Value], numeric: str) -> list[Any]:
     """The breakpoints of the sources under bindings ``b`` (evaluated by ``ev``, the double
     reading): numbers as the reading compares them.  Raises ``Undecided`` when a point at an
     exact-equality position of a ``REAL`` variable is no double."""
@@ -48,7 +48,7 @@ def breakpoints(ev: Any, sources: tuple[Source, ...], b: Mapping[str, Any], nume
     return [x for x in out if x is not None]
 
 
-def _values(ev: Any, s: Source, b: Mapping[str, Any]) -> list[Any]:
+def _values(ev: Any, s: Source, b: Mapping[str, Value]) -> list[Any]:
     """The values ``s.expr`` takes: its value, or a table's results and default."""
     if not s.table:
         return [ev.eval(s.expr, b)]
@@ -167,7 +167,7 @@ def numeric_of(ev: Any, dom: Any) -> str | None:
     return name if name in ("REAL", "INTEGER", "NATURAL") else None
 
 
-def quantify(ev: Any, e: ast.Quant, b: Mapping[str, Any], finite_domain: Any, max_product: int) -> bool | None:
+def quantify(ev: Any, e: ast.Quant, b: Mapping[str, Value], finite_domain: Any, max_product: int) -> bool | None:
     """Quantifier ``e`` under bindings ``b`` in the reading of evaluator ``ev``: each variable
     over its finite domain (``finite_domain(ev, e, binding, name, b)``, raising ``Undecided``)
     or, where that finds an unbounded numeric domain, over its candidate points.  ``None``
@@ -201,7 +201,7 @@ def quantify(ev: Any, e: ast.Quant, b: Mapping[str, Any], finite_domain: Any, ma
     steps = [0]
     unique = e.kind == "exists_unique"
 
-    def level(j: int, cur: dict[str, Any]) -> int:
+    def level(j: int, cur: dict[str, Value]) -> int:
         """forall: 1 when the body holds everywhere; exists: 1 when somewhere; unique: how
         many times (capped at MANY)."""
         if j == len(slots):

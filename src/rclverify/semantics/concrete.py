@@ -99,12 +99,12 @@ def _io_type(node: CheckedNode, qualified: str) -> Type:
     return table[name]
 
 
-_ENCODED: dict[tuple[int, str], tuple[ast.Expr, z3.BoolRef, dict[str, Any], list[z3.BoolRef]]] = {}
+_ENCODED: dict[tuple[int, str], tuple[ast.Expr, z3.BoolRef, dict[str, z3.ExprRef | z3.FuncDeclRef], list[z3.BoolRef]]] = {}
 on_fresh(_ENCODED.clear)  # its formulas belong to the Z3 context they were made in
 
 
 def _encoded_typed(formula: ast.Expr, checked: Checked,
-                   node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any], list[z3.BoolRef]]:
+                   node: CheckedNode) -> tuple[z3.BoolRef, dict[str, z3.ExprRef | z3.FuncDeclRef], list[z3.BoolRef]]:
     """``formula`` encoded once over free I/O symbols (cached per formula object:
     encoding costs more than the check), with those symbols by qualified name
     and the encoder's typing axioms over them (``NATURAL >= 0``, ...)."""
@@ -114,7 +114,7 @@ def _encoded_typed(formula: ast.Expr, checked: Checked,
         return hit[1], hit[2], hit[3]
     enc = Encoder(checked.env)
     phi = enc.formula(formula, node)
-    free: dict[str, Any] = {}
+    free: dict[str, z3.ExprRef | z3.FuncDeclRef] = {}
     for sym in enc.symbols.values():
         q = sym.z3name.split(".", 1)[1]  # "<Node>.in.x" -> "in.x"
         free[q] = sym.decl
@@ -123,7 +123,7 @@ def _encoded_typed(formula: ast.Expr, checked: Checked,
     return phi, free, axioms
 
 
-def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, Any]]:
+def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, z3.ExprRef | z3.FuncDeclRef]]:
     """:func:`_encoded_typed` without the axioms."""
     phi, free, _ = _encoded_typed(formula, checked, node)
     return phi, free
@@ -136,7 +136,7 @@ def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3
 CHECK_RLIMIT = 8_000_000
 
 
-def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,
+def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object], *,
                    timeout_ms: int = SAFETY_TIMEOUT_MS, rlimit: int = CHECK_RLIMIT) -> tuple[bool | None, str]:
     """Does ``formula`` (an RCL formula of ``node``) hold on these concrete values?
 
@@ -192,7 +192,7 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     return None, wallclock.why_unknown(s, cut) or "unknown"
 
 
-def false_whatever_the_rest(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,
+def false_whatever_the_rest(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object], *,
                             timeout_ms: int = SAFETY_TIMEOUT_MS, rlimit: int = CHECK_RLIMIT) -> bool:
     """Is ``formula`` false for these values of some of ``node``'s inputs and
     outputs whatever values the others take (within their types)?  ``values``

@@ -14,7 +14,7 @@ values).
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
@@ -23,7 +23,7 @@ from rclverify.semantics.evaluate import evaluate
 from rclverify.semantics.retry import SAFETY_TIMEOUT_MS
 
 
-def decide(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any], *,
+def decide(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object], *,
            timeout_ms: int = SAFETY_TIMEOUT_MS, rlimit: int = CHECK_RLIMIT) -> tuple[bool | None, str]:
     """Does ``formula`` (an RCL formula of ``node``) hold on these concrete values?
 

@@ -121,7 +121,7 @@ class Encoder:
         return out
 
     # -- formulas ----------------------------------------------------------------------------
-    def formula(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None,
+    def formula(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, z3.ExprRef | z3.FuncDeclRef] | None = None,
                 bound: Mapping[str, z3.ExprRef] | None = None) -> z3.BoolRef:
         """Encode a (type-checked) formula of ``node``.
 
@@ -136,7 +136,7 @@ class Encoder:
             raise EncodingError(e.loc, "expected a formula")
         return r
 
-    def term(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, Any] | None = None) -> z3.ExprRef:
+    def term(self, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, z3.ExprRef | z3.FuncDeclRef] | None = None) -> z3.ExprRef:
         """Encode a term (e.g. the left-hand side of a binding) of ``node``."""
         return _Ctx(self, node, dict(symbols or {})).enc(e, {})
 

@@ -15,14 +15,14 @@ from typing import Any, Callable, Mapping
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode
 from rclverify.lang.visit import Visitor
-from rclverify.semantics.values import Term
+from rclverify.semantics.values import Term, Value
 from rclverify.semantics.eval_values import _CMP, _LIT, Undecided
 from rclverify.semantics.operators import OPERATORS, UNARY, Operator
 
 
 #: Compiled expressions kept (per AST node and I/O node); cleared when full.
 COMPILED_SIZE = 10_000
-_Fn = Callable[[Any, Mapping[str, Any]], Any]  # (the evaluator, bound variables) -> value
+_Fn = Callable[[Any, Mapping[str, Value]], Any]  # (the evaluator, bound variables) -> value
 _COMPILED: dict[tuple[int, int, int], tuple[Any, Any, Any, _Fn]] = {}
 
 
@@ -72,7 +72,7 @@ class _Compiler(Visitor[_Fn]):
         ctor = func.prefix is None and fname in self.env.ctors
         fvar = _compile_var(func, self.env, self.node, self.mode)
 
-        def apply(ev: Any, b: Mapping[str, Any]) -> Any:
+        def apply(ev: Any, b: Mapping[str, Value]) -> Any:
             vals = tuple([a(ev, b) for a in args])
             if ctor and fname not in b:
                 return Term(fname, vals)
@@ -95,7 +95,7 @@ class _Compiler(Visitor[_Fn]):
             parts = tuple(self.visit(o) for o in e.operands)
             ops = e.ops
 
-            def compare_in_mode(ev: Any, b: Mapping[str, Any]) -> Any:
+            def compare_in_mode(ev: Any, b: Mapping[str, Value]) -> Any:
                 vals = [o(ev, b) for o in parts]
                 return all(ev.compare(e, b, op, x, y) for op, x, y in zip(ops, vals, vals[1:]))
             return compare_in_mode
@@ -106,7 +106,7 @@ class _Compiler(Visitor[_Fn]):
             cmp = cmps[0]
             return lambda ev, b: bool(cmp(first(ev, b), second(ev, b)))  # all() of one comparison
 
-        def compare(ev: Any, b: Mapping[str, Any]) -> Any:
+        def compare(ev: Any, b: Mapping[str, Value]) -> Any:
             vals = [o(ev, b) for o in operands]
             return all(c(x, y) for c, x, y in zip(cmps, vals, vals[1:]))
         return compare
@@ -121,7 +121,7 @@ def _compile_var(v: ast.Var, env: Any, node: CheckedNode, mode: str | None = Non
     else:
         key = ("in." + v.name) if v.name in node.inputs else ("out." + v.name)
 
-    def io(ev: Any, b: Mapping[str, Any]) -> Any:
+    def io(ev: Any, b: Mapping[str, Value]) -> Any:
         value = ev.values.get(key)
         if value is None:
             raise Undecided(f"no value for {key}")

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang import types as T
-from rclverify.semantics.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term, Value
 from rclverify.semantics.eval_search import _Pin, _Preimage, _joint_groups, _plan, _preimage_group
 from rclverify.semantics.eval_shapes import _children, _ctor_uses, _integer_range, _shift, _static_literals, _static_shifts, _unused
 from rclverify.semantics.eval_values import _INFINITE, Undecided, _Fresh, _NoDomain, _fits
@@ -30,23 +30,23 @@ class QuantifierEvaluation:
 
     env: Any
     node: Any
-    values: Mapping[str, Any]
+    values: Mapping[str, object]
     io_names: frozenset[str]
     uncacheable: bool
     _slots: dict[int, Any]
 
     if TYPE_CHECKING:  # provided by the evaluator
-        def eval(self, e: ast.Expr, b: Mapping[str, Any]) -> Any: ...
+        def eval(self, e: ast.Expr, b: Mapping[str, Value]) -> Any: ...
 
-        def var(self, v: ast.Var, bound: Mapping[str, Any]) -> Any: ...
+        def var(self, v: ast.Var, bound: Mapping[str, Value]) -> Any: ...
 
         def io(self, v: ast.Var) -> Any: ...
 
         def numbers(self) -> set[Any]: ...
 
-        def collection(self, e: Any, b: Mapping[str, Any]) -> Any: ...
+        def collection(self, e: Any, b: Mapping[str, Value]) -> Any: ...
 
-    def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Any],
+    def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Value],
                kind: str = "forall", qvars: tuple[str, ...] = ()) -> list[Any]:
         dom = binding.domain
         if isinstance(dom, ast.TBase):
@@ -71,7 +71,7 @@ class QuantifierEvaluation:
             return self.candidates(name, typ.name, body, b, qvars)
         raise Undecided(f"quantifier over {dom} is not finite")
 
-    def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Any],
+    def candidates(self, name: str, scalar: str, body: ast.Expr, b: Mapping[str, Value],
                    qvars: tuple[str, ...] = ()) -> list[Any]:
         found_shifts = _static_shifts(body, name, frozenset(qvars))
         if found_shifts is not None and _ctor_uses(body, frozenset({name}), self.env.ctors, self.io_names) is None:
@@ -134,7 +134,7 @@ class QuantifierEvaluation:
             walk(v)
         return out
 
-    def _results(self, e: Any, b: Mapping[str, Any]) -> set[Any] | None:
+    def _results(self, e: Any, b: Mapping[str, Value]) -> set[Any] | None:
         """Every value ``e`` can take whatever the bound variables are, when known."""
         if isinstance(e, ast.NumLit):
             return {e.value}
@@ -148,7 +148,7 @@ class QuantifierEvaluation:
                 return set(f.table.values()) | {f.default}
         return None
 
-    def _positional(self, e: Any, name: str, b: Mapping[str, Any], vals: set[Any]) -> bool:
+    def _positional(self, e: Any, name: str, b: Mapping[str, Value], vals: set[Any]) -> bool:
         """Collect the only values ``name`` can take to make an atom differ from a
         fresh value; False when some occurrence gives no such bound."""
         if isinstance(e, ast.Quant) and name in e.variables:
@@ -182,7 +182,7 @@ class QuantifierEvaluation:
             return all(self._positional(o, name, b, vals) for o in e.operands if _shift(o, name) is None)
         return all(self._positional(c, name, b, vals) for c in _children(e))
 
-    def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+    def quant(self, e: ast.Quant, b: Mapping[str, Value]) -> bool:
         cached = self._slots.get(id(e))
         if cached is None:
             self.uncacheable = False
@@ -213,7 +213,7 @@ class QuantifierEvaluation:
                     return False
         return count == 1
 
-    def slots(self, e: ast.Quant, b: Mapping[str, Any]) -> tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]:
+    def slots(self, e: ast.Quant, b: Mapping[str, Value]) -> tuple[list[tuple[str, ...]], list[list[tuple[Any, ...]]]]:
         """The quantifier's variables in enumeration slots and each slot's candidate tuples.
 
         Variables that occur only together, as the whole argument list of
@@ -257,7 +257,7 @@ class QuantifierEvaluation:
                 doms.append(_NoDomain(str(exc)))  # type: ignore[arg-type]
         return slots, doms
 
-    def _joint(self, e: ast.Quant, b: Mapping[str, Any],
+    def _joint(self, e: ast.Quant, b: Mapping[str, Value],
                bindings: Mapping[str, ast.Binding]) -> tuple[tuple[str, ...], list[tuple[Any, ...]]] | None:
         for group, kinds, uses, literal_keys in _joint_groups(e, bindings, self.env.ctors, self.io_names):
             keys: set[tuple[Any, ...]] = set(literal_keys)
@@ -279,7 +279,7 @@ class QuantifierEvaluation:
         return None
 
     def _search(self, e: ast.Quant, slots: list[tuple[str, ...]], doms: list[Any],
-                staged: list[list[ast.Expr]], depth: int, cur: dict[str, Any],
+                staged: list[list[ast.Expr]], depth: int, cur: dict[str, Value],
                 pins: list[Any] | None = None) -> bool:
         """True when some assignment is a counterexample (forall) or a witness (exists);
         guards whose variables are all bound are checked as soon as possible.  A slot

@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Any, Mapping, cast
 
 from rclverify.lang import ast
-from rclverify.semantics.values import FiniteFunction, Term
+from rclverify.semantics.values import FiniteFunction, Term, Value
 from rclverify.semantics.eval_shapes import _STATIC, _conjuncts, _ctor_uses, _free, _only_as, _tuple_apps
 from rclverify.semantics.eval_values import _INFINITE, _fit
 
@@ -213,7 +213,7 @@ class _Preimage:
     def __init__(self, func: ast.Var, term: Any, kinds: tuple[str, ...]) -> None:
         self.func, self.term, self.kinds = func, term, kinds
 
-    def keys(self, ev: Any, cur: Mapping[str, Any]) -> list[tuple[Any, ...]] | None:
+    def keys(self, ev: Any, cur: Mapping[str, Value]) -> list[tuple[Any, ...]] | None:
         """The slot's candidate tuples under ``cur``, or None (use its domain)."""
         f = ev.var(self.func, cur)
         if not isinstance(f, FiniteFunction) or f.arity != len(self.kinds):

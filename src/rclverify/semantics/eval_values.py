@@ -19,7 +19,7 @@ from rclverify.semantics.values import FiniteFunction, Term
 #: comparison symbol -> its exact meaning (the semantics table's entry)
 _CMP: Mapping[str, Callable[[Any, Any], bool]] = {s: OPERATORS[s].exact for s in COMPARISONS}
 _INFINITE = ("REAL", "INTEGER", "NATURAL")
-_LIT: dict[str, Any] = {}
+_LIT: dict[str, int | Fraction] = {}
 
 
 def _numbers(v: Any, out: set[Any]) -> None:

@@ -48,7 +48,7 @@ this module is the entry point and keeps every name importable from here.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
@@ -65,7 +65,7 @@ from rclverify.semantics.evaluator import Evaluator
 
 
 def evaluate(formula: ast.Expr, checked: Checked, node: CheckedNode,
-             values: Mapping[str, Any]) -> bool | None:
+             values: Mapping[str, object]) -> bool | None:
     """Truth value of ``formula`` for ``node`` on ``values``.
 
     ``values`` maps qualified names (``"in.r"``) to values in the
@@ -80,7 +80,7 @@ def evaluate(formula: ast.Expr, checked: Checked, node: CheckedNode,
         return None
 
 
-def why_undecided(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> str:
+def why_undecided(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object]) -> str:
     """The reason :func:`evaluate` answers ``None`` ('' when it decides)."""
     try:
         Evaluator(checked, node, values).eval(formula, {})

@@ -17,7 +17,7 @@ from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.visit import Visitor
-from rclverify.semantics.values import Term, conforms
+from rclverify.semantics.values import Term, Value, conforms
 from rclverify.semantics.eval_closures import COMPILED_SIZE, _COMPILED, _compile
 from rclverify.semantics.eval_quant import QuantifierEvaluation
 from rclverify.semantics.eval_values import _CMP, _LIT, Undecided, _numbers, arithmetic
@@ -38,7 +38,7 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
     #: :meth:`compare`)
     mode: str | None = None
 
-    def __init__(self, checked: Checked, node: CheckedNode, values: Mapping[str, Any]) -> None:
+    def __init__(self, checked: Checked, node: CheckedNode, values: Mapping[str, object]) -> None:
         self.env = checked.env
         self.node = node
         self.values = values
@@ -68,7 +68,7 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
             raise Undecided(f"no value for {key}")
         return value
 
-    def var(self, v: ast.Var, bound: Mapping[str, Any]) -> Any:
+    def var(self, v: ast.Var, bound: Mapping[str, Value]) -> Any:
         if v.prefix is None and v.name in bound:
             return bound[v.name]
         if v.prefix is None and v.name in self.env.enum_values:
@@ -80,7 +80,7 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
         return self.io(v)
 
     # -- expressions -----------------------------------------------------------
-    def eval(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+    def eval(self, e: ast.Expr, b: Mapping[str, Value]) -> Any:
         """The value of ``e`` under bound variables ``b``: the expression is
         compiled once (per AST node and I/O node) into nested closures that
         do what :meth:`interpret` does, node for node (:func:`_compile`)."""
@@ -96,7 +96,7 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
             hit = _COMPILED[key] = (e, self.node, self.env, _compile(e, self.env, self.node, mode))
         return hit[3](self, b)
 
-    def interpret(self, e: ast.Expr, b: Mapping[str, Any]) -> Any:
+    def interpret(self, e: ast.Expr, b: Mapping[str, Value]) -> Any:
         """The value of ``e`` under ``b`` by walking the tree (the reference the
         compiled closures follow; what they delegate membership, set and
         tuple literals and quantifiers to): the method ``visit_<Class>`` of
@@ -107,19 +107,19 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
             return self.visit(e, b)  # not a node: the visitor's error
         return method(self, e, b)
 
-    def generic_visit(self, e: Any, b: Mapping[str, Any]) -> Any:
+    def generic_visit(self, e: Any, b: Mapping[str, Value]) -> Any:
         raise Undecided(f"cannot evaluate {type(e).__name__}")
 
-    def visit_BoolLit(self, e: ast.BoolLit, b: Mapping[str, Any]) -> Any:
+    def visit_BoolLit(self, e: ast.BoolLit, b: Mapping[str, Value]) -> Any:
         return e.value
 
-    def visit_NumLit(self, e: ast.NumLit, b: Mapping[str, Any]) -> Any:
+    def visit_NumLit(self, e: ast.NumLit, b: Mapping[str, Value]) -> Any:
         return self.literal(e)
 
-    def visit_Var(self, e: ast.Var, b: Mapping[str, Any]) -> Any:
+    def visit_Var(self, e: ast.Var, b: Mapping[str, Value]) -> Any:
         return self.var(e, b)
 
-    def visit_Apply(self, e: ast.Apply, b: Mapping[str, Any]) -> Any:
+    def visit_Apply(self, e: ast.Apply, b: Mapping[str, Value]) -> Any:
         args = tuple(self.eval(a, b) for a in e.args)
         if e.func.prefix is None and e.func.name in self.env.ctors and e.func.name not in b:
             return Term(e.func.name, args)
@@ -128,17 +128,17 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
             raise Undecided(f"{e.func.qualified} is not a function value")
         return f(*args)
 
-    def visit_Unary(self, e: ast.Unary, b: Mapping[str, Any]) -> Any:
+    def visit_Unary(self, e: ast.Unary, b: Mapping[str, Value]) -> Any:
         return UNARY[e.op].exact(self.eval(e.operand, b))
 
-    def visit_Binary(self, e: ast.Binary, b: Mapping[str, Any]) -> Any:
+    def visit_Binary(self, e: ast.Binary, b: Mapping[str, Value]) -> Any:
         return self.binary(e, b)
 
-    def visit_Compare(self, e: ast.Compare, b: Mapping[str, Any]) -> Any:
+    def visit_Compare(self, e: ast.Compare, b: Mapping[str, Value]) -> Any:
         vals = [self.eval(o, b) for o in e.operands]
         return all(self.compare(e, b, op, x, y) for op, x, y in zip(e.ops, vals, vals[1:]))
 
-    def visit_Member(self, e: ast.Member, b: Mapping[str, Any]) -> Any:
+    def visit_Member(self, e: ast.Member, b: Mapping[str, Value]) -> Any:
         x = self.eval(e.elem, b)
         carrier = self.carrier(e.collection, b)
         if carrier is not None:  # `x in NATURAL`, `(x, y) in REAL.REAL`
@@ -147,18 +147,18 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
         coll = self.collection(e.collection, b)
         return (x not in coll) if e.negated else (x in coll)
 
-    def visit_SetLit(self, e: ast.SetLit, b: Mapping[str, Any]) -> Any:
+    def visit_SetLit(self, e: ast.SetLit, b: Mapping[str, Value]) -> Any:
         return frozenset(self.eval(i, b) for i in e.items)
 
-    def visit_TupleLit(self, e: ast.TupleLit, b: Mapping[str, Any]) -> Any:
+    def visit_TupleLit(self, e: ast.TupleLit, b: Mapping[str, Value]) -> Any:
         return tuple(self.eval(i, b) for i in e.items)
 
     visit_SeqLit = visit_TupleLit
 
-    def visit_Quant(self, e: ast.Quant, b: Mapping[str, Any]) -> Any:
+    def visit_Quant(self, e: ast.Quant, b: Mapping[str, Value]) -> Any:
         return self.quant(e, b)
 
-    def carrier(self, e: Any, b: Mapping[str, Any]) -> T.Type | None:
+    def carrier(self, e: Any, b: Mapping[str, Value]) -> T.Type | None:
         """The type a built-in term on the right of ``in`` stands for
         (``NATURAL``, or the product ``REAL.REAL``), else ``None``."""
         if not isinstance(e, ast.Var) or e.prefix is not None or e.name in b:
@@ -167,7 +167,7 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
             return T.Scalar(e.name)
         return T.qualified_base(e.name)
 
-    def collection(self, e: Any, b: Mapping[str, Any]) -> Any:
+    def collection(self, e: Any, b: Mapping[str, Value]) -> Any:
         if isinstance(e, ast.SetLit):
             return {self.eval(i, b) for i in e.items}
         v = self.eval(e, b)
@@ -175,7 +175,7 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
             return v
         raise Undecided("membership in a value that is not a set")
 
-    def binary(self, e: ast.Binary, b: Mapping[str, Any]) -> Any:
+    def binary(self, e: ast.Binary, b: Mapping[str, Value]) -> Any:
         """A connective (short-circuit left to right) or arithmetic (:meth:`arith`),
         as the operator's entry in the semantics table states it."""
         entry = OPERATORS[e.op]
@@ -201,6 +201,6 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
         """``x op y`` (:func:`arithmetic`: exact)."""
         return arithmetic(op, x, y)
 
-    def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
+    def compare(self, e: ast.Compare, b: Mapping[str, Value], op: str, x: Any, y: Any) -> bool:
         """One comparison ``x op y`` of ``e`` under bound variables ``b`` (exact)."""
         return _CMP[op](x, y)

@@ -74,6 +74,8 @@ from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.evaluate import Evaluator, Undecided, evaluate, why_undecided
 from rclverify.semantics.floatsens import float_sensitive
 from rclverify.semantics.operators import COMPARISONS, OPERATORS
+from rclverify.semantics.shapes import ToleranceJSON
+from rclverify.semantics.values import Value
 
 #: The semantics a verdict may be decided in, in the order they are tried.
 SEMANTICS = ("exact", "double", "tolerance")
@@ -121,7 +123,8 @@ class Tolerance:
         parts = [f"{k} {_num_text(v)}" for k, v in (("abs", self.abs), ("rel", self.rel), ("ulps", self.ulps)) if v]
         return ", ".join(parts) or "none"
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> ToleranceJSON:
+        """The bounds as JSON (:class:`rclverify.semantics.shapes.ToleranceJSON`)."""
         return {"abs": float(self.abs), "rel": float(self.rel), "ulps": self.ulps}
 
     def __bool__(self) -> bool:
@@ -159,7 +162,8 @@ def parse_tolerance(raw: Any) -> Tolerance | None:
     unknown = sorted(str(k) for k in raw if k not in ("abs", "rel", "ulps"))
     if unknown:
         raise ToleranceError(f"tolerance: unknown key {unknown[0]!r} (expected abs, rel, ulps)", unknown[0])
-    out: dict[str, Any] = {}
+    out: dict[str, Fraction] = {}
+    ulps = 0
     for key in ("abs", "rel", "ulps"):
         if key not in raw:
             continue
@@ -174,10 +178,10 @@ def parse_tolerance(raw: Any) -> Tolerance | None:
         if key == "ulps":
             if float(v) != int(v):
                 raise ToleranceError(f"tolerance: ulps must be a whole number, not {raw[key]!r}", key)
-            out[key] = int(v)
+            ulps = int(v)
         else:
             out[key] = Fraction(v)
-    return Tolerance(**out)
+    return Tolerance(out.get("abs", Fraction(0)), out.get("rel", Fraction(0)), ulps)
 
 
 @dataclass(frozen=True)
@@ -196,7 +200,7 @@ class Judgement:
     reason: str = ""
 
 
-def judge(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any],
+def judge(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object],
           tolerance: Tolerance | None = None) -> Judgement:
     """Does ``formula`` (an RCL formula of ``node``) hold of the recorded
     ``values`` (qualified names ``in.r``/``out.d`` -> values of
@@ -247,7 +251,7 @@ def judge(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappin
     return Judgement(None, "", reason)
 
 
-def holds_in(semantics: str, formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, Any],
+def holds_in(semantics: str, formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object],
              tolerance: Tolerance | None = None) -> bool | None:
     """Does ``formula`` hold of ``values`` in the one arithmetic ``semantics``
     (``exact``, ``double``, ``tolerance``), ``None`` when undecided there?
@@ -274,7 +278,7 @@ def _run(ev: Evaluator, formula: ast.Expr) -> tuple[bool | None, str]:
 
 
 #: a literal's text -> its value in the double reading (parsed once)
-_DOUBLE_LITERALS: dict[str, Any] = {}
+_DOUBLE_LITERALS: dict[str, int | float] = {}
 
 
 class _Double(Evaluator):
@@ -293,12 +297,12 @@ class _Double(Evaluator):
         """``x op y`` in binary64 (the double meaning of the semantics table)."""
         return _DOUBLE[op](x, y)
 
-    def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
+    def compare(self, e: ast.Compare, b: Mapping[str, Value], op: str, x: Any, y: Any) -> bool:
         """``x op y`` on the doubles (the double meaning of the semantics table)."""
         truth: bool = _DOUBLE[op](x, y)
         return truth
 
-    def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+    def quant(self, e: ast.Quant, b: Mapping[str, Value]) -> bool:
         got = quantify(self, e, b, _finite_domain, MAX_ENUMERATION)
         return _enumerate(self, e, b) if got is None else got
 
@@ -310,7 +314,7 @@ class _Tolerant(Evaluator):
     mode = "tolerance"
     tolerance: Tolerance = Tolerance()
 
-    def compare(self, e: ast.Compare, b: Mapping[str, Any], op: str, x: Any, y: Any) -> bool:
+    def compare(self, e: ast.Compare, b: Mapping[str, Value], op: str, x: Any, y: Any) -> bool:
         if not (_number(x) and _number(y)) or not _reads_io(e, b, self.io_names):
             return bool(_CMP[op](x, y))
         close = self.tolerance.close(x, y)
@@ -326,7 +330,7 @@ class _Tolerant(Evaluator):
             return x < y and not close
         return x > y and not close  # ">"
 
-    def quant(self, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+    def quant(self, e: ast.Quant, b: Mapping[str, Value]) -> bool:
         return _enumerate(self, e, b)
 
 
@@ -337,7 +341,7 @@ def _number(v: Any) -> bool:
 _IO_READS: dict[int, tuple[ast.Compare, bool, frozenset[str]]] = {}
 
 
-def _reads_io(e: ast.Compare, b: Mapping[str, Any], io: frozenset[str]) -> bool:
+def _reads_io(e: ast.Compare, b: Mapping[str, Value], io: frozenset[str]) -> bool:
     """Does comparison ``e`` read a recorded value: an ``in.``/``out.``
     variable, or a bare I/O name not bound by a quantifier (``b``)?"""
     hit = _IO_READS.get(id(e))
@@ -364,7 +368,7 @@ def _io_names(e: Any, bare: set[str]) -> bool:
     return any([_io_names(getattr(e, f), bare) for f in e.__dataclass_fields__])
 
 
-def _enumerate(ev: Evaluator, e: ast.Quant, b: Mapping[str, Any]) -> bool:
+def _enumerate(ev: Evaluator, e: ast.Quant, b: Mapping[str, Value]) -> bool:
     """Quantifier ``e`` by enumerating finite domains only (module docstring)."""
     names: list[str] = []
     doms: list[list[Any]] = []
@@ -395,7 +399,7 @@ def _enumerate(ev: Evaluator, e: ast.Quant, b: Mapping[str, Any]) -> bool:
     return e.kind == "forall" or (e.kind == "exists_unique" and count == 1)
 
 
-def _finite_domain(ev: Evaluator, e: ast.Quant, bd: ast.Binding, name: str, b: Mapping[str, Any]) -> list[Any]:
+def _finite_domain(ev: Evaluator, e: ast.Quant, bd: ast.Binding, name: str, b: Mapping[str, Value]) -> list[Any]:
     dom = bd.domain
     if isinstance(dom, ast.TEnum):
         return list(dom.values)

@@ -52,33 +52,33 @@ class _Sensitive(Visitor[bool]):
         self.env, self.node, self.tolerant = env, node, tolerant
         self.seen: set[str] = set()
 
-    def generic_visit(self, e: Any, scope: Mapping[str, Any]) -> bool:
+    def generic_visit(self, e: Any, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
         return any(self.visit(c, scope) for c in children(e))
 
-    def visit_NumLit(self, e: ast.NumLit, scope: Mapping[str, Any]) -> bool:
+    def visit_NumLit(self, e: ast.NumLit, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
         v = e.value
         return v.denominator != 1 and Fraction(float(v)) != v
 
-    def visit_Var(self, e: ast.Var, scope: Mapping[str, Any]) -> bool:
+    def visit_Var(self, e: ast.Var, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
         env = self.env
         if e.prefix is None and e.name not in scope and e.name in env.constants and e.name not in self.seen:
             self.seen.add(e.name)
             return self.visit(env.constants[e.name][1], {})
         return False
 
-    def visit_Binary(self, e: ast.Binary, scope: Mapping[str, Any]) -> bool:
+    def visit_Binary(self, e: ast.Binary, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
         if OPERATORS[e.op].kind == "arithmetic" and (
                 e.op == "/" or _fractional(e.left, self.env, self.node, scope)
                 or _fractional(e.right, self.env, self.node, scope)):
             return True
         return self.generic_visit(e, scope)
 
-    def visit_Compare(self, e: ast.Compare, scope: Mapping[str, Any]) -> bool:
+    def visit_Compare(self, e: ast.Compare, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
         if self.tolerant and any(_fractional(o, self.env, self.node, scope) for o in e.operands):
             return True
         return self.generic_visit(e, scope)
 
-    def visit_Quant(self, e: ast.Quant, scope: Mapping[str, Any]) -> bool:
+    def visit_Quant(self, e: ast.Quant, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
         inner = dict(scope)
         for bd in e.bindings:
             if not isinstance(bd.domain, (ast.TBase, ast.TName, ast.TEnum)) and self.visit(bd.domain, scope):
@@ -92,7 +92,7 @@ def _integral_type(t: Any) -> bool:
     return isinstance(t, T.Scalar) and t.name in ("INTEGER", "NATURAL")
 
 
-def _fractional(e: Any, env: Any, node: CheckedNode, scope: Mapping[str, Any]) -> bool:
+def _fractional(e: Any, env: Any, node: CheckedNode, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
     """May ``e``'s value be a non-integer number?  (False only when its type
     is INTEGER/NATURAL or it is an integer literal; unknown is True.)"""
     if isinstance(e, ast.NumLit):

@@ -24,7 +24,7 @@ The :attr:`FormulaJudge.fallback` text says when a formula is always left to
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
@@ -66,7 +66,7 @@ class FormulaJudge:
         """Whether the formula's exact truth comes from straight-line code."""
         return self._fn is not None
 
-    def quick(self, values: Mapping[str, Any]) -> Judgement | None:
+    def quick(self, values: Mapping[str, object]) -> Judgement | None:
         """The judgement when the straight-line code decides it alone (true,
         a missing value, or false in a formula no other semantics can
         change); ``None`` when :func:`judge` must be asked."""
@@ -86,7 +86,7 @@ class FormulaJudge:
             return HOLDS_EXACT
         return self._false
 
-    def __call__(self, values: Mapping[str, Any]) -> Judgement:
+    def __call__(self, values: Mapping[str, object]) -> Judgement:
         """The judgement of the formula on ``values``: :func:`judge`'s."""
         hit = self.quick(values)
         if hit is not None:

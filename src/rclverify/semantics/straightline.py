@@ -81,7 +81,7 @@ class Straight:
     the formula is left to the evaluator, :attr:`fallback` saying why),
     ``source`` the generated Python text (``""`` when not compiled)."""
 
-    fn: Callable[[Mapping[str, Any]], bool] | None
+    fn: Callable[[Mapping[str, object]], bool] | None
     source: str
     fallback: str = ""
 
@@ -177,7 +177,7 @@ class _Gen(Visitor[str]):
     def __init__(self, env: Any, node: CheckedNode) -> None:
         self.env, self.node = env, node
         self.loads: dict[str, str] = {}  # I/O key -> local name
-        self.ns: dict[str, Any] = {"_missing": _missing, "_call": _call, "_chain": _chain, "_Term": Term}
+        self.ns: dict[str, object] = {"_missing": _missing, "_call": _call, "_chain": _chain, "_Term": Term}
         #: operator symbol -> the name its exact meaning is bound to (the semantics table's entry)
         self.meanings: dict[str, str] = {}
         self.expanding: set[str] = set()  # named constants being expanded (a cycle is not compiled)
@@ -189,7 +189,7 @@ class _Gen(Visitor[str]):
         code = compile(source, "<rcl formula>", "exec")
         ns = dict(self.ns)
         exec(code, ns)  # noqa: S102 - the source is generated above from the checked formula, no user text
-        return Straight(ns["rcl_formula"], source)
+        return Straight(cast(Callable[[Mapping[str, object]], bool], ns["rcl_formula"]), source)
 
     def const(self, value: Any) -> str:
         """A name in the namespace bound to ``value``."""

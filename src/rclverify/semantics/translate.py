@@ -43,7 +43,7 @@ def unary_z3(op: ast.UnaryOp, v: Any) -> Any:
 
 
 class _Ctx(Visitor[Any]):
-    def __init__(self, enc: Any, node: CheckedNode, symbols: dict[str, Any]) -> None:
+    def __init__(self, enc: Any, node: CheckedNode, symbols: dict[str, z3.ExprRef | z3.FuncDeclRef]) -> None:
         self.e, self.node, self.symbols = enc, node, symbols
         self.var_types: dict[int, Type] = {}  # RCL type of each bound variable made here, by Z3 id
 
@@ -80,22 +80,22 @@ class _Ctx(Visitor[Any]):
         ``visit_<Class>`` of ``x``'s class (:class:`rclverify.lang.visit.Visitor`)."""
         return self.visit(x, bound)
 
-    def visit_BoolLit(self, x: ast.BoolLit, b: Mapping[str, Any]) -> Any:
+    def visit_BoolLit(self, x: ast.BoolLit, b: Mapping[str, z3.ExprRef]) -> Any:
         return z3.BoolVal(x.value)
 
-    def visit_NumLit(self, x: ast.NumLit, b: Mapping[str, Any]) -> Any:
+    def visit_NumLit(self, x: ast.NumLit, b: Mapping[str, z3.ExprRef]) -> Any:
         v = x.value
         if x.is_integral:
             return z3.IntVal(int(v))
         return z3.RealVal(f"{v.numerator}/{v.denominator}")
 
-    def visit_Var(self, x: ast.Var, b: Mapping[str, Any]) -> Any:
+    def visit_Var(self, x: ast.Var, b: Mapping[str, z3.ExprRef]) -> Any:
         r = self.var(x, b)
         if isinstance(r, z3.FuncDeclRef) and r.arity() > 0:
             raise EncodingError(x.loc, f"{x.qualified} is a function; comparing whole functions is not supported, apply it")
         return r() if isinstance(r, z3.FuncDeclRef) else r
 
-    def visit_Apply(self, x: ast.Apply, b: Mapping[str, Any]) -> Any:
+    def visit_Apply(self, x: ast.Apply, b: Mapping[str, z3.ExprRef]) -> Any:
         f = x.func
         args = [self.enc(a, b) for a in x.args]
         is_value = f.prefix is not None or f.name in b or f.name in self.node.inputs or f.name in self.node.outputs
@@ -109,10 +109,10 @@ class _Ctx(Visitor[Any]):
             return z3.Select(fn, *[widen(a, fn.sort().domain_n(k)) for k, a in enumerate(args)])
         raise EncodingError(x.loc, f"{f.qualified} cannot be applied")
 
-    def visit_Unary(self, x: ast.Unary, b: Mapping[str, Any]) -> Any:
+    def visit_Unary(self, x: ast.Unary, b: Mapping[str, z3.ExprRef]) -> Any:
         return unary_z3(x.op, self.enc(x.operand, b))
 
-    def visit_Binary(self, x: ast.Binary, b: Mapping[str, Any]) -> Any:
+    def visit_Binary(self, x: ast.Binary, b: Mapping[str, z3.ExprRef]) -> Any:
         if x.op in FLAT_CHAINS:
             # One n-ary And/Or over the whole chain, opened iteratively, so a
             # chain of any length or shape (also one built by a program,
@@ -121,10 +121,10 @@ class _Ctx(Visitor[Any]):
             return conj(*parts) if x.op == "and" else disj(*parts)
         return apply_operator(x.op, self.enc(x.left, b), self.enc(x.right, b))
 
-    def visit_StrLit(self, x: ast.StrLit, b: Mapping[str, Any]) -> Any:
+    def visit_StrLit(self, x: ast.StrLit, b: Mapping[str, z3.ExprRef]) -> Any:
         return z3.StringVal(x.value)
 
-    def visit_SeqRange(self, x: ast.SeqRange, b: Mapping[str, Any]) -> Any:
+    def visit_SeqRange(self, x: ast.SeqRange, b: Mapping[str, z3.ExprRef]) -> Any:
         lo, hi = x.lo, x.hi
         if isinstance(lo, ast.NumLit) and isinstance(hi, ast.NumLit) and lo.is_integral and hi.is_integral:
             a, z = int(lo.value), int(hi.value)
@@ -138,7 +138,7 @@ class _Ctx(Visitor[Any]):
         raise EncodingError(x.loc, "a range with non-literal bounds is only supported on the right of 'in' "
                                    "by backend z3")
 
-    def visit_TupleQuant(self, x: ast.TupleQuant, b: Mapping[str, Any]) -> Any:
+    def visit_TupleQuant(self, x: ast.TupleQuant, b: Mapping[str, z3.ExprRef]) -> Any:
         """``Q((u, v) in S | body)``: one bound variable per component, and
         the tuple they form must be an element of ``S`` (no guard when ``S``
         is a tuple type)."""
@@ -159,7 +159,7 @@ class _Ctx(Visitor[Any]):
             guards.append(self.member(tup, coll, b))
         return self._close(x.kind, xs, guards, self.enc(x.body, inner))
 
-    def _bind(self, name: str, t: Type, inner: dict[str, Any], xs: list[z3.ExprRef], guards: list[Any]) -> z3.ExprRef:
+    def _bind(self, name: str, t: Type, inner: dict[str, z3.ExprRef], xs: list[z3.ExprRef], guards: list[Any]) -> z3.ExprRef:
         """A bound variable ``name`` of type ``t``: put in scope (``inner``) and in
         the quantifier's variables (``xs``), with ``>= 0`` for a NATURAL (``guards``)."""
         v = z3.Const(smt_symbol(name), sort_of(t))
@@ -177,7 +177,7 @@ class _Ctx(Visitor[Any]):
             return None
         return ast.Var(d.name, None, d.loc) if isinstance(d, ast.TName) else cast(ast.Expr, d)
 
-    def visit_Compare(self, x: ast.Compare, b: Mapping[str, Any]) -> Any:
+    def visit_Compare(self, x: ast.Compare, b: Mapping[str, z3.ExprRef]) -> Any:
         vals = [None if _is_empty_literal(o) else self.enc(o, b) for o in x.operands]
         for k, o in enumerate(x.operands):
             if vals[k] is None:
@@ -187,7 +187,7 @@ class _Ctx(Visitor[Any]):
         parts = [apply_operator(op, l, r) for op, l, r in zip(x.ops, vals, vals[1:])]
         return parts[0] if len(parts) == 1 else conj(*parts)
 
-    def member(self, elem: Any, coll: ast.Expr, b: Mapping[str, Any]) -> Any:
+    def member(self, elem: Any, coll: ast.Expr, b: Mapping[str, z3.ExprRef]) -> Any:
         env = self.e.env
         if isinstance(coll, ast.SeqRange):
             lo, hi = self.enc(coll.lo, b), self.enc(coll.hi, b)
@@ -227,11 +227,11 @@ class _Ctx(Visitor[Any]):
             return z3.And(integral, elem >= 0) if base == "NATURAL" else integral
         return z3.BoolVal(True)
 
-    def visit_Member(self, x: ast.Member, b: Mapping[str, Any]) -> Any:
+    def visit_Member(self, x: ast.Member, b: Mapping[str, z3.ExprRef]) -> Any:
         r = self.member(self.enc(x.elem, b), x.collection, b)
         return z3.Not(r) if x.negated else r
 
-    def _items(self, x: ast.SetLit | ast.SeqLit, b: Mapping[str, Any], what: str) -> list[Any]:
+    def _items(self, x: ast.SetLit | ast.SeqLit, b: Mapping[str, z3.ExprRef], what: str) -> list[Any]:
         """The items of a set or sequence literal, widened to one sort."""
         if not x.items:
             raise EncodingError(x.loc, f"an empty {what} literal is only supported where its element type is "
@@ -242,14 +242,14 @@ class _Ctx(Visitor[Any]):
             elem = _join_sort(elem, i.sort())
         return [widen(i, elem) for i in items]
 
-    def visit_SetLit(self, x: ast.SetLit, b: Mapping[str, Any]) -> Any:
+    def visit_SetLit(self, x: ast.SetLit, b: Mapping[str, z3.ExprRef]) -> Any:
         items = self._items(x, b, "set")
         s = z3.EmptySet(items[0].sort())
         for i in items:
             s = z3.SetAdd(s, i)
         return s
 
-    def visit_SeqLit(self, x: ast.SeqLit, b: Mapping[str, Any]) -> Any:
+    def visit_SeqLit(self, x: ast.SeqLit, b: Mapping[str, z3.ExprRef]) -> Any:
         units = [z3.Unit(i) for i in self._items(x, b, "sequence")]
         return units[0] if len(units) == 1 else z3.Concat(*units)
 
@@ -270,11 +270,11 @@ class _Ctx(Visitor[Any]):
                 return z3.EmptySet(like.domain())
         raise EncodingError(x.loc, f"an empty literal compared with a value of Z3 sort {like}")
 
-    def visit_TupleLit(self, x: ast.TupleLit, b: Mapping[str, Any]) -> Any:
+    def visit_TupleLit(self, x: ast.TupleLit, b: Mapping[str, z3.ExprRef]) -> Any:
         items = [self.enc(i, b) for i in x.items]
         return cast(z3.DatatypeSortRef, tuple_sort([i.sort() for i in items])).constructor(0)(*items)
 
-    def visit_Quant(self, x: ast.Quant, b: Mapping[str, Any]) -> Any:
+    def visit_Quant(self, x: ast.Quant, b: Mapping[str, z3.ExprRef]) -> Any:
         inner = dict(b)
         xs: list[z3.ExprRef] = []
         guards: list[Any] = []
@@ -305,7 +305,7 @@ class _Ctx(Visitor[Any]):
         unique = z3.ForAll(ys, z3.Implies(body_y, conj(*[y == v for y, v in zip(ys, xs)])))
         return z3.Exists(xs, z3.And(core, unique))
 
-    def _bound_types(self, b: Mapping[str, Any]) -> dict[str, Type]:
+    def _bound_types(self, b: Mapping[str, z3.ExprRef]) -> dict[str, Type]:
         """RCL types of the bound names in scope: recorded for variables this
         encoder bound; read off the sort for scalars bound by the caller."""
         scalars = {z3.RealSort(): Scalar("REAL"), z3.IntSort(): Scalar("INTEGER"), z3.BoolSort(): BOOL}

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any, Iterator, Mapping
+from typing import Any, Iterator, Mapping, TypeAlias, Union
 
 from rclverify.lang import types as T
 
@@ -106,6 +106,13 @@ class FiniteFunction(Mapping[tuple[Any, ...], Any]):
 
     def __repr__(self) -> str:
         return render(self)
+
+
+#: One RCL value in this module's convention (the table in the module
+#: docstring): what an environment maps a name to (``Mapping[str, Value]``:
+#: a node's I/O values by qualified name, or bound variables by name).
+Value: TypeAlias = Union[bool, int, Fraction, float, str, frozenset["Value"], tuple["Value", ...], Term,
+                         FiniteFunction]
 
 
 def exact(x: Any) -> Fraction:

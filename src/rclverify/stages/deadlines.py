@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import re
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, TypeGuard
 
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.store import atomic_write_text, dumps
@@ -30,6 +30,7 @@ from rclverify.calculus.deadlines import DeadlineResult, decide_plan
 from rclverify.calculus.worst_path import nodes_between, with_worst_path
 
 if TYPE_CHECKING:
+    from rclverify.records.stage_records import DeadlineCheck, DeadlineRecord
     from rclverify.stages.workspace import Workspace
 
 DIR = "artifacts/deadlines"
@@ -42,7 +43,12 @@ def smt2_path(req_id: str) -> str:
     return f"{DIR}/{_SAFE.sub('_', req_id)}.smt2"
 
 
-def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list[dict[str, Any]]]:
+def _is_check(rec: Mapping[str, object]) -> TypeGuard["DeadlineCheck"]:
+    """Does ``rec`` (calculus/deadlines.py ``DeadlineResult.to_json``) name its requirement and status?"""
+    return isinstance(rec.get("requirement"), str) and isinstance(rec.get("status"), str)
+
+
+def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list["DeadlineRecord"]]:
     """Decide every end-to-end deadline of ``ws``'s plan (rule D3) and write
     the stage's record (module docstring).  Reads the contract snapshots the
     ``check`` stage wrote (their sha256 are the record's ``inputs``).
@@ -51,17 +57,18 @@ def stage_deadlines(ws: "Workspace") -> tuple[list[DeadlineResult], list[dict[st
     be written."""
     results = [with_worst_path(r, ws.checked, ws.model) for r in decide_plan(ws.plan, ws.checked, ws.model)]
     model_hash = hashlib.sha256(dumps(ws.model.to_json()).encode("utf-8")).hexdigest()  # as the report takes it
-    records: list[dict[str, Any]] = []
+    records: list[DeadlineRecord] = []
     keep = {"index.json"}
     for r in results:
-        rec = r.to_json()
-        rec["smt2"] = smt2_path(r.requirement) if r.smt2 else ""
+        made = r.to_json()
+        if not _is_check(made):
+            raise ValueError(f"the deadline of {r.requirement} was decided without a requirement or status")
         inputs = {}
         for n in nodes_between(ws.model, r.path):  # every node the worst path may take, as the task's inputs
             p = ws.path(ws.snapshot(n))
             inputs[ws.snapshot(n)] = hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else ""
         inputs[ws.MODEL] = model_hash
-        rec["inputs"] = inputs
+        rec: DeadlineRecord = {**made, "smt2": smt2_path(r.requirement) if r.smt2 else "", "inputs": inputs}
         if r.smt2:  # it ends naming the statement it decides (records/ties.py)
             atomic_write_text(ws.path(rec["smt2"]), tie_query(r.smt2, "deadline", r.requirement, rec))
             keep.add(rec["smt2"].rsplit("/", 1)[1])

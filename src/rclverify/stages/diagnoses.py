@@ -24,7 +24,7 @@ from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.store import dumps
 
 if TYPE_CHECKING:
-    from rclverify.records.stage_records import DiagnosisRecord
+    from rclverify.records.stage_records import DiagnosisEntry, DiagnosisRecord
     from rclverify.stages.workspace import Workspace
 
 DIR = "artifacts/diagnosis"
@@ -45,7 +45,7 @@ def _without_timing(value: object) -> object:
     return value
 
 
-def report_digest(report: Mapping[str, Any]) -> str:
+def report_digest(report: Mapping[str, object]) -> str:
     """The sha256 (hex) of the compact JSON of ``report`` (the report dict
     without diagnoses) less its :data:`TIMING_KEYS`, keys sorted: encoded by
     msgspec (5x faster than the standard library, the same bytes for the
@@ -59,7 +59,7 @@ def report_digest(report: Mapping[str, Any]) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def write_diagnoses(ws: "Workspace", digest: str, diagnoses: list[dict[str, Any]]) -> "DiagnosisRecord":
+def write_diagnoses(ws: "Workspace", digest: str, diagnoses: list["DiagnosisEntry"]) -> "DiagnosisRecord":
     """Seal ``diagnoses`` (:func:`rclverify.diagnosis.build.diagnose` of the
     report dict without diagnoses whose :func:`report_digest` is ``digest``)
     into :data:`INDEX`, atomically, and return the record as a reader gets
@@ -70,7 +70,7 @@ def write_diagnoses(ws: "Workspace", digest: str, diagnoses: list[dict[str, Any]
     return cast("DiagnosisRecord", record)
 
 
-def read_diagnoses(ws: "Workspace", report: Mapping[str, Any]) -> tuple[list[dict[str, Any]] | None, str]:
+def read_diagnoses(ws: "Workspace", report: Mapping[str, object]) -> tuple[list[dict[str, Any]] | None, str]:
     """``(diagnoses, problem)`` of :data:`INDEX` for ``report`` (the report
     dict without diagnoses being built now): the records and ``""`` when
     the record is current; ``None`` and one sentence saying why the

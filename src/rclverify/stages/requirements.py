@@ -20,13 +20,14 @@ from __future__ import annotations
 import hashlib
 import json
 import re
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal, Mapping, TypeGuard
 
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.store import atomic_write_text, dumps
 from rclverify.records.ties import tie_query
 
 if TYPE_CHECKING:
+    from rclverify.records.stage_records import RequirementCheck, RequirementRecord
     from rclverify.stages.workspace import Workspace
 
 DIR = "artifacts/requirements"
@@ -37,6 +38,10 @@ _SAFE = re.compile(r"[^A-Za-z0-9_.-]+")
 #: The side queries of a proved requirement whose scripts are kept beside its record
 #: (``artifacts/requirements/<ID>.<side>.smt2``, ``<side>_smt2`` in the record).
 SIDE_QUERIES = ("consistency", "vacuity")
+#: ``(kind, record key, file suffix)`` of each query kept beside a record: the proof's, then :data:`SIDE_QUERIES`.
+_QUERIES: tuple[tuple[str, Literal["smt2", "consistency_smt2", "vacuity_smt2"], str], ...] = (
+    ("requirement", "smt2", ""), ("consistency", "consistency_smt2", ".consistency"),
+    ("vacuity", "vacuity_smt2", ".vacuity"))
 
 
 def record_path(req_id: str) -> str:
@@ -44,13 +49,24 @@ def record_path(req_id: str) -> str:
     return f"{DIR}/{_SAFE.sub('_', req_id)}.json"
 
 
-def _read(path: Any) -> dict[str, Any] | None:
-    """The sealed record at ``path``; ``None`` when absent or not intact."""
+def _is_check(rec: Mapping[str, object]) -> TypeGuard["RequirementCheck"]:
+    """Does ``rec`` (a requirement check's record, calculus/requirements/own_nodes.py ``decide``) name
+    its requirement and verdict?"""
+    return isinstance(rec.get("id"), str) and isinstance(rec.get("verdict"), str)
+
+
+def _is_record(rec: Mapping[str, object]) -> TypeGuard["RequirementRecord"]:
+    """Is ``rec`` a requirement's record as this stage writes it (a check with its ``fingerprint``)?"""
+    return _is_check(rec) and isinstance(rec.get("fingerprint"), str)
+
+
+def _read(path: Any) -> "RequirementRecord | None":
+    """The sealed record at ``path``; ``None`` when absent, not intact or not a requirement's record."""
     rec, problem = read_sealed(path)
-    return None if problem else rec
+    return None if problem or rec is None or not _is_record(rec) else rec
 
 
-def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[dict[str, Any], bool]]:
+def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple["RequirementRecord", bool]]:
     """Check the requirements of ``ws`` (module docstring).  Returns
     ``(record, checked_now)`` per requirement, in plan order (the plan's,
     then the Doorstop items').  Raises ``RclError`` for contracts or a plan
@@ -75,7 +91,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
             p = ws.root / ws.snapshot(n)
             snaps[n] = p.read_text(encoding="utf-8") if p.is_file() else ""
         return snaps[n]
-    out: list[tuple[dict[str, Any], bool]] = []
+    out: list[tuple[RequirementRecord, bool]] = []
     index: dict[str, str] = {}
     keep = set()
     for req in all_requirements(plan):
@@ -91,29 +107,33 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple[di
         rel = record_path(req.id)
         keep.add(rel.rsplit("/", 1)[1])
         old = None if force else _read(ws.root / rel)
+        rec: RequirementRecord
         if old is not None and old.get("fingerprint") == fp:
             rec, now = old, False
         else:
             fresh()  # each check in the same Z3 state whatever ran before it (semantics/world.py)
-            rec = decide(req, checked, model, plan)  # its own nodes first (calculus/requirements/own_nodes.py)
-            queries: dict[str, tuple[str, str]] = {}  # record key -> (kind, text)
-            for kind, key, suffix in (("requirement", "smt2", ""), *((s, f"{s}_smt2", f".{s}") for s in SIDE_QUERIES)):
-                text = rec.pop(key, None)  # the proof's query, then the consistency and vacuity queries
+            made = decide(req, checked, model, plan)  # its own nodes first (calculus/requirements/own_nodes.py)
+            if not _is_check(made):
+                raise ValueError(f"the check of requirement {req.id} gave no id and verdict")
+            queries: dict[str, tuple[str, str]] = {}  # the script's path -> (kind, text)
+            for kind, key, suffix in _QUERIES:
+                text = made.pop(key, None)  # the proof's query, then the consistency and vacuity queries
                 if text is not None:
-                    rec[key] = rel[:-5] + f"{suffix}.smt2"
-                    queries[key] = (kind, text)
-            rec["fingerprint"] = fp
-            rec["inputs"] = input_hashes(ws, cone, snap, model_hash) if formal is not None else {}
+                    made[key] = rel[:-5] + f"{suffix}.smt2"
+                    queries[made[key]] = (kind, text)
+            rec = {**made, "fingerprint": fp,
+                   "inputs": input_hashes(ws, cone, snap, model_hash) if formal is not None else {}}
             if traces:
                 rec["traces"] = trace_rows(req, checked, plan, ws.root)
                 rec["inputs"].update(th)
-            for key, (kind, text) in queries.items():  # each ends naming the statement it decides (records/ties.py)
-                atomic_write_text(ws.root / rec[key], tie_query(text, kind, req.id, rec))
+            for path, (kind, text) in queries.items():  # each ends naming the statement it decides (records/ties.py)
+                atomic_write_text(ws.root / path, tie_query(text, kind, req.id, rec))
             write_sealed(ws.root / rel, rec)
             now = True
-        for key in ("smt2", *(f"{side}_smt2" for side in SIDE_QUERIES)):
-            if rec.get(key):
-                keep.add(rec[key].rsplit("/", 1)[1])
+        for _, key, _ in _QUERIES:
+            kept = rec.get(key)
+            if kept:
+                keep.add(kept.rsplit("/", 1)[1])
         index[req.id] = hashlib.sha256((ws.root / rel).read_bytes()).hexdigest()
         out.append((rec, now))
     write_sealed(ws.root / INDEX, {"records": index})

@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import copy
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, Iterator, Sequence
 
 from rclverify.traces.events import Event, TraceError, header_stamp
+
+if TYPE_CHECKING:  # rosbags is the optional ``ros`` extra: its types only for the checker
+    from rosbags.interfaces.typing import Typesdict
 
 
 def _definitions(msg_dirs: Sequence[Path]) -> tuple[tuple[str, str, Path], ...]:
@@ -26,7 +29,7 @@ def _definitions(msg_dirs: Sequence[Path]) -> tuple[tuple[str, str, Path], ...]:
     return tuple(found)
 
 
-def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
+def custom_types(msg_dirs: Sequence[Path]) -> Typesdict:
     """Type definitions parsed from every ``<pkg>/msg/<Type>.msg`` under ``msg_dirs``.
 
     Raises :class:`TraceError` (naming the file) for a definition rosbags rejects,
@@ -36,12 +39,12 @@ def custom_types(msg_dirs: Sequence[Path]) -> dict[str, Any]:
     return _parsed(_definitions(msg_dirs))
 
 
-def _parsed(definitions: tuple[tuple[str, str, Path], ...]) -> dict[str, Any]:
+def _parsed(definitions: tuple[tuple[str, str, Path], ...]) -> Typesdict:
     if not definitions:
         return {}
     from rclverify.core.extras import require  # deferred: start-up (loads rosbags and more only when called)
     get_types_from_msg = require("rosbags.typesys", "reading the workspace's .msg definitions").get_types_from_msg
-    types: dict[str, Any] = {}
+    types: Typesdict = {}
     for name, text, f in definitions:
         try:
             types.update(get_types_from_msg(text, name))
@@ -96,12 +99,12 @@ def typestore(msg_dirs: Sequence[Path]) -> Any:
     return _copy(store)
 
 
-def flatten(msg: Any) -> dict[str, Any]:
+def flatten(msg: Any) -> dict[str, object]:
     """A deserialised message as a dict of its fields (nested messages as dicts,
     arrays as lists, an array of messages as a list of dicts), so a mapping's
     field path (``pose.pose.position.x``, ``poses[0].position.x``) reads a
     bag as it reads a log."""
-    out: dict[str, Any] = {}
+    out: dict[str, object] = {}
     for name in getattr(msg, "__dataclass_fields__", {}):
         if name == "__msgtype__":
             continue

@@ -68,7 +68,7 @@ def _storage_class() -> Any:
                 raise ReaderError(f"schema {schema!r}")
             kind = 4 if schema >= 4 else 2 if schema >= 2 else 1
             msgtypes: list[dict[str, str]] = []
-            defs: dict[str, Any] = {}
+            defs: dict[str, tuple[str, str]] = {}
             if kind == 4:
                 for name, enc, text, digest in db.execute("SELECT topic_type, encoding, encoded_message_definition, "
                                                           "type_description_hash FROM message_definitions ORDER BY id"):

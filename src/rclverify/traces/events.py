@@ -63,7 +63,7 @@ def to_ns(seconds: float) -> int:
     return int(whole) * 1_000_000_000 + round((seconds - whole) * 1e9)
 
 
-def header_stamp(fields: Mapping[str, Any]) -> float | None:
+def header_stamp(fields: Mapping[str, object]) -> float | None:
     """The message's ``header.stamp`` in seconds, or ``None`` when it has none.
 
     Accepts a nested header (``{"header": {"stamp": {"secs": 1, "nsecs": 5}}}``,
@@ -87,7 +87,7 @@ def header_stamp(fields: Mapping[str, Any]) -> float | None:
     return None
 
 
-def header_stamp_ns(fields: Mapping[str, Any]) -> int | None:
+def header_stamp_ns(fields: Mapping[str, object]) -> int | None:
     """The message's ``header.stamp`` in integer nanoseconds, or ``None`` as for
     :func:`header_stamp`: integer ``secs``/``nsecs`` (ROS 1's ``time``) or
     ``sec``/``nanosec`` (ROS 2's ``builtin_interfaces/Time``) exactly, a stamp

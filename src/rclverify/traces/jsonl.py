@@ -122,7 +122,7 @@ def _checked(path: Path, lineno: int, topic: Any, time: Any) -> float | int:
     return time
 
 
-def _slow(path: Path, lineno: int, raw: bytes) -> dict[str, Any] | None:
+def _slow(path: Path, lineno: int, raw: bytes) -> dict[str, object] | None:
     """The object of line ``lineno`` (``raw``, its bytes) read by JSON's
     scanner or, failing that, ``json.loads``, which words every error;
     ``None`` for a blank line.  Raises :class:`TraceError` located at the
@@ -144,7 +144,7 @@ def _slow(path: Path, lineno: int, raw: bytes) -> dict[str, Any] | None:
         else:
             rest = len(line) - end
             if not rest or (rest == 1 and line[-1] == "\n") or not line[end:].strip(_JSON_SPACE):
-                return cast("dict[str, Any]", obj)  # a line that starts with "{" scans to an object
+                return cast("dict[str, object]", obj)  # a line that starts with "{" scans to an object
             # else more than JSON whitespace after the object: json.loads says what
     if not line.strip():
         return None

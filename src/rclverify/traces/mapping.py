@@ -172,7 +172,7 @@ def parse_path(text: str) -> tuple[str | int, ...] | None:
     return tuple(steps)
 
 
-def field_value(fields: Mapping[str, Any], name: str) -> Any:
+def field_value(fields: Mapping[str, object], name: str) -> Any:
     """The value of field ``name`` of a message (its fields as a dict, nested
     messages as dicts, arrays as lists): a top-level key as it is (also one
     that is literally ``a.b``, as some loggers flatten), else the path
@@ -216,7 +216,7 @@ def _follow(fields: Any, steps: Sequence[str | int], name: str, done: str = "") 
     return cur
 
 
-def field_items(fields: Mapping[str, Any], rule: TopicRule) -> list[tuple[str, Any]]:
+def field_items(fields: Mapping[str, object], rule: TopicRule) -> list[tuple[str, Any]]:
     """The message fields the rule reads, in order (:func:`field_value` for
     each named field; the top-level fields without a ``fields`` list)."""
     if rule.fields:
@@ -235,7 +235,7 @@ def field_items(fields: Mapping[str, Any], rule: TopicRule) -> list[tuple[str, A
     return list(fields.items())
 
 
-def map_value(typ: T.Type, fields: Mapping[str, Any], rule: TopicRule, previous: Any) -> Any:
+def map_value(typ: T.Type, fields: Mapping[str, object], rule: TopicRule, previous: Any) -> Any:
     """The variable's new value after one message (``previous`` is its value so far,
     ``None`` at the start).  Raises :class:`MappingError`."""
     fs = _Fields(field_items(fields, rule))
@@ -283,7 +283,7 @@ def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
     names = rule.fields
     isfinite = math.isfinite
 
-    def mapper(fields: Mapping[str, Any], previous: Any) -> Any:
+    def mapper(fields: Mapping[str, object], previous: Any) -> Any:
         if names:
             try:  # the named fields as top-level keys (field_value reads such a key first)
                 items: Any = [(f, fields[f]) for f in names]
@@ -304,7 +304,7 @@ def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
         return mapper
     only = names[0]
 
-    def one_field(fields: Mapping[str, Any], previous: Any) -> Any:
+    def one_field(fields: Mapping[str, object], previous: Any) -> Any:
         # one named field (the common rule) holding a finite float or a string: the value itself; anything
         # else (a path, a missing field, another type, NaN) goes the general way above, with its errors
         try:

@@ -61,7 +61,7 @@ class Question:
     __slots__ = ("event", "stamp", "inputs", "triggers", "owed", "answered", "settled", "reported", "answer",
                  "answered_triggers", "passed", "followed", "waiting", "decided", "last_out", "view", "due", "info")
 
-    def __init__(self, event: Event, stamp: float, inputs: dict[str, Any], owed: bool = True,
+    def __init__(self, event: Event, stamp: float, inputs: dict[str, object], owed: bool = True,
                  info: Any = None) -> None:
         self.event, self.stamp, self.inputs, self.owed, self.info = event, stamp, inputs, owed, info
         #: inputs -> the first message of each not answered yet (``triggered by``), carried when superseded
@@ -69,18 +69,18 @@ class Question:
         self.answered = self.settled = self.reported = False
         #: another question came within its horizon: what its answer left out is owed to that one now
         self.followed = False
-        self.answer: dict[str, Any] = {}
+        self.answer: dict[str, object] = {}
         #: triggers an output of their guarantee answered, and those carried on to the next question
         #: (made when first needed: most nodes have no trigger)
         self.answered_triggers: set[str] = _NO_SET
         self.passed: set[str] = _NO_SET
         #: guarantee -> (output event, reason, outputs): a partial answer waiting for another output
-        self.waiting: dict[int, tuple[Event, str, dict[str, Any]]] = {}
+        self.waiting: dict[int, tuple[Event, str, dict[str, object]]] = {}
         #: guarantees decided (true or false) on this question so far, and the last output that answered it
         self.decided: set[int] = set()
         self.last_out: Event | None = None
         #: its inputs and answer in one dict, kept up to date as the answer grows (the judge's values)
-        self.view: dict[str, Any] | None = None
+        self.view: dict[str, object] | None = None
         #: the time (s, the run's clock) its horizon passes
         self.due = float("inf")
 

@@ -44,7 +44,7 @@ class ColumnTrace:
     is not finite, or a field is given for a topic with no rows."""
 
     def __init__(self, topic: Sequence[str] | np.ndarray, time: Sequence[float] | np.ndarray,
-                 fields: Mapping[str, Mapping[str, Any]] | None = None, name: str = "columns",
+                 fields: Mapping[str, Mapping[str, Sequence[object] | np.ndarray]] | None = None, name: str = "columns",
                  names: Sequence[str] | None = None) -> None:
         if names is None:
             found, codes = np.unique(np.asarray(topic, dtype=str), return_inverse=True)
@@ -72,7 +72,7 @@ class ColumnTrace:
             self.pos[rows] = np.arange(len(rows))
         given = {str(t).lstrip("/"): cols for t, cols in (fields or {}).items()}
         #: per topic code, field -> its column (a float64 or string array, else a list)
-        self.columns: list[dict[str, Any]] = []
+        self.columns: list[dict[str, np.ndarray | list[object]]] = []
         for c, t in enumerate(self.names):
             cols = {f: _column(v) for f, v in given.pop(t, {}).items()}
             for f, v in cols.items():
@@ -95,7 +95,7 @@ class ColumnTrace:
         return (ColumnBlock(self, a, min(len(self), a + step)) for a in range(0, len(self), step))
 
 
-def _column(values: Any) -> Any:
+def _column(values: Sequence[object] | np.ndarray) -> np.ndarray | list[object]:
     """A field's values as kept: a float64 or string array as given, anything else as a list
     (another array's values as Python numbers, the type a log's message gives: an ``int64``
     array's as ``int``, never a numpy scalar)."""

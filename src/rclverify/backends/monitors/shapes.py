@@ -14,6 +14,8 @@ text (``dict[str, str]``).
 from typing import NotRequired, TypedDict
 
 from rclverify.backends.shapes import DeclarationRow as DeclarationRow  # re-exported: a declaration row is the monitors' too
+# sealed in a requirement's record (its traces), so defined with it (records/ is below backends/)
+from rclverify.records.stage_records import TraceVerdictJson as TraceVerdictJson, Witness as Witness
 
 
 class OriginLine(TypedDict):
@@ -177,29 +179,6 @@ class PeriodResultJson(TypedDict):
     messages: dict[str, int]
     late: dict[str, PeriodGapJson]
     end: float | None
-
-
-class Witness(TypedDict):
-    """One operand of a temporal statement at one step of a trace."""
-    step: int
-    time: float
-    where: str
-    operand: str
-    holds: bool | None
-    values: dict[str, str]
-    unreadable: NotRequired[list[str]]
-    semantics: NotRequired[str]
-
-
-class TraceVerdictJson(TypedDict):
-    """A temporal statement's verdict on one trace (:class:`.temporal_trace.TraceVerdict`)."""
-    verdict: str
-    steps: int
-    reason: str
-    step: int | None
-    time: float | None
-    where: str
-    witness: list[Witness]
 
 
 class PeriodsPart(TypedDict):

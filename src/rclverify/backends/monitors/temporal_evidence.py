@@ -30,7 +30,6 @@ the record ``stale`` in ``rclverify report`` before that.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from rclverify.model.plan.model import Plan, Requirement
 from rclverify.model.plan.state import state_types
@@ -41,6 +40,7 @@ from rclverify.traces import TraceError, read_trace
 from rclverify.traces.files import trace_sha256
 from rclverify.backends.monitors.config import ConfigError, load_mapping
 from rclverify.backends.monitors.temporal_trace import check_temporal_trace
+from rclverify.records.stage_records import TraceFailure, TraceRow, TraceVerdictJson
 import hashlib
 import json
 
@@ -97,26 +97,26 @@ def fingerprint_text(root: Path, traces: list[tuple[str, str | None]]) -> str:
     return json.dumps(out)
 
 
-def trace_rows(req: Requirement, checked: Checked, plan: Plan, root: Path) -> list[dict[str, Any]]:
+def trace_rows(req: Requirement, checked: Checked, plan: Plan, root: Path) -> list[TraceRow]:
     """One row per trace of ``req`` (module table); never raises for a
     user-caused problem (an unreadable trace or mapping is an ``error`` row)."""
-    rows: list[dict[str, Any]] = []
+    rows: list[TraceRow] = []
     traces = requirement_traces(req, checked, plan)
     if not traces:
         return rows
     t = parse_temporal(req.formal, checked, req.id, state_types(plan.states, checked))  # type: ignore[arg-type]
     assert isinstance(t, Temporal)
     for tr, mapping in traces:
-        row: dict[str, Any] = {"trace": tr, "mapping": mapping,
-                               "sha256": trace_hashes(root, [(tr, mapping)])[trace_key(tr)]}
+        sha = trace_hashes(root, [(tr, mapping)])[trace_key(tr)]
+        verdict: TraceVerdictJson | TraceFailure
         try:
             cfg = load_mapping(root, mapping)
             v = check_temporal_trace(t, checked, plan.states,
                                      read_trace(root / tr, [root / d for d in cfg.msg_dirs]), cfg.rules)
-            row.update(status=STATUS[v.verdict], verdict=v.to_json())
+            status, verdict = STATUS[v.verdict], v.to_json()
         except (TraceError, ConfigError, OSError, RclError) as exc:
-            row.update(status="error", verdict={"verdict": "error", "reason": str(exc)})
-        rows.append(row)
+            status, verdict = "error", {"verdict": "error", "reason": str(exc)}
+        rows.append({"trace": tr, "mapping": mapping, "sha256": sha, "status": status, "verdict": verdict})
     return rows
 
 

@@ -56,7 +56,8 @@ import z3
 
 from rclverify.calculus.requirements.exercised import antecedent as _premise  # the condition a requirement demands under
 from rclverify.calculus.compose import split_assumption
-from rclverify.calculus.shapes import RequirementBase, TraceNode
+from rclverify.calculus.shapes import TraceNode
+from rclverify.records.stage_records import RequirementBase
 from rclverify.semantics.encode import Encoder
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, satisfiable, solver_session

@@ -74,7 +74,8 @@ from rclverify.calculus.requirements.transition import ComposedSystem, build_sys
 from rclverify.semantics.encode import Encoder
 from rclverify.lang.types import FuncT
 from rclverify.semantics import wallclock
-from rclverify.calculus.shapes import Gaps, RequirementBase, TraceStep, Vacuity
+from rclverify.calculus.shapes import Gaps, TraceStep, Vacuity
+from rclverify.records.stage_records import RequirementBase
 
 #: The bound of BMC for an unbounded ``eventually`` and of k-induction's k.
 DEFAULT_BOUND = 10

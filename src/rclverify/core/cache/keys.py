@@ -192,7 +192,7 @@ class Keyer:
 
     def __init__(self, salt_hex: str) -> None:
         self.salt = salt_hex
-        self._prefixes: dict[str, Any] = {}
+        self._prefixes: dict[str, hashlib._Hash] = {}
 
     def __call__(self, part: str, *contents: bytes | str) -> bytes:
         """The 32-byte key of an entry of sub-kind ``part`` computed from

@@ -50,16 +50,17 @@ from rclverify.core.atomic import atomic_write_bytes
 from rclverify.core.cache.heap import no_collection
 from rclverify.core.cache.keys import CACHE_DIR, FORMAT, Keyer, code_stamp, salt
 from rclverify.core.cache.safeload import load
+from rclverify.core.cache.shapes import KeptFile, KeptHeader
 
 _PROTOCOL = pickle.HIGHEST_PROTOCOL
 
 
-def header(kind: str, salt_hex: str) -> dict[str, Any]:
+def header(kind: str, salt_hex: str) -> KeptHeader:
     """The header of a kept file of ``kind`` under ``salt_hex``."""
     return {"format": FORMAT, "kind": kind, "code": code_stamp(), "salt": salt_hex}
 
 
-def read_header(fh: BinaryIO) -> dict[str, Any] | None:
+def read_header(fh: BinaryIO) -> dict[str, object] | None:
     """The header of an open kept file, or ``None`` when it has none.  Never raises."""
     try:
         got = load(fh)
@@ -325,14 +326,14 @@ def _alive(claim: Path) -> bool:
     return True
 
 
-def kept_files(root: Path) -> list[dict[str, Any]]:
+def kept_files(root: Path) -> list[KeptFile]:
     """What ``root``'s ``artifacts/cache`` holds, for ``rclverify cache``:
     ``[{"file": path relative to root, "kind": str or None, "bytes": int,
     "current": whether it was written by this rclverify code}, ...]``,
     sorted by file.  A directory of :class:`Blobs` is one row (its files'
     bytes summed).  Never raises."""
     base = root / CACHE_DIR
-    out: list[dict[str, Any]] = []
+    out: list[KeptFile] = []
     try:
         entries = sorted(base.iterdir())
     except OSError:

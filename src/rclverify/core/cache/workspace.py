@@ -40,6 +40,7 @@ from typing import Any, BinaryIO
 
 from rclverify.core.cache.keys import file_digest, resolved_paths, salt
 from rclverify.core.cache.safeload import load
+from rclverify.core.cache.shapes import WorkspaceInputs
 from rclverify.core.cache.store import open_stream, write_stream
 from rclverify.core.cache.heap import no_collection
 from rclverify.core.forksafe import fork_is_safe
@@ -49,7 +50,7 @@ KIND = "workspace"
 
 
 def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = None,
-            paths: Any = None) -> dict[str, Any]:
+            paths: Any = None) -> WorkspaceInputs:
     """What ``ws``'s (a :class:`rclverify.stages.workspace.Workspace`) cache was
     computed from.  ``known`` gives sha256s of contract files already taken
     in this run (by :func:`restore`, before the files were parsed).
@@ -142,7 +143,7 @@ def _load_large(fh: Any) -> Any:
         return load(fh)
 
 
-def _load_deferred(ws: Any, kept: dict[str, Any], offset: int) -> None:
+def _load_deferred(ws: Any, kept: WorkspaceInputs, offset: int) -> None:
     """Fill ``ws``'s plan and parsed contracts from the cache that
     :func:`restore` validated, if the cache file is still the one read then
     and the plan file is unchanged; else fill nothing (``ws`` then loads from

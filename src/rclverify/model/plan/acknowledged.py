@@ -181,7 +181,7 @@ def _node_text(node: ast.Node) -> str:
     return to_rcl(ast.Spec((), (node,)))
 
 
-def lint_flagged(row: Mapping[str, Any], checked: Checked, source: str = "") -> str:
+def lint_flagged(row: Mapping[str, object], checked: Checked, source: str = "") -> str:
     """The flagged text of a lint row (``file``/``line``/``col`` or
     ``location``): the clause or constant whose span holds the location,
     else the node's whole contract, else the source line ``source`` gives."""
@@ -211,7 +211,7 @@ def conjuncts(e: ast.Expr) -> list[ast.Expr]:
     return [e]
 
 
-def _lint_place(row: Mapping[str, Any], checked: Checked) -> tuple[str, str | None]:
+def _lint_place(row: Mapping[str, object], checked: Checked) -> tuple[str, str | None]:
     """``(file, node)`` of a lint row: its file as :func:`_path` writes it and
     the node whose span holds its location (``None``: outside every node)."""
     file, line, col = _where(row)
@@ -223,7 +223,7 @@ def _lint_place(row: Mapping[str, Any], checked: Checked) -> tuple[str, str | No
     return _path(file), None
 
 
-def _answers(a: Acknowledgement, kind: str, row: Mapping[str, Any], checked: Checked) -> bool:
+def _answers(a: Acknowledgement, kind: str, row: Mapping[str, object], checked: Checked) -> bool:
     """Does ``a`` name the finding ``row``: its id (health) or its code, file
     and node (lint)?  Its text is compared by :meth:`Acknowledgement.binds`."""
     if kind == "health":
@@ -239,14 +239,21 @@ def _answers(a: Acknowledgement, kind: str, row: Mapping[str, Any], checked: Che
     return _same(file, a.file) and (a.node is None or node == a.node)
 
 
-def _where(row: Mapping[str, Any]) -> tuple[str, int, int]:
+def _number(value: object) -> int:
+    """``int(value)`` of a row's line or column (a number, or its text); ``TypeError`` for anything else."""
+    if isinstance(value, (int, float, str)):
+        return int(value)
+    raise TypeError(f"a line or column is a number, not {value!r}")
+
+
+def _where(row: Mapping[str, object]) -> tuple[str, int, int]:
     if "file" in row:
-        return str(row["file"]), int(row.get("line", 0)), int(row.get("col", 0))
+        return str(row["file"]), _number(row.get("line", 0)), _number(row.get("col", 0))
     file, line, col = (str(row.get("location", "")).rsplit(":", 2) + ["0", "0"])[:3]
     return file, int(line) if line.isdigit() else 0, int(col) if col.isdigit() else 0
 
 
-def health_flagged(finding: Mapping[str, Any], checked: Checked) -> str:
+def health_flagged(finding: Mapping[str, object], checked: Checked) -> str:
     """The flagged text of a health finding: conjunct ``j`` of guarantee
     ``k`` (``<Node>.g<k>.c<j>.<check>``), guarantee ``k``
     (``<Node>.g<k>.<check>``), the node's contract (``<Node>.<check>``), or
@@ -269,16 +276,16 @@ def health_flagged(finding: Mapping[str, Any], checked: Checked) -> str:
     return expr_to_rcl(parts[j - 1]) if 1 <= j <= len(parts) else expr_to_rcl(g.formula)
 
 
-def _is_warning(kind: str, row: Mapping[str, Any]) -> bool:
+def _is_warning(kind: str, row: Mapping[str, object]) -> bool:
     return str(row.get("status" if kind == "health" else "severity", "")).lower() == "warning"
 
 
-def _ident(kind: str, row: Mapping[str, Any]) -> str:
+def _ident(kind: str, row: Mapping[str, object]) -> str:
     return str(row["id"]) if kind == "health" else f"{row.get('location', '')}:{row.get('code', '')}"
 
 
-def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[MutableMapping[str, Any]],
-                           lint_rows: Iterable[MutableMapping[str, Any]], checked: Checked) -> list[dict[str, Any]]:
+def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[MutableMapping[str, object]],
+                           lint_rows: Iterable[MutableMapping[str, object]], checked: Checked) -> list[dict[str, Any]]:
     """Match the plan's acknowledgements with this run's warnings.
 
     ``findings`` are the report's health rows (``id``, ``status``,
@@ -295,14 +302,15 @@ def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[M
     binding warnings of several nodes; it then accepts none).  A finding is
     matched by its id (health; with ``file``, the node's file too) or by its
     code, file and node (lint), then by its flagged text."""
-    rows: list[tuple[str, MutableMapping[str, Any]]] = (
+    rows: list[tuple[str, MutableMapping[str, object]]] = (
         [("health", f) for f in findings] + [("lint", x) for x in lint_rows])
     for kind, r in rows:
         for k in ("acknowledged", "flagged", "sha256"):  # rows kept between runs in one process start clean
             r.pop(k, None)
         if _is_warning(kind, r):
-            r["flagged"] = health_flagged(r, checked) if kind == "health" else lint_flagged(r, checked)
-            r["sha256"] = digest(r["flagged"])
+            flagged = health_flagged(r, checked) if kind == "health" else lint_flagged(r, checked)
+            r["flagged"] = flagged
+            r["sha256"] = digest(flagged)
     out = []
     for a in acks:
         cands = [(k, r) for k, r in rows if _answers(a, k, r, checked)]
@@ -347,7 +355,7 @@ def _too_wide(a: Acknowledgement, owners: set[str | None]) -> str:
     return ""
 
 
-def hint(kind: str, row: Mapping[str, Any]) -> str:
+def hint(kind: str, row: Mapping[str, object]) -> str:
     """The plan entry that would acknowledge the warning ``row`` (one YAML
     flow mapping; ``reason`` left for the user to write)."""
     name = row["id"] if kind == "health" else row.get("code", "")

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Any
+
+from rclverify.records.statistics import TargetJson
 
 #: What a target counts: a whole run with any violation, or one judged answer.
 PER = ("run", "answer")
@@ -27,7 +28,7 @@ class Target:
     text: str
     guarantee: int = 0
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> TargetJson:
         return {"bound": self.bound, "level": self.level, "per": self.per, "text": self.text,
                 "guarantee": self.guarantee}
 

@@ -31,6 +31,7 @@ from rclverify.lang.types import Checked, EmptyT
 from rclverify.model.system.services import peers as service_peers, side_conditions as service_conditions
 from rclverify.model.system.units import connection_diagnostics
 from rclverify.model.system.cycles import elementary_cycles, strongly_connected_components, upstream_bits
+from rclverify.model.system.shapes import LinkJson, ModelJson, ModelView
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,7 @@ class Link:
     to_var: str
     via: str
 
-    def to_json(self) -> dict[str, str]:
+    def to_json(self) -> LinkJson:
         return {"from_node": self.from_node, "from_var": self.from_var, "to_node": self.to_node,
                 "to_var": self.to_var, "via": self.via}
 
@@ -164,7 +165,7 @@ class SystemModel:
             read.setdefault((l.from_node, l.from_var), []).append(l.to_node)
         return ({n: tuple(ls) for n, ls in into.items()}, {k: tuple(ns) for k, ns in read.items()})
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> ModelJson:
         return {
             "nodes": list(self.nodes),
             "connections": [l.to_json() for l in self.links],
@@ -190,7 +191,7 @@ class SystemModel:
             out.append(c[k:] + c[:k])
         return tuple(tuple(c) for c in sorted(out, key=lambda c: (len(c), [order[n] for n in c])))
 
-    def view(self, status: dict[str, str], cycles: list[list[str]] | None = None) -> dict[str, Any]:
+    def view(self, status: Mapping[str, str], cycles: list[list[str]] | None = None) -> ModelView:
         """:meth:`to_json` with each node's roll-up status (``pending`` when
         unknown): what the diagram and the report's system section show.
         There ``loops`` are the graph's real cycles (:meth:`cycles`, or
@@ -199,13 +200,12 @@ class SystemModel:
         connections; the strongly connected components R4 is applied to are
         under ``loop_components``."""
         d = self.to_json()
-        d["nodes"] = [{"name": n, "status": status.get(n, "pending")} for n in self.nodes]
-        d["loop_components"] = d["loops"]
-        d["loops"] = self.cycles() if cycles is None else cycles
-        return d
+        return {"nodes": [{"name": n, "status": status.get(n, "pending")} for n in self.nodes],
+                "connections": d["connections"], "environment_inputs": d["environment_inputs"],
+                "loops": self.cycles() if cycles is None else cycles, "loop_components": d["loops"]}
 
     @staticmethod
-    def from_json(d: dict[str, Any]) -> "SystemModel":
+    def from_json(d: ModelJson) -> "SystemModel":
         return SystemModel(tuple(d["nodes"]), tuple(Link(**l) for l in d["connections"]),
                            tuple((e["node"], e["var"], e["type"]) for e in d["environment_inputs"]),
                            tuple(tuple(l) for l in d["loops"]))

@@ -11,13 +11,17 @@ record is altered) reads ``one solver`` with the reason.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping, TypeVar
 
 from rclverify.stages.crosscheck.items import witness_query
 from rclverify.stages.crosscheck.stage import DOWNGRADES
 import hashlib
 from rclverify.stages.crosscheck.stage import read_crosscheck
 from rclverify.stages.crosscheck.items import SIDE_ANSWERS
+
+#: A record the second solver's verdict is folded into (a side-condition row, a health finding, a
+#: requirement or deadline record): given back as it is when nothing changes, else a new dict.
+Row = TypeVar("Row", bound=Mapping[str, object])
 
 _STAGE_MISSING = "the second-solver stage has not decided it (run `doit verify`)"
 _NO_QUERY = ("no single SMT-LIB2 query is kept for this verdict (a temporal proof by BMC, k-induction or a "
@@ -50,8 +54,9 @@ class SecondSolver:
                 "cvc5": None if c is None else {k: c.get(k) for k in ("answer", "reason", "version", "proof_checked")},
                 "proof": (c or {}).get("proof", ""), "smt2": str(r.get("smt2", ""))}
 
-    def _fold(self, row: dict[str, Any] | None, kind: str, id_key: str, status_key: str, good: str,
-              downgraded: Any, query: str | None = None) -> dict[str, Any] | None:
+    def _fold(self, row: Row | None, kind: str, id_key: str, status_key: str, good: str,
+              downgraded: Callable[[Row, dict[str, Any]], dict[str, str]],
+              query: str | None = None) -> Row | dict[str, object] | None:
         """``row`` with ``solvers`` when its ``status_key`` reads ``good``;
         then, when the solvers do not agree, ``status_key`` set to
         ``inconclusive`` and the fields ``downgraded(row, solvers)`` gives.
@@ -62,46 +67,49 @@ class SecondSolver:
         if not row.get("smt2"):  # no query kept (a temporal proof, a scan instance by instance): nothing to re-decide
             return {**row, "solvers": {"agreement": "one solver", "why": _NO_QUERY, "cvc5": None, "proof": "",
                                        "smt2": ""}}
-        s = self.solvers(kind, str(row.get(id_key)), query or row.get("smt2"))
+        smt2 = row.get("smt2")
+        s = self.solvers(kind, str(row.get(id_key)), query or (smt2 if isinstance(smt2, str) else None))
         if s["agreement"] in DOWNGRADES:
             return {**row, status_key: "inconclusive", "solvers": s, **downgraded(row, s)}
         return {**row, "solvers": s}
 
-    def side_condition(self, sc: dict[str, Any]) -> dict[str, Any]:
+    def side_condition(self, sc: Row) -> Row | dict[str, object]:
         """``sc`` (a side-condition row) with ``solvers``; a discharged one
         the solvers do not agree on is ``inconclusive``."""
         return self._fold(sc, "side-condition", "id", "status", "discharged", lambda r, s: {
             "explanation": f"Not discharged: {s['why']} (second solver). Z3 alone: {r.get('explanation', '')}"}) or sc
 
-    def finding(self, f: dict[str, Any]) -> dict[str, Any]:
+    def finding(self, f: Row) -> Row | dict[str, object]:
         """A health finding with ``solvers``; an ``ok`` one the solvers do
         not agree on is ``inconclusive``."""
         return self._fold(f, "health", "id", "status", "ok", lambda r, s: {
             "message": f"{r.get('message', '')} Not confirmed: {s['why']} (second solver)."}, witness_query(f)) or f
 
-    def requirement(self, rec: dict[str, Any] | None) -> dict[str, Any] | None:
+    def requirement(self, rec: Row | None) -> Row | dict[str, object] | None:
         """A requirement record with ``solvers``; a ``proved`` one the
         solvers do not agree on has verdict ``inconclusive`` and the reason.
         A proved one's decided consistency and vacuity answers get
         ``consistency_solvers`` and ``vacuity_solvers``; one the solvers do
         not agree on reads ``undecided`` with the reason (the requirement is
         then ``inconclusive``, calculus/requirements/rollup.py)."""
-        rec = self._fold(rec, "requirement", "id", "verdict", "proved", lambda r, s: {
+        out = self._fold(rec, "requirement", "id", "verdict", "proved", lambda r, s: {
             "recorded_verdict": "proved", "reason": f"second solver: {s['why']}"})
-        if rec is None or rec.get("verdict") != "proved":
-            return rec
+        if out is None or out.get("verdict") != "proved":
+            return out
         for side, answers in SIDE_ANSWERS.items():
-            if rec.get(side) not in answers or not rec.get(f"{side}_smt2"):
+            smt2 = out.get(f"{side}_smt2")
+            if out.get(side) not in answers or not smt2:
                 continue
-            s = self.solvers(side, str(rec.get("id")), rec.get(f"{side}_smt2"))
-            rec = {**rec, f"{side}_solvers": s}
+            s = self.solvers(side, str(out.get("id")), smt2 if isinstance(smt2, str) else None)
+            new = {**out, f"{side}_solvers": s}
             if s["agreement"] in DOWNGRADES:
-                rec.update({side: "undecided", f"recorded_{side}": rec[side],
-                            f"{side}_reason": f"Z3 found it {rec[side]}, but the second solver does not agree: "
+                new.update({side: "undecided", f"recorded_{side}": new[side],
+                            f"{side}_reason": f"Z3 found it {new[side]}, but the second solver does not agree: "
                                               f"{s['why']}"})
-        return rec
+            out = new
+        return out
 
-    def deadline(self, d: dict[str, Any]) -> dict[str, Any]:
+    def deadline(self, d: Row) -> Row | dict[str, object]:
         """A deadline record with ``solvers``; a ``proved`` one the solvers
         do not agree on is ``inconclusive``."""
         return self._fold(d, "deadline", "requirement", "status", "proved", lambda r, s: {

@@ -36,6 +36,8 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+from rclverify.records.stage_records import Cvc5Answer
+
 #: cvc5 resource units per check: some 150k units a second on the case
 #: study's heaviest quantified query, so about 10 s of work, the Z3 budget.
 RLIMIT = 1_500_000
@@ -63,7 +65,7 @@ class Decision:
     version: str
     duration_s: float
 
-    def row(self) -> dict[str, Any]:
+    def row(self) -> Cvc5Answer:
         """The decision as the second-solver record keeps it (the proof's
         path, ``proof``, is the caller's to fill in)."""
         return {"answer": self.answer, "reason": self.reason, "proof_checked": self.proof_checked,

@@ -71,7 +71,7 @@ class Item:
     #: witness query, whose unsat implies the verdict's; calculus/health/realizer.py)
     via: str = ""
     #: the record row that states what the script decides (its statement: rclverify.records.ties)
-    row: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False, repr=False)
+    row: Mapping[str, object] = field(default_factory=dict, compare=False, hash=False, repr=False)
 
 
 def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:

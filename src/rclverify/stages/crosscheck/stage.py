@@ -25,7 +25,7 @@ from typing import Any, Iterable, cast
 from rclverify.core import cpus as cpus_now
 from rclverify.core.forksafe import fork_is_safe
 from rclverify.records.sealed import read_sealed, write_sealed
-from rclverify.records.stage_records import CrosscheckRecord
+from rclverify.records.stage_records import CrosscheckRecord, Cvc5Answer
 from rclverify.records.store import atomic_write_text
 from rclverify.records.ties import proof_tie, tie_proof
 from rclverify.stages.crosscheck.cvc5_decide import RLIMIT, Decision, Session, decide, version
@@ -40,7 +40,7 @@ INDEX = f"{DIR}/index.json"
 DOWNGRADES = frozenset({"disagree", "inconclusive"})
 
 
-def agreement(expects: str, d: dict[str, Any] | None) -> tuple[str, str]:
+def agreement(expects: str, d: Cvc5Answer | None) -> tuple[str, str]:
     """``(agreement, why)`` of Z3's answer ``expects`` (``unsat``/``sat``)
     and cvc5's decision ``d`` (a row's ``cvc5`` object, ``None`` when cvc5
     is not installed).
@@ -112,8 +112,8 @@ def stage_crosscheck(root: Path, nodes: Iterable[str], *, split_min: int = SPLIT
     return cast(CrosscheckRecord, index)
 
 
-def _lookup(root: Path, it: Item, ver: str, cache: dict[str, dict[str, Any]]
-            ) -> tuple[Item, dict[str, Any], str | None, dict[str, Any] | Decision | None]:
+def _lookup(root: Path, it: Item, ver: str, cache: dict[str, Cvc5Answer]
+            ) -> tuple[Item, dict[str, Any], str | None, Cvc5Answer | Decision | None]:
     """``(item, row, script text, decision)`` of ``it``: the decision kept in
     the last index under the script's key (``None`` when cvc5 must decide it,
     or when the script cannot be read: then ``text`` is ``None`` and the row
@@ -149,7 +149,7 @@ def proof_tied(path: Path, query_sha256: str) -> bool:
         return False
 
 
-def _finish(root: Path, it: Item, row: dict[str, Any], d: dict[str, Any] | Decision | None,
+def _finish(root: Path, it: Item, row: dict[str, Any], d: Cvc5Answer | Decision | None,
             keep: set[str]) -> dict[str, Any]:
     """The row of ``it`` with cvc5's decision ``d`` (kept, or just made: its
     proof is written then) and the agreement."""

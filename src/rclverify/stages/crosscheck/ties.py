@@ -69,8 +69,8 @@ def index_rows(raw: bytes | None) -> tuple[dict[tuple[str, str], dict[str, Any]]
         if isinstance(items, list) else {}, ""
 
 
-def tie_problems(items: list[Item], rows: Mapping[tuple[str, str], Mapping[str, Any]] | None,
-                 present: Mapping[str, Any], tails: Mapping[str, bytes]) -> tuple[list[str], set[int]]:
+def tie_problems(items: list[Item], rows: Mapping[tuple[str, str], Mapping[str, object]] | None,
+                 present: Mapping[str, object], tails: Mapping[str, bytes]) -> tuple[list[str], set[int]]:
     """``(problems, untied)``: one sentence naming the item for each query
     that is missing or not tied to its item's statement and each proof not
     tied to its row's query (module docstring), and the positions in
@@ -99,10 +99,11 @@ def tie_problems(items: list[Item], rows: Mapping[tuple[str, str], Mapping[str, 
     return problems, untied
 
 
-def _proof_problem(row: Mapping[str, Any], present: Mapping[str, Any], tails: Mapping[str, bytes]) -> str:
+def _proof_problem(row: Mapping[str, object], present: Mapping[str, object], tails: Mapping[str, bytes]) -> str:
     """Why the proof ``row`` of the second-solver record keeps cannot be
     believed to prove its query, or ''."""
-    c = row.get("cvc5") if isinstance(row.get("cvc5"), dict) else {}
+    answer = row.get("cvc5")
+    c = answer if isinstance(answer, dict) else {}
     proof, sha = (c or {}).get("proof"), str(row.get("sha256", ""))
     if not proof:
         if (c or {}).get("answer") == "unsat" and row.get("agreement") == "two solvers":

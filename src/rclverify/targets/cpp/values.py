@@ -20,6 +20,7 @@ from typing import Any
 from rclverify.lang.types import DataT, EnumT, FuncT, Scalar, Type
 from rclverify.targets.cpp.common import CPP_SCALARS, camel_words
 from rclverify.targets.names import ctor_field, snake
+from rclverify.targets.shapes import TermCtor, TermFields
 
 #: RCL scalar -> C++ type inside a table or a term: a field's, but INTEGER and NATURAL both std::int64_t (module docstring)
 _INNER = {**CPP_SCALARS, "NATURAL": "std::int64_t"}
@@ -60,14 +61,14 @@ def term_struct(t: DataT) -> str | None:
     return "Term" + camel_words(t.name)
 
 
-def term_fields(t: DataT) -> dict[str, Any]:
+def term_fields(t: DataT) -> TermFields:
     """The template context of ``Term<Name>``: per constructor its index, name and arguments
     (field, C++ type)."""
-    ctors = []
+    ctors: list[TermCtor] = []
     for k, (name, args) in enumerate(t.ctors):
-        ctors.append(dict(index=k, name=name, fn=snake(name),
-                          args=[dict(field=ctor_field(name, j), cpp=inner_type(a)) for j, a in enumerate(args)]))
-    return dict(name=t.name, struct=term_struct(t), ctors=ctors)
+        ctors.append({"index": k, "name": name, "fn": snake(name),
+                      "args": [{"field": ctor_field(name, j), "cpp": inner_type(a)} for j, a in enumerate(args)]})
+    return {"name": t.name, "struct": term_struct(t), "ctors": ctors}
 
 
 def parse_code(t: Type, var: str) -> str:

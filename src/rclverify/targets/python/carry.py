@@ -41,6 +41,7 @@ from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.printer import expr_to_rcl
+from rclverify.targets.shapes import Carried, CarriedClause
 
 #: a note every undecided reason of an uncarried part ends with
 NOT_CARRIED = "not judged by the carried contract layer (rclverify's monitor judges it)"
@@ -167,7 +168,7 @@ def _vars(e: Any, out: list[ast.Var]) -> None:
         _vars(getattr(e, f), out)
 
 
-def carried(checked: Checked, node: CheckedNode) -> dict[str, Any]:
+def carried(checked: Checked, node: CheckedNode) -> Carried:
     """What ``contract.py`` carries for ``node``: ``assumes`` and ``guarantees`` (each
     ``{"tree", "fs", "fs_tol"}``: the clause's tree and whether the double and the tolerance
     readings can change it), ``ins`` (the inputs the contract reads, in declaration order),
@@ -175,7 +176,7 @@ def carried(checked: Checked, node: CheckedNode) -> dict[str, Any]:
     of its enumeration), as ``contract.py.j2`` renders them."""
     tree = _Tree(checked, node)
 
-    def clause(c: Any) -> dict[str, Any]:
+    def clause(c: Any) -> CarriedClause:
         f = c.formula
         return {"tree": tree.expr(f, frozenset()), "fs": float_sensitive(f, checked, node),
                 "fs_tol": float_sensitive(f, checked, node, tolerant=True)}

@@ -26,6 +26,8 @@ from rclverify.targets.cpp.values import data_types, parse_code, table_parse, te
 from rclverify.tools.generate.nodes import NodePackage
 from rclverify.targets import names
 from rclverify.targets.typemap import camel, snake
+from rclverify.traces.mapping import TopicRule
+from rclverify.tools.generate.shapes import CppTolerance, EndContext, EndRead, EndWrite, NodeContext, TermContext
 from rclverify.tools.generate.wiring import wires
 
 
@@ -119,9 +121,9 @@ class Checks:
     skipped_out: list[str] = field(default_factory=list)
     enums: list[Any] = field(default_factory=list)
     #: the constructor sets held as ``Term<Name>`` (:func:`.cpp_values.term_fields`)
-    terms: list[dict[str, Any]] = field(default_factory=list)
+    terms: list[TermContext] = field(default_factory=list)
     clauses: list[Clause] = field(default_factory=list)
-    tolerance: dict[str, Any] | None = None
+    tolerance: CppTolerance | None = None
     tolerance_text: str = ""
     #: per guarantee (1-based, index 0 unused): the input of ``triggered by in.x``, "" none
     triggers: list[str] = field(default_factory=list)
@@ -158,10 +160,10 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
         enums.setdefault(t.name, t)
     c.enums = [_Enum(t.name, snake(t.name), [(v, enum_const(t, v)) for v in t.values])
                for t in sorted(enums.values(), key=lambda t: t.name)]
-    c.terms = [dict(term_fields(t), fn=snake(t.name),
-                    parse=[(k["name"], len(k["args"]), k["fn"],
-                            [parse_code(a, f"q_a[{j}]") for j, a in enumerate(dict(t.ctors)[k["name"]])])
-                           for k in term_fields(t)["ctors"]]) for t in data_types(checked)]
+    c.terms = [{**term_fields(t), "fn": snake(t.name),
+                "parse": [(k["name"], len(k["args"]), k["fn"],
+                           [parse_code(a, f"q_a[{j}]") for j, a in enumerate(dict(t.ctors)[k["name"]])])
+                          for k in term_fields(t)["ctors"]]} for t in data_types(checked)]
     c.triggers = [""] + [f"in.{g.trigger.name}" if g.trigger is not None else "" for g in cn.node.guarantees]
     dbl = CppTranslator(checked, cn, "double")
     tol = CppTranslator(checked, cn, "tolerance")
@@ -197,29 +199,30 @@ def _cpp_type(ros_type: str, kind: str) -> str:
     return f"{pkg}::{kind}::{name}"
 
 
-def node_context(checked: Checked, np: NodePackage, c: Checks, rules: Mapping[str, Any] | None) -> dict[str, Any]:
+def node_context(checked: Checked, np: NodePackage, c: Checks, rules: Mapping[str, TopicRule] | None) -> NodeContext:
     """The template context of ``src/<pkg>_node.cpp``: ``ends`` (each end with its C++ type and the
     struct fields it reads into and writes from, by field path), ``headers``, ``deps``."""
     # tables and terms are filled by the driver, not from messages (docs/generate.md)
     held = {f"{f.side}.{f.var}": f.field for f in c.inputs + c.outputs if not isinstance(f.t, (FuncT, DataT))}
     ws = [w for w in wires(np, rules) if w.path and w.var in held]
-    ends = []
+    ends: list[EndContext] = []
     headers: set[str] = set()
     for e in np.endpoints:
         kind = e.kind
         headers.add(_header(e.ros_type, kind))
         mine = [w for w in ws if w.attr == e.attr]
-        reads = [dict(field=held[w.var], path=w.path, part=w.part, var=w.var) for w in mine if w.side == "in"]
-        writes = [dict(field=held[w.var], path=w.path, part=w.part) for w in mine if w.side == "out"]
-        ends.append(dict(role=e.role, name=e.name, var=e.var, attr=e.attr, cpp=_cpp_type(e.ros_type, kind),
-                         reads=reads, writes=writes))
+        reads: list[EndRead] = [{"field": held[w.var], "path": w.path, "part": w.part, "var": w.var}
+                                for w in mine if w.side == "in"]
+        writes: list[EndWrite] = [{"field": held[w.var], "path": w.path, "part": w.part} for w in mine if w.side == "out"]
+        ends.append({"role": e.role, "name": e.name, "var": e.var, "attr": e.attr, "cpp": _cpp_type(e.ros_type, kind),
+                     "reads": reads, "writes": writes})
     deps = ["rclcpp"] + (["rclcpp_action"] if np.has("action_server", "action_client") else [])
     deps += sorted(set(np.depends()) | {"std_msgs"})
-    return dict(ends=ends, headers=sorted(headers), deps=deps, cls=camel(np.ros_name) + "Node")
+    return {"ends": ends, "headers": sorted(headers), "deps": deps, "cls": camel(np.ros_name) + "Node"}
 
 
 def cpp_package(checked: Checked, cn: CheckedNode, np: NodePackage, env: Any, marker: str, once_marker: str,
-                qos_depth: int, rules: Mapping[str, Any] | None = None,
+                qos_depth: int, rules: Mapping[str, TopicRule] | None = None,
                 tolerance: Tolerance | None = None) -> tuple[dict[str, str], dict[str, str]]:
     """The files of node ``np``'s rclcpp package: ``(generated, created_once)``, relative path ->
     text, rendered with jinja2 environment ``env``."""

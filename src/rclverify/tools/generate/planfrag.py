@@ -17,14 +17,14 @@ from typing import Any, Mapping
 
 from rclverify.tools.generate.nodes import NodePackage
 from rclverify.tools.generate.wiring import wires
-from rclverify.traces.mapping import rule_for
+from rclverify.traces.mapping import TopicRule, rule_for
 from rclverify.ros.extract.model import canon_type
 
 #: property test examples per generated node
 MAX_EXAMPLES = 100
 
 
-def plan_fragment(nodes: list[NodePackage], prefix: str, lang: str, rules: Mapping[str, Any] | None,
+def plan_fragment(nodes: list[NodePackage], prefix: str, lang: str, rules: Mapping[str, TopicRule] | None,
                   env: Any, marker: str) -> dict[str, str]:
     """``{path: text}`` of ``rclverify_plan.yaml`` and ``rclverify_mapping.yaml`` for the generated
     ``nodes``; ``prefix`` is the output directory relative to the workspace (``gen``)."""
@@ -36,8 +36,8 @@ def plan_fragment(nodes: list[NodePackage], prefix: str, lang: str, rules: Mappi
             "rclverify_mapping.yaml": env.get_template("plan_mapping.yaml.j2").render(ctx).rstrip("\n") + "\n"}
 
 
-def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
-                  ) -> tuple[dict[str, Any], list[dict[str, str]]]:
+def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, TopicRule] | None
+                  ) -> tuple[dict[str, str | dict[str, str]], list[dict[str, str]]]:
     """What the generated mapping says of each topic of ``nodes``: ``(topics,
     omitted)``.  ``topics`` maps a topic to the one field path its variables
     read (a string), or, when variables of different names share the topic,
@@ -78,7 +78,7 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, Any] | None
                 f"to the hand-written logic; to monitor it, name each variable's field in "
                 f"backends/monitors/mapping.yaml ('{topic}: {{fields: {{x: [<field>], y: [<field>]}}}}', "
                 f"docs/monitors.md \"One topic, several variables\")")})
-    topics: dict[str, Any] = {}
+    topics: dict[str, str | dict[str, str]] = {}
     for topic, by_name in per.items():
         topics[topic] = next(iter(by_name.values())) if len(by_name) == 1 else dict(sorted(by_name.items()))
     return topics, sorted(omitted, key=lambda o: (o["topic"], o["var"]))

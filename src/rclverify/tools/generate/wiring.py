@@ -15,12 +15,12 @@ generator).  The field is
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.tools.generate.interfaces import is_standard
 from rclverify.tools.generate.nodes import NodePackage
 from rclverify.targets.names import field_name
-from rclverify.traces.mapping import rule_for
+from rclverify.traces.mapping import TopicRule, rule_for
 
 #: std_msgs messages holding one value in field ``data``
 STD_DATA = frozenset({"Bool", "Byte", "Char", "Float32", "Float64", "Int8", "Int16", "Int32", "Int64", "UInt8",
@@ -56,7 +56,7 @@ class Wire:
         return self.var.split(".", 1)[1]
 
 
-def _path(ros_type: str, var: str, topic: str, rules: Mapping[str, Any]) -> str:
+def _path(ros_type: str, var: str, topic: str, rules: Mapping[str, TopicRule]) -> str:
     pkg, cls = ros_type.split("/")[0], ros_type.split("/")[-1]
     if not is_standard(ros_type):
         return field_name(var.split(".", 1)[1])
@@ -66,7 +66,7 @@ def _path(ros_type: str, var: str, topic: str, rules: Mapping[str, Any]) -> str:
     return fields[0] if len(fields) == 1 else ""
 
 
-def wires(np: NodePackage, rules: Mapping[str, Any] | None = None) -> list[Wire]:
+def wires(np: NodePackage, rules: Mapping[str, TopicRule] | None = None) -> list[Wire]:
     """Every variable the node's ends carry, in end order.  ``rules``: the monitors' mapping
     rules by topic (``traces.mapping.TopicRule``), used for standard types only."""
     rules = rules or {}

@@ -22,7 +22,7 @@ import shutil
 import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Mapping
 
 import jinja2
 import yaml
@@ -37,6 +37,7 @@ from rclverify.tools.generate.cpp import cpp_package
 from rclverify.tools.generate.nodes import QOS_DEPTH, NodePackage, node_packages
 from rclverify.tools.generate.planfrag import plan_fragment
 from rclverify.targets.python.carry import carried, evaluator_text
+from rclverify.traces.mapping import TopicRule
 from rclverify.tools.generate.wiring import wires
 from rclverify.tools.generate.namecheck import check_names, short_name
 from rclverify.targets.typemap import camel, snake
@@ -91,7 +92,7 @@ class Result:
 
 
 def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = None, lang: str = "python",
-                rules: Mapping[str, Any] | None = None,
+                rules: Mapping[str, TopicRule] | None = None,
                 tolerance: Tolerance | None = None,
                 prefix: str = ".") -> tuple[dict[str, str], dict[str, str], dict[str, list[str]]]:
     """The generated tree of ``checked`` for system ``system`` (a ROS package name prefix).
@@ -209,7 +210,7 @@ def _is_generated(text: str) -> bool:
 
 
 def write_tree(out: Path, checked: Checked, system: str, sources: dict[str, str] | None = None,
-               lang: str = "python", rules: Mapping[str, Any] | None = None,
+               lang: str = "python", rules: Mapping[str, TopicRule] | None = None,
                tolerance: Tolerance | None = None, prefix: str = ".") -> Result:
     """Write the tree of :func:`render_tree` under ``out``; see :class:`Result`.
 

@@ -32,6 +32,7 @@ from rclverify.tools.lsp.diagnostics import utf16_col
 from rclverify.tools.lsp.lastrun import LastRun
 from rclverify.tools.lsp.lines import eol_of, for_parser, split_lines, with_eol
 from rclverify.tools.lsp.rpc import Failed
+from rclverify.records.sarif import SarifFix
 from rclverify.tools.lsp.workspace import LspWorkspace, Outside
 from rclverify.lang.printer import context_to_rcl, node_to_rcl
 from rclverify.tools.lsp.diagnostics import MAX_CHARS
@@ -54,7 +55,7 @@ def _pos(lines: list[str], line: int, col: int) -> lsp.Position:
     return lsp.Position(k, utf16_col(lines[k] if lines else "", col - 1))
 
 
-def fix_edit(ws: LspWorkspace, open_docs: Mapping[str, str], fix: Mapping[str, Any]) -> lsp.WorkspaceEdit | None:
+def fix_edit(ws: LspWorkspace, open_docs: Mapping[str, str], fix: SarifFix) -> lsp.WorkspaceEdit | None:
     """The workspace edit of one SARIF ``fix`` (§3.55) whose artifact paths
     are root-relative; ``None`` when a file it edits is outside the
     workspace, unreadable, or its text is not the one the run checked."""
@@ -93,7 +94,8 @@ def quick_fixes(ws: LspWorkspace, open_docs: Mapping[str, str], rel: str,
         if f.file != rel or not lo <= f.line <= hi:
             continue
         for fix in f.fixes:
-            desc = str((fix.get("description") or {}).get("text", "repair"))
+            described = fix.get("description")
+            desc = str(described.get("text", "repair") if described else "repair")
             if desc in seen:
                 continue
             edit = fix_edit(ws, open_docs, fix)

@@ -17,12 +17,13 @@ contract parts are shown alone.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Mapping
 
 import jinja2
 from lsprotocol import types as lsp
 
 from rclverify.lang import ast
+from rclverify.records.report_schema import GuaranteeRow, NodeRow, Report
 from rclverify.tools.lsp.diagnostics import Analysis
 from rclverify.tools.lsp.index import Symbol, all_nodes, declarations
 from rclverify.lang.printer import node_to_rcl, type_to_rcl
@@ -31,14 +32,14 @@ _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.tools.lsp", "te
                           keep_trailing_newline=False, undefined=jinja2.StrictUndefined)
 
 
-def _report_node(report: Mapping[str, Any] | None, name: str) -> Mapping[str, Any]:
-    for n in (report or {}).get("nodes", ()):
+def _report_node(report: Report | None, name: str) -> NodeRow | None:
+    for n in report.get("nodes", ()) if report else ():
         if isinstance(n, Mapping) and n.get("name") == name:
             return n
-    return {}
+    return None
 
 
-def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> str | None:
+def hover_text(a: Analysis, sym: Symbol, report: Report | None) -> str | None:
     """The Markdown hover of ``sym`` in the analysis ``a`` with the last
     ``report`` (``None``: no last run); ``None`` when there is nothing to say."""
     nodes = all_nodes(a)
@@ -46,9 +47,10 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
     if sym.kind == "node" and sym.name in nodes:
         rn = _report_node(report, sym.name)
         model = a.model
-        return t.render(kind="node", name=sym.name, status=rn.get("status"), culprit_of=rn.get("culprit_of") or [],
+        return t.render(kind="node", name=sym.name, status=rn.get("status") if rn else None,
+                        culprit_of=(rn.get("culprit_of") if rn else None) or [],
                         contract=node_to_rcl(nodes[sym.name]).rstrip(),
-                        guarantees=rn.get("guarantees") or [],
+                        guarantees=(rn.get("guarantees") if rn else None) or [],
                         producers=model.producers(sym.name) if model else [],
                         consumers=model.consumers(sym.name) if model else [])
     if sym.kind == "io" and sym.node in nodes:
@@ -71,23 +73,25 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
         if not 1 <= sym.index <= len(n.guarantees):
             return None
         from rclverify.lang.printer import expr_to_rcl  # deferred: optional or conditional (inside a block)
-        g: Mapping[str, Any] = next((x for x in _report_node(report, sym.node).get("guarantees") or ()
-                                     if x.get("index") == sym.index), {})
-        obligations = [o for o in (report or {}).get("obligations", ())
+        rn = _report_node(report, sym.node)
+        g: GuaranteeRow | None = next((x for x in (rn.get("guarantees") if rn else None) or ()
+                                       if x.get("index") == sym.index), None)
+        obligations = [o for o in (report.get("obligations", ()) if report else ())
                        if o.get("node") == sym.node and o.get("guarantee") == sym.index]
-        findings = [f for f in (report or {}).get("findings", ())
+        findings = [f for f in (report.get("findings", ()) if report else ())
                     if f.get("node") == sym.node and f.get("guarantee") == sym.index]
-        return t.render(kind="guarantee", node=sym.node, index=sym.index, status=g.get("status"),
-                        culprit_of=g.get("culprit_of") or [],
+        return t.render(kind="guarantee", node=sym.node, index=sym.index, status=g.get("status") if g else None,
+                        culprit_of=(g.get("culprit_of") if g else None) or [],
                         text=expr_to_rcl(n.guarantees[sym.index - 1].formula), obligations=obligations, findings=findings)
     if sym.kind == "requirement":
-        r = next((x for x in (report or {}).get("requirements", ()) if x.get("id") == sym.name), None)
+        r = next((x for x in (report.get("requirements", ()) if report else ()) if x.get("id") == sym.name), None)
         req = next((x for x in (a.plan.requirements if a.plan else ()) if x.id == sym.name), None)
         if r is None and req is None:
             return None
-        check = (r or {}).get("check") or {}
-        return t.render(kind="requirement", name=sym.name, verdict=(r or {}).get("verdict"), status=(r or {}).get("status"),
-                        text=(r or {}).get("text") or (req.text if req else ""), used=check.get("used") or [])
+        check = (r.get("check") if r else None) or {}
+        return t.render(kind="requirement", name=sym.name, verdict=r.get("verdict") if r else None,
+                        status=r.get("status") if r else None,
+                        text=(r.get("text") if r else None) or (req.text if req else ""), used=check.get("used") or [])
     if sym.kind == "decl":
         found = declarations(a).get(sym.name)
         if found is None:
@@ -102,7 +106,7 @@ def hover_text(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> st
     return None
 
 
-def hover(a: Analysis, sym: Symbol, report: Mapping[str, Any] | None) -> lsp.Hover | None:
+def hover(a: Analysis, sym: Symbol, report: Report | None) -> lsp.Hover | None:
     """The LSP hover of ``sym`` (see :func:`hover_text`)."""
     text = hover_text(a, sym, report)
     if text is None:

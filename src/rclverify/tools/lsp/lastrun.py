@@ -20,13 +20,15 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import cast
 
 from lsprotocol import types as lsp
 
 from rclverify.lang.errors import RclError
+from rclverify.records.report_schema import Report
 from rclverify.tools.lsp.diagnostics import utf16_col
 from rclverify.tools.lsp.lines import split_lines
+from rclverify.records.sarif import SarifFix
 
 SARIF = "reports/assurance.sarif"
 REPORT = "reports/assurance.json"
@@ -47,7 +49,7 @@ class Finding:
     rule: str
     level: str
     message: str
-    fixes: tuple[dict[str, Any], ...]
+    fixes: tuple[SarifFix, ...]
 
 
 def _stamp(p: Path) -> float | None:
@@ -63,7 +65,7 @@ class LastRun:
     def __init__(self, root: Path) -> None:
         self.root = root
         self._sarif: tuple[float | None, list[Finding]] = (None, [])
-        self._report: tuple[float | None, dict[str, Any] | None] = (None, None)
+        self._report: tuple[float | None, Report | None] = (None, None)
 
     def findings(self) -> list[Finding]:
         """Every located result of the SARIF log; ``[]`` without a readable one."""
@@ -76,14 +78,15 @@ class LastRun:
         """When the SARIF log was written (``None``: no last run)."""
         return _stamp(self.root / SARIF)
 
-    def report(self) -> dict[str, Any] | None:
-        """The report dict of the last run, ``None`` when there is none or it
-        is not of the report's shape."""
+    def report(self) -> Report | None:
+        """The report dict of the last run (its shape checked by
+        :func:`rclverify.report.lastrun.read_report`), ``None`` when there is
+        none or it is not of the report's shape."""
         stamp = _stamp(self.root / REPORT)
         if stamp != self._report[0]:
             from rclverify.report.lastrun import read_report  # deferred: optional or conditional (inside a block)
             try:
-                rep: dict[str, Any] | None = read_report(self.root)
+                rep: Report | None = cast(Report, read_report(self.root))  # shape-checked as it is read
             except RclError:
                 rep = None
             self._report = (stamp, rep)
@@ -131,9 +134,10 @@ def _read_sarif(path: Path) -> list[Finding]:
         try:
             phys = r["locations"][0]["physicalLocation"]
             region = phys.get("region") or {}
+            fixes = tuple(cast(SarifFix, x) for x in r.get("fixes") or () if isinstance(x, dict))
             out.append(Finding(str(phys["artifactLocation"]["uri"]), int(region.get("startLine", 1)),
                                int(region.get("startColumn", 1)), str(r["ruleId"]), str(r.get("level", "warning")),
-                               str(r["message"]["text"]), tuple(x for x in r.get("fixes") or () if isinstance(x, dict))))
+                               str(r["message"]["text"]), fixes))
         except (KeyError, IndexError, TypeError, ValueError):
             continue
     return out

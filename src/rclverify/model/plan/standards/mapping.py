@@ -9,9 +9,10 @@ The mapping is a traceability aid for an assessor, not a compliance claim.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, TypedDict
+from typing import Mapping, Sequence, TypedDict
 
 from rclverify.model.plan.standards.profiles import Profile
+from rclverify.records.report_schema import EvidenceRow
 
 #: (evidence row field, its value) -> the profile evidence kind it supports.  ``kind`` is the
 #: record's kind (each backend's ``kind``: hoare and dafny "proof", ajpf "model checking",
@@ -50,14 +51,14 @@ class ClauseRow(TypedDict):
     status: str
 
 
-def kinds_of(row: Mapping[str, Any]) -> set[str]:
+def kinds_of(row: EvidenceRow) -> set[str]:
     """The profile evidence kinds the evidence ``row`` (a report ``evidence[]`` row) supports, by :data:`SUPPORTS`."""
     strength = row.get("strength")
     values = {"kind": row.get("kind"), "strength": strength.get("kind") if isinstance(strength, Mapping) else None}
     return {kind for (field, value), kind in SUPPORTS.items() if values[field] == value}
 
 
-def clause_rows(profile: Profile, level: str | None, evidence: Sequence[Mapping[str, Any]]) -> list[ClauseRow]:
+def clause_rows(profile: Profile, level: str | None, evidence: Sequence[EvidenceRow]) -> list[ClauseRow]:
     """The clause rows of ``profile`` at ``level`` (``None`` for a profile
     without levels) over the report's ``evidence`` rows (each with
     ``obligation``, ``backend``, ``kind``, ``status`` and optionally

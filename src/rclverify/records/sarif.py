@@ -1,0 +1,127 @@
+"""The SARIF 2.1.0 objects rclverify writes and reads, as types: one TypedDict per object.
+
+``reports/assurance.sarif`` is written by :mod:`rclverify.report.sarif`; a
+result's ``fixes`` are the checked repairs :func:`rclverify.diagnosis.edits.sarif_fix`
+writes; the language server reads the fixes back (:mod:`rclverify.tools.lsp`).
+Sections (§) are those of the OASIS SARIF 2.1.0 standard.  A key written
+only in some cases is ``NotRequired``; a value only passed on to JSON (a
+result's ``properties``) is ``object``.
+"""
+# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
+# annotations (with string annotations every key would count as required).
+from typing import NotRequired, TypedDict
+
+
+class SarifText(TypedDict):
+    """A ``message`` (§3.11) or an inserted ``artifactContent`` (§3.3): plain text."""
+    text: str
+
+
+class SarifArtifactLocation(TypedDict):
+    """A file relative to the workspace root (§3.4); ``uriBaseId`` in the log's locations, not in a fix."""
+    uri: str
+    uriBaseId: NotRequired[str]
+
+
+class SarifRegion(TypedDict):
+    """A place in a file (§3.30): 1-based line, the column when known; a fix's deleted region has its end."""
+    startLine: int
+    startColumn: NotRequired[int]
+    endLine: NotRequired[int]
+    endColumn: NotRequired[int]
+
+
+class SarifReplacement(TypedDict):
+    """The region deleted and the text inserted in its place (§3.57)."""
+    deletedRegion: SarifRegion
+    insertedContent: SarifText
+
+
+class SarifArtifactChange(TypedDict):
+    """The replacements in one file (§3.56)."""
+    artifactLocation: SarifArtifactLocation
+    replacements: NotRequired[list[SarifReplacement]]
+
+
+class SarifFix(TypedDict):
+    """One fix (§3.55): its ``description`` and the changes to each file."""
+    description: NotRequired[SarifText]
+    artifactChanges: NotRequired[list[SarifArtifactChange]]
+
+
+class SarifPhysicalLocation(TypedDict):
+    """A file and a place in it (§3.29)."""
+    artifactLocation: SarifArtifactLocation
+    region: SarifRegion
+
+
+class SarifLocation(TypedDict):
+    """A result's location (§3.28); ``id`` and ``message`` only for a related location."""
+    physicalLocation: SarifPhysicalLocation
+    id: NotRequired[int]
+    message: NotRequired[SarifText]
+
+
+class SarifSuppression(TypedDict):
+    """A plan acknowledgement of a result (§3.35): ``kind`` external, ``status`` accepted."""
+    kind: str
+    status: str
+    justification: str
+    location: NotRequired[SarifLocation]
+
+
+class SarifResult(TypedDict):
+    """One ``result`` (§3.27); ``partialFingerprints`` holds the item's stable key,
+    ``properties`` the item's fields (JSON values, only written), ``fixes`` the checked repairs."""
+    ruleId: str
+    level: str
+    message: SarifText
+    locations: list[SarifLocation]
+    partialFingerprints: dict[str, str]
+    properties: dict[str, object]
+    relatedLocations: NotRequired[list[SarifLocation]]
+    suppressions: NotRequired[list[SarifSuppression]]
+    fixes: NotRequired[list[SarifFix]]
+    ruleIndex: NotRequired[int]
+
+
+class SarifLevel(TypedDict):
+    """A rule's ``defaultConfiguration`` (§3.50)."""
+    level: str
+
+
+class SarifDescriptor(TypedDict):
+    """A rule as the driver lists it (§3.49, ``reportingDescriptor``)."""
+    id: str
+    name: str
+    shortDescription: SarifText
+    defaultConfiguration: SarifLevel
+
+
+class SarifDriver(TypedDict):
+    """The tool that made the log (§3.19): rclverify, its version and every rule it may report."""
+    name: str
+    version: str
+    rules: list[SarifDescriptor]
+
+
+class SarifTool(TypedDict):
+    """A run's ``tool`` (§3.18)."""
+    driver: SarifDriver
+
+
+class SarifRun(TypedDict):
+    """The one run of the log (§3.14); ``properties`` the report's workspace, plan, status and gate."""
+    tool: SarifTool
+    originalUriBaseIds: dict[str, object]
+    columnKind: str
+    results: list[SarifResult]
+    properties: dict[str, object]
+
+
+#: ``reports/assurance.sarif`` (§3.13): the schema, the version and one run.
+SarifLog = TypedDict("SarifLog", {"$schema": str, "version": str, "runs": list[SarifRun]})
+
+__all__ = ["SarifArtifactChange", "SarifArtifactLocation", "SarifDescriptor", "SarifDriver", "SarifFix", "SarifLevel",
+           "SarifLocation", "SarifLog", "SarifPhysicalLocation", "SarifRegion", "SarifReplacement", "SarifResult",
+           "SarifRun", "SarifSuppression", "SarifText", "SarifTool"]
