@@ -49,6 +49,11 @@ def _time(label: str, n: int, run: Callable[[dict[str, Any]], Any], rows: list[d
 
 def main() -> None:
     arg = sys.argv[1] if len(sys.argv) > 1 else "20000"
+    if arg in ("-h", "--help"):
+        print(__doc__)
+        return
+    if arg != "--smoke" and not arg.isdigit():
+        sys.exit(f"formula_core: N must be a whole number of evaluations, or --smoke (got {arg!r}); see --help")
     n = 200 if arg == "--smoke" else int(arg)
     spec = parse_text(SPEC, "bench.rcl")
     checked = check([spec])

@@ -98,8 +98,8 @@ def release_in_order() -> None:
     order they started in was that of the objects' hashes (their memory
     addresses): a run sometimes began with the requirements and one node's
     long health checks on the two processes while the quick ``node`` tasks,
-    which the evidence tasks are created after, waited 5 s (docs/scale.md,
-    "Round nine").  Installed once per process (idempotent); with a doit
+    which the evidence tasks are created after, waited 5 s (CHANGELOG.md,
+    "Speed round nine").  Installed once per process (idempotent); with a doit
     whose ``ExecNode`` does not start with an empty set there, nothing is
     changed (docs/decisions.md, "Where rclverify reaches into doit")."""
     from doit.control import ExecNode  # deferred: start-up (loads doit only when called)

@@ -4,7 +4,7 @@
 as many processes as this process has CPUs (:func:`rclverify.core.cpus.allowed_cpus`),
 at most :data:`MAX_DEFAULT`: on the 2-core machines of the benches the case
 study's cold run took 23.9 s serially and 14.2 s in two processes, for the
-same CPU seconds (21.5 and 21.3; docs/scale.md, "Round eight").  The
+same CPU seconds (21.5 and 21.3; docs/scale.md, "Standing decisions").  The
 verdicts and reports do not depend on the number of processes (each stage
 starts from a fresh Z3 context and writes its own records;
 ``tests/test_pipeline_e2e.py`` holds a parallel run against the serial one).

@@ -6,8 +6,8 @@ before they sleep.  rclverify's arrays are elementwise (monitor columns,
 trace blocks, the statistics of recorded runs) and make no BLAS call, so
 those threads only spend CPU.  Measured on a 2-core machine (CPU seconds
 of a process that only imports): ``import numpy`` 0.33 -> 0.24, ``from
-scipy.special import betaincinv`` 0.70 -> 0.51 (docs/scale.md, round
-sixteen).
+scipy.special import betaincinv`` 0.70 -> 0.51 (docs/scale.md,
+"Start-up").
 
 OpenBLAS reads ``OPENBLAS_NUM_THREADS`` once, when it loads (OpenBLAS's
 documentation, "Setting the number of threads using environment

@@ -126,7 +126,7 @@ def solver_session() -> Iterator[None]:
 
     A fresh ``z3.Solver()`` costs about 1.5 ms of set-up and tear-down,
     more than most queries of a contract take to solve; a scope of an
-    incremental solver costs about 0.25 ms (docs/scale.md, sixth round).
+    incremental solver costs about 0.25 ms.
     The solver is Z3's incremental SMT core (``z3.SimpleSolver``, the
     engine ``z3.Solver()`` itself switches to once a scope is pushed) with
     unsat cores enabled.  A popped scope leaves no assertion behind, so

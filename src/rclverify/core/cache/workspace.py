@@ -190,7 +190,7 @@ def save_in_background(ws: Any) -> None:
     """:func:`save` in a forked child process, so that pickling the parsed
     contracts (0.3 s for 1000 nodes, on every run after an edit) overlaps
     with the rest of the run instead of delaying its first task
-    (docs/scale.md, seventh round).  The process that forked waits for the
+    (docs/scale.md, "What is kept between runs").  The process that forked waits for the
     child before it exits, and :func:`restore` first waits for it, so a
     run's cache is complete when the run ends, as with :func:`save`.
     Saves in this process where ``fork`` is missing or other threads run
