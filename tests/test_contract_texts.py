@@ -1,4 +1,4 @@
-"""The texts kept per contract file (report/contract_texts.py): the same with the
+"""The texts kept per contract file (stages/contract_texts.py): the same with the
 cache as without it, made again for an edited file, and a bad cache file is
 an empty cache."""
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import pickle
 from pathlib import Path
 
-from rclverify.report.contract_texts import CACHE, ContractTexts, lint_json, node_texts
+from rclverify.stages.contract_texts import CACHE, ContractTexts, lint_json, node_texts
 from rclverify.app.pipeline import Workspace
 
 RCL = """node A {

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from rclverify.calculus.compose import compose_node
 from rclverify.calculus.scale import _range, scale_findings, scale_power
 from rclverify.cli.commands import main
-from rclverify.report.contract_texts import node_texts
+from rclverify.stages.contract_texts import node_texts
 from rclverify.lang.errors import RclError
 from rclverify.lang.latex import to_latex
 from rclverify.lang.parser import parse_text

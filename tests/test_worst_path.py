@@ -128,7 +128,7 @@ def test_an_edit_off_the_named_path_makes_the_recorded_deadline_stale(tmp_path) 
     slower hop off the named path refutes the deadline, so a proof recorded before the edit must read
     ``stale`` in a report made without the stage (it read ``proved``)."""
     from rclverify.stages.deadlines import read_deadlines
-    from rclverify.report.contract_texts import ContractTexts
+    from rclverify.stages.contract_texts import ContractTexts
     from rclverify.app.pipeline import stage_check, stage_deadlines
     from rclverify.stages.workspace import Workspace, current_snapshot_hashes
     (tmp_path / "contracts").mkdir()

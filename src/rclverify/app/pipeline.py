@@ -60,7 +60,7 @@ def stage_check(ws: Workspace) -> CheckRecord:
 
     Returns the diagnostics JSON (lint warnings).  Raises RclError/PlanError.
     """
-    from rclverify.report.contract_texts import ContractTexts  # deferred: start-up (loads rclverify.core.cache, rclverify.lang.ast and more only when called)
+    from rclverify.stages.contract_texts import ContractTexts  # deferred: start-up (loads rclverify.core.cache, rclverify.lang.ast and more only when called)
     checked, model = ws.checked, ws.model
     texts = ContractTexts(ws)  # each file's lint and each node's RCL text, kept by the file's sha256
     warnings = [w for s in checked.specs for w in texts.lint(s)]

@@ -31,7 +31,7 @@ from rclverify.records.report_schema import Report
 from rclverify.report import assemble
 from rclverify.report.confidence_rows import confidence_part
 from rclverify.report.contract_rows import GuaranteeStatuses, contract_records, derived_rows, involved_model, node_part
-from rclverify.report.contract_texts import ContractTexts
+from rclverify.stages.contract_texts import ContractTexts
 from rclverify.report.culprits import marked_nodes
 from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
 from rclverify.report.evidence_rows import evidence_part

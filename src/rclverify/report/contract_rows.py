@@ -23,7 +23,7 @@ from rclverify.records.report_schema import DerivedPropertyRow, GuaranteeRow, No
 from rclverify.records.statuses import EvidenceStatus, HealthStatus
 from rclverify.report.cex_cone import side_condition_view
 from rclverify.report.cones import DERIVATION, ConeEvidence
-from rclverify.report.contract_texts import ContractTexts
+from rclverify.stages.contract_texts import ContractTexts
 from rclverify.report.records import node_records
 from rclverify.stages.crosscheck.apply import SecondSolver
 from rclverify.stages.workspace import Workspace

@@ -17,7 +17,7 @@ from rclverify.records.records import worst
 from rclverify.records.report_schema import RequirementRow, SupportRow
 from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters
 from rclverify.report.contract_rows import GuaranteeStatuses
-from rclverify.report.contract_texts import ContractTexts
+from rclverify.stages.contract_texts import ContractTexts
 from rclverify.stages.workspace import Workspace
 
 #: The fields of a requirement's check record (calculus/requirements/check.py) the report carries.

@@ -301,18 +301,3 @@ class ArgumentJson(TypedDict):
     elements: list[ElementJson]
 
 
-class NodeTexts(TypedDict):
-    """The texts of one node (report/contract_texts.py ``node_texts``): its RCL and LaTeX, its ports as
-    ``[name, type with unit]`` and its assumptions and guarantees as ``[formula, "file:line:col"]``."""
-    rcl: str
-    latex: str
-    inputs: list[list[str]]
-    outputs: list[list[str]]
-    assumptions: list[list[str]]
-    guarantees: list[list[str]]
-
-
-class FileTexts(TypedDict):
-    """One contract file's kept texts: node name -> :class:`NodeTexts`, and its lint warnings' JSON once made."""
-    nodes: dict[str, NodeTexts]
-    lint: NotRequired[list[dict[str, Any]]]

@@ -3,7 +3,7 @@ what is derived from them without running a stage.
 
 Below the stages and the report: :mod:`rclverify.app.pipeline` (the stages),
 :mod:`rclverify.report` (the roll-up), :mod:`rclverify.core.cache.workspace` and
-:mod:`rclverify.report.contract_texts` (kept between runs) all read a
+:mod:`rclverify.stages.contract_texts` (kept between runs) all read a
 :class:`Workspace`; this module imports none of them (the layers of
 ``tests/test_layers.py``).  It holds:
 
@@ -280,7 +280,7 @@ def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:
     ``stage_check`` writes them (``artifacts/contracts/<Node>.json``); the
     report recomputes them from the current files to find evidence produced
     from another contract text (:func:`current_snapshot_hashes`).  ``texts``
-    is the run's :class:`~rclverify.report.contract_texts.ContractTexts` (the caller's: it
+    is the run's :class:`~rclverify.stages.contract_texts.ContractTexts` (the caller's: it
     sits above this module).
     Raises RclError/PlanError for contracts or a plan that do not check."""
     from rclverify.lang import ast  # deferred: start-up (loads rclverify.lang.ast, fractions only when called)

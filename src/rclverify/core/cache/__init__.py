@@ -14,7 +14,7 @@ file                                   kind                 keyed by
                                                             what each plan path resolves to
                                                             (:mod:`.workspace`)
 ``contract-texts.pickle``              ``contract-texts``   sha256 of each contract file's parsed text
-                                                            (:mod:`rclverify.report.contract_texts`)
+                                                            (:mod:`rclverify.stages.contract_texts`)
 ``report-fragments.<part>.pickle``     ``report-fragments`` fingerprint of the data a piece shows
                                                             (:mod:`rclverify.report.fragments`)
 ``layout/<key>.svg``                   ``layout``           the DOT text and the ``dot`` program

@@ -1,7 +1,7 @@
 """Texts made from each contract file's syntax tree, kept between runs.
 
-The check stage and the report print every node of the system again on
-every run: its RCL text (the snapshot), the RCL text of each assumption and
+Every node of the system is printed by the check stage (and by the report
+for what the check stage did not keep): its RCL text (the snapshot), the RCL text of each assumption and
 guarantee, its LaTeX, and each file's lint warnings.  For a 1000-node
 system that was 0.2 s of the check task and 0.2-0.3 s of each report task
 after a one-contract edit (docs/scale.md, "What is kept between runs"), although only the
@@ -17,20 +17,36 @@ file; the report tasks, which run after it, only read it and make what it
 lacks.  A damaged, missing or foreign file is an empty cache; the texts are
 the same with or without it (``tests/test_contract_texts.py``).
 """
-from __future__ import annotations
-
+# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
+# annotations (the TypedDicts below).
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NotRequired, TypedDict
 
 from rclverify.core.cache import Shelf
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl, to_rcl, type_to_rcl, unit_to_rcl
-from rclverify.report.shapes import FileTexts, NodeTexts
 
 if TYPE_CHECKING:
     from rclverify.stages.workspace import Workspace
 
 CACHE = "artifacts/cache/contract-texts.pickle"
+
+
+class NodeTexts(TypedDict):
+    """The texts of one node (stages/contract_texts.py ``node_texts``): its RCL and LaTeX, its ports as
+    ``[name, type with unit]`` and its assumptions and guarantees as ``[formula, "file:line:col"]``."""
+    rcl: str
+    latex: str
+    inputs: list[list[str]]
+    outputs: list[list[str]]
+    assumptions: list[list[str]]
+    guarantees: list[list[str]]
+
+
+class FileTexts(TypedDict):
+    """One contract file's kept texts: node name -> :class:`NodeTexts`, and its lint warnings' JSON once made."""
+    nodes: dict[str, NodeTexts]
+    lint: NotRequired[list[dict[str, Any]]]
 
 
 def node_texts(node: ast.Node) -> NodeTexts:
