@@ -261,7 +261,7 @@ async def test_a_quick_fix_inserts_the_documents_line_end(client: LanguageClient
     the run's own producer of it): a run of the pipeline offers no repair of two lines to test with."""
     import json
 
-    from rclverify.diagnosis.edits import sarif_fix
+    from rclverify.records.sarif import sarif_fix
     rel = "contracts/c.rcl"
     lf = CONTRACT.replace("Driver", "Third").replace("Brake", "Stop")
     text = lf.replace("\n", "\r\n")

@@ -42,7 +42,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.diagnosis import realize, recheck
 from rclverify.diagnosis.bounds import FLIP, bound_literals, thresholds, value
 from rclverify.diagnosis.edits import Edit
-from rclverify.diagnosis.links import link_pairs
+from rclverify.records.links import link_pairs
 from rclverify.diagnosis.shapes import ReportRows, Strengthening
 from rclverify.records.report_schema import SideConditionRow
 from rclverify.diagnosis.repairs import _numbers, _peel, _rename

@@ -47,7 +47,7 @@ from rclverify.diagnosis.deadline import budget_repairs, deadline_record
 from rclverify.diagnosis.requirement import requirement_record
 from rclverify.diagnosis.sidecond import side_condition_repairs
 from rclverify.diagnosis.culprits import culprits, parse_core, plan_facts
-from rclverify.diagnosis.links import link_pairs
+from rclverify.records.links import link_pairs
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
 from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows

@@ -6,7 +6,6 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass
 
-from rclverify.records.sarif import SarifFix
 from rclverify.records.stage_records import EditJson
 
 
@@ -48,16 +47,3 @@ class Edit:
     def to_json(self, source: str) -> EditJson:
         return {"file": self.file, "line": self.line, "col": self.col, "end_line": self.end_line,
                 "end_col": self.end_col, "inserted": self.text, "deleted": self.deleted(source)}
-
-
-def sarif_fix(description: str, edit: EditJson) -> SarifFix:
-    """A SARIF 2.1.0 ``fix`` object (§3.55) for an edit in its JSON form
-    (:meth:`Edit.to_json`): one ``artifactChange`` (§3.56) with one
-    ``replacement`` (§3.57)."""
-    return {"description": {"text": description},
-            "artifactChanges": [{
-                "artifactLocation": {"uri": edit["file"]},
-                "replacements": [{
-                    "deletedRegion": {"startLine": edit["line"], "startColumn": edit["col"],
-                                      "endLine": edit["end_line"], "endColumn": edit["end_col"]},
-                    "insertedContent": {"text": edit["inserted"]}}]}]}

@@ -57,7 +57,7 @@ from rclverify.lang.walk import subexpressions
 from rclverify.diagnosis import realize, recheck
 from rclverify.diagnosis.bounds import coefficient_literals, number_text, power_of_ten, value
 from rclverify.diagnosis.edits import Edit
-from rclverify.diagnosis.links import link_pairs
+from rclverify.records.links import link_pairs
 from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, _record, _rename
 from rclverify.diagnosis.shapes import SideConditionRepairs
 from rclverify.records.report_schema import SideConditionRow

@@ -28,7 +28,7 @@ from rclverify.lang.units import Unit, ratio
 from rclverify.model.system.units import Mismatch, mismatches
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
-from rclverify.diagnosis.links import link_pairs
+from rclverify.records.links import link_pairs
 from rclverify.diagnosis.repairs import _record
 from rclverify.lang.printer import level, expr_to_rcl
 from rclverify.lang import ast

@@ -1,7 +1,7 @@
 """The SARIF 2.1.0 objects rclverify writes and reads, as types: one TypedDict per object.
 
 ``reports/assurance.sarif`` is written by :mod:`rclverify.report.sarif`; a
-result's ``fixes`` are the checked repairs :func:`rclverify.diagnosis.edits.sarif_fix`
+result's ``fixes`` are the checked repairs :func:`sarif_fix`
 writes; the language server reads the fixes back (:mod:`rclverify.tools.lsp`).
 Sections (§) are those of the OASIS SARIF 2.1.0 standard.  A key written
 only in some cases is ``NotRequired``; a value only passed on to JSON (a
@@ -10,6 +10,8 @@ result's ``properties``) is ``object``.
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
 from typing import NotRequired, TypedDict
+
+from rclverify.records.stage_records import EditJson
 
 
 class SarifText(TypedDict):
@@ -122,6 +124,20 @@ class SarifRun(TypedDict):
 #: ``reports/assurance.sarif`` (§3.13): the schema, the version and one run.
 SarifLog = TypedDict("SarifLog", {"$schema": str, "version": str, "runs": list[SarifRun]})
 
+
+def sarif_fix(description: str, edit: EditJson) -> SarifFix:
+    """A SARIF 2.1.0 ``fix`` object (§3.55) for an edit in its JSON form
+    (:meth:`rclverify.diagnosis.edits.Edit.to_json`): one ``artifactChange`` (§3.56) with one
+    ``replacement`` (§3.57)."""
+    return {"description": {"text": description},
+            "artifactChanges": [{
+                "artifactLocation": {"uri": edit["file"]},
+                "replacements": [{
+                    "deletedRegion": {"startLine": edit["line"], "startColumn": edit["col"],
+                                      "endLine": edit["end_line"], "endColumn": edit["end_col"]},
+                    "insertedContent": {"text": edit["inserted"]}}]}]}
+
+
 __all__ = ["SarifArtifactChange", "SarifArtifactLocation", "SarifDescriptor", "SarifDriver", "SarifFix", "SarifLevel",
            "SarifLocation", "SarifLog", "SarifPhysicalLocation", "SarifRegion", "SarifReplacement", "SarifResult",
-           "SarifRun", "SarifSuppression", "SarifText", "SarifTool"]
+           "SarifRun", "SarifSuppression", "SarifText", "SarifTool", "sarif_fix"]

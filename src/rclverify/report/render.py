@@ -81,7 +81,7 @@ def _argument(report: Report, rendering: diagram.Rendering | None,
 @last_call  # the HTML report's layout and page both show it
 def _system_dot(report: Report) -> str:
     """The system diagram with the problems' culprit nodes and the failing connections marked."""
-    from rclverify.diagnosis.links import link_pairs  # deferred: start-up (loads rclverify.diagnosis.links only when called)
+    from rclverify.records.links import link_pairs  # deferred: start-up (loads rclverify.records.links only when called)
     failing = {(p, c) for sc in report.get("side_conditions") or () if sc.get("status") in ("failed", "inconclusive", "error")
                for p, _, c, _ in link_pairs(sc)}
     culprits = culprit_nodes(problem_groups(report))

@@ -38,7 +38,7 @@ from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
 from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, FindingRow, LintRow, Report
 from rclverify.report.severity import of
-from rclverify.diagnosis.edits import sarif_fix
+from rclverify.records.sarif import sarif_fix
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
                                      SarifSuppression)
 
