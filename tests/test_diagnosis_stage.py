@@ -149,3 +149,9 @@ def test_the_digest_leaves_out_when_and_how_long_a_run_took() -> None:
                          "started": "2026-11-27T05:17:23+00:00"}], "meta": {"inputs_sha256": {"a.rcl": "ab"}}}
     failed = {**two, "evidence": [{**two["evidence"][0], "status": "failed"}]}
     assert report_digest(one) == report_digest(two) != report_digest(failed)
+    # a timing inside a row's record (a requirement's check) is left out too, and nothing else is
+    req = {"id": "REQ1", "verdict": "met", "check": {"verdict": "proved", "duration_s": 0.4}}
+    slow = {**one, "requirements": [req]}
+    quick = {**one, "requirements": [{**req, "check": {**req["check"], "duration_s": 0.1}}]}
+    refuted = {**one, "requirements": [{**req, "check": {"verdict": "refuted", "duration_s": 0.4}}]}
+    assert report_digest(slow) == report_digest(quick) != report_digest(refuted)

@@ -37,12 +37,21 @@ _RUN = "run `doit verify` or `rclverify report` to explain them again"
 TIMING_KEYS = frozenset({"duration_s", "started"})
 
 
-def _without_timing(value: object) -> object:
-    if isinstance(value, dict):
-        return {k: _without_timing(v) for k, v in value.items() if k not in TIMING_KEYS}
-    if isinstance(value, list):
-        return [_without_timing(v) for v in value]
-    return value
+def _strip(row: Mapping[str, Any]) -> Mapping[str, Any]:
+    """``row`` without :data:`TIMING_KEYS`, in itself and in the mappings it holds (a requirement's
+    ``check``, an evidence row's ``monitoring``); ``row`` itself when it has none (no copy)."""
+    if TIMING_KEYS.isdisjoint(row) and not any(isinstance(v, dict) and not TIMING_KEYS.isdisjoint(v)
+                                               for v in row.values()):
+        return row
+    return {k: ({a: b for a, b in v.items() if a not in TIMING_KEYS} if isinstance(v, dict) else v)
+            for k, v in row.items() if k not in TIMING_KEYS}
+
+
+def _without_timing(report: Mapping[str, Any]) -> dict[str, Any]:
+    """``report`` with :data:`TIMING_KEYS` left out of its rows (each list of rows, and the mappings a
+    row holds: where the report's records keep their timings), copying only the rows that have one."""
+    return {k: [_strip(r) if isinstance(r, dict) else r for r in v] if isinstance(v, list) else v
+            for k, v in report.items()}
 
 
 def report_digest(report: Mapping[str, object]) -> str:
@@ -51,7 +60,7 @@ def report_digest(report: Mapping[str, object]) -> str:
     msgspec (5x faster than the standard library, the same bytes for the
     report's values), by :func:`json.dumps` for a value msgspec does not
     encode.  Raises ``TypeError`` for a value JSON cannot hold."""
-    stable = _without_timing(dict(report))
+    stable = _without_timing(report)
     try:
         data = msgspec.json.encode(stable, order="sorted")
     except (TypeError, msgspec.EncodeError):
