@@ -103,6 +103,31 @@ def _py_types(ann: Any) -> set[str] | None:
     return {str: {"string"}, int: {"integer"}, float: {"number"}, bool: {"boolean"}, type(None): {"null"}}[ann]
 
 
+def _words(ann: Any) -> set[str] | None:
+    """The status words a ``Literal`` annotation (or a union of them, ``None`` aside) allows; ``None``
+    for any other annotation."""
+    parts = [a for a in (typing.get_args(ann) if typing.get_origin(ann) in (typing.Union, types.UnionType)
+                         else (ann,)) if a is not type(None)]
+    if not parts or any(typing.get_origin(a) is not typing.Literal for a in parts):
+        return None
+    return {w for a in parts for w in typing.get_args(a)}
+
+
+def _schema_words(sub: Any) -> set[str] | None:
+    """The words the schema ``sub`` enumerates (``enum``, ``const``, or a union of them; ``null`` aside)."""
+    sub = _resolve(sub)
+    if not isinstance(sub, dict):
+        return None
+    if "const" in sub:
+        return {sub["const"]}
+    if "enum" in sub:
+        return {w for w in sub["enum"] if w is not None}
+    if "anyOf" in sub:
+        parts = [_schema_words(x) for x in sub["anyOf"] if _resolve(x).get("type") != "null"]
+        return None if not parts or any(p is None for p in parts) else set().union(*parts)  # type: ignore[arg-type]
+    return None
+
+
 def _typeddicts_in(ann: Any) -> list[Any]:
     """The TypedDicts ``ann`` holds directly, as itself, a list's item or a member of a union."""
     if typing.is_typeddict(ann):
@@ -137,6 +162,14 @@ def _disagreements(td: Any, sub: Any, where: str) -> list[str]:
         have, want = _py_types(ann), _json_types(props[k])
         if have is not None and want is not None and not have <= want | ({"number"} if "integer" in have else set()):
             out.append(f"{where}.{k}: {sorted(have)} in the TypedDict, {sorted(want)} in the schema")
+        elif have is not None and want is not None and "null" in want and "null" not in have:
+            out.append(f"{where}.{k}: null allowed by the schema only")
+        # status words: a Literal's words are the schema's; a vocabulary of the schema ($defs) is a Literal
+        words, schema_words = _words(ann), _schema_words(props[k])
+        vocabulary = "$ref" in props[k] or any("$ref" in x for x in props[k].get("anyOf", ()))
+        if (words is not None or (vocabulary and schema_words is not None)) and words != schema_words:
+            out.append(f"{where}.{k}: words {sorted(words or ())} in the TypedDict, "
+                       f"{sorted(schema_words or ())} in the schema")
         array = typing.get_origin(ann) is list or any(typing.get_origin(a) is list for a in typing.get_args(ann))
         for inner in _typeddicts_in(ann):
             out += _disagreements(inner, _object_of(props[k], array), f"{where}.{k}")
@@ -160,7 +193,7 @@ def _reached(ann: Any) -> set[Any]:
 
 def test_a_key_in_one_and_not_the_other_is_found() -> None:
     """The check above fails for a key added to the schema only, to the TypedDict only, made optional
-    in one only, or given another type, at any depth."""
+    in one only, given another type, other status words or a null only one side allows, at any depth."""
     import copy
     global SCHEMA
     kept = SCHEMA
@@ -173,7 +206,12 @@ def test_a_key_in_one_and_not_the_other_is_found() -> None:
                 (lambda s: s["properties"]["obligations"]["items"]["properties"]["guarantee"].update(type="string"),
                  "report.obligations.guarantee: ['integer'] in the TypedDict, ['string'] in the schema"),
                 (lambda s: s["properties"]["requirements"]["items"]["properties"].pop("strength_shortfall"),
-                 "report.requirements.strength_shortfall: only in the TypedDict")):
+                 "report.requirements.strength_shortfall: only in the TypedDict"),
+                (lambda s: s["properties"]["unverified"]["items"]["properties"]["status"].update(const="pending"),
+                 "report.unverified.status: words ['unverified'] in the TypedDict, ['pending'] in the schema"),
+                (lambda s: s["properties"]["obligations"]["items"]["properties"]["guarantee"].update(
+                    type=["integer", "null"]),
+                 "report.obligations.guarantee: null allowed by the schema only")):
             SCHEMA = copy.deepcopy(kept)
             change(SCHEMA)
             assert want in _disagreements(st.Report, SCHEMA, "report"), want
