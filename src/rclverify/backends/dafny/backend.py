@@ -64,6 +64,10 @@ def _jinja() -> jinja2.Environment:
                               undefined=jinja2.StrictUndefined, keep_trailing_newline=True, autoescape=False)
 
 
+#: this backend's declaration (its folder's declaration.yaml)
+_DECLARED = declared_in(__file__)
+
+
 class _Config:
     """The validated plan entry (see the module docstring)."""
 
@@ -101,8 +105,8 @@ class _Config:
 class DafnyBackend:
     """Backend ``dafny`` (kind ``proof``); see the module docstring."""
 
-    name = declared_in(__file__).name
-    kind = declared_in(__file__).evidence_kind
+    name = _DECLARED.name
+    kind = _DECLARED.evidence_kind
 
     # -- export -------------------------------------------------------------------------
     def stub_path(self, target: NodeTarget) -> Path:

@@ -41,7 +41,8 @@ from rclverify.backends.experiment.target import run_target, target_obligations
 from rclverify.backends.shapes import ExperimentDetails
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
-NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
+_DECLARED = declared_in(__file__)
+NAME, KIND = _DECLARED.name, _DECLARED.evidence_kind
 
 
 def load(target: NodeTarget) -> ExperimentConfig:

@@ -40,7 +40,8 @@ from rclverify.backends.hoare.wp import VC, WP, ProgramModel, main_vc, wp
 from rclverify.backends.shapes import HoareData, HoareDetails
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
-NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
+_DECLARED = declared_in(__file__)
+NAME, KIND = _DECLARED.name, _DECLARED.evidence_kind
 
 
 @lru_cache(maxsize=1)  # one environment per process: jinja2 then compiles each template once

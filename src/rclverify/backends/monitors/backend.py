@@ -49,7 +49,8 @@ from rclverify.backends.monitors.runset import run_counts, run_runset, runset_ob
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
-NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
+_DECLARED = declared_in(__file__)
+NAME, KIND = _DECLARED.name, _DECLARED.evidence_kind
 #: The reorder window ROSMonitoring's monitors are configured with (ms); the
 #: same default as ``rclverify monitor --live --reorder-window``.
 REORDER_WINDOW_MS = 50

@@ -42,7 +42,8 @@ import inspect
 from rclverify.backends.shapes import DeclarationRow, PropertyTestDetails
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
-NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
+_DECLARED = declared_in(__file__)
+NAME, KIND = _DECLARED.name, _DECLARED.evidence_kind
 
 
 @lru_cache(maxsize=1)

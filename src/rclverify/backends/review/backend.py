@@ -29,7 +29,8 @@ from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.review.record import Question, RecordError, ReviewRecord, assumption_text, checklist, judge, parse_record
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
-NAME, KIND = declared_in(__file__).name, declared_in(__file__).evidence_kind
+_DECLARED = declared_in(__file__)
+NAME, KIND = _DECLARED.name, _DECLARED.evidence_kind
 
 
 def read_record(root: Path, config: Any, loc: Any) -> tuple[str, ReviewRecord]:

@@ -21,31 +21,16 @@ plan validates an entry against them without importing any backend's code.
 from __future__ import annotations
 
 import difflib
-from dataclasses import dataclass
 from typing import Any, Iterator, Mapping
 
-from rclverify.model.plan.declarations import BACKEND_NAMES, DECLARATIONS
+from rclverify.model.plan.declarations import BACKEND_NAMES as BACKEND_NAMES, DECLARATIONS, PlanEntry
 
 #: Keys every entry may have, whatever its backend.
 COMMON_KEYS: tuple[str, ...] = ("backend", "expected")
 
 
-@dataclass(frozen=True)
-class EntrySchema:
-    """One backend's plan-entry schema (see the module docstring)."""
-
-    name: str
-    keys: tuple[str, ...]
-    path_keys: frozenset[str] = frozenset()
-    tool_keys: frozenset[str] = frozenset()
-    #: Path keys whose value is ``<file>:<name>`` (the file part is the path).
-    qualified_keys: frozenset[str] = frozenset()
-
-
 #: Backend name -> schema, in registry order (each backend's ``declaration.yaml``, :mod:`.declarations`).
-SCHEMAS: dict[str, EntrySchema] = {
-    d.name: EntrySchema(d.name, d.plan.keys, d.plan.path_keys, d.plan.tool_keys, d.plan.qualified_keys)
-    for d in DECLARATIONS.values()}
+SCHEMAS: dict[str, PlanEntry] = {d.name: d.plan for d in DECLARATIONS.values()}
 
 #: Every key, of any backend, that names a tool rather than a workspace file.
 TOOL_KEYS: frozenset[str] = frozenset(k for s in SCHEMAS.values() for k in s.tool_keys)

@@ -81,6 +81,10 @@ _JAVA_CLASS = re.compile(r"^[A-Za-z_$][\w$]*(\.[A-Za-z_$][\w$]*)*$")
 _AGENT = re.compile(r"^[a-z][A-Za-z0-9_]*$")
 
 
+#: this backend's declaration (its folder's declaration.yaml)
+_DECLARED = declared_in(__file__)
+
+
 @dataclass(frozen=True)
 class AjpfConfig:
     """A checked ``ajpf`` plan entry (see the module docstring for the keys)."""
@@ -214,8 +218,8 @@ class _Property:
 class AjpfBackend:
     """Model checking of Gwendolen agents with AJPF (``backend: ajpf``)."""
 
-    name = declared_in(__file__).name
-    kind = declared_in(__file__).evidence_kind
+    name = _DECLARED.name
+    kind = _DECLARED.evidence_kind
 
     def __init__(self) -> None:
         self._runs: dict[tuple[str, str], tuple[runner.RunOutcome, AjpfResult, str]] = {}
