@@ -20,6 +20,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 from markupsafe import Markup
 
+from rclverify.records.links import link_pairs
 from rclverify.records.report_schema import Report
 from rclverify.core.cache.memo import last_call
 from rclverify.records.published import write_published
@@ -81,7 +82,6 @@ def _argument(report: Report, rendering: diagram.Rendering | None,
 @last_call  # the HTML report's layout and page both show it
 def _system_dot(report: Report) -> str:
     """The system diagram with the problems' culprit nodes and the failing connections marked."""
-    from rclverify.records.links import link_pairs  # deferred: start-up (loads rclverify.records.links only when called)
     failing = {(p, c) for sc in report.get("side_conditions") or () if sc.get("status") in ("failed", "inconclusive", "error")
                for p, _, c, _ in link_pairs(sc)}
     culprits = culprit_nodes(problem_groups(report))
