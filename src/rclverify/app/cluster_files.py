@@ -33,7 +33,7 @@ import io
 import os
 import tarfile
 from pathlib import Path
-from rclverify.core.atomic import atomic_write_bytes
+from rclverify.core.atomic import atomic_write_bytes, move_into_place
 
 #: Folders of a workspace never sent: written by runs, or not part of the inputs.
 SKIPPED_TOP = frozenset({"artifacts", "reports"})
@@ -168,7 +168,7 @@ def materialise(base: Path, name: str, blob: bytes) -> Path:
         shutil.rmtree(tmp, ignore_errors=True)
         raise ShippingError("the workspace's sources arrived damaged (their sha256 differs)")
     try:
-        os.replace(tmp, root)
+        move_into_place(tmp, root)
     except OSError:  # another job of this worker unpacked it first
         import shutil  # deferred: optional or conditional (inside a block)
         shutil.rmtree(tmp, ignore_errors=True)

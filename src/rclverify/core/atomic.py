@@ -2,15 +2,21 @@
 
 Every write goes to a temporary file in the destination directory and is
 moved into place with :func:`os.replace`, so a crash or a failing stage never
-leaves a half-written file and never loses the file already there.  Nothing
-here knows of RCL or evidence: the caches (``core/cache``), the evidence
-store (``records/store.py``) and every stage's artifacts write through it.
+leaves a half-written file and never loses the file already there.  A target
+that is not a regular file is never replaced: a device, FIFO or socket is
+written in place (``-o /dev/null`` discards, as a shell redirection does),
+and a symbolic link is followed to the file it names, which is then written
+atomically, so the link stays a link.  Nothing here knows of RCL or evidence:
+the caches (``core/cache``), the evidence store (``records/store.py``), every
+stage's artifacts and every ``-o FILE`` write through it; a directory built
+beside its place is moved there by :func:`move_into_place`.
 """
 from __future__ import annotations
 
 import itertools
 import json
 import os
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +35,9 @@ def atomic_write_text(path: Path, text: str, *, durable: bool = False) -> bool:
     Returns ``True`` when the file changed.  Parent directories are created.
     Raises ``OSError`` when the directory cannot be written.
     """
+    if _special(path) is not None:
+        atomic_write_bytes(path, text.encode("utf-8"), durable=durable)
+        return True
     try:
         if path.read_text(encoding="utf-8") == text:
             return False
@@ -54,7 +63,19 @@ def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: 
     finds the directory missing).  Raises ``OSError`` when the directory
     cannot be written; the temporary file is removed and ``path`` is left as
     it was.
+
+    A ``path`` that is a symbolic link is resolved first and the file it
+    names is replaced (the link stays); a character or block device, FIFO or
+    socket is opened and written in place, never renamed over (as root, a
+    rename over ``/dev/null`` would replace the machine's device node); a
+    directory raises :class:`IsADirectoryError`.
     """
+    special = _special(path)
+    if special is not None:
+        _write_in_place(special, data)
+        return
+    if os.path.islink(path):
+        path = Path(os.path.realpath(path))
     fd, tmp = _create_temporary(path)
     try:
         if mode is not None:
@@ -71,6 +92,45 @@ def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: 
         except FileNotFoundError:
             pass
         raise
+
+
+def _special(path: Path) -> Path | None:
+    """The resolved path when ``path`` (after symbolic links) is a device,
+    FIFO or socket; ``None`` for a regular file, a missing one or a dangling
+    link.  Raises :class:`IsADirectoryError` for a directory."""
+    try:
+        st = os.stat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    if stat.S_ISDIR(st.st_mode):
+        raise IsADirectoryError(21, "Is a directory", str(path))
+    if stat.S_ISREG(st.st_mode):
+        return None
+    return Path(os.path.realpath(path))
+
+
+def _write_in_place(path: Path, data: bytes) -> None:
+    """Write ``data`` into the existing special file ``path`` (device, FIFO,
+    socket-free: a socket cannot be opened and raises ``OSError``) without
+    creating, truncating a regular file or renaming anything."""
+    fd = os.open(path, os.O_WRONLY | getattr(os, "O_CLOEXEC", 0))
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+    finally:
+        os.close(fd)
+
+
+def move_into_place(built: Path, final: Path) -> None:
+    """Move the directory ``built`` (made beside ``final``, on its file
+    system) to ``final`` with one rename, so readers see all of it or none.
+    Raises ``OSError`` when ``final`` exists and is not an empty directory
+    (another process placed it first) or is not a directory at all: a file,
+    device or link at ``final`` is never replaced."""
+    if os.path.lexists(final) and not os.path.isdir(final) or os.path.islink(final):
+        raise FileExistsError(17, "exists and is not a directory", str(final))
+    os.rename(built, final)
 
 
 _TEMPORARY_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)

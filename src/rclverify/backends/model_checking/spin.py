@@ -46,6 +46,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from rclverify.core.atomic import move_into_place
 from rclverify.core.cache.keys import user_cache_dir
 from rclverify.lang.ast import Loc
 from rclverify.backends.bounded import forget_directory, register_directory, run_bounded, temporary_directory
@@ -215,7 +216,7 @@ def compile_model(tools: Tools, text: str, cache: Path | None = None, timeout_s:
         for junk in tmp.glob("pan.[bchmpt]"):
             junk.unlink()
         try:
-            os.rename(tmp, final)
+            move_into_place(tmp, final)
         except OSError:  # another run built it first
             if not (final / "pan").is_file():
                 raise

@@ -29,6 +29,7 @@ import yaml
 
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError, error
+from rclverify.core.atomic import move_into_place
 from rclverify.records.store import atomic_write_text
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked
@@ -234,7 +235,7 @@ def write_tree(out: Path, checked: Checked, system: str, sources: dict[str, str]
         out.parent.mkdir(parents=True, exist_ok=True)
         staging.mkdir()
         res = _write(staging, gen, once, interface_of)
-        os.rename(staging, out)
+        move_into_place(staging, out)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         if made != out:
