@@ -7,11 +7,12 @@ every recorded run of the node's ``monitors`` entry, a row of the record's
 ``details.declarations`` (:meth:`DeclarationResult.rows`).  The run is read
 in the stream model of the paper (lines 462-495): a *step* of the node is
 one of its input events (a message on a topic ``topics(...)`` binds to an
-input, or a call part a link binds to one) that carries an input its
-contract reads (its assumption or a guarantee: a message no clause reads
-cannot oblige an answer, e.g. an action's feedback to a client that only
-sends goals), and the node *answers* at that step when one of its output
-messages comes after it and before its next step.  The assumption is judged on the inputs current at the event
+input, or a call part a link binds to one: a message on the link's topic,
+or a call line of a live run's log) that carries an input its contract
+reads (its assumption or a guarantee, a quantifier's domain included: a
+message no clause reads cannot oblige an answer, e.g. an action's feedback
+to a client that only sends goals), and the node *answers* at that step
+when one of its output messages comes after it and before its next step.  The assumption is judged on the inputs current at the event
 (:func:`rclverify.semantics.floatsem.judge`, as the untimed monitor judges it);
 a step at which it holds is *accepted*.
 
@@ -42,9 +43,13 @@ a step at which it holds is *accepted*.
   message and the run ending within the period ``inconclusive`` (too short
   to show a gap); none ``pending``.
 
-The verdicts map to evidence statuses as the monitors' do (``true``
-discharged, ``false`` failed); each row names the declaration's source so
-a requirement resting on it (calculus/requirements/rollup.py) can read it.
+Each row's status is its verdict's (:data:`STATUS`: ``true`` discharged,
+``false`` failed, ``inconclusive``, ``pending``) and names the
+declaration's source, so a requirement resting on it
+(calculus/requirements/rollup.py) can read it.  The node's record folds
+them in by the rule of evidence (docs/semantics.md, "Verdicts and
+evidence"; :func:`declaration_status`, :func:`with_declarations`): a
+declaration pending or undecided never leaves the record ``discharged``.
 """
 from __future__ import annotations
 
@@ -56,13 +61,14 @@ from rclverify.lang import ast
 from rclverify.lang.liveness import _steps, period_seconds
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.lang.walk import subexpressions
+from rclverify.lang.walk import free_names, subexpressions
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
 from rclverify.backends.monitors.deadlines import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
 from rclverify.backends.monitors.periods import PeriodResult
-from rclverify.backends.monitors.verdicts import names
+from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
+from rclverify.backends.monitors.verdicts import LINK_TOPICS
 from rclverify.backends.monitors.shapes import DeclarationsPart
 from rclverify.backends.shapes import DeclarationRow
 
@@ -148,17 +154,14 @@ class DeclarationMonitor:
         self._step_topics: set[str] = set()
         self.bindings = topic_bindings(node)
         self.assumption = tuple(c.formula for c in node.node.assumes)
-        mentioned: set[str] = set()
-        for f in self.assumption:
-            names(f, mentioned)
-        self.needed = sorted(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
+        self.needed = sorted(_inputs_read(self.assumption, node))
         self.needed_set = frozenset(self.needed)
         #: the assumption's verdict per tuple of the inputs it reads (a run repeats its inputs)
         self.accepted: dict[Any, bool] = {}
-        for c in node.node.guarantees:
-            names(c.formula, mentioned)
         #: the inputs the contract reads: an event carrying one of them is a step of the node
-        self.read = frozenset(f"in.{v}" for v in node.inputs if v in mentioned or f"in.{v}" in mentioned)
+        self.read = frozenset(_inputs_read(self.assumption + tuple(c.formula for c in node.node.guarantees), node))
+        #: input events the contract reads, accepted or not (a ``pending`` verdict says which it was)
+        self.input_events = 0
         self.values: dict[str, object] = {}
         self.first: dict[str, tuple[Any, str]] = {}
         self.first_input = ""  # where the first input event was (an output message after it may be an answer)
@@ -180,11 +183,21 @@ class DeclarationMonitor:
                                           f"periodic( out.{per.output.name}, {per.amount} {per.unit} )"))
 
     def feed(self, ev: Event) -> None:
-        """Process one event (any topic; only the node's move its state)."""
+        """Process one event (any topic; only the node's move its state).  A
+        call line of a live run's log (:data:`~.dds_calls.CALL_LOG_TOPIC`:
+        a request, response, goal, feedback or result of a link) is the
+        event of its link's part, as the message on the link's topic is."""
+        if ev.topic.strip("/") == CALL_LOG_TOPIC:
+            call = _call_part(ev)
+            if call is None:
+                return
+            ev, part_fields = call
+        else:
+            part_fields = None
         keys = self.bindings.get(ev.topic.lstrip("/"))
         if not keys:
             return
-        changed = self._map(ev, keys)
+        changed = self._map(ev, keys, part_fields)
         outs = {c for c in changed if c.startswith("out.")}
         for key in outs:
             if key in self.awaited:
@@ -199,17 +212,19 @@ class DeclarationMonitor:
         if outs:
             self._step_at = None  # an output ends the instant: the next input is a step of its own
         if any(k in self.read for k in changed):
+            self.input_events += 1
             self._step(ev)
         if not self.first_input and any(k.startswith("in.") for k in changed):
             self.first_input = ev.where
 
-    def _map(self, ev: Event, keys: list[tuple[str, str]]) -> list[str]:
+    def _map(self, ev: Event, keys: list[tuple[str, str]], part_fields: Mapping[str, Any] | None = None) -> list[str]:
         """The keys ``ev`` carries; the values mapped only where a judgement
         needs them (the assumption's inputs, an output whose first value an
-        ``initially`` waits for): a step or an answer needs only the event."""
+        ``initially`` waits for): a step or an answer needs only the event.
+        ``part_fields``: a call line's fields, the part's own."""
         changed = []
         for key, part in keys:
-            fields = ev.fields.get(part) if part else ev.fields
+            fields = part_fields if part_fields is not None else ev.fields.get(part) if part else ev.fields
             typ = self.node.inputs.get(key[3:]) if key.startswith("in.") else self.node.outputs.get(key[4:])
             if not isinstance(fields, Mapping) or typ is None:  # an action message without this part
                 continue
@@ -329,8 +344,13 @@ class DeclarationMonitor:
     def _count_verdict(self, c: _Count) -> tuple[str, str]:
         if c.broken:
             return "false", c.broken
+        if not c.accepted and not self.input_events:
+            return "pending", ("no input event of " + (", ".join(sorted(self.read)) or "the node")
+                               + " was read (a message on its topics, or a call part in a live run's log): "
+                               "nothing to answer")
         if not c.accepted:
-            return "pending", "no input event the node's assumption accepts: nothing to answer"
+            return "pending", (f"none of its {self.input_events} input event(s) meets its assumption: "
+                               "nothing to answer")
         if not c.heard:
             return "inconclusive", (f"{c.accepted} accepted input event(s) came and no {self._answer_words(c)} was "
                                     "heard: judging starts at the first one (its reader may have matched after the "
@@ -342,6 +362,35 @@ class DeclarationMonitor:
                                     f"(a finite run never refutes 'eventually'){before}")
         return "true", (f"{c.accepted} accepted input events, none left unanswered for more than "
                         + (f"{c.bound} steps" if c.bound is not None else "the run") + before)
+
+
+def _inputs_read(formulas: Iterable[ast.Expr], node: CheckedNode) -> set[str]:
+    """``{"in.x"}``: the inputs of ``node`` that ``formulas`` read, a
+    quantifier's domain included (``exists(r in in.ranges | ...)``), a name
+    a quantifier binds not."""
+    out: set[str] = set()
+    for f in formulas:
+        out |= {f"in.{v}" for v in free_names(f) if v in node.inputs}
+        out |= {f"in.{e.name}" for e in subexpressions(f)
+                if isinstance(e, ast.Var) and e.prefix == "in" and e.name in node.inputs}
+    return out
+
+
+#: the parts of a call line that carry a link's values (a goal's ``status`` carries none)
+_CALL_PARTS = frozenset(p for parts in LINK_TOPICS.values() for p in parts)
+
+
+def _call_part(ev: Event) -> tuple[Event, Mapping[str, Any]] | None:
+    """A live log's call line (``{"kind": "call", "link", "part", "fields"}``,
+    :class:`~.dds_calls.CallBook`) as the event of its link's part on topic
+    ``link/part``, with the part's fields; ``None`` for a line that carries
+    no part (a status, a tick) or repeats a call for another server."""
+    f = ev.fields
+    part, link, fields = f.get("part"), f.get("link"), f.get("fields")
+    if f.get("kind") != "call" or f.get("also") or part not in _CALL_PARTS or not isinstance(link, str) \
+            or not isinstance(fields, Mapping):
+        return None
+    return Event(ev.index, ev.time, f"{link.strip('/')}/{part}", dict(fields), ev.where), fields
 
 
 def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> DeclarationRow:
@@ -377,31 +426,55 @@ def _period_verdict(res: PeriodResult | None, key: str) -> tuple[str, str]:
 
 
 def declaration_status(res: DeclarationResult, trace: str) -> tuple[str, str]:
-    """The evidence status the declarations add to the node's record on
-    ``trace``: ``failed`` when one is false (named), else ``discharged`` with
-    a note listing the ones the run did not decide."""
-    # a late period fails the record through periods.py already: not said twice
-    bad = [r for r in res.declarations if r["verdict"] == "false" and r["premise"]]
+    """``(status, explanation)`` the declarations of ``res`` give on
+    ``trace``, by the rule of evidence (docs/semantics.md, "Verdicts and
+    evidence"): a ``false`` row -> ``failed`` (named, a declaration of the
+    contract before a period in time); else an ``inconclusive`` row, or a
+    ``pending`` row beside a ``true`` one -> ``inconclusive``; else every row
+    ``pending`` (or none) -> ``pending``; else ``discharged``.  The
+    explanation lists the rows that held and those not decided, each with
+    its reason."""
+    rows = res.declarations
+    bad = sorted((r for r in rows if r["verdict"] == "false"), key=lambda r: not r["premise"])
     if bad:
         r = bad[0]
         return "failed", f"{res.node} declares {r['text']} ({r['source']}) but in {trace}: {r['reason']}"
-    open_ = [f"{r['text']}: {r['verdict']} ({r['reason']})" for r in res.declarations
-             if r["verdict"] not in ("true", "false")]
-    done = [r["text"] for r in res.declarations if r["verdict"] == "true"]
-    words = (["held: " + ", ".join(done)] if done else []) + (["not decided: " + "; ".join(open_)] if open_ else [])
-    return "discharged", "; ".join(words) or "none"
+    open_ = [f"{r['text']}: {r['verdict']} ({r['reason']})" for r in rows if r["verdict"] not in ("true", "false")]
+    done = [r["text"] for r in rows if r["verdict"] == "true"]
+    words = "; ".join((["held: " + ", ".join(done)] if done else [])
+                      + (["not decided: " + "; ".join(open_)] if open_ else [])) or "none judged"
+    if any(r["verdict"] == "inconclusive" for r in rows) or (open_ and done):
+        return "inconclusive", words
+    if not done:
+        return "pending", words
+    return "discharged", words
 
 
 def with_declarations(res: DeclarationResult, trace: str, status: str,
                       explanation: str) -> tuple[str, str, DeclarationsPart]:
-    """The monitor's verdict combined with the node's declarations on the
-    same run: a false declaration fails the evidence (it is a claim of the
-    node's contract), otherwise the verdict stands with a note.  Returns
+    """The record's status from the other checks' ``status`` (with its
+    ``explanation``) and the node's declarations on the same run
+    (:func:`declaration_status`), by the rule of evidence (docs/semantics.md,
+    "Verdicts and evidence"): a false declaration fails the record (it is a
+    claim of the node's contract); a declaration not decided keeps a
+    ``discharged`` record from ``discharged`` (``inconclusive``) and makes a
+    ``pending`` one ``inconclusive`` when one was undecided; ``failed``,
+    ``error``, ``stale`` and ``inconclusive`` stand.  Returns
     ``(status, explanation, {"declarations": rows})``."""
     dstatus, dexpl = declaration_status(res, trace)
+    part: DeclarationsPart = {"declarations": res.rows()}
     if dstatus == "failed":
-        return "failed", f"declarations: {dexpl}; {explanation}", {"declarations": res.rows()}
-    return status, f"{explanation}; declarations: {dexpl}", {"declarations": res.rows()}
+        late_period = not any(r["verdict"] == "false" and r["premise"] for r in res.declarations)
+        if late_period and status == "failed":  # a late period fails the record through periods.py: not said twice
+            return status, f"{explanation}; declarations: {dexpl}", part
+        return "failed", f"declarations: {dexpl}; {explanation}", part
+    if status == "discharged" and dstatus != "discharged":
+        return "inconclusive", (f"{explanation}; but a declaration is not decided on this run, so the record is "
+                                f"not discharged (docs/semantics.md, \"Verdicts and evidence\"); declarations: "
+                                f"{dexpl}"), part
+    if status == "pending" and dstatus == "inconclusive":
+        return "inconclusive", f"{explanation}; declarations: {dexpl}", part
+    return status, f"{explanation}; declarations: {dexpl}", part
 
 
 def check_declarations(checked: Checked, node: CheckedNode, events: Iterable[Event],
