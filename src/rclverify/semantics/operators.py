@@ -30,6 +30,14 @@ instead of restating it:
   :attr:`Operator.z3` (the ``z3.ArithRef`` method, or the Z3 function of a
   connective), :attr:`Operator.numpy` (the numpy ufunc's name for the
   column evaluation of recorded runs), :attr:`Operator.smtlib`, :attr:`Operator.dafny`.
+* :attr:`Operator.partial` states where a partial operator is undefined
+  (:class:`Partial`: which operand must avoid which value, and what the
+  failure is called); ``None`` for a total operator.  The well-definedness
+  conditions every proof path proves are generated from it
+  (:mod:`rclverify.semantics.definedness`), with the connectives'
+  short circuit (:attr:`Operator.decisive`) as their guards.  Division is
+  RCL's only partial operator: RCL has no modulo and no sequence indexing
+  (docs/semantics.md, "Definedness").
 * :attr:`Operator.identity` is the neutral element (``and`` TRUE, ``+`` 0, ...)
   when there is one; :attr:`Operator.converse` and :attr:`Operator.negation`
   relate the comparisons (``a < b`` is ``b > a`` and ``not (a >= b)``).
@@ -52,6 +60,19 @@ Kind = Literal["connective", "comparison", "arithmetic", "negation"]
 class Undecided(Exception):
     """The formula cannot be decided by direct evaluation (reason in ``str``):
     a division by zero, a value missing or of the wrong form."""
+
+
+@dataclass(frozen=True)
+class Partial:
+    """Where a partial operator is undefined: its operand number ``operand``
+    (0 the left, 1 the right) must differ from ``excluded``; ``failure``
+    names what happens otherwise (``"division by zero"``).  The condition
+    is Why3's, Dafny's and SPARK's for the operator (their ``div``/``/``
+    checks: the divisor is not zero)."""
+
+    operand: int
+    excluded: int
+    failure: str
 
 
 @dataclass(frozen=True)
@@ -83,6 +104,8 @@ class Operator:
     negation: str | None = None
     #: what a zero divisor does: ``"undecided"`` (both readings) or ``""`` (cannot happen)
     zero_divisor: str = ""
+    #: where the operator is undefined (:class:`Partial`); ``None`` for a total operator
+    partial: Partial | None = None
 
 
 def _exact_number(x: Any) -> Any:
@@ -171,7 +194,8 @@ _ENTRIES = (
              cpp="({l} * {r})", z3="__mul__", numpy="multiply", smtlib="*",
              dafny="*", python_reading="({l} * {r})", identity=1),
     Operator("/", "division", "arithmetic", 2, _exact_div, _double_div, cpp=None, z3="__truediv__",
-             numpy="true_divide", smtlib="/", dafny="/", python_reading="({l} / {r})", zero_divisor="undecided"),
+             numpy="true_divide", smtlib="/", dafny="/", python_reading="({l} / {r})", zero_divisor="undecided",
+             partial=Partial(1, 0, "division by zero")),
 )
 
 #: binary operator symbol -> its entry
@@ -200,4 +224,5 @@ def is_nan(x: Any) -> bool:
     return type(x) is float and math.isnan(x)
 
 
-__all__ = ["ARITHMETIC", "COMPARISONS", "CONNECTIVES", "OPERATORS", "Operator", "UNARY", "Undecided", "is_nan"]
+__all__ = ["ARITHMETIC", "COMPARISONS", "CONNECTIVES", "OPERATORS", "Operator", "Partial", "UNARY", "Undecided",
+           "is_nan"]

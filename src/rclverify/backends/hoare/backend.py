@@ -10,6 +10,9 @@ backend mechanises that step:
   node's guarantees into triples (:mod:`.obligations`), computes each one's
   weakest-precondition proof outline (:mod:`.wp`) and renders it to
   ``artifacts/hoare/<Node>/g<guarantee>.<program>.c<k>.txt``;
+* every triple has definedness VCs as well (:mod:`.defined`): each
+  division in the program, the precondition and the postcondition must not
+  divide by zero where it is evaluated (docs/semantics.md, "Definedness");
 * ``run`` checks every verification condition with Z3 (:mod:`.solve`):
   all valid -> ``discharged``; one refuted -> ``failed`` with a
   counterexample (initial values, extern applications, final values);
@@ -33,6 +36,7 @@ from rclverify.records.ties import tie_query
 from rclverify.semantics.encode import EncodingError, Encoder
 from rclverify.lang.errors import RclError, error
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.hoare.defined import definedness_vcs
 from rclverify.backends.hoare.obligations import Conjunct, EncodedTriple, HoareConfig, conjuncts, encode_triple, load_program, statement
 from rclverify.backends.hoare.outline import OutlineLine, outline_text, render_outline, term_printer
 from rclverify.backends.hoare.solve import TripleResult, check_all
@@ -121,7 +125,7 @@ def prepare(target: NodeTarget, only: str | None = None) -> list[Prepared]:
             except EncodingError as exc:
                 raise RclError([error(exc.loc, str(exc).split(": error: ", 1)[-1], "E-encode")]) from None
             result = wp(program.body, triple.post, m)
-            vcs = (main_vc(triple.pre, result, m, c.loc), *result.vcs)
+            vcs = (main_vc(triple.pre, result, m, c.loc), *result.vcs, *definedness_vcs(program, m, triple, c.loc))
         src = _source(target, c.clause.loc)
         text = statement(c, cfg, node, frozenset(types.vars))
         stem = f"g{c.guarantee}.{instance}"
@@ -269,6 +273,11 @@ class HoareBackend:
             details["failed_vc"] = res.failed.vc.id
             if res.notes:
                 details["notes"] = list(res.notes)
+            if res.failed.vc.id.startswith("defined"):
+                return evidence("failed", f"{p.config.program} does not meet the triple: it is not defined on this "
+                                f"run, {res.failed.vc.label} does not hold (verification condition "
+                                f"{res.failed.vc.id}): {_cex_text(res.counterexample or {})}", log=log,
+                                artifacts=tuple(artifacts), counterexample=res.counterexample, details=details)
             return evidence("failed", f"{p.config.program} does not meet the triple: the postcondition "
                             f"{details['triple']['post']} fails on this run (verification condition "
                             f"{res.failed.vc.id}: {res.failed.vc.label}): {_cex_text(res.counterexample or {})}", log=log,

@@ -37,6 +37,7 @@ from typing import Any, Mapping
 import z3
 
 from rclverify.semantics.connectives import conj
+from rclverify.semantics.definedness import Condition, conditions
 from rclverify.semantics.encode import Encoder
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
@@ -360,7 +361,13 @@ class EncodedTriple:
                        variable that is not a program variable -> its constant
                        (shown in counterexamples);
     ``observe_final``  RCL output name -> program variable;
-    ``names``          Z3 symbol name -> display name (``in.command``).
+    ``names``          Z3 symbol name -> display name (``in.command``);
+    ``pre_defined``    the well-definedness conditions of the precondition
+                       (:func:`rclverify.semantics.definedness.conditions`),
+                       each with its formula over the initial-state constants;
+    ``post_defined``   those of the postcondition, over the final-state ones;
+    ``pre_guards``     the ranges of the guarantee's bound variables (part of
+                       ``pre``), the hypotheses of the precondition's conditions.
     """
 
     pre: z3.BoolRef
@@ -369,6 +376,9 @@ class EncodedTriple:
     observe: Mapping[str, z3.ExprRef]
     observe_final: Mapping[str, str]
     names: Mapping[str, str] = field(default_factory=dict)
+    pre_defined: tuple[tuple[Condition, z3.BoolRef], ...] = ()
+    post_defined: tuple[tuple[Condition, z3.BoolRef], ...] = ()
+    pre_guards: tuple[z3.BoolRef, ...] = ()
 
 
 def _encode(enc: Encoder, e: ast.Expr, node: CheckedNode, symbols: Mapping[str, object],
@@ -440,8 +450,12 @@ def encode_triple(c: Conjunct, cfg: HoareConfig, m: ProgramModel, enc: Encoder, 
     post = _encode(enc, c.conclusion, node, post_syms, post_b)
     if post_prem:
         post = z3.Implies(conj(*[_encode(enc, p, node, post_syms, post_b) for p in post_prem]), post)
+    post_rcl = c.conclusion if not post_prem else ast.Binary("->", _conj(post_prem), c.conclusion, c.conclusion.loc)
+    pre_defined = tuple((d, _encode(enc, d.formula, node, pre_syms, pre_b))
+                        for d in conditions(_conj(pre_parts)))
+    post_defined = tuple((d, _encode(enc, d.formula, node, post_syms, post_b)) for d in conditions(post_rcl))
     background.extend(enc.axioms())
     names = {s.z3name: s.display.split(".", 1)[1] if s.display.startswith(node.name + ".") else s.display
              for s in enc.symbols.values()}
     return EncodedTriple(pre, post, tuple(background), observe,
-                         {k: v for k, v in cfg.outputs.items()}, names)
+                         {k: v for k, v in cfg.outputs.items()}, names, pre_defined, post_defined, tuple(pre_guards))

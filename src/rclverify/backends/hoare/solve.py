@@ -49,7 +49,8 @@ class TripleResult:
 
     ``status``          ``discharged``/``failed``/``inconclusive``;
     ``results``         per VC, ``main`` first;
-    ``failed``          the first refuted VC's result (``failed`` only);
+    ``failed``          the first refuted definedness VC's result (:mod:`.defined`),
+                        else the first refuted VC's (``failed`` only);
     ``counterexample``  JSON-serialisable name -> value (``failed`` only).
     """
 
@@ -211,7 +212,9 @@ def check_all(vcs: Sequence[VC], background: Sequence[z3.BoolRef], m: ProgramMod
     run, a cluster worker), so the answers and counterexamples are too."""
     with solver_session():
         results = tuple(check_vc(vc, background, m, timeout_ms) for vc in vcs)
-    bad = next((r for r in results if r.status == "invalid"), None)
+    # a definedness VC refuted is the failure reported: what else fails reads an undefined value
+    bad = next((r for r in results if r.status == "invalid" and r.vc.id.startswith("defined")),
+               next((r for r in results if r.status == "invalid"), None))
     if bad is not None:
         cex, notes = counterexample(bad, m, observe, observe_final, names)
         return TripleResult("failed", results, bad, cex, tuple(notes))

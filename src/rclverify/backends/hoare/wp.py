@@ -27,6 +27,21 @@ them; ``old(x)`` is a constant named ``old(x)``; externs are uninterpreted
 functions.  Alongside the precondition the computation records a proof
 outline: the assertion that holds before every statement, as in the paper's
 proof figures.
+
+Definedness (docs/semantics.md, "Definedness"): a division in the program
+must not divide by zero.  Every application of a partial operator of the
+semantics table (:attr:`rclverify.semantics.operators.Operator.partial`)
+gets verification conditions of its own, computed by the same calculus run
+for that one application (``wp(..., target=...)``): where the expression
+holding it is evaluated, its condition (``d != 0``, under the guards the
+connectives' short circuit puts before it, as
+:func:`rclverify.semantics.definedness.right_guard` states it) must hold; the
+statements before it carry it back to the initial state, a loop's body and
+its exit to the loop head (under the invariant), and a loop's condition is
+evaluated at the head of every iteration.  In that run a loop's weakest
+precondition is ``TRUE``: that the invariant holds on entry is the
+ordinary run's to prove (its ``main`` VC), so a definedness VC fails only
+for a division that can see a zero divisor.
 """
 from __future__ import annotations
 
@@ -37,6 +52,7 @@ import z3
 from z3.z3 import _to_expr_ref  # the typed wrapper of a raw term (ArithRef, BoolRef ...)
 
 from rclverify.semantics.encode import apply_operator, widen
+from rclverify.semantics.operators import OPERATORS
 from rclverify.lang.ast import Loc, unhandled
 from rclverify.lang.types import NATURAL, Type
 from rclverify.backends.hoare import lang
@@ -137,6 +153,97 @@ class ProgramModel:
         """Program variables whose ``old(x)`` constant occurs in ``formulas``."""
         ids = term_ids(formulas)
         return [n for n in self.types.vars if self.olds[n].get_id() in ids]
+
+
+def partial_applications(body: tuple[lang.Stmt, ...]) -> list[lang.Binary]:
+    """Every application of a partial operator (division) in ``body``, in
+    program order (conditions, then branches; a loop's condition before its
+    body).  Each is one definedness target of :func:`wp`."""
+    out: list[lang.Binary] = []
+
+    def expr(e: lang.Expr) -> None:
+        if isinstance(e, lang.Binary):
+            expr(e.left)
+            expr(e.right)
+            if OPERATORS[e.op].partial is not None:
+                out.append(e)
+        elif isinstance(e, lang.Unary):
+            expr(e.operand)
+        elif isinstance(e, lang.Call):
+            for a in e.args:
+                expr(a)
+
+    def block(stmts: tuple[lang.Stmt, ...]) -> None:
+        for s in stmts:
+            if isinstance(s, lang.Assign):
+                expr(s.value)
+            elif isinstance(s, lang.If):
+                expr(s.cond)
+                block(s.then_)
+                block(s.else_)
+            elif isinstance(s, lang.While):
+                expr(s.cond)
+                block(s.body)
+    block(body)
+    return out
+
+
+def requirement_text(target: lang.Binary) -> str:
+    """The condition a partial application needs, as program text (``d != 0``)."""
+    p = OPERATORS[target.op].partial
+    assert p is not None
+    operand = (target.left, target.right)[p.operand]
+    return f"{lang.expr_text(operand)} != {p.excluded}"
+
+
+def contains(e: lang.Expr | lang.Stmt, target: lang.Binary) -> bool:
+    """Whether ``target`` (by identity) occurs in expression or statement ``e``."""
+    if e is target:
+        return True
+    if isinstance(e, lang.Binary):
+        return contains(e.left, target) or contains(e.right, target)
+    if isinstance(e, lang.Unary):
+        return contains(e.operand, target)
+    if isinstance(e, lang.Call):
+        return any(contains(a, target) for a in e.args)
+    if isinstance(e, lang.Assign):
+        return contains(e.value, target)
+    if isinstance(e, lang.If):
+        return contains(e.cond, target) or any(contains(x, target) for x in (*e.then_, *e.else_))
+    if isinstance(e, lang.While):
+        return contains(e.cond, target) or any(contains(x, target) for x in e.body)
+    return False
+
+
+def defined_at(e: lang.Expr, target: lang.Binary, m: ProgramModel) -> z3.BoolRef | None:
+    """The condition under which evaluating ``e`` applies ``target`` inside
+    its domain (``guards -> d != 0``, the guards of the connectives' short
+    circuit from the semantics table); ``None`` when ``target`` is not in ``e``."""
+    if e is target:
+        p = OPERATORS[target.op].partial
+        assert p is not None
+        operand = m.term((target.left, target.right)[p.operand])
+        return operand != p.excluded
+    if isinstance(e, lang.Binary):
+        left = defined_at(e.left, target, m)
+        if left is not None:
+            return left
+        right = defined_at(e.right, target, m)
+        if right is None:
+            return None
+        entry = OPERATORS[e.op]
+        if entry.kind != "connective" or entry.decisive is None:  # both operands evaluated
+            return right
+        c = m.formula(e.left)  # the guard of semantics.definedness.right_guard, on Z3 terms
+        return z3.Implies(c if entry.decisive is False else z3.Not(c), right)
+    if isinstance(e, lang.Unary):
+        return defined_at(e.operand, target, m)
+    if isinstance(e, lang.Call):
+        for a in e.args:
+            found = defined_at(a, target, m)
+            if found is not None:
+                return found
+    return None
 
 
 # Walking terms: Z3's low-level API directly.  The typed Python wrappers
@@ -263,10 +370,13 @@ def _needs_range(s: lang.Assign, m: ProgramModel) -> bool:
     return m.types.vars[s.target] == NATURAL and expr_type(s.value, m.types) != NATURAL
 
 
-def _stmt(s: lang.Stmt, post: z3.BoolRef, m: ProgramModel, depth: int
+def _stmt(s: lang.Stmt, post: z3.BoolRef, m: ProgramModel, depth: int, target: lang.Binary | None = None
           ) -> tuple[z3.BoolRef, list[VC], list[OutlineItem]]:
-    """wp of one statement: (pre, VCs, outline lines of the statement itself)."""
+    """wp of one statement: (pre, VCs, outline lines of the statement itself);
+    with ``target``, of that partial application's definedness alone (module docstring)."""
     line = s.loc.line
+    if target is not None:
+        return _stmt_defined(s, post, m, depth, target)
     if isinstance(s, lang.Assign):
         value = m.value_for(s.target, m.term(s.value))
         pre = z3.substitute(post, (m.consts[s.target], value))
@@ -301,12 +411,52 @@ def _stmt(s: lang.Stmt, post: z3.BoolRef, m: ProgramModel, depth: int
     return inv, [preserve, *vcs_body, exit_], items
 
 
-def _block(stmts: tuple[lang.Stmt, ...], post: z3.BoolRef, m: ProgramModel, depth: int, post_note: str
-           ) -> tuple[z3.BoolRef, list[VC], list[OutlineItem]]:
+def _stmt_defined(s: lang.Stmt, post: z3.BoolRef, m: ProgramModel, depth: int, target: lang.Binary
+                  ) -> tuple[z3.BoolRef, list[VC], list[OutlineItem]]:
+    """The definedness run's wp of one statement for partial application
+    ``target`` (module docstring): the ordinary rules with ``target``'s
+    condition added where its expression is evaluated, a loop's wp ``TRUE``."""
+    if z3.is_true(post) and not contains(s, target):
+        return post, [], []
+    line = s.loc.line
+    if isinstance(s, lang.Assign):
+        pre = z3.substitute(post, (m.consts[s.target], m.value_for(s.target, m.term(s.value))))
+        here = defined_at(s.value, target, m)
+        return (pre if here is None else z3.And(here, pre)), [], []
+    if isinstance(s, lang.Skip):
+        return post, [], []
+    if isinstance(s, lang.If):
+        c = m.formula(s.cond)
+        w1, vcs1, _ = _block(s.then_, post, m, depth + 1, "", target)
+        w2, vcs2, _ = _block(s.else_, post, m, depth + 1, "", target)
+        pre = z3.And(z3.Implies(c, w1), z3.Implies(z3.Not(c), w2))
+        here = defined_at(s.cond, target, m)
+        return (pre if here is None else z3.And(here, pre)), vcs1 + vcs2, []
+    assert isinstance(s, lang.While)
+    c, inv = m.formula(s.cond), m.formula(s.invariant)
+    wbody, vcs_body, _ = _block(s.body, z3.BoolVal(True), m, depth + 1, "", target)
+    vid = f"loop@{line}"
+    vcs: list[VC] = []
+    here = defined_at(s.cond, target, m)
+    if here is not None:
+        vcs.append(VC(f"{vid}.condition", f"the condition of the loop at line {line} is defined at its head",
+                      (inv,), here, s.loc, "loop"))
+    if not z3.is_true(wbody):
+        vcs.append(VC(f"{vid}.body", f"the body of the loop at line {line} is defined", (inv, c), wbody, s.loc,
+                      "loop"))
+    vcs.extend(vcs_body)
+    if not z3.is_true(post):
+        vcs.append(VC(f"{vid}.after", f"what follows the loop at line {line} is defined", (inv, z3.Not(c)), post,
+                      s.loc, "loop"))
+    return z3.BoolVal(True), vcs, []
+
+
+def _block(stmts: tuple[lang.Stmt, ...], post: z3.BoolRef, m: ProgramModel, depth: int, post_note: str,
+           target: lang.Binary | None = None) -> tuple[z3.BoolRef, list[VC], list[OutlineItem]]:
     segments: list[tuple[lang.Stmt, z3.BoolRef, list[VC], list[OutlineItem]]] = []
     q = post
     for s in reversed(stmts):
-        pre_s, vcs_s, items_s = _stmt(s, q, m, depth)
+        pre_s, vcs_s, items_s = _stmt(s, q, m, depth, target)
         segments.append((s, pre_s, vcs_s, items_s))
         q = pre_s
     segments.reverse()
@@ -320,15 +470,18 @@ def _block(stmts: tuple[lang.Stmt, ...], post: z3.BoolRef, m: ProgramModel, dept
     return q, vcs, items
 
 
-def wp(body: tuple[lang.Stmt, ...], post: z3.BoolRef, m: ProgramModel) -> WP:
+def wp(body: tuple[lang.Stmt, ...], post: z3.BoolRef, m: ProgramModel, target: lang.Binary | None = None) -> WP:
     """Weakest precondition of ``body`` for ``post`` (a Z3 formula over the
     current-state constants of ``m``).
 
     Returns :class:`WP`: ``pre`` over the initial-state constants, the loop
-    VCs (``state == "loop"``) and the proof outline.  Pure: no solver call.
+    VCs (``state == "loop"``) and the proof outline.  With ``target`` (one
+    of :func:`partial_applications`) it is the definedness run for that
+    application (module docstring; call it with ``post`` ``TRUE``): no
+    outline, and only the loop VCs that read the condition.  Pure: no solver call.
     """
-    pre, vcs, items = _block(body, post, m, 0, "postcondition")
-    return WP(pre, tuple(vcs), tuple(items))
+    pre, vcs, items = _block(body, post, m, 0, "postcondition", target)
+    return WP(pre, tuple(vcs), tuple(items) if target is None else ())
 
 
 def main_vc(pre: z3.BoolRef, result: WP, m: ProgramModel, loc: Loc) -> VC:
