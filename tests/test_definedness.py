@@ -92,3 +92,44 @@ def test_hoare_division_in_a_loop_is_checked_at_every_iteration(tmp_path: Path) 
     (tmp_path / "control").mkdir()
     ev = _hoare(tmp_path / "control", 0, bad)
     assert ev.details["vcs"]["defined@6:8.loop@5.body"] == "invalid"
+
+
+# ---------------------------------------------------------------------------
+# side conditions (calculus/compose.py, calculus/side_condition.py)
+# ---------------------------------------------------------------------------
+
+LINKED = """\
+node Producer {{
+  inputs( s : INTEGER )
+  outputs( n : INTEGER, d : INTEGER, r : REAL )
+  guarantee( {low} <= out.d <= 10 and out.r == out.n / out.d )
+}}
+node Consumer {{
+  inputs( n : INTEGER, d : INTEGER, r : REAL )
+  outputs( ok : BOOL )
+  assume( in.r == in.n / in.d )
+  guarantee( out.ok )
+}}
+"""
+
+
+def _side_condition(low: int) -> Any:
+    from rclverify.calculus.compose import compose_node
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    from rclverify.model.system.model import build
+    checked = check([parse_text(LINKED.format(low=low), "linked.rcl")])
+    (sc,) = compose_node(checked, build(checked), "Consumer").side_conditions
+    return sc
+
+
+def test_side_condition_dividing_by_a_possible_zero_fails_with_the_condition_named() -> None:
+    sc = _side_condition(0)
+    assert sc.status == "failed", sc.explanation
+    assert "the division at linked.rcl:9:19 needs in.d != 0" in sc.explanation
+    assert sc.model is not None and sc.model["Producer.out.d"] == "0", sc.model
+
+
+def test_side_condition_control_with_the_divisor_off_zero_is_discharged() -> None:
+    sc = _side_condition(1)
+    assert sc.status == "discharged", sc.explanation

@@ -67,7 +67,8 @@ from rclverify.calculus.side_condition import (IN_CONTEXT as IN_CONTEXT, STATUS 
                                                VARIANT_AS_WRITTEN as VARIANT_AS_WRITTEN,
                                                VARIANT_IN_CONTEXT as VARIANT_IN_CONTEXT,
                                                VARIANT_WITH_ASSUMPTIONS as VARIANT_WITH_ASSUMPTIONS, ConeView,
-                                               SideCondition as SideCondition, explain_local, in_context)
+                                               SideCondition as SideCondition, defined_goal, explain_local,
+                                               in_context, name_undefined)
 from rclverify.calculus.summary import decide as decide_by_summaries
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, prove, solver_session
 from rclverify.lang import ast
@@ -262,7 +263,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
     # one loop, not a step per method: Z3 numbers a new term with the id of a freed one and the `let` names of
     # every recorded script follow those ids, so the answers below live exactly as long as they always did
     for k, c in enumerate(internal, 1):
-        goal = enc.formula(c, cn)
+        goal = enc.formula(defined_goal(c), cn)  # c and its definedness (docs/semantics.md, "Definedness")
         links = _links_of(model, cn, node, c)
         head = (f"rclverify side condition {node}.sc{k} ({rule}): guarantees of {who} "
                 f"entail {expr_to_rcl(c)}\nsource {_loc(c.loc)}; unsat means discharged")
@@ -285,6 +286,8 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
         if status != "discharged":  # context before blame (docs/calculus.md)
             sc, cone_ctx = _in_context_step(checked, model, node, c, sc, cone_ctx, head, links,
                                             facts, timeout_ms, summaries)
+        if sc.status == "failed" and defined_goal(c) is not c:  # a division its premises let see a zero?
+            sc = name_undefined(sc, c, cn, enc, hyps + prod_assumptions, who, cone_ctx, timeout_ms)
         if sc.status != "discharged":  # neither locally nor in context: a power of ten between the ranges?
             scale = tuple(probable_mismatches(checked, model.links_into(node), enc, node, c))
             if scale:
@@ -337,13 +340,14 @@ def _in_context_step(checked: Checked, model: SystemModel, node: str, c: ast.Exp
     who = ", ".join(model.producers(node))
     env_of = lambda m: environment_conjuncts(checked, model, m)  # noqa: E731
     comment = head + "\nvariant: " + VARIANT_IN_CONTEXT
-    cr = (decide_by_summaries(checked, model, node, c, env_of, facts, comment + " (the summaries of the "
+    goal = defined_goal(c)
+    cr = (decide_by_summaries(checked, model, node, goal, env_of, facts, comment + " (the summaries of the "
                               "producers' cones)", timeout_ms) if summaries else None)
     if cr is not None:  # proved from the producers' summaries: the cone is not read (calculus/summary.py)
         return in_context(sc, cr, ConeView(tuple(model.upstream(node)), ()), who), cone_ctx
     if cone_ctx is None:
         cone_ctx = ConeContext(checked, model, node, env_of, facts)
-    cr = cone_ctx.decide(c, comment + " (the upstream cone; each guarantee under its node's assumption)",
+    cr = cone_ctx.decide(goal, comment + " (the upstream cone; each guarantee under its node's assumption)",
                          timeout_ms)
     read_from = {x.split(".", 1)[0] for x in links}
     keep: set[str] = ({node}.union(*(model.upstream(p) for p in read_from)) if read_from

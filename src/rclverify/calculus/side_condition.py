@@ -7,15 +7,27 @@ and then with their assumptions; one neither variant discharges is decided
 again against its upstream cone (:mod:`.context`, :mod:`.summary`), and
 :func:`in_context` folds that verdict into the record.  The explanations
 say in words what Z3 answered (docs/calculus.md).
+
+A conjunct that divides is proved with its well-definedness conditions
+(docs/semantics.md, "Definedness"): the goal is :func:`defined_goal`, and
+a side condition that is not discharged names the condition its
+producers' guarantees do not ensure (:func:`undefined_note`).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Callable, Protocol, Sequence
+
+import z3
 
 from rclverify.calculus.context import ConeContext, ContextResult
 from rclverify.calculus.shapes import ContextRecord, LocalVerdict, ScaleMismatch
-from rclverify.semantics.query import QueryResult
+from rclverify.lang import ast
+from rclverify.lang.types import CheckedNode
+from rclverify.semantics.definedness import conditions, guarded
+from rclverify.semantics.encode import Encoder
+from rclverify.semantics.query import QueryResult, prove
 
 STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive"}
 
@@ -62,6 +74,68 @@ class SideCondition:
                 "explanation": self.explanation, "variant": self.variant, "links": list(self.links),
                 "verdict": self.verdict or self.status, "context": self.context,
                 **({"scale_mismatch": list(self.scale)} if self.scale else {})}
+
+
+def defined_goal(c: ast.Expr) -> ast.Expr:
+    """The formula a side condition proves for conjunct ``c``: ``c`` and its
+    well-definedness conditions (:func:`rclverify.semantics.definedness.guarded`;
+    ``c`` itself when it does not divide)."""
+    return guarded(c)
+
+
+class _Answer(Protocol):
+    """What :func:`undefined_note` reads of an answer (a :class:`QueryResult` or a :class:`ContextResult`)."""
+
+    @property
+    def status(self) -> str: ...
+
+    @property
+    def model(self) -> dict[str, str] | None: ...
+
+
+def undefined_note(c: ast.Expr, decide: Callable[[ast.Expr, str], _Answer], premises: str
+                   ) -> tuple[str, dict[str, str] | None]:
+    """Why a conjunct ``c`` that divides is not proved, when the reason is a
+    division: ``(sentence, counterexample)`` for the first of its
+    well-definedness conditions that ``decide`` (a formula and a comment ->
+    Z3's answer, ``refuted`` with a model when the premises of the side
+    condition's verdict allow it false) refutes, e.g. " It is not defined
+    there: the division at f.rcl:3:20 needs in.d != 0, which the guarantees
+    of P do not ensure (counterexample: in.d = 0)." with ``premises`` "the
+    guarantees of P"; ``("", None)`` when no condition is refuted (the
+    conjunct itself is what fails) or ``c`` does not divide."""
+    for cond in conditions(c):
+        r = decide(cond.formula, f"rclverify definedness of {cond.where}: {cond.text}; unsat means defined")
+        if r.status == "refuted":
+            shown = ", ".join(f"{k} = {v}" for k, v in sorted((r.model or {}).items()))
+            return (f" It is not defined there: {cond.describe()}, which {premises} do not ensure"
+                    + (f" (counterexample: {shown})." if shown else "."), r.model)
+    return "", None
+
+
+def local_decider(cn: CheckedNode, enc: Encoder, hyps: Sequence[z3.BoolRef], timeout_ms: int
+                  ) -> Callable[[ast.Expr, str], QueryResult]:
+    """The ``decide`` of :func:`undefined_note` for a side condition of
+    node ``cn`` decided locally: is the formula valid under ``hyps``?"""
+    return lambda f, comment: prove(enc.formula(f, cn), list(hyps), enc, timeout_ms=timeout_ms, comment=comment)
+
+
+def name_undefined(sc: SideCondition, c: ast.Expr, cn: CheckedNode, enc: Encoder, hyps: Sequence[z3.BoolRef],
+                   who: str, cone: ConeContext | None, timeout_ms: int) -> SideCondition:
+    """``sc`` (failed; conjunct ``c`` of node ``cn``'s assumption, which
+    divides) with the definedness condition behind its failure named
+    (:func:`undefined_note`): decided in context over ``cone`` when its
+    verdict was, else from ``hyps`` (the producers' guarantees and
+    assumptions; ``who`` names the producers).  The counterexample becomes
+    the one with the zero divisor.  ``sc`` unchanged when every condition
+    is proved."""
+    if sc.variant == VARIANT_IN_CONTEXT and cone is not None:
+        in_cone = cone
+        note, model = undefined_note(c, lambda f, comment: in_cone.decide(f, comment, timeout_ms),
+                                     "the premises of its upstream cone")
+    else:
+        note, model = undefined_note(c, local_decider(cn, enc, hyps, timeout_ms), f"the guarantees of {who}")
+    return dataclasses.replace(sc, explanation=sc.explanation + note, model=model) if note else sc
 
 
 def explain_local(node: str, who: str, producers: Sequence[str], links: Sequence[str], assumptions: bool,
