@@ -133,3 +133,50 @@ def test_side_condition_dividing_by_a_possible_zero_fails_with_the_condition_nam
 def test_side_condition_control_with_the_divisor_off_zero_is_discharged() -> None:
     sc = _side_condition(1)
     assert sc.status == "discharged", sc.explanation
+
+
+# ---------------------------------------------------------------------------
+# requirements (calculus/requirements/check.py; own_nodes asks the same query)
+# ---------------------------------------------------------------------------
+
+REQ_RCL = """\
+node Divider {{
+  inputs( n : INTEGER, d : INTEGER )
+  outputs( r : REAL, dd : INTEGER, nn : INTEGER )
+  guarantee( {low} <= out.dd <= 10 and out.r == out.nn / out.dd )
+}}
+"""
+REQ_PLAN = """\
+contracts: [contracts/divider.rcl]
+requirements:
+  - id: QUOTIENT
+    text: the quotient is the numerator over the divisor
+    formal: "Divider.out.r == Divider.out.nn / Divider.out.dd"
+"""
+
+
+def _requirement(tmp_path: Path, low: int) -> dict[str, Any]:
+    from rclverify.app.pipeline import Workspace
+    from rclverify.calculus.requirements import own_nodes
+    from rclverify.semantics import world
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts/divider.rcl").write_text(REQ_RCL.format(low=low))
+    (tmp_path / "contracts/plan.yaml").write_text(REQ_PLAN)
+    w = Workspace(tmp_path)
+    (req,) = w.plan.requirements
+    world.fresh()
+    return own_nodes.decide(req, w.checked, w.model, w.plan)
+
+
+def test_requirement_dividing_by_a_possible_zero_is_refuted_with_the_condition_named(tmp_path: Path) -> None:
+    rec = _requirement(tmp_path, 0)
+    assert rec["verdict"] == "refuted", rec
+    assert "needs Divider.out.dd != 0" in rec["explanation"]
+    assert "contracts/plan.yaml:5:" in rec["explanation"]
+    values = {f"{row['node']}.{k}": v for row in rec["counterexample"] for k, v in row["values"].items()}
+    assert values["Divider.out.dd"] == "0", values
+
+
+def test_requirement_control_with_the_divisor_off_zero_is_proved(tmp_path: Path) -> None:
+    rec = _requirement(tmp_path, 1)
+    assert rec["verdict"] == "proved", rec

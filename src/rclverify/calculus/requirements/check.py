@@ -19,7 +19,10 @@ discharges them as side conditions from the producers' guarantees, and a
 guarantee used by a proof only counts once its node's side conditions are
 discharged (the roll-up, :mod:`.rollup`).
 
-One labelled satisfiability query of ``premises and not R`` decides it:
+One labelled satisfiability query of ``premises and not R`` decides it
+(``R`` with its well-definedness conditions, and those of the
+``assuming:`` formulas, when they divide: docs/semantics.md,
+"Definedness"; a refutation that divides by zero names the condition):
 
 ``proved``        unsat.  The unsat core, mapped back to the labelled premises
                   with their RCL source locations, is what the proof used; the
@@ -58,6 +61,7 @@ from rclverify.calculus.requirements.exercised import antecedent as _premise  # 
 from rclverify.calculus.compose import split_assumption
 from rclverify.calculus.shapes import TraceNode
 from rclverify.records.stage_records import RequirementBase
+from rclverify.semantics.definedness import Condition, conditions, conjoin
 from rclverify.semantics.encode import Encoder
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, satisfiable, solver_session
@@ -226,16 +230,56 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return out
     out.update(used=[], traced_not_needed=[])
     if r.status == "sat":
+        undefined = _undefined(q, formal, assuming, symbols, req.id, timeout_ms)
+        refuting = q.labelled
+        if undefined is not None:  # not defined where the premises allow: that condition and its model
+            cond, refuting, r = undefined
+            out["explanation"] = (f"The statement is not defined where the premises allow it: {cond.describe()}, "
+                                  "which the premises do not ensure (the counterexample divides by zero); a "
+                                  "statement is proved only where it is defined (docs/semantics.md, "
+                                  "\"Definedness\").")
         mentioned = {enc.symbol_name(n, p, v) for f in (formal,) for n, p, v in f.mentions}
         hit = [lbl for lbl, syms in q.g_symbols.items() if syms & mentioned]
         first = [l for l in hit if l in traced] or hit
         from rclverify.calculus.requirements.readable import readable_counterexample  # within the assumptions, short values; deferred: optional or conditional (inside a block); deferred: optional or conditional (inside a block)
-        shown, note = readable_counterexample(q.labelled, r.model or {}, cone, checked, model, enc)
+        shown, note = readable_counterexample(refuting, r.model or {}, cone, checked, model, enc)
         out.update(verdict="refuted", counterexample=_counterexample(shown, cone, checked, enc),
                    failed_to_prevent=[q.by_label[l] for l in first], **note)
         return out
     out.update(verdict="inconclusive", reason=r.reason or "unknown")
     return out
+
+
+def definedness(formal: Formal, assuming: Sequence[Formal], enc: Encoder, symbols: dict[str, z3.AstRef]
+                ) -> list[tuple[Condition, z3.BoolRef]]:
+    """The well-definedness conditions of a requirement's ``assuming:``
+    formulas (each under the ones before it) and of its statement
+    (:func:`rclverify.semantics.definedness.conditions`), each with its Z3
+    formula over the statements' ``symbols``; empty when nothing divides."""
+    out: list[tuple[Condition, z3.BoolRef]] = []
+    before: list[ast.Expr] = []
+    for f in (*assuming, formal):
+        for c in conditions(f.expr):
+            closed = c.formula if not before else ast.Binary("->", conjoin(before, f.expr.loc), c.formula, c.loc)
+            out.append((c, enc.formula(closed, f.scope, symbols)))
+        before.append(f.expr)
+    return out
+
+
+def _undefined(q: "_Query", formal: Formal, assuming: Sequence[Formal], symbols: dict[str, z3.AstRef], rid: str,
+               timeout_ms: int) -> tuple[Condition, list[tuple[str, z3.BoolRef]], QueryResult] | None:
+    """The first definedness condition of the statement the query's
+    premises do not ensure, with the labelled query that breaks it (the
+    premises and the condition negated) and its answer (``sat``, with the
+    model); ``None`` when each is ensured or undecided."""
+    premises = [(lbl, f) for lbl, f in q.labelled if lbl != NEGATED]
+    for cond, f in definedness(formal, assuming, q.enc, symbols):
+        asked = [*premises, ("undefined", z3.Not(f))]
+        r = satisfiable(asked, q.enc, timeout_ms=timeout_ms,
+                        comment=f"rclverify requirement {rid}: is {cond.text} ({cond.where}) ensured? sat means not")
+        if r.status == "sat":
+            return cond, asked, r
+    return None
 
 
 def _ask(base: RequirementBase, nodes: Sequence[str], formal: Formal, assuming: Sequence[Formal], checked: Checked,
@@ -257,7 +301,10 @@ def _ask(base: RequirementBase, nodes: Sequence[str], formal: Formal, assuming: 
                for f in (formal, *assuming) for n, p, v in f.mentions}
     for k, a in enumerate(assuming, 1):
         q.add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))
+    defined = [f for _, f in definedness(formal, assuming, enc, symbols)]
     goal = enc.formula(formal.expr, formal.scope, symbols)
+    if defined:  # the statement and its definedness (docs/semantics.md, "Definedness")
+        goal = z3.And(*defined, goal)
     q.labelled.append((NEGATED, z3.Not(goal)))
     head = (f"rclverify requirement {base['id']}: {base['formal']}\nsource {base['source']}; "
             "unsat means the requirement follows from the premises" + note)
