@@ -6,9 +6,12 @@ a running system adds (docs/monitors.md, "Live monitoring"):
 
 * **ordering**: a message is stamped with its ``header.stamp`` when it has
   one (ROS 1 ``secs``/``nsecs``, ROS 2 ``sec``/``nanosec``, nested or
-  flattened), else with its receipt time; messages wait in a reorder buffer
-  for ``reorder_window`` seconds and are released to the monitors in stamp
-  order (ties in arrival order).  A message older than the last one
+  flattened), else with its event time (the publisher's source timestamp on
+  ROS 2, the receipt on ROS 1: :mod:`rclverify.traces.event_time`); messages
+  wait in a reorder buffer until the watermark (the clock less
+  ``reorder_window`` seconds, the lateness bound) passes them and are
+  released to the monitors in stamp order (equal stamps by event time, then
+  in arrival order).  A message older than the last one
   released arrives too late to be ordered: it is still checked (at the
   current clock, never dropped silently) and counted in ``late`` (the
   largest lag in ``max_late_s``); its own stamp decides what it answers, and
@@ -35,6 +38,7 @@ from typing import Any, Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.event_time import order_key
 from rclverify.traces.events import Event, header_stamp, header_stamp_ns
 from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
@@ -77,7 +81,7 @@ class OnlineEngine:
     late: int = field(init=False, default=0)
     max_late_s: float = field(init=False, default=0.0)
     released: int = field(init=False, default=0)
-    _heap: list[tuple[float, int, str, Mapping[str, object], str]] = field(init=False, default_factory=list)
+    _heap: list[tuple[float, float, int, str, Mapping[str, object], str]] = field(init=False, default_factory=list)
     _seq: Any = field(init=False, default_factory=itertools.count)
     _clock: float = field(init=False, default=-math.inf)
 
@@ -88,8 +92,11 @@ class OnlineEngine:
 
     # -- input -------------------------------------------------------------------
     def push(self, topic: str, fields: Mapping[str, object], received: float, where: str = "") -> None:
-        """One message as received: ``topic`` (with or without ``/``), its fields,
-        the receipt time (s).  Ordered by its header stamp when it has one."""
+        """One message as heard: ``topic`` (with or without ``/``), its fields,
+        its event time (s: the publisher's source timestamp where the source
+        gives one, else the receipt; :mod:`rclverify.traces.event_time`).
+        Ordered by its header stamp when it has one, else by that time; equal
+        stamps by that time, then in the order heard."""
         topic = topic.lstrip("/")
         status = self.topics.get(topic)
         if status is None:
@@ -102,7 +109,7 @@ class OnlineEngine:
                 self.on_silence(topic, 0.0, False)
         stamp = header_stamp(fields)
         t = received if stamp is None else stamp
-        heapq.heappush(self._heap, (t, next(self._seq), topic, fields, where))
+        heapq.heappush(self._heap, (*order_key(t, received, next(self._seq)), topic, fields, where))
         if self.reorder_window <= 0:
             self._release(math.inf)
 
@@ -121,7 +128,7 @@ class OnlineEngine:
 
     def _release(self, upto: float) -> None:
         while self._heap and self._heap[0][0] <= upto:
-            t, _, topic, fields, where = heapq.heappop(self._heap)
+            t, _, _, topic, fields, where = heapq.heappop(self._heap)
             stamp = None
             if t < self._clock:
                 self.late += 1

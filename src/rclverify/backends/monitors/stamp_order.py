@@ -33,6 +33,7 @@ import heapq
 import math
 from typing import Any, Callable, Iterable, Iterator
 
+from rclverify.traces.event_time import order_key
 from rclverify.traces.events import Event, header_stamp
 
 
@@ -116,23 +117,25 @@ class StampWatch:
 
 
 def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
-    """``events`` in the order of their stamps on the run's clock (ties in
-    the order read), each with that stamp as its ``time`` and its index in
+    """``events`` in the order of their stamps on the run's clock (equal
+    stamps by their recorded times, the publishers' source times in a bag
+    the live monitor wrote, then in the order read:
+    :func:`rclverify.traces.event_time.order_key`), each with that stamp as its ``time`` and its index in
     the new order; ``lag`` (s) is the largest lag a :class:`StampWatch`
     measured on the same run, which bounds what the buffer holds."""
-    heap: list[tuple[float, int, Event]] = []
+    heap: list[tuple[float, float, int, Event]] = []
     latest = -math.inf
     out = 0
     for k, ev in enumerate(events):
         t = run_clock(ev)
         latest = max(latest, t)
-        heapq.heappush(heap, (t, k, ev))
+        heapq.heappush(heap, (*order_key(t, ev.time, k), ev))
         while heap and heap[0][0] < latest - lag:
-            t0, _, e0 = heapq.heappop(heap)
+            t0, _, _, e0 = heapq.heappop(heap)
             yield Event(out, t0, e0.topic, e0.fields, e0.where)
             out += 1
     while heap:
-        t0, _, e0 = heapq.heappop(heap)
+        t0, _, _, e0 = heapq.heappop(heap)
         yield Event(out, t0, e0.topic, e0.fields, e0.where)
         out += 1
 

@@ -51,6 +51,7 @@ from rclverify.runtime.live import VERDICT_LOG_TOPIC, LiveRun, dumps, stop_and_r
 from rclverify.runtime.ros1 import contract_topics
 from rclverify.runtime.worker import EngineWorker
 from rclverify.runtime.dds.bag import BagError
+from rclverify.traces.event_time import event_ns
 from rclverify.runtime.dds.bus import Bus
 from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade
 
@@ -166,6 +167,7 @@ class _DdsRun:
         self.calls: CallTaps | None = None
         self.call_counts: dict[tuple[str, str], int] = {}
         self.bus: Any = None  # the DDS bus, or the rclpy source's (join)
+        self.receipt_timed = 0  # samples placed at their receipt: no source time, or one ahead of the clock
 
     def open_recorder(self, record: tuple[Path, str] | None, msg_dirs: list[Path] | None) -> None:
         """The bag the run is written to, when ``record`` names one: the contract topics'
@@ -209,7 +211,12 @@ class _DdsRun:
             return (bytes(guid) or None) if guid is not None else writers.of(tap.reader, info)
 
         def on_sample(tap: Any, raw: bytes, info: Any, rns: int) -> None:
-            self.worker_box[0].offer(tap.key, (raw, info.source_timestamp, rns, writer_of(tap, info)), rns / 1e9)
+            # the robot's time: the publisher's source timestamp (event_time.py), the receipt only without one
+            source_ns = int(getattr(info, "source_timestamp", 0) or 0)
+            ens, from_source = event_ns(source_ns, rns)
+            if not from_source:
+                self.receipt_timed += 1
+            self.worker_box[0].offer(tap.key, (raw, source_ns, rns, writer_of(tap, info), ens), ens / 1e9)
         if bus_factory is not None:
             self.bus = bus = bus_factory(on_sample, self.warn, on_reader=self.on_reader,
                                          type_hash=self.types.type_hash)
@@ -299,7 +306,7 @@ class _DdsRun:
             self.decode_errors[key] = self.decode_errors.get(key, 0) + 1
             return None
         if self.recorder is not None:
-            self.recorder.write(key, received_ns, raw)
+            self.recorder.write(key, payload[4], raw)  # at its event time, as the log and the engine place it
         if key in self.enforce:
             self.live.stash(fields, raw)  # type: ignore[attr-defined]
         return fields
@@ -351,7 +358,8 @@ class _DdsRun:
         qos = {t.key: t.to_json() for t in bus.taps}
         for key, n in getattr(bus, "before", {}).items():
             qos[key]["published_before_heard"] = n
-        record_.update(warnings=self.warnings, decode_errors=self.decode_errors, qos=qos)
+        record_.update(warnings=self.warnings, decode_errors=self.decode_errors, qos=qos,
+                       event_time={"clock": "source timestamp", "receipt_timed": self.receipt_timed})
         if summary is not None and book is not None:
             record_["calls"] = _calls_record(summary, book, calls)
             record_["deadlines"] = {"results": summary["deadlines"], "false": summary["false"]}
