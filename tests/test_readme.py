@@ -14,7 +14,7 @@ def test_the_readme_is_short_and_starts_with_the_two_commands() -> None:
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     assert len(text.splitlines()) < 150
     blocks = re.findall(r"```sh\n(.*?)\n```", text, flags=re.S)
-    assert blocks[:2] == ["bash scripts/setup.sh && .venv/bin/rclverify verify",
+    assert blocks[:2] == ["bash scripts/setup.sh && .venv/bin/doit verify",
                           "bash scripts/setup.sh --tests && .venv/bin/python -m pytest -n 3"]
     assert text.index("```sh") < text.index("\n## ", text.index("## Quick start") + 1)
     assert 'pytest -m "not slow and not live"' in text
