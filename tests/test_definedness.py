@@ -180,3 +180,41 @@ def test_requirement_dividing_by_a_possible_zero_is_refuted_with_the_condition_n
 def test_requirement_control_with_the_divisor_off_zero_is_proved(tmp_path: Path) -> None:
     rec = _requirement(tmp_path, 1)
     assert rec["verdict"] == "proved", rec
+
+
+# ---------------------------------------------------------------------------
+# contract health (calculus/health/defined.py)
+# ---------------------------------------------------------------------------
+
+HEALTH_RCL = """\
+node Divider {{
+  inputs( n : INTEGER, d : INTEGER )
+  outputs( r : REAL )
+  assume( {low} <= in.d and in.d <= 10 )
+  assume( in.d == 0 or in.n / in.d >= 0 )
+  guarantee( out.r == in.n / in.d )
+}}
+"""
+
+
+def _health(low: int) -> dict[str, Any]:
+    from rclverify.calculus.health.checks import check_node
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    checked = check([parse_text(HEALTH_RCL.format(low=low), "divider.rcl")])
+    return {f.id: f for f in check_node(checked, "Divider") if f.check == "defined"}
+
+
+def test_health_guarantee_dividing_by_a_possible_zero_is_a_problem_named() -> None:
+    found = _health(0)
+    assert found["Divider.a2.defined"].status == "ok"  # guarded by `in.d == 0 or`
+    g = found["Divider.g1.defined"]
+    assert g.status == "problem", g
+    assert "the division at divider.rcl:6:23 needs in.d != 0" in g.message
+    assert g.model is not None and g.model["Divider.in.d"] == "0"
+
+
+def test_health_control_with_the_divisor_off_zero_is_ok() -> None:
+    found = _health(1)
+    assert set(found) == {"Divider.a2.defined", "Divider.g1.defined"}
+    assert all(f.status == "ok" for f in found.values())

@@ -22,6 +22,10 @@ decide is examined instance by instance.
 Findings: ``ok`` (with a witness model), ``problem`` (with an unsat core in
 RCL terms: which clauses contradict each other), ``inconclusive`` (Z3 could
 not decide within the timeout; never counted as ok).
+
+A contract that divides gets a ``defined`` finding per clause that does
+(:mod:`.defined`): each division's divisor is non-zero wherever the
+clause is read.
 """
 from __future__ import annotations
 
@@ -38,6 +42,7 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.typecheck import domain_type
 from rclverify.lang.types import NATURAL, Checked, CheckedNode
+from rclverify.calculus.health.defined import definedness_findings
 from rclverify.calculus.health.finding import Finding as Finding  # re-exported: callers import it from here too
 from rclverify.calculus.health.realizable import realizability_findings
 from rclverify.calculus.health.shape import shape_findings
@@ -248,6 +253,9 @@ def _check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast
     done(mark)
     mark = len(out)
     out += shape_findings(checked, node, formulas=table)
+    done(mark)
+    mark = len(out)
+    out += definedness_findings(checked, node, facts, timeout_ms)  # only for a contract that divides
     done(mark)
     return out
 
