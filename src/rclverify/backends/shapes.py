@@ -124,8 +124,11 @@ class ChecklistAnswer(TypedDict):
 
 
 class ReviewDetails(TypedDict):
-    """A review record's evidence ``details``."""
+    """A review record's evidence ``details``: ``author`` who wrote what was reviewed (``""``: not named),
+    ``independence`` the record's stated level (``""``: not stated)."""
     reviewer: str
+    author: str
+    independence: str
     date: str
     scope: str
     files: list[ReviewedFile]

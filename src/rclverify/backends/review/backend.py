@@ -115,7 +115,9 @@ class ReviewBackend:
         qs: list[Question] = [q for q in checklist(target.node) if q.guarantee == obligation.guarantee]
         status, explanation, details = judge(rec, qs, target.root, assumption_text(target.node))
         details["record"] = rel
-        details["figures_table"] = ([["reviewer", rec.reviewer], ["date", rec.date], ["scope", rec.scope],
+        details["figures_table"] = ([["reviewer", rec.reviewer], ["author", rec.author or "(not named)"],
+                                     ["independence", rec.independence or ("(not stated)" if rec.author else "(not shown)")],
+                                     ["date", rec.date], ["scope", rec.scope],
                                      ["verdict", rec.verdict or "(none)"]]
                                     + [[f"{q['id']} ({q['location']})", f"{q['answer'] or 'unanswered'}: {q['question']}"
                                         + (f" -- {q['note']}" if q["note"] else "")] for q in details["checklist"]]

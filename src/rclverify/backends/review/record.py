@@ -4,6 +4,8 @@ Record (YAML)::
 
     node: Localisation
     reviewer: <who reviewed; say so when unknown>
+    author: <who wrote what was reviewed>          # optional; needed for independence
+    independence: person                # optional: person | department | organisation
     date: <YYYY-MM-DD, or text saying it is unknown>
     scope: <what was reviewed, against what>
     files:                              # the reviewed files, workspace-relative
@@ -12,6 +14,14 @@ Record (YAML)::
     checklist:                          # one answer per generated question
       - {id: g1.c1, conjunct: <RCL>, answer: yes, note: <why>}   # yes | no | (empty: unanswered)
     verdict: pass                       # pass | fail | (empty: not decided)
+
+``author`` and ``independence`` say who checked what: a review counts for
+a standard's clause that asks independence (IEC 61508-1:2010 clause 8.2.18,
+DO-178C 6.2 "with independence") only when the record names both its
+reviewer and its author, they differ, and ``independence`` (``person``
+when left out) is at least the clause's (docs/standards.md).  A record
+may leave them out: it is still a review, shown everywhere, never counted
+as independent.
 
 The checklist has one question per conjunct of each guarantee (top-level
 ``and`` split), with the conjunct's RCL location, so a reviewer knows what
@@ -92,6 +102,8 @@ class ReviewRecord:
     verdict: str | None
     conjuncts: Mapping[str, str] = field(default_factory=dict)
     assumption: str | None = None
+    author: str = ""
+    independence: str = ""
 
 
 def _answer(v: Any, where: str) -> str | None:
@@ -131,12 +143,17 @@ def parse_record(text: str, file: str) -> ReviewRecord:
         if q.get("conjunct") is not None:
             conjuncts[str(q["id"])] = str(q["conjunct"])
     assumption = data.get("assumption")
+    independence = str(data.get("independence") or "").strip()
+    if independence not in ("", "person", "department", "organisation"):
+        raise RecordError(f"{file}: independence must be person, department or organisation (IEC 61508-1 "
+                          f"clause 8), found {independence!r}")
     verdict = data["verdict"]
     if verdict not in (None, "", "pass", "fail"):
         raise RecordError(f"{file}: verdict must be pass, fail or empty, found {verdict!r}")
     return ReviewRecord(str(data["node"]), str(data["reviewer"] or "").strip(), str(data["date"] or "").strip(),
                         str(data["scope"] or "").strip(), tuple(files), answers, notes, verdict or None, conjuncts,
-                        None if assumption is None else str(assumption))
+                        None if assumption is None else str(assumption), str(data.get("author") or "").strip(),
+                        independence)
 
 
 def assumption_text(node: CheckedNode) -> str:
@@ -196,7 +213,8 @@ def judge(record: ReviewRecord, questions: list[Question], root: Path,
     * an unanswered question, no verdict, or no reviewed file -> ``pending``;
     * otherwise ``discharged``.
     """
-    details: ReviewDetails = {"reviewer": record.reviewer, "date": record.date, "scope": record.scope,
+    details: ReviewDetails = {"reviewer": record.reviewer, "author": record.author,
+                              "independence": record.independence, "date": record.date, "scope": record.scope,
                                "files": [{"path": p, "sha256": h} for p, h in record.files], "verdict": record.verdict,
                                "checklist": [{"id": q.id, "question": q.question, "location": q.location,
                                               "answer": record.answers.get(q.id), "note": record.notes.get(q.id, "")}
