@@ -85,3 +85,64 @@ def test_an_item_id_used_twice_names_the_first() -> None:
     text = GOOD + GOOD[GOOD.index("  - id"):]
     msg = _error(text)
     assert "'T 1' is used twice (first at line 7)" in msg and msg.startswith("std/mine.yaml:12:")
+
+
+# --- the profiles' own text (docs/standards.md, "The built-in profiles") -------------------------
+
+def test_functional_testing_of_the_integrated_system_is_a_7_4_not_modelling() -> None:
+    ids = {i.id: i for i in load_builtin("iec61508-3").items}
+    assert "A.7 4" in ids and "A.7 3" not in ids and "black-box" in ids["A.7 4"].title
+    left = dict(load_builtin("iec61508-3").left_out)
+    assert "modelling" in left["A.7 3"] and "A.5 3" in left  # data recording is not run data: left out, said why
+
+
+def test_standards_that_do_not_grade_hr_r_are_not_shown_so() -> None:
+    for name in ("ul4600", "iso13482", "do-333"):
+        p = load_builtin(name)
+        codes = {i.at(level) for i in p.items for level in (p.levels or (None,))}
+        assert codes <= {"required", "---"}, (name, codes)
+
+
+def test_do_333_codes_follow_the_profiles_own_rule() -> None:
+    """``required`` where the table has objectives at the level, ``---`` where none: the low-level requirements
+    and source code tables have none at level D, and independence is asked at levels A and B only."""
+    items = {i.id: i for i in load_builtin("do-333").items}
+    assert [items["FM.A-4"].at(d) for d in "ABCD"] == ["required", "required", "required", "---"]
+    assert [items["FM.A-5"].at(d) for d in "ABCD"] == ["required", "required", "required", "---"]
+    assert [items["FM.A-7"].independence_at(d) for d in "ABCD"] == ["person", "person", "none", "none"]
+
+
+OUTCOME_WORDS = ("argued safe", "reach their", "are met", "meet their", "achieved", "shown to", "checked complete",
+                 "analysed formally", "qualified")
+
+
+def test_titles_say_what_a_clause_asks_not_an_outcome() -> None:
+    for name in builtin_names():
+        for item in load_builtin(name).items:
+            assert not any(w in item.title.lower() for w in OUTCOME_WORDS), (name, item.id, item.title)
+            assert item.about and item.evidence
+
+
+def test_every_builtin_profile_says_what_it_leaves_out() -> None:
+    for name in builtin_names():
+        p = load_builtin(name)
+        assert p.left_out and all(why for _, why in p.left_out), name
+        assert not {i.id for i in p.items} & {x for x, _ in p.left_out}, name
+    # IEC 61508-3 at SIL 2: the profile lists its HR items, and names the Annex A items it leaves out
+    iec = load_builtin("iec61508-3")
+    assert sum(1 for i in iec.items if i.at("2") == "HR") == 8 and len(iec.left_out) >= 20
+
+
+def test_no_claim_of_every_clause_of_each_standard() -> None:
+    root = Path(__file__).resolve().parents[1]
+    for rel in ("src/rclverify/report/templates/parts/standards.md.j2",
+                "src/rclverify/report/templates/parts/standards.html.j2", "docs/standards.md"):
+        assert "every clause of each standard" not in (root / rel).read_text(encoding="utf-8"), rel
+
+
+def test_independence_per_level_must_name_the_levels() -> None:
+    msg = _error(GOOD.replace('recommendation: {"1": R, "2": HR}',
+                              'recommendation: {"1": R, "2": HR}\n    independence: {"1": person}'))
+    assert msg.startswith("std/mine.yaml:12:19: error:") and "independence names levels 1" in msg
+    assert _error(GOOD.replace("strength: proof", "strength: proof\n    about: everything")).startswith(
+        "std/mine.yaml:11:12: error:")

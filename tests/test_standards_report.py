@@ -62,10 +62,17 @@ def test_the_json_part_maps_the_tests_and_matches_the_schema(ws: Path) -> None:
     clauses = {c["id"]: c for c in iec["clauses"]}
     assert clauses["B.2 1"]["status"] == "covered"
     assert clauses["B.2 1"]["evidence"][0]["backend"] == "property_tests"
+    assert clauses["B.2 1"]["covered_by"] == ["Gain.g1.property_tests.e0"]
+    assert clauses["B.2 1"]["scope"] == [{"item": "Gain g1", "kind": "guarantee", "covered": True, "state": "covered",
+                                          "detail": "covered", "evidence": ["Gain.g1.property_tests.e0"]}]
+    assert clauses["B.2 1"]["checked_by"][0].startswith("property_tests (")
     assert clauses["A.9 1"]["status"] == "open" and "A.9 1" in iec["open"]
     assert "B.8 6c" in iec["required_not_covered"] and "B.2 1" not in iec["required_not_covered"]
     assert ul["level"] is None and "16" in ul["required_not_covered"]
-    assert any(p.startswith("Standard IEC 61508-3:2010 SIL 2: ") for p in report["summary"]["problems"])
+    assert iec["origin"]["kind"] == "built-in" and iec["origin"]["file"].endswith("iec61508-3.yaml")
+    assert len(iec["origin"]["sha256"]) == 64 and iec["left_out"]
+    assert any(p.startswith("Standard IEC 61508-3:2010 SIL 2 (built-in profile): ")
+               for p in report["summary"]["problems"])
     assert report["meta"]["strict_ok"] is False
 
 
@@ -73,6 +80,8 @@ def test_the_markdown_and_html_sections(ws: Path) -> None:
     md = (ws / "reports" / "assurance.md").read_text(encoding="utf-8")
     assert "### Safety standards (traceability aid)" in md and "#### IEC 61508-3:2010, SIL 2" in md
     assert "not a claim of compliance" in md and "| B.2 1 |" in md
+    assert "| Clause | What it asks | Recommendation | About | Evidence that covers it | Who checked it | Status | Why |" in md
+    assert "(profile `iec61508-3`, built-in, IEC 61508-3:2010;" in md and "Left out of this profile: A.1 1a" in md
     html = (ws / "reports" / "assurance.html").read_text(encoding="utf-8")
     assert '<h3 id="standards">' in html and "<td>A.9 1</td>" in html
 
@@ -88,13 +97,14 @@ def test_strict_names_the_items(ws: Path, capsys: pytest.CaptureFixture[str]) ->
 def test_the_part_without_a_pipeline() -> None:
     choice = StandardChoice(load_builtin("do-333"), "D", Loc("p.yaml", 3, 5), strict=True)
     rows = [{"obligation": "A.g1.review", "backend": "review", "kind": "review", "status": "discharged"}]
-    part = standards_part([choice], rows)
-    assert part["ok"] is False and part["rows"][0]["required_not_covered"] == ["FM.A-6"]
+    part = standards_part([choice], rows)  # evidence rows alone: nothing is in any clause's scope
+    assert part["ok"] is False and part["rows"][0]["required_not_covered"] == ["FM.A-3", "FM.A-6", "FM.A-7"]
+    assert part["rows"][0]["counts"]["open"] == 5 and part["rows"][0]["counts"]["covered"] == 0
     # without strict: true the item is shown and named in the summary's problems, and --strict does not fail on it
     shown = standards_part([StandardChoice(load_builtin("do-333"), "D", Loc("p.yaml", 3, 5))], rows)
     assert shown["ok"] is True and len(shown["problems"]) == 1 and strict_reason({"standards": shown["rows"]}) == []
     assert strict_reason({"standards": part["rows"]}) == [
-        "RTCA DO-333 (2011) DAL D: highly recommended item not covered (FM.A-6)"]
+        "RTCA DO-333 (2011) DAL D: required items not covered (FM.A-3, FM.A-6, FM.A-7)"]
     assert standards_part([], rows) == {"rows": [], "problems": [], "ok": True}
 
 
@@ -128,7 +138,11 @@ def test_the_bundle_carries_the_mapping_and_the_own_profile(ws: Path, tmp_path: 
     iec = manifest["standards"][0]
     assert iec["profile"] == "iec61508-3" and iec["level"] == "2"
     assert iec["clauses"]["B.2 1"] == {"status": "covered", "recommendation": "HR",
-                                       "evidence": ["Gain.g1.property_tests.e0"]}
+                                       "why": "all 1 item in scope covered",
+                                       "evidence": ["Gain.g1.property_tests.e0"],
+                                       "covered_by": ["Gain.g1.property_tests.e0"]}
+    assert iec["origin"]["kind"] == "built-in"
+
 
 
 def test_an_edited_own_profile_is_read_again(tmp_path: Path) -> None:

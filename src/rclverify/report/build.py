@@ -168,7 +168,7 @@ def undiagnosed_report(ws: Workspace) -> dict[str, Any]:
     confidence = confidence_part(report, [(l.from_node, l.to_node) for l in ws.model.links],
                                  {r.id: r.strength for r in all_requirements(plan) if r.strength})
     report = assemble.with_confidence(report, confidence)
-    standards = standards_part(plan.standards, report["evidence"])  # docs/standards.md
+    standards = standards_part(plan.standards, report)  # docs/standards.md
     report = assemble.with_standards(report, standards)
     # one severity per finding: --strict fails on every error and warning, health and lint warnings included
     return assemble.with_strict(report, bool(report["meta"]["strict_ok"]) and confidence["ok"]

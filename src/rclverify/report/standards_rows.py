@@ -1,12 +1,16 @@
 """The report's ``standards`` part: the evidence rows mapped onto the plan's standard profiles (docs/standards.md).
 
 One row per ``standards:`` entry of the plan, each with its clause rows
-(:func:`rclverify.model.plan.standards.mapping.clause_rows`) over the
-report's evidence rows once the confidence pass has given them their
-strength.  A clause recommended HR at the chosen level and not covered is
-a sentence of the summary's problems; ``--strict`` fails on it for a
-standard chosen with ``strict: true`` (:func:`strict_reason` names them).  The mapping is a
-traceability aid, not a compliance claim.
+(:func:`rclverify.model.plan.standards.mapping.clause_rows`: each clause's
+scope, the evidence in it, who checked it, its status and why) over the
+report once the confidence pass has given its evidence rows their
+strength, where the profile comes from (``origin``: ``built-in`` with its
+edition, or ``workspace`` with the file and its sha256) and the clauses
+the profile leaves out.  A clause the standard asks at the chosen level
+(``HR``, or ``required`` for a standard that does not grade) and not
+covered is a sentence of the summary's problems; ``--strict`` fails on it
+for a standard chosen with ``strict: true`` (:func:`strict_reason` names
+them).  The mapping is a traceability aid, not a compliance claim.
 """
 from __future__ import annotations
 
@@ -15,6 +19,23 @@ from typing import Any, Mapping, Sequence, TypedDict
 from rclverify.records.report_schema import EvidenceRow, Report
 from rclverify.model.plan.standards.choice import StandardChoice
 from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
+from rclverify.model.plan.standards.profiles import Profile
+
+
+class ProfileOrigin(TypedDict):
+    """Where a profile comes from (``standards[].origin``): ``kind`` ``built-in`` (one of rclverify's
+    profiles, ``file`` its package-relative path) or ``workspace`` (``file`` workspace-relative), with
+    the ``edition`` it names and the ``sha256`` of the file's bytes."""
+    kind: str
+    file: str
+    sha256: str
+    edition: str
+
+
+class LeftOut(TypedDict):
+    """A clause of the standard the profile does not list, and why (``standards[].left_out[]``)."""
+    id: str
+    why: str
 
 
 class StandardRow(TypedDict):
@@ -25,7 +46,9 @@ class StandardRow(TypedDict):
     level_name: str
     level: str | None
     source: str
+    origin: ProfileOrigin
     clauses: list[ClauseRow]
+    left_out: list[LeftOut]
     open: list[str]
     counts: dict[str, int]
     required_not_covered: list[str]
@@ -40,25 +63,43 @@ class StandardsPart(TypedDict):
     ok: bool
 
 
+def profile_origin(p: Profile) -> ProfileOrigin:
+    """Where the profile ``p`` comes from (:class:`ProfileOrigin`)."""
+    return {"kind": "built-in" if p.builtin else "workspace", "file": p.file, "sha256": p.sha256,
+            "edition": p.edition}
+
+
+def origin_text(origin: Mapping[str, Any]) -> str:
+    """``origin`` (a :class:`ProfileOrigin`) as one phrase: ``built-in profile`` or
+    ``workspace profile std/mine.yaml, sha256 <hex>``."""
+    if origin.get("kind") == "built-in":
+        return "built-in profile"
+    return f"workspace profile {origin.get('file')}, sha256 {origin.get('sha256')}"
+
+
 def _label(row: Mapping[str, Any]) -> str:
     level = f" {str(row['level_name']).upper()} {row['level']}" if row.get("level") is not None else ""
     return f"{row['edition']}{level}"
 
 
-def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[EvidenceRow]) -> StandardsPart:
-    """The ``standards`` part of the plan's ``choices`` over the report's
-    ``evidence`` rows (``obligation``, ``backend``, ``kind``, ``status``,
-    ``strength``).  Pure; raises nothing."""
+def standards_part(choices: Sequence[StandardChoice],
+                   report: Mapping[str, Any] | Sequence[EvidenceRow]) -> StandardsPart:
+    """The ``standards`` part of the plan's ``choices`` over ``report`` (the
+    report dict so far: its evidence rows with their strength, obligations,
+    nodes, side conditions, requirements, findings, unverified guarantees,
+    system and summary; a bare list of evidence rows reads as a report of
+    those rows alone).  Pure; raises nothing."""
     rows: list[StandardRow] = []
     problems: list[str] = []
     ok = True
     for c in choices:
-        clauses = clause_rows(c.profile, c.level, evidence)
+        clauses = clause_rows(c.profile, c.level, report)
         missing = not_covered(clauses)
         row: StandardRow = {
             "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,
             "level_name": c.profile.level_name, "level": c.level,
-            "source": f"{c.loc.file}:{c.loc.line}:{c.loc.col}", "clauses": clauses,
+            "source": f"{c.loc.file}:{c.loc.line}:{c.loc.col}", "origin": profile_origin(c.profile),
+            "clauses": clauses, "left_out": [{"id": i, "why": w} for i, w in c.profile.left_out],
             "open": [x["id"] for x in clauses if x["status"] == "open"],
             "counts": {s: sum(1 for x in clauses if x["status"] == s) for s in CLAUSE_STATUSES},
             "required_not_covered": missing, "strict": c.strict}
@@ -70,31 +111,33 @@ def standards_part(choices: Sequence[StandardChoice], evidence: Sequence[Evidenc
 
 
 def _missing_sentence(row: StandardRow, missing: Sequence[ClauseRow]) -> str:
-    """The summary's sentence for a standard's HR items not covered: each with
-    its title and why (no evidence of the kinds it accepts, or some of its
-    records not discharged), and where to read them."""
-    def why(c: ClauseRow) -> str:
-        if not c["evidence"]:
-            return f"no {' or '.join(c['accepts'])} evidence"
-        bad = sum(1 for e in c["evidence"] if e["status"] != "discharged")
-        return f"{bad} of its {len(c['evidence'])} records not discharged"
-    items = "; ".join(f"{c['id']} {c['title'].lower()} ({why(c)})" for c in missing)
-    return (f"Standard {_label(row)}: {len(missing)} highly recommended item{'s' if len(missing) != 1 else ''} "
-            f"not covered by discharged evidence: {items}; the report's section Safety standards lists each "
-            f"item's records")
+    """The summary's sentence for a standard's asked items not covered: each with
+    its title and why (its clause row's ``why``), where the profile comes
+    from, and where to read them."""
+    items = "; ".join(f"{c['id']} {c['title'][:1].lower()}{c['title'][1:]} ({c['why']})" for c in missing)
+    return (f"Standard {_label(row)} ({origin_text(row['origin'])}): {len(missing)} {_asked(row)} "
+            f"item{'s' if len(missing) != 1 else ''} not covered: {items}; the report's section Safety "
+            f"standards lists each item's scope and records")
+
+
+def _asked(row: Mapping[str, Any]) -> str:
+    """How the standard's asked items are called: highly recommended (a graded standard) or required."""
+    codes = {c["recommendation"] for c in row.get("clauses") or () if c["id"] in (row.get("required_not_covered") or ())}
+    return "highly recommended" if codes == {"HR"} else "required" if codes == {"required"} else "asked"
 
 
 def strict_reason(report: Report) -> list[str]:
     """Why the chosen standards fail ``--strict`` on ``report``: one clause
-    per standard chosen with ``strict: true`` naming its HR items not
-    covered (empty when none)."""
+    per standard chosen with ``strict: true`` naming its asked items (``HR``
+    or ``required``) not covered (empty when none)."""
     out = []
     for row in report.get("standards") or ():
         missing = list(row.get("required_not_covered") or ())
         if missing and row.get("strict"):
-            out.append(f"{_label(row)}: highly recommended item{'s' if len(missing) != 1 else ''} not covered ("
+            out.append(f"{_label(row)}: {_asked(row)} item{'s' if len(missing) != 1 else ''} not covered ("
                        + ", ".join(missing) + ")")
     return out
 
 
-__all__ = ["StandardRow", "StandardsPart", "standards_part", "strict_reason"]
+__all__ = ["LeftOut", "ProfileOrigin", "StandardRow", "StandardsPart", "origin_text", "profile_origin",
+           "standards_part", "strict_reason"]

@@ -2,8 +2,10 @@
 
 For each standard the plan names (the report's ``standards`` rows,
 report/standards_rows.py), every clause with supporting evidence becomes
-one GSN *context* (``C``) naming the standard, the clause, its own short
-title, its recommendation at the chosen level and its status.  A strategy
+one GSN *context* (``C``) naming the standard, where its profile comes
+from (built-in, or the workspace file and its sha256), the clause, its
+own short title, its recommendation at the chosen level, its status and
+why.  A strategy
 addresses a clause when a solution under it (through ``supported_by``)
 stands for an evidence row that supports the clause; the strategy then
 carries the clause's context in ``in_context_of``.  Contexts have no
@@ -16,6 +18,7 @@ from typing import Any, Mapping
 
 from rclverify.records.report_schema import Report
 from rclverify.report.argument.model import Element
+from rclverify.report.standards_rows import origin_text
 
 
 def _solutions_under(els: Mapping[str, Element], start: str) -> set[str]:
@@ -47,9 +50,10 @@ def add_standard_links(els: dict[str, Element], report: Report, ident: Any) -> N
             if not obligations:
                 continue
             cid = ident("C", "std", row["profile"], c["id"])
-            els[cid] = Element(cid, "context", f"{row['edition']}{level}, {c['id']}: {c['title']} "
-                               f"(recommendation {c['recommendation']}; {c['status']}; a traceability aid, "
-                               "not a compliance claim)", ref=f"{row['profile']}:{c['id']}")
+            els[cid] = Element(cid, "context", f"{row['edition']}{level} ({origin_text(row.get('origin') or {})}), "
+                               f"{c['id']}: {c['title']} (recommendation {c['recommendation']}; {c['status']}: "
+                               f"{c.get('why', '')}; a traceability aid, not a compliance claim)",
+                               ref=f"{row['profile']}:{c['id']}")
             clauses.append((cid, obligations))
     if not clauses:
         return

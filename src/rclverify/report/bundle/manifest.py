@@ -250,9 +250,14 @@ def build_manifest(root: Path, plan: Plan, files: list[str], missing: list[str],
 
 def _standard_brief(row: Mapping[str, Any]) -> dict[str, Any]:
     """A report ``standards[]`` row as the manifest carries it: the profile,
-    its level, and each clause's id, status and supporting obligations."""
+    where it comes from (``origin``: built-in with its edition, or the
+    workspace file with its sha256), its level, and each clause's status,
+    recommendation, why, the evidence in its scope and what covers it."""
     return {"profile": str(row["profile"]), "edition": str(row["edition"]), "level": row.get("level"),
+            "origin": dict(row.get("origin") or {}),
             "clauses": {str(c["id"]): {"status": str(c["status"]), "recommendation": str(c["recommendation"]),
-                                       "evidence": sorted({str(e["obligation"]) for e in c["evidence"]})}
+                                       "why": str(c.get("why", "")),
+                                       "evidence": sorted({str(e["obligation"]) for e in c["evidence"]}),
+                                       "covered_by": [str(x) for x in c.get("covered_by") or ()]}
                         for c in row["clauses"]},
             "required_not_covered": [str(x) for x in row.get("required_not_covered") or ()]}

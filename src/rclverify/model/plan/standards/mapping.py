@@ -1,17 +1,51 @@
-"""A report's evidence rows mapped onto a standard profile's clauses (docs/standards.md).
+"""A report's evidence mapped onto a standard profile's clauses, each within its scope (docs/standards.md).
 
 :data:`SUPPORTS` is the one table from what an evidence row says (its record
 ``kind``, records/statuses.py ``EvidenceKind``, and its ``strength.kind``,
-docs/confidence.md) to the profile evidence kinds it can support.  A clause
-is ``covered`` when some supporting row is discharged, ``partial`` when
-supporting rows exist but none is discharged, ``open`` when none exists.
-The mapping is a traceability aid for an assessor, not a compliance claim.
+docs/confidence.md) to the profile evidence kinds it can support.
+
+A clause is about something (its item's ``about``, :data:`~.profiles.ABOUT`):
+its *scope* is the items of the report that concern it (:func:`scope_items`):
+
+* ``guarantees``: every guarantee of every node;
+* ``interfaces``: every side condition (what a node's inputs receive from
+  another node's outputs) and every guarantee of a node on a connection;
+* ``requirements``: every requirement and the guarantees that support them;
+* ``system``: every guarantee, side condition and requirement, every
+  health check that failed or is outstanding, and the workspace itself
+  while its status is not ``discharged`` (a gate: it never makes a clause
+  partial);
+* ``field-data``: every run-set target decided over runs of ``origin:
+  operation``;
+* ``trials``: every target decided over runs or trials (a run set of
+  origin ``operation`` or ``simulation``, an experiment's per-trial data).
+
+A guarantee in scope is covered when its own status is ``discharged``, it
+has evidence of a kind the clause accepts, all of that evidence is
+discharged, and no health check of it failed or is outstanding; a side
+condition when Z3 proved it; a requirement when its verdict is ``met``,
+its deadline is not left undecided or refuted and its statistical targets
+are met (its check is ``proof`` evidence of its own); a target when it
+is met; the workspace when its status is ``discharged``.  A run of
+``origin: harness`` never counts; a review counts for a clause that asks
+independence only when the record names its author and its reviewer, they
+differ, and its stated independence is at least the clause's
+(:func:`review_identity`).
+
+A clause is ``covered`` when its scope is not empty and every item in it
+is covered, ``partial`` when some but not all are, ``not covered`` when
+none is and some evidence of an accepted kind is there, ``open`` when no
+evidence of an accepted kind is in scope at all, and ``not recommended``
+when the standard marks it ``NR`` at the level (shown, never read as met).
+Each clause row says why.  The mapping is a traceability aid for an
+assessor, not a compliance claim.
 """
 from __future__ import annotations
 
-from typing import Mapping, Sequence, TypedDict
+from collections import Counter
+from typing import Any, Iterable, Mapping, Sequence, TypedDict
 
-from rclverify.model.plan.standards.profiles import Profile
+from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
 from rclverify.records.report_schema import EvidenceRow
 
 #: (evidence row field, its value) -> the profile evidence kind it supports.  ``kind`` is the
@@ -28,60 +62,359 @@ SUPPORTS: Mapping[tuple[str, str], str] = {
     ("strength", "statistical"): "run-statistics",
 }
 
-#: A clause's status: all its supporting evidence discharged, some of it not, none.
-CLAUSE_STATUSES: tuple[str, ...] = ("covered", "partial", "open")
+#: A clause's status (the module docstring).
+CLAUSE_STATUSES: tuple[str, ...] = ("covered", "partial", "not covered", "open", "not recommended")
+
+#: A side condition's verdicts that count as proved.
+_PROVED = ("discharged", "discharged in context")
+#: The states of an item not covered, worst first (what the clause's ``why`` counts).
+_WORST: tuple[str, ...] = ("failed", "problem", "error", "stale", "inconclusive", "pending", "unverified",
+                           "not counted", "no evidence")
+#: What an empty scope lacks, by ``about``.
+_NOTHING: Mapping[str, str] = {
+    "guarantees": "guarantees", "interfaces": "connections between nodes", "requirements": "requirements",
+    "system": "nodes", "field-data": "target decided over runs of origin operation",
+    "trials": "target decided over runs or trials"}
+#: Health check outcomes that leave a guarantee covered (``warning`` is shown, not a failure).
+_HEALTH_OK = ("ok", "warning")
 
 
 class Support(TypedDict):
-    """An evidence row that supports a clause, as the clause row shows it."""
+    """An evidence row of an accepted kind in a clause's scope: ``counts`` whether it may cover the
+    clause, ``note`` why not (a harness run, a review without the independence asked), or ``""``."""
     obligation: str
     backend: str
     kind: str
     status: str
+    counts: bool
+    note: str
+
+
+class ScopeItem(TypedDict):
+    """One item of a clause's scope: ``item`` what it is (``Base g1``, ``side condition Planner.sc1``,
+    ``requirement STOP``, ``target <obligation>``, ``health check <id>``, ``workspace``), ``kind`` its
+    sort, ``state`` ``covered`` or in one word what keeps it from being covered (a status, ``no
+    evidence``, ``not counted``), ``detail`` the sentence, ``evidence`` the obligations that cover it."""
+    item: str
+    kind: str
+    covered: bool
+    state: str
+    detail: str
+    evidence: list[str]
 
 
 class ClauseRow(TypedDict):
-    """One clause of a profile at the chosen level, with its supporting evidence."""
+    """One clause of a profile at the chosen level: what it asks (``title``), its scope and the evidence
+    in it, what covers its covered items (``covered_by``: obligations, side conditions, requirement
+    checks), who checked that (``checked_by``), its status and why (a row of the compliance
+    matrix, docs/standards.md)."""
     id: str
     title: str
     recommendation: str
     accepts: list[str]
     strength: str
+    about: str
+    independence: str
     evidence: list[Support]
+    scope: list[ScopeItem]
+    covered_by: list[str]
+    checked_by: list[str]
     status: str
+    why: str
 
 
-def kinds_of(row: EvidenceRow) -> set[str]:
+def kinds_of(row: Mapping[str, Any]) -> set[str]:
     """The profile evidence kinds the evidence ``row`` (a report ``evidence[]`` row) supports, by :data:`SUPPORTS`."""
     strength = row.get("strength")
     values = {"kind": row.get("kind"), "strength": strength.get("kind") if isinstance(strength, Mapping) else None}
     return {kind for (field, value), kind in SUPPORTS.items() if values[field] == value}
 
 
-def clause_rows(profile: Profile, level: str | None, evidence: Sequence[EvidenceRow]) -> list[ClauseRow]:
-    """The clause rows of ``profile`` at ``level`` (``None`` for a profile
-    without levels) over the report's ``evidence`` rows (each with
-    ``obligation``, ``backend``, ``kind``, ``status`` and optionally
-    ``strength``), in the profile's order.  Pure: reads nothing else,
-    raises nothing for well-formed rows."""
-    kinds = [kinds_of(r) for r in evidence]
-    out: list[ClauseRow] = []
-    for item in profile.items:
-        accepted = set(item.evidence)
-        support: list[Support] = [
-            {"obligation": str(r["obligation"]), "backend": str(r["backend"]), "kind": str(r["kind"]),
-             "status": str(r["status"])} for r, k in zip(evidence, kinds) if k & accepted]
-        status = ("covered" if support and all(s["status"] == "discharged" for s in support)
-                  else "partial" if support else "open")
-        out.append({"id": item.id, "title": item.title, "recommendation": item.at(level),
-                    "accepts": list(item.evidence), "strength": item.strength, "evidence": support,
-                    "status": status})
+def review_identity(row: Mapping[str, Any]) -> tuple[str, str, str]:
+    """(reviewer, author, independence) a review evidence row names in its ``figures`` rows
+    (backends/review: ``reviewer``, ``author``, ``independence``); ``""`` for what it does not name."""
+    said = {str(r[0]): str(r[1]).strip() for r in row.get("figures") or () if isinstance(r, (list, tuple)) and len(r) == 2}
+    def named(key: str) -> str:  # "(not named)": the backend's word for a field the record leaves empty
+        v = said.get(key, "")
+        return "" if v.startswith("(") and v.endswith(")") else v
+    return named("reviewer"), named("author"), named("independence")
+
+
+def _same_person(a: str, b: str) -> bool:
+    return " ".join(a.casefold().split()) == " ".join(b.casefold().split())
+
+
+def independence_of(row: Mapping[str, Any]) -> tuple[str, str]:
+    """(the independence level a review row shows, one of :data:`~.profiles.INDEPENDENCE`; why it is
+    ``none`` or ``""``): ``none`` when the record does not name both its reviewer and its author or
+    they are one person (a self-review); else the record's stated level, ``person`` when it states none."""
+    reviewer, author, stated = review_identity(row)
+    if not reviewer or not author:
+        return "none", ("the record does not name " + ("its author" if reviewer else "its reviewer")
+                        + ": its independence is not shown")
+    if _same_person(reviewer, author):
+        return "none", f"self-review: {reviewer} reviewed their own work"
+    return (stated if stated in INDEPENDENCE and stated != "none" else "person"), ""
+
+
+def _harness(row: Mapping[str, Any]) -> bool:
+    s = row.get("statistics")
+    return isinstance(s, Mapping) and s.get("origin") == "harness"
+
+
+def _support(row: Mapping[str, Any], asked: str) -> Support:
+    note = ""
+    if _harness(row):
+        note = "origin: harness: shown, never counted"
+    elif row.get("kind") == "review" and asked != "none":
+        level, why = independence_of(row)
+        if INDEPENDENCE.index(level) < INDEPENDENCE.index(asked):
+            note = why or f"independence {level}; the clause asks {asked}"
+    return {"obligation": str(row["obligation"]), "backend": str(row["backend"]), "kind": str(row["kind"]),
+            "status": str(row["status"]), "counts": not note, "note": note}
+
+
+class _Index:
+    """The report read once for every clause: each guarantee's evidence rows and status, its health checks."""
+
+    def __init__(self, report: Mapping[str, Any]) -> None:
+        self.report = report
+        where = {str(o["id"]): (str(o["node"]), int(o["guarantee"])) for o in report.get("obligations") or ()}
+        self.guarantees: list[tuple[str, int, str]] = [
+            (str(n["name"]), int(g["index"]), str(g["status"]))
+            for n in report.get("nodes") or () for g in n.get("guarantees") or ()]
+        self.rows: dict[tuple[str, int], list[Mapping[str, Any]]] = {}
+        for e in report.get("evidence") or ():
+            node, k = where.get(str(e.get("obligation")), ("", -1))
+            if k == 0:  # an obligation of the whole contract is evidence for each of its guarantees
+                for n, g, _ in self.guarantees:
+                    if n == node:
+                        self.rows.setdefault((n, g), []).append(e)
+            elif node:
+                self.rows.setdefault((node, k), []).append(e)
+        self.health: dict[tuple[str, int | None], list[Mapping[str, Any]]] = {}
+        for f in report.get("findings") or ():
+            self.health.setdefault((str(f.get("node")), f.get("guarantee")), []).append(f)
+
+
+def _counted(rows: Iterable[Mapping[str, Any]], accepts: set[str], asked: str) -> list[tuple[Mapping[str, Any], Support]]:
+    return [(r, _support(r, asked)) for r in rows if kinds_of(r) & accepts]
+
+
+def _guarantee_item(ix: _Index, node: str, k: int, status: str, accepts: set[str], asked: str) -> ScopeItem:
+    supports = [s for _, s in _counted(ix.rows.get((node, k), ()), accepts, asked)]
+    counting = [s for s in supports if s["counts"]]
+    bad = [s for s in counting if s["status"] != "discharged"]
+    health = [f for f in ix.health.get((node, k), []) + ix.health.get((node, None), [])
+              if str(f.get("status")) not in _HEALTH_OK]
+    state, detail = "covered", "covered"
+    if not counting:
+        state = "not counted" if supports else "no evidence"
+        detail = (f"no {' or '.join(sorted(accepts))} evidence that counts"
+                  + (f" ({len(supports)} shown: {supports[0]['note']})" if supports else ""))
+    elif bad:
+        counts = Counter(b["status"] for b in bad)
+        state = min(counts, key=lambda x: _WORST.index(x) if x in _WORST else len(_WORST))
+        detail = (", ".join(f"{n} {st}" for st, n in sorted(counts.items()))
+                  + f" of its {len(counting)} record{'s' if len(counting) != 1 else ''}")
+    elif status != "discharged":
+        state, detail = status, f"the guarantee is {status} by its other evidence"
+    elif health:
+        state, detail = "problem", f"health check {health[0].get('check')}: {health[0].get('status')}"
+    ok = state == "covered"
+    return {"item": f"{node} g{k}", "kind": "guarantee", "covered": ok, "state": state, "detail": detail,
+            "evidence": [s["obligation"] for s in counting] if ok else []}
+
+
+def _item(item: str, kind: str, state: str, detail: str, evidence: list[str]) -> ScopeItem:
+    ok = state == "covered"
+    return {"item": item, "kind": kind, "covered": ok, "state": state, "detail": detail if not ok else "covered",
+            "evidence": evidence if ok else []}
+
+
+def _side_condition_item(sc: Mapping[str, Any]) -> ScopeItem:
+    ok = sc.get("verdict") in _PROVED and sc.get("status") == "discharged"
+    return _item(f"side condition {sc.get('id')}", "side condition", "covered" if ok else str(sc.get("status")),
+                 f"side condition {sc.get('verdict')}", [str(sc.get("id"))])
+
+
+def _requirement_item(rq: Mapping[str, Any], ix: _Index, accepts: set[str], asked: str) -> ScopeItem:
+    state, detail = "covered", ""
+    if rq.get("status") != "discharged":
+        state, detail = str(rq.get("status")), f"verdict: {rq.get('verdict')}"
+    deadline = rq.get("deadline")
+    if state == "covered" and isinstance(deadline, Mapping) and deadline.get("verdict") != "proved":
+        state, detail = "pending", f"deadline {deadline.get('verdict')}"
+    targets = [t for t in rq.get("statistics") or () if t.get("target") and t.get("status") != "discharged"]
+    if state == "covered" and targets:
+        state = str(targets[0].get("status") or "pending")
+        detail = f"target {state} ({targets[0].get('origin')} runs)"
+    if state == "covered" and "proof" not in accepts:
+        support = [(str(s["node"]), int(s["guarantee"])) for s in rq.get("support") or ()]
+        if not any(sp["counts"] and sp["status"] == "discharged" for key in support
+                   for _, sp in _counted(ix.rows.get(key, ()), accepts, asked)):
+            state, detail = "no evidence", f"no {' or '.join(sorted(accepts))} evidence of its supporting guarantees"
+    return _item(f"requirement {rq.get('id')}", "requirement", state, detail, [f"requirement {rq.get('id')}"])
+
+
+def _target_item(e: Mapping[str, Any]) -> ScopeItem:
+    st = str(e.get("status"))
+    return _item(f"target {e.get('obligation')}", "target", "covered" if st == "discharged" else st,
+                 f"target {st}", [str(e.get("obligation"))])
+
+
+def _targets(report: Mapping[str, Any], origins: tuple[str, ...], experiments: bool) -> list[ScopeItem]:
+    out = []
+    for e in report.get("evidence") or ():
+        s = e.get("statistics")
+        if not (isinstance(s, Mapping) and "decision" in s):
+            continue
+        if (e.get("backend") == "monitors" and s.get("origin") in origins) or (experiments and e.get("backend") == "experiment"):
+            out.append(_target_item(e))
+    for rq in report.get("requirements") or ():
+        for t in rq.get("statistics") or ():
+            if t.get("target") and t.get("origin") in origins:
+                st = str(t.get("status") or "pending")
+                out.append(_item(f"target of requirement {rq.get('id')} ({t.get('environment')}, {t.get('origin')})",
+                                 "target", "covered" if st == "discharged" else st, f"target {st}",
+                                 [f"requirement {rq.get('id')}"]))
     return out
 
 
-def not_covered(rows: Sequence[ClauseRow], code: str = "HR") -> list[str]:
-    """The ids of the clause rows recommended ``code`` that are not ``covered`` (the ``--strict`` reading)."""
-    return [r["id"] for r in rows if r["recommendation"] == code and r["status"] != "covered"]
+def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _Index | None = None) -> list[ScopeItem]:
+    """The items of ``report`` (a report dict, or the parts of it it has) in the scope of the profile
+    ``item`` at ``level``, each with its state (the module docstring).  Pure; raises nothing for a
+    well-formed report."""
+    ix = ix or _Index(report)
+    accepts, asked = set(item.evidence), item.independence_at(level)
+
+    def guarantees(nodes: set[str] | None = None) -> list[ScopeItem]:
+        return [_guarantee_item(ix, n, k, st, accepts, asked) for n, k, st in ix.guarantees if nodes is None or n in nodes]
+
+    scs = [_side_condition_item(sc) for sc in report.get("side_conditions") or ()]
+    reqs = [_requirement_item(rq, ix, accepts, asked) for rq in report.get("requirements") or ()]
+    if item.about == "guarantees":
+        return guarantees()
+    if item.about == "interfaces":
+        linked = {str(c.get(k)) for c in (report.get("system") or {}).get("connections") or ()
+                  for k in ("from_node", "to_node")}
+        return scs + guarantees(linked)
+    if item.about == "requirements":
+        supporting = {str(s["node"]) for rq in report.get("requirements") or () for s in rq.get("support") or ()}
+        return reqs + guarantees(supporting)
+    if item.about == "field-data":
+        return _targets(report, ("operation",), experiments=False)
+    if item.about == "trials":
+        return _targets(report, ("operation", "simulation"), experiments=True)
+    # system: everything, the health checks and the workspace's own status
+    health = [_item(f"health check {f.get('id')}", "health check", str(f.get("status")),
+                    f"health check {f.get('check')}: {f.get('status')}", []) for f in report.get("findings") or ()
+              if str(f.get("status")) not in _HEALTH_OK]
+    known = {(n, k) for n, k, _ in ix.guarantees}
+    unverified = [_item(f"{u.get('node')} g{u.get('guarantee')}", "guarantee", "unverified",
+                        "no obligation covers the guarantee", []) for u in report.get("unverified") or ()
+                  if (str(u.get("node")), int(u.get("guarantee") or 0)) not in known]
+    status = str((report.get("summary") or {}).get("status", "pending"))
+    whole = [] if status == "discharged" else [_item("workspace", "workspace", status,
+                                                     f"the workspace's status is {status}", [])]
+    return guarantees() + scs + reqs + health + unverified + whole
 
 
-__all__ = ["CLAUSE_STATUSES", "ClauseRow", "SUPPORTS", "Support", "clause_rows", "kinds_of", "not_covered"]
+def _evidence_in_scope(item: Item, level: str | None, scope: Sequence[ScopeItem], ix: _Index) -> list[Support]:
+    """The evidence rows of an accepted kind in the clause's scope (the guarantees', the targets'), once each."""
+    accepts, asked = set(item.evidence), item.independence_at(level)
+    keys = {tuple(s["item"].rsplit(" g", 1)) for s in scope if s["kind"] == "guarantee"}
+    seen: set[str] = set()
+    out: list[Support] = []
+    rows: list[Mapping[str, Any]] = [r for (n, k), rs in ix.rows.items() if (n, f"{k}") in keys for r in rs]
+    targets = {s["item"][len("target "):] for s in scope if s["kind"] == "target"}
+    rows += [e for e in ix.report.get("evidence") or () if str(e.get("obligation")) in targets]
+    for r in rows:
+        if str(r["obligation"]) in seen or not (kinds_of(r) & accepts or str(r["obligation"]) in targets):
+            continue
+        seen.add(str(r["obligation"]))
+        out.append(_support(r, asked))
+    return out
+
+
+def _checked_by(scope: Sequence[ScopeItem], ix: _Index) -> list[str]:
+    """Who checked what covers the clause's covered items: each backend with its tool and version, each
+    review's reviewer and author, Z3 for side conditions and requirement checks."""
+    rows = {str(e.get("obligation")): e for e in ix.report.get("evidence") or ()}
+    out: list[str] = []
+    for s in scope:
+        if not s["covered"]:
+            continue
+        for ob in s["evidence"]:
+            r = rows.get(ob)
+            if r is None:
+                who = f"Z3 ({s['kind']} check)"
+            elif r.get("kind") == "review":
+                reviewer, author, _ = review_identity(r)
+                who = f"review by {reviewer or 'an unnamed reviewer'} (author: {author or 'not named'})"
+            else:
+                who = f"{r.get('backend')} ({r.get('tool', '')} {r.get('tool_version', '')})".replace(" )", ")")
+            if who not in out:
+                out.append(who)
+    return out
+
+
+def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], item: Item, code: str,
+         level: str | None) -> str:
+    if status == "not recommended":
+        return "not recommended at this level: the evidence is listed, nothing is asked"
+    if not scope:
+        return f"nothing in scope: the workspace has no {_NOTHING.get(item.about, item.about)}"
+    n, done = len(scope), sum(1 for s in scope if s["covered"])
+    if status == "covered":
+        return f"all {n} item{'s' if n != 1 else ''} in scope covered"
+    left = Counter(s["state"] for s in scope if not s["covered"])
+    head = ", ".join(f"{left[st]} {st}" for st in sorted(left, key=lambda x: _WORST.index(x) if x in _WORST else 0))
+    shown = [e for e in evidence if not e["counts"]]
+    extra = f"; {len(shown)} record{'s' if len(shown) != 1 else ''} shown, not counted ({shown[0]['note']})" if shown else ""
+    return f"{status}: {done} of {n} in scope covered; {head}{extra}"
+
+
+def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceRow]) -> list[ClauseRow]:
+    """The clause rows of ``profile`` at ``level`` (``None`` for a profile
+    without levels) over ``report`` (a report dict: its ``evidence``,
+    ``obligations``, ``nodes``, ``side_conditions``, ``requirements``,
+    ``findings``, ``unverified``, ``system`` and ``summary`` as far as it
+    has them; a bare list of evidence rows reads as a report of those rows
+    alone), in the profile's order.  Pure: reads nothing else, raises
+    nothing for well-formed rows."""
+    rep: Mapping[str, Any] = report if isinstance(report, Mapping) else {"evidence": list(report)}
+    ix = _Index(rep)
+    out: list[ClauseRow] = []
+    for item in profile.items:
+        code = item.at(level)
+        scope = scope_items(item, level, rep, ix)
+        evidence = _evidence_in_scope(item, level, scope, ix)
+        done = sum(1 for s in scope if s["covered"])
+        if code == "NR":
+            status = "not recommended"
+        elif scope and done == len(scope):
+            status = "covered"
+        elif done:
+            status = "partial"
+        elif any(e["counts"] for e in evidence) or any(s["kind"] != "guarantee" for s in scope):
+            status = "not covered"
+        else:
+            status = "open"
+        out.append({"id": item.id, "title": item.title, "recommendation": code, "accepts": list(item.evidence),
+                    "strength": item.strength, "about": item.about, "independence": item.independence_at(level),
+                    "evidence": evidence, "scope": scope,
+                    "covered_by": list(dict.fromkeys(ob for x in scope if x["covered"] for ob in x["evidence"])),
+                    "checked_by": _checked_by(scope, ix),
+                    "status": status, "why": _why(status, scope, evidence, item, code, level)})
+    return out
+
+
+def not_covered(rows: Sequence[ClauseRow], codes: Sequence[str] = ASKED) -> list[str]:
+    """The ids of the clause rows whose recommendation is one of ``codes`` (default: ``HR`` and
+    ``required``) that are not ``covered`` (the ``--strict`` reading)."""
+    return [r["id"] for r in rows if r["recommendation"] in codes and r["status"] != "covered"]
+
+
+__all__ = ["CLAUSE_STATUSES", "ClauseRow", "SUPPORTS", "ScopeItem", "Support", "clause_rows", "independence_of",
+           "kinds_of", "not_covered", "review_identity", "scope_items"]

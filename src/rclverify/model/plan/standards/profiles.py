@@ -5,14 +5,17 @@ draft 2020-12, the way the plan is checked, model/plan/load.py) and then for
 what a schema cannot say: item ids unique, and a per-level recommendation
 naming exactly the profile's levels.  The built-in profiles live in
 ``profiles/`` inside the package; a user's profile is any file of the same
-shape.  Every mistake is one :class:`~rclverify.model.plan.errors.PlanError`
-at ``file:line:col``.  A profile's ids and titles are a traceability aid,
+shape, which may not take a built-in profile's ``id`` or ``edition`` (both
+reserved, so a workspace file is never shown as a built-in profile).  Every
+mistake is one :class:`~rclverify.model.plan.errors.PlanError` at
+``file:line:col``.  A profile's ids and titles are a traceability aid,
 never the standard's text.
 """
 from __future__ import annotations
 
+import hashlib
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
@@ -23,9 +26,19 @@ from rclverify.lang import ast
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.yamlguard import Path_, load_located, read_yaml_text, schema_error_loc
 
-#: The recommendation codes, strongest first (IEC 61508-3's: highly recommended, recommended, no
-#: recommendation, not recommended).
-CODES: tuple[str, ...] = ("HR", "R", "---", "NR")
+#: The recommendation codes: IEC 61508-3's grades (highly recommended, recommended, no recommendation,
+#: not recommended), and ``required`` for a standard that does not grade so (the clause is part of what
+#: it asks at that level: UL 4600's clauses, ISO 13482's, DO-178C's objectives that apply at a level).
+CODES: tuple[str, ...] = ("HR", "R", "---", "NR", "required")
+#: The codes ``--strict`` holds a ``strict: true`` standard to (docs/standards.md).
+ASKED: tuple[str, ...] = ("HR", "required")
+#: What a clause can be about (its scope, docs/standards.md "Scope"): each guarantee of every node, the
+#: interfaces between nodes, the requirements, the whole system, field data from operation, trials
+#: against a stated target.
+ABOUT: tuple[str, ...] = ("guarantees", "interfaces", "requirements", "system", "field-data", "trials")
+#: Independence levels, weakest first (IEC 61508-1:2010 clause 8.2.18: independent person, department,
+#: organisation; DO-178C 6.2 "with independence": a person other than the author).
+INDEPENDENCE: tuple[str, ...] = ("none", "person", "department", "organisation")
 #: Where the built-in profiles are named in messages (package-relative, never a machine path).
 BUILTIN_DIR = "rclverify/model/plan/standards/profiles"
 
@@ -35,12 +48,17 @@ class Item:
     """One clause or technique of a profile: ``evidence`` the evidence kinds
     that can support it, ``strength`` the least strength it asks
     (docs/confidence.md's words), ``recommendation`` one code for every
-    level or level -> code."""
+    level or level -> code, ``about`` what it concerns (one of
+    :data:`ABOUT`), ``independence`` the reviewer's independence from the
+    author it asks (one of :data:`INDEPENDENCE`, for every level or per
+    level)."""
     id: str
     title: str
     evidence: tuple[str, ...]
     strength: str
     recommendation: str | Mapping[str, str]
+    about: str = "guarantees"
+    independence: str | Mapping[str, str] = "none"
 
     def at(self, level: str | None) -> str:
         """The recommendation code at ``level`` (``None``: a profile without levels)."""
@@ -48,12 +66,21 @@ class Item:
             return self.recommendation
         return self.recommendation.get(str(level), "---")
 
+    def independence_at(self, level: str | None) -> str:
+        """The independence asked at ``level``: one of :data:`INDEPENDENCE`."""
+        if isinstance(self.independence, str):
+            return self.independence
+        return self.independence.get(str(level), "none")
+
 
 @dataclass(frozen=True)
 class Profile:
     """A loaded profile: ``levels`` empty when the standard has none,
     ``level_name`` the plan key that names the level (``sil``, ``dal``...),
-    ``file`` where it was read (package-relative for the built-ins)."""
+    ``file`` where it was read (package-relative for the built-ins),
+    ``builtin`` whether it is one of the package's profiles, ``sha256`` the
+    hex sha256 of its file's bytes (of the UTF-8 text when parsed from a string), ``left_out`` the standard's clauses it does not
+    list, each ``(id, why)``."""
     id: str
     title: str
     edition: str
@@ -61,6 +88,9 @@ class Profile:
     levels: tuple[str, ...]
     items: tuple[Item, ...]
     file: str
+    builtin: bool = False
+    sha256: str = ""
+    left_out: tuple[tuple[str, str], ...] = ()
 
 
 def builtin_names() -> tuple[str, ...]:
@@ -77,14 +107,38 @@ def load_builtin(name: str) -> Profile:
     if name not in builtin_names():
         raise KeyError(name)
     res = resources.files("rclverify.model.plan.standards").joinpath("profiles", f"{name}.yaml")
-    return parse_profile(res.read_text(encoding="utf-8"), f"{BUILTIN_DIR}/{name}.yaml")
+    p = parse_profile(res.read_text(encoding="utf-8"), f"{BUILTIN_DIR}/{name}.yaml", builtin=True)
+    return replace(p, sha256=hashlib.sha256(res.read_bytes()).hexdigest())
+
+
+def _reserved() -> dict[str, tuple[str, str]]:
+    """Each built-in profile's id and edition -> (what it is, the built-in id)."""
+    out: dict[str, tuple[str, str]] = {}
+    for name in builtin_names():
+        p = load_builtin(name)
+        out[f"id:{p.id}"] = ("id", p.id)
+        out[f"edition:{p.edition}"] = ("edition", p.id)
+    return out
 
 
 def load_profile_file(path: Path, file: str) -> Profile:
-    """The profile in the YAML file at ``path`` (named ``file`` in messages).
-    Raises :class:`PlanError` (unreadable, bad YAML, schema, the checks of
-    the module docstring)."""
-    return parse_profile(read_yaml_text(path, file), file)
+    """The workspace profile in the YAML file at ``path`` (named ``file`` in
+    messages).  Raises :class:`PlanError` (unreadable, bad YAML, schema,
+    the checks of the module docstring, and an ``id`` or ``edition`` a
+    built-in profile has, located at that key)."""
+    text = read_yaml_text(path, file)
+    p = parse_profile(text, file)
+    reserved = _reserved()
+    for key, value in (("id", p.id), ("edition", p.edition)):
+        if f"{key}:{value}" in reserved:
+            _, locs = load_located(text, file)
+            raise _bad(locs, (key,), file, f"standard profile: {key} {value!r} is the built-in profile "
+                       f"{reserved[f'{key}:{value}'][1]!r}'s; a workspace profile takes its own {key} (choose the "
+                       f"built-in one with `profile: {reserved[f'{key}:{value}'][1]}`)")
+    try:
+        return replace(p, sha256=hashlib.sha256(path.read_bytes()).hexdigest())
+    except OSError:  # read just above; gone since: the text's digest
+        return p
 
 
 def _schema() -> dict[str, Any]:
@@ -116,8 +170,8 @@ def _check_schema(data: object, locs: Mapping[Path_, ast.Loc], file: str) -> Non
         raise plan_error(l.file, l.line, l.col, f"standard profile: {where}: {e.message}", "E-profile")
 
 
-def parse_profile(text: str, file: str) -> Profile:
-    """The profile written in the YAML ``text`` of ``file``.
+def parse_profile(text: str, file: str, builtin: bool = False) -> Profile:
+    """The profile written in the YAML ``text`` of ``file`` (``builtin``: one of the package's).
 
     Raises :class:`PlanError` at ``file:line:col``: malformed YAML (the
     YAML library's mark), a schema violation, an item id used twice, or a
@@ -147,10 +201,20 @@ def parse_profile(text: str, file: str) -> Profile:
                            f"standard profile: item {iid!r}: the recommendation names levels "
                            f"{', '.join(sorted(rec)) or 'none'}; the profile's levels are "
                            f"{', '.join(levels) or 'none (write one code)'}")
-        items.append(Item(iid, str(it["title"]), tuple(it["evidence"]), str(it["strength"]), rec))
+        ind = it.get("independence", "none")
+        if isinstance(ind, dict):
+            ind = {str(k): str(v) for k, v in ind.items()}
+            if set(ind) != set(levels):
+                raise _bad(locs, ("items", i, "independence"), file,
+                           f"standard profile: item {iid!r}: the independence names levels "
+                           f"{', '.join(sorted(ind)) or 'none'}; the profile's levels are "
+                           f"{', '.join(levels) or 'none (write one level of independence)'}")
+        items.append(Item(iid, str(it["title"]), tuple(it["evidence"]), str(it["strength"]), rec,
+                          str(it.get("about", "guarantees")), ind))
+    left = tuple((str(x["id"]), str(x["why"])) for x in data.get("left_out", []))
     return Profile(str(data["id"]), str(data["title"]), str(data["edition"]), str(data.get("level_name", "level")),
-                   levels, tuple(items), file)
+                   levels, tuple(items), file, builtin, hashlib.sha256(text.encode("utf-8")).hexdigest(), left)
 
 
-__all__ = ["BUILTIN_DIR", "CODES", "Item", "Profile", "builtin_names", "load_builtin", "load_profile_file",
+__all__ = ["ABOUT", "ASKED", "BUILTIN_DIR", "CODES", "INDEPENDENCE", "Item", "Profile", "builtin_names", "load_builtin", "load_profile_file",
            "parse_profile"]
