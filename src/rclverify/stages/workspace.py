@@ -150,7 +150,7 @@ class Workspace:
             ros=dict(getattr(plan, "ros", None) or {}),
             # every node between a deadline's ends: the slowest path may leave the named one
             deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))),
-            profiles=tuple(c.profile.file for c in plan.standards if not c.profile.file.startswith("rclverify/")))
+            profiles=tuple(c.profile.file for c in plan.standards if not c.profile.builtin))
 
     @cached_property
     def checked(self) -> Checked:

@@ -67,9 +67,9 @@ def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = 
 def _own_profiles(plan: Any) -> tuple[str, ...]:
     """The workspace's own standard profile files the plan read (``standards:``, docs/standards.md):
     hashed with the contract files, so an edited profile loads the plan anew; the built-in ones are
-    package data (``rclverify/...``), covered by the code's salt."""
+    package data (``Profile.builtin``), covered by the code's salt."""
     return tuple(str(c.profile.file) for c in getattr(plan, "standards", ())
-                 if not str(c.profile.file).startswith("rclverify/"))
+                 if not getattr(c.profile, "builtin", False))
 
 
 def _resolved(root: str, paths: Any) -> dict[str, str] | None:

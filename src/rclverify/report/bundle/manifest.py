@@ -43,7 +43,6 @@ from rclverify.model.plan.declarations import DECLARATIONS
 from rclverify.model.plan.load import Plan
 from rclverify.model.plan.paths import config_strings, escape_reason, looks_like_path
 from rclverify.model.plan.entries import declared_paths
-from rclverify.model.plan.standards.profiles import BUILTIN_DIR
 
 #: Format tag of the manifest.
 FORMAT = "rclverify-bundle/1"
@@ -115,7 +114,7 @@ def _named(plan: Plan) -> set[str]:
     if ros.get("mapping"):
         out.add(str(ros["mapping"]))
     # a workspace's own standard profile (the built-in ones are package data, docs/standards.md)
-    out.update(c.profile.file for c in getattr(plan, "standards", ()) if not c.profile.file.startswith(BUILTIN_DIR))
+    out.update(c.profile.file for c in getattr(plan, "standards", ()) if not c.profile.builtin)
     return out
 
 
