@@ -86,10 +86,11 @@ def test_the_offline_command_judges_a_live_logs_calls_as_the_live_book(wrong: bo
     assert live["counts"]["rejected"] == 1
     deadlines = {e["node"]: e["call_deadlines"]["counts"] for e in report if "call_deadlines" in e}
     assert deadlines == {r["node"]: r["counts"] for r in live["deadlines"]}
-    # the unpaired call stays inconclusive with the live reason
+    # the unpaired call stays inconclusive, and the answer whose request was not heard is named undecided
     base = [e for e in report if e["node"] == "Base" and "calls" in e][0]["calls"]
-    assert base["counts"]["inconclusive"] == 1
-    assert "2 requests of /estop were unanswered" in base["first_inconclusive"]["reason"]
+    assert base["counts"]["inconclusive"] == 2
+    assert "1 answer(s) of /estop whose request the monitor did not hear" in base["first_inconclusive"]["reason"]
+    assert "12:9" in base["first_inconclusive"]["reason"]
     if wrong:
         assert live["false"] == 3 and base["counts"]["violated"] == 1  # the wrong answer is false too
         assert code == 1  # a violated call, a missed call deadline
@@ -97,9 +98,9 @@ def test_the_offline_command_judges_a_live_logs_calls_as_the_live_book(wrong: bo
         assert live["false"] == 0 and base["counts"]["violated"] == 0
         # Base's unpaired call leaves its calls inconclusive (never a guess), nothing failed
         assert code == 0
-    # the nodes judged by their calls are judged: no not-judged item names them or their links
+    # the nodes judged by their calls are judged; /estop's undecided answer is named, whatever else was judged
     items = [i for e in report if e.get("not_judged") for i in e["not_judged"]]
-    assert items == [], items
+    assert [(i["name"], i["reason"]) for i in items] == [("/estop", "not paired")], items
     # --strict fails on an undecided verdict too (Base's unpaired call: inconclusive, never a guess)
     assert _offline(log, "--strict")[0] == 1
 
@@ -111,7 +112,8 @@ def test_the_offline_text_says_the_calls_as_the_live_run_does(tmp_path: Path,
     out = capsys.readouterr().out
     assert f"{log}: calls: Base: failed: " in out
     assert f"{log}: deadlines: 3 of 5 judged call(s) or goal(s) missed their deadline" in out
-    assert "not judged" not in out
+    assert "not judged: service /estop (Teleop): not paired: 1 answer(s) of /estop came whose request was not " \
+           "heard" in out, out
 
 
 def test_a_log_without_its_call_lines_is_not_judged(tmp_path: Path) -> None:
@@ -152,12 +154,14 @@ def test_doit_verifys_monitors_evidence_judges_a_live_logs_calls(wrong: bool, tm
         (ob,) = MonitorsBackend().export(t)
         ev = MonitorsBackend().run(ob, t)
         status[node] = ev.status
-        assert ev.details["not_judged"] == [], (node, ev.details["not_judged"])
+        # /estop's answer whose request was not heard is named undecided for both its ends
+        assert [(i["name"], i["reason"]) for i in ev.details["not_judged"]] == \
+            ([] if node == "Mover" else [("/estop", "not paired")]), (node, ev.details["not_judged"])
         assert ev.details["calls"]["counts"] == {r["node"]: r["counts"] for r in live["nodes"]}[node]
-    if wrong:  # Base: a wrong answer and a late one; Mover: a negative feedback
-        assert status == {"Base": "failed", "Teleop": "discharged", "Mover": "failed"}, status
+    if wrong:  # Base: a wrong answer and a late one; Mover: a negative feedback; Teleop: the undecided answer
+        assert status == {"Base": "failed", "Teleop": "inconclusive", "Mover": "failed"}, status
     else:  # Base's unpaired call is inconclusive, never guessed; Mover's rejected goal was left open, as live
-        assert status == {"Base": "inconclusive", "Teleop": "discharged", "Mover": "inconclusive"}, status
+        assert status == {"Base": "inconclusive", "Teleop": "inconclusive", "Mover": "inconclusive"}, status
 
 
 def test_the_source_a_live_log_names_is_in_the_evidence_and_the_report(tmp_path: Path) -> None:

@@ -38,7 +38,9 @@ book, as a log's are:
   with them what no ROS 2 message can say: the book's clock ticks that
   decided something, the calls it could not pair (``unpaired``, with the
   live reason), the calls of a service with several servers, the goals it
-  closed as rejected.  With it the lines are replayed as they are, their
+  closed as rejected, the endpoints it did not hear with contents
+  (``unjudged``, with the live reason: the link is not judged for them, so
+  the bag's check is never greener than its live run).  With it the lines are replayed as they are, their
   fields read from the ROS 2 messages: the live pairing and clock, exactly.
   Without it (a bag ``ros2 bag record`` made) the lines are made from the
   events alone, in their stamps' order, the book's clock each line's stamp
@@ -159,11 +161,16 @@ class BagCalls:
     def explain(self, items: list[dict[str, str]]) -> None:
         """Say in not-judged ``items`` (:func:`.judged.not_judged`'s) which call topics the bag
         lacks: a link's detail names them, a node's too when it has links and none of them is in
-        the bag (its silence is then the bag's, not the robot's)."""
+        the bag (its silence is then the bag's, not the robot's); a link's endpoints the live run
+        did not hear with contents (its ``unjudged`` lines) are named with the live reason."""
         missing = self.missing()
+        book = self.calls.book
         for i in items:
             link = i["name"].strip("/")
-            if i["kind"] in ("service", "action") and link in missing:
+            ends = book.unjudged_ends.get(link) if book is not None else None
+            if i["kind"] in ("service", "action") and i["reason"] == "endpoint not heard" and ends:
+                i["detail"] += " (" + "; ".join(ends.values()) + ")"  # the live run's reasons, in the bag's lines
+            elif i["kind"] in ("service", "action") and link in missing:
                 i["detail"] = _lacks(self.trace, missing[link])
             elif i["kind"] in ("service", "action") and i["reason"] == "nothing heard" and self.skipped.get(link):
                 i["detail"] += (f"; {self.skipped[link]} of its events in the bag carry no request or response "

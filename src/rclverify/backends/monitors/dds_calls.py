@@ -57,6 +57,8 @@ from rclverify.backends.monitors.verdicts import LINK_TOPICS
 CALL_LOG_TOPIC = "rclverify/call"
 #: seconds an unanswered call is kept after its horizon and deadlines passed (a late answer still shown)
 LINGER_S = 10.0
+#: undecided answers named one by one (client gid and sequence number); the rest are counted
+NAMED = 5
 
 
 def link_view(node: CheckedNode, link: ast.Link) -> CheckedNode:
@@ -122,6 +124,10 @@ class CallBook:
         self.now = float("-inf")
         self.counts = {"calls": 0, "goals": 0, "answered": 0, "unanswered": 0, "orphan_answers": 0, "evicted": 0,
                        "rejected": 0, "unpaired": 0}
+        #: link -> answers heard whose request was not: ``{"count", "first"}`` (the first :data:`NAMED` keys)
+        self.undecided: dict[str, dict[str, Any]] = {}
+        #: link -> endpoint (``"server /ns/n"``) -> why its calls were not all heard with contents
+        self.unjudged_ends: dict[str, dict[str, str]] = {}
 
     # -- input -------------------------------------------------------------------------------
     def open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, object], stamp: float,
@@ -157,9 +163,9 @@ class CallBook:
         call = self.calls.get(key)
         if call is None:
             if final:
-                self.counts["orphan_answers"] += 1
                 self._log({"link": name.strip("/"), "part": part, "time": stamp, "key": _key(key), "orphan": True,
                            "fields": dict(fields)})
+                self.orphan(name, key, stamp)
             return False
         self._feed(call, part, fields, stamp)
         if final and not call.answered:
@@ -213,6 +219,49 @@ class CallBook:
                 total.first_unaccepted = {"where": f"{call.label} request", "stamp": call.opened,
                                           "guarantee": d.pending[0].k, "why": "undecided", "reason": reason}
             d.pending = []
+
+    def orphan(self, name: str, key: tuple[Any, ...], stamp: float) -> None:
+        """An answer (reply or result) of link ``name`` stamped ``stamp`` (s)
+        whose request was not heard (made before the monitor started, or of
+        an endpoint it does not hear): counted (``orphan_answers``), its key
+        named among the first :data:`NAMED` (``undecided``), and every node of
+        the link kept from ``discharged``: one more ``inconclusive`` answer,
+        the reason naming the count and the first keys (docs/monitors.md,
+        "Every endpoint of a call accounted for")."""
+        link = name.strip("/")
+        self.counts["orphan_answers"] += 1
+        if link not in self.links:
+            return
+        u = self.undecided.setdefault(link, {"count": 0, "first": []})
+        u["count"] += 1
+        if len(u["first"]) < NAMED:
+            u["first"].append(_key(key))
+        named = ", ".join(_named(k) for k in u["first"]) + (", ..." if u["count"] > len(u["first"]) else "")
+        self._mark(link, f"{link} answer {_named(_key(key))}", stamp,
+                   f"{u['count']} answer(s) of /{link} whose request the monitor did not hear (made before it "
+                   f"started, or by an endpoint it does not hear) are undecided: {named}")
+
+    def unjudged(self, name: str, endpoint: str, why: str, stamp: float) -> None:
+        """Endpoint ``endpoint`` (``"server /ns/n"``, ``"client /ns/n"``) of
+        link ``name`` was not heard with contents from ``stamp`` (s), ``why``:
+        the link is not judged for it; every node of the link is kept from
+        ``discharged`` (one more ``inconclusive``, with ``why``), and the line
+        (``part`` ``unjudged``) goes to the log and the bag."""
+        link = name.strip("/")
+        ends = self.unjudged_ends.setdefault(link, {})
+        if ends.get(endpoint) == why or link not in self.links:
+            return
+        ends[endpoint] = why
+        self._log({"link": link, "part": "unjudged", "time": stamp, "endpoint": endpoint, "reason": why})
+        self._mark(link, f"{link} {endpoint}", stamp, f"/{link} is not judged for {len(ends)} endpoint(s): "
+                   + "; ".join(ends.values()))
+
+    def _mark(self, link: str, where: str, stamp: float, reason: str) -> None:
+        """Keep each node of ``link`` from ``discharged``: one more ``inconclusive``, ``reason`` its first."""
+        for node in dict.fromkeys(view.name for view, _v, _t in self.links[link]):
+            res = self.results.setdefault(node, NodeResult(node))
+            res.counts["inconclusive"] += 1
+            res.first_inconclusive = {"event": self.index, "time": stamp, "where": where, "reason": reason}
 
     def note(self, obj: dict[str, Any]) -> None:
         """A line for the log about a call (a status change) that no monitor reads."""
@@ -276,7 +325,8 @@ class CallBook:
         ``deadlines``: per node its deadline result)."""
         for key in list(self.calls):
             self._close(key)
-        return {"counts": dict(self.counts),
+        return {"counts": dict(self.counts), "undecided": {k: dict(v) for k, v in self.undecided.items()},
+                "unjudged": {k: dict(v) for k, v in self.unjudged_ends.items()},
                 "nodes": [self.results[n].to_json() for n in sorted(self.results)],
                 "deadlines": [self.deadline_results[n].to_json() for n in sorted(self.deadline_results)],
                 "false": sum(r.counts["false"] for r in self.deadline_results.values())}
@@ -299,6 +349,13 @@ class CallBook:
 
 def _key(key: tuple[Any, ...]) -> list[Any]:
     return [k.hex() if isinstance(k, bytes) else k for k in key]
+
+
+def _named(key: list[Any]) -> str:
+    """A call's key as a person reads it: ``client gid G seq N`` for an introspection event's."""
+    if key[:1] == ["ev"] and len(key) >= 3:
+        return f"client gid {key[1]} seq {key[2]}"
+    return ":".join(str(k) for k in key)
 
 
 def _add(total: NodeResult, one: NodeResult) -> None:
@@ -338,8 +395,10 @@ def replay_line(book: CallBook, x: Mapping[str, Any]) -> None:
                       not x.get("also"))
         else:
             book.answer(key, part, x["fields"], float(x["time"]), part != "feedback", name)
+    elif part == "unjudged":
+        book.unjudged(str(x["link"]), str(x["endpoint"]), str(x["reason"]), float(x["time"]))
     elif x.get("orphan") and str(x.get("link", "")).strip("/") in book.links:
-        book.counts["orphan_answers"] += 1  # live, no call of its identity was open: nothing to feed
+        book.orphan(str(x["link"]), tuple(x["key"]), float(x["time"]))  # live, no call of its identity was open
 
 
 def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]:

@@ -21,8 +21,13 @@ contract's type), ``not paired`` (answers of a service or action came
 whose request or goal was not heard or could not be matched to them),
 ``no answer`` (calls or goals came, no reply or result), ``no verdict``
 (messages came but decided nothing: every input outside the assumption,
-or no accepted trigger event).  ``rclverify monitor --strict`` exits 1
-when the list is not empty.
+or no accepted trigger event), ``endpoint not heard`` (a server or client
+of a service or action was not heard with contents: its introspection
+off or metadata, so the link is not judged for it, whatever else of it
+was; docs/monitors.md, "Every endpoint of a call accounted for").  A link
+with an answer whose request was not heard (made before the monitor
+started) is ``not paired`` whatever else of it was judged.
+``rclverify monitor --strict`` exits 1 when the list is not empty.
 
 Standard library only, shared by the offline command (:mod:`.cli`) and
 the live runs (:mod:`.live`, :mod:`.dds_live`).
@@ -38,7 +43,8 @@ from rclverify.lang.types import CheckedNode
 from rclverify.backends.monitors.stamp_order import StampWatch
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
-REASONS = ("nothing heard", "type refused", "not decoded", "not paired", "no answer", "no verdict")
+REASONS = ("nothing heard", "type refused", "not decoded", "not paired", "no answer", "no verdict",
+           "endpoint not heard")
 #: the parts of a link that open a call (a service's request, an action's goal) and that answer one
 _OPENS = ("request", "goal")
 _ANSWERS = ("response", "result")
@@ -117,18 +123,32 @@ class Counted:
             yield block
 
 
+#: the ``orphans`` keys (``"<link>/<key>"``) counting a link's endpoints not heard with contents and its
+#: answers whose request was not heard (:func:`count_call_line`)
+UNJUDGED, UNDECIDED = "unjudged", "undecided"
+
+
 def count_call_line(obj: Mapping[str, object], messages: dict[str, int], orphans: dict[str, int]) -> None:
     """Count one call line of a live log (``kind`` ``"call"``, the DDS call
     book's) as the live run counts what it heard: a paired part (a line with
     an ``index``) into ``messages``, an answer heard without its call
     (``orphan``) into ``orphans``, both keyed ``"<link>/<part>"`` (no leading
-    ``/``); other lines are not counted."""
+    ``/``); an orphan that is no unpaired call (its request was not heard)
+    also under ``"<link>/undecided"``, an endpoint not heard with contents
+    (``part`` ``unjudged``) under ``"<link>/unjudged"``; other lines are not
+    counted."""
     if obj.get("kind") != "call" or obj.get("link") is None:
         return
-    key = f"{str(obj['link']).strip('/')}/{obj.get('part')}"
+    link = str(obj["link"]).strip("/")
+    if obj.get("part") == UNJUDGED:
+        orphans[f"{link}/{UNJUDGED}"] = orphans.get(f"{link}/{UNJUDGED}", 0) + 1
+        return
+    key = f"{link}/{obj.get('part')}"
     book = messages if "index" in obj else orphans if obj.get("orphan") else None
     if book is not None:
         book[key] = book.get(key, 0) + 1
+    if book is orphans and not obj.get("unpaired"):
+        orphans[f"{link}/{UNDECIDED}"] = orphans.get(f"{link}/{UNDECIDED}", 0) + 1
 
 
 def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str, Iterable[tuple[str, str]]],
@@ -247,6 +267,14 @@ def _link_reason(key: str, kind: str, heard: Heard, where: str) -> tuple[str, st
     answered = sum(heard.messages.get(f"{key}/{p}", 0) for p in parts if p in _ANSWERS)
     orphans = sum(heard.orphans.get(f"{key}/{p}", 0) for p in parts)
     what = "call(s)" if kind == "service" else "goal(s)"
+    ends, undecided = heard.orphans.get(f"{key}/{UNJUDGED}", 0), heard.orphans.get(f"{key}/{UNDECIDED}", 0)
+    if ends:  # whatever else of it was judged (module docstring)
+        return "endpoint not heard", (f"{ends} endpoint(s) of /{key} were not heard with contents {where}: the "
+                                      f"link is not judged for them")
+    if opened and answered and undecided:
+        return "not paired", (f"{undecided} answer(s) of /{key} came whose request was not heard (made before the "
+                              f"monitor started, or by an endpoint it does not hear): undecided, beside "
+                              f"{opened} {what} judged {where}")
     if opened and answered:
         return None
     bad = sum(n for k, n in heard.decode_errors.items() if key in k)
@@ -276,4 +304,4 @@ def strict_line(items: list[dict[str, str]]) -> str:
             f"{first['name']}: {first['reason']}: {first['detail']}")
 
 
-__all__ = ["Counted", "Heard", "REASONS", "count_call_line", "explain", "not_judged", "strict_line"]
+__all__ = ["Counted", "Heard", "REASONS", "UNDECIDED", "UNJUDGED", "count_call_line", "explain", "not_judged", "strict_line"]

@@ -42,7 +42,10 @@ Where they come from (:class:`CallRecorder`):
   book could not pair (``unpaired``, with the reason), a call of a service
   with several servers (its key names the server, ``also`` marks the
   second server's call of one request), the goals it closed as rejected
-  (their send-goal response event, ``accepted: false``, is written too).
+  (their send-goal response event, ``accepted: false``, is written too),
+  the endpoints of a link it did not hear with contents (``unjudged``: what
+  the live run knew of the graph and of each endpoint's introspection, so
+  the bag's check is never greener than the live run).
   So the bag check replays the live book's pairing and clock exactly, the
   values read from the ROS 2 messages.
 

@@ -17,10 +17,12 @@ GUID as its gid exactly so that the server's events and the client's agree:
 ``rmw_get_gid_for_client.cpp``), so calls are paired exactly however many
 are outstanding.
 
-Which events are read: the server's (REQUEST_RECEIVED, RESPONSE_SENT) when
-the server publishes them (they cover every client), else the clients'
-(REQUEST_SENT, RESPONSE_RECEIVED) when every client publishes them; never
-both (a call would be counted twice).  :func:`event_side` decides from the
+Which events are read: the servers' (REQUEST_RECEIVED, RESPONSE_SENT) when
+every server publishes them with contents (they cover every client), else
+the clients' (REQUEST_SENT, RESPONSE_RECEIVED) when every client does;
+never both (a call would be counted twice).  An endpoint publishes
+``contents`` until one of its events comes without the request or response
+it is about (``metadata``).  :func:`event_side` decides from the
 writers discovery reports on the event topic and on the service's reply and
 request topics, and the node each belongs to (a service's event writer is
 its server's node's, a client's its client's node's).  The event type is made here from the service's request and
@@ -64,7 +66,7 @@ def event_struct(types: TypeBook, srv_type: str) -> type:
 
 def event_side(event_writers: Iterable[bytes], reply_writers: Iterable[bytes], request_writers: Iterable[bytes],
                owner: Callable[[bytes], str | None] = lambda g: None) -> str | None:
-    """``"server"`` when a server of the service publishes introspection
+    """``"server"`` when every server of the service publishes introspection
     events, ``"client"`` when every client does, else ``None``.  Arguments
     are writer GUIDs (16 bytes each) and ``owner(guid)``: the ROS node a
     writer belongs to (``ros_discovery_info``, ``None`` not known yet), else
@@ -75,17 +77,47 @@ def event_side(event_writers: Iterable[bytes], reply_writers: Iterable[bytes], r
                    {who(g) for g in request_writers})
 
 
-def side_of(publishers: set[str], servers: set[str], clients: set[str]) -> str | None:
-    """:func:`event_side` on names: ``publishers`` of the event topic, the
-    service's (or action's) ``servers`` and ``clients``, each named by its
-    node (``/ns/name``; the rclpy source reads them from the graph API) or
-    its participant.  ``"server"`` when a server is among the publishers,
-    ``"client"`` when every client is, else ``None``."""
+def side_of(publishers: set[str], servers: set[str], clients: set[str], partial: bool = False) -> str | None:
+    """:func:`event_side` on names: ``publishers`` of the event topic with
+    contents (a node seen publishing metadata only is left out by the
+    caller), the service's (or action's) ``servers`` and ``clients``, each
+    named by its node (``/ns/name``; the rclpy source reads them from the
+    graph API) or its participant.  ``"server"`` when every server is among
+    the publishers, ``"client"`` when every client is (either side then hears
+    every call); with ``partial``, else ``"server"`` when some server is,
+    ``"client"`` when some client is (the calls of the others are not heard:
+    :func:`uncovered` names them); else ``None``."""
     if not publishers:
         return None
-    if servers & publishers:
+    if servers and servers <= publishers:
         return "server"
-    return "client" if clients and clients <= publishers else None
+    if clients and clients <= publishers:
+        return "client"
+    if partial:
+        return "server" if servers & publishers else "client" if clients & publishers else None
+    return None
+
+
+def uncovered(servers: set[str], clients: set[str], levels: dict[str, str]) -> dict[str, str]:
+    """The endpoints of a service or action whose calls are not all heard
+    with contents: ``"server /ns/n"`` or ``"client /ns/n"`` -> why.
+    ``levels``: node -> the introspection it publishes (``"contents"`` or
+    ``"metadata"``; a node absent publishes none: ``off``).  A call is heard
+    with contents when its server or its client publishes contents events, so
+    an endpoint is covered when it publishes contents itself or when every
+    endpoint of the other side does (docs/ros2.md, "Every endpoint of a call
+    accounted for")."""
+    full = {n for n, level in levels.items() if level == "contents"}
+    out: dict[str, str] = {}
+    for role, mine, other, others in (("server", servers, clients, "client"), ("client", clients, servers, "server")):
+        if other and other <= full:
+            continue
+        for n in sorted(mine - full):
+            has = ("publishes introspection events without contents (METADATA)" if levels.get(n) == "metadata"
+                   else "publishes no introspection events (off)")
+            out[f"{role} {n}"] = f"{role} {n} {has}, and not every {others} of it publishes contents: its calls " \
+                                 "are not all heard"
+    return out
 
 
 def event_key(sample: Any) -> tuple[str, int]:
@@ -94,4 +126,4 @@ def event_key(sample: Any) -> tuple[str, int]:
 
 
 __all__ = ["EVENT_SUFFIX", "REQUEST_RECEIVED", "REQUEST_SENT", "RESPONSE_RECEIVED", "RESPONSE_SENT", "SIDES",
-           "event_key", "event_side", "event_struct", "side_of"]
+           "event_key", "event_side", "event_struct", "side_of", "uncovered"]

@@ -56,7 +56,7 @@ from rclverify.ros.live.dds import ACTION_INFIX
 from rclverify.runtime.dds.bus import NAME_GRACE_S, Tap
 from rclverify.backends.monitors.dds_calls import CallBook
 from rclverify.runtime.dds.call_plan import CallPlan
-from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, event_side, side_of
+from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, side_of, uncovered
 from rclverify.runtime.dds.order import OrderPairer, Pending
 from rclverify.runtime.dds.shadow import REPLY_OF, SHADOW, Shadows
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
@@ -68,6 +68,11 @@ EARLY_S = 2.0
 SETTLE_S = 0.3
 #: seconds after its receipt a sample is taken whatever its stamp says (a writer whose clock runs ahead)
 LATE_S = 1.0
+#: seconds an endpoint goes unheard with contents before it is said not judged (the graph's reading of a node
+#: that just appeared may list its service before its event publisher)
+ENDPOINT_GRACE_S = 1.5
+#: the introspection event parts of an action that tell its goals and results (cancel's only tell cancels)
+_GOAL_EVENTS = ("goal_event", "result_event")
 #: action_msgs/msg/GoalStatus values (ROS 2 design "Actions")
 GOAL_STATUS = {0: "unknown", 1: "accepted", 2: "executing", 3: "canceling", 4: "succeeded", 5: "canceled",
                6: "aborted"}
@@ -106,6 +111,13 @@ class CallTaps:
         self._pairers: dict[str, OrderPairer] = {}
         self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
         self.sided: set[str] = set()  # the links some of whose calls an introspection side paired
+        #: (link, endpoint owner) -> "metadata": an endpoint seen publishing events without contents
+        self._levels: dict[tuple[str, str], str] = {}
+        #: (link, endpoint, why) -> since when (s) the endpoint has been unheard with contents
+        self._uncovered: dict[tuple[str, str, str], float] = {}
+        #: link -> endpoint -> why, the endpoints said not judged (events only; the book has them too)
+        self.unjudged: dict[str, dict[str, str]] = {}
+        self._ev_opened: dict[tuple[str, str, int], int] = {}  # (link, client gid, seq) -> servers that took it
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
         #: pairer name -> (the reply reader's writers, the pairer's servers) when discovery was last read
@@ -179,6 +191,7 @@ class CallTaps:
         self._take(lambda stamp, got: stamp <= now - SETTLE_S or got <= now - LATE_S)
         if now - self._checked >= 0.5:
             self._checked = now
+            self._coverage(now)
             self.check_forms(now)
             if self.shadows is not None:
                 self.shadows.update()
@@ -215,9 +228,9 @@ class CallTaps:
                 return  # a writer of the other middleware: its bytes are not this reader's layout
         s = struct.deserialize(raw)
         if part == "event":
-            self._event(name, s, stamp, now)
+            self._event(name, s, stamp, now, writer)
         elif part.endswith("_event"):
-            self._action_event(name, part, s, stamp, now)
+            self._action_event(name, part, s, stamp, now, writer)
         elif part in ("request", "reply"):
             if self._side(name, stamp) is not None:
                 self.counts["introspected"] += 1
@@ -232,21 +245,80 @@ class CallTaps:
             self._action(name, part, s, stamp, now, framed, writer)
 
     def unheard(self) -> dict[str, str]:
-        """Events only (module docstring): each link (``/s``) no introspection
-        event of which was heard from its server or from every client, with
-        what that left unheard; ``{}`` on the DDS source."""
+        """Events only (module docstring): each link (``/s``) with what the
+        run could not hear of it: no introspection event of its server or of
+        every client (none of its calls), and each endpoint said not judged
+        (:meth:`_coverage`: its calls not all heard with contents); ``{}`` on
+        the DDS source."""
         if not self.events:
             return {}
         out = {}
         for name, kind in sorted(self.kinds.items()):
-            if name in self.sided:
-                continue
-            out[name] = (f"no introspection event of its server or of every client was heard "
-                         f"({name}{EVENT_SUFFIX}): none of its calls was heard" if kind == "service" else
-                         f"no introspection event of its own services was heard ({name}{ACTION_INFIX}send_goal"
-                         f"{EVENT_SUFFIX}, get_result's, cancel_goal's): none of its goals or results was heard "
-                         "(its feedback and status topics are)")
+            said = [] if name in self.sided else [
+                f"no introspection event of its server or of every client was heard "
+                f"({name}{EVENT_SUFFIX}): none of its calls was heard" if kind == "service" else
+                f"no introspection event of its own services was heard ({name}{ACTION_INFIX}send_goal"
+                f"{EVENT_SUFFIX}, get_result's, cancel_goal's): none of its goals or results was heard "
+                "(its feedback and status topics are)"]
+            said += list(self.unjudged.get(name, {}).values())
+            if said:
+                out[name] = "; ".join(said)
         return out
+
+    # -- endpoints -------------------------------------------------------------------------------
+    def _owner(self, guid: bytes) -> str:
+        """The endpoint a writer belongs to: its ROS node (``/ns/name``), else its participant."""
+        return self._node_of(bytes(guid)) or bytes(guid[:12]).hex()
+
+    def _level(self, name: str, writer: bytes | None, s: Any) -> None:
+        """Note an event without the request or response it is about: its endpoint publishes metadata only."""
+        kind = int(s.info.event_type)
+        body = s.request if kind in (SIDES["server"][0], SIDES["client"][0]) else s.response
+        if writer is not None and not body:
+            self._levels[(name, self._owner(writer))] = "metadata"
+
+    def _publishing(self, name: str, part: str) -> set[str]:
+        """The endpoints that publish the introspection events of tap ``part`` of ``name`` (an action's
+        goal and result events both, for ``goal_event``/``result_event``): the graph API's report of the
+        event publishers (the rclpy source) and the writers the tap hears, by owner."""
+        parts = _GOAL_EVENTS if part in _GOAL_EVENTS else (part,)
+        graph = (getattr(self._disc, "services", None) or {}) if self._ends is not None else {}
+        reported = graph.get(name, {}).get("events") if part != "cancel_event" else None
+        found: set[str] | None = None
+        for p in parts:
+            ev = self.taps.get(f"call:{name}:{p}")
+            heard = {self._owner(g) for g in ev.heard} if ev is not None else set()
+            found = heard if found is None else found & heard
+        return (found or set()) | set(reported or ())
+
+    def _contents(self, name: str, part: str) -> set[str]:
+        """:meth:`_publishing` without the endpoints seen publishing metadata only."""
+        return {o for o in self._publishing(name, part) if self._levels.get((name, o)) != "metadata"}
+
+    def _coverage(self, now: float) -> None:
+        """Events only: every endpoint of each link not heard with contents for
+        :data:`ENDPOINT_GRACE_S` s (:func:`~.introspection.uncovered`: its
+        introspection off or metadata, from the graph API's endpoints and
+        event publishers, read again at each look) is told to the book as not
+        judged (:meth:`~.dds_calls.CallBook.unjudged`), once per reason."""
+        if not self.events or self._ends is None:
+            return
+        now_uncovered: set[tuple[str, str, str]] = set()
+        for name, kind in self.kinds.items():
+            servers, clients = self._ends(name)
+            part = "event" if kind == "service" else "goal_event"
+            pubs = self._publishing(name, part)
+            levels = {o: self._levels.get((name, o), "contents") for o in pubs}
+            for end, why in uncovered(set(servers), set(clients), levels).items():
+                k = (name, end, why)
+                now_uncovered.add(k)
+                since = self._uncovered.setdefault(k, now)
+                said = self.unjudged.setdefault(name, {})
+                if now - since >= ENDPOINT_GRACE_S and said.get(end) != why:
+                    said[end] = why
+                    self.book.unjudged(name, end, why, max(self.book.now, now - SETTLE_S))
+        for k in [k for k in self._uncovered if k not in now_uncovered]:
+            del self._uncovered[k]
 
     # -- services ------------------------------------------------------------------------------
     def _request(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
@@ -315,19 +387,34 @@ class CallTaps:
 
     def _side(self, name: str, stamp: float, part: str = "event") -> str | None:
         """Which side's introspection events (tap ``part``) pair the calls of
-        service or action ``name`` (:func:`event_side`; with the graph API's
-        nodes, :func:`side_of`) at the sample stamped ``stamp``.  When that
-        changes (an event writer discovered after calls began, or gone), the
-        calls the other source opened can no longer be answered by it: they
-        are unpaired."""
+        service or action ``name`` at the sample stamped ``stamp``
+        (:func:`~.introspection.side_of` on the endpoints that publish them
+        with contents).  The DDS source takes a side only when it hears every
+        call (every server publishes, or every client), else it pairs the
+        request and reply topics; the rclpy source, which hears nothing else,
+        takes the side some endpoint publishes (the others are said not
+        judged: :meth:`_coverage`).  When the side changes (an event writer
+        discovered after calls began, gone, or seen to publish metadata only),
+        the calls the other source opened can no longer be answered by it:
+        they are unpaired."""
         ev = self.taps.get(f"call:{name}:{part}")
         if ev is None:
             side = None
         elif self._ends is not None:
-            side = side_of({self._node_of(bytes(g)) or bytes(g[:12]).hex() for g in ev.heard}, *self._ends(name))
+            servers, clients = self._ends(name)
+            side = side_of(self._contents(name, part), set(servers), set(clients), partial=self.events)
         else:
             rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("reply", "request"))
-            side = None if rep is None or req is None else event_side(ev.heard, rep.heard, req.heard, self._node_of)
+            if rep is None or req is None:
+                side = None
+            else:
+                try:
+                    shadows = {p.guid for p in self._disc.publishers(rep.dds_topic) if SHADOW in p.qos.user_data} \
+                        if self._disc is not None else set()
+                except RuntimeError:  # discovery changed under us (the DDS thread): as last time
+                    shadows = set()
+                side = side_of(self._contents(name, part), {self._owner(g) for g in rep.heard if g not in shadows},
+                               {self._owner(g) for g in req.heard})
         memo = f"{name}:{part}"
         if side is not None:
             self.sided.add(name)
@@ -344,25 +431,37 @@ class CallTaps:
         self._pairers.pop(name, None)
         return side
 
-    def _event(self, name: str, s: Any, stamp: float, now: float) -> None:
+    def _event(self, name: str, s: Any, stamp: float, now: float, writer: bytes | None = None) -> None:
+        self._level(name, writer, s)
         side = self._side(name, stamp)
         if side is None:
             return
         asked, told = SIDES[side]
         gid, seq = event_key(s)
-        key = ("ev", gid, seq)
+        # a server's events: each server that took the request has a call of its own (two servers of one
+        # service both answer it), named by its event writer; a client's: the client gid names it
+        key: tuple[Any, ...] = ("ev", gid, seq, bytes(writer).hex()) if side == "server" and writer else \
+            ("ev", gid, seq)
         kind = int(s.info.event_type)
         if kind == asked:
             if not s.request:
                 self.counts["no_contents"] += 1
                 return  # introspection without CONTENTS: nothing to judge (docs/ros2.md)
-            self._open(name, key, f"{name.strip('/')} call {gid}:{seq}", to_fields(s.request[0]), stamp)
+            memo = (name, gid, seq)
+            taken = self._ev_opened[memo] = self._ev_opened.get(memo, 0) + 1
+            while len(self._ev_opened) > 10_000:
+                self._ev_opened.pop(next(iter(self._ev_opened)))
+            where = "" if len(key) == 3 else f" at {self._owner(writer or b'')}"
+            self._open(name, key, f"{name.strip('/')} call {gid}:{seq}{where if taken > 1 else ''}",
+                       to_fields(s.request[0]), stamp, count=taken == 1)
         elif kind == told and s.response:
             self._answer(key, "response", to_fields(s.response[0]), stamp, True, name, now)
 
     # -- actions -------------------------------------------------------------------------------
-    def _action_event(self, name: str, part: str, s: Any, stamp: float, now: float) -> None:
+    def _action_event(self, name: str, part: str, s: Any, stamp: float, now: float,
+                      writer: bytes | None = None) -> None:
         """An introspection event of one of action ``name``'s own services (module docstring, events only)."""
+        self._level(name, writer, s)
         side = self._side(name, stamp, part)
         if side is None:
             return

@@ -23,11 +23,25 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
 * **Services and actions** (``{"op": "service", "name", "action"}``): the
   nodes that serve and that call each one (``/ns/name``), from the graph
   API (``get_service_names_and_types_by_node`` and its client twin;
-  rclpy.action's for actions), sent with the graph every
-  :data:`SERVICE_PERIOD_S`: the monitor reads from them whose introspection
-  events pair a call (the server's, else every client's).
+  rclpy.action's for actions), and the nodes that publish its introspection
+  events, sent with the graph every :data:`SERVICE_PERIOD_S`: the monitor
+  reads from them whose introspection events pair a call (the servers',
+  else the clients') and which endpoints it does not hear with contents.
 * **Writers** (``writer``, ``write``): publishers of the monitor (its
   verdicts), written with serialized messages the monitor made.
+* **Type descriptions** (``{"op": "describe", "type", "hash", "node",
+  "ns"}``): the definition a publisher declares, as a type description
+  (type_description_interfaces/msg/TypeDescription as a dict), for a
+  publisher whose type hash is not the monitor's.  First rosidl's own
+  description of the type in this Python (``share/<pkg>/msg/<T>.json``,
+  written beside the interface when it was built), when its hash is the
+  one asked (sha256 of the same description: the same definition); else
+  the publisher's node's type description service
+  (``<node>/get_type_description``, REP-2011, from Iron on), waited for
+  at most :data:`DESCRIBE_TIMEOUT_S`.  Answered by one ``description``
+  frame: the descriptions found (``candidates``, each with where it came
+  from) and why the others were not had (``failures``); the monitor checks
+  each candidate's hash itself.
 
 SIGINT is ignored (the monitor stops the agent when it stops: ``stop`` or
 the end of stdin), so a Ctrl-C in a terminal does not cut the stream short.
@@ -60,6 +74,8 @@ import wire  # type: ignore[import-not-found]  # beside this script (module docs
 GRAPH_PERIOD_S = 0.1
 #: seconds between two readings of the services' and actions' servers and clients (one query per node each)
 SERVICE_PERIOD_S = 0.5
+#: seconds a publisher's node has to answer a type description request (its service found, then the answer)
+DESCRIBE_TIMEOUT_S = 5.0
 
 
 def _emit(frame: bytes) -> None:
@@ -91,6 +107,9 @@ class _Command(TypedDict, total=False):
     reliable: bool
     transient_local: bool
     raw: str
+    hash: str
+    node: str
+    ns: str
 
 
 class _Endpoint(TypedDict):
@@ -143,6 +162,8 @@ class Agent:
         self.next_ends = 0.0
         self.writers: dict[int, Any] = {}
         self.last_graph: Any = None
+        #: type description requests waiting for a node's answer: (type, hash) -> their state (:meth:`describe`)
+        self.asked: dict[tuple[str, str], dict[str, Any]] = {}
 
     def hello(self) -> None:
         try:
@@ -177,6 +198,77 @@ class Agent:
             self.writers[int(c["id"])] = self.node.create_publisher(_class(c["type"]), c["topic"], qos)
         elif op == "write":
             self.writers[int(c["id"])].publish(base64.b64decode(c["raw"]))
+        elif op == "describe":
+            self.describe(c["type"], c["hash"], c.get("node", ""), c.get("ns", "/"))
+
+    # -- type descriptions ---------------------------------------------------------------------
+    def describe(self, type_name: str, type_hash: str, node: str, ns: str) -> None:
+        """Find the description of ``type_name`` whose hash is ``type_hash`` (module docstring): this
+        Python's own when its hash is that one (said at once), else ask ``node``'s service (said by
+        :meth:`describing` when it answers or :data:`DESCRIBE_TIMEOUT_S` passed)."""
+        failures: list[str] = []
+        own = installed_description(type_name)
+        if own is not None and own[0] == type_hash:
+            _emit(_description_frame(type_name, type_hash, [{"from": own[2], "description": own[1]}], []))
+            return
+        if own is not None:
+            failures.append(f"{own[2]} has the type hash {own[0]}")
+        else:
+            failures.append(f"this ROS 2 Python has no rosidl description of {type_name}")
+        if not node:
+            _emit(_description_frame(type_name, type_hash, [], failures + ["the publisher's node is not known"]))
+            return
+        try:
+            self.asked[(type_name, type_hash)] = self.ask_service(type_name, type_hash, node, ns)
+        except Exception as exc:  # noqa: BLE001 - a ROS 2 without type_description_interfaces: said
+            _emit(_description_frame(type_name, type_hash, [], failures + [
+                f"the type description service cannot be called ({type(exc).__name__}: {exc})"]))
+            return
+        self.asked[(type_name, type_hash)]["failures"] = failures
+
+    def ask_service(self, type_name: str, type_hash: str, node: str, ns: str) -> dict[str, Any]:
+        """A request of ``type_name``'s description (hash ``type_hash``) to the type description
+        service of node ``ns``/``node``: its state, which :meth:`step_request` moves on.  Raises
+        ``ImportError`` where this ROS 2 has no ``type_description_interfaces`` (before Iron)."""
+        from type_description_interfaces.srv import GetTypeDescription  # deferred: Iron and later only
+        service = ns.rstrip("/") + "/" + node + "/get_type_description"
+        client = self.node.create_client(GetTypeDescription, service)
+        request = GetTypeDescription.Request(type_name=type_name, type_hash=type_hash, include_type_sources=False)
+        return {"client": client, "request": request, "future": None, "service": service, "failures": [],
+                "deadline": time.monotonic() + DESCRIBE_TIMEOUT_S}
+
+    def step_request(self, state: dict[str, Any]) -> dict[str, Any] | None:
+        """Move one service request on: send it once the service is found; ``None`` while it
+        waits, else ``{"candidates": [...], "failures": [...]}`` (the client then destroyed)."""
+        fut = state["future"]
+        done: dict[str, Any] | None = None
+        origin = f"the type description service {state['service']}"
+        if fut is None and state["client"].service_is_ready():
+            state["future"] = fut = state["client"].call_async(state["request"])
+        if fut is not None and fut.done():
+            exc = fut.exception()
+            answer = None if exc is not None else fut.result()
+            if answer is not None and answer.successful:
+                done = {"candidates": [{"from": origin, "description": _description_dict(answer.type_description)}],
+                        "failures": []}
+            else:
+                why = answer.failure_reason if answer is not None else f"{type(exc).__name__}: {exc}"
+                done = {"candidates": [], "failures": [f"{origin} answered: {why}"]}
+        elif time.monotonic() >= state["deadline"]:
+            done = {"candidates": [], "failures": [f"{origin} did not answer within {DESCRIBE_TIMEOUT_S:g} s" + (
+                "" if fut is not None else " (not found: a node from before Iron, or one started with "
+                "start_type_description_service false)")]}
+        if done is not None:
+            self.node.destroy_client(state["client"])
+        return done
+
+    def describing(self) -> None:
+        """Say each service request that is answered or out of time (:meth:`step_request`)."""
+        for key, state in list(self.asked.items()):
+            done = self.step_request(state)
+            if done is not None:
+                del self.asked[key]
+                _emit(_description_frame(key[0], key[1], done["candidates"], state["failures"] + done["failures"]))
 
     # -- the graph -----------------------------------------------------------------------------
     def _publishers(self, topic: str) -> list[Any]:
@@ -217,8 +309,15 @@ class Agent:
             self._said(k, tap)
 
     def _service_ends(self) -> dict[str, dict[str, list[str]]]:
-        """Each watched service's or action's serving and calling nodes (``/ns/name``)."""
-        ends: dict[str, dict[str, set[str]]] = {n: {"servers": set(), "clients": set()} for n in self.services}
+        """Each watched service's or action's serving and calling nodes
+        (``/ns/name``), and ``events``: the nodes that publish its
+        introspection events (:func:`_introspecting`; a node whose
+        introspection is off has no such publisher; whether one publishes
+        metadata or contents its events tell the monitor)."""
+        ends: dict[str, dict[str, set[str]]] = {n: {"servers": set(), "clients": set(), "events": set()}
+                                                for n in self.services}
+        for svc, is_action in self.services.items():
+            ends[svc]["events"] = self._introspecting(svc, is_action)
         for name, ns in self.node.get_node_names_and_namespaces():
             if name == self.name and ns == "/":
                 continue
@@ -236,6 +335,18 @@ class Agent:
                 if svc in (acts_c if is_action else called):
                     ends[svc]["clients"].add(full)
         return {n: {k: sorted(v) for k, v in e.items()} for n, e in ends.items()}
+
+    def _introspecting(self, svc: str, is_action: bool) -> set[str]:
+        """The nodes (``/ns/name``) that publish the introspection events of
+        service ``svc`` (``<svc>/_service_event``), or of action ``svc``'s
+        send-goal and get-result services both (a goal and its result)."""
+        topics = ([f"{svc}/_action/send_goal/_service_event", f"{svc}/_action/get_result/_service_event"]
+                  if is_action else [f"{svc}/_service_event"])
+        found: set[str] | None = None
+        for t in topics:
+            nodes = {p.node_namespace.rstrip("/") + "/" + p.node_name for p in self._publishers(t)}
+            found = nodes if found is None else found & nodes
+        return found or set()
 
     def _said(self, k: int, tap: _Tap) -> None:
         qos = tap["qos"]
@@ -265,6 +376,57 @@ def _matches(qos: tuple[bool, bool] | None, pubs: list[_Endpoint]) -> bool:
     reliable, latched = qos
     return all((p["reliable"] or not reliable) and (p["durability"] == "transient_local" or not latched)
                for p in pubs)
+
+
+def installed_description(type_name: str) -> tuple[str, dict[str, Any], str] | None:
+    """``(type hash, type description, where)`` of ``type_name`` (``pkg/msg/T``) as rosidl wrote it
+    for this Python (``share/<pkg>/msg/<T>.json``: ``type_description_msg`` and ``type_hashes``), from
+    the package's share directory in the ament index, else under ``AMENT_PREFIX_PATH`` and this
+    Python's prefix; ``None`` where there is none (or it does not describe ``type_name``)."""
+    parts = type_name.strip("/").split("/")
+    if len(parts) != 3:
+        return None
+    pkg, kind, name = parts
+    shares = []
+    try:
+        from ament_index_python.packages import get_package_share_directory  # deferred: not in every ROS 2 Python
+        shares.append(get_package_share_directory(pkg))
+    except Exception:  # noqa: BLE001 - not indexed: the prefixes below
+        pass
+    prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p] + [sys.prefix]
+    shares += [os.path.join(p, "share", pkg) for p in prefixes]
+    for share in shares:
+        path = os.path.join(share, kind, name + ".json")
+        try:
+            with open(path, encoding="utf-8") as fh:
+                doc = json.load(fh)
+            desc = doc["type_description_msg"]
+            if desc["type_description"]["type_name"] != type_name:
+                continue
+            found = next(h["hash_string"] for h in doc["type_hashes"] if h["type_name"] == type_name)
+        except (OSError, ValueError, KeyError, TypeError, StopIteration):
+            continue
+        return str(found), desc, f"this ROS 2 Python's {pkg} ({path})"
+    return None
+
+
+def _description_dict(td: Any) -> dict[str, Any]:
+    """A ``type_description_interfaces/msg/TypeDescription`` as the dict the monitor reads (rosidl's
+    ``.json`` form)."""
+    def one(d: Any) -> dict[str, Any]:
+        return {"type_name": d.type_name, "fields": [
+            {"name": f.name, "type": {"type_id": f.type.type_id, "capacity": f.type.capacity,
+                                      "string_capacity": f.type.string_capacity,
+                                      "nested_type_name": f.type.nested_type_name},
+             "default_value": f.default_value} for f in d.fields]}
+    return {"type_description": one(td.type_description),
+            "referenced_type_descriptions": [one(r) for r in td.referenced_type_descriptions]}
+
+
+def _description_frame(type_name: str, type_hash: str, candidates: list[dict[str, Any]],
+                       failures: list[str]) -> bytes:
+    return wire.json_frame({"what": "description", "type": type_name, "hash": type_hash,
+                            "candidates": candidates, "failures": failures})
 
 
 def _handler(k: int) -> Any:
@@ -358,6 +520,8 @@ def main() -> int:
             if now >= next_graph:
                 agent.update()
                 next_graph = now + GRAPH_PERIOD_S
+            if agent.asked:
+                agent.describing()
             agent.ex.spin_once(timeout_sec=GRAPH_PERIOD_S)
     finally:
         agent.close()
