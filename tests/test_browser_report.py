@@ -362,9 +362,9 @@ def test_the_warehouse_first_screen_says_what_to_fix(tmp_path: Path, driver: Any
 
 def test_the_standards_section_maps_every_clause_of_the_case_study(tmp_path: Path, driver: Any) -> None:
     """The case study's plan maps its evidence onto IEC 61508-3 at SIL 2 and UL 4600 (docs/standards.md):
-    in the browser, one table per standard, one row per clause of its profile, each showing its
-    supporting evidence (folded, every record linked to the evidence it names) or that it is open,
-    and a status that is never "covered" while one of its records is not discharged."""
+    in the browser, one compliance matrix per standard, one row per clause of its profile, each showing
+    what covers it (or none), who checked it, its status and why, the status never "covered" while an
+    item in the clause's scope is not, and never "partial" with nothing covered."""
     with gzip.open(REPO / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
         report = json.load(f)
     report.pop("problems", None)
@@ -379,15 +379,14 @@ def test_the_standards_section_maps_every_clause_of_the_case_study(tmp_path: Pat
         assert len(rows) == len(s["clauses"]) > 0, profile
         for row, clause in zip(rows, s["clauses"]):
             cells = row.find_elements("tag name", "td")
-            assert cells[0].text == clause["id"]
-            links = cells[5].find_elements("css selector", "a")
-            if clause["evidence"]:
-                assert len(links) == len(clause["evidence"]) and "record" in cells[5].text
-            else:
-                assert clause["status"] == "open" and "open: no evidence" in cells[5].text
-            statuses = {e["status"] for e in clause["evidence"]}
-            assert cells[6].text == clause["status"]
-            assert clause["status"] != "covered" or statuses == {"discharged"}
+            assert cells[0].text == clause["id"] and cells[6].text == clause["status"]
+            covered = [x for x in clause["scope"] if x["covered"]]
+            assert cells[4].text == (", ".join(clause["covered_by"]) if clause["covered_by"] else "none")
+            assert cells[7].text.startswith(clause["why"][:40])
+            assert clause["status"] != "covered" or len(covered) == len(clause["scope"]) > 0
+            assert clause["status"] != "partial" or (covered and clause["covered_by"])
+            links = cells[7].find_elements("css selector", "a")
+            assert len(links) == sum(1 for e in clause["evidence"] if not e["counts"])
     assert driver.execute_script(_BROKEN_LINKS, "table.standard a") == []
     driver.execute_script(f"document.getElementById('{anchor('standard', 'iec61508-3')}').scrollIntoView()")
     _screenshot(driver, tmp_path, "assurance-standards.png")

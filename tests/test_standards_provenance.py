@@ -149,3 +149,55 @@ def test_a_workspace_file_under_a_package_like_path_is_still_the_workspace_s(tmp
     plan = load_plan(root)
     assert plan.standards[1].profile.builtin is False
     assert rel in collect(root, plan)[0]
+
+
+# --- a review record through the pipeline: the self-review of the first attempt -----------------
+
+REVIEW_PLAN = """name: review
+contracts: [contracts/gain.rcl]
+standards:
+  - {profile: iec61508-3, sil: 2}
+nodes:
+  Gain:
+    evidence:
+      - backend: property_tests
+        implementation: impl/gain.py:gain
+        max_examples: 20
+      - backend: review
+        record: reviews/gain.yaml
+"""
+
+
+def _review_ws(root: Path, reviewer: str, author: str) -> dict[str, Any]:
+    import yaml
+    _write(root, {"contracts/gain.rcl": RCL, "contracts/plan.yaml": REVIEW_PLAN, "impl/gain.py": IMPL})
+    assert main(["review", "Gain", "-w", str(root), "-o", str(root / "reviews" / "gain.yaml"),
+                 "-f", "impl/gain.py"]) == 0
+    blank = (root / "reviews" / "gain.yaml").read_text(encoding="utf-8")
+    assert "\nauthor: " in blank and "\nindependence: " in blank  # the record asks for both names
+    data = yaml.safe_load(blank)
+    data.update(reviewer=reviewer, author=author, date="2026-11-27", scope="impl/gain.py against Gain's contract",
+                verdict="pass")
+    for q in data["checklist"]:
+        q["answer"] = "yes"
+    (root / "reviews" / "gain.yaml").write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    main(["verify", "-w", str(root)])
+    report = _report(root)
+    check_report(report, "review")
+    assert {e["obligation"]: e["status"] for e in report["evidence"]}["Gain.g1.review.e1"] == "discharged"
+    return {c["id"]: c for c in report["standards"][0]["clauses"]}
+
+
+def test_a_self_review_through_the_pipeline_covers_no_independence_clause(tmp_path: Path) -> None:
+    clauses = _review_ws(tmp_path / "ws", "Ada Lovelace", "Ada Lovelace")
+    b86c = clauses["B.8 6c"]
+    assert b86c["status"] == "open" and b86c["evidence"][0]["note"] == "self-review: Ada Lovelace reviewed their own work"
+    # nor static analysis (a manual review counts there only when independent), nor a modular design
+    assert clauses["A.9 3"]["status"] == "open" and clauses["A.4 4"]["status"] != "covered"
+
+
+def test_control_an_independent_review_through_the_pipeline_covers_it(tmp_path: Path) -> None:
+    clauses = _review_ws(tmp_path / "ws", "Ada Lovelace", "Charles Babbage")
+    b86c = clauses["B.8 6c"]
+    assert b86c["status"] == "covered" and b86c["checked_by"] == ["review by Ada Lovelace (author: Charles Babbage)"]
+    assert clauses["A.9 3"]["status"] == "covered"

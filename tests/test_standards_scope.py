@@ -297,3 +297,21 @@ def test_statuses_against_a_reading_of_the_scope_rule() -> None:
                 assert got["status"] == want, (item.id, got["why"])
             else:
                 assert got["status"] in ("not covered", "open") and got["covered_by"] == []
+
+
+# --- the compliance matrix's types are the published schema's ------------------------------------
+
+def test_the_standards_typeddicts_are_the_schema() -> None:
+    """StandardRow (and the clause, scope and evidence rows inside it) held to ``$defs/standard`` key by key,
+    both ways, as tests/test_report_vocabulary.py holds the report's other rows."""
+    import test_report_vocabulary as voc
+    from _report_schema import SCHEMA
+    from rclverify.report.standards_rows import StandardRow
+    assert voc._disagreements(StandardRow, SCHEMA["$defs"]["standard"], "standard") == []
+    # control: a key the schema lacks is found
+    kept = SCHEMA["$defs"]["standard_clause"]["properties"].pop("why")
+    try:
+        assert voc._disagreements(StandardRow, SCHEMA["$defs"]["standard"], "standard") == [
+            "standard.clauses.why: only in the TypedDict"]
+    finally:
+        SCHEMA["$defs"]["standard_clause"]["properties"]["why"] = kept

@@ -14,7 +14,7 @@ them).  The mapping is a traceability aid, not a compliance claim.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, TypedDict
+from typing import Any, Literal, Mapping, Sequence, TypedDict
 
 from rclverify.records.report_schema import EvidenceRow, Report
 from rclverify.model.plan.standards.choice import StandardChoice
@@ -26,7 +26,7 @@ class ProfileOrigin(TypedDict):
     """Where a profile comes from (``standards[].origin``): ``kind`` ``built-in`` (one of rclverify's
     profiles, ``file`` its package-relative path) or ``workspace`` (``file`` workspace-relative), with
     the ``edition`` it names and the ``sha256`` of the file's bytes."""
-    kind: str
+    kind: Literal["built-in", "workspace"]
     file: str
     sha256: str
     edition: str

@@ -43,10 +43,22 @@ assessor, not a compliance claim.
 from __future__ import annotations
 
 from collections import Counter
-from typing import Any, Iterable, Mapping, Sequence, TypedDict
+from typing import Any, Iterable, Literal, Mapping, Sequence, TypedDict, cast, get_args
 
 from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
 from rclverify.records.report_schema import EvidenceRow
+from rclverify.records.statuses import EvidenceKind, EvidenceStatus
+
+#: A clause's status (the module docstring).
+ClauseStatus = Literal["covered", "partial", "not covered", "open", "not recommended"]
+#: A recommendation code (profiles.CODES).
+Recommendation = Literal["HR", "R", "---", "NR", "required"]
+#: What a clause is about (profiles.ABOUT).
+About = Literal["guarantees", "interfaces", "requirements", "system", "field-data", "trials"]
+#: An independence level (profiles.INDEPENDENCE).
+Independence = Literal["none", "person", "department", "organisation"]
+#: The sort of an item in a clause's scope.
+ScopeKind = Literal["guarantee", "side condition", "requirement", "target", "health check", "workspace"]
 
 #: (evidence row field, its value) -> the profile evidence kind it supports.  ``kind`` is the
 #: record's kind (each backend's ``kind``: hoare and dafny "proof", ajpf "model checking",
@@ -62,8 +74,8 @@ SUPPORTS: Mapping[tuple[str, str], str] = {
     ("strength", "statistical"): "run-statistics",
 }
 
-#: A clause's status (the module docstring).
-CLAUSE_STATUSES: tuple[str, ...] = ("covered", "partial", "not covered", "open", "not recommended")
+#: A clause's statuses, in the order the report counts them.
+CLAUSE_STATUSES: tuple[ClauseStatus, ...] = get_args(ClauseStatus)
 
 #: A side condition's verdicts that count as proved.
 _PROVED = ("discharged", "discharged in context")
@@ -84,8 +96,8 @@ class Support(TypedDict):
     clause, ``note`` why not (a harness run, a review without the independence asked), or ``""``."""
     obligation: str
     backend: str
-    kind: str
-    status: str
+    kind: EvidenceKind
+    status: EvidenceStatus
     counts: bool
     note: str
 
@@ -96,7 +108,7 @@ class ScopeItem(TypedDict):
     sort, ``state`` ``covered`` or in one word what keeps it from being covered (a status, ``no
     evidence``, ``not counted``), ``detail`` the sentence, ``evidence`` the obligations that cover it."""
     item: str
-    kind: str
+    kind: ScopeKind
     covered: bool
     state: str
     detail: str
@@ -110,16 +122,16 @@ class ClauseRow(TypedDict):
     matrix, docs/standards.md)."""
     id: str
     title: str
-    recommendation: str
+    recommendation: Recommendation
     accepts: list[str]
     strength: str
-    about: str
-    independence: str
+    about: About
+    independence: Independence
     evidence: list[Support]
     scope: list[ScopeItem]
     covered_by: list[str]
     checked_by: list[str]
-    status: str
+    status: ClauseStatus
     why: str
 
 
@@ -170,8 +182,9 @@ def _support(row: Mapping[str, Any], asked: str) -> Support:
         level, why = independence_of(row)
         if INDEPENDENCE.index(level) < INDEPENDENCE.index(asked):
             note = why or f"independence {level}; the clause asks {asked}"
-    return {"obligation": str(row["obligation"]), "backend": str(row["backend"]), "kind": str(row["kind"]),
-            "status": str(row["status"]), "counts": not note, "note": note}
+    return {"obligation": str(row["obligation"]), "backend": str(row["backend"]),
+            "kind": cast(EvidenceKind, str(row["kind"])), "status": cast(EvidenceStatus, str(row["status"])),
+            "counts": not note, "note": note}
 
 
 class _Index:
@@ -226,7 +239,7 @@ def _guarantee_item(ix: _Index, node: str, k: int, status: str, accepts: set[str
             "evidence": [s["obligation"] for s in counting] if ok else []}
 
 
-def _item(item: str, kind: str, state: str, detail: str, evidence: list[str]) -> ScopeItem:
+def _item(item: str, kind: ScopeKind, state: str, detail: str, evidence: list[str]) -> ScopeItem:
     ok = state == "covered"
     return {"item": item, "kind": kind, "covered": ok, "state": state, "detail": detail if not ok else "covered",
             "evidence": evidence if ok else []}
@@ -391,6 +404,7 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
         scope = scope_items(item, level, rep, ix)
         evidence = _evidence_in_scope(item, level, scope, ix)
         done = sum(1 for s in scope if s["covered"])
+        status: ClauseStatus
         if code == "NR":
             status = "not recommended"
         elif scope and done == len(scope):
@@ -401,8 +415,9 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
             status = "not covered"
         else:
             status = "open"
-        out.append({"id": item.id, "title": item.title, "recommendation": code, "accepts": list(item.evidence),
-                    "strength": item.strength, "about": item.about, "independence": item.independence_at(level),
+        out.append({"id": item.id, "title": item.title, "recommendation": cast(Recommendation, code),
+                    "accepts": list(item.evidence), "strength": item.strength, "about": cast(About, item.about),
+                    "independence": cast(Independence, item.independence_at(level)),
                     "evidence": evidence, "scope": scope,
                     "covered_by": list(dict.fromkeys(ob for x in scope if x["covered"] for ob in x["evidence"])),
                     "checked_by": _checked_by(scope, ix),
@@ -416,5 +431,5 @@ def not_covered(rows: Sequence[ClauseRow], codes: Sequence[str] = ASKED) -> list
     return [r["id"] for r in rows if r["recommendation"] in codes and r["status"] != "covered"]
 
 
-__all__ = ["CLAUSE_STATUSES", "ClauseRow", "SUPPORTS", "ScopeItem", "Support", "clause_rows", "independence_of",
+__all__ = ["About", "CLAUSE_STATUSES", "ClauseRow", "ClauseStatus", "Independence", "Recommendation", "ScopeKind", "SUPPORTS", "ScopeItem", "Support", "clause_rows", "independence_of",
            "kinds_of", "not_covered", "review_identity", "scope_items"]
