@@ -236,10 +236,7 @@ class CallBook:
         u["count"] += 1
         if len(u["first"]) < NAMED:
             u["first"].append(_key(key))
-        named = ", ".join(_named(k) for k in u["first"]) + (", ..." if u["count"] > len(u["first"]) else "")
-        self._mark(link, f"{link} answer {_named(_key(key))}", stamp,
-                   f"{u['count']} answer(s) of /{link} whose request the monitor did not hear (made before it "
-                   f"started, or by an endpoint it does not hear) are undecided: {named}")
+        self._mark(link, f"{link} answer {_named(_key(key))}", stamp, self._said(link, "undecided"))
 
     def unjudged(self, name: str, endpoint: str, why: str, stamp: float) -> None:
         """Endpoint ``endpoint`` (``"server /ns/n"``, ``"client /ns/n"``) of
@@ -253,8 +250,38 @@ class CallBook:
             return
         ends[endpoint] = why
         self._log({"link": link, "part": "unjudged", "time": stamp, "endpoint": endpoint, "reason": why})
-        self._mark(link, f"{link} {endpoint}", stamp, f"/{link} is not judged for {len(ends)} endpoint(s): "
-                   + "; ".join(ends.values()))
+        self._mark(link, f"{link} {endpoint}", stamp, self._said(link, "not judged"))
+
+    def _said(self, link: str, which: str) -> str:
+        """The sentence of :meth:`notes` about ``link``'s undecided answers or its endpoints not judged."""
+        if which == "undecided":
+            u = self.undecided[link]
+            named = ", ".join(_named(k) for k in u["first"]) + (", ..." if u["count"] > len(u["first"]) else "")
+            return (f"{u['count']} answer(s) of /{link} whose request the monitor did not hear (made before it "
+                    f"started, or by an endpoint it does not hear) are undecided: {named}")
+        ends = self.unjudged_ends[link]
+        return f"/{link} is not judged for {len(ends)} endpoint(s): " + "; ".join(ends.values())
+
+    def notes(self, node: str) -> list[str]:
+        """What ``node``'s calls leave undecided whatever else of them was
+        judged, one sentence per link it serves or calls: the answers whose
+        request was not heard (:meth:`orphan`: their count and the first
+        :data:`NAMED` keys) and the endpoints not heard with contents
+        (:meth:`unjudged`)."""
+        out = []
+        for link, views in self.links.items():
+            if node not in {n.name for n, _v, _t in views}:
+                continue
+            out += [self._said(link, w) for w, have in (("undecided", self.undecided), ("not judged",
+                                                                                       self.unjudged_ends))
+                    if have.get(link)]
+        return out
+
+    def with_notes(self, node: str, explanation: str) -> str:
+        """``explanation`` (a status's, :func:`.summary.verdict_status`) with each of :meth:`notes` it does
+        not already say, so a failed or inconclusive status names them too."""
+        extra = [n for n in self.notes(node) if n not in explanation]
+        return explanation + "".join(f"; {n}" for n in extra)
 
     def _mark(self, link: str, where: str, stamp: float, reason: str) -> None:
         """Keep each node of ``link`` from ``discharged``: one more ``inconclusive``, ``reason`` its first."""

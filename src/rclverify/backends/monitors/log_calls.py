@@ -107,10 +107,14 @@ class LogCalls:
 
     def entries(self) -> list[dict[str, Any]]:
         """Per node ``{node, status, explanation, calls}`` (``calls``: the
-        result as JSON, its ``counts`` the live record's ``calls.nodes``)."""
+        result as JSON, its ``counts`` the live record's ``calls.nodes``); the
+        explanation names the node's undecided answers and endpoints not
+        judged whatever its status (:meth:`~.dds_calls.CallBook.with_notes`)."""
         out = []
         for res in self.results():
             status, explanation = verdict_status(res, f"the calls in {self.trace}")
+            assert self.book is not None  # results() is empty without it
+            explanation = self.book.with_notes(res.node, explanation)  # named whatever else was judged
             out.append({"node": res.node, "status": status, "explanation": explanation, "trace": self.trace,
                         "calls": res.to_json()})
         return out
