@@ -148,6 +148,11 @@ class LiveRun:
             if self.results is None:
                 self.engine.push(topic, fields, received)
 
+    def due(self) -> float:
+        """When the next buffered message is released (s; :meth:`OnlineEngine.due`)."""
+        with self.lock:
+            return self.engine.due() if self.results is None else math.inf
+
     def tick(self, now: float) -> None:
         """The timer (see :meth:`OnlineEngine.tick`)."""
         with self.lock:

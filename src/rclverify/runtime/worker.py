@@ -21,8 +21,11 @@ milliseconds with spikes of hundreds (docs/monitors.md, "Live monitoring",
   ``batch`` messages between timer ticks (one lock acquisition, one log
   flush and one latched-verdict publication per batch, not per message);
 * the timer (:meth:`~.live.LiveRun.tick`) runs in the same thread every
-  ``tick_s`` seconds, so a horizon is closed without a new message and the
-  engine is never entered by two threads.  While messages still wait in the
+  ``tick_s`` seconds, and as soon as the watermark reaches the earliest
+  buffered message (the sink's ``due()``, at most every :data:`MIN_TICK_S`),
+  so a horizon is closed without a new message, a verdict waits the
+  lateness bound and not a timer period more, and the engine is never
+  entered by two threads.  While messages still wait in the
   queue the timer's time is that of the last message checked, not the
   clock's: the clock never passes a message received earlier, so a backlog
   cannot close an obligation before the answer waiting behind it is read.
@@ -49,6 +52,8 @@ class Sink(Protocol):
 
 
 _STOP = object()
+#: the shortest time between two timer runs (s) when the sink asks for one sooner than ``tick_s``
+MIN_TICK_S = 0.002
 
 
 class EngineWorker:
@@ -113,9 +118,14 @@ class EngineWorker:
 
     def _loop(self) -> None:
         q, live = self._q, self.live
+        due = getattr(live, "due", None)  # the sink's next release (s, the now() clock), where it tells
         next_tick = _time.monotonic() + self.tick_s
         last = -math.inf  # receipt time of the last message pushed
         while True:
+            if due is not None:
+                soon = _time.monotonic() + max(due() - self.now(), MIN_TICK_S)
+                if soon < next_tick:
+                    next_tick = soon
             wait = next_tick - _time.monotonic()
             try:
                 item = q.get(timeout=wait) if wait > 0 else q.get_nowait()

@@ -113,6 +113,13 @@ class OnlineEngine:
         if self.reorder_window <= 0:
             self._release(math.inf)
 
+    def due(self) -> float:
+        """When (s, on the engine's clock) the earliest buffered message is
+        released: its time plus the reorder window (the watermark reaches it);
+        ``inf`` with nothing buffered.  The live worker ticks then, so a
+        verdict waits the lateness bound and not a timer period more."""
+        return self._heap[0][0] + self.reorder_window if self._heap else math.inf
+
     def tick(self, now: float) -> None:
         """The timer: release messages older than the reorder window, resolve
         obligations whose horizon has passed, report silent topics."""

@@ -65,6 +65,9 @@ class _Sink:
     def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
         self.live.push(topic, fields, received)
 
+    def due(self) -> float:
+        return self.live.due()
+
     def tick(self, now: float) -> None:
         self.live.tick(now)
         if self.book is not None and self.taps is not None:
