@@ -218,3 +218,93 @@ def test_health_control_with_the_divisor_off_zero_is_ok() -> None:
     found = _health(1)
     assert set(found) == {"Divider.a2.defined", "Divider.g1.defined"}
     assert all(f.status == "ok" for f in found.values())
+
+
+# ---------------------------------------------------------------------------
+# the random oracle: Z3 on the generated conditions against brute force
+# ---------------------------------------------------------------------------
+
+ORACLE_RCL = """\
+node N {
+  inputs( a : INTEGER, b : INTEGER, c : INTEGER )
+  outputs( o : BOOL )
+  guarantee( TRUE )
+}
+"""
+#: every value of every input the enumeration tries
+RANGE = range(-2, 3)
+
+
+def _term(draw: Any, depth: int) -> str:
+    from hypothesis import strategies as st
+    if depth == 0 or draw(st.integers(0, 2)) == 0:
+        return draw(st.sampled_from(["in.a", "in.b", "in.c", "0", "1", "2", "(in.a * in.a + 1)"]))
+    op = draw(st.sampled_from(["+", "-", "*", "/", "/"]))
+    return f"({_term(draw, depth - 1)} {op} {_term(draw, depth - 1)})"
+
+
+def _formula(draw: Any, depth: int) -> str:
+    from hypothesis import strategies as st
+    if depth == 0 or draw(st.integers(0, 3)) == 0:
+        cmp = draw(st.sampled_from(["==", "!=", "<", "<=", ">", ">="]))
+        return f"({_term(draw, 2)} {cmp} {_term(draw, 2)})"
+    op = draw(st.sampled_from(["and", "or", "->", "<=>", "not"]))
+    if op == "not":
+        return f"(not {_formula(draw, depth - 1)})"
+    return f"({_formula(draw, depth - 1)} {op} {_formula(draw, depth - 1)})"
+
+
+def _holds_at(w: Any, symbols: list[Any], point: tuple[int, ...]) -> bool:
+    import z3
+    sub = z3.simplify(z3.substitute(w, *[(s, z3.IntVal(v)) for s, v in zip(symbols, point)]))
+    if z3.is_true(sub) or z3.is_false(sub):
+        return z3.is_true(sub)
+    s = z3.Solver()
+    s.add(z3.Not(sub))
+    return s.check() == z3.unsat
+
+
+def test_definedness_conditions_agree_with_brute_force_enumeration() -> None:
+    import itertools
+
+    import z3
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    from rclverify.lang.parser import parse_formula, parse_text
+    from rclverify.lang.typecheck import check
+    from rclverify.semantics.definedness import conditions, defined
+    from rclverify.semantics.encode import Encoder
+    from rclverify.semantics.evaluate import why_undecided
+    from rclverify.semantics.query import prove
+
+    checked = check([parse_text(ORACLE_RCL, "oracle.rcl")])
+    node = checked.nodes["N"]
+    seen = {"undefined somewhere": 0, "defined everywhere": 0, "guarded": 0}
+
+    @settings(max_examples=150, deadline=None, derandomize=True,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    @given(st.data())
+    def one(data: Any) -> None:
+        text = _formula(data.draw, 3)
+        e = parse_formula(text, "oracle.rcl")
+        enc = Encoder(checked.env)
+        w = enc.formula(defined(e), node)
+        symbols = [enc.io_symbol(node, "in", v) for v in ("a", "b", "c")]
+        points = list(itertools.product(RANGE, repeat=3))
+        brute = {p: why_undecided(e, checked, node, dict(zip(("in.a", "in.b", "in.c"), p))) for p in points}
+        assert set(brute.values()) <= {"", "division by zero"}, text
+        for p in points:  # pointwise: the condition holds exactly where the evaluator decides
+            assert _holds_at(w, symbols, p) == (brute[p] == ""), (text, p, brute[p])
+        ranges = [z3.And(s >= min(RANGE), s <= max(RANGE)) for s in symbols]
+        verdict = prove(w, ranges, enc).status  # the verdict a proof path gives: defined on the whole range?
+        assert verdict == ("proved" if all(v == "" for v in brute.values()) else "refuted"), text
+        if verdict == "refuted":
+            seen["undefined somewhere"] += 1
+        elif conditions(e):
+            seen["defined everywhere"] += 1
+        if any(c.formula is not c.requires for c in conditions(e)):
+            seen["guarded"] += 1
+
+    one()
+    assert all(n >= 5 for n in seen.values()), seen  # the corpus exercised each kind of answer
