@@ -179,6 +179,18 @@ def test_every_form_of_a_run_is_one_run_and_different_runs_are_different(store: 
     assert len(set(identities)) == N_RUNS
 
 
+def test_the_bundled_live_recordings_and_their_bags_are_one_run_each(store: Any) -> None:
+    """``examples/ros2_robot``: each run ``rclverify monitor --live --ros2 --record`` recorded over
+    rclpy nodes on Fast DDS, as its log and its MCAP bag (which also hold the run's calls)."""
+    base = Path(__file__).resolve().parents[1] / "examples" / "ros2_robot"
+    pairs = [(base / "runs", "robot.jsonl", "robot")] + [
+        (d, "run.jsonl", "run") for d in sorted((base / "defects").iterdir()) if (d / "run.jsonl").is_file()]
+    assert len(pairs) >= 6
+    got = [(run_digest(d, log), run_digest(d, bag)) for d, log, bag in pairs]
+    assert all(a == b for a, b in got), [p[0].name for p, (a, b) in zip(pairs, got) if a != b]
+    assert len({a for a, _ in got}) == len(pairs)
+
+
 def test_a_changed_value_time_or_message_is_another_run(store: Any, tmp_path: Path) -> None:
     run = _random_run(store, 99, size=40)
     plain = next(i for i, (t, _, _) in enumerate(run) if t not in STAMPED)
