@@ -40,6 +40,9 @@ def requirement_record(ws: Any, report: ReportRows, q: RequirementRow, cache: An
     guarantee's (text, source)."""
     check = q.get("check") or {}
     cone = [str(n) for n in check.get("cone") or []]
+    run = next((t for t in check.get("traces") or [] if t.get("status") == "failed"), None)
+    if run is not None:  # a recorded run refutes it: that run's step and values, not Z3's (empty) counterexample
+        return _run_record(q, check, run)
     if check.get("temporal"):
         rec = _temporal_record(q, check, lambda: cache.get(
             ["progress-repair", q["id"], check.get("formal"), cone],
@@ -301,6 +304,41 @@ def _between(report: ReportRows, sources: set[str], sinks: set[str]) -> set[str]
                     todo.append(m)
         return seen
     return (reach(sources, down) & reach(sinks, up)) - sources - sinks
+
+
+def _run_record(q: RequirementRow, check: Mapping[str, Any], row: Mapping[str, Any]) -> DiagnosisEntry:
+    """The diagnosis of a requirement a recorded run refutes
+    (backends/monitors/temporal_evidence.py: a trace row ``failed``): the
+    run, the step of the composed system at which it was refuted
+    (docs/semantics.md, "Steps") with its message and time, and the values
+    the operand read there, as the counterexample.  What Z3 said of the
+    contracts is kept beside it: a run that breaks what the contracts prove
+    breaks one of its premises (a node's guarantee or declaration, an
+    assumption of the environment), which that run's evidence of the
+    nodes names."""
+    v = row.get("verdict") or {}
+    witness = [w for w in v.get("witness") or [] if isinstance(w, Mapping)]
+    table: list[CexRow] = []
+    for w in witness:
+        for name, value in (w.get("values") or {}).items():
+            node, _, var = str(name).partition(".")
+            table.append({"node": node, "variable": var, "value": str(value), "table": None})
+    at = (f"step {v['step']} of the run ({v.get('where')}, t = {v.get('time')} s)" if v.get("step") is not None
+          else "its end")
+    seen = "; ".join(f"{w.get('operand')} is {'true' if w.get('holds') else 'false' if w.get('holds') is False else 'undecided'}"
+                     f" at step {w.get('step')} ({w.get('where')})"
+                     + (" with " + ", ".join(f"{k} = {x}" for k, x in (w.get("values") or {}).items())
+                        if w.get("values") else "") for w in witness)
+    proof = (check.get("temporal") or {}).get("status") or q.get("verdict")
+    z3 = (" Over the composed contracts it is proved: the run breaks a premise of that proof (a node's guarantee "
+          "or declaration, or an assumption of the environment), which the run's evidence of each node names."
+          if proof in ("proved", "met") else f" Over the composed contracts: {proof}." if proof else "")
+    sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by the recorded "
+                f"run {row.get('trace')} at {at}: {v.get('reason', '')}"
+                + (f". {seen[0].upper()}{seen[1:]}" if seen else "") + f" ({v.get('steps')} steps of the system "
+                f"in the run, docs/semantics.md \"Steps\").{z3}")
+    return {"id": str(q["id"]), "kind": "requirement", "node": "", "status": "failed", "sentence": sentence,
+            "culprits": [], "counterexample": table, "repairs": [], "guarantee": None, "related": []}
 
 
 def _temporal_record(q: RequirementRow, check: Mapping[str, Any],

@@ -5,20 +5,26 @@ The statement is one of the decided shapes of
 ``eventually F``, ``eventually[<= N] F``, ``next F``, ``F until G``) over
 ``Node.in.x``/``Node.out.y``/``Node.state.v``.
 
-**Steps of a trace.**  The nodes the statement reads have a state, the
-latest value of each input and output mapped from the messages on their
-topics (:mod:`rclverify.traces.mapping`, as the node monitors of
-:mod:`.check` keep it: outputs persist until changed, the stream model of
-paper lines 462-495).  Every message on one of those topics is one *step*:
-step i is the state after the i-th such message (messages on other topics
-change nothing the statement reads and are no step).  A declared state
-variable (the plan's ``state:``, :mod:`rclverify.model.plan.state`) has at step 0
-the value its ``init`` defines and at step i+1 the value its ``next``
-defines from step i's state and the node's inputs and outputs at step i,
-as in the composed system (:mod:`rclverify.calculus.requirements.transition`).  Both
-are found by Z3 on the concrete values, and used only when the formula
-defines exactly one value (else the variable has no value from there on,
-and what reads it is undecided).
+**Steps of a trace.**  A step is a step of the composed system, as in the
+proofs (docs/semantics.md, "Steps"): :class:`~.trace_states.StepClock`
+gives each message on a topic of the statement's cone
+(:func:`~.trace_states.cone_of`: the nodes it reads and every node
+upstream of them; other messages are no step) its step: a question and
+its answer are one step, a node reads another node's output in the step
+after it, inputs that come at once are one instant.  The nodes the
+statement reads have a state, the latest value of each input and output
+mapped from the messages on their topics (:mod:`rclverify.traces.mapping`,
+as the node monitors of :mod:`.check` keep it: outputs persist until
+changed, the stream model of paper lines 462-495); step i is judged on the
+state after its last message, an output another node reads being that
+node's input from the next step on.  A declared state variable (the
+plan's ``state:``, :mod:`rclverify.model.plan.state`) has at step 0 the value its
+``init`` defines and at step i+1 the value its ``next`` defines from step
+i's state and the node's inputs and outputs at step i, as in the composed
+system (:mod:`rclverify.calculus.requirements.transition`).  Both are found by Z3
+on the concrete values, and used only when the formula defines exactly
+one value (else the variable has no value from there on, and what reads
+it is undecided).
 
 **Operands** are decided at each step by the judgement of the node monitors
 (:func:`rclverify.semantics.floatsem.judge`: direct evaluation, Z3 on concrete
@@ -66,7 +72,7 @@ from rclverify.model.plan.formal import Formal
 from rclverify.model.plan.state import StateVar, state_type
 from rclverify.model.plan.temporal import Temporal, shape
 from rclverify.backends.monitors.response_trace import ResponseTracker
-from rclverify.backends.monitors.trace_states import TraceStates
+from rclverify.backends.monitors.trace_states import StepClock, TraceStates, cone_of
 from rclverify.lang.types import Checked
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
@@ -278,8 +284,9 @@ def _operands(t: Temporal, kind: str) -> tuple[list[Formal], ResponseTracker | N
 def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, ...], events: Iterable[Event],
                          rules: Mapping[str, TopicRule]) -> TraceVerdict:
     """The verdict of statement ``t`` on the recorded run ``events`` (module
-    docstring).  ``states`` the plan's state declarations, ``rules`` the
-    topic mapping.  Raises :class:`~rclverify.lang.errors.RclError` for a
+    docstring), its steps the composed system's over the statement's cone
+    (the mapping's ``skew`` joins inputs that come at once).  ``states`` the
+    plan's state declarations, ``rules`` the topic mapping.  Raises :class:`~rclverify.lang.errors.RclError` for a
     shape that is not decided and whatever the event source raises
     (:class:`~rclverify.traces.TraceError`)."""
     kind = shape(t, None)
@@ -288,18 +295,44 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     for sv in states:
         state_type(sv, checked)
     st = TraceStates(checked, nodes, states, rules)
+    # the steps of the composed system, over the statement's cone (trace_states.StepClock)
+    clock = StepClock(checked, cone_of(checked, nodes), getattr(rules, "skew", None) or 0.0)
     # the mapping's tolerance of recorded numbers
     r = _Run(kind, ops, t.bound, checked, st, getattr(rules, "tolerance", None), tracker)
     step = _STEPS[kind]
+    now = -1  # the step the messages read so far end in
     for ev in events:
-        if not st.feed(ev):
+        got = clock.tick(ev)
+        if got is None:
             continue
-        r.i, r.last = r.i + 1, ev
-        r.vals = st.values()
-        verdict = step(r)
+        k, later = got
+        while 0 <= now < k:  # the steps before this message's are over: each judged on its last state
+            verdict = _close(r, step, now)
+            if verdict is not None:
+                return verdict
+            moved = st.advance()
+            r.last = moved or r.last  # the step's place: the last message whose values are current in it
+            now += 1
+        now = k
+        if st.feed(ev, later) or r.last is None:
+            r.last = ev
+    if now >= 0:
+        verdict = _close(r, step, now)
         if verdict is not None:
             return verdict
+        if st.pending:  # outputs read in the step after the last: the readers' step, on what the run recorded
+            r.last = st.advance() or r.last
+            verdict = _close(r, step, now + 1)
+            if verdict is not None:
+                return verdict
     return _at_end(r, nodes)
+
+
+def _close(r: _Run, step: Any, i: int) -> TraceVerdict | None:
+    """Step ``i`` judged on its state: the values after its last message."""
+    r.i, r.vals = i, r.st.values()
+    verdict: TraceVerdict | None = step(r)
+    return verdict
 
 
 def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
