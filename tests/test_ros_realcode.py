@@ -215,10 +215,12 @@ def test_python_launch_variables_are_read_and_a_literal_is_never_called_not_a_li
     assert [(c.tag, c.attrs) for c in el.children[:3]] == [
         ("arg", {"name": "port", "default": "$(var-default port /dev/ttyACM0)"}), ("arg", {"name": "ns", "default": "robot"}),
         ("node", {"pkg": "p", "exec": "e", "namespace": "$(var ns)"})]
-    assert [n.message for n in notes] == ["Node(...): variable 'undefined_name' (not assigned in "
-                                          "generate_launch_description()) cannot be read statically; action skipped"]
+    assert [n.message for n in notes] == ["Node(...): name variable 'undefined_name' (not assigned in "
+                                          "generate_launch_description()) cannot be read statically; the name the "
+                                          "code gives is kept"]
     from rclverify.ros.extract.launch import Interpreter
     it = Interpreter(lambda p: None, lambda p: read_python(p, p.name), lambda p: p.name)
     it.run(lf, {})
-    assert [(n.exe, n.ns) for n in it.nodes] == [("e", "/robot"), ("g", "/")]  # an empty default is no namespace
+    # an unreadable name drops the name, never the node; an empty default is no namespace
+    assert [(n.exe, n.name, n.ns) for n in it.nodes] == [("e", None, "/robot"), ("f", None, "/"), ("g", None, "/")]
     assert it.notes == notes

@@ -167,9 +167,18 @@ class CallReader:
 
     def action2(self, last: str, targs: list[str], args: list[Any], n: Any) -> None:
         """``rclcpp_action::create_server<T>`` / ``create_client<T>`` with a
-        node, or four node interfaces, before the name."""
+        node before the name, or node interfaces (four for a server: base,
+        clock, logging, waitables; three for a client: base, graph, logging).
+        rclcpp_action's overloads tell them apart by count: a server given a
+        node takes at most 7 arguments, given interfaces at least 8; a client
+        given a node at most 4, given interfaces at least 4 (at 4, a first
+        argument written as an interface decides)."""
         kind = "action_servers" if last == "create_server" else "action_clients"
-        k = 4 if len(args) >= 5 and "interface" in _T(args[0]) else 1
+        named = "interface" in _T(args[0]) if args else False
+        if kind == "action_servers":
+            k = 4 if len(args) >= 8 or (len(args) >= 5 and named) else 1
+        else:
+            k = 3 if len(args) >= 5 or (len(args) == 4 and named) else 1
         if len(args) <= k:
             return
         t = action_type(self.aliases.get(targs[0], targs[0])) if targs else None

@@ -8,9 +8,13 @@ interpreted here:
 * ``arg`` (``default``/``value``), ``let`` (ROS 2); substitutions ``$(arg x)``
   / ``$(var x)``, ``$(find pkg)`` / ``$(find-pkg-share pkg)``,
   ``$(env X)``, ``$(optenv X d)``, ``$(dirname)``; anything else
-  (``$(eval ...)``, ``$(command ...)``) is reported unresolved, located;
+  ``$(eval ...)`` of literals, ``not``, ``and``, ``or``, ``==``, ``!=``,
+  ``in`` (:func:`evaluate`); anything else (``$(command ...)``, an
+  ``$(eval)`` of names or calls) is reported unresolved, located;
 * ``group`` with ``ns`` (ROS 1) or a ``push-ros-namespace`` child (ROS 2);
-  ``if`` / ``unless`` on any element (``true``/``1`` or ``false``/``0``);
+  ``if`` / ``unless`` on any element (``true``/``1`` or ``false``/``0``,
+  any case); a condition that cannot be evaluated is read as holding, with
+  a note (the element is never dropped for it);
 * ``node`` (``pkg``, ``type``/``exec``, ``name``, ``ns``/``namespace``) with
   ``remap`` and ``param`` (``name``/``value``: the node's private parameter)
   children, and ``remap``/``param`` in a scope (applies to the nodes after it);
@@ -25,6 +29,7 @@ frontend design (design.ros2.org "ROS 2 Launch XML/YAML format").
 """
 from __future__ import annotations
 
+import ast
 import os
 import re
 from dataclasses import dataclass, field
@@ -60,6 +65,8 @@ class LaunchNode:
     # the node's private parameters the launch file sets: ``~name`` -> (value, where set)
     params: dict[str, tuple[str, Src]] = field(default_factory=dict)
     args: str | None = None  # the node's command-line ``args`` (a nodelet's ``load pkg/Type manager``)
+    # where a condition guarding the node could not be evaluated (the node was read as if it held)
+    unsure: Src | None = None
 
 
 @dataclass
@@ -67,6 +74,11 @@ class _Scope:
     ns: str
     args: dict[str, str]
     remaps: list[tuple[str, str, Src]] = field(default_factory=list)
+    unsure: Src | None = None  # a condition of an enclosing element read as holding without being evaluated
+
+
+#: the attribute a reader sets on an element whose condition it could not read (value: where)
+UNREAD = "condition-unread"
 
 
 class Unresolved(Exception):
@@ -98,9 +110,10 @@ class Interpreter:
         self.params: dict[str, tuple[str, Src]] = {}
         self._stack: list[Path] = []
         self._cut = False
+        self._guess: Src | None = None  # set by _cond when it takes an unevaluated condition as holding
 
     def run(self, path: Path, args: dict[str, str] | None = None, ns: str = "/",
-            remaps: list[tuple[str, str, Src]] | None = None) -> None:
+            remaps: list[tuple[str, str, Src]] | None = None, unsure: Src | None = None) -> None:
         path = path.resolve() if path.exists() else path
         if path in self._stack or len(self._stack) > MAX_INCLUDE_DEPTH:
             self.notes.append(Note(Src(self.show(path)), "include cycle: file already being read", "ROS-LAUNCH"))
@@ -119,7 +132,7 @@ class Interpreter:
             return
         self._stack.append(path)
         try:
-            self._body(root.children, _Scope(ns, dict(args or {}), list(remaps or [])), path)
+            self._body(root.children, _Scope(ns, dict(args or {}), list(remaps or []), unsure), path)
         finally:
             self._stack.pop()
 
@@ -159,7 +172,8 @@ class Interpreter:
         ns = self._attr(el, "namespace", scope, path) or self._attr(el, "ns", scope, path)
         node_ns = names.join(scope.ns, ns) if ns else scope.ns
         remaps, params = self._node_children(el, scope, path, node_ns, name)
-        self.nodes.append(LaunchNode(pkg, "", name, node_ns, remaps, el.src, plugin, params))
+        self.nodes.append(LaunchNode(pkg, "", name, node_ns, remaps, el.src, plugin, params,
+                                     unsure=scope.unsure))
 
     # -- substitutions
     def sub(self, text: str, scope: _Scope, path: Path) -> str:
@@ -192,6 +206,8 @@ class Interpreter:
                 return str(path.parent)
             if kind == "anon" and rest:
                 return rest[0]
+            if kind == "eval" and rest:
+                return evaluate(m.group(1)[len("eval"):].strip())
             raise Unresolved(f"$({m.group(1)}) cannot be resolved statically")
         out = text
         for _ in range(10):
@@ -208,8 +224,19 @@ class Interpreter:
         return default if v is None else self.sub(v, scope, path)
 
     def _cond(self, el: El, scope: _Scope, path: Path) -> bool:
+        """Whether ``el``'s ``if`` / ``unless`` hold; a condition that cannot be
+        evaluated statically is taken to hold (the element is read), said with a
+        located note: an unknown condition never drops what it guards."""
+        if UNREAD in el.attrs:  # a Python launch file's condition its reader could not read (noted there)
+            self._guess = el.src
         for key, want in (("if", True), ("unless", False)):
-            v = self._attr(el, key, scope, path)
+            try:
+                v = self._attr(el, key, scope, path)
+            except Unresolved as exc:
+                self.notes.append(Note(el.src, f"<{el.tag}>: {key}: {exc}; read as if the condition held",
+                                       "ROS-LAUNCH"))
+                self._guess = el.src
+                continue
             if v is None:
                 continue
             lv = v.strip().lower()
@@ -218,19 +245,27 @@ class Interpreter:
             elif lv in ("false", "0"):
                 val = False
             else:
-                raise Unresolved(f"{key}=\"{v}\" is not true/false/1/0")
+                self.notes.append(Note(el.src, f"<{el.tag}>: {key}=\"{v}\" is not true/false/1/0; read as if "
+                                               f"the condition held", "ROS-LAUNCH"))
+                self._guess = el.src
+                continue
             if val != want:
                 return False
         return True
 
     def _body(self, els: list[El], scope: _Scope, path: Path) -> None:
         for el in els:
+            outer = scope.unsure
             try:
+                self._guess = None
                 if not self._cond(el, scope, path):
                     continue
+                scope.unsure = outer or self._guess
                 self._element(el, scope, path)
             except Unresolved as exc:
                 self.notes.append(Note(el.src, f"<{el.tag}>: {exc}; element skipped", "ROS-LAUNCH"))
+            finally:
+                scope.unsure = outer
 
     def _element(self, el: El, scope: _Scope, path: Path) -> None:
         t = el.tag
@@ -246,7 +281,7 @@ class Interpreter:
         elif t == "group":
             ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
             inner = _Scope(names.join(scope.ns, ns) if ns else scope.ns, scope.args if el.attrs.get("scoped") == "false"
-                           else dict(scope.args), list(scope.remaps))
+                           else dict(scope.args), list(scope.remaps), scope.unsure)
             self._body(el.children, inner, path)
         elif t == "push-ros-namespace":
             ns = self._attr(el, "namespace", scope, path) or self._attr(el, "ns", scope, path) or ""
@@ -263,11 +298,16 @@ class Interpreter:
         elif t in ("node_container", "load_composable_node"):
             for c in el.children:
                 if c.tag == "composable_node":
+                    outer = scope.unsure
                     try:
+                        self._guess = None
                         if self._cond(c, scope, path):
+                            scope.unsure = outer or self._guess
                             self._composable(c, scope, path)
                     except Unresolved as exc:
                         self.notes.append(Note(c.src, f"<composable_node>: {exc}; element skipped", "ROS-LAUNCH"))
+                    finally:
+                        scope.unsure = outer
         elif t == "node":
             pkg = self._attr(el, "pkg", scope, path)
             exe = self._attr(el, "type", scope, path) or self._attr(el, "exec", scope, path)
@@ -278,7 +318,8 @@ class Interpreter:
             node_ns = names.join(scope.ns, ns) if ns else scope.ns
             remaps, params = self._node_children(el, scope, path, node_ns, name)
             self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params,
-                                         self._attr(el, "args", scope, path) if pkg == "nodelet" else None))
+                                         self._attr(el, "args", scope, path) if pkg == "nodelet" else None,
+                                         scope.unsure))
         elif t == "include":
             f = self._attr(el, "file", scope, path)
             if not f:
@@ -296,8 +337,59 @@ class Interpreter:
                     v = self._attr(c, "value", scope, path) or self._attr(c, "default", scope, path)
                     if n and v is not None:
                         args[n] = v
-            self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps)
+            self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps, scope.unsure)
         # rosparam, env, machine, test, executable ...: not part of the topic graph
+
+
+_EVAL_NODES = (ast.Expression, ast.BoolOp, ast.And, ast.Or, ast.UnaryOp, ast.Not, ast.Compare, ast.Eq, ast.NotEq,
+               ast.In, ast.NotIn, ast.Constant, ast.Name, ast.Load, ast.Tuple, ast.List)
+
+
+def evaluate(expr: str) -> str:
+    """The value of ``$(eval expr)`` / ``PythonExpression`` as launch gives it
+    (``str()`` of the result: ``True`` / ``False``), for the expressions a
+    condition is made of: string, number and boolean literals, ``True`` /
+    ``False`` / ``None``, ``not``, ``and``, ``or``, ``==``, ``!=``, ``in``,
+    ``not in``.  Raises :class:`Unresolved` for anything else (a name, a call,
+    arithmetic): such an expression is not evaluated statically.
+
+    Source: launch's ``PythonExpression`` (``eval`` of the substituted text),
+    roslaunch ``$(eval ...)``."""
+    try:
+        tree = ast.parse(expr, mode="eval")
+    except SyntaxError as exc:
+        raise Unresolved(f"$(eval {expr}): not a Python expression ({exc.msg})") from None
+    for n in ast.walk(tree):
+        if not isinstance(n, _EVAL_NODES) or (isinstance(n, ast.Name) and n.id not in ("True", "False", "None")):
+            raise Unresolved(f"$(eval {expr}) is not evaluated statically (only literals, not, and, or, ==, !=, in)")
+
+    def ev(n: ast.AST) -> Any:
+        if isinstance(n, ast.Expression):
+            return ev(n.body)
+        if isinstance(n, ast.Constant):
+            return n.value
+        if isinstance(n, ast.Name):
+            return {"True": True, "False": False, "None": None}[n.id]
+        if isinstance(n, (ast.Tuple, ast.List)):
+            return tuple(ev(x) for x in n.elts)
+        if isinstance(n, ast.UnaryOp):
+            return not ev(n.operand)
+        if isinstance(n, ast.BoolOp):
+            vals = [ev(x) for x in n.values]
+            return all(vals) if isinstance(n.op, ast.And) else any(vals)
+        assert isinstance(n, ast.Compare)
+        left = ev(n.left)
+        for op, right in zip(n.ops, (ev(x) for x in n.comparators)):
+            ok = {ast.Eq: lambda a, b: a == b, ast.NotEq: lambda a, b: a != b,
+                  ast.In: lambda a, b: a in b, ast.NotIn: lambda a, b: a not in b}[type(op)](left, right)
+            if not ok:
+                return False
+            left = right
+        return True
+    try:
+        return str(ev(tree))
+    except TypeError as exc:  # 'x' in 3
+        raise Unresolved(f"$(eval {expr}): {exc}") from None
 
 
 # -- readers ------------------------------------------------------------

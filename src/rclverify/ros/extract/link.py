@@ -38,7 +38,7 @@ from rclverify.ros.extract.cpp_types import split_template
 from rclverify.ros.extract.model import Endpoint, Note, Src
 from rclverify.ros.extract.link_members import LinkMembers
 from rclverify.ros.extract.link_returns import Returns
-from rclverify.ros.extract.link_types import Instances
+from rclverify.ros.extract.link_types import Instances, is_template_param
 from rclverify.ros.extract.link_values import MAX_DEPTH, MAX_VALUES, Values
 from rclverify.ros.extract.programs import PackageCode, Program
 from rclverify.ros.extract.unit_names import canonical
@@ -253,14 +253,35 @@ class Linker(LinkMembers, Values, Returns, Instances):
         if recv is not None and recv.replace("this", "").strip("()*&") and unit:
             ty = self.units.get(unit, {}).get("members", {}).get(recv.replace("this->", "").strip())
             cls = self.match(_held(ty), unit) if ty else None
+            if ty is None and "->" not in recv and "." not in recv:  # a local (auto node = shared_from_this())
+                own = self.inherited(unit, meth)
+                if own is not None and not any(k.endswith("::" + meth) and v[0] != k and k != own
+                                               for k, v in self.fns.items()):
+                    return own, self.fns[own][0]
             return (f"{cls}::{meth}", cls) if cls and f"{cls}::{meth}" in self.fns else (None, None)
-        if unit and f"{unit}::{meth}" in self.fns:
-            return f"{unit}::{meth}", unit
+        if unit and (own := self.inherited(unit, meth)) is not None:
+            return own, self.fns[own][0]
         cls = self.match(meth, unit)
         if cls is not None and recv is None:
             return self._ctor(cls), cls
         free = [k for k, v in self.fns.items() if v[0] == k and (k == meth or k.endswith("::" + meth))]
         return (free[0], free[0]) if len(free) == 1 else (None, None)
+
+    def inherited(self, unit: str, meth: str, depth: int = 0) -> str | None:
+        """The key of method ``meth`` as class ``unit`` has it: its own, else the
+        nearest base class's of the program (a derived node calling its base's
+        ``create_action_server<T>("name", ...)`` unqualified); ``None`` when
+        neither defines it."""
+        if f"{unit}::{meth}" in self.fns:
+            return f"{unit}::{meth}"
+        if depth > 8:
+            return None
+        for b in self.units.get(unit, {}).get("bases", []):
+            cls = self.match(b, unit)
+            got = self.inherited(cls, meth, depth + 1) if cls is not None and cls != unit else None
+            if got is not None:
+                return got
+        return None
 
     def _ctor(self, cls: str) -> str:
         return f"{cls}::{cls.split('::')[-1]}"
@@ -429,7 +450,12 @@ class Linker(LinkMembers, Values, Returns, Instances):
         if e.pending is None:
             return [e]
         name, handle, cb, fkey, written, nsrc = e.pending
-        t = e.msg_type if e.msg_type is not None else self.cb_type(e.kind, cb)
+        if self.uninstantiated(name):
+            return []  # made only by a template this program never instantiates: nothing to say
+        # a template's own parameter (ActionT) names no alias of another class ([temp.local]):
+        # its type is read per instantiation below, never through the program's aliases
+        own = isinstance(cb, tuple) and cb[:1] == ("type",) and is_template_param(cb[1], e.unit, e.func, self)
+        t = e.msg_type if e.msg_type is not None else None if own else self.cb_type(e.kind, cb)
         types: list[str | None] = [t]
         ambiguous = False
         if t is None and isinstance(cb, tuple) and cb[:1] == ("type",):  # a template's type parameter
@@ -457,6 +483,31 @@ class Linker(LinkMembers, Values, Returns, Instances):
         if got and t is None and not ambiguous:
             note(emit.type_note(got[0]))
         return got
+
+    def uninstantiated(self, v: Any, depth: int = 0) -> bool:
+        """Whether name value ``v`` reaches the program only through parameters of
+        templates nothing in the program calls: a function template, or a
+        function of a class template, with no call site that runs (a library's
+        ``create_action_server<T>(name)`` member the program never calls).  C++
+        instantiates such a template only where it is used ([temp.inst]), so
+        the endpoint it would make does not exist in this program; a template
+        with a site, and any other function, is never taken as uncalled."""
+        if v is None or not isinstance(v, tuple) or depth > MAX_DEPTH:
+            return False
+        if v[0] == "cat":
+            return any(self.uninstantiated(x, depth + 1) for x in v[1])
+        if v[0] == "field":
+            binds = self.fields.get((v[1], v[2]))
+            return bool(binds) and all(self.uninstantiated(b, depth + 1) for b in binds)
+        if v[0] != "arg" or v[1] not in self.fns:
+            return False
+        key = v[1]
+        live = [(a, caller) for a, _kw, caller in self.sites.get(key, []) if caller is None or self.runs(None, caller)]
+        if not live:
+            unit = self.fns[key][0]
+            return bool(self.fn_tparams.get(key) or self.fn_tparams.get(key.split("#")[0])
+                        or self.units.get(unit, {}).get("tparams"))
+        return all(v[2] < len(a) and self.uninstantiated(a[v[2]], depth + 1) for a, _c in live)
 
     def owners(self, units: list[str | None], eps: list[Endpoint]) -> list[int]:
         """Each endpoint's node (an index in the named nodes; -1 when none)."""

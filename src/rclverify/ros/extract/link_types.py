@@ -142,19 +142,36 @@ class Instances:
             keys, i = [k for k in self.site_targs if k.split("#")[0] == ctor], cls_tps.index(param)
         else:
             return []
+        return self._at_sites(keys, i, unit if param in cls_tps and param not in fn_tps else None, depth)
+
+    def _at_sites(self, keys: list[str], i: int, cls: str | None, depth: int
+                  ) -> list[tuple[dict[str, int], str | None]]:
+        """:meth:`instances` read at the sites of ``keys``, the template argument
+        the ``i``-th; ``cls`` the class template whose parameter it is (``None``:
+        a function template's).  A constructor of ``cls`` delegating to another
+        (``Host(node, n) : Host(node->base(), n)``) writes no argument: the
+        delegated-to constructor runs in the delegating one's instantiation, so
+        the delegating constructor's own sites give it."""
         out: list[tuple[dict[str, int], str | None]] = []
         unwritten: list[tuple[dict[str, int], str | None]] = []  # sites whose argument is deduced
         for k in sorted(keys):
             for j, (targs, caller) in enumerate(self.site_targs[k]):
                 if caller is not None and not self.runs(None, caller):
                     continue
+                cunit = self.fns[caller][0] if caller in self.fns else None
+                if len(targs) <= i and cls is not None and caller is not None and cunit == cls and \
+                        caller.split("#")[0] == k.split("#")[0] and caller != k and depth <= 4:
+                    for pins, text in self._at_sites([caller], i, cls, depth + 1):
+                        item = ({**pins, k: j}, text)
+                        if item not in out:
+                            out.append(item)
+                    continue
                 if len(targs) <= i:
                     unwritten.append(({k: j}, None))
                     continue
                 arg = targs[i]
-                cunit = self.fns[caller][0] if caller in self.fns else None
                 inner = self.instances(cunit, caller, arg, depth + 1) if caller is not None else []
-                for pins, text in inner or ([({}, arg)] if not _is_param(arg, cunit, caller, self) else []):
+                for pins, text in inner or ([({}, arg)] if not is_template_param(arg, cunit, caller, self) else []):
                     item = ({**pins, k: j}, text)
                     if item not in out:
                         out.append(item)
@@ -164,7 +181,8 @@ class Instances:
         return out + unwritten if out else []
 
 
-def _is_param(arg: str, unit: str | None, fkey: str | None, lk: Instances) -> bool:
-    """Whether ``arg`` is a template parameter of the calling class or function (not a type)."""
+def is_template_param(arg: str, unit: str | None, fkey: str | None, lk: Instances) -> bool:
+    """Whether type text ``arg`` is a template parameter of class ``unit`` or
+    function ``fkey`` (not a type); ``lk`` the linker holding their tables."""
     return arg in lk.units.get(unit or "", {}).get("tparams", []) or \
         arg in lk.fn_tparams.get(fkey or "", lk.fn_tparams.get((fkey or "").split("#")[0], []))

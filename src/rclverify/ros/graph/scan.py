@@ -155,6 +155,7 @@ class _Scan:
         self.records: dict[str, dict[str, dict[str, Any]]] = {}
         self.tgts: dict[str, Targets] = {}
         self.launch_params: dict[str, tuple[str, Src]] = {}
+        self.unsure: dict[Src, Src] = {}  # a launch node -> the unevaluated condition it was read under
         self.by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
         self.standard = True  # whether the standard (installed) interface packages are read (read_types)
 
@@ -266,6 +267,7 @@ class _Scan:
                     pass
             g.notes.extend(interp.notes)
             self.launch_params.update(interp.params)
+            self.unsure = {ln.src: ln.unsure for ln in interp.nodes if ln.unsure is not None}
             for ln in interp.nodes:
                 self.asm.launch_node(ln, self.add_node, g)
         else:
@@ -288,7 +290,14 @@ class _Scan:
         if origin == "source":
             node, key = self._source_key(node, full, pkg, exe, files, declared, lifecycle)
         elif full in g.nodes:
-            g.notes.append(Note(declared, f"node {full} is started twice (first at {g.nodes[full].declared_at}); "
+            first = g.nodes[full].declared_at
+            guess = self.unsure.get(declared) or (self.unsure.get(first) if first is not None else None)
+            if guess is not None:  # one of two branches whose condition is not known: alternatives
+                g.notes.append(Note(declared, f"node {full} is also started at {first}, under a condition not "
+                                              f"evaluated statically ({guess}): taken as alternatives, the first "
+                                              f"is kept", "ROS-LAUNCH"))
+                return
+            g.notes.append(Note(declared, f"node {full} is started twice (first at {first}); "
                                           f"ROS keeps only the last one", "ROS-LAUNCH"))
         mine: dict[str, Any] = {names.resolve(k, ns, full): v for k, v in (params or {}).items()}
         if origin == "source":  # no launch file: the package's parameter files (param_yaml)

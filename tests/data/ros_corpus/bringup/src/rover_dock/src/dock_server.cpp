@@ -1,0 +1,23 @@
+#include "rover_dock/dock_server.hpp"
+
+namespace rover_dock
+{
+
+DockServer::DockServer(const rclcpp::NodeOptions & options)
+: rover_core::ManagedNode("dock_server", options)
+{
+}
+
+rover_core::CallbackReturn DockServer::on_configure(const rclcpp_lifecycle::State &)
+{
+  auto node = shared_from_this();
+  dock_server_ = node->create_action_server<Dock>("dock", [] {});
+  undock_server_ = node->create_action_server<Undock>(
+    "undock", [] {});
+  return rover_core::CallbackReturn::SUCCESS;
+}
+
+}  // namespace rover_dock
+
+#include "rclcpp_components/register_node_macro.hpp"
+RCLCPP_COMPONENTS_REGISTER_NODE(rover_dock::DockServer)

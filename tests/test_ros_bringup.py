@@ -1,0 +1,170 @@
+"""A bringup read whole (issue 97): the idioms of a large ROS 2 stack's own
+launch files and servers, on the project's own tree
+(tests/data/ros_corpus/bringup), its graph counted by hand:
+
+* ``remappings``, ``parameters``, ``name`` bound to a variable (in the
+  function or at module level), lists joined with ``+``: read, never the
+  node dropped;
+* a standalone branch and a composed branch (``LoadComposableNodes``) chosen
+  by a launch argument through ``IfCondition(PythonExpression([...]))``;
+  a map server chosen by ``EqualsSubstitution`` / ``NotEqualsSubstitution``;
+* action servers made through a node's member template that forwards the
+  name to a free factory, ``make_shared`` of a class template, a delegating
+  constructor and a member: each named where the server's code writes the
+  literal, typed by that call's template argument;
+* a template parameter named like another class's ``using`` alias.
+
+By hand, with the launch arguments' defaults: two launch files start three
+nodes, ``/rover/drive_server`` (publishes ``/rover/cmd_vel_raw``, subscribes
+``/rover/odom``, ``/rover/tf``, ``/rover/tf_static``, serves action
+``/rover/drive_to`` of ``rover_msgs/action/DriveTo``, calls action
+``/rover/dock`` of ``rover_msgs/action/Dock``), ``/rover/dock`` (serves
+``/rover/dock`` of ``Dock`` and ``/rover/undock`` of ``Undock``) and
+``/rover/map_server`` (publishes ``/rover/map``)."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.ros.extract.launch import Unresolved, evaluate
+from rclverify.ros.graph.scan import scan
+
+WS = Path(__file__).parent / "data" / "ros_corpus" / "bringup"
+LAUNCH = WS / "src" / "rover_bringup" / "launch"
+NAV, LOC = LAUNCH / "navigation.launch.py", LAUNCH / "localization.launch.py"
+
+DRIVE = {("pub", "/rover/cmd_vel_raw", "geometry_msgs/msg/Twist"), ("sub", "/rover/odom", "nav_msgs/msg/Odometry"),
+         ("sub", "/rover/tf", "tf2_msgs/msg/TFMessage"), ("sub", "/rover/tf_static", "tf2_msgs/msg/TFMessage"),
+         ("action_servers", "/rover/drive_to", "rover_msgs/action/DriveTo"),
+         ("action_clients", "/rover/dock", "rover_msgs/action/Dock")}
+DOCK = {("action_servers", "/rover/dock", "rover_msgs/action/Dock"),
+        ("action_servers", "/rover/undock", "rover_msgs/action/Undock")}
+ROLES = ("publishes", "subscribes", "service_servers", "service_clients", "action_servers", "action_clients")
+SHORT = {"publishes": "pub", "subscribes": "sub"}
+
+
+def _edges(g: Any, node: str) -> set[tuple[str, str, str | None]]:
+    n = g.nodes[node]
+    return {(SHORT.get(r, r), e.topic, e.msg_type) for r in ROLES for e in getattr(n, r)}
+
+
+def _said(g: Any) -> list[str]:
+    return [n.message for n in g.notes]
+
+
+@pytest.fixture(scope="module")
+def default() -> Any:
+    return scan([WS], [NAV, LOC]).graph
+
+
+def test_the_bringup_counted_by_hand(default: Any) -> None:
+    g = default
+    assert sorted(g.nodes) == ["/rover/dock", "/rover/drive_server", "/rover/map_server"]
+    assert _edges(g, "/rover/drive_server") == DRIVE
+    assert _edges(g, "/rover/dock") == DOCK
+    assert _edges(g, "/rover/map_server") == {("pub", "/rover/map", "nav_msgs/msg/OccupancyGrid")}
+    said = _said(g)
+    assert not [m for m in said if "action skipped" in m or "not a string literal" in m], said
+    # the parameter file is a file: said once where it is bound, the rest of the node read
+    assert [m for m in said if "parameter file" in m] == [
+        "parameters 'ParameterFile(LaunchConfiguration('params_file'), allow_substs=True)' are not a literal dict "
+        "(a parameter file is not read): not resolved statically"]
+    # the standalone branch ran: the nodes are the executables', not the components'
+    assert g.nodes["/rover/drive_server"].executable == "drive_server"
+    assert g.nodes["/rover/dock"].executable == "rover_dock"
+
+
+def test_the_composed_branch_chosen_by_its_argument_gives_the_same_graph() -> None:
+    g = scan([WS], [NAV, LOC], {"use_composition": "True"}).graph
+    assert sorted(g.nodes) == ["/rover/dock", "/rover/drive_server", "/rover/map_server"]
+    assert _edges(g, "/rover/drive_server") == DRIVE
+    assert _edges(g, "/rover/dock") == DOCK
+    assert g.nodes["/rover/drive_server"].executable is None  # a component in a container
+
+
+def test_a_condition_on_a_launch_argument_picks_one_map_server() -> None:
+    g = scan([WS], [LOC], {"map": "/maps/yard.yaml", "namespace": "r2"}).graph
+    assert sorted(g.nodes) == ["/r2/map_server"]
+    assert _edges(g, "/r2/map_server") == {("pub", "/r2/map_loaded", "nav_msgs/msg/OccupancyGrid")}
+    assert not [m for m in _said(g) if "started twice" in m]
+
+
+def test_an_unreadable_condition_keeps_both_branches_as_alternatives(tmp_path: Path) -> None:
+    lf = tmp_path / "pick.launch.py"
+    lf.write_text(
+        "from launch import LaunchDescription\nfrom launch.actions import GroupAction\n"
+        "from launch.conditions import IfCondition, UnlessCondition\nfrom launch_ros.actions import Node\n"
+        "from rover_bringup.subst import AsBool\n\n\n"
+        "def generate_launch_description():\n"
+        "    flag = AsBool('use_sim')\n"
+        "    return LaunchDescription([\n"
+        "        GroupAction(condition=UnlessCondition(flag), actions=[\n"
+        "            Node(package='rover_map', executable='map_server', name='map_server')]),\n"
+        "        GroupAction(condition=IfCondition(flag), actions=[\n"
+        "            Node(package='rover_map', executable='map_server', name='map_server',\n"
+        "                 remappings=[('map', 'sim_map')])]),\n"
+        "    ])\n")
+    g = scan([WS], [lf]).graph
+    assert _edges(g, "/map_server") == {("pub", "/map", "nav_msgs/msg/OccupancyGrid")}  # the first kept
+    said = _said(g)
+    assert sum("condition 'AsBool('use_sim')' (not a literal or a known substitution) cannot be read statically; "
+               "the action is read as if it held" in m for m in said) == 2
+    assert [m for m in said if "also started" in m] == [
+        f"node /map_server is also started at {lf}:12:13, under a condition not evaluated statically "
+        f"({lf}:13:9): taken as alternatives, the first is kept"]
+    # control: the same two nodes with no condition at all are two starts, the last kept
+    plain = tmp_path / "both.launch.py"
+    plain.write_text(lf.read_text().replace("condition=UnlessCondition(flag), ", "")
+                     .replace("condition=IfCondition(flag), ", ""))
+    g = scan([WS], [plain]).graph
+    assert _edges(g, "/map_server") == {("pub", "/sim_map", "nav_msgs/msg/OccupancyGrid")}
+    assert [m for m in _said(g) if "started twice" in m]
+
+
+def test_what_cannot_be_read_drops_only_that_attribute(tmp_path: Path) -> None:
+    lf = tmp_path / "loose.launch.py"
+    lf.write_text(
+        "from launch import LaunchDescription\nfrom launch_ros.actions import Node\n"
+        "from rover_bringup.names import remaps_for, name_of\n\n\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        "        Node(package='rover_map', executable='map_server', name=name_of('map'),\n"
+        "             remappings=remaps_for('map')),\n"
+        "        Node(package='rover_drive', executable='drive_server', namespace='r',\n"
+        "             remappings=[('odom', 'wheel_odom'), (topic_of('cmd'), 'cmd')]),\n"
+        "    ])\n")
+    g = scan([WS], [lf]).graph
+    assert sorted(g.nodes) == ["/map_server", "/r/drive_server"]  # the code's own name, no remapping
+    assert ("pub", "/map", "nav_msgs/msg/OccupancyGrid") in _edges(g, "/map_server")
+    assert ("sub", "/r/wheel_odom", "nav_msgs/msg/Odometry") in _edges(g, "/r/drive_server")
+    said = _said(g)
+    assert "Node(...): name 'name_of('map')' (not a literal or a known substitution) cannot be read statically; " \
+           "the name the code gives is kept" in said
+    assert "Node(...): remappings 'remaps_for('map')' cannot be read statically; the node is read without " \
+           "them" in said
+    assert "Node(...): remapping 'topic_of('cmd')' (not a literal or a known substitution) cannot be read " \
+           "statically; remapping left out" in said
+    assert not [m for m in said if "action skipped" in m]
+
+
+def test_a_template_parameter_is_no_alias_of_the_class_calling_it(default: Any) -> None:
+    """DriveServer has ``using ActionT = DriveTo``; the client member template's own
+    parameter is also ``ActionT``: the dock client is a ``Dock`` client, never a
+    ``DriveTo`` one (C++ [temp.local])."""
+    clients = {(e.topic, e.msg_type) for e in default.nodes["/rover/drive_server"].action_clients}
+    assert clients == {("/rover/dock", "rover_msgs/action/Dock")}
+
+
+@pytest.mark.parametrize("expr,want", [("not False", "True"), ("not True", "False"), ("'' == ''", "True"),
+                                        ("'a.yaml' != ''", "True"), ("'x' in ('x', 'y') and not False", "True"),
+                                        ("False or 'a' == 'b'", "False")])
+def test_eval_of_literals(expr: str, want: str) -> None:
+    assert evaluate(expr) == want
+
+
+@pytest.mark.parametrize("expr", ["not false", "__import__('os')", "1 + 1", "x == 'y'", "'a' in 3", "not"])
+def test_eval_refuses_what_it_cannot_know(expr: str) -> None:
+    with pytest.raises(Unresolved):
+        evaluate(expr)
