@@ -16,8 +16,8 @@ Record (YAML)::
     verdict: pass                       # pass | fail | (empty: not decided)
 
 ``author`` and ``independence`` say who checked what: a review counts for
-a standard's clause that asks independence (IEC 61508-1:2010 clause 8.2.18,
-DO-178C 6.2 "with independence") only when the record names both its
+a standard's clause that asks independence (IEC 61508-1:2010 clause 8,
+DO-178C Annex A "with independence") only when the record names both its
 reviewer and its author, they differ, and ``independence`` (``person``
 when left out) is at least the clause's (docs/standards.md).  A record
 may leave them out: it is still a review, shown everywhere, never counted

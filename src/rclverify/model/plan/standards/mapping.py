@@ -366,7 +366,8 @@ def _checked_by(scope: Sequence[ScopeItem], ix: _Index) -> list[str]:
                 reviewer, author, _ = review_identity(r)
                 who = f"review by {reviewer or 'an unnamed reviewer'} (author: {author or 'not named'})"
             else:
-                who = f"{r.get('backend')} ({r.get('tool', '')} {r.get('tool_version', '')})".replace(" )", ")")
+                tool, version = str(r.get("tool", "")), str(r.get("tool_version", ""))
+                who = f"{r.get('backend')} ({version if version.startswith(tool) else f'{tool} {version}'.strip()})"
             if who not in out:
                 out.append(who)
     return out
