@@ -6,10 +6,16 @@ version).
 
 Each message of a contract topic is stored as it came off the wire (its CDR
 bytes, encapsulation header included: what rosbag2 stores), under its ROS
-name, with the time the monitor received it, the same time the live engine
-gives a message without a header stamp; the message definition comes from
+name, at its event time (its publisher's source timestamp:
+:mod:`rclverify.traces.event_time`), the same time the live engine gives a
+message without a header stamp; the message definition comes from
 the workspace's ``.msg`` files and rosbags' store (the types the monitor
-decoded with).  So ``rclverify monitor BAG`` checks exactly the messages the
+decoded with), or, for samples the monitor decoded in the definition their
+publisher declared (:class:`~.types.Declared`), that definition
+(:func:`~.bag_types.declared_store`).  A topic's connection is made at its
+first message, in the definition that message is written in (one topic,
+one definition: a later message in another is not written, and counted in
+``failed``), and at the end for a topic that had none.  So ``rclverify monitor BAG`` checks exactly the messages the
 live run checked, at the same times, and gives the same verdicts
 (tests/test_monitor_live_dds.py).
 
@@ -27,6 +33,7 @@ import threading
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 from rclverify.traces.bag import typestore
+from rclverify.runtime.dds.bag_types import declared_store
 from rclverify.traces.events import TraceError
 from rclverify.runtime.shapes import BagSummary
 
@@ -75,8 +82,10 @@ class BagRecorder:
         #: (type, None, None) for a type rosbags' store describes
         self.calls = {t.strip("/"): d for t, d in (calls or {}).items()}
         self.count = self.call_count = self.failed = 0
+        #: per contract topic whose connection is made: the declaration it records (``None``: the workspace's)
+        self._declared: dict[str, Any] = {}
         self.error = ""
-        self._queue: queue.SimpleQueue[tuple[str, int, bytes] | None] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[tuple[str, int, bytes, Any] | None] = queue.SimpleQueue()
         self._opened = threading.Event()
         self._thread = threading.Thread(target=self._run, name="rclverify-bag", daemon=True)
         self._thread.start()
@@ -93,10 +102,10 @@ class BagRecorder:
                         storage_plugin=StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3)
         writer.open()
         connections: dict[str, Any] = {}
-        for topic, msg_type in self.topics.items():
-            pkg, _, name = msg_type.replace("/msg/", "/").partition("/")
+        for topic, msg_type in self.topics.items():  # each described now; its connection made at its first message
             try:
-                connections[topic] = writer.add_connection("/" + topic, f"{pkg}/msg/{name}", typestore=self._store)
+                self._store.generate_msgdef(_msg_name(msg_type), ros_version=2)
+                self._store.hash_rihs01(_msg_name(msg_type))
             except Exception as exc:  # rosbags: a type its store cannot describe
                 writer.close()
                 wide = " (rosbags has no wide string: a wstring cannot be stored)" if "wstring" in str(exc) else ""
@@ -123,9 +132,14 @@ class BagRecorder:
                 item = self._queue.get()
                 if item is None:
                     break
-                topic, time_ns, raw = item
+                topic, time_ns, raw, decl = item
                 try:
-                    writer.write(connections[topic], time_ns, raw)
+                    conn = connections.get(topic)
+                    if conn is None:  # a contract topic's first message: its definition (module docstring)
+                        conn = connections[topic] = self._connect(writer, topic, decl)
+                    if topic in self.topics and decl is not self._declared.get(topic):
+                        raise ValueError(f"/{topic}: a message in another definition than the topic's recorded one")
+                    writer.write(conn, time_ns, raw)
                     if topic in self.topics:
                         self.count += 1
                     else:
@@ -134,12 +148,29 @@ class BagRecorder:
                     self.failed += 1
                     self.error = f"{type(exc).__name__}: {exc}"
         finally:
+            for topic in self.topics:  # a topic without a message is in the bag too, in the workspace's definition
+                if topic not in connections:
+                    try:
+                        connections[topic] = self._connect(writer, topic, None)
+                    except Exception as exc:  # noqa: BLE001 - said in close()'s record
+                        self.error = f"{type(exc).__name__}: {exc}"
             writer.close()
+
+    def _connect(self, writer: Any, topic: str, decl: Any) -> Any:
+        """The connection of ``topic``: a contract topic's in ``decl``'s definition (a
+        :class:`~.types.Declaration`) or, ``None``, the workspace's; a call topic's from :attr:`calls`."""
+        if topic in self.topics:
+            self._declared[topic] = decl
+            if decl is not None:
+                return writer.add_connection("/" + topic, decl.name, typestore=declared_store(decl))
+            return writer.add_connection("/" + topic, _msg_name(self.topics[topic]), typestore=self._store)
+        msg_type, msgdef, digest = self.calls[topic]
+        return writer.add_connection("/" + topic, msg_type, msgdef=msgdef, rihs01=digest, typestore=self._store)
 
     def write(self, topic: str, time_ns: int, raw: bytes) -> None:
         """Queue one message of ``topic`` (a contract topic or a call topic, no
         leading ``/``) at ``time_ns`` (ns since the epoch: a contract topic's
-        receipt, a call topic's time in the call book, :mod:`.bag_calls`); a
+        event time, a call topic's time in the call book, :mod:`.bag_calls`); a
         topic not recorded, or data that are not bytes, is ignored (counted in
         ``failed`` for the latter: nothing malformed reaches the bag)."""
         if topic not in self.topics and topic not in self.calls:
@@ -147,7 +178,7 @@ class BagRecorder:
         if not isinstance(raw, (bytes, bytearray, memoryview)) or not isinstance(time_ns, int) or time_ns < 0:
             self.failed += 1
             return
-        self._queue.put((topic, time_ns, bytes(raw)))
+        self._queue.put((topic, time_ns, bytes(raw), getattr(raw, "declaration", None)))
 
     def close(self, timeout_s: float = 60.0) -> BagSummary:
         """Write what is queued, finish the bag (idempotent); returns what the evidence says of it
@@ -165,6 +196,12 @@ class BagRecorder:
             out["failed"] = self.failed
             out["error"] = self.error or f"the bag was not finished within {timeout_s:g} s"
         return out
+
+
+def _msg_name(msg_type: str) -> str:
+    """``pkg/msg/T`` of ``pkg/T`` or ``pkg/msg/T``."""
+    pkg, _, name = msg_type.replace("/msg/", "/").partition("/")
+    return f"{pkg}/msg/{name}"
 
 
 __all__ = ["BagError", "BagRecorder", "STORAGES", "storage_of"]

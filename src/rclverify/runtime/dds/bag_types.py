@@ -16,13 +16,19 @@ rosbags' of the definition read back, which equals what rosidl wrote into
 the Kilted wheels (``std_srvs/srv/SetBool_Event``:
 ``RIHS01_3c4c2001...``), ``service_msgs/msg/ServiceEventInfo``'s
 ``client_gid`` being ``uint8[16]``.
+
+:func:`declared_store` is the type store of a type a publisher declared
+(:class:`~.types.Declaration`): a contract topic's samples heard in the
+publisher's own definition are recorded under that definition (rosbags
+writes it as ``ros2msg`` text with the hash of it), never under the
+workspace's, which would not read them back.
 """
 from __future__ import annotations
 
 from functools import cache
 from typing import TYPE_CHECKING, Any
 
-from rclverify.runtime.dds.types import DdsTypeError, TypeBook
+from rclverify.runtime.dds.types import DdsTypeError, Declaration, TypeBook
 from rclverify.runtime.shapes import IdlMember, IdlStruct, IdlTypedef
 
 if TYPE_CHECKING:
@@ -108,4 +114,21 @@ def definition(types: TypeBook, name: str) -> tuple[str, str]:
     return text, str(store.hash_rihs01(name))
 
 
-__all__ = ["definition"]
+def declared_store(decl: Declaration) -> Any:
+    """A rosbags type store holding exactly the types of ``decl`` (its
+    description's fields, no constants: a description carries none), from
+    which rosbags' writer makes the connection's ``ros2msg`` definition and
+    hash.  Raises :class:`~.types.DdsTypeError` for a type rosbags cannot
+    describe (a ``wstring``)."""
+    from rosbags.typesys import Stores, get_typestore  # deferred: start-up (only when recording)
+    store = get_typestore(Stores.EMPTY)
+    try:
+        store.register({name: ([], list(fields)) for name, fields in decl.fields.items()})
+        store.generate_msgdef(decl.name, ros_version=2)
+    except Exception as exc:  # rosbags' own errors: a type it cannot describe
+        raise DdsTypeError(f"{decl.name} as {decl.origin} declares it cannot be described for a bag: {exc}") \
+            from None
+    return store
+
+
+__all__ = ["declared_store", "definition"]
