@@ -230,7 +230,7 @@ class Agent:
         """A request of ``type_name``'s description (hash ``type_hash``) to the type description
         service of node ``ns``/``node``: its state, which :meth:`step_request` moves on.  Raises
         ``ImportError`` where this ROS 2 has no ``type_description_interfaces`` (before Iron)."""
-        from type_description_interfaces.srv import GetTypeDescription  # deferred: Iron and later only
+        from type_description_interfaces.srv import GetTypeDescription  # type: ignore[import-not-found]  # deferred: Iron and later only
         service = ns.rstrip("/") + "/" + node + "/get_type_description"
         client = self.node.create_client(GetTypeDescription, service)
         request = GetTypeDescription.Request(type_name=type_name, type_hash=type_hash, include_type_sources=False)
@@ -389,7 +389,7 @@ def installed_description(type_name: str) -> tuple[str, dict[str, Any], str] | N
     pkg, kind, name = parts
     shares = []
     try:
-        from ament_index_python.packages import get_package_share_directory  # deferred: not in every ROS 2 Python
+        from ament_index_python.packages import get_package_share_directory  # type: ignore[import-not-found]  # deferred: not in every ROS 2 Python
         shares.append(get_package_share_directory(pkg))
     except Exception:  # noqa: BLE001 - not indexed: the prefixes below
         pass
@@ -425,8 +425,9 @@ def _description_dict(td: Any) -> dict[str, Any]:
 
 def _description_frame(type_name: str, type_hash: str, candidates: list[dict[str, Any]],
                        failures: list[str]) -> bytes:
-    return wire.json_frame({"what": "description", "type": type_name, "hash": type_hash,
-                            "candidates": candidates, "failures": failures})
+    frame: bytes = wire.json_frame({"what": "description", "type": type_name, "hash": type_hash,
+                                    "candidates": candidates, "failures": failures})
+    return frame
 
 
 def _handler(k: int) -> Any:

@@ -11,9 +11,17 @@ a top-level module (its folder is the script's); the monitor imports it as
   number, 0 unknown) then the 16-byte publisher GID, then the serialized
   message as rmw handed it over (CDR with its encapsulation header, as on
   the wire and in a bag); ``J``: a JSON object (``hello``, ``graph``,
-  ``tap``, ``error``: its ``what`` key says which).
+  ``tap``, ``error``, ``description``: its ``what`` key says which).  A
+  ``description`` answers a ``describe``: ``type``, ``hash`` (the
+  publisher's), ``candidates`` (``[{"from": where, "description": {...}}]``,
+  each a type_description_interfaces/msg/TypeDescription as a dict:
+  ``type_description`` and ``referenced_type_descriptions``, each
+  ``{"type_name", "fields": [{"name", "type": {"type_id", "capacity",
+  "string_capacity", "nested_type_name"}, "default_value"}]}``, rosidl's
+  ``.json`` form) and ``failures`` (why other sources gave none, as text).
 * **monitor -> agent**: JSON lines (``op``: ``tap``, ``watch``,
-  ``writer``, ``write``, ``start``, ``stop``).
+  ``writer``, ``write``, ``describe`` (``type``, ``hash``, and the
+  publisher's ``node`` and ``ns``), ``start``, ``stop``).
 """
 from __future__ import annotations
 
