@@ -15,9 +15,24 @@ pipe (:mod:`.wire`):
   received, decoded by the monitor as the DDS path decodes them (every field
   at its width);
 * discovery is rclpy's graph API: each publisher's GID, node, type, ROS 2
-  type hash (REP-2011) and QoS; a publisher of another type or of another
-  type hash than the contract's is named in a located warning and never
-  heard;
+  type hash (REP-2011) and QoS; a publisher of another type than the
+  contract's is named in a located warning and never heard;
+* a publisher of the contract's type with **another type hash** than the
+  monitor's definition (the robot's distribution changed the type: Kilted's
+  ``sensor_msgs/Range`` has ``variance``) is read in its own definition:
+  the agent is asked for the type description it declares (``describe``:
+  the ROS 2 Python's own when its hash is that one, else the publisher's
+  node's type description service), each description found is checked to
+  hash to the publisher's hash (:func:`~rclverify.runtime.dds.types.declare`),
+  and the publisher's samples are handed on as
+  :class:`~rclverify.runtime.dds.types.Declared` bytes, which the contract's
+  struct reads in that definition; the run says so in a located note.
+  Its samples that arrive before the answer are held (at most
+  :data:`HOLD_MAX` per publisher) and handed on, in order and with their
+  own stamps, once it comes.  When no description checks out, one located
+  warning says what was heard, what the monitor knows, why the publisher's
+  own definition could not be had, and what to do (the robot's ``.msg``
+  with ``--interfaces``); the publisher is never heard;
 * a sample carries its writer's GID and sequence number: the messages a
   publisher wrote before the monitor heard it are counted
   (``published_before_heard``);
@@ -48,11 +63,15 @@ from typing import Any, Callable, IO, Mapping
 from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.live.dds_qos import QosProfile
 from rclverify.runtime.dds.bus import Tap
+from rclverify.runtime.dds.types import DdsTypeError, Declaration, Declared, declare
 from rclverify.runtime.rclpy_source.wire import parse_sample, read_frame
 
 AGENT = Path(__file__).with_name("agent.py")
 #: seconds the agent has to say hello (rclpy's start-up)
 HELLO_TIMEOUT_S = 30.0
+#: samples held per publisher while its type description is asked for (the agent answers within its
+#: DESCRIBE_TIMEOUT_S); past it, each further one is dropped and counted in the tap's ``dropped``
+HOLD_MAX = 10_000
 
 
 class RclpyUnavailable(Exception):
@@ -149,7 +168,12 @@ class RclpyBus:
         self.before: dict[str, int] = {}  # tap key -> messages its publishers wrote before the monitor heard them
         self._first: dict[tuple[int, bytes], int] = {}
         self._warned: set[tuple[str, bytes, str]] = set()
-        self._admitted: dict[tuple[int, bytes], bool] = {}
+        self._admitted: dict[tuple[int, bytes], bool | Declaration] = {}
+        #: (type, publisher's hash) -> the declaration its samples are read with, ``None`` when refused
+        self._declared: dict[tuple[str, str], Declaration | None] = {}
+        self._why: dict[tuple[str, str], str] = {}  # a refused declaration: why, as the warning says it
+        self._asking: set[tuple[str, str]] = set()  # descriptions asked for, not yet answered
+        self._held: dict[tuple[int, bytes], list[bytes]] = {}  # sample frames waiting for an answer
         self._writers = 0
         self._proc: subprocess.Popen[bytes] | None = None
         self._thread = threading.Thread(target=self._run, name="rclverify-rclpy", daemon=True)
@@ -215,6 +239,9 @@ class RclpyBus:
                 proc.kill()
                 proc.wait(5)
         self._thread.join(timeout)
+        for (k, _gid), bodies in self._held.items():  # never answered: not heard, counted
+            self.taps[k].dropped += len(bodies)
+        self._held.clear()
         if self.error is not None:
             raise self.error
 
@@ -275,10 +302,20 @@ class RclpyBus:
         t = self.taps[k]
         ok = self._admitted.get((k, gid))
         if ok is None:
-            ok = self._admitted[(k, gid)] = self._admit(t, gid)
-        if not ok:
+            now = self._admit(t, gid)
+            if now is None:  # its definition asked for: held until the answer (module docstring)
+                held = self._held.setdefault((k, gid), [])
+                if len(held) < HOLD_MAX:
+                    held.append(body)
+                else:
+                    t.dropped += 1
+                return
+            ok = self._admitted[(k, gid)] = now
+        if ok is False:
             t.dropped += 1
             return
+        if isinstance(ok, Declaration):
+            raw = Declared.of(raw, ok)
         if seq and (k, gid) not in self._first:
             self._first[(k, gid)] = seq
             self.before[t.key] = self.before.get(t.key, 0) + seq - 1
@@ -286,16 +323,77 @@ class RclpyBus:
         self.on_sample(t, raw, SimpleNamespace(source_timestamp=source_ns, writer_guid=gid, sequence=seq),
                        received_ns)
 
-    def _admit(self, t: Tap, gid: bytes) -> bool:
-        """Whether publisher ``gid`` writes the contract's layout: its ROS 2 type hash against the
-        contract type's (REP-2011); a publisher whose hash is not known is taken at its type name."""
+    def _admit(self, t: Tap, gid: bytes) -> bool | Declaration | None:
+        """How publisher ``gid``'s samples are read: ``True`` in the contract's layout (its ROS 2 type
+        hash is the contract type's, REP-2011, or a hash is not known: taken at its type name), a
+        :class:`~rclverify.runtime.dds.types.Declaration` in the definition it declares, ``False``
+        not at all (no declaration checked out: warned once), ``None`` not known yet (asked for)."""
         theirs, ours = self.discovery.hash_of(t.dds_topic, gid), self.type_hash(t.struct)
         if not theirs or not ours or theirs == ours:
             return True
-        self._warn_once(t.key, gid, "layout", f"{t.where}: warning: {t.key}: publisher {gid.hex()} of "
-                        f"{ros_type(t.struct)} has the type hash {theirs}, the contract's type {ours}: another "
-                        "layout; its messages are not heard")
+        key = (ros_type(t.struct), theirs)
+        if key not in self._declared:
+            self._ask(t, gid, key)
+            return None
+        decl = self._declared[key]
+        if decl is not None:
+            return decl
+        pkg, _, name = key[0].partition("/msg/")
+        self._warn_once(t.key, gid, "layout", f"{t.where}: warning: {t.key}: {self._who(t, gid)} publishes "
+                        f"{key[0]} with the type hash {theirs}, the monitor's definition of it hashes to {ours}, "
+                        f"and the publisher's own definition could not be had ({self._why[key]}): its messages "
+                        f"are not heard; give the robot's definition as DIR/{pkg}/msg/{name}.msg with "
+                        "--interfaces DIR (or the mapping's msg_dirs)")
         return False
+
+    def _who(self, t: Tap, gid: bytes) -> str:
+        node = self.discovery.node_of(gid)
+        return f"node {node} (publisher {gid.hex()})" if node else f"publisher {gid.hex()}"
+
+    def _ask(self, t: Tap, gid: bytes, key: tuple[str, str]) -> None:
+        """Ask the agent, once per type and hash, for the description publisher ``gid`` declares."""
+        if key in self._asking or key in self._declared:
+            return
+        self._asking.add(key)
+        pub = next((p for p in self.discovery.topics.get(ros_name(t.dds_topic) or "", [])
+                    if bytes.fromhex(p["gid"]) == gid), {})
+        self._send({"op": "describe", "type": key[0], "hash": key[1], "node": pub.get("node", ""),
+                    "ns": pub.get("ns", "/")})
+
+    def _described(self, obj: dict[str, Any]) -> None:
+        """The agent's answer to a ``describe`` (:mod:`.wire`): the first candidate that hashes to
+        the publisher's hash is the type's declaration; each that does not is said; the samples held
+        for it are handed on (or dropped, with the warning, when none checks out)."""
+        key = (str(obj.get("type", "")), str(obj.get("hash", "")))
+        self._asking.discard(key)
+        decl: Declaration | None = None
+        why = [str(f) for f in obj.get("failures", [])]
+        for cand in obj.get("candidates", []):
+            try:
+                decl = declare(key[0], key[1], cand.get("description", {}), str(cand.get("from", "the agent")))
+                break
+            except DdsTypeError as exc:
+                why.append(str(exc))
+                self.warn(f"warning: {exc}")
+        self._declared[key] = decl
+        self._why[key] = "; ".join(why) or "nothing answered"
+        for t in self.taps:  # refused: each such publisher said at once (the warning of _admit), not at its sample
+            if decl is None and ros_type(t.struct) == key[0]:
+                for p in self.discovery.publishers(t.dds_topic):
+                    if self.discovery.hash_of(t.dds_topic, p.guid) == key[1]:
+                        self._admit(t, p.guid)
+        if decl is not None:
+            for t in self.taps:
+                if ros_type(t.struct) == key[0]:
+                    self.warn(f"{t.where}: note: {t.key}: publishers of {key[0]} with the type hash {key[1]} (not "
+                              f"the monitor's {self.type_hash(t.struct)}) are read in their own definition, from "
+                              f"{decl.origin}")
+        for (k, gid), bodies in list(self._held.items()):
+            t = self.taps[k]
+            if ros_type(t.struct) == key[0] and self.discovery.hash_of(t.dds_topic, gid) == key[1]:
+                del self._held[(k, gid)]
+                for body in bodies:
+                    self._sample(body)
 
     def _json(self, obj: dict[str, Any]) -> None:
         what = obj.get("what")
@@ -310,6 +408,8 @@ class RclpyBus:
             t.heard = {bytes.fromhex(g) for g in obj["heard"]}
             if first and self.on_reader is not None:
                 self.on_reader(t, self.discovery.publishers(t.dds_topic))
+        elif what == "description":
+            self._described(obj)
         elif what == "error":
             k = obj.get("id")
             where = f"{self.taps[int(k)].where}: warning: {self.taps[int(k)].key}: " if k is not None else "warning: "
@@ -317,7 +417,8 @@ class RclpyBus:
                       f"{self.python} lacks the message package; its messages are not heard")
 
     def _check_graph(self) -> None:
-        """Warn about publishers of another type on a tapped topic and other writers on a watched one."""
+        """Warn about publishers of another type on a tapped topic and other writers on a watched one;
+        ask for the definition of each of the contract's type with another type hash (:meth:`_ask`)."""
         for t in self.taps:
             want = ros_type(t.struct)
             for p in self.discovery.publishers(t.dds_topic):
@@ -325,6 +426,10 @@ class RclpyBus:
                     self._warn_once(t.key, p.guid, "type", f"{t.where}: warning: {t.key}: "
                                     f"{self.discovery.who(p)} publishes {p.type_name}, the contract's type is "
                                     f"{want}; its messages are not heard")
+                    continue
+                theirs, ours = self.discovery.hash_of(t.dds_topic, p.guid), self.type_hash(t.struct)
+                if theirs and ours and theirs != ours:
+                    self._ask(t, p.guid, (want, theirs))
         for dds_topic, (key, where, role) in self.watched.items():
             for p in self.discovery.publishers(dds_topic):
                 who = self.discovery.who(p)
