@@ -1,8 +1,13 @@
 """ROS 1 ``.bag`` and ROS 2 (sqlite3, MCAP) bags through ``rosbags``.
 
-Standard message types come from ``rosbags``' type store (ROS 2 Humble's
+A ROS 2 bag from Iron on carries each topic's message definition, and
+``rosbags`` decodes with it (and checks its type hash), whatever the
+workspace defines.  For a bag without definitions (rosbag2 before Iron),
+standard message types come from ``rosbags``' type store (ROS 2 Humble's
 definitions, which cover ROS 1's common types too); the workspace's own
-``.msg`` files (``<dir>/<pkg>/msg/<Type>.msg``) are registered on top.
+``.msg`` files (``<dir>/<pkg>/msg/<Type>.msg``) are registered on top, and a
+message they do not read is an error that says how to give the recording
+robot's definition.
 """
 from __future__ import annotations
 
@@ -162,14 +167,28 @@ def open_bag(path: Path, store: Any) -> Any:
     return reader
 
 
+def _what_to_do(conn: Any) -> str:
+    """For a message of a ROS 2 bag that carries no definition of its type (rosbag2 before Iron
+    wrote none): that the monitor's definition was used, and how to give the recording robot's."""
+    fmt = getattr(getattr(conn, "msgdef", None), "format", None)
+    if getattr(fmt, "name", "") != "NONE" or conn.msgtype.count("/") != 2:
+        return ""  # the bag's own definition was used: the bytes are what is wrong
+    pkg, _, name = conn.msgtype.partition("/msg/")
+    return (f"; the bag carries no definition of {conn.msgtype}, and the monitor's (the workspace's .msg files, "
+            f"else ROS 2 Humble's) does not read it: give the recording robot's as DIR/{pkg}/msg/{name}.msg with "
+            "DIR in the mapping's msg_dirs")
+
+
 def bag_event(reader: Any, path: Path, index: int, conn: Any, stamp: int, raw: bytes) -> Event:
     """The event of message ``index`` of the bag (``stamp`` in ns, ``raw`` its bytes), as :func:`read_bag`
     makes it; raises :class:`TraceError` (located) when the message cannot be decoded."""
     try:
         msg = reader.deserialize(raw, conn.msgtype)
     except Exception as exc:
+        hint = _what_to_do(conn)
+        why = str(exc).rstrip(".") + hint if hint else str(exc)
         raise TraceError(f"{path}: message {index} (topic {conn.topic}, {len(raw)} bytes): error: "
-                         f"cannot decode {conn.msgtype}: {exc}") from None
+                         f"cannot decode {conn.msgtype}: {why}") from None
     fields = flatten(msg)  # its header's stamp, when it has one, is its own time (docs/semantics.md)
     return Event(index, stamp / 1e9, conn.topic.lstrip("/"), fields, f"{path.name}: message {index}",
                  header_stamp(fields) if "header" in fields else None)
