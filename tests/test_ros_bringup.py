@@ -168,3 +168,37 @@ def test_eval_of_literals(expr: str, want: str) -> None:
 def test_eval_refuses_what_it_cannot_know(expr: str) -> None:
     with pytest.raises(Unresolved):
         evaluate(expr)
+
+
+def _many(tmp_path: Path, loose: int) -> Path:
+    """A launch file with three nodes whose package is not read (dropped) and
+    ``loose`` nodes whose remappings are not read (kept, a warning each)."""
+    lf = tmp_path / f"many{loose}.launch.py"
+    body = "".join(f"        Node(package=pkg_of({i}), executable='x'),\n" for i in range(3))
+    body += "".join(f"        Node(package='rover_map', executable='map_server', name='m{i}', "
+                    f"remappings=remaps_for({i})),\n" for i in range(loose))
+    lf.write_text("from launch import LaunchDescription\nfrom launch_ros.actions import Node\n\n\n"
+                  "def generate_launch_description():\n    return LaunchDescription([\n" + body + "    ])\n")
+    return lf
+
+
+def test_the_first_screen_names_what_dropped_nodes_first(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from rclverify.cli.commands import main
+    lf = _many(tmp_path, 30)
+    assert main(["ros", "scan", str(WS), "--launch", str(lf), "--json", str(tmp_path / "g.json")]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) <= 20 and err[-1].endswith("0 error(s), 33 warning(s)"), err
+    assert err[0] == "33 warning(s) by cause (each located in the JSON's \"unresolved\"; --verbose lists them here):"
+    assert err[1].startswith(f"    3  launch nodes dropped (not started in the graph): {lf}:7:9, {lf}:8:9, {lf}:9:9")
+    assert err[2].startswith(f"   30  launch attributes not read (parameter files, conditions, remappings): {lf}:10:")
+    assert err[2].endswith("(+27 more)")  # the launch file lies in no scanned package: no package named
+    # --verbose: every warning, one a line
+    assert main(["ros", "scan", str(WS), "--launch", str(lf), "--json", str(tmp_path / "g.json"), "--verbose"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 34 and sum("action skipped" in x for x in err) == 3
+    # control: a few warnings are listed one a line, as they always were
+    few = _many(tmp_path, 2)
+    assert main(["ros", "scan", str(WS), "--launch", str(few), "--json", str(tmp_path / "g.json")]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 6 and err[0] == f"{few}:7:9: warning: Node(...): package 'pkg_of(0)' (not a literal or a " \
+                                       f"known substitution) cannot be read statically; action skipped", err

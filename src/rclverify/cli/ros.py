@@ -21,6 +21,8 @@ MASTER_TIMEOUT_S = 10.0
 #: the code of the scan's note on an absent interface package (ros/graph/absent.py CODE; not imported here,
 #: so that building the command line does not load the scan)
 ABSENT = "ROS-INTERFACE-ABSENT"
+#: the lines of the scan's first screen (ros/graph/summary.py SCREEN, not imported here for the same reason)
+_SCREEN = 20
 
 
 def add_parsers(sub: Any) -> None:
@@ -36,6 +38,9 @@ def add_parsers(sub: Any) -> None:
                    help=f"seconds each call to the master may take (default {MASTER_TIMEOUT_S:g})")
     s.add_argument("--json", metavar="FILE", help="write the graph as JSON (docs/ros-graph.schema.json)")
     s.add_argument("--cache", metavar="DIR", help="per-file parse cache directory (e.g. artifacts/cache)")
+    s.add_argument("--verbose", "-v", action="store_true",
+                   help=f"list every warning, one a line (default: when there are more than {_SCREEN}, one line per "
+                        f"cause with its count, first places and packages; errors always in full)")
     s.set_defaults(fn=cmd_scan)
     d = rs.add_parser("diff", help="the graph the code promises against a running ROS 1 master, a running ROS 2 "
                                    "system or a recorded run",
@@ -133,8 +138,10 @@ def cmd_scan(args: argparse.Namespace) -> int:
         data["master"] = {"uri": args.master, "nodes": [n.to_json() for _, n in sorted(mg.nodes.items())]}
         for n in mg.notes:  # a service whose type the probe could not read
             print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
-    for n in g.notes:
-        print(n, file=sys.stderr)
+    from rclverify.ros.graph.summary import report  # deferred: start-up (the scan's own module, loaded with it)
+    packages = {p["manifest"]: p["name"] for p in data.get("packages", []) if p.get("manifest")}
+    for text in report(g.notes, packages, bool(getattr(args, "verbose", False))):
+        print(text, file=sys.stderr)
     if args.json:
         atomic_write_text(Path(args.json), json.dumps(data, indent=2, sort_keys=False) + "\n")
     else:

@@ -156,6 +156,19 @@ def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
     return out
 
 
+def _required(c: ast.Call, attrs: dict[str, str], keys: tuple[tuple[str, str], ...]) -> None:
+    """The keyword arguments ``keys`` (``(python name, attribute)``) of action
+    ``c`` without which it starts nothing known (its package, executable or
+    plugin): one that cannot be read raises :class:`_Unres` naming it."""
+    for py, key in keys:
+        v = _kw(c, py)
+        if v is not None:
+            try:
+                attrs[key] = _value(v)
+            except _Unres as exc:
+                raise _Unres(f"{py} {exc}") from None
+
+
 def _optional(c: ast.Call, attrs: dict[str, str], keys: tuple[tuple[str, str], ...], shown: str,
               notes: list[Note]) -> None:
     """The keyword arguments ``keys`` (``(python name, attribute)``) of action
@@ -199,19 +212,13 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
     try:
         attrs: dict[str, str] = {}
         if name == "Node":
-            for py, key in (("package", "pkg"), ("executable", "exec"), ("node_executable", "exec")):
-                v = _kw(c, py)
-                if v is not None:
-                    attrs[key] = _value(v)
+            _required(c, attrs, (("package", "pkg"), ("executable", "exec"), ("node_executable", "exec")))
             _optional(c, attrs, (("name", "name"), ("namespace", "namespace"), ("node_name", "name"),
                                  ("node_namespace", "namespace")), shown, notes)
             _condition(c, attrs, shown, notes)
             return El("node", attrs, _node_kids(c, shown, notes), src)
         if name == "ComposableNode":
-            for py, key in (("package", "pkg"), ("plugin", "plugin")):
-                v = _kw(c, py)
-                if v is not None:
-                    attrs[key] = _value(v)
+            _required(c, attrs, (("package", "pkg"), ("plugin", "plugin")))
             _optional(c, attrs, (("name", "name"), ("namespace", "namespace")), shown, notes)
             return El("composable_node", attrs, _node_kids(c, shown, notes), src)
         if name in ("ComposableNodeContainer", "LoadComposableNodes"):
