@@ -176,3 +176,38 @@ def test_an_endpoint_not_judged_is_an_item_whatever_else_was_judged() -> None:
     items = not_judged(NODES, Heard(messages, orphans), {}, {}, "in the run")
     assert [(i["name"], i["reason"]) for i in items if i["name"] == "/estop"] == [("/estop", "endpoint not heard")]
     assert replay(_book([]), lines) == summary
+
+
+@pytest.mark.parametrize("before", [False, True])
+def test_a_request_event_stamped_before_the_monitor_began_is_named_undecided(before: bool) -> None:
+    """An event of a request stamped well before the monitor began (a durable event, a late delivery): the
+    monitor may have missed the exchange's start, so it opens no call; its answer is named undecided by its
+    client gid and sequence number.  The control: the same request stamped after the start is judged."""
+    from rclverify.runtime.dds.introspection import event_struct
+    lines: list[dict[str, Any]] = []
+    taps, types = _taps(lines, {"/s"}, {"/a"})
+    taps.taps = {"call:/estop:event": SimpleNamespace(heard={b"\x05" * 16})}  # the server publishes contents
+    ev = event_struct(types, "std_srvs/SetBool")
+    server, gid = b"\x05" * 16, b"\x0a" * 16
+    taps.tick(20.0)  # the monitor begins
+
+    def event(kind: int, stamp: float, now: float, **parts: Any) -> None:
+        s = types.build(ev, {"info": {"event_type": kind, "client_gid": list(gid), "sequence_number": 1},
+                             **{k: [v] for k, v in parts.items()}})
+        taps.handle("call:/estop:event", s.serialize(), stamp, now, server)
+    asked = 12.0 if before else 20.5
+    event(1, asked, 20.6, request={"data": True})
+    event(2, 20.7, 20.7, response={"success": False, "message": ""})
+    for now in (21.0, 23.0, 25.0):
+        taps.tick(now)
+    summary = taps.finish()
+    if before:
+        assert taps.counts["before_start"] == 1 and summary["counts"]["calls"] == 0
+        assert summary["undecided"]["estop"] == {"count": 1, "first": [["ev", gid.hex(), 1, server.hex()]]}
+        base = next(r for r in summary["nodes"] if r["node"] == "Base")
+        assert base["counts"]["violated"] == 0 and base["counts"]["inconclusive"] == 1
+        assert f"client gid {gid.hex()} seq 1" in base["first_inconclusive"]["reason"]
+    else:
+        assert summary["counts"]["calls"] == 1 and summary["undecided"] == {}
+        base = next(r for r in summary["nodes"] if r["node"] == "Base")
+        assert base["counts"]["violated"] == 1

@@ -118,6 +118,9 @@ class CallTaps:
         #: link -> endpoint -> why, the endpoints said not judged (events only; the book has them too)
         self.unjudged: dict[str, dict[str, str]] = {}
         self._ev_opened: dict[tuple[str, str, int], int] = {}  # (link, client gid, seq) -> servers that took it
+        #: when the monitor began (s, the first sample's or tick's receipt time): an event of a request stamped
+        #: more than :data:`LATE_S` before it opens no call, and its answer is named undecided (docs/ros2.md)
+        self.started: float | None = None
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
         #: pairer name -> (the reply reader's writers, the pairer's servers) when discovery was last read
@@ -125,9 +128,9 @@ class CallTaps:
         self.last = float("-inf")  # the stamp of the last sample taken
         #: samples taken after a later-stamped one (``late``), of a writer no longer known or of the other
         #: wire form (:mod:`.dds_wire`), events without contents, request/reply samples left to the
-        #: introspection events, samples that did not decode
+        #: introspection events, samples that did not decode, request events stamped before the monitor began
         self.counts = {"late": 0, "unknown_writer": 0, "other_form": 0, "no_contents": 0, "introspected": 0,
-                       "undecodable": 0}
+                       "undecodable": 0, "before_start": 0}
 
     def attach(self, bus: Any, warn: Any = None) -> None:
         """Ask ``bus`` (a :class:`~.dds_bus.Bus`, before it starts) for every topic of the plan;
@@ -181,12 +184,16 @@ class CallTaps:
         """One sample of tap ``key`` (serialized, source stamp ``stamp``, received
         ``now``, written by ``writer``: its GUID), taken at a later :meth:`tick`."""
         self._n += 1
+        if self.started is None:
+            self.started = now
         heapq.heappush(self._queue, (stamp, self._n, now, key, raw, writer))
 
     def tick(self, now: float, window: float = 0.0) -> None:
         """Take the samples whose time has come, in their stamps' order; answers
         that waited :data:`EARLY_S` s for their call count as answers without
         one; the book's clock moves to ``now - max(window, SETTLE_S)``."""
+        if self.started is None:
+            self.started = now
         self._discover(now)
         self._take(lambda stamp, got: stamp <= now - SETTLE_S or got <= now - LATE_S)
         if now - self._checked >= 0.5:
@@ -447,6 +454,9 @@ class CallTaps:
             if not s.request:
                 self.counts["no_contents"] += 1
                 return  # introspection without CONTENTS: nothing to judge (docs/ros2.md)
+            if self.started is not None and stamp < self.started - LATE_S:
+                self.counts["before_start"] += 1
+                return  # made before the monitor began: its answer is an orphan, named undecided (CallBook.orphan)
             memo = (name, gid, seq)
             taken = self._ev_opened[memo] = self._ev_opened.get(memo, 0) + 1
             while len(self._ev_opened) > 10_000:
