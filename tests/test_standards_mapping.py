@@ -99,7 +99,7 @@ def test_the_evidence_shown_is_a_reading_of_the_kinds_table() -> None:
             supporting = []
             for r in rows:  # brute force: does any (field, value) of the table match and name an accepted kind?
                 hits = [k for (f, v), k in SUPPORTS.items()
-                        if (r.get(f) if f == "kind" else (r.get("strength") or {}).get("kind")) == v]  # type: ignore[union-attr]
+                        if (r.get(f) if f == "kind" else dict(r.get("strength") or {}).get("kind")) == v]  # type: ignore[call-overload]
                 if set(hits) & set(item.evidence):
                     supporting.append(r["obligation"])
             assert [e["obligation"] for e in got["evidence"]] == supporting
