@@ -121,6 +121,7 @@ class CallTaps:
         #: when the monitor began (s, the first sample's or tick's receipt time): an event of a request stamped
         #: more than :data:`LATE_S` before it opens no call, and its answer is named undecided (docs/ros2.md)
         self.started: float | None = None
+        self._shadow_guids: dict[str, set[bytes]] = {}  # reply topic -> monitors' shadow writers (read each 0.5 s)
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
         #: pairer name -> (the reply reader's writers, the pairer's servers) when discovery was last read
@@ -202,6 +203,7 @@ class CallTaps:
             self.check_forms(now)
             if self.shadows is not None:
                 self.shadows.update()
+            self._read_shadows()
         for key in [k for k, xs in self._early.items() if now - xs[0][4] > EARLY_S]:
             for part, fields, stamp, final, _t, name in self._early.pop(key):
                 self.book.answer(key, part, fields, stamp, final, name)
@@ -301,6 +303,21 @@ class CallTaps:
     def _contents(self, name: str, part: str) -> set[str]:
         """:meth:`_publishing` without the endpoints seen publishing metadata only."""
         return {o for o in self._publishing(name, part) if self._levels.get((name, o)) != "metadata"}
+
+    def _read_shadows(self) -> None:
+        """The DDS source: each reply topic's shadow writers (:mod:`.shadow`, this monitor's and any
+        other's), which are no servers, as discovery shows them now."""
+        if self.events or self._disc is None:
+            return
+        for key, (_name, _struct, _header, part) in self.specs.items():
+            if part != "reply":
+                continue
+            try:
+                topic = self.taps[key].dds_topic
+                self._shadow_guids[topic] = {p.guid for p in self._disc.publishers(topic)
+                                             if SHADOW in p.qos.user_data}
+            except (RuntimeError, KeyError):  # discovery changed under us (the DDS thread): next time
+                continue
 
     def _coverage(self, now: float) -> None:
         """Events only: every endpoint of each link not heard with contents for
@@ -415,11 +432,7 @@ class CallTaps:
             if rep is None or req is None:
                 side = None
             else:
-                try:
-                    shadows = {p.guid for p in self._disc.publishers(rep.dds_topic) if SHADOW in p.qos.user_data} \
-                        if self._disc is not None else set()
-                except RuntimeError:  # discovery changed under us (the DDS thread): as last time
-                    shadows = set()
+                shadows = self._shadow_guids.get(rep.dds_topic, set())
                 side = side_of(self._contents(name, part), {self._owner(g) for g in rep.heard if g not in shadows},
                                {self._owner(g) for g in req.heard})
         memo = f"{name}:{part}"
