@@ -111,6 +111,8 @@ class _Initial:
     outs: frozenset[str]
     verdict: str = ""
     reason: str = ""
+    #: whether the run cannot show it: its first published value came after an input
+    unobservable: bool = False
 
 
 @dataclass
@@ -119,6 +121,9 @@ class DeclarationResult:
 
     node: str
     declarations: list[DeclarationRow] = field(default_factory=list)
+    #: the labels of the rows no run can decide (an ``initially`` whose first published value came after
+    #: an input: the property tests' to show): listed in the record's explanation, not folded into its status
+    unobservable: set[str] = field(default_factory=set)
 
     def rows(self) -> list[DeclarationRow]:
         """``[{"declaration", "premise", "index", "source", "verdict", "status", "reason"}]``:
@@ -312,6 +317,7 @@ class DeclarationMonitor:
                 continue
             at = ", ".join(f"{o} = {self.first[o][0]!r} ({self.first[o][1]})" for o in sorted(ini.outs))
             if self.first_input:
+                ini.unobservable = True
                 ini.verdict, ini.reason = "inconclusive", (
                     f"the first published values ({at}) came after the input at {self.first_input}: they may be "
                     "the node's answer to it, not the value it starts from (a node publishes its initial value "
@@ -337,6 +343,8 @@ class DeclarationMonitor:
                 + ": its first value was not seen")
             res.declarations.append(_row(f"initially {ini.index}", "initial value", ini.index, ini.source,
                                               f"initially( {expr_to_rcl(ini.formula)} )", verdict, reason))
+            if ini.unobservable:
+                res.unobservable.add(f"initially {ini.index}")
         for c in self.counts:
             res.declarations.append(_row(c.label, c.premise, 0, c.source, c.text, *self._count_verdict(c)))
         return res
@@ -431,18 +439,32 @@ def declaration_status(res: DeclarationResult, trace: str) -> tuple[str, str]:
     evidence"): a ``false`` row -> ``failed`` (named, a declaration of the
     contract before a period in time); else an ``inconclusive`` row, or a
     ``pending`` row beside a ``true`` one -> ``inconclusive``; else every row
-    ``pending`` (or none) -> ``pending``; else ``discharged``.  The
-    explanation lists the rows that held and those not decided, each with
-    its reason."""
-    rows = res.declarations
+    ``pending`` (or none) -> ``pending``; else ``discharged``.  A row no run
+    can decide (:attr:`DeclarationResult.unobservable`) is listed apart and
+    left out of the status.  The explanation lists the rows that held, those
+    not decided and those no run shows, each with its reason."""
+    status, words = _fold(res, trace)
+    return status or "pending", words
+
+
+def _fold(res: DeclarationResult, trace: str) -> tuple[str | None, str]:
+    """:func:`declaration_status`, with ``None`` for a status when every row
+    is one no run can decide (nothing for the record's status)."""
+    rows = [r for r in res.declarations if r["declaration"] not in res.unobservable]
     bad = sorted((r for r in rows if r["verdict"] == "false"), key=lambda r: not r["premise"])
     if bad:
         r = bad[0]
         return "failed", f"{res.node} declares {r['text']} ({r['source']}) but in {trace}: {r['reason']}"
     open_ = [f"{r['text']}: {r['verdict']} ({r['reason']})" for r in rows if r["verdict"] not in ("true", "false")]
     done = [r["text"] for r in rows if r["verdict"] == "true"]
+    apart = [f"{r['text']}: {r['verdict']} ({r['reason']})" for r in res.declarations
+             if r["declaration"] in res.unobservable]
     words = "; ".join((["held: " + ", ".join(done)] if done else [])
-                      + (["not decided: " + "; ".join(open_)] if open_ else [])) or "none judged"
+                      + (["not decided: " + "; ".join(open_)] if open_ else [])
+                      + (["not shown by a run (its first published value answers an input; the property tests "
+                          "show it): " + "; ".join(apart)] if apart else [])) or "none judged"
+    if not rows and res.declarations:
+        return None, words
     if any(r["verdict"] == "inconclusive" for r in rows) or (open_ and done):
         return "inconclusive", words
     if not done:
@@ -456,19 +478,21 @@ def with_declarations(res: DeclarationResult, trace: str, status: str,
     ``explanation``) and the node's declarations on the same run
     (:func:`declaration_status`), by the rule of evidence (docs/semantics.md,
     "Verdicts and evidence"): a false declaration fails the record (it is a
-    claim of the node's contract); a declaration not decided keeps a
-    ``discharged`` record from ``discharged`` (``inconclusive``) and makes a
-    ``pending`` one ``inconclusive`` when one was undecided; ``failed``,
-    ``error``, ``stale`` and ``inconclusive`` stand.  Returns
-    ``(status, explanation, {"declarations": rows})``."""
-    dstatus, dexpl = declaration_status(res, trace)
+    claim of the node's contract); a declaration pending or undecided keeps
+    a ``discharged`` record from ``discharged`` (``inconclusive``) and makes
+    a ``pending`` one ``inconclusive`` when one was undecided; ``failed``,
+    ``error``, ``stale`` and ``inconclusive`` stand; a row no run can decide
+    changes nothing but the explanation.  Returns ``(status, explanation,
+    {"declarations": rows})``."""
+    dstatus, dexpl = _fold(res, trace)
     part: DeclarationsPart = {"declarations": res.rows()}
     if dstatus == "failed":
-        late_period = not any(r["verdict"] == "false" and r["premise"] for r in res.declarations)
+        late_period = not any(r["verdict"] == "false" and r["premise"] for r in res.declarations
+                              if r["declaration"] not in res.unobservable)
         if late_period and status == "failed":  # a late period fails the record through periods.py: not said twice
             return status, f"{explanation}; declarations: {dexpl}", part
         return "failed", f"declarations: {dexpl}; {explanation}", part
-    if status == "discharged" and dstatus != "discharged":
+    if status == "discharged" and dstatus not in (None, "discharged"):
         return "inconclusive", (f"{explanation}; but a declaration is not decided on this run, so the record is "
                                 f"not discharged (docs/semantics.md, \"Verdicts and evidence\"); declarations: "
                                 f"{dexpl}"), part
