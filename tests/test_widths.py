@@ -68,13 +68,14 @@ def test_oracle_the_nearest_binary32_equals_a_brute_force_search() -> None:
     assert nearest_at_width(Fraction(10) ** 39, "float32") is None
 
 
-def test_only_a_constant_compared_with_a_variable_of_known_width_moves() -> None:
+def test_only_a_constant_read_with_a_variable_of_known_width_moves() -> None:
     spec = parse_text("node N { inputs( p : REAL, q : REAL ) outputs( y : BOOL ) assume( TRUE ) "
                       "guarantee( out.y <=> (in.p <= 0.2 and 0.5 < in.q and in.p + 0.1 <= 1) ) }", "n.rcl")
     g = spec.nodes[0].guarantees[0].formula
     text = expr_to_rcl(at_widths(g, {"in.p": "float32"}))
     assert "in.p <= 0.20000000298023223876953125" in text
-    assert "0.5 < in.q" in text and "in.p + 0.1 <= 1" in text  # q's width unknown; arithmetic as written
+    assert "0.5 < in.q" in text  # q's width unknown: as written
+    assert "in.p + 0.100000001490116119384765625 <= 1" in text  # a sum with p is at p's width, its constants too
 
 
 def _workspace(tmp: Path, msg_type: str) -> Path:

@@ -276,7 +276,7 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     is given.  Raises what the readers and the checkers raise (the caller reports it)."""
     # the contract's constants compared as the fields carry them (widths.py)
     fields = carried_fields(target.node, cfg.rules, [target.root / d for d in cfg.msg_dirs])
-    node = at_carried_widths(target.node, float_widths(target.node, fields))
+    node = at_carried_widths(target.node, float_widths(target.node, fields), target.checked.env.constants)
     beside = _Beside()
     if has_deadlines(node):
         beside.add("deadlines", lambda: DeadlineMonitor(target.checked, node, cfg.rules,

@@ -125,7 +125,7 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     dirs = [root / d for d in cfg.msg_dirs]
     fields = [carried_fields(n, cfg.rules, dirs) for n in nodes]
     sources = [(k, s) for f in fields for k, s in f.items()]
-    nodes = [at_carried_widths(n, float_widths(n, f)) for n, f in zip(nodes, fields)]
+    nodes = [at_carried_widths(n, float_widths(n, f), checked.env.constants) for n, f in zip(nodes, fields)]
     dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
              for n in nodes if has_deadlines(n)]
     pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]

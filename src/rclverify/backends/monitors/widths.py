@@ -229,16 +229,19 @@ def float_widths(node: CheckedNode, fields: Mapping[str, FieldSource]) -> dict[s
     return out
 
 
-def at_carried_widths(node: CheckedNode, widths: Mapping[str, str]) -> CheckedNode:
+def at_carried_widths(node: CheckedNode, widths: Mapping[str, str],
+                      constants: Mapping[str, tuple[T.Type, ast.Expr]] | None = None) -> CheckedNode:
     """``node`` with every formula of its contract (assumptions, guarantees,
     initial values) comparing its constants at the widths ``widths`` carries
-    (:func:`rclverify.semantics.widths.at_widths`); ``node`` itself without widths."""
+    (:func:`rclverify.semantics.widths.at_widths`; ``constants`` the
+    context's named constants, ``Env.constants``, read at the width as a
+    literal is); ``node`` itself without widths."""
     if not widths:
         return node
     n = node.node
 
     def clauses(cs: tuple[ast.Clause, ...]) -> tuple[ast.Clause, ...]:
-        return tuple(dataclasses.replace(c, formula=at_widths(c.formula, widths)) for c in cs)
+        return tuple(dataclasses.replace(c, formula=at_widths(c.formula, widths, constants)) for c in cs)
     return dataclasses.replace(node, node=dataclasses.replace(n, assumes=clauses(n.assumes),
                                                               guarantees=clauses(n.guarantees)))
 

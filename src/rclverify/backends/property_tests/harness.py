@@ -445,8 +445,8 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
         impl = load_implementation(root, cfg)
     widths, carried = carried_in(root, node)
     with on_harness_path(root, cfg.file):
-        return GuaranteeRun(checked, at_carried_widths(node, widths), guarantee, cfg, impl, facts, widths=widths,
-                            carried=carried).run()
+        return GuaranteeRun(checked, at_carried_widths(node, widths, checked.env.constants), guarantee, cfg, impl,
+                            facts, widths=widths, carried=carried).run()
 
 
 def versions() -> str:
