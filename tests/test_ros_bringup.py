@@ -12,14 +12,20 @@ launch files and servers, on the project's own tree
   name to a free factory, ``make_shared`` of a class template, a delegating
   constructor and a member: each named where the server's code writes the
   literal, typed by that call's template argument;
-* a template parameter named like another class's ``using`` alias.
+* a template parameter named like another class's ``using`` alias;
+* two helper classes each with its own ``using Request = ...`` (a service),
+  used in their ``.cpp`` files, beside the server's ``using Charge =
+  sensor_msgs::msg::BatteryState``: each client typed by its own class's
+  alias, never by the other's nor by an alias of its last name part.
 
 By hand, with the launch arguments' defaults: two launch files start three
 nodes, ``/rover/drive_server`` (publishes ``/rover/cmd_vel_raw``, subscribes
 ``/rover/odom``, ``/rover/tf``, ``/rover/tf_static``, serves action
 ``/rover/drive_to`` of ``rover_msgs/action/DriveTo``, calls action
 ``/rover/dock`` of ``rover_msgs/action/Dock``), ``/rover/dock`` (serves
-``/rover/dock`` of ``Dock`` and ``/rover/undock`` of ``Undock``) and
+``/rover/dock`` of ``Dock`` and ``/rover/undock`` of ``Undock``, subscribes
+``/rover/battery``, calls services ``/rover/charge`` of ``rover_msgs/srv/Charge``
+and ``/rover/lamp`` of ``std_srvs/srv/SetBool``) and
 ``/rover/map_server`` (publishes ``/rover/map``)."""
 from __future__ import annotations
 
@@ -40,7 +46,10 @@ DRIVE = {("pub", "/rover/cmd_vel_raw", "geometry_msgs/msg/Twist"), ("sub", "/rov
          ("action_servers", "/rover/drive_to", "rover_msgs/action/DriveTo"),
          ("action_clients", "/rover/dock", "rover_msgs/action/Dock")}
 DOCK = {("action_servers", "/rover/dock", "rover_msgs/action/Dock"),
-        ("action_servers", "/rover/undock", "rover_msgs/action/Undock")}
+        ("action_servers", "/rover/undock", "rover_msgs/action/Undock"),
+        ("sub", "/rover/battery", "sensor_msgs/msg/BatteryState"),
+        ("service_clients", "/rover/charge", "rover_msgs/srv/Charge"),
+        ("service_clients", "/rover/lamp", "std_srvs/srv/SetBool")}
 ROLES = ("publishes", "subscribes", "service_servers", "service_clients", "action_servers", "action_clients")
 SHORT = {"publishes": "pub", "subscribes": "sub"}
 
@@ -202,3 +211,26 @@ def test_the_first_screen_names_what_dropped_nodes_first(tmp_path: Path, capsys:
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 6 and err[0] == f"{few}:7:9: warning: Node(...): package 'pkg_of(0)' (not a literal or a " \
                                        f"known substitution) cannot be read statically; action skipped", err
+
+
+def test_each_helper_class_types_its_client_by_its_own_alias(default: Any) -> None:
+    """ChargerClient's ``Request`` is ``rover_msgs::srv::Charge``, LampClient's
+    ``std_srvs::srv::SetBool``, the dock server's ``Charge`` a message: before,
+    both clients were typed ``sensor_msgs/msg/BatteryState``, silently."""
+    clients = {(e.topic, e.msg_type) for e in default.nodes["/rover/dock"].service_clients}
+    assert clients == {("/rover/charge", "rover_msgs/srv/Charge"), ("/rover/lamp", "std_srvs/srv/SetBool")}
+
+
+def test_an_alias_is_looked_up_in_its_scope() -> None:
+    from rclverify.ros.extract.cpp_types import alias_of, message_type
+    aliases = {"a::Helper::Request": "other_msgs::srv::Charge", "a::Node::Charge": "geometry_msgs::msg::Point",
+               "Charge": "geometry_msgs::msg::Point", "ns::Twist": "geometry_msgs::msg::Twist"}
+    assert alias_of("Request", aliases, ["a::Helper", "a"]) == "other_msgs::srv::Charge"
+    assert alias_of("Request", aliases, ["a::Node", "a"]) is None  # not the helper's in another class
+    assert alias_of("other_msgs::srv::Charge", aliases) is None  # a namespace's name: no class's alias
+    assert alias_of("Helper::Request", aliases) == "other_msgs::srv::Charge"
+    assert alias_of("ns::Twist", aliases) == "geometry_msgs::msg::Twist"
+    assert alias_of("Node::Charge", aliases) == "geometry_msgs::msg::Point"
+    # control: a bare name still reads its one alias
+    assert alias_of("Charge", aliases) == "geometry_msgs::msg::Point"
+    assert message_type("other_msgs::msg::Charge", aliases) == "other_msgs/msg/Charge"

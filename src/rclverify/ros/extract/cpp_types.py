@@ -5,7 +5,9 @@ docs/ros.md, "Reading real code").
 A type's text (a template argument, a callback's parameter type) is read
 through:
 
-* ``using``/``typedef`` aliases of the file (followed four deep);
+* ``using``/``typedef`` aliases of the file (followed four deep), looked up
+  in the scope of the use (:func:`alias_of`): a name qualified by a
+  namespace is never another class's alias of its last part;
 * qualifiers and pointers: ``const``, ``&``, ``*``, ``typename``;
 * wrappers: ``std::shared_ptr<T>``, ``boost::shared_ptr<const T>``,
   ``std::unique_ptr<T>``, ``ros::MessageEvent<T const>``;
@@ -27,6 +29,7 @@ Sources: roscpp's message generator (``genpy``/``gencpp`` typedefs), rclcpp
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping, Sequence
 
 from rclverify.ros.extract.model import canon_type
 
@@ -69,6 +72,40 @@ def _after(text: str) -> str:
     return ""
 
 
+def _namespace_like(qualifier: str) -> bool:
+    """Whether ``qualifier`` (what precedes a name's last ``::``) names a
+    namespace rather than a class: its last part is lower-case (ROS packages
+    and the ``msg``/``srv``/``action`` namespaces of generated interfaces are,
+    by REP 144 and the ROS 2 C++ style; classes are CamelCase)."""
+    last = qualifier.split("::")[-1].split("<")[0]
+    return not last or last[0].islower() or last[0] == "_"
+
+
+def alias_of(text: str, aliases: Mapping[str, str], scopes: Sequence[str] = ()) -> str | None:
+    """What the ``using``/``typedef`` alias written ``text`` stands for, looked up
+    as C++ does (ISO C++ [basic.lookup]): a bare name in ``scopes`` (qualified
+    class or namespace names, innermost first) and then among the aliases
+    whose bare name is unique in the program; a qualified name by its
+    qualification (``ns::Cls::Alias``, or a unique key ending so); a name
+    qualified by a namespace (``other_msgs::srv::Charge``) is never another
+    class's alias of its last part.  ``aliases`` holds bare names and
+    scope-qualified ones (:mod:`sources_cpp`).  ``None``: no alias."""
+    if "::" not in text:
+        for sc in scopes:
+            hit = aliases.get(f"{sc}::{text}")
+            if hit is not None:
+                return hit
+        return aliases.get(text)
+    hit = aliases.get(text)
+    if hit is not None:
+        return hit
+    ends = {v for k, v in aliases.items() if k.endswith("::" + text)}
+    if len(ends) == 1:
+        return next(iter(ends))
+    qual, last = text.rsplit("::", 1)
+    return None if _namespace_like(qual) or ends else aliases.get(last)
+
+
 def plain(text: str | None, aliases: dict[str, str] | None = None) -> str | None:
     """The C++ type ``text`` as the ROS type's qualified name (``pkg::msg::T``), or
     ``None`` when empty: aliases followed, qualifiers, pointer wrappers and
@@ -79,7 +116,7 @@ def plain(text: str | None, aliases: dict[str, str] | None = None) -> str | None
     s = " ".join(_QUALS.sub(" ", text).split())
     for _ in range(8):
         s = s.replace(" ", "")
-        hit = aliases.get(s) or aliases.get(s.split("::")[-1])
+        hit = alias_of(s, aliases)
         if hit is not None and hit != s:
             s = " ".join(_QUALS.sub(" ", hit).split()).replace(" ", "")
             continue

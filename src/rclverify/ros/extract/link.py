@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from rclverify.ros.extract import emit, names, plugins, symbols
-from rclverify.ros.extract.cpp_types import split_template
+from rclverify.ros.extract.cpp_types import alias_of, split_template
 from rclverify.ros.extract.model import Endpoint, Note, Src
 from rclverify.ros.extract.link_members import LinkMembers
 from rclverify.ros.extract.link_returns import Returns
@@ -103,6 +103,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
         """The program's files' records merged (a header read by several
         files counted once); returns the units its entry files define."""
         entry_units: set[str] = set()
+        bare_twice: set[str] = set()
         for r in self.recs.values():  # a header read by several files: its definitions once
             self.fn_tparams.update(r.get("fn_tparams", {}))
             self.call_targs += [tuple(c) for c in r.get("call_targs", []) if tuple(c) not in self.call_targs]
@@ -130,11 +131,15 @@ class Linker(LinkMembers, Values, Returns, Instances):
             for k, v in r.get("callbacks", {}).items():
                 self.callbacks.setdefault(k, v)
             for k, v in r.get("aliases", {}).items():
+                if "::" not in k and self.aliases.get(k, v) != v:
+                    bare_twice.add(k)  # two files give one bare name two texts: read only in its scope
                 self.aliases.setdefault(k, v)
             for c in r.get("calls", []):
                 self.calls.append(tuple(c) + (({},) if len(c) == 6 else ()))
             if r.get("lang") == "py":
                 entry_units.add(f"{f}::<module>")  # a module's code runs when it is imported
+        for k in bare_twice:
+            self.aliases.pop(k, None)
         return entry_units
 
     def _link_calls(self, prog: Program) -> None:
@@ -186,7 +191,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
             return None
         cands = [u for u in self.classes if u == t or u.endswith("::" + t)]
         for _ in range(4):  # using Filter = ns::FilterNode<Ekf>; make_shared<Filter>(...), or ns::Filter
-            alias = self.aliases.get(t) or self.aliases.get(t.split("::")[-1])
+            alias = alias_of(t, self.aliases, self.scopes(caller)) or alias_of(t.split("::")[-1], self.aliases)
             if cands or alias is None:
                 break
             t = split_template(alias.replace(" ", ""))[0].strip(":")
@@ -282,6 +287,17 @@ class Linker(LinkMembers, Values, Returns, Instances):
             if got is not None:
                 return got
         return None
+
+    def scopes(self, unit: str | None) -> list[str]:
+        """The scopes a name written in class ``unit`` is looked up in, innermost
+        first: the class, its base classes of the program, then its enclosing
+        classes and namespaces (``a::B`` -> ``a::B``, bases, ``a``)."""
+        if not unit:
+            return []
+        out = [unit] + [b for b in (self.match(x, None) for x in self.units.get(unit, {}).get("bases", [])) if b]
+        parts = unit.split("::")
+        out += ["::".join(parts[:i]) for i in range(len(parts) - 1, 0, -1)]
+        return list(dict.fromkeys(out))
 
     def _ctor(self, cls: str) -> str:
         return f"{cls}::{cls.split('::')[-1]}"
@@ -455,7 +471,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
         # a template's own parameter (ActionT) names no alias of another class ([temp.local]):
         # its type is read per instantiation below, never through the program's aliases
         own = isinstance(cb, tuple) and cb[:1] == ("type",) and is_template_param(cb[1], e.unit, e.func, self)
-        t = e.msg_type if e.msg_type is not None else None if own else self.cb_type(e.kind, cb)
+        t = e.msg_type if e.msg_type is not None else None if own else self.cb_type(e.kind, cb, e.unit)
         types: list[str | None] = [t]
         ambiguous = False
         if t is None and isinstance(cb, tuple) and cb[:1] == ("type",):  # a template's type parameter

@@ -19,7 +19,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Callable
 
 from rclverify.ros.extract import cpp_helpers, symbols
-from rclverify.ros.extract.cpp_types import action_type, action_type_in, message_type, service_type, split_template
+from rclverify.ros.extract.cpp_types import (action_type, action_type_in, alias_of, message_type, service_type,
+                                             split_template)
 from rclverify.ros.extract.model import Endpoint
 
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
@@ -43,16 +44,22 @@ class LinkMembers:
         def match(self, name: str, caller: str | None) -> str | None:
             ...
 
-    def cb_type(self, kind: str, cb: Any) -> str | None:
+        def scopes(self, unit: str | None) -> list[str]:
+            ...
+
+    def cb_type(self, kind: str, cb: Any, unit: str | None = None) -> str | None:
         """The type a callback (C++: its name; Python: ``("cands", types)`` of a star
-        import) gives an endpoint of role ``kind``."""
+        import) or a type text (``("type", text)``) gives an endpoint of role
+        ``kind``; an alias in the text is read in the scopes of class ``unit``
+        (:func:`~.cpp_types.alias_of`), never another class's of the same name."""
         if isinstance(cb, tuple) and cb and cb[0] == "cands":
             known = [t for t in cb[1] if self.known(t)]
             return known[0] if len(known) == 1 else None
         if isinstance(cb, tuple) and cb and cb[0] == "type":
             text: str | None = cb[1]
+            scopes = self.scopes(unit)
             for _ in range(4):
-                text = self.aliases.get(text or "", self.aliases.get((text or "").split("::")[-1], text))
+                text = alias_of(text or "", self.aliases, scopes) or text
         elif isinstance(cb, str):
             text = self.callbacks.get(cb)
             if text is None:  # written with another qualification than declared

@@ -23,7 +23,7 @@ import dataclasses
 from typing import TYPE_CHECKING, Any, Callable
 
 from rclverify.ros.extract import emit
-from rclverify.ros.extract.cpp_types import split_template
+from rclverify.ros.extract.cpp_types import alias_of, split_template
 from rclverify.ros.extract.model import Endpoint, Note
 
 #: instantiations read per endpoint at most (bounded work)
@@ -56,7 +56,7 @@ class Instances:
         def resolve(self, e: Endpoint, note: Callable[[Note], None]) -> list[Endpoint]:
             ...
 
-        def cb_type(self, kind: str, cb: Any) -> str | None:
+        def cb_type(self, kind: str, cb: Any, unit: str | None = None) -> str | None:
             ...
 
         def template_types(self, unit: str | None, param: str, depth: int = 0) -> list[str]:
@@ -115,7 +115,7 @@ class Instances:
                 return
         text = callee.replace(" ", "").split("->")[-1].split(".")[-1]
         for _ in range(4):  # a using alias of an instantiation: using Filter = FilterNode<Ekf>
-            alias = self.aliases.get(text) or self.aliases.get(split_template(text)[0].split("::")[-1])
+            alias = alias_of(text, self.aliases) or alias_of(split_template(text)[0], self.aliases)
             if alias is None or "<" in text:
                 break
             text = alias.replace(" ", "")

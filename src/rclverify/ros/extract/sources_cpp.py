@@ -71,6 +71,7 @@ class _File(CallReader, MemberReader):
         root = treesitter.parser("cpp").parse(data).root_node
         self.nodes = list(treesitter.walk(root))
         self.aliases: dict[str, str] = adapters
+        self._bare: dict[str, set[str]] = {}  # an alias's bare name -> the texts the file gives it
         for n in self.nodes:
             self._index(n)
         self.scope = CppValues(self.nodes)
@@ -99,17 +100,33 @@ class _File(CallReader, MemberReader):
                 for key in {written, "::".join(cls + [written]), written.split("::")[-1]}:
                     self.out["callbacks"].setdefault(key, ty)
         elif t == "alias_declaration":
-            self.aliases[_T(n.child_by_field_name("name"))] = _T(n.child_by_field_name("type"))
+            self._alias(n, _T(n.child_by_field_name("name")), _T(n.child_by_field_name("type")))
         elif t == "type_definition":
             for d in n.children_by_field_name("declarator"):
-                self.aliases[_T(d)] = _T(n.child_by_field_name("type"))
+                self._alias(n, _T(d), _T(n.child_by_field_name("type")))
         elif t == "using_declaration" and not any(c.type == "namespace" for c in n.children) and n.named_children:
             full = _T(n.named_children[-1])
-            self.aliases[full.split("::")[-1]] = full
+            self._alias(n, full.split("::")[-1], full)
         elif t == "preproc_include":
             p = n.child_by_field_name("path")
             if p is not None:
                 self.out["includes"].append(_T(p).strip('"<>'))
+
+    def _alias(self, n: Any, name: str, text: str) -> None:
+        """Alias ``name`` of ``text`` declared at syntax node ``n``: kept under its
+        scope-qualified name (``ns::Cls::name``) and, while one text is all the
+        file gives it, under its bare name too; a bare name two scopes give
+        different texts is left out (each scope's stays: :func:`~.cpp_types.alias_of`
+        reads it in the scope of its use, never one scope's for the other's)."""
+        nss, cls = namespaces_of(n)
+        if nss or cls:
+            self.aliases["::".join(nss + cls + [name])] = text
+        seen = self._bare.setdefault(name, set())
+        seen.add(text)
+        if len(seen) == 1:
+            self.aliases[name] = text
+        else:
+            self.aliases.pop(name, None)
 
     def msg(self, text: str | None) -> str | None:
         t = message_type(text, self.aliases)

@@ -14,6 +14,9 @@ rover_core::CallbackReturn DockServer::on_configure(const rclcpp_lifecycle::Stat
   dock_server_ = node->create_action_server<Dock>("dock", [] {});
   undock_server_ = node->create_action_server<Undock>(
     "undock", [] {});
+  battery_sub_ = create_subscription<Charge>("battery", 1, [](Charge::ConstSharedPtr) {});
+  charger_ = std::make_unique<ChargerClient>(this);
+  lamp_ = std::make_unique<LampClient>(this);
   return rover_core::CallbackReturn::SUCCESS;
 }
 
