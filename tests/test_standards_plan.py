@@ -84,3 +84,28 @@ def test_strict_is_true_or_false(tmp_path: Path) -> None:
     assert plain.strict is False
     with pytest.raises(PlanError, match="'strict' is true or false"):
         read_standards(tmp_path, {"standards": [{"profile": "ul4600", "strict": "yes"}]}, {}, "plan.yaml")
+
+
+# --- what the plan says of a clause: a narrowed scope with its reason, a justification -------------
+
+def test_a_clause_note_is_read(tmp_path: Path) -> None:
+    plan = _load(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 2\n    clauses:\n"
+                           "      B.8 6c: {nodes: [A], reason: only A is safety related, justification: reviewed by QA team}\n")
+    note = plan.standards[0].clauses["B.8 6c"]  # type: ignore[attr-defined]
+    assert (note.nodes, note.reason, note.justification, note.at) == (
+        ("A",), "only A is safety related", "reviewed by QA team", "contracts/plan.yaml:7:7")
+
+
+def test_a_clause_the_profile_lacks_is_located(tmp_path: Path) -> None:
+    msg = _error(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 2\n    clauses:\n"
+                           "      A.7 3: {justification: modelling is done by hand}\n")
+    assert msg.startswith("contracts/plan.yaml:7:7: error:") and "'A.7 3' is not a clause of profile" in msg
+
+
+def test_narrowing_needs_a_reason(tmp_path: Path) -> None:
+    msg = _error(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 2\n    clauses:\n"
+                           "      B.8 6c: {nodes: [A]}\n")
+    assert msg.startswith("contracts/plan.yaml:7:23: error:") and "needs a 'reason' of at least three words" in msg
+    msg = _error(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 2\n    clauses:\n"
+                           "      B.8 6c: {nodes: [A], reason: fine, scope: all}\n")
+    assert msg.startswith("contracts/plan.yaml:7:42: error:") and "'scope' is not a key here" in msg

@@ -138,7 +138,7 @@ def test_the_bundle_carries_the_mapping_and_the_own_profile(ws: Path, tmp_path: 
     iec = manifest["standards"][0]
     assert iec["profile"] == "iec61508-3" and iec["level"] == "2"
     assert iec["clauses"]["B.2 1"] == {"status": "covered", "recommendation": "HR",
-                                       "why": "all 1 item in scope covered",
+                                       "why": "all 1 item in scope covered", "plan": None,
                                        "evidence": ["Gain.g1.property_tests.e0"],
                                        "covered_by": ["Gain.g1.property_tests.e0"]}
     assert iec["origin"]["kind"] == "built-in"

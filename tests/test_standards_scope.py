@@ -315,3 +315,24 @@ def test_the_standards_typeddicts_are_the_schema() -> None:
             "standard.clauses.why: only in the TypedDict"]
     finally:
         SCHEMA["$defs"]["standard_clause"]["properties"]["why"] = kept
+
+
+# --- the plan narrows a clause's scope, with its reason shown ------------------------------------
+
+def test_a_scope_the_plan_narrows_says_so() -> None:
+    from rclverify.model.plan.standards.choice import ClauseNote
+    r = _warehouse().review("Base", 1, "Ada", "Charles")
+    note = ClauseNote(("Base",), "only Base stops the robot", "the review covers the stop path", "plan.yaml:9:7")
+    clause = {c["id"]: c for c in clause_rows(load_builtin("iec61508-3"), "2", r.dict(), {"B.8 6c": note})}["B.8 6c"]
+    assert clause["status"] == "covered" and [x["item"] for x in clause["scope"]] == ["Base g1"]
+    assert clause["why"] == "all 1 item in scope covered; scope narrowed by the plan to Base (only Base stops the robot)"
+    assert clause["plan"] == {"nodes": ["Base"], "reason": "only Base stops the robot",
+                              "justification": "the review covers the stop path", "at": "plan.yaml:9:7"}
+    # control: without the note the same review leaves the clause partial, and a justification alone narrows nothing
+    assert _clause("iec61508-3", "2", "B.8 6c", r)["status"] == "partial"
+    just = ClauseNote(None, "", "the review covers the stop path", "plan.yaml:9:7")
+    assert clause_rows(load_builtin("iec61508-3"), "2", r.dict(), {"B.8 6c": just})[-1]["status"] == "partial"
+    # a node the workspace lacks is an item never covered
+    ghost = ClauseNote(("Bsae",), "only Base stops the robot", "", "plan.yaml:9:7")
+    clause = clause_rows(load_builtin("iec61508-3"), "2", r.dict(), {"B.8 6c": ghost})[-1]
+    assert clause["status"] == "open" and clause["scope"][0]["item"] == "node Bsae"

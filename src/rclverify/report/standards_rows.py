@@ -93,7 +93,7 @@ def standards_part(choices: Sequence[StandardChoice],
     problems: list[str] = []
     ok = True
     for c in choices:
-        clauses = clause_rows(c.profile, c.level, report)
+        clauses = clause_rows(c.profile, c.level, report, c.clauses)
         missing = not_covered(clauses)
         row: StandardRow = {
             "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,

@@ -251,11 +251,13 @@ def _standard_brief(row: Mapping[str, Any]) -> dict[str, Any]:
     """A report ``standards[]`` row as the manifest carries it: the profile,
     where it comes from (``origin``: built-in with its edition, or the
     workspace file with its sha256), its level, and each clause's status,
-    recommendation, why, the evidence in its scope and what covers it."""
+    recommendation, why, what the plan says of it, the evidence in its scope
+    and what covers it."""
     return {"profile": str(row["profile"]), "edition": str(row["edition"]), "level": row.get("level"),
             "origin": dict(row.get("origin") or {}),
             "clauses": {str(c["id"]): {"status": str(c["status"]), "recommendation": str(c["recommendation"]),
                                        "why": str(c.get("why", "")),
+                                       "plan": c.get("plan"),
                                        "evidence": sorted({str(e["obligation"]) for e in c["evidence"]}),
                                        "covered_by": [str(x) for x in c.get("covered_by") or ()]}
                         for c in row["clauses"]},

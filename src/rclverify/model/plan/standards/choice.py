@@ -1,17 +1,22 @@
 """The plan's ``standards:`` entries: which profiles the evidence is mapped onto, at which level.
 
-An entry is ``{profile: NAME, <level key>: LEVEL, strict: BOOL}``: ``NAME`` a built-in
+An entry is ``{profile: NAME, <level key>: LEVEL, strict: BOOL, clauses: {...}}``: ``NAME`` a built-in
 profile (:func:`.profiles.builtin_names`) or a workspace-relative YAML file of
 the same shape (``*.yaml``/``*.yml``); the level key is the profile's
 ``level_name`` (``sil``, ``dal``, ``pl``) or ``level``, absent for a profile
 without levels; ``strict: true`` makes ``--strict`` fail while an item
 recommended HR at that level is not covered (default ``false``: the items
-are shown, and named in the summary, without failing it).  Every mistake is one located
+are shown, and named in the summary, without failing it).  ``clauses`` maps a
+clause id of the profile to what the plan says of it: ``nodes`` (the nodes
+whose guarantees are in its scope, narrowing it) with the ``reason`` for
+narrowing it, and a ``justification`` (why the evidence suffices, or why the
+clause does not apply) shown in the compliance matrix; neither makes a
+clause covered by itself.  Every mistake is one located
 :class:`~rclverify.model.plan.errors.PlanError` in the plan (docs/standards.md).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -21,14 +26,31 @@ from rclverify.model.plan.yamlguard import KEY, Path_
 from rclverify.model.plan.standards.profiles import Profile, builtin_names, load_builtin, load_profile_file
 
 
+#: The keys of a clause's entry under ``clauses:``.
+CLAUSE_KEYS: tuple[str, ...] = ("nodes", "reason", "justification")
+
+
+@dataclass(frozen=True)
+class ClauseNote:
+    """What the plan says of one clause: ``nodes`` the nodes its scope is narrowed to (``None``: not
+    narrowed) and the ``reason``, ``justification`` shown beside it (``""``: none), written at ``at``
+    (``file:line:col``)."""
+    nodes: tuple[str, ...] | None
+    reason: str
+    justification: str
+    at: str
+
+
 @dataclass(frozen=True)
 class StandardChoice:
     """A profile chosen by the plan at ``level`` (``None``: the profile has no levels), written at ``loc``;
-    ``strict``: ``--strict`` requires its highly recommended items covered."""
+    ``strict``: ``--strict`` requires the items it asks covered; ``clauses``: clause id -> what the plan
+    says of it."""
     profile: Profile
     level: str | None
     loc: ast.Loc
     strict: bool = False
+    clauses: Mapping[str, ClauseNote] = field(default_factory=dict)
 
 
 def _profile(root: Path, name: str, at: ast.Loc) -> Profile:
@@ -51,7 +73,7 @@ def _level(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Path
 
     allowed = {p.level_name, "level"} if p.levels else set()
     for key in entry:
-        if key not in ("profile", "strict") and key not in allowed:
+        if key not in ("profile", "strict", "clauses") and key not in allowed:
             l = at(key)
             say = f"its level key is {p.level_name!r} ({', '.join(p.levels)})" if p.levels else "it has no levels"
             raise plan_error(l.file, l.line, l.col, f"standards: {key!r} is not a key of profile {p.id!r}: {say}",
@@ -75,13 +97,65 @@ def _level(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Path
     return value
 
 
+def _words(value: Any, n: int) -> bool:
+    return isinstance(value, str) and len(value.split()) >= n
+
+
+def _clauses(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Path_, ast.Loc],
+             file: str) -> dict[str, ClauseNote]:
+    """The entry's ``clauses:`` read and checked: each id one of the profile's, each key one of
+    :data:`CLAUSE_KEYS`, ``nodes`` a non-empty list of names given with a ``reason`` of at least three
+    words, a ``justification`` of at least three words."""
+    def at(*path: Any) -> ast.Loc:
+        full = base + ("clauses",) + path
+        while full not in locs and len(full) > len(base):
+            full = full[:-1]
+        return locs.get(full, locs.get(base, ast.Loc(file, 1, 1)))
+
+    def bad(l: ast.Loc, message: str) -> PlanError:
+        return plan_error(l.file, l.line, l.col, f"standards: {message}", "E-profile")
+
+    given = entry.get("clauses")
+    if given is None:
+        return {}
+    if not isinstance(given, dict):
+        raise bad(at(), "'clauses' maps a clause id of the profile to {nodes, reason, justification}")
+    ids = [i.id for i in p.items]
+    out: dict[str, ClauseNote] = {}
+    for cid, note in given.items():
+        cid = str(cid)
+        if cid not in ids:
+            raise bad(at(cid, KEY), f"{cid!r} is not a clause of profile {p.id!r}; its clauses are {', '.join(ids)}")
+        if not isinstance(note, dict) or not note:
+            raise bad(at(cid), f"clause {cid!r}: write {{nodes: [...], reason: ..., justification: ...}}")
+        for key in note:
+            if key not in CLAUSE_KEYS:
+                raise bad(at(cid, key, KEY), f"clause {cid!r}: {key!r} is not a key here; the keys are "
+                          f"{', '.join(CLAUSE_KEYS)}")
+        nodes = note.get("nodes")
+        if nodes is not None and not (isinstance(nodes, list) and nodes and all(isinstance(n, str) for n in nodes)):
+            raise bad(at(cid, "nodes"), f"clause {cid!r}: 'nodes' is a non-empty list of node names")
+        if nodes is not None and not _words(note.get("reason"), 3):
+            raise bad(at(cid, "reason") if "reason" in note else at(cid, "nodes"),
+                      f"clause {cid!r}: narrowing its scope needs a 'reason' of at least three words, shown with it")
+        if "reason" in note and nodes is None:
+            raise bad(at(cid, "reason"), f"clause {cid!r}: a 'reason' goes with 'nodes' (the scope it narrows)")
+        if "justification" in note and not _words(note.get("justification"), 3):
+            raise bad(at(cid, "justification"), f"clause {cid!r}: a 'justification' is at least three words")
+        l = at(cid, KEY)
+        out[cid] = ClauseNote(None if nodes is None else tuple(nodes), str(note.get("reason") or ""),
+                              str(note.get("justification") or ""), f"{l.file}:{l.line}:{l.col}")
+    return out
+
+
 def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast.Loc],
                    file: str) -> tuple[StandardChoice, ...]:
     """The plan's ``standards:`` (``data``: the schema-checked plan data,
     ``locs``: its locations, ``file``: the plan's name) as
     :class:`StandardChoice` values, in order.  Raises :class:`PlanError`
     for an unknown profile (naming the profiles there are), a bad profile
-    file, a missing or unknown level, or a profile chosen twice."""
+    file, a missing or unknown level, a profile chosen twice, or a bad
+    ``clauses:`` entry (:func:`_clauses`)."""
     out: list[StandardChoice] = []
     for i, entry in enumerate(data.get("standards") or []):
         base: Path_ = ("standards", i)
@@ -90,8 +164,8 @@ def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast
         if any(c.profile.id == p.id for c in out):
             raise plan_error(at.file, at.line, at.col, f"standards: profile {p.id!r} is chosen twice", "E-profile")
         out.append(StandardChoice(p, _level(p, entry, base, locs, file), locs.get(base, at),
-                                  bool(entry.get("strict", False))))
+                                  bool(entry.get("strict", False)), _clauses(p, entry, base, locs, file)))
     return tuple(out)
 
 
-__all__ = ["PlanError", "StandardChoice", "read_standards"]
+__all__ = ["CLAUSE_KEYS", "ClauseNote", "PlanError", "StandardChoice", "read_standards"]

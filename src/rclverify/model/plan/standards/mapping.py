@@ -43,7 +43,7 @@ assessor, not a compliance claim.
 from __future__ import annotations
 
 from collections import Counter
-from typing import Any, Iterable, Literal, Mapping, Sequence, TypedDict, cast, get_args
+from typing import Any, Callable, Iterable, Literal, Mapping, Sequence, TypedDict, cast, get_args
 
 from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
 from rclverify.records.report_schema import EvidenceRow
@@ -115,6 +115,15 @@ class ScopeItem(TypedDict):
     evidence: list[str]
 
 
+class PlanNote(TypedDict):
+    """What the plan says of a clause (``standards[].clauses:``): ``nodes`` the nodes its scope is
+    narrowed to (``None``: not narrowed) with the ``reason``, a ``justification``, where it is written."""
+    nodes: list[str] | None
+    reason: str
+    justification: str
+    at: str
+
+
 class ClauseRow(TypedDict):
     """One clause of a profile at the chosen level: what it asks (``title``), its scope and the evidence
     in it, what covers its covered items (``covered_by``: obligations, side conditions, requirement
@@ -133,6 +142,7 @@ class ClauseRow(TypedDict):
     checked_by: list[str]
     status: ClauseStatus
     why: str
+    plan: PlanNote | None
 
 
 def kinds_of(row: Mapping[str, Any]) -> set[str]:
@@ -294,18 +304,37 @@ def _targets(report: Mapping[str, Any], origins: tuple[str, ...], experiments: b
     return out
 
 
-def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _Index | None = None) -> list[ScopeItem]:
+def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _Index | None = None,
+                narrowed: Sequence[str] | None = None) -> list[ScopeItem]:
     """The items of ``report`` (a report dict, or the parts of it it has) in the scope of the profile
-    ``item`` at ``level``, each with its state (the module docstring).  Pure; raises nothing for a
-    well-formed report."""
+    ``item`` at ``level``, each with its state (the module docstring).  ``narrowed``: the nodes the plan
+    narrows the scope to (their guarantees, their side conditions, the requirements they support; a
+    node the workspace does not have is an item never covered), ``None`` for every item.  Pure;
+    raises nothing for a well-formed report."""
     ix = ix or _Index(report)
     accepts, asked = set(item.evidence), item.independence_at(level)
+    keep = None if narrowed is None else set(narrowed)
 
     def guarantees(nodes: set[str] | None = None) -> list[ScopeItem]:
-        return [_guarantee_item(ix, n, k, st, accepts, asked) for n, k, st in ix.guarantees if nodes is None or n in nodes]
+        return [_guarantee_item(ix, n, k, st, accepts, asked) for n, k, st in ix.guarantees
+                if (nodes is None or n in nodes) and (keep is None or n in keep)]
 
-    scs = [_side_condition_item(sc) for sc in report.get("side_conditions") or ()]
-    reqs = [_requirement_item(rq, ix, accepts, asked) for rq in report.get("requirements") or ()]
+    scs = [_side_condition_item(sc) for sc in report.get("side_conditions") or ()
+           if keep is None or str(sc.get("node")) in keep]
+    reqs = [_requirement_item(rq, ix, accepts, asked) for rq in report.get("requirements") or ()
+            if keep is None or any(str(x.get("node")) in keep for x in rq.get("support") or ())]
+    known = {n for n, _, _ in ix.guarantees}
+    unknown = [_item(f"node {n}", "guarantee", "no evidence", "the plan names this node; the workspace has no such "
+                     "node", []) for n in sorted(keep or ()) if n not in known]
+    return unknown + _scope(item, report, ix, guarantees, scs, reqs, keep)
+
+
+def _scope(item: Item, report: Mapping[str, Any], ix: _Index, guarantees: Callable[..., list[ScopeItem]],
+           scs: list[ScopeItem], reqs: list[ScopeItem], keep: set[str] | None) -> list[ScopeItem]:
+    """The scope of ``item`` by its ``about`` (:func:`scope_items`); ``keep`` the nodes it is narrowed to."""
+    def kept(node: object) -> bool:
+        return keep is None or str(node) in keep
+
     if item.about == "guarantees":
         return guarantees()
     if item.about == "interfaces":
@@ -315,18 +344,19 @@ def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _I
     if item.about == "requirements":
         supporting = {str(s["node"]) for rq in report.get("requirements") or () for s in rq.get("support") or ()}
         return reqs + guarantees(supporting)
-    if item.about == "field-data":
-        return _targets(report, ("operation",), experiments=False)
-    if item.about == "trials":
-        return _targets(report, ("operation", "simulation"), experiments=True)
+    if item.about in ("field-data", "trials"):
+        targets = _targets(report, ("operation",) if item.about == "field-data" else ("operation", "simulation"),
+                           experiments=item.about == "trials")
+        return [t for t in targets if kept(t["item"].removeprefix("target ").split(".")[0])
+                or t["item"].startswith("target of requirement")]
     # system: everything, the health checks and the workspace's own status
     health = [_item(f"health check {f.get('id')}", "health check", str(f.get("status")),
                     f"health check {f.get('check')}: {f.get('status')}", []) for f in report.get("findings") or ()
-              if str(f.get("status")) not in _HEALTH_OK]
+              if str(f.get("status")) not in _HEALTH_OK and kept(f.get("node"))]
     known = {(n, k) for n, k, _ in ix.guarantees}
     unverified = [_item(f"{u.get('node')} g{u.get('guarantee')}", "guarantee", "unverified",
                         "no obligation covers the guarantee", []) for u in report.get("unverified") or ()
-                  if (str(u.get("node")), int(u.get("guarantee") or 0)) not in known]
+                  if (str(u.get("node")), int(u.get("guarantee") or 0)) not in known and kept(u.get("node"))]
     status = str((report.get("summary") or {}).get("status", "pending"))
     whole = [] if status == "discharged" else [_item("workspace", "workspace", status,
                                                      f"the workspace's status is {status}", [])]
@@ -389,20 +419,25 @@ def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], i
     return f"{status}: {done} of {n} in scope covered; {head}{extra}"
 
 
-def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceRow]) -> list[ClauseRow]:
+def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceRow],
+                notes: Mapping[str, Any] | None = None) -> list[ClauseRow]:
     """The clause rows of ``profile`` at ``level`` (``None`` for a profile
     without levels) over ``report`` (a report dict: its ``evidence``,
     ``obligations``, ``nodes``, ``side_conditions``, ``requirements``,
     ``findings``, ``unverified``, ``system`` and ``summary`` as far as it
     has them; a bare list of evidence rows reads as a report of those rows
-    alone), in the profile's order.  Pure: reads nothing else, raises
+    alone), in the profile's order.  ``notes``: clause id -> what the plan
+    says of it (a :class:`~rclverify.model.plan.standards.choice.ClauseNote`:
+    ``nodes``, ``reason``, ``justification``, ``at``): the scope narrowed to
+    those nodes, and the note shown.  Pure: reads nothing else, raises
     nothing for well-formed rows."""
     rep: Mapping[str, Any] = report if isinstance(report, Mapping) else {"evidence": list(report)}
     ix = _Index(rep)
     out: list[ClauseRow] = []
     for item in profile.items:
         code = item.at(level)
-        scope = scope_items(item, level, rep, ix)
+        note = (notes or {}).get(item.id)
+        scope = scope_items(item, level, rep, ix, None if note is None else note.nodes)
         evidence = _evidence_in_scope(item, level, scope, ix)
         done = sum(1 for s in scope if s["covered"])
         status: ClauseStatus
@@ -422,7 +457,12 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
                     "evidence": evidence, "scope": scope,
                     "covered_by": list(dict.fromkeys(ob for x in scope if x["covered"] for ob in x["evidence"])),
                     "checked_by": _checked_by(scope, ix),
-                    "status": status, "why": _why(status, scope, evidence, item, code, level)})
+                    "status": status, "why": _why(status, scope, evidence, item, code, level)
+                    + ("" if note is None or note.nodes is None else
+                       f"; scope narrowed by the plan to {', '.join(note.nodes)} ({note.reason})"),
+                    "plan": None if note is None else {"nodes": None if note.nodes is None else list(note.nodes),
+                                                       "reason": note.reason, "justification": note.justification,
+                                                       "at": note.at}})
     return out
 
 
@@ -433,4 +473,4 @@ def not_covered(rows: Sequence[ClauseRow], codes: Sequence[str] = ASKED) -> list
 
 
 __all__ = ["About", "CLAUSE_STATUSES", "ClauseRow", "ClauseStatus", "Independence", "Recommendation", "ScopeKind", "SUPPORTS", "ScopeItem", "Support", "clause_rows", "independence_of",
-           "kinds_of", "not_covered", "review_identity", "scope_items"]
+           "kinds_of", "not_covered", "PlanNote", "review_identity", "scope_items"]
