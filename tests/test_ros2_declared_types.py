@@ -221,9 +221,9 @@ def test_the_publisher_s_service_is_asked_and_a_forged_answer_refused(tmp_path: 
     real node's answer hashes to its type hash and is accepted; a node serving a description with
     ``variance`` as a float64 is refused by the hash check."""
     env = ros2_env(tmp_path)
-    share = Path(own["from"].rsplit("(", 1)[1].rstrip(")"))
+    described = Path(own["from"].rsplit("(", 1)[1].rstrip(")"))  # rosidl's Range.json, which the forger alters
     ranger = start_node(tmp_path, "ranger", SPINNER, env)
-    forger = start_node(tmp_path, "forger", FORGER.replace("sys.argv[1]", repr(str(share))), env)
+    forger = start_node(tmp_path, "forger", FORGER.replace("sys.argv[1]", repr(str(described))), env)
     try:
         script = tmp_path / "ask.py"
         script.write_text(ASK)
@@ -380,3 +380,43 @@ def test_the_bus_reads_a_checked_declaration_and_says_what_to_do_without_one(
     assert "did not answer within 5 s" in line and "from a forger hashes to RIHS01_" in line, line
     assert line.endswith("its messages are not heard; give the robot's definition as DIR/sensor_msgs/msg/Range.msg "
                          "with --interfaces DIR (or the mapping's msg_dirs)"), line
+
+
+def test_the_agent_asks_the_node_when_its_own_description_is_another(tmp_path: Path, own: Any,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """A publisher's hash that the ROS 2 Python's own description does not have (a robot of another
+    distribution): the agent asks the node's type description service, and the bus checks the answer.
+    rcl's service of a real node answers that it has no such type; the forger's description, for any
+    hash, is refused by the hash check; the line of each gives every reason, source by source."""
+    from rclverify.runtime.rclpy_source.bus import RclpyBus
+    env = ros2_env(tmp_path)
+    for k, v in env.items():
+        monkeypatch.setenv(k, v)
+    described = Path(own["from"].rsplit("(", 1)[1].rstrip(")"))  # rosidl's Range.json, which the forger alters
+    nodes = [start_node(tmp_path, "ranger", SPINNER, env),
+             start_node(tmp_path, "forger", FORGER.replace("sys.argv[1]", repr(str(described))), env)]
+    other = "RIHS01_" + "ab" * 32  # a Range of another distribution
+    said: list[str] = []
+    bus = RclpyBus(ros2_python(), lambda *a: None, said.append)
+    try:
+        bus.start()
+        for node in ("ranger", "forger"):
+            bus._send({"op": "describe", "type": "sensor_msgs/msg/Range", "hash": other, "node": node, "ns": "/"})
+            bus._asking.add(("sensor_msgs/msg/Range", other))
+            until = time.monotonic() + 30
+            while ("sensor_msgs/msg/Range", other) in bus._asking and time.monotonic() < until:
+                time.sleep(0.05)
+            assert bus._declared[("sensor_msgs/msg/Range", other)] is None
+            why = bus._why[("sensor_msgs/msg/Range", other)]
+            assert f"this ROS 2 Python's sensor_msgs ({described}) has the type hash {own['hash']}" in why, why
+            if node == "ranger":
+                assert "the type description service /ranger/get_type_description answered: Type not currently in use " \
+                    "by this node" in why, why
+            else:
+                assert "from the type description service /forger/get_type_description hashes to RIHS01_" in why, why
+                assert f"not to the publisher's {other}: not used" in why, why
+            del bus._declared[("sensor_msgs/msg/Range", other)]
+    finally:
+        bus.stop()
+        for p in nodes:
+            stop(p)
