@@ -12,6 +12,7 @@ the event of its link's part.  Real parser, real Z3, the real pipeline.
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -198,3 +199,40 @@ def test_the_record_of_a_run_follows_its_declarations(tmp_path: Path, decl: str,
     ev = json.loads((ws / "artifacts/evidence/Guard.g0.monitors.run_jsonl.json").read_text())
     assert ev["status"] == status and words in ev["explanation"], ev["explanation"]
     assert ev["details"]["monitoring"]["counts"]["satisfied"] >= 29
+
+
+ROBOT = Path(__file__).resolve().parents[1] / "examples" / "ros2_robot"
+
+
+def test_the_recorded_robot_run_judges_progress_on_topics_and_calls(tmp_path: Path, capsys: Any) -> None:
+    """The ros2_robot example's live log (rclpy nodes over Fast DDS), its contracts given a ``progress`` each
+    on a copy: the scan guard's (its ranges read in a quantifier's domain), the e-stop's (a service) and the
+    dock's (an action) are judged on the log (before: pending, no input event, beside 6, 3 and 11
+    satisfied answers).  The control: the bag of the same run carries the calls as ROS 2 records them,
+    which the declarations do not read: pending there, with the reason, never discharged."""
+    ws = tmp_path / "robot"
+    shutil.copytree(ROBOT / "contracts", ws / "contracts")
+    shutil.copytree(ROBOT / "runs", ws / "runs")
+    shutil.copytree(ROBOT / "interfaces", ws / "interfaces")
+    rcl = ws / "contracts/robot.rcl"
+    text = rcl.read_text()
+    for end, decl in (("triggered by in.ranges within 100 ms\n}", "progress( within 0 steps )"),
+                      ("triggered by in.engage within 200 ms\n}", "progress( within 0 steps )"),
+                      ("out.final <= 0.05 )\n}", "progress( eventually )")):
+        assert end in text
+        text = text.replace(end, end[:-1] + f"  {decl}\n}}")
+    rcl.write_text(text)
+
+    def judged(trace: str) -> dict[str, dict[str, Any]]:
+        main(["monitor", "-w", str(ws), "--mapping", "contracts/mapping.yaml", "--json", str(ws / trace)])
+        return {e["node"]: e for e in json.loads(capsys.readouterr().out) if "declarations" in e}
+    log = judged("runs/robot.jsonl")
+    for node, text_ in (("ScanGuard", "progress( within 0 steps )"), ("EStop", "progress( within 0 steps )"),
+                        ("Dock", "progress( eventually )")):
+        [row] = log[node]["declarations"]
+        assert (row["text"], row["verdict"], log[node]["status"]) == (text_, "true", "discharged"), row["reason"]
+    bag = judged("runs/robot")
+    assert bag["ScanGuard"]["status"] == "discharged"
+    [row] = bag["EStop"]["declarations"]
+    assert (row["verdict"], bag["EStop"]["status"]) == ("pending", "pending")
+    assert "no input event of in.engage was read" in row["reason"]
