@@ -274,9 +274,9 @@ class HoareBackend:
             if res.notes:
                 details["notes"] = list(res.notes)
             if res.failed.vc.id.startswith("defined"):
-                return evidence("failed", f"{p.config.program} does not meet the triple: it is not defined on this "
-                                f"run, {res.failed.vc.label} does not hold (verification condition "
-                                f"{res.failed.vc.id}): {_cex_text(res.counterexample or {})}", log=log,
+                return evidence("failed", f"{p.config.program} does not meet the triple: a division by zero on this "
+                                f"run ({res.failed.vc.label}; verification condition {res.failed.vc.id}): "
+                                f"{_cex_text(res.counterexample or {})}", log=log,
                                 artifacts=tuple(artifacts), counterexample=res.counterexample, details=details)
             return evidence("failed", f"{p.config.program} does not meet the triple: the postcondition "
                             f"{details['triple']['post']} fails on this run (verification condition "
