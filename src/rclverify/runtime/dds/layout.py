@@ -21,7 +21,9 @@ DDS discovery tells a publisher's type name; for the layout, two sources:
   participant ignores, :data:`rclverify.ros.live.dds.COMPATIBILITY`): compared
   with the hash of the contract's type as rosbags computes it from the
   same definitions.  A hash does not say which field differs: the warning
-  says the definitions differ and gives both hashes.
+  says the definitions differ, gives both hashes, and what to do (the
+  robot's ``.msg`` with ``--interfaces``, or the rclpy source, which reads
+  the publisher's own definition).
 
 A publisher that announces neither (ROS 2 Humble, plain DDS) is taken at
 its type name, as ROS 2's middlewares take each other.
@@ -126,8 +128,12 @@ class LayoutJudge:
         mine = self._hashes[struct]
         if theirs is None or mine is None or theirs == mine:
             return SAME, ""
+        from rclverify.ros.live.dds import ros_type  # deferred: as announced_type_hash above
+        pkg, _, name = (ros_type(getattr(struct, "__idl_typename__", "")) or "pkg/msg/T").partition("/msg/")
         return OTHER, (f"its ROS 2 type hash {theirs[:19]}... differs from the contract's type's {mine[:19]}... "
-                       "(REP-2011; the definitions differ: fields, their types or names)")
+                       "(REP-2011; the definitions differ: fields, their types or names): give the robot's "
+                       f"definition as DIR/{pkg}/msg/{name}.msg with --interfaces DIR, or hear it with --source rclpy, "
+                       "which reads the publisher's own definition")
 
     def _by_type_object(self, struct: type, type_id: Any) -> tuple[str, str]:
         try:
