@@ -420,3 +420,29 @@ def test_the_agent_asks_the_node_when_its_own_description_is_another(tmp_path: P
         bus.stop()
         for p in nodes:
             stop(p)
+
+
+def test_the_dds_source_says_what_to_do(tmp_path: Path) -> None:
+    """The DDS source does not ask for the publisher's definition: the publisher is refused, and the one
+    warning gives both hashes and what to do (the robot's .msg with --interfaces, or the rclpy source)."""
+    ros2_python()  # skips, with the reason, without a ROS 2 Python
+    ws = tmp_path / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/r.rcl").write_text(RCL)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/r.rcl]\n")
+    (ws / "mapping.yaml").write_text("topics:\n  range: {fields: [variance]}\n")
+    env = ros2_env(tmp_path)
+    publisher = start_node(tmp_path, "ranger", SPINNER.replace('"unheard"', '"range"'), env)
+    try:
+        monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml", "--status",
+                             "0", "--duration", "6", "--source", "dds", "--evidence", str(tmp_path / "live.json")],
+                            env, tmp_path, tmp_path / "monitor.out")
+        monitor.wait(120)
+    finally:
+        stop(publisher)
+    warnings = json.loads((tmp_path / "live.json").read_text())["warnings"]
+    (line,) = [w for w in warnings if ": warning: range:" in w]
+    assert "publishes sensor_msgs::msg::dds_::Range_ with another layout than the contract's type: its ROS 2 type " \
+        "hash RIHS01_b42b" in line, line
+    assert "give the robot's definition as DIR/sensor_msgs/msg/Range.msg with --interfaces DIR, or hear it with " \
+        "--source rclpy, which reads the publisher's own definition; its messages are not heard" in line, line
