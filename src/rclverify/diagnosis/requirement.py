@@ -335,8 +335,8 @@ def _run_record(q: RequirementRow, check: Mapping[str, Any], row: Mapping[str, A
           if proof in ("proved", "met") else f" Over the composed contracts: {proof}." if proof else "")
     sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by the recorded "
                 f"run {row.get('trace')} at {at}: {v.get('reason', '')}"
-                + (f". {seen[0].upper()}{seen[1:]}" if seen else "") + f" ({v.get('steps')} steps of the system "
-                f"in the run, docs/semantics.md \"Steps\").{z3}")
+                + (f". {seen[0].upper()}{seen[1:]}" if seen else "") + " (a step of the run is a step of the "
+                f"composed system, as in the proof: docs/semantics.md, \"Steps\").{z3}")
     return {"id": str(q["id"]), "kind": "requirement", "node": "", "status": "failed", "sentence": sentence,
             "culprits": [], "counterexample": table, "repairs": [], "guarantee": None, "related": []}
 
