@@ -155,13 +155,13 @@ requirements:
 """
 
 
-def _requirement(tmp_path: Path, low: int) -> dict[str, Any]:
+def _requirement(tmp_path: Path, low: int, temporal: str = "") -> dict[str, Any]:
     from rclverify.app.pipeline import Workspace
     from rclverify.calculus.requirements import own_nodes
     from rclverify.semantics import world
     (tmp_path / "contracts").mkdir()
     (tmp_path / "contracts/divider.rcl").write_text(REQ_RCL.format(low=low))
-    (tmp_path / "contracts/plan.yaml").write_text(REQ_PLAN)
+    (tmp_path / "contracts/plan.yaml").write_text(REQ_PLAN.replace('formal: "', f'formal: "{temporal}'))
     w = Workspace(tmp_path)
     (req,) = w.plan.requirements
     world.fresh()
@@ -308,3 +308,10 @@ def test_definedness_conditions_agree_with_brute_force_enumeration() -> None:
 
     one()
     assert all(n >= 5 for n in seen.values()), seen  # the corpus exercised each kind of answer
+
+
+@pytest.mark.parametrize("low, verdict", [(0, "refuted"), (1, "proved")])
+def test_temporal_requirement_holds_only_where_its_state_formula_is_defined(tmp_path: Path, low: int,
+                                                                            verdict: str) -> None:
+    rec = _requirement(tmp_path, low, "always ")
+    assert rec["verdict"] == verdict, rec

@@ -71,6 +71,7 @@ from rclverify.calculus.requirements.initial_needed import initially_not_needed
 from rclverify.calculus.requirements.exercised import NON_VACUOUS, vacuity
 from rclverify.calculus.requirements.progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
 from rclverify.calculus.requirements.transition import ComposedSystem, build_system, variable_types
+from rclverify.semantics.definedness import guarded
 from rclverify.semantics.encode import Encoder
 from rclverify.lang.types import FuncT
 from rclverify.semantics import wallclock
@@ -351,8 +352,11 @@ class _System:
         self.points = max([points_for(q.plan.instances.get(n)) for n in q.cone] or [points_for(None)])
 
     def raw(self, f: Formal) -> Callable[[Any], Any]:
+        """``f`` in a state; a statement's formula counts only where it is defined (its definedness
+        conditions with it, docs/semantics.md, "Definedness"), an ``assuming`` formula as written."""
         enc, sys = self.enc, self.sys
-        return lambda s: enc.formula(f.expr, f.scope, sys.statement_symbols(s))
+        expr = f.expr if any(f is a for a in self.q.assuming) else guarded(f.expr)
+        return lambda s: enc.formula(expr, f.scope, sys.statement_symbols(s))
 
     def pred(self, f: Formal) -> Callable[[Any], Any]:  # must hold: only where its values are published
         raw = self.raw(f)
