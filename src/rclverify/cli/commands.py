@@ -37,7 +37,7 @@ import sys
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from rclverify.cli import bundle, calculus, contracts, explain, requirements, runs, verify, workspace
+from rclverify.cli import bundle, calculus, contracts, explain, requirements, runs, standards, verify, workspace
 from rclverify.cli.common import AddCommand, print_diags
 from rclverify.core.extras import MissingExtra
 from rclverify.lang.errors import RclError
@@ -64,6 +64,7 @@ COMMANDS: tuple[Callable[[AddCommand], None], ...] = (
     contracts.add_check, contracts.add_latex_fmt, calculus.add_graph_to_export, verify.add_report,
     requirements.add_requirements_deadlines, workspace.add_cache, explain.add_status_explain, verify.add_verify,
     workspace.add_init, bundle.add_bundle, workspace.add_review, calculus.add_quotient_refines,
+    standards.add_standards,
 )
 #: The commands with subcommands of their own (``ros``, ``generate``), and ``lsp``: each adds to the subparsers.
 SUBCOMMAND_GROUPS: tuple[Callable[[Any], None], ...] = (_ros, _generate, _lsp)

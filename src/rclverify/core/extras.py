@@ -19,7 +19,7 @@ EXTRA_OF: dict[str, str] = {
     "numpy": "fast", "rosbags": "ros", "catkin_pkg": "ros", "lxml": "ros", "tree_sitter": "ros", "tree_sitter_cpp": "ros",
     "tree_sitter_python": "ros", "cyclonedds": "ros2", "matplotlib": "plots", "scipy": "stats",
     "dask": "cluster", "distributed": "cluster", "doorstop": "doorstop", "cryptography": "sign",
-    "pygls": "lsp", "lsprotocol": "lsp",
+    "pygls": "lsp", "lsprotocol": "lsp", "openpyxl": "xlsx",
 }
 
 
