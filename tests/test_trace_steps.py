@@ -176,3 +176,28 @@ def test_the_bound_the_proof_refutes_is_refuted_on_the_run(verified: Any) -> Non
     assert req["check"]["temporal"]["status"] == "refuted"
     [row] = req["check"]["traces"]
     assert row["verdict"]["verdict"] == "false" and row["verdict"]["step"] == 1, row["verdict"]
+
+
+def test_a_live_logs_calls_are_steps_of_a_temporal_requirement() -> None:
+    """The ros2_robot example's live log carries the e-stop's calls as call lines: each request and its
+    response are one step, read with the link's mapping (before: no message on EStop's topics, nothing
+    checked).  The control: a statement the answers break is false at the first engaged answer."""
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.backends.monitors.temporal_trace import check_temporal_trace
+    from rclverify.model.plan.formal import Source
+    from rclverify.model.plan.temporal import parse_temporal
+    from rclverify.traces import read_trace
+    robot = Path(__file__).resolve().parents[1] / "examples" / "ros2_robot"
+    c = check([parse_text((robot / "contracts/robot.rcl").read_text(), "robot.rcl")])
+    cfg = load_mapping(robot, "contracts/mapping.yaml")
+
+    def verdict(formal: str) -> Any:
+        t = parse_temporal(Source(formal, 1, 1, "plan.yaml"), c, "T", {})
+        return check_temporal_trace(t, c, (), read_trace(robot / "runs/robot.jsonl"), cfg.rules)
+    ok = verdict("always EStop.out.engaged == EStop.in.engage")
+    assert ok.verdict == "true" and ok.steps == 3, ok.reason  # three calls, each request and response one step
+    bad = verdict("always not EStop.out.engaged")
+    assert (bad.verdict, bad.step, bad.witness[0]["values"]) == ("false", 0, {"EStop.out.engaged": "TRUE"}), bad
+    line = json.loads((robot / "runs/robot.jsonl").read_text().splitlines()[int(bad.where.rsplit(":", 1)[1]) - 1])
+    assert (line["topic"], line["link"], line["part"], line["fields"]["success"]) == (
+        "rclverify/call", "estop", "response", True)

@@ -193,7 +193,7 @@ class DeclarationMonitor:
         a request, response, goal, feedback or result of a link) is the
         event of its link's part, as the message on the link's topic is."""
         if ev.topic.strip("/") == CALL_LOG_TOPIC:
-            call = _call_part(ev)
+            call = call_part(ev)
             if call is None:
                 return
             ev, part_fields = call
@@ -388,7 +388,7 @@ def _inputs_read(formulas: Iterable[ast.Expr], node: CheckedNode) -> set[str]:
 _CALL_PARTS = frozenset(p for parts in LINK_TOPICS.values() for p in parts)
 
 
-def _call_part(ev: Event) -> tuple[Event, Mapping[str, Any]] | None:
+def call_part(ev: Event) -> tuple[Event, Mapping[str, Any]] | None:
     """A live log's call line (``{"kind": "call", "link", "part", "fields"}``,
     :class:`~.dds_calls.CallBook`) as the event of its link's part on topic
     ``link/part``, with the part's fields; ``None`` for a line that carries

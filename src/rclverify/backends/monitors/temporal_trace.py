@@ -72,6 +72,8 @@ from rclverify.model.plan.formal import Formal
 from rclverify.model.plan.state import StateVar, state_type
 from rclverify.model.plan.temporal import Temporal, shape
 from rclverify.backends.monitors.response_trace import ResponseTracker
+from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
+from rclverify.backends.monitors.declarations import call_part
 from rclverify.backends.monitors.trace_states import StepClock, TraceStates, cone_of
 from rclverify.lang.types import Checked
 from rclverify.traces.events import Event
@@ -302,6 +304,12 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     step = _STEPS[kind]
     now = -1  # the step the messages read so far end in
     for ev in events:
+        part: Mapping[str, Any] | None = None
+        if ev.topic.strip("/") == CALL_LOG_TOPIC:  # a live log's call line: the event of its link's part
+            call = call_part(ev)
+            if call is None:
+                continue
+            ev, part = call
         got = clock.tick(ev)
         if got is None:
             continue
@@ -314,7 +322,7 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
             r.last = moved or r.last  # the step's place: the last message whose values are current in it
             now += 1
         now = k
-        if st.feed(ev, later) or r.last is None:
+        if st.feed(ev, later, part) or r.last is None:
             r.last = ev
     if now >= 0:
         verdict = _close(r, step, now)

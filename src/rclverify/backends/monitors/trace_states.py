@@ -28,6 +28,7 @@ from rclverify.traces.mapping import MappingError, TopicRule, initial_value, map
 from rclverify.semantics.values import FiniteFunction
 from rclverify.semantics import wallclock
 from rclverify.backends.monitors.deadlines import topic_bindings
+from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 #: :func:`solve_value`'s answer when a value the formula reads is not observed yet.
 MISSING = object()
@@ -288,18 +289,22 @@ class TraceStates:
                  rules: Mapping[str, TopicRule]) -> None:
         self.checked, self.rules = checked, rules
         self.nodes = list(nodes)
-        self.topics: dict[str, list[tuple[str, str, Type]]] = {}  # topic -> [(node, "in.x", type)]
+        #: topic -> [(node, "in.x", type, part)]: ``part`` the action message part that carries it (``""``: the
+        #: whole message); a link's parts are on ``link/request`` ... ``link/result``, as a live log's call lines
+        self.topics: dict[str, list[tuple[str, str, Type, str]]] = {}
         self.io: dict[str, dict[str, object]] = {n: {} for n in self.nodes}
         for n in self.nodes:
             cn = checked.nodes[n]
-            for t in cn.node.topics:
-                typ = cn.io_type(t.match) if t.match is not None else None
-                if typ is None or t.match is None:
+            bound = [(t.field.lstrip("/"), t.match, "") for t in cn.node.topics if t.match is not None]
+            bound += [(f"{lk.name.strip('/')}/{suffix}", v, suffix if lk.kind == "action" else "")
+                      for lk in cn.node.links for suffix, v in zip(LINK_TOPICS[lk.kind], lk.parts)]
+            for topic, var, part in bound:
+                typ = cn.io_type(var)
+                if typ is None:
                     continue
-                inp = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in cn.inputs)
-                key = ("in." if inp else "out.") + t.match.name
-                topic = t.field.lstrip("/")
-                self.topics.setdefault(topic, []).append((n, key, typ))
+                inp = var.prefix == "in" or (var.prefix is None and var.name in cn.inputs)
+                key = ("in." if inp else "out.") + var.name
+                self.topics.setdefault(topic, []).append((n, key, typ, part))
                 self.io[n][key] = initial_value(typ, rule_for(rules, topic, key))
         self.vars = [sv for sv in states if sv.node in self.nodes]
         self.formulas = {(sv.node, sv.name): (parse_state_formula(sv, "init", checked, states),
@@ -321,19 +326,23 @@ class TraceStates:
         out.update({f"state.{v}": x for (m, v), x in self.state.items() if m == n and x is not None})
         return out
 
-    def feed(self, ev: Event, later: Iterable[str] = ()) -> bool:
+    def feed(self, ev: Event, later: Iterable[str] = (), part_fields: Mapping[str, Any] | None = None) -> bool:
         """Apply one event: its values are the state's now, but an input of
-        a node of ``later`` is read from the next step on (:meth:`advance`).
-        Returns whether a value of the state changed now (on a topic of the
-        nodes, not all of it read from the next step on)."""
+        a node of ``later`` is read from the next step on (:meth:`advance`);
+        ``part_fields`` a call line's fields (the link part's own).  Returns
+        whether a value of the state changed now (on a topic of the nodes,
+        not all of it read from the next step on)."""
         vs = self.topics.get(ev.topic.lstrip("/"))
         if not vs:
             return False
         now = False
-        for n, key, typ in vs:
+        for n, key, typ, part in vs:
             p, _, name = key.partition(".")
+            fields = part_fields if part_fields is not None else ev.fields.get(part) if part else ev.fields
+            if not isinstance(fields, Mapping):
+                continue  # an action message without this part
             try:
-                value: object = map_value(typ, ev.fields, rule_for(self.rules, ev.topic, key), self.io[n].get(key))
+                value: object = map_value(typ, fields, rule_for(self.rules, ev.topic, key), self.io[n].get(key))
                 bad = None
             except MappingError as exc:
                 value, bad = None, f"{ev.where}: {n}.{key}: {exc}"
