@@ -11,7 +11,11 @@ each path that reads widths: the monitors' and the property tests' judge
 (:func:`rclverify.semantics.floatsem.judge` on the contract as
 :func:`rclverify.backends.monitors.widths.at_carried_widths` reads it),
 and the exact and double readings alone.  The control: the same forms read
-without the widths disagree with the oracle next to the threshold.
+without the widths disagree with the oracle next to the threshold.  End to
+end, the monitor of a recorded bag and the property tests find a node's
+``<``-for-``<=`` slip at the carried threshold in each form and pass the
+correct node; the plain ``x <= 0.2`` is the control there (it was read at
+the width before the other forms were).
 """
 from __future__ import annotations
 
@@ -91,3 +95,87 @@ def test_without_the_widths_the_forms_disagree_with_float32_next_to_the_threshol
     wrong = [f for (f, strict), cl in zip(FORMS, node.node.guarantees) if not strict
              and judge(cl.formula, checked, node, {"in.p": p}).truth is not True]
     assert len(wrong) == sum(1 for _, strict in FORMS if not strict), wrong
+
+
+# ---------------------------------------------------------------------------
+# end to end: the monitor of a recorded run and the property tests, each form
+# ---------------------------------------------------------------------------
+
+#: the forms of "at or below the threshold 0.2" the end-to-end runs read, over the value ``{x}``
+LOW_FORMS = ("{x} <= Low", "{x} - 0.2 <= 0", "-{x} >= -0.2", "abs({x}) <= 0.2", "{x} <= 0.1 + 0.1", "{x} <= 0.2")
+
+GAUGE = """
+context { Low : REAL = 0.2 ; }
+node Gauge {
+  inputs( p : REAL )
+  outputs( low : BOOL )
+  topics( std_msgs/Float32 battery matches(in.p), std_msgs/Bool low matches(out.low) )
+  assume( TRUE )
+  guarantee( out.low <=> FORM )
+}
+"""
+
+
+def _gauge_bag(path: Path, value: float, low: bool) -> Path:
+    from rosbags.rosbag2 import Writer
+
+    from rclverify.traces.bag import typestore
+    store = typestore([])
+    with Writer(path, version=9) as w:
+        c1 = w.add_connection("/battery", "std_msgs/msg/Float32", typestore=store)
+        c2 = w.add_connection("/low", "std_msgs/msg/Bool", typestore=store)
+        w.write(c1, 1_000_000_000, store.serialize_cdr(store.types["std_msgs/msg/Float32"](data=value),
+                                                       "std_msgs/msg/Float32"))
+        w.write(c2, 1_010_000_000, store.serialize_cdr(store.types["std_msgs/msg/Bool"](data=low), "std_msgs/msg/Bool"))
+    return path
+
+
+@pytest.mark.parametrize("form", LOW_FORMS)
+def test_the_monitor_finds_the_slip_in_every_form(tmp_path: Path, form: str) -> None:
+    """A bag carrying 0.2 as a Float32 (0.2000000030): the correct node (`<=` at the width) says low and
+    is satisfied, the `<` slip says not low and is violated, whatever form the contract writes."""
+    from rclverify.cli.commands import main
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "c.rcl").write_text(GAUGE.replace("FORM", form.format(x="in.p")))
+    (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
+    (tmp_path / "mapping.yaml").write_text("topics:\n  battery: {fields: [data]}\n  low: {fields: [data]}\n")
+    args = ["monitor", "-w", str(tmp_path), "--mapping", "mapping.yaml", "--horizon", "1"]
+    assert main([*args, str(_gauge_bag(tmp_path / "correct", 0.2, True))]) == 0
+    assert main([*args, str(_gauge_bag(tmp_path / "slip", 0.2, False))]) == 1
+
+
+BATTERY = """
+context { Low : REAL = 0.2 ; }
+node Battery {
+  inputs( level : REAL )
+  outputs( p : REAL, low : BOOL )
+  topics( std_msgs/Float64 level matches(in.level), std_msgs/Float32 battery matches(out.p),
+          std_msgs/Bool low matches(out.low) )
+  assume( 0 <= in.level and in.level <= 1 )
+  guarantee( out.low <=> FORM )
+}
+"""
+CORRECT = ("import struct\n\ndef battery(level):\n    p = struct.unpack('<f', struct.pack('<f', level))[0]\n"
+           "    return {'p': p, 'low': p <= struct.unpack('<f', struct.pack('<f', 0.2))[0]}\n")
+
+
+def _property_run(tmp: Path, form: str, code: str) -> object:
+    from rclverify.backends.property_tests.config import read_config
+    from rclverify.backends.property_tests.harness import run_guarantee
+    tmp.mkdir()
+    (tmp / "impl.py").write_text(code)
+    (tmp / "backends" / "monitors").mkdir(parents=True)
+    (tmp / "backends" / "monitors" / "mapping.yaml").write_text("topics:\n  battery: {fields: [data]}\n")
+    checked = check([parse_text(BATTERY.replace("FORM", form.format(x="out.p")), "b.rcl")])
+    cn = checked.nodes["Battery"]
+    cfg = read_config({"implementation": "impl.py:battery", "max_examples": 200}, cn, tmp)
+    return run_guarantee(checked, cn, 1, cfg, tmp)
+
+
+@pytest.mark.parametrize("form", LOW_FORMS)
+def test_the_property_tests_find_the_slip_in_every_form(tmp_path: Path, form: str) -> None:
+    """The implementation decides at the field's width: `<=` is correct and discharged, `<` the slip,
+    found on the carried 0.2, whatever form the contract writes."""
+    assert getattr(_property_run(tmp_path / "correct", form, CORRECT), "status") == "discharged"
+    out = _property_run(tmp_path / "slip", form, CORRECT.replace("p <= struct", "p < struct"))
+    assert getattr(out, "status") == "failed", getattr(out, "message")
