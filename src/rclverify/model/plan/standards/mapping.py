@@ -20,22 +20,28 @@ its *scope* is the items of the report that concern it (:func:`scope_items`):
 * ``trials``: every target decided over runs or trials (a run set of
   origin ``operation`` or ``simulation``, an experiment's per-trial data).
 
+The plan may narrow a clause's scope to named nodes (:func:`clause_rows`'s
+``notes``; the reason is shown in the clause's ``why``).
+
 A guarantee in scope is covered when its own status is ``discharged``, it
 has evidence of a kind the clause accepts, all of that evidence is
 discharged, and no health check of it failed or is outstanding; a side
 condition when Z3 proved it; a requirement when its verdict is ``met``,
-its deadline is not left undecided or refuted and its statistical targets
-are met (its check is ``proof`` evidence of its own); a target when it
+its deadline is not left undecided or refuted, its statistical targets
+are met and, unless the clause accepts ``proof`` (which its check is), a
+supporting guarantee has discharged evidence of an accepted kind; a target when it
 is met; the workspace when its status is ``discharged``.  A run of
 ``origin: harness`` never counts; a review counts for a clause that asks
 independence only when the record names its author and its reviewer, they
 differ, and its stated independence is at least the clause's
-(:func:`review_identity`).
+(:func:`independence_of`).
 
 A clause is ``covered`` when its scope is not empty and every item in it
 is covered, ``partial`` when some but not all are, ``not covered`` when
-none is and some evidence of an accepted kind is there, ``open`` when no
-evidence of an accepted kind is in scope at all, and ``not recommended``
+none is and evidence of an accepted kind that counts, or an item with a
+check of its own (a side condition, requirement, target, health check, the
+workspace), is in scope, ``open`` otherwise (no such evidence, or an empty
+scope), and ``not recommended``
 when the standard marks it ``NR`` at the level (shown, never read as met).
 Each clause row says why.  The mapping is a traceability aid for an
 assessor, not a compliance claim.
