@@ -372,7 +372,9 @@ def test_the_bus_reads_a_checked_declaration_and_says_what_to_do_without_one(
         assert any(": note: range: publishers of sensor_msgs/msg/Range" in s for s in said), said
         return
     assert got == [] and bus.taps[0].dropped == 1
-    (line,) = [s for s in said if s.startswith("contracts/r.rcl:4:11: warning: range:")]
+    forged, line = [s for s in said if s.startswith("contracts/r.rcl:4:11: warning: range:")]
+    assert forged.startswith("contracts/r.rcl:4:11: warning: range: the type description of sensor_msgs/msg/Range "
+                             "from a forger hashes to RIHS01_") and forged.endswith(": not used"), forged
     assert "\n" not in line
     assert line.startswith(f"contracts/r.rcl:4:11: warning: range: node /ranger (publisher {gid.hex()}) publishes "
                            f"sensor_msgs/msg/Range with the type hash {own['hash']}, the monitor's definition of it "

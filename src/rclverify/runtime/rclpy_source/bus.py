@@ -29,7 +29,8 @@ pipe (:mod:`.wire`):
   struct reads in that definition; the run says so in a located note.
   Its samples that arrive before the answer are held (at most
   :data:`HOLD_MAX` per publisher) and handed on, in order and with their
-  own stamps, once it comes.  When no description checks out, one located
+  own stamps, once it comes (after what other publishers' samples were
+  handed on meanwhile).  When no description checks out, one located
   warning says what was heard, what the monitor knows, why the publisher's
   own definition could not be had, and what to do (the robot's ``.msg``
   with ``--interfaces``); the publisher is never heard;
@@ -372,9 +373,11 @@ class RclpyBus:
             try:
                 decl = declare(key[0], key[1], cand.get("description", {}), str(cand.get("from", "the agent")))
                 break
-            except DdsTypeError as exc:
+            except DdsTypeError as exc:  # a stale or forged description: said where the contract names the type
                 why.append(str(exc))
-                self.warn(f"warning: {exc}")
+                for t in self.taps:
+                    if ros_type(t.struct) == key[0]:
+                        self.warn(f"{t.where}: warning: {t.key}: {exc}")
         self._declared[key] = decl
         self._why[key] = "; ".join(why) or "nothing answered"
         for t in self.taps:  # refused: each such publisher said at once (the warning of _admit), not at its sample
