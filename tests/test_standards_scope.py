@@ -336,3 +336,25 @@ def test_a_scope_the_plan_narrows_says_so() -> None:
     ghost = ClauseNote(("Bsae",), "only Base stops the robot", "", "plan.yaml:9:7")
     clause = clause_rows(load_builtin("iec61508-3"), "2", r.dict(), {"B.8 6c": ghost})[-1]
     assert clause["status"] == "open" and clause["scope"][0]["item"] == "node Bsae"
+
+
+# --- the first attempt end to end in the standards part: --strict at SIL 2 with strict: true ------
+
+def test_a_self_review_does_not_make_strict_pass_and_independent_reviews_do() -> None:
+    """A repaired workspace (every guarantee tested, every side condition proved) at IEC 61508-3 SIL 2
+    chosen with strict: true: one self-review leaves --strict failing on the review and static analysis
+    items; the control, every guarantee reviewed by someone other than its author, passes."""
+    from rclverify.lang.ast import Loc
+    from rclverify.model.plan.standards.choice import StandardChoice
+    from rclverify.report.standards_rows import standards_part, strict_reason
+    choice = StandardChoice(load_builtin("iec61508-3"), "2", Loc("contracts/plan.yaml", 4, 5), strict=True)
+    r = _warehouse().review("Base", 1, "Ada", "Ada")
+    part = standards_part([choice], r.dict())
+    assert part["ok"] is False and part["rows"][0]["required_not_covered"] == ["A.9 3", "B.8 6c"]
+    assert strict_reason({"standards": part["rows"]}) == [
+        "IEC 61508-3:2010 SIL 2: highly recommended items not covered (A.9 3, B.8 6c)"]
+    r = _warehouse()
+    for n in ("Lidar", "Controller", "Base"):
+        r.review(n, 1, "Ada", "Charles")
+    part = standards_part([choice], r.dict())
+    assert part["ok"] is True and part["rows"][0]["required_not_covered"] == [] and part["problems"] == []
