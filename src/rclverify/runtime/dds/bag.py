@@ -15,9 +15,10 @@ publisher declared (:class:`~.types.Declared`), that definition
 (:func:`~.bag_types.declared_store`).  A topic's connection is made at its
 first message, in the definition that message is written in (one topic,
 one definition: a later message in another is not written, and counted in
-``failed``), and at the end for a topic that had none.  So ``rclverify monitor BAG`` checks exactly the messages the
-live run checked, at the same times, and gives the same verdicts
-(tests/test_monitor_live_dds.py).
+``failed``), and at the end for a topic that had none.  So ``rclverify
+monitor BAG`` checks exactly the messages the live run checked, at the same
+times, and gives the same verdicts (tests/test_monitor_live_dds.py,
+tests/test_ros2_declared_types.py).
 
 The linked services' and actions' calls go to the bag too, as ROS 2 records
 them (``<service>/_service_event`` ...), with the live call book's pairing
