@@ -201,3 +201,22 @@ def test_a_live_logs_calls_are_steps_of_a_temporal_requirement() -> None:
     line = json.loads((robot / "runs/robot.jsonl").read_text().splitlines()[int(bad.where.rsplit(":", 1)[1]) - 1])
     assert (line["topic"], line["link"], line["part"], line["fields"]["success"]) == (
         "rclverify/call", "estop", "response", True)
+
+
+def test_a_refuted_run_is_never_worded_as_a_run_of_no_state() -> None:
+    """A temporal record that kept no state names none (the sentence the run-refuted requirement used to
+    get: "a run of 0 states ... The state it repeats: ."); the control: one that kept its states names
+    them, a loop as the state it repeats, a run that stops by its last state."""
+    from rclverify.diagnosis.requirement import _temporal_record
+    q: Any = {"id": "R"}
+
+    def sentence(trace: list[Any], loop: Any) -> str:
+        check = {"formal": "eventually A.out.y", "source": "plan.yaml:1:1",
+                 "temporal": {"trace": trace, "loop": loop, "method": "bmc", "detail": "k = 3"}}
+        return str(_temporal_record(q, check, lambda: [])["sentence"])
+    empty = sentence([], None)
+    assert "0 states" not in empty and "The state it repeats" not in empty and "state: ." not in empty, empty
+    states = [{"nodes": [{"node": "A", "values": {"out.y": "false"}}]}] * 2
+    assert "a run of 2 states whose last returns to step 0" in sentence(states, 0)
+    assert "The state it repeats: A.out.y = false" in sentence(states, 0)
+    assert "Its last state: A.out.y = false" in sentence(states, None)

@@ -272,9 +272,9 @@ def _with_slips(rec: DiagnosisEntry, q: RequirementRow, check: Mapping[str, obje
                 slips: list[CulpritRow]) -> DiagnosisEntry:
     """``rec`` (a temporal record without a culprit) naming the guarantees of ``slips`` (:func:`_slips`)."""
     f = slips[0]
-    head = rec["sentence"].split(" The state it repeats: ")[0].split(" that meets every contract")[0]
-    state = rec["sentence"].split(" The state it repeats: ", 1)[1].split(". No guarantee")[0] \
-        if " The state it repeats: " in rec["sentence"] else ""
+    marker = next((m for m in (" The state it repeats: ", " Its last state: ") if m in rec["sentence"]), None)
+    head = (rec["sentence"].split(marker)[0] if marker else rec["sentence"]).split(" that meets every contract")[0]
+    state = rec["sentence"].split(marker, 1)[1].split(". No guarantee")[0] if marker else ""
     sentence = (f"{head}, because of guarantee {f['guarantee']} of {f['node']} ({f['source']}) `{f['text']}`: "
                 f"with `{f['old']}` as `{f['new']}` (off by one) Z3's temporal check proves {q['id']}"
                 + (f". The state: {state}" if state else "") + ".")
@@ -360,16 +360,18 @@ def _temporal_record(q: RequirementRow, check: Mapping[str, Any],
     table: list[CexRow] = [{"node": r["node"], "variable": v, "value": x, "table": None}
                            for r in shown.get("nodes", []) for v, x in r["values"].items()]
     run = (f"a run of {len(trace)} states whose last returns to step {loop} and repeats forever"
-           if loop is not None else f"a run of {len(trace)} states")
+           if loop is not None and trace else f"a run of {len(trace)} states" if trace else "a run")
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
+    # a state is named only when the check kept one (never "The state it repeats: .")
+    said = (f"The state it repeats: {cex}" if loop is not None else f"Its last state: {cex}") if cex else ""
     node, culprits, missing = liveness_culprits(t)
     if missing:
         sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by {run} in "
-                    f"which {missing}. The state it repeats: {cex} ({t.get('method')}; {t.get('detail')}).")
+                    f"which {missing}." + (f" {said}" if said else "") + f" ({t.get('method')}; {t.get('detail')}).")
     else:
         sentence = (f"Requirement {q['id']} (`{check.get('formal')}`, {check.get('source')}) is refuted by {run} that "
                     f"meets every contract of its cone ({t.get('method')}; {t.get('detail')}). "
-                    f"The state it repeats: {cex}. No guarantee of the cone prevents it: "
+                    + (f"{said}. " if said else "") + "No guarantee of the cone prevents it: "
                     "a guarantee that forces progress, or an assuming: that excludes the run, is needed.")
     fixes = repairs() if t.get("missing_progress") else []
     return {"id": str(q["id"]), "kind": "requirement", "node": node, "status": "failed", "sentence": sentence,
