@@ -52,7 +52,7 @@ LIVE = frozenset({
     "test_ros2_diff", "test_ros2_generated", "test_ros2_services_actions", "test_ros2_silence_deadlines",
     "test_ros2_declarations", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_ros2_calls_paired", "test_ros2_carried",
-    "test_ros2_bag_calls",
+    "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -96,7 +96,8 @@ WALL: dict[str, float] = {
     "test_services_live_ros1": 10.0, "test_ros2_silence_deadlines": 8.6, "test_ros_live": 6.7,
     "test_ros2_declarations": 25.4, "test_monitor_live_dds": 6.1, "test_lsp_hostile": 5.0,
     "test_ros_master_hostile": 5.0, "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
-    "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0,
+    "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0, "test_ros2_event_time": 40.0,
+    "test_example_manipulator": 25.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.

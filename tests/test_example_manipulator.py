@@ -1,0 +1,83 @@
+"""examples/manipulator live: sixteen real rclpy nodes on Fast DDS (a
+lifecycle battery, a service with introspection, an action, unstamped
+inputs answered within a millisecond, stamped inputs, an answer stamped at
+publish), with both cores kept busy by two CPU-burning processes
+(docs/semantics.md, "Event time").
+
+* the correct robot, heard through rclpy and recorded: every node's answers
+  judged, none violated, none undecided, both ``progress`` declarations
+  held, ``--strict`` exit 0; its log and its bag, checked offline, give
+  the same verdicts answer for answer;
+* the robot with all seven seeded defects, heard through the monitor's own
+  DDS participant: red at exactly the seven defects' nodes, and the two
+  correct nodes beside them green.
+
+bench/manipulator_live.py runs both many times (docs/scale.md)."""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+from _ros2 import ros2_env, ros2_python
+
+from rclverify.cli.commands import main
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "manipulator"
+sys.path.insert(0, str(EXAMPLE))
+from watch import node_status as _status, watch  # noqa: E402  (the example's own harness)
+
+NODES = ["ObstacleGuard", "Battery", "ChargeMonitor", "JointLimiter", "SpeedGovernor", "Docking", "Planner",
+         "EStop", "Arm"]
+#: seeded defect -> the node it makes red (examples/manipulator/robot.py)
+DEFECTS = {"guard_last_beam": "ObstacleGuard", "charge_lt": "ChargeMonitor", "limiter_first_five": "JointLimiter",
+           "governor_cap": "SpeedGovernor", "docking_threshold": "Docking", "estop_always": "EStop",
+           "arm_spoilt": "Arm"}
+
+
+@pytest.fixture(scope="module")
+def correct(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    tmp = tmp_path_factory.mktemp("manipulator-correct")
+    yield watch(tmp, ros2_python(), ros2_env(tmp), source="rclpy", record=True)
+
+
+@pytest.fixture(scope="module")
+def defective(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    tmp = tmp_path_factory.mktemp("manipulator-defects")
+    yield watch(tmp, ros2_python(), ros2_env(tmp), source="dds", defects="all")
+
+
+def test_the_correct_robot_is_green_live(correct: dict[str, Any]) -> None:
+    rec = correct["record"]
+    assert correct["code"] == 0, correct["out"]
+    assert _status(rec) == dict.fromkeys(NODES, "discharged"), correct["out"]
+    for n in rec["nodes"]:
+        c = n["counts"]
+        assert c.get("violated", 0) == 0 and c.get("inconclusive", 0) == 0, (n["node"], c)
+    assert {d["node"]: d["status"] for d in rec["declarations"]} == {"ObstacleGuard": "discharged",
+                                                                     "Planner": "discharged"}, rec["declarations"]
+    assert "estop [True, False, True, False, False, True] arm [2, 5, 8]" in correct["robot"], correct["robot"]
+
+
+def test_the_correct_robots_log_and_bag_give_its_verdicts(correct: dict[str, Any],
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    live = {n["node"]: n["counts"] for n in correct["record"]["nodes"]}
+    for trace in ("live.jsonl", "bag"):
+        capsys.readouterr()
+        code = main(["monitor", "-w", str(EXAMPLE), "--mapping", "contracts/mapping.yaml", "--json",
+                     *[a for n in NODES[:7] for a in ("--node", n)], str(correct["tmp"] / trace)])
+        got = {e["node"]: e["counts"] for e in json.loads(capsys.readouterr().out) if "counts" in e}
+        assert code == 0, got
+        for node in NODES[:7]:
+            assert got[node].get("violated", 0) == 0, (trace, node, got[node])
+            assert got[node].get("satisfied", 0) == live[node].get("satisfied", 0), (trace, node, got[node], live[node])
+
+
+def test_each_defect_is_red_at_its_own_node_only(defective: dict[str, Any]) -> None:
+    status = _status(defective["record"])
+    assert defective["code"] == 1, defective["out"]
+    red = {n for n, s in status.items() if s == "failed"}
+    assert red == set(DEFECTS.values()), status
+    assert status["Battery"] == status["Planner"] == "discharged", status
