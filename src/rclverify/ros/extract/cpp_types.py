@@ -81,7 +81,16 @@ def _namespace_like(qualifier: str) -> bool:
     return not last or last[0].islower() or last[0] == "_"
 
 
-def alias_of(text: str, aliases: Mapping[str, str], scopes: Sequence[str] = ()) -> str | None:
+def alias_index(aliases: Mapping[str, str]) -> dict[str, list[str]]:
+    """The keys of ``aliases`` by their last ``::`` part, for :func:`alias_of`."""
+    out: dict[str, list[str]] = {}
+    for k in aliases:
+        out.setdefault(k.rsplit("::", 1)[-1], []).append(k)
+    return out
+
+
+def alias_of(text: str, aliases: Mapping[str, str], scopes: Sequence[str] = (),
+             index: Mapping[str, list[str]] | None = None) -> str | None:
     """What the ``using``/``typedef`` alias written ``text`` stands for, looked up
     as C++ does (ISO C++ [basic.lookup]): a bare name in ``scopes`` (qualified
     class or namespace names, innermost first) and then among the aliases
@@ -89,7 +98,8 @@ def alias_of(text: str, aliases: Mapping[str, str], scopes: Sequence[str] = ()) 
     qualification (``ns::Cls::Alias``, or a unique key ending so); a name
     qualified by a namespace (``other_msgs::srv::Charge``) is never another
     class's alias of its last part.  ``aliases`` holds bare names and
-    scope-qualified ones (:mod:`sources_cpp`).  ``None``: no alias."""
+    scope-qualified ones (:mod:`sources_cpp`); ``index`` (:func:`alias_index`
+    of ``aliases``) spares a walk over every key.  ``None``: no alias."""
     if "::" not in text:
         for sc in scopes:
             hit = aliases.get(f"{sc}::{text}")
@@ -99,10 +109,13 @@ def alias_of(text: str, aliases: Mapping[str, str], scopes: Sequence[str] = ()) 
     hit = aliases.get(text)
     if hit is not None:
         return hit
-    ends = {v for k, v in aliases.items() if k.endswith("::" + text)}
+    qual, last = text.rsplit("::", 1)
+    if qual.rsplit("::", 1)[-1] in ("msg", "srv", "action"):
+        return None  # a generated interface's name (pkg::msg::T), never an alias
+    keys = index.get(last, ()) if index is not None else aliases
+    ends = {aliases[k] for k in keys if k.endswith("::" + text)}
     if len(ends) == 1:
         return next(iter(ends))
-    qual, last = text.rsplit("::", 1)
     return None if _namespace_like(qual) or ends else aliases.get(last)
 
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from rclverify.ros.extract import emit, names, plugins, symbols
-from rclverify.ros.extract.cpp_types import alias_of, split_template
+from rclverify.ros.extract.cpp_types import alias_index, alias_of, split_template
 from rclverify.ros.extract.model import Endpoint, Note, Src
 from rclverify.ros.extract.link_members import LinkMembers
 from rclverify.ros.extract.link_returns import Returns
@@ -85,6 +85,12 @@ class Linker(LinkMembers, Values, Returns, Instances):
         self.fn_tparams: dict[str, list[str]] = {}
         self.call_targs: list[tuple[str, str | None, str | None, int, list[str]]] = []
         entry_units = self._merge_records(prog)
+        self.alias_index = alias_index(self.aliases)
+        self._scopes: dict[str, list[str]] = {}
+        self._inherited: dict[tuple[str, str], str | None] = {}
+        self._by_meth: dict[str, set[str]] | None = None
+        self._by_last: dict[str, list[str]] | None = None  # classes by last name part
+        self._overs: dict[str, list[str]] | None = None  # function keys by key without '#N'
         self.py = bool(self.recs) and all(r.get("lang") == "py" for r in self.recs.values())
         self.classes = [] if self.py else sorted(self.units)
         self.entry = prog.units if prog.units is not None else entry_units
@@ -189,13 +195,16 @@ class Linker(LinkMembers, Values, Returns, Instances):
         t = split_template(name.replace("*", "").replace("&", "").strip())[0].strip(":")
         if not t:
             return None
-        cands = [u for u in self.classes if u == t or u.endswith("::" + t)]
+        cands = self._classes_named(t)
         for _ in range(4):  # using Filter = ns::FilterNode<Ekf>; make_shared<Filter>(...), or ns::Filter
-            alias = alias_of(t, self.aliases, self.scopes(caller)) or alias_of(t.split("::")[-1], self.aliases)
-            if cands or alias is None:
+            if cands:
+                break
+            alias = alias_of(t, self.aliases, self.scopes(caller), self.alias_index) or \
+                alias_of(t.split("::")[-1], self.aliases, (), self.alias_index)
+            if alias is None:
                 break
             t = split_template(alias.replace(" ", ""))[0].strip(":")
-            cands = [u for u in self.classes if u == t or u.endswith("::" + t)]
+            cands = self._classes_named(t)
         if not cands:
             return None
         if len(cands) > 1 and caller:
@@ -219,7 +228,11 @@ class Linker(LinkMembers, Values, Returns, Instances):
         ``nargs`` arguments may run: those whose parameters, less the defaulted ones,
         take that many; when several do (their argument types would decide), all of
         them; ``[ck]`` when none does or ``ck`` has no overload."""
-        over = [k for k in self.fns if k == ck or k.startswith(ck + "#")]
+        if self._overs is None:
+            self._overs = {}
+            for k in self.fns:
+                self._overs.setdefault(k.split("#")[0], []).append(k)
+        over = [k for k in self._overs.get(ck.split("#")[0], []) if k == ck or k.startswith(ck + "#")]
         if len(over) <= 1:
             return [ck]
         fit = [k for k in over if len(self.fns[k][1]) - self.optional.get(k, 0) <= nargs <= len(self.fns[k][1])]
@@ -260,8 +273,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
             cls = self.match(_held(ty), unit) if ty else None
             if ty is None and "->" not in recv and "." not in recv:  # a local (auto node = shared_from_this())
                 own = self.inherited(unit, meth)
-                if own is not None and not any(k.endswith("::" + meth) and v[0] != k and k != own
-                                               for k, v in self.fns.items()):
+                if own is not None and self.methods_named(meth) == {own}:
                     return own, self.fns[own][0]
             return (f"{cls}::{meth}", cls) if cls and f"{cls}::{meth}" in self.fns else (None, None)
         if unit and (own := self.inherited(unit, meth)) is not None:
@@ -272,6 +284,23 @@ class Linker(LinkMembers, Values, Returns, Instances):
         free = [k for k, v in self.fns.items() if v[0] == k and (k == meth or k.endswith("::" + meth))]
         return (free[0], free[0]) if len(free) == 1 else (None, None)
 
+    def _classes_named(self, t: str) -> list[str]:
+        """The program's classes named ``t`` or ending in ``::t``."""
+        if self._by_last is None:
+            self._by_last = {}
+            for u in self.classes:
+                self._by_last.setdefault(u.rsplit("::", 1)[-1], []).append(u)
+        return [u for u in self._by_last.get(t.rsplit("::", 1)[-1], []) if u == t or u.endswith("::" + t)]
+
+    def methods_named(self, meth: str) -> set[str]:
+        """The keys of the program's class methods (not free functions) named ``meth``."""
+        if self._by_meth is None:
+            self._by_meth = {}
+            for k, v in self.fns.items():
+                if v[0] != k and "::" in k:
+                    self._by_meth.setdefault(k.split("#")[0].rsplit("::", 1)[1], set()).add(k)
+        return self._by_meth.get(meth, set())
+
     def inherited(self, unit: str, meth: str, depth: int = 0) -> str | None:
         """The key of method ``meth`` as class ``unit`` has it: its own, else the
         nearest base class's of the program (a derived node calling its base's
@@ -279,14 +308,19 @@ class Linker(LinkMembers, Values, Returns, Instances):
         neither defines it."""
         if f"{unit}::{meth}" in self.fns:
             return f"{unit}::{meth}"
-        if depth > 8:
+        if depth > 8 or not self.methods_named(meth):
             return None
+        if (unit, meth) in self._inherited:
+            return self._inherited[(unit, meth)]
+        self._inherited[(unit, meth)] = None  # a cycle of bases finds nothing
+        got = None
         for b in self.units.get(unit, {}).get("bases", []):
             cls = self.match(b, unit)
             got = self.inherited(cls, meth, depth + 1) if cls is not None and cls != unit else None
             if got is not None:
-                return got
-        return None
+                break
+        self._inherited[(unit, meth)] = got
+        return got
 
     def scopes(self, unit: str | None) -> list[str]:
         """The scopes a name written in class ``unit`` is looked up in, innermost
@@ -294,10 +328,14 @@ class Linker(LinkMembers, Values, Returns, Instances):
         classes and namespaces (``a::B`` -> ``a::B``, bases, ``a``)."""
         if not unit:
             return []
+        if unit in self._scopes:
+            return self._scopes[unit]
+        self._scopes[unit] = [unit]  # while its bases are matched (a base named through an alias)
         out = [unit] + [b for b in (self.match(x, None) for x in self.units.get(unit, {}).get("bases", [])) if b]
         parts = unit.split("::")
         out += ["::".join(parts[:i]) for i in range(len(parts) - 1, 0, -1)]
-        return list(dict.fromkeys(out))
+        self._scopes[unit] = list(dict.fromkeys(out))
+        return self._scopes[unit]
 
     def _ctor(self, cls: str) -> str:
         return f"{cls}::{cls.split('::')[-1]}"

@@ -36,6 +36,7 @@ class LinkMembers:
     aliases: dict[str, str]
     known: Callable[[str], bool]
     using_ns: list[str]  # the program's ``using namespace`` directives
+    alias_index: dict[str, list[str]]  # the aliases' keys by last name part (cpp_types.alias_index)
 
     if TYPE_CHECKING:  # provided by the class that mixes this one in
         def runs(self, unit: str | None, fkey: str | None, reach: set[str] | None = None) -> bool:
@@ -59,7 +60,7 @@ class LinkMembers:
             text: str | None = cb[1]
             scopes = self.scopes(unit)
             for _ in range(4):
-                text = alias_of(text or "", self.aliases, scopes) or text
+                text = alias_of(text or "", self.aliases, scopes, self.alias_index) or text
         elif isinstance(cb, str):
             text = self.callbacks.get(cb)
             if text is None:  # written with another qualification than declared

@@ -37,6 +37,7 @@ class Instances:
     units: dict[str, dict[str, Any]]
     fn_tparams: dict[str, list[str]]
     aliases: dict[str, str]
+    alias_index: dict[str, list[str]]
     call_targs: list[tuple[str, str | None, str | None, int, list[str]]]
     _targ_seen: dict[tuple[str, str | None, str | None, int], int]
     sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]]
@@ -115,7 +116,8 @@ class Instances:
                 return
         text = callee.replace(" ", "").split("->")[-1].split(".")[-1]
         for _ in range(4):  # a using alias of an instantiation: using Filter = FilterNode<Ekf>
-            alias = alias_of(text, self.aliases) or alias_of(split_template(text)[0], self.aliases)
+            alias = alias_of(text, self.aliases, (), self.alias_index) or \
+                alias_of(split_template(text)[0], self.aliases, (), self.alias_index)
             if alias is None or "<" in text:
                 break
             text = alias.replace(" ", "")
