@@ -448,3 +448,32 @@ def test_the_dds_source_says_what_to_do(tmp_path: Path) -> None:
         "hash RIHS01_b42b" in line, line
     assert "give the robot's definition as DIR/sensor_msgs/msg/Range.msg with --interfaces DIR, or hear it with " \
         "--source rclpy, which reads the publisher's own definition; its messages are not heard" in line, line
+
+
+#: a type_description_interfaces/FieldType serialized by rclpy (a type rosbags' Humble store lacks)
+FIELD_TYPE = """\
+from rclpy.serialization import serialize_message
+from type_description_interfaces.msg import FieldType
+print(serialize_message(FieldType(type_id=FieldType.FIELD_TYPE_FLOAT_ARRAY, capacity=7, nested_type_name="a/b")).hex())
+"""
+
+
+def test_a_type_with_no_local_definition_is_defined_from_the_ros2_python(tmp_path: Path) -> None:
+    """A contract type the monitor has no definition of: without one, the error names the file to give
+    and the option; the ROS 2 Python's own description (the agent's --describe, checked against rosidl's
+    hash) defines it, nested types included, and rclpy's bytes decode with it."""
+    from rclverify.runtime.rclpy_source.bus import installed_declarations
+    name = "type_description_interfaces/msg/FieldType"
+    book = TypeBook([])
+    with pytest.raises(DdsTypeError, match=f"message type {name} is neither in the workspace's interface files nor "
+                       "a standard type: give its definition as DIR/type_description_interfaces/msg/FieldType.msg "
+                       r"with --interfaces DIR \(or the mapping's msg_dirs\)"):
+        book.message(name)
+    found = installed_declarations(ros2_python(), [name, "no_such_msgs/msg/Nothing"])
+    assert list(found) == [name]
+    assert book.add_declaration(found[name]) == [name]
+    struct: Any = book.message(name)
+    assert book.type_hash(struct) == found[name].type_hash
+    out = subprocess.run([str(ros2_python()), "-c", FIELD_TYPE], capture_output=True, text=True, timeout=60, check=True)
+    fields = to_fields(struct.deserialize(bytes.fromhex(out.stdout.strip())))
+    assert fields == {"type_id": 58, "capacity": 7, "string_capacity": 0, "nested_type_name": "a/b"}

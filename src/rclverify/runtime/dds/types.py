@@ -168,6 +168,15 @@ class TypeBook:
         book._structs, book.nested, book._hints = {}, {}, {}
         return book
 
+    def add_declaration(self, decl: Declaration) -> list[str]:
+        """Define, from ``decl``'s description, each of its types this book does not define (a
+        contract type with no local definition, and the types it nests that none defines); the
+        book's own definitions stay.  Returns the types added; a struct already made is unchanged."""
+        added = [n for n in decl.fields if self.table.get(n) is None]
+        for n in added:
+            self.table.types[n] = TypeInfo([], list(decl.fields[n]), "declared")
+        return added
+
     def _add_debian_services(self, share: Path = Path("/usr/share")) -> None:
         """Debian's ``/usr/share/<pkg>/srv`` and ``action`` files for packages the
         workspace does not define (``std_srvs``): ROS 1 packages, whose

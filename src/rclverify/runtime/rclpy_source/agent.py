@@ -41,7 +41,10 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   at most :data:`DESCRIBE_TIMEOUT_S`.  Answered by one ``description``
   frame: the descriptions found (``candidates``, each with where it came
   from) and why the others were not had (``failures``); the monitor checks
-  each candidate's hash itself.
+  each candidate's hash itself.  Run as ``agent.py --describe TYPE...``,
+  the agent prints this Python's own descriptions of the types named (one
+  ``descriptions`` frame) and exits: the definition of a contract type the
+  monitor has none of (:func:`.bus.installed_declarations`).
 
 SIGINT is ignored (the monitor stops the agent when it stops: ``stop`` or
 the end of stdin), so a Ctrl-C in a terminal does not cut the stream short.
@@ -490,6 +493,11 @@ def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> di
 def main() -> int:
     if len(sys.argv) == 3 and sys.argv[1] == "--graph":  # ``ros diff --ros2 --source rclpy``: one dump, then exit
         _emit(wire.json_frame(graph_dump(float(sys.argv[2]))))
+        return 0
+    if len(sys.argv) >= 2 and sys.argv[1] == "--describe":  # this Python's own descriptions of the types named
+        found = {t: installed_description(t) for t in sys.argv[2:]}
+        _emit(wire.json_frame({"what": "descriptions", "types": {
+            t: None if f is None else {"hash": f[0], "description": f[1], "from": f[2]} for t, f in found.items()}}))
         return 0
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     q: queue.Queue[_Command | None] = queue.Queue()

@@ -54,6 +54,7 @@ start): one message.
 from __future__ import annotations
 
 import base64
+import io
 import json
 import subprocess
 import threading
@@ -447,4 +448,32 @@ class RclpyBus:
             self.warn(text)
 
 
-__all__ = ["AGENT", "RclpyBus", "RclpyUnavailable", "ros_name", "ros_type"]
+def installed_declarations(python: Path, names: list[str], timeout_s: float = 60.0) -> dict[str, Declaration]:
+    """The definitions the ROS 2 Python ``python`` has of message types ``names`` (``pkg/msg/T``), as
+    rosidl described them when the packages were built (the agent's ``--describe``), each checked to
+    hash to the hash rosidl gave it (:func:`~rclverify.runtime.dds.types.declare`): what a contract type
+    with no local definition is read with (:meth:`~rclverify.runtime.dds.types.TypeBook.add_declaration`).
+    A type the Python has no description of is left out.  Raises :class:`RclpyUnavailable` (one line)
+    when the agent cannot run or answer, or a description does not hash to its own hash."""
+    try:
+        proc = subprocess.run([str(python), str(AGENT), "--describe", *names], capture_output=True,
+                              timeout=timeout_s)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)}: {exc}") from None
+    frame = read_frame(io.BytesIO(proc.stdout))
+    if proc.returncode != 0 or frame is None or frame[0] != b"J":
+        last = proc.stderr.decode(errors="replace").strip().splitlines()[-1:]
+        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)} "
+                               f"(exit {proc.returncode}): {' '.join(last)}")
+    out: dict[str, Declaration] = {}
+    for name, found in json.loads(frame[1]).get("types", {}).items():
+        if found is None:
+            continue
+        try:
+            out[name] = declare(name, str(found["hash"]), found["description"], str(found["from"]))
+        except (DdsTypeError, KeyError, TypeError) as exc:
+            raise RclpyUnavailable(f"the ROS 2 Python {python}'s description of {name}: {exc}") from None
+    return out
+
+
+__all__ = ["AGENT", "RclpyBus", "RclpyUnavailable", "installed_declarations", "ros_name", "ros_type"]
