@@ -16,6 +16,10 @@ and language versions", and REP 122's ``include/<package>/`` headers):
 * an ``#include "P/x.hpp"`` or ``<P/x.hpp>`` whose first path component is
   another scanned package ``P`` (never the program's own), found at
   ``P/include/P/x.hpp`` (or ``P/P/x.hpp``), is a file of the program;
+* an include whose first path component is no package (a scoped install
+  directory, ``install(DIRECTORY include/vendor ...)``: ``<vendor/p/x.hpp>``)
+  is the header at ``include/vendor/p/x.hpp`` of the one other package that
+  has it;
 * with it, what it includes in ``P`` and, for each header, the source of the
   same name in ``P`` (its implementation: ``src/x.cpp``), as within a package
   (:func:`programs._closure`);
@@ -35,15 +39,24 @@ MAX_FILES = 2000  # files of other packages one program may take in
 
 
 def _other(inc: str, own: str, codes: dict[str, PackageCode]) -> tuple[str, str] | None:
-    """``(package, file)`` an include of ``inc`` names in another scanned package."""
-    pkg = inc.split("/", 1)[0] if "/" in inc else None
-    code = codes.get(pkg) if pkg is not None and pkg != own else None
-    if code is None:
+    """``(package, file)`` an include of ``inc`` names in another scanned package:
+    the package its first path component names, else the one other package
+    with a header at ``include/<inc>`` (a scoped install directory:
+    ``#include <vendor/pkg/helper.hpp>`` of ``include/vendor/pkg/``); ``None``
+    when none or several have it."""
+    if "/" not in inc:
         return None
-    for cand in (f"{code.root}/include/{inc}", f"{code.root}/{inc}"):
-        if cand in code.records:
-            return pkg, cand  # type: ignore[return-value]
-    return None
+    pkg = inc.split("/", 1)[0]
+    code = codes.get(pkg) if pkg != own else None
+    if code is not None:
+        for cand in (f"{code.root}/include/{inc}", f"{code.root}/{inc}"):
+            if cand in code.records:
+                return pkg, cand
+    if pkg in codes:
+        return None
+    hits = [(name, f"{c.root}/include/{inc}") for name, c in codes.items()
+            if name != own and f"{c.root}/include/{inc}" in c.records]
+    return hits[0] if len(hits) == 1 else None
 
 
 def _implementations(code: PackageCode, header: str) -> list[str]:

@@ -1,6 +1,7 @@
 #include <memory>
 
 #include "nav_msgs/msg/occupancy_grid.hpp"
+#include "rover/core/pose_relay.hpp"
 #include "rover_core/managed_node.hpp"
 
 namespace rover_map
@@ -18,11 +19,13 @@ public:
   {
     map_pub_ = create_publisher<nav_msgs::msg::OccupancyGrid>(
       "map", rclcpp::QoS(1).transient_local().reliable());
+    relay_ = std::make_unique<rover::core::PoseRelay>(this, "initialpose", "map_origin");
     return rover_core::CallbackReturn::SUCCESS;
   }
 
 private:
   rclcpp_lifecycle::LifecyclePublisher<nav_msgs::msg::OccupancyGrid>::SharedPtr map_pub_;
+  std::unique_ptr<rover::core::PoseRelay> relay_;
 };
 
 }  // namespace rover_map
