@@ -242,3 +242,12 @@ def test_an_alias_is_looked_up_in_its_scope() -> None:
     # control: a bare name still reads its one alias
     assert alias_of("Charge", aliases) == "geometry_msgs::msg::Point"
     assert message_type("other_msgs::msg::Charge", aliases) == "other_msgs/msg/Charge"
+
+
+def test_a_class_the_package_re_exports_is_followed_to_its_module() -> None:
+    """``from rover_tools import Beacon``, where ``rover_tools/__init__.py`` says
+    ``from .beacon import Beacon``: the beacon's publisher, named at the call site,
+    is the node's (before: 'names no node ...: not in the graph')."""
+    g = scan([WS / "src" / "rover_tools"]).graph
+    assert _edges(g, "/beacon_node") == {("pub", "/rover_beacon", "std_msgs/msg/String")}
+    assert not _said(g)

@@ -80,15 +80,36 @@ class PackageCode:
         for shown in records:
             self.by_name.setdefault(shown.rsplit("/", 1)[-1], []).append(shown)
 
-    def module(self, dotted: str) -> tuple[str, str] | None:
+    def module(self, dotted: str, depth: int = 0) -> tuple[str, str] | None:
         """``(file, attribute path)`` a dotted import origin names in this package:
-        ``pkg.sensors.Sensor`` -> (``.../pkg/sensors.py``, ``Sensor``)."""
+        ``pkg.sensors.Sensor`` -> (``.../pkg/sensors.py``, ``Sensor``).  A name the
+        module found does not define but imports itself (a package's
+        ``__init__.py`` re-exporting ``from .sensors import Sensor``) is followed
+        to the module defining it (Python's import system binds the name in the
+        importing module's namespace: ``pkg.Sensor`` is ``pkg.sensors.Sensor``),
+        at most four modules deep."""
         parts = dotted.split(".")
         for k in range(len(parts), 0, -1):
             f = self.modules.get(".".join(parts[:k]))
             if f is not None:
-                return f, ".".join(parts[k:])
+                attr = ".".join(parts[k:])
+                again = self._reexported(f, attr, dotted) if attr and depth < 4 else None
+                hit = self.module(again, depth + 1) if again is not None else None
+                return hit if hit is not None and hit[0] != f else (f, attr)
         return None
+
+    def _reexported(self, f: str, attr: str, dotted: str) -> str | None:
+        """The origin module file ``f`` imports ``attr``'s first name from, when ``f``
+        does not define it (no class, function or constant of that name)."""
+        r = self.records.get(f, {})
+        head, _, rest = attr.partition(".")
+        if r.get("lang") != "py" or f"{f}::{head}" in r.get("units", {}) or f"{f}::{head}" in r.get("fns", {}) \
+                or head in r.get("consts", {}):
+            return None
+        origins = [o for o in r.get("imports", []) if o.rsplit(".", 1)[-1] == head and o != dotted]
+        if len(origins) != 1:
+            return None
+        return origins[0] + ("." + rest if rest else "")
 
     def include(self, name: str, at: str) -> str | None:
         """The package file an ``#include`` of ``name`` from file ``at`` reads."""

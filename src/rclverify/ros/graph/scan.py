@@ -87,13 +87,25 @@ def _source_files(root: Path, skipped: list[str] | None = None) -> tuple[list[Pa
                              if d not in _SKIP_DIRS and not d.startswith("."))
         for f in sorted(safefs.keep_names(dirpath, filenames, skipped)):
             p = Path(dirpath) / f
-            if f.endswith(".py") and f != "setup.py" and not f.endswith(".launch.py") and f != "__init__.py":
-                py.append(p)
+            if f.endswith(".py") and f != "setup.py" and not f.endswith(".launch.py") and (
+                    f != "__init__.py" or _reexports(p)):
+                py.append(p)  # a package's __init__.py read when it imports names (re-exports them)
             elif p.suffix in _CPP:
                 cpp.append(p)
             elif not p.suffix and not f.startswith(".") and f not in _NOT_SCRIPTS:
                 bare.append(p)
     return py, cpp, bare
+
+
+def _reexports(p: Path) -> bool:
+    """Whether package ``__init__.py`` ``p`` imports names (``from .x import
+    Name``, ``from pkg.x import Name``): read, so ``from pkg import Name`` finds
+    ``Name``'s module (:meth:`~rclverify.ros.extract.programs.PackageCode.module`);
+    an empty or unreadable one is not."""
+    try:
+        return b"from " in safefs.read_bytes(p)
+    except OSError:
+        return False
 
 
 def _python_shebang(data: bytes) -> bool:
