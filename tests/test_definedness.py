@@ -156,7 +156,7 @@ requirements:
 
 
 def _requirement(tmp_path: Path, low: int, temporal: str = "") -> dict[str, Any]:
-    from rclverify.app.pipeline import Workspace
+    from rclverify.stages.workspace import Workspace
     from rclverify.calculus.requirements import own_nodes
     from rclverify.semantics import world
     (tmp_path / "contracts").mkdir()
@@ -238,7 +238,8 @@ RANGE = range(-2, 3)
 def _term(draw: Any, depth: int) -> str:
     from hypothesis import strategies as st
     if depth == 0 or draw(st.integers(0, 2)) == 0:
-        return draw(st.sampled_from(["in.a", "in.b", "in.c", "0", "1", "2", "(in.a * in.a + 1)"]))
+        leaf: str = draw(st.sampled_from(["in.a", "in.b", "in.c", "0", "1", "2", "(in.a * in.a + 1)"]))
+        return leaf
     op = draw(st.sampled_from(["+", "-", "*", "/", "/"]))
     return f"({_term(draw, depth - 1)} {op} {_term(draw, depth - 1)})"
 
@@ -258,10 +259,10 @@ def _holds_at(w: Any, symbols: list[Any], point: tuple[int, ...]) -> bool:
     import z3
     sub = z3.simplify(z3.substitute(w, *[(s, z3.IntVal(v)) for s, v in zip(symbols, point)]))
     if z3.is_true(sub) or z3.is_false(sub):
-        return z3.is_true(sub)
+        return bool(z3.is_true(sub))
     s = z3.Solver()
     s.add(z3.Not(sub))
-    return s.check() == z3.unsat
+    return bool(s.check() == z3.unsat)
 
 
 def test_definedness_conditions_agree_with_brute_force_enumeration() -> None:
