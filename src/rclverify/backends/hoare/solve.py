@@ -165,7 +165,8 @@ def counterexample(res: VCResult, m: ProgramModel, observe: Mapping[str, z3.Expr
     values; ``observe`` adds named initial-state terms (``in.r``), and the
     VC's other free symbols are added under their ``names`` (``in.command``);
     for the
-    ``main`` VC the program is replayed and ``"<x> (final)"`` gives each
+    ``main`` VC (any VC of the initial state but a division of the program's
+    own, :mod:`.defined`, whose run stops there) the program is replayed and ``"<x> (final)"`` gives each
     assigned variable's final value, ``observe_final`` names some of them
     again (``out.radiationStatus`` -> ``output``).  ``notes`` explain what the
     state is.
@@ -188,7 +189,10 @@ def counterexample(res: VCResult, m: ProgramModel, observe: Mapping[str, z3.Expr
             label = (names or {}).get(t.decl().name(), t.decl().name())
             out.setdefault(label, json_value(model.eval(t, model_completion=True)))
     notes: list[str] = []
-    if res.vc.state == "initial":
+    if res.vc.id.startswith("defined@") and res.vc.state == "initial":  # the run stops there (.defined)
+        notes.append(f"the run divides by zero at {res.vc.loc.file}:{res.vc.loc.line}:{res.vc.loc.col}: it has no "
+                     "final state")
+    elif res.vc.state == "initial":
         replay = _Replay(m, model)
         if replay.run(m.program.body):
             for n in _assigned(m.program.body):
