@@ -94,6 +94,25 @@ def test_hoare_division_in_a_loop_is_checked_at_every_iteration(tmp_path: Path) 
     assert ev.details["vcs"]["defined@6:8.loop@5.body"] == "invalid"
 
 
+def test_the_tables_partiality_is_where_its_meanings_are_undecided() -> None:
+    """``Operator.partial`` (what the conditions are generated from) marks exactly the operands and
+    values at which the operator's exact and double meanings answer undecided."""
+    from rclverify.semantics.operators import OPERATORS, Undecided
+    for op in OPERATORS.values():
+        if op.kind != "arithmetic":
+            assert op.partial is None, op.symbol
+            continue
+        for left, right in ((3, 0), (0, 3), (0, 0), (3, 2)):
+            undefined = op.partial is not None and (left, right)[op.partial.operand] == op.partial.excluded
+            for meaning in (op.exact, op.double):
+                if undefined:
+                    with pytest.raises(Undecided):
+                        meaning(left, right)
+                else:
+                    meaning(left, right)
+    assert [o.symbol for o in OPERATORS.values() if o.partial is not None] == ["/"]
+
+
 # ---------------------------------------------------------------------------
 # side conditions (calculus/compose.py, calculus/side_condition.py)
 # ---------------------------------------------------------------------------
