@@ -380,8 +380,12 @@ def evaluate(expr: str) -> str:
         assert isinstance(n, ast.Compare)
         left = ev(n.left)
         for op, right in zip(n.ops, (ev(x) for x in n.comparators)):
-            ok = {ast.Eq: lambda a, b: a == b, ast.NotEq: lambda a, b: a != b,
-                  ast.In: lambda a, b: a in b, ast.NotIn: lambda a, b: a not in b}[type(op)](left, right)
+            if isinstance(op, ast.Eq):
+                ok = left == right
+            elif isinstance(op, ast.NotEq):
+                ok = left != right
+            else:
+                ok = (left in right) == isinstance(op, ast.In)  # In / NotIn (the only others allowed)
             if not ok:
                 return False
             left = right

@@ -376,9 +376,8 @@ def _once(stmts: list[ast.stmt] | list[ast.AST]) -> tuple[dict[str, ast.expr], d
             if len(targets) == 1 and isinstance(targets[0], ast.Name) and st.value is not None:
                 lines.setdefault(targets[0].id, []).append(st.lineno)
                 seen[targets[0].id] = st.value
-        elif isinstance(st, (ast.AugAssign, ast.For, ast.With)) and isinstance(
-                getattr(st, "target", None), ast.Name):
-            lines.setdefault(st.target.id, []).append(st.lineno)  # type: ignore[attr-defined]
+        elif isinstance(st, (ast.AugAssign, ast.For)) and isinstance(st.target, ast.Name):
+            lines.setdefault(st.target.id, []).append(st.lineno)  # x += [...], a loop's variable: not one value
     twice = {k: sorted(v) for k, v in lines.items() if len(v) > 1}
     return {k: v for k, v in seen.items() if k not in twice}, twice
 

@@ -551,7 +551,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
         if v[0] == "cat":
             return any(self.uninstantiated(x, depth + 1) for x in v[1])
         if v[0] == "field":
-            binds = self.fields.get((v[1], v[2]))
+            binds = self.fields.get((v[1], v[2])) or []
             return bool(binds) and all(self.uninstantiated(b, depth + 1) for b in binds)
         if v[0] != "arg" or v[1] not in self.fns:
             return False

@@ -109,7 +109,7 @@ class PackageCode:
         origins = [o for o in r.get("imports", []) if o.rsplit(".", 1)[-1] == head and o != dotted]
         if len(origins) != 1:
             return None
-        return origins[0] + ("." + rest if rest else "")
+        return str(origins[0]) + ("." + rest if rest else "")
 
     def include(self, name: str, at: str) -> str | None:
         """The package file an ``#include`` of ``name`` from file ``at`` reads."""
