@@ -1,0 +1,358 @@
+"""The space margin of an RCL state formula on concrete values: how far the
+values are from the formula's boundary, signed (docs/semantics.md, "Margins").
+
+The quantitative semantics of Donzé and Maler ("Robust satisfaction of
+temporal logic over real-valued signals", FORMATS 2010) and of Fainekos and
+Pappas ("Robustness of temporal logic specifications for continuous-time
+signals", TCS 2009), read through RCL's state formulas, on the values the
+evaluator judges (:mod:`rclverify.semantics.evaluate`, the operators of
+:mod:`rclverify.semantics.operators`):
+
+* a comparison of two numbers: ``a <= b`` and ``a < b`` give ``b - a``,
+  ``a >= b`` and ``a > b`` give ``a - b``; ``a == b`` gives ``-|a - b|``
+  (``a <= b and b <= a``: 0 when equal, never positive, since any change of
+  either side breaks an equality), ``a != b`` gives ``|a - b|``; a chain
+  ``a < b <= c`` is the ``and`` of its links;
+* ``not`` negates, ``and`` is the minimum, ``or`` the maximum, ``a -> b`` is
+  ``not a or b``, ``a <=> b`` is ``(a -> b) and (b -> a)``;
+* ``forall`` is the minimum and ``exists`` the maximum over the quantifier's
+  domain (a sequence's or a set's elements, an enumeration, BOOL, an integer
+  range bounded by literal guards: the values the guard admits); over the
+  empty domain ``+inf`` and ``-inf``; ``exists_unique`` is
+  ``min(r1, -r2)`` for the largest and second largest margins of the body
+  (``r2 = -inf`` on one element): positive when exactly one element is
+  clear of the boundary on the true side and every other on the false side;
+* a number's membership in a finite collection of numbers (``x in {1, 2}``)
+  is the ``or`` of its equalities, ``!in`` their ``and`` of disequalities;
+* every other atom (a BOOL value, a comparison of enumeration values,
+  constructor terms or truth values, membership in a type, a function's
+  BOOL result) has no distance: ``+inf`` when true, ``-inf`` when false
+  (the convention of Donzé and Maler for Boolean signals).
+
+**Sign.**  ``margin > 0`` implies the formula holds and ``margin < 0``
+implies it fails, on the same values in the same arithmetic (by induction:
+min and max keep the implication).  ``margin == 0`` is the boundary, where
+the Boolean verdict decides: ``a <= b`` holds there, ``a < b`` does not, a
+satisfied ``a == b`` is always at 0.  tests/test_robustness.py checks this
+against the evaluator on random formulas and values.
+
+**Arithmetic.**  ``exact``: the terms in exact rational arithmetic (the
+evaluator's), the distances exact, rounded once to a double at the end (a
+non-zero distance too small for a double becomes the smallest double of its
+sign, so the sign never changes).  ``double``: the terms and distances in
+IEEE-754 binary64 (:mod:`rclverify.semantics.floatsem`), whose subtraction
+is zero only between equal numbers.  A verdict decided within a declared
+tolerance has no margin here (the tolerance is a relation, not a distance).
+
+**Unit.**  The margin is a value of the comparison that decides it (the one
+whose distance min and max select, :attr:`Margin.atom`); its unit is that
+comparison's (docs/rcl-language.md, "Units of measure": both sides have one
+unit; the type checker's :class:`rclverify.lang.unitcheck.UnitChecker`
+gives it), ``""`` when neither side declares one.  Distances of different
+units meet in min and max as numbers, as in the standard semantics; the
+atom and its unit say which one a margin is.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any, Mapping
+
+from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.unitcheck import UnitChecker
+from rclverify.lang.units import best_name, canonical_text
+from rclverify.semantics.evaluator import Evaluator
+from rclverify.semantics.floatsem import MAX_ENUMERATION, _Double, _finite_domain
+from rclverify.semantics.operators import OPERATORS, Undecided
+from rclverify.semantics.values import Value
+
+INF = math.inf
+
+#: The arithmetics a margin is computed in (those of semantics/floatsem.py that measure a distance).
+ARITHMETICS = ("exact", "double")
+
+
+@dataclass(frozen=True)
+class Margin:
+    """A formula's space margin on some values.
+
+    ``value``: the signed distance to the boundary (float; ``inf``/``-inf``
+    when only atoms without a distance decide), in ``unit`` (the deciding
+    comparison's unit text, ``""`` when it has none); ``atom``: that
+    comparison's RCL text (``""`` when none decides: a BOOL atom, an empty
+    domain); ``arithmetic``: ``exact`` or ``double``."""
+
+    value: float
+    unit: str = ""
+    atom: str = ""
+    arithmetic: str = "exact"
+
+
+class MarginUndefined(Exception):
+    """No margin on these values (the reason in ``str``): a quantifier over
+    an infinite domain, a value missing, a division by zero, a value of the
+    wrong form."""
+
+
+_R = tuple[Any, Any]  # (distance: int | Fraction | float, the deciding atom: (ast node, bound names) or None)
+
+
+#: the domains that are terms (a set's or a sequence's elements), not types
+_COLLECTIONS = (ast.Var, ast.SetLit, ast.SeqLit, ast.SeqRange, ast.Apply)
+
+
+def _number(v: Any) -> bool:
+    return not isinstance(v, bool) and isinstance(v, (int, float, Fraction))
+
+
+class _Margins:
+    """One computation: the evaluator ``ev`` gives the terms' values."""
+
+    def __init__(self, ev: Evaluator, exact: bool) -> None:
+        self.ev = ev
+        self.exact = exact
+        self._sub = OPERATORS["-"].exact if exact else OPERATORS["-"].double
+
+    def diff(self, x: Any, y: Any) -> Any:
+        """``x - y`` in the arithmetic (a difference of doubles is zero only when they are equal)."""
+        return self._sub(x, y)
+
+    def truth(self, e: ast.Expr, b: Mapping[str, Value], holds: bool) -> _R:
+        return (INF if holds else -INF), None
+
+    def rob(self, e: ast.Expr, b: Mapping[str, Value], idx: frozenset[str] = frozenset()) -> _R:  # a flat dispatch
+        """The margin of ``e`` under bound variables ``b``; ``idx``: the bound
+        variables that range over a type (an index, not a value of the run)."""
+        if isinstance(e, ast.BoolLit):
+            return self.truth(e, b, e.value)
+        if isinstance(e, ast.Unary) and e.op == "not":
+            r, at = self.rob(e.operand, b, idx)
+            return -r, at
+        if isinstance(e, ast.Binary) and e.op in ("and", "or", "->", "<=>"):
+            return self.connective(e, b, idx)
+        if isinstance(e, ast.Compare):
+            return self.compare(e, b, idx)
+        if isinstance(e, ast.Member):
+            return self.member(e, b, idx)
+        if isinstance(e, ast.Quant):
+            return self.quant(e, b, idx)
+        if isinstance(e, ast.TupleQuant):
+            return self.tuple_quant(e, b, idx)
+        return self.truth(e, b, bool(self.ev.eval(e, b)))  # a BOOL value, a function's BOOL result
+
+    def measured(self, terms: Any, b: Mapping[str, Value], idx: frozenset[str]) -> bool:
+        """Whether ``terms`` read a value of the run: an input or output, or a
+        variable bound to an element of a collection (not one ranging over a type)."""
+        io = self.ev.io_names
+        for t in terms:
+            for v in _vars(t):
+                if v.prefix is not None or (v.name in b and v.name not in idx) or (v.name not in b and v.name in io):
+                    return True
+        return False
+
+    def connective(self, e: ast.Binary, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        left, right = self.rob(e.left, b, idx), self.rob(e.right, b, idx)
+        if e.op == "and":
+            return _min(left, right)
+        if e.op == "or":
+            return _max(left, right)
+        if e.op == "->":
+            return _max(_neg(left), right)
+        return _min(_max(_neg(left), right), _max(_neg(right), left))  # <=>
+
+    def compare(self, e: ast.Compare, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        vals = [self.ev.eval(o, b) for o in e.operands]
+        out: _R = (INF, None)
+        for i, op in enumerate(e.ops):
+            x, y = vals[i], vals[i + 1]
+            if _number(x) and _number(y) and self.measured(e.operands[i:i + 2], b, idx):
+                r: _R = (self.distance(op, x, y), (e, i, frozenset(b)))
+            else:
+                r = self.truth(e, b, bool(self.ev.compare(e, b, op, x, y)))
+            out = _min(out, r)
+        return out
+
+    def distance(self, op: str, x: Any, y: Any) -> Any:
+        if op in ("<", "<="):
+            return self.diff(y, x)
+        if op in (">", ">="):
+            return self.diff(x, y)
+        d = abs(self.diff(x, y))
+        return -d if op == "==" else d
+
+    def member(self, e: ast.Member, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        x = self.ev.eval(e.elem, b)
+        carrier = self.ev.carrier(e.collection, b)
+        if carrier is not None or not _number(x) or not self.measured((e.elem, e.collection), b, idx):
+            return self.truth(e, b, bool(self.ev.eval(e, b)))
+        items = list(self.ev.collection(e.collection, b))
+        if not all(_number(v) for v in items):
+            return self.truth(e, b, bool(self.ev.eval(e, b)))
+        at = (e, 0, frozenset(b))
+        near: _R = (-INF, None)
+        for v in items:  # x in S: the or of x == v
+            near = _max(near, (-abs(self.diff(x, v)), at))
+        return _neg(near) if e.negated else near
+
+    def quant(self, e: ast.Quant, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        names: list[str] = []
+        doms: list[list[Any]] = []
+        size = 1
+        inner = set(idx)
+        for bd in e.bindings:
+            for n in bd.names:
+                try:
+                    dom = self.domain(e, bd, n, b)
+                except Undecided as exc:
+                    raise MarginUndefined(f"{n}: {exc}") from None
+                names.append(n)
+                doms.append(dom)
+                if self.indexes(bd.domain, b):
+                    inner.add(n)
+                else:
+                    inner.discard(n)
+                size *= max(len(dom), 1)
+                if size > MAX_ENUMERATION:
+                    raise MarginUndefined(f"quantifier over more than {MAX_ENUMERATION} values")
+        return self.over(e.kind, e.body, names, itertools.product(*doms), b, frozenset(inner))
+
+    def indexes(self, dom: Any, b: Mapping[str, Value]) -> bool:
+        """Whether a variable over ``dom`` is an index (a type, a literal integer range), not a value of the run."""
+        if isinstance(dom, ast.SeqRange):
+            return not self.measured((dom.lo, dom.hi), b, frozenset())
+        return not isinstance(dom, _COLLECTIONS) or self.ev.carrier(dom, b) is not None
+
+    def domain(self, e: ast.Quant, bd: ast.Binding, name: str, b: Mapping[str, Value]) -> list[Any]:
+        """The values ``name`` takes: a collection's elements, a range's integers,
+        else a finite type's values (:func:`rclverify.semantics.floatsem._finite_domain`)."""
+        dom = bd.domain
+        if isinstance(dom, ast.SeqRange):
+            lo, hi = self.ev.eval(dom.lo, b), self.ev.eval(dom.hi, b)
+            return list(range(int(lo), int(hi) + 1))
+        if isinstance(dom, _COLLECTIONS) and self.ev.carrier(dom, b) is None:
+            return list(self.ev.collection(dom, b))
+        return _finite_domain(self.ev, e, bd, name, b)
+
+    def tuple_quant(self, e: ast.TupleQuant, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        dom = e.domain
+        if not isinstance(dom, _COLLECTIONS) or self.ev.carrier(dom, b) is not None:
+            raise MarginUndefined("a tuple quantifier over a type is not finite")
+        elems = list(self.ev.collection(dom, b))
+        return self.over(e.kind, e.body, list(e.names), (tuple(t) for t in elems), b, idx - frozenset(e.names))
+
+    def over(self, kind: str, body: ast.Expr, names: list[str], combos: Any, b: Mapping[str, Value],
+             idx: frozenset[str]) -> _R:
+        """``forall`` (min), ``exists`` (max) or ``exists_unique`` (``min(r1, -r2)``) of ``body``."""
+        best: _R = (INF, None) if kind == "forall" else (-INF, None)
+        second: _R = (-INF, None)
+        for combo in combos:
+            cur = dict(b)
+            cur.update(zip(names, combo))
+            r = self.rob(body, cur, idx)
+            if kind == "forall":
+                best = _min(best, r)
+            elif r[0] > best[0]:
+                best, second = r, best
+            elif r[0] > second[0]:
+                second = r
+        if kind == "exists_unique":
+            return _min(best, _neg(second))
+        return best
+
+
+def _vars(e: Any) -> list[ast.Var]:
+    """The variables of term ``e`` (function names aside)."""
+    hit = _VARS.get(id(e))
+    if hit is not None and hit[0] is e:
+        return hit[1]
+    out: list[ast.Var] = []
+    stack = [e]
+    while stack:
+        x = stack.pop()
+        if isinstance(x, ast.Var):
+            out.append(x)
+        elif isinstance(x, ast.Apply):
+            stack.extend(x.args)
+        elif isinstance(x, tuple):
+            stack.extend(x)
+        elif hasattr(x, "__dataclass_fields__") and not isinstance(x, ast.Loc):
+            stack.extend(getattr(x, f) for f in x.__dataclass_fields__ if f not in ("loc", "name_locs"))
+    if len(_VARS) >= 10_000:
+        _VARS.clear()
+    _VARS[id(e)] = (e, out)
+    return out
+
+
+_VARS: dict[int, tuple[Any, list[ast.Var]]] = {}
+
+
+def _min(x: _R, y: _R) -> _R:
+    return y if y[0] < x[0] else x
+
+
+def _max(x: _R, y: _R) -> _R:
+    return y if y[0] > x[0] else x
+
+
+def _neg(x: _R) -> _R:
+    return -x[0], x[1]
+
+
+def _to_float(v: Any) -> float:
+    """``v`` as a double, never changing its sign (a non-zero rational too small
+    for a double becomes the smallest double of its sign)."""
+    f = float(v) + 0.0  # -0.0 is 0
+    if f == 0 and v != 0:
+        return math.nextafter(0.0, 1.0 if v > 0 else -1.0)
+    return f
+
+
+def _unit(checked: Checked, node: CheckedNode, e: Any, i: int, bound: frozenset[str]) -> str:
+    """The unit text of the compared terms of atom ``e`` (operands ``i`` and ``i + 1``
+    of a comparison; the element and items of a membership), ``""`` when none is known."""
+    units = UnitChecker(lambda *_: None)
+    units.constants = dict(checked.env.units)
+    if isinstance(e, ast.Compare):
+        terms = [e.operands[i], e.operands[i + 1]]
+    else:
+        terms = [e.elem, e.collection]
+    for t in terms:
+        q = units.term(t, node, bound)
+        if q.kind == "unit" and q.unit is not None:
+            u = q.unit
+            return u.text or best_name(u) or canonical_text(u)
+    return ""
+
+
+def margin(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object],
+           arithmetic: str = "exact") -> Margin:
+    """The space margin of ``formula`` (a state formula of ``node``) on
+    ``values`` (qualified names ``in.r``/``out.d`` -> values of
+    :mod:`rclverify.semantics.values`, as :func:`rclverify.semantics.evaluate.evaluate`
+    takes them), in ``arithmetic`` (``exact`` or ``double``, :data:`ARITHMETICS`).
+    Returns a :class:`Margin` (module docstring for the rules and the sign).
+    Raises :class:`MarginUndefined` when there is none (a quantifier over an
+    infinite domain, a missing value, a division by zero, a value of the
+    wrong form) and ``ValueError`` for an unknown ``arithmetic``."""
+    if arithmetic not in ARITHMETICS:
+        raise ValueError(f"no margin in {arithmetic!r} arithmetic (one of {', '.join(ARITHMETICS)})")
+    ev = Evaluator(checked, node, values) if arithmetic == "exact" else _Double(checked, node, values)
+    try:
+        value, at = _Margins(ev, arithmetic == "exact").rob(formula, {})
+    except Undecided as exc:
+        raise MarginUndefined(str(exc)) from None
+    except (TypeError, ZeroDivisionError, OverflowError, ValueError) as exc:
+        raise MarginUndefined(f"a value has the wrong form for the formula: {exc}") from None
+    if at is None:
+        return Margin(float(value), "", "", arithmetic)
+    atom, i, bound = at
+    text = expr_to_rcl(atom) if not isinstance(atom, ast.Compare) or len(atom.ops) == 1 else \
+        expr_to_rcl(ast.Compare((atom.ops[i],), (atom.operands[i], atom.operands[i + 1])))
+    return Margin(_to_float(value), _unit(checked, node, atom, i, bound), text, arithmetic)
+
+
+__all__ = ["ARITHMETICS", "INF", "Margin", "MarginUndefined", "margin"]
