@@ -53,6 +53,7 @@ LIVE = frozenset({
     "test_ros2_declarations", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
+    "test_ros2_undefined_type",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children

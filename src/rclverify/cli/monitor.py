@@ -251,9 +251,15 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
             bus_factory = _source(args)
             if bus_factory is False:
                 return 2
+            describe = None
+            if bus_factory is not None:  # the rclpy source (partial(RclpyBus, ros2_python)): types its Python knows
+                from functools import partial  # deferred: start-up (only --ros2)
+
+                from rclverify.runtime.rclpy_source.bus import installed_declarations  # deferred: optional or conditional (only --ros2)
+                describe = partial(installed_declarations, bus_factory.args[0])
             record_ = run_dds(factory, checked, nodes, msg_dirs + interfaces, **common,
                               enforce=extra.get("guarded"), record=rec, msg_dirs=msg_dirs,
-                              reorder_window=args.reorder_window, bus_factory=bus_factory)
+                              reorder_window=args.reorder_window, bus_factory=bus_factory, describe=describe)
         else:
             proxy = proxy_factory(checked, nodes, getattr(args, "forward", []), interfaces)
             record_ = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)

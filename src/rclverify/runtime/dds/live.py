@@ -95,7 +95,8 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
             status_s: float, evidence: Path | None, stop: Any, out: Callable[[str], None],
             enforce: Mapping[str, str] | None = None, record: tuple[Path, str] | None = None,
             msg_dirs: list[Path] | None = None, reorder_window: float = 0.0,
-            bus_factory: Callable[..., Any] | None = None, **_ignored: Any) -> dict[str, Any]:
+            bus_factory: Callable[..., Any] | None = None,
+            describe: Callable[[list[str]], Mapping[str, Any]] | None = None, **_ignored: Any) -> dict[str, Any]:
     """Monitor the ROS 2 system on the DDS domain until ``stop`` is set or
     ``duration`` s passed; returns the evidence record (written to
     ``evidence`` too).  ``type_dirs``: directories of ``<pkg>/msg|srv|action``
@@ -105,11 +106,13 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     storage)``; ``bus_factory(on_sample, warn, on_reader=, type_hash=)``: the
     bus of another source with the DDS bus's face (the rclpy source,
     :mod:`rclverify.runtime.rclpy_source.bus`), else a Cyclone DDS participant
-    of the monitor's own.  Raises
+    of the monitor's own; ``describe(["pkg/msg/T"])``: the declarations the
+    rclpy source's ROS 2 Python has of types the workspace does not define
+    (:func:`~rclverify.runtime.rclpy_source.bus.installed_declarations`).  Raises
     :class:`~rclverify.ros.live.dds.DdsUnavailable` (the binding, the domain,
     a type that cannot be made, a bag that cannot be created, the rclpy agent
     that cannot start: one message)."""
-    run = _DdsRun(checked, nodes, type_dirs, dict(enforce or {}), out)
+    run = _DdsRun(checked, nodes, type_dirs, dict(enforce or {}), out, describe)
     run.open_recorder(record, msg_dirs)
     dp = make_participant() if bus_factory is None else None
     run.join(dp, run_factory, verdict_topic, last_prefix, bus_factory)
@@ -137,7 +140,8 @@ class _DdsRun:
     thread's decoding, and the evidence record at the end."""
 
     def __init__(self, checked: Checked, nodes: list[CheckedNode], type_dirs: list[Path],
-                 enforce: dict[str, str], out: Callable[[str], None]) -> None:
+                 enforce: dict[str, str], out: Callable[[str], None],
+                 describe: Callable[[list[str]], Mapping[str, Any]] | None = None) -> None:
         self.checked, self.nodes, self.type_dirs, self.enforce, self.out = checked, nodes, type_dirs, enforce, out
         try:
             self.types = TypeBook(type_dirs)
@@ -150,7 +154,7 @@ class _DdsRun:
         self.structs: dict[str, Any] = {}
         for t, typ in self.topics.items():
             try:
-                self.structs[t.strip("/")] = self.types.message(typ)
+                self.structs[t.strip("/")] = self._message(typ, describe)
             except DdsTypeError as exc:
                 raise DdsUnavailable(f"{self.where.get(t.strip('/'), t)}: error: topic {t} ({typ}): {exc}") from None
         self.links = [(n, lk) for n in nodes for lk in n.node.links]
@@ -171,6 +175,28 @@ class _DdsRun:
         self.call_counts: dict[tuple[str, str], int] = {}
         self.bus: Any = None  # the DDS bus, or the rclpy source's (join)
         self.receipt_timed = 0  # samples placed at their receipt: no source time, or one ahead of the clock
+
+    def _message(self, typ: str, describe: Callable[[list[str]], Mapping[str, Any]] | None) -> Any:
+        """The struct of contract type ``typ``: the workspace's definition, else (the rclpy source,
+        ``describe``) the ROS 2 Python's own description of it, checked against its hash
+        (:func:`~rclverify.runtime.rclpy_source.bus.installed_declarations`).  Raises
+        :class:`DdsTypeError` when neither defines it."""
+        try:
+            return self.types.message(typ)
+        except DdsTypeError:
+            if describe is None:
+                raise
+            pkg, _, name = typ.replace("/msg/", "/").partition("/")
+            full = f"{pkg}/msg/{name}"
+            try:
+                decls = describe([full])
+            except Exception:  # noqa: BLE001 - the ROS 2 Python could not say: the workspace's error stands
+                decls = {}
+            if full not in decls:
+                raise
+            self.types.add_declaration(decls[full])
+            self.out(f"{full}: no definition in the workspace: read as the ROS 2 Python's rosidl describes it")
+            return self.types.message(typ)
 
     def open_recorder(self, record: tuple[Path, str] | None, msg_dirs: list[Path] | None) -> None:
         """The bag the run is written to, when ``record`` names one: the contract topics'
