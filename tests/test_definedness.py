@@ -335,3 +335,53 @@ def test_temporal_requirement_holds_only_where_its_state_formula_is_defined(tmp_
                                                                             verdict: str) -> None:
     rec = _requirement(tmp_path, low, "always ")
     assert rec["verdict"] == verdict, rec
+
+
+# ---------------------------------------------------------------------------
+# end to end: the tester's triple through `rclverify verify`
+# ---------------------------------------------------------------------------
+
+E2E_RCL = """\
+node Divider {{
+  inputs( n : INTEGER, d : INTEGER )
+  outputs( r : REAL )
+  assume( {low} <= in.d and in.d <= 10 )
+  guarantee( out.r == in.n / in.d )
+}}
+"""
+E2E_PLAN = """\
+contracts: [contracts/divider.rcl]
+nodes:
+  Divider:
+    evidence:
+      - backend: hoare
+        program: divider.imp
+        binding: {in.n: n, in.d: d, out.r: r}
+"""
+
+
+@pytest.mark.parametrize("low", [0, 1])
+def test_verify_reports_the_division_by_zero_and_its_diagnosis(tmp_path: Path, low: int,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """`{0 <= d <= 10} r := n / d {r == n / d}` through the whole pipeline: the triple fails on its
+    definedness VC and the diagnosis blames the division (not a constant); the contract's health names the
+    guarantee's own division.  The control, `1 <= d`, verifies with the triple discharged."""
+    import json
+
+    from rclverify.cli.commands import main
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts/divider.rcl").write_text(E2E_RCL.format(low=low))
+    (tmp_path / "contracts/plan.yaml").write_text(E2E_PLAN)
+    (tmp_path / "divider.imp").write_text(PROGRAM)
+    assert main(["verify", "-w", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    report = json.loads((tmp_path / "reports/assurance.json").read_text())
+    (ob,) = report["obligations"]
+    if low == 1:
+        assert ob["status"] == "discharged", ob
+        assert "divide by zero" not in out
+        return
+    assert ob["status"] == "failed", ob
+    assert "divider.imp can divide by zero under guarantee 1 of Divider" in out
+    assert "d != 0 for the division at divider.imp:3:6" in out
+    assert "the division at contracts/divider.rcl:5:23 needs in.d != 0" in out  # health, check `defined`

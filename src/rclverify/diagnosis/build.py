@@ -434,6 +434,15 @@ def _hoare(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow, cache:
     table = counterexample_table({kk: v for kk, v in cex.items() if "(final)" not in kk}, node)
     inputs = ", ".join(f"{kk} = {v}" for kk, v in cex.items() if kk.startswith("in."))
     outputs = ", ".join(f"{kk} = {v}" for kk, v in cex.items() if kk.startswith("out."))
+    zero = re.search(r"a division by zero on this run \((.+?); verification condition (defined\S*)\)",
+                     str(e.get("explanation", "")))
+    if zero:  # a definedness VC refuted (backends/hoare/defined.py): the division is the culprit, not a constant
+        at = re.search(r"division at (\S+?:\d+:\d+)", zero.group(1))
+        return _record(e["obligation"], "hoare", node, e["status"],
+                       f"{program} can divide by zero under guarantee {k} of {node} ({gsrc}): {zero.group(1)} does "
+                       f"not hold on {inputs or 'the counterexample'} (verification condition {zero.group(2)}).",
+                       culprits=[{"what": "the division", "source": at.group(1) if at else conj_src,
+                                  "text": zero.group(1)}], counterexample=table, guarantee=k)
     sentence = (f"{program} and guarantee {k} of {node} ({gsrc}) disagree on their constants: the program "
                 f"compares with {'/'.join(prog_texts) or 'other constants'} (" + ", ".join(prog_consts) + ") where the "
                 f"guarantee uses {'/'.join(conj_nums) or 'other constants'}; on {inputs or 'the counterexample'} the "
