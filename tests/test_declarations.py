@@ -76,6 +76,7 @@ def test_a_well_formed_declaration_is_read_whole() -> None:
 @pytest.mark.parametrize("edit, fault", [
     (("name: sketch", "name: other"), "the registry calls it 'sketch'"),
     (("strength: proof", "strength: strong"), "strength 'strong' is none of"),
+    (("evidence_kind: proof", "evidence_kind: vibes"), "evidence_kind 'vibes' is none of"),
     (("evidence_kind: proof\n", "colour: red\nevidence_kind: proof\n"), "unknown key(s) colour"),
     (("path_keys: [program]", "path_keys: [programme]"), "plan.path_keys names keys not in plan.keys: programme"),
     (("tool_paths: {exe: executable}", "tool_paths: {exe: file}"), "tool_paths must map"),

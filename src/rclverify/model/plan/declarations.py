@@ -14,7 +14,9 @@ versions.  Adding a backend touches its own folder and :data:`REGISTRY`.
 The declarations are read as files, not imported: the plan sits below the
 backends (docs/architecture.md) and validates an entry without loading any
 backend's code.  A malformed declaration is a fault of rclverify, not of a user's
-input: :class:`DeclarationError` names the file and what is wrong.
+input: :class:`DeclarationError` names the file and what is wrong, at load; an
+evidence kind the report's schema does not declare, or a strength not among
+:data:`STRENGTHS`, is one.
 """
 from __future__ import annotations
 
@@ -24,6 +26,8 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import yaml
+
+from rclverify.records.statuses import EVIDENCE_KINDS
 
 #: The backends, in the order the report's columns and the plan's messages list them:
 #: name -> its folder under ``rclverify/backends`` (which holds ``declaration.yaml``).
@@ -151,6 +155,9 @@ def parse(text: str, name: str, folder: str) -> Declaration:
             raise DeclarationError(f"{where}: {k} must be a non-empty string")
     if raw["strength"] not in STRENGTHS:
         raise DeclarationError(f"{where}: strength {raw['strength']!r} is none of {', '.join(STRENGTHS)}")
+    if raw["evidence_kind"] not in EVIDENCE_KINDS:  # the report's schema declares these kinds and no other
+        raise DeclarationError(f"{where}: evidence_kind {raw['evidence_kind']!r} is none of "
+                               f"{', '.join(EVIDENCE_KINDS)} (records/statuses.py, the report's schema)")
     if ":" not in raw["implementation"] or not isinstance(raw.get("whole_contract"), bool):
         raise DeclarationError(f"{where}: implementation is module:Class and whole_contract true or false")
     tools = raw.get("tools", [])
