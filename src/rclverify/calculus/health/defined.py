@@ -56,7 +56,7 @@ def definedness_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.
         if not conds:
             continue
         fid = f"{node}.{kind[0]}{k}.defined"
-        where = "the assumptions before it" if kind == "assumption" else "its node's assumption"
+        where, hold = ("the assumptions before it", "hold") if kind == "assumption" else ("its node's assumption", "holds")
         duration = 0.0
         finding: Finding | None = None
         for cond in conds:
@@ -65,7 +65,7 @@ def definedness_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.
             duration += r.duration_s
             if r.status == "refuted":
                 finding = Finding(fid, node, "defined", k if kind == "guarantee" else None, "problem",
-                                  f"{kind.capitalize()} {k} of {node} is not defined wherever {where} holds: "
+                                  f"{kind.capitalize()} {k} of {node} is not defined wherever {where} {hold}: "
                                   f"{cond.describe()}.",
                                   f"Z3 found values where {where} and the environment facts hold and the divisor is "
                                   "zero (below): the clause has no truth value there, so no check can decide it.",
@@ -77,7 +77,7 @@ def definedness_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.
                                   r.reason or "unknown", duration_s=round(duration, 4))
                 break
         out.append(finding or Finding(fid, node, "defined", k if kind == "guarantee" else None, "ok",
-                                      f"{kind.capitalize()} {k} of {node} is defined wherever {where} holds.",
+                                      f"{kind.capitalize()} {k} of {node} is defined wherever {where} {hold}.",
                                       "Z3 proved each division's divisor non-zero there: "
                                       + "; ".join(c.describe() for c in conds) + ".",
                                       duration_s=round(duration, 4)))
