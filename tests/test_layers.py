@@ -208,3 +208,16 @@ def test_no_folder_cycle(graph: nx.DiGraph) -> None:
             folders.add_edge(fa, fb)
     cycles = [sorted(c) for c in nx.strongly_connected_components(folders) if len(c) > 1]
     assert not cycles, f"folder cycles: {cycles}"
+
+
+def test_the_layers_are_numbered_in_one_place() -> None:
+    """docs/architecture.md's table is the one numbering: its folders in LAYERS' order, and no folder's
+    ``__init__`` docstring gives a number of its own (they disagreed: ``cli`` said 16 against 20)."""
+    import re
+    table = (SRC.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\| (\d+) \| `([a-z/]+)/` \|", table, flags=re.M)
+    assert [int(n) for n, _ in rows] == list(range(1, len(LAYERS) + 1))
+    assert [f for _, f in rows] == [name for name, _ in LAYERS]
+    numbered = [str(p.relative_to(SRC)) for p in (SRC / PACKAGE).rglob("__init__.py")
+                if re.search(r"\blayer \d+\b", (p.read_text(encoding="utf-8").split('"""') + ["", ""])[1], re.I)]
+    assert not numbered, numbered

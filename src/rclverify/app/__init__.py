@@ -1,4 +1,4 @@
-"""Layer 14, app: the one orchestrator.
+"""app (its place among the layers: docs/architecture.md): the one orchestrator.
 
 ``pipeline`` (the stages run in order), ``tasks`` (the same stages as doit
 tasks: what every workspace's ``dodo.py`` imports), ``cluster`` (Dask),

@@ -1,4 +1,4 @@
-"""Layer 8, calculus: the contracts composed (rules R1-R4, paper section 4)
+"""calculus (its place among the layers: docs/architecture.md): the contracts composed (rules R1-R4, paper section 4)
 and judged.
 
 The composition and refinement checks with Z3 (``compose``, ``refinement``,

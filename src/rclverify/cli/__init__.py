@@ -1,4 +1,4 @@
-"""Layer 16, cli: the ``rclverify`` command, parsing and printing only.
+"""cli (its place among the layers: docs/architecture.md): the ``rclverify`` command, parsing and printing only.
 
 ``commands`` (the commands' table and the entry point), one module per
 command group: ``contracts`` (check, latex, fmt), ``calculus`` (graph,

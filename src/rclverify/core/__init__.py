@@ -1,4 +1,4 @@
-"""Layer 1, core: what every layer needs and that knows nothing of RCL.
+"""core (its place among the layers: docs/architecture.md): what every layer needs and that knows nothing of RCL.
 
 ``faults`` (machine faults worded as one line), ``atomic`` (atomic file
 writes, deterministic JSON), ``runlock`` (one run of a workspace at a

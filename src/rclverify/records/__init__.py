@@ -1,4 +1,4 @@
-"""Layer 2, records: the formats every stage writes and the report reads.
+"""records (its place among the layers: docs/architecture.md): the formats every stage writes and the report reads.
 
 Obligations and evidence records (``records``), their atomic store
 (``store``), sealed stage records (``sealed``) and their types

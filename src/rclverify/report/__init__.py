@@ -1,4 +1,4 @@
-"""Layer 13, report: the results rendered.
+"""report (its place among the layers: docs/architecture.md): the results rendered.
 
 The assurance report (``build``, HTML, SARIF, JUnit, CI summaries), the GSN
 argument (``argument/``) and the assessor's bundle (``bundle/``).  Imports

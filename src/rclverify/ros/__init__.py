@@ -1,4 +1,4 @@
-"""Layer 7, ros: the ROS computation graph read from a robot's software, and
+"""ros (its place among the layers: docs/architecture.md): the ROS computation graph read from a robot's software, and
 contracts grounded in it (docs/ros.md).
 
 Four folders, lowest first, each importing only those before it:

@@ -1,4 +1,4 @@
-"""Layer 10, runtime: live monitoring as a product.
+"""runtime (its place among the layers: docs/architecture.md): live monitoring as a product.
 
 The monitors' engine (``backends/monitors``) judging a running robot: the
 ROS 1 transport (``ros1``, ``ros1_interfaces``, ``service_proxy``,

@@ -1,4 +1,4 @@
-"""Layer 4, semantics: what an RCL formula means.
+"""semantics (its place among the layers: docs/architecture.md): what an RCL formula means.
 
 RCL values (``values``), the reference evaluator and its fast paths
 (closures, straight-line code), exact / IEEE-754 / tolerant judging, and

@@ -1,4 +1,4 @@
-"""Layer 12, stages: the workspace on disk and the stages whose sealed
+"""stages (its place among the layers: docs/architecture.md): the workspace on disk and the stages whose sealed
 records the report reads.
 
 ``workspace`` (the loaded plan and contracts, artifact paths, snapshots,
