@@ -57,7 +57,8 @@ def _near(c: float, steps: int = 3) -> list[float]:
 
 def _checked(c: str) -> tuple[Checked, CheckedNode]:
     clauses = "\n".join(f"  guarantee( {f.format(c=c, h=_half(c))} )" for f, _ in FORMS)
-    text = f"context {{ Limit : REAL = {c} ; }}\nnode N {{\n  inputs( p : REAL )\n  outputs( y : BOOL )\n{clauses}\n}}\n"
+    text = (f"context {{ Limit : REAL = {c} ; }}\n"
+            f"node N {{\n  inputs( p : REAL )\n  outputs( y : BOOL )\n{clauses}\n}}\n")
     checked = check([parse_text(text, "forms.rcl")])
     return checked, checked.nodes["N"]
 

@@ -49,7 +49,8 @@ def definedness_vcs(program: lang.Program, m: ProgramModel, triple: EncodedTripl
     for target in partial_applications(program.body):
         where = target.loc
         vid = f"defined@{where.line}:{where.col}"
-        label = f"{requirement_text(target)} for the {OPERATORS[target.op].name} at {where.file}:{where.line}:{where.col}"
+        label = (f"{requirement_text(target)} for the {OPERATORS[target.op].name} at "
+                 f"{where.file}:{where.line}:{where.col}")
         run = wp(program.body, z3.BoolVal(True), m, target=target)
         if not z3.is_true(run.pre):
             vcs.append(dataclasses.replace(main_vc(triple.pre, run, m, where), id=vid, label=label))

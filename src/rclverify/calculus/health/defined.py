@@ -56,7 +56,8 @@ def definedness_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.
         if not conds:
             continue
         fid = f"{node}.{kind[0]}{k}.defined"
-        where, hold = ("the assumptions before it", "hold") if kind == "assumption" else ("its node's assumption", "holds")
+        where, hold = (("the assumptions before it", "hold") if kind == "assumption"
+                       else ("its node's assumption", "holds"))
         duration = 0.0
         finding: Finding | None = None
         for cond in conds:
