@@ -253,3 +253,31 @@ def test_a_helper_created_in_front_of_the_hashed_one_re_runs_the_tests(tmp_path:
     (ws / "backends/property_tests/helper.py").write_text(BAD)  # now found first: what runs changed
     assert _verify(ws) == ("failed", "failed")
     assert _clean(ws, tmp_path / "clean") == ("failed", "failed")
+
+
+@pytest.mark.parametrize("own", [
+    "os.path.dirname(os.path.abspath(__file__))", "os.path.dirname(__file__)",
+    "os.path.abspath(os.path.dirname(__file__))", "str(pathlib.Path(__file__).resolve().parent)",
+    "str(pathlib.Path(__file__).parent)",
+])
+def test_the_ros_idiom_of_putting_its_own_folder_on_sys_path_is_followed(tmp_path: Path, own: str) -> None:
+    """``sys.path.insert(0, <its own folder>)`` then ``import helper`` (a ROS script's idiom): the folder is the
+    harness's first already, so the helper beside it is what runs and is hashed, and a correct helper is
+    discharged (it was inconclusive: 'changes sys.path'); a wrong one fails."""
+    impl = (f"import os, pathlib, sys\nsys.path.insert(0, {own})\nimport helper\n\n"
+            "def agent(x):\n    return {'y': helper.cap(x)}\n")
+    root = _workspace(tmp_path, {"backends/property_tests/helper.py": GOOD}, impl=impl)
+    closure = resolve_closure(root, IMPL)
+    assert closure.unresolved == () and "backends/property_tests/helper.py" in closure.files
+    ev = _evidence(root)
+    assert ev.status == "discharged", ev.explanation
+    (root / "backends/property_tests/helper.py").write_text(BAD)
+    assert _evidence(root).status == "failed"
+
+
+def test_control_another_folder_put_on_sys_path_is_still_named(tmp_path: Path) -> None:
+    impl = ("import os, sys\nsys.path.insert(0, os.path.join(os.path.dirname(__file__), 'lib'))\nimport helper\n\n"
+            "def agent(x):\n    return {'y': helper.cap(x)}\n")
+    root = _workspace(tmp_path, {"backends/property_tests/lib/helper.py": GOOD}, impl=impl)
+    assert f"{IMPL}:2: changes sys.path, so imports are not found where the harness's path says" in \
+        resolve_closure(root, IMPL).unresolved

@@ -29,7 +29,9 @@ What cannot be followed is named, ``file:line: why``, in
 :attr:`Closure.unresolved`, and the harness then gives no verdict
 (inconclusive): an import of a computed name, code loaded from a path
 (``spec_from_file_location``, ``runpy.run_path``, a loader class), a change
-of ``sys.path``, ``sys.meta_path``, ``sys.path_hooks``, ``sys.modules`` or a
+of ``sys.path`` (except ``sys.path.insert(0, <its own folder>)``, the ROS
+script idiom, where that folder is on the harness's path already: the
+implementation's folder and the workspace root), ``sys.meta_path``, ``sys.path_hooks``, ``sys.modules`` or a
 package's ``__path__``, a
 name found nowhere or outside the workspace in no installed distribution, a
 workspace module with the name of one outside it (which of the two runs
@@ -72,6 +74,42 @@ _MUTATORS = frozenset({"insert", "append", "extend", "remove", "pop", "clear", "
                        "__delitem__", "__iadd__", "setdefault", "update"})
 #: the calls that put a module into ``sys.modules`` (taking one out only makes the next import find it again)
 _ADDS = frozenset({"__setitem__", "setdefault", "update"})
+#: :attr:`Ref.problem` of ``sys.path.insert(0, <the module's own folder>)`` (or ``append``): no problem where
+#: that folder is on the harness's path already (:func:`~.importpath.harness_path`), which :class:`_Walk` decides
+OWN_FOLDER = "adds its own folder to sys.path"
+
+
+def _own_folder(e: ast.expr) -> bool:
+    """Whether ``e`` is the folder of the file that runs it, written as ROS scripts write it:
+    ``os.path.dirname(__file__)`` (through ``abspath``/``realpath`` either side), ``Path(__file__).parent``
+    (through ``resolve()``/``absolute()``), either in ``str(...)`` or ``os.fspath(...)``."""
+    if isinstance(e, ast.Call) and _dotted(e.func) in ("str", "os.fspath") and len(e.args) == 1:
+        return _own_folder(e.args[0])
+    if isinstance(e, ast.Call) and _dotted(e.func) in ("os.path.abspath", "os.path.realpath", "os.path.normpath") \
+            and len(e.args) == 1:
+        return _own_folder(e.args[0])
+    if isinstance(e, ast.Call) and _dotted(e.func) == "os.path.dirname" and len(e.args) == 1:
+        return _this_file(e.args[0])
+    if isinstance(e, ast.Attribute) and e.attr == "parent":
+        return _this_file(e.value)
+    if isinstance(e, ast.Call) and isinstance(e.func, ast.Attribute) and e.func.attr in ("resolve", "absolute") \
+            and not e.args:
+        return _own_folder(e.func.value)
+    return False
+
+
+def _this_file(e: ast.expr) -> bool:
+    """Whether ``e`` is the running file's path: ``__file__``, through ``abspath``/``realpath``, ``Path(...)``,
+    ``resolve()``/``absolute()``."""
+    if isinstance(e, ast.Name):
+        return e.id == "__file__"
+    if isinstance(e, ast.Call) and _dotted(e.func) in ("os.path.abspath", "os.path.realpath", "Path",
+                                                       "pathlib.Path") and len(e.args) == 1:
+        return _this_file(e.args[0])
+    if isinstance(e, ast.Call) and isinstance(e.func, ast.Attribute) and e.func.attr in ("resolve", "absolute") \
+            and not e.args:
+        return _this_file(e.func.value)
+    return False
 
 
 def _dotted(e: ast.expr) -> str:
@@ -139,6 +177,8 @@ class _Reader(ast.NodeVisitor):
             self.refs.append(Ref(arg, 0, (), n.lineno) if arg else Ref("", 0, (), n.lineno, f"{name}() of a computed name"))
         elif last in _BY_PATH:
             self.refs.append(Ref("", 0, (), n.lineno, f"{name}() loads code from a path, which no import names"))
+        elif name in ("sys.path.insert", "sys.path.append") and n.args and _own_folder(n.args[-1]):
+            self.refs.append(Ref("", 0, (), n.lineno, OWN_FOLDER))
         elif last in (_MUTATORS if name.rpartition(".")[0] != "sys.modules" else _ADDS) and \
                 name.rpartition(".")[0] in _IMPORT_STATE:
             self._state(n.func.value if isinstance(n.func, ast.Attribute) else n.func, n.lineno)
@@ -227,6 +267,8 @@ class _Walk:
                 continue
             package = name if os.path.basename(path) == "__init__.py" else name.rpartition(".")[0]
             for ref in _imports(path):
+                if ref.problem == OWN_FOLDER and os.path.dirname(path) in self.finder.first:
+                    continue  # the folder is on the harness's path already: what imports find is unchanged
                 self.follow(ref, package, f"{rel}:{ref.line}")
         f = self.finder
         outside = (n for n in self.outside if n not in sys.stdlib_module_names and n not in sys.builtin_module_names)
