@@ -14,7 +14,7 @@ def cmd_standards(args: argparse.Namespace) -> int:
     the trace matrix (CSV), ``--xlsx`` both as a workbook.  Exit 0; 1 (one located line) when there is
     no report or it is of another shape, or openpyxl is missing for ``--xlsx``."""
     from rclverify.report.lastrun import read_report  # deferred: start-up (loads the report's readers only when called)
-    from rclverify.report.standards_export import gaps, matrix_rows, trace_rows, write_csv, write_xlsx
+    from rclverify.report.standards_export import gaps, matrix_rows, trace_rows, write_csv, write_xlsx  # deferred: start-up (the exports, only when called)
     report = read_report(Path(args.workspace))
     lines = gaps(report)
     print("\n".join(lines) if lines else "the plan maps no standard (docs/standards.md)")
