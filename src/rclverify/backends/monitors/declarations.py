@@ -50,6 +50,11 @@ declaration's source, so a requirement resting on it
 them in by the rule of evidence (docs/semantics.md, "Verdicts and
 evidence"; :func:`declaration_status`, :func:`with_declarations`): a
 declaration pending or undecided never leaves the record ``discharged``.
+
+Long module: the monitor of the declarations on a run and the fold of their
+verdicts into the record's status (:func:`declaration_status`,
+:func:`with_declarations`) read the same rows and the same rule of
+evidence, and are read together by every engine that judges runs.
 """
 from __future__ import annotations
 

@@ -48,6 +48,11 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
 
 SIGINT is ignored (the monitor stops the agent when it stops: ``stop`` or
 the end of stdin), so a Ctrl-C in a terminal does not cut the stream short.
+
+Long module: it runs as one script in another Python (a ROS 2 installation's),
+importing rclpy, the standard library and :mod:`wire` beside it only, so the
+taps, the graph, the services' ends and the type descriptions it serves live
+in one file that any ROS 2 Python can run.
 """
 from __future__ import annotations
 
