@@ -251,3 +251,15 @@ def test_a_class_the_package_re_exports_is_followed_to_its_module() -> None:
     g = scan([WS / "src" / "rover_tools"]).graph
     assert _edges(g, "/beacon_node") == {("pub", "/rover_beacon", "std_msgs/msg/String")}
     assert not _said(g)
+
+
+def test_a_child_node_is_its_class_and_a_reference_member_makes_nothing() -> None:
+    """OdomServer makes ``Odometer("wheel_odometer", ...)`` and lends it to a
+    helper holding ``Odometer & odometer_``: two nodes, the odometer's publisher
+    its own.  Before: ``odometer_(odometer)`` was read as a construction through
+    Odometer's one-argument constructor (a third node, ``/odometer``), and every
+    node named through the shared base class's constructor got every endpoint."""
+    g = scan([WS / "src" / "rover_odom", WS / "src" / "rover_core"]).graph
+    assert sorted(g.nodes) == ["/odom_server", "/wheel_odometer"]
+    assert _edges(g, "/wheel_odometer") == {("pub", "/odom", "nav_msgs/msg/Odometry")}
+    assert _edges(g, "/odom_server") == set()

@@ -288,6 +288,8 @@ class CppScope:
                 if nm is None:
                     continue
                 info["members"][_T(nm)] = ty
+                if d.type == "reference_declarator":  # Costmap & costmap_: bound in a constructor, never made
+                    info.setdefault("refs", []).append(_T(nm))
                 if dv is not None:
                     v = dv.named_children[0] if dv.type == "initializer_list" and len(dv.named_children) == 1 else dv
                     self.fields.setdefault((name, _T(nm)), []).append((None, v))

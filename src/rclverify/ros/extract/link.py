@@ -128,6 +128,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
                 cur = self.units.setdefault(u, {"bases": [], "members": {}})
                 cur["bases"] += [b for b in info["bases"] if b not in cur["bases"]]
                 cur["members"].update(info["members"])
+                cur.setdefault("refs", []).extend(r for r in info.get("refs", []) if r not in cur["refs"])
                 if info.get("tparams"):
                     cur["tparams"] = info["tparams"]
                 if f in prog.entry:
@@ -245,6 +246,8 @@ class Linker(LinkMembers, Values, Returns, Instances):
             info = self.units.get(unit or "", {})
             ty = info.get("members", {}).get(callee)
             cls = self.match(_held(ty), unit) if ty else None
+            if cls is not None and callee in info.get("refs", []):
+                return None, cls  # a reference member bound to what the constructor is given: nothing made
             if cls is not None and _held(ty) != split_template(ty.replace(" ", ""))[0].replace("*", "").strip():
                 return None, cls  # a pointer member: made by the new/make_shared it is given
             base = callee.split("<")[0].split("::")[-1]  # ClientBase<ServiceT>(node, name): a template base
@@ -472,7 +475,8 @@ class Linker(LinkMembers, Values, Returns, Instances):
                                                f"gives one)"))
                                 nsv = None
                             # "" and no namespace are the same (a base's default ns = "")
-                            item = (t, src, (symbols.text(nsv) or None) if nsv is not None else None, unit, pins)
+                            item = (t, src, (symbols.text(nsv) or None) if nsv is not None else None,
+                                    self.made_as(unit, fkey, pins), pins)
                             if not any(x[0] == t and x[2] == item[2] for x in named):
                                 named.append(item)
                                 out.kinds.append(kind)
@@ -480,6 +484,21 @@ class Linker(LinkMembers, Values, Returns, Instances):
                                 out.files.append(f)
         self.pin({})
         return named
+
+    def made_as(self, unit: str | None, fkey: str | None, pins: dict[str, int]) -> str | None:
+        """The class a node named in ``unit``'s constructor ``fkey`` is, read at the
+        call site ``pins`` names: a base class's constructor called from a derived
+        class's constructor (``Odometer(name) : ManagedNode(name)``) makes a node of
+        the derived class, whose own endpoints are that node's; else ``unit``."""
+        if unit is None or fkey is None or fkey not in pins or fkey.split("#")[0] != self._ctor(unit):
+            return unit
+        sites = self.sites.get(fkey, [])
+        caller = sites[pins[fkey]][2] if pins[fkey] < len(sites) else None
+        cunit = self.fns[caller][0] if caller in self.fns else None
+        if cunit is None or cunit == unit or caller.split("#")[0] != self._ctor(cunit) or \
+                f"U:{unit}" not in self._reach({f"U:{cunit}"}):
+            return unit
+        return cunit
 
     def user_creates(self, note: Callable[[Note], None]) -> None:
         """A located note at each call of a user's method named like rclcpp's

@@ -237,8 +237,8 @@ class _File(CallReader, MemberReader):
                                   if n.type == "function_definition" and n.id in s.fns and n.parent is not None
                                   and n.parent.type == "template_declaration"}
         self.out["aliases"] = self.aliases
-        self.out["units"] = {c: {"bases": i["bases"], "members": i["members"], "tparams": i.get("tparams", [])}
-                             for c, i in s.classes.items()}
+        self.out["units"] = {c: {"bases": i["bases"], "members": i["members"], "tparams": i.get("tparams", []),
+                                 "refs": i.get("refs", [])} for c, i in s.classes.items()}
         self.out["fields"] = s.field_values()
         self.out["consts"] = {k: v for k, v in ((k, s._one([s.value(x) if not isinstance(x, tuple) else x
                                                              for x in vs])) for k, vs in s.consts.items())
