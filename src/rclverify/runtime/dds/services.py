@@ -71,6 +71,9 @@ LATE_S = 1.0
 #: seconds an endpoint goes unheard with contents before it is said not judged (the graph's reading of a node
 #: that just appeared may list its service before its event publisher)
 ENDPOINT_GRACE_S = 1.5
+#: seconds before a sample's stamp the endpoints last read still count for it (the graph is read each 0.5 s and a
+#: sample is taken 0.3 s after its stamp or later: an endpoint that left meanwhile was there when it was written)
+RECENT_S = 1.0
 #: the introspection event parts of an action that tell its goals and results (cancel's only tell cancels)
 _GOAL_EVENTS = ("goal_event", "result_event")
 #: action_msgs/msg/GoalStatus values (ROS 2 design "Actions")
@@ -121,6 +124,8 @@ class CallTaps:
         #: when the monitor began (s, the first sample's or tick's receipt time): an event of a request stamped
         #: more than :data:`LATE_S` before it opens no call, and its answer is named undecided (docs/ros2.md)
         self.started: float | None = None
+        #: (link, "servers" | "clients" | an event part) -> endpoint -> when last read (s)
+        self._seen: dict[tuple[str, str], dict[str, float]] = {}
         self._shadow_guids: dict[str, set[bytes]] = {}  # reply topic -> monitors' shadow writers (read each 0.5 s)
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
@@ -332,6 +337,13 @@ class CallTaps:
             servers, clients = self._ends(name)
             part = "event" if kind == "service" else "goal_event"
             pubs = self._publishing(name, part)
+            parts = ("event",) if kind == "service" else ("goal_event", "result_event", "cancel_event")
+            for what, ends in (("servers", servers), ("clients", clients),
+                               *((p, pubs if p == part else self._publishing(name, p)) for p in parts)):
+                seen = self._seen.setdefault((name, what), {})
+                seen.update(dict.fromkeys(ends, now))
+                for gone in [e for e, t in seen.items() if t < now - 10 * RECENT_S]:
+                    del seen[gone]
             levels = {o: self._levels.get((name, o), "contents") for o in pubs}
             for end, why in uncovered(set(servers), set(clients), levels).items():
                 k = (name, end, why)
@@ -409,7 +421,7 @@ class CallTaps:
                     self.book.unpaired(p.key, now, why)
             self._servers_seen[pname] = (frozenset(rr.heard), frozenset(pairer.servers))
 
-    def _side(self, name: str, stamp: float, part: str = "event") -> str | None:
+    def _side(self, name: str, stamp: float, part: str = "event", writer: bytes | None = None) -> str | None:
         """Which side's introspection events (tap ``part``) pair the calls of
         service or action ``name`` at the sample stamped ``stamp``
         (:func:`~.introspection.side_of` on the endpoints that publish them
@@ -417,7 +429,9 @@ class CallTaps:
         call (every server publishes, or every client), else it pairs the
         request and reply topics; the rclpy source, which hears nothing else,
         takes the side some endpoint publishes (the others are said not
-        judged: :meth:`_coverage`).  When the side changes (an event writer
+        judged: :meth:`_coverage`), the endpoints read up to :data:`RECENT_S`
+        s before the sample's stamp and the event's own ``writer`` counted
+        (a node that left since was there).  When the side changes (an event writer
         discovered after calls began, gone, or seen to publish metadata only),
         the calls the other source opened can no longer be answered by it:
         they are unpaired."""
@@ -426,7 +440,13 @@ class CallTaps:
             side = None
         elif self._ends is not None:
             servers, clients = self._ends(name)
-            side = side_of(self._contents(name, part), set(servers), set(clients), partial=self.events)
+            recent = {what: {e for e, t in self._seen.get((name, what), {}).items() if t >= stamp - RECENT_S}
+                      for what in ("servers", "clients", part)}
+            pubs = self._contents(name, part) | {o for o in recent[part] if self._levels.get((name, o)) != "metadata"}
+            if writer is not None and self._levels.get((name, self._owner(writer))) != "metadata":
+                pubs.add(self._owner(writer))
+            side = side_of(pubs, set(servers) | recent["servers"], set(clients) | recent["clients"],
+                           partial=self.events)
         else:
             rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("reply", "request"))
             if rep is None or req is None:
@@ -453,7 +473,7 @@ class CallTaps:
 
     def _event(self, name: str, s: Any, stamp: float, now: float, writer: bytes | None = None) -> None:
         self._level(name, writer, s)
-        side = self._side(name, stamp)
+        side = self._side(name, stamp, writer=writer)
         if side is None:
             return
         asked, told = SIDES[side]
@@ -485,7 +505,7 @@ class CallTaps:
                       writer: bytes | None = None) -> None:
         """An introspection event of one of action ``name``'s own services (module docstring, events only)."""
         self._level(name, writer, s)
-        side = self._side(name, stamp, part)
+        side = self._side(name, stamp, part, writer)
         if side is None:
             return
         asked, told = SIDES[side]
