@@ -19,6 +19,7 @@
 ``rclverify review NODE [-o FILE]``  write a review record to fill in
 ``rclverify ros scan PATH...``     the ROS computation graph from workspaces (docs/ros.md)
 ``rclverify ros check``            the plan's contracts against that graph
+``rclverify nodl check``           the NoDL documents against the contracts (docs/nodl.md)
 ``rclverify lsp``                  the RCL language server over stdio (docs/editor.md)
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
@@ -53,6 +54,11 @@ def _generate(sub: Any) -> None:
     add_parsers(sub)
 
 
+def _nodl(sub: Any) -> None:
+    from rclverify.cli.nodl import add_parsers  # deferred: start-up (loads rclverify.cli.nodl only when called)
+    add_parsers(sub)
+
+
 def _lsp(sub: Any) -> None:
     from rclverify.cli.lsp import add_parsers  # deferred: start-up (loads rclverify.cli.lsp only when called)
     add_parsers(sub)
@@ -66,8 +72,8 @@ COMMANDS: tuple[Callable[[AddCommand], None], ...] = (
     workspace.add_init, bundle.add_bundle, workspace.add_review, calculus.add_quotient_refines,
     standards.add_standards,
 )
-#: The commands with subcommands of their own (``ros``, ``generate``), and ``lsp``: each adds to the subparsers.
-SUBCOMMAND_GROUPS: tuple[Callable[[Any], None], ...] = (_ros, _generate, _lsp)
+#: The commands with subcommands of their own (``ros``, ``nodl``, ``generate``), and ``lsp``: each adds to the subparsers.
+SUBCOMMAND_GROUPS: tuple[Callable[[Any], None], ...] = (_ros, _nodl, _generate, _lsp)
 #: Listed after them: monitoring recorded and live runs (docs/monitors.md).
 LAST_COMMANDS: tuple[Callable[[AddCommand], None], ...] = (runs.add_monitor, runs.add_oracle)
 

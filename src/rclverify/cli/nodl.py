@@ -1,0 +1,103 @@
+"""``rclverify nodl``: NoDL v2 node interface documents (docs/nodl.md).
+
+``rclverify nodl check``          the workspace's documents against its contracts and each other
+``rclverify nodl validate FILE...`` documents against the schema, their includes followed
+``rclverify nodl write [-o DIR]`` one document per node from its contract
+
+Exit codes: 0 nothing found (``check``: no error, or under ``--strict`` no
+warning either); 1 a finding, a document that cannot be read (located
+``file:line:col: error:`` lines, printed by ``rclverify``'s main), or
+contracts that do not check; 2 usage errors.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+
+def add_parsers(sub: Any) -> None:
+    """Add the ``nodl`` command and its ``check``, ``validate`` and ``write`` subcommands."""
+    g = sub.add_parser("nodl", help="NoDL node interface documents: check, validate, write (docs/nodl.md)",
+                       description="NoDL v2 node interface documents beside the contracts (docs/nodl.md)")
+    gs = g.add_subparsers(dest="nodl_command", required=True)
+
+    def common(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--ament-prefix", action="append", default=[], metavar="DIR",
+                        help="an install prefix whose ament index resolves nodl:// includes (repeatable)")
+
+    c = gs.add_parser("check", help="the workspace's NoDL documents against its contracts and each other")
+    c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
+    c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
+    c.add_argument("--nodl", metavar="DIR", help="folder of the documents (default: nodl/ in the workspace)")
+    c.add_argument("--json", metavar="FILE", help="also write the findings as JSON")
+    c.add_argument("--strict", action="store_true", help="exit 1 on a warning too")
+    common(c)
+    c.set_defaults(fn=cmd_check)
+    v = gs.add_parser("validate", help="NoDL documents against the schema, their includes followed")
+    v.add_argument("files", nargs="+", metavar="FILE")
+    common(v)
+    v.set_defaults(fn=cmd_validate)
+    w = gs.add_parser("write", help="one NoDL document per node from its contract")
+    w.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
+    w.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
+    w.add_argument("-o", "--output", metavar="DIR", help="folder written (default: nodl/ in the workspace)")
+    w.add_argument("nodes", nargs="*", metavar="NODE", help="the nodes (default: every node)")
+    w.set_defaults(fn=cmd_write)
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """Print each finding once per place it involves; see the module docstring for the exit code."""
+    from rclverify.model.nodl.check import check  # deferred: start-up (loads jsonschema, yaml and more only when called)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    ws = Path(args.workspace)
+    checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
+    folder = Path(args.nodl) if args.nodl else None
+    res = check(checked, ws, folder, [Path(p) for p in args.ament_prefix])
+    for f in res.findings:
+        for line in f.lines():
+            print(line, file=sys.stderr)
+    warnings = len(res.findings) - res.errors
+    print(f"{len(res.documents)} node document(s) and {len(res.parts)} part(s) read; "
+          f"{res.errors} error(s), {warnings} warning(s)")
+    if args.json:
+        from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
+        data = {"documents": {n: d.files for n, d in sorted(res.documents.items())},
+                "parts": [d.file for d in res.parts], "findings": [f.to_json() for f in res.findings]}
+        write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
+    return 1 if res.errors or (args.strict and warnings) else 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    """Read each file as a NoDL document; prints one line per valid file."""
+    from rclverify.model.nodl.check import read_all, shown  # deferred: start-up (loads jsonschema, yaml and more only when called)
+    from rclverify.model.nodl.document import Resolver  # deferred: start-up (loads jsonschema, yaml and more only when called)
+    resolver = Resolver([Path(p) for p in args.ament_prefix], shown(Path(".")))
+    for doc in read_all([Path(f) for f in args.files], resolver):  # raises RclError, printed located by main
+        n = len(doc.endpoints)
+        print(f"{doc.file}: valid NoDL v2: {n} endpoint(s), {len(doc.parameters)} parameter(s)"
+              + (f", {len(doc.files) - 1} included document(s)" if len(doc.files) > 1 else ""))
+    return 0
+
+
+def cmd_write(args: argparse.Namespace) -> int:
+    """Write ``<Node>.nodl.yaml`` per node; prints each file written."""
+    from rclverify.model.nodl.contract import document_text  # deferred: start-up (loads yaml and more only when called)
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.records only when called)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    ws = Path(args.workspace)
+    checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
+    unknown = [n for n in args.nodes if n not in checked.nodes]
+    if unknown:
+        print(f"error: no node {unknown[0]!r} in the contracts (nodes: {', '.join(checked.nodes)})", file=sys.stderr)
+        return 2
+    out = Path(args.output) if args.output else ws / "nodl"
+    texts = {n: document_text(cn, cn.node.loc.file, "written by rclverify nodl write from the RCL contract")
+             for n, cn in checked.nodes.items() if not args.nodes or n in args.nodes}  # raises RclError (located)
+    for name, text in texts.items():
+        path = out / f"{name}.nodl.yaml"
+        atomic_write_text(path, text)
+        print(path)
+    return 0
