@@ -125,7 +125,7 @@ class CallTaps:
         #: more than :data:`LATE_S` before it opens no call, and its answer is named undecided (docs/ros2.md)
         self.started: float | None = None
         #: (link, "servers" | "clients" | an event part) -> endpoint -> when last read (s)
-        self._seen: dict[tuple[str, str], dict[str, float]] = {}
+        self._ends_seen: dict[tuple[str, str], dict[str, float]] = {}
         self._shadow_guids: dict[str, set[bytes]] = {}  # reply topic -> monitors' shadow writers (read each 0.5 s)
         self._asked: dict[bytes, int] = {}  # requests heard per writer without identity
         self._changes: dict[str, tuple[int, int]] = {}  # pairer name -> its readers' reader_changes seen
@@ -340,7 +340,7 @@ class CallTaps:
             parts = ("event",) if kind == "service" else ("goal_event", "result_event", "cancel_event")
             for what, ends in (("servers", servers), ("clients", clients),
                                *((p, pubs if p == part else self._publishing(name, p)) for p in parts)):
-                seen = self._seen.setdefault((name, what), {})
+                seen = self._ends_seen.setdefault((name, what), {})
                 seen.update(dict.fromkeys(ends, now))
                 for gone in [e for e, t in seen.items() if t < now - 10 * RECENT_S]:
                     del seen[gone]
@@ -440,7 +440,7 @@ class CallTaps:
             side = None
         elif self._ends is not None:
             servers, clients = self._ends(name)
-            recent = {what: {e for e, t in self._seen.get((name, what), {}).items() if t >= stamp - RECENT_S}
+            recent = {what: {e for e, t in self._ends_seen.get((name, what), {}).items() if t >= stamp - RECENT_S}
                       for what in ("servers", "clients", part)}
             pubs = self._contents(name, part) | {o for o in recent[part] if self._levels.get((name, o)) != "metadata"}
             if writer is not None and self._levels.get((name, self._owner(writer))) != "metadata":
