@@ -263,3 +263,53 @@ def test_a_child_node_is_its_class_and_a_reference_member_makes_nothing() -> Non
     assert sorted(g.nodes) == ["/odom_server", "/wheel_odometer"]
     assert _edges(g, "/wheel_odometer") == {("pub", "/odom", "nav_msgs/msg/Odometry")}
     assert _edges(g, "/odom_server") == set()
+
+
+def test_a_type_the_code_chooses_at_run_time_grounds_as_the_contract_says(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A node publishing ``cmd`` as ``TwistStamped`` or ``Twist`` by a parameter (Nav2's
+    twist publisher): its own skeleton grounds with a warning, not an error; a
+    contract type the node's code never makes stays an error."""
+    import json
+
+    from rclverify.cli.commands import main
+    pkg = tmp_path / "src" / "pilot"
+    (pkg / "scripts").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<?xml version="1.0"?>\n<package format="3"><name>pilot</name><version>0.1.0</version><description>d'
+        '</description><maintainer email="dev@example.org">dev</maintainer><license>MIT</license>'
+        '<exec_depend>rclpy</exec_depend><export><build_type>ament_python</build_type></export></package>\n')
+    (pkg / "scripts" / "pilot.py").write_text(
+        "#!/usr/bin/env python3\nimport rclpy\nfrom geometry_msgs.msg import Twist, TwistStamped\n"
+        "rclpy.init()\nn = rclpy.create_node('pilot')\n"
+        "if n.declare_parameter('stamped', True).value:\n"
+        "    pub = n.create_publisher(TwistStamped, 'cmd', 1)\n"
+        "else:\n"
+        "    pub = n.create_publisher(Twist, 'cmd', 1)\n")
+    ws = tmp_path / "ws"
+    assert main(["init", str(ws), "--from-ros", str(tmp_path / "src")]) == 0
+    capsys.readouterr()
+    out = tmp_path / "ground.json"
+
+    def codes() -> list[str]:
+        main(["ros", "check", "-w", str(ws), "--json", str(out)])
+        return [f["code"] for f in json.loads(out.read_text())["findings"]]
+    got = codes()
+    assert "ROS-TYPE-ALTERNATIVE" in got and "ROS-TYPE-DIFFERS" not in got, got
+    rcl = next((ws / "contracts").glob("pilot*.rcl"))
+    text = rcl.read_text()
+    for t in ("geometry_msgs/TwistStamped", "geometry_msgs/Twist"):
+        if t in text:  # control: a type the code never makes is an error
+            rcl.write_text(text.replace(t, "geometry_msgs/Vector3"))
+            break
+    got = codes()
+    assert "ROS-TYPE-DIFFERS" in got, got
+
+
+def test_the_node_name_inside_a_name_is_not_read_as_tilde() -> None:
+    """``std::string("get_cost_") + get_name()`` is ``get_cost_<node name>``: not
+    ``/get_cost_~`` (a wrong name, silently, before); ``get_name() + "/x"`` stays
+    ``~/x``."""
+    from rclverify.ros.extract import symbols
+    assert symbols.text(symbols.cat([symbols.lit("get_cost_"), symbols.NODE])) is None
+    assert symbols.text(symbols.cat([symbols.NODE, symbols.lit("/x")])) == "~x"  # private x

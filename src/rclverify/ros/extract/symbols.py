@@ -126,7 +126,8 @@ def is_concrete(v: Val) -> bool:
 
 def text(v: Val) -> str | None:
     """The string a concrete value stands for (``("node",)`` is ``~``, the node's
-    own name); ``None`` for a parameter read, a handle or anything unknown."""
+    own name, as the first part of a name only); ``None`` for a parameter read,
+    a handle, a name with the node's name after its start, or anything unknown."""
     if v is None:
         return None
     if v[0] == "str":
@@ -136,6 +137,8 @@ def text(v: Val) -> str | None:
     if v[0] == "each":
         return f"[{v[1]}]"
     if v[0] == "cat":
+        if any(x is not None and x[0] == "node" for x in v[1][1:]):
+            return None  # "get_cost_" + get_name(): the node's bare name inside a name, which "~" is not
         parts = [text(x) for x in v[1]]
         if any(p is None for p in parts):
             return None

@@ -61,6 +61,8 @@ RULES: dict[str, tuple[str, str]] = {
     "ROS-TOPIC-NOT-SUBSCRIBED": ("warning", "a contract input's topic that its node does not subscribe to"),
     "ROS-TYPE-UNKNOWN": ("error", "a contract topic's message type that no package defines"),
     "ROS-TYPE-DIFFERS": ("error", "a contract topic's message type differs from the graph's"),
+    "ROS-TYPE-ALTERNATIVE": ("warning", "a contract topic's message type is one of several its node's code "
+                                        "makes the topic with, chosen at run time"),
     "ROS-FIELD-MISSING": ("error", "a field path the topic's message does not have"),
     "ROS-FIELD-TYPE": ("error", "an RCL variable's type does not match the ROS field it is read from"),
     "ROS-TOPIC-UNDOCUMENTED": ("warning", "a topic the node's code publishes or subscribes to that its contract leaves out"),
@@ -292,7 +294,17 @@ class Grounder:
                          rcl_loc, type_src, node.name, tp.field)
                 continue
             assert ctype is not None  # the table knows no type without a name
-            differs = sorted(t for t in graph_types if t != ctype)
+            # the node's own code may make the topic with several types, one chosen at run time (a
+            # parameter picks TwistStamped or Twist): the contract naming one of them is that choice
+            own = {e.msg_type for e in (gn.publishes if kind == "pub" else gn.subscribes)
+                   if edge is not None and e.topic == edge.topic and e.msg_type}
+            chosen = ctype in own and len(own) > 1
+            differs = sorted(t for t in graph_types if t != ctype and not (chosen and t in own))
+            if chosen and not differs:
+                self.add("ROS-TYPE-ALTERNATIVE", f"topic '{tp.field}' is made as "
+                         f"{', '.join(short_type(t) for t in sorted(own))} in {gn.name}'s code, one of them chosen "
+                         f"at run time; the contract says {tp.msg_type}, checked as that", rcl_loc, type_src,
+                         node.name, tp.field)
             if differs:
                 self.add("ROS-TYPE-DIFFERS", f"topic '{tp.field}' carries {', '.join(short_type(t) for t in differs)} "
                          f"in the code, the contract says {tp.msg_type}", rcl_loc, type_src, node.name, tp.field)
