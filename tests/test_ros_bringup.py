@@ -309,7 +309,7 @@ def test_a_type_the_code_chooses_at_run_time_grounds_as_the_contract_says(
 def test_the_node_name_inside_a_name_is_not_read_as_tilde() -> None:
     """``std::string("get_cost_") + get_name()`` is ``get_cost_<node name>``: not
     ``/get_cost_~`` (a wrong name, silently, before); ``get_name() + "/x"`` stays
-    ``~/x``."""
+    the private ``~x``."""
     from rclverify.ros.extract import symbols
     assert symbols.text(symbols.cat([symbols.lit("get_cost_"), symbols.NODE])) is None
     assert symbols.text(symbols.cat([symbols.NODE, symbols.lit("/x")])) == "~x"  # private x
