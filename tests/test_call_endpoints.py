@@ -211,3 +211,26 @@ def test_a_request_event_stamped_before_the_monitor_began_is_named_undecided(bef
         assert summary["counts"]["calls"] == 1 and summary["undecided"] == {}
         base = next(r for r in summary["nodes"] if r["node"] == "Base")
         assert base["counts"]["violated"] == 1
+
+
+@pytest.mark.parametrize("result_events", [True, False])
+def test_an_action_server_is_covered_only_with_its_goal_and_result_events(result_events: bool) -> None:
+    """An action's goals are heard through its send-goal events and their results through its get-result
+    events: a server publishing both covers its clients (the control); one publishing only the send-goal
+    events leaves the action not judged for it and for its clients."""
+    lines: list[dict[str, Any]] = []
+    taps, _types = _taps(lines, set(), set())
+    server, client = b"\x05" * 16, b"\x0a" * 16
+    taps._node_of = {server: "/s", client: "/a"}.get
+    taps._ends = lambda name: ({"/s"}, {"/a"}) if name == "/move" else (set(), set())
+    taps.taps = {"call:/move:goal_event": SimpleNamespace(heard={server}),
+                 "call:/move:result_event": SimpleNamespace(heard={server} if result_events else set())}
+    for now in (20.0, 21.0, 22.0):
+        taps.tick(now)
+    summary = taps.finish()
+    if result_events:
+        assert "move" not in summary["unjudged"], summary["unjudged"]
+    else:
+        assert set(summary["unjudged"]["move"]) == {"server /s", "client /a"}, summary["unjudged"]
+        mover = next(r for r in summary["nodes"] if r["node"] == "Mover")
+        assert mover["counts"]["inconclusive"] == 2
