@@ -15,8 +15,8 @@ counted, not decoded:
   under its identity (the client's writer handle and the sequence number),
   the reply with the same identity answers it;
 * **without it** (rmw_fastrtps): the service's introspection events pair
-  request and reply exactly when the server (or every client) publishes
-  them; else the order pairs them where it is certain
+  request and reply exactly when every server (or every client) publishes
+  them with contents; else the order pairs them where it is certain
   (:mod:`.dds_order`), and says which calls it cannot pair;
 * **an action**: a goal opens its call under its ``goal_id``, the feedback
   messages and the get-result reply carrying that goal id answer it (the
@@ -32,10 +32,18 @@ cancels from the introspection events of its own three services
 (``<a>/_action/send_goal/_service_event``, ``get_result``'s, ``cancel_goal``'s;
 the goal id in each request names the goal, the event's client gid and
 sequence number name the reply), its feedback and status from their
-topics.  Whose events are read (the server's, else every client's) is
-decided from the serving and calling nodes the graph API reports
-(:func:`~.introspection.side_of`).  A link none of whose nodes publish
-events is not heard, and is said so.
+topics.  Whose events are read (the servers', else the clients') is
+decided from the serving and calling nodes the graph API reports and the
+nodes that publish the events (:func:`~.introspection.side_of`).  A link
+none of whose nodes publish events is not heard, and is said so; an
+endpoint not heard with contents (its introspection off, or metadata as its
+events show) is told to the call book as not judged
+(:meth:`CallTaps._coverage`, docs/ros2.md "Every endpoint of a call
+accounted for").
+
+An answer whose request was not heard, and an event of a request stamped
+more than :data:`LATE_S` before the monitor began, leave an answer the book
+names undecided (:meth:`~.dds_calls.CallBook.orphan`).
 
 Samples are taken in the order of their DDS source timestamps: each waits
 :data:`SETTLE_S` seconds after its stamp (so that a request taken after its
