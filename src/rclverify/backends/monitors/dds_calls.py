@@ -33,6 +33,14 @@ each call (each goal) is checked as a trace of its own (docs/monitors.md,
   ``false`` as soon as its deadline has passed, and a late answer is shown
   with its stamp (an ``update``).
 
+What no call's trace can decide is still said: an answer whose request was
+not heard (:meth:`CallBook.orphan`: made before the monitor started) and an
+endpoint of a link not heard with contents (:meth:`CallBook.unjudged`) each
+keep the link's nodes from ``discharged`` (one more ``inconclusive``) and
+are named in their explanation (:meth:`CallBook.with_notes`), in the
+summary (``undecided``, ``unjudged``) and in the log's lines, so the replay
+says the same (docs/monitors.md, "Every endpoint of a call accounted for").
+
 A call is dropped from memory once it is answered and nothing about it is
 pending, or :data:`LINGER_S` seconds after its horizon and deadlines passed
 unanswered; at most ``max_calls`` are kept (the oldest is closed first,
@@ -439,4 +447,4 @@ def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]
     return book.finish()
 
 
-__all__ = ["CALL_LOG_TOPIC", "CallBook", "LINGER_S", "link_view", "replay", "replay_line"]
+__all__ = ["CALL_LOG_TOPIC", "CallBook", "LINGER_S", "NAMED", "link_view", "replay", "replay_line"]
