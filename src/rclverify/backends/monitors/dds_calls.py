@@ -411,7 +411,9 @@ def replay_line(book: CallBook, x: Mapping[str, Any]) -> None:
     line (written where a live tick decided something) moves the clock as the
     live timer did; an ``unpaired`` line leaves its call inconclusive with the
     live reason; a ``rejected`` line closes its goal as the live book did; an
-    ``orphan`` answer (no call of its identity was open) is counted.  Raises
+    ``orphan`` answer (no call of its identity was open) is counted and named
+    undecided (:meth:`CallBook.orphan`); an ``unjudged`` line says an
+    endpoint not heard with contents (:meth:`CallBook.unjudged`).  Raises
     ``KeyError``, ``TypeError`` or ``ValueError`` for a call line missing its
     keys (a log not written by the monitor)."""
     if x.get("kind") != "call":
