@@ -78,7 +78,8 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     report: list[Mapping[str, object]] = []
     for trace in args.traces:
         try:
-            run = check_recorded(checked, nodes, cfg, root, trace, lambda w: print(w, file=sys.stderr))
+            run = check_recorded(checked, nodes, cfg, root, trace, lambda w: print(w, file=sys.stderr),
+                                 margins=args.json)  # the margins (docs/semantics.md) are in the JSON only
         except TraceError as exc:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)

@@ -58,13 +58,14 @@ import itertools
 import math
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.unitcheck import UnitChecker
 from rclverify.lang.units import best_name, canonical_text
+from rclverify.semantics.eval_closures import _compile
 from rclverify.semantics.evaluator import Evaluator
 from rclverify.semantics.floatsem import MAX_ENUMERATION, _Double, _finite_domain
 from rclverify.semantics.operators import OPERATORS, Undecided
@@ -124,35 +125,27 @@ class _Margins:
     def truth(self, e: ast.Expr, b: Mapping[str, Value], holds: bool) -> _R:
         return (INF if holds else -INF), None
 
-    def rob(self, e: ast.Expr, b: Mapping[str, Value], idx: frozenset[str] = frozenset()) -> _R:  # a flat dispatch
+    def rob(self, e: ast.Expr, b: Mapping[str, Value], idx: frozenset[str] = frozenset()) -> _R:
         """The margin of ``e`` under bound variables ``b``; ``idx``: the bound
         variables that range over a type (an index, not a value of the run)."""
-        if isinstance(e, ast.BoolLit):
-            return self.truth(e, b, e.value)
-        if isinstance(e, ast.Unary) and e.op == "not":
-            r, at = self.rob(e.operand, b, idx)
-            return -r, at
-        if isinstance(e, ast.Binary) and e.op in ("and", "or", "->", "<=>"):
-            return self.connective(e, b, idx)
-        if isinstance(e, ast.Compare):
-            return self.compare(e, b, idx)
-        if isinstance(e, ast.Member):
-            return self.member(e, b, idx)
-        if isinstance(e, ast.Quant):
-            return self.quant(e, b, idx)
-        if isinstance(e, ast.TupleQuant):
-            return self.tuple_quant(e, b, idx)
-        return self.truth(e, b, bool(self.ev.eval(e, b)))  # a BOOL value, a function's BOOL result
+        return self.compiled(e, frozenset(b), idx)(self, b)
+
+    def compiled(self, e: ast.Expr, scope: frozenset[str], idx: frozenset[str]) -> Callable[..., _R]:
+        """``e``'s margin as nested closures ``f(margins, bound)`` for the bound
+        names ``scope`` (:func:`_build`), made once per formula, node and scope."""
+        ev = self.ev
+        node = ev.node
+        key = (id(e), scope, idx, id(node), id(ev.env), ev.mode)
+        hit = _CLOSURES.get(key)
+        if hit is None or hit[0] is not e or hit[1] is not node:
+            if len(_CLOSURES) >= 4096:
+                _CLOSURES.clear()
+            hit = _CLOSURES[key] = (e, node, _build(e, scope, idx, _Static(ev.io_names, ev.env, node, ev.mode)))
+        return hit[2]
 
     def measured(self, terms: Any, b: Mapping[str, Value], idx: frozenset[str]) -> bool:
-        """Whether ``terms`` read a value of the run: an input or output, or a
-        variable bound to an element of a collection (not one ranging over a type)."""
-        io = self.ev.io_names
-        for t in terms:
-            for v in _vars(t):
-                if v.prefix is not None or (v.name in b and v.name not in idx) or (v.name not in b and v.name in io):
-                    return True
-        return False
+        """Whether ``terms`` read a value of the run (:func:`_measured`)."""
+        return _measured(terms, b, idx, self.ev.io_names)
 
     def connective(self, e: ast.Binary, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
         left, right = self.rob(e.left, b, idx), self.rob(e.right, b, idx)
@@ -249,10 +242,11 @@ class _Margins:
         """``forall`` (min), ``exists`` (max) or ``exists_unique`` (``min(r1, -r2)``) of ``body``."""
         best: _R = (INF, None) if kind == "forall" else (-INF, None)
         second: _R = (-INF, None)
+        f = self.compiled(body, frozenset(b) | frozenset(names), idx)
         for combo in combos:
             cur = dict(b)
             cur.update(zip(names, combo))
-            r = self.rob(body, cur, idx)
+            r = f(self, cur)
             if kind == "forall":
                 best = _min(best, r)
             elif r[0] > best[0]:
@@ -262,6 +256,91 @@ class _Margins:
         if kind == "exists_unique":
             return _min(best, _neg(second))
         return best
+
+
+def _measured(terms: Any, b: Any, idx: frozenset[str], io: frozenset[str]) -> bool:
+    """Whether ``terms`` read a value of the run: an input or output (``io``:
+    the node's I/O names), or a variable bound (``b``: the bound names) to an
+    element of a collection (not one ranging over a type, ``idx``)."""
+    for t in terms:
+        for v in _vars(t):
+            if v.prefix is not None or (v.name in b and v.name not in idx) or (v.name not in b and v.name in io):
+                return True
+    return False
+
+
+@dataclass(frozen=True)
+class _Static:
+    """What a closure is built for: the node's I/O names ``io``, the contract's
+    environment ``env``, the node and the evaluator's number ``mode``."""
+
+    io: frozenset[str]
+    env: Any
+    node: CheckedNode
+    mode: str | None
+
+
+def _build(e: ast.Expr, scope: frozenset[str], idx: frozenset[str], st: _Static) -> Callable[..., _R]:  # long: one closure per formula class, a flat table
+    """``e``'s margin as a closure ``f(margins, bound)`` doing what the
+    :class:`_Margins` methods do, with what is static decided here: the
+    connectives' shape, whether a comparison measures a value of the run, its
+    atom, its operands as the evaluator's compiled closures
+    (:func:`rclverify.semantics.eval_closures._compile`).  Members and
+    quantifiers call their methods."""
+    io = st.io
+    if isinstance(e, ast.BoolLit):
+        const: _R = (INF if e.value else -INF), None
+        return lambda m, b: const
+    if isinstance(e, ast.Unary) and e.op == "not":
+        inner = _build(e.operand, scope, idx, st)
+        return lambda m, b: _neg(inner(m, b))
+    if isinstance(e, ast.Binary) and e.op in ("and", "or", "->", "<=>"):
+        lf, rf = _build(e.left, scope, idx, st), _build(e.right, scope, idx, st)
+        if e.op == "and":
+            return lambda m, b: _min(lf(m, b), rf(m, b))
+        if e.op == "or":
+            return lambda m, b: _max(lf(m, b), rf(m, b))
+        if e.op == "->":
+            return lambda m, b: _max(_neg(lf(m, b)), rf(m, b))
+        return lambda m, b: _iff(lf(m, b), rf(m, b))
+    if isinstance(e, ast.Compare) and len(e.ops) == 1:
+        cmp_ = e
+        op, (o1, o2) = e.ops[0], e.operands
+        atom = (e, 0, scope)
+        f1, f2 = _compile(o1, st.env, st.node, st.mode), _compile(o2, st.env, st.node, st.mode)
+        if not _measured(e.operands, scope, idx, io):
+            return lambda m, b: (INF if m.ev.compare(cmp_, b, op, f1(m.ev, b), f2(m.ev, b)) else -INF, None)
+
+        def compare(m: _Margins, b: Mapping[str, Value]) -> _R:
+            ev = m.ev
+            x, y = f1(ev, b), f2(ev, b)
+            if _number(x) and _number(y):
+                return m.distance(op, x, y), atom
+            return (INF if ev.compare(cmp_, b, op, x, y) else -INF), None
+        return compare
+    if isinstance(e, ast.Compare):
+        chain = e
+        return lambda m, b: m.compare(chain, b, idx)
+    if isinstance(e, ast.Member):
+        mem = e
+        return lambda m, b: m.member(mem, b, idx)
+    if isinstance(e, ast.Quant):
+        q = e
+        return lambda m, b: m.quant(q, b, idx)
+    if isinstance(e, ast.TupleQuant):
+        tq = e
+        return lambda m, b: m.tuple_quant(tq, b, idx)
+    other = e
+    return lambda m, b: m.truth(other, b, bool(m.ev.eval(other, b)))  # a BOOL value, a function's BOOL result
+
+
+def _iff(left: _R, right: _R) -> _R:
+    """``(a -> b) and (b -> a)``."""
+    return _min(_max(_neg(left), right), _max(_neg(right), left))
+
+
+#: (formula id, bound names, index names, node id) -> (the formula, the node, its closure)
+_CLOSURES: dict[tuple[Any, ...], tuple[Any, Any, Callable[..., _R]]] = {}
 
 
 def _vars(e: Any) -> list[ast.Var]:
@@ -350,9 +429,19 @@ def margin(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappi
     if at is None:
         return Margin(float(value), "", "", arithmetic)
     atom, i, bound = at
-    text = expr_to_rcl(atom) if not isinstance(atom, ast.Compare) or len(atom.ops) == 1 else \
-        expr_to_rcl(ast.Compare((atom.ops[i],), (atom.operands[i], atom.operands[i + 1])))
-    return Margin(_to_float(value), _unit(checked, node, atom, i, bound), text, arithmetic)
+    key = (id(atom), i, bound, id(node), id(checked))
+    hit = _ATOMS.get(key)
+    if hit is None or hit[0] is not atom:
+        text = expr_to_rcl(atom) if not isinstance(atom, ast.Compare) or len(atom.ops) == 1 else \
+            expr_to_rcl(ast.Compare((atom.ops[i],), (atom.operands[i], atom.operands[i + 1])))
+        if len(_ATOMS) >= 4096:
+            _ATOMS.clear()
+        hit = _ATOMS[key] = (atom, text, _unit(checked, node, atom, i, bound))
+    return Margin(_to_float(value), hit[2], hit[1], arithmetic)
+
+
+#: (atom id, link, bound names, node id, contract id) -> (the atom, its text, its unit): computed once per atom
+_ATOMS: dict[tuple[Any, ...], tuple[Any, str, str]] = {}
 
 
 __all__ = ["ARITHMETICS", "INF", "Margin", "MarginUndefined", "margin"]

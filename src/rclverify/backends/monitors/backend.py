@@ -303,7 +303,7 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     origin = RunOrigin()  # the source and middleware a live log says it was heard through (run_origin.py)
     events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(origin.tap(inner))), heard,
                                                                   watch), cfg.rules, cfg.horizon,
-                                  tolerance=cfg.tolerance)
+                                  tolerance=cfg.tolerance, margins=True)
     return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag, origin.origin)
 
 

@@ -24,7 +24,7 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
                 rules: Mapping[str, TopicRule], horizon: float,
                 on_verdict: Callable[[Verdict], None] | None = None,
                 tolerance: Tolerance | None = None,
-                end: float | None = None, batch: bool = True) -> tuple[int, list[NodeResult]]:
+                end: float | None = None, batch: bool = True, margins: bool = False) -> tuple[int, list[NodeResult]]:
     """Stream ``events`` through a monitor per node; returns (events read, results).
 
     The online engine (:class:`NodeMonitor`) run over a recorded trace: each
@@ -42,14 +42,23 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     order, the same result (tests/test_monitor_batch.py).  Without numpy (the
     ``fast`` extra) every node is streamed.  A live monitor never comes here:
     it feeds :class:`NodeMonitor` itself.
+
+    ``margins``: every guarantee judged on an answer also has its space
+    margin computed (:mod:`rclverify.semantics.robustness`; docs/semantics.md,
+    "Margins"): each ``satisfied`` or ``violated`` verdict on an output
+    carries its message's margin (:attr:`Verdict.margin`) and each result
+    the smallest margin of every guarantee (:attr:`NodeResult.margins`).
+    The batch path computes none, so a run asked for margins is streamed.
     """
     nodes = list(nodes)
-    if len(nodes) == 1 and batch and installed("numpy"):
+    if len(nodes) == 1 and batch and not margins and installed("numpy"):
         from rclverify.backends.monitors.batch import check_batch  # deferred: optional or conditional (numpy, the fast extra)
         done = check_batch(checked, nodes[0], events, rules, horizon, on_verdict, tolerance, end)
         if done is not None:  # eligible: the same verdicts, in batches (batch.py)
             return done[0], [done[1]]
     monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict, tolerance) for n in nodes]
+    for m in monitors:
+        m.margins = margins
     count = 0
     last_time = 0.0
     if len(monitors) == 1:  # feed() moves the clock first itself

@@ -204,7 +204,7 @@ class NodeMonitor(Judging, Closing, Late):
         if self.on_verdict is not None:
             self.on_verdict(Verdict(self.node.name, verdict, ev.index, ev.time, ev.where, ev.topic,
                                     max(self.now, ev.time), guarantee, dict(values or {}), reason, semantics,
-                                    question))
+                                    question, self._message_margin(ev, verdict)))
 
     # -- streaming ---------------------------------------------------------------
     def feed(self, ev: Event) -> None:
@@ -365,7 +365,8 @@ class NodeMonitor(Judging, Closing, Late):
         # before it is heard after it (late.py)
         self._recent.append((ev, stamped, mine, self._state() if self._state_outs else _EMPTY))
         k = self._single.get(ev.topic, 0)
-        if k and q is not None and q.owed and q.view is not None and outs is q.answer and not self._state_outs:
+        if k and q is not None and q.owed and q.view is not None and outs is q.answer and not self._state_outs \
+                and not self.margins:  # with margins, the general path (judging.py) computes them
             # the common case inline: one guarantee, no trigger, no state, no output-only guarantee
             view = q.view
             judged = self._judges[k].quick(view) or self._judge(k, view)

@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import Any, Callable, Mapping
 
 from rclverify.semantics.floatsem import Judgement, holds_in, judge
+from rclverify.semantics.robustness import Margin, MarginUndefined, margin
 from rclverify.semantics.values import render
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
@@ -28,7 +29,71 @@ def _always(k: int) -> bool:
 
 
 class Judging(EngineState):
-    """The judging part of :class:`~.engine.NodeMonitor` (module docstring)."""
+    """The judging part of :class:`~.engine.NodeMonitor` (module docstring).
+
+    ``margins`` (False unless :func:`.check.check_trace` is asked for them):
+    every guarantee judged true or false on an answer has its space margin
+    computed (:func:`_note_margin`), counted in the result and given to the
+    message's verdict."""
+
+    margins = False
+    #: (event index, the least margin of the guarantees judged on that message so far)
+    _margin_now: tuple[int, float | None] = (-1, None)
+    _margin_cache: dict[tuple[Any, ...], tuple[float, str, str, str] | None] | None = None
+
+    def _note_margin(self, k: int, values: Mapping[str, object], judged: Judgement, ev: Event,
+                     q: Question | None) -> None:
+        """Guarantee ``k``'s margin on ``values``, counted in the result's margins
+        and in the message's: in double arithmetic where its sign is the
+        verdict's (a verdict decided exactly: the exact margin differs from it
+        only by the rounding of the terms), else in the arithmetic that decided
+        ``judged`` (exact for a violation); none for a verdict decided within a
+        tolerance (docs/semantics.md, "Margins")."""
+        sem = judged.semantics
+        arith = "exact" if judged.truth is False or sem == "exact" else "double" if sem == "double" else ""
+        cache = self._margin_cache
+        if cache is None:
+            cache = self._margin_cache = {}
+        key = (k, arith, tuple([values.get(d) for d in self._deps[k]]))
+        got: tuple[float, str, str, str] | None
+        if key in cache:
+            got = cache[key]
+        else:
+            got = None
+            formula = self._guaranteed[k]
+            m: Margin | None = None
+            if arith:
+                try:
+                    m = margin(formula, self.checked, self.node, values, "double")
+                except MarginUndefined:
+                    pass
+            if arith == "exact" and (m is None or not (m.value > 0 if judged.truth else m.value < 0)):
+                try:
+                    m = margin(formula, self.checked, self.node, values, "exact")
+                except MarginUndefined:
+                    m = None
+            if m is not None:
+                got = (m.value, m.unit, m.atom, m.arithmetic)
+            if len(cache) >= 4096:
+                cache.clear()
+            cache[key] = got
+        at = (ev.index, ev.time, ev.where, q.event.where if q is not None else "")
+        if got is None:
+            self.result.note_margin(k, self._texts[k], None, "", "", "", at)
+            return
+        value = got[0]
+        self.result.note_margin(k, self._texts[k], value, got[1], got[2], got[3], at)
+        index, least = self._margin_now
+        if index != ev.index or least is None or value < least:
+            self._margin_now = (ev.index, value)
+
+    def _message_margin(self, ev: Event, verdict: str) -> float | None:
+        """The margin of the message ``ev`` whose verdict is ``verdict`` (``None``
+        without margins, for another verdict, or when no guarantee had one)."""
+        if not self.margins or verdict not in ("satisfied", "violated"):
+            return None
+        index, least = self._margin_now
+        return least if index == ev.index else None
 
     def _judge(self, k: Any, values: Mapping[str, object]) -> Judgement:
         """The judgement of guarantee ``k`` (``("A", j)``: assumption ``j``) on
@@ -96,6 +161,8 @@ class Judging(EngineState):
             if q is not None and k in self._trigger:
                 q.mark("answered_triggers", self._trigger[k])
             judged = self._judge(k, values)
+            if self.margins and judged.truth is not None:
+                self._note_margin(k, values, judged, ev, q)
             if judged.truth is False:
                 if q is not None:
                     q.waiting.pop(k, None)

@@ -65,17 +65,19 @@ class RecordedRun:
 
 
 def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
-                   on_warning: Callable[[str], None]) -> RecordedRun:
+                   on_warning: Callable[[str], None], margins: bool = False) -> RecordedRun:
     """Check the run at path ``trace`` against ``nodes`` under the monitor
     configuration ``cfg`` (:func:`.config.load_mapping`; its message
     directories relative to the workspace ``root``); ``on_warning`` gets
-    the reader's warnings.  Raises :class:`rclverify.traces.TraceError` for
+    the reader's warnings; ``margins``: the untimed check also computes the
+    space margins (:func:`.check.check_trace`; the run is then streamed).
+    Raises :class:`rclverify.traces.TraceError` for
     a run that cannot be read, and whatever a malformed run makes the
     readers raise (the caller reports either, located)."""
-    one = _pass(checked, nodes, cfg, root, trace, on_warning, None)
+    one = _pass(checked, nodes, cfg, root, trace, on_warning, None, margins)
     lag, note, stale = second_read(one.watch, trace, _readable_again(Path(trace)))  # one clock (stamp_order.py)
     if lag is not None:
-        one = _pass(checked, nodes, cfg, root, trace, on_warning, lag)
+        one = _pass(checked, nodes, cfg, root, trace, on_warning, lag, margins)
         one.note = note
     dmons, pmons, decl, calls, heard, events, results = (one.dmons, one.pmons, one.decl, one.calls, one.heard,
                                                          one.events, one.results)
@@ -119,7 +121,7 @@ class _Pass:
 
 
 def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
-          on_warning: Callable[[str], None], lag: float | None) -> _Pass:
+          on_warning: Callable[[str], None], lag: float | None, margins: bool = False) -> _Pass:
     """One read of the run feeding every monitor; in stamp order when ``lag`` is given
     (:func:`.stamp_order.in_stamp_order`); each node's constants compared as its fields carry them (widths.py)."""
     dirs = [root / d for d in cfg.msg_dirs]
@@ -155,7 +157,7 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
         source = calls.tap(source)  # only nodes with links: never the batch path
     watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
     events, results = check_trace(checked, nodes, Counted(source, heard, watch), cfg.rules, cfg.horizon,
-                                  tolerance=cfg.tolerance)
+                                  tolerance=cfg.tolerance, margins=margins)
     return _Pass(dmons, pmons, decl, calls, heard, watch, events, results, bag=bag)
 
 

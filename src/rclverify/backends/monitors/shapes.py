@@ -113,6 +113,7 @@ class VerdictJson(TypedDict):
     reason: str
     semantics: str
     question: NotRequired[str]
+    margin: NotRequired[float | None]
 
 
 class NodeResultJson(TypedDict):
@@ -145,6 +146,7 @@ class DeadlineVerdictJson(TypedDict):
     reason: str
     update: bool
     semantics: str
+    time_margin: NotRequired[float]
 
 
 class Unaccepted(TypedDict):
@@ -163,6 +165,7 @@ class DeadlineResultJson(TypedDict):
     first_false: DeadlineVerdictJson | None
     unaccepted: dict[str, int]
     first_unaccepted: Unaccepted | None
+    time_margins: list[dict[str, object]]
 
 
 #: The first gap longer than an output's period: stamps ``from`` and ``to``

@@ -37,7 +37,11 @@ def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versi
     its time, message, guarantee, values and the question it answered;
     ``violations_dropped`` the count beyond them), which ``rclverify explain
     OBLIGATION#N`` prints one by one; ``duration_s``: the run's span in trace
-    time, seconds from its first event to its last (``None``: not measured)."""
+    time, seconds from its first event to its last (``None``: not measured);
+    ``margins``: per guarantee its smallest space margin on the run, the
+    message and the time (:meth:`.verdicts.NodeResult.margins_json`, each
+    naming ``trace``; empty when the run was judged without margins;
+    docs/semantics.md, "Margins")."""
     return {"trace": trace, "sha256": sha, "events_read": events, "node_events": res.events,
             "horizon_s": horizon, "counts": dict(res.counts), "first_violation": res.first_violation,
             "first_assumption_violation": res.first_assumption_violation,
@@ -45,7 +49,7 @@ def monitoring_details(res: NodeResult, trace: str, events: int, sha: str, versi
             "semantics": dict(res.semantics), "first_inexact": res.first_inexact,
             "tolerance": tolerance.to_json() if tolerance else None, "tools": versions,
             "violations": list(res.violations), "violations_dropped": res.violations_dropped,
-            "unasked": res.unasked, "duration_s": duration_s}
+            "unasked": res.unasked, "duration_s": duration_s, "margins": res.margins_json(trace)}
 
 
 def summary_line(res: NodeResult) -> str:

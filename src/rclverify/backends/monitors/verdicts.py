@@ -7,8 +7,9 @@ evidence builder read them without the engine; docs/monitors.md,
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import Any, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.walk import names, reads  # re-exported: the engine and its mixins import them from here
@@ -51,7 +52,13 @@ class Verdict:
     its assumption and guarantees needed), the semantics that all agreed for
     a ``violated`` or ``assumption violated`` (``exact, double``), else ``""``;
     ``question`` where the question an output verdict answers was raised
-    (``""`` for a verdict on a question itself or on a node without inputs).
+    (``""`` for a verdict on a question itself or on a node without inputs);
+    ``margin`` the message's space margin (the least of the judged
+    guarantees' margins, :func:`rclverify.semantics.robustness.margin`;
+    docs/semantics.md, "Margins") when the run was judged with margins and
+    the verdict is ``satisfied`` or ``violated`` on values that have one,
+    else ``None`` (``inf``/``-inf`` when only atoms without a distance
+    decided).
     """
 
     node: str
@@ -66,15 +73,59 @@ class Verdict:
     reason: str = ""
     semantics: str = ""
     question: str = ""
+    margin: float | None = None
 
     def to_json(self) -> VerdictJson:
-        """A JSON-ready dict (the live monitor's verdict message)."""
+        """A JSON-ready dict (the live monitor's verdict message); ``margin``
+        only when there is one, an infinite one as ``null`` (JSON has no infinity)."""
         out: VerdictJson = {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
                             "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
                             "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason,
                             "semantics": self.semantics}
         if self.question:
             out["question"] = self.question
+        if self.margin is not None:
+            out["margin"] = self.margin if math.isfinite(self.margin) else None
+        return out
+
+
+@dataclass
+class GuaranteeMargin:
+    """The smallest space margin of one guarantee over a run's judged answers.
+
+    ``guarantee`` 1-based, ``formula`` its text; ``value`` the smallest
+    margin (``inf``/``-inf``: only atoms without a distance decided it),
+    in ``unit`` (``""``: none declared), decided by the comparison ``atom``
+    in ``arithmetic`` (``exact`` or ``double``); ``event``/``time``/``where``
+    the output message it was judged on and ``question`` where that
+    message's question was raised (``""``: none); ``answers`` how many judged
+    answers gave the guarantee a margin, ``undefined`` how many had none
+    (docs/semantics.md, "Margins")."""
+
+    guarantee: int
+    formula: str
+    value: float
+    unit: str
+    atom: str
+    arithmetic: str
+    event: int
+    time: float
+    where: str
+    question: str = ""
+    answers: int = 1
+    undefined: int = 0
+
+    def to_json(self, trace: str = "") -> dict[str, Any]:
+        """A JSON-ready dict: ``margin`` the value (``null`` when infinite, then
+        ``holds`` says on which side), ``trace`` the run when given."""
+        out: dict[str, Any] = {"guarantee": self.guarantee, "formula": self.formula,
+                               "margin": self.value if math.isfinite(self.value) else None,
+                               "holds": self.value >= 0, "unit": self.unit, "atom": self.atom,
+                               "arithmetic": self.arithmetic, "event": self.event, "time": self.time,
+                               "where": self.where, "question": self.question, "answers": self.answers,
+                               "undefined": self.undefined}
+        if trace:
+            out["trace"] = trace
         return out
 
 
@@ -99,6 +150,10 @@ class NodeResult:
     :data:`KEPT_VIOLATIONS`, in the order decided; ``violations_dropped``
     counts the rest), each as ``first_violation`` is.
     ``evaluation`` how each formula was evaluated (debug; not in :meth:`to_json`).
+    ``margins`` guarantee -> its smallest space margin on the run
+    (:class:`GuaranteeMargin`), filled only when the run is judged with
+    margins (:func:`.check.check_trace`); not compared, so a run judged with
+    and without margins gives equal results.
     """
 
     node: str
@@ -118,6 +173,7 @@ class NodeResult:
     #: (``assumption 1`` / ``guarantee 2`` -> ``compiled``, or why the
     #: straight-line code left it to the evaluator; semantics/judges.py)
     evaluation: dict[str, str] = field(default_factory=dict, compare=False)
+    margins: dict[int, GuaranteeMargin] = field(default_factory=dict, compare=False)
 
     @property
     def assumption(self) -> AssumptionVerdict:
@@ -138,6 +194,30 @@ class NodeResult:
                 "semantics": dict(self.semantics), "first_inexact": self.first_inexact, "unowed": self.unowed,
                 "unasked": self.unasked, "violations": list(self.violations),
                 "violations_dropped": self.violations_dropped}
+
+    def note_margin(self, k: int, formula: str, value: float | None, unit: str, atom: str, arithmetic: str,
+                    at: tuple[int, float, str, str]) -> None:
+        """Count guarantee ``k``'s margin ``value`` (``None``: it has none on these
+        values) on the answer ``at`` (event index, time, where, the question's
+        where), keeping the smallest (the first of equals)."""
+        kept = self.margins.get(k)
+        if value is None:
+            if kept is not None:
+                kept.undefined += 1
+            else:
+                self.margins[k] = GuaranteeMargin(k, formula, math.nan, "", "", "", -1, 0.0, "", "", 0, 1)
+            return
+        if kept is None:
+            self.margins[k] = GuaranteeMargin(k, formula, value, unit, atom, arithmetic, *at)
+            return
+        kept.answers += 1
+        if kept.answers == 1 or value < kept.value:  # answers == 1: the first after only undefined ones
+            kept.value, kept.unit, kept.atom, kept.arithmetic = value, unit, atom, arithmetic
+            kept.event, kept.time, kept.where, kept.question = at
+
+    def margins_json(self, trace: str = "") -> list[dict[str, Any]]:
+        """The smallest margin of every guarantee that had one, by guarantee (:meth:`GuaranteeMargin.to_json`)."""
+        return [m.to_json(trace) for _, m in sorted(self.margins.items()) if m.answers]
 
     def add_violation(self, record: Violation) -> None:
         """Keep ``record`` (one ``violated`` verdict) in :attr:`violations`
@@ -189,4 +269,4 @@ def in_all(semantics: str) -> str:
     return f" (false in {text})"
 
 
-__all__ = ["KEPT_VIOLATIONS", "LINK_TOPICS", "WEAK", "VERDICTS", "NodeResult", "Verdict", "in_all", "link_of", "producers", "reads", "names"]
+__all__ = ["GuaranteeMargin", "KEPT_VIOLATIONS", "LINK_TOPICS", "WEAK", "VERDICTS", "NodeResult", "Verdict", "in_all", "link_of", "producers", "reads", "names"]
