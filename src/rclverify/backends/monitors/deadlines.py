@@ -62,6 +62,7 @@ from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.online import header_stamp_ns
 from rclverify.backends.monitors.verdicts import LINK_TOPICS, names
 from rclverify.backends.monitors.shapes import DeadlineResultJson, DeadlineVerdictJson, Unaccepted
+from rclverify.backends.monitors.time_margins import TimeMargin, note
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
 #: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).
@@ -86,12 +87,19 @@ class DeadlineVerdict:
     update: bool = False
     #: the arithmetic the answer's formula held in (``exact``, ``double``, ``tolerance``; ``""``: no answer)
     semantics: str = ""
+    #: the time margin (s): the deadline less the answer's stamp, exact in integer nanoseconds (negative: late;
+    #: ``None``: no answer yet; docs/semantics.md, "Margins")
+    time_margin: float | None = None
 
     def to_json(self) -> DeadlineVerdictJson:
-        return {"node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
-                "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
-                "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
-                "update": self.update, "semantics": self.semantics}
+        out: DeadlineVerdictJson = {
+            "node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
+            "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
+            "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
+            "update": self.update, "semantics": self.semantics}
+        if self.time_margin is not None:
+            out["time_margin"] = self.time_margin
+        return out
 
 
 @dataclass
@@ -122,11 +130,19 @@ class DeadlineResult:
     first_false: DeadlineVerdict | None = None
     unaccepted: dict[str, int] = field(default_factory=lambda: {v: 0 for v in UNACCEPTED})
     first_unaccepted: Unaccepted | None = None
+    #: guarantee -> its smallest time margin on the run (:class:`TimeMargin`)
+    time_margins: dict[int, TimeMargin] = field(default_factory=dict)
 
     def to_json(self) -> DeadlineResultJson:
         return {"node": self.node, "counts": dict(self.counts),
                 "first_false": None if self.first_false is None else self.first_false.to_json(),
-                "unaccepted": dict(self.unaccepted), "first_unaccepted": self.first_unaccepted}
+                "unaccepted": dict(self.unaccepted), "first_unaccepted": self.first_unaccepted,
+                "time_margins": [m.to_json() for _, m in sorted(self.time_margins.items())]}
+
+    def note_time_margin(self, k: int, margin_ns: int | None, trigger_where: str, answer_where: str,
+                         answer: float, was_unanswered: bool = False) -> None:
+        """Count guarantee ``k``'s time margin on one trigger (:func:`.time_margins.note`)."""
+        note(self.time_margins, k, margin_ns, trigger_where, answer_where, answer, was_unanswered)
 
 
 def event_stamp_ns(ev: Event) -> int:
@@ -307,7 +323,9 @@ class DeadlineMonitor:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
                                            ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
                                            f"{_ms_ns(ns - p.due_ns)} past the deadline of "
-                                           f"{_ms_ns(p.due_ns - p.stamp_ns)}", update=True))
+                                           f"{_ms_ns(p.due_ns - p.stamp_ns)}", update=True,
+                                           time_margin=(p.due_ns - ns) / 1e9))
+                self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp, was_unanswered=True)
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
         self.heard.append((ns, ev, outs, {c: self.values[c] for c in outs if c not in self.state_outs}))
 
@@ -327,12 +345,13 @@ class DeadlineMonitor:
         if ns <= p.due_ns:  # "within": at the deadline is in time (integer ns, no rounding)
             self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
                                        ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)} (deadline {_ms(d)})",
-                                       semantics=j.semantics))
+                                       semantics=j.semantics, time_margin=(p.due_ns - ns) / 1e9))
         else:
             self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
                                        ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
                                        f"{_ms_ns(ns - p.due_ns)} past the deadline of {_ms(d)}",
-                                       semantics=j.semantics))
+                                       semantics=j.semantics, time_margin=(p.due_ns - ns) / 1e9))
+        self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp)
         return True
 
     def _heard_late(self, p: _Pending) -> bool:
@@ -386,6 +405,7 @@ class DeadlineMonitor:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
                                            f"no answer within the deadline of {_ms_ns(p.due_ns - p.stamp_ns)} "
                                            f"(clock at {now:.3f} s)" + (f"; {p.rejected}" if p.rejected else "")))
+                self.result.note_time_margin(p.k, None, p.trigger.where, "", 0.0)  # until a late answer comes
                 self.expired.append(p)
             else:
                 keep.append(p)
@@ -398,9 +418,12 @@ class DeadlineMonitor:
                 for p in self.pending]
 
     def finish(self) -> DeadlineResult:
-        """End of the run: obligations still within their deadline are ``currently_false``."""
+        """End of the run: obligations still within their deadline are ``currently_false``;
+        those and the expired ones never answered are counted unanswered in the time margins."""
         for v in self.pending_verdicts():
             self._emit(v)
+        for p in self.pending:
+            self.result.note_time_margin(p.k, None, p.trigger.where, "", 0.0)
         self.pending = []
         return self.result
 
