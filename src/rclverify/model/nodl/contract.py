@@ -129,42 +129,53 @@ def compare(cn: CheckedNode, doc: Document) -> list[Finding]:
     return out
 
 
-def document_data(cn: CheckedNode, contract_file: str) -> dict[str, object]:
-    """The NoDL v2 document of contract ``cn``'s endpoints (keys in the schema's order): each
-    directed endpoint in its list, its type written ``pkg/<kind>/Name``, topics with the QoS a
-    generated node gives them (:data:`GENERATED_QOS`).  Raises :class:`RclError` (located,
-    ``E-nodl-write``) for a topic entry whose direction the contract leaves open or a type
-    without a package: NoDL cannot say either."""
-    data: dict[str, object] = {"nodl_version": 2,
-                               "description": f"Node {cn.name}: its interface as its RCL contract ({contract_file}) "
-                                              "names it, written by rclverify"}
+def document_of(description: str, ends: list[tuple[str, str, str]]) -> dict[str, object]:
+    """A NoDL v2 document (keys in the schema's order) of ``ends``: ``(list, name, type)``, the list
+    one of :data:`ENDPOINT_LISTS`; each type written ``pkg/<kind>/Name``, topics with the QoS a
+    generated node gives them (:data:`GENERATED_QOS`)."""
+    data: dict[str, object] = {"nodl_version": 2, "description": description}
     lists: dict[str, list[dict[str, object]]] = {k: [] for k in ENDPOINT_LISTS}
+    for kind, name, ros_type in ends:
+        entry: dict[str, object] = {"name": name, "type": full_type(ros_type, kind)}
+        if ENDPOINT_LISTS[kind] == "msg":
+            entry["qos"] = dict(GENERATED_QOS)
+        lists[kind].append(entry)
+    data.update({k: v for k, v in lists.items() if v})
+    return data
+
+
+def document_data(cn: CheckedNode, contract_file: str) -> dict[str, object]:
+    """The NoDL v2 document of contract ``cn``'s endpoints (:func:`contract_ends`, :func:`document_of`).
+    Raises :class:`RclError` (located, ``E-nodl-write``) for a topic entry whose direction the
+    contract leaves open or a type without a package: NoDL cannot say either."""
+    ends: list[tuple[str, str, str]] = []
     diags = []
     for c in contract_ends(cn):
         if c.kind == TOPIC:
             diags.append(error(c.loc, f"topic {c.name} matches no input or output of {cn.name}: a NoDL document "
                                       "needs its direction (write matches(in.x) or matches(out.y))", "E-nodl-write"))
-            continue
-        if not type_key(c.type)[0]:
+        elif not type_key(c.type)[0]:
             diags.append(error(c.loc, f"type {c.type} has no package: a NoDL document names pkg/Name",
                                "E-nodl-write"))
-            continue
-        entry: dict[str, object] = {"name": c.name, "type": full_type(c.type, c.kind)}
-        if ENDPOINT_LISTS[c.kind] == "msg":
-            entry["qos"] = dict(GENERATED_QOS)
-        lists[c.kind].append(entry)
+        else:
+            ends.append((c.kind, c.name, c.type))
     if diags:
         raise RclError(diags)
-    data.update({k: v for k, v in lists.items() if v})
-    return data
+    return document_of(f"Node {cn.name}: the interface its RCL contract ({contract_file}) names, written by "
+                       "rclverify", ends)
 
 
-def document_text(cn: CheckedNode, contract_file: str, header: str = "") -> str:
-    """:func:`document_data` as YAML text (NoDL's first form; ``ament_nodl_register`` installs YAML),
-    after ``header`` as a comment line when given."""
-    body = yaml.safe_dump(document_data(cn, contract_file), sort_keys=False, allow_unicode=True, width=100)
+def yaml_text(data: dict[str, object], header: str = "") -> str:
+    """A document as YAML text (NoDL's first form; ``ament_nodl_register`` installs YAML), after
+    ``header`` as a comment line when given."""
+    body = yaml.safe_dump(data, sort_keys=False, allow_unicode=True, width=100)
     return (f"# {header}\n" if header else "") + "---\n" + body
 
 
-__all__ = ["ContractEnd", "GENERATED_QOS", "TOPIC", "compare", "contract_ends", "document_data", "document_text",
-           "full_name", "full_type", "type_key"]
+def document_text(cn: CheckedNode, contract_file: str, header: str = "") -> str:
+    """:func:`document_data` as YAML text (:func:`yaml_text`)."""
+    return yaml_text(document_data(cn, contract_file), header)
+
+
+__all__ = ["ContractEnd", "GENERATED_QOS", "TOPIC", "compare", "contract_ends", "document_data", "document_of",
+           "document_text", "full_name", "full_type", "type_key", "yaml_text"]

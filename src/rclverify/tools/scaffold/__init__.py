@@ -3,7 +3,8 @@
 The workspace has the layout of docs/architecture.md: ``dodo.py``,
 ``contracts/`` with one documented example contract per node (a chain: each
 node's output feeds the next node's input, so the calculus has a side
-condition to prove per link, paper rule R1), a commented
+condition to prove per link, paper rule R1), each node's NoDL document in
+``nodl/`` written from its contract (:mod:`.nodl`), a commented
 ``contracts/plan.yaml``, and empty ``backends/``, ``artifacts/`` and
 ``reports/``.  Every file comes from the jinja2 templates in
 ``scaffold/templates``.  Decisions are written down in docs/ci.md.
@@ -109,6 +110,8 @@ def render_workspace(name: str, names: list[str]) -> dict[str, str]:
              "contracts/plan.yaml": env.get_template("plan.yaml.j2").render(name=name, nodes=nodes)}
     for node in nodes:
         files[node.file] = env.get_template("contract.rcl.j2").render(name=name, node=node)
+    from rclverify.tools.scaffold.nodl import nodl_documents  # deferred: start-up (loads lark, yaml and more only when called)
+    files.update(nodl_documents({n.file: files[n.file] for n in nodes}))
     return files
 
 
