@@ -418,9 +418,11 @@ class _DdsRun:
 def _calls_record(summary: Mapping[str, object], book: CallBook, calls: CallTaps | None) -> dict[str, Any]:
     """The record's ``calls``: the counts of the call-by-call verdicts, each
     node's status over its calls, and the samples heard per call topic."""
-    out: dict[str, Any] = {"counts": summary["counts"], "nodes": [], "samples": calls.counts if calls is not None else {}}
+    out: dict[str, Any] = {"counts": summary["counts"], "nodes": [], "samples": calls.counts if calls is not None else {},
+                           "undecided": summary.get("undecided", {}), "unjudged": summary.get("unjudged", {})}
     for name, res in book.results.items():
         status, explanation = verdict_status(res, "the live calls")
+        explanation = book.with_notes(name, explanation)  # undecided answers and endpoints not heard, whatever the status
         out["nodes"].append({"node": name, "status": status, "explanation": explanation, **res.to_json()})
     return out
 
