@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import json
 import re
-from json.decoder import scanstring
-from typing import Any
+from json import decoder
+from typing import Any, Callable
 
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError, error
@@ -33,6 +33,9 @@ _NUMBER = re.compile(r"-?(?:0|[1-9][0-9]*)(?:\.[0-9]+)?(?:[eE][-+]?[0-9]+)?")
 _WORDS = {"true": True, "false": False, "null": None}
 
 Path_ = tuple[Any, ...]
+#: The standard library's JSON string scanner (``json.decoder.scanstring``, which typeshed does not
+#: declare): ``scanstring(text, offset after the quote, strict)`` -> (the string, the offset after it).
+scanstring: Callable[[str, int, bool], tuple[str, int]] = getattr(decoder, "scanstring")
 
 
 def _fail(file: str, line: int, col: int, message: str) -> RclError:
