@@ -91,6 +91,8 @@ class Linker(LinkMembers, Values, Returns, Instances):
         self._by_meth: dict[str, set[str]] | None = None
         self._by_last: dict[str, list[str]] | None = None  # classes by last name part
         self._overs: dict[str, list[str]] | None = None  # function keys by key without '#N'
+        self._free: dict[str, list[str]] | None = None  # free functions by last name part
+        self._targs_at: dict[tuple[Any, ...], list[list[str]]] | None = None  # call_targs by their site
         self.py = bool(self.recs) and all(r.get("lang") == "py" for r in self.recs.values())
         self.classes = [] if self.py else sorted(self.units)
         self.entry = prog.units if prog.units is not None else entry_units
@@ -172,11 +174,11 @@ class Linker(LinkMembers, Values, Returns, Instances):
                     self._edge(here, f"F:{k}")
                 self.sites.setdefault(k, []).append((args, kwargs, fkey))
                 self.record_site(k, callee, fkey, kind, unit, len(args))
+        # a delegating constructor's call (Sensor(o) : Sensor("sensor", o)) is no construction read
+        made_outside = {s.split("#")[0] for s, sites in self.sites.items()
+                        if any((c or "").split("#")[0] != s.split("#")[0] for _a, _k, c in sites)}
         for k, (unit, *_rest) in self.fns.items():  # an overload's class made where no call is read: all run
-            base = k.split("#")[0]
-            # a delegating constructor's call (Sensor(o) : Sensor("sensor", o)) is no construction read
-            outside = any(s.split("#")[0] == base and any((c or "").split("#")[0] != base for _a, _k, c in sites)
-                          for s, sites in self.sites.items())
+            outside = k.split("#")[0] in made_outside
             if ("#" in k or k in overloaded) and not outside:
                 self._edge(f"U:{unit}", f"F:{k}")
         if prog.instance is not None:  # a plugin's methods its loader calls, given the instance's name
@@ -284,7 +286,12 @@ class Linker(LinkMembers, Values, Returns, Instances):
         cls = self.match(meth, unit)
         if cls is not None and recv is None:
             return self._ctor(cls), cls
-        free = [k for k, v in self.fns.items() if v[0] == k and (k == meth or k.endswith("::" + meth))]
+        if self._free is None:
+            self._free = {}
+            for k, v in self.fns.items():
+                if v[0] == k:
+                    self._free.setdefault(k.rsplit("::", 1)[-1], []).append(k)
+        free = [k for k in self._free.get(meth.rsplit("::", 1)[-1], []) if k == meth or k.endswith("::" + meth)]
         return (free[0], free[0]) if len(free) == 1 else (None, None)
 
     def _classes_named(self, t: str) -> list[str]:

@@ -40,6 +40,7 @@ class Instances:
     alias_index: dict[str, list[str]]
     call_targs: list[tuple[str, str | None, str | None, int, list[str]]]
     _targ_seen: dict[tuple[str, str | None, str | None, int], int]
+    _targs_at: dict[tuple[Any, ...], list[list[str]]] | None
     sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]]
     #: per function key, parallel to ``sites``: the template arguments written at each
     #: site (``Client<pkg::srv::T>(...)``: ``["pkg::srv::T"]``) and the calling function
@@ -110,7 +111,11 @@ class Instances:
             same = (callee, unit, caller, nargs)
             k = self._targ_seen.get(same, 0)
             self._targ_seen[same] = k + 1
-            written = [c[4] for c in self.call_targs if tuple(c[:4]) == same]
+            if self._targs_at is None:
+                self._targs_at = {}
+                for c in self.call_targs:
+                    self._targs_at.setdefault(tuple(c[:4]), []).append(c[4])
+            written = self._targs_at.get(same, [])
             if k < len(written):
                 self.site_targs.setdefault(key, []).append((list(written[k]), caller))
                 return
