@@ -501,8 +501,8 @@ class Linker(LinkMembers, Values, Returns, Instances):
             return unit
         sites = self.sites.get(fkey, [])
         caller = sites[pins[fkey]][2] if pins[fkey] < len(sites) else None
-        cunit = self.fns[caller][0] if caller in self.fns else None
-        if cunit is None or cunit == unit or caller.split("#")[0] != self._ctor(cunit) or \
+        cunit = self.fns[caller][0] if caller is not None and caller in self.fns else None
+        if caller is None or cunit is None or cunit == unit or caller.split("#")[0] != self._ctor(cunit) or \
                 f"U:{unit}" not in self._reach({f"U:{cunit}"}):
             return unit
         return cunit
