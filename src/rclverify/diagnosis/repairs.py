@@ -47,6 +47,7 @@ from rclverify.semantics.query import prove
 from rclverify.lang.parser import parse_formula
 from rclverify.lang.typecheck import domain_type
 from rclverify.lang.types import Scalar
+from rclverify.semantics.operators import OPERATORS
 
 #: Most candidates tried per problem (each costs Z3 queries).
 MAX_CANDIDATES = 12
@@ -87,7 +88,9 @@ def _disjuncts(e: ast.Expr) -> list[ast.Expr]:
     return [e]
 
 
-_FLIP = {"==": "!=", "!=": "==", "<": ">=", "<=": ">", ">": "<=", ">=": "<"}
+def _negated(op: str) -> str:
+    """The comparison that is ``op``'s negation, from the semantics table."""
+    return str(OPERATORS[op].negation)
 
 
 def _negation(e: ast.Expr) -> str:
@@ -101,7 +104,7 @@ def _negation(e: ast.Expr) -> str:
         if e.ops[0] in ("==", "!=") and isinstance(b, ast.BoolLit):
             flipped = b.value if e.ops[0] == "!=" else not b.value
             return f"{expr_to_rcl(a)} == {'TRUE' if flipped else 'FALSE'}"
-        return f"{expr_to_rcl(a)} {_FLIP[e.ops[0]]} {expr_to_rcl(b)}"
+        return f"{expr_to_rcl(a)} {_negated(e.ops[0])} {expr_to_rcl(b)}"
     return f"not ({expr_to_rcl(e)})"
 
 

@@ -65,9 +65,14 @@ from rclverify.records.stage_records import Repair
 from rclverify.model.plan.errors import PlanError
 from rclverify.model.plan.load import all_requirements
 from rclverify.diagnosis.units import declared_unit, literal_si, literal_in
+from rclverify.semantics.operators import OPERATORS
 
 _UPPER = {"<=": True, "<": True, ">=": False, ">": False}
-_MIRROR = {"<=": ">=", "<": ">", ">=": "<=", ">": "<"}
+
+
+def _mirror(op: str) -> str:
+    """The comparison ``op`` reads as with its operands swapped, from the semantics table."""
+    return str(OPERATORS[op].converse)
 
 
 def _bound_shape(target: ast.Expr, inputs: set[str]) -> tuple[str, bool, ast.NumLit] | None:
@@ -79,7 +84,7 @@ def _bound_shape(target: ast.Expr, inputs: set[str]) -> tuple[str, bool, ast.Num
     a, b = target.operands
     op: str = target.ops[0]
     if isinstance(b, ast.Var) and isinstance(a, ast.NumLit):
-        a, b, op = b, a, _MIRROR[op]
+        a, b, op = b, a, _mirror(op)
     if isinstance(a, ast.Var) and a.prefix in ("in", None) and a.name in inputs and isinstance(b, ast.NumLit):
         return a.name, _UPPER[op], b
     return None
@@ -265,7 +270,7 @@ def _normal(c: ast.Expr, prefix: str | None, name: str,
         return isinstance(e, ast.NumLit) or (constants is not None and isinstance(e, ast.Var) and e.prefix is None
                                              and e.name in constants and _const_value(e, constants) is not None)
     if bound(a) and isinstance(b, ast.Var) and not bound(b):
-        a, b, op = b, a, _MIRROR[op]
+        a, b, op = b, a, _mirror(op)
     if isinstance(a, ast.Var) and a.prefix == prefix and a.name == name and bound(b):
         return op, b
     return None

@@ -40,6 +40,7 @@ from rclverify.lang import types as T
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.mapping import TopicRule
+from rclverify.semantics.operators import OPERATORS
 
 #: Words the RML grammar reserves (RML.g4 and its later versions).
 KEYWORDS = frozenset({"not", "matches", "with", "empty", "all", "let", "var", "if", "else", "abs", "true",
@@ -245,7 +246,7 @@ class Translator:
         side, other = self._observed(lhs), rhs
         if side is None:
             side, other = self._observed(rhs), lhs
-            op = {"<": ">", "<=": ">=", ">": "<", ">=": "<="}.get(op, op)  # type: ignore[assignment]
+            op = OPERATORS[op].converse or op  # type: ignore[assignment]  # read with its operands swapped
         if side is None:
             raise Inexpressible(e, "the comparison mentions no input or output of the node")
         if self._observed(other) is not None:

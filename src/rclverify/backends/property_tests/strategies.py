@@ -35,6 +35,7 @@ from rclverify.backends.property_tests.hypothesis_lib import st
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode, DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 from rclverify.semantics.values import FiniteFunction, Term
+from rclverify.semantics.operators import OPERATORS
 
 SMALL_NAT = 5
 POOL_SIZE = 4
@@ -105,7 +106,9 @@ def conjuncts(e: ast.Expr) -> list[ast.Expr]:
     return [e]
 
 
-_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+def _converse(op: str) -> str:
+    """The comparison ``op`` reads as with its operands swapped, from the semantics table."""
+    return str(OPERATORS[op].converse)
 
 
 def assumption_bounds(node: CheckedNode, named: Mapping[str, Fraction] | None = None) -> dict[str, Bound]:
@@ -120,10 +123,10 @@ def assumption_bounds(node: CheckedNode, named: Mapping[str, Fraction] | None = 
                     op: str = cop
                     name, v = _input(a, node), _num(b, named)
                     if name is None:
-                        name, v, op = _input(b, node), _num(a, named), _FLIP[cop]
+                        name, v, op = _input(b, node), _num(a, named), _converse(cop)
                     if name is None:  # abs(in.x) <= c: -c <= x <= c
                         _abs_bound(out, cop, _abs_input(a, node), _num(b, named))
-                        _abs_bound(out, _FLIP[cop], _abs_input(b, node), _num(a, named))
+                        _abs_bound(out, _converse(cop), _abs_input(b, node), _num(a, named))
                     if name is None or v is None:
                         continue
                     bd = out.setdefault(name, Bound())
