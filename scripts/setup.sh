@@ -8,7 +8,7 @@
 #     refuses pip, so nothing is ever installed into it;
 #   - rclverify in that environment with every optional extra (docs/install.md),
 #     pinned by constraints.txt where it was resolved for this Python;
-#   - with --tests, the test extras (pytest, mypy) and the test modules' bytecode
+#   - with --tests, the test extras (pytest, mypy), the monitors' peers (RTAMT, Reelay, mstlo) and the test modules' bytecode
 #     as pytest rewrites it (below); with --tests or --ros2, ROS 2's PyPI wheels in .venv-ros2/.
 # Afterwards: .venv/bin/rclverify verify (or `. .venv/bin/activate` and doit verify).
 # Safe to run again.
@@ -87,6 +87,16 @@ extras=all
 if [ "${1:-}" = "--tests" ]; then extras=all,test,dev; fi
 echo "setup: installing rclverify[$extras] into $VENV"
 "$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[$extras]"
+# --tests: the monitors' peers of the bench extra (RTAMT, Reelay, mstlo: pyproject.toml), at the versions
+# constraints.txt pins, which tests/test_margins_peers.py compares the margins with (RTAMT's parser runtime,
+# antlr4-python3-runtime 4.7, is a source archive: pip builds it, pure Python).  Optional: without them that
+# test is skipped with the reason.
+if [ "${1:-}" = "--tests" ]; then
+  echo "setup: installing RTAMT, Reelay and mstlo into $VENV"
+  "$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt \
+      "rtamt>=0.4.10,<0.5" "reelay>=25.0.0,<26" "mstlo-python>=0.2.2,<0.3" \
+    || echo "setup: RTAMT, Reelay or mstlo could not be installed; tests/test_margins_peers.py skips it with the reason"
+fi
 # The package's bytecode, compiled once here: an editable install compiles nothing, and a shell
 # with PYTHONDONTWRITEBYTECODE set would otherwise compile every module in every doit process.
 "$VPY" -m compileall -q src/rclverify >/dev/null || true

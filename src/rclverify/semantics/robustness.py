@@ -344,7 +344,8 @@ _CLOSURES: dict[tuple[Any, ...], tuple[Any, Any, Callable[..., _R]]] = {}
 
 
 def _vars(e: Any) -> list[ast.Var]:
-    """The variables of term ``e`` (function names aside)."""
+    """The variables of term ``e``, an applied function's name among them
+    (``in.x(k)`` reads the run's ``in.x``; a constructor's name is no I/O value)."""
     hit = _VARS.get(id(e))
     if hit is not None and hit[0] is e:
         return hit[1]
@@ -355,6 +356,7 @@ def _vars(e: Any) -> list[ast.Var]:
         if isinstance(x, ast.Var):
             out.append(x)
         elif isinstance(x, ast.Apply):
+            stack.append(x.func)
             stack.extend(x.args)
         elif isinstance(x, tuple):
             stack.extend(x)
