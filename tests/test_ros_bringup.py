@@ -313,3 +313,16 @@ def test_the_node_name_inside_a_name_is_not_read_as_tilde() -> None:
     from rclverify.ros.extract import symbols
     assert symbols.text(symbols.cat([symbols.lit("get_cost_"), symbols.NODE])) is None
     assert symbols.text(symbols.cat([symbols.NODE, symbols.lit("/x")])) == "~x"  # private x
+
+
+def test_a_library_of_a_source_directory_is_its_component() -> None:
+    """``ament_auto_add_library(lights_component SHARED DIRECTORY src)`` registered
+    as ``rover_lights::Lights`` with executable ``lights_node``: its sources are
+    those under ``src/`` (before: none, and the component was said to be in no
+    node of the graph)."""
+    g = scan([WS / "src" / "rover_lights"]).graph
+    assert _edges(g, "/lights") == {("sub", "/headlights", "std_msgs/msg/Bool")}
+    assert g.nodes["/lights"].executable == "lights_node"
+    assert [(p["name"], p["nodes"], p["unaccounted"]) for p in g.programs] == [
+        ("rover_lights::Lights", ["/lights"], None)]
+    assert not _said(g)

@@ -3,7 +3,8 @@ is run; docs/ros.md, "Reading real code").
 
 * ``CMakeLists.txt`` (:mod:`cmake`: variables, ``foreach``, the file's own
   ``function``/``macro`` wrappers, ``file(GLOB)``): ``add_executable(name src...)``
-  (also ament_cmake_auto's ``ament_auto_add_executable`` and catkin_simple's
+  (also ament_cmake_auto's ``ament_auto_add_executable`` (its ``DIRECTORY``
+  sources globbed as ament_cmake_auto does) and catkin_simple's
   ``cs_add_executable``), ``add_library`` (``ament_auto_add_library``,
   ``cs_add_library``), ``target_sources``, ``target_link_libraries(target
   libs...)`` (an ``ament_auto`` executable links every ``ament_auto`` library
@@ -172,6 +173,8 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
     for name, args, line in cmds:
         if not args:
             continue
+        if name in ("ament_auto_add_library", "ament_auto_add_executable") and "DIRECTORY" in args:
+            args = _auto_directory(args, root)
         if name == "add_subdirectory" and (root / args[0]).is_dir() and not args[0].startswith(("test", "..")) \
                 and ".." not in Path(args[0]).parts and not Path(args[0]).is_absolute():
             subdirs.append(root / args[0])
@@ -211,6 +214,23 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
                     t.programs.setdefault(f.name, [f])
                     t.programs.setdefault(f.stem, [f])
                 k += 1
+
+
+_AUTO_SOURCES = ("*.c", "*.cc", "*.cpp", "*.cxx")
+
+
+def _auto_directory(args: list[str], root: Path) -> list[str]:
+    """``ament_auto_add_library(t [SHARED] DIRECTORY d... [sources])``'s arguments
+    with each directory ``d`` replaced by the C and C++ sources under it, as
+    ament_cmake_auto globs them (``GLOB_RECURSE`` of ``*.c``, ``*.cc``,
+    ``*.cpp``, ``*.cxx``); a directory outside the package gives none."""
+    k = args.index("DIRECTORY")
+    j = k + 1
+    while j < len(args) and args[j] not in _KEYWORDS:
+        j += 1
+    glob = _glob(root)
+    found = [f for d in args[k + 1:j] for pat in _AUTO_SOURCES for f in glob(f"{d.rstrip('/')}/{pat}", True)]
+    return args[:k] + sorted(dict.fromkeys(found)) + args[j:]
 
 
 def cmake_components(root: Path, pkg: str) -> tuple[dict[str, tuple[str, int]], list[str]]:
