@@ -1,6 +1,7 @@
 """``rclverify nodl``: NoDL v2 node interface documents (docs/nodl.md).
 
 ``rclverify nodl check``          the workspace's documents against its contracts and each other
+                                  (``--ros PATH...``: and against the code's endpoints)
 ``rclverify nodl validate FILE...`` documents against the schema, their includes followed
 ``rclverify nodl write [-o DIR]`` one document per node from its contract
 
@@ -32,6 +33,10 @@ def add_parsers(sub: Any) -> None:
     c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
     c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
     c.add_argument("--nodl", metavar="DIR", help="folder of the documents (default: nodl/ in the workspace)")
+    c.add_argument("--ros", nargs="+", default=[], metavar="PATH",
+                   help="also check the documents against the endpoints the code of these ROS workspaces creates "
+                        "(the ROS scan, docs/ros.md)")
+    c.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file of the scan")
     c.add_argument("--json", metavar="FILE", help="also write the findings as JSON")
     c.add_argument("--strict", action="store_true", help="exit 1 on a warning too")
     common(c)
@@ -56,6 +61,14 @@ def cmd_check(args: argparse.Namespace) -> int:
     checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
     folder = Path(args.nodl) if args.nodl else None
     res = check(checked, ws, folder, [Path(p) for p in args.ament_prefix])
+    if args.ros:
+        from rclverify.ros.graph.scan import scan  # deferred: start-up (loads the ROS scan only when called)
+        from rclverify.ros.ground.nodl_code import check_code  # deferred: start-up (loads the ROS scan only when called)
+        graph = scan([Path(p) for p in args.ros], [Path(p) for p in args.launch]).graph
+        matched, found = check_code(res.documents, graph.nodes)
+        res.findings += found
+        print(f"{len(matched)} document(s) matched to a node of the scanned code"
+              + "".join(f"; {n} -> {g}" for n, g in sorted(matched.items())))
     for f in res.findings:
         for line in f.lines():
             print(line, file=sys.stderr)

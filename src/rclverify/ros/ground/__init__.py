@@ -1,3 +1,4 @@
 """ROS layer d: contracts grounded in the computation graph (``ground``,
-``ground_services``, the lifecycle management interface).
+``ground_services``, the lifecycle management interface), and NoDL
+documents against the code's endpoints (``nodl_code``).
 """
