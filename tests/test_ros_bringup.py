@@ -326,3 +326,15 @@ def test_a_library_of_a_source_directory_is_its_component() -> None:
     assert [(p["name"], p["nodes"], p["unaccounted"]) for p in g.programs] == [
         ("rover_lights::Lights", ["/lights"], None)]
     assert not _said(g)
+
+
+def test_a_component_registered_by_another_packages_cmake_macro() -> None:
+    """``rover_register_node(horn_component PLUGIN "rover_horn::Horn" EXECUTABLE
+    horn_node)``, a macro rover_core exports (``cmake/*.cmake``, ``CONFIG_EXTRAS``):
+    the component and its executable are declared (before: no program, a node of no
+    executable)."""
+    g = scan([WS / "src" / "rover_horn", WS / "src" / "rover_core"]).graph
+    assert _edges(g, "/horn") == {("sub", "/honk", "std_msgs/msg/Empty")}
+    assert g.nodes["/horn"].executable == "horn_node"
+    assert [(p["name"], p["kind"], p["nodes"], p["unaccounted"]) for p in g.programs] == [
+        ("rover_horn::Horn", "component", ["/horn"], None)]

@@ -134,8 +134,19 @@ def _block(seq: list[tuple[str, list[str], int]], i: int, opener: str, closer: s
 _Cmd = tuple[str, list[str], int]
 
 
+Definitions = dict[str, tuple[list[str], list[tuple[str, list[str], int]]]]
+
+
+def definitions_of(text: str) -> Definitions:
+    """The ``function``/``macro`` definitions of CMake source ``text`` (name
+    lower-cased -> (parameters, body)): what a package exports for others to
+    call (``cmake/*.cmake``, ``*-extras.cmake``)."""
+    return _definitions(commands_of(text))[0]
+
+
 def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = None,
-           read: Callable[[str], str | None] | None = None) -> list[tuple[str, list[str], int]]:
+           read: Callable[[str], str | None] | None = None,
+           extra: Definitions | None = None) -> list[tuple[str, list[str], int]]:
     """The commands ``text`` runs, with variables substituted, ``foreach`` loops
     unrolled and calls of the file's own ``function``/``macro`` definitions
     replaced by their bodies (arguments substituted); each keeps the line of
@@ -144,9 +155,11 @@ def expand(text: str, pkg: str, glob: Callable[[str, bool], list[str]] | None = 
     ``file(GLOB ...)`` pattern matches (relative paths); without it globs are empty.
     ``read(path)`` gives the text of a package file an ``include(path.cmake)`` names
     (``None`` when it cannot): its commands, its functions and macros included, run
-    where the ``include`` is, at its line."""
+    where the ``include`` is, at its line.  ``extra``: the functions and macros of
+    other packages (:func:`definitions_of`), called as the package's own are; the
+    package's own of the same name win."""
     defs, top = _definitions(_included(commands_of(text), read, 0))
-    runner = _Runner(defs, glob)
+    runner = _Runner({**(extra or {}), **defs}, glob)
     runner.run(top, {"PROJECT_NAME": pkg, "CMAKE_CURRENT_SOURCE_DIR": ".", "PROJECT_SOURCE_DIR": "."}, 0, None)
     return runner.out
 

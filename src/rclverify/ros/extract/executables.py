@@ -30,7 +30,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from rclverify.ros.extract.cmake import expand
+from rclverify.ros.extract.cmake import Definitions, definitions_of, expand
 from rclverify.ros.extract.model import Note
 from rclverify.ros.extract.nodelets import plugin_classes
 from rclverify.ros.extract.plugins import PluginClass, described
@@ -130,10 +130,11 @@ def _reader(root: Path, here: Path):  # type: ignore[no-untyped-def]
 MAX_SUBDIRS = 32  # CMakeLists.txt files read per package (add_subdirectory)
 
 
-def targets(root: Path, pkg: str) -> Targets:
+def targets(root: Path, pkg: str, extra: Definitions | None = None) -> Targets:
     """The :class:`Targets` of the package at ``root`` named ``pkg`` (its
     ``CMakeLists.txt`` and those its ``add_subdirectory`` calls name, each
-    with source paths relative to its own directory)."""
+    with source paths relative to its own directory); ``extra``: CMake
+    functions and macros other packages export (:func:`exported_cmake`)."""
     t = Targets()
     todo, seen = [root], 0
     auto_libs: list[str] = []
@@ -141,7 +142,7 @@ def targets(root: Path, pkg: str) -> Targets:
         here = todo.pop(0)
         seen += 1
         try:
-            cmds = expand(safefs.read_text(here / "CMakeLists.txt"), pkg, _glob(here), _reader(root, here))
+            cmds = expand(safefs.read_text(here / "CMakeLists.txt"), pkg, _glob(here), _reader(root, here), extra)
         except OSError:
             continue
         _read(cmds, here, t, auto_libs, todo)
@@ -214,6 +215,25 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
                     t.programs.setdefault(f.name, [f])
                     t.programs.setdefault(f.stem, [f])
                 k += 1
+
+
+MAX_EXPORTED = 64  # .cmake files read per package for the functions and macros it exports
+
+
+def exported_cmake(root: Path) -> Definitions:
+    """The CMake functions and macros the package at ``root`` exports for the
+    packages that ``find_package`` it: those of its ``cmake/*.cmake`` files
+    and its ``*-extras.cmake`` (ament's ``CONFIG_EXTRAS``, also ``.in``);
+    a file that cannot be read gives none."""
+    files = sorted((root / "cmake").glob("*.cmake")) if (root / "cmake").is_dir() else []
+    files += sorted(root.glob("*-extras.cmake")) + sorted(root.glob("*-extras.cmake.in"))
+    out: Definitions = {}
+    for f in files[:MAX_EXPORTED]:
+        try:
+            out.update(definitions_of(safefs.read_text(f)))
+        except (OSError, RecursionError):
+            continue
+    return out
 
 
 _AUTO_SOURCES = ("*.c", "*.cc", "*.cpp", "*.cxx")

@@ -26,7 +26,7 @@ from rclverify.ros.extract import namespaces
 from rclverify.ros.graph.absent import absent_interfaces
 from rclverify.ros.graph.assemble import Assembly
 from rclverify.ros.extract.cache import ParseCache
-from rclverify.ros.extract.executables import Targets, targets
+from rclverify.ros.extract.executables import Targets, exported_cmake, targets
 from rclverify.ros.extract.interfaces import TypeTable
 from rclverify.ros.extract.launch import El, Interpreter, read_xml, read_yaml
 from rclverify.ros.extract.launch_ros2 import read_python
@@ -227,9 +227,12 @@ class _Scan:
         """Each package's build targets and the record of each of its source
         files (Python, C++, and extensionless Python programs)."""
         g, show, cache = self.g, self.show, self.cache
+        exported = {name: exported_cmake(self.pkgs[name].root) for name in sorted(self.pkgs)}
         for name in sorted(self.pkgs):
             root = self.pkgs[name].root
-            self.tgts[name] = targets(root, name)
+            # the CMake functions and macros the other packages export (vendor_register_node(...))
+            others = {k: v for other, defs in exported.items() if other != name for k, v in defs.items()}
+            self.tgts[name] = targets(root, name, others)
             installed = {p for paths in self.tgts[name].programs.values() for p in paths}
             py, cpp, bare = _source_files(root, self.skipped)
             recs = self.records[name] = {}
