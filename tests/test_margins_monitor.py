@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import random
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -134,3 +135,24 @@ def test_monitor_json_names_the_smallest_margin(capsys: pytest.CaptureFixture[st
     assert (first["formula"], first["margin"], first["where"], first["time"]) == \
         ("out.progress >= 0", -1.0, "late_stop.jsonl:12", 8.5)
     assert first["trace"].endswith("late_stop.jsonl")
+
+
+def test_evidence_records_carry_both_margins(tmp_path: Path) -> None:
+    """`verify` on the safety-stop example with its late run: Base's evidence names the smallest space
+    margin of its untimed check and the time margin of its deadline (150 ms late), Mover's both too."""
+    ws = tmp_path / "ws"
+    shutil.copytree(REPO / "examples" / "safety_stop", ws, ignore=shutil.ignore_patterns("artifacts", "reports",
+                                                                                         "__pycache__"))
+    plan = ws / "contracts" / "plan.yaml"
+    plan.write_text(plan.read_text().replace("traces: [traces/nominal.jsonl]\n  Mover",
+                                             "traces: [traces/late_stop.jsonl]\n  Mover"))
+    main(["verify", "-w", str(ws)])
+    base = json.loads((ws / "artifacts" / "evidence" / "Base.g0.monitors.late_stop_jsonl.json").read_text())
+    (space,) = base["details"]["monitoring"]["margins"]
+    assert (space["formula"], space["margin"], space["holds"], space["trace"]) == \
+        ("in.stop_req -> out.stopped", None, True, "traces/late_stop.jsonl")  # BOOL atoms: no distance
+    (time_,) = base["details"]["deadlines"]["time_margins"]
+    assert (time_["margin_ns"], time_["answer_where"], time_["answers"]) == (-150_000_000, "late_stop.jsonl:5", 2)
+    mover = json.loads((ws / "artifacts" / "evidence" / "Mover.g0.monitors.nominal_jsonl.json").read_text())
+    assert [m["guarantee"] for m in mover["details"]["monitoring"]["margins"]] == [1, 2]
+    assert mover["details"]["deadlines"]["time_margins"][0]["margin"] > 0
