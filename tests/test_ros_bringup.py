@@ -338,3 +338,12 @@ def test_a_component_registered_by_another_packages_cmake_macro() -> None:
     assert g.nodes["/horn"].executable == "horn_node"
     assert [(p["name"], p["kind"], p["nodes"], p["unaccounted"]) for p in g.programs] == [
         ("rover_horn::Horn", "component", ["/horn"], None)]
+
+
+def test_a_script_and_an_executable_of_one_name_are_two_programs() -> None:
+    """``beeper`` (C++) and ``scripts/beeper.py`` (Python, also called ``beeper``):
+    the executable's account holds its own node only (before: both nodes)."""
+    g = scan([WS / "src" / "rover_beeper"]).graph
+    assert _edges(g, "/beeper") == {("pub", "/beep", "std_msgs/msg/Empty")}
+    assert _edges(g, "/beeper_py") == {("pub", "/beep_text", "std_msgs/msg/String")}
+    assert [(p["name"], p["nodes"]) for p in g.programs] == [("beeper", ["/beeper"])]

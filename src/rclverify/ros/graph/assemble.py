@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from pathlib import Path
 import dataclasses
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 from rclverify.ros.extract import cross_package, emit, names, nodelets, plugins
 from rclverify.ros.extract.executables import Targets
@@ -215,7 +215,7 @@ class Assembly:
                     g.notes.extend(got.notes)
                     eps = [e for e, _o in got.endpoints]
                     add_node("/" + name, "/", pkg, prog.nodelet, _files(prog, got, eps, None), at, eps, [], "source")
-                    self.ledger.gave(pkg, _keys(prog), "/" + name)
+                    self.ledger.gave(pkg, _keys(prog, self.progs.get(pkg, [])), "/" + name)
                     continue
                 if not got.nodes:
                     self._nameless(pkg, prog, got, g)
@@ -224,7 +224,7 @@ class Assembly:
                 for i, (name, src, ns) in enumerate(got.nodes):
                     eps = [e for e, o in got.endpoints if o == i]
                     full = names.join(names.join("/", ns or ""), name)
-                    self.ledger.gave(pkg, _keys(prog), full)
+                    self.ledger.gave(pkg, _keys(prog, self.progs.get(pkg, [])), full)
                     files = _files(prog, got, eps, src.file)
                     add_node(full, names.split(full)[0], pkg, prog.exe, files, src, eps, [], "source",
                              lifecycle=got.kinds[i] == "lifecycle" if i < len(got.kinds) else False)
@@ -252,7 +252,7 @@ class Assembly:
                   (", ..." if len(prog.files) > 3 else "") + ")"
         else:
             why = "no source file of it is read"
-        self.ledger.none(pkg, _keys(prog), why)
+        self.ledger.none(pkg, _keys(prog, self.progs.get(pkg, [])), why)
 
     def launch_node(self, ln: LaunchNode, add_node: Callable[..., None], g: Graph) -> None:
         """The node launch element ``ln`` starts (see the module docstring)."""
@@ -322,9 +322,12 @@ class Assembly:
                  lifecycle="lifecycle" in got.kinds)
 
 
-def _keys(prog: Program) -> list[str]:
-    """The names a declaration may give program ``prog``: its executable, aliases, classes."""
-    return [k for k in [prog.exe, *prog.aliases, *sorted(prog.units or ())] if k]
+def _keys(prog: Program, others: Sequence[Program] = ()) -> list[str]:
+    """The names a declaration may give program ``prog``: its executable, aliases, classes;
+    an alias another program of ``others`` (its package's) has as its executable is that
+    program's (a script ``beeper.py`` beside a C++ executable ``beeper``: two programs)."""
+    taken = {p.exe for p in others if p is not prog and p.exe}
+    return [k for k in [prog.exe, *(a for a in prog.aliases if a not in taken), *sorted(prog.units or ())] if k]
 
 
 def _files(prog: Program, got: Linked, eps: list[Endpoint], named_in: str | None) -> list[str]:
