@@ -53,7 +53,7 @@ LIVE = frozenset({
     "test_ros2_declarations", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
-    "test_ros2_undefined_type",
+    "test_ros2_undefined_type", "test_nodl_live",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -83,7 +83,7 @@ SECONDS: dict[str, float] = {
     "test_generate_cpp_candidates": 2.2, "test_jsonl_columns": 2.2, "test_realizable": 2.1,
     "test_bench_compose_pacti": 2.1, "test_deterministic_queries": 2.1, "test_findings_health": 2.1,
     "test_health_fast": 3.3, "test_requirements_own_nodes": 2.0, "test_bundle_ties": 3.0,
-    "test_paths_rechecked": 3.5, "test_ros2_bag_calls": 7.0,
+    "test_paths_rechecked": 3.5, "test_ros2_bag_calls": 7.0, "test_nodl_live": 2.4,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -98,7 +98,7 @@ WALL: dict[str, float] = {
     "test_ros2_declarations": 25.4, "test_monitor_live_dds": 6.1, "test_lsp_hostile": 5.0,
     "test_ros_master_hostile": 5.0, "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
     "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0, "test_ros2_event_time": 40.0,
-    "test_example_manipulator": 25.0,
+    "test_example_manipulator": 25.0, "test_nodl_live": 12.8,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.

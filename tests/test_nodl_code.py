@@ -51,7 +51,7 @@ def test_a_seeded_type_and_an_endpoint_the_code_lacks_are_found(tree, tmp_path: 
     assert sorted((f.code, f.severity) for f in found) == [("nodl-code-absent", "warning"), ("nodl-code-type", "error")]
     t = next(f for f in found if f.code == "nodl-code-type")
     assert (t.locs[0].file, t.locs[1].file) == ("gen/guard/guard/node.py", "guard.nodl.yaml")
-    assert "/scan has type sensor_msgs/msg/LaserScan in the code and sensor_msgs/msg/PointCloud2" in t.message
+    assert "/scan has type sensor_msgs/msg/LaserScan in the scanned code and sensor_msgs/msg/PointCloud2" in t.message
 
 
 def test_the_hand_written_documents_against_the_generated_code(tree, capsys) -> None:
@@ -63,7 +63,7 @@ def test_the_hand_written_documents_against_the_generated_code(tree, capsys) -> 
     codes = sorted({ln.rsplit("[", 1)[1] for ln in captured.err.splitlines()})
     assert codes == ["nodl-code-qos]", "nodl-code-undeclared]"]
     assert "/scan's reliability is RELIABLE in the code (QOS_DEPTH) and BEST_EFFORT in its NoDL document" in captured.err
-    assert "node /Dock's code creates /Dock/contract_verdict (std_msgs/msg/String) in publishers" in captured.err
+    assert "node /Dock has /Dock/contract_verdict (std_msgs/msg/String) in publishers in the scanned code" in captured.err
 
 
 def test_names_resolve_in_the_scanned_nodes_namespace() -> None:

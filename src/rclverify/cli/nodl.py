@@ -1,7 +1,8 @@
 """``rclverify nodl``: NoDL v2 node interface documents (docs/nodl.md).
 
 ``rclverify nodl check``          the workspace's documents against its contracts and each other
-                                  (``--ros PATH...``: and against the code's endpoints)
+                                  (``--ros PATH...``: and against the code's endpoints;
+                                  ``--ros2``: and against the running ROS 2 graph)
 ``rclverify nodl validate FILE...`` documents against the schema, their includes followed
 ``rclverify nodl write [-o DIR]`` one document per node from its contract
 
@@ -17,6 +18,8 @@ import json
 import sys
 from pathlib import Path
 from typing import Any
+
+from rclverify.cli.common import seconds
 
 
 def add_parsers(sub: Any) -> None:
@@ -37,6 +40,11 @@ def add_parsers(sub: Any) -> None:
                    help="also check the documents against the endpoints the code of these ROS workspaces creates "
                         "(the ROS scan, docs/ros.md)")
     c.add_argument("--launch", action="append", default=[], metavar="FILE", help="entry launch file of the scan")
+    c.add_argument("--ros2", action="store_true",
+                   help="also check the documents against the running ROS 2 graph (DDS discovery: ROS_DOMAIN_ID, "
+                        "CYCLONEDDS_URI)")
+    c.add_argument("--wait", type=seconds, default=2.0, metavar="S",
+                   help="with --ros2: seconds to listen to discovery before the graph settles (default: 2)")
     c.add_argument("--json", metavar="FILE", help="also write the findings as JSON")
     c.add_argument("--strict", action="store_true", help="exit 1 on a warning too")
     common(c)
@@ -69,6 +77,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         res.findings += found
         print(f"{len(matched)} document(s) matched to a node of the scanned code"
               + "".join(f"; {n} -> {g}" for n, g in sorted(matched.items())))
+    if args.ros2 and not _live(args, res):
+        return 1
     for f in res.findings:
         for line in f.lines():
             print(line, file=sys.stderr)
@@ -81,6 +91,30 @@ def cmd_check(args: argparse.Namespace) -> int:
                 "parts": [d.file for d in res.parts], "findings": [f.to_json() for f in res.findings]}
         write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
     return 1 if res.errors or (args.strict and warnings) else 0
+
+
+def _live(args: argparse.Namespace, res: Any) -> bool:
+    """Add the findings of ``res.documents`` against the running graph to ``res``; ``False`` after
+    printing why the graph cannot be read."""
+    from rclverify.ros.ground.nodl_code import check_code, live_qos_of  # deferred: start-up (loads the ROS layers only when called)
+    from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
+    from rclverify.ros.live.diff_dds import read_dds_graph  # deferred: optional or conditional (inside a block)
+    try:
+        running, disc, source, dp = read_dds_graph(args.wait)
+    except DdsUnavailable as exc:
+        print(f"nodl check --ros2: error: {exc}", file=sys.stderr)
+        return False
+    try:
+        for n in running.notes:
+            print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
+        matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(disc))
+    finally:
+        disc.close()
+        dp.__del__()
+    res.findings += found
+    print(f"{len(matched)} document(s) matched to a running node ({source})"
+          + "".join(f"; {n} -> {g}" for n, g in sorted(matched.items())))
+    return True
 
 
 def cmd_validate(args: argparse.Namespace) -> int:

@@ -1,4 +1,5 @@
-"""A node's NoDL document against the endpoints its code creates (the ROS scan; docs/nodl.md, "Against the code").
+"""A node's NoDL document against the endpoints its code creates (the ROS scan) or its running node has
+(docs/nodl.md, "Against the code", "Against the running graph").
 
 The scan (:mod:`rclverify.ros.graph.scan`) gives each node of the code its
 publishers, subscriptions, service and action servers and clients, each
@@ -17,11 +18,18 @@ Findings, each located at both the code and the document:
 * ``nodl-code-qos`` (error): a topic's reliability or durability the code
   asks for literally (:mod:`rclverify.ros.extract.code_qos`) differs from
   the one the document writes (a policy either leaves unsaid is not compared).
+
+The same comparison against the running graph (``side="live"``: the nodes
+DDS discovery shows, :func:`rclverify.ros.live.diff_dds.read_dds_graph`)
+gives ``nodl-live-*`` findings, located at the document and the graph's
+source (``DDS domain N``); there an endpoint the document declares and the
+running node lacks is an error, and the QoS compared is what each running
+endpoint announces (:func:`live_qos_of`).
 """
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Mapping
+from typing import Callable, Mapping
 
 from rclverify.lang import ast
 from rclverify.model.nodl.contract import type_key
@@ -29,6 +37,8 @@ from rclverify.model.nodl.document import Document, Endpoint
 from rclverify.model.nodl.findings import Finding
 from rclverify.ros.extract import code_qos
 from rclverify.ros.extract.model import GraphEdge, GraphNode, Src
+from rclverify.ros.live.dds import ros_name
+from rclverify.ros.live.dds_discovery import Discovery
 from rclverify.ros.ground.ground import match_nodes
 
 #: A scanned node's list of each NoDL endpoint list.
@@ -52,68 +62,104 @@ def _loc(src: Src | None, fallback: ast.Loc) -> ast.Loc:
     return ast.Loc(src.file, src.line, src.col) if src is not None else fallback
 
 
-def _qos(doc_end: Endpoint, edge: GraphEdge, kind: str, base: Path | None, fqn: str, node: str) -> list[Finding]:
-    """The reliability and durability the code asks for against the document's."""
-    if doc_end.qos is None or kind not in ("publishers", "subscriptions"):
+#: What a comparison calls each side and its finding codes' prefix: the scan's code, or the running graph.
+SIDES = {"code": ("the scanned code", "nodl-code"), "live": ("the running node", "nodl-live")}
+#: The reliability and durability one side gives the endpoint ``edge`` of list ``kind`` of node ``node`` (its
+#: full name): lower case, ``None`` where unsaid, and in words where it comes from; ``None`` when unknown.
+QosOf = Callable[[str, str, GraphEdge], "tuple[str | None, str | None, str] | None"]
+
+
+def code_qos_of(base: Path | None) -> QosOf:
+    """The QoS the code asks for literally where it creates a topic's endpoint (:mod:`.code_qos`)."""
+    def read(node: str, kind: str, edge: GraphEdge) -> tuple[str | None, str | None, str] | None:
+        q = code_qos.read(edge.src, "pub" if kind == "publishers" else "sub", base)
+        return None if q is None else (q.reliability, q.durability, f"in the code ({q.text})")
+    return read
+
+
+def live_qos_of(disc: Discovery) -> QosOf:
+    """The QoS a running endpoint announces in DDS discovery (:mod:`rclverify.ros.live.dds_discovery`):
+    that of the node's writers (publishers) or readers (subscriptions) of the topic, as
+    ``ros_discovery_info`` gives endpoints to nodes; unknown (``None``) when the node has none
+    there or several that announce different QoS."""
+    def read(node: str, kind: str, edge: GraphEdge) -> tuple[str | None, str | None, str] | None:
+        table = disc.writers if kind == "publishers" else disc.readers
+        got = {("reliable" if e.qos.reliable else "best_effort", e.qos.durability) for e in table.values()
+               if disc.node_of(e.guid) == node and ros_name(e.topic) == ("topic", edge.topic)}
+        if len(got) != 1:
+            return None
+        rel, dur = got.pop()
+        return rel, dur, "announced by the running node"
+    return read
+
+
+def _qos(doc_end: Endpoint, edge: GraphEdge, qos_of: QosOf, fqn: str, node: str, code: str) -> list[Finding]:
+    """The reliability and durability the other side gives against the document's."""
+    if doc_end.qos is None or doc_end.kind not in ("publishers", "subscriptions"):
         return []
-    code = code_qos.read(edge.src, "pub" if kind == "publishers" else "sub", base)
-    if code is None:
+    got = qos_of(node, doc_end.kind, edge)
+    if got is None:
         return []
     out = []
-    for policy, said in (("reliability", code.reliability), ("durability", code.durability)):
+    for policy, said in (("reliability", got[0]), ("durability", got[1])):
         written = getattr(doc_end.qos, policy)
         if said is None or written in (None, "SYSTEM_DEFAULT", "BEST_AVAILABLE") or said.upper() == written:
             continue
-        out.append(Finding("nodl-code-qos", f"node {node}: {fqn}'s {policy} is {said.upper()} in the code "
-                                            f"({code.text}) and {written} in its NoDL document",
+        out.append(Finding(f"{code}-qos", f"node {node}: {fqn}'s {policy} is {said.upper()} {got[2]} and "
+                                          f"{written} in its NoDL document",
                            (_loc(edge.src, doc_end.loc), doc_end.qos.where(policy))))
     return out
 
 
-def compare_code(doc: Document, gn: GraphNode, base: Path | None = None) -> list[Finding]:
-    """The findings of document ``doc`` against scanned node ``gn`` (module docstring); ``base``
-    is the folder the scan's file names are relative to (for reading the code's QoS)."""
+def compare_code(doc: Document, gn: GraphNode, base: Path | None = None, side: str = "code",
+                 qos_of: QosOf | None = None) -> list[Finding]:
+    """The findings of document ``doc`` against node ``gn`` of the scan (``side="code"``) or of the
+    running graph (``"live"``; codes ``nodl-live-*``): module docstring.  ``qos_of`` gives the
+    other side's QoS of a topic's endpoint (default: the code's, read from the files the scan
+    names, relative to ``base``)."""
+    what, code = SIDES[side]
+    qos_of = qos_of or code_qos_of(base)
     top = ast.Loc(doc.file, 1, 1)
     node_loc = _loc(gn.declared_at, top)
-    code: dict[tuple[str, str], GraphEdge] = {}
+    ends: dict[tuple[str, str], GraphEdge] = {}
     for kind, attr in GRAPH_LISTS.items():
         for edge in getattr(gn, attr):
-            code.setdefault((kind, edge.topic), edge)
+            ends.setdefault((kind, edge.topic), edge)
     out: list[Finding] = []
     seen: set[tuple[str, str]] = set()
     for e in doc.endpoints:
         key = (e.kind, resolve(e.name, gn.name, gn.namespace))
         seen.add(key)
-        edge = code.get(key)
+        edge = ends.get(key)
         if edge is None:
-            out.append(Finding("nodl-code-absent", f"node {gn.name}'s NoDL document declares {key[1]} ({e.type}) in "
-                                                   f"{e.kind}, and the scanned code creates no such endpoint",
-                               (e.loc, node_loc), "warning"))
+            out.append(Finding(f"{code}-absent", f"node {gn.name}'s NoDL document declares {key[1]} ({e.type}) in "
+                                                 f"{e.kind}, and {what} has no such endpoint",
+                               (e.loc, node_loc), "warning" if side == "code" else "error"))
             continue
         if edge.msg_type and type_key(edge.msg_type) != type_key(e.type):
-            out.append(Finding("nodl-code-type", f"node {gn.name}: {key[1]} has type {edge.msg_type} in the code and "
-                                                 f"{e.type} in its NoDL document", (_loc(edge.src, top), e.type_loc)))
+            out.append(Finding(f"{code}-type", f"node {gn.name}: {key[1]} has type {edge.msg_type} in {what} and "
+                                               f"{e.type} in its NoDL document", (_loc(edge.src, top), e.type_loc)))
             continue
-        out += _qos(e, edge, e.kind, base, key[1], gn.name)
-    for key, edge in code.items():
+        out += _qos(e, edge, qos_of, key[1], gn.name, code)
+    for key, edge in ends.items():
         if key not in seen:
-            out.append(Finding("nodl-code-undeclared", f"node {gn.name}'s code creates {key[1]} "
-                                                       f"({edge.msg_type or 'type unknown'}) in {key[0]}, and its "
-                                                       f"NoDL document {doc.file} does not declare it",
+            out.append(Finding(f"{code}-undeclared", f"node {gn.name} has {key[1]} "
+                                                     f"({edge.msg_type or 'type unknown'}) in {key[0]} in {what}, "
+                                                     f"and its NoDL document {doc.file} does not declare it",
                                (_loc(edge.src, top), top)))
     return out
 
 
-def check_code(documents: Mapping[str, Document], nodes: Mapping[str, GraphNode],
-               base: Path | None = None) -> tuple[dict[str, str], list[Finding]]:
-    """Each document of ``documents`` (by node) against the scanned node it matches among
-    ``nodes`` (the scan's graph nodes by full name); returns ``({document's node: scanned node},
-    findings)``.  A document matching no scanned node is not compared."""
+def check_code(documents: Mapping[str, Document], nodes: Mapping[str, GraphNode], base: Path | None = None,
+               side: str = "code", qos_of: QosOf | None = None) -> tuple[dict[str, str], list[Finding]]:
+    """Each document of ``documents`` (by node) against the node it matches among ``nodes`` (a
+    graph's nodes by full name; :func:`compare_code` for ``base``, ``side``, ``qos_of``); returns
+    ``({document's node: graph node}, findings)``.  A document matching no node is not compared."""
     matched = match_nodes(list(documents), nodes, {})
     out: list[Finding] = []
     for name, full in sorted(matched.items()):
-        out += compare_code(documents[name], nodes[full], base)
+        out += compare_code(documents[name], nodes[full], base, side, qos_of)
     return matched, out
 
 
-__all__ = ["GRAPH_LISTS", "check_code", "compare_code", "resolve"]
+__all__ = ["GRAPH_LISTS", "QosOf", "SIDES", "check_code", "code_qos_of", "compare_code", "live_qos_of", "resolve"]

@@ -1,0 +1,92 @@
+"""NoDL documents against the running ROS 2 graph (docs/nodl.md, "Against the running graph"): real rclpy nodes on
+Fast DDS (tests/_ros2.py), read by ``rclverify nodl check --ros2`` through DDS discovery.
+
+The documents are tests/data/nodl/ws's.  One process runs two nodes: ``Guard`` exactly as its document says (the
+control: reliable, transient-local ``/stop``, best-effort ``/scan``) and ``Base`` with one seeded mismatch of each
+kind: ``/speed`` published as ``std_msgs/Float32`` (the document: ``Float64``), ``/stop`` subscribed volatile (the
+document: transient-local), no ``/estop`` server, and a publisher ``/odom`` its document does not declare.
+``Dock`` does not run: a document matched to no running node is not compared."""
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+
+from _procs import stop
+from _ros2 import rclverify, ros2_env, start_node
+
+WS = Path(__file__).parent / "data" / "nodl" / "ws"
+
+NODES = """\
+import rclpy
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool, Float32, Float64
+
+rclpy.init()
+guard = Node('Guard')
+guard.create_publisher(Bool, '/stop', QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                                                 durability=DurabilityPolicy.TRANSIENT_LOCAL))
+guard.create_subscription(LaserScan, 'scan', lambda m: None,
+                          QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT))
+base = Node('Base')
+base.create_subscription(Bool, '/stop', lambda m: None, QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                                                                   durability=DurabilityPolicy.VOLATILE))
+base.create_publisher(Float32, '/speed', 10)
+base.create_publisher(Float64, '/odom', 10)
+ex = MultiThreadedExecutor()
+ex.add_node(guard)
+ex.add_node(base)
+print('ready', flush=True)
+ex.spin()
+"""
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    tmp = tmp_path_factory.mktemp("nodl_live")
+    ws = tmp / "ws"
+    shutil.copytree(WS, ws)
+    env = ros2_env(tmp)
+    procs: list[subprocess.Popen[bytes]] = []
+    try:
+        procs.append(start_node(tmp, "robot", NODES, env))
+        log = tmp / "check.log"
+        p = rclverify(["nodl", "check", "-w", str(ws), "--ros2", "--wait", "2"], env, ws, log)
+        procs.append(p)
+        code = p.wait(90)
+        yield {"code": code, "log": log.read_text()}
+    finally:
+        for p in procs:
+            stop(p)
+
+
+def _lines(log: str, node: str) -> list[str]:
+    return [ln for ln in log.splitlines() if f"node /{node}" in ln and ln.startswith("nodl/")]
+
+
+def test_the_documents_are_matched_to_the_running_nodes(run) -> None:
+    assert "2 document(s) matched to a running node (DDS domain" in run["log"]
+    assert "; Base -> /Base; Guard -> /Guard" in run["log"]
+    assert run["code"] == 1 and "Traceback" not in run["log"]
+
+
+def test_the_node_running_as_its_document_says_has_no_finding(run) -> None:
+    assert _lines(run["log"], "Guard") == []
+
+
+def test_each_seeded_mismatch_of_the_running_node_is_found(run) -> None:
+    found = {ln.rsplit("[", 1)[1].rstrip("]"): ln for ln in _lines(run["log"], "Base")}
+    assert sorted(found) == ["nodl-live-absent", "nodl-live-qos", "nodl-live-type", "nodl-live-undeclared"]
+    assert "/speed has type std_msgs/msg/Float32 in the running node and std_msgs/msg/Float64" in found["nodl-live-type"]
+    assert "/stop's durability is VOLATILE announced by the running node and TRANSIENT_LOCAL" in found["nodl-live-qos"]
+    assert "declares /estop (std_srvs/srv/SetBool) in service_servers, and the running node has no such endpoint" \
+        in found["nodl-live-absent"]
+    assert "/odom (std_msgs/msg/Float64) in publishers in the running node" in found["nodl-live-undeclared"]
+    # each is located in the document too: the document's line of the policy, of the type, of the entry
+    assert found["nodl-live-qos"].startswith("nodl/Base.nodl.json:6:") and "(also at DDS domain" in found["nodl-live-qos"]
