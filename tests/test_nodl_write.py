@@ -3,6 +3,7 @@
 document per node package and its registration; `init`'s documents."""
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import jsonschema
@@ -106,3 +107,26 @@ def test_init_writes_a_document_per_node_that_nodl_check_accepts(tmp_path: Path)
     cam.write_text(cam.read_text().replace("reliability: RELIABLE", "reliability: BEST_EFFORT"))
     res = nodl_check(Workspace(tmp_path / "w", "contracts/plan.yaml").checked, tmp_path / "w")
     assert [f.code for f in res.findings] == ["nodl-qos"]
+
+
+@pytest.mark.parametrize("lang", ["cpp", "python"])
+def test_init_from_ros_takes_the_document_each_package_registers(lang: str, tmp_path: Path) -> None:
+    ws = tmp_path / "ws"
+    shutil.copytree(WORKSPACES[0], ws)
+    assert main(["generate", "ros2", "-w", str(ws), "-o", str(tmp_path / "gen"), "--system", "robot", "--lang", lang]) == 0
+    # the control: a package that registers no document gives its node none
+    shutil.rmtree(tmp_path / "gen" / "dock" / "nodl")
+    if lang == "cpp":  # and a registration under another path is followed (ament_nodl_register's FILE)
+        guard = tmp_path / "gen" / "guard"
+        (guard / "nodl" / "guard.nodl.yaml").rename(guard / "interface.yaml")
+        cmake = guard / "CMakeLists.txt"
+        cmake.write_text(cmake.read_text().replace("FILE nodl/guard.nodl.yaml", "FILE interface.yaml"))
+    new = tmp_path / "new"
+    assert main(["init", str(new), "--from-ros", str(tmp_path / "gen")]) == 0
+    assert sorted(p.name for p in (new / "nodl").iterdir()) == ["Base.nodl.yaml", "Guard.nodl.yaml"]
+    inc = yaml.safe_load((new / "nodl" / "Guard.nodl.yaml").read_text())["include"]
+    assert inc == [{"ref": "local://../ros/guard/" + ("interface.yaml" if lang == "cpp" else "nodl/guard.nodl.yaml")}]
+    # the skeletons (from the scanned code) and the packages' documents agree
+    res = nodl_check(Workspace(new, "contracts/plan.yaml").checked, new)
+    assert sorted(res.documents) == ["Base", "Guard"] and res.findings == []
+    assert res.documents["Guard"].files[1].startswith("ros/guard/")

@@ -8,8 +8,11 @@ entry without ``matches`` a topic of either direction; ``services(...)``
 same for actions.  The node's ROS name is the contract's node name (as
 ``rclverify generate`` makes it).
 
-Names are compared fully qualified, the node in the root namespace (where a
-generated node runs): ``x`` and ``/x`` are ``/x``, ``~/x`` is
+A contract's endpoint name is an RCL name (no ``/``), so it is compared
+with a document's name as the grounding compares it with the code's
+(:func:`rcl_name_of`: ``/robot/cmd`` is ``robot_cmd``, ``~/status`` is
+``status``); messages show names fully qualified, the node in the root
+namespace (where a generated node runs): ``x`` is ``/x``, ``~/x`` is
 ``/<node>/x``.  Types are compared by package and name: ``std_msgs/Bool``
 is ``std_msgs/msg/Bool`` (NoDL lets the middle part be implied by use).
 """
@@ -50,6 +53,14 @@ def full_name(name: str, node: str) -> str:
     if name.startswith("~/"):
         return f"/{node}/{name[2:]}"
     return name if name.startswith("/") else f"/{name}"
+
+
+def rcl_name_of(name: str) -> str:
+    """The name a contract gives ROS name ``name``: a leading ``/`` or ``~`` dropped, each ``/``
+    written ``_`` (an RCL name holds no ``/``), as the grounding reads contract names
+    (docs/ros.md, "Names in skeletons"): ``/robot/cmd`` and ``robot/cmd`` are ``robot_cmd``,
+    ``~/status`` is ``status``."""
+    return name.strip("/~").replace("/", "_").replace("~", "")
 
 
 def type_key(ros_type: str) -> tuple[str, str]:
@@ -101,19 +112,20 @@ def compare(cn: CheckedNode, doc: Document) -> list[Finding]:
     top = ast.Loc(doc.file, 1, 1)
     by_name: dict[str, list[Endpoint]] = {}
     for e in doc.endpoints:
-        by_name.setdefault(full_name(e.name, node), []).append(e)
+        by_name.setdefault(rcl_name_of(e.name), []).append(e)
     used: set[int] = set()
     out: list[Finding] = []
     for c in contract_ends(cn):
         fqn = full_name(c.name, node)
         kinds = ("publishers", "subscriptions") if c.kind == TOPIC else (c.kind,)
-        same = [e for e in by_name.get(fqn, []) if e.kind in kinds]
+        named = by_name.get(rcl_name_of(c.name), [])
+        same = [e for e in named if e.kind in kinds]
         if not same:
-            other = [e.kind.replace("_", " ")[:-1] for e in by_name.get(fqn, [])]
-            hint = f"; the document has {fqn} as a {' and a '.join(other)}" if other else ""
+            other = [f"{e.name} as a {e.kind.replace('_', ' ')[:-1]}" for e in named]
+            hint = f"; the document has {' and '.join(other)}" if other else ""
             out.append(Finding("nodl-missing", f"node {node} {_word(c.kind)} {fqn} ({c.type}) in its contract, and "
                                                f"its NoDL document {doc.file} does not declare it{hint}",
-                               (c.loc, by_name[fqn][0].loc if other else top)))
+                               (c.loc, named[0].loc if other else top)))
             continue
         for e in same:
             used.add(id(e))
@@ -178,4 +190,4 @@ def document_text(cn: CheckedNode, contract_file: str, header: str = "") -> str:
 
 
 __all__ = ["ContractEnd", "GENERATED_QOS", "TOPIC", "compare", "contract_ends", "document_data", "document_of",
-           "document_text", "full_name", "full_type", "type_key", "yaml_text"]
+           "document_text", "full_name", "full_type", "rcl_name_of", "type_key", "yaml_text"]

@@ -322,7 +322,8 @@ def build_skeletons(res: ScanResult, library: bool = False
 def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: list[Path],
                    library: bool = False) -> list[Path]:
     """Write the workspace: ``dodo.py``, ``contracts/*.rcl``, ``contracts/plan.yaml``,
-    ``ros/`` (a copy of each scanned package directory) and empty ``backends``,
+    ``ros/`` (a copy of each scanned package directory), ``nodl/<Node>.nodl.yaml`` for each node
+    whose package registers a NoDL document (:func:`.nodl.from_ros_documents`) and empty ``backends``,
     ``artifacts``, ``reports``.  Returns the paths written.  Raises ``OSError``.
     ``library``: library endpoints become inputs and outputs too (:func:`build_skeletons`)."""
     nodes, fields, external, context = build_skeletons(res, library)
@@ -353,6 +354,9 @@ def write_from_ros(root: Path, res: ScanResult, scanned: list[Path], launch: lis
     files[TYPES_FILE] = _ENV.get_template("skeleton-types.rcl.j2").render(context=context)
     files["contracts/plan.yaml"] = _ENV.get_template("skeleton-plan.yaml.j2").render(
         name=name, nodes=nodes, types=TYPES_FILE, launch=launch_rel, external=external, fields=sorted(fields.items()))
+    from rclverify.tools.scaffold.nodl import from_ros_documents  # deferred: start-up (loads yaml and more only when called)
+    files.update(from_ros_documents([(n.name, n.package, n.executable) for n in nodes],
+                                    {p.name: p.root for p in res.packages.values()}))
     for rel, text in files.items():
         atomic_write_text(root / rel, text)
         written.append(root / rel)
