@@ -431,6 +431,15 @@ def margin(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappi
     if at is None:
         return Margin(float(value), "", "", arithmetic)
     atom, i, bound = at
+    text, unit = atom_words(checked, node, atom, i, bound)
+    return Margin(_to_float(value), unit, text, arithmetic)
+
+
+def atom_words(checked: Checked, node: CheckedNode, atom: ast.Compare | ast.Member, i: int,
+               bound: frozenset[str] = frozenset()) -> tuple[str, str]:
+    """``(text, unit)`` of a deciding atom: link ``i`` of comparison ``atom``
+    (its RCL text, ``a <= b``) or membership ``atom``, under the bound names
+    ``bound``, and the unit of its terms (``""``: none declared); computed once per atom."""
     key = (id(atom), i, bound, id(node), id(checked))
     hit = _ATOMS.get(key)
     if hit is None or hit[0] is not atom:
@@ -439,11 +448,18 @@ def margin(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappi
         if len(_ATOMS) >= 4096:
             _ATOMS.clear()
         hit = _ATOMS[key] = (atom, text, _unit(checked, node, atom, i, bound))
-    return Margin(_to_float(value), hit[2], hit[1], arithmetic)
+    return hit[1], hit[2]
 
 
 #: (atom id, link, bound names, node id, contract id) -> (the atom, its text, its unit): computed once per atom
 _ATOMS: dict[tuple[Any, ...], tuple[Any, str, str]] = {}
 
 
-__all__ = ["ARITHMETICS", "INF", "Margin", "MarginUndefined", "margin"]
+def measures_the_run(terms: Any, io: frozenset[str]) -> bool:
+    """Whether the terms of a comparison outside every quantifier read a value
+    of the run (an input or output; ``io``: the node's I/O names): else the
+    comparison has no distance (``+inf`` or ``-inf``; module docstring)."""
+    return _measured(terms, frozenset(), frozenset(), io)
+
+
+__all__ = ["ARITHMETICS", "INF", "Margin", "MarginUndefined", "atom_words", "margin", "measures_the_run"]

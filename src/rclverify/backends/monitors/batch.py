@@ -47,6 +47,8 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
 from rclverify.traces.questions import KEPT, Question, QuestionStream
 from rclverify.backends.monitors.answered import AnsweredRun, RecentOutput
+from rclverify.semantics.robustness import atom_words
+from rclverify.targets.column_margins import ColumnMargin, MarginCompiler
 from rclverify.targets.columns import ColumnCompiler, Unsupported, io_kind, seed
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
@@ -91,6 +93,13 @@ class BatchPlan:
         self.codes = compiler.codes
         self.formulas = [compiler.compile(f) for f in m.assumption + m.guarantees]
         self.asked = set(m._asked)
+        #: with margins: each guarantee's margin over the columns, and the (text, unit) of each deciding comparison
+        self.margins: list[ColumnMargin] = []
+        self.atoms: list[tuple[str, str]] = []
+        if m.margins:
+            margins = MarginCompiler(compiler)
+            self.margins = [margins.compile(g) for g in m.guarantees]
+            self.atoms = [atom_words(m.checked, m.node, e, i) for e, i in margins.atoms]
 
 
 def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | None:
@@ -111,14 +120,19 @@ def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | No
 def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], rules: Mapping[str, TopicRule],
                 horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
                 tolerance: Tolerance | None = None, end: float | None = None, chunk: int = CHUNK,
-                stats: dict[str, int] | None = None) -> tuple[int, NodeResult] | None:
+                stats: dict[str, int] | None = None, margins: bool = False) -> tuple[int, NodeResult] | None:
     """:func:`~.check.check_trace` for one node, in batches: (events read, the
     node's result), the same verdicts in the same order to ``on_verdict``;
     ``None`` before reading any event when the node is not eligible (module
     docstring).  ``chunk``: events (a log's lines) read at once (>= 2); ``stats``, when given,
     receives ``batched`` (answer pairs judged in batches) and ``streamed``
-    (events fed to the streaming engine).  Raises what the event source raises."""
+    (events fed to the streaming engine).  ``margins``: the space margins too
+    (:func:`~.check.check_trace`; a batch row's in float64 columns,
+    :mod:`rclverify.targets.column_margins`, where every guarantee's is
+    positive, as the engine computes it in doubles; every other row is the
+    engine's).  Raises what the event source raises."""
     m = NodeMonitor(checked, node, rules, horizon, on_verdict, tolerance)
+    m.margins = margins
     plan = batch_plan(m, rules)
     if plan is None:
         return None
@@ -286,6 +300,9 @@ class _Run:
         for f in plan.formulas:
             truth, certain = f(columns)
             sure &= np.broadcast_to(truth & certain, sure.shape)
+        margins = [g(columns) for g in plan.margins]
+        for value, _ in margins:  # a margin the engine would compute in exact arithmetic (0, not positive): its row
+            sure &= value > 0
         p, total = 0, len(at)
         m = self.m
         bad = np.flatnonzero(~sure)
@@ -296,7 +313,8 @@ class _Run:
                 limit = m._held[0][1] + m.stream.skew
                 b = p + int(np.searchsorted(times[at[p:b] + 1], limit, side="right"))
             if b > p and self._quiet(times[at[p]]):
-                self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times)
+                self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times,
+                                [(v[p:b], a[p:b]) for v, a in margins])
                 p = b
                 if p >= total:
                     break
@@ -305,6 +323,20 @@ class _Run:
             feed(chunk[i + 1])
             p += 1
         return int(at[-1]) + 2
+
+    def _margins(self, chunk: EventRows | BlockRows, at: np.ndarray,
+                 margins: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+        """Each guarantee's smallest margin over the pairs at ``at`` counted in the
+        result, as the engine counts them one by one; returns each pair's message margin."""
+        m, plan = self.m, self.plan
+        for k, (value, atom) in enumerate(margins, 1):
+            j = int(np.argmin(value))
+            text, unit = plan.atoms[int(atom[j])] if atom[j] >= 0 else ("", "")
+            qe, ev = chunk[int(at[j])], chunk[int(at[j]) + 1]
+            m.result.note_margins(k, m._texts[k], float(value[j]), unit, text, "double",
+                                  (ev.index, ev.time, ev.where, qe.where), len(at))
+        least: np.ndarray = np.minimum.reduce([v for v, _ in margins])
+        return least
 
     def _quiet(self, t: float) -> bool:
         """Whether the engine would give no verdict of its own at an input at time ``t`` followed by its answer."""
@@ -322,8 +354,9 @@ class _Run:
         return not stamps or stamps[-1] <= t
 
     def _satisfied(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
-                   times: np.ndarray) -> None:
-        """The pairs at ``at`` are surely satisfied: their verdicts, and the engine's state as feeding them sets it."""
+                   times: np.ndarray, margins: list[tuple[np.ndarray, np.ndarray]] | None = None) -> None:
+        """The pairs at ``at`` are surely satisfied: their verdicts (with their margins,
+        ``margins``: per guarantee its values and deciding atoms), and the engine's state as feeding them sets it."""
         plan, m = self.plan, self.m
         h, okey, keys = m.horizon, plan.output[1], plan.keys
         n = len(at)
@@ -345,12 +378,13 @@ class _Run:
         result.semantics["exact"] += n
         result.accepted += n
         ofield = plan.output[2]
+        least = self._margins(chunk, at, margins) if margins else None
         if m.on_verdict is not None:
             name, emit = m.node.name, m.on_verdict
-            for i in at.tolist():
+            for j, i in enumerate(at.tolist()):
                 qe, ev = chunk[i], chunk[i + 1]
                 emit(Verdict(name, "satisfied", ev.index, ev.time, ev.where, ev.topic, ev.time, 0, {}, "", "exact",
-                             qe.where))
+                             qe.where, float(least[j]) if least is not None else None))
         # the questions the stream keeps (the newest made now, the older ones when the engine may look them
         # up: _materialise), and the outputs the engine remembers for the transport skew
         stream = m.stream

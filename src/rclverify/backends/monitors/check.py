@@ -48,12 +48,12 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     "Margins"): each ``satisfied`` or ``violated`` verdict on an output
     carries its message's margin (:attr:`Verdict.margin`) and each result
     the smallest margin of every guarantee (:attr:`NodeResult.margins`).
-    The batch path computes none, so a run asked for margins is streamed.
+    The batch path computes them over its columns as the engine does.
     """
     nodes = list(nodes)
-    if len(nodes) == 1 and batch and not margins and installed("numpy"):
+    if len(nodes) == 1 and batch and installed("numpy"):
         from rclverify.backends.monitors.batch import check_batch  # deferred: optional or conditional (numpy, the fast extra)
-        done = check_batch(checked, nodes[0], events, rules, horizon, on_verdict, tolerance, end)
+        done = check_batch(checked, nodes[0], events, rules, horizon, on_verdict, tolerance, end, margins=margins)
         if done is not None:  # eligible: the same verdicts, in batches (batch.py)
             return done[0], [done[1]]
     monitors = [NodeMonitor(checked, n, rules, horizon, on_verdict, tolerance) for n in nodes]

@@ -215,6 +215,21 @@ class NodeResult:
             kept.value, kept.unit, kept.atom, kept.arithmetic = value, unit, atom, arithmetic
             kept.event, kept.time, kept.where, kept.question = at
 
+    def note_margins(self, k: int, formula: str, value: float, unit: str, atom: str, arithmetic: str,
+                     at: tuple[int, float, str, str], answers: int) -> None:
+        """Count ``answers`` margins of guarantee ``k`` at once (the batch path),
+        ``value`` the smallest of them, on the answer ``at``: as that many
+        :meth:`note_margin` calls in order would."""
+        kept = self.margins.get(k)
+        if kept is None:
+            self.margins[k] = GuaranteeMargin(k, formula, value, unit, atom, arithmetic, *at, answers=answers)
+            return
+        first = not kept.answers
+        kept.answers += answers
+        if first or value < kept.value:
+            kept.value, kept.unit, kept.atom, kept.arithmetic = value, unit, atom, arithmetic
+            kept.event, kept.time, kept.where, kept.question = at
+
     def margins_json(self, trace: str = "") -> list[dict[str, Any]]:
         """The smallest margin of every guarantee that had one, by guarantee (:meth:`GuaranteeMargin.to_json`)."""
         return [m.to_json(trace) for _, m in sorted(self.margins.items()) if m.answers]

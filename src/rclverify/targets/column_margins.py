@@ -1,0 +1,126 @@
+"""An RCL formula's space margin over whole columns of recorded values (the batch path's margins).
+
+The column twin of :func:`rclverify.semantics.robustness.margin` in double
+arithmetic (docs/semantics.md, "Margins"), for the formulas the batch path
+compiles (:class:`rclverify.targets.columns.ColumnCompiler`: quantifier-free,
+``REAL`` and enumeration values): a comparison of numbers that reads a value
+of the run gives its distance (``b - a`` for ``a <= b``, ``-|a - b|`` for
+``a == b``, ...), computed by numpy in float64 on the terms as the column
+compiler computes them (the IEEE-754 operations of the double reading, in
+the same order); every other comparison ``+inf`` or ``-inf`` by its truth;
+``not`` negates, ``and``/``or`` are minimum and maximum, ``->`` and ``<=>``
+as in the module above, ties kept on the left as there.  Each row also gets
+the index of its deciding comparison in :attr:`MarginCompiler.atoms` (-1:
+none).  tests/test_margins_batch.py checks that the batch path's margins are
+the streaming engine's, verdict by verdict.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping
+
+from rclverify.core.numeric import np
+
+from rclverify.lang import ast
+from rclverify.semantics.robustness import measures_the_run
+from rclverify.targets.columns import ColumnCompiler, Unsupported
+
+#: A compiled margin: columns (``in.r`` -> float64 or int array) -> (margins float64, deciding atom int array).
+ColumnMargin = Callable[[Mapping[str, np.ndarray]], tuple[np.ndarray, np.ndarray]]
+
+
+class MarginCompiler:
+    """Compiles the margins of formulas of the column compiler ``columns``'s node;
+    ``atoms`` lists the deciding comparisons met, ``(comparison, link)``."""
+
+    def __init__(self, columns: ColumnCompiler) -> None:
+        self.columns = columns
+        self.io = frozenset(columns.node.inputs) | frozenset(columns.node.outputs)
+        self.atoms: list[tuple[ast.Compare, int]] = []
+
+    def compile(self, formula: ast.Expr) -> ColumnMargin:
+        """``formula``'s margin as a function of the columns (raises :class:`Unsupported`)."""
+        return self._rob(formula)
+
+    def _rob(self, e: Any) -> ColumnMargin:
+        if isinstance(e, ast.Unary) and e.op == "not":
+            f = self._rob(e.operand)
+            return lambda c: _neg(f(c))
+        if isinstance(e, ast.Binary) and e.op in ("and", "or", "->", "<=>"):
+            a, b = self._rob(e.left), self._rob(e.right)
+            if e.op == "and":
+                return lambda c: _min(a(c), b(c))
+            if e.op == "or":
+                return lambda c: _max(a(c), b(c))
+            if e.op == "->":
+                return lambda c: _max(_neg(a(c)), b(c))
+            return lambda c: _iff(a(c), b(c))
+        if isinstance(e, ast.Compare):
+            links = [self._link(e, i) for i in range(len(e.ops))]
+            if len(links) == 1:
+                return links[0]
+
+            def chain(c: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+                out = _truth(c, np.ones(_rows(c), dtype=bool))
+                for link in links:
+                    out = _min(out, link(c))
+                return out
+            return chain
+        truth = self.columns.compile(e)  # a BOOL literal or constant: no distance
+        return lambda c: _truth(c, truth(c)[0])
+
+    def _link(self, e: ast.Compare, i: int) -> ColumnMargin:
+        op, x, y = e.ops[i], e.operands[i], e.operands[i + 1]
+        cols = self.columns
+        truth = cols._compare(op, x, y)
+        if cols._enum(x) is not None or cols._enum(y) is not None or not measures_the_run((x, y), self.io):
+            return lambda c: _truth(c, truth(c)[0])
+        nx, ny = cols._num(x), cols._num(y)
+        atom = len(self.atoms)
+        self.atoms.append((e, i))
+
+        def link(c: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+            vx, vy = nx(c)[0], ny(c)[0]
+            n = _rows(c)
+            with np.errstate(all="ignore"):
+                if op in ("<", "<="):
+                    d = vy - vx
+                elif op in (">", ">="):
+                    d = vx - vy
+                else:
+                    d = np.abs(vx - vy)
+                    d = -d if op == "==" else d
+            return np.broadcast_to(np.asarray(d, dtype=np.float64), (n,)) + 0.0, np.full(n, atom, dtype=np.int32)
+        return link
+
+
+def _rows(c: Mapping[str, np.ndarray]) -> int:
+    return len(next(iter(c.values()))) if c else 0
+
+
+def _truth(c: Mapping[str, np.ndarray], truth: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``+inf`` where ``truth`` holds, ``-inf`` elsewhere; no deciding atom."""
+    n = _rows(c)
+    return np.where(np.broadcast_to(truth, (n,)), np.inf, -np.inf), np.full(n, -1, dtype=np.int32)
+
+
+def _neg(a: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    return -a[0], a[1]
+
+
+def _min(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The smaller of each row, the left one on a tie (as robustness._min)."""
+    right = b[0] < a[0]
+    return np.where(right, b[0], a[0]), np.where(right, b[1], a[1])
+
+
+def _max(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The larger of each row, the left one on a tie (as robustness._max)."""
+    right = b[0] > a[0]
+    return np.where(right, b[0], a[0]), np.where(right, b[1], a[1])
+
+
+def _iff(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    return _min(_max(_neg(a), b), _max(_neg(b), a))
+
+
+__all__ = ["ColumnMargin", "MarginCompiler", "Unsupported"]

@@ -1,0 +1,153 @@
+"""The batch path's space margins (backends/monitors/batch.py, targets/column_margins.py) against the
+streaming engine's (judging.py, semantics/robustness.py), their oracle.
+
+On random runs of small eligible contracts (a band classifier, a linear bound
+with inexact literals and two guarantees, a stop distance in metres, an
+equality that puts every row on the engine), values on and next to the
+boundaries, answers right, wrong, late, missing and out of order, the batch
+path with margins gives exactly the streaming engine's verdicts, each with
+the same margin, and the same smallest margin per guarantee (value, atom,
+unit, message, count).  The control turns the columns' ``and`` into a
+maximum and finds the two apart.
+"""
+from __future__ import annotations
+
+import random
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.batch import check_batch
+from rclverify.backends.monitors.check import check_trace
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.targets import column_margins
+from rclverify.traces.events import Event
+from rclverify.traces.mapping import load_rules
+
+CONTRACTS = """
+context { Band : {green, orange, red} ; }
+node Classifier {
+  inputs( r : REAL )
+  outputs( status : Band )
+  topics( std_msgs/Float64 reading matches(in.r), std_msgs/String status matches(out.status) )
+  assume( 0 <= in.r )
+  guarantee( (in.r < 120 -> out.status == green)
+         and (120 <= in.r and in.r < 250 -> out.status == orange)
+         and (250 <= in.r -> out.status == red) )
+}
+node Linear {
+  inputs( a : REAL, b : REAL )
+  outputs( y : REAL )
+  topics( std_msgs/Float64 a matches(in.a), std_msgs/Float64 b matches(in.b), std_msgs/Float64 y matches(out.y) )
+  guarantee( out.y <= 0.1 * in.a + in.b )
+  guarantee( out.y >= in.a - 30 - in.b * 2 or not (out.y != 7) )
+}
+node Stop {
+  inputs( r : REAL [m] )
+  outputs( d : REAL [m] )
+  topics( std_msgs/Float64 range matches(in.r), std_msgs/Float64 dist matches(out.d) )
+  guarantee( in.r - 2 <= out.d <= in.r - 0.5 )
+}
+node Echo {
+  inputs( r : REAL )
+  outputs( d : REAL )
+  topics( std_msgs/Float64 range matches(in.r), std_msgs/Float64 dist matches(out.d) )
+  guarantee( out.d == in.r )
+}
+"""
+CHECKED = check([parse_text(CONTRACTS)])
+RULES = load_rules({t: {"fields": ["data"]} for t in ("reading", "status", "a", "b", "y", "range", "dist")})
+
+
+def _band(r: float) -> str:
+    return "green" if r < 120 else "orange" if r < 250 else "red"
+
+
+def _run(rnd: random.Random, node: str) -> list[Event]:
+    events: list[Event] = []
+    t = 0.0
+
+    def add(topic: str, value: Any, time: float) -> None:
+        events.append(Event(len(events), time, topic, {"data": value}, f"run.jsonl:{len(events) + 1}"))
+    a = b = 1.0
+    for _ in range(rnd.randint(20, 400)):
+        t += rnd.choice([0.01, 0.01, 0.01, 0.004, 0.05])
+        odd = rnd.random()
+        if node == "Classifier":
+            r = rnd.choice([rnd.uniform(0, 400), 120.0, 119.99999999999999, 250.0])
+            add("reading", r, t)
+            answer = _band(r) if odd < 0.9 else rnd.choice(["green", "orange", "red"])
+            if odd < 0.97:
+                add("status", answer, t + rnd.choice([0.0, 0.001]))
+        elif node == "Linear":
+            if rnd.random() < 0.5:
+                a = rnd.choice([rnd.uniform(-60, 60), 10.0, 0.1])
+                add("a", a, t)
+            else:
+                b = rnd.choice([rnd.uniform(-10, 110), 0.0, 1.0])
+                add("b", b, t)
+            y = rnd.choice([0.1 * a + b - rnd.uniform(0, 5), 0.1 * a + b, 7.0, rnd.uniform(-100, 100)])
+            if odd < 0.95:
+                add("y", y, t + rnd.choice([0.0, 0.001]))
+        else:
+            r = rnd.choice([rnd.uniform(0, 5), 0.5, 2.0])
+            add("range", r, t)
+            d = rnd.choice([r - 0.5, r - 0.5 - rnd.uniform(0, 1), r, r - 0.5 + 1e-15]) if node == "Stop" else \
+                rnd.choice([r, r, r + 1e-9])
+            if odd < 0.95:
+                add("dist", d, t + rnd.choice([0.0, 0.001]))
+        if odd > 0.98 and len(events) > 2:  # heard out of order
+            events[-1], events[-2] = events[-2], events[-1]
+    return events
+
+
+def _both(node: str, events: list[Event]) -> tuple[Any, Any, int]:
+    streamed: list[Any] = []
+    _, (s_res,) = check_trace(CHECKED, [CHECKED.nodes[node]], iter(events), RULES, 0.1, streamed.append,
+                              batch=False, margins=True)
+    batched: list[Any] = []
+    stats: dict[str, int] = {}
+    done = check_batch(CHECKED, CHECKED.nodes[node], iter(events), RULES, 0.1, batched.append, chunk=64,
+                       stats=stats, margins=True)
+    assert done is not None, f"{node} should be eligible"
+    return (streamed, s_res), (batched, done[1]), stats["batched"]
+
+
+def _margins(res: Any) -> dict[int, Any]:
+    return {k: (m.value, m.unit, m.atom, m.event, m.where, m.question, m.answers) for k, m in res.margins.items()}
+
+
+@pytest.mark.parametrize("node", ["Classifier", "Linear", "Stop", "Echo"])
+def test_batch_margins_are_the_engines(node: str) -> None:
+    rnd = random.Random(f"margins-{node}")
+    batched_rows = 0
+    for _ in range(12):
+        events = _run(rnd, node)
+        (seen_s, res_s), (seen_b, res_b), batched = _both(node, events)
+        batched_rows += batched
+        assert seen_b == seen_s  # verdicts, order, reasons and margins
+        assert res_b == res_s and _margins(res_b) == _margins(res_s)
+        assert any(v.margin is not None for v in seen_s)
+    if node == "Echo":  # a satisfied equality is at 0: the engine computes it exactly, no row in batches
+        assert batched_rows == 0
+    else:
+        assert batched_rows > 300
+
+
+def test_units_and_atoms_from_the_columns() -> None:
+    events = [Event(0, 1.0, "range", {"data": 3.0}, "r:1"), Event(1, 1.0, "dist", {"data": 2.25}, "r:2"),
+              Event(2, 2.0, "range", {"data": 2.0}, "r:3"), Event(3, 2.0, "dist", {"data": 1.0}, "r:4")]
+    (_, res_s), (seen_b, res_b), batched = _both("Stop", events)
+    assert batched == 2 and [v.margin for v in seen_b] == [0.25, 0.5]
+    assert (res_b.margins[1].value, res_b.margins[1].unit, res_b.margins[1].atom) == (0.25, "m", "out.d <= in.r - 0.5")
+
+
+def test_control_a_wrong_column_and_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(column_margins, "_min", column_margins._max)
+    rnd = random.Random("control")
+    differ = 0
+    for _ in range(5):
+        (seen_s, _), (seen_b, _), _ = _both("Classifier", _run(rnd, "Classifier"))
+        differ += sum(a.margin != b.margin for a, b in zip(seen_s, seen_b))
+    assert differ > 0
