@@ -296,3 +296,22 @@ def test_nodl_check_prints_each_finding_at_each_file_and_exits_1(ws: Path, capsy
     _edit(ws / "nodl" / "Guard.nodl.yaml", "durability: VOLATILE", "durability: TRANSIENT_LOCAL")
     assert main(["nodl", "check", "-w", str(ws)]) == 0  # a warning only
     assert main(["nodl", "check", "-w", str(ws), "--strict"]) == 1
+
+
+def test_a_parameters_constraints_discharge_the_assumption_on_the_input_it_sets(ws: Path) -> None:
+    res = check(Workspace(ws, "contracts/plan.yaml").checked, ws)
+    assert [(s.node, s.parameter, s.conjunct, s.status) for s in res.sides] == [
+        ("Base", "limit", "0 < in.limit", "proved"), ("Base", "limit", "in.limit <= MaxSpeed", "proved")]
+    # seeded: the declaration lets the limit rise above MaxSpeed (1.5), which Base assumes it never does
+    _edit(ws / "nodl" / "Base.nodl.json", '"lt_eq<>": [1.2]', '"lt_eq<>": [1.8]')
+    res = check(Workspace(ws, "contracts/plan.yaml").checked, ws)
+    assert [(s.conjunct, s.status) for s in res.sides] == [("0 < in.limit", "proved"),
+                                                          ("in.limit <= MaxSpeed", "refuted")]
+    f = res.findings
+    assert [x.code for x in f] == ["nodl-parameter-assume"]
+    assert "node Base assumes in.limit <= MaxSpeed of input limit, which parameter limit sets" in f[0].message
+    m = re.search(r"allow Base\.in\.limit = ([0-9.]+), which breaks it", f[0].message)
+    assert m is not None and 1.5 < float(m.group(1)) <= 1.8  # Z3's counterexample: allowed, above MaxSpeed
+    assert [(loc.file, loc.line) for loc in f[0].locs] == [
+        ("contracts/robot.rcl", _line_of(ws / "contracts" / "robot.rcl", "assume( 0 < in.limit")),
+        ("nodl/Base.nodl.json", _line_of(ws / "nodl" / "Base.nodl.json", '"limit"'))]

@@ -82,13 +82,19 @@ def cmd_check(args: argparse.Namespace) -> int:
     for f in res.findings:
         for line in f.lines():
             print(line, file=sys.stderr)
+    for side in res.sides:
+        if side.status == "proved":
+            print(f"node {side.node}: parameter {side.parameter}'s declared constraints ensure the assumption "
+                  f"{side.conjunct} (Z3: proved)")
     warnings = len(res.findings) - res.errors
     print(f"{len(res.documents)} node document(s) and {len(res.parts)} part(s) read; "
           f"{res.errors} error(s), {warnings} warning(s)")
     if args.json:
         from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
         data = {"documents": {n: d.files for n, d in sorted(res.documents.items())},
-                "parts": [d.file for d in res.parts], "findings": [f.to_json() for f in res.findings]}
+                "parts": [d.file for d in res.parts], "findings": [f.to_json() for f in res.findings],
+                "side_conditions": [{"node": s.node, "parameter": s.parameter, "conjunct": s.conjunct,
+                                     "status": s.status, "model": dict(s.model)} for s in res.sides]}
         write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
     return 1 if res.errors or (args.strict and warnings) else 0
 

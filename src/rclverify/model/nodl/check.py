@@ -14,7 +14,9 @@ all (:mod:`.document`), then finds
   offers meets what the reader requests (``nodl-qos``, :mod:`.qos`);
 * per parameter: its default against its declared constraints, and the
   contracts' constant of the same name against them (``nodl-parameter``,
-  :mod:`.params`);
+  :mod:`.params`); and, where it sets an input of the node's contract,
+  whether its constraints ensure what the contract assumes of that input
+  (Z3; ``nodl-parameter-assume``, :mod:`.param_assume`);
 * a document named after no node that no other document includes
   (``nodl-node``, a warning: a part meant for ``include`` is fine).
 """
@@ -31,6 +33,7 @@ from rclverify.lang.types import Checked
 from rclverify.model.nodl.contract import compare, full_name, type_key
 from rclverify.model.nodl.document import SUFFIXES, Document, Endpoint, Resolver, read_document
 from rclverify.model.nodl.findings import Finding
+from rclverify.model.nodl.param_assume import Side, check_parameters
 from rclverify.model.nodl.params import broken
 from rclverify.model.nodl.qos import mismatches
 
@@ -46,6 +49,8 @@ class Result:
     documents: dict[str, Document] = field(default_factory=dict)
     parts: list[Document] = field(default_factory=list)
     findings: list[Finding] = field(default_factory=list)
+    #: the side conditions of parameters that set an input (:mod:`.param_assume`), each decided
+    sides: list[Side] = field(default_factory=list)
 
     @property
     def errors(self) -> int:
@@ -186,6 +191,9 @@ def check(checked: Checked, root: Path, folder: Path | None = None, prefixes: Se
         if cn is not None:
             res.documents[doc.node] = doc
             res.findings += compare(cn, doc)
+            sides, found = check_parameters(cn, doc, checked)
+            res.sides += sides
+            res.findings += found
         else:
             res.parts.append(doc)
             if doc.file not in included:

@@ -19,7 +19,13 @@ CODES = {
     "nodl-qos": "a topic's or service's writer offers less than its reader requests (request-offered QoS)",
     "nodl-connect-type": "two documents give one topic, service or action different types",
     "nodl-parameter": "a parameter's default, or the contract constant of its name, breaks its declared constraints",
+    "nodl-parameter-assume": "a parameter's declared constraints do not ensure what the contract assumes of the "
+                             "input it sets",
     "nodl-node": "a document is named after no node of the contracts",
+    "nodl-code-undeclared": "the code (or the running node: nodl-live-*) has an endpoint the document lacks",
+    "nodl-code-absent": "the document declares an endpoint the code (the running node) lacks",
+    "nodl-code-type": "the code (the running node) and the document give an endpoint different types",
+    "nodl-code-qos": "the code (the running node) gives a topic another reliability or durability than the document",
 }
 
 
