@@ -77,7 +77,7 @@ def test_smallest_margin_per_guarantee() -> None:
     assert (two.value, two.unit, two.where, two.time, two.answers) == (pytest.approx(0.1), "m/s", "run.jsonl:8", 3.02, 2)
     details = monitoring_details(res, "run.jsonl", 8, "", "", 0.5)
     assert [(m["guarantee"], m["margin"], m["trace"], m["holds"]) for m in details["margins"]] == \
-        [(1, -0.25, "run.jsonl", False), (2, pytest.approx(0.1), "run.jsonl", True)]
+        [(1, -0.25, "run.jsonl", None), (2, pytest.approx(0.1), "run.jsonl", None)]  # holds: an infinite one's
 
 
 def test_control_without_margins_same_verdicts_none_carried() -> None:
@@ -86,6 +86,15 @@ def test_control_without_margins_same_verdicts_none_carried() -> None:
     assert with_m == without and not without.margins
     assert [(v.where, v.verdict) for v in seen] == [(v.where, v.verdict) for v in seen_m]
     assert all(v.margin is None for v in seen) and "margin" not in seen[1].to_json()
+
+
+def test_a_guarantee_without_margins_says_so() -> None:
+    """A quantifier over REAL has no margin: the guarantee is listed with none, its answers counted undefined."""
+    checked = check([parse_text(CONTRACT.replace("guarantee( out.v <= 2 )",
+                                                 "guarantee( forall(x in REAL | x > out.v -> x > 1) )"))])
+    _, (res,) = check_trace(checked, [checked.nodes["Stop"]], iter(_events(SCRIPT)), RULES, 0.5, margins=True)
+    two = next(m for m in res.margins_json() if m["guarantee"] == 2)
+    assert (two["margin"], two["holds"], two["answers"], two["undefined"]) == (None, None, 0, 2)
 
 
 def test_control_a_turned_comparison_gives_other_figures(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -121,6 +130,7 @@ def test_sign_agrees_with_every_verdict_on_random_runs() -> None:
         carried = [v.margin for v in seen if v.margin is not None]
         if carried:  # the least over the guarantees is the least over the messages
             assert min(m.value for m in res.margins.values() if m.answers) == min(carried)
+        assert all(m.undefined == 0 for m in res.margins.values())
         assert res == _run(False, script)[0]
     assert judged > 100
 

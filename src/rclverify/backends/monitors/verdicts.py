@@ -116,11 +116,14 @@ class GuaranteeMargin:
     undefined: int = 0
 
     def to_json(self, trace: str = "") -> dict[str, Any]:
-        """A JSON-ready dict: ``margin`` the value (``null`` when infinite, then
-        ``holds`` says on which side), ``trace`` the run when given."""
+        """A JSON-ready dict: ``margin`` the value, ``null`` when infinite (then
+        ``holds`` says on which side: true for ``+inf``) or when no answer had
+        one (``answers`` 0; ``holds`` is ``null`` but for an infinite margin),
+        ``trace`` the run when given."""
         out: dict[str, Any] = {"guarantee": self.guarantee, "formula": self.formula,
                                "margin": self.value if math.isfinite(self.value) else None,
-                               "holds": self.value >= 0, "unit": self.unit, "atom": self.atom,
+                               "holds": self.value > 0 if math.isinf(self.value) else None,
+                               "unit": self.unit, "atom": self.atom,
                                "arithmetic": self.arithmetic, "event": self.event, "time": self.time,
                                "where": self.where, "question": self.question, "answers": self.answers,
                                "undefined": self.undefined}
@@ -231,8 +234,9 @@ class NodeResult:
             kept.event, kept.time, kept.where, kept.question = at
 
     def margins_json(self, trace: str = "") -> list[dict[str, Any]]:
-        """The smallest margin of every guarantee that had one, by guarantee (:meth:`GuaranteeMargin.to_json`)."""
-        return [m.to_json(trace) for _, m in sorted(self.margins.items()) if m.answers]
+        """The smallest margin of every guarantee judged with margins, by guarantee
+        (:meth:`GuaranteeMargin.to_json`; one whose answers had none: ``answers`` 0, ``margin`` null)."""
+        return [m.to_json(trace) for _, m in sorted(self.margins.items())]
 
     def add_violation(self, record: Violation) -> None:
         """Keep ``record`` (one ``violated`` verdict) in :attr:`violations`
