@@ -130,3 +130,20 @@ def test_init_from_ros_takes_the_document_each_package_registers(lang: str, tmp_
     res = nodl_check(Workspace(new, "contracts/plan.yaml").checked, new)
     assert sorted(res.documents) == ["Base", "Guard"] and res.findings == []
     assert res.documents["Guard"].files[1].startswith("ros/guard/")
+
+
+def test_nodl_write_writes_what_nodl_check_accepts_and_overwrites_nothing(tmp_path: Path, capsys) -> None:
+    ws = tmp_path / "ws"
+    shutil.copytree(WORKSPACES[0], ws)
+    shutil.rmtree(ws / "nodl")
+    assert main(["nodl", "write", "-w", str(ws), "Guard", "Dock"]) == 0
+    assert sorted(p.name for p in (ws / "nodl").iterdir()) == ["Dock.nodl.yaml", "Guard.nodl.yaml"]
+    assert nodl_check(Workspace(ws, "contracts/plan.yaml").checked, ws).findings == []
+    before = (ws / "nodl" / "Guard.nodl.yaml").read_text()
+    (ws / "nodl" / "Guard.nodl.yaml").write_text(before + "# edited\n")
+    capsys.readouterr()
+    assert main(["nodl", "write", "-w", str(ws)]) == 1  # Guard's exists: nothing written
+    assert "Guard.nodl.yaml: error: exists" in capsys.readouterr().err and not (ws / "nodl" / "Base.nodl.yaml").exists()
+    assert main(["nodl", "write", "-w", str(ws), "--force"]) == 0
+    assert (ws / "nodl" / "Guard.nodl.yaml").read_text() == before
+    assert main(["nodl", "write", "-w", str(ws), "Nobody"]) == 2

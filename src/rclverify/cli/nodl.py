@@ -57,6 +57,7 @@ def add_parsers(sub: Any) -> None:
     w.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
     w.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
     w.add_argument("-o", "--output", metavar="DIR", help="folder written (default: nodl/ in the workspace)")
+    w.add_argument("--force", action="store_true", help="overwrite documents that exist (default: refuse)")
     w.add_argument("nodes", nargs="*", metavar="NODE", help="the nodes (default: every node)")
     w.set_defaults(fn=cmd_write)
 
@@ -136,7 +137,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_write(args: argparse.Namespace) -> int:
-    """Write ``<Node>.nodl.yaml`` per node; prints each file written."""
+    """Write ``<Node>.nodl.yaml`` per node (none when one exists, unless ``--force``); prints each file written."""
     from rclverify.model.nodl.contract import document_text  # deferred: start-up (loads yaml and more only when called)
     from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.records only when called)
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
@@ -149,8 +150,13 @@ def cmd_write(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else ws / "nodl"
     texts = {n: document_text(cn, cn.node.loc.file, "written by rclverify nodl write from the RCL contract")
              for n, cn in checked.nodes.items() if not args.nodes or n in args.nodes}  # raises RclError (located)
+    paths = {name: out / f"{name}.nodl.yaml" for name in texts}
+    there = [p for p in paths.values() if p.exists()]
+    if there and not args.force:
+        for p in there:
+            print(f"{p}: error: exists; nodl write overwrites no document unless --force", file=sys.stderr)
+        return 1
     for name, text in texts.items():
-        path = out / f"{name}.nodl.yaml"
-        atomic_write_text(path, text)
-        print(path)
+        atomic_write_text(paths[name], text)
+        print(paths[name])
     return 0
