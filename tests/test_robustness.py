@@ -191,3 +191,16 @@ def test_controls_the_oracle_catches_a_wrong_margin(broken: str, monkeypatch: py
                             if op in ("<", "<=") else self.diff(y, x))
     found = [_agrees(t, dict(VALUES, **v), "exact") for t, v in CONTROL_CASES]
     assert False in found
+
+
+def test_tuple_quantifiers_over_a_sequence_of_pairs() -> None:
+    checked = check([parse_text("node p { inputs( ps : seq((REAL, REAL)) ) outputs( d : REAL ) guarantee( TRUE ) }")])
+    node = checked.nodes["p"]
+    values = {"in.ps": ((1.0, 3.0), (2.0, 2.5)), "out.d": 1.0}
+
+    def got(text: str) -> float:
+        return margin(parse_formula(text), checked, node, values).value
+    assert got("forall((a, b) in in.ps | a < b)") == 0.5
+    assert got("exists((a, b) in in.ps | a > b)") == -0.5
+    assert got("exists_unique((a, b) in in.ps | b - a > 1)") == 0.5  # (1, 3) by 1 above, (2, 2.5) by 0.5 below
+    assert got("exists_unique((a, b) in in.ps | b - a > 0.25)") == -0.25  # both above: not unique

@@ -99,7 +99,7 @@ class MarginUndefined(Exception):
     wrong form."""
 
 
-_R = tuple[Any, Any]  # (distance: int | Fraction | float, the deciding atom: (ast node, bound names) or None)
+_R = tuple[Any, Any]  # (distance: int | Fraction | float, the deciding atom: (node, link, bound names) or None)
 
 
 #: the domains that are terms (a set's or a sequence's elements), not types
@@ -123,6 +123,7 @@ class _Margins:
         return self._sub(x, y)
 
     def truth(self, e: ast.Expr, b: Mapping[str, Value], holds: bool) -> _R:
+        """An atom without a distance: ``+inf`` when it holds, ``-inf`` when not."""
         return (INF if holds else -INF), None
 
     def rob(self, e: ast.Expr, b: Mapping[str, Value], idx: frozenset[str] = frozenset()) -> _R:
@@ -147,17 +148,8 @@ class _Margins:
         """Whether ``terms`` read a value of the run (:func:`_measured`)."""
         return _measured(terms, b, idx, self.ev.io_names)
 
-    def connective(self, e: ast.Binary, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
-        left, right = self.rob(e.left, b, idx), self.rob(e.right, b, idx)
-        if e.op == "and":
-            return _min(left, right)
-        if e.op == "or":
-            return _max(left, right)
-        if e.op == "->":
-            return _max(_neg(left), right)
-        return _min(_max(_neg(left), right), _max(_neg(right), left))  # <=>
-
     def compare(self, e: ast.Compare, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        """A comparison chain: the ``and`` of its links."""
         vals = [self.ev.eval(o, b) for o in e.operands]
         out: _R = (INF, None)
         for i, op in enumerate(e.ops):
@@ -170,6 +162,7 @@ class _Margins:
         return out
 
     def distance(self, op: str, x: Any, y: Any) -> Any:
+        """The margin of ``x op y`` on two numbers (module docstring)."""
         if op in ("<", "<="):
             return self.diff(y, x)
         if op in (">", ">="):
@@ -178,6 +171,7 @@ class _Margins:
         return -d if op == "==" else d
 
     def member(self, e: ast.Member, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        """``x in S``: the ``or`` of ``x == s`` over a finite collection of numbers, else its truth."""
         x = self.ev.eval(e.elem, b)
         carrier = self.ev.carrier(e.collection, b)
         if carrier is not None or not _number(x) or not self.measured((e.elem, e.collection), b, idx):
@@ -192,6 +186,7 @@ class _Margins:
         return _neg(near) if e.negated else near
 
     def quant(self, e: ast.Quant, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        """A quantifier over finite domains (:meth:`domain`), its variables indexes or values (:meth:`indexes`)."""
         names: list[str] = []
         doms: list[list[Any]] = []
         size = 1
@@ -231,6 +226,7 @@ class _Margins:
         return _finite_domain(self.ev, e, bd, name, b)
 
     def tuple_quant(self, e: ast.TupleQuant, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
+        """A quantifier over a collection's tuples, destructured."""
         dom = e.domain
         if not isinstance(dom, _COLLECTIONS) or self.ev.carrier(dom, b) is not None:
             raise MarginUndefined("a tuple quantifier over a type is not finite")
