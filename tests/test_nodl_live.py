@@ -1,5 +1,6 @@
 """NoDL documents against the running ROS 2 graph (docs/nodl.md, "Against the running graph"): real rclpy nodes on
-Fast DDS (tests/_ros2.py), read by ``rclverify nodl check --ros2`` through DDS discovery.
+Fast DDS (tests/_ros2.py), read by ``rclverify nodl check --ros2`` through rclverify's own DDS participant and
+through rclpy's graph API (``--source dds``, ``--source rclpy``).
 
 The documents are tests/data/nodl/ws's.  One process runs two nodes: ``Guard`` exactly as its document says (the
 control: reliable, transient-local ``/stop``, best-effort ``/scan``) and ``Base`` with one seeded mismatch of each
@@ -16,7 +17,7 @@ from typing import Any, Iterator
 import pytest
 
 from _procs import stop
-from _ros2 import rclverify, ros2_env, start_node
+from _ros2 import rclverify, ros2_env, ros2_python, start_node
 
 WS = Path(__file__).parent / "data" / "nodl" / "ws"
 
@@ -56,11 +57,15 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     procs: list[subprocess.Popen[bytes]] = []
     try:
         procs.append(start_node(tmp, "robot", NODES, env))
-        log = tmp / "check.log"
-        p = rclverify(["nodl", "check", "-w", str(ws), "--ros2", "--wait", "2"], env, ws, log)
-        procs.append(p)
-        code = p.wait(90)
-        yield {"code": code, "log": log.read_text()}
+        out: dict[str, Any] = {}
+        for source in ("dds", "rclpy"):  # rclverify's own DDS participant, rclpy's graph API (as ros diff reads)
+            log = tmp / f"check_{source}.log"
+            p = rclverify(["nodl", "check", "-w", str(ws), "--ros2", "--wait", "2", "--source", source,
+                           "--ros2-python", str(ros2_python())], env, ws, log)
+            procs.append(p)
+            code = p.wait(120)
+            out[source] = {"code": code, "log": log.read_text()}
+        yield out
     finally:
         for p in procs:
             stop(p)
@@ -70,18 +75,25 @@ def _lines(log: str, node: str) -> list[str]:
     return [ln for ln in log.splitlines() if f"node /{node}" in ln and ln.startswith("nodl/")]
 
 
-def test_the_documents_are_matched_to_the_running_nodes(run) -> None:
-    assert "2 document(s) matched to a running node (DDS domain" in run["log"]
-    assert "; Base -> /Base; Guard -> /Guard" in run["log"]
-    assert run["code"] == 1 and "Traceback" not in run["log"]
+SOURCES = {"dds": "DDS domain", "rclpy": "rclpy on rmw_fastrtps_cpp"}
 
 
-def test_the_node_running_as_its_document_says_has_no_finding(run) -> None:
-    assert _lines(run["log"], "Guard") == []
+@pytest.mark.parametrize("source", SOURCES)
+def test_the_documents_are_matched_to_the_running_nodes(run, source: str) -> None:
+    log = run[source]["log"]
+    assert f"2 document(s) matched to a running node ({SOURCES[source]}" in log
+    assert "; Base -> /Base; Guard -> /Guard" in log
+    assert run[source]["code"] == 1 and "Traceback" not in log
 
 
-def test_each_seeded_mismatch_of_the_running_node_is_found(run) -> None:
-    found = {ln.rsplit("[", 1)[1].rstrip("]"): ln for ln in _lines(run["log"], "Base")}
+@pytest.mark.parametrize("source", SOURCES)
+def test_the_node_running_as_its_document_says_has_no_finding(run, source: str) -> None:
+    assert _lines(run[source]["log"], "Guard") == []
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_each_seeded_mismatch_of_the_running_node_is_found(run, source: str) -> None:
+    found = {ln.rsplit("[", 1)[1].rstrip("]"): ln for ln in _lines(run[source]["log"], "Base")}
     assert sorted(found) == ["nodl-live-absent", "nodl-live-qos", "nodl-live-type", "nodl-live-undeclared"]
     assert "/speed has type std_msgs/msg/Float32 in the running node and std_msgs/msg/Float64" in found["nodl-live-type"]
     assert "/stop's durability is VOLATILE announced by the running node and TRANSIENT_LOCAL" in found["nodl-live-qos"]
@@ -89,4 +101,5 @@ def test_each_seeded_mismatch_of_the_running_node_is_found(run) -> None:
         in found["nodl-live-absent"]
     assert "/odom (std_msgs/msg/Float64) in publishers in the running node" in found["nodl-live-undeclared"]
     # each is located in the document too: the document's line of the policy, of the type, of the entry
-    assert found["nodl-live-qos"].startswith("nodl/Base.nodl.json:6:") and "(also at DDS domain" in found["nodl-live-qos"]
+    assert found["nodl-live-qos"].startswith("nodl/Base.nodl.json:6:")
+    assert f"(also at {SOURCES[source]}" in found["nodl-live-qos"]

@@ -45,6 +45,11 @@ def add_parsers(sub: Any) -> None:
                         "CYCLONEDDS_URI)")
     c.add_argument("--wait", type=seconds, default=2.0, metavar="S",
                    help="with --ros2: seconds to listen to discovery before the graph settles (default: 2)")
+    c.add_argument("--source", choices=("auto", "rclpy", "dds"), default="auto",
+                   help="--ros2: read the graph through rclpy's graph API or a DDS participant of rclverify's own; "
+                        "auto: rclpy where rclverify's Python imports it (as ros diff)")
+    c.add_argument("--ros2-python", metavar="PYTHON",
+                   help="--ros2 --source rclpy: the Python with rclpy (default: $RCLVERIFY_ROS2_PYTHON, else this one)")
     c.add_argument("--json", metavar="FILE", help="also write the findings as JSON")
     c.add_argument("--strict", action="store_true", help="exit 1 on a warning too")
     common(c)
@@ -101,23 +106,34 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def _live(args: argparse.Namespace, res: Any) -> bool:
-    """Add the findings of ``res.documents`` against the running graph to ``res``; ``False`` after
-    printing why the graph cannot be read."""
+    """Add the findings of ``res.documents`` against the running graph to ``res``, read through the
+    source ``--source`` picks (as ``ros diff --ros2`` does); ``False`` after printing why it cannot be read."""
     from rclverify.ros.ground.nodl_code import check_code, live_qos_of  # deferred: start-up (loads the ROS layers only when called)
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
-    from rclverify.ros.live.diff_dds import read_dds_graph  # deferred: optional or conditional (inside a block)
+    from rclverify.ros.live.diff_dds import graph_of, read_dds_graph  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.graph import read_rclpy_graph  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
     try:
-        running, disc, source, dp = read_dds_graph(args.wait)
-    except DdsUnavailable as exc:
+        kind, py, why = pick_source(args.source, args.ros2_python)
+        print(f"source: {kind} ({why})", file=sys.stderr)
+        if kind == "rclpy" and py is not None:
+            rdisc = read_rclpy_graph(py, args.wait)
+            source = f"rclpy on {rdisc.rmw}"
+            running = graph_of(rdisc, source)  # type: ignore[arg-type]  # the same shape as Discovery
+            matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(rdisc))
+        else:
+            running, disc, source, dp = read_dds_graph(args.wait)
+            try:
+                matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(disc))
+            finally:
+                disc.close()
+                dp.__del__()
+    except (ValueError, DdsUnavailable, RclpyUnavailable) as exc:
         print(f"nodl check --ros2: error: {exc}", file=sys.stderr)
         return False
-    try:
-        for n in running.notes:
-            print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
-        matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(disc))
-    finally:
-        disc.close()
-        dp.__del__()
+    for n in running.notes:
+        print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
     res.findings += found
     print(f"{len(matched)} document(s) matched to a running node ({source})"
           + "".join(f"; {n} -> {g}" for n, g in sorted(matched.items())))

@@ -20,7 +20,8 @@ Findings, each located at both the code and the document:
   the one the document writes (a policy either leaves unsaid is not compared).
 
 The same comparison against the running graph (``side="live"``: the nodes
-DDS discovery shows, :func:`rclverify.ros.live.diff_dds.read_dds_graph`)
+DDS discovery shows, :func:`rclverify.ros.live.diff_dds.read_dds_graph`, or
+rclpy's graph API)
 gives ``nodl-live-*`` findings, located at the document and the graph's
 source (``DDS domain N``); there an endpoint the document declares and the
 running node lacks is an error, and the QoS compared is what each running
@@ -29,7 +30,7 @@ endpoint announces (:func:`live_qos_of`).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable, Mapping
+from typing import Callable, Mapping, Protocol
 
 from rclverify.lang import ast
 from rclverify.model.nodl.contract import type_key
@@ -38,7 +39,7 @@ from rclverify.model.nodl.findings import Finding
 from rclverify.ros.extract import code_qos
 from rclverify.ros.extract.model import GraphEdge, GraphNode, Src
 from rclverify.ros.live.dds import ros_name
-from rclverify.ros.live.dds_discovery import Discovery
+from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.ground.ground import match_nodes
 
 #: A scanned node's list of each NoDL endpoint list.
@@ -77,7 +78,18 @@ def code_qos_of(base: Path | None) -> QosOf:
     return read
 
 
-def live_qos_of(disc: Discovery) -> QosOf:
+class Announced(Protocol):
+    """What discovery tells of the running endpoints: rclverify's DDS participant
+    (:class:`~rclverify.ros.live.dds_discovery.Discovery`) or rclpy's graph API
+    (:class:`~rclverify.runtime.rclpy_source.graph.RclpyDiscovery`, the same shape)."""
+
+    writers: dict[bytes, EndpointInfo]
+    readers: dict[bytes, EndpointInfo]
+
+    def node_of(self, guid: bytes) -> str | None: ...
+
+
+def live_qos_of(disc: Announced) -> QosOf:
     """The QoS a running endpoint announces in DDS discovery (:mod:`rclverify.ros.live.dds_discovery`):
     that of the node's writers (publishers) or readers (subscriptions) of the topic, as
     ``ros_discovery_info`` gives endpoints to nodes; unknown (``None``) when the node has none
@@ -162,4 +174,4 @@ def check_code(documents: Mapping[str, Document], nodes: Mapping[str, GraphNode]
     return matched, out
 
 
-__all__ = ["GRAPH_LISTS", "QosOf", "SIDES", "check_code", "code_qos_of", "compare_code", "live_qos_of", "resolve"]
+__all__ = ["Announced", "GRAPH_LISTS", "QosOf", "SIDES", "check_code", "code_qos_of", "compare_code", "live_qos_of", "resolve"]
