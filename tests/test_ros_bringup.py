@@ -347,3 +347,26 @@ def test_a_script_and_an_executable_of_one_name_are_two_programs() -> None:
     assert _edges(g, "/beeper") == {("pub", "/beep", "std_msgs/msg/Empty")}
     assert _edges(g, "/beeper_py") == {("pub", "/beep_text", "std_msgs/msg/String")}
     assert [(p["name"], p["nodes"]) for p in g.programs] == [("beeper", ["/beeper"])]
+
+
+def test_a_warm_scan_links_again_what_changed(tmp_path: Path) -> None:
+    """Linked programs are kept in the parse cache (the second scan reads the
+    same graph from it); a change in a program's own file, or in another
+    package's header it takes in, is read on the next scan."""
+    import shutil
+    ws = tmp_path / "ws"
+    shutil.copytree(WS, ws)
+    nav = [ws / "src/rover_bringup/launch/navigation.launch.py", ws / "src/rover_bringup/launch/localization.launch.py"]
+    cache = tmp_path / "cache.pickle"
+    first = scan([ws], nav, cache_path=cache, base=tmp_path).graph
+    again = scan([ws], nav, cache_path=cache, base=tmp_path)
+    assert again.cache_misses == 0 and again.link_misses == 0 and again.link_hits > 0
+    assert again.graph.to_json() == first.to_json()
+    drive = ws / "src/rover_drive/src/drive_server.cpp"
+    drive.write_text(drive.read_text().replace('"drive_to"', '"drive_home"'))
+    relay = ws / "src/rover_core/include/rover/core/pose_relay.hpp"
+    relay.write_text(relay.read_text().replace("create_publisher<geometry_msgs::msg::PoseStamped>(to, 1)",
+                                               'create_publisher<geometry_msgs::msg::PoseStamped>("relayed/" + to, 1)'))
+    g = scan([ws], nav, cache_path=cache, base=tmp_path).graph
+    assert ("action_servers", "/rover/drive_home", "rover_msgs/action/DriveTo") in _edges(g, "/rover/drive_server")
+    assert ("pub", "/rover/relayed/map_origin", POSE) in _edges(g, "/rover/map_server")

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 from pathlib import Path
 import dataclasses
+import functools
+import hashlib
 from typing import Any, Callable, Sequence
 
 from rclverify.ros.extract import cross_package, emit, names, nodelets, plugins
@@ -37,8 +39,9 @@ class Assembly:
     table defines type ``t``."""
 
     def __init__(self, pkgs: dict[str, Package], records: dict[str, dict[str, dict[str, Any]]],
-                 targets: dict[str, Targets], show: Callable[[Path], str], known: Callable[[str], bool]) -> None:
-        self.pkgs, self.known = pkgs, known
+                 targets: dict[str, Targets], show: Callable[[Path], str], known: Callable[[str], bool],
+                 kept: "LinkCache | None" = None) -> None:
+        self.pkgs, self.known, self.kept = pkgs, known, kept
         self.codes = {p: PackageCode(p, show(pkgs[p].root), records.get(p, {}), show) for p in sorted(pkgs)}
         self.progs = {p: programs(self.codes[p], targets[p]) for p in sorted(pkgs)}
         self.targets = targets
@@ -67,7 +70,9 @@ class Assembly:
         got = self._linked.get(id(prog))
         if got is None:
             code = self._views.get(id(prog), self.codes[prog.package])
-            got = self._linked[id(prog)] = Linker(prog, code, self.known).run()
+            make = functools.partial(_link, prog, code, self.known)
+            got = self._linked[id(prog)] = self.kept.kept("link", prog, code, make) if self.kept is not None \
+                else make()
         return got
 
     def program(self, pkg: str, exe: str) -> Program | None:
@@ -188,11 +193,11 @@ class Assembly:
             if t in self.plugins_loaded:
                 continue
             pc = self.plugin_classes[t]
-            lk = Linker(prog, self._views.get(id(prog), self.codes[prog.package]), self.known)
-            eps = {e.src: e for r in lk.recs.values() for e in list(r.get("endpoints", [])) + lk.members(r)
-                   if (e.unit is not None or e.func is not None) and lk.runs(e.unit, e.func)}
-            out += [plugins.unloaded_note(e, pc, self.codes[prog.package].show(pc.xml))
-                    for _s, e in sorted(eps.items(), key=lambda x: (x[0].file, x[0].line, x[0].col))]
+            code = self._views.get(id(prog), self.codes[prog.package])
+            make = functools.partial(_running_endpoints, prog, code, self.known)
+            eps: list[Endpoint] = self.kept.kept("plugin-endpoints", prog, code, make) if self.kept is not None \
+                else make()
+            out += [plugins.unloaded_note(e, pc, self.codes[prog.package].show(pc.xml)) for e in eps]
         return out
 
     def source_nodes(self, add_node: Callable[..., None], g: Graph) -> None:
@@ -320,6 +325,58 @@ class Assembly:
         files = _files(prog, got, eps, None) if prog is not None else []
         add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params,
                  lifecycle="lifecycle" in got.kinds)
+
+
+class LinkCache:
+    """Linked programs kept in the scan's parse cache between scans: a program is
+    linked again only when what the linker reads changed.  The key is the
+    sha256 of the program (its package, executable, entry files, files, units,
+    aliases, nodelet, plugin and instance), of every record its code holds
+    (each file's own sha256: the linker reads the package's records, and the
+    other packages' files a program takes in) and of the type names the scan
+    knows; the cache's own key holds the rclverify code, so a changed linker
+    links again.  ``get(kind, sha, make)`` is :meth:`ParseCache.get`."""
+
+    def __init__(self, get: Callable[[str, str, Callable[[], Any]], Any], digests: dict[str, str],
+                 types: list[str]) -> None:
+        self.get, self.digests = get, digests
+        self.types = hashlib.sha256("\n".join(types).encode()).hexdigest()
+        self.hits = self.misses = 0  # results the cache gave, results made
+
+    def kept(self, kind: str, prog: Program, code: PackageCode, make: Callable[[], Any]) -> Any:
+        """``make()``'s result of ``kind`` for ``prog`` read from ``code``, kept or made now."""
+        h = hashlib.sha256()
+        ident = (prog.package, prog.exe, tuple(prog.entry), tuple(prog.files), tuple(sorted(prog.units or ())),
+                 prog.units is None, tuple(prog.aliases), prog.nodelet, prog.plugin, prog.instance, code.root)
+        h.update(repr(ident).encode())
+        for f in sorted(code.records):
+            h.update(f"\0{f}\0{self.digests.get(f, '')}".encode())
+        h.update(self.types.encode())
+        made: list[bool] = []
+
+        def counted() -> Any:
+            made.append(True)
+            return make()
+        got = self.get(kind, h.hexdigest(), counted)
+        if made:
+            self.misses += 1
+        else:
+            self.hits += 1
+        return got
+
+
+def _link(prog: Program, code: PackageCode, known: Callable[[str], bool]) -> Linked:
+    """Program ``prog`` linked over ``code``."""
+    return Linker(prog, code, known).run()
+
+
+def _running_endpoints(prog: Program, code: PackageCode, known: Callable[[str], bool]) -> list[Endpoint]:
+    """The endpoints the code of plugin program ``prog`` makes in what it runs,
+    in source order (each place once)."""
+    lk = Linker(prog, code, known)
+    eps = {e.src: e for r in lk.recs.values() for e in list(r.get("endpoints", [])) + lk.members(r)
+           if (e.unit is not None or e.func is not None) and lk.runs(e.unit, e.func)}
+    return [e for _s, e in sorted(eps.items(), key=lambda x: (x[0].file, x[0].line, x[0].col))]
 
 
 def _keys(prog: Program, others: Sequence[Program] = ()) -> list[str]:

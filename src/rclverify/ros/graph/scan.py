@@ -24,7 +24,7 @@ from typing import Any, Sequence
 from rclverify.ros.extract import names
 from rclverify.ros.extract import namespaces
 from rclverify.ros.graph.absent import absent_interfaces
-from rclverify.ros.graph.assemble import Assembly
+from rclverify.ros.graph.assemble import Assembly, LinkCache
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.executables import Targets, exported_cmake, targets
 from rclverify.ros.extract.interfaces import TypeTable
@@ -55,8 +55,10 @@ class ScanResult:
     packages: dict[str, Package]
     table: TypeTable
     sources: dict[str, dict[str, Any]] = field(default_factory=dict)
-    cache_hits: int = 0
-    cache_misses: int = 0
+    cache_hits: int = 0  # source files whose parse the cache gave
+    cache_misses: int = 0  # source files parsed (the cache had none)
+    link_hits: int = 0  # programs whose linking the cache gave
+    link_misses: int = 0  # programs linked (the cache had none)
 
 
 class Shower:
@@ -168,6 +170,7 @@ class _Scan:
         self.tgts: dict[str, Targets] = {}
         self.launch_params: dict[str, tuple[str, Src]] = {}
         self.unsure: dict[Src, Src] = {}  # a launch node -> the unevaluated condition it was read under
+        self.digests: dict[str, str] = {}  # a source file as shown -> the sha256 of its bytes
         self.by_ros_name: dict[str, list[str]] = {}  # a ROS node name -> the graph nodes of the programs taking it
         self.standard = True  # whether the standard (installed) interface packages are read (read_types)
 
@@ -256,6 +259,7 @@ class _Scan:
                 fn = functools.partial(_parse, data, shown, is_py)
                 r = cache.get(f"{'py' if is_py else 'cpp'}:{shown}", sha, fn) if cache else fn()
                 recs[shown] = r
+                self.digests[shown] = sha
                 if r["nodes"] or r["endpoints"] or r["notes"] or r.get("node_names"):
                     g.files[shown] = sha
                     self.res.sources[shown] = r
@@ -267,7 +271,11 @@ class _Scan:
         programs of the packages and the ros2_control controllers."""
         g, show, pkgs = self.g, self.show, self.pkgs
         table = self.table
-        self.asm = Assembly(pkgs, self.records, self.tgts, show, lambda t: table.get(t) is not None)
+        kept = None
+        if self.cache is not None:  # linked programs kept between scans, keyed by what they read
+            cache = self.cache
+            kept = LinkCache(cache.get, self.digests, sorted(table.types))
+        self.asm = Assembly(pkgs, self.records, self.tgts, show, lambda t: table.get(t) is not None, kept)
         self.pfiles = PackageParams({} if launch else {p: pkgs[p].root for p in pkgs}, show)
         g.notes.extend(self.pfiles.notes)
         if launch:
@@ -405,7 +413,9 @@ class _Scan:
         g.types = {k: v.to_json() for k, v in self.table.closure(sorted(used)).items()}
         if self.cache is not None:
             self.cache.save()
-            res.cache_hits, res.cache_misses = self.cache.hits, self.cache.misses
+            kept = getattr(getattr(self, "asm", None), "kept", None)
+            res.link_hits, res.link_misses = (kept.hits, kept.misses) if kept is not None else (0, 0)
+            res.cache_hits, res.cache_misses = self.cache.hits - res.link_hits, self.cache.misses - res.link_misses
 
 
 def apart_name(full: str, pkg: str | None, exe: str | None, declared: Src | None, taken: dict[str, Any]) -> str:
