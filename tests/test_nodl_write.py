@@ -85,8 +85,8 @@ def test_generate_ros2_writes_and_registers_a_document_per_node(lang: str) -> No
         assert ends == want | {("publishers", "~/contract_verdict", "std_msgs/msg/String")}, name
         if lang == "python":
             setup = gen[f"{pkg}/setup.py"]
-            assert "('share/ament_index/resource_index/nodl', ['resource/nodl/' + package_name + '__' + package_name])" \
-                in setup and "('share/' + package_name + '/nodl', ['nodl/' + package_name + '.nodl.yaml'])" in setup
+            assert f"('share/ament_index/resource_index/nodl', ['resource/nodl/{pkg}__{pkg}'])" in setup
+            assert f"('share/' + package_name + '/nodl', ['nodl/{pkg}.nodl.yaml'])" in setup
         else:
             cmake = gen[f"{pkg}/CMakeLists.txt"]
             assert f"ament_nodl_register({pkg} FILE nodl/{pkg}.nodl.yaml)" in cmake
@@ -147,3 +147,16 @@ def test_nodl_write_writes_what_nodl_check_accepts_and_overwrites_nothing(tmp_pa
     assert main(["nodl", "write", "-w", str(ws), "--force"]) == 0
     assert (ws / "nodl" / "Guard.nodl.yaml").read_text() == before
     assert main(["nodl", "write", "-w", str(ws), "Nobody"]) == 2
+
+
+def test_a_long_package_name_keeps_its_document_without_the_index_entry_it_cannot_name() -> None:
+    """The index key is the package name twice: past a file name's length the document stays, the entry goes."""
+    long = "n" * 120  # a package of 120 characters: its key 242, over the 235 a generated file name may have
+    spec = parse_text(f"node {long} {{\n  inputs( x : REAL )\n  outputs( y : REAL )\n"
+                      "  topics( std_msgs/Float64 y matches(out.y) )\n  guarantee( out.y == in.x )\n}\n", "n.rcl")
+    gen, _, _ = render_tree(check([spec]), "s")
+    assert f"{long}/nodl/{long}.nodl.yaml" in gen and not any("resource/nodl" in p for p in gen)
+    assert "resource_index/nodl" not in gen[f"{long}/setup.py"] and f"['nodl/{long}.nodl.yaml']" in gen[f"{long}/setup.py"]
+    cpp, _, _ = render_tree(check([spec]), "s", lang="cpp")
+    cmake = cpp[f"{long}/CMakeLists.txt"]
+    assert "ament_nodl_register" not in cmake and f"install(FILES nodl/{long}.nodl.yaml DESTINATION" in cmake

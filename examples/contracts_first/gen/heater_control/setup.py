@@ -10,8 +10,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
-        ('share/' + package_name + '/nodl', ['nodl/' + package_name + '.nodl.yaml']),
-        ('share/ament_index/resource_index/nodl', ['resource/nodl/' + package_name + '__' + package_name]),
+        ('share/' + package_name + '/nodl', ['nodl/heater_control.nodl.yaml']),
+        ('share/ament_index/resource_index/nodl', ['resource/nodl/heater_control__heater_control']),
     ],
     install_requires=['setuptools'],
     zip_safe=True,

@@ -10,8 +10,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
-        ('share/' + package_name + '/nodl', ['nodl/' + package_name + '.nodl.yaml']),
-        ('share/ament_index/resource_index/nodl', ['resource/nodl/' + package_name + '__' + package_name]),
+        ('share/' + package_name + '/nodl', ['nodl/temp_sensor.nodl.yaml']),
+        ('share/ament_index/resource_index/nodl', ['resource/nodl/temp_sensor__temp_sensor']),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
