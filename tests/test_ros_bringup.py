@@ -370,3 +370,16 @@ def test_a_warm_scan_links_again_what_changed(tmp_path: Path) -> None:
     g = scan([ws], nav, cache_path=cache, base=tmp_path).graph
     assert ("action_servers", "/rover/drive_home", "rover_msgs/action/DriveTo") in _edges(g, "/rover/drive_server")
     assert ("pub", "/rover/relayed/map_origin", POSE) in _edges(g, "/rover/map_server")
+
+
+def test_init_from_ros_summarises_the_scans_warnings(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``init --from-ros`` on a launch file with three dropped nodes and thirty
+    loose ones: the first lines are the summary, what dropped nodes first."""
+    from rclverify.cli.commands import main
+    lf = _many(tmp_path, 30)
+    assert main(["init", str(tmp_path / "ws"), "--from-ros", str(WS), "--launch", str(lf)]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("33 warning(s) by cause (`rclverify ros scan ") and "--verbose` lists each one" in err[0]
+    assert err[1].startswith("    3  launch nodes dropped (not started in the graph): ") and \
+        "many30.launch.py:7:9, " in err[1]
+    assert not [x for x in err if "cannot be read statically; the node is read without them" in x]

@@ -257,8 +257,13 @@ def init_from_ros(args: argparse.Namespace) -> int:
             return 2
     res = scan([Path(p) for p in args.from_ros], [Path(p) for p in args.launch], base=_shown_base(
         [Path(p) for p in list(args.from_ros) + [str(Path(lf).parent) for lf in args.launch]]))
-    for n in res.graph.notes:
-        print(n, file=sys.stderr)
+    from rclverify.ros.graph.summary import report  # deferred: start-up (the scan's own module, loaded with it)
+    packages = {str(p["manifest"]): str(p["name"]) for p in res.graph.to_json().get("packages", [])
+                if p.get("manifest")}
+    full = (f"`rclverify ros scan {' '.join(args.from_ros)} --verbose` lists each one; `rclverify ros check` in "
+            f"the new workspace writes them, located, to artifacts/ros/graph.json")
+    for text in report(res.graph.notes, packages, full=full):
+        print(text, file=sys.stderr)
     missing = unaccounted_lines(res.graph.programs)
     for line in missing:
         print(line, file=sys.stderr)

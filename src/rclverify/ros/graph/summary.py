@@ -128,12 +128,16 @@ def line(g: Group) -> str:
     return text
 
 
+FULL = "each located in the JSON's \"unresolved\"; --verbose lists them here"
+
+
 def report(notes: Sequence[_NoteLike], packages: Mapping[str, str], verbose: bool = False,
-           screen: int = SCREEN) -> list[str]:
-    """The lines ``ros scan`` prints about ``notes``: every note, one a line, when
-    ``verbose`` or when they fit in ``screen`` lines; else every error, then one
-    line per cause of the warnings (:func:`group`), then where the full list
-    is.  ``packages`` maps each package's shown manifest path to its name."""
+           screen: int = SCREEN, full: str = FULL) -> list[str]:
+    """The lines ``ros scan`` (and ``init --from-ros``) prints about ``notes``: every
+    note, one a line, when ``verbose`` or when they fit in ``screen`` lines; else
+    every error, then a heading saying where the full list is (``full``), then
+    one line per cause of the warnings (:func:`group`).  ``packages`` maps each
+    package's shown manifest path to its name."""
     if verbose or len(notes) <= screen:
         return [str(n) for n in notes]
     roots = sorted(((m.rsplit("/", 1)[0] + "/" if "/" in m else "", name) for m, name in packages.items()),
@@ -144,7 +148,6 @@ def report(notes: Sequence[_NoteLike], packages: Mapping[str, str], verbose: boo
     errors = [str(n) for n in notes if n.severity == "error"]
     groups = group(notes, package_of)
     warned = sum(len(g.places) for g in groups)
-    out = errors + [f"{warned} warning(s) by cause (each located in the JSON's \"unresolved\"; --verbose lists "
-                    f"them here):"]
+    out = errors + [f"{warned} warning(s) by cause ({full}):"]
     out += [line(g) for g in groups]
     return out
