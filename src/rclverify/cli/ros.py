@@ -260,8 +260,9 @@ def init_from_ros(args: argparse.Namespace) -> int:
     from rclverify.ros.graph.summary import report  # deferred: start-up (the scan's own module, loaded with it)
     packages = {str(p["manifest"]): str(p["name"]) for p in res.graph.to_json().get("packages", [])
                 if p.get("manifest")}
-    full = (f"`rclverify ros scan {' '.join(args.from_ros)} --verbose` lists each one; `rclverify ros check` in "
-            f"the new workspace writes them, located, to artifacts/ros/graph.json")
+    again = " ".join(list(args.from_ros) + [f"--launch {lf}" for lf in args.launch])
+    full = (f"`rclverify ros scan {again} --verbose` lists each one; `rclverify ros check` in the new workspace "
+            f"writes them, located, to artifacts/ros/graph.json")
     for text in report(res.graph.notes, packages, full=full):
         print(text, file=sys.stderr)
     missing = unaccounted_lines(res.graph.programs)
