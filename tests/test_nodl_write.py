@@ -98,15 +98,17 @@ def test_init_writes_a_document_per_node_that_nodl_check_accepts(tmp_path: Path)
     files = render_workspace("rover", ["Camera", "Planner"])
     assert sorted(p for p in files if p.startswith("nodl/")) == ["nodl/Camera.nodl.yaml", "nodl/Planner.nodl.yaml"]
     planner = yaml.safe_load(files["nodl/Planner.nodl.yaml"])
-    assert [(e["name"], e["type"]) for e in planner["subscriptions"]] == [("camera_value", "std_msgs/msg/Float64")]
+    assert list(jsonschema.Draft202012Validator(schema()).iter_errors(planner)) == []
+    assert planner["description"].startswith("Node Planner: the interface its RCL contract (contracts/planner.rcl)")
     assert main(["init", str(tmp_path / "w"), "--nodes", "Camera,Planner"]) == 0
     res = nodl_check(Workspace(tmp_path / "w", "contracts/plan.yaml").checked, tmp_path / "w")
     assert sorted(res.documents) == ["Camera", "Planner"] and res.findings == []
-    # the control: the camera's document offering its topic best-effort breaks the planner's reliable subscription
+    # the control: the camera's document declaring a topic its contract does not name is found
     cam = tmp_path / "w" / "nodl" / "Camera.nodl.yaml"
-    cam.write_text(cam.read_text().replace("reliability: RELIABLE", "reliability: BEST_EFFORT"))
+    cam.write_text(cam.read_text() + "publishers:\n- {name: image, type: sensor_msgs/msg/Image, "
+                                     "qos: {history: KEEP_LAST, depth: 1, reliability: BEST_EFFORT}}\n")
     res = nodl_check(Workspace(tmp_path / "w", "contracts/plan.yaml").checked, tmp_path / "w")
-    assert [f.code for f in res.findings] == ["nodl-qos"]
+    assert [f.code for f in res.findings] == ["nodl-extra"]
 
 
 @pytest.mark.parametrize("lang", ["cpp", "python"])
