@@ -26,6 +26,12 @@ endpoint belongs to the node whose class creates it or constructs (directly
 or not) the class that does; the rest to the node named outside any class.
 Values are evaluated by :mod:`link_values` (bounded: :data:`MAX_DEPTH` nested
 calls, :data:`MAX_VALUES` values).
+
+Long module: the walk over what a program runs and the evaluation of the
+names it leaves symbolic share one index of the program (classes, aliases,
+overloads, members by name), built once per program; the value evaluation
+itself is already apart (:mod:`link_values`, :mod:`link_members`,
+:mod:`link_types`).
 """
 from __future__ import annotations
 

@@ -51,6 +51,11 @@ reply, the two travelling on different topics, still comes first), and the
 call book's clock runs that far behind.  An answer whose request has not been
 heard waits up to :data:`EARLY_S` seconds for it before it counts as an
 answer without a call.
+
+Long module: one state per link reads both wire forms (the request and
+reply topics, the introspection events) and an action's five parts, and
+decides per endpoint which it hears; its methods share that state, and a
+split along the parts would hand the same tables between modules.
 """
 from __future__ import annotations
 
