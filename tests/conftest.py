@@ -53,7 +53,7 @@ LIVE = frozenset({
     "test_ros2_declarations", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
-    "test_ros2_undefined_type", "test_nodl_live",
+    "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -84,6 +84,9 @@ SECONDS: dict[str, float] = {
     "test_bench_compose_pacti": 2.1, "test_deterministic_queries": 2.1, "test_findings_health": 2.1,
     "test_health_fast": 3.3, "test_requirements_own_nodes": 2.0, "test_bundle_ties": 3.0,
     "test_paths_rechecked": 3.5, "test_ros2_bag_calls": 7.0, "test_nodl_live": 3.0,
+    "test_declarations_evidence": 15.0, "test_definedness": 6.6, "test_run_identity": 5.0,
+    "test_ros2_declared_types": 10.0, "test_ros2_call_endpoints": 4.0, "test_widths_forms": 2.5,
+    "test_margins_batch": 2.2, "test_example_manipulator": 3.0, "test_ros2_event_time": 3.0,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -97,8 +100,9 @@ WALL: dict[str, float] = {
     "test_services_live_ros1": 10.0, "test_ros2_silence_deadlines": 8.6, "test_ros_live": 6.7,
     "test_ros2_declarations": 25.4, "test_monitor_live_dds": 6.1, "test_lsp_hostile": 5.0,
     "test_ros_master_hostile": 5.0, "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
-    "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0, "test_ros2_event_time": 40.0,
-    "test_example_manipulator": 25.0, "test_nodl_live": 12.8,
+    "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0, "test_ros2_event_time": 20.0,
+    "test_example_manipulator": 25.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
+    "test_ros2_undefined_type": 6.0, "test_nodl_live": 12.8,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
