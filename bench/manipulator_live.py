@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"manipulator: skipped: {why}")
         return 0
     if a.smoke:
-        c = correct_run(py, "rclpy", 0, 8, a.keep)
+        c = correct_run(py, "rclpy", 0, 4, a.keep)
         print(f"manipulator smoke: correct robot, rclpy source: {json.dumps(c)}")
         return 0
     green = exact = same = 0
