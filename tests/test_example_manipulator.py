@@ -81,3 +81,44 @@ def test_each_defect_is_red_at_its_own_node_only(defective: dict[str, Any]) -> N
     red = {n for n, s in status.items() if s == "failed"}
     assert red == set(DEFECTS.values()), status
     assert status["Battery"] == status["Planner"] == "discharged", status
+
+
+def test_its_nodl_documents_match_the_contracts_and_the_running_robot(tmp_path: Path) -> None:
+    """examples/manipulator/nodl/ (written by ``rclverify nodl write`` from the contracts) agrees with the
+    contracts, and with the sixteen running rclpy nodes (the library's own ends, introspection events and
+    the lifecycle interface, are not the nodes' and no finding); control: a copy whose Docking document
+    declares a publisher the contract does not name (statically a warning) is an error against the running
+    node, which has no such endpoint."""
+    import shutil
+    import subprocess
+
+    from _procs import stop
+    py = ros2_python()
+    ws = tmp_path / "ws"
+    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__"))
+    env = ros2_env(tmp_path)
+    with open(tmp_path / "robot.log", "wb") as fh:
+        robot = subprocess.Popen([str(py), str(EXAMPLE / "robot.py"), "--monitors", "0", "--rounds", "0"], cwd=tmp_path,
+                                 env=env, stdout=fh, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        from _procs import wait_for
+        wait_for(tmp_path / "robot.log", "ready", 60)
+
+        def check() -> subprocess.CompletedProcess[str]:
+            return subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "nodl", "check", "-w", str(ws),
+                                   "--ros2", "--source", "rclpy", "--ros2-python", str(py), "--wait", "2"],
+                                  cwd=tmp_path, env=dict(env, PYTHONPATH=str(EXAMPLE.parents[1] / "src")),
+                                  capture_output=True, text=True, timeout=120)
+        r = check()
+        assert r.returncode == 0 and "9 document(s) matched to a running node" in r.stdout, r.stdout + r.stderr
+        assert "0 error(s), 0 warning(s)" in r.stdout, r.stdout
+        doc = ws / "nodl" / "Docking.nodl.yaml"
+        doc.write_text(doc.read_text().replace("publishers:\n", "publishers:\n- name: dock_status\n"
+                                                                 "  type: std_msgs/msg/String\n"
+                                                                 "  qos: {history: KEEP_LAST, depth: 10, reliability: RELIABLE,"
+                                                                 " durability: VOLATILE}\n", 1))
+        r = check()
+        out = r.stdout + r.stderr
+        assert r.returncode == 1 and "dock_status" in out and "nodl-live-absent" in out, out
+    finally:
+        stop(robot)

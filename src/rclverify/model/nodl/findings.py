@@ -26,6 +26,8 @@ CODES = {
     "nodl-code-absent": "the document declares an endpoint the code (the running node) lacks",
     "nodl-code-type": "the code (the running node) and the document give an endpoint different types",
     "nodl-code-qos": "the code (the running node) gives a topic another reliability or durability than the document",
+    "nodl-code-unmatched": "no node of the code (of the running graph: an error there) is the document's: nothing "
+                           "of it was compared",
 }
 
 

@@ -25,7 +25,9 @@ rclpy's graph API)
 gives ``nodl-live-*`` findings, located at the document and the graph's
 source (``DDS domain N``); there an endpoint the document declares and the
 running node lacks is an error, and the QoS compared is what each running
-endpoint announces (:func:`live_qos_of`).
+endpoint announces (:func:`live_qos_of`).  The ends a running node's client
+library makes rather than its code (introspection events, a managed node's
+lifecycle interface) are not its own: undeclared, they are no finding.
 """
 from __future__ import annotations
 
@@ -41,6 +43,7 @@ from rclverify.ros.extract.model import GraphEdge, GraphNode, Src
 from rclverify.ros.live.dds import ros_name
 from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.ground.ground import match_nodes
+from rclverify.ros.ground.lifecycle import MANAGEMENT
 
 #: A scanned node's list of each NoDL endpoint list.
 GRAPH_LISTS = {"publishers": "publishes", "subscriptions": "subscribes", "service_servers": "service_servers",
@@ -123,6 +126,23 @@ def _qos(doc_end: Endpoint, edge: GraphEdge, qos_of: QosOf, fqn: str, node: str,
     return out
 
 
+#: the ends of a running node that its client library makes, not its code (:func:`_library_made`)
+_LIFECYCLE_ENDS = {(("publishers" if role == "pub" else role), name) for role, name, _t in MANAGEMENT}
+
+
+def _library_made(key: tuple[str, str], gn: GraphNode) -> bool:
+    """Whether the running node's end ``key`` (``(kind, ROS name)``) is one its client library makes
+    rather than its code, which a NoDL document does not declare: a service's or an action's
+    introspection events (``<name>/_service_event``, made when introspection is configured) and a
+    managed node's lifecycle interface (``~/change_state``, ``~/transition_event``, ...,
+    :data:`~rclverify.ros.ground.lifecycle.MANAGEMENT`; ROS 2 design, "Managed nodes")."""
+    kind, name = key
+    if name.endswith("/_service_event"):
+        return True
+    prefix = gn.name.rstrip("/") + "/"
+    return name.startswith(prefix) and (kind, name[len(prefix):]) in _LIFECYCLE_ENDS
+
+
 def compare_code(doc: Document, gn: GraphNode, base: Path | None = None, side: str = "code",
                  qos_of: QosOf | None = None) -> list[Finding]:
     """The findings of document ``doc`` against node ``gn`` of the scan (``side="code"``) or of the
@@ -154,7 +174,7 @@ def compare_code(doc: Document, gn: GraphNode, base: Path | None = None, side: s
             continue
         out += _qos(e, edge, qos_of, key[1], gn.name, code)
     for key, edge in ends.items():
-        if key not in seen:
+        if key not in seen and not (side == "live" and _library_made(key, gn)):
             out.append(Finding(f"{code}-undeclared", f"node {gn.name} has {key[1]} "
                                                      f"({edge.msg_type or 'type unknown'}) in {key[0]} in {what}, "
                                                      f"and its NoDL document {doc.file} does not declare it",
@@ -166,11 +186,20 @@ def check_code(documents: Mapping[str, Document], nodes: Mapping[str, GraphNode]
                side: str = "code", qos_of: QosOf | None = None) -> tuple[dict[str, str], list[Finding]]:
     """Each document of ``documents`` (by node) against the node it matches among ``nodes`` (a
     graph's nodes by full name; :func:`compare_code` for ``base``, ``side``, ``qos_of``); returns
-    ``({document's node: graph node}, findings)``.  A document matching no node is not compared."""
+    ``({document's node: graph node}, findings)``.  A document matching no node is not compared, and
+    says so (``nodl-code-unmatched``, a warning; ``nodl-live-unmatched``, an error: a node not running,
+    or not yet discovered, is never checked green)."""
     matched = match_nodes(list(documents), nodes, {})
+    code = SIDES[side][1]
     out: list[Finding] = []
     for name, full in sorted(matched.items()):
         out += compare_code(documents[name], nodes[full], base, side, qos_of)
+    for name in sorted(set(documents) - set(matched)):
+        doc = documents[name]
+        where = "the scanned code" if side == "code" else "the running graph (not running, or not yet discovered)"
+        out.append(Finding(f"{code}-unmatched", f"node {name}'s NoDL document matches no node of {where}: nothing "
+                                                f"of it was compared", (ast.Loc(doc.file, 1, 1),),
+                           "warning" if side == "code" else "error"))
     return matched, out
 
 
