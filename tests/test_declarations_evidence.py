@@ -195,8 +195,12 @@ def test_the_record_of_a_run_follows_its_declarations(tmp_path: Path, decl: str,
     if last_answered == "after input":
         rows = rows[1:]  # the first stop after the first scan: an answer, not the value it starts from
     (ws / "traces/run.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
-    main(["verify", "-w", str(ws)])
-    ev = json.loads((ws / "artifacts/evidence/Guard.g0.monitors.run_jsonl.json").read_text())
+    # the monitors backend on the workspace's obligation, as the pipeline's evidence task runs it
+    from rclverify.app.pipeline import Workspace
+    from rclverify.backends.monitors.backend import MonitorsBackend
+    target = Workspace(ws).target("Guard", 0)
+    backend = MonitorsBackend()
+    ev = backend.run(backend.export(target)[0], target).to_json()
     assert ev["status"] == status and words in ev["explanation"], ev["explanation"]
     assert ev["details"]["monitoring"]["counts"]["satisfied"] >= 29
 

@@ -10,7 +10,12 @@ publish), with both cores kept busy by two CPU-burning processes
   the same verdicts answer for answer;
 * the robot with all seven seeded defects, heard through the monitor's own
   DDS participant: red at exactly the seven defects' nodes, and the two
-  correct nodes beside them green.
+  correct nodes beside them green;
+* its NoDL documents against the running nodes (docs/nodl.md).
+
+Before messages were placed at their publishers' source timestamps, the
+correct robot read red (a false ``progress`` declaration, offline counts
+differing from live).
 
 bench/manipulator_live.py runs both many times (docs/scale.md)."""
 from __future__ import annotations
@@ -45,8 +50,33 @@ def correct(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]
 
 @pytest.fixture(scope="module")
 def defective(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    """The defective robot through DDS; while its nodes still run, its NoDL documents checked live."""
     tmp = tmp_path_factory.mktemp("manipulator-defects")
-    yield watch(tmp, ros2_python(), ros2_env(tmp), source="dds", defects="all")
+    env = ros2_env(tmp)
+    yield watch(tmp, ros2_python(), env, source="dds", defects="all", after=lambda: _nodl_live(tmp, env))
+
+
+def _nodl_live(tmp: Path, env: dict[str, str]) -> tuple[Any, Any]:
+    """``rclverify nodl check --ros2`` on a copy of the example, then on the copy with the Docking document
+    declaring a publisher the contract does not name (statically a warning, live an error)."""
+    import shutil
+    import subprocess
+    py = ros2_python()
+    ws = tmp / "ws"
+    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__"))
+
+    def check() -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "nodl", "check", "-w", str(ws),
+                               "--ros2", "--source", "rclpy", "--ros2-python", str(py), "--wait", "2"],
+                              cwd=tmp, env=dict(env, PYTHONPATH=str(EXAMPLE.parents[1] / "src")),
+                              capture_output=True, text=True, timeout=120)
+    first = check()
+    doc = ws / "nodl" / "Docking.nodl.yaml"
+    doc.write_text(doc.read_text().replace("publishers:\n", "publishers:\n- name: dock_status\n"
+                                                             "  type: std_msgs/msg/String\n"
+                                                             "  qos: {history: KEEP_LAST, depth: 10, reliability: "
+                                                             "RELIABLE, durability: VOLATILE}\n", 1))
+    return first, check()
 
 
 def test_the_correct_robot_is_green_live(correct: dict[str, Any]) -> None:
@@ -83,42 +113,26 @@ def test_each_defect_is_red_at_its_own_node_only(defective: dict[str, Any]) -> N
     assert status["Battery"] == status["Planner"] == "discharged", status
 
 
-def test_its_nodl_documents_match_the_contracts_and_the_running_robot(tmp_path: Path) -> None:
+
+def test_its_nodl_documents_match_the_contracts_and_the_running_robot(defective: dict[str, Any]) -> None:
     """examples/manipulator/nodl/ (written by ``rclverify nodl write`` from the contracts) agrees with the
-    contracts, and with the sixteen running rclpy nodes (the library's own ends, introspection events and
-    the lifecycle interface, are not the nodes' and no finding); control: a copy whose Docking document
-    declares a publisher the contract does not name (statically a warning) is an error against the running
-    node, which has no such endpoint."""
-    import shutil
-    import subprocess
+    contracts and with the sixteen running rclpy nodes (the library's own ends, introspection events and
+    the lifecycle interface, are not the nodes' and no finding; the defects change no interface);
+    control: a Docking document declaring a publisher the contract does not name (statically a warning)
+    is an error against the running node, which has no such endpoint."""
+    first, control = defective["after"]
+    assert first.returncode == 0 and "9 document(s) matched to a running node" in first.stdout, \
+        first.stdout + first.stderr
+    assert "0 error(s), 0 warning(s)" in first.stdout, first.stdout
+    out = control.stdout + control.stderr
+    assert control.returncode == 1 and "dock_status" in out and "nodl-live-absent" in out, out
 
-    from _procs import stop
-    py = ros2_python()
-    ws = tmp_path / "ws"
-    shutil.copytree(EXAMPLE, ws, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*", "__pycache__"))
-    env = ros2_env(tmp_path)
-    with open(tmp_path / "robot.log", "wb") as fh:
-        robot = subprocess.Popen([str(py), str(EXAMPLE / "robot.py"), "--monitors", "0", "--rounds", "0"], cwd=tmp_path,
-                                 env=env, stdout=fh, stderr=subprocess.STDOUT, start_new_session=True)
-    try:
-        from _procs import wait_for
-        wait_for(tmp_path / "robot.log", "ready", 60)
 
-        def check() -> subprocess.CompletedProcess[str]:
-            return subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "nodl", "check", "-w", str(ws),
-                                   "--ros2", "--source", "rclpy", "--ros2-python", str(py), "--wait", "2"],
-                                  cwd=tmp_path, env=dict(env, PYTHONPATH=str(EXAMPLE.parents[1] / "src")),
-                                  capture_output=True, text=True, timeout=120)
-        r = check()
-        assert r.returncode == 0 and "9 document(s) matched to a running node" in r.stdout, r.stdout + r.stderr
-        assert "0 error(s), 0 warning(s)" in r.stdout, r.stdout
-        doc = ws / "nodl" / "Docking.nodl.yaml"
-        doc.write_text(doc.read_text().replace("publishers:\n", "publishers:\n- name: dock_status\n"
-                                                                 "  type: std_msgs/msg/String\n"
-                                                                 "  qos: {history: KEEP_LAST, depth: 10, reliability: RELIABLE,"
-                                                                 " durability: VOLATILE}\n", 1))
-        r = check()
-        out = r.stdout + r.stderr
-        assert r.returncode == 1 and "dock_status" in out and "nodl-live-absent" in out, out
-    finally:
-        stop(robot)
+def test_the_log_holds_the_robots_time(correct: dict[str, Any]) -> None:
+    """Every answer is placed after the question it answers, though many were heard before it: an
+    unstamped /dock_cmd after its unstamped /dock_range, at their publishers' source times (on receipt
+    times a correct robot read red: docs/semantics.md, "Event time")."""
+    log = [json.loads(x) for x in (correct["tmp"] / "live.jsonl").read_text().splitlines()]
+    order = [x["topic"] for x in log if x.get("topic") in ("dock_range", "dock_cmd")]
+    assert len(order) >= 70 and order[:2] == ["dock_range", "dock_cmd"], order[:6]
+    assert all(a != b for a, b in zip(order, order[1:])), order  # question, answer, question, answer ...

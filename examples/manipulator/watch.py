@@ -26,7 +26,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
@@ -79,8 +79,11 @@ def _wait(path: Path, text: str, timeout: float, proc: subprocess.Popen[bytes]) 
 
 
 def watch(tmp: Path, ros2_python: Path, env: dict[str, str], *, source: str, defects: str = "",
-          record: bool = False, burners: int = 2, rounds: int = 40) -> dict[str, Any]:
-    """One live run (module docstring)."""
+          record: bool = False, burners: int = 2, rounds: int = 40,
+          after: Callable[[], Any] | None = None) -> dict[str, Any]:
+    """One live run (module docstring); ``after()``, when given, is called once the robot is done and
+    the monitor stopped, while the robot's nodes still run, and what it returns is the result's
+    ``"after"``."""
     procs: list[subprocess.Popen[bytes]] = []
 
     def start(cmd: list[str], out: str, extra: dict[str, str] | None = None) -> subprocess.Popen[bytes]:
@@ -99,14 +102,17 @@ def watch(tmp: Path, ros2_python: Path, env: dict[str, str], *, source: str, def
                          "--log", str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json"),
                          *(["--record", str(tmp / "bag")] if record else [])], "monitor.out", {"PYTHONPATH": str(SRC)})
         _wait(tmp / "robot.log", "rounds", 60, robot)
-        for _ in range(burners):
-            start([sys.executable, "-c", BURN], f"burn{len(procs)}.out")
+        burning = [start([sys.executable, "-c", BURN], f"burn{k}.out") for k in range(burners)]
         _wait(tmp / "robot.log", "done", 90, robot)
         stop(monitor, signal.SIGINT)
+        for p in burning:
+            stop(p)
         if not (tmp / "live.json").exists():
             raise RuntimeError("the monitor wrote no evidence:\n" + (tmp / "monitor.out").read_text()[-2000:])
+        extra = after() if after is not None else None
         return {"tmp": tmp, "code": monitor.returncode, "out": (tmp / "monitor.out").read_text(),
-                "robot": (tmp / "robot.log").read_text(), "record": json.loads((tmp / "live.json").read_text())}
+                "robot": (tmp / "robot.log").read_text(), "record": json.loads((tmp / "live.json").read_text()),
+                "after": extra}
     finally:
         for p in reversed(procs):
             stop(p)
