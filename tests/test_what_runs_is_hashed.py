@@ -269,10 +269,11 @@ def test_the_ros_idiom_of_putting_its_own_folder_on_sys_path_is_followed(tmp_pat
     root = _workspace(tmp_path, {"backends/property_tests/helper.py": GOOD}, impl=impl)
     closure = resolve_closure(root, IMPL)
     assert closure.unresolved == () and "backends/property_tests/helper.py" in closure.files
-    ev = _evidence(root)
-    assert ev.status == "discharged", ev.explanation
-    (root / "backends/property_tests/helper.py").write_text(BAD)
-    assert _evidence(root).status == "failed"
+    if own == "os.path.dirname(os.path.abspath(__file__))":  # the tests run and decide (one form: each costs a run)
+        ev = _evidence(root)
+        assert ev.status == "discharged", ev.explanation
+        (root / "backends/property_tests/helper.py").write_text(BAD)
+        assert _evidence(root).status == "failed"
 
 
 def test_control_another_folder_put_on_sys_path_is_still_named(tmp_path: Path) -> None:
