@@ -113,6 +113,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     a type that cannot be made, a bag that cannot be created, the rclpy agent
     that cannot start: one message)."""
     run = _DdsRun(checked, nodes, type_dirs, dict(enforce or {}), out, describe)
+    run.by_receipt = reorder_window <= 0
     run.open_recorder(record, msg_dirs)
     dp = make_participant() if bus_factory is None else None
     run.join(dp, run_factory, verdict_topic, last_prefix, bus_factory)
@@ -175,6 +176,10 @@ class _DdsRun:
         self.call_counts: dict[tuple[str, str], int] = {}
         self.bus: Any = None  # the DDS bus, or the rclpy source's (join)
         self.receipt_timed = 0  # samples placed at their receipt: no source time, or one ahead of the clock
+        #: --reorder-window 0: no watermark, so messages are judged in the order heard, at their receipt
+        #: (a source time would make every message heard after a later-published one late, judged apart
+        #: from how its log line, at the clock, reads offline)
+        self.by_receipt = False
 
     def _message(self, typ: str, describe: Callable[[list[str]], Mapping[str, Any]] | None) -> Any:
         """The struct of contract type ``typ``: the workspace's definition, else (the rclpy source,
@@ -242,7 +247,7 @@ class _DdsRun:
         def on_sample(tap: Any, raw: bytes, info: Any, rns: int) -> None:
             # the robot's time: the publisher's source timestamp (event_time.py), the receipt only without one
             source_ns = int(getattr(info, "source_timestamp", 0) or 0)
-            ens, from_source = event_ns(source_ns, rns)
+            ens, from_source = (rns, True) if self.by_receipt else event_ns(source_ns, rns)
             if not from_source:
                 self.receipt_timed += 1
             self.worker_box[0].offer(tap.key, (raw, source_ns, rns, writer_of(tap, info), ens), ens / 1e9)
@@ -388,7 +393,8 @@ class _DdsRun:
         for key, n in getattr(bus, "before", {}).items():
             qos[key]["published_before_heard"] = n
         record_.update(warnings=self.warnings, decode_errors=self.decode_errors, qos=qos,
-                       event_time={"clock": "source timestamp", "receipt_timed": self.receipt_timed})
+                       event_time={"clock": "receipt (--reorder-window 0)" if self.by_receipt else
+                                   "source timestamp", "receipt_timed": self.receipt_timed})
         if summary is not None and book is not None:
             record_["calls"] = _calls_record(summary, book, calls)
             record_["deadlines"] = {"results": summary["deadlines"], "false": summary["false"]}
