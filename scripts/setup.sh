@@ -122,17 +122,6 @@ if [ "${1:-}" = "--tests" ] || [ "${1:-}" = "--ros2" ]; then
   fi
 fi
 
-# --tests: the ros2_robot example's interface package (robot_msgs) built with colcon once, here, into
-# examples/ros2_robot/.ros2/ (git-ignored), where its live test and record_live.py look for it first
-# (examples/ros2_recording.py, build): the suite does not spend its time on a build it would repeat in
-# every fresh clone.  Optional: the test builds it itself when this could not.
-if [ "${1:-}" = "--tests" ] && [ -x .venv-ros2/bin/python ]; then
-  echo "setup: building the ros2_robot example's interfaces with colcon"
-  "$VPY" -c 'import os, sys; from pathlib import Path; sys.path.insert(0, "examples"); from ros2_recording import build
-build(Path(".venv-ros2/bin/python").absolute(), dict(os.environ), Path("examples/ros2_robot").absolute(), ["interfaces/robot_msgs"])' \
-    >/dev/null || echo "setup: the ros2_robot example's interfaces could not be built; its live test builds them"
-fi
-
 # --tests: the test modules' bytecode with pytest's assertion rewriting, written once here into
 # tests/__pycache__.  Where PYTHONDONTWRITEBYTECODE is set, pytest writes none, and each of the
 # suite's three workers rewrote every test module again (about 5 CPU s each); it reads what is
