@@ -192,6 +192,27 @@ def test_unit_errors_in_formulas_are_located(formula, code, col, words):
     assert words in msg
 
 
+_WHEEL = """node Wheel {{
+  inputs( w : REAL [rad/s], r : REAL [m], rr : REAL [m/rad] )
+  outputs( v : REAL [m/s] )
+  guarantee( {formula} )
+}}
+"""
+
+
+def test_dimensions_differing_only_by_angle_say_how_to_write_the_radian():
+    [(line, col, code, msg)] = _errors(_WHEEL.format(formula="out.v == in.w * in.r"))
+    assert (line, col, code) == (4, 23, "E-unit-dimension"), msg
+    assert "different dimensions (velocity against length*time^-1*angle)" in msg
+    assert "differ only by angle (the second side has rad more)" in msg
+    assert "angle is a base dimension" in msg and "[m/rad]" in msg and "1 [1/rad]" in msg
+    # both ways the message proposes are accepted
+    assert _errors(_WHEEL.format(formula="out.v == in.w * in.rr and out.v == in.w * in.r * 1 [1/rad]")) == []
+    # control: dimensions that differ by more than angle get no angle advice
+    [(_, _, _, other)] = _errors(_WHEEL.format(formula="out.v == in.r"))
+    assert "different dimensions (velocity against length)" in other and "angle" not in other
+
+
 @pytest.mark.parametrize("formula", [
     "out.d == 1000 [mm/m] * in.r", "in.r <= 30 and in.t < 2000", "out.v == in.r / (in.t / 1000 [ms/s])",
     "out.v * 2 [s] <= in.r", "in.x * in.r > in.t", "in.c < 40 and in.c + 2 < in.c", "in.r in {1 [m], 2}",

@@ -41,7 +41,7 @@ from typing import Callable, Mapping, cast
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import CheckedNode, Scalar, Type, is_numeric
-from rclverify.lang.units import Unit, UnitError, best_name, describe, dimension_name, factor_text, parse_unit
+from rclverify.lang.units import BASE_DIMENSIONS, Unit, UnitError, best_name, describe, dimension_name, factor_text, parse_unit
 from rclverify.lang.printer import level, is_type
 from rclverify.lang.units import ratio
 
@@ -96,6 +96,24 @@ def read_unit(ann: ast.UnitAnn, t: Type | None, what: str, err: Report) -> Unit 
         return None
 
 
+def _angle_hint(a: Unit, b: Unit) -> str:
+    """When ``a`` and ``b`` differ only in their power of angle: the text
+    saying so and how to write it, else "".  Angle is a base dimension in
+    RCL (docs/rcl-language.md, "Units of measure"), so an arc length is a
+    radius in ``[m/rad]`` times an angle in ``[rad]``."""
+    angle = BASE_DIMENSIONS.index("angle")
+    if any(x != y for k, (x, y) in enumerate(zip(a.dims, b.dims)) if k != angle):
+        return ""
+    d = b.dims[angle] - a.dims[angle]
+    more = "the second side" if d > 0 else "the first side"
+    power = "rad" if abs(d) == 1 else f"rad^{abs(d)}"
+    per = "1 [1/rad]" if abs(d) == 1 else f"1 [rad^-{abs(d)}]"
+    return (f"; they differ only by angle ({more} has {power} more): angle is a base dimension in RCL, "
+            f"not dimensionless, so a radius that turns an angle into a length is in [m/rad] (length per "
+            f"radian turned); declare that quantity per radian, or multiply {more} by {per} to say "
+            f"that the radian is meant")
+
+
 def mismatch(a: Unit, b: Unit) -> tuple[str, str] | None:
     """``(code, reason)`` when the units ``a`` and ``b`` may not meet in a
     sum or comparison (see the module docstring), else ``None``."""
@@ -103,7 +121,7 @@ def mismatch(a: Unit, b: Unit) -> tuple[str, str] | None:
         return None
     if a.dims != b.dims:
         return "E-unit-dimension", (f"different dimensions ({dimension_name(a.dims)} against "
-                                    f"{dimension_name(b.dims)})")
+                                    f"{dimension_name(b.dims)}){_angle_hint(a, b)}")
     if a.offset is not None or b.offset is not None:
         return "E-unit-offset", factor_text(a, b)
     return "E-unit-scale", f"one dimension ({dimension_name(a.dims)}) at two scales, {factor_text(a, b)}"
