@@ -55,6 +55,27 @@ def ros2_env(tmp: Path, rmw: str = "rmw_fastrtps_cpp") -> dict[str, str]:
     return env
 
 
+#: std_srvs/SetBool, the service the live call tests use, for a workspace whose contracts read it.
+SETBOOL = "bool data\n---\nbool success\nstring message\n"
+
+
+def live_workspace(tmp: Path, rcl: str, mapping: str | None = None, setbool: bool = False) -> Path:
+    """A workspace ``tmp/ws`` for one live test: ``rcl`` as
+    ``contracts/sys.rcl`` in a plan of its own, ``mapping`` (YAML text) as
+    ``mapping.yaml`` when given, and std_srvs/SetBool's definition under
+    ``interfaces/`` when ``setbool``; returns the workspace's path."""
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/sys.rcl").write_text(rcl)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
+    if mapping is not None:
+        (ws / "mapping.yaml").write_text(mapping)
+    if setbool:
+        (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
+        (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text(SETBOOL)
+    return ws
+
+
 def start_node(tmp: Path, name: str, source: str, env: dict[str, str], ready: str | None = "ready",
                timeout: float = 30) -> subprocess.Popen[bytes]:
     """Write ``source`` (dedented) to ``tmp/<name>.py`` and run it in the

@@ -35,8 +35,8 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, ros2_python, start_node
-from test_ros2_services_actions import FIBONACCI, MAPPING, SETBOOL
+from _ros2 import SETBOOL, rclverify, ros2_env, ros2_python, start_node
+from test_ros2_services_actions import FIBONACCI, MAPPING
 from test_ros2_services_actions import RCL as CALLS_RCL
 
 # the services_actions module's system contracts (Base, Brake, Lamp, Fib) and a topic beside them

@@ -42,7 +42,7 @@ from typing import Any
 
 import pytest
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, ros2_python, start_node
+from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 SERVICES = ("ctl", "two", "both", "meta", "half", "rs", "early")
 RCL = "".join(f"""\
@@ -55,7 +55,6 @@ node {s.capitalize()} {{
 }}
 
 """ for s in SERVICES)
-SETBOOL = "bool data\n---\nbool success\nstring message\n"
 
 SYSTEM = """\
 import time
@@ -170,13 +169,7 @@ while True:
 
 
 def _workspace(tmp: Path) -> Path:
-    ws = tmp / "ws"
-    (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/sys.rcl").write_text(RCL)
-    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
-    (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
-    (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text(SETBOOL)
-    return ws
+    return live_workspace(tmp, RCL, setbool=True)
 
 
 def _args(ws: Path, tmp: Path, name: str, *extra: str, source: str = "rclpy") -> list[str]:

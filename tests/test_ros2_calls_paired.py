@@ -31,7 +31,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, ros2_python, start_node
+from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.backends.monitors.dds_calls import CallBook, replay
 from rclverify.lang.typecheck import load
@@ -146,12 +146,7 @@ while True:
 def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     ros2_python()  # skips, with the reason, without a ROS 2 Python
     tmp = tmp_path_factory.mktemp("paired")
-    ws = tmp / "ws"
-    (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/sys.rcl").write_text(RCL)
-    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
-    (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
-    (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text("bool data\n---\nbool success\nstring message\n")
+    ws = live_workspace(tmp, RCL, setbool=True)
     env = ros2_env(tmp)
     monitor = system = deaf = None
     try:

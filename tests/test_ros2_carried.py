@@ -41,7 +41,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, ros2_python, start_node
+from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
 
@@ -231,11 +231,7 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
     py = ros2_python()  # skips, with the reason, without a ROS 2 Python
     source = request.param
     tmp = tmp_path_factory.mktemp(f"carried-{source}")
-    ws = tmp / "ws"
-    (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/sys.rcl").write_text(RCL)
-    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
-    (ws / "mapping.yaml").write_text(MAPPING)
+    ws = live_workspace(tmp, RCL, MAPPING)
     env = ros2_env(tmp)
     system = monitor = nan = None
     common = ["--live", "--ros2", "--mapping", "mapping.yaml", "--horizon", "0.5", "--status", "0",

@@ -17,7 +17,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, ros2_python, start_node
+from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 from test_sequences_of_messages import INSIDE, INSIDE_MAPPING
 
 from rclverify.cli.commands import main
@@ -67,11 +67,7 @@ while True:
 def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     ros2_python()  # skips, with the reason, without a ROS 2 Python
     tmp = tmp_path_factory.mktemp("sequences")
-    ws = tmp / "ws"
-    (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/sys.rcl").write_text(RCL)
-    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
-    (ws / "mapping.yaml").write_text(MAPPING)
+    ws = live_workspace(tmp, RCL, MAPPING)
     env = ros2_env(tmp)
     monitor = system = None
     try:

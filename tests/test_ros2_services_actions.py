@@ -49,7 +49,7 @@ from typing import Any
 
 import pytest
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, ros2_python, start_node
+from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.backends.monitors.dds_calls import CallBook, replay
 from rclverify.lang.typecheck import load
@@ -93,7 +93,6 @@ topics:
   fib/feedback: {fields: ["sequence[-1]"]}
   fib/result: {fields: ["sequence[-1]"]}
 """
-SETBOOL = "bool data\n---\nbool success\nstring message\n"
 FIBONACCI = "int32 order\n---\nint32[] sequence\n---\nint32[] sequence\n"
 
 SYSTEM = """\
@@ -203,13 +202,7 @@ while True:
 
 
 def _workspace(tmp: Path) -> Path:
-    ws = tmp / "ws"
-    (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/sys.rcl").write_text(RCL)
-    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
-    (ws / "mapping.yaml").write_text(MAPPING)
-    (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
-    (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text(SETBOOL)
+    ws = live_workspace(tmp, RCL, MAPPING, setbool=True)
     (ws / "interfaces/test_msgs/action").mkdir(parents=True)
     (ws / "interfaces/test_msgs/action/Fibonacci.action").write_text(FIBONACCI)
     return ws

@@ -40,7 +40,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for
-from _ros2 import rclverify, ros2_env, ros2_python, start_node
+from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
 
@@ -131,7 +131,6 @@ while True:
     ex.spin_once(timeout_sec=0.1)
 """
 
-SETBOOL = "bool data\n---\nbool success\nstring message\n"
 MONITORS = {"echo": ["--node", "Echo", "--strict"], "ghost": ["--node", "Ghost", "--strict"],
             "ghost_lax": ["--node", "Ghost"], "base": ["--node", "Base", "--strict"]}
 
@@ -141,12 +140,7 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
     """The run heard through each source (docs/ros2.md, "Two sources"): the same verdicts and exit codes."""
     py = ros2_python()  # skips, with the reason, without a ROS 2 Python
     tmp = tmp_path_factory.mktemp(f"silence-{request.param}")
-    ws = tmp / "ws"
-    (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/sys.rcl").write_text(RCL)
-    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
-    (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
-    (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text(SETBOOL)
+    ws = live_workspace(tmp, RCL, setbool=True)
     env = ros2_env(tmp)
     procs = {}
     system = None
