@@ -84,6 +84,32 @@ class ExpectedVerdictRow(TypedDict):
     outcome: str
 
 
+class HopTimeMargin(TypedDict):
+    """A hop's smallest time margin on its node's runs (``$defs/hop_time_margin``; report/chain_margins.py)."""
+    margin_s: float | None
+    margin_ns: int | None
+    obligation: str
+    trigger_where: str
+    answer_where: str
+    answers: int
+    unanswered: int
+
+
+class DeadlineHop(TypedDict):
+    """One timed guarantee of a deadline's chain (``$defs/deadline_hop``; report/deadlines.py)."""
+    node: str
+    guarantee: int
+    trigger: str
+    outputs: list[str]
+    within_s: str
+    within: str
+    loc: str
+    status: NotRequired[EvidenceStatus]
+    timing: NotRequired[str]
+    monitors: NotRequired[list[dict[str, Any]]]
+    time_margin: NotRequired[HopTimeMargin | None]
+
+
 class DeadlineRow(TypedDict):
     """An end-to-end deadline decided by rule D3 (``deadlines[]``, ``$defs/deadline``; report/deadlines.py)."""
     requirement: str
@@ -94,8 +120,10 @@ class DeadlineRow(TypedDict):
     status: NotRequired[EvidenceStatus]
     evidence_status: NotRequired[EvidenceStatus]
     reason: NotRequired[str]
-    chain: NotRequired[list[dict[str, Any]]]
+    chain: NotRequired[list[DeadlineHop]]
     total: NotRequired[str | None]
+    time_margin: NotRequired[str | None]
+    time_margin_ns: NotRequired[int | None]
     stamps: NotRequired[list[Any]]
     smt2: NotRequired[str]
     solvers: NotRequired[Solvers | None]
@@ -387,6 +415,42 @@ class ProblemRow(TypedDict):
     repairs: list[RepairRef]
 
 
+class NodlPlaceRow(TypedDict):
+    """A place a NoDL finding involves (``$defs/nodl_place``): file, line, column (1-based)."""
+    file: str
+    line: int
+    col: int
+
+
+class NodlFindingRow(TypedDict):
+    """A finding of the NoDL check (``nodl.findings[]``; docs/nodl.md, "Findings"), at every place it involves."""
+    code: str
+    severity: Literal["error", "warning"]
+    message: str
+    places: list[NodlPlaceRow]
+
+
+class NodlSideConditionRow(TypedDict):
+    """A parameter's declared constraints against an assumption of its node (``nodl.side_conditions[]``)."""
+    node: str
+    parameter: str
+    conjunct: str
+    status: Literal["proved", "refuted", "inconclusive"]
+    model: dict[str, str]
+
+
+class NodlRow(TypedDict):
+    """The workspace's NoDL documents against its contracts and each other (``nodl``; stages/nodl.py)."""
+    documents: dict[str, list[str]]
+    parts: list[str]
+    findings: list[NodlFindingRow]
+    counts: dict[str, int]
+    side_conditions: list[NodlSideConditionRow]
+    inputs: dict[str, str]
+    stale: NotRequired[str]
+    altered: NotRequired[str]
+
+
 class Report(TypedDict):
     """``reports/assurance.json`` (docs/assurance.schema.json)."""
     meta: Meta
@@ -404,6 +468,8 @@ class Report(TypedDict):
     lint: list[LintRow]
     expected_verdicts: list[ExpectedVerdictRow]
     grounding: dict[str, Any] | None
+    #: the NoDL documents' check (stages/nodl.py, report/nodl.py), ``None`` when the workspace has none
+    nodl: NodlRow | None
     unverified: list[UnverifiedRow]
     deadlines: list[DeadlineRow]
     acknowledgements: list[AcknowledgementRow]

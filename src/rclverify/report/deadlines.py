@@ -17,6 +17,9 @@ one row per deadline of the current plan (:func:`deadline_rows`):
   evidence status and the deadline verdicts the monitors recorded for its
   node (``true`` / ``currently_false`` / ``false`` counts, the first
   ``false`` with its stamps);
+* ``time_margin``/``time_margin_ns``: the chain's measured margin, the
+  bound less every hop's worst measured latency summed
+  (:func:`.chain_margins.chain_margin`; ``None`` unless every hop has one);
 * ``total`` (the sum), ``within`` (the requirement's bound), ``reason``
   (the chain named), ``stamps`` (a late run, for a refuted one), ``smt2``.
 
@@ -46,6 +49,7 @@ from rclverify.records.records import worst
 from rclverify.records.statuses import DEADLINE_STATUS
 from rclverify.stages.workspace import Workspace
 from rclverify.records.store import EvidenceStore
+from rclverify.report.chain_margins import chain_margin, hop_margin
 
 #: A deadline verdict as an evidence status (the report's badges and roll-up).
 STATUS_OF = {"proved": "discharged", **DEADLINE_STATUS}  # records/statuses.py, "Verdict and status"
@@ -105,9 +109,13 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
         rows.append({**base, "verdict": verdict if verdict in STATUS_OF else "error", "reason": reason,
                      "chain": chain, "total": rec.get("total"), "stamps": list(rec.get("stamps") or []),
                      "smt2": str(rec.get("smt2") or ""), "solvers": rec.get("solvers")})
-    for row in rows:
+    for row, spec in zip(rows, specs):
         for h in row["chain"]:
             _timing_measured(h)
+            h["time_margin"] = hop_margin(h)  # the hop's smallest time margin on the runs
+        measured = chain_margin(spec.within, row["chain"])
+        row["time_margin_ns"] = measured
+        row["time_margin"] = None if measured is None else f"{measured / 1e6:.3f} ms"
         # the timed guarantees the decision rests on: their evidence (the monitors check the stamps)
         row["evidence_status"] = worst([h["status"] for h in row["chain"]], empty="pending")
         # proved is a green tick only when every hop's guarantee is discharged (as a requirement's "met")
@@ -147,7 +155,8 @@ def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationRow],
         if isinstance(d, dict):
             out.setdefault(str(o["node"]), []).append({"obligation": o["id"], "status": o["status"],
                                                        "counts": dict(d.get("counts") or {}),
-                                                       "first_false": d.get("first_false")})
+                                                       "first_false": d.get("first_false"),
+                                                       "time_margins": list(d.get("time_margins") or ())})
     return out
 
 

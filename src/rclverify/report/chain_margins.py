@@ -1,0 +1,79 @@
+"""Time margins of an end-to-end deadline's chain, hop by hop, on the recorded
+runs (docs/semantics.md, "Margins", "Time margin of a chain").
+
+Each hop of a chain (:mod:`rclverify.calculus.deadlines`, rule D3) is a timed
+guarantee ``triggered by in.x within d`` of one node.  The deadline monitor
+(:mod:`rclverify.backends.monitors.deadlines`) measured, on every run of that
+node's monitors evidence, the guarantee's smallest time margin: its deadline
+less its answer's stamp, in integer nanoseconds
+(:class:`rclverify.backends.monitors.time_margins.TimeMargin`).  Here:
+
+* :func:`hop_margin`: a hop's smallest time margin over its node's runs (the
+  run, the trigger and the answer it was measured on, how many triggers were
+  answered and how many never were);
+* :func:`chain_margin`: the chain's measured margin, ``within`` less the sum
+  of each hop's worst measured latency ``d_i - m_i``: how much later the
+  slowest answer of every hop could have come, all at once, and the chain
+  still met its bound.  It is ``None`` unless every hop has a margin (a hop
+  no run timed, or one with triggers never answered, has no latency bound).
+
+The latencies are summed as rule D3 sums the deadlines: each hop's worst
+case, whether or not they fell on one event's way through the chain, so the
+measured margin is never larger than the margin of any one event's
+end-to-end latency.
+"""
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from typing import Any, Mapping, Sequence
+
+
+def hop_margin(hop: Mapping[str, Any]) -> dict[str, Any] | None:
+    """The smallest time margin of ``hop``'s guarantee over the deadline
+    records of its node's monitors evidence (``hop["monitors"]``, each with
+    ``time_margins``, :meth:`TimeMargin.to_json`).  Returns ``{"margin_s",
+    "margin_ns", "obligation", "trigger_where", "answer_where", "answers",
+    "unanswered"}`` (``answers`` and ``unanswered`` summed over the runs;
+    ``margin_s``/``margin_ns`` ``None`` when no trigger was answered), or
+    ``None`` when no run measured the guarantee."""
+    k = int(hop["guarantee"])
+    best: dict[str, Any] | None = None
+    answers = unanswered = 0
+    for m in hop.get("monitors") or ():
+        for t in m.get("time_margins") or ():
+            if int(t.get("guarantee", 0)) != k:
+                continue
+            answers += int(t.get("answers") or 0)
+            unanswered += int(t.get("unanswered") or 0)
+            ns = t.get("margin_ns")
+            if ns is not None and (best is None or best["margin_ns"] is None or int(ns) < best["margin_ns"]):
+                best = {"margin_ns": int(ns), "obligation": str(m.get("obligation", "")),
+                        "trigger_where": str(t.get("trigger_where", "")), "answer_where": str(t.get("answer_where", ""))}
+            elif best is None:
+                best = {"margin_ns": None, "obligation": str(m.get("obligation", "")),
+                        "trigger_where": "", "answer_where": ""}
+    if best is None:
+        return None
+    ns = best["margin_ns"]
+    return {**best, "margin_s": None if ns is None else ns / 1e9, "answers": answers, "unanswered": unanswered}
+
+
+def chain_margin(within_s: Fraction, chain: Sequence[Mapping[str, Any]]) -> int | None:
+    """The chain's measured margin in integer nanoseconds (module
+    docstring): ``within_s`` (the requirement's bound, s) less the sum over
+    the hops of ``within_s - margin`` (each hop's ``within_s``, an exact
+    fraction text, and its :func:`hop_margin`); ``None`` when the chain is
+    empty or a hop has no margin or had a trigger never answered."""
+    if not chain:
+        return None
+    spent = Fraction(0)
+    for h in chain:
+        m = h.get("time_margin")
+        if not m or m.get("margin_ns") is None or m.get("unanswered"):
+            return None
+        spent += Fraction(str(h["within_s"])) * 10**9 - int(m["margin_ns"])
+    return math.floor(within_s * 10**9 - spent)  # rounded down: never more slack than measured
+
+
+__all__ = ["chain_margin", "hop_margin"]
