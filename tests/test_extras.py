@@ -68,6 +68,19 @@ def test_a_workspace_that_needs_the_ros_extra_says_so_in_one_line(tmp_path: Path
     assert "Traceback" not in r.stderr
 
 
+def test_the_live_ros2_monitor_without_its_extra_is_one_line_and_exit_1(tmp_path: Path) -> None:
+    shutil.copytree(ROOT / "examples" / "ros2_robot" / "contracts", tmp_path / "contracts")
+    r = cli_without("cyclonedds", "monitor", "--live", "--ros2", "--source", "dds", cwd=tmp_path)
+    assert (r.returncode, r.stdout) == (1, ""), (r.stdout, r.stderr)
+    assert r.stderr.strip().splitlines() == [
+        "rclverify monitor --live: error: ROS 2 over DDS needs rclverify's [ros2] extra (cyclonedds is not "
+        "installed): pip install 'rclverify[ros2]'"]
+    # control: with the extra, a problem of the workspace (an action type it does not define) stays exit 2
+    c = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "--source",
+                        "dds"], cwd=tmp_path, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+    assert c.returncode == 2 and "robot_msgs/action/Dock_Goal" in c.stderr, (c.stdout, c.stderr)
+
+
 def test_a_statistical_target_without_scipy_is_inconclusive_with_the_reason() -> None:
     code = """
 import importlib.abc, sys

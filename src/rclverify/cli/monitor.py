@@ -34,6 +34,7 @@ from rclverify.backends.monitors.judged import explain, strict_line
 from rclverify.backends.monitors.declarations import declaration_status
 from rclverify.backends.monitors.periods import period_status
 from rclverify.backends.monitors.recorded import RecordedRun, check_recorded
+from rclverify.core.extras import MissingExtra
 
 
 
@@ -267,7 +268,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     except (RosUnavailable, DdsUnavailable, ProxyUsage, RclpyUnavailable) as exc:
         text = str(exc)
         print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
-        return 2
+        return 1 if isinstance(exc, MissingExtra) else 2  # a missing extra exits 1 (docs/install.md)
     _print_live(log, record_)
     return _live_exit(args, record_)
 
@@ -275,7 +276,8 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
 def _source(args: argparse.Namespace) -> Any:
     """The bus factory of the ROS 2 source ``--source`` asks for (docs/ros2.md, "Two sources"): the rclpy
     source's, ``None`` for the DDS source, ``False`` after printing why it cannot be had (exit 2). Says
-    which source on the first line."""
+    which source on the first line.  Raises :class:`~rclverify.ros.live.dds.DdsUnavailable` (its subclass
+    ``DdsExtraMissing`` without the ``[ros2]`` extra) before that line when the DDS source cannot load."""
     from functools import partial  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
 
     from rclverify.runtime.rclpy_source.bus import RclpyBus  # deferred: optional or conditional (only --ros2)
@@ -285,6 +287,9 @@ def _source(args: argparse.Namespace) -> Any:
     except ValueError as exc:
         print(f"rclverify monitor --live --ros2: error: {exc}", file=sys.stderr)
         return False
+    if source == "dds":  # the binding first: without the [ros2] extra the one line is the error
+        from rclverify.ros.live.dds import import_cyclonedds  # deferred: optional or conditional (only --ros2)
+        import_cyclonedds()
     print(f"source: {source} ({why})", flush=True)
     return partial(RclpyBus, py) if source == "rclpy" and py else None
 

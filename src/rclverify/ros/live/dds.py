@@ -46,6 +46,8 @@ import struct
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
+from rclverify.core.extras import MissingExtra
+
 #: The highest ROS_DOMAIN_ID usable on Linux (ROS 2 documentation, "The ROS_DOMAIN_ID").
 MAX_DOMAIN_ID = 232
 DISCOVERY_TOPIC = "ros_discovery_info"
@@ -61,16 +63,24 @@ class DdsUnavailable(Exception):
     ``ROS_DOMAIN_ID``, a Cyclone configuration that does not load); ``str`` says why."""
 
 
+class DdsExtraMissing(DdsUnavailable, MissingExtra):
+    """The ``cyclonedds`` binding is not installed: rclverify's ``[ros2]``
+    extra is missing (one line naming it; commands exit 1 for it, as for
+    every missing extra: docs/install.md)."""
+
+
 def import_cyclonedds() -> Any:
-    """The ``cyclonedds`` package; raises :class:`DdsUnavailable` with the remedy."""
+    """The ``cyclonedds`` package; raises :class:`DdsExtraMissing` when it
+    is not installed and :class:`DdsUnavailable` when it does not load,
+    each with the remedy."""
     try:
         import cyclonedds  # deferred: optional or conditional (inside a block)
         import cyclonedds.domain  # noqa: F401  (loads the C library: fails here when it cannot); deferred: optional or conditional (inside a block)
         return cyclonedds
     except ImportError as exc:
-        from rclverify.core.extras import installed, missing_message  # deferred: optional or conditional (inside a block)
+        from rclverify.core.extras import installed  # deferred: optional or conditional (inside a block)
         if not installed("cyclonedds"):
-            raise DdsUnavailable(missing_message("cyclonedds", "ROS 2 over DDS")) from None
+            raise DdsExtraMissing("cyclonedds", "ROS 2 over DDS") from None
         raise DdsUnavailable(f"the cyclonedds Python binding does not load ({exc})") from None
 
 
