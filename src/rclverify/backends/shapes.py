@@ -236,6 +236,9 @@ class DeclarationRow(TypedDict):
     verdict: str
     status: str
     reason: str
+    #: ``progress( within K steps )`` or a period in steps judged ``true``: K less the longest row of accepted
+    #: steps left unanswered (the steps to spare; docs/semantics.md, "Margins in steps")
+    spare: NotRequired[int]
 
 
 class InputCoverage(TypedDict):

@@ -20,7 +20,7 @@ records/records.py ``Obligation.to_json``; ``deadlines``
 calculus/deadlines.py ``DeadlineResult.to_json`` with stages/deadlines.py;
 ``requirements`` calculus/requirements/check.py, temporal_check.py and
 stages/requirements.py; ``crosscheck`` stages/crosscheck/stage.py;
-``ground`` app/ros_stage.py; ``diagnosis`` diagnosis/build.py with
+``ground`` app/ros_stage.py; ``nodl`` stages/nodl.py; ``diagnosis`` diagnosis/build.py with
 stages/diagnoses.py.  tests/test_stage_records.py checks every
 record the case study's stages return against these types.
 """
@@ -248,6 +248,8 @@ class TraceVerdictJson(TypedDict):
     time: float | None
     where: str
     witness: list[Witness]
+    #: a bounded ``eventually`` or response judged ``true``: the steps to spare (docs/semantics.md, "Margins in steps")
+    spare: NotRequired[int]
 
 
 class TraceFailure(TypedDict):
@@ -486,5 +488,44 @@ class GroundingRecord(TypedDict):
     inputs: dict[str, str]
 
 
+class NodlPlace(TypedDict):
+    """A place a NoDL finding involves: workspace-relative file, line and column (1-based)."""
+    file: str
+    line: int
+    col: int
+
+
+class NodlFinding(TypedDict):
+    """One finding of the NoDL check (model/nodl/findings.py ``Finding.to_json``): its code, ``error``
+    or ``warning``, the message and every place it involves, most important first."""
+    code: str
+    severity: str
+    message: str
+    places: list[NodlPlace]
+
+
+class NodlSideCondition(TypedDict):
+    """A parameter's declared constraints against one conjunct its node assumes of the input it sets
+    (model/nodl/param_assume.py ``Side``): Z3's ``status`` and, refuted, the counterexample."""
+    node: str
+    parameter: str
+    conjunct: str
+    status: str
+    model: dict[str, str]
+
+
+class NodlRecord(TypedDict):
+    """``artifacts/nodl/index.json``: the workspace's NoDL documents checked against its contracts and
+    each other (stages/nodl.py): the files of each node's document (``documents``), the parts read
+    only through ``include``, the findings, their ``counts`` per severity, the parameters' side
+    conditions and the sha256 of the files it was made from (``inputs``)."""
+    documents: dict[str, list[str]]
+    parts: list[str]
+    findings: list[NodlFinding]
+    counts: dict[str, int]
+    side_conditions: list[NodlSideCondition]
+    inputs: dict[str, str]
+
+
 __all__ = ["CheckRecord", "CompositionRecord", "CrosscheckRecord", "DeadlineRecord", "DiagnosisRecord", "GroundingRecord",
-           "HealthFinding", "ObligationRecord", "RequirementRecord"]
+           "HealthFinding", "NodlRecord", "ObligationRecord", "RequirementRecord"]

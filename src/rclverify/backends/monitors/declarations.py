@@ -106,6 +106,8 @@ class _Count:
     heard: bool = False
     #: accepted steps before the first answering output was heard (not counted against the node)
     before: int = 0
+    #: the longest row of unanswered accepted steps seen (counted from the first answering output)
+    longest: int = 0
 
 
 @dataclass
@@ -285,6 +287,7 @@ class DeclarationMonitor:
                 if c.row == 0:
                     c.first_open = ev.where
                 c.row += 1
+                c.longest = max(c.longest, c.row)
             else:
                 c.row = 0
 
@@ -351,7 +354,10 @@ class DeclarationMonitor:
             if ini.unobservable:
                 res.unobservable.add(f"initially {ini.index}")
         for c in self.counts:
-            res.declarations.append(_row(c.label, c.premise, 0, c.source, c.text, *self._count_verdict(c)))
+            row = _row(c.label, c.premise, 0, c.source, c.text, *self._count_verdict(c))
+            if row["verdict"] == "true" and c.bound is not None:
+                row["spare"] = c.bound - c.longest  # the steps to spare (docs/semantics.md, "Margins in steps")
+            res.declarations.append(row)
         return res
 
     def _count_verdict(self, c: _Count) -> tuple[str, str]:

@@ -23,6 +23,14 @@ class ResponseTracker:
         self.within = within
         self.pending: int | None = None  # the step of the oldest trigger not yet answered
         self.before: bool | None = False  # next form: the trigger's value at the step before
+        self.longest: int | None = None  # the longest wait (steps) of a trigger answered in time
+
+    def spare(self) -> int | None:
+        """The steps to spare: N less the longest wait of an answered trigger
+        (``None`` for the next form, the unbounded one, or no trigger answered)."""
+        if self.within is None or self.within == float("inf") or self.longest is None:
+            return None
+        return int(self.within) - self.longest
 
     def step(self, i: int, p: bool | None, q: bool | None) -> tuple[str, int] | None:
         """Read step ``i`` with the trigger's and the response's truth
@@ -38,6 +46,9 @@ class ResponseTracker:
                 return "undecided", 0
             return ("undecided", 1) if before is True and q is None else None
         if q is True:
+            wait = i - self.pending if self.pending is not None else 0 if p is True else None
+            if wait is not None:
+                self.longest = wait if self.longest is None else max(self.longest, wait)
             self.pending = None
             return None
         if q is None:  # the response may hold here: what is pending, and a trigger now, may be answered

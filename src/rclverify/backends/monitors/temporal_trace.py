@@ -92,7 +92,10 @@ class TraceVerdict:
     ``verdict`` one of :data:`VERDICTS`; ``step``/``time``/``where`` where it
     was decided (``None`` when at the end of the trace); ``steps`` the
     number of steps; ``witness`` ``[{"step", "time", "where", "operand",
-    "holds", "values"}]``; ``reason`` one sentence.
+    "holds", "values"}]``; ``reason`` one sentence; ``spare`` the steps to
+    spare of a bounded ``eventually[<= N]`` (N less the step it held at) or
+    response (N less the longest wait of an answered trigger) judged
+    ``true``, else ``None`` (docs/semantics.md, "Margins in steps").
     """
 
     verdict: str
@@ -102,10 +105,14 @@ class TraceVerdict:
     time: float | None = None
     where: str = ""
     witness: list[Witness] = field(default_factory=list)
+    spare: int | None = None
 
     def to_json(self) -> TraceVerdictJson:
-        return {"verdict": self.verdict, "steps": self.steps, "reason": self.reason, "step": self.step,
-                "time": self.time, "where": self.where, "witness": self.witness}
+        out: TraceVerdictJson = {"verdict": self.verdict, "steps": self.steps, "reason": self.reason,
+                                 "step": self.step, "time": self.time, "where": self.where, "witness": self.witness}
+        if self.spare is not None:
+            out["spare"] = self.spare
+        return out
 
 
 
@@ -237,7 +244,9 @@ def _step_eventually(r: _Run) -> TraceVerdict | None:
     f = r.ops[0]
     h = r.decide(f, False)
     if h is True:
-        return r.at("true", f"{_text(f)} holds at step {r.i} ({r.where()})", [r.wit(f, True)])
+        v = r.at("true", f"{_text(f)} holds at step {r.i} ({r.where()})", [r.wit(f, True)])
+        v.spare = None if r.bound is None else r.bound - r.i
+        return v
     r.note(f, h)
     if r.bound is not None and r.i >= r.bound:
         if r.undecided is not None:
@@ -364,7 +373,7 @@ def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
     if tracker is not None and tracker.pending is None:
         return TraceVerdict("true", n, f"every step where {_text(ops[0])} held was answered by {_text(ops[1])} in "
                                        f"time in this trace ({n} steps): evidence for the requirement, not a proof",
-                            **end)
+                            **end, spare=tracker.spare())
     if tracker is not None:
         return TraceVerdict("currently_false", n, f"{_text(ops[0])} held at step {tracker.pending} and {_text(ops[1])} has "
                                                   f"not held since when the trace ended after {n} steps (a longer run "
