@@ -143,32 +143,40 @@ def test_missing_plan_file(tmp_path: Path) -> None:
 def test_missing_contracts_key(tmp_path: Path) -> None:
     text = BASE.replace("contracts:\n  - contracts/remote_inspection.rcl\n", "")
     (d,) = load_errors(tmp_path, text)
-    assert "'contracts' is a required property" in d.message and at(d) == (1, 1)
+    assert "plan: 'contracts' is a required key and is missing" in d.message and at(d) == (1, 1)
 
 
 def test_unknown_top_level_key_is_named(tmp_path: Path) -> None:
     (d,) = load_errors(tmp_path, BASE.replace("name: test plan", "nmae: test plan"))
-    assert "'nmae' was unexpected" in d.message and at(d) == (1, 1)
+    assert "plan: unknown key 'nmae' (did you mean 'name'?); the known keys are: " in d.message and at(d) == (1, 1)
 
 
 def test_unknown_top_level_key_is_located_at_the_key(tmp_path: Path) -> None:
     text = BASE + "extra_key: 1\n"
     (d,) = load_errors(tmp_path, text)
-    assert "'extra_key' was unexpected" in d.message
+    assert "plan: unknown key 'extra_key'; the known keys are: acknowledged, connections, contracts," in d.message
     assert d.loc.line == where(text, "extra_key")[0]
 
 
 def test_unknown_nested_key(tmp_path: Path) -> None:
     text = BASE.replace("{node: RadiationSensor, guarantees: [1]}", "{node: RadiationSensor, guarantees: [1], why: x}")
     (d,) = load_errors(tmp_path, text)
-    assert "requirements.0.supported_by.1" in d.message and "'why' was unexpected" in d.message
+    assert "requirements.0.supported_by.1: unknown key 'why'; the known keys are: guarantees, node" in d.message
     assert at(d) == where(text, "why: x")  # located at the offending key
+
+
+def test_an_unknown_key_in_place_of_a_required_one_is_one_line_naming_both(tmp_path: Path) -> None:
+    text = BASE.replace("contracts:\n  - contracts/remote_inspection.rcl\n", "clauses:\n  - contracts/remote_inspection.rcl\n")
+    (d,) = load_errors(tmp_path, text)  # not a second line for the missing 'contracts'
+    assert d.message.startswith("plan: unknown key 'clauses' (did you mean 'contracts'? it is required and missing); "
+                                "the known keys are: "), d.message
+    assert "type" not in d.message and at(d) == where(text, "clauses:")
 
 
 def test_requirement_without_text(tmp_path: Path) -> None:
     text = BASE.replace("    text: The robot inspects the waypoints.\n", "")
     (d,) = load_errors(tmp_path, text)
-    assert "requirements.0: 'text' is a required property" in d.message
+    assert "requirements.0: 'text' is a required key and is missing" in d.message
     assert at(d) == where(text, "id: R1")
 
 

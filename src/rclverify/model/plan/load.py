@@ -23,7 +23,8 @@ from rclverify.lang.types import BOOL, Checked
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.formal import Source
 from rclverify.model.plan.targets import check_targets, requirement_target
-from rclverify.model.plan.yamlguard import KEY, Blocks, compose_guarded, read_yaml_text, schema_error_loc, to_data
+from rclverify.model.plan.yamlguard import (KEY, Blocks, compose_guarded, read_yaml_text, schema_error_loc,
+                                             schema_messages, to_data)
 
 # The plan's values live in model/plan/model.py (below this loader and what it calls); re-exported here.
 from rclverify.model.plan.model import Connection, DeadlineSpec, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
@@ -107,10 +108,9 @@ def _check_schema(data: dict[str, Any], locs: Mapping[Path_, ast.Loc], plan_rel:
         kept.put("plan-schema", True, key)
     if errors:
         diags: list[Diagnostic] = []
-        for e in errors:
+        for e, message in schema_messages(errors, lambda e: ".".join(map(str, e.absolute_path)) or "plan"):
             loc = schema_error_loc(e, locs, plan_rel)
-            where = ".".join(map(str, e.absolute_path)) or "plan"
-            diags.extend(plan_error(loc.file, loc.line, loc.col, f"{where}: {e.message}").diagnostics)
+            diags.extend(plan_error(loc.file, loc.line, loc.col, message).diagnostics)
         raise PlanError(diags)
 
 

@@ -48,6 +48,7 @@ records them.
 """
 from __future__ import annotations
 
+import difflib
 import os
 from pathlib import Path
 from typing import Any
@@ -276,12 +277,68 @@ def schema_error_loc(error: Any, locs: dict[Path_, ast.Loc] | Any, file: str) ->
     written ancestor (``file:1:1`` when none is)."""
     path: Path_ = tuple(error.absolute_path)
     if error.validator == "additionalProperties" and isinstance(error.instance, dict):
-        allowed = set(error.schema.get("properties", {})) if isinstance(error.schema, dict) else set()
-        extra = [k for k in error.instance if k not in allowed]
+        extra = _unknown_keys(error)
         if extra and path + (extra[0], KEY) in locs:
             path = path + (extra[0], KEY)
     while path and path not in locs:
         path = path[:-1]
     loc: ast.Loc = locs.get(path, ast.Loc(file, 1, 1))
     return loc
+
+
+def _unknown_keys(error: Any) -> list[Any]:
+    """The keys an ``additionalProperties`` ``error`` refuses, in written order."""
+    allowed = set(error.schema.get("properties", {})) if isinstance(error.schema, dict) else set()
+    return [k for k in error.instance if k not in allowed] if isinstance(error.instance, dict) else []
+
+
+def _named_missing(error: Any) -> str | None:
+    """The one required key an ``additionalProperties`` ``error``'s object
+    lacks while it has exactly one unknown key (that key may mean it), else ``None``."""
+    schema = error.schema if isinstance(error.schema, dict) else {}
+    if error.validator != "additionalProperties" or len(_unknown_keys(error)) != 1:
+        return None
+    missing = [str(r) for r in schema.get("required", []) if r not in error.instance]
+    return missing[0] if len(missing) == 1 else None
+
+
+def schema_messages(errors: list[Any], where_of: Any) -> list[tuple[Any, str]]:
+    """``(error, message)`` for each ``jsonschema`` error of ``errors`` worth
+    a line (:func:`schema_message`; ``where_of(error)`` is its place).  A
+    missing required key is left out when an unknown key beside it is
+    already said to perhaps mean it, so one slip gives one line."""
+    hinted = {(tuple(e.absolute_path), m) for e in errors if (m := _named_missing(e)) is not None}
+    out: list[tuple[Any, str]] = []
+    for e in errors:
+        if e.validator == "required" and isinstance(e.validator_value, list):
+            missing = [r for r in e.validator_value if isinstance(e.instance, dict) and r not in e.instance]
+            if missing and all((tuple(e.absolute_path), str(r)) in hinted for r in missing):
+                continue
+        out.append((e, schema_message(e, where_of(e))))
+    return out
+
+
+def schema_message(error: Any, where: str) -> str:
+    """The one-line message of a ``jsonschema`` validation ``error`` at
+    ``where`` (``"plan"``, ``"nodes.Base"``): an unknown key is named as
+    one, with the known key it may mean (a close spelling, or the one
+    required key missing beside it) and the keys that are known; a missing
+    key is named as one; every other error keeps jsonschema's text."""
+    schema = error.schema if isinstance(error.schema, dict) else {}
+    known = sorted(map(str, schema.get("properties", {})))
+    if error.validator == "additionalProperties" and known and (unknown := _unknown_keys(error)):
+        key = str(unknown[0])
+        close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+        missing = _named_missing(error)
+        if close:
+            hint = f" (did you mean {close[0]!r}?)"
+        elif missing is not None:
+            hint = f" (did you mean {missing!r}? it is required and missing)"
+        else:
+            hint = ""
+        more = f" (and {', '.join(repr(str(k)) for k in unknown[1:])})" if len(unknown) > 1 else ""
+        return f"{where}: unknown key {key!r}{more}{hint}; the known keys are: {', '.join(known)}"
+    if error.validator == "required":
+        return f"{where}: {error.message.replace(' is a required property', '')} is a required key and is missing"
+    return f"{where}: {error.message}"
 
