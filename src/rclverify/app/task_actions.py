@@ -279,6 +279,21 @@ def act_ground(root: str) -> Any:
     return None
 
 
+def act_nodl(root: str) -> Any:
+    """The NoDL stage (docs/nodl.md, :mod:`rclverify.stages.nodl`): the workspace's documents
+    against its contracts and each other; findings go to the report."""
+    from rclverify.stages.nodl import stage_nodl  # deferred: start-up (loads jsonschema, yaml and z3 only when called)
+    try:
+        data = stage_nodl(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    c = data["counts"]
+    print(f"NoDL: {len(data['documents'])} node document(s), {c['error']} error(s), {c['warning']} warning(s) "
+          "(rclverify nodl check lists them)")
+    return None
+
 
 @_extras_said
 def act_verify(root: str, strict: bool) -> Any:

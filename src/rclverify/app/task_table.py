@@ -8,7 +8,7 @@ method that doit calls as a task creator (doit accepts bound methods, also
 with ``create_after``).  doit orders the tasks by the line where each
 creator is defined, so the methods stand in the order the tasks run:
 check, graph, node, health, requirements, deadlines, evidence, crosscheck, ground,
-diagnosis, report, verify.  The actions the tasks run are in
+nodl, diagnosis, report, verify.  The actions the tasks run are in
 :mod:`rclverify.app.task_actions`, the ``uptodate`` checks in
 :mod:`rclverify.app.task_checks`.
 """
@@ -27,7 +27,7 @@ from doit.tools import config_changed
 
 from rclverify.core.cache import code_stamp
 from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_diagnosis, act_graph, act_ground,
-                                        act_node, act_report, act_requirements, act_run, act_verify)
+                                        act_node, act_nodl, act_report, act_requirements, act_run, act_verify)
 from rclverify.app.shapes import DoitTask
 from rclverify.app.task_checks import (RecordIntact, TargetsAsWritten, entry_inputs, ros_fingerprint, strict_uptodate,
                                        tool_fingerprint, z3_version)
@@ -71,6 +71,10 @@ DEADLINES_INDEX = "artifacts/deadlines/index.json"
 CROSSCHECK_INDEX = "artifacts/crosscheck/index.json"
 #: The diagnosis stage's record (stages/diagnoses.py: ``INDEX``), named here for the same reason.
 DIAGNOSIS_INDEX = "artifacts/diagnosis/index.json"
+#: The NoDL stage's record (stages/nodl.py: ``INDEX``) and its documents' folder (model/nodl/check.py: ``FOLDER``).
+NODL_INDEX = "artifacts/nodl/index.json"
+NODL_FOLDER = "nodl"
+NODL_SUFFIXES = (".nodl.yaml", ".nodl.yml", ".nodl.json")
 
 
 class TaskTable:
@@ -103,6 +107,7 @@ class TaskTable:
             else [self.code, self.sealed]
         self.deadline_nodes = list(index.deadline_nodes) if index is not None else []
         self.ros_section = dict(index.ros) if index is not None else {}  # from the index: a no-op run loads no contract
+        self.nodl_files = self._nodl_files()
         self._exported: Exported | None = None
         self._report_deps: list[str] | None = None
 
@@ -233,6 +238,14 @@ class TaskTable:
                 "targets": [self.at("artifacts/ros/grounding.json"), self.at("artifacts/ros/graph.json")],
                 "task_dep": ["check"], "verbosity": 2, "clean": True}
 
+    def task_nodl(self) -> DoitTask:
+        """Check the NoDL documents of nodl/ against the contracts and each other (docs/nodl.md)."""
+        # every file under nodl/: a document's includes in sub-folders are read too
+        return {"actions": [(act_nodl, [self.r])],
+                "file_dep": [str(self.rootp / self.plan_file)] + list(self.snap.values()) + self.nodl_files,
+                "targets": [self.at(NODL_INDEX)], "uptodate": [self.code, self.sealed], "task_dep": ["check"],
+                "verbosity": 2, "clean": True}
+
     @create_after(executed="evidence")
     def task_diagnosis(self) -> DoitTask:
         """Explain every problem of the report, repairs checked by Z3, as a sealed record the report reads
@@ -270,7 +283,7 @@ class TaskTable:
         # rest, since the report and crosscheck (created after the evidence) are otherwise the only tasks
         # that reach them, which made them start after the evidence instead of beside it
         before = ([f"node:{n}" for n in self.nodes] + [f"health:{n}" for n in self.nodes] + ["requirements"]
-                  + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"] + (["ground"] if self.ros_section else []) + ["diagnosis"])
+                  + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"] + (["ground"] if self.ros_section else []) + (["nodl"] if self.nodl_files else []) + ["diagnosis"])
         ok = self.ok
         return {"actions": [(act_verify, [self.r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(self.rootp / REPORTS[2])] if ok else [],
@@ -281,7 +294,7 @@ class TaskTable:
     def creators(self) -> dict[str, Callable[[], Any]]:
         """The ``task_*`` creators of this run, by the names a ``dodo.py`` gives them: ``check`` and
         ``verify`` always; the rest when the workspace loaded (``ground`` with a ``ros:`` section,
-        ``deadlines`` with an end-to-end deadline)."""
+        ``deadlines`` with an end-to-end deadline, ``nodl`` with a NoDL document in nodl/)."""
         creators: dict[str, Callable[[], Any]] = {"task_check": self.task_check, "task_verify": self.task_verify}
         if self.ok:
             creators.update({"task_graph": self.task_graph, "task_node": self.task_node, "task_health": self.task_health,
@@ -292,6 +305,8 @@ class TaskTable:
                 creators["task_ground"] = self.task_ground
             if self.deadline_nodes:
                 creators["task_deadlines"] = self.task_deadlines
+            if self.nodl_files:
+                creators["task_nodl"] = self.task_nodl
         return creators
 
     def exported(self) -> Exported:
@@ -304,6 +319,15 @@ class TaskTable:
                 out.extend((n, o) for o in records or [])
             self._exported = out
         return self._exported
+
+    def _nodl_files(self) -> list[str]:
+        """Every file under nodl/ when a NoDL document lies directly in it (stages/nodl.py: the
+        discovery rule of ``rclverify nodl check``), else none: the NoDL task's file dependencies."""
+        folder = self.rootp / NODL_FOLDER
+        if not self.ok or not folder.is_dir() \
+                or not any(p.is_file() and p.name.endswith(NODL_SUFFIXES) for p in folder.iterdir()):
+            return []
+        return sorted(str(p) for p in folder.rglob("*") if p.is_file())
 
     def _requirement_inputs(self) -> list[str]:
         """The files besides the plan, model and snapshots that the requirements read: the Doorstop
@@ -353,5 +377,7 @@ class TaskTable:
             deps.append(at("artifacts/ros/grounding.json"))
         if self.deadline_nodes:
             deps.append(at(DEADLINES_INDEX))  # the deadlines task's target
+        if self.nodl_files:
+            deps.append(at(NODL_INDEX))  # the NoDL task's target
         deps.append(at(CROSSCHECK_INDEX))  # the second solver's verdicts
         return deps

@@ -24,6 +24,9 @@ Stages and their real file dependencies, per node ``N``:
 ``deadlines``      plan + model + snapshots of the nodes between a deadline's ends ->
                    artifacts/deadlines/index.json (rule D3, every end-to-end deadline;
                    only when the plan has one)
+``nodl``           plan + contract snapshots + the NoDL documents under nodl/ ->
+                   artifacts/nodl/index.json (the documents against the contracts and
+                   each other, docs/nodl.md; only when nodl/ holds a document)
 ``diagnosis``      every artifact the report reads -> artifacts/diagnosis/index.json (each
                    problem of the report explained, repairs checked by Z3; sealed with the
                    digest of the report dict it explains: stages/diagnoses.py)

@@ -31,7 +31,8 @@ from rclverify.records.store import SEAL, _sealed_text, atomic_write_text, seal_
 
 #: Workspace-relative directories and files whose JSON records are sealed (:func:`is_sealed_path`).
 SEALED_DIRS = ("artifacts/requirements/", "artifacts/health/", "artifacts/calculus/", "artifacts/provenance/",
-               "artifacts/obligations/", "artifacts/deadlines/", "artifacts/crosscheck/", "artifacts/diagnosis/")
+               "artifacts/obligations/", "artifacts/deadlines/", "artifacts/crosscheck/", "artifacts/diagnosis/",
+               "artifacts/nodl/")
 SEALED_FILES = ("artifacts/check/diagnostics.json", "artifacts/report/summary.json", "artifacts/ros/grounding.json",
                 "artifacts/check/index.json")
 

@@ -10,6 +10,7 @@ while any of its evidence is failed, pending, stale or missing:
 * requirement: worst of the guarantees that support it and of the side
   conditions of their nodes, with its Z3 check's verdict and its deadline
   (report/requirement_rows.py, report/deadlines.py);
+* the NoDL documents' check: report/nodl.py (its errors fail ``--strict``);
 * the summary and the ``--strict`` gate: report/summary_rows.py.
 
 Each pass returns its part and changes nothing it was given; the parts
@@ -37,6 +38,7 @@ from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as de
 from rclverify.report.evidence_rows import evidence_part
 from rclverify.report.expected import expected_rows
 from rclverify.report.finding_rows import acknowledged_rows, finding_rows, grounding_row, lint_rows
+from rclverify.report.nodl import blocks_strict as nodl_blocks, nodl_problems, nodl_row
 from rclverify.report.problems import group_problems
 from rclverify.report.records import inputs_sha256, node_obligations
 from rclverify.report.requirement_rows import requirement_rows
@@ -121,7 +123,7 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
             "obligations": ev["obligations"], "evidence": ev["evidence"],
             "environment_assumptions": [e for n in names for e in comps[n].get("environment_assumptions", [])],
             "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
-            "grounding": grounding_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
+            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
             "deadlines": deadlines, "acknowledgements": acknowledgements}, Facts(
         nodes["status"], ev["altered"], checks, ev["inputs"], deadlines_ok(deadlines),
         lambda: all(g_status(name, k) == "discharged" for name, cn in ws.checked.nodes.items()
@@ -134,8 +136,9 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
     counts = status_counts(rows["obligations"])
     overall = worst([r["status"] for r in rows["requirements"]] + list(node_status.values())
                     + [d["status"] for d in rows["derived_properties"]])
-    strict_ok = strict_gate(rows, facts.guarantees_discharged, facts.deadlines_ok, rows["grounding"])
-    problems = problem_sentences(rows, facts.altered) + grounding_problems(rows["grounding"])
+    strict_ok = strict_gate(rows, facts.guarantees_discharged, facts.deadlines_ok, rows["grounding"]) \
+        and not nodl_blocks(rows["nodl"])
+    problems = problem_sentences(rows, facts.altered) + grounding_problems(rows["grounding"]) + nodl_problems(rows["nodl"])
     plan = ws.plan
     return {
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name,

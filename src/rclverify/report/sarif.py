@@ -36,7 +36,7 @@ from typing import Mapping, Sequence
 
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
-from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, FindingRow, LintRow, Report
+from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, FindingJson, LintRow, Report
 from rclverify.report.severity import of
 from rclverify.records.sarif import sarif_fix
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
@@ -303,7 +303,7 @@ def _requirement_results(report: Report) -> list[SarifResult]:
     return out
 
 
-def _finding_location(report: Report, f: FindingRow) -> str:
+def _finding_location(report: Report, f: FindingJson) -> str:
     for n in report["nodes"]:
         if n["name"] == f["node"]:
             for g in n["guarantees"]:
@@ -334,7 +334,7 @@ def _finding_results(report: Report) -> list[SarifResult]:
     return out
 
 
-def _suppressed(res: SarifResult, row: FindingRow | LintRow) -> SarifResult:
+def _suppressed(res: SarifResult, row: FindingJson | LintRow) -> SarifResult:
     """``res`` with a SARIF ``suppressions`` entry (kind ``external``, status
     ``accepted``, the reason as ``justification``, SARIF 2.1.0 section
     3.35) when the plan acknowledges the warning ``row`` (model/plan/acknowledged.py)."""
@@ -467,10 +467,13 @@ def sarif_log(report: Report) -> SarifLog:
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
     from rclverify.report.deadlines import SARIF_RULES, sarif_results  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
+    from rclverify.report import nodl  # deferred: start-up (loads rclverify.report.nodl only when called)
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
+               + nodl.sarif_results(report, _result, _location)
                + _requirement_results(report) + sarif_results(report, _result) + _acknowledgement_results(report))
     _attach_diagnoses(report, results)
-    rules: Sequence[Rule] = list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + lint_rules + ground_rules
+    rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
+                             + lint_rules + ground_rules)
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:
         res["ruleIndex"] = index[res["ruleId"]]

@@ -23,7 +23,9 @@ items of severity ``error`` or ``warning`` (the ``-Werror`` reading of a
 strict mode: a warning is not a pass), and names them
 (:func:`blocking`).  ROS grounding findings keep the rule of docs/ros.md:
 their errors fail ``--strict``, their warnings (software the contracts
-need not describe: a graph node without a contract) do not.
+need not describe: a graph node without a contract) do not; NoDL findings
+likewise (report/nodl.py: an endpoint a document declares and the contract
+does not constrain is a warning).
 
 Kinds: ``obligation``, ``guarantee`` (one no obligation covers),
 ``side-condition``, ``health``, ``requirement`` (by verdict), ``deadline``
@@ -133,7 +135,8 @@ def acknowledged(report: Mapping[str, Any]) -> set[tuple[str, str]]:
 def blocking(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
     """The findings that fail ``--strict`` (severity ``error`` or
     ``warning``), as :func:`items` gives them, plus the ROS grounding
-    errors (``("grounding", code, "error", "error")``) and a stale grounding."""
+    errors (``("grounding", code, "error", "error")``) and a stale grounding, and likewise the NoDL
+    errors (``("nodl", code, "error", "error")``) and a stale or altered NoDL record."""
     answered = acknowledged(report)
     out = [x for x in items(report) if gates(x[3]) and not (x[3] == WARNING and (x[0], x[1]) in answered)]
     g = report.get("grounding")
@@ -143,4 +146,10 @@ def blocking(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
                 out.append(("grounding", str(f.get("code", "")), "error", ERROR))
         if g.get("stale"):
             out.append(("grounding", "stale", "stale", WARNING))
+    nodl = report.get("nodl")
+    if isinstance(nodl, Mapping):
+        out += [("nodl", str(f.get("code", "")), "error", ERROR) for f in nodl.get("findings") or ()
+                if f.get("severity") == "error"]
+        if nodl.get("stale"):
+            out.append(("nodl", "stale", "stale", WARNING))
     return out

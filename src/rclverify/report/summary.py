@@ -14,7 +14,7 @@ from typing import IO, TYPE_CHECKING, Any, Literal, Mapping, Sequence, TypeGuard
 
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
-from rclverify.records.report_schema import (FindingRow, ObligationRow, Report, SideConditionRow,
+from rclverify.records.report_schema import (FindingJson, ObligationRow, Report, SideConditionRow,
                                              UnverifiedRow)
 from rclverify.report.shapes import GroundingBrief, NodeSummaryRow, SummaryData
 from rclverify.records.records import SEVERITY
@@ -23,7 +23,7 @@ from rclverify.records.records import SEVERITY
 MAX_ROWS = 15
 
 #: A report row that names its node (an obligation, side condition, health finding, unverified guarantee).
-_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingRow, UnverifiedRow)
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingJson, UnverifiedRow)
 
 #: The counts of a node's summary row that a merged row sums.
 _Count = Literal["sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"]
@@ -184,7 +184,7 @@ def strict_reasons(report: Report) -> list[str]:
     guarantees no obligation covers, side conditions not proved, health
     checks with a problem or undecided, health and lint warnings (one
     severity per finding, :mod:`.severity`), formal requirements not met,
-    ROS grounding errors (the gate of
+    ROS grounding errors, NoDL errors (the gate of
     :func:`rclverify.report.build.build_report`)."""
     if report["meta"]["strict_ok"]:
         return []
@@ -230,6 +230,8 @@ def strict_reasons(report: Report) -> list[str]:
     g = _grounding(report.get("grounding"))
     if g and g["error"]:
         out.append(f"{g['error']} ROS grounding error{'s' if g['error'] != 1 else ''} (`rclverify ros check`)")
+    from rclverify.report.nodl import strict_reason as nodl_reason  # deferred: start-up (loads rclverify.report.nodl only when --strict failed)
+    out += nodl_reason(report)  # NoDL errors, a stale NoDL check
     return out
 
 

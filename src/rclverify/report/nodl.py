@@ -1,0 +1,95 @@
+"""The NoDL documents in the report (docs/nodl.md, "In the report").
+
+The ``nodl`` stage (:mod:`rclverify.stages.nodl`) checks a workspace's NoDL
+documents against its contracts and each other; here its sealed record
+becomes the report's ``nodl`` (``null`` when the workspace has no document),
+its problems, the ``--strict`` clause and the SARIF results.  NoDL findings
+keep the rule of the ROS grounding (docs/ros.md; report/severity.py): they
+change no proof's verdict; an error, a stale record or an altered one fails
+``--strict``; a warning (an endpoint the contract does not constrain, a part
+no document includes) is shown and does not.
+
+Each finding is located at every place it involves (the contract's entry and
+the document's, or the two documents of a topic's writer and reader): in
+SARIF the first is the result's location and the others its related
+locations, so a code-scanning view marks both files' lines.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping, cast
+
+from rclverify.records.report_schema import NodlRow, Report
+from rclverify.records.sarif import SarifLocation, SarifResult
+from rclverify.stages.workspace import Workspace
+
+#: SARIF rule of every NoDL finding: ``(id, name, level, text)`` (report/sarif.py ``Rule``).
+SARIF_RULES = (
+    ("RCL-NODL", "NodlFinding", "error",
+     "A NoDL document disagrees with its node's contract or with a connected node's document: a missing, extra "
+     "or differently typed endpoint, incompatible QoS, a parameter outside its declared constraints "
+     "(docs/nodl.md; the finding's code names which)."),
+)
+
+
+def nodl_row(ws: Workspace) -> NodlRow | None:
+    """The report's ``nodl``: the stage's record as :func:`rclverify.stages.nodl.read_nodl` reads
+    it (stale or altered said), ``None`` when the workspace has no NoDL document."""
+    from rclverify.stages.nodl import read_nodl  # deferred: start-up (loads jsonschema and yaml only when called)
+    return cast(NodlRow | None, read_nodl(ws))
+
+
+def _where(place: Mapping[str, Any]) -> str:
+    return f"{place['file']}:{place['line']}:{place['col']}"
+
+
+def nodl_problems(row: Mapping[str, Any] | None) -> list[str]:
+    """The report's problem sentences of ``row``: a stale or altered record, each NoDL error."""
+    if row is None:
+        return []
+    out = [f"NoDL check is stale: {row['stale']}"] if row.get("stale") else []
+    for f in row["findings"]:
+        if f["severity"] == "error":
+            at = f" at {', '.join(_where(p) for p in f['places'])}" if f["places"] else ""
+            out.append(f"NoDL {f['code']}{at}: {f['message']}")
+    return out
+
+
+def blocks_strict(row: Mapping[str, Any] | None) -> bool:
+    """Whether ``row`` fails ``--strict``: a NoDL error, or a record stale or altered."""
+    return row is not None and bool(row["counts"].get("error") or row.get("stale"))
+
+
+def strict_reason(report: Report) -> list[str]:
+    """The clause ``verify --strict`` names for the NoDL check (``[]`` when it passes)."""
+    row = report.get("nodl")
+    if not blocks_strict(row):
+        return []
+    assert row is not None
+    n = int(row["counts"].get("error", 0))
+    out = [f"{n} NoDL error{'s' if n != 1 else ''} (`rclverify nodl check`)"] if n else []
+    return out + (["the NoDL check is stale"] if row.get("stale") else [])
+
+
+def sarif_results(report: Report, result: Callable[..., SarifResult],
+                  location: Callable[[str], list[SarifLocation]]) -> list[SarifResult]:
+    """One SARIF result per NoDL finding, at its first place, the others as related locations;
+    ``result(rule, level, text, where, key, props)`` and ``location(where)`` are report/sarif.py's."""
+    row = report.get("nodl")
+    if row is None:
+        return []
+    out = []
+    for k, f in enumerate(row["findings"]):
+        places = [_where(p) for p in f["places"]]
+        res = result("RCL-NODL", "error" if f["severity"] == "error" else "warning", f"{f['message']} [{f['code']}]",
+                     places[0] if places else "", f"nodl:{f['code']}:{':'.join(places)}:{k}", {"code": f["code"]})
+        related = [loc for p in places[1:] for loc in location(p)]
+        for i, loc in enumerate(related):
+            loc["id"] = i
+            loc["message"] = {"text": "the other place of this finding"}
+        if related:
+            res["relatedLocations"] = related
+        out.append(res)
+    return out
+
+
+__all__ = ["SARIF_RULES", "blocks_strict", "nodl_problems", "nodl_row", "sarif_results", "strict_reason"]
