@@ -49,8 +49,14 @@ import z3
 #: depend on the machine's load: a serial run, ``doit -n 2`` and a busy CI
 #: machine decide the same queries.
 STEPS_PER_MS = 2_000
-#: The wall-clock safety net, a multiple of a budget's time on an idle core.
-SAFETY_FACTOR = 10
+#: The wall-clock safety net, a multiple of a budget's time on an idle core:
+#: far above it, so that on a loaded machine the budget of steps, which gives
+#: the same answer everywhere, runs out first.  A query whose steps are slow
+#: (3 s of an idle core for a 2,000 ms budget: quantifier elimination over a
+#: sequence's items) given a tenth of a core by the load takes 30 s, past a
+#: net of ten times its budget; at a hundred times the process would need
+#: less than a hundredth of a core for the net to fire.
+SAFETY_FACTOR = 100
 #: The shortest net (ms): a smaller one fires on the cost of starting a check
 #: (a first look of a few steps takes a millisecond), not on the search.
 MIN_WALL_MS = 1_000

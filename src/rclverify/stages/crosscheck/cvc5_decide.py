@@ -41,8 +41,12 @@ from rclverify.records.stage_records import Cvc5Answer
 #: cvc5 resource units per check: some 150k units a second on the case
 #: study's heaviest quantified query, so about 10 s of work, the Z3 budget.
 RLIMIT = 1_500_000
-#: Wall-clock safety net per check, in milliseconds.
-WALL_MS = 60_000
+#: Wall-clock safety net per check, in milliseconds: some sixty times the
+#: budget's time on an idle core, so that on a loaded machine the budget
+#: (which answers ``unknown (RESOURCEOUT)`` the same everywhere) runs out
+#: first; when the net fires cvc5 answers ``unknown (TIMEOUT)``, never
+#: another verdict.
+WALL_MS = 600_000
 
 
 @dataclass(frozen=True)
