@@ -101,6 +101,25 @@ def test_an_endpoint_seen_publishing_metadata_is_not_judged(metadata: bool) -> N
     assert replay(_book([]), lines) == summary
 
 
+@pytest.mark.parametrize("heard", [False, True])
+def test_a_link_heard_only_at_metadata_level_says_what_was_heard(heard: bool) -> None:
+    from rclverify.runtime.dds.introspection import event_struct
+    taps, types = _taps([], {"/s"}, {"/a", "/b"})
+    ev = event_struct(types, "std_srvs/SetBool")
+    if heard:  # every endpoint publishes its events without contents: three of them heard
+        for k, (writer, kind) in enumerate([(b"\x0a" * 16, 0), (b"\x0b" * 16, 0), (b"\x05" * 16, 1)]):
+            s = types.build(ev, {"info": {"event_type": kind, "client_gid": list(b"\x0a" * 16), "sequence_number": 1}})
+            taps.handle("call:/estop:event", s.serialize(), 20.0 + k / 10, 20.0 + k / 10, writer)
+    taps.tick(22.0)  # the samples are taken
+    said = taps.unheard()["/estop"]
+    if heard:
+        assert said.startswith("3 introspection event(s) of it were heard (/estop/_service_event), all at metadata "
+                               "level: their request and response contents are not introspected"), said
+        assert "CONTENTS" in said and "none of its calls was heard" not in said
+    else:  # the control: nothing heard at all is said as such
+        assert said.startswith("no introspection event of its server or of every client was heard"), said
+
+
 @pytest.mark.parametrize("both", [False, True])
 def test_the_dds_source_takes_a_side_only_when_every_server_publishes(both: bool) -> None:
     """Two servers of /estop on the DDS source: with one publishing events, the request and reply topics

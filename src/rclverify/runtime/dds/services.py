@@ -129,6 +129,10 @@ class CallTaps:
         self.sided: set[str] = set()  # the links some of whose calls an introspection side paired
         #: (link, endpoint owner) -> "metadata": an endpoint seen publishing events without contents
         self._levels: dict[tuple[str, str], str] = {}
+        #: link -> introspection events heard of it without a request or response (metadata level)
+        self.metadata_events: dict[str, int] = {}
+        #: link -> introspection events heard of it with their request or response (contents level)
+        self.content_events: dict[str, int] = {}
         #: (link, endpoint, why) -> since when (s) the endpoint has been unheard with contents
         self._uncovered: dict[tuple[str, str, str], float] = {}
         #: link -> endpoint -> why, the endpoints said not judged (events only; the book has them too)
@@ -274,23 +278,38 @@ class CallTaps:
     def unheard(self) -> dict[str, str]:
         """Events only (module docstring): each link (``/s``) with what the
         run could not hear of it: no introspection event of its server or of
-        every client (none of its calls), and each endpoint said not judged
+        every client (none of its calls), or only events at metadata level
+        (counted: heard, but without a request or response to judge), and each endpoint said not judged
         (:meth:`_coverage`: its calls not all heard with contents); ``{}`` on
         the DDS source."""
         if not self.events:
             return {}
         out = {}
         for name, kind in sorted(self.kinds.items()):
-            said = [] if name in self.sided else [
-                f"no introspection event of its server or of every client was heard "
-                f"({name}{EVENT_SUFFIX}): none of its calls was heard" if kind == "service" else
-                f"no introspection event of its own services was heard ({name}{ACTION_INFIX}send_goal"
-                f"{EVENT_SUFFIX}, get_result's, cancel_goal's): none of its goals or results was heard "
-                "(its feedback and status topics are)"]
+            metadata_only = self.metadata_events.get(name, 0) > 0 and not self.content_events.get(name)
+            said = [] if name in self.sided and not metadata_only else [self._silence(name, kind)]
             said += list(self.unjudged.get(name, {}).values())
             if said:
                 out[name] = "; ".join(said)
         return out
+
+    def _silence(self, name: str, kind: str) -> str:
+        """Why no call of link ``name`` (a ``service`` or an action) was paired: no introspection event
+        was heard of it, or only events at metadata level (counted), which carry no request or response."""
+        topics = (f"{name}{EVENT_SUFFIX}" if kind == "service" else
+                  f"{name}{ACTION_INFIX}send_goal{EVENT_SUFFIX}, get_result's, cancel_goal's")
+        calls = "calls" if kind == "service" else "goals or results"
+        n = self.metadata_events.get(name, 0)
+        if n:
+            return (f"{n} introspection event(s) of it were heard ({topics}), all at metadata level: their "
+                    f"request and response contents are not introspected, so none of its {calls} could be "
+                    "judged; configure its server's (or every client's) introspection with CONTENTS "
+                    "(ServiceIntrospectionState.CONTENTS; docs/ros2.md, \"Enabling service introspection\")")
+        if kind == "service":
+            return (f"no introspection event of its server or of every client was heard ({topics}): none of its "
+                    "calls was heard")
+        return (f"no introspection event of its own services was heard ({topics}): none of its goals or results "
+                "was heard (its feedback and status topics are)")
 
     # -- endpoints -------------------------------------------------------------------------------
     def _owner(self, guid: bytes) -> str:
@@ -301,6 +320,8 @@ class CallTaps:
         """Note an event without the request or response it is about: its endpoint publishes metadata only."""
         kind = int(s.info.event_type)
         body = s.request if kind in (SIDES["server"][0], SIDES["client"][0]) else s.response
+        counts = self.content_events if body else self.metadata_events
+        counts[name] = counts.get(name, 0) + 1
         if writer is not None and not body:
             self._levels[(name, self._owner(writer))] = "metadata"
 
