@@ -15,12 +15,16 @@ Where the workspace's message definitions tell what an input's field carries
   (the harness then narrows each value to the field's width, and the
   thresholds are drawn at that width), a ``float32`` one within binary32's
   finite range;
-* a sequence: items each drawn as above (a sequence of tuples: one tuple per
-  item, each component at its own field's type), lengths within the bound:
-  exactly ``N`` for a fixed array ``T[N]``, ``0 .. N`` for ``T[<=N]`` with
-  the empty sequence and ``N`` items drawn as edges, ``0`` to
-  :data:`.strategies.POOL_SIZE` for an unbounded one; beyond
-  :data:`MAX_DRAWN_ITEMS` items, the rest repeat one drawn item.
+* a sequence: items each drawn as above within the sequence's bound (the
+  assumption's ``forall(q in in.s | lo <= q and q <= hi)``, the plan's
+  ``bounds`` of ``in.s``: :func:`.strategies.assumption_bounds`), with its
+  ends as edges (a sequence of tuples: one tuple per item, each component
+  at its own field's type, unbounded), lengths within the bound: exactly
+  ``N`` for a fixed array ``T[N]``, ``m .. N`` for ``T[<=N]`` with ``m``
+  and ``N`` items drawn as edges, ``m`` to :data:`.strategies.POOL_SIZE`
+  for an unbounded one (``m``: 1 under the assumption's
+  ``exists(q in in.s | ...)``, else 0); beyond :data:`MAX_DRAWN_ITEMS`
+  items, the rest repeat one drawn item.
 """
 from __future__ import annotations
 
@@ -98,13 +102,20 @@ def carried_value(space: InputSpace, t: T.Type, bd: Bound | None, c: Carried) ->
         out = scalar_at(space, t, bd, c.items[0])
     elif isinstance(t, T.SeqT):
         elems = t.elem.elems if isinstance(t.elem, T.TupleT) else (t.elem,)
-        parts = [scalar_at(space, e, None, w) for e, w in zip(elems, c.items)]
-        item = st.tuples(*parts) if isinstance(t.elem, T.TupleT) else parts[0]
+        if isinstance(t.elem, T.TupleT):  # no bound reaches a tuple's components
+            item = st.tuples(*[scalar_at(space, e, None, w) for e, w in zip(elems, c.items)])
+        else:  # the sequence's bound is its items' (strategies.assumption_bounds, the plan's bounds)
+            item = scalar_at(space, t.elem, bd, c.items[0])
+        least = bd.min_len if bd is not None else 0
         if c.max_len is None:
-            out = st.lists(item, max_size=POOL_SIZE).map(tuple)
+            out = st.lists(item, min_size=least, max_size=max(POOL_SIZE, least)).map(tuple)
+        elif c.fixed:
+            out = _items(item, c.max_len) if c.max_len >= least else st.nothing()
+        elif c.max_len < least:
+            out = st.nothing()
         else:
             n = c.max_len
-            sizes = st.just(n) if c.fixed else st.one_of(st.sampled_from(sorted({0, n})), st.integers(0, n))
+            sizes = st.one_of(st.sampled_from(sorted({least, n})), st.integers(least, n))
             out = sizes.flatmap(lambda k: _items(item, k))
     else:
         out = space.value(t, bd)

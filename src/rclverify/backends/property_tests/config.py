@@ -3,7 +3,9 @@ implementation imported from it (docs/property-tests.md, "The plan entry").
 
 ``{backend: property_tests, implementation: file.py:callable, seed, steps,
 max_examples, deadline_ms, bounds, timeout_s}`` becomes a :class:`Config`
-(:func:`read_config`); :func:`load_implementation` imports the named
+(:func:`read_config`; ``bounds: {in.x: [lo, hi]}`` of a numeric input
+bounds it, of a sequence of numbers each of its items, docs/property-tests.md,
+"Sequences"); :func:`load_implementation` imports the named
 callable afresh.  A bad entry is a :class:`ConfigError` carrying the key
 path inside the entry, which the backend turns into a located message.
 """
@@ -17,6 +19,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, Mapping
 
+from rclverify.lang import types as T
 from rclverify.lang.types import CheckedNode
 
 DEFAULT_MAX_EXAMPLES = 200
@@ -57,6 +60,12 @@ def _positive(raw: Mapping[str, object], key: str, default: int) -> int:
     return v
 
 
+def _boundable(t: T.Type) -> bool:
+    """A type the plan's ``bounds`` apply to: a number, or a sequence of numbers (its items)."""
+    item = t.elem if isinstance(t, T.SeqT) else t
+    return isinstance(item, T.Scalar) and item.name in ("REAL", "INTEGER", "NATURAL")
+
+
 def read_config(raw: Mapping[str, object], node: CheckedNode, root: Path) -> Config:
     """Validate a plan entry.  Raises :class:`ConfigError` (with the key path)."""
     impl = raw.get("implementation")
@@ -79,6 +88,9 @@ def read_config(raw: Mapping[str, object], node: CheckedNode, root: Path) -> Con
         name = str(k).removeprefix("in.")
         if name not in node.inputs:
             raise ConfigError(f"{k!r} is not an input of {node.name} ({', '.join(node.inputs)})", "bounds", k)
+        if not _boundable(node.inputs[name]):
+            raise ConfigError(f"bounds of {k}: {node.inputs[name]} has no numbers to bound (bounds apply to a "
+                              f"REAL, INTEGER or NATURAL input, and to the items of a sequence of them)", "bounds", k)
         if (not isinstance(v, list) or len(v) != 2
                 or any(x is not None and (isinstance(x, bool) or not isinstance(x, (int, float))) for x in v)):
             raise ConfigError(f"bounds of {k} must be [lo, hi] (numbers or null)", "bounds", k)

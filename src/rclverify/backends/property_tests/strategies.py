@@ -6,6 +6,16 @@ constrained by the node's assumption (docs/property-tests.md, "Strategies").
   named constants of the context) bounds
   a numeric input; ``in.e in {v1, v2}`` restricts an enumeration input.  The
   plan's ``bounds: {in.x: [lo, hi]}`` narrows further (either end may be null).
+* Sequence items by construction: a top-level ``forall(q in in.s | body)``
+  bounds every item of the sequence input ``s`` by ``body``'s top-level
+  conjuncts of the forms above over ``q``, and the plan's ``bounds`` of
+  ``in.s`` bound its items too; the items are drawn within those bounds
+  (:meth:`InputSpace.item`), not filtered into them.  A top-level
+  ``exists(q in in.s | ...)`` makes ``s`` drawn with at least one item.
+* Bound ends: each end of an input's (or its items') bounds is drawn as a
+  boundary value with its neighbour inside (a decimal end that is no double
+  is met by the nearest double inside it, so a drawn value never breaks the
+  bound as an exact rational).
 * Boundary values: the numeric literals of the node's contract, the values
   of the context constants it names and the numbers its implementation
   compares with (:mod:`.constants`), each with its neighbours (one ulp
@@ -46,13 +56,16 @@ _EDITS = st.integers(min_value=0, max_value=MAX_EDITS)
 
 @dataclass
 class Bound:
-    """Closed/open numeric bounds of one input (``None``: unbounded)."""
+    """Closed/open numeric bounds of one input (``None``: unbounded); of a sequence input, the bounds of
+    each of its items."""
 
     lo: Fraction | None = None
     hi: Fraction | None = None
     lo_strict: bool = False
     hi_strict: bool = False
     enum: frozenset[str] | None = None
+    #: the least number of items of a sequence input (1 under a top-level ``exists(q in in.s | ...)``)
+    min_len: int = 0
 
     def lower(self, v: Fraction, strict: bool) -> None:
         if self.lo is None or v > self.lo or (v == self.lo and strict):
@@ -61,6 +74,14 @@ class Bound:
     def upper(self, v: Fraction, strict: bool) -> None:
         if self.hi is None or v < self.hi or (v == self.hi and strict):
             self.hi, self.hi_strict = v, strict
+
+
+def _double_inside(v: Fraction, towards: float) -> float:
+    """The double nearest ``v`` on the side of ``towards`` (``math.inf``: at or above ``v``)."""
+    f = float(v)
+    if (Fraction(f) < v) if towards > 0 else (Fraction(f) > v):
+        f = math.nextafter(f, towards)
+    return f
 
 
 def _num(e: ast.Expr, named: Mapping[str, Fraction] | None = None) -> Fraction | None:
@@ -79,11 +100,6 @@ def _input(e: ast.Expr, node: CheckedNode) -> str | None:
     if isinstance(e, ast.Var) and e.prefix in (None, "in") and e.name in node.inputs:
         return e.name
     return None
-
-
-def _abs_input(e: ast.Expr, node: CheckedNode) -> str | None:
-    """The input ``x`` of a term ``abs(in.x)``, else ``None``."""
-    return _input(e.operand, node) if isinstance(e, ast.Unary) and e.op == "abs" else None
 
 
 def _abs_bound(out: dict[str, Bound], op: str, name: str | None, v: Fraction | None) -> None:
@@ -111,35 +127,97 @@ def _converse(op: str) -> str:
     return str(OPERATORS[op].converse)
 
 
+def _compare_bounds(out: dict[str, Bound], c: ast.Compare, who: Callable[[ast.Expr], str | None],
+                    named: Mapping[str, Fraction] | None) -> None:
+    """The bounds ``c`` (a chain ``a op b op ...``) puts on the variables ``who`` names (``who``: an
+    operand -> the input it bounds, else ``None``), against numeric literals and the constants of ``named``."""
+    for cop, a, b in zip(c.ops, c.operands, c.operands[1:]):
+        op: str = cop
+        name, v = who(a), _num(b, named)
+        if name is None:
+            name, v, op = who(b), _num(a, named), _converse(cop)
+        if name is None:  # abs(x) <= c: -c <= x <= c
+            _abs_bound(out, cop, _abs_of(a, who), _num(b, named))
+            _abs_bound(out, _converse(cop), _abs_of(b, who), _num(a, named))
+        if name is None or v is None:
+            continue
+        bd = out.setdefault(name, Bound())
+        if op in (">", ">=", "=="):
+            bd.lower(v, op == ">")
+        if op in ("<", "<=", "=="):
+            bd.upper(v, op == "<")
+
+
+def _abs_of(e: ast.Expr, who: Callable[[ast.Expr], str | None]) -> str | None:
+    """The input ``who`` names in a term ``abs(x)``, else ``None``."""
+    return who(e.operand) if isinstance(e, ast.Unary) and e.op == "abs" else None
+
+
+def _member_bound(out: dict[str, Bound], c: ast.Member, name: str | None, t: Type | None) -> None:
+    """``x in {v1, v2}`` of an enumeration ``x`` (of type ``t``): ``x``'s values narrowed to those named."""
+    if name is not None and isinstance(t, EnumT) and not c.negated and isinstance(c.collection, ast.SetLit):
+        vals = frozenset(i.name for i in c.collection.items if isinstance(i, ast.Var))
+        bd = out.setdefault(name, Bound())
+        bd.enum = vals if bd.enum is None else bd.enum & vals
+
+
+def _seq_input(q: ast.Expr, node: CheckedNode) -> tuple[str, str, Type] | None:
+    """``(input, bound name, item type)`` of a quantifier ``forall(x in in.s | ...)`` over one input
+    sequence ``s`` of scalars or enumeration values, else ``None``."""
+    if not isinstance(q, ast.Quant) or len(q.bindings) != 1 or len(q.bindings[0].names) != 1:
+        return None
+    dom = q.bindings[0].domain
+    name = _input(dom, node) if isinstance(dom, ast.Var) else None
+    t = node.inputs.get(name) if name is not None else None
+    if name is None or not isinstance(t, SeqT) or not isinstance(t.elem, (Scalar, EnumT)):
+        return None
+    return name, q.bindings[0].names[0], t.elem
+
+
+def _item_bounds(out: dict[str, Bound], q: ast.Quant, node: CheckedNode,
+                 named: Mapping[str, Fraction] | None) -> None:
+    """A top-level ``forall(x in in.s | body)``: the top-level conjuncts of ``body`` comparing ``x``
+    with constants bound every item of ``s``; ``exists(x in in.s | ...)``: ``s`` has an item."""
+    found = _seq_input(q, node)
+    if found is None:
+        return
+    name, var, elem = found
+    if q.kind != "forall":
+        bd = out.setdefault(name, Bound())
+        bd.min_len = max(bd.min_len, 1)
+        return
+
+    def who(e: ast.Expr) -> str | None:
+        return name if isinstance(e, ast.Var) and e.prefix is None and e.name == var else None
+
+    for c in conjuncts(q.body):
+        if isinstance(c, ast.Compare):
+            _compare_bounds(out, c, who, named)
+        elif isinstance(c, ast.Member):
+            _member_bound(out, c, who(c.elem), elem)
+
+
 def assumption_bounds(node: CheckedNode, named: Mapping[str, Fraction] | None = None) -> dict[str, Bound]:
     """Bounds per input name found in the assumption's top-level conjuncts
     (against numeric literals, and against the context constants of
-    ``named``, name -> value: ``in.x <= MaxRange``)."""
+    ``named``, name -> value: ``in.x <= MaxRange``).  The bound of a
+    sequence input is the bound of each of its items, from a top-level
+    ``forall(q in in.s | lo <= q and q <= hi)``; a top-level
+    ``exists(q in in.s | ...)`` gives it at least one item (:attr:`Bound.min_len`)."""
     out: dict[str, Bound] = {}
+
+    def who(e: ast.Expr) -> str | None:
+        return _input(e, node)
+
     for clause in node.node.assumes:
         for c in conjuncts(clause.formula):
             if isinstance(c, ast.Compare):
-                for cop, a, b in zip(c.ops, c.operands, c.operands[1:]):
-                    op: str = cop
-                    name, v = _input(a, node), _num(b, named)
-                    if name is None:
-                        name, v, op = _input(b, node), _num(a, named), _converse(cop)
-                    if name is None:  # abs(in.x) <= c: -c <= x <= c
-                        _abs_bound(out, cop, _abs_input(a, node), _num(b, named))
-                        _abs_bound(out, _converse(cop), _abs_input(b, node), _num(a, named))
-                    if name is None or v is None:
-                        continue
-                    bd = out.setdefault(name, Bound())
-                    if op in (">", ">=", "=="):
-                        bd.lower(v, op == ">")
-                    if op in ("<", "<=", "=="):
-                        bd.upper(v, op == "<")
-            elif isinstance(c, ast.Member) and not c.negated and isinstance(c.collection, ast.SetLit):
+                _compare_bounds(out, c, who, named)
+            elif isinstance(c, ast.Member):
                 name = _input(c.elem, node)
-                if name is not None and isinstance(node.inputs[name], EnumT):
-                    vals = frozenset(i.name for i in c.collection.items if isinstance(i, ast.Var))
-                    bd = out.setdefault(name, Bound())
-                    bd.enum = vals if bd.enum is None else bd.enum & vals
+                _member_bound(out, c, name, node.inputs[name] if name is not None else None)
+            elif isinstance(c, ast.Quant):
+                _item_bounds(out, c, node, named)
     return out
 
 
@@ -179,32 +257,47 @@ class InputSpace:
     carried: dict[str, st.SearchStrategy[Any]] = field(default_factory=dict)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
-        lo = float(bd.lo) if bd and bd.lo is not None else (-1000.0 if small else None)
-        hi = float(bd.hi) if bd and bd.hi is not None else (1000.0 if small else None)
+        """Finite doubles within ``bd`` (``small``: within +-1000 where ``bd`` leaves a side open),
+        with the thresholds inside and each end ``bd`` gives and its neighbour inside as edges.  A
+        bound that is no double (``3.14``) is met by the nearest double inside it, so that every
+        drawn value satisfies it as an exact rational."""
+        lo = _double_inside(bd.lo, math.inf) if bd and bd.lo is not None else (-1000.0 if small else None)
+        hi = _double_inside(bd.hi, -math.inf) if bd and bd.hi is not None else (1000.0 if small else None)
+        no_lo = bool(bd and bd.lo is not None and lo is not None and bd.lo_strict and Fraction(lo) == bd.lo)
+        no_hi = bool(bd and bd.hi is not None and hi is not None and bd.hi_strict and Fraction(hi) == bd.hi)
         edges: set[float] = set()
         for c in self.constants:
             f = float(c)
             edges.update((f, math.nextafter(f, -math.inf), math.nextafter(f, math.inf)))
-        edges_in = sorted(e for e in edges if (lo is None or e >= lo) and (hi is None or e <= hi))
+        if bd is not None and bd.lo is not None and lo is not None:
+            edges.update((lo, math.nextafter(lo, math.inf)))
+        if bd is not None and bd.hi is not None and hi is not None:
+            edges.update((hi, math.nextafter(hi, -math.inf)))
+        edges_in = sorted(e for e in edges if (lo is None or e > lo or (e == lo and not no_lo))
+                          and (hi is None or e < hi or (e == hi and not no_hi)))
         floats = st.floats(min_value=lo, max_value=hi, allow_nan=False, allow_infinity=False,
-                           exclude_min=bool(bd and bd.lo_strict), exclude_max=bool(bd and bd.hi_strict))
+                           exclude_min=no_lo, exclude_max=no_hi)
         return st.one_of(st.sampled_from(edges_in), floats) if edges_in else floats
 
     def integer(self, bd: Bound | None, natural: bool, small: bool = False) -> st.SearchStrategy[int]:
+        """Integers within ``bd`` (``natural``: from 0; ``small``: a few values near 0, no edges), with
+        the integer thresholds' neighbours and the ends ``bd`` gives and their neighbours inside as edges."""
         lo = math.ceil(bd.lo) if bd and bd.lo is not None else None
         hi = math.floor(bd.hi) if bd and bd.hi is not None else None
         if lo is not None and bd is not None and bd.lo_strict and bd.lo == lo:
             lo += 1
         if hi is not None and bd is not None and bd.hi_strict and bd.hi == hi:
             hi -= 1
+        ends = {v + d for v, d in ((lo, 0), (lo, 1), (hi, 0), (hi, -1)) if v is not None}
         if natural:
             lo = 0 if lo is None else max(lo, 0)
         if small:
             lo = -SMALL_NAT if lo is None else lo
             hi = lo + 2 * SMALL_NAT if hi is None else hi
             hi = min(hi, SMALL_NAT) if lo <= SMALL_NAT else hi
-        edges = sorted({int(c) + d for c in self.constants if c.denominator == 1 for d in (-1, 0, 1)
-                        if (lo is None or int(c) + d >= lo) and (hi is None or int(c) + d <= hi)})
+        edges = sorted(e for e in {*(int(c) + d for c in self.constants if c.denominator == 1 for d in (-1, 0, 1)),
+                                   *ends}
+                       if (lo is None or e >= lo) and (hi is None or e <= hi))
         ints = st.integers(min_value=lo, max_value=hi)
         return st.one_of(st.sampled_from(edges), ints) if edges and not small else ints
 
@@ -238,12 +331,21 @@ class InputSpace:
         if isinstance(t, SetT):
             return st.frozensets(self.value(t.elem, small=True), max_size=POOL_SIZE)
         if isinstance(t, SeqT):
-            return st.lists(self.value(t.elem, small=True), max_size=POOL_SIZE).map(tuple)
+            least = bd.min_len if bd is not None else 0
+            return st.lists(self.item(t.elem, bd), min_size=least, max_size=max(POOL_SIZE, least)).map(tuple)
         if isinstance(t, FuncT):
             return self.function(t)
         if isinstance(t, EmptyT):
             return st.nothing()
         raise ValueError(f"no strategy for {t}")
+
+    def item(self, t: Type, bd: Bound | None) -> st.SearchStrategy[Any]:
+        """An item of type ``t`` of a sequence input whose items ``bd`` bounds: drawn within ``bd`` by
+        construction, with the bounds' ends and the thresholds as edges, as a scalar input with that
+        bound is; an item without a bound is drawn small (:meth:`value`)."""
+        if bd is not None and isinstance(t, (Scalar, EnumT)):
+            return self.value(t, bd)
+        return self.value(t, small=True)
 
     def function(self, t: FuncT) -> st.SearchStrategy[FiniteFunction]:
         @st.composite
@@ -417,7 +519,8 @@ def input_space(node: CheckedNode, plan_bounds: Mapping[str, tuple[Fraction | No
     varied per example, see :meth:`InputSpace.vary`); ``constants`` the
     thresholds drawn beside the contract's literals, each with its
     neighbours (the named constants and the code's, :mod:`.constants`);
-    ``named`` the context constants' values, which bound an input as literals do."""
+    ``named`` the context constants' values, which bound an input as literals do.  A plan bound of
+    a sequence input bounds its items."""
     bounds = assumption_bounds(node, named)
     for name, (lo, hi) in plan_bounds.items():
         bd = bounds.setdefault(name, Bound())
