@@ -21,7 +21,8 @@ BENCHES = sorted(p.name for p in (REPO / "bench").glob("*.py") if not p.name.sta
 #: the whole pipeline several times: run from tests/test_bench_smoke_live.py, so that pytest-xdist's
 #: one-file-per-worker distribution (--dist loadfile) gives the two halves to the two workers.
 HEAVY = ("monitor_live_dds.py", "monitor_live_rclpy.py", "monitor_live.py", "incremental_equivalence.py",
-         "verify_pacti.py", "diagnosis_scale.py", "pipeline_scale.py", "second_solver.py", "manipulator_live.py")
+         "verify_pacti.py", "diagnosis_scale.py", "pipeline_scale.py", "second_solver.py", "manipulator_live.py",
+         "verify_under_load.py")
 
 
 def test_there_are_benches() -> None:
