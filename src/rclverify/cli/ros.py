@@ -63,6 +63,10 @@ def add_parsers(sub: Any) -> None:
                         "more while a ROS 2 participant's node list or endpoints are still on their way")
     d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
     d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
+    d.add_argument("--nodl", metavar="DIR", help="the expected graph is the one the NoDL documents of DIR declare "
+                   "(*.nodl.yaml|yml|json, QoS included; docs/nodl.md) instead of the code's")
+    d.add_argument("--ament-prefix", action="append", default=[], metavar="DIR",
+                   help="--nodl: an install prefix whose ament index resolves nodl:// includes (repeatable)")
     d.set_defaults(fn=cmd_diff)
     c = rs.add_parser("check", help="check the plan's contracts against the graph of its ros: section")
     c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
@@ -164,8 +168,11 @@ def cmd_diff(args: argparse.Namespace) -> int:
     if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)))) != 1:
         print("error: ros diff needs exactly one running side: --master URI, --ros2 or --bag BAG", file=sys.stderr)
         return 2
+    if getattr(args, "nodl", None):
+        return _diff_nodl(args)
     if not args.paths and not args.launch:
-        print("error: ros diff needs the code: PATH... and/or --launch FILE", file=sys.stderr)
+        print("error: ros diff needs the code: PATH... and/or --launch FILE (or the documents: --nodl DIR)",
+              file=sys.stderr)
         return 2
     res = _scan_args(args, [], None, [args.bag] if args.bag else [])
     if res is None:
@@ -205,15 +212,52 @@ def cmd_diff(args: argparse.Namespace) -> int:
     return 0 if result.equal and not errors else 1
 
 
-def _diff_ros2(args: argparse.Namespace, static: Any) -> Any:
+def _diff_nodl(args: argparse.Namespace) -> int:
+    """``ros diff --nodl DIR``: the graph the documents declare against the running side
+    (:mod:`rclverify.ros.live.diff_nodl`); exit 0 equal, 1 they differ or a side cannot be read, 2 usage."""
+    from rclverify.model.nodl.check import document_files, read_all, shown  # deferred: start-up (loads jsonschema and yaml only when called)
+    from rclverify.model.nodl.document import Resolver  # deferred: start-up (loads jsonschema and yaml only when called)
+    from rclverify.ros.live.diff import render_text  # deferred: start-up (loads the ROS layers only when called)
+    from rclverify.ros.live.diff_nodl import nodes_of  # deferred: start-up (loads the ROS layers only when called)
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.records only when called)
+    if args.paths or args.launch:
+        print("error: ros diff --nodl compares the documents, not the code: give no PATH or --launch", file=sys.stderr)
+        return 2
+    folder = Path(args.nodl)
+    files = document_files(folder)
+    if not files:
+        print(f"{args.nodl}: error: no NoDL document (*.nodl.yaml, *.nodl.yml, *.nodl.json) in this folder",
+              file=sys.stderr)
+        return 2
+    docs = nodes_of(read_all(files, Resolver([Path(p) for p in args.ament_prefix], shown(Path(".")))))  # raises RclError, printed located by main
+    if not args.ros2:
+        print("error: ros diff --nodl compares with the running ROS 2 system: give --ros2", file=sys.stderr)
+        return 2
+    result = _diff_ros2(args, None, docs)
+    if result is None:
+        return 1
+    for line in render_text(result):
+        print(line)
+    if args.json:
+        try:
+            atomic_write_text(Path(args.json), json.dumps(result.to_json(), indent=2) + "\n")
+        except OSError as exc:
+            print(f"{args.json}: error: cannot write: {exc.strerror or exc}", file=sys.stderr)
+            return 1
+    return 0 if result.equal else 1
+
+
+def _diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> Any:
     """``ros diff --ros2``: the running graph through the source ``--source`` picks (docs/ros2.md, "Two
     sources": rclpy's graph API in the ROS 2 Python, or a DDS participant of rclverify's own), compared with
-    ``static``; ``None`` after printing why it cannot be read."""
+    ``static`` (the code's graph) or, given ``documents`` (NoDL documents by node), with the graph they
+    declare; ``None`` after printing why it cannot be read."""
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.ros.live.diff_dds import diff_dds, graph_of, qos_conflicts, read_dds_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.graph import read_rclpy_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
+    from rclverify.ros.live.diff_nodl import diff_nodl  # deferred: optional or conditional (inside a block)
     try:
         source_kind, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None))
     except ValueError as exc:
@@ -227,6 +271,8 @@ def _diff_ros2(args: argparse.Namespace, static: Any) -> Any:
             print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
             return None
         source = f"rclpy on {rdisc.rmw}"
+        if documents is not None:
+            return diff_nodl(documents, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc)  # type: ignore[arg-type]
         return diff_dds(static, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc)  # type: ignore[arg-type]
     try:
         running, disc, source, dp = read_dds_graph(max(0.0, args.wait))
@@ -236,6 +282,8 @@ def _diff_ros2(args: argparse.Namespace, static: Any) -> Any:
     try:
         for n in running.notes:
             print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
+        if documents is not None:
+            return diff_nodl(documents, running, source, qos_conflicts(disc), disc)
         return diff_dds(static, running, source, qos_conflicts(disc), disc)
     finally:
         disc.close()

@@ -108,8 +108,12 @@ def live_qos_of(disc: Announced) -> QosOf:
     return read
 
 
-def _qos(doc_end: Endpoint, edge: GraphEdge, qos_of: QosOf, fqn: str, node: str, code: str) -> list[Finding]:
-    """The reliability and durability the other side gives against the document's."""
+def qos_differences(doc_end: Endpoint, edge: GraphEdge, qos_of: QosOf, fqn: str, node: str,
+                    code: str) -> list[Finding]:
+    """The reliability and durability the other side gives endpoint ``edge`` (``qos_of``) against
+    what document endpoint ``doc_end`` writes: one finding ``<code>-qos`` per policy that differs,
+    located at ``edge`` and at the document's field; a policy either side leaves unsaid,
+    ``SYSTEM_DEFAULT`` and ``BEST_AVAILABLE`` are not compared (docs/nodl.md)."""
     if doc_end.qos is None or doc_end.kind not in ("publishers", "subscriptions"):
         return []
     got = qos_of(node, doc_end.kind, edge)
@@ -172,7 +176,7 @@ def compare_code(doc: Document, gn: GraphNode, base: Path | None = None, side: s
             out.append(Finding(f"{code}-type", f"node {gn.name}: {key[1]} has type {edge.msg_type} in {what} and "
                                                f"{e.type} in its NoDL document", (_loc(edge.src, top), e.type_loc)))
             continue
-        out += _qos(e, edge, qos_of, key[1], gn.name, code)
+        out += qos_differences(e, edge, qos_of, key[1], gn.name, code)
     for key, edge in ends.items():
         if key not in seen and not (side == "live" and _library_made(key, gn)):
             out.append(Finding(f"{code}-undeclared", f"node {gn.name} has {key[1]} "
@@ -203,4 +207,5 @@ def check_code(documents: Mapping[str, Document], nodes: Mapping[str, GraphNode]
     return matched, out
 
 
-__all__ = ["Announced", "GRAPH_LISTS", "QosOf", "SIDES", "check_code", "code_qos_of", "compare_code", "live_qos_of", "resolve"]
+__all__ = ["Announced", "GRAPH_LISTS", "QosOf", "SIDES", "check_code", "code_qos_of", "compare_code", "live_qos_of",
+           "qos_differences", "resolve"]

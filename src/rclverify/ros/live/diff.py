@@ -20,6 +20,11 @@ naming its edges, not one item per edge.  Against a bag
 (:func:`diff_bag`) only topics, actions (on their actionlib topics) and
 types are compared: a bag records no node names.  A type the code does not
 say statically (``None``) or the master could not tell is not compared.
+
+The expected side is the code by default; ``rclverify ros diff --nodl``
+gives the graph the NoDL documents declare instead (:mod:`.diff_nodl`), and
+the items then name the documents (:data:`NODL`) where they name the code
+(:data:`CODE`).
 """
 from __future__ import annotations
 
@@ -42,6 +47,28 @@ MASTER_KINDS: tuple[tuple[str, str, str], ...] = (
     ("action_clients", "action client", "calls action"),
 )
 _VERB = {k: v for k, _c, v in MASTER_KINDS} | {"service_clients": "calls"}
+
+
+@dataclass(frozen=True)
+class Expected:
+    """How the items name the expected side: ``side`` (the headings: ``in the code, not in ...``),
+    ``within`` (an edge ``in the code``), ``its`` (a node's ``its code``), ``lacks`` (``the code has no
+    such node``), ``nowhere`` (``the code names`` a name ``nowhere``), ``type_of`` (``the code's type``)."""
+
+    side: str
+    within: str
+    its: str
+    lacks: str
+    nowhere: str
+    type_of: str
+
+
+#: The expected side is the code (the static scan).
+CODE = Expected("the code", "in the code", "its code", "the code has no such node", "the code names {} nowhere",
+                "the code's type")
+#: The expected side is the graph the NoDL documents declare (:mod:`.diff_nodl`).
+NODL = Expected("the NoDL documents", "in its NoDL document", "its NoDL document", "no NoDL document declares it",
+                "no NoDL document names {}", "its NoDL document's type")
 
 
 @dataclass(frozen=True)
@@ -87,6 +114,8 @@ class DiffResult:
     not_compared: list[str] = field(default_factory=list)
     #: what the running side could not be read completely (a ROS 2 node list still on its way): never equal then
     incomplete: list[str] = field(default_factory=list)
+    #: the expected side (the code, or the NoDL documents)
+    expected: Expected = CODE
 
     @property
     def equal(self) -> bool:
@@ -131,26 +160,27 @@ def _first(edges: list[GraphEdge]) -> dict[str, GraphEdge]:
     return out
 
 
-def diff_master(static: Graph, running: Graph, uri: str) -> DiffResult:
+def diff_master(static: Graph, running: Graph, uri: str, said: Expected = CODE) -> DiffResult:
     """Compare the code's graph ``static`` with the graph read from the master at ``uri``
-    (``running``, from :func:`rclverify.ros.live.master.read_master`).  Lists are sorted by
+    (``running``, from :func:`rclverify.ros.live.master.read_master`); ``said`` names the
+    expected side in the items (:data:`CODE`, :data:`NODL`).  Lists are sorted by
     category, node and name.  Pure: raises nothing."""
     static = copy.deepcopy(static)
     fold_actions(static)  # an action written on its raw actionlib topics is compared as the action
     res = DiffResult("master", uri, compared=["nodes", "topics", "types", "publishers", "subscribers",
                                                "service servers", "action servers", "action clients"],
-                     not_compared=["service clients: a ROS 1 master registers only a service's servers"])
+                     not_compared=["service clients: a ROS 1 master registers only a service's servers"], expected=said)
     kinds = [k for k, _c, _v in MASTER_KINDS]
     static_names = {e.topic for n in static.nodes.values() for k in kinds + ["service_clients"] for e in n.edges_of(k)}
     running_names = {e.topic for n in running.nodes.values() for k in kinds for e in n.edges_of(k)}
     for name in sorted(set(static.nodes) - set(running.nodes)):
         n = static.nodes[name]
         res.missing.append(Item("node", name, None, None, None, _node_src(n), uri,
-                                f"node {name} is not running (its code {_summary(n, kinds)})"))
+                                f"node {name} is not running ({said.its} {_summary(n, kinds)})"))
     for name in sorted(set(running.nodes) - set(static.nodes)):
         n = running.nodes[name]
         res.extra.append(Item("node", name, None, None, None, None, uri,
-                              f"node {name} runs, but the code has no such node (it {_summary(n, kinds)})"))
+                              f"node {name} runs, but {said.lacks} (it {_summary(n, kinds)})"))
     for name in sorted(set(static.nodes) & set(running.nodes)):
         sn, rn = static.nodes[name], running.nodes[name]
         for kind, cat, verb in MASTER_KINDS:
@@ -159,19 +189,19 @@ def diff_master(static: Graph, running: Graph, uri: str) -> DiffResult:
                 e = se[t]
                 gone = "" if t in running_names else f"; nothing running has {t}"
                 res.missing.append(Item(cat, t, name, e.msg_type, None, e.src, uri,
-                                        f"{name} {verb} {t}{_t(e.msg_type)} in the code, not in the running "
+                                        f"{name} {verb} {t}{_t(e.msg_type)} {said.within}, not in the running "
                                         f"system{gone}"))
             for t in sorted(set(re_) - set(se)):
                 e = re_[t]
-                unknown = "" if t in static_names else f"; the code names {t} nowhere"
+                unknown = "" if t in static_names else f"; {said.nowhere.format(t)}"
                 res.extra.append(Item(cat, t, name, None, e.msg_type, None, uri,
-                                      f"{name} {verb} {t}{_t(e.msg_type)} in the running system, not in the "
-                                      f"code{unknown}"))
+                                      f"{name} {verb} {t}{_t(e.msg_type)} in the running system, not "
+                                      f"{said.within}{unknown}"))
             for t in sorted(set(se) & set(re_)):
                 a, b = se[t].msg_type, re_[t].msg_type
                 if a and b and a != b:
                     res.missing.append(Item("type", t, name, a, b, se[t].src, uri,
-                                            f"{name} {verb} {t}: the code's type is {short_type(a)}, the running "
+                                            f"{name} {verb} {t}: {said.type_of} is {short_type(a)}, the running "
                                             f"system's {short_type(b)}"))
     return res
 
@@ -259,10 +289,10 @@ def render_text(res: DiffResult) -> list[str]:
     where = f"the recorded run {res.source}" if res.kind == "bag" else f"the running system at {res.source}"
     lines: list[str] = []
     if res.missing:
-        lines.append(f"in the code, not in {where}:")
+        lines.append(f"in {res.expected.side}, not in {where}:")
         lines += [f"  {i}" for i in res.missing]
     if res.extra:
-        lines.append(f"in {where}, not in the code:")
+        lines.append(f"in {where}, not in {res.expected.side}:")
         lines += [f"  {i}" for i in res.extra]
     for nc in res.not_compared:
         lines.append(f"not compared: {nc}")

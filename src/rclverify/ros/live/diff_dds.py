@@ -39,7 +39,7 @@ from rclverify.ros.live.dds import ACTION_INFIX, ACTION_SERVICES, DISCOVERY_TOPI
 from rclverify.ros.live.dds import service_type as _service_type
 from rclverify.ros.live.dds_discovery import Discovery, EndpointInfo
 from rclverify.ros.live.dds_qos import mismatches
-from rclverify.ros.live.diff import DiffResult, Item, _first, _t, diff_master
+from rclverify.ros.live.diff import CODE, DiffResult, Expected, Item, _first, _t, diff_master
 from rclverify.ros.extract.model import Graph, GraphEdge, GraphNode, Note, Src, short_type
 
 INFRA_TOPICS = {"/rosout", "/parameter_events"}
@@ -164,18 +164,19 @@ def read_dds_graph(wait_s: float = 2.0, domain: int | None = None,
 
 def diff_dds(static: Graph, running: Graph, source: str,
              conflicts: list[tuple[str, EndpointInfo, EndpointInfo, list[str]]] = (),  # type: ignore[assignment]
-             disc: Discovery | None = None) -> DiffResult:
+             disc: Discovery | None = None, said: Expected = CODE) -> DiffResult:
     """Compare the code's graph with the running ROS 2 graph: what
     :func:`.diff.diff_master` compares, the service clients, and each QoS
     conflict as a ``qos`` item of the missing list (the connection the code
     promises is not made).  With ``disc``, also the reliability and
     durability each publisher and subscriber asks for in the code against
     its running endpoint (:func:`code_qos_items`; reads the code's files,
-    relative to the current directory as the scan showed them)."""
+    relative to the current directory as the scan showed them).  ``said`` names the expected side
+    (the code, or the NoDL documents: :mod:`.diff_nodl`, which passes no ``disc``)."""
     hidden = sorted(n for n in running.nodes if n.rsplit("/", 1)[-1].startswith(HIDDEN_PREFIX) and n not in static.nodes)
     if hidden:  # ROS 2's tools (the ros2cli daemon, ros2 topic echo): left out as `ros2 node list` leaves them out
         running = Graph(nodes={k: v for k, v in running.nodes.items() if k not in hidden}, notes=running.notes)
-    res = diff_master(static, running, source)
+    res = diff_master(static, running, source, said)
     res.kind = "dds"
     res.incomplete = [n.message for n in running.notes if n.code == "ROS-DDS" and INCOMPLETE in n.message]
     res.compared += ["service clients", "QoS of the publishers and subscribers of each topic"]
@@ -197,10 +198,10 @@ def diff_dds(static: Graph, running: Graph, source: str,
             _first(running.nodes[name].edges_of("service_clients"))
         for t in sorted(set(se) - set(re_)):
             res.missing.append(Item("service client", t, name, se[t].msg_type, None, se[t].src, source,
-                                    f"{name} calls {t}{_t(se[t].msg_type)} in the code, not in the running system"))
+                                    f"{name} calls {t}{_t(se[t].msg_type)} {said.within}, not in the running system"))
         for t in sorted(set(re_) - set(se)):
             res.extra.append(Item("service client", t, name, None, re_[t].msg_type, None, source,
-                                  f"{name} calls {t}{_t(re_[t].msg_type)} in the running system, not in the code"))
+                                  f"{name} calls {t}{_t(re_[t].msg_type)} in the running system, not {said.within}"))
     for topic, w, r, why in conflicts:
         who_w = disc.who(w) if disc is not None else w.label
         who_r = disc.who(r) if disc is not None else r.label
