@@ -319,6 +319,7 @@ def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | N
 
     from rclverify.semantics.floatsem import judge as floatjudge, parse_tolerance
     from rclverify.app.pipeline import Workspace
+    from rclverify.backends.monitors.widths import at_carried_widths, carried_widths
     ws = _ws(tmp_path, DIFF_CONTRACT)
     if tolerance:
         (ws / "contracts" / "plan.yaml").write_text(
@@ -342,7 +343,9 @@ def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | N
         layer = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(layer)
         checked = Workspace(w, "contracts/plan.yaml").checked
-        cn = checked.nodes[node]
+        # the contract as rclverify's monitor reads it: each comparison at its fields' widths
+        cn = at_carried_widths(checked.nodes[node], carried_widths(checked.nodes[node], {}, []),
+                               checked.env.constants)
         tol = parse_tolerance(tolerance) if w == ws else None
         mine_tol = layer._TOL
         assert (mine_tol is None) == (tol is None)
@@ -375,7 +378,8 @@ def test_the_carried_judgement_is_rclverifys(tmp_path: Path, tolerance: dict | N
         agree()
         if node == "Mixer":  # the readings random values meet rarely: double only, within the tolerance only
             for values in ({"in.b": 3, "out.ok": False}, {"in.b": 3.0, "out.ok": True},
-                           {"out.q": 20.000000000000004, "in.f": False}, {"out.s": 0.1, "in.a": 0, "in.b": 1}):
+                           {"out.q": 20.000000000000004, "in.f": False}, {"out.s": 0.1, "in.a": 0, "in.b": 1},
+                           {"out.s": 0.30000000000000004, "in.a": 0.1, "in.b": 2.0}):
                 compare(values)
     assert decided.get("Mixer", 0) >= 200 and all(decided.get(n, 0) > 0 for _, n in cases), decided
     want = {(True, "exact"), (True, "double"), (False, "exact"), (False, "exact, double"), (None, "")}

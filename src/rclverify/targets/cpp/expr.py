@@ -10,6 +10,14 @@ integers (``std::int64_t``), comparisons on the doubles.  With a declared
 tolerance a second reading compares numbers that read a recorded value up to
 the tolerance (``rclverify_rt::close``), in double arithmetic too.
 
+A comparison with a field of known width (``widths``: the IDL type of the
+field each variable travels in) is read at that width, as every path reads
+it (:func:`rclverify.semantics.widths.at_widths`; docs/semantics.md,
+"Widths"): a constant compared with a ``float32`` field is written as the
+exact decimal of its ``float32`` value (``in.p <= 0.2`` as ``in.p <=
+double{0.20000000298023223876953125}``, the double ``0.2f`` converts to),
+so the check answers as ``p <= 0.2f`` in the node does.
+
 Plain C++ has no exact rational arithmetic: the monitor's first reading,
 *exact* (the values as rationals, literals as the decimals they spell), is
 not made.  A formula exact arithmetic finds true and double arithmetic
@@ -33,12 +41,13 @@ answers *undecided* (the monitor's ``inconclusive``), never a guess.
 """
 from __future__ import annotations
 
-from typing import Any, cast
+from typing import Any, Mapping, cast
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from rclverify.lang.visit import Visitor
 from rclverify.semantics.operators import OPERATORS, UNARY
+from rclverify.semantics.widths import at_widths
 from rclverify.targets.cpp.common import CPP_SCALARS, Untranslatable, enum_const
 from rclverify.targets.cpp.quant import quantifier
 from rclverify.targets.cpp.values import kind_of, table_type, term_struct
@@ -58,21 +67,24 @@ def cpp_type(t: Type) -> str | None:
 
 
 class CppTranslator(Visitor[tuple[str, str]]):
-    """Translates the formulas of one node; ``mode`` is ``double`` or ``tolerance``.
+    """Translates the formulas of one node; ``mode`` is ``double`` or ``tolerance``; ``widths``
+    (``"in.x"`` -> ``float32``/``float64``) the widths its comparisons are read at (module docstring).
 
     ``translate(formula)`` returns a C++ expression of type ``bool`` reading ``in``
     and ``out`` (``const Inputs&``, ``const Outputs&``) that may throw
     ``rclverify_rt::Undecided``; raises :class:`Untranslatable`."""
 
-    def __init__(self, checked: Checked, node: CheckedNode, mode: str = "double") -> None:
+    def __init__(self, checked: Checked, node: CheckedNode, mode: str = "double",
+                 widths: Mapping[str, str] | None = None) -> None:
         self.env, self.node, self.mode = checked.env, node, mode
+        self.widths: Mapping[str, str] = widths or {}
         #: the quantified variables in scope: RCL name -> (C++ name, kind) (:mod:`.cpp_quant`)
         self.bound: dict[str, tuple[str, str]] = {}
         #: why a translated formula may be undecided (a quantifier the double reading cannot enumerate)
         self.notes: list[str] = []
 
     def translate(self, e: ast.Expr) -> str:
-        code, kind = self.expr(e)
+        code, kind = self.expr(at_widths(e, self.widths, self.env.constants))
         if kind != "bool":
             raise Untranslatable(f"a clause of type {kind}")
         return code

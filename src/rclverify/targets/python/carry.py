@@ -37,6 +37,7 @@ from rclverify.lang.walk import names, reads
 from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.floatsens import float_sensitive
 from rclverify.semantics.operators import OPERATORS, UNARY, Operator
+from rclverify.semantics.widths import at_widths
 from rclverify.lang import ast
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
@@ -168,16 +169,23 @@ def _vars(e: Any, out: list[ast.Var]) -> None:
         _vars(getattr(e, f), out)
 
 
-def carried(checked: Checked, node: CheckedNode) -> Carried:
+def carried(checked: Checked, node: CheckedNode, widths: Mapping[str, str] | None = None) -> Carried:
     """What ``contract.py`` carries for ``node``: ``assumes`` and ``guarantees`` (each
     ``{"tree", "fs", "fs_tol"}``: the clause's tree and whether the double and the tolerance
     readings can change it), ``ins`` (the inputs the contract reads, in declaration order),
     ``per`` (guarantee k -> [inputs, outputs] it reads) and ``enums`` (variable -> the values
-    of its enumeration), as ``contract.py.j2`` renders them."""
+    of its enumeration), as ``contract.py.j2`` renders them.
+
+    ``widths`` (``"in.x"``/``"out.y"`` -> ``float32`` or ``float64``: the IDL width of the field
+    each variable travels in) reads every comparison at the width of what it compares
+    (:func:`rclverify.semantics.widths.at_widths`; docs/semantics.md, "Widths"): the tree holds
+    each constant compared with a ``float32`` field as the exact rational of its ``float32``
+    value, so the carried readings judge ``in.p <= 0.2`` against 0.20000000298023223876953125 as
+    rclverify's monitor does."""
     tree = _Tree(checked, node)
 
     def clause(c: Any) -> CarriedClause:
-        f = c.formula
+        f = at_widths(c.formula, widths or {}, checked.env.constants)
         return {"tree": tree.expr(f, frozenset()), "fs": float_sensitive(f, checked, node),
                 "fs_tol": float_sensitive(f, checked, node, tolerant=True)}
     needed: set[str] = set()

@@ -140,10 +140,13 @@ def _one_line(text: str) -> str:
     return re.sub(r"\s+", " ", text).strip()
 
 
-def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tolerance | None = None) -> Checks:
+def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tolerance | None = None,
+              widths: Mapping[str, str] | None = None) -> Checks:
     """The checks of node ``cn``: struct fields for every input and output a C++ field can hold,
     every clause translated (:class:`rclverify.targets.cpp.expr.CppTranslator`; an untranslatable clause keeps
-    its reason), the enumerations they use.  ``tolerance``: the monitors' declared one."""
+    its reason), the enumerations they use.  ``tolerance``: the monitors' declared one; ``widths``
+    (``"in.x"`` -> ``float32``/``float64``): the widths of the fields the variables travel in, at which
+    the comparisons are read (docs/semantics.md, "Widths")."""
     c = Checks(cn.name, namespace, cn.node.loc.file, f"{namespace.upper()}__CONTRACT_CHECKS_HPP_")
     enums: dict[str, EnumT] = {}
     for side, table, skipped, into in (("in", cn.inputs, c.skipped_in, c.inputs),
@@ -165,8 +168,8 @@ def checks_of(checked: Checked, cn: CheckedNode, namespace: str, tolerance: Tole
                            [parse_code(a, f"q_a[{j}]") for j, a in enumerate(dict(t.ctors)[k["name"]])])
                           for k in term_fields(t)["ctors"]]} for t in data_types(checked)]
     c.triggers = [""] + [f"in.{g.trigger.name}" if g.trigger is not None else "" for g in cn.node.guarantees]
-    dbl = CppTranslator(checked, cn, "double")
-    tol = CppTranslator(checked, cn, "tolerance")
+    dbl = CppTranslator(checked, cn, "double", widths)
+    tol = CppTranslator(checked, cn, "tolerance", widths)
     if tolerance:
         c.tolerance = {"abs": repr(float(tolerance.abs)), "rel": repr(float(tolerance.rel)), "ulps": tolerance.ulps}
         c.tolerance_text = tolerance.text()
@@ -223,11 +226,12 @@ def node_context(checked: Checked, np: NodePackage, c: Checks, rules: Mapping[st
 
 def cpp_package(checked: Checked, cn: CheckedNode, np: NodePackage, env: Any, marker: str, once_marker: str,
                 qos_depth: int, rules: Mapping[str, TopicRule] | None = None,
-                tolerance: Tolerance | None = None) -> tuple[dict[str, str], dict[str, str]]:
+                tolerance: Tolerance | None = None,
+                widths: Mapping[str, str] | None = None) -> tuple[dict[str, str], dict[str, str]]:
     """The files of node ``np``'s rclcpp package: ``(generated, created_once)``, relative path ->
-    text, rendered with jinja2 environment ``env``."""
+    text, rendered with jinja2 environment ``env``; ``widths`` as :func:`checks_of` takes them."""
     d = np.package
-    c = checks_of(checked, cn, d, tolerance)
+    c = checks_of(checked, cn, d, tolerance, widths)
     ctx = dict(marker=marker, np=np, c=c, qos_depth=qos_depth, max_candidate_steps=MAX_CANDIDATE_STEPS, guard=c.guard.replace("__CONTRACT_CHECKS_HPP_", ""),
                **node_context(checked, np, c, rules))
     gen = {

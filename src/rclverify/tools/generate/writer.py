@@ -38,6 +38,7 @@ from rclverify.tools.generate.cpp import cpp_package
 from rclverify.tools.generate.nodes import QOS_DEPTH, NodePackage, node_packages
 from rclverify.tools.generate.planfrag import plan_fragment
 from rclverify.targets.python.carry import carried, evaluator_text
+from rclverify.backends.monitors.widths import carried_widths
 from rclverify.traces.mapping import TopicRule
 from rclverify.tools.generate.wiring import wires
 from rclverify.tools.generate.namecheck import check_names, short_name
@@ -124,9 +125,12 @@ def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = 
     interface_of: dict[str, list[str]] = {}
     for np in nodes:
         d = np.package
+        # the widths of the fields each variable travels in (the topics' message types): every
+        # comparison is read at them, in the carried evaluator and in the C++ checks alike
+        widths = carried_widths(checked.nodes[np.ros_name], rules or {}, [])
         if lang == "cpp":
             g, o = cpp_package(checked, checked.nodes[np.ros_name], np, _ENV, GENERATED, ONCE, QOS_DEPTH,
-                               rules, tolerance)
+                               rules, tolerance, widths)
             gen.update(g)
             once.update(o)
             main = f"{d}/src/{d}_node.cpp"
@@ -140,7 +144,7 @@ def render_tree(checked: Checked, system: str, sources: dict[str, str] | None = 
         gen[f"{d}/{d}/contract_eval.py"] = evaluator_text(GENERATED)
         gen[f"{d}/{d}/contract.py"] = _ENV.get_template("contract.py.j2").render(
             ctx, sources_json=json.dumps(sources or {}, sort_keys=True),
-            carried_py=pprint.pformat(carried(checked, checked.nodes[np.ros_name]), width=110, sort_dicts=True),
+            carried_py=pprint.pformat(carried(checked, checked.nodes[np.ros_name], widths), width=110, sort_dicts=True),
             tolerance=tolerance.to_json() if tolerance else None,
             triggers=[(k, f"in.{c.trigger.name}") for k, c in
                       enumerate(checked.nodes[np.ros_name].node.guarantees, 1) if c.trigger is not None])
