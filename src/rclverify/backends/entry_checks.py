@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from rclverify.model.plan.mapping_file import plan_mapping
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.load import KEY, Plan
 from rclverify.lang import ast
@@ -57,7 +58,7 @@ def check_entries(plan: Plan, checked: Checked) -> list[Diagnostic]:
                     from rclverify.backends.review.backend import read_record  # deferred: optional or conditional (inside a block)
                     read_record(plan.root, e.config, loc)
                 else:
-                    _check_monitors(plan, e.config, loc, checked)
+                    _check_monitors(plan, e.config, loc, checked, node)
                     out.extend(d for d in _shared_topics(plan, e.config, checked, node) if d not in out)
             except PlanError as exc:  # once each: entries sharing a mapping file share its errors
                 out.extend(d for d in exc.diagnostics if d not in out)
@@ -114,6 +115,7 @@ def _shared_topics(plan: Plan, config: Any, checked: Checked, node: str) -> list
     from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping  # deferred: start-up (loads lark, z3 and more only when called)
     from rclverify.backends.monitors.shared_topics import shared_topic_errors  # deferred: start-up (loads rclverify.backends.monitors, rclverify.semantics and more only when called)
     rel = config.get("mapping")
+    rel = plan_mapping(plan, node, config) if rel is None else rel  # the mapping the plan names for the entry
     rules: Any = {}
     if isinstance(rel, (str, type(None))) and (plan.root / (rel or DEFAULT_MAPPING)).is_file():
         try:
@@ -123,16 +125,24 @@ def _shared_topics(plan: Plan, config: Any, checked: Checked, node: str) -> list
     return shared_topic_errors(checked, node, rules, rel or DEFAULT_MAPPING)
 
 
-def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None = None) -> None:
-    """Read the monitors entry's trace mapping when it exists (its YAML, its
-    ``msg_dirs``, which must lie inside the workspace, and its field paths
-    against the message definitions the contracts' topics name,
+def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None = None, node: str | None = None) -> None:
+    """Read the monitors entry's ``near_miss`` threshold
+    (:mod:`.monitors.near_miss`), its trace mapping when it exists (its
+    YAML, its ``msg_dirs``, which must lie inside the workspace, and its
+    field paths against the message definitions the contracts' topics name,
     :mod:`.monitors.fieldpaths`) and the entry's ``tolerance``.  A missing
     mapping or trace is left to the export stage (a workspace may record its
     traces after writing the plan).  Raises :class:`PlanError`."""
+    from rclverify.backends.monitors.near_miss import NearMissError, parse_near_miss  # deferred: start-up (loads rclverify.lang.timing only when called)
+    try:
+        parse_near_miss(config.get("near_miss"))
+    except NearMissError as exc:
+        l = loc("near_miss", *exc.key)
+        raise plan_error(l.file, l.line, l.col, str(exc)) from None
     from rclverify.semantics.floatsem import ToleranceError, parse_tolerance  # deferred: start-up (loads lark, z3 and more only when called)
     from rclverify.backends.monitors.config import DEFAULT_MAPPING, ConfigError, load_mapping  # deferred: start-up (loads lark, z3 and more only when called)
     rel = config.get("mapping")
+    rel = plan_mapping(plan, node, config) if rel is None else rel  # the mapping the plan names for the entry
     if not isinstance(rel, (str, type(None))) or not (plan.root / (rel or DEFAULT_MAPPING)).is_file():
         try:
             parse_tolerance(config.get("tolerance"))

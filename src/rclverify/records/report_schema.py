@@ -110,6 +110,25 @@ class DeadlineHop(TypedDict):
     time_margin: NotRequired[HopTimeMargin | None]
 
 
+class NearMissRow(TypedDict):
+    """A guarantee held on its runs with a margin below the plan's near-miss threshold (``near_misses[]``;
+    report/near_misses.py): ``kind`` ``value`` (a space margin, in ``unit``) or ``time`` (a deadline's
+    time margin, s); ``source`` the guarantee's place, ``threshold_source`` the plan's ``near_miss``."""
+    node: str
+    guarantee: int
+    kind: Literal["value", "time"]
+    margin: float
+    threshold: float
+    unit: str
+    atom: str
+    where: str
+    time: float | None
+    trace: str
+    obligation: str
+    source: str
+    threshold_source: str
+
+
 class DeadlineRow(TypedDict):
     """An end-to-end deadline decided by rule D3 (``deadlines[]``, ``$defs/deadline``; report/deadlines.py)."""
     requirement: str
@@ -473,6 +492,8 @@ class Report(TypedDict):
     unverified: list[UnverifiedRow]
     deadlines: list[DeadlineRow]
     acknowledgements: list[AcknowledgementRow]
+    #: guarantees held with a margin below the plan's near-miss threshold (report/near_misses.py)
+    near_misses: list[NearMissRow]
     statistics: list[dict[str, Any]]
     #: the evidence mapped onto the plan's standard profiles (report/standards_rows.py, docs/standards.md)
     standards: list[dict[str, Any]]

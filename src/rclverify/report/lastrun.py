@@ -34,6 +34,7 @@ SUMMARY_SHAPE: dict[str, Any] = {
     "problems?": [{"status": str, "sentence": str, "culprits": [str], "members": [str], "repairs": _NUM}],
     "grounding?": (dict, type(None)),
     "strict?": [str],
+    "near_misses?": [str],
 }
 
 #: What :func:`rclverify.report.summary.summary_data` reads of a JSON report.

@@ -467,13 +467,15 @@ def sarif_log(report: Report) -> SarifLog:
     lint, lint_rules = _lint_results(report)
     ground, ground_rules = _grounding_results(report)
     from rclverify.report.deadlines import SARIF_RULES, sarif_results  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
+    from rclverify.report import near_misses  # deferred: start-up (loads rclverify.report.near_misses only when called)
     from rclverify.report import nodl  # deferred: start-up (loads rclverify.report.nodl only when called)
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
                + nodl.sarif_results(report, _result, _location)
-               + _requirement_results(report) + sarif_results(report, _result) + _acknowledgement_results(report))
+               + _requirement_results(report) + sarif_results(report, _result) + _acknowledgement_results(report)
+               + near_misses.sarif_results(report, _result))
     _attach_diagnoses(report, results)
     rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
-                             + lint_rules + ground_rules)
+                             + [Rule(*r) for r in near_misses.SARIF_RULES] + lint_rules + ground_rules)
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:
         res["ruleIndex"] = index[res["ruleId"]]

@@ -76,6 +76,8 @@ class SummaryData(TypedDict):
     grounding: GroundingBrief | None
     strict: list[str]
     acknowledged: list[str]
+    #: the near misses, one line each after a heading (report/near_misses.py ``summary_lines``)
+    near_misses: NotRequired[list[str]]
 
 
 class AttentionItem(TypedDict):

@@ -145,7 +145,14 @@ def summary_data(report: Report) -> SummaryData:
             "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report),
             # warnings answered in the plan (model/plan/acknowledged.py): named, so an accepted risk is never silent
             "acknowledged": [f"{m} ({a['at']}: {a['reason']})" for a in report.get("acknowledgements") or ()
-                             if a.get("status") == "ok" for m in a.get("matched") or ()]}
+                             if a.get("status") == "ok" for m in a.get("matched") or ()],
+            # guarantees held by less than the plan's near-miss threshold (report/near_misses.py)
+            "near_misses": _near_miss_lines(report)}
+
+
+def _near_miss_lines(report: Report) -> list[str]:
+    from rclverify.report.near_misses import summary_lines  # deferred: start-up (loads rclverify.report.near_misses only when called)
+    return summary_lines(report.get("near_misses") or ())
 
 
 def group_sentence(group: Mapping[str, Any]) -> str:
@@ -396,5 +403,7 @@ def print_last_run(root: Path) -> SummaryData:
     if acks:
         print(f"accepted risks: {len(acks)} warning{'s' if len(acks) != 1 else ''} acknowledged in the plan: "
               + "; ".join(acks[:3]) + ("; ..." if len(acks) > 3 else ""))
+    for line in data.get("near_misses") or ():
+        print(line)
     print_summary(data, "reports/assurance.html", rows=data["rows"])
     return data
