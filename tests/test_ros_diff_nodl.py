@@ -22,7 +22,7 @@ from rclverify.model.nodl.check import document_files, read_all, shown
 from rclverify.model.nodl.document import Resolver
 from rclverify.ros.live.diff import render_text
 from rclverify.ros.live.diff_dds import graph_of, qos_conflicts
-from rclverify.ros.live.diff_nodl import diff_nodl, nodes_of
+from rclverify.ros.ground.diff_nodl import diff_nodl, nodes_of
 from rclverify.runtime.rclpy_source.graph import RclpyDiscovery
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "manipulator" / "nodl"

@@ -214,11 +214,11 @@ def cmd_diff(args: argparse.Namespace) -> int:
 
 def _diff_nodl(args: argparse.Namespace) -> int:
     """``ros diff --nodl DIR``: the graph the documents declare against the running side
-    (:mod:`rclverify.ros.live.diff_nodl`); exit 0 equal, 1 they differ or a side cannot be read, 2 usage."""
+    (:mod:`rclverify.ros.ground.diff_nodl`); exit 0 equal, 1 they differ or a side cannot be read, 2 usage."""
     from rclverify.model.nodl.check import document_files, read_all, shown  # deferred: start-up (loads jsonschema and yaml only when called)
     from rclverify.model.nodl.document import Resolver  # deferred: start-up (loads jsonschema and yaml only when called)
     from rclverify.ros.live.diff import render_text  # deferred: start-up (loads the ROS layers only when called)
-    from rclverify.ros.live.diff_nodl import nodes_of  # deferred: start-up (loads the ROS layers only when called)
+    from rclverify.ros.ground.diff_nodl import nodes_of  # deferred: start-up (loads the ROS layers only when called)
     from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.records only when called)
     if args.paths or args.launch:
         print("error: ros diff --nodl compares the documents, not the code: give no PATH or --launch", file=sys.stderr)
@@ -257,7 +257,7 @@ def _diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> 
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.graph import read_rclpy_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
-    from rclverify.ros.live.diff_nodl import diff_nodl  # deferred: optional or conditional (inside a block)
+    from rclverify.ros.ground.diff_nodl import diff_nodl  # deferred: optional or conditional (inside a block)
     try:
         source_kind, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None))
     except ValueError as exc:

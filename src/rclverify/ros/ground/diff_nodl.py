@@ -12,10 +12,10 @@ there (``x`` is ``<namespace>/x``, ``~/x`` is ``<node>/x``); a document
 that matches no running node is the node ``/<Node>`` of the root namespace,
 which is then missing.  Types are compared as ``pkg/<msg|srv|action>/Name``.
 
-The graph is compared by :func:`.diff_dds.diff_dds`'s rules (nodes,
+The graph is compared by :func:`rclverify.ros.live.diff_dds.diff_dds`'s rules (nodes,
 publishers, subscribers, service servers and clients, action servers and
 clients, types, and the running endpoints' QoS conflicts), with the items
-naming the documents (:data:`.diff.NODL`).  QoS is compared as ``nodl check
+naming the documents (:data:`rclverify.ros.live.diff.NODL`).  QoS is compared as ``nodl check
 --ros2`` compares it: the reliability and durability each document writes
 for a topic's publisher or subscription against what the node's running
 endpoint announces (:func:`rclverify.ros.ground.nodl_code.live_qos_of`,
@@ -65,8 +65,8 @@ def nodl_graph(documents: Mapping[str, Document], names: Mapping[str, str]) -> G
 
 def diff_nodl(documents: Mapping[str, Document], running: Graph, source: str, conflicts: list[Any],
               disc: Announced | None) -> DiffResult:
-    """The documents (by node) as the expected graph against ``running`` (:func:`.diff_dds.graph_of`
-    of ``disc``, read through either source), with ``conflicts`` (:func:`.diff_dds.qos_conflicts`)
+    """The documents (by node) as the expected graph against ``running`` (:func:`rclverify.ros.live.diff_dds.graph_of`
+    of ``disc``, read through either source), with ``conflicts`` (:func:`rclverify.ros.live.diff_dds.qos_conflicts`)
     and, with ``disc``, each document's topic QoS against what its running endpoint announces
     (module docstring).  Pure: raises nothing."""
     names = match_nodes(list(documents), running.nodes, {})

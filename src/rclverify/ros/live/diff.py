@@ -22,7 +22,7 @@ types are compared: a bag records no node names.  A type the code does not
 say statically (``None``) or the master could not tell is not compared.
 
 The expected side is the code by default; ``rclverify ros diff --nodl``
-gives the graph the NoDL documents declare instead (:mod:`.diff_nodl`), and
+gives the graph the NoDL documents declare instead (:mod:`rclverify.ros.ground.diff_nodl`), and
 the items then name the documents (:data:`NODL`) where they name the code
 (:data:`CODE`).
 """
@@ -66,7 +66,7 @@ class Expected:
 #: The expected side is the code (the static scan).
 CODE = Expected("the code", "in the code", "its code", "the code has no such node", "the code names {} nowhere",
                 "the code's type")
-#: The expected side is the graph the NoDL documents declare (:mod:`.diff_nodl`).
+#: The expected side is the graph the NoDL documents declare (:mod:`rclverify.ros.ground.diff_nodl`).
 NODL = Expected("the NoDL documents", "in its NoDL document", "its NoDL document", "no NoDL document declares it",
                 "no NoDL document names {}", "its NoDL document's type")
 

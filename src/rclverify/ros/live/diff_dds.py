@@ -172,7 +172,7 @@ def diff_dds(static: Graph, running: Graph, source: str,
     durability each publisher and subscriber asks for in the code against
     its running endpoint (:func:`code_qos_items`; reads the code's files,
     relative to the current directory as the scan showed them).  ``said`` names the expected side
-    (the code, or the NoDL documents: :mod:`.diff_nodl`, which passes no ``disc``)."""
+    (the code, or the NoDL documents: :mod:`rclverify.ros.ground.diff_nodl`, which passes no ``disc``)."""
     hidden = sorted(n for n in running.nodes if n.rsplit("/", 1)[-1].startswith(HIDDEN_PREFIX) and n not in static.nodes)
     if hidden:  # ROS 2's tools (the ros2cli daemon, ros2 topic echo): left out as `ros2 node list` leaves them out
         running = Graph(nodes={k: v for k, v in running.nodes.items() if k not in hidden}, notes=running.notes)
