@@ -45,10 +45,11 @@ from rclverify.records.sealed import read_sealed
 
 if TYPE_CHECKING:
     from rclverify.calculus.health.checks import Finding
+    from rclverify.records.findings import HealthFinding
     from rclverify.model.plan.model import EvidenceEntry
     from rclverify.records.report_schema import Report
     from rclverify.records.stage_records import (CheckRecord, CompositionRecord, DeadlineRecord, DiagnosisRecord,
-                                                 HealthFinding, ObligationRecord, RequirementRecord)
+                                                 ObligationRecord, RequirementRecord)
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached
@@ -150,36 +151,37 @@ def plan_facts(ws: Workspace) -> dict[str, list[Any]]:
     return {n: [f.expr for f in fs] for n, fs in ws.plan.facts.items()}
 
 
-def health_findings(ws: Workspace, node: str) -> list[Any]:
+def health_findings(ws: Workspace, node: str) -> list[HealthFinding]:
     """The contract health findings of ``node`` (``calculus.health.finding.Finding``
     objects, its replacement's refinement finding last), from a fresh Z3 state;
     writes nothing (:func:`stage_health` records them)."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     from rclverify.calculus.health.checks import check_node  # deferred: start-up (loads lark, yaml and more only when called)
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
-    found: list[Any] = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
+    found: list[HealthFinding] = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
     if node in ws.plan.replacements:
         found.append(replacement_finding(ws, node))
     return found
 
 
 def stage_health(ws: Workspace, node: str) -> list[HealthFinding]:
-    """Run the contract health checks of ``node``; writes its findings JSON."""
-    checked = health_findings(ws, node)
-    findings = []
-    for f in checked:
-        j = f.to_json()
-        if f.smt2:
-            j["smt2"] = f"artifacts/health/{f.id}.smt2"
-        if f.witness_smt2:  # the quantifier-free query the second solver decides (calculus/health/realizer.py)
-            j["witness_smt2"] = f"artifacts/health/{f.id}.witness.smt2"
-        for key, text in (("smt2", f.smt2), ("witness_smt2", f.witness_smt2)):
+    """Run the contract health checks of ``node``; keep each query a check
+    decided as ``artifacts/health/<id>.smt2`` (``<id>.witness.smt2`` for a
+    witness's), seal the findings with those paths in ``smt2`` and
+    ``witness_smt2`` (records/findings.py) and return them as sealed."""
+    from msgspec.structs import replace  # deferred: start-up (loads msgspec only when called)
+    findings: list[HealthFinding] = []
+    for f in health_findings(ws, node):
+        kept = replace(f, smt2=f"artifacts/health/{f.id}.smt2" if f.smt2 else "",
+                       witness_smt2=f"artifacts/health/{f.id}.witness.smt2" if f.witness_smt2 else "")
+        row = kept.to_json()
+        for path, text in ((kept.smt2, f.smt2), (kept.witness_smt2, f.witness_smt2)):
             if text:  # each ends naming the finding it decides (records/ties.py)
-                atomic_write_text(ws.path(j[key]), tie_query(text, "health", f.id, j))
-        findings.append(j)
-    write_sealed(ws.path(ws.health(node)), {"node": node, "findings": findings})
+                atomic_write_text(ws.path(path), tie_query(text, "health", f.id, row))
+        findings.append(kept)
+    write_sealed(ws.path(ws.health(node)), {"node": node, "findings": [f.to_json() for f in findings]})
     record_provenance(ws, node, "health", stage_inputs(ws, node, "health"))
-    return cast("list[HealthFinding]", findings)
+    return findings
 
 
 def replacement_finding(ws: Workspace, node: str) -> Finding:

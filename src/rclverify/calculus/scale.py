@@ -46,7 +46,7 @@ from rclverify.lang.types import Checked, CheckedNode, is_numeric
 from rclverify.lang.walk import free_names, subexpressions
 from rclverify.semantics import wallclock
 from rclverify.calculus.shapes import ScaleMismatch
-from rclverify.records.stage_records import HealthFinding
+from rclverify.records.findings import HealthFinding
 
 #: Budget of one optimisation, milliseconds.
 OPTIMIZE_MS = 1000
@@ -240,8 +240,8 @@ def probable_mismatches(checked: Checked, links: Iterable[Any], enc: Any, node: 
 
 
 def scale_findings(side_conditions: Iterable[Mapping[str, Any]]) -> list[HealthFinding]:
-    """Report findings (the shape of a contract-health finding,
-    :class:`~rclverify.calculus.health.finding.Finding`, status ``warning``) for the
+    """Contract-health findings (:class:`~rclverify.records.findings.HealthFinding`,
+    status ``warning``) for the
     probable scale mismatches recorded on side conditions that are failed
     or inconclusive (a stale or altered record gives none): check
     ``probable-scale-mismatch``, id ``<side condition>.scale``, the
@@ -251,11 +251,10 @@ def scale_findings(side_conditions: Iterable[Mapping[str, Any]]) -> list[HealthF
         if sc.get("status") not in ("failed", "inconclusive"):
             continue
         for k, m in enumerate(sc.get("scale_mismatch") or (), 1):
-            out.append({"id": f"{sc['id']}.scale" + (f"{k}" if k > 1 else ""), "node": sc["node"],
-                        "check": "probable-scale-mismatch", "guarantee": None, "status": "warning",
-                        "message": f"side condition {sc['id']}: {m['message']}",
-                        "explanation": (f"Side condition {sc['id']} ({sc.get('conjunct', '')}) is {sc['status']}; "
-                                        f"the ranges of its two ends differ by a factor of {m['factor']}, "
-                                        "which a unit mismatch explains better than a range problem."),
-                        "model": None, "core": None, "duration_s": 0.0, "instances": None})
+            out.append(HealthFinding(
+                id=f"{sc['id']}.scale" + (f"{k}" if k > 1 else ""), node=sc["node"], check="probable-scale-mismatch",
+                guarantee=None, status="warning", message=f"side condition {sc['id']}: {m['message']}",
+                explanation=(f"Side condition {sc['id']} ({sc.get('conjunct', '')}) is {sc['status']}; "
+                             f"the ranges of its two ends differ by a factor of {m['factor']}, "
+                             "which a unit mismatch explains better than a range problem.")))
     return out

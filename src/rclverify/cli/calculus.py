@@ -81,10 +81,10 @@ def cmd_health(args: argparse.Namespace) -> int:
             print(f"error: no node named {n!r}; nodes: {', '.join(ws.node_names())}", file=sys.stderr)
             return 2
         for f in stage_health(ws, n):
-            print(f"{f['id']} [{f['status']}]: {f['message']}")
-            for c in f["core"] or []:
+            print(f"{f.id} [{f.status}]: {f.message}")
+            for c in f.core or []:
                 print(f"    core: {c}")
-            problems += f["status"] == "problem"
+            problems += f.status == "problem"
     return 1 if problems else 0
 
 

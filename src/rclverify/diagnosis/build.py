@@ -51,7 +51,7 @@ from rclverify.records.links import link_pairs
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
 from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows
-from rclverify.records.report_schema import EvidenceRow, FindingRow, ObligationRow, SideConditionRow
+from rclverify.records.report_schema import EvidenceRow, FindingJson, ObligationRow, SideConditionRow
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 
 CACHE = "artifacts/cache/diagnosis.pickle"
@@ -218,7 +218,7 @@ def _record(id: str, kind: str, node: str, status: str, sentence: str, *, culpri
             "repairs": [r for r in repairs if r], "guarantee": guarantee, "related": []}
 
 
-def _finding(ws: Any, report: ReportRows, f: FindingRow, guard: Callable[[str, int], Repair | None]) -> DiagnosisEntry:
+def _finding(ws: Any, report: ReportRows, f: FindingJson, guard: Callable[[str, int], Repair | None]) -> DiagnosisEntry:
     node, k = f["node"], f["guarantee"]
     facts = plan_facts(ws, node)
     members = parse_core(f.get("core"), facts)

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from typing import NotRequired, TypedDict, cast
 
 from rclverify.diagnosis.edits import Edit
-from rclverify.records.report_schema import (DeadlineRow, EvidenceRow, FindingRow, LintRow, NodeRow, ObligationRow,
+from rclverify.records.report_schema import (DeadlineRow, EvidenceRow, FindingJson, LintRow, NodeRow, ObligationRow,
                                              RequirementRow, SideConditionRow, SystemView)
 from rclverify.records.stage_records import Repair
 
@@ -27,7 +27,7 @@ class ReportRows(TypedDict):
     requirements: list[RequirementRow]
     nodes: list[NodeRow]
     side_conditions: list[SideConditionRow]
-    findings: list[FindingRow]
+    findings: list[FindingJson]
     obligations: list[ObligationRow]
     evidence: list[EvidenceRow]
     lint: list[LintRow]

@@ -306,26 +306,11 @@ class DerivedPropertyRow(TypedDict):
     limited_by: NotRequired[LimitedBy | None]
 
 
-class FindingRow(TypedDict):
-    """A contract health finding (``findings[]``); ``guarantee`` ``None`` for the whole contract."""
-    id: str
-    node: str
-    check: str
-    status: HealthStatus
-    message: str
-    guarantee: NotRequired[int | None]
-    explanation: NotRequired[str]
-    duration_s: NotRequired[float]
-    smt2: NotRequired[str]
-    core: NotRequired[list[str] | None]
-    instances: NotRequired[dict[str, Any] | None]
-    model: NotRequired[dict[str, Any] | None]
-    witness: NotRequired[dict[str, Any]]
-    witness_smt2: NotRequired[str]
-    solvers: NotRequired[Solvers]
-    flagged: NotRequired[str]
-    sha256: NotRequired[str]
-    acknowledged: NotRequired[dict[str, str]]
+#: A contract health finding (``findings[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.findings.FindingRow`, the one definition of its fields (the schema's
+#: ``findings`` items are generated from it, records/schema_gen.py); decode it with
+#: ``FindingRow.of`` to read its fields as attributes.
+FindingJson = dict[str, Any]
 
 
 class ObligationRow(TypedDict):
@@ -479,7 +464,7 @@ class Report(TypedDict):
     nodes: list[NodeRow]
     side_conditions: list[SideConditionRow]
     derived_properties: list[DerivedPropertyRow]
-    findings: list[FindingRow]
+    findings: list[FindingJson]
     obligations: list[ObligationRow]
     evidence: list[EvidenceRow]
     environment_assumptions: list[EnvironmentAssumptionRow]

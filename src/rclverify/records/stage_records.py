@@ -15,7 +15,8 @@ writes or reads them.
 
 Producers: ``check`` app/pipeline.py ``stage_check``; ``compose``
 calculus/compose.py ``composition_json`` and calculus/side_condition.py;
-``health`` calculus/health/finding.py ``Finding.to_json``; ``export``
+``health`` app/pipeline.py ``stage_health`` (its findings are
+:class:`rclverify.records.findings.HealthFinding`, defined there once); ``export``
 records/records.py ``Obligation.to_json``; ``deadlines``
 calculus/deadlines.py ``DeadlineResult.to_json`` with stages/deadlines.py;
 ``requirements`` calculus/requirements/check.py, temporal_check.py and
@@ -127,24 +128,6 @@ class CompositionRecord(TypedDict):
     cone_size: int
     cone_environment_assumptions: list[str]
     guarantee: str
-
-
-class HealthFinding(TypedDict):
-    """One contract-health finding (consistency, vacuity, realizability, shape); ``duration_s`` in seconds."""
-    id: str
-    node: str
-    check: str
-    guarantee: int | None
-    status: str
-    message: str
-    explanation: str
-    model: dict[str, str] | None
-    core: list[str] | None
-    duration_s: float
-    instances: dict[str, str] | None
-    witness: NotRequired[dict[str, str]]
-    smt2: NotRequired[str]
-    witness_smt2: NotRequired[str]
 
 
 class SourceRef(TypedDict):
@@ -528,4 +511,4 @@ class NodlRecord(TypedDict):
 
 
 __all__ = ["CheckRecord", "CompositionRecord", "CrosscheckRecord", "DeadlineRecord", "DiagnosisRecord", "GroundingRecord",
-           "HealthFinding", "NodlRecord", "ObligationRecord", "RequirementRecord"]
+           "NodlRecord", "ObligationRecord", "RequirementRecord"]

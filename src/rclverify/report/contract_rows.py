@@ -17,7 +17,10 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence, TypedDict, cast
 
+from msgspec.structs import replace
+
 from rclverify.report.diagnosis_text import natural_sorted  # p1 < p2 < p10
+from rclverify.records.findings import FindingRow, HealthFinding
 from rclverify.records.records import Obligation, worst
 from rclverify.records.report_schema import DerivedPropertyRow, GuaranteeRow, NodeRow, SideConditionRow
 from rclverify.records.statuses import EvidenceStatus, HealthStatus
@@ -58,26 +61,28 @@ def _stale_side_condition(sc: dict[str, Any]) -> dict[str, Any]:
 
 
 def contract_records(ws: Workspace, nodes: Sequence[str], stale: Mapping[str, set[str]],
-                     second: SecondSolver) -> tuple[dict[str, dict[str, Any]], dict[str, list[dict[str, Any]]]]:
+                     second: SecondSolver) -> tuple[dict[str, dict[str, Any]], dict[str, list[FindingRow]]]:
     """``(calculus record by node, health findings by node)`` as the report
     shows them: sealed (an altered record is error, never what it says,
     report/records.py), ``stale`` (node -> the stages made from another
-    contract text) applied, and the second solver's verdicts folded in."""
+    contract text) applied, and the second solver's verdicts folded in
+    (each finding a :class:`~rclverify.records.findings.FindingRow`)."""
     comps, health = node_records(ws, nodes)
     for n, stages in stale.items():  # never the status of an old contract text
         if "compose" in stages:
             comps[n] = {**comps[n], "side_conditions": [_stale_side_condition(sc)
                                                         for sc in comps[n].get("side_conditions", [])]}
         if "health" in stages:
-            health[n] = [f if f["status"] == "error" else
-                         {**f, "status": "stale", "message": _STALE + f["status"] + ". " + f["message"]}
+            health[n] = [f if f.status == "error" else
+                         replace(f, status="stale", message=_STALE + f.status + ". " + f.message)
                          for f in health[n]]
+    rows: dict[str, list[FindingRow]] = {}
     for n in nodes:
         if comps[n]:  # {} before the calculus ran
             comps[n] = {**comps[n], "side_conditions": [verdict_of_status(second.side_condition(sc))
                                                         for sc in comps[n].get("side_conditions", [])]}
-        health[n] = [second.finding(f) for f in health[n]]
-    return comps, health
+        rows[n] = [FindingRow.of(second.finding(f.to_json())) for f in health[n]]
+    return comps, rows
 
 
 def involved_model(sc: Mapping[str, Any]) -> SideConditionRow:
@@ -94,7 +99,7 @@ class GuaranteeStatuses:
     is the whole contract and bears on every guarantee of its node."""
 
     def __init__(self, obligations: Sequence[Obligation], status: Mapping[str, str],
-                 health: Mapping[str, Sequence[Mapping[str, Any]]]) -> None:
+                 health: Mapping[str, Sequence[HealthFinding]]) -> None:
         self.by_node: dict[str, list[Obligation]] = {}  # one pass; a scan per guarantee was quadratic
         for o in obligations:
             self.by_node.setdefault(o.node, []).append(o)
@@ -108,8 +113,8 @@ class GuaranteeStatuses:
         sts = [self.status[o.id] for o in self.by_node.get(node, []) if o.guarantee in (k, 0)]
         s = worst(sts) if sts else "unverified"
         for f in self.health[node]:
-            if f["guarantee"] in (None, k) and f["status"] != "ok":
-                s = worst([s, FINDING_AS[f["status"]]])
+            if f.guarantee in (None, k) and f.status != "ok":
+                s = worst([s, FINDING_AS[f.status]])
         return s
 
 

@@ -2,7 +2,7 @@
 acknowledgements of warnings, and the grounding in the robot's software.
 
 Each function returns its rows and changes nothing it was given (the
-acknowledgement pass marks copies of the findings and lint rows).
+acknowledgement pass marks the findings' JSON objects and copies of the lint rows).
 """
 from __future__ import annotations
 
@@ -10,18 +10,17 @@ from typing import Any, Mapping, Sequence, cast
 
 from rclverify.calculus.scale import scale_findings
 from rclverify.model.plan.acknowledged import apply_acknowledgements
-from rclverify.records.report_schema import AcknowledgementRow, FindingRow, LintRow
-from rclverify.records.stage_records import HealthFinding
+from rclverify.records.findings import FindingRow
+from rclverify.records.report_schema import AcknowledgementRow, FindingJson, LintRow
 from rclverify.report.records import diagnostics as read_diagnostics, grounding as read_grounding
 from rclverify.stages.workspace import Workspace
 
 
-def finding_rows(nodes: Sequence[str], health: Mapping[str, Sequence[Mapping[str, Any]]],
-                 side_conditions: Sequence[Mapping[str, Any]]) -> list[dict[str, Any] | HealthFinding]:
+def finding_rows(nodes: Sequence[str], health: Mapping[str, Sequence[FindingRow]],
+                 side_conditions: Sequence[Mapping[str, Any]]) -> list[FindingRow]:
     """The health findings of ``nodes`` in their order, then the side
     conditions whose ranges lie a power of ten apart (a warning, calculus/scale.py)."""
-    rows: list[dict[str, Any] | HealthFinding] = [dict(f) for n in nodes for f in health[n]]
-    return rows + scale_findings(list(side_conditions))
+    return [f for n in nodes for f in health[n]] + [FindingRow.of(f) for f in scale_findings(list(side_conditions))]
 
 
 def lint_rows(ws: Workspace) -> list[dict[str, Any]]:
@@ -30,15 +29,20 @@ def lint_rows(ws: Workspace) -> list[dict[str, Any]]:
              "code": d.get("code", "")} for d in read_diagnostics(ws)]
 
 
-def acknowledged_rows(ws: Workspace, findings: Sequence[Mapping[str, Any]], lint: Sequence[Mapping[str, Any]]
-                      ) -> tuple[list[FindingRow], list[LintRow], list[AcknowledgementRow]]:
-    """``(findings, lint, acknowledgements)``: new finding and lint rows
-    marked with what each warning flags (``flagged``, ``sha256``) and the
-    plan's answer to it (``acknowledged``), and one row per acknowledgement
-    of the plan with its status (model/plan/acknowledged.py; docs/plan.md)."""
-    f_rows, l_rows = [dict(f) for f in findings], [dict(x) for x in lint]
+def acknowledged_rows(ws: Workspace, findings: Sequence[FindingRow], lint: Sequence[Mapping[str, Any]]
+                      ) -> tuple[list[FindingJson], list[LintRow], list[AcknowledgementRow]]:
+    """``(findings, lint, acknowledgements)``: the finding rows as the
+    report's JSON objects and new lint rows, each marked with what a warning
+    flags (``flagged``, ``sha256``) and the plan's answer to it
+    (``acknowledged``), and one row per acknowledgement of the plan with its
+    status (model/plan/acknowledged.py; docs/plan.md).  Each marked finding
+    is decoded into :class:`~rclverify.records.findings.FindingRow` again, so
+    the report holds no key the class does not declare
+    (:class:`msgspec.ValidationError` otherwise: a bug of the build)."""
+    f_rows, l_rows = [f.to_json() for f in findings], [dict(x) for x in lint]
     acks = apply_acknowledgements(ws.plan.acknowledged, f_rows, l_rows, ws.checked)
-    return cast(list[FindingRow], f_rows), cast(list[LintRow], l_rows), cast(list[AcknowledgementRow], acks)
+    return ([FindingRow.of(f).to_json() for f in f_rows], cast(list[LintRow], l_rows),
+            cast(list[AcknowledgementRow], acks))
 
 
 def grounding_row(ws: Workspace) -> dict[str, Any] | None:

@@ -15,6 +15,9 @@ from __future__ import annotations
 import hashlib
 from typing import Any, Iterable, Mapping
 
+import msgspec
+
+from rclverify.records.findings import HealthFinding
 from rclverify.records.records import Obligation, SourceRef
 from rclverify.records.sealed import obligation_list, read_sealed
 from rclverify.records.stage_records import LintWarning
@@ -35,28 +38,38 @@ def _error_side_conditions(node: str, body: dict[str, Any] | None, why: str) -> 
         for sc in rows]}
 
 
-def _error_finding(node: str, why: str) -> dict[str, Any]:
-    return {"id": f"{node}.health-record", "node": node, "check": "record", "guarantee": None, "status": "error",
-            "message": f"error: contract health of {node}: {why}", "explanation": "", "model": None, "core": [],
-            "duration_s": 0.0, "instances": None}
+def _error_finding(node: str, why: str) -> HealthFinding:
+    return HealthFinding(id=f"{node}.health-record", node=node, check="record", guarantee=None, status="error",
+                         message=f"error: contract health of {node}: {why}", explanation="")
 
 
-def node_records(ws: Workspace, nodes: Iterable[str]) -> tuple[dict[str, dict[str, Any]], dict[str, list[dict[str, Any]]]]:
+def _findings(body: Mapping[str, Any] | None) -> tuple[list[HealthFinding], str]:
+    """``(findings, problem)`` of a sealed health record's content, decoded into
+    :class:`~rclverify.records.findings.HealthFinding` (``[]`` before the stage
+    ran); a key the class does not declare or a value of another type is a
+    problem (``([], why)``)."""
+    try:
+        return msgspec.convert((body or {}).get("findings", []), list[HealthFinding]), ""
+    except msgspec.ValidationError as e:
+        return [], f"contract health record malformed ({e}): altered outside rclverify"
+
+
+def node_records(ws: Workspace, nodes: Iterable[str]) -> tuple[dict[str, dict[str, Any]], dict[str, list[HealthFinding]]]:
     """``(compositions, health findings)`` of ``nodes``, by node: ``{}`` /
-    ``[]`` before the stage ran, the records' content when their seals hold,
-    and ``error`` rows otherwise (module docstring)."""
+    ``[]`` before the stage ran, the records' content when their seals hold
+    (the findings decoded, :func:`_findings`), and ``error`` rows otherwise
+    (module docstring)."""
     comps: dict[str, dict[str, Any]] = {}
-    health: dict[str, list[dict[str, Any]]] = {}
+    health: dict[str, list[HealthFinding]] = {}
     for n in nodes:
         rel = ws.calculus(n)
         body, why = read_sealed(ws.path(rel), "side-condition record")
         comps[n] = _error_side_conditions(n, body, f"{rel}: {why}") if why else (body or {})
         rel = ws.health(n)
         body, why = read_sealed(ws.path(rel), "contract health record")
-        findings = (body or {}).get("findings", [])
-        if not why and body is not None and not isinstance(findings, list):
-            why = "contract health record malformed: altered outside rclverify"
-        health[n] = [_error_finding(n, f"{rel}: {why}")] if why else list(findings)
+        findings, malformed = _findings(body) if not why else ([], "")
+        why = why or malformed
+        health[n] = [_error_finding(n, f"{rel}: {why}")] if why else findings
     return comps, health
 
 

@@ -12,7 +12,7 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 # annotations (with string annotations every key would count as required).
 from typing import Any, NotRequired, TypedDict
 
-from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceRow, FindingRow, NodeRow,
+from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceRow, FindingJson, NodeRow,
                                              LimitedBy, ObligationRow, PendingRow, ProblemRow, RequirementRow, SideConditionRow,
                                              Summary, SupportRow)
 
@@ -160,7 +160,7 @@ class Section(TypedDict):
     node: NodeRow | None
     derived: list[DerivedPropertyRow]
     side: list[SideConditionRow]
-    findings: list[FindingRow]
+    findings: list[FindingJson]
     ob_status: NotRequired[dict[str, str]]
 
 
@@ -178,7 +178,7 @@ class EvidenceRun(TypedDict):
 
 class TableRuns(TypedDict):
     """The health, obligations and evidence tables' rows cut into runs of one node each."""
-    finding_runs: list[list[FindingRow]]
+    finding_runs: list[list[FindingJson]]
     obligation_runs: list[list[ObligationRun]]
     evidence_runs: list[list[EvidenceRun]]
 

@@ -12,12 +12,13 @@ from __future__ import annotations
 import re
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 from urllib.parse import quote
 
 import jinja2
 from markupsafe import Markup, escape
 
+from rclverify.records.findings import FindingRow
 from rclverify.records.records import SEVERITY
 from rclverify.report import htmlfilters
 from rclverify.report.textfmt import breakable, formula_html, formula_lines
@@ -227,6 +228,15 @@ def model_text(model: Mapping[str, Any] | None) -> str:
     return ", ".join(f"{k} = {clip(v)}" for k, v in sorted((model or {}).items()))
 
 
+def finding_rows(rows: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
+    """The report's finding rows (``findings[]``) decoded into
+    :class:`~rclverify.records.findings.FindingRow`, so a template reads
+    declared fields only (an undeclared attribute raises under
+    ``StrictUndefined``; tests/test_record_shapes.py holds every field to a
+    renderer or :data:`~rclverify.records.findings.INTERNAL`)."""
+    return [FindingRow.of(f) for f in rows]
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -251,7 +261,7 @@ def environment() -> jinja2.Environment:
         anchor=anchor, badge=html_badge, md=md_text, code=md_code, fence=md_fence,
         mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
         formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
-        formulas=formula_html_list,
+        formulas=formula_html_list, findings=finding_rows,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame

@@ -13,7 +13,7 @@ import re
 from collections import defaultdict
 from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
-from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceRow, FindingRow, ObligationRow, ProblemRow,
+from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceRow, FindingJson, ObligationRow, ProblemRow,
                                              Report, SideConditionRow)
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
@@ -25,7 +25,7 @@ from rclverify.report.templating import COUNT_ORDER, anchor, rank
 from rclverify.report.textfmt import natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
-_Row = TypeVar("_Row", DerivedPropertyRow, SideConditionRow, FindingRow)
+_Row = TypeVar("_Row", DerivedPropertyRow, SideConditionRow, FindingJson)
 
 #: Top-level keys every report dict carries.
 REPORT_KEYS: tuple[str, ...] = (

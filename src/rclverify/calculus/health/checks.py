@@ -30,7 +30,7 @@ clause is read.
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from msgspec.structs import replace
 from typing import Any, Callable, Sequence
 
 import z3
@@ -44,6 +44,7 @@ from rclverify.lang.typecheck import domain_type
 from rclverify.lang.types import NATURAL, Checked, CheckedNode
 from rclverify.calculus.health.defined import definedness_findings
 from rclverify.calculus.health.finding import Finding as Finding  # re-exported: callers import it from here too
+from rclverify.records.statuses import HealthStatus
 from rclverify.calculus.health.realizable import realizability_findings
 from rclverify.calculus.health.shape import shape_findings
 from rclverify.calculus.health.shared import SharedEncoder, Table
@@ -445,6 +446,7 @@ def refinement_finding(node: str, spec: str, r: RefinementResult) -> Finding:
         if x.strategy:
             detail += f" Z3's default strategy gave up on the {x.name} side; answered with {x.strategy}."
     failed = next((s for s in (r.assumption, r.guarantee) if s.status == "refuted"), None)
+    status: HealthStatus
     if r.verdict == "refines":
         status, msg = "ok", f"The replacement contract {spec} refines {node}: it may replace it."
     elif failed is not None:

@@ -38,7 +38,7 @@ import hashlib
 import re
 from typing import Any, Iterable, Mapping, TypeVar
 
-from rclverify.records.report_schema import (EnvironmentAssumptionRow, FindingRow, NodeRow, ObligationRow, Report,
+from rclverify.records.report_schema import (EnvironmentAssumptionRow, FindingJson, NodeRow, ObligationRow, Report,
                                              RequirementRow, SideConditionRow)
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
@@ -50,7 +50,7 @@ from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
 
 #: A report row that names its node.
-_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingRow, EnvironmentAssumptionRow)
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingJson, EnvironmentAssumptionRow)
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")

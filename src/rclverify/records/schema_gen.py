@@ -1,0 +1,97 @@
+"""The parts of docs/assurance.schema.json generated from the record classes.
+
+Each entry of :data:`GENERATED` names a top-level key of the report and the
+:mod:`msgspec` class of one of its items; :func:`generated_part` turns
+:func:`msgspec.json.schema` of the class into the file's style (JSON Schema
+draft 2020-12, https://json-schema.org/draft/2020-12): each class inlined
+as an object that rejects unknown keys, every nested object too; no
+``title`` or ``default`` (the class's docstring and field descriptions say
+what a missing key means); an enumeration equal to one of the status
+vocabularies of :mod:`rclverify.records.statuses` written as a ``$ref`` to
+that vocabulary's ``$defs`` entry, and a class named in :data:`SHARED` as a
+``$ref`` to its ``$defs`` entry.
+
+``python -m rclverify.records.schema_gen [FILE]`` rewrites those parts of
+``FILE`` (default ``docs/assurance.schema.json``) in place through
+core/atomic.py and leaves every other part as it is; it prints what it
+rewrote.  tests/test_record_shapes.py fails when the file and the classes
+differ.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import msgspec
+
+from rclverify.core.atomic import atomic_write_text
+from rclverify.records.findings import FindingRow
+from rclverify.records.statuses import VOCABULARY
+
+#: Top-level key of the report -> (the class of its items, the key's description).
+GENERATED: dict[str, tuple[type[msgspec.Struct], str]] = {
+    "findings": (FindingRow, "Contract health findings (vacuity, consistency, realizability, scale)."),
+}
+
+#: A type the report's schema already defines in ``$defs`` -> that entry's name.
+SHARED: dict[str, str] = {"Solvers": "solvers"}
+
+
+def _styled(x: Any, defs: dict[str, Any]) -> Any:
+    """``x`` (a part of msgspec's schema whose ``$defs`` are ``defs``) in the file's style (module docstring)."""
+    if isinstance(x, list):
+        return [_styled(v, defs) for v in x]
+    if not isinstance(x, dict):
+        return x
+    if "$ref" in x:
+        name = x["$ref"].rsplit("/", 1)[1]
+        if name in SHARED:
+            return {"$ref": f"#/$defs/{SHARED[name]}", **{k: v for k, v in x.items() if k != "$ref"}}
+        return _styled({**defs[name], **{k: v for k, v in x.items() if k != "$ref"}}, defs)
+    if "enum" in x:
+        for name, words in VOCABULARY.items():
+            if set(x["enum"]) == set(words):
+                return {"$ref": f"#/$defs/{name}", **{k: v for k, v in x.items() if k != "enum"}}
+    out = {k: _styled(v, defs) for k, v in x.items() if k not in ("title", "default")}
+    if out.get("type") == "object" and "properties" in out:
+        head = {k: out.pop(k) for k in ("type", "description", "required", "properties") if k in out}
+        out = {**head, **out}
+    return out
+
+
+def generated_part(key: str) -> dict[str, Any]:
+    """The schema of the report's top-level ``key`` (an array of its class's items), in the file's style."""
+    cls, description = GENERATED[key]
+    raw = msgspec.json.schema(cls)
+    item = _styled({"$ref": raw["$ref"]}, raw.get("$defs", {}))
+    return {"type": "array", "items": item, "description": description}
+
+
+def with_generated(schema: dict[str, Any]) -> dict[str, Any]:
+    """``schema`` (the report's whole schema) with every generated part put in its place (order kept)."""
+    props = {k: generated_part(k) if k in GENERATED else v for k, v in schema["properties"].items()}
+    return {**schema, "properties": props}
+
+
+def schema_text(schema: dict[str, Any]) -> str:
+    """The schema file's text: JSON, one-space indent, final newline."""
+    return json.dumps(schema, indent=1, ensure_ascii=False) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Rewrite the generated parts of the schema file (module docstring); 0, or 2 when it cannot be read."""
+    path = Path((argv if argv is not None else sys.argv[1:] or ["docs/assurance.schema.json"])[0])
+    try:
+        schema = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as e:
+        print(f"error: {path}:1:1: {e}", file=sys.stderr)
+        return 2
+    changed = atomic_write_text(path, schema_text(with_generated(schema)))
+    print(f"{path}: {', '.join(GENERATED)} {'rewritten' if changed else 'unchanged'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
