@@ -83,9 +83,11 @@ def test_a_max_for_min_over_a_float64_sequence_is_found_and_its_twin_passes(tmp_
     assert good.counts.valid == 200 and good.counts.rejected == 0, good.counts  # by construction: no filtering
     items = [q for s in seen for q in s]
     assert all(s for s in seen)  # exists(...): at least one item, drawn so
-    assert all(-Fraction("3.14") <= Fraction(q) <= Fraction("3.14") for q in items)  # as exact rationals
-    assert Fraction(3.14) > Fraction("3.14")  # the double 3.14 lies outside: its neighbour inside is the end
-    assert (min(items), max(items)) == (math.nextafter(-3.14, 0), math.nextafter(3.14, 0))
+    # the ends: 3.14 as the float64 field carries it (the double 3.14), or, read as the exact decimal, the
+    # double next to it inside (the double 3.14 lies just above the decimal)
+    assert Fraction(3.14) > Fraction("3.14")
+    assert all(-3.14 <= q <= 3.14 for q in items)
+    assert min(items) in (-3.14, math.nextafter(-3.14, 0)) and max(items) in (3.14, math.nextafter(3.14, 0))
 
 
 def test_the_plans_bounds_of_a_sequence_bound_its_items_with_their_edges(tmp_path: Path) -> None:
@@ -115,3 +117,69 @@ def test_bounds_on_an_input_without_numbers_are_refused(tmp_path: Path) -> None:
     (tmp_path / "impl.py").write_text("def step(on):\n    return {'y': on}\n")
     with pytest.raises(ConfigError, match="BOOL has no numbers to bound"):
         read_config({"implementation": "impl.py:step", "bounds": {"in.on": [0, 1]}}, checked.nodes["B"], tmp_path)
+
+
+# -- one mapping per plan ------------------------------------------------------------------------
+
+RANGER = """
+node Ranger {
+  inputs( dist : REAL )
+  outputs( near : BOOL )
+  topics( sensor_msgs/Range range matches(in.dist), std_msgs/Bool near matches(out.near) )
+  assume( 0 <= in.dist and in.dist <= 10 )
+  guarantee( out.near <=> in.dist <= 0.2 )
+}
+"""
+
+#: records each call's input; decides at the carried threshold (float32 0.2)
+RANGER_IMPL = '''import json, pathlib, struct
+SEEN = pathlib.Path(__file__).with_name("seen.jsonl")
+
+def step(dist):
+    with SEEN.open("a") as fh:
+        fh.write(json.dumps(dist) + "\\n")
+    return {"near": dist <= struct.unpack("<f", struct.pack("<f", 0.2))[0]}
+'''
+
+
+def _ranger(tmp: Path, mapping: str, named: bool) -> tuple[Any, list[Any]]:
+    """The property test of the range reader in a workspace whose mapping file lies at ``mapping``
+    (named by the plan's monitors entry when ``named``): the evidence, the target and every drawn input."""
+    from rclverify.backends.property_tests.backend import PropertyTestsBackend
+    from rclverify.stages.workspace import Workspace
+    (tmp / "contracts").mkdir(parents=True)
+    (tmp / "contracts" / "ranger.rcl").write_text(RANGER)
+    (tmp / "impl.py").write_text(RANGER_IMPL)
+    (tmp / mapping).parent.mkdir(parents=True, exist_ok=True)
+    (tmp / mapping).write_text("topics:\n  range: {fields: [range]}\n  near: {fields: [data]}\n")
+    (tmp / "contracts" / "plan.yaml").write_text(
+        "contracts: [contracts/ranger.rcl]\nnodes:\n  Ranger:\n    evidence:\n      - backend: property_tests\n"
+        "        implementation: impl.py:step\n        max_examples: 40\n      - backend: monitors\n"
+        + (f"        mapping: {mapping}\n" if named else "") + "        traces: []\n")
+    target = Workspace(tmp).target("Ranger", 0)
+    backend = PropertyTestsBackend()
+    obligation = backend.export(target)[0]
+    ev = backend.run(obligation, target)
+    seen = [json.loads(line) for line in (tmp / "seen.jsonl").read_text().splitlines()]
+    return (ev, target, obligation), seen
+
+
+def _f32(x: float) -> float:
+    import struct
+    return float(struct.unpack("<f", struct.pack("<f", x))[0])
+
+
+@pytest.mark.parametrize("mapping, named", [("contracts/mapping.yaml", True),
+                                            ("backends/monitors/mapping.yaml", False)])
+def test_the_property_tests_read_widths_from_the_mapping_the_plan_names(tmp_path: Path, mapping: str,
+                                                                        named: bool) -> None:
+    """Range's float32 ``range`` (not its uint8 ``radiation_type``, the first field the message has) is
+    drawn at float32 width: the mapping the plan's monitors entry names at a path of its own, and the
+    control at the default path the plan need not name.  The mapping is an input of the obligation."""
+    (ev, target, obligation), seen = _ranger(tmp_path, mapping, named)
+    assert target.mapping == (mapping if named else None)  # none named: the default path
+    assert ev.status == "discharged", ev.explanation
+    assert mapping in obligation.inputs
+    assert all(_f32(v) == v and 0 <= v <= 10 for v in seen)  # binary32 values within the assumption
+    assert any(v != int(v) for v in seen)  # not the integers 0..4 of radiation_type
+    assert _f32(0.2) in seen  # the threshold as the field carries it

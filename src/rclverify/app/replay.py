@@ -31,7 +31,8 @@ def check_from_workspace(root: Path, plan_file: str, node: str, entry: int, guar
     """
     target = Workspace(root, plan_file).target(node, entry)
     cfg = read_config(target.config, target.node, target.root)
-    return run_guarantee(target.checked, target.node, guarantee, cfg, target.root, target.facts)
+    return run_guarantee(target.checked, target.node, guarantee, cfg, target.root, target.facts,
+                         mapping=target.mapping)
 
 
 __all__ = ["check_from_workspace"]

@@ -5,7 +5,8 @@ section names, ground the contracts in it, write
 
 ``ros:`` keys (docs/ros.md): ``workspaces`` (directories), ``launch``
 (entry launch files), ``args`` (launch arguments), ``bags``, ``mapping``
-(field lists; default ``backends/monitors/mapping.yaml`` when present),
+(field lists; else the plan's one mapping file,
+:func:`~rclverify.model.plan.mapping_file.plan_mapping`),
 ``fields`` (``{topic: [field paths]}``, overrides the mapping), ``nodes``
 (``{ContractNode: /graph/node}``), ``ignore`` (graph nodes left out).
 Every path is workspace-relative and must stay inside the workspace.
@@ -20,6 +21,7 @@ from typing import Any
 from rclverify.lang import ast
 from rclverify.records.stage_records import GroundedNode, GroundingContext, GroundingRecord
 from rclverify.model.plan.errors import plan_error
+from rclverify.model.plan.mapping_file import DEFAULT_MAPPING, plan_mapping
 from rclverify.ros.extract import names
 from rclverify.ros.graph.inputs import input_files
 
@@ -28,7 +30,6 @@ GROUNDING = "artifacts/ros/grounding.json"
 DOT = "artifacts/ros/grounding.dot"
 SVG = "artifacts/ros/grounding.svg"
 CACHE = "artifacts/cache/ros-scan.pickle"
-DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 
 
 def _paths(ws: Any, key: str, missing: list[Any] | None = None) -> list[Path]:
@@ -57,7 +58,7 @@ def _fields(ws: Any) -> dict[str, list[str]]:
     import yaml  # deferred: start-up (loads yaml only when called)
     ros = ws.plan.ros
     out: dict[str, list[str]] = {}
-    mapping = ros.get("mapping") or (DEFAULT_MAPPING if (ws.root / DEFAULT_MAPPING).is_file() else None)
+    mapping = plan_mapping(ws.plan) or DEFAULT_MAPPING  # the plan's one mapping file (ros.mapping, else the monitors entries')
     if mapping:
         try:
             data = yaml.safe_load((ws.root / mapping).read_text(encoding="utf-8")) or {}

@@ -50,7 +50,11 @@ class NodeTarget:
                         where the backend renders its files;
     ``index``           position of this entry among the node's evidence
                         entries (distinguishes two entries of one backend);
-    ``plan_locs``       the plan's value locations (see :meth:`config_loc`).
+    ``plan_locs``       the plan's value locations (see :meth:`config_loc`);
+    ``mapping``         the workspace-relative trace mapping file the plan names
+                        for this entry (:func:`~rclverify.model.plan.mapping_file.plan_mapping`;
+                        ``None``: none, the default path if present), where every
+                        backend reads what a field carries.
     """
 
     root: Path
@@ -63,6 +67,7 @@ class NodeTarget:
     artifacts: Path = field(default_factory=Path)
     index: int = 0
     plan_locs: Mapping[tuple[Any, ...], ast.Loc] = field(default_factory=dict)
+    mapping: str | None = None
 
     def config_loc(self, *path: Any, key: bool = False) -> ast.Loc:
         """Where ``nodes.<Node>.evidence[index].<path...>`` is written in the plan.

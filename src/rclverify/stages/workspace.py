@@ -258,12 +258,13 @@ class Workspace:
 
     def target(self, node: str, index: int) -> NodeTarget:
         from rclverify.backends.base import NodeTarget  # deferred: start-up (loads yaml, rclverify.backends and more only when called)
+        from rclverify.model.plan.mapping_file import plan_mapping  # deferred: start-up (as NodeTarget)
         entry = self.plan.evidence[node][index]
         return NodeTarget(
             root=self.root.resolve(), checked=self.checked, node=self.checked.nodes[node], config=entry.config,
             facts=tuple(f.expr for f in self.plan.facts.get(node, ())), contract_files=self.plan.contracts,
             plan_file=self.plan.file, artifacts=(self.root / "artifacts" / entry.backend / node).resolve(), index=index,
-            plan_locs=self.plan.locs)
+            plan_locs=self.plan.locs, mapping=plan_mapping(self.plan, node, entry.config))
 
 
 def node_snapshots(ws: Workspace, texts: Any) -> dict[str, dict[str, Any]]:

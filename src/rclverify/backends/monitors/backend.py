@@ -119,7 +119,9 @@ class MonitorsBackend:
     def _config(self, target: NodeTarget) -> MonitorConfig:
         c = target.config
         try:
-            return load_mapping(target.root, c.get("mapping"), c.get("horizon"), c.get("traces", ()),
+            # the entry's mapping, else the one the plan names for it (model/plan/mapping_file.py)
+            rel = target.mapping if c.get("mapping") is None else c.get("mapping")
+            return load_mapping(target.root, rel, c.get("horizon"), c.get("traces", ()),
                                 c.get("tolerance"))
         except ConfigError as exc:
             if exc.located:  # an error inside the mapping file: located there

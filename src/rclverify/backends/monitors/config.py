@@ -38,10 +38,10 @@ from rclverify.model.plan.yamlguard import read_yaml_text, safe_load_guarded
 from rclverify.backends.monitors.skew import DEFAULT_SKEW_S, parse_skew
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.yamlguard import load_located
+from rclverify.model.plan.mapping_file import DEFAULT_MAPPING as DEFAULT_MAPPING  # the one default path, re-exported
 from rclverify.model.plan.paths import escape_reason
 from rclverify.lang.errors import Diagnostic
 
-DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
 DEFAULT_HORIZON = 5.0
 
 

@@ -1,7 +1,8 @@
 """Recorded runs as evidence for a temporal requirement (docs/plan.md, "Traces of a temporal requirement").
 
 Which runs: the traces of the plan's ``monitors`` entries of the nodes the
-statement reads, each with its entry's mapping (no new plan key: a run the
+statement reads, each with its entry's mapping file (the one the plan names
+for the entry, :func:`~rclverify.model.plan.mapping_file.plan_mapping`; no new plan key: a run the
 plan records for a node is a run of the system those nodes are part of).
 A trace named by several entries is checked once, with the first entry's
 mapping.
@@ -31,6 +32,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rclverify.model.plan.mapping_file import plan_mapping
 from rclverify.model.plan.model import Plan, Requirement
 from rclverify.model.plan.state import state_types
 from rclverify.model.plan.temporal import Temporal, operands, parse_temporal
@@ -66,7 +68,7 @@ def requirement_traces(req: Requirement, checked: Checked, plan: Plan) -> list[t
         for e in plan.evidence.get(n, ()):
             if e.backend == "monitors":
                 for tr in e.config.get("traces", ()) or ():
-                    out.setdefault(str(tr), e.config.get("mapping"))
+                    out.setdefault(str(tr), plan_mapping(plan, n, e.config))
     return list(out.items())
 
 

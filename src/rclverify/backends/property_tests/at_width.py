@@ -123,21 +123,35 @@ def carried_value(space: InputSpace, t: T.Type, bd: Bound | None, c: Carried) ->
     return out
 
 
-def carried_in(root: Path, node: CheckedNode) -> tuple[dict[str, str], dict[str, Carried]]:
+def carried_in(root: Path, node: CheckedNode, mapping: str | None = None) -> tuple[dict[str, str], dict[str, Carried]]:
     """``(widths, carried)`` of ``node``'s inputs and outputs (``"in.x"`` keys), read with the
-    workspace's monitor mapping (its rules and message folders): the floating widths the contract's
-    constants are compared at (:func:`~rclverify.backends.monitors.widths.float_widths`) and what each
-    field carries (:func:`~rclverify.backends.monitors.widths.carried_fields`); both ``{}`` when the
-    mapping does not load (the monitors backend reports it)."""
+    workspace's mapping file ``mapping`` (workspace-relative, the one the plan names:
+    :func:`~rclverify.model.plan.mapping_file.plan_mapping`; ``None``: the default path), its
+    rules and message folders: the floating widths the contract's constants are compared at
+    (:func:`~rclverify.backends.monitors.widths.float_widths`) and what each field carries
+    (:func:`~rclverify.backends.monitors.widths.carried_fields`); both ``{}`` when the mapping does
+    not load (the monitors backend and the plan's checks report it)."""
     from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (yaml, the mapping)
     from rclverify.backends.monitors.widths import carried_fields, float_widths  # deferred: as above
     try:
-        mapping = load_mapping(root, None)
+        cfg = load_mapping(root, mapping)
     except Exception:  # noqa: BLE001 - the monitors backend reports a mapping that does not load; no width here
         return {}, {}
-    dirs = [root / d for d in mapping.msg_dirs]
-    fields = carried_fields(node, mapping.rules, dirs)
+    dirs = [root / d for d in cfg.msg_dirs]
+    fields = carried_fields(node, cfg.rules, dirs)
     return float_widths(node, fields), {k: src.carried for k, src in fields.items()}
+
+
+def mapping_inputs(root: Path, mapping: str | None = None) -> list[str]:
+    """The workspace-relative files what a field carries is read from: the mapping file ``mapping``
+    (as :func:`carried_in`) when it exists and the ``.msg`` files under its ``msg_dirs`` (``[]``
+    when it does not load)."""
+    from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (yaml, the mapping)
+    try:
+        cfg = load_mapping(root, mapping)
+    except Exception:  # noqa: BLE001 - reported by the monitors backend and the plan's checks
+        return []
+    return [*([cfg.mapping] if cfg.mapping else []), *cfg.msg_files(root)]
 
 
 def input_strategies(space: InputSpace, carried: dict[str, Carried]) -> dict[str, st.SearchStrategy[Any]]:
@@ -151,4 +165,4 @@ def input_strategies(space: InputSpace, carried: dict[str, Carried]) -> dict[str
     return out
 
 
-__all__ = ["carried_in", "carried_value", "input_strategies", "scalar_at"]
+__all__ = ["carried_in", "carried_value", "input_strategies", "mapping_inputs", "scalar_at"]

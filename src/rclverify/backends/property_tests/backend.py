@@ -37,6 +37,7 @@ from rclverify.backends.property_tests.closure import import_closure, outside_ve
 from rclverify.backends.property_tests.importpath import on_harness_path
 from rclverify.backends.property_tests.declared import declaration_rows, has_declarations
 from rclverify.backends.property_tests.seeding import SeedingCut, split_facts
+from rclverify.backends.property_tests.at_width import mapping_inputs
 from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 import inspect
 from rclverify.backends.shapes import DeclarationRow, PropertyTestDetails
@@ -144,7 +145,9 @@ class PropertyTestsBackend:
         path = test_file(target)
         atomic_write_text(path, render_tests(target, cfg, _is_class(target, cfg)))
         closure, outside = import_closure(target.root, cfg.file)  # every workspace module the code imports
-        inputs = tuple(sorted({cfg.file, *closure, *target.contract_files, target.plan_file}))
+        # the mapping and the message definitions tell what each field carries: the inputs' widths
+        carried = mapping_inputs(target.root, target.mapping)
+        inputs = tuple(sorted({cfg.file, *closure, *target.contract_files, target.plan_file, *carried}))
         imported = outside_versions(outside)
         out = []
         for k, g in enumerate(target.node.node.guarantees, 1):
@@ -181,7 +184,8 @@ class PropertyTestsBackend:
             impl = _load(target, cfg)  # imported once for the run: the test file's kind and the run itself
             atomic_write_text(path, render_tests(target, cfg, inspect.isclass(impl)))
             with wall_clock_limit(cfg.timeout_s):
-                outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts, impl)
+                outcome = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts, impl,
+                                        target.mapping)
         except TimeLimitExceeded as exc:
             return evidence("inconclusive", f"{cfg.implementation}: the run of guarantee {k} {exc} (timeout_s of "
                             f"the plan entry, {target.config_loc('timeout_s') if 'timeout_s' in target.config else 'default'}"

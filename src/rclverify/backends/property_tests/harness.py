@@ -424,10 +424,13 @@ def _example_text(cex: Mapping[str, str]) -> str:
 
 
 def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Config, root: Path,
-                  facts: tuple[ast.Expr, ...] = (), impl: Any = None) -> Outcome:
+                  facts: tuple[ast.Expr, ...] = (), impl: Any = None, mapping: str | None = None) -> Outcome:
     """Run guarantee ``guarantee`` (1-based) of ``node`` on the implementation
     ``impl`` (loaded afresh here when ``None``: :func:`load_implementation`),
-    inputs drawn under the assumption and the environment ``facts`` (parsed plan facts),
+    inputs drawn under the assumption and the environment ``facts`` (parsed plan facts)
+    at the widths of the fields the mapping file ``mapping`` names (workspace-relative, the
+    plan's: :attr:`~rclverify.backends.base.NodeTarget.mapping`; ``None``: the default path;
+    :func:`.at_width.carried_in`),
     with the harness's folders first on ``sys.path`` (:func:`.importpath.on_harness_path`).
 
     An import closure (:func:`.closure.resolve_closure`) with an import that
@@ -443,7 +446,7 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
                        f"with the evidence: {'; '.join(unhashed)}", Counts(), unhashed=unhashed)
     if impl is None:
         impl = load_implementation(root, cfg)
-    widths, carried = carried_in(root, node)
+    widths, carried = carried_in(root, node, mapping)
     with on_harness_path(root, cfg.file):
         return GuaranteeRun(checked, at_carried_widths(node, widths, checked.env.constants), guarantee, cfg, impl,
                             facts, widths=widths, carried=carried).run()
