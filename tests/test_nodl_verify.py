@@ -124,3 +124,31 @@ def test_a_workspace_without_documents_has_no_nodl_part(tmp_path: Path) -> None:
     ws = _copy(tmp_path / "manipulator")
     shutil.rmtree(ws / "nodl")
     assert read_nodl(Workspace(ws, "contracts/plan.yaml")) is None
+
+
+def test_a_parameters_declared_constraints_ensure_an_environment_assumption(tmp_path: Path) -> None:
+    """tests/data/nodl/ws: Base assumes ``0 < in.limit and in.limit <= MaxSpeed`` of the input its parameter
+    ``limit`` sets, declared ``gt 0`` and ``lt_eq 1.2``: both conjuncts are ensured (Z3: proved), which the
+    report's environment assumptions say; declared ``lt_eq 1.8`` the second is refuted, an error at the
+    conjunct and at the parameter, and no longer said to be ensured."""
+    ws = tmp_path / "ws"
+    shutil.copytree(Path(__file__).parent / "data" / "nodl" / "ws", ws)
+    assert main(["verify", "-w", str(ws)]) == 0
+    report = _read(ws)
+    check_report(report, "nodl ws")
+    assert [(s["conjunct"], s["status"]) for s in report["nodl"]["side_conditions"]] == [
+        ("0 < in.limit", "proved"), ("in.limit <= MaxSpeed", "proved")]
+    md = (ws / "reports" / "assurance.md").read_text(encoding="utf-8")
+    assert md.count("ensured by NoDL parameter `limit`") == 2
+    doc = ws / "nodl" / "Base.nodl.json"
+    doc.write_text(doc.read_text(encoding="utf-8").replace('"lt_eq<>": [1.2]', '"lt_eq<>": [1.8]'), encoding="utf-8")
+    assert main(["verify", "-w", str(ws)]) == 0
+    report = _read(ws)
+    [f] = [f for f in report["nodl"]["findings"] if f["code"] == "nodl-parameter-assume"]
+    rcl = (ws / "contracts" / "robot.rcl").read_text(encoding="utf-8").splitlines()
+    assert [(p["file"], p["line"]) for p in f["places"]] == [
+        ("contracts/robot.rcl", next(i for i, t in enumerate(rcl, 1) if "assume( 0 < in.limit" in t)),
+        ("nodl/Base.nodl.json", _line_of(doc, '"limit"'))]
+    assert "limit = 9/5" in f["message"] or "limit = 1.8" in f["message"], f["message"]
+    md = (ws / "reports" / "assurance.md").read_text(encoding="utf-8")
+    assert md.count("ensured by NoDL parameter `limit`") == 1 and not report["meta"]["strict_ok"]
