@@ -122,7 +122,7 @@ PIPELINE = frozenset({
     "test_one_row_per_cause", "test_repairs_units", "test_report_hygiene", "test_report_schema",
     "test_example_safety_stop", "test_init", "test_stage_records", "test_what_runs_is_hashed",
     "test_example_ros2_robot",  # its one live test is marked in the module (the rest is offline)
-    "test_margins_monitor", "test_margins_chain", "test_near_misses",
+    "test_margins_monitor", "test_margins_chain", "test_near_misses", "test_margin_targets",
 })
 
 #: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.

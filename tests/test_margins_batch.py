@@ -115,7 +115,7 @@ def _both(node: str, events: list[Event]) -> tuple[Any, Any, int]:
 
 
 def _margins(res: Any) -> dict[int, Any]:
-    return {k: (m.value, m.unit, m.atom, m.event, m.where, m.question, m.answers) for k, m in res.margins.items()}
+    return {k: (m.value, m.unit, m.atom, m.event, m.where, m.question, m.answers, m.lowest) for k, m in res.margins.items()}
 
 
 @pytest.mark.parametrize("node", ["Classifier", "Linear", "Stop", "Echo"])

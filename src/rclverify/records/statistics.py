@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Iterable, Mapping, Protocol, TypedDict
+from typing import Any, Iterable, Mapping, NotRequired, Protocol, TypedDict
 
 #: What a target counts: a whole run with any violation, or one judged answer.
 PER = ("run", "answer")
@@ -122,6 +122,8 @@ class TargetJson(TypedDict):
     per: str
     text: str
     guarantee: int
+    #: a margin target (docs/statistics.md, "Margin targets"): the least margin a trial must keep
+    margin: NotRequired[float]
 
 
 class TargetDecision(TypedDict):

@@ -52,7 +52,7 @@ from rclverify.targets.column_margins import ColumnMargin, MarginCompiler
 from rclverify.targets.columns import ColumnCompiler, Unsupported, io_kind, seed
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
-from rclverify.backends.monitors.verdicts import NodeResult, Verdict
+from rclverify.backends.monitors.verdicts import KEPT_MARGINS, NodeResult, Verdict
 
 #: Events read per chunk: the columns held at once.
 CHUNK = 16384
@@ -333,8 +333,9 @@ class _Run:
             j = int(np.argmin(value))
             text, unit = plan.atoms[int(atom[j])] if atom[j] >= 0 else ("", "")
             qe, ev = chunk[int(at[j])], chunk[int(at[j]) + 1]
+            few = value if len(value) <= KEPT_MARGINS else np.partition(value, KEPT_MARGINS - 1)[:KEPT_MARGINS]
             m.result.note_margins(k, m._texts[k], float(value[j]), unit, text, "double",
-                                  (ev.index, ev.time, ev.where, qe.where), len(at))
+                                  (ev.index, ev.time, ev.where, qe.where), len(at), few.tolist())
         least: np.ndarray = np.minimum.reduce([v for v, _ in margins])
         return least
 

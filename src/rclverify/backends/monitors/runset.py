@@ -32,6 +32,7 @@ from rclverify.model.plan.targets import entry_environment, entry_origin, entry_
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.verdicts import NodeResult
 from rclverify.backends.monitors.shapes import RunCounts
+from rclverify.backends.monitors.margin_target import of_margin
 
 #: The suffixes of a bag file (a directory is a ROS 2 bag too).
 BAG_SUFFIXES = (".bag", ".mcap", ".db3")
@@ -404,7 +405,9 @@ def runset_obligations(target: NodeTarget, traces: list[str], per_trace: list[Ob
     oid = make_obligation_id(target.node.name, k, "monitors", f"runs_{env}_e{target.index}")
     what = f"guarantee {k}" if k else "its contract"
     statement = (f"the runs of {target.node.name} recorded under {env} bound the probability that a "
-                 f"{t.per} violates {what}: {t.words()}")
+                 f"{t.per} violates {what}: {t.words()}" if t.margin is None else
+                 f"the runs of {target.node.name} recorded under {env} bound the probability that a {t.per} "
+                 f"keeps less than {t.margin:g} of guarantee {k}'s margin: {t.words()}")
     data = {"trace": "", "run_set": list(traces), "target": t.to_json(), "environment": env}
     if not per_trace:  # a target and no run: pending, never silently dropped
         loc = target.node.node.guarantees[k - 1].loc if k else target.node.node.loc
@@ -447,10 +450,14 @@ def run_runset(check_one: Callable[[Obligation, NodeTarget], Evidence], obligati
         one = dataclasses.replace(target, config={**target.config, "traces": [trace]})
         ev = check_one(dataclasses.replace(obligation, data={**own, "trace": trace}, inputs=()), one)
         stats = (ev.details or {}).get("statistics")
+        if t.margin is not None and isinstance(stats, dict):  # a margin target: the answers below its margin
+            mon = (ev.details or {}).get("monitoring") or {}
+            stats = of_margin(stats, mon.get("margins") or (), t.guarantee, t.margin, t.per)
         rows.append(stats if isinstance(stats, dict) else
                     {"trace": trace, "sha256": f"unread:{trace}", "status": ev.status, "answers": 0,
                      "violations": 0, "inconclusive": 0, "seconds": 0.0, "reason": ev.explanation})
-    counted = [] if origin == "harness" else [of_guarantee(r, t.guarantee) for r in rows] if t.guarantee else rows
+    counted = ([] if origin == "harness" else rows if t.margin is not None
+               else [of_guarantee(r, t.guarantee) for r in rows] if t.guarantee else rows)
     counts = count_runs(counted)
     verdict = decide(counts, t)
     status, explanation = verdict["status"], f"under {env}: {verdict['explanation']}"

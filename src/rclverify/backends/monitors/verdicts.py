@@ -34,6 +34,9 @@ VERDICTS = ("satisfied", "violated", "open", "assumption violated", "inconclusiv
 WEAK = {"exact": 0, "double": 1, "tolerance": 2}
 #: Violations kept per node and run (each a few hundred bytes; the count is exact beyond it).
 KEPT_VIOLATIONS = 200
+#: How many of each guarantee's smallest margins a run keeps (a margin target counts the answers below its
+#: margin from them; docs/statistics.md, "Margin targets")
+KEPT_MARGINS = 256
 LINK_TOPICS = {"service": ("request", "response"), "action": ("goal", "feedback", "result")}
 
 
@@ -100,7 +103,8 @@ class GuaranteeMargin:
     the output message it was judged on and ``question`` where that
     message's question was raised (``""``: none); ``answers`` how many judged
     answers gave the guarantee a margin, ``undefined`` how many had none
-    (docs/semantics.md, "Margins")."""
+    (docs/semantics.md, "Margins"); ``lowest`` the :data:`KEPT_MARGINS`
+    smallest of those margins, ascending (all of them on a shorter run)."""
 
     guarantee: int
     formula: str
@@ -114,6 +118,14 @@ class GuaranteeMargin:
     question: str = ""
     answers: int = 1
     undefined: int = 0
+    lowest: list[float] = field(default_factory=list)
+
+    def keep(self, values: Any) -> None:
+        """Keep the smallest of ``lowest`` and ``values`` (floats), at most :data:`KEPT_MARGINS`."""
+        low = self.lowest
+        if len(low) >= KEPT_MARGINS and not any(v < low[-1] for v in values):
+            return
+        self.lowest = sorted([*low, *values])[:KEPT_MARGINS]
 
     def to_json(self, trace: str = "") -> dict[str, Any]:
         """A JSON-ready dict: ``margin`` the value, ``null`` when infinite (then
@@ -126,7 +138,9 @@ class GuaranteeMargin:
                                "unit": self.unit, "atom": self.atom,
                                "arithmetic": self.arithmetic, "event": self.event, "time": self.time,
                                "where": self.where, "question": self.question, "answers": self.answers,
-                               "undefined": self.undefined}
+                               "undefined": self.undefined,
+                               # -inf (decided by an atom without a distance, violated) as null
+                               "lowest": [v if math.isfinite(v) else None for v in self.lowest if v != math.inf]}
         if trace:
             out["trace"] = trace
         return out
@@ -211,22 +225,26 @@ class NodeResult:
                 self.margins[k] = GuaranteeMargin(k, formula, math.nan, "", "", "", -1, 0.0, "", "", 0, 1)
             return
         if kept is None:
-            self.margins[k] = GuaranteeMargin(k, formula, value, unit, atom, arithmetic, *at)
+            self.margins[k] = GuaranteeMargin(k, formula, value, unit, atom, arithmetic, *at, lowest=[value])
             return
+        kept.keep((value,))
         kept.answers += 1
         if kept.answers == 1 or value < kept.value:  # answers == 1: the first after only undefined ones
             kept.value, kept.unit, kept.atom, kept.arithmetic = value, unit, atom, arithmetic
             kept.event, kept.time, kept.where, kept.question = at
 
     def note_margins(self, k: int, formula: str, value: float, unit: str, atom: str, arithmetic: str,
-                     at: tuple[int, float, str, str], answers: int) -> None:
+                     at: tuple[int, float, str, str], answers: int, lowest: Any = ()) -> None:
         """Count ``answers`` margins of guarantee ``k`` at once (the batch path),
-        ``value`` the smallest of them, on the answer ``at``: as that many
+        ``value`` the smallest of them, on the answer ``at``, ``lowest`` the
+        smallest of them (at least :data:`KEPT_MARGINS`, or all): as that many
         :meth:`note_margin` calls in order would."""
         kept = self.margins.get(k)
         if kept is None:
-            self.margins[k] = GuaranteeMargin(k, formula, value, unit, atom, arithmetic, *at, answers=answers)
+            self.margins[k] = kept = GuaranteeMargin(k, formula, value, unit, atom, arithmetic, *at, answers=answers)
+            kept.keep(lowest)
             return
+        kept.keep(lowest)
         first = not kept.answers
         kept.answers += answers
         if first or value < kept.value:

@@ -77,6 +77,9 @@ def requirement_target(text: Any, loc: ast.Loc) -> Target | None:
     if t.per != "run":
         raise plan_error(loc.file, loc.line, loc.col, "a requirement's target counts per run (a run gives the "
                                                       "requirement one verdict), not per answer")
+    if t.margin is not None:
+        raise plan_error(loc.file, loc.line, loc.col, "a requirement's target counts violating runs: a margin "
+                                                      "target belongs on a node's monitors entry")
     if t.guarantee:
         raise plan_error(loc.file, loc.line, loc.col, "a requirement's target is about the requirement: 'of "
                                                       "guarantee K' belongs on a node's evidence entry")
@@ -102,7 +105,10 @@ def _entry_problems(e: EvidenceEntry, at: Any, guarantees: int | None) -> list[D
             except ValueError as exc:
                 bad("target", str(exc))
             else:
-                if e.backend == "experiment" and t.guarantee:
+                if e.backend == "experiment" and t.margin is not None:
+                    bad("target", "an experiment entry's target counts trials that miss its criterion: a margin "
+                                  "target belongs on a monitors entry (its runs' answers have margins)")
+                elif e.backend == "experiment" and t.guarantee:
                     bad("target", "an experiment entry's target is about the entry's guarantee: leave out "
                                   "'of guarantee K'")
                 elif guarantees is not None and t.guarantee > guarantees:
