@@ -1,6 +1,7 @@
 """NoDL documents against the running ROS 2 graph (docs/nodl.md, "Against the running graph"): real rclpy nodes on
 Fast DDS (tests/_ros2.py), read by ``rclverify nodl check --ros2`` through rclverify's own DDS participant and
-through rclpy's graph API (``--source dds``, ``--source rclpy``).
+through rclpy's graph API (``--source dds``, ``--source rclpy``), and by ``rclverify ros diff --nodl`` (the
+documents as the expected graph, through rclpy's graph API).
 
 The documents are tests/data/nodl/ws's.  One process runs two nodes: ``Guard`` exactly as its document says (the
 control: reliable, transient-local ``/stop``, best-effort ``/scan``) and ``Base`` with one seeded mismatch of each
@@ -65,6 +66,11 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
             procs.append(p)
             code = p.wait(120)
             out[source] = {"code": code, "log": log.read_text()}
+        log = tmp / "diff.log"  # the documents as ros diff's expected graph (rclpy's graph API, as above)
+        p = rclverify(["ros", "diff", "--nodl", str(ws / "nodl"), "--ros2", "--wait", "2", "--source", "rclpy",
+                       "--ros2-python", str(ros2_python())], env, ws, log)
+        procs.append(p)
+        out["diff"] = {"code": p.wait(120), "log": log.read_text()}
         yield out
     finally:
         for p in procs:
@@ -103,3 +109,21 @@ def test_each_seeded_mismatch_of_the_running_node_is_found(run, source: str) -> 
     # each is located in the document too: the document's line of the policy, of the type, of the entry
     assert found["nodl-live-qos"].startswith("nodl/Base.nodl.json:6:")
     assert f"(also at {SOURCES[source]}" in found["nodl-live-qos"]
+
+
+def test_ros_diff_takes_the_documents_as_its_expected_graph(run) -> None:
+    """The same seeded mismatches as ros diff's items, each of the documents' side at the document's line; the
+    node running as its document says gives none (the control); Dock, not running, is missing."""
+    log, code = run["diff"]["log"], run["diff"]["code"]
+    assert code == 1 and "Traceback" not in log
+    items = [ln.strip() for ln in log.splitlines() if ln.startswith("  ")]
+    assert not [i for i in items if "/Guard" in i], items
+    assert any(i.startswith("nodl/Dock.nodl.yaml:1:1: node /Dock is not running") for i in items), items
+    assert any(i.startswith("nodl/Base.nodl.json:6:") and "/stop" in i and "durability is VOLATILE announced by the "
+               "running node and TRANSIENT_LOCAL in its NoDL document" in i for i in items), items
+    assert any(i.startswith("nodl/Base.nodl.json:10:") and "/Base publishes /speed: its NoDL document's type is "
+               "std_msgs/Float64, the running system's std_msgs/Float32" in i for i in items), items
+    assert any(i.startswith("nodl/Base.nodl.json:") and "/Base serves /estop" in i and "in its NoDL document, not in "
+               "the running system" in i for i in items), items
+    assert any("/Base publishes /odom" in i and "not in its NoDL document" in i for i in items), items
+    assert "in the NoDL documents, not in the running system at rclpy on rmw_fastrtps_cpp:" in log
