@@ -2,10 +2,11 @@
 
 The rule lives in :func:`rclverify.semantics.widths.at_widths`; each path
 asks it for the width of each comparison and its constants' values there:
-rclverify's monitor (recorded and live), the property tests, the reference
-judgement (:func:`rclverify.semantics.floatsem.judge`), the Z3 encoding, and
-the translations: the evaluator ``generate ros2`` packages carry
-(``contract_eval.py``), the generated C++ checks, Dafny and RML.
+rclverify's monitor (recorded and live) and the property tests, which judge
+the contract so read (:func:`rclverify.semantics.floatsem.judge`, Z3 on the
+values where direct evaluation cannot decide), and the translations: the
+evaluator ``generate ros2`` packages carry (``contract_eval.py``), the
+generated C++ checks, Dafny and RML.
 
 * **The slip and its correct twin.**  A ``std_msgs/Float32`` battery level
   and ``out.low <=> in.p <= 0.2`` in six forms: the package's carried
@@ -33,6 +34,9 @@ the translations: the evaluator ``generate ros2`` packages carry
   checks do not enumerate a quantifier over a sequence; RCL has no modulo
   (``%``) to translate.  The plain threshold forms are also checked against
   numpy's ``float32`` comparison, the oracle independent of rclverify.
+  A ``float64`` constant is all the digits of its double: the exact reading
+  of ``in.q == 0.2`` at the double 0.2 is numpy's float64 verdict (a
+  constant cut to 28 digits read it as false).
 * **Dafny and RML** state the constant compared with a ``float32`` field as
   the exact value of its ``float32`` (a Dafny ``real``, an RML guard).
 """
@@ -173,8 +177,11 @@ OTHER_FORMS = (
     "in.p + in.q <= {c} + 1", "in.q - {K} >= 0", "not (in.p > {K}) <=> in.q >= 0",
     "forall(r in in.xs | r <= {c})", "exists(r in in.xs | r - {K} < 0)",
     "forall(r in in.xs | -r >= -{c} -> in.p <= {c})", "exists(r in in.xs | abs(r) <= {h} + {h})",
-    "in.p / in.q <= {c}", "in.q == {c}",
+    "in.p / in.q <= {c}", "in.q == {c}", "in.q >= {c}", "in.q > {K}",
 )
+#: forms over the float64 ``in.q`` whose truth is numpy's float64 comparison of q with the threshold
+Q_FORMS = (("in.q == {c}", np.equal), ("in.q >= {c}", np.greater_equal), ("in.q > {K}", np.greater),
+           ("in.q - {K} >= 0", np.greater_equal))
 THRESHOLDS = (("0.2", "0.1", "Low"), ("0.15", "0.075", "Mid"))
 
 
@@ -316,7 +323,8 @@ def test_every_path_gives_each_guarantee_the_same_truth(corpus: dict[str, Any]) 
 
 
 def test_the_threshold_forms_are_float32_comparisons(corpus: dict[str, Any]) -> None:
-    """The independent oracle: numpy's float32 ``p <= c`` (``<`` for a strict form; ``abs(p)`` for ``abs``)."""
+    """The independent oracle: numpy's float32 ``p <= c`` (``<`` for a strict form; ``abs(p)`` for ``abs``),
+    and for the float64 ``in.q`` numpy's float64 comparison, in the exact reading alone."""
     checked, at = corpus["checked"], corpus["at"]
     n = len(THRESHOLD_FORMS)
     for t, (c, _, _) in enumerate(THRESHOLDS):
@@ -327,3 +335,46 @@ def test_the_threshold_forms_are_float32_comparisons(corpus: dict[str, Any]) -> 
                 p = abs(F32(vals["in.p"])) if "abs" in form else F32(vals["in.p"])
                 want = bool(p < limit) if strict else bool(p <= limit)
                 assert judge(clause.formula, checked, at, vals).truth is want, (form, c, vals)
+    for c, h, k in THRESHOLDS:  # float64: the constant is the double nearest it, all its digits exact
+        for form, op in Q_FORMS:
+            clause = at.node.guarantees[CORPUS.index(form.format(c=c, h=h, K=k))]
+            for vals in POINTS:
+                want = bool(op(np.float64(vals["in.q"]), np.float64(float(Fraction(c)))))
+                assert holds_in("exact", clause.formula, checked, at, vals) is want, (form, c, vals)
+
+
+# ---------------------------------------------------------------------------------------------
+# Dafny and RML: the constant compared with a float32 field is its float32 value, exactly
+# ---------------------------------------------------------------------------------------------
+
+def test_dafny_and_rml_state_the_carried_constant(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The Dafny stub's ``ensures`` and the RML guard compare the ``float32`` field with
+    0.20000000298023223876953125 (the float32 of 0.2, a Dafny ``real`` exactly; a double exactly
+    in RML's guard), as the backends export them from a workspace; the ``float64`` output keeps
+    the double of its constant; without a message type (no width) the decimal is kept."""
+    from rclverify.backends.base import NodeTarget
+    from rclverify.backends.dafny.backend import DafnyBackend
+    from rclverify.backends.monitors.backend import MonitorsBackend
+    from rclverify.lang.typecheck import load
+    rcl = GAUGE.replace("FORM", "in.p <= Low").replace(
+        "outputs( low : BOOL )", "outputs( low : BOOL, e : REAL, u : REAL )").replace(
+        "std_msgs/Bool low matches(out.low) )", "std_msgs/Bool low matches(out.low),\n"
+        "          std_msgs/Float64 e matches(out.e) )\n  guarantee( out.e <= 0.1 and out.u <= 0.1 )")
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "gauge.rcl").write_text(rcl)
+    (tmp_path / "contracts" / "plan.yaml").write_text("contracts: [contracts/gauge.rcl]\n")
+    monkeypatch.chdir(tmp_path)
+    checked = load(["contracts/gauge.rcl"])
+
+    def target(backend: str, config: dict[str, Any]) -> NodeTarget:
+        return NodeTarget(root=tmp_path, checked=checked, node=checked.nodes["Gauge"],
+                          config={"backend": backend, **config}, contract_files=("contracts/gauge.rcl",),
+                          plan_file="contracts/plan.yaml", artifacts=tmp_path / "artifacts" / backend / "Gauge")
+    stub, _ = DafnyBackend().render(target("dafny", {"implementation": "backends/dafny/gauge.dfy"}))
+    ensures = [c.dafny for c in stub.clauses if c.kind == "ensures"]
+    assert "low <==> (p <= 0.20000000298023223876953125)" in ensures, ensures
+    assert "e <= 0.1000000000000000055511151231257827021181583404541015625" in ensures, ensures
+    assert "u <= 0.1" in ensures, ensures  # no message type: no width, the decimal as written
+    MonitorsBackend().export(target("monitors", {"traces": []}))
+    rml = (tmp_path / "artifacts" / "monitors" / "Gauge" / "Gauge.rml").read_text()
+    assert "0.20000000298023223876953125" in rml and "0.2 " not in rml, rml

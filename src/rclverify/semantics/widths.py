@@ -45,7 +45,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import struct
-from decimal import Decimal
 from fractions import Fraction
 from typing import Any, Iterable, Mapping
 
@@ -255,11 +254,24 @@ def carried_fault(value: Any, carried: Carried) -> str | None:
     return None
 
 
+def exact_decimal(v: Fraction) -> str:
+    """The decimal digits of ``v``, a dyadic rational (``n / 2**k``, as every value of a binary
+    floating width is), written out exactly: ``0.1000000000000000055511151231257827021181583404541015625``
+    for the double nearest 0.1 (all its 55 significant digits; ``decimal``'s default context would
+    round to 28).  Raises ``ValueError`` for a denominator that is not a power of two."""
+    a, den = abs(v), v.denominator
+    k = den.bit_length() - 1
+    if den != 1 << k:
+        raise ValueError(f"{v} has no finite binary expansion")
+    digits = str(a.numerator * 5 ** k).rjust(k + 1, "0")
+    text = digits if k == 0 else f"{digits[:-k]}.{digits[-k:]}"
+    return ("-" if v < 0 else "") + text
+
+
 def _literal(v: Fraction, like: ast.Expr) -> ast.Expr:
-    """``v`` (a dyadic rational: finitely many decimal digits) as a literal where ``like`` stood."""
-    text = str(Decimal(v.numerator) / Decimal(v.denominator)) if v.denominator != 1 else str(v.numerator)
-    if "E" in text or "e" in text:  # Decimal's exponent form: write the digits out
-        text = format(Decimal(v.numerator) / Decimal(v.denominator), "f")
+    """``v`` (a dyadic rational: finitely many decimal digits) as a literal where ``like`` stood,
+    its digits exact (:func:`exact_decimal`)."""
+    text = exact_decimal(v)
     loc: ast.Loc = like.loc
     if v < 0:
         return ast.Unary("-", ast.NumLit(text.lstrip("-"), loc), loc)
@@ -391,4 +403,4 @@ class _AtWidths(Transformer):
 
 
 __all__ = ["FLOAT_WIDTHS", "IDL_ALIASES", "INT_RANGES", "Carried", "Width", "at_widths", "carried_fault",
-           "edges_at_width", "idl_name", "int_edges", "narrow", "nearest_at_width", "width_fault"]
+           "edges_at_width", "exact_decimal", "idl_name", "int_edges", "narrow", "nearest_at_width", "width_fault"]

@@ -31,6 +31,7 @@ fields are flattened beside it, as ROSMonitoring sends them.
 """
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass, field
 from typing import Any, Mapping
@@ -41,6 +42,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.mapping import TopicRule
 from rclverify.semantics.operators import OPERATORS
+from rclverify.semantics.widths import at_widths
 
 #: Words the RML grammar reserves (RML.g4 and its later versions).
 KEYWORDS = frozenset({"not", "matches", "with", "empty", "all", "let", "var", "if", "else", "abs", "true",
@@ -416,10 +418,17 @@ def _mentions(e: Any, names: set[str]) -> bool:
 
 
 def translate(checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
-              msg_fields: Mapping[str, list[tuple[str, str]]]) -> Spec:
+              msg_fields: Mapping[str, list[tuple[str, str]]], widths: Mapping[str, str] | None = None) -> Spec:
     """The node's RML specification: one term per expressible guarantee, the
-    reason for each inexpressible one (paper lines 873-975)."""
+    reason for each inexpressible one (paper lines 873-975).  ``widths``
+    (``"in.x"`` -> ``float32``/``float64``: the IDL width of the field each
+    variable travels in) reads each comparison at the width of what it
+    compares (:func:`rclverify.semantics.widths.at_widths`; docs/semantics.md,
+    "Widths"): a guard compares a ``float32`` field with the exact decimal of
+    its constant's ``float32`` value (``with p <= 0.20000000298023223876953125``)."""
     tr = Translator(checked, node, rules, msg_fields)
     for k, clause in enumerate(node.node.guarantees, 1):
+        if widths:
+            clause = dataclasses.replace(clause, formula=at_widths(clause.formula, widths, checked.env.constants))
         tr.spec.terms.append(tr.guarantee(k, clause))
     return tr.spec

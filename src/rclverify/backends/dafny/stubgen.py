@@ -134,13 +134,16 @@ def _type_rank(env: Env, dafny_name: str) -> int:
 
 
 def build_stub(env: Env, node: CheckedNode, *, ghost: bool = True, header: str = "",
-               commands: tuple[str, ...] = (), implementation: str = "") -> Stub:
+               commands: tuple[str, ...] = (), implementation: str = "",
+               widths: Mapping[str, str] | None = None) -> Stub:
     """Build (and render) the Dafny contract stub of ``node``.
 
     ``ghost``          emit a ``ghost method`` (default) or a compiled ``method``;
     ``header``         the first line's text (after ``// ``);
     ``commands``       Dafny command lines shown in the stub's comment;
-    ``implementation`` the workspace-relative implementation path shown there.
+    ``implementation`` the workspace-relative implementation path shown there;
+    ``widths``         ``"in.x"`` -> ``float32``/``float64``: the widths the clauses'
+                       comparisons are read at (:class:`~rclverify.targets.dafny.translate.Translator`).
 
     Raises :class:`~rclverify.model.plan.errors.PlanError` (located at the RCL
     construct) for types or formulas Dafny cannot express, e.g. an input of
@@ -155,7 +158,7 @@ def build_stub(env: Env, node: CheckedNode, *, ghost: bool = True, header: str =
                    for v in n.inputs)
     returns = tuple((io[f"out.{v.name}"], _param_type(env, v, node.outputs[v.name], "output", needed, synonyms))
                     for v in n.outputs)
-    tr = Translator(env, node, io, consts, frozenset(reserved | set(synonyms)))
+    tr = Translator(env, node, io, consts, frozenset(reserved | set(synonyms)), dict(widths or {}))
     clauses = _clauses(tr, n)
     const_lines = _constant_lines(env, tr, consts, needed)
     dts: list[EnumT | DataT] = []

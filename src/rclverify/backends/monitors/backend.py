@@ -140,7 +140,8 @@ class MonitorsBackend:
             fields = msg_fields(target.root, cfg)
         except TraceError as exc:
             raise target.config_error(str(exc), "mapping") from None
-        spec = translate(target.checked, node, cfg.rules, fields)
+        carried = carried_fields(node, cfg.rules, [target.root / d for d in cfg.msg_dirs])
+        spec = translate(target.checked, node, cfg.rules, fields, float_widths(node, carried))
         src = node.node.loc
         source = f"{_rel(target, src.file)}:{src.line}:{src.col}"
         rml = target.artifacts / f"{node.name}.rml"

@@ -44,6 +44,7 @@ from typing import Any, Mapping, cast
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
 from rclverify.semantics.operators import OPERATORS
+from rclverify.semantics.widths import at_widths
 from rclverify.lang.errors import error
 from rclverify.lang.printer import is_type
 from rclverify.lang.typecheck import domain_type
@@ -91,7 +92,13 @@ class Translator:
     ``node``    the node whose formulas are translated;
     ``io``      ``"in.x"``/``"out.x"`` -> Dafny parameter name;
     ``consts``  RCL constant name -> Dafny constant name;
-    ``taken``   further Dafny names in scope (datatype, type and method names).
+    ``taken``   further Dafny names in scope (datatype, type and method names);
+    ``widths``  ``"in.x"``/``"out.x"`` -> ``float32``/``float64``, the IDL width of the
+                field each variable travels in: each comparison is read at the width of
+                what it compares (:func:`rclverify.semantics.widths.at_widths`;
+                docs/semantics.md, "Widths"), so a constant compared with a ``float32``
+                field is the exact ``real`` of its ``float32`` value
+                (``p <= 0.20000000298023223876953125``).
 
     :meth:`formula` returns the Dafny text of a BOOL formula; raises
     :class:`PlanError` (located) for constructs Dafny cannot express.
@@ -102,13 +109,14 @@ class Translator:
     io: Mapping[str, str]
     consts: Mapping[str, str] = field(default_factory=dict)
     taken: frozenset[str] = frozenset()
+    widths: Mapping[str, str] = field(default_factory=dict)
     used_consts: set[str] = field(default_factory=set)
     used_types: list[Type] = field(default_factory=list)
 
     # -- entry points ---------------------------------------------------------------
     def formula(self, e: ast.Expr) -> str:
         """Dafny text of the formula ``e`` (type-checked RCL, BOOL)."""
-        text, t = self.tr(e, {})
+        text, t = self.tr(at_widths(e, self.widths, self.env.constants), {})
         if t != BOOL:
             raise self._err(e.loc, f"expected a formula, found a term of type {t}")
         return strip_parens(text)
