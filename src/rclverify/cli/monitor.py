@@ -233,8 +233,11 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     from rclverify.backends.monitors.widths import at_carried_widths, carried_widths  # deferred: start-up (only live)
     dirs = [root / d for d in cfg.msg_dirs]  # the contract's constants as the fields carry them, as offline
     judged = [at_carried_widths(n, carried_widths(n, cfg.rules, dirs)) for n in nodes]
+    warn_margin = getattr(args, "warn_margin", None)
     factory = partial(run_class, checked, judged, cfg.rules, cfg.horizon, log,
-                      reorder_window=args.reorder_window, silence_s=args.silence, **extra)
+                      reorder_window=args.reorder_window, silence_s=args.silence,
+                      margins=bool(getattr(args, "margins", False)), warn_margin=warn_margin,
+                      warn=lambda line: print(line, file=sys.stderr, flush=True), **extra)
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop.set())

@@ -40,6 +40,18 @@ def add_monitor(add: AddCommand) -> None:
     _live_options(m.add_argument_group("live monitoring (ROS 1, ROS 2 over DDS; docs/monitors.md)"))
 
 
+def _margin(text: str) -> float:
+    """``--warn-margin``'s VALUE: a finite number > 0 (a space margin, in the deciding comparison's unit)."""
+    import math  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    try:
+        v = float(text)
+    except ValueError:
+        v = math.nan
+    if not math.isfinite(v) or v <= 0:
+        raise argparse.ArgumentTypeError(f"a margin is a finite number > 0, not {text!r}")
+    return v
+
+
 def _live_options(lv: argparse._ArgumentGroup) -> None:
     """``monitor --live``'s options."""
     lv.add_argument("--live", action="store_true", help="monitor the running ROS system instead (ROS 1: "
@@ -56,6 +68,12 @@ def _live_options(lv: argparse._ArgumentGroup) -> None:
     lv.add_argument("--silence", type=seconds, default=10.0,
                     help="report a contract topic not received for this many seconds (default 10; 0: off)")
     lv.add_argument("--status", type=seconds, default=1.0, help="seconds between status lines (0: off)")
+    lv.add_argument("--margins", action="store_true",
+                    help="compute each answer's space margin: in the verdicts, the status line (each guarantee's "
+                         "smallest so far) and the record (docs/semantics.md, \"Margins\")")
+    lv.add_argument("--warn-margin", type=_margin, metavar="VALUE",
+                    help="warn on stderr (one line: guarantee, margin, time) when a satisfied answer sets a "
+                         "guarantee's smallest margin below VALUE (implies --margins)")
     lv.add_argument("--verdict-topic", default="/rclverify/verdict", help="topic of the per-event verdicts")
     lv.add_argument("--node", dest="nodes", action="append", metavar="NODE", help="monitor only NODE (repeatable)")
     lv.add_argument("--ros", choices=("1", "2"), help="ROS version (default: $ROS_VERSION, else 1)")

@@ -20,6 +20,13 @@ ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
   ``time`` the clock that decided it) and is published (``{"kind":
   "deadline", ...}``);
 * counts what it heard of every item of the contracts (:mod:`.judged`);
+* with ``margins``, computes every judged answer's space margin
+  (docs/semantics.md, "Margins"): each verdict carries its message's
+  (``margin``), the status line each guarantee's smallest so far, the
+  record each guarantee's smallest; with ``warn_margin`` (which implies
+  ``margins``) ``warn`` gets one line whenever a satisfied answer sets a
+  guarantee's new smallest margin below it, before any violation
+  (:meth:`LiveRun._warn_low`);
 * on :meth:`stop` writes a monitoring evidence record shaped like the
   offline one (events, verdict counts, first violation, the log's sha256,
   the deadlines as ``topic_deadlines``, the periods as ``periods``).
@@ -88,7 +95,8 @@ class LiveRun:
     def __init__(self, checked: Checked, nodes: Iterable[CheckedNode], rules: Mapping[str, TopicRule],
                  horizon: float, log: Path, *, reorder_window: float = 0.05, silence_s: float = 0.0,
                  publish: Callable[[str], None] | None = None,
-                 publish_last: Callable[[str, str], None] | None = None) -> None:
+                 publish_last: Callable[[str, str], None] | None = None, margins: bool = False,
+                 warn_margin: float | None = None, warn: Callable[[str], None] | None = None) -> None:
         self.log_path = log
         log.parent.mkdir(parents=True, exist_ok=True)
         self._log: IO[str] = log.open("w", encoding="utf-8")
@@ -101,6 +109,12 @@ class LiveRun:
         self.nodes = nodes
         self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
                                    on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
+        #: margins (module docstring): computed when asked for or warned about; warn below ``warn_margin``
+        self.warn_margin, self.warn = warn_margin, warn
+        self._warned: dict[tuple[str, int], float] = {}
+        self._by_node = {m.node.name: m for m in self.engine.monitors}
+        for m in self.engine.monitors:
+            m.margins = margins or warn_margin is not None
         #: the offline check's deadline and period monitors, fed the log's lines (logchecks.py)
         self.checks = LogChecks(checked, nodes, rules, horizon, self._deadline)
         #: link part ("estop/request") -> its call events heard (paired), and answers heard without their call
@@ -131,6 +145,27 @@ class LiveRun:
         if self.publish is not None:
             self.publish(text)
         self._last[v.node] = text
+        if self.warn_margin is not None and v.verdict == "satisfied" and v.margin is not None \
+                and v.margin < self.warn_margin:
+            self._warn_low(v)
+
+    def _warn_low(self, v: Verdict) -> None:
+        """Warn (one line each) of every guarantee whose smallest margin this
+        satisfied answer ``v`` has just lowered below :attr:`warn_margin`
+        (a new smallest only: a guarantee hovering low is not repeated)."""
+        limit = self.warn_margin
+        mon = self._by_node.get(v.node)
+        if mon is None or limit is None:
+            return
+        for k, gm in sorted(mon.result.margins.items()):
+            if gm.event != v.event or not math.isfinite(gm.value) or gm.value >= limit \
+                    or gm.value >= self._warned.get((v.node, k), math.inf):
+                continue
+            self._warned[(v.node, k)] = gm.value
+            unit = f" {gm.unit}" if gm.unit else ""
+            if self.warn is not None:
+                self.warn(f"rclverify monitor: warning: {v.node} guarantee {k} held with margin {gm.value:g}{unit} "
+                          f"({gm.atom}), below --warn-margin {limit:g}, at t = {v.time:.6f} s ({v.where})")
 
     def _silence(self, topic: str, seconds: float, silent: bool) -> None:
         note: SilenceNote = {"topic": topic, "silent": silent, "for_s": round(seconds, 3),
@@ -192,7 +227,8 @@ class LiveRun:
         """``Node: 3 satisfied, 1 violated; 4 answer(s) counted, 95 % bound 0.75 per answer | Node2: ...``
         (a live per-node status: the counts so far, docs/statistics.md)."""
         with self.lock:
-            parts = [summary_line(m.result) + running_bound(m.result) for m in self.engine.monitors]
+            parts = [summary_line(m.result) + running_bound(m.result) + least_margins(m.result)
+                     for m in self.engine.monitors]
             parts += self.checks.status()
         silent = [t for t, s in self.engine.topics.items() if s.silent]
         return " | ".join(parts) + (f" | silent: {', '.join(sorted(silent))}" if silent else "")
@@ -270,6 +306,15 @@ def running_bound(res: NodeResult) -> str:
         return ""
     bound, why = trivial_or_exact(n - c.get('satisfied', 0), n, 0.95)
     return f"; {n} answer(s) counted, 95 % bound {bound:.3g} per answer" + (f" ({why})" if why else "")
+
+
+def least_margins(res: NodeResult) -> str:
+    """``; least margin g1 0.04 m, g2 0.5``: each guarantee's smallest space
+    margin so far (docs/semantics.md, "Margins"), ``""`` without margins or
+    before the first; an infinite one (no distance) is left out."""
+    shown = [f"g{k} {m.value:g}" + (f" {m.unit}" if m.unit else "") for k, m in sorted(res.margins.items())
+             if m.answers and math.isfinite(m.value)]
+    return f"; least margin {', '.join(shown)}" if shown else ""
 
 
 def live_counts(res: NodeResult, sha: str, seconds: float) -> LiveCounts:
