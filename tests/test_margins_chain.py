@@ -12,6 +12,7 @@ from typing import Any
 
 import pytest
 
+from _report_schema import check_report
 from rclverify.cli.commands import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "ros2_robot"
@@ -66,6 +67,7 @@ def test_each_hop_has_its_smallest_time_margin(report):
     assert d["time_margin_ns"] == 150_000_000 - (100_000_000 - m["margin_ns"])
     assert d["time_margin"] == f"{d['time_margin_ns'] / 1e6:.3f} ms"
     assert f"measured margin {d['time_margin']}" in report["_md"]
+    check_report({k: v for k, v in report.items() if not k.startswith("_")})  # the schema declares the hops' margins
 
 
 def test_a_hop_no_run_timed_has_none():

@@ -11,6 +11,7 @@ from typing import Any
 
 import pytest
 
+from _report_schema import check_report
 from rclverify.cli.commands import main
 
 BRAKE = """node Brake{x} {{
@@ -68,6 +69,11 @@ def test_a_margin_under_the_threshold_is_named_and_the_control_is_not(run) -> No
     assert abs(value["margin"] - 0.04) < 1e-9 and value["threshold"] == 0.05 and value["atom"] == "out.speed <= in.dist"
     assert abs(time["margin"] - 0.03) < 1e-9 and time["threshold"] == 0.05 and time["where"] == value["where"]
     assert value["source"] == "contracts/brake.rcl:6:3" and value["threshold_source"].startswith("contracts/plan.yaml:6:")
+    # the report keeps to its schema, which declares the near misses and the runs' margins
+    check_report({k: v for k, v in report.items() if not k.startswith("_")})
+    assert "Smallest margins</th><td>guarantee 1: <strong>0.04" in report["_html"]
+    [m] = next(e for e in report["evidence"] if e["obligation"].startswith("BrakeA."))["monitoring"]["margins"]
+    assert [round(x, 9) for x in m["lowest"]] == [0.04, 0.3]
     # a near miss changes no status: both held
     assert {o["node"]: o["status"] for o in report["obligations"]} == {"BrakeA": "discharged", "BrakeB": "discharged"}
 
