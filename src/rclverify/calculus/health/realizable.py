@@ -36,6 +36,12 @@ guarantees went undecided in 5.6 s that ``qe`` decides in 0.02 s).  Then it name
 conflict: the smallest set of them (single guarantees, then pairs) that
 already has no answer for some input.
 
+An output sequence its interface bounds (``bounds``: a ``T[<=N]`` or
+``T[N]`` field) is quantified item by item over the lengths it can carry
+(:mod:`.bounded`), and an implementation's outputs given as terms
+(``implementation``) decide the contract realizable when Z3 proves they
+answer every admissible input (:mod:`.implemented`: decided by a witness).
+
 An answer is looked for first (:mod:`.realizer`): output terms, constants
 or affine in the inputs, that answer every admissible input prove the
 contract realizable by a quantifier-free query, and the quantified query
@@ -55,7 +61,7 @@ from __future__ import annotations
 
 import itertools
 import time
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import z3
 
@@ -65,8 +71,10 @@ from rclverify.semantics import wallclock
 from rclverify.semantics.query import render_model, satisfiable, smt2_script, tactic_solver
 from rclverify.lang import ast
 from rclverify.semantics.natural import natural_typing
-from rclverify.lang.types import Checked, FuncT
+from rclverify.lang.types import Checked, FuncT, SeqT
+from rclverify.calculus.health.bounded import Bound, expand
 from rclverify.calculus.health.finding import Finding
+from rclverify.calculus.health.implemented import implemented
 from rclverify.calculus.health.realizer import Witness, find_witness
 from rclverify.calculus.health.shape import outputs_mentioned
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
@@ -107,7 +115,7 @@ class _Query:
     """The node's contract encoded once: inputs' formulas, guarantees, and the outputs to quantify."""
 
     def __init__(self, checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
-                 instances: tuple[int, int] | None) -> None:
+                 instances: tuple[int, int] | None, bounds: Mapping[str, Bound] | None = None) -> None:
         cn = checked.nodes[node]
         self.cn, self.instances = cn, instances
         self.enc = enc = Encoder(checked.env)
@@ -121,18 +129,28 @@ class _Query:
         for f in [g.formula for g in cn.node.guarantees] + [f for f, _ in facts]:
             named |= outputs_mentioned(f, cn)
         constrained = [v for v in cn.outputs if v in named]
+        self.names = constrained
         self.outs = [enc.io_symbol(cn, "out", v) for v in constrained]
         typed = Encoder(checked.env)  # the outputs' names, and only theirs
         for v in constrained:
             typed.io_symbol(cn, "out", v)
         self.typing: list[z3.BoolRef] = []
+        self.types = [cn.outputs[v] for v in constrained]
+        #: the output sequences the interface bounds, by index in ``outs``, written out over their lengths
+        #: (:mod:`.bounded`) when that is small enough
+        self.bounds = {k: (bounds or {})[v] for k, v in enumerate(constrained)
+                       if v in (bounds or {}) and isinstance(cn.outputs[v], SeqT)}
+        trial = expand(self.outs, self.types, self.bounds, z3.BoolVal(True)) if self.bounds else None
+        if trial is None:
+            self.bounds = {}
+        self.bounded = {constrained[k]: b for k, b in self.bounds.items()}
         #: every NATURAL part of the outputs typed: without it an ``unsat`` is not a proof (module docstring)
-        self.exact = True
-        for v in constrained:
+        self.exact = trial.exact if trial is not None else True
+        for k, v in enumerate(constrained):
             if not isinstance(cn.outputs[v], FuncT):
                 cs, ok = natural_typing(enc.io_symbol(cn, "out", v), cn.outputs[v])
                 self.typing += cs
-                self.exact = self.exact and ok
+                self.exact = self.exact and (ok or k in self.bounds)
         out_names = {typed.symbol_name(cn.name, "out", v) for v in constrained}
         for name in out_names:  # bound below: not free symbols of the query (models show the inputs)
             enc.symbols.pop(name, None)
@@ -141,7 +159,8 @@ class _Query:
         """The query with guarantees ``ks`` (0-based) only."""
         g = [self.guarantees[k] for k in ks]
         body = z3.Implies(_conj([*self.typing, *self.out_facts]), z3.Not(_conj(g)))
-        return _conj([*self.given, z3.ForAll(self.outs, body)])
+        e = expand(self.outs, self.types, self.bounds, body) if self.bounds else None
+        return _conj([*self.given, e.formula if e is not None else z3.ForAll(self.outs, body)])
 
     def answer(self, ks: Sequence[int], comment: str, general: bool = True, budget_ms: int = REALIZABLE_TIMEOUT_MS
                ) -> tuple[str, dict[str, str] | None, float, str]:
@@ -196,12 +215,21 @@ class _Query:
 
 
 def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
-                           instances: tuple[int, int] | None = None) -> list[Finding]:
+                           instances: tuple[int, int] | None = None, *, bounds: Mapping[str, Bound] | None = None,
+                           implementation: Mapping[str, ast.Expr] | None = None) -> list[Finding]:
     """The ``realizable`` finding of ``node``: ``problem`` when its contract
     is not realizable, ``ok`` when Z3 proves it is; ``[]`` when not decided
     or not checked (module docstring).  ``facts``: the plan's
     environment facts of the node with their locations; ``instances``: its
-    ``instances`` range (the tables' size).  Never raises on solver trouble.
+    ``instances`` range (the tables' size).  ``bounds``: output name -> how
+    its interface bounds that output sequence (:class:`.bounded.Bound`): the
+    quantifier over it is written out over its lengths (:mod:`.bounded`).
+    ``implementation``: output name -> the RCL term over the inputs an
+    implementation computes it by (the outputs of a proved implementation):
+    when Z3 proves those terms answer every admissible input (and fit the
+    bounds), they are the witness of realizability and the finding is
+    ``ok``, decided by the witness; otherwise the queries above decide.
+    Never raises on solver trouble.
 
     When the wall-clock safety net cut any of its queries
     (:mod:`rclverify.semantics.wallclock`: a loaded machine), the finding is
@@ -210,7 +238,7 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
     the next subset when one is undecided, so a cut would show another
     input and other guarantees than the budget finds."""
     with wallclock.watch() as w:
-        found = _realizability(checked, node, facts, instances)
+        found = _realizability(checked, node, facts, instances, bounds, implementation)
     if not w.cut:
         return found
     return [Finding(f"{node}.realizable", node, "realizable", None, "inconclusive",
@@ -219,23 +247,32 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
 
 
 def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
-                   instances: tuple[int, int] | None) -> list[Finding]:
+                   instances: tuple[int, int] | None, bounds: Mapping[str, Bound] | None = None,
+                   implementation: Mapping[str, ast.Expr] | None = None) -> list[Finding]:
     """:func:`realizability_findings`, whatever the wall clock did."""
     cn = checked.nodes[node]
     n = cn.node
     if not n.guarantees or not n.outputs:
         return []
-    q = _Query(checked, node, facts, instances)
+    q = _Query(checked, node, facts, instances, bounds)
     if not q.outs:
         return []  # no guarantee constrains an output: any output answers (the shape checks say so)
     if any(isinstance(o, z3.FuncDeclRef) for o in q.outs):
         return []  # forall over a function-typed output: not first-order, not checked
     every = list(range(len(n.guarantees)))
     comment = f"health {node}: is there an input no output answers?"
+    over = "".join(f" The quantifier over out.{v} ranges over the sequences its interface carries ({b.text()}), "
+                   "written out item by item." for v, b in q.bounded.items())
+    if implementation:
+        by_witness = implemented(q.enc, cn, [(v, o, cn.outputs[v]) for v, o in zip(q.names, q.outs)], q.given,
+                            [*q.out_facts, *q.guarantees], implementation, q.bounded, bool(facts))
+        if by_witness is not None:
+            return [by_witness]
     # an answer first (calculus/health/realizer.py): output terms that answer every admissible input prove the
-    # contract realizable with a quantifier-free query; the quantified query is asked only without one
+    # contract realizable with a quantifier-free query; the quantified query is asked only without one (and
+    # not over written-out sequences: a term of the sequence sort may not fit the interface's bound)
     t0 = time.perf_counter()
-    w = q.witness(node) if q.exact else None  # None with function-typed inputs (their tables: answer())
+    w = q.witness(node) if q.exact and not q.bounds else None  # None with function-typed inputs (tables: answer())
     if w is not None:
         status, model, secs = "unsat", None, round(time.perf_counter() - t0, 4)
         smt2 = smt2_script(q.enc.axioms() + [q.formula(every)], comment)()
@@ -256,7 +293,7 @@ def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, 
                         "Realizability (forall in. A(in) -> exists out. G(in, out)): "
                         + ("it follows from the answer above, which Z3 proved answers every admissible input; "
                            "the query below states it (unsat)." if w is not None else
-                           "Z3 proved that no admissible input lacks an answer (the query below is unsat)."),
+                           "Z3 proved that no admissible input lacks an answer (the query below is unsat).") + over,
                         None, None, secs, smt2=smt2,
                         witness=dict(w.terms) if w is not None else None, witness_smt2=witness_smt2)]
     if status != "sat":
@@ -291,6 +328,7 @@ def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, 
            f"`rclverify explain {node}.realizable`), no output satisfies {which}.")
     expl = ("Realizability (forall in. A(in) -> exists out. G(in, out)) fails: Z3 found an admissible input for which "
             "every output violates " + (" and ".join(x.split(" (")[0] for x in names) if len(names) > 1 else names[0])
-            + ". An implementation meeting the contract cannot exist; the guarantees ask for incompatible outputs there.")
+            + ". An implementation meeting the contract cannot exist; the guarantees ask for incompatible outputs there."
+            + over)
     return [Finding(f"{node}.realizable", node, "realizable", conflict[0] + 1 if len(conflict) == 1 else None,
                     "problem", msg, expl, model, names, secs, smt2=smt2)]

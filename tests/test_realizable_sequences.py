@@ -1,0 +1,84 @@
+"""Realizability of a contract that quantifies over an output sequence
+(docs/semantics.md, "Realizability over bounded output sequences"): decided
+over the lengths the interface carries (a bounded sequence, a fixed array),
+or by a witness (an implementation's outputs); in both cases the query kept
+is one cvc5 decides too, where the quantifier over the sequence left it
+``unknown`` (so ``--strict`` could never pass)."""
+from __future__ import annotations
+
+from rclverify.calculus.health.bounded import Bound
+from rclverify.calculus.health.realizable import realizability_findings
+from rclverify.lang.parser import parse_formula, parse_text
+from rclverify.lang.typecheck import check
+from rclverify.semantics import world
+from rclverify.stages.crosscheck.cvc5_decide import decide
+
+#: Every item at most the input, one item equal to it: realizable (``<in.x>``).
+ECHO = """
+node S { inputs( x : INTEGER ) outputs( ys : seq(INTEGER) )
+  assume( 0 <= in.x and in.x <= 5 )
+  guarantee( forall(y in out.ys | y <= in.x) )
+  guarantee( exists(y in out.ys | y == in.x) ) }
+"""
+#: Every item below the input, one item equal to it: not realizable, whatever the length.
+BELOW = ECHO.replace("y <= in.x", "y < in.x")
+#: Three different items: realizable only with room for three.
+THREE = """
+node T { inputs( x : INTEGER ) outputs( ys : seq(INTEGER) ) assume( TRUE )
+  guarantee( exists(a in out.ys | a == 1) and exists(b in out.ys | b == 2) and exists(c in out.ys | c == in.x) )
+  guarantee( 2 < in.x -> forall(y in out.ys | y <= in.x) ) }
+"""
+
+
+def _one(text: str, node: str, **kw: object):  # type: ignore[no-untyped-def]
+    world.fresh()
+    found = realizability_findings(check([parse_text(text, "s.rcl")]), node, **kw)  # type: ignore[arg-type]
+    assert len(found) == 1, found
+    return found[0]
+
+
+def test_a_bounded_output_sequence_is_decided_both_ways_and_cvc5_agrees() -> None:
+    ok = _one(ECHO, "S", bounds={"ys": Bound(3)})
+    assert ok.status == "ok" and "at most 3 items), written out item by item" in ok.explanation
+    assert decide(ok.smt2).answer == "unsat"  # the second solver decides the kept query: --strict can pass
+    bad = _one(BELOW, "S", bounds={"ys": Bound(3)})
+    assert bad.status == "problem" and bad.core == ["guarantee 1 (s.rcl:4:3)", "guarantee 2 (s.rcl:5:3)"]
+    assert decide(bad.smt2).answer == "sat"
+    # control: the same contract without a bound is decided by Z3, but its query over the sequence sort is
+    # beyond cvc5 (unknown: the second solver cannot confirm it, and --strict fails)
+    free = _one(ECHO, "S")
+    assert free.status == "ok" and "written out" not in free.explanation
+    assert decide(free.smt2).answer == "unknown"
+
+
+def test_the_bound_decides_where_the_length_matters() -> None:
+    """Three different items fit in at most 3 (and in exactly 3), not in at most 2 or exactly 2."""
+    assert _one(THREE, "T", bounds={"ys": Bound(3)}).status == "ok"
+    assert _one(THREE, "T", bounds={"ys": Bound(3, fixed=True)}).status == "ok"
+    short = _one(THREE, "T", bounds={"ys": Bound(2)})
+    assert short.status == "problem" and "at most 2 items" in short.explanation
+    assert _one(THREE, "T", bounds={"ys": Bound(2, fixed=True)}).status == "problem"
+
+
+def test_a_bounded_natural_sequence_has_its_items_typed() -> None:
+    """Unbounded, a seq(NATURAL)'s items are not typed and no ``ok`` may be claimed
+    (tests/test_realizable.py); written out, every item is typed ``>= 0``, so a contract asking for a
+    negative item is decided not realizable, and one asking for a non-negative one realizable."""
+    neg = ("node C { inputs( x : INTEGER ) outputs( y : seq(NATURAL) ) assume( TRUE ) "
+           "guarantee( exists(v in INTEGER | v in out.y and v < 0) ) }")
+    assert _one(neg, "C", bounds={"y": Bound(2)}).status == "problem"
+    assert _one(neg.replace("v < 0", "v >= 0"), "C", bounds={"y": Bound(2)}).status == "ok"
+
+
+def test_a_witness_decides_and_a_wrong_one_does_not() -> None:
+    w = _one(ECHO, "S", implementation={"ys": parse_formula("<in.x>")})
+    assert w.status == "ok" and "Decided by a witness" in w.message and w.witness == {"out.ys": "<in.x>"}
+    assert decide(w.witness_smt2).answer == "unsat"  # the witness query has no quantifier over the outputs
+    # controls: an implementation whose second item breaks guarantee 1, and one longer than the interface
+    # carries, are no witness (the quantified query decides instead, as without them)
+    wrong = _one(ECHO, "S", implementation={"ys": parse_formula("<in.x, in.x + 1>")})
+    assert wrong.status == "ok" and "witness" not in wrong.message and wrong.witness is None
+    long = _one(ECHO, "S", implementation={"ys": parse_formula("<in.x, in.x>")}, bounds={"ys": Bound(1)})
+    assert long.status == "ok" and "witness" not in long.message and "at most 1 item)" in long.explanation
+    # and no witness makes an unrealizable contract realizable
+    assert _one(BELOW, "S", implementation={"ys": parse_formula("<in.x>")}).status == "problem"
