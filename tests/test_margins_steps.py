@@ -87,3 +87,15 @@ def test_progress_within_k_steps_has_k_less_its_longest_unanswered_row() -> None
     assert (two["verdict"], two["spare"]) == ("true", 0)
     broken = row([("b", 0), ("a", 1), ("a", 2), ("a", 3), ("a", 4), ("b", 5)])  # three in a row: broken
     assert broken["verdict"] == "false" and "spare" not in broken
+
+
+def test_the_report_says_the_steps_to_spare(ws) -> None:
+    from rclverify.report.templating import environment
+    v = _check(ws, "eventually[<= 5] Inc.out.b == 6", RUN).to_json()
+    row = {"trace": "run.jsonl", "status": "discharged", "verdict": v}
+    html = environment().get_template("parts/trace_verdicts.html.j2").render(rows=[row])
+    md = environment().get_template("parts/trace_verdicts.md.j2").render(rows=[row])
+    assert "step 2 at t = 0.5 s, 3 step(s) to spare" in html and "3 step(s) to spare" in md
+    none = _check(ws, "eventually Inc.out.b == 6", RUN).to_json()
+    assert "to spare" not in environment().get_template("parts/trace_verdicts.md.j2").render(
+        rows=[{**row, "verdict": none}])
