@@ -19,6 +19,8 @@ Artifact layout (workspace-relative)::
     artifacts/requirements/<ID>.json     a requirement's Z3 check (proved/refuted/...)
     artifacts/deadlines/index.json       the end-to-end deadlines decided by rule D3 (sealed),
                                          each query as artifacts/deadlines/<ID>.smt2
+    artifacts/nodl/index.json            the NoDL documents of nodl/ against the contracts and each
+                                         other (sealed; stages/nodl.py, run by the nodl task)
     artifacts/diagnosis/index.json       one diagnosis per problem of the report, repairs checked
                                          by Z3, with the digest of the report they explain (sealed)
 """
