@@ -26,8 +26,8 @@ generated C++ checks, Dafny and RML.
   three steps either side of 0.2f and 0.15f; ``float64`` values at and next
   to 0.2; sequences empty, at and next to 0.2f), each guarantee's truth is
   the same on each path: the reference judgement, Z3 on the point, rclverify's
-  monitor (its batch path where it takes the contract, its engine
-  elsewhere), the carried evaluator run as Python, and the C++ checks
+  monitor (its streaming engine; and its batch path, numpy columns, on
+  each guarantee not over the sequence as a node of the inputs it reads), the carried evaluator run as Python, and the C++ checks
   compiled once with g++ (its double reading; where the exact and double
   readings agree, the verdict).  Where a path declines a guarantee it says
   why, and the test names the reason: the carried evaluator and the C++
@@ -320,6 +320,52 @@ def test_every_path_gives_each_guarantee_the_same_truth(corpus: dict[str, Any]) 
     # the corpus meets both truths on most guarantees, and undecided (the division by q = 0)
     assert sum(1 for k in range(len(CORPUS)) if {(k, True), (k, False)} <= truths) >= len(CORPUS) * 2 // 3
     assert any(t is None for _, t in truths)
+
+
+def test_the_batch_monitor_gives_each_guarantee_the_same_truth(corpus: dict[str, Any]) -> None:
+    """rclverify's batch monitor (numpy columns, :mod:`rclverify.backends.monitors.batch`) takes a node
+    whose inputs are one field each and all read, and declines a quotient (its columns hold none).
+    Each form at 0.2 not over the sequence, as a node of the inputs it reads (its answer a ``float64``
+    1.0: the columns hold numbers, so the guarantee is ``out.r == 1 <=> (F)``, of F's truth), judged
+    over the run of every point, gives the reference's truth at each answer (the forms at 0.15 and
+    the random combinations are left to the engine: a node each costs the engine's set-up)."""
+    from rclverify.backends.monitors.batch import check_batch
+    from rclverify.traces.mapping import TopicRule
+    checked, at = corpus["checked"], corpus["at"]
+    base = 2 * (len(THRESHOLD_FORMS) + len(OTHER_FORMS))
+    kept = [(k, f) for k, f in enumerate(CORPUS[:base]) if not any(w in f for w in ("in.xs", "0.15", "Mid"))]
+    types = {"p": "std_msgs/Float32", "q": "std_msgs/Float64"}
+    text = "context { Low : REAL = 0.2 ; Mid : REAL = 0.15 ; }\n"
+    for k, f in kept:
+        ins = [v for v in ("p", "q") if f"in.{v}" in f]
+        text += (f"node B{k} {{\n  inputs( {', '.join(f'{v} : REAL' for v in ins)} )\n  outputs( r : REAL )\n"
+                 f"  topics( {', '.join(f'{types[v]} {v} matches(in.{v})' for v in ins)}, "
+                 f"std_msgs/Float64 r matches(out.r) )\n  guarantee( out.r == 1 <=> ({f}) )\n}}\n")
+    alone = check([parse_text(text, "batch.rcl")])
+    rules = {t: TopicRule(("data",)) for t in ("p", "q", "r")}
+    declined: set[int] = set()
+    for k, f in kept:
+        node = alone.nodes[f"B{k}"]
+        keys = [f"in.{v}" for v in ("p", "q") if f"in.{v}" in f]
+        widths = carried_widths(node, rules, [])
+        assert sorted(widths) == [*keys, "out.r"], f
+        node = at_carried_widths(node, widths, alone.env.constants)
+        events: list[Event] = []
+        for vals in POINTS:
+            for key in [*keys, "out.r"]:
+                value = 1.0 if key == "out.r" else vals[key]
+                events.append(Event(len(events), 0.1 * (len(events) + 1), key.split(".")[1], {"data": value},
+                                    f"m:{len(events)}"))
+        got: dict[int, str] = {}
+        done = check_batch(alone, node, events, rules, 100.0, on_verdict=lambda v: got.__setitem__(v.event, v.verdict))
+        if done is None:  # the batch path declines: its columns hold no quotient (targets/columns.py)
+            assert "/" in f, f
+            declined.add(k)
+            continue
+        answers = [got.get(e.index, "none") for e in events if e.topic == "r"]
+        want = [judge(at.node.guarantees[k].formula, checked, at, vals).truth for vals in POINTS]
+        assert answers == [{True: "satisfied", False: "violated", None: "inconclusive"}[w] for w in want], f
+    assert declined == {k for k, f in kept if "/" in f} and len(declined) < len(kept) // 3, declined
 
 
 def test_the_threshold_forms_are_float32_comparisons(corpus: dict[str, Any]) -> None:
