@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import io
 import re
+from fractions import Fraction
 from pathlib import Path
 
 import pytest
@@ -15,6 +16,7 @@ import pytest
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.dafny import DafnyBackend
 from rclverify.backends.dafny.implementation import scan_implementation
+from rclverify.backends.dafny.refute import model_value, read_models
 from rclverify.backends.dafny.runner import find_dafny, parse_output
 from rclverify.backends.dafny.stubgen import clause_lines
 from rclverify.targets.dafny.text import real_literal
@@ -200,10 +202,21 @@ def test_breaking_implementation_fails_located_and_mapped_to_rcl(tmp_path: Path,
     assert ev.details["guarantees"]["1"] == "failed"
     assert all(ev.details["guarantees"][str(k)] != "failed" for k in range(2, 6))
     assert "guarantee 1 (contracts/classifier.rcl:" in ev.explanation
+    # failed because refuted: a reading in [9, 10) from the prover's model, on which Dafny proves that every
+    # run of the implementation breaks guarantee 1, and Z3 finds the assumptions satisfiable
+    [refuted] = ev.details["refutations"]
+    assert refuted["status"] == "refuted" and refuted["clause"] == "1", refuted
+    assert ev.counterexample is not None and set(ev.counterexample) == {"in.r"}
+    assert 9 <= Fraction(str(ev.counterexample["in.r"])) < 10
+    refutation = (root / refuted["artifact"]).read_text(encoding="utf-8")
+    assert "ensures !((r < (Lim as real)) ==> (level == low))" in refutation
+    assert "requires r == " in refutation and refuted["artifact"] in ev.artifacts
 
 
 @needs_dafny
-def test_bundled_agent_fails_on_the_published_contract(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_bundled_agent_is_unproved_on_the_published_contract(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Dafny proves none of the Agent's guarantees (the published contract is unrealisable), yet its inputs
+    are functions, so no counterexample is shown: inconclusive, never failed on Dafny's word alone."""
     root = _workspace(tmp_path, "remote_inspection.rcl", CASE_STUDY.read_text(encoding="utf-8"),
                       (REPO / "backends" / "dafny" / "agent.dfy").read_text(encoding="utf-8"), "agent.dfy")
     target = _target(root, "contracts/remote_inspection.rcl", "Agent", monkeypatch,
@@ -211,12 +224,74 @@ def test_bundled_agent_fails_on_the_published_contract(tmp_path: Path, monkeypat
     backend = DafnyBackend()
     [ob] = backend.export(target)
     ev = backend.run(ob, target)
-    assert ev.status == "failed", ev.explanation
+    assert ev.status == "inconclusive", ev.explanation
+    assert "A verification error is no counterexample" in ev.explanation and ev.counterexample is None
+    assert [t["status"] for t in ev.details["refutations"]] == ["not refuted"]  # one try with every input free
+    assert set(ev.details["guarantees"].values()) == {"unproved"}
     errors = [e for e in ev.details["errors"] if e["severity"] == "error"]
     # every error is a guarantee of the method; the unrealisability proof and the auxiliary methods verify
     assert errors and all(e.get("role") == "guarantee" for e in errors), ev.log
     assert {e["guarantee"] for e in errors} >= {2, 3}
     assert ev.details["verified"] == 3
+
+
+DOUBLER = """\
+node Doubler {
+  inputs( n : NATURAL )
+  outputs( y : INTEGER )
+  guarantee( out.y == 2 * in.n )
+}
+"""
+
+# True (y is 2 * n on exit), but the loop invariant does not say what y is: Dafny cannot prove it.
+DOUBLER_IMPL = """\
+module DoublerImpl refines DoublerContract {
+  ghost method Doubler(n: nat) returns (y: int)
+  {
+    var i := 0;
+    y := 0;
+    while i < n
+      invariant 0 <= i <= n
+    {
+      y := y + 2;
+      i := i + 1;
+    }
+  }
+}
+"""
+
+
+@needs_dafny
+@pytest.mark.parametrize("invariant", ["", "y == 2 * i"])
+def test_a_true_claim_dafny_cannot_prove_is_inconclusive(invariant: str, tmp_path: Path,
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    impl = DOUBLER_IMPL.replace("invariant 0 <= i <= n", f"invariant 0 <= i <= n\n      invariant {invariant}") \
+        if invariant else DOUBLER_IMPL
+    root = _workspace(tmp_path, "doubler.rcl", DOUBLER, impl, "doubler.dfy")
+    target = _target(root, "contracts/doubler.rcl", "Doubler", monkeypatch)
+    backend = DafnyBackend()
+    [ob] = backend.export(target)
+    ev = backend.run(ob, target)
+    if invariant:  # the control: with the invariant the same claim is proved, so it was true
+        assert ev.status == "discharged", ev.explanation
+        return
+    assert ev.details["error_count"] >= 1 and ev.details["guarantees"]["1"] == "unproved"
+    assert ev.status == "inconclusive" and ev.counterexample is None, ev.explanation
+    assert "Dafny could not prove that backends/dafny/doubler.dfy meets guarantee 1" in ev.explanation
+    assert "A verification error is no counterexample" in ev.explanation
+    # the prover's model gave n; on it Dafny cannot show that every run breaks the guarantee (it holds)
+    [tried] = ev.details["refutations"]
+    assert tried["status"] == "not refuted" and set(tried["inputs"]) == {"in.n"}, tried
+    assert "Dafny did not prove that every run on in.n = " in tried["reason"]
+
+
+def test_the_prover_s_model_values_are_read_exactly() -> None:
+    text = ("*** MODEL\nr#0 -> (/ 39.0 4.0)\nn#0 -> 3\nk#0 -> (- 5)\nb#0 -> true\nlevel#0 -> T@U!val!73\n"
+            "lambda#0 -> {\n  else -> 0\n}\n*** END_MODEL\n*** MODEL\nr#0 -> (- (/ 1.0 3.0))\n*** END_MODEL\n")
+    first, second = read_models(text)
+    assert [model_value(first[k]) for k in ("r#0", "n#0", "k#0", "b#0", "level#0", "lambda#0")] == [
+        Fraction(39, 4), 3, -5, True, None, None]
+    assert model_value(second["r#0"]) == Fraction(-1, 3)
 
 
 @needs_dafny

@@ -196,42 +196,38 @@ def test_wp_of_while_is_the_invariant_with_two_side_conditions(checked: Any) -> 
     assert result.status == "discharged"
 
 
-def test_while_loop_with_a_wrong_invariant_fails(checked: Any) -> None:
-    src = ("var k : NATURAL; var s : INTEGER;\ns := 0\n"
-           "while k > 0 invariant {inv} do\n  s := s + 1\n  k := k - 1\nend\n")
-    good = src.format(inv="s + k == old(k)")
-    prog, m, _ = model_of(good, checked)
+def _loop_triple(checked: Any, inv: str, start: str = "0", pre: Any = None) -> Any:
+    """``s := start; while k > 0 invariant inv do s := s + 1; k := k - 1 end`` against ``s == old(k)``."""
+    prog, m, _ = model_of("var k : NATURAL; var s : INTEGER;\n"
+                          f"s := {start}\nwhile k > 0 invariant {inv} do\n  s := s + 1\n  k := k - 1\nend\n", checked)
     post = m.consts["s"] == m.olds["k"]
+    pre = z3.BoolVal(True) if pre is None else pre(m)
     res = wp(prog.body, post, m)
-    ok = check_all([main_vc(z3.BoolVal(True), res, m, prog.body[0].loc), *res.vcs], [], m, 10_000)
-    assert ok.status == "discharged"
-
-    prog, m, _ = model_of(src.format(inv="s >= 0"), checked)  # too weak to give s == old(k) on exit
-    res = wp(prog.body, m.consts["s"] == m.olds["k"], m)
-    bad = check_all([main_vc(z3.BoolVal(True), res, m, prog.body[0].loc), *res.vcs], [], m, 10_000)
-    assert bad.status == "failed"
-    assert bad.failed is not None and bad.failed.vc.id == "loop@3.exit"
-    cex = bad.counterexample or {}
-    assert cex["k"] == 0 and cex["s"] >= 0 and cex["s"] != cex["old(k)"]
-
-    prog, m, _ = model_of(src.format(inv="s + k == old(k) and s <= 0"), checked)  # not preserved
-    res = wp(prog.body, m.consts["s"] == m.olds["k"], m)
-    bad = check_all([main_vc(z3.BoolVal(True), res, m, prog.body[0].loc), *res.vcs], [], m, 10_000)
-    assert bad.status == "failed" and bad.failed is not None and bad.failed.vc.id == "loop@3.preserve"
+    return check_all([main_vc(pre, res, m, prog.body[0].loc), *res.vcs], [], m, 10_000, triple=(pre, post))
 
 
-def test_counterexample_replays_a_loop_to_its_final_state(checked: Any) -> None:
-    prog, m, _ = model_of("var k : NATURAL; var s : INTEGER;\ns := 0\n"
-                          "while k > 0 invariant s + k == old(k) and k <= 5 do\n  s := s + 1\n  k := k - 1\nend\n",
-                          checked)
-    res = wp(prog.body, m.consts["s"] == m.olds["k"], m)
-    pre = m.consts["k"] <= 10
-    out = check_all([main_vc(pre, res, m, prog.body[0].loc), *res.vcs], [], m, 10_000)
-    # the invariant's k <= 5 does not hold on entry for 5 < k <= 10
-    assert out.status == "failed" and out.failed is not None and out.failed.vc.id == "main"
+def test_a_loop_invariant_too_weak_leaves_a_true_triple_unproved_not_failed(checked: Any) -> None:
+    assert _loop_triple(checked, "s + k == old(k)").status == "discharged"  # the control: the triple is true
+    weak = _loop_triple(checked, "s >= 0")  # too weak to give s == old(k) on exit
+    assert weak.status == "inconclusive" and weak.counterexample is None
+    [why] = weak.notes
+    assert why.startswith("Z3 refutes loop@3.exit") and "which no run need reach" in why
+    assert "the run from the initial values it gives meets the postcondition" in why
+    unkept = _loop_triple(checked, "s + k == old(k) and s <= 0")  # not preserved
+    assert unkept.status == "inconclusive" and unkept.notes[0].startswith("Z3 refutes loop@3.preserve")
+    # an invariant false on entry (k <= 5 for 5 < k <= 10): the main VC's model is a run that meets the post
+    entry = _loop_triple(checked, "s + k == old(k) and k <= 5", pre=lambda m: m.consts["k"] <= 10)
+    assert entry.status == "inconclusive" and entry.notes[0].startswith("Z3 refutes main"), entry.notes
+
+
+def test_a_wrong_loop_fails_with_the_run_that_breaks_it(checked: Any) -> None:
+    # s starts at 1: the invariant s + k == old(k) + 1 holds and is kept; on exit s == old(k) + 1, not old(k)
+    out = _loop_triple(checked, "s + k == old(k) + 1", start="1")
+    assert out.status == "failed" and out.failed is not None and out.failed.vc.id == "loop@3.exit"
     cex = out.counterexample or {}
-    assert 5 < cex["k"] <= 10
-    assert cex["s (final)"] == cex["k"] and cex["k (final)"] == 0
+    assert cex["s (final)"] == cex["k"] + 1 and cex["k (final)"] == 0, cex  # a run from k, replayed to its end
+    # the weak invariant on the same wrong program: its refuted exit VC still yields the breaking run
+    assert _loop_triple(checked, "s >= 0", start="1").status == "failed"
 
 
 def test_outline_annotates_each_statement_like_the_papers_figure(checked: Any) -> None:

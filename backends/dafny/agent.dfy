@@ -30,8 +30,10 @@
 // every step, whatever the radiation.  Guarantee 2 demands `inspect(i)`
 // whenever the robot is at an uninspected waypoint i.  Both cannot hold at
 // once, so the contract has no implementation.  Dafny therefore reports the
-// method's postconditions as unproved (the evidence is `failed`, each error
-// mapped back to its RCL guarantee), and the ghost method
+// method's postconditions as unproved (each error mapped back to its RCL
+// guarantee; the evidence is `inconclusive`: the inputs are functions, so
+// rclverify fixes none of them from the prover's model and shows no
+// counterexample), and the ghost method
 // `PublishedContractIsUnrealisable` below makes the argument checkable: it
 // calls the contract on the mission's first step (13 waypoints 0-12 on the
 // line y = 0, the robot at waypoint 0, nothing inspected, radiation green)

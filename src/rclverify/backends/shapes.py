@@ -82,6 +82,20 @@ class UnsoundConstruct(TypedDict):
     construct: str
 
 
+class DafnyRefutation(TypedDict):
+    """One sought refutation of a guarantee clause Dafny could not prove (backends/dafny/refute.py):
+    ``clause`` ``"2"`` or ``"2.1"``, ``rcl`` its RCL location, ``inputs`` the pinned inputs (RCL name ->
+    value text), ``status`` ``refuted`` or ``not refuted`` with the ``reason``, ``artifact`` its stub."""
+    guarantee: int
+    conjunct: int
+    clause: str
+    rcl: str
+    inputs: dict[str, str]
+    status: str
+    reason: str
+    artifact: str
+
+
 class DafnyDetails(TypedDict):
     """A Dafny run's evidence ``details``: its counts, diagnostics and a verdict per guarantee."""
     verified: int
@@ -100,6 +114,7 @@ class DafnyDetails(TypedDict):
     unsound_constructs: NotRequired[list[UnsoundConstruct]]
     command: NotRequired[str]
     log_filtered: NotRequired[list[str]]
+    refutations: NotRequired[list[DafnyRefutation]]
 
 
 class DafnyScan(TypedDict):

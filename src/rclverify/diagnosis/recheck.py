@@ -208,7 +208,7 @@ def hoare_statuses(ws: Any, node: str, index: int, program: str, new_text: str) 
                 out[p.id] = "pending"
                 continue
             res = check_all(p.vcs, p.triple.background, p.model, p.config.timeout_ms, p.triple.observe,
-                            p.triple.observe_final, p.triple.names)
+                            p.triple.observe_final, p.triple.names, triple=(p.triple.pre, p.triple.post))
             out[p.id] = res.status if res.status in ("discharged", "failed") else "inconclusive"
         return out
     finally:

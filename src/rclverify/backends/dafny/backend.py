@@ -25,11 +25,16 @@ the guarantees it covers.  Evidence statuses:
 * ``discharged``  Dafny finished with 0 errors, no time-outs, at least one
   verified procedure, and the implementation uses no construct that makes
   Dafny accept an unproved claim;
-* ``failed``      Dafny reported verification errors (each one located,
-  and mapped back to the RCL assumption/guarantee when it concerns a
-  ``requires``/``ensures`` of the stub);
-* ``inconclusive`` a verification condition or the process timed out, or
-  the implementation uses ``assume``/``{:axiom}``/... (listed);
+* ``failed``      a guarantee Dafny could not prove is refuted (:mod:`.refute`:
+  Dafny proves every run on the prover's model's inputs breaks it, and Z3
+  finds the assumptions satisfiable there); the counterexample is those
+  inputs;
+* ``inconclusive`` Dafny reported verification errors but no refutation was
+  found (each error located, and mapped back to the RCL
+  assumption/guarantee when it concerns a ``requires``/``ensures`` of the
+  stub; a verification error is no counterexample), a verification
+  condition or the process timed out, or the implementation uses
+  ``assume``/``{:axiom}``/... (listed);
 * ``error``       parse/resolution errors, a crash, an implementation that
   refines nothing or gives the method no body;
 * ``pending``     Dafny is not installed, or the implementation file does
@@ -37,6 +42,7 @@ the guarantees it covers.  Evidence statuses:
 """
 from __future__ import annotations
 
+import tempfile
 from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping
@@ -50,12 +56,14 @@ from rclverify.records.store import atomic_write_text
 from rclverify.lang.errors import RclError
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
-from rclverify.backends.dafny import implementation, runner
-from rclverify.backends.dafny.stubgen import ClauseRef, Stub, build_stub, clause_lines, snake
-from rclverify.backends.shapes import DafnyDetails, DafnyError, DafnyPlace, DafnyScan
+from rclverify.backends.dafny import implementation, refute, runner
+from rclverify.backends.dafny.stubgen import ClauseRef, Refutation, Stub, build_stub, clause_lines, snake
+from rclverify.backends.shapes import DafnyDetails, DafnyError, DafnyPlace, DafnyRefutation, DafnyScan
 
 DEFAULT_TIME_LIMIT_S = 60
 DEFAULT_TIMEOUT_S = 600
+#: :func:`_judge`'s word for a run whose errors left clauses unproved; :func:`_confirm` turns it into a status
+UNPROVED = "unproved"
 
 
 @lru_cache(maxsize=1)
@@ -211,27 +219,129 @@ class DafnyBackend:
         argv = runner.verify_argv(tool, files, cfg.time_limit, error_limit=len(stub.clauses) + 10,
                                   options=cfg.options)
         shown = " ".join([Path(argv[0]).name, *argv[1:]])
-        try:
-            res = runner.run(argv, target.root, float(cfg.timeout))
-        except OSError as exc:
-            return ev("error", f"could not start {exe}: {exc}", tool.version, details={"command": shown})
+        with tempfile.TemporaryDirectory(prefix="rclverify-dafny-") as tmp:
+            model = Path(tmp) / "model.bvd" if runner.takes_model_file(tool) else None
+            try:
+                res = runner.run(runner.verify_argv(tool, files, cfg.time_limit, error_limit=len(stub.clauses) + 10,
+                                                    options=cfg.options, model_file=str(model) if model else None),
+                                 target.root, float(cfg.timeout))
+            except OSError as exc:
+                return ev("error", f"could not start {exe}: {exc}", tool.version, details={"command": shown})
+            models = refute.read_models(model.read_text(encoding="utf-8", errors="replace")) \
+                if model is not None and model.is_file() else []
         log_path = target.artifacts / f"{snake(target.node.name)}_dafny.log"
         shown_log, log_notes = runner.filter_log(res.output)
         atomic_write_text(log_path, _jinja().get_template("log.txt.j2").render(
             node=target.node.name, obligation=obligation.id, command=shown,
             exit_code="killed at the process timeout" if res.timed_out else res.returncode,
             output=shown_log.rstrip("\n"), notes=log_notes))
-        artifacts = (stub_rel, target.rel(log_path))
+        artifacts: tuple[str, ...] = (stub_rel, target.rel(log_path))
         out = runner.parse_output(res.output)
         clauses = clause_lines(stub.text)
         status, explanation, details = _judge(res, out, clauses, stub_rel, cfg, scan, tool,
                                               len(target.node.node.guarantees), target)
+        cex: dict[str, object] | None = None
+        if status == UNPROVED:
+            status, explanation, cex, tried = _confirm(target, cfg, tool, stub, scan, out, clauses, stub_rel, models,
+                                                       explanation, details)
+            artifacts += tuple(t["artifact"] for t in tried if t["artifact"])
         details["refining_modules"] = scan_details["refining_modules"]
         details["unsound_constructs"] = scan_details["unsound_constructs"]
         details["command"] = shown
         if log_notes:
             details["log_filtered"] = log_notes
-        return ev(status, explanation, tool.version, log=shown_log, artifacts=artifacts, details=details)
+        return ev(status, explanation, tool.version, log=shown_log, artifacts=artifacts, details=details,
+                  counterexample=cex)
+
+
+def _confirm(target: NodeTarget, cfg: _Config, tool: runner.DafnyTool, stub: Stub,
+             scan: implementation.ImplementationScan, out: runner.Output, clauses: Mapping[int, ClauseRef],
+             stub_rel: str, models: list[dict[str, str]], unproved: str,
+             details: DafnyDetails) -> tuple[str, str, dict[str, object] | None, list[DafnyRefutation]]:
+    """Status, explanation, counterexample and refutation attempts of a run
+    whose errors left guarantees unproved (:mod:`.refute`): ``failed`` when
+    one guarantee clause is refuted, else ``inconclusive`` with each reason.
+    Sets ``details["guarantees"]`` of a refuted guarantee to ``failed`` and
+    ``details["refutations"]``."""
+    failing: list[tuple[int, int, int]] = []  # (guarantee, conjunct, index of its model)
+    k = -1
+    for m in out.messages:
+        if m.severity != "error":
+            continue
+        k += 1
+        c = _clause_of(m, clauses, stub_rel, target.root)
+        if c is not None and c.role == "guarantee" and all((g, j) != (c.index, c.conjunct) for g, j, _ in failing):
+            failing.append((c.index, c.conjunct, k))
+    tried: list[DafnyRefutation] = []
+    free = 0  # refutations sought with every input free: one per run (each is rarely true, and costs a run)
+    for g, j, k in failing[:refute.MAX_REFUTATIONS]:
+        if scan.unsound:
+            break  # a refutation proved with `assume` in the code proves nothing either
+        pinned = refute.pins(models[k] if k < len(models) else {}, stub)
+        if not pinned and free:
+            continue
+        free += not pinned
+        tried.append(_refute_one(target, cfg, tool, g, j, pinned))
+    details["refutations"] = tried
+    done = [t for t in tried if t["status"] == "refuted"]
+    for t in done:
+        details.setdefault("guarantees", {})[str(t["guarantee"])] = "failed"
+    if done:
+        t = done[0]
+        on = (", ".join(f"{n} = {v}" for n, v in t["inputs"].items()) if t["inputs"]
+              else "every input that meets the assumptions")
+        return "failed", (f"Dafny refutes guarantee {t['clause']} ({t['rcl']}) of {cfg.implementation}: on {on}, "
+                          f"Dafny proves that every run of the implementation breaks it ({t['artifact']}), and Z3 "
+                          f"finds the assumptions satisfiable there. {unproved}"), dict(t["inputs"]), tried
+    if scan.unsound:
+        why = "the implementation relies on constructs Dafny does not prove, so no refutation was sought"
+    elif not failing:
+        why = "no guarantee clause was among them (an assertion, a loop invariant or a call's precondition was)"
+    else:
+        why = "; ".join(f"guarantee {t['clause']}: {t['reason']}" for t in tried)
+        if len(failing) > len(tried):
+            why += (f"; {len(failing) - len(tried)} more guarantee clause(s) not tried (at most "
+                    f"{refute.MAX_REFUTATIONS} per run, one of them with no input fixed by the prover's model)")
+    return "inconclusive", (f"{unproved}. A verification error is no counterexample (the verifier may lack a loop "
+                            f"invariant, a lemma or nonlinear arithmetic), and none was shown: {why}"), None, tried
+
+
+def _refute_one(target: NodeTarget, cfg: _Config, tool: runner.DafnyTool, g: int, j: int,
+                pinned: list[refute.Pin]) -> DafnyRefutation:
+    """Seek the refutation of guarantee ``g``'s conjunct ``j`` on the ``pinned`` inputs (:mod:`.refute`):
+    writes the refutation stub under the node's artifacts and runs Dafny on it and the implementation."""
+    label = f"{g}.{j}" if j else str(g)
+    stub = build_stub(target.checked.env, target.node, ghost=cfg.ghost,
+                      header=f"Dafny refutation of guarantee {label} of node {target.node.name} -- generated by "
+                             "rclverify",
+                      refute=Refutation(g, j, tuple((p.param, p.literal, f"{p.name} == {p.shown}") for p in pinned)))
+    [clause] = [c for c in stub.clauses if c.kind == "ensures"]
+    path = target.artifacts / f"{snake(target.node.name)}_refute_g{label.replace('.', '_')}.dfy"
+    atomic_write_text(path, stub.text)
+    rel = target.rel(path)
+    record: DafnyRefutation = {"guarantee": g, "conjunct": j, "clause": label, "rcl": str(clause.source),
+                               "inputs": {p.name: p.shown for p in pinned}, "status": "not refuted", "reason": "",
+                               "artifact": rel}
+    try:
+        res = runner.run(runner.verify_argv(tool, [rel, cfg.implementation], cfg.time_limit, options=cfg.options),
+                         target.root, float(cfg.timeout))
+    except OSError as exc:
+        record["reason"] = f"Dafny could not be started for the refutation: {exc}"
+        return record
+    out = runner.parse_output(res.output)
+    if res.timed_out or not out.summary or out.errors or out.timeouts or out.other or not out.verified:
+        shown = ", ".join(f"{n} = {v}" for n, v in record["inputs"].items()) or "the inputs left free"
+        record["reason"] = (f"Dafny did not prove that every run on {shown} breaks it ({out.errors} error(s), "
+                            f"{out.timeouts} time-out(s){', killed at the process timeout' if res.timed_out else ''}"
+                            f"; {rel})")
+        return record
+    answer, why = refute.assumptions_satisfiable(target.checked, target.node, pinned)
+    if answer != "sat":
+        record["reason"] = ("Z3 finds no inputs that meet the assumptions there, so the refutation is vacuous"
+                            if answer == "unsat" else f"whether inputs meet the assumptions there is not known: {why}")
+        return record
+    record["status"] = "refuted"
+    return record
 
 
 def _same_file(printed: str, rel: str, root: Path) -> bool:
@@ -293,12 +403,12 @@ def _judge(res: runner.RunOutput, out: runner.Output, clauses: Mapping[int, Clau
         kind = ("parse errors" if out.parse_errors else "resolution/type errors" if out.resolution_errors
                 else "no verification summary (Dafny crashed or was misconfigured)")
         status, expl = "error", f"Dafny stopped with {kind}: {first}"
-    elif out.errors:
+    elif out.errors:  # unproved: failed or inconclusive once a refutation was sought (:func:`_confirm`)
         failed = sorted({(e["index"], e["rcl"]) for e in errors if e.get("role") == "guarantee"
                          and e["severity"] == "error"})
         which = ", ".join(f"guarantee {k} ({src})" for k, src in failed) or "the contract"
-        status = "failed"
-        expl = (f"Dafny could not prove that {cfg.implementation} meets {which}: {out.errors} error(s); "
+        status = UNPROVED
+        expl = (f"Dafny could not prove that {cfg.implementation} meets {which}: {out.errors} error(s): "
                 + "; ".join(located(e) for e in errors if e["severity"] == "error")[:1500])
     elif out.timeouts or out.other:
         status = "inconclusive"
@@ -318,7 +428,7 @@ def _judge(res: runner.RunOutput, out: runner.Output, clauses: Mapping[int, Clau
     for k in range(1, n_guarantees + 1):
         sev = per.get(str(k), [])
         if "error" in sev:
-            guarantees[str(k)] = "failed"
+            guarantees[str(k)] = "unproved"  # "failed" once refuted (:func:`_confirm`)
         elif "timeout" in sev:
             guarantees[str(k)] = "inconclusive"
         elif status == "discharged":

@@ -102,20 +102,29 @@ def detect(exe: str, timeout_s: float = 120.0) -> DafnyTool | None:
 
 
 def verify_argv(tool: DafnyTool | None, files: Sequence[str], time_limit_s: int, error_limit: int = 20,
-                options: Sequence[str] = ()) -> list[str]:
+                options: Sequence[str] = (), model_file: str | None = None) -> list[str]:
     """The command line verifying ``files`` (workspace-relative) with Dafny.
 
     ``time_limit_s`` bounds each verification condition (seconds);
     ``error_limit`` the errors reported per procedure (legacy CLI);
     ``options`` extra options passed verbatim before the files (they must
-    suit the CLI generation of ``tool``).  With ``tool=None`` the legacy
-    form of the Debian package is returned with the command name ``dafny``.
+    suit the CLI generation of ``tool``); ``model_file`` (legacy CLI only:
+    :func:`takes_model_file`) where Boogie writes the prover's model of each
+    error (``/mv:``).  With ``tool=None`` the legacy form of the Debian
+    package is returned with the command name ``dafny``.
     """
     exe = tool.exe if tool else "dafny"
     if tool is None or tool.legacy:
+        mv = [f"/mv:{model_file}"] if model_file else []
         return [exe, "/compile:0", "/nologo", f"/timeLimit:{time_limit_s}", f"/errorLimit:{error_limit}",
-                *options, *files]
+                *options, *mv, *files]
     return [exe, "verify", "--verification-time-limit", str(time_limit_s), *options, *files]
+
+
+def takes_model_file(tool: DafnyTool) -> bool:
+    """Whether :func:`verify_argv` can ask ``tool`` for the prover's models
+    (Boogie's ``/mv:`` of the legacy CLI; ``dafny verify`` has no such option)."""
+    return tool.legacy
 
 
 def user_commands(files: Sequence[str], time_limit_s: int, options: Sequence[str] = ()) -> tuple[str, str]:

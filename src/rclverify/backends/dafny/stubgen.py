@@ -34,6 +34,7 @@ The user writes ``module <Any> refines <Node>Contract { [ghost] method
 """
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -105,6 +106,19 @@ def _jinja() -> jinja2.Environment:
                               trim_blocks=True, lstrip_blocks=True, autoescape=False)
 
 
+@dataclass(frozen=True)
+class Refutation:
+    """What a refutation stub states instead of the contract (:mod:`.refute`):
+    the method keeps every ``requires``, gains one ``requires`` per pinned
+    input, and has the one ``ensures`` ``!(g)`` of guarantee ``guarantee``'s
+    conjunct ``conjunct`` (0: the whole guarantee).  ``pins`` are
+    ``(parameter, Dafny literal, RCL text of the pin)`` triples."""
+
+    guarantee: int
+    conjunct: int
+    pins: tuple[tuple[str, str, str], ...] = ()
+
+
 def conjuncts(e: ast.Expr) -> list[ast.Expr]:
     """The top-level conjuncts of ``e`` (``a and (b and c)`` -> ``[a, b, c]``)."""
     if isinstance(e, ast.Binary) and e.op == "and":
@@ -135,7 +149,7 @@ def _type_rank(env: Env, dafny_name: str) -> int:
 
 def build_stub(env: Env, node: CheckedNode, *, ghost: bool = True, header: str = "",
                commands: tuple[str, ...] = (), implementation: str = "",
-               widths: Mapping[str, str] | None = None) -> Stub:
+               widths: Mapping[str, str] | None = None, refute: Refutation | None = None) -> Stub:
     """Build (and render) the Dafny contract stub of ``node``.
 
     ``ghost``          emit a ``ghost method`` (default) or a compiled ``method``;
@@ -143,7 +157,10 @@ def build_stub(env: Env, node: CheckedNode, *, ghost: bool = True, header: str =
     ``commands``       Dafny command lines shown in the stub's comment;
     ``implementation`` the workspace-relative implementation path shown there;
     ``widths``         ``"in.x"`` -> ``float32``/``float64``: the widths the clauses'
-                       comparisons are read at (:class:`~rclverify.targets.dafny.translate.Translator`).
+                       comparisons are read at (:class:`~rclverify.targets.dafny.translate.Translator`);
+    ``refute``         build the refutation stub of one guarantee instead (:class:`Refutation`): the
+                       same module name, declarations and signature, so the user's implementation
+                       refines it unchanged.
 
     Raises :class:`~rclverify.model.plan.errors.PlanError` (located at the RCL
     construct) for types or formulas Dafny cannot express, e.g. an input of
@@ -160,6 +177,12 @@ def build_stub(env: Env, node: CheckedNode, *, ghost: bool = True, header: str =
                     for v in n.outputs)
     tr = Translator(env, node, io, consts, frozenset(reserved | set(synonyms)), dict(widths or {}))
     clauses = _clauses(tr, n)
+    if refute is not None:
+        negated = [dataclasses.replace(c, rcl=f"not ({c.rcl})", dafny=f"!({c.dafny})") for c in clauses
+                   if c.role == "guarantee" and (c.index, c.conjunct) == (refute.guarantee, refute.conjunct)]
+        pins = [StubClause("requires", "counterexample input", k, 0, n.loc, rcl, f"{param} == {lit}")
+                for k, (param, lit, rcl) in enumerate(refute.pins, start=1)]
+        clauses = [c for c in clauses if c.kind == "requires"] + pins + negated
     const_lines = _constant_lines(env, tr, consts, needed)
     dts: list[EnumT | DataT] = []
     for t in needed + tr.used_types:
@@ -174,7 +197,7 @@ def build_stub(env: Env, node: CheckedNode, *, ghost: bool = True, header: str =
         synonyms=sorted(synonyms.items(), key=lambda kv: (_type_rank(env, kv[0]), kv[0])),
         consts=[const_lines[c] for c in env.constants if c in const_lines],
         signature=stub.signature(), clauses=clauses, commands=list(commands), implementation=implementation,
-        ghost=ghost,
+        ghost=ghost, refutation=refute,
     )
     return Stub(module, method, ghost, params, returns, tuple(clauses), io, text)
 

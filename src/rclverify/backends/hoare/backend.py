@@ -14,9 +14,11 @@ backend mechanises that step:
   division in the program, the precondition and the postcondition must not
   divide by zero where it is evaluated (docs/semantics.md, "Definedness");
 * ``run`` checks every verification condition with Z3 (:mod:`.solve`):
-  all valid -> ``discharged``; one refuted -> ``failed`` with a
-  counterexample (initial values, extern applications, final values);
-  unknown/timeout -> ``inconclusive``; a conjunct the program does not model
+  all valid -> ``discharged``; one refuted with a run of the program that
+  breaks the triple -> ``failed`` with that counterexample (initial values,
+  extern applications, final values); refuted only in a state no run need
+  reach (a loop invariant too weak), unknown or timeout -> ``inconclusive``
+  with the reason; a conjunct the program does not model
   -> ``pending`` with the reason (never discharged).
 """
 from __future__ import annotations
@@ -249,7 +251,7 @@ class HoareBackend:
                             details={"reason": p.pending, "uncovered": list(p.conjunct.uncovered)})
         try:
             res = check_all(p.vcs, p.triple.background, p.model, p.config.timeout_ms, p.triple.observe,
-                            p.triple.observe_final, p.triple.names)
+                            p.triple.observe_final, p.triple.names, triple=(p.triple.pre, p.triple.post))
         except z3.Z3Exception as exc:
             return evidence("error", f"Z3 failed: {exc}", log=str(exc), artifacts=tuple(artifacts))
         # it ends naming the obligation it decides (records/ties.py), read back by `bundle --verify`
@@ -282,6 +284,11 @@ class HoareBackend:
                             f"{details['triple']['post']} fails on this run (verification condition "
                             f"{res.failed.vc.id}: {res.failed.vc.label}): {_cex_text(res.counterexample or {})}", log=log,
                             artifacts=tuple(artifacts), counterexample=res.counterexample, details=details)
+        if res.notes:  # refuted verification conditions, but no run of the program that breaks the triple
+            details["notes"] = list(res.notes)
+            return evidence("inconclusive", f"{p.config.program} is not proved to meet the triple, and no "
+                            f"counterexample was shown: {'; '.join(res.notes)}", log=log,
+                            artifacts=tuple(artifacts), details=details)
         reasons = sorted({r.reason for r in res.results if r.status == "unknown"})
         return evidence("inconclusive", f"Z3 answered unknown ({', '.join(reasons) or 'no reason given'}) "
                         f"within {p.config.timeout_ms} ms", log=log, artifacts=tuple(artifacts), details=details)

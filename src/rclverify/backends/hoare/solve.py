@@ -3,9 +3,11 @@
 Each VC ``hyps => goal`` (:class:`rclverify.backends.hoare.wp.VC`) is
 checked by asking Z3 whether ``hyps and not goal`` is satisfiable, with a
 timeout (shared/DESIGN.md, "Solver answers"): unsat -> the VC is valid;
-sat -> it is refuted and the model is a counterexample; unknown (or timeout)
--> nothing is concluded.  A triple is ``discharged`` only when every VC is
-valid, ``failed`` when one is refuted, ``inconclusive`` otherwise.
+sat -> it is refuted; unknown (or timeout) -> nothing is concluded.  A
+triple is ``discharged`` only when every VC is valid, ``failed`` when a
+refuted VC comes with a run of the program that breaks the triple
+(:func:`check_all`: a loop's VC is refuted in a state no run need reach, so
+its model is no counterexample), ``inconclusive`` otherwise.
 
 A counterexample of the triple's own VC (``main``) names concrete values of
 the program's initial variables and of the uninterpreted function
@@ -49,9 +51,11 @@ class TripleResult:
 
     ``status``          ``discharged``/``failed``/``inconclusive``;
     ``results``         per VC, ``main`` first;
-    ``failed``          the first refuted definedness VC's result (:mod:`.defined`),
-                        else the first refuted VC's (``failed`` only);
-    ``counterexample``  JSON-serialisable name -> value (``failed`` only).
+    ``failed``          the refuted VC whose run breaks the triple, a definedness VC
+                        (:mod:`.defined`) first (``failed`` only);
+    ``counterexample``  JSON-serialisable name -> value (``failed`` only);
+    ``notes``           what the values are (``failed``), or why each refuted VC
+                        shows no run (``inconclusive``).
     """
 
     status: str
@@ -110,11 +114,13 @@ def check_vc(vc: VC, background: Sequence[z3.BoolRef], m: ProgramModel, timeout_
 
 
 class _Replay:
-    """Runs the program concretely under a model (externs as the model interprets them)."""
+    """Runs the program concretely under a model (externs as the model interprets them), from
+    ``init`` (variable -> value; default: the model's values of the variables' constants)."""
 
-    def __init__(self, m: ProgramModel, model: z3.ModelRef) -> None:
+    def __init__(self, m: ProgramModel, model: z3.ModelRef, init: Mapping[str, z3.ExprRef] | None = None) -> None:
         self.m, self.model = m, model
-        self.init = {n: model.eval(c, model_completion=True) for n, c in m.consts.items()}
+        self.init = dict(init) if init is not None else {
+            n: model.eval(c, model_completion=True) for n, c in m.consts.items()}
         self.state = dict(self.init)
         self.steps = 0
 
@@ -206,22 +212,101 @@ def counterexample(res: VCResult, m: ProgramModel, observe: Mapping[str, z3.Expr
     return out, notes
 
 
+def _has_loop(body: tuple[lang.Stmt, ...]) -> bool:
+    return any(isinstance(s, lang.While) or (isinstance(s, lang.If) and (_has_loop(s.then_) or _has_loop(s.else_)))
+               for s in body)
+
+
+def _exact(res: VCResult, m: ProgramModel) -> bool:
+    """Whether a model of ``res``'s refuted VC is itself a run that breaks the triple: a VC of the
+    initial state of a program without loops (weakest preconditions are exact there), or a
+    definedness VC of the initial state (a division that sees a zero divisor, :mod:`.defined`)."""
+    return res.vc.state == "initial" and (res.vc.id.startswith("defined") or not _has_loop(m.program.body))
+
+
+def breaking_run(res: VCResult, m: ProgramModel, pre: z3.BoolRef, post: z3.BoolRef,
+                 background: Sequence[z3.BoolRef] = (), observe: Mapping[str, z3.ExprRef] | None = None,
+                 observe_final: Mapping[str, str] | None = None) -> dict[str, object] | str:
+    """A run that breaks the triple, from a refuted VC that is not :func:`_exact`, or why none is shown.
+
+    A loop's VCs hold in an arbitrary state at its head (:mod:`.wp`), which no
+    run need reach, and the ``main`` VC of a program with loops fails as well
+    when an invariant does not hold on entry: such a model is no
+    counterexample.  The run tried starts in the model's initial state (its
+    values of the variables for a VC of the initial state, of their
+    ``old(x)`` for a loop's), must meet ``pre`` and the ``background`` facts
+    and the variables' types there, and is replayed to its end; it breaks the
+    triple when ``post`` is false in its final state.  Returns the run's
+    values (``x``, ``old`` names of ``observe``, ``x (final)``, the
+    ``observe_final`` names) or the reason in one sentence."""
+    assert res.model is not None
+    model = res.model
+    source = m.consts if res.vc.state == "initial" else m.olds
+    init = {n: model.eval(source[n], model_completion=True) for n in m.consts}
+
+    def at_init(f: z3.ExprRef) -> z3.ExprRef:
+        subs = [(m.consts[n], v) for n, v in init.items()] + [(m.olds[n], v) for n, v in init.items()]
+        return model.eval(z3.substitute(f, *subs), model_completion=True)
+
+    where = (f"a state at the head of the loop at line {res.vc.loc.line}, which no run need reach"
+             if res.vc.state == "loop" else "the initial state of a program with loops")
+    typed = m.typing_facts([*m.consts.values()])
+    if not all(z3.is_true(at_init(f)) for f in (pre, *background, *typed)):
+        return (f"Z3 refutes {res.vc.id} ({res.vc.label}) in {where}; the run from the initial values it gives "
+                "does not meet the precondition, so no run breaking the triple was shown")
+    replay = _Replay(m, model, init)
+    if not replay.run(m.program.body):
+        return (f"Z3 refutes {res.vc.id} ({res.vc.label}) in {where}; replaying the program from its initial "
+                f"values did not finish within {MAX_STEPS} steps, so no run breaking the triple was shown")
+    subs = [(m.consts[n], v) for n, v in replay.state.items()] + [(m.olds[n], v) for n, v in init.items()]
+    if z3.is_true(model.eval(z3.substitute(post, *subs), model_completion=True)):
+        return (f"Z3 refutes {res.vc.id} ({res.vc.label}) in {where}, but the run from the initial values it "
+                "gives meets the postcondition: a loop invariant is too weak, not preserved or not true on "
+                "entry, and no run breaking the triple was shown")
+    out: dict[str, object] = {n: json_value(v) for n, v in init.items()}
+    for label, term in (observe or {}).items():
+        out[label] = json_value(at_init(term))
+    for n in _assigned(m.program.body):
+        out[f"{n} (final)"] = json_value(replay.state[n])
+    for label, var in (observe_final or {}).items():
+        out[label] = json_value(replay.state[var])
+    return out
+
+
 def check_all(vcs: Sequence[VC], background: Sequence[z3.BoolRef], m: ProgramModel, timeout_ms: int,
               observe: Mapping[str, z3.ExprRef] | None = None, observe_final: Mapping[str, str] | None = None,
-              names: Mapping[str, str] | None = None) -> TripleResult:
+              names: Mapping[str, str] | None = None,
+              triple: tuple[z3.BoolRef, z3.BoolRef] | None = None) -> TripleResult:
     """Check every VC of a triple (``main`` first) and roll the answers up.
 
-    The VCs share one solver session (:func:`~rclverify.semantics.query.solver_session`):
-    the same VCs in the same order wherever the triple is checked (a local
-    run, a cluster worker), so the answers and counterexamples are too."""
+    A refuted VC makes the triple ``failed`` only with a run that breaks it:
+    the model itself where it is one (a VC of the initial state of a program
+    without loops, a definedness VC of the initial state), else the run
+    :func:`breaking_run` replays from the model's initial values against
+    ``triple`` (``(pre, post)``; without it none is tried); with none the
+    triple is ``inconclusive`` and ``notes`` say why.  The VCs share one
+    solver session (:func:`~rclverify.semantics.query.solver_session`): the
+    same VCs in the same order wherever the triple is checked (a local run,
+    a cluster worker), so the answers and counterexamples are too."""
     with solver_session():
         results = tuple(check_vc(vc, background, m, timeout_ms) for vc in vcs)
     # a definedness VC refuted is the failure reported: what else fails reads an undefined value
-    bad = next((r for r in results if r.status == "invalid" and r.vc.id.startswith("defined")),
-               next((r for r in results if r.status == "invalid"), None))
-    if bad is not None:
-        cex, notes = counterexample(bad, m, observe, observe_final, names)
-        return TripleResult("failed", results, bad, cex, tuple(notes))
+    refuted = sorted((r for r in results if r.status == "invalid"), key=lambda r: not r.vc.id.startswith("defined"))
+    why: list[str] = []
+    for bad in refuted:
+        if _exact(bad, m):
+            cex, notes = counterexample(bad, m, observe, observe_final, names)
+            return TripleResult("failed", results, bad, cex, tuple(notes))
+        if triple is None:
+            why.append(f"Z3 refutes {bad.vc.id} ({bad.vc.label}), whose model is no run of the program")
+            continue
+        run = breaking_run(bad, m, triple[0], triple[1], background, observe, observe_final)
+        if isinstance(run, dict):
+            return TripleResult("failed", results, bad, run, (
+                f"{bad.vc.id} is refuted; the run from its model's initial values breaks the triple",))
+        why.append(run)
+    if why:
+        return TripleResult("inconclusive", results, notes=tuple(why))
     if any(r.status == "unknown" for r in results):
         return TripleResult("inconclusive", results)
     return TripleResult("discharged", results)
