@@ -19,6 +19,7 @@ import pytest
 
 from _report_schema import check_report
 from rclverify.cli.commands import main
+from rclverify.report.bundle.fresh import report_out_of_date
 from rclverify.stages.nodl import INDEX, read_nodl
 from rclverify.stages.workspace import Workspace
 
@@ -97,9 +98,12 @@ def test_a_record_of_other_documents_is_stale_and_an_altered_one_an_error(runs: 
         doc.write_text(kept + "# edited after the run\n", encoding="utf-8")
         row = read_nodl(Workspace(ws, "contracts/plan.yaml"))
         assert row is not None and "other NoDL documents" in str(row.get("stale"))
+        # nor does a bundle pack the report written before the edit (meta.inputs_sha256)
+        assert "built from other inputs" in " ".join(report_out_of_date(Workspace(ws, "contracts/plan.yaml")))
     finally:
         doc.write_text(kept, encoding="utf-8")
     assert "stale" not in (read_nodl(Workspace(ws, "contracts/plan.yaml")) or {"stale": "none read"})
+    assert report_out_of_date(Workspace(ws, "contracts/plan.yaml")) == []
     record = ws / INDEX
     text = record.read_text(encoding="utf-8")
     record.write_text(text.replace('"error": 1', '"error": 0'), encoding="utf-8")

@@ -39,7 +39,7 @@ from rclverify.report.near_misses import near_miss_rows
 from rclverify.report.evidence_rows import evidence_part
 from rclverify.report.expected import expected_rows
 from rclverify.report.finding_rows import acknowledged_rows, finding_rows, grounding_row, lint_rows
-from rclverify.report.nodl import blocks_strict as nodl_blocks, nodl_problems, nodl_row
+from rclverify.report.nodl import blocks_strict as nodl_blocks, nodl_inputs, nodl_problems, nodl_row
 from rclverify.report.problems import group_problems
 from rclverify.report.records import inputs_sha256, node_obligations
 from rclverify.report.requirement_rows import requirement_rows
@@ -146,7 +146,7 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
         "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name,
                  "plan": plan.file, "contracts": list(plan.contracts), "z3_version": z3.get_version_string(),
                  "strict_ok": strict_ok, "inputs_sha256": inputs_sha256(ws, inp.made_from, facts.evidence_inputs,
-                                                                        facts.checks)},
+                                                                        facts.checks, nodl_inputs(ws, rows["nodl"]))},
         "summary": {"status": overall, "counts": counts, "problems": problems,
                     "headline": headline(rows["obligations"], counts, rows["side_conditions"], rows["findings"],
                                          rows["unverified"])},

@@ -38,6 +38,19 @@ def nodl_row(ws: Workspace) -> NodlRow | None:
     return cast(NodlRow | None, read_nodl(ws))
 
 
+def nodl_inputs(ws: Workspace, row: Mapping[str, Any] | None) -> dict[str, object] | None:
+    """What ``meta.inputs_sha256`` takes of the NoDL check (:func:`rclverify.report.records.inputs_sha256`):
+    the sha256 the record was made from (``made_from``) and those of the same files and the current
+    documents now (``now``), so a report built before a document changed is not the one built after;
+    ``None`` for a workspace without a document."""
+    if row is None:
+        return None
+    from rclverify.records.records import hash_inputs  # deferred: start-up (loads rclverify.records only when called)
+    from rclverify.stages.nodl import documents  # deferred: start-up (loads jsonschema and yaml only when called)
+    made = dict(row.get("inputs") or {})
+    return {"made_from": made, "now": hash_inputs(ws.root, sorted(set(made) | set(documents(ws.root))))}
+
+
 def _where(place: Mapping[str, Any]) -> str:
     return f"{place['file']}:{place['line']}:{place['col']}"
 
@@ -92,4 +105,4 @@ def sarif_results(report: Report, result: Callable[..., SarifResult],
     return out
 
 
-__all__ = ["SARIF_RULES", "blocks_strict", "nodl_problems", "nodl_row", "sarif_results", "strict_reason"]
+__all__ = ["SARIF_RULES", "blocks_strict", "nodl_inputs", "nodl_problems", "nodl_row", "sarif_results", "strict_reason"]

@@ -122,7 +122,7 @@ def grounding(ws: Workspace, rel: str) -> dict[str, Any] | None:
 
 
 def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: Mapping[str, object],
-                  checks: Mapping[str, Mapping[str, object]]) -> str:
+                  checks: Mapping[str, Mapping[str, object]], nodl: Mapping[str, object] | None = None) -> str:
     """One sha256 over what a report is built from, recorded in its
     ``meta.inputs_sha256``: the sha256 of the plan, contract and replacement
     files (:func:`rclverify.stages.workspace.check_inputs`), of the contract
@@ -130,10 +130,14 @@ def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: 
     ``input_hashes`` of each obligation's evidence record
     (``evidence_inputs``: obligation id -> hashes, ``None`` without a
     record), and each requirement record's verdict, fingerprint and inputs
-    (``checks``).  Timestamps and durations are left out, so an incremental
+    (``checks``), and for a workspace with NoDL documents the files the NoDL
+    record was made from and their sha256 now (``nodl``,
+    :func:`rclverify.report.nodl.nodl_inputs`).  Timestamps and durations are left out, so an incremental
     run and a clean one give the same value.  The bundle compares it with
     the value of a report built now (docs/argument.md): a report written
     before the evidence was produced again is not packed."""
     body = {"files": check_inputs(ws), "made_from": dict(made_from), "evidence": dict(evidence_inputs),
             "requirements": {k: [v.get("verdict"), v.get("fingerprint"), v.get("inputs")] for k, v in checks.items()}}
+    if nodl is not None:  # only then: a workspace without NoDL documents keeps the value it had
+        body["nodl"] = dict(nodl)
     return hashlib.sha256(dumps(body).encode("utf-8")).hexdigest()
