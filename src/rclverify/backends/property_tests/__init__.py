@@ -3,7 +3,7 @@ Hypothesis against their contracts, every example's outputs checked by Z3
 (docs/property-tests.md).
 
 Modules: :mod:`.strategies` (input strategies from RCL types and the
-assumption), :mod:`.harness` (one guarantee's Hypothesis run; also what the
+assumption, whose bounds :mod:`.bounds` reads), :mod:`.harness` (one guarantee's Hypothesis run; also what the
 generated pytest files call), :mod:`.backend` (:class:`PropertyTestsBackend`).
 """
 from typing import Any
