@@ -34,12 +34,18 @@ FIELDS = {
 }
 #: the clauses as trees (contract_eval), the inputs the contract reads, per guarantee the inputs
 #: and outputs it reads, the enumerations' values: settled by rclverify when it generated this file
-CARRIED = {'assumes': [{'fs': True,
+CARRIED = {'assumes': [{'fs': False,
               'fs_tol': True,
               'tree': ['bin',
                        'and',
-                       ['cmp', ['<='], [['unary', '-', ['num', 5463, 20]], ['io', 'in.celsius']], True],
-                       ['cmp', ['<='], [['io', 'in.celsius'], ['num', 2537, 20]], True]]}],
+                       ['cmp',
+                        ['<='],
+                        [['unary', '-', ['num', 2402652809016115, 8796093022208]], ['io', 'in.celsius']],
+                        True],
+                       ['cmp',
+                        ['<='],
+                        [['io', 'in.celsius'], ['num', 4463137599468339, 35184372088832]],
+                        True]]}],
  'enums': {},
  'guarantees': [{'fs': False,
                  'fs_tol': True,
