@@ -49,10 +49,10 @@ def _report() -> dict[str, Any]:
         "findings": [
             {"id": "N.g1.non-vacuous", "node": "N", "check": "non-vacuous", "guarantee": 1, "status": "problem",
              "message": "Guarantee 1 of N is vacuous.", "explanation": "", "core": ["guarantee 1", "fact 1"],
-             "model": None, "duration_s": 0.1, "smt2": None, "instances": None},
+             "model": None, "duration_s": 0.1, "smt2": "", "instances": None},
             {"id": "N.contract-consistent", "node": "N", "check": "contract-consistent", "guarantee": None,
              "status": "ok", "message": "consistent", "explanation": "", "core": None, "model": {}, "duration_s": 0.1,
-             "smt2": None, "instances": None}],
+             "smt2": "", "instances": None}],
         "lint": [{"severity": "warning", "location": f"{SRC}:4:21", "message": "unused x'", "code": "W-unused-bound"}],
     }
 

@@ -4,7 +4,9 @@ The case study's stages run once on a copy of the repository root's workspace (c
 inputs, the robot's code): check, compose, health, export per node, deadlines, requirements, the second
 solver, the ROS grounding and the diagnosis; the deadlines on a copy of examples/safety_stop (the rover has none).  Each record a stage returned, and each record it sealed on disk, is walked
 against its TypedDict: no key the type does not declare, every required key present, each value of its
-JSON type (nested TypedDicts, lists, dicts and unions walked).
+JSON type (nested TypedDicts, lists, dicts and unions walked).  A contract-health finding is no TypedDict
+but its one definition, records/findings.py: the stage returns instances of it and its sealed record
+decodes into them.
 """
 # No ``from __future__ import annotations``: the test's own TypedDicts need ``NotRequired`` evaluated.
 import shutil

@@ -51,7 +51,8 @@ from rclverify.records.links import link_pairs
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
 from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows
-from rclverify.records.report_schema import EvidenceRow, FindingJson, ObligationRow, SideConditionRow
+from rclverify.records.findings import FindingRow, rows_of
+from rclverify.records.report_schema import EvidenceRow, ObligationRow, SideConditionRow
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 
 CACHE = "artifacts/cache/diagnosis.pickle"
@@ -151,18 +152,19 @@ def _diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
     cache = _Cache(ws)
     out: list[DiagnosisEntry] = []
     health_by_node: dict[str, dict[str, str]] = {}
-    for f in report["findings"]:
-        health_by_node.setdefault(f["node"], {})[f["id"]] = f["status"]
+    findings = rows_of(report["findings"])
+    for f in findings:
+        health_by_node.setdefault(f.node, {})[f.id] = f.status
     # which guarantees of a node each culprit guarantee makes vacuous (one guard repair for all of them)
     victims: dict[tuple[str, int], list[tuple[int, int | None]]] = {}
-    for f in report["findings"]:
-        fk = f.get("guarantee")
-        if f["status"] == "problem" and f["check"] == "non-vacuous" and fk is not None:  # a guarantee's check
-            vac = sorted(int(x) for x, st in (f.get("instances") or {}).items() if st == "vacuous")
+    for f in findings:
+        fk = f.guarantee
+        if f.status == "problem" and f.check == "non-vacuous" and fk is not None:  # a guarantee's check
+            vac = sorted(int(x) for x, st in (f.instances or {}).items() if st == "vacuous")
             victim = (fk, vac[0] if vac else None)  # where it was vacuous
-            for m in culprits(parse_core(f.get("core")), fk):
-                if m.kind == "guarantee" and victim not in victims.setdefault((f["node"], m.index), []):
-                    victims[(f["node"], m.index)].append(victim)
+            for m in culprits(parse_core(f.core), fk):
+                if m.kind == "guarantee" and victim not in victims.setdefault((f.node, m.index), []):
+                    victims[(f.node, m.index)].append(victim)
 
     def guard(node: str, c: int) -> Repair | None:
         vs = sorted(victims.get((node, c), []), key=lambda v: v[0])
@@ -173,8 +175,8 @@ def _diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
 
     # a unit mismatch on a connection first: it explains the side condition and the runs that follow from it
     out += unit_records(ws, report, cache.get)
-    for f in report["findings"]:
-        if f["status"] != "problem":
+    for f in findings:
+        if f.status != "problem":
             continue
         out.append(_finding(ws, report, f, guard))
     sc_before = {sc["id"]: sc["status"] for sc in report["side_conditions"]}
@@ -218,33 +220,33 @@ def _record(id: str, kind: str, node: str, status: str, sentence: str, *, culpri
             "repairs": [r for r in repairs if r], "guarantee": guarantee, "related": []}
 
 
-def _finding(ws: Any, report: ReportRows, f: FindingJson, guard: Callable[[str, int], Repair | None]) -> DiagnosisEntry:
-    node, k = f["node"], f["guarantee"]
+def _finding(ws: Any, report: ReportRows, f: FindingRow, guard: Callable[[str, int], Repair | None]) -> DiagnosisEntry:
+    node, k = f.node, f.guarantee
     facts = plan_facts(ws, node)
-    members = parse_core(f.get("core"), facts)
-    table = counterexample_table(f.get("model"), node)
-    if f["check"] == "non-vacuous":
+    members = parse_core(f.core, facts)
+    table = counterexample_table(f.model, node)
+    if f.check == "non-vacuous":
         text, src = _guarantee_source(report, node, k)
         cs = culprits(members, k)
         names = [m.name() for m in cs]
         sentence = (f"Guarantee {k} of {node} ({src}) can never fire"
-                    + (f" for {_after(f['message'], ' is vacuous for ', ':')}" if " is vacuous for " in f["message"] else "")
+                    + (f" for {_after(f.message, ' is vacuous for ', ':')}" if " is vacuous for " in f.message else "")
                     + ": " + (_and(names) + (" exclude" if len(names) > 1 else " excludes") + " its premise"
                               if names else "its premise contradicts the node's contract") + ".")
         reps = [guard(node, m.index) for m in cs if m.kind == "guarantee"]
         kind = "vacuity"
-    elif f["check"] in ("contract-consistent", "assumption-satisfiable"):
+    elif f.check in ("contract-consistent", "assumption-satisfiable"):
         names = [m.name() for m in members]
-        kind = "inconsistency" if f["check"] == "contract-consistent" else "unsatisfiable-assumption"
+        kind = "inconsistency" if f.check == "contract-consistent" else "unsatisfiable-assumption"
         what = "contract" if kind == "inconsistency" else "assumption"
         sentence = (f"The {what} of {node} cannot hold: " + (_and(names) + " contradict each other" if names
                                                                else "Z3 found no way to satisfy it") + ".")
         cs = members
         reps = [guard(node, m.index) for m in members if m.kind == "guarantee"] if kind == "inconsistency" else []
     else:
-        cs, reps, kind = [], [], "refinement" if f["check"] == "replacement-refines" else f["check"]
-        sentence = f["message"] + (" " + f["explanation"] if f.get("explanation") else "")
-    return _record(f["id"], kind, node, "failed", sentence,
+        cs, reps, kind = [], [], "refinement" if f.check == "replacement-refines" else f.check
+        sentence = f.message + (" " + f.explanation if f.explanation else "")
+    return _record(f.id, kind, node, "failed", sentence,
                    culprits=[{"what": m.name(), "source": m.source, "text": m.text} for m in cs],
                    counterexample=table, repairs=[r for r in reps if r], guarantee=k)
 

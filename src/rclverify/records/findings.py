@@ -15,10 +15,10 @@ The rules (docs/decisions.md, "One definition per record"):
 * These classes are the only statement of a finding's fields.  Records are
   written with :func:`msgspec.to_builtins` (:meth:`HealthFinding.to_json`)
   and read with :func:`msgspec.convert`; a key a class does not declare is
-  refused (``forbid_unknown_fields``).  A field at its default is left out
-  of the JSON (``omit_defaults``): ``model``, ``core``, ``instances`` and
-  ``witness`` are absent when there is none, ``duration_s`` when zero,
-  ``smt2`` and ``witness_smt2`` when no query was kept.
+  refused (``forbid_unknown_fields``).  Every field is in the JSON, at its
+  default when there is nothing to say (``null``, ``""``, ``0``): a key
+  present in one run and absent in the next would make two reports of the
+  same inputs differ.
 * ``smt2`` and ``witness_smt2`` hold a query's SMT-LIB2 *text* as a check
   returns it and the workspace-relative *path* of the script the health
   stage keeps (``artifacts/health/<id>.smt2``, ``<id>.witness.smt2``) in
@@ -35,7 +35,7 @@ The rules (docs/decisions.md, "One definition per record"):
 """
 from __future__ import annotations
 
-from typing import Annotated, Any, Mapping
+from typing import Annotated, Any, Iterable, Mapping
 
 import msgspec
 
@@ -45,7 +45,7 @@ from rclverify.records.statuses import HealthStatus
 _DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
 
 
-class HealthFinding(msgspec.Struct, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
+class HealthFinding(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """One health finding of one node (module docstring for the rules)."""
 
     id: Annotated[str, _DOC(description="The item's stable id (the anchor the HTML report, SARIF and "
@@ -59,18 +59,18 @@ class HealthFinding(msgspec.Struct, frozen=True, omit_defaults=True, forbid_unkn
     message: Annotated[str, _DOC(description="The problem or outcome in one sentence.")]
     explanation: Annotated[str, _DOC(description="What the tool found, in words.")]
     model: Annotated[dict[str, str] | None, _DOC(
-        description="A witness or counterexample in RCL terms (name -> value), absent when none.")] = None
+        description="A witness or counterexample in RCL terms (name -> value), null when none.")] = None
     core: Annotated[list[str] | None, _DOC(
-        description="An unsatisfiable core (RCL clauses), absent when none.")] = None
-    duration_s: Annotated[float, _DOC(description="The solver's wall-clock time, seconds (absent: 0).")] = 0.0
+        description="An unsatisfiable core (RCL clauses), null when none.")] = None
+    duration_s: Annotated[float, _DOC(description="The solver's wall-clock time, seconds (0 when no solver ran).")] = 0.0
     instances: Annotated[dict[str, str] | None, _DOC(
-        description="The verdict per instance of a quantified premise, absent when none.")] = None
-    smt2: Annotated[str, _DOC(description="Path of its SMT-LIB2 query (absent when none was kept).")] = ""
+        description="The verdict per instance of a quantified premise, null when none.")] = None
+    smt2: Annotated[str, _DOC(description="Path of its SMT-LIB2 query (\"\" when none was kept).")] = ""
     witness: Annotated[dict[str, str] | None, _DOC(
         description="A realizable contract's witness: output name -> RCL term answering every admissible "
-                    "input (calculus/health/realizer.py), absent when none.")] = None
+                    "input (calculus/health/realizer.py), null when none.")] = None
     witness_smt2: Annotated[str, _DOC(
-        description="Path of the quantifier-free query showing the witness (absent when none).")] = ""
+        description="Path of the quantifier-free query showing the witness (\"\" when none).")] = ""
 
     def __eq__(self, other: object) -> bool:
         """Equal when every field but the two queries is (module docstring)."""
@@ -82,7 +82,7 @@ class HealthFinding(msgspec.Struct, frozen=True, omit_defaults=True, forbid_unkn
         return hash(repr(_compared(self)))
 
     def to_json(self) -> dict[str, Any]:
-        """The finding as its JSON object (fields at their default left out)."""
+        """The finding as its JSON object (every field)."""
         out: dict[str, Any] = msgspec.to_builtins(self)
         return out
 
@@ -98,15 +98,17 @@ class Acknowledged(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     at: Annotated[str, _DOC(description="file:line:col of the RCL or plan text (1-based line and column)")]
 
 
-class FindingRow(HealthFinding, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
+class FindingRow(HealthFinding, frozen=True, forbid_unknown_fields=True):
     """A contract health finding as the report shows it (``findings[]``; docs/semantics.md, health checks)."""
 
     solvers: Annotated[Solvers | None, _DOC(
-        description="The second solver's agreement (docs/second-solver.md).")] = None
-    flagged: Annotated[str, _DOC(description="The flagged text of a warning (what an acknowledgement binds).")] = ""
-    sha256: Annotated[str, _DOC(description="The sha256 of the flagged text, hex.")] = ""
+        description="The second solver's agreement (docs/second-solver.md), null when it decided nothing.")] = None
+    flagged: Annotated[str, _DOC(description="The flagged text of a warning (what an acknowledgement binds), "
+                                             "\"\" for a finding that is no warning.")] = ""
+    sha256: Annotated[str, _DOC(description="The sha256 of the flagged text, hex (\"\" for a finding that is "
+                                            "no warning).")] = ""
     acknowledged: Annotated[Acknowledged | None, _DOC(
-        description="The plan acknowledgement that answers this warning.")] = None
+        description="The plan acknowledgement that answers this warning, null when none.")] = None
 
     @classmethod
     def of(cls, finding: HealthFinding | Mapping[str, Any]) -> FindingRow:
@@ -117,10 +119,18 @@ class FindingRow(HealthFinding, frozen=True, omit_defaults=True, forbid_unknown_
         return msgspec.convert(data, cls)
 
 
+def rows_of(findings: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
+    """The report's ``findings[]`` (JSON objects, as built or as read back
+    from ``reports/assurance.json``) decoded, in order, so that a reader
+    reads attributes mypy checks.  Raises :class:`msgspec.ValidationError`
+    for a key no field declares or a value of another type."""
+    return [FindingRow.of(f) for f in findings]
+
+
 #: The fields of :class:`FindingRow` no finding renderer shows, each with the reason.
 INTERNAL: dict[str, str] = {
     "flagged": "the text an acknowledgement binds; the row shows its sha256 and the finding's own message",
 }
 
 
-__all__ = ["Acknowledged", "FindingRow", "HealthFinding", "INTERNAL"]
+__all__ = ["Acknowledged", "FindingRow", "HealthFinding", "INTERNAL", "rows_of"]

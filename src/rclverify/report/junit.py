@@ -53,6 +53,7 @@ from typing import Any, Mapping
 from rclverify.report.fragments import FragmentCache
 from rclverify.report.sarif import split_location
 from rclverify.report.templating import model_text
+from rclverify.records.findings import rows_of
 from rclverify.records.report_schema import Report
 from rclverify.report.severity import junit_outcome
 
@@ -268,15 +269,15 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         if sc["status"] == "discharged" and verdict != sc["status"]:  # a pass that rests on the upstream cone
             ET.SubElement(case, "system-out").text = _lines(
                 f"verdict: {verdict}", "upstream premises used: " + "; ".join(str(h) for h in sc.get("hypotheses") or []))
-    for f in items.get("findings", ()):
-        case = _case(suite, f"{name}.health", str(f["id"]), _source_of(node, f), f.get("duration_s"))
-        core = "; ".join(str(c) for c in f.get("core") or [])
-        model = model_text(f.get("model"))
-        ack = f.get("acknowledged")
-        tally(case, "acknowledged" if ack else str(f["status"]),
-              str(f["message"]) + (f" (acknowledged at {ack['at']}: {ack['reason']})" if ack else ""),
-              _lines(str(f["message"]), str(f.get("explanation") or ""), f"unsat core: {core}" if core else "",
-                     f"counterexample: {model}" if model else ""), f.get("duration_s"))
+    for f in rows_of(items.get("findings", ())):
+        case = _case(suite, f"{name}.health", f.id, _source_of(node, f.guarantee), f.duration_s)
+        core = "; ".join(f.core or [])
+        model = model_text(f.model)
+        ack = f.acknowledged
+        tally(case, "acknowledged" if ack else f.status,
+              f.message + (f" (acknowledged at {ack.at}: {ack.reason})" if ack else ""),
+              _lines(f.message, f.explanation, f"unsat core: {core}" if core else "",
+                     f"counterexample: {model}" if model else ""), f.duration_s)
     for u in items.get("unverified", ()):
         case = _case(suite, f"{name}.guarantee", str(u["id"]), str(u["source"]), 0.0)
         tally(case, str(u["status"]), f"unverified: {u['reason']}",
@@ -289,9 +290,9 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
     return suite, counts, time
 
 
-def _source_of(node: Mapping[str, Any], finding: Mapping[str, Any]) -> str:
+def _source_of(node: Mapping[str, Any], guarantee: int | None) -> str:
     for g in node["guarantees"]:
-        if finding["guarantee"] is not None and g["index"] == finding["guarantee"]:
+        if guarantee is not None and g["index"] == guarantee:
             return str(g["source"])
     return str(node["source"])
 

@@ -145,6 +145,17 @@ def read_checked(path: Path, shape: Any, what: str) -> Any:
 
 def read_report(root: Path) -> dict[str, Any]:
     """``reports/assurance.json`` of the workspace ``root``, shape-checked
-    (:data:`REPORT_SHAPE`).  Raises :class:`RclError` as :func:`read_checked` does."""
-    data: dict[str, Any] = read_checked(root / "reports/assurance.json", REPORT_SHAPE, "an rclverify report")
+    (:data:`REPORT_SHAPE`), its ``findings`` decoding into their one
+    definition (:class:`rclverify.records.findings.FindingRow`).  Raises
+    :class:`RclError` as :func:`read_checked` does, and for a finding that
+    does not decode."""
+    import msgspec  # deferred: start-up (loads msgspec only when called)
+    from rclverify.records.findings import rows_of  # deferred: start-up (loads msgspec only when called)
+    path = root / "reports/assurance.json"
+    data: dict[str, Any] = read_checked(path, REPORT_SHAPE, "an rclverify report")
+    try:
+        rows_of(data["findings"])
+    except msgspec.ValidationError as exc:
+        raise located(path, f"not an rclverify report: findings: {exc}; run `rclverify verify` (or `doit verify`) "
+                            "to write it again") from None
     return data

@@ -36,7 +36,8 @@ from typing import Mapping, Sequence
 
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
-from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, FindingJson, LintRow, Report
+from rclverify.records.findings import FindingRow, rows_of
+from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, LintRow, Report
 from rclverify.report.severity import of
 from rclverify.records.sarif import sarif_fix
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
@@ -303,11 +304,11 @@ def _requirement_results(report: Report) -> list[SarifResult]:
     return out
 
 
-def _finding_location(report: Report, f: FindingJson) -> str:
+def _finding_location(report: Report, f: FindingRow) -> str:
     for n in report["nodes"]:
-        if n["name"] == f["node"]:
+        if n["name"] == f.node:
             for g in n["guarantees"]:
-                if f["guarantee"] is not None and g["index"] == f["guarantee"]:
+                if f.guarantee is not None and g["index"] == f.guarantee:
                     return str(g["source"])
             return str(n["source"])
     return ""
@@ -315,36 +316,42 @@ def _finding_location(report: Report, f: FindingJson) -> str:
 
 def _finding_results(report: Report) -> list[SarifResult]:
     out = []
-    for f in report["findings"]:
-        if f["status"] == "ok":
+    for f in rows_of(report["findings"]):
+        if f.status == "ok":
             continue
-        rule = ("RCL-HEALTH-INCONCLUSIVE" if f["status"] == "inconclusive"
-                else "RCL-HEALTH-STALE" if f["status"] == "stale"
-                else _HEALTH_RULE.get(str(f["check"]), "RCL-HEALTH-OTHER"))
-        words = [str(f["message"])]
-        if f.get("explanation"):
-            words.append(str(f["explanation"]))
-        if f.get("core"):
-            words.append("Unsat core: " + "; ".join(str(c) for c in f.get("core") or ()) + ".")
-        if f.get("model"):
-            words.append(f"Counterexample: {model_text(f['model'])}.")
-        props = {"finding": f["id"], "node": f["node"], "check": f["check"], "status": f["status"]}
-        out.append(_suppressed(_result(rule, _level("health", str(f["status"])), " ".join(words),
-                                       _finding_location(report, f), f"health:{f['id']}", props), f))
+        rule = ("RCL-HEALTH-INCONCLUSIVE" if f.status == "inconclusive"
+                else "RCL-HEALTH-STALE" if f.status == "stale"
+                else _HEALTH_RULE.get(f.check, "RCL-HEALTH-OTHER"))
+        words = [f.message]
+        if f.explanation:
+            words.append(f.explanation)
+        if f.core:
+            words.append("Unsat core: " + "; ".join(f.core) + ".")
+        if f.model:
+            words.append(f"Counterexample: {model_text(f.model)}.")
+        props = {"finding": f.id, "node": f.node, "check": f.check, "status": f.status}
+        res = _result(rule, _level("health", f.status), " ".join(words), _finding_location(report, f),
+                      f"health:{f.id}", props)
+        out.append(_accepted(res, f.acknowledged.reason, f.acknowledged.at) if f.acknowledged else res)
     return out
 
 
-def _suppressed(res: SarifResult, row: FindingJson | LintRow) -> SarifResult:
-    """``res`` with a SARIF ``suppressions`` entry (kind ``external``, status
-    ``accepted``, the reason as ``justification``, SARIF 2.1.0 section
-    3.35) when the plan acknowledges the warning ``row`` (model/plan/acknowledged.py)."""
+def _suppressed(res: SarifResult, row: LintRow) -> SarifResult:
+    """``res`` with a SARIF ``suppressions`` entry when the plan acknowledges
+    the lint warning ``row`` (:func:`_accepted`; model/plan/acknowledged.py)."""
     ack = row.get("acknowledged")
-    if ack:
-        sup: SarifSuppression = {"kind": "external", "status": "accepted", "justification": str(ack["reason"])}
-        where = _location(str(ack["at"]))
-        if where:
-            sup["location"] = where[0]  # the plan entry (SARIF 2.1.0 section 3.35.6: one location)
-        res["suppressions"] = [sup]
+    return _accepted(res, str(ack["reason"]), str(ack["at"])) if ack else res
+
+
+def _accepted(res: SarifResult, reason: str, at: str) -> SarifResult:
+    """``res`` with a SARIF ``suppressions`` entry (kind ``external``, status
+    ``accepted``, ``reason`` as ``justification``, SARIF 2.1.0 section 3.35)
+    located at ``at``, the plan entry's ``file:line:col``."""
+    sup: SarifSuppression = {"kind": "external", "status": "accepted", "justification": reason}
+    where = _location(at)
+    if where:
+        sup["location"] = where[0]  # the plan entry (SARIF 2.1.0 section 3.35.6: one location)
+    res["suppressions"] = [sup]
     return res
 
 

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+from rclverify.records.findings import rows_of
 from rclverify.records.statuses import SEVERITIES
 
 #: The three severities (the vocabulary's set, records/statuses.py).
@@ -109,8 +110,8 @@ def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
         add("guarantee", str(u["id"]), "unverified")
     for sc in report.get("side_conditions") or ():
         add("side-condition", str(sc["id"]), str(sc["status"]))
-    for f in report.get("findings") or ():
-        add("health", str(f["id"]), str(f["status"]))
+    for f in rows_of(report.get("findings") or ()):
+        add("health", f.id, f.status)
     for r in report.get("requirements") or ():
         add("requirement", str(r["id"]), str(r.get("verdict", "informal")))
     for d in report.get("deadlines") or ():  # proved from a chain whose evidence is outstanding: not a pass
@@ -127,7 +128,7 @@ def acknowledged(report: Mapping[str, Any]) -> set[tuple[str, str]]:
     """The ``(kind, id)`` of :func:`items` that a plan acknowledgement
     answers (a warning accepted as a risk with a reason, docs/plan.md): they
     keep their severity in every output but do not fail ``--strict``."""
-    out = {("health", str(f["id"])) for f in report.get("findings") or () if f.get("acknowledged")}
+    out = {("health", f.id) for f in rows_of(report.get("findings") or ()) if f.acknowledged}
     return out | {("lint", f"{x['location']}:{x.get('code', '')}") for x in report.get("lint") or ()
                   if x.get("acknowledged")}
 

@@ -14,7 +14,8 @@ from typing import IO, TYPE_CHECKING, Any, Literal, Mapping, Sequence, TypeGuard
 
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
-from rclverify.records.report_schema import (FindingJson, ObligationRow, Report, SideConditionRow,
+from rclverify.records.findings import FindingRow, rows_of
+from rclverify.records.report_schema import (ObligationRow, Report, SideConditionRow,
                                              UnverifiedRow)
 from rclverify.report.shapes import GroundingBrief, NodeSummaryRow, SummaryData
 from rclverify.records.records import SEVERITY
@@ -23,7 +24,7 @@ from rclverify.records.records import SEVERITY
 MAX_ROWS = 15
 
 #: A report row that names its node (an obligation, side condition, health finding, unverified guarantee).
-_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingJson, UnverifiedRow)
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, UnverifiedRow)
 
 #: The counts of a node's summary row that a merged row sums.
 _Count = Literal["sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"]
@@ -48,8 +49,10 @@ def node_rows(report: Report) -> list[NodeSummaryRow]:
         for it in items:
             out.setdefault(it["node"], []).append(it)
         return out
-    obligations, sides, findings = by_node(report["obligations"]), by_node(report["side_conditions"]), \
-        by_node(report["findings"])
+    obligations, sides = by_node(report["obligations"]), by_node(report["side_conditions"])
+    findings: dict[str, list[FindingRow]] = {}
+    for f in rows_of(report["findings"]):
+        findings.setdefault(f.node, []).append(f)
     unverified = by_node(list(report.get("unverified") or ()))
     from rclverify.report.culprits import culprit_nodes  # deferred: start-up (loads rclverify.report.culprits only when called)
     blamed = culprit_nodes(report.get("problems") or ())
@@ -63,9 +66,9 @@ def node_rows(report: Report) -> list[NodeSummaryRow]:
         fs = findings.get(name, [])
         rows.append({"node": name, "status": n["status"], "obligations": obs, "order": k,
                      "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
-                     "health_problems": sum(f["status"] in ("problem", "error") for f in fs),
-                     "health_open": sum(f["status"] == "inconclusive" for f in fs), "health_total": len(fs),
-                     "health_warnings": sum(f["status"] == "warning" for f in fs),
+                     "health_problems": sum(f.status in ("problem", "error") for f in fs),
+                     "health_open": sum(f.status == "inconclusive" for f in fs), "health_total": len(fs),
+                     "health_warnings": sum(f.status == "warning" for f in fs),
                      "unverified": [f"g{u['guarantee']}" for u in unverified.get(name, [])],
                      "culprit": name in blamed})
     rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
@@ -209,10 +212,11 @@ def strict_reasons(report: Report) -> list[str]:
     sc = [x for x in report["side_conditions"] if x["status"] != "discharged"]
     if sc:
         out.append(f"{len(sc)} side condition{'s are' if len(sc) != 1 else ' is'} not proved")
-    fs = [f for f in report["findings"] if f["status"] not in ("ok", "warning")]
+    findings = rows_of(report["findings"])
+    fs = [f for f in findings if f.status not in ("ok", "warning")]
     if fs:
         out.append(f"{len(fs)} contract health check{'s' if len(fs) != 1 else ''} found a problem or could not decide")
-    warned = [str(f["id"]) for f in report["findings"] if f["status"] == "warning" and not f.get("acknowledged")]
+    warned = [f.id for f in findings if f.status == "warning" and not f.acknowledged]
     if warned:  # one severity per finding: a warning fails --strict as it is a warning everywhere (report/severity.py)
         out.append(f"{len(warned)} contract health warning{'s' if len(warned) != 1 else ''} ("
                    + ", ".join(warned[:4]) + (", ..." if len(warned) > 4 else "") + ")")

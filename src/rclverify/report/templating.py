@@ -18,7 +18,7 @@ from urllib.parse import quote
 import jinja2
 from markupsafe import Markup, escape
 
-from rclverify.records.findings import FindingRow
+from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.records import SEVERITY
 from rclverify.report import htmlfilters
 from rclverify.report.textfmt import breakable, formula_html, formula_lines
@@ -234,7 +234,7 @@ def finding_rows(rows: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
     declared fields only (an undeclared attribute raises under
     ``StrictUndefined``; tests/test_record_shapes.py holds every field to a
     renderer or :data:`~rclverify.records.findings.INTERNAL`)."""
-    return [FindingRow.of(f) for f in rows]
+    return rows_of(rows)
 
 
 @lru_cache(maxsize=1)

@@ -13,6 +13,7 @@ import re
 from collections import defaultdict
 from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
+from rclverify.records.findings import rows_of
 from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceRow, FindingJson, ObligationRow, ProblemRow,
                                              Report, SideConditionRow)
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
@@ -101,11 +102,11 @@ def _attention(report: Report, ev_anchor: Sequence[str]) -> tuple[list[Attention
             add(sc["status"], "side condition", sc["id"], anchor("sc", sc["id"]),
                 f"{sc['node']}, {sc['rule']}, {sc['source']}",
                 str(sc["explanation"]) or "Assumption conjunct not established:", str(sc["conjunct"]))
-    for f in report["findings"]:
-        if rank(f["status"]) > 0 and not f.get("acknowledged"):  # an accepted risk is listed with its reason
-            where = str(f["node"]) + (f", guarantee {f['guarantee']}" if f["guarantee"] is not None else "")
-            msg = str(f["message"]) + (f" {f['explanation']}" if f["explanation"] else "")
-            add(f["status"], f"contract health: {f['check']}", f["id"], anchor("finding", f["id"]), where, msg)
+    for f in rows_of(report["findings"]):
+        if rank(f.status) > 0 and not f.acknowledged:  # an accepted risk is listed with its reason
+            where = f.node + (f", guarantee {f.guarantee}" if f.guarantee is not None else "")
+            msg = f.message + (f" {f.explanation}" if f.explanation else "")
+            add(f.status, f"contract health: {f.check}", f.id, anchor("finding", f.id), where, msg)
     for d in report["derived_properties"]:
         if rank(d["status"]) > SEVERITY["pending"]:
             add(d["status"], "derived property", d["node"], anchor("derived", d["node"]),
@@ -215,9 +216,8 @@ def dashboard(report: Report, evidence_of: Mapping[str, Sequence[tuple[str, obje
         evs = evidence_of.get(str(o["id"]), [])
         items[(str(o["node"]), str(o["backend"]))].append(
             (str(o["status"]), evs[0][0] if evs else anchor("ob", o["id"])))
-    for f in report["findings"]:
-        items[(str(f["node"]), "health")].append((_HEALTH_AS.get(str(f["status"]), str(f["status"])),
-                                                  anchor("finding", f["id"])))
+    for f in rows_of(report["findings"]):
+        items[(f.node, "health")].append((_HEALTH_AS.get(f.status, f.status), anchor("finding", f.id)))
     for sc in report["side_conditions"]:
         items[(str(sc["node"]), "side conditions")].append((str(sc["status"]), anchor("sc", sc["id"])))
     for u in report.get("unverified") or ():  # no obligation at all: a column of its own, after the techniques

@@ -38,7 +38,8 @@ import hashlib
 import re
 from typing import Any, Iterable, Mapping, TypeVar
 
-from rclverify.records.report_schema import (EnvironmentAssumptionRow, FindingJson, NodeRow, ObligationRow, Report,
+from rclverify.records.findings import FindingRow, rows_of
+from rclverify.records.report_schema import (EnvironmentAssumptionRow, NodeRow, ObligationRow, Report,
                                              RequirementRow, SideConditionRow)
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
@@ -50,7 +51,7 @@ from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
 
 #: A report row that names its node.
-_Row = TypeVar("_Row", ObligationRow, SideConditionRow, FindingJson, EnvironmentAssumptionRow)
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, EnvironmentAssumptionRow)
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -204,7 +205,10 @@ class _Goals:
         self.ev_of = {str(e["obligation"]): e for e in report["evidence"]}
         # by node, still sorted by id: p1 < p2 < p10
         self.obligations_of = _by_node(sorted(report["obligations"], key=lambda o: natural_key(o["id"])))
-        self.sides, self.findings = _by_node(report["side_conditions"]), _by_node(report["findings"])
+        self.sides = _by_node(report["side_conditions"])
+        self.findings: dict[str, list[FindingRow]] = {}
+        for f in rows_of(report["findings"]):
+            self.findings.setdefault(f.node, []).append(f)
         self.env = _by_node(report["environment_assumptions"])
         self.loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
         self.loop_of: dict[str, str] = {}
@@ -267,12 +271,11 @@ class _Goals:
                                            f"Evidence that {node} guarantee {k} holds: no obligation was exported for it",
                                            undeveloped=True, ref=f"{node}.g{k}", status="unverified")))
         for f in self.findings.get(node, []):
-            if f["guarantee"] in (None, k):
+            if f.guarantee in (None, k):
                 kids.append(self.b.add(Element(
-                    ident("Sn", "health", f["id"]), "solution",
-                    _clip(f"Contract health check {f['check']} (Z3): {f['status']}. {f['message']}"),
-                    status=_FINDING_AS.get(str(f["status"]), "error"), ref=str(f["id"]),
-                    url=str(f.get("smt2") or ""))))
+                    ident("Sn", "health", f.id), "solution",
+                    _clip(f"Contract health check {f.check} (Z3): {f.status}. {f.message}"),
+                    status=_FINDING_AS.get(f.status, "error"), ref=f.id, url=f.smt2)))
         return kids
 
     def side_goal(self, sc: SideConditionRow) -> str:
