@@ -72,7 +72,7 @@ SECONDS: dict[str, float] = {
     "test_spin_oracle": 5.6, "test_generate_cpp": 5.5, "test_browser_report": 5.4, "test_cluster": 5.4,
     "test_cache_poison": 5.2, "test_hardening_misc": 5.2, "test_health": 5.2, "test_temporal_oracle": 5.1,
     "test_rcl_printer": 4.8, "test_diagnosis": 4.7, "test_lsp_fuzz": 4.5, "test_ros_hostile": 4.4,
-    "test_property_tests_facts": 4.4, "test_ros2_silence_deadlines": 4.0, "test_query_ladder": 3.8,
+    "test_property_tests_facts": 4.4, "test_property_tests_seqs": 2.9, "test_ros2_silence_deadlines": 4.0, "test_query_ladder": 3.8,
     "test_services_live_ros1": 3.7, "test_report_problems_roots": 3.7, "test_rooms": 3.7,
     "test_findings_context": 3.6, "test_rcl_fuzz": 3.6, "test_monitor_live_ros1": 3.5, "test_jsonl_blocks": 3.3,
     "test_declarations_verified": 3.3, "test_calculus_context": 3.1, "test_ros_diff_live": 3.0,
