@@ -183,3 +183,39 @@ def test_the_property_tests_read_widths_from_the_mapping_the_plan_names(tmp_path
     assert all(_f32(v) == v and 0 <= v <= 10 for v in seen)  # binary32 values within the assumption
     assert any(v != int(v) for v in seen)  # not the integers 0..4 of radiation_type
     assert _f32(0.2) in seen  # the threshold as the field carries it
+
+
+@pytest.mark.parametrize("idl, max_len, fixed, lengths", [
+    ("float64", 3, False, {1, 2, 3}),  # float64[<=3] under exists(...): 1 to 3 items, both ends drawn
+    ("float64", 4, True, {4}),         # float64[4]: exactly 4
+    ("float32", None, False, {1, 2, 3, 4}),  # float32[]: 1 to the default 4
+    ("int32", 3, False, {1, 2, 3}),    # int32[<=3]: integer items within the bound too
+])
+def test_items_and_lengths_of_every_array_form_stay_within_their_bounds(idl: str, max_len: int | None, fixed: bool,
+                                                                       lengths: set[int]) -> None:
+    """The drawing rule itself (``at_width.carried_value``) for each array form of the field, the items bounded by
+    the assumption's ``forall`` to [-2, 5] and its ``exists`` asking for one item: every drawn sequence within."""
+    from hypothesis import given, settings
+
+    from rclverify.backends.property_tests.at_width import carried_value
+    from rclverify.backends.property_tests.strategies import input_space
+    from rclverify.semantics.widths import Carried, Width
+    elem = "INTEGER" if idl.startswith("int") else "REAL"
+    text = (f"node N {{\n  inputs( xs : seq({elem}) )\n  outputs( y : BOOL )\n"
+            "  assume( exists(x in in.xs | x >= -2) and forall(x in in.xs | -2 <= x and x <= 5) )\n"
+            "  guarantee( out.y )\n}\n")
+    cn = check([parse_text(text, "n.rcl")]).nodes["N"]
+    space = input_space(cn, {})
+    strategy = carried_value(space, cn.inputs["xs"], space.bounds["xs"],
+                             Carried((Width(idl),), seq=True, max_len=max_len, fixed=fixed))
+    drawn: list[tuple[Any, ...]] = []
+
+    @settings(max_examples=150, database=None, derandomize=True)
+    @given(strategy)
+    def draw(xs: tuple[Any, ...]) -> None:
+        drawn.append(xs)
+
+    draw()
+    assert {len(xs) for xs in drawn} == lengths
+    items = [x for xs in drawn for x in xs]
+    assert all(-2 <= x <= 5 for x in items) and {-2, 5} <= set(items)
