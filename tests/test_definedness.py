@@ -113,6 +113,25 @@ def test_the_tables_partiality_is_where_its_meanings_are_undecided() -> None:
     assert [o.symbol for o in OPERATORS.values() if o.partial is not None] == ["/"]
 
 
+@pytest.mark.parametrize(("p", "q", "truth"), [(0.1, 0, None), (0.2, 0, None), (0.1, 1, True), (0.1, 0.25, False)])
+def test_a_judgement_on_values_is_undecided_where_the_formula_divides_by_zero(p: float, q: float,
+                                                                           truth: bool | None) -> None:
+    """The monitors' and property tests' judgement on recorded values (:func:`floatsem.judge`, Z3 on the
+    values where direct evaluation cannot decide) reads a division by zero as undefined, as the
+    definedness conditions do (the left operand of ``or`` first): Z3 alone reads ``p / 0`` as some number.
+    Controls: the same formula with a non-zero divisor is decided, either way."""
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    from rclverify.semantics.floatsem import judge
+    checked = check([parse_text("node N {\n  inputs( p : REAL, q : REAL )\n  outputs( ok : BOOL )\n"
+                                "  guarantee( (in.p / in.q <= 0.2) or not (0.15 >= in.p) )\n}\n", "n.rcl")])
+    node = checked.nodes["N"]
+    j = judge(node.node.guarantees[0].formula, checked, node, {"in.p": p, "in.q": q, "out.ok": True})
+    assert j.truth is truth, j
+    if truth is None:
+        assert "division by zero" in j.reason or "undefined" in j.reason, j.reason
+
+
 # ---------------------------------------------------------------------------
 # side conditions (calculus/compose.py, calculus/side_condition.py)
 # ---------------------------------------------------------------------------

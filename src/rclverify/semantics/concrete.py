@@ -21,8 +21,10 @@ from typing import Any, Mapping
 import z3
 
 from rclverify.lang import ast
+from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 from rclverify.semantics.connectives import conj
+from rclverify.semantics.definedness import defined
 from rclverify.semantics.values import FiniteFunction, Term, exact
 from rclverify.semantics.encode import Encoder, sort_of, widen
 from rclverify.semantics import wallclock
@@ -123,6 +125,23 @@ def _encoded_typed(formula: ast.Expr, checked: Checked,
     return phi, free, axioms
 
 
+#: formula id -> (formula, its well-definedness condition or None), kept as :data:`_ENCODED` keeps encodings
+_DEFINED: dict[int, tuple[ast.Expr, ast.Expr | None]] = {}
+
+
+def _definedness(formula: ast.Expr) -> ast.Expr | None:
+    """``formula``'s well-definedness condition (:func:`~.definedness.defined`),
+    ``None`` for a formula of total operators; one object per formula, so
+    that its encoding is cached as the formula's is."""
+    hit = _DEFINED.get(id(formula))
+    if hit is not None and hit[0] is formula:
+        return hit[1]
+    cond = defined(formula)
+    out = None if isinstance(cond, ast.BoolLit) and cond.value is True else cond
+    _DEFINED[id(formula)] = (formula, out)
+    return out
+
+
 def _encoded(formula: ast.Expr, checked: Checked, node: CheckedNode) -> tuple[z3.BoolRef, dict[str, z3.ExprRef | z3.FuncDeclRef]]:
     """:func:`_encoded_typed` without the axioms."""
     phi, free, _ = _encoded_typed(formula, checked, node)
@@ -157,6 +176,12 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     """
     for q in values:
         _io_type(node, q)  # KeyError for a name that is not an I/O variable of the node
+    cond = _definedness(formula)
+    if cond is not None:  # a partial operator: the formula has a truth value only where it is defined
+        ok, why = check_concrete(cond, checked, node, values, timeout_ms=timeout_ms, rlimit=rlimit)
+        if ok is not True:
+            return None, (why if ok is None else
+                          f"undefined on these values: {expr_to_rcl(cond)} does not hold (a division by zero)")
     phi, free = _encoded(formula, checked, node)
     consts: list[tuple[z3.ExprRef, z3.ExprRef]] = []
     funcs: list[tuple[z3.FuncDeclRef, z3.ExprRef]] = []
