@@ -450,14 +450,27 @@ class Topic:
     """``ros_pkg/Type field matches(in.x)``.
 
     ``msg_type`` is the ROS message type (``gazebo_radiation_plugin/Snapshot``),
-    ``field`` the message field, ``match`` the contract variable it populates
-    (``None`` when there is no ``matches`` clause).
+    ``field`` the topic's name as written (a ROS name: ``stop``, relative in a
+    namespace ``safety/stop``, global ``/safety/stop``), ``match`` the contract
+    variable it populates (``None`` when there is no ``matches`` clause);
+    ``name_loc`` where the name is written.
     """
 
     msg_type: str
     field: str
     match: Var | None = None
     loc: Loc = _loc()
+    name_loc: Loc = _loc()
+
+    @property
+    def key(self) -> str:
+        """The name the system model and the monitors know the topic by: as
+        written, a global name's leading ``/`` dropped (a contract's nodes
+        sit in the root namespace, where ``safety/stop`` and
+        ``/safety/stop`` are one topic; the grounding resolves the written
+        name against the running node's namespace, ROS 2 design "Topic and
+        Service Names")."""
+        return self.field.lstrip("/")
 
 
 @dataclass(frozen=True)
@@ -503,6 +516,7 @@ class Link:
     role: str
     parts: tuple[Var, ...]
     loc: Loc = _loc()
+    name_loc: Loc = _loc()
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ from rclverify.lang.errors import RclError, error
 # syntax, kept in the children only for its position.  "QUANT" is the
 # quantifier-kind token the transformer itself makes.
 _VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
-                              "QUANT", "STRING_LIT", "QUALIFIED_BASE", "UNIT"})
+                              "QUANT", "STRING_LIT", "QUALIFIED_BASE", "UNIT", "GLOBAL_NAME", "PRIVATE_NAME"})
 
 
 class _Spanned:
@@ -171,7 +171,7 @@ class ToAst(Transformer[Token, Any]):
     def topic(self, c: list[Any]) -> ast.Topic:
         v = _vals(c)
         match = v[2].value if v[2] is not None else None
-        return ast.Topic(str(v[0]), str(v[1]), match, self._span(c))
+        return ast.Topic(str(v[0]), str(v[1]), match, self._span(c), self._span([v[1]]))
 
     def topic_match(self, c: list[Any]) -> _Spanned:
         return _Spanned(_vals(c)[0], self._span(c))
@@ -225,7 +225,7 @@ class ToAst(Transformer[Token, Any]):
 
     def _link(self, kind: str, c: list[Any]) -> ast.Link:
         v = _vals(c)
-        return ast.Link(kind, str(v[0]), str(v[1]), v[2], tuple(v[3:]), self._span(c))
+        return ast.Link(kind, str(v[0]), str(v[1]), v[2], tuple(v[3:]), self._span(c), self._span([v[1]]))
 
     def service_link(self, c: list[Any]) -> ast.Link:
         return self._link("service", c)

@@ -48,7 +48,8 @@ _FRIENDLY = {
     "CMP_OP": "a comparison", "EXISTS_BANG": "'exists!'", "$END": "end of file",
     "BASE_TYPE": "REAL/INTEGER/NATURAL/BOOL/STRING",
     "QUALIFIED_BASE": "a qualified built-in such as REAL.REAL", "STRING_LIT": "a string", "LT": "'<'", "GT": "'>'",
-    "UNIT": "a unit such as [m]",
+    "UNIT": "a unit such as [m]", "GLOBAL_NAME": "a global ROS name such as /safety/stop",
+    "PRIVATE_NAME": "a private ROS name such as ~/stop",
 }
 
 

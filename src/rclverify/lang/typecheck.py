@@ -98,6 +98,15 @@ class _Checker(ExprChecker):
                     ok = False
         typed = {f"in.{k}": t for k, t in inputs.items()} | {f"out.{k}": t for k, t in outputs.items()}
         cn = CheckedNode(n, inputs, outputs, self.units.declare(n, typed))
+        for where, name, at in ([("topic", t.field, t.name_loc if t.name_loc.line else t.loc) for t in n.topics]
+                                + [(lk.kind, lk.name, lk.name_loc if lk.name_loc.line else lk.loc)
+                                   for lk in n.links]):
+            if name.startswith("~"):
+                self.err(at, f"{where} {name}: a private name resolves against the running node's own name, "
+                             f"which a contract does not give (the monitors could not find it); write the "
+                             f"resolved name, e.g. /<node name>{name[1:]}, or a relative one, {name[2:]}",
+                         "E-topic-name")
+                ok = False
         for t in n.topics:
             if t.match is not None:
                 try:

@@ -275,14 +275,14 @@ def unit_diagnostics(checked: Checked, connections: Sequence[Connection] = ()) -
 
 def _by_topic(checked: Checked, node: str, var: str) -> list[tuple[str, str]]:
     cn = checked.nodes[node]
-    keys = {(t.msg_type, t.field) for t in cn.node.topics
+    keys = {(t.msg_type, t.key) for t in cn.node.topics
             if t.match is not None and t.match.name == var and t.match.prefix in (None, "in")}
     out = []
     for m, other in checked.nodes.items():
         if m == node:
             continue
         for t in other.node.topics:
-            if t.match is not None and (t.msg_type, t.field) in keys and t.match.prefix in (None, "out") \
+            if t.match is not None and (t.msg_type, t.key) in keys and t.match.prefix in (None, "out") \
                     and t.match.name in other.outputs and other.outputs[t.match.name] == cn.inputs[var]:
                 out.append((m, t.match.name))
     return out
