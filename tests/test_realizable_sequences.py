@@ -3,15 +3,22 @@
 over the lengths the interface carries (a bounded sequence, a fixed array),
 or by a witness (an implementation's outputs); in both cases the query kept
 is one cvc5 decides too, where the quantifier over the sequence left it
-``unknown`` (so ``--strict`` could never pass)."""
+``unknown`` (so ``--strict`` could never pass).  The health stage reads the
+bound from the message definition the mapping names."""
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+
+from rclverify.app.pipeline import health_findings
 from rclverify.calculus.health.bounded import Bound
 from rclverify.calculus.health.realizable import realizability_findings
 from rclverify.lang.parser import parse_formula, parse_text
 from rclverify.lang.typecheck import check
 from rclverify.semantics import world
 from rclverify.stages.crosscheck.cvc5_decide import decide
+from rclverify.stages.workspace import Workspace, stage_inputs
 
 #: Every item at most the input, one item equal to it: realizable (``<in.x>``).
 ECHO = """
@@ -82,3 +89,34 @@ def test_a_witness_decides_and_a_wrong_one_does_not() -> None:
     assert long.status == "ok" and "witness" not in long.message and "at most 1 item)" in long.explanation
     # and no witness makes an unrealizable contract realizable
     assert _one(BELOW, "S", implementation={"ys": parse_formula("<in.x>")}).status == "problem"
+
+
+def _workspace(root: Path, field: str) -> Workspace:
+    """A one-node workspace whose output ``ys`` is carried by ``robot_msgs/Picks``'s ``items`` of type ``field``."""
+    (root / "contracts").mkdir(parents=True)
+    (root / "backends" / "monitors").mkdir(parents=True)
+    (root / "msg" / "robot_msgs" / "msg").mkdir(parents=True)
+    (root / "contracts" / "s.rcl").write_text(ECHO.replace(
+        "outputs( ys : seq(INTEGER) )",
+        "outputs( ys : seq(INTEGER) )\n  topics( std_msgs/Int32 x matches(in.x), robot_msgs/Picks picks matches(out.ys) )"))
+    (root / "contracts" / "plan.yaml").write_text(
+        "name: bounded\ncontracts:\n  - contracts/s.rcl\nconnections: []\nenvironment: {}\n")
+    (root / "backends" / "monitors" / "mapping.yaml").write_text(
+        "msg_dirs: [msg]\ntopics:\n  picks: {fields: [items]}\n  x: {fields: [data]}\n")
+    (root / "msg" / "robot_msgs" / "msg" / "Picks.msg").write_text(f"{field} items\n")
+    return Workspace(root)
+
+
+def test_the_health_stage_reads_the_bound_from_the_message_definition(tmp_path: Path) -> None:
+    """``int32[<=3]`` bounds the output: the health stage's finding is decided over it, and the mapping and
+    the ``.msg`` are inputs of the node's health record and task; control: ``int32[]`` bounds nothing."""
+    pytest.importorskip("rosbags")  # the ros extra reads the message definitions
+    ws = _workspace(tmp_path / "bounded", "int32[<=3]")
+    [f] = [f for f in health_findings(ws, "S") if f.check == "realizable"]
+    assert f.status == "ok" and "(at most 3 items), written out item by item" in f.explanation
+    files = ["backends/monitors/mapping.yaml", "msg/robot_msgs/msg/Picks.msg"]
+    assert stage_inputs(ws, "S", "health")[1:] == files and list(ws.index.bound_inputs["S"]) == files
+    free = _workspace(tmp_path / "free", "int32[]")
+    [g] = [f for f in health_findings(free, "S") if f.check == "realizable"]
+    assert g.status == "ok" and "written out" not in g.explanation
+    assert stage_inputs(free, "S", "health")[1:] == files  # an edit that adds a bound checks it again

@@ -159,8 +159,10 @@ def health_findings(ws: Workspace, node: str) -> list[HealthFinding]:
     writes nothing (:func:`stage_health` records them)."""
     fresh_z3()  # the same Z3 state whatever ran before in this process (semantics/world.py)
     from rclverify.calculus.health.checks import check_node  # deferred: start-up (loads lark, yaml and more only when called)
+    from rclverify.stages.interface_bounds import output_bounds  # deferred: start-up (as above)
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
-    found: list[HealthFinding] = check_node(ws.checked, node, facts, ws.plan.instances.get(node))
+    found: list[HealthFinding] = check_node(ws.checked, node, facts, ws.plan.instances.get(node),
+                                            bounds=output_bounds(ws, node))
     if node in ws.plan.replacements:
         found.append(replacement_finding(ws, node))
     return found

@@ -166,7 +166,8 @@ class TaskTable:
                       "vacuity, realizability, refinement of its replacement)."}
         for n in self.nodes:
             repl = index.replacement.get(n)
-            deps = {"health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else [])}
+            deps = {"health": [snap[n]] + ([str(rootp / repl)] if repl and (rootp / repl).is_file() else [])
+                    + [str(rootp / f) for f in index.bound_inputs.get(n, ())]}  # the output sequences' bounds
             yield {"name": n, "actions": [(act_node, [self.r, n, deps])], "file_dep": deps["health"],
                    "targets": [at(ws.health(n))], "uptodate": [self.code, self.sealed], "verbosity": 2,
                    "clean": True}

@@ -91,6 +91,9 @@ class TaskIndex:
     deadline_nodes: tuple[str, ...] = ()
     #: The workspace's own standard profile files the plan names (docs/standards.md): inputs of ``report``.
     profiles: tuple[str, ...] = ()
+    #: Per node with an output sequence, the files its bounds are read from (the mapping and its ``.msg``
+    #: files, :func:`rclverify.stages.interface_bounds.bound_inputs`): inputs of ``health:<node>``.
+    bound_inputs: dict[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
 
 
 @dataclass
@@ -141,6 +144,7 @@ class Workspace:
     def index(self) -> TaskIndex:
         """The :class:`TaskIndex` of the loaded workspace (raises like :attr:`model`)."""
         from rclverify.calculus.worst_path import nodes_between  # deferred: start-up (loads yaml, z3 and more only when called)
+        from rclverify.stages.interface_bounds import bound_inputs  # deferred: as above
         plan, model = self.plan, self.model
         return TaskIndex(
             nodes=tuple(self.checked.nodes), producers={n: tuple(model.producers(n)) for n in self.checked.nodes},
@@ -150,7 +154,8 @@ class Workspace:
             ros=dict(getattr(plan, "ros", None) or {}),
             # every node between a deadline's ends: the slowest path may leave the named one
             deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))),
-            profiles=tuple(c.profile.file for c in plan.standards if not c.profile.builtin))
+            profiles=tuple(c.profile.file for c in plan.standards if not c.profile.builtin),
+            bound_inputs={n: tuple(fs) for n in self.checked.nodes if (fs := bound_inputs(self, n))})
 
     @cached_property
     def checked(self) -> Checked:
@@ -419,14 +424,17 @@ def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) 
     ``in_context=False``: the record of a composition whose side conditions
     were all decided locally, which the rest of the cone cannot change;
     :mod:`rclverify.app.conetask` reads which the record lists) and the system
-    model, for ``health`` the plan's replacement contract file if any.
+    model, for ``health`` the plan's replacement contract file if any and
+    the files its output sequences' bounds are read from
+    (:func:`rclverify.stages.interface_bounds.bound_inputs`).
     (Export's are the inputs of each obligation, hashed into its
     evidence.)"""
     if stage == "compose":
         return [ws.snapshot(node), *(ws.snapshot(p) for p in ws.model.producers(node)),
                 *([ws.cone(node)] if in_context else []), ws.MODEL]
+    from rclverify.stages.interface_bounds import bound_inputs  # deferred: start-up (loads z3 only when called)
     repl = ws.plan.replacements.get(node)
-    return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else [])
+    return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else []) + bound_inputs(ws, node)
 
 
 def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import time
 from msgspec.structs import replace
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
@@ -45,6 +45,7 @@ from rclverify.lang.types import NATURAL, Checked, CheckedNode
 from rclverify.calculus.health.defined import definedness_findings
 from rclverify.calculus.health.finding import Finding as Finding  # re-exported: callers import it from here too
 from rclverify.records.statuses import HealthStatus
+from rclverify.calculus.health.bounded import Bound
 from rclverify.calculus.health.realizable import realizability_findings
 from rclverify.calculus.health.shape import shape_findings
 from rclverify.calculus.health.shared import SharedEncoder, Table
@@ -163,12 +164,14 @@ class _NodeHealth:
 
 @solver_session()
 def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]] = (),
-               instances: tuple[int, int] | None = None, *, timeout_ms: int = HEALTH_TIMEOUT_MS) -> list[Finding]:
+               instances: tuple[int, int] | None = None, *, timeout_ms: int = HEALTH_TIMEOUT_MS,
+               bounds: Mapping[str, Bound] | None = None) -> list[Finding]:
     """Run the three health checks on ``node``, then realizability
     (:mod:`rclverify.calculus.health.realizable`: an admissible input no output
     answers) and the checks of :mod:`rclverify.calculus.health.shape` (tautologies,
     guarantees constraining no output, unconstrained outputs, redundant
-    conjuncts); returns its findings
+    conjuncts); returns its findings (``bounds``: the output sequences the
+    interface bounds, for realizability: :mod:`.bounded`)
     in order.  The queries share one solver session
     (:func:`~rclverify.semantics.query.solver_session`): they depend on the
     node's contract, facts and instances alone, and run in a fixed order.
@@ -181,7 +184,8 @@ def check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.
     cores could differ from what the budget alone decides."""
     with wallclock.watch() as w:
         cuts: list[int] = []
-        out = _check_node(checked, node, facts, instances, timeout_ms, lambda k: cuts.append(k) if w.cut else None)
+        out = _check_node(checked, node, facts, instances, timeout_ms, lambda k: cuts.append(k) if w.cut else None,
+                          bounds)
     return out[:cuts[0]] + [_cut_short(f) for f in out[cuts[0]:]] if cuts else out
 
 
@@ -196,7 +200,8 @@ def _cut_short(f: Finding) -> Finding:
 
 
 def _check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
-                instances: tuple[int, int] | None, timeout_ms: int, done: Callable[[int], None]) -> list[Finding]:
+                instances: tuple[int, int] | None, timeout_ms: int, done: Callable[[int], None],
+                bounds: Mapping[str, Bound] | None = None) -> list[Finding]:
     """:func:`check_node`'s checks, whatever the wall clock did; ``done(k)``
     is called after each check with the index of its first finding."""
     table: Table = {}
@@ -250,7 +255,7 @@ def _check_node(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast
     mark = len(out)
     # realizability encodes on its own: served from the table, its recorded query's shared subterms got other
     # term ids, hence other let names (bench/health_equivalence.py); shape, last, records no query of those
-    out += realizability_findings(checked, node, facts, instances)
+    out += realizability_findings(checked, node, facts, instances, bounds=bounds)
     done(mark)
     mark = len(out)
     out += shape_findings(checked, node, formulas=table)
