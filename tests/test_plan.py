@@ -173,6 +173,20 @@ def test_an_unknown_key_in_place_of_a_required_one_is_one_line_naming_both(tmp_p
     assert "type" not in d.message and at(d) == where(text, "clauses:")
 
 
+@pytest.mark.parametrize("key", ["clauses", "Agent"])
+def test_a_key_under_nodes_that_names_no_node_is_an_unknown_key(key: str, tmp_path: Path) -> None:
+    # a node's key indented one level too high reads as a node named 'clauses' whose entry is a list
+    text = BASE.replace("nodes:\n  Agent:\n", f"nodes:\n  {key}: [1]\n  Agent:\n" if key != "Agent" else
+                        "nodes:\n  Agent: [1]\n  Agents:\n")
+    (d,) = load_errors(tmp_path, text)
+    if key == "Agent":  # the control: a node's entry of the wrong type says so
+        assert d.message == "nodes.Agent: [1] is not of type 'object'", d.message
+        return
+    assert d.message.startswith("nodes.clauses: unknown key 'clauses': no node of the contracts is named so; "), d.message
+    assert "the nodes are: Localisation, Navigation, Agent, RadiationSensor" in d.message
+    assert at(d) == where(text, "clauses: [1]") and "type" not in d.message
+
+
 def test_requirement_without_text(tmp_path: Path) -> None:
     text = BASE.replace("    text: The robot inspects the waypoints.\n", "")
     (d,) = load_errors(tmp_path, text)

@@ -10,6 +10,8 @@ file.  The format is documented in docs/plan.md.
 """
 from __future__ import annotations
 
+import difflib
+
 import json
 from importlib import resources
 from pathlib import Path
@@ -82,11 +84,46 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     if not isinstance(data, dict):
         raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
-    _check_schema(data, locs, plan_rel)
+    _check_schema(data, locs, plan_rel, root)
     return data, locs, blocks
 
 
-def _check_schema(data: dict[str, Any], locs: Mapping[Path_, ast.Loc], plan_rel: str) -> None:
+def _node_names(root: Path | None, data: Mapping[str, Any]) -> list[str]:
+    """The node names of the plan's contract files that parse (none when they cannot be read): only
+    asked for a message, so a file that does not parse is reported later, where it is checked."""
+    from rclverify.lang.parser import parse_file  # deferred: start-up (only for an error's message)
+    names: list[str] = []
+    files = data.get("contracts")
+    if root is None or not isinstance(files, list):
+        return names
+    for c in files:
+        try:
+            names += [n.name for n in parse_file(root / str(c)).nodes]
+        except (RclError, OSError):
+            continue
+    return names
+
+
+def _not_a_node(e: Any, root: Path | None, data: Mapping[str, Any]) -> str | None:
+    """The message of a schema error that a key under ``nodes:`` is not a node's entry, when that key
+    names no node of the contracts (an unknown key, e.g. a node's key indented one level too high)."""
+    path = tuple(e.absolute_path)
+    if e.validator != "type" or len(path) != 2 or path[0] != "nodes":
+        return None
+    names = _node_names(root, data)
+    key = str(path[1])
+    if key in names:
+        return None
+    close = difflib.get_close_matches(key, names, n=1, cutoff=0.6)
+    entry = difflib.get_close_matches(key, ["evidence", "replacement"], n=1, cutoff=0.6)
+    hint = (f" (did you mean the node {close[0]!r}?)" if close else
+            f" (did you mean a node's {entry[0]!r}? indent it under the node's name)" if entry else "")
+    return (f"nodes.{key}: unknown key {key!r}: no node of the contracts is named so{hint}; under 'nodes' each key "
+            f"is a node's name with its entry (evidence, replacement); the nodes are: {', '.join(names) or 'none read'}")
+
+
+def _check_schema(data: dict[str, Any], locs: Mapping[Path_, ast.Loc], plan_rel: str,
+                  root: Path | None = None) -> None:
     """Validate the plan's ``data`` against ``plan.schema.json``; raises
     :class:`PlanError` with a located diagnostic per violation (``locs``).
     A pass is kept by a process that keeps its start-up
@@ -109,7 +146,10 @@ def _check_schema(data: dict[str, Any], locs: Mapping[Path_, ast.Loc], plan_rel:
     if errors:
         diags: list[Diagnostic] = []
         for e, message in schema_messages(errors, lambda e: ".".join(map(str, e.absolute_path)) or "plan"):
+            message = _not_a_node(e, root, data) or message
             loc = schema_error_loc(e, locs, plan_rel)
+            if message.startswith("nodes.") and " unknown key " in message:
+                loc = locs.get(("nodes", e.absolute_path[1], KEY), loc)  # at the key itself
             diags.extend(plan_error(loc.file, loc.line, loc.col, message).diagnostics)
         raise PlanError(diags)
 
