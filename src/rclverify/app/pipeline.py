@@ -162,7 +162,7 @@ def health_findings(ws: Workspace, node: str) -> list[HealthFinding]:
     from rclverify.stages.interface_bounds import output_bounds  # deferred: start-up (as above)
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
     found: list[HealthFinding] = check_node(ws.checked, node, facts, ws.plan.instances.get(node),
-                                            bounds=output_bounds(ws, node))
+                                            bounds=output_bounds(ws.root, ws.plan, ws.checked.nodes[node]))
     if node in ws.plan.replacements:
         found.append(replacement_finding(ws, node))
     return found

@@ -155,7 +155,8 @@ class Workspace:
             # every node between a deadline's ends: the slowest path may leave the named one
             deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))),
             profiles=tuple(c.profile.file for c in plan.standards if not c.profile.builtin),
-            bound_inputs={n: tuple(fs) for n in self.checked.nodes if (fs := bound_inputs(self, n))})
+            bound_inputs={n: tuple(fs) for n, cn in self.checked.nodes.items()
+                          if (fs := bound_inputs(self.root, plan, cn))})
 
     @cached_property
     def checked(self) -> Checked:
@@ -434,7 +435,8 @@ def stage_inputs(ws: Workspace, node: str, stage: str, in_context: bool = True) 
                 *([ws.cone(node)] if in_context else []), ws.MODEL]
     from rclverify.stages.interface_bounds import bound_inputs  # deferred: start-up (loads z3 only when called)
     repl = ws.plan.replacements.get(node)
-    return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else []) + bound_inputs(ws, node)
+    return [ws.snapshot(node)] + ([repl[0].rpartition(":")[0]] if repl else []) + bound_inputs(ws.root, ws.plan,
+                                                                                             ws.checked.nodes[node])
 
 
 def stale_stages(ws: Workspace, current: dict[str, str]) -> dict[str, set[str]]:
