@@ -1,6 +1,6 @@
 """Locations at the cause (issue 48): a property-test failure shown at the
 boundary the contract names and located at the implementation line the
-failing example takes (evidence, SARIF, report); Hoare culprit lines only
+failing example takes, the comparison with the slip (evidence, SARIF, report); Hoare culprit lines only
 the constants the program compares with, in line order."""
 from __future__ import annotations
 
@@ -80,14 +80,14 @@ def test_the_failure_is_at_the_boundary_and_at_the_implementation_line(tmp_path:
     assert cex["in.clearance"] == "2.0" and float(cex["in.speed_request"]) > 0.5
     assert len(cex["in.speed_request"].split(".")[-1]) <= 3
     assert float(cex["out.speed"]) > 0.5  # still a failure: the harness confirmed it with Z3
-    assert cex["cause"] == "nodes/speed_governor.py:12"  # `speed = speed_request`: what computed the output (issue 64)
-    assert "nodes/speed_governor.py:12" in ev.explanation
+    assert cex["cause"] == "nodes/speed_governor.py:10"  # `if clearance < NEAR`: the slip that sent it down this branch
+    assert "nodes/speed_governor.py:10" in ev.explanation
 
 
 def test_a_class_is_replayed_to_its_failing_step(tmp_path: Path) -> None:
     ev = _run(_ws(tmp_path, STATEFUL, "Governor"))
     assert ev.status == "failed" and ev.counterexample is not None
-    assert ev.counterexample["cause"] == "nodes/speed_governor.py:12"
+    assert ev.counterexample["cause"] == "nodes/speed_governor.py:10"  # `if clearance < 2.0`
 
 
 def test_sarif_and_report_put_the_failure_on_the_implementation_line(tmp_path: Path) -> None:
@@ -99,14 +99,14 @@ def test_sarif_and_report_put_the_failure_on_the_implementation_line(tmp_path: P
     sarif = json.loads((ws / "reports/assurance.sarif").read_text())
     res = next(r for r in sarif["runs"][0]["results"] if r["partialFingerprints"]["rclverifyItem/v1"].startswith("obligation:"))
     loc = res["locations"][0]["physicalLocation"]
-    assert (loc["artifactLocation"]["uri"], loc["region"]["startLine"]) == ("nodes/speed_governor.py", 12)
+    assert (loc["artifactLocation"]["uri"], loc["region"]["startLine"]) == ("nodes/speed_governor.py", 10)
     rel = res["relatedLocations"][0]["physicalLocation"]
     assert (rel["artifactLocation"]["uri"], rel["region"]["startLine"]) == ("contracts/speed_governor.rcl", 7)
     html = (ws / "reports/assurance.html").read_text()
-    assert "Where the implementation goes wrong" in html and "nodes/speed_governor.py:12" in html
+    assert "Where the implementation goes wrong" in html and "nodes/speed_governor.py:10" in html
     report = json.loads((ws / "reports/assurance.json").read_text())
     d = next(x for x in report["diagnoses"] if x["kind"] == "property-test")
-    assert "nodes/speed_governor.py:12" in d["sentence"]
+    assert "nodes/speed_governor.py:10" in d["sentence"]
 
 
 PROGRAM = """var x : REAL;

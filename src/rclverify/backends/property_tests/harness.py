@@ -346,7 +346,8 @@ class GuaranteeRun:
         except _Violation:
             assert self.last_failure is not None
             from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line; deferred: optional or conditional (inside a block)
-            moved = readable_failure(self, _Violation)
+            with _no_local_constants():  # it draws neighbour examples as the run drew its own
+                moved = readable_failure(self, _Violation)
             unconfirmed = self._unconfirmed()
             if unconfirmed is not None:
                 return unconfirmed

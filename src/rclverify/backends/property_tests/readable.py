@@ -1,12 +1,15 @@
 """A property-test failure as a person reads it: the example at
 the boundary the contract names (:mod:`.boundary`) and the implementation
-line it takes (:mod:`.cause`), folded into the harness's counterexample."""
+line with the slip (:mod:`.slips`; else the line that computed the output,
+:mod:`.cause`), folded into the harness's counterexample."""
 from __future__ import annotations
 
 from typing import Any
 
-from rclverify.backends.property_tests.boundary import boundary_example, boundary_first
+from rclverify.backends.property_tests.boundary import boundary_example, boundary_first, contract_numbers
 from rclverify.backends.property_tests.cause import cause_line
+from rclverify.backends.property_tests import neighbours
+from rclverify.backends.property_tests.slips import slip_line
 
 
 def readable_failure(run: Any, violation: type[BaseException]) -> bool:
@@ -36,7 +39,13 @@ def readable_failure(run: Any, violation: type[BaseException]) -> bool:
             example = inputs
     if example is not None:
         step = int(run.last_failure["step"]) if "step" in run.last_failure else None
-        cause = cause_line(run.impl, example, step, run.cfg.file)
+        cause = _slip(run, example, step, violation) or cause_line(run.impl, example, step, run.cfg.file)
         if cause is not None:
             run.last_failure["cause"] = cause
     return moved
+
+
+def _slip(run: Any, example: Any, step: int | None, violation: type[BaseException]) -> str | None:
+    line = slip_line(run.impl, example, step, contract_numbers(run.node), neighbours.judge(run, violation),
+                     lambda: neighbours.neighbours(run, violation))
+    return f"{run.cfg.file}:{line}" if line is not None else None

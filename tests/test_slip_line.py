@@ -1,0 +1,109 @@
+"""The culprit line is the line that made the wrong value: a property test's
+failure names the statement with the slip, found by following the failing
+example back from the ``return`` and correcting one token at a time
+(backends/property_tests/slips.py), not the ``return`` that passes a wrong
+value on.  Each implementation below carries one seeded slip, and the real
+backend (Hypothesis, the harness's own check) runs it."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.app.pipeline import Workspace
+from rclverify.backends.property_tests.backend import PropertyTestsBackend
+
+# (a) a BOOL computed on an earlier line: `<` for `<=`
+GATE_RCL = """node Gate {
+  inputs( level : INTEGER )
+  outputs( open : BOOL )
+  assume( 0 <= in.level and in.level <= 100 )
+  guarantee( out.open == (in.level <= 50) )
+}
+"""
+GATE = '''LIMIT = 50
+
+
+def gate(level):
+    seen = level
+    ok = seen < LIMIT
+    return {"open": ok}
+'''
+
+# (b) a class whose step sets the returned attribute in a branch: 2 for 1
+MODE_RCL = """node Mode {
+  inputs( command : INTEGER )
+  outputs( mode : INTEGER )
+  assume( 0 <= in.command and in.command <= 2 )
+  guarantee( in.command == 1 -> out.mode == 1 )
+}
+"""
+MODE = '''class Mode:
+    def __init__(self):
+        self.mode = 0
+        self.calls = 0
+
+    def step(self, command):
+        self.calls += 1
+        if command == 1:
+            self.mode = 2
+        elif command == 2:
+            self.mode = 0
+        return {"mode": self.mode}
+'''
+
+# (c) a helper variable feeding an arithmetic return: gain 3 for 2; (d) the slip in the return itself: - for +
+SCALE_RCL = """node Scale {
+  inputs( speed : INTEGER )
+  outputs( command : INTEGER )
+  assume( 0 <= in.speed and in.speed <= 10 )
+  guarantee( out.command == 2 * in.speed + 1 )
+}
+"""
+HELPER = '''def scale(speed):
+    gain = 3
+    offset = 1
+    doubled = gain * speed
+    return {"command": doubled + offset}
+'''
+IN_RETURN = '''def scale(speed):
+    gain = 2
+    offset = 1
+    doubled = gain * speed
+    return {"command": doubled - offset}
+'''
+
+
+def _cause(tmp: Path, node: str, rcl: str, impl: str, attr: str) -> str:
+    (tmp / "contracts").mkdir()
+    (tmp / "nodes").mkdir()
+    (tmp / "contracts" / "c.rcl").write_text(rcl, encoding="utf-8")
+    (tmp / "nodes" / "impl.py").write_text(impl, encoding="utf-8")
+    (tmp / "contracts" / "plan.yaml").write_text(
+        f"contracts: [contracts/c.rcl]\nnodes:\n  {node}:\n    evidence:\n      - backend: property_tests\n"
+        f"        implementation: nodes/impl.py:{attr}\n        max_examples: 60\n", encoding="utf-8")
+    target = Workspace(tmp).target(node, 0)
+    backend = PropertyTestsBackend()
+    ev: Any = backend.run(backend.export(target)[0], target)
+    assert ev.status == "failed" and ev.counterexample is not None, ev.explanation
+    cause: str = ev.counterexample["cause"]
+    assert cause in ev.explanation
+    return cause
+
+
+@pytest.mark.parametrize(("node", "rcl", "impl", "attr", "line"), [
+    ("Gate", GATE_RCL, GATE, "gate", 6),             # (a) `ok = seen < LIMIT`, not `return {"open": ok}`
+    ("Mode", MODE_RCL, MODE, "Mode", 9),             # (b) `self.mode = 2`, not `return {"mode": self.mode}`
+    ("Scale", SCALE_RCL, HELPER, "scale", 2),        # (c) `gain = 3`, not `doubled = ...` nor the return
+    ("Scale", SCALE_RCL, IN_RETURN, "scale", 5),     # (d) control: the slip is in the return expression
+], ids=["bool-earlier-line", "step-attribute", "helper-of-arithmetic", "slip-in-return"])
+def test_the_line_with_the_slip_is_named(tmp_path: Path, node: str, rcl: str, impl: str, attr: str,
+                                         line: int) -> None:
+    assert _cause(tmp_path, node, rcl, impl, attr) == f"nodes/impl.py:{line}"
+
+
+def test_without_a_one_token_correction_the_computing_line_is_named(tmp_path: Path) -> None:
+    """No single token fixes `speed * speed`: the statement that computed the output is named, as before."""
+    impl = 'def scale(speed):\n    squared = speed * speed\n    return {"command": squared}\n'
+    assert _cause(tmp_path, "Scale", SCALE_RCL, impl, "scale") == "nodes/impl.py:2"
