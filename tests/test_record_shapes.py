@@ -11,6 +11,7 @@ field added, and must then fail.  In-process and cheap: no pipeline runs here.
 from __future__ import annotations
 
 import copy
+import typing
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
@@ -71,20 +72,20 @@ def test_every_field_of_a_finding_is_rendered_or_internal() -> None:
 
 class _WithMargin(FindingRow, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
     """The definition with one field added, as a change to records/findings.py would add it."""
-    margin: str = ""
+    margin_added_here: str = ""
 
 
 def test_a_field_added_and_not_rendered_fails_until_rendered_or_internal() -> None:
     sources = _sources()
-    assert unaccounted(_WithMargin, sources, INTERNAL) == ["margin: neither rendered nor declared internal"]
+    assert unaccounted(_WithMargin, sources, INTERNAL) == ["margin_added_here: neither rendered nor declared internal"]
     # declared internal: accounted for
-    assert unaccounted(_WithMargin, sources, {**INTERNAL, "margin": "why it is not shown"}) == []
+    assert unaccounted(_WithMargin, sources, {**INTERNAL, "margin_added_here": "why it is not shown"}) == []
     # rendered: the HTML part with one more read of the row
-    html = sources[0].replace("{{ f.check }}", "{{ f.check }} {{ f.margin }}", 1)
+    html = sources[0].replace("{{ f.check }}", "{{ f.check }} {{ f.margin_added_here }}", 1)
     assert html != sources[0]
     assert unaccounted(_WithMargin, [html, sources[1]], INTERNAL) == []
     # a read outside the loop over the decoded rows does not count
-    assert unaccounted(_WithMargin, [sources[0] + "{{ f.margin }}", sources[1]], INTERNAL) != []
+    assert unaccounted(_WithMargin, [sources[0] + "{{ f.margin_added_here }}", sources[1]], INTERNAL) != []
     # a field that is rendered may not also be declared internal
     assert unaccounted(FindingRow, sources, {**INTERNAL, "core": "x"}) == ["core: declared internal but rendered"]
 
@@ -99,7 +100,7 @@ def test_the_schema_findings_part_is_generated_from_the_definition() -> None:
 def test_a_field_added_reaches_the_schema_and_the_checked_in_file_then_differs(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(schema_gen.GENERATED, "findings", (_WithMargin, schema_gen.GENERATED["findings"][1]))
     part = schema_gen.generated_part("findings")
-    assert "margin" in part["items"]["properties"] and part["items"]["properties"]["margin"]["type"] == "string"
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
     assert SCHEMA["properties"]["findings"] != part
     regenerated = schema_gen.with_generated(copy.deepcopy(SCHEMA))
     assert regenerated["properties"]["findings"] == part
@@ -107,41 +108,55 @@ def test_a_field_added_reaches_the_schema_and_the_checked_in_file_then_differs(m
         "findings"]  # only the generated part changes
 
 
-def _full_row() -> dict[str, Any]:
-    """A warning row with every field set to a value of its own."""
-    f = HealthFinding(id="N.g1.c2.redundant", node="N", check="redundant", guarantee=1, status="warning",
-                      message="msg-text", explanation="expl-text", model={"in.x": "model-value"},
-                      core=["x > 0"], duration_s=1.5, instances={"i1": "inst-verdict"},
-                      smt2="artifacts/health/N.g1.c2.redundant.smt2", witness={"out.y": "witness-term"},
-                      witness_smt2="artifacts/health/N.g1.c2.redundant.witness.smt2")
-    row = FindingRow.of(f).to_json()
-    row.update(solvers={"agreement": "two solvers", "why": "both unsat", "cvc5": None, "proof": "", "smt2": ""},
-               flagged="flagged-text", sha256="ab" * 32, acknowledged={"reason": "ack-reason", "at": "plan.yaml:3:5"})
-    return row
+#: Values of the fields whose type a generic value does not fit, and the text each shows as.
+_SET: dict[str, tuple[Any, str]] = {
+    "id": ("N.g1.c2.redundant", "N.g1.c2.redundant"), "node": ("N", "N"), "check": ("redundant", "redundant"),
+    "guarantee": (1, ""), "status": ("warning", ""), "core": (["x > 0"], "x"), "duration_s": (1.5, "1.5"),
+    "solvers": ({"agreement": "two solvers", "why": "both unsat", "cvc5": None, "proof": "", "smt2": ""},
+                "two solvers"),
+    "acknowledged": ({"reason": "ack-reason", "at": "plan.yaml:3:5"}, "ack-reason"),
+    "sha256": ("ab" * 32, "abab"),
+}
+
+
+def _value(name: str, ann: Any) -> tuple[Any, str]:
+    """A value of field ``name`` (annotation ``ann``) and the text a renderer that shows it writes."""
+    if name in _SET:
+        return _SET[name]
+    args = [a for a in (typing.get_args(ann) or (ann,)) if a is not type(None)]
+    if args == [str]:
+        return f"{name}-text", f"{name}-text"
+    if typing.get_origin(args[0]) is dict:
+        return {f"{name}-key": f"{name}-value"}, f"{name}-value"
+    if typing.get_origin(args[0]) is list:
+        return [f"{name}-item"], f"{name}-item"
+    raise AssertionError(f"{name}: give the field a value in _SET (its type {ann} has no generic one)")
+
+
+def _full_row(cls: type[msgspec.Struct] = FindingRow) -> tuple[dict[str, Any], dict[str, str]]:
+    """A warning row of ``cls`` with every field set to a value of its own, and each field's shown text."""
+    hints = typing.get_type_hints(cls)
+    made = {k: _value(k, hints[k]) for k in cls.__struct_fields__}
+    return {k: v for k, (v, _) in made.items()}, {k: t for k, (_, t) in made.items()}
 
 
 def test_the_renderers_show_each_field_they_read() -> None:
     """Both parts render a row with every field set (and the same row not acknowledged, whose warning
-    offers its sha256 to acknowledge it); each value but the internal ones is in one of them."""
+    offers its sha256 to acknowledge it); each field's value but the internal ones is in one of them."""
     part = part_renderer(FragmentCache(), "")
-    row = _full_row()
+    row, shown = _full_row()
     rows = [row, {k: v for k, v in row.items() if k != "acknowledged"} | {"id": "N.g1.c3.redundant"}]
     text = str(part("findings.html", rows=rows)) + part("findings.md", rows=rows)
-    shown = {"model": "model-value", "instances": "inst-verdict", "witness": "witness-term", "message": "msg-text",
-             "explanation": "expl-text", "smt2": row["smt2"], "witness_smt2": row["witness_smt2"],
-             "acknowledged": "ack-reason", "solvers": "two solvers", "core": "x", "id": "N.g1.c2.redundant",
-             "check": "redundant", "duration_s": "1.5", "sha256": "abab"}
-    assert [k for k, v in shown.items() if v not in text] == []
-    assert set(shown) | {"node", "guarantee", "status"} | set(INTERNAL) == set(FindingRow.__struct_fields__)
-    assert row["flagged"] not in text
+    assert [k for k, t in shown.items() if k not in INTERNAL and t not in text] == []
+    assert all(shown[k] not in text for k in INTERNAL)
 
 
 def test_an_undeclared_key_never_reaches_a_renderer_or_the_report() -> None:
     part = part_renderer(FragmentCache(), "")
-    with pytest.raises(msgspec.ValidationError, match="margin"):
-        part("findings.html", rows=[{**_full_row(), "margin": "0.5 m"}])
-    with pytest.raises(msgspec.ValidationError, match="margin"):
-        FindingRow.of({**_full_row(), "margin": "0.5 m"})
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("findings.html", rows=[{**_full_row()[0], "margin_added_here": "0.5 m"}])
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        FindingRow.of({**_full_row()[0], "margin_added_here": "0.5 m"})
 
 
 def test_a_sealed_health_record_decodes_into_the_definition() -> None:
