@@ -35,6 +35,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
+import msgspec
+
+from rclverify.records.findings import HealthFinding
 from rclverify.records.sealed import read_sealed
 from rclverify.stages.requirements import record_path
 from rclverify.records.sealed import obligation_list
@@ -86,15 +89,15 @@ def discharging_items(root: Any, nodes: Iterable[str]) -> list[Item]:
             if sc.get("status") == "discharged" and _path(sc.get("smt2")):
                 out.append(Item("side-condition", str(sc.get("id")), sc["smt2"], "discharged", "unsat", row=sc))
         body, why = read_sealed(root / f"artifacts/health/{n}.json", "contract health record")
-        for f in _rows(body, why, "findings"):
-            witness = witness_query(f)
-            if f.get("status") == "ok" and witness is not None:
+        for f in _findings(body, why):
+            row = f.to_json()
+            witness = witness_query(row)
+            if f.status == "ok" and witness is not None:
                 # the witness's quantifier-free query, which implies realizability (calculus/health/realizer.py)
-                out.append(Item("health", str(f.get("id")), witness, "ok", "unsat", every=True, via=WITNESS, row=f))
-            elif f.get("status") == "ok" and _path(f.get("smt2")):
-                proof = f.get("check") in PROOF_CHECKS  # both sides of a replacement (joined by a reset) must hold
-                out.append(Item("health", str(f.get("id")), f["smt2"], "ok", "unsat" if proof else "sat", every=proof,
-                                row=f))
+                out.append(Item("health", f.id, witness, "ok", "unsat", every=True, via=WITNESS, row=row))
+            elif f.status == "ok" and _path(f.smt2):
+                proof = f.check in PROOF_CHECKS  # both sides of a replacement (joined by a reset) must hold
+                out.append(Item("health", f.id, f.smt2, "ok", "unsat" if proof else "sat", every=proof, row=row))
     index, why = read_sealed(root / "artifacts/requirements/index.json", "requirement index")
     records = index.get("records") if isinstance(index, dict) and not why else None
     for rid in sorted(records) if isinstance(records, dict) else []:
@@ -121,6 +124,16 @@ def witness_query(finding: Any) -> str | None:
         return None
     path = finding.get("witness_smt2")
     return path if _path(path) else None
+
+
+def _findings(body: Any, why: str) -> list[HealthFinding]:
+    """The findings of a sealed health record, decoded into their one
+    definition (records/findings.py); none when the record is missing,
+    altered or does not decode."""
+    try:
+        return msgspec.convert(_rows(body, why, "findings"), list[HealthFinding])
+    except msgspec.ValidationError:
+        return []
 
 
 def _rows(body: Any, why: str, key: str) -> list[dict[str, Any]]:
