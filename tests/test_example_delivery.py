@@ -175,18 +175,18 @@ def test_each_defect_is_one_row_with_the_right_culprit(runs: dict[str, Any]) -> 
     blamed = culprit_nodes(report["problems"])
     assert {"GnssDriver", "MissionPlanner", "RouteServer", "WheelController", "SpeedGovernor"} <= blamed
     assert not {"Localiser", "LockerController"} & blamed  # victims only
-    # (e) the property test: the implementation's line, the boundary value first
+    # (e) the property test: the implementation's line with the slip (`clearance < SLOW_ZONE`), the boundary first
     slow = ROWS["05-slow-zone.diff"]
-    assert "the implementation line that computed the failing output is nodes/speed_governor.py:18" in rows[slow]["sentence"]
+    assert "the implementation line that computed the failing output is nodes/speed_governor.py:16" in rows[slow]["sentence"]
     ev = next(e for e in report["evidence"] if e["obligation"] == "SpeedGovernor.g2.property_tests.e0")
     cex = ev["counterexample"]
-    assert (cex["cause"], cex["boundary"], cex["in.clearance"]) == ("nodes/speed_governor.py:18", "in.clearance", "2.0")
+    assert (cex["cause"], cex["boundary"], cex["in.clearance"]) == ("nodes/speed_governor.py:16", "in.clearance", "2.0")
     assert len(cex["in.cmd_vel"]) <= 4 and Fraction(cex["in.cmd_vel"]) > Fraction(1, 2)  # a short value past 0.5
     from rclverify.report.sarif import sarif_log
     res = next(r for r in sarif_log(report)["runs"][0]["results"]
                if r["ruleId"] == "RCL-OBL-FAILED" and "SpeedGovernor.g2" in json.dumps(r))
     loc = res["locations"][0]["physicalLocation"]
-    assert (loc["artifactLocation"]["uri"], loc["region"]["startLine"]) == ("nodes/speed_governor.py", 18)
+    assert (loc["artifactLocation"]["uri"], loc["region"]["startLine"]) == ("nodes/speed_governor.py", 16)
     # (f) the deadline: refuted along the worst path, through the Navigator, not the path named
     dl = ROWS["06-deadline.diff"]
     assert [w for w, _ in _culprits(report, dl)] == [
