@@ -51,15 +51,27 @@ def test_a_bounded_output_sequence_is_decided_both_ways_and_cvc5_agrees() -> Non
     bad = _one(BELOW, "S", bounds={"ys": Bound(3)})
     assert bad.status == "problem" and bad.core == ["guarantee 1 (s.rcl:4:3)", "guarantee 2 (s.rcl:5:3)"]
     assert decide(bad.smt2).answer == "sat"
-    # control: the same contract without a bound is decided by Z3, but its query over the sequence sort is
-    # beyond cvc5 (unknown: the second solver cannot confirm it, and --strict fails)
-    free = _one(ECHO, "S")
-    assert free.status == "ok" and "written out" not in free.explanation
+    # control: without a bound Z3 still finds the input with no answer, but its query over the sequence sort
+    # is beyond cvc5 (unknown: the second solver cannot confirm it, and --strict fails)
+    free = _one(BELOW, "S")
+    assert free.status == "problem" and "written out" not in free.explanation
     assert decide(free.smt2).answer == "unknown"
 
 
+def test_an_unbounded_output_sequence_is_decided_by_an_answer_of_a_simple_shape() -> None:
+    """``<in.x>`` answers ECHO: the finding says it was decided by that witness, and cvc5 decides its query;
+    no such answer exists for BELOW (not realizable) or THREE (three items needed: undecided unbounded)."""
+    w = _one(ECHO, "S")
+    assert w.status == "ok" and "Decided by a witness: the answer out.ys = <in.x>" in w.message
+    assert w.witness == {"out.ys": "<in.x>"} and decide(w.witness_smt2).answer == "unsat"
+    assert _one(BELOW, "S").witness is None
+    world.fresh()
+    assert realizability_findings(check([parse_text(THREE, "s.rcl")]), "T") == []
+
+
 def test_the_bound_decides_where_the_length_matters() -> None:
-    """Three different items fit in at most 3 (and in exactly 3), not in at most 2 or exactly 2."""
+    """Three different items fit in at most 3 (and in exactly 3), not in at most 2 or exactly 2; unbounded
+    the contract is not decided at all (previous test)."""
     assert _one(THREE, "T", bounds={"ys": Bound(3)}).status == "ok"
     assert _one(THREE, "T", bounds={"ys": Bound(3, fixed=True)}).status == "ok"
     short = _one(THREE, "T", bounds={"ys": Bound(2)})
@@ -118,5 +130,5 @@ def test_the_health_stage_reads_the_bound_from_the_message_definition(tmp_path: 
     assert stage_inputs(ws, "S", "health")[1:] == files and list(ws.index.bound_inputs["S"]) == files
     free = _workspace(tmp_path / "free", "int32[]")
     [g] = [f for f in health_findings(free, "S") if f.check == "realizable"]
-    assert g.status == "ok" and "written out" not in g.explanation
+    assert g.status == "ok" and "written out" not in g.explanation and g.witness == {"out.ys": "<in.x>"}
     assert stage_inputs(free, "S", "health")[1:] == files  # an edit that adds a bound checks it again

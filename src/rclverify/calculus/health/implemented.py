@@ -5,7 +5,9 @@ A contract ``(A, G)`` is realizable when some output answers every input the
 assumption admits (:mod:`.realizable`).  An implementation whose outputs are
 the terms ``w(in)`` (one RCL term over the inputs per output: what a
 straight-line node computes, the outputs of a proved implementation) is such
-an answer when the quantifier-free-over-the-outputs query
+an answer (so is an answer of a simple shape for outputs that are all
+sequences, :func:`rclverify.calculus.health.realizable._sequence_answers`)
+when the quantifier-free-over-the-outputs query
 
     A(in) and F_in(in) and not (typing(w(in)) and fits(w(in)) and F_out(in, w(in)) and G(in, w(in)))
 
@@ -44,7 +46,7 @@ WITNESS_MS = 2_000
 
 def implemented(enc: Encoder, cn: CheckedNode, outs: Sequence[tuple[str, z3.ExprRef, Type]],
                 given: Sequence[z3.BoolRef], body: Sequence[z3.BoolRef], terms: Mapping[str, ast.Expr],
-                bounds: Mapping[str, Bound], with_facts: bool) -> Finding | None:
+                bounds: Mapping[str, Bound], with_facts: bool, source: str = "the implementation") -> Finding | None:
     """The ``ok`` realizability finding of node ``cn`` decided by the witness
     ``terms`` (output name -> RCL term over the inputs), or ``None`` when
     they do not answer every admissible input, are not decided, leave an
@@ -52,7 +54,8 @@ def implemented(enc: Encoder, cn: CheckedNode, outs: Sequence[tuple[str, z3.Expr
     type)`` of the constrained outputs; ``given``: the formulas over the
     inputs; ``body``: the facts over outputs and the guarantees, over the
     output constants; ``with_facts``: the plan states environment facts
-    (the message says so)."""
+    (the message says so); ``source`` names where the terms come from in
+    the message (``the implementation``, ``the answer``)."""
     if any(v not in terms or outputs_mentioned(terms[v], cn) for v, _, _ in outs):
         return None
     t0 = time.perf_counter()
@@ -80,10 +83,10 @@ def implemented(enc: Encoder, cn: CheckedNode, outs: Sequence[tuple[str, z3.Expr
     admits = " and the environment facts admit" if with_facts else " admits"
     return Finding(f"{cn.name}.realizable", cn.name, "realizable", None, "ok",
                    f"The contract of {cn.name} can be implemented: every input its assumption{admits} has an output "
-                   f"satisfying every guarantee. Decided by a witness: the implementation {text} answers every one "
+                   f"satisfying every guarantee. Decided by a witness: {source} {text} answers every one "
                    "of them (Z3 checked it: the witness query is unsat).",
                    "Realizability (forall in. A(in) -> exists out. G(in, out)) follows from the implementation's "
-                   "outputs, an instance of exists out that Z3 proved answers every admissible input"
+                   f"outputs ({source}), an instance of exists out that Z3 proved answers every admissible input"
                    + ("".join(f"; out.{v} fits its interface ({b.text()})" for v, b in bounds.items()
                               if any(v == name for name, _, _ in outs)))
                    + ". The witness query below has no quantifier over the outputs.",

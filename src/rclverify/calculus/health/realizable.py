@@ -71,7 +71,7 @@ from rclverify.semantics import wallclock
 from rclverify.semantics.query import render_model, satisfiable, smt2_script, tactic_solver
 from rclverify.lang import ast
 from rclverify.semantics.natural import natural_typing
-from rclverify.lang.types import Checked, FuncT, SeqT
+from rclverify.lang.types import Checked, CheckedNode, FuncT, SeqT
 from rclverify.calculus.health.bounded import Bound, expand
 from rclverify.calculus.health.finding import Finding
 from rclverify.calculus.health.implemented import implemented
@@ -88,6 +88,8 @@ REALIZABLE_TIMEOUT_MS = 2_000
 #: example's ScanGuard) it spent the whole query budget, 4 million steps and
 #: 3 s of one idle core, before the general solver decided in 0.01 s.
 QE_MS = 100
+#: Answers of a simple shape tried for outputs that are all sequences (:func:`_sequence_answers`).
+MAX_SEQUENCE_ANSWERS = 4
 #: Guarantees beyond this many are not searched for the conflicting subset.
 MAX_SUBSET_SEARCH = 5
 #: Budget of the first look at each subset of one size in the search for the
@@ -246,6 +248,24 @@ def realizability_findings(checked: Checked, node: str, facts: Sequence[tuple[as
                     f"A realizability query {wallclock.cut_reason()}.")]
 
 
+def _sequence_answers(cn: CheckedNode, names: Sequence[str]) -> list[dict[str, ast.Expr]]:
+    """Answers of a simple shape when every output in ``names`` is a
+    sequence: each an input sequence of its type or the one-item sequence
+    of an input of its item type (declaration order; at most
+    :data:`MAX_SEQUENCE_ANSWERS`); ``[]`` otherwise."""
+    per: list[list[ast.Expr]] = []
+    for v in names:
+        t = cn.outputs[v]
+        if not isinstance(t, SeqT):
+            return []
+        opts: list[ast.Expr] = [ast.Var(i, "in") for i, ti in cn.inputs.items() if ti == t]
+        opts += [ast.SeqLit((ast.Var(i, "in"),)) for i, ti in cn.inputs.items() if ti == t.elem]
+        if not opts:
+            return []
+        per.append(opts)
+    return [dict(zip(names, c)) for c in itertools.islice(itertools.product(*per), MAX_SEQUENCE_ANSWERS)]
+
+
 def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
                    instances: tuple[int, int] | None, bounds: Mapping[str, Bound] | None = None,
                    implementation: Mapping[str, ast.Expr] | None = None) -> list[Finding]:
@@ -263,9 +283,12 @@ def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, 
     comment = f"health {node}: is there an input no output answers?"
     over = "".join(f" The quantifier over out.{v} ranges over the sequences its interface carries ({b.text()}), "
                    "written out item by item." for v, b in q.bounded.items())
-    if implementation:
+    # a witness first: the implementation's outputs, else (every constrained output an unbounded sequence) an
+    # answer of a simple shape; its query has no quantifier over the outputs, which cvc5 decides
+    for terms, source in ([(implementation, "the implementation")] if implementation else
+                          [(c, "the answer") for c in _sequence_answers(cn, q.names)] if not q.bounds else []):
         by_witness = implemented(q.enc, cn, [(v, o, cn.outputs[v]) for v, o in zip(q.names, q.outs)], q.given,
-                            [*q.out_facts, *q.guarantees], implementation, q.bounded, bool(facts))
+                                 [*q.out_facts, *q.guarantees], terms, q.bounded, bool(facts), source)
         if by_witness is not None:
             return [by_witness]
     # an answer first (calculus/health/realizer.py): output terms that answer every admissible input prove the
