@@ -103,6 +103,11 @@ def test_one_run_s_counts() -> None:
     full = [{"guarantee": 1, "answers": 1000, "undefined": 0, "lowest": [0.1] * KEPT_MARGINS}]
     got = of_margin({**row, "inconclusive": 0}, full, 1, 0.5, "answer")
     assert (got["answers"], got["violations"], got["inconclusive"]) == (KEPT_MARGINS, KEPT_MARGINS, 1000 - KEPT_MARGINS)
+    # a record that kept only its smallest margin: clean when it is, else one below and the others undecided
+    only = [{"guarantee": 1, "answers": 10, "undefined": 0, "margin": 0.3, "holds": None}]
+    assert of_margin({**row, "inconclusive": 0}, only, 1, 0.25, "answer")["violations"] == 0
+    got = of_margin({**row, "inconclusive": 0}, only, 1, 0.5, "answer")
+    assert (got["answers"], got["violations"], got["inconclusive"]) == (1, 1, 9)
 
 
 def test_the_text_reads_and_a_bad_one_says_why() -> None:

@@ -15,7 +15,9 @@ for ``-inf``); :func:`of_margin` turns them into the counts
 * ``inconclusive``: the answers with no margin, the run's undecided
   answers, and, when every kept margin is below ``M`` and more answers
   were judged than kept, those others (their margins are at least the
-  largest kept one, which may still be below ``M``): never counted clean;
+  largest kept one, which may still be below ``M``): never counted clean
+  (a record that kept only the smallest margin: its answers are clean when
+  that one is at least ``M``, else one is below and the others undecided);
 * ``answers``: the rest of guarantee K's judged answers.
 
 So an answer is counted once, in the run it was judged in, and the run set's
@@ -39,9 +41,14 @@ def of_margin(row: Mapping[str, Any], margins: Sequence[Mapping[str, Any]], guar
     if m is None:  # the guarantee judged on no answer of this run: nothing counted beside its undecided answers
         return {**row, "answers": 0, "violations": 0, "inconclusive": unsure}
     answers, undefined = int(m.get("answers") or 0), int(m.get("undefined") or 0)
-    lowest = list(m.get("lowest") or ())
-    below = sum(1 for v in lowest if v is None or v < least)
-    unknown = answers - len(lowest) if lowest and below == len(lowest) and len(lowest) >= KEPT_MARGINS else 0
+    if "lowest" in m:
+        lowest = list(m.get("lowest") or ())
+        below = sum(1 for v in lowest if v is None or v < least)
+        unknown = answers - len(lowest) if lowest and below == len(lowest) and len(lowest) >= KEPT_MARGINS else 0
+    else:  # a record that kept only the smallest: all clean when it is clean, else the others unknown
+        v, holds = m.get("margin"), m.get("holds")
+        clean = holds is True if v is None else v >= least
+        below, unknown = (0, 0) if clean or not answers else (1, answers - 1)
     if per == "run":
         return {**row, "answers": 1 if answers else 0, "violations": 1 if below else 0,
                 "inconclusive": 0 if below else unsure + undefined + unknown}
