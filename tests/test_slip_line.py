@@ -107,3 +107,25 @@ def test_without_a_one_token_correction_the_computing_line_is_named(tmp_path: Pa
     """No single token fixes `speed * speed`: the statement that computed the output is named, as before."""
     impl = 'def scale(speed):\n    squared = speed * speed\n    return {"command": squared}\n'
     assert _cause(tmp_path, "Scale", SCALE_RCL, impl, "scale") == "nodes/impl.py:2"
+
+
+DOCK_RCL = """node Dock {
+  inputs( distance : REAL )
+  outputs( final : REAL )
+  assume( 0 <= in.distance and in.distance <= 5 )
+  guarantee( 0 <= out.final and out.final <= 0.05 )
+}
+"""
+#: the loop stops at 0.5 m for 0.05 m; several corrections of it and of its body loop for ever (`max(1.0, ...)`,
+#: `remaining + STEP`, `remaining > -0.5`) and are stopped by the budget of lines
+DOCK = '''STEP = 0.25
+def dock(distance):
+    remaining = distance
+    while remaining > 0.5:
+        remaining = max(0.0, remaining - STEP)
+    return {"final": remaining}
+'''
+
+
+def test_a_correction_that_loops_for_ever_is_stopped(tmp_path: Path) -> None:
+    assert _cause(tmp_path, "Dock", DOCK_RCL, DOCK, "dock") == "nodes/impl.py:4"  # the loop's condition
