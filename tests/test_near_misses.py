@@ -1,8 +1,9 @@
 """Near misses (docs/monitors.md, "Near misses"): a guarantee held on every run
 with a margin under the plan's ``near_miss`` threshold is named in the report,
-in SARIF at the guarantee's line (level warning) and in the summary verify ends
-with; the control, the same run under a threshold below its margins, is not
-named; a threshold that does not read is a located plan error."""
+in SARIF at the guarantee's line (level warning), in JUnit, in the summary
+verify ends with, and fails --strict as a warning does; the control, the same
+run under a threshold below its margins, is not named; a threshold that does
+not read is a located plan error."""
 from __future__ import annotations
 
 import json
@@ -56,6 +57,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], dict[
     assert main(["verify", "-w", str(ws)]) == 0
     read = lambda p: json.loads((ws / p).read_text(encoding="utf-8"))  # noqa: E731
     out = read("reports/assurance.json"), read("reports/assurance.sarif"), read("artifacts/report/summary.json")
+    out[0]["_junit"] = (ws / "reports" / "assurance.junit.xml").read_text(encoding="utf-8")
     out[0]["_md"] = (ws / "reports" / "assurance.md").read_text(encoding="utf-8")
     out[0]["_html"] = (ws / "reports" / "assurance.html").read_text(encoding="utf-8")
     return out
@@ -74,8 +76,18 @@ def test_a_margin_under_the_threshold_is_named_and_the_control_is_not(run) -> No
     assert "Smallest margins</th><td>guarantee 1: <strong>0.04" in report["_html"]
     [m] = next(e for e in report["evidence"] if e["obligation"].startswith("BrakeA."))["monitoring"]["margins"]
     assert [round(x, 9) for x in m["lowest"]] == [0.04, 0.3]
-    # a near miss changes no status: both held
+    # a near miss changes no status: both held; but it is a warning, so --strict fails and names it
     assert {o["node"]: o["status"] for o in report["obligations"]} == {"BrakeA": "discharged", "BrakeB": "discharged"}
+    assert report["meta"]["strict_ok"] is False
+
+
+def test_junit_and_strict_name_them_as_the_warnings_they_are(run) -> None:
+    import xml.etree.ElementTree as ET
+    report, _, summary = run
+    [suite] = [s for s in ET.fromstring(report["_junit"]) if s.get("name") == "near_misses"]
+    assert (suite.get("tests"), suite.get("failures")) == ("2", "2")
+    assert {c.get("name") for c in suite} == {"BrakeA.g0.monitors.run_jsonl.g1.value", "BrakeA.g0.monitors.run_jsonl.g1.time"}
+    assert summary["strict"] == ["2 near misses: a margin under the plan's near_miss threshold (BrakeA guarantee 1)"]
 
 
 def test_sarif_and_the_first_screen_name_them(run, capsys) -> None:

@@ -33,7 +33,9 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
 * when the plan has end-to-end deadlines, a ``deadlines`` ``<testsuite>``
   with one ``<testcase>`` per deadline (:func:`.deadlines.junit_suite`);
 * when the contracts have lint diagnostics, a ``lint`` ``<testsuite>`` with
-  one failing ``<testcase>`` per diagnostic (:func:`_lint_suite`).
+  one failing ``<testcase>`` per diagnostic (:func:`_lint_suite`);
+* when the runs nearly missed a guarantee, a ``near_misses`` ``<testsuite>``
+  with one failing ``<testcase>`` per near miss (:func:`.near_misses.junit_suite`).
 
 Every outcome is the item's one severity (:mod:`.severity`, docs/ci.md):
 an ``error`` is a ``<failure>`` (``<error>`` for a record not believed), a
@@ -123,7 +125,9 @@ def junit_tree(report: Report) -> ET.Element:
             totals[k] += v
         total_time += time
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
-    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
+    from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
+    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report),
+                near_misses_suite(report, _case, _outcome)):
         if req is None:
             continue
         root.append(req[0])
@@ -325,7 +329,9 @@ def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
             totals[k] += v
         total_time += piece["time"]
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
-    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report)):
+    from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
+    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report),
+                near_misses_suite(report, _case, _outcome)):
         if req is None:
             continue
         ET.indent(req[0], level=1)

@@ -10,14 +10,18 @@ each guarantee's smallest space margin on the run
 ``value``, and each timed guarantee's smallest time margin
 (``details.deadlines.time_margins``) at least 0 and below ``time``, is one
 row of the report's ``near_misses`` (:func:`near_miss_rows`), a SARIF
-result ``RCL-NEAR-MISS`` at level ``warning`` at the guarantee's line
-(:func:`sarif_results`), and a line of the summary ``verify`` ends with
-(:func:`summary_lines`).  A near miss changes no status: the guarantee held
-on every run.
+result ``RCL-NEAR-MISS`` at its severity, ``warning``, at the guarantee's
+line (:func:`sarif_results`), a failing test case of the JUnit
+``near_misses`` suite (:func:`junit_suite`), and a line of the summary
+``verify`` ends with (:func:`summary_lines`).  A near miss changes no
+status (the guarantee held on every run) but, a warning like every other
+(report/severity.py), fails ``--strict`` (:func:`strict_reason`): the plan
+stated the threshold to be told.
 """
 from __future__ import annotations
 
 import math
+import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.records.report_schema import NearMissRow, ObligationRow, Report
@@ -128,12 +132,14 @@ def sarif_results(report: Report, result: Callable[..., SarifResult]) -> list[Sa
     """One SARIF result per near miss at its guarantee's line (level
     ``warning``); ``result(rule, level, text, where, key, props)`` is
     report/sarif.py's result maker."""
+    from rclverify.report.severity import of  # deferred: start-up (one severity in every output)
+    level = of("near-miss", "warning") or "note"
     out = []
     for r in report.get("near_misses") or ():
         props = {"node": r["node"], "guarantee": r["guarantee"], "kind": r["kind"], "margin": r["margin"],
                  "threshold": r["threshold"], "unit": r["unit"], "obligation": r["obligation"],
                  "threshold_source": r["threshold_source"]}
-        out.append(result("RCL-NEAR-MISS", "warning", f"Near miss: {describe(r)}.", r["source"] or r["threshold_source"],
+        out.append(result("RCL-NEAR-MISS", level, f"Near miss: {describe(r)}.", r["source"] or r["threshold_source"],
                           f"near-miss:{r['obligation']}:{r['guarantee']}:{r['kind']}", props))
     return out
 
@@ -150,4 +156,38 @@ def summary_lines(rows: Sequence[Mapping[str, Any]], most: int = 5) -> list[str]
     return out
 
 
-__all__ = ["SARIF_RULES", "describe", "near_miss_rows", "sarif_results", "summary_lines"]
+def junit_suite(report: Report, case: Callable[..., ET.Element],
+                outcome: Callable[..., str]) -> tuple[ET.Element, dict[str, int], float] | None:
+    """The ``near_misses`` ``<testsuite>``: one failing ``<testcase>`` per
+    near miss (``classname`` ``near_miss``, name ``<obligation>.g<k>.<kind>``,
+    at the guarantee); ``case`` and ``outcome`` are report/junit.py's.
+    ``None`` without near misses."""
+    rows = list(report.get("near_misses") or ())
+    if not rows:
+        return None
+    suite = ET.Element("testsuite", {"name": "near_misses"})
+    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    for r in rows:
+        c = case(suite, "near_miss", f"{r['obligation']}.g{r['guarantee']}.{r['kind']}", r["source"], 0.0)
+        counts["tests"] += 1
+        bumped = outcome(c, "warning", f"near miss: {describe(r)}", f"threshold: {r['threshold_source']}", "near-miss")
+        if bumped:
+            counts[bumped] += 1
+    for k, v in counts.items():
+        suite.set(k, str(v))
+    suite.set("time", "0.000")
+    return suite, counts, 0.0
+
+
+def strict_reason(report: Report) -> list[str]:
+    """The clause a failed ``--strict`` names for near misses (``[]`` without)."""
+    rows = list(report.get("near_misses") or ())
+    if not rows:
+        return []
+    names = list(dict.fromkeys(f"{r['node']} guarantee {r['guarantee']}" for r in rows))
+    return [f"{len(rows)} near miss{'es' if len(rows) != 1 else ''}: a margin under the plan's near_miss threshold ("
+            + ", ".join(names[:4]) + (", ..." if len(names) > 4 else "") + ")"]
+
+
+__all__ = ["SARIF_RULES", "describe", "junit_suite", "near_miss_rows", "sarif_results", "strict_reason",
+           "summary_lines"]

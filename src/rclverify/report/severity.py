@@ -30,7 +30,9 @@ does not constrain is a warning).
 Kinds: ``obligation``, ``guarantee`` (one no obligation covers),
 ``side-condition``, ``health``, ``requirement`` (by verdict), ``deadline``
 (by verdict), ``lint`` (by its severity word), ``acknowledgement`` (a plan
-entry answering a warning: ``stale`` is a warning, ``error`` an error).
+entry answering a warning: ``stale`` is a warning, ``error`` an error),
+``near-miss`` (a guarantee held by less than the plan's ``near_miss``
+threshold, report/near_misses.py: a warning; the plan asked to be told).
 
 A health or lint warning that a plan acknowledgement answers
 (model/plan/acknowledged.py) keeps its severity in every output (SARIF marks it
@@ -96,8 +98,8 @@ def junit_outcome(kind: str, status: str) -> str:
 def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
     """Every finding of ``report`` as ``(kind, id, status, severity)``, in
     the report's order (obligations, guarantees no obligation covers, side
-    conditions, health checks, requirements, deadlines, lint); items that
-    hold are left out."""
+    conditions, health checks, requirements, deadlines, lint,
+    acknowledgements, near misses); items that hold are left out."""
     out: list[tuple[str, str, str, str]] = []
 
     def add(kind: str, ident: str, status: str) -> None:
@@ -121,6 +123,8 @@ def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
         add("lint", f"{x['location']}:{x.get('code', '')}", str(x["severity"]))
     for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (model/plan/acknowledged.py)
         add("acknowledgement", f"{a['at']}:{a['warning']}", str(a["status"]))
+    for n in report.get("near_misses") or ():  # held by less than the plan's threshold (report/near_misses.py)
+        add("near-miss", f"{n['obligation']}:g{n['guarantee']}:{n['kind']}", "warning")
     return out
 
 

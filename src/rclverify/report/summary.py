@@ -243,6 +243,8 @@ def strict_reasons(report: Report) -> list[str]:
         out.append(f"{g['error']} ROS grounding error{'s' if g['error'] != 1 else ''} (`rclverify ros check`)")
     from rclverify.report.nodl import strict_reason as nodl_reason  # deferred: start-up (loads rclverify.report.nodl only when --strict failed)
     out += nodl_reason(report)  # NoDL errors, a stale NoDL check
+    from rclverify.report.near_misses import strict_reason as near_reason  # deferred: start-up (only when --strict failed)
+    out += near_reason(report)  # guarantees held by less than the plan's near_miss threshold
     return out
 
 
