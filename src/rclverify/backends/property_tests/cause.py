@@ -1,8 +1,10 @@
-"""The implementation line a failing example takes.
+"""The implementation line that computed a failing example's output.
 
 A property-test failure is the implementation's, not the contract's: the
 place to look is the line of the implementation that produced the wrong
-output (the branch taken), not the guarantee it violates.  The failing
+output, not the guarantee it violates.  The line with the slip
+(:mod:`.slips`) is named first; this module's line is named when no
+one-token correction makes the example meet the guarantee.  The failing
 example is run once more under :func:`sys.settrace`, tracing only the
 frames of the implementation's own file.  The cause is the statement that
 computed the value returned: the tracer follows the entry
