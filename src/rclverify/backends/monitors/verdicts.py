@@ -6,6 +6,7 @@ evidence builder read them without the engine; docs/monitors.md,
 """
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import math
 from dataclasses import dataclass, field
@@ -123,6 +124,12 @@ class GuaranteeMargin:
     def keep(self, values: Any) -> None:
         """Keep the smallest of ``lowest`` and ``values`` (floats), at most :data:`KEPT_MARGINS`."""
         low = self.lowest
+        if len(values) == 1:  # the engine's one answer at a time: an insertion, not a sort
+            v = values[0]
+            if len(low) < KEPT_MARGINS or v < low[-1]:
+                bisect.insort(low, v)
+                del low[KEPT_MARGINS:]
+            return
         if len(low) >= KEPT_MARGINS and not any(v < low[-1] for v in values):
             return
         self.lowest = sorted([*low, *values])[:KEPT_MARGINS]
