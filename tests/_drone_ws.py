@@ -35,7 +35,7 @@ def verify(root: Path) -> tuple[Workspace, dict[str, Any]]:
         stage_compose(ws, n)
         stage_health(ws, n)
         for o in stage_export(ws, n):
-            stage_run(ws, n, o["id"])
+            stage_run(ws, n, o.id)
     stage_requirements(ws)
     report, _ = stage_report(ws)
     return ws, report

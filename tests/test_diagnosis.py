@@ -36,7 +36,7 @@ def _run(root: Path) -> tuple[Workspace, dict[str, Any]]:
         stage_compose(ws, n)
         stage_health(ws, n)
         for o in stage_export(ws, n):
-            stage_run(ws, n, o["id"])
+            stage_run(ws, n, o.id)
     return ws, diagnosed(ws)
 
 

@@ -33,7 +33,7 @@ def ws(tmp_path: Path) -> Workspace:
 def run_navigation(ws: Workspace) -> dict[str, object]:
     stage_check(ws)
     obligations = stage_export(ws, "Navigation")
-    return {o["id"]: stage_run(ws, "Navigation", o["id"]) for o in obligations}
+    return {o.id: stage_run(ws, "Navigation", o.id) for o in obligations}
 
 
 def test_quantities_are_exact_in_base_units() -> None:

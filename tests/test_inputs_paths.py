@@ -149,7 +149,7 @@ def test_a_tool_named_by_a_command_not_on_path_stays_pending(tmp_path: Path) -> 
     impl.write_text("// the implementation would refine the generated contract module\n", encoding="utf-8")
     w = Workspace(ws)
     stage_check(w)
-    ids = [o["id"] for o in stage_export(w, "Sensor")]
+    ids = [o.id for o in stage_export(w, "Sensor")]
     ev = stage_run(w, "Sensor", ids[0])
     assert ev.status == "pending" and "no 'no-such-dafny-here' on PATH" in ev.explanation
 

@@ -29,7 +29,7 @@ def ws(tmp_path: Path) -> Workspace:
 
 def run(ws: Workspace):  # type: ignore[no-untyped-def]
     stage_check(ws)
-    ids = [o["id"] for o in stage_export(ws, "Localisation")]
+    ids = [o.id for o in stage_export(ws, "Localisation")]
     assert ids == [OID]
     return stage_run(ws, "Localisation", OID)
 

@@ -306,7 +306,7 @@ def _start_run(tmp_path: Path) -> tuple[subprocess.Popen[str], Path, Path, str]:
     root = tmp_path / "ws"
     workspace(root)
     ws = pipeline.Workspace(root)
-    oid = next(o["id"] for o in pipeline.stage_export(ws, "Agent") if o["guarantee"] == 2)
+    oid = next(o.id for o in pipeline.stage_export(ws, "Agent") if o.guarantee == 2)
     cache = tmp_path / "cache"
     (tmp_path / "tmp").mkdir()  # the run's $TMPDIR: what a killed compiler would leave there
     env = {**os.environ, "XDG_CACHE_HOME": str(cache), "PYTHONPATH": str(REPO / "src"),

@@ -5,10 +5,11 @@ inputs, the robot's code): check, compose, health, export per node, deadlines, r
 solver, the ROS grounding and the diagnosis; the deadlines on a copy of examples/safety_stop (the rover has none).  Each record a stage returned, and each record it sealed on disk, is walked
 against its TypedDict: no key the type does not declare, every required key present, each value of its
 JSON type (nested TypedDicts, lists, dicts and unions walked).  A contract-health finding is no TypedDict
-but its one definition, records/findings.py: the stage returns instances of it and its sealed record
-decodes into them.
+but its one definition, records/findings.py, and an obligation records/records.py ``Obligation``: the
+stages return instances of them and their sealed records decode into them.
 """
 # No ``from __future__ import annotations``: the test's own TypedDicts need ``NotRequired`` evaluated.
+import dataclasses
 import shutil
 import types
 import typing
@@ -20,6 +21,7 @@ import pytest
 
 from rclverify.records import stage_records as sr
 from rclverify.records.findings import HealthFinding
+from rclverify.records.records import Obligation
 from rclverify.records.sealed import read_sealed
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -143,7 +145,7 @@ def test_the_returned_records_are_their_types(run: tuple[Path, dict[str, Any]]) 
     for n in out["compose"]:
         _check(out["compose"][n], sr.CompositionRecord, f"compose[{n}]")
         assert out["health"][n] and all(type(f) is HealthFinding for f in out["health"][n]), n
-        _check(out["export"][n], list[sr.ObligationRecord], f"export[{n}]")
+        assert out["export"][n] and all(type(o) is Obligation for o in out["export"][n]), n
     _check(out["deadlines"], list[sr.DeadlineRecord], "deadlines")
     _check(out["requirements"], list[sr.RequirementRecord], "requirements")
     _check(out["crosscheck"], sr.CrosscheckRecord, "crosscheck")
@@ -163,8 +165,10 @@ def test_the_sealed_records_are_their_types(run: tuple[Path, dict[str, Any]]) ->
         assert set(health) == {"node", "findings"} and health["node"] == n
         # the one definition decodes the record (an undeclared key or a value of another type is refused)
         assert msgspec.convert(health["findings"], list[HealthFinding]) == out["health"][n], W.health(n)
-        for o in out["export"][n]:
-            _check(_sealed(root, W.obligation(n, o["id"])), sr.ObligationRecord, W.obligation(n, o["id"]))
+        for o in out["export"][n]:  # its one definition: exactly its fields, decoding into the obligation exported
+            rec = _sealed(root, W.obligation(n, o.id))
+            assert set(rec) - {"record_sha256"} == {f.name for f in dataclasses.fields(Obligation)}, o.id
+            assert Obligation.from_json(rec) == o, o.id
     deadlines = _sealed(root, "artifacts/deadlines/index.json")
     assert set(deadlines) == {"results"}
     _check(deadlines["results"], list[sr.DeadlineRecord], "artifacts/deadlines/index.json")

@@ -246,7 +246,7 @@ def planner(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
     w = Workspace(root)
     stage_check(w)
     for o in stage_export(w, "Planner"):
-        stage_run(w, "Planner", o["id"])
+        stage_run(w, "Planner", o.id)
     import contextlib
     import io
     buf = io.StringIO()

@@ -51,7 +51,7 @@ if TYPE_CHECKING:
     from rclverify.model.plan.model import EvidenceEntry
     from rclverify.records.report_schema import Report
     from rclverify.records.stage_records import (CheckRecord, CompositionRecord, DeadlineRecord, DiagnosisRecord,
-                                                 ObligationRecord, RequirementRecord)
+                                                 RequirementRecord)
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached
@@ -218,8 +218,9 @@ def replacement_finding(ws: Workspace, node: str) -> Finding:
                                                            instances=ws.plan.instances.get(node)))
 
 
-def stage_export(ws: Workspace, node: str) -> list[ObligationRecord]:
-    """Export ``node``'s obligations for every evidence entry of the plan.
+def stage_export(ws: Workspace, node: str) -> list[Obligation]:
+    """Export ``node``'s obligations for every evidence entry of the plan;
+    returns them as sealed (records/records.py ``Obligation``).
 
     The export starts a fresh Z3 context (semantics/world.py) unless every
     entry's backend says its export reads no Z3 state (``export_reads_z3_state
@@ -259,7 +260,7 @@ def stage_export(ws: Workspace, node: str) -> list[ObligationRecord]:
     for old in ws.path(f"artifacts/obligations/{node}").glob("*.json"):
         if old.name not in keep:
             old.unlink()
-    return [o.to_json() for o in obligations]
+    return obligations
 
 
 def ast_loc(rel: str) -> Any:

@@ -95,7 +95,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     stage_check(ws)
     for n in ws.node_names():
         for o in stage_export(ws, n):
-            print(f"{o['id']}  [{o['backend']}]  {o['artifact'] or ''}")
+            print(f"{o.id}  [{o.backend}]  {o.artifact or ''}")
     return 0
 
 

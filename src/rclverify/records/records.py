@@ -29,9 +29,10 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
+import msgspec
+
 #: Severity order used by every roll-up; larger is worse (defined with the vocabulary).
 from rclverify.records.statuses import RECORD_STATUSES, SEVERITY as SEVERITY
-from rclverify.records.stage_records import ObligationRecord
 
 #: Roll-up status for a parent with no evidence at all.
 MISSING = "pending"
@@ -77,7 +78,13 @@ class SourceRef:
 
 @dataclass(frozen=True)
 class Obligation:
-    """A proof obligation exported to a backend.
+    """A proof obligation exported to a backend: the one definition of an
+    exported obligation's record (``artifacts/obligations/``), written by
+    :meth:`to_json` and read by :meth:`from_json` through msgspec.  A frozen
+    dataclass rather than a ``msgspec.Struct``: backends derive obligations
+    with :func:`dataclasses.replace`, and the kept caches' safe loader admits
+    dataclasses (core/cache/safeload.py); msgspec encodes and decodes it all
+    the same.
 
     ``id``           stable id (see :func:`make_obligation_id`);
     ``node``         the node name; ``guarantee`` the 1-based guarantee index;
@@ -105,23 +112,27 @@ class Obligation:
     inputs: tuple[str, ...] = ()
     data: Mapping[str, Any] = field(default_factory=dict)
 
-    def to_json(self) -> ObligationRecord:
-        # dataclasses.asdict's mapping without its deep copy of ``data``, which the shallow copy replaced
-        # (a fifth of writing a 1000-node system's obligations); the fields in their order, as asdict gives
-        return {"id": self.id, "node": self.node, "guarantee": self.guarantee, "backend": self.backend,
-                "kind": self.kind, "statement": self.statement,
-                "source": {"file": self.source.file, "line": self.source.line, "col": self.source.col},
-                "instance": self.instance, "artifact": self.artifact, "inputs": list(self.inputs),
-                "data": dict(self.data)}
+    def to_json(self) -> dict[str, Any]:
+        """The obligation as its JSON object: msgspec's encoding of this
+        class, every field (``inputs`` a list, ``data`` a plain object), so
+        a field added here is in every record written."""
+        out: dict[str, Any] = msgspec.to_builtins(self, enc_hook=_plain)
+        out["inputs"] = list(self.inputs)
+        return out
 
     @staticmethod
     def from_json(d: Mapping[str, Any]) -> "Obligation":
-        return Obligation(
-            id=d["id"], node=d["node"], guarantee=int(d["guarantee"]), backend=d["backend"],
-            kind=d["kind"], statement=d["statement"], source=SourceRef(**d["source"]),
-            instance=d.get("instance", ""), artifact=d.get("artifact", ""),
-            inputs=tuple(d.get("inputs", ())), data=dict(d.get("data", {})),
-        )
+        """The obligation of its JSON object ``d``, decoded into this class
+        by msgspec.  Raises :class:`msgspec.ValidationError` (a
+        ``ValueError``) for a missing field or a value of another type."""
+        return msgspec.convert(d, Obligation)
+
+
+def _plain(x: object) -> object:
+    """A mapping other than a dict (an obligation's ``data`` may be one) as a dict, for msgspec's encoder."""
+    if isinstance(x, Mapping):
+        return dict(x)
+    raise NotImplementedError(f"cannot encode {type(x).__name__}")
 
 
 @dataclass(frozen=True)

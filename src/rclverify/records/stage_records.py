@@ -17,7 +17,8 @@ Producers: ``check`` app/pipeline.py ``stage_check``; ``compose``
 calculus/compose.py ``composition_json`` and calculus/side_condition.py;
 ``health`` app/pipeline.py ``stage_health`` (its findings are
 :class:`rclverify.records.findings.HealthFinding`, defined there once); ``export``
-records/records.py ``Obligation.to_json``; ``deadlines``
+app/pipeline.py ``stage_export`` (an obligation is records/records.py
+``Obligation``, defined there once); ``deadlines``
 calculus/deadlines.py ``DeadlineResult.to_json`` with stages/deadlines.py;
 ``requirements`` calculus/requirements/check.py, temporal_check.py and
 stages/requirements.py; ``crosscheck`` stages/crosscheck/stage.py;
@@ -135,21 +136,6 @@ class SourceRef(TypedDict):
     file: str
     line: int
     col: int
-
-
-class ObligationRecord(TypedDict):
-    """One exported obligation (records/records.py ``Obligation``); ``data`` is its backend's."""
-    id: str
-    node: str
-    guarantee: int
-    backend: str
-    kind: str
-    statement: str
-    source: SourceRef
-    instance: str
-    artifact: str
-    inputs: list[str]
-    data: dict[str, Any]
 
 
 class DeadlineHop(TypedDict):
@@ -511,4 +497,4 @@ class NodlRecord(TypedDict):
 
 
 __all__ = ["CheckRecord", "CompositionRecord", "CrosscheckRecord", "DeadlineRecord", "DiagnosisRecord", "GroundingRecord",
-           "NodlRecord", "ObligationRecord", "RequirementRecord"]
+           "NodlRecord", "RequirementRecord"]

@@ -81,10 +81,14 @@ def node_obligations(ws: Workspace, node: str) -> tuple[list[Obligation], str]:
     obligation removed by hand is never believed)."""
     rel = ws.obligations(node)
     records, problem = obligation_list(ws.path(rel))
+    try:
+        obligations = [Obligation.from_json(d) for d in records or []]
+    except msgspec.ValidationError as e:  # sealed, but not an obligation: altered and sealed again by hand
+        problem = problem or f"obligation list malformed ({e}): altered outside rclverify"
     if problem:
         return [Obligation(id=f"{node}.obligations", node=node, guarantee=0, backend="record", kind="proof",
                            statement=f"error: {rel}: {problem}", source=SourceRef(rel, 1, 1))], f"{rel}: {problem}"
-    return [Obligation.from_json(d) for d in records or []], ""
+    return obligations, ""
 
 
 def diagnostics(ws: Workspace) -> list[LintWarning]:
