@@ -75,7 +75,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         def export() -> int:
             for node in nodes:
-                hoare.extend((node, o["id"]) for o in stage_export(ws, node) if o["backend"] == "hoare")
+                hoare.extend((node, o.id) for o in stage_export(ws, node) if o.backend == "hoare")
             return len(nodes)
 
         def run() -> int:
