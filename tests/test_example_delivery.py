@@ -177,7 +177,7 @@ def test_each_defect_is_one_row_with_the_right_culprit(runs: dict[str, Any]) -> 
     assert not {"Localiser", "LockerController"} & blamed  # victims only
     # (e) the property test: the implementation's line with the slip (`clearance < SLOW_ZONE`), the boundary first
     slow = ROWS["05-slow-zone.diff"]
-    assert "the implementation line that computed the failing output is nodes/speed_governor.py:16" in rows[slow]["sentence"]
+    assert "the implementation line where the failing example goes wrong is nodes/speed_governor.py:16" in rows[slow]["sentence"]
     ev = next(e for e in report["evidence"] if e["obligation"] == "SpeedGovernor.g2.property_tests.e0")
     cex = ev["counterexample"]
     assert (cex["cause"], cex["boundary"], cex["in.clearance"]) == ("nodes/speed_governor.py:16", "in.clearance", "2.0")

@@ -387,7 +387,7 @@ def _evidence(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow | No
             computed = _computed_line(report, node, gk, h.file)
             if computed:
                 sentence = sentence[:-1] + f"; the value it published is computed at {computed} (the property test)."
-                cul.insert(0, {"what": f"{computed}: the line that computed the failing output (property test)",
+                cul.insert(0, {"what": f"{computed}: the line where the failing output goes wrong (property test)",
                                "source": computed, "text": ""})
         return _record(e["obligation"], "monitor", node, e["status"], sentence, culprits=cul,
                        counterexample=counterexample_table(fv.get("values"), node), guarantee=gk)
@@ -397,7 +397,7 @@ def _evidence(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow | No
         impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
         cause = ce.get("cause")  # the implementation line the example takes
         sentence = (f"Hypothesis found inputs on which {impl} "
-                    f"violates {where}" + (f"; the implementation line that computed the failing output is {cause}"
+                    f"violates {where}" + (f"; the implementation line where the failing example goes wrong is {cause}"
                                            if cause else "") + f"; replay: `{ce.get('replay', '')}`.")
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
                        culprits=[{"what": where, "source": src, "text": text}],
