@@ -67,7 +67,7 @@ SECONDS: dict[str, float] = {
     "test_generate_names": 8.6, "test_stage_records": 8.1, "test_temporal_semantics_oracle": 8.0,
     "test_solver_session": 8.0, "test_one_evaluator": 8.0, "test_generate_ros2": 7.1,
     "test_spin_no_wrong_green": 7.0, "test_spin": 7.0, "test_temporal_pdr": 6.8, "test_ros2_types_record": 6.7,
-    "test_dafny": 6.7, "test_calculus_summary": 6.6, "test_summary_incremental": 6.4,
+    "test_dafny": 9.0, "test_calculus_summary": 6.6, "test_summary_incremental": 6.4,
     "test_temporal_progress": 6.1, "test_response_pattern": 6.1, "test_property_tests": 6.0,
     "test_spin_oracle": 5.6, "test_generate_cpp": 5.5, "test_browser_report": 5.4, "test_cluster": 5.4,
     "test_cache_poison": 5.2, "test_hardening_misc": 5.2, "test_health": 5.2, "test_temporal_oracle": 5.1,
