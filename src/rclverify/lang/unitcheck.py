@@ -110,8 +110,8 @@ def _angle_hint(a: Unit, b: Unit) -> str:
     per = "1 [1/rad]" if abs(d) == 1 else f"1 [rad^-{abs(d)}]"
     return (f"; they differ only by angle ({more} has {power} more): angle is a base dimension in RCL, "
             f"not dimensionless, so a radius that turns an angle into a length is in [m/rad] (length per "
-            f"radian turned); declare that quantity per radian, or multiply {more} by {per} to say "
-            f"that the radian is meant")
+            f"radian turned); declare that quantity per radian, or, in a formula, multiply {more} by {per} "
+            f"to say that the radian is meant")
 
 
 def mismatch(a: Unit, b: Unit) -> tuple[str, str] | None:
