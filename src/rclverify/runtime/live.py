@@ -26,7 +26,7 @@ ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
   record each guarantee's smallest; with ``warn_margin`` (which implies
   ``margins``) ``warn`` gets one line whenever a satisfied answer sets a
   guarantee's new smallest margin below it, before any violation
-  (:meth:`LiveRun._warn_low`);
+  (:class:`.live_status.LowMargins`);
 * on :meth:`stop` writes a monitoring evidence record shaped like the
   offline one (events, verdict counts, first violation, the log's sha256,
   the deadlines as ``topic_deadlines``, the periods as ``periods``).
@@ -53,12 +53,12 @@ from rclverify.backends.monitors.check import NodeResult, Verdict
 from rclverify.backends.monitors.deadlines import DeadlineVerdict
 from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
 from rclverify.backends.monitors.run_origin import unseen_links
+from rclverify.runtime.live_status import LowMargins, least_margins, running_bound
 from rclverify.runtime.logchecks import LogChecks
 from rclverify.runtime.shapes import LiveCounts, SilenceNote
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.runtime.worker import EngineWorker
 import warnings
-from rclverify.records.statistics import trivial_or_exact
 from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
 
 VERDICT_LOG_TOPIC = "rclverify/verdict"
@@ -109,10 +109,8 @@ class LiveRun:
         self.nodes = nodes
         self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
                                    on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
-        #: margins (module docstring): computed when asked for or warned about; warn below ``warn_margin``
-        self.warn_margin, self.warn = warn_margin, warn
-        self._warned: dict[tuple[str, int], float] = {}
-        self._by_node = {m.node.name: m for m in self.engine.monitors}
+        #: margins (module docstring): computed when asked for or warned about; warned below ``warn_margin``
+        self.low = None if warn_margin is None else LowMargins(self.engine.monitors, warn_margin, warn)
         for m in self.engine.monitors:
             m.margins = margins or warn_margin is not None
         #: the offline check's deadline and period monitors, fed the log's lines (logchecks.py)
@@ -145,27 +143,8 @@ class LiveRun:
         if self.publish is not None:
             self.publish(text)
         self._last[v.node] = text
-        if self.warn_margin is not None and v.verdict == "satisfied" and v.margin is not None \
-                and v.margin < self.warn_margin:
-            self._warn_low(v)
-
-    def _warn_low(self, v: Verdict) -> None:
-        """Warn (one line each) of every guarantee whose smallest margin this
-        satisfied answer ``v`` has just lowered below :attr:`warn_margin`
-        (a new smallest only: a guarantee hovering low is not repeated)."""
-        limit = self.warn_margin
-        mon = self._by_node.get(v.node)
-        if mon is None or limit is None:
-            return
-        for k, gm in sorted(mon.result.margins.items()):
-            if gm.event != v.event or not math.isfinite(gm.value) or gm.value >= limit \
-                    or gm.value >= self._warned.get((v.node, k), math.inf):
-                continue
-            self._warned[(v.node, k)] = gm.value
-            unit = f" {gm.unit}" if gm.unit else ""
-            if self.warn is not None:
-                self.warn(f"rclverify monitor: warning: {v.node} guarantee {k} held with margin {gm.value:g}{unit} "
-                          f"({gm.atom}), below --warn-margin {limit:g}, at t = {v.time:.6f} s ({v.where})")
+        if self.low is not None:
+            self.low.heard(v)
 
     def _silence(self, topic: str, seconds: float, silent: bool) -> None:
         note: SilenceNote = {"topic": topic, "silent": silent, "for_s": round(seconds, 3),
@@ -293,28 +272,6 @@ class LiveRun:
         for entry in record["nodes"]:  # a pending node says why itself
             explain(entry, items)
         return items
-
-
-def running_bound(res: NodeResult) -> str:
-    """``; 40 answer(s) counted, 95 % bound 0.0722 per answer``: the one-sided
-    Clopper-Pearson bound on the probability that an answer violates the
-    contract, from the counts so far (undecided answers count as
-    violations; docs/statistics.md); ``""`` before the first answer."""
-    c = res.counts
-    n = c.get("satisfied", 0) + c.get("violated", 0) + c.get("inconclusive", 0)
-    if not n:
-        return ""
-    bound, why = trivial_or_exact(n - c.get('satisfied', 0), n, 0.95)
-    return f"; {n} answer(s) counted, 95 % bound {bound:.3g} per answer" + (f" ({why})" if why else "")
-
-
-def least_margins(res: NodeResult) -> str:
-    """``; least margin g1 0.04 m, g2 0.5``: each guarantee's smallest space
-    margin so far (docs/semantics.md, "Margins"), ``""`` without margins or
-    before the first; an infinite one (no distance) is left out."""
-    shown = [f"g{k} {m.value:g}" + (f" {m.unit}" if m.unit else "") for k, m in sorted(res.margins.items())
-             if m.answers and math.isfinite(m.value)]
-    return f"; least margin {', '.join(shown)}" if shown else ""
 
 
 def live_counts(res: NodeResult, sha: str, seconds: float) -> LiveCounts:
