@@ -156,3 +156,42 @@ def test_a_parameters_declared_constraints_ensure_an_environment_assumption(tmp_
     assert "limit = 9/5" in f["message"] or "limit = 1.8" in f["message"], f["message"]
     md = (ws / "reports" / "assurance.md").read_text(encoding="utf-8")
     assert md.count("ensured by NoDL parameter `limit`") == 1 and not report["meta"]["strict_ok"]
+
+
+def test_the_terminal_summary_lists_each_nodl_error_at_its_lines(runs: dict[str, Any],
+                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    """What ``verify`` ends with (read back from the last run's summary, as ``rclverify explain`` prints
+    it) counts the seeded NoDL error on the overall line and lists it at both documents' lines; the
+    clean run's summary has no NoDL line (the control)."""
+    from rclverify.report.summary import print_last_run, status_text, summary_data
+    ws = runs["ws"]
+    print_last_run(ws)
+    out = capsys.readouterr().out
+    sub = _line_of(ws / "nodl" / "ChargeMonitor.nodl.yaml", "reliability:", 2)
+    pub = _line_of(ws / "nodl" / "Battery.nodl.yaml", "reliability: BEST_EFFORT")
+    assert out.splitlines()[0].endswith("; 1 NoDL error."), out
+    [line] = [t for t in out.splitlines() if "[nodl-qos]" in t]
+    assert line.lstrip().startswith(f"nodl/ChargeMonitor.nodl.yaml:{sub}:") and f"nodl/Battery.nodl.yaml:{pub}:" in line
+    assert "1 NoDL error: " in out
+    clean = "\n".join(status_text(summary_data(runs["clean"])))
+    assert "NoDL" not in clean and "nodl-" not in clean
+
+
+def test_junit_has_a_nodl_suite_with_a_failing_case_per_error(runs: dict[str, Any]) -> None:
+    """reports/assurance.junit.xml of the seeded run: a ``nodl`` suite, its one failing case at the
+    reader's document line; the clean report's suite is one passing case (the control)."""
+    import xml.etree.ElementTree as ET
+    from rclverify.report.junit import junit_tree
+    ws = runs["ws"]
+    root = ET.parse(ws / "reports" / "assurance.junit.xml").getroot()
+    [suite] = [s for s in root.iter("testsuite") if s.get("name") == "nodl"]
+    [case] = list(suite.iter("testcase"))
+    failure = case.find("failure")
+    assert failure is not None and "[nodl-qos]" in str(failure.get("message"))
+    assert (case.get("file"), case.get("line")) == (
+        "nodl/ChargeMonitor.nodl.yaml", str(_line_of(ws / "nodl" / "ChargeMonitor.nodl.yaml", "reliability:", 2)))
+    assert "nodl/Battery.nodl.yaml:" in str(failure.text)
+    assert (suite.get("tests"), suite.get("failures")) == ("1", "1")
+    [clean] = [s for s in junit_tree(runs["clean"]).iter("testsuite") if s.get("name") == "nodl"]
+    assert (clean.get("tests"), clean.get("failures"), clean.get("errors")) == ("1", "0", "0")
+    assert [c.find("failure") for c in clean.iter("testcase")] == [None]

@@ -35,7 +35,11 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
 * when the contracts have lint diagnostics, a ``lint`` ``<testsuite>`` with
   one failing ``<testcase>`` per diagnostic (:func:`_lint_suite`);
 * when the runs nearly missed a guarantee, a ``near_misses`` ``<testsuite>``
-  with one failing ``<testcase>`` per near miss (:func:`.near_misses.junit_suite`).
+  with one failing ``<testcase>`` per near miss (:func:`.near_misses.junit_suite`);
+* when the workspace has NoDL documents, a ``nodl`` ``<testsuite>`` with one
+  failing ``<testcase>`` per NoDL error, or one passing case for a check
+  without one (:func:`.nodl.junit_suite`; docs/nodl.md).  The ROS grounding
+  has no suite: its errors are in the terminal summary, the report and SARIF.
 
 Every outcome is the item's one severity (:mod:`.severity`, docs/ci.md):
 an ``error`` is a ``<failure>`` (``<error>`` for a record not believed), a
@@ -126,8 +130,9 @@ def junit_tree(report: Report) -> ET.Element:
         total_time += time
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
+    from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
     for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report),
-                near_misses_suite(report, _case, _outcome)):
+                near_misses_suite(report, _case, _outcome), nodl_suite(report, _case, _outcome)):
         if req is None:
             continue
         root.append(req[0])
@@ -330,8 +335,9 @@ def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
         total_time += piece["time"]
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
+    from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
     for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report),
-                near_misses_suite(report, _case, _outcome)):
+                near_misses_suite(report, _case, _outcome), nodl_suite(report, _case, _outcome)):
         if req is None:
             continue
         ET.indent(req[0], level=1)

@@ -33,6 +33,7 @@ SUMMARY_SHAPE: dict[str, Any] = {
     "deadlines?": [list],
     "problems?": [{"status": str, "sentence": str, "culprits": [str], "members": [str], "repairs": _NUM}],
     "grounding?": (dict, type(None)),
+    "nodl?": (dict, type(None)),
     "strict?": [str],
     "near_misses?": [str],
 }
@@ -47,6 +48,7 @@ SUMMARY_SOURCE_SHAPE: dict[str, Any] = {
     "requirements?": [{"id": str, "status": str}],
     "problems?": [dict],
     "grounding?": (dict, type(None)),
+    "nodl?": (dict, type(None)),
 }
 
 _ITEM = {"id": str, "status": str, "node": str}

@@ -16,10 +16,12 @@ locations, so a code-scanning view marks both files' lines.
 """
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, cast
 
 from rclverify.records.report_schema import NodlRow, Report
 from rclverify.records.sarif import SarifLocation, SarifResult
+from rclverify.report.shapes import GroundingBrief
 from rclverify.stages.workspace import Workspace
 
 #: SARIF rule of every NoDL finding: ``(id, name, level, text)`` (report/sarif.py ``Rule``).
@@ -83,6 +85,70 @@ def strict_reason(report: Report) -> list[str]:
     return out + (["the NoDL check is stale"] if row.get("stale") else [])
 
 
+def terminal_brief(row: Mapping[str, Any] | None) -> GroundingBrief | None:
+    """The NoDL check as the summary ``verify`` prints shows it, in the shape of the ROS grounding's
+    (report/summary.py): ``{"error": n, "warning": m, "errors": ["file:line:col: message [code]
+    (also at file:line:col, ...)", ...]}``, a stale record one more line; ``None`` for a workspace
+    without a document."""
+    if row is None:
+        return None
+    errors: list[str] = []
+    for f in row["findings"]:
+        if f["severity"] == "error":
+            places = [_where(p) for p in f["places"]]
+            also = f" (also at {', '.join(places[1:])})" if len(places) > 1 else ""
+            errors.append(f"{places[0] + ': ' if places else ''}{f['message']} [{f['code']}]{also}")
+    if row.get("stale"):
+        errors.append(f"the NoDL check is stale: {row['stale']}")
+    return {"error": int(row["counts"].get("error", 0)), "warning": int(row["counts"].get("warning", 0)),
+            "errors": errors}
+
+
+def junit_suite(report: Report, case: Callable[..., ET.Element],
+                outcome: Callable[..., str]) -> tuple[ET.Element, dict[str, int], float] | None:
+    """The ``nodl`` ``<testsuite>`` (docs/nodl.md, "In doit verify's report"): one failing
+    ``<testcase>`` per NoDL error (``classname`` ``nodl``, name its code and first place, at that
+    place, the other places in the failure's text; the record not believed, ``nodl-record``, an
+    ``<error>``), one failing ``stale`` case for a record made from other files; a check with
+    neither is one passing case, its warnings (which do not fail ``--strict``) in its
+    ``<system-out>``.  ``case`` and ``outcome`` are report/junit.py's.  ``None`` for a workspace
+    without a document."""
+    row = report.get("nodl")
+    if row is None:
+        return None
+    suite = ET.Element("testsuite", {"name": "nodl"})
+    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+
+    def add(c: ET.Element, status: str, summary: str, detail: str) -> None:
+        counts["tests"] += 1
+        bumped = outcome(c, status, summary, detail, "nodl")
+        if bumped:
+            counts[bumped] += 1
+    for f in row["findings"]:
+        if f["severity"] != "error":
+            continue
+        places = [_where(p) for p in f["places"]]
+        first = places[0] if places else ""
+        add(case(suite, "nodl", f"{f['code']} {first}".strip(), first, 0.0),
+            "error" if f["code"] == "nodl-record" else "failed", f"{f['message']} [{f['code']}]",
+            "\n".join(f"{p}: error: {f['message']}" for p in places))
+    if row.get("stale"):
+        add(case(suite, "nodl", "nodl-stale", "", 0.0), "stale", f"the NoDL check is stale: {row['stale']}",
+            "`doit verify` checks the current documents")
+    if not counts["tests"]:
+        n = len(row["documents"])
+        c = case(suite, "nodl", f"nodl check of {n} document{'s' if n != 1 else ''}", "", 0.0)
+        add(c, "ok", "", "")
+        warned = [f"{_where(f['places'][0]) + ': ' if f['places'] else ''}warning: {f['message']} [{f['code']}]"
+                  for f in row["findings"] if f["severity"] == "warning"]
+        if warned:
+            ET.SubElement(c, "system-out").text = "\n".join(warned)
+    for k, v in counts.items():
+        suite.set(k, str(v))
+    suite.set("time", "0.000")
+    return suite, counts, 0.0
+
+
 def sarif_results(report: Report, result: Callable[..., SarifResult],
                   location: Callable[[str], list[SarifLocation]]) -> list[SarifResult]:
     """One SARIF result per NoDL finding, at its first place, the others as related locations;
@@ -105,4 +171,5 @@ def sarif_results(report: Report, result: Callable[..., SarifResult],
     return out
 
 
-__all__ = ["SARIF_RULES", "blocks_strict", "nodl_inputs", "nodl_problems", "nodl_row", "sarif_results", "strict_reason"]
+__all__ = ["SARIF_RULES", "blocks_strict", "junit_suite", "nodl_inputs", "nodl_problems", "nodl_row", "sarif_results",
+           "strict_reason", "terminal_brief"]

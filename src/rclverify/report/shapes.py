@@ -74,6 +74,8 @@ class SummaryData(TypedDict):
     deadlines: list[list[str]]
     problems: list[ProblemBrief]
     grounding: GroundingBrief | None
+    #: the NoDL check in the grounding's shape (report/nodl.py ``terminal_brief``); absent in an older summary
+    nodl: NotRequired[GroundingBrief | None]
     strict: list[str]
     acknowledged: list[str]
     #: the near misses, one line each after a heading (report/near_misses.py ``summary_lines``)

@@ -145,7 +145,7 @@ def summary_data(report: Report) -> SummaryData:
                                                  if m.get("consequence_of") else "") for m in g.get("members", [])],
                           "repairs": len(g.get("repairs", []))}
                          for g in report.get("problems", ())],
-            "grounding": _grounding(report.get("grounding")), "strict": strict_reasons(report),
+            "grounding": _grounding(report.get("grounding")), "nodl": _nodl(report), "strict": strict_reasons(report),
             # warnings answered in the plan (model/plan/acknowledged.py): named, so an accepted risk is never silent
             "acknowledged": [f"{m} ({a['at']}: {a['reason']})" for a in report.get("acknowledgements") or ()
                              if a.get("status") == "ok" for m in a.get("matched") or ()],
@@ -186,6 +186,15 @@ def _grounding(g: object) -> GroundingBrief | None:
             errors.append(f"{where}{f.get('message', '')} ({f.get('code', '')})")
     counts = g.get("counts", {})
     return {"error": int(counts.get("error", len(errors))), "warning": int(counts.get("warning", 0)), "errors": errors}
+
+
+def _nodl(report: Report) -> GroundingBrief | None:
+    """The NoDL check as the terminal shows it (:func:`rclverify.report.nodl.terminal_brief`)."""
+    row = report.get("nodl")
+    if row is None:
+        return None
+    from rclverify.report.nodl import terminal_brief  # deferred: start-up (loads rclverify.report.nodl only when NoDL documents were checked)
+    return terminal_brief(row)
 
 
 def strict_reasons(report: Report) -> list[str]:
@@ -260,14 +269,18 @@ def strict_sentence(data: SummaryData) -> str:
 def status_text(data: SummaryData) -> list[str]:
     """The overall line and the problems of the summary ``data``
     (:func:`rclverify.report.diagnosis_text.status_lines`), with the ROS grounding
-    errors: counted on the overall line and listed one a line (they change
-    no verdict, docs/ros.md, but fail ``--strict``)."""
+    errors and the NoDL errors (a stale NoDL check too): counted on the overall
+    line and listed one a line, each at its file:line:col (they change no
+    verdict, docs/ros.md, docs/nodl.md, but fail ``--strict``)."""
     from rclverify.report.diagnosis_text import status_lines  # deferred: start-up (loads rclverify.report.diagnosis_text only when called)
-    g = data.get("grounding")
+    g, nd = data.get("grounding"), data.get("nodl")
     errors = int(g.get("error", 0) or 0) if g is not None else 0
-    if errors:  # listed below one a line, not as the report's one summary problem
+    nodl_lines = list(nd.get("errors", [])) if nd is not None else []
+    nodl_errors = int(nd.get("error", 0) or 0) if nd is not None else 0
+    drop = (("Grounding: ",) if errors else ()) + (("NoDL ",) if nodl_lines else ())
+    if drop:  # listed below one a line, not as the report's summary problems
         data = {**data, "summary": {**data["summary"], "problems": [
-            p for p in data["summary"]["problems"] if not str(p).startswith("Grounding: ")]}}
+            p for p in data["summary"]["problems"] if not str(p).startswith(drop)]}}
     lines = status_lines(data)
     if errors:
         plural = "s" if errors != 1 else ""
@@ -275,6 +288,14 @@ def status_text(data: SummaryData) -> list[str]:
         lines.append(f"{errors} ROS grounding error{plural}: the contracts do not match the ROS software "
                      f"(no verdict changes; `--strict` fails; `rclverify ros check`, docs/ros.md):")
         lines += [f"  {e}" for e in (g.get("errors", []) if g is not None else [])]
+    if nodl_lines:
+        plural = "s" if nodl_errors != 1 else ""
+        if nodl_errors:
+            lines[0] = lines[0].rstrip(".") + f"; {nodl_errors} NoDL error{plural}."
+        lines.append(f"{nodl_errors} NoDL error{plural}: the node interface documents disagree with the contracts "
+                     f"or each other (no verdict changes; `--strict` fails; `rclverify nodl check`, docs/nodl.md):"
+                     if nodl_errors else "NoDL (`--strict` fails; `doit verify` checks the current documents):")
+        lines += [f"  {e}" for e in nodl_lines]
     return lines
 
 
