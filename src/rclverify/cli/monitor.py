@@ -249,22 +249,10 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     interfaces = [root / d for d in getattr(args, "interfaces", [])]
     try:
         if ros == "2":
-            from rclverify.runtime.dds.bag import storage_of  # deferred: optional or conditional (inside a block)
-            from rclverify.runtime.dds.live import run_dds  # deferred: optional or conditional (inside a block)
-            msg_dirs = [root / d for d in cfg.msg_dirs]
-            rec = (Path(record), storage_of(Path(record), getattr(args, "record_storage", None))) if record else None
-            bus_factory = _source(args)
-            if bus_factory is False:
+            record_ = _run_ros2(args, factory, checked, nodes, [root / d for d in cfg.msg_dirs], interfaces, common,
+                                extra.get("guarded"), record)
+            if record_ is None:
                 return 2
-            describe = None
-            if bus_factory is not None:  # the rclpy source (partial(RclpyBus, ros2_python)): types its Python knows
-                from functools import partial  # deferred: start-up (only --ros2)
-
-                from rclverify.runtime.rclpy_source.bus import installed_declarations  # deferred: optional or conditional (only --ros2)
-                describe = partial(installed_declarations, bus_factory.args[0])
-            record_ = run_dds(factory, checked, nodes, msg_dirs + interfaces, **common,
-                              enforce=extra.get("guarded"), record=rec, msg_dirs=msg_dirs,
-                              reorder_window=args.reorder_window, bus_factory=bus_factory, describe=describe)
         else:
             proxy = proxy_factory(checked, nodes, getattr(args, "forward", []), interfaces)
             record_ = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
@@ -274,6 +262,27 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         return 1 if isinstance(exc, MissingExtra) else 2  # a missing extra exits 1 (docs/install.md)
     _print_live(log, record_)
     return _live_exit(args, record_)
+
+
+def _run_ros2(args: argparse.Namespace, factory: Any, checked: Any, nodes: Any, msg_dirs: list[Path],
+              interfaces: list[Path], common: dict[str, Any], guarded: Any, record: str | None) -> Any:
+    """Run the live monitor on ROS 2 (``run_dds``) through the source ``--source`` picks, recording to
+    ``record`` (``--record``) when given; returns the run's evidence record, ``None`` after printing why
+    the source cannot be had (exit 2).  Raises what ``run_dds`` and :func:`_source` raise."""
+    from functools import partial  # deferred: start-up (only --ros2)
+
+    from rclverify.runtime.dds.bag import storage_of  # deferred: optional or conditional (only --ros2)
+    from rclverify.runtime.dds.live import run_dds  # deferred: optional or conditional (only --ros2)
+    rec = (Path(record), storage_of(Path(record), getattr(args, "record_storage", None))) if record else None
+    bus_factory = _source(args)
+    if bus_factory is False:
+        return None
+    describe = None
+    if bus_factory is not None:  # the rclpy source (partial(RclpyBus, ros2_python)): types its Python knows
+        from rclverify.runtime.rclpy_source.bus import installed_declarations  # deferred: optional or conditional (only --ros2)
+        describe = partial(installed_declarations, bus_factory.args[0])
+    return run_dds(factory, checked, nodes, msg_dirs + interfaces, **common, enforce=guarded, record=rec,
+                   msg_dirs=msg_dirs, reorder_window=args.reorder_window, bus_factory=bus_factory, describe=describe)
 
 
 def _source(args: argparse.Namespace) -> Any:
