@@ -355,9 +355,9 @@ def test_probable_scale_mismatch_on_a_side_condition():
     assert "rather than widen Controller's assumption" in m["message"]
     assert "Probable scale mismatch" in sc.explanation
     [f] = scale_findings([sc.to_json("x.smt2")])
-    assert (f["check"], f["status"], f["node"], f["id"]) == ("probable-scale-mismatch", "warning", "Controller",
+    assert (f.check, f.status, f.node, f.id) == ("probable-scale-mismatch", "warning", "Controller",
                                                             "Controller.sc2.scale")
-    assert "probable scale mismatch" in f["message"]
+    assert "probable scale mismatch" in f.message
     # a stale record, or a discharged side condition, gives no finding
     assert scale_findings([{**sc.to_json("x.smt2"), "status": "stale"}]) == []
 
@@ -461,4 +461,4 @@ def test_the_usual_conversions_are_named(producer, consumer, factor, units):
     [m] = sc.scale
     assert m["factor"] == factor and f"as a value in {units} would" in m["message"], m["message"]
     [f] = scale_findings([sc.to_json("x.smt2")])
-    assert f"differ by a factor of {factor}" in f["explanation"]
+    assert f"differ by a factor of {factor}" in f.explanation
