@@ -129,6 +129,43 @@ class NearMissRow(TypedDict):
     threshold_source: str
 
 
+class MarginBounds(TypedDict):
+    """A figure of the answers' margins as the bounds the runs' kept margins prove (``$defs/margin_bounds``;
+    report/margin_rows.py): ``low`` and ``high`` equal where they decide it; ``None`` for an infinite bound."""
+    low: float | None
+    high: float | None
+
+
+class MarginRow(TypedDict):
+    """A guarantee's margins over every recorded run (``margins[]``, ``$defs/margins_over_runs``;
+    report/margin_rows.py): the smallest (``margin``, ``None`` when infinite, then ``holds`` its side, or
+    when no answer had one) on the run ``trace`` at the answer ``time``/``where``; the counts summed over
+    the ``runs``; the figures over the ``count`` answers with a margin, ``kept`` of them recorded; the
+    plot of the kept margins per run (``plot_svg``) or why none (``plot_note``)."""
+    node: str
+    guarantee: int
+    formula: str
+    source: str
+    margin: float | None
+    holds: bool | None
+    unit: str
+    atom: str
+    trace: str
+    obligation: str
+    time: float | None
+    where: str
+    runs: int
+    answers: int
+    undefined: int
+    count: int
+    kept: int
+    min: MarginBounds
+    p5: MarginBounds
+    p50: MarginBounds
+    plot_svg: NotRequired[str]
+    plot_note: NotRequired[str]
+
+
 class DeadlineRow(TypedDict):
     """An end-to-end deadline decided by rule D3 (``deadlines[]``, ``$defs/deadline``; report/deadlines.py)."""
     requirement: str
@@ -479,6 +516,8 @@ class Report(TypedDict):
     acknowledgements: list[AcknowledgementRow]
     #: guarantees held with a margin below the plan's near-miss threshold (report/near_misses.py)
     near_misses: list[NearMissRow]
+    #: per guarantee, its margins over every recorded run (report/margin_rows.py)
+    margins: list[MarginRow]
     statistics: list[dict[str, Any]]
     #: the evidence mapped onto the plan's standard profiles (report/standards_rows.py, docs/standards.md)
     standards: list[dict[str, Any]]

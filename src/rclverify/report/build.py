@@ -35,6 +35,7 @@ from rclverify.report.contract_rows import GuaranteeStatuses, contract_records, 
 from rclverify.stages.contract_texts import ContractTexts
 from rclverify.report.culprits import marked_nodes
 from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
+from rclverify.report.margin_rows import margin_rows
 from rclverify.report.near_misses import near_miss_rows
 from rclverify.report.evidence_rows import evidence_part
 from rclverify.report.expected import expected_rows
@@ -126,7 +127,8 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
             "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
             "grounding": grounding_row(ws), "nodl": nodl_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
             "deadlines": deadlines, "acknowledgements": acknowledgements,
-            "near_misses": near_miss_rows(ws, ev["obligations"])}, Facts(
+            "near_misses": near_miss_rows(ws, ev["obligations"]),
+            "margins": margin_rows(ws, ev["obligations"])}, Facts(
         nodes["status"], ev["altered"], checks, ev["inputs"], deadlines_ok(deadlines),
         lambda: all(g_status(name, k) == "discharged" for name, cn in ws.checked.nodes.items()
                     for k in range(1, len(cn.node.guarantees) + 1)))

@@ -1,0 +1,67 @@
+"""SVG plot of one guarantee's margins over its runs (matplotlib, Agg).
+
+One column per run: the margins the run kept (its smallest, at most
+:data:`~rclverify.backends.monitors.verdicts.KEPT_MARGINS`; docs/semantics.md,
+"Margins over runs"), the run's smallest marked, a line at 0 (the
+boundary: below it the guarantee failed) and the quantiles the kept
+margins decide.  Deterministic as backends/experiment/plot.py is: a fixed
+``svg.hashsalt``, no date in the metadata, the same figures the same bytes
+for one matplotlib version.
+"""
+from __future__ import annotations
+
+import io
+import math
+from typing import Sequence
+
+from rclverify.records.report_schema import MarginRow
+
+
+def _label(trace: str, most: int = 24) -> str:
+    name = trace.rstrip("/").rsplit("/", 1)[-1] or trace
+    return name if len(name) <= most else "…" + name[-(most - 1):]
+
+
+def render_svg(row: MarginRow, runs: Sequence[tuple[str, Sequence[float]]]) -> str:
+    """The SVG text of ``row``'s margins: ``runs`` is ``[(trace, kept margins)]``
+    (floats, ``-inf`` for a margin without distance, not drawn).  Raises
+    :class:`~rclverify.core.extras.MissingExtra` without matplotlib (the
+    ``plots`` extra)."""
+    from rclverify.core.numeric import import_numpy  # deferred: start-up (numpy, matplotlib's, with one BLAS thread)
+    import_numpy()
+    from rclverify.core.extras import require  # deferred: start-up (only where a plot is drawn)
+    matplotlib = require("matplotlib", "the margins' plot")  # raises MissingExtra (core/extras.py)
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # deferred: start-up (loads matplotlib and more only when called)
+    unit = f" [{row['unit']}]" if row["unit"] else ""
+    with matplotlib.rc_context({"svg.hashsalt": "rclverify", "svg.fonttype": "none", "font.size": 9}):
+        f, ax = plt.subplots(figsize=(6.4, 3.6))
+        try:
+            for x, (_, kept) in enumerate(runs, start=1):
+                ys = [v for v in kept if math.isfinite(v)]
+                ax.plot([x] * len(ys), ys, "o", color="C0", markersize=2.5, alpha=0.5,
+                        label="kept margins" if x == 1 else None)
+                if ys:
+                    ax.plot([x], [ys[0]], "v", color="C3", markersize=6, label="run's smallest" if x == 1 else None)
+            ax.axhline(0.0, color="black", linewidth=0.8)
+            for k, (name, b) in enumerate((("p5", row["p5"]), ("p50", row["p50"]))):
+                if b["low"] is not None and b["low"] == b["high"]:
+                    ax.axhline(float(b["low"]), color=f"C{1 + k}", linestyle="--",
+                               label=f"{name} over {row['count']} answers ({b['low']:g})")
+            ax.set_xticks(range(1, len(runs) + 1), [_label(t) for t, _ in runs], rotation=30, ha="right",
+                          fontsize=7)
+            ax.set_xlim(0.5, len(runs) + 0.5)
+            ax.set_xlabel("run")
+            ax.set_ylabel(f"margin{unit}")
+            ax.set_title(f"{row['node']} guarantee {row['guarantee']}")
+            ax.legend(loc="best", fontsize=7)
+            f.tight_layout()
+            out = io.StringIO()
+            f.savefig(out, format="svg", metadata={"Date": None})
+        finally:
+            plt.close(f)
+    text = out.getvalue()
+    return text[text.index("<svg"):]
+
+
+__all__ = ["render_svg"]

@@ -1,0 +1,166 @@
+"""Margins over runs: per guarantee, the smallest space margin any recorded
+run gave it, where, and the distribution of its answers' margins
+(docs/semantics.md, "Margins over runs"; docs/reading-the-report.md).
+
+Each monitors run's record names, per guarantee, its smallest margin, the
+answers that gave one (``answers``), those that had none (``undefined``) and
+the :data:`~rclverify.backends.monitors.verdicts.KEPT_MARGINS` smallest
+margins (``lowest``; ``details.monitoring.margins``).  The report's
+``margins`` (:func:`margin_rows`) has one row per guarantee judged with
+margins on at least one run: the smallest over the runs (``margin``, the
+run ``trace``, its ``obligation``, the answer's ``time`` and ``where``, the
+deciding ``atom`` and ``unit``), the counts summed over the runs, and the
+figures of :func:`figures`: ``count`` (every answer with a margin, on every
+run), ``min`` and the quantiles ``p5`` and ``p50`` of those answers'
+margins, each given by the bounds the kept margins prove (equal when they
+decide it).  With at least two runs, ``plot_svg`` is the distribution drawn
+per run (report/margin_plot.py, the ``plots`` extra), or ``plot_note`` says
+why none was drawn.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Iterable, Mapping, Sequence
+
+from rclverify.backends.monitors.verdicts import KEPT_MARGINS
+from rclverify.records.report_schema import MarginBounds, MarginRow, ObligationRow
+from rclverify.records.store import EvidenceStore
+from rclverify.stages.workspace import Workspace
+
+#: The quantiles the figures give (``p5``, ``p50``): the share of answers at or below them.
+QUANTILES = (("p5", 0.05), ("p50", 0.5))
+#: At most this many guarantees get a plot (the smallest margins first): each costs matplotlib a tenth of a second.
+MAX_PLOTS = 24
+#: The bounds of a figure no answer gives.
+_NONE: MarginBounds = {"low": None, "high": None}
+
+
+def _number(v: float) -> float | None:
+    """``v`` for JSON: ``None`` when infinite."""
+    return v if math.isfinite(v) else None
+
+
+def _run_margins(m: Mapping[str, Any]) -> tuple[list[float], int, float | None]:
+    """One run's record of one guarantee as ``(known, unknown, floor)``: the
+    margins known exactly (the kept ones, ``null`` read as ``-inf``, and the
+    answers the record dropped as ``+inf``), how many answers' margins are
+    unknown, and the least those can be (the largest kept margin)."""
+    answers = int(m.get("answers") or 0)
+    if "lowest" in m:
+        kept = [-math.inf if v is None else float(v) for v in m.get("lowest") or ()]
+    else:  # a record that kept only the smallest
+        v, holds = m.get("margin"), m.get("holds")
+        kept = [] if not answers else [float(v) if v is not None else math.inf if holds else -math.inf]
+    rest = max(answers - len(kept), 0)
+    if "lowest" in m and len(kept) < KEPT_MARGINS:  # to_json drops +inf: an answer not listed held without distance
+        return kept + [math.inf] * rest, 0, None
+    return kept, rest, (kept[-1] if kept else None)
+
+
+def _kth(values: Sequence[float], k: int) -> float:
+    return sorted(values)[k - 1]
+
+
+def figures(runs: Iterable[Mapping[str, Any]]) -> tuple[int, int, dict[str, MarginBounds]]:
+    """``(count, kept, quantiles)`` of one guarantee's margins over ``runs``
+    (each a ``details.monitoring.margins`` item).
+
+    ``count`` is every answer with a margin on every run; the q-quantile is
+    the ``ceil(q * count)``-th smallest of their margins (the empirical
+    quantile that inverts the distribution function, Hyndman and Fan's type 1,
+    "Sample quantiles in statistical packages", The American Statistician,
+    1996); ``min`` is the first.  A run records its smallest margins only,
+    so each quantile is given by bounds: ``high`` the rank's margin among
+    the kept ones (adding the unkept answers can only lower it), ``low`` the
+    same with every unkept answer at the least it can be, its run's largest
+    kept margin.  They are equal where the kept margins decide the quantile,
+    always for ``min``.  ``None`` stands for an infinite bound."""
+    known: list[float] = []
+    floors: list[float] = []
+    for m in runs:
+        k, unknown, floor = _run_margins(m)
+        known += k
+        if unknown and floor is not None:
+            floors += [floor] * unknown
+    count = len(known) + len(floors)
+    out: dict[str, MarginBounds] = {}
+    if not count:
+        return 0, 0, out
+    for name, q in (("min", 0.0), *QUANTILES):
+        rank = max(1, math.ceil(q * count))
+        high = _kth(known, rank) if rank <= len(known) else math.inf
+        low = _kth(known + floors, rank)
+        out[name] = {"low": _number(low), "high": _number(high)}
+    return count, len(known), out
+
+
+def _guarantee_place(ws: Workspace, node: str, k: int) -> str:
+    cn = ws.checked.nodes.get(node)
+    if cn is None or not 1 <= k <= len(cn.node.guarantees):
+        return ""
+    loc = cn.node.guarantees[k - 1].loc
+    return f"{loc.file}:{loc.line}:{loc.col}"
+
+
+def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginRow]:
+    """The report's ``margins`` (module docstring), by node and guarantee."""
+    runs: dict[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]] = {}
+    store: EvidenceStore | None = None
+    for o in ob_rows:
+        if o["backend"] != "monitors" or o["status"] == "error":
+            continue
+        store = store or EvidenceStore(ws.root)
+        ev, problem = store.read(str(o["id"]))
+        if ev is None or problem or not isinstance(ev.details, dict):
+            continue
+        mon = ev.details.get("monitoring") or {}
+        for m in mon.get("margins") or () if isinstance(mon, dict) else ():
+            if isinstance(m, dict) and isinstance(m.get("guarantee"), int):
+                runs.setdefault((str(o["node"]), m["guarantee"]), []).append(
+                    (str(o["id"]), str(m.get("trace") or mon.get("trace", "")), m))
+    rows: list[MarginRow] = []
+    for (node, k), got in sorted(runs.items()):
+        def order(r: tuple[str, str, Mapping[str, Any]]) -> float:
+            v, holds, answers = r[2].get("margin"), r[2].get("holds"), r[2].get("answers")
+            if not answers:
+                return math.nan
+            return float(v) if v is not None else math.inf if holds else -math.inf
+        measured = [r for r in got if not math.isnan(order(r))]
+        least = min(measured, key=order) if measured else got[0]
+        m = least[2]
+        count, kept, fig = figures(r[2] for r in got)
+        v = order(least)
+        rows.append({"node": node, "guarantee": k, "formula": str(m.get("formula", "")),
+                     "source": _guarantee_place(ws, node, k),
+                     "margin": None if math.isnan(v) else _number(v),
+                     "holds": (v > 0) if math.isinf(v) else None, "unit": str(m.get("unit", "")),
+                     "atom": str(m.get("atom", "")), "trace": least[1], "obligation": least[0],
+                     "time": float(m["time"]) if measured and isinstance(m.get("time"), (int, float)) else None,
+                     "where": str(m.get("where", "")) if measured else "",
+                     "runs": len(got), "answers": sum(int(r[2].get("answers") or 0) for r in got),
+                     "undefined": sum(int(r[2].get("undefined") or 0) for r in got),
+                     "count": count, "kept": kept, "min": fig.get("min", _NONE), "p5": fig.get("p5", _NONE),
+                     "p50": fig.get("p50", _NONE)})
+    _plots(rows, runs)
+    return rows
+
+
+def _plots(rows: list[MarginRow], runs: Mapping[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]]) -> None:
+    """Draw the distribution of every row measured on two runs or more (at most :data:`MAX_PLOTS`)."""
+    from rclverify.core.extras import MissingExtra  # deferred: start-up (only where a plot is drawn)
+    wanted = [r for r in rows if r["runs"] >= 2 and r["count"]]
+    wanted.sort(key=lambda r: math.inf if r["margin"] is None else r["margin"])
+    for n, r in enumerate(wanted):
+        if n >= MAX_PLOTS:
+            r["plot_note"] = f"no plot drawn: the report draws the {MAX_PLOTS} smallest margins' plots only"
+            continue
+        try:
+            from rclverify.report.margin_plot import render_svg  # deferred: start-up (matplotlib only when drawn)
+            per_run = [(trace, [-math.inf if v is None else float(v) for v in m.get("lowest") or ()])
+                       for _, trace, m in runs[(r["node"], r["guarantee"])]]
+            r["plot_svg"] = render_svg(r, per_run)
+        except MissingExtra as exc:  # the plot illustrates; the figures above do not rest on it
+            r["plot_note"] = f"no plot drawn: {exc}"
+
+
+__all__ = ["MAX_PLOTS", "QUANTILES", "figures", "margin_rows"]
