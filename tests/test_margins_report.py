@@ -1,0 +1,95 @@
+"""Margins over runs (docs/semantics.md, "Margins over runs"): the report names, per guarantee, its
+smallest margin over every recorded run with the run, the answer's time and message, the distribution
+of its answers' margins (count, min, p5, p50) and, for two runs or more, a plot of each run's kept
+margins (matplotlib, the ``plots`` extra); the figures are the bounds the kept margins prove."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from _report_schema import check_report
+from rclverify.backends.monitors.verdicts import KEPT_MARGINS
+from rclverify.cli.commands import main
+from rclverify.report.margin_rows import figures
+
+BRAKE = """node Brake {
+  inputs( dist : REAL )
+  outputs( speed : REAL )
+  topics( std_msgs/Float64 dist matches(in.dist), std_msgs/Float64 speed matches(out.speed) )
+  assume( TRUE )
+  guarantee( out.speed <= in.dist )
+}
+"""
+PLAN = """name: brakes
+contracts: [contracts/brake.rcl]
+nodes:
+  Brake:
+    evidence:
+      - {backend: monitors, traces: [runs/one.jsonl, runs/two.jsonl], mapping: contracts/mapping.yaml}
+"""
+# (dist, speed) answered 10 ms later: margins 0.3, 0.04 on run one; 0.5, 0.1, 1.0 on run two
+RUNS = {"one": ((1.0, 0.7), (2.0, 1.96)), "two": ((3.0, 2.5), (4.0, 3.9), (5.0, 4.0))}
+
+
+def _workspace(root: Path) -> Path:
+    for d in ("contracts", "runs"):
+        (root / d).mkdir(parents=True, exist_ok=True)
+    (root / "contracts" / "brake.rcl").write_text(BRAKE, encoding="utf-8")
+    (root / "contracts" / "plan.yaml").write_text(PLAN, encoding="utf-8")
+    (root / "contracts" / "mapping.yaml").write_text("horizon: 1.0\n", encoding="utf-8")
+    for name, pairs in RUNS.items():
+        rows = [r for i, (d, s) in enumerate(pairs, start=1) for r in
+                ({"topic": "dist", "time": float(i), "data": d}, {"topic": "speed", "time": i + 0.01, "data": s})]
+        (root / "runs" / f"{name}.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows), encoding="utf-8")
+    return root
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    ws = _workspace(tmp_path_factory.mktemp("margins") / "ws")
+    assert main(["verify", "-w", str(ws)]) == 0
+    out: dict[str, Any] = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    check_report(out)  # the schema declares the margins part
+    out["_html"] = (ws / "reports" / "assurance.html").read_text(encoding="utf-8")
+    out["_md"] = (ws / "reports" / "assurance.md").read_text(encoding="utf-8")
+    return out
+
+
+def test_the_smallest_margin_over_the_runs_is_named_with_its_run_and_time(report: dict[str, Any]) -> None:
+    [m] = report["margins"]
+    assert (m["node"], m["guarantee"], m["source"]) == ("Brake", 1, "contracts/brake.rcl:6:3")
+    assert abs(m["margin"] - 0.04) < 1e-9 and m["atom"] == "out.speed <= in.dist" and m["holds"] is None
+    assert m["trace"] == "runs/one.jsonl" and m["time"] == 2.01 and m["obligation"].startswith("Brake.")
+    assert (m["runs"], m["answers"], m["undefined"], m["count"], m["kept"]) == (2, 5, 0, 5, 5)
+    # margins 0.04, 0.1, 0.3, 0.5, 1.0: min the 1st, p5 the ceil(0.25) = 1st, p50 the ceil(2.5) = 3rd; all kept
+    got = {k: (round(m[k]["low"], 9), round(m[k]["high"], 9)) for k in ("min", "p5", "p50")}
+    assert got == {"min": (0.04, 0.04), "p5": (0.04, 0.04), "p50": (0.3, 0.3)}
+    # the first screen names it, in HTML and Markdown
+    first = report["_html"][:report["_html"].index('<section id="dashboard">')]
+    assert 'id="margins"' in first and "<strong>0.04</strong>" in first and "runs/one.jsonl, 2.010 s" in first
+    assert "- Brake guarantee 1: 0.04 on `out.speed <= in.dist` at " in report["_md"]
+
+
+def test_the_distribution_over_runs_is_plotted(report: dict[str, Any]) -> None:
+    pytest.importorskip("matplotlib", reason="the plots extra (matplotlib) is not installed: no plot is drawn")
+    [m] = report["margins"]
+    assert "plot_note" not in m and m["plot_svg"].startswith("<svg")
+    assert "one.jsonl" in m["plot_svg"] and "two.jsonl" in m["plot_svg"]  # one column per run
+    assert '<figure class="plot"><svg' in report["_html"]
+
+
+def test_a_quantile_the_kept_margins_do_not_decide_is_given_by_its_bounds() -> None:
+    # run A judged 1000 answers and kept its 256 smallest (0 .. 255): the other 744 are at least 255
+    a = {"guarantee": 1, "answers": 1000, "lowest": [float(i) for i in range(KEPT_MARGINS)]}
+    b = {"guarantee": 1, "answers": 10, "lowest": [1000.0 + i for i in range(10)]}
+    count, kept, fig = figures([a, b])
+    assert (count, kept) == (1010, KEPT_MARGINS + 10)
+    assert fig["min"] == {"low": 0.0, "high": 0.0}
+    assert fig["p5"] == {"low": 50.0, "high": 50.0}  # rank 51: decided by the kept margins
+    assert fig["p50"] == {"low": 255.0, "high": None}  # rank 505: past the kept, at least run A's largest
+    # a run that kept fewer than it judged without being full: the rest held without a distance (+inf)
+    count, kept, fig = figures([{"guarantee": 1, "answers": 3, "lowest": [0.5]}])
+    assert (count, kept, fig["p50"]) == (3, 3, {"low": None, "high": None})
