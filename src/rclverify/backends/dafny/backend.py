@@ -45,7 +45,7 @@ from __future__ import annotations
 import tempfile
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import jinja2
 
@@ -216,42 +216,51 @@ class DafnyBackend:
             return ev("error", f"{where}: module {scan.refining[0][0]} gives no body for method {stub.method}, "
                                "so Dafny would verify nothing", tool.version, artifacts=(stub_rel,),
                       details=scan_details)
-        argv = runner.verify_argv(tool, files, cfg.time_limit, error_limit=len(stub.clauses) + 10,
-                                  options=cfg.options)
-        shown = " ".join([Path(argv[0]).name, *argv[1:]])
-        with tempfile.TemporaryDirectory(prefix="rclverify-dafny-") as tmp:
-            model = Path(tmp) / "model.bvd" if runner.takes_model_file(tool) else None
-            try:
-                res = runner.run(runner.verify_argv(tool, files, cfg.time_limit, error_limit=len(stub.clauses) + 10,
-                                                    options=cfg.options, model_file=str(model) if model else None),
-                                 target.root, float(cfg.timeout))
-            except OSError as exc:
-                return ev("error", f"could not start {exe}: {exc}", tool.version, details={"command": shown})
-            models = refute.read_models(model.read_text(encoding="utf-8", errors="replace")) \
-                if model is not None and model.is_file() else []
-        log_path = target.artifacts / f"{snake(target.node.name)}_dafny.log"
-        shown_log, log_notes = runner.filter_log(res.output)
-        atomic_write_text(log_path, _jinja().get_template("log.txt.j2").render(
-            node=target.node.name, obligation=obligation.id, command=shown,
-            exit_code="killed at the process timeout" if res.timed_out else res.returncode,
-            output=shown_log.rstrip("\n"), notes=log_notes))
-        artifacts: tuple[str, ...] = (stub_rel, target.rel(log_path))
-        out = runner.parse_output(res.output)
-        clauses = clause_lines(stub.text)
-        status, explanation, details = _judge(res, out, clauses, stub_rel, cfg, scan, tool,
-                                              len(target.node.node.guarantees), target)
-        cex: dict[str, object] | None = None
-        if status == UNPROVED:
-            status, explanation, cex, tried = _confirm(target, cfg, tool, stub, scan, out, clauses, stub_rel, models,
-                                                       explanation, details)
-            artifacts += tuple(t["artifact"] for t in tried if t["artifact"])
-        details["refining_modules"] = scan_details["refining_modules"]
-        details["unsound_constructs"] = scan_details["unsound_constructs"]
-        details["command"] = shown
-        if log_notes:
-            details["log_filtered"] = log_notes
-        return ev(status, explanation, tool.version, log=shown_log, artifacts=artifacts, details=details,
-                  counterexample=cex)
+        return _verified(obligation, target, ev, cfg, stub, stub_rel, files, tool, scan, scan_details)
+
+def _verified(obligation: Obligation, target: NodeTarget, ev: Callable[..., Evidence], cfg: _Config, stub: Stub,
+              stub_rel: str, files: list[str], tool: runner.DafnyTool, scan: implementation.ImplementationScan,
+              scan_details: DafnyScan) -> Evidence:
+    """Run Dafny on ``files`` (the stub and the implementation), write its
+    log, and judge what it said: a guarantee left unproved is confirmed
+    ``failed`` only by a refutation (:func:`_confirm`), else
+    ``inconclusive``; ``ev`` makes the evidence (module docstring)."""
+    argv = runner.verify_argv(tool, files, cfg.time_limit, error_limit=len(stub.clauses) + 10,
+                              options=cfg.options)
+    shown = " ".join([Path(argv[0]).name, *argv[1:]])
+    with tempfile.TemporaryDirectory(prefix="rclverify-dafny-") as tmp:
+        model = Path(tmp) / "model.bvd" if runner.takes_model_file(tool) else None
+        try:
+            res = runner.run(runner.verify_argv(tool, files, cfg.time_limit, error_limit=len(stub.clauses) + 10,
+                                                options=cfg.options, model_file=str(model) if model else None),
+                             target.root, float(cfg.timeout))
+        except OSError as exc:
+            return ev("error", f"could not start {tool.exe}: {exc}", tool.version, details={"command": shown})
+        models = refute.read_models(model.read_text(encoding="utf-8", errors="replace")) \
+            if model is not None and model.is_file() else []
+    log_path = target.artifacts / f"{snake(target.node.name)}_dafny.log"
+    shown_log, log_notes = runner.filter_log(res.output)
+    atomic_write_text(log_path, _jinja().get_template("log.txt.j2").render(
+        node=target.node.name, obligation=obligation.id, command=shown,
+        exit_code="killed at the process timeout" if res.timed_out else res.returncode,
+        output=shown_log.rstrip("\n"), notes=log_notes))
+    artifacts: tuple[str, ...] = (stub_rel, target.rel(log_path))
+    out = runner.parse_output(res.output)
+    clauses = clause_lines(stub.text)
+    status, explanation, details = _judge(res, out, clauses, stub_rel, cfg, scan, tool,
+                                          len(target.node.node.guarantees), target)
+    cex: dict[str, object] | None = None
+    if status == UNPROVED:
+        status, explanation, cex, tried = _confirm(target, cfg, tool, stub, scan, out, clauses, stub_rel, models,
+                                                   explanation, details)
+        artifacts += tuple(t["artifact"] for t in tried if t["artifact"])
+    details["refining_modules"] = scan_details["refining_modules"]
+    details["unsound_constructs"] = scan_details["unsound_constructs"]
+    details["command"] = shown
+    if log_notes:
+        details["log_filtered"] = log_notes
+    return ev(status, explanation, tool.version, log=shown_log, artifacts=artifacts, details=details,
+              counterexample=cex)
 
 
 def _confirm(target: NodeTarget, cfg: _Config, tool: runner.DafnyTool, stub: Stub,
