@@ -4,7 +4,8 @@ through rclpy's graph API (``--source dds``, ``--source rclpy``), and by ``rclve
 documents as the expected graph, through rclpy's graph API).
 
 The documents are tests/data/nodl/ws's.  One process runs two nodes: ``Guard`` exactly as its document says (the
-control: reliable, transient-local ``/stop``, best-effort ``/scan``) and ``Base`` with one seeded mismatch of each
+control: reliable, transient-local ``/stop`` offering a 100 ms deadline, best-effort ``/scan``; without the deadline
+it would be a ``nodl-live-qos`` finding: the document offers it) and ``Base`` with one seeded mismatch of each
 kind: ``/speed`` published as ``std_msgs/Float32`` (the document: ``Float64``), ``/stop`` subscribed volatile (the
 document: transient-local), no ``/estop`` server, and a publisher ``/odom`` its document does not declare.
 ``Dock`` does not run: a document matched to no running node is not compared."""
@@ -24,6 +25,7 @@ WS = Path(__file__).parent / "data" / "nodl" / "ws"
 
 NODES = """\
 import rclpy
+from rclpy.duration import Duration
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -33,7 +35,8 @@ from std_msgs.msg import Bool, Float32, Float64
 rclpy.init()
 guard = Node('Guard')
 guard.create_publisher(Bool, '/stop', QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                                                 durability=DurabilityPolicy.TRANSIENT_LOCAL))
+                                                 durability=DurabilityPolicy.TRANSIENT_LOCAL,
+                                                 deadline=Duration(nanoseconds=100_000_000)))
 guard.create_subscription(LaserScan, 'scan', lambda m: None,
                           QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT))
 base = Node('Base')

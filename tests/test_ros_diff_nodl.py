@@ -110,3 +110,93 @@ def test_the_command_needs_the_running_system_and_no_code(docs: tuple[Path, dict
     assert "no NoDL document" in capsys.readouterr().err
     assert main(["ros", "diff", "--nodl", str(folder), "--ros2", str(folder)]) == 2
     assert "give no PATH" in capsys.readouterr().err
+
+
+def _read(folder: Path) -> dict[str, Any]:
+    return nodes_of(read_all(document_files(folder), Resolver([], shown(folder.parent))))
+
+
+def _edit(path: Path, old: str, new: str, nth: int = 1) -> int:
+    """Replace the ``nth`` ``old`` of ``path`` by ``new``; the 1-based line of the replaced text's first line."""
+    text = path.read_text(encoding="utf-8")
+    at = -1
+    for _ in range(nth):
+        at = text.index(old, at + 1)
+    path.write_text(text[:at] + new + text[at + len(old):], encoding="utf-8")
+    return text[:at].count("\n") + 1
+
+
+def _timing(end: dict[str, Any], deadline_ns: int | None = None, liveliness: str = "automatic",
+            lease_ns: int | None = None) -> None:
+    """Give a dump endpoint the deadline, liveliness and lease rclpy reports (2**63 - 1 ns: none)."""
+    none = 2 ** 63 - 1
+    end.update(deadline_ns=deadline_ns or none, liveliness=liveliness, lease_ns=lease_ns or none)
+
+
+def test_a_publishers_deadline_longer_than_its_document_offers(docs: tuple[Path, dict[str, Any]]) -> None:
+    """Battery's document offers a 100 ms deadline: its running publisher offering 300 ms is a QoS item
+    at the document's ``deadline_ns`` line; offering 100 ms or a tighter 50 ms keeps the document's
+    promise (the controls).  ChargeMonitor's document requests no deadline, so its running subscription
+    requesting one is an item at its ``qos`` (a publisher the document admits, without a deadline,
+    would not connect)."""
+    folder, _ = docs
+    line = _edit(folder / "Battery.nodl.yaml", "    durability: VOLATILE\n",
+                 "    durability: VOLATILE\n    deadline_ns: 100000000\n") + 1
+    documents = _read(folder)
+    for offered in (100_000_000, 50_000_000):
+        dump = _dump()
+        _timing(dump["endpoints"]["/battery"]["pubs"][0], deadline_ns=offered)
+        _timing(dump["endpoints"]["/battery"]["subs"][0])
+        res = _diff(documents, dump)
+        assert res.equal, render_text(res)
+    dump = _dump()
+    _timing(dump["endpoints"]["/battery"]["pubs"][0], deadline_ns=300_000_000)
+    _timing(dump["endpoints"]["/battery"]["subs"][0])
+    res = _diff(documents, dump)
+    [item] = res.missing
+    assert (item.category, item.node) == ("qos", "/battery")
+    assert item.src is not None and (item.src.file.rsplit("/", 1)[-1], item.src.line) == ("Battery.nodl.yaml", line)
+    assert "offers deadline 300000000 ns announced by the running node" in item.message
+    assert "its NoDL document offers 100000000 ns" in item.message
+    dump = _dump()
+    _timing(dump["endpoints"]["/battery"]["pubs"][0], deadline_ns=100_000_000)
+    _timing(dump["endpoints"]["/battery"]["subs"][0], deadline_ns=200_000_000)
+    res = _diff(documents, dump)
+    [item] = res.missing
+    lines = (folder / "ChargeMonitor.nodl.yaml").read_text(encoding="utf-8").splitlines()
+    assert (item.category, item.node) == ("qos", "/charge_monitor") and item.src is not None
+    assert item.src.line == [i for i, t in enumerate(lines, 1) if t.strip() == "qos:"][1] + 1  # the qos mapping
+    assert "requests deadline 200000000 ns announced by the running node and its NoDL document requests none" \
+        in item.message
+
+
+def test_a_subscriptions_liveliness_and_lease_stricter_than_its_document_requests(
+        docs: tuple[Path, dict[str, Any]]) -> None:
+    """ChargeMonitor's document requests automatic liveliness with a 1 s lease: its running
+    subscription requesting manual-by-topic, or a 0.5 s lease, is a QoS item at the document's field
+    (the liveliness at its ``qos``, which leaves the kind unsaid, rmw's automatic); requesting a 2 s
+    lease asks less than the document and is no item (the control).  The running publisher offers
+    automatic with a 0.5 s lease: against the manual-by-topic request the running ends' own conflict
+    is said too (rclpy's graph carries liveliness)."""
+    folder, _ = docs
+    doc = folder / "ChargeMonitor.nodl.yaml"
+    qos_line = _edit(doc, "    durability: VOLATILE\n", "    durability: VOLATILE\n"
+                     "    liveliness_lease_duration_ns: 1000000000\n", nth=2) + 1
+    documents = _read(folder)
+    lines = doc.read_text(encoding="utf-8").splitlines()
+    qos_at = [i for i, t in enumerate(lines, 1) if t.strip() == "qos:"][1] + 1  # where the qos mapping starts
+    assert lines[qos_line - 1].strip().startswith("liveliness_lease_duration_ns")
+
+    def run(liveliness: str, lease_ns: int) -> list[Any]:
+        dump = _dump()
+        _timing(dump["endpoints"]["/battery"]["pubs"][0], lease_ns=500_000_000)
+        _timing(dump["endpoints"]["/battery"]["subs"][0], liveliness=liveliness, lease_ns=lease_ns)
+        res = _diff(documents, dump)
+        return list(res.missing)
+    assert run("automatic", 2_000_000_000) == []
+    kind, running = sorted(run("manual_by_topic", 2_000_000_000), key=lambda i: i.node is None)
+    assert kind.src is not None and kind.src.line == qos_at and "requests liveliness MANUAL_BY_TOPIC" in kind.message, kind.message
+    assert running.category == "qos" and running.node is None and "liveliness" in running.message
+    [lease] = run("automatic", 500_000_000)
+    assert lease.src is not None and lease.src.line == qos_line
+    assert "requests liveliness lease duration 500000000 ns" in lease.message and "requests 1000000000 ns" in lease.message

@@ -18,7 +18,10 @@ clients, types, and the running endpoints' QoS conflicts), with the items
 naming the documents (:data:`rclverify.ros.live.diff.NODL`).  QoS is compared as ``nodl check
 --ros2`` compares it: the reliability and durability each document writes
 for a topic's publisher or subscription against what the node's running
-endpoint announces (:func:`rclverify.ros.ground.nodl_code.live_qos_of`,
+endpoint announces, and its deadline, liveliness and lease by the
+request-offered rules (a running publisher offers at least, a running
+subscription requests at most, what the document says)
+(:func:`rclverify.ros.ground.nodl_code.live_qos_of`,
 :func:`~rclverify.ros.ground.nodl_code.qos_differences`), each difference a
 ``qos`` item located at the document's field.  The ends ROS 2 makes for
 itself (``/rosout``, ``/parameter_events``, parameter services) are left out
@@ -89,7 +92,7 @@ def diff_nodl(documents: Mapping[str, Document], running: Graph, source: str, co
                                         source, f"{full} {'publishes' if e.kind == 'publishers' else 'subscribes to'} "
                                                 f"{edge.topic}{_t(edge.msg_type)}: {f.message.split(': ', 1)[1]}"))
     res.compared.append("the reliability and durability each document writes for a topic, against what the running "
-                        "endpoint announces")
+                        "endpoint announces, and its deadline and liveliness by the request-offered rules")
     return res
 
 

@@ -32,16 +32,18 @@ lifecycle interface) are not its own: undeclared, they are no finding.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable, Mapping, Protocol
+from typing import Callable, Mapping, NamedTuple, Protocol
 
 from rclverify.lang import ast
 from rclverify.model.nodl.contract import type_key
-from rclverify.model.nodl.document import Document, Endpoint
+from rclverify.model.nodl.document import Document, Endpoint, QoS
 from rclverify.model.nodl.findings import Finding
+from rclverify.model.nodl.qos import DURATIONS, mismatches
 from rclverify.ros.extract import code_qos
 from rclverify.ros.extract.model import GraphEdge, GraphNode, Src
 from rclverify.ros.live.dds import ros_name
 from rclverify.ros.live.dds_discovery import EndpointInfo
+from rclverify.ros.live.dds_qos import INFINITE_NS
 from rclverify.ros.ground.ground import match_nodes
 from rclverify.ros.ground.lifecycle import MANAGEMENT
 
@@ -68,17 +70,35 @@ def _loc(src: Src | None, fallback: ast.Loc) -> ast.Loc:
 
 #: What a comparison calls each side and its finding codes' prefix: the scan's code, or the running graph.
 SIDES = {"code": ("the scanned code", "nodl-code"), "live": ("the running node", "nodl-live")}
-#: The reliability and durability one side gives the endpoint ``edge`` of list ``kind`` of node ``node`` (its
-#: full name): lower case, ``None`` where unsaid, and in words where it comes from; ``None`` when unknown.
-QosOf = Callable[[str, str, GraphEdge], "tuple[str | None, str | None, str] | None"]
+
+
+class OtherQos(NamedTuple):
+    """The QoS the other side gives a topic's endpoint: ``reliability`` and ``durability`` lower case
+    (``None`` where unsaid), ``where`` in words; ``timing`` the deadline, liveliness kind and lease
+    as a document's :class:`~rclverify.model.nodl.document.QoS` would write them (0 ns: none),
+    ``None`` when that side does not say them (the code's literal QoS)."""
+
+    reliability: str | None
+    durability: str | None
+    where: str
+    timing: QoS | None = None
+
+
+#: The QoS one side gives the endpoint ``edge`` of list ``kind`` of node ``node`` (its full name); ``None`` when unknown.
+QosOf = Callable[[str, str, GraphEdge], "OtherQos | None"]
 
 
 def code_qos_of(base: Path | None) -> QosOf:
     """The QoS the code asks for literally where it creates a topic's endpoint (:mod:`.code_qos`)."""
-    def read(node: str, kind: str, edge: GraphEdge) -> tuple[str | None, str | None, str] | None:
+    def read(node: str, kind: str, edge: GraphEdge) -> OtherQos | None:
         q = code_qos.read(edge.src, "pub" if kind == "publishers" else "sub", base)
-        return None if q is None else (q.reliability, q.durability, f"in the code ({q.text})")
+        return None if q is None else OtherQos(q.reliability, q.durability, f"in the code ({q.text})")
     return read
+
+
+def _doc_ns(ns: int) -> int:
+    """A running duration (ns, :data:`INFINITE_NS` for none) as a document writes it (0: none)."""
+    return 0 if ns <= 0 or ns >= INFINITE_NS else ns
 
 
 class Announced(Protocol):
@@ -97,36 +117,56 @@ def live_qos_of(disc: Announced) -> QosOf:
     that of the node's writers (publishers) or readers (subscriptions) of the topic, as
     ``ros_discovery_info`` gives endpoints to nodes; unknown (``None``) when the node has none
     there or several that announce different QoS."""
-    def read(node: str, kind: str, edge: GraphEdge) -> tuple[str | None, str | None, str] | None:
+    def read(node: str, kind: str, edge: GraphEdge) -> OtherQos | None:
         table = disc.writers if kind == "publishers" else disc.readers
-        got = {("reliable" if e.qos.reliable else "best_effort", e.qos.durability) for e in table.values()
+        got = {("reliable" if e.qos.reliable else "best_effort", e.qos.durability, _doc_ns(e.qos.deadline_ns),
+                e.qos.liveliness.upper(), _doc_ns(e.qos.lease_ns)) for e in table.values()
                if disc.node_of(e.guid) == node and ros_name(e.topic) == ("topic", edge.topic)}
         if len(got) != 1:
             return None
-        rel, dur = got.pop()
-        return rel, dur, "announced by the running node"
+        rel, dur, deadline, live, lease = got.pop()
+        timing = QoS("SYSTEM_DEFAULT", rel.upper(), deadline_ns=deadline, liveliness=live,
+                     liveliness_lease_duration_ns=lease)
+        return OtherQos(rel, dur, "announced by the running node", timing)
     return read
 
 
 def qos_differences(doc_end: Endpoint, edge: GraphEdge, qos_of: QosOf, fqn: str, node: str,
                     code: str) -> list[Finding]:
-    """The reliability and durability the other side gives endpoint ``edge`` (``qos_of``) against
-    what document endpoint ``doc_end`` writes: one finding ``<code>-qos`` per policy that differs,
-    located at ``edge`` and at the document's field; a policy either side leaves unsaid,
-    ``SYSTEM_DEFAULT`` and ``BEST_AVAILABLE`` are not compared (docs/nodl.md)."""
+    """The QoS the other side gives endpoint ``edge`` (``qos_of``) against what document endpoint
+    ``doc_end`` writes: one finding ``<code>-qos`` per policy, located at ``edge`` and at the
+    document's field (docs/nodl.md).  Reliability and durability must be what the document writes (a
+    policy either side leaves unsaid, ``SYSTEM_DEFAULT`` and ``BEST_AVAILABLE`` are not compared).
+    Deadline, liveliness and its lease, where the other side says them (a running endpoint), are
+    judged by the request-offered rules (:func:`rclverify.model.nodl.qos.mismatches`, the document's
+    unsaid policies rmw's defaults): a publisher must offer at least what its document offers, a
+    subscription request at most what its document requests, so every end the document admits
+    still connects."""
     if doc_end.qos is None or doc_end.kind not in ("publishers", "subscriptions"):
         return []
     got = qos_of(node, doc_end.kind, edge)
     if got is None:
         return []
     out = []
-    for policy, said in (("reliability", got[0]), ("durability", got[1])):
+    for policy, said in (("reliability", got.reliability), ("durability", got.durability)):
         written = getattr(doc_end.qos, policy)
         if said is None or written in (None, "SYSTEM_DEFAULT", "BEST_AVAILABLE") or said.upper() == written:
             continue
-        out.append(Finding(f"{code}-qos", f"node {node}: {fqn}'s {policy} is {said.upper()} {got[2]} and "
+        out.append(Finding(f"{code}-qos", f"node {node}: {fqn}'s {policy} is {said.upper()} {got.where} and "
                                           f"{written} in its NoDL document",
                            (_loc(edge.src, doc_end.loc), doc_end.qos.where(policy))))
+    if got.timing is None:
+        return out
+    pub = doc_end.kind == "publishers"
+    for m in mismatches(got.timing, doc_end.qos) if pub else mismatches(doc_end.qos, got.timing):
+        if m.policy in ("reliability", "durability"):
+            continue
+        what = dict(DURATIONS).get(m.policy, m.policy)
+        ran, doc = (m.offered, m.requested) if pub else (m.requested, m.offered)
+        verb, other = ("offers", "subscription") if pub else ("requests", "publisher")
+        out.append(Finding(f"{code}-qos", f"node {node}: {fqn} {verb} {what} {ran} {got.where} and its NoDL "
+                                          f"document {verb} {doc}: a {other} the document admits does not connect "
+                                          f"({m.why})", (_loc(edge.src, doc_end.loc), doc_end.qos.where(m.policy))))
     return out
 
 
@@ -207,5 +247,5 @@ def check_code(documents: Mapping[str, Document], nodes: Mapping[str, GraphNode]
     return matched, out
 
 
-__all__ = ["Announced", "GRAPH_LISTS", "QosOf", "SIDES", "check_code", "code_qos_of", "compare_code", "live_qos_of",
+__all__ = ["Announced", "GRAPH_LISTS", "OtherQos", "QosOf", "SIDES", "check_code", "code_qos_of", "compare_code", "live_qos_of",
            "qos_differences", "resolve"]

@@ -129,6 +129,11 @@ class _Endpoint(TypedDict):
     hash: str
     reliable: bool
     durability: str
+    #: the offered (publisher) or requested (subscription) deadline and liveliness lease in ns, as
+    #: rmw reports them (``RMW_DURATION_INFINITE``, 2**63 - 1, for none), and the liveliness kind's name
+    deadline_ns: int
+    liveliness: str
+    lease_ns: int
 
 
 class _Tap(TypedDict):
@@ -374,7 +379,9 @@ def _endpoint(p: Any) -> _Endpoint:
             "type": p.topic_type, "hash": str(p.topic_type_hash),
             "reliable": p.qos_profile.reliability == ReliabilityPolicy.RELIABLE,
             "durability": "transient_local" if p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
-            else "volatile"}
+            else "volatile",
+            "deadline_ns": int(p.qos_profile.deadline.nanoseconds), "liveliness": p.qos_profile.liveliness.name.lower(),
+            "lease_ns": int(p.qos_profile.liveliness_lease_duration.nanoseconds)}
 
 
 def _matches(qos: tuple[bool, bool] | None, pubs: list[_Endpoint]) -> bool:
@@ -456,7 +463,7 @@ def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> di
     until it has not changed for ``quiet_s``.  Each node with its publishers,
     subscribers, service servers and clients (hidden names included: an
     action's services), and each topic's publishers and subscriptions (GID,
-    node, type, reliability, durability)."""
+    node, type, reliability, durability, deadline, liveliness and its lease)."""
     rclpy.init()
     name = f"_rclverify_graph_{os.getpid()}"
     node = Node(name)

@@ -23,9 +23,24 @@ from typing import Any
 
 from rclverify.ros.live.dds import NodeInfo, dds_type, reply_topic, request_topic, topic_name
 from rclverify.ros.live.dds_discovery import EndpointInfo
-from rclverify.ros.live.dds_qos import QosProfile
+from rclverify.ros.live.dds_qos import INFINITE_NS, LIVELINESS, QosProfile
 from rclverify.runtime.rclpy_source.bus import AGENT, RclpyUnavailable
 from rclverify.runtime.rclpy_source.wire import read_frame
+
+
+def _ns(value: object) -> int:
+    """A duration of the dump in ns, :data:`INFINITE_NS` for none (rmw's 0 "default" or its infinite)."""
+    ns = int(value) if isinstance(value, (int, float)) else 0
+    return INFINITE_NS if ns <= 0 or ns >= INFINITE_NS else ns
+
+
+def _qos(p: dict[str, Any]) -> QosProfile:
+    """The matching policies of one endpoint of the dump: reliability, durability, and, where the dump
+    has them, deadline, liveliness (a kind DDS does not have, rclpy's ``system_default`` or
+    ``unknown``, read as the rmw default ``automatic``) and its lease."""
+    live = str(p.get("liveliness", "automatic"))
+    return QosProfile(reliable=bool(p["reliable"]), durability=p["durability"], deadline_ns=_ns(p.get("deadline_ns")),
+                      liveliness=live if live in LIVELINESS else "automatic", lease_ns=_ns(p.get("lease_ns")))
 
 
 class RclpyDiscovery:
@@ -44,8 +59,7 @@ class RclpyDiscovery:
             for role, table in (("pubs", self.writers), ("subs", self.readers)):
                 for p in roles.get(role, []):
                     gid = bytes.fromhex(p["gid"])
-                    table[gid] = EndpointInfo(gid, gid[:12], topic_name(topic), dds_type(p["type"]),
-                                              QosProfile(reliable=bool(p["reliable"]), durability=p["durability"]))
+                    table[gid] = EndpointInfo(gid, gid[:12], topic_name(topic), dds_type(p["type"]), _qos(p))
                     if (p["ns"], p["node"]) in full:
                         self._node[gid] = full[(p["ns"], p["node"])]
         for n in dump.get("nodes", []):
