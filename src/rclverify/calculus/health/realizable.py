@@ -266,6 +266,32 @@ def _sequence_answers(cn: CheckedNode, names: Sequence[str]) -> list[dict[str, a
     return [dict(zip(names, c)) for c in itertools.islice(itertools.product(*per), MAX_SEQUENCE_ANSWERS)]
 
 
+def _smallest_conflict(q: _Query, node: str, every: list[int]) -> tuple[list[int], tuple[dict[str, str] | None, str] | None, float]:
+    """A smallest set of guarantees (0-based) no output can answer together
+    for some admissible input, searched by size (up to
+    :data:`MAX_SUBSET_SEARCH` guarantees; ``every`` beyond that or when no
+    smaller set conflicts); returns it, the (model, query text) of the query
+    that found it (``None``: none smaller than ``every``), and the solver's
+    seconds spent."""
+    secs = 0.0
+    if not 1 < len(every) <= MAX_SUBSET_SEARCH:
+        return every, None, secs
+    for size in range(1, len(every)):
+        subsets = list(itertools.combinations(every, size))
+        # with tables, a first look at each subset of this size, then the whole budget: the first conflict
+        # in that order is reported (a smallest set of guarantees without an answer); without tables the
+        # queries have their whole budget whatever budget_ms says, so they are asked once
+        for budget in ((SUBSET_FIRST_MS, REALIZABLE_TIMEOUT_MS) if has_tables(q.enc) else (REALIZABLE_TIMEOUT_MS,)):
+            for ks in subsets:
+                st, m, dt, text = q.answer(ks, f"health {node}: is there an input guarantees "
+                                                f"{', '.join(str(k + 1) for k in ks)} cannot answer?",
+                                           general=False, budget_ms=budget)
+                secs += dt
+                if st == "sat":
+                    return list(ks), (m, text), secs
+    return every, None, secs
+
+
 def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, ast.Loc]],
                    instances: tuple[int, int] | None, bounds: Mapping[str, Bound] | None = None,
                    implementation: Mapping[str, ast.Expr] | None = None) -> list[Finding]:
@@ -321,28 +347,10 @@ def _realizability(checked: Checked, node: str, facts: Sequence[tuple[ast.Expr, 
                         witness=dict(w.terms) if w is not None else None, witness_smt2=witness_smt2)]
     if status != "sat":
         return []
-    conflict = every
-    if 1 < len(every) <= MAX_SUBSET_SEARCH:
-        for size in range(1, len(every)):
-            found = None
-            subsets = list(itertools.combinations(every, size))
-            # with tables, a first look at each subset of this size, then the whole budget: the first conflict
-            # in that order is reported (a smallest set of guarantees without an answer); without tables the
-            # queries have their whole budget whatever budget_ms says, so they are asked once
-            for budget in ((SUBSET_FIRST_MS, REALIZABLE_TIMEOUT_MS) if has_tables(q.enc) else (REALIZABLE_TIMEOUT_MS,)):
-                for ks in subsets:
-                    st, m, dt, text = q.answer(ks, f"health {node}: is there an input guarantees "
-                                                    f"{', '.join(str(k + 1) for k in ks)} cannot answer?",
-                                               general=False, budget_ms=budget)
-                    secs += dt
-                    if st == "sat":
-                        found = (list(ks), m, text)
-                        break
-                if found:
-                    break
-            if found:
-                conflict, model, smt2 = found[0], found[1], found[2] or smt2
-                break
+    conflict, found, dt = _smallest_conflict(q, node, every)
+    secs += dt
+    if found is not None:
+        model, smt2 = found[0], found[1] or smt2
     names = [f"guarantee {k + 1} ({_where(n.guarantees[k].loc)})" for k in conflict]
     short = [x.split(" (")[0] for x in names]
     which = short[0] if len(short) == 1 else ", ".join(short[:-1]) + f" and {short[-1]} together"
