@@ -1,19 +1,21 @@
-"""Each record defined once (records/findings.py): the schema's part generated from it, every field
-rendered or declared internal, sealed records decoded into it.
+"""Each record defined once (records/findings.py, records/obligations.py): the schema's part generated from
+it, every field rendered or declared internal, sealed records decoded into it.
 
 The rule, for a contract-health finding: :class:`~rclverify.records.findings.FindingRow` (extending
 :class:`~rclverify.records.findings.HealthFinding`) is the only statement of its fields; the
 ``findings[]`` items of docs/assurance.schema.json are generated from it (records/schema_gen.py); each
 field is read by one of the report's finding renderers (report/templates/parts/findings.{html,md}.j2)
-or named in :data:`~rclverify.records.findings.INTERNAL`.  Each check is also run on a definition with a
-field added, and must then fail.  In-process and cheap: no pipeline runs here.
+or named in :data:`~rclverify.records.findings.INTERNAL`.  The same holds for an obligation's row
+(:class:`~rclverify.records.obligations.ObligationRow`, ``obligations[]``, rendered by
+report/templates/parts/obligations.{html,md}.j2).  Each check is also run on a definition with a field
+added, and must then fail.  In-process and cheap: no pipeline runs here.
 """
 from __future__ import annotations
 
 import copy
 import typing
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, NamedTuple
 
 import jinja2
 import msgspec
@@ -22,7 +24,9 @@ from jinja2 import nodes
 
 from _report_schema import SCHEMA
 from rclverify.records import schema_gen
+from rclverify.records import obligations
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
+from rclverify.records.obligations import ObligationRow
 from rclverify.report.render import part_renderer
 from rclverify.report.fragments import FragmentCache
 
@@ -30,30 +34,51 @@ PARTS = Path(__file__).resolve().parents[1] / "src" / "rclverify" / "report" / "
 RENDERERS = ("findings.html.j2", "findings.md.j2")
 
 
-def fields_read(source: str) -> set[str]:
-    """The attributes a template reads on the loop variable of each ``for`` over ``...|findings``
-    (the filter that decodes the rows into :class:`FindingRow`), found in jinja2's parse tree."""
+class Record(NamedTuple):
+    """A record defined once: its class, its INTERNAL table, the filter its renderers decode it with,
+    its renderers (parts), and the schema key generated from it."""
+    cls: type[msgspec.Struct]
+    internal: Mapping[str, str]
+    filter: str
+    renderers: tuple[str, ...]
+
+
+RECORDS: dict[str, Record] = {
+    "findings": Record(FindingRow, INTERNAL, "findings", RENDERERS),
+    "obligations": Record(ObligationRow, obligations.INTERNAL, "obligation_row",
+                          ("obligations.html.j2", "obligations.md.j2")),
+}
+
+
+def fields_read(source: str, filter_name: str = "findings") -> set[str]:
+    """The attributes a template reads on a name bound to a value of ``...|<filter_name>`` (the filter that
+    decodes rows into their class): the loop variable of a ``for`` over it, or a name ``set`` to it inside
+    a loop (read within that loop), found in jinja2's parse tree."""
     tree = jinja2.Environment().parse(source)
     out: set[str] = set()
+
+    def decoded(x: nodes.Node) -> bool:
+        return isinstance(x, nodes.Filter) and x.name == filter_name
+
     for loop in tree.find_all(nodes.For):
-        if not (isinstance(loop.iter, nodes.Filter) and loop.iter.name == "findings"
-                and isinstance(loop.target, nodes.Name)):
-            continue
-        var = loop.target.name
+        names = {loop.target.name} if decoded(loop.iter) and isinstance(loop.target, nodes.Name) else set()
+        names |= {a.target.name for a in loop.find_all(nodes.Assign)
+                  if decoded(a.node) and isinstance(a.target, nodes.Name)}
         for n in loop.find_all(nodes.Getattr):
-            if isinstance(n.node, nodes.Name) and n.node.name == var:
+            if isinstance(n.node, nodes.Name) and n.node.name in names:
                 out.add(n.attr)
         for n in loop.find_all(nodes.Getitem):
-            if isinstance(n.node, nodes.Name) and n.node.name == var and isinstance(n.arg, nodes.Const):
+            if isinstance(n.node, nodes.Name) and n.node.name in names and isinstance(n.arg, nodes.Const):
                 out.add(str(n.arg.value))
     return out
 
 
-def unaccounted(cls: type[msgspec.Struct], sources: Iterable[str], internal: Mapping[str, str]) -> list[str]:
+def unaccounted(cls: type[msgspec.Struct], sources: Iterable[str], internal: Mapping[str, str],
+                filter_name: str = "findings") -> list[str]:
     """What breaks the rule for ``cls``: a field no renderer reads and not internal, an internal name
     that is no field, a field both internal and rendered, a read of a name that is no field."""
     fields = set(cls.__struct_fields__)
-    read = set().union(*(fields_read(s) for s in sources))
+    read = set().union(*(fields_read(s, filter_name) for s in sources))
     out = [f"{k}: neither rendered nor declared internal" for k in sorted(fields - read - set(internal))]
     out += [f"{k}: declared internal but no field" for k in sorted(set(internal) - fields)]
     out += [f"{k}: declared internal but rendered" for k in sorted(set(internal) & read)]
@@ -61,13 +86,15 @@ def unaccounted(cls: type[msgspec.Struct], sources: Iterable[str], internal: Map
     return out
 
 
-def _sources() -> list[str]:
-    return [(PARTS / name).read_text(encoding="utf-8") for name in RENDERERS]
+def _sources(renderers: tuple[str, ...] = RENDERERS) -> list[str]:
+    return [(PARTS / name).read_text(encoding="utf-8") for name in renderers]
 
 
-def test_every_field_of_a_finding_is_rendered_or_internal() -> None:
-    assert unaccounted(FindingRow, _sources(), INTERNAL) == []
-    assert all(why for why in INTERNAL.values())  # each internal field says why it is not shown
+@pytest.mark.parametrize("key", list(RECORDS))
+def test_every_field_of_a_record_is_rendered_or_internal(key: str) -> None:
+    r = RECORDS[key]
+    assert unaccounted(r.cls, _sources(r.renderers), r.internal, r.filter) == []
+    assert all(why for why in r.internal.values())  # each internal field says why it is not shown
 
 
 class _WithMargin(FindingRow, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
@@ -90,11 +117,59 @@ def test_a_field_added_and_not_rendered_fails_until_rendered_or_internal() -> No
     assert unaccounted(FindingRow, sources, {**INTERNAL, "core": "x"}) == ["core: declared internal but rendered"]
 
 
-def test_the_schema_findings_part_is_generated_from_the_definition() -> None:
-    assert SCHEMA["properties"]["findings"] == schema_gen.generated_part("findings")
-    items = SCHEMA["properties"]["findings"]["items"]
-    assert list(items["properties"]) == list(FindingRow.__struct_fields__)
+@pytest.mark.parametrize("key", list(RECORDS))
+def test_the_schema_part_is_generated_from_the_definition(key: str) -> None:
+    assert list(schema_gen.GENERATED) == list(RECORDS)  # each generated part is a record checked here
+    assert SCHEMA["properties"][key] == schema_gen.generated_part(key)
+    items = SCHEMA["properties"][key]["items"]
+    assert list(items["properties"]) == list(RECORDS[key].cls.__struct_fields__)
     assert items["additionalProperties"] is False
+
+
+class _ObligationWithMargin(ObligationRow, frozen=True, forbid_unknown_fields=True):
+    """The obligation row with one field added, as a change to records/obligations.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_an_obligation_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["obligations"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_ObligationWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_ObligationWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ o.backend }}", "{{ o.backend }} {{ o.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_ObligationWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    # a read of the undecoded row (``row.obligation``) does not count: only the decoded row's reads do
+    raw = sources[0].replace("{{ o.backend }}", "{{ o.backend }} {{ row.obligation.margin_added_here }}", 1)
+    assert unaccounted(_ObligationWithMargin, [raw, sources[1]], r.internal, r.filter) != []
+    # the schema part follows the definition, and then the checked-in file differs
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "obligations", (_ObligationWithMargin, schema_gen.GENERATED["obligations"][1]))
+        part = schema_gen.generated_part("obligations")
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["obligations"] != part
+
+
+_OBLIGATION: dict[str, Any] = {
+    "id": "N.g1.hoare.c1", "node": "Nodey", "guarantee": 1, "backend": "backend-text", "kind": "model checking",
+    "instance": "instance-text", "statement": "statement_text", "source": "a.rcl:3:4",
+    "artifact": "artifact-text", "status": "failed"}
+
+
+def test_the_obligation_renderers_show_each_field_and_refuse_an_undeclared_key() -> None:
+    part = part_renderer(FragmentCache(), "")
+    shown = {**{k: str(v) for k, v in _OBLIGATION.items()}, "guarantee": "Nodey g1", "source": "rcl:3:4"}
+    assert list(shown) == list(ObligationRow.__struct_fields__)
+    rows = [{"obligation": _OBLIGATION, "evidence": ["ev-x"]}]
+    for name in ("obligations.html", "obligations.md"):
+        text = str(part(name, rows=rows))
+        assert [k for k, t in shown.items() if t not in text] == [], name
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("obligations.html", rows=[{"obligation": {**_OBLIGATION, "margin_added_here": "0.5 m"}, "evidence": []}])
+    # the JSON object the report writes is every field, in the order declared
+    assert ObligationRow.of(_OBLIGATION).to_json() == _OBLIGATION
+    assert list(ObligationRow.of(_OBLIGATION).to_json()) == list(ObligationRow.__struct_fields__)
 
 
 def test_a_field_added_reaches_the_schema_and_the_checked_in_file_then_differs(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -203,15 +203,15 @@ def test_a_key_in_one_and_not_the_other_is_found() -> None:
                  "report.evidence.strength.colour: only in the schema"),
                 (lambda s: s["properties"]["nodes"]["items"]["required"].remove("latex"),
                  "report.nodes.latex: required in one only"),
-                (lambda s: s["properties"]["obligations"]["items"]["properties"]["guarantee"].update(type="string"),
-                 "report.obligations.guarantee: ['integer'] in the TypedDict, ['string'] in the schema"),
+                (lambda s: s["properties"]["unverified"]["items"]["properties"]["guarantee"].update(type="string"),
+                 "report.unverified.guarantee: ['integer'] in the TypedDict, ['string'] in the schema"),
                 (lambda s: s["properties"]["requirements"]["items"]["properties"].pop("strength_shortfall"),
                  "report.requirements.strength_shortfall: only in the TypedDict"),
                 (lambda s: s["properties"]["unverified"]["items"]["properties"]["status"].update(const="pending"),
                  "report.unverified.status: words ['unverified'] in the TypedDict, ['pending'] in the schema"),
-                (lambda s: s["properties"]["obligations"]["items"]["properties"]["guarantee"].update(
+                (lambda s: s["properties"]["unverified"]["items"]["properties"]["guarantee"].update(
                     type=["integer", "null"]),
-                 "report.obligations.guarantee: null allowed by the schema only")):
+                 "report.unverified.guarantee: null allowed by the schema only")):
             SCHEMA = copy.deepcopy(kept)
             change(SCHEMA)
             assert want in _disagreements(st.Report, SCHEMA, "report"), want

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from typing import NotRequired, TypedDict, cast
 
 from rclverify.diagnosis.edits import Edit
-from rclverify.records.report_schema import (DeadlineRow, EvidenceRow, FindingJson, LintRow, NodeRow, ObligationRow,
+from rclverify.records.report_schema import (DeadlineRow, EvidenceRow, FindingJson, LintRow, NodeRow, ObligationJson,
                                              RequirementRow, SideConditionRow, SystemView)
 from rclverify.records.stage_records import Repair
 
@@ -28,7 +28,7 @@ class ReportRows(TypedDict):
     nodes: list[NodeRow]
     side_conditions: list[SideConditionRow]
     findings: list[FindingJson]
-    obligations: list[ObligationRow]
+    obligations: list[ObligationJson]
     evidence: list[EvidenceRow]
     lint: list[LintRow]
     deadlines: list[DeadlineRow]

@@ -350,18 +350,13 @@ class DerivedPropertyRow(TypedDict):
 FindingJson = dict[str, Any]
 
 
-class ObligationRow(TypedDict):
-    """An obligation (``obligations[]``); ``guarantee`` 0 is the whole contract."""
-    id: str
-    node: str
-    guarantee: int
-    backend: str
-    kind: EvidenceKind
-    instance: str
-    statement: str
-    source: str
-    artifact: str
-    status: EvidenceStatus
+#: An obligation's row (``obligations[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.obligations.ObligationRow`, the one definition of its fields (the schema's
+#: ``obligations`` items are generated from it, records/schema_gen.py); decode it with
+#: ``ObligationRow.of`` to read its fields as attributes.
+ObligationJson = dict[str, Any]
+#: The same JSON object, by the name report/margin_rows.py imports.
+ObligationRow = ObligationJson
 
 
 class EvidenceRow(TypedDict):
@@ -502,7 +497,7 @@ class Report(TypedDict):
     side_conditions: list[SideConditionRow]
     derived_properties: list[DerivedPropertyRow]
     findings: list[FindingJson]
-    obligations: list[ObligationRow]
+    obligations: list[ObligationJson]
     evidence: list[EvidenceRow]
     environment_assumptions: list[EnvironmentAssumptionRow]
     pending: list[PendingRow]

@@ -28,11 +28,13 @@ import msgspec
 
 from rclverify.core.atomic import atomic_write_text
 from rclverify.records.findings import FindingRow
+from rclverify.records.obligations import ObligationRow
 from rclverify.records.statuses import VOCABULARY
 
 #: Top-level key of the report -> (the class of its items, the key's description).
 GENERATED: dict[str, tuple[type[msgspec.Struct], str]] = {
     "findings": (FindingRow, "Contract health findings (vacuity, consistency, realizability, scale)."),
+    "obligations": (ObligationRow, "Every obligation of the plan's evidence entries."),
 }
 
 #: A type the report's schema already defines in ``$defs`` -> that entry's name.

@@ -43,7 +43,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence
 
-from rclverify.records.report_schema import DeadlineRow, ObligationRow, Report
+from rclverify.records.report_schema import DeadlineRow, ObligationJson, Report
 from rclverify.records.sarif import SarifResult
 from rclverify.records.records import worst
 from rclverify.records.statuses import DEADLINE_STATUS
@@ -68,7 +68,7 @@ def _spec_of(rec: Mapping[str, Any], spec: Any) -> bool:
 
 
 def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[[str, int], str],
-                  ob_rows: Sequence[ObligationRow], second: Any = None) -> list[dict[str, Any]]:
+                  ob_rows: Sequence[ObligationJson], second: Any = None) -> list[dict[str, Any]]:
     """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
     docstring).  ``current``: path -> sha256 of the current snapshots and
     model (:func:`rclverify.stages.workspace.current_snapshot_hashes`);
@@ -140,7 +140,7 @@ def _timing_measured(hop: dict[str, Any]) -> None:
                          "guarantee's formula only (a monitors entry on a recorded or live run times it)")
 
 
-def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationRow],
+def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationJson],
                       nodes: set[str]) -> dict[str, list[dict[str, Any]]]:
     """node -> the deadline verdicts of its monitors' evidence records
     (``details["deadlines"]``, backends/monitors/deadlines.py):

@@ -13,7 +13,9 @@ from __future__ import annotations
 from typing import Any, Mapping, Sequence, TypedDict, cast
 
 from rclverify.records.records import Obligation
-from rclverify.records.report_schema import EvidenceRow, ObligationRow, PendingRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.report_schema import EvidenceRow, ObligationJson, PendingRow
+from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 from rclverify.records.store import EvidenceStore
 from rclverify.report.statistics import compact as compact_statistics
 from rclverify.stages.crosscheck.apply import SecondSolver
@@ -29,7 +31,7 @@ class EvidencePart(TypedDict):
     declarations; ``altered``: one problem sentence per record
     that cannot be read as rclverify wrote it; ``inputs``: obligation id ->
     the input sha256s its evidence was made from (``None``: no record)."""
-    obligations: list[ObligationRow]
+    obligations: list[ObligationJson]
     evidence: list[EvidenceRow]
     pending: list[PendingRow]
     status: dict[str, str]
@@ -109,10 +111,10 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
         status = "error" if altered else (store.current_status(ev, hashes) if ev else "pending")
         status, solvers = second.evidence(o.id, o.backend, status)
         part["status"][o.id] = status
-        part["obligations"].append(cast(ObligationRow, {
-            "id": o.id, "node": o.node, "guarantee": o.guarantee, "backend": o.backend, "kind": o.kind,
-            "instance": o.instance, "statement": o.statement, "source": str(o.source), "artifact": o.artifact,
-            "status": status}))  # the record's words: the vocabulary's (records/statuses.py)
+        part["obligations"].append(ObligationRow(
+            id=o.id, node=o.node, guarantee=o.guarantee, backend=o.backend, kind=cast(EvidenceKind, o.kind),
+            instance=o.instance, statement=o.statement, source=str(o.source), artifact=o.artifact,
+            status=cast(EvidenceStatus, status)).to_json())  # the record's words: the vocabulary's (records/statuses.py)
         if ev is None:
             if altered:
                 part["altered"].append(f"Evidence {o.id} is error: {altered}")

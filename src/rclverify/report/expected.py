@@ -24,7 +24,7 @@ from typing import Any, Mapping, Sequence
 
 from rclverify.model.plan.expected import VERDICTS
 from rclverify.model.plan.load import Plan
-from rclverify.records.report_schema import ObligationRow
+from rclverify.records.report_schema import ObligationJson
 
 
 def _loc(plan: Plan, node: str, index: int, k: int) -> str:
@@ -35,7 +35,7 @@ def _loc(plan: Plan, node: str, index: int, k: int) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
-def expected_rows(plan: Plan, ob_rows: Sequence[ObligationRow]) -> list[dict[str, Any]]:
+def expected_rows(plan: Plan, ob_rows: Sequence[ObligationJson]) -> list[dict[str, Any]]:
     """One row per (expectation, matching obligation) of every evidence entry:
     ``{"node", "backend", "guarantee", "instance", "expected", "actual",
     "obligation", "outcome", "reason", "source"}``; ``actual``/``obligation``

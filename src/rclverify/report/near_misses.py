@@ -24,7 +24,7 @@ import math
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence
 
-from rclverify.records.report_schema import NearMissRow, ObligationRow, Report
+from rclverify.records.report_schema import NearMissRow, ObligationJson, Report
 from rclverify.records.sarif import SarifResult
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
@@ -66,7 +66,7 @@ def _guarantee_place(ws: Workspace, node: str, k: int) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
-def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[NearMissRow]:
+def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[NearMissRow]:
     """The report's ``near_misses`` (module docstring), in obligation order,
     space margins before time margins, guarantees in order."""
     rows: list[NearMissRow] = []
@@ -91,7 +91,7 @@ def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[Near
         t, plan_place = hit[1], hit[2]
 
         def row(m: Mapping[str, Any], kind: str, margin: float, threshold: float, unit: str, atom: str,
-                where: str, at: Any, node: str = node, o: ObligationRow = o, trace: str = trace,
+                where: str, at: Any, node: str = node, o: ObligationJson = o, trace: str = trace,
                 plan_place: str = plan_place) -> NearMissRow:
             k = int(m["guarantee"])
             return {"node": node, "guarantee": k, "kind": "time" if kind == "time" else "value", "margin": margin,

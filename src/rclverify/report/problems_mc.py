@@ -27,7 +27,7 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from rclverify.records.report_schema import ObligationRow, Report
+from rclverify.records.report_schema import ObligationJson, Report
 from rclverify.model.plan.declarations import DECLARATIONS
 
 #: Backends whose evidence is a model checker's verdict on a property instance.
@@ -37,12 +37,12 @@ OUTSTANDING_PREFIX = "outstanding:model-checking:"
 _TRAIL = re.compile(r"Gwendolen lines? ([\d, ]+) of (\S+)")
 
 
-def mc_obligations(report: Report) -> dict[str, ObligationRow]:
+def mc_obligations(report: Report) -> dict[str, ObligationJson]:
     """``{obligation id: obligation}`` of the report's model-checking obligations."""
     return {str(o["id"]): o for o in report.get("obligations", []) if o.get("backend") in MC_BACKENDS}
 
 
-def mc_key(o: ObligationRow, status: str) -> str:
+def mc_key(o: ObligationJson, status: str) -> str:
     """The group key of an instance of obligation ``o`` with ``status`` whose
     diagnosis names no culprit but its own guarantee (module docstring)."""
     prefix = OUTSTANDING_PREFIX if status in ("inconclusive", "pending", "stale") else FAILED_PREFIX

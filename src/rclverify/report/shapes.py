@@ -13,7 +13,7 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 from typing import Any, NotRequired, TypedDict
 
 from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceRow, FindingJson, NodeRow,
-                                             LimitedBy, ObligationRow, PendingRow, ProblemRow, RequirementRow, SideConditionRow,
+                                             LimitedBy, ObligationJson, PendingRow, ProblemRow, RequirementRow, SideConditionRow,
                                              Summary, SupportRow)
 
 
@@ -168,7 +168,7 @@ class Section(TypedDict):
 
 class ObligationRun(TypedDict):
     """An obligation's row of the obligations table: the fragment ids of its evidence records."""
-    obligation: ObligationRow
+    obligation: ObligationJson
     evidence: list[str]
 
 
@@ -200,7 +200,7 @@ class ReportView(TableRuns):
     unmet_requirements: list[RequirementRow]
     ev_anchor: list[str]
     evidence_of: dict[str, list[tuple[str, EvidenceRow]]]
-    obligation: dict[str, ObligationRow]
+    obligation: dict[str, ObligationJson]
     trace: list[TraceEntry]
     sections: list[Section]
     lint_errors: int

@@ -19,6 +19,7 @@ import jinja2
 from markupsafe import Markup, escape
 
 from rclverify.records.findings import FindingRow, rows_of
+from rclverify.records.obligations import ObligationRow
 from rclverify.records.records import SEVERITY
 from rclverify.report import htmlfilters
 from rclverify.report.textfmt import breakable, formula_html, formula_lines
@@ -237,6 +238,15 @@ def finding_rows(rows: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
     return rows_of(rows)
 
 
+def obligation_row(row: Mapping[str, Any] | ObligationRow) -> ObligationRow:
+    """An obligation's row (``obligations[]``) decoded into
+    :class:`~rclverify.records.obligations.ObligationRow`, so a template
+    reads declared fields only (tests/test_record_shapes.py holds every
+    field to a renderer or :data:`~rclverify.records.obligations.INTERNAL`).
+    Raises :class:`msgspec.ValidationError` for a key no field declares."""
+    return ObligationRow.of(row)
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -261,7 +271,7 @@ def environment() -> jinja2.Environment:
         anchor=anchor, badge=html_badge, md=md_text, code=md_code, fence=md_fence,
         mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
         formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
-        formulas=formula_html_list, findings=finding_rows,
+        formulas=formula_html_list, findings=finding_rows, obligation_row=obligation_row,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame

@@ -14,7 +14,7 @@ from collections import defaultdict
 from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
 from rclverify.records.findings import rows_of
-from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceRow, FindingJson, ObligationRow, ProblemRow,
+from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceRow, FindingJson, ObligationJson, ProblemRow,
                                              Report, SideConditionRow)
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
@@ -249,7 +249,7 @@ def dashboard(report: Report, evidence_of: Mapping[str, Sequence[tuple[str, obje
 
 
 
-def _trace(report: Report, obligation: Mapping[str, ObligationRow],
+def _trace(report: Report, obligation: Mapping[str, ObligationJson],
            evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> list[TraceEntry]:
     """The traceability rows: per requirement, its supporting guarantees with
     each obligation's status and evidence (``rowspan``: rows it spans)."""
@@ -272,7 +272,7 @@ def _trace(report: Report, obligation: Mapping[str, ObligationRow],
     return trace
 
 
-def _sections(report: Report, obligation: Mapping[str, ObligationRow]) -> list[Section]:
+def _sections(report: Report, obligation: Mapping[str, ObligationJson]) -> list[Section]:
     """Per node (then per name only the calculus knows): the node, its derived
     property, side conditions, findings and ``ob_status`` (the status of each
     obligation its guarantees list)."""
@@ -304,7 +304,7 @@ def _pending_groups(report: Report) -> list[PendingGroup]:
     return list(groups.values())
 
 
-def _table_runs(report: Report, ev_anchor: Sequence[str], obligation: Mapping[str, ObligationRow],
+def _table_runs(report: Report, ev_anchor: Sequence[str], obligation: Mapping[str, ObligationJson],
                 evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> TableRuns:
     """``finding_runs``, ``obligation_runs`` and ``evidence_runs`` of :func:`view`."""
     def node_of_evidence(item: EvidenceRun) -> str:

@@ -39,7 +39,7 @@ import re
 from typing import Any, Iterable, Mapping, TypeVar
 
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import (EnvironmentAssumptionRow, NodeRow, ObligationRow, Report,
+from rclverify.records.report_schema import (EnvironmentAssumptionRow, NodeRow, ObligationJson, Report,
                                              RequirementRow, SideConditionRow)
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
@@ -51,7 +51,7 @@ from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
 
 #: A report row that names its node.
-_Row = TypeVar("_Row", ObligationRow, SideConditionRow, EnvironmentAssumptionRow)
+_Row = TypeVar("_Row", ObligationJson, SideConditionRow, EnvironmentAssumptionRow)
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -246,7 +246,7 @@ class _Goals:
                                                              str(text)))
                 self.loop_of[str(d["node"])] = self.loop_ids[text]
 
-    def _evidence(self, o: ObligationRow) -> str:
+    def _evidence(self, o: ObligationJson) -> str:
         """The solution of obligation ``o`` (its evidence record), or an undeveloped goal without one."""
         oid = str(o["id"])
         ev = self.ev_of.get(oid)

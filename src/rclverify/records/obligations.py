@@ -1,0 +1,77 @@
+"""An obligation's row of the report, defined once: :class:`ObligationRow`.
+
+The report's ``obligations[]`` holds one row per obligation of the plan's
+evidence entries: the exported obligation (records/records.py
+:class:`~rclverify.records.records.Obligation`, its ``source`` as
+``file:line:col``) with the *current* status of its evidence
+(report/evidence_rows.py: ``stale`` when an input changed, ``pending``
+without a record, ``error`` for an altered record, a proof the second
+solver does not confirm downgraded).
+
+The rules (docs/decisions.md, "One definition per record"):
+
+* This class is the only statement of the row's fields.  The report pass
+  builds it and writes :meth:`ObligationRow.to_json` (every field, in the
+  order declared); a reader decodes the JSON object with
+  :meth:`ObligationRow.of` (a key the class does not declare, or a value of
+  another type, raises :class:`msgspec.ValidationError`).
+* The ``obligations[]`` items of docs/assurance.schema.json are generated
+  from it (records/schema_gen.py); tests/test_record_shapes.py fails when
+  the file and the class differ.
+* Every field is read by a renderer of the obligations table
+  (report/templates/parts/obligations.{html,md}.j2, which decode each row
+  with the ``obligation_row`` filter) or named in :data:`INTERNAL` with the
+  reason it is not shown; tests/test_record_shapes.py fails otherwise.
+"""
+from __future__ import annotations
+
+from typing import Annotated, Any, Iterable, Mapping
+
+import msgspec
+
+from rclverify.records.statuses import EvidenceKind, EvidenceStatus
+
+_DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
+
+
+class ObligationRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """An obligation: what one backend must establish about one guarantee."""
+
+    id: Annotated[str, _DOC(description="Stable id <node>.g<k>.<backend>[.<instance>].")]
+    node: Annotated[str, _DOC(description="The node's name as the contracts declare it.")]
+    guarantee: Annotated[int, _DOC(ge=0, description="1-based guarantee index; 0: the whole contract.")]
+    backend: Annotated[str, _DOC(description="The backend that discharges the obligation (hoare, dafny, ajpf, "
+                                             "property_tests, monitors, experiment, review, ...).")]
+    kind: Annotated[EvidenceKind, _DOC(description="The kind of evidence it asks for.")]
+    instance: Annotated[str, _DOC(description="The part of the guarantee the obligation covers (a conjunct, a "
+                                              "waypoint instance), empty for all of it.")]
+    statement: Annotated[str, _DOC(description="What must be established, RCL text.")]
+    source: Annotated[str, _DOC(description="file:line:col of the RCL or plan text (1-based line and column)")]
+    artifact: Annotated[str, _DOC(description="The file it was rendered to.")]
+    status: Annotated[EvidenceStatus, _DOC(description="Its evidence's current status (stale when an input "
+                                                       "changed; pending without a record).")]
+
+    def to_json(self) -> dict[str, Any]:
+        """The row as its JSON object (every field, in the order declared)."""
+        out: dict[str, Any] = msgspec.to_builtins(self)
+        return out
+
+    @classmethod
+    def of(cls, row: ObligationRow | Mapping[str, Any]) -> ObligationRow:
+        """``row`` (a row or its JSON object) as a row.  Raises
+        :class:`msgspec.ValidationError` for a key no field declares, a
+        missing field or a value of another type."""
+        return row if isinstance(row, ObligationRow) else msgspec.convert(dict(row), cls)
+
+
+def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[ObligationRow]:
+    """The report's ``obligations[]`` (JSON objects) decoded, in order
+    (:meth:`ObligationRow.of` for what raises)."""
+    return [ObligationRow.of(r) for r in rows]
+
+
+#: The fields of :class:`ObligationRow` no obligations-table renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {}
+
+
+__all__ = ["INTERNAL", "ObligationRow", "rows_of"]
