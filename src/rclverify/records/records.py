@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
@@ -137,7 +137,13 @@ def _plain(x: object) -> object:
 
 @dataclass(frozen=True)
 class Evidence:
-    """The result of one backend run (or import) for one obligation.
+    """The result of one backend run (or import) for one obligation: the one
+    definition of an evidence record (``artifacts/evidence/<id>.json``,
+    records/store.py), written by :meth:`to_json` and read by
+    :meth:`from_json` through msgspec.  A frozen dataclass rather than a
+    ``msgspec.Struct``: backends derive records with
+    :func:`dataclasses.replace`, and the kept caches' safe loader admits
+    dataclasses (core/cache/safeload.py).
 
     ``started`` is an ISO-8601 UTC timestamp; ``duration_s`` in seconds.
     ``input_hashes`` maps each workspace-relative input path to the sha256
@@ -145,7 +151,9 @@ class Evidence:
     ``artifacts`` are workspace-relative paths produced; ``log`` is the tool
     output (possibly truncated, the full log then lives in an artifact);
     ``counterexample`` is a JSON-serialisable mapping of names to values, or
-    ``None``; ``explanation`` is a sentence for the report.
+    ``None``; ``explanation`` is a sentence for the report; ``details`` the
+    backend's JSON-serialisable payload (figures, examples, monitoring,
+    statistics, declarations ..., read by report/evidence_rows.py).
     """
 
     obligation: str
@@ -164,28 +172,34 @@ class Evidence:
     details: Mapping[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["artifacts"] = list(self.artifacts)
-        d["input_hashes"] = dict(sorted(self.input_hashes.items()))
-        return d
+        """The record as its JSON object: msgspec's encoding of this class,
+        every field (``artifacts`` a list, ``input_hashes`` sorted by path),
+        so a field added here is in every record written."""
+        out: dict[str, Any] = msgspec.to_builtins(self, enc_hook=_plain)
+        out["artifacts"] = list(self.artifacts)
+        out["input_hashes"] = dict(sorted(self.input_hashes.items()))
+        return out
 
     @staticmethod
     def from_json(d: Mapping[str, Any]) -> "Evidence":
-        """The record of the JSON object ``d``.  Raises ``TypeError`` when
-        ``d`` is not an object (a record file holding ``[]`` or ``null``),
-        ``KeyError``/``ValueError`` for a missing field or an unknown status."""
+        """The record of the JSON object ``d``, decoded into this class by
+        msgspec.  Raises ``TypeError`` when ``d`` is not an object (a record
+        file holding ``[]`` or ``null``), ``ValueError`` (msgspec's
+        :class:`msgspec.ValidationError` among them) for a missing field, a
+        key no field declares, a value of another type or a status that is
+        no record's (records/statuses.py ``RECORD_STATUSES``)."""
         if not isinstance(d, Mapping):
             raise TypeError(f"an evidence record is a JSON object, not {type(d).__name__}")
+        undeclared = sorted(set(d) - set(_EVIDENCE_FIELDS))
+        if undeclared:
+            raise ValueError(f"an evidence record has no field {', '.join(map(repr, undeclared))}")
         if d.get("status") not in RECORD_STATUSES:  # never ``unverified``: a guarantee's status only
             raise ValueError(f"unknown evidence status {d.get('status')!r}")
-        return Evidence(
-            obligation=d["obligation"], backend=d["backend"], kind=d["kind"], status=d["status"],
-            tool=d["tool"], tool_version=d["tool_version"], started=d["started"],
-            duration_s=float(d["duration_s"]), input_hashes=dict(d.get("input_hashes", {})),
-            artifacts=tuple(d.get("artifacts", ())), log=d.get("log", ""),
-            counterexample=d.get("counterexample"), explanation=d.get("explanation", ""),
-            details=dict(d.get("details", {})),
-        )
+        return msgspec.convert(dict(d), Evidence)
+
+
+#: The fields of :class:`Evidence`, in the order declared.
+_EVIDENCE_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(Evidence))
 
 
 def sha256_file(path: Path) -> str:

@@ -113,7 +113,7 @@ class EvidenceStore:
         except (OSError, ValueError) as exc:
             return None, f"evidence record unreadable ({exc.__class__.__name__}): not written by rclverify"
         try:
-            ev = Evidence.from_json(raw)
+            ev = Evidence.from_json({k: v for k, v in raw.items() if k != SEAL} if isinstance(raw, dict) else raw)
         except (ValueError, KeyError, TypeError) as exc:
             return None, f"evidence record malformed ({exc}): altered outside rclverify"
         if not isinstance(raw, dict) or SEAL not in raw:
