@@ -82,8 +82,15 @@ and, unless ``--no-bags``, on the two bags) from an older source tree (e.g. ``gi
 and new/old: issue 44's "at least 3x today's samples/s" is that ratio, in
 one run on one machine.
 
+``--margins`` runs only the margins race (bench/_margin_peers.py): the
+batch path's space margins of ``G(x > 1)`` as a per-answer guarantee
+against RTAMT's, Reelay's and mstlo's robustness on ``--samples`` samples,
+samples per CPU second and whether every sample's value agrees; ``--smoke``
+ends with it on 1,000 samples.
+
 Usage::
 
+    python3 bench/monitor_peers.py --margins --samples 300000
     python3 bench/monitor_peers.py [--samples 1000000] [--wrong 0.001] [--compare OLD_SRC] [--no-bags] [--repeat K]
     python3 bench/monitor_peers.py --smoke     # 2,000 samples: a few seconds
 """
@@ -391,7 +398,9 @@ def main() -> int:
     ap.add_argument("--wrong", type=float, default=0.001, help="probability of a wrong status (a violation)")
     ap.add_argument("--seed", type=int, default=44)
     ap.add_argument("--compare", metavar="OLD_SRC", help="also run the engine and the command from this source tree")
-    ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI)")
+    ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI); then the margins race on 1,000")
+    ap.add_argument("--margins", action="store_true",
+                    help="only the margins race: G(x > 1) on --samples (bench/_margin_peers.py)")
     ap.add_argument("--no-bags", action="store_true", help="leave out the command on the sqlite3 and MCAP bags")
     ap.add_argument("--repeat", type=int, default=1, metavar="K",
                     help="run the command on the log and the bags, its start-up, the readings and the columns path K times; keep "
@@ -404,12 +413,18 @@ def main() -> int:
     args = ap.parse_args()
     if args.child:
         return child(args)
+    if args.margins:  # bench/_margin_peers.py: rclverify's margins against the peers' robustness
+        from _margin_peers import race
+        return 0 if race(1_000 if args.smoke else args.samples, args.seed, args.wrong) else 1
     if args.smoke:
         args.samples = 2_000
     print(f"{args.samples} samples (a reading and its answer each), {args.wrong:g} of the answers wrong, "
           f"seed {args.seed}")
     rows, verdicts = _measure(args)
     _print(rows, verdicts, args)
+    if args.smoke:
+        from _margin_peers import race
+        return 0 if race(1_000, args.seed, args.wrong) else 1
     return 0
 
 

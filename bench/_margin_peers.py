@@ -1,0 +1,164 @@
+"""The margins race of bench/monitor_peers.py (``--margins``): rclverify's batch path with margins
+against RTAMT's, Reelay's and mstlo's robustness on the same samples of ``G(x > 1)``.
+
+STL's ``G(x > 1)`` judged at time 0 has the robustness ``min_t (x(t) - 1)``
+(Donzé and Maler): the least of the per-sample robustness of ``x > 1``.
+RCL states it as a per-answer guarantee, ``guarantee( out.x > in.r )`` of a
+node answering each reading ``r`` (the limit, 1 in every sample) with ``x``:
+every answer's margin is that sample's ``x - 1`` and the run's smallest
+margin is ``G``'s robustness (docs/semantics.md, "Margins").  The same bound
+as an output-only guarantee, ``guarantee( out.x > 1 )``, reads no input, so
+the batch path leaves it to the streaming engine: its row gives that
+figure and its smallest margin (which must be the same).  Each tool gives the per-sample robustness of
+``x > 1`` (RTAMT 0.4.10's discrete-time specification updated sample by
+sample, Reelay 25's discrete robustness monitor sample by sample, mstlo
+0.2.2's ``DelayedQuantitative`` monitor by its batch call 16,384 samples at a
+time), rclverify its answers' margins: the bench compares every sample and
+the minimum, within 1e-9.
+
+rclverify is timed on the samples held in columns (traces/table.py, the
+readings and the answers as float64 arrays), judged by ``check_trace`` with
+``margins=True`` (the batch path: every answer's margin over the columns, the
+smallest kept per guarantee); its per-answer margins are collected in a
+second, untimed run through the verdict callback.  Every tool's set-up
+(imports, parsing, a first run on ten samples) is outside the timing, CPU
+seconds of this one process.  A peer that is not installed is skipped with
+the reason.
+"""
+from __future__ import annotations
+
+import math
+import time
+from typing import Any, Callable
+
+CONTRACT = ("node Level { inputs( r : REAL ) outputs( x : REAL ) "
+            "topics( std_msgs/Float64 raw matches(in.r), std_msgs/Float64 level matches(out.x) ) "
+            "guarantee( out.x > in.r ) }")
+#: The same bound as an output-only guarantee (it reads no input): the batch path leaves it to the engine.
+ALONE = CONTRACT.replace("out.x > in.r", "out.x > 1")
+PERIOD = 0.01  # s between samples
+HORIZON = 0.005  # s: a reading is answered by its own sample's x only
+
+
+def samples(n: int, seed: int, wrong: float) -> Any:
+    """``x`` (float64, n): uniform in [1, 5), below 1 (uniform in [0, 1)) with probability ``wrong``."""
+    import numpy as np
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(1.0, 5.0, n)
+    low = rng.random(n) < wrong
+    x[low] = rng.uniform(0.0, 1.0, int(low.sum()))
+    return x
+
+
+def _columns(x: Any) -> Any:
+    import numpy as np
+    from rclverify.traces.table import ColumnTrace
+    n = len(x)
+    topic = np.empty(2 * n + 1, dtype=np.int8)
+    topic[0:2 * n:2], topic[1:2 * n:2], topic[-1] = 0, 1, 2
+    t = np.arange(n, dtype=np.float64) * PERIOD
+    limit = np.ones(n)  # every reading states the limit 1
+    times = np.empty(2 * n + 1)
+    times[0:2 * n:2], times[1:2 * n:2], times[-1] = t, t, n * PERIOD + 10 * HORIZON
+    return ColumnTrace(topic, times, {"raw": {"data": limit}, "level": {"data": x}}, "synthetic", ["raw", "level", "tick"])
+
+
+def rclverify(x: Any, contract: str = CONTRACT, collect: bool = True) -> tuple[float, list[float], float]:
+    """CPU s of ``check_trace`` with margins on ``contract``, every answer's margin (an untimed run; none
+    unless ``collect``), the smallest kept."""
+    from rclverify.backends.monitors.check import check_trace
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    from rclverify.traces.mapping import load_rules
+    checked = check([parse_text(contract)])
+    node = checked.nodes["Level"]
+    rules = load_rules({"raw": {"fields": ["data"]}, "level": {"fields": ["data"]}})
+    check_trace(checked, [node], _columns(x[:10]), rules, HORIZON, margins=True)
+    t0 = time.process_time()
+    _, (res,) = check_trace(checked, [node], _columns(x), rules, HORIZON, margins=True)
+    cpu = time.process_time() - t0
+    got: list[float] = [math.nan] * len(x)
+    if not collect:
+        return cpu, got, res.margins[1].value
+
+    def seen(v: Any) -> None:
+        if v.margin is not None:
+            got[v.event // 2] = v.margin
+    check_trace(checked, [node], _columns(x), rules, HORIZON, seen, margins=True)
+    return cpu, got, res.margins[1].value
+
+
+def rtamt(x: Any) -> tuple[float, list[float]]:
+    import rtamt as rt  # type: ignore[import-not-found]
+    spec = rt.StlDiscreteTimeSpecification()
+    spec.declare_var("x", "float")
+    spec.spec = "x > 1"
+    spec.parse()
+    xs = x.tolist()
+    update = spec.update
+    t0 = time.process_time()
+    out = [update(i, [("x", v)]) for i, v in enumerate(xs)]
+    return time.process_time() - t0, [float(r) for r in out]
+
+
+def reelay(x: Any) -> tuple[float, list[float]]:
+    import reelay as rl  # type: ignore[import-not-found]
+    mon = rl.discrete_timed_monitor(pattern="{x > 1}", semantics="robustness", condense=False)
+    xs = x.tolist()
+    update = mon.update
+    t0 = time.process_time()
+    out = [update({"time": i, "x": v})["value"] for i, v in enumerate(xs)]
+    return time.process_time() - t0, [float(r) for r in out]
+
+
+def mstlo(x: Any) -> tuple[float, list[float]]:
+    import mstlo_python  # type: ignore[import-not-found]
+    mon = mstlo_python.Monitor(mstlo_python.parse_formula("x > 1"), semantics="DelayedQuantitative")
+    xs = x.tolist()
+    out: list[float] = []
+    step = 16384
+    t0 = time.process_time()
+    for a in range(0, len(xs), step):
+        got = mon.update_batch({"x": [(v, i * PERIOD) for i, v in enumerate(xs[a:a + step], start=a)]}).verdicts()
+        out += [r for _, r in got]
+    return time.process_time() - t0, [float(r) for r in out]
+
+
+PEERS: dict[str, Callable[[Any], tuple[float, list[float]]]] = {"RTAMT": rtamt, "Reelay": reelay, "mstlo": mstlo}
+
+
+def _agree(mine: list[float], theirs: list[float]) -> str:
+    if len(theirs) != len(mine):
+        return f"{len(theirs)} values for {len(mine)} samples"
+    bad = [i for i, (a, b) in enumerate(zip(mine, theirs)) if not abs(a - b) <= 1e-9 * max(1.0, abs(a))]
+    return f"{len(mine) - len(bad)}/{len(mine)}" + (f" (first difference at sample {bad[0]})" if bad else "")
+
+
+def race(n: int, seed: int, wrong: float) -> bool:
+    """Print each tool's samples per CPU second and whether its robustness agrees; True when all agree."""
+    x = samples(n, seed, wrong)
+    cpu, mine, least = rclverify(x)
+    print(f"margins of G(x > 1): {n} samples, {wrong:g} of them below 1, seed {seed}")
+    print(f"{'tool':<32} {'samples/s':>11}  per-sample robustness agrees with rclverify's margins; min")
+    print(f"{'rclverify batch, margins':<32} {n / cpu:>11.0f}  -; smallest margin {least:.12g} "
+          f"(of every answer's: {min(mine):.12g})")
+    ok = least == min(mine) == float(x.min()) - 1.0
+    acpu, _, aleast = rclverify(x, ALONE, collect=False)
+    ok = ok and aleast == least
+    print(f"{'rclverify streamed, out.x > 1':<32} {n / acpu:>11.0f}  -; smallest margin {aleast:.12g} (an "
+          f"output-only guarantee: the engine judges it)")
+    for name, peer in PEERS.items():
+        try:
+            peer(x[:10])  # the set-up and first use, outside the timing
+        except ImportError as exc:
+            print(f"{name:<32} skipped: not installed ({exc}); pip install '.[bench]'")
+            continue
+        pcpu, theirs = peer(x)
+        agree = _agree(mine, theirs)
+        ok = ok and agree == f"{n}/{n}" and min(theirs) == least
+        print(f"{name:<32} {n / pcpu:>11.0f}  {agree}; min {min(theirs):.12g}; rclverify / {name} samples/s: "
+                  f"{pcpu / cpu:.2f}")
+    return ok
+
+
+__all__ = ["race"]
