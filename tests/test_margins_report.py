@@ -93,3 +93,11 @@ def test_a_quantile_the_kept_margins_do_not_decide_is_given_by_its_bounds() -> N
     # a run that kept fewer than it judged without being full: the rest held without a distance (+inf)
     count, kept, fig = figures([{"guarantee": 1, "answers": 3, "lowest": [0.5]}])
     assert (count, kept, fig["p50"]) == (3, 3, {"low": None, "high": None})
+
+
+def test_a_long_run_draws_its_kept_margins_spread_in_rank() -> None:
+    from rclverify.report.margin_plot import POINTS_PER_RUN, _spread
+    ys = [float(i) for i in range(KEPT_MARGINS)]
+    drawn = _spread(ys)
+    assert len(drawn) == POINTS_PER_RUN and drawn[0] == 0.0 and drawn[-1] == KEPT_MARGINS - 1
+    assert drawn == sorted(set(drawn)) and _spread(ys[:5]) == ys[:5]

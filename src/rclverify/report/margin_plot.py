@@ -2,7 +2,8 @@
 
 One column per run: the margins the run kept (its smallest, at most
 :data:`~rclverify.backends.monitors.verdicts.KEPT_MARGINS`; docs/semantics.md,
-"Margins over runs"), the run's smallest marked, a line at 0 (the
+"Margins over runs"; at most :data:`POINTS_PER_RUN` of them drawn, evenly
+spaced in rank), the run's smallest marked, a line at 0 (the
 boundary: below it the guarantee failed) and the quantiles the kept
 margins decide.  Deterministic as backends/experiment/plot.py is: a fixed
 ``svg.hashsalt``, no date in the metadata, the same figures the same bytes
@@ -22,6 +23,19 @@ def _label(trace: str, most: int = 24) -> str:
     return name if len(name) <= most else "…" + name[-(most - 1):]
 
 
+#: At most this many of a run's kept margins are drawn, evenly spaced in rank (the smallest and the largest
+#: among them): a column of more overlaps itself, and each marker is a hundred bytes of SVG.
+POINTS_PER_RUN = 32
+
+
+def _spread(ys: Sequence[float]) -> list[float]:
+    """``ys`` (ascending), or :data:`POINTS_PER_RUN` of them evenly spaced in rank."""
+    if len(ys) <= POINTS_PER_RUN:
+        return list(ys)
+    last = len(ys) - 1
+    return [ys[round(i * last / (POINTS_PER_RUN - 1))] for i in range(POINTS_PER_RUN)]
+
+
 def render_svg(row: MarginRow, runs: Sequence[tuple[str, Sequence[float]]]) -> str:
     """The SVG text of ``row``'s margins: ``runs`` is ``[(trace, kept margins)]``
     (floats, ``-inf`` for a margin without distance, not drawn).  Raises
@@ -38,9 +52,9 @@ def render_svg(row: MarginRow, runs: Sequence[tuple[str, Sequence[float]]]) -> s
         f, ax = plt.subplots(figsize=(6.4, 3.6))
         try:
             for x, (_, kept) in enumerate(runs, start=1):
-                ys = [v for v in kept if math.isfinite(v)]
+                ys = _spread([v for v in kept if math.isfinite(v)])
                 ax.plot([x] * len(ys), ys, "o", color="C0", markersize=2.5, alpha=0.5,
-                        label="kept margins" if x == 1 else None)
+                        label=f"kept margins (at most {POINTS_PER_RUN} a run drawn)" if x == 1 else None)
                 if ys:
                     ax.plot([x], [ys[0]], "v", color="C3", markersize=6, label="run's smallest" if x == 1 else None)
             ax.axhline(0.0, color="black", linewidth=0.8)
@@ -64,4 +78,4 @@ def render_svg(row: MarginRow, runs: Sequence[tuple[str, Sequence[float]]]) -> s
     return text[text.index("<svg"):]
 
 
-__all__ = ["render_svg"]
+__all__ = ["POINTS_PER_RUN", "render_svg"]

@@ -29,8 +29,9 @@ from rclverify.stages.workspace import Workspace
 
 #: The quantiles the figures give (``p5``, ``p50``): the share of answers at or below them.
 QUANTILES = (("p5", 0.05), ("p50", 0.5))
-#: At most this many guarantees get a plot (the smallest margins first): each costs matplotlib a tenth of a second.
-MAX_PLOTS = 24
+#: At most this many guarantees get a plot (the smallest margins first): each costs matplotlib a tenth of a
+#: second and up to a few hundred kilobytes of the HTML report.
+MAX_PLOTS = 12
 #: The bounds of a figure no answer gives.
 _NONE: MarginBounds = {"low": None, "high": None}
 
