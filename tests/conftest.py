@@ -124,6 +124,7 @@ PIPELINE = frozenset({
     "test_example_safety_stop", "test_init", "test_stage_records", "test_what_runs_is_hashed",
     "test_example_ros2_robot",  # its one live test is marked in the module (the rest is offline)
     "test_margins_monitor", "test_margins_chain", "test_near_misses", "test_margin_targets",
+    "test_margins_report",
 })
 
 #: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.
