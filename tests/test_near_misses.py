@@ -102,8 +102,8 @@ def test_sarif_and_the_first_screen_name_them(run, capsys) -> None:
     assert any("answered 30.000 ms before its deadline" in x for x in lines)
     # the report's first section lists them too
     md, html = run[0]["_md"], run[0]["_html"]
-    block = md[md.index("**Near misses**"):md.index("## System model")]
-    assert md.index("**Near misses**") < md.index("## System model")
+    block = md[md.index("**Near misses**"):md.index("**Smallest margins**")]  # every guarantee's margins follow
+    assert md.index("**Near misses**") < md.index("**Smallest margins**") < md.index("## System model")
     assert "BrakeA guarantee 1: margin 0.04" in block and "BrakeB" not in block
     assert '<h3 id="near-misses">' in html[:html.index('id="system"')]
 
