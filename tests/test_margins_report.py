@@ -1,7 +1,8 @@
 """Margins over runs (docs/semantics.md, "Margins over runs"): the report names, per guarantee, its
 smallest margin over every recorded run with the run, the answer's time and message, the distribution
 of its answers' margins (count, min, p5, p50) and, for two runs or more, a plot of each run's kept
-margins (matplotlib, the ``plots`` extra); the figures are the bounds the kept margins prove."""
+margins (matplotlib, the ``plots`` extra); the figures are the bounds the kept margins prove; a timed
+guarantee's row has its smallest time margin over the runs."""
 from __future__ import annotations
 
 import json
@@ -20,7 +21,7 @@ BRAKE = """node Brake {
   outputs( speed : REAL )
   topics( std_msgs/Float64 dist matches(in.dist), std_msgs/Float64 speed matches(out.speed) )
   assume( TRUE )
-  guarantee( out.speed <= in.dist )
+  guarantee( out.speed <= in.dist ) triggered by in.dist within 100 ms
 }
 """
 PLAN = """name: brakes
@@ -30,8 +31,9 @@ nodes:
     evidence:
       - {backend: monitors, traces: [runs/one.jsonl, runs/two.jsonl], mapping: contracts/mapping.yaml}
 """
-# (dist, speed) answered 10 ms later: margins 0.3, 0.04 on run one; 0.5, 0.1, 1.0 on run two
-RUNS = {"one": ((1.0, 0.7), (2.0, 1.96)), "two": ((3.0, 2.5), (4.0, 3.9), (5.0, 4.0))}
+# (dist, speed, latency s): margins 0.3, 0.04 on run one; 0.5, 0.1, 1.0 on run two; the smallest time
+# margin 100 - 70 = 30 ms, on run two's second answer
+RUNS = {"one": ((1.0, 0.7, 0.01), (2.0, 1.96, 0.01)), "two": ((3.0, 2.5, 0.01), (4.0, 3.9, 0.07), (5.0, 4.0, 0.01))}
 
 
 def _workspace(root: Path) -> Path:
@@ -41,8 +43,8 @@ def _workspace(root: Path) -> Path:
     (root / "contracts" / "plan.yaml").write_text(PLAN, encoding="utf-8")
     (root / "contracts" / "mapping.yaml").write_text("horizon: 1.0\n", encoding="utf-8")
     for name, pairs in RUNS.items():
-        rows = [r for i, (d, s) in enumerate(pairs, start=1) for r in
-                ({"topic": "dist", "time": float(i), "data": d}, {"topic": "speed", "time": i + 0.01, "data": s})]
+        rows = [r for i, (d, s, late) in enumerate(pairs, start=1) for r in
+                ({"topic": "dist", "time": float(i), "data": d}, {"topic": "speed", "time": i + late, "data": s})]
         (root / "runs" / f"{name}.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows), encoding="utf-8")
     return root
 
@@ -67,10 +69,15 @@ def test_the_smallest_margin_over_the_runs_is_named_with_its_run_and_time(report
     # margins 0.04, 0.1, 0.3, 0.5, 1.0: min the 1st, p5 the ceil(0.25) = 1st, p50 the ceil(2.5) = 3rd; all kept
     got = {k: (round(m[k]["low"], 9), round(m[k]["high"], 9)) for k in ("min", "p5", "p50")}
     assert got == {"min": (0.04, 0.04), "p5": (0.04, 0.04), "p50": (0.3, 0.3)}
+    # and its smallest time margin over the runs, with the run's obligation and the answer
+    tm = m["time_margin"]
+    assert tm["margin_ns"] == 30_000_000 and (tm["answers"], tm["unanswered"]) == (5, 0)
+    assert tm["answer_where"] == "two.jsonl:4" and tm["obligation"] != m["obligation"]
     # the first screen names it, in HTML and Markdown
     first = report["_html"][:report["_html"].index('<section id="dashboard">')]
     assert 'id="margins"' in first and "<strong>0.04</strong>" in first and "runs/one.jsonl, 2.010 s" in first
     assert "- Brake guarantee 1: 0.04 on `out.speed <= in.dist` at " in report["_md"]
+    assert "time margin <strong>30.000 ms</strong>" in first and "time margin 30.000 ms (answer two.jsonl:4)" in report["_md"]
 
 
 def test_the_distribution_over_runs_is_plotted(report: dict[str, Any]) -> None:

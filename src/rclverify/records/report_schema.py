@@ -140,7 +140,8 @@ class MarginRow(TypedDict):
     """A guarantee's margins over every recorded run (``margins[]``, ``$defs/margins_over_runs``;
     report/margin_rows.py): the smallest (``margin``, ``None`` when infinite, then ``holds`` its side, or
     when no answer had one) on the run ``trace`` at the answer ``time``/``where``; the counts summed over
-    the ``runs``; the figures over the ``count`` answers with a margin, ``kept`` of them recorded; the
+    the ``runs``; the figures over the ``count`` answers with a margin, ``kept`` of them recorded; a timed
+    guarantee's smallest time margin over the runs (``time_margin``); the
     plot of the kept margins per run (``plot_svg``) or why none (``plot_note``)."""
     node: str
     guarantee: int
@@ -162,6 +163,7 @@ class MarginRow(TypedDict):
     min: MarginBounds
     p5: MarginBounds
     p50: MarginBounds
+    time_margin: HopTimeMargin | None
     plot_svg: NotRequired[str]
     plot_note: NotRequired[str]
 

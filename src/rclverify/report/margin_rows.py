@@ -13,17 +13,20 @@ deciding ``atom`` and ``unit``), the counts summed over the runs, and the
 figures of :func:`figures`: ``count`` (every answer with a margin, on every
 run), ``min`` and the quantiles ``p5`` and ``p50`` of those answers'
 margins, each given by the bounds the kept margins prove (equal when they
-decide it).  With at least two runs, ``plot_svg`` is the distribution drawn
+decide it); ``time_margin``, for a ``triggered by ... within`` guarantee, its
+smallest time margin over the runs (:func:`.chain_margins.hop_margin`, as a
+deadline's hop has it; ``None`` for an untimed guarantee).  With at least two runs, ``plot_svg`` is the distribution drawn
 per run (report/margin_plot.py, the ``plots`` extra), or ``plot_note`` says
 why none was drawn.
 """
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence, cast
 
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
-from rclverify.records.report_schema import MarginBounds, MarginRow, ObligationRow
+from rclverify.report.chain_margins import hop_margin
+from rclverify.records.report_schema import HopTimeMargin, MarginBounds, MarginRow, ObligationRow
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
 
@@ -103,9 +106,17 @@ def _guarantee_place(ws: Workspace, node: str, k: int) -> str:
     return f"{loc.file}:{loc.line}:{loc.col}"
 
 
+def _formula(ws: Workspace, node: str, k: int) -> str:
+    from rclverify.lang.printer import expr_to_rcl  # deferred: start-up (only for a guarantee timed but never measured)
+    cn = ws.checked.nodes.get(node)
+    return expr_to_rcl(cn.node.guarantees[k - 1].formula) if cn is not None and 1 <= k <= len(cn.node.guarantees) \
+        else ""
+
+
 def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginRow]:
     """The report's ``margins`` (module docstring), by node and guarantee."""
     runs: dict[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]] = {}
+    timed: dict[tuple[str, int], list[dict[str, Any]]] = {}  # the runs' deadline records, as hop_margin reads them
     store: EvidenceStore | None = None
     for o in ob_rows:
         if o["backend"] != "monitors" or o["status"] == "error":
@@ -119,8 +130,23 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginR
             if isinstance(m, dict) and isinstance(m.get("guarantee"), int):
                 runs.setdefault((str(o["node"]), m["guarantee"]), []).append(
                     (str(o["id"]), str(m.get("trace") or mon.get("trace", "")), m))
+        dl = ev.details.get("deadlines")
+        for t in (dl.get("time_margins") or ()) if isinstance(dl, dict) else ():
+            if isinstance(t, dict) and isinstance(t.get("guarantee"), int):
+                timed.setdefault((str(o["node"]), t["guarantee"]), []).append(
+                    {"obligation": str(o["id"]), "time_margins": [t]})
     rows: list[MarginRow] = []
-    for (node, k), got in sorted(runs.items()):
+    for node, k in sorted(set(runs) | set(timed)):
+        got = runs.get((node, k), [])
+        time_margin = cast("HopTimeMargin | None", hop_margin({"guarantee": k, "monitors": timed[(node, k)]})
+                           if (node, k) in timed else None)
+        if not got:  # timed only: no answer was judged with a space margin
+            rows.append({"node": node, "guarantee": k, "formula": _formula(ws, node, k),
+                         "source": _guarantee_place(ws, node, k), "margin": None, "holds": None, "unit": "",
+                         "atom": "", "trace": "", "obligation": "", "time": None, "where": "", "runs": 0,
+                         "answers": 0, "undefined": 0, "count": 0, "kept": 0, "min": _NONE, "p5": _NONE,
+                         "p50": _NONE, "time_margin": time_margin})
+            continue
         def order(r: tuple[str, str, Mapping[str, Any]]) -> float:
             v, holds, answers = r[2].get("margin"), r[2].get("holds"), r[2].get("answers")
             if not answers:
@@ -141,7 +167,7 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginR
                      "runs": len(got), "answers": sum(int(r[2].get("answers") or 0) for r in got),
                      "undefined": sum(int(r[2].get("undefined") or 0) for r in got),
                      "count": count, "kept": kept, "min": fig.get("min", _NONE), "p5": fig.get("p5", _NONE),
-                     "p50": fig.get("p50", _NONE)})
+                     "p50": fig.get("p50", _NONE), "time_margin": time_margin})
     _plots(rows, runs)
     return rows
 
