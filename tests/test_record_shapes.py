@@ -1,5 +1,5 @@
-"""Each record defined once (records/findings.py, records/obligations.py): the schema's part generated from
-it, every field rendered or declared internal, sealed records decoded into it.
+"""Each record defined once (records/findings.py, records/obligations.py, records/evidence_rows.py): the
+schema's part generated from it, every field rendered or declared internal, sealed records decoded into it.
 
 The rule, for a contract-health finding: :class:`~rclverify.records.findings.FindingRow` (extending
 :class:`~rclverify.records.findings.HealthFinding`) is the only statement of its fields; the
@@ -7,7 +7,9 @@ The rule, for a contract-health finding: :class:`~rclverify.records.findings.Fin
 field is read by one of the report's finding renderers (report/templates/parts/findings.{html,md}.j2)
 or named in :data:`~rclverify.records.findings.INTERNAL`.  The same holds for an obligation's row
 (:class:`~rclverify.records.obligations.ObligationRow`, ``obligations[]``, rendered by
-report/templates/parts/obligations.{html,md}.j2).  Each check is also run on a definition with a field
+report/templates/parts/obligations.{html,md}.j2) and an evidence record's row
+(:class:`~rclverify.records.evidence_rows.EvidenceRow`, ``evidence[]``, rendered by
+report/templates/parts/evidence.{html,md}.j2).  Each check is also run on a definition with a field
 added, and must then fail.  In-process and cheap: no pipeline runs here.
 """
 from __future__ import annotations
@@ -24,7 +26,8 @@ from jinja2 import nodes
 
 from _report_schema import SCHEMA
 from rclverify.records import schema_gen
-from rclverify.records import obligations
+from rclverify.records import evidence_rows, obligations
+from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
 from rclverify.report.render import part_renderer
@@ -47,6 +50,7 @@ RECORDS: dict[str, Record] = {
     "findings": Record(FindingRow, INTERNAL, "findings", RENDERERS),
     "obligations": Record(ObligationRow, obligations.INTERNAL, "obligation_row",
                           ("obligations.html.j2", "obligations.md.j2")),
+    "evidence": Record(EvidenceRow, evidence_rows.INTERNAL, "evidence_row", ("evidence.html.j2", "evidence.md.j2")),
 }
 
 
@@ -120,7 +124,7 @@ def test_a_field_added_and_not_rendered_fails_until_rendered_or_internal() -> No
 @pytest.mark.parametrize("key", list(RECORDS))
 def test_the_schema_part_is_generated_from_the_definition(key: str) -> None:
     assert list(schema_gen.GENERATED) == list(RECORDS)  # each generated part is a record checked here
-    assert SCHEMA["properties"][key] == schema_gen.generated_part(key)
+    assert SCHEMA["properties"][key] == schema_gen.generated_part(key, SCHEMA)
     items = SCHEMA["properties"][key]["items"]
     assert list(items["properties"]) == list(RECORDS[key].cls.__struct_fields__)
     assert items["additionalProperties"] is False
@@ -245,3 +249,73 @@ def test_a_sealed_health_record_decodes_into_the_definition() -> None:
         msgspec.convert({**j, "guarantee": "one"}, HealthFinding)
     # the two queries are not compared: the same finding with a re-numbered query text is equal
     assert msgspec.structs.replace(f, smt2="(check-sat)") == f and hash(msgspec.structs.replace(f, smt2="")) == hash(f)
+
+
+class _EvidenceWithMargin(EvidenceRow, frozen=True, forbid_unknown_fields=True):
+    """The evidence row with one field added, as a change to records/evidence_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_an_evidence_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["evidence"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_EvidenceWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_EvidenceWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ ev.tool_version }}", "{{ ev.tool_version }} {{ ev.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_EvidenceWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    raw = sources[0].replace("{{ ev.tool_version }}", "{{ ev.tool_version }} {{ item.record.margin_added_here }}", 1)
+    assert unaccounted(_EvidenceWithMargin, [raw, sources[1]], r.internal, r.filter) != []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "evidence", (_EvidenceWithMargin, schema_gen.GENERATED["evidence"][1]))
+        part = schema_gen.generated_part("evidence", SCHEMA)
+        regenerated = schema_gen.with_generated(copy.deepcopy(SCHEMA))
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["evidence"] != part == regenerated["properties"]["evidence"]
+    # the monitors backend's run summary keeps its hand-written schema in the generated part
+    assert part["items"]["properties"]["monitoring"] == SCHEMA["properties"]["evidence"]["items"]["properties"]["monitoring"]
+    with pytest.raises(KeyError, match="monitoring"):
+        schema_gen.generated_part("evidence")
+
+
+#: An evidence row with every field set to a value of its own, and the text each shows as.
+_EVIDENCE: dict[str, tuple[Any, str]] = {
+    "obligation": ("N.g1.property_tests.c1", "N.g1.property_tests.c1"), "backend": ("backend-text", "backend-text"),
+    "kind": ("testing", "testing"), "status": ("failed", "failed"), "tool": ("tool-text", "tool-text"),
+    "tool_version": ("9.8.7", "9.8.7"), "started": ("2026-01-02T03:04:05Z", "2026-01-02T03:04:05Z"),
+    "duration_s": (1.5, "1.5"), "explanation": ("explanation-text", "explanation-text"),
+    "counterexample": ({"in.x": "42"}, "42"), "artifacts": (["artifact-text"], "artifact-text"),
+    "log_excerpt": ("log-text", "log-text"), "figures": ([["figure-name", "figure-value"]], "figure-value"),
+    "plot_svg": ("<svg><title>plot-text</title></svg>", "plot-text"),
+    "solvers": ({"agreement": "two solvers", "why": "solvers-text", "cvc5": None}, "solvers-text"),
+    "examples": ({"run": 100, "valid": 90, "rejected": 10, "failures": 1, "inconclusive": 0, "seed": 7,
+                  "replay": "replay-text", "facts": [], "coverage": {}}, "replay-text"),
+    "monitoring": ({"trace": "trace-text", "events_read": 3, "node_events": 2, "horizon_s": 1.0, "sha256": "ab" * 32,
+                    "counts": {"ok": 3}, "first_violation": None, "first_assumption_violation": None}, "trace-text"),
+    "statistics": ({"sha256": "cd" * 32, "answers": 3, "violations": 0, "inconclusive": 0, "seconds": 2.0,
+                    "recorded": "2026-01-02", "environment": "environment-text", "origin": "operation"},
+                   "environment-text"),
+    "strength": ({"kind": "tested", "doubt": 0.2, "detail": "strength-text"}, "strength-text"),
+}
+
+
+def test_the_evidence_renderers_show_each_field_they_read_and_refuse_an_undeclared_key() -> None:
+    part = part_renderer(FragmentCache(), "")
+    assert list(_EVIDENCE) == list(EvidenceRow.__struct_fields__)
+    row = {k: v for k, (v, _) in _EVIDENCE.items()}
+    rows = [{"anchor": "ev-x", "record": row}]
+    html, md = str(part("evidence.html", rows=rows)), part("evidence.md", rows=rows)
+    for k, (_, text) in _EVIDENCE.items():
+        if k in evidence_rows.INTERNAL:
+            assert text not in html + md, k
+        else:
+            assert text in html and (text in md or k == "plot_svg"), k  # the Markdown report draws no plot
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("evidence.html", rows=[{"anchor": "ev-y", "record": {**row, "margin_added_here": "0.5 m"}}])
+    # the JSON object the report writes is every field, in the order declared, each at its default if unset
+    bare = EvidenceRow(*(row[k] for k in list(EvidenceRow.__struct_fields__)[:12])).to_json()
+    assert list(bare) == list(EvidenceRow.__struct_fields__)
+    assert (bare["figures"], bare["plot_svg"], bare["solvers"], bare["monitoring"], bare["strength"]) == (
+        [], "", None, {}, None)
+    assert EvidenceRow.of(bare).to_json() == bare

@@ -200,7 +200,7 @@ def test_a_key_in_one_and_not_the_other_is_found() -> None:
     try:
         for change, want in (
                 (lambda s: s["$defs"]["strength"]["properties"].update(colour={"type": "string", "description": "x"}),
-                 "report.evidence.strength.colour: only in the schema"),
+                 "report.side_conditions.strength.colour: only in the schema"),
                 (lambda s: s["properties"]["nodes"]["items"]["required"].remove("latex"),
                  "report.nodes.latex: required in one only"),
                 (lambda s: s["properties"]["unverified"]["items"]["properties"]["guarantee"].update(type="string"),

@@ -52,7 +52,7 @@ from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
 from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import EvidenceRow, ObligationJson, SideConditionRow
+from rclverify.records.report_schema import EvidenceJson, ObligationJson, SideConditionRow
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 
 CACHE = "artifacts/cache/diagnosis.pickle"
@@ -356,7 +356,7 @@ def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
     return {}
 
 
-def _evidence(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationJson | None,
+def _evidence(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson | None,
               cache: _Cache) -> DiagnosisEntry:
     node = o["node"] if o is not None else e["obligation"].split(".", 1)[0]
     k = o["guarantee"] if o is not None else 0
@@ -411,7 +411,7 @@ def _evidence(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationJson | N
                    guarantee=k)
 
 
-def _hoare(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationJson, cache: _Cache) -> DiagnosisEntry:
+def _hoare(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson, cache: _Cache) -> DiagnosisEntry:
     from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
     from rclverify.backends.hoare.culprit_lines import compared_constants  # deferred: start-up (loads jinja2, z3 and more only when called)
     node, k = o["node"], o["guarantee"]

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from typing import NotRequired, TypedDict, cast
 
 from rclverify.diagnosis.edits import Edit
-from rclverify.records.report_schema import (DeadlineRow, EvidenceRow, FindingJson, LintRow, NodeRow, ObligationJson,
+from rclverify.records.report_schema import (DeadlineRow, EvidenceJson, FindingJson, LintRow, NodeRow, ObligationJson,
                                              RequirementRow, SideConditionRow, SystemView)
 from rclverify.records.stage_records import Repair
 
@@ -29,7 +29,7 @@ class ReportRows(TypedDict):
     side_conditions: list[SideConditionRow]
     findings: list[FindingJson]
     obligations: list[ObligationJson]
-    evidence: list[EvidenceRow]
+    evidence: list[EvidenceJson]
     lint: list[LintRow]
     deadlines: list[DeadlineRow]
 

@@ -361,27 +361,11 @@ ObligationJson = dict[str, Any]
 ObligationRow = ObligationJson
 
 
-class EvidenceRow(TypedDict):
-    """An evidence record as the report shows it (``evidence[]``); ``started`` ISO 8601, ``duration_s`` seconds."""
-    obligation: str
-    backend: str
-    kind: EvidenceKind
-    status: EvidenceStatus
-    tool: str
-    tool_version: str
-    started: str
-    duration_s: float
-    explanation: str
-    counterexample: dict[str, Any] | None
-    artifacts: list[str]
-    log_excerpt: str
-    figures: NotRequired[list[list[str]]]
-    plot_svg: NotRequired[str]
-    solvers: NotRequired[Solvers]
-    examples: NotRequired[dict[str, Any]]
-    monitoring: NotRequired[dict[str, Any]]
-    statistics: NotRequired[dict[str, Any]]
-    strength: NotRequired[Strength]
+#: An evidence record's row (``evidence[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.evidence_rows.EvidenceRow`, the one definition of its fields (the schema's
+#: ``evidence`` items are generated from it, records/schema_gen.py); decode it with ``EvidenceRow.of``
+#: to read its fields as attributes.
+EvidenceJson = dict[str, Any]
 
 
 class PendingRow(TypedDict):
@@ -500,7 +484,7 @@ class Report(TypedDict):
     derived_properties: list[DerivedPropertyRow]
     findings: list[FindingJson]
     obligations: list[ObligationJson]
-    evidence: list[EvidenceRow]
+    evidence: list[EvidenceJson]
     environment_assumptions: list[EnvironmentAssumptionRow]
     pending: list[PendingRow]
     lint: list[LintRow]

@@ -6,10 +6,12 @@ Each entry of :data:`GENERATED` names a top-level key of the report and the
 draft 2020-12, https://json-schema.org/draft/2020-12): each class inlined
 as an object that rejects unknown keys, every nested object too; no
 ``title`` or ``default`` (the class's docstring and field descriptions say
-what a missing key means); an enumeration equal to one of the status
+what a missing key means); a value's ``description`` after its type; an enumeration equal to one of the status
 vocabularies of :mod:`rclverify.records.statuses` written as a ``$ref`` to
 that vocabulary's ``$defs`` entry, and a class named in :data:`SHARED` as a
-``$ref`` to its ``$defs`` entry.
+``$ref`` to its ``$defs`` entry.  A field named in :data:`KEPT` holds a
+value whose inner shape belongs to a tool: its schema is the file's own,
+described by hand, taken as it is.
 
 ``python -m rclverify.records.schema_gen [FILE]`` rewrites those parts of
 ``FILE`` (default ``docs/assurance.schema.json``) in place through
@@ -27,6 +29,7 @@ from typing import Any
 import msgspec
 
 from rclverify.core.atomic import atomic_write_text
+from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.statuses import VOCABULARY
@@ -35,10 +38,15 @@ from rclverify.records.statuses import VOCABULARY
 GENERATED: dict[str, tuple[type[msgspec.Struct], str]] = {
     "findings": (FindingRow, "Contract health findings (vacuity, consistency, realizability, scale)."),
     "obligations": (ObligationRow, "Every obligation of the plan's evidence entries."),
+    "evidence": (EvidenceRow, "One row per obligation with an evidence record."),
 }
 
 #: A type the report's schema already defines in ``$defs`` -> that entry's name.
-SHARED: dict[str, str] = {"Solvers": "solvers"}
+SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength"}
+
+#: Top-level key -> the fields of its items whose schema the file states by hand (a tool's record:
+#: the monitors backend's run summary, docs/monitors.md).
+KEPT: dict[str, tuple[str, ...]] = {"evidence": ("monitoring",)}
 
 
 def _styled(x: Any, defs: dict[str, Any]) -> Any:
@@ -60,20 +68,28 @@ def _styled(x: Any, defs: dict[str, Any]) -> Any:
     if out.get("type") == "object" and "properties" in out:
         head = {k: out.pop(k) for k in ("type", "description", "required", "properties") if k in out}
         out = {**head, **out}
+    elif "description" in out:  # a value's schema: what it is, then what it means
+        out = {**{k: v for k, v in out.items() if k != "description"}, "description": out["description"]}
     return out
 
 
-def generated_part(key: str) -> dict[str, Any]:
-    """The schema of the report's top-level ``key`` (an array of its class's items), in the file's style."""
+def generated_part(key: str, schema: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The schema of the report's top-level ``key`` (an array of its class's items), in the file's style;
+    each field of :data:`KEPT` as ``schema`` (the report's whole schema, as the file holds it) states it.
+    Raises ``KeyError`` when ``key`` has such fields and ``schema`` does not state them."""
     cls, description = GENERATED[key]
     raw = msgspec.json.schema(cls)
     item = _styled({"$ref": raw["$ref"]}, raw.get("$defs", {}))
+    for name in KEPT.get(key, ()):
+        if schema is None:
+            raise KeyError(f"{key}[].{name}: stated by hand in the schema file, which was not given")
+        item["properties"][name] = schema["properties"][key]["items"]["properties"][name]
     return {"type": "array", "items": item, "description": description}
 
 
 def with_generated(schema: dict[str, Any]) -> dict[str, Any]:
     """``schema`` (the report's whole schema) with every generated part put in its place (order kept)."""
-    props = {k: generated_part(k) if k in GENERATED else v for k, v in schema["properties"].items()}
+    props = {k: generated_part(k, schema) if k in GENERATED else v for k, v in schema["properties"].items()}
     return {**schema, "properties": props}
 
 

@@ -14,7 +14,8 @@ from typing import Any, Mapping, Sequence, TypedDict, cast
 
 from rclverify.records.records import Obligation
 from rclverify.records.obligations import ObligationRow
-from rclverify.records.report_schema import EvidenceRow, ObligationJson, PendingRow
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.report_schema import EvidenceJson, ObligationJson, PendingRow, Solvers
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 from rclverify.records.store import EvidenceStore
 from rclverify.report.statistics import compact as compact_statistics
@@ -32,7 +33,7 @@ class EvidencePart(TypedDict):
     that cannot be read as rclverify wrote it; ``inputs``: obligation id ->
     the input sha256s its evidence was made from (``None``: no record)."""
     obligations: list[ObligationJson]
-    evidence: list[EvidenceRow]
+    evidence: list[EvidenceJson]
     pending: list[PendingRow]
     status: dict[str, str]
     declared: dict[str, list[tuple[str, Any]]]
@@ -40,22 +41,23 @@ class EvidencePart(TypedDict):
     inputs: dict[str, object]
 
 
-def evidence_extras(ws: Workspace, details: Any) -> dict[str, Any]:
-    """Rows a backend asks the report to show (``details.figures_table``: the
-    experiment figures, the review record) and the inline SVG of its plot
-    (``details.plot``, an SVG artifact the backend drew with matplotlib)."""
-    out: dict[str, Any] = {}
+def evidence_extras(ws: Workspace, details: Any) -> tuple[list[list[str]], str]:
+    """``(figures, plot_svg)``: the rows a backend asks the report to show
+    (``details.figures_table``: the experiment figures, the review record;
+    ``[]`` when none) and the inline SVG of its plot (``details.plot``, an
+    SVG artifact the backend drew with matplotlib; ``""`` when none or
+    unreadable)."""
     rows = details.get("figures_table") if isinstance(details, dict) else None
-    if rows:
-        out["figures"] = [[str(a), str(b)] for a, b in rows]
+    figures = [[str(a), str(b)] for a, b in rows] if rows else []
     plot = details.get("plot") if isinstance(details, dict) else None
+    svg = ""
     if isinstance(plot, str) and plot.endswith(".svg"):
         try:
             text = ws.path(plot).read_text(encoding="utf-8")
-            out["plot_svg"] = text[text.index("<svg"):]
+            svg = text[text.index("<svg"):]
         except (OSError, ValueError):
             pass
-    return out
+    return figures, svg
 
 
 def _explanation(ev: Any, status: str, altered: str, solvers: Mapping[str, Any] | None) -> str:
@@ -70,27 +72,26 @@ def _explanation(ev: Any, status: str, altered: str, solvers: Mapping[str, Any] 
     return expl
 
 
-def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: dict[str, Any] | None) -> EvidenceRow:
+def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Solvers | None) -> EvidenceJson:
     """The report's row of the evidence record ``ev`` shown with ``status``
     (``altered``: why the record is not believed, '' when it is;
-    ``solvers``: the second solver's agreement, ``None`` without one)."""
-    row: dict[str, Any] = {
-        "obligation": ev.obligation, "backend": ev.backend, "kind": ev.kind, "status": status,
-        "tool": ev.tool, "tool_version": ev.tool_version, "started": ev.started,
-        "duration_s": ev.duration_s, "explanation": _explanation(ev, status, altered, solvers),
-        "counterexample": ev.counterexample, "artifacts": list(ev.artifacts), "log_excerpt": ev.log[-2000:],
-        **evidence_extras(ws, ev.details)}
-    d = ev.details
-    if solvers is not None:
-        row["solvers"] = solvers
+    ``solvers``: the second solver's agreement, ``None`` without one), as
+    the JSON object of :class:`~rclverify.records.evidence_rows.EvidenceRow`
+    (every field)."""
+    d = ev.details if isinstance(ev.details, dict) else {}
+    figures, svg = evidence_extras(ws, d)
+    examples: dict[str, Any] = {}
     if isinstance(d.get("examples"), dict):  # property tests: example counts and seed
-        row["examples"] = {**d["examples"], "seed": d.get("seed"), "replay": d.get("replay", ""),
-                           "facts": d.get("facts", []), "coverage": d.get("coverage") or {}}
-    if isinstance(d, dict) and d.get("monitoring"):
-        row["monitoring"] = d["monitoring"]
-    if isinstance(d, dict) and isinstance(d.get("statistics"), dict):  # runs counted
-        row["statistics"] = compact_statistics(d["statistics"])
-    return cast(EvidenceRow, row)  # built as a dict for the optional keys
+        examples = {**d["examples"], "seed": d.get("seed"), "replay": d.get("replay", ""),
+                    "facts": d.get("facts", []), "coverage": d.get("coverage") or {}}
+    return EvidenceRow(
+        obligation=ev.obligation, backend=ev.backend, kind=ev.kind, status=cast(EvidenceStatus, status),
+        tool=ev.tool, tool_version=ev.tool_version, started=ev.started, duration_s=ev.duration_s,
+        explanation=_explanation(ev, status, altered, solvers), counterexample=ev.counterexample,
+        artifacts=list(ev.artifacts), log_excerpt=ev.log[-2000:], figures=figures, plot_svg=svg, solvers=solvers,
+        examples=examples, monitoring=d["monitoring"] if d.get("monitoring") else {},
+        statistics=compact_statistics(d["statistics"]) if isinstance(d.get("statistics"), dict) else {},
+    ).to_json()
 
 
 def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_lists: Mapping[str, str],
@@ -109,7 +110,8 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
         ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
         part["inputs"][o.id] = dict(ev.input_hashes) if ev is not None else None
         status = "error" if altered else (store.current_status(ev, hashes) if ev else "pending")
-        status, solvers = second.evidence(o.id, o.backend, status)
+        status, agreement = second.evidence(o.id, o.backend, status)
+        solvers = cast(Solvers | None, agreement)  # stages/crosscheck/apply.py builds the $defs/solvers object
         part["status"][o.id] = status
         part["obligations"].append(ObligationRow(
             id=o.id, node=o.node, guarantee=o.guarantee, backend=o.backend, kind=cast(EvidenceKind, o.kind),

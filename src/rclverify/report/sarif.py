@@ -37,7 +37,7 @@ from typing import Mapping, Sequence
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import DiagnosisRow, EvidenceRow, LintRow, Report
+from rclverify.records.report_schema import DiagnosisRow, EvidenceJson, LintRow, Report
 from rclverify.report.severity import of
 from rclverify.records.sarif import sarif_fix
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
@@ -195,7 +195,7 @@ def _result(rule: str, level: str, text: str, where: str, key: str, props: Mappi
 
 
 def _obligation_results(report: Report) -> list[SarifResult]:
-    evidence: dict[str, EvidenceRow] = {}
+    evidence: dict[str, EvidenceJson] = {}
     for row in report["evidence"]:
         evidence[str(row["obligation"])] = row
     reasons: dict[str, str] = {}

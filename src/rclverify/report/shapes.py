@@ -12,7 +12,7 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 # annotations (with string annotations every key would count as required).
 from typing import Any, NotRequired, TypedDict
 
-from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceRow, FindingJson, NodeRow,
+from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceJson, FindingJson, NodeRow,
                                              LimitedBy, ObligationJson, PendingRow, ProblemRow, RequirementRow, SideConditionRow,
                                              Summary, SupportRow)
 
@@ -139,7 +139,7 @@ class TraceObligation(TypedDict):
     known: bool
     status: str
     backend: str
-    evidence: list[tuple[str, EvidenceRow]]
+    evidence: list[tuple[str, EvidenceJson]]
 
 
 class TraceSupport(TypedDict):
@@ -175,7 +175,7 @@ class ObligationRun(TypedDict):
 class EvidenceRun(TypedDict):
     """An evidence record with its fragment id."""
     anchor: str
-    record: EvidenceRow
+    record: EvidenceJson
 
 
 class TableRuns(TypedDict):
@@ -199,7 +199,7 @@ class ReportView(TableRuns):
     pending_groups: list[PendingGroup]
     unmet_requirements: list[RequirementRow]
     ev_anchor: list[str]
-    evidence_of: dict[str, list[tuple[str, EvidenceRow]]]
+    evidence_of: dict[str, list[tuple[str, EvidenceJson]]]
     obligation: dict[str, ObligationJson]
     trace: list[TraceEntry]
     sections: list[Section]

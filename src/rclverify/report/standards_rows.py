@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any, Literal, Mapping, Sequence, TypedDict
 
-from rclverify.records.report_schema import EvidenceRow, Report
+from rclverify.records.report_schema import EvidenceJson, Report
 from rclverify.model.plan.standards.choice import StandardChoice
 from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
 from rclverify.model.plan.standards.profiles import Profile
@@ -83,7 +83,7 @@ def _label(row: Mapping[str, Any]) -> str:
 
 
 def standards_part(choices: Sequence[StandardChoice],
-                   report: Mapping[str, Any] | Sequence[EvidenceRow]) -> StandardsPart:
+                   report: Mapping[str, Any] | Sequence[EvidenceJson]) -> StandardsPart:
     """The ``standards`` part of the plan's ``choices`` over ``report`` (the
     report dict so far: its evidence rows with their strength, obligations,
     nodes, side conditions, requirements, findings, unverified guarantees,

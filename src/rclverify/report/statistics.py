@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping, TypedDict
 
-from rclverify.records.report_schema import EvidenceRow
+from rclverify.records.report_schema import EvidenceJson
 from rclverify.report.shapes import RequirementRuns, RequirementRunsRow, RunGroupBound, RunGroupRow, TargetRow
 
 from rclverify.records.statistics import count_runs, decide, trivial_or_exact
@@ -66,7 +66,7 @@ def _group_row(node: str, env: str, origin: str, rows: list[dict[str, Any]]) -> 
                                          else "no judged run: no bound")}
 
 
-def _target_row(e: EvidenceRow) -> TargetRow:
+def _target_row(e: EvidenceJson) -> TargetRow:
     s = e["statistics"]
     d = s.get("decision") or {}
     return {"node": _node(str(e.get("obligation"))), "environment": s.get("environment", UNSTATED),
@@ -128,14 +128,14 @@ class StatisticsPart(TypedDict):
     requirements: dict[str, list[RequirementRuns]]
 
 
-def _per_run(e: EvidenceRow) -> bool:
+def _per_run(e: EvidenceJson) -> bool:
     """``e`` (an evidence row) is a believed monitored run of a run set (not a target's decision)."""
     s = e.get("statistics")
     return isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s \
         and e.get("status") not in _UNBELIEVED
 
 
-def _group_key(e: EvidenceRow) -> tuple[str, str, str]:
+def _group_key(e: EvidenceJson) -> tuple[str, str, str]:
     s = e["statistics"]
     return _node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation"))
 

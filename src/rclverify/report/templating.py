@@ -18,6 +18,7 @@ from urllib.parse import quote
 import jinja2
 from markupsafe import Markup, escape
 
+from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.records import SEVERITY
@@ -247,6 +248,15 @@ def obligation_row(row: Mapping[str, Any] | ObligationRow) -> ObligationRow:
     return ObligationRow.of(row)
 
 
+def evidence_row(row: Mapping[str, Any] | EvidenceRow) -> EvidenceRow:
+    """An evidence record's row (``evidence[]``) decoded into
+    :class:`~rclverify.records.evidence_rows.EvidenceRow`, so a template
+    reads declared fields only (tests/test_record_shapes.py holds every
+    field to a renderer or :data:`~rclverify.records.evidence_rows.INTERNAL`).
+    Raises :class:`msgspec.ValidationError` for a key no field declares."""
+    return EvidenceRow.of(row)
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -272,6 +282,7 @@ def environment() -> jinja2.Environment:
         mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
         formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
         formulas=formula_html_list, findings=finding_rows, obligation_row=obligation_row,
+        evidence_row=evidence_row,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame

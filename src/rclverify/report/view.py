@@ -14,7 +14,7 @@ from collections import defaultdict
 from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
 from rclverify.records.findings import rows_of
-from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceRow, FindingJson, ObligationJson, ProblemRow,
+from rclverify.records.report_schema import (DerivedPropertyRow, EvidenceJson, FindingJson, ObligationJson, ProblemRow,
                                              Report, SideConditionRow)
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
@@ -250,7 +250,7 @@ def dashboard(report: Report, evidence_of: Mapping[str, Sequence[tuple[str, obje
 
 
 def _trace(report: Report, obligation: Mapping[str, ObligationJson],
-           evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> list[TraceEntry]:
+           evidence_of: Mapping[str, list[tuple[str, EvidenceJson]]]) -> list[TraceEntry]:
     """The traceability rows: per requirement, its supporting guarantees with
     each obligation's status and evidence (``rowspan``: rows it spans)."""
     trace: list[TraceEntry] = []
@@ -305,7 +305,7 @@ def _pending_groups(report: Report) -> list[PendingGroup]:
 
 
 def _table_runs(report: Report, ev_anchor: Sequence[str], obligation: Mapping[str, ObligationJson],
-                evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> TableRuns:
+                evidence_of: Mapping[str, list[tuple[str, EvidenceJson]]]) -> TableRuns:
     """``finding_runs``, ``obligation_runs`` and ``evidence_runs`` of :func:`view`."""
     def node_of_evidence(item: EvidenceRun) -> str:
         o = obligation.get(str(item["record"]["obligation"]))
@@ -342,7 +342,7 @@ def view(report: Report) -> ReportView:
     """
     validate(report)
     ev_anchor = evidence_anchors(report)
-    evidence_of: dict[str, list[tuple[str, EvidenceRow]]] = defaultdict(list)
+    evidence_of: dict[str, list[tuple[str, EvidenceJson]]] = defaultdict(list)
     for aid, ev in zip(ev_anchor, report["evidence"]):
         evidence_of[str(ev["obligation"])].append((aid, ev))
     obligation = {str(o["id"]): o for o in report["obligations"]}

@@ -52,7 +52,7 @@ from collections import Counter
 from typing import Any, Callable, Iterable, Literal, Mapping, Sequence, TypedDict, cast, get_args
 
 from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
-from rclverify.records.report_schema import EvidenceRow
+from rclverify.records.report_schema import EvidenceJson
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 
 #: A clause's status (the module docstring).
@@ -425,7 +425,7 @@ def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], i
     return f"{status}: {done} of {n} in scope covered; {head}{extra}"
 
 
-def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceRow],
+def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceJson],
                 notes: Mapping[str, Any] | None = None) -> list[ClauseRow]:
     """The clause rows of ``profile`` at ``level`` (``None`` for a profile
     without levels) over ``report`` (a report dict: its ``evidence``,
