@@ -357,8 +357,6 @@ FindingJson = dict[str, Any]
 #: ``obligations`` items are generated from it, records/schema_gen.py); decode it with
 #: ``ObligationRow.of`` to read its fields as attributes.
 ObligationJson = dict[str, Any]
-#: The same JSON object, by the name report/margin_rows.py imports.
-ObligationRow = ObligationJson
 
 
 #: An evidence record's row (``evidence[]``) as the report's JSON object: the encoding of

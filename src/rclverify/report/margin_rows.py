@@ -26,7 +26,7 @@ from typing import Any, Iterable, Mapping, Sequence, cast
 
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.report.chain_margins import hop_margin
-from rclverify.records.report_schema import HopTimeMargin, MarginBounds, MarginRow, ObligationRow
+from rclverify.records.report_schema import HopTimeMargin, MarginBounds, MarginRow, ObligationJson
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
 
@@ -113,7 +113,7 @@ def _formula(ws: Workspace, node: str, k: int) -> str:
         else ""
 
 
-def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginRow]:
+def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[MarginRow]:
     """The report's ``margins`` (module docstring), by node and guarantee."""
     runs: dict[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]] = {}
     timed: dict[tuple[str, int], list[dict[str, Any]]] = {}  # the runs' deadline records, as hop_margin reads them
