@@ -22,11 +22,11 @@ SRC = "contracts/n.rcl"
 
 def _report() -> dict[str, Any]:
     def ob(i: str, status: str, line: int) -> dict[str, Any]:
-        return {"id": i, "node": "N", "guarantee": 1, "backend": "hoare", "kind": "triple", "instance": "c1",
+        return {"id": i, "node": "N", "guarantee": 1, "backend": "hoare", "kind": "proof", "instance": "c1",
                 "statement": "out.x <= 3 & <tag>", "source": f"{SRC}:{line}:3", "artifact": "", "status": status}
 
     def ev(i: str, status: str, cex: dict[str, Any] | None = None) -> dict[str, Any]:
-        return {"obligation": i, "backend": "hoare", "kind": "triple", "status": status, "tool": "z3",
+        return {"obligation": i, "backend": "hoare", "kind": "proof", "status": status, "tool": "z3",
                 "tool_version": "4", "started": "t", "duration_s": 0.5, "explanation": f"{status} because <&>",
                 "counterexample": cex, "artifacts": [], "log_excerpt": ""}
     return {

@@ -37,7 +37,9 @@ from typing import Mapping, Sequence
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import DiagnosisRow, EvidenceJson, LintRow, Report
+from rclverify.records.evidence_rows import rows_of as evidence_rows_of
+from rclverify.records.obligations import rows_of as obligation_rows_of
+from rclverify.records.report_schema import DiagnosisRow, LintRow, Report
 from rclverify.report.severity import of
 from rclverify.records.sarif import sarif_fix
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
@@ -195,37 +197,36 @@ def _result(rule: str, level: str, text: str, where: str, key: str, props: Mappi
 
 
 def _obligation_results(report: Report) -> list[SarifResult]:
-    evidence: dict[str, EvidenceJson] = {}
-    for row in report["evidence"]:
-        evidence[str(row["obligation"])] = row
+    """One result per obligation that is not discharged, its rows decoded into their definitions
+    (records/obligations.py, records/evidence_rows.py)."""
+    evidence = {ev.obligation: ev for ev in evidence_rows_of(report["evidence"])}
     reasons: dict[str, str] = {}
     for p in report["pending"]:
         reasons.setdefault(str(p["obligation"]), str(p["reason"]))
     out = []
-    for o in report["obligations"]:
-        rule = _OBLIGATION_RULE.get(str(o["status"]))
+    for o in obligation_rows_of(report["obligations"]):
+        rule = _OBLIGATION_RULE.get(o.status)
         if rule is None:
             continue
-        ev = evidence.get(str(o["id"]))
-        words = [f"Obligation {o['id']} ({o['backend']}, {o['kind']}) of {o['node']} guarantee {o['guarantee']} "
-                 f"is {o['status']}: {o['statement']}."]
-        expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
+        ev = evidence.get(o.id)
+        words = [f"Obligation {o.id} ({o.backend}, {o.kind}) of {o.node} guarantee {o.guarantee} "
+                 f"is {o.status}: {o.statement}."]
+        expl = ev.explanation if ev is not None else reasons.get(o.id, "no evidence record yet")
         if expl:
             words.append(expl)
-        if ev is not None and ev.get("counterexample"):
-            words.append(f"Counterexample: {model_text(ev['counterexample'])}.")
-        props: dict[str, object] = {"obligation": o["id"], "node": o["node"], "guarantee": o["guarantee"],
-                                    "backend": o["backend"], "status": o["status"]}
-        cex = ev.get("counterexample") if ev is not None else None
+        cex = ev.counterexample if ev is not None else None
+        if cex:
+            words.append(f"Counterexample: {model_text(cex)}.")
+        props: dict[str, object] = {"obligation": o.id, "node": o.node, "guarantee": o.guarantee,
+                                    "backend": o.backend, "status": o.status}
         if cex:
             props["counterexample"] = dict(cex)
-        if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
-            props["strength"] = dict(ev["strength"])
-        res = _result(rule, _level("obligation", str(o["status"])), " ".join(words), str(o["source"]),
-                      f"obligation:{o['id']}", props)
+        if ev is not None and ev.strength:  # the evidence's kind (docs/confidence.md)
+            props["strength"] = dict(ev.strength)
+        res = _result(rule, _level("obligation", o.status), " ".join(words), o.source, f"obligation:{o.id}", props)
         cause = (cex or {}).get("cause")
         if isinstance(cause, str) and _location(f"{cause}:0"):  # at the implementation's line
-            rel = _location(str(o["source"]))
+            rel = _location(o.source)
             for loc in rel:
                 loc["id"] = 0
                 loc["message"] = {"text": "the guarantee the example violates"}
