@@ -32,15 +32,14 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Iterable, Mapping
 
-import msgspec
-
+from rclverify.records.row import DOC, Row, decode_rows
 from rclverify.records.report_schema import Solvers, Strength
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 
-_DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
+_DOC = DOC
 
 
-class EvidenceRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+class EvidenceRow(Row, frozen=True, forbid_unknown_fields=True):
     """An evidence record as the report shows it."""
 
     obligation: Annotated[str, _DOC(description="The obligation's id.")]
@@ -73,23 +72,11 @@ class EvidenceRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     strength: Annotated[Strength | None, _DOC(
         description="How strong the evidence is (docs/confidence.md), null until the report rates it.")] = None
 
-    def to_json(self) -> dict[str, Any]:
-        """The row as its JSON object (every field, in the order declared)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
-        return out
-
-    @classmethod
-    def of(cls, row: EvidenceRow | Mapping[str, Any]) -> EvidenceRow:
-        """``row`` (a row or its JSON object) as a row.  Raises
-        :class:`msgspec.ValidationError` for a key no field declares, a
-        missing field or a value of another type."""
-        return row if isinstance(row, EvidenceRow) else msgspec.convert(dict(row), cls)
-
 
 def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[EvidenceRow]:
     """The report's ``evidence[]`` (JSON objects) decoded, in order
     (:meth:`EvidenceRow.of` for what raises)."""
-    return [EvidenceRow.of(r) for r in rows]
+    return decode_rows(EvidenceRow, rows)
 
 
 #: The fields of :class:`EvidenceRow` no evidence renderer shows, each with the reason.

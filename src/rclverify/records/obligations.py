@@ -27,14 +27,13 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Iterable, Mapping
 
-import msgspec
-
+from rclverify.records.row import DOC, Row, decode_rows
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 
-_DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
+_DOC = DOC
 
 
-class ObligationRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+class ObligationRow(Row, frozen=True, forbid_unknown_fields=True):
     """An obligation: what one backend must establish about one guarantee."""
 
     id: Annotated[str, _DOC(description="Stable id <node>.g<k>.<backend>[.<instance>].")]
@@ -51,23 +50,11 @@ class ObligationRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     status: Annotated[EvidenceStatus, _DOC(description="Its evidence's current status (stale when an input "
                                                        "changed; pending without a record).")]
 
-    def to_json(self) -> dict[str, Any]:
-        """The row as its JSON object (every field, in the order declared)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
-        return out
-
-    @classmethod
-    def of(cls, row: ObligationRow | Mapping[str, Any]) -> ObligationRow:
-        """``row`` (a row or its JSON object) as a row.  Raises
-        :class:`msgspec.ValidationError` for a key no field declares, a
-        missing field or a value of another type."""
-        return row if isinstance(row, ObligationRow) else msgspec.convert(dict(row), cls)
-
 
 def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[ObligationRow]:
     """The report's ``obligations[]`` (JSON objects) decoded, in order
     (:meth:`ObligationRow.of` for what raises)."""
-    return [ObligationRow.of(r) for r in rows]
+    return decode_rows(ObligationRow, rows)
 
 
 #: The fields of :class:`ObligationRow` no obligations-table renderer shows, each with the reason.
