@@ -50,6 +50,7 @@ from rclverify.records.statuses import DEADLINE_STATUS
 from rclverify.stages.workspace import Workspace
 from rclverify.records.store import EvidenceStore
 from rclverify.report.chain_margins import chain_margin, hop_margin
+from rclverify.report.junit_suite import closed
 
 #: A deadline verdict as an evidence status (the report's badges and roll-up).
 STATUS_OF = {"proved": "discharged", **DEADLINE_STATUS}  # records/statuses.py, "Verdict and status"
@@ -297,7 +298,4 @@ def junit_suite(report: Report, case: Callable[..., ET.Element],
                                     f"chain: {_chain_text(r)}", f"sum: {r['total']}", f"verdict: {r['verdict']}"]))
         if bumped:
             counts[bumped] += 1
-    for k, v in counts.items():
-        suite.set(k, str(v))
-    suite.set("time", "0.000")
-    return suite, counts, 0.0
+    return closed(suite, counts)

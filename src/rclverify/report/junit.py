@@ -62,6 +62,7 @@ from rclverify.report.templating import model_text
 from rclverify.records.findings import rows_of
 from rclverify.records.report_schema import Report
 from rclverify.report.severity import junit_outcome
+from rclverify.report.junit_suite import closed
 
 
 def _case(suite: ET.Element, classname: str, name: str, where: str, seconds: Any) -> ET.Element:
@@ -204,10 +205,7 @@ def _lint_suite(report: Report) -> tuple[ET.Element, dict[str, int], float] | No
                           f"{x['location']}: {sev}: {x['message']}", kind="lint")
         if bumped:
             counts[bumped] += 1
-    for k, v in counts.items():
-        suite.set(k, str(v))
-    suite.set("time", "0.000")
-    return suite, counts, 0.0
+    return closed(suite, counts)
 
 
 def _suite_data(report: Report) -> list[tuple[Mapping[str, Any], dict[str, Any]]]:

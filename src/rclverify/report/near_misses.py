@@ -28,6 +28,7 @@ from rclverify.records.report_schema import NearMissRow, ObligationJson, Report
 from rclverify.records.sarif import SarifResult
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
+from rclverify.report.junit_suite import closed
 
 #: SARIF rule of a near miss (``id``, ``name``, ``level``, ``text``), listed by report/sarif.py.
 SARIF_RULES = (
@@ -173,10 +174,7 @@ def junit_suite(report: Report, case: Callable[..., ET.Element],
         bumped = outcome(c, "warning", f"near miss: {describe(r)}", f"threshold: {r['threshold_source']}", "near-miss")
         if bumped:
             counts[bumped] += 1
-    for k, v in counts.items():
-        suite.set(k, str(v))
-    suite.set("time", "0.000")
-    return suite, counts, 0.0
+    return closed(suite, counts)
 
 
 def strict_reason(report: Report) -> list[str]:

@@ -23,6 +23,7 @@ from rclverify.records.report_schema import NodlRow, Report
 from rclverify.records.sarif import SarifLocation, SarifResult
 from rclverify.report.shapes import GroundingBrief
 from rclverify.stages.workspace import Workspace
+from rclverify.report.junit_suite import closed
 
 #: SARIF rule of every NoDL finding: ``(id, name, level, text)`` (report/sarif.py ``Rule``).
 SARIF_RULES = (
@@ -143,10 +144,7 @@ def junit_suite(report: Report, case: Callable[..., ET.Element],
                   for f in row["findings"] if f["severity"] == "warning"]
         if warned:
             ET.SubElement(c, "system-out").text = "\n".join(warned)
-    for k, v in counts.items():
-        suite.set(k, str(v))
-    suite.set("time", "0.000")
-    return suite, counts, 0.0
+    return closed(suite, counts)
 
 
 def sarif_results(report: Report, result: Callable[..., SarifResult],
