@@ -134,8 +134,8 @@ def test_per_trial_data_end_to_end_with_plot(ws: Workspace) -> None:
     assert first.lstrip().startswith(b"<?xml") and b"tolerance (25 cm)" in first
     stage_run(Workspace(root), "Navigation", E0)
     assert svg.read_bytes() == first  # deterministic
-    extras = _evidence_extras(Workspace(root), ev.details)  # type: ignore[attr-defined]
-    assert extras["plot_svg"].startswith("<svg") and ["worst", "0.12 m"] in extras["figures"]
+    figures, plot_svg = _evidence_extras(Workspace(root), ev.details)  # type: ignore[attr-defined]
+    assert plot_svg.startswith("<svg") and ["worst", "0.12 m"] in figures
     # a trial beyond the tolerance makes it failed, naming the trial
     (root / "backends/experiment/runs.csv").write_text("trial,error\n1,10\n2,31\n3,9\n", encoding="utf-8")
     assert EvidenceStore(root).current_status(ev) == "stale"  # type: ignore[arg-type]

@@ -5,16 +5,14 @@ One column per run: the margins the run kept (its smallest, at most
 "Margins over runs"; at most :data:`POINTS_PER_RUN` of them drawn, evenly
 spaced in rank), the run's smallest marked, a line at 0 (the
 boundary: below it the guarantee failed) and the quantiles the kept
-margins decide.  Deterministic as backends/experiment/plot.py is: a fixed
-``svg.hashsalt``, no date in the metadata, the same figures the same bytes
-for one matplotlib version.
+margins decide.  Deterministic (:func:`rclverify.core.svgplot.svg_plot`).
 """
 from __future__ import annotations
 
-import io
 import math
-from typing import Sequence
+from typing import Any, Sequence
 
+from rclverify.core.svgplot import svg_plot
 from rclverify.records.report_schema import MarginRow
 
 
@@ -41,40 +39,29 @@ def render_svg(row: MarginRow, runs: Sequence[tuple[str, Sequence[float]]]) -> s
     (floats, ``-inf`` for a margin without distance, not drawn).  Raises
     :class:`~rclverify.core.extras.MissingExtra` without matplotlib (the
     ``plots`` extra)."""
-    from rclverify.core.numeric import import_numpy  # deferred: start-up (numpy, matplotlib's, with one BLAS thread)
-    import_numpy()
-    from rclverify.core.extras import require  # deferred: start-up (only where a plot is drawn)
-    matplotlib = require("matplotlib", "the margins' plot")  # raises MissingExtra (core/extras.py)
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # deferred: start-up (loads matplotlib and more only when called)
     unit = f" [{row['unit']}]" if row["unit"] else ""
-    with matplotlib.rc_context({"svg.hashsalt": "rclverify", "svg.fonttype": "none", "font.size": 9}):
-        f, ax = plt.subplots(figsize=(6.4, 3.6))
-        try:
-            for x, (_, kept) in enumerate(runs, start=1):
-                ys = _spread([v for v in kept if math.isfinite(v)])
-                ax.plot([x] * len(ys), ys, "o", color="C0", markersize=2.5, alpha=0.5,
-                        label=f"kept margins (at most {POINTS_PER_RUN} a run drawn)" if x == 1 else None)
-                if ys:
-                    ax.plot([x], [ys[0]], "v", color="C3", markersize=6, label="run's smallest" if x == 1 else None)
-            ax.axhline(0.0, color="black", linewidth=0.8)
-            for k, (name, b) in enumerate((("p5", row["p5"]), ("p50", row["p50"]))):
-                if b["low"] is not None and b["low"] == b["high"]:
-                    ax.axhline(float(b["low"]), color=f"C{1 + k}", linestyle="--",
-                               label=f"{name} over {row['count']} answers ({b['low']:g})")
-            ax.set_xticks(range(1, len(runs) + 1), [_label(t) for t, _ in runs], rotation=30, ha="right",
-                          fontsize=7)
-            ax.set_xlim(0.5, len(runs) + 0.5)
-            ax.set_xlabel("run")
-            ax.set_ylabel(f"margin{unit}")
-            ax.set_title(f"{row['node']} guarantee {row['guarantee']}")
-            ax.legend(loc="best", fontsize=7)
-            f.tight_layout()
-            out = io.StringIO()
-            f.savefig(out, format="svg", metadata={"Date": None})
-        finally:
-            plt.close(f)
-    text = out.getvalue()
+
+    def draw(f: Any, ax: Any) -> None:
+        for x, (_, kept) in enumerate(runs, start=1):
+            ys = _spread([v for v in kept if math.isfinite(v)])
+            ax.plot([x] * len(ys), ys, "o", color="C0", markersize=2.5, alpha=0.5,
+                    label=f"kept margins (at most {POINTS_PER_RUN} a run drawn)" if x == 1 else None)
+            if ys:
+                ax.plot([x], [ys[0]], "v", color="C3", markersize=6, label="run's smallest" if x == 1 else None)
+        ax.axhline(0.0, color="black", linewidth=0.8)
+        for k, (name, b) in enumerate((("p5", row["p5"]), ("p50", row["p50"]))):
+            if b["low"] is not None and b["low"] == b["high"]:
+                ax.axhline(float(b["low"]), color=f"C{1 + k}", linestyle="--",
+                           label=f"{name} over {row['count']} answers ({b['low']:g})")
+        ax.set_xticks(range(1, len(runs) + 1), [_label(t) for t, _ in runs], rotation=30, ha="right",
+                      fontsize=7)
+        ax.set_xlim(0.5, len(runs) + 0.5)
+        ax.set_xlabel("run")
+        ax.set_ylabel(f"margin{unit}")
+        ax.set_title(f"{row['node']} guarantee {row['guarantee']}")
+        ax.legend(loc="best", fontsize=7)
+
+    text = svg_plot("the margins' plot", draw)
     return text[text.index("<svg"):]
 
 
