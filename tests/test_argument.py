@@ -71,6 +71,18 @@ def _status(arg: Argument, eid: str) -> str | None:
     return arg.elements[eid].status
 
 
+
+def _rendered() -> dict[str, Any]:
+    """:func:`_report` as the report writes it for its renderers: each requirement with its verdict, note
+    and check record (records/requirement_rows.py), here informal (no formal statement: traced only)."""
+    from rclverify.report.requirement_rows import _CHECK_FIELDS
+    rep = _report()
+    check = {**{k: None for k in _CHECK_FIELDS}, "origin": "plan", "source": "contracts/plan.yaml:3:5",
+             "declarations": []}  # an informal requirement's record: nothing checked
+    rep["requirements"] = [{**rq, "verdict": "informal", "note": "no formal statement: traced only",
+                            "check": check} for rq in rep["requirements"]]
+    return rep
+
 def test_structure_has_the_gsn_elements_of_the_method() -> None:
     arg = build_argument(_report())
     els = arg.elements
@@ -209,7 +221,7 @@ def test_hostile_text_cannot_break_the_yaml_or_the_dot() -> None:
 
 @pytest.mark.skipif(shutil.which("dot") is None, reason="graphviz not installed")
 def test_the_html_report_embeds_the_argument_diagram(tmp_path: Any) -> None:
-    html = render.render_html(_report())
+    html = render.render_html(_rendered())
     section = html[html.index('<section id="argument">'):]
     section = section[:section.index("</section>")]
     assert "<svg" in section and "G-system" in section and 'href="#argument"' in html
@@ -223,9 +235,9 @@ def test_the_html_report_embeds_the_argument_diagram(tmp_path: Any) -> None:
 def test_without_graphviz_the_report_shows_the_dot_source() -> None:
     view = argument_view(_report(), NO_DOT)
     assert view["svg"] is None and view["dot"].startswith("// assurance argument of mini")
-    html = render.render_html(_report(), rendering=NO_DOT)
+    html = render.render_html(_rendered(), rendering=NO_DOT)
     assert "The argument's Graphviz source" in html and "no graphviz in this test" in html
-    md = render.render_markdown(_report())
+    md = render.render_markdown(_rendered())
     assert "## Assurance argument (GSN)" in md and "`G-REQ1`" in md
 
 
@@ -244,19 +256,19 @@ def test_a_long_element_text_is_clipped_in_the_tooltip_so_dot_accepts_it(tmp_pat
 def test_an_argument_too_large_to_draw_is_not_laid_out(tmp_path: Any, monkeypatch: pytest.MonkeyPatch) -> None:
     from rclverify.report.argument import export
     from rclverify.report import diagram
-    n = len(build_argument(_report()).elements)
+    n = len(build_argument(_rendered()).elements)
     monkeypatch.setattr(export, "MAX_LAYOUT_ELEMENTS", n - 1)
     monkeypatch.setattr(diagram, "render_dot", lambda *a, **k: pytest.fail("dot must not run"))
-    view = argument_view(_report())
+    view = argument_view(_rendered())
     assert view["too_large"] and view["svg"] is None and f"the argument has {n} elements" in view["note"]
     (tmp_path / "argument.svg").write_text("<svg/>")  # a diagram of an earlier, smaller argument
-    names = [p.name for p in write_argument(_report(), tmp_path)]
+    names = [p.name for p in write_argument(_rendered(), tmp_path)]
     assert names == ["argument.json", "argument.gsn.yaml", "argument.dot"] and not (tmp_path / "argument.svg").exists()
-    html = render.render_html(_report(), rendering=NO_DOT)
+    html = render.render_html(_rendered(), rendering=NO_DOT)
     section = html[html.index('<section id="argument">'):html.index("</section>", html.index('<section id="argument">'))]
     assert f"the argument has {n} elements" in section and '<a href="argument.dot">' in section
     assert "<pre>" not in section and 'href="argument.svg"' not in section
-    assert "No diagram: the argument has" in render.render_markdown(_report())
+    assert "No diagram: the argument has" in render.render_markdown(_rendered())
 
 
 def _claim_points_obey_v09(data: dict[str, Any]) -> list[tuple[str, str]]:

@@ -7,9 +7,11 @@ The rule, for a contract-health finding: :class:`~rclverify.records.findings.Fin
 field is read by one of the report's finding renderers (report/templates/parts/findings.{html,md}.j2)
 or named in :data:`~rclverify.records.findings.INTERNAL`.  The same holds for an obligation's row
 (:class:`~rclverify.records.obligations.ObligationRow`, ``obligations[]``, rendered by
-report/templates/parts/obligations.{html,md}.j2) and an evidence record's row
+report/templates/parts/obligations.{html,md}.j2) an evidence record's row
 (:class:`~rclverify.records.evidence_rows.EvidenceRow`, ``evidence[]``, rendered by
-report/templates/parts/evidence.{html,md}.j2).  Each check is also run on a definition with a field
+report/templates/parts/evidence.{html,md}.j2) and a requirement's row
+(:class:`~rclverify.records.requirement_rows.RequirementRow`, ``requirements[]``, rendered by
+report/templates/assurance.{html,md}.j2).  Each check is also run on a definition with a field
 added, and must then fail.  In-process and cheap: no pipeline runs here.
 """
 from __future__ import annotations
@@ -26,10 +28,11 @@ from jinja2 import nodes
 
 from _report_schema import SCHEMA
 from rclverify.records import schema_gen
-from rclverify.records import evidence_rows, obligations
+from rclverify.records import evidence_rows, obligations, requirement_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.render import part_renderer
 from rclverify.report.fragments import FragmentCache
 
@@ -47,6 +50,9 @@ class Record(NamedTuple):
 
 
 RECORDS: dict[str, Record] = {
+    # a requirement's row is rendered by the main templates (the requirements table, the Z3 checks' list)
+    "requirements": Record(RequirementRow, requirement_rows.INTERNAL, "requirement_rows",
+                           ("../assurance.html.j2", "../assurance.md.j2")),
     "findings": Record(FindingRow, INTERNAL, "findings", RENDERERS),
     "obligations": Record(ObligationRow, obligations.INTERNAL, "obligation_row",
                           ("obligations.html.j2", "obligations.md.j2")),
@@ -319,3 +325,60 @@ def test_the_evidence_renderers_show_each_field_they_read_and_refuse_an_undeclar
     assert (bare["figures"], bare["plot_svg"], bare["solvers"], bare["monitoring"], bare["strength"]) == (
         [], "", None, {}, None)
     assert EvidenceRow.of(bare).to_json() == bare
+
+
+class _RequirementWithMargin(RequirementRow, frozen=True, forbid_unknown_fields=True):
+    """The requirement row with one field added, as a change to records/requirement_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_a_requirement_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["requirements"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_RequirementWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_RequirementWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ req.note|prose }}", "{{ req.note|prose }} {{ req.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_RequirementWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    # a read of an undecoded row (the view's ``t.req``) does not count
+    raw = sources[0].replace("{% set req = t.req %}", "{% set req = t.req %}{{ req.margin_added_here }}", 1)
+    assert raw != sources[0]
+    assert unaccounted(_RequirementWithMargin, [raw, sources[1]], r.internal, r.filter) != []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "requirements",
+                   (_RequirementWithMargin, schema_gen.GENERATED["requirements"][1]))
+        part = schema_gen.generated_part("requirements", SCHEMA)
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["requirements"] != part
+    # the requirements stage's check record keeps its hand-written schema in the generated part
+    assert part["items"]["properties"]["check"] == SCHEMA["properties"]["requirements"]["items"]["properties"]["check"]
+
+
+_REQUIREMENT: dict[str, Any] = {
+    "id": "R1", "text": "text-words", "verdict": "met", "status": "discharged", "note": "note-words",
+    "support": [{"node": "N", "guarantee": 1, "text": "y > 0", "source": "a.rcl:3:4", "status": "discharged",
+                 "obligations": ["N.g1.hoare.c1"]}],
+    "check": {"formal": "y > 0", "source": "plan.yaml:4:5", "declarations": []}}
+
+
+def test_a_requirement_row_is_written_whole_and_refuses_an_undeclared_key() -> None:
+    from rclverify.model.plan.declarations import STRENGTHS
+    assert typing.get_args(requirement_rows.StrengthKind) == STRENGTHS  # the plan's strength words
+    row = RequirementRow.of(_REQUIREMENT).to_json()
+    # every field, in the order declared, the later passes' at their defaults (a key never absent in one run)
+    assert list(row) == list(RequirementRow.__struct_fields__)
+    assert (row["deadline"], row["without_deadline"], row["statistics"], row["confidence"], row["limited_by"],
+            row["required_strength"], row["strength_shortfall"]) == (None, None, [], None, None, None, [])
+    assert RequirementRow.of(row).to_json() == row
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        RequirementRow.of({**row, "margin_added_here": "0.5 m"})
+    with pytest.raises(msgspec.ValidationError, match="verdict"):
+        RequirementRow.of({**row, "verdict": "nearly met"})
+    env = __import__("rclverify.report.templating", fromlist=["environment"]).environment()
+    shown = env.from_string("{% for q in rows|requirement_rows %}{{ q.id }} {{ q|reqbadges }} {{ q.note }}"
+                            "{% endfor %}").render(rows=[row])
+    assert "R1" in shown and "note-words" in shown
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        env.from_string("{% for q in rows|requirement_rows %}{{ q.id }}{% endfor %}").render(
+            rows=[{**row, "margin_added_here": "0.5 m"}])

@@ -15,6 +15,15 @@ import pytest
 from rclverify.report import diagram, render
 
 
+def _check(formal: str, source: str) -> dict[str, Any]:
+    """A requirement's check record as the report carries it (report/requirement_rows.py): every field the
+    report keeps, the formal statement proved from the premises it is traced to."""
+    from rclverify.report.requirement_rows import _CHECK_FIELDS
+    return {**{k: None for k in _CHECK_FIELDS}, "origin": "plan", "source": source, "formal": formal,
+            "assuming": [], "used": [], "consistency": "consistent", "vacuity": "not vacuous",
+            "declarations": []}
+
+
 def _report() -> dict[str, Any]:
     """A small report in the shape the pipeline produces: two nodes in a loop,
     an environment input, one failed evidence (with a hostile explanation),
@@ -41,7 +50,9 @@ def _report() -> dict[str, Any]:
             "loops": [["Agent", "Sensor"]],
         },
         "requirements": [
-            {"id": "REQ1", "text": "Report high radiation as red.", "status": "failed",
+            {"id": "REQ1", "text": "Report high radiation as red.", "verdict": "proved, evidence outstanding",
+             "status": "failed", "note": "proved from the guarantees it is traced to; their evidence is failed",
+             "check": _check("in.r >= 250 -> out.command == stop", "contracts/plan.yaml:5:11"),
              "support": [
                  {"node": "Sensor", "guarantee": 1, "text": "in.r >= 250 -> out.status == red",
                   "source": "contracts/mini.rcl:12:3", "status": "failed",
@@ -50,7 +61,9 @@ def _report() -> dict[str, Any]:
                   "source": "contracts/mini.rcl:20:3", "status": "pending",
                   "obligations": ["Agent.g1.ajpf"]},
              ]},
-            {"id": "REQ2", "text": "Move when | safe & sound.", "status": "discharged",
+            {"id": "REQ2", "text": "Move when | safe & sound.", "verdict": "met", "status": "discharged",
+             "note": "proved from consistent premises whose evidence is all discharged",
+             "check": _check("in.status == green -> out.command == go", "contracts/plan.yaml:9:11"),
              "support": [
                  {"node": "Agent", "guarantee": 2, "text": "forall(k in NATURAL | in.status == green -> out.command == go)",
                   "source": "contracts/mini.rcl:21:3", "status": "discharged",

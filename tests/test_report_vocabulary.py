@@ -205,8 +205,8 @@ def test_a_key_in_one_and_not_the_other_is_found() -> None:
                  "report.nodes.latex: required in one only"),
                 (lambda s: s["properties"]["unverified"]["items"]["properties"]["guarantee"].update(type="string"),
                  "report.unverified.guarantee: ['integer'] in the TypedDict, ['string'] in the schema"),
-                (lambda s: s["properties"]["requirements"]["items"]["properties"].pop("strength_shortfall"),
-                 "report.requirements.strength_shortfall: only in the TypedDict"),
+                (lambda s: s["properties"]["derived_properties"]["items"]["properties"].pop("evidence_note"),
+                 "report.derived_properties.evidence_note: only in the TypedDict"),
                 (lambda s: s["properties"]["unverified"]["items"]["properties"]["status"].update(const="pending"),
                  "report.unverified.status: words ['unverified'] in the TypedDict, ['pending'] in the schema"),
                 (lambda s: s["properties"]["unverified"]["items"]["properties"]["guarantee"].update(
@@ -218,7 +218,7 @@ def test_a_key_in_one_and_not_the_other_is_found() -> None:
     finally:
         SCHEMA = kept
     assert {k: v for k, v in typing.get_type_hints(st.Strength).items()} and \
-        st.RequirementRow.__optional_keys__ >= {"required_strength", "strength_shortfall"}
+        st.NodeRow.__optional_keys__ >= {"confidence", "limited_by"}
 
 
 def test_a_status_that_does_not_follow_from_its_verdict_is_found() -> None:

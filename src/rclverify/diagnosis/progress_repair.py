@@ -29,7 +29,7 @@ from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
 from rclverify.calculus.shapes import Gaps
-from rclverify.records.report_schema import RequirementRow
+from rclverify.records.report_schema import RequirementJson
 from rclverify.records.stage_records import Repair
 from rclverify.model.plan.load import all_requirements
 from rclverify.calculus.requirements.check import check_requirement
@@ -68,7 +68,7 @@ def _declaration_edit(ws: Any, node: Any, k: int) -> Edit | None:
     return Edit(node.loc.file, end_line, 1, end_line, 1, f"  {text}\n")
 
 
-def progress_repairs(ws: Any, q: RequirementRow, temporal: Gaps) -> list[Repair]:
+def progress_repairs(ws: Any, q: RequirementJson, temporal: Gaps) -> list[Repair]:
     """The repairs (:func:`.repairs._record` dicts, kind
     ``declare-progress``) for the refuted temporal requirement ``q`` (a
     report row) whose record ``temporal`` names ``missing_progress``: for

@@ -18,7 +18,7 @@ from fractions import Fraction
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.calculus.compose import conjuncts
 from rclverify.diagnosis.shapes import CulpritRow, ProducerCulprits, ReportRows, Strengthening
-from rclverify.records.report_schema import RequirementRow, SideConditionRow
+from rclverify.records.report_schema import RequirementJson, SideConditionRow
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 
 #: ``guarantee_source(report, node, k)``: a guarantee's (text, source) (diagnosis/build.py).
@@ -28,7 +28,7 @@ GuaranteeSource = Callable[[ReportRows, str, int], tuple[str, str]]
 _KIND = {"bound": "tighten-bound", "threshold": "move-threshold", "conclusion": "strengthen-guarantee"}
 
 
-def requirement_record(ws: Any, report: ReportRows, q: RequirementRow, cache: Any,
+def requirement_record(ws: Any, report: ReportRows, q: RequirementJson, cache: Any,
                        guarantee_source: GuaranteeSource) -> DiagnosisEntry:
     """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the refuted
     requirement ``q`` (a report row): the guarantees Z3 showed a
@@ -82,7 +82,7 @@ def requirement_record(ws: Any, report: ReportRows, q: RequirementRow, cache: An
             "passes_through": [str(sc["id"]) for sc in through]}
 
 
-def _culprit_rows(ws: Any, report: ReportRows, q: RequirementRow, cone: list[str],
+def _culprit_rows(ws: Any, report: ReportRows, q: RequirementJson, cone: list[str],
                   guarantee_source: GuaranteeSource) -> list[CulpritRow]:
     """One row per guarantee whose strengthening Z3 showed proves ``q``
     (:func:`blame.requirement_culprits`), with that strengthening as a repair."""
@@ -108,7 +108,7 @@ def _culprit_rows(ws: Any, report: ReportRows, q: RequirementRow, cone: list[str
     return rows
 
 
-def _summary(f: Strengthening, q: RequirementRow, src: str) -> str:
+def _summary(f: Strengthening, q: RequirementJson, src: str) -> str:
     """The repair's one-paragraph summary for culprit ``f`` (``src`` its guarantee's location)."""
     what = f"guarantee {f['guarantee']} of {f['node']}"
     if f["how"] == "bound":
@@ -124,7 +124,7 @@ def _summary(f: Strengthening, q: RequirementRow, src: str) -> str:
             f"{f['node']}'s evidence must then establish it.")
 
 
-def _refuted(q: RequirementRow, check: Mapping[str, object], f: CulpritRow | None, cex: str) -> str:
+def _refuted(q: RequirementJson, check: Mapping[str, object], f: CulpritRow | None, cex: str) -> str:
     """The record's sentence: why ``q`` is refuted, naming the first culprit
     ``f`` (``None``: no single strengthening proves it) and the counterexample."""
     if f is not None:
@@ -141,7 +141,7 @@ def _refuted(q: RequirementRow, check: Mapping[str, object], f: CulpritRow | Non
             + (f". Z3's counterexample: {cex}" if cex else "") + ".")
 
 
-def _causes(ws: Any, report: ReportRows, q: RequirementRow, cone: list[str],
+def _causes(ws: Any, report: ReportRows, q: RequirementJson, cone: list[str],
             cache: Any) -> list[tuple[SideConditionRow, str, int]]:
     """``[(side condition row, producer, guarantee index)]``: the failed side
     conditions of ``q``'s cone whose discharge alone proves ``q`` -- each
@@ -181,7 +181,7 @@ def _cex_value(text: Any) -> Any:
         return None
 
 
-def _passes_through(ws: Any, report: ReportRows, q: RequirementRow,
+def _passes_through(ws: Any, report: ReportRows, q: RequirementJson,
                     cone: list[str]) -> list[SideConditionRow]:
     """The failed side conditions of ``q``'s cone whose conjunct is false on
     the consumer's values in ``q``'s counterexample (decided by the
@@ -207,7 +207,7 @@ def _passes_through(ws: Any, report: ReportRows, q: RequirementRow,
     return out
 
 
-def _consequence_record(report: ReportRows, q: RequirementRow, check: Mapping[str, Any],
+def _consequence_record(report: ReportRows, q: RequirementJson, check: Mapping[str, Any],
                         causes: list[tuple[SideConditionRow, str, int]],
                         guarantee_source: GuaranteeSource) -> DiagnosisEntry:
     """The diagnosis record of a requirement refuted only because of the
@@ -240,7 +240,7 @@ def _consequence_record(report: ReportRows, q: RequirementRow, check: Mapping[st
             "related": [], "consequence_of": ids}
 
 
-def _slips(ws: Any, report: ReportRows, q: RequirementRow,
+def _slips(ws: Any, report: ReportRows, q: RequirementJson,
            guarantee_source: GuaranteeSource) -> list[CulpritRow]:
     """The guarantees :func:`blame.temporal_culprits` names for the refuted
     temporal requirement ``q``, each ``{"node", "guarantee", "how", "old",
@@ -268,7 +268,7 @@ def _slips(ws: Any, report: ReportRows, q: RequirementRow,
     return rows
 
 
-def _with_slips(rec: DiagnosisEntry, q: RequirementRow, check: Mapping[str, object],
+def _with_slips(rec: DiagnosisEntry, q: RequirementJson, check: Mapping[str, object],
                 slips: list[CulpritRow]) -> DiagnosisEntry:
     """``rec`` (a temporal record without a culprit) naming the guarantees of ``slips`` (:func:`_slips`)."""
     f = slips[0]
@@ -306,7 +306,7 @@ def _between(report: ReportRows, sources: set[str], sinks: set[str]) -> set[str]
     return (reach(sources, down) & reach(sinks, up)) - sources - sinks
 
 
-def _run_record(q: RequirementRow, check: Mapping[str, Any], row: Mapping[str, Any]) -> DiagnosisEntry:
+def _run_record(q: RequirementJson, check: Mapping[str, Any], row: Mapping[str, Any]) -> DiagnosisEntry:
     """The diagnosis of a requirement a recorded run refutes
     (backends/monitors/temporal_evidence.py: a trace row ``failed``): the
     run, the step of the composed system at which it was refuted
@@ -341,7 +341,7 @@ def _run_record(q: RequirementRow, check: Mapping[str, Any], row: Mapping[str, A
             "culprits": [], "counterexample": table, "repairs": [], "guarantee": None, "related": []}
 
 
-def _temporal_record(q: RequirementRow, check: Mapping[str, Any],
+def _temporal_record(q: RequirementJson, check: Mapping[str, Any],
                      repairs: Callable[[], list[Repair]]) -> DiagnosisEntry:
     """The diagnosis of a refuted temporal requirement: its counterexample
     run (docs/requirements.md, "Temporal requirements"), the state it loops

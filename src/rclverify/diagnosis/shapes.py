@@ -15,7 +15,7 @@ from typing import NotRequired, TypedDict, cast
 
 from rclverify.diagnosis.edits import Edit
 from rclverify.records.report_schema import (DeadlineRow, EvidenceJson, FindingJson, LintRow, NodeRow, ObligationJson,
-                                             RequirementRow, SideConditionRow, SystemView)
+                                             RequirementJson, SideConditionRow, SystemView)
 from rclverify.records.stage_records import Repair
 
 
@@ -24,7 +24,7 @@ class ReportRows(TypedDict):
     report/build.py ``undiagnosed_report``; a whole :class:`~rclverify.records.report_schema.Report`
     is one too)."""
     system: SystemView
-    requirements: list[RequirementRow]
+    requirements: list[RequirementJson]
     nodes: list[NodeRow]
     side_conditions: list[SideConditionRow]
     findings: list[FindingJson]

@@ -279,34 +279,6 @@ class NodeRow(TypedDict):
     culprit_of: NotRequired[list[CulpritOf]]
 
 
-class SupportRow(TypedDict):
-    """A guarantee a requirement is traced to (``requirements[].support[]``)."""
-    node: str
-    guarantee: int
-    text: str
-    source: str
-    status: EvidenceStatus
-    obligations: list[str]
-
-
-class RequirementRow(TypedDict):
-    """A requirement (``requirements[]``): only ``verdict`` ``met`` has ``status`` ``discharged``."""
-    id: str
-    text: str
-    verdict: RequirementVerdict
-    status: EvidenceStatus
-    note: str
-    support: list[SupportRow]
-    check: dict[str, Any]
-    deadline: NotRequired[DeadlineRow]
-    without_deadline: NotRequired[dict[str, Any]]
-    statistics: NotRequired[list[dict[str, Any]]]
-    confidence: NotRequired[float]
-    limited_by: NotRequired[LimitedBy | None]
-    required_strength: NotRequired[str]
-    strength_shortfall: NotRequired[list[str]]
-
-
 class SideConditionRow(TypedDict):
     """A side condition decided by Z3 (``side_conditions[]``); ``duration_s`` in seconds."""
     id: str
@@ -364,6 +336,17 @@ ObligationJson = dict[str, Any]
 #: ``evidence`` items are generated from it, records/schema_gen.py); decode it with ``EvidenceRow.of``
 #: to read its fields as attributes.
 EvidenceJson = dict[str, Any]
+
+
+#: A requirement's row (``requirements[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.requirement_rows.RequirementRow`, the one definition of its fields (the
+#: schema's ``requirements`` items are generated from it, records/schema_gen.py); decode it with
+#: ``RequirementRow.of`` to read its fields as attributes.
+RequirementJson = dict[str, Any]
+
+#: A guarantee a requirement is traced to (``requirements[].support[]``) as its JSON object: the encoding
+#: of :class:`rclverify.records.requirement_rows.SupportRow`.
+SupportJson = dict[str, Any]
 
 
 class PendingRow(TypedDict):
@@ -476,7 +459,7 @@ class Report(TypedDict):
     meta: Meta
     summary: Summary
     system: SystemView
-    requirements: list[RequirementRow]
+    requirements: list[RequirementJson]
     nodes: list[NodeRow]
     side_conditions: list[SideConditionRow]
     derived_properties: list[DerivedPropertyRow]

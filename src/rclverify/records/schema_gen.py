@@ -32,21 +32,25 @@ from rclverify.core.atomic import atomic_write_text
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow
 from rclverify.records.obligations import ObligationRow
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.statuses import VOCABULARY
 
 #: Top-level key of the report -> (the class of its items, the key's description).
 GENERATED: dict[str, tuple[type[msgspec.Struct], str]] = {
+    "requirements": (RequirementRow, "The plan's requirements, in plan order."),
     "findings": (FindingRow, "Contract health findings (vacuity, consistency, realizability, scale)."),
     "obligations": (ObligationRow, "Every obligation of the plan's evidence entries."),
     "evidence": (EvidenceRow, "One row per obligation with an evidence record."),
 }
 
 #: A type the report's schema already defines in ``$defs`` -> that entry's name.
-SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength"}
+SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength", "DeadlineRow": "deadline",
+                           "LimitedBy": "limited_by"}
 
 #: Top-level key -> the fields of its items whose schema the file states by hand (a tool's record:
-#: the monitors backend's run summary, docs/monitors.md).
-KEPT: dict[str, tuple[str, ...]] = {"evidence": ("monitoring",)}
+#: the monitors backend's run summary, docs/monitors.md; the requirements stage's check record,
+#: calculus/requirements/check.py).
+KEPT: dict[str, tuple[str, ...]] = {"evidence": ("monitoring",), "requirements": ("check",)}
 
 
 def _styled(x: Any, defs: dict[str, Any]) -> Any:

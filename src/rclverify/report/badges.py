@@ -15,6 +15,8 @@ from typing import Any, Mapping
 import jinja2
 from markupsafe import Markup, escape
 
+from rclverify.records.requirement_rows import RequirementRow
+
 __all__ = ["VERDICT_STYLE", "requirement_badges"]
 
 #: Verdict word -> (badge text, badge style) of the proof badge; a verdict
@@ -39,12 +41,16 @@ def _badge(text: str, style: str, title: str = "") -> Markup:
 
 
 @jinja2.pass_environment
-def requirement_badges(env: jinja2.Environment, req: Mapping[str, Any]) -> Markup:
+def requirement_badges(env: jinja2.Environment, req: Mapping[str, Any] | RequirementRow) -> Markup:
     """The badges of a requirement of the report dict (``{"status",
     "verdict"?, "note"?}``): without a verdict, its status badge; else the
     proof badge (:data:`VERDICT_STYLE`) and, when the proof holds and the
     status is the evidence's, ``evidence: <status>``.  The status word is
-    the badges' ``title`` and the note the proof badge's; text escaped."""
+    the badges' ``title`` and the note the proof badge's; text escaped.  A
+    decoded :class:`~rclverify.records.requirement_rows.RequirementRow` is
+    read as its JSON object."""
+    if isinstance(req, RequirementRow):
+        req = req.to_json()
     status = str(req["status"])
     verdict = req.get("verdict")
     if verdict is None:

@@ -9,12 +9,13 @@ nodes' side conditions; only ``met`` is ``discharged``): records/statuses.py,
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Mapping, cast
+from typing import Any, Callable, Mapping
 
 from rclverify.calculus.requirements.rollup import declaration_evidence, declaration_statuses, roll_up
 from rclverify.model.plan.load import all_requirements
 from rclverify.records.records import worst
-from rclverify.records.report_schema import RequirementRow, SupportRow
+from rclverify.records.report_schema import RequirementJson
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters
 from rclverify.report.contract_rows import GuaranteeStatuses
 from rclverify.stages.contract_texts import ContractTexts
@@ -62,23 +63,28 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
 
 
 def requirement_rows(ws: Workspace, texts: ContractTexts, checks: Mapping[str, Any], g_status: GuaranteeStatuses,
-                     sc_status: Mapping[str, str], declared: Mapping[str, list[tuple[str, Any]]]) -> list[RequirementRow]:
-    """One row per requirement of ``ws``'s plan (module docstring): its
-    support (the guarantees it is traced to, with their statuses), then its
-    check's fields (:func:`requirement_check`).  ``checks``: requirement id
-    -> its check record (sealed, stale and second solver applied);
-    ``declared``: node -> the records that judged its declarations."""
-    rows: list[RequirementRow] = []
+                     sc_status: Mapping[str, str], declared: Mapping[str, list[tuple[str, Any]]]) -> list[RequirementJson]:
+    """One row per requirement of ``ws``'s plan (module docstring), each
+    :class:`~rclverify.records.requirement_rows.RequirementRow` as its JSON
+    object (every field; the later passes' at their defaults): its support
+    (the guarantees it is traced to, with their statuses), then its check's
+    fields (:func:`requirement_check`).  ``checks``: requirement id -> its
+    check record (sealed, stale and second solver applied); ``declared``:
+    node -> the records that judged its declarations.  Raises
+    :class:`msgspec.ValidationError` when a check's verdict or status is
+    outside the vocabulary (a bug of the roll-up)."""
+    rows: list[RequirementJson] = []
     for r in all_requirements(ws.plan):
-        support: list[SupportRow] = []
+        support: list[dict[str, Any]] = []  # SupportRow's fields, checked when the row is decoded below
         for s in r.support:
             for k in s.guarantees:
                 text, src = texts.node(ws.checked.nodes[s.node].node)["guarantees"][k - 1]
-                support.append(cast(SupportRow, {"node": s.node, "guarantee": k, "text": text, "source": src,
-                                                 "status": g_status(s.node, k),
-                                                 "obligations": g_status.obligations(s.node, k)}))
+                support.append({"node": s.node, "guarantee": k, "text": text, "source": src,
+                                "status": g_status(s.node, k), "obligations": g_status.obligations(s.node, k)})
         st = worst([x["status"] for x in support] + [sc_status[x["node"]] for x in support]) if support else "pending"
-        rows.append(cast(RequirementRow, {"id": r.id, "text": r.text, "status": st, "support": support,
-                                          **requirement_check(current_record(r, checks.get(r.id)), st, g_status,
-                                                              sc_status, declaration_statuses(declared, ws.checked))}))
+        got = requirement_check(current_record(r, checks.get(r.id)), st, g_status, sc_status,
+                                declaration_statuses(declared, ws.checked))
+        rows.append(RequirementRow.of({"id": r.id, "text": r.text, "verdict": got["verdict"], "status": got["status"],
+                                       "note": got["note"], "support": support,
+                                       "check": got["check"]}).to_json())
     return rows

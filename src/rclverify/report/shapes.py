@@ -13,8 +13,8 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 from typing import Any, NotRequired, TypedDict
 
 from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceJson, FindingJson, NodeRow,
-                                             LimitedBy, ObligationJson, PendingRow, ProblemRow, RequirementRow, SideConditionRow,
-                                             Summary, SupportRow)
+                                             LimitedBy, ObligationJson, PendingRow, ProblemRow, RequirementJson, SideConditionRow,
+                                             Summary, SupportJson)
 
 
 
@@ -144,13 +144,13 @@ class TraceObligation(TypedDict):
 
 class TraceSupport(TypedDict):
     """A guarantee that supports a requirement, with its obligations."""
-    support: SupportRow
+    support: SupportJson
     obligations: list[TraceObligation]
 
 
 class TraceEntry(TypedDict):
     """A requirement's traceability rows; ``rowspan`` the rows it spans."""
-    req: RequirementRow
+    req: RequirementJson
     rows: list[TraceSupport]
     rowspan: int
 
@@ -197,7 +197,7 @@ class ReportView(TableRuns):
     outstanding: list[AttentionItem]
     outstanding_groups: list[AttentionGroup]
     pending_groups: list[PendingGroup]
-    unmet_requirements: list[RequirementRow]
+    unmet_requirements: list[RequirementJson]
     ev_anchor: list[str]
     evidence_of: dict[str, list[tuple[str, EvidenceJson]]]
     obligation: dict[str, ObligationJson]

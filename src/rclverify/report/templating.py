@@ -19,6 +19,7 @@ import jinja2
 from markupsafe import Markup, escape
 
 from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.requirement_rows import RequirementRow, rows_of as requirement_rows_of
 from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.records import SEVERITY
@@ -257,6 +258,16 @@ def evidence_row(row: Mapping[str, Any] | EvidenceRow) -> EvidenceRow:
     return EvidenceRow.of(row)
 
 
+def requirement_rows(rows: Iterable[Mapping[str, Any] | RequirementRow]) -> list[RequirementRow]:
+    """The report's ``requirements[]`` decoded into
+    :class:`~rclverify.records.requirement_rows.RequirementRow`, in order, so
+    a template reads declared fields only (tests/test_record_shapes.py holds
+    every field to a renderer or
+    :data:`~rclverify.records.requirement_rows.INTERNAL`).  Raises
+    :class:`msgspec.ValidationError` for a key no field declares."""
+    return requirement_rows_of(rows)
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -282,7 +293,7 @@ def environment() -> jinja2.Environment:
         mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
         formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
         formulas=formula_html_list, findings=finding_rows, obligation_row=obligation_row,
-        evidence_row=evidence_row,
+        evidence_row=evidence_row, requirement_rows=requirement_rows,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame

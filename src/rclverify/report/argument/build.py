@@ -40,7 +40,7 @@ from typing import Any, Iterable, Mapping, TypeVar
 
 from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.report_schema import (EnvironmentAssumptionRow, NodeRow, ObligationJson, Report,
-                                             RequirementRow, SideConditionRow)
+                                             RequirementJson, SideConditionRow)
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
@@ -323,7 +323,7 @@ class _Goals:
             f"eventually an output satisfying its guarantees (paper lines 462-495)",
             supported_by=tuple(g_ids + sc_ids), in_context_of=tuple(ctx), ref=name))
 
-    def requirement_goal(self, r: RequirementRow) -> str:
+    def requirement_goal(self, r: RequirementJson) -> str:
         """The goal of requirement ``r``: Z3's entailment when it was checked, else the calculus over its support."""
         b, rid = self.b, str(r["id"])
         if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
