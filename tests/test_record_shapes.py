@@ -9,7 +9,9 @@ or named in :data:`~rclverify.records.findings.INTERNAL`.  The same holds for an
 (:class:`~rclverify.records.obligations.ObligationRow`, ``obligations[]``, rendered by
 report/templates/parts/obligations.{html,md}.j2) an evidence record's row
 (:class:`~rclverify.records.evidence_rows.EvidenceRow`, ``evidence[]``, rendered by
-report/templates/parts/evidence.{html,md}.j2) and a requirement's row
+report/templates/parts/evidence.{html,md}.j2), a row of the statistics table
+(:class:`~rclverify.records.statistics_rows.StatisticsRow`, ``statistics[]``, rendered by
+report/templates/parts/statistics.{html,md}.j2) and a requirement's row
 (:class:`~rclverify.records.requirement_rows.RequirementRow`, ``requirements[]``, rendered by
 report/templates/assurance.{html,md}.j2).  Each check is also run on a definition with a field
 added, and must then fail.  In-process and cheap: no pipeline runs here.
@@ -28,11 +30,12 @@ from jinja2 import nodes
 
 from _report_schema import SCHEMA
 from rclverify.records import schema_gen
-from rclverify.records import evidence_rows, obligations, requirement_rows
+from rclverify.records import evidence_rows, obligations, requirement_rows, statistics_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.statistics_rows import RequirementRuns, StatisticsRow
 from rclverify.report.render import part_renderer
 from rclverify.report.fragments import FragmentCache
 
@@ -57,6 +60,8 @@ RECORDS: dict[str, Record] = {
     "obligations": Record(ObligationRow, obligations.INTERNAL, "obligation_row",
                           ("obligations.html.j2", "obligations.md.j2")),
     "evidence": Record(EvidenceRow, evidence_rows.INTERNAL, "evidence_row", ("evidence.html.j2", "evidence.md.j2")),
+    "statistics": Record(StatisticsRow, statistics_rows.INTERNAL, "statistics_rows",
+                         ("statistics.html.j2", "statistics.md.j2")),
 }
 
 
@@ -382,3 +387,53 @@ def test_a_requirement_row_is_written_whole_and_refuses_an_undeclared_key() -> N
     with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
         env.from_string("{% for q in rows|requirement_rows %}{{ q.id }}{% endfor %}").render(
             rows=[{**row, "margin_added_here": "0.5 m"}])
+
+
+class _StatisticsWithMargin(StatisticsRow, frozen=True, forbid_unknown_fields=True):
+    """The statistics row with one field added, as a change to records/statistics_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_a_statistics_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["statistics"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_StatisticsWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_StatisticsWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ s.origin }}", "{{ s.origin }} {{ s.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_StatisticsWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "statistics", (_StatisticsWithMargin, schema_gen.GENERATED["statistics"][1]))
+        part = schema_gen.generated_part("statistics")
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["statistics"] != part
+
+
+#: One row of each kind, as report/statistics.py writes them, each field's value its own.
+_STATISTICS: list[dict[str, Any]] = [
+    StatisticsRow(kind="runs", node="Nodey", environment="env-text", origin="operation",
+                  counts={"runs": 17, "violating_runs": 0, "undecided_runs": 0, "answers": 90, "seconds": 1.5},
+                  recorded={"live": 17}, level=0.95, bound=0.1625, note="note-text").to_json(),
+    StatisticsRow(kind="target", node="Nodey", environment="env-text", origin="trials", counts=None, level=0.9,
+                  bound=0.25, obligation="Nodey.g1.experiment.t1", backend="experiment", status="pending",
+                  target="target-text", runs_needed=13, sprt="continue").to_json(),
+    StatisticsRow(kind="requirement", requirement="R1", environment="env-text", origin="operation",
+                  **{k: v for k, v in RequirementRuns(
+                      environment="env-text", origin="operation", counts={"runs": 3}, bound=0.6316, level=0.95,
+                      target="target-text", status="failed", explanation="explanation-text", runs_needed=None,
+                      sprt="reject").to_json().items() if k not in ("environment", "origin")}).to_json(),
+]
+
+
+def test_the_statistics_renderers_show_each_field_they_read_and_refuse_an_undeclared_key() -> None:
+    part = part_renderer(FragmentCache(), "")
+    html, md = str(part("statistics.html", rows=_STATISTICS)), part("statistics.md", rows=_STATISTICS)
+    for text in ("Nodey (every run)", "env-text", "operation", "17", "live 17", "0.163 at 95 %", "note-text",
+                 "Nodey.g1.experiment.t1", "target-text", "13", "continue", "R1", "explanation-text", "reject"):
+        assert text in html and text in md, text
+    assert all(list(r) == list(StatisticsRow.__struct_fields__) for r in _STATISTICS)  # every field, always
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("statistics.html", rows=[{**_STATISTICS[0], "margin_added_here": "0.5 m"}])
+    with pytest.raises(msgspec.ValidationError, match="kind"):
+        StatisticsRow.of({**_STATISTICS[0], "kind": "guess"})

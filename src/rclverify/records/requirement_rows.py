@@ -38,6 +38,7 @@ from typing import Annotated, Any, Iterable, Literal, Mapping
 import msgspec
 
 from rclverify.records.report_schema import DeadlineRow, LimitedBy
+from rclverify.records.statistics_rows import RequirementRuns
 from rclverify.records.statuses import EvidenceStatus, RequirementVerdict
 
 _DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
@@ -84,8 +85,9 @@ class RequirementRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
                     "verdict includes it.")] = None
     without_deadline: Annotated[WithoutDeadline | None, _DOC(
         description="Its verdict before the deadline was folded in; null without a deadline.")] = None
-    statistics: Annotated[list[dict[str, Any]], _DOC(
-        description="Its statistical target over runs (docs/statistics.md); empty without one.")] = []
+    statistics: Annotated[list[RequirementRuns], _DOC(
+        description="Its recorded runs by environment tag, decided against its statistical target when it "
+                    "states one (docs/statistics.md); empty without recorded runs.")] = []
     confidence: Annotated[Annotated[float, _DOC(ge=0, le=1)] | None, _DOC(
         description="Confidence over the argument, 0 to 1 (docs/confidence.md); null for an informal "
                     "requirement.")] = None

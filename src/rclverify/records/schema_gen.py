@@ -33,6 +33,7 @@ from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.statistics_rows import StatisticsRow
 from rclverify.records.statuses import VOCABULARY
 
 #: Top-level key of the report -> (the class of its items, the key's description).
@@ -41,6 +42,7 @@ GENERATED: dict[str, tuple[type[msgspec.Struct], str]] = {
     "findings": (FindingRow, "Contract health findings (vacuity, consistency, realizability, scale)."),
     "obligations": (ObligationRow, "Every obligation of the plan's evidence entries."),
     "evidence": (EvidenceRow, "One row per obligation with an evidence record."),
+    "statistics": (StatisticsRow, "Runs counted by environment, bounds and targets (docs/statistics.md)."),
 }
 
 #: A type the report's schema already defines in ``$defs`` -> that entry's name.

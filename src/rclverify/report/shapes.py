@@ -206,60 +206,6 @@ class ReportView(TableRuns):
     lint_errors: int
 
 
-class RunGroupRow(TypedDict):
-    """A row of the report's ``statistics`` table: the monitored runs of a node under one environment tag and
-    origin, counted once each, with the one-sided bound at ``level`` (``None``: no judged run)."""
-    node: str
-    environment: str
-    origin: str
-    kind: str
-    counts: dict[str, int]
-    recorded: dict[str, int]
-    level: float
-    bound: float | None
-    note: str
-
-
-class TargetRow(TypedDict):
-    """A row of the ``statistics`` table: a target's decision as its evidence record gives it."""
-    node: str
-    environment: str
-    origin: str
-    kind: str
-    obligation: str
-    backend: str
-    status: str
-    target: str | None
-    counts: dict[str, int] | None
-    recorded: dict[str, int]
-    level: float | None
-    bound: float | None
-    runs_needed: int | None
-    sprt: str | None
-
-
-class RequirementRuns(TypedDict):
-    """A requirement's runs under one environment tag and origin (``requirements[].statistics[]``), decided
-    against its target when it states one."""
-    environment: str
-    origin: str
-    counts: dict[str, int]
-    bound: float
-    note: NotRequired[str]
-    level: float
-    target: NotRequired[str]
-    status: NotRequired[str]
-    explanation: NotRequired[str]
-    runs_needed: NotRequired[int | None]
-    sprt: NotRequired[str | None]
-
-
-class RequirementRunsRow(RequirementRuns):
-    """:class:`RequirementRuns` as a row of the ``statistics`` table: with its requirement."""
-    requirement: str
-    kind: str
-
-
 class RunGroupBound(TypedDict):
     """A per-run evidence row's ``statistics.group``: its group's runs and bound at ``level``."""
     runs: int

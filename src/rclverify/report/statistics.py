@@ -18,8 +18,11 @@ from __future__ import annotations
 
 from typing import Any, Mapping, TypedDict
 
+import msgspec
+
 from rclverify.records.report_schema import EvidenceJson
-from rclverify.report.shapes import RequirementRuns, RequirementRunsRow, RunGroupBound, RunGroupRow, TargetRow
+from rclverify.records.statistics_rows import RequirementRuns, StatisticsRow
+from rclverify.report.shapes import RunGroupBound
 
 from rclverify.records.statistics import count_runs, decide, trivial_or_exact
 from rclverify.model.plan.model import Plan
@@ -51,7 +54,7 @@ def _node(obligation: str) -> str:
     return obligation.split(".", 1)[0]
 
 
-def _group_row(node: str, env: str, origin: str, rows: list[dict[str, Any]]) -> RunGroupRow:
+def _group_row(node: str, env: str, origin: str, rows: list[dict[str, Any]]) -> StatisticsRow:
     counts = count_runs(rows)
     recorded: dict[str, int] = {}
     for r in rows:
@@ -59,22 +62,24 @@ def _group_row(node: str, env: str, origin: str, rows: list[dict[str, Any]]) -> 
     n, k = counts["runs"], counts["violating_runs"] + counts["undecided_runs"]
     counted = origin != "harness" and n > 0
     bound, why = trivial_or_exact(k, n, LEVEL) if counted else (None, "")
-    return {"node": node, "environment": env, "origin": origin, "kind": "runs",
-            "counts": {key: v for key, v in counts.items() if key != "digests"}, "recorded": recorded,
-            "level": LEVEL, "bound": bound,
-            "note": why if counted else ("driven by a test harness: not operation, no bound" if origin == "harness"
-                                         else "no judged run: no bound")}
+    return StatisticsRow.of({
+        "node": node, "environment": env, "origin": origin, "kind": "runs",
+        "counts": {key: v for key, v in counts.items() if key != "digests"}, "recorded": recorded,
+        "level": LEVEL, "bound": bound,
+        "note": why if counted else ("driven by a test harness: not operation, no bound" if origin == "harness"
+                                     else "no judged run: no bound")})
 
 
-def _target_row(e: EvidenceJson) -> TargetRow:
+def _target_row(e: EvidenceJson) -> StatisticsRow:
     s = e["statistics"]
     d = s.get("decision") or {}
-    return {"node": _node(str(e.get("obligation"))), "environment": s.get("environment", UNSTATED),
-            "origin": s.get("origin", "operation"), "kind": "target", "obligation": e["obligation"],
-            "backend": e["backend"], "status": e["status"], "target": (s.get("target") or {}).get("text"),
-            "counts": s.get("counts"), "recorded": s.get("recorded", {}), "level": d.get("level"),
-            "bound": d.get("bound"), "runs_needed": d.get("runs_needed"),
-            "sprt": (d.get("sprt") or {}).get("decision")}
+    return StatisticsRow.of({
+        "node": _node(str(e.get("obligation"))), "environment": s.get("environment", UNSTATED),
+        "origin": s.get("origin", "operation"), "kind": "target", "obligation": e["obligation"],
+        "backend": e["backend"], "status": e["status"], "target": (s.get("target") or {}).get("text"),
+        "counts": s.get("counts"), "recorded": s.get("recorded", {}), "level": d.get("level"),
+        "bound": d.get("bound"), "runs_needed": d.get("runs_needed"),
+        "sprt": (d.get("sprt") or {}).get("decision")})
 
 
 def _trace_environments(plan: Plan) -> dict[str, tuple[str, str]]:
@@ -105,27 +110,26 @@ def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[s
         counts = count_runs([] if origin == "harness" else rows)
         level = target.level if target is not None else LEVEL
         bound, why = trivial_or_exact(counts["violating_runs"] + counts["undecided_runs"], counts["runs"], level)
-        row: RequirementRuns = {"environment": env, "origin": origin,
-                                "counts": {k: v for k, v in counts.items() if k != "digests"}, "bound": bound,
-                                "level": level}
-        if why:
-            row["note"] = why
+        row: dict[str, Any] = {"environment": env, "origin": origin,
+                               "counts": {k: v for k, v in counts.items() if k != "digests"}, "bound": bound,
+                               "level": level, "note": why}
         if target is not None:
             d = decide(counts, target)
             row["target"], row["status"] = target.text, d["status"]
             row["explanation"] = f"under {env}: {d['explanation']}"
             row["runs_needed"], row["sprt"] = d["runs_needed"], d["sprt"]["decision"]
-        out.append(row)
+        out.append(msgspec.convert(row, RequirementRuns))
     return out
 
 
 class StatisticsPart(TypedDict):
     """The statistics pass's part: the report's ``statistics`` table;
     ``groups``: index of a per-run evidence row -> its ``statistics.group``;
-    ``requirements``: requirement id -> its ``statistics`` rows."""
-    table: list[RunGroupRow | TargetRow | RequirementRunsRow]
+    ``requirements``: requirement id -> its ``statistics`` rows; each row
+    as its JSON object (records/statistics_rows.py: every field)."""
+    table: list[dict[str, Any]]
     groups: dict[int, RunGroupBound]
-    requirements: dict[str, list[RequirementRuns]]
+    requirements: dict[str, list[dict[str, Any]]]
 
 
 def _per_run(e: EvidenceJson) -> bool:
@@ -140,9 +144,9 @@ def _group_key(e: EvidenceJson) -> tuple[str, str, str]:
     return _node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation"))
 
 
-def _requirement_row(rid: str, runs: RequirementRuns) -> RequirementRunsRow:
+def _requirement_row(rid: str, runs: RequirementRuns) -> StatisticsRow:
     """``runs`` as a row of the ``statistics`` table, with its requirement ``rid``."""
-    return {"requirement": rid, "kind": "requirement", **runs}
+    return StatisticsRow.of({"requirement": rid, "kind": "requirement", **runs.to_json()})
 
 
 def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str, Any]) -> StatisticsPart:
@@ -152,25 +156,25 @@ def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str,
     ``targets``: requirement id -> its
     :class:`~rclverify.records.statistics.Target` (or ``None``)."""
     groups: dict[tuple[str, str, str], list[dict[str, Any]]] = {}
-    decisions: list[RunGroupRow | TargetRow | RequirementRunsRow] = []
+    decisions: list[StatisticsRow] = []
     for e in report.get("evidence", []):
         if isinstance(e.get("statistics"), dict) and "decision" in e["statistics"]:
             decisions.append(_target_row(e))
         elif _per_run(e):
             groups.setdefault(_group_key(e), []).append(e["statistics"])
     by_key = {key: _group_row(*key, rows) for key, rows in groups.items()}
-    part: StatisticsPart = {"table": [by_key[k] for k in sorted(by_key)] + decisions, "groups": {},
-                            "requirements": {}}
+    part: StatisticsPart = {"table": [r.to_json() for r in [by_key[k] for k in sorted(by_key)] + decisions],
+                            "groups": {}, "requirements": {}}
     for i, e in enumerate(report.get("evidence", [])):
         if _per_run(e):
             g = by_key[_group_key(e)]
-            part["groups"][i] = {"runs": g["counts"]["runs"], "bound": g["bound"], "level": LEVEL}
+            part["groups"][i] = {"runs": int((g.counts or {})["runs"]), "bound": g.bound, "level": LEVEL}
     where = _trace_environments(plan)
     for rq in report.get("requirements", []):
         rows = requirement_statistics(rq, targets.get(str(rq.get("id"))), where)
         if rows:
-            part["requirements"][str(rq["id"])] = rows
-            part["table"].extend(_requirement_row(rq["id"], r) for r in rows)
+            part["requirements"][str(rq["id"])] = [r.to_json() for r in rows]
+            part["table"].extend(_requirement_row(rq["id"], r).to_json() for r in rows)
     return part
 
 

@@ -20,6 +20,7 @@ from markupsafe import Markup, escape
 
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.requirement_rows import RequirementRow, rows_of as requirement_rows_of
+from rclverify.records.statistics_rows import StatisticsRow, rows_of as statistics_rows_of
 from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.records import SEVERITY
@@ -268,6 +269,16 @@ def requirement_rows(rows: Iterable[Mapping[str, Any] | RequirementRow]) -> list
     return requirement_rows_of(rows)
 
 
+def statistics_rows(rows: Iterable[Mapping[str, Any] | StatisticsRow]) -> list[StatisticsRow]:
+    """The report's ``statistics[]`` decoded into
+    :class:`~rclverify.records.statistics_rows.StatisticsRow`, in order, so
+    a template reads declared fields only (tests/test_record_shapes.py holds
+    every field to a renderer or
+    :data:`~rclverify.records.statistics_rows.INTERNAL`).  Raises
+    :class:`msgspec.ValidationError` for a key no field declares."""
+    return statistics_rows_of(rows)
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -294,6 +305,7 @@ def environment() -> jinja2.Environment:
         formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
         formulas=formula_html_list, findings=finding_rows, obligation_row=obligation_row,
         evidence_row=evidence_row, requirement_rows=requirement_rows,
+        statistics_rows=statistics_rows,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame
