@@ -11,7 +11,9 @@ report/templates/parts/obligations.{html,md}.j2) an evidence record's row
 (:class:`~rclverify.records.evidence_rows.EvidenceRow`, ``evidence[]``, rendered by
 report/templates/parts/evidence.{html,md}.j2), a row of the statistics table
 (:class:`~rclverify.records.statistics_rows.StatisticsRow`, ``statistics[]``, rendered by
-report/templates/parts/statistics.{html,md}.j2) and a requirement's row
+report/templates/parts/statistics.{html,md}.j2), a chosen standard's row
+(:class:`~rclverify.records.standards_rows.StandardRow`, ``standards[]``, rendered by
+report/templates/parts/standards.{html,md}.j2) and a requirement's row
 (:class:`~rclverify.records.requirement_rows.RequirementRow`, ``requirements[]``, rendered by
 report/templates/assurance.{html,md}.j2).  Each check is also run on a definition with a field
 added, and must then fail.  In-process and cheap: no pipeline runs here.
@@ -30,11 +32,12 @@ from jinja2 import nodes
 
 from _report_schema import SCHEMA
 from rclverify.records import schema_gen
-from rclverify.records import evidence_rows, obligations, requirement_rows, statistics_rows
+from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.standards_rows import StandardRow
 from rclverify.records.statistics_rows import RequirementRuns, StatisticsRow
 from rclverify.report.render import part_renderer
 from rclverify.report.fragments import FragmentCache
@@ -62,6 +65,7 @@ RECORDS: dict[str, Record] = {
     "evidence": Record(EvidenceRow, evidence_rows.INTERNAL, "evidence_row", ("evidence.html.j2", "evidence.md.j2")),
     "statistics": Record(StatisticsRow, statistics_rows.INTERNAL, "statistics_rows",
                          ("statistics.html.j2", "statistics.md.j2")),
+    "standards": Record(StandardRow, standards_rows.INTERNAL, "standard_rows", ("standards.html.j2", "standards.md.j2")),
 }
 
 
@@ -437,3 +441,24 @@ def test_the_statistics_renderers_show_each_field_they_read_and_refuse_an_undecl
         part("statistics.html", rows=[{**_STATISTICS[0], "margin_added_here": "0.5 m"}])
     with pytest.raises(msgspec.ValidationError, match="kind"):
         StatisticsRow.of({**_STATISTICS[0], "kind": "guess"})
+
+
+class _StandardWithMargin(StandardRow, frozen=True, forbid_unknown_fields=True):
+    """The standard's row with one field added, as a change to records/standards_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_a_standard_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["standards"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_StandardWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_StandardWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ s.title }}", "{{ s.title }} {{ s.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_StandardWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "standards", (_StandardWithMargin, schema_gen.GENERATED["standards"][1]))
+        part = schema_gen.generated_part("standards")
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["standards"] != part

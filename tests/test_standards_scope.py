@@ -301,20 +301,18 @@ def test_statuses_against_a_reading_of_the_scope_rule() -> None:
 
 # --- the compliance matrix's types are the published schema's ------------------------------------
 
-def test_the_standards_typeddicts_are_the_schema() -> None:
-    """StandardRow (and the clause, scope and evidence rows inside it) held to ``$defs/standard`` key by key,
-    both ways, as tests/test_report_vocabulary.py holds the report's other rows."""
-    import test_report_vocabulary as voc
+def test_the_standards_rows_are_the_schema() -> None:
+    """The schema's ``standards`` part is generated from records/standards_rows.py ``StandardRow``, the clause,
+    scope and evidence rows inside it included (tests/test_record_shapes.py holds the file to every generated
+    part); a clause row in the file has exactly the definition's keys and refuses others."""
     from _report_schema import SCHEMA
-    from rclverify.report.standards_rows import StandardRow
-    assert voc._disagreements(StandardRow, SCHEMA["$defs"]["standard"], "standard") == []
-    # control: a key the schema lacks is found
-    kept = SCHEMA["$defs"]["standard_clause"]["properties"].pop("why")
-    try:
-        assert voc._disagreements(StandardRow, SCHEMA["$defs"]["standard"], "standard") == [
-            "standard.clauses.why: only in the TypedDict"]
-    finally:
-        SCHEMA["$defs"]["standard_clause"]["properties"]["why"] = kept
+    from rclverify.records import schema_gen
+    from rclverify.records.standards_rows import ClauseRow, ScopeItem
+    assert SCHEMA["properties"]["standards"] == schema_gen.generated_part("standards", SCHEMA)
+    clause = SCHEMA["properties"]["standards"]["items"]["properties"]["clauses"]["items"]
+    assert list(clause["properties"]) == list(ClauseRow.__struct_fields__) and clause["additionalProperties"] is False
+    scope = clause["properties"]["scope"]["items"]
+    assert list(scope["properties"]) == list(ScopeItem.__struct_fields__) and scope["additionalProperties"] is False
 
 
 # --- the plan narrows a clause's scope, with its reason shown ------------------------------------

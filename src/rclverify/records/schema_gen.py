@@ -33,6 +33,7 @@ from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.standards_rows import StandardRow
 from rclverify.records.statistics_rows import StatisticsRow
 from rclverify.records.statuses import VOCABULARY
 
@@ -43,6 +44,8 @@ GENERATED: dict[str, tuple[type[msgspec.Struct], str]] = {
     "obligations": (ObligationRow, "Every obligation of the plan's evidence entries."),
     "evidence": (EvidenceRow, "One row per obligation with an evidence record."),
     "statistics": (StatisticsRow, "Runs counted by environment, bounds and targets (docs/statistics.md)."),
+    "standards": (StandardRow, "The evidence mapped onto the standards the plan names (docs/standards.md); empty "
+                               "when it names none."),
 }
 
 #: A type the report's schema already defines in ``$defs`` -> that entry's name.
@@ -70,7 +73,8 @@ def _styled(x: Any, defs: dict[str, Any]) -> Any:
         for name, words in VOCABULARY.items():
             if set(x["enum"]) == set(words):
                 return {"$ref": f"#/$defs/{name}", **{k: v for k, v in x.items() if k != "enum"}}
-    out = {k: _styled(v, defs) for k, v in x.items() if k not in ("title", "default")}
+    out = {k: {name: _styled(sub, defs) for name, sub in v.items()} if k == "properties" else _styled(v, defs)
+           for k, v in x.items() if k not in ("title", "default")}  # a field may be called title
     if out.get("type") == "object" and "properties" in out:
         head = {k: out.pop(k) for k in ("type", "description", "required", "properties") if k in out}
         out = {**head, **out}

@@ -14,57 +14,33 @@ them).  The mapping is a traceability aid, not a compliance claim.
 """
 from __future__ import annotations
 
-from typing import Any, Literal, Mapping, Sequence, TypedDict
+from typing import Any, Mapping, Sequence, TypedDict
 
 from rclverify.records.report_schema import EvidenceJson, Report
 from rclverify.model.plan.standards.choice import StandardChoice
 from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
 from rclverify.model.plan.standards.profiles import Profile
+from rclverify.records.standards_rows import StandardRow
 
 
-class ProfileOrigin(TypedDict):
-    """Where a profile comes from (``standards[].origin``): ``kind`` ``built-in`` (one of rclverify's
-    profiles, ``file`` its package-relative path) or ``workspace`` (``file`` workspace-relative), with
-    the ``edition`` it names and the ``sha256`` of the file's bytes."""
-    kind: Literal["built-in", "workspace"]
-    file: str
-    sha256: str
-    edition: str
-
-
-class LeftOut(TypedDict):
-    """A clause of the standard the profile does not list, and why (``standards[].left_out[]``)."""
-    id: str
-    why: str
-
-
-class StandardRow(TypedDict):
-    """One chosen standard (``standards[]`` of the report)."""
-    profile: str
-    title: str
-    edition: str
-    level_name: str
-    level: str | None
-    source: str
-    origin: ProfileOrigin
-    clauses: list[ClauseRow]
-    left_out: list[LeftOut]
-    open: list[str]
-    counts: dict[str, int]
-    required_not_covered: list[str]
-    strict: bool
+#: Where a profile comes from (``standards[].origin``) as its JSON object: the encoding of
+#: :class:`rclverify.records.standards_rows.ProfileOrigin`.
+ProfileOriginJson = dict[str, Any]
+#: A chosen standard's row (``standards[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.standards_rows.StandardRow`, the one definition of its fields.
+StandardJson = dict[str, Any]
 
 
 class StandardsPart(TypedDict):
     """What the pass gives the report: the rows, one problem sentence per
     standard with an HR clause not covered, and whether none has one."""
-    rows: list[StandardRow]
+    rows: list[StandardJson]
     problems: list[str]
     ok: bool
 
 
-def profile_origin(p: Profile) -> ProfileOrigin:
-    """Where the profile ``p`` comes from (:class:`ProfileOrigin`)."""
+def profile_origin(p: Profile) -> ProfileOriginJson:
+    """Where the profile ``p`` comes from (records/standards_rows.py :class:`ProfileOrigin`'s fields)."""
     return {"kind": "built-in" if p.builtin else "workspace", "file": p.file, "sha256": p.sha256,
             "edition": p.edition}
 
@@ -88,21 +64,25 @@ def standards_part(choices: Sequence[StandardChoice],
     report dict so far: its evidence rows with their strength, obligations,
     nodes, side conditions, requirements, findings, unverified guarantees,
     system and summary; a bare list of evidence rows reads as a report of
-    those rows alone).  Pure; raises nothing."""
-    rows: list[StandardRow] = []
+    those rows alone).  Each row is checked by decoding it into
+    :class:`~rclverify.records.standards_rows.StandardRow` and written as
+    its JSON object (every field).  Pure; raises
+    :class:`msgspec.ValidationError` only for a row its definition does not
+    admit (a bug of the mapping)."""
+    rows: list[StandardJson] = []
     problems: list[str] = []
     ok = True
     for c in choices:
         clauses = clause_rows(c.profile, c.level, report, c.clauses)
         missing = not_covered(clauses)
-        row: StandardRow = {
+        row = StandardRow.of({
             "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,
             "level_name": c.profile.level_name, "level": c.level,
             "source": f"{c.loc.file}:{c.loc.line}:{c.loc.col}", "origin": profile_origin(c.profile),
             "clauses": clauses, "left_out": [{"id": i, "why": w} for i, w in c.profile.left_out],
             "open": [x["id"] for x in clauses if x["status"] == "open"],
             "counts": {s: sum(1 for x in clauses if x["status"] == s) for s in CLAUSE_STATUSES},
-            "required_not_covered": missing, "strict": c.strict}
+            "required_not_covered": missing, "strict": c.strict}).to_json()
         rows.append(row)
         ok = ok and not (missing and c.strict)
         if missing:
@@ -110,7 +90,7 @@ def standards_part(choices: Sequence[StandardChoice],
     return {"rows": rows, "problems": problems, "ok": ok}
 
 
-def _missing_sentence(row: StandardRow, missing: Sequence[ClauseRow]) -> str:
+def _missing_sentence(row: StandardJson, missing: Sequence[ClauseRow]) -> str:
     """The summary's sentence for a standard's asked items not covered: each with
     its title and why (its clause row's ``why``), where the profile comes
     from, and where to read them."""
@@ -139,5 +119,5 @@ def strict_reason(report: Report) -> list[str]:
     return out
 
 
-__all__ = ["LeftOut", "ProfileOrigin", "StandardRow", "StandardsPart", "origin_text", "profile_origin",
+__all__ = ["ProfileOriginJson", "StandardJson", "StandardsPart", "origin_text", "profile_origin",
            "standards_part", "strict_reason"]

@@ -21,6 +21,7 @@ from markupsafe import Markup, escape
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.requirement_rows import RequirementRow, rows_of as requirement_rows_of
 from rclverify.records.statistics_rows import StatisticsRow, rows_of as statistics_rows_of
+from rclverify.records.standards_rows import StandardRow, rows_of as standard_rows_of
 from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.records import SEVERITY
@@ -279,6 +280,16 @@ def statistics_rows(rows: Iterable[Mapping[str, Any] | StatisticsRow]) -> list[S
     return statistics_rows_of(rows)
 
 
+def standard_rows(rows: Iterable[Mapping[str, Any] | StandardRow]) -> list[StandardRow]:
+    """The report's ``standards[]`` decoded into
+    :class:`~rclverify.records.standards_rows.StandardRow`, in order, so a
+    template reads declared fields only (tests/test_record_shapes.py holds
+    every field to a renderer or
+    :data:`~rclverify.records.standards_rows.INTERNAL`).  Raises
+    :class:`msgspec.ValidationError` for a key no field declares."""
+    return standard_rows_of(rows)
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -305,7 +316,7 @@ def environment() -> jinja2.Environment:
         formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
         formulas=formula_html_list, findings=finding_rows, obligation_row=obligation_row,
         evidence_row=evidence_row, requirement_rows=requirement_rows,
-        statistics_rows=statistics_rows,
+        statistics_rows=statistics_rows, standard_rows=standard_rows,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame

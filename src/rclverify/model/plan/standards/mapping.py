@@ -49,23 +49,14 @@ assessor, not a compliance claim.
 from __future__ import annotations
 
 from collections import Counter
-from typing import Any, Callable, Iterable, Literal, Mapping, Sequence, TypedDict, cast, get_args
+from typing import Any, Callable, Iterable, Mapping, Sequence, cast, get_args
 
 from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
 from rclverify.records.report_schema import EvidenceJson
+from rclverify.records.standards_rows import About, ClauseStatus, Independence, Recommendation, ScopeKind
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 
 #: A clause's status (the module docstring).
-ClauseStatus = Literal["covered", "partial", "not covered", "open", "not recommended"]
-#: A recommendation code (profiles.CODES).
-Recommendation = Literal["HR", "R", "---", "NR", "required"]
-#: What a clause is about (profiles.ABOUT).
-About = Literal["guarantees", "interfaces", "requirements", "system", "field-data", "trials"]
-#: An independence level (profiles.INDEPENDENCE).
-Independence = Literal["none", "person", "department", "organisation"]
-#: The sort of an item in a clause's scope.
-ScopeKind = Literal["guarantee", "side condition", "requirement", "target", "health check", "workspace"]
-
 #: (evidence row field, its value) -> the profile evidence kind it supports.  ``kind`` is the
 #: record's kind (each backend's ``kind``: hoare and dafny "proof", ajpf "model checking",
 #: property_tests "testing", monitors "monitoring", experiment, review); ``strength`` is the
@@ -97,58 +88,13 @@ _NOTHING: Mapping[str, str] = {
 _HEALTH_OK = ("ok", "warning")
 
 
-class Support(TypedDict):
-    """An evidence row of an accepted kind in a clause's scope: ``counts`` whether it may cover the
-    clause, ``note`` why not (a harness run, a review without the independence asked), or ``""``."""
-    obligation: str
-    backend: str
-    kind: EvidenceKind
-    status: EvidenceStatus
-    counts: bool
-    note: str
-
-
-class ScopeItem(TypedDict):
-    """One item of a clause's scope: ``item`` what it is (``Base g1``, ``side condition Planner.sc1``,
-    ``requirement STOP``, ``target <obligation>``, ``health check <id>``, ``workspace``), ``kind`` its
-    sort, ``state`` ``covered`` or in one word what keeps it from being covered (a status, ``no
-    evidence``, ``not counted``), ``detail`` the sentence, ``evidence`` the obligations that cover it."""
-    item: str
-    kind: ScopeKind
-    covered: bool
-    state: str
-    detail: str
-    evidence: list[str]
-
-
-class PlanNote(TypedDict):
-    """What the plan says of a clause (``standards[].clauses:``): ``nodes`` the nodes its scope is
-    narrowed to (``None``: not narrowed) with the ``reason``, a ``justification``, where it is written."""
-    nodes: list[str] | None
-    reason: str
-    justification: str
-    at: str
-
-
-class ClauseRow(TypedDict):
-    """One clause of a profile at the chosen level: what it asks (``title``), its scope and the evidence
-    in it, what covers its covered items (``covered_by``: obligations, side conditions, requirement
-    checks), who checked that (``checked_by``), its status and why (a row of the compliance
-    matrix, docs/standards.md)."""
-    id: str
-    title: str
-    recommendation: Recommendation
-    accepts: list[str]
-    strength: str
-    about: About
-    independence: Independence
-    evidence: list[Support]
-    scope: list[ScopeItem]
-    covered_by: list[str]
-    checked_by: list[str]
-    status: ClauseStatus
-    why: str
-    plan: PlanNote | None
+#: The JSON objects of a clause row and its parts, as the report carries them: the encodings of
+#: :mod:`rclverify.records.standards_rows` ``ClauseEvidence``, ``ScopeItem``, ``PlanNote`` and ``ClauseRow``,
+#: the one definition of their fields (the standards pass decodes each standard's row into them).
+Support = dict[str, Any]
+ScopeItem = dict[str, Any]
+PlanNote = dict[str, Any]
+ClauseRow = dict[str, Any]
 
 
 def kinds_of(row: Mapping[str, Any]) -> set[str]:
