@@ -3,6 +3,7 @@ and judged.
 
 The composition and refinement checks with Z3 (``compose``, ``refinement``,
 ``context``, ``quotient``, ``deadlines``), contract health (``health/``:
-vacuity, realizability, shape) and formal requirements decided from the
+vacuity, realizability, over a bounded output sequence or by a witness,
+shape) and formal requirements decided from the
 composed contracts (``requirements/``).  Imports ``ros`` and below.
 """

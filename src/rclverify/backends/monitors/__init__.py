@@ -4,5 +4,7 @@ from the contracts, and offline checking of recorded runs (paper lines
 
 :mod:`rclverify.targets.rml` translates guarantees to RML, :mod:`.config` reads the plan
 entry and the mapping file, :mod:`.check` checks a trace against a node's
-contract, :mod:`.backend` is the plug-in (export, run).
+contract, :mod:`.margin_target` counts a margin target's trials on a run,
+:mod:`.near_miss` reads an entry's near-miss threshold, :mod:`.backend` is
+the plug-in (export, run).
 """

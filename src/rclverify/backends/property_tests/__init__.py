@@ -4,7 +4,10 @@ Hypothesis against their contracts, every example's outputs checked by Z3
 
 Modules: :mod:`.strategies` (input strategies from RCL types and the
 assumption, whose bounds :mod:`.bounds` reads), :mod:`.harness` (one guarantee's Hypothesis run; also what the
-generated pytest files call), :mod:`.backend` (:class:`PropertyTestsBackend`).
+generated pytest files call), :mod:`.slips` (the implementation line with the
+slip, a correction weighed on the :mod:`.neighbours` examples; :mod:`.cause`
+the line that computed the value, its fallback), :mod:`.backend`
+(:class:`PropertyTestsBackend`).
 """
 from typing import Any
 
