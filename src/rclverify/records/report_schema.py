@@ -1,4 +1,10 @@
-"""The assurance report's shape as types: one TypedDict per row kind and :class:`Report`.
+"""The assurance report's shape as types: :class:`Report` and a TypedDict per row kind not defined once.
+
+The rows defined once as msgspec Structs (findings, obligations, evidence,
+requirements, statistics, standards: :mod:`rclverify.records.row` and the
+modules beside it) appear here as the JSON objects they write
+(``FindingJson``, ``ObligationJson``, ...); their schema parts are generated
+(:mod:`rclverify.records.schema_gen`).
 
 These are the static reading of ``docs/assurance.schema.json`` (JSON Schema
 draft 2020-12), the published shape of ``reports/assurance.json``; the
