@@ -9,7 +9,7 @@ result's ``properties``) is ``object``.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import NotRequired, TypedDict
+from typing import Mapping, NotRequired, TypedDict
 
 from rclverify.records.stage_records import EditJson
 
@@ -138,6 +138,40 @@ def sarif_fix(description: str, edit: EditJson) -> SarifFix:
                     "insertedContent": {"text": edit["inserted"]}}]}]}
 
 
-__all__ = ["SarifArtifactChange", "SarifArtifactLocation", "SarifDescriptor", "SarifDriver", "SarifFix", "SarifLevel",
+#: Base id of every artifact location: the workspace root.
+SRCROOT = "%SRCROOT%"
+
+
+def split_location(text: str) -> tuple[str, int, int] | None:
+    """``'contracts/x.rcl:12:5'`` -> ``('contracts/x.rcl', 12, 5)``; ``None``
+    when ``text`` is not of that shape (or names no file)."""
+    parts = str(text).rsplit(":", 2)
+    if len(parts) != 3 or not parts[0] or not parts[1].isdigit() or not parts[2].isdigit():
+        return None
+    return parts[0], int(parts[1]), int(parts[2])
+
+
+def sarif_locations(text: str) -> list[SarifLocation]:
+    """The SARIF ``locations`` of ``text`` (``file:line:col``, 1-based,
+    relative to :data:`SRCROOT`): one, or none when ``text`` names no file
+    (a ``<...>`` pseudo-file, or not that shape)."""
+    loc = split_location(text)
+    if loc is None or loc[0].startswith("<"):
+        return []
+    file, line, col = loc
+    region: SarifRegion = {"startLine": max(1, line)}
+    if col >= 1:
+        region["startColumn"] = col
+    return [{"physicalLocation": {"artifactLocation": {"uri": file, "uriBaseId": SRCROOT}, "region": region}}]
+
+
+def sarif_result(rule: str, level: str, text: str, where: str, key: str, props: Mapping[str, object]) -> SarifResult:
+    """One SARIF ``result`` of rule ``rule`` at ``where`` (``file:line:col``),
+    fingerprinted by the report item ``key`` (``rclverifyItem/v1``)."""
+    return {"ruleId": rule, "level": level, "message": {"text": text}, "locations": sarif_locations(where),
+            "partialFingerprints": {"rclverifyItem/v1": key}, "properties": dict(props)}
+
+
+__all__ = ["SRCROOT", "sarif_locations", "sarif_result", "split_location", "SarifArtifactChange", "SarifArtifactLocation", "SarifDescriptor", "SarifDriver", "SarifFix", "SarifLevel",
            "SarifLocation", "SarifLog", "SarifPhysicalLocation", "SarifRegion", "SarifReplacement", "SarifResult",
            "SarifRun", "SarifSuppression", "SarifText", "SarifTool", "sarif_fix"]

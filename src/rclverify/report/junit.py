@@ -57,7 +57,7 @@ import xml.etree.ElementTree as ET
 from typing import Any, Mapping
 
 from rclverify.report.fragments import FragmentCache
-from rclverify.report.sarif import split_location
+from rclverify.records.sarif import split_location
 from rclverify.report.templating import model_text
 from rclverify.records.findings import rows_of
 from rclverify.records.report_schema import Report

@@ -41,15 +41,13 @@ from rclverify.records.evidence_rows import rows_of as evidence_rows_of
 from rclverify.records.obligations import rows_of as obligation_rows_of
 from rclverify.records.report_schema import DiagnosisRow, LintRow, Report
 from rclverify.report.severity import of
-from rclverify.records.sarif import sarif_fix
-from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifRegion, SarifResult, SarifRun,
+from rclverify.records.sarif import SRCROOT, sarif_fix, sarif_locations, sarif_result
+from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifResult, SarifRun,
                                      SarifSuppression)
 
 #: The SARIF version written and the schema it validates against.
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://docs.oasis-open.org/sarif/sarif/v2.1.0/errata01/os/schemas/sarif-schema-2.1.0.json"
-#: Base id of every artifact location: the workspace root.
-SRCROOT = "%SRCROOT%"
 
 
 @dataclass(frozen=True)
@@ -171,31 +169,6 @@ def lint_rule_id(code: str) -> str:
     return f"RCL-LINT-{tail.upper()}" if tail else "RCL-LINT"
 
 
-def split_location(text: str) -> tuple[str, int, int] | None:
-    """``'contracts/x.rcl:12:5'`` -> ``('contracts/x.rcl', 12, 5)``; ``None``
-    when ``text`` is not of that shape (or names no file)."""
-    parts = str(text).rsplit(":", 2)
-    if len(parts) != 3 or not parts[0] or not parts[1].isdigit() or not parts[2].isdigit():
-        return None
-    return parts[0], int(parts[1]), int(parts[2])
-
-
-def _location(text: str) -> list[SarifLocation]:
-    loc = split_location(text)
-    if loc is None or loc[0].startswith("<"):
-        return []
-    file, line, col = loc
-    region: SarifRegion = {"startLine": max(1, line)}
-    if col >= 1:
-        region["startColumn"] = col
-    return [{"physicalLocation": {"artifactLocation": {"uri": file, "uriBaseId": SRCROOT}, "region": region}}]
-
-
-def _result(rule: str, level: str, text: str, where: str, key: str, props: Mapping[str, object]) -> SarifResult:
-    return {"ruleId": rule, "level": level, "message": {"text": text}, "locations": _location(where),
-            "partialFingerprints": {"rclverifyItem/v1": key}, "properties": dict(props)}
-
-
 def _obligation_results(report: Report) -> list[SarifResult]:
     """One result per obligation that is not discharged, its rows decoded into their definitions
     (records/obligations.py, records/evidence_rows.py)."""
@@ -223,14 +196,14 @@ def _obligation_results(report: Report) -> list[SarifResult]:
             props["counterexample"] = dict(cex)
         if ev is not None and ev.strength:  # the evidence's kind (docs/confidence.md)
             props["strength"] = dict(ev.strength)
-        res = _result(rule, _level("obligation", o.status), " ".join(words), o.source, f"obligation:{o.id}", props)
+        res = sarif_result(rule, _level("obligation", o.status), " ".join(words), o.source, f"obligation:{o.id}", props)
         cause = (cex or {}).get("cause")
-        if isinstance(cause, str) and _location(f"{cause}:0"):  # at the implementation's line
-            rel = _location(o.source)
+        if isinstance(cause, str) and sarif_locations(f"{cause}:0"):  # at the implementation's line
+            rel = sarif_locations(o.source)
             for loc in rel:
                 loc["id"] = 0
                 loc["message"] = {"text": "the guarantee the example violates"}
-            res["locations"] = _location(f"{cause}:0")
+            res["locations"] = sarif_locations(f"{cause}:0")
             res["locations"][0]["message"] = {"text": "the implementation's last line the failing example runs"}
             if rel:
                 res["relatedLocations"] = rel
@@ -241,7 +214,7 @@ def _obligation_results(report: Report) -> list[SarifResult]:
 def _unverified_results(report: Report) -> list[SarifResult]:
     """One result per guarantee no obligation covers, at the guarantee (report/unverified.py)."""
     rule = RULES["RCL-GUARANTEE-UNVERIFIED"]
-    return [_result(rule.id, _level("guarantee", "unverified"), f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
+    return [sarif_result(rule.id, _level("guarantee", "unverified"), f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
                     f"The guarantee: {u['text']}", str(u["source"]), f"guarantee:{u['id']}",
                     {"guarantee": u["id"], "node": u["node"], "status": u["status"]})
             for u in report.get("unverified") or ()]
@@ -273,7 +246,7 @@ def _side_condition_results(report: Report) -> list[SarifResult]:
             props["inContext"] = {"cone": ctx.get("cone"), "used": list(ctx.get("used") or []),
                                   "opened": list(ctx.get("opened") or []), "violated": list(ctx.get("violated") or [])}
         # one severity (report/severity.py): a side condition discharged in context holds (a note, not gating)
-        out.append(_result(rule, _level("side-condition", status), " ".join(words), str(sc["source"]),
+        out.append(sarif_result(rule, _level("side-condition", status), " ".join(words), str(sc["source"]),
                            f"side-condition:{sc['id']}", props))
     return out
 
@@ -300,7 +273,7 @@ def _requirement_results(report: Report) -> list[SarifResult]:
         for p in c.get("failed_to_prevent") or []:
             words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
         props = {"requirement": r["id"], "verdict": r["verdict"], "status": r["status"]}
-        out.append(_result(rule, _level("requirement", str(r.get("verdict"))), " ".join(words),
+        out.append(sarif_result(rule, _level("requirement", str(r.get("verdict"))), " ".join(words),
                            str(c.get("source") or ""), f"requirement:{r['id']}", props))
     return out
 
@@ -331,7 +304,7 @@ def _finding_results(report: Report) -> list[SarifResult]:
         if f.model:
             words.append(f"Counterexample: {model_text(f.model)}.")
         props = {"finding": f.id, "node": f.node, "check": f.check, "status": f.status}
-        res = _result(rule, _level("health", f.status), " ".join(words), _finding_location(report, f),
+        res = sarif_result(rule, _level("health", f.status), " ".join(words), _finding_location(report, f),
                       f"health:{f.id}", props)
         out.append(_accepted(res, f.acknowledged.reason, f.acknowledged.at) if f.acknowledged else res)
     return out
@@ -349,7 +322,7 @@ def _accepted(res: SarifResult, reason: str, at: str) -> SarifResult:
     ``accepted``, ``reason`` as ``justification``, SARIF 2.1.0 section 3.35)
     located at ``at``, the plan entry's ``file:line:col``."""
     sup: SarifSuppression = {"kind": "external", "status": "accepted", "justification": reason}
-    where = _location(at)
+    where = sarif_locations(at)
     if where:
         sup["location"] = where[0]  # the plan entry (SARIF 2.1.0 section 3.35.6: one location)
     res["suppressions"] = [sup]
@@ -358,7 +331,7 @@ def _accepted(res: SarifResult, reason: str, at: str) -> SarifResult:
 
 def _acknowledgement_results(report: Report) -> list[SarifResult]:
     """Stale or refused plan acknowledgements, at their plan entry."""
-    return [_result("RCL-ACK-STALE", _level("acknowledgement", str(a["status"])),
+    return [sarif_result("RCL-ACK-STALE", _level("acknowledgement", str(a["status"])),
                     f"Acknowledgement of {a['warning']} is {a['status']}: {a['message']}", str(a["at"]),
                     f"ack:{a['at']}:{a['warning']}", {"status": a["status"]})
             for a in report.get("acknowledgements") or () if a.get("status") != "ok"]
@@ -372,7 +345,7 @@ def _lint_results(report: Report) -> tuple[list[SarifResult], list[Rule]]:
         level = _level("lint", str(d["severity"]))
         rules.setdefault(rid, Rule(rid, "Lint" + "".join(w.capitalize() for w in rid.split("-")[2:]), level,
                                    "RCL lint: a contract clause that is legal but probably not what was meant."))
-        out.append(_suppressed(_result(rid, level, str(d["message"]), str(d["location"]),
+        out.append(_suppressed(sarif_result(rid, level, str(d["message"]), str(d["location"]),
                                        f"lint:{d['location']}:{d.get('code', '')}:{k}", {"severity": d["severity"]}), d))
     return out, sorted(rules.values(), key=lambda r: r.id)
 
@@ -391,11 +364,11 @@ def _grounding_results(report: Report) -> tuple[list[SarifResult], list[Rule]]:
         rcl, ros = f.get("rcl"), f.get("ros")
         main = rcl or ros
         where = f"{main['file']}:{main['line']}:{main['col']}" if main else ""
-        res = _result(str(f["code"]), "error" if f["severity"] == "error" else "warning", str(f["message"]), where,
+        res = sarif_result(str(f["code"]), "error" if f["severity"] == "error" else "warning", str(f["message"]), where,
                       f"grounding:{f['code']}:{f.get('node', '')}:{f.get('topic', '')}:{k}",
                       {"node": f.get("node", ""), "topic": f.get("topic", "")})
         if rcl and ros:
-            rel = _location(f"{ros['file']}:{ros['line']}:{ros['col']}")
+            rel = sarif_locations(f"{ros['file']}:{ros['line']}:{ros['col']}")
             for i, loc in enumerate(rel):
                 loc["id"] = i
                 loc["message"] = {"text": "the software this contradicts"}
@@ -444,7 +417,7 @@ def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
                       and str(c.get("what", "")).startswith("guarantee") and c.get("source")), None)
     if guarantee is None:
         return
-    at = _location(str(guarantee["source"]))
+    at = sarif_locations(str(guarantee["source"]))
     if not at:
         return
     rel = res.get("locations") or []
@@ -478,9 +451,9 @@ def sarif_log(report: Report) -> SarifLog:
     from rclverify.report import near_misses  # deferred: start-up (loads rclverify.report.near_misses only when called)
     from rclverify.report import nodl  # deferred: start-up (loads rclverify.report.nodl only when called)
     results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
-               + nodl.sarif_results(report, _result, _location)
-               + _requirement_results(report) + sarif_results(report, _result) + _acknowledgement_results(report)
-               + near_misses.sarif_results(report, _result))
+               + nodl.sarif_results(report, sarif_result, sarif_locations)
+               + _requirement_results(report) + sarif_results(report, sarif_result) + _acknowledgement_results(report)
+               + near_misses.sarif_results(report, sarif_result))
     _attach_diagnoses(report, results)
     rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
                              + [Rule(*r) for r in near_misses.SARIF_RULES] + lint_rules + ground_rules)
