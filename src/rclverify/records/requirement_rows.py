@@ -39,9 +39,10 @@ import msgspec
 
 from rclverify.records.report_schema import DeadlineRow, LimitedBy
 from rclverify.records.statistics_rows import RequirementRuns
+from rclverify.records.row import DOC, Row
 from rclverify.records.statuses import EvidenceStatus, RequirementVerdict
 
-_DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
+_DOC = DOC  # a field's description, as the generated JSON Schema shows it
 
 #: The strengths of evidence, strongest first (docs/confidence.md; the plan's ``strength:`` words).
 StrengthKind = Literal["proof", "bounded", "statistical", "tested", "observed", "reviewed", "assumed"]
@@ -67,7 +68,7 @@ class WithoutDeadline(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     note: Annotated[str, _DOC(description="Why this verdict, in a sentence.")]
 
 
-class RequirementRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+class RequirementRow(Row, frozen=True, forbid_unknown_fields=True):
     """A requirement with its verdict, the guarantees it is traced to and its Z3 check."""
 
     id: Annotated[str, _DOC(description="The item's stable id (the anchor the HTML report, SARIF and "
@@ -100,18 +101,6 @@ class RequirementRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         description="The guarantees its proof uses whose evidence is weaker than required_strength, each with "
                     "its strength ('nothing discharged' when none); empty when none falls short. A shortfall "
                     "fails --strict.")] = []
-
-    def to_json(self) -> dict[str, Any]:
-        """The row as its JSON object (every field, in the order declared)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
-        return out
-
-    @classmethod
-    def of(cls, row: RequirementRow | Mapping[str, Any]) -> RequirementRow:
-        """``row`` (a row or its JSON object) as a row.  Raises
-        :class:`msgspec.ValidationError` for a key no field declares, a
-        missing field or a value of another type."""
-        return row if isinstance(row, RequirementRow) else msgspec.convert(dict(row), cls)
 
 
 def rows_of(rows: Iterable[RequirementRow | Mapping[str, Any]]) -> list[RequirementRow]:

@@ -27,9 +27,10 @@ from typing import Annotated, Any, Iterable, Literal, Mapping
 
 import msgspec
 
+from rclverify.records.row import DOC, Row
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 
-_DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
+_DOC = DOC  # a field's description, as the generated JSON Schema shows it
 
 #: A recommendation code (model/plan/standards/profiles.py ``CODES``).
 Recommendation = Literal["HR", "R", "---", "NR", "required"]
@@ -134,7 +135,7 @@ class LeftOut(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     why: Annotated[str, _DOC(description="Why the profile leaves it out.")]
 
 
-class StandardRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+class StandardRow(Row, frozen=True, forbid_unknown_fields=True):
     """A standard the plan names (standards:), its clauses and the evidence mapped onto them: a traceability
     aid, not a compliance claim."""
 
@@ -159,18 +160,6 @@ class StandardRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
                     "with strict: true.")]
     strict: Annotated[bool, _DOC(description="Chosen with strict: true: --strict requires every clause asked at "
                                              "the level covered.")]
-
-    def to_json(self) -> dict[str, Any]:
-        """The row as its JSON object (every field, in the order declared)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
-        return out
-
-    @classmethod
-    def of(cls, row: StandardRow | Mapping[str, Any]) -> StandardRow:
-        """``row`` (a row or its JSON object) as a row.  Raises
-        :class:`msgspec.ValidationError` for a key no field declares, a
-        missing field or a value of another type."""
-        return row if isinstance(row, StandardRow) else msgspec.convert(dict(row), cls)
 
 
 def rows_of(rows: Iterable[StandardRow | Mapping[str, Any]]) -> list[StandardRow]:

@@ -31,18 +31,17 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Iterable, Literal, Mapping
 
-import msgspec
-
+from rclverify.records.row import DOC, Row
 from rclverify.records.statuses import EvidenceStatus
 
-_DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it
+_DOC = DOC  # a field's description, as the generated JSON Schema shows it
 
 #: The counts of a set of runs (records/statistics.py ``count_runs`` without its digests): runs, violating,
 #: undecided and unjudged runs, duplicates, answers, violations, inconclusive answers (integers), seconds.
 Counts = dict[str, int | float]
 
 
-class RequirementRuns(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+class RequirementRuns(Row, frozen=True, forbid_unknown_fields=True):
     """A requirement's recorded runs under one environment tag and origin, decided against its target
     when it states one."""
 
@@ -65,13 +64,8 @@ class RequirementRuns(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     sprt: Annotated[str | None, _DOC(description="Wald's SPRT's state (accept, continue, reject), null without "
                                                  "a target.")] = None
 
-    def to_json(self) -> dict[str, Any]:
-        """The row as its JSON object (every field, in the order declared)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
-        return out
 
-
-class StatisticsRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+class StatisticsRow(Row, frozen=True, forbid_unknown_fields=True):
     """A row of the statistics table: a node's runs, a target's decision or a requirement's runs
     (module docstring); the fields its kind does not fill at their defaults."""
 
@@ -100,18 +94,6 @@ class StatisticsRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
                                                         "when none would or without a target.")] = None
     sprt: Annotated[str | None, _DOC(description="Wald's SPRT's state (accept, continue, reject), null without "
                                                  "a target.")] = None
-
-    def to_json(self) -> dict[str, Any]:
-        """The row as its JSON object (every field, in the order declared)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
-        return out
-
-    @classmethod
-    def of(cls, row: StatisticsRow | Mapping[str, Any]) -> StatisticsRow:
-        """``row`` (a row or its JSON object) as a row.  Raises
-        :class:`msgspec.ValidationError` for a key no field declares, a
-        missing field or a value of another type."""
-        return row if isinstance(row, StatisticsRow) else msgspec.convert(dict(row), cls)
 
 
 def rows_of(rows: Iterable[StatisticsRow | Mapping[str, Any]]) -> list[StatisticsRow]:
