@@ -151,3 +151,34 @@ def test_control_a_wrong_column_and_is_caught(monkeypatch: pytest.MonkeyPatch) -
         (seen_s, _), (seen_b, _), _ = _both("Classifier", _run(rnd, "Classifier"))
         differ += sum(a.margin != b.margin for a, b in zip(seen_s, seen_b))
     assert differ > 0
+
+
+def _long_run(rnd: random.Random, pairs: int, wrong: float) -> list[Event]:
+    """``pairs`` answered readings of Stop, a fraction ``wrong`` of the answers violated (past the lower bound)."""
+    events: list[Event] = []
+    for i in range(pairs):
+        r = rnd.uniform(2, 5)
+        d = r - 2 - rnd.uniform(0.01, 1) if rnd.random() < wrong else rnd.uniform(r - 2, r - 0.5)
+        for topic, v in (("range", r), ("dist", d)):
+            events.append(Event(len(events), 0.01 * i, topic, {"data": v}, f"run.jsonl:{len(events) + 1}"))
+    return events
+
+
+def test_many_violations_beyond_the_kept_ones() -> None:
+    # 3,000 answers, 10 % violated: past the 200 violation records and 256 margins kept, with and without a
+    # verdict callback, the batch path's result (counts, records, kept margins) is the engine's
+    events = _long_run(random.Random("many"), 3000, 0.1)
+    node = CHECKED.nodes["Stop"]
+    seen_s: list[Any] = []
+    _, (res_s,) = check_trace(CHECKED, [node], iter(events), RULES, 0.1, seen_s.append, batch=False, margins=True)
+    _, (quiet_s,) = check_trace(CHECKED, [node], iter(events), RULES, 0.1, batch=False, margins=True)
+    seen_b: list[Any] = []
+    stats: dict[str, int] = {}
+    loud = check_batch(CHECKED, node, iter(events), RULES, 0.1, seen_b.append, margins=True)
+    quiet = check_batch(CHECKED, node, iter(events), RULES, 0.1, stats=stats, margins=True)
+    assert loud is not None and quiet is not None
+    assert res_s.counts["violated"] > 250 and res_s.violations_dropped > 50 and len(res_s.margins[1].lowest) == 256
+    assert seen_b == seen_s
+    for res in (quiet_s, loud[1], quiet[1]):
+        assert res == res_s and _margins(res) == _margins(res_s)
+    assert stats["batched"] > 2000

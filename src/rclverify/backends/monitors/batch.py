@@ -329,8 +329,14 @@ class _Run:
         """Each guarantee's smallest margin over the pairs at ``at`` counted in the
         result, as the engine counts them one by one; returns each pair's message margin."""
         m, plan = self.m, self.plan
+        kept_all = m.result.margins
         for k, (value, atom) in enumerate(margins, 1):
             j = int(np.argmin(value))
+            kept = kept_all.get(k)
+            if kept is not None and kept.answers and not value[j] < kept.value and \
+                    len(kept.lowest) >= KEPT_MARGINS and not value[j] < kept.lowest[-1]:
+                kept.answers += len(at)  # none of them is kept: note_margins would only count them
+                continue
             text, unit = plan.atoms[int(atom[j])] if atom[j] >= 0 else ("", "")
             qe, ev = chunk[int(at[j])], chunk[int(at[j]) + 1]
             few = value if len(value) <= KEPT_MARGINS else np.partition(value, KEPT_MARGINS - 1)[:KEPT_MARGINS]

@@ -27,7 +27,7 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.questions import Question
-from rclverify.backends.monitors.verdicts import WEAK as _WEAK, in_all, link_of, names, producers
+from rclverify.backends.monitors.verdicts import KEPT_VIOLATIONS, WEAK as _WEAK, in_all, link_of, names, producers
 from rclverify.backends.monitors.shapes import Violation
 from rclverify.backends.monitors.engine_state import EngineState
 
@@ -79,6 +79,12 @@ class Closing(EngineState):
 
     def _violation(self, ev: Event, k: int, values: Mapping[str, object], reason: str, semantics: str,
                    trigger: Event | None) -> None:
+        result = self.result
+        if self.on_verdict is None and result.first_violation is not None and \
+                len(result.violations) >= KEPT_VIOLATIONS:  # a record nobody keeps or receives: counted, not rendered
+            result.violations_dropped += 1
+            result.counts["violated"] += 1
+            return
         record: Violation = {"event": ev.index, "time": ev.time, "where": ev.where, "guarantee": k,
                                   "formula": self._texts.get(k, ""), "values": self._rendered(values),
                                   "reason": reason, "semantics": semantics}

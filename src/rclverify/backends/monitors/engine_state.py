@@ -11,7 +11,7 @@ holds no value and no behaviour of its own.
 from __future__ import annotations
 
 from collections import deque
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
@@ -19,7 +19,7 @@ from rclverify.semantics.floatsem import Judgement, Tolerance
 from rclverify.semantics.judges import FormulaJudge
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question, QuestionStream
-from rclverify.backends.monitors.verdicts import NodeResult
+from rclverify.backends.monitors.verdicts import NodeResult, Verdict
 
 if TYPE_CHECKING:
     from rclverify.backends.monitors.answered import Recent
@@ -35,6 +35,7 @@ class EngineState:
     horizon: float
     tolerance: Tolerance | None
     result: NodeResult
+    on_verdict: Callable[[Verdict], None] | None
     values: dict[str, object]
     invalid: dict[str, str]
     assumption: tuple[ast.Expr, ...]
