@@ -18,8 +18,10 @@ How a contract names ROS things (decisions written in docs/ros.md):
 * the fields a topic's variable is read from are the plan's
   ``ros.fields[C.T]`` (contract ``C``'s own topic ``T``: one name may carry
   different message types in different contracts), else ``ros.fields[T]``,
-  else the monitor mapping's ``fields`` list for ``T``
-  (``backends/monitors/mapping.yaml``, docs/monitors.md), else the message's
+  else the ``fields`` list for ``T`` of the plan's one mapping file
+  (:func:`rclverify.model.plan.mapping_file.plan_mapping`: ``ros.mapping``,
+  else the monitors entries', else ``backends/monitors/mapping.yaml``;
+  docs/monitors.md, "The mapping file"), else the message's
   fields in order; paths may be nested (``pose.position.x``) and index
   arrays (``readings[0].value``, ``readings[].value``).
 
