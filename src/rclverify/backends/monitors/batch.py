@@ -52,7 +52,7 @@ from rclverify.targets.column_margins import ColumnMargin, MarginCompiler
 from rclverify.targets.columns import ColumnCompiler, Unsupported, io_kind, seed
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
-from rclverify.backends.monitors.verdicts import KEPT_MARGINS, NodeResult, Verdict
+from rclverify.backends.monitors.verdicts import KEPT_MARGINS, KEPT_VIOLATIONS, NodeResult, Verdict
 
 #: Events read per chunk: the columns held at once.
 CHUNK = 16384
@@ -185,6 +185,16 @@ class _Run:
         self.ghosts: list[AnsweredRun] = []
         self.fields = {key: field for key, field, _ in plan.inputs.values()}
         self.node_topics = frozenset(self.kinds)
+        m = self.m
+        #: surely violated answers are judged in batches too once nothing renders them: one guarantee (its first
+        #: false one is the only one judged), no verdict callback, no transport skew (closing.py: a violation
+        #: past the kept records is only counted)
+        self.wrong = len(m.guarantees) == 1 and m.on_verdict is None and not m.stream.skew
+
+    def _full(self) -> bool:
+        """Whether the run's violation records are full: a further violation is only counted."""
+        result = self.m.result
+        return result.first_violation is not None and len(result.violations) >= KEPT_VIOLATIONS
 
     def feed(self, ev: Event) -> None:
         """``ev`` to the engine, the kept questions made first when it may look one up (stamped before the latest)."""
@@ -297,24 +307,41 @@ class _Run:
                     col[before] = first
             columns[key] = col
         sure = seen.copy()
-        for f in plan.formulas:
-            truth, certain = f(columns)
+        judged = [f(columns) for f in plan.formulas]
+        for truth, certain in judged:
             sure &= np.broadcast_to(truth & certain, sure.shape)
         margins = [g(columns) for g in plan.margins]
         for value, _ in margins:  # a margin the engine would compute in exact arithmetic (0, not positive): its row
             sure &= value > 0
+        wrong: np.ndarray | None = None
+        bad = np.flatnonzero(~sure)
+        loose = bad
+        if self.wrong:  # the assumptions surely true, the guarantee surely false with a negative margin
+            wrong = seen.copy()
+            for truth, certain in judged[:-1]:
+                wrong &= np.broadcast_to(truth & certain, wrong.shape)
+            truth, certain = judged[-1]
+            wrong &= np.broadcast_to(~truth & certain, wrong.shape)
+            for value, _ in margins:
+                wrong &= value < 0
+            loose = np.flatnonzero(~(sure | wrong))
+        full = wrong is not None and self._full()
         p, total = 0, len(at)
         m = self.m
-        bad = np.flatnonzero(~sure)
         feed = self.feed
         while p < total:
+            if not full and wrong is not None and self._full():
+                full = True
+            if full:
+                bad = loose
             b = int(bad[np.searchsorted(bad, p)]) if len(bad) and bad[-1] >= p else total
             if b > p and m._held:  # an output held for the skew: batch only up to the event that releases it
                 limit = m._held[0][1] + m.stream.skew
                 b = p + int(np.searchsorted(times[at[p:b] + 1], limit, side="right"))
             if b > p and self._quiet(times[at[p]]):
                 self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times,
-                                [(v[p:b], a[p:b]) for v, a in margins])
+                                [(v[p:b], a[p:b]) for v, a in margins], wrong[p:b] if full and wrong is not None
+                                else None)
                 p = b
                 if p >= total:
                     break
@@ -361,8 +388,10 @@ class _Run:
         return not stamps or stamps[-1] <= t
 
     def _satisfied(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
-                   times: np.ndarray, margins: list[tuple[np.ndarray, np.ndarray]] | None = None) -> None:
-        """The pairs at ``at`` are surely satisfied: their verdicts (with their margins,
+                   times: np.ndarray, margins: list[tuple[np.ndarray, np.ndarray]] | None = None,
+                   wrong: np.ndarray | None = None) -> None:
+        """The pairs at ``at`` are surely satisfied, or surely violated where ``wrong``
+        (then only counted: :attr:`wrong`): their verdicts (with their margins,
         ``margins``: per guarantee its values and deciding atoms), and the engine's state as feeding them sets it."""
         plan, m = self.plan, self.m
         h, okey, keys = m.horizon, plan.output[1], plan.keys
@@ -381,8 +410,12 @@ class _Run:
             m._open, m._due = None, float("inf")
         result = m.result
         result.events += 2 * n
-        result.counts["satisfied"] += n
-        result.semantics["exact"] += n
+        bad = int(np.count_nonzero(wrong)) if wrong is not None else 0
+        result.counts["satisfied"] += n - bad
+        result.semantics["exact"] += n - bad
+        if bad:
+            result.counts["violated"] += bad
+            result.violations_dropped += bad
         result.accepted += n
         ofield = plan.output[2]
         least = self._margins(chunk, at, margins) if margins else None
