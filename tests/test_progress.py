@@ -6,6 +6,7 @@ from types import SimpleNamespace
 from typing import Any
 
 from rclverify.app.progress import ProgressReporter, backend_of
+from rclverify.records.findings import HealthFinding
 from rclverify.report.summary import MAX_ROWS, node_rows, print_summary
 
 
@@ -14,7 +15,8 @@ def _report(n_nodes: int) -> dict[str, Any]:
     obligations = [{"node": f"N{k}", "status": "failed" if k == 7 else "discharged"} for k in range(n_nodes)]
     obligations.append({"node": "N0", "status": "pending"})
     scs = [{"node": f"N{k}", "status": "discharged"} for k in range(1, n_nodes)]
-    findings = [{"node": "N7", "status": "problem"}, {"node": "N3", "status": "inconclusive"}, {"node": "N1", "status": "ok"}]
+    findings = [HealthFinding(f"{node}.consistent", node, "contract-consistent", None, status, "", "").to_json()
+                for node, status in (("N7", "problem"), ("N3", "inconclusive"), ("N1", "ok"))]
     return {"meta": {"workspace": "w [x]"}, "nodes": nodes, "obligations": obligations, "side_conditions": scs,
             "findings": findings}
 
