@@ -1,7 +1,11 @@
 """The one-screen summary that ends ``doit verify`` and ``rclverify verify``.
 
 Per node: obligations by status, side conditions proved, contract health,
-the node's rolled-up status; a total row; the path of the report.  Built from
+the node's rolled-up status; a total row; then the requirements, deadlines,
+problems by root cause, the ROS grounding's and the NoDL documents' errors
+at their ``file:line:col``, the near misses, the warnings answered in the
+plan and the clauses a failed ``--strict`` names; the path of the report.
+Built from
 the report dict of :func:`rclverify.report.build.build_report` with ``rich``
 tables.  On a terminal the table has colours; otherwise it is plain ASCII
 (no escape codes), so CI logs stay readable.
@@ -127,7 +131,8 @@ def summary_data(report: Report) -> SummaryData:
     ``{"meta": {"workspace", "strict_ok"}, "summary": report["summary"],
     "rows": node_rows(report), "requirements": [[id, verdict, status], ...],
     "problems": [{"status", "sentence", "culprits": ["what (file:line:col)"],
-    "members": [finding ids], "repairs": int}, ...]}`` (the problems grouped by
+    "members": [finding ids], "repairs": int}, ...], "unverified", "deadlines",
+    "grounding", "nodl", "strict", "acknowledged", "near_misses"}`` (the problems grouped by
     root cause, :mod:`rclverify.report.problems`).  The report task writes it next to the
     report (``artifacts/report/summary.json``), so ``verify`` reads a few
     kilobytes instead of the whole JSON report (6 MB at 1000 nodes)."""
