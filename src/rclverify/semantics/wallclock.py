@@ -24,7 +24,7 @@ checks) can ask, with :func:`watch`, whether anything in it was cut.
 Solvers register their limits with :func:`limit` (budgeted ones) or
 :func:`note_limit` (a limit set elsewhere); :func:`check` of a solver
 never registered counts no cut.  A budget that runs out only after the
-net's time (a machine ten times slower than the calibration) also counts
+net's time (a machine :data:`SAFETY_FACTOR` times slower than the calibration) also counts
 as cut: inconclusive, never a different answer.  Nets are at least
 :data:`MIN_WALL_MS`: Z3 does not always honour a net of a few milliseconds
 (its timer can fire before the search starts), and a first look of a few
