@@ -1,7 +1,11 @@
 """Obligation and evidence records (shared/DESIGN.md, "Evidence").
 
-Both are plain, JSON-serialisable frozen dataclasses.  ``to_json``/``from_json``
-round-trip exactly; keys are sorted when written so that artifacts are
+Both are plain, JSON-serialisable frozen dataclasses, each defined once:
+``to_json`` writes every field through msgspec's encoding and ``from_json``
+reads it back through msgspec's decoding into the class, which refuses a
+missing field or a value of another type (an evidence record also a key its
+class does not declare); the two round-trip
+exactly, and keys are sorted when written so that artifacts are
 byte-for-byte reproducible.
 
 Statuses, from best to worst (roll-up takes the worst child):
@@ -9,11 +13,15 @@ Statuses, from best to worst (roll-up takes the worst child):
 ``discharged``  the backend checked the obligation and it holds;
 ``pending``     exported, but the external tool or the manual step is
                 outstanding (``explanation`` gives the reason);
-``inconclusive`` the tool answered unknown or timed out (never proved);
+``inconclusive`` the tool answered unknown, timed out, or could not prove
+                the claim but showed no counterexample (never proved; an
+                unproved claim is not a failed one);
 ``stale``       an input changed after the evidence was produced;
 ``error``       the tool itself broke;
-``failed``      the tool found the obligation does not hold
-                (``counterexample`` when there is one).
+``failed``      the tool showed the obligation does not hold
+                (``counterexample`` when there is one: a proof backend
+                fails an obligation only with a refutation or a replayed
+                run).
 
 Kinds of evidence: ``proof``, ``model checking``, ``testing``,
 ``experiment``, ``review``, ``monitoring``.
