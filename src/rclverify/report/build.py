@@ -11,6 +11,8 @@ while any of its evidence is failed, pending, stale or missing:
   conditions of their nodes, with its Z3 check's verdict and its deadline
   (report/requirement_rows.py, report/deadlines.py);
 * the NoDL documents' check: report/nodl.py (its errors fail ``--strict``);
+* near misses and the margins over runs: report/near_misses.py (warnings:
+  they fail ``--strict``), report/margin_rows.py;
 * the summary and the ``--strict`` gate: report/summary_rows.py.
 
 Each pass returns its part and changes nothing it was given; the parts
