@@ -3,12 +3,15 @@ streaming engine's (judging.py, semantics/robustness.py), their oracle.
 
 On random runs of small eligible contracts (a band classifier, a linear bound
 with inexact literals and two guarantees, a stop distance in metres, an
-equality that puts every row on the engine), values on and next to the
+output-only bound alone and beside a guarantee on a question, an equality
+that puts every row on the engine), values on and next to the
 boundaries, answers right, wrong, late, missing and out of order, the batch
 path with margins gives exactly the streaming engine's verdicts, each with
 the same margin, and the same smallest margin per guarantee (value, atom,
 unit, message, count).  The control turns the columns' ``and`` into a
-maximum and finds the two apart.
+maximum and finds the two apart.  A long run with 10 % of its answers
+violated, past the violation records and margins a run keeps, gives the
+engine's result with and without a verdict callback.
 """
 from __future__ import annotations
 
@@ -49,6 +52,19 @@ node Stop {
   outputs( d : REAL [m] )
   topics( std_msgs/Float64 range matches(in.r), std_msgs/Float64 dist matches(out.d) )
   guarantee( in.r - 2 <= out.d <= in.r - 0.5 )
+}
+node Ceiling {
+  inputs( r : REAL [m] )
+  outputs( d : REAL [m] )
+  topics( std_msgs/Float64 range matches(in.r), std_msgs/Float64 dist matches(out.d) )
+  guarantee( out.d <= 4.5 )
+}
+node Both {
+  inputs( r : REAL [m] )
+  outputs( d : REAL [m] )
+  topics( std_msgs/Float64 range matches(in.r), std_msgs/Float64 dist matches(out.d) )
+  guarantee( out.d <= 4.5 and out.d != 3.25 )
+  guarantee( in.r - 2 <= out.d )
 }
 node Echo {
   inputs( r : REAL )
@@ -95,6 +111,7 @@ def _run(rnd: random.Random, node: str) -> list[Event]:
             r = rnd.choice([rnd.uniform(0, 5), 0.5, 2.0])
             add("range", r, t)
             d = rnd.choice([r - 0.5, r - 0.5 - rnd.uniform(0, 1), r, r - 0.5 + 1e-15]) if node == "Stop" else \
+                rnd.choice([r - 0.5, r - 2.5, r, 4.5, 3.25, 4.5 + 1e-15]) if node in ("Ceiling", "Both") else \
                 rnd.choice([r, r, r + 1e-9])
             if odd < 0.95:
                 add("dist", d, t + rnd.choice([0.0, 0.001]))
@@ -119,7 +136,7 @@ def _margins(res: Any) -> dict[int, Any]:
     return {k: (m.value, m.unit, m.atom, m.event, m.where, m.question, m.answers, m.lowest) for k, m in res.margins.items()}
 
 
-@pytest.mark.parametrize("node", ["Classifier", "Linear", "Stop", "Echo"])
+@pytest.mark.parametrize("node", ["Classifier", "Linear", "Stop", "Ceiling", "Both", "Echo"])
 def test_batch_margins_are_the_engines(node: str) -> None:
     rnd = random.Random(f"margins-{node}")
     batched_rows = 0
@@ -142,6 +159,18 @@ def test_units_and_atoms_from_the_columns() -> None:
     (_, res_s), (seen_b, res_b), batched = _both("Stop", events)
     assert batched == 2 and [v.margin for v in seen_b] == [0.25, 0.5]
     assert (res_b.margins[1].value, res_b.margins[1].unit, res_b.margins[1].atom) == (0.25, "m", "out.d <= in.r - 0.5")
+
+
+def test_output_only_guarantee_in_batches() -> None:
+    # out.d <= 4.5 reads no input: judged on each answer as the outputs stand, its margin on no question
+    events = [Event(2 * i + j, float(i), topic, {"data": v}, f"r:{2 * i + j + 1}")
+              for i, (r, d) in enumerate([(3.0, 2.25), (9.0, 4.0), (1.0, 0.5)])
+              for j, (topic, v) in enumerate((("range", r), ("dist", d)))]
+    (seen_s, res_s), (seen_b, res_b), batched = _both("Ceiling", events)
+    assert batched == 3 and seen_b == seen_s and res_b == res_s and _margins(res_b) == _margins(res_s)
+    assert [(v.verdict, v.margin, v.question) for v in seen_b] == [
+        ("satisfied", 2.25, "r:1"), ("satisfied", 0.5, "r:3"), ("satisfied", 4.0, "r:5")]
+    assert (res_b.margins[1].value, res_b.margins[1].where, res_b.margins[1].question) == (0.5, "r:4", "")
 
 
 def test_control_a_wrong_column_and_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:

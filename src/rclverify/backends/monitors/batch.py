@@ -10,10 +10,15 @@ the engine or the batch path's state needs), finds those rows (a
 output the answer the stream model gives it, docs/semantics.md),
 evaluates the assumptions and guarantees over the chunk's columns in
 float64 with a certificate per row (:mod:`.columns`), and gives the rows
-surely true in exact arithmetic their ``satisfied`` verdict directly.  Every
-other event (an input with no answer, a late or duplicated answer, a value
-that does not map, a formula false or near a boundary, a message of another
-topic) goes through the streaming engine (:class:`~.engine.NodeMonitor`,
+surely true in exact arithmetic their ``satisfied`` verdict directly.  A
+row surely violated (assumptions surely true, the one guarantee surely
+false, its margin negative) is counted directly too once the run's
+:data:`~.verdicts.KEPT_VIOLATIONS` violation records are full and no
+verdict callback is given, without a transport skew: the engine would only
+count it (closing.py); before that the engine renders its values and
+reason.  Every other event (an input with no answer, a late or duplicated
+answer, a value that does not map, a formula near a boundary, a message of
+another topic) goes through the streaming engine (:class:`~.engine.NodeMonitor`,
 its ``feed``) exactly as :func:`~.check.check_trace` would feed it, so its
 verdict is the engine's by construction.
 
@@ -29,9 +34,11 @@ columns and that small state: flat in the trace's length.
 Eligible (:func:`batch_plan`), else the caller streams: one node; no
 service or action link, no ``triggered by``, no state topic; every topic
 carries one ``REAL`` or enumeration variable through a rule naming one
-field; one output topic; every guarantee reads an input and the output, and
-Z3 showed only an answer decides them (the engine evaluates nothing when a
-question comes); every formula compiled by :mod:`.columns`.
+field; one output topic; every guarantee reads the output (one that reads no
+input is output-only: judged on each answer on the outputs as they stand,
+its margin on no question, as the engine judges it), and Z3 showed only an
+answer decides them (the engine evaluates nothing when a question comes);
+every formula compiled by :mod:`.columns`.
 """
 from __future__ import annotations
 
@@ -85,7 +92,7 @@ class BatchPlan:
         #: the message fields the columns read (a log read in blocks decodes them: rows.py)
         self.fields = [f for _, f, _ in self.inputs.values()] + [self.output[2]]
         if not self.output[0] or not self.inputs or len(set(self.keys)) != len(self.keys) or \
-                sorted(self.keys) != sorted(m._in_keys) or sorted(m.needed_inputs) != sorted(self.keys):
+                sorted(self.keys) != sorted(m._in_keys) or not set(m.needed_inputs) <= set(self.keys):
             raise Unsupported("inputs and output not one topic each")
         #: enumeration-valued keys -> the code of each value of their type (a value of no other type)
         self.enums = {key: {v: compiler.codes[v] for v in typ.values if v in compiler.codes}
@@ -106,9 +113,9 @@ def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | No
     """The batch plan of monitor ``m`` when its node is eligible (module docstring), else ``None``."""
     node = m.node
     ks = range(1, len(m.guarantees) + 1)
-    if node.node.links or m._trigger or m._state_outs or not m.has_inputs or m._alone or m.unbound or \
+    if node.node.links or m._trigger or m._state_outs or not m.has_inputs or m.unbound or \
             m._ask_at_question or any(len(vs) != 1 for vs in m.topics.values()) or \
-            any(not m._reads_out[k] for k in ks) or sorted(m._asked) != list(ks):
+            any(not m._reads_out[k] for k in ks) or sorted(m._asked + m._alone) != list(ks):
         return None
     try:
         plan = BatchPlan(m, rules, ColumnCompiler(m.checked, node))
@@ -366,9 +373,10 @@ class _Run:
                 continue
             text, unit = plan.atoms[int(atom[j])] if atom[j] >= 0 else ("", "")
             qe, ev = chunk[int(at[j])], chunk[int(at[j]) + 1]
+            asker = "" if k in m._alone else qe.where  # an output-only guarantee is judged on no question
             few = value if len(value) <= KEPT_MARGINS else np.partition(value, KEPT_MARGINS - 1)[:KEPT_MARGINS]
             m.result.note_margins(k, m._texts[k], float(value[j]), unit, text, "double",
-                                  (ev.index, ev.time, ev.where, qe.where), len(at), few.tolist())
+                                  (ev.index, ev.time, ev.where, asker), len(at), few.tolist())
         least: np.ndarray = np.minimum.reduce([v for v, _ in margins])
         return least
 
