@@ -1,6 +1,6 @@
 """The report's published JSON Schema (docs/assurance.schema.json), the one status vocabulary
-(rclverify.records.statuses) and the report's TypedDicts (records/report_schema.py) held in step, and
-the stages' own status tables held to the vocabulary.  Nothing here runs the pipeline (the inner
+(rclverify.records.statuses) and the report's TypedDicts (records/report_schema.py, records/nodl_rows.py)
+held in step, and the stages' own status tables held to the vocabulary.  Nothing here runs the pipeline (the inner
 tier); tests/test_report_schema.py validates the reports of a run.
 """
 from __future__ import annotations
@@ -13,7 +13,7 @@ from jsonschema import Draft202012Validator
 
 from _report_schema import SCHEMA
 from rclverify.records import records, statuses
-from rclverify.records import report_schema as st
+from rclverify.records import nodl_rows, report_schema as st
 
 
 def _undescribed(x: Any, where: str = "") -> list[str]:
@@ -181,7 +181,8 @@ def test_the_typeddicts_are_the_schema() -> None:
     assert _disagreements(st.Report, SCHEMA, "report") == []
     # every row type is reached from Report (none is left out of the walk)
     reached = {t for k, ann in typing.get_type_hints(st.Report).items() for t in _reached(ann)}
-    assert {getattr(st, n) for n in dir(st) if typing.is_typeddict(getattr(st, n))} == reached | {st.Report}
+    assert {getattr(m, n) for m in (st, nodl_rows) for n in dir(m)
+            if typing.is_typeddict(getattr(m, n))} == reached | {st.Report}
 
 
 def _reached(ann: Any) -> set[Any]:

@@ -27,6 +27,7 @@ from typing import Any, Literal, Mapping, NotRequired, TypedDict, cast
 from rclverify.records.statuses import (AcknowledgementStatus, Agreement, AnyStatus, DeadlineVerdict, Derivation,
                                         EvidenceKind, EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
                                         SideConditionVerdict, EVIDENCE_STATUSES)
+from rclverify.records.nodl_rows import NodlRow
 
 
 class Solvers(TypedDict):
@@ -422,42 +423,6 @@ class ProblemRow(TypedDict):
     culprits: list[dict[str, Any]]
     members: list[ProblemMember]
     repairs: list[RepairRef]
-
-
-class NodlPlaceRow(TypedDict):
-    """A place a NoDL finding involves (``$defs/nodl_place``): file, line, column (1-based)."""
-    file: str
-    line: int
-    col: int
-
-
-class NodlFindingRow(TypedDict):
-    """A finding of the NoDL check (``nodl.findings[]``; docs/nodl.md, "Findings"), at every place it involves."""
-    code: str
-    severity: Literal["error", "warning"]
-    message: str
-    places: list[NodlPlaceRow]
-
-
-class NodlSideConditionRow(TypedDict):
-    """A parameter's declared constraints against an assumption of its node (``nodl.side_conditions[]``)."""
-    node: str
-    parameter: str
-    conjunct: str
-    status: Literal["proved", "refuted", "inconclusive"]
-    model: dict[str, str]
-
-
-class NodlRow(TypedDict):
-    """The workspace's NoDL documents against its contracts and each other (``nodl``; stages/nodl.py)."""
-    documents: dict[str, list[str]]
-    parts: list[str]
-    findings: list[NodlFindingRow]
-    counts: dict[str, int]
-    side_conditions: list[NodlSideConditionRow]
-    inputs: dict[str, str]
-    stale: NotRequired[str]
-    altered: NotRequired[str]
 
 
 class Report(TypedDict):

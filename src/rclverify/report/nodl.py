@@ -19,7 +19,8 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, cast
 
-from rclverify.records.report_schema import NodlRow, Report
+from rclverify.records.nodl_rows import NodlRow
+from rclverify.records.report_schema import Report
 from rclverify.records.sarif import SarifLocation, SarifResult
 from rclverify.report.shapes import GroundingBrief
 from rclverify.stages.workspace import Workspace
