@@ -6,10 +6,11 @@ Obligations and evidence records (``records``), their atomic store
 decides and a kept proof to its query (``ties``), published artifacts,
 run-based statistics, the one status vocabulary (``statuses``), the
 assurance report's schema as types (``report_schema``), the records
-defined once as msgspec Structs on one base (``row``): the contract-health
-finding (``findings``) and the report's obligation, evidence, requirement,
+defined once as msgspec Structs: the contract-health finding
+(``findings``) and the report's obligation, evidence, requirement,
 statistics and standards rows (``obligations``, ``evidence_rows``,
-``requirement_rows``, ``statistics_rows``, ``standards_rows``), and the parts
+``requirement_rows``, ``statistics_rows``, ``standards_rows``, on one base,
+``row``), and the parts
 of the report's JSON Schema generated from them (``schema_gen``).  Imports
 ``core``.
 """

@@ -1,8 +1,8 @@
 """The assurance report's shape as types: :class:`Report` and a TypedDict per row kind not defined once.
 
 The rows defined once as msgspec Structs (findings, obligations, evidence,
-requirements, statistics, standards: :mod:`rclverify.records.row` and the
-modules beside it) appear here as the JSON objects they write
+requirements, statistics, standards: :mod:`rclverify.records.findings` and
+the modules beside it) appear here as the JSON objects they write
 (``FindingJson``, ``ObligationJson``, ...); their schema parts are generated
 (:mod:`rclverify.records.schema_gen`).
 
