@@ -5,7 +5,8 @@ Obligations and evidence records (``records``), their atomic store
 (``stage_records``), the lines that tie a kept query to the statement it
 decides and a kept proof to its query (``ties``), published artifacts,
 run-based statistics, the one status vocabulary (``statuses``), the
-assurance report's schema as types (``report_schema``), the records
+assurance report's schema as types (``report_schema``, its NoDL part
+``nodl_rows``), the records
 defined once as msgspec Structs: the contract-health finding
 (``findings``) and the report's obligation, evidence, requirement,
 statistics and standards rows (``obligations``, ``evidence_rows``,
