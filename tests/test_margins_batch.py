@@ -183,32 +183,35 @@ def test_control_a_wrong_column_and_is_caught(monkeypatch: pytest.MonkeyPatch) -
     assert differ > 0
 
 
-def _long_run(rnd: random.Random, pairs: int, wrong: float) -> list[Event]:
-    """``pairs`` answered readings of Stop, a fraction ``wrong`` of the answers violated (past the lower bound)."""
+def _long_run(rnd: random.Random, pairs: int, wrong: float, node: str = "Stop") -> list[Event]:
+    """``pairs`` answered readings of Stop (or Ceiling), a fraction ``wrong`` of the answers violated (below
+    the lower bound, or above the ceiling)."""
     events: list[Event] = []
     for i in range(pairs):
         r = rnd.uniform(2, 5)
-        d = r - 2 - rnd.uniform(0.01, 1) if rnd.random() < wrong else rnd.uniform(r - 2, r - 0.5)
+        d = rnd.uniform(r - 2, min(r - 0.5, 4.4))
+        if rnd.random() < wrong:
+            d = r - 2 - rnd.uniform(0.01, 1) if node == "Stop" else 4.5 + rnd.uniform(0.01, 1)
         for topic, v in (("range", r), ("dist", d)):
             events.append(Event(len(events), 0.01 * i, topic, {"data": v}, f"run.jsonl:{len(events) + 1}"))
     return events
 
 
-@pytest.mark.parametrize("margins", [True, False])
-def test_many_violations_beyond_the_kept_ones(margins: bool) -> None:
+@pytest.mark.parametrize("node,margins", [("Stop", True), ("Stop", False), ("Ceiling", True)])
+def test_many_violations_beyond_the_kept_ones(node: str, margins: bool) -> None:
     # 3,000 answers, 10 % violated: past the 200 violation records and 256 margins kept, with and without a
     # verdict callback, the batch path's result (counts, records, kept margins) is the engine's; without a
     # callback the violations past the kept records are judged in batches too
-    events = _long_run(random.Random("many"), 3000, 0.1)
-    node = CHECKED.nodes["Stop"]
+    events = _long_run(random.Random(f"many-{node}"), 3000, 0.1, node)
+    checked_node = CHECKED.nodes[node]
     seen_s: list[Any] = []
-    _, (res_s,) = check_trace(CHECKED, [node], iter(events), RULES, 0.1, seen_s.append, batch=False,
+    _, (res_s,) = check_trace(CHECKED, [checked_node], iter(events), RULES, 0.1, seen_s.append, batch=False,
                               margins=margins)
-    _, (quiet_s,) = check_trace(CHECKED, [node], iter(events), RULES, 0.1, batch=False, margins=margins)
+    _, (quiet_s,) = check_trace(CHECKED, [checked_node], iter(events), RULES, 0.1, batch=False, margins=margins)
     seen_b: list[Any] = []
     stats: dict[str, int] = {}
-    loud = check_batch(CHECKED, node, iter(events), RULES, 0.1, seen_b.append, margins=margins)
-    quiet = check_batch(CHECKED, node, iter(events), RULES, 0.1, stats=stats, margins=margins, chunk=512)
+    loud = check_batch(CHECKED, checked_node, iter(events), RULES, 0.1, seen_b.append, margins=margins)
+    quiet = check_batch(CHECKED, checked_node, iter(events), RULES, 0.1, stats=stats, margins=margins, chunk=512)
     assert loud is not None and quiet is not None
     assert res_s.counts["violated"] > 250 and res_s.violations_dropped > 50
     assert len(res_s.margins[1].lowest) == 256 if margins else not res_s.margins
