@@ -162,6 +162,8 @@ class NodeMonitor(Judging, Closing, Late):
         #: outputs false for the question at their stamp, waiting for the questions within the skew after them:
         #: (event, stamp, that question, outputs of the answer, state outputs, output-only outcome, its reading)
         self._held: deque[tuple[Any, ...]] = deque()
+        #: with margins: each held output's message margin (event index -> margin), for its verdict
+        self._held_margins: dict[int, float | None] = {}
         #: outputs held for the skew and judged since, kept as ``_recent`` keeps those judged at once (late.py)
         self._released: deque[Recent] = deque(maxlen=64)
         #: input -> (stamp, why) of its latest unreadable message (a NaN) until a message stamped after it maps
@@ -389,6 +391,9 @@ class NodeMonitor(Judging, Closing, Late):
             # skew after it that gets no answer of its own; judged once that is known (docs/semantics.md)
             self._recent.pop()  # judged with both readings when released, not reconsidered
             self._held.append((ev, stamped, q, dict(outs), state, alone_now, first))
+            if self.margins:  # its message's margin so far, given to its verdict when released
+                index, least = self._margin_now
+                self._held_margins[ev.index] = least if index == ev.index else None
             return
         if alone_now is _NONE and first.kind == "satisfied":  # the common case, without combining
             self._verdict("satisfied", ev, semantics=first.semantics, question=q.event.where if q else "")
@@ -407,6 +412,8 @@ class NodeMonitor(Judging, Closing, Late):
             if not end and any(not o.reported and (now <= o.due or self._at_due(now, o.due)) for o in others):
                 return  # a question it may answer has no answer of its own yet: wait
             held.popleft()
+            if self.margins:
+                self._margin_now = (ev.index, self._held_margins.pop(ev.index, None))
             self._decide(ev, q, others, alone, outs, first, state)
             # judged now: an input heard later but stamped before it may still be its question (late.py)
             self._released.append((ev, stamped, {k: outs[k] for k in self._topic_io[ev.topic][1] if k in outs}, state))
