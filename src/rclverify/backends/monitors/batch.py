@@ -194,9 +194,11 @@ class _Run:
         self.node_topics = frozenset(self.kinds)
         m = self.m
         #: surely violated answers are judged in batches too once nothing renders them: one guarantee (its first
-        #: false one is the only one judged), no verdict callback, no transport skew (closing.py: a violation
-        #: past the kept records is only counted)
-        self.wrong = len(m.guarantees) == 1 and m.on_verdict is None and not m.stream.skew
+        #: false one is the only one judged), no verdict callback (closing.py: a violation past the kept records
+        #: is only counted); with a transport skew, only those released within their run (_released)
+        self.wrong = len(m.guarantees) == 1 and m.on_verdict is None
+        #: a violated answer of a guarantee on a question is held for the skew (an output-only one is not)
+        self.held = bool(m.stream.skew) and not m._alone
 
     def _full(self) -> bool:
         """Whether the run's violation records are full: a further violation is only counted."""
@@ -345,6 +347,8 @@ class _Run:
             if b > p and m._held:  # an output held for the skew: batch only up to the event that releases it
                 limit = m._held[0][1] + m.stream.skew
                 b = p + int(np.searchsorted(times[at[p:b] + 1], limit, side="right"))
+            if b > p and full and wrong is not None and self.held:
+                b = self._released(at, times, wrong, p, b)
             if b > p and self._quiet(times[at[p]]):
                 self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times,
                                 [(v[p:b], a[p:b]) for v, a in margins], wrong[p:b] if full and wrong is not None
@@ -357,6 +361,21 @@ class _Run:
             feed(chunk[i + 1])
             p += 1
         return int(at[-1]) + 2
+
+    def _released(self, at: np.ndarray, times: np.ndarray, wrong: np.ndarray, p: int, b: int) -> int:
+        """The end of the run of pairs ``p:b`` whose violated answers the engine would have
+        released (judged) within it: a violated output is held for the transport skew and
+        released at the first event later than its stamp plus the skew (the questions within
+        the skew after it are the run's, each answered by its own output); a run ending
+        within the skew of one stops before it."""
+        skew = self.m.stream.skew
+        while b > p:
+            outs = times[at[p:b] + 1]
+            held = np.flatnonzero(wrong[p:b] & (outs + skew >= outs[-1]))
+            if not len(held):
+                break
+            b = p + int(held[0])
+        return b
 
     def _margins(self, chunk: EventRows | BlockRows, at: np.ndarray,
                  margins: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
@@ -460,7 +479,13 @@ class _Run:
         # the answers' entries (the skew's, late.py's), each event made if the engine reads it (answered.py)
         recent = m._recent
         assert recent.maxlen is not None  # the engine keeps a bounded deque
-        outs = at[-recent.maxlen:] + 1
+        if bad and wrong is not None and self.held:  # a violated output is held for the skew, then kept as released (engine.py)
+            released = at[wrong][-recent.maxlen:] + 1
+            m._released.extend(map(RecentOutput, repeat(chunk), released.tolist(), times[released].tolist(),
+                                   repeat(okey), repeat(ofield)))
+            outs = at[~wrong][-recent.maxlen:] + 1
+        else:
+            outs = at[-recent.maxlen:] + 1
         recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
                           repeat(ofield)))
         values = m.values
