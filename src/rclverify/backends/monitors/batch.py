@@ -14,9 +14,9 @@ surely true in exact arithmetic their ``satisfied`` verdict directly.  A
 row surely violated (assumptions surely true, the one guarantee surely
 false, its margin negative) is counted directly too once the run's
 :data:`~.verdicts.KEPT_VIOLATIONS` violation records are full and no
-verdict callback is given, without a transport skew: the engine would only
-count it (closing.py); before that the engine renders its values and
-reason.  Every other event (an input with no answer, a late or duplicated
+verdict callback is given: the engine would only count it (closing.py);
+before that the engine renders its values and reason.  With a transport
+skew, only one the engine would release within the run (:meth:`_Run._released`).  Every other event (an input with no answer, a late or duplicated
 answer, a value that does not map, a formula near a boundary, a message of
 another topic) goes through the streaming engine (:class:`~.engine.NodeMonitor`,
 its ``feed``) exactly as :func:`~.check.check_trace` would feed it, so its
