@@ -74,9 +74,10 @@ def _columns(x: Any) -> Any:
     return ColumnTrace(topic, times, {"raw": {"data": limit}, "level": {"data": x}}, "synthetic", ["raw", "level", "tick"])
 
 
-def rclverify(x: Any, contract: str = CONTRACT, collect: bool = True) -> tuple[float, list[float], float]:
-    """CPU s of ``check_trace`` with margins on ``contract``, every answer's margin (an untimed run; none
-    unless ``collect``), the smallest kept."""
+def rclverify(x: Any, contract: str = CONTRACT, collect: bool = True, skew: float = 0.0) -> tuple[float, list[float],
+                                                                                               float]:
+    """CPU s of ``check_trace`` with margins on ``contract`` (``skew``: the mapping's transport skew, s), every
+    answer's margin (an untimed run; none unless ``collect``), the smallest kept."""
     from rclverify.backends.monitors.check import check_trace
     from rclverify.lang.parser import parse_text
     from rclverify.lang.typecheck import check
@@ -84,6 +85,7 @@ def rclverify(x: Any, contract: str = CONTRACT, collect: bool = True) -> tuple[f
     checked = check([parse_text(contract)])
     node = checked.nodes["Level"]
     rules = load_rules({"raw": {"fields": ["data"]}, "level": {"fields": ["data"]}})
+    rules.skew = skew
     check_trace(checked, [node], _columns(x[:10]), rules, HORIZON, margins=True)
     cpu = math.inf
     for _ in range(REPEAT):
@@ -147,21 +149,21 @@ def _agree(mine: list[float], theirs: list[float]) -> str:
     return f"{len(mine) - len(bad)}/{len(mine)}" + (f" (first difference at sample {bad[0]})" if bad else "")
 
 
-def race(n: int, seed: int, wrong: float) -> bool:
-    """Print each tool's samples per CPU second and whether its robustness agrees, formula by formula;
-    True when all agree."""
+def race(n: int, seed: int, wrong: float, skew: float = 0.0) -> bool:
+    """Print each tool's samples per CPU second and whether its robustness agrees, formula by formula
+    (``skew``: rclverify's transport skew, s); True when all agree."""
     x = samples(n, seed, wrong)
     ok = True
-    print(f"margins against robustness: {n} samples, {wrong:g} of them below 1, seed {seed}")
+    print(f"margins against robustness: {n} samples, {wrong:g} of them below 1, seed {seed}, skew {skew:g} s")
     print(f"{'formula, tool':<40} {'samples/s':>11}  per-sample robustness agrees with rclverify's margins; min")
     for formula, (guarantee, *_) in FORMULAS.items():
-        cpu, mine, least = rclverify(x, NODE.format(guarantee))
+        cpu, mine, least = rclverify(x, NODE.format(guarantee), skew=skew)
         print(f"{formula + ', rclverify batch':<40} {n / cpu:>11.0f}  -; smallest margin {least:.12g} "
               f"(of every answer's: {min(mine):.12g})")
         ok = ok and least == min(mine)
         if formula == "G(x > 1)":
             ok = ok and least == float(x.min()) - 1.0
-            acpu, _, aleast = rclverify(x, ALONE, collect=False)
+            acpu, _, aleast = rclverify(x, ALONE, collect=False, skew=skew)
             ok = ok and aleast == least
             print(f"{formula + ', rclverify output-only':<40} {n / acpu:>11.0f}  -; smallest margin {aleast:.12g} "
                   f"(out.x > 1, reading no input)")

@@ -401,6 +401,8 @@ def main() -> int:
     ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI); then the margins race on 1,000")
     ap.add_argument("--margins", action="store_true",
                     help="only the margins race: G(x > 1) on --samples (bench/_margin_peers.py)")
+    ap.add_argument("--skew", type=float, default=0.0, metavar="S",
+                    help="with --margins: the mapping's transport skew for rclverify, s (the command's default: 0.02)")
     ap.add_argument("--no-bags", action="store_true", help="leave out the command on the sqlite3 and MCAP bags")
     ap.add_argument("--repeat", type=int, default=1, metavar="K",
                     help="run the command on the log and the bags, its start-up, the readings and the columns path K times; keep "
@@ -415,7 +417,7 @@ def main() -> int:
         return child(args)
     if args.margins:  # bench/_margin_peers.py: rclverify's margins against the peers' robustness
         from _margin_peers import race
-        return 0 if race(1_000 if args.smoke else args.samples, args.seed, args.wrong) else 1
+        return 0 if race(1_000 if args.smoke else args.samples, args.seed, args.wrong, args.skew) else 1
     if args.smoke:
         args.samples = 2_000
     print(f"{args.samples} samples (a reading and its answer each), {args.wrong:g} of the answers wrong, "
