@@ -6,7 +6,7 @@ assumption bounds (``forall(q in in.position | -3.14 <= q and q <= 3.14)``)
 is drawn with every item inside the bounds and the bounds' ends among the
 items, by construction: no drawn example is filtered away.  A joint guard
 that takes ``max`` where it should take ``min`` fails within the default
-number of examples, at the line that computed the output; its correct twin
+number of examples, at the line with the slip; its correct twin
 passes.  The plan's ``bounds`` of a sequence input bound its items, with
 their ends and their neighbours inside drawn.  The property tests read the
 field widths from the mapping the plan names (a ``monitors`` entry's
@@ -69,7 +69,7 @@ def _guard_run(tmp: Path, code: str, assume: str | None = None, **entry: Any) ->
 
 
 def test_a_max_for_min_over_a_float64_sequence_is_found_and_its_twin_passes(tmp_path: Path) -> None:
-    """Default examples (200), default seed: the slip fails at the line that computed the output; the
+    """Default examples (200), default seed: the slip fails at the line with the slip; the
     correct code passes with every drawn example kept (before: 2369 drawn for 200 kept)."""
     (tmp_path / "slip").mkdir()
     (tmp_path / "good").mkdir()

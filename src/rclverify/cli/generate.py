@@ -59,20 +59,21 @@ def cmd_ros2(args: argparse.Namespace) -> int:
 
 
 def monitor_rules(ws: Path, plan: str) -> tuple[Any, Any]:
-    """The monitors' mapping rules by topic and declared tolerance of workspace ``ws``: from the
-    first ``monitors`` evidence entry of the plan naming a ``mapping`` (its ``tolerance``
-    overriding the file's; not the ``rclverify_mapping.yaml`` this command writes), else the default mapping file (``backends/monitors/mapping.yaml``,
-    absent: no rules).  Raises ``ConfigError`` (located) for a malformed mapping file."""
+    """The monitors' mapping rules by topic and declared tolerance of workspace ``ws``: the plan's one
+    mapping file (:func:`~rclverify.model.plan.mapping_file.plan_mapping`; not the
+    ``rclverify_mapping.yaml`` this command writes, whose rules are read from the one before it), else
+    the default mapping file (``backends/monitors/mapping.yaml``, absent: no rules); the tolerance of
+    the first ``monitors`` entry stating one overrides the file's.  Raises ``ConfigError`` (located)
+    for a malformed mapping file."""
     from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (loads lark, yaml and more only when called)
     from rclverify.model.plan.load import load_plan  # deferred: start-up (loads yaml, rclverify.lang and more only when called)
-    rel, tol = None, None
+    from rclverify.model.plan.mapping_file import plan_mapping  # deferred: start-up (only when called)
     p = load_plan(ws, plan)
-    for e in (e for es in p.evidence.values() for e in es if e.backend == "monitors"):
-        mapping = e.config.get("mapping")
-        if mapping and Path(str(mapping)).name == "rclverify_mapping.yaml":
-            continue  # the one this command writes (the plan fragment's): it reads the rules, not them
-        if mapping or e.config.get("tolerance") is not None:
-            rel, tol = e.config.get("mapping"), e.config.get("tolerance")
-            break
+    entries = [e for es in p.evidence.values() for e in es if e.backend == "monitors"]
+    rel = plan_mapping(p)
+    if rel is not None and Path(rel).name == "rclverify_mapping.yaml":  # the one this command writes
+        rel = next((str(m) for e in entries if (m := e.config.get("mapping"))
+                    and Path(str(m)).name != "rclverify_mapping.yaml"), None)
+    tol = next((e.config.get("tolerance") for e in entries if e.config.get("tolerance") is not None), None)
     cfg = load_mapping(ws, rel, tolerance=tol)
     return cfg.rules, cfg.tolerance

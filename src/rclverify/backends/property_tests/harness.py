@@ -353,7 +353,7 @@ class GuaranteeRun:
                 return unconfirmed
             cause = self.last_failure.get("cause")
             return Outcome("failed", f"{self.last_failure['reason']} on the {'example' if moved else 'shrunk example'} "
-                           f"{_example_text(self.last_failure)}" + (f" (the implementation line that computed the output: {cause})"
+                           f"{_example_text(self.last_failure)}" + (f" (the implementation line where the failing example goes wrong: {cause})"
                                                                     if cause else ""),
                            self.counts, self.last_failure, sorted(self.unknown))
         except (FailedHealthCheck, Unsatisfiable) as exc:

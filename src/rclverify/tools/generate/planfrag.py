@@ -63,8 +63,8 @@ def mapped_topics(nodes: list[NodePackage], rules: Mapping[str, TopicRule] | Non
                 continue
             why = (f"{end.ros_type} has several fields and no mapping rule names the one {np.ros_name}'s {w.var} "
                    f"reads; the monitors would read its first top-level field of the variable's type, which "
-                   f"may be another quantity: name it in backends/monitors/mapping.yaml "
-                   f"('{topic}: {{fields: [<field>]}}') and generate again")
+                   f"may be another quantity: name it in the plan's mapping file (backends/monitors/mapping.yaml "
+                   f"by default; '{topic}: {{fields: [<field>]}}') and generate again")
             item = {"topic": topic, "type": end.ros_type, "var": f"{np.ros_name}.{w.var}", "why": why}
             if item not in omitted:
                 omitted.append(item)
