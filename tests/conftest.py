@@ -86,7 +86,7 @@ SECONDS: dict[str, float] = {
     "test_paths_rechecked": 3.5, "test_ros2_bag_calls": 7.0, "test_nodl_live": 4.0,
     "test_definedness": 6.6, "test_run_identity": 5.0,
     "test_ros2_declared_types": 10.0, "test_ros2_call_endpoints": 4.0, "test_widths_forms": 2.5,
-    "test_margins_batch": 2.2, "test_example_manipulator": 3.0, "test_ros2_event_time": 3.0, "test_widths_paths": 3.3,
+    "test_margins_batch": 3.6, "test_example_manipulator": 3.0, "test_ros2_event_time": 3.0, "test_widths_paths": 3.3,
     "test_property_tests_plugins": 4.2, "test_numeric": 4.1, "test_startup_cache": 3.7,
     "test_refinement_oracle": 3.6, "test_diagnosis_stage": 3.0, "test_widths_ints": 2.7,
     "test_sequences_of_messages": 2.5, "test_layers": 2.5, "test_trace_fifo": 2.1,
