@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.backends.monitors.engine import node_topics
+from rclverify.backends.monitors.node_topics import node_topics
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.lang.errors import RclError
 from rclverify.lang.parser import parse_text

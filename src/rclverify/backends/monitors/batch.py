@@ -54,9 +54,8 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
 from rclverify.traces.questions import KEPT, Question, QuestionStream
 from rclverify.backends.monitors.answered import AnsweredRun, RecentOutput
-from rclverify.semantics.robustness import atom_words
-from rclverify.targets.column_margins import ColumnMargin, MarginCompiler
-from rclverify.targets.columns import ColumnCompiler, Unsupported, io_kind, seed
+from rclverify.targets.columns import seed
+from rclverify.backends.monitors.batch_plan import BatchPlan, batch_plan
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS, KEPT_VIOLATIONS, NodeResult, Verdict
@@ -64,64 +63,6 @@ from rclverify.backends.monitors.verdicts import KEPT_MARGINS, KEPT_VIOLATIONS, 
 #: Events read per chunk: the columns held at once.
 CHUNK = 16384
 _EMPTY: Mapping[str, int] = {}
-
-
-class BatchPlan:
-    """What the batch path needs of an eligible node's monitor ``m``: its input
-    topics (topic -> (key, field, kind)), its output topic and key, the
-    compiled assumptions and guarantees."""
-
-    def __init__(self, m: NodeMonitor, rules: Mapping[str, TopicRule], compiler: ColumnCompiler) -> None:
-        self.m = m
-        self.inputs: dict[str, tuple[str, str, str]] = {}
-        self.output: tuple[str, str, str, str] = ("", "", "", "")
-        for topic, vs in m.topics.items():
-            (key, typ, is_input), = vs
-            rule = rules.get(topic)
-            kind = io_kind(typ)
-            if rule is None or len(rule.fields) != 1 or not rule.fields[0].isidentifier() or rule.state or \
-                    kind is None:  # a field path is read by the general mapper: every message would be streamed
-                raise Unsupported(f"topic {topic}: not one REAL/enumeration field named at the top level")
-            if is_input:
-                self.inputs[topic] = (key, rule.fields[0], kind)
-            elif self.output[0]:
-                raise Unsupported("more than one output topic")
-            else:
-                self.output = (topic, key, rule.fields[0], kind)
-        self.keys = [k for k, _, _ in self.inputs.values()]
-        #: the message fields the columns read (a log read in blocks decodes them: rows.py)
-        self.fields = [f for _, f, _ in self.inputs.values()] + [self.output[2]]
-        if not self.output[0] or not self.inputs or len(set(self.keys)) != len(self.keys) or \
-                sorted(self.keys) != sorted(m._in_keys) or not set(m.needed_inputs) <= set(self.keys):
-            raise Unsupported("inputs and output not one topic each")
-        #: enumeration-valued keys -> the code of each value of their type (a value of no other type)
-        self.enums = {key: {v: compiler.codes[v] for v in typ.values if v in compiler.codes}
-                      for vs in m.topics.values() for key, typ, _ in vs if io_kind(typ) == "enum"}
-        self.codes = compiler.codes
-        self.formulas = [compiler.compile(f) for f in m.assumption + m.guarantees]
-        self.asked = set(m._asked)
-        #: with margins: each guarantee's margin over the columns, and the (text, unit) of each deciding comparison
-        self.margins: list[ColumnMargin] = []
-        self.atoms: list[tuple[str, str]] = []
-        if m.margins:
-            margins = MarginCompiler(compiler)
-            self.margins = [margins.compile(g) for g in m.guarantees]
-            self.atoms = [atom_words(m.checked, m.node, e, i) for e, i in margins.atoms]
-
-
-def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | None:
-    """The batch plan of monitor ``m`` when its node is eligible (module docstring), else ``None``."""
-    node = m.node
-    ks = range(1, len(m.guarantees) + 1)
-    if node.node.links or m._trigger or m._state_outs or not m.has_inputs or m.unbound or \
-            m._ask_at_question or any(len(vs) != 1 for vs in m.topics.values()) or \
-            any(not m._reads_out[k] for k in ks) or sorted(m._asked + m._alone) != list(ks):
-        return None
-    try:
-        plan = BatchPlan(m, rules, ColumnCompiler(m.checked, node))
-    except (Unsupported, ValueError):
-        return None
-    return plan
 
 
 def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], rules: Mapping[str, TopicRule],
@@ -420,8 +361,8 @@ class _Run:
         """The pairs at ``at`` are surely satisfied, or surely violated where ``wrong``
         (then only counted: :attr:`wrong`): their verdicts (with their margins,
         ``margins``: per guarantee its values and deciding atoms), and the engine's state as feeding them sets it."""
-        plan, m = self.plan, self.m
-        h, okey, keys = m.horizon, plan.output[1], plan.keys
+        m = self.m
+        h = m.horizon
         n = len(at)
         self.batched += n
         t_first = float(times[at[0]])  # the chunk's time column holds each event's time: no event made for it
@@ -444,7 +385,6 @@ class _Run:
             result.counts["violated"] += bad
             result.violations_dropped += bad
         result.accepted += n
-        ofield = plan.output[2]
         least = self._margins(chunk, at, margins) if margins else None
         if m.on_verdict is not None:
             name, emit = m.node.name, m.on_verdict
@@ -452,9 +392,15 @@ class _Run:
                 qe, ev = chunk[i], chunk[i + 1]
                 emit(Verdict(name, "satisfied", ev.index, ev.time, ev.where, ev.topic, ev.time, 0, {}, "", "exact",
                              qe.where, float(least[j]) if least is not None else None))
-        # the questions the stream keeps (the newest made now, the older ones when the engine may look them
-        # up: _materialise), and the outputs the engine remembers for the transport skew
-        stream = m.stream
+        newest = self._keep_questions(chunk, at, src, times)
+        self._remember_outputs(chunk, at, times, wrong, bad, newest)
+
+    def _keep_questions(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
+                        times: np.ndarray) -> Question:
+        """The stream's questions after the pairs at ``at``, as feeding them keeps them (the
+        newest made now, the older ones when the engine may look them up); returns the newest."""
+        m, n = self.m, len(at)
+        stream = m.stream  # the older questions are made when the engine may look them up: _materialise
         old = len(stream._questions)
         total = old + n
         keptn = total if total <= 2 * KEPT else KEPT + 1 + (total - 2 * KEPT - 1) % KEPT
@@ -476,6 +422,15 @@ class _Run:
             left = _kept(stream).count(None)  # the ghosts the stream still keeps: the latest of them
             while self.ghosts and sum(len(g.at) - 1 for g in self.ghosts[1:]) >= left:
                 del self.ghosts[0]
+        return newest
+
+    def _remember_outputs(self, chunk: EventRows | BlockRows, at: np.ndarray, times: np.ndarray,
+                          wrong: np.ndarray | None, bad: int, newest: Question) -> None:
+        """The engine's state after the pairs at ``at`` (``bad`` of them violated, where
+        ``wrong``): the outputs it remembers for the transport skew, the values, the clock and
+        the watched question, as feeding them sets them."""
+        plan, m = self.plan, self.m
+        okey, keys, ofield = plan.output[1], plan.keys, plan.output[2]
         # the answers' entries (the skew's, late.py's), each event made if the engine reads it (answered.py)
         recent = m._recent
         assert recent.maxlen is not None  # the engine keeps a bounded deque

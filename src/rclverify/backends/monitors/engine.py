@@ -47,7 +47,8 @@ from rclverify.backends.monitors.judging import Judging
 from rclverify.backends.monitors.late import Late
 from rclverify.backends.monitors.needs_answer import answer_decides
 from rclverify.backends.monitors.outcome import Outcome, combine, skew_reason
-from rclverify.backends.monitors.verdicts import LINK_TOPICS, NodeResult, Verdict, in_all, names, reads
+from rclverify.backends.monitors.node_topics import node_topics
+from rclverify.backends.monitors.verdicts import NodeResult, Verdict, in_all, names, reads
 
 if TYPE_CHECKING:
     from rclverify.backends.monitors.answered import Recent
@@ -69,7 +70,7 @@ class NodeMonitor(Judging, Closing, Late):
     ``horizon`` is in seconds; ``tolerance`` overrides the rules'.  Every
     formula is judged by :func:`rclverify.semantics.floatsem.judge` (exact,
     double, tolerance).  The node's topics are its ``topics(...)`` and the
-    parts of its service and action links (:data:`LINK_TOPICS`)."""
+    parts of its service and action links (:data:`~.verdicts.LINK_TOPICS`)."""
 
     #: Evaluations remembered per (formula, inputs, outputs); 0 turns the cache off.
     cache_size = 4096
@@ -470,33 +471,4 @@ class NodeMonitor(Judging, Closing, Late):
         return self.result
 
 
-def node_topics(node: CheckedNode) -> tuple[dict[str, list[tuple[str, Any, bool]]], dict[tuple[str, str], str]]:
-    """The topics that carry ``node``'s variables: topic (no leading ``/``) ->
-    ``[(key, type, is_input)]`` with ``key`` ``in.x``/``out.x``, from its
-    ``topics(...)`` and the parts of its service and action links
-    (:data:`LINK_TOPICS`); and ``(topic, key)`` -> the actionlib part of the
-    message that maps to the variable."""
-    topics: dict[str, list[tuple[str, Any, bool]]] = {}
-    for t in node.node.topics:
-        if t.match is None:
-            continue
-        typ = node.io_type(t.match)
-        if typ is None:
-            continue
-        is_input = t.match.prefix == "in" or (t.match.prefix is None and t.match.name in node.inputs)
-        key = ("in." if is_input else "out.") + t.match.name
-        topics.setdefault(t.field.lstrip("/"), []).append((key, typ, is_input))
-    parts: dict[tuple[str, str], str] = {}
-    for lk in node.node.links:
-        for suffix, v in zip(LINK_TOPICS.get(lk.kind, ()), lk.parts):
-            typ = node.io_type(v)
-            if typ is None or v.prefix not in ("in", "out"):
-                continue
-            topic, key = f"{lk.name.lstrip('/')}/{suffix}", f"{v.prefix}.{v.name}"
-            topics.setdefault(topic, []).append((key, typ, v.prefix == "in"))
-            if lk.kind == "action":
-                parts[(topic, key)] = suffix
-    return topics, parts
-
-
-__all__ = ["NodeMonitor", "node_topics"]
+__all__ = ["NodeMonitor"]

@@ -1,0 +1,73 @@
+"""What the offline batch path needs of a node's monitor, and whether the
+node is eligible (:func:`batch_plan`; the rule is :mod:`.batch`'s module
+docstring, "Eligible")."""
+from __future__ import annotations
+
+from typing import Mapping
+
+from rclverify.traces.mapping import TopicRule
+from rclverify.semantics.robustness import atom_words
+from rclverify.targets.column_margins import ColumnMargin, MarginCompiler
+from rclverify.targets.columns import ColumnCompiler, Unsupported, io_kind
+from rclverify.backends.monitors.engine import NodeMonitor
+
+
+class BatchPlan:
+    """What the batch path needs of an eligible node's monitor ``m``: its input
+    topics (topic -> (key, field, kind)), its output topic and key, the
+    compiled assumptions and guarantees."""
+
+    def __init__(self, m: NodeMonitor, rules: Mapping[str, TopicRule], compiler: ColumnCompiler) -> None:
+        self.m = m
+        self.inputs: dict[str, tuple[str, str, str]] = {}
+        self.output: tuple[str, str, str, str] = ("", "", "", "")
+        for topic, vs in m.topics.items():
+            (key, typ, is_input), = vs
+            rule = rules.get(topic)
+            kind = io_kind(typ)
+            if rule is None or len(rule.fields) != 1 or not rule.fields[0].isidentifier() or rule.state or \
+                    kind is None:  # a field path is read by the general mapper: every message would be streamed
+                raise Unsupported(f"topic {topic}: not one REAL/enumeration field named at the top level")
+            if is_input:
+                self.inputs[topic] = (key, rule.fields[0], kind)
+            elif self.output[0]:
+                raise Unsupported("more than one output topic")
+            else:
+                self.output = (topic, key, rule.fields[0], kind)
+        self.keys = [k for k, _, _ in self.inputs.values()]
+        #: the message fields the columns read (a log read in blocks decodes them: rows.py)
+        self.fields = [f for _, f, _ in self.inputs.values()] + [self.output[2]]
+        if not self.output[0] or not self.inputs or len(set(self.keys)) != len(self.keys) or \
+                sorted(self.keys) != sorted(m._in_keys) or not set(m.needed_inputs) <= set(self.keys):
+            raise Unsupported("inputs and output not one topic each")
+        #: enumeration-valued keys -> the code of each value of their type (a value of no other type)
+        self.enums = {key: {v: compiler.codes[v] for v in typ.values if v in compiler.codes}
+                      for vs in m.topics.values() for key, typ, _ in vs if io_kind(typ) == "enum"}
+        self.codes = compiler.codes
+        self.formulas = [compiler.compile(f) for f in m.assumption + m.guarantees]
+        self.asked = set(m._asked)
+        #: with margins: each guarantee's margin over the columns, and the (text, unit) of each deciding comparison
+        self.margins: list[ColumnMargin] = []
+        self.atoms: list[tuple[str, str]] = []
+        if m.margins:
+            margins = MarginCompiler(compiler)
+            self.margins = [margins.compile(g) for g in m.guarantees]
+            self.atoms = [atom_words(m.checked, m.node, e, i) for e, i in margins.atoms]
+
+
+def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | None:
+    """The batch plan of monitor ``m`` when its node is eligible (module docstring), else ``None``."""
+    node = m.node
+    ks = range(1, len(m.guarantees) + 1)
+    if node.node.links or m._trigger or m._state_outs or not m.has_inputs or m.unbound or \
+            m._ask_at_question or any(len(vs) != 1 for vs in m.topics.values()) or \
+            any(not m._reads_out[k] for k in ks) or sorted(m._asked + m._alone) != list(ks):
+        return None
+    try:
+        plan = BatchPlan(m, rules, ColumnCompiler(m.checked, node))
+    except (Unsupported, ValueError):
+        return None
+    return plan
+
+
+__all__ = ["BatchPlan", "batch_plan"]
