@@ -1,6 +1,6 @@
 """How the proof of a bounded response scales when k-induction alone cannot finish it (issue 64).
 
-The system is the one-node planner of tests/test_temporal_pdr.py, built as a
+The system is the one-node planner of tests/calculus/test_temporal_pdr.py, built as a
 transition system directly: a cycle counter ``c`` from 0 that wraps at ``W``
 (above ``W``, a state no run reaches, it counts on for ever), and the
 requirement

@@ -216,7 +216,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--isolated", action="store_true", help="workers in their own working folders that never read "
                                                             "the workspace's folder (as on other machines)")
     ap.add_argument("--smoke", action="store_true", help="N = 12, local, no property tests (CI; the cluster "
-                                                         "path is tests/test_cluster.py's)")
+                                                         "path is tests/app/test_cluster.py's)")
     args = ap.parse_args(argv)
     if args.smoke:
         args.sizes, args.workers, args.property_tests, args.deadlines, args.services = "12", "0", 0, 6, 5

@@ -26,7 +26,7 @@ as_root() {
 #   ROS 1 (ros-core ...)     a real ROS master and rospy nodes for the live monitor and the graph read
 #                            from a running system; message definitions for grounding
 #   chromium(-driver)        the browser test of the HTML report
-#   neovim                   the language server's test in a real editor (tests/test_lsp_nvim.py)
+#   neovim                   the language server's test in a real editor (tests/tools/test_lsp_nvim.py)
 DEBIAN_PACKAGES=(
   dafny graphviz spin gcc
   ros-core python3-rospy python3-rosbag python3-rosgraph python3-roslaunch python3-genpy python3-catkin-pkg
@@ -88,14 +88,14 @@ if [ "${1:-}" = "--tests" ]; then extras=all,test,dev; fi
 echo "setup: installing rclverify[$extras] into $VENV"
 "$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[$extras]"
 # --tests: the monitors' peers of the bench extra (RTAMT, Reelay, mstlo: pyproject.toml), at the versions
-# constraints.txt pins, which tests/test_margins_peers.py compares the margins with (RTAMT's parser runtime,
+# constraints.txt pins, which tests/semantics/test_margins_peers.py compares the margins with (RTAMT's parser runtime,
 # antlr4-python3-runtime 4.7, is a source archive: pip builds it, pure Python).  Optional: without them that
 # test is skipped with the reason.
 if [ "${1:-}" = "--tests" ]; then
   echo "setup: installing RTAMT, Reelay and mstlo into $VENV"
   "$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt \
       "rtamt>=0.4.10,<0.5" "reelay>=25.0.0,<26" "mstlo-python>=0.2.2,<0.3" \
-    || echo "setup: RTAMT, Reelay or mstlo could not be installed; tests/test_margins_peers.py skips it with the reason"
+    || echo "setup: RTAMT, Reelay or mstlo could not be installed; tests/semantics/test_margins_peers.py skips it with the reason"
 fi
 # The package's bytecode, compiled once here: an editable install compiles nothing, and a shell
 # with PYTHONDONTWRITEBYTECODE set would otherwise compile every module in every doit process.
@@ -123,7 +123,7 @@ if [ "${1:-}" = "--tests" ] || [ "${1:-}" = "--ros2" ]; then
 fi
 
 # --tests: the test modules' bytecode with pytest's assertion rewriting, written once here into
-# tests/__pycache__.  Where PYTHONDONTWRITEBYTECODE is set, pytest writes none, and each of the
+# each test folder's __pycache__.  Where PYTHONDONTWRITEBYTECODE is set, pytest writes none, and each of the
 # suite's three workers rewrote every test module again (about 5 CPU s each); it reads what is
 # here whether or not it may write.
 if [ "${1:-}" = "--tests" ]; then

@@ -1,6 +1,6 @@
 """Reading the report of an example workspace (examples/warehouse, examples/delivery): its
 problem rows, their first repairs, a fix's changed lines, a node's monitored run.  Shared by
-tests/test_example_warehouse.py and tests/test_example_delivery.py."""
+tests/examples/test_example_warehouse.py and tests/examples/test_example_delivery.py."""
 from __future__ import annotations
 
 import json

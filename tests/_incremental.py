@@ -1,7 +1,7 @@
 """Incremental equals clean: a workspace, the edits a user makes to it, and
 the comparison of an incremental ``doit verify`` with a from-scratch one.
 
-Used by ``tests/test_incremental_equivalence.py`` (a few sequences, driven by
+Used by ``tests/app/test_incremental_equivalence.py`` (a few sequences, driven by
 Hypothesis) and by ``bench/incremental_equivalence.py`` (hundreds).  The
 workspace is the case study cut down to what runs in a few seconds: the
 four-node rover contracts, its requirements and environment facts, and one

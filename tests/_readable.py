@@ -1,6 +1,6 @@
 """Issue 48's readability check on a report's counterexamples, shared by the
-examples' tests (the case study in tests/test_pipeline_e2e.py, the delivery
-robot in tests/test_example_delivery.py): each failed side condition's
+examples' tests (the case study in tests/report/test_pipeline_e2e.py, the delivery
+robot in tests/examples/test_example_delivery.py): each failed side condition's
 values short and of the nodes it involves (the cone, in context), an input
 outside its node's assumption said so; each refuted requirement's values
 short, of its cone, within the assumptions or with the note saying why

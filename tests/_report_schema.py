@@ -1,7 +1,7 @@
 """Checking an assurance report against its published schema and the status vocabulary.
 
-Shared by tests/test_report_schema.py and the tests that verify a whole
-workspace (tests/test_pipeline_e2e.py, the examples' tests): each hands the
+Shared by tests/report/test_report_schema.py and the tests that verify a whole
+workspace (tests/report/test_pipeline_e2e.py, the examples' tests): each hands the
 reports it already built to :func:`check_report`, so no workspace is verified
 twice for this check.
 """

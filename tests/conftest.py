@@ -30,12 +30,12 @@ seconds belongs in :data:`SLOW` and here.
 
 Memory.  A test module keeps what it computes once in a module-scoped
 fixture, never in a cache of the module: a worker runs many modules, and what
-a module cache holds (tests/test_rooms.py held the package's syntax trees, two
+a module cache holds (tests/project/test_rooms.py held the package's syntax trees, two
 million objects) is walked by every later full garbage collection of the
 worker, and by the five pytest makes at its end.  The suite freezes nothing
 itself: rclverify's own heap handling (``core/cache/heap.py``) freezes and
 gives back the whole heap of a process around an in-process doit run, and
-tests/test_heap.py checks it from an unfrozen start.
+tests/core/test_heap.py checks it from an unfrozen start.
 """
 from __future__ import annotations
 
@@ -158,7 +158,7 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "tests"))
 
 # A pipeline run without ``-n`` uses one doit process per CPU (app/jobs.py).  The suite's three
 # workers already fill the two cores, so its runs stay serial unless a test asks for more (``-n 2``,
-# or RCLVERIFY_JOBS in the test's own environment: tests/test_jobs.py): the same CPU seconds, and
+# or RCLVERIFY_JOBS in the test's own environment: tests/app/test_jobs.py): the same CPU seconds, and
 # doit's task lines in their serial order, which several tests read.  Subprocesses inherit it.
 os.environ.setdefault("RCLVERIFY_JOBS", "1")
 

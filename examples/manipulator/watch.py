@@ -2,7 +2,7 @@
 ``rclverify monitor --live --ros2 --strict`` (in the project's Python),
 optionally with CPU-burning processes beside it, everything on loopback.
 
-Used by tests/test_example_manipulator.py and bench/manipulator_live.py::
+Used by tests/examples/test_example_manipulator.py and bench/manipulator_live.py::
 
     from watch import watch
     result = watch(tmp, ros2_python, env, source="rclpy", defects="", record=True, burners=2)

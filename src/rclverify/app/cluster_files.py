@@ -23,7 +23,7 @@ not, the job runs in a copy in the worker's own working folder:
 
 The evidence record names files by their workspace-relative paths and hashes
 their contents, so a job run in a copy gives the record a run in place gives
-(timing fields aside; tests/test_cluster.py).  Decisions: docs/scale.md,
+(timing fields aside; tests/app/test_cluster.py).  Decisions: docs/scale.md,
 "Workers that do not share the file system".
 """
 from __future__ import annotations

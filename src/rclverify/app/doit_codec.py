@@ -10,7 +10,7 @@ with msgspec's JSON decoder (26-42 ms against 64-78 ms for those texts)
 and, for a text msgspec refuses (``NaN``, ``Infinity``, a
 number beyond a double, an unpaired surrogate: what Python's ``json``
 accepts and RFC 8259 does not), with the standard library's, so every text
-decodes to the value doit's codec gives (tests/test_doit_codec.py).
+decodes to the value doit's codec gives (tests/app/test_doit_codec.py).
 :func:`rclverify.app.tasks.doit_config` hands it to doit as ``codec_cls``.
 """
 from __future__ import annotations

@@ -6,7 +6,7 @@ task dependencies that file dependencies imply (docs/decisions.md, "doit");
 disk) into one plain line; :func:`release_in_order` makes ``doit -n N``
 start the tasks that waited for one task in the order they began to wait.  Each checks the doit method it wraps or replaces
 (``pyproject.toml`` pins the doit versions it was checked against;
-tests/test_tasks_doit.py holds the replacement equal to doit's own).
+tests/app/test_tasks_doit.py holds the replacement equal to doit's own).
 """
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ def linear_implicit_task_dep(targets: dict[str, str], task: Any, deps_list: Sequ
 def use_linear_implicit_task_dep() -> None:
     """Install :func:`linear_implicit_task_dep` in doit (idempotent), when
     doit's own has the signature it replaces (``pyproject.toml`` pins the
-    doit versions it was checked against; ``tests/test_tasks_doit.py``
+    doit versions it was checked against; ``tests/app/test_tasks_doit.py``
     compares the two)."""
     from doit.control import TaskControl  # deferred: start-up (loads doit only when called)
     current = TaskControl.add_implicit_task_dep

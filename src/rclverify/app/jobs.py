@@ -7,7 +7,7 @@ study's cold run took 23.9 s serially and 14.2 s in two processes, for the
 same CPU seconds (21.5 and 21.3; docs/scale.md, "Standing decisions").  The
 verdicts and reports do not depend on the number of processes (each stage
 starts from a fresh Z3 context and writes its own records;
-``tests/test_pipeline_e2e.py`` holds a parallel run against the serial one).
+``tests/report/test_pipeline_e2e.py`` holds a parallel run against the serial one).
 
 ``RCLVERIFY_JOBS=N`` (a whole number, at least 1) sets the default instead,
 for a CI job that shares its machine or a test suite that counts CPU

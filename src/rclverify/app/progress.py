@@ -94,7 +94,7 @@ def whole_lines() -> None:
     set in many CI images), ``print`` wrote a line's text and its newline in
     two ``write`` calls.  Either way another process's line landed inside
     one, e.g. a problem line of the summary followed by ``.  verify`` on the
-    same line (tests/test_jobs.py).  Called before doit forks its workers,
+    same line (tests/app/test_jobs.py).  Called before doit forks its workers,
     which inherit the setting; a line of up to ``PIPE_BUF`` (4096) bytes is
     written to a pipe whole (pipe(7))."""
     for stream in (sys.stdout, sys.stderr):

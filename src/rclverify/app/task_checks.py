@@ -78,7 +78,7 @@ class TargetsAsWritten:
     (or ``doit verify`` made the record again, byte for byte), the report
     task's inputs were what it last read, doit called it up to date, and the
     report kept the ``error`` of a record that was intact again (a false
-    alarm; found by tests/test_hardening_greens.py).  After the task ran the
+    alarm; found by tests/report/test_hardening_greens.py).  After the task ran the
     size and modification time of each target are saved with doit's task
     values; any other write (or a missing file) makes it run again.  A stat
     a file, no read: nothing on a no-op run."""

@@ -66,7 +66,7 @@ def create_after(executed: str) -> Callable[[_F], _F]:
 
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
 #: The deadlines' and the second solver's records (stages/deadlines.py, stages/crosscheck/stage.py: ``INDEX``),
-#: named here so that defining the tasks imports neither stage (tests/test_scale.py holds them equal).
+#: named here so that defining the tasks imports neither stage (tests/app/test_scale.py holds them equal).
 DEADLINES_INDEX = "artifacts/deadlines/index.json"
 CROSSCHECK_INDEX = "artifacts/crosscheck/index.json"
 #: The diagnosis stage's record (stages/diagnoses.py: ``INDEX``), named here for the same reason.

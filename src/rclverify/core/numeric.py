@@ -17,7 +17,7 @@ rclverify starts (the user's nodes, property-test processes) inherits the
 environment the user gave it.  A value the user set is kept, and a numpy
 loaded before rclverify's first import keeps its threads.  rclverify
 imports numpy and scipy through this module only
-(``tests/test_numeric.py``).
+(``tests/core/test_numeric.py``).
 """
 from __future__ import annotations
 

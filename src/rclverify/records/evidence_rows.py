@@ -22,11 +22,11 @@ The rules (docs/decisions.md, "One definition per record"):
   it (records/schema_gen.py), but for ``monitoring``: its inner shape
   belongs to the monitors backend (docs/monitors.md) and is described by
   hand in the file (records/schema_gen.py ``KEPT``).
-  tests/test_record_shapes.py fails when the file and the class differ.
+  tests/records/test_record_shapes.py fails when the file and the class differ.
 * Every field is read by a renderer of the evidence records
   (report/templates/parts/evidence.{html,md}.j2, which decode each row with
   the ``evidence_row`` filter) or named in :data:`INTERNAL` with the reason
-  it is not shown; tests/test_record_shapes.py fails otherwise.
+  it is not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 

@@ -26,11 +26,11 @@ The rules (docs/decisions.md, "One definition per record"):
   Neither is compared (:meth:`HealthFinding.__eq__` ignores them: Z3 may
   number the same query's terms differently from run to run).
 * The ``findings[]`` items of docs/assurance.schema.json are generated from
-  :class:`FindingRow` (records/schema_gen.py); tests/test_record_shapes.py
+  :class:`FindingRow` (records/schema_gen.py); tests/records/test_record_shapes.py
   fails when the file and the classes differ.
 * Every field of :class:`FindingRow` is read by a renderer of the report's
   finding rows (report/templates/parts/findings.*.j2) or named in
-  :data:`INTERNAL` with the reason it is not shown; tests/test_record_shapes.py
+  :data:`INTERNAL` with the reason it is not shown; tests/records/test_record_shapes.py
   fails otherwise.
 """
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The NoDL part of the report (``nodl``; docs/nodl.md, stages/nodl.py) as
 types: the static reading of its ``docs/assurance.schema.json`` part, held
-to it key by key by ``tests/test_report_vocabulary.py`` through
+to it key by key by ``tests/report/test_report_vocabulary.py`` through
 :class:`~rclverify.records.report_schema.Report`."""
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).

@@ -16,12 +16,12 @@ The rules (docs/decisions.md, "One definition per record"):
   :meth:`ObligationRow.of` (a key the class does not declare, or a value of
   another type, raises :class:`msgspec.ValidationError`).
 * The ``obligations[]`` items of docs/assurance.schema.json are generated
-  from it (records/schema_gen.py); tests/test_record_shapes.py fails when
+  from it (records/schema_gen.py); tests/records/test_record_shapes.py fails when
   the file and the class differ.
 * Every field is read by a renderer of the obligations table
   (report/templates/parts/obligations.{html,md}.j2, which decode each row
   with the ``obligation_row`` filter) or named in :data:`INTERNAL` with the
-  reason it is not shown; tests/test_record_shapes.py fails otherwise.
+  reason it is not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ These are the static reading of ``docs/assurance.schema.json`` (JSON Schema
 draft 2020-12), the published shape of ``reports/assurance.json``; the
 status words are the Literal types of :mod:`rclverify.records.statuses`.
 A key the schema lists as optional is ``NotRequired`` here; the two are held
-to one shape key by key, both ways, by ``tests/test_report_vocabulary.py``.  Records whose
+to one shape key by key, both ways, by ``tests/report/test_report_vocabulary.py``.  Records whose
 inner shape belongs to a tool (a requirement's check record, a monitoring
 summary, a counterexample, the grounding) are ``dict[str, Any]``, as the
 schema leaves them open.

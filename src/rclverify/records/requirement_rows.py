@@ -24,12 +24,12 @@ The rules (docs/decisions.md, "One definition per record"):
   from it (records/schema_gen.py), but for ``check``: the requirements
   stage's record (calculus/requirements/check.py) whose inner shape belongs
   to that stage, described by hand in the file (records/schema_gen.py ``KEPT``).
-  tests/test_record_shapes.py fails when the file and the class differ.
+  tests/records/test_record_shapes.py fails when the file and the class differ.
 * Every field is read by a renderer of the requirements (the requirement
   tables and the list of requirements checked with Z3 in
   report/templates/assurance.{html,md}.j2, which decode the rows with the
   ``requirement_rows`` filter) or named in :data:`INTERNAL` with the reason
-  it is not shown; tests/test_record_shapes.py fails otherwise.
+  it is not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 

@@ -16,7 +16,7 @@ described by hand, taken as it is.
 ``python -m rclverify.records.schema_gen [FILE]`` rewrites those parts of
 ``FILE`` (default ``docs/assurance.schema.json``) in place through
 core/atomic.py and leaves every other part as it is; it prints what it
-rewrote.  tests/test_record_shapes.py fails when the file and the classes
+rewrote.  tests/records/test_record_shapes.py fails when the file and the classes
 differ.
 """
 from __future__ import annotations

@@ -23,7 +23,7 @@ calculus/deadlines.py ``DeadlineResult.to_json`` with stages/deadlines.py;
 ``requirements`` calculus/requirements/check.py, temporal_check.py and
 stages/requirements.py; ``crosscheck`` stages/crosscheck/stage.py;
 ``ground`` app/ros_stage.py; ``nodl`` stages/nodl.py; ``diagnosis`` diagnosis/build.py with
-stages/diagnoses.py.  tests/test_stage_records.py checks every
+stages/diagnoses.py.  tests/records/test_stage_records.py checks every
 record the case study's stages return against these types.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated

@@ -19,7 +19,7 @@ docs/assurance.schema.json are generated from it (records/schema_gen.py);
 every field of a standard's row is read by the standards renderers
 (report/templates/parts/standards.{html,md}.j2, which decode the rows with
 the ``standard_rows`` filter) or named in :data:`INTERNAL`;
-tests/test_record_shapes.py fails otherwise.
+tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 

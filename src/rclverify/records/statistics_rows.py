@@ -25,7 +25,7 @@ docs/assurance.schema.json are generated from :class:`StatisticsRow`
 (records/schema_gen.py); every field is read by the statistics table's
 renderers (report/templates/parts/statistics.{html,md}.j2, which decode the
 rows with the ``statistics_rows`` filter) or named in :data:`INTERNAL`;
-tests/test_record_shapes.py fails otherwise.
+tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 

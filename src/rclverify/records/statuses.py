@@ -2,7 +2,7 @@
 
 Every status or verdict word the report (``reports/assurance.json``) carries
 is one of the sets below, and ``docs/assurance.schema.json`` lists the same
-words as its enums (``tests/test_report_vocabulary.py`` holds the two equal).
+words as its enums (``tests/report/test_report_vocabulary.py`` holds the two equal).
 Each set is a :class:`typing.Literal` type for mypy and a tuple of its words
 for the code that checks or ranks them.
 

@@ -20,7 +20,7 @@ data the key is computed from); :meth:`FragmentCache.save` keeps the pieces
 used in this run (pieces of an old version of a node are dropped).
 
 A report rendered with a warm cache is byte for byte the one rendered
-without (``tests/test_report_fragments.py``).
+without (``tests/report/test_report_fragments.py``).
 """
 from __future__ import annotations
 

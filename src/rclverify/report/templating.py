@@ -237,7 +237,7 @@ def finding_rows(rows: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
     """The report's finding rows (``findings[]``) decoded into
     :class:`~rclverify.records.findings.FindingRow`, so a template reads
     declared fields only (an undeclared attribute raises under
-    ``StrictUndefined``; tests/test_record_shapes.py holds every field to a
+    ``StrictUndefined``; tests/records/test_record_shapes.py holds every field to a
     renderer or :data:`~rclverify.records.findings.INTERNAL`)."""
     return rows_of(rows)
 
@@ -245,7 +245,7 @@ def finding_rows(rows: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
 def obligation_row(row: Mapping[str, Any] | ObligationRow) -> ObligationRow:
     """An obligation's row (``obligations[]``) decoded into
     :class:`~rclverify.records.obligations.ObligationRow`, so a template
-    reads declared fields only (tests/test_record_shapes.py holds every
+    reads declared fields only (tests/records/test_record_shapes.py holds every
     field to a renderer or :data:`~rclverify.records.obligations.INTERNAL`).
     Raises :class:`msgspec.ValidationError` for a key no field declares."""
     return ObligationRow.of(row)
@@ -254,7 +254,7 @@ def obligation_row(row: Mapping[str, Any] | ObligationRow) -> ObligationRow:
 def evidence_row(row: Mapping[str, Any] | EvidenceRow) -> EvidenceRow:
     """An evidence record's row (``evidence[]``) decoded into
     :class:`~rclverify.records.evidence_rows.EvidenceRow`, so a template
-    reads declared fields only (tests/test_record_shapes.py holds every
+    reads declared fields only (tests/records/test_record_shapes.py holds every
     field to a renderer or :data:`~rclverify.records.evidence_rows.INTERNAL`).
     Raises :class:`msgspec.ValidationError` for a key no field declares."""
     return EvidenceRow.of(row)
@@ -263,7 +263,7 @@ def evidence_row(row: Mapping[str, Any] | EvidenceRow) -> EvidenceRow:
 def requirement_rows(rows: Iterable[Mapping[str, Any] | RequirementRow]) -> list[RequirementRow]:
     """The report's ``requirements[]`` decoded into
     :class:`~rclverify.records.requirement_rows.RequirementRow`, in order, so
-    a template reads declared fields only (tests/test_record_shapes.py holds
+    a template reads declared fields only (tests/records/test_record_shapes.py holds
     every field to a renderer or
     :data:`~rclverify.records.requirement_rows.INTERNAL`).  Raises
     :class:`msgspec.ValidationError` for a key no field declares."""
@@ -273,7 +273,7 @@ def requirement_rows(rows: Iterable[Mapping[str, Any] | RequirementRow]) -> list
 def statistics_rows(rows: Iterable[Mapping[str, Any] | StatisticsRow]) -> list[StatisticsRow]:
     """The report's ``statistics[]`` decoded into
     :class:`~rclverify.records.statistics_rows.StatisticsRow`, in order, so
-    a template reads declared fields only (tests/test_record_shapes.py holds
+    a template reads declared fields only (tests/records/test_record_shapes.py holds
     every field to a renderer or
     :data:`~rclverify.records.statistics_rows.INTERNAL`).  Raises
     :class:`msgspec.ValidationError` for a key no field declares."""
@@ -283,7 +283,7 @@ def statistics_rows(rows: Iterable[Mapping[str, Any] | StatisticsRow]) -> list[S
 def standard_rows(rows: Iterable[Mapping[str, Any] | StandardRow]) -> list[StandardRow]:
     """The report's ``standards[]`` decoded into
     :class:`~rclverify.records.standards_rows.StandardRow`, in order, so a
-    template reads declared fields only (tests/test_record_shapes.py holds
+    template reads declared fields only (tests/records/test_record_shapes.py holds
     every field to a renderer or
     :data:`~rclverify.records.standards_rows.INTERNAL`).  Raises
     :class:`msgspec.ValidationError` for a key no field declares."""

@@ -15,7 +15,7 @@ every call in rclverify), nothing needs coercing, and the term is made by
 one call of ``Z3_mk_and`` / ``Z3_mk_or`` on the arguments as they are,
 which is what ``z3.And`` / ``z3.Or`` call after coercing them: Z3 shares
 equal terms, so the result is the very term (the same ``get_id()``;
-``tests/test_connectives.py``).  Any other arguments (none, a Python
+``tests/semantics/test_connectives.py``).  Any other arguments (none, a Python
 ``bool``, a probe, a context, a list, terms of two contexts) are handed to
 ``z3.And`` / ``z3.Or`` unchanged, so they give what those give and raise what
 those raise.  A ``BoolRef`` whose sort is not Boolean (a ``z3.Lambda``)

@@ -9,7 +9,7 @@ variable is used outside equalities and function/constructor arguments and
 is not bounded by a literal guard (``k <= 12 -> ...``), a quantifier over a
 function or product type, division by zero, a function-typed value that is
 not a :class:`~rclverify.semantics.values.FiniteFunction`.  Where both engines decide,
-they agree (tests/test_one_evaluator.py checks it on random formulas and
+they agree (tests/semantics/test_one_evaluator.py checks it on random formulas and
 values).
 """
 from __future__ import annotations

@@ -36,7 +36,7 @@ Quantifiers are decided by enumeration:
   quantifier undecidable here and :func:`evaluate` answers ``None`` (the
   callers then ask Z3).
 
-tests/test_one_evaluator.py checks on random formulas and values that
+tests/semantics/test_one_evaluator.py checks on random formulas and values that
 wherever this module and Z3 (:mod:`.concrete`) both decide, they agree.
 
 The evaluator is split by job: values and domains (:mod:`.eval_values`),

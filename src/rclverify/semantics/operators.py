@@ -42,7 +42,7 @@ instead of restating it:
   when there is one; :attr:`Operator.converse` and :attr:`Operator.negation`
   relate the comparisons (``a < b`` is ``b > a`` and ``not (a >= b)``).
 
-``tests/test_operators.py`` checks each entry against the reference
+``tests/semantics/test_operators.py`` checks each entry against the reference
 evaluator, the double reading against Python's floats and the text fields
 by compiling them.
 """

@@ -33,7 +33,7 @@ evaluator judges (:mod:`rclverify.semantics.evaluate`, the operators of
 implies it fails, on the same values in the same arithmetic (by induction:
 min and max keep the implication).  ``margin == 0`` is the boundary, where
 the Boolean verdict decides: ``a <= b`` holds there, ``a < b`` does not, a
-satisfied ``a == b`` is always at 0.  tests/test_robustness.py checks this
+satisfied ``a == b`` is always at 0.  tests/semantics/test_robustness.py checks this
 against the evaluator on random formulas and values.
 
 **Arithmetic.**  ``exact``: the terms in exact rational arithmetic (the

@@ -36,7 +36,7 @@ arithmetic, comparisons (also chained) and membership in a set literal.
 Quantifiers, membership in a type or a set-valued term, tuple, sequence and
 string literals and ranges are not: :attr:`Straight.fallback` then says
 which construct, and the caller evaluates that formula with the
-evaluator, as before.  ``tests/test_straightline.py`` checks on random
+evaluator, as before.  ``tests/semantics/test_straightline.py`` checks on random
 formulas and values that the compiled function and the evaluator give the
 same truth, the same missing value, and that the monitors' judgement is
 unchanged.

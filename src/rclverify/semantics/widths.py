@@ -207,7 +207,7 @@ def width_fault(value: Any, width: Width) -> str | None:
     bounded string's length.  Without the checks (Kilted's default) the
     conversion to C raises, wraps an integer (300 is heard as 44) or reads an
     ``int`` in a floating field as another number (3 as 5e-324), as
-    tests/test_widths_ints.py measures; C++ would wrap the integer too, so
+    tests/semantics/test_widths_ints.py measures; C++ would wrap the integer too, so
     the value the node computed never reaches a subscriber either way."""
     name = width.idl
     if name in INT_RANGES:

@@ -15,7 +15,7 @@ changed printer misses).
 The check task (:func:`rclverify.app.pipeline.stage_check`) fills and writes the
 file; the report tasks, which run after it, only read it and make what it
 lacks.  A damaged, missing or foreign file is an empty cache; the texts are
-the same with or without it (``tests/test_contract_texts.py``).
+the same with or without it (``tests/stages/test_contract_texts.py``).
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (the TypedDicts below).

@@ -5,7 +5,7 @@ Below the stages and the report: :mod:`rclverify.app.pipeline` (the stages),
 :mod:`rclverify.report` (the roll-up), :mod:`rclverify.core.cache.workspace` and
 :mod:`rclverify.stages.contract_texts` (kept between runs) all read a
 :class:`Workspace`; this module imports none of them (the layers of
-``tests/test_layers.py``).  It holds:
+``tests/project/test_layers.py``).  It holds:
 
 * :class:`Workspace` and :class:`TaskIndex` (what defining doit's tasks needs);
 * the artifact paths and :func:`read_artifact`;

@@ -11,7 +11,7 @@ the same order); every other comparison ``+inf`` or ``-inf`` by its truth;
 ``not`` negates, ``and``/``or`` are minimum and maximum, ``->`` and ``<=>``
 as in the module above, ties kept on the left as there.  Each row also gets
 the index of its deciding comparison in :attr:`MarginCompiler.atoms` (-1:
-none).  tests/test_margins_batch.py checks that the batch path's margins are
+none).  tests/backends/test_margins_batch.py checks that the batch path's margins are
 the streaming engine's, verdict by verdict.
 """
 from __future__ import annotations

@@ -21,7 +21,7 @@ meets a real as a real (Z3's parser inserts ``to_real`` as the encoder's
 ``coerce`` does), ``/`` is real division, a NATURAL symbol's ``>= 0`` is the
 encoder's axiom.  Anything else (quantifiers, functions, enumerations,
 sets, constants of the context) is outside: :func:`to_smt` returns ``None``
-and the caller encodes with the encoder.  ``tests/test_calculus_context.py``
+and the caller encodes with the encoder.  ``tests/calculus/test_calculus_context.py``
 checks both ways give the same verdicts.
 """
 from __future__ import annotations

@@ -39,7 +39,7 @@ Anything else (ROS 1, several bags, per-message or per-file compression,
 an unindexed or overlapping MCAP, another ``rosbags`` version or storage
 class) gives ``None`` before reading a message: the caller takes
 ``AnyReader.messages()`` itself.  Errors: what ``rosbags`` raises, after
-the blocks of every message before it (tests/test_bag_raw.py compares the
+the blocks of every message before it (tests/traces/test_bag_raw.py compares the
 order, bytes and errors with ``AnyReader.messages()``).
 """
 from __future__ import annotations

@@ -9,7 +9,7 @@ four times JSON's scanner) when it can be: it reads every JSON text that
 Python's ``json`` reads to the same value (floats correctly rounded,
 integers of any size exact, duplicate keys the last, strings alike:
 compared on 300,000 random numbers and the corner cases of
-``tests/test_traces.py``), and rejects what ``json`` reads beyond the
+``tests/traces/test_traces.py``), and rejects what ``json`` reads beyond the
 standard (``NaN``, ``Infinity``, numbers that overflow to infinity, lone
 surrogates).  A line it rejects is read again by the scanner and
 ``json.loads`` path below, as before: the same events, the same errors.

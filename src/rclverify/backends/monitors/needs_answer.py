@@ -29,7 +29,7 @@ do:
 
 Anything else, and any ``unknown`` from Z3, answers ``False``: evaluate as
 before.  Skipping never changes a verdict, its guarantee, its reason or when
-it is decided; ``tests/test_monitor_needs_answer.py`` checks the verdicts
+it is decided; ``tests/backends/test_monitor_needs_answer.py`` checks the verdicts
 with and without on random traces.
 """
 from __future__ import annotations

@@ -17,7 +17,7 @@ The variable is set only while Hypothesis is imported and restored after, so
 a workspace's own processes see the environment they were given.  A process
 that had imported Hypothesis before (a pytest session, whose Hypothesis
 plugin imports it first) keeps the import it made.  Every import of
-Hypothesis in rclverify goes through this module (tests/test_property_tests_plugins.py).
+Hypothesis in rclverify goes through this module (tests/backends/test_property_tests_plugins.py).
 """
 from __future__ import annotations
 

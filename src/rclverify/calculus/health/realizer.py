@@ -154,7 +154,7 @@ def _cegis(params: Sequence[z3.ExprRef], terms: Sequence[_Term], given: Sequence
     a check's budget run out."""
     answered = z3.substitute(body, *[(o, _expr(t)) for o, t in zip(outs, terms)])
     # made when the first input is to be added (_first_model); made first, as before, without
-    # FIRST_ROUND_UNASKED (the reference path of tests/test_health_fast.py)
+    # FIRST_ROUND_UNASKED (the reference path of tests/calculus/test_health_fast.py)
     synth: z3.Solver | None = None if FIRST_ROUND_UNASKED else budgeted_solver(CHECK_MS)
     for _ in range(ROUNDS):
         if synth is None:

@@ -22,7 +22,7 @@ new context, and the interpretation back into the caller's.  Its search
 depended on what the caller's context held before: in a context that
 earlier queries had filled, it spent its whole budget on a system whose one
 reachable state has no successor, which it proves at once in a fresh
-context (tests/test_temporal_pdr.py).  A requirement's decision asks
+context (tests/calculus/test_temporal_pdr.py).  A requirement's decision asks
 k-induction, the hint and Houdini first, in the caller's context; they no
 longer change what Spacer answers.
 

@@ -126,7 +126,7 @@ def derived_claims(own: Mapping[str, Sequence[Premise]], producers: Mapping[str,
     (:func:`_vector_claims`: sorting each cone's names was most of the
     report's time at 5000 nodes; without numpy, the ``fast`` extra, the
     per-node path).  Equal to :func:`claim` over the
-    cone (``tests/test_confidence.py``)."""
+    cone (``tests/report/test_confidence.py``)."""
     labels = [p.label for ps in own.values() for p in ps]
     reads = {n: list(producers.get(n, ())) for n in own}
     if len(labels) == len(set(labels)) and len(own) >= vector_from and installed("numpy"):

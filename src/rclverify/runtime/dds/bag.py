@@ -17,14 +17,14 @@ first message, in the definition that message is written in (one topic,
 one definition: a later message in another is not written, and counted in
 ``failed``), and at the end for a topic that had none.  So ``rclverify
 monitor BAG`` checks exactly the messages the live run checked, at the same
-times, and gives the same verdicts (tests/test_monitor_live_dds.py,
-tests/test_ros2_declared_types.py).
+times, and gives the same verdicts (tests/backends/test_monitor_live_dds.py,
+tests/runtime/test_ros2_declared_types.py).
 
 The linked services' and actions' calls go to the bag too, as ROS 2 records
 them (``<service>/_service_event`` ...), with the live call book's pairing
 (:mod:`.bag_calls`): their connections carry the definitions and type
 hashes :mod:`.bag_types` makes, so ``rclverify monitor BAG`` judges the calls
-as the live run did (tests/test_ros2_bag_calls.py).
+as the live run did (tests/runtime/test_ros2_bag_calls.py).
 """
 from __future__ import annotations
 

@@ -132,7 +132,7 @@ class Session:
     any answer other than ``sat``/``unsat``.  Only scripts :meth:`takes`
     admits come here; the caller decides the rest in a fresh solver.
     Answers and proofs equal a fresh solver's on the quantifier-free
-    scripts it admits (``tests/test_second_solver.py`` compares them).
+    scripts it admits (``tests/stages/test_second_solver.py`` compares them).
     Raises ``ImportError`` when cvc5 is missing.
     """
 

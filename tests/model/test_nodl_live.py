@@ -1,0 +1,132 @@
+"""NoDL documents against the running ROS 2 graph (docs/nodl.md, "Against the running graph"): real rclpy nodes on
+Fast DDS (tests/_ros2.py), read by ``rclverify nodl check --ros2`` through rclverify's own DDS participant and
+through rclpy's graph API (``--source dds``, ``--source rclpy``), and by ``rclverify ros diff --nodl`` (the
+documents as the expected graph, through rclpy's graph API).
+
+The documents are tests/data/nodl/ws's.  One process runs two nodes: ``Guard`` exactly as its document says (the
+control: reliable, transient-local ``/stop`` offering a 100 ms deadline, best-effort ``/scan``; without the deadline
+it would be a ``nodl-live-qos`` finding: the document offers it) and ``Base`` with one seeded mismatch of each
+kind: ``/speed`` published as ``std_msgs/Float32`` (the document: ``Float64``), ``/stop`` subscribed volatile (the
+document: transient-local), no ``/estop`` server, and a publisher ``/odom`` its document does not declare.
+``Dock`` does not run: a document matched to no running node is not compared."""
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+
+from _procs import stop
+from _ros2 import rclverify, ros2_env, ros2_python, start_node
+
+WS = Path(__file__).parent.parent / "data" / "nodl" / "ws"
+
+NODES = """\
+import rclpy
+from rclpy.duration import Duration
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool, Float32, Float64
+
+rclpy.init()
+guard = Node('Guard')
+guard.create_publisher(Bool, '/stop', QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                                                 durability=DurabilityPolicy.TRANSIENT_LOCAL,
+                                                 deadline=Duration(nanoseconds=100_000_000)))
+guard.create_subscription(LaserScan, 'scan', lambda m: None,
+                          QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT))
+base = Node('Base')
+base.create_subscription(Bool, '/stop', lambda m: None, QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                                                                   durability=DurabilityPolicy.VOLATILE))
+base.create_publisher(Float32, '/speed', 10)
+base.create_publisher(Float64, '/odom', 10)
+ex = MultiThreadedExecutor()
+ex.add_node(guard)
+ex.add_node(base)
+print('ready', flush=True)
+ex.spin()
+"""
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    tmp = tmp_path_factory.mktemp("nodl_live")
+    ws = tmp / "ws"
+    shutil.copytree(WS, ws)
+    env = ros2_env(tmp)
+    procs: list[subprocess.Popen[bytes]] = []
+    try:
+        procs.append(start_node(tmp, "robot", NODES, env))
+        out: dict[str, Any] = {}
+        for source in ("dds", "rclpy"):  # rclverify's own DDS participant, rclpy's graph API (as ros diff reads)
+            log = tmp / f"check_{source}.log"
+            p = rclverify(["nodl", "check", "-w", str(ws), "--ros2", "--wait", "2", "--source", source,
+                           "--ros2-python", str(ros2_python())], env, ws, log)
+            procs.append(p)
+            code = p.wait(120)
+            out[source] = {"code": code, "log": log.read_text()}
+        log = tmp / "diff.log"  # the documents as ros diff's expected graph (rclpy's graph API, as above)
+        p = rclverify(["ros", "diff", "--nodl", str(ws / "nodl"), "--ros2", "--wait", "2", "--source", "rclpy",
+                       "--ros2-python", str(ros2_python())], env, ws, log)
+        procs.append(p)
+        out["diff"] = {"code": p.wait(120), "log": log.read_text()}
+        yield out
+    finally:
+        for p in procs:
+            stop(p)
+
+
+def _lines(log: str, node: str) -> list[str]:
+    return [ln for ln in log.splitlines() if f"node /{node}" in ln and ln.startswith("nodl/")]
+
+
+SOURCES = {"dds": "DDS domain", "rclpy": "rclpy on rmw_fastrtps_cpp"}
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_the_documents_are_matched_to_the_running_nodes(run, source: str) -> None:
+    log = run[source]["log"]
+    assert f"2 document(s) matched to a running node ({SOURCES[source]}" in log
+    assert "; Base -> /Base; Guard -> /Guard" in log
+    assert run[source]["code"] == 1 and "Traceback" not in log
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_the_node_running_as_its_document_says_has_no_finding(run, source: str) -> None:
+    assert _lines(run[source]["log"], "Guard") == []
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_each_seeded_mismatch_of_the_running_node_is_found(run, source: str) -> None:
+    found = {ln.rsplit("[", 1)[1].rstrip("]"): ln for ln in _lines(run[source]["log"], "Base")}
+    assert sorted(found) == ["nodl-live-absent", "nodl-live-qos", "nodl-live-type", "nodl-live-undeclared"]
+    assert "/speed has type std_msgs/msg/Float32 in the running node and std_msgs/msg/Float64" in found["nodl-live-type"]
+    assert "/stop's durability is VOLATILE announced by the running node and TRANSIENT_LOCAL" in found["nodl-live-qos"]
+    assert "declares /estop (std_srvs/srv/SetBool) in service_servers, and the running node has no such endpoint" \
+        in found["nodl-live-absent"]
+    assert "/odom (std_msgs/msg/Float64) in publishers in the running node" in found["nodl-live-undeclared"]
+    # each is located in the document too: the document's line of the policy, of the type, of the entry
+    assert found["nodl-live-qos"].startswith("nodl/Base.nodl.json:6:")
+    assert f"(also at {SOURCES[source]}" in found["nodl-live-qos"]
+
+
+def test_ros_diff_takes_the_documents_as_its_expected_graph(run) -> None:
+    """The same seeded mismatches as ros diff's items, each of the documents' side at the document's line; the
+    node running as its document says gives none (the control); Dock, not running, is missing."""
+    log, code = run["diff"]["log"], run["diff"]["code"]
+    assert code == 1 and "Traceback" not in log
+    items = [ln.strip() for ln in log.splitlines() if ln.startswith("  ")]
+    assert not [i for i in items if "/Guard" in i], items
+    assert any(i.startswith("nodl/Dock.nodl.yaml:1:1: node /Dock is not running") for i in items), items
+    assert any(i.startswith("nodl/Base.nodl.json:6:") and "/stop" in i and "durability is VOLATILE announced by the "
+               "running node and TRANSIENT_LOCAL in its NoDL document" in i for i in items), items
+    assert any(i.startswith("nodl/Base.nodl.json:10:") and "/Base publishes /speed: its NoDL document's type is "
+               "std_msgs/Float64, the running system's std_msgs/Float32" in i for i in items), items
+    assert any(i.startswith("nodl/Base.nodl.json:") and "/Base serves /estop" in i and "in its NoDL document, not in "
+               "the running system" in i for i in items), items
+    assert any("/Base publishes /odom" in i and "not in its NoDL document" in i for i in items), items
+    assert "in the NoDL documents, not in the running system at rclpy on rmw_fastrtps_cpp:" in log

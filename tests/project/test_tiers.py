@@ -1,0 +1,30 @@
+"""The tiers and the module order of tests/conftest.py name real modules
+(docs/ci.md, "The test suite"): a renamed module must not drop out of its tier."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import conftest
+
+HERE = Path(__file__).resolve().parent.parent
+
+
+def test_every_module_the_tiers_name_exists() -> None:
+    modules = {p.stem for p in HERE.rglob("test_*.py")}
+    for name in sorted(conftest.LIVE | conftest.PIPELINE | set(conftest.SECONDS) | set(conftest.WALL)):
+        assert name in modules, f"tests/conftest.py names {name}, which is not a test module"
+
+
+def test_the_slow_tier_holds_the_measured_and_the_pipeline_modules() -> None:
+    assert conftest.PIPELINE <= conftest.SLOW
+    assert {n for n, s in conftest.SECONDS.items() if s >= 2.0} <= conftest.SLOW
+    assert "test_pipeline_e2e" in conftest.SLOW and "test_rcl_parser" not in conftest.SLOW | conftest.LIVE
+
+
+def test_only_live_modules_are_weighed_by_their_wall_clock_time() -> None:
+    assert set(conftest.WALL) <= conftest.LIVE
+
+
+def test_this_module_is_marked_by_neither_tier(request) -> None:  # type: ignore[no-untyped-def]
+    names = {m.name for m in request.node.iter_markers()}
+    assert not names & {"slow", "live"}

@@ -1,0 +1,464 @@
+"""Each record defined once (records/findings.py, records/obligations.py, records/evidence_rows.py): the
+schema's part generated from it, every field rendered or declared internal, sealed records decoded into it.
+
+The rule, for a contract-health finding: :class:`~rclverify.records.findings.FindingRow` (extending
+:class:`~rclverify.records.findings.HealthFinding`) is the only statement of its fields; the
+``findings[]`` items of docs/assurance.schema.json are generated from it (records/schema_gen.py); each
+field is read by one of the report's finding renderers (report/templates/parts/findings.{html,md}.j2)
+or named in :data:`~rclverify.records.findings.INTERNAL`.  The same holds for an obligation's row
+(:class:`~rclverify.records.obligations.ObligationRow`, ``obligations[]``, rendered by
+report/templates/parts/obligations.{html,md}.j2) an evidence record's row
+(:class:`~rclverify.records.evidence_rows.EvidenceRow`, ``evidence[]``, rendered by
+report/templates/parts/evidence.{html,md}.j2), a row of the statistics table
+(:class:`~rclverify.records.statistics_rows.StatisticsRow`, ``statistics[]``, rendered by
+report/templates/parts/statistics.{html,md}.j2), a chosen standard's row
+(:class:`~rclverify.records.standards_rows.StandardRow`, ``standards[]``, rendered by
+report/templates/parts/standards.{html,md}.j2) and a requirement's row
+(:class:`~rclverify.records.requirement_rows.RequirementRow`, ``requirements[]``, rendered by
+report/templates/assurance.{html,md}.j2).  Each check is also run on a definition with a field
+added, and must then fail.  In-process and cheap: no pipeline runs here.
+"""
+from __future__ import annotations
+
+import copy
+import typing
+from pathlib import Path
+from typing import Any, Iterable, Mapping, NamedTuple
+
+import jinja2
+import msgspec
+import pytest
+from jinja2 import nodes
+
+from _report_schema import SCHEMA
+from rclverify.records import schema_gen
+from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.standards_rows import StandardRow
+from rclverify.records.statistics_rows import RequirementRuns, StatisticsRow
+from rclverify.report.render import part_renderer
+from rclverify.report.fragments import FragmentCache
+
+PARTS = Path(__file__).resolve().parents[2] / "src" / "rclverify" / "report" / "templates" / "parts"
+RENDERERS = ("findings.html.j2", "findings.md.j2")
+
+
+class Record(NamedTuple):
+    """A record defined once: its class, its INTERNAL table, the filter its renderers decode it with,
+    its renderers (parts), and the schema key generated from it."""
+    cls: type[msgspec.Struct]
+    internal: Mapping[str, str]
+    filter: str
+    renderers: tuple[str, ...]
+
+
+RECORDS: dict[str, Record] = {
+    # a requirement's row is rendered by the main templates (the requirements table, the Z3 checks' list)
+    "requirements": Record(RequirementRow, requirement_rows.INTERNAL, "requirement_rows",
+                           ("../assurance.html.j2", "../assurance.md.j2")),
+    "findings": Record(FindingRow, INTERNAL, "findings", RENDERERS),
+    "obligations": Record(ObligationRow, obligations.INTERNAL, "obligation_row",
+                          ("obligations.html.j2", "obligations.md.j2")),
+    "evidence": Record(EvidenceRow, evidence_rows.INTERNAL, "evidence_row", ("evidence.html.j2", "evidence.md.j2")),
+    "statistics": Record(StatisticsRow, statistics_rows.INTERNAL, "statistics_rows",
+                         ("statistics.html.j2", "statistics.md.j2")),
+    "standards": Record(StandardRow, standards_rows.INTERNAL, "standard_rows", ("standards.html.j2", "standards.md.j2")),
+}
+
+
+def fields_read(source: str, filter_name: str = "findings") -> set[str]:
+    """The attributes a template reads on a name bound to a value of ``...|<filter_name>`` (the filter that
+    decodes rows into their class): the loop variable of a ``for`` over it, or a name ``set`` to it inside
+    a loop (read within that loop), found in jinja2's parse tree."""
+    tree = jinja2.Environment().parse(source)
+    out: set[str] = set()
+
+    def decoded(x: nodes.Node) -> bool:
+        return isinstance(x, nodes.Filter) and x.name == filter_name
+
+    for loop in tree.find_all(nodes.For):
+        names = {loop.target.name} if decoded(loop.iter) and isinstance(loop.target, nodes.Name) else set()
+        names |= {a.target.name for a in loop.find_all(nodes.Assign)
+                  if decoded(a.node) and isinstance(a.target, nodes.Name)}
+        for n in loop.find_all(nodes.Getattr):
+            if isinstance(n.node, nodes.Name) and n.node.name in names:
+                out.add(n.attr)
+        for n in loop.find_all(nodes.Getitem):
+            if isinstance(n.node, nodes.Name) and n.node.name in names and isinstance(n.arg, nodes.Const):
+                out.add(str(n.arg.value))
+    return out
+
+
+def unaccounted(cls: type[msgspec.Struct], sources: Iterable[str], internal: Mapping[str, str],
+                filter_name: str = "findings") -> list[str]:
+    """What breaks the rule for ``cls``: a field no renderer reads and not internal, an internal name
+    that is no field, a field both internal and rendered, a read of a name that is no field."""
+    fields = set(cls.__struct_fields__)
+    read = set().union(*(fields_read(s, filter_name) for s in sources))
+    out = [f"{k}: neither rendered nor declared internal" for k in sorted(fields - read - set(internal))]
+    out += [f"{k}: declared internal but no field" for k in sorted(set(internal) - fields)]
+    out += [f"{k}: declared internal but rendered" for k in sorted(set(internal) & read)]
+    out += [f"{k}: rendered but no field" for k in sorted(read - fields)]
+    return out
+
+
+def _sources(renderers: tuple[str, ...] = RENDERERS) -> list[str]:
+    return [(PARTS / name).read_text(encoding="utf-8") for name in renderers]
+
+
+@pytest.mark.parametrize("key", list(RECORDS))
+def test_every_field_of_a_record_is_rendered_or_internal(key: str) -> None:
+    r = RECORDS[key]
+    assert unaccounted(r.cls, _sources(r.renderers), r.internal, r.filter) == []
+    assert all(why for why in r.internal.values())  # each internal field says why it is not shown
+
+
+class _WithMargin(FindingRow, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
+    """The definition with one field added, as a change to records/findings.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_and_not_rendered_fails_until_rendered_or_internal() -> None:
+    sources = _sources()
+    assert unaccounted(_WithMargin, sources, INTERNAL) == ["margin_added_here: neither rendered nor declared internal"]
+    # declared internal: accounted for
+    assert unaccounted(_WithMargin, sources, {**INTERNAL, "margin_added_here": "why it is not shown"}) == []
+    # rendered: the HTML part with one more read of the row
+    html = sources[0].replace("{{ f.check }}", "{{ f.check }} {{ f.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_WithMargin, [html, sources[1]], INTERNAL) == []
+    # a read outside the loop over the decoded rows does not count
+    assert unaccounted(_WithMargin, [sources[0] + "{{ f.margin_added_here }}", sources[1]], INTERNAL) != []
+    # a field that is rendered may not also be declared internal
+    assert unaccounted(FindingRow, sources, {**INTERNAL, "core": "x"}) == ["core: declared internal but rendered"]
+
+
+@pytest.mark.parametrize("key", list(RECORDS))
+def test_the_schema_part_is_generated_from_the_definition(key: str) -> None:
+    assert list(schema_gen.GENERATED) == list(RECORDS)  # each generated part is a record checked here
+    assert SCHEMA["properties"][key] == schema_gen.generated_part(key, SCHEMA)
+    items = SCHEMA["properties"][key]["items"]
+    assert list(items["properties"]) == list(RECORDS[key].cls.__struct_fields__)
+    assert items["additionalProperties"] is False
+
+
+class _ObligationWithMargin(ObligationRow, frozen=True, forbid_unknown_fields=True):
+    """The obligation row with one field added, as a change to records/obligations.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_an_obligation_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["obligations"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_ObligationWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_ObligationWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ o.backend }}", "{{ o.backend }} {{ o.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_ObligationWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    # a read of the undecoded row (``row.obligation``) does not count: only the decoded row's reads do
+    raw = sources[0].replace("{{ o.backend }}", "{{ o.backend }} {{ row.obligation.margin_added_here }}", 1)
+    assert unaccounted(_ObligationWithMargin, [raw, sources[1]], r.internal, r.filter) != []
+    # the schema part follows the definition, and then the checked-in file differs
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "obligations", (_ObligationWithMargin, schema_gen.GENERATED["obligations"][1]))
+        part = schema_gen.generated_part("obligations")
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["obligations"] != part
+
+
+_OBLIGATION: dict[str, Any] = {
+    "id": "N.g1.hoare.c1", "node": "Nodey", "guarantee": 1, "backend": "backend-text", "kind": "model checking",
+    "instance": "instance-text", "statement": "statement_text", "source": "a.rcl:3:4",
+    "artifact": "artifact-text", "status": "failed"}
+
+
+def test_the_obligation_renderers_show_each_field_and_refuse_an_undeclared_key() -> None:
+    part = part_renderer(FragmentCache(), "")
+    shown = {**{k: str(v) for k, v in _OBLIGATION.items()}, "guarantee": "Nodey g1", "source": "rcl:3:4"}
+    assert list(shown) == list(ObligationRow.__struct_fields__)
+    rows = [{"obligation": _OBLIGATION, "evidence": ["ev-x"]}]
+    for name in ("obligations.html", "obligations.md"):
+        text = str(part(name, rows=rows))
+        assert [k for k, t in shown.items() if t not in text] == [], name
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("obligations.html", rows=[{"obligation": {**_OBLIGATION, "margin_added_here": "0.5 m"}, "evidence": []}])
+    # the JSON object the report writes is every field, in the order declared
+    assert ObligationRow.of(_OBLIGATION).to_json() == _OBLIGATION
+    assert list(ObligationRow.of(_OBLIGATION).to_json()) == list(ObligationRow.__struct_fields__)
+
+
+def test_a_field_added_reaches_the_schema_and_the_checked_in_file_then_differs(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(schema_gen.GENERATED, "findings", (_WithMargin, schema_gen.GENERATED["findings"][1]))
+    part = schema_gen.generated_part("findings")
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["findings"] != part
+    regenerated = schema_gen.with_generated(copy.deepcopy(SCHEMA))
+    assert regenerated["properties"]["findings"] == part
+    assert [k for k in regenerated["properties"] if regenerated["properties"][k] != SCHEMA["properties"][k]] == [
+        "findings"]  # only the generated part changes
+
+
+#: Values of the fields whose type a generic value does not fit, and the text each shows as.
+_SET: dict[str, tuple[Any, str]] = {
+    "id": ("N.g1.c2.redundant", "N.g1.c2.redundant"), "node": ("N", "N"), "check": ("redundant", "redundant"),
+    "guarantee": (1, ""), "status": ("warning", ""), "core": (["x > 0"], "x"), "duration_s": (1.5, "1.5"),
+    "solvers": ({"agreement": "two solvers", "why": "both unsat", "cvc5": None, "proof": "", "smt2": ""},
+                "two solvers"),
+    "acknowledged": ({"reason": "ack-reason", "at": "plan.yaml:3:5"}, "ack-reason"),
+    "sha256": ("ab" * 32, "abab"),
+}
+
+
+def _value(name: str, ann: Any) -> tuple[Any, str]:
+    """A value of field ``name`` (annotation ``ann``) and the text a renderer that shows it writes."""
+    if name in _SET:
+        return _SET[name]
+    args = [a for a in (typing.get_args(ann) or (ann,)) if a is not type(None)]
+    if args == [str]:
+        return f"{name}-text", f"{name}-text"
+    if typing.get_origin(args[0]) is dict:
+        return {f"{name}-key": f"{name}-value"}, f"{name}-value"
+    if typing.get_origin(args[0]) is list:
+        return [f"{name}-item"], f"{name}-item"
+    raise AssertionError(f"{name}: give the field a value in _SET (its type {ann} has no generic one)")
+
+
+def _full_row(cls: type[msgspec.Struct] = FindingRow) -> tuple[dict[str, Any], dict[str, str]]:
+    """A warning row of ``cls`` with every field set to a value of its own, and each field's shown text."""
+    hints = typing.get_type_hints(cls)
+    made = {k: _value(k, hints[k]) for k in cls.__struct_fields__}
+    return {k: v for k, (v, _) in made.items()}, {k: t for k, (_, t) in made.items()}
+
+
+def test_the_renderers_show_each_field_they_read() -> None:
+    """Both parts render a row with every field set (and the same row not acknowledged, whose warning
+    offers its sha256 to acknowledge it); each field's value but the internal ones is in one of them."""
+    part = part_renderer(FragmentCache(), "")
+    row, shown = _full_row()
+    rows = [row, {k: v for k, v in row.items() if k != "acknowledged"} | {"id": "N.g1.c3.redundant"}]
+    text = str(part("findings.html", rows=rows)) + part("findings.md", rows=rows)
+    assert [k for k, t in shown.items() if k not in INTERNAL and t not in text] == []
+    assert all(shown[k] not in text for k in INTERNAL)
+
+
+def test_an_undeclared_key_never_reaches_a_renderer_or_the_report() -> None:
+    part = part_renderer(FragmentCache(), "")
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("findings.html", rows=[{**_full_row()[0], "margin_added_here": "0.5 m"}])
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        FindingRow.of({**_full_row()[0], "margin_added_here": "0.5 m"})
+
+
+def test_a_sealed_health_record_decodes_into_the_definition() -> None:
+    f = HealthFinding("N.realizable", "N", "realizable", None, "ok", "m", "e", witness={"out.y": "1"},
+                      smt2="artifacts/health/N.realizable.smt2")
+    j = f.to_json()
+    # every field in the JSON, none at its default left out (a key's presence never differs run to run)
+    assert list(j) == list(HealthFinding.__struct_fields__) and j["model"] is None and j["duration_s"] == 0.0
+    assert msgspec.convert(j, HealthFinding) == f
+    with pytest.raises(msgspec.ValidationError):
+        msgspec.convert({**j, "guarantee": "one"}, HealthFinding)
+    # the two queries are not compared: the same finding with a re-numbered query text is equal
+    assert msgspec.structs.replace(f, smt2="(check-sat)") == f and hash(msgspec.structs.replace(f, smt2="")) == hash(f)
+
+
+class _EvidenceWithMargin(EvidenceRow, frozen=True, forbid_unknown_fields=True):
+    """The evidence row with one field added, as a change to records/evidence_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_an_evidence_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["evidence"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_EvidenceWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_EvidenceWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ ev.tool_version }}", "{{ ev.tool_version }} {{ ev.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_EvidenceWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    raw = sources[0].replace("{{ ev.tool_version }}", "{{ ev.tool_version }} {{ item.record.margin_added_here }}", 1)
+    assert unaccounted(_EvidenceWithMargin, [raw, sources[1]], r.internal, r.filter) != []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "evidence", (_EvidenceWithMargin, schema_gen.GENERATED["evidence"][1]))
+        part = schema_gen.generated_part("evidence", SCHEMA)
+        regenerated = schema_gen.with_generated(copy.deepcopy(SCHEMA))
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["evidence"] != part == regenerated["properties"]["evidence"]
+    # the monitors backend's run summary keeps its hand-written schema in the generated part
+    assert part["items"]["properties"]["monitoring"] == SCHEMA["properties"]["evidence"]["items"]["properties"]["monitoring"]
+    with pytest.raises(KeyError, match="monitoring"):
+        schema_gen.generated_part("evidence")
+
+
+#: An evidence row with every field set to a value of its own, and the text each shows as.
+_EVIDENCE: dict[str, tuple[Any, str]] = {
+    "obligation": ("N.g1.property_tests.c1", "N.g1.property_tests.c1"), "backend": ("backend-text", "backend-text"),
+    "kind": ("testing", "testing"), "status": ("failed", "failed"), "tool": ("tool-text", "tool-text"),
+    "tool_version": ("9.8.7", "9.8.7"), "started": ("2026-01-02T03:04:05Z", "2026-01-02T03:04:05Z"),
+    "duration_s": (1.5, "1.5"), "explanation": ("explanation-text", "explanation-text"),
+    "counterexample": ({"in.x": "42"}, "42"), "artifacts": (["artifact-text"], "artifact-text"),
+    "log_excerpt": ("log-text", "log-text"), "figures": ([["figure-name", "figure-value"]], "figure-value"),
+    "plot_svg": ("<svg><title>plot-text</title></svg>", "plot-text"),
+    "solvers": ({"agreement": "two solvers", "why": "solvers-text", "cvc5": None}, "solvers-text"),
+    "examples": ({"run": 100, "valid": 90, "rejected": 10, "failures": 1, "inconclusive": 0, "seed": 7,
+                  "replay": "replay-text", "facts": [], "coverage": {}}, "replay-text"),
+    "monitoring": ({"trace": "trace-text", "events_read": 3, "node_events": 2, "horizon_s": 1.0, "sha256": "ab" * 32,
+                    "counts": {"ok": 3}, "first_violation": None, "first_assumption_violation": None}, "trace-text"),
+    "statistics": ({"sha256": "cd" * 32, "answers": 3, "violations": 0, "inconclusive": 0, "seconds": 2.0,
+                    "recorded": "2026-01-02", "environment": "environment-text", "origin": "operation"},
+                   "environment-text"),
+    "strength": ({"kind": "tested", "doubt": 0.2, "detail": "strength-text"}, "strength-text"),
+}
+
+
+def test_the_evidence_renderers_show_each_field_they_read_and_refuse_an_undeclared_key() -> None:
+    part = part_renderer(FragmentCache(), "")
+    assert list(_EVIDENCE) == list(EvidenceRow.__struct_fields__)
+    row = {k: v for k, (v, _) in _EVIDENCE.items()}
+    rows = [{"anchor": "ev-x", "record": row}]
+    html, md = str(part("evidence.html", rows=rows)), part("evidence.md", rows=rows)
+    for k, (_, text) in _EVIDENCE.items():
+        if k in evidence_rows.INTERNAL:
+            assert text not in html + md, k
+        else:
+            assert text in html and (text in md or k == "plot_svg"), k  # the Markdown report draws no plot
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("evidence.html", rows=[{"anchor": "ev-y", "record": {**row, "margin_added_here": "0.5 m"}}])
+    # the JSON object the report writes is every field, in the order declared, each at its default if unset
+    bare = EvidenceRow(*(row[k] for k in list(EvidenceRow.__struct_fields__)[:12])).to_json()
+    assert list(bare) == list(EvidenceRow.__struct_fields__)
+    assert (bare["figures"], bare["plot_svg"], bare["solvers"], bare["monitoring"], bare["strength"]) == (
+        [], "", None, {}, None)
+    assert EvidenceRow.of(bare).to_json() == bare
+
+
+class _RequirementWithMargin(RequirementRow, frozen=True, forbid_unknown_fields=True):
+    """The requirement row with one field added, as a change to records/requirement_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_a_requirement_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["requirements"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_RequirementWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_RequirementWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ req.note|prose }}", "{{ req.note|prose }} {{ req.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_RequirementWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    # a read of an undecoded row (the view's ``t.req``) does not count
+    raw = sources[0].replace("{% set req = t.req %}", "{% set req = t.req %}{{ req.margin_added_here }}", 1)
+    assert raw != sources[0]
+    assert unaccounted(_RequirementWithMargin, [raw, sources[1]], r.internal, r.filter) != []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "requirements",
+                   (_RequirementWithMargin, schema_gen.GENERATED["requirements"][1]))
+        part = schema_gen.generated_part("requirements", SCHEMA)
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["requirements"] != part
+    # the requirements stage's check record keeps its hand-written schema in the generated part
+    assert part["items"]["properties"]["check"] == SCHEMA["properties"]["requirements"]["items"]["properties"]["check"]
+
+
+_REQUIREMENT: dict[str, Any] = {
+    "id": "R1", "text": "text-words", "verdict": "met", "status": "discharged", "note": "note-words",
+    "support": [{"node": "N", "guarantee": 1, "text": "y > 0", "source": "a.rcl:3:4", "status": "discharged",
+                 "obligations": ["N.g1.hoare.c1"]}],
+    "check": {"formal": "y > 0", "source": "plan.yaml:4:5", "declarations": []}}
+
+
+def test_a_requirement_row_is_written_whole_and_refuses_an_undeclared_key() -> None:
+    from rclverify.model.plan.declarations import STRENGTHS
+    assert typing.get_args(requirement_rows.StrengthKind) == STRENGTHS  # the plan's strength words
+    row = RequirementRow.of(_REQUIREMENT).to_json()
+    # every field, in the order declared, the later passes' at their defaults (a key never absent in one run)
+    assert list(row) == list(RequirementRow.__struct_fields__)
+    assert (row["deadline"], row["without_deadline"], row["statistics"], row["confidence"], row["limited_by"],
+            row["required_strength"], row["strength_shortfall"]) == (None, None, [], None, None, None, [])
+    assert RequirementRow.of(row).to_json() == row
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        RequirementRow.of({**row, "margin_added_here": "0.5 m"})
+    with pytest.raises(msgspec.ValidationError, match="verdict"):
+        RequirementRow.of({**row, "verdict": "nearly met"})
+    env = __import__("rclverify.report.templating", fromlist=["environment"]).environment()
+    shown = env.from_string("{% for q in rows|requirement_rows %}{{ q.id }} {{ q|reqbadges }} {{ q.note }}"
+                            "{% endfor %}").render(rows=[row])
+    assert "R1" in shown and "note-words" in shown
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        env.from_string("{% for q in rows|requirement_rows %}{{ q.id }}{% endfor %}").render(
+            rows=[{**row, "margin_added_here": "0.5 m"}])
+
+
+class _StatisticsWithMargin(StatisticsRow, frozen=True, forbid_unknown_fields=True):
+    """The statistics row with one field added, as a change to records/statistics_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_a_statistics_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["statistics"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_StatisticsWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_StatisticsWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ s.origin }}", "{{ s.origin }} {{ s.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_StatisticsWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "statistics", (_StatisticsWithMargin, schema_gen.GENERATED["statistics"][1]))
+        part = schema_gen.generated_part("statistics")
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["statistics"] != part
+
+
+#: One row of each kind, as report/statistics.py writes them, each field's value its own.
+_STATISTICS: list[dict[str, Any]] = [
+    StatisticsRow(kind="runs", node="Nodey", environment="env-text", origin="operation",
+                  counts={"runs": 17, "violating_runs": 0, "undecided_runs": 0, "answers": 90, "seconds": 1.5},
+                  recorded={"live": 17}, level=0.95, bound=0.1625, note="note-text").to_json(),
+    StatisticsRow(kind="target", node="Nodey", environment="env-text", origin="trials", counts=None, level=0.9,
+                  bound=0.25, obligation="Nodey.g1.experiment.t1", backend="experiment", status="pending",
+                  target="target-text", runs_needed=13, sprt="continue").to_json(),
+    StatisticsRow(kind="requirement", requirement="R1", environment="env-text", origin="operation",
+                  **{k: v for k, v in RequirementRuns(
+                      environment="env-text", origin="operation", counts={"runs": 3}, bound=0.6316, level=0.95,
+                      target="target-text", status="failed", explanation="explanation-text", runs_needed=None,
+                      sprt="reject").to_json().items() if k not in ("environment", "origin")}).to_json(),
+]
+
+
+def test_the_statistics_renderers_show_each_field_they_read_and_refuse_an_undeclared_key() -> None:
+    part = part_renderer(FragmentCache(), "")
+    html, md = str(part("statistics.html", rows=_STATISTICS)), part("statistics.md", rows=_STATISTICS)
+    for text in ("Nodey (every run)", "env-text", "operation", "17", "live 17", "0.163 at 95 %", "note-text",
+                 "Nodey.g1.experiment.t1", "target-text", "13", "continue", "R1", "explanation-text", "reject"):
+        assert text in html and text in md, text
+    assert all(list(r) == list(StatisticsRow.__struct_fields__) for r in _STATISTICS)  # every field, always
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        part("statistics.html", rows=[{**_STATISTICS[0], "margin_added_here": "0.5 m"}])
+    with pytest.raises(msgspec.ValidationError, match="kind"):
+        StatisticsRow.of({**_STATISTICS[0], "kind": "guess"})
+
+
+class _StandardWithMargin(StandardRow, frozen=True, forbid_unknown_fields=True):
+    """The standard's row with one field added, as a change to records/standards_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_a_field_added_to_a_standard_row_fails_until_rendered_or_internal() -> None:
+    r = RECORDS["standards"]
+    sources = _sources(r.renderers)
+    assert unaccounted(_StandardWithMargin, sources, r.internal, r.filter) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_StandardWithMargin, sources, {**r.internal, "margin_added_here": "why"}, r.filter) == []
+    html = sources[0].replace("{{ s.title }}", "{{ s.title }} {{ s.margin_added_here }}", 1)
+    assert html != sources[0]
+    assert unaccounted(_StandardWithMargin, [html, sources[1]], r.internal, r.filter) == []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(schema_gen.GENERATED, "standards", (_StandardWithMargin, schema_gen.GENERATED["standards"][1]))
+        part = schema_gen.generated_part("standards")
+    assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
+    assert SCHEMA["properties"]["standards"] != part

@@ -1,0 +1,142 @@
+"""Services, actions and deadlines monitored live on ROS 1 (issue 33).
+
+A ROS 1 master on 127.0.0.1 (a free port), the safety-stop example's nodes
+as rospy processes, and ``rclverify monitor --live --forward /estop=/estop_real
+--interfaces interfaces`` (the service proxy inside the live monitor): the estop server answers
+its second call 400 ms late (its deadline is 200 ms), the move action's
+feedback comes 0.5 s after the goal (deadline 2 s).  The monitor's log must
+hold a ``false`` verdict with the late call's stamps and a ``true`` one for
+the feedback.  Every process is stopped in a ``finally``; skipped, with the
+reason, only where ROS 1 cannot be imported.
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+from _procs import stop, wait_for
+
+from rclverify.runtime.ros1 import LocalMaster, RosUnavailable, import_rospy
+
+REPO = Path(__file__).resolve().parents[2]
+EXAMPLE = REPO / "examples" / "safety_stop"
+NODES = EXAMPLE / "nodes" / "ros1_nodes.py"
+
+try:
+    import_rospy()
+    REASON = ""
+except RosUnavailable as exc:
+    REASON = str(exc)
+pytestmark = pytest.mark.skipif(bool(REASON), reason=f"ROS 1 unavailable: {REASON}")
+
+
+def _start(args: list[str], env: dict[str, str], out: Path) -> subprocess.Popen[bytes]:
+    return subprocess.Popen([sys.executable, *args], env=env, cwd=EXAMPLE, stdout=out.open("wb"),
+                            stderr=subprocess.STDOUT, start_new_session=True)
+
+
+@pytest.fixture(scope="module")
+def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    tmp = tmp_path_factory.mktemp("svc")
+    procs: list[subprocess.Popen[bytes]] = []
+    log = tmp / "monitor.jsonl"
+    with LocalMaster(tmp / "ros") as env:
+        (tmp / "scratch").mkdir()  # the processes' $TMPDIR: what they leave behind
+        env = {**env, "PYTHONPATH": str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""),
+               "TMPDIR": str(tmp / "scratch")}
+        try:
+            base = _start([str(NODES), "base", "--serve", "/estop_real", "--late-call", "2", "--delay", "0.4"],
+                          env, tmp / "base.out")
+            mover = _start([str(NODES), "mover", "--feedback-after", "0.5"], env, tmp / "mover.out")
+            procs += [base, mover]
+            wait_for(tmp / "base.out", "ready", 60)
+            wait_for(tmp / "mover.out", "ready", 60)
+            # the proxy inside the live monitor: one process, one log, one verdict topic
+            monitor = _start(["-m", "rclverify.cli.commands", "monitor", "-w", str(EXAMPLE), "--live", "--interfaces",
+                              "interfaces", "--forward", "/estop=/estop_real", "--log", str(log),
+                              "--evidence", str(tmp / "live.json"), "--duration", "60"], env, tmp / "monitor.out")
+            procs.append(monitor)
+            wait_for(tmp / "monitor.out", "monitoring ", 60)
+            # the deadline verdicts on the live monitor's verdict topic, as a subscriber sees them
+            echo = subprocess.Popen(["rostopic", "echo", "/rclverify/verdict"], env=env, stdout=(tmp / "echo.out").open("wb"),
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+            procs.append(echo)
+            time.sleep(1.0)  # subscribed before the first call
+            teleop = _start([str(NODES), "teleop", "--call", "/estop", "--count", "2", "--every", "0.3"],
+                            env, tmp / "teleop.out")
+            mission = _start([str(NODES), "mission", "--target", "2.0"], env, tmp / "mission.out")
+            procs += [teleop, mission]
+            assert teleop.wait(60) == 0, (tmp / "teleop.out").read_text()
+            assert mission.wait(60) == 0, (tmp / "mission.out").read_text()
+            wait_for(log, '"node": "Mover"', 30)
+            stop(monitor, signal.SIGINT)
+            code = monitor.returncode
+        finally:
+            for p in reversed(procs):
+                stop(p)
+    # the proxy's lines ("kind": event, verdict, summary) among the live monitor's own
+    lines = [x for x in map(json.loads, log.read_text().splitlines()) if "kind" in x]
+    return {"lines": lines, "code": code, "tmp": tmp, "out": (tmp / "monitor.out").read_text(),
+            "echo": (tmp / "echo.out").read_text(errors="replace"),
+            "record": json.loads((tmp / "live.json").read_text())}
+
+
+def test_the_late_service_answer_is_false_with_the_calls_stamps(live_log: dict[str, Any]) -> None:
+    verdicts = [x for x in live_log["lines"] if x["kind"] == "verdict" and x["node"] == "Base"]
+    assert [(v["verdict"], v["update"]) for v in verdicts] == [("true", False), ("false", False), ("false", True)]
+    expired, late = verdicts[1], verdicts[2]
+    # false as soon as the clock passed the deadline (the proxy's timer), before the answer came ...
+    assert expired["answer"] is None and expired["reason"].startswith("no answer within the deadline of 200 ms")
+    # ... and the late answer, when it came, shown with the call's stamps
+    assert late["trigger_where"] == expired["trigger_where"] and late["guarantee"] == 1
+    assert late["due"] == pytest.approx(late["trigger_stamp"] + 0.2)
+    assert late["answer"] - late["trigger_stamp"] >= 0.4  # the server slept 400 ms
+    # the stamps are those of the second call's request and response events, as the proxy logged them
+    events = {x["index"] + 1: x for x in live_log["lines"] if x["kind"] == "event"}
+    req = events[int(late["trigger_where"].split(":")[1])]
+    resp = events[int(late["answer_where"].split(":")[1])]
+    assert (req["topic"], resp["topic"]) == ("estop/request", "estop/response")
+    assert (req["time"], resp["time"]) == (late["trigger_stamp"], late["answer"])
+    assert live_log["code"] == 1  # a false verdict: the monitor's exit code says so
+
+
+def test_the_action_feedback_arrives_in_time(live_log: dict[str, Any]) -> None:
+    verdicts = [x for x in live_log["lines"] if x["kind"] == "verdict" and x["node"] == "Mover"]
+    assert [v["verdict"] for v in verdicts] == ["true"], verdicts
+    v = verdicts[0]
+    assert 0.4 <= v["answer"] - v["trigger_stamp"] <= 2.0
+    topics = [x["topic"] for x in live_log["lines"] if x["kind"] == "event"]
+    assert {"move/goal", "move/feedback", "move/result"} <= set(topics)
+    summary = [x for x in live_log["lines"] if x["kind"] == "summary"]
+    assert len(summary) == 1 and summary[0]["false"] == 1
+    # the command's evidence record and output carry the deadline verdicts too
+    assert live_log["record"]["deadlines"]["false"] == 1
+    assert [r["node"] for r in live_log["record"]["deadlines"]["results"]] == ["Teleop", "Base", "Mover"]
+    assert re.search(r"deadlines: 1 of \d+ judged call\(s\) or goal\(s\) missed their deadline", live_log["out"])
+    published = live_log["echo"]
+    assert '\\"kind\\": \\"deadline\\"' in published and '\\"verdict\\": \\"false\\"' in published, published[-2000:]
+
+
+def test_the_calls_reach_the_node_monitors_live(live_log: dict[str, Any]) -> None:
+    """The proxy hands each call and action message to the live engine too
+    (issue 40): the untimed monitors check the server's responses against
+    its guarantees as the offline check does."""
+    nodes = {n["node"]: n for n in live_log["record"]["nodes"]}
+    assert nodes["Base"]["counts"]["satisfied"] == 2, nodes["Base"]  # both estop calls answered as guaranteed
+    # the goal's feedback and result, each judged when it answers the goal (one heard before the goal answers none)
+    assert 1 <= nodes["Mover"]["counts"]["satisfied"] <= 2 and nodes["Mover"]["counts"]["violated"] == 0, nodes["Mover"]
+    assert nodes["Base"]["status"] == nodes["Mover"]["status"] == "discharged"
+
+
+def test_the_generated_action_messages_do_not_outlive_the_processes(live_log: dict[str, Any]) -> None:
+    # the monitor's proxy and the mover each write the action's expanded .msg files to make rospy's
+    # classes; the classes live on in memory, the files go with the class generation
+    assert not [p.name for p in (live_log["tmp"] / "scratch").iterdir()]
