@@ -1,7 +1,7 @@
 """Realizability verdicts are a function of the inputs alone (docs/decisions.md,
 "Results never depend on the wall clock"): the checks of the case study and
-of the ros2_robot example, run with both cores kept busy (the suite's
-workers and a CPU-burning process; two burners when run alone), give the same findings every time, equal to an idle run's; with
+of the ros2_robot example, run with both cores kept busy (by the parallel
+suite's own workers, or by two CPU-burning processes when run alone), give the same findings every time, equal to an idle run's; with
 the wall-clock net made as small as a loaded machine made the old one, the
 same comparison sees the difference (the control)."""
 from __future__ import annotations
@@ -26,9 +26,9 @@ ROOT = Path(__file__).resolve().parents[2]
 #: sequence's items, on which quantifier elimination spends its steps slowly).
 WORKSPACES = ((ROOT, ["contracts/remote_inspection.rcl"]), (ROOT / "examples" / "ros2_robot", ["contracts/robot.rcl"]))
 RUNS = 3
-#: CPU-burning processes beside the checks: one in the suite (its own workers keep both cores busy; each
-#: burner's CPU is the suite's time), two when the module runs alone (RCLVERIFY_BURNERS=2)
-BURNERS = int(os.environ.get("RCLVERIFY_BURNERS", "1"))
+#: CPU-burning processes beside the checks: none in the parallel suite (its own workers keep both cores
+#: busy, and a burner's CPU is the suite's time), two when the module runs alone; RCLVERIFY_BURNERS says
+BURNERS = int(os.environ.get("RCLVERIFY_BURNERS", "0" if os.environ.get("PYTEST_XDIST_WORKER") else "2"))
 
 
 @contextmanager
