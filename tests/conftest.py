@@ -109,7 +109,8 @@ WALL: dict[str, float] = {
     "test_ros_master_hostile": 5.0, "test_ros_diff_dds": 4.7, "test_lsp_invalid": 3.3, "test_lsp_nvim": 2.7, "test_monitor_oracle": 2.2,
     "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0, "test_ros2_event_time": 20.0,
     "test_example_manipulator": 32.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
-    "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0,
+    "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
+    "test_example_ros2_robot": 30.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.

@@ -138,9 +138,9 @@ while True:
     ex.spin_once(timeout_sec=0.1)
 """.replace("ROUNDS", str(ROUNDS))
 
-#: CPU-burning processes beside the nodes: one in the suite (its own workers load both cores; each burner's
-#: CPU is the suite's time), two when the module runs alone (RCLVERIFY_BURNERS)
-BURNERS = int(os.environ.get("RCLVERIFY_BURNERS", "1"))
+#: CPU-burning processes beside the nodes: none in the parallel suite (its own workers keep both cores
+#: busy, and a burner's CPU is the suite's time), two when the module runs alone; RCLVERIFY_BURNERS says
+BURNERS = int(os.environ.get("RCLVERIFY_BURNERS", "0" if os.environ.get("PYTEST_XDIST_WORKER") else "2"))
 BURN = "import time\nend = time.monotonic() + 60\nwhile time.monotonic() < end:\n    pass\n"
 
 
