@@ -137,10 +137,11 @@ class Obligation:
 
 
 def _plain(x: object) -> object:
-    """A mapping other than a dict (an obligation's ``data`` may be one) as a dict, for msgspec's encoder."""
+    """A mapping other than a dict (an obligation's ``data`` may be one) as a dict, for msgspec's encoder
+    (its ``enc_hook``).  Raises ``TypeError`` for any other value msgspec cannot encode."""
     if isinstance(x, Mapping):
         return dict(x)
-    raise NotImplementedError(f"cannot encode {type(x).__name__}")
+    raise TypeError(f"cannot encode {type(x).__name__}")
 
 
 @dataclass(frozen=True)
