@@ -12,17 +12,17 @@ from __future__ import annotations
 import re
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Callable, Mapping
 from urllib.parse import quote
 
 import jinja2
 from markupsafe import Markup, escape
 
 from rclverify.records.evidence_rows import EvidenceRow
-from rclverify.records.requirement_rows import RequirementRow, rows_of as requirement_rows_of
-from rclverify.records.statistics_rows import StatisticsRow, rows_of as statistics_rows_of
-from rclverify.records.standards_rows import StandardRow, rows_of as standard_rows_of
-from rclverify.records.findings import FindingRow, rows_of
+from rclverify.records.requirement_rows import rows_of as requirement_rows_of
+from rclverify.records.statistics_rows import rows_of as statistics_rows_of
+from rclverify.records.standards_rows import rows_of as standard_rows_of
+from rclverify.records.findings import rows_of
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.records import SEVERITY
 from rclverify.report import htmlfilters
@@ -233,63 +233,6 @@ def model_text(model: Mapping[str, Any] | None) -> str:
     return ", ".join(f"{k} = {clip(v)}" for k, v in sorted((model or {}).items()))
 
 
-def finding_rows(rows: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
-    """The report's finding rows (``findings[]``) decoded into
-    :class:`~rclverify.records.findings.FindingRow`, so a template reads
-    declared fields only (an undeclared attribute raises under
-    ``StrictUndefined``; tests/records/test_record_shapes.py holds every field to a
-    renderer or :data:`~rclverify.records.findings.INTERNAL`)."""
-    return rows_of(rows)
-
-
-def obligation_row(row: Mapping[str, Any] | ObligationRow) -> ObligationRow:
-    """An obligation's row (``obligations[]``) decoded into
-    :class:`~rclverify.records.obligations.ObligationRow`, so a template
-    reads declared fields only (tests/records/test_record_shapes.py holds every
-    field to a renderer or :data:`~rclverify.records.obligations.INTERNAL`).
-    Raises :class:`msgspec.ValidationError` for a key no field declares."""
-    return ObligationRow.of(row)
-
-
-def evidence_row(row: Mapping[str, Any] | EvidenceRow) -> EvidenceRow:
-    """An evidence record's row (``evidence[]``) decoded into
-    :class:`~rclverify.records.evidence_rows.EvidenceRow`, so a template
-    reads declared fields only (tests/records/test_record_shapes.py holds every
-    field to a renderer or :data:`~rclverify.records.evidence_rows.INTERNAL`).
-    Raises :class:`msgspec.ValidationError` for a key no field declares."""
-    return EvidenceRow.of(row)
-
-
-def requirement_rows(rows: Iterable[Mapping[str, Any] | RequirementRow]) -> list[RequirementRow]:
-    """The report's ``requirements[]`` decoded into
-    :class:`~rclverify.records.requirement_rows.RequirementRow`, in order, so
-    a template reads declared fields only (tests/records/test_record_shapes.py holds
-    every field to a renderer or
-    :data:`~rclverify.records.requirement_rows.INTERNAL`).  Raises
-    :class:`msgspec.ValidationError` for a key no field declares."""
-    return requirement_rows_of(rows)
-
-
-def statistics_rows(rows: Iterable[Mapping[str, Any] | StatisticsRow]) -> list[StatisticsRow]:
-    """The report's ``statistics[]`` decoded into
-    :class:`~rclverify.records.statistics_rows.StatisticsRow`, in order, so
-    a template reads declared fields only (tests/records/test_record_shapes.py holds
-    every field to a renderer or
-    :data:`~rclverify.records.statistics_rows.INTERNAL`).  Raises
-    :class:`msgspec.ValidationError` for a key no field declares."""
-    return statistics_rows_of(rows)
-
-
-def standard_rows(rows: Iterable[Mapping[str, Any] | StandardRow]) -> list[StandardRow]:
-    """The report's ``standards[]`` decoded into
-    :class:`~rclverify.records.standards_rows.StandardRow`, in order, so a
-    template reads declared fields only (tests/records/test_record_shapes.py holds
-    every field to a renderer or
-    :data:`~rclverify.records.standards_rows.INTERNAL`).  Raises
-    :class:`msgspec.ValidationError` for a key no field declares."""
-    return standard_rows_of(rows)
-
-
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     """The report's jinja2 environment.
@@ -314,9 +257,12 @@ def environment() -> jinja2.Environment:
         anchor=anchor, badge=html_badge, md=md_text, code=md_code, fence=md_fence,
         mdbadge=md_badge, secs=seconds, comment_safe=comment_safe, style=style, clip=clip,
         formula=formula_html, lines=formula_lines, wbr=breakable, codes=md_code_list,
-        formulas=formula_html_list, findings=finding_rows, obligation_row=obligation_row,
-        evidence_row=evidence_row, requirement_rows=requirement_rows,
-        statistics_rows=statistics_rows, standard_rows=standard_rows,
+        formulas=formula_html_list,
+        # the rows defined once, decoded so that a template reads declared fields only (an undeclared
+        # attribute raises under StrictUndefined, an undeclared key msgspec.ValidationError; every field is
+        # held to a renderer or its record's INTERNAL by tests/records/test_record_shapes.py)
+        findings=rows_of, obligation_row=ObligationRow.of, evidence_row=EvidenceRow.of,
+        requirement_rows=requirement_rows_of, statistics_rows=statistics_rows_of, standard_rows=standard_rows_of,
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame
