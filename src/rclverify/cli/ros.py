@@ -161,9 +161,8 @@ def cmd_diff(args: argparse.Namespace) -> int:
     """``rclverify ros diff``: print the missing and extra lists (docs/ros.md,
     "Expected against observed"); exit 0 equal, 1 they differ (or the master or
     the DDS domain cannot be read, or a scanned file cannot be), 2 usage."""
-    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     from rclverify.ros.graph.bag import bag_topics  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
-    from rclverify.ros.live.diff import diff_bag, diff_master, render_text  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
+    from rclverify.ros.live.diff import diff_bag, diff_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
     from rclverify.ros.live.master import MasterError, read_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
     if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)))) != 1:
         print("error: ros diff needs exactly one running side: --master URI, --ros2 or --bag BAG", file=sys.stderr)
@@ -200,14 +199,8 @@ def cmd_diff(args: argparse.Namespace) -> int:
                 print(n, file=sys.stderr)
             return 1
         result = diff_bag(res.graph, bag)
-    for line in render_text(result):
-        print(line)
-    if args.json:
-        try:
-            atomic_write_text(Path(args.json), json.dumps(result.to_json(), indent=2) + "\n")
-        except OSError as exc:
-            print(f"{args.json}: error: cannot write: {exc.strerror or exc}", file=sys.stderr)
-            return 1
+    if not _shown(result, args.json):
+        return 1
     errors = any(n.severity == "error" for n in res.graph.notes)
     return 0 if result.equal and not errors else 1
 
@@ -217,9 +210,7 @@ def _diff_nodl(args: argparse.Namespace) -> int:
     (:mod:`rclverify.ros.ground.diff_nodl`); exit 0 equal, 1 they differ or a side cannot be read, 2 usage."""
     from rclverify.model.nodl.check import document_files, read_all, shown  # deferred: start-up (loads jsonschema and yaml only when called)
     from rclverify.model.nodl.document import Resolver  # deferred: start-up (loads jsonschema and yaml only when called)
-    from rclverify.ros.live.diff import render_text  # deferred: start-up (loads the ROS layers only when called)
     from rclverify.ros.ground.diff_nodl import nodes_of  # deferred: start-up (loads the ROS layers only when called)
-    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.records only when called)
     if args.paths or args.launch:
         print("error: ros diff --nodl compares the documents, not the code: give no PATH or --launch", file=sys.stderr)
         return 2
@@ -236,15 +227,25 @@ def _diff_nodl(args: argparse.Namespace) -> int:
     result = _diff_ros2(args, None, docs)
     if result is None:
         return 1
+    if not _shown(result, args.json):
+        return 1
+    return 0 if result.equal else 1
+
+
+def _shown(result: Any, json_path: str | None) -> bool:
+    """Print the diff ``result`` and write its JSON to ``json_path`` (``--json``) when given; ``False``
+    after saying on stderr why the JSON could not be written."""
+    from rclverify.ros.live.diff import render_text  # deferred: start-up (loads the ROS layers only when called)
+    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.records only when called)
     for line in render_text(result):
         print(line)
-    if args.json:
+    if json_path:
         try:
-            atomic_write_text(Path(args.json), json.dumps(result.to_json(), indent=2) + "\n")
+            atomic_write_text(Path(json_path), json.dumps(result.to_json(), indent=2) + "\n")
         except OSError as exc:
-            print(f"{args.json}: error: cannot write: {exc.strerror or exc}", file=sys.stderr)
-            return 1
-    return 0 if result.equal else 1
+            print(f"{json_path}: error: cannot write: {exc.strerror or exc}", file=sys.stderr)
+            return False
+    return True
 
 
 def _diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> Any:
