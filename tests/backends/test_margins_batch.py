@@ -21,6 +21,7 @@ import random
 from typing import Any
 
 import pytest
+from _classifier import CLASSIFIER
 
 from rclverify.backends.monitors.batch import check_batch
 from rclverify.backends.monitors.check import check_trace
@@ -31,18 +32,7 @@ from rclverify.targets import column_margins
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import load_rules
 
-CONTRACTS = """
-context { Band : {green, orange, red} ; }
-node Classifier {
-  inputs( r : REAL )
-  outputs( status : Band )
-  topics( std_msgs/Float64 reading matches(in.r), std_msgs/String status matches(out.status) )
-  assume( 0 <= in.r )
-  guarantee( (in.r < 120 -> out.status == green)
-         and (120 <= in.r and in.r < 250 -> out.status == orange)
-         and (250 <= in.r -> out.status == red) )
-}
-node Linear {
+CONTRACTS = "\n" + CLASSIFIER + """node Linear {
   inputs( a : REAL, b : REAL )
   outputs( y : REAL )
   topics( std_msgs/Float64 a matches(in.a), std_msgs/Float64 b matches(in.b), std_msgs/Float64 y matches(out.y) )
