@@ -27,6 +27,7 @@ from typing import Any, Literal, Mapping, NotRequired, TypedDict, cast
 from rclverify.records.statuses import (AcknowledgementStatus, Agreement, AnyStatus, DeadlineVerdict, Derivation,
                                         EvidenceKind, EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
                                         SideConditionVerdict, EVIDENCE_STATUSES)
+from rclverify.records import stage_records
 from rclverify.records.nodl_rows import NodlRow
 
 
@@ -102,15 +103,9 @@ class HopTimeMargin(TypedDict):
     unanswered: int
 
 
-class DeadlineHop(TypedDict):
-    """One timed guarantee of a deadline's chain (``$defs/deadline_hop``; report/deadlines.py)."""
-    node: str
-    guarantee: int
-    trigger: str
-    outputs: list[str]
-    within_s: str
-    within: str
-    loc: str
+class DeadlineHop(stage_records.DeadlineHop):
+    """One timed guarantee of a deadline's chain (``$defs/deadline_hop``; report/deadlines.py): the
+    stage's hop with the report's status and timing."""
     status: NotRequired[EvidenceStatus]
     timing: NotRequired[str]
     monitors: NotRequired[list[dict[str, Any]]]
