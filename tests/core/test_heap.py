@@ -29,9 +29,17 @@ def test_loading_restores_the_collector_also_after_an_error() -> None:
         gc.enable()
 
 
-def test_a_run_heap_is_given_back_after_the_run() -> None:
-    heap.release_after_run()  # a build_tasks of an earlier test without a doit run to end it
+def _unfrozen_start() -> None:
+    """The collector as a fresh process has it: nothing frozen by a build_tasks of an earlier
+    test without a doit run to end it, nor by a live monitor an earlier test ran in this worker
+    (freeze_for_live: never undone, the monitor's process ends with it)."""
+    heap.release_after_run()
+    gc.unfreeze()
     assert gc.get_freeze_count() == 0
+
+
+def test_a_run_heap_is_given_back_after_the_run() -> None:
+    _unfrozen_start()
     heap.freeze_for_run()
     assert gc.get_freeze_count() > 0
     heap.release_after_run()
