@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import sys
+import typing
 from pathlib import Path
 from typing import Any
 
@@ -37,25 +38,43 @@ from rclverify.records.standards_rows import StandardRow
 from rclverify.records.statistics_rows import StatisticsRow
 from rclverify.records.statuses import VOCABULARY
 
-#: Top-level key of the report -> (the class of its items, the key's description).
-GENERATED: dict[str, tuple[type[msgspec.Struct], str]] = {
-    "requirements": (RequirementRow, "The plan's requirements, in plan order."),
-    "findings": (FindingRow, "Contract health findings (vacuity, consistency, realizability, scale)."),
-    "obligations": (ObligationRow, "Every obligation of the plan's evidence entries."),
-    "evidence": (EvidenceRow, "One row per obligation with an evidence record."),
-    "statistics": (StatisticsRow, "Runs counted by environment, bounds and targets (docs/statistics.md)."),
-    "standards": (StandardRow, "The evidence mapped onto the standards the plan names (docs/standards.md); empty "
-                               "when it names none."),
+#: Top-level key of the report -> (its type: ``list[Row]`` for an array of a record's items, a record's
+#: class, or ``Row | None``; the key's description).
+GENERATED: dict[str, tuple[Any, str]] = {
+    "requirements": (list[RequirementRow], "The plan's requirements, in plan order."),
+    "findings": (list[FindingRow], "Contract health findings (vacuity, consistency, realizability, scale)."),
+    "obligations": (list[ObligationRow], "Every obligation of the plan's evidence entries."),
+    "evidence": (list[EvidenceRow], "One row per obligation with an evidence record."),
+    "statistics": (list[StatisticsRow], "Runs counted by environment, bounds and targets (docs/statistics.md)."),
+    "standards": (list[StandardRow], "The evidence mapped onto the standards the plan names (docs/standards.md); "
+                                     "empty when it names none."),
 }
 
-#: A type the report's schema already defines in ``$defs`` -> that entry's name.
+#: A type the report's schema defines in ``$defs`` -> that entry's name.
 SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength", "DeadlineRow": "deadline",
                            "LimitedBy": "limited_by"}
 
-#: Top-level key -> the fields of its items whose schema the file states by hand (a tool's record:
-#: the monitors backend's run summary, docs/monitors.md; the requirements stage's check record,
-#: calculus/requirements/check.py).
+#: Top-level key -> the fields of its items (or of its object) whose schema the file states by hand (a
+#: tool's record: the monitors backend's run summary, docs/monitors.md; the requirements stage's check
+#: record, calculus/requirements/check.py).
 KEPT: dict[str, tuple[str, ...]] = {"evidence": ("monitoring",), "requirements": ("check",)}
+
+
+def record_type(key: str) -> Any:
+    """The class of the record of the report's top-level ``key``."""
+    tp = GENERATED[key][0]
+    args = [a for a in typing.get_args(tp) if a is not type(None)]
+    return args[0] if args else tp
+
+
+def object_of(part: dict[str, Any]) -> dict[str, Any]:
+    """The object schema inside a generated part: an array's items, a nullable record's record."""
+    if part.get("type") == "array":
+        return object_of(part["items"])
+    for branch in part.get("anyOf", ()):
+        if branch.get("type") == "object":
+            return object_of(branch)
+    return part
 
 
 def _styled(x: Any, defs: dict[str, Any]) -> Any:
@@ -84,17 +103,18 @@ def _styled(x: Any, defs: dict[str, Any]) -> Any:
 
 
 def generated_part(key: str, schema: dict[str, Any] | None = None) -> dict[str, Any]:
-    """The schema of the report's top-level ``key`` (an array of its class's items), in the file's style;
-    each field of :data:`KEPT` as ``schema`` (the report's whole schema, as the file holds it) states it.
-    Raises ``KeyError`` when ``key`` has such fields and ``schema`` does not state them."""
-    cls, description = GENERATED[key]
-    raw = msgspec.json.schema(cls)
-    item = _styled({"$ref": raw["$ref"]}, raw.get("$defs", {}))
+    """The schema of the report's top-level ``key`` (:data:`GENERATED`: an array of a record's items, a
+    record, or a record or null), in the file's style; each field of :data:`KEPT` as ``schema`` (the
+    report's whole schema, as the file holds it) states it.  Raises ``KeyError`` when ``key`` has such
+    fields and ``schema`` does not state them."""
+    tp, description = GENERATED[key]
+    raw = msgspec.json.schema(tp)
+    part = _styled({k: v for k, v in raw.items() if k != "$defs"}, raw.get("$defs", {}))
     for name in KEPT.get(key, ()):
         if schema is None:
-            raise KeyError(f"{key}[].{name}: stated by hand in the schema file, which was not given")
-        item["properties"][name] = schema["properties"][key]["items"]["properties"][name]
-    return {"type": "array", "items": item, "description": description}
+            raise KeyError(f"{key}.{name}: stated by hand in the schema file, which was not given")
+        object_of(part)["properties"][name] = object_of(schema["properties"][key])["properties"][name]
+    return {**part, "description": description}
 
 
 def with_generated(schema: dict[str, Any]) -> dict[str, Any]:
