@@ -34,9 +34,9 @@ def test_every_backend_has_a_strength() -> None:
     assert set(BACKEND_NAMES) == set(BACKEND_KIND)
     assert set(BACKEND_KIND.values()) <= set(KINDS)
     for b in BACKEND_NAMES:  # any status but discharged gives no confidence
-        assert evidence_strength({"backend": b, "status": "failed"})["doubt"] == 1.0
+        assert evidence_strength({"backend": b, "status": "failed"}).doubt == 1.0
         s = evidence_strength({"backend": b, "status": "discharged", "figures": [["count", "60"]]})
-        assert s["kind"] == BACKEND_KIND[b] and 0 < s["doubt"] < 1
+        assert s.kind == BACKEND_KIND[b] and 0 < s.doubt < 1
 
 
 def test_the_experiment_bound_is_clopper_pearson_with_no_failure() -> None:
@@ -45,7 +45,7 @@ def test_the_experiment_bound_is_clopper_pearson_with_no_failure() -> None:
         p = one_sided_bound(n)
         assert abs((1 - p) ** n - 0.05) < 1e-12
     s = evidence_strength({"backend": "experiment", "status": "discharged", "figures": [["count", "10"]]})
-    assert s["doubt"] == pytest.approx(one_sided_bound(10)) and "10 trials" in s["detail"]
+    assert s.doubt == pytest.approx(one_sided_bound(10)) and "10 trials" in str(s.detail)
 
 
 # -- the oracle: random argument graphs with loops against a direct reading of the rules ----------------
@@ -215,9 +215,9 @@ def test_a_side_condition_read_from_cone_summaries_is_not_two_solvers() -> None:
     from rclverify.report.argument.strength import DOUBT, side_condition_strength
     sc = {"status": "discharged", "solvers": {"agreement": "two solvers"}, "context": {"summaries": ["Planner"]}}
     s = side_condition_strength(sc)
-    assert s["solvers"] == 1 and s["doubt"] == DOUBT["proof"] and "summaries" in s["detail"], s
+    assert s.solvers == 1 and s.doubt == DOUBT["proof"] and "summaries" in str(s.detail), s
     sc["context"] = {"summaries": []}
-    assert side_condition_strength(sc)["doubt"] == DOUBT["proof2"]
+    assert side_condition_strength(sc).doubt == DOUBT["proof2"]
 
 
 def test_the_observed_detail_counts_judged_messages_not_questions() -> None:
@@ -225,5 +225,5 @@ def test_the_observed_detail_counts_judged_messages_not_questions() -> None:
     alone decide; docs/semantics.md): a node without inputs has no question, yet its 5 outputs read
     "5 questions answered"."""
     row = {"backend": "monitors", "status": "discharged", "monitoring": {"counts": {"satisfied": 5}, "events_read": 5}}
-    d = evidence_strength(row)["detail"]
+    d = str(evidence_strength(row).detail)
     assert d.startswith("5 verdicts on messages (satisfied or violated)") and "question" not in d, d

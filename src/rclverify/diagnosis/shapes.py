@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from typing import NotRequired, TypedDict, cast
 
 from rclverify.diagnosis.edits import Edit
-from rclverify.records.report_schema import (DeadlineRow, EvidenceJson, FindingJson, LintRow, NodeRow, ObligationJson,
+from rclverify.records.report_schema import (DeadlineRow, EvidenceJson, FindingJson, LintRow, NodeJson, ObligationJson,
                                              RequirementJson, SideConditionRow, SystemView)
 from rclverify.records.stage_records import Repair
 
@@ -25,7 +25,7 @@ class ReportRows(TypedDict):
     is one too)."""
     system: SystemView
     requirements: list[RequirementJson]
-    nodes: list[NodeRow]
+    nodes: list[NodeJson]
     side_conditions: list[SideConditionRow]
     findings: list[FindingJson]
     obligations: list[ObligationJson]

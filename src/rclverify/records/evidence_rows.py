@@ -33,8 +33,9 @@ from __future__ import annotations
 from typing import Annotated, Any, Iterable, Mapping
 
 from rclverify.records.row import DOC, Row, decode_rows
-from rclverify.records.report_schema import Solvers, Strength
+from rclverify.records.report_schema import Solvers
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
+from rclverify.records.strength_rows import Strength
 
 _DOC = DOC
 

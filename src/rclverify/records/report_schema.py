@@ -29,6 +29,7 @@ from rclverify.records.statuses import (AcknowledgementStatus, Agreement, AnySta
                                         SideConditionVerdict, EVIDENCE_STATUSES)
 from rclverify.records import stage_records
 from rclverify.records.nodl_rows import NodlRow
+from rclverify.records.strength_rows import Strength
 
 
 class Solvers(TypedDict):
@@ -40,28 +41,6 @@ class Solvers(TypedDict):
     smt2: NotRequired[str]
 
 
-class Strength(TypedDict):
-    """How strong a piece of evidence is (``$defs/strength``; docs/confidence.md); ``doubt`` 0 to 1."""
-    kind: str
-    doubt: float
-    detail: NotRequired[str]
-    solvers: NotRequired[int]
-
-
-class LimitedBy(TypedDict):
-    """The premise with the largest doubt behind a confidence (``$defs/limited_by``)."""
-    label: str
-    kind: str
-    doubt: float
-    sentence: NotRequired[str]
-
-
-class CulpritOf(TypedDict):
-    """A problem row an item is the culprit of (``$defs/culprit_of``)."""
-    sentence: str
-    status: EvidenceStatus
-
-
 class SystemView(TypedDict):
     """The system model as the report draws it (``system``; model/system/model.py ``view``)."""
     nodes: list[dict[str, Any]]
@@ -69,13 +48,6 @@ class SystemView(TypedDict):
     environment_inputs: list[dict[str, Any]]
     loops: list[list[str]]
     loop_components: list[list[str]]
-
-
-class EnvironmentAssumptionRow(TypedDict):
-    """An environment conjunct of a node's assumption (``environment_assumptions[]``)."""
-    node: str
-    text: str
-    source: str
 
 
 class ExpectedVerdictRow(TypedDict):
@@ -234,53 +206,6 @@ class Summary(TypedDict):
     confidence: NotRequired[float]
 
 
-class InputRow(TypedDict):
-    """An input variable of a node (``nodes[].inputs[]``); ``producer`` ``Node.var``, ``None`` from the environment."""
-    name: str
-    type: str
-    producer: str | None
-
-
-class OutputRow(TypedDict):
-    """An output variable of a node (``nodes[].outputs[]``); ``consumers`` the linked inputs ``Node.var``."""
-    name: str
-    type: str
-    consumers: list[str]
-
-
-class AssumptionRow(TypedDict):
-    """An assumption of a node (``nodes[].assumptions[]``); ``environment``: no node's guarantee discharges it."""
-    text: str
-    source: str
-    environment: bool
-
-
-class GuaranteeRow(TypedDict):
-    """A guarantee of a node (``nodes[].guarantees[]``); ``index`` is 1-based."""
-    index: int
-    text: str
-    source: str
-    status: EvidenceStatus
-    obligations: list[str]
-    strength: NotRequired[Strength]
-    culprit_of: NotRequired[list[CulpritOf]]
-
-
-class NodeRow(TypedDict):
-    """A node's contract and status (``nodes[]``); ``source`` is file:line:col."""
-    name: str
-    source: str
-    status: EvidenceStatus
-    inputs: list[InputRow]
-    outputs: list[OutputRow]
-    assumptions: list[AssumptionRow]
-    guarantees: list[GuaranteeRow]
-    latex: str
-    confidence: NotRequired[float]
-    limited_by: NotRequired[LimitedBy | None]
-    culprit_of: NotRequired[list[CulpritOf]]
-
-
 class SideConditionRow(TypedDict):
     """A side condition decided by Z3 (``side_conditions[]``); ``duration_s`` in seconds."""
     id: str
@@ -303,20 +228,34 @@ class SideConditionRow(TypedDict):
     strength: NotRequired[Strength]
 
 
-class DerivedPropertyRow(TypedDict):
-    """A node's derived property with its derivation and evidence statuses (``derived_properties[]``)."""
-    node: str
-    rules: list[str]
-    instances: list[dict[str, Any]]
-    environment_assumptions: list[str]
-    property: str
-    status: EvidenceStatus
-    derivation: Derivation
-    evidence_status: EvidenceStatus
-    evidence_note: str
-    loop_assumption: str | None
-    confidence: NotRequired[float]
-    limited_by: NotRequired[LimitedBy | None]
+#: A node's row (``nodes[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.node_rows.NodeRow` (its guarantees
+#: :class:`~rclverify.records.node_rows.GuaranteeRow`), the one definition of its fields (the schema's
+#: ``nodes`` items are generated from it, records/schema_gen.py); decode it with ``NodeRow.of`` to read
+#: its fields as attributes.
+NodeJson = dict[str, Any]
+
+#: A guarantee of a node's row (``nodes[].guarantees[]``) as its JSON object: the encoding of
+#: :class:`rclverify.records.node_rows.GuaranteeRow`.
+GuaranteeJson = dict[str, Any]
+
+#: A derived property's row (``derived_properties[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.derived_rows.DerivedPropertyRow`, the one definition of its fields (the
+#: schema's ``derived_properties`` items are generated from it, records/schema_gen.py).
+DerivedPropertyJson = dict[str, Any]
+
+#: An environment assumption's row (``environment_assumptions[]``) as the report's JSON object: the
+#: encoding of :class:`rclverify.records.derived_rows.EnvironmentAssumptionRow` (its schema generated
+#: from it, records/schema_gen.py).
+EnvironmentAssumptionJson = dict[str, Any]
+
+#: A guarantee no obligation covers (``unverified[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.node_rows.UnverifiedRow` (its schema generated from it, records/schema_gen.py).
+UnverifiedJson = dict[str, Any]
+
+#: The weakest premise behind a confidence (``$defs/limited_by``) as its JSON object: the encoding of
+#: :class:`rclverify.records.strength_rows.LimitedBy`.
+LimitedByJson = dict[str, Any]
 
 
 #: A contract health finding (``findings[]``) as the report's JSON object: the encoding of
@@ -379,18 +318,6 @@ class AcknowledgementRow(TypedDict):
     matched: list[str]
 
 
-class UnverifiedRow(TypedDict):
-    """A guarantee no obligation covers (``unverified[]``)."""
-    id: str
-    node: str
-    guarantee: int
-    text: str
-    source: str
-    status: Literal["unverified"]
-    reason: str
-    message: str
-
-
 class ProblemMember(TypedDict):
     """An item of a problem row (``problems[].members[]``); ``consequence_of`` the ids of the items whose
     failure it follows from."""
@@ -426,20 +353,20 @@ class Report(TypedDict):
     summary: Summary
     system: SystemView
     requirements: list[RequirementJson]
-    nodes: list[NodeRow]
+    nodes: list[NodeJson]
     side_conditions: list[SideConditionRow]
-    derived_properties: list[DerivedPropertyRow]
+    derived_properties: list[DerivedPropertyJson]
     findings: list[FindingJson]
     obligations: list[ObligationJson]
     evidence: list[EvidenceJson]
-    environment_assumptions: list[EnvironmentAssumptionRow]
+    environment_assumptions: list[EnvironmentAssumptionJson]
     pending: list[PendingRow]
     lint: list[LintRow]
     expected_verdicts: list[ExpectedVerdictRow]
     grounding: dict[str, Any] | None
     #: the NoDL documents' check (stages/nodl.py, report/nodl.py), ``None`` when the workspace has none
     nodl: NodlRow | None
-    unverified: list[UnverifiedRow]
+    unverified: list[UnverifiedJson]
     deadlines: list[DeadlineRow]
     acknowledgements: list[AcknowledgementRow]
     #: guarantees held with a margin below the plan's near-miss threshold (report/near_misses.py)

@@ -9,12 +9,13 @@ as an object that rejects unknown keys, every nested object too; no
 what a missing key means); a value's ``description`` after its type; an enumeration equal to one of the status
 vocabularies of :mod:`rclverify.records.statuses` written as a ``$ref`` to
 that vocabulary's ``$defs`` entry, and a class named in :data:`SHARED` as a
-``$ref`` to its ``$defs`` entry.  A field named in :data:`KEPT` holds a
+``$ref`` to its ``$defs`` entry, that entry itself generated from the class
+when :data:`DEFINED` lists it.  A field named in :data:`KEPT` holds a
 value whose inner shape belongs to a tool: its schema is the file's own,
 described by hand, taken as it is.
 
 ``python -m rclverify.records.schema_gen [FILE]`` rewrites those parts of
-``FILE`` (default ``docs/assurance.schema.json``) in place through
+``FILE`` (default ``docs/assurance.schema.json``) and those ``$defs`` entries in place through
 core/atomic.py and leaves every other part as it is; it prints what it
 rewrote.  tests/records/test_record_shapes.py fails when the file and the classes
 differ.
@@ -31,12 +32,15 @@ import msgspec
 
 from rclverify.core.atomic import atomic_write_text
 from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
 from rclverify.records.findings import FindingRow
+from rclverify.records.node_rows import CulpritOf, NodeRow, UnverifiedRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.standards_rows import StandardRow
 from rclverify.records.statistics_rows import StatisticsRow
 from rclverify.records.statuses import VOCABULARY
+from rclverify.records.strength_rows import LimitedBy, Strength
 
 #: Top-level key of the report -> (its type: ``list[Row]`` for an array of a record's items, a record's
 #: class, or ``Row | None``; the key's description).
@@ -44,7 +48,11 @@ GENERATED: dict[str, tuple[Any, str]] = {
     "requirements": (list[RequirementRow], "The plan's requirements, in plan order."),
     "findings": (list[FindingRow], "Contract health findings (vacuity, consistency, realizability, scale)."),
     "obligations": (list[ObligationRow], "Every obligation of the plan's evidence entries."),
+    "nodes": (list[NodeRow], "The nodes, in contract order."),
+    "derived_properties": (list[DerivedPropertyRow], "One per node the calculus ran on."),
     "evidence": (list[EvidenceRow], "One row per obligation with an evidence record."),
+    "environment_assumptions": (list[EnvironmentAssumptionRow], "Assumptions the system leaves to its environment."),
+    "unverified": (list[UnverifiedRow], "Guarantees no obligation covers."),
     "statistics": (list[StatisticsRow], "Runs counted by environment, bounds and targets (docs/statistics.md)."),
     "standards": (list[StandardRow], "The evidence mapped onto the standards the plan names (docs/standards.md); "
                                      "empty when it names none."),
@@ -52,7 +60,10 @@ GENERATED: dict[str, tuple[Any, str]] = {
 
 #: A type the report's schema defines in ``$defs`` -> that entry's name.
 SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength", "DeadlineRow": "deadline",
-                           "LimitedBy": "limited_by"}
+                           "LimitedBy": "limited_by", "CulpritOf": "culprit_of"}
+
+#: The classes of :data:`SHARED` whose ``$defs`` entry is generated from the class (the others' are stated by hand).
+DEFINED: tuple[type[msgspec.Struct], ...] = (Strength, LimitedBy, CulpritOf)
 
 #: Top-level key -> the fields of its items (or of its object) whose schema the file states by hand (a
 #: tool's record: the monitors backend's run summary, docs/monitors.md; the requirements stage's check
@@ -117,10 +128,22 @@ def generated_part(key: str, schema: dict[str, Any] | None = None) -> dict[str, 
     return {**part, "description": description}
 
 
+def generated_def(cls: type[msgspec.Struct]) -> dict[str, Any]:
+    """The ``$defs`` entry of ``cls`` (one of :data:`DEFINED`), in the file's style: its object, the class's
+    docstring its description."""
+    raw = msgspec.json.schema(cls)
+    defs: dict[str, Any] = raw["$defs"]
+    out: dict[str, Any] = _styled(defs[cls.__name__], defs)
+    return out
+
+
 def with_generated(schema: dict[str, Any]) -> dict[str, Any]:
-    """``schema`` (the report's whole schema) with every generated part put in its place (order kept)."""
+    """``schema`` (the report's whole schema) with every generated part and ``$defs`` entry put in its place
+    (order kept; an entry of :data:`DEFINED` the file lacks is added at the end of ``$defs``)."""
     props = {k: generated_part(k, schema) if k in GENERATED else v for k, v in schema["properties"].items()}
-    return {**schema, "properties": props}
+    made = {SHARED[c.__name__]: generated_def(c) for c in DEFINED}
+    defs = {**{k: made.get(k, v) for k, v in schema.get("$defs", {}).items()}, **made}
+    return {**schema, "$defs": defs, "properties": props}
 
 
 def schema_text(schema: dict[str, Any]) -> str:
@@ -137,7 +160,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {path}:1:1: {e}", file=sys.stderr)
         return 2
     changed = atomic_write_text(path, schema_text(with_generated(schema)))
-    print(f"{path}: {', '.join(GENERATED)} {'rewritten' if changed else 'unchanged'}")
+    print(f"{path}: {', '.join(GENERATED)}, $defs {', '.join(SHARED[c.__name__] for c in DEFINED)} "
+          f"{'rewritten' if changed else 'unchanged'}")
     return 0
 
 

@@ -41,7 +41,7 @@ def _nodes_with_confidence(nodes: Sequence[Mapping[str, Any]], part: ConfidenceP
     out = []
     for n in nodes:
         strengths = part["guarantees"].get(n["name"], [])
-        guarantees = [{**g, "strength": s} for g, s in zip(n["guarantees"], strengths)]
+        guarantees = [{**g, "strength": s.to_json()} for g, s in zip(n["guarantees"], strengths)]
         out.append({**n, "guarantees": guarantees + list(n["guarantees"][len(strengths):]),
                     **part["nodes"].get(n["name"], {})})
     return out
@@ -57,8 +57,9 @@ def with_confidence(report: Mapping[str, Any], part: ConfidencePart) -> dict[str
         summary["confidence"] = part["confidence"]
     return {
         **report, "summary": summary,
-        "evidence": [{**e, "strength": s} for e, s in zip(report["evidence"], part["evidence"])],
-        "side_conditions": [{**sc, "strength": s} for sc, s in zip(report["side_conditions"], part["side_conditions"])],
+        "evidence": [{**e, "strength": s.to_json()} for e, s in zip(report["evidence"], part["evidence"])],
+        "side_conditions": [{**sc, "strength": s.to_json()}
+                            for sc, s in zip(report["side_conditions"], part["side_conditions"])],
         "nodes": _nodes_with_confidence(report["nodes"], part),
         "derived_properties": [{**d, **part["derived"].get(d["node"], {})} for d in report["derived_properties"]],
         "requirements": [{**rq, **part["requirements"].get(str(rq["id"]), {})} for rq in report["requirements"]],

@@ -33,7 +33,8 @@ from rclverify.records.records import Obligation, worst
 from rclverify.records.report_schema import Report
 from rclverify.report import assemble
 from rclverify.report.confidence_rows import confidence_part
-from rclverify.report.contract_rows import GuaranteeStatuses, contract_records, derived_rows, involved_model, node_part
+from rclverify.report.contract_rows import (GuaranteeStatuses, contract_records, derived_rows, environment_rows,
+                                          involved_model, node_part)
 from rclverify.stages.contract_texts import ContractTexts
 from rclverify.report.culprits import marked_nodes
 from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
@@ -125,7 +126,7 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
     return {"requirements": requirements, "nodes": nodes["nodes"], "side_conditions": side_conditions,
             "derived_properties": derived_rows(ws, comps, nodes, sc_status), "findings": findings,
             "obligations": ev["obligations"], "evidence": ev["evidence"],
-            "environment_assumptions": [e for n in names for e in comps[n].get("environment_assumptions", [])],
+            "environment_assumptions": environment_rows(comps, names),
             "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
             "grounding": grounding_row(ws), "nodl": nodl_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
             "deadlines": deadlines, "acknowledgements": acknowledgements,

@@ -18,7 +18,9 @@ from __future__ import annotations
 
 from typing import Any, Mapping, TypedDict
 
-from rclverify.records.report_schema import Strength
+import msgspec
+
+from rclverify.records.strength_rows import LimitedBy, Strength
 from rclverify.report.shapes import Confidence, RequirementConfidence
 from rclverify.report.argument.confidence import (Claim, Premise, derived_claims, guarantee_premise, node_claims,
                                                   requirement_claim)
@@ -44,8 +46,9 @@ class ConfidencePart(TypedDict):
     """What the confidence pass adds to the report's rows (module docstring),
     by row: ``evidence``/``side_conditions``: one ``strength`` per row, in
     the report's order; ``guarantees``: node -> one ``strength`` per
-    guarantee; ``nodes``/``derived``/``requirements``: name or id -> the
-    keys the row gains (``confidence``, ``limited_by``; a requirement also
+    guarantee (report/assemble.py writes each as its JSON object);
+    ``nodes``/``derived``/``requirements``: name or id -> the keys the row
+    gains, as JSON (``confidence``, ``limited_by``; a requirement also
     ``required_strength`` and ``strength_shortfall``); ``problems``: one
     sentence per requirement short of its required strength; ``confidence``:
     the least confidence of the formal requirements (``None``: none);
@@ -80,7 +83,7 @@ def confidence_part(report: Mapping[str, Any], links: list[tuple[str, str]],
     for sc in report.get("side_conditions", []):
         part["side_conditions"].append(side_condition_strength(sc))
         sc_premises.setdefault(str(sc.get("node")), []).append(
-            Premise(f"side condition {sc['id']}", "proof", part["side_conditions"][-1]["doubt"]))
+            Premise(f"side condition {sc['id']}", "proof", part["side_conditions"][-1].doubt))
     own: dict[str, list[Premise]] = {}
     guarantee: dict[tuple[str, int], Premise] = {}
     for n in report.get("nodes", []):
@@ -88,7 +91,7 @@ def confidence_part(report: Mapping[str, Any], links: list[tuple[str, str]],
         for g in n.get("guarantees", []):
             p = guarantee_premise(f"{name} guarantee {g['index']}", _legs(g.get("obligations", []), by_ob, status))
             guarantee[(name, int(g["index"]))] = p
-            part["guarantees"].setdefault(name, []).append({"kind": p.kind, "doubt": p.doubt})
+            part["guarantees"].setdefault(name, []).append(Strength(kind=p.kind, doubt=p.doubt))
             ps.append(p)
         own[name] = ps + sc_premises.get(name, [])
     producers: dict[str, set[str]] = {n: set() for n in own}
@@ -132,13 +135,12 @@ def _requirement(rq: Mapping[str, Any], guarantee: Mapping[tuple[str, int], Prem
             part["ok"] = False
             part["problems"].append(f"Requirement {rq['id']} requires {need} evidence; " + ", ".join(
                 f"{g.label} rests on {g.kind if g.doubt < 1.0 else 'no discharged'} evidence" for g in short))
-    conf = _put(c)
+    if c.limits is not None and rq.get("verdict") not in _PROVED:  # a claim always has its proof as a premise
+        conf = _put(c, f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it")
+    else:
+        conf = _put(c, None if c.limits is None else limit_sentence(rq["id"], c.limits))
     row["confidence"] = conf["confidence"]
-    row["limited_by"] = limited = conf["limited_by"]
-    if limited is not None and rq.get("verdict") not in _PROVED:  # a claim always has its proof as a premise
-        limited["sentence"] = f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it"
-    elif limited is not None and c.limits is not None:
-        limited["sentence"] = limit_sentence(rq["id"], c.limits)
+    row["limited_by"] = conf["limited_by"]
     part["requirements"][str(rq["id"])] = row
     return float(c.confidence)
 
@@ -159,13 +161,16 @@ def _legs(obligations: list[str], by_ob: dict[str, list[Strength]],
     for o in obligations:
         parts = o.split(".")
         leg = ".".join(parts[:4])
-        strengths: list[Strength] = by_ob.get(o) or [{"kind": "assumed", "doubt": 1.0}]
-        legs.setdefault(leg, []).extend((s["kind"], s["doubt"]) for s in strengths)
+        strengths: list[Strength] = by_ob.get(o) or [Strength(kind="assumed", doubt=1.0)]
+        legs.setdefault(leg, []).extend((s.kind, s.doubt) for s in strengths)
     return [(ps[0][0], min(1.0, sum(d for _, d in ps))) for ps in legs.values()]
 
 
-def _put(c: Claim) -> Confidence:
-    """A claim's ``confidence`` and ``limited_by`` (the premise with the largest doubt) as row keys."""
+def _put(c: Claim, sentence: str | None = None) -> Confidence:
+    """A claim's ``confidence`` and ``limited_by`` (the premise with the largest doubt, named in
+    ``sentence`` when given: a requirement's) as row keys, their JSON."""
+    lim = c.limits
     return {"confidence": c.confidence,
-            "limited_by": None if c.limits is None else {"label": c.limits.label, "kind": c.limits.kind,
-                                                         "doubt": c.limits.doubt}}
+            "limited_by": None if lim is None else LimitedBy(
+                label=lim.label, kind=lim.kind, doubt=lim.doubt,
+                sentence=msgspec.UNSET if sentence is None else sentence).to_json()}

@@ -22,7 +22,10 @@ from msgspec.structs import replace
 from rclverify.report.diagnosis_text import natural_sorted  # p1 < p2 < p10
 from rclverify.records.findings import FindingRow, HealthFinding
 from rclverify.records.records import Obligation, worst
-from rclverify.records.report_schema import DerivedPropertyRow, GuaranteeRow, NodeRow, SideConditionRow
+from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
+from rclverify.records.node_rows import AssumptionRow, GuaranteeRow, InputRow, NodeRow, OutputRow
+from rclverify.records.report_schema import (DerivedPropertyJson, EnvironmentAssumptionJson, NodeJson,
+                                             SideConditionRow)
 from rclverify.records.statuses import EvidenceStatus, HealthStatus
 from rclverify.report.cex_cone import side_condition_view
 from rclverify.report.cones import DERIVATION, ConeEvidence
@@ -119,21 +122,23 @@ class GuaranteeStatuses:
 
 
 class NodesPart(TypedDict):
-    """The node rows and, by node name, each node's status and the worst status of its guarantees."""
-    nodes: list[NodeRow]
+    """The node rows (each :class:`~rclverify.records.node_rows.NodeRow`'s JSON object) and, by node name,
+    each node's status and the worst status of its guarantees."""
+    nodes: list[NodeJson]
     status: dict[str, str]
     evidence: dict[str, str]
 
 
-def _ports(to_node: Sequence[Any], from_node: Sequence[Any], tx: Mapping[str, Any]) -> dict[str, Any]:
+def _ports(to_node: Sequence[Any], from_node: Sequence[Any],
+           tx: Mapping[str, Any]) -> tuple[list[InputRow], list[OutputRow]]:
     """A node's ``inputs`` (with the producer linked to each) and ``outputs``
     (with their consumers); ``to_node``/``from_node``: the model's links into and out of it."""
     internal = {l.to_var: f"{l.from_node}.{l.from_var}" for l in to_node}
     consumers: dict[str, list[str]] = {}
     for l in from_node:
         consumers.setdefault(l.from_var, []).append(f"{l.to_node}.{l.to_var}")
-    return {"inputs": [{"name": v, "type": t, "producer": internal.get(v)} for v, t in tx["inputs"]],
-            "outputs": [{"name": v, "type": t, "consumers": consumers.get(v, [])} for v, t in tx["outputs"]]}
+    return ([InputRow(name=v, type=t, producer=internal.get(v)) for v, t in tx["inputs"]],
+            [OutputRow(name=v, type=t, consumers=consumers.get(v, [])) for v, t in tx["outputs"]])
 
 
 def node_part(ws: Workspace, texts: ContractTexts, comps: Mapping[str, Mapping[str, Any]],
@@ -149,41 +154,48 @@ def node_part(ws: Workspace, texts: ContractTexts, comps: Mapping[str, Mapping[s
     for name, cn in ws.checked.nodes.items():
         tx = texts.node(cn.node)
         env_texts = {e["text"] for e in comps[name].get("environment_assumptions", [])}
-        guarantees: list[GuaranteeRow] = [
-            cast(GuaranteeRow, {"index": k, "text": text, "source": src, "status": g_status(name, k),
-                                "obligations": g_status.obligations(name, k)})
-            for k, (text, src) in enumerate(tx["guarantees"], 1)]
-        status = worst([g["status"] for g in guarantees] + [sc_status[name]])
+        guarantees = [GuaranteeRow(index=k, text=text, source=src, status=cast(EvidenceStatus, g_status(name, k)),
+                                   obligations=g_status.obligations(name, k))
+                      for k, (text, src) in enumerate(tx["guarantees"], 1)]
+        status = worst([g.status for g in guarantees] + [sc_status[name]])
         part["status"][name] = status
-        part["evidence"][name] = worst([g["status"] for g in guarantees], empty="pending")
-        part["nodes"].append(cast(NodeRow, {
-            "name": name, "source": str(cn.node.loc), "status": status,
-            **_ports(links_to.get(name, []), links_from.get(name, []), tx),
-            "assumptions": [{"text": text, "source": src, "environment": text in env_texts}
-                            for text, src in tx["assumptions"]],
-            "guarantees": guarantees, "latex": tx["latex"],
-        }))
+        part["evidence"][name] = worst([g.status for g in guarantees], empty="pending")
+        inputs, outputs = _ports(links_to.get(name, []), links_from.get(name, []), tx)
+        part["nodes"].append(NodeRow(
+            name=name, source=str(cn.node.loc), status=cast(EvidenceStatus, status), inputs=inputs, outputs=outputs,
+            assumptions=[AssumptionRow(text=text, source=src, environment=text in env_texts)
+                         for text, src in tx["assumptions"]],
+            guarantees=guarantees, latex=tx["latex"]).to_json())
     return part
 
 
 def derived_rows(ws: Workspace, comps: Mapping[str, Mapping[str, Any]], nodes: NodesPart,
-                 sc_status: Mapping[str, str]) -> list[DerivedPropertyRow]:
+                 sc_status: Mapping[str, str]) -> list[DerivedPropertyJson]:
     """One row per node the calculus derived a property for: its rules,
     instances, the cone's environment assumptions, and its two statuses
     (derivation and evidence, report/cones.py)."""
     model = ws.model
     cones, cone_of = ConeEvidence(model.nodes, nodes["evidence"], sc_status), model.upstream_masks()
-    rows: list[DerivedPropertyRow] = []
+    rows: list[DerivedPropertyJson] = []
     for n in ws.checked.nodes:
         c = comps[n]
         if not c:
             continue
         derivation, ev_status, ev_note = cones.summary(cone_of[n])  # the cone of the calculus (model.upstream)
-        rows.append(cast(DerivedPropertyRow, {"node": n, "rules": c["rules"], "instances": c["instances"],
-                     "environment_assumptions": c["cone_environment_assumptions"], "property": c["derived_property"],
-                     # the derivation: every side condition of the cone discharged
-                     "status": derivation, "derivation": DERIVATION.get(derivation, "undecided"),
-                     # what the rules' premises (the node contracts) rest on
-                     "evidence_status": ev_status, "evidence_note": ev_note,
-                     "loop_assumption": c["loop_assumption"]}))
+        rows.append(DerivedPropertyRow(
+            node=n, rules=c["rules"], instances=c["instances"],
+            environment_assumptions=c["cone_environment_assumptions"], property=c["derived_property"],
+            # the derivation: every side condition of the cone discharged
+            status=cast(EvidenceStatus, derivation), derivation=DERIVATION.get(derivation, "undecided"),
+            # what the rules' premises (the node contracts) rest on
+            evidence_status=cast(EvidenceStatus, ev_status), evidence_note=ev_note,
+            loop_assumption=c["loop_assumption"]).to_json())
     return rows
+
+
+def environment_rows(comps: Mapping[str, Mapping[str, Any]], nodes: Sequence[str]) -> list[EnvironmentAssumptionJson]:
+    """The environment assumptions of the calculus records ``comps`` (node -> record), node by node in the
+    order of ``nodes``, each an :class:`~rclverify.records.derived_rows.EnvironmentAssumptionRow`'s JSON
+    object (``KeyError`` for a record's assumption without ``node``, ``text`` or ``source``)."""
+    return [EnvironmentAssumptionRow(node=str(e["node"]), text=str(e["text"]), source=str(e["source"])).to_json()
+            for n in nodes for e in comps[n].get("environment_assumptions", [])]

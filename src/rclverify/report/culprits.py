@@ -6,9 +6,11 @@ culprit are where the repair goes; the dashboard of the HTML report and the term
 """
 from __future__ import annotations
 
-from typing import Any, Iterable, Iterator, Mapping, Sequence
+from typing import Any, Iterable, Iterator, Mapping, Sequence, cast
 
+from rclverify.records.node_rows import CulpritOf
 from rclverify.records.records import SEVERITY, worst
+from rclverify.records.statuses import EvidenceStatus
 
 
 def culprit_nodes(groups: Iterable[Any]) -> set[str]:
@@ -35,13 +37,14 @@ def culprit_nodes(groups: Iterable[Any]) -> set[str]:
 _AS_EVIDENCE = {"problem": "failed", "refuted": "failed", "unknown": "inconclusive", "warning": "pending"}
 
 
-def _status(word: Any) -> str | None:
+def _status(word: Any) -> EvidenceStatus | None:
     s = _AS_EVIDENCE.get(str(word), str(word))
-    return s if s in SEVERITY else None
+    return cast(EvidenceStatus, s) if s in SEVERITY else None  # SEVERITY ranks the evidence statuses
 
 
-def _blamed(problems: Iterable[Mapping[str, Any]]) -> Iterator[tuple[str, str, str, dict[str, str]]]:
-    """``(kind, node, guarantee index or '', {"status", "sentence"})`` for each culprit a problem row blames."""
+def _blamed(problems: Iterable[Mapping[str, Any]]) -> Iterator[tuple[str, str, str, dict[str, Any]]]:
+    """``(kind, node, guarantee index or '', {"status", "sentence"})`` for each culprit a problem row blames
+    (the last a :class:`~rclverify.records.node_rows.CulpritOf`'s JSON object)."""
     for g in problems:
         st = _status(g.get("status"))
         if st is None or st == "discharged" or str((g.get("key") or [""])[0]).startswith("unverified:"):
@@ -52,10 +55,10 @@ def _blamed(problems: Iterable[Mapping[str, Any]]) -> Iterator[tuple[str, str, s
             if kind == "line":  # a line of a node's code: the node, no guarantee (problems.py)
                 kind, name = "contract", str(c.get("node") or "")
             if kind in ("guarantee", "contract"):
-                yield kind, name, k, {"status": st, "sentence": str(g.get("sentence", ""))}
+                yield kind, name, k, CulpritOf(status=st, sentence=str(g.get("sentence", ""))).to_json()
 
 
-def _marked(row: Mapping[str, Any], blame: Mapping[str, str]) -> dict[str, Any]:
+def _marked(row: Mapping[str, Any], blame: Mapping[str, Any]) -> dict[str, Any]:
     """``row`` (a node or guarantee) with the status of the problem ``blame`` and the problem in ``culprit_of``."""
     seen = list(row.get("culprit_of") or [])
     if blame not in seen:

@@ -39,6 +39,7 @@ from rclverify.report.templating import model_text
 from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.evidence_rows import rows_of as evidence_rows_of
 from rclverify.records.obligations import rows_of as obligation_rows_of
+from rclverify.records.strength_rows import Strength
 from rclverify.records.report_schema import DiagnosisRow, LintRow, Report
 from rclverify.report.severity import of
 from rclverify.records.sarif import SRCROOT, sarif_fix, sarif_locations, sarif_result
@@ -195,7 +196,7 @@ def _obligation_results(report: Report) -> list[SarifResult]:
         if cex:
             props["counterexample"] = dict(cex)
         if ev is not None and ev.strength:  # the evidence's kind (docs/confidence.md)
-            props["strength"] = dict(ev.strength)
+            props["strength"] = ev.strength.to_json()
         res = sarif_result(rule, _level("obligation", o.status), " ".join(words), o.source, f"obligation:{o.id}", props)
         cause = (cex or {}).get("cause")
         if isinstance(cause, str) and sarif_locations(f"{cause}:0"):  # at the implementation's line
@@ -238,7 +239,7 @@ def _side_condition_results(report: Report) -> list[SarifResult]:
         props: dict[str, object] = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status,
                                  "verdict": verdict}
         if sc.get("strength"):
-            props["strength"] = dict(sc["strength"])
+            props["strength"] = Strength.of(sc["strength"]).to_json()
         if sc.get("solvers"):
             props["solvers"] = {k: sc["solvers"].get(k) for k in ("agreement", "why", "proof")}
         ctx = sc.get("context")

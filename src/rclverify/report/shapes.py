@@ -12,8 +12,8 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 # annotations (with string annotations every key would count as required).
 from typing import Any, NotRequired, TypedDict
 
-from rclverify.records.report_schema import (DerivedPropertyRow, DiagnosisRow, EvidenceJson, FindingJson, NodeRow,
-                                             LimitedBy, ObligationJson, PendingRow, ProblemRow, RequirementJson, SideConditionRow,
+from rclverify.records.report_schema import (DerivedPropertyJson, DiagnosisRow, EvidenceJson, FindingJson, NodeJson,
+                                             LimitedByJson, ObligationJson, PendingRow, ProblemRow, RequirementJson, SideConditionRow,
                                              Summary, SupportJson)
 
 
@@ -159,8 +159,8 @@ class Section(TypedDict):
     """A node's section (``node`` ``None`` for a name only the calculus knows); ``ob_status`` the status of
     each obligation its guarantees list."""
     name: str
-    node: NodeRow | None
-    derived: list[DerivedPropertyRow]
+    node: NodeJson | None
+    derived: list[DerivedPropertyJson]
     side: list[SideConditionRow]
     findings: list[FindingJson]
     ob_status: NotRequired[dict[str, str]]
@@ -216,7 +216,7 @@ class RunGroupBound(TypedDict):
 class Confidence(TypedDict):
     """A claim's confidence (docs/confidence.md) as the row keys it adds; ``limited_by`` ``None`` without premises."""
     confidence: float
-    limited_by: LimitedBy | None
+    limited_by: LimitedByJson | None
 
 
 class RequirementConfidence(TypedDict, total=False):
@@ -225,7 +225,7 @@ class RequirementConfidence(TypedDict, total=False):
     required_strength: str
     strength_shortfall: list[str]
     confidence: float
-    limited_by: LimitedBy | None
+    limited_by: LimitedByJson | None
 
 
 class ElementJson(TypedDict):

@@ -14,10 +14,13 @@ inconclusive); docs/reading-the-report.md, "Unverified guarantees".
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Literal
+
+from rclverify.records.node_rows import UnverifiedRow
+from rclverify.records.report_schema import UnverifiedJson
 
 #: The status of a guarantee without any obligation.
-UNVERIFIED = "unverified"
+UNVERIFIED: Literal["unverified"] = "unverified"
 
 
 def guarantee_id(node: str, k: int) -> str:
@@ -25,10 +28,11 @@ def guarantee_id(node: str, k: int) -> str:
     return f"{node}.g{k}"
 
 
-def unverified_guarantees(plan: Any, nodes: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+def unverified_guarantees(plan: Any, nodes: Sequence[Mapping[str, Any]]) -> list[UnverifiedJson]:
     """One row per guarantee of ``nodes`` (the report's node rows, each with
     ``name`` and ``guarantees``: ``[{"index", "text", "source",
-    "obligations"}]``) that no obligation covers, in report order::
+    "obligations"}]``) that no obligation covers, in report order, each an
+    :class:`~rclverify.records.node_rows.UnverifiedRow`'s JSON object::
 
         {"id": "Node.g<k>", "node", "guarantee": k, "text", "source" (file:line:col),
          "status": "unverified", "reason", "message"}
@@ -38,7 +42,7 @@ def unverified_guarantees(plan: Any, nodes: Sequence[Mapping[str, Any]]) -> list
     obligation for this guarantee.  ``message`` is the one-line problem
     (summary ``problems``).  ``plan.evidence`` maps node names to their
     entries (:class:`rclverify.model.plan.model.EvidenceEntry`)."""
-    out: list[dict[str, Any]] = []
+    out: list[UnverifiedJson] = []
     for n in nodes:
         name = str(n["name"])
         entries = tuple(getattr(plan, "evidence", {}).get(name, ()))
@@ -53,9 +57,9 @@ def unverified_guarantees(plan: Any, nodes: Sequence[Mapping[str, Any]]) -> list
                 reason = (f"none of the plan's evidence entries for {name} ({', '.join(backends)}) "
                           "exports an obligation for it")
             gid = guarantee_id(name, k)
-            out.append({"id": gid, "node": name, "guarantee": k, "text": str(g["text"]), "source": str(g["source"]),
-                        "status": UNVERIFIED, "reason": reason,
-                        "message": f"Guarantee {gid} ({g['source']}) is unverified: {reason}."})
+            out.append(UnverifiedRow(id=gid, node=name, guarantee=k, text=str(g["text"]), source=str(g["source"]),
+                                     status=UNVERIFIED, reason=reason,
+                                     message=f"Guarantee {gid} ({g['source']}) is unverified: {reason}.").to_json())
     return out
 
 

@@ -39,7 +39,7 @@ import re
 from typing import Any, Iterable, Mapping, TypeVar
 
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import (EnvironmentAssumptionRow, NodeRow, ObligationJson, Report,
+from rclverify.records.report_schema import (EnvironmentAssumptionJson, NodeJson, ObligationJson, Report,
                                              RequirementJson, SideConditionRow)
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
@@ -51,7 +51,7 @@ from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
 
 #: A report row that names its node.
-_Row = TypeVar("_Row", ObligationJson, SideConditionRow, EnvironmentAssumptionRow)
+_Row = TypeVar("_Row", ObligationJson, SideConditionRow, EnvironmentAssumptionJson)
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -301,7 +301,7 @@ class _Goals:
                                    f"{sc['conjunct']} of {sc['node']}'s assumption follows from its producers' guarantees"),
                              supported_by=(sn,), ref=sid))
 
-    def contract_goal(self, n: NodeRow) -> str:
+    def contract_goal(self, n: NodeJson) -> str:
         """The goal that node ``n`` meets its contract: its guarantees' goals and its side conditions'."""
         b, name = self.b, str(n["name"])
         g_ids = []

@@ -33,6 +33,7 @@ from dataclasses import replace
 from typing import Any, Callable, Mapping
 
 from rclverify.records.report_schema import Report
+from rclverify.records.strength_rows import Strength
 from rclverify.report.argument.model import Element
 
 _GUARANTEE = re.compile(r"^(?P<node>\S+) guarantee (?P<k>\d+)$")
@@ -127,10 +128,9 @@ def _challenged(els: dict[str, Element], report: Report, ident: Callable[..., st
                 confidence[ident("G", n["name"], f"g{g['index']}")] = (
                     1.0 - float(s["doubt"]), "C0" if s.get("kind") == "defeated" else "C1")
     for sc in report.get("side_conditions", []):
-        s = sc.get("strength")
-        if s is not None and "doubt" in s:
-            confidence[ident("G", "sc", sc["id"])] = (1.0 - float(s["doubt"]),
-                                                      "C0" if float(s["doubt"]) >= 1.0 else "strength")
+        if sc.get("strength"):
+            doubt = float(Strength.of(sc["strength"]).doubt)
+            confidence[ident("G", "sc", sc["id"])] = (1.0 - doubt, "C0" if doubt >= 1.0 else "strength")
     for r in report.get("requirements", []):
         if r.get("confidence") is not None:
             confidence[ident("G", r["id"])] = (float(r["confidence"]), "C5")

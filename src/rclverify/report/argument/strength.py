@@ -1,7 +1,8 @@
 """Typed evidence strength (docs/confidence.md).
 
 Every evidence record and side condition of the report carries a
-``strength``: ``{"kind", "detail", "doubt"}``.
+``strength``: a :class:`~rclverify.records.strength_rows.Strength` (``kind``,
+``detail``, ``doubt``; a side condition's also ``solvers``).
 
 =============  ==========================================================
 kind           what it rests on
@@ -35,7 +36,7 @@ import math
 from typing import Any, Mapping
 
 from rclverify.model.plan.declarations import DECLARATIONS, STRENGTHS
-from rclverify.records.report_schema import Strength
+from rclverify.records.strength_rows import Strength
 
 #: The kinds, strongest first (the report orders and compares by this).
 KINDS = STRENGTHS
@@ -67,8 +68,8 @@ def _figure(row: Mapping[str, Any], name: str) -> str | None:
 def evidence_strength(row: Mapping[str, Any]) -> Strength:
     """The strength of one evidence row of the report (``backend``,
     ``status``, and the backend's figures: ``examples``, ``monitoring``,
-    ``figures``).  Returns ``{"kind", "detail", "doubt"}``; an unknown
-    backend is ``assumed``."""
+    ``figures``): a :class:`~rclverify.records.strength_rows.Strength` with
+    its ``kind``, ``detail`` and ``doubt``; an unknown backend is ``assumed``."""
     backend = str(row.get("backend", ""))
     kind = BACKEND_KIND.get(backend, "assumed")
     detail, doubt = "", DOUBT[kind]
@@ -116,7 +117,7 @@ def evidence_strength(row: Mapping[str, Any]) -> Strength:
         detail = f"review by {who[:60] or 'an unnamed reviewer'}"
     if row.get("status") != "discharged":
         doubt = 1.0
-    return {"kind": kind, "detail": detail, "doubt": doubt}
+    return Strength(kind=kind, detail=detail, doubt=doubt)
 
 
 def target_strength(row: Mapping[str, Any], stats: Mapping[str, Any]) -> Strength:
@@ -133,7 +134,7 @@ def target_strength(row: Mapping[str, Any], stats: Mapping[str, Any]) -> Strengt
               + (f": a one-sided {float(d.get('level', 0.95)) * 100:g} % bound of {bound:.3g} on the probability "
                  f"that a {per} violates it" if isinstance(bound, (int, float)) else ""))
     doubt = float(bound) if row.get("status") == "discharged" and isinstance(bound, (int, float)) else 1.0
-    return {"kind": "statistical", "detail": detail, "doubt": doubt}
+    return Strength(kind="statistical", detail=detail, doubt=doubt)
 
 
 def coverage_text(cov: Mapping[str, Any]) -> str:
@@ -165,7 +166,7 @@ def side_condition_strength(sc: Mapping[str, Any]) -> Strength:
         # cvc5 decided the query over the cone summaries; each summary's own proof (implied by its cone) is Z3's
         two, detail = False, "Z3 and cvc5 on the query over the cone summaries, the summaries by Z3 alone"
     doubt = DOUBT["proof2" if two else "proof"] if sc.get("status") == "discharged" else 1.0
-    return {"kind": "proof", "detail": detail, "solvers": 2 if two else 1, "doubt": doubt}
+    return Strength(kind="proof", detail=detail, solvers=2 if two else 1, doubt=doubt)
 
 
 def stronger(a: str, b: str) -> str:

@@ -23,7 +23,7 @@ import jinja2
 from lsprotocol import types as lsp
 
 from rclverify.lang import ast
-from rclverify.records.report_schema import GuaranteeRow, NodeRow, Report
+from rclverify.records.report_schema import GuaranteeJson, NodeJson, Report
 from rclverify.tools.lsp.diagnostics import Analysis
 from rclverify.tools.lsp.index import Symbol, all_nodes, declarations
 from rclverify.lang.printer import node_to_rcl, type_to_rcl
@@ -32,7 +32,7 @@ _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.tools.lsp", "te
                           keep_trailing_newline=False, undefined=jinja2.StrictUndefined)
 
 
-def _report_node(report: Report | None, name: str) -> NodeRow | None:
+def _report_node(report: Report | None, name: str) -> NodeJson | None:
     for n in report.get("nodes", ()) if report else ():
         if isinstance(n, Mapping) and n.get("name") == name:
             return n
@@ -74,7 +74,7 @@ def hover_text(a: Analysis, sym: Symbol, report: Report | None) -> str | None:
             return None
         from rclverify.lang.printer import expr_to_rcl  # deferred: optional or conditional (inside a block)
         rn = _report_node(report, sym.node)
-        g: GuaranteeRow | None = next((x for x in (rn.get("guarantees") if rn else None) or ()
+        g: GuaranteeJson | None = next((x for x in (rn.get("guarantees") if rn else None) or ()
                                        if x.get("index") == sym.index), None)
         obligations = [o for o in (report.get("obligations", ()) if report else ())
                        if o.get("node") == sym.node and o.get("guarantee") == sym.index]
