@@ -141,8 +141,33 @@ def test_the_schema_part_is_generated_from_the_definition(key: str) -> None:
     assert set(RECORDS) <= set(schema_gen.GENERATED)  # each record checked here has its part generated
     assert SCHEMA["properties"][key] == schema_gen.generated_part(key, SCHEMA)
     items = schema_gen.object_of(SCHEMA["properties"][key])
+    if "$ref" in items:  # a class of schema_gen.SHARED: its $defs entry, generated too (test below)
+        items = SCHEMA["$defs"][items["$ref"].rsplit("/", 1)[1]]
     assert list(items["properties"]) == list(schema_gen.record_type(key).__struct_fields__)
     assert items["additionalProperties"] is False
+
+
+@pytest.mark.parametrize("cls", schema_gen.DEFINED, ids=lambda c: c.__name__)
+def test_a_shared_entry_is_generated_from_its_class(cls: type[msgspec.Struct]) -> None:
+    name = schema_gen.SHARED[cls.__name__]
+    assert SCHEMA["$defs"][name] == schema_gen.generated_def(cls)
+    assert list(SCHEMA["$defs"][name]["properties"]) == list(cls.__struct_fields__)
+
+
+def test_every_shared_entry_is_referred_to() -> None:
+    """A ``$defs`` entry of a record class no part of the schema refers to is left over: drop it."""
+    text = schema_gen.schema_text(SCHEMA)
+    assert [n for n in schema_gen.SHARED.values() if f'"#/$defs/{n}"' not in text] == []
+
+
+def test_the_report_hop_begins_with_the_deadline_stages_hop() -> None:
+    """records/deadline_rows.py: the report's hop is the stage's sealed hop (records/stage_records.py) with
+    what the report adds, the same keys first, in order."""
+    from rclverify.records.deadline_rows import DeadlineHop
+    from rclverify.records.stage_records import DeadlineHop as StageHop
+    stage = list(typing.get_type_hints(StageHop))
+    assert list(DeadlineHop.__struct_fields__)[:len(stage)] == stage
+    assert set(DeadlineHop.__struct_fields__[len(stage):]) == {"status", "timing", "monitors", "time_margin"}
 
 
 class _ObligationWithMargin(ObligationRow, frozen=True, forbid_unknown_fields=True):

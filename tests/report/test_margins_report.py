@@ -14,6 +14,7 @@ import pytest
 from _report_schema import check_report
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.cli.commands import main
+from rclverify.records.margin_rows import MarginBounds
 from rclverify.report.margin_rows import figures
 
 BRAKE = """node Brake {
@@ -94,12 +95,12 @@ def test_a_quantile_the_kept_margins_do_not_decide_is_given_by_its_bounds() -> N
     b = {"guarantee": 1, "answers": 10, "lowest": [1000.0 + i for i in range(10)]}
     count, kept, fig = figures([a, b])
     assert (count, kept) == (1010, KEPT_MARGINS + 10)
-    assert fig["min"] == {"low": 0.0, "high": 0.0}
-    assert fig["p5"] == {"low": 50.0, "high": 50.0}  # rank 51: decided by the kept margins
-    assert fig["p50"] == {"low": 255.0, "high": None}  # rank 505: past the kept, at least run A's largest
+    assert fig["min"] == MarginBounds(low=0.0, high=0.0)
+    assert fig["p5"] == MarginBounds(low=50.0, high=50.0)  # rank 51: decided by the kept margins
+    assert fig["p50"] == MarginBounds(low=255.0, high=None)  # rank 505: past the kept, at least run A's largest
     # a run that kept fewer than it judged without being full: the rest held without a distance (+inf)
     count, kept, fig = figures([{"guarantee": 1, "answers": 3, "lowest": [0.5]}])
-    assert (count, kept, fig["p50"]) == (3, 3, {"low": None, "high": None})
+    assert (count, kept, fig["p50"]) == (3, 3, MarginBounds(low=None, high=None))
 
 
 def test_a_long_run_draws_its_kept_margins_spread_in_rank() -> None:

@@ -44,7 +44,7 @@ from rclverify.diagnosis.bounds import FLIP, bound_literals, thresholds, value
 from rclverify.diagnosis.edits import Edit
 from rclverify.records.links import link_pairs
 from rclverify.diagnosis.shapes import ReportRows, Strengthening
-from rclverify.records.report_schema import SideConditionRow
+from rclverify.records.report_schema import SideConditionJson
 from rclverify.diagnosis.repairs import _numbers, _peel, _rename
 from rclverify.model.plan.load import all_requirements
 from rclverify.calculus.requirements.check import check_requirement, formals_of
@@ -84,7 +84,7 @@ def conclusion_edit(ws: Any, node: str, k: int, extra: str) -> Edit | None:
     return Edit(g.loc.file, *span, f"({old}) and ({extra})")
 
 
-def side_condition_culprits(ws: Any, sc: SideConditionRow) -> tuple[list[tuple[str, int]], int]:
+def side_condition_culprits(ws: Any, sc: SideConditionJson) -> tuple[list[tuple[str, int]], int]:
     """``([(producer, guarantee index)], undecided)`` of the failed side
     condition ``sc`` (a report row with ``id``, ``node``, ``conjunct``,
     ``links``): the producer guarantees on the linked outputs whose
@@ -118,7 +118,7 @@ def side_condition_culprits(ws: Any, sc: SideConditionRow) -> tuple[list[tuple[s
     return out, undecided
 
 
-def fixed_side_condition(ws: Any, sc: SideConditionRow, producer: str, k: int) -> Edit | None:
+def fixed_side_condition(ws: Any, sc: SideConditionJson, producer: str, k: int) -> Edit | None:
     """The edit that discharges the failed side condition ``sc`` through
     guarantee ``k`` of ``producer`` (one of :func:`side_condition_culprits`):
     its conclusion strengthened by the consumer's conjunct in the producer's

@@ -52,7 +52,7 @@ from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
 from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import EvidenceJson, ObligationJson, SideConditionRow
+from rclverify.records.report_schema import EvidenceJson, ObligationJson, SideConditionJson
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 
 CACHE = "artifacts/cache/diagnosis.pickle"
@@ -259,7 +259,7 @@ def _and(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _side_condition(ws: Any, report: ReportRows, sc: SideConditionRow, cache: _Cache,
+def _side_condition(ws: Any, report: ReportRows, sc: SideConditionJson, cache: _Cache,
                     sc_before: Mapping[str, str]) -> DiagnosisEntry:
     pairs = link_pairs(sc)
     cul: list[Culprit] = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]

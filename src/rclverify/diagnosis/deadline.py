@@ -29,7 +29,7 @@ from rclverify.lang.timing import UNITS
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.bounds import number_text
 from rclverify.diagnosis.shapes import ReportRows
-from rclverify.records.report_schema import DeadlineRow
+from rclverify.records.report_schema import DeadlineJson
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
@@ -69,7 +69,7 @@ def _decide_all(ws: Any, checked: Any, model: Any) -> dict[str, str]:
             for d in ws.plan.deadlines}
 
 
-def budget_repairs(ws: Any, row: DeadlineRow) -> list[Repair]:
+def budget_repairs(ws: Any, row: DeadlineJson) -> list[Repair]:
     """The repairs of the refuted deadline ``row`` (a report row of
     :func:`rclverify.report.deadlines.deadline_rows`), each checked by Z3
     (module docstring), in the order shown."""
@@ -183,7 +183,7 @@ def break_node(ws: Any, path: Sequence[str]) -> str | None:
     return None
 
 
-def deadline_record(ws: Any, report: ReportRows, row: DeadlineRow,
+def deadline_record(ws: Any, report: ReportRows, row: DeadlineJson,
                     repairs: Sequence[Repair]) -> DiagnosisEntry:
     """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the
     refuted or inconclusive deadline ``row``: id ``<REQ>.deadline``, kind

@@ -18,7 +18,7 @@ from fractions import Fraction
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.calculus.compose import conjuncts
 from rclverify.diagnosis.shapes import CulpritRow, ProducerCulprits, ReportRows, Strengthening
-from rclverify.records.report_schema import RequirementJson, SideConditionRow
+from rclverify.records.report_schema import RequirementJson, SideConditionJson
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 
 #: ``guarantee_source(report, node, k)``: a guarantee's (text, source) (diagnosis/build.py).
@@ -142,7 +142,7 @@ def _refuted(q: RequirementJson, check: Mapping[str, object], f: CulpritRow | No
 
 
 def _causes(ws: Any, report: ReportRows, q: RequirementJson, cone: list[str],
-            cache: Any) -> list[tuple[SideConditionRow, str, int]]:
+            cache: Any) -> list[tuple[SideConditionJson, str, int]]:
     """``[(side condition row, producer, guarantee index)]``: the failed side
     conditions of ``q``'s cone whose discharge alone proves ``q`` -- each
     producer guarantee that discharges it when strengthened by the
@@ -151,17 +151,17 @@ def _causes(ws: Any, report: ReportRows, q: RequirementJson, cone: list[str],
     proves ``q`` from consistent premises (:func:`blame.proved_with`).  The
     requirement is then a consequence of that problem, not a problem of its
     own (docs/diagnosis.md, "One row per cause")."""
-    out: list[tuple[SideConditionRow, str, int]] = []
+    out: list[tuple[SideConditionJson, str, int]] = []
     check = q.get("check") or {}
     for sc in report.get("side_conditions") or ():
         if sc.get("status") != "failed" or str(sc.get("node")) not in cone:
             continue
-        def producers(sc: SideConditionRow = sc) -> ProducerCulprits:  # as diagnosis/build.py keeps them
+        def producers(sc: SideConditionJson = sc) -> ProducerCulprits:  # as diagnosis/build.py keeps them
             found, undecided = blame.side_condition_culprits(ws, sc)
             return {"culprits": [list(x) for x in found], "undecided": undecided}
         shown: ProducerCulprits | None = cache.get(["sc-culprits", sc["id"], sc["conjunct"]], producers)
         for p, k in (shown.get("culprits") or []) if shown else ():
-            def proves(p: str = str(p), k: int = int(k), sc: SideConditionRow = sc) -> bool:
+            def proves(p: str = str(p), k: int = int(k), sc: SideConditionJson = sc) -> bool:
                 edit = blame.fixed_side_condition(ws, sc, p, k)
                 return edit is not None and blame.proved_with(ws, str(q["id"]), edit)
             if cache.get(["consequence", q["id"], check.get("formal"), cone, sc["id"], sc["conjunct"], p, k], proves):
@@ -182,7 +182,7 @@ def _cex_value(text: Any) -> Any:
 
 
 def _passes_through(ws: Any, report: ReportRows, q: RequirementJson,
-                    cone: list[str]) -> list[SideConditionRow]:
+                    cone: list[str]) -> list[SideConditionJson]:
     """The failed side conditions of ``q``'s cone whose conjunct is false on
     the consumer's values in ``q``'s counterexample (decided by the
     monitors' evaluator, :func:`rclverify.semantics.decide.decide`): the
@@ -208,7 +208,7 @@ def _passes_through(ws: Any, report: ReportRows, q: RequirementJson,
 
 
 def _consequence_record(report: ReportRows, q: RequirementJson, check: Mapping[str, Any],
-                        causes: list[tuple[SideConditionRow, str, int]],
+                        causes: list[tuple[SideConditionJson, str, int]],
                         guarantee_source: GuaranteeSource) -> DiagnosisEntry:
     """The diagnosis record of a requirement refuted only because of the
     failed side conditions ``causes`` (:func:`_causes`): its culprits are

@@ -14,8 +14,8 @@ from collections.abc import Mapping
 from typing import NotRequired, TypedDict, cast
 
 from rclverify.diagnosis.edits import Edit
-from rclverify.records.report_schema import (DeadlineRow, EvidenceJson, FindingJson, LintRow, NodeJson, ObligationJson,
-                                             RequirementJson, SideConditionRow, SystemView)
+from rclverify.records.report_schema import (DeadlineJson, EvidenceJson, FindingJson, LintRow, NodeJson, ObligationJson,
+                                             RequirementJson, SideConditionJson, SystemView)
 from rclverify.records.stage_records import Repair
 
 
@@ -26,12 +26,12 @@ class ReportRows(TypedDict):
     system: SystemView
     requirements: list[RequirementJson]
     nodes: list[NodeJson]
-    side_conditions: list[SideConditionRow]
+    side_conditions: list[SideConditionJson]
     findings: list[FindingJson]
     obligations: list[ObligationJson]
     evidence: list[EvidenceJson]
     lint: list[LintRow]
-    deadlines: list[DeadlineRow]
+    deadlines: list[DeadlineJson]
 
 
 #: The keys of :class:`ReportRows`.

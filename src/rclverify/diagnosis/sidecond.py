@@ -60,7 +60,7 @@ from rclverify.diagnosis.edits import Edit
 from rclverify.records.links import link_pairs
 from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, _record, _rename
 from rclverify.diagnosis.shapes import SideConditionRepairs
-from rclverify.records.report_schema import SideConditionRow
+from rclverify.records.report_schema import SideConditionJson
 from rclverify.records.stage_records import Repair
 from rclverify.model.plan.errors import PlanError
 from rclverify.model.plan.load import all_requirements
@@ -96,7 +96,7 @@ def _implementable_check(status: str, node: str) -> dict[str, str]:
         "inconclusive": "not decided (Z3 could not say in its budget)"}.get(status, status)}
 
 
-def side_condition_repairs(ws: Any, sc: SideConditionRow, before_sc: Mapping[str, str],
+def side_condition_repairs(ws: Any, sc: SideConditionJson, before_sc: Mapping[str, str],
                            consumer_evidence: Sequence[str] = ()) -> SideConditionRepairs:
     """The repairs of the failed side condition ``sc`` (a report row), in
     the order of the module docstring: ``{"repairs": [repair records],
@@ -162,7 +162,7 @@ def side_condition_repairs(ws: Any, sc: SideConditionRow, before_sc: Mapping[str
     return out
 
 
-def _stems_from(ws: Any, sc: SideConditionRow, pairs: Sequence[tuple[str, str, str, str]],
+def _stems_from(ws: Any, sc: SideConditionJson, pairs: Sequence[tuple[str, str, str, str]],
                 target: ast.Expr) -> list[str]:
     """The ids of the plan's requirements the consumer's assumption ``target``
     stems from: a formal statement that reads the linked value
@@ -183,7 +183,7 @@ def _stems_from(ws: Any, sc: SideConditionRow, pairs: Sequence[tuple[str, str, s
     return out
 
 
-def _requirement_guard(out: SideConditionRepairs, sc: SideConditionRow, reqs: Sequence[str]) -> None:
+def _requirement_guard(out: SideConditionRepairs, sc: SideConditionJson, reqs: Sequence[str]) -> None:
     """Weakening a consumer's assumption that stems from a requirement is
     never the first repair: when it would be the only one it is
     withdrawn into ``not_offered`` with the reason; after a safe repair it
@@ -206,7 +206,7 @@ def _requirement_guard(out: SideConditionRepairs, sc: SideConditionRow, reqs: Se
                          "it is never the first repair.")
 
 
-def _strengthen(ws: Any, sc: SideConditionRow, p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
+def _strengthen(ws: Any, sc: SideConditionJson, p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
                 not_offered: list[str], inplace: tuple[Edit, int, str] | None = None) -> list[Repair]:
     """1. the consumer's conjunct as a new guarantee of ``p``, or a bound of
     ``p`` tightened to it in place (``inplace``: :func:`_inplace`; module docstring)."""
@@ -340,7 +340,7 @@ def _trigger_of(node: ast.Node, outs: set[str]) -> str:
     return ""
 
 
-def _rescale(ws: Any, sc: SideConditionRow, p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,
+def _rescale(ws: Any, sc: SideConditionJson, p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,
              discharged: dict[str, str]) -> list[Repair]:
     """2. a coefficient of ``p``'s guarantees on ``out.ov`` divided by ``10**k`` (module docstring)."""
     factor = Fraction(10) ** k
@@ -404,7 +404,7 @@ def _conjunct_after(target: ast.Expr, edit: Edit, source: str) -> str:
     return Edit(edit.file, loc.line, loc.col, loc.end_line, loc.end_col + delta, "").deleted(edit.apply(source))
 
 
-def _weaken(ws: Any, sc: SideConditionRow, target: ast.Expr, shape: tuple[str, bool, ast.NumLit] | None,
+def _weaken(ws: Any, sc: SideConditionJson, target: ast.Expr, shape: tuple[str, bool, ast.NumLit] | None,
             extreme: Fraction | None, scale: int | None, producers: Sequence[str],
             to_consumer: Sequence[tuple[str, str]], cost_of: Any, discharged: dict[str, str],
             consumer_evidence: Sequence[str]) -> list[Repair]:

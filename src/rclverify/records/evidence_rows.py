@@ -33,7 +33,7 @@ from __future__ import annotations
 from typing import Annotated, Any, Iterable, Mapping
 
 from rclverify.records.row import DOC, Row, decode_rows
-from rclverify.records.report_schema import Solvers
+from rclverify.records.solvers_rows import Solvers
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 from rclverify.records.strength_rows import Strength
 

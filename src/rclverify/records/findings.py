@@ -39,7 +39,7 @@ from typing import Annotated, Any, Iterable, Mapping
 
 import msgspec
 
-from rclverify.records.report_schema import Solvers
+from rclverify.records.solvers_rows import Solvers
 from rclverify.records.statuses import HealthStatus
 
 _DOC = msgspec.Meta  # a field's description, as the generated JSON Schema shows it

@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import re
 
-from rclverify.records.report_schema import SideConditionRow
+from rclverify.records.report_schema import SideConditionJson
 from rclverify.records.stage_records import SideCondition
 
 
-def link_pairs(sc: SideConditionRow | SideCondition) -> list[tuple[str, str, str, str]]:
+def link_pairs(sc: SideConditionJson | SideCondition) -> list[tuple[str, str, str, str]]:
     """``(producer, out var, consumer, in var)`` of each of a side condition
     record's ``links`` (``Planner.out.speed -> Controller.in.speed (via
     name)``), in order; a link of another shape is left out."""

@@ -24,21 +24,11 @@ a report that lacks a part.
 # annotations (with string annotations every key would count as required).
 from typing import Any, Literal, Mapping, NotRequired, TypedDict, cast
 
-from rclverify.records.statuses import (AcknowledgementStatus, Agreement, AnyStatus, DeadlineVerdict, Derivation,
+from rclverify.records.statuses import (AcknowledgementStatus, AnyStatus, Derivation,
                                         EvidenceKind, EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
-                                        SideConditionVerdict, EVIDENCE_STATUSES)
-from rclverify.records import stage_records
+                                        EVIDENCE_STATUSES)
 from rclverify.records.nodl_rows import NodlRow
 from rclverify.records.strength_rows import Strength
-
-
-class Solvers(TypedDict):
-    """The second solver's agreement on a verdict (``$defs/solvers``; docs/second-solver.md)."""
-    agreement: Agreement
-    why: str
-    cvc5: dict[str, Any] | None
-    proof: NotRequired[str]
-    smt2: NotRequired[str]
 
 
 class SystemView(TypedDict):
@@ -62,103 +52,6 @@ class ExpectedVerdictRow(TypedDict):
     obligation: str | None
     reason: str
     outcome: str
-
-
-class HopTimeMargin(TypedDict):
-    """A hop's smallest time margin on its node's runs (``$defs/hop_time_margin``; report/chain_margins.py)."""
-    margin_s: float | None
-    margin_ns: int | None
-    obligation: str
-    trigger_where: str
-    answer_where: str
-    answers: int
-    unanswered: int
-
-
-class DeadlineHop(stage_records.DeadlineHop):
-    """One timed guarantee of a deadline's chain (``$defs/deadline_hop``; report/deadlines.py): the
-    stage's hop with the report's status and timing."""
-    status: NotRequired[EvidenceStatus]
-    timing: NotRequired[str]
-    monitors: NotRequired[list[dict[str, Any]]]
-    time_margin: NotRequired[HopTimeMargin | None]
-
-
-class NearMissRow(TypedDict):
-    """A guarantee held on its runs with a margin below the plan's near-miss threshold (``near_misses[]``;
-    report/near_misses.py): ``kind`` ``value`` (a space margin, in ``unit``) or ``time`` (a deadline's
-    time margin, s); ``source`` the guarantee's place, ``threshold_source`` the plan's ``near_miss``."""
-    node: str
-    guarantee: int
-    kind: Literal["value", "time"]
-    margin: float
-    threshold: float
-    unit: str
-    atom: str
-    where: str
-    time: float | None
-    trace: str
-    obligation: str
-    source: str
-    threshold_source: str
-
-
-class MarginBounds(TypedDict):
-    """A figure of the answers' margins as the bounds the runs' kept margins prove (``$defs/margin_bounds``;
-    report/margin_rows.py): ``low`` and ``high`` equal where they decide it; ``None`` for an infinite bound."""
-    low: float | None
-    high: float | None
-
-
-class MarginRow(TypedDict):
-    """A guarantee's margins over every recorded run (``margins[]``, ``$defs/margins_over_runs``;
-    report/margin_rows.py): the smallest (``margin``, ``None`` when infinite, then ``holds`` its side, or
-    when no answer had one) on the run ``trace`` at the answer ``time``/``where``; the counts summed over
-    the ``runs``; the figures over the ``count`` answers with a margin, ``kept`` of them recorded; a timed
-    guarantee's smallest time margin over the runs (``time_margin``); the
-    plot of the kept margins per run (``plot_svg``) or why none (``plot_note``)."""
-    node: str
-    guarantee: int
-    formula: str
-    source: str
-    margin: float | None
-    holds: bool | None
-    unit: str
-    atom: str
-    trace: str
-    obligation: str
-    time: float | None
-    where: str
-    runs: int
-    answers: int
-    undefined: int
-    count: int
-    kept: int
-    min: MarginBounds
-    p5: MarginBounds
-    p50: MarginBounds
-    time_margin: HopTimeMargin | None
-    plot_svg: NotRequired[str]
-    plot_note: NotRequired[str]
-
-
-class DeadlineRow(TypedDict):
-    """An end-to-end deadline decided by rule D3 (``deadlines[]``, ``$defs/deadline``; report/deadlines.py)."""
-    requirement: str
-    path: list[str]
-    within: str
-    source: str
-    verdict: DeadlineVerdict
-    status: NotRequired[EvidenceStatus]
-    evidence_status: NotRequired[EvidenceStatus]
-    reason: NotRequired[str]
-    chain: NotRequired[list[DeadlineHop]]
-    total: NotRequired[str | None]
-    time_margin: NotRequired[str | None]
-    time_margin_ns: NotRequired[int | None]
-    stamps: NotRequired[list[Any]]
-    smt2: NotRequired[str]
-    solvers: NotRequired[Solvers | None]
 
 
 class DiagnosisRow(TypedDict):
@@ -206,28 +99,6 @@ class Summary(TypedDict):
     confidence: NotRequired[float]
 
 
-class SideConditionRow(TypedDict):
-    """A side condition decided by Z3 (``side_conditions[]``); ``duration_s`` in seconds."""
-    id: str
-    node: str
-    rule: str
-    conjunct: str
-    source: str
-    hypotheses: list[str]
-    status: EvidenceStatus
-    verdict: SideConditionVerdict
-    duration_s: float
-    smt2: str
-    model: dict[str, Any] | None
-    explanation: str
-    variant: str
-    links: list[str]
-    context: dict[str, Any] | None
-    scale_mismatch: NotRequired[list[dict[str, Any]]]
-    solvers: NotRequired[Solvers]
-    strength: NotRequired[Strength]
-
-
 #: A node's row (``nodes[]``) as the report's JSON object: the encoding of
 #: :class:`rclverify.records.node_rows.NodeRow` (its guarantees
 #: :class:`~rclverify.records.node_rows.GuaranteeRow`), the one definition of its fields (the schema's
@@ -256,6 +127,27 @@ UnverifiedJson = dict[str, Any]
 #: The weakest premise behind a confidence (``$defs/limited_by``) as its JSON object: the encoding of
 #: :class:`rclverify.records.strength_rows.LimitedBy`.
 LimitedByJson = dict[str, Any]
+
+
+#: A side condition's row (``side_conditions[]``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.side_condition_rows.SideConditionRow`, the one definition of its fields (the
+#: schema's ``side_conditions`` items are generated from it, records/schema_gen.py).
+SideConditionJson = dict[str, Any]
+
+#: An end-to-end deadline's row (``deadlines[]``, ``$defs/deadline``) as the report's JSON object: the
+#: encoding of :class:`rclverify.records.deadline_rows.DeadlineRow` (its hops
+#: :class:`~rclverify.records.deadline_rows.DeadlineHop`), the one definition of its fields (the schema's
+#: ``$defs`` entry is generated from it, records/schema_gen.py).
+DeadlineJson = dict[str, Any]
+
+#: A near miss (``near_misses[]``, ``$defs/near_miss``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.margin_rows.NearMissRow` (its schema generated from it, records/schema_gen.py).
+NearMissJson = dict[str, Any]
+
+#: A guarantee's margins over every recorded run (``margins[]``, ``$defs/margins_over_runs``) as the
+#: report's JSON object: the encoding of :class:`rclverify.records.margin_rows.MarginRow` (its schema
+#: generated from it, records/schema_gen.py).
+MarginJson = dict[str, Any]
 
 
 #: A contract health finding (``findings[]``) as the report's JSON object: the encoding of
@@ -354,7 +246,7 @@ class Report(TypedDict):
     system: SystemView
     requirements: list[RequirementJson]
     nodes: list[NodeJson]
-    side_conditions: list[SideConditionRow]
+    side_conditions: list[SideConditionJson]
     derived_properties: list[DerivedPropertyJson]
     findings: list[FindingJson]
     obligations: list[ObligationJson]
@@ -367,12 +259,12 @@ class Report(TypedDict):
     #: the NoDL documents' check (stages/nodl.py, report/nodl.py), ``None`` when the workspace has none
     nodl: NodlRow | None
     unverified: list[UnverifiedJson]
-    deadlines: list[DeadlineRow]
+    deadlines: list[DeadlineJson]
     acknowledgements: list[AcknowledgementRow]
     #: guarantees held with a margin below the plan's near-miss threshold (report/near_misses.py)
-    near_misses: list[NearMissRow]
+    near_misses: list[NearMissJson]
     #: per guarantee, its margins over every recorded run (report/margin_rows.py)
-    margins: list[MarginRow]
+    margins: list[MarginJson]
     statistics: list[dict[str, Any]]
     #: the evidence mapped onto the plan's standard profiles (report/standards_rows.py, docs/standards.md)
     standards: list[dict[str, Any]]

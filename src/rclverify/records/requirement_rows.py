@@ -37,7 +37,7 @@ from typing import Annotated, Any, Iterable, Literal, Mapping
 
 import msgspec
 
-from rclverify.records.report_schema import DeadlineRow
+from rclverify.records.deadline_rows import DeadlineRow
 from rclverify.records.strength_rows import LimitedBy
 from rclverify.records.statistics_rows import RequirementRuns
 from rclverify.records.row import DOC, Row

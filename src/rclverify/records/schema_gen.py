@@ -32,11 +32,15 @@ import msgspec
 
 from rclverify.core.atomic import atomic_write_text
 from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow, HopTimeMargin
 from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
 from rclverify.records.findings import FindingRow
 from rclverify.records.node_rows import CulpritOf, NodeRow, UnverifiedRow
 from rclverify.records.obligations import ObligationRow
+from rclverify.records.margin_rows import MarginBounds, MarginRow, NearMissRow
 from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.records.solvers_rows import Solvers
 from rclverify.records.standards_rows import StandardRow
 from rclverify.records.statistics_rows import StatisticsRow
 from rclverify.records.statuses import VOCABULARY
@@ -49,10 +53,16 @@ GENERATED: dict[str, tuple[Any, str]] = {
     "findings": (list[FindingRow], "Contract health findings (vacuity, consistency, realizability, scale)."),
     "obligations": (list[ObligationRow], "Every obligation of the plan's evidence entries."),
     "nodes": (list[NodeRow], "The nodes, in contract order."),
+    "side_conditions": (list[SideConditionRow], "Every side condition of every node."),
     "derived_properties": (list[DerivedPropertyRow], "One per node the calculus ran on."),
     "evidence": (list[EvidenceRow], "One row per obligation with an evidence record."),
     "environment_assumptions": (list[EnvironmentAssumptionRow], "Assumptions the system leaves to its environment."),
     "unverified": (list[UnverifiedRow], "Guarantees no obligation covers."),
+    "deadlines": (list[DeadlineRow], "End-to-end deadlines (rule D3)."),
+    "near_misses": (list[NearMissRow], "Guarantees held on every run with a margin below the plan's near-miss "
+                                       "threshold (report/near_misses.py)."),
+    "margins": (list[MarginRow], "Per guarantee judged with margins, its margins over every recorded run "
+                                 "(report/margin_rows.py)."),
     "statistics": (list[StatisticsRow], "Runs counted by environment, bounds and targets (docs/statistics.md)."),
     "standards": (list[StandardRow], "The evidence mapped onto the standards the plan names (docs/standards.md); "
                                      "empty when it names none."),
@@ -60,10 +70,13 @@ GENERATED: dict[str, tuple[Any, str]] = {
 
 #: A type the report's schema defines in ``$defs`` -> that entry's name.
 SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength", "DeadlineRow": "deadline",
-                           "LimitedBy": "limited_by", "CulpritOf": "culprit_of"}
+                           "LimitedBy": "limited_by", "CulpritOf": "culprit_of", "DeadlineHop": "deadline_hop",
+                           "HopTimeMargin": "hop_time_margin", "NearMissRow": "near_miss",
+                           "MarginRow": "margins_over_runs", "MarginBounds": "margin_bounds"}
 
 #: The classes of :data:`SHARED` whose ``$defs`` entry is generated from the class (the others' are stated by hand).
-DEFINED: tuple[type[msgspec.Struct], ...] = (Strength, LimitedBy, CulpritOf)
+DEFINED: tuple[type[msgspec.Struct], ...] = (Strength, LimitedBy, CulpritOf, Solvers, DeadlineRow, DeadlineHop,
+                                             HopTimeMargin, NearMissRow, MarginRow, MarginBounds)
 
 #: Top-level key -> the fields of its items (or of its object) whose schema the file states by hand (a
 #: tool's record: the monitors backend's run summary, docs/monitors.md; the requirements stage's check

@@ -26,23 +26,23 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
+
+from rclverify.records.deadline_rows import DeadlineHop, HopTimeMargin
 
 
-def hop_margin(hop: Mapping[str, Any]) -> dict[str, Any] | None:
-    """The smallest time margin of ``hop``'s guarantee over the deadline
-    records of its node's monitors evidence (``hop["monitors"]``, each with
-    ``time_margins``, :meth:`TimeMargin.to_json`).  Returns ``{"margin_s",
-    "margin_ns", "obligation", "trigger_where", "answer_where", "answers",
-    "unanswered"}`` (``answers`` and ``unanswered`` summed over the runs;
-    ``margin_s``/``margin_ns`` ``None`` when no trigger was answered), or
-    ``None`` when no run measured the guarantee."""
-    k = int(hop["guarantee"])
+def hop_margin(guarantee: int, monitors: Iterable[Mapping[str, Any]]) -> HopTimeMargin | None:
+    """The smallest time margin of guarantee ``guarantee`` (1-based) of a
+    hop's node over its monitors evidence's deadline records ``monitors``
+    (each with ``obligation`` and ``time_margins``, :meth:`TimeMargin.to_json`):
+    ``answers`` and ``unanswered`` summed over the runs, ``margin_s``/
+    ``margin_ns`` ``None`` when no trigger was answered.  ``None`` when no
+    run measured the guarantee."""
     best: dict[str, Any] | None = None
     answers = unanswered = 0
-    for m in hop.get("monitors") or ():
+    for m in monitors:
         for t in m.get("time_margins") or ():
-            if int(t.get("guarantee", 0)) != k:
+            if int(t.get("guarantee", 0)) != guarantee:
                 continue
             answers += int(t.get("answers") or 0)
             unanswered += int(t.get("unanswered") or 0)
@@ -56,23 +56,26 @@ def hop_margin(hop: Mapping[str, Any]) -> dict[str, Any] | None:
     if best is None:
         return None
     ns = best["margin_ns"]
-    return {**best, "margin_s": None if ns is None else ns / 1e9, "answers": answers, "unanswered": unanswered}
+    return HopTimeMargin(margin_s=None if ns is None else ns / 1e9, margin_ns=ns, obligation=best["obligation"],
+                         trigger_where=best["trigger_where"], answer_where=best["answer_where"], answers=answers,
+                         unanswered=unanswered)
 
 
-def chain_margin(within_s: Fraction, chain: Sequence[Mapping[str, Any]]) -> int | None:
+def chain_margin(within_s: Fraction, chain: Sequence[DeadlineHop]) -> int | None:
     """The chain's measured margin in integer nanoseconds (module
     docstring): ``within_s`` (the requirement's bound, s) less the sum over
     the hops of ``within_s - margin`` (each hop's ``within_s``, an exact
-    fraction text, and its :func:`hop_margin`); ``None`` when the chain is
-    empty or a hop has no margin or had a trigger never answered."""
+    fraction text, and its ``time_margin``, :func:`hop_margin`); ``None``
+    when the chain is empty or a hop has no margin or had a trigger never
+    answered."""
     if not chain:
         return None
     spent = Fraction(0)
     for h in chain:
-        m = h.get("time_margin")
-        if not m or m.get("margin_ns") is None or m.get("unanswered"):
+        m = h.time_margin
+        if not isinstance(m, HopTimeMargin) or m.margin_ns is None or m.unanswered:
             return None
-        spent += Fraction(str(h["within_s"])) * 10**9 - int(m["margin_ns"])
+        spent += Fraction(h.within_s) * 10**9 - m.margin_ns
     return math.floor(within_s * 10**9 - spent)  # rounded down: never more slack than measured
 
 

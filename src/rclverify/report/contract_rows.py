@@ -25,7 +25,8 @@ from rclverify.records.records import Obligation, worst
 from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
 from rclverify.records.node_rows import AssumptionRow, GuaranteeRow, InputRow, NodeRow, OutputRow
 from rclverify.records.report_schema import (DerivedPropertyJson, EnvironmentAssumptionJson, NodeJson,
-                                             SideConditionRow)
+                                             SideConditionJson)
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.statuses import EvidenceStatus, HealthStatus
 from rclverify.report.cex_cone import side_condition_view
 from rclverify.report.cones import DERIVATION, ConeEvidence
@@ -88,12 +89,14 @@ def contract_records(ws: Workspace, nodes: Sequence[str], stale: Mapping[str, se
     return comps, rows
 
 
-def involved_model(sc: Mapping[str, Any]) -> SideConditionRow:
-    """``sc`` (a side-condition row of the calculus) with its Z3 ``model``
-    cut to the nodes its conjunct involves (:func:`.cex_cone.side_condition_view`:
-    the consumer, the producers of its links and, decided in context, the
-    nodes whose assumption the counterexample violates)."""
-    return cast(SideConditionRow, side_condition_view(sc))  # a calculus record's row, the schema's shape
+def involved_model(sc: Mapping[str, Any]) -> SideConditionJson:
+    """``sc`` (a side-condition row of the calculus, as :func:`contract_records` shows it) with its Z3
+    ``model`` cut to the nodes its conjunct involves (:func:`.cex_cone.side_condition_view`: the consumer,
+    the producers of its links and, decided in context, the nodes whose assumption the counterexample
+    violates), as the report's row (decoded into
+    :class:`~rclverify.records.side_condition_rows.SideConditionRow`, which report/records.py checked the
+    record's rows against)."""
+    return SideConditionRow.of(side_condition_view(sc)).to_json()
 
 
 class GuaranteeStatuses:

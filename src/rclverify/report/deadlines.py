@@ -41,9 +41,14 @@ covers is ``pending``: they check its formula, not its time)
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence, cast
 
-from rclverify.records.report_schema import DeadlineRow, ObligationJson, Report
+import msgspec
+
+from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow
+from rclverify.records.report_schema import DeadlineJson, ObligationJson, Report
+from rclverify.records.solvers_rows import Solvers
+from rclverify.records.statuses import DeadlineVerdict, EvidenceStatus
 from rclverify.records.sarif import SarifResult
 from rclverify.records.records import worst
 from rclverify.records.statuses import DEADLINE_STATUS
@@ -69,9 +74,10 @@ def _spec_of(rec: Mapping[str, Any], spec: Any) -> bool:
 
 
 def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[[str, int], str],
-                  ob_rows: Sequence[ObligationJson], second: Any = None) -> list[dict[str, Any]]:
+                  ob_rows: Sequence[ObligationJson], second: Any = None) -> list[DeadlineJson]:
     """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
-    docstring).  ``current``: path -> sha256 of the current snapshots and
+    docstring), each a :class:`~rclverify.records.deadline_rows.DeadlineRow`'s
+    JSON object.  ``current``: path -> sha256 of the current snapshots and
     model (:func:`rclverify.stages.workspace.current_snapshot_hashes`);
     ``g_status(node, k)``: a guarantee's evidence status; ``ob_rows``: the
     report's obligation rows (``id``, ``node``, ``backend``, ``status``).
@@ -86,59 +92,80 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
     records, why = read_deadlines(ws, current)
     by_req = {str(r.get("requirement")): r for r in records or []}
     monitors = _monitor_verdicts(ws, ob_rows, {n for s in specs for n in s.path})
-    rows: list[dict[str, Any]] = []
+    rows: list[DeadlineJson] = []
     for spec in specs:
-        base = {"requirement": spec.requirement, "path": list(spec.path), "within": _show(spec.within),
-                "source": f"{spec.loc.file}:{spec.loc.line}:{spec.loc.col}", "chain": [], "total": None,
-                "stamps": [], "smt2": ""}
         rec = by_req.get(spec.requirement)
-        if why:
-            rows.append({**base, "verdict": "error", "reason": f"error: {why}; the recorded verdict is not shown"})
-            continue
-        if rec is None or not _spec_of(rec, spec):
-            rows.append({**base, "verdict": "pending",
-                         "reason": f"not decided yet for this path and bound ({INDEX}): run `doit verify`"})
-            continue
-        if second is not None:
+        rec = rec if not why and rec is not None and _spec_of(rec, spec) else None  # None: no decision shown
+        if rec is not None and second is not None:
             rec = second.deadline(rec)
-        chain = [{**h, "status": g_status(str(h["node"]), int(h["guarantee"])),
-                  "monitors": monitors.get(str(h["node"]), [])} for h in rec.get("chain") or []]
-        verdict = str(rec.get("status"))
-        reason = str(rec.get("reason", ""))
-        if verdict == "stale":
-            reason = f"STALE: {reason}; recorded verdict {rec.get('recorded_status')}"
-        rows.append({**base, "verdict": verdict if verdict in STATUS_OF else "error", "reason": reason,
-                     "chain": chain, "total": rec.get("total"), "stamps": list(rec.get("stamps") or []),
-                     "smt2": str(rec.get("smt2") or ""), "solvers": rec.get("solvers")})
-    for row, spec in zip(rows, specs):
-        for h in row["chain"]:
-            _timing_measured(h)
-            h["time_margin"] = hop_margin(h)  # the hop's smallest time margin on the runs
-        measured = chain_margin(spec.within, row["chain"])
-        row["time_margin_ns"] = measured
-        row["time_margin"] = None if measured is None else f"{measured / 1e6:.3f} ms"
+        verdict, reason = _verdict(rec, why, INDEX)
+        chain = [_hop(h, g_status(str(h["node"]), int(h["guarantee"])), monitors.get(str(h["node"]), []))
+                 for h in (rec or {}).get("chain") or []]
+        measured = chain_margin(spec.within, chain)
         # the timed guarantees the decision rests on: their evidence (the monitors check the stamps)
-        row["evidence_status"] = worst([h["status"] for h in row["chain"]], empty="pending")
-        # proved is a green tick only when every hop's guarantee is discharged (as a requirement's "met")
-        row["status"] = row["evidence_status"] if row["verdict"] == "proved" else STATUS_OF[row["verdict"]]
+        evidence_status = cast(EvidenceStatus, worst([str(h.status) for h in chain], empty="pending"))
+        rows.append(DeadlineRow(
+            requirement=spec.requirement, path=list(spec.path), within=_show(spec.within),
+            source=f"{spec.loc.file}:{spec.loc.line}:{spec.loc.col}", verdict=verdict,
+            # proved is a green tick only when every hop's guarantee is discharged (as a requirement's "met")
+            status=evidence_status if verdict == "proved" else STATUS_OF[verdict],
+            evidence_status=evidence_status, reason=reason, chain=chain, total=(rec or {}).get("total"),
+            time_margin=None if measured is None else f"{measured / 1e6:.3f} ms", time_margin_ns=measured,
+            stamps=list((rec or {}).get("stamps") or []), smt2=str((rec or {}).get("smt2") or ""),
+            solvers=msgspec.UNSET if rec is None else _solvers(rec.get("solvers"))).to_json())
     return rows
 
 
-def _timing_measured(hop: dict[str, Any]) -> None:
-    """A hop whose guarantee is discharged by evidence that checks only its
-    formula (a property test, a proof: backends/timing_scope.py) while no
-    run timed it (no monitors' deadline record of its node with a ``true``
-    verdict and no ``false`` one) is ``pending``: the deadline the sum rests
-    on was measured by nothing (a proved deadline is no green tick
-    on an unmeasured hop).  ``hop["timing"]`` says so."""
-    if hop["status"] != "discharged":
-        return
-    timed = [m for m in hop.get("monitors") or () if m.get("status") == "discharged"
+def _verdict(rec: Mapping[str, Any] | None, why: str, index: str) -> tuple[DeadlineVerdict, str]:
+    """``(verdict, reason)`` of a deadline from its stage record ``rec`` (``None``: none decided for the plan's
+    path and bound now, or none believed); ``why``: why the stage's record is not believed (``""`` when it
+    is); ``index``: the record's path."""
+    if why:
+        return "error", f"error: {why}; the recorded verdict is not shown"
+    if rec is None:
+        return "pending", f"not decided yet for this path and bound ({index}): run `doit verify`"
+    verdict = str(rec.get("status"))
+    reason = str(rec.get("reason", ""))
+    if verdict == "stale":
+        reason = f"STALE: {reason}; recorded verdict {rec.get('recorded_status')}"
+    return cast(DeadlineVerdict, verdict if verdict in STATUS_OF else "error"), reason
+
+
+def _solvers(s: Any) -> Solvers | None | msgspec.UnsetType:
+    """A deadline record's ``solvers`` (stages/crosscheck/apply.py) as the row holds it: absent when the
+    record has none."""
+    return Solvers.of(s) if isinstance(s, Mapping) else None if s is None else msgspec.UNSET
+
+
+def _hop(h: Mapping[str, Any], status: str, monitors: list[dict[str, Any]]) -> DeadlineHop:
+    """The stage's hop ``h`` (records/stage_records.py ``DeadlineHop``) as the report's row: its guarantee's
+    evidence ``status``, its node's monitors' deadline records ``monitors``, whether a run timed it
+    (:func:`_timing_measured`) and its smallest time margin on the runs (:func:`.chain_margins.hop_margin`)."""
+    status, timing = _timing_measured(status, monitors, str(h.get("within", "")))
+    return DeadlineHop(node=str(h["node"]), guarantee=int(h["guarantee"]), trigger=str(h["trigger"]),
+                       outputs=[str(o) for o in h["outputs"]], within_s=str(h["within_s"]), within=str(h["within"]),
+                       loc=str(h["loc"]), status=cast(EvidenceStatus, status), timing=timing, monitors=monitors,
+                       time_margin=hop_margin(int(h["guarantee"]), monitors))
+
+
+def _timing_measured(status: str, monitors: Sequence[Mapping[str, Any]],
+                     within: str) -> tuple[str, str | msgspec.UnsetType]:
+    """``(status, timing)`` of a hop whose guarantee's evidence status is
+    ``status``: one discharged by evidence that checks only its formula (a
+    property test, a proof: backends/timing_scope.py) while no run timed it
+    (no monitors' deadline record of its node, of ``monitors``, with a
+    ``true`` verdict and no ``false`` one) is ``pending``: the deadline
+    ``within`` the sum rests on was measured by nothing (a proved deadline
+    is no green tick on an unmeasured hop); ``timing`` says so, ``UNSET``
+    otherwise."""
+    if status != "discharged":
+        return status, msgspec.UNSET
+    timed = [m for m in monitors if m.get("status") == "discharged"
              and int((m.get("counts") or {}).get("true", 0) or 0) > 0]
-    if not timed:
-        hop["status"] = "pending"
-        hop["timing"] = (f"its {hop.get('within', '')} deadline is measured by no run: its evidence checks the "
-                         "guarantee's formula only (a monitors entry on a recorded or live run times it)")
+    if timed:
+        return status, msgspec.UNSET
+    return "pending", (f"its {within} deadline is measured by no run: its evidence checks the "
+                       "guarantee's formula only (a monitors entry on a recorded or live run times it)")
 
 
 def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationJson],
@@ -230,7 +257,7 @@ def strict_reason(report: Report) -> list[str]:
     return out
 
 
-def _chain_text(row: DeadlineRow) -> str:
+def _chain_text(row: DeadlineJson) -> str:
     return " -> ".join(f"{h['node']} guarantee {h['guarantee']} ({h['trigger']} -> {', '.join(h['outputs'])} "
                        f"within {h['within']}, {h['loc']})" for h in row["chain"]) or "no chain"
 

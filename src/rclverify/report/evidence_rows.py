@@ -15,7 +15,8 @@ from typing import Any, Mapping, Sequence, TypedDict, cast
 from rclverify.records.records import Obligation
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.evidence_rows import EvidenceRow
-from rclverify.records.report_schema import EvidenceJson, ObligationJson, PendingRow, Solvers
+from rclverify.records.report_schema import EvidenceJson, ObligationJson, PendingRow
+from rclverify.records.solvers_rows import Solvers
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 from rclverify.records.store import EvidenceStore
 from rclverify.report.statistics import compact as compact_statistics
@@ -60,13 +61,13 @@ def evidence_extras(ws: Workspace, details: Any) -> tuple[list[list[str]], str]:
     return figures, svg
 
 
-def _explanation(ev: Any, status: str, altered: str, solvers: Mapping[str, Any] | None) -> str:
+def _explanation(ev: Any, status: str, altered: str, solvers: Solvers | None) -> str:
     """The record's explanation, prefixed with why the report does not show its recorded status."""
     expl = str(ev.explanation)
     if altered:
         expl = f"{altered[0].upper()}{altered[1:]}. The record's own text follows, not to be believed: " + expl
     if solvers is not None and status != ev.status:
-        expl = f"Not discharged: {solvers['why']} (second solver). Z3 alone: " + expl
+        expl = f"Not discharged: {solvers.why} (second solver). Z3 alone: " + expl
     if status == "stale" and ev.status != "stale":
         expl = f"STALE: an input changed since this evidence was produced (recorded status {ev.status}). " + expl
     return expl
@@ -111,7 +112,7 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
         part["inputs"][o.id] = dict(ev.input_hashes) if ev is not None else None
         status = "error" if altered else (store.current_status(ev, hashes) if ev else "pending")
         status, agreement = second.evidence(o.id, o.backend, status)
-        solvers = cast(Solvers | None, agreement)  # stages/crosscheck/apply.py builds the $defs/solvers object
+        solvers = None if agreement is None else Solvers.of(agreement)  # stages/crosscheck/apply.py builds it
         part["status"][o.id] = status
         part["obligations"].append(ObligationRow(
             id=o.id, node=o.node, guarantee=o.guarantee, backend=o.backend, kind=cast(EvidenceKind, o.kind),

@@ -13,7 +13,7 @@ import math
 from typing import Any, Sequence
 
 from rclverify.core.svgplot import svg_plot
-from rclverify.records.report_schema import MarginRow
+from rclverify.records.margin_rows import MarginRow
 
 
 def _label(trace: str, most: int = 24) -> str:
@@ -39,7 +39,7 @@ def render_svg(row: MarginRow, runs: Sequence[tuple[str, Sequence[float]]]) -> s
     (floats, ``-inf`` for a margin without distance, not drawn).  Raises
     :class:`~rclverify.core.extras.MissingExtra` without matplotlib (the
     ``plots`` extra)."""
-    unit = f" [{row['unit']}]" if row["unit"] else ""
+    unit = f" [{row.unit}]" if row.unit else ""
 
     def draw(f: Any, ax: Any) -> None:
         for x, (_, kept) in enumerate(runs, start=1):
@@ -49,16 +49,16 @@ def render_svg(row: MarginRow, runs: Sequence[tuple[str, Sequence[float]]]) -> s
             if ys:
                 ax.plot([x], [ys[0]], "v", color="C3", markersize=6, label="run's smallest" if x == 1 else None)
         ax.axhline(0.0, color="black", linewidth=0.8)
-        for k, (name, b) in enumerate((("p5", row["p5"]), ("p50", row["p50"]))):
-            if b["low"] is not None and b["low"] == b["high"]:
-                ax.axhline(float(b["low"]), color=f"C{1 + k}", linestyle="--",
-                           label=f"{name} over {row['count']} answers ({b['low']:g})")
+        for k, (name, b) in enumerate((("p5", row.p5), ("p50", row.p50))):
+            if b.low is not None and b.low == b.high:
+                ax.axhline(float(b.low), color=f"C{1 + k}", linestyle="--",
+                           label=f"{name} over {row.count} answers ({b.low:g})")
         ax.set_xticks(range(1, len(runs) + 1), [_label(t) for t, _ in runs], rotation=30, ha="right",
                       fontsize=7)
         ax.set_xlim(0.5, len(runs) + 0.5)
         ax.set_xlabel("run")
         ax.set_ylabel(f"margin{unit}")
-        ax.set_title(f"{row['node']} guarantee {row['guarantee']}")
+        ax.set_title(f"{row.node} guarantee {row.guarantee}")
         ax.legend(loc="best", fontsize=7)
 
     text = svg_plot("the margins' plot", draw)

@@ -22,11 +22,15 @@ why none was drawn.
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Mapping, Sequence, cast
+from typing import Any, Iterable, Mapping, Sequence
+
+from msgspec.structs import replace
 
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.report.chain_margins import hop_margin
-from rclverify.records.report_schema import HopTimeMargin, MarginBounds, MarginRow, ObligationJson
+from rclverify.records.deadline_rows import HopTimeMargin
+from rclverify.records.margin_rows import MarginBounds, MarginRow
+from rclverify.records.report_schema import MarginJson, ObligationJson
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
 
@@ -36,7 +40,7 @@ QUANTILES = (("p5", 0.05), ("p50", 0.5))
 #: second and up to a few hundred kilobytes of the HTML report.
 MAX_PLOTS = 12
 #: The bounds of a figure no answer gives.
-_NONE: MarginBounds = {"low": None, "high": None}
+_NONE = MarginBounds(low=None, high=None)
 
 
 def _number(v: float) -> float | None:
@@ -94,7 +98,7 @@ def figures(runs: Iterable[Mapping[str, Any]]) -> tuple[int, int, dict[str, Marg
         rank = max(1, math.ceil(q * count))
         high = _kth(known, rank) if rank <= len(known) else math.inf
         low = _kth(known + floors, rank)
-        out[name] = {"low": _number(low), "high": _number(high)}
+        out[name] = MarginBounds(low=_number(low), high=_number(high))
     return count, len(known), out
 
 
@@ -113,8 +117,9 @@ def _formula(ws: Workspace, node: str, k: int) -> str:
         else ""
 
 
-def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[MarginRow]:
-    """The report's ``margins`` (module docstring), by node and guarantee."""
+def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[MarginJson]:
+    """The report's ``margins`` (module docstring), by node and guarantee, each a
+    :class:`~rclverify.records.margin_rows.MarginRow`'s JSON object."""
     runs: dict[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]] = {}
     timed: dict[tuple[str, int], list[dict[str, Any]]] = {}  # the runs' deadline records, as hop_margin reads them
     store: EvidenceStore | None = None
@@ -135,59 +140,67 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Margin
             if isinstance(t, dict) and isinstance(t.get("guarantee"), int):
                 timed.setdefault((str(o["node"]), t["guarantee"]), []).append(
                     {"obligation": str(o["id"]), "time_margins": [t]})
-    rows: list[MarginRow] = []
-    for node, k in sorted(set(runs) | set(timed)):
-        got = runs.get((node, k), [])
-        time_margin = cast("HopTimeMargin | None", hop_margin({"guarantee": k, "monitors": timed[(node, k)]})
-                           if (node, k) in timed else None)
-        if not got:  # timed only: no answer was judged with a space margin
-            rows.append({"node": node, "guarantee": k, "formula": _formula(ws, node, k),
-                         "source": _guarantee_place(ws, node, k), "margin": None, "holds": None, "unit": "",
-                         "atom": "", "trace": "", "obligation": "", "time": None, "where": "", "runs": 0,
-                         "answers": 0, "undefined": 0, "count": 0, "kept": 0, "min": _NONE, "p5": _NONE,
-                         "p50": _NONE, "time_margin": time_margin})
-            continue
-        def order(r: tuple[str, str, Mapping[str, Any]]) -> float:
-            v, holds, answers = r[2].get("margin"), r[2].get("holds"), r[2].get("answers")
-            if not answers:
-                return math.nan
-            return float(v) if v is not None else math.inf if holds else -math.inf
-        measured = [r for r in got if not math.isnan(order(r))]
-        least = min(measured, key=order) if measured else got[0]
-        m = least[2]
-        count, kept, fig = figures(r[2] for r in got)
-        v = order(least)
-        rows.append({"node": node, "guarantee": k, "formula": str(m.get("formula", "")),
-                     "source": _guarantee_place(ws, node, k),
-                     "margin": None if math.isnan(v) else _number(v),
-                     "holds": (v > 0) if math.isinf(v) else None, "unit": str(m.get("unit", "")),
-                     "atom": str(m.get("atom", "")), "trace": least[1], "obligation": least[0],
-                     "time": float(m["time"]) if measured and isinstance(m.get("time"), (int, float)) else None,
-                     "where": str(m.get("where", "")) if measured else "",
-                     "runs": len(got), "answers": sum(int(r[2].get("answers") or 0) for r in got),
-                     "undefined": sum(int(r[2].get("undefined") or 0) for r in got),
-                     "count": count, "kept": kept, "min": fig.get("min", _NONE), "p5": fig.get("p5", _NONE),
-                     "p50": fig.get("p50", _NONE), "time_margin": time_margin})
-    _plots(rows, runs)
-    return rows
+    rows = [_row(ws, node, k, runs.get((node, k), []), hop_margin(k, timed.get((node, k), [])))
+            for node, k in sorted(set(runs) | set(timed))]
+    return [r.to_json() for r in _plots(rows, runs)]
 
 
-def _plots(rows: list[MarginRow], runs: Mapping[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]]) -> None:
-    """Draw the distribution of every row measured on two runs or more (at most :data:`MAX_PLOTS`)."""
+def _order(r: tuple[str, str, Mapping[str, Any]]) -> float:
+    """A run's smallest margin of a guarantee as a number (``inf`` for one held without a distance, ``nan``
+    when no answer gave one)."""
+    v, holds, answers = r[2].get("margin"), r[2].get("holds"), r[2].get("answers")
+    if not answers:
+        return math.nan
+    return float(v) if v is not None else math.inf if holds else -math.inf
+
+
+def _row(ws: Workspace, node: str, k: int, got: Sequence[tuple[str, str, Mapping[str, Any]]],
+         time_margin: HopTimeMargin | None) -> MarginRow:
+    """Guarantee ``k`` of ``node``'s row over the runs ``got`` (``[(obligation, trace, margins item)]``) with
+    its smallest time margin ``time_margin`` (module docstring)."""
+    place = _guarantee_place(ws, node, k)
+    if not got:  # timed only: no answer was judged with a space margin
+        return MarginRow(node=node, guarantee=k, formula=_formula(ws, node, k), source=place, margin=None,
+                         holds=None, unit="", atom="", trace="", obligation="", time=None, where="", runs=0,
+                         answers=0, undefined=0, count=0, kept=0, min=_NONE, p5=_NONE, p50=_NONE,
+                         time_margin=time_margin)
+    measured = [r for r in got if not math.isnan(_order(r))]
+    least = min(measured, key=_order) if measured else got[0]
+    m = least[2]
+    count, kept, fig = figures(r[2] for r in got)
+    v = _order(least)
+    return MarginRow(node=node, guarantee=k, formula=str(m.get("formula", "")), source=place,
+                     margin=None if math.isnan(v) else _number(v), holds=(v > 0) if math.isinf(v) else None,
+                     unit=str(m.get("unit", "")), atom=str(m.get("atom", "")), trace=least[1], obligation=least[0],
+                     time=float(m["time"]) if measured and isinstance(m.get("time"), (int, float)) else None,
+                     where=str(m.get("where", "")) if measured else "", runs=len(got),
+                     answers=sum(int(r[2].get("answers") or 0) for r in got),
+                     undefined=sum(int(r[2].get("undefined") or 0) for r in got), count=count, kept=kept,
+                     min=fig.get("min", _NONE), p5=fig.get("p5", _NONE), p50=fig.get("p50", _NONE),
+                     time_margin=time_margin)
+
+
+def _plots(rows: list[MarginRow],
+           runs: Mapping[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]]) -> list[MarginRow]:
+    """``rows`` with the distribution of every row measured on two runs or more drawn (``plot_svg``, at most
+    :data:`MAX_PLOTS`) or why not (``plot_note``)."""
     from rclverify.core.extras import MissingExtra  # deferred: start-up (only where a plot is drawn)
-    wanted = [r for r in rows if r["runs"] >= 2 and r["count"]]
-    wanted.sort(key=lambda r: math.inf if r["margin"] is None else r["margin"])
+    wanted = [r for r in rows if r.runs >= 2 and r.count]
+    wanted.sort(key=lambda r: math.inf if r.margin is None else r.margin)
+    drawn: dict[int, MarginRow] = {}
     for n, r in enumerate(wanted):
         if n >= MAX_PLOTS:
-            r["plot_note"] = f"no plot drawn: the report draws the {MAX_PLOTS} smallest margins' plots only"
+            drawn[id(r)] = replace(r, plot_note=f"no plot drawn: the report draws the {MAX_PLOTS} smallest margins' "
+                                                "plots only")
             continue
         try:
             from rclverify.report.margin_plot import render_svg  # deferred: start-up (matplotlib only when drawn)
             per_run = [(trace, [-math.inf if v is None else float(v) for v in m.get("lowest") or ()])
-                       for _, trace, m in runs[(r["node"], r["guarantee"])]]
-            r["plot_svg"] = render_svg(r, per_run)
+                       for _, trace, m in runs[(r.node, r.guarantee)]]
+            drawn[id(r)] = replace(r, plot_svg=render_svg(r, per_run))
         except MissingExtra as exc:  # the plot illustrates; the figures above do not rest on it
-            r["plot_note"] = f"no plot drawn: {exc}"
+            drawn[id(r)] = replace(r, plot_note=f"no plot drawn: {exc}")
+    return [drawn.get(id(r), r) for r in rows]
 
 
 __all__ = ["MAX_PLOTS", "QUANTILES", "figures", "margin_rows"]

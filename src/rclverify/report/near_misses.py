@@ -22,9 +22,10 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Literal, Mapping, Sequence
 
-from rclverify.records.report_schema import NearMissRow, ObligationJson, Report
+from rclverify.records.margin_rows import NearMissRow
+from rclverify.records.report_schema import NearMissJson, ObligationJson, Report
 from rclverify.records.sarif import SarifResult
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
@@ -67,10 +68,11 @@ def _guarantee_place(ws: Workspace, node: str, k: int) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
-def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[NearMissRow]:
+def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[NearMissJson]:
     """The report's ``near_misses`` (module docstring), in obligation order,
-    space margins before time margins, guarantees in order."""
-    rows: list[NearMissRow] = []
+    space margins before time margins, guarantees in order, each a
+    :class:`~rclverify.records.margin_rows.NearMissRow`'s JSON object."""
+    rows: list[NearMissJson] = []
     nodes = {str(o["node"]) for o in ob_rows if o["backend"] == "monitors"}
     wanted = {n: _entries(ws, n) for n in nodes}
     if not any(wanted.values()):
@@ -91,15 +93,14 @@ def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Nea
             continue
         t, plan_place = hit[1], hit[2]
 
-        def row(m: Mapping[str, Any], kind: str, margin: float, threshold: float, unit: str, atom: str,
-                where: str, at: Any, node: str = node, o: ObligationJson = o, trace: str = trace,
-                plan_place: str = plan_place) -> NearMissRow:
+        def row(m: Mapping[str, Any], kind: Literal["value", "time"], margin: float, threshold: float, unit: str,
+                atom: str, where: str, at: Any, node: str = node, o: ObligationJson = o, trace: str = trace,
+                plan_place: str = plan_place) -> NearMissJson:
             k = int(m["guarantee"])
-            return {"node": node, "guarantee": k, "kind": "time" if kind == "time" else "value", "margin": margin,
-                    "threshold": threshold, "unit": unit, "atom": atom, "where": where,
-                    "time": float(at) if isinstance(at, (int, float)) else None, "trace": trace,
-                    "obligation": str(o["id"]), "source": _guarantee_place(ws, node, k),
-                    "threshold_source": plan_place}
+            return NearMissRow(node=node, guarantee=k, kind=kind, margin=margin, threshold=threshold, unit=unit,
+                               atom=atom, where=where, time=float(at) if isinstance(at, (int, float)) else None,
+                               trace=trace, obligation=str(o["id"]), source=_guarantee_place(ws, node, k),
+                               threshold_source=plan_place).to_json()
         if t.value is not None:
             for m in mon.get("margins") or ():
                 v = m.get("margin")

@@ -6,7 +6,8 @@ diagnostics and the grounding are sealed records
 (:mod:`rclverify.records.sealed`, docs/integrity.md).  A record whose seal
 does not hold is shown as ``error`` ("... altered outside rclverify"),
 never with the statuses it claims: its side conditions are each ``error``
-(one placeholder when it cannot be read at all), its findings are replaced
+(one placeholder when it cannot be read at all; so are they when they are
+no side-condition rows), its findings are replaced
 by one ``error`` finding, which fails ``--strict`` and is listed among the
 problems.
 """
@@ -20,6 +21,7 @@ import msgspec
 from rclverify.records.findings import HealthFinding
 from rclverify.records.records import Obligation, SourceRef
 from rclverify.records.sealed import obligation_list, read_sealed
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.stage_records import LintWarning
 from rclverify.stages.workspace import Workspace
 from rclverify.records.store import dumps
@@ -30,12 +32,39 @@ def _error_side_conditions(node: str, body: dict[str, Any] | None, why: str) -> 
     scs = (body or {}).get("side_conditions")
     rows = [sc for sc in scs if isinstance(sc, dict) and "id" in sc] if isinstance(scs, list) else []
     if not rows:  # nothing to name: one placeholder, so the node is never shown with no open side condition
-        rows = [{"id": f"{node}.calculus", "node": node, "rule": "", "conjunct": "(the node's side conditions)",
-                 "source": "", "hypotheses": [], "duration_s": 0.0, "smt2": "", "model": None, "variant": "",
-                 "links": []}]
-    return {**(body or {}), "node": node, "side_conditions": [
-        {**sc, "status": "error", "model": None, "explanation": f"error: {why}; recorded status not shown"}
-        for sc in rows]}
+        rows = [{"id": f"{node}.calculus", "node": node, "conjunct": "(the node's side conditions)"}]
+    return {**(body or {}), "node": node, "side_conditions": [_error_side_condition(node, sc, why) for sc in rows]}
+
+
+def _error_side_condition(node: str, sc: Mapping[str, Any], why: str) -> dict[str, Any]:
+    """The side condition ``sc`` of ``node``'s record not believed (``why``) as an ``error`` row
+    (:class:`~rclverify.records.side_condition_rows.SideConditionRow`'s JSON object): its texts kept where
+    they are texts, no model."""
+    def text(k: str) -> str:
+        v = sc.get(k)
+        return v if isinstance(v, str) else ""
+
+    def texts(k: str) -> list[str]:
+        v = sc.get(k)
+        return [x for x in v if isinstance(x, str)] if isinstance(v, list) else []
+    d, ctx = sc.get("duration_s"), sc.get("context")
+    return SideConditionRow(
+        id=str(sc["id"]), node=text("node") or node, rule=text("rule"), conjunct=text("conjunct"),
+        source=text("source"), hypotheses=texts("hypotheses"), status="error", verdict="error",
+        duration_s=float(d) if isinstance(d, (int, float)) and not isinstance(d, bool) and d >= 0 else 0.0,
+        smt2=text("smt2"), model=None, explanation=f"error: {why}; recorded status not shown",
+        variant=text("variant"), links=texts("links"), context=ctx if isinstance(ctx, dict) else None).to_json()
+
+
+def _malformed_side_conditions(body: Mapping[str, Any] | None) -> str:
+    """Why a sealed calculus record's side conditions are not side-condition rows
+    (:class:`~rclverify.records.side_condition_rows.SideConditionRow`: a key the class does not declare, a
+    value of another type), ``""`` when they are (or the stage has not run)."""
+    try:
+        msgspec.convert((body or {}).get("side_conditions", []), list[SideConditionRow])
+    except msgspec.ValidationError as e:
+        return f"side-condition record malformed ({e}): altered outside rclverify"
+    return ""
 
 
 def _error_finding(node: str, why: str) -> HealthFinding:
@@ -64,6 +93,7 @@ def node_records(ws: Workspace, nodes: Iterable[str]) -> tuple[dict[str, dict[st
     for n in nodes:
         rel = ws.calculus(n)
         body, why = read_sealed(ws.path(rel), "side-condition record")
+        why = why or _malformed_side_conditions(body)
         comps[n] = _error_side_conditions(n, body, f"{rel}: {why}") if why else (body or {})
         rel = ws.health(n)
         body, why = read_sealed(ws.path(rel), "contract health record")

@@ -13,7 +13,7 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 from typing import Any, NotRequired, TypedDict
 
 from rclverify.records.report_schema import (DerivedPropertyJson, DiagnosisRow, EvidenceJson, FindingJson, NodeJson,
-                                             LimitedByJson, ObligationJson, PendingRow, ProblemRow, RequirementJson, SideConditionRow,
+                                             LimitedByJson, ObligationJson, PendingRow, ProblemRow, RequirementJson, SideConditionJson,
                                              Summary, SupportJson)
 
 
@@ -161,7 +161,7 @@ class Section(TypedDict):
     name: str
     node: NodeJson | None
     derived: list[DerivedPropertyJson]
-    side: list[SideConditionRow]
+    side: list[SideConditionJson]
     findings: list[FindingJson]
     ob_status: NotRequired[dict[str, str]]
 

@@ -19,7 +19,7 @@ from typing import IO, TYPE_CHECKING, Any, Literal, Mapping, Sequence, TypeGuard
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import (ObligationJson, Report, SideConditionRow,
+from rclverify.records.report_schema import (ObligationJson, Report, SideConditionJson,
                                              UnverifiedJson)
 from rclverify.report.shapes import GroundingBrief, NodeSummaryRow, SummaryData
 from rclverify.records.records import SEVERITY
@@ -28,7 +28,7 @@ from rclverify.records.records import SEVERITY
 MAX_ROWS = 15
 
 #: A report row that names its node (an obligation, side condition, health finding, unverified guarantee).
-_Row = TypeVar("_Row", ObligationJson, SideConditionRow, UnverifiedJson)
+_Row = TypeVar("_Row", ObligationJson, SideConditionJson, UnverifiedJson)
 
 #: The counts of a node's summary row that a merged row sums.
 _Count = Literal["sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"]

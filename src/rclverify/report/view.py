@@ -15,7 +15,7 @@ from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
 from rclverify.records.findings import rows_of
 from rclverify.records.report_schema import (DerivedPropertyJson, EvidenceJson, FindingJson, ObligationJson, ProblemRow,
-                                             Report, SideConditionRow)
+                                             Report, SideConditionJson)
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
 from rclverify.model.plan.declarations import BACKEND_NAMES
@@ -26,7 +26,7 @@ from rclverify.report.templating import COUNT_ORDER, anchor, rank
 from rclverify.report.textfmt import natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
-_Row = TypeVar("_Row", DerivedPropertyJson, SideConditionRow, FindingJson)
+_Row = TypeVar("_Row", DerivedPropertyJson, SideConditionJson, FindingJson)
 
 #: Top-level keys every report dict carries.
 REPORT_KEYS: tuple[str, ...] = (

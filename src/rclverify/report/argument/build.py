@@ -40,7 +40,7 @@ from typing import Any, Iterable, Mapping, TypeVar
 
 from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.report_schema import (EnvironmentAssumptionJson, NodeJson, ObligationJson, Report,
-                                             RequirementJson, SideConditionRow)
+                                             RequirementJson, SideConditionJson)
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
@@ -51,7 +51,7 @@ from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
 
 #: A report row that names its node.
-_Row = TypeVar("_Row", ObligationJson, SideConditionRow, EnvironmentAssumptionJson)
+_Row = TypeVar("_Row", ObligationJson, SideConditionJson, EnvironmentAssumptionJson)
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -89,7 +89,7 @@ _PROOF_STATUS = {"met": "discharged", "proved, evidence outstanding": "discharge
 
 
 def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mapping[tuple[str, int], str],
-                      sides: Mapping[str, list[SideConditionRow]], j_calc: str) -> str:
+                      sides: Mapping[str, list[SideConditionJson]], j_calc: str) -> str:
     """The goal of a requirement the report's requirement check decided
     (its ``verdict``): an informal one is an undeveloped goal; a formal one is
     supported by a formal-entailment strategy whose children are the Z3
@@ -278,7 +278,7 @@ class _Goals:
                     status=_FINDING_AS.get(f.status, "error"), ref=f.id, url=f.smt2)))
         return kids
 
-    def side_goal(self, sc: SideConditionRow) -> str:
+    def side_goal(self, sc: SideConditionJson) -> str:
         """The goal of side condition ``sc`` with its Z3 query as solution (in context: the weaker claim)."""
         b, sid = self.b, str(sc["id"])
         verdict = str(sc.get("verdict") or sc["status"])
