@@ -14,8 +14,8 @@ from collections.abc import Mapping
 from typing import NotRequired, TypedDict, cast
 
 from rclverify.diagnosis.edits import Edit
-from rclverify.records.report_schema import (DeadlineJson, EvidenceJson, FindingJson, LintRow, NodeJson, ObligationJson,
-                                             RequirementJson, SideConditionJson, SystemView)
+from rclverify.records.report_schema import (DeadlineJson, EvidenceJson, FindingJson, LintJson, NodeJson, ObligationJson,
+                                             RequirementJson, SideConditionJson, SystemJson)
 from rclverify.records.stage_records import Repair
 
 
@@ -23,14 +23,14 @@ class ReportRows(TypedDict):
     """The parts of the report dict the diagnosis reads (the report without diagnoses,
     report/build.py ``undiagnosed_report``; a whole :class:`~rclverify.records.report_schema.Report`
     is one too)."""
-    system: SystemView
+    system: SystemJson
     requirements: list[RequirementJson]
     nodes: list[NodeJson]
     side_conditions: list[SideConditionJson]
     findings: list[FindingJson]
     obligations: list[ObligationJson]
     evidence: list[EvidenceJson]
-    lint: list[LintRow]
+    lint: list[LintJson]
     deadlines: list[DeadlineJson]
 
 

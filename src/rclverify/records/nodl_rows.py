@@ -1,46 +1,78 @@
-"""The NoDL part of the report (``nodl``; docs/nodl.md, stages/nodl.py) as
-types: the static reading of its ``docs/assurance.schema.json`` part, held
-to it key by key by ``tests/report/test_report_vocabulary.py`` through
-:class:`~rclverify.records.report_schema.Report`."""
-# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
-# annotations (with string annotations every key would count as required).
-from typing import Literal, NotRequired, TypedDict
+"""The NoDL part of the report, defined once: :class:`NodlRow` (with :class:`NodlFindingRow`,
+:class:`NodlPlaceRow` and :class:`NodlSideConditionRow`).
+
+``nodl`` is the NoDL stage's record (artifacts/nodl/index.json,
+stages/nodl.py; docs/nodl.md) as the report shows it: the workspace's NoDL
+documents checked against its contracts and each other, with ``stale``
+when the record was made from other files (or not made yet) and
+``altered`` when its seal does not hold; ``null`` when the workspace has no
+NoDL document.
+
+The rules (docs/decisions.md, "One definition per record"):
+
+* These classes are the only statement of the part's fields.
+  report/nodl.py decodes the stage's record into :class:`NodlRow` and
+  writes :meth:`~rclverify.records.row.Row.to_json` (the fields in the
+  order declared; ``stale`` and ``altered`` absent when there is nothing to
+  say).
+* The ``nodl`` part of docs/assurance.schema.json is generated from them
+  (records/schema_gen.py); tests/records/test_record_shapes.py fails when
+  the file and the classes differ.
+"""
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import msgspec
+
+from rclverify.records.row import DOC, Row
+
+_DOC = DOC  # a field's description, as the generated JSON Schema shows it
 
 
-class NodlPlaceRow(TypedDict):
-    """A place a NoDL finding involves (``$defs/nodl_place``): file, line, column (1-based)."""
-    file: str
-    line: int
-    col: int
+class NodlPlaceRow(Row, frozen=True, forbid_unknown_fields=True):
+    """A place a NoDL finding involves."""
+
+    file: Annotated[str, _DOC(description="Workspace-relative file.")]
+    line: Annotated[int, _DOC(description="Line, 1-based.")]
+    col: Annotated[int, _DOC(description="Column, 1-based.")]
 
 
-class NodlFindingRow(TypedDict):
-    """A finding of the NoDL check (``nodl.findings[]``; docs/nodl.md, "Findings"), at every place it involves."""
-    code: str
-    severity: Literal["error", "warning"]
-    message: str
-    places: list[NodlPlaceRow]
+class NodlFindingRow(Row, frozen=True, forbid_unknown_fields=True):
+    """One finding, at every place it involves."""
+
+    code: Annotated[str, _DOC(description="The finding's code (docs/nodl.md, \"Findings\").")]
+    severity: Annotated[Literal["error", "warning"], _DOC(description="An error fails --strict; a warning does "
+                                                                      "not.")]
+    message: Annotated[str, _DOC(description="What is wrong, in one sentence.")]
+    places: Annotated[list[NodlPlaceRow], _DOC(description="Every place involved, most important first.")]
 
 
-class NodlSideConditionRow(TypedDict):
-    """A parameter's declared constraints against an assumption of its node (``nodl.side_conditions[]``)."""
-    node: str
-    parameter: str
-    conjunct: str
-    status: Literal["proved", "refuted", "inconclusive"]
-    model: dict[str, str]
+class NodlSideConditionRow(Row, frozen=True, forbid_unknown_fields=True):
+    """A parameter's declared constraints against one conjunct its node assumes of the input it sets."""
+
+    node: Annotated[str, _DOC(description="The node.")]
+    parameter: Annotated[str, _DOC(description="The parameter.")]
+    conjunct: Annotated[str, _DOC(description="The assumption's conjunct, as RCL text.")]
+    status: Annotated[Literal["proved", "refuted", "inconclusive"], _DOC(description="Z3's decision.")]
+    model: Annotated[dict[str, str], _DOC(description="Refuted: Z3's counterexample, RCL name to value.")]
 
 
-class NodlRow(TypedDict):
-    """The workspace's NoDL documents against its contracts and each other (``nodl``; stages/nodl.py)."""
-    documents: dict[str, list[str]]
-    parts: list[str]
-    findings: list[NodlFindingRow]
-    counts: dict[str, int]
-    side_conditions: list[NodlSideConditionRow]
-    inputs: dict[str, str]
-    stale: NotRequired[str]
-    altered: NotRequired[str]
+class NodlRow(Row, frozen=True, forbid_unknown_fields=True, omit_defaults=True):
+    """The NoDL stage's record (artifacts/nodl/index.json) as the report shows it."""
+
+    documents: Annotated[dict[str, list[str]], _DOC(
+        description="Per node with a document: the files read for it (the document, then what it includes).")]
+    parts: Annotated[list[str], _DOC(description="Documents named after no node (parts for include).")]
+    findings: Annotated[list[NodlFindingRow], _DOC(description="The findings, in file order.")]
+    counts: Annotated[dict[str, int], _DOC(description="Findings per severity (error, warning).")]
+    side_conditions: Annotated[list[NodlSideConditionRow], _DOC(
+        description="The parameters' side conditions, each decided by Z3.")]
+    inputs: Annotated[dict[str, str], _DOC(description="The sha256 of each file the record was made from.")]
+    stale: Annotated[str | msgspec.UnsetType, _DOC(
+        description="Why the record is not current (made from other files, or not made yet).")] = msgspec.UNSET
+    altered: Annotated[str | msgspec.UnsetType, _DOC(
+        description="Why the record is not believed (its seal does not hold).")] = msgspec.UNSET
 
 
 __all__ = ["NodlFindingRow", "NodlPlaceRow", "NodlRow", "NodlSideConditionRow"]

@@ -27,76 +27,7 @@ from typing import Any, Literal, Mapping, NotRequired, TypedDict, cast
 from rclverify.records.statuses import (AcknowledgementStatus, AnyStatus, Derivation,
                                         EvidenceKind, EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
                                         EVIDENCE_STATUSES)
-from rclverify.records.nodl_rows import NodlRow
 from rclverify.records.strength_rows import Strength
-
-
-class SystemView(TypedDict):
-    """The system model as the report draws it (``system``; model/system/model.py ``view``)."""
-    nodes: list[dict[str, Any]]
-    connections: list[dict[str, Any]]
-    environment_inputs: list[dict[str, Any]]
-    loops: list[list[str]]
-    loop_components: list[list[str]]
-
-
-class ExpectedVerdictRow(TypedDict):
-    """An expectation of the plan against the obligation it names (``expected_verdicts[]``; report/expected.py)."""
-    node: str
-    backend: str
-    source: str
-    guarantee: int | None
-    instance: str | None
-    expected: str | None
-    actual: EvidenceStatus | None
-    obligation: str | None
-    reason: str
-    outcome: str
-
-
-class DiagnosisRow(TypedDict):
-    """One problem explained, with its repairs checked by Z3 (``diagnoses[]``; docs/diagnosis.md)."""
-    id: str
-    kind: str
-    status: AnyStatus
-    node: str
-    guarantee: int | None
-    sentence: str
-    culprits: list[Any]
-    counterexample: list[Any]
-    related: list[Any]
-    repairs: list[dict[str, Any]]
-
-
-class Meta(TypedDict):
-    """Where the report comes from (``meta``)."""
-    tool: str
-    version: str
-    workspace: str
-    plan: str
-    contracts: list[str]
-    z3_version: str
-    strict_ok: bool
-    inputs_sha256: str
-
-
-class DiagnosisBrief(TypedDict):
-    """One diagnosis in short (``summary.diagnoses[]``); ``repairs``: how many repairs Z3 checked."""
-    id: str
-    kind: str
-    sentence: str
-    repairs: int
-
-
-class Summary(TypedDict):
-    """The one-screen summary (``summary``); ``counts``: obligations per status."""
-    status: EvidenceStatus
-    counts: dict[str, int]
-    headline: str
-    problems: list[str]
-    solvers: dict[str, int]
-    diagnoses: list[DiagnosisBrief]
-    confidence: NotRequired[float]
 
 
 #: A node's row (``nodes[]``) as the report's JSON object: the encoding of
@@ -181,69 +112,60 @@ RequirementJson = dict[str, Any]
 #: of :class:`rclverify.records.requirement_rows.SupportRow`.
 SupportJson = dict[str, Any]
 
+#: Where the report comes from (``meta``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.summary_rows.Meta`, the one definition of its fields (the schema's ``meta``
+#: is generated from it, records/schema_gen.py).
+MetaJson = dict[str, Any]
 
-class PendingRow(TypedDict):
-    """An obligation without a decided record (``pending[]``)."""
-    obligation: str
-    backend: str
-    reason: str
+#: The one-screen summary (``summary``) as the report's JSON object: the encoding of
+#: :class:`rclverify.records.summary_rows.Summary` (its diagnoses in short
+#: :class:`~rclverify.records.summary_rows.DiagnosisBrief`); decode it with ``Summary.of``.
+SummaryJson = dict[str, Any]
 
+#: The system model as the report draws it (``system``) as its JSON object: the encoding of
+#: :class:`rclverify.records.summary_rows.SystemView`.
+SystemJson = dict[str, Any]
 
-class LintRow(TypedDict):
-    """A diagnostic of the contract or plan text (``lint[]``); ``location`` is file:line:col."""
-    severity: LintSeverity
-    location: str
-    message: str
-    code: str
-    flagged: NotRequired[str]
-    sha256: NotRequired[str]
-    acknowledged: NotRequired[dict[str, str]]
+#: An obligation without a decided record (``pending[]``) as its JSON object: the encoding of
+#: :class:`rclverify.records.verdict_rows.PendingRow`.
+PendingJson = dict[str, Any]
 
+#: An expectation of the plan against the obligation it names (``expected_verdicts[]``) as its JSON
+#: object: the encoding of :class:`rclverify.records.verdict_rows.ExpectedVerdictRow`.
+ExpectedVerdictJson = dict[str, Any]
 
-class AcknowledgementRow(TypedDict):
-    """A plan acknowledgement of a warning (``acknowledgements[]``); ``at`` is file:line:col."""
-    warning: str
-    reason: str
-    at: str
-    status: AcknowledgementStatus
-    message: str
-    matched: list[str]
+#: A diagnostic of the contract or plan text (``lint[]``) as its JSON object: the encoding of
+#: :class:`rclverify.records.lint_rows.LintRow`.
+LintJson = dict[str, Any]
 
+#: A plan acknowledgement of a warning (``acknowledgements[]``) as its JSON object: the encoding of
+#: :class:`rclverify.records.lint_rows.AcknowledgementRow`.
+AcknowledgementJson = dict[str, Any]
 
-class ProblemMember(TypedDict):
-    """An item of a problem row (``problems[].members[]``); ``consequence_of`` the ids of the items whose
-    failure it follows from."""
-    id: str
-    kind: str
-    status: AnyStatus
-    sentence: str
-    anchor: str
-    diagnosis: bool
-    consequence_of: NotRequired[list[str]]
+#: One problem explained (``diagnoses[]``) as its JSON object: the encoding of
+#: :class:`rclverify.records.problem_rows.DiagnosisRow`; decode it with ``DiagnosisRow.of``.
+DiagnosisJson = dict[str, Any]
 
+#: Problems grouped by one root cause (``problems[]``) as its JSON object: the encoding of
+#: :class:`rclverify.records.problem_rows.ProblemRow` (its members
+#: :class:`~rclverify.records.problem_rows.ProblemMember`, its repairs
+#: :class:`~rclverify.records.problem_rows.RepairRef`); decode it with ``ProblemRow.of``.
+ProblemJson = dict[str, Any]
 
-class RepairRef(TypedDict):
-    """A repair by reference (``problems[].repairs[]``): the diagnosis's id and the 0-based index of its repair."""
-    diagnosis: str
-    index: int
+#: The grounding in the robot's software (``grounding``) as its JSON object: the encoding of
+#: :class:`rclverify.records.grounding_rows.GroundingRow`.
+GroundingJson = dict[str, Any]
 
-
-class ProblemRow(TypedDict):
-    """Problems grouped by one root cause (``problems[]``)."""
-    key: list[str]
-    sentence: str
-    status: EvidenceStatus
-    where: str
-    culprits: list[dict[str, Any]]
-    members: list[ProblemMember]
-    repairs: list[RepairRef]
+#: The NoDL documents' check (``nodl``) as its JSON object: the encoding of
+#: :class:`rclverify.records.nodl_rows.NodlRow`.
+NodlJson = dict[str, Any]
 
 
 class Report(TypedDict):
     """``reports/assurance.json`` (docs/assurance.schema.json)."""
-    meta: Meta
-    summary: Summary
-    system: SystemView
+    meta: MetaJson
+    summary: SummaryJson
+    system: SystemJson
     requirements: list[RequirementJson]
     nodes: list[NodeJson]
     side_conditions: list[SideConditionJson]
@@ -252,15 +174,15 @@ class Report(TypedDict):
     obligations: list[ObligationJson]
     evidence: list[EvidenceJson]
     environment_assumptions: list[EnvironmentAssumptionJson]
-    pending: list[PendingRow]
-    lint: list[LintRow]
-    expected_verdicts: list[ExpectedVerdictRow]
-    grounding: dict[str, Any] | None
+    pending: list[PendingJson]
+    lint: list[LintJson]
+    expected_verdicts: list[ExpectedVerdictJson]
+    grounding: GroundingJson | None
     #: the NoDL documents' check (stages/nodl.py, report/nodl.py), ``None`` when the workspace has none
-    nodl: NodlRow | None
+    nodl: NodlJson | None
     unverified: list[UnverifiedJson]
     deadlines: list[DeadlineJson]
-    acknowledgements: list[AcknowledgementRow]
+    acknowledgements: list[AcknowledgementJson]
     #: guarantees held with a margin below the plan's near-miss threshold (report/near_misses.py)
     near_misses: list[NearMissJson]
     #: per guarantee, its margins over every recorded run (report/margin_rows.py)
@@ -268,8 +190,8 @@ class Report(TypedDict):
     statistics: list[dict[str, Any]]
     #: the evidence mapped onto the plan's standard profiles (report/standards_rows.py, docs/standards.md)
     standards: list[dict[str, Any]]
-    diagnoses: list[DiagnosisRow]
-    problems: list[ProblemRow]
+    diagnoses: list[DiagnosisJson]
+    problems: list[ProblemJson]
 
 
 #: The report's top-level keys, in the order build_report writes them.

@@ -8,7 +8,8 @@ as an object that rejects unknown keys, every nested object too; no
 ``title`` or ``default`` (the class's docstring and field descriptions say
 what a missing key means); a value's ``description`` after its type; an enumeration equal to one of the status
 vocabularies of :mod:`rclverify.records.statuses` written as a ``$ref`` to
-that vocabulary's ``$defs`` entry, and a class named in :data:`SHARED` as a
+that vocabulary's ``$defs`` entry (a union of them :data:`UNIONS` names as a ``$ref`` to
+that union's entry), and a class named in :data:`SHARED` as a
 ``$ref`` to its ``$defs`` entry, that entry itself generated from the class
 when :data:`DEFINED` lists it.  A field named in :data:`KEPT` holds a
 value whose inner shape belongs to a tool: its schema is the file's own,
@@ -37,18 +38,36 @@ from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssump
 from rclverify.records.findings import FindingRow
 from rclverify.records.node_rows import CulpritOf, NodeRow, UnverifiedRow
 from rclverify.records.obligations import ObligationRow
+from rclverify.records.grounding_rows import GroundingRow
+from rclverify.records.lint_rows import AcknowledgementRow, LintRow
+from rclverify.records.nodl_rows import NodlRow
+from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
+from rclverify.records.summary_rows import Meta, Summary, SystemView
+from rclverify.records.verdict_rows import ExpectedVerdictRow, PendingRow
 from rclverify.records.margin_rows import MarginBounds, MarginRow, NearMissRow
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.solvers_rows import Solvers
 from rclverify.records.standards_rows import StandardRow
 from rclverify.records.statistics_rows import StatisticsRow
-from rclverify.records.statuses import VOCABULARY
+from rclverify.records.statuses import VOCABULARY, AnyStatus
 from rclverify.records.strength_rows import LimitedBy, Strength
 
 #: Top-level key of the report -> (its type: ``list[Row]`` for an array of a record's items, a record's
 #: class, or ``Row | None``; the key's description).
 GENERATED: dict[str, tuple[Any, str]] = {
+    "meta": (Meta, "Where the report comes from."),
+    "summary": (Summary, "The one-screen summary."),
+    "system": (SystemView, "The system model: nodes, links, loops."),
+    "pending": (list[PendingRow], "Obligations without a decided record."),
+    "lint": (list[LintRow], "Diagnostics of the contract and plan texts."),
+    "expected_verdicts": (list[ExpectedVerdictRow], "Verdicts the plan expects."),
+    "grounding": (GroundingRow | None, "The grounding in the ROS code, null when the plan names none."),
+    "nodl": (NodlRow | None, "The NoDL documents checked against the contracts and each other (docs/nodl.md), null "
+                             "when the workspace has no document in nodl/."),
+    "acknowledgements": (list[AcknowledgementRow], "The plan's acknowledgements of warnings."),
+    "diagnoses": (list[DiagnosisRow], "One diagnosis per problem."),
+    "problems": (list[ProblemRow], "The problems grouped by root cause."),
     "requirements": (list[RequirementRow], "The plan's requirements, in plan order."),
     "findings": (list[FindingRow], "Contract health findings (vacuity, consistency, realizability, scale)."),
     "obligations": (list[ObligationRow], "Every obligation of the plan's evidence entries."),
@@ -77,6 +96,11 @@ SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength", "Deadlin
 #: The classes of :data:`SHARED` whose ``$defs`` entry is generated from the class (the others' are stated by hand).
 DEFINED: tuple[type[msgspec.Struct], ...] = (Strength, LimitedBy, CulpritOf, Solvers, DeadlineRow, DeadlineHop,
                                              HopTimeMargin, NearMissRow, MarginRow, MarginBounds)
+
+#: A union of status vocabularies the report's schema names in ``$defs`` (the vocabularies' entry names, in
+#: order) -> that entry's name: ``any_status`` (records/statuses.py ``AnyStatus``).
+UNIONS: dict[tuple[str, ...], str] = {
+    tuple(n for a in typing.get_args(AnyStatus) for n, w in VOCABULARY.items() if w == typing.get_args(a)): "any_status"}
 
 #: Top-level key -> the fields of its items (or of its object) whose schema the file states by hand (a
 #: tool's record: the monitors backend's run summary, docs/monitors.md; the requirements stage's check
@@ -118,6 +142,9 @@ def _styled(x: Any, defs: dict[str, Any]) -> Any:
                 return {"$ref": f"#/$defs/{name}", **{k: v for k, v in x.items() if k != "enum"}}
     out = {k: {name: _styled(sub, defs) for name, sub in v.items()} if k == "properties" else _styled(v, defs)
            for k, v in x.items() if k not in ("title", "default")}  # a field may be called title
+    refs = tuple(b["$ref"].rsplit("/", 1)[1] for b in out.get("anyOf", ()) if list(b) == ["$ref"])
+    if refs and len(refs) == len(out["anyOf"]) and refs in UNIONS:  # a union the file names in $defs
+        out = {"$ref": f"#/$defs/{UNIONS[refs]}", **{k: v for k, v in out.items() if k != "anyOf"}}
     if out.get("type") == "object" and "properties" in out:
         head = {k: out.pop(k) for k in ("type", "description", "required", "properties") if k in out}
         out = {**head, **out}

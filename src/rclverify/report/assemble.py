@@ -12,7 +12,9 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
+from rclverify.records.problem_rows import DiagnosisRow
 from rclverify.records.report_schema import Report, as_report
+from rclverify.records.summary_rows import DiagnosisBrief, Summary
 from rclverify.report.confidence_rows import ConfidencePart
 from rclverify.report.standards_rows import StandardsPart
 from rclverify.report.statistics import StatisticsPart
@@ -79,11 +81,17 @@ def with_strict(report: Mapping[str, Any], strict_ok: bool) -> dict[str, Any]:
 
 
 def with_diagnoses(report: Mapping[str, Any], diagnoses: list[dict[str, Any]]) -> dict[str, Any]:
-    """``report`` with one diagnosis record per problem (docs/diagnosis.md)
-    and their brief in ``summary.diagnoses`` (how many repairs Z3 checked)."""
-    brief = [{"id": d["id"], "kind": d["kind"], "sentence": d["sentence"], "repairs": len(d["repairs"])}
-             for d in diagnoses]
-    return {**report, "diagnoses": diagnoses, "summary": {**report["summary"], "diagnoses": brief}}
+    """``report`` with one diagnosis record per problem (docs/diagnosis.md;
+    :class:`~rclverify.records.problem_rows.DiagnosisRow`) and their brief
+    in ``summary.diagnoses`` (how many repairs Z3 checked): the last part
+    of the summary, which is then decoded into
+    :class:`~rclverify.records.summary_rows.Summary`.  Raises
+    :class:`msgspec.ValidationError` for a record or summary of another
+    shape (a bug of the build)."""
+    rows = [DiagnosisRow.of(d) for d in diagnoses]
+    brief = [DiagnosisBrief(d.id, d.kind, d.sentence, len(d.repairs)) for d in rows]
+    summary = Summary.of({**report["summary"], "diagnoses": [b.to_json() for b in brief]})
+    return {**report, "diagnoses": [d.to_json() for d in rows], "summary": summary.to_json()}
 
 
 def finished(report: Mapping[str, Any], problems: list[dict[str, Any]], nodes: list[dict[str, Any]]) -> Report:

@@ -31,6 +31,7 @@ from rclverify.model.plan.load import all_requirements
 from rclverify.model.system.model import cycles_kept
 from rclverify.records.records import Obligation, worst
 from rclverify.records.report_schema import Report
+from rclverify.records.summary_rows import Meta, SystemView
 from rclverify.report import assemble
 from rclverify.report.confidence_rows import confidence_part
 from rclverify.report.contract_rows import (GuaranteeStatuses, contract_records, derived_rows, environment_rows,
@@ -148,14 +149,15 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
     problems = problem_sentences(rows, facts.altered) + grounding_problems(rows["grounding"]) + nodl_problems(rows["nodl"])
     plan = ws.plan
     return {
-        "meta": {"tool": "rclverify", "version": __version__, "workspace": plan.name or ws.root.resolve().name,
-                 "plan": plan.file, "contracts": list(plan.contracts), "z3_version": z3.get_version_string(),
-                 "strict_ok": strict_ok, "inputs_sha256": inputs_sha256(ws, inp.made_from, facts.evidence_inputs,
-                                                                        facts.checks, nodl_inputs(ws, rows["nodl"]))},
+        "meta": Meta("rclverify", __version__, plan.name or ws.root.resolve().name, plan.file, list(plan.contracts),
+                     z3.get_version_string(), strict_ok,
+                     inputs_sha256(ws, inp.made_from, facts.evidence_inputs, facts.checks,
+                                   nodl_inputs(ws, rows["nodl"]))).to_json(),
         "summary": {"status": overall, "counts": counts, "problems": problems,
                     "headline": headline(rows["obligations"], counts, rows["side_conditions"], rows["findings"],
                                          rows["unverified"])},
-        "system": ws.model.view(node_status, cycles_kept(ws.model, ws.path("artifacts/cache/system-cycles.pickle"))),
+        "system": SystemView.of(ws.model.view(
+            node_status, cycles_kept(ws.model, ws.path("artifacts/cache/system-cycles.pickle")))).to_json(),
         **rows,
     }
 

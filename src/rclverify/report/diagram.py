@@ -20,7 +20,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import jinja2
 
-from rclverify.records.report_schema import SystemView
+from rclverify.records.report_schema import SystemJson
 from rclverify.report import layoutcache
 
 #: Fill and border colour of a node box, by (normalised) status.
@@ -178,19 +178,19 @@ class Rendering:
     note: str
 
 
-def system_elements(system: SystemView) -> int:
+def system_elements(system: SystemJson) -> int:
     """How many elements the diagram of ``report["system"]`` draws: its
     nodes, connections and environment inputs.  Raises ``KeyError`` when a
     key :func:`system_dot` needs is missing."""
     return len(system["nodes"]) + len(system["connections"]) + len(system["environment_inputs"])
 
 
-def system_too_large(system: SystemView) -> bool:
+def system_too_large(system: SystemJson) -> bool:
     """More than :data:`MAX_SYSTEM_LAYOUT_ELEMENTS` elements: the report does not lay the system out."""
     return system_elements(system) > MAX_SYSTEM_LAYOUT_ELEMENTS
 
 
-def system_layout(system: SystemView, dot: str) -> Rendering:
+def system_layout(system: SystemJson, dot: str) -> Rendering:
     """The SVG of the system diagram's DOT text ``dot`` (:func:`render_dot`)
     for ``report["system"]``, or, for a system of more than
     :data:`MAX_SYSTEM_LAYOUT_ELEMENTS` elements, no SVG and a note saying

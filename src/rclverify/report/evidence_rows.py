@@ -15,8 +15,9 @@ from typing import Any, Mapping, Sequence, TypedDict, cast
 from rclverify.records.records import Obligation
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.evidence_rows import EvidenceRow
-from rclverify.records.report_schema import EvidenceJson, ObligationJson, PendingRow
+from rclverify.records.report_schema import EvidenceJson, ObligationJson, PendingJson
 from rclverify.records.solvers_rows import Solvers
+from rclverify.records.verdict_rows import PendingRow
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 from rclverify.records.store import EvidenceStore
 from rclverify.report.statistics import compact as compact_statistics
@@ -35,7 +36,7 @@ class EvidencePart(TypedDict):
     the input sha256s its evidence was made from (``None``: no record)."""
     obligations: list[ObligationJson]
     evidence: list[EvidenceJson]
-    pending: list[PendingRow]
+    pending: list[PendingJson]
     status: dict[str, str]
     declared: dict[str, list[tuple[str, Any]]]
     altered: list[str]
@@ -122,12 +123,11 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
             if altered:
                 part["altered"].append(f"Evidence {o.id} is error: {altered}")
             else:
-                part["pending"].append({"obligation": o.id, "backend": o.backend,
-                                        "reason": "no evidence record yet: run `doit verify`"})
+                part["pending"].append(PendingRow(o.id, o.backend, "no evidence record yet: run `doit verify`").to_json())
             continue
         if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged
             part["declared"].setdefault(o.node, []).append((status, ev.details["declarations"]))
         part["evidence"].append(evidence_row(ws, ev, status, altered, solvers))
         if status == "pending":
-            part["pending"].append({"obligation": o.id, "backend": o.backend, "reason": ev.explanation})
+            part["pending"].append(PendingRow(o.id, o.backend, ev.explanation).to_json())
     return part

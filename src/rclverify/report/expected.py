@@ -20,11 +20,12 @@ is shown as such, never dropped.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 from rclverify.model.plan.expected import VERDICTS
 from rclverify.model.plan.load import Plan
-from rclverify.records.report_schema import ObligationJson
+from rclverify.records.report_schema import ExpectedVerdictJson, ObligationJson
+from rclverify.records.verdict_rows import ExpectedVerdictRow
 
 
 def _loc(plan: Plan, node: str, index: int, k: int) -> str:
@@ -35,13 +36,11 @@ def _loc(plan: Plan, node: str, index: int, k: int) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
-def expected_rows(plan: Plan, ob_rows: Sequence[ObligationJson]) -> list[dict[str, Any]]:
-    """One row per (expectation, matching obligation) of every evidence entry:
-    ``{"node", "backend", "guarantee", "instance", "expected", "actual",
-    "obligation", "outcome", "reason", "source"}``; ``actual``/``obligation``
-    are ``None`` when nothing matches or the expectation is malformed
-    (``outcome`` then says why)."""
-    rows: list[dict[str, Any]] = []
+def expected_rows(plan: Plan, ob_rows: Sequence[ObligationJson]) -> list[ExpectedVerdictJson]:
+    """One :class:`~rclverify.records.verdict_rows.ExpectedVerdictRow` per (expectation, matching
+    obligation) of every evidence entry, as its JSON object; ``actual``/``obligation`` are ``None`` when
+    nothing matches or the expectation is malformed (``outcome`` then says why)."""
+    rows: list[ExpectedVerdictJson] = []
     for node, entries in plan.evidence.items():
         for e in entries:
             exp = e.config.get("expected")
@@ -50,25 +49,24 @@ def expected_rows(plan: Plan, ob_rows: Sequence[ObligationJson]) -> list[dict[st
             items = exp if isinstance(exp, list) else [exp]
             for k, item in enumerate(items):
                 src = _loc(plan, node, e.index, k)
-                base: dict[str, Any] = {"node": node, "backend": e.backend, "source": src, "obligation": None,
-                                        "actual": None}
                 if not (isinstance(item, Mapping) and isinstance(item.get("guarantee"), int)
                         and item.get("verdict") in VERDICTS):
-                    rows.append({**base, "guarantee": None, "instance": None, "expected": None, "reason": "",
-                                 "outcome": "invalid expectation: give guarantee (a number) and verdict "
-                                            "(discharged or failed)"})
+                    rows.append(ExpectedVerdictRow(
+                        node, e.backend, src, None, None, None, None, None, "",
+                        "invalid expectation: give guarantee (a number) and verdict (discharged or failed)").to_json())
                     continue
                 g, verdict = int(item["guarantee"]), str(item["verdict"])
                 inst = item.get("instance")
-                base.update({"guarantee": g, "instance": inst, "expected": verdict,
-                             "reason": str(item.get("reason", ""))})
+                reason = str(item.get("reason", ""))
                 matches = [o for o in ob_rows if o["node"] == node and o["backend"] == e.backend
                            and o["guarantee"] == g and (inst is None or o["instance"] == inst)]
                 if not matches:
-                    rows.append({**base, "outcome": "no obligation matches"})
+                    rows.append(ExpectedVerdictRow(node, e.backend, src, None, None, g, inst, verdict, reason,
+                                                   "no obligation matches").to_json())
                 for o in matches:
-                    actual = str(o["status"])
+                    actual = o["status"]
                     outcome = ("as expected" if actual == verdict
                                else "MISMATCH" if actual in VERDICTS else "not yet decided")
-                    rows.append({**base, "obligation": o["id"], "actual": actual, "outcome": outcome})
+                    rows.append(ExpectedVerdictRow(node, e.backend, src, o["id"], actual, g, inst, verdict, reason,
+                                                   outcome).to_json())
     return rows

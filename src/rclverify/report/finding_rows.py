@@ -6,12 +6,14 @@ acknowledgement pass marks the findings' JSON objects and copies of the lint row
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, cast
+from typing import Any, Mapping, Sequence
 
 from rclverify.calculus.scale import scale_findings
 from rclverify.model.plan.acknowledged import apply_acknowledgements
 from rclverify.records.findings import FindingRow
-from rclverify.records.report_schema import AcknowledgementRow, FindingJson, LintRow
+from rclverify.records.grounding_rows import GroundingRow
+from rclverify.records.lint_rows import AcknowledgementRow, LintRow
+from rclverify.records.report_schema import AcknowledgementJson, FindingJson, GroundingJson, LintJson
 from rclverify.report.records import diagnostics as read_diagnostics, grounding as read_grounding
 from rclverify.stages.workspace import Workspace
 
@@ -30,25 +32,30 @@ def lint_rows(ws: Workspace) -> list[dict[str, Any]]:
 
 
 def acknowledged_rows(ws: Workspace, findings: Sequence[FindingRow], lint: Sequence[Mapping[str, Any]]
-                      ) -> tuple[list[FindingJson], list[LintRow], list[AcknowledgementRow]]:
+                      ) -> tuple[list[FindingJson], list[LintJson], list[AcknowledgementJson]]:
     """``(findings, lint, acknowledgements)``: the finding rows as the
     report's JSON objects and new lint rows, each marked with what a warning
     flags (``flagged``, ``sha256``) and the plan's answer to it
     (``acknowledged``), and one row per acknowledgement of the plan with its
-    status (model/plan/acknowledged.py; docs/plan.md).  Each marked finding
-    is decoded into :class:`~rclverify.records.findings.FindingRow` again, so
-    the report holds no key the class does not declare
-    (:class:`msgspec.ValidationError` otherwise: a bug of the build)."""
+    status (model/plan/acknowledged.py; docs/plan.md).  Each marked row
+    is decoded into its class (:class:`~rclverify.records.findings.FindingRow`,
+    :class:`~rclverify.records.lint_rows.LintRow`,
+    :class:`~rclverify.records.lint_rows.AcknowledgementRow`), so the report
+    holds no key the class does not declare (:class:`msgspec.ValidationError`
+    otherwise: a bug of the build)."""
     f_rows, l_rows = [f.to_json() for f in findings], [dict(x) for x in lint]
     acks = apply_acknowledgements(ws.plan.acknowledged, f_rows, l_rows, ws.checked)
-    return ([FindingRow.of(f).to_json() for f in f_rows], cast(list[LintRow], l_rows),
-            cast(list[AcknowledgementRow], acks))
+    return ([FindingRow.of(f).to_json() for f in f_rows], [LintRow.of(r).to_json() for r in l_rows],
+            [AcknowledgementRow.of(a).to_json() for a in acks])
 
 
-def grounding_row(ws: Workspace) -> dict[str, Any] | None:
+def grounding_row(ws: Workspace) -> GroundingJson | None:
     """The grounding in the robot's software (docs/ros.md) with its drawing's
-    SVG text (``svg_text``, ``None`` when unreadable); ``None`` when the plan
-    names no ROS software."""
+    SVG text (``svg_text``, ``None`` when unreadable), decoded into
+    :class:`~rclverify.records.grounding_rows.GroundingRow`, as its JSON object;
+    ``None`` when the plan names no ROS software.  Raises
+    :class:`msgspec.ValidationError` for a record of another shape (a bug:
+    the stage seals what it writes)."""
     if not getattr(ws.plan, "ros", None):
         return None
     grounding = read_grounding(ws, "artifacts/ros/grounding.json")
@@ -59,4 +66,4 @@ def grounding_row(ws: Workspace) -> dict[str, Any] | None:
         svg_text = ws.path(svg_rel).read_text(encoding="utf-8") if svg_rel else None
     except OSError:
         svg_text = None
-    return {**grounding, "svg_text": svg_text}
+    return GroundingRow.of({**grounding, "svg_text": svg_text}).to_json()

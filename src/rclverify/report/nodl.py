@@ -17,10 +17,10 @@ locations, so a code-scanning view marks both files' lines.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import Any, Callable, Mapping, cast
+from typing import Any, Callable, Mapping
 
 from rclverify.records.nodl_rows import NodlRow
-from rclverify.records.report_schema import Report
+from rclverify.records.report_schema import NodlJson, Report
 from rclverify.records.sarif import SarifLocation, SarifResult
 from rclverify.report.shapes import GroundingBrief
 from rclverify.stages.workspace import Workspace
@@ -35,11 +35,15 @@ SARIF_RULES = (
 )
 
 
-def nodl_row(ws: Workspace) -> NodlRow | None:
+def nodl_row(ws: Workspace) -> NodlJson | None:
     """The report's ``nodl``: the stage's record as :func:`rclverify.stages.nodl.read_nodl` reads
-    it (stale or altered said), ``None`` when the workspace has no NoDL document."""
+    it (stale or altered said) decoded into :class:`~rclverify.records.nodl_rows.NodlRow`, as its
+    JSON object; ``None`` when the workspace has no NoDL document.  Raises
+    :class:`msgspec.ValidationError` for a record of another shape (a bug: the stage seals what it
+    writes)."""
     from rclverify.stages.nodl import read_nodl  # deferred: start-up (loads jsonschema and yaml only when called)
-    return cast(NodlRow | None, read_nodl(ws))
+    record = read_nodl(ws)
+    return None if record is None else NodlRow.of(record).to_json()
 
 
 def nodl_inputs(ws: Workspace, row: Mapping[str, Any] | None) -> dict[str, object] | None:

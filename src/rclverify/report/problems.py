@@ -69,7 +69,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from rclverify.records.report_schema import Report
+from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.report_schema import ProblemJson, Report
 from rclverify.report.shapes import AttentionItem
 from rclverify.report import problems_causes as pc
 from rclverify.report import problems_mc as mc
@@ -85,8 +86,9 @@ Member = tuple[dict[str, Any], list[str]]  # a problem of the report and its roo
 
 
 def group_problems(report: Report, items: Sequence[AttentionItem],
-                   anchor: Callable[..., str]) -> list[dict[str, Any]]:
-    """The problems of ``report`` grouped by root cause (module docstring).
+                   anchor: Callable[..., str]) -> list[ProblemJson]:
+    """The problems of ``report`` grouped by root cause (module docstring), each a
+    :class:`~rclverify.records.problem_rows.ProblemRow` written as its JSON object.
 
     ``items`` are the report's attention problems (``render.problem_items``:
     dicts with ``status``, ``kind``, ``ref``, ``anchor``, ``message``);
@@ -104,7 +106,8 @@ def group_problems(report: Report, items: Sequence[AttentionItem],
                       "consequence_of": [ids of the members it follows from] (only on a consequence)}],
          "repairs": [{"diagnosis": id, "index": n}]  (distinct diffs, each checked by Z3)}
 
-    Raises ``KeyError`` for a report dict without ``nodes``.
+    Raises ``KeyError`` for a report dict without ``nodes``, :class:`msgspec.ValidationError` for a
+    row the class does not decode (a bug of the grouping).
     """
     g = _Grouping(report, items, anchor)
     g.diagnosis_members()
@@ -123,7 +126,7 @@ def group_problems(report: Report, items: Sequence[AttentionItem],
             g.sentence_and_repairs(row)
     out = list(groups.values())
     out.sort(key=lambda row: -pp.severity(row["status"]))  # stable: report order within a status
-    return out
+    return [ProblemRow.of(row).to_json() for row in out]
 
 
 def _victim_of(node: Any, k: Any) -> str | None:

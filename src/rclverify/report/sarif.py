@@ -40,7 +40,7 @@ from rclverify.records.findings import FindingRow, rows_of
 from rclverify.records.evidence_rows import rows_of as evidence_rows_of
 from rclverify.records.obligations import rows_of as obligation_rows_of
 from rclverify.records.strength_rows import Strength
-from rclverify.records.report_schema import DiagnosisRow, LintRow, Report
+from rclverify.records.report_schema import DiagnosisJson, LintJson, Report
 from rclverify.report.severity import of
 from rclverify.records.sarif import SRCROOT, sarif_fix, sarif_locations, sarif_result
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifResult, SarifRun,
@@ -311,7 +311,7 @@ def _finding_results(report: Report) -> list[SarifResult]:
     return out
 
 
-def _suppressed(res: SarifResult, row: LintRow) -> SarifResult:
+def _suppressed(res: SarifResult, row: LintJson) -> SarifResult:
     """``res`` with a SARIF ``suppressions`` entry when the plan acknowledges
     the lint warning ``row`` (:func:`_accepted`; model/plan/acknowledged.py)."""
     ack = row.get("acknowledged")
@@ -383,7 +383,7 @@ def _attach_diagnoses(report: Report, results: Sequence[SarifResult]) -> None:
     sentence naming the culprit) and its repairs as SARIF ``fix`` objects
     (§3.55; each repair was checked by Z3 before it entered the report,
     docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
-    by_key: dict[str, DiagnosisRow] = {}
+    by_key: dict[str, DiagnosisJson] = {}
     for dg in report.get("diagnoses", []):
         if dg.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
             by_key[f"unit:{dg.get('lint')}"] = dg
@@ -409,7 +409,7 @@ def _attach_diagnoses(report: Report, results: Sequence[SarifResult]) -> None:
             res["fixes"] = fixes
 
 
-def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
+def _at_the_culprit(res: SarifResult, d: DiagnosisJson) -> None:
     """A failed side condition is located at the guarantee its diagnosis blames
     (a producer that publishes what the consumer does not accept), so that a CI
     annotation lands on the node to repair; the consumer's assumption it fails

@@ -12,9 +12,9 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 # annotations (with string annotations every key would count as required).
 from typing import Any, NotRequired, TypedDict
 
-from rclverify.records.report_schema import (DerivedPropertyJson, DiagnosisRow, EvidenceJson, FindingJson, NodeJson,
-                                             LimitedByJson, ObligationJson, PendingRow, ProblemRow, RequirementJson, SideConditionJson,
-                                             Summary, SupportJson)
+from rclverify.records.report_schema import (DerivedPropertyJson, DiagnosisJson, EvidenceJson, FindingJson, NodeJson,
+                                             LimitedByJson, ObligationJson, PendingJson, ProblemJson, RequirementJson, SideConditionJson,
+                                             SummaryJson, SupportJson)
 
 
 
@@ -67,7 +67,7 @@ class SummaryData(TypedDict):
     ``requirements`` rows are ``[id, verdict, status]``, ``deadlines`` rows ``[requirement, verdict,
     total, bound, evidence status]``; ``strict`` the clauses a failed ``--strict`` names."""
     meta: SummaryMeta
-    summary: Summary
+    summary: SummaryJson
     rows: list[NodeSummaryRow]
     unverified: list[str]
     requirements: list[list[str]]
@@ -106,7 +106,7 @@ class PendingGroup(TypedDict):
     """The pending rows of one backend with one reason, numbers aside."""
     backend: str
     reason: str
-    items: list[PendingRow]
+    items: list[PendingJson]
 
 
 class DashboardCell(TypedDict):
@@ -190,8 +190,8 @@ class ReportView(TableRuns):
     by root cause (the report's rows, or grouped now), ``diagnosis`` id -> record, ``counts``
     ``[(status, n)]`` worst first, ``evidence_of`` obligation id -> ``[(anchor, record)]``."""
     dashboard: Dashboard
-    problem_groups: list[ProblemRow] | list[dict[str, Any]]
-    diagnosis: dict[str, DiagnosisRow]
+    problem_groups: list[ProblemJson] | list[dict[str, Any]]
+    diagnosis: dict[str, DiagnosisJson]
     counts: list[tuple[str, int]]
     problems: list[AttentionItem]
     outstanding: list[AttentionItem]

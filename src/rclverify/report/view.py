@@ -14,7 +14,7 @@ from collections import defaultdict
 from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
 from rclverify.records.findings import rows_of
-from rclverify.records.report_schema import (DerivedPropertyJson, EvidenceJson, FindingJson, ObligationJson, ProblemRow,
+from rclverify.records.report_schema import (DerivedPropertyJson, EvidenceJson, FindingJson, ObligationJson, ProblemJson,
                                              Report, SideConditionJson)
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
@@ -167,7 +167,7 @@ def problem_items(report: Report) -> list[AttentionItem]:
     return _attention(report, evidence_anchors(report))[0]
 
 
-def problem_groups(report: Report) -> list[ProblemRow] | list[dict[str, Any]]:
+def problem_groups(report: Report) -> list[ProblemJson] | list[dict[str, Any]]:
     """The report's problems grouped by root cause
     (:func:`rclverify.report.problems.group_problems`): the report dict's
     ``problems`` when it has them, else computed from ``report``."""

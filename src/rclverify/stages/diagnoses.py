@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Mapping, cast
 
 import msgspec
 
+from rclverify.records.problem_rows import DiagnosisRow
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.store import dumps
 
@@ -81,18 +82,21 @@ def write_diagnoses(ws: "Workspace", digest: str, diagnoses: list["DiagnosisEntr
 
 def read_diagnoses(ws: "Workspace", report: Mapping[str, object]) -> tuple[list[dict[str, Any]] | None, str]:
     """``(diagnoses, problem)`` of :data:`INDEX` for ``report`` (the report
-    dict without diagnoses being built now): the records and ``""`` when
-    the record is current; ``None`` and one sentence saying why the
+    dict without diagnoses being built now): the records, each decoded into
+    :class:`~rclverify.records.problem_rows.DiagnosisRow` and written as its
+    JSON object, and ``""`` when the record is current; ``None`` and one sentence saying why the
     problems are not explained when it is missing, altered outside
-    rclverify (its seal does not hold), malformed, or made from another
+    rclverify (its seal does not hold), malformed (a record the class does
+    not decode), or made from another
     report (its ``report_sha256`` differs)."""
     body, why = read_sealed(ws.path(INDEX), "diagnosis record")
     if why:
         return None, f"{INDEX}: {why}"
     if body is None:
         return None, f"the problems are not explained: the diagnosis stage has not run ({INDEX} is missing); {_RUN}"
-    rows = body.get("diagnoses")
-    if not isinstance(rows, list) or not all(isinstance(d, dict) for d in rows):
+    try:  # each record as the report's row (records/problem_rows.py): the fields in the order declared
+        rows = [DiagnosisRow.of(d).to_json() for d in body["diagnoses"]]
+    except (KeyError, TypeError, msgspec.ValidationError):
         return None, f"{INDEX}: diagnosis record malformed: altered outside rclverify"
     if body.get("report_sha256") != report_digest(report):
         return None, (f"the problems are not explained: {INDEX} was made from other artifacts than this report "
