@@ -31,7 +31,7 @@ import pytest
 from jinja2 import nodes
 
 from _report_schema import SCHEMA
-from rclverify.records import schema_gen
+from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
@@ -158,6 +158,49 @@ def test_every_shared_entry_is_referred_to() -> None:
     """A ``$defs`` entry of a record class no part of the schema refers to is left over: drop it."""
     text = schema_gen.schema_text(SCHEMA)
     assert [n for n in schema_gen.SHARED.values() if f'"#/$defs/{n}"' not in text] == []
+
+
+def _refs(x: Any) -> set[str]:
+    """The ``$defs`` entries the schema part ``x`` refers to, and those they refer to in turn."""
+    out: set[str] = set()
+    todo = [x]
+    while todo:
+        y = todo.pop()
+        if isinstance(y, dict):
+            name = str(y.get("$ref", "")).rsplit("/", 1)[-1]
+            if name and name not in out:
+                out.add(name)
+                todo.append(SCHEMA["$defs"][name])
+            todo += list(y.values())
+        elif isinstance(y, list):
+            todo += y
+    return out
+
+
+def stated_by_hand(schema: dict[str, Any]) -> list[str]:
+    """The parts of the report's ``schema`` no record class generates: a top-level key not in
+    schema_gen.GENERATED, a ``$defs`` entry that is neither generated (schema_gen.DEFINED), a status
+    vocabulary (records/statuses.py, or a union of them schema_gen.UNIONS names), nor reached only from a
+    field schema_gen.KEPT states by hand (a tool's record)."""
+    kept = set().union(*(_refs(schema_gen.object_of(schema["properties"][k])["properties"][f])
+                         for k, fields in schema_gen.KEPT.items() for f in fields))
+    allowed = ({schema_gen.SHARED[c.__name__] for c in schema_gen.DEFINED} | set(statuses.VOCABULARY)
+               | set(schema_gen.UNIONS.values()) | kept)
+    return ([f"properties/{k}" for k in schema["properties"] if k not in schema_gen.GENERATED]
+            + [f"$defs/{k}" for k in schema["$defs"] if k not in allowed])
+
+
+def test_every_top_level_key_of_the_schema_is_generated(monkeypatch: pytest.MonkeyPatch) -> None:
+    """docs/assurance.schema.json states nothing by hand but the status vocabularies and the tools' records
+    (schema_gen.KEPT): every top-level key is a record class's part, every other ``$defs`` entry a class's."""
+    assert list(SCHEMA["properties"]) == list(report_schema.REPORT_KEYS) == SCHEMA["required"]
+    assert stated_by_hand(SCHEMA) == []
+    assert schema_gen.with_generated(copy.deepcopy(SCHEMA)) == SCHEMA
+    # a key or an entry written by hand again is found
+    monkeypatch.delitem(schema_gen.GENERATED, "meta")
+    hand = copy.deepcopy(SCHEMA)
+    hand["$defs"]["nodl_place"] = {"type": "object", "description": "A place a NoDL finding involves."}
+    assert stated_by_hand(hand) == ["properties/meta", "$defs/nodl_place"]
 
 
 def test_the_report_hop_begins_with_the_deadline_stages_hop() -> None:
