@@ -8,10 +8,12 @@ run-based statistics, the one status vocabulary (``statuses``), the
 assurance report's schema as types (``report_schema``, its NoDL part
 ``nodl_rows``), the records
 defined once as msgspec Structs: the contract-health finding
-(``findings``) and the report's obligation, evidence, requirement,
-statistics and standards rows (``obligations``, ``evidence_rows``,
-``requirement_rows``, ``statistics_rows``, ``standards_rows``, on one base,
-``row``), and the parts
-of the report's JSON Schema generated from them (``schema_gen``).  Imports
-``core``.
+(``findings``) and every part of the report (``obligations``,
+``evidence_rows``, ``requirement_rows``, ``statistics_rows``,
+``standards_rows``, ``node_rows``, ``derived_rows``, ``strength_rows``,
+``side_condition_rows``, ``deadline_rows``, ``margin_rows``,
+``solvers_rows``, ``summary_rows``, ``verdict_rows``, ``lint_rows``,
+``problem_rows``, ``grounding_rows``, ``nodl_rows``, on one base, ``row``),
+and the report's JSON Schema generated from them (``schema_gen``).
+Imports ``core``.
 """
