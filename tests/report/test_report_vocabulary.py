@@ -16,6 +16,7 @@ from jsonschema import Draft202012Validator
 from _report_schema import SCHEMA
 from rclverify.records import records, statuses
 from rclverify.records import nodl_rows, report_schema as st
+from rclverify.records.report_record import AssuranceReport
 
 
 def _undescribed(x: Any, where: str = "") -> list[str]:
@@ -184,6 +185,8 @@ def _disagreements(td: Any, sub: Any, where: str) -> list[str]:
 
 def test_the_typeddicts_are_the_schema() -> None:
     assert list(st.REPORT_KEYS) == list(SCHEMA["properties"]) == SCHEMA["required"]
+    # the renderers' dict-shaped view names the keys of the report's one definition, in its order
+    assert list(st.Report.__annotations__) == list(st.REPORT_KEYS) == list(AssuranceReport.__struct_fields__)
     assert _disagreements(st.Report, SCHEMA, "report") == []
     # every row type is reached from Report (none is left out of the walk)
     reached = {t for k, ann in typing.get_type_hints(st.Report).items() for t in _reached(ann)}

@@ -14,6 +14,7 @@ defined once as msgspec Structs: the contract-health finding
 ``side_condition_rows``, ``deadline_rows``, ``margin_rows``,
 ``solvers_rows``, ``summary_rows``, ``verdict_rows``, ``lint_rows``,
 ``problem_rows``, ``grounding_rows``, ``nodl_rows``, on one base, ``row``),
+the report whole (``report_record``, whose fields are its top-level keys),
 and the report's JSON Schema generated from them (``schema_gen``).
 Imports ``core``.
 """

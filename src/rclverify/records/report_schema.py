@@ -1,33 +1,26 @@
-"""The assurance report's shape as types: :class:`Report` and a TypedDict per row kind not defined once.
+"""The assurance report as the renderers read it: :class:`Report`, the dict-shaped view of
+:class:`rclverify.records.report_record.AssuranceReport`, and a JSON alias per part.
 
-The rows defined once as msgspec Structs (findings, obligations, evidence,
-requirements, statistics, standards: :mod:`rclverify.records.findings` and
-the modules beside it) appear here as the JSON objects they write
-(``FindingJson``, ``ObligationJson``, ...); their schema parts are generated
-(:mod:`rclverify.records.schema_gen`).
-
-These are the static reading of ``docs/assurance.schema.json`` (JSON Schema
-draft 2020-12), the published shape of ``reports/assurance.json``; the
-status words are the Literal types of :mod:`rclverify.records.statuses`.
-A key the schema lists as optional is ``NotRequired`` here; the two are held
-to one shape key by key, both ways, by ``tests/report/test_report_vocabulary.py``.  Records whose
-inner shape belongs to a tool (a requirement's check record, a monitoring
-summary, a counterexample, the grounding) are ``dict[str, Any]``, as the
-schema leaves them open.
+Every part of the report is defined once as a msgspec Struct (the modules
+beside this one: :mod:`rclverify.records.findings`, ``node_rows``,
+``deadline_rows`` and the others), and docs/assurance.schema.json is
+generated from them (:mod:`rclverify.records.schema_gen`).  The report is
+built and read as its JSON object, pass by pass (report/build.py): here each
+part appears as that object (``FindingJson``, ``NodeJson``, ...), an alias
+naming the Struct whose ``of`` decodes it to read its fields as attributes.
+:class:`Report` lists the top-level keys with those aliases, for mypy; its
+keys are held to :class:`~rclverify.records.report_record.AssuranceReport`'s
+fields by tests/records/test_record_shapes.py.
 
 :func:`as_report` is the one place a report dict built pass by pass
 (report/build.py) becomes a :class:`Report`: it checks the top-level keys
 and the summary status, so a renderer typed on :class:`Report` never reads
 a report that lacks a part.
 """
-# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
-# annotations (with string annotations every key would count as required).
-from typing import Any, Literal, Mapping, NotRequired, TypedDict, cast
+from typing import Any, Mapping, TypedDict, cast
 
-from rclverify.records.statuses import (AcknowledgementStatus, AnyStatus, Derivation,
-                                        EvidenceKind, EvidenceStatus, HealthStatus, LintSeverity, RequirementVerdict,
-                                        EVIDENCE_STATUSES)
-from rclverify.records.strength_rows import Strength
+from rclverify.records import report_record
+from rclverify.records.statuses import EVIDENCE_STATUSES
 
 
 #: A node's row (``nodes[]``) as the report's JSON object: the encoding of
@@ -194,8 +187,8 @@ class Report(TypedDict):
     problems: list[ProblemJson]
 
 
-#: The report's top-level keys, in the order build_report writes them.
-REPORT_KEYS: tuple[str, ...] = tuple(Report.__annotations__)
+#: The report's top-level keys, in the order build_report writes them (the fields of its one definition).
+REPORT_KEYS: tuple[str, ...] = report_record.REPORT_KEYS
 
 
 def as_report(report: Mapping[str, Any]) -> Report:

@@ -32,60 +32,20 @@ from typing import Any
 import msgspec
 
 from rclverify.core.atomic import atomic_write_text
-from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow, HopTimeMargin
-from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
-from rclverify.records.findings import FindingRow
-from rclverify.records.node_rows import CulpritOf, NodeRow, UnverifiedRow
-from rclverify.records.obligations import ObligationRow
-from rclverify.records.grounding_rows import GroundingRow
-from rclverify.records.lint_rows import AcknowledgementRow, LintRow
-from rclverify.records.nodl_rows import NodlRow
-from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
-from rclverify.records.summary_rows import Meta, Summary, SystemView
-from rclverify.records.verdict_rows import ExpectedVerdictRow, PendingRow
 from rclverify.records.margin_rows import MarginBounds, MarginRow, NearMissRow
-from rclverify.records.requirement_rows import RequirementRow
-from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.records.node_rows import CulpritOf
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.solvers_rows import Solvers
-from rclverify.records.standards_rows import StandardRow
-from rclverify.records.statistics_rows import StatisticsRow
 from rclverify.records.statuses import VOCABULARY, AnyStatus
 from rclverify.records.strength_rows import LimitedBy, Strength
 
 #: Top-level key of the report -> (its type: ``list[Row]`` for an array of a record's items, a record's
-#: class, or ``Row | None``; the key's description).
+#: class, or ``Row | None``; the key's description): the fields of :class:`AssuranceReport`, in its order.
 GENERATED: dict[str, tuple[Any, str]] = {
-    "meta": (Meta, "Where the report comes from."),
-    "summary": (Summary, "The one-screen summary."),
-    "system": (SystemView, "The system model: nodes, links, loops."),
-    "pending": (list[PendingRow], "Obligations without a decided record."),
-    "lint": (list[LintRow], "Diagnostics of the contract and plan texts."),
-    "expected_verdicts": (list[ExpectedVerdictRow], "Verdicts the plan expects."),
-    "grounding": (GroundingRow | None, "The grounding in the ROS code, null when the plan names none."),
-    "nodl": (NodlRow | None, "The NoDL documents checked against the contracts and each other (docs/nodl.md), null "
-                             "when the workspace has no document in nodl/."),
-    "acknowledgements": (list[AcknowledgementRow], "The plan's acknowledgements of warnings."),
-    "diagnoses": (list[DiagnosisRow], "One diagnosis per problem."),
-    "problems": (list[ProblemRow], "The problems grouped by root cause."),
-    "requirements": (list[RequirementRow], "The plan's requirements, in plan order."),
-    "findings": (list[FindingRow], "Contract health findings (vacuity, consistency, realizability, scale)."),
-    "obligations": (list[ObligationRow], "Every obligation of the plan's evidence entries."),
-    "nodes": (list[NodeRow], "The nodes, in contract order."),
-    "side_conditions": (list[SideConditionRow], "Every side condition of every node."),
-    "derived_properties": (list[DerivedPropertyRow], "One per node the calculus ran on."),
-    "evidence": (list[EvidenceRow], "One row per obligation with an evidence record."),
-    "environment_assumptions": (list[EnvironmentAssumptionRow], "Assumptions the system leaves to its environment."),
-    "unverified": (list[UnverifiedRow], "Guarantees no obligation covers."),
-    "deadlines": (list[DeadlineRow], "End-to-end deadlines (rule D3)."),
-    "near_misses": (list[NearMissRow], "Guarantees held on every run with a margin below the plan's near-miss "
-                                       "threshold (report/near_misses.py)."),
-    "margins": (list[MarginRow], "Per guarantee judged with margins, its margins over every recorded run "
-                                 "(report/margin_rows.py)."),
-    "statistics": (list[StatisticsRow], "Runs counted by environment, bounds and targets (docs/statistics.md)."),
-    "standards": (list[StandardRow], "The evidence mapped onto the standards the plan names (docs/standards.md); "
-                                     "empty when it names none."),
-}
+    name: (hints[name].__origin__, hints[name].__metadata__[0].description)
+    for hints in [typing.get_type_hints(AssuranceReport, include_extras=True)]
+    for name in AssuranceReport.__struct_fields__}
 
 #: A type the report's schema defines in ``$defs`` -> that entry's name.
 SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength", "DeadlineRow": "deadline",
@@ -178,12 +138,15 @@ def generated_def(cls: type[msgspec.Struct]) -> dict[str, Any]:
 
 
 def with_generated(schema: dict[str, Any]) -> dict[str, Any]:
-    """``schema`` (the report's whole schema) with every generated part and ``$defs`` entry put in its place
-    (order kept; an entry of :data:`DEFINED` the file lacks is added at the end of ``$defs``)."""
-    props = {k: generated_part(k, schema) if k in GENERATED else v for k, v in schema["properties"].items()}
+    """``schema`` (the report's whole schema) with its top level generated from :class:`AssuranceReport`
+    (every field a required key, in the class's order, no other key) and every generated part and
+    ``$defs`` entry put in its place (an entry of :data:`DEFINED` the file lacks is added at the end of
+    ``$defs``; the vocabularies' entries and the file's title, ``$id`` and description are kept)."""
+    props = {**{k: generated_part(k, schema) for k in GENERATED},
+             **{k: v for k, v in schema["properties"].items() if k not in GENERATED}}
     made = {SHARED[c.__name__]: generated_def(c) for c in DEFINED}
     defs = {**{k: made.get(k, v) for k, v in schema.get("$defs", {}).items()}, **made}
-    return {**schema, "$defs": defs, "properties": props}
+    return {**schema, "$defs": defs, "properties": props, "additionalProperties": False, "required": list(GENERATED)}
 
 
 def schema_text(schema: dict[str, Any]) -> str:
