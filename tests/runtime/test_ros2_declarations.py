@@ -75,7 +75,8 @@ for n in (base, lazy, driver):
     ex.add_node(n)
 print("ready", flush=True)
 until = time.monotonic() + 20
-while time.monotonic() < until and min(p.get_subscription_count() for p in (pose, target, lazy_target)) < 2:
+# the monitor reads every topic; base and lazy read the targets as well
+while time.monotonic() < until and any(p.get_subscription_count() < n for p, n in ((pose, 1), (target, 2), (lazy_target, 2))):
     ex.spin_once(timeout_sec=0.05)
 time.sleep(0.3)
 pose.publish(Int64(data=0))  # the initial pose, before any target
