@@ -33,6 +33,7 @@ from jinja2 import nodes
 from _report_schema import SCHEMA
 from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
+from rclverify.records import lint_rows, verdict_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
@@ -55,6 +56,8 @@ class Record(NamedTuple):
     renderers: tuple[str, ...]
 
 
+_MAIN = ("../assurance.html.j2", "../assurance.md.j2")
+
 RECORDS: dict[str, Record] = {
     # a requirement's row is rendered by the main templates (the requirements table, the Z3 checks' list)
     "requirements": Record(RequirementRow, requirement_rows.INTERNAL, "requirement_rows",
@@ -66,6 +69,9 @@ RECORDS: dict[str, Record] = {
     "statistics": Record(StatisticsRow, statistics_rows.INTERNAL, "statistics_rows",
                          ("statistics.html.j2", "statistics.md.j2")),
     "standards": Record(StandardRow, standards_rows.INTERNAL, "standard_rows", ("standards.html.j2", "standards.md.j2")),
+    # rendered by the main templates: the pending table, the lint table
+    "pending": Record(verdict_rows.PendingRow, verdict_rows.INTERNAL, "pending_rows", _MAIN),
+    "lint": Record(lint_rows.LintRow, lint_rows.INTERNAL, "lint_rows", _MAIN),
 }
 
 

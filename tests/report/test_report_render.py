@@ -151,7 +151,7 @@ def _report() -> dict[str, Any]:
         "pending": [{"obligation": "Agent.g1.ajpf", "backend": "ajpf",
                      "reason": "AJPF is not installed; run: ajpf-run artifacts/ajpf/Agent.g1.jpf"}],
         "lint": [{"severity": "warning", "location": "contracts/mini.rcl:20:3",
-                  "message": "'->' mixed with 'and' without parentheses."}],
+                  "message": "'->' mixed with 'and' without parentheses.", "code": "W-implication-precedence"}],
     }
 
 

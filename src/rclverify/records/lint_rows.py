@@ -20,6 +20,10 @@ The rules (docs/decisions.md, "One definition per record"):
   are generated from them (records/schema_gen.py);
   tests/records/test_record_shapes.py fails when the file and the classes
   differ.
+* Every field of :class:`LintRow` is read by the lint table's renderers
+  (report/templates/assurance.{html,md}.j2, which decode each row with the
+  ``lint_rows`` filter) or named in :data:`INTERNAL` with the reason it is
+  not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -59,4 +63,11 @@ class AcknowledgementRow(Row, frozen=True, forbid_unknown_fields=True):
     matched: Annotated[list[str], _DOC(description="The warnings it acknowledges.")]
 
 
-__all__ = ["AcknowledgementRow", "LintRow"]
+#: The fields of :class:`LintRow` no lint-table renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {
+    "flagged": "the text an acknowledgement binds; the row shows its sha256, to acknowledge it by, and the "
+               "diagnostic's own message",
+}
+
+
+__all__ = ["AcknowledgementRow", "INTERNAL", "LintRow"]

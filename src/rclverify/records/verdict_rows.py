@@ -12,7 +12,10 @@ and write :meth:`~rclverify.records.row.Row.to_json` (every field, in the
 order declared); the ``pending`` and ``expected_verdicts`` items of
 docs/assurance.schema.json are generated from them (records/schema_gen.py);
 tests/records/test_record_shapes.py fails when the file and the classes
-differ.
+differ.  Every field of :class:`PendingRow` is read by the pending table's
+renderers (report/templates/assurance.{html,md}.j2, which decode each row
+with the ``pending_rows`` filter) or named in :data:`INTERNAL` with the
+reason it is not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -54,4 +57,8 @@ class ExpectedVerdictRow(Row, frozen=True, forbid_unknown_fields=True):
                                              "why the expectation is invalid.")]
 
 
-__all__ = ["ExpectedVerdictRow", "PendingRow"]
+#: The fields of :class:`PendingRow` no pending-table renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {}
+
+
+__all__ = ["ExpectedVerdictRow", "INTERNAL", "PendingRow"]

@@ -10,7 +10,7 @@ markupsafe's.  Nothing here depends on the time of rendering.
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any, Callable, Mapping
 from urllib.parse import quote
@@ -18,7 +18,16 @@ from urllib.parse import quote
 import jinja2
 from markupsafe import Markup, escape
 
+from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow
+from rclverify.records.derived_rows import DerivedPropertyRow
 from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.lint_rows import LintRow
+from rclverify.records.margin_rows import MarginRow, NearMissRow
+from rclverify.records.node_rows import GuaranteeRow, NodeRow, UnverifiedRow
+from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.row import decode_rows
+from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.records.verdict_rows import PendingRow
 from rclverify.records.requirement_rows import rows_of as requirement_rows_of
 from rclverify.records.statistics_rows import rows_of as statistics_rows_of
 from rclverify.records.standards_rows import rows_of as standard_rows_of
@@ -263,6 +272,12 @@ def environment() -> jinja2.Environment:
         # held to a renderer or its record's INTERNAL by tests/records/test_record_shapes.py)
         findings=rows_of, obligation_row=ObligationRow.of, evidence_row=EvidenceRow.of,
         requirement_rows=requirement_rows_of, statistics_rows=statistics_rows_of, standard_rows=standard_rows_of,
+        node_rows=partial(decode_rows, NodeRow), guarantee_rows=partial(decode_rows, GuaranteeRow),
+        side_condition_rows=partial(decode_rows, SideConditionRow), derived_rows=partial(decode_rows, DerivedPropertyRow),
+        deadline_rows=partial(decode_rows, DeadlineRow), hop_rows=partial(decode_rows, DeadlineHop),
+        lint_rows=partial(decode_rows, LintRow), unverified_rows=partial(decode_rows, UnverifiedRow),
+        pending_rows=partial(decode_rows, PendingRow), near_miss_rows=partial(decode_rows, NearMissRow),
+        margin_rows=partial(decode_rows, MarginRow), problem_rows=partial(decode_rows, ProblemRow),
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame
