@@ -33,7 +33,7 @@ from jinja2 import nodes
 from _report_schema import SCHEMA
 from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
-from rclverify.records import lint_rows, verdict_rows
+from rclverify.records import lint_rows, margin_rows, node_rows, verdict_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
@@ -69,9 +69,11 @@ RECORDS: dict[str, Record] = {
     "statistics": Record(StatisticsRow, statistics_rows.INTERNAL, "statistics_rows",
                          ("statistics.html.j2", "statistics.md.j2")),
     "standards": Record(StandardRow, standards_rows.INTERNAL, "standard_rows", ("standards.html.j2", "standards.md.j2")),
-    # rendered by the main templates: the pending table, the lint table
+    # rendered by the main templates: the pending and unverified tables, the lint table, the near misses
     "pending": Record(verdict_rows.PendingRow, verdict_rows.INTERNAL, "pending_rows", _MAIN),
+    "unverified": Record(node_rows.UnverifiedRow, node_rows.UNVERIFIED_INTERNAL, "unverified_rows", _MAIN),
     "lint": Record(lint_rows.LintRow, lint_rows.INTERNAL, "lint_rows", _MAIN),
+    "near_misses": Record(margin_rows.NearMissRow, margin_rows.NEAR_MISS_INTERNAL, "near_miss_rows", _MAIN),
 }
 
 

@@ -27,6 +27,12 @@ The rules (docs/decisions.md, "One definition per record"):
   ``margins_over_runs``, ``margin_bounds``), generated from the class
   (records/schema_gen.py ``SHARED``, ``DEFINED``); tests/records/test_record_shapes.py
   fails when the file and the classes differ.
+* Every field of :class:`NearMissRow` is read by the near misses' renderers
+  (report/templates/assurance.{html,md}.j2, filter ``near_miss_rows``) or
+  named in :data:`NEAR_MISS_INTERNAL` with the reason it is not shown; the
+  same holds for :class:`MarginRow` (report/templates/parts/margins.{html,md}.j2,
+  filter ``margin_rows``) and :data:`INTERNAL`; tests/records/test_record_shapes.py
+  fails otherwise.
 """
 from __future__ import annotations
 
@@ -113,4 +119,11 @@ class MarginRow(Row, frozen=True, omit_defaults=True, forbid_unknown_fields=True
         description="Why a guarantee judged on two runs or more has no plot.")] = msgspec.UNSET
 
 
-__all__ = ["MarginBounds", "MarginRow", "NearMissRow"]
+_OBLIGATION = ("names the monitors evidence of the run shown (trace); the row links to the guarantee, whose row lists "
+               "its obligations and their evidence")
+
+#: The fields of :class:`NearMissRow` no near-miss renderer shows, each with the reason.
+NEAR_MISS_INTERNAL: dict[str, str] = {"obligation": _OBLIGATION}
+
+
+__all__ = ["MarginBounds", "MarginRow", "NEAR_MISS_INTERNAL", "NearMissRow"]

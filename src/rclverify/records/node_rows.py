@@ -31,6 +31,10 @@ The rules (docs/decisions.md, "One definition per record"):
   are generated from them, and ``$defs/culprit_of`` from
   :class:`CulpritOf` (records/schema_gen.py); tests/records/test_record_shapes.py
   fails when the file and the classes differ.
+* Every field of :class:`UnverifiedRow` is read by the unverified table's
+  renderers (report/templates/assurance.{html,md}.j2, filter
+  ``unverified_rows``) or named in :data:`UNVERIFIED_INTERNAL` with the
+  reason it is not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -130,5 +134,12 @@ class UnverifiedRow(Row, frozen=True, forbid_unknown_fields=True):
     message: Annotated[str, _DOC(description="The problem or outcome in one sentence.")]
 
 
+#: The fields of :class:`UnverifiedRow` no unverified-table renderer shows, each with the reason.
+UNVERIFIED_INTERNAL: dict[str, str] = {
+    "message": "the row's id, source and reason in one sentence, for the one-line outputs (terminal, SARIF); the "
+               "table shows each of them",
+}
+
+
 __all__ = ["AssumptionRow", "Confidence", "CulpritOf", "GuaranteeRow", "InputRow", "NodeRow", "OutputRow",
-           "UnverifiedRow"]
+           "UNVERIFIED_INTERNAL", "UnverifiedRow"]
