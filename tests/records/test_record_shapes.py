@@ -33,7 +33,7 @@ from jinja2 import nodes
 from _report_schema import SCHEMA
 from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
-from rclverify.records import lint_rows, margin_rows, node_rows, verdict_rows
+from rclverify.records import deadline_rows, lint_rows, margin_rows, node_rows, verdict_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
@@ -74,6 +74,15 @@ RECORDS: dict[str, Record] = {
     "unverified": Record(node_rows.UnverifiedRow, node_rows.UNVERIFIED_INTERNAL, "unverified_rows", _MAIN),
     "lint": Record(lint_rows.LintRow, lint_rows.INTERNAL, "lint_rows", _MAIN),
     "near_misses": Record(margin_rows.NearMissRow, margin_rows.NEAR_MISS_INTERNAL, "near_miss_rows", _MAIN),
+    "margins": Record(margin_rows.MarginRow, margin_rows.INTERNAL, "margin_rows", ("margins.html.j2", "margins.md.j2")),
+    "deadlines": Record(deadline_rows.DeadlineRow, deadline_rows.INTERNAL, "deadline_rows",
+                        ("deadlines.html.j2", "deadlines.md.j2")),
+}
+
+#: Records within a row of :data:`RECORDS`, each decoded by its renderers with a filter of its own.
+NESTED: dict[str, Record] = {
+    "deadlines.chain": Record(deadline_rows.DeadlineHop, deadline_rows.HOP_INTERNAL, "hop_rows",
+                              ("deadlines.html.j2", "deadlines.md.j2")),
 }
 
 
@@ -117,9 +126,9 @@ def _sources(renderers: tuple[str, ...] = RENDERERS) -> list[str]:
     return [(PARTS / name).read_text(encoding="utf-8") for name in renderers]
 
 
-@pytest.mark.parametrize("key", list(RECORDS))
+@pytest.mark.parametrize("key", [*RECORDS, *NESTED])
 def test_every_field_of_a_record_is_rendered_or_internal(key: str) -> None:
-    r = RECORDS[key]
+    r = RECORDS[key] if key in RECORDS else NESTED[key]
     assert unaccounted(r.cls, _sources(r.renderers), r.internal, r.filter) == []
     assert all(why for why in r.internal.values())  # each internal field says why it is not shown
 

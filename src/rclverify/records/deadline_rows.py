@@ -26,6 +26,11 @@ The rules (docs/decisions.md, "One definition per record"):
   ``deadline_hop``, ``hop_time_margin``), generated from the class
   (records/schema_gen.py ``SHARED``, ``DEFINED``); tests/records/test_record_shapes.py
   fails when the file and the classes differ.
+* Every field of :class:`DeadlineRow` and of :class:`DeadlineHop` is read by
+  the deadlines' renderers (report/templates/parts/deadlines.{html,md}.j2,
+  filters ``deadline_rows`` and ``hop_rows``) or named in :data:`INTERNAL`
+  or :data:`HOP_INTERNAL` with the reason it is not shown;
+  tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -103,4 +108,16 @@ class DeadlineRow(Row, frozen=True, omit_defaults=True, forbid_unknown_fields=Tr
         description="The second solver's agreement, null when not asked.")] = msgspec.UNSET
 
 
-__all__ = ["DeadlineHop", "DeadlineRow", "HopTimeMargin"]
+#: The fields of :class:`DeadlineRow` no deadline renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {
+    "evidence_status": "the worst status of the chain's hops, each shown on its hop and folded into status, shown",
+    "time_margin_ns": "the measured margin shown (time_margin) in integer nanoseconds, for exact comparison by tools",
+}
+
+#: The fields of :class:`DeadlineHop` no deadline renderer shows, each with the reason.
+HOP_INTERNAL: dict[str, str] = {
+    "within_s": "the hop's deadline shown (within) as an exact fraction of seconds, which the sum (total) adds up",
+}
+
+
+__all__ = ["DeadlineHop", "DeadlineRow", "HOP_INTERNAL", "HopTimeMargin", "INTERNAL"]

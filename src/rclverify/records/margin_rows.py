@@ -125,5 +125,13 @@ _OBLIGATION = ("names the monitors evidence of the run shown (trace); the row li
 #: The fields of :class:`NearMissRow` no near-miss renderer shows, each with the reason.
 NEAR_MISS_INTERNAL: dict[str, str] = {"obligation": _OBLIGATION}
 
+#: The fields of :class:`MarginRow` no margins renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {
+    "formula": "the guarantee's text, shown in its node's section, which the row links to; the row shows the "
+               "comparison (atom) that decided the smallest margin",
+    "obligation": _OBLIGATION,
+    "min": "the bounds of the smallest margin, which are equal (decided) and shown as margin",
+}
 
-__all__ = ["MarginBounds", "MarginRow", "NEAR_MISS_INTERNAL", "NearMissRow"]
+
+__all__ = ["INTERNAL", "MarginBounds", "MarginRow", "NEAR_MISS_INTERNAL", "NearMissRow"]
