@@ -33,7 +33,8 @@ from jinja2 import nodes
 from _report_schema import SCHEMA
 from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
-from rclverify.records import deadline_rows, lint_rows, margin_rows, node_rows, verdict_rows
+from rclverify.records import deadline_rows, lint_rows, margin_rows, node_rows, problem_rows, verdict_rows
+from rclverify.records import side_condition_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
@@ -70,11 +71,14 @@ RECORDS: dict[str, Record] = {
                          ("statistics.html.j2", "statistics.md.j2")),
     "standards": Record(StandardRow, standards_rows.INTERNAL, "standard_rows", ("standards.html.j2", "standards.md.j2")),
     # rendered by the main templates: the pending and unverified tables, the lint table, the near misses
+    "problems": Record(problem_rows.ProblemRow, problem_rows.INTERNAL, "problem_rows", _MAIN),
     "pending": Record(verdict_rows.PendingRow, verdict_rows.INTERNAL, "pending_rows", _MAIN),
     "unverified": Record(node_rows.UnverifiedRow, node_rows.UNVERIFIED_INTERNAL, "unverified_rows", _MAIN),
     "lint": Record(lint_rows.LintRow, lint_rows.INTERNAL, "lint_rows", _MAIN),
     "near_misses": Record(margin_rows.NearMissRow, margin_rows.NEAR_MISS_INTERNAL, "near_miss_rows", _MAIN),
     "margins": Record(margin_rows.MarginRow, margin_rows.INTERNAL, "margin_rows", ("margins.html.j2", "margins.md.j2")),
+    "side_conditions": Record(side_condition_rows.SideConditionRow, side_condition_rows.INTERNAL,
+                              "side_condition_rows", ("section.html.j2", "section.md.j2")),
     "deadlines": Record(deadline_rows.DeadlineRow, deadline_rows.INTERNAL, "deadline_rows",
                         ("deadlines.html.j2", "deadlines.md.j2")),
 }

@@ -25,6 +25,10 @@ The rules (docs/decisions.md, "One definition per record"):
   are generated from them (records/schema_gen.py);
   tests/records/test_record_shapes.py fails when the file and the classes
   differ.
+* Every field of :class:`ProblemRow` is read by the problems table's
+  renderers (report/templates/assurance.{html,md}.j2, filter
+  ``problem_rows``) or named in :data:`INTERNAL` with the reason it is not
+  shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -103,4 +107,11 @@ class ProblemRow(Row, frozen=True, forbid_unknown_fields=True):
     where: Annotated[str, _DOC(description="file:line:col of the RCL or plan text (1-based line and column)")]
 
 
-__all__ = ["DiagnosisRow", "ProblemMember", "ProblemRow", "RepairRef"]
+#: The fields of :class:`ProblemRow` no problems-table renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {
+    "key": "the culprits' keys, by which the dashboard and the system diagram mark culprit nodes and a row is "
+           "matched across runs; the row shows the culprits themselves",
+}
+
+
+__all__ = ["DiagnosisRow", "INTERNAL", "ProblemMember", "ProblemRow", "RepairRef"]

@@ -22,6 +22,10 @@ The rules (docs/decisions.md, "One definition per record"):
 * The ``side_conditions[]`` items of docs/assurance.schema.json are
   generated from it (records/schema_gen.py); tests/records/test_record_shapes.py
   fails when the file and the class differ.
+* Every field is read by a renderer of a node's side conditions
+  (report/templates/parts/section.{html,md}.j2, filter
+  ``side_condition_rows``) or named in :data:`INTERNAL` with the reason it
+  is not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -70,4 +74,16 @@ class SideConditionRow(Row, frozen=True, kw_only=True, omit_defaults=True, forbi
         description="How strong the evidence is (docs/confidence.md).")] = msgspec.UNSET
 
 
-__all__ = ["SideConditionRow"]
+#: The fields of :class:`SideConditionRow` no side-condition renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {
+    "node": "the consumer node, whose section of the calculus lists the side condition (report/view.py)",
+    "links": "the links it reads, drawn in the system diagram, where a failing side condition marks them",
+    "context": "how the in-context check went, read by the diagnosis and the argument; the row shows its outcome "
+               "(verdict: in context), the premises it used (hypotheses) and the explanation",
+    "scale_mismatch": "each probable mismatch's sentence is part of the explanation shown (calculus/compose.py)",
+    "strength": "follows from the status and the second solver's agreement, both shown; the argument's confidence "
+                "reads it",
+}
+
+
+__all__ = ["INTERNAL", "SideConditionRow"]
