@@ -34,7 +34,7 @@ from _report_schema import SCHEMA
 from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
 from rclverify.records import deadline_rows, lint_rows, margin_rows, node_rows, problem_rows, verdict_rows
-from rclverify.records import side_condition_rows
+from rclverify.records import derived_rows, side_condition_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
@@ -77,6 +77,11 @@ RECORDS: dict[str, Record] = {
     "lint": Record(lint_rows.LintRow, lint_rows.INTERNAL, "lint_rows", _MAIN),
     "near_misses": Record(margin_rows.NearMissRow, margin_rows.NEAR_MISS_INTERNAL, "near_miss_rows", _MAIN),
     "margins": Record(margin_rows.MarginRow, margin_rows.INTERNAL, "margin_rows", ("margins.html.j2", "margins.md.j2")),
+    # a node's section of the calculus (its contract, derived property, side conditions) and its LaTeX
+    "nodes": Record(node_rows.NodeRow, node_rows.INTERNAL, "node_rows",
+                    ("section.html.j2", "section.md.j2", "latex.html.j2", "latex.md.j2")),
+    "derived_properties": Record(derived_rows.DerivedPropertyRow, derived_rows.INTERNAL, "derived_rows",
+                                 ("section.html.j2", "section.md.j2")),
     "side_conditions": Record(side_condition_rows.SideConditionRow, side_condition_rows.INTERNAL,
                               "side_condition_rows", ("section.html.j2", "section.md.j2")),
     "deadlines": Record(deadline_rows.DeadlineRow, deadline_rows.INTERNAL, "deadline_rows",
@@ -85,6 +90,8 @@ RECORDS: dict[str, Record] = {
 
 #: Records within a row of :data:`RECORDS`, each decoded by its renderers with a filter of its own.
 NESTED: dict[str, Record] = {
+    "nodes.guarantees": Record(node_rows.GuaranteeRow, node_rows.GUARANTEE_INTERNAL, "guarantee_rows",
+                               ("section.html.j2", "section.md.j2")),
     "deadlines.chain": Record(deadline_rows.DeadlineHop, deadline_rows.HOP_INTERNAL, "hop_rows",
                               ("deadlines.html.j2", "deadlines.md.j2")),
 }

@@ -112,7 +112,7 @@ def _report() -> dict[str, Any]:
                             "conclusion": "A_S => <> G_A"}],
              "environment_assumptions": ["in.r >= 0"],
              "property": "in.r >= 0 => <> (in.status == red -> out.command == stop)",
-             "status": "failed",
+             "status": "failed", "derivation": "not derived", "evidence_status": "discharged", "evidence_note": "",
              "loop_assumption": "Every node on the loop Agent -> Sensor terminates for each input."},
         ],
         "findings": [

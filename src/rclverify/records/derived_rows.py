@@ -23,6 +23,10 @@ The rules (docs/decisions.md, "One definition per record"):
 * The ``derived_properties[]`` and ``environment_assumptions[]`` items of
   docs/assurance.schema.json are generated from them (records/schema_gen.py);
   tests/records/test_record_shapes.py fails when the file and the classes differ.
+* Every field of :class:`DerivedPropertyRow` is read by a node's section of
+  the calculus (report/templates/parts/section.{html,md}.j2, filter
+  ``derived_rows``) or named in :data:`INTERNAL` with the reason it is not
+  shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -71,4 +75,8 @@ class EnvironmentAssumptionRow(Row, frozen=True, forbid_unknown_fields=True):
     source: Annotated[str, _DOC(description="file:line:col of the RCL or plan text (1-based line and column)")]
 
 
-__all__ = ["DerivedPropertyRow", "EnvironmentAssumptionRow"]
+#: The fields of :class:`DerivedPropertyRow` no derived-property renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {}
+
+
+__all__ = ["DerivedPropertyRow", "EnvironmentAssumptionRow", "INTERNAL"]

@@ -31,10 +31,15 @@ The rules (docs/decisions.md, "One definition per record"):
   are generated from them, and ``$defs/culprit_of`` from
   :class:`CulpritOf` (records/schema_gen.py); tests/records/test_record_shapes.py
   fails when the file and the classes differ.
-* Every field of :class:`UnverifiedRow` is read by the unverified table's
-  renderers (report/templates/assurance.{html,md}.j2, filter
-  ``unverified_rows``) or named in :data:`UNVERIFIED_INTERNAL` with the
-  reason it is not shown; tests/records/test_record_shapes.py fails otherwise.
+* Every field of :class:`NodeRow` is read by a node's renderers (its
+  section of the calculus, report/templates/parts/section.{html,md}.j2, and
+  the LaTeX appendix, parts/latex.{html,md}.j2, filter ``node_rows``), every
+  field of :class:`GuaranteeRow` by the section's guarantees table (filter
+  ``guarantee_rows``), every field of :class:`UnverifiedRow` by the
+  unverified table's renderers (report/templates/assurance.{html,md}.j2,
+  filter ``unverified_rows``), or is named in :data:`INTERNAL`,
+  :data:`GUARANTEE_INTERNAL` or :data:`UNVERIFIED_INTERNAL` with the reason
+  it is not shown; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -134,6 +139,12 @@ class UnverifiedRow(Row, frozen=True, forbid_unknown_fields=True):
     message: Annotated[str, _DOC(description="The problem or outcome in one sentence.")]
 
 
+#: The fields of :class:`NodeRow` no node renderer shows, each with the reason.
+INTERNAL: dict[str, str] = {}
+
+#: The fields of :class:`GuaranteeRow` no guarantees-table renderer shows, each with the reason.
+GUARANTEE_INTERNAL: dict[str, str] = {}
+
 #: The fields of :class:`UnverifiedRow` no unverified-table renderer shows, each with the reason.
 UNVERIFIED_INTERNAL: dict[str, str] = {
     "message": "the row's id, source and reason in one sentence, for the one-line outputs (terminal, SARIF); the "
@@ -141,5 +152,5 @@ UNVERIFIED_INTERNAL: dict[str, str] = {
 }
 
 
-__all__ = ["AssumptionRow", "Confidence", "CulpritOf", "GuaranteeRow", "InputRow", "NodeRow", "OutputRow",
-           "UNVERIFIED_INTERNAL", "UnverifiedRow"]
+__all__ = ["AssumptionRow", "Confidence", "CulpritOf", "GUARANTEE_INTERNAL", "GuaranteeRow", "INTERNAL", "InputRow",
+           "NodeRow", "OutputRow", "UNVERIFIED_INTERNAL", "UnverifiedRow"]
