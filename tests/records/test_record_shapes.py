@@ -558,3 +558,27 @@ def test_a_field_added_to_a_standard_row_fails_until_rendered_or_internal() -> N
         part = schema_gen.generated_part("standards")
     assert part["items"]["properties"]["margin_added_here"]["type"] == "string"
     assert SCHEMA["properties"]["standards"] != part
+
+
+_NODE: dict[str, Any] = {
+    "name": "Nodey", "source": "a.rcl:1:1", "status": "failed", "inputs": [], "outputs": [], "assumptions": [],
+    "guarantees": [{"index": 1, "text": "out.y > 0", "source": "a.rcl:3:3", "status": "failed", "obligations": []}],
+    "latex": "latex-text"}
+
+
+def test_a_node_section_shows_the_later_passes_fields_only_when_they_are_set() -> None:
+    """records/node_rows.py: confidence, limited_by, strength and culprit_of are UNSET until their pass runs
+    (or when no problem blames the item); the section shows each when set and nothing of it when not."""
+    part = part_renderer(FragmentCache(), "")
+    bare = {"name": "Nodey", "node": _NODE, "derived": [], "side": [], "findings": [], "ob_status": {}}
+    culprit = [{"status": "failed", "sentence": "culprit-sentence"}]
+    full = {**bare, "node": {**_NODE, "confidence": 0.25, "culprit_of": culprit,
+                             "limited_by": {"label": "limit-label", "kind": "tested", "doubt": 0.75},
+                             "guarantees": [{**_NODE["guarantees"][0], "strength": {"kind": "strength-kind",
+                                                                                    "doubt": 0.5},
+                                             "culprit_of": culprit}]}}
+    for name in ("section.html", "section.md"):
+        plain, shown = str(part(name, sec=bare)), str(part(name, sec=full))
+        assert "UNSET" not in plain + shown and "out.y" in plain
+        for text in ("Confidence 0.25", "limit-label", "strength-kind", "culprit-sentence", "culprit of 1 problem"):
+            assert text in shown and text not in plain, (name, text)
