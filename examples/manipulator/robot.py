@@ -7,7 +7,7 @@ line.  Run it in a ROS 2 Python (rclpy, std_srvs, test_msgs)::
     python robot.py [--defects all|NAME,NAME...] [--monitors N] [--rounds N]
 
 It waits until ``N`` verdict publishers (``rclverify monitor --live
---ros2``) are in the graph, publishes ``--rounds`` rounds 80 ms apart
+--ros2``) are in the graph, publishes ``--rounds`` rounds 150 ms apart
 (a scan stamped at acquisition, a battery reading from the lifecycle
 node, joint positions, an unstamped speed request, an unstamped docking
 range and an unstamped pose), calls the e-stop six times, sends the arm
@@ -183,7 +183,7 @@ def main(argv=None):
         out["cmd_in"].publish(t)
         out["dock_range"].publish(Float32(data=RANGES[k % len(RANGES)]))
         out["pose"].publish(Pose2D(x=float(k) / 4))
-        spin(0.08)  # rounds further apart than a loaded machine delays an answer (docs/semantics.md, "Event time")
+        spin(0.15)  # rounds further apart than a loaded machine delays an answer (docs/semantics.md, "Event time")
     answers = []
     for engage in (True, False, True, False, False, True):
         r = done(client.call_async(SetBool.Request(data=engage)))
