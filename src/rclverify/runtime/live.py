@@ -59,7 +59,7 @@ from rclverify.runtime.shapes import LiveCounts, SilenceNote
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.runtime.worker import EngineWorker
 import warnings
-from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
+from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, shutdown_limit, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
 
 VERDICT_LOG_TOPIC = "rclverify/verdict"
 
@@ -395,8 +395,8 @@ def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_nam
     try:
         return run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}",  # type: ignore[no-any-return]
                            register_node)
-    except RosUnavailable:
-        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+    except RosUnavailable as exc:
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), shutdown_limit(exc))
         raise
 
 
@@ -436,10 +436,10 @@ def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri
     try:
         return run_bounded(stop, max(until - _time.monotonic(), 0.1), f"subscribing at the master at {uri}",
                            register_topics)
-    except RosUnavailable:
-        finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S)
+    except RosUnavailable as exc:
+        finish_within(unsubscribe, shutdown_limit(exc))
         stop_and_record(worker, live, None, lambda _line: None)
-        finish_within(lambda: rospy.signal_shutdown("monitor not started"), SHUTDOWN_TIMEOUT_S)
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), shutdown_limit(exc))
         raise
 
 

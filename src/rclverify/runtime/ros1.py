@@ -54,6 +54,10 @@ DEBIAN_DIST_PACKAGES = "/usr/lib/python3/dist-packages"
 REGISTER_TIMEOUT_S = 60.0
 #: Seconds unregistering and shutting rospy down may take when a run stops.
 SHUTDOWN_TIMEOUT_S = 5.0
+#: Seconds shutting rospy down may take when a signal stopped the monitor while it registered: rospy's
+#: ``signal_shutdown`` joins each of its threads for up to 5 s, and one of them is the registration the
+#: signal interrupted, held by the master; the user asked to stop, so the exit does not wait for it.
+STOPPED_SHUTDOWN_S = 0.5
 
 
 class RosUnavailable(Exception):
@@ -104,6 +108,13 @@ def run_bounded(stop: threading.Event, limit: float, what: str, fn: Callable[[],
     if state == "error":
         raise got
     return got
+
+
+def shutdown_limit(exc: RosUnavailable) -> float:
+    """Seconds rospy's shutdown may take after ``exc`` ended the registration:
+    :data:`STOPPED_SHUTDOWN_S` when a signal stopped it (:class:`RosStopped`),
+    else :data:`SHUTDOWN_TIMEOUT_S`."""
+    return STOPPED_SHUTDOWN_S if isinstance(exc, RosStopped) else SHUTDOWN_TIMEOUT_S
 
 
 def finish_within(fn: Callable[[], Any], limit: float = SHUTDOWN_TIMEOUT_S) -> bool:
@@ -274,5 +285,6 @@ class LocalMaster:
 
 
 __all__ = ["DEBIAN_DIST_PACKAGES", "LocalMaster", "REGISTER_TIMEOUT_S", "RosStopped", "RosUnavailable",
+           "STOPPED_SHUTDOWN_S", "shutdown_limit",
            "SHUTDOWN_TIMEOUT_S", "bound_master_calls", "build_message", "check_master", "contract_topics", "flatten",
            "free_port", "import_rospy", "message_class", "run_bounded", "finish_within"]

@@ -43,7 +43,8 @@ from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineVerdi
 from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
 from rclverify.runtime.ros1_interfaces import action_classes, service_class
 from rclverify.runtime.shapes import DeadlineSummary
-from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, bound_master_calls, check_master, finish_within, run_bounded
+from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, check_master, finish_within,
+                                    run_bounded, shutdown_limit)
 
 
 class ProxyRun:
@@ -245,7 +246,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ProxyUsage, RosUnavailable) as exc:
         print(f"service_proxy: error: {exc}", file=sys.stderr)
         run.close()
-        finish_within(lambda: rospy.signal_shutdown("usage"))
+        finish_within(lambda: rospy.signal_shutdown("usage"),
+                      shutdown_limit(exc) if isinstance(exc, RosUnavailable) else SHUTDOWN_TIMEOUT_S)
         return 2
     print("service_proxy: ready", flush=True)
     end = time.monotonic() + args.duration if args.duration > 0 else float("inf")
