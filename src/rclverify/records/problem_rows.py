@@ -32,11 +32,11 @@ The rules (docs/decisions.md, "One definition per record"):
 """
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Annotated, Any, Iterable, Mapping
 
 import msgspec
 
-from rclverify.records.row import DOC, Row
+from rclverify.records.row import DOC, Row, decode_rows
 from rclverify.records.statuses import AnyStatus
 
 _DOC = DOC  # a field's description, as the generated JSON Schema shows it
@@ -114,4 +114,15 @@ INTERNAL: dict[str, str] = {
 }
 
 
-__all__ = ["DiagnosisRow", "INTERNAL", "ProblemMember", "ProblemRow", "RepairRef"]
+#: Keys a report written before they existed lacks, with the value such a row is read with: a stored
+#: report of an earlier version still renders (its rows placed nowhere).
+EARLIER: dict[str, Any] = {"where": ""}
+
+
+def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[ProblemRow]:
+    """The report's ``problems[]`` (JSON objects) decoded, in order, a key of :data:`EARLIER` a row lacks
+    read as its value there (:meth:`ProblemRow.of` for what raises)."""
+    return decode_rows(ProblemRow, ({**EARLIER, **r} for r in rows))
+
+
+__all__ = ["DiagnosisRow", "EARLIER", "INTERNAL", "ProblemMember", "ProblemRow", "RepairRef", "rows_of"]
