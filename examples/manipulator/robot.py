@@ -151,13 +151,13 @@ def main(argv=None):
 
     def spin(seconds):
         until = time.monotonic() + seconds
-        while time.monotonic() < until:
-            ex.spin_once(timeout_sec=0.002)
+        while (left := until - time.monotonic()) > 0:
+            ex.spin_once(timeout_sec=min(left, 0.05))  # returns as soon as a callback is ready
 
     def done(fut, timeout=5.0):
         until = time.monotonic() + timeout
-        while time.monotonic() < until and not fut.done():
-            ex.spin_once(timeout_sec=0.005)
+        while (left := until - time.monotonic()) > 0 and not fut.done():
+            ex.spin_once(timeout_sec=min(left, 0.05))
         return fut.result() if fut.done() else None
     battery.trigger_configure()
     battery.trigger_activate()
