@@ -22,8 +22,7 @@ the classic tail of list scheduling.  ``pyproject.toml`` turns that reordering
 off (``--no-loadscope-reorder``) and this file sorts the modules by the CPU
 seconds measured for them (:data:`SECONDS`, longest first; Graham's LPT rule),
 the modules not listed after them in their usual order (a live module by its
-wall-clock seconds, :data:`WALL`, when they are longer), with the live
-modules spread among the others (:func:`_interleaved`).  The figures are
+wall-clock seconds, :data:`WALL`, when they are longer).  The figures are
 the CPU seconds of each module's tests taken inside a whole run on the 2-core
 development machine (``RCLVERIFY_TEST_CPU``, below); only their order
 matters, so a rough figure is enough, and a module that grows past two
@@ -143,22 +142,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.live)
         if module in SLOW:
             item.add_marker(pytest.mark.slow)
-    rank = {m: k for k, m in enumerate(_interleaved(sorted(first, key=lambda m: (-_weight(m), first[m]))))}
-    items.sort(key=lambda item: (rank[item.path.stem], first[item.path.stem]))
-
-
-def _interleaved(modules: list[str]) -> list[str]:
-    """``modules`` (longest first) with the live ones spread among the others: one live module, then two
-    others, and so on while both last, each kind longest first.  A live module mostly waits (on nodes,
-    discovery, a master), so the two cores stay busy when one worker of three waits and the other two
-    compute; sorted by length alone, the long live modules came first together and the cores idled."""
-    live = [m for m in modules if m in LIVE]
-    other = [m for m in modules if m not in LIVE]
-    out: list[str] = []
-    while live and other:
-        out += [live.pop(0), *other[:2]]
-        del other[:2]
-    return out + live + other
+    items.sort(key=lambda item: (-_weight(item.path.stem), first[item.path.stem]))
 
 
 def _weight(module: str) -> float:
