@@ -13,7 +13,7 @@ side conditions).  Later passes add keys to the row they built: the
 confidence pass a guarantee's ``strength`` and the node's ``confidence``
 and ``limited_by`` (report/confidence_rows.py, docs/confidence.md), the
 culprit pass ``culprit_of`` on a node or guarantee a problem row blames
-(report/culprits.py; such an item never reads discharged, issue 64).
+(report/culprits.py; such an item never reads discharged while its problem stands).
 ``unverified[]`` holds a row per guarantee of ``nodes[]`` no obligation
 covers (report/unverified.py).
 
@@ -57,7 +57,7 @@ _NAME = "The name as the contracts declare it."
 _NODE = "The node's name as the contracts declare it."
 _TEXT = "The text as written (RCL for a contract clause, words for a requirement)."
 _SOURCE = "file:line:col of the RCL or plan text (1-based line and column)"
-_CULPRIT = "The problem rows this item is the culprit of: such an item never reads discharged (issue 64)."
+_CULPRIT = "The problem rows this item is the culprit of: such an item never reads discharged while its problem stands."
 #: a claim's confidence, 0 to 1 (docs/confidence.md, rules C3-C5)
 Confidence = Annotated[float, _DOC(ge=0, le=1)]
 
