@@ -24,7 +24,7 @@ The rules (docs/decisions.md, "One definition per record"):
   shape); tests/records/test_record_shapes.py holds the two to one list of keys.
 * Each is one entry of the schema's ``$defs`` (``deadline``,
   ``deadline_hop``, ``hop_time_margin``), generated from the class
-  (records/schema_gen.py ``SHARED``, ``DEFINED``); tests/records/test_record_shapes.py
+  (records/schema_gen.py ``DEFS``); tests/records/test_record_shapes.py
   fails when the file and the classes differ.
 * Every field of :class:`DeadlineRow` and of :class:`DeadlineHop` is read by
   the deadlines' renderers (report/templates/parts/deadlines.{html,md}.j2,

@@ -25,7 +25,7 @@ The rules (docs/decisions.md, "One definition per record"):
   :meth:`~rclverify.records.row.Row.of`.
 * Each is one entry of the schema's ``$defs`` (``near_miss``,
   ``margins_over_runs``, ``margin_bounds``), generated from the class
-  (records/schema_gen.py ``SHARED``, ``DEFINED``); tests/records/test_record_shapes.py
+  (records/schema_gen.py ``DEFS``); tests/records/test_record_shapes.py
   fails when the file and the classes differ.
 * Every field of :class:`NearMissRow` is read by the near misses' renderers
   (report/templates/assurance.{html,md}.j2, filter ``near_miss_rows``) or

@@ -9,9 +9,8 @@ as an object that rejects unknown keys, every nested object too; no
 what a missing key means); a value's ``description`` after its type; an enumeration equal to one of the status
 vocabularies of :mod:`rclverify.records.statuses` written as a ``$ref`` to
 that vocabulary's ``$defs`` entry (a union of them :data:`UNIONS` names as a ``$ref`` to
-that union's entry), and a class named in :data:`SHARED` as a
-``$ref`` to its ``$defs`` entry, that entry itself generated from the class
-when :data:`DEFINED` lists it.  A field named in :data:`KEPT` holds a
+that union's entry), and a class of :data:`DEFS` as a
+``$ref`` to its ``$defs`` entry, that entry itself generated from the class.  A field named in :data:`KEPT` holds a
 value whose inner shape belongs to a tool: its schema is the file's own,
 described by hand, taken as it is.
 
@@ -47,15 +46,18 @@ GENERATED: dict[str, tuple[Any, str]] = {
     for hints in [typing.get_type_hints(AssuranceReport, include_extras=True)]
     for name in AssuranceReport.__struct_fields__}
 
-#: A type the report's schema defines in ``$defs`` -> that entry's name.
-SHARED: dict[str, str] = {"Solvers": "solvers", "Strength": "strength", "DeadlineRow": "deadline",
-                           "LimitedBy": "limited_by", "CulpritOf": "culprit_of", "DeadlineHop": "deadline_hop",
-                           "HopTimeMargin": "hop_time_margin", "NearMissRow": "near_miss",
-                           "MarginRow": "margins_over_runs", "MarginBounds": "margin_bounds"}
+#: A record class the report's schema defines once in ``$defs`` -> that entry's name; every use of the
+#: class is a ``$ref`` to it, and the entry is generated from the class.
+DEFS: dict[type[msgspec.Struct], str] = {
+    Strength: "strength", LimitedBy: "limited_by", CulpritOf: "culprit_of", Solvers: "solvers",
+    DeadlineRow: "deadline", DeadlineHop: "deadline_hop", HopTimeMargin: "hop_time_margin",
+    NearMissRow: "near_miss", MarginRow: "margins_over_runs", MarginBounds: "margin_bounds"}
 
-#: The classes of :data:`SHARED` whose ``$defs`` entry is generated from the class (the others' are stated by hand).
-DEFINED: tuple[type[msgspec.Struct], ...] = (Strength, LimitedBy, CulpritOf, Solvers, DeadlineRow, DeadlineHop,
-                                             HopTimeMargin, NearMissRow, MarginRow, MarginBounds)
+#: :data:`DEFS` by class name (how msgspec's schema names the class) -> the entry's name.
+SHARED: dict[str, str] = {cls.__name__: name for cls, name in DEFS.items()}
+
+#: The classes whose ``$defs`` entry :func:`with_generated` writes: those of :data:`DEFS`.
+DEFINED: tuple[type[msgspec.Struct], ...] = tuple(DEFS)
 
 #: A union of status vocabularies the report's schema names in ``$defs`` (the vocabularies' entry names, in
 #: order) -> that entry's name: ``any_status`` (records/statuses.py ``AnyStatus``).

@@ -15,7 +15,7 @@ The rules (docs/decisions.md, "One definition per record"):
   written (an object read from a record that kept neither the proof nor
   the query).
 * It is one entry of the schema's ``$defs`` (``solvers``), generated from
-  the class (records/schema_gen.py ``SHARED``, ``DEFINED``); every row that
+  the class (records/schema_gen.py ``DEFS``); every row that
   holds one refers to that entry.  tests/records/test_record_shapes.py fails
   when the file and the class differ.
 """

@@ -19,7 +19,7 @@ The rules (docs/decisions.md, "One definition per record"):
   e.g. :class:`~rclverify.records.evidence_rows.EvidenceRow`).
 * Each is one entry of the schema's ``$defs`` (``strength``,
   ``limited_by``), generated from the class (records/schema_gen.py
-  ``SHARED``); every row that holds one refers to that entry.
+  ``DEFS``); every row that holds one refers to that entry.
   tests/records/test_record_shapes.py fails when the file and the classes differ.
 """
 from __future__ import annotations
