@@ -18,8 +18,9 @@ Two messages with equal stamps are ordered by their source times, then by
 the order heard: an answer that copies its question's stamp was published
 after that question, whichever of the two reached the monitor first.
 
-:func:`event_ns` is the rule for one live sample; :func:`order_key` the key
-every reorder buffer sorts by.  A message is released for judging only once
+:func:`event_ns` (:func:`event_s` in seconds) is the rule for one live
+sample; :func:`order_key` the key of the one reorder buffer
+(:mod:`.reorder`), which every path that orders a run calls.  A message is released for judging only once
 no message that could precede it can still arrive: the **watermark** is the
 monitor's clock less the lateness bound (``--reorder-window``, seconds), the
 event-time watermark of stream processors (Akidau et al., "The Dataflow
@@ -48,6 +49,13 @@ def event_ns(source_ns: int, received_ns: int) -> tuple[int, bool]:
     return received_ns, False
 
 
+def event_s(source: float, received: float) -> float:
+    """:func:`event_ns` in seconds: the sample's time on the robot's clock
+    (s), its source time ``source`` (s, 0 when none) unless that is more
+    than :data:`AHEAD_NS` ahead of its receipt ``received`` (s)."""
+    return source if source > 0 and (source - received) * 1e9 <= AHEAD_NS else received
+
+
 def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]:
     """The reorder buffers' key: a message's time on the run's clock
     (``stamp``, s: its header stamp, else its event time), then its source
@@ -56,4 +64,4 @@ def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]
     return (stamp, source, seq)
 
 
-__all__ = ["AHEAD_NS", "event_ns", "order_key"]
+__all__ = ["AHEAD_NS", "event_ns", "event_s", "order_key"]

@@ -30,16 +30,14 @@ the horizon) plus the reorder buffer (messages within the window).
 """
 from __future__ import annotations
 
-import heapq
-import itertools
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping
+from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.traces.event_time import order_key
 from rclverify.traces.events import Event, header_stamp, header_stamp_ns
+from rclverify.traces.reorder import ReorderBuffer
 from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 
@@ -78,11 +76,9 @@ class OnlineEngine:
     tolerance: Tolerance | None = None
     monitors: list[NodeMonitor] = field(init=False)
     topics: dict[str, TopicStatus] = field(init=False)
-    late: int = field(init=False, default=0)
-    max_late_s: float = field(init=False, default=0.0)
     released: int = field(init=False, default=0)
-    _heap: list[tuple[float, float, int, str, Mapping[str, object], str]] = field(init=False, default_factory=list)
-    _seq: Any = field(init=False, default_factory=itertools.count)
+    #: the reorder buffer (traces/reorder.py, the one every path uses): (topic, fields, where) by stamp
+    _buffer: ReorderBuffer[tuple[str, Mapping[str, object], str]] = field(init=False, default_factory=ReorderBuffer)
     _clock: float = field(init=False, default=-math.inf)
 
     def __post_init__(self) -> None:
@@ -109,7 +105,7 @@ class OnlineEngine:
                 self.on_silence(topic, 0.0, False)
         stamp = header_stamp(fields)
         t = received if stamp is None else stamp
-        heapq.heappush(self._heap, (*order_key(t, received, next(self._seq)), topic, fields, where))
+        self._buffer.push(t, received, (topic, fields, where))
         if self.reorder_window <= 0:
             self._release(math.inf)
 
@@ -118,7 +114,7 @@ class OnlineEngine:
         released: its time plus the reorder window (the watermark reaches it);
         ``inf`` with nothing buffered.  The live worker ticks then, so a
         verdict waits the lateness bound and not a timer period more."""
-        return self._heap[0][0] + self.reorder_window if self._heap else math.inf
+        return self._buffer.head() + self.reorder_window
 
     def tick(self, now: float) -> None:
         """The timer: release messages older than the reorder window, resolve
@@ -133,13 +129,20 @@ class OnlineEngine:
                     if self.on_silence is not None:
                         self.on_silence(topic, now - st.last, True)
 
+    @property
+    def late(self) -> int:
+        """How many messages were released after one stamped later (the buffer's count)."""
+        return self._buffer.late
+
+    @property
+    def max_late_s(self) -> float:
+        """The largest lateness (s) of a late message."""
+        return self._buffer.max_late_s
+
     def _release(self, upto: float) -> None:
-        while self._heap and self._heap[0][0] <= upto:
-            t, _, _, topic, fields, where = heapq.heappop(self._heap)
+        for t, _, (topic, fields, where), late in self._buffer.release(upto):
             stamp = None
-            if t < self._clock:
-                self.late += 1
-                self.max_late_s = max(self.max_late_s, self._clock - t)
+            if late:
                 stamp, t = t, self._clock  # checked at the clock; its own stamp decides what it answers
             self._clock = t
             ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp)

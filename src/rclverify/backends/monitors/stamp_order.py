@@ -29,12 +29,11 @@ inconclusive with the reason (:func:`stale_reason`): never a silent green.
 """
 from __future__ import annotations
 
-import heapq
 import math
 from typing import Any, Callable, Iterable, Iterator
 
-from rclverify.traces.event_time import order_key
 from rclverify.traces.events import Event, header_stamp
+from rclverify.traces.reorder import ReorderBuffer
 
 
 def run_clock(ev: Event) -> float:
@@ -123,19 +122,17 @@ def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
     :func:`rclverify.traces.event_time.order_key`), each with that stamp as its ``time`` and its index in
     the new order; ``lag`` (s) is the largest lag a :class:`StampWatch`
     measured on the same run, which bounds what the buffer holds."""
-    heap: list[tuple[float, float, int, Event]] = []
+    buffer: ReorderBuffer[Event] = ReorderBuffer()  # the one reorder buffer (traces/reorder.py)
     latest = -math.inf
     out = 0
-    for k, ev in enumerate(events):
+    for ev in events:
         t = run_clock(ev)
         latest = max(latest, t)
-        heapq.heappush(heap, (*order_key(t, ev.time, k), ev))
-        while heap and heap[0][0] < latest - lag:
-            t0, _, _, e0 = heapq.heappop(heap)
+        buffer.push(t, ev.time, ev)
+        for t0, _, e0, _ in buffer.release(latest - lag, strict=True):
             yield Event(out, t0, e0.topic, e0.fields, e0.where)
             out += 1
-    while heap:
-        t0, _, _, e0 = heapq.heappop(heap)
+    for t0, _, e0, _ in buffer.drain():
         yield Event(out, t0, e0.topic, e0.fields, e0.where)
         out += 1
 

@@ -45,8 +45,10 @@ An answer whose request was not heard, and an event of a request stamped
 more than :data:`LATE_S` before the monitor began, leave an answer the book
 names undecided (:meth:`~.dds_calls.CallBook.orphan`).
 
-Samples are taken in the order of their DDS source timestamps: each waits
-:data:`SETTLE_S` seconds after its stamp (so that a request taken after its
+Samples are taken in the order of their event times (the DDS source
+timestamp, else the receipt: :func:`~rclverify.traces.event_time.event_s`),
+held in the one reorder buffer (:mod:`rclverify.traces.reorder`): each waits
+:data:`SETTLE_S` seconds after its time (so that a request taken after its
 reply, the two travelling on different topics, still comes first), and the
 call book's clock runs that far behind.  An answer whose request has not been
 heard waits up to :data:`EARLY_S` seconds for it before it counts as an
@@ -59,7 +61,6 @@ split along the parts would hand the same tables between modules.
 """
 from __future__ import annotations
 
-import heapq
 import os
 from typing import Any, Iterable, Mapping
 
@@ -74,6 +75,8 @@ from rclverify.runtime.dds.order import OrderPairer, Pending
 from rclverify.runtime.dds.shadow import REPLY_OF, SHADOW, Shadows
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
 from rclverify.runtime.dds.wire import framed_rmw, has_header, vendor
+from rclverify.traces.event_time import event_s
+from rclverify.traces.reorder import ReorderBuffer
 
 #: seconds an answer waits for its request (or goal) to be heard
 EARLY_S = 2.0
@@ -122,7 +125,8 @@ class CallTaps:
         self._goal_of: dict[tuple[Any, ...], str] = {}  # send-goal/get-result request id (or event key) -> goal id
         self._status: dict[str, int] = {}
         self._early: dict[tuple[Any, ...], list[tuple[str, Mapping[str, object], float, bool, float, str]]] = {}
-        self._queue: list[tuple[float, int, float, str, bytes, bytes | None]] = []
+        #: samples waiting to be taken (traces/reorder.py, the one reorder buffer): (received, key, raw, writer)
+        self._queue: ReorderBuffer[tuple[float, str, bytes, bytes | None]] = ReorderBuffer()
         self._n = 0
         self._pairers: dict[str, OrderPairer] = {}
         self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
@@ -205,11 +209,15 @@ class CallTaps:
     # -- samples (engine thread) -------------------------------------------------------------
     def handle(self, key: str, raw: bytes, stamp: float, now: float, writer: bytes | None = None) -> None:
         """One sample of tap ``key`` (serialized, source stamp ``stamp``, received
-        ``now``, written by ``writer``: its GUID), taken at a later :meth:`tick`."""
+        ``now``, written by ``writer``: its GUID), taken at a later :meth:`tick`
+        at its event time (:func:`~rclverify.traces.event_time.event_s`: the
+        source stamp, or the receipt when the source stamp is missing or
+        more than a second ahead of it), as the topics' engine places its samples."""
         self._n += 1
         if self.started is None:
             self.started = now
-        heapq.heappush(self._queue, (stamp, self._n, now, key, raw, writer))
+        t = event_s(stamp, now)
+        self._queue.push(t, t, (now, key, raw, writer))
 
     def tick(self, now: float, window: float = 0.0) -> None:
         """Take the samples whose time has come, in their stamps' order; answers
@@ -218,7 +226,7 @@ class CallTaps:
         if self.started is None:
             self.started = now
         self._discover(now)
-        self._take(lambda stamp, got: stamp <= now - SETTLE_S or got <= now - LATE_S)
+        self._take(lambda stamp, _src, item: stamp <= now - SETTLE_S or item[0] <= now - LATE_S)
         if now - self._checked >= 0.5:
             self._checked = now
             self._coverage(now)
@@ -233,13 +241,12 @@ class CallTaps:
 
     def finish(self) -> dict[str, Any]:
         """Take every sample still waiting, then finish the book (its summary)."""
-        self._take(lambda stamp, got: True)
+        self._take(lambda _stamp, _src, _item: True)
         return self.book.finish()
 
     def _take(self, due: Any) -> None:
-        while self._queue and due(self._queue[0][0], self._queue[0][2]):
-            stamp, _n, got, key, raw, writer = heapq.heappop(self._queue)
-            if stamp < self.last - 1e-9:
+        for stamp, _, (got, key, raw, writer), late in self._queue.release_while(due):
+            if late > 1e-9:
                 self.counts["late"] += 1
             self.last = max(self.last, stamp)
             try:
