@@ -230,9 +230,9 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         if enforcing is None:
             return 2
         run_class = enforcing
-    from rclverify.backends.monitors.widths import at_carried_widths, carried_widths  # deferred: start-up (only live)
-    dirs = [root / d for d in cfg.msg_dirs]  # the contract's constants as the fields carry them, as offline
-    judged = [at_carried_widths(n, carried_widths(n, cfg.rules, dirs)) for n in nodes]
+    from rclverify.backends.monitors.widths import judged_at_widths  # deferred: start-up (only live)
+    dirs = [root / d for d in cfg.msg_dirs]  # the contract's constants, named ones too, as the fields carry them
+    judged = [judged_at_widths(checked, n, cfg.rules, dirs)[0] for n in nodes]  # the offline check's route
     warn_margin = getattr(args, "warn_margin", None)
     factory = partial(run_class, checked, judged, cfg.rules, cfg.horizon, log,
                       reorder_window=args.reorder_window, silence_s=args.silence,

@@ -36,7 +36,7 @@ from typing import Any, Iterable, Iterator, Mapping, Sequence
 from rclverify.core.extras import installed
 from rclverify.lang import ast
 from rclverify.lang import types as T
-from rclverify.lang.types import CheckedNode
+from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.widths import FLOAT_WIDTHS, INT_RANGES, Carried, Width, at_widths, carried_fault, idl_name
 from rclverify.traces.events import Event, TraceError
 from rclverify.traces.guard import LOG_SUFFIXES
@@ -246,6 +246,19 @@ def at_carried_widths(node: CheckedNode, widths: Mapping[str, str],
                                                               guarantees=clauses(n.guarantees)))
 
 
+def judged_at_widths(checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
+                     msg_dirs: Sequence[Path]) -> tuple[CheckedNode, dict[str, FieldSource]]:
+    """``(node as judged, its fields)``: ``node`` with its contract's constants, literals and the
+    context's named constants (``checked.env.constants``) alike, compared at the widths its fields
+    carry (:func:`at_carried_widths` of :func:`float_widths`), and :func:`carried_fields` of it.  The
+    one route every monitor takes to the widths: the offline check (:mod:`.recorded`, :mod:`.backend`)
+    and the live monitor (``rclverify monitor --live``), so a named constant compared with a ``float32``
+    field gets the same verdict live and offline (docs/monitors.md, "Widths live and offline").
+    ``msg_dirs``: the mapping's message directories, resolved."""
+    fields = carried_fields(node, rules, msg_dirs)
+    return at_carried_widths(node, float_widths(node, fields), checked.env.constants), fields
+
+
 def _bounded(c: Carried) -> bool:
     """Whether a field carrying ``c`` has a range a JSON log's value may leave: an integer, a bounded
     string, a bounded or fixed sequence (a ``float32`` beyond its range is not looked for: every log
@@ -292,4 +305,4 @@ def _refusing(events: Iterable[Event], by_topic: Mapping[str, list[tuple[str, Fi
 
 
 __all__ = ["FieldSource", "at_carried_widths", "carried_by", "carried_fields", "carried_widths", "float_widths",
-           "refuse_out_of_range", "resolve"]
+           "judged_at_widths", "refuse_out_of_range", "resolve"]
