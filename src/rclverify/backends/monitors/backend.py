@@ -43,7 +43,7 @@ from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
 from rclverify.targets.rml import Spec, rml_id, translate
-from rclverify.backends.monitors.widths import at_carried_widths, carried_fields, float_widths, refuse_out_of_range
+from rclverify.backends.monitors.widths import carried_fields, float_widths, judged_at_widths, refuse_out_of_range
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
@@ -278,8 +278,7 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     declarations and a live log's calls; in stamp order when ``lag`` (s, :func:`.stamp_order.in_stamp_order`)
     is given.  Raises what the readers and the checkers raise (the caller reports it)."""
     # the contract's constants compared as the fields carry them (widths.py)
-    fields = carried_fields(target.node, cfg.rules, [target.root / d for d in cfg.msg_dirs])
-    node = at_carried_widths(target.node, float_widths(target.node, fields), target.checked.env.constants)
+    node, fields = judged_at_widths(target.checked, target.node, cfg.rules, [target.root / d for d in cfg.msg_dirs])
     beside = _Beside()
     if has_deadlines(node):
         beside.add("deadlines", lambda: DeadlineMonitor(target.checked, node, cfg.rules,

@@ -25,7 +25,7 @@ from rclverify.backends.monitors.log_calls import LogCalls
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.summary import verdict_status
-from rclverify.backends.monitors.widths import at_carried_widths, carried_fields, float_widths, refuse_out_of_range
+from rclverify.backends.monitors.widths import judged_at_widths, refuse_out_of_range
 from rclverify.backends.monitors.verdicts import NodeResult
 from rclverify.backends.monitors.run_origin import unseen_links
 
@@ -125,9 +125,9 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     """One read of the run feeding every monitor; in stamp order when ``lag`` is given
     (:func:`.stamp_order.in_stamp_order`); each node's constants compared as its fields carry them (widths.py)."""
     dirs = [root / d for d in cfg.msg_dirs]
-    fields = [carried_fields(n, cfg.rules, dirs) for n in nodes]
-    sources = [(k, s) for f in fields for k, s in f.items()]
-    nodes = [at_carried_widths(n, float_widths(n, f), checked.env.constants) for n, f in zip(nodes, fields)]
+    judged = [judged_at_widths(checked, n, cfg.rules, dirs) for n in nodes]  # the live monitor's route too
+    sources = [(k, s) for _, f in judged for k, s in f.items()]
+    nodes = [n for n, _ in judged]
     dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
              for n in nodes if has_deadlines(n)]
     pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
