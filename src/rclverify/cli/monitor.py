@@ -216,6 +216,15 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     nodes = selected_nodes(checked, args.nodes, "monitor")
     if nodes is None:
         return 2
+    if cfg.mapping:  # the mapping's field paths against the definitions: the check `doit verify` makes
+        from rclverify.backends.monitors.fieldpaths import check_field_paths  # deferred: start-up (only live)
+        try:
+            wrong = check_field_paths(root, cfg.mapping, cfg.msg_dirs, checked)
+        except MissingExtra:  # without rosbags no standard definition is known: the run reads what comes
+            wrong = []
+        if wrong:
+            print("\n".join(map(str, wrong)), file=sys.stderr)
+            return 2
     log = Path(args.log)
     ros = args.ros or os.environ.get("ROS_VERSION", "1")  # ROS's setup scripts set ROS_VERSION
     enforce_items, record = getattr(args, "enforce", []), getattr(args, "record", None)

@@ -102,14 +102,22 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
 
 
 def _sequence_topics(checked: Checked) -> set[str]:
-    """The topics (no leading ``/``) that set a ``seq(T)`` variable: an array fills it whole."""
+    """The topics (no leading ``/``) that set a ``seq(T)`` variable: an array fills it whole.  A topic
+    of the contracts' ``topics(...)``, and a part of a linked service or action (``move/feedback``, the
+    link's variable of that part: :data:`~.verdicts.LINK_TOPICS`), as :func:`topic_types` names them."""
     out: set[str] = set()
+
+    def sets_seq(node: Any, v: Any) -> bool:
+        typ = (node.inputs if v.prefix == "in" else node.outputs).get(v.name) if v is not None else None
+        return isinstance(typ, SeqT)
     for node in checked.nodes.values():
         for t in node.node.topics:
-            v = t.match
-            typ = (node.inputs if v.prefix == "in" else node.outputs).get(v.name) if v is not None else None
-            if isinstance(typ, SeqT):
+            if sets_seq(node, t.match):
                 out.add(t.field.lstrip("/"))
+        for lk in node.node.links:
+            for part, v in zip(LINK_TOPICS.get(lk.kind, ()), lk.parts):
+                if sets_seq(node, v):
+                    out.add(f"{lk.name.lstrip('/')}/{part}")
     return out
 
 
