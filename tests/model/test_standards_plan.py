@@ -88,12 +88,27 @@ def test_strict_is_true_or_false(tmp_path: Path) -> None:
 
 # --- what the plan says of a clause: a narrowed scope with its reason, a justification -------------
 
+WHY = "B and C carry no safety function per hazard log H-3 revision 2"
+
+
 def test_a_clause_note_is_read(tmp_path: Path) -> None:
     plan = _load(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 2\n    clauses:\n"
-                           "      B.8 6c: {nodes: [A], reason: only A is safety related, justification: reviewed by QA team}\n")
+                           f"      B.8 6c: {{nodes: [A], reason: only A is safety related, justification: {WHY}}}\n")
     note = plan.standards[0].clauses["B.8 6c"]  # type: ignore[attr-defined]
     assert (note.nodes, note.reason, note.justification, note.at) == (
-        ("A",), "only A is safety related", "reviewed by QA team", "contracts/plan.yaml:7:7")
+        ("A",), "only A is safety related", WHY, "contracts/plan.yaml:7:7")
+
+
+def test_narrowing_a_clause_asked_at_the_level_needs_a_full_justification(tmp_path: Path) -> None:
+    """A 3-word reason narrowed an HR clause and passed --strict: narrowing a clause asked at the level
+    needs a justification of at least 8 words; a clause not asked there (A.9 1 is R at SIL 2) is the control."""
+    msg = _error(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 2\n    clauses:\n"
+                           "      B.8 6c: {nodes: [A], reason: only A matters, justification: reviewed by QA}\n")
+    assert msg.startswith("contracts/plan.yaml:7:") and "is asked at this level (HR)" in msg
+    assert "at least 8 words" in msg
+    plan = _load(tmp_path, "standards:\n  - profile: iec61508-3\n    sil: 2\n    clauses:\n"
+                           "      A.9 1: {nodes: [A], reason: only A matters}\n")
+    assert plan.standards[0].clauses["A.9 1"].nodes == ("A",)  # type: ignore[attr-defined]
 
 
 def test_a_clause_the_profile_lacks_is_located(tmp_path: Path) -> None:

@@ -14,7 +14,7 @@ them).  The mapping is a traceability aid, not a compliance claim.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, TypedDict
+from typing import Any, Collection, Mapping, Sequence, TypedDict
 
 from rclverify.records.report_schema import EvidenceJson, Report
 from rclverify.model.plan.standards.choice import StandardChoice
@@ -59,12 +59,15 @@ def _label(row: Mapping[str, Any]) -> str:
 
 
 def standards_part(choices: Sequence[StandardChoice],
-                   report: Mapping[str, Any] | Sequence[EvidenceJson]) -> StandardsPart:
+                   report: Mapping[str, Any] | Sequence[EvidenceJson],
+                   unstated: Collection[tuple[str, str]] = ()) -> StandardsPart:
     """The ``standards`` part of the plan's ``choices`` over ``report`` (the
     report dict so far: its evidence rows with their strength, obligations,
     nodes, side conditions, requirements, findings, unverified guarantees,
     system and summary; a bare list of evidence rows reads as a report of
-    those rows alone).  Each row is checked by decoding it into
+    those rows alone); ``unstated``: the (node, environment) of the run
+    sets whose plan entry states no origin, never field data
+    (:func:`~rclverify.model.plan.standards.field_data.unstated_origins`).  Each row is checked by decoding it into
     :class:`~rclverify.records.standards_rows.StandardRow` and written as
     its JSON object (every field).  Pure; raises
     :class:`msgspec.ValidationError` only for a row its definition does not
@@ -73,7 +76,7 @@ def standards_part(choices: Sequence[StandardChoice],
     problems: list[str] = []
     ok = True
     for c in choices:
-        clauses = clause_rows(c.profile, c.level, report, c.clauses)
+        clauses = clause_rows(c.profile, c.level, report, c.clauses, unstated)
         missing = not_covered(clauses)
         row = StandardRow.of({
             "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,

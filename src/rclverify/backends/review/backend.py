@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from rclverify.model.plan.declarations import declared_in
+from rclverify.model.plan.standards.identity import confusable
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.paths import escape_reason
@@ -50,7 +51,28 @@ def read_record(root: Path, config: Any, loc: Any) -> tuple[str, ReviewRecord]:
     except RecordError as exc:
         raise plan_error(l.file, l.line, l.col, f"review record: {exc}") from None
     check_reviewed_paths(root, rel, text, record)
+    check_names(rel, text, record)
     return rel, record
+
+
+def check_names(rel: str, text: str, record: ReviewRecord) -> None:
+    """Refuse a record whose ``reviewer``, ``author`` or an alias could be spelt to look like another name
+    (mixed scripts, an invisible character: :func:`~rclverify.model.plan.standards.identity.confusable`).
+    Raises :class:`PlanError` at the name in the record (``rel:line:col``), naming why."""
+    named: list[tuple[tuple[str | int, ...], str]] = [(("reviewer",), record.reviewer), (("author",), record.author)]
+    named += [(("author_aliases", i), a) for i, a in enumerate(record.author_aliases)]
+    named += [(("reviewer_aliases", i), a) for i, a in enumerate(record.reviewer_aliases)]
+    bad = [(path, name, why) for path, name in named for why in [confusable(name)] if why is not None]
+    if not bad:
+        return
+    _, locs = load_located(text, rel)
+    diags: list[Diagnostic] = []
+    for path, name, why in bad:
+        at = locs.get(path, locs.get(path[:1], ast.Loc(rel, 1, 1)))
+        diags.extend(plan_error(at.file, at.line, at.col, f"review record: {'.'.join(map(str, path))} {name!r}: "
+                                f"{why}; write the name in one script without invisible characters",
+                                "E-plan").diagnostics)
+    raise PlanError(diags)
 
 
 def check_reviewed_paths(root: Path, rel: str, text: str, record: ReviewRecord) -> None:
@@ -117,6 +139,9 @@ class ReviewBackend:
         details["record"] = rel
         details["figures_table"] = ([["reviewer", rec.reviewer], ["author", rec.author or "(not named)"],
                                      ["independence", rec.independence or ("(not stated)" if rec.author else "(not shown)")],
+                                     *([["author aliases", "; ".join(rec.author_aliases)]] if rec.author_aliases else []),
+                                     *([["reviewer aliases", "; ".join(rec.reviewer_aliases)]]
+                                       if rec.reviewer_aliases else []),
                                      ["date", rec.date], ["scope", rec.scope],
                                      ["verdict", rec.verdict or "(none)"]]
                                     + [[f"{q['id']} ({q['location']})", f"{q['answer'] or 'unanswered'}: {q['question']}"

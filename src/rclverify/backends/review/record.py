@@ -5,6 +5,8 @@ Record (YAML)::
     node: Localisation
     reviewer: <who reviewed; say so when unknown>
     author: <who wrote what was reviewed>          # optional; needed for independence
+    author_aliases: [<other names of the author>]  # optional: e-mail addresses, spellings
+    reviewer_aliases: [<other names of the reviewer>]
     independence: person                # optional: person | department | organisation
     date: <YYYY-MM-DD, or text saying it is unknown>
     scope: <what was reviewed, against what>
@@ -18,10 +20,12 @@ Record (YAML)::
 ``author`` and ``independence`` say who checked what: a review counts for
 a standard's clause that asks independence (IEC 61508-1:2010 clause 8,
 DO-178C Annex A "with independence") only when the record names both its
-reviewer and its author, they differ, and ``independence`` (``person``
-when left out) is at least the clause's (docs/standards.md).  A record
-may leave them out: it is still a review, shown everywhere, never counted
-as independent.
+reviewer and its author, each names a person, they are not one person as
+:mod:`rclverify.model.plan.standards.identity` compares names (NFKC, case,
+punctuation and spaces aside, e-mail addresses and the declared aliases
+resolved), and ``independence`` (``person`` when left out) is at least the
+clause's (docs/standards.md).  A record may leave them out: it is still a
+review, shown everywhere, never counted as independent.
 
 The checklist has one question per conjunct of each guarantee (top-level
 ``and`` split), with the conjunct's RCL location, so a reviewer knows what
@@ -104,6 +108,8 @@ class ReviewRecord:
     assumption: str | None = None
     author: str = ""
     independence: str = ""
+    author_aliases: tuple[str, ...] = ()
+    reviewer_aliases: tuple[str, ...] = ()
 
 
 def _answer(v: Any, where: str) -> str | None:
@@ -147,13 +153,23 @@ def parse_record(text: str, file: str) -> ReviewRecord:
     if independence not in ("", "person", "department", "organisation"):
         raise RecordError(f"{file}: independence must be person, department or organisation (IEC 61508-1 "
                           f"clause 8), found {independence!r}")
+    aliases = {k: _names(data.get(k), f"{file}: {k}") for k in ("author_aliases", "reviewer_aliases")}
     verdict = data["verdict"]
     if verdict not in (None, "", "pass", "fail"):
         raise RecordError(f"{file}: verdict must be pass, fail or empty, found {verdict!r}")
     return ReviewRecord(str(data["node"]), str(data["reviewer"] or "").strip(), str(data["date"] or "").strip(),
                         str(data["scope"] or "").strip(), tuple(files), answers, notes, verdict or None, conjuncts,
                         None if assumption is None else str(assumption), str(data.get("author") or "").strip(),
-                        independence)
+                        independence, aliases["author_aliases"], aliases["reviewer_aliases"])
+
+
+def _names(value: Any, where: str) -> tuple[str, ...]:
+    """A record's list of aliases (absent: none).  Raises :class:`RecordError` for another shape."""
+    if value is None:
+        return ()
+    if not isinstance(value, list) or not all(isinstance(v, str) and v.strip() for v in value):
+        raise RecordError(f"{where}: a list of names (other spellings, e-mail addresses), found {value!r}")
+    return tuple(v.strip() for v in value)
 
 
 def assumption_text(node: CheckedNode) -> str:

@@ -23,9 +23,11 @@ from typing import Any, Mapping
 from rclverify.lang import ast
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.yamlguard import KEY, Path_
-from rclverify.model.plan.standards.profiles import Profile, builtin_names, load_builtin, load_profile_file
+from rclverify.model.plan.standards.profiles import ASKED, Profile, builtin_names, load_builtin, load_profile_file
 
 
+#: The fewest words of the justification that narrowing a clause asked at the level needs.
+ASKED_WORDS = 8
 #: The keys of a clause's entry under ``clauses:``.
 CLAUSE_KEYS: tuple[str, ...] = ("nodes", "reason", "justification")
 
@@ -102,10 +104,12 @@ def _words(value: Any, n: int) -> bool:
 
 
 def _clauses(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Path_, ast.Loc],
-             file: str) -> dict[str, ClauseNote]:
+             file: str, level: str | None = None) -> dict[str, ClauseNote]:
     """The entry's ``clauses:`` read and checked: each id one of the profile's, each key one of
     :data:`CLAUSE_KEYS`, ``nodes`` a non-empty list of names given with a ``reason`` of at least three
-    words, a ``justification`` of at least three words."""
+    words, a ``justification`` of at least three words; narrowing a clause asked at ``level`` (``HR``,
+    or ``required``) also needs a ``justification`` of at least :data:`ASKED_WORDS` words (shown in full
+    in the matrix)."""
     def at(*path: Any) -> ast.Loc:
         full = base + ("clauses",) + path
         while full not in locs and len(full) > len(base):
@@ -140,6 +144,11 @@ def _clauses(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Pa
                       f"clause {cid!r}: narrowing its scope needs a 'reason' of at least three words, shown with it")
         if "reason" in note and nodes is None:
             raise bad(at(cid, "reason"), f"clause {cid!r}: a 'reason' goes with 'nodes' (the scope it narrows)")
+        asked = p.items[ids.index(cid)].at(level) in ASKED
+        if nodes is not None and asked and not _words(note.get("justification"), ASKED_WORDS):
+            raise bad(at(cid, "justification") if "justification" in note else at(cid, "nodes"),
+                      f"clause {cid!r} is asked at this level ({p.items[ids.index(cid)].at(level)}): narrowing its "
+                      f"scope needs a 'justification' of at least {ASKED_WORDS} words, shown in full in the matrix")
         if "justification" in note and not _words(note.get("justification"), 3):
             raise bad(at(cid, "justification"), f"clause {cid!r}: a 'justification' is at least three words")
         l = at(cid, KEY)
@@ -163,9 +172,10 @@ def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast
         p = _profile(root, str(entry["profile"]), at)
         if any(c.profile.id == p.id for c in out):
             raise plan_error(at.file, at.line, at.col, f"standards: profile {p.id!r} is chosen twice", "E-profile")
-        out.append(StandardChoice(p, _level(p, entry, base, locs, file), locs.get(base, at),
-                                  bool(entry.get("strict", False)), _clauses(p, entry, base, locs, file)))
+        level = _level(p, entry, base, locs, file)
+        out.append(StandardChoice(p, level, locs.get(base, at), bool(entry.get("strict", False)),
+                                  _clauses(p, entry, base, locs, file, level)))
     return tuple(out)
 
 
-__all__ = ["CLAUSE_KEYS", "ClauseNote", "PlanError", "StandardChoice", "read_standards"]
+__all__ = ["ASKED_WORDS", "CLAUSE_KEYS", "ClauseNote", "PlanError", "StandardChoice", "read_standards"]

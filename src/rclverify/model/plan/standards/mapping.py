@@ -49,9 +49,11 @@ assessor, not a compliance claim.
 from __future__ import annotations
 
 from collections import Counter
-from typing import Any, Callable, Iterable, Mapping, Sequence, cast, get_args
+from typing import Any, Callable, Collection, Iterable, Mapping, Sequence, cast, get_args
 
 from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
+from rclverify.model.plan.standards.field_data import target_items
+from rclverify.model.plan.standards.reviews import independence_of, review_as_stated, review_identity
 from rclverify.records.report_schema import EvidenceJson
 from rclverify.records.standards_rows import About, ClauseStatus, Independence, Recommendation, ScopeKind
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
@@ -104,33 +106,6 @@ def kinds_of(row: Mapping[str, Any]) -> set[str]:
     return {kind for (field, value), kind in SUPPORTS.items() if values[field] == value}
 
 
-def review_identity(row: Mapping[str, Any]) -> tuple[str, str, str]:
-    """(reviewer, author, independence) a review evidence row names in its ``figures`` rows
-    (backends/review: ``reviewer``, ``author``, ``independence``); ``""`` for what it does not name."""
-    said = {str(r[0]): str(r[1]).strip() for r in row.get("figures") or () if isinstance(r, (list, tuple)) and len(r) == 2}
-    def named(key: str) -> str:  # "(not named)": the backend's word for a field the record leaves empty
-        v = said.get(key, "")
-        return "" if v.startswith("(") and v.endswith(")") else v
-    return named("reviewer"), named("author"), named("independence")
-
-
-def _same_person(a: str, b: str) -> bool:
-    return " ".join(a.casefold().split()) == " ".join(b.casefold().split())
-
-
-def independence_of(row: Mapping[str, Any]) -> tuple[str, str]:
-    """(the independence level a review row shows, one of :data:`~.profiles.INDEPENDENCE`; why it is
-    ``none`` or ``""``): ``none`` when the record does not name both its reviewer and its author or
-    they are one person (a self-review); else the record's stated level, ``person`` when it states none."""
-    reviewer, author, stated = review_identity(row)
-    if not reviewer or not author:
-        return "none", ("the record does not name " + ("its author" if reviewer else "its reviewer")
-                        + ": its independence is not shown")
-    if _same_person(reviewer, author):
-        return "none", f"self-review: {reviewer} reviewed their own work"
-    return (stated if stated in INDEPENDENCE and stated != "none" else "person"), ""
-
-
 def _harness(row: Mapping[str, Any]) -> bool:
     s = row.get("statistics")
     return isinstance(s, Mapping) and s.get("origin") == "harness"
@@ -152,8 +127,9 @@ def _support(row: Mapping[str, Any], asked: str) -> Support:
 class _Index:
     """The report read once for every clause: each guarantee's evidence rows and status, its health checks."""
 
-    def __init__(self, report: Mapping[str, Any]) -> None:
+    def __init__(self, report: Mapping[str, Any], unstated: Collection[tuple[str, str]] = ()) -> None:
         self.report = report
+        self.unstated = unstated  # (node, environment) of the run sets whose plan entry states no origin
         where = {str(o["id"]): (str(o["node"]), int(o["guarantee"])) for o in report.get("obligations") or ()}
         self.guarantees: list[tuple[str, int, str]] = [
             (str(n["name"]), int(g["index"]), str(g["status"]))
@@ -232,30 +208,6 @@ def _requirement_item(rq: Mapping[str, Any], ix: _Index, accepts: set[str], aske
     return _item(f"requirement {rq.get('id')}", "requirement", state, detail, [f"requirement {rq.get('id')}"])
 
 
-def _target_item(e: Mapping[str, Any]) -> ScopeItem:
-    st = str(e.get("status"))
-    return _item(f"target {e.get('obligation')}", "target", "covered" if st == "discharged" else st,
-                 f"target {st}", [str(e.get("obligation"))])
-
-
-def _targets(report: Mapping[str, Any], origins: tuple[str, ...], experiments: bool) -> list[ScopeItem]:
-    out = []
-    for e in report.get("evidence") or ():
-        s = e.get("statistics")
-        if not (isinstance(s, Mapping) and "decision" in s):
-            continue
-        if (e.get("backend") == "monitors" and s.get("origin") in origins) or (experiments and e.get("backend") == "experiment"):
-            out.append(_target_item(e))
-    for rq in report.get("requirements") or ():
-        for t in rq.get("statistics") or ():
-            if t.get("target") and t.get("origin") in origins:
-                st = str(t.get("status") or "pending")
-                out.append(_item(f"target of requirement {rq.get('id')} ({t.get('environment')}, {t.get('origin')})",
-                                 "target", "covered" if st == "discharged" else st, f"target {st}",
-                                 [f"requirement {rq.get('id')}"]))
-    return out
-
-
 def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _Index | None = None,
                 narrowed: Sequence[str] | None = None) -> list[ScopeItem]:
     """The items of ``report`` (a report dict, or the parts of it it has) in the scope of the profile
@@ -271,8 +223,11 @@ def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _I
         return [_guarantee_item(ix, n, k, st, accepts, asked) for n, k, st in ix.guarantees
                 if (nodes is None or n in nodes) and (keep is None or n in keep)]
 
+    # a side condition's check is a Z3 proof: it covers only a clause that accepts proofs; for another
+    # clause a side condition not proved is still in scope, a defect of the interface that keeps it uncovered
     scs = [_side_condition_item(sc) for sc in report.get("side_conditions") or ()
-           if keep is None or str(sc.get("node")) in keep]
+           if (keep is None or str(sc.get("node")) in keep)
+           and ("proof" in accepts or not (sc.get("verdict") in _PROVED and sc.get("status") == "discharged"))]
     reqs = [_requirement_item(rq, ix, accepts, asked) for rq in report.get("requirements") or ()
             if keep is None or any(str(x.get("node")) in keep for x in rq.get("support") or ())]
     known = {n for n, _, _ in ix.guarantees}
@@ -297,8 +252,7 @@ def _scope(item: Item, report: Mapping[str, Any], ix: _Index, guarantees: Callab
         supporting = {str(s["node"]) for rq in report.get("requirements") or () for s in rq.get("support") or ()}
         return reqs + guarantees(supporting)
     if item.about in ("field-data", "trials"):
-        targets = _targets(report, ("operation",) if item.about == "field-data" else ("operation", "simulation"),
-                           experiments=item.about == "trials")
+        targets = target_items(report, item.about, item.min_runs, ix.unstated)
         return [t for t in targets if kept(t["item"].removeprefix("target ").split(".")[0])
                 or t["item"].startswith("target of requirement")]
     # system: everything, the health checks and the workspace's own status
@@ -346,7 +300,9 @@ def _checked_by(scope: Sequence[ScopeItem], ix: _Index) -> list[str]:
                 who = f"Z3 ({s['kind']} check)"
             elif r.get("kind") == "review":
                 reviewer, author, _ = review_identity(r)
-                who = f"review by {reviewer or 'an unnamed reviewer'} (author: {author or 'not named'})"
+                stated = review_as_stated(r)
+                who = (f"review by {reviewer or 'an unnamed reviewer'} (author: {author or 'not named'}"
+                       + (f"; {stated})" if stated else ")"))
             else:
                 tool, version = str(r.get("tool", "")), str(r.get("tool_version", ""))
                 who = f"{r.get('backend')} ({version if version.startswith(tool) else f'{tool} {version}'.strip()})"
@@ -365,6 +321,8 @@ def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], i
     if status == "covered":
         return f"all {n} item{'s' if n != 1 else ''} in scope covered"
     left = Counter(s["state"] for s in scope if not s["covered"])
+    if not left:  # every item covered, the clause asking more than the tool holds (_adds says what)
+        return f"{status}: {done} of {n} in scope covered"
     head = ", ".join(f"{left[st]} {st}" for st in sorted(left, key=lambda x: _WORST.index(x) if x in _WORST else 0))
     shown = [e for e in evidence if not e["counts"]]
     extra = f"; {len(shown)} record{'s' if len(shown) != 1 else ''} shown, not counted ({shown[0]['note']})" if shown else ""
@@ -372,7 +330,8 @@ def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], i
 
 
 def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceJson],
-                notes: Mapping[str, Any] | None = None) -> list[ClauseRow]:
+                notes: Mapping[str, Any] | None = None,
+                unstated: Collection[tuple[str, str]] = ()) -> list[ClauseRow]:
     """The clause rows of ``profile`` at ``level`` (``None`` for a profile
     without levels) over ``report`` (a report dict: its ``evidence``,
     ``obligations``, ``nodes``, ``side_conditions``, ``requirements``,
@@ -381,10 +340,12 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
     alone), in the profile's order.  ``notes``: clause id -> what the plan
     says of it (a :class:`~rclverify.model.plan.standards.choice.ClauseNote`:
     ``nodes``, ``reason``, ``justification``, ``at``): the scope narrowed to
-    those nodes, and the note shown.  Pure: reads nothing else, raises
-    nothing for well-formed rows."""
+    those nodes, and the note shown.  ``unstated``: the (node, environment)
+    of the run sets whose plan entry states no origin (never field data,
+    :func:`~.field_data.unstated_origins`).  Pure: reads nothing else,
+    raises nothing for well-formed rows."""
     rep: Mapping[str, Any] = report if isinstance(report, Mapping) else {"evidence": list(report)}
-    ix = _Index(rep)
+    ix = _Index(rep, unstated)
     out: list[ClauseRow] = []
     for item in profile.items:
         code = item.at(level)
@@ -395,7 +356,7 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
         status: ClauseStatus
         if code == "NR":
             status = "not recommended"
-        elif scope and done == len(scope):
+        elif scope and done == len(scope) and not item.safety_case_adds:
             status = "covered"
         elif done:
             status = "partial"
@@ -410,12 +371,21 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
                     "covered_by": list(dict.fromkeys(ob for x in scope if x["covered"] for ob in x["evidence"])),
                     "checked_by": _checked_by(scope, ix),
                     "status": status, "why": _why(status, scope, evidence, item, code, level)
+                    + _adds(item, scope, done)
                     + ("" if note is None or note.nodes is None else
                        f"; scope narrowed by the plan to {', '.join(note.nodes)} ({note.reason})"),
                     "plan": None if note is None else {"nodes": None if note.nodes is None else list(note.nodes),
                                                        "reason": note.reason, "justification": note.justification,
                                                        "at": note.at}})
     return out
+
+
+def _adds(item: Item, scope: Sequence[ScopeItem], done: int) -> str:
+    """What a clause the tool never covers alone (its item's ``safety_case_adds``) leaves to the safety case."""
+    if not item.safety_case_adds:
+        return ""
+    got = f"rclverify's evidence covers {done} of {len(scope)} item{'s' if len(scope) != 1 else ''} in scope"
+    return f"; never covered by the tool alone: {got}; the safety case must add {item.safety_case_adds}"
 
 
 def not_covered(rows: Sequence[ClauseRow], codes: Sequence[str] = ASKED) -> list[str]:
@@ -425,4 +395,4 @@ def not_covered(rows: Sequence[ClauseRow], codes: Sequence[str] = ASKED) -> list
 
 
 __all__ = ["About", "CLAUSE_STATUSES", "ClauseRow", "ClauseStatus", "Independence", "Recommendation", "ScopeKind", "SUPPORTS", "ScopeItem", "Support", "clause_rows", "independence_of",
-           "kinds_of", "not_covered", "PlanNote", "review_identity", "scope_items"]
+           "kinds_of", "not_covered", "PlanNote", "review_as_stated", "review_identity", "scope_items"]

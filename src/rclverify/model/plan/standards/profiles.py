@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
+import unicodedata
 from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
@@ -51,7 +53,10 @@ class Item:
     level or level -> code, ``about`` what it concerns (one of
     :data:`ABOUT`), ``independence`` the reviewer's independence from the
     author it asks (one of :data:`INDEPENDENCE`, for every level or per
-    level)."""
+    level), ``min_runs`` the fewest independent runs a target in its scope
+    must count (0: no minimum), ``safety_case_adds`` what the clause asks
+    beyond any evidence rclverify holds (``""``: nothing; else the clause is
+    never covered by the tool alone, docs/standards.md)."""
     id: str
     title: str
     evidence: tuple[str, ...]
@@ -59,6 +64,8 @@ class Item:
     recommendation: str | Mapping[str, str]
     about: str = "guarantees"
     independence: str | Mapping[str, str] = "none"
+    min_runs: int = 0
+    safety_case_adds: str = ""
 
     def at(self, level: str | None) -> str:
         """The recommendation code at ``level`` (``None``: a profile without levels)."""
@@ -111,13 +118,26 @@ def load_builtin(name: str) -> Profile:
     return replace(p, sha256=hashlib.sha256(res.read_bytes()).hexdigest())
 
 
+#: Dashes and hyphens other than '-' (Unicode category Pd and the minus sign), read as '-' in an edition.
+_DASHES = dict.fromkeys(map(ord, "\u2010\u2011\u2012\u2013\u2014\u2015\u2212\ufe58\ufe63\uff0d\u2e3a\u2e3b"), "-")
+
+
+def edition_key(edition: str) -> str:
+    """``edition`` as editions are compared: NFKC, case folded, every dash read as '-', spaces around
+    ':', '/', '-' and ',' removed and other runs of whitespace read as one space, stripped.  Two editions
+    with one key name one standard's edition."""
+    text = unicodedata.normalize("NFKC", edition).translate(_DASHES).casefold()
+    text = "".join(c for c in text if unicodedata.category(c) not in ("Cf", "Cc") or c.isspace())
+    return re.sub(r"\s*([:/,-])\s*", r"\1", " ".join(text.split()))
+
+
 def _reserved() -> dict[str, tuple[str, str]]:
-    """Each built-in profile's id and edition -> (what it is, the built-in id)."""
+    """Each built-in profile's id and edition (as :func:`edition_key` reads it) -> (what it is, the built-in id)."""
     out: dict[str, tuple[str, str]] = {}
     for name in builtin_names():
         p = load_builtin(name)
         out[f"id:{p.id}"] = ("id", p.id)
-        out[f"edition:{p.edition}"] = ("edition", p.id)
+        out[f"edition:{edition_key(p.edition)}"] = ("edition", p.id)
     return out
 
 
@@ -129,12 +149,14 @@ def load_profile_file(path: Path, file: str) -> Profile:
     text = read_yaml_text(path, file)
     p = parse_profile(text, file)
     reserved = _reserved()
-    for key, value in (("id", p.id), ("edition", p.edition)):
-        if f"{key}:{value}" in reserved:
+    for key, value, seen in (("id", p.id, p.id), ("edition", p.edition, edition_key(p.edition))):
+        if f"{key}:{seen}" in reserved:
             _, locs = load_located(text, file)
+            builtin = reserved[f"{key}:{seen}"][1]
+            alike = "" if key == "id" else " (editions are compared without case, spacing or the kind of dash)"
             raise _bad(locs, (key,), file, f"standard profile: {key} {value!r} is the built-in profile "
-                       f"{reserved[f'{key}:{value}'][1]!r}'s; a workspace profile takes its own {key} (choose the "
-                       f"built-in one with `profile: {reserved[f'{key}:{value}'][1]}`)")
+                       f"{builtin!r}'s{alike}; a workspace profile takes its own {key} (choose the "
+                       f"built-in one with `profile: {builtin}`)")
     try:
         return replace(p, sha256=hashlib.sha256(path.read_bytes()).hexdigest())
     except OSError:  # read just above; gone since: the text's digest
@@ -210,11 +232,13 @@ def parse_profile(text: str, file: str, builtin: bool = False) -> Profile:
                            f"{', '.join(sorted(ind)) or 'none'}; the profile's levels are "
                            f"{', '.join(levels) or 'none (write one level of independence)'}")
         items.append(Item(iid, str(it["title"]), tuple(it["evidence"]), str(it["strength"]), rec,
-                          str(it.get("about", "guarantees")), ind))
+                          str(it.get("about", "guarantees")), ind, int(it.get("min_runs", 0)),
+                          str(it.get("safety_case_adds", "")).strip()))
     left = tuple((str(x["id"]), str(x["why"])) for x in data.get("left_out", []))
     return Profile(str(data["id"]), str(data["title"]), str(data["edition"]), str(data.get("level_name", "level")),
                    levels, tuple(items), file, builtin, hashlib.sha256(text.encode("utf-8")).hexdigest(), left)
 
 
-__all__ = ["ABOUT", "ASKED", "BUILTIN_DIR", "CODES", "INDEPENDENCE", "Item", "Profile", "builtin_names", "load_builtin", "load_profile_file",
+__all__ = ["ABOUT", "ASKED", "BUILTIN_DIR", "CODES", "INDEPENDENCE", "Item", "Profile", "builtin_names", "edition_key",
+           "load_builtin", "load_profile_file",
            "parse_profile"]

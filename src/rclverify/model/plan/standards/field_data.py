@@ -1,0 +1,125 @@
+"""The statistical targets in a ``field-data`` or ``trials`` clause's scope (docs/standards.md, "Scope").
+
+A target is an evidence row that decided a stated target over counted runs
+(docs/statistics.md: ``statistics.decision``), or a requirement's target
+decided over its runs.  A clause about ``field-data`` takes run sets of the
+``monitors`` backend whose plan entry *states* ``origin: operation`` (a run
+set whose entry names no origin is read as operation by the statistics,
+never as field data here: :func:`unstated_origins`); a ``trials`` clause
+also takes ``simulation`` runs and an experiment's per-trial data.
+
+A target in scope is covered when its decision is ``discharged`` (the
+bound at the stated confidence meets the target) and it counts at least the
+clause's ``min_runs`` independent runs (each run counted once by its
+digest, docs/statistics.md "A run's identity").  Each item's detail shows
+the figures an assessor checks: the runs counted, the violating runs, the
+bound, its confidence, the target, the environment and the origin
+(:func:`figures`).  Pure functions of the report's rows; nothing raises.
+"""
+from __future__ import annotations
+
+from typing import Any, Collection, Iterable, Mapping
+
+#: The JSON object of a scope item (records/standards_rows.py ``ScopeItem``).
+ScopeItem = dict[str, Any]
+
+
+def figures(s: Mapping[str, Any]) -> dict[str, str]:
+    """The figures of a target's ``statistics`` (an evidence row's, or a requirement's runs row): ``n``
+    (runs counted), ``violations``, ``target`` and ``confidence`` (percent), ``bound``, ``environment`` and
+    ``origin``, each as text (``""`` for what it does not hold)."""
+    d = _part(s, "decision")
+    counts = _part(s, "counts")
+    target = _part(d, "target")
+    n = d.get("n", counts.get("runs", ""))
+    k = d.get("k", counts.get("violating_runs", ""))
+    bound = d.get("bound", s.get("bound"))
+    level = d.get("level", s.get("level"))
+    limit = target.get("bound")
+    text = s.get("target") if isinstance(s.get("target"), str) else target.get("text", "")
+
+    def pct(x: Any) -> str:
+        return "" if not isinstance(x, (int, float)) else f"{100 * float(x):.4g} %"
+    return {"n": str(n), "violations": str(k),
+            "target": (pct(limit) if limit is not None else str(text or "")),
+            "confidence": pct(level), "bound": pct(bound), "environment": str(s.get("environment", "")),
+            "origin": str(s.get("origin", ""))}
+
+
+def _part(s: Mapping[str, Any], key: str) -> Mapping[str, Any]:
+    """``s[key]`` when it is an object, else an empty one."""
+    v = s.get(key)
+    return v if isinstance(v, Mapping) else {}
+
+
+def sentence(f: Mapping[str, str]) -> str:
+    """The :func:`figures` of a target in one phrase."""
+    return (f"{f['n']} independent run(s), {f['violations']} violating; bound {f['bound'] or 'none'} at "
+            f"{f['confidence'] or '?'} confidence against the target {f['target'] or 'none stated'}; "
+            f"environment {f['environment'] or 'unstated'}, origin {f['origin'] or 'unstated'}")
+
+
+def _state(status: str, n: Any, min_runs: int, stated: bool, field_data: bool) -> tuple[str, str]:
+    """(state, why not covered) of a target whose decision is ``status`` over ``n`` runs."""
+    if field_data and not stated:
+        return "not counted", ("the plan entry states no origin: a run set counts as field data only when it "
+                               "says origin: operation")
+    if status != "discharged":
+        return status, f"target {status}"
+    if min_runs and (not isinstance(n, int) or n < min_runs):
+        return "not counted", f"{n} independent runs; the clause asks at least {min_runs}"
+    return "covered", ""
+
+
+def unstated_origins(entries: Iterable[Any]) -> frozenset[tuple[str, str]]:
+    """The (node, environment tag) of each ``monitors`` plan entry (model/plan/model.py ``EvidenceEntry``:
+    ``node``, ``backend``, ``config``) that states no ``origin:``; an entry without an ``environment:``
+    is under the tag ``unstated`` (docs/statistics.md)."""
+    from rclverify.model.plan.targets import entry_environment  # deferred: the plan's target reader imports the plan model
+    return frozenset((str(e.node), entry_environment(e.config)) for e in entries
+                     if e.backend == "monitors" and "origin" not in e.config)
+
+
+def target_items(report: Mapping[str, Any], about: str, min_runs: int,
+                 unstated: Collection[tuple[str, str]] = ()) -> list[ScopeItem]:
+    """The targets of ``report`` in the scope of a clause about ``about`` (``field-data`` or ``trials``)
+    that asks ``min_runs`` independent runs (0: no minimum), each with its state and figures (the module
+    docstring); ``unstated``: the (node, environment) of the run sets whose plan entry states no origin
+    (:func:`unstated_origins`)."""
+    field_data = about == "field-data"
+    origins = ("operation",) if field_data else ("operation", "simulation")
+    out: list[ScopeItem] = []
+    envs_unstated = {env for _, env in unstated}
+    for e in report.get("evidence") or ():
+        s = e.get("statistics")
+        if not (isinstance(s, Mapping) and "decision" in s):
+            continue
+        monitors = e.get("backend") == "monitors"
+        if not ((monitors and s.get("origin") in origins) or (not field_data and e.get("backend") == "experiment")):
+            continue
+        f = figures(s)
+        d = _part(s, "decision")
+        node = str(e.get("obligation")).split(".", 1)[0]
+        stated = not monitors or (node, str(s.get("environment", ""))) not in unstated
+        state, why = _state(str(e.get("status")), d.get("n"), min_runs, stated, field_data)
+        out.append(_target(f"target {e.get('obligation')}", state, why, f, str(e.get("obligation"))))
+    for rq in report.get("requirements") or ():
+        for t in rq.get("statistics") or ():
+            if not (t.get("target") and t.get("origin") in origins):
+                continue
+            f = figures(t)
+            counts = _part(t, "counts")
+            stated = t.get("origin") != "operation" or str(t.get("environment", "")) not in envs_unstated
+            state, why = _state(str(t.get("status") or "pending"), counts.get("runs"), min_runs, stated, field_data)
+            out.append(_target(f"target of requirement {rq.get('id')} ({t.get('environment')}, {t.get('origin')})",
+                               state, why, f, f"requirement {rq.get('id')}"))
+    return out
+
+
+def _target(item: str, state: str, why: str, f: Mapping[str, str], evidence: str) -> ScopeItem:
+    ok = state == "covered"
+    return {"item": item, "kind": "target", "covered": ok, "state": state,
+            "detail": sentence(f) if ok else f"{why}: {sentence(f)}", "evidence": [evidence] if ok else []}
+
+
+__all__ = ["figures", "sentence", "target_items", "unstated_origins"]
