@@ -28,6 +28,7 @@ import z3
 
 from rclverify import __version__
 from rclverify.model.plan.load import all_requirements
+from rclverify.model.plan.standards.field_data import unstated_origins
 from rclverify.model.system.model import cycles_kept
 from rclverify.records.records import Obligation, worst
 from rclverify.records.report_schema import Report
@@ -180,7 +181,8 @@ def undiagnosed_report(ws: Workspace) -> dict[str, Any]:
     confidence = confidence_part(report, [(l.from_node, l.to_node) for l in ws.model.links],
                                  {r.id: r.strength for r in all_requirements(plan) if r.strength})
     report = assemble.with_confidence(report, confidence)
-    standards = standards_part(plan.standards, report)  # docs/standards.md
+    standards = standards_part(plan.standards, report,  # docs/standards.md
+                               unstated_origins(e for es in plan.evidence.values() for e in es))
     report = assemble.with_standards(report, standards)
     # one severity per finding: --strict fails on every error and warning, health and lint warnings included
     return assemble.with_strict(report, bool(report["meta"]["strict_ok"]) and confidence["ok"]
