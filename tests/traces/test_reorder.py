@@ -65,12 +65,18 @@ def test_released_in_event_time_order_up_to_the_watermark() -> None:
     assert [r.item for r in buf.release(2.0)] == ["question", "answer", "b"]
     assert len(buf) == 1 and buf.late == 0
     assert [r.item for r in buf.release(3.0, strict=True)] == []  # before the watermark only
-    buf.push(2.5, 2.6, "late")  # stamped before the latest released: late by 0.5 s once released after "c"
+    buf.push(2.5, 2.6, "late")  # pushed after the watermark (3.0) passed its stamp: late by 0.5 s
     got = list(buf.drain())
-    assert [(r.item, r.late) for r in got] == [("late", 0.0), ("c", 0.0)]  # still held: put in its place
-    buf.push(1.5, 3.5, "too late")
+    assert [(r.item, r.late) for r in got] == [("late", 0.5), ("c", 0.0)]  # still put before "c"
+    buf.push(1.5, 3.5, "too late")  # stamped before the latest released
     assert [(r.item, r.late) for r in buf.drain()] == [("too late", 1.5)]
-    assert buf.late == 1 and buf.max_late_s == 1.5 and buf.last == 3.0 and buf.head() == float("inf")
+    assert buf.late == 2 and buf.max_late_s == 1.5 and buf.last == 3.0 and buf.head() == float("inf")
+    # the control: without a watermark (released with none reached), nothing pushed in its place is late
+    plain: ReorderBuffer[str] = ReorderBuffer()
+    plain.push(2.0, 2.0, "x")
+    assert [r.late for r in plain.release(float("inf"))] == [0.0]
+    plain.push(2.5, 2.5, "y")
+    assert [r.late for r in plain.release(float("inf"))] == [0.0] and plain.late == 0
 
 
 def test_a_watermark_on_the_source_time() -> None:

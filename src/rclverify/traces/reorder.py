@@ -9,8 +9,8 @@ its time on the run's clock (``stamp``, s: its header stamp, else its event
 time, :mod:`.event_time`) and its source time (``source``, s); it is
 released once the caller's watermark reaches it, in the order of
 :func:`.event_time.order_key` (stamp, then source time, then the order
-heard).  A message released after one stamped later is **late**: the
-buffer counts it (``late``) and keeps the largest lateness (``max_late_s``,
+heard).  A message stamped before the watermark a release already
+reached, or before one already released, is **late**: the buffer counts it (``late``) and keeps the largest lateness (``max_late_s``,
 s), and says so with each release, so that each path treats a late
 message by one rule.
 
@@ -47,15 +47,19 @@ class Released(NamedTuple, Generic[T]):
 class ReorderBuffer(Generic[T]):
     """Messages ordered by :func:`~.event_time.order_key`, released up to a
     watermark (module docstring).  ``last``: the latest stamp released
-    (s, ``-inf`` before any); ``late``: how many were released after a
-    later-stamped one; ``max_late_s``: the largest such lateness (s)."""
+    (s, ``-inf`` before any); ``passed``: the latest finite watermark a
+    release reached (s); ``late``: how many were released stamped before
+    either (pushed after the watermark passed them, or after a
+    later-stamped one was released); ``max_late_s``: the largest such
+    lateness (s)."""
 
-    __slots__ = ("_heap", "_seq", "last", "late", "max_late_s")
+    __slots__ = ("_heap", "_seq", "last", "passed", "late", "max_late_s")
 
     def __init__(self) -> None:
         self._heap: list[tuple[float, float, int, T]] = []
         self._seq = itertools.count()
         self.last = -math.inf
+        self.passed = -math.inf
         self.late = 0
         self.max_late_s = 0.0
 
@@ -78,9 +82,15 @@ class ReorderBuffer(Generic[T]):
     def release(self, upto: float, strict: bool = False) -> Iterator[Released[T]]:
         """The held messages stamped at or before ``upto`` (s; before it when
         ``strict``), in order, each removed as it is given."""
-        if strict:
-            return self.release_while(lambda s, _src, _item: s < upto)
-        return self.release_while(lambda s, _src, _item: s <= upto)
+        got = self.release_while((lambda s, _src, _item: s < upto) if strict else (lambda s, _src, _item: s <= upto))
+        if math.isfinite(upto):
+            return self._then_passed(got, upto)
+        return got
+
+    def _then_passed(self, got: Iterator[Released[T]], upto: float) -> Iterator[Released[T]]:
+        yield from got
+        if upto > self.passed:
+            self.passed = upto  # a message stamped before it, pushed after this release, is late
 
     def release_while(self, due: Callable[[float, float, T], bool]) -> Iterator[Released[T]]:
         """The held messages, in order, while ``due(stamp, source, item)`` of
@@ -90,8 +100,9 @@ class ReorderBuffer(Generic[T]):
         while heap and due(heap[0][0], heap[0][1], heap[0][3]):
             stamp, source, _, item = heapq.heappop(heap)
             late = 0.0
-            if stamp < self.last:
-                late = self.last - stamp
+            passed = self.last if self.last > self.passed else self.passed
+            if stamp < passed:
+                late = passed - stamp
                 self.late += 1
                 if late > self.max_late_s:
                     self.max_late_s = late

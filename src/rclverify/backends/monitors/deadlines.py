@@ -227,17 +227,27 @@ class DeadlineMonitor:
         self.now = float("-inf")
         self.now_ns: int | None = None
         self.result = DeadlineResult(node.name)
+        #: the ``false`` verdicts given, in order, by (trigger where, guarantee): the first still standing is
+        #: the result's first (a false withdrawn by an answer stamped in time, :meth:`_met_late`)
+        self._falses: dict[tuple[str, int], DeadlineVerdict] = {}
+        self._last_false: DeadlineVerdict | None = None
 
     def _emit(self, v: DeadlineVerdict) -> None:
         if v.update:  # the answer of an expired obligation: shown, not counted again
             if self.result.first_false is not None and self.result.first_false.trigger_where == v.trigger_where:
                 self.result.first_false = v
+            if (v.trigger_where, v.guarantee) in self._falses:
+                self._falses[(v.trigger_where, v.guarantee)] = v
             if self.on_verdict is not None:
                 self.on_verdict(v)
             return
         self.result.counts[v.verdict] += 1
-        if v.verdict == "false" and self.result.first_false is None:
-            self.result.first_false = v
+        if v.verdict == "false":
+            self._last_false = v
+            if len(self._falses) < 1024:  # bounded; past it the latest false stands in (_met_late)
+                self._falses[(v.trigger_where, v.guarantee)] = v
+            if self.result.first_false is None:
+                self.result.first_false = v
         if self.on_verdict is not None:
             self.on_verdict(v)
 
@@ -320,6 +330,9 @@ class DeadlineMonitor:
         for p in list(self.expired):
             if self._answers(p, ns, outs):
                 self.expired.remove(p)
+                if ns <= p.due_ns:  # stamped within the deadline, heard after the clock passed it
+                    self._met_late(p, ev, ns)
+                    continue
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
                                            ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
                                            f"{_ms_ns(ns - p.due_ns)} past the deadline of "
@@ -328,6 +341,33 @@ class DeadlineMonitor:
                 self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp, was_unanswered=True)
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
         self.heard.append((ns, ev, outs, {c: self.values[c] for c in outs if c not in self.state_outs}))
+
+    def _met_late(self, p: _Pending, ev: Event, ns: int) -> None:
+        """Obligation ``p`` was judged ``false`` when the clock passed its deadline;
+        output ``ev``, stamped ``ns`` (within it), answers it, heard after the
+        clock passed (a message later than the lateness bound, or a stamp the
+        node copied from its question): the deadline is met, on the answer's
+        own stamp, as a run read in stamp order finds it (docs/semantics.md,
+        "Event time": lateness never makes a violation).  The ``false`` given
+        is withdrawn from the counts; the verdict that follows says why."""
+        counts = self.result.counts
+        counts["false"] -= 1
+        counts["true"] += 1
+        key = (p.trigger.where, p.k)
+        self._falses.pop(key, None)
+        first = self.result.first_false
+        if first is not None and (first.trigger_where, first.guarantee) == key:
+            self.result.first_false = next(iter(self._falses.values()), None) or (
+                self._last_false if counts["false"] else None)
+        late = _ms_ns(self.now_ns - ns) if self.now_ns is not None else "?"
+        v = DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
+                            f"answered after {_ms_ns(ns - p.stamp_ns)} (deadline {_ms_ns(p.due_ns - p.stamp_ns)}), "
+                            f"heard after the clock had passed the deadline (at {late} behind it): met on the "
+                            "answer's own stamp; the false given when the clock passed is withdrawn",
+                            update=True, time_margin=(p.due_ns - ns) / 1e9)
+        if self.on_verdict is not None:
+            self.on_verdict(v)
+        self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True)
 
     def _try(self, p: _Pending, ev: Event, ns: int, outs: set[str]) -> bool:
         """Whether output ``ev`` (stamp ``ns``, setting ``outs``) answers obligation ``p``:

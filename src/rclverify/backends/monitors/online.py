@@ -11,10 +11,12 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   wait in a reorder buffer until the watermark (the clock less
   ``reorder_window`` seconds, the lateness bound) passes them and are
   released to the monitors in stamp order (equal stamps by event time, then
-  in arrival order).  A message older than the last one
-  released arrives too late to be ordered: it is still checked (at the
-  current clock, never dropped silently) and counted in ``late`` (the
-  largest lag in ``max_late_s``); its own stamp decides what it answers, and
+  in arrival order), all held in the one reorder buffer
+  (:mod:`rclverify.traces.reorder`).  A message stamped before the
+  watermark already reached (or before one already released) arrives too
+  late to be ordered: it is still checked (at the current clock, never
+  dropped silently) and counted in ``late`` (the largest lag in
+  ``max_late_s``); its own stamp decides what it answers, and
   an input put at its stamp revises what was judged without it, as offline
   (``late.py``, docs/semantics.md "Answers");
 * **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
