@@ -182,7 +182,8 @@ def test_launch_fanout_deep_args_yaml_bomb_and_many_depends_are_bounded(tmp_path
     assert any(f == "p/launch/deep.launch" and "expands beyond 65536 characters" in m for f, m in notes)
     assert any(f == "p/launch/bomb.launch.yaml" and "refused" in m for f, m in notes)
     assert any(f == "q/package.xml" and "5000 dependency elements" in m for f, m in notes)
-    assert {n["name"] for n in graph["nodes"]} == {f"/n{i}" for i in range(20)}
+    # deep.launch's node is kept without the name that expands too far (named by its executable)
+    assert {n["name"] for n in graph["nodes"]} == {f"/n{i}" for i in range(20)} | {"/x"}
 
 
 @pytest.mark.skipif(sys.platform == "darwin", reason="needs a filesystem that takes any bytes in names")

@@ -38,6 +38,7 @@ from typing import Any, Callable
 
 from rclverify.ros.extract import safefs
 from rclverify.ros.extract import names
+from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
 from rclverify.ros.extract.model import Note, Src
 from rclverify.ros.extract.xmlsrc import line_of, parse_xml
 
@@ -79,6 +80,11 @@ class _Scope:
 
 #: the attribute a reader sets on an element whose condition it could not read (value: where)
 UNREAD = "condition-unread"
+#: what joins the tokens of a node's ``ros_args`` attribute when a reader gives them one by one
+SEP = "\x1f"
+#: tags read as another: ROS 2's ``lifecycle_node`` is a node, ``set_remap`` a remap in its scope,
+#: ``push_ros_namespace`` (the YAML and later XML spelling) is ``push-ros-namespace``
+ALIASES = {"lifecycle_node": "node", "set_remap": "remap", "push_ros_namespace": "push-ros-namespace"}
 
 
 class Unresolved(Exception):
@@ -168,8 +174,8 @@ class Interpreter:
         pkg, plugin = self._attr(el, "pkg", scope, path), self._attr(el, "plugin", scope, path)
         if not pkg or not plugin:
             raise Unresolved("composable_node needs 'pkg' and 'plugin'")
-        name = self._attr(el, "name", scope, path)
-        ns = self._attr(el, "namespace", scope, path) or self._attr(el, "ns", scope, path)
+        name = self._soft(el, "name", scope, path)
+        ns = self._soft(el, "namespace", scope, path) or self._soft(el, "ns", scope, path)
         node_ns = names.join(scope.ns, ns) if ns else scope.ns
         remaps, params = self._node_children(el, scope, path, node_ns, name)
         self.nodes.append(LaunchNode(pkg, "", name, node_ns, remaps, el.src, plugin, params,
@@ -223,6 +229,37 @@ class Interpreter:
         v = el.attrs.get(key)
         return default if v is None else self.sub(v, scope, path)
 
+    def _soft(self, el: El, key: str, scope: _Scope, path: Path) -> str | None:
+        """Attribute ``key`` of a node the node can do without (its name,
+        namespace): one that cannot be resolved is dropped, said with a located
+        note; the node is kept."""
+        try:
+            return self._attr(el, key, scope, path)
+        except Unresolved as exc:
+            self.notes.append(Note(el.src, f"<{el.tag}>: {key}: {exc}; the node is kept without it", "ROS-LAUNCH"))
+            return None
+
+    def _ros_args(self, el: El, scope: _Scope, path: Path, name: str | None) -> RosArgs:
+        """A ROS 2 node's ROS arguments (``ros_args``, and ``args`` after
+        ``--ros-args``; :mod:`launch_rosargs`); what cannot be resolved or read
+        leaves them out, said with a located note."""
+        toks: list[str] = []
+        for key in ("ros_args", "args"):
+            raw = el.attrs.get(key)
+            if raw is None or (key == "args" and "--ros-args" not in raw):
+                continue
+            try:
+                got = [self.sub(t, scope, path) for t in (raw.split(SEP) if SEP in raw else raw.split())]
+            except Unresolved as exc:
+                self.notes.append(Note(el.src, f"<{el.tag}>: {key}: {exc}; its ROS arguments (remaps) are left "
+                                               f"out", "ROS-LAUNCH"))
+                continue
+            toks += got if key == "ros_args" else after_ros_args(got)
+        out = parse_ros_args(toks, name)
+        for p in out.problems:
+            self.notes.append(Note(el.src, f"<{el.tag}>: ROS argument {p}; left out", "ROS-LAUNCH"))
+        return out
+
     def _cond(self, el: El, scope: _Scope, path: Path) -> bool:
         """Whether ``el``'s ``if`` / ``unless`` hold; a condition that cannot be
         evaluated statically is taken to hold (the element is read), said with a
@@ -268,7 +305,7 @@ class Interpreter:
                 scope.unsure = outer
 
     def _element(self, el: El, scope: _Scope, path: Path) -> None:
-        t = el.tag
+        t = ALIASES.get(el.tag, el.tag)
         if t in ("arg", "let"):
             name = self._attr(el, "name", scope, path)
             if not name:
@@ -313,10 +350,14 @@ class Interpreter:
             exe = self._attr(el, "type", scope, path) or self._attr(el, "exec", scope, path)
             if not pkg or not exe:
                 raise Unresolved("node needs 'pkg' and 'type'/'exec'")
-            name = self._attr(el, "name", scope, path)
-            ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
+            name = self._soft(el, "name", scope, path)
+            ns = self._soft(el, "ns", scope, path) or self._soft(el, "namespace", scope, path)
+            given = self._ros_args(el, scope, path, name)
+            name, ns = given.name or name, given.ns or ns
             node_ns = names.join(scope.ns, ns) if ns else scope.ns
             remaps, params = self._node_children(el, scope, path, node_ns, name)
+            remaps += [(frm, to, el.src) for frm, to in given.remaps]
+            params.update({"~" + k.lstrip("~/"): (v, el.src) for k, v in given.params.items()})
             self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params,
                                          self._attr(el, "args", scope, path) if pkg == "nodelet" else None,
                                          scope.unsure))
@@ -416,7 +457,9 @@ def read_xml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
 def _yaml_el(tag: str, body: Any, shown: str, line: int) -> El:
     attrs: dict[str, str] = {}
     kids: list[El] = []
-    if isinstance(body, dict):
+    if isinstance(body, list):  # - group: [ {push_ros_namespace: ...}, {node: ...} ] (the form in ROS 2's examples)
+        kids.extend(_yaml_list(body, shown, line))
+    elif isinstance(body, dict):
         for k, v in body.items():
             if k in ("remap", "arg", "param", "composable_node") and isinstance(v, list):
                 for item in v:

@@ -38,108 +38,30 @@ from pathlib import Path
 
 from rclverify.ros.extract import safefs
 from rclverify.ros.extract.launch import UNREAD, El
+from rclverify.ros.extract.launch_py_values import ENV as _ENV, HERE as _HERE, TWICE as _TWICE
+from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg, callee as _callee
+from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, value as _value
+from rclverify.ros.extract.launch_py_node import node_kids as _node_kids, ros_args as _ros_args
 from rclverify.ros.extract.model import Note, Src
 
-
-class _Unres(Exception):
-    pass
-
-
-def _callee(c: ast.Call) -> str:
-    f = c.func
-    return f.attr if isinstance(f, ast.Attribute) else (f.id if isinstance(f, ast.Name) else "")
-
-
-#: the variables ``generate_launch_description()`` (or the module) binds once, while one file is read
-_ENV: dict[str, ast.expr] = {}
-#: the variables it assigns more than once (chosen at run time): name -> lines
-_TWICE: dict[str, list[int]] = {}
-_HERE = [""]  # the launch file's name
-MAX_DEPTH = 16  # names followed through names
-
-
-def _expand(e: ast.expr, depth: int = 0) -> ast.expr:
-    """``e`` with each name bound once replaced by its bound expression and
-    ``a + b`` of two lists or tuples folded into one list; anything else is
-    returned as written (the caller says what it cannot read)."""
-    if depth > MAX_DEPTH:
-        return e
-    if isinstance(e, ast.Name) and e.id in _ENV:
-        return _expand(_ENV[e.id], depth + 1)
-    if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Add):
-        a, b = _expand(e.left, depth + 1), _expand(e.right, depth + 1)
-        if isinstance(a, (ast.List, ast.Tuple)) and isinstance(b, (ast.List, ast.Tuple)):
-            return ast.copy_location(ast.List(elts=[*a.elts, *b.elts], ctx=ast.Load()), e)
-        return e
-    if isinstance(e, (ast.List, ast.Tuple)):
-        elts = [_expand(x, depth + 1) for x in e.elts]
-        return ast.copy_location(ast.List(elts=elts, ctx=ast.Load()) if isinstance(e, ast.List)
-                                 else ast.Tuple(elts=elts, ctx=ast.Load()), e)
-    if isinstance(e, ast.Dict):
-        return ast.copy_location(ast.Dict(keys=[k if k is None else _expand(k, depth + 1) for k in e.keys],
-                                          values=[_expand(v, depth + 1) for v in e.values]), e)
-    return e
-
-
-def _unbound(e: ast.Name) -> _Unres:
-    if e.id in _TWICE:
-        return _Unres(f"variable '{e.id}' (assigned {len(_TWICE[e.id])} times, lines "
-                      f"{', '.join(map(str, _TWICE[e.id]))}: chosen at run time)")
-    return _Unres(f"variable '{e.id}' (not assigned in generate_launch_description())")
-
-
-def _value(e: ast.AST, depth: int = 0) -> str:
-    if isinstance(e, ast.Constant) and isinstance(e.value, (str, int, float, bool)):
-        return str(e.value).lower() if isinstance(e.value, bool) else str(e.value)
-    if isinstance(e, ast.Name) and e.id in _ENV and depth < MAX_DEPTH:
-        return _value(_ENV[e.id], depth + 1)
-    if isinstance(e, ast.Name):
-        raise _unbound(e)
-    if isinstance(e, ast.Call):
-        name = _callee(e)
-        if name == "LaunchConfiguration" and len(e.args) == 1:
-            var = _value(e.args[0], depth + 1)
-            d = _kw(e, "default")
-            return f"$(var-default {var} {_value(d, depth + 1)})" if d is not None else f"$(var {var})"
-        if name in ("ThisLaunchFileDir", "ThisLaunchFile") and not e.args:
-            return "$(dirname)" if name == "ThisLaunchFileDir" else "$(dirname)/" + _HERE[0]
-        if name == "PythonExpression" and len(e.args) == 1:
-            return f"$(eval {_value(e.args[0], depth + 1)})"
-        if name in ("EqualsSubstitution", "NotEqualsSubstitution") and len(e.args) == 2:
-            a, b = (_value(x, depth + 1) for x in e.args)
-            if "'" in a + b or "\\" in a + b:
-                raise _Unres(f"'{ast.unparse(e)}' (a quote in a compared value)")
-            return f"$(eval '{a}' {'==' if name == 'EqualsSubstitution' else '!='} '{b}')"
-        args = [_value(a, depth + 1) for a in e.args]
-        if name in ("get_package_share_directory", "FindPackageShare") and len(args) == 1:
-            return f"$(find-pkg-share {args[0]})"
-        if name == "join" and args:
-            return "/".join(a.rstrip("/") for a in args)
-        if name == "PathJoinSubstitution" and len(e.args) == 1:
-            parts = _expand(e.args[0])
-            if isinstance(parts, (ast.List, ast.Tuple)):
-                return "/".join(_value(a, depth + 1).rstrip("/") for a in parts.elts)
-        if name in ("PythonLaunchDescriptionSource", "XMLLaunchDescriptionSource", "YAMLLaunchDescriptionSource",
-                    "AnyLaunchDescriptionSource", "FrontendLaunchDescriptionSource") and len(args) == 1:
-            return args[0]
-    if isinstance(e, ast.BinOp) and isinstance(e.op, ast.Add):
-        x = _expand(e)
-        if x is not e:
-            return _value(x, depth + 1)
-        return _value(e.left, depth + 1) + _value(e.right, depth + 1)  # str + str, a substitution + str
-    if isinstance(e, (ast.List, ast.Tuple)) and all(isinstance(x, (ast.Constant, ast.Name, ast.Call, ast.BinOp))
-                                                    for x in e.elts):
-        return "".join(_value(x, depth + 1) for x in e.elts)  # a list of substitutions concatenates
-    if isinstance(e, ast.JoinedStr):
-        raise _Unres("an f-string")
-    raise _Unres(f"'{ast.unparse(e)}' (not a literal or a known substitution)")
-
-
-def _kw(c: ast.Call, name: str) -> ast.expr | None:
-    return next((k.value for k in c.keywords if k.arg == name), None)
+#: actions that start no node and set nothing the graph reads (passed over without a note)
+QUIET = frozenset({"LogInfo", "SetEnvironmentVariable", "UnsetEnvironmentVariable", "AppendEnvironmentVariable",
+                   "PrependEnvironmentVariable", "ResetEnvironment", "SetParameter", "SetParametersFromFile",
+                   "SetUseSimTime", "SetROSLogDir", "Shutdown", "EmitEvent", "ResetLaunchConfigurations",
+                   "PopLaunchConfigurations", "PushLaunchConfigurations", "PopEnvironment", "PushEnvironment",
+                   "SetLaunchConfigurationIfUnset"})
+#: event handlers and the keyword holding the actions each starts
+HANDLERS = {"OnProcessExit": "on_exit", "OnProcessStart": "on_start", "OnExecutionComplete": "on_completion",
+            "OnProcessIO": "on_stdout", "OnStateTransition": "entities"}
+MAX_CALLS = 8  # functions of the launch file evaluated inside one another
+_FUNCS: dict[str, ast.FunctionDef] = {}  # the launch file's module-level functions, while it is read
+_CALLING: list[str] = []  # the functions being evaluated (a recursion stops)
 
 
 def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
+    """The actions of list (or single action) ``e``: each call read by
+    :func:`_action`; what is no call of a known action is named in a located
+    note (every miss said)."""
     out: list[El] = []
     if isinstance(e, ast.expr):
         e = _expand(e)
@@ -149,7 +71,15 @@ def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
             el = _action(x, shown, notes)
             if el is not None:
                 out.append(el)
-        elif isinstance(x, ast.Starred) or isinstance(x, ast.Name):
+        elif isinstance(x, ast.ListComp):
+            from rclverify.ros.extract.launch_py_values import unroll  # the reason it did not unroll
+            try:
+                unroll(x)
+            except _Unres as exc:
+                notes.append(Note(Src(shown, x.lineno, x.col_offset + 1), f"launch actions built by a list "
+                                  f"comprehension over {exc} cannot be read statically; the nodes it starts are "
+                                  f"unknown", "ROS-LAUNCH"))
+        elif isinstance(x, (ast.Starred, ast.Name, ast.Subscript, ast.IfExp, ast.BinOp)):
             notes.append(Note(Src(shown, x.lineno, x.col_offset + 1),
                               f"launch action '{ast.unparse(x)}' is not a literal call: not resolved statically",
                               "ROS-LAUNCH"))
@@ -211,10 +141,11 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
     name = _callee(c)
     try:
         attrs: dict[str, str] = {}
-        if name == "Node":
+        if name in ("Node", "LifecycleNode"):
             _required(c, attrs, (("package", "pkg"), ("executable", "exec"), ("node_executable", "exec")))
             _optional(c, attrs, (("name", "name"), ("namespace", "namespace"), ("node_name", "name"),
                                  ("node_namespace", "namespace")), shown, notes)
+            _ros_args(c, attrs, shown, notes)
             _condition(c, attrs, shown, notes)
             return El("node", attrs, _node_kids(c, shown, notes), src)
         if name == "ComposableNode":
@@ -246,7 +177,12 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
             if n is not None:
                 attrs["name"] = _value(n)
             if default is not None:
-                attrs["default"] = _value(default)
+                try:
+                    attrs["default"] = _value(default)
+                except _Unres as exc:
+                    notes.append(Note(Src(shown, default.lineno, default.col_offset + 1), f"{name}(...): "
+                                      f"default_value {exc} cannot be read statically; the argument has no value "
+                                      f"unless one is given", "ROS-LAUNCH"))
             _condition(c, attrs, shown, notes)
             return El("arg", attrs, [], src)
         if name in ("PushRosNamespace", "PushROSNamespace"):
@@ -282,62 +218,121 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
             attrs["file"] = _value(s)
             _condition(c, attrs, shown, notes)
             return El("include", attrs, kids, src)
+        return _more(c, name, attrs, src, shown, notes)
     except _Unres as exc:
         notes.append(Note(src, f"{name}(...): {exc} cannot be read statically; action skipped", "ROS-LAUNCH"))
     return None
 
 
-def _node_kids(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
-    """``remappings=[(a, b)]`` and ``parameters=[{name: value}]`` of a ``Node`` or
-    ``ComposableNode`` as ``remap`` and ``param`` elements, through names bound
-    once and list concatenation (:func:`_expand`); a parameter file (a path in
-    ``parameters``), an unreadable pair or value is left out with a located
-    note.  A parameter whose value is a list of literals (a string array) is
-    no name and is not kept."""
-    kids = []
-    rm = _kw(c, "remappings")
-    if rm is not None:
-        rm = _expand(rm)
-        if not isinstance(rm, (ast.List, ast.Tuple)):
-            notes.append(Note(Src(shown, rm.lineno, rm.col_offset + 1), f"{_callee(c)}(...): remappings "
-                              f"'{ast.unparse(rm)}' cannot be read statically; the node is read without them",
-                              "ROS-LAUNCH"))
-        else:
-            for pair in rm.elts:
-                at = Src(shown, pair.lineno, pair.col_offset + 1)
-                try:
-                    if not isinstance(pair, (ast.Tuple, ast.List)) or len(pair.elts) != 2:
-                        raise _Unres(f"'{ast.unparse(pair)}' (not a pair)")
-                    kids.append(El("remap", {"from": _value(pair.elts[0]), "to": _value(pair.elts[1])}, [], at))
-                except _Unres as exc:
-                    notes.append(Note(at, f"{_callee(c)}(...): remapping {exc} cannot be read statically; "
-                                          f"remapping left out", "ROS-LAUNCH"))
-    ps = _kw(c, "parameters")
-    ps = _expand(ps) if ps is not None else None
-    if isinstance(ps, (ast.List, ast.Tuple)):
-        for item in ps.elts:
-            at = Src(shown, item.lineno, item.col_offset + 1)
-            if not isinstance(item, ast.Dict):
-                notes.append(Note(at, f"parameters '{ast.unparse(item)}' are not a literal dict (a parameter "
-                                      f"file is not read): not resolved statically", "ROS-LAUNCH"))
-                continue
-            for k, v in zip(item.keys, item.values):
-                if k is None:
-                    continue
-                if isinstance(v, (ast.List, ast.Tuple)) and v.elts and all(isinstance(x, ast.Constant)
-                                                                             for x in v.elts):
-                    continue  # a string (or number) array: a list value, never a name
-                try:
-                    kids.append(El("param", {"name": _value(k), "value": _value(v)}, [],
-                                   Src(shown, v.lineno, v.col_offset + 1)))
-                except _Unres as exc:
-                    notes.append(Note(at, f"parameter value {exc} is not a literal: not resolved statically",
-                                      "ROS-LAUNCH"))
-    elif ps is not None:
-        notes.append(Note(Src(shown, ps.lineno, ps.col_offset + 1), f"parameters '{ast.unparse(ps)}' are not a "
-                                                                    f"literal list: not resolved statically",
-                          "ROS-LAUNCH"))
-    return kids
+def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, notes: list[Note]) -> El | None:
+    """The actions other than nodes, arguments, groups and includes: remaps and
+    configurations set in a scope, timers and event handlers (their actions
+    started), ``OpaqueFunction`` and the launch file's own functions
+    (evaluated, :func:`_function_actions`); any other call is named in a
+    located note."""
+    if name == "SetRemap":
+        frm, to = _arg(c, 0, "src"), _arg(c, 1, "dst")
+        if frm is None or to is None:
+            raise _Unres("a remap without src and dst")
+        attrs.update({"from": _value(frm), "to": _value(to)})
+        _condition(c, attrs, shown, notes)
+        return El("remap", attrs, [], src)
+    if name == "SetLaunchConfiguration":
+        n, v = _arg(c, 0, "name"), _arg(c, 1, "value")
+        if n is None or v is None:
+            raise _Unres("a configuration without name and value")
+        attrs.update({"name": _value(n), "value": _value(v)})
+        _condition(c, attrs, shown, notes)
+        return El("let", attrs, [], src)
+    acts: ast.expr | None = None
+    if name in ("TimerAction", "RosTimer"):
+        acts = _arg(c, 1, "actions")
+    elif name == "RegisterEventHandler":
+        h = _arg(c, 0, "event_handler")
+        h = _expand(h) if h is not None else None
+        kind = _callee(h) if isinstance(h, ast.Call) else ""
+        acts = _arg(h, 1, HANDLERS[kind]) if isinstance(h, ast.Call) and kind in HANDLERS else None
+        if acts is None:
+            raise _Unres(f"event handler '{ast.unparse(h) if h is not None else ''}' (not one of "
+                         f"{', '.join(sorted(HANDLERS))} with its actions)")
+        if isinstance(_expand(acts), ast.Lambda):
+            raise _Unres(f"the actions of {kind}, a function run at the event,")
+    elif name == "OpaqueFunction" or name in _FUNCS:
+        fn = _arg(c, 0, "function") if name == "OpaqueFunction" else c.func
+        got = _function_actions(fn, c, name == "OpaqueFunction", shown, notes)
+        if isinstance(got, str):
+            what = f"OpaqueFunction {ast.unparse(fn) if fn is not None else '?'}" if name == "OpaqueFunction" \
+                else f"function {name}()"
+            notes.append(Note(src, f"{what} not evaluated: {got}; the nodes it starts are unknown", "ROS-LAUNCH"))
+            return None
+        _condition(c, attrs, shown, notes)
+        return El("group", {**attrs, "scoped": "false"}, got, src)
+    elif name in QUIET:
+        return None
+    else:
+        notes.append(Note(src, f"launch action {name or ast.unparse(c.func)}(...) is not one the scan reads: the "
+                               f"nodes it starts, if any, are unknown", "ROS-LAUNCH"))
+        return None
+    _condition(c, attrs, shown, notes)
+    return El("group", {**attrs, "scoped": "false"}, _actions(acts, shown, notes) if acts is not None else [], src)
+
+
+def _function_actions(fn: ast.expr | None, call: ast.Call, opaque: bool, shown: str,
+                      notes: list[Note]) -> list[El] | str:
+    """The actions a function of the launch file returns, its parameters bound
+    to the call's arguments (``OpaqueFunction(function=f, args=[...],
+    kwargs={...})`` calls ``f(context, *args, **kwargs)``) and its own names
+    bound once read as in ``generate_launch_description()``; a function with
+    other than one ``return``, or returning what is not a list of actions,
+    gives why as a string."""
+    if not isinstance(fn, ast.Name) or fn.id not in _FUNCS:
+        return f"'{ast.unparse(fn) if fn is not None else ''}' is not a function defined in the launch file"
+    f = _FUNCS[fn.id]
+    if fn.id in _CALLING or len(_CALLING) >= MAX_CALLS:
+        return "it is called inside itself"
+    rets = [r.value for r in ast.walk(f) if isinstance(r, ast.Return) and r.value is not None]
+    if len(rets) != 1:
+        return f"it has {len(rets)} return statements (which one runs is chosen at run time)" if rets \
+            else "it returns no actions"
+    params = [a.arg for a in f.args.posonlyargs + f.args.args]
+    given: dict[str, ast.expr] = dict(zip(params[len(params) - len(f.args.defaults):], f.args.defaults))
+    pos: list[ast.expr] = list(call.args) if not opaque else []
+    named = {k.arg: k.value for k in call.keywords if k.arg} if not opaque else {}
+    if opaque:
+        more, kwmore = _kw(call, "args"), _kw(call, "kwargs")
+        more, kwmore = _expand(more) if more is not None else None, _expand(kwmore) if kwmore is not None else None
+        pos = list(more.elts) if isinstance(more, (ast.List, ast.Tuple)) else []
+        if isinstance(kwmore, ast.Dict):
+            named = {k.value: v for k, v in zip(kwmore.keys, kwmore.values)
+                     if isinstance(k, ast.Constant) and isinstance(k.value, str)}
+        params = params[1:]  # the launch context
+    given.update({p: _expand(v) for p, v in zip(params, pos)})
+    given.update({p: _expand(v) for p, v in named.items() if p in params})
+    mine, twice = _once(list(ast.walk(f)))
+    saved, saved_twice = dict(_ENV), dict(_TWICE)
+    _CALLING.append(fn.id)
+    try:
+        for p in params:
+            _ENV.pop(p, None)
+        _ENV.update(given)
+        _ENV.update(mine)
+        for k in twice:
+            _ENV.pop(k, None)
+        for k in mine:
+            _TWICE.pop(k, None)
+        _TWICE.update(twice)
+        ret = _expand(rets[0])
+        if isinstance(ret, ast.Call) and _callee(ret) == "LaunchDescription" and ret.args:
+            ret = _expand(ret.args[0])
+        if not isinstance(ret, (ast.List, ast.Tuple)):
+            return f"it returns '{ast.unparse(rets[0])}', not a list of actions read statically"
+        return _actions(ret, shown, notes)
+    finally:
+        _CALLING.pop()
+        _ENV.clear()
+        _ENV.update(saved)
+        _TWICE.clear()
+        _TWICE.update(saved_twice)
 
 
 def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
@@ -356,6 +351,9 @@ def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
     fn = next((f for f in tree.body if isinstance(f, ast.FunctionDef) and f.name == "generate_launch_description"), None)
     _ENV.clear()
     _TWICE.clear()
+    _FUNCS.clear()
+    _FUNCS.update({f.name: f for f in tree.body if isinstance(f, ast.FunctionDef)
+                   and f.name != "generate_launch_description"})
     _HERE[0] = path.name
     try:
         _bind(tree, fn)
@@ -363,23 +361,7 @@ def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
     finally:
         _ENV.clear()
         _TWICE.clear()
-
-
-def _once(stmts: list[ast.stmt] | list[ast.AST]) -> tuple[dict[str, ast.expr], dict[str, list[int]]]:
-    """Names each simple assignment among ``stmts`` binds: those bound once
-    (name -> expression) and those bound more often (name -> lines)."""
-    seen: dict[str, ast.expr] = {}
-    lines: dict[str, list[int]] = {}
-    for st in stmts:
-        if isinstance(st, (ast.Assign, ast.AnnAssign)):
-            targets = st.targets if isinstance(st, ast.Assign) else [st.target]
-            if len(targets) == 1 and isinstance(targets[0], ast.Name) and st.value is not None:
-                lines.setdefault(targets[0].id, []).append(st.lineno)
-                seen[targets[0].id] = st.value
-        elif isinstance(st, (ast.AugAssign, ast.For)) and isinstance(st.target, ast.Name):
-            lines.setdefault(st.target.id, []).append(st.lineno)  # x += [...], a loop's variable: not one value
-    twice = {k: sorted(v) for k, v in lines.items() if len(v) > 1}
-    return {k: v for k, v in seen.items() if k not in twice}, twice
+        _FUNCS.clear()
 
 
 def _bind(tree: ast.Module, fn: ast.FunctionDef | None) -> None:
