@@ -23,6 +23,8 @@ from rclverify.ros.extract.model import Note, Src
 
 #: the note code of an unaccounted program (``ros check`` lists these)
 CODE = "ROS-PROGRAM"
+#: the note code of ROS 1 code no target builds (accounted for as ``not built``: ros/extract/built.py)
+NOT_BUILT = "ROS-NOT-BUILT"
 
 
 @dataclass

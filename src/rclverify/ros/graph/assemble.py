@@ -22,6 +22,7 @@ import hashlib
 from typing import Any, Callable, Sequence
 
 from rclverify.ros.extract import cross_package, emit, names, nodelets, plugins
+from rclverify.ros.extract.built import Unbuilt, not_built
 from rclverify.ros.extract.executables import Targets
 from rclverify.ros.extract.launch import LaunchNode
 from rclverify.ros.extract.link import Linked, Linker
@@ -44,6 +45,10 @@ class Assembly:
         self.pkgs, self.known, self.kept = pkgs, known, kept
         self.codes = {p: PackageCode(p, show(pkgs[p].root), records.get(p, {}), show) for p in sorted(pkgs)}
         self.progs = {p: programs(self.codes[p], targets[p]) for p in sorted(pkgs)}
+        self.unbuilt: list[Unbuilt] = []  # ROS 1 code no target builds: listed apart, never nodes (built.py)
+        for p in sorted(pkgs):
+            self.progs[p], gone = not_built(pkgs[p], self.progs[p], self.codes[p], targets[p])
+            self.unbuilt += gone
         self.targets = targets
         self._linked: dict[int, Linked] = {}
         # a program's code in the workspace's other packages (helper libraries)

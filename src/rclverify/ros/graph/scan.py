@@ -24,6 +24,7 @@ from typing import Any, Sequence
 from rclverify.ros.extract import names
 from rclverify.ros.extract import namespaces
 from rclverify.ros.graph.absent import absent_interfaces
+from rclverify.ros.graph.accounting import NOT_BUILT, Account
 from rclverify.ros.graph.assemble import Assembly, LinkCache
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.executables import Targets, exported_cmake, targets
@@ -298,8 +299,11 @@ class _Scan:
             self.asm.controller_nodes(self.add_node, self.pfiles.entries, g)  # ros2_control controllers
         g.notes.extend(self.asm.unloaded_plugins())
         accounts = self.asm.ledger.accounts({p: self.tgts[p].declared for p in self.tgts}, bool(launch))
+        accounts += [Account(u.package, "not built", u.name, u.at) for u in self.asm.unbuilt]
         g.programs = [a.to_json() for a in accounts]
         g.notes.extend(a.note() for a in accounts if a.why is not None and a.kind != "launch node")
+        g.notes.extend(Note(u.at, f"{u.kind} {u.name} of package {u.package} is not built: {u.why}; listed apart, "
+                                  f"not a node", NOT_BUILT) for u in self.asm.unbuilt)
 
     def add_node(self, full: str, ns: str, pkg: str | None, exe: str | None, files: list[str], declared: Src,
                  eps: list[Endpoint], remaps: list[tuple[str, str, Src]], origin: str,

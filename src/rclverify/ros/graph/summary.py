@@ -49,6 +49,8 @@ class Cause:
     key: str
     label: str
     test: Callable[[str, str], bool]
+    # what a place of this cause is named by (``OpaqueFunction launch_setup``), shown before it; "" none
+    named: Callable[[str], str] | None = None
 
 
 def _has(*parts: str) -> Callable[[str, str], bool]:
@@ -59,6 +61,10 @@ _NAME = re.compile(r"\b(name|topic name) is '.*', (not a string literal|discover
 
 #: the causes, in the order they are shown: what drops nodes first
 CAUSES: tuple[Cause, ...] = (
+    Cause("launch-unevaluated", "launch actions not evaluated (the nodes they start are unknown)",
+          lambda code, msg: code == "ROS-LAUNCH" and (" not evaluated: " in msg or "the nodes it starts" in msg
+                                                      or "nodes it starts are unknown" in msg),
+          named=lambda msg: msg.split(" not evaluated: ")[0] if " not evaluated: " in msg else ""),
     Cause("nodes-dropped", "launch nodes dropped (not started in the graph)",
           lambda code, msg: code == "ROS-LAUNCH" and ("action skipped" in msg or "element skipped" in msg)
           or "its topics are unknown" in msg or "its endpoints are not in the graph" in msg),
@@ -77,6 +83,8 @@ CAUSES: tuple[Cause, ...] = (
           or "which no scanned package or standard package defines" in msg),
     Cause("types", "types not read (endpoint kept untyped)",
           lambda code, msg: "type of" in msg or code in ("ROS-TYPE", "ROS-TYPE-UNKNOWN")),
+    Cause("not-built", "programs not built (ROS 1 code no target of the ament package builds: listed apart, "
+                       "not nodes)", lambda code, _msg: code == "ROS-NOT-BUILT"),
     Cause("launch-attributes", "launch attributes not read (parameter files, conditions, remappings)",
           lambda code, _msg: code == "ROS-LAUNCH"),
     Cause("parse", "sources read in part (syntax errors recovered, files skipped)",
@@ -109,7 +117,8 @@ def group(notes: Iterable[_NoteLike], package_of: Callable[[str], str | None]) -
             continue
         c = cause_of(n.code, n.message)
         g = groups.setdefault(c.key, Group(c))
-        g.places.append(str(n.src))
+        what = c.named(n.message) if c.named is not None else ""
+        g.places.append(f"{what} at {n.src}" if what else str(n.src))
         pkg = package_of(str(n.src).rsplit(":", 2)[0])
         if pkg is not None:
             g.packages[pkg] = g.packages.get(pkg, 0) + 1
