@@ -24,6 +24,10 @@ keeps every byte offset (same length, newlines kept), so locations stay.
   (after ``;``, ``{``, ``}``, ``:`` or a directive) and followed by no ``;``,
   is blanked; ``RCLCPP_COMPONENTS_REGISTER_NODE(ns::C)`` too, its class
   recorded by the caller;
+* the lines of an ``#if 0`` (also ``#if false``) group up to its ``#else``,
+  ``#elif`` or ``#endif`` (nested groups counted) are blanked: the
+  preprocessor drops them, so nothing in them is built (C++ standard
+  [cpp.cond]); the directives themselves stay;
 * explicit template instantiations (``template class Server<pkg::srv::T>;``,
   ``extern template class ...;``; C++ standard [temp.explicit]), which the
   grammar reads with a missing declarator: they make no object, so nothing
@@ -101,6 +105,32 @@ def _format(m: re.Match[bytes]) -> bytes:
         return m.group(1) + b'"' + b"d" * (len(w) - 2) + b'"'
     w = m.group(3)
     return b'"' + b"d" * (len(w) - 2) + b'"'
+
+
+_IF0 = re.compile(rb"^[ \t]*#[ \t]*if[ \t]+(?:0|false)[ \t]*(?://[^\n]*|/\*[^\n]*)?\r?$", re.M)
+_DIRECTIVE = re.compile(rb"^[ \t]*#[ \t]*(if|ifdef|ifndef|elif|else|endif)\b", re.M)
+
+
+def blank_if0(data: bytes) -> bytes:
+    """``data`` with the lines inside each ``#if 0`` group blanked, up to its
+    ``#else`` / ``#elif`` / ``#endif`` (same length, newlines kept); applied
+    before anything else reads the file (registration macros included)."""
+    if b"#" not in data or not _IF0.search(data):
+        return data
+    out = bytearray(data)
+    for m in _IF0.finditer(data):
+        depth, start, end = 0, m.end(), len(data)
+        for d in _DIRECTIVE.finditer(data, m.end()):
+            word = d.group(1)
+            if word in (b"if", b"ifdef", b"ifndef"):
+                depth += 1
+            elif word == b"endif" and depth:
+                depth -= 1
+            elif not depth:
+                end = d.start()
+                break
+        out[start:end] = _spaces(data[start:end])
+    return bytes(out)
 
 
 def prepare(data: bytes) -> bytes:

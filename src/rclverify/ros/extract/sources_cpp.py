@@ -39,7 +39,7 @@ from rclverify.ros.extract import cpp_helpers, emit, names, symbols, treesitter
 from rclverify.ros.extract.cpp_bases import node_base
 from rclverify.ros.extract.cpp_calls import LIBRARY, CallReader
 from rclverify.ros.extract.cpp_members import MemberReader
-from rclverify.ros.extract.cpp_prep import REGISTER, prepare
+from rclverify.ros.extract.cpp_prep import REGISTER, blank_if0, prepare
 from rclverify.ros.extract.nodelets import registered
 from rclverify.ros.extract.cpp_scope import base_name, namespaces_of
 from rclverify.ros.extract.cpp_values import CppValues
@@ -61,6 +61,7 @@ class _File(CallReader, MemberReader):
         self.out: dict[str, Any] = {"nodes": [], "endpoints": [], "notes": [], "classes": {}, "components": [],
                                     "lang": "cpp", "calls": [], "node_names": [], "member_decls": [],
                                     "member_calls": [], "includes": [], "callbacks": {}}
+        data = blank_if0(data)  # code the preprocessor drops is never read
         for m in REGISTER.finditer(data):
             line = data.count(b"\n", 0, m.start()) + 1
             self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
