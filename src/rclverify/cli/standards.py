@@ -11,21 +11,32 @@ from rclverify.cli.common import AddCommand
 def cmd_standards(args: argparse.Namespace) -> int:
     """Print each mapped standard's counts and the clauses it asks that are not covered (with why) from
     ``reports/assurance.json``, and write the exports asked: ``--csv`` the compliance matrix, ``--trace``
-    the trace matrix (CSV), ``--xlsx`` both as a workbook.  Exit 0; 1 (one located line) when there is
-    no report or it is of another shape, or openpyxl is missing for ``--xlsx``."""
-    from rclverify.report.lastrun import read_report  # deferred: start-up (loads the report's readers only when called)
-    from rclverify.report.standards_export import gaps, matrix_rows, trace_rows, write_csv, write_xlsx  # deferred: start-up (the exports, only when called)
-    report = read_report(Path(args.workspace))
+    the trace matrix (CSV), ``--xlsx`` both as a workbook with a sheet saying what they were read from
+    (each CSV starts with the same header rows).  Exit 0; 1 (one located line) when there is no report,
+    it is of another shape, it is older than the last ``verify`` or than its inputs
+    (:func:`~rclverify.report.standards_export.report_out_of_date`), or openpyxl is missing for
+    ``--xlsx``."""
+    from rclverify.report.lastrun import located, read_report  # deferred: start-up (loads the report's readers only when called)
+    from rclverify.report.standards_export import (REPORT, evidence_digests, export_header, gaps, matrix_rows,  # deferred: start-up (the exports, only when called)
+                                                   report_out_of_date, trace_rows, write_csv, write_xlsx)
+    root = Path(args.workspace)
+    report = read_report(root)
+    why = report_out_of_date(root, report)
+    if why:
+        raise located(root / REPORT, why)
     lines = gaps(report)
     print("\n".join(lines) if lines else "the plan maps no standard (docs/standards.md)")
+    header = export_header(root, report)
+    matrix = matrix_rows(report, evidence_digests(root, report))
     if args.csv:
-        write_csv(Path(args.csv), matrix_rows(report))
+        write_csv(Path(args.csv), matrix, header)
         print(f"compliance matrix: {args.csv}")
     if args.trace:
-        write_csv(Path(args.trace), trace_rows(report))
+        write_csv(Path(args.trace), trace_rows(report), header)
         print(f"trace matrix: {args.trace}")
     if args.xlsx:
-        write_xlsx(Path(args.xlsx), {"compliance matrix": matrix_rows(report), "trace matrix": trace_rows(report)})
+        write_xlsx(Path(args.xlsx), {"about this export": [["what", "value"], *header],
+                                     "compliance matrix": matrix, "trace matrix": trace_rows(report)})
         print(f"workbook: {args.xlsx}")
     return 0
 

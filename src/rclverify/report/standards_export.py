@@ -1,110 +1,118 @@
-"""What an assessor takes away from a report: the compliance matrix and the trace matrix as tables
+"""What an assessor takes away from a report: the compliance matrix and the trace matrix as files
 (CSV, and XLSX through openpyxl, the ``xlsx`` extra), and the standards' gaps in a few lines
 (docs/standards.md, "Exports").
 
-* The compliance matrix (:func:`matrix_rows`): one row per clause of each standard the report maps,
-  with :data:`MATRIX_COLUMNS`, read from the report's ``standards`` rows (report/standards_rows.py).
-* The trace matrix (:func:`trace_rows`): one row per requirement, supporting guarantee, obligation
-  and evidence record (:data:`TRACE_COLUMNS`), then one per obligation of a guarantee no requirement
-  names (its requirement cell empty), from the report's ``requirements``, ``obligations`` and
-  ``evidence``.
+The tables are :mod:`rclverify.report.standards_sheets`' (the compliance matrix, the trace matrix, the
+header saying what they were read from).  Here:
 
-Pure readings of a report dict (``reports/assurance.json``); the writers raise ``OSError`` for a file
-that cannot be written and :class:`~rclverify.core.extras.MissingExtra` when openpyxl is not installed.
+* :func:`report_out_of_date`: why the written report is older than the last ``verify`` or than its
+  inputs (``rclverify standards`` refuses to export it);
+* :func:`export_header` and :func:`evidence_digests`: the header and each evidence record's sha256,
+  read from the workspace's files;
+* :func:`write_csv` and :func:`write_xlsx`: the writers.  A CSV cell a spreadsheet would read as a
+  formula is written with a leading apostrophe (:func:`escape_cell`, OWASP's rule against CSV
+  injection); an XLSX cell is always written as text.
+
+The writers raise ``OSError`` for a file that cannot be written and
+:class:`~rclverify.core.extras.MissingExtra` when openpyxl is not installed.
 """
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify.core.atomic import atomic_write_bytes, atomic_write_text
 from rclverify.report.standards_rows import origin_text
+from rclverify.report.standards_sheets import (MATRIX_COLUMNS, TRACE_COLUMNS, header_rows, matrix_rows,
+                                               trace_rows)
 
-#: The compliance matrix's columns.
-MATRIX_COLUMNS: tuple[str, ...] = (
-    "standard", "level", "profile", "profile origin", "clause", "what it asks", "recommendation", "about",
-    "independence asked", "items in scope", "items covered", "items not covered", "evidence that covers it",
-    "who checked it", "status", "why", "plan's justification", "plan note at")
-#: The trace matrix's columns.
-TRACE_COLUMNS: tuple[str, ...] = (
-    "requirement", "requirement verdict", "node", "guarantee", "guarantee status", "obligation", "backend",
-    "kind", "evidence status", "tool")
+#: The characters a spreadsheet reads as the start of a formula or a command (OWASP, "CSV Injection":
+#: ``=``, ``+``, ``-``, ``@``, tab, carriage return); a cell that starts with one gets a leading ``'``.
+FORMULA_START: tuple[str, ...] = ("=", "+", "-", "@", "\t", "\r")
+#: Where the report is, in the workspace.
+REPORT = "reports/assurance.json"
 
 
-def _origin(o: Mapping[str, Any]) -> str:
-    if o.get("kind") == "built-in":
-        return f"built-in ({o.get('edition')})"
-    return f"workspace file {o.get('file')} sha256 {o.get('sha256')}"
+def escape_cell(value: str) -> str:
+    """``value`` with a leading apostrophe when it starts with one of :data:`FORMULA_START` (a spreadsheet
+    then shows it as text, never runs it); unchanged otherwise."""
+    return "'" + value if value.startswith(FORMULA_START) else value
 
 
-def matrix_rows(report: Mapping[str, Any]) -> list[list[str]]:
-    """The compliance matrix of ``report``: :data:`MATRIX_COLUMNS` then one row per clause, standard by
-    standard in the plan's order, clause by clause in the profile's."""
-    out = [list(MATRIX_COLUMNS)]
-    for s in report.get("standards") or ():
-        level = "" if s.get("level") is None else f"{str(s.get('level_name', '')).upper()} {s['level']}"
-        for c in s.get("clauses") or ():
-            scope = c.get("scope") or []
-            plan = c.get("plan") or {}
-            out.append([
-                str(s.get("edition", "")), level, str(s.get("profile", "")), _origin(s.get("origin") or {}),
-                str(c["id"]), str(c.get("title", "")), str(c.get("recommendation", "")), str(c.get("about", "")),
-                str(c.get("independence", "")), str(len(scope)), str(sum(1 for x in scope if x.get("covered"))),
-                "; ".join(f"{x['item']}: {x.get('detail', x.get('state', ''))}" for x in scope if not x.get("covered")),
-                "; ".join(str(x) for x in c.get("covered_by") or ()), "; ".join(str(x) for x in c.get("checked_by") or ()),
-                str(c.get("status", "")), str(c.get("why", "")), str(plan.get("justification", "")),
-                str(plan.get("at", ""))])
-    return out
+def _digest(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return "missing"
 
 
-def trace_rows(report: Mapping[str, Any]) -> list[list[str]]:
-    """The trace matrix of ``report``: :data:`TRACE_COLUMNS` then requirement -> guarantee -> obligation ->
-    evidence rows (a guarantee without an obligation, or an obligation without a record, is one row with
-    the missing cells empty), then the obligations of guarantees no requirement names."""
-    evidence = {str(e.get("obligation")): e for e in report.get("evidence") or ()}
-    guarantee_status = {(str(n.get("name")), int(g.get("index", 0))): str(g.get("status", ""))
-                        for n in report.get("nodes") or () for g in n.get("guarantees") or ()}
-    obligations: dict[tuple[str, int], list[Mapping[str, Any]]] = {}
-    for o in report.get("obligations") or ():
-        obligations.setdefault((str(o.get("node")), int(o.get("guarantee", 0))), []).append(o)
-    out = [list(TRACE_COLUMNS)]
-    traced: set[tuple[str, int]] = set()
-
-    def rows_of(rid: str, verdict: str, key: tuple[str, int]) -> None:
-        obs = obligations.get(key, []) + ([] if key[1] == 0 else obligations.get((key[0], 0), []))
-        for o in obs or [{}]:
-            e = evidence.get(str(o.get("id")), {}) if o else {}
-            out.append([rid, verdict, key[0], f"g{key[1]}", guarantee_status.get(key, ""), str(o.get("id", "")),
-                        str(o.get("backend", "")), str(o.get("kind", "")), str(e.get("status", "")),
-                        _tool(e)])
-
-    for rq in report.get("requirements") or ():
-        for sp in rq.get("support") or ():
-            key = (str(sp.get("node")), int(sp.get("guarantee", 0)))
-            traced.add(key)
-            rows_of(str(rq.get("id")), str(rq.get("verdict", "")), key)
-    for key in sorted(set(guarantee_status) - traced):
-        rows_of("", "", key)
-    return out
+def _inputs(root: Path, report: Mapping[str, Any]) -> list[str]:
+    """The workspace files the report was built from that can be named without rebuilding it: the plan,
+    its contract files, the workspace's own profile files and the review records."""
+    meta = report.get("meta") or {}
+    files = [str(meta.get("plan", "")), *(str(c) for c in meta.get("contracts") or ())]
+    files += [str((s.get("origin") or {}).get("file")) for s in report.get("standards") or ()
+              if (s.get("origin") or {}).get("kind") == "workspace"]
+    files += [str(e.get("tool_version")) for e in report.get("evidence") or () if e.get("backend") == "review"]
+    return [f for f in dict.fromkeys(files) if f and (root / f).is_file()]
 
 
-def _tool(e: Mapping[str, Any]) -> str:
-    """An evidence record's tool and version, the tool named once when the version starts with it."""
-    tool, version = str(e.get("tool", "")), str(e.get("tool_version", ""))
-    return version if version.startswith(tool) else f"{tool} {version}".strip()
+def report_out_of_date(root: Path, report: Mapping[str, Any]) -> str | None:
+    """Why ``reports/assurance.json`` of the workspace ``root`` is older than the last ``verify`` or than
+    its inputs, in one sentence, or ``None``: a file it was built from (:func:`_inputs`) or an evidence
+    record (``artifacts/evidence/*.json``, written by a ``verify`` that did not reach its report) was
+    modified after it."""
+    try:
+        written = (root / REPORT).stat().st_mtime_ns
+    except OSError:
+        return None
+    newer = [f for f in _inputs(root, report) if (root / f).stat().st_mtime_ns > written]
+    if newer:
+        return (f"the report is older than {', '.join(newer[:3])}{' ...' if len(newer) > 3 else ''} (modified "
+                "since it was written): run `rclverify verify` and export again")
+    records = sorted((root / "artifacts/evidence").glob("*.json")) if (root / "artifacts/evidence").is_dir() else []
+    late = [p.name for p in records if p.stat().st_mtime_ns > written]
+    if late:
+        return (f"the report is older than the last verify's evidence ({len(late)} record(s) written since, "
+                f"e.g. artifacts/evidence/{late[0]}): that verify did not write its report; run `rclverify "
+                "verify` and export again")
+    return None
+
+
+def evidence_digests(root: Path, report: Mapping[str, Any]) -> dict[str, str]:
+    """Obligation -> hex sha256 of its evidence record file ``artifacts/evidence/<id>.json`` (``missing``
+    when it cannot be read), for each evidence row of ``report``."""
+    return {str(e.get("obligation")): _digest(root / "artifacts/evidence" / f"{e.get('obligation')}.json")
+            for e in report.get("evidence") or ()}
+
+
+def export_header(root: Path, report: Mapping[str, Any]) -> list[list[str]]:
+    """The header of an export of the workspace ``root``'s ``report`` (:func:`~.standards_sheets.header_rows`),
+    with the report file's sha256 and modification time and the plan's and contracts' sha256."""
+    path = root / REPORT
+    try:
+        when = datetime.fromtimestamp(path.stat().st_mtime, timezone.utc).isoformat(timespec="seconds")
+    except OSError:
+        when = "unknown"
+    meta = report.get("meta") or {}
+    files = [str(meta.get("plan", "")), *(str(c) for c in meta.get("contracts") or ())]
+    return header_rows(report, _digest(path), when, {f: _digest(root / f) for f in files if f})
 
 
 def _csv(rows: list[list[str]]) -> str:
     buf = io.StringIO(newline="")
-    csv.writer(buf, lineterminator="\r\n").writerows(rows)  # RFC 4180 line ends
-    return buf.getvalue()
+    csv.writer(buf, lineterminator="\r\n").writerows([[escape_cell(str(v)) for v in row] for row in rows])
+    return buf.getvalue()  # RFC 4180 line ends
 
 
-def write_csv(path: Path, rows: list[list[str]]) -> None:
-    """Write ``rows`` to ``path`` as RFC 4180 CSV in UTF-8 (atomically).  Raises ``OSError``."""
-    atomic_write_text(path, _csv(rows))
+def write_csv(path: Path, rows: list[list[str]], header: list[list[str]] | None = None) -> None:
+    """Write ``rows`` to ``path`` as RFC 4180 CSV in UTF-8 (atomically), each cell escaped
+    (:func:`escape_cell`); ``header``: ``[what, value]`` rows written first, then one empty row, then ``rows`` (its first row the column names).  Raises ``OSError``."""
+    atomic_write_text(path, _csv((header + [[]] if header else []) + rows))
 
 
 def write_xlsx(path: Path, sheets: Mapping[str, list[list[str]]]) -> None:
@@ -115,6 +123,7 @@ def write_xlsx(path: Path, sheets: Mapping[str, list[list[str]]]) -> None:
     openpyxl = require("openpyxl", "an XLSX export of the compliance matrix")
     styles = require("openpyxl.styles", "an XLSX export of the compliance matrix")
     Workbook, Font = openpyxl.Workbook, styles.Font
+    illegal = require("openpyxl.cell.cell", "an XLSX export of the compliance matrix").ILLEGAL_CHARACTERS_RE
     wb = Workbook()
     first = True
     for name, rows in sheets.items():
@@ -124,8 +133,10 @@ def write_xlsx(path: Path, sheets: Mapping[str, list[list[str]]]) -> None:
         first = False
         for i, row in enumerate(rows, 1):
             for j, value in enumerate(row, 1):
+                if isinstance(value, str):  # a control character the format cannot hold, shown as U+FFFD
+                    value = illegal.sub("\ufffd", value)
                 cell = ws.cell(row=i, column=j, value=value)
-                if isinstance(value, str) and value.startswith("="):
+                if isinstance(value, str):
                     cell.data_type = "s"  # text, never a formula (openpyxl reads a leading '=' as one)
         for cell in ws[1]:
             cell.font = Font(bold=True)
@@ -150,4 +161,5 @@ def gaps(report: Mapping[str, Any]) -> list[str]:
     return out
 
 
-__all__ = ["MATRIX_COLUMNS", "TRACE_COLUMNS", "gaps", "matrix_rows", "trace_rows", "write_csv", "write_xlsx"]
+__all__ = ["FORMULA_START", "MATRIX_COLUMNS", "REPORT", "TRACE_COLUMNS", "escape_cell", "evidence_digests",
+           "export_header", "gaps", "matrix_rows", "report_out_of_date", "trace_rows", "write_csv", "write_xlsx"]
