@@ -107,8 +107,10 @@ class ClauseRow(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         description="Who checked what covers the clause: each backend with its tool and version, each review's "
                     "reviewer and author, Z3.")]
     status: Annotated[ClauseStatus, _DOC(
-        description="covered: every item in scope covered; partial: some; not covered: none; open: no evidence "
-                    "of an accepted kind in scope; not recommended: NR at this level.")]
+        description="covered: every item in scope covered (never a clause the tool does not cover alone); "
+                    "partial: some, or all of a clause that asks more than rclverify's evidence (its why says "
+                    "what the safety case must add); not covered: none; open: no evidence of an accepted kind in "
+                    "scope; not recommended: NR at this level.")]
     why: Annotated[str, _DOC(description="Why the clause has its status, with the items in scope counted by "
                                          "state.")]
     plan: Annotated[PlanNote | None, _DOC(
