@@ -310,9 +310,14 @@ class Interpreter:
             name = self._attr(el, "name", scope, path)
             if not name:
                 raise Unresolved("no name")
-            val = self._attr(el, "value", scope, path)
-            if val is None:
-                val = scope.args.get(name) if t == "arg" and name in scope.args else self._attr(el, "default", scope, path)
+            try:
+                val = self._attr(el, "value", scope, path)
+                if val is None:
+                    val = scope.args.get(name) if t == "arg" and name in scope.args \
+                        else self._attr(el, "default", scope, path)
+            except Unresolved as exc:  # the argument stays without a value; what uses it says so
+                self.notes.append(Note(el.src, f"<{t}> {name}: {exc}; the argument has no value", "ROS-LAUNCH"))
+                return
             if val is not None:
                 scope.args[name] = val
         elif t == "group":

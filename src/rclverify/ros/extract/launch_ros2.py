@@ -67,6 +67,8 @@ def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
         e = _expand(e)
     elems = e.elts if isinstance(e, (ast.List, ast.Tuple)) else [e]
     for x in elems:
+        if isinstance(x, ast.Starred) and isinstance(x.value, ast.ListComp):
+            x = x.value  # *[... for ...] that did not unroll: said as a comprehension
         if isinstance(x, ast.Call):
             el = _action(x, shown, notes)
             if el is not None:
