@@ -15,7 +15,8 @@ check``/``compose``, doit's ``check`` task), before any task runs:
   (:data:`TOOL_KEYS`: ``dafny``, ``mcapl_home``, ``options``), which may
   name anything installed on the machine.
 
-A path leaves the workspace when it is absolute (``/etc/passwd``, ``C:\\x``),
+The rule itself is :func:`rclverify.core.within.escape_reason`, shared with the
+assessor's bundle and the one writer.  A path leaves the workspace when it is absolute (``/etc/passwd``, ``C:\\x``),
 when it climbs out with ``..``, or when it exists and resolves (through
 symbolic links) outside the workspace root.  A backslash counts as a
 separator for these checks (``..\\..\\evil.py`` climbs out), and a
@@ -37,18 +38,17 @@ those files.
 from __future__ import annotations
 
 import os
-import re
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from rclverify.core.cache.keys import resolved_paths
+from rclverify.core.within import escape_reason
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic
 from rclverify.model.plan.entries import TOOL_KEYS, TOOL_PATH_KINDS, declared_paths
 from rclverify.model.plan.errors import PlanError, plan_error
 
 __all__ = ["TOOL_KEYS", "check_plan_paths", "config_strings", "escape_reason", "looks_like_path"]
-_DRIVE = re.compile(r"^[A-Za-z]:[\\/]")
 
 Path_ = tuple[Any, ...]
 
@@ -61,25 +61,6 @@ def looks_like_path(root: Path, value: str) -> bool:
     if not any(c.isspace() for c in value) and ("/" in value or value == ".."):
         return True
     return os.path.lexists(root / value)
-
-
-def escape_reason(root: Path, value: str) -> str | None:
-    """Why the workspace-relative ``value`` leaves ``root`` (``None`` if it does not).
-    A backslash counts as a separator; a drive letter (``C:\\``) or a UNC
-    name (``\\\\host``) is absolute."""
-    slashed = value.replace("\\", "/")
-    pure = PurePosixPath(slashed)
-    if pure.is_absolute() or Path(value).is_absolute() or _DRIVE.match(value):
-        return "is an absolute path"
-    if os.path.normpath(slashed).split("/")[0] == "..":
-        return "climbs out of the workspace with '..'"
-    base = root.resolve()
-    target = root / value
-    if os.path.lexists(target):
-        real = target.resolve()
-        if real != base and base not in real.parents:
-            return f"resolves to {real}, outside the workspace (through a symbolic link)"
-    return None
 
 
 def config_strings(value: Any, path: Path_ = ()) -> Iterator[tuple[Path_, str]]:
