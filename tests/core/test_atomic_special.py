@@ -1,6 +1,7 @@
 """The one writer never destroys what it writes over: a device, a FIFO and a
 symbolic link named as an output (``-o FILE``) are written through, never
-replaced by a regular file; a regular file is replaced atomically."""
+replaced by a regular file; a regular file is replaced atomically.  (Where a
+write may go at all: tests/core/test_write_bounds.py.)"""
 from __future__ import annotations
 
 import os
@@ -13,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from rclverify.core.atomic import atomic_write_bytes, atomic_write_text, move_into_place
+from rclverify.core.within import Refused
 from rclverify.lang.errors import RclError
 from rclverify.lang.output import write_atomic
 
@@ -30,9 +32,11 @@ def _null_device(tmp_path: Path) -> Path:
 def test_device_is_written_in_place_not_replaced(tmp_path: Path) -> None:
     dn = _null_device(tmp_path)
     before = os.stat(dn)
-    atomic_write_bytes(dn, b"discarded\n", durable=True)
-    atomic_write_text(dn, "again\n")
+    atomic_write_bytes(dn, b"discarded\n", durable=True, named=True)
+    atomic_write_text(dn, "again\n", named=True)
     write_atomic(dn, "through -o\n")
+    with pytest.raises(Refused, match="character device, not a regular file"):  # not named: never opened
+        atomic_write_text(dn, "an artifact\n")
     after = os.stat(dn)
     assert stat.S_ISCHR(after.st_mode)
     assert (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
@@ -45,7 +49,7 @@ def test_fifo_is_written_in_place(tmp_path: Path) -> None:
     got: list[bytes] = []
     reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()))
     reader.start()
-    atomic_write_bytes(fifo, b"to the reader\n")
+    atomic_write_bytes(fifo, b"to the reader\n", named=True)
     reader.join(timeout=10)
     assert got == [b"to the reader\n"]
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode)

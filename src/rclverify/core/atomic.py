@@ -2,26 +2,51 @@
 
 Every write goes to a temporary file in the destination directory and is
 moved into place with :func:`os.replace`, so a crash or a failing stage never
-leaves a half-written file and never loses the file already there.  A target
-that is not a regular file is never replaced: a device, FIFO or socket is
-written in place (``-o /dev/null`` discards, as a shell redirection does),
-and a symbolic link is followed to the file it names, which is then written
-atomically, so the link stays a link.  Nothing here knows of RCL or evidence:
-the caches (``core/cache``), the evidence store (``records/store.py``), every
-stage's artifacts and every ``-o FILE`` write through it; a directory built
-beside its place is moved there by :func:`move_into_place`.
+leaves a half-written file and never loses the file already there.  Nothing
+here knows of RCL or evidence: the caches (``core/cache``), the evidence
+store (``records/store.py``), every stage's artifacts, the reports and every
+``-o FILE`` write through it; a directory built beside its place is moved
+there by :func:`move_into_place`.
+
+Where a write may go (docs/integrity.md, "Where outputs go"):
+
+* a path the user named on the command line (``named=True``: ``-o FILE``,
+  ``--json FILE``) is written wherever it leads: a symbolic link is followed
+  (the link stays a link, its target is replaced atomically), and a FIFO or
+  a device is written in place, never renamed over (``-o /dev/null``
+  discards, as a shell redirection does; as root a rename over
+  ``/dev/null`` would replace the machine's device node).  The special file
+  is opened without blocking: a FIFO no process reads fails at once
+  (``ENXIO``), and a write that finds no room for
+  :data:`SPECIAL_WRITE_TIMEOUT_S` seconds fails (``ETIMEDOUT``), so the write
+  cannot hang;
+* every other path (a report, an artifact) is written only as a regular
+  file: a FIFO, device or socket there is refused, never opened
+  (:class:`~rclverify.core.within.Refused`), and with ``within`` (the
+  workspace) the path must resolve inside it, so a symbolic link planted in
+  ``reports/`` that leads out is refused as the bundle refuses it
+  (:func:`rclverify.core.within.outside`).
 """
 from __future__ import annotations
 
+import errno
 import itertools
 import json
 import os
+import select
 import stat
+import time
 from pathlib import Path
 from typing import Any
 
+from rclverify.core.within import Refused, kind_of, outside
 
-def atomic_write_text(path: Path, text: str, *, durable: bool = False) -> bool:
+#: Seconds a write into a FIFO or device the user named may find no room before it fails.
+SPECIAL_WRITE_TIMEOUT_S = 10.0
+
+
+def atomic_write_text(path: Path, text: str, *, durable: bool = False, within: Path | None = None,
+                      named: bool = False) -> bool:
     """Write ``text`` to ``path`` atomically; skip the write when the file
     already holds exactly ``text``.
 
@@ -30,24 +55,23 @@ def atomic_write_text(path: Path, text: str, *, durable: bool = False) -> bool:
     data to disk (fsync) before the rename, so the new content survives a
     power loss; evidence records are written so.  Other artifacts are derived
     and re-created by the next run, and an fsync per artifact (eight per node)
-    was the largest single cost of a cold run of a large system.
+    was the largest single cost of a cold run of a large system.  ``within``
+    and ``named`` as in :func:`atomic_write_bytes`.
 
     Returns ``True`` when the file changed.  Parent directories are created.
-    Raises ``OSError`` when the directory cannot be written.
+    Raises ``OSError`` when the directory cannot be written and
+    :class:`~rclverify.core.within.Refused` for a target the module
+    docstring refuses.
     """
-    if _special(path) is not None:
-        atomic_write_bytes(path, text.encode("utf-8"), durable=durable)
-        return True
-    try:
-        if path.read_text(encoding="utf-8") == text:
-            return False
-    except (FileNotFoundError, UnicodeDecodeError):
-        pass
-    atomic_write_bytes(path, text.encode("utf-8"), durable=durable)
+    data = text.encode("utf-8")
+    if output_target(path, within=within, named=named) is None and holds(path, data):
+        return False
+    atomic_write_bytes(path, data, durable=durable, within=within, named=named)
     return True
 
 
-def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: int | None = None) -> None:
+def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: int | None = None,
+                       within: Path | None = None, named: bool = False) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same
     directory renamed into place (:func:`os.replace`): readers see the old
     content or the new, never a part.  ``durable=True`` fsyncs before the
@@ -64,15 +88,19 @@ def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: 
     cannot be written; the temporary file is removed and ``path`` is left as
     it was.
 
-    A ``path`` that is a symbolic link is resolved first and the file it
-    names is replaced (the link stays); a character or block device, FIFO or
-    socket is opened and written in place, never renamed over (as root, a
-    rename over ``/dev/null`` would replace the machine's device node); a
-    directory raises :class:`IsADirectoryError`.
+    ``named=True``: the user named ``path`` (module docstring): a symbolic
+    link is followed wherever it leads, a character or block device or FIFO
+    is written in place within :data:`SPECIAL_WRITE_TIMEOUT_S` seconds of no
+    progress (``ENXIO`` for a FIFO no process reads, ``ETIMEDOUT`` past the
+    limit).  Otherwise a special file raises
+    :class:`~rclverify.core.within.Refused` without being opened, and with
+    ``within`` (a directory, the workspace) a ``path`` that resolves outside
+    it does too.  A socket is always refused; a directory raises
+    :class:`IsADirectoryError`.
     """
-    special = _special(path)
+    special = output_target(path, within=within, named=named)
     if special is not None:
-        _write_in_place(special, data)
+        _write_in_place(special, data, SPECIAL_WRITE_TIMEOUT_S)
         return
     if os.path.islink(path):
         path = Path(os.path.realpath(path))
@@ -94,30 +122,80 @@ def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: 
         raise
 
 
-def _special(path: Path) -> Path | None:
-    """The resolved path when ``path`` (after symbolic links) is a device,
-    FIFO or socket; ``None`` for a regular file, a missing one or a dangling
-    link.  Raises :class:`IsADirectoryError` for a directory."""
+def output_target(path: Path, *, within: Path | None = None, named: bool = False) -> Path | None:
+    """Check ``path`` as a place to write (module docstring): ``None`` when it
+    is written as a regular file (it is one, or is missing, or is a dangling
+    link), the resolved special file when it is a device or FIFO the user
+    named (``named=True``).  Raises :class:`~rclverify.core.within.Refused`
+    for a special file not named, a socket, or (``within`` given, not
+    ``named``) a path that resolves outside ``within``;
+    :class:`IsADirectoryError` for a directory."""
+    if not named and within is not None:
+        real = outside(within, path)
+        if real is not None:
+            how = "through a symbolic link" if real != Path(os.path.abspath(path)) else "as written"
+            raise Refused(path, f"leads to {real}, outside the workspace ({how}); rclverify writes there only "
+                                "inside the workspace or where the command line names")
     try:
         st = os.stat(path)
     except (FileNotFoundError, NotADirectoryError):
         return None
     if stat.S_ISDIR(st.st_mode):
-        raise IsADirectoryError(21, "Is a directory", str(path))
+        raise IsADirectoryError(errno.EISDIR, "Is a directory", str(path))
     if stat.S_ISREG(st.st_mode):
         return None
+    if stat.S_ISSOCK(st.st_mode) or not named:
+        raise Refused(path, f"is {kind_of(st.st_mode)}, not a regular file; rclverify writes into a FIFO or a "
+                            "device only when the command line names it (-o)")
     return Path(os.path.realpath(path))
 
 
-def _write_in_place(path: Path, data: bytes) -> None:
-    """Write ``data`` into the existing special file ``path`` (device, FIFO,
-    socket-free: a socket cannot be opened and raises ``OSError``) without
-    creating, truncating a regular file or renaming anything."""
-    fd = os.open(path, os.O_WRONLY | getattr(os, "O_CLOEXEC", 0))
+def holds(path: Path, data: bytes) -> bool:
+    """Whether the regular file ``path`` holds exactly ``data`` (``False``
+    when it is missing, unreadable as a file or anything but a regular
+    file: it is opened without blocking and checked on its descriptor, so a
+    FIFO put there is never waited on)."""
     try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError:
+        return False
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_size != len(data):
+            return False
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            return fh.read(len(data) + 1) == data
+    finally:
+        os.close(fd)
+
+
+def _write_in_place(path: Path, data: bytes, timeout_s: float) -> None:
+    """Write ``data`` into the existing device or FIFO ``path`` without
+    creating, truncating or renaming anything, never blocking: opened with
+    ``O_NONBLOCK`` (a FIFO no process reads: ``ENXIO`` at once), and each
+    time the file takes no byte, waiting for room at most ``timeout_s``
+    seconds (then ``TimeoutError``, ``ETIMEDOUT``)."""
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        if exc.errno == errno.ENXIO:
+            raise Refused(path, "is a FIFO no process reads: nothing would take the output", errno.ENXIO) from None
+        raise
+    try:
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
         view = memoryview(data)
         while view:
-            view = view[os.write(fd, view):]
+            try:
+                view = view[os.write(fd, view):]
+                continue
+            except BlockingIOError:
+                pass
+            waited = time.monotonic()
+            while not poller.poll(max(1, int(timeout_s * 1000 - (time.monotonic() - waited) * 1000))):
+                if time.monotonic() - waited >= timeout_s:
+                    raise TimeoutError(errno.ETIMEDOUT, f"took no output for {timeout_s:g} s (its reader does not "
+                                                        "read); the output is incomplete", str(path))
     finally:
         os.close(fd)
 
@@ -183,10 +261,11 @@ def reference_dumps(value: Any) -> str:
     return json.dumps(value, sort_keys=True, indent=2, ensure_ascii=False) + "\n"
 
 
-def write_json(path: Path, value: Any, *, durable: bool = False) -> bool:
+def write_json(path: Path, value: Any, *, durable: bool = False, within: Path | None = None,
+               named: bool = False) -> bool:
     """Atomically write ``value`` as deterministic JSON (see :func:`dumps`;
-    ``durable`` as in :func:`atomic_write_text`)."""
-    return atomic_write_text(path, dumps(value), durable=durable)
+    ``durable``, ``within`` and ``named`` as in :func:`atomic_write_text`)."""
+    return atomic_write_text(path, dumps(value), durable=durable, within=within, named=named)
 
 
 def read_json(path: Path) -> Any:
