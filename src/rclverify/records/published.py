@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from rclverify.core.atomic import holds, output_target
 from rclverify.records.store import atomic_write_bytes
 
 _MODE: list[int] = []
@@ -29,25 +30,25 @@ def published_mode() -> int:
     return _MODE[0]
 
 
-def write_published(path: Path, text: str) -> bool:
+def write_published(path: Path, text: str, within: Path | None = None) -> bool:
     """Write ``text`` (UTF-8) to ``path`` atomically with :func:`published_mode`;
     when the file already holds ``text``, only its mode is corrected (a file
-    written by an earlier version with 0600).  Returns ``True`` when the
-    content changed.  Raises ``OSError`` when the directory cannot be
-    written; ``path`` is then left as it was."""
+    written by an earlier version with 0600).  ``within`` (the workspace):
+    ``path`` must resolve inside it, so a symbolic link planted in
+    ``reports/`` that leads out is refused; a FIFO, device or socket at
+    ``path`` is refused, never opened (:func:`rclverify.core.atomic.output_target`).
+    Returns ``True`` when the content changed.  Raises ``OSError`` when the
+    directory cannot be written (``path`` is then left as it was) and
+    :class:`~rclverify.core.within.Refused` for a target refused so."""
     mode = published_mode()
     data = text.encode("utf-8")
+    output_target(path, within=within)
+    if holds(path, data):
+        if os.stat(path).st_mode & 0o777 != mode:
+            os.chmod(path, mode)
+        return False
     try:
-        with open(path, "rb") as fh:
-            same = fh.read() == data
-        if same:
-            if os.stat(path).st_mode & 0o777 != mode:
-                os.chmod(path, mode)
-            return False
-    except FileNotFoundError:
-        pass
-    try:
-        atomic_write_bytes(path, data, mode=mode)
+        atomic_write_bytes(path, data, mode=mode, within=within)
     except OSError as exc:
         if exc.filename is not None:
             raise
