@@ -17,21 +17,25 @@ from rclverify.records.report_schema import Report
 CI_FILES: tuple[str, ...] = ("assurance.sarif", "assurance.junit.xml")
 
 
-def write_ci_reports(report: Report, out_dir: Path, fragments: FragmentCache | None = None) -> list[Path]:
+def write_ci_reports(report: Report, out_dir: Path, fragments: FragmentCache | None = None,
+                     within: Path | None = None) -> list[Path]:
     """Render ``report`` (the dict of ``build_report``) as SARIF 2.1.0 and JUnit
     XML and write both to ``out_dir``; ``fragments`` keeps the JUnit text of
     each node between runs (:func:`rclverify.report.junit.render_junit`).
 
     Both texts are rendered before anything is written, so an error leaves the
     previous files untouched; each write is atomic (and skipped when the text
-    is unchanged).  Returns the two paths (see :data:`CI_FILES`).  Raises
-    ``KeyError`` for a malformed report and ``OSError`` when ``out_dir``
-    cannot be written.
+    is unchanged; ``within``, the workspace, bounds where they may lead:
+    :func:`rclverify.records.published.write_published`).  Returns the two
+    paths (see :data:`CI_FILES`).  Raises ``KeyError`` for a malformed
+    report and ``OSError`` when ``out_dir`` cannot be written
+    (:class:`~rclverify.core.within.Refused` for a special file or a link
+    out of ``within`` at a file's place).
     """
     texts = dict(zip(CI_FILES, (render_sarif(report), render_junit(report, fragments))))
     paths = []
     for name, text in texts.items():
         path = Path(out_dir) / name
-        write_published(path, text)
+        write_published(path, text, within)
         paths.append(path)
     return paths

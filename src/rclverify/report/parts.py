@@ -39,10 +39,13 @@ PARTS = REPORT_PARTS
 FRAGMENTS = {part: f"artifacts/cache/report-fragments.{part}.pickle" for part in PARTS}
 
 
-def write_part(report: Report, out_dir: Path, part: str, fragments: FragmentCache | None = None) -> list[Path]:
+def write_part(report: Report, out_dir: Path, part: str, fragments: FragmentCache | None = None,
+               within: Path | None = None) -> list[Path]:
     """Render and write the files of ``part`` (a key of :data:`PARTS`) for
     ``report`` into ``out_dir``; ``fragments`` keeps rendered pieces
-    between runs (the caller saves it).  Returns the paths written: the
+    between runs (the caller saves it); ``within`` (the workspace): every
+    file must resolve inside it, and none may be a FIFO, device or socket
+    (:func:`rclverify.records.published.write_published`).  Returns the paths written: the
     report files, then the CI files, then the argument files.  Raises
     ``KeyError`` for an unknown part and what
     :func:`~rclverify.report.render.render_files`,
@@ -55,10 +58,11 @@ def write_part(report: Report, out_dir: Path, part: str, fragments: FragmentCach
         # laid out once, in render_files' thread, and written as argument.svg too
         argument = lru_cache(maxsize=None)(argument_layout(report, fragments))
     paths = render_files(report, out_dir, [n for n in REPORT_FILES if n in names], fragments=fragments,
-                         argument=argument)
+                         argument=argument, within=within)
     if any(n in names for n in CI_FILES):
-        paths += write_ci_reports(report, out_dir, fragments)
+        paths += write_ci_reports(report, out_dir, fragments, within)
     files = tuple(n for n in ARGUMENT_FILES if n in names)
     if files:
-        paths += write_argument(report, out_dir, fragments, files, argument() if argument is not None else None)
+        paths += write_argument(report, out_dir, fragments, files, argument() if argument is not None else None,
+                                within)
     return paths

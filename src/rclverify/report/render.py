@@ -159,7 +159,8 @@ def render_all(report: Report, out_dir: Path, link_prefix: str = "../",
 
 def render_files(report: Report, out_dir: Path, names: Sequence[str] = REPORT_FILES,
                  link_prefix: str = "../", fragments: FragmentCache | None = None,
-                 argument: Callable[[], diagram.Rendering] | None = None) -> list[Path]:
+                 argument: Callable[[], diagram.Rendering] | None = None,
+                 within: Path | None = None) -> list[Path]:
     """Write the report files of :data:`REPORT_FILES` named in ``names`` to ``out_dir``.
 
     All the texts are rendered before anything is written, so a rendering
@@ -171,10 +172,14 @@ def render_files(report: Report, out_dir: Path, names: Sequence[str] = REPORT_FI
     rendered pieces between runs (:mod:`rclverify.report.fragments`; the
     caller saves it); the files are the same with or without it.
     ``argument`` lays the argument out (default
-    :func:`rclverify.report.argument.export.argument_layout`).  Returns the paths
+    :func:`rclverify.report.argument.export.argument_layout`).  ``within``
+    (the workspace) bounds where the files may lead
+    (:func:`rclverify.records.published.write_published`).  Returns the paths
     in :data:`REPORT_FILES` order.  Raises
     ``ValueError``/``TypeError``/``jinja2.UndefinedError`` for a malformed
-    report and ``OSError`` when ``out_dir`` cannot be written.
+    report and ``OSError`` when ``out_dir`` cannot be written
+    (:class:`~rclverify.core.within.Refused` for a special file or a link
+    out of ``within`` at a file's place).
     """
     from concurrent.futures import Future, ThreadPoolExecutor  # deferred: start-up (loads concurrent and more only when called)
 
@@ -198,7 +203,7 @@ def render_files(report: Report, out_dir: Path, names: Sequence[str] = REPORT_FI
     for name in REPORT_FILES:
         if name in texts:
             path = Path(out_dir) / name
-            write_published(path, texts[name])
+            write_published(path, texts[name], within)
             paths.append(path)
     return paths
 

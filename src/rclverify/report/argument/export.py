@@ -270,7 +270,8 @@ def argument_view(report: Report, rendering: diagram.Rendering | None = None,
 
 
 def write_argument(report: Report, out_dir: Path, fragments: FragmentCache | None = None,
-                   files: tuple[str, ...] = FILES, rendering: diagram.Rendering | None = None) -> list[Path]:
+                   files: tuple[str, ...] = FILES, rendering: diagram.Rendering | None = None,
+                   within: Path | None = None) -> list[Path]:
     """Write the :data:`FILES` named in ``files`` for ``report`` into ``out_dir`` (``reports/``).
 
     Everything is rendered before anything is written; each file is written
@@ -279,9 +280,12 @@ def write_argument(report: Report, out_dir: Path, fragments: FragmentCache | Non
     diagram remains) and not returned.  ``fragments`` keeps rendered pieces
     between runs (:mod:`rclverify.report.fragments`; the files are the same
     without it); ``rendering`` is the argument's layout when already made
-    (:func:`argument_layout`).  Returns the paths written, in
-    :data:`FILES` order.  Raises ``KeyError`` for a malformed report and
-    ``OSError`` when ``out_dir`` cannot be written.
+    (:func:`argument_layout`); ``within`` (the workspace) bounds where the
+    files may lead (:func:`rclverify.records.published.write_published`).
+    Returns the paths written, in :data:`FILES` order.  Raises ``KeyError``
+    for a malformed report and ``OSError`` when ``out_dir`` cannot be
+    written (:class:`~rclverify.core.within.Refused` for a special file or
+    a link out of ``within`` at a file's place).
     """
     arg = _built(report)
     title = f"assurance argument of {report['meta']['workspace']}"
@@ -297,7 +301,7 @@ def write_argument(report: Report, out_dir: Path, fragments: FragmentCache | Non
         svg = (rendering if rendering is not None else argument_layout(report, fragments)()).svg
     paths = []
     for name, text in texts.items():
-        write_published(out_dir / name, text)
+        write_published(out_dir / name, text, within)
         paths.append(out_dir / name)
     if FILES[3] not in files:
         return paths
@@ -305,6 +309,6 @@ def write_argument(report: Report, out_dir: Path, fragments: FragmentCache | Non
     if svg is None:
         svg_path.unlink(missing_ok=True)
     else:
-        write_published(svg_path, svg)
+        write_published(svg_path, svg, within)
         paths.append(svg_path)
     return paths
