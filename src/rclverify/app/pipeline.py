@@ -363,7 +363,7 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
     paths: list[Path] = []
     for part in parts:
         fragments = FragmentCache(ws.path(FRAGMENTS[part]))
-        paths += write_part(report, out, part, fragments)
+        paths += write_part(report, out, part, fragments, within=ws.root)
         fragments.save()
         if part == "html":  # with assurance.json: what verify prints
             from rclverify.report.summary import summary_data  # deferred: optional or conditional (inside a block)
