@@ -52,7 +52,7 @@ def cmd_bundle(args: argparse.Namespace) -> int:
         out = Path(args.output) if args.output else Path(f"{name or 'workspace'}-bundle.tar.gz")
         try:
             private = signature.load_private_key(Path(args.sign)) if args.sign else None
-            manifest = write_bundle(ws.root, ws.plan, out, key=private)
+            manifest = write_bundle(ws.root, ws.plan, out, key=private, named=args.output is not None)
         except BundleError as exc:
             for problem in exc.problems:
                 print(f"{args.workspace}: error: {problem}", file=sys.stderr)

@@ -10,20 +10,26 @@ from rclverify.cli.common import AddCommand, emit, workspace_of
 
 
 def cmd_graph(args: argparse.Namespace) -> int:
-    """Write the system model as DOT (``-o FILE``, default under artifacts/) and as SVG when Graphviz is there."""
+    """Write the system model as DOT (``-o FILE``, default under artifacts/) and as SVG beside it when
+    Graphviz is there and the DOT went to a regular file (never beside a FIFO or device named by ``-o``)."""
     from rclverify.app.pipeline import stage_check, stage_graph  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
+    from rclverify.core.atomic import atomic_write_text, output_target  # deferred: start-up (loads rclverify.core only when called)
+    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.output and more only when called)
     from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.core and more only when called)
     ws = workspace_of(args)
     stage_check(ws)
     dot = stage_graph(ws)
     out = Path(args.output) if args.output else ws.path(ws.DOT)
     if args.output:
-        out.write_text(dot, encoding="utf-8")
+        write_atomic(out, dot)  # the path the user named: a device or FIFO written in place, bounded in time
     print(f"DOT: {out}")
+    if args.output and output_target(out, named=True) is not None:
+        print(f"SVG not written: {out} is not a regular file")
+        return 0
     svg = dot_to_svg(dot)
     if svg is not None:
-        svg_path = out.with_suffix(".svg")
-        svg_path.write_text(svg, encoding="utf-8")
+        svg_path = out.with_suffix(".svg")  # not named by the user: a regular file, inside the workspace by default
+        atomic_write_text(svg_path, svg, within=None if args.output else ws.root)
         print(f"SVG: {svg_path}")
     else:
         print("graphviz 'dot' not found: SVG not written")

@@ -147,7 +147,7 @@ def cmd_scan(args: argparse.Namespace) -> int:
     for text in report(g.notes, packages, bool(getattr(args, "verbose", False))):
         print(text, file=sys.stderr)
     if args.json:
-        atomic_write_text(Path(args.json), json.dumps(data, indent=2, sort_keys=False) + "\n")
+        atomic_write_text(Path(args.json), json.dumps(data, indent=2, sort_keys=False) + "\n", named=True)
     else:
         print(json.dumps(data, indent=2))
     errors = sum(1 for n in g.notes if n.severity == "error")
@@ -241,7 +241,7 @@ def _shown(result: Any, json_path: str | None) -> bool:
         print(line)
     if json_path:
         try:
-            atomic_write_text(Path(json_path), json.dumps(result.to_json(), indent=2) + "\n")
+            atomic_write_text(Path(json_path), json.dumps(result.to_json(), indent=2) + "\n", named=True)
         except OSError as exc:
             print(f"{json_path}: error: cannot write: {exc.strerror or exc}", file=sys.stderr)
             return False

@@ -61,7 +61,7 @@ def cmd_cache(args: argparse.Namespace) -> int:
 def cmd_review(args: argparse.Namespace) -> int:
     """Write (``-o FILE``) or print the review record to fill in for ``args.node`` (a checklist from its guarantees, the reviewed files with their sha256); exit 2 for an unknown node."""
     from rclverify.backends.review.blank import blank_record  # deferred: start-up (loads jinja2, yaml and more only when called)
-    from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
+    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.output and more only when called)
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     root = Path(args.workspace)
     out_rel = ""
@@ -80,7 +80,7 @@ def cmd_review(args: argparse.Namespace) -> int:
         print(f"error: cannot read reviewed file {exc}", file=sys.stderr)
         return 1
     if args.output:
-        atomic_write_text(Path(args.output), text)
+        write_atomic(Path(args.output), text)
         print(f"review record to fill in: {args.output}")
     else:
         print(text, end="")

@@ -110,14 +110,16 @@ def _csv(rows: list[list[str]]) -> str:
 
 
 def write_csv(path: Path, rows: list[list[str]], header: list[list[str]] | None = None) -> None:
-    """Write ``rows`` to ``path`` as RFC 4180 CSV in UTF-8 (atomically), each cell escaped
-    (:func:`escape_cell`); ``header``: ``[what, value]`` rows written first, then one empty row, then ``rows`` (its first row the column names).  Raises ``OSError``."""
-    atomic_write_text(path, _csv((header + [[]] if header else []) + rows))
+    """Write ``rows`` to ``path`` (named on the command line: a FIFO or device is written in place,
+    bounded in time, :func:`rclverify.core.atomic.atomic_write_bytes`) as RFC 4180 CSV in UTF-8
+    (atomically), each cell escaped (:func:`escape_cell`); ``header``: ``[what, value]`` rows written
+    first, then one empty row, then ``rows`` (its first row the column names).  Raises ``OSError``."""
+    atomic_write_text(path, _csv((header + [[]] if header else []) + rows), named=True)
 
 
 def write_xlsx(path: Path, sheets: Mapping[str, list[list[str]]]) -> None:
     """Write ``sheets`` (sheet name -> rows, the first row its header) to ``path`` as an XLSX workbook with
-    openpyxl (atomically).  Raises :class:`~rclverify.core.extras.MissingExtra` (one line naming the
+    openpyxl (atomically; ``path`` is named on the command line, as in :func:`write_csv`).  Raises :class:`~rclverify.core.extras.MissingExtra` (one line naming the
     ``xlsx`` extra) when openpyxl is not installed and ``OSError`` for a file that cannot be written."""
     from rclverify.core.extras import require  # deferred: the optional extra is looked up only for an XLSX export
     openpyxl = require("openpyxl", "an XLSX export of the compliance matrix")
@@ -143,7 +145,7 @@ def write_xlsx(path: Path, sheets: Mapping[str, list[list[str]]]) -> None:
         ws.freeze_panes = "A2"
     buf = io.BytesIO()
     wb.save(buf)
-    atomic_write_bytes(path, buf.getvalue())
+    atomic_write_bytes(path, buf.getvalue(), named=True)
 
 
 def gaps(report: Mapping[str, Any]) -> list[str]:

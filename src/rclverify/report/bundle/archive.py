@@ -63,11 +63,14 @@ def _zip_bytes(members: Mapping[str, bytes]) -> bytes:
 
 
 def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | None = None,
-                 key: Any = None) -> dict[str, Any]:
+                 key: Any = None, named: bool = False) -> dict[str, Any]:
     """Pack the workspace ``root`` (plan ``plan``) into the archive ``out``;
     with ``key`` (an Ed25519 private key, :mod:`.signature`) the member
     ``MANIFEST.sig`` signs the manifest's bytes.
 
+    ``named``: the user named ``out`` (``-o``), which may then be a FIFO or
+    device, written in place (:func:`rclverify.core.atomic.atomic_write_bytes`);
+    a default ``out`` is written only as a regular file.
     ``tools`` overrides :func:`.manifest.tool_versions` (tests).  Returns the
     manifest.  Raises :class:`BundleError` when the report has not been
     written yet, a file comes from outside the workspace or a record's seal
@@ -92,7 +95,8 @@ def write_bundle(root: Path, plan: Plan, out: Path, tools: Mapping[str, str] | N
     members.update(contents)
     out.parent.mkdir(parents=True, exist_ok=True)
     # durable, and 0644: an archive is for others to read
-    atomic_write_bytes(out, _zip_bytes(members) if is_zip(out) else _tar_bytes(members), durable=True, mode=0o644)
+    atomic_write_bytes(out, _zip_bytes(members) if is_zip(out) else _tar_bytes(members), durable=True, mode=0o644,
+                       named=named)
     return manifest
 
 
