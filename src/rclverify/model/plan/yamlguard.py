@@ -12,9 +12,13 @@ alias.  This module refuses such input before that happens:
                                 iterative walk of the node graph that counts
                                 the nodes the expansion would produce
                                 (memoised per node, so the walk itself is
-                                linear in the file) and refuses more than
-                                :data:`MAX_YAML_NODES`, an alias cycle, or
-                                nesting deeper than :data:`MAX_YAML_DEPTH`.
+                                linear in the file) and refuses an expansion
+                                that aliases make more than
+                                :data:`MAX_YAML_NODES` larger than the nodes
+                                written (a document without aliases is bounded
+                                by its size alone, however many entries it
+                                has), an alias cycle, or nesting deeper than
+                                :data:`MAX_YAML_DEPTH`.
 
 ``to_data(node, file, ...)``     the plain data of a composed node, with a
                                 location for every value path (the plan
@@ -23,7 +27,10 @@ alias.  This module refuses such input before that happens:
                                 names (review records, summary statistics,
                                 trace mappings), keys constructed as
                                 ``yaml.safe_load`` would;
-``read_yaml_text(path, file)``  a YAML file's text (size bound, UTF-8 rules of
+``read_yaml_text(path, file)``  a YAML file's text (a regular file only: a FIFO,
+                                device or socket is refused without waiting on
+                                it, :func:`rclverify.core.within.read_regular`;
+                                size bound, UTF-8 rules of
                                 :mod:`rclverify.lang.source`: a UTF-8
                                 byte-order mark accepted, UTF-16/32 and
                                 invalid UTF-8 refused naming the encoding).
@@ -55,6 +62,7 @@ from typing import Any
 
 import yaml
 
+from rclverify.core.within import read_regular
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError
 from rclverify.model.plan.errors import PlanError, plan_error
@@ -76,7 +84,7 @@ _COMPOSER: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 #: Largest plan file read, in bytes (1 MiB).
 MAX_YAML_BYTES = 1 << 20
-#: Largest number of YAML nodes after alias expansion.
+#: Largest number of YAML nodes aliases may add to those written, when expanded.
 MAX_YAML_NODES = 100_000
 #: Deepest nesting of YAML collections.
 MAX_YAML_DEPTH = 100
@@ -137,9 +145,11 @@ def compose_guarded(text: str, file: str) -> yaml.Node | None:
         if done:
             on_path.discard(key)
             total = 1 + sum(size[id(c)] for c in _children(node))
-            if total > MAX_YAML_NODES:
-                raise _refuse(file, node, f"YAML expands to more than {MAX_YAML_NODES} nodes through aliases "
-                                          "(alias bomb?); refused")
+            # the node's subtree holds at most the len(size) + 1 distinct nodes done so far: what it
+            # expands to beyond them comes from aliases
+            if total - len(size) - 1 > MAX_YAML_NODES:
+                raise _refuse(file, node, f"YAML aliases expand to more than {MAX_YAML_NODES} nodes beyond those "
+                                          "written (alias bomb?); refused")
             size[key] = total
             continue
         if key in size:
@@ -257,11 +267,12 @@ def read_yaml_text(path: Path, file: str) -> str:
     """The text of the YAML file at ``path`` (named ``file`` in messages).
 
     Raises ``PlanError``: over :data:`MAX_YAML_BYTES` (``E-yaml-limit``), not
-    readable (``E-io``), not UTF-8 (``E-encoding``, naming the encoding a
-    byte-order mark shows; :mod:`rclverify.lang.source`)."""
+    readable or not a regular file (``E-io``: a FIFO is refused, never waited
+    on), not UTF-8 (``E-encoding``, naming the encoding a byte-order mark
+    shows; :mod:`rclverify.lang.source`)."""
     check_size(path, file)
     try:
-        data = path.read_bytes()
+        data = read_regular(path)
     except OSError as exc:
         raise plan_error(file, 1, 1, f"cannot read file: {exc.strerror or exc}", "E-io") from None
     try:
