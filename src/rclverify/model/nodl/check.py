@@ -178,11 +178,13 @@ def _parameters(documents: Sequence[tuple[str, Document]], checked: Checked) -> 
 def check(checked: Checked, root: Path, folder: Path | None = None, prefixes: Sequence[Path] = ()) -> Result:
     """Read the NoDL documents of ``folder`` (default ``root/nodl``) and check them against the
     contracts ``checked`` and each other (module docstring).  ``prefixes``: install prefixes whose
-    ament index resolves ``nodl://`` includes.  Raises :class:`RclError` (located) when a
+    ament index resolves ``nodl://`` includes.  A document read must lie inside ``root`` or
+    ``folder`` (a ``local://`` include or a link leading elsewhere is a located error:
+    :class:`~rclverify.model.nodl.document.Resolver`).  Raises :class:`RclError` (located) when a
     document cannot be read (not JSON or YAML, against the schema, an include not resolved or
     cycling); returns the findings otherwise."""
     display = shown(root)
-    resolver = Resolver(prefixes, display)
+    resolver = Resolver(prefixes, display, (root,) + ((folder,) if folder is not None else ()))
     docs = read_all(document_files(folder or root / FOLDER), resolver)
     res = Result()
     included = {f for d in docs for f in d.files[1:]}

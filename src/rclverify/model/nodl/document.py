@@ -18,6 +18,8 @@ located at ``file:line:col`` (codes ``E-nodl-*``).
 from __future__ import annotations
 
 import json
+import os
+import stat
 from dataclasses import dataclass, field
 from functools import lru_cache
 from importlib import resources
@@ -26,6 +28,7 @@ from typing import Any, Callable, Sequence
 
 import yaml
 
+from rclverify.core.within import kind_of, outside
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.model.nodl.jsonpos import load_json_located
@@ -170,11 +173,26 @@ class Resolver:
     including document's folder; ``nodl://<package>/<name>`` is the ament index resource
     ``share/ament_index/resource_index/nodl/<package>__<name>`` under the first of ``prefixes``
     that has it (what ``ament_nodl_register`` installs).  ``display`` turns a path into the file
-    name diagnostics show."""
+    name diagnostics show.  ``within`` (the workspace, and a folder of documents named on the
+    command line): when given, every document read -- a ``local://`` include, and a document
+    found in a folder -- must resolve inside one of them (:func:`rclverify.core.within.outside`;
+    the ament prefixes are named on the command line, so ``nodl://`` reaches them); with none
+    (``nodl validate``, whose files are all named) no place is refused.  A document is a regular
+    file: a FIFO, device or socket is refused without being opened for a wait."""
 
-    def __init__(self, prefixes: Sequence[Path] = (), display: Callable[[Path], str] = str) -> None:
+    def __init__(self, prefixes: Sequence[Path] = (), display: Callable[[Path], str] = str,
+                 within: Sequence[Path] = ()) -> None:
         self.prefixes = tuple(prefixes)
         self.display = display
+        self.within = tuple(within)
+
+    def outside(self, path: Path) -> Path | None:
+        """Where ``path`` leads when ``within`` is given and that is outside all of its folders and
+        the ament prefixes (``None``: allowed)."""
+        if not self.within:
+            return None
+        reals = [outside(w, path) for w in self.within + self.prefixes]
+        return reals[0] if all(r is not None for r in reals) else None
 
     def resolve(self, ref: str, origin: Path, at: ast.Loc) -> Path:
         """The file ``ref`` names, read from document ``origin``; raises :class:`RclError`
@@ -182,8 +200,18 @@ class Resolver:
         scheme, _, body = ref.partition("://")
         if scheme == "local":
             target = (origin.parent / body).resolve()
-            if not target.is_file():
-                raise _fail(at, f"include {ref!r}: no file {self.display(target)}", "E-nodl-include")
+            real = self.outside(target)
+            if real is not None:
+                raise _fail(at, f"include {ref!r}: resolves to {real}, outside the workspace; an include must lie "
+                                "inside it (only a document named on the command line may lie outside)",
+                            "E-nodl-include")
+            try:
+                mode = os.stat(target).st_mode
+            except OSError:
+                raise _fail(at, f"include {ref!r}: no file {self.display(target)}", "E-nodl-include") from None
+            if not stat.S_ISREG(mode):
+                raise _fail(at, f"include {ref!r}: {self.display(target)} is {kind_of(mode)}, not a regular file",
+                            "E-nodl-include")
             return target
         if scheme == "nodl":
             pkg, _, name = body.partition("/")
@@ -236,6 +264,11 @@ class _Reader:
         self.files: list[str] = []
 
     def load(self, path: Path, file: str) -> dict[str, Any]:
+        real = self.resolver.outside(path)
+        if real is not None:
+            raise _fail(ast.Loc(file, 1, 1), f"resolves to {real}, outside the workspace (through a symbolic link); "
+                                             "a NoDL document is read there only when the command line names it",
+                        "E-nodl-include")
         text = read_yaml_text(path, file)
         data, locs = parse_text(text, file, path.suffix == ".json")
         if not isinstance(data, dict):
