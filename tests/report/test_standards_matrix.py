@@ -273,3 +273,21 @@ def test_every_clause_of_the_stored_case_study_is_one_row_agreeing_with_the_json
     col = MATRIX_COLUMNS.index
     assert [(r[col("clause")], r[col("status")], r[col("why")]) for r in rows[1:]] == want
     assert trace_rows(report)[0] == list(TRACE_COLUMNS)
+
+
+# --- the tool classification per chosen profile and level ----------------------------------------------------
+
+@pytest.mark.parametrize("level,tql", [("A", "TQL-4"), ("B", "TQL-4"), ("C", "TQL-5"), ("D", "TQL-5")])
+def test_the_tool_classification_names_the_criterion_and_tql_at_the_chosen_level(level: str, tql: str) -> None:
+    from rclverify.report.templating import environment
+    report = _report()
+    rows = standards_part([StandardChoice(load_builtin("do-333"), level, Loc("contracts/plan.yaml", 4, 5))],
+                          report)["rows"]
+    text = " ".join(environment().get_template("parts/tool_classification.j2").render(rows=rows).split())
+    assert f"criterion 2, so at software level {level} rclverify qualifies at {tql} " in text
+    assert "T2 off-line support tool" in text and "7.4.4.6 then also asks" in text
+    assert "UL 4600 clause 13" not in text  # control: said only when UL 4600 is chosen
+    rows = standards_part([StandardChoice(load_builtin("ul4600"), None, Loc("contracts/plan.yaml", 4, 5))],
+                          report)["rows"]
+    text = " ".join(environment().get_template("parts/tool_classification.j2").render(rows=rows).split())
+    assert "UL 4600 clause 13 asks the safety case to address the tools" in text and "software level" not in text
