@@ -1,0 +1,389 @@
+"""A monitored run's identity: what one run is, whatever the form it was recorded in (docs/statistics.md,
+"A run's identity").
+
+:func:`run_digest` gives each recorded run (a ROSMonitoring log, a ROS 2
+bag in sqlite3 or MCAP, a ROS 1 bag) a hex sha256 over the sorted multiset
+of its messages' canonical records, each ``[topic, time, fields]``.  The
+fields are the ones the contracts read: with the entry's topic rules
+(:func:`read_fields`: the ``fields`` each rule of the mapping file lists),
+a message's other fields are left out, so a copy of a run with a field
+added that no rule reads is the same run, and a run with a read value
+changed is another.  A topic whose rule lists no fields (its fields are
+taken in order) keeps every field.  The run set's counts
+(:mod:`.runset`) and the report's margins (report/margin_rows.py) count a
+run once per identity.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from pathlib import Path
+from typing import IO, Any, Callable, Iterator, Mapping
+
+from rclverify.traces.mapping import EVERY, TopicRule, parse_path
+
+#: The suffixes of a bag file (a directory is a ROS 2 bag too).
+BAG_SUFFIXES = (".bag", ".mcap", ".db3")
+#: Topic (no leading ``/``) -> the field paths its rule reads (each the path's field names up to its first
+#: index: ``ranges[0]`` reads ``ranges``); a topic absent reads every field.
+ReadFields = Mapping[str, tuple[str, ...]]
+
+
+def read_fields(rules: Mapping[str, TopicRule] | None) -> dict[str, tuple[str, ...]]:
+    """The fields a mapping's topic ``rules`` read (:data:`ReadFields`): per
+    topic, the paths its rule lists, or, for a topic whose variables have
+    rules of their own (``fields: {x: [...], y: [...]}``), the paths of
+    those lists; each path cut at its first index (``ranges[0]`` and
+    ``poses[*].position.x`` read ``ranges`` and ``poses``).  A topic whose
+    rule lists no field, or a field that is no name (a position), is left
+    out: every field of it is read.  ``None`` gives ``{}``."""
+    if not rules:
+        return {}
+    lists: dict[str, list[tuple[str, ...]]] = {}
+    for (topic, _), rule in getattr(rules, "by_var", {}).items():
+        lists.setdefault(str(topic).lstrip("/"), []).append(rule.fields)
+    for topic, rule in rules.items():
+        if str(topic).lstrip("/") not in lists:
+            lists[str(topic).lstrip("/")] = [rule.fields]
+    out: dict[str, tuple[str, ...]] = {}
+    for topic, field_lists in lists.items():
+        cut = [_read_path(f) for fields in field_lists for f in fields]
+        if all(field_lists) and cut and all(cut):
+            out[topic] = tuple(sorted(set(cut)))
+    return out
+
+
+def _read_path(field: str) -> str:
+    """The field names of a rule's path up to its first index (``""``: not a path)."""
+    steps = parse_path(field)
+    names: list[str] = []
+    for s in steps or ():
+        if not isinstance(s, str) or s == EVERY:
+            break
+        names.append(s)
+    return ".".join(names)
+
+
+def run_digest(root: Path, trace: str, read: ReadFields | None = None) -> str:
+    """The run's identity (docs/statistics.md, "A run's identity"): a hex
+    sha256 over the sorted multiset of its messages' canonical records, so
+    one run is one identity whatever its form.
+
+    ``trace`` is read from ``root`` by the monitors' own readers (a
+    ROSMonitoring log by :func:`~rclverify.traces.jsonl.read_lines`, a bag
+    opened by :func:`~rclverify.traces.bag.open_bag` and each message
+    decoded by its type store, as :func:`~rclverify.traces.bag.bag_event`
+    decodes it, less the type's constants), each message becoming
+    ``[topic, time, fields]`` (:func:`_record`): the topic without its
+    leading ``/``; the time the message's header stamp when it has one (its
+    source time, :attr:`~rclverify.traces.events.Event.stamped`), else its
+    time (a bag's recording time ``ns / 1e9``, a log's ``time``); the
+    fields flattened to dotted paths, sorted, a number by its value; with
+    ``read`` (:func:`read_fields` of the entry's mapping), only the fields
+    it names for the message's topic.  So a run written as a log, an
+    sqlite3 bag and an MCAP bag, reformatted, reordered, with its topics
+    written with or without ``/``, or with fields added that no rule reads,
+    is one run; a changed read value, time or message makes another.
+
+    Left out, because a log and a bag hold them in different forms: the
+    lines of rclverify's own topics (``rclverify/verdict``,
+    ``rclverify/run``, ``rclverify/call``, ...), a log's lines that are no
+    message (no string ``topic`` or no numeric ``time``), and a bag's
+    service and action call topics (``.../_service_event``,
+    ``.../_action/...``) and ``rclverify/call_decisions``.  A run with no
+    message beside those is identified by its call lines (a log) or call
+    messages (a bag), then, with none either, by its bytes, as is a file
+    neither reader takes (a bag directory's files by their names).  Never
+    raises for an unreadable run: its bytes identify it (or, unreadable
+    too, ``unread:<trace>``); the check reports why it is unreadable."""
+    p = root / trace
+    try:
+        found = _bag_identity(p, read or {}) if p.is_dir() or p.suffix in BAG_SUFFIXES else _log_identity(p, read or {})
+    except Exception:  # noqa: BLE001 - unreadable as a run: identified by its bytes; the check reports why
+        found = None
+    if found is not None:
+        return found
+    h = hashlib.sha256()
+    try:
+        files = sorted(f for f in p.rglob("*") if f.is_file()) if p.is_dir() else [p]
+        for f in files:
+            if p.is_dir():
+                h.update(f.relative_to(p).as_posix().encode() + b"\0")
+            with f.open("rb") as fh:
+                for block in iter(lambda: fh.read(1 << 20), b""):
+                    h.update(block)
+    except OSError:
+        return f"unread:{trace}"
+    return h.hexdigest()
+
+
+#: The topics of rclverify's own lines and messages (verdicts, the run's origin, its calls as the live call
+#: book wrote them, blocked messages, the call decisions of a bag): no message of the robot.
+_OWN = "rclverify/"
+#: The member rosidl gives a message without fields (rosbags decodes it; the live monitor leaves it out).
+_EMPTY_MEMBER = "structure_needs_at_least_one_member"
+#: Top-level fields a ROSMonitoring log cannot hold beside its own ``topic`` and ``time``.
+_LOG_KEYS = frozenset(("topic", "time"))
+
+
+def _is_call_topic(topic: str) -> bool:
+    """A bag topic that holds service or action calls (backends/monitors/bag_calls.py), or the call decisions."""
+    return topic.endswith("/_service_event") or "/_action/" in topic or topic.startswith(_OWN)
+
+
+def _identity(messages: list[bytes], calls: list[bytes]) -> str | None:
+    """The hex sha256 of the sorted multiset ``messages`` (each a record's own sha256), else of ``calls``
+    (marked so it never equals a run's messages), else ``None`` (no record: the caller hashes the bytes)."""
+    kind, records = (b"messages", messages) if messages else (b"calls", calls)
+    if not records:
+        return None
+    records.sort()
+    h = hashlib.sha256(b"rclverify run identity 1: " + kind + b"\n")
+    for r in records:
+        h.update(r)
+    return h.hexdigest()
+
+
+def _log_identity(path: Path, read: ReadFields) -> str | None:
+    """:func:`run_digest` of a ROSMonitoring log; raises what its reader raises for a line that is
+    neither a message nor a JSON object without ``topic`` or ``time`` (a line that is no message)."""
+    from rclverify.traces.jsonl import read_lines  # deferred: start-up (only where a run is counted)
+    from rclverify.traces.events import TraceError  # deferred: start-up (only where a run is counted)
+    messages: list[bytes] = []
+    calls: list[bytes] = []
+    record, sha = _record, hashlib.sha256
+    last = [b""]
+
+    def lines(fh: IO[bytes]) -> Iterator[bytes]:
+        for raw in fh:
+            last[0] = raw
+            yield raw
+    end = [0, 0]
+    with path.open("rb") as fh:
+        chunks = lines(fh)
+        while True:
+            try:
+                for ev in read_lines(path, chunks, end[0], end[1], end):
+                    topic = ev.topic
+                    if not topic.startswith(_OWN):
+                        messages.append(sha(record(topic, ev.stamped, ev.fields, read)).digest())
+                    elif topic == "rclverify/call":
+                        calls.append(sha(record(topic, ev.stamped, ev.fields)).digest())
+                break
+            except TraceError:
+                if not _no_message(last[0]):
+                    raise
+                # a line that is no message (the ROS 1 service proxy's verdict and summary lines): the next one
+    return _identity(messages, calls)
+
+
+def _no_message(raw: bytes) -> bool:
+    """Whether ``raw`` is a JSON object without a string ``topic`` or without a numeric ``time``."""
+    try:
+        obj = json.loads(raw)
+    except (ValueError, RecursionError):
+        return False
+    if not isinstance(obj, dict):
+        return False
+    t = obj.get("time")
+    return not isinstance(obj.get("topic"), str) or isinstance(t, bool) or not isinstance(t, (int, float))
+
+
+def _bag_identity(path: Path, read: ReadFields) -> str | None:
+    """:func:`run_digest` of a bag.  A message its type store cannot decode (a type the bag does not
+    define) is recorded by its topic, time, type and serialized bytes, as every form of the bag holds them."""
+    from rclverify.traces.bag import open_bag, typestore  # deferred: start-up (loads rosbags only when called)
+    from rclverify.traces.events import header_stamp  # deferred: start-up (only where a run is counted)
+    reader = open_bag(path, typestore([]))
+    messages: list[bytes] = []
+    held: list[tuple[Any, int, bytes]] = []  # the call topics' messages, decoded only for a run without others
+    sha, names = hashlib.sha256, _field_names(reader.typestore)
+
+    def one(index: int, conn: Any, stamp: int, raw: bytes) -> bytes:
+        try:
+            msg = reader.deserialize(raw, conn.msgtype)
+        except Exception:  # noqa: BLE001 - a type the bag does not define: the message as every form stores it
+            return sha(_raw_record(conn.topic.lstrip("/"), stamp / 1e9, conn.msgtype, raw)).digest()
+        pairs: list[tuple[str, Any]] = []
+        _flat_message("", msg, names, pairs)
+        t: Any = getattr(getattr(msg, "header", None), "stamp", None)
+        # as bag_event: its header's stamp, when it has one, is its source time
+        own = header_stamp({"header": {"stamp": {"sec": t.sec, "nanosec": t.nanosec}}}) \
+            if hasattr(t, "sec") and hasattr(t, "nanosec") else None
+        name = conn.topic.lstrip("/")
+        return sha(_ENCODE([name, _value(stamp / 1e9 if own is None else own),
+                            _sorted(_only_read([kv for kv in pairs if kv[0] not in _LOG_KEYS],
+                                               read.get(name)))])).digest()
+    try:
+        for index, (conn, stamp, raw) in enumerate(reader.messages()):
+            if _is_call_topic(conn.topic.lstrip("/")):
+                held.append((conn, stamp, bytes(raw)))
+            else:
+                messages.append(one(index, conn, stamp, raw))
+        calls = [] if messages else [one(i, c, s, r) for i, (c, s, r) in enumerate(held)]
+    finally:
+        reader.close()
+    return _identity(messages, calls)
+
+
+def _flat_message(prefix: str, msg: Any, names: Callable[[Any], tuple[str, ...]],
+                  out: list[tuple[str, Any]]) -> None:
+    """A decoded bag message's fields into ``out`` as :func:`_flat` puts the same message's fields
+    read from a log (``names``: a message's field names): rosbags' message classes also hold the
+    type's constants and name as dataclass fields, which are not the message's, and the live
+    monitor's log, decoded with other classes, does not hold them."""
+    for n in names(msg):
+        if n == _EMPTY_MEMBER:
+            continue
+        x = getattr(msg, n)
+        p = prefix + n
+        t = type(x)
+        if t is float:
+            out.append((p, int(x) if x.is_integer() else x if -_INF < x < _INF else repr(x)))
+        elif t is int or t is str or t is bool:
+            out.append((p, x))
+        elif hasattr(x, "__dataclass_fields__"):
+            k = len(out)
+            _flat_message(p + ".", x, names, out)
+            if len(out) == k:
+                out.append((p, {}))
+        else:
+            out.append((p, _message_value(x, names)))
+
+
+def _message_value(v: Any, names: Callable[[Any], tuple[str, ...]]) -> Any:
+    """A decoded field's value that is no scalar and no message, as :func:`_value` gives it from a log:
+    an array as a list, a message in a sequence as its sorted flattened pairs."""
+    if hasattr(v, "tolist"):
+        return _value(v.tolist())
+    if isinstance(v, (list, tuple)):
+        out = []
+        for x in v:
+            if hasattr(x, "__dataclass_fields__"):
+                pairs: list[tuple[str, Any]] = []
+                _flat_message("", x, names, pairs)
+                out.append(_sorted(pairs))
+            else:
+                out.append(_message_value(x, names))
+        return out
+    return _value(v)
+
+
+def _field_names(store: Any) -> Callable[[Any], tuple[str, ...]]:
+    """A decoded message's field names, as its type's definition in ``store`` (a rosbags type store)
+    lists them (not its constants), each type's looked up once."""
+    known: dict[str, tuple[str, ...]] = {}
+
+    def names(msg: Any) -> tuple[str, ...]:
+        t = getattr(msg, "__msgtype__", "")
+        got = known.get(t)
+        if got is None:
+            defs = store.fielddefs.get(t)
+            got = known[t] = (tuple(f[0] for f in defs[1]) if defs is not None else
+                              tuple(f.name for f in dataclasses.fields(msg) if f.default is dataclasses.MISSING))
+        return got
+    return names
+
+
+def _record(topic: str, time: float, fields: Any, read: ReadFields | None = None) -> bytes:
+    """One message's canonical record: JSON ``[topic, time, [[path, value], ...]]``, the topic without
+    its leading ``/``, the fields flattened (:func:`_flat`; a top-level ``topic`` or ``time``, which a
+    log cannot hold beside its own, left out; with ``read``, the fields it names for the topic only) and
+    sorted by path (:func:`run_digest`)."""
+    pairs: list[tuple[str, Any]] = []
+    _flat("", fields, pairs)
+    if "topic" in fields or "time" in fields:
+        pairs = [kv for kv in pairs if kv[0] not in _LOG_KEYS]
+    name = topic.lstrip("/")
+    if read:
+        pairs = _only_read(pairs, read.get(name))
+    return _ENCODE([name, _value(time), _sorted(pairs)])
+
+
+def _only_read(pairs: list[tuple[str, Any]], paths: tuple[str, ...] | None) -> list[tuple[str, Any]]:
+    """The flattened ``pairs`` a rule reading ``paths`` reads (all of them for ``None``): a pair at a path,
+    below it or above it (a value the path's steps go into)."""
+    if not paths:
+        return pairs
+    return [kv for kv in pairs
+            if any(kv[0] == p or kv[0].startswith(p + ".") or p.startswith(kv[0] + ".") for p in paths)]
+
+
+def _raw_record(topic: str, time: float, msgtype: str, raw: bytes) -> bytes:
+    """The record of a bag message that does not decode: its topic, time, type and bytes' sha256."""
+    return _ENCODE([topic, _value(time), msgtype, hashlib.sha256(raw).hexdigest()])
+
+
+def _flat(prefix: str, fields: Any, out: list[tuple[str, Any]]) -> None:
+    """The fields of mapping ``fields`` into ``out`` as ``(path, value)``: a field's path is
+    ``prefix.name`` (``name`` at the top), a nested mapping's fields are flattened (an empty one, or
+    one holding rosidl's placeholder member alone, is ``{}`` at its path), any other value is
+    :func:`_value`'s."""
+    for k, x in fields.items():
+        if k == _EMPTY_MEMBER:
+            continue
+        p = f"{prefix}.{k}" if prefix else str(k)
+        t = type(x)
+        if t is float:
+            out.append((p, int(x) if x.is_integer() else x if -_INF < x < _INF else repr(x)))
+        elif t is int or t is str or t is bool:
+            out.append((p, x))
+        elif isinstance(x, dict):
+            n = len(out)
+            _flat(p, x, out)
+            if len(out) == n:
+                out.append((p, {}))
+        else:
+            out.append((p, _value(x)))
+
+
+def _value(v: Any) -> Any:
+    """``v`` canonical: a float that is an integer as that integer, a NaN or an infinity as the text the
+    live monitor writes for it (``"nan"``, ``"inf"``, ``"-inf"``), bytes and arrays as lists, a mapping
+    as its sorted flattened pairs; booleans, integers, other floats and text as they are."""
+    t = type(v)
+    if t is float:
+        if v.is_integer():
+            return int(v)
+        return v if -_INF < v < _INF else repr(v)
+    if t is list or t is tuple:
+        return [_value(x) for x in v]
+    if isinstance(v, dict):
+        pairs: list[tuple[str, Any]] = []
+        _flat("", v, pairs)
+        return _sorted(pairs)
+    if isinstance(v, (bytes, bytearray)):
+        return list(v)
+    if hasattr(v, "tolist"):  # an array, or a numpy scalar
+        return _value(v.tolist())
+    return v
+
+
+def _sorted(pairs: list[tuple[str, Any]]) -> list[list[Any]]:
+    """``pairs`` sorted by path; two of one path (a log naming ``a.b`` and ``a: {b}``) by their JSON."""
+    pairs.sort(key=_first)
+    if len({p for p, _ in pairs}) != len(pairs):
+        pairs.sort(key=lambda kv: (kv[0], _ENCODE(kv[1])))
+    return [[p, x] for p, x in pairs]
+
+
+def _first(kv: tuple[str, Any]) -> str:
+    return kv[0]
+
+
+_INF = float("inf")
+
+
+def _encode(v: Any) -> bytes:
+    """Compact JSON of a canonical record (msgspec: floats by their shortest repr, integers exact)."""
+    global _ENCODE
+    import msgspec  # deferred: start-up (only where a run is counted)
+    _ENCODE = msgspec.json.Encoder(order="sorted").encode
+    return _ENCODE(v)
+
+
+_ENCODE: Callable[[Any], bytes] = _encode
+
+
+__all__ = ["BAG_SUFFIXES", "ReadFields", "read_fields", "run_digest"]
