@@ -251,7 +251,8 @@ class MonitorsBackend:
             details["stamp_order"] = note
         if read.origin is not None:
             details["source"] = read.origin
-        extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds)
+        extra["statistics"] = run_counts(target.root, target.config, trace, details["sha256"], res, status, span.seconds,
+                                         calls=extra.get("calls"), rules=cfg.rules)
         return evidence(status, explanation, details={"monitoring": details, **extra},
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))
