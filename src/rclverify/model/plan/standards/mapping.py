@@ -371,7 +371,7 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
                     "covered_by": list(dict.fromkeys(ob for x in scope if x["covered"] for ob in x["evidence"])),
                     "checked_by": _checked_by(scope, ix),
                     "status": status, "why": _why(status, scope, evidence, item, code, level)
-                    + _adds(item, scope, done)
+                    + _adds(item)
                     + ("" if note is None or note.nodes is None else
                        f"; scope narrowed by the plan to {', '.join(note.nodes)} ({note.reason})"),
                     "plan": None if note is None else {"nodes": None if note.nodes is None else list(note.nodes),
@@ -380,12 +380,11 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
     return out
 
 
-def _adds(item: Item, scope: Sequence[ScopeItem], done: int) -> str:
+def _adds(item: Item) -> str:
     """What a clause the tool never covers alone (its item's ``safety_case_adds``) leaves to the safety case."""
     if not item.safety_case_adds:
         return ""
-    got = f"rclverify's evidence covers {done} of {len(scope)} item{'s' if len(scope) != 1 else ''} in scope"
-    return f"; never covered by the tool alone: {got}; the safety case must add {item.safety_case_adds}"
+    return f"; never covered by the tool alone: the safety case must add {item.safety_case_adds}"
 
 
 def not_covered(rows: Sequence[ClauseRow], codes: Sequence[str] = ASKED) -> list[str]:
