@@ -95,6 +95,7 @@ SECONDS: dict[str, float] = {
     "test_realizable_under_load": 12.0,  # two CPU burners beside three runs
     "test_realizable_sequences": 2.4,
     "test_nodl_verify": 3.3,
+    "test_write_bounds_cli": 30.0, "test_read_bounds": 2.5,  # one verify, every output path tried three ways
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -122,7 +123,7 @@ PIPELINE = frozenset({
     "test_units_inferred", "test_deadline_monitors", "test_monitor_floats", "test_acknowledged",
     "test_blame_line", "test_deadline_timing_measured", "test_example_fleet_trials", "test_mapping_hygiene",
     "test_one_row_per_cause", "test_repairs_units", "test_report_hygiene", "test_report_schema",
-    "test_example_safety_stop", "test_init", "test_stage_records", "test_what_runs_is_hashed",
+    "test_example_safety_stop", "test_init", "test_stage_records", "test_what_runs_is_hashed", "test_write_bounds_cli",
     "test_example_ros2_robot",  # its one live test is marked in the module (the rest is offline)
     "test_margins_monitor", "test_margins_chain", "test_near_misses", "test_margin_targets",
     "test_margins_report",
