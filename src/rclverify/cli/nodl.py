@@ -173,6 +173,6 @@ def cmd_write(args: argparse.Namespace) -> int:
             print(f"{p}: error: exists; nodl write overwrites no document unless --force", file=sys.stderr)
         return 1
     for name, text in texts.items():
-        atomic_write_text(paths[name], text)
+        atomic_write_text(paths[name], text, within=None if args.output else ws)  # a special file there refused
         print(paths[name])
     return 0
