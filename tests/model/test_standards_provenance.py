@@ -171,6 +171,7 @@ nodes:
 def _review_ws(root: Path, reviewer: str, author: str) -> dict[str, Any]:
     import yaml
     _write(root, {"contracts/gain.rcl": RCL, "contracts/plan.yaml": REVIEW_PLAN, "impl/gain.py": IMPL})
+    (root / "reviews").mkdir(exist_ok=True)
     assert main(["review", "Gain", "-w", str(root), "-o", str(root / "reviews" / "gain.yaml"),
                  "-f", "impl/gain.py"]) == 0
     blank = (root / "reviews" / "gain.yaml").read_text(encoding="utf-8")
@@ -191,7 +192,8 @@ def _review_ws(root: Path, reviewer: str, author: str) -> dict[str, Any]:
 def test_a_self_review_through_the_pipeline_covers_no_independence_clause(tmp_path: Path) -> None:
     clauses = _review_ws(tmp_path / "ws", "Ada Lovelace", "Ada Lovelace")
     b86c = clauses["B.8 6c"]
-    assert b86c["status"] == "open" and b86c["evidence"][0]["note"] == "self-review: Ada Lovelace reviewed their own work"
+    assert b86c["status"] == "open" and b86c["evidence"][0]["note"] == (
+        "self-review: Ada Lovelace reviewed their own work (author: Ada Lovelace)")
     # nor static analysis (a manual review counts there only when independent), nor a modular design
     assert clauses["A.9 3"]["status"] == "open" and clauses["A.4 4"]["status"] != "covered"
 
@@ -199,5 +201,7 @@ def test_a_self_review_through_the_pipeline_covers_no_independence_clause(tmp_pa
 def test_control_an_independent_review_through_the_pipeline_covers_it(tmp_path: Path) -> None:
     clauses = _review_ws(tmp_path / "ws", "Ada Lovelace", "Charles Babbage")
     b86c = clauses["B.8 6c"]
-    assert b86c["status"] == "covered" and b86c["checked_by"] == ["review by Ada Lovelace (author: Charles Babbage)"]
+    assert b86c["status"] == "covered" and b86c["checked_by"] == [
+        "review by Ada Lovelace (author: Charles Babbage; dated 2026-11-27; scope as stated: impl/gain.py against "
+        "Gain's contract)"]
     assert clauses["A.9 3"]["status"] == "covered"
