@@ -29,6 +29,14 @@ specifications"; Why3's ``div`` precondition; SPARK's division check,
 The conditions are RCL formulas themselves (``forall (k in NATURAL | k > 2
 -> in.d != 0)``), so every path encodes and evaluates them as it does any
 formula, with the same symbols.
+
+A named constant of a context (``K = 10 / Zero ;``) is read by the same
+rule: its defining expression's conditions are closed formulas over the
+context's constants, decided by the reference evaluator when the contracts
+are checked (:func:`constant_faults`); one that is false (``Zero != 0``
+with ``Zero = 0``) is an error at the constant's definition, as the same
+division written inside a clause is a problem of that clause
+(docs/rcl-language.md, "Constants").
 """
 from __future__ import annotations
 
@@ -36,9 +44,13 @@ from dataclasses import dataclass
 from typing import Union
 
 from rclverify.lang import ast
+from rclverify.lang.errors import Diagnostic, error
 from rclverify.lang.printer import expr_to_rcl, is_type
-from rclverify.lang.walk import children
-from rclverify.semantics.operators import OPERATORS, Operator
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.lang.walk import children, subexpressions
+from rclverify.semantics.evaluator import Evaluator
+from rclverify.semantics.operators import OPERATORS, Operator, Undecided
+from rclverify.semantics.values import render
 
 #: what a condition is read under: a guard formula, or a quantifier whose variables it holds for
 Frame = Union[ast.Expr, ast.Quant, ast.TupleQuant]
@@ -163,4 +175,51 @@ def guarded(e: ast.Expr) -> ast.Expr:
     return ast.Binary("and", conjoin([c.formula for c in conds], e.loc), e, e.loc)
 
 
-__all__ = ["Condition", "conditions", "conjoin", "defined", "guarded", "right_guard"]
+#: the node a context's constants are evaluated in: no inputs, no outputs, no clauses
+_CONTEXT = CheckedNode(ast.Node("<context>", (), (), (), (), ()), {}, {})
+
+
+def constant_faults(checked: Checked) -> list[Diagnostic]:
+    """The context constants of ``checked`` (every file's ``context { ... }``)
+    whose definition is undefined: one located error per constant, at its
+    definition (``file:line:col`` of its name), naming the first condition of
+    its defining expression (:func:`conditions`) that the reference evaluator
+    (:class:`~rclverify.semantics.evaluator.Evaluator`, exact arithmetic)
+    finds false, e.g. ``constant K is undefined: the division at
+    c.rcl:2:28 needs Zero != 0, which is false (Zero = 0)``.  A condition the
+    evaluator cannot decide (it reads a constant that is itself undefined,
+    reported at that constant) adds nothing.  Source of the rule: the
+    module docstring (Dafny's well-formedness of a definition's body).
+    Returns ``[]`` when every constant is defined; never raises."""
+    out: list[Diagnostic] = []
+    ev = Evaluator(checked, _CONTEXT, {})
+    for spec in checked.specs:
+        for ctx in spec.contexts:
+            for d in ctx.decls:
+                if not isinstance(d, ast.ConstDecl) or checked.env.constants.get(d.name, (None, None))[1] is not d.value:
+                    continue
+                for cond in conditions(d.value):
+                    try:
+                        holds = ev.eval(cond.formula, {})
+                    except (Undecided, TypeError, ValueError, ZeroDivisionError):
+                        continue  # not decided here: an undefined constant it reads is reported at its own definition
+                    if holds is False:
+                        out.append(error(d.loc, f"constant {d.name} is undefined: {cond.describe()}, which is false"
+                                         f"{_values_of(cond.requires, checked, ev)}", "E-undefined-constant"))
+                        break
+    return out
+
+
+def _values_of(e: ast.Expr, checked: Checked, ev: Evaluator) -> str:
+    """`` (Zero = 0)``: the values of the named constants ``e`` reads, "" when it reads none."""
+    shown: dict[str, str] = {}
+    for x in subexpressions(e):
+        if isinstance(x, ast.Var) and x.prefix is None and x.name in checked.env.constants and x.name not in shown:
+            try:
+                shown[x.name] = render(ev.eval(x, {}))
+            except (Undecided, TypeError, ValueError, ZeroDivisionError):
+                continue
+    return f" ({', '.join(f'{k} = {v}' for k, v in shown.items())})" if shown else ""
+
+
+__all__ = ["Condition", "conditions", "conjoin", "constant_faults", "defined", "guarded", "right_guard"]
