@@ -36,6 +36,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         except RclError as exc:
             errors += exc.diagnostics
             continue
+        from rclverify.semantics.definedness import constant_faults  # deferred: start-up (loads the evaluator only when called)
+        errors += constant_faults(checked)  # a constant dividing by zero, at its definition (docs/rcl-language.md)
         warnings += [d for s in specs for d in file_warnings(s)] + [d for s in specs for d in lint(s)]
         from rclverify.model.system.model import unit_diagnostics  # units at both ends of each connection (docs/rcl-language.md); deferred: optional or conditional (inside a block)
         for d in unit_diagnostics(checked):

@@ -187,6 +187,10 @@ class Workspace:
         if diags:
             raise RclError(diags)
         c = check(specs, self.interface_only)
+        from rclverify.semantics.definedness import constant_faults  # deferred: start-up (loads the evaluator only when called)
+        undefined = constant_faults(c)  # a constant dividing by zero, at its definition (docs/rcl-language.md)
+        if undefined:
+            raise RclError(undefined)
         from rclverify.model.plan.errors import PlanError  # deferred: start-up (loads rclverify.lang.ast, rclverify.model and more only when called)
         try:
             resolve(self.plan, c)
