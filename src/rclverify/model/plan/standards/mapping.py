@@ -84,7 +84,7 @@ _WORST: tuple[str, ...] = ("failed", "problem", "error", "stale", "inconclusive"
 #: What an empty scope lacks, by ``about``.
 _NOTHING: Mapping[str, str] = {
     "guarantees": "guarantees", "interfaces": "connections between nodes", "requirements": "requirements",
-    "system": "nodes", "field-data": "target decided over runs of origin operation",
+    "system": "nodes", "field-data": "target decided over runs whose plan entry states origin: operation",
     "trials": "target decided over runs or trials"}
 #: Health check outcomes that leave a guarantee covered (``warning`` is shown, not a failure).
 _HEALTH_OK = ("ok", "warning")
