@@ -128,3 +128,15 @@ def test_control_a_name_in_one_writing_system_is_read(tmp_path: Path, name: str)
     assert confusable(name) is None
     _, record = _read(tmp_path, "Charles Babbage", name)
     assert record.author == name
+
+
+def test_a_confusable_alias_is_refused_at_its_item_and_a_plain_one_read(tmp_path: Path) -> None:
+    (tmp_path / "reviews").mkdir()
+    text = RECORD.format(reviewer="Charles Babbage", author="Ada Lovelace") + "author_aliases: [ada@example.org, AdaL\u200b]\n"
+    (tmp_path / "reviews/gain.yaml").write_text(text, encoding="utf-8")
+    with pytest.raises(PlanError) as exc:
+        read_record(tmp_path, {"record": "reviews/gain.yaml"}, lambda *p: Loc("contracts/plan.yaml", 9, 11))
+    assert str(exc.value).startswith("reviews/gain.yaml:9:35: error: review record: author_aliases.1 ")
+    (tmp_path / "reviews/gain.yaml").write_text(text.replace("\u200b", ""), encoding="utf-8")
+    _, record = read_record(tmp_path, {"record": "reviews/gain.yaml"}, lambda *p: Loc("contracts/plan.yaml", 9, 11))
+    assert record.author_aliases == ("ada@example.org", "AdaL")
