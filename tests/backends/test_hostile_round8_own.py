@@ -33,8 +33,9 @@ def _statuses(trace: Path) -> list[str]:
 def test_stamps_in_simulated_time_beside_the_wall_clock_are_not_ordered_as_one_clock(tmp_path: Path) -> None:
     """The requests carry header stamps in simulated time (100 s), the responses none (the wall clock):
     ordered by one key, every response would come after every request, and the reorder buffer would
-    hold the whole run.  No one order of the run: the untimed verdicts are not given as green, and the
-    reason names the two clocks."""
+    hold the whole run.  The requests' writer is named as another clock (its measured offset) and its
+    messages are placed at their recorded times (issue 106: before, the verdicts were withheld, and the
+    reds stood); the seeded defect (a request refused) is still found on the placed run."""
     rows = [{"topic": "estop/request", "time": WALL + 0.0, **_stamp(100.0), "data": True},
             {"topic": "estop/response", "time": WALL + 0.1, "success": True},
             {"topic": "estop/request", "time": WALL + 1.0, **_stamp(101.0), "data": True},
@@ -45,7 +46,12 @@ def test_stamps_in_simulated_time_beside_the_wall_clock_are_not_ordered_as_one_c
     run = recorded.check_recorded(checked, [checked.nodes["Base"]], load_mapping(EXAMPLE, None), EXAMPLE,
                                   str(trace), lambda w: None)
     status, text = run.verdict(run.results[0], str(trace))
-    assert status == "inconclusive" and "reads two clocks" in text, text
+    assert status == "discharged" and "/estop/request: header stamps -1.7e+09 s" in text, text
+    assert "another clock (2 of 2 stamped message(s)" in text and "placed at their source times" in text, text
+    # the seeded defect on the same two clocks: a refused stop is red, on the placed run
+    bad = [*rows[:3], {**rows[3], "success": False}]
+    trace.write_text("".join(json.dumps(r) + "\n" for r in bad))
+    assert _statuses(trace) == ["failed"]
     # the control: the same run on one clock (every message stamped) is judged, and green
     one = [{**r, **_stamp(r["time"] - WALL + 100.0)} for r in rows]
     trace.write_text("".join(json.dumps(r) + "\n" for r in one))

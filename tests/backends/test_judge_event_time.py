@@ -134,3 +134,119 @@ def test_a_stamp_copying_answer_heard_in_time_is_met_without_a_false(tmp_path: P
     ws, _ = _workspace(tmp_path, RELAY, lines)
     verdicts, live, eng = _live(ws, [(1.0, lines[0]), (1.03, lines[1]), (1.5, lines[2])], "Relay")
     assert eng.late == 0 and [v.verdict for v in verdicts][0] == "true" and live["true"] == 1
+
+
+# -- clocks: a driver's stamps seconds off the wall clock, simulated time -------------------------------------
+
+BAND = """
+context { Stat : {red, orange, green} ; }
+node Band {
+  inputs( r : REAL )
+  outputs( status : Stat )
+  topics( pkg/Reading r matches(in.r), pkg/Status status matches(out.status) )
+  assume( 0 <= in.r )
+  guarantee( (in.r < 120 -> out.status == green) and (120 <= in.r -> out.status == red) )
+}
+"""
+BAND_MAPPING = "topics:\n  r: {fields: [value]}\n  status: {fields: [level]}\n"
+#: the readings, one a second: each differs from the one two periods before it
+VALUES = [50.0, 130.0, 130.0, 50.0, 50.0, 130.0, 130.0, 50.0]
+WALL = 1_700_000_000.0
+
+
+def _alarm_run(offset: float | None, lag_readings: int = 0, sim: bool = False) -> list[dict[str, Any]]:
+    """A driver publishing ``VALUES`` one a second on the wall clock, stamping each
+    ``offset`` s off its publish time (``sim``: on a simulated clock at 100 s); an
+    alarm answering each 10 ms later, unstamped, with the status of the reading
+    ``lag_readings`` before (0: the correct node)."""
+    lines = []
+    for i, v in enumerate(VALUES):
+        t = WALL + i
+        stamp = (100.0 + i) if sim else (t + offset if offset is not None else None)
+        lines.append(_msg("r", t, stamp, value=v))
+        seen = VALUES[max(i - lag_readings, 0)]
+        lines.append(_msg("status", t + 0.01, None, level="green" if seen < 120 else "red"))
+    return lines
+
+
+def _band_offline(ws: Path, run: Path) -> tuple[str, str, list[tuple[str, str]]]:
+    """The recorded path's status and explanation, and the verdicts (where, verdict) of
+    the run as the recorded path orders it (its second read, when it makes one)."""
+    from rclverify.backends.monitors.check import check_trace
+    from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read
+    from rclverify.traces import read_trace
+    checked = load([ws / "contracts" / "c.rcl"])
+    cfg = load_mapping(ws, "mapping.yaml")
+    got = recorded.check_recorded(checked, [checked.nodes["Band"]], cfg, ws, str(run), lambda w: None)
+    status, text = got.verdict(got.results[0], str(run))
+    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)
+    for ev in read_trace(run):
+        watch.see(ev)
+    lag, _, _ = second_read(watch, str(run), True)
+    events = read_trace(run) if lag is None else in_stamp_order(read_trace(run), lag)
+    verdicts: list[Any] = []
+    check_trace(checked, [checked.nodes["Band"]], events, cfg.rules, 0.5, verdicts.append)
+    return status, text, sorted((v.where, v.verdict) for v in verdicts)
+
+
+def _band_live(ws: Path, lines: list[dict[str, Any]]) -> tuple[list[tuple[str, str]], OnlineEngine]:
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    verdicts: list[Any] = []
+    eng = OnlineEngine(checked, [checked.nodes["Band"]], rules, 0.5, reorder_window=0.05, on_verdict=verdicts.append)
+    now = lines[0]["time"]
+    for k, line in enumerate(lines):  # heard 1 ms after it was published, the timer every 10 ms
+        while now + 0.01 <= line["time"] + 0.001:
+            now += 0.01
+            eng.tick(now)
+        eng.push(line["topic"], {x: v for x, v in line.items() if x not in ("topic", "time")}, line["time"],
+                 f"run.jsonl:{k + 1}")
+    eng.finish()
+    return sorted((v.where, v.verdict) for v in verdicts), eng
+
+
+@pytest.mark.parametrize("offset, sim", [(-2.0, False), (0.3, False), (2.0, False), (None, True)],
+                         ids=["2 s behind", "0.3 s ahead", "2 s ahead", "simulated time at 100 s"])
+def test_a_writer_in_another_clock_is_named_and_placed_never_a_violation(tmp_path: Path, offset: float | None,
+                                                                        sim: bool) -> None:
+    """Row 4 (and row 2's simulated time): the correct alarm was ``failed``
+    ("5 satisfied, 10 violated" for 5 alarms); its answers were judged against
+    the reading the shifted stamps put before them."""
+    lines = _alarm_run(offset, sim=sim)
+    ws, run = _workspace(tmp_path, BAND, lines, BAND_MAPPING)
+    status, text, offline = _band_offline(ws, run)
+    assert status == "discharged", text
+    assert "/r: header stamps" in text and "another clock (8 of 8 stamped message(s)" in text, text
+    assert [v for _, v in offline].count("satisfied") == len(VALUES) and "violated" not in [v for _, v in offline]
+    live, eng = _band_live(ws, lines)
+    assert live == offline
+    assert [line.split(":")[0] for line in eng.clock_lines()] == ["/r"]
+
+
+@pytest.mark.parametrize("offset, sim", [(-2.0, False), (0.3, False), (2.0, False), (None, True)],
+                         ids=["2 s behind", "0.3 s ahead", "2 s ahead", "simulated time at 100 s"])
+def test_a_defective_alarm_beside_a_writer_in_another_clock_is_found(tmp_path: Path, offset: float | None,
+                                                                     sim: bool) -> None:
+    """Row 6: the sensor 2 s ahead, readings one a second: an alarm answering
+    each reading with the status of the one two periods before was
+    ``discharged`` (each answer judged against the reading two periods before)."""
+    lines = _alarm_run(offset, lag_readings=2, sim=sim)
+    ws, run = _workspace(tmp_path, BAND, lines, BAND_MAPPING)
+    status, text, offline = _band_offline(ws, run)
+    assert status == "failed", text
+    live, _ = _band_live(ws, lines)
+    assert live == offline and ("run.jsonl:6", "violated") in offline
+
+
+def test_the_control_one_clock_judged_on_its_stamps(tmp_path: Path) -> None:
+    # a driver stamping 20 ms before it publishes: one clock, judged on the stamps, nothing named
+    lines = _alarm_run(-0.02)
+    ws, run = _workspace(tmp_path, BAND, lines, BAND_MAPPING)
+    status, text, offline = _band_offline(ws, run)
+    assert status == "discharged" and "another clock" not in text, text
+    live, eng = _band_live(ws, lines)
+    assert live == offline and eng.clock_lines() == []
+    # and the defect on one clock
+    lines = _alarm_run(-0.02, lag_readings=2)
+    ws, run = _workspace(tmp_path, BAND, lines, BAND_MAPPING)
+    assert _band_offline(ws, run)[0] == "failed"

@@ -30,6 +30,8 @@ watermark passed its time is **late**: counted, with the largest lateness.
 """
 from __future__ import annotations
 
+from typing import Any, Mapping
+
 #: a source time more than this ahead of its receipt (ns) is not the monitor's clock: the receipt stands in
 AHEAD_NS = 1_000_000_000
 
@@ -56,6 +58,87 @@ def event_s(source: float, received: float) -> float:
     return source if source > 0 and (source - received) * 1e9 <= AHEAD_NS else received
 
 
+#: a header stamp more than this (s) ahead of its message's source time is on another clock: a node stamps
+#: its data before it publishes it, and hosts synchronised to within this bound stamp no later
+STAMP_AHEAD_S = 0.1
+#: a header stamp more than this (s) behind its message's source time is on another clock: longer than a
+#: driver's acquisition-to-publish delay or a relay's processing time when it copies its question's stamp
+STAMP_BEHIND_S = 1.0
+
+
+def other_clock(stamp: float, source: float) -> bool:
+    """Whether header stamp ``stamp`` (s) runs in another clock than its
+    message's source time ``source`` (s): more than :data:`STAMP_AHEAD_S`
+    ahead of it or :data:`STAMP_BEHIND_S` behind it (simulated time beside
+    the wall clock, a driver stamping seconds off)."""
+    d = stamp - source
+    return d > STAMP_AHEAD_S or d < -STAMP_BEHIND_S
+
+
+def without_stamp(fields: Mapping[str, Any]) -> dict[str, Any]:
+    """``fields`` without the header's stamp (nested ``header.stamp`` or
+    ROSMonitoring's flattened ``header.stamp.*``), the rest of the header
+    kept: the message placed at its source time reads as unstamped to every
+    monitor (a stamp in another clock set aside)."""
+    out = {k: v for k, v in fields.items() if not k.startswith("header.stamp.")}
+    h = out.get("header")
+    if isinstance(h, Mapping) and "stamp" in h:
+        out["header"] = {k: v for k, v in h.items() if k != "stamp"}
+    return out
+
+
+class WriterClocks:
+    """Per writer (a topic), the offset between its header stamps and its
+    messages' source times, measured: ``offsets[topic] = [lo, hi, n,
+    other]`` (the smallest and largest ``stamp - source`` in s, the stamped
+    messages seen, how many of them ran in another clock,
+    :func:`other_clock`).  :meth:`lines` names each writer with stamps in
+    another clock in one line."""
+
+    __slots__ = ("offsets",)
+
+    def __init__(self) -> None:
+        self.offsets: dict[str, list[Any]] = {}
+
+    def see(self, topic: str, stamp: float, source: float) -> bool:
+        """Note one stamped message of ``topic``; whether its stamp runs in another clock."""
+        d = stamp - source
+        o = self.offsets.get(topic)
+        if o is None:
+            o = self.offsets[topic] = [d, d, 0, 0]
+        if d < o[0]:
+            o[0] = d
+        if d > o[1]:
+            o[1] = d
+        o[2] += 1
+        other = other_clock(stamp, source)
+        if other:
+            o[3] += 1
+        return other
+
+    def others(self) -> list[str]:
+        """The writers with a stamp in another clock, by name."""
+        return sorted(t for t, o in self.offsets.items() if o[3])
+
+    def lines(self, placed: bool) -> list[str]:
+        """One line per writer with stamps in another clock: its measured
+        offsets and what became of them (``placed``: its messages were put at
+        their source times, else they were not related)."""
+        out = []
+        for t in self.others():
+            lo, hi, n, other = self.offsets[t]
+            fate = ("placed at their source times" if placed else
+                    "not related to the run's clock")
+            out.append(f"/{t}: header stamps {_signed(lo)} to {_signed(hi)} from its source times, another clock "
+                       f"({other} of {n} stamped message(s) beyond -{STAMP_BEHIND_S:g} s .. +{STAMP_AHEAD_S:g} s, "
+                       f"{fate})")
+        return out
+
+
+def _signed(d: float) -> str:
+    return f"{d:+.3f} s" if abs(d) < 1e4 else f"{d:+.6g} s"
+
+
 def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]:
     """The reorder buffers' key: a message's time on the run's clock
     (``stamp``, s: its header stamp, else its event time), then its source
@@ -64,4 +147,5 @@ def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]
     return (stamp, source, seq)
 
 
-__all__ = ["AHEAD_NS", "event_ns", "event_s", "order_key"]
+__all__ = ["AHEAD_NS", "STAMP_AHEAD_S", "STAMP_BEHIND_S", "event_ns", "event_s", "order_key", "other_clock",
+           "without_stamp", "WriterClocks"]

@@ -19,6 +19,12 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   ``max_late_s``); its own stamp decides what it answers, and
   an input put at its stamp revises what was judged without it, as offline
   (``late.py``, docs/semantics.md "Answers");
+* **clocks**: per writer (topic) the offset between its header stamps and
+  its source times is measured (:attr:`clocks`); a stamp more than 0.1 s
+  ahead of its message's source time or 1 s behind it runs in another
+  clock, and its message is placed at its source time, its stamp set aside,
+  as a recorded run read again is (:mod:`.stamp_order`); :meth:`clock_lines`
+  names each such writer;
 * **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
   clock to ``now - reorder_window``, so an obligation whose horizon (the
   contract's response time) has passed is resolved ``violated`` without
@@ -38,6 +44,7 @@ from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.event_time import WriterClocks, without_stamp
 from rclverify.traces.events import Event, header_stamp, header_stamp_ns
 from rclverify.traces.reorder import ReorderBuffer
 from rclverify.traces.mapping import TopicRule
@@ -82,6 +89,8 @@ class OnlineEngine:
     #: the reorder buffer (traces/reorder.py, the one every path uses): (topic, fields, where) by stamp
     _buffer: ReorderBuffer[tuple[str, Mapping[str, object], str]] = field(init=False, default_factory=ReorderBuffer)
     _clock: float = field(init=False, default=-math.inf)
+    #: per writer (topic), its header stamps' offset from its source times (traces/event_time.py)
+    clocks: WriterClocks = field(init=False, default_factory=WriterClocks)
 
     def __post_init__(self) -> None:
         self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict, self.tolerance)
@@ -106,6 +115,8 @@ class OnlineEngine:
             if self.on_silence is not None:
                 self.on_silence(topic, 0.0, False)
         stamp = header_stamp(fields)
+        if stamp is not None and self.clocks.see(topic, stamp, received):
+            stamp, fields = None, without_stamp(fields)  # another clock: placed at its source time
         t = received if stamp is None else stamp
         self._buffer.push(t, received, (topic, fields, where))
         if self.reorder_window <= 0:
@@ -155,6 +166,12 @@ class OnlineEngine:
                 m.advance(t)
             for m in self.monitors:
                 m.feed(ev)
+
+    def clock_lines(self) -> list[str]:
+        """One line per writer whose header stamps ran in another clock than
+        its source times (:class:`~rclverify.traces.event_time.WriterClocks`),
+        with its measured offsets."""
+        return self.clocks.lines(True)
 
     def finish(self) -> list[NodeResult]:
         """Release what is buffered, close the horizons up to the last message,

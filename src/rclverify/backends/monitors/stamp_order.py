@@ -25,13 +25,26 @@ every message in stamp order (no later message can be stamped before the
 latest stamp heard less that lag), each with its stamp as its time, and
 every engine judges that order.  A run that cannot be read again (a FIFO
 named on the command line) keeps the first pass's verdicts, which are then
-inconclusive with the reason (:func:`stale_reason`): never a silent green.
+inconclusive with the reason (:func:`stale_reason`): never a silent green,
+and never a red judged in an order that is not the run's.
+
+**Two clocks.**  :class:`StampWatch` also measures, per writer (topic),
+the offset between its header stamps and its messages' trace times
+(:class:`~rclverify.traces.event_time.WriterClocks`; a live monitor's log
+and bag record each message's source time).  A stamp more than 0.1 s ahead
+of its message's trace time or 1 s behind it runs in another clock (:func:`~rclverify.traces.event_time.other_clock`: simulated
+time, a driver stamping seconds off); the run is read again with each such
+message placed at its trace time and its stamp set aside (:class:`Reread`,
+:func:`placed_clock`), and the note names each writer in one line with its
+measured offsets, as the live engine places and names them
+(:mod:`.online`).  A stamp within those bounds is the message's time.
 """
 from __future__ import annotations
 
 import math
 from typing import Any, Callable, Iterable, Iterator
 
+from rclverify.traces.event_time import WriterClocks, other_clock, without_stamp
 from rclverify.traces.events import Event, header_stamp
 from rclverify.traces.reorder import ReorderBuffer
 
@@ -48,7 +61,8 @@ class StampWatch:
     ``skew`` seconds before the latest stamp already heard (``count``; the
     largest such ``lag`` in seconds; ``first``: where the first was read)."""
 
-    __slots__ = ("skew", "latest", "count", "lag", "first", "stamped", "plain")
+    __slots__ = ("skew", "latest", "count", "lag", "first", "stamped", "plain", "clocks", "placed_latest",
+                 "placed_lag")
 
     def __init__(self, skew: float) -> None:
         self.skew = skew
@@ -59,12 +73,22 @@ class StampWatch:
         #: the smallest and largest header stamp, and trace time of a message without one (s)
         self.stamped = [math.inf, -math.inf]
         self.plain = [math.inf, -math.inf]
+        #: per writer, its stamps' offset from its trace times (traces/event_time.py)
+        self.clocks = WriterClocks()
+        #: the latest time and the largest lag with the stamps in another clock placed at their trace times
+        self.placed_latest = -math.inf
+        self.placed_lag = 0.0
 
     def see(self, ev: Event) -> None:
         """Note event ``ev``'s place on the run's clock."""
         s = header_stamp(ev.fields) if ev.fields else None
         t = ev.time if s is None else s
         span = self.plain if s is None else self.stamped
+        p = ev.time if s is None or self.clocks.see(ev.topic, s, ev.time) else s
+        if p >= self.placed_latest:
+            self.placed_latest = p
+        elif self.placed_latest - p > self.placed_lag:
+            self.placed_lag = self.placed_latest - p
         if t < span[0]:
             span[0] = t
         if t > span[1]:
@@ -87,6 +111,9 @@ class StampWatch:
             return
         from rclverify.core.numeric import np  # deferred: optional or conditional (columnar blocks exist with numpy only)
         self.plain = [min(self.plain[0], float(times.min())), max(self.plain[1], float(times.max()))]
+        placed = np.maximum(np.maximum.accumulate(times), self.placed_latest)
+        self.placed_lag = max(self.placed_lag, float((placed - times).max()))
+        self.placed_latest = float(placed[-1])
         ahead = np.maximum(np.maximum.accumulate(times), self.latest)  # the latest time heard up to each row
         behind = ahead - times
         late = behind > self.skew
@@ -95,6 +122,11 @@ class StampWatch:
             self.lag = max(self.lag, float(behind.max()))
             self.first = self.first or where(int(late.argmax()))
         self.latest = float(ahead[-1])
+
+    def other_clocks(self) -> bool:
+        """Whether a header stamp of the run ran in another clock than its
+        message's trace time (:func:`~rclverify.traces.event_time.other_clock`)."""
+        return bool(self.clocks.others())
 
     def two_clocks(self) -> bool:
         """Whether the header stamps and the times of the messages without one
@@ -115,6 +147,31 @@ class StampWatch:
                 f"{self.lag * 1e3:.1f} ms later (the first at {self.first}; transport skew {self.skew * 1e3:g} ms)")
 
 
+class Reread(float):
+    """The window (s) of a second read in stamp order, and whether the stamps
+    in another clock are ``placed`` at their messages' trace times in it
+    (:meth:`StampWatch.other_clocks`)."""
+
+    placed: bool
+
+    def __new__(cls, value: float, placed: bool = False) -> Reread:
+        self = super().__new__(cls, value)
+        self.placed = placed
+        return self
+
+
+def placed_clock(ev: Event) -> tuple[float, bool]:
+    """``(time, placed)``: the event's time on the run's clock when stamps in
+    another clock are placed at their trace times, and whether its stamp was
+    set aside so (the message is then judged as unstamped)."""
+    s = header_stamp(ev.fields) if ev.fields else None
+    if s is None:
+        return ev.time, False
+    if other_clock(s, ev.time):
+        return ev.time, True
+    return s, False
+
+
 def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
     """``events`` in the order of their stamps on the run's clock (equal
     stamps by their recorded times, the publishers' source times in a bag
@@ -125,8 +182,14 @@ def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
     buffer: ReorderBuffer[Event] = ReorderBuffer()  # the one reorder buffer (traces/reorder.py)
     latest = -math.inf
     out = 0
+    place = isinstance(lag, Reread) and lag.placed
     for ev in events:
-        t = run_clock(ev)
+        if place:
+            t, aside = placed_clock(ev)
+            if aside:
+                ev = Event(ev.index, ev.time, ev.topic, without_stamp(ev.fields), ev.where)
+        else:
+            t = run_clock(ev)
         latest = max(latest, t)
         buffer.push(t, ev.time, ev)
         for t0, _, e0, _ in buffer.release(latest - lag, strict=True):
@@ -143,6 +206,10 @@ def stale_reason(watch: StampWatch, trace: str) -> str:
     times read two clocks (:meth:`StampWatch.two_clocks`)."""
     late = (f"{watch.count} message(s) were recorded after one stamped up to {watch.lag * 1e3:.1f} ms later (the "
             f"first at {watch.first})")
+    if watch.other_clocks():
+        return (f"{trace} reads two clocks: " + "; ".join(watch.clocks.lines(False)) + f", and it cannot be read a "
+                "second time to place them (a stream): no one order of the run decides which question an answer "
+                "answers")
     if watch.two_clocks():
         (s0, s1), (p0, p1) = watch.stamped, watch.plain
         return (f"{trace} reads two clocks: header stamps from {s0:.3f} s to {s1:.3f} s, the messages without one "
@@ -158,6 +225,14 @@ def second_read(watch: StampWatch, trace: str, readable: bool) -> tuple[float | 
     second read), ``note`` says so for the evidence, ``stale`` is why the
     first read's greens are not given (two clocks, or a run that cannot be
     read again: ``readable`` false); all empty for a run read in stamp order."""
+    if watch.other_clocks():  # writers in another clock: read again with their stamps placed (module docstring)
+        if not readable:
+            return None, "", stale_reason(watch, trace)
+        note = "; ".join(watch.clocks.lines(True))
+        if watch.placed_lag:
+            note += (f"; judged in stamp order with those stamps placed (a lag of up to "
+                     f"{watch.placed_lag * 1e3:.1f} ms)")
+        return Reread(watch.placed_lag, placed=True), note, ""
     if not watch.count:
         return None, "", ""
     if watch.two_clocks() or not readable:
@@ -167,10 +242,14 @@ def second_read(watch: StampWatch, trace: str, readable: bool) -> tuple[float | 
 
 def unless_stale(status: tuple[str, str], stale: str) -> tuple[str, str]:
     """``(status, explanation)``, or ``inconclusive`` with ``stale`` (the reason)
-    where it would otherwise be ``discharged`` or ``pending``."""
-    if stale and status[0] in ("discharged", "pending"):
+    where it would otherwise be ``discharged``, ``pending`` or ``failed``: a
+    run judged in an order that is not its clock's gives no verdict either
+    way (a violation there may be the order's, docs/semantics.md "Event
+    time")."""
+    if stale and status[0] in ("discharged", "pending", "failed"):
         return "inconclusive", f"{stale}; in recording order: {status[1]}"
     return status
 
 
-__all__ = ["StampWatch", "in_stamp_order", "run_clock", "second_read", "stale_reason", "unless_stale"]
+__all__ = ["Reread", "StampWatch", "in_stamp_order", "placed_clock", "run_clock", "second_read", "stale_reason",
+           "unless_stale"]
