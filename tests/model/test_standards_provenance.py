@@ -203,5 +203,5 @@ def test_control_an_independent_review_through_the_pipeline_covers_it(tmp_path: 
     b86c = clauses["B.8 6c"]
     assert b86c["status"] == "covered" and b86c["checked_by"] == [
         "review by Ada Lovelace (author: Charles Babbage; dated 2026-11-27; scope as stated: impl/gain.py against "
-        "Gain's contract)"]
+        "Gain's contract; files reviewed: impl/gain.py)"]
     assert clauses["A.9 3"]["status"] == "covered"

@@ -79,9 +79,11 @@ def test_an_author_that_names_nobody_is_not_a_person(nobody: str) -> None:
 def test_what_a_review_states_is_shown_as_stated() -> None:
     row = _row("Charles Babbage", "Ada Lovelace", independence="department", date="2026-03-01",
                scope="the stop path against H-3")
+    row["figures"] += [["file", "nodes/base.py sha256 " + "0" * 64], ["file", "nodes/stop.py sha256 " + "1" * 64]]
     clause = _b86c(row)
     assert clause["checked_by"] == ["review by Charles Babbage (author: Ada Lovelace; independence as stated: "
-                                    "department; dated 2026-03-01; scope as stated: the stop path against H-3)"]
+                                    "department; dated 2026-03-01; scope as stated: the stop path against H-3; "
+                                    "files reviewed: nodes/base.py, nodes/stop.py)"]
     # control: a record that states none of it shows none
     assert _b86c(_row("Charles Babbage", "Ada Lovelace"))["checked_by"] == [
         "review by Charles Babbage (author: Ada Lovelace)"]

@@ -41,12 +41,17 @@ def _aliases(row: Mapping[str, Any], who: str) -> tuple[str, ...]:
 
 
 def review_as_stated(row: Mapping[str, Any]) -> str:
-    """What a review row states of itself, as the record states it (the tool checks none of it): its
-    independence, date and scope, ``"; "``-joined (``""`` when it states none)."""
+    """What a review row states of itself, as the record states it: its independence, date and scope
+    (the tool checks none of them) and the files it lists as reviewed (their sha256 is checked, not
+    that they are the node's code), ``"; "``-joined (``""`` when it states none)."""
     said = _said(row)
     parts = [f"{label} {said[k]}" for k, label in (("independence", "independence as stated:"),
                                                     ("date", "dated"), ("scope", "scope as stated:"))
              if said.get(k) and not (said[k].startswith("(") and said[k].endswith(")"))]
+    files = [str(r[1]).split(" sha256 ", 1)[0] for r in row.get("figures") or ()
+             if isinstance(r, (list, tuple)) and len(r) == 2 and r[0] == "file"]
+    if files:
+        parts.append(f"files reviewed: {', '.join(files)}")
     return "; ".join(parts)
 
 
