@@ -291,3 +291,21 @@ def test_the_tool_classification_names_the_criterion_and_tql_at_the_chosen_level
                           report)["rows"]
     text = " ".join(environment().get_template("parts/tool_classification.j2").render(rows=rows).split())
     assert "UL 4600 clause 13 asks the safety case to address the tools" in text and "software level" not in text
+
+
+def test_iso13482_chosen_strict_does_not_pass_on_the_tools_evidence_alone() -> None:
+    """ISO 13482 with strict: true passed --strict on a toy workspace: its clauses 5 and 7 are about the
+    whole robot, never covered by the tool alone.  The control: a workspace profile's clause about the
+    system, with nothing left to the safety case, is covered by the same evidence and passes."""
+    from rclverify.model.plan.standards.profiles import parse_profile
+    from rclverify.report.standards_rows import strict_reason
+    report = _report()
+    part = standards_part([StandardChoice(load_builtin("iso13482"), "d", Loc("contracts/plan.yaml", 4, 5),
+                                          strict=True)], report)
+    assert part["ok"] is False and part["rows"][0]["required_not_covered"] == ["5", "7"]
+    assert strict_reason({"standards": part["rows"]}) == [
+        "ISO 13482:2014 PL d: required items not covered (5, 7)"]
+    tested = parse_profile("id: t\ntitle: T\nedition: T 1\nitems:\n  - {id: S, title: tested, about: system, "
+                           "evidence: [property-tests, review], strength: tested, recommendation: required}\n", "t.yaml")
+    part = standards_part([StandardChoice(tested, None, Loc("contracts/plan.yaml", 4, 5), strict=True)], report)
+    assert part["ok"] is True and part["rows"][0]["clauses"][0]["status"] == "covered"
