@@ -2,7 +2,8 @@
 and YAML (launch frontend), and ROS 2 Python through ``launch_ros2``
 (no launch file is ever executed).
 
-All formats become one element tree ``El(tag, attrs, children, src)``,
+All formats become one element tree ``El(tag, attrs, children, src)``
+(:mod:`launch_tree`; XML and YAML read by :mod:`launch_readers`),
 interpreted here:
 
 * ``arg`` (``default``/``value``), ``let`` (ROS 2); substitutions ``$(arg x)``
@@ -29,26 +30,18 @@ frontend design (design.ros2.org "ROS 2 Launch XML/YAML format").
 """
 from __future__ import annotations
 
-import ast
 import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
-from rclverify.ros.extract import safefs
 from rclverify.ros.extract import names
+from rclverify.ros.extract.launch_readers import read_xml as read_xml, read_yaml as read_yaml
 from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
+from rclverify.ros.extract.launch_tree import ALIASES, SEP as SEP, UNREAD as UNREAD, El as El
+from rclverify.ros.extract.launch_tree import Unresolved as Unresolved, evaluate as evaluate
 from rclverify.ros.extract.model import Note, Src
-from rclverify.ros.extract.xmlsrc import line_of, parse_xml
-
-
-@dataclass
-class El:
-    tag: str
-    attrs: dict[str, str]
-    children: list["El"]
-    src: Src
 
 
 @dataclass
@@ -77,18 +70,6 @@ class _Scope:
     remaps: list[tuple[str, str, Src]] = field(default_factory=list)
     unsure: Src | None = None  # a condition of an enclosing element read as holding without being evaluated
 
-
-#: the attribute a reader sets on an element whose condition it could not read (value: where)
-UNREAD = "condition-unread"
-#: what joins the tokens of a node's ``ros_args`` attribute when a reader gives them one by one
-SEP = "\x1f"
-#: tags read as another: ROS 2's ``lifecycle_node`` is a node, ``set_remap`` a remap in its scope,
-#: ``push_ros_namespace`` (the YAML and later XML spelling) is ``push-ros-namespace``
-ALIASES = {"lifecycle_node": "node", "set_remap": "remap", "push_ros_namespace": "push-ros-namespace"}
-
-
-class Unresolved(Exception):
-    pass
 
 
 _SUBST = re.compile(r"\$\(([^()]*)\)")
@@ -385,142 +366,3 @@ class Interpreter:
                         args[n] = v
             self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps, scope.unsure)
         # rosparam, env, machine, test, executable ...: not part of the topic graph
-
-
-_EVAL_NODES = (ast.Expression, ast.BoolOp, ast.And, ast.Or, ast.UnaryOp, ast.Not, ast.Compare, ast.Eq, ast.NotEq,
-               ast.In, ast.NotIn, ast.Constant, ast.Name, ast.Load, ast.Tuple, ast.List)
-
-
-def evaluate(expr: str) -> str:
-    """The value of ``$(eval expr)`` / ``PythonExpression`` as launch gives it
-    (``str()`` of the result: ``True`` / ``False``), for the expressions a
-    condition is made of: string, number and boolean literals, ``True`` /
-    ``False`` / ``None``, ``not``, ``and``, ``or``, ``==``, ``!=``, ``in``,
-    ``not in``.  Raises :class:`Unresolved` for anything else (a name, a call,
-    arithmetic): such an expression is not evaluated statically.
-
-    Source: launch's ``PythonExpression`` (``eval`` of the substituted text),
-    roslaunch ``$(eval ...)``."""
-    try:
-        tree = ast.parse(expr, mode="eval")
-    except SyntaxError as exc:
-        raise Unresolved(f"$(eval {expr}): not a Python expression ({exc.msg})") from None
-    for n in ast.walk(tree):
-        if not isinstance(n, _EVAL_NODES) or (isinstance(n, ast.Name) and n.id not in ("True", "False", "None")):
-            raise Unresolved(f"$(eval {expr}) is not evaluated statically (only literals, not, and, or, ==, !=, in)")
-
-    def ev(n: ast.AST) -> Any:
-        if isinstance(n, ast.Expression):
-            return ev(n.body)
-        if isinstance(n, ast.Constant):
-            return n.value
-        if isinstance(n, ast.Name):
-            return {"True": True, "False": False, "None": None}[n.id]
-        if isinstance(n, (ast.Tuple, ast.List)):
-            return tuple(ev(x) for x in n.elts)
-        if isinstance(n, ast.UnaryOp):
-            return not ev(n.operand)
-        if isinstance(n, ast.BoolOp):
-            vals = [ev(x) for x in n.values]
-            return all(vals) if isinstance(n.op, ast.And) else any(vals)
-        assert isinstance(n, ast.Compare)
-        left = ev(n.left)
-        for op, right in zip(n.ops, (ev(x) for x in n.comparators)):
-            if isinstance(op, ast.Eq):
-                ok = left == right
-            elif isinstance(op, ast.NotEq):
-                ok = left != right
-            else:
-                ok = (left in right) == isinstance(op, ast.In)  # In / NotIn (the only others allowed)
-            if not ok:
-                return False
-            left = right
-        return True
-    try:
-        return str(ev(tree))
-    except TypeError as exc:  # 'x' in 3
-        raise Unresolved(f"$(eval {expr}): {exc}") from None
-
-
-# -- readers ------------------------------------------------------------
-
-def _from_xml(e: Any, shown: str) -> El:
-    kids = [_from_xml(c, shown) for c in e if isinstance(c.tag, str)]
-    return El(str(e.tag), {str(k): str(v) for k, v in e.attrib.items()}, kids, Src(shown, line_of(e)))
-
-
-def read_xml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
-    """A ROS 1 or ROS 2 XML launch file as an element tree (root ``launch``)."""
-    root, note = parse_xml(path, shown)
-    if root is None:
-        return None, [note] if note else []
-    if root.tag != "launch":
-        return None, [Note(Src(shown, 1), f"root element is <{root.tag}>, not <launch>", "ROS-PARSE", "error")]
-    return _from_xml(root, shown), []
-
-
-def _yaml_el(tag: str, body: Any, shown: str, line: int) -> El:
-    attrs: dict[str, str] = {}
-    kids: list[El] = []
-    if isinstance(body, list):  # - group: [ {push_ros_namespace: ...}, {node: ...} ] (the form in ROS 2's examples)
-        kids.extend(_yaml_list(body, shown, line))
-    elif isinstance(body, dict):
-        for k, v in body.items():
-            if k in ("remap", "arg", "param", "composable_node") and isinstance(v, list):
-                for item in v:
-                    kids.append(_yaml_el(str(k), item, shown, line))
-            elif k == "children" and isinstance(v, list):
-                kids.extend(_yaml_list(v, shown, line))
-            elif isinstance(v, (str, int, float, bool)):
-                attrs[str(k)] = str(v).lower() if isinstance(v, bool) else str(v)
-    return El(tag, attrs, kids, Src(shown, line))
-
-
-def _yaml_list(items: list[Any], shown: str, line: int) -> list[El]:
-    out = []
-    for item in items:
-        if isinstance(item, dict) and len(item) == 1:
-            (tag, body), = item.items()
-            ln = getattr(item, "line", line)
-            out.append(_yaml_el(str(tag), body, shown, ln))
-    return out
-
-
-def read_yaml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
-    """A ROS 2 YAML launch file (``launch: [ {node: {...}}, ...]``) as an element tree.
-
-    Lines: each top-level action is located at its own line."""
-    import yaml  # deferred: start-up (loads yaml only when called)
-
-    class _L(yaml.SafeLoader):
-        pass
-
-    def _map(loader: Any, node: Any) -> Any:
-        d = _LineDict(loader.construct_mapping(node, deep=True))
-        d.line = node.start_mark.line + 1
-        return d
-    _L.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _map)
-    try:
-        text = safefs.read_text(path)
-        if len(text) > 5_000_000:
-            return None, [Note(Src(shown), "launch file too large", "ROS-PARSE", "error")]
-        from rclverify.model.plan.errors import PlanError  # deferred: optional or conditional (inside a block)
-        from rclverify.model.plan.yamlguard import compose_guarded  # deferred: optional or conditional (inside a block)
-        try:
-            compose_guarded(text, shown)  # alias bombs, cycles and depth refused before expansion
-        except PlanError as exc:
-            return None, [Note(Src(shown), f"YAML launch file refused: {exc}", "ROS-PARSE", "error")]
-        data = yaml.load(text, Loader=_L)  # noqa: S506 (a SafeLoader subclass)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        return None, [Note(Src(shown, mark.line + 1 if mark else 1, mark.column + 1 if mark else 1),
-                           f"not valid YAML: {getattr(exc, 'problem', exc)}", "ROS-PARSE", "error")]
-    except (OSError, RecursionError, ValueError) as exc:
-        return None, [Note(Src(shown), f"cannot read: {exc}", "ROS-PARSE", "error")]
-    if not isinstance(data, dict) or not isinstance(data.get("launch"), list):
-        return None, [Note(Src(shown), "a YAML launch file is a mapping with a 'launch' list", "ROS-PARSE", "error")]
-    return El("launch", {}, _yaml_list(data["launch"], shown, 1), Src(shown, 1)), []
-
-
-class _LineDict(dict):  # type: ignore[type-arg]
-    line = 1

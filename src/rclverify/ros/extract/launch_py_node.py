@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import ast
 
-from rclverify.ros.extract.launch import SEP, El
+from rclverify.ros.extract.launch_tree import SEP, El
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, callee as _callee, expand as _expand
 from rclverify.ros.extract.launch_py_values import kw as _kw, value as _value
 from rclverify.ros.extract.launch_rosargs import after_ros_args
@@ -17,7 +17,7 @@ from rclverify.ros.extract.model import Note, Src
 
 def ros_args(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note]) -> None:
     """``ros_arguments=[...]`` and the ``--ros-args`` part of ``arguments=[...]``
-    of a node as its ``ros_args`` attribute (tokens joined by :data:`.launch.SEP`, read
+    of a node as its ``ros_args`` attribute (tokens joined by :data:`.launch_tree.SEP`, read
     by :mod:`launch_rosargs`); a ROS argument that cannot be read leaves them
     out, said with a located note (the program's own arguments are not read)."""
     toks: list[str] = []

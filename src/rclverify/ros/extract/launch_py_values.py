@@ -31,7 +31,7 @@ from __future__ import annotations
 import ast
 import copy
 
-from rclverify.ros.extract.launch import Unresolved, evaluate
+from rclverify.ros.extract.launch_tree import Unresolved, evaluate
 
 
 class Unres(Exception):

@@ -37,10 +37,11 @@ import ast
 from pathlib import Path
 
 from rclverify.ros.extract import safefs
-from rclverify.ros.extract.launch import UNREAD, El
+from rclverify.ros.extract.launch_tree import UNREAD, El
 from rclverify.ros.extract.launch_py_values import ENV as _ENV, HERE as _HERE, TWICE as _TWICE
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg, callee as _callee
-from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, value as _value
+from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
+from rclverify.ros.extract.launch_py_values import value as _value
 from rclverify.ros.extract.launch_py_node import node_kids as _node_kids, ros_args as _ros_args
 from rclverify.ros.extract.model import Note, Src
 
@@ -74,9 +75,8 @@ def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
             if el is not None:
                 out.append(el)
         elif isinstance(x, ast.ListComp):
-            from rclverify.ros.extract.launch_py_values import unroll  # the reason it did not unroll
             try:
-                unroll(x)
+                _unroll(x)  # the reason it did not unroll
             except _Unres as exc:
                 notes.append(Note(Src(shown, x.lineno, x.col_offset + 1), f"launch actions built by a list "
                                   f"comprehension over {exc} cannot be read statically; the nodes it starts are "
@@ -155,24 +155,7 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
             _optional(c, attrs, (("name", "name"), ("namespace", "namespace")), shown, notes)
             return El("composable_node", attrs, _node_kids(c, shown, notes), src)
         if name in ("ComposableNodeContainer", "LoadComposableNodes"):
-            descs = _kw(c, "composable_node_descriptions")
-            kids = []
-            if descs is not None:
-                descs = _expand(descs)
-                if not isinstance(descs, (ast.List, ast.Tuple)):
-                    raise _Unres(f"composable_node_descriptions '{ast.unparse(descs)}'")
-                for d in descs.elts:
-                    if isinstance(d, ast.Call) and _callee(d) == "ComposableNode":
-                        el = _action(d, shown, notes)
-                        if el is not None:
-                            kids.append(el)
-                    else:
-                        notes.append(Note(Src(shown, d.lineno, d.col_offset + 1), f"composable node "
-                                          f"'{ast.unparse(d)}' is not a literal ComposableNode(...): not resolved "
-                                          f"statically", "ROS-LAUNCH"))
-            _condition(c, attrs, shown, notes)
-            tag = "node_container" if name == "ComposableNodeContainer" else "load_composable_node"
-            return El(tag, attrs, kids, src)
+            return _container(c, name, attrs, src, shown, notes)
         if name == "DeclareLaunchArgument":
             n = c.args[0] if c.args else _kw(c, "name")
             default = _kw(c, "default_value")
@@ -198,32 +181,60 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
             _condition(c, attrs, shown, notes)
             return El("group", attrs, _actions(acts, shown, notes) if acts is not None else [], src)
         if name == "IncludeLaunchDescription":
-            s = c.args[0] if c.args else _kw(c, "launch_description_source")
-            kids = []
-            la = _kw(c, "launch_arguments")
-            if la is not None:
-                if isinstance(la, ast.Call) and isinstance(la.func, ast.Attribute) and la.func.attr == "items":
-                    la = la.func.value
-                la = _expand(la)
-                if isinstance(la, ast.Dict):
-                    for k, v in zip(la.keys, la.values):
-                        if k is not None:
-                            kids.append(El("arg", {"name": _value(k), "value": _value(v)}, [], src))
-                elif isinstance(la, (ast.List, ast.Tuple)):
-                    for pair in la.elts:
-                        if isinstance(pair, ast.Tuple) and len(pair.elts) == 2:
-                            kids.append(El("arg", {"name": _value(pair.elts[0]), "value": _value(pair.elts[1])}, [], src))
-                else:
-                    raise _Unres(f"launch_arguments '{ast.unparse(la)}'")
-            if s is None:
-                raise _Unres("an include without a source")
-            attrs["file"] = _value(s)
-            _condition(c, attrs, shown, notes)
-            return El("include", attrs, kids, src)
+            return _include(c, attrs, src, shown, notes)
         return _more(c, name, attrs, src, shown, notes)
     except _Unres as exc:
         notes.append(Note(src, f"{name}(...): {exc} cannot be read statically; action skipped", "ROS-LAUNCH"))
     return None
+
+
+def _container(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, notes: list[Note]) -> El:
+    """``ComposableNodeContainer`` / ``LoadComposableNodes`` with its
+    ``composable_node_descriptions``; raises :class:`_Unres`."""
+    descs = _kw(c, "composable_node_descriptions")
+    kids = []
+    if descs is not None:
+        descs = _expand(descs)
+        if not isinstance(descs, (ast.List, ast.Tuple)):
+            raise _Unres(f"composable_node_descriptions '{ast.unparse(descs)}'")
+        for d in descs.elts:
+            if isinstance(d, ast.Call) and _callee(d) == "ComposableNode":
+                el = _action(d, shown, notes)
+                if el is not None:
+                    kids.append(el)
+            else:
+                notes.append(Note(Src(shown, d.lineno, d.col_offset + 1), f"composable node "
+                                  f"'{ast.unparse(d)}' is not a literal ComposableNode(...): not resolved "
+                                  f"statically", "ROS-LAUNCH"))
+    _condition(c, attrs, shown, notes)
+    tag = "node_container" if name == "ComposableNodeContainer" else "load_composable_node"
+    return El(tag, attrs, kids, src)
+
+
+def _include(c: ast.Call, attrs: dict[str, str], src: Src, shown: str, notes: list[Note]) -> El:
+    """``IncludeLaunchDescription(source, launch_arguments=...)``; raises :class:`_Unres`."""
+    s = c.args[0] if c.args else _kw(c, "launch_description_source")
+    kids = []
+    la = _kw(c, "launch_arguments")
+    if la is not None:
+        if isinstance(la, ast.Call) and isinstance(la.func, ast.Attribute) and la.func.attr == "items":
+            la = la.func.value
+        la = _expand(la)
+        if isinstance(la, ast.Dict):
+            for k, v in zip(la.keys, la.values):
+                if k is not None:
+                    kids.append(El("arg", {"name": _value(k), "value": _value(v)}, [], src))
+        elif isinstance(la, (ast.List, ast.Tuple)):
+            for pair in la.elts:
+                if isinstance(pair, ast.Tuple) and len(pair.elts) == 2:
+                    kids.append(El("arg", {"name": _value(pair.elts[0]), "value": _value(pair.elts[1])}, [], src))
+        else:
+            raise _Unres(f"launch_arguments '{ast.unparse(la)}'")
+    if s is None:
+        raise _Unres("an include without a source")
+    attrs["file"] = _value(s)
+    _condition(c, attrs, shown, notes)
+    return El("include", attrs, kids, src)
 
 
 def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, notes: list[Note]) -> El | None:

@@ -29,7 +29,9 @@ from rclverify.ros.graph.assemble import Assembly, LinkCache
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.executables import Targets, exported_cmake, targets
 from rclverify.ros.extract.interfaces import TypeTable
-from rclverify.ros.extract.launch import El, Interpreter, read_xml, read_yaml
+from rclverify.ros.extract.launch import Interpreter
+from rclverify.ros.extract.launch_readers import read_xml, read_yaml
+from rclverify.ros.extract.launch_tree import El
 from rclverify.ros.extract.launch_ros2 import read_python
 from rclverify.ros.extract.link import UNBUILT
 from rclverify.ros.extract.model import SERVICE_ROLES, Endpoint, Graph, GraphEdge, GraphNode, Note, Src
