@@ -281,6 +281,8 @@ class Assembly:
             prog = self.nodelet_program(lookup)
             if prog is None:
                 where = "is not in the scanned workspaces" if pkg not in self.pkgs else \
+                    "has it, not built (no target of its CMakeLists.txt builds its sources)" \
+                    if any(u.package == pkg and u.name == lookup for u in self.unbuilt) else \
                     "has no nodelet of that name (plugin description, PLUGINLIB_EXPORT_CLASS)"
                 g.notes.append(Note(ln.src, f"nodelet '{lookup}': package '{pkg}' {where}; its topics are unknown",
                                     "ROS-LAUNCH"))
