@@ -382,6 +382,13 @@ def test_ros1_code_no_ament_target_builds_is_listed_apart(tmp_path: Path, capsys
     assert main(["init", str(out), "--from-ros", str(ws)]) == 0
     capsys.readouterr()
     assert sorted(p.name for p in (out / "contracts").glob("*.rcl") if p.name != "ros_types.rcl") == ["talker.rcl"]
+    # a ROS 1 launch file loading the nodelet is told it is not built
+    lf = tmp_path / "filter.launch"
+    lf.write_text('<launch>\n  <node pkg="nodelet" type="nodelet" name="filter" args="load port/Filter mgr"/>\n'
+                  '</launch>\n')
+    g = scan([ws], [lf], base=tmp_path, standard=False).graph
+    assert "filter.launch:2:3: warning: nodelet 'port/Filter': package 'port' has it, not built (no target of its " \
+           "CMakeLists.txt builds its sources); its topics are unknown" in _said(g)
 
 
 @pytest.mark.parametrize("tool, more", [
