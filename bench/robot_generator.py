@@ -1,0 +1,433 @@
+"""A generator of correct robots (issue 106): random ROS 2 systems of real rclpy nodes, each node
+written for the RCL contract generated with it, judged live by ``rclverify monitor --live --ros2``
+and offline on the run's log and bag, verdict counts compared node by node.
+
+Given a seed, :func:`generate` draws a system of N nodes from five templates (the spec is plain data):
+
+* **sensor**: a periodic publisher (100-400 ms) of ``std_msgs/Float32`` or ``std_msgs/UInt8``
+  (unstamped), ``sensor_msgs/Range`` (float32, stamped by the sensor 0-30 ms before it is
+  published), ``std_msgs/Float32MultiArray`` (a float32 sequence, unstamped) or
+  ``sensor_msgs/LaserScan`` (a stamped float32 sequence); its guarantee keeps every value in its
+  band ``[LO, HI]``, both named constants, both values published exactly;
+* **alarm**: a ``std_msgs/Bool`` answer to one sensor, ``out.low <=> (in.x <= K)`` (float32 K read
+  as the field carries it: the node compares with ``numpy.float32(K)``), ``out.high <=> (in.n >= K)``
+  (uint8) or ``out.low <=> exists(v in in.cells | v < K)``, its deadline ``triggered by`` the input;
+  the sensor publishes K itself and its float32 neighbours, so the boundary is hit;
+* **relay**: a ``sensor_msgs/Range`` copy of a float32 reading, ``out.r == in.x``, either copying
+  the input's header stamp (its processing delay up to twice the input's period) or stamped with its
+  own clock when it publishes (delay under a third of the period);
+* **fuse**: two inputs, ``out.alert <=> (in.a <= KA and in.b >= KB)`` (float32 and uint8) or
+  ``out.low <=> (in.x <= K or exists(v in in.cells | v < K2))``, answering each ``in.a``; its second
+  sensor is its own, publishing half a period after the first, so an answer is never computed from
+  a value the monitor does not yet hold;
+* **service**: a ``std_srvs/SetBool`` server, ``out.ok == in.on`` within a deadline, with or without
+  service introspection, called one call at a time by a client in the same process.
+
+Nodes get a namespace at random.  ``defect=True`` seeds one defect in one node: ``<`` for ``<=``
+(``>`` for ``>=``, ``<=`` for ``<``), a relay adding 0.5 to every fourth reading, a server
+answering every third call wrongly, a sensor publishing just beyond its band; the runner
+(``bench/_robot_run.py``) checks it is red at that node and only there.
+
+:func:`write_workspace` renders the workspace from the jinja2 templates of
+``bench/templates/robot_generator/``: ``contracts/robot.rcl`` (a ``context`` of the named
+constants), ``contracts/plan.yaml``, ``mapping.yaml``, ``interfaces/`` (SetBool) and ``robot.py``
+(every node in one rclpy process, run in ROS 2's Python).
+
+CLI (from the repository root)::
+
+    python3 bench/robot_generator.py --seeds 0-49 --nodes 5-8 --seconds 10 --burn
+    python3 bench/robot_generator.py --seeds 3 --defect
+    python3 bench/robot_generator.py --write DIR --seeds 7     # the workspace alone
+
+``--smoke``: generates and type-checks the workspaces of 20 seeds (with and without a defect); no
+live run (tests/bench/test_robot_generator.py runs the live seeds).
+"""
+from __future__ import annotations
+
+if __name__ == "__main__":  # run as a script: a Python without the dependencies runs again under .venv/
+    import _venv  # noqa: F401
+
+import json
+import random
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+TEMPLATES = ROOT / "bench" / "templates" / "robot_generator"
+#: message type, field, RCL variable type and stamped-ness of each sensor kind
+SENSORS: dict[str, tuple[str, str, str, bool]] = {
+    "f32": ("std_msgs/Float32", "data", "REAL", False),
+    "u8": ("std_msgs/UInt8", "data", "INTEGER", False),
+    "range": ("sensor_msgs/Range", "range", "REAL", True),
+    "arr": ("std_msgs/Float32MultiArray", "data", "seq(REAL)", False),
+    "scan": ("sensor_msgs/LaserScan", "ranges", "seq(REAL)", True),
+}
+SETBOOL = "bool data\n---\nbool success\nstring message\n"
+#: sensor_msgs/Range as ROS 2 Kilted defines it (with ``variance``): the monitor's DDS reader is told the
+#: robot's layout (``--interfaces interfaces``), whose type hash differs from the older definition's
+RANGE = ("std_msgs/Header header\nuint8 ULTRASOUND=0\nuint8 INFRARED=1\nuint8 radiation_type\n"
+         "float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range\nfloat32 variance\n")
+HORIZON = 1.0
+
+
+def f32(v: float) -> float:
+    """``v`` rounded to the nearest float32, as a Python float."""
+    return float(np.float32(v))
+
+
+def _float_band(rng: random.Random) -> tuple[str, str, list[str]]:
+    lo = rng.choice(["0", "0.1", "0.25", "0.5"])
+    hi = f"{float(lo) + rng.choice([1.5, 2.2, 3.0, 4.7]):.2f}".rstrip("0").rstrip(".")
+    ks = sorted({f"{rng.uniform(float(lo) + 0.05, float(hi) - 0.05):.2f}" for _ in range(3)})
+    return lo, hi, ks
+
+
+def _float_values(rng: random.Random, lo: str, hi: str, ks: list[str], n: int) -> list[float]:
+    """Float32 readings within [lo, hi]: both ends, each threshold and its float32 neighbours, and
+    random values; each as the float32 a field carries."""
+    pool = [f32(float(lo)), f32(float(hi))]
+    for k in ks:
+        x = np.float32(float(k))
+        pool += [float(x), float(np.nextafter(x, np.float32(-np.inf))), float(np.nextafter(x, np.float32(np.inf)))]
+    pool = [v for v in pool if f32(float(lo)) <= v <= f32(float(hi))]
+    out = [rng.choice(pool) if rng.random() < 0.6 else f32(rng.uniform(float(lo), float(hi))) for _ in range(n)]
+    return _with_all(rng, out, pool)
+
+
+def _with_all(rng: random.Random, values: list[Any], must: list[Any]) -> list[Any]:
+    """``values`` with every item of ``must`` put in at a random place (each boundary is hit)."""
+    out = list(values)
+    for v in must:
+        if v not in out:
+            out.insert(rng.randrange(len(out) + 1), v)
+    return out
+
+
+def _sensor(rng: random.Random, i: int, kinds: tuple[str, ...], kind: str | None = None) -> dict[str, Any]:
+    kind = kind or rng.choice(kinds)
+    period = rng.choice([100, 150, 200, 250, 300, 400])
+    s: dict[str, Any] = {"kind": "sensor", "name": f"Sensor{i}", "ros_name": f"sensor{i}", "topic_base": f"s{i}",
+                         "sensor_kind": kind, "period_ms": period, "phase_ms": rng.randrange(0, period),
+                         "back_ms": rng.choice([0, 5, 10, 30]) if SENSORS[kind][3] else 0}
+    if kind == "u8":
+        lo, hi = rng.randrange(0, 20), rng.randrange(150, 256)
+        ks = sorted({rng.randrange(lo + 2, hi - 2) for _ in range(3)})
+        pool = [lo, hi] + [v for k in ks for v in (k - 1, k, k + 1)]
+        s.update(lo=str(lo), hi=str(hi), thresholds=[str(k) for k in ks],
+                 values=_with_all(rng, [rng.choice(pool) if rng.random() < 0.6 else rng.randrange(lo, hi + 1)
+                                        for _ in range(16)], pool),
+                 beyond=hi + 1 if hi < 255 else None)
+        if s["beyond"] is None:  # a uint8 cannot leave [lo, 255] above: the defect goes below
+            s["beyond"] = lo - 1 if lo > 0 else None
+        return s
+    lo_t, hi_t, ks_t = _float_band(rng)
+    over = float(np.nextafter(np.float32(float(hi_t)), np.float32(np.inf)))
+    if kind in ("f32", "range"):
+        vals: list[Any] = _float_values(rng, lo_t, hi_t, ks_t, 16)
+        beyond: Any = over
+    else:
+        cells = _float_values(rng, lo_t, hi_t, ks_t, 80)
+        vals = [rng.sample(cells, rng.randint(3, 6)) for _ in range(12)]
+        for k in ks_t:  # readings whose least cell is the threshold itself, and one just below it
+            x = np.float32(float(k))
+            for least in (float(x), float(np.nextafter(x, np.float32(-np.inf)))):
+                above = [c for c in cells if c > least][:rng.randint(2, 5)] or [least]
+                vals.insert(rng.randrange(len(vals) + 1), rng.sample(above + [least], len(above) + 1))
+        beyond = [f32(float(lo_t)), over, f32(float(hi_t))]
+    s.update(lo=lo_t, hi=hi_t, thresholds=ks_t, values=vals, beyond=beyond)
+    return s
+
+
+def generate(seed: int, nodes: int = 5, defect: bool = False,
+             kinds: tuple[str, ...] = tuple(SENSORS)) -> dict[str, Any]:
+    """The spec of generated robot ``seed``: ``{"seed", "defect", "nodes": [node spec, ...]}``, ``nodes``
+    contract nodes (at least 2: a sensor and one consumer); with ``defect``, exactly one node's spec
+    holds ``"defect": True``; ``kinds``: the sensor kinds drawn from (keys of :data:`SENSORS`).
+    Deterministic in (seed, nodes, defect, kinds)."""
+    rng = random.Random(f"robot-{seed}-{nodes}" + ("" if kinds == tuple(SENSORS) else "-" + ",".join(kinds)))
+    out: list[dict[str, Any]] = []
+    sensors: list[dict[str, Any]] = []
+    spaces = [None, None, "ns1", "ns2", "arm/ns3"]
+
+    def new_sensor(kind: str | None = None) -> dict[str, Any]:
+        s = _sensor(rng, len(out), kinds, kind)
+        s["namespace"] = rng.choice(spaces)
+        out.append(s)
+        sensors.append(s)
+        return s
+    new_sensor(rng.choice([k for k in ("f32", "range") if k in kinds]))
+    while len(out) < nodes:
+        i = len(out)
+        roll = rng.random()
+        ns = rng.choice(spaces)
+        base = {"name": "", "ros_name": "", "namespace": ns}
+        if roll < 0.2 or len(sensors) == 0:
+            new_sensor()
+            continue
+        if roll < 0.5:
+            src = rng.choice(sensors)
+            kind = src["sensor_kind"]
+            op = "ge" if kind == "u8" else ("exists_lt" if kind in ("arr", "scan") else "le")
+            out.append({**base, "kind": "alarm", "name": f"Alarm{i}", "ros_name": f"alarm{i}", "topic_base": f"a{i}",
+                        "source": src["name"], "in_kind": kind, "op": op, "k": rng.choice(src["thresholds"]),
+                        "delay_ms": rng.randrange(0, int(src["period_ms"] * 0.3) + 1),
+                        "assume_band": rng.random() < 0.5})
+            continue
+        scalars = [s for s in sensors if s["sensor_kind"] in ("f32", "range")]
+        if roll < 0.7 and scalars:
+            src = rng.choice(scalars)
+            copy = src["sensor_kind"] == "range" and rng.random() < 0.7
+            top = 2 * src["period_ms"] if copy else int(src["period_ms"] * 0.3)
+            out.append({**base, "kind": "relay", "name": f"Relay{i}", "ros_name": f"relay{i}", "topic_base": f"r{i}",
+                        "source": src["name"], "in_kind": src["sensor_kind"], "copy": copy,
+                        "delay_ms": rng.randrange(0, top + 1)})
+            continue
+        if roll < 0.85 and scalars and len(out) + 2 <= nodes:
+            a = rng.choice(scalars)
+            b = _sensor(rng, i, kinds, rng.choice([k for k in ("u8", "arr", "scan") if k in kinds] or ["u8"]))
+            b.update(namespace=rng.choice(spaces), period_ms=a["period_ms"],
+                     phase_ms=(a["phase_ms"] + a["period_ms"] // 2) % a["period_ms"])
+            out.append(b)
+            sensors.append(b)
+            j = len(out)
+            out.append({**base, "kind": "fuse", "name": f"Fuse{j}", "ros_name": f"fuse{j}", "topic_base": f"f{j}",
+                        "a_source": a["name"], "a_kind": a["sensor_kind"], "ka": rng.choice(a["thresholds"]),
+                        "b_source": b["name"], "b_kind": b["sensor_kind"], "kb": rng.choice(b["thresholds"]),
+                        "op_b": "ge" if b["sensor_kind"] == "u8" else "exists_lt",
+                        "delay_ms": rng.randrange(0, int(a["period_ms"] * 0.3) + 1)})
+            continue
+        period = rng.choice([150, 200, 300])
+        out.append({**base, "kind": "service", "name": f"Switch{i}", "ros_name": f"switch{i}", "topic_base": f"srv{i}",
+                    "introspection": rng.random() < 0.5, "period_ms": period, "phase_ms": rng.randrange(0, period),
+                    "pattern": [rng.random() < 0.5 for _ in range(7)]})
+    by_name = {n["name"]: n for n in out}
+    for n in out:  # resolved names: the ROS topic (absolute), its RCL spelling, and each input's topic
+        ns = n.get("namespace")
+        rel = f"{ns}/{n['topic_base']}" if ns else n["topic_base"]
+        n["rcl_topic"] = rel
+        if n["kind"] == "service":
+            n["service"] = "/" + rel
+        else:
+            n["topic"] = "/" + rel
+    for n in out:
+        if n["kind"] in ("alarm", "relay"):
+            n["in_topic"] = by_name[n["source"]]["topic"]
+        if n["kind"] == "fuse":
+            n["a_topic"], n["b_topic"] = by_name[n["a_source"]]["topic"], by_name[n["b_source"]]["topic"]
+    spec = {"seed": seed, "defect": defect, "nodes": out}
+    if defect:
+        candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None]
+        # a node whose defect shows on the values the run carries: an alarm or fuse is wrong only at its threshold
+        victim = random.Random(f"defect-{seed}-{nodes}").choice(candidates)
+        victim["defect"] = True
+    return spec
+
+
+def _consts(spec: dict[str, Any]) -> tuple[list[dict[str, str]], dict[str, dict[str, str]]]:
+    """The context's named constants and, per node, its own names for them."""
+    consts: list[dict[str, str]] = []
+    names: dict[str, dict[str, str]] = {}
+
+    def const(node: str, role: str, text: str, integer: bool) -> None:
+        name = f"{node.upper()}_{role}"
+        consts.append({"name": name, "type": "INTEGER" if integer else "REAL", "text": text})
+        names.setdefault(node, {})[role] = name
+    for n in spec["nodes"]:
+        if n["kind"] == "sensor":
+            u8 = n["sensor_kind"] == "u8"
+            const(n["name"], "LO", n["lo"], u8)
+            const(n["name"], "HI", n["hi"], u8)
+        elif n["kind"] == "alarm":
+            const(n["name"], "K", n["k"], n["in_kind"] == "u8")
+        elif n["kind"] == "fuse":
+            const(n["name"], "KA", n["ka"], False)
+            const(n["name"], "KB", n["kb"], n["b_kind"] == "u8")
+    return consts, names
+
+
+def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str, dict[str, str]]) -> dict[str, Any]:
+    """One node's contract as the template's fields (inputs, outputs, topics, services, assume, guarantees)."""
+    c: dict[str, Any] = {"name": n["name"], "topics": [], "services": [], "assume": "TRUE", "inputs": [], "outputs": []}
+    k = names.get(n["name"], {})
+
+    def band(var: str, s: dict[str, Any]) -> str:
+        lo, hi = names[s["name"]]["LO"], names[s["name"]]["HI"]
+        if s["sensor_kind"] in ("arr", "scan"):
+            return f"forall(v in {var} | {lo} <= v and v <= {hi})"
+        return f"{lo} <= {var} and {var} <= {hi}"
+    if n["kind"] == "sensor":
+        typ, _f, rcl, stamped = SENSORS[n["sensor_kind"]]
+        var = "cells" if rcl.startswith("seq") else ("n" if rcl == "INTEGER" else "x")
+        c["outputs"] = [f"{var} : {rcl}"]
+        c["topics"] = [f"{typ} {n['rcl_topic']} matches(out.{var})"]
+        c["guarantees"] = [{"formula": band(f"out.{var}", n), "trigger": ""}]
+        c["comment"] = (f"a sensor publishing every {n['period_ms']} ms, {'stamped' if stamped else 'unstamped'}"
+                        + (f", its stamp {n['back_ms']} ms before it publishes" if n["back_ms"] else "")
+                        + (" [seeded defect: publishes beyond its band]" if n.get("defect") else ""))
+        return c
+    if n["kind"] == "service":
+        c["inputs"], c["outputs"] = ["on : BOOL"], ["ok : BOOL"]
+        c["services"] = [f"std_srvs/SetBool {n['rcl_topic']} serves(in.on, out.ok)"]
+        c["guarantees"] = [{"formula": "out.ok == in.on", "trigger": "triggered by in.on within 800 ms"}]
+        c["comment"] = (f"a SetBool server, {'with' if n['introspection'] else 'without'} introspection"
+                        + (" [seeded defect: every third answer wrong]" if n.get("defect") else ""))
+        return c
+    deadline = n["delay_ms"] + 500
+    if n["kind"] in ("alarm", "relay"):
+        s = by[n["source"]]
+        typ, _f, rcl, _st = SENSORS[s["sensor_kind"]]
+        var = "cells" if rcl.startswith("seq") else ("n" if rcl == "INTEGER" else "x")
+        c["inputs"] = [f"{var} : {rcl}"]
+        c["topics"] = [f"{typ} {s['rcl_topic']} matches(in.{var})"]
+        if n["kind"] == "relay":
+            c["outputs"] = ["r : REAL"]
+            c["topics"].append(f"sensor_msgs/Range {n['rcl_topic']} matches(out.r)")
+            c["guarantees"] = [{"formula": f"out.r == in.{var}", "trigger": f"triggered by in.{var} within {deadline} ms"}]
+            c["comment"] = (f"a relay {'copying the header stamp' if n['copy'] else 'stamping with its own clock'}, "
+                            f"after {n['delay_ms']} ms" + (" [seeded defect: adds 0.5 to every fourth reading]"
+                                                          if n.get("defect") else ""))
+        else:
+            out, cond = {"le": ("low", f"in.x <= {k['K']}"), "ge": ("high", f"in.n >= {k['K']}"),
+                         "exists_lt": ("low", f"exists(v in in.cells | v < {k['K']})")}[n["op"]]
+            c["outputs"] = [f"{out} : BOOL"]
+            c["topics"].append(f"std_msgs/Bool {n['rcl_topic']} matches(out.{out})")
+            c["guarantees"] = [{"formula": f"out.{out} <=> ({cond})", "trigger": f"triggered by in.{var} within {deadline} ms"}]
+            c["comment"] = (f"an alarm at a threshold, answering after {n['delay_ms']} ms"
+                            + (" [seeded defect: the strict comparison for the other]" if n.get("defect") else ""))
+        if n.get("assume_band"):
+            c["assume"] = band(f"in.{var}", s)
+        return c
+    a, b = by[n["a_source"]], by[n["b_source"]]
+    ta, tb = SENSORS[a["sensor_kind"]][0], SENSORS[b["sensor_kind"]][0]
+    if n["op_b"] == "ge":
+        c["inputs"], c["outputs"] = ["a : REAL", "b : INTEGER"], ["alert : BOOL"]
+        c["topics"] = [f"{ta} {a['rcl_topic']} matches(in.a)", f"{tb} {b['rcl_topic']} matches(in.b)",
+                       f"std_msgs/Bool {n['rcl_topic']} matches(out.alert)"]
+        g = f"out.alert <=> (in.a <= {k['KA']} and in.b >= {k['KB']})"
+    else:
+        c["inputs"], c["outputs"] = ["x : REAL", "cells : seq(REAL)"], ["low : BOOL"]
+        c["topics"] = [f"{ta} {a['rcl_topic']} matches(in.x)", f"{tb} {b['rcl_topic']} matches(in.cells)",
+                       f"std_msgs/Bool {n['rcl_topic']} matches(out.low)"]
+        g = f"out.low <=> (in.x <= {k['KA']} or exists(v in in.cells | v < {k['KB']}))"
+    trig = "in.a" if n["op_b"] == "ge" else "in.x"
+    c["guarantees"] = [{"formula": g, "trigger": f"triggered by {trig} within {deadline} ms"}]
+    c["comment"] = (f"two inputs, answering each {trig} after {n['delay_ms']} ms"
+                    + (" [seeded defect: the strict comparison for the other]" if n.get("defect") else ""))
+    return c
+
+
+def render(spec: dict[str, Any]) -> dict[str, str]:
+    """The workspace's files (relative path -> text) of ``spec``, rendered from the jinja2 templates."""
+    import jinja2
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(str(TEMPLATES)), keep_trailing_newline=True,
+                             undefined=jinja2.StrictUndefined, autoescape=False)
+    by = {n["name"]: n for n in spec["nodes"]}
+    consts, names = _consts(spec)
+    contracts = [_contract(n, by, names) for n in spec["nodes"]]
+    fields: list[tuple[str, str]] = []
+    for n in spec["nodes"]:
+        if n["kind"] == "sensor":
+            fields.append((n["rcl_topic"], SENSORS[n["sensor_kind"]][1]))
+        elif n["kind"] == "service":
+            fields += [(f"{n['rcl_topic']}/request", "data"), (f"{n['rcl_topic']}/response", "success")]
+        elif n["kind"] == "relay":
+            fields.append((n["rcl_topic"], "range"))
+        else:
+            fields.append((n["rcl_topic"], "data"))
+    robot_spec = {"nodes": spec["nodes"]}
+    return {
+        "contracts/robot.rcl": env.get_template("contracts.rcl.j2").render(
+            seed=spec["seed"], defect=spec["defect"], constants=consts, nodes=contracts),
+        "contracts/plan.yaml": env.get_template("plan.yaml.j2").render(seed=spec["seed"], nodes=spec["nodes"]),
+        "mapping.yaml": env.get_template("mapping.yaml.j2").render(fields=fields, horizon=HORIZON),
+        "interfaces/std_srvs/srv/SetBool.srv": SETBOOL,
+        "interfaces/sensor_msgs/msg/Range.msg": RANGE,
+        "robot.py": env.get_template("robot.py.j2").render(
+            seed=spec["seed"], count=len(spec["nodes"]), spec_json=json.dumps(robot_spec, sort_keys=True)),
+        "spec.json": json.dumps(spec, indent=1, sort_keys=True) + "\n",
+    }
+
+
+def write_workspace(spec: dict[str, Any], ws: Path) -> Path:
+    """Write the workspace of ``spec`` under ``ws`` (created; files written atomically); returns ``ws``."""
+    from rclverify.core.atomic import atomic_write_text
+    for rel, text in render(spec).items():
+        path = ws / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(path, text)
+    return ws
+
+
+def check_workspace(ws: Path) -> list[str]:
+    """The project's parser and type checker on ``ws/contracts/robot.rcl`` and its plan: the names of the
+    contracts checked.  Raises what the front end raises on an ill-formed contract."""
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.lang.typecheck import load
+    from rclverify.model.plan.load import load_plan
+    load_plan(ws)
+    load_mapping(ws, "mapping.yaml")
+    return list(load([ws / "contracts" / "robot.rcl"]).nodes)
+
+
+def _seeds(text: str) -> list[int]:
+    out: list[int] = []
+    for part in text.split(","):
+        lo, _, hi = part.partition("-")
+        out += list(range(int(lo), int(hi or lo) + 1))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--seeds", default="0-4", help="seeds, e.g. 0-49 or 3,7,9 (default 0-4)")
+    p.add_argument("--nodes", default="5", help="contract nodes per system, N or LO-HI (drawn per seed)")
+    p.add_argument("--seconds", type=float, default=10.0, help="seconds of sensing per run")
+    p.add_argument("--defect", action="store_true", help="seed one defect per system; check it is red at its node")
+    p.add_argument("--without", action="append", default=[], choices=list(SENSORS),
+                   help="leave this sensor kind out (repeatable)")
+    p.add_argument("--burn", action="store_true", help="one CPU-burning process beside each run (both cores busy)")
+    p.add_argument("--write", metavar="DIR", help="write the workspaces under DIR/seed-N and stop (no live run)")
+    p.add_argument("--keep", metavar="DIR", help="keep each run's workspace, log and bag under DIR/seed-N")
+    p.add_argument("--src", metavar="SRC", help="the rclverify sources to judge with (default: this tree's src/)")
+    p.add_argument("--smoke", action="store_true", help="CI: generate and type-check 20 workspaces, no live run")
+    a = p.parse_args(argv)
+    lo, _, hi = a.nodes.partition("-")
+    sizes = (int(lo), int(hi or lo))
+    if a.smoke:
+        return _smoke()
+    seeds = _seeds(a.seeds)
+    kinds = tuple(k for k in SENSORS if k not in a.without)
+    if a.write:
+        for seed in seeds:
+            n = random.Random(seed).randint(*sizes)
+            ws = write_workspace(generate(seed, n, a.defect, kinds), Path(a.write) / f"seed-{seed}")
+            print(f"seed {seed}: {n} nodes: {ws}")
+        return 0
+    sys.path.insert(0, str(ROOT / "bench"))
+    from _robot_run import run_many
+    return run_many(seeds, sizes, a.seconds, a.defect, a.burn, Path(a.keep) if a.keep else None, kinds,
+                    Path(a.src).resolve() if a.src else ROOT / "src")
+
+
+def _smoke() -> int:
+    import tempfile
+    import time
+    t0 = time.perf_counter()
+    checked = 0
+    with tempfile.TemporaryDirectory() as d:
+        for seed in range(10):
+            for defect in (False, True):
+                n = 5 + seed % 12
+                ws = write_workspace(generate(seed, n, defect), Path(d) / f"seed-{seed}-{defect}")
+                checked += len(check_workspace(ws))
+    print(f"robot generator smoke: 20 workspaces generated and type-checked, {checked} contracts, "
+          f"{time.perf_counter() - t0:.2f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
