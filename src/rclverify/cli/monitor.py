@@ -219,7 +219,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     if cfg.mapping:  # the mapping's field paths against the definitions: the check `doit verify` makes
         from rclverify.backends.monitors.fieldpaths import check_field_paths  # deferred: start-up (only live)
         try:
-            wrong = check_field_paths(root, cfg.mapping, cfg.msg_dirs, checked)
+            wrong = check_field_paths(root, cfg.mapping, cfg.msg_dirs, checked, robot_types=True)
         except MissingExtra:  # without rosbags no standard definition is known: the run reads what comes
             wrong = []
         if wrong:

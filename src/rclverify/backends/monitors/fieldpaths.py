@@ -9,14 +9,20 @@ the type is known (the mapping's ``msg_dirs``, or the standard types of
 rosbags' store, which the bag reader uses too), every entry is followed
 through the definitions (:func:`rclverify.ros.extract.interfaces.field_path`, the
 ROS grounding's reader): a field that does not exist, a message where a
-number is read, an array read without an index (unless the topic sets a
-``seq(T)`` variable, which the array fills) or a path through every item
-(``poses[*].position.x``, read as the grounding's ``poses[].position.x``)
-on a topic whose variable is not a sequence is one located error at the
-entry in the mapping file (``mapping.yaml:7:22: error: topic cmd_vel:
-field 'linar.x' of geometry_msgs/Twist: ...``), before any run is read.
-An unknown type is left to the run (its events are then ``inconclusive``
-with the reason when a field is missing).
+number is read, an array read without an index (unless the topic, or the
+service's or action's part, sets a ``seq(T)`` variable, which the array
+fills: an action's ``int32[] sequence`` feedback for a ``seq(INTEGER)``) or
+a path through every item (``poses[*].position.x``, read as the grounding's
+``poses[].position.x``) on a topic whose variable is not a sequence is one
+located error at the entry in the mapping file (``mapping.yaml:7:22: error:
+topic cmd_vel: field 'linar.x' of geometry_msgs/Twist: ...``), before any
+run is read.  An unknown type is left to the run (its events are then
+``inconclusive`` with the reason when a field is missing).
+
+``doit verify`` (the plan's check) and ``rclverify monitor --live`` call the
+one :func:`check_field_paths`; the live monitor leaves a field the
+definitions lack to the run (a publisher may declare its own definition of
+the type, docs/ros2.md "Types from the robot") and refuses the rest alike.
 """
 from __future__ import annotations
 
@@ -68,10 +74,17 @@ def _table(root: Path, msg_dirs: Sequence[str]) -> TypeTable:
     return table
 
 
-def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Checked) -> list[Diagnostic]:
+def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Checked,
+                      robot_types: bool = False) -> list[Diagnostic]:
     """Located errors for the ``fields`` entries of mapping file ``rel`` that
     do not name a number, string or boolean field of their topic's known
-    type (module docstring); empty when every known one does."""
+    type (module docstring); empty when every known one does.  ``doit verify``
+    and ``rclverify monitor --live`` both call it; the live monitor with
+    ``robot_types`` true: a field the definitions lack is then left to the
+    run, which reads a publisher's own definition of its type (docs/ros2.md,
+    "Types from the robot"), while a field that is there and cannot fill its
+    variable (an array for a single value ...) is refused as ``doit verify``
+    refuses it."""
     path = root / rel
     raw, locs = load_located(read_yaml_text(path, rel), rel)
     topics = raw.get("topics") if isinstance(raw, Mapping) else None
@@ -91,7 +104,7 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
         if table.get(typ) is None:
             continue  # a type this workspace does not define: the run decides
         for k, f in enumerate(fields):
-            why = _why(table, typ, str(f), str(topic).lstrip("/") in seqs)
+            why = _why(table, typ, str(f), str(topic).lstrip("/") in seqs, robot_types)
             if why is None:
                 continue
             at = locs.get(("topics", topic, "fields", k)) or locs.get(("topics", topic, "fields"))
@@ -121,13 +134,16 @@ def _sequence_topics(checked: Checked) -> set[str]:
     return out
 
 
-def _why(table: TypeTable, typ: str, name: str, sequence: bool = False) -> str | None:
+def _why(table: TypeTable, typ: str, name: str, sequence: bool = False, robot_types: bool = False) -> str | None:
     """What is wrong with field ``name`` of ``typ`` (``None``: nothing); ``sequence``: the topic sets a
-    ``seq(T)`` variable, which an array, or a path through every item of one (``poses[*].position.x``), fills."""
+    ``seq(T)`` variable, which an array, or a path through every item of one (``poses[*].position.x``), fills;
+    ``robot_types``: a path the definitions cannot follow is not wrong (:func:`check_field_paths`)."""
     every = "[*]" in name
     rt, err, arr = field_path(table, typ, name.replace("[*]", "[]"))  # the grounding's reader writes every item []
     if err is not None:
-        return err
+        return None if robot_types else err
+    if (rt or "").endswith("/wstring"):  # rosbags' .msg reader takes wstring, which it lacks, for a message
+        rt = "wstring"
     if every and not sequence:
         return "every item ([*]) fills a sequence; the topic's variable is not a seq(T)"
     if every and arr:
