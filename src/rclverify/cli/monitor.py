@@ -200,8 +200,6 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     status 1 when a contract was violated (a topic, a call, a deadline), 0
     otherwise, 2 when ROS 1, the DDS domain or a message type is unavailable
     (one message on stderr)."""
-    import signal  # deferred: start-up (loads signal only when called)
-    import threading  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     from functools import partial  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
 
     import os  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
@@ -247,9 +245,9 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
                       reorder_window=args.reorder_window, silence_s=args.silence,
                       margins=bool(getattr(args, "margins", False)), warn_margin=warn_margin,
                       warn=lambda line: print(line, file=sys.stderr, flush=True), **extra)
-    stop = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
+    from rclverify.runtime.stopping import StopFlag, on_signals  # deferred: start-up (only live)
+    stop = StopFlag()  # a handler that takes no lock: a stop is always heard (stopping.py)
+    on_signals(stop)
     common: dict[str, Any] = dict(
         verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
         node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
 import sys
 import tempfile
 import threading
@@ -43,6 +42,7 @@ from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineVerdi
 from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
 from rclverify.runtime.ros1_interfaces import action_classes, service_class
 from rclverify.runtime.shapes import DeadlineSummary
+from rclverify.runtime.stopping import StopFlag, on_signals
 from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, check_master, finish_within,
                                     run_bounded, shutdown_limit)
 
@@ -229,9 +229,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
     import rosgraph  # deferred: start-up (loads rosgraph only when called)
     uri = rosgraph.get_master_uri()
-    stop = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
+    stop = StopFlag()  # a handler that takes no lock: a stop is always heard (stopping.py)
+    on_signals(stop)
     run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in deadline_nodes(checked)], Path(args.log))
     now: Callable[[], float] = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
     bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)  # a master that hangs holds nothing (ros1.py)
