@@ -53,7 +53,7 @@ from rclverify.backends.monitors.check import NodeResult, Verdict
 from rclverify.backends.monitors.deadlines import DeadlineVerdict
 from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
 from rclverify.backends.monitors.run_origin import unseen_links
-from rclverify.runtime.live_status import LowMargins, least_margins, running_bound
+from rclverify.runtime.live_status import LowMargins, least_margins, running_bound, warm_bounds
 from rclverify.runtime.logchecks import LogChecks
 from rclverify.runtime.shapes import LiveCounts, SilenceNote
 from rclverify.backends.monitors.online import OnlineEngine
@@ -202,11 +202,12 @@ class LiveRun:
                 self.publish_last(node, text)
         self._last.clear()
 
-    def status_line(self) -> str:
+    def status_line(self, wait: bool = True) -> str:
         """``Node: 3 satisfied, 1 violated; 4 answer(s) counted, 95 % bound 0.75 per answer | Node2: ...``
-        (a live per-node status: the counts so far, docs/statistics.md)."""
+        (a live per-node status: the counts so far, docs/statistics.md); ``wait`` false: at once, the
+        bound said to be loading until its library is (:func:`.live_status.running_bound`)."""
         with self.lock:
-            parts = [summary_line(m.result) + running_bound(m.result) + least_margins(m.result)
+            parts = [summary_line(m.result) + running_bound(m.result, wait) + least_margins(m.result)
                      for m in self.engine.monitors]
             parts += self.checks.status()
         silent = [t for t, s in self.engine.topics.items() if s.silent]
@@ -351,6 +352,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
             s.unregister()
     calls = _subscribe(rospy, String, stop, until, uri, topics, pub, live, worker, subs, unsubscribe, proxy)
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
+    warm_bounds()  # the status line a stop prints need not wait for scipy (live_status.py)
     try:
         _watch(rospy, stop, duration, tick_s, status_s, calls, worker, pub, live, out)
     finally:
@@ -366,7 +368,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
         record["not_judged"] = live.not_judged(record)  # silence is never green (judged.py)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
-        out(live.status_line())
+        out(live.status_line(wait=False))
         finish_within(lambda: rospy.signal_shutdown("monitor stopped"), SHUTDOWN_TIMEOUT_S)
     return record
 
@@ -460,7 +462,7 @@ def _watch(rospy: Any, stop: threading.Event, duration: float | None, tick_s: fl
             break  # the engine thread died: stop and say so, never monitor on silently
         _no_delay(pub)
         if status_s > 0 and _time.monotonic() >= next_status:
-            out(live.status_line())
+            out(live.status_line(wait=False))
             next_status += status_s
 
 

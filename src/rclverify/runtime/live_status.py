@@ -9,6 +9,7 @@ The counts and margins are the engine's (each judged answer's space margin,
 from __future__ import annotations
 
 import math
+import threading
 from typing import Callable, Iterable
 
 from rclverify.backends.monitors.check import NodeResult, Verdict
@@ -55,17 +56,47 @@ def least_margins(res: NodeResult) -> str:
     return f"; least margin {', '.join(shown)}" if shown else ""
 
 
-def running_bound(res: NodeResult) -> str:
+#: set once :func:`warm_bounds`'s thread has loaded the bound's library (or found it missing)
+_READY = threading.Event()
+
+
+def running_bound(res: NodeResult, wait: bool = True) -> str:
     """``; 40 answer(s) counted, 95 % bound 0.0722 per answer``: the one-sided
     Clopper-Pearson bound on the probability that an answer violates the
     contract, from the counts so far (undecided answers count as
-    violations; docs/statistics.md); ``""`` before the first answer."""
+    violations; docs/statistics.md); ``""`` before the first answer.  With
+    ``wait`` false (a running live monitor's status line) and the bound's
+    library not yet loaded by :func:`warm_bounds`: ``; 40 answer(s) counted,
+    95 % bound not yet computed (its library is loading)``, at once."""
     c = res.counts
     n = c.get("satisfied", 0) + c.get("violated", 0) + c.get("inconclusive", 0)
     if not n:
         return ""
+    if not wait and not _READY.is_set():
+        return f"; {n} answer(s) counted, 95 % bound not yet computed (its library is loading)"
     bound, why = trivial_or_exact(n - c.get('satisfied', 0), n, 0.95)
     return f"; {n} answer(s) counted, 95 % bound {bound:.3g} per answer" + (f" ({why})" if why else "")
 
 
-__all__ = ["LowMargins", "least_margins", "running_bound"]
+def warm_bounds() -> threading.Thread:
+    """Start loading, in a daemon thread (``rclverify-warm``), the library :func:`running_bound` computes
+    its exact bound with (scipy's, about a second of CPU): a live run calls it once it has started
+    (after its last child process is started: the load sets ``OPENBLAS_NUM_THREADS`` for its duration,
+    :mod:`rclverify.core.numeric`), so the status line a stop prints never waits for the load and a
+    stop ends the run within a second (docs/monitors.md, "Stopping"); until it has, a status line asked
+    not to wait says the bound is loading (:func:`running_bound`).  Without the ``stats`` extra the
+    thread ends at once (the line then names the extra).  Returns the thread, started."""
+    def load() -> None:
+        try:
+            from rclverify.core.numeric import scipy_special  # deferred: start-up (loads numpy and scipy, in this thread)
+            scipy_special()
+        except ImportError:
+            pass
+        finally:
+            _READY.set()
+    t = threading.Thread(target=load, name="rclverify-warm", daemon=True)
+    t.start()
+    return t
+
+
+__all__ = ["LowMargins", "least_margins", "running_bound", "warm_bounds"]

@@ -48,6 +48,7 @@ from rclverify.runtime.dds.services import CallTaps
 from rclverify.runtime.dds.types import DdsTypeError, TypeBook, to_fields
 from rclverify.runtime.dds.wire import WriterIds
 from rclverify.runtime.live import VERDICT_LOG_TOPIC, LiveRun, dumps, stop_and_record
+from rclverify.runtime.live_status import warm_bounds
 from rclverify.runtime.ros1 import contract_topics
 from rclverify.runtime.worker import EngineWorker
 from rclverify.runtime.dds.bag import BagError
@@ -76,7 +77,7 @@ class _Sink:
 
 def _status(live: LiveRun, calls: Mapping[tuple[str, str], int]) -> str:
     """The topic engine's status line, then the calls' verdicts per node."""
-    line = live.status_line()
+    line = live.status_line(wait=False)  # never waits for the bound's library: a stop is heard (live_status.py)
     per: dict[str, list[str]] = {}
     for (node, verdict), n in sorted(dict(calls).items()):  # copied at once: the engine thread adds to it
         per.setdefault(node, []).append(f"{n} {verdict}")
@@ -125,6 +126,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     via = f"through rclpy on {run.source_rmw()}" if dp is None else f"on DDS domain {domain_id()}"
     out(f"monitoring {len(run.structs)} topic(s) and {len(run.calls.specs) if run.calls else 0} service/action "
         f"topic(s) for {len(nodes)} node(s) {via}; verdicts on {verdict_topic}")
+    warm_bounds()  # the status line a stop prints need not wait for scipy (live_status.py)
     try:
         run.wait(worker, stop, duration, tick_s, status_s)
     finally:
