@@ -92,8 +92,10 @@ def test_the_literal_finds_it_too_and_the_correct_code_passes(tmp_path: Path) ->
 
 def test_without_the_named_constant_the_same_run_misses_it(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """The control: boundaries from the contract's literals only (the rule
-    before issue 64) and the same seed pass the slip."""
+    before issue 64, without the thresholds solved from the comparisons,
+    thresholds.py, which find ProtectiveDist too) and the same seed pass the slip."""
     monkeypatch.setattr(harness, "boundary_constants", lambda *a, **k: [])
+    monkeypatch.setattr(harness, "solved_thresholds", lambda *a, **k: [])  # the comparisons' thresholds too
     monkeypatch.setattr(boundary, "boundary_constants", lambda c, n, i, lit: sorted(lit))
     out = _run(tmp_path, "Stopper", STOPPER.format(op="<"))
     assert out.status == "discharged", out.message

@@ -45,6 +45,7 @@ from rclverify.backends.property_tests.seeding import Seeder, split_facts
 from rclverify.backends.property_tests.coverage import Coverage
 from rclverify.backends.property_tests.constants import boundary_constants, constant_values
 from rclverify.backends.property_tests.strategies import assumption_bounds, conjuncts, input_space
+from rclverify.backends.property_tests.thresholds import drawn_thresholds, solved_thresholds
 from rclverify.backends.property_tests.config import Config, ConfigError, load_implementation, read_config
 from rclverify.backends.property_tests.closure import resolve_closure
 from rclverify.backends.property_tests.importpath import on_harness_path
@@ -196,9 +197,14 @@ class GuaranteeRun:
         # a named constant bounds an input as a literal does
         named = constant_values(self.checked, self.node)
         constants = boundary_constants(self.checked, self.node, self.impl)
+        # and every threshold a comparison puts on an input, however written (in.p / 2 <= 0.1: 0.2), solved on the
+        # contract read at the fields' widths, as the monitors judge it (.thresholds)
+        solved = solved_thresholds(self.node, self.checked.env.constants, self.used_facts)
+        constants = sorted({*constants, *solved})
         for width in sorted(set(self.widths.values())):  # the thresholds as the fields carry them, and their neighbours
             constants = sorted(set(constants) | set(edges_at_width(constants, width)))
         space = input_space(self.node, self.cfg.bounds, seed, constants, named)
+        space.thresholds = drawn_thresholds(self.node, solved, space.bounds, self.widths)
         space.carried = input_strategies(space, dict(self.carried))
         self.coverage = Coverage(self.node, space.bounds, assumption_bounds(self.node, named))
         one = space.inputs().filter(self.assumption_holds)

@@ -20,7 +20,11 @@ constrained by the node's assumption (docs/property-tests.md, "Strategies").
   of the context constants it names and the numbers its implementation
   compares with (:mod:`.constants`), each with its neighbours (one ulp
   either side for REAL, one either side for integers), are drawn alongside
-  arbitrary values, so a threshold that is off by one is hit.
+  arbitrary values, so a threshold that is off by one is hit.  The
+  thresholds the contract's comparisons put on an input, however written
+  (``in.p / 2 <= 0.1``: 0.2; :mod:`.thresholds`), are drawn with their
+  neighbours at each field width in a choice of their own
+  (:attr:`InputSpace.thresholds`).
 * Function-typed inputs are finite tables with a default
   (:class:`~rclverify.semantics.values.FiniteFunction`).  Their keys come from one pool
   of argument tuples per argument type, drawn once per example, so two
@@ -100,6 +104,10 @@ class InputSpace:
     misc_cache: dict[tuple[Any, ...], Any] = field(default_factory=dict)
     #: input name -> its strategy as its field carries it (:mod:`.at_width`), used instead of its type's
     carried: dict[str, st.SearchStrategy[Any]] = field(default_factory=dict)
+    #: the thresholds the contract's comparisons put on an input, however written (``in.p / 2 <= 0.1``:
+    #: 0.2; :mod:`.thresholds`), at each field width with their neighbours: drawn by a REAL input in a
+    #: choice of their own, beside the constants' edges and arbitrary values
+    thresholds: list[Fraction] = field(default_factory=list)
 
     def real(self, bd: Bound | None, small: bool = False) -> st.SearchStrategy[Any]:
         """Finite doubles within ``bd`` (``small``: within +-1000 where ``bd`` leaves a side open),
@@ -122,7 +130,11 @@ class InputSpace:
                           and (hi is None or e < hi or (e == hi and not no_hi)))
         floats = st.floats(min_value=lo, max_value=hi, allow_nan=False, allow_infinity=False,
                            exclude_min=no_lo, exclude_max=no_hi)
-        return st.one_of(st.sampled_from(edges_in), floats) if edges_in else floats
+        solved = sorted({float(t) for t in self.thresholds if Fraction(float(t)) == t
+                         and (lo is None or float(t) > lo or (float(t) == lo and not no_lo))
+                         and (hi is None or float(t) < hi or (float(t) == hi and not no_hi))})
+        branches = [st.sampled_from(xs) for xs in (solved, edges_in) if xs]
+        return st.one_of(*branches, floats) if branches else floats
 
     def integer(self, bd: Bound | None, natural: bool, small: bool = False) -> st.SearchStrategy[int]:
         """Integers within ``bd`` (``natural``: from 0; ``small``: a few values near 0, no edges), with
