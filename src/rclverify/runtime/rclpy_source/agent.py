@@ -48,6 +48,9 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
 
 SIGINT is ignored (the monitor stops the agent when it stops: ``stop`` or
 the end of stdin), so a Ctrl-C in a terminal does not cut the stream short.
+At ``stop`` the agent says ``stopped`` once every sample it took is handed
+over, then leaves the graph (its node destroyed, rclpy shut down) on its own:
+the monitor need not wait for that to end its run.
 
 Long module: it runs as one script in another Python (a ROS 2 installation's),
 importing rclpy, the standard library and :mod:`wire` beside it only, so the
@@ -528,7 +531,10 @@ def main() -> int:
             try:
                 while True:
                     c = q.get_nowait() if started else q.get(timeout=0.05)
-                    if c is None or c.get("op") == "stop":
+                    if c is None:
+                        return 0
+                    if c.get("op") == "stop":  # every sample taken is handed over: said, then the node leaves
+                        _emit(wire.json_frame({"what": "stopped"}))
                         return 0
                     if c.get("op") == "start":
                         started = True

@@ -180,6 +180,8 @@ class RclpyBus:
         self._proc: subprocess.Popen[bytes] | None = None
         self._thread = threading.Thread(target=self._run, name="rclverify-rclpy", daemon=True)
         self._hello = threading.Event()
+        #: the agent said ``stopped``: every sample it took was handed over (:meth:`stop`)
+        self.stopped = False
         self._lock = threading.Lock()
         self._start()
 
@@ -231,16 +233,19 @@ class RclpyBus:
         return self
 
     def stop(self, timeout: float = 10.0) -> None:
-        """Stop the agent (after it handed over what it had); re-raise what the reading thread died of."""
+        """Stop the agent (after it handed over what it had: its ``stopped``, or the end of its output);
+        re-raise what the reading thread died of.  An agent that said ``stopped`` leaves the graph on
+        its own, unwaited for; one that did not within ``timeout`` s is killed."""
         self._send({"op": "stop"})
+        self._thread.join(timeout)
         proc = self._proc
-        if proc is not None:
+        if proc is not None and not self.stopped:
             try:
                 proc.wait(timeout)
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait(5)
-        self._thread.join(timeout)
+            self._thread.join(timeout)
         for (k, _gid), bodies in self._held.items():  # never answered: not heard, counted
             self.taps[k].dropped += len(bodies)
         self._held.clear()
@@ -248,7 +253,8 @@ class RclpyBus:
             raise self.error
 
     def close(self) -> None:
-        if self._proc is not None and self._proc.poll() is None:
+        """Kill the agent unless it said ``stopped`` (then it is leaving the graph on its own)."""
+        if self._proc is not None and not self.stopped and self._proc.poll() is None:
             self._proc.kill()
             self._proc.wait(5)
 
@@ -292,8 +298,12 @@ class RclpyBus:
                 kind, body = frame
                 if kind == b"S":
                     self._sample(body)
-                else:
-                    self._json(json.loads(body))
+                    continue
+                obj = json.loads(body)
+                if obj.get("what") == "stopped":  # everything handed over (the agent's stop)
+                    self.stopped = True
+                    return
+                self._json(obj)
             if proc.wait() not in (0, None):
                 raise RclpyUnavailable(f"the rclpy agent exited with status {proc.returncode}")
         except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead reader must be said
