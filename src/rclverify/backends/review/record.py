@@ -17,9 +17,10 @@ Record (YAML)::
       - {id: g1.c1, conjunct: <RCL>, answer: yes, note: <why>}   # yes | no | (empty: unanswered)
     verdict: pass                       # pass | fail | (empty: not decided)
 
-``author`` and ``independence`` say who checked what: a review counts for
-a standard's clause that asks independence (IEC 61508-1:2010 clause 8,
-DO-178C Annex A "with independence") only when the record names both its
+``author`` and ``independence`` say who checked what: by rclverify's rule
+(docs/standards.md, its levels borrowed from IEC 61508-1:2010 clause 8,
+which grades the functional safety assessment; DO-178C Annex A "with
+independence"), a review counts for a clause that asks independence only when the record names both its
 reviewer and its author, each names a person, they are not one person as
 :mod:`rclverify.model.plan.standards.identity` compares names (NFKC, case,
 punctuation and spaces aside, e-mail addresses and the declared aliases
@@ -151,8 +152,8 @@ def parse_record(text: str, file: str) -> ReviewRecord:
     assumption = data.get("assumption")
     independence = str(data.get("independence") or "").strip()
     if independence not in ("", "person", "department", "organisation"):
-        raise RecordError(f"{file}: independence must be person, department or organisation (IEC 61508-1 "
-                          f"clause 8), found {independence!r}")
+        raise RecordError(f"{file}: independence must be person, department or organisation (docs/standards.md), "
+                          f"found {independence!r}")
     aliases = {k: _names(data.get(k), f"{file}: {k}") for k in ("author_aliases", "reviewer_aliases")}
     verdict = data["verdict"]
     if verdict not in (None, "", "pass", "fail"):

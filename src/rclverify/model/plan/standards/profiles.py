@@ -38,8 +38,10 @@ ASKED: tuple[str, ...] = ("HR", "required")
 #: interfaces between nodes, the requirements, the whole system, field data from operation, trials
 #: against a stated target.
 ABOUT: tuple[str, ...] = ("guarantees", "interfaces", "requirements", "system", "field-data", "trials")
-#: Independence levels, weakest first (IEC 61508-1:2010 clause 8 and its Tables 4 and 5: independent person,
-#: department, organisation; DO-178C Annex A "with independence": a person other than the author).
+#: Independence levels, weakest first: rclverify's rule for who checked a review (docs/standards.md), its
+#: levels borrowed from IEC 61508-1:2010 clause 8, Tables 4 and 5 (independent person, department,
+#: organisation), which grade the functional safety assessment, not a review; DO-178C Annex A's "with
+#: independence" is a person other than the author.
 INDEPENDENCE: tuple[str, ...] = ("none", "person", "department", "organisation")
 #: Where the built-in profiles are named in messages (package-relative, never a machine path).
 BUILTIN_DIR = "rclverify/model/plan/standards/profiles"
