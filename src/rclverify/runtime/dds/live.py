@@ -55,6 +55,7 @@ from rclverify.runtime.dds.bag import BagError
 from rclverify.traces.event_time import event_ns
 from rclverify.runtime.dds.bus import Bus
 from rclverify.runtime.dds.trust import VERDICT_KEY, downgrade
+from rclverify.runtime.dds.nobody import nobody_line
 
 
 class _Sink:
@@ -182,6 +183,7 @@ class _DdsRun:
         #: (a source time would make every message heard after a later-published one late, judged apart
         #: from how its log line, at the clock, reads offline)
         self.by_receipt = False
+        self.t0 = _time.monotonic()  # when the run began to listen (wait)
 
     def _message(self, typ: str, describe: Callable[[list[str]], Mapping[str, Any]] | None) -> Any:
         """The struct of contract type ``typ``: the workspace's definition, else (the rclpy source,
@@ -350,7 +352,7 @@ class _DdsRun:
     def wait(self, worker: EngineWorker, stop: Any, duration: float | None, tick_s: float, status_s: float) -> None:
         """Until ``stop`` is set, ``duration`` s passed or a thread died,
         with a status line every ``status_s`` s."""
-        t0 = _time.monotonic()
+        t0 = self.t0 = _time.monotonic()
         next_status = t0 + status_s
         while not stop.is_set():
             if duration is not None and _time.monotonic() - t0 >= duration:
@@ -394,6 +396,11 @@ class _DdsRun:
         qos = {t.key: t.to_json() for t in bus.taps}
         for key, n in getattr(bus, "before", {}).items():
             qos[key]["published_before_heard"] = n
+        writers = getattr(getattr(bus, "discovery", None), "writers", None)  # the DDS source's discovery only
+        nobody = nobody_line(qos, _time.monotonic() - self.t0, middleware,
+                             None if writers is None else len({w.participant for w in writers.values()}))
+        if nobody is not None:  # said, and in the record's warnings (nobody.py)
+            self.warn(nobody)
         record_.update(warnings=self.warnings, decode_errors=self.decode_errors, qos=qos,
                        event_time={"clock": "receipt (--reorder-window 0)" if self.by_receipt else
                                    "source timestamp", "receipt_timed": self.receipt_timed})
