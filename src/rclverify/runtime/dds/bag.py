@@ -12,7 +12,9 @@ message without a header stamp; the message definition comes from
 the workspace's ``.msg`` files and rosbags' store (the types the monitor
 decoded with), or, for samples the monitor decoded in the definition their
 publisher declared (:class:`~.types.Declared`), that definition
-(:func:`~.bag_types.declared_store`).  A topic's connection is made at its
+(:func:`~.bag_types.declared_store`); a contract type the workspace does not
+define and the rclpy source's ROS 2 Python describes (``described``: docs/ros2.md,
+"Types from the robot") is recorded in that description, as it was read.  A topic's connection is made at its
 first message, in the definition that message is written in (one topic,
 one definition: a later message in another is not written, and counted in
 ``failed``), and at the end for a topic that had none.  So ``rclverify
@@ -35,6 +37,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 from rclverify.traces.bag import typestore
 from rclverify.runtime.dds.bag_types import declared_store
+from rclverify.runtime.dds.types import Declaration
 from rclverify.traces.events import TraceError
 from rclverify.runtime.shapes import BagSummary
 
@@ -57,7 +60,8 @@ class BagRecorder:
     """Write raw messages of ``topics`` (contract topic without ``/`` ->
     ``pkg/msg/T``) and of ``calls`` (call topic without ``/`` -> ``(type,
     ros2idl definition, type hash)``, :mod:`.bag_calls`) to a new ROS 2 bag
-    directory ``path``.  Raises :class:`BagError` when the bag cannot be
+    directory ``path``; ``described``: contract topic -> the :class:`~.types.Declaration`
+    its type is known from when no definition of the workspace or rosbags' store has it.  Raises :class:`BagError` when the bag cannot be
     created.
 
     Threads: rosbags' writer is opened, written and closed in one thread of
@@ -68,7 +72,8 @@ class BagRecorder:
 
     def __init__(self, path: Path, storage: str, topics: Mapping[str, str], msg_dirs: Sequence[Path],
                  open_timeout_s: float = 30.0,
-                 calls: Mapping[str, tuple[str, str | None, str | None]] | None = None) -> None:
+                 calls: Mapping[str, tuple[str, str | None, str | None]] | None = None,
+                 described: Mapping[str, Declaration] | None = None) -> None:
         self.path = Path(path)
         if self.path.suffix == ".mcap":  # a bag is a directory: name it without the suffix
             self.path = self.path.with_suffix("")
@@ -82,6 +87,9 @@ class BagRecorder:
         #: the call topics (:mod:`.bag_calls`): topic -> (type, ros2idl definition, type hash), or
         #: (type, None, None) for a type rosbags' store describes
         self.calls = {t.strip("/"): d for t, d in (calls or {}).items()}
+        #: contract topic -> the declaration its type is known from when the workspace does not define it
+        #: (the rclpy source's ROS 2 Python describes it): its messages are recorded in that definition
+        self.described = {t.strip("/"): d for t, d in (described or {}).items()}
         self.count = self.call_count = self.failed = 0
         #: per contract topic whose connection is made: the declaration it records (``None``: the workspace's)
         self._declared: dict[str, Any] = {}
@@ -105,8 +113,11 @@ class BagRecorder:
         connections: dict[str, Any] = {}
         for topic, msg_type in self.topics.items():  # each described now; its connection made at its first message
             try:
-                self._store.generate_msgdef(_msg_name(msg_type), ros_version=2)
-                self._store.hash_rihs01(_msg_name(msg_type))
+                if topic in self.described:
+                    declared_store(self.described[topic])  # raises for a type rosbags cannot describe
+                else:
+                    self._store.generate_msgdef(_msg_name(msg_type), ros_version=2)
+                    self._store.hash_rihs01(_msg_name(msg_type))
             except Exception as exc:  # rosbags: a type its store cannot describe
                 writer.close()
                 wide = " (rosbags has no wide string: a wstring cannot be stored)" if "wstring" in str(exc) else ""
@@ -162,6 +173,7 @@ class BagRecorder:
         :class:`~.types.Declaration`) or, ``None``, the workspace's; a call topic's from :attr:`calls`."""
         if topic in self.topics:
             self._declared[topic] = decl
+            decl = decl if decl is not None else self.described.get(topic)
             if decl is not None:
                 return writer.add_connection("/" + topic, decl.name, typestore=declared_store(decl))
             return writer.add_connection("/" + topic, _msg_name(self.topics[topic]), typestore=self._store)

@@ -153,6 +153,8 @@ class _DdsRun:
         except DdsTypeError as exc:
             raise DdsUnavailable(str(exc)) from None
         self.topics = contract_topics(checked, nodes)  # "/topic" -> "pkg/Type"
+        #: "pkg/msg/T" -> the ROS 2 Python's declaration of a contract type the workspace does not define
+        self.described: dict[str, Any] = {}
         self.where = {t.field.strip("/"): f"{t.loc.file}:{t.loc.line}:{t.loc.col}" for n in reversed(nodes)
                       for t in reversed(n.node.topics)}  # the first mention of each topic
         self.structs: dict[str, Any] = {}
@@ -195,8 +197,7 @@ class _DdsRun:
         except DdsTypeError:
             if describe is None:
                 raise
-            pkg, _, name = typ.replace("/msg/", "/").partition("/")
-            full = f"{pkg}/msg/{name}"
+            full = _full(typ)
             try:
                 decls = describe([full])
             except Exception:  # noqa: BLE001 - the ROS 2 Python could not say: the workspace's error stands
@@ -204,6 +205,7 @@ class _DdsRun:
             if full not in decls:
                 raise
             self.types.add_declaration(decls[full])
+            self.described[full] = decls[full]  # recorded in this definition too (open_recorder)
             self.out(f"{full}: no definition in the workspace: read as the ROS 2 Python's rosidl describes it")
             return self.types.message(typ)
 
@@ -214,9 +216,12 @@ class _DdsRun:
             return
         try:
             self.call_recorder = CallRecorder(self.types, self.links) if self.links else None
+            described = {t.strip("/"): self.described[_full(ty)] for t, ty in self.topics.items()
+                         if _full(ty) in self.described}  # a type known only from its description: recorded in it
             self.recorder = BagRecorder(record[0], record[1], {t.strip("/"): ty for t, ty in self.topics.items()},
                                         msg_dirs if msg_dirs is not None else self.type_dirs,
-                                        calls=self.call_recorder.plan if self.call_recorder else None)
+                                        calls=self.call_recorder.plan if self.call_recorder else None,
+                                        described=described)
         except (BagError, DdsTypeError) as exc:
             raise DdsUnavailable(str(exc)) from None
         if self.call_recorder is not None:
@@ -428,6 +433,12 @@ class _DdsRun:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
         self.out(_status(live, self.call_counts))
         return record_
+
+
+def _full(typ: str) -> str:
+    """``pkg/msg/T`` of a contract's ``pkg/T`` or ``pkg/msg/T``."""
+    pkg, _, name = typ.replace("/msg/", "/").partition("/")
+    return f"{pkg}/msg/{name}"
 
 
 def _calls_record(summary: Mapping[str, object], book: CallBook, calls: CallTaps | None) -> dict[str, Any]:
