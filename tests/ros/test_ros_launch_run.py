@@ -315,6 +315,29 @@ def test_nodes_started_by_an_event_handler_are_started(ws: Path) -> None:
                            "actions of OnProcessExit, a function run at the event, cannot be read statically")
 
 
+def _grow(ws: Path, name: str, grow: str) -> Path:
+    f = ws / "ws" / "demo" / "launch" / name
+    f.parent.mkdir(exist_ok=True)
+    f.write_text(PY_HEAD + "def generate_launch_description():\n"
+                 "    nodes = [Node(package='demo', executable='talker')]\n" + grow +
+                 "    return LaunchDescription(nodes)\n")
+    return f
+
+
+def test_a_list_of_actions_grown_in_order_is_read_whole(ws: Path) -> None:
+    lf = _grow(ws, "grow.launch.py", "    nodes.append(Node(package='demo', executable='listener'))\n"
+                                     "    nodes += [Node(package='demo', executable='listener', name='two')]\n")
+    g = _graph(ws, lf)
+    assert sorted(g.nodes) == ["/listener", "/talker", "/two"] and _said(g) == []
+    # control: grown under a condition only running decides, the list is named, not guessed
+    lf = _grow(ws, "grow_if.launch.py", "    if os.environ.get('SIM'):\n"
+                                        "        nodes.append(Node(package='demo', executable='listener'))\n")
+    g = _graph(ws, lf)
+    assert sorted(g.nodes) == ["/talker"]
+    assert _said(g) == ["ws/demo/launch/grow_if.launch.py:13:30: warning: launch actions 'nodes' is grown at line "
+                        "12 inside a block or a loop (chosen at run time): not resolved statically"]
+
+
 # -- YAML group as a list --------------------------------------------------------
 
 def test_a_yaml_group_written_as_a_list(ws: Path) -> None:
@@ -387,7 +410,7 @@ def test_ros1_code_no_ament_target_builds_is_listed_apart(tmp_path: Path, capsys
     lf.write_text('<launch>\n  <node pkg="nodelet" type="nodelet" name="filter" args="load port/Filter mgr"/>\n'
                   '</launch>\n')
     g = scan([ws], [lf], base=tmp_path, standard=False).graph
-    assert "filter.launch:2:3: warning: nodelet 'port/Filter': package 'port' has it, not built (no target of its " \
+    assert "filter.launch:2:1: warning: nodelet 'port/Filter': package 'port' has it, not built (no target of its " \
            "CMakeLists.txt builds its sources); its topics are unknown" in _said(g)
 
 
@@ -413,3 +436,36 @@ def test_code_under_if_0_is_not_read() -> None:
     r = scan_cpp(src.encode(), "talker.cpp")
     assert sorted(e.topic for e in r["endpoints"]) == ["chatter", "kept"]
     assert [e.src.line for e in r["endpoints"] if e.topic == "chatter"] == [14]  # lines unchanged
+
+
+DUAL = """cmake_minimum_required(VERSION 3.8)
+project(dual)
+if({cond})
+  find_package(catkin REQUIRED COMPONENTS roscpp)
+  catkin_package()
+  add_executable(old_node src/old_main.cpp)
+else()
+  find_package(ament_cmake REQUIRED)
+  add_executable(talker src/talker.cpp)
+  ament_package()
+endif()
+"""
+
+
+@pytest.mark.parametrize("cond, tool, apart_", [
+    ('"$ENV{ROS_VERSION}" STREQUAL "1"', "ament_cmake", [("old_node", 6)]),
+    ("catkin_FOUND", "ament_cmake", [("old_node", 6)]),
+    ("NOT ament_cmake_FOUND", "ament_cmake", [("old_node", 6)]),
+    ("NOT catkin_FOUND", "ament_cmake", [("talker", 9)]),  # control: the branches swapped
+    ("catkin_FOUND", "catkin", []),  # control: a catkin package builds what it declares
+])
+def test_catkin_only_code_of_a_dual_build_is_not_built(tmp_path: Path, cond: str, tool: str,
+                                                       apart_: list[tuple[str, int]]) -> None:
+    _write(tmp_path / "ws" / "dual", {
+        "package.xml": PKG.format(name="dual", tool=tool, export=""),
+        "CMakeLists.txt": DUAL.format(cond=cond), "src/talker.cpp": TALKER, "src/old_main.cpp": ROS1_MAIN})
+    g = scan([tmp_path / "ws"], [], base=tmp_path, standard=False).graph
+    apart = [(p["name"], p["declared"]["line"]) for p in g.programs if p["kind"] == "not built"]
+    assert apart == apart_
+    assert sorted(g.nodes) == sorted({"/old_node", "/talker"} - {"/" + name for name, _line in apart_})
+    assert not g.unaccounted()

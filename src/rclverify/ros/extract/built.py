@@ -8,6 +8,11 @@ classes its plugin description still exports, programs calling
 their sources, they are never compiled, so they run nowhere.  In an
 ``ament_cmake`` package with a ``CMakeLists.txt``:
 
+* an executable declared only in a branch a catkin build takes
+  (``if(catkin_FOUND)``, ``if($ENV{ROS_VERSION} EQUAL 1)``, the ``else`` of
+  ``if(ament_cmake_FOUND)`` or of ``ROS_VERSION`` ``2``:
+  :func:`executables.catkin_branch`) is *not built* (catkin-only code), and
+  the targets of such branches build nothing below;
 * a nodelet program (:mod:`nodelets`) none of whose sources a target lists
   (its library is no longer built, or the file registering it is in no
   target) is *not built*;
@@ -40,7 +45,7 @@ _CPP = (".cpp", ".cc", ".cxx", ".c")
 @dataclass(frozen=True)
 class Unbuilt:
     """One program of ROS 1 code no target builds: its ``package``, ``kind``
-    (``ROS 1 nodelet``, ``ROS 1 program``), ``name`` (a nodelet's lookup name,
+    (``catkin-only executable``, ``ROS 1 nodelet``, ``ROS 1 program``), ``name`` (a nodelet's lookup name,
     a program's file name), where it is (``at``) and ``why`` it is not built."""
 
     package: str
@@ -62,11 +67,18 @@ def not_built(pkg: Package, progs: list[Program], code: PackageCode,
     module docstring); a package not built by ament_cmake keeps them all."""
     if not pkg.build_type.startswith("ament_cmake") or not (pkg.root / "CMakeLists.txt").is_file():
         return progs, []
-    built = {code.show(p) for srcs in list(t.executables.values()) + list(t.libraries.values()) for p in srcs}
+    built = {code.show(p) for name, srcs in list(t.executables.items()) + list(t.libraries.items())
+             if name not in t.catkin_only for p in srcs}
     kept: list[Program] = []
     gone: list[Unbuilt] = []
     for prog in progs:
-        if prog.nodelet is not None and not set(prog.entry) & built:
+        if prog.exe is not None and prog.exe in t.catkin_only:
+            d = next((d for d in t.declared if d.kind == "executable" and d.name == prog.exe), None)
+            gone.append(Unbuilt(pkg.name, "catkin-only executable", prog.exe,
+                                Src(code.show(d.file), d.line) if d is not None else Src(code.show(pkg.manifest)),
+                                "CMakeLists.txt declares it only in a branch a catkin build takes "
+                                "(if(catkin_FOUND), ROS_VERSION 1)"))
+        elif prog.nodelet is not None and not set(prog.entry) & built:
             gone.append(Unbuilt(pkg.name, "ROS 1 nodelet", prog.nodelet, _registered(prog, code, pkg),
                                 "its plugin description (or PLUGINLIB_EXPORT_CLASS) names a ROS 1 nodelet whose "
                                 "sources no target of CMakeLists.txt builds"))

@@ -52,7 +52,9 @@ class Targets:
     ``programs`` ``{executable: [Python file]}`` (installed scripts, entry
     points), ``nodelets`` ``{lookup name: (class, library)}`` (:mod:`nodelets`),
     ``pluginlib`` the ROS 2 plugin classes it exports and ``plugin_notes`` what
-    could not be read of their descriptions (:mod:`plugins`)."""
+    could not be read of their descriptions (:mod:`plugins`), ``declared`` the
+    programs its build files declare and ``catkin_only`` the targets declared
+    only in a branch a catkin build takes (:func:`catkin_branch`)."""
 
     executables: dict[str, list[Path]] = field(default_factory=dict)
     libraries: dict[str, list[Path]] = field(default_factory=dict)
@@ -64,6 +66,8 @@ class Targets:
     pluginlib: list[PluginClass] = field(default_factory=list)
     plugin_notes: list[Note] = field(default_factory=list)
     declared: list[Declared] = field(default_factory=list)
+    # targets declared only in a branch a catkin (ROS 1) build takes (if(catkin_FOUND), ROS_VERSION 1)
+    catkin_only: set[str] = field(default_factory=set)
 
 
 @dataclass(frozen=True)
@@ -171,9 +175,16 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
         t.declared.append(Declared(kind, name, root / "CMakeLists.txt", line, named,
                                    all((root / x).is_file() for x in named)))
 
+    branches: list[list[int | str]] = []  # each open if(): [catkin_branch(cond), "then" | "else" | "other"]
     for name, args, line in cmds:
+        if name in ("if", "elseif", "else", "endif"):
+            _branch(branches, name, args)
+            continue
         if not args:
             continue
+        if name in _EXE | _LIB and any((k == 1 and part == "then") or (k == -1 and part == "else")
+                                       for k, part in branches):
+            t.catkin_only.add(args[0])  # declared where only a catkin build goes (built.py)
         if name in ("ament_auto_add_library", "ament_auto_add_executable") and "DIRECTORY" in args:
             args = _auto_directory(args, root)
         if name == "add_subdirectory" and (root / args[0]).is_dir() and not args[0].startswith(("test", "..")) \
@@ -215,6 +226,33 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
                     t.programs.setdefault(f.name, [f])
                     t.programs.setdefault(f.stem, [f])
                 k += 1
+
+
+def catkin_branch(cond: list[str]) -> int:
+    """Which branch of ``if(cond)`` only a catkin (ROS 1) build takes: ``1`` the
+    ``if`` branch (``if(catkin_FOUND)``, ``if($ENV{ROS_VERSION} EQUAL 1)``),
+    ``-1`` the ``else`` branch (``if(ament_cmake_FOUND)``, ``ROS_VERSION``
+    ``2``, or a ``NOT`` of the first kind), ``0`` neither or not known."""
+    text = " ".join(cond)
+    flip = -1 if cond and cond[0] == "NOT" else 1
+    if "catkin_FOUND" in text:
+        return flip
+    if "ament_cmake_FOUND" in text:
+        return -flip
+    if "ROS_VERSION" in text and any(a in ("EQUAL", "STREQUAL", "VERSION_EQUAL") for a in cond):
+        v = cond[-1].strip("\"'")
+        return flip if v == "1" else -flip if v == "2" else 0
+    return 0
+
+
+def _branch(branches: list[list[int | str]], name: str, args: list[str]) -> None:
+    """Track the open ``if()`` blocks of a ``CMakeLists.txt`` (:func:`catkin_branch`)."""
+    if name == "if":
+        branches.append([catkin_branch(args), "then"])
+    elif name in ("elseif", "else") and branches:
+        branches[-1][1] = "other" if name == "elseif" else ("else" if branches[-1][1] == "then" else "other")
+    elif name == "endif" and branches:
+        branches.pop()
 
 
 MAX_EXPORTED = 64  # .cmake files read per package for the functions and macros it exports

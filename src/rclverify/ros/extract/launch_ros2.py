@@ -41,7 +41,7 @@ from rclverify.ros.extract.launch_tree import UNREAD, El
 from rclverify.ros.extract.launch_py_values import ENV as _ENV, HERE as _HERE, TWICE as _TWICE
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg, callee as _callee
 from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
-from rclverify.ros.extract.launch_py_values import value as _value
+from rclverify.ros.extract.launch_py_values import grown as _grown, value as _value
 from rclverify.ros.extract.launch_py_node import node_kids as _node_kids, ros_args as _ros_args
 from rclverify.ros.extract.model import Note, Src
 
@@ -401,7 +401,13 @@ def _read(fn: ast.FunctionDef | None, shown: str, notes: list[Note]) -> tuple[El
             v = st.value
             if isinstance(v, ast.Call) and _callee(v) == "LaunchDescription":
                 arg = v.args[0] if v.args else None
-                if isinstance(arg, ast.Name) and arg.id in assigned:
+                if isinstance(arg, ast.Name) and arg.id in _TWICE:  # a list grown before it is returned
+                    grown = _grown(fn, arg.id)
+                    if isinstance(grown, str):
+                        notes.append(Note(Src(shown, arg.lineno, arg.col_offset + 1), f"launch actions "
+                                          f"'{arg.id}' {grown}: not resolved statically", "ROS-LAUNCH"))
+                    arg = grown if not isinstance(grown, str) else assigned.get(arg.id, arg)
+                elif isinstance(arg, ast.Name) and arg.id in assigned:
                     arg = assigned[arg.id]
                 if arg is not None:
                     elems = arg.elts if isinstance(arg, (ast.List, ast.Tuple)) else [arg]

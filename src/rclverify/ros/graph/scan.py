@@ -300,7 +300,9 @@ class _Scan:
             self.asm.source_nodes(self.add_node, g)
             self.asm.controller_nodes(self.add_node, self.pfiles.entries, g)  # ros2_control controllers
         g.notes.extend(self.asm.unloaded_plugins())
-        accounts = self.asm.ledger.accounts({p: self.tgts[p].declared for p in self.tgts}, bool(launch))
+        apart = {(u.package, u.name) for u in self.asm.unbuilt}  # accounted for as not built, below
+        accounts = self.asm.ledger.accounts({p: [d for d in self.tgts[p].declared if (p, d.name) not in apart]
+                                             for p in self.tgts}, bool(launch))
         accounts += [Account(u.package, "not built", u.name, u.at) for u in self.asm.unbuilt]
         g.programs = [a.to_json() for a in accounts]
         g.notes.extend(a.note() for a in accounts if a.why is not None and a.kind != "launch node")
