@@ -54,6 +54,7 @@ LIVE = frozenset({
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
+    "test_live_stops",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -96,6 +97,7 @@ SECONDS: dict[str, float] = {
     "test_realizable_sequences": 2.4,
     "test_nodl_verify": 3.3,
     "test_write_bounds_cli": 30.0, "test_read_bounds": 2.5,  # one verify, every output path tried three ways
+    "test_live_stops": 18.0,  # six starts of the live monitor, each a ROS 2 Python or a DDS participant
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -112,6 +114,7 @@ WALL: dict[str, float] = {
     "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0, "test_ros2_event_time": 20.0,
     "test_example_manipulator": 32.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
     "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
+    "test_live_stops": 45.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
