@@ -22,7 +22,7 @@ run is read.  An unknown type is left to the run (its events are then
 ``doit verify`` (the plan's check) and ``rclverify monitor --live`` call the
 one :func:`check_field_paths`; the live monitor leaves a field the
 definitions lack to the run (a publisher may declare its own definition of
-the type, docs/ros2.md "Types from the robot") and refuses the rest alike.
+the type, docs/ros2.md, "The publisher's own definition") and refuses the rest alike.
 """
 from __future__ import annotations
 
@@ -82,7 +82,7 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
     and ``rclverify monitor --live`` both call it; the live monitor with
     ``robot_types`` true: a field the definitions lack is then left to the
     run, which reads a publisher's own definition of its type (docs/ros2.md,
-    "Types from the robot"), while a field that is there and cannot fill its
+    "The publisher's own definition"), while a field that is there and cannot fill its
     variable (an array for a single value ...) is refused as ``doit verify``
     refuses it."""
     path = root / rel

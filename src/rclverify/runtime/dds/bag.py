@@ -13,9 +13,10 @@ the workspace's ``.msg`` files and rosbags' store (the types the monitor
 decoded with), or, for samples the monitor decoded in the definition their
 publisher declared (:class:`~.types.Declared`), that definition
 (:func:`~.bag_types.declared_store`); a contract type the workspace does not
-define and the rclpy source's ROS 2 Python describes (``described``: docs/ros2.md,
-"Types from the robot") is recorded in that description, as it was read.  A topic's connection is made at its
-first message, in the definition that message is written in (one topic,
+define and the rclpy source's ROS 2 Python describes (``described``:
+docs/ros2.md, "The publisher's own definition") is recorded in that
+description, as it was read.  A topic's connection is made at its first
+message, in the definition that message is written in (one topic,
 one definition: a later message in another is not written, and counted in
 ``failed``), and at the end for a topic that had none.  So ``rclverify
 monitor BAG`` checks exactly the messages the live run checked, at the same
