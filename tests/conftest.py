@@ -96,6 +96,7 @@ SECONDS: dict[str, float] = {
     "test_realizable_under_load": 12.0,  # two CPU burners beside three runs
     "test_realizable_sequences": 2.4,
     "test_nodl_verify": 3.3,
+    "test_property_tests_thresholds": 9.0,  # 68 property-test runs: 17 forms, two widths, a correct node and its slip
     "test_write_bounds_cli": 30.0, "test_read_bounds": 2.5,  # one verify, every output path tried three ways
     "test_live_stops": 18.0,  # six starts of the live monitor, each a ROS 2 Python or a DDS participant
 }
@@ -129,7 +130,7 @@ PIPELINE = frozenset({
     "test_example_safety_stop", "test_init", "test_stage_records", "test_what_runs_is_hashed", "test_write_bounds_cli",
     "test_example_ros2_robot",  # its one live test is marked in the module (the rest is offline)
     "test_margins_monitor", "test_margins_chain", "test_near_misses", "test_margin_targets",
-    "test_margins_report",
+    "test_margins_report", "test_near_miss_units_report",
 })
 
 #: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.
