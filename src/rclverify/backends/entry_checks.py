@@ -133,9 +133,13 @@ def _check_monitors(plan: Plan, config: Any, loc: Any, checked: Checked | None =
     :mod:`.monitors.fieldpaths`) and the entry's ``tolerance``.  A missing
     mapping or trace is left to the export stage (a workspace may record its
     traces after writing the plan).  Raises :class:`PlanError`."""
-    from rclverify.backends.monitors.near_miss import NearMissError, parse_near_miss  # deferred: start-up (loads rclverify.lang.timing only when called)
+    from rclverify.backends.monitors.near_miss import NearMissError, guarantee_units, parse_near_miss, value_fault  # deferred: start-up (loads rclverify.lang.timing only when called)
     try:
-        parse_near_miss(config.get("near_miss"))
+        t = parse_near_miss(config.get("near_miss"))
+        if t is not None and t.value is not None and checked is not None and node in checked.nodes:
+            why = value_fault(t, guarantee_units(checked, str(node)), str(node))  # one reading on every guarantee
+            if why:
+                raise NearMissError(why, ("value",))
     except NearMissError as exc:
         l = loc("near_miss", *exc.key)
         raise plan_error(l.file, l.line, l.col, str(exc)) from None

@@ -104,8 +104,9 @@ def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Nea
         if t.value is not None:
             for m in mon.get("margins") or ():
                 v = m.get("margin")
-                if isinstance(v, (int, float)) and math.isfinite(v) and 0 <= v < t.value:
-                    rows.append(row(m, "value", float(v), t.value, str(m.get("unit", "")), str(m.get("atom", "")),
+                limit = t.value_in(str(m.get("unit", "")))  # in the margin's unit (0.1 mm on a margin in m: 0.0001)
+                if limit is not None and isinstance(v, (int, float)) and math.isfinite(v) and 0 <= v < limit:
+                    rows.append(row(m, "value", float(v), limit, str(m.get("unit", "")), str(m.get("atom", "")),
                                     str(m.get("where", "")), m.get("time")))
         dl = ev.details.get("deadlines") or {}
         if t.time_ns is not None and isinstance(dl, dict):
