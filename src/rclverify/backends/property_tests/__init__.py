@@ -3,7 +3,8 @@ Hypothesis against their contracts, every example's outputs checked by Z3
 (docs/property-tests.md).
 
 Modules: :mod:`.strategies` (input strategies from RCL types and the
-assumption, whose bounds :mod:`.bounds` reads), :mod:`.harness` (one guarantee's Hypothesis run; also what the
+assumption, whose bounds :mod:`.bounds` reads; the thresholds every comparison puts on an input,
+:mod:`.thresholds`), :mod:`.harness` (one guarantee's Hypothesis run; also what the
 generated pytest files call), :mod:`.slips` (the implementation line with the
 slip, a correction weighed on the :mod:`.neighbours` examples; :mod:`.cause`
 the line that computed the value, its fallback), :mod:`.backend`
