@@ -72,10 +72,10 @@ def live_counts(log: Path) -> dict[str, Counter[str]]:
         v = rec["verdict"]
         c = out.setdefault(str(v.get("node")), Counter())
         if rec.get("kind") == "deadline":
-            if v.get("update"):
-                c[f"deadline {v.get('was', 'false')}"] -= 0  # an update counted below by its final verdict
+            if v.get("update"):  # a late answer to a deadline already counted false
                 c["deadline updates"] += 1
-            c[f"deadline {v['verdict']}"] += 1
+            else:
+                c[f"deadline {v['verdict']}"] += 1
         else:
             verdict = str(v.get("verdict"))
             c["undecided" if verdict in UNDECIDED else verdict] += 1
@@ -111,19 +111,41 @@ def _answers(c: Counter[str], counts: dict[str, int]) -> None:
     c["undecided"] += sum(counts.get(k, 0) for k in UNDECIDED)
 
 
-def _offline(ws: Path, trace: str, env: dict[str, str]) -> tuple[list[dict[str, Any]], str]:
-    p = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(ws), "--mapping",
-                        "mapping.yaml", "--horizon", "1.0", "--json", trace], cwd=ws, env=env, capture_output=True,
-                       text=True, timeout=300)
-    try:
-        rows = json.loads(p.stdout)
-    except ValueError:
-        return [], f"exit {p.returncode}: {(p.stdout + p.stderr)[-1500:]}"
-    return rows, (f"exit {p.returncode}: {p.stderr[-1500:]}" if p.returncode not in (0, 1) else "")
+def _offline(ws: Path, traces: list[str], env: dict[str, str]) -> list[tuple[list[dict[str, Any]], str]]:
+    """``rclverify monitor --json TRACE`` on each trace, the checks run side by side: per trace the rows
+    and ``""``, or what went wrong."""
+    procs = [subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(ws), "--mapping",
+                               "mapping.yaml", "--horizon", "1.0", "--json", t], cwd=ws, env=env,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for t in traces]
+    out: list[tuple[list[dict[str, Any]], str]] = []
+    for p in procs:
+        stdout, stderr = p.communicate(timeout=300)
+        try:
+            rows = json.loads(stdout)
+        except ValueError:
+            out.append(([], f"exit {p.returncode}: {(stdout + stderr)[-1500:]}"))
+            continue
+        out.append((rows, f"exit {p.returncode}: {stderr[-1500:]}" if p.returncode not in (0, 1) else ""))
+    return out
 
 
 class RobotFailed(Exception):
     """The generated robot's process exited or hung before it said ``done`` (a fault of the generator)."""
+
+
+def _domain() -> tuple[int, int]:
+    """A ``ROS_DOMAIN_ID`` (1..230) no other process of this machine holds, by the test suite's lock files
+    (tests/dds_ros2.py): the domain and the open lock file, which the caller closes when its run is over."""
+    import fcntl
+    for d in random.SystemRandom().sample(range(1, 231), 230):
+        fd = os.open(os.path.join(tempfile.gettempdir(), f"rclverify-test-dds-domain-{d}.lock"), os.O_CREAT | os.O_RDWR)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        return d, fd
+    raise SystemExit("no free DDS domain: all 230 are held")
 
 
 def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2: Path,
@@ -135,7 +157,8 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     (ws / "runs").mkdir(exist_ok=True)
     (tmp / "cyclonedds.xml").write_text(CONFIG)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONSTARTUP")}
-    env.update(CYCLONEDDS_URI=(tmp / "cyclonedds.xml").as_uri(), ROS_DOMAIN_ID=str(random.SystemRandom().randint(1, 200)),
+    domain, lock = _domain()
+    env.update(CYCLONEDDS_URI=(tmp / "cyclonedds.xml").as_uri(), ROS_DOMAIN_ID=str(domain),
                ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RMW_IMPLEMENTATION="rmw_fastrtps_cpp",
                ROS_LOG_DIR=str(tmp / "ros_log"), PYTHONUNBUFFERED="1")
     menv = {**env, "PYTHONPATH": str(src)}
@@ -165,12 +188,12 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     finally:
         for p in procs:
             stop(p)
+        os.close(lock)
     res: dict[str, Any] = {"seed": seed, "nodes": nodes, "defect": defect, "spec": spec, "errors": []}
     WHY.clear()
     res["live"] = live_counts(ws / "runs" / "live.jsonl")
     res["undecided_why"] = {k: sorted(set(v)) for k, v in WHY.items()}
-    for name, trace in (("log", "runs/live.jsonl"), ("bag", "runs/bag")):
-        rows, err = _offline(ws, trace, menv)
+    for name, (rows, err) in zip(("log", "bag"), _offline(ws, ["runs/live.jsonl", "runs/bag"], menv)):
         if name == "bag" and RANGE_UNREAD in err:
             res["bag_unread"] = err.strip().splitlines()[-1]  # a known fault of the recorder (docs/monitors.md)
         elif err:

@@ -18,8 +18,8 @@ Given a seed, :func:`generate` draws a system of N nodes from five templates (th
   own clock when it publishes (delay under a third of the period);
 * **fuse**: two inputs, ``out.alert <=> (in.a <= KA and in.b >= KB)`` (float32 and uint8) or
   ``out.low <=> (in.x <= K or exists(v in in.cells | v < K2))``, answering each ``in.a``; its second
-  sensor is its own, publishing half a period after the first, so an answer is never computed from
-  a value the monitor does not yet hold;
+  sensor is its own, publishing half a period before the first (every ``in.a`` finds a value of
+  ``in.b``);
 * **service**: a ``std_srvs/SetBool`` server, ``out.ok == in.on`` within a deadline, with or without
   service introspection, called one call at a time by a client in the same process.
 
@@ -47,6 +47,7 @@ from __future__ import annotations
 if __name__ == "__main__":  # run as a script: a Python without the dependencies runs again under .venv/
     import _venv  # noqa: F401
 
+import functools
 import json
 import random
 import sys
@@ -189,7 +190,7 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
             a = rng.choice(scalars)
             b = _sensor(rng, i, kinds, rng.choice([k for k in ("u8", "arr", "scan") if k in kinds] or ["u8"]))
             b.update(namespace=rng.choice(spaces), period_ms=a["period_ms"],
-                     phase_ms=(a["phase_ms"] + a["period_ms"] // 2) % a["period_ms"])
+                     phase_ms=a["phase_ms"] - a["period_ms"] // 2)
             out.append(b)
             sensors.append(b)
             j = len(out)
@@ -319,11 +320,16 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
     return c
 
 
+@functools.lru_cache(maxsize=1)
+def _templates() -> Any:
+    import jinja2
+    return jinja2.Environment(loader=jinja2.FileSystemLoader(str(TEMPLATES)), keep_trailing_newline=True,
+                              undefined=jinja2.StrictUndefined, autoescape=False)
+
+
 def render(spec: dict[str, Any]) -> dict[str, str]:
     """The workspace's files (relative path -> text) of ``spec``, rendered from the jinja2 templates."""
-    import jinja2
-    env = jinja2.Environment(loader=jinja2.FileSystemLoader(str(TEMPLATES)), keep_trailing_newline=True,
-                             undefined=jinja2.StrictUndefined, autoescape=False)
+    env = _templates()
     by = {n["name"]: n for n in spec["nodes"]}
     consts, names = _consts(spec)
     contracts = [_contract(n, by, names) for n in spec["nodes"]]
@@ -430,4 +436,7 @@ def _smoke() -> int:
 
 
 if __name__ == "__main__":
+    sys.path.insert(0, str(ROOT / "bench"))
+    from _live import exit_on_sigterm  # SIGTERM stops what the bench started (bench/_live.py)
+    exit_on_sigterm()
     sys.exit(main())

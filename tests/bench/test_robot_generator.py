@@ -5,8 +5,9 @@ In process, over many seeds: every generated workspace's contracts parse and typ
 project's front end, its plan and mapping load, the float32 thresholds are hit exactly by the
 sensors' values, a defect is seeded in exactly one node, and a workspace spoilt on purpose is refused
 (the control).  Live (marked ``live``, real rclpy nodes on Fast DDS, loopback, a domain of their own):
-one correct seed judged green with live = log = bag, one seed with a seeded defect red at its node
-and only there; each under about 20 s.
+one correct seed judged green with live = log (its bag, of sensor_msgs/Range, is not read back: a
+fault of rclverify kept as a strict xfail), one seed with a seeded defect red at its node and only
+there, live = log = bag; each under about 20 s on an idle machine.
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ import robot_generator as gen  # noqa: E402
 
 from rclverify.lang.errors import RclError  # noqa: E402
 
-SEEDS = [(seed, 5 + seed % 16) for seed in range(12)]
+SEEDS = [(seed, 5 + seed * 3 % 16) for seed in range(10)]
 
 
 @pytest.mark.parametrize(("seed", "nodes"), SEEDS)
@@ -69,7 +70,7 @@ def _cells(values: list[Any]) -> list[float]:
     return [c for v in values for c in (v if isinstance(v, list) else [v])]
 
 
-@pytest.mark.parametrize("seed", range(20))
+@pytest.mark.parametrize("seed", range(12))
 def test_thresholds_are_hit_exactly(seed: int) -> None:
     """Every alarm's and fuse's threshold is among its sensor's readings as the float32 field carries
     it (the boundary is exercised), and every reading is within its sensor's band."""
@@ -89,7 +90,7 @@ def test_thresholds_are_hit_exactly(seed: int) -> None:
             assert want in _cells(s["values"]), (n["name"], src, k)
 
 
-@pytest.mark.parametrize("seed", range(15))
+@pytest.mark.parametrize("seed", range(10))
 def test_a_defect_is_seeded_in_exactly_one_node(seed: int) -> None:
     spec = gen.generate(seed, 8, defect=True)
     assert sum(bool(n.get("defect")) for n in spec["nodes"]) == 1
@@ -109,16 +110,34 @@ def _live(tmp_path: Path, seed: int, nodes: int, defect: bool, kinds: tuple[str,
     return _robot_run.run_one(seed, nodes, 4.0, defect, tmp_path, ros2, kinds)
 
 
+@pytest.fixture(scope="module")
+def correct_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """Seed 0 of 5 nodes, run live once: a sonar (sensor_msgs/Range, stamped 30 ms before it is sent),
+    a relay copying its header stamp, a SetBool server, an alarm at a float32 threshold, a relay
+    stamping with its own clock."""
+    return _live(tmp_path_factory.mktemp("seed0"), 0, 5, False, tuple(gen.SENSORS))
+
+
 @pytest.mark.live
-def test_a_correct_robot_is_green_live_on_the_log_and_on_the_bag(tmp_path: Path) -> None:
-    res = _live(tmp_path, 2, 5, False, tuple(k for k in gen.SENSORS if k != "range"))
+def test_a_correct_robot_is_green_live_and_on_its_log(correct_run: dict[str, Any]) -> None:
+    res = correct_run
     assert not res["errors"], res["errors"]
     assert res["findings"] == [], res["findings"]
     for node in (n["name"] for n in res["spec"]["nodes"]):
         live = res["live"][node]
         assert live["satisfied"] > 0 and live["violated"] == 0 and live["deadline false"] == 0, (node, live)
-        for other in ("log", "bag"):
-            assert {k: res[other][node][k] for k in _robot_kinds()} == {k: live[k] for k in _robot_kinds()}, (node, other)
+        assert {k: res["log"][node][k] for k in _robot_kinds()} == {k: live[k] for k in _robot_kinds()}, node
+
+
+@pytest.mark.live
+@pytest.mark.xfail(strict=True, reason="rclverify fault (docs/monitors.md, 'Generated robots'): the monitor told "
+                   "Kilted's sensor_msgs/Range by --interfaces records its messages under the older definition's "
+                   "type, and the offline check cannot decode the bag it wrote")
+def test_the_recorded_bag_of_a_correct_robot_is_read_back(correct_run: dict[str, Any]) -> None:
+    res = correct_run
+    assert not res.get("bag_unread"), res.get("bag_unread")
+    for node in (n["name"] for n in res["spec"]["nodes"]):
+        assert {k: res["bag"][node][k] for k in _robot_kinds()} == {k: res["live"][node][k] for k in _robot_kinds()}
 
 
 @pytest.mark.live
