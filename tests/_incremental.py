@@ -8,7 +8,8 @@ four-node rover contracts, its requirements and environment facts, and one
 entry of each cheap backend (review, experiment, Hoare, property tests,
 monitors).  Each edit is a change a user makes between two runs: a
 requirement's text or tracing, the plan's name, a fact, a connection, a
-contract's formula or comment, a backend input, a recorded run, a file
+contract's formula or comment, a backend input, a recorded run (also one
+rewritten in place with its size and modification time kept), a file
 deleted or added, every edit so far undone.
 
 After every edit ``doit verify`` runs in the workspace (incrementally, as a
@@ -313,6 +314,30 @@ def edit_trace(root: Path, k: int) -> str:
     return f"line {k % max(len(lines), 1) + 1} of the nominal run dropped"
 
 
+#: Readings of the nominal run, each as wide as the others: one rewritten as another keeps the file's size.
+_IN_PLACE = (b'"value": 245.0', b'"value": 265.0', b'"value": 255.0')
+
+
+def edit_trace_in_place(root: Path, k: int) -> str:
+    """Rewrite one reading of the nominal run in place, the file's size and
+    modification time kept (``os.utime``: an editor or a copy tool that
+    keeps times; issue 107): only its content says that it changed."""
+    trace = root / "backends/monitors/traces/nominal.jsonl"
+    st = trace.stat()
+    data = trace.read_bytes()
+    now = next((v for v in _IN_PLACE if v in data), None)
+    if now is not None:
+        old, new = now, _IN_PLACE[(_IN_PLACE.index(now) + 1 + k % 2) % len(_IN_PLACE)]
+    else:  # that reading's line was dropped (edit_trace): the first time stamp's first digit instead
+        m = re.search(rb'"time": (\d)', data)
+        assert m is not None, "the nominal run has no time stamp left to rewrite"
+        old, new = m.group(0), m.group(0)[:-1] + str((int(m.group(1)) + 1) % 10).encode()
+    with trace.open("r+b") as fh:  # the same file, rewritten where it is
+        fh.write(data.replace(old, new, 1))
+    os.utime(trace, ns=(st.st_atime_ns, st.st_mtime_ns))
+    return f"the nominal run's {old.decode()} rewritten in place as {new.decode()}, its size and mtime kept"
+
+
 def edit_trace_file(root: Path, k: int) -> str:
     """Add a second recorded run to the monitors entry, or take it away and delete its file."""
     extra = root / "backends/monitors/traces/env_fault.jsonl"
@@ -368,5 +393,5 @@ def edit_revert(root: Path, k: int) -> str:
 EDITS: tuple[Edit, ...] = (
     edit_requirement_text, edit_requirement_tracing, edit_plan_name, edit_fact, edit_connection,
     edit_contract_formula, edit_contract_comment, edit_hoare_program, edit_experiment_data, edit_review_record,
-    edit_trace, edit_trace_file, edit_contract_file, edit_revert,
+    edit_trace, edit_trace_in_place, edit_trace_file, edit_contract_file, edit_revert,
 )

@@ -9,6 +9,9 @@ This file checks the harness itself.
 """
 from __future__ import annotations
 
+import json
+import os
+import shutil
 from pathlib import Path
 
 import _incremental as inc
@@ -45,3 +48,60 @@ def test_the_revert_edit_gives_back_the_inputs_as_written(tmp_path: Path) -> Non
     inc.edit_revert(ws, 0)
     files = {p.relative_to(ws): p.read_bytes() for p in ws.rglob("*") if p.is_file()}
     assert files == {p.relative_to(fresh): p.read_bytes() for p in fresh.rglob("*") if p.is_file()}
+
+
+def test_the_in_place_edit_keeps_size_and_mtime(tmp_path: Path) -> None:
+    """``edit_trace_in_place`` changes the run's bytes and nothing a time-based
+    up-to-date check reads: the same size, the same modification time, the same file."""
+    ws = inc.make_workspace(tmp_path / "ws")
+    trace = ws / "backends/monitors/traces/nominal.jsonl"
+    for k in range(4):
+        before, st = trace.read_bytes(), trace.stat()
+        inc.edit_trace_in_place(ws, k)
+        after = trace.stat()
+        assert trace.read_bytes() != before
+        assert (after.st_size, after.st_mtime_ns, after.st_ino) == (st.st_size, st.st_mtime_ns, st.st_ino)
+
+
+RCL = """node Echo {
+  inputs( r : REAL )
+  outputs( y : REAL )
+  topics( std_msgs/Float64 r matches(in.r), std_msgs/Float64 out matches(out.y) )
+  guarantee( out.y == in.r )
+}
+"""
+PLAN = """contracts: [contracts/echo.rcl]
+nodes:
+  Echo:
+    evidence:
+      - backend: monitors
+        traces: [traces/run.jsonl]
+"""
+
+
+def test_a_run_edited_in_place_with_size_and_mtime_kept_is_judged_again(tmp_path: Path) -> None:
+    """Issue 107: a green run rewritten in place, its size and modification time
+    restored, was stale in every report and never judged again.  The
+    incremental run judges it again (it is red now) and writes the clean run's
+    report; control: the first run of the same workspace was green."""
+    ws = tmp_path / "echo"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "traces").mkdir()
+    shutil.copyfile(inc.REPO / "dodo.py", ws / "dodo.py")
+    (ws / "contracts/echo.rcl").write_text(RCL, encoding="utf-8")
+    (ws / "contracts/plan.yaml").write_text(PLAN, encoding="utf-8")
+    rows = [{"topic": "r", "time": 0.0, "data": 1.5}, {"topic": "out", "time": 0.01, "data": 1.5},
+            {"topic": "r", "time": 1.0, "data": 2.5}, {"topic": "out", "time": 1.01, "data": 2.5}]
+    trace = ws / "traces/run.jsonl"
+    trace.write_text("".join(json.dumps(r) + "\n" for r in rows), encoding="utf-8")
+    report = ws / "reports/assurance.md"
+    assert inc.verify(ws).returncode == 0
+    assert "**Overall status:** ✅ discharged." in report.read_text(encoding="utf-8")
+    st = trace.stat()
+    answer = b'{"topic": "out", "time": 1.01, "data": 2.5}'
+    with trace.open("r+b") as fh:  # 2.5 answered with 2.0: the same size, written where it is
+        fh.write(trace.read_bytes().replace(answer, answer.replace(b"2.5", b"2.0")))
+    os.utime(trace, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert (trace.stat().st_size, trace.stat().st_mtime_ns) == (st.st_size, st.st_mtime_ns)
+    assert inc.compare(ws, tmp_path / "scratch" / "echo") == []
+    assert "**Overall status:** ❌ **failed**" in report.read_text(encoding="utf-8")

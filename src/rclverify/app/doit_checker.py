@@ -1,17 +1,25 @@
-"""doit's md5 file checker, each file's md5 computed once per process and file state.
+"""doit's file checker for rclverify: a file dependency is changed when its content is.
 
-doit keeps ``(modification time, size, md5)`` for every file dependency of
-every task, and computes the md5 again for each task that names the file
-(doit's ``MD5Checker.get_state``, when the task's state is saved after it
-ran).  Every node task of a run depends on the system model
-(``artifacts/system/model.json``, 1.15 MB at 5000 nodes): doit's process
-hashed it 5000 times, about 10 CPU s of a cold run, quadratic in the
-system's size.  :class:`MD5Checker` gives doit's states and
-answers, with the md5 of a file kept while the file's ``stat`` (modification
-time in nanoseconds, size, inode, device) is unchanged; every write of
-rclverify's is a rename of a new file, so a rewritten file has a new inode
-and is hashed again, which is stricter than doit's own shortcut (an equal
-modification time alone means unchanged).
+A task's file dependencies are compared by their sha256, the digest the
+evidence records keep of their inputs (``input_hashes``,
+:func:`rclverify.records.records.sha256_file`) and the report reads when it
+calls a record ``stale``.  doit's own checker (``MD5Checker``) believes a
+file unchanged while its modification time is the one saved; a run edited
+in place with its size and modification time kept (``os.utime``, a copy
+tool that keeps times, a clock set back) was then ``stale`` in every
+report and never judged again, so an incremental run differed from a clean
+one.  :class:`ContentChecker` never trusts a time: every run reads each
+file dependency's bytes once (docs/integrity.md, "Content digests").
+
+The state saved per file is doit's shape, ``(modification time, size,
+digest)``, the digest a hex sha256; a different size is a change without
+reading.  Within one process each file is hashed once per file state
+(modification time in nanoseconds, size, inode, device, change time):
+every task of a run depends on the system model
+(``artifacts/system/model.json``, 1.15 MB at 5000 nodes), and hashing it
+per task was quadratic in the system's size.  Every write of rclverify's is
+a rename of a new file (a new inode), and any write or ``utime`` sets a
+file's change time, so a file changed meanwhile is hashed again.
 
 The ``stat`` of each file dependency is also taken once between two task
 events of a run, not once per task that names it: doit asks for it in
@@ -24,23 +32,24 @@ says; they are kept only while that reporter runs the run
 (:func:`keep_stats`), so doit with another reporter stats every time, as
 doit does.
 
-It is named ``MD5Checker``, as doit's: doit saves the checker's class name
-with each task's state and runs a task again when the name differs, and the
-states this one saves are doit's, so a workspace verified before keeps its
-state.  :func:`rclverify.app.tasks.doit_config` hands it to doit as
+doit saves the checker's class name with each task's state and runs a task
+again when the name differs: a workspace whose states were saved by doit's
+``MD5Checker`` runs every task once, and its states are then this
+checker's.  :func:`rclverify.app.tasks.doit_config` hands it to doit as
 ``check_file_uptodate`` (doit accepts a checker class there).
 """
 from __future__ import annotations
 
+import hashlib
 import os
 from typing import Any
 
-from doit.dependency import MD5Checker as DoitMD5Checker
-from doit.dependency import get_file_md5
-
+from doit.dependency import FileChangedChecker
 
 #: ``os.stat`` of file dependencies since the last task event, or ``None`` when none are kept (module docstring).
 _STATS: dict[str, os.stat_result] | None = None
+#: Bytes read at a time when a file is hashed.
+_BLOCK = 1 << 20
 
 
 def keep_stats(keep: bool) -> None:
@@ -56,14 +65,25 @@ def forget_stats() -> None:
         _STATS.clear()
 
 
-class MD5Checker(DoitMD5Checker):  # type: ignore[misc]
-    """doit's ``MD5Checker`` (module docstring) with one md5 per file state
-    and process, and one ``stat`` per file between two task events; the same
-    states and the same answers."""
+def file_sha256(path: str) -> str:
+    """The hex sha256 of the bytes of the file at ``path`` (as
+    :func:`rclverify.records.records.sha256_file` gives it for a file that
+    exists).  Raises ``OSError`` when it cannot be read."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(_BLOCK), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+class ContentChecker(FileChangedChecker):  # type: ignore[misc]
+    """doit's file checker comparing contents (module docstring): a file
+    dependency is changed when its size or its sha256 differs from the
+    saved state, whatever its modification time."""
 
     def __init__(self) -> None:
         super().__init__()
-        self._md5: dict[tuple[str, int, int, int, int], str] = {}
+        self._digests: dict[tuple[str, int, int, int, int, int], str] = {}
         keep_stats(False)  # a new run: nothing kept until its reporter says so
 
     def info(self, file_path: str) -> os.stat_result:
@@ -77,30 +97,31 @@ class MD5Checker(DoitMD5Checker):  # type: ignore[misc]
             st = stats[file_path] = os.stat(file_path)
         return st
 
-    def md5_of(self, path: str, st: os.stat_result) -> str:
-        """The md5 of the file at ``path`` whose ``stat`` is ``st``, computed
-        once while the state is the same.  Raises ``OSError`` when it cannot
-        be read."""
-        key = (path, st.st_mtime_ns, st.st_size, st.st_ino, st.st_dev)
-        md5 = self._md5.get(key)
-        if md5 is None:
-            md5 = self._md5[key] = get_file_md5(path)
-        return md5
+    def digest_of(self, path: str, st: os.stat_result) -> str:
+        """The hex sha256 of the file at ``path`` whose ``stat`` is ``st``,
+        computed once while that file state is the same.  Raises ``OSError``
+        when it cannot be read."""
+        key = (path, st.st_mtime_ns, st.st_size, st.st_ino, st.st_dev, st.st_ctime_ns)
+        digest = self._digests.get(key)
+        if digest is None:
+            digest = self._digests[key] = file_sha256(path)
+        return digest
 
     def check_modified(self, file_path: str, file_stat: os.stat_result, state: Any) -> bool:
-        """doit's: unchanged when the modification time is the saved one,
-        changed when the size differs, else as the md5 says."""
-        timestamp, size, file_md5 = state
-        if file_stat.st_mtime == timestamp:
-            return False
+        """doit's question: is the file changed since ``state`` (``(modification
+        time, size, digest)``)?  Changed when its size differs, else when its
+        sha256 does; its modification time is never trusted."""
+        _, size, digest = state
         if file_stat.st_size != size:
             return True
-        return bool(file_md5 != self.md5_of(file_path, file_stat))
+        return bool(digest != self.digest_of(file_path, file_stat))
 
     def get_state(self, dep: str, current_state: Any) -> Any:
-        """doit's: ``None`` when the saved modification time is the file's,
-        else ``(modification time, size, md5)``."""
+        """doit's: the state to save after the task ran, ``(modification time,
+        size, sha256)``, or ``None`` when ``current_state`` already holds this
+        size and content."""
         st = os.stat(dep)
-        if current_state and current_state[0] == st.st_mtime:
+        digest = self.digest_of(dep, st)
+        if current_state and tuple(current_state[1:]) == (st.st_size, digest):
             return None
-        return st.st_mtime, st.st_size, self.md5_of(dep, st)
+        return st.st_mtime, st.st_size, digest

@@ -25,11 +25,13 @@ from rclverify.model.plan.paths import config_strings
 from rclverify.records.store import EvidenceStore
 
 
-def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int]]:
-    """(path, size, mtime_ns) of every file under the ``ros:`` section's paths:
-    the grounding task runs again when one changes (the scan's own cache then
-    re-parses only the changed files)."""
-    out: list[tuple[str, int, int]] = []
+def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int, int]]:
+    """(path, size, mtime_ns, ctime_ns) of every file under the ``ros:``
+    section's paths: the grounding task runs again when one changes (the
+    scan's own cache then re-parses only the changed files).  The change
+    time is set by every write and every ``utime``, so an edit that keeps
+    the size and restores the modification time is a change too."""
+    out: list[tuple[str, int, int, int]] = []
     for key in ("workspaces", "launch", "bags"):
         for rel in ros.get(key, []) or []:
             top = root / str(rel)
@@ -39,13 +41,13 @@ def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, 
                     st = p.stat()
                 except OSError:
                     continue
-                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns))
+                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns, st.st_ctime_ns))
     for key in ("mapping",):
         if ros.get(key):
             p = root / str(ros[key])
             if p.is_file():
                 st = p.stat()
-                out.append((str(ros[key]), st.st_size, st.st_mtime_ns))
+                out.append((str(ros[key]), st.st_size, st.st_mtime_ns, st.st_ctime_ns))
     return out
 
 
@@ -57,16 +59,18 @@ UPTODATE_SIGNATURE = inspect.Signature([inspect.Parameter("task", inspect.Parame
 
 
 def _stats(paths: list[str]) -> list[list[int]] | None:
-    """``[mtime_ns, size]`` of each of ``paths``, or ``None`` when one is
-    missing: what an ``uptodate`` check saves with doit's task values after
-    the task ran and compares on the next run, without reading a file."""
+    """``[mtime_ns, size, ctime_ns]`` of each of ``paths``, or ``None`` when
+    one is missing: what an ``uptodate`` check saves with doit's task values
+    after the task ran and compares on the next run, without reading a file.
+    The change time is set by every write and every ``utime``: a file
+    rewritten with its size and modification time kept differs too."""
     out = []
     for path in paths:
         try:
             st = os.stat(path)
         except OSError:
             return None
-        out.append([st.st_mtime_ns, st.st_size])
+        out.append([st.st_mtime_ns, st.st_size, st.st_ctime_ns])
     return out
 
 
@@ -79,7 +83,7 @@ class TargetsAsWritten:
     task's inputs were what it last read, doit called it up to date, and the
     report kept the ``error`` of a record that was intact again (a false
     alarm; found by tests/report/test_hardening_greens.py).  After the task ran the
-    size and modification time of each target are saved with doit's task
+    size, modification and change times of each target are saved with doit's task
     values; any other write (or a missing file) makes it run again.  A stat
     a file, no read: nothing on a no-op run."""
 
@@ -100,8 +104,10 @@ class RecordIntact:
     instead of believing it (the report of a run that does not re-run it,
     ``rclverify report``, shows it as ``error``: evidence altered).
 
-    Cheap on a no-op run: after the task ran, the record's size and
-    modification time are saved with doit's task values; while they are the
+    Cheap on a no-op run: after the task ran, the record's size,
+    modification and change times are saved with doit's task values (an edit
+    that restores the size and modification time still sets the change
+    time, :func:`_stats`); while they are the
     same the record is not read.  Otherwise its seal is checked
     (:meth:`rclverify.records.store.EvidenceStore.read`)."""
 

@@ -37,7 +37,7 @@ Stages and their real file dependencies, per node ``N``:
 ``verify``         the whole pipeline; ``doit verify --strict`` fails unless every
                    obligation is discharged
 
-doit compares file contents (md5), so editing one node's contract changes
+doit compares file contents (sha256), so editing one node's contract changes
 only that node's snapshot: its node and health tasks and run tasks,
 its consumers' node tasks (the compose stage only: their side conditions), the
 node tasks downstream whose side conditions were decided in context against
@@ -96,8 +96,9 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     per task with ``ast.literal_eval``, about 0.3 CPU s of a 1000-node no-op
     run when it had 5000 tasks (docs/scale.md).  A workspace that switches store runs
     every task once, as doit knows no earlier state in the new file.  The
-    file checker is doit's md5 checker with one md5 per file state and
-    process (:mod:`rclverify.app.doit_checker`); the store's codec writes
+    file checker compares contents by sha256, each file hashed once per file
+    state and process, never trusting a modification time
+    (:mod:`rclverify.app.doit_checker`); the store's codec writes
     doit's JSON and reads it with msgspec (:mod:`rclverify.app.doit_codec`).
 
     ``num_process``: the processes of a run without ``-n``
@@ -107,7 +108,7 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
     ``error:`` line and raises ``SystemExit(1)``, as :func:`build_tasks`
     does for its faults."""
     from rclverify.app.progress import ProgressReporter  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
-    from rclverify.app.doit_checker import MD5Checker  # deferred: start-up (loads doit.dependency only when called)
+    from rclverify.app.doit_checker import ContentChecker  # deferred: start-up (loads doit.dependency only when called)
     from rclverify.app.doit_codec import StateCodec  # deferred: start-up (loads msgspec only when called)
     from rclverify.app.jobs import JobsError, default_jobs, doit_num_process  # deferred: start-up (loads multiprocessing only when called)
     try:
@@ -116,7 +117,7 @@ def doit_config(dep_file: str = DEP_FILE) -> dict[str, Any]:
         print(f"error: {exc}", file=sys.stderr)
         raise SystemExit(1) from None
     return {"default_tasks": ["verify"], "verbosity": 2, "dep_file": dep_file, "backend": "sqlite3",
-            "reporter": ProgressReporter, "check_file_uptodate": MD5Checker, "codec_cls": StateCodec,
+            "reporter": ProgressReporter, "check_file_uptodate": ContentChecker, "codec_cls": StateCodec,
             "num_process": doit_num_process(jobs)}
 
 
