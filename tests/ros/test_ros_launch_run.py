@@ -68,7 +68,8 @@ int main(int argc, char ** argv) { rclcpp::init(argc, argv); rclcpp::spin(std::m
 """
 CMAKE = "cmake_minimum_required(VERSION 3.8)\nproject({name})\nfind_package(rclcpp REQUIRED)\n"
 PY_HEAD = ("import os\nfrom launch import LaunchDescription\n"
-           "from launch.actions import DeclareLaunchArgument, GroupAction, OpaqueFunction, RegisterEventHandler\n"
+           "from launch.actions import DeclareLaunchArgument, ExecuteProcess, GroupAction, OpaqueFunction, "
+           "RegisterEventHandler\n"
            "from launch.event_handlers import OnProcessExit\n"
            "from launch.substitutions import EnvironmentVariable, LaunchConfiguration, TextSubstitution\n"
            "from launch_ros.actions import LifecycleNode, Node, SetRemap\n\n\n")
@@ -336,6 +337,19 @@ def test_a_list_of_actions_grown_in_order_is_read_whole(ws: Path) -> None:
     assert sorted(g.nodes) == ["/talker"]
     assert _said(g) == ["ws/demo/launch/grow_if.launch.py:13:30: warning: launch actions 'nodes' is grown at line "
                         "12 inside a block or a loop (chosen at run time): not resolved statically"]
+
+
+def test_a_process_running_ros2_run_is_its_node(ws: Path) -> None:
+    lf = _py(ws, "exec.launch.py", "ExecuteProcess(cmd=['ros2', 'run', 'demo', 'listener', '--ros-args', '-r', "
+                                   "'__node:=ears', '-r', 'heard:=chatter']),")
+    g = _graph(ws, lf)
+    assert sorted(g.nodes) == ["/ears"] and _subs(g, "/ears") == REMAPPED and _said(g) == []
+    # control: another program is no node read, and said so
+    lf = _py(ws, "exec_other.launch.py", "ExecuteProcess(cmd=['gzserver', '--verbose']),")
+    g = _graph(ws, lf)
+    assert g.nodes == {}
+    assert _said(g) == ["ws/demo/launch/exec_other.launch.py:11:9: warning: ExecuteProcess(...) runs 'gzserver "
+                        "--verbose', not 'ros2 run PKG EXE': the nodes it starts, if any, are unknown"]
 
 
 # -- YAML group as a list --------------------------------------------------------

@@ -2,7 +2,9 @@
 a ROS 2 Python launch file, read from its syntax tree: ``remappings``,
 ``parameters`` (literal dicts), and ``ros_arguments`` / the ``--ros-args``
 part of ``arguments`` (kept as tokens for :mod:`launch_rosargs`).  What
-cannot be read is left out with a located note; the node is kept.
+cannot be read is left out with a located note; the node is kept.  An
+``ExecuteProcess`` running ``ros2 run PKG EXE`` is that node
+(:func:`execute_process`).
 """
 from __future__ import annotations
 
@@ -101,3 +103,28 @@ def node_kids(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
                                                                     f"literal list: not resolved statically",
                           "ROS-LAUNCH"))
     return kids
+
+
+def execute_process(c: ast.Call, src: Src, notes: list[Note]) -> El | None:
+    """``ExecuteProcess(cmd=['ros2', 'run', pkg, exe, ...])`` as the node it
+    starts (its ``--ros-args`` read as a node's); any other command, or one
+    that cannot be read, is named in a located note (``None``)."""
+    cmd = _kw(c, "cmd") or (c.args[0] if c.args else None)
+    toks: list[str] = []
+    seq = _expand(cmd) if cmd is not None else None
+    if isinstance(seq, (ast.List, ast.Tuple)):
+        try:
+            toks = [_value(x) for x in seq.elts]
+        except _Unres as exc:
+            notes.append(Note(src, f"ExecuteProcess(...): command item {exc} cannot be read statically; the node "
+                                   f"it starts, if any, is unknown", "ROS-LAUNCH"))
+            return None
+    if len(toks) >= 4 and toks[0].rsplit("/", 1)[-1] == "ros2" and toks[1] == "run":
+        attrs = {"pkg": toks[2], "exec": toks[3]}
+        ros = after_ros_args(toks[4:])
+        if ros:
+            attrs["ros_args"] = SEP.join(ros)
+        return El("node", attrs, [], src)
+    notes.append(Note(src, f"ExecuteProcess(...) runs '{' '.join(toks) or (ast.unparse(cmd) if cmd else '?')}', not "
+                           f"'ros2 run PKG EXE': the nodes it starts, if any, are unknown", "ROS-LAUNCH"))
+    return None

@@ -42,7 +42,7 @@ from rclverify.ros.extract.launch_py_values import ENV as _ENV, HERE as _HERE, T
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg, callee as _callee
 from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
 from rclverify.ros.extract.launch_py_values import grown as _grown, value as _value
-from rclverify.ros.extract.launch_py_node import node_kids as _node_kids, ros_args as _ros_args
+from rclverify.ros.extract.launch_py_node import execute_process, node_kids as _node_kids, ros_args as _ros_args
 from rclverify.ros.extract.model import Note, Src
 
 #: actions that start no node and set nothing the graph reads (passed over without a note)
@@ -280,6 +280,11 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
             return None
         _condition(c, attrs, shown, notes)
         return El("group", {**attrs, "scoped": "false"}, got, src)
+    elif name == "ExecuteProcess":
+        el = execute_process(c, src, notes)
+        if el is not None:
+            _condition(c, el.attrs, shown, notes)
+        return el
     elif name in QUIET:
         return None
     else:
