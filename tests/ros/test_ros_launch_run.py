@@ -265,6 +265,19 @@ def test_an_opaque_function_built_from_literals_is_evaluated(ws: Path) -> None:
     assert sorted(g.nodes) == ["/rover_ears", "/rover_mouth"] and _said(g) == []
 
 
+def test_what_an_opaque_function_pushes_stays_after_it_and_a_group_scopes_it(ws: Path) -> None:
+    pushed = "def pushes(context):\n    return [PushRosNamespace('deck'), SetRemap('heard', 'chatter')]\n\n\n"
+    lf = _py(ws, "pushes.launch.py", "OpaqueFunction(function=pushes),\nNode(package='demo', executable='listener'),",
+             "from launch_ros.actions import PushRosNamespace\n\n\n" + pushed)
+    g = _graph(ws, lf)
+    assert _subs(g, "/deck/listener") == {("/deck/chatter", "std_msgs/msg/Int32")}
+    # control: the same function inside a GroupAction, which scopes what it pushes
+    lf = _py(ws, "pushes_grouped.launch.py", "GroupAction([OpaqueFunction(function=pushes)]),\n"
+                                             "Node(package='demo', executable='listener'),",
+             "from launch_ros.actions import PushRosNamespace\n\n\n" + pushed)
+    assert _subs(_graph(ws, lf), "/listener") == {("/heard", "std_msgs/msg/Int32")}
+
+
 def test_an_opaque_function_chosen_at_run_time_is_named_on_the_first_screen(ws: Path) -> None:
     lf = _py(ws, "branched.launch.py", "OpaqueFunction(function=launch_setup),", BRANCHED)
     g = _graph(ws, lf)

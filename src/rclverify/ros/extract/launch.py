@@ -303,6 +303,11 @@ class Interpreter:
                 scope.args[name] = val
         elif t == "group":
             ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
+            if el.attrs.get("scoped") == "false" and not ns:
+                # an unscoped group (OpaqueFunction's, an event handler's, a timer's actions): what it
+                # pushes (namespace, remaps, arguments) stays for the actions after it, as launch runs it
+                self._body(el.children, scope, path)
+                return
             inner = _Scope(names.join(scope.ns, ns) if ns else scope.ns, scope.args if el.attrs.get("scoped") == "false"
                            else dict(scope.args), list(scope.remaps), scope.unsure)
             self._body(el.children, inner, path)
