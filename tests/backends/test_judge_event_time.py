@@ -250,3 +250,48 @@ def test_the_control_one_clock_judged_on_its_stamps(tmp_path: Path) -> None:
     lines = _alarm_run(-0.02, lag_readings=2)
     ws, run = _workspace(tmp_path, BAND, lines, BAND_MAPPING)
     assert _band_offline(ws, run)[0] == "failed"
+
+
+# -- a stamp copied from an earlier question: the answer judged against every question it could answer ----------
+
+def _stale_run(level: str, stamp: float) -> list[dict[str, Any]]:
+    """r = 50 at 1.0 s, 130 at 1.2 s, 50 at 1.4 s, each answered 10 ms later stamped with its
+    question's stamp, but the second answer (``level``) stamped ``stamp``."""
+    return [_msg("r", 1.0, 1.0, value=50.0), _msg("status", 1.01, 1.0, level="green"),
+            _msg("r", 1.2, 1.2, value=130.0), _msg("status", 1.21, stamp, level=level),
+            _msg("r", 1.4, 1.4, value=50.0), _msg("status", 1.41, 1.4, level="green"),
+            _msg("tick", 3.0, None, data=0)]
+
+
+def _stale_live(ws: Path, lines: list[dict[str, Any]]) -> list[tuple[str, str]]:
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    verdicts: list[Any] = []
+    eng = OnlineEngine(checked, [checked.nodes["Band"]], rules, 0.5, reorder_window=0.05, on_verdict=verdicts.append)
+    now = 1.0
+    for k, line in enumerate(lines):  # heard 1 ms after it was published, the timer every 10 ms
+        while now + 0.01 <= line["time"] + 0.001:
+            now += 0.01
+            eng.tick(now)
+        eng.push(line["topic"], {x: v for x, v in line.items() if x not in ("topic", "time")}, line["time"],
+                 f"run.jsonl:{k + 1}")
+    eng.finish()
+    return sorted((v.where, v.verdict) for v in verdicts)
+
+
+@pytest.mark.parametrize("level, stamp, status, verdict", [
+    ("green", 1.0, "inconclusive", "inconclusive"),  # row 5: a wrong answer, a stale stamp: was discharged
+    ("red", 1.0, "inconclusive", "inconclusive"),    # its control: the right answer, a stale stamp: was failed
+    ("red", 1.2, "discharged", "satisfied"),         # the correct node, its question's stamp
+    ("green", 1.2, "failed", "violated"),            # the defect, its question's stamp
+])
+def test_an_answer_with_a_stale_stamp_is_judged_against_every_question_it_could_answer(
+        tmp_path: Path, level: str, stamp: float, status: str, verdict: str) -> None:
+    lines = _stale_run(level, stamp)
+    ws, run = _workspace(tmp_path, BAND, lines, BAND_MAPPING)
+    got, text, offline = _band_offline(ws, run)
+    assert got == status, text
+    assert dict(offline)["run.jsonl:4"] == verdict, offline
+    if verdict == "inconclusive":
+        assert "satisfied" not in [v for w, v in offline if w == "run.jsonl:4"]  # never green first
+    assert _stale_live(ws, lines) == offline

@@ -189,14 +189,24 @@ def test_the_online_engine_applies_the_same_rule(simple: Any) -> None:
 
 def test_a_late_output_live_is_judged_by_its_own_stamp(simple: Any) -> None:
     """Live, a message older than one already released is checked at the
-    clock; a green stamped before the reading 110 arrives late: it was
-    computed before the question, so it does not answer it."""
+    clock; a green stamped before the reading 110 arrives late.  Published
+    (its source time) before the reading, it was computed before the
+    question, so it does not answer it.  Published after it (issue 106: its
+    stamp may be a stale copy), it may answer it: the run is not green on
+    the reading either way, and the green is never a violation."""
     got: list[Any] = []
+    eng = OnlineEngine(simple, [simple.nodes["Sensor"]], {}, horizon=0.5, on_verdict=got.append)
+    eng.push("r", {"header": {"stamp": {"secs": 2, "nsecs": 0}}, "value": 110.0}, 2.0)
+    eng.push("status", {"header": {"stamp": {"secs": 1, "nsecs": 900_000_000}}, "level": "green"}, 1.95)
+    eng.tick(3.0)
+    assert eng.late == 1 and [v.verdict for v in got] == ["inconclusive"] and "unanswered" in got[0].reason
+    got.clear()
     eng = OnlineEngine(simple, [simple.nodes["Sensor"]], {}, horizon=0.5, on_verdict=got.append)
     eng.push("r", {"header": {"stamp": {"secs": 2, "nsecs": 0}}, "value": 110.0}, 2.0)
     eng.push("status", {"header": {"stamp": {"secs": 1, "nsecs": 900_000_000}}, "level": "green"}, 2.05)
     eng.tick(3.0)
-    assert eng.late == 1 and [v.verdict for v in got] == ["inconclusive"] and "unanswered" in got[0].reason
+    verdicts = [v.verdict for v in got]
+    assert eng.late == 1 and "inconclusive" in verdicts and "violated" not in verdicts, verdicts
 
 
 def test_the_deadline_monitor_applies_the_same_rule(tmp_path: Path) -> None:

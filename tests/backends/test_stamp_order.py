@@ -152,7 +152,10 @@ def test_the_reorder_buffer_releases_in_stamp_order() -> None:
 
 def test_oracle_any_recording_order_gives_the_stamp_order_verdicts(tmp_path: Path, checked: Any) -> None:
     """Random runs of Base's service recorded with random delays: the verdicts of the run as recorded
-    equal those of the same messages written in stamp order (each message's time its stamp)."""
+    equal those of the same messages written in stamp order (each message's time its stamp), except
+    that a response recorded more than 20 ms after its stamp with a request stamped in between may
+    answer that request (its stamp may be a stale copy: docs/semantics.md, "Event time"), so its
+    verdicts there may be inconclusive, never the other colour."""
     rng = random.Random(11)
     for case in range(60):
         rows = []
@@ -165,4 +168,9 @@ def test_oracle_any_recording_order_gives_the_stamp_order_verdicts(tmp_path: Pat
         recorded_order = _write(tmp_path / f"rec{case}.jsonl", sorted(rows, key=lambda r: r[1]))
         stamp_order = _write(tmp_path / f"st{case}.jsonl", [(tp, st, st, f) for tp, _, st, f in
                                                             sorted(rows, key=lambda r: r[2])])
-        assert _statuses(checked, recorded_order) == _statuses(checked, stamp_order), recorded_order.read_text()
+        got, oracle = _statuses(checked, recorded_order), _statuses(checked, stamp_order)
+        stale = any(tp.endswith("response") and rec - st > 0.02 and
+                    any(t2.endswith("request") and st < s2 <= rec for t2, _, s2, _ in rows)
+                    for tp, rec, st, _ in rows)
+        assert got == oracle or (stale and all(a in (b, "inconclusive") for a, b in zip(got, oracle))), \
+            recorded_order.read_text()

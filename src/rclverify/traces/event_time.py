@@ -87,6 +87,19 @@ def without_stamp(fields: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+#: a header stamp more than this (s) before its message's source time is older than its publication: the
+#: message may answer any question asked up to its source time (a stamp copied from an earlier question)
+STALE_S = 0.02
+
+
+def published(stamp: float, source: float) -> float | None:
+    """``source`` (s) when a message placed at header stamp ``stamp`` (s) was
+    published more than :data:`STALE_S` after it, else ``None``: what an
+    event placed at its stamp carries as its ``source``
+    (:class:`~rclverify.traces.events.Event`)."""
+    return source if source - stamp > STALE_S else None
+
+
 class WriterClocks:
     """Per writer (a topic), the offset between its header stamps and its
     messages' source times, measured: ``offsets[topic] = [lo, hi, n,
@@ -147,5 +160,5 @@ def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]
     return (stamp, source, seq)
 
 
-__all__ = ["AHEAD_NS", "STAMP_AHEAD_S", "STAMP_BEHIND_S", "event_ns", "event_s", "order_key", "other_clock",
+__all__ = ["AHEAD_NS", "STALE_S", "STAMP_AHEAD_S", "published", "STAMP_BEHIND_S", "event_ns", "event_s", "order_key", "other_clock",
            "without_stamp", "WriterClocks"]

@@ -28,7 +28,12 @@ class Event:
     ``stamp``  the message's own time when ``time`` is not it (``None``
                otherwise): a live monitor checks a message that arrives too
                late to be ordered at its clock, but whether it answers an
-               input event is decided by when it was stamped.
+               input event is decided by when it was stamped;
+    ``source`` when the message was published (s: its source time), where
+               neither ``time`` nor ``stamp`` is it (``None`` otherwise): a
+               message placed at a header stamp older than its publication
+               (a stamp copied from an earlier question) may answer the
+               questions asked up to then (docs/semantics.md, "Event time").
     """
 
     index: int
@@ -37,14 +42,16 @@ class Event:
     fields: Mapping[str, Any]
     where: str
     stamp: float | None = None
+    source: float | None = None
 
     def __init__(self, index: int, time: float, topic: str, fields: Mapping[str, Any], where: str,
-                 stamp: float | None = None) -> None:
+                 stamp: float | None = None, source: float | None = None) -> None:
         # Frozen: each attribute is set once, here, in the instance's dict (the dataclass's own
         # __init__ goes through object.__setattr__ per field, twice as slow, and a run has
         # millions of events)
         d = self.__dict__
         d["index"], d["time"], d["topic"], d["fields"], d["where"], d["stamp"] = index, time, topic, fields, where, stamp
+        d["source"] = source
 
     @property
     def stamped(self) -> float:

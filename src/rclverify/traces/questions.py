@@ -174,16 +174,19 @@ class QuestionStream:
         i = bisect.bisect_right(stamps, stamp)
         return self._questions[i - 1] if i else None
 
-    def within_skew(self, stamp: float, answered: Question | None) -> list[Question]:
+    def within_skew(self, stamp: float, answered: Question | None, reach: float | None = None) -> list[Question]:
         """The questions an output stamped ``stamp`` may answer besides
         ``answered`` (the latest question at its stamp when it came): those
-        stamped within the skew after it, or at its stamp but asked after it."""
-        if not self.skew:
+        stamped within the skew after it (within ``reach`` s when given: an
+        output published that long after its stamp), or at its stamp but
+        asked after it."""
+        reach = self.skew if reach is None else reach
+        if not reach:
             return []
         qs = self._questions
         i = qs.index(answered) + 1 if answered is not None and answered in qs else \
             bisect.bisect_left(self._stamps, stamp)
-        j = bisect.bisect_right(self._stamps, stamp + self.skew)
+        j = bisect.bisect_right(self._stamps, stamp + reach)
         return [q for q in qs[i:j] if q.stamp >= stamp]
 
 

@@ -167,6 +167,9 @@ class NodeMonitor(Judging, Closing, Late):
         self._held_margins: dict[int, float | None] = {}
         #: outputs held for the skew and judged since, kept as ``_recent`` keeps those judged at once (late.py)
         self._released: deque[Recent] = deque(maxlen=64)
+        #: event index -> how far after its stamp (s) a question may be the one an output answers, where that is
+        #: beyond the skew: published that long after its stamp (a stamp copied from an earlier question)
+        self._wins: dict[int, float] = {}
         #: input -> (stamp, why) of its latest unreadable message (a NaN) until a message stamped after it maps
         self._unread: dict[str, tuple[float, str]] = {}
         #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late
@@ -218,7 +221,7 @@ class NodeMonitor(Judging, Closing, Late):
         t = ev.time
         if t > self.now:
             self.now = t
-        if self._held and self.now > self._held[0][1] + self.stream.skew:
+        if self._held and self.now > self._held[0][1] + self._reach_of(self._held[0][0]):
             self._release(self.now)
         if self.now > self._due:
             self._expire(self.now)
@@ -315,7 +318,7 @@ class NodeMonitor(Judging, Closing, Late):
                 self._wrong_whatever(followed)
         if old is not None:
             old.reported = True
-            if self.stream.skew and self._recent:
+            if (self.stream.skew or self._wins) and self._recent:
                 self._early_answer(old)
             self._verdict("superseded", old.event, reason=f"the input at {ev.where} came before any output "
                           f"answered the question raised at {old.event.where}: the node owes the latest one an answer")
@@ -364,12 +367,13 @@ class NodeMonitor(Judging, Closing, Late):
             outs = mine
         if stamped > self._hi:
             self._hi = stamped
+        reach = self._reach(ev, stamped)
         # remembered: reconsidered if a question within the skew after it gets no answer, or a question stamped
         # before it is heard after it (late.py)
         self._recent.append((ev, stamped, mine, self._state() if self._state_outs else _EMPTY))
         k = self._single.get(ev.topic, 0)
         if k and q is not None and q.owed and q.view is not None and outs is q.answer and not self._state_outs \
-                and not self.margins:  # with margins, the general path (judging.py) computes them
+                and not self.margins and reach <= self.stream.skew:  # with margins, the general path (judging.py) computes them
             # the common case inline: one guarantee, no trigger, no state, no output-only guarantee
             view = q.view
             judged = self._judges[k].quick(view) or self._judge(k, view)
@@ -387,9 +391,11 @@ class NodeMonitor(Judging, Closing, Late):
         state = self._state() if self._state_outs else {}
         first = self._question_outcome(q, ev, asked, outs, state)
         alone_now = self._alone_outcome(ev, alone) if alone else _NONE
-        if first.kind == "violated" and self.stream.skew:
+        if reach and (first.kind == "violated" or reach > self.stream.skew):
             # false for the question at its stamp: it may be the right answer to a question stamped within the
-            # skew after it that gets no answer of its own; judged once that is known (docs/semantics.md)
+            # skew after it that gets no answer of its own; judged once that is known (docs/semantics.md); one
+            # published well after its stamp is held whatever it is for that question (a stale stamp's answer
+            # is satisfied only if it satisfies every question it could answer: docs/semantics.md, "Event time")
             self._recent.pop()  # judged with both readings when released, not reconsidered
             self._held.append((ev, stamped, q, dict(outs), state, alone_now, first))
             if self.margins:  # its message's margin so far, given to its verdict when released
@@ -405,11 +411,10 @@ class NodeMonitor(Judging, Closing, Late):
         """Judge the held outputs whose skew has passed and whose questions within
         the skew are settled (answered by outputs of their own, closed, or past
         their horizon); all of them at the ``end``."""
-        skew = self.stream.skew
         held = self._held
-        while held and (end or held[0][1] + skew < now):
+        while held and (end or held[0][1] + self._reach_of(held[0][0]) < now):
             ev, stamped, q, outs, state, alone, first = held[0]
-            others = [o for o in self.stream.within_skew(stamped, q) if not o.answered]
+            others = [o for o in self.stream.within_skew(stamped, q, self._reach_of(ev)) if not o.answered]
             if not end and any(not o.reported and (now <= o.due or self._at_due(now, o.due)) for o in others):
                 return  # a question it may answer has no answer of its own yet: wait
             held.popleft()
@@ -439,7 +444,7 @@ class NodeMonitor(Judging, Closing, Late):
                       (f" answering the question at {qwhere}" if qwhere else "") +
                       (f": {outcome.reason}" if outcome.reason else in_all(outcome.semantics)))
             if len(readings) > 1:
-                reason += f" (and on every question it may answer within the transport skew of {self.stream.skew:g} s)"
+                reason += f" (and on every question it may answer {self._within(ev)})"
             self._violation(ev, k, outcome.values, reason, outcome.semantics, question.event if question else None)
         elif outcome.kind == "inconclusive":
             reason = outcome.reason if len(readings) < 2 or outcome.reason else skew_reason(ev, q, others,

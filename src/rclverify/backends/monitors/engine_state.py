@@ -17,6 +17,7 @@ from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.floatsem import Judgement, Tolerance
 from rclverify.semantics.judges import FormulaJudge
+from rclverify.traces.event_time import STALE_S
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.verdicts import NodeResult, Verdict
@@ -61,6 +62,7 @@ class EngineState:
     _recent: deque[Recent]
     _held: deque[tuple[Any, ...]]
     _released: deque[Recent]
+    _wins: dict[int, float]
     _unread: dict[str, tuple[float, str]]
     _in_force: dict[str, list[tuple[float, Any, Event]]]
     _open: Question | None
@@ -71,6 +73,37 @@ class EngineState:
     _assumed: list[tuple[tuple[str, int], ast.Expr]]
     _guaranteed: dict[int, ast.Expr]
     _judges: dict[Any, FormulaJudge]
+
+    def _reach(self, ev: Event, stamped: float) -> float:
+        """How far after its stamp ``stamped`` (s) a question may be the one output
+        ``ev`` answers: the transport skew, or, for an output published more than
+        :data:`~rclverify.traces.event_time.STALE_S` after its stamp (its source
+        time: ``ev.source``, or its trace time where ``ev.stamp`` is its header
+        stamp), up to then: a node that copied an earlier question's stamp onto
+        its answer answers a question asked before it published
+        (docs/semantics.md, "Event time").  Noted for :meth:`_reach_of`."""
+        src = ev.source if ev.source is not None else ev.time if ev.stamp is not None else stamped
+        lag = src - stamped
+        if lag > STALE_S and lag > self.stream.skew:
+            wins = self._wins
+            if len(wins) >= 1024:
+                del wins[next(iter(wins))]  # the oldest: long judged
+            wins[ev.index] = lag
+            return lag
+        return self.stream.skew
+
+    def _reach_of(self, ev: Event) -> float:
+        """:meth:`_reach` of an output already judged or held."""
+        return self._wins.get(ev.index, self.stream.skew)
+
+    def _within(self, ev: Event) -> str:
+        """The words for the questions output ``ev`` may answer: within the skew, or
+        until it was published (its stamp older than that)."""
+        reach = self._wins.get(ev.index)
+        if reach is None:
+            return f"within the transport skew of {self.stream.skew:g} s"
+        return (f"until it was published, {reach * 1e3:.1f} ms after its stamp (a header stamp older than the "
+                "message: copied from an earlier question?)")
 
     if TYPE_CHECKING:  # the helpers one part calls of another (defined in engine.py and the parts)
         def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,

@@ -44,7 +44,7 @@ from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.traces.event_time import WriterClocks, without_stamp
+from rclverify.traces.event_time import WriterClocks, published, without_stamp
 from rclverify.traces.events import Event, header_stamp, header_stamp_ns
 from rclverify.traces.reorder import ReorderBuffer
 from rclverify.traces.mapping import TopicRule
@@ -153,12 +153,15 @@ class OnlineEngine:
         return self._buffer.max_late_s
 
     def _release(self, upto: float) -> None:
-        for t, _, (topic, fields, where), late in self._buffer.release(upto):
+        for t, src, (topic, fields, where), late in self._buffer.release(upto):
             stamp = None
+            source = published(t, src)  # published after its stamp: it may answer what was asked until then
             if late:
-                stamp, t = t, self._clock  # checked at the clock; its own stamp decides what it answers
+                stamp, t, source = t, self._clock, src  # checked at the clock; its own stamp decides what it answers
+            elif source is not None:
+                stamp = t
             self._clock = t
-            ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp)
+            ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp, source)
             self.released += 1
             if self.on_event is not None:
                 self.on_event(ev)

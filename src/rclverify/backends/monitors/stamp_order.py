@@ -44,7 +44,7 @@ from __future__ import annotations
 import math
 from typing import Any, Callable, Iterable, Iterator
 
-from rclverify.traces.event_time import WriterClocks, other_clock, without_stamp
+from rclverify.traces.event_time import WriterClocks, other_clock, published, without_stamp
 from rclverify.traces.events import Event, header_stamp
 from rclverify.traces.reorder import ReorderBuffer
 
@@ -192,12 +192,23 @@ def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
             t = run_clock(ev)
         latest = max(latest, t)
         buffer.push(t, ev.time, ev)
-        for t0, _, e0, _ in buffer.release(latest - lag, strict=True):
-            yield Event(out, t0, e0.topic, e0.fields, e0.where)
+        for t0, src, e0, _ in buffer.release(latest - lag, strict=True):
+            yield _placed(out, t0, src, e0)
             out += 1
-    for t0, _, e0, _ in buffer.drain():
-        yield Event(out, t0, e0.topic, e0.fields, e0.where)
+    for t0, src, e0, _ in buffer.drain():
+        yield _placed(out, t0, src, e0)
         out += 1
+
+
+def _placed(index: int, t: float, source: float, ev: Event) -> Event:
+    """``ev`` as the ``index``-th of the run in stamp order, at its time ``t`` (s);
+    published more than :data:`~rclverify.traces.event_time.STALE_S` after it
+    (``source``, s), it carries that as its source time (and ``t`` as its
+    stamp: it is judged by the streaming engine, which reads both)."""
+    src = published(t, source)
+    if src is None:
+        return Event(index, t, ev.topic, ev.fields, ev.where)
+    return Event(index, t, ev.topic, ev.fields, ev.where, t, src)
 
 
 def stale_reason(watch: StampWatch, trace: str) -> str:
