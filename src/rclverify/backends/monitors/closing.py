@@ -162,16 +162,16 @@ class Closing(EngineState):
         gap = max(qb.stamp - stamped, 0.0) * 1000
         self._verdict("inconclusive", ev, guarantee=reading.guarantee, values=self._rendered(reading.values),
                       reason=f"the output at {ev.where} met the question at its stamp, but it was stamped {gap:.2f} ms "
-                             f"before the question at {qb.event.where}, within the transport skew of "
-                             f"{self.stream.skew:g} s, and that question got no answer of its own: as its answer, "
+                             f"before the question at {qb.event.where}, {self._within(ev)}, "
+                             f"and that question got no answer of its own: as its answer, "
                              f"guarantee {reading.guarantee} is false; the two readings disagree (docs/semantics.md, "
                              f"\"Transport skew\")", question=qb.event.where)
 
     def _early(self, q: Question) -> list[Any]:
         """The outputs judged at once (``_recent``) that were received before
         question ``q`` and stamped within the transport skew before it."""
-        floor = q.stamp - self.stream.skew
-        return [r for r in self._recent if floor <= r[1] <= q.stamp and r[0].index < q.event.index]
+        return [r for r in self._recent if q.stamp - self._reach_of(r[0]) <= r[1] <= q.stamp
+                and r[0].index < q.event.index]
 
     def _forget(self, used: list[Any]) -> None:
         """Drop the outputs ``used`` from ``_recent``: their reconsideration is given (an input
@@ -209,7 +209,7 @@ class Closing(EngineState):
         was, q.reported = q.reported, True  # closed: superseded no more
         if q.answered or q.settled or was or judged_now:
             return
-        if self.stream.skew and self._recent:
+        if (self.stream.skew or self._wins) and self._recent:
             self._early_answer(q)
         if end:
             self._verdict("open", q.event, reason=f"unanswered when the run ended, within {self.horizon} s")
@@ -239,7 +239,7 @@ class Closing(EngineState):
                 self._violation(ev, k, values, f"guarantee {k} is false on the outputs published after the question "
                                 f"at {q.event.where} (the last at {ev.where}) whatever the value of the outputs not "
                                 f"published before the next question ({why})", "", q.event)
-            elif self.stream.skew and self._recent:
+            elif (self.stream.skew or self._wins) and self._recent:
                 self._early_part(q, k, values)
         q.waiting.clear()
 
@@ -267,7 +267,7 @@ class Closing(EngineState):
         gap = max(q.stamp - stamped, 0.0) * 1000
         self._verdict("inconclusive", ev, guarantee=k, values=self._rendered(completed),
                       reason=f"the output at {ev.where} was stamped {gap:.2f} ms before the question at "
-                             f"{q.event.where}, within the transport skew of {self.stream.skew:g} s, and that "
+                             f"{q.event.where}, {self._within(ev)}, and that "
                              f"question's answer lacks what it published: as the rest of that answer, guarantee {k} "
                              f"is false; taken for the question at its stamp, it left that answer incomplete; the "
                              f"two readings disagree (docs/semantics.md, \"Transport skew\")", question=q.event.where)
