@@ -286,7 +286,7 @@ class _Run:
                 bad = loose
             b = int(bad[np.searchsorted(bad, p)]) if len(bad) and bad[-1] >= p else total
             if b > p and m._held:  # an output held for the skew: batch only up to the event that releases it
-                limit = m._held[0][1] + m.stream.skew
+                limit = m._held[0][1] + m._reach_of(m._held[0][0])
                 b = p + int(np.searchsorted(times[at[p:b] + 1], limit, side="right"))
             if b > p and full and wrong is not None and self.held:
                 b = self._released(at, times, wrong, p, b)
