@@ -6,7 +6,8 @@ The report files under ``reports/`` are not named by the user: a planted link le
 or a device there is refused in one line (exit 1) and left as it was, the outside file untouched;
 a regular file there (the control) is written.  A path the user names is written wherever it
 leads: a link is followed, a device written in place (exit 0), and a FIFO no process reads fails
-at once in one line (exit 1), never hangs.  The report files are checked in process through
+in one line (exit 1) once no reader
+opened it within the wait, never hangs.  The report files are checked in process through
 ``rclverify report`` (the code the ``report:`` tasks of ``verify`` run), and ``verify`` itself once
 end to end on the issue's own cases.
 """
@@ -23,6 +24,7 @@ from typing import Callable, Iterator
 import pytest
 
 from rclverify.cli.commands import main
+from rclverify.core import atomic
 from rclverify.stages.workspace import REPORT_PARTS
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
@@ -140,7 +142,9 @@ def _commands(ws: Path) -> dict[str, Callable[[Path], list[str]]]:
 @pytest.mark.parametrize("command", ["fmt", "latex", "graph", "quotient", "review", "bundle", "nodl check --json",
                                      "standards --csv"])
 def test_every_named_output_goes_where_the_user_said_and_never_hangs(ws: Path, tmp_path: Path, command: str,
-                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+                                                                      capsys: pytest.CaptureFixture[str],
+                                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(atomic, "READER_WAIT_S", 0.2)  # the wait for a reader to open the FIFO (2 s)
     argv = _commands(ws)[command]
     # control: a regular file
     plain = tmp_path / "out.bin"
@@ -160,7 +164,7 @@ def test_every_named_output_goes_where_the_user_said_and_never_hangs(ws: Path, t
     assert _bounded(lambda: main(argv(dev))) == 0
     assert not stat.S_ISREG(os.stat(dev).st_mode)
     assert not (tmp_path / "dev.svg").exists()  # issue 112: graph drew FILE.svg beside even a device
-    # a FIFO no process reads: one line, exit 1, at once
+    # a FIFO no process reads: one line, exit 1, within the wait for a reader
     fifo = tmp_path / "fifo"
     os.mkfifo(fifo)
     capsys.readouterr()

@@ -16,10 +16,10 @@ Where a write may go (docs/integrity.md, "Where outputs go"):
   a device is written in place, never renamed over (``-o /dev/null``
   discards, as a shell redirection does; as root a rename over
   ``/dev/null`` would replace the machine's device node).  The special file
-  is opened without blocking: a FIFO no process reads fails at once
-  (``ENXIO``), and a write that finds no room for
-  :data:`SPECIAL_WRITE_TIMEOUT_S` seconds fails (``ETIMEDOUT``), so the write
-  cannot hang;
+  is opened without blocking: a FIFO no process opens for reading within
+  :data:`READER_WAIT_S` seconds fails (``ENXIO``), and a write that finds no
+  room for :data:`SPECIAL_WRITE_TIMEOUT_S` seconds fails (``ETIMEDOUT``), so
+  the write cannot hang;
 * every other path (a report, an artifact) is written only as a regular
   file: a FIFO, device or socket there is refused, never opened
   (:class:`~rclverify.core.within.Refused`), and with ``within`` (the
@@ -43,6 +43,8 @@ from rclverify.core.within import Refused, kind_of, outside
 
 #: Seconds a write into a FIFO or device the user named may find no room before it fails.
 SPECIAL_WRITE_TIMEOUT_S = 10.0
+#: Seconds a FIFO the user named is given for a reader to open it (``cat FIFO`` started beside the command).
+READER_WAIT_S = 2.0
 
 
 def atomic_write_text(path: Path, text: str, *, durable: bool = False, within: Path | None = None,
@@ -91,8 +93,8 @@ def atomic_write_bytes(path: Path, data: bytes, *, durable: bool = False, mode: 
     ``named=True``: the user named ``path`` (module docstring): a symbolic
     link is followed wherever it leads, a character or block device or FIFO
     is written in place within :data:`SPECIAL_WRITE_TIMEOUT_S` seconds of no
-    progress (``ENXIO`` for a FIFO no process reads, ``ETIMEDOUT`` past the
-    limit).  Otherwise a special file raises
+    progress (``ENXIO`` for a FIFO no process opens for reading within
+    :data:`READER_WAIT_S` seconds, ``ETIMEDOUT`` past the limit).  Otherwise a special file raises
     :class:`~rclverify.core.within.Refused` without being opened, and with
     ``within`` (a directory, the workspace) a ``path`` that resolves outside
     it does too.  A socket is always refused; a directory raises
@@ -172,15 +174,22 @@ def holds(path: Path, data: bytes) -> bool:
 def _write_in_place(path: Path, data: bytes, timeout_s: float) -> None:
     """Write ``data`` into the existing device or FIFO ``path`` without
     creating, truncating or renaming anything, never blocking: opened with
-    ``O_NONBLOCK`` (a FIFO no process reads: ``ENXIO`` at once), and each
-    time the file takes no byte, waiting for room at most ``timeout_s``
-    seconds (then ``TimeoutError``, ``ETIMEDOUT``)."""
-    try:
-        fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    except OSError as exc:
-        if exc.errno == errno.ENXIO:
-            raise Refused(path, "is a FIFO no process reads: nothing would take the output", errno.ENXIO) from None
-        raise
+    ``O_NONBLOCK`` (a FIFO no process has open for reading gives ``ENXIO``;
+    the open is tried again for :data:`READER_WAIT_S` seconds, then refused),
+    and each time the file takes no byte, waiting for room at most
+    ``timeout_s`` seconds (then ``TimeoutError``, ``ETIMEDOUT``)."""
+    waited = time.monotonic()
+    while True:
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+            break
+        except OSError as exc:
+            if exc.errno != errno.ENXIO:
+                raise
+            if time.monotonic() - waited >= READER_WAIT_S:
+                raise Refused(path, f"is a FIFO no process reads (none opened it within {READER_WAIT_S:g} s): "
+                                    "nothing would take the output", errno.ENXIO) from None
+            time.sleep(0.02)
     try:
         poller = select.poll()
         poller.register(fd, select.POLLOUT)
