@@ -5,7 +5,7 @@ arithmetic (docs/semantics.md, "Margins"), for the formulas the batch path
 compiles (:class:`rclverify.targets.columns.ColumnCompiler`: quantifier-free,
 ``REAL`` and enumeration values): a comparison of numbers that reads a value
 of the run gives its distance (``b - a`` for ``a <= b``, ``-|a - b|`` for
-``a == b``, ...), computed by numpy in float64 on the terms as the column
+``a == b`` on unequal sides and ``+inf`` on equal ones, ...), computed by numpy in float64 on the terms as the column
 compiler computes them (the IEEE-754 operations of the double reading, in
 the same order); every other comparison ``+inf`` or ``-inf`` by its truth;
 ``not`` negates, ``and``/``or`` are minimum and maximum, ``->`` and ``<=>``
@@ -87,8 +87,8 @@ class MarginCompiler:
                 elif op in (">", ">="):
                     d = vx - vy
                 else:
-                    d = np.abs(vx - vy)
-                    d = -d if op == "==" else d
+                    d = np.abs(vx - vy)  # an equality holds without a distance: +inf (robustness.distance)
+                    d = np.where(d == 0, np.inf, -d) if op == "==" else np.where(d == 0, -np.inf, d)
             return np.broadcast_to(np.asarray(d, dtype=np.float64), (n,)) + 0.0, np.full(n, atom, dtype=np.int32)
         return link
 
