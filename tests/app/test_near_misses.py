@@ -120,3 +120,51 @@ def test_a_threshold_that_does_not_read_is_a_located_plan_error(tmp_path, capsys
     err = capsys.readouterr()
     text = err.out + err.err
     assert f"contracts/plan.yaml:{at}:" in text and says in text and "Traceback" not in text
+
+
+RELAY = """node Copy {
+  inputs( ox : REAL )
+  outputs( px : REAL )
+  topics( std_msgs/Float64 c_in matches(in.ox), std_msgs/Float64 c_out matches(out.px) )
+  guarantee( out.px == in.ox )
+}
+node Below {
+  inputs( ox : REAL )
+  outputs( px : REAL )
+  topics( std_msgs/Float64 b_in matches(in.ox), std_msgs/Float64 b_out matches(out.px) )
+  guarantee( out.px <= in.ox )
+}
+"""
+RELAY_PLAN = """name: relays
+contracts: [contracts/relay.rcl]
+nodes:
+  Copy:
+    evidence:
+      - {backend: monitors, traces: [runs/run.jsonl], mapping: contracts/mapping.yaml, near_miss: {value: 0.1}}
+  Below:
+    evidence:
+      - {backend: monitors, traces: [runs/run.jsonl], mapping: contracts/mapping.yaml, near_miss: {value: 0.1}}
+"""
+
+
+def test_an_exact_copy_is_never_a_near_miss_and_a_bound_met_at_zero_is(tmp_path: Path) -> None:
+    """Issue 107: ``out.px == in.ox`` right on every answer had margin 0, below every threshold, so a
+    correct relay was a near miss on each answer; an equality that holds has no distance to a boundary
+    (docs/semantics.md, "Margins"): the report says it held without one.  Control: ``out.px <= in.ox``
+    met with equality is right by 0, and still a near miss."""
+    ws = tmp_path / "ws"
+    for d in ("contracts", "runs"):
+        (ws / d).mkdir(parents=True)
+    (ws / "contracts" / "relay.rcl").write_text(RELAY, encoding="utf-8")
+    (ws / "contracts" / "plan.yaml").write_text(RELAY_PLAN, encoding="utf-8")
+    (ws / "contracts" / "mapping.yaml").write_text("horizon: 1.0\n", encoding="utf-8")
+    rows = [{"topic": f"{x}_{t}", "time": k + (0.01 if t == "out" else 0.0), "data": v}
+            for k, v in enumerate((0.5, 1.25, 3.0)) for t in ("in", "out") for x in "cb"]  # each answer copies
+    (ws / "runs" / "run.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows), encoding="utf-8")
+    assert main(["verify", "-w", str(ws)]) == 0
+    report = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    assert {o["node"]: o["status"] for o in report["obligations"]} == {"Copy": "discharged", "Below": "discharged"}
+    assert [(r["node"], r["margin"]) for r in report["near_misses"]] == [("Below", 0.0)]
+    margins = {r["node"]: r for r in report["margins"]}
+    assert (margins["Copy"]["margin"], margins["Copy"]["holds"], margins["Copy"]["answers"]) == (None, True, 3)
+    assert (margins["Below"]["margin"], margins["Below"]["answers"]) == (0.0, 3)

@@ -9,10 +9,15 @@ evaluator judges (:mod:`rclverify.semantics.evaluate`, the operators of
 :mod:`rclverify.semantics.operators`):
 
 * a comparison of two numbers: ``a <= b`` and ``a < b`` give ``b - a``,
-  ``a >= b`` and ``a > b`` give ``a - b``; ``a == b`` gives ``-|a - b|``
-  (``a <= b and b <= a``: 0 when equal, never positive, since any change of
-  either side breaks an equality), ``a != b`` gives ``|a - b|``; a chain
-  ``a < b <= c`` is the ``and`` of its links;
+  ``a >= b`` and ``a > b`` give ``a - b``; a chain ``a < b <= c`` is the
+  ``and`` of its links;
+* an exact relation of two numbers: ``a == b`` gives ``-|a - b|`` when the
+  sides differ and, when they are equal, ``+inf``: it holds without a
+  distance (any change of either side breaks an equality, so a distance to
+  the boundary would be 0 on every correct answer, and a correct copy
+  ``out.x == in.x`` would read as the nearest of near misses);
+  ``a != b`` is its negation, ``|a - b|`` when they differ and ``-inf``
+  when equal;
 * ``not`` negates, ``and`` is the minimum, ``or`` the maximum, ``a -> b`` is
   ``not a or b``, ``a <=> b`` is ``(a -> b) and (b -> a)``;
 * ``forall`` is the minimum and ``exists`` the maximum over the quantifier's
@@ -32,8 +37,8 @@ evaluator judges (:mod:`rclverify.semantics.evaluate`, the operators of
 **Sign.**  ``margin > 0`` implies the formula holds and ``margin < 0``
 implies it fails, on the same values in the same arithmetic (by induction:
 min and max keep the implication).  ``margin == 0`` is the boundary, where
-the Boolean verdict decides: ``a <= b`` holds there, ``a < b`` does not, a
-satisfied ``a == b`` is always at 0.  tests/semantics/test_robustness.py checks this
+the Boolean verdict decides: ``a <= b`` holds there, ``a < b`` does not (an
+equality is never at 0: it holds at ``+inf``).  tests/semantics/test_robustness.py checks this
 against the evaluator on random formulas and values.
 
 **Arithmetic.**  ``exact``: the terms in exact rational arithmetic (the
@@ -168,6 +173,8 @@ class _Margins:
         if op in (">", ">="):
             return self.diff(x, y)
         d = abs(self.diff(x, y))
+        if d == 0:  # an exact relation at equality: no distance (module docstring)
+            return INF if op == "==" else -INF
         return -d if op == "==" else d
 
     def member(self, e: ast.Member, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
@@ -182,7 +189,7 @@ class _Margins:
         at = (e, 0, frozenset(b))
         near: _R = (-INF, None)
         for v in items:  # x in S: the or of x == v
-            near = _max(near, (-abs(self.diff(x, v)), at))
+            near = _max(near, (self.distance("==", x, v), at))
         return _neg(near) if e.negated else near
 
     def quant(self, e: ast.Quant, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
