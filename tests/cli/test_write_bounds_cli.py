@@ -127,6 +127,7 @@ def test_verify_on_the_issue_cases_ends_in_one_line(ws: Path, tmp_path: Path, na
 def _commands(ws: Path) -> dict[str, Callable[[Path], list[str]]]:
     """Every command that writes a FILE the user names, as the argv writing it to ``out``."""
     w = ["-w", str(ws)]
+    (ws.parent / "no-ros").mkdir(exist_ok=True)  # a ROS scan of nothing: its --json is still written
     return {
         "fmt": lambda out: ["fmt", str(ws / "contracts" / "sensor.rcl"), "-o", str(out)],
         "latex": lambda out: ["latex", str(ws / "contracts" / "sensor.rcl"), "-o", str(out)],
@@ -136,11 +137,12 @@ def _commands(ws: Path) -> dict[str, Callable[[Path], list[str]]]:
         "bundle": lambda out: ["bundle", *w, "-o", str(out)],
         "nodl check --json": lambda out: ["nodl", "check", *w, "--json", str(out)],
         "standards --csv": lambda out: ["standards", *w, "--csv", str(out)],
+        "ros scan --json": lambda out: ["ros", "scan", str(ws.parent / "no-ros"), "--json", str(out)],
     }
 
 
 @pytest.mark.parametrize("command", ["fmt", "latex", "graph", "quotient", "review", "bundle", "nodl check --json",
-                                     "standards --csv"])
+                                     "standards --csv", "ros scan --json"])
 def test_every_named_output_goes_where_the_user_said_and_never_hangs(ws: Path, tmp_path: Path, command: str,
                                                                       capsys: pytest.CaptureFixture[str],
                                                                       monkeypatch: pytest.MonkeyPatch) -> None:
