@@ -109,3 +109,64 @@ def test_a_long_run_draws_its_kept_margins_spread_in_rank() -> None:
     drawn = _spread(ys)
     assert len(drawn) == POINTS_PER_RUN and drawn[0] == 0.0 and drawn[-1] == KEPT_MARGINS - 1
     assert drawn == sorted(set(drawn)) and _spread(ys[:5]) == ys[:5]
+
+
+ONE_RUN_PLAN = """name: one run, many forms
+contracts: [contracts/brake.rcl]
+nodes:
+  Brake:
+    evidence:
+      - backend: monitors
+        traces: [runs/run.jsonl, runs/noted.jsonl, runs/sq, runs/mc, runs/other.jsonl]
+        mapping: contracts/mapping.yaml
+        target: violation probability <= 50 % at 90 % per answer
+"""
+#: (time s, dist, speed answered 10 ms later): margins 0.3 and 0.04
+ONE_RUN = ((1.0, 1.0, 0.7), (2.0, 2.0, 1.96))
+
+
+def _forms(root: Path, store: Any) -> None:
+    """One run as a log, the log with a field no rule reads on each line, an sqlite3 bag and an MCAP bag;
+    and another run (its second answer 1.9, not 1.96): the control."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    rows = [r for t, d, s in ONE_RUN for r in ({"topic": "dist", "time": t, "data": d},
+                                               {"topic": "speed", "time": t + 0.01, "data": s})]
+    write = lambda name, rs: (root / "runs" / name).write_text("".join(json.dumps(r) + "\n" for r in rs))  # noqa: E731
+    write("run.jsonl", rows)
+    write("noted.jsonl", [{**r, "note": f"copied {k}"} for k, r in enumerate(rows)])
+    write("other.jsonl", [{**r, "data": 1.9} if r["data"] == 1.96 else r for r in rows])
+    float64 = store.types["std_msgs/msg/Float64"]
+    for name, plugin, version in (("sq", StoragePlugin.SQLITE3, 8), ("mc", StoragePlugin.MCAP, 9)):
+        with Writer(root / "runs" / name, version=version, storage_plugin=plugin) as w:
+            conns = {t: w.add_connection(f"/{t}", "std_msgs/msg/Float64", typestore=store) for t in ("dist", "speed")}
+            for r in rows:
+                w.write(conns[r["topic"]], round(r["time"] * 1e9), store.serialize_cdr(float64(data=r["data"]),
+                                                                                        "std_msgs/msg/Float64"))
+
+
+def test_a_run_in_many_forms_is_one_run_in_the_margins_and_the_statistics(tmp_path: Path) -> None:
+    """Issues 106 and 107: one run given as a log, an sqlite3 bag, an MCAP bag and a copy with an unread
+    field was counted as four runs in the margins row (and the copy as a second run in the statistics);
+    each part counts it once, by its identity over the fields the mapping reads.  Control: a run with a
+    read value changed is another run."""
+    pytest.importorskip("rosbags")
+    from rclverify.traces.bag import typestore
+    ws = tmp_path / "ws"
+    for d in ("contracts", "runs"):
+        (ws / d).mkdir(parents=True)
+    (ws / "contracts" / "brake.rcl").write_text(BRAKE, encoding="utf-8")
+    (ws / "contracts" / "plan.yaml").write_text(ONE_RUN_PLAN, encoding="utf-8")
+    (ws / "contracts" / "mapping.yaml").write_text(
+        "horizon: 1.0\ntopics:\n  dist: {fields: [data]}\n  speed: {fields: [data]}\n", encoding="utf-8")
+    _forms(ws, typestore([]))
+    assert main(["verify", "-w", str(ws)]) == 0
+    report = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
+    ev = {e["obligation"]: e for e in report["evidence"]}
+    assert sum(1 for o in ev if ".monitors." in o and "runs_" not in o) == 5  # every form judged
+    [row] = report["margins"]
+    assert (row["runs"], row["answers"], row["count"]) == (2, 4, 4)  # the run and the control, once each
+    assert abs(row["margin"] - 0.04) < 1e-9
+    # the statistics: the node's runs and the target's, each the same two runs with their four answers
+    rows = {r["kind"]: r["counts"] for r in report["statistics"]}
+    assert {k: (c["runs"], c["duplicates"], c["answers"]) for k, c in rows.items()} == {"runs": (2, 3, 4),
+                                                                                         "target": (2, 3, 4)}

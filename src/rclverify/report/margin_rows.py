@@ -7,7 +7,12 @@ answers that gave one (``answers``), those that had none (``undefined``) and
 the :data:`~rclverify.backends.monitors.verdicts.KEPT_MARGINS` smallest
 margins (``lowest``; ``details.monitoring.margins``).  The report's
 ``margins`` (:func:`margin_rows`) has one row per guarantee judged with
-margins on at least one run: the smallest over the runs (``margin``, the
+margins on at least one run, each run counted once: a run is its identity
+(``details.statistics.sha256``, :func:`rclverify.backends.monitors.run_identity.run_digest`,
+as the statistics count runs), so one run given as a log, an sqlite3 bag
+and an MCAP bag, or copied with a field no rule reads, is one run, its
+first record in the report's obligation order standing for it.  Each row gives the
+smallest over the runs (``margin``, the
 run ``trace``, its ``obligation``, the answer's ``time`` and ``where``, the
 deciding ``atom`` and ``unit``), the counts summed over the runs, and the
 figures of :func:`figures`: ``count`` (every answer with a margin, on every
@@ -122,6 +127,7 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Margin
     :class:`~rclverify.records.margin_rows.MarginRow`'s JSON object."""
     runs: dict[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]] = {}
     timed: dict[tuple[str, int], list[dict[str, Any]]] = {}  # the runs' deadline records, as hop_margin reads them
+    seen: dict[str, set[str]] = {}  # node -> the identities of its runs read so far
     store: EvidenceStore | None = None
     for o in ob_rows:
         if o["backend"] != "monitors" or o["status"] == "error":
@@ -130,6 +136,8 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Margin
         ev, problem = store.read(str(o["id"]))
         if ev is None or problem or not isinstance(ev.details, dict):
             continue
+        if _seen_before(seen.setdefault(str(o["node"]), set()), ev.details, str(o["id"])):
+            continue  # another form or copy of a run already read: one run, counted once
         mon = ev.details.get("monitoring") or {}
         for m in mon.get("margins") or () if isinstance(mon, dict) else ():
             if isinstance(m, dict) and isinstance(m.get("guarantee"), int):
@@ -143,6 +151,19 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Margin
     rows = [_row(ws, node, k, runs.get((node, k), []), hop_margin(k, timed.get((node, k), [])))
             for node, k in sorted(set(runs) | set(timed))]
     return [r.to_json() for r in _plots(rows, runs)]
+
+
+def _seen_before(seen: set[str], details: Mapping[str, Any], obligation: str) -> bool:
+    """Whether the run of a record with ``details`` is among the identities ``seen`` (which it joins):
+    its ``statistics.sha256``; a record without one (written before runs had an identity) is a run of
+    its own, by its obligation."""
+    stats = details.get("statistics")
+    sha = stats.get("sha256") if isinstance(stats, Mapping) else None
+    key = str(sha) if isinstance(sha, str) and sha else "obligation:" + obligation
+    if key in seen:
+        return True
+    seen.add(key)
+    return False
 
 
 def _order(r: tuple[str, str, Mapping[str, Any]]) -> float:
