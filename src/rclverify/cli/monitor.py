@@ -247,28 +247,31 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
                       warn=lambda line: print(line, file=sys.stderr, flush=True), **extra)
     from rclverify.runtime.stopping import StopFlag, on_signals  # deferred: start-up (only live)
     stop = StopFlag()  # a handler that takes no lock: a stop is always heard (stopping.py)
-    on_signals(stop)
-    common: dict[str, Any] = dict(
-        verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
-        node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
-        evidence=Path(args.evidence) if args.evidence else None, out=lambda line: print(line, flush=True))
-    from rclverify.runtime.service_proxy import ProxyUsage, proxy_factory  # deferred: start-up (loads rclverify.runtime, rclverify.runtime.ros1 and more only when called)
-    interfaces = [root / d for d in getattr(args, "interfaces", [])]
+    on_signals(stop)  # kept once the run is over: a second Ctrl-C while the process ends is no traceback
     try:
-        if ros == "2":
-            record_ = _run_ros2(args, factory, checked, nodes, [root / d for d in cfg.msg_dirs], interfaces, common,
-                                extra.get("guarded"), record)
-            if record_ is None:
-                return 2
-        else:
-            proxy = proxy_factory(checked, nodes, getattr(args, "forward", []), interfaces)
-            record_ = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
-    except (RosUnavailable, DdsUnavailable, ProxyUsage, RclpyUnavailable) as exc:
-        text = str(exc)
-        print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
-        return 1 if isinstance(exc, MissingExtra) else 2  # a missing extra exits 1 (docs/install.md)
-    _print_live(log, record_)
-    return _live_exit(args, record_)
+        common: dict[str, Any] = dict(
+            verdict_topic=args.verdict_topic, last_prefix=args.verdict_topic.rsplit("/", 1)[0] or "/rclverify",
+            node_name="rclverify_monitor", duration=args.duration, tick_s=0.02, status_s=args.status, stop=stop,
+            evidence=Path(args.evidence) if args.evidence else None, out=lambda line: print(line, flush=True))
+        from rclverify.runtime.service_proxy import ProxyUsage, proxy_factory  # deferred: start-up (loads rclverify.runtime, rclverify.runtime.ros1 and more only when called)
+        interfaces = [root / d for d in getattr(args, "interfaces", [])]
+        try:
+            if ros == "2":
+                record_ = _run_ros2(args, factory, checked, nodes, [root / d for d in cfg.msg_dirs], interfaces, common,
+                                    extra.get("guarded"), record)
+                if record_ is None:
+                    return 2
+            else:
+                proxy = proxy_factory(checked, nodes, getattr(args, "forward", []), interfaces)
+                record_ = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
+        except (RosUnavailable, DdsUnavailable, ProxyUsage, RclpyUnavailable) as exc:
+            text = str(exc)
+            print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
+            return 1 if isinstance(exc, MissingExtra) else 2  # a missing extra exits 1 (docs/install.md)
+        _print_live(log, record_)
+        return _live_exit(args, record_)
+    finally:
+        stop.close()  # the stop request's pipe given back (an in-process caller runs many)
 
 
 def _run_ros2(args: argparse.Namespace, factory: Any, checked: Any, nodes: Any, msg_dirs: list[Path],

@@ -16,7 +16,9 @@ flag and writes one byte to a non-blocking pipe of its own (a self-pipe), and
 wakes at once, in whichever thread waits.  The byte is never read, so every
 later wait returns at once too.  It keeps ``threading.Event``'s face
 (``set``, ``is_set``, ``wait``), so the code that polls a stop takes either.
-:func:`on_signals` installs the handler that only calls :meth:`StopFlag.set`.
+:func:`on_signals` installs the handler that only calls :meth:`StopFlag.set`; it
+stays installed once the run is over (a second Ctrl-C while the process ends
+is then only one more request, never a ``KeyboardInterrupt``).
 """
 from __future__ import annotations
 
@@ -79,13 +81,13 @@ class StopFlag(threading.Event):
         self._r = self._w = -1
 
 
-def on_signals(stop: StopFlag, signals: Iterable[int] = (signal.SIGINT, signal.SIGTERM)) -> None:
+def on_signals(stop: StopFlag, signals: Iterable[int] = (signal.SIGINT, signal.SIGTERM)) -> dict[int, Any]:
     """Make each of ``signals`` (default SIGINT and SIGTERM) request ``stop`` and do nothing else;
-    only from the main thread (``signal.signal``'s rule, :class:`ValueError` otherwise)."""
+    returns the handlers they had.  Only from the main thread (``signal.signal``'s rule,
+    :class:`ValueError` otherwise)."""
     def handler(_signum: int, _frame: Any) -> None:
         stop.set()
-    for sig in signals:
-        signal.signal(sig, handler)
+    return {sig: signal.signal(sig, handler) for sig in signals}
 
 
 __all__ = ["StopFlag", "on_signals"]
