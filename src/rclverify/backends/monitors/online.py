@@ -13,10 +13,10 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   released to the monitors in stamp order (equal stamps by event time, then
   in arrival order), all held in the one reorder buffer
   (:mod:`rclverify.traces.reorder`).  A message stamped before the
-  watermark already reached (or before one already released) arrives too
-  late to be ordered: it is still checked (at the current clock, never
-  dropped silently) and counted in ``late`` (the largest lag in
-  ``max_late_s``); its own stamp decides what it answers, and
+  watermark already reached (or before one already released) is counted in
+  ``late`` (the largest lag in ``max_late_s``); one older than a message
+  already released arrives too late to be ordered: it is still checked (at
+  the current clock, never dropped silently); its own stamp decides what it answers, and
   an input put at its stamp revises what was judged without it, as offline
   (``late.py``, docs/semantics.md "Answers");
 * **clocks**: per writer (topic) the offset between its header stamps and
@@ -153,11 +153,11 @@ class OnlineEngine:
         return self._buffer.max_late_s
 
     def _release(self, upto: float) -> None:
-        for t, src, (topic, fields, where), late in self._buffer.release(upto):
+        for t, src, (topic, fields, where), _ in self._buffer.release(upto):
             stamp = None
             source = published(t, src)  # published after its stamp: it may answer what was asked until then
-            if late:
-                stamp, t, source = t, self._clock, src  # checked at the clock; its own stamp decides what it answers
+            if t < self._clock:  # older than one released: checked at the clock; its own stamp decides what it answers
+                stamp, t, source = t, self._clock, src
             elif source is not None:
                 stamp = t
             self._clock = t
