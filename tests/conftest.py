@@ -85,7 +85,7 @@ SECONDS: dict[str, float] = {
     "test_generate_cpp_candidates": 2.2, "test_jsonl_columns": 2.2, "test_realizable": 2.1,
     "test_bench_compose_pacti": 2.1, "test_deterministic_queries": 2.1, "test_findings_health": 2.1,
     "test_health_fast": 3.3, "test_requirements_own_nodes": 2.0, "test_bundle_ties": 3.0,
-    "test_paths_rechecked": 3.5, "test_incremental_equivalence": 6.8, "test_ros2_bag_calls": 7.0, "test_nodl_live": 4.0,
+    "test_paths_rechecked": 3.5, "test_incremental_equivalence": 6.8, "test_server_targets": 2.3, "test_ros2_bag_calls": 7.0, "test_nodl_live": 4.0,
     "test_definedness": 6.6, "test_run_identity": 5.0,
     "test_ros2_declared_types": 10.0, "test_ros2_call_endpoints": 4.0, "test_widths_forms": 2.5,
     "test_margins_batch": 3.6, "test_example_manipulator": 3.0, "test_ros2_event_time": 3.0, "test_widths_paths": 3.3,
