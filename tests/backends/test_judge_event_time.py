@@ -295,3 +295,33 @@ def test_an_answer_with_a_stale_stamp_is_judged_against_every_question_it_could_
     if verdict == "inconclusive":
         assert "satisfied" not in [v for w, v in offline if w == "run.jsonl:4"]  # never green first
     assert _stale_live(ws, lines) == offline
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="no FIFOs on this platform")
+@pytest.mark.parametrize("lag", [0, 2], ids=["correct", "defective"])
+def test_clocks_that_cannot_be_related_give_no_verdict_either_way(tmp_path: Path, lag: int) -> None:
+    """A stream (read once) whose driver stamps 2 s ahead: its messages cannot be placed
+    by a second read, so neither the correct alarm nor the defective one gets a verdict
+    judged on the shifted stamps: inconclusive, the writer named."""
+    import os
+    import threading
+    lines = _alarm_run(2.0, lag_readings=lag)
+    ws, _ = _workspace(tmp_path, BAND, [], BAND_MAPPING)
+    fifo = tmp_path / "stream.jsonl"
+    os.mkfifo(fifo)
+    text = "".join(json.dumps(x) + "\n" for x in lines)
+
+    def feed() -> None:
+        with open(fifo, "w") as fh:
+            fh.write(text)
+    writer = threading.Thread(target=feed)
+    writer.start()
+    try:
+        checked = load([ws / "contracts" / "c.rcl"])
+        got = recorded.check_recorded(checked, [checked.nodes["Band"]], load_mapping(ws, "mapping.yaml"), ws,
+                                      str(fifo), lambda w: None)
+        status, reason = got.verdict(got.results[0], str(fifo))
+    finally:
+        writer.join(timeout=10)
+    assert status == "inconclusive", reason
+    assert "/r: header stamps +2.000 s" in reason and "cannot be read a second time" in reason, reason

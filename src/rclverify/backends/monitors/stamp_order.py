@@ -253,11 +253,11 @@ def second_read(watch: StampWatch, trace: str, readable: bool) -> tuple[float | 
 
 def unless_stale(status: tuple[str, str], stale: str) -> tuple[str, str]:
     """``(status, explanation)``, or ``inconclusive`` with ``stale`` (the reason)
-    where it would otherwise be ``discharged``, ``pending`` or ``failed``: a
-    run judged in an order that is not its clock's gives no verdict either
-    way (a violation there may be the order's, docs/semantics.md "Event
-    time")."""
-    if stale and status[0] in ("discharged", "pending", "failed"):
+    where it would otherwise be ``discharged``, ``pending``, ``failed`` or
+    ``inconclusive`` for another reason: a run judged in an order that is
+    not its clock's gives no verdict either way (a violation there may be
+    the order's, docs/semantics.md "Event time"), and says why."""
+    if stale and status[0] in ("discharged", "pending", "failed", "inconclusive"):
         return "inconclusive", f"{stale}; in recording order: {status[1]}"
     return status
 
