@@ -325,3 +325,26 @@ def test_clocks_that_cannot_be_related_give_no_verdict_either_way(tmp_path: Path
         writer.join(timeout=10)
     assert status == "inconclusive", reason
     assert "/r: header stamps +2.000 s" in reason and "cannot be read a second time" in reason, reason
+
+
+@pytest.mark.parametrize("value, counts", [(True, {"true": 5, "currently_false": 0, "false": 0}),
+                                           (False, {"true": 0, "currently_false": 0, "false": 5})],
+                         ids=["correct", "defective"])
+def test_deadlines_on_simulated_time_beside_the_wall_clock(tmp_path: Path, value: bool,
+                                                           counts: dict[str, int]) -> None:
+    """Row 2: questions stamped on the simulated clock (100 s), answers unstamped (their
+    source times on the wall clock): every deadline was false, "answered after
+    1795807407.964 s".  The questions' writer runs in another clock: placed at their
+    source times, the correct relay meets every deadline and the defect misses them,
+    offline and live alike."""
+    lines: list[dict[str, Any]] = []
+    for i in range(5):
+        lines.append(_msg("b", WALL + i, 100.0 + i, data=True))
+        lines.append(_msg("stop", WALL + i + 0.03, None, data=value))
+    lines.append(_msg("tick", WALL + 6, None, data=0))
+    ws, run = _workspace(tmp_path, RELAY, lines)
+    statuses, offline = _offline(ws, run, "Relay")
+    assert offline == [counts]
+    assert statuses[-1] == ("discharged" if value else "failed")
+    _, live, eng = _live(ws, [(x["time"] + 0.001, x) for x in lines], "Relay")
+    assert live == counts and [c.split(":")[0] for c in eng.clock_lines()] == ["/b"]
