@@ -238,7 +238,7 @@ class LiveRun:
                   "started": self.started,
                   "stopped": datetime.now(timezone.utc).isoformat(timespec="seconds"),
                   "events": self.engine.released, "late_events": self.engine.late,
-                  "max_late_s": round(self.engine.max_late_s, 6),
+                  "max_late_s": round(self.engine.max_late_s, 6), "other_clocks": self.engine.clock_lines(),
                   "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
                   "silent_topics": self.silences, "nodes": nodes, **self.checks.record(self.log_path.name)}
         if evidence is not None:
