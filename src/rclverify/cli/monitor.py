@@ -240,6 +240,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     from rclverify.backends.monitors.widths import judged_at_widths  # deferred: start-up (only live)
     dirs = [root / d for d in cfg.msg_dirs]  # the contract's constants, named ones too, as the fields carry them
     judged = [judged_at_widths(checked, n, cfg.rules, dirs)[0] for n in nodes]  # the offline check's route
+    nodes = judged  # every part of the run judges them so: the topics' engine, the calls, the service proxy
     warn_margin = getattr(args, "warn_margin", None)
     factory = partial(run_class, checked, judged, cfg.rules, cfg.horizon, log,
                       reorder_window=args.reorder_window, silence_s=args.silence,
