@@ -263,6 +263,22 @@ def _stale_run(level: str, stamp: float) -> list[dict[str, Any]]:
             _msg("tick", 3.0, None, data=0)]
 
 
+def _stale_reasons(ws: Path, run: Path) -> str:
+    """The reason of the verdict on line 4 of ``run`` read in stamp order."""
+    from rclverify.backends.monitors.check import check_trace
+    from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order
+    from rclverify.traces import read_trace
+    checked = load([ws / "contracts" / "c.rcl"])
+    cfg = load_mapping(ws, "mapping.yaml")
+    watch = StampWatch(0.02)
+    for ev in read_trace(run):
+        watch.see(ev)
+    got: list[Any] = []
+    check_trace(checked, [checked.nodes["Band"]], in_stamp_order(read_trace(run), watch.lag), cfg.rules, 0.5,
+                got.append)
+    return " | ".join(v.reason for v in got if v.where == "run.jsonl:4")
+
+
 def _stale_live(ws: Path, lines: list[dict[str, Any]]) -> list[tuple[str, str]]:
     checked = load([ws / "contracts" / "c.rcl"])
     rules = load_mapping(ws, "mapping.yaml").rules
@@ -294,6 +310,8 @@ def test_an_answer_with_a_stale_stamp_is_judged_against_every_question_it_could_
     assert dict(offline)["run.jsonl:4"] == verdict, offline
     if verdict == "inconclusive":
         assert "satisfied" not in [v for w, v in offline if w == "run.jsonl:4"]  # never green first
+        reasons = _stale_reasons(ws, run)
+        assert "published 210.0 ms after its header stamp, after the question(s) at run.jsonl:3" in reasons, reasons
     assert _stale_live(ws, lines) == offline
 
 

@@ -447,8 +447,9 @@ class NodeMonitor(Judging, Closing, Late):
                 reason += f" (and on every question it may answer {self._within(ev)})"
             self._violation(ev, k, outcome.values, reason, outcome.semantics, question.event if question else None)
         elif outcome.kind == "inconclusive":
-            reason = outcome.reason if len(readings) < 2 or outcome.reason else skew_reason(ev, q, others,
-                                                                                           self.stream.skew)
+            reason = outcome.reason if len(readings) < 2 or outcome.reason else \
+                self._stale_reason(ev, q, others) if ev.index in self._wins else \
+                skew_reason(ev, q, others, self.stream.skew)
             self._verdict("inconclusive", ev, guarantee=outcome.guarantee, reason=reason, question=qwhere)
         elif outcome.kind == "satisfied":
             self._verdict("satisfied", ev, semantics=outcome.semantics, question=qwhere)

@@ -96,6 +96,17 @@ class EngineState:
         """:meth:`_reach` of an output already judged or held."""
         return self._wins.get(ev.index, self.stream.skew)
 
+    def _stale_reason(self, ev: Event, q: Question | None, others: list[Question]) -> str:
+        """The sentence of an output published well after its stamp whose readings
+        disagree: the question at its stamp (``q``) or one of ``others``, asked
+        before it was published."""
+        first = f"the question at {q.event.where}" if q is not None else "no question (none was asked before it)"
+        asked = ", ".join(o.event.where for o in others)
+        return (f"the output at {ev.where} was published {self._wins[ev.index] * 1e3:.1f} ms after its header "
+                f"stamp, after the question(s) at {asked}: it answers {first} (its stamp) or one of them (a stamp "
+                "copied from an earlier question), and the readings give different verdicts, which the run cannot "
+                "tell apart (docs/semantics.md, \"Event time\")")
+
     def _within(self, ev: Event) -> str:
         """The words for the questions output ``ev`` may answer: within the skew, or
         until it was published (its stamp older than that)."""
