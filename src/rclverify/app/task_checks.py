@@ -58,19 +58,20 @@ UPTODATE_SIGNATURE = inspect.Signature([inspect.Parameter("task", inspect.Parame
                                         inspect.Parameter("values", inspect.Parameter.POSITIONAL_OR_KEYWORD)])
 
 
-def _stats(paths: list[str]) -> list[list[int]] | None:
-    """``[mtime_ns, size, ctime_ns]`` of each of ``paths``, or ``None`` when
-    one is missing: what an ``uptodate`` check saves with doit's task values
-    after the task ran and compares on the next run, without reading a file.
-    The change time is set by every write and every ``utime``: a file
-    rewritten with its size and modification time kept differs too."""
+def _stats(paths: list[str], changed: bool = True) -> list[list[int]] | None:
+    """``[mtime_ns, size, ctime_ns]`` of each of ``paths`` (``[mtime_ns,
+    size]`` when ``changed`` is false), or ``None`` when one is missing: what
+    an ``uptodate`` check saves with doit's task values after the task ran
+    and compares on the next run, without reading a file.  The change time
+    is set by every write and every ``utime``: a file rewritten with its
+    size and modification time kept differs too."""
     out = []
     for path in paths:
         try:
             st = os.stat(path)
         except OSError:
             return None
-        out.append([st.st_mtime_ns, st.st_size, st.st_ctime_ns])
+        out.append([st.st_mtime_ns, st.st_size, st.st_ctime_ns] if changed else [st.st_mtime_ns, st.st_size])
     return out
 
 
@@ -104,12 +105,14 @@ class RecordIntact:
     instead of believing it (the report of a run that does not re-run it,
     ``rclverify report``, shows it as ``error``: evidence altered).
 
-    Cheap on a no-op run: after the task ran, the record's size,
-    modification and change times are saved with doit's task values (an edit
-    that restores the size and modification time still sets the change
-    time, :func:`_stats`); while they are the
+    Cheap on a no-op run: after the task ran, the record's size and
+    modification time are saved with doit's task values; while they are the
     same the record is not read.  Otherwise its seal is checked
-    (:meth:`rclverify.records.store.EvidenceStore.read`)."""
+    (:meth:`rclverify.records.store.EvidenceStore.read`), which is what
+    proves a record intact (an altered one reads ``error`` in every
+    report).  Not its change time: an intact record whose stat differs is
+    read on every run until its task runs again, and a copied or restored
+    workspace (a CI cache) gives every file a new change time."""
 
     __signature__ = UPTODATE_SIGNATURE
 
@@ -117,10 +120,10 @@ class RecordIntact:
         target = task.targets[0]
 
         def saved() -> dict[str, list[int] | None]:
-            stats = _stats([target])
+            stats = _stats([target], changed=False)
             return {"_record_stat": stats[0] if stats else None}
         task.value_savers.append(saved)
-        now = _stats([target])
+        now = _stats([target], changed=False)
         if now is None:
             return False
         if values.get("_record_stat") == now[0]:
