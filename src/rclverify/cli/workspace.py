@@ -80,6 +80,7 @@ def cmd_review(args: argparse.Namespace) -> int:
         print(f"error: cannot read reviewed file {exc}", file=sys.stderr)
         return 1
     if args.output:
+        Path(args.output).parent.mkdir(parents=True, exist_ok=True)  # reviews/ of a new workspace, as before
         write_atomic(Path(args.output), text)
         print(f"review record to fill in: {args.output}")
     else:
