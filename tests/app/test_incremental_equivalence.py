@@ -5,7 +5,9 @@ report files as a from-scratch run on a copy of the inputs.
 The edits and the comparison live in ``tests/_incremental.py``;
 ``bench/incremental_equivalence.py`` runs random sequences of them (hundreds;
 one in its smoke mode, which the suite runs: tests/bench/test_bench_smoke_live.py).
-This file checks the harness itself.
+This file checks the harness itself, and runs the one edit a time-based
+up-to-date check cannot see (a run rewritten in place with its size and
+modification time kept, issue 107) through an incremental and a clean run.
 """
 from __future__ import annotations
 
