@@ -116,7 +116,6 @@ WALL: dict[str, float] = {
     "test_example_manipulator": 32.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
     "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
     "test_live_stops": 45.0,
-    "test_robot_generator": 40.0,  # two generated robots run live (its live tests are marked in the module)
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
