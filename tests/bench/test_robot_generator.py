@@ -169,8 +169,9 @@ def _robot_kinds() -> tuple[str, ...]:
 # first): the fuse's first trigger, ``in.x``, came before any value of its other input ``in.cells``;
 # the node cannot answer it (it answers the next ``in.x``).  docs/semantics.md ("Deadlines"): "A trigger
 # message before every input has a value raises no question and gets no deadline verdict (counted as
-# incomplete input)".  rclverify, live and offline alike, judged it a question (``superseded``) and its
-# deadline ``false`` ("answered after 639 ms, 111 ms past the deadline").  The run's pattern, in a log:
+# incomplete input)".  ``in.cells`` is read only as a quantifier's domain, which the contract's list of
+# the inputs it reads (lang/walk.py ``names``) missed: the trigger was judged a question (``superseded``)
+# and its deadline ``false`` ("answered after 639 ms, 111 ms past the deadline").  The run's pattern, in a log:
 FUSE_RCL = """\
 context { KA : REAL = 1.0 ; KB : REAL = 0.5 ; }
 node Fuse {
@@ -209,8 +210,6 @@ def test_a_trigger_with_every_input_valued_and_unanswered_is_a_false_deadline(
     assert _fuse_deadlines(tmp_path, log, capsys)["false"] == 1
 
 
-@pytest.mark.xfail(strict=True, reason="rclverify fault (docs/monitors.md, 'Generated robots'): a trigger before "
-                   "every input has a value is given a deadline verdict (false) where docs/semantics.md gives none")
 def test_a_trigger_before_every_input_has_a_value_gets_no_deadline_verdict(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     counts = _fuse_deadlines(tmp_path, FUSE_LOG, capsys)

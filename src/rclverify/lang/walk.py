@@ -119,7 +119,8 @@ def names(e: Any, out: set[str]) -> None:
     expression's operands (quantifier domains and bodies included; binding names not)."""
     if isinstance(e, ast.Var):
         out.add(e.qualified)
-    for name in ("args", "operand", "left", "right", "operands", "elem", "collection", "items", "body", "func"):
+    for name in ("args", "operand", "left", "right", "operands", "elem", "collection", "items", "body", "func",
+                 "bindings", "domain"):
         c = getattr(e, name, None)
         if c is None:
             continue
