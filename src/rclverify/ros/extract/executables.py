@@ -15,7 +15,10 @@ is run; docs/ros.md, "Reading real code").
   wrapper); ``rclcpp_components_register_nodes(target "ns::C" ...)`` registers
   plugins only (started by a launch file's composable node);
 * ``setup.py`` (read with ``ast``): ``console_scripts`` entries
-  ``exe = module.path:func`` and ``scripts=[...]``;
+  ``exe = module.path:func`` and ``scripts=[...]``, a module found where
+  ``package_dir={'': 'src'}`` (or ``{'pkg': 'dir'}``) puts it, as setuptools does;
+* ``set_target_properties(t PROPERTIES OUTPUT_NAME name)`` names executable
+  ``t``'s file ``name``, the name a launch file runs;
 * a ROS 1 Python script is its own executable (``scripts/talker.py`` is
   ``talker.py``; its stem is accepted too).
 """
@@ -27,7 +30,7 @@ import ast
 import fnmatch
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from rclverify.ros.extract.cmake import Definitions, definitions_of, expand
@@ -68,6 +71,8 @@ class Targets:
     declared: list[Declared] = field(default_factory=list)
     # targets declared only in a branch a catkin (ROS 1) build takes (if(catkin_FOUND), ROS_VERSION 1)
     catkin_only: set[str] = field(default_factory=set)
+    # set_target_properties(t PROPERTIES OUTPUT_NAME name): {target: file name}
+    output_names: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -150,6 +155,7 @@ def targets(root: Path, pkg: str, extra: Definitions | None = None) -> Targets:
         except OSError:
             continue
         _read(cmds, here, t, auto_libs, todo)
+    _rename(t)
     for exe, srcs in setup_py_executables(root).items():
         t.programs.setdefault(exe, srcs)
     for d in entry_points(root):
@@ -202,6 +208,13 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
         elif name == "target_sources":
             bucket = t.executables if args[0] in t.executables else t.libraries
             bucket.setdefault(args[0], []).extend(files(args[1:]))
+        elif name == "set_target_properties" and "PROPERTIES" in args:
+            k = args.index("PROPERTIES")
+            props = args[k + 1:]
+            for j in range(0, len(props) - 1, 2):
+                if props[j] == "OUTPUT_NAME" and props[j + 1]:
+                    for target in args[:k]:
+                        t.output_names[target] = props[j + 1]
         elif name in ("target_link_libraries", "ament_target_dependencies"):
             t.links.setdefault(args[0], []).extend(a for a in args[1:] if a not in _KEYWORDS)
         elif name == "rclcpp_components_register_node" and "PLUGIN" in args:
@@ -226,6 +239,23 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
                     t.programs.setdefault(f.name, [f])
                     t.programs.setdefault(f.stem, [f])
                 k += 1
+
+
+def _rename(t: Targets) -> None:
+    """Executables whose ``OUTPUT_NAME`` differs from the target's name renamed in
+    ``t`` (CMake's ``OUTPUT_NAME`` target property: the file built, which
+    ``ros2 run`` and a launch file's ``executable`` name); the target's links
+    and components follow."""
+    for target, out in t.output_names.items():
+        if target not in t.executables or out == target:
+            continue
+        t.executables[out] = t.executables.pop(target)
+        if target in t.links:
+            t.links[out] = t.links.pop(target)
+        if target in t.components:
+            t.components[out] = t.components.pop(target)
+        t.declared = [replace(d, name=out) if d.kind == "executable" and d.name == target else d
+                      for d in t.declared]
 
 
 def catkin_branch(cond: list[str]) -> int:
@@ -307,11 +337,12 @@ def setup_py_executables(root: Path) -> dict[str, list[Path]]:
         tree = ast.parse(safefs.read_text(f))
     except (OSError, SyntaxError, ValueError, RecursionError):
         return out
+    dirs = _package_dirs(tree)
     for n in ast.walk(tree):
         if isinstance(n, ast.Constant) and isinstance(n.value, str):
             m = _ENTRY.match(n.value)
             if m:
-                mod = root / (m.group(2).replace(".", "/") + ".py")
+                mod = root / module_file(m.group(2), dirs)
                 if mod.is_file():
                     out[m.group(1)] = [mod]
         elif isinstance(n, ast.keyword) and n.arg == "scripts" and isinstance(n.value, (ast.List, ast.Tuple)):
@@ -329,12 +360,18 @@ def entry_points(root: Path) -> list[Declared]:
     "Entry points" specification); ``found`` is false when the module file is not
     in the package.  Read as text, never run."""
     out: list[Declared] = []
+    dirs: dict[str, str] = {}
     for name in ("setup.py", "setup.cfg"):
         f = root / name
         try:
             text = safefs.read_text(f)
         except OSError:
             continue
+        if name == "setup.py":
+            try:
+                dirs = _package_dirs(ast.parse(text))
+            except (SyntaxError, ValueError, RecursionError):
+                dirs = {}
         in_scripts = name == "setup.py"
         for i, line in enumerate(text.splitlines(), 1):
             if name == "setup.cfg" and line.strip().startswith("console_scripts"):
@@ -345,10 +382,37 @@ def entry_points(root: Path) -> list[Declared]:
             if not in_scripts:
                 continue
             for m in _ENTRY_IN.finditer(line):
-                mod = m.group(2).replace(".", "/") + ".py"
+                mod = module_file(m.group(2), dirs)
                 if not any(d.name == m.group(1) for d in out):
                     out.append(Declared("entry point", m.group(1), f, i, (mod,), (root / mod).is_file()))
     return out
+
+
+def _package_dirs(tree: ast.AST) -> dict[str, str]:
+    """``setup(package_dir={...})``'s literal mapping ``{package prefix: directory}``
+    (``{'': 'src'}``: every package under ``src``); empty when absent or not a
+    literal dictionary of strings."""
+    for n in ast.walk(tree):
+        if isinstance(n, ast.keyword) and n.arg == "package_dir" and isinstance(n.value, ast.Dict):
+            out = {k.value: v.value for k, v in zip(n.value.keys, n.value.values)
+                   if isinstance(k, ast.Constant) and isinstance(k.value, str)
+                   and isinstance(v, ast.Constant) and isinstance(v.value, str)}
+            return out
+    return {}
+
+
+def module_file(dotted: str, dirs: dict[str, str]) -> str:
+    """The file of module ``dotted`` (``pkg.module``) relative to the package root,
+    where ``package_dir`` ``dirs`` puts it: the longest package prefix mapped
+    wins (setuptools' rule), ``''`` maps every package, none maps the root."""
+    parts = dotted.split(".")
+    for k in range(len(parts), -1, -1):
+        prefix = ".".join(parts[:k])
+        if prefix in dirs:
+            base = dirs[prefix].strip("/")
+            rest = parts[k:]
+            return "/".join(([base] if base and base != "." else []) + rest) + ".py"
+    return "/".join(parts) + ".py"
 
 
 _ENTRY_IN = re.compile(r"(?:^|[\"'\s])([A-Za-z0-9_.\-]+)\s*=\s*([A-Za-z_][A-Za-z0-9_.]*)\s*:\s*[A-Za-z_][A-Za-z0-9_]*")

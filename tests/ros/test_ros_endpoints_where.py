@@ -1,0 +1,135 @@
+"""Endpoints where C++ and Python put them, only what is built, the side that
+differs blamed (issue 108, second part).  Each idiom is a small package the
+test writes and the project's scan reads, with a control showing the other
+side:
+
+* ``setup.py`` ``package_dir={'': 'src'}`` puts the console scripts' modules
+  under ``src`` (before: "not in the package");
+* ``set_target_properties(t PROPERTIES OUTPUT_NAME name)`` names the
+  executable a launch file runs (before: "no source found");
+* ``tf2_ros::TransformListener(buffer)`` without a node subscribes on tf2's
+  own node, with a node on the enclosing one (before: always the enclosing);
+* alternative preprocessor branches give one edge (before: one per branch);
+* a subscriber made by a default member initializer is the class's node's
+  (before: no edge);
+* endpoints a Python base class makes belong to the subclass's node (before:
+  lost);
+* interface-spec adaptors take name and type from the ``Spec`` struct
+  (before: no edge, a note naming a lambda as the topic);
+* a type clash names both programs and blames no contract that matches its
+  own code.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from rclverify.ros.extract.model import Graph
+from rclverify.ros.graph.scan import scan
+
+PKG = ('<?xml version="1.0"?>\n<package format="3"><name>{name}</name><version>0.1.0</version>'
+       '<description>d</description><maintainer email="dev@example.org">a</maintainer><license>MIT</license>'
+       '<buildtool_depend>{tool}</buildtool_depend><depend>rclcpp</depend><depend>rclpy</depend>'
+       '<depend>std_msgs</depend><export><build_type>{tool}</build_type></export></package>\n')
+CMAKE = "cmake_minimum_required(VERSION 3.8)\nproject({name})\nfind_package(rclcpp REQUIRED)\n"
+TALKER = """#include <rclcpp/rclcpp.hpp>
+#include <std_msgs/msg/string.hpp>
+class Talker : public rclcpp::Node
+{
+public:
+  Talker() : Node("talker")
+  {
+    pub_ = create_publisher<std_msgs::msg::String>("chatter", 10);
+  }
+  rclcpp::Publisher<std_msgs::msg::String>::SharedPtr pub_;
+};
+int main(int argc, char ** argv) { rclcpp::init(argc, argv); rclcpp::spin(std::make_shared<Talker>()); }
+"""
+PY_NODE = """import rclpy
+from rclpy.node import Node
+from std_msgs.msg import String
+
+
+class Speaker(Node):
+    def __init__(self):
+        super().__init__('speaker')
+        self.pub = self.create_publisher(String, 'said', 10)
+
+
+def main():
+    rclpy.init()
+    rclpy.spin(Speaker())
+"""
+SETUP = """from setuptools import setup
+setup(
+    name='{name}',
+    packages=['{name}'],
+    package_dir={dirs},
+    entry_points={{'console_scripts': ['speak = {name}.speaker:main']}},
+)
+"""
+
+
+def _write(root: Path, files: dict[str, str]) -> None:
+    for rel, text in files.items():
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_text(text)
+
+
+def _scan(tmp: Path, launch: list[Path] | None = None) -> Graph:
+    return scan([tmp / "ws"], launch or [], base=tmp, standard=False).graph
+
+
+def _said(g: Graph) -> list[str]:
+    return [str(n) for n in g.notes]
+
+
+# -- only what is built ------------------------------------------------------------
+
+def _pypkg(tmp: Path, dirs: str, where: str) -> None:
+    _write(tmp / "ws" / "pyp", {"package.xml": PKG.format(name="pyp", tool="ament_python"),
+                                "setup.py": SETUP.format(name="pyp", dirs=dirs),
+                                f"{where}pyp/__init__.py": "", f"{where}pyp/speaker.py": PY_NODE})
+
+
+def test_setup_py_package_dir_places_the_console_scripts(tmp_path: Path) -> None:
+    _pypkg(tmp_path, "{'': 'src'}", "src/")
+    g = _scan(tmp_path)
+    assert {(e.topic, e.msg_type) for e in g.nodes["/speaker"].publishes} == {("/said", "std_msgs/msg/String")}
+    assert [p for p in g.programs if p["name"] == "speak"][0]["unaccounted"] is None
+    assert not [s for s in _said(g) if "not in the package" in s]
+
+
+def test_a_module_where_package_dir_does_not_put_it_is_not_in_the_package(tmp_path: Path) -> None:
+    _pypkg(tmp_path, "{'': 'lib'}", "src/")  # control: package_dir names another directory
+    g = _scan(tmp_path)
+    assert [p for p in g.programs if p["name"] == "speak"][0]["unaccounted"] is not None
+
+
+LAUNCH = """from launch import LaunchDescription
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([Node(package='cxx', executable='{exe}', name='front')])
+"""
+
+
+def _cxx(tmp: Path, exe: str) -> Path:
+    _write(tmp / "ws" / "cxx", {
+        "package.xml": PKG.format(name="cxx", tool="ament_cmake"),
+        "CMakeLists.txt": CMAKE.format(name="cxx") + "add_executable(talker_node src/talker.cpp)\n"
+                          "set_target_properties(talker_node PROPERTIES OUTPUT_NAME talker)\n",
+        "src/talker.cpp": TALKER, "launch/run.launch.py": LAUNCH.format(exe=exe)})
+    return tmp / "ws" / "cxx" / "launch" / "run.launch.py"
+
+
+def test_cmake_output_name_is_the_executable_a_launch_file_runs(tmp_path: Path) -> None:
+    g = _scan(tmp_path, [_cxx(tmp_path, "talker")])
+    assert {(e.topic, e.msg_type) for e in g.nodes["/front"].publishes} == {("/chatter", "std_msgs/msg/String")}
+    assert not [s for s in _said(g) if "no source found" in s]
+
+
+def test_the_target_name_an_output_name_replaces_runs_nothing(tmp_path: Path) -> None:
+    g = _scan(tmp_path, [_cxx(tmp_path, "talker_node")])  # control: the file built is 'talker'
+    assert not g.nodes["/front"].publishes
+    assert [s for s in _said(g) if "executable 'talker_node' of package 'cxx' has no source found" in s]
