@@ -3,6 +3,8 @@
 ``rclverify nodl check``          the workspace's documents against its contracts and each other
                                   (``--ros PATH...``: and against the code's endpoints;
                                   ``--ros2``: and against the running ROS 2 graph)
+``rclverify nodl check DIR|FILE...`` (no ``-w``) a set of documents against each other, no contract
+                                  (``--external NAME``, ``--namespace NODE=NS``, ``--sarif FILE``)
 ``rclverify nodl validate FILE...`` documents against the schema, their includes followed
 ``rclverify nodl write [-o DIR]`` one document per node from its contract
 
@@ -17,7 +19,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from rclverify.cli.common import seconds
 
@@ -32,8 +34,17 @@ def add_parsers(sub: Any) -> None:
         sp.add_argument("--ament-prefix", action="append", default=[], metavar="DIR",
                         help="an install prefix whose ament index resolves nodl:// includes (repeatable)")
 
-    c = gs.add_parser("check", help="the workspace's NoDL documents against its contracts and each other")
-    c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
+    c = gs.add_parser("check", help="the workspace's NoDL documents against its contracts and each other; "
+                                    "without -w, the documents named against each other")
+    c.add_argument("paths", nargs="*", metavar="DIR|FILE",
+                   help="check these documents (a folder's *.nodl.yaml/.yml/.json) against each other, with no "
+                        "workspace (docs/nodl.md, 'Document sets')")
+    c.add_argument("-w", "--workspace", help="workspace root (default: .; not with DIR|FILE)")
+    c.add_argument("--external", action="append", default=[], metavar="NAME",
+                   help="DIR|FILE: a topic, service or action served from outside the set (repeatable)")
+    c.add_argument("--namespace", action="append", default=[], metavar="NODE=NS",
+                   help="DIR|FILE: the namespace node NODE runs in (repeatable; default /)")
+    c.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0 (rule RCL-NODL)")
     c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
     c.add_argument("--nodl", metavar="DIR", help="folder of the documents (default: nodl/ in the workspace)")
     c.add_argument("--ros", nargs="+", default=[], metavar="PATH",
@@ -71,7 +82,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     """Print each finding once per place it involves; see the module docstring for the exit code."""
     from rclverify.model.nodl.check import check  # deferred: start-up (loads jsonschema, yaml and more only when called)
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
-    ws = Path(args.workspace)
+    if args.paths:
+        return _check_set(args)
+    if args.external or args.namespace:
+        print("nodl check: error: --external and --namespace apply to a set of documents named without -w "
+              "(nodl check DIR|FILE...)", file=sys.stderr)
+        return 2
+    ws = Path(args.workspace or ".")
     checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
     folder = Path(args.nodl) if args.nodl else None
     res = check(checked, ws, folder, [Path(p) for p in args.ament_prefix])
@@ -102,7 +119,83 @@ def cmd_check(args: argparse.Namespace) -> int:
                 "side_conditions": [{"node": s.node, "parameter": s.parameter, "conjunct": s.conjunct,
                                      "status": s.status, "model": dict(s.model)} for s in res.sides]}
         write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
+    if args.sarif:
+        _write_sarif(Path(args.sarif), res.findings, "the root of the rclverify workspace")
     return 1 if res.errors or (args.strict and warnings) else 0
+
+
+def _check_set(args: argparse.Namespace) -> int:
+    """``nodl check DIR|FILE...``: the documents named against each other (:mod:`rclverify.model.nodl.sets`),
+    findings printed once per place; the exit code as for a workspace's check."""
+    from rclverify.model.nodl.check import read_all, shown  # deferred: start-up (loads jsonschema, yaml and more only when called)
+    from rclverify.model.nodl.sets import check_set, namespace_of, set_files, set_resolver  # deferred: start-up (as above)
+    alone = [o for o, given in (("-w", args.workspace), ("--ros", args.ros), ("--ros2", args.ros2), ("--nodl", args.nodl),
+                                ("--launch", args.launch)) if given]
+    if alone:
+        print(f"nodl check: error: {', '.join(alone)} with DIR|FILE: a set of documents is checked against each "
+              "other only (a workspace's documents: nodl check -w WS --nodl DIR)", file=sys.stderr)
+        return 2
+    namespaces: dict[str, str] = {}
+    try:
+        for item in args.namespace:
+            node, eq, ns = item.partition("=")
+            if not eq or not node:
+                raise ValueError(f"--namespace {item!r}: write NODE=NAMESPACE")
+            namespaces[node] = namespace_of(ns)
+        paths = [Path(p) for p in args.paths]
+        files = set_files(paths)
+    except ValueError as exc:
+        print(f"nodl check: error: {exc}", file=sys.stderr)
+        return 2
+    docs = read_all(files, set_resolver(paths, [Path(p) for p in args.ament_prefix], shown(Path("."))))  # raises RclError
+    unknown = sorted(set(namespaces) - {d.node for d in docs})
+    if unknown:
+        print(f"nodl check: error: --namespace {unknown[0]}=...: no document of the set is named after node "
+              f"{unknown[0]!r}", file=sys.stderr)
+        return 2
+    res = check_set(docs, namespaces, args.external)
+    for f in res.findings:
+        for line in f.lines():
+            print(line, file=sys.stderr)
+    warnings = len(res.findings) - res.errors
+    print(f"{len(res.members)} node document(s) and {len(res.parts)} part(s) checked as a set; "
+          f"{res.errors} error(s), {warnings} warning(s)")
+    if args.json:
+        from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
+        data = {"nodes": {m.node: {"namespace": m.namespace, "files": list(m.doc.files)} for m in res.members},
+                "parts": [d.file for d in res.parts], "external": sorted(args.external),
+                "findings": [f.to_json() for f in res.findings]}
+        write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
+    if args.sarif:
+        _write_sarif(Path(args.sarif), res.findings, "the directory nodl check ran in")
+    return 1 if res.errors or (args.strict and warnings) else 0
+
+
+def _write_sarif(path: Path, findings: Any, root: str) -> None:
+    """Write ``findings`` as a SARIF 2.1.0 log at ``path`` (atomically): one run of tool ``rclverify``,
+    rule ``RCL-NODL``, one result per finding laid out by the report's writer
+    (:func:`rclverify.report.nodl.sarif_results`: its first place, the others related); file names are
+    relative to ``%SRCROOT%``, described as ``root``."""
+    from rclverify import __version__  # deferred: start-up (the package is loaded already)
+    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
+    from rclverify.records.report_schema import Report  # deferred: start-up (loads the report's records only when called)
+    from rclverify.records.sarif import SRCROOT, SarifDescriptor, SarifLog, sarif_locations, sarif_result  # deferred: start-up (as above)
+    from rclverify.records.store import dumps  # deferred: start-up (as above)
+    from rclverify.report import nodl as report_nodl  # deferred: start-up (loads the report layer only when called)
+    from rclverify.report.sarif import SARIF_SCHEMA, SARIF_VERSION  # deferred: start-up (as above)
+    row = {"findings": [f.to_json() for f in findings]}
+    results = report_nodl.sarif_results(cast(Report, {"nodl": row}), sarif_result, sarif_locations)
+    for res in results:
+        res["ruleIndex"] = 0
+    rules: list[SarifDescriptor] = [{"id": i, "name": n, "shortDescription": {"text": t}, "defaultConfiguration": {"level": lv}}
+             for i, n, lv, t in report_nodl.SARIF_RULES]
+    errors = sum(f.severity == "error" for f in findings)
+    log: SarifLog = {"$schema": SARIF_SCHEMA, "version": SARIF_VERSION, "runs": [{
+        "tool": {"driver": {"name": "rclverify", "version": __version__, "rules": rules}},
+        "originalUriBaseIds": {SRCROOT: {"description": {"text": root}}},
+        "columnKind": "unicodeCodePoints", "results": results,
+        "properties": {"command": "nodl check", "errors": errors, "warnings": len(findings) - errors}}]}
+    write_atomic(path, dumps(log))
 
 
 def _live(args: argparse.Namespace, res: Any) -> bool:

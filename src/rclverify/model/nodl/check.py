@@ -8,10 +8,12 @@ all (:mod:`.document`), then finds
 
 * per node with a document: its contract's endpoints against the document's
   (:func:`.contract.compare`: ``nodl-missing``, ``nodl-extra``, ``nodl-type``);
-* per topic, service and action two nodes' documents share: the types they
-  give it (``nodl-connect-type``) and, for a topic's publisher and
-  subscriber and a service's server and client, whether the QoS the writer
-  offers meets what the reader requests (``nodl-qos``, :mod:`.qos`);
+* per topic, service and action two documents share (the nodes' and those
+  named after no node that no document includes, each in the root
+  namespace): the types they give it (``nodl-connect-type``) and, for a
+  topic's publisher and subscriber and a service's server and client,
+  whether the QoS the writer offers meets what the reader requests
+  (``nodl-qos``; :func:`.sets.connections`);
 * per parameter: its default against its declared constraints, and the
   contracts' constant of the same name against them (``nodl-parameter``,
   :mod:`.params`); and, where it sets an input of the node's contract,
@@ -30,12 +32,12 @@ from typing import Iterable, Sequence
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError
 from rclverify.lang.types import Checked
-from rclverify.model.nodl.contract import compare, full_name, type_key
-from rclverify.model.nodl.document import SUFFIXES, Document, Endpoint, Resolver, read_document
+from rclverify.model.nodl.contract import compare
+from rclverify.model.nodl.document import SUFFIXES, Document, Resolver, read_document
 from rclverify.model.nodl.findings import Finding
 from rclverify.model.nodl.param_assume import Side, check_parameters
 from rclverify.model.nodl.params import broken
-from rclverify.model.nodl.qos import mismatches
+from rclverify.model.nodl.sets import Member, connections
 
 #: The folder of a workspace's NoDL documents, relative to its root.
 FOLDER = "nodl"
@@ -95,51 +97,6 @@ def read_all(files: Iterable[Path], resolver: Resolver) -> list[Document]:
     if diags:
         raise RclError(diags)
     return docs
-
-
-def _connections(documents: dict[str, Document]) -> list[Finding]:
-    """Type and QoS findings between the documents of connected nodes (module docstring)."""
-    ends: dict[str, list[tuple[str, Endpoint]]] = {}
-    for node, doc in documents.items():
-        for e in doc.endpoints:
-            ends.setdefault(full_name(e.name, node), []).append((node, e))
-    pairs = (("publishers", "subscriptions", "topic"), ("service_servers", "service_clients", "service"),
-             ("action_servers", "action_clients", "action"))
-    out: list[Finding] = []
-    for fqn, group in sorted(ends.items()):
-        for give, take, what in pairs:
-            for w_node, w in (x for x in group if x[1].kind == give):
-                for r_node, r in (x for x in group if x[1].kind == take):
-                    out += _pair(fqn, what, (w_node, w), (r_node, r))
-    return out
-
-
-def _pair(fqn: str, what: str, writer: tuple[str, Endpoint], reader: tuple[str, Endpoint]) -> list[Finding]:
-    """The findings of one writer (publisher, server) and one reader (subscriber, client) of ``fqn``."""
-    (w_node, w), (r_node, r) = writer, reader
-    if type_key(w.type) != type_key(r.type):
-        return [Finding("nodl-connect-type", f"{what} {fqn}: {w_node}'s NoDL document gives it type {w.type}, "
-                                             f"{r_node}'s {r.type}", (r.type_loc, w.type_loc))]
-    if what == "action":
-        return []
-    sides = [("", w.qos, r.qos)] if what == "topic" else [(" (requests)", r.qos, w.qos), (" (responses)", w.qos, r.qos)]
-    out = []
-    for part, offered, requested in sides:
-        if what == "service" and offered is None and requested is None:
-            continue
-        for m in mismatches(offered, requested):
-            role = ("publisher", "subscriber") if what == "topic" else \
-                ("client", "server") if part == " (requests)" else ("server", "client")
-            who = (w_node, r_node) if what == "topic" or part == " (responses)" else (r_node, w_node)
-            out.append(Finding("nodl-qos", f"{what} {fqn}{part}: the {role[0]} {who[0]} and the {role[1]} {who[1]} "
-                                           f"never connect: {m.why} ({m.policy}: offered {m.offered}, requested "
-                                           f"{m.requested})", (_at(r, m.policy), _at(w, m.policy))))
-    return out
-
-
-def _at(e: Endpoint, policy: str) -> ast.Loc:
-    """Where endpoint ``e`` writes QoS ``policy``: the field, else its ``qos``, else its name."""
-    return e.qos.where(policy) if e.qos is not None else e.loc
 
 
 def _constant_value(expr: ast.Expr) -> Fraction | None:
@@ -202,7 +159,8 @@ def check(checked: Checked, root: Path, folder: Path | None = None, prefixes: Se
                 res.findings.append(Finding("nodl-node", f"NoDL document {doc.file} is named after {doc.node!r}, and no "
                                                          "contract declares that node (nor does another document "
                                                          "include it)", (ast.Loc(doc.file, 1, 1),), "warning"))
-    res.findings += _connections(res.documents)
+    nodes = [Member(n, "/", d) for n, d in sorted(res.documents.items())]
+    res.findings += connections(nodes + [Member(d.node, "/", d) for d in res.parts if d.file not in included])
     res.findings += _parameters(sorted(res.documents.items()), checked)
     res.findings.sort(key=lambda f: (f.locs[0].file, f.locs[0].line, f.locs[0].col, f.code))
     return res

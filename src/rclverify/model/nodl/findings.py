@@ -22,6 +22,8 @@ CODES = {
     "nodl-parameter-assume": "a parameter's declared constraints do not ensure what the contract assumes of the "
                              "input it sets",
     "nodl-node": "a document is named after no node of the contracts",
+    "nodl-no-publisher": "a subscription no document of the set publishes, not declared external",
+    "nodl-no-server": "a service or action client no document of the set serves, not declared external",
     "nodl-code-undeclared": "the code (or the running node: nodl-live-*) has an endpoint the document lacks",
     "nodl-code-absent": "the document declares an endpoint the code (the running node) lacks",
     "nodl-code-type": "the code (the running node) and the document give an endpoint different types",
