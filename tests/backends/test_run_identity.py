@@ -272,6 +272,31 @@ def test_the_copies_count_as_duplicates(store: Any, tmp_path: Path) -> None:
     assert (c["runs"], c["duplicates"], c["answers"]) == (N_RUNS, len(rows) - N_RUNS, 3 * N_RUNS)
 
 
+def test_a_copy_with_every_time_shifted_is_the_same_run(tmp_path: Path) -> None:
+    """Times are relative to the run's first (a receipt time to the first receipt time, a header stamp
+    to the first stamp): a copy re-timed by one offset is no new trial; a changed value or a changed
+    interval is."""
+    def rows(offset_s: int, offset_ns: int, level: float = 1.5, gap: str = "0.25") -> list[dict[str, Any]]:
+        out: list[dict[str, Any]] = []
+        for j in range(4):
+            out.append({"topic": "level", "time": float(f"{1700000000 + offset_s + j}.{j}25"), "data": level + j})
+            ns = 1_700_000_000_000_000_000 + offset_ns + j * 100_000_007
+            out.append({"topic": "battery", "time": float(f"{12 + offset_s + j}.{gap[2:]}"), "percentage": 0.5,
+                        "header": {"stamp": {"sec": ns // 10**9, "nanosec": ns % 10**9}, "frame_id": "base"}})
+        return out
+    base = run_digest(tmp_path, _write(tmp_path / "base.jsonl", rows(0, 0)))
+    shifted = run_digest(tmp_path, _write(tmp_path / "shifted.jsonl", rows(3600, 3_600_000_000_123)))
+    assert shifted == base
+    # the controls: a read value changed, or one interval changed, is another run
+    assert run_digest(tmp_path, _write(tmp_path / "value.jsonl", rows(3600, 3_600_000_000_123, level=2.5))) != base
+    moved = rows(3600, 3_600_000_000_123)
+    moved[2]["time"] = float(f"{1700003601}.126")
+    assert run_digest(tmp_path, _write(tmp_path / "moved.jsonl", moved)) != base
+    stamp = rows(0, 0)
+    stamp[3]["header"]["stamp"]["nanosec"] += 1
+    assert run_digest(tmp_path, _write(tmp_path / "stamp.jsonl", stamp)) != base
+
+
 def test_a_file_neither_reader_takes_is_its_bytes(tmp_path: Path) -> None:
     (tmp_path / "a.jsonl").write_text("not json\n")
     (tmp_path / "b.jsonl").write_text("not json \n")
@@ -359,7 +384,7 @@ def test_thirty_runs_and_their_slashed_copies_are_thirty_runs(tmp_path: Path) ->
     traces = []
     for k in range(30):
         rows = [{"topic": t, "time": 1000.0 + k + 0.1 * j + dt, "data": v}
-                for j in range(2) for t, dt, v in (("a", 0.0, float(j + k % 7)), ("x", 0.01, 20.0))]
+                for j in range(2) for t, dt, v in (("a", 0.0, float(j + k)), ("x", 0.01, 20.0))]
         traces.append("runs/" + _write(tmp_path / "runs" / f"run{k:02d}.jsonl", rows))
         traces.append("runs/" + _write(tmp_path / "runs" / f"copy{k:02d}.jsonl",
                                        [{**r, "topic": "/" + r["topic"]} for r in rows]))

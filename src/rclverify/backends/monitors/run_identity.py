@@ -3,7 +3,9 @@
 
 :func:`run_digest` gives each recorded run (a ROSMonitoring log, a ROS 2
 bag in sqlite3 or MCAP, a ROS 1 bag) a hex sha256 over the sorted multiset
-of its messages' canonical records, each ``[topic, time, fields]``.  The
+of its messages' canonical records, each ``[topic, time, fields]``, the
+time relative to the run's first (so a copy with every time shifted by one
+offset is the same run).  The
 fields are the ones the contracts read: with the entry's topic rules
 (:func:`read_fields`: the ``fields`` each rule of the mapping file lists),
 a message's other fields are left out, so a copy of a run with a field
@@ -18,6 +20,8 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
+from decimal import Decimal
 from pathlib import Path
 from typing import IO, Any, Callable, Iterator, Mapping
 
@@ -75,16 +79,19 @@ def run_digest(root: Path, trace: str, read: ReadFields | None = None) -> str:
     opened by :func:`~rclverify.traces.bag.open_bag` and each message
     decoded by its type store, as :func:`~rclverify.traces.bag.bag_event`
     decodes it, less the type's constants), each message becoming
-    ``[topic, time, fields]`` (:func:`_record`): the topic without its
-    leading ``/``; the time the message's header stamp when it has one (its
-    source time, :attr:`~rclverify.traces.events.Event.stamped`), else its
-    time (a bag's recording time ``ns / 1e9``, a log's ``time``); the
-    fields flattened to dotted paths, sorted, a number by its value; with
-    ``read`` (:func:`read_fields` of the entry's mapping), only the fields
-    it names for the message's topic.  So a run written as a log, an
-    sqlite3 bag and an MCAP bag, reformatted, reordered, with its topics
-    written with or without ``/``, or with fields added that no rule reads,
-    is one run; a changed read value, time or message makes another.
+    ``[topic, time, fields]`` (:func:`_record`, :func:`_relative`): the
+    topic without its leading ``/``; the time the message's header stamp
+    when it has one (its source time, in integer nanoseconds after the run's
+    first stamp), else its time (a bag's recording time ``ns / 1e9``, a
+    log's ``time``) as the exact decimal difference from the run's first
+    such time; the fields flattened to dotted paths, sorted, a number by its
+    value, the header stamp left out when it is the time; with ``read``
+    (:func:`read_fields` of the entry's mapping), only the fields it names
+    for the message's topic.  So a run written as a log, an sqlite3 bag and
+    an MCAP bag, reformatted, reordered, with its topics written with or
+    without ``/``, with fields added that no rule reads, or with every time
+    shifted by one offset, is one run; a changed read value, a changed time
+    between two messages, or a changed message makes another.
 
     Left out, because a log and a bag hold them in different forms: the
     lines of rclverify's own topics (``rclverify/verdict``,
@@ -132,14 +139,45 @@ def _is_call_topic(topic: str) -> bool:
     return topic.endswith("/_service_event") or "/_action/" in topic or topic.startswith(_OWN)
 
 
-def _identity(messages: list[bytes], calls: list[bytes]) -> str | None:
-    """The hex sha256 of the sorted multiset ``messages`` (each a record's own sha256), else of ``calls``
-    (marked so it never equals a run's messages), else ``None`` (no record: the caller hashes the bytes)."""
-    kind, records = (b"messages", messages) if messages else (b"calls", calls)
-    if not records:
+#: A record before its time is made relative: ``(topic, stamp_ns, time, payload)``, ``stamp_ns`` the
+#: header stamp in integer nanoseconds (``None``: no stamp), ``time`` the receipt time (s) otherwise,
+#: ``payload`` the sorted read fields' pairs, or ``[type, sha256]`` of a bag message that does not decode
+#: (``raw`` true).
+Pending = tuple[str, "int | None", float, Any, bool]
+
+
+def _relative(pending: list[Pending]) -> list[bytes]:
+    """Each pending record's canonical record's sha256, its time made relative to the run's first
+    (docs/statistics.md, "A run's identity"): a header stamp as integer nanoseconds after the run's
+    first stamp, a receipt time as the exact decimal difference of its double and the run's first
+    receipt time's (each by its shortest repr), so a copy with every time shifted by one offset gives
+    the same records."""
+    stamps = [p[1] for p in pending if p[1] is not None]
+    times = [_decimal(p[2]) for p in pending if p[1] is None]
+    s0 = min(stamps) if stamps else 0
+    t0 = min(times) if times else Decimal(0)
+    sha, out = hashlib.sha256, []
+    for topic, ns, t, payload, raw in pending:
+        when: list[Any] = ["stamp", ns - s0] if ns is not None else ["time", str((_decimal(t) - t0).normalize())]
+        out.append(sha(_ENCODE([topic, when, *payload] if raw else [topic, when, payload])).digest())
+    return out
+
+
+def _decimal(t: float) -> Decimal:
+    """The double ``t`` as the decimal its shortest repr writes (a NaN or an infinity as 0: no time)."""
+    return Decimal(repr(float(t))) if math.isfinite(t) else Decimal(0)
+
+
+def _identity(messages: list[Pending], calls: list[Pending]) -> str | None:
+    """The hex sha256 of the sorted multiset of ``messages``' records (each its own sha256,
+    :func:`_relative`), else of ``calls``' (marked so it never equals a run's messages), else ``None``
+    (no record: the caller hashes the bytes)."""
+    kind, pending = (b"messages", messages) if messages else (b"calls", calls)
+    if not pending:
         return None
+    records = _relative(pending)
     records.sort()
-    h = hashlib.sha256(b"rclverify run identity 1: " + kind + b"\n")
+    h = hashlib.sha256(b"rclverify run identity 2: " + kind + b"\n")
     for r in records:
         h.update(r)
     return h.hexdigest()
@@ -150,9 +188,9 @@ def _log_identity(path: Path, read: ReadFields) -> str | None:
     neither a message nor a JSON object without ``topic`` or ``time`` (a line that is no message)."""
     from rclverify.traces.jsonl import read_lines  # deferred: start-up (only where a run is counted)
     from rclverify.traces.events import TraceError  # deferred: start-up (only where a run is counted)
-    messages: list[bytes] = []
-    calls: list[bytes] = []
-    record, sha = _record, hashlib.sha256
+    messages: list[Pending] = []
+    calls: list[Pending] = []
+    record = _record
     last = [b""]
 
     def lines(fh: IO[bytes]) -> Iterator[bytes]:
@@ -167,15 +205,25 @@ def _log_identity(path: Path, read: ReadFields) -> str | None:
                 for ev in read_lines(path, chunks, end[0], end[1], end):
                     topic = ev.topic
                     if not topic.startswith(_OWN):
-                        messages.append(sha(record(topic, ev.stamped, ev.fields, read)).digest())
+                        messages.append(record(topic, _stamp_ns(ev), ev.time, ev.fields, read))
                     elif topic == "rclverify/call":
-                        calls.append(sha(record(topic, ev.stamped, ev.fields)).digest())
+                        calls.append(record(topic, _stamp_ns(ev), ev.time, ev.fields))
                 break
             except TraceError:
                 if not _no_message(last[0]):
                     raise
                 # a line that is no message (the ROS 1 service proxy's verdict and summary lines): the next one
     return _identity(messages, calls)
+
+
+def _stamp_ns(ev: Any) -> int | None:
+    """A log event's header stamp in integer nanoseconds (``None``: the event has none), exactly as its
+    ``sec``/``nanosec`` integers give it (:func:`~rclverify.traces.events.header_stamp_ns`)."""
+    if ev.stamp is None:
+        return None
+    from rclverify.traces.events import header_stamp_ns, to_ns  # deferred: start-up
+    ns = header_stamp_ns(ev.fields)
+    return to_ns(ev.stamp) if ns is None else ns
 
 
 def _no_message(raw: bytes) -> bool:
@@ -196,15 +244,15 @@ def _bag_identity(path: Path, read: ReadFields) -> str | None:
     from rclverify.traces.bag import open_bag, typestore  # deferred: start-up (loads rosbags only when called)
     from rclverify.traces.events import header_stamp  # deferred: start-up (only where a run is counted)
     reader = open_bag(path, typestore([]))
-    messages: list[bytes] = []
+    messages: list[Pending] = []
     held: list[tuple[Any, int, bytes]] = []  # the call topics' messages, decoded only for a run without others
-    sha, names = hashlib.sha256, _field_names(reader.typestore)
+    names = _field_names(reader.typestore)
 
-    def one(index: int, conn: Any, stamp: int, raw: bytes) -> bytes:
+    def one(index: int, conn: Any, stamp: int, raw: bytes) -> Pending:
         try:
             msg = reader.deserialize(raw, conn.msgtype)
         except Exception:  # noqa: BLE001 - a type the bag does not define: the message as every form stores it
-            return sha(_raw_record(conn.topic.lstrip("/"), stamp / 1e9, conn.msgtype, raw)).digest()
+            return (conn.topic.lstrip("/"), None, stamp / 1e9, [conn.msgtype, hashlib.sha256(raw).hexdigest()], True)
         pairs: list[tuple[str, Any]] = []
         _flat_message("", msg, names, pairs)
         t: Any = getattr(getattr(msg, "header", None), "stamp", None)
@@ -212,9 +260,9 @@ def _bag_identity(path: Path, read: ReadFields) -> str | None:
         own = header_stamp({"header": {"stamp": {"sec": t.sec, "nanosec": t.nanosec}}}) \
             if hasattr(t, "sec") and hasattr(t, "nanosec") else None
         name = conn.topic.lstrip("/")
-        return sha(_ENCODE([name, _value(stamp / 1e9 if own is None else own),
-                            _sorted(_only_read([kv for kv in pairs if kv[0] not in _LOG_KEYS],
-                                               read.get(name)))])).digest()
+        kept = [kv for kv in pairs if kv[0] not in _LOG_KEYS and (own is None or not _is_stamp(kv[0]))]
+        return (name, None if own is None else int(t.sec) * 1_000_000_000 + int(t.nanosec), stamp / 1e9,
+                _sorted(_only_read(kept, read.get(name))), False)
     try:
         for index, (conn, stamp, raw) in enumerate(reader.messages()):
             if _is_call_topic(conn.topic.lstrip("/")):
@@ -286,19 +334,27 @@ def _field_names(store: Any) -> Callable[[Any], tuple[str, ...]]:
     return names
 
 
-def _record(topic: str, time: float, fields: Any, read: ReadFields | None = None) -> bytes:
-    """One message's canonical record: JSON ``[topic, time, [[path, value], ...]]``, the topic without
-    its leading ``/``, the fields flattened (:func:`_flat`; a top-level ``topic`` or ``time``, which a
-    log cannot hold beside its own, left out; with ``read``, the fields it names for the topic only) and
-    sorted by path (:func:`run_digest`)."""
+def _record(topic: str, stamp_ns: int | None, time: float, fields: Any, read: ReadFields | None = None) -> Pending:
+    """One message's pending record (:data:`Pending`): the topic without its leading ``/``, its header
+    stamp ``stamp_ns`` or else its ``time``, its fields flattened (:func:`_flat`; a top-level ``topic``
+    or ``time``, which a log cannot hold beside its own, left out, and the header stamp, which is its
+    time, left out when it has one; with ``read``, the fields it names for the topic only) and sorted by
+    path (:func:`run_digest`)."""
     pairs: list[tuple[str, Any]] = []
     _flat("", fields, pairs)
     if "topic" in fields or "time" in fields:
         pairs = [kv for kv in pairs if kv[0] not in _LOG_KEYS]
+    if stamp_ns is not None:
+        pairs = [kv for kv in pairs if not _is_stamp(kv[0])]
     name = topic.lstrip("/")
     if read:
         pairs = _only_read(pairs, read.get(name))
-    return _ENCODE([name, _value(time), _sorted(pairs)])
+    return (name, stamp_ns, time, _sorted(pairs), False)
+
+
+def _is_stamp(path: str) -> bool:
+    """Whether a flattened field's ``path`` is the header stamp or below it."""
+    return path == "header.stamp" or path.startswith("header.stamp.")
 
 
 def _only_read(pairs: list[tuple[str, Any]], paths: tuple[str, ...] | None) -> list[tuple[str, Any]]:
@@ -308,11 +364,6 @@ def _only_read(pairs: list[tuple[str, Any]], paths: tuple[str, ...] | None) -> l
         return pairs
     return [kv for kv in pairs
             if any(kv[0] == p or kv[0].startswith(p + ".") or p.startswith(kv[0] + ".") for p in paths)]
-
-
-def _raw_record(topic: str, time: float, msgtype: str, raw: bytes) -> bytes:
-    """The record of a bag message that does not decode: its topic, time, type and bytes' sha256."""
-    return _ENCODE([topic, _value(time), msgtype, hashlib.sha256(raw).hexdigest()])
 
 
 def _flat(prefix: str, fields: Any, out: list[tuple[str, Any]]) -> None:
