@@ -134,7 +134,7 @@ class NodeResultJson(TypedDict):
 
 
 class DeadlineVerdictJson(TypedDict):
-    """One trigger's deadline verdict (:class:`.deadlines.DeadlineVerdict`)."""
+    """One trigger's deadline verdict (:class:`.deadline_records.DeadlineVerdict`)."""
     node: str
     guarantee: int
     verdict: str
@@ -159,7 +159,7 @@ class Unaccepted(TypedDict):
 
 
 class DeadlineResultJson(TypedDict):
-    """One node's deadline verdicts on one run (:class:`.deadlines.DeadlineResult`)."""
+    """One node's deadline verdicts on one run (:class:`.deadline_records.DeadlineResult`)."""
     node: str
     counts: dict[str, int]
     first_false: DeadlineVerdictJson | None
