@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, check_deadlines, deadline_status
+from rclverify.backends.monitors.deadline_text import deadline_status
+from rclverify.backends.monitors.deadlines import DeadlineMonitor, check_deadlines
 from rclverify.cli.commands import main
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check

@@ -20,7 +20,9 @@ import pytest
 
 from rclverify.backends.monitors import recorded
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineVerdict, deadline_status
+from rclverify.backends.monitors.deadline_records import DeadlineVerdict
+from rclverify.backends.monitors.deadline_text import deadline_status
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.lang.typecheck import load
 

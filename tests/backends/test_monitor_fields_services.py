@@ -22,7 +22,8 @@ import pytest
 
 from rclverify.backends.monitors.backend import verdict_status
 from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.deadlines import check_deadlines, deadline_status
+from rclverify.backends.monitors.deadline_text import deadline_status
+from rclverify.backends.monitors.deadlines import check_deadlines
 from rclverify.app.tasks import act_check
 from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace

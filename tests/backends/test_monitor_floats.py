@@ -20,7 +20,8 @@ from hypothesis import given, settings, strategies as st
 
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import ConfigError, load_mapping
-from rclverify.backends.monitors.deadlines import check_deadlines, deadline_status
+from rclverify.backends.monitors.deadline_text import deadline_status
+from rclverify.backends.monitors.deadlines import check_deadlines
 from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.backends.monitors.backend import verdict_status
 from rclverify.semantics.floatsem import Tolerance, judge, parse_tolerance, ulp_distance

@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.backends.monitors.deadlines import check_deadlines, deadline_status
+from rclverify.backends.monitors.deadline_text import deadline_status
+from rclverify.backends.monitors.deadlines import check_deadlines
 from rclverify.cli.commands import main
 from rclverify.lang.typecheck import load
 from rclverify.traces import read_trace

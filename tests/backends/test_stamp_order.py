@@ -18,7 +18,7 @@ import pytest
 
 from rclverify.backends.monitors import recorded
 from rclverify.backends.monitors.config import load_mapping
-from rclverify.backends.monitors.deadlines import deadline_status
+from rclverify.backends.monitors.deadline_text import deadline_status
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order
 from rclverify.cli.commands import main
 from rclverify.lang.parser import parse_text

@@ -28,7 +28,7 @@ from rclverify.lang.errors import RclError
 from rclverify.lang.types import Checked
 from rclverify.traces import TraceError
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
-from rclverify.backends.monitors.deadlines import deadline_status
+from rclverify.backends.monitors.deadline_text import deadline_status
 from rclverify.backends.monitors.config import ConfigError, load_mapping
 from rclverify.backends.monitors.judged import explain, strict_line
 from rclverify.backends.monitors.declarations import declaration_status

@@ -23,7 +23,7 @@ order, so the live verdicts are the offline check's on the live run's log:
   offline check's clock to the same point).
 
 The results are reported as the offline command reports them
-(:func:`~.deadlines.deadline_status`, :func:`~.periods.period_status`).
+(:func:`~.deadline_text.deadline_status`, :func:`~.periods.period_status`).
 """
 from __future__ import annotations
 
@@ -33,7 +33,10 @@ from typing import Any, Callable, Iterable, Mapping
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict, deadline_status, has_deadlines
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict
+from rclverify.backends.monitors.deadline_topics import has_deadlines
+from rclverify.backends.monitors.deadline_text import deadline_status
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.declarations import DeclarationMonitor, DeclarationResult, add_periods, declaration_status, has_declarations
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods, period_status
 from rclverify.runtime.shapes import LogChecksPart

@@ -38,7 +38,8 @@ from typing import Any, Callable, Mapping, Sequence
 from rclverify.lang.errors import RclError
 from rclverify.lang.typecheck import load
 from rclverify.traces.events import Event
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineVerdict
+from rclverify.backends.monitors.deadline_records import DeadlineVerdict
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
 from rclverify.runtime.ros1_interfaces import action_classes, service_class
 from rclverify.runtime.shapes import DeadlineSummary

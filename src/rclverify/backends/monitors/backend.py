@@ -36,7 +36,10 @@ from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.run_origin import RunOrigin, unseen_links
 from rclverify.backends.monitors.shapes import DeadlinesPart, RunSource
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, deadline_status, has_deadlines
+from rclverify.backends.monitors.deadline_records import DeadlineResult
+from rclverify.backends.monitors.deadline_topics import has_deadlines
+from rclverify.backends.monitors.deadline_text import deadline_status
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
 from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judged
 from rclverify.backends.monitors.recorded import decided_of

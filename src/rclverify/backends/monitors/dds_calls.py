@@ -58,7 +58,8 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, DeadlineVerdict
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 #: the ``topic`` of a call's log lines: no contract names it; ``rclverify monitor LOG`` replays them (:func:`replay`)

@@ -20,7 +20,7 @@ ROSMonitoring's terms:
 is judged on the trigger's inputs; a trigger whose inputs violate it (or
 whose inputs are not all observed yet, or whose assumption cannot be
 decided) gets no deadline verdict and is counted apart
-(:attr:`DeadlineResult.unaccepted`): a node is not obliged to answer an
+(:attr:`.deadline_records.DeadlineResult.unaccepted`): a node is not obliged to answer an
 input its contract does not accept, so a ``true`` there would be evidence
 of nothing and a ``false`` a false alarm.  Formulas are judged as the
 untimed monitor judges them (:func:`rclverify.semantics.floatsem.judge`: exact,
@@ -47,7 +47,6 @@ actionlib's ``a/goal``, ``a/feedback`` and ``a/result`` (the message's
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass, field
 from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance, judge
@@ -59,117 +58,10 @@ from rclverify.lang.walk import subexpressions
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
 from rclverify.traces.questions import Question, QuestionStream
-from rclverify.backends.monitors.online import header_stamp_ns
-from rclverify.backends.monitors.verdicts import LINK_TOPICS, names
-from rclverify.backends.monitors.shapes import DeadlineResultJson, DeadlineVerdictJson, Unaccepted
-from rclverify.backends.monitors.time_margins import TimeMargin, note
-
-DEADLINE_VERDICTS = ("true", "currently_false", "false")
-#: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).
-UNACCEPTED = ("assumption violated", "incomplete input", "undecided")
-
-
-@dataclass(frozen=True)
-class DeadlineVerdict:
-    """One trigger event's deadline verdict.  Times in seconds on the stamps'
-    clock; ``answer`` is the answering message's stamp (``None``: none)."""
-
-    node: str
-    guarantee: int
-    verdict: str
-    trigger_where: str
-    trigger_stamp: float
-    due: float
-    answer: float | None = None
-    answer_where: str = ""
-    reason: str = ""
-    #: the late answer of a trigger already judged ``false`` when its deadline expired (not a new verdict)
-    update: bool = False
-    #: the arithmetic the answer's formula held in (``exact``, ``double``, ``tolerance``; ``""``: no answer)
-    semantics: str = ""
-    #: the time margin (s): the deadline less the answer's stamp, exact in integer nanoseconds (negative: late;
-    #: ``None``: no answer yet; docs/semantics.md, "Margins")
-    time_margin: float | None = None
-
-    def to_json(self) -> DeadlineVerdictJson:
-        out: DeadlineVerdictJson = {
-            "node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
-            "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
-            "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
-            "update": self.update, "semantics": self.semantics}
-        if self.time_margin is not None:
-            out["time_margin"] = self.time_margin
-        return out
-
-
-@dataclass
-class _Pending:
-    k: int
-    trigger: Event
-    stamp: float
-    due: float
-    inputs: dict[str, object]
-    #: the outputs published after the trigger (stamp at or after it): only they answer it
-    outs: dict[str, object] = field(default_factory=dict)
-    #: the last output after the trigger that did not satisfy the guarantee (where, why)
-    rejected: str = ""
-    #: the trigger's stamp and its deadline in integer nanoseconds: what the deadline is compared in
-    stamp_ns: int = 0
-    due_ns: int = 0
-
-
-@dataclass
-class DeadlineResult:
-    """Counts per verdict and the first ``false`` of one node on one run;
-    ``unaccepted`` the (trigger, guarantee) pairs given no verdict, per reason
-    (:data:`UNACCEPTED`), and the first of them (``first_unaccepted``:
-    where, stamp, guarantee, reason)."""
-
-    node: str
-    counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in DEADLINE_VERDICTS})
-    first_false: DeadlineVerdict | None = None
-    unaccepted: dict[str, int] = field(default_factory=lambda: {v: 0 for v in UNACCEPTED})
-    first_unaccepted: Unaccepted | None = None
-    #: guarantee -> its smallest time margin on the run (:class:`TimeMargin`)
-    time_margins: dict[int, TimeMargin] = field(default_factory=dict)
-
-    def to_json(self) -> DeadlineResultJson:
-        return {"node": self.node, "counts": dict(self.counts),
-                "first_false": None if self.first_false is None else self.first_false.to_json(),
-                "unaccepted": dict(self.unaccepted), "first_unaccepted": self.first_unaccepted,
-                "time_margins": [m.to_json() for _, m in sorted(self.time_margins.items())]}
-
-    def note_time_margin(self, k: int, margin_ns: int | None, trigger_where: str, answer_where: str,
-                         answer: float, was_unanswered: bool = False) -> None:
-        """Count guarantee ``k``'s time margin on one trigger (:func:`.time_margins.note`)."""
-        note(self.time_margins, k, margin_ns, trigger_where, answer_where, answer, was_unanswered)
-
-
-def event_stamp_ns(ev: Event) -> int:
-    """The event's time on the stamps' clock in integer nanoseconds: a header's
-    ``secs``/``nsecs`` (ROS 1) or ``sec``/``nanosec`` (ROS 2, builtin_interfaces/Time)
-    exactly, else :func:`~rclverify.traces.events.to_ns` of the time the trace gives it.
-    Deadlines are compared in these integers (docs/semantics.md, "Deadlines"):
-    ``0.7 + 0.2`` in doubles is ``0.8999999999999999``, and an answer stamped at
-    0.9 s was reported "0 ms past the deadline"."""
-    s = header_stamp_ns(ev.fields)
-    return to_ns(ev.time) if s is None else s
-
-
-def topic_bindings(node: CheckedNode) -> dict[str, list[tuple[str, str]]]:
-    """topic (no leading ``/``) -> ``[(key, part)]``: ``key`` is ``in.x`` or
-    ``out.y``; ``part`` the message part that maps to it (``""``: the whole
-    message, ``"goal"``/``"feedback"``/``"result"`` for an actionlib topic)."""
-    out: dict[str, list[tuple[str, str]]] = {}
-    for t in node.node.topics:
-        if t.match is not None:
-            prefix = t.match.prefix or ("in" if t.match.name in node.inputs else "out")
-            out.setdefault(t.field.lstrip("/"), []).append((f"{prefix}.{t.match.name}", ""))
-    for lk in node.node.links:
-        for suffix, v in zip(LINK_TOPICS[lk.kind], lk.parts):
-            part = suffix if lk.kind == "action" else ""
-            out.setdefault(f"{lk.name.lstrip('/')}/{suffix}", []).append((f"{v.prefix}.{v.name}", part))
-    return out
+from rclverify.backends.monitors.verdicts import names
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending, UNACCEPTED
+from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
+from rclverify.backends.monitors.deadline_text import ms, ms_ns
 
 
 class DeadlineMonitor:
@@ -219,8 +111,8 @@ class DeadlineMonitor:
         #: keys whose latest message did not map (NaN, a missing field): key -> why; their stale value never
         #: stands in (docs/semantics.md, "Values")
         self.invalid: dict[str, str] = {}
-        self.pending: list[_Pending] = []
-        self.expired: deque[_Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
+        self.pending: list[Pending] = []
+        self.expired: deque[Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
         #: the last outputs heard: (stamp ns, event, outputs it set, their values): a trigger heard after them
         #: but stamped before them is answered by them
         self.heard: deque[tuple[int, Event, set[str], dict[str, object]]] = deque(maxlen=64)
@@ -301,7 +193,7 @@ class DeadlineMonitor:
         for k, cl, trig, _, d in triggered:
             if refused is None:
                 d_ns = self.bounds_ns[k]
-                p = _Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
+                p = Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
                 if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
                     self.pending.append(p)
                 continue
@@ -334,15 +226,15 @@ class DeadlineMonitor:
                     self._met_late(p, ev, ns)
                     continue
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
-                                           f"{_ms_ns(ns - p.due_ns)} past the deadline of "
-                                           f"{_ms_ns(p.due_ns - p.stamp_ns)}", update=True,
+                                           ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
+                                           f"{ms_ns(ns - p.due_ns)} past the deadline of "
+                                           f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
                                            time_margin=(p.due_ns - ns) / 1e9))
                 self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp, was_unanswered=True)
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
         self.heard.append((ns, ev, outs, {c: self.values[c] for c in outs if c not in self.state_outs}))
 
-    def _met_late(self, p: _Pending, ev: Event, ns: int) -> None:
+    def _met_late(self, p: Pending, ev: Event, ns: int) -> None:
         """Obligation ``p`` was judged ``false`` when the clock passed its deadline;
         output ``ev``, stamped ``ns`` (within it), answers it, heard after the
         clock passed (a message later than the lateness bound, or a stamp the
@@ -359,9 +251,9 @@ class DeadlineMonitor:
         if first is not None and (first.trigger_where, first.guarantee) == key:
             self.result.first_false = next(iter(self._falses.values()), None) or (
                 self._last_false if counts["false"] else None)
-        late = _ms_ns(self.now_ns - ns) if self.now_ns is not None else "?"
+        late = ms_ns(self.now_ns - ns) if self.now_ns is not None else "?"
         v = DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
-                            f"answered after {_ms_ns(ns - p.stamp_ns)} (deadline {_ms_ns(p.due_ns - p.stamp_ns)}), "
+                            f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms_ns(p.due_ns - p.stamp_ns)}), "
                             f"heard after the clock had passed the deadline (at {late} behind it): met on the "
                             "answer's own stamp; the false given when the clock passed is withdrawn",
                             update=True, time_margin=(p.due_ns - ns) / 1e9)
@@ -369,7 +261,7 @@ class DeadlineMonitor:
             self.on_verdict(v)
         self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True)
 
-    def _try(self, p: _Pending, ev: Event, ns: int, outs: set[str]) -> bool:
+    def _try(self, p: Pending, ev: Event, ns: int, outs: set[str]) -> bool:
         """Whether output ``ev`` (stamp ``ns``, setting ``outs``) answers obligation ``p``:
         its verdict given (``true``, or ``false`` when late), else ``False`` (still pending)."""
         k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
@@ -384,17 +276,17 @@ class DeadlineMonitor:
             return False
         if ns <= p.due_ns:  # "within": at the deadline is in time (integer ns, no rounding)
             self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
-                                       ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)} (deadline {_ms(d)})",
+                                       ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms(d)})",
                                        semantics=j.semantics, time_margin=(p.due_ns - ns) / 1e9))
         else:
             self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
-                                       ev.where, f"answered after {_ms_ns(ns - p.stamp_ns)}, "
-                                       f"{_ms_ns(ns - p.due_ns)} past the deadline of {_ms(d)}",
+                                       ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
+                                       f"{ms_ns(ns - p.due_ns)} past the deadline of {ms(d)}",
                                        semantics=j.semantics, time_margin=(p.due_ns - ns) / 1e9))
         self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp)
         return True
 
-    def _heard_late(self, p: _Pending) -> bool:
+    def _heard_late(self, p: Pending) -> bool:
         """A trigger heard after outputs stamped after it (docs/semantics.md, "Answers"):
         those outputs (the last 64 kept), in the order heard, answer it as they would
         have had it been heard first.  Returns whether one did (its verdict given)."""
@@ -405,14 +297,14 @@ class DeadlineMonitor:
                     return True
         return False
 
-    def _answers(self, p: _Pending, ns: int, outs: set[str]) -> bool:
+    def _answers(self, p: Pending, ns: int, outs: set[str]) -> bool:
         """Whether outputs ``outs`` now (stamp ``ns``, integer ns) answer obligation ``p``."""
         _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
         if not (gouts & outs) or ns < p.stamp_ns:
             return False
         return judge(cl.formula, self.checked, self.node, self._visible(p, ns / 1e9), self.tolerance).truth is True
 
-    def _visible(self, p: _Pending, stamp: float | None = None) -> dict[str, object]:
+    def _visible(self, p: Pending, stamp: float | None = None) -> dict[str, object]:
         """What obligation ``p`` is judged on for an output stamped ``stamp``:
         the inputs of the latest question at that stamp (the trigger's own, or
         the accepted question that superseded it: docs/semantics.md), with the
@@ -443,7 +335,7 @@ class DeadlineMonitor:
         for p in self.pending:
             if p.due_ns < now_ns:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                                           f"no answer within the deadline of {_ms_ns(p.due_ns - p.stamp_ns)} "
+                                           f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
                                            f"(clock at {now:.3f} s)" + (f"; {p.rejected}" if p.rejected else "")))
                 self.result.note_time_margin(p.k, None, p.trigger.where, "", 0.0)  # until a late answer comes
                 self.expired.append(p)
@@ -454,7 +346,7 @@ class DeadlineMonitor:
     def pending_verdicts(self) -> list[DeadlineVerdict]:
         """The obligations not answered whose deadline has not expired yet."""
         return [DeadlineVerdict(self.node.name, p.k, "currently_false", p.trigger.where, p.stamp, p.due, None, "",
-                                f"not answered yet; {_ms_ns(p.due_ns - (self.now_ns or 0))} left")
+                                f"not answered yet; {ms_ns(p.due_ns - (self.now_ns or 0))} left")
                 for p in self.pending]
 
     def finish(self) -> DeadlineResult:
@@ -479,57 +371,3 @@ def check_deadlines(checked: Checked, nodes: Iterable[CheckedNode], events: Iter
         for m in monitors:
             m.feed(ev)
     return [m.finish() for m in monitors]
-
-
-def has_deadlines(node: CheckedNode) -> bool:
-    """Whether ``node`` has a guarantee with a trigger (with or without a deadline)."""
-    return any(c.trigger is not None for c in node.node.guarantees)
-
-
-def _ms(x: float) -> str:
-    return f"{x * 1000:.0f} ms" if abs(x) < 10 else f"{x:.3f} s"
-
-
-def _ms_ns(ns: int) -> str:
-    """A duration of ``ns`` integer nanoseconds as :func:`_ms` shows it; a late
-    answer less than half a millisecond past shows its microseconds (never
-    "0 ms past the deadline")."""
-    if 0 < abs(ns) < 500_000:
-        return f"{ns / 1000:.0f} us" if abs(ns) >= 500 else f"{ns} ns"
-    return _ms(ns / 1e9)
-
-
-def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
-    """Evidence status and explanation of one node's deadline verdicts on a
-    trace: any ``false`` -> ``failed`` (the first named with its stamps);
-    any ``currently_false`` (a trigger unanswered and within its deadline
-    when the run ended: not decided, as an untimed question still open at
-    the end) -> ``inconclusive``; else ``discharged``, or ``pending`` when
-    no trigger event was seen."""
-    c = res.counts
-    f = res.first_false
-    u = res.unaccepted
-    refused = ""
-    if any(u.values()):
-        first: Mapping[str, object] = res.first_unaccepted or {}
-        words = {"assumption violated": "whose inputs violated the assumption",
-                 "incomplete input": "with inputs not all observed yet", "undecided": "whose assumption was undecided"}
-        refused = ("; no deadline verdict for " + ", ".join(f"{n} trigger event(s) {words[k]}"
-                                                            for k, n in u.items() if n)
-                   + f" (first at {first.get('where')}: {first.get('reason')})")
-    if c["false"] and f is not None:
-        late = (f"answered at {f.answer:.3f} s ({f.answer_where})" if f.answer is not None else
-                "never answered as guaranteed" if "did not satisfy" in f.reason else "never answered")
-        return "failed", (f"{c['false']} trigger event(s) of {trace} missed {res.node}'s deadline; the first: "
-                          f"guarantee {f.guarantee}, triggered at {f.trigger_where} (stamp {f.trigger_stamp:.3f} s), "
-                          f"due {f.due:.3f} s, {late}: {f.reason}{refused}")
-    if u["undecided"]:
-        return "inconclusive", (f"{u['undecided']} trigger event(s) could not be judged against the assumption"
-                                f"{refused}")
-    if c["currently_false"]:
-        met = f"; {c['true']} other(s) were answered within their deadline" if c["true"] else ""
-        return "inconclusive", (f"{c['currently_false']} trigger event(s) were unanswered and within their "
-                                f"deadline when {trace} ended: not decided{met}{refused}")
-    if not c["true"]:
-        return "pending", f"{trace} has no accepted trigger event of {res.node}'s timed guarantees: nothing was checked{refused}"
-    return "discharged", f"all {c['true']} accepted trigger event(s) were answered within their deadline{refused}"

@@ -69,7 +69,7 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import free_names, subexpressions
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
-from rclverify.backends.monitors.deadlines import topic_bindings
+from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
 from rclverify.backends.monitors.periods import PeriodResult
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC

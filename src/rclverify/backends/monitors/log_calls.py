@@ -28,7 +28,8 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event, TraceError
 from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC, CallBook, replay_line
-from rclverify.backends.monitors.deadlines import DeadlineResult, deadline_status
+from rclverify.backends.monitors.deadline_records import DeadlineResult
+from rclverify.backends.monitors.deadline_text import deadline_status
 from rclverify.backends.monitors.judged import count_call_line
 from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC, RunOrigin
 from rclverify.backends.monitors.summary import verdict_status

@@ -4,7 +4,7 @@ A node's ``periodic( out.y, 100 ms )`` (docs/rcl-language.md, "Progress,
 initial values and periodic outputs") says the node refreshes ``out.y`` at
 least once per period: a rate, a watchdog's heartbeat.  On a recorded run
 the messages that carry ``out.y`` (the topic ``topics(...)`` binds to it,
-:func:`.deadlines.topic_bindings`) are stamped as the deadline monitor
+:func:`.deadline_topics.topic_bindings`) are stamped as the deadline monitor
 stamps them (:func:`.stamp_order.run_clock`: the header's stamp, else the
 trace's time), and:
 
@@ -33,7 +33,7 @@ from typing import Iterable
 from rclverify.lang.liveness import period_seconds
 from rclverify.lang.types import CheckedNode
 from rclverify.traces.events import Event
-from rclverify.backends.monitors.deadlines import topic_bindings
+from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
 from rclverify.backends.monitors.shapes import PeriodGapJson, PeriodResultJson, PeriodsPart
 

@@ -16,7 +16,9 @@ from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces import read_trace
 from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.deadlines import DeadlineMonitor, DeadlineResult, has_deadlines
+from rclverify.backends.monitors.deadline_records import DeadlineResult
+from rclverify.backends.monitors.deadline_topics import has_deadlines
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.declarations import (DeclarationMonitor, DeclarationResult, add_periods,
                                                       has_declarations)
 from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag

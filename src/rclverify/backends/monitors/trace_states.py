@@ -27,7 +27,7 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, initial_value, map_value, rule_for
 from rclverify.semantics.values import FiniteFunction
 from rclverify.semantics import wallclock
-from rclverify.backends.monitors.deadlines import topic_bindings
+from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 #: :func:`solve_value`'s answer when a value the formula reads is not observed yet.

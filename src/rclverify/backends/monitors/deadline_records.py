@@ -1,0 +1,102 @@
+"""The records of the deadline monitor (:mod:`.deadlines`): one trigger's
+verdict (:class:`DeadlineVerdict`) and one node's result on a run
+(:class:`DeadlineResult`), with their JSON shapes (:mod:`.shapes`), and an
+accepted trigger's open obligation (:class:`Pending`).
+
+Verdicts in ROSMonitoring's terms (:data:`DEADLINE_VERDICTS`; docs/monitors.md):
+``true`` answered in time, ``false`` the deadline expired or the answer came
+late, ``currently_false`` not answered yet and the deadline not yet expired.
+A trigger the node's assumption does not accept gets no verdict and is
+counted by why (:data:`UNACCEPTED`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from rclverify.traces.events import Event
+from rclverify.backends.monitors.shapes import DeadlineResultJson, DeadlineVerdictJson, Unaccepted
+from rclverify.backends.monitors.time_margins import TimeMargin, note
+
+DEADLINE_VERDICTS = ("true", "currently_false", "false")
+#: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).
+UNACCEPTED = ("assumption violated", "incomplete input", "undecided")
+
+
+@dataclass(frozen=True)
+class DeadlineVerdict:
+    """One trigger event's deadline verdict.  Times in seconds on the stamps'
+    clock; ``answer`` is the answering message's stamp (``None``: none)."""
+
+    node: str
+    guarantee: int
+    verdict: str
+    trigger_where: str
+    trigger_stamp: float
+    due: float
+    answer: float | None = None
+    answer_where: str = ""
+    reason: str = ""
+    #: the late answer of a trigger already judged ``false`` when its deadline expired (not a new verdict)
+    update: bool = False
+    #: the arithmetic the answer's formula held in (``exact``, ``double``, ``tolerance``; ``""``: no answer)
+    semantics: str = ""
+    #: the time margin (s): the deadline less the answer's stamp, exact in integer nanoseconds (negative: late;
+    #: ``None``: no answer yet; docs/semantics.md, "Margins")
+    time_margin: float | None = None
+
+    def to_json(self) -> DeadlineVerdictJson:
+        out: DeadlineVerdictJson = {
+            "node": self.node, "guarantee": self.guarantee, "verdict": self.verdict,
+            "trigger_where": self.trigger_where, "trigger_stamp": self.trigger_stamp, "due": self.due,
+            "answer": self.answer, "answer_where": self.answer_where, "reason": self.reason,
+            "update": self.update, "semantics": self.semantics}
+        if self.time_margin is not None:
+            out["time_margin"] = self.time_margin
+        return out
+
+
+@dataclass
+class Pending:
+    """One accepted trigger's open obligation: guarantee ``k`` (1-based), the
+    trigger event, its stamp and deadline ``due`` (s), and the inputs it is judged on."""
+
+    k: int
+    trigger: Event
+    stamp: float
+    due: float
+    inputs: dict[str, object]
+    #: the outputs published after the trigger (stamp at or after it): only they answer it
+    outs: dict[str, object] = field(default_factory=dict)
+    #: the last output after the trigger that did not satisfy the guarantee (where, why)
+    rejected: str = ""
+    #: the trigger's stamp and its deadline in integer nanoseconds: what the deadline is compared in
+    stamp_ns: int = 0
+    due_ns: int = 0
+
+
+@dataclass
+class DeadlineResult:
+    """Counts per verdict and the first ``false`` of one node on one run;
+    ``unaccepted`` the (trigger, guarantee) pairs given no verdict, per reason
+    (:data:`UNACCEPTED`), and the first of them (``first_unaccepted``:
+    where, stamp, guarantee, reason)."""
+
+    node: str
+    counts: dict[str, int] = field(default_factory=lambda: {v: 0 for v in DEADLINE_VERDICTS})
+    first_false: DeadlineVerdict | None = None
+    unaccepted: dict[str, int] = field(default_factory=lambda: {v: 0 for v in UNACCEPTED})
+    first_unaccepted: Unaccepted | None = None
+    #: guarantee -> its smallest time margin on the run (:class:`TimeMargin`)
+    time_margins: dict[int, TimeMargin] = field(default_factory=dict)
+
+    def to_json(self) -> DeadlineResultJson:
+        return {"node": self.node, "counts": dict(self.counts),
+                "first_false": None if self.first_false is None else self.first_false.to_json(),
+                "unaccepted": dict(self.unaccepted), "first_unaccepted": self.first_unaccepted,
+                "time_margins": [m.to_json() for _, m in sorted(self.time_margins.items())]}
+
+    def note_time_margin(self, k: int, margin_ns: int | None, trigger_where: str, answer_where: str,
+                         answer: float, was_unanswered: bool = False) -> None:
+        """Count guarantee ``k``'s time margin on one trigger (:func:`.time_margins.note`)."""
+        note(self.time_margins, k, margin_ns, trigger_where, answer_where, answer, was_unanswered)
+
