@@ -171,7 +171,8 @@ def test_names_are_resolved_in_each_nodes_namespace(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(("name", "node", "ns", "full"), [
     ("x", "n", "/", "/x"), ("x", "n", "/a/b", "/a/b/x"), ("/x", "n", "/a", "/x"), ("~", "n", "/a", "/a/n"),
-    ("~/x", "n", "/", "/n/x"), ("~/x", "n", "/a", "/a/n/x"), ("{node}/x", "n", "/a", "/a/n/x")])
+    ("~/x", "n", "/", "/n/x"), ("~/x", "n", "/a", "/a/n/x"), ("{node}/x", "n", "/a", "/a/n/x"),
+    ("{ns}/x", "n", "/", "/x"), ("{ns}/x", "n", "/a", "/a/x")])
 def test_resolve_follows_ros2_name_expansion(name: str, node: str, ns: str, full: str) -> None:
     assert resolve(name, node, ns) == full
 
@@ -261,3 +262,19 @@ def test_a_workspaces_documents_without_a_contract_are_checked_against_each_othe
     _write(ws / "nodl", "Camera", CAMERA.format(reliability="RELIABLE"))  # the control: only the two warnings
     found = check(checked, ws).findings
     assert sorted(f.code for f in found) == ["nodl-node", "nodl-node"]
+    # the workspace's check writes SARIF too, its file names relative to the workspace
+    assert main(["nodl", "check", "-w", str(ws), "--sarif", str(tmp_path / "ws.sarif")]) == 0
+    results = _sarif(tmp_path / "ws.sarif")["runs"][0]["results"]
+    assert sorted((r["level"], r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"]) for r in results) == [
+        ("warning", "nodl/Camera.nodl.yaml"), ("warning", "nodl/Viewer.nodl.yaml")]
+
+
+def test_an_include_leading_outside_the_folders_named_is_a_located_error(tmp_path: Path, capsys,
+                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    _write(tmp_path / "elsewhere", "common", CAMERA.format(reliability="RELIABLE"))
+    _write(tmp_path / "docs", "Arm", "nodl_version: 2\ninclude:\n  - ref: local://../elsewhere/common.nodl.yaml\n")
+    assert main(["nodl", "check", "docs"]) == 1
+    assert "docs/Arm.nodl.yaml:3:10: error: include 'local://../elsewhere/common.nodl.yaml': resolves to" in \
+        capsys.readouterr().err
+    assert main(["nodl", "check", "docs", "elsewhere"]) == 0  # the control: the folder named too

@@ -84,6 +84,8 @@ def resolve(name: str, node: str, namespace: str = "/") -> str:
     name, ``~/x`` below it; ``/x`` stays; a relative ``x`` is ``<namespace>/x``."""
     ns = namespace.rstrip("/")
     name = name.replace("{node}", node).replace("{ns}", ns or "/").replace("{namespace}", ns or "/")
+    while "//" in name:  # "{ns}/x" in the root namespace
+        name = name.replace("//", "/")
     if name == "~":
         return f"{ns}/{node}"
     if name.startswith("~/"):
