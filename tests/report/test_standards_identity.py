@@ -142,3 +142,47 @@ def test_a_confusable_alias_is_refused_at_its_item_and_a_plain_one_read(tmp_path
     (tmp_path / "reviews/gain.yaml").write_text(text.replace("\u200b", ""), encoding="utf-8")
     _, record = read_record(tmp_path, {"record": "reviews/gain.yaml"}, lambda *p: Loc("contracts/plan.yaml", 9, 11))
     assert record.author_aliases == ("ada@example.org", "AdaL")
+
+
+def test_the_plans_people_make_an_alias_one_person_for_every_record_and_their_absence_the_control(
+        tmp_path: Path) -> None:
+    from rclverify.model.plan.load import load_plan
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "a.rcl").write_text("node Gain {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n"
+                                                  "  guarantee( out.y >= 0 )\n}\n", encoding="utf-8")
+    (tmp_path / "contracts" / "plan.yaml").write_text(
+        "name: s\ncontracts: [contracts/a.rcl]\nstandards:\n  - {profile: iec61508-3, sil: 2}\n"
+        "people:\n  - {name: Ada Lovelace, aliases: [AL-7], emails: [countess@example.org]}\n", encoding="utf-8")
+    [choice] = load_plan(tmp_path, "contracts/plan.yaml").standards
+    report = {"summary": {"status": "discharged"}, "nodes": [{"name": "Gain", "guarantees": [
+        {"index": 1, "status": "discharged"}]}], "obligations": [{"id": "Gain.g1.review.e0", "node": "Gain",
+                                                                  "guarantee": 1}]}
+
+    def b86c(row: dict[str, Any], people: Any) -> str:
+        rows = clause_rows(load_builtin("iec61508-3"), "2", {**report, "evidence": [row]}, people=people)
+        return str({c["id"]: c for c in rows}["B.8 6c"]["status"])
+    for reviewer in ("AL-7", "countess@example.org", "Countess <countess@example.org>"):
+        row = _row(reviewer, "Ada Lovelace")  # the record declares no alias: the plan's list does
+        assert b86c(row, choice.people) == "open"
+        assert independence_of(row, choice.people)[1].startswith("self-review")
+        assert b86c(row, ()) == "covered"  # the control: without the list the tool cannot know
+    assert b86c(_row("Charles Babbage", "Ada Lovelace"), choice.people) == "covered"  # another person still covers
+
+
+@pytest.mark.parametrize("people, said", [
+    ("  - {name: Ada Lovelace}\n  - {name: ada.lovelace}\n", "share a name, alias or e-mail"),
+    ("  - {name: Ada Lovelace, aliases: [unknown]}\n", "'unknown' names nobody"),
+    ("  - {name: Ada Lovelace, aliases: [\"Ad\u0430\"]}\n", "scripts"),
+])
+def test_a_people_entry_that_cannot_name_one_person_is_refused_at_its_line(tmp_path: Path, people: str,
+                                                                          said: str) -> None:
+    from rclverify.model.plan.load import load_plan
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "a.rcl").write_text("node Gain {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n"
+                                                  "  guarantee( out.y >= 0 )\n}\n", encoding="utf-8")
+    (tmp_path / "contracts" / "plan.yaml").write_text("name: s\ncontracts: [contracts/a.rcl]\npeople:\n" + people,
+                                                      encoding="utf-8")
+    with pytest.raises(PlanError) as info:
+        load_plan(tmp_path, "contracts/plan.yaml")
+    [d] = info.value.diagnostics
+    assert said in str(d) and str(d).startswith(f"contracts/plan.yaml:{4 + people.count(chr(10)) - 1}:")

@@ -76,7 +76,7 @@ def standards_part(choices: Sequence[StandardChoice],
     problems: list[str] = []
     ok = True
     for c in choices:
-        clauses = clause_rows(c.profile, c.level, report, c.clauses, unstated)
+        clauses = clause_rows(c.profile, c.level, report, c.clauses, unstated, c.people)
         missing = not_covered(clauses)
         row = StandardRow.of({
             "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,

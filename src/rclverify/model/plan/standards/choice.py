@@ -23,6 +23,7 @@ from typing import Any, Mapping
 from rclverify.lang import ast
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.yamlguard import KEY, Path_
+from rclverify.model.plan.standards.identity import Person, confusable, is_person, person_keys
 from rclverify.model.plan.standards.profiles import ASKED, Profile, builtin_names, load_builtin, load_profile_file
 
 
@@ -47,12 +48,38 @@ class ClauseNote:
 class StandardChoice:
     """A profile chosen by the plan at ``level`` (``None``: the profile has no levels), written at ``loc``;
     ``strict``: ``--strict`` requires the items it asks covered; ``clauses``: clause id -> what the plan
-    says of it."""
+    says of it; ``people``: the plan's ``people:`` entries, names of one person each (for a review's
+    independence)."""
     profile: Profile
     level: str | None
     loc: ast.Loc
     strict: bool = False
     clauses: Mapping[str, ClauseNote] = field(default_factory=dict)
+    people: tuple[Person, ...] = ()
+
+
+def read_people(data: Mapping[str, Any], locs: Mapping[Path_, ast.Loc], file: str) -> tuple[Person, ...]:
+    """The plan's ``people:`` list (``data``: the schema-checked plan data) as :class:`~.identity.Person`
+    values, in order.  Raises :class:`PlanError` at the entry for a name that names nobody or holds mixed
+    scripts or invisible characters (:func:`~.identity.confusable`), and for two entries that name one
+    person (their names' keys meet: they would be one entry)."""
+    out: list[Person] = []
+    for i, entry in enumerate(data.get("people") or []):
+        at = locs.get(("people", i), ast.Loc(file, 1, 1))
+        p = Person(str(entry["name"]), tuple(str(a) for a in entry.get("aliases") or ()),
+                   tuple(str(e) for e in entry.get("emails") or ()), (at.file, at.line, at.col))
+        for n in p.names():
+            bad = confusable(n)
+            if bad or not is_person(n):
+                raise plan_error(at.file, at.line, at.col, f"people: {n!r} " + (
+                    bad if bad else "names nobody") + " (docs/plan.md, \"people\")", "E-people")
+        keys = person_keys(p.name, p.names()[1:])
+        for q in out:
+            if keys & person_keys(q.name, q.names()[1:]):
+                raise plan_error(at.file, at.line, at.col, f"people: {p.name!r} and {q.name!r} (line {q.loc[1]}) "
+                                 "share a name, alias or e-mail: one person is one entry", "E-people")
+        out.append(p)
+    return tuple(out)
 
 
 def _profile(root: Path, name: str, at: ast.Loc) -> Profile:
@@ -164,8 +191,10 @@ def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast
     :class:`StandardChoice` values, in order.  Raises :class:`PlanError`
     for an unknown profile (naming the profiles there are), a bad profile
     file, a missing or unknown level, a profile chosen twice, or a bad
-    ``clauses:`` entry (:func:`_clauses`)."""
+    ``clauses:`` entry (:func:`_clauses`) or ``people:`` entry (:func:`read_people`).
+    Each choice carries the plan's ``people``."""
     out: list[StandardChoice] = []
+    people = read_people(data, locs, file)
     for i, entry in enumerate(data.get("standards") or []):
         base: Path_ = ("standards", i)
         at = locs.get(base + ("profile",), ast.Loc(file, 1, 1))
@@ -174,8 +203,8 @@ def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast
             raise plan_error(at.file, at.line, at.col, f"standards: profile {p.id!r} is chosen twice", "E-profile")
         level = _level(p, entry, base, locs, file)
         out.append(StandardChoice(p, level, locs.get(base, at), bool(entry.get("strict", False)),
-                                  _clauses(p, entry, base, locs, file, level)))
+                                  _clauses(p, entry, base, locs, file, level), people))
     return tuple(out)
 
 
-__all__ = ["ASKED_WORDS", "CLAUSE_KEYS", "ClauseNote", "PlanError", "StandardChoice", "read_standards"]
+__all__ = ["ASKED_WORDS", "CLAUSE_KEYS", "ClauseNote", "PlanError", "StandardChoice", "read_people", "read_standards"]

@@ -14,7 +14,10 @@ names somebody; two names are one person when their keys meet
   (``Ada Lovelace <ada@example.org>``): the name, the whole address and
   its local part (without a ``+tag``) are each a key of the person;
 * the declared aliases of the record (its ``author_aliases`` and
-  ``reviewer_aliases``) are keys of the same person.
+  ``reviewer_aliases``) are keys of the same person;
+* the plan's ``people:`` list (:class:`Person`: a name, its aliases and
+  e-mail addresses) makes every name of one entry a key of the person any
+  of them names (:func:`with_people`), for every record.
 
 A name that reads as nobody (:data:`NOBODY`: empty, ``-``, ``unknown``,
 ``n/a``, ``tbd``...) has no key: it is not a person, so nothing is
@@ -30,6 +33,8 @@ right-to-left mark).  The rule of comparison is rclverify's; no standard
 prescribes one.  Pure functions of their arguments; nothing raises.
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import re
 import unicodedata
@@ -91,6 +96,31 @@ def person_keys(name: str, aliases: Iterable[str] = ()) -> frozenset[str]:
     return frozenset(out)
 
 
+@dataclass(frozen=True)
+class Person:
+    """One entry of the plan's ``people:`` list (docs/plan.md): ``name``, its ``aliases`` and ``emails``, all
+    names of one person, written at ``loc`` (``file``, ``line``, ``col``)."""
+    name: str
+    aliases: tuple[str, ...] = ()
+    emails: tuple[str, ...] = ()
+    loc: tuple[str, int, int] = ("", 0, 0)
+
+    def names(self) -> tuple[str, ...]:
+        """Every name the entry gives the person."""
+        return (self.name, *self.aliases, *self.emails)
+
+
+def with_people(name: str, aliases: Iterable[str], people: Iterable[Person]) -> tuple[str, ...]:
+    """``aliases`` with every name of each entry of ``people`` whose names' keys meet the keys of ``name``
+    with ``aliases`` (:func:`person_keys`); ``aliases`` as given when none does."""
+    mine = person_keys(name, aliases)
+    out = list(aliases)
+    for p in people:
+        if mine and mine & person_keys(p.name, p.names()[1:]):
+            out += [n for n in p.names() if n not in out]
+    return tuple(out)
+
+
 def is_person(name: str, aliases: Iterable[str] = ()) -> bool:
     """Whether ``name`` (with its ``aliases``) names somebody."""
     return bool(person_keys(name, aliases))
@@ -101,4 +131,4 @@ def same_person(a: str, b: str, a_aliases: Iterable[str] = (), b_aliases: Iterab
     return bool(person_keys(a, a_aliases) & person_keys(b, b_aliases))
 
 
-__all__ = ["NOBODY", "confusable", "is_person", "key", "person_keys", "same_person"]
+__all__ = ["NOBODY", "Person", "confusable", "is_person", "key", "person_keys", "same_person", "with_people"]

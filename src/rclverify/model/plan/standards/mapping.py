@@ -53,6 +53,7 @@ from typing import Any, Callable, Collection, Iterable, Mapping, Sequence, cast,
 
 from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
 from rclverify.model.plan.standards.field_data import target_items
+from rclverify.model.plan.standards.identity import Person
 from rclverify.model.plan.standards.reviews import independence_of, review_as_stated, review_identity
 from rclverify.records.report_schema import EvidenceJson
 from rclverify.records.standards_rows import About, ClauseStatus, Independence, Recommendation, ScopeKind
@@ -111,12 +112,12 @@ def _harness(row: Mapping[str, Any]) -> bool:
     return isinstance(s, Mapping) and s.get("origin") == "harness"
 
 
-def _support(row: Mapping[str, Any], asked: str) -> Support:
+def _support(row: Mapping[str, Any], asked: str, people: Sequence[Person] = ()) -> Support:
     note = ""
     if _harness(row):
         note = "origin: harness: shown, never counted"
     elif row.get("kind") == "review" and asked != "none":
-        level, why = independence_of(row)
+        level, why = independence_of(row, people)
         if INDEPENDENCE.index(level) < INDEPENDENCE.index(asked):
             note = why or f"independence {level}; the clause asks {asked}"
     return {"obligation": str(row["obligation"]), "backend": str(row["backend"]),
@@ -127,8 +128,10 @@ def _support(row: Mapping[str, Any], asked: str) -> Support:
 class _Index:
     """The report read once for every clause: each guarantee's evidence rows and status, its health checks."""
 
-    def __init__(self, report: Mapping[str, Any], unstated: Collection[tuple[str, str]] = ()) -> None:
+    def __init__(self, report: Mapping[str, Any], unstated: Collection[tuple[str, str]] = (),
+                 people: Sequence[Person] = ()) -> None:
         self.report = report
+        self.people = people  # the plan's people: (identity.Person), for a review's independence
         self.unstated = unstated  # (node, environment) of the run sets whose plan entry states no origin
         where = {str(o["id"]): (str(o["node"]), int(o["guarantee"])) for o in report.get("obligations") or ()}
         self.guarantees: list[tuple[str, int, str]] = [
@@ -148,12 +151,13 @@ class _Index:
             self.health.setdefault((str(f.get("node")), f.get("guarantee")), []).append(f)
 
 
-def _counted(rows: Iterable[Mapping[str, Any]], accepts: set[str], asked: str) -> list[tuple[Mapping[str, Any], Support]]:
-    return [(r, _support(r, asked)) for r in rows if kinds_of(r) & accepts]
+def _counted(rows: Iterable[Mapping[str, Any]], accepts: set[str], asked: str,
+             people: Sequence[Person] = ()) -> list[tuple[Mapping[str, Any], Support]]:
+    return [(r, _support(r, asked, people)) for r in rows if kinds_of(r) & accepts]
 
 
 def _guarantee_item(ix: _Index, node: str, k: int, status: str, accepts: set[str], asked: str) -> ScopeItem:
-    supports = [s for _, s in _counted(ix.rows.get((node, k), ()), accepts, asked)]
+    supports = [s for _, s in _counted(ix.rows.get((node, k), ()), accepts, asked, ix.people)]
     counting = [s for s in supports if s["counts"]]
     bad = [s for s in counting if s["status"] != "discharged"]
     health = [f for f in ix.health.get((node, k), []) + ix.health.get((node, None), [])
@@ -203,7 +207,7 @@ def _requirement_item(rq: Mapping[str, Any], ix: _Index, accepts: set[str], aske
     if state == "covered" and "proof" not in accepts:
         support = [(str(s["node"]), int(s["guarantee"])) for s in rq.get("support") or ()]
         if not any(sp["counts"] and sp["status"] == "discharged" for key in support
-                   for _, sp in _counted(ix.rows.get(key, ()), accepts, asked)):
+                   for _, sp in _counted(ix.rows.get(key, ()), accepts, asked, ix.people)):
             state, detail = "no evidence", f"no {' or '.join(sorted(accepts))} evidence of its supporting guarantees"
     return _item(f"requirement {rq.get('id')}", "requirement", state, detail, [f"requirement {rq.get('id')}"])
 
@@ -282,7 +286,7 @@ def _evidence_in_scope(item: Item, level: str | None, scope: Sequence[ScopeItem]
         if str(r["obligation"]) in seen or not (kinds_of(r) & accepts or str(r["obligation"]) in targets):
             continue
         seen.add(str(r["obligation"]))
-        out.append(_support(r, asked))
+        out.append(_support(r, asked, ix.people))
     return out
 
 
@@ -331,7 +335,7 @@ def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], i
 
 def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceJson],
                 notes: Mapping[str, Any] | None = None,
-                unstated: Collection[tuple[str, str]] = ()) -> list[ClauseRow]:
+                unstated: Collection[tuple[str, str]] = (), people: Sequence[Person] = ()) -> list[ClauseRow]:
     """The clause rows of ``profile`` at ``level`` (``None`` for a profile
     without levels) over ``report`` (a report dict: its ``evidence``,
     ``obligations``, ``nodes``, ``side_conditions``, ``requirements``,
@@ -342,10 +346,12 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
     ``nodes``, ``reason``, ``justification``, ``at``): the scope narrowed to
     those nodes, and the note shown.  ``unstated``: the (node, environment)
     of the run sets whose plan entry states no origin (never field data,
-    :func:`~.field_data.unstated_origins`).  Pure: reads nothing else,
+    :func:`~.field_data.unstated_origins`).  ``people``: the plan's ``people:``
+    entries (:class:`~.identity.Person`), names of one person for a review's
+    independence (:func:`~.reviews.independence_of`).  Pure: reads nothing else,
     raises nothing for well-formed rows."""
     rep: Mapping[str, Any] = report if isinstance(report, Mapping) else {"evidence": list(report)}
-    ix = _Index(rep, unstated)
+    ix = _Index(rep, unstated, people)
     out: list[ClauseRow] = []
     for item in profile.items:
         code = item.at(level)

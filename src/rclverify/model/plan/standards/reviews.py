@@ -8,9 +8,9 @@ tool does not check (shown in the matrix as stated).  Pure functions of the row;
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping
 
-from rclverify.model.plan.standards.identity import is_person, same_person
+from rclverify.model.plan.standards.identity import Person, is_person, same_person, with_people
 from rclverify.model.plan.standards.profiles import INDEPENDENCE
 
 
@@ -55,15 +55,17 @@ def review_as_stated(row: Mapping[str, Any]) -> str:
     return "; ".join(parts)
 
 
-def independence_of(row: Mapping[str, Any]) -> tuple[str, str]:
+def independence_of(row: Mapping[str, Any], people: Iterable[Person] = ()) -> tuple[str, str]:
     """(the independence level a review row shows, one of :data:`~.profiles.INDEPENDENCE`; why it is
     ``none`` or ``""``): ``none`` when the record does not name a person as its reviewer and as its author
     (an empty name, ``-``, ``unknown``... names nobody), or they are one person as
     :func:`~.identity.same_person` compares names (NFKC, case, punctuation and spaces aside, e-mail
-    addresses and the record's declared aliases resolved); else the record's stated level, ``person``
-    when it states none."""
+    addresses, the record's declared aliases and the plan's ``people`` entries resolved,
+    :func:`~.identity.with_people`); else the record's stated level, ``person`` when it states none."""
     reviewer, author, stated = review_identity(row)
-    r_alias, a_alias = _aliases(row, "reviewer"), _aliases(row, "author")
+    known = tuple(people)
+    r_alias = with_people(reviewer, _aliases(row, "reviewer"), known)
+    a_alias = with_people(author, _aliases(row, "author"), known)
     if not is_person(reviewer, r_alias) or not is_person(author, a_alias):
         missing = [w for w, n, al in (("its reviewer", reviewer, r_alias), ("its author", author, a_alias))
                    if not is_person(n, al)]
