@@ -24,6 +24,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from rclverify.ros.extract.model import Graph
+from rclverify.ros.graph import summary
 from rclverify.ros.graph.scan import scan
 
 PKG = ('<?xml version="1.0"?>\n<package format="3"><name>{name}</name><version>0.1.0</version>'
@@ -133,3 +134,82 @@ def test_the_target_name_an_output_name_replaces_runs_nothing(tmp_path: Path) ->
     g = _scan(tmp_path, [_cxx(tmp_path, "talker_node")])  # control: the file built is 'talker'
     assert not g.nodes["/front"].publishes
     assert [s for s in _said(g) if "executable 'talker_node' of package 'cxx' has no source found" in s]
+
+
+# -- endpoints where C++ puts them ---------------------------------------------------
+
+LISTENS = """#include <rclcpp/rclcpp.hpp>
+#include <std_msgs/msg/string.hpp>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+class Looker : public rclcpp::Node
+{
+public:
+  Looker() : Node("looker")
+  {
+    buffer_ = std::make_shared<tf2_ros::Buffer>(get_clock());
+    listener_ = std::make_shared<tf2_ros::TransformListener>(LISTENER_ARGS);
+#if defined(HUMBLE)
+    sub_ = create_subscription<std_msgs::msg::String>("seen", 10, [](std_msgs::msg::String::SharedPtr) {});
+#elif defined(IRON)
+    sub_ = create_subscription<std_msgs::msg::String>("seen", 10, [](std_msgs::msg::String::SharedPtr) {});
+#else
+    sub_ = create_subscription<std_msgs::msg::String>(BRANCH_TOPIC, 10, [](std_msgs::msg::String::SharedPtr) {});
+#endif
+  }
+  rclcpp::Subscription<std_msgs::msg::String>::SharedPtr sub_;
+  rclcpp::Subscription<std_msgs::msg::String>::SharedPtr member_sub_ =
+    create_subscription<std_msgs::msg::String>("kept", 10, [](std_msgs::msg::String::SharedPtr) {});
+  autoware_utils::InterProcessPollingSubscriber<std_msgs::msg::String> polled_{this, "~/input/polled"};
+  std::shared_ptr<tf2_ros::Buffer> buffer_;
+  std::shared_ptr<tf2_ros::TransformListener> listener_;
+};
+int main(int argc, char ** argv) { rclcpp::init(argc, argv); rclcpp::spin(std::make_shared<Looker>()); }
+"""
+
+
+def _looker(tmp: Path, listener_args: str, branch_topic: str = '"seen"', polled: str = "") -> Graph:
+    _write(tmp / "ws" / "eyes", {
+        "package.xml": PKG.format(name="eyes", tool="ament_cmake"),
+        "CMakeLists.txt": CMAKE.format(name="eyes") + "add_executable(looker src/looker.cpp)\n",
+        "src/looker.cpp": LISTENS.replace("LISTENER_ARGS", listener_args).replace("BRANCH_TOPIC", branch_topic)
+        .replace('polled_{this, "~/input/polled"};', polled or 'polled_{this, "~/input/polled"};')})
+    return _scan(tmp)
+
+
+def _subs_at(g: Graph, node: str) -> list[tuple[str, int]]:
+    return sorted((e.topic, e.src.line) for e in g.nodes[node].subscribes)
+
+
+def test_a_transform_listener_given_no_node_subscribes_on_tf2s_own_node(tmp_path: Path) -> None:
+    g = _looker(tmp_path, "*buffer_")
+    assert "/tf" not in {t for t, _ in _subs_at(g, "/looker")}
+    assert "ws/eyes/src/looker.cpp:11:17: warning: tf2_ros::TransformListener made without a node subscribes /tf " \
+           "and /tf_static on tf2's own node (transform_listener_impl_...), not on this one" in _said(g)
+    assert summary.cause_of("ROS-TF-OWN-NODE", "").key == "endpoints-own-node"
+    g = _looker(tmp_path, "*buffer_, false")  # the spin_thread flag is no node either
+    assert "/tf" not in {t for t, _ in _subs_at(g, "/looker")}
+
+
+def test_a_transform_listener_given_the_node_subscribes_on_it(tmp_path: Path) -> None:
+    g = _looker(tmp_path, "*buffer_, this, false")  # control: the enclosing node is given
+    assert {("/tf", 11), ("/tf_static", 11)} <= set(_subs_at(g, "/looker"))
+    assert not [s for s in _said(g) if "own node" in s]
+
+
+def test_alternative_preprocessor_branches_give_one_edge(tmp_path: Path) -> None:
+    g = _looker(tmp_path, "*buffer_")
+    assert [x for x in _subs_at(g, "/looker") if x[0] == "/seen"] == [("/seen", 13)]
+    # control: branches creating different topics keep each
+    g = _looker(tmp_path, "*buffer_", '"other"')
+    assert [x for x in _subs_at(g, "/looker") if x[0] in ("/seen", "/other")] == [("/other", 17), ("/seen", 13)]
+
+
+def test_a_subscription_made_by_a_default_member_initializer_is_the_nodes(tmp_path: Path) -> None:
+    g = _looker(tmp_path, "*buffer_")
+    assert {("/kept", 22), ("/looker/input/polled", 23)} <= set(_subs_at(g, "/looker"))
+    types = {e.topic: e.msg_type for e in g.nodes["/looker"].subscribes}
+    assert types["/looker/input/polled"] == types["/kept"] == "std_msgs/msg/String"
+    # control: a member declared without an initializer creates nothing
+    g = _looker(tmp_path, "*buffer_", '"seen"', polled="polled_;")
+    assert "/looker/input/polled" not in {t for t, _ in _subs_at(g, "/looker")}

@@ -9,7 +9,7 @@ documented API and source):
 | --- | --- |
 | ``tf2_ros::TransformBroadcaster`` / ``tf::TransformBroadcaster`` | publishes ``/tf`` (``tf2_msgs/msg/TFMessage``) |
 | ``tf2_ros::StaticTransformBroadcaster`` | publishes ``/tf_static`` |
-| ``tf2_ros::TransformListener`` / ``tf::TransformListener`` | subscribes ``/tf`` and ``/tf_static`` |
+| ``tf2_ros::TransformListener`` / ``tf::TransformListener`` | subscribes ``/tf`` and ``/tf_static``; ROS 2's ``TransformListener(buffer[, spin_thread])``, given no node, on tf2's own node (:func:`own_node`) |
 | ``message_filters::Subscriber<T>(h, name, ...)`` / ``.subscribe(h, name, ...)`` | subscribes ``name`` (``T``) |
 | ``image_transport::SubscriberFilter(h, name, ...)`` / ``.subscribe(h, name, ...)`` | subscribes ``name`` (``sensor_msgs/msg/Image``) |
 | ``image_transport::ImageTransport`` ``advertise``/``subscribe``; ROS 2 ``image_transport::create_publisher``/``create_subscription`` | ``name`` (``sensor_msgs/msg/Image``); the ``Camera`` forms add ``camera_info`` beside it (``sensor_msgs/msg/CameraInfo``) |
@@ -23,6 +23,7 @@ documented API and source):
 | ``self_test::TestRunner([h, [ph]])`` | serves ``self_test`` (``diagnostic_msgs/srv/SelfTest``) through ``ph`` (default ``~``) |
 | ``camera_info_manager::CameraInfoManager(h, ...)`` | serves ``set_camera_info`` (``sensor_msgs/srv/SetCameraInfo``) through ``h`` |
 | ``bond::Bond(topic, id, ...)`` (bondcpp, ROS 1 and 2) | publishes and subscribes ``topic`` (``bond/msg/Status``): the heartbeat |
+| Autoware's ``InterProcessPollingSubscriber<T>(node, name, ...)`` (``autoware_utils``, ``tier4_autoware_utils``; also a default member initializer ``{this, name}``) | subscribes ``name`` (``T``) on ``node`` |
 | ``realtime_tools::RealtimePublisher<T>(h, name, ...)`` / ``.init(h, name, ...)`` (ROS 1) | publishes ``name`` (``T``) through ``h``; ROS 2's ``RealtimePublisher<T>(publisher)`` wraps a publisher already read |
 
 Each spec is ``(role, name value, type, handle value)``; a handle is the
@@ -53,7 +54,7 @@ RECONF = "dynamic_reconfigure/"
 CONSTRUCTED = {"TransformBroadcaster", "StaticTransformBroadcaster", "TransformListener", "Subscriber",
                "InteractiveMarkerServer", "ParameterEventHandler", "CameraPublisher", "CameraSubscriber",
                "Updater", "Server", "Client", "TestRunner", "RealtimePublisher", "CameraInfoManager", "Bond",
-               "SubscriberFilter"}
+               "SubscriberFilter", "InterProcessPollingSubscriber"}
 #: helper methods that create endpoints, by the receiver's class (last name part)
 METHODS = {"ImageTransport": {"advertise", "subscribe", "advertiseCamera", "subscribeCamera"},
            "Subscriber": {"subscribe"}, "SubscriberFilter": {"subscribe"}, "AsyncParametersClient": {"on_parameter_event"},
@@ -83,6 +84,19 @@ def _markers(ns: symbols.Val, h: symbols.Val, ros2: bool) -> list[Spec]:
     else:
         out.append(("pub", under("update_full"), VIS + "InteractiveMarkerInit", h))
     return out
+
+
+def own_node(type_text: str, args: list[Any], ros2: bool) -> bool:
+    """Whether a ROS 2 ``tf2_ros::TransformListener`` made with syntax nodes
+    ``args`` creates its own node for ``/tf`` and ``/tf_static``: given the
+    buffer alone or with the ``spin_thread`` flag (``true``/``false``), tf2_ros
+    makes a node of its own (``transform_listener_impl_...``, tf2_ros'
+    ``transform_listener.h``); given a node, it subscribes on that node."""
+    head, _ = split_template(type_text.replace(" ", "").replace("\n", ""))
+    if not ros2 or head.split("::")[-1] != "TransformListener" or "tf2_ros" not in head or not args:
+        return False
+    rest = [a for a in args[1:] if getattr(a, "type", None) not in ("comment",)]
+    return len(rest) == 0 or (len(rest) == 1 and getattr(rest[0], "type", "") in ("true", "false"))
 
 
 def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
@@ -119,6 +133,8 @@ def constructed(type_text: str, args: list[Any], val: Value, ros2: bool,
         if len(args) < 2:
             return []  # made empty: .subscribe(...) names the topic
         return [("sub", val(args[1]), message_type(targs[0], aliases) if targs else None, val(args[0]))]
+    if last == "InterProcessPollingSubscriber" and "autoware" in head + type_text and len(args) >= 2:
+        return [("sub", val(args[1]), message_type(targs[0], aliases) if targs else None, None)]
     if last == "InteractiveMarkerServer" and args:
         return _markers(val(args[0]), None, ros2)
     if last == "ParameterEventHandler" and "rclcpp" in head:

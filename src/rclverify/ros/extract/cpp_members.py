@@ -55,6 +55,11 @@ class MemberReader:
         if self.scope.fn_of(n) is not None or not held_helper(ty):
             return
         nss, cls = namespaces_of(n)
+        init = n.child_by_field_name("default_value")
+        if init is not None and init.type in ("initializer_list", "argument_list") and init.named_children:
+            # a default member initializer (Sub<T> sub_{this, "~/input/x"}): made with every object of the class
+            getattr(self, "construct")(ty, list(init.named_children), n)
+            return
         for d in n.children_by_field_name("declarator"):
             if d.type == "field_identifier":  # a value member (a pointer is made elsewhere)
                 self.out["member_decls"].append(("::".join(nss + cls), _T(d), ty, self.src(n)))

@@ -133,6 +133,45 @@ def blank_if0(data: bytes) -> bytes:
     return bytes(out)
 
 
+def branches(data: bytes) -> dict[int, tuple[tuple[int, int], ...]]:
+    """Per 1-based line inside a preprocessor conditional, the groups it lies in,
+    outermost first: ``((group, branch), ...)``, ``group`` the line of the
+    group's ``#if``/``#ifdef``/``#ifndef`` and ``branch`` 0 for its first
+    branch, 1, 2 ... for each ``#elif`` / ``#else`` after it.  Two lines in
+    different branches of one group are alternatives: one of them is compiled."""
+    out: dict[int, tuple[tuple[int, int], ...]] = {}
+    if b"#" not in data:
+        return out
+    stack: list[tuple[int, int]] = []
+    marks = [(data.count(b"\n", 0, d.start()) + 1, d.group(1)) for d in _DIRECTIVE.finditer(data)]
+    total = data.count(b"\n") + 1
+    marks.append((total + 1, b""))
+    prev = 1
+    for line, word in marks:
+        if stack:
+            for k in range(prev, line):
+                out[k] = tuple(stack)
+        if word in (b"if", b"ifdef", b"ifndef"):
+            stack.append((line, 0))
+        elif word in (b"elif", b"else") and stack:
+            stack[-1] = (stack[-1][0], stack[-1][1] + 1)
+        elif word == b"endif" and stack:
+            stack.pop()
+        prev = line + 1
+    return out
+
+
+def alternatives(a: tuple[tuple[int, int], ...], b: tuple[tuple[int, int], ...]) -> bool:
+    """Whether branch paths ``a`` and ``b`` (:func:`branches`) part in different
+    branches of one group (only one of the two lines is compiled)."""
+    for x, y in zip(a, b):
+        if x[0] != y[0]:
+            return False
+        if x[1] != y[1]:
+            return True
+    return False
+
+
 def prepare(data: bytes) -> bytes:
     """``data`` with every rewrite of the module docstring applied (same length)."""
     data = blank_macros(data)

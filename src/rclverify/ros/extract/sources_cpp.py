@@ -39,7 +39,7 @@ from rclverify.ros.extract import cpp_helpers, emit, names, symbols, treesitter
 from rclverify.ros.extract.cpp_bases import node_base
 from rclverify.ros.extract.cpp_calls import LIBRARY, CallReader
 from rclverify.ros.extract.cpp_members import MemberReader
-from rclverify.ros.extract.cpp_prep import REGISTER, blank_if0, prepare
+from rclverify.ros.extract.cpp_prep import REGISTER, alternatives, blank_if0, branches, prepare
 from rclverify.ros.extract.nodelets import registered
 from rclverify.ros.extract.cpp_scope import base_name, namespaces_of
 from rclverify.ros.extract.cpp_values import CppValues
@@ -62,6 +62,7 @@ class _File(CallReader, MemberReader):
                                     "lang": "cpp", "calls": [], "node_names": [], "member_decls": [],
                                     "member_calls": [], "includes": [], "callbacks": {}}
         data = blank_if0(data)  # code the preprocessor drops is never read
+        self.branch = branches(data)
         for m in REGISTER.finditer(data):
             line = data.count(b"\n", 0, m.start()) + 1
             self.out["components"].append((m.group(1).decode().lstrip(":"), Src(shown, line, 1)))
@@ -195,6 +196,12 @@ class _File(CallReader, MemberReader):
         if base in _ACTIONLIB and targs and "actionlib" in head + type_text:
             self.actionlib(_ACTIONLIB[base], targs[0], args, at)
             return
+        if cpp_helpers.own_node(type_text, args, self.ros2):
+            self.out["notes"].append(Note(self.src(at), "tf2_ros::TransformListener made without a node subscribes "
+                                                        "/tf and /tf_static on tf2's own node "
+                                                        "(transform_listener_impl_...), not on this one",
+                                          "ROS-TF-OWN-NODE"))
+            return
         specs = cpp_helpers.constructed(type_text, args, self.scope.value, self.ros2, self.aliases)
         if specs is not None:
             self.specs(specs, at)
@@ -227,6 +234,7 @@ class _File(CallReader, MemberReader):
                 self.bases(n)
             elif t == "call_expression":
                 self.call(n)
+        self.one_per_branch()
         s = self.scope
         # how many trailing parameters have a default (read or not): which overload a call picks
         self.out["optional"] = {f.key: sum(d is not None for d in f.defaults)
@@ -246,6 +254,28 @@ class _File(CallReader, MemberReader):
                               if v is not None}
         self.out["ros2"], self.out["using_ns"] = self.ros2, s.using_ns
         return self.out
+
+    def one_per_branch(self) -> None:
+        """Of endpoints alike (role, name, type, handle, function) created in
+        alternative branches of one ``#if ... #elif ... #else ... #endif`` group,
+        the first is kept: one of the branches is compiled, so it is one edge."""
+        def key(e: Any) -> tuple[Any, ...]:
+            return (e.kind, e.topic, e.msg_type, e.param, e.handle, e.unit, e.func,
+                    repr(e.pending[:5]) if e.pending else None)
+        if not self.branch:
+            return
+        kept: list[Any] = []
+        dropped: set[int] = set()
+        for e in self.out["endpoints"]:
+            here = self.branch.get(e.src.line, ())
+            if here and any(key(k) == key(e) and alternatives(self.branch.get(k.src.line, ()), here) for k in kept):
+                dropped.add(id(e))
+                continue
+            kept.append(e)
+        if dropped:
+            self.out["endpoints"] = kept
+            for c in self.out["classes"].values():
+                c["endpoints"] = [e for e in c["endpoints"] if id(e) not in dropped]
 
     def rclcpp_like(self, full: str, args: list[Any], n: Any) -> bool:
         """Whether qualified call ``full(args)`` may be rclcpp's (a create/advertise
