@@ -53,7 +53,7 @@ def _write(folder: Path, node: str, text: str) -> Path:
     return path
 
 
-def _check(folder: Path, namespaces: dict[str, str] | None = None, external: tuple[str, ...] = ()) -> SetResult:
+def _check(folder: Path, namespaces: dict[str, list[str]] | None = None, external: tuple[str, ...] = ()) -> SetResult:
     docs = read_all(set_files([folder]), Resolver((), shown(folder), [folder]))
     return check_set(docs, namespaces, external)
 
@@ -164,9 +164,20 @@ def test_names_are_resolved_in_each_nodes_namespace(tmp_path: Path) -> None:
     _write(tmp_path, "Camera", CAMERA.format(reliability="RELIABLE"))  # relative: <ns>/image
     _write(tmp_path, "Viewer", VIEWER.format(type="sensor_msgs/msg/Image"))  # absolute: /image
     assert _check(tmp_path).findings == []  # both in the root namespace
-    res = _check(tmp_path, {"Camera": "/robot1"})
+    res = _check(tmp_path, {"Camera": ["/robot1"]})
     assert _codes(res) == ["nodl-no-publisher"]  # the camera now publishes /robot1/image
-    assert _check(tmp_path, {"Camera": "/robot1"}, ("/image",)).findings == []
+    assert _check(tmp_path, {"Camera": ["/robot1"]}, ("/image",)).findings == []
+
+
+def test_a_document_given_two_namespaces_is_two_nodes(tmp_path: Path) -> None:
+    _write(tmp_path, "Camera", CAMERA.format(reliability="RELIABLE"))
+    _write(tmp_path, "Viewer", VIEWER.format(type="sensor_msgs/msg/Image").replace("/image", "image"))
+    res = _check(tmp_path, {"Viewer": ["/r1", "/r2"]})
+    assert sorted(f.message.split(":")[0] for f in res.findings) == ["topic /r1/image", "topic /r2/image"]
+    assert all(f.code == "nodl-no-publisher" for f in res.findings)
+    assert {f.message.split(": ")[1].split(" subscribes")[0] for f in res.findings} == {"/r1/Viewer", "/r2/Viewer"}
+    # the control: the camera in both namespaces too
+    assert _check(tmp_path, {"Viewer": ["/r1", "/r2"], "Camera": ["/r1", "/r2"]}).findings == []
 
 
 @pytest.mark.parametrize(("name", "node", "ns", "full"), [
@@ -222,7 +233,8 @@ def test_nodl_check_on_a_bare_folder_exits_1_with_sarif_at_the_documents_lines(t
     assert (region["region"]["startLine"], region["region"]["startColumn"]) == (line, col)
     related = by_code["nodl-qos"]["relatedLocations"][0]["physicalLocation"]["artifactLocation"]["uri"]
     assert related == "docs/Camera.nodl.yaml"  # the writer's document, the other place of the finding
-    assert json.loads((tmp_path / "out.json").read_text())["nodes"]["Viewer"]["namespace"] == "/"
+    assert [(n["node"], n["namespace"]) for n in json.loads((tmp_path / "out.json").read_text())["nodes"]] == [
+        ("Camera", "/"), ("Viewer", "/")]
     # the control: the same folder made compatible, the service declared external: exit 0, an empty SARIF run
     _write(docs, "Camera", CAMERA.format(reliability="RELIABLE"))
     assert main(["nodl", "check", "docs", "--external", "/reset", "--sarif", "out.sarif"]) == 0

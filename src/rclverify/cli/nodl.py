@@ -135,13 +135,15 @@ def _check_set(args: argparse.Namespace) -> int:
         print(f"nodl check: error: {', '.join(alone)} with DIR|FILE: a set of documents is checked against each "
               "other only (a workspace's documents: nodl check -w WS --nodl DIR)", file=sys.stderr)
         return 2
-    namespaces: dict[str, str] = {}
+    namespaces: dict[str, list[str]] = {}
     try:
         for item in args.namespace:
             node, eq, ns = item.partition("=")
             if not eq or not node:
                 raise ValueError(f"--namespace {item!r}: write NODE=NAMESPACE")
-            namespaces[node] = namespace_of(ns)
+            there = namespaces.setdefault(node, [])
+            if namespace_of(ns) not in there:
+                there.append(namespace_of(ns))
         paths = [Path(p) for p in args.paths]
         files = set_files(paths)
     except ValueError as exc:
@@ -162,7 +164,7 @@ def _check_set(args: argparse.Namespace) -> int:
           f"{res.errors} error(s), {warnings} warning(s)")
     if args.json:
         from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
-        data = {"nodes": {m.node: {"namespace": m.namespace, "files": list(m.doc.files)} for m in res.members},
+        data = {"nodes": [{"node": m.node, "namespace": m.namespace, "files": list(m.doc.files)} for m in res.members],
                 "parts": [d.file for d in res.parts], "external": sorted(args.external),
                 "findings": [f.to_json() for f in res.findings]}
         write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")

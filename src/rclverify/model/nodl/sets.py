@@ -4,7 +4,8 @@ A set is the documents of the folders and files named (a folder's
 ``*.nodl.yaml``, ``*.nodl.yml`` and ``*.nodl.json``, not its sub-folders);
 each document that no other document of the set includes is a node, named
 by its file (:func:`~rclverify.model.nodl.document.node_of`), in the
-namespace given for it (default ``/``).  Names are compared after ROS 2's
+namespace given for it (default ``/``; a document given several namespaces
+is one node in each).  Names are compared after ROS 2's
 name resolution (:func:`resolve`).  :func:`connections` finds, per name
 two nodes share,
 
@@ -47,6 +48,11 @@ class Member:
     node: str
     namespace: str
     doc: Document
+
+    @property
+    def label(self) -> str:
+        """How messages name the node: its name in the root namespace, else its fully qualified name."""
+        return self.node if self.namespace == "/" else resolve("~", self.node, self.namespace)
 
     def name(self, e: Endpoint) -> str:
         """Endpoint ``e``'s name resolved for this node (:func:`resolve`)."""
@@ -101,7 +107,7 @@ def connections(members: Sequence[Member]) -> list[Finding]:
     ends: dict[str, list[tuple[str, Endpoint]]] = {}
     for m in members:
         for e in m.doc.endpoints:
-            ends.setdefault(m.name(e), []).append((m.node, e))
+            ends.setdefault(m.name(e), []).append((m.label, e))
     out: list[Finding] = []
     for fqn, group in sorted(ends.items()):
         for give, take, what in PAIRS:
@@ -154,7 +160,7 @@ def unserved(members: Sequence[Member], external: Iterable[str] = ()) -> list[Fi
                 if fqn in outside or (give, fqn) in writers:
                     continue
                 code, word = ("nodl-no-publisher", "publishes") if what == "topic" else ("nodl-no-server", "serves")
-                out.append(Finding(code, f"{what} {fqn}: {m.node} {'subscribes to' if what == 'topic' else 'calls'} "
+                out.append(Finding(code, f"{what} {fqn}: {m.label} {'subscribes to' if what == 'topic' else 'calls'} "
                                          f"it and no document of the set {word} it (declare it external if it comes "
                                          "from outside the set)", (e.loc,)))
     return out
@@ -178,19 +184,22 @@ def set_files(paths: Sequence[Path]) -> list[Path]:
     return list(dict.fromkeys(out))
 
 
-def members_of(docs: Sequence[Document], namespaces: Mapping[str, str] | None = None) -> tuple[list[Member], list[Document]]:
+def members_of(docs: Sequence[Document], namespaces: Mapping[str, Sequence[str]] | None = None
+               ) -> tuple[list[Member], list[Document]]:
     """``(members, parts)`` of ``docs``: a document another one includes is a part, every other a
-    member in its namespace of ``namespaces`` (node -> namespace, default ``/``)."""
+    member per namespace ``namespaces`` gives its node (node -> namespaces; none given: ``/``), so
+    one document run in several namespaces is several nodes."""
     included = {f for d in docs for f in d.files[1:]}
     ns = namespaces or {}
-    members = [Member(d.node, ns.get(d.node, "/"), d) for d in docs if d.file not in included]
+    members = [Member(d.node, n, d) for d in docs if d.file not in included for n in (ns.get(d.node) or ("/",))]
     return members, [d for d in docs if d.file in included]
 
 
-def check_set(docs: Sequence[Document], namespaces: Mapping[str, str] | None = None,
+def check_set(docs: Sequence[Document], namespaces: Mapping[str, Sequence[str]] | None = None,
               external: Iterable[str] = ()) -> SetResult:
     """Check the documents ``docs`` (read: :func:`rclverify.model.nodl.check.read_all`) against
-    each other (module docstring); ``namespaces`` node -> namespace, ``external`` names served from
+    each other (module docstring); ``namespaces`` node -> the namespaces it runs in (:func:`members_of`),
+    ``external`` names served from
     outside the set."""
     members, parts = members_of(docs, namespaces)
     res = SetResult(members, parts)
