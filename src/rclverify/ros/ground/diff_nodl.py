@@ -5,12 +5,16 @@ Each NoDL document named after a node (a document another one includes is a
 part, not a node) is one node of the expected graph, its publishers,
 subscriptions, service and action servers and clients its edges, each
 located at the document's entry.  A document does not name its node's
-namespace, so it is given the running node it matches by name (as a
-contract is matched: case, ``_`` and ``-`` ignored,
-:func:`rclverify.ros.ground.ground.match_nodes`) and its names are resolved
-there (``x`` is ``<namespace>/x``, ``~/x`` is ``<node>/x``); a document
-that matches no running node is the node ``/<Node>`` of the root namespace,
-which is then missing.  Types are compared as ``pkg/<msg|srv|action>/Name``.
+namespace: each namespace given for it (``--namespace NODE=NS``) is one
+instance, the node ``NS/<Node>``, matched to the running node of that fully
+qualified name; a document given none is matched by its base name where
+that is unambiguous (:func:`rclverify.model.nodl.match.match_instances`;
+case, ``_`` and ``-`` ignored).  Its names are resolved for the node it
+matched as rcl resolves them (:func:`rclverify.ros.ground.nodl_code.resolve`),
+so a running node wired to another instance's topic (``/r1/odom`` in
+``/r2``'s relay, whose document says ``odom``) differs from its document
+there; an instance that matches no running node is the node ``NS/<Node>``
+(``/<Node>`` with no namespace), which is then missing.  Types are compared as ``pkg/<msg|srv|action>/Name``.
 
 The graph is compared by :func:`rclverify.ros.live.diff_dds.diff_dds`'s rules (nodes,
 publishers, subscribers, service servers and clients, action servers and
@@ -29,12 +33,12 @@ as ``ros diff --ros2`` leaves them out.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 from rclverify.model.nodl.contract import full_type
 from rclverify.model.nodl.document import Document
 from rclverify.ros.extract.model import Graph, GraphEdge, GraphNode, Src
-from rclverify.ros.ground.ground import match_nodes
+from rclverify.model.nodl.match import Instance, match_instances
 from rclverify.ros.ground.nodl_code import GRAPH_LISTS, Announced, live_qos_of, qos_differences, resolve
 from rclverify.ros.live.diff import NODL, DiffResult, Item, _t
 from rclverify.ros.live.diff_dds import diff_dds
@@ -50,12 +54,14 @@ def nodes_of(documents: list[Document]) -> dict[str, Document]:
     return {d.node: d for d in documents if d.file not in included}
 
 
-def nodl_graph(documents: Mapping[str, Document], names: Mapping[str, str]) -> Graph:
-    """The expected graph ``documents`` (by node) declare: node ``names[node]`` (its running
-    full name), else ``/<node>``, each endpoint an edge located at the document's entry."""
+def nodl_graph(documents: Mapping[str, Document], instances: Sequence[Instance]) -> Graph:
+    """The expected graph ``documents`` (by node) declare, one node per instance
+    (:func:`rclverify.model.nodl.match.match_instances`) named :attr:`Instance.expected` (the
+    running node it matched, else ``NS/<node>``), each endpoint an edge located at the document's entry."""
     g = Graph()
-    for node, doc in sorted(documents.items()):
-        full = names.get(node, f"/{node}")
+    for inst in instances:
+        doc = documents[inst.node]
+        full = inst.expected
         ns = full.rsplit("/", 1)[0] or "/"
         gn = GraphNode(full, ns, None, None, sources=list(doc.files), declared_at=Src(doc.file, 1, 1), origin="nodl")
         for e in doc.endpoints:
@@ -67,22 +73,26 @@ def nodl_graph(documents: Mapping[str, Document], names: Mapping[str, str]) -> G
 
 
 def diff_nodl(documents: Mapping[str, Document], running: Graph, source: str, conflicts: list[Any],
-              disc: Announced | None) -> DiffResult:
+              disc: Announced | None, namespaces: Mapping[str, Sequence[str]] | None = None) -> DiffResult:
     """The documents (by node) as the expected graph against ``running`` (:func:`rclverify.ros.live.diff_dds.graph_of`
     of ``disc``, read through either source), with ``conflicts`` (:func:`rclverify.ros.live.diff_dds.qos_conflicts`)
     and, with ``disc``, each document's topic QoS against what its running endpoint announces
-    (module docstring).  Pure: raises nothing."""
-    names = match_nodes(list(documents), running.nodes, {})
-    static = nodl_graph(documents, names)
+    (module docstring), each document in each of the ``namespaces`` given for it (by node).  Pure:
+    raises nothing."""
+    instances = match_instances(documents, running.nodes, namespaces)
+    static = nodl_graph(documents, instances)
     res = diff_dds(static, running, source, conflicts, None, NODL)
     res.not_compared = [n for n in res.not_compared if not n.startswith("the QoS the code asks for")]
     if disc is None:
         res.not_compared.append("the QoS the documents write (no discovery of the running endpoints' QoS)")
         return res
     qos_of = live_qos_of(disc)
-    for node, full in sorted(names.items()):
+    for inst in instances:
+        if inst.running is None:
+            continue
+        full = inst.running
         gn = static.nodes[full]
-        for e in documents[node].endpoints:
+        for e in documents[inst.node].endpoints:
             if e.kind not in ("publishers", "subscriptions"):
                 continue
             edge = next(x for x in gn.edges_of(_KIND[e.kind]) if x.written == e.name)

@@ -4,10 +4,12 @@
 The scan (:mod:`rclverify.ros.graph.scan`) gives each node of the code its
 publishers, subscriptions, service and action servers and clients, each
 fully resolved (its namespace, remappings) with its type where the code
-says it, and where the code creates it.  A document is matched to a scanned
-node as a contract is (:func:`rclverify.ros.ground.ground.match_nodes`: by
-name, ignoring case, ``_``, ``-``), and its names are resolved in that
-node's namespace (``x`` is ``<namespace>/x``, ``~/x`` is ``<node>/x``).
+says it, and where the code creates it.  A document is matched to a node
+by its fully qualified name, in each namespace given for it, else by its
+base name where that is unambiguous (:mod:`rclverify.model.nodl.match`;
+names compared ignoring case, ``_``, ``-``), and its names are resolved for
+that node as rcl resolves them (:func:`resolve`: ``x`` is ``<namespace>/x``,
+``~/x`` is ``<node>/x``, ``{node}`` and ``{ns}`` substituted).
 Findings, each located at both the code and the document:
 
 * ``nodl-code-undeclared`` (error): the code creates an endpoint the document lacks;
@@ -32,19 +34,20 @@ lifecycle interface) are not its own: undeclared, they are no finding.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable, Mapping, NamedTuple, Protocol
+from typing import Callable, Mapping, NamedTuple, Protocol, Sequence
 
 from rclverify.lang import ast
 from rclverify.model.nodl.contract import type_key
 from rclverify.model.nodl.document import Document, Endpoint, QoS
+from rclverify.model import names
 from rclverify.model.nodl.findings import Finding
+from rclverify.model.nodl.match import match_instances
 from rclverify.model.nodl.qos import DURATIONS, mismatches
 from rclverify.ros.extract import code_qos
 from rclverify.ros.extract.model import GraphEdge, GraphNode, Src
 from rclverify.ros.live.dds import ros_name
 from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.live.dds_qos import INFINITE_NS
-from rclverify.ros.ground.ground import match_nodes
 from rclverify.ros.ground.lifecycle import MANAGEMENT
 
 #: A scanned node's list of each NoDL endpoint list.
@@ -54,7 +57,14 @@ GRAPH_LISTS = {"publishers": "publishes", "subscriptions": "subscribes", "servic
 
 
 def resolve(name: str, node: str, namespace: str) -> str:
-    """A document's ``name`` fully qualified for node ``node`` (its full name) in ``namespace``."""
+    """A document's ``name`` fully qualified for node ``node`` (its full name) in ``namespace``, as rcl
+    expands it (:func:`rclverify.model.names.expand`: ``~``, ``{node}``, ``{ns}``, relative names); a
+    name rcl refuses, or a scanned node whose name is none (``/talker@pkg.exe``), by the plain rule
+    (``~/x`` below the node, ``/x`` as written, ``x`` below the namespace)."""
+    try:
+        return names.expand(name, names.split_fqn(node)[1], namespace)
+    except names.BadName:
+        pass
     if name == "~":
         return node
     if name.startswith("~/"):
@@ -227,22 +237,29 @@ def compare_code(doc: Document, gn: GraphNode, base: Path | None = None, side: s
 
 
 def check_code(documents: Mapping[str, Document], nodes: Mapping[str, GraphNode], base: Path | None = None,
-               side: str = "code", qos_of: QosOf | None = None) -> tuple[dict[str, str], list[Finding]]:
-    """Each document of ``documents`` (by node) against the node it matches among ``nodes`` (a
-    graph's nodes by full name; :func:`compare_code` for ``base``, ``side``, ``qos_of``); returns
-    ``({document's node: graph node}, findings)``.  A document matching no node is not compared, and
-    says so (``nodl-code-unmatched``, a warning; ``nodl-live-unmatched``, an error: a node not running,
-    or not yet discovered, is never checked green)."""
-    matched = match_nodes(list(documents), nodes, {})
+               side: str = "code", qos_of: QosOf | None = None,
+               namespaces: Mapping[str, Sequence[str]] | None = None) -> tuple[dict[str, str], list[Finding]]:
+    """Each document of ``documents`` (by node), in each namespace ``namespaces`` gives it, against
+    the node it matches among ``nodes`` (a graph's nodes by fully qualified name;
+    :func:`rclverify.model.nodl.match.match_instances`: by fully qualified name, by base name only
+    when unambiguous; :func:`compare_code` for ``base``, ``side``, ``qos_of``); returns
+    ``({instance: graph node}, findings)``, an instance named by its document's node, ``in NS``
+    when a namespace was given.  An instance matching no node is not compared, and says so, with
+    why (``nodl-code-unmatched``, a warning; ``nodl-live-unmatched``, an error: a node not
+    running, or not yet discovered, is never checked green)."""
     code = SIDES[side][1]
+    matched: dict[str, str] = {}
     out: list[Finding] = []
-    for name, full in sorted(matched.items()):
-        out += compare_code(documents[name], nodes[full], base, side, qos_of)
-    for name in sorted(set(documents) - set(matched)):
-        doc = documents[name]
+    for inst in match_instances(documents, nodes, namespaces):
+        doc = documents[inst.node]
+        if inst.running is not None:
+            matched[inst.label] = inst.running
+            out += compare_code(doc, nodes[inst.running], base, side, qos_of)
+            continue
         where = "the scanned code" if side == "code" else "the running graph (not running, or not yet discovered)"
-        out.append(Finding(f"{code}-unmatched", f"node {name}'s NoDL document matches no node of {where}: nothing "
-                                                f"of it was compared", (ast.Loc(doc.file, 1, 1),),
+        inside = "" if inst.namespace is None else f" in {inst.namespace}"
+        out.append(Finding(f"{code}-unmatched", f"node {inst.node}'s NoDL document{inside} matches no node of {where}: "
+                                                f"{inst.why}; nothing of it was compared", (ast.Loc(doc.file, 1, 1),),
                            "warning" if side == "code" else "error"))
     return matched, out
 
