@@ -43,7 +43,8 @@ def add_parsers(sub: Any) -> None:
     c.add_argument("--external", action="append", default=[], metavar="NAME",
                    help="DIR|FILE: a topic, service or action served from outside the set (repeatable)")
     c.add_argument("--namespace", action="append", default=[], metavar="NODE=NS",
-                   help="DIR|FILE: the namespace node NODE runs in (repeatable; default /)")
+                   help="DIR|FILE: the namespace node NODE runs in (repeatable; default /); with --ros/--ros2: "
+                        "each namespace one instance of NODE's document is matched in (docs/nodl.md)")
     c.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0 (rule RCL-NODL)")
     c.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
     c.add_argument("--nodl", metavar="DIR", help="folder of the documents (default: nodl/ in the workspace)")
@@ -84,19 +85,25 @@ def cmd_check(args: argparse.Namespace) -> int:
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     if args.paths:
         return _check_set(args)
-    if args.external or args.namespace:
+    if args.external or (args.namespace and not (args.ros or args.ros2)):
         print("nodl check: error: --external and --namespace apply to a set of documents named without -w "
-              "(nodl check DIR|FILE...)", file=sys.stderr)
+              "(nodl check DIR|FILE...); --namespace also to a workspace's documents with --ros or --ros2", file=sys.stderr)
         return 2
     ws = Path(args.workspace or ".")
     checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
     folder = Path(args.nodl) if args.nodl else None
     res = check(checked, ws, folder, [Path(p) for p in args.ament_prefix])
+    from rclverify.model.nodl.match import parse_namespaces  # deferred: start-up (as above)
+    try:
+        args.namespaces = parse_namespaces(args.namespace, res.documents)
+    except ValueError as exc:
+        print(f"nodl check: error: {exc}", file=sys.stderr)
+        return 2
     if args.ros:
         from rclverify.ros.graph.scan import scan  # deferred: start-up (loads the ROS scan only when called)
         from rclverify.ros.ground.nodl_code import check_code  # deferred: start-up (loads the ROS scan only when called)
         graph = scan([Path(p) for p in args.ros], [Path(p) for p in args.launch]).graph
-        matched, found = check_code(res.documents, graph.nodes)
+        matched, found = check_code(res.documents, graph.nodes, namespaces=args.namespaces)
         res.findings += found
         print(f"{len(matched)} document(s) matched to a node of the scanned code"
               + "".join(f"; {n} -> {g}" for n, g in sorted(matched.items())))
@@ -216,11 +223,13 @@ def _live(args: argparse.Namespace, res: Any) -> bool:
             rdisc = read_rclpy_graph(py, args.wait)
             source = f"rclpy on {rdisc.rmw}"
             running = graph_of(rdisc, source)  # type: ignore[arg-type]  # the same shape as Discovery
-            matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(rdisc))
+            matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(rdisc),
+                                        namespaces=args.namespaces)
         else:
             running, disc, source, dp = read_dds_graph(args.wait)
             try:
-                matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(disc))
+                matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(disc),
+                                            namespaces=args.namespaces)
             finally:
                 disc.close()
                 dp.__del__()

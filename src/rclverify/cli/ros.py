@@ -67,6 +67,8 @@ def add_parsers(sub: Any) -> None:
                    "(*.nodl.yaml|yml|json, QoS included; docs/nodl.md) instead of the code's")
     d.add_argument("--ament-prefix", action="append", default=[], metavar="DIR",
                    help="--nodl: an install prefix whose ament index resolves nodl:// includes (repeatable)")
+    d.add_argument("--namespace", action="append", default=[], metavar="NODE=NS",
+                   help="--nodl: a namespace one instance of node NODE's document runs in (repeatable; docs/nodl.md)")
     d.set_defaults(fn=cmd_diff)
     c = rs.add_parser("check", help="check the plan's contracts against the graph of its ros: section")
     c.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
@@ -221,6 +223,12 @@ def _diff_nodl(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 2
     docs = nodes_of(read_all(files, Resolver([Path(p) for p in args.ament_prefix], shown(Path(".")))))  # raises RclError, printed located by main
+    from rclverify.model.nodl.match import parse_namespaces  # deferred: start-up (as above)
+    try:
+        args.namespaces = parse_namespaces(args.namespace, docs)
+    except ValueError as exc:
+        print(f"ros diff: error: {exc}", file=sys.stderr)
+        return 2
     if not args.ros2:
         print("error: ros diff --nodl compares with the running ROS 2 system: give --ros2", file=sys.stderr)
         return 2
@@ -273,7 +281,8 @@ def _diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> 
             return None
         source = f"rclpy on {rdisc.rmw}"
         if documents is not None:
-            return diff_nodl(documents, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc)  # type: ignore[arg-type]
+            return diff_nodl(documents, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc,  # type: ignore[arg-type]
+                             args.namespaces)
         return diff_dds(static, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc)  # type: ignore[arg-type]
     try:
         running, disc, source, dp = read_dds_graph(max(0.0, args.wait))
@@ -284,7 +293,7 @@ def _diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> 
         for n in running.notes:
             print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
         if documents is not None:
-            return diff_nodl(documents, running, source, qos_conflicts(disc), disc)
+            return diff_nodl(documents, running, source, qos_conflicts(disc), disc, args.namespaces)
         return diff_dds(static, running, source, qos_conflicts(disc), disc)
     finally:
         disc.close()
