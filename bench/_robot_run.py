@@ -1,7 +1,8 @@
 """The runner of bench/robot_generator.py: one generated robot run live and judged three ways.
 
-For one seed: the workspace is written, ``rclverify monitor --live --ros2 --source dds`` starts with
-``--log`` and ``--record`` (a ROS 2 bag), then the robot (one process of rclpy nodes, ROS 2's
+For one seed: the workspace is written, ``rclverify monitor --live --ros2 --source dds`` (or
+``--source rclpy --ros2-python`` the robot's Python) starts with ``--log`` and ``--record`` (a ROS 2
+bag, MCAP), then the robot (one process of rclpy nodes, ROS 2's
 Python); after its sensing it says ``done`` and both are stopped.  The log and the bag are then
 checked offline (``rclverify monitor --json``), and per node the verdicts are counted three ways:
 live (the log's ``rclverify/verdict`` lines), offline on the log, offline on the bag:
@@ -40,9 +41,7 @@ from robot_generator import SENSORS, generate, write_workspace  # noqa: E402
 
 KINDS = ("satisfied", "violated", "undecided", "deadline true", "deadline false")
 UNDECIDED = ("inconclusive", "incomplete input", "open")
-#: the offline bag check's error on a bag whose sensor_msgs/Range messages have Kilted's layout (with
-#: ``variance``): the recorder writes the bag under the older definition's type, so it cannot be read back
-RANGE_UNREAD = "cannot decode sensor_msgs/msg/Range"
+SOURCES = ("dds", "rclpy")
 
 
 def ros2_python() -> tuple[Path | None, str]:
@@ -133,6 +132,11 @@ class RobotFailed(Exception):
     """The generated robot's process exited or hung before it said ``done`` (a fault of the generator)."""
 
 
+def _source_args(source: str, ros2: Path) -> list[str]:
+    """The monitor's ``--source`` arguments: the rclpy source runs in the robot's ROS 2 Python."""
+    return ["--source", "dds"] if source == "dds" else ["--source", "rclpy", "--ros2-python", str(ros2)]
+
+
 def _domain() -> tuple[int, int]:
     """A ``ROS_DOMAIN_ID`` (1..230) no other process of this machine holds, by the test suite's lock files
     (tests/dds_ros2.py): the domain and the open lock file, which the caller closes when its run is over."""
@@ -149,10 +153,13 @@ def _domain() -> tuple[int, int]:
 
 
 def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2: Path,
-            kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src") -> dict[str, Any]:
-    """Run generated robot ``seed`` live and offline under ``tmp`` with rclverify's sources ``src``;
-    returns the counts and findings."""
-    spec = generate(seed, nodes, defect, kinds)
+            kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src", source: str = "dds",
+            sim_clock: bool = False) -> dict[str, Any]:
+    """Run generated robot ``seed`` live and offline under ``tmp`` with rclverify's sources ``src``,
+    the monitor hearing the robot through ``source`` (:data:`SOURCES`), the robot on a ``/clock`` of its
+    own with ``sim_clock``; returns the counts and findings (``other_clocks``: the live record's writers
+    placed at their source times)."""
+    spec = generate(seed, nodes, defect, kinds, sim_clock)
     ws = write_workspace(spec, tmp / "ws")
     (ws / "runs").mkdir(exist_ok=True)
     (tmp / "cyclonedds.xml").write_text(CONFIG)
@@ -166,7 +173,7 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     try:
         mon = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2",
                                 "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--status", "0",
-                                "--silence", "0", "--source", "dds", "--interfaces", "interfaces", "--log", "runs/live.jsonl",
+                                "--silence", "0", *_source_args(source, ros2), "--interfaces", "interfaces", "--log", "runs/live.jsonl",
                                 "--evidence", str(tmp / "evidence.json"), "--record", "runs/bag", "--record-storage", "mcap"],
                                cwd=ws, env=menv, stdout=(tmp / "monitor.out").open("wb"), stderr=subprocess.STDOUT,
                                start_new_session=True)
@@ -189,14 +196,17 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
         for p in procs:
             stop(p)
         os.close(lock)
-    res: dict[str, Any] = {"seed": seed, "nodes": nodes, "defect": defect, "spec": spec, "errors": []}
+    res: dict[str, Any] = {"seed": seed, "nodes": nodes, "defect": defect, "spec": spec, "errors": [],
+                           "source": source, "clock": spec.get("clock")}
+    try:
+        res["other_clocks"] = json.loads((tmp / "evidence.json").read_text()).get("other_clocks", [])
+    except (OSError, ValueError):
+        res["other_clocks"] = []
     WHY.clear()
     res["live"] = live_counts(ws / "runs" / "live.jsonl")
     res["undecided_why"] = {k: sorted(set(v)) for k, v in WHY.items()}
     for name, (rows, err) in zip(("log", "bag"), _offline(ws, ["runs/live.jsonl", "runs/bag"], menv)):
-        if name == "bag" and RANGE_UNREAD in err:
-            res["bag_unread"] = err.strip().splitlines()[-1]  # a known fault of the recorder (docs/monitors.md)
-        elif err:
+        if err:
             res["errors"].append(f"offline {name}: {err}")
         res[name] = offline_counts(rows)
     res["findings"] = findings(res)
@@ -250,7 +260,7 @@ def findings(res: dict[str, Any]) -> list[str]:
     victim = next((n["name"] for n in res["spec"]["nodes"] if n.get("defect")), None)
     for node in names:
         live = res["live"].get(node, Counter())
-        for other in ("log",) if res.get("bag_unread") else ("log", "bag"):
+        for other in ("log", "bag"):
             off = res[other].get(node, Counter())
             diff = {k: (live.get(k, 0), off.get(k, 0)) for k in KINDS if live.get(k, 0) != off.get(k, 0)}
             if diff:
@@ -273,20 +283,25 @@ def _line(res: dict[str, Any]) -> str:
     tot = Counter[str]()
     for c in res["live"].values():
         tot.update(c)
-    return (f"seed {res['seed']}{' defect' if res['defect'] else ''}: {res['nodes']} nodes: live satisfied "
+    clock = res.get("clock")
+    return (f"seed {res['seed']}{' defect' if res['defect'] else ''}: {res['nodes']} nodes, source "
+            f"{res.get('source', 'dds')}, " + (f"/clock x{clock['rate']:g} from {clock['start_s']:g} s" if clock
+                                               else "wall clock") + ": live satisfied "
             f"{tot['satisfied']}, violated {tot['violated']}, undecided {tot['undecided']}, deadlines true "
             f"{tot['deadline true']} false {tot['deadline false']}; "
             f"{'agree' if not res['findings'] else 'FINDINGS: ' + '; '.join(res['findings'])}"
             + ("; " + "; ".join(res["errors"]) if res["errors"] else "")
-            + (f"; bag not read back: {res['bag_unread']}" if res.get("bag_unread") else "")
+            + "".join(f"\n  other clock: {c}" for c in res.get("other_clocks", []))
             + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items())
             + "".join(f"\n  violated: {e}" for e in res.get("explained", [])))
 
 
 def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: bool, burn: bool,
-             keep: Path | None, kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src") -> int:
-    """Run every seed (a node count drawn per seed in ``sizes``); print one line per seed and the totals.
-    Returns 0 (the figures are the output; a finding is printed, not raised)."""
+             keep: Path | None, kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src",
+             source: str = "dds", sim_clock: bool = False) -> int:
+    """Run every seed (a node count drawn per seed in ``sizes``) through ``source``, on a ``/clock`` with
+    ``sim_clock``; print one line per seed and the totals.  Returns 0 (the figures are the output; a
+    finding is printed, not raised)."""
     ros2, why = ros2_python()
     if ros2 is None:
         print(f"robot generator: skipped: {why}")
@@ -296,13 +311,13 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
         burner = subprocess.Popen([sys.executable, "-c", "while True: pass"], start_new_session=True)
     total = Counter[str]()
     failing: list[int] = []
-    unread = 0
+    agree = 0
     try:
         for seed in seeds:
             n = random.Random(seed).randint(*sizes)
             with tempfile.TemporaryDirectory() as d:
                 try:
-                    res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src)
+                    res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src, source, sim_clock)
                 except RobotFailed as exc:
                     print(f"seed {seed}: GENERATOR FAULT: {exc}", flush=True)
                     failing.append(seed)
@@ -314,7 +329,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
                 total.update(c)
             if res["findings"] or res["errors"]:
                 failing.append(seed)
-            unread += bool(res.get("bag_unread"))
+            agree += not any(" != " in f for f in res["findings"]) and not res["errors"]
     finally:
         if burner is not None:
             stop(burner, signal.SIGKILL)
@@ -322,5 +337,5 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           f"{'one CPU burner beside, ' if burn else ''}load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} "
           f"core(s): live satisfied {total['satisfied']}, violated {total['violated']}, undecided "
           f"{total['undecided']}, deadlines true {total['deadline true']} false {total['deadline false']}; "
-          f"seeds with findings: {failing or 'none'}; bags not read back (sensor_msgs/Range): {unread}")
+          f"seeds with findings: {failing or 'none'}; live = log = bag on {agree} of {len(seeds)}")
     return 0

@@ -33,9 +33,14 @@ answering every third call wrongly, a sensor publishing just beyond its band; th
 constants), ``contracts/plan.yaml``, ``mapping.yaml``, ``interfaces/`` (SetBool) and ``robot.py``
 (every node in one rclpy process, run in ROS 2's Python).
 
+``sim_clock=True`` (``--clock``) adds a clock node publishing ``rosgraph_msgs/Clock`` on ``/clock``
+every 20 ms at a real-time factor drawn from 0.5-2, from a simulated start of 0, 100 or 5000 s, and
+runs every other node with ``use_sim_time`` (their header stamps come from ``/clock``).
+
 CLI (from the repository root)::
 
     python3 bench/robot_generator.py --seeds 0-49 --nodes 5-8 --seconds 10 --burn
+    python3 bench/robot_generator.py --seeds 0-9 --source rclpy --clock
     python3 bench/robot_generator.py --seeds 3 --defect
     python3 bench/robot_generator.py --write DIR --seeds 7     # the workspace alone
 
@@ -72,6 +77,10 @@ SETBOOL = "bool data\n---\nbool success\nstring message\n"
 RANGE = ("std_msgs/Header header\nuint8 ULTRASOUND=0\nuint8 INFRARED=1\nuint8 radiation_type\n"
          "float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range\nfloat32 variance\n")
 HORIZON = 1.0
+#: the real-time factors a ``/clock`` robot draws from: simulated seconds per wall-clock second
+CLOCK_RATES = (0.5, 0.75, 1.0, 1.5, 2.0)
+#: how often the clock node publishes ``rosgraph_msgs/Clock`` (wall-clock ms)
+CLOCK_STEP_MS = 20
 
 
 def f32(v: float) -> float:
@@ -145,11 +154,13 @@ def _sensor(rng: random.Random, i: int, kinds: tuple[str, ...], kind: str | None
 
 
 def generate(seed: int, nodes: int = 5, defect: bool = False,
-             kinds: tuple[str, ...] = tuple(SENSORS)) -> dict[str, Any]:
-    """The spec of generated robot ``seed``: ``{"seed", "defect", "nodes": [node spec, ...]}``, ``nodes``
-    contract nodes (at least 2: a sensor and one consumer); with ``defect``, exactly one node's spec
-    holds ``"defect": True``; ``kinds``: the sensor kinds drawn from (keys of :data:`SENSORS`).
-    Deterministic in (seed, nodes, defect, kinds)."""
+             kinds: tuple[str, ...] = tuple(SENSORS), sim_clock: bool = False) -> dict[str, Any]:
+    """The spec of generated robot ``seed``: ``{"seed", "defect", "clock", "nodes": [node spec, ...]}``,
+    ``nodes`` contract nodes (at least 2: a sensor and one consumer); with ``defect``, exactly one node's
+    spec holds ``"defect": True``; ``kinds``: the sensor kinds drawn from (keys of :data:`SENSORS`);
+    ``sim_clock``: ``"clock"`` is ``{"rate", "start_s"}`` (a ``/clock`` node, :data:`CLOCK_RATES`),
+    else ``None``.  The nodes drawn do not depend on ``sim_clock``.  Deterministic in (seed, nodes,
+    defect, kinds, sim_clock)."""
     rng = random.Random(f"robot-{seed}-{nodes}" + ("" if kinds == tuple(SENSORS) else "-" + ",".join(kinds)))
     out: list[dict[str, Any]] = []
     sensors: list[dict[str, Any]] = []
@@ -220,7 +231,11 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
             n["in_topic"] = by_name[n["source"]]["topic"]
         if n["kind"] == "fuse":
             n["a_topic"], n["b_topic"] = by_name[n["a_source"]]["topic"], by_name[n["b_source"]]["topic"]
-    spec = {"seed": seed, "defect": defect, "nodes": out}
+    clock = None
+    if sim_clock:
+        crng = random.Random(f"clock-{seed}-{nodes}")
+        clock = {"rate": crng.choice(CLOCK_RATES), "start_s": float(crng.choice([0, 100, 5000]))}
+    spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out}
     if defect:
         candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None]
         # a node whose defect shows on the values the run carries: an alarm or fuse is wrong only at its threshold
@@ -345,7 +360,7 @@ def render(spec: dict[str, Any]) -> dict[str, str]:
             fields.append((n["rcl_topic"], "range"))
         else:
             fields.append((n["rcl_topic"], "data"))
-    robot_spec = {"nodes": spec["nodes"]}
+    robot_spec = {"nodes": spec["nodes"], "clock": spec.get("clock"), "clock_step_ms": CLOCK_STEP_MS}
     return {
         "contracts/robot.rcl": env.get_template("contracts.rcl.j2").render(
             seed=spec["seed"], defect=spec["defect"], constants=consts, nodes=contracts),
@@ -397,6 +412,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--defect", action="store_true", help="seed one defect per system; check it is red at its node")
     p.add_argument("--without", action="append", default=[], choices=list(SENSORS),
                    help="leave this sensor kind out (repeatable)")
+    p.add_argument("--source", choices=("dds", "rclpy"), default="dds",
+                   help="how the monitor hears the robot (rclverify monitor --source; default dds)")
+    p.add_argument("--clock", action="store_true",
+                   help="a /clock node at a real-time factor of 0.5-2 (drawn per seed), every node on use_sim_time")
     p.add_argument("--burn", action="store_true", help="one CPU-burning process beside each run (both cores busy)")
     p.add_argument("--write", metavar="DIR", help="write the workspaces under DIR/seed-N and stop (no live run)")
     p.add_argument("--keep", metavar="DIR", help="keep each run's workspace, log and bag under DIR/seed-N")
@@ -412,13 +431,13 @@ def main(argv: list[str] | None = None) -> int:
     if a.write:
         for seed in seeds:
             n = random.Random(seed).randint(*sizes)
-            ws = write_workspace(generate(seed, n, a.defect, kinds), Path(a.write) / f"seed-{seed}")
+            ws = write_workspace(generate(seed, n, a.defect, kinds, a.clock), Path(a.write) / f"seed-{seed}")
             print(f"seed {seed}: {n} nodes: {ws}")
         return 0
     sys.path.insert(0, str(ROOT / "bench"))
     from _robot_run import run_many
     return run_many(seeds, sizes, a.seconds, a.defect, a.burn, Path(a.keep) if a.keep else None, kinds,
-                    Path(a.src).resolve() if a.src else ROOT / "src")
+                    Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock)
 
 
 def _smoke() -> int:
