@@ -118,15 +118,33 @@ def test_the_command_without_a_report_is_one_located_line(tmp_path: Path, capsys
 
 
 def test_the_command_writes_the_exports_of_the_last_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A report as a run writes it (the stored case study's), read by the command: gaps printed, files written."""
-    report = _stored_report(tmp_path)
+    """A report a run wrote, read by the command: gaps printed, files written; the stored case study's
+    report, whose files the workspace does not hold, is refused as not what the workspace gives."""
+    report = _verified(tmp_path)
     capsys.readouterr()
     assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv"),
                  "--trace", str(tmp_path / "t.csv")]) == 0
     out = capsys.readouterr().out
     assert out.startswith("IEC 61508-3:2010 SIL 2 (built-in profile): ") and "\n  B.8 6c [HR] " in out
     assert len(_read_csv(tmp_path / "m.csv")) == sum(len(s["clauses"]) for s in report["standards"])
-    assert {r["requirement"] for r in _read_csv(tmp_path / "t.csv")} >= {q["id"] for q in report["requirements"]}
+    assert {r["requirement"] for r in _read_csv(tmp_path / "t.csv")} >= {"R1"}
+    _stored_report(tmp_path)
+    assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "n.csv")]) == 1
+    assert "run `rclverify verify` and export again" in capsys.readouterr().err and not (tmp_path / "n.csv").exists()
+
+
+def _verified(root: Path) -> dict[str, Any]:
+    """A one-node workspace with IEC 61508-3 SIL 2 mapped and a requirement, verified; its report."""
+    (root / "contracts").mkdir()
+    (root / "contracts/plan.yaml").write_text(
+        "name: s\ncontracts: [contracts/robot.rcl]\nstandards:\n  - {profile: iec61508-3, sil: 2}\n"
+        "requirements:\n  - {id: R1, text: y is never negative, supported_by: [{node: Base, guarantees: [1]}]}\n",
+        encoding="utf-8")
+    (root / "contracts/robot.rcl").write_text(
+        "node Base {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n  guarantee( out.y >= 0 )\n}\n", encoding="utf-8")
+    assert main(["verify", "-w", str(root)]) == 0
+    report: dict[str, Any] = json.loads((root / "reports/assurance.json").read_text(encoding="utf-8"))
+    return report
 
 
 def _stored_report(root: Path) -> dict[str, Any]:
@@ -143,7 +161,7 @@ def _stored_report(root: Path) -> dict[str, Any]:
 def test_without_openpyxl_the_workbook_is_one_line_naming_the_extra(tmp_path: Path) -> None:
     """In an interpreter that cannot import openpyxl: one line, exit 1, no workbook; the CSV still works."""
     from _blocked import cli_without
-    report = _stored_report(tmp_path)
+    report = _verified(tmp_path)
     r = cli_without("openpyxl", "standards", "-w", str(tmp_path), "--xlsx", str(tmp_path / "w.xlsx"))
     assert r.returncode == 1 and "Traceback" not in r.stderr and not (tmp_path / "w.xlsx").exists()
     assert r.stderr.strip().splitlines() == [

@@ -11,6 +11,7 @@ import gzip
 import hashlib
 import json
 import os
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,8 @@ from rclverify.model.plan.errors import PlanError
 from rclverify.model.plan.standards.choice import ClauseNote, StandardChoice
 from rclverify.model.plan.standards.mapping import clause_rows
 from rclverify.model.plan.standards.profiles import load_builtin, load_profile_file
-from rclverify.report.standards_export import FORMULA_START, escape_cell, matrix_rows, trace_rows, write_csv
+from rclverify.report.standards_export import (FORMULA_START, escape_cell, evidence_digests, export_header,
+                                               matrix_rows, trace_rows, write_csv, write_xlsx)
 from rclverify.report.standards_rows import standards_part
 from rclverify.report.standards_sheets import MATRIX_COLUMNS, TRACE_COLUMNS
 
@@ -181,9 +183,22 @@ def _workspace(root: Path) -> dict[str, Any]:
         (root / rel).write_text(text, encoding="utf-8")
     (root / "reports").mkdir(exist_ok=True)
     (root / "reports/assurance.json").write_text(json.dumps(report), encoding="utf-8")
-    later = (root / "reports/assurance.json").stat().st_mtime + 5
-    os.utime(root / "reports/assurance.json", (later, later))
     return report
+
+
+def _export(root: Path, report: dict[str, Any], csv_: Path | None = None, trace: Path | None = None,
+            xlsx: Path | None = None) -> None:
+    """What ``rclverify standards`` writes for ``report`` (cli/standards.py), without its freshness check,
+    which a hand-made report cannot pass (tested below on a verified workspace)."""
+    header = export_header(root, report)
+    matrix = matrix_rows(report, evidence_digests(root, report))
+    if csv_:
+        write_csv(csv_, matrix, header)
+    if trace:
+        write_csv(trace, trace_rows(report), header)
+    if xlsx:
+        write_xlsx(xlsx, {"about this export": [["what", "value"], *header], "compliance matrix": matrix,
+                          "trace matrix": trace_rows(report)})
 
 
 def _blocks(path: Path) -> tuple[list[list[str]], list[list[str]]]:
@@ -195,9 +210,7 @@ def _blocks(path: Path) -> tuple[list[list[str]], list[list[str]]]:
 
 def test_the_export_carries_a_header_the_figures_and_an_extended_trace(tmp_path: Path,
                                                                       capsys: pytest.CaptureFixture[str]) -> None:
-    _workspace(tmp_path)
-    assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv"),
-                 "--trace", str(tmp_path / "t.csv")]) == 0
+    _export(tmp_path, _workspace(tmp_path), csv_=tmp_path / "m.csv", trace=tmp_path / "t.csv")
     header, table = _blocks(tmp_path / "m.csv")
     said = dict((r[0], r[1]) for r in header if r[0] != "contract")
     assert said["report sha256"] == hashlib.sha256((tmp_path / "reports/assurance.json").read_bytes()).hexdigest()
@@ -232,8 +245,7 @@ def test_the_export_carries_a_header_the_figures_and_an_extended_trace(tmp_path:
 
 def test_the_workbook_has_the_header_sheet_and_text_cells(tmp_path: Path) -> None:
     openpyxl = pytest.importorskip("openpyxl")
-    _workspace(tmp_path)
-    assert main(["standards", "-w", str(tmp_path), "--xlsx", str(tmp_path / "w.xlsx")]) == 0
+    _export(tmp_path, _workspace(tmp_path), xlsx=tmp_path / "w.xlsx")
     wb = openpyxl.load_workbook(tmp_path / "w.xlsx")
     assert wb.sheetnames == ["about this export", "compliance matrix", "trace matrix"]
     about = {r[0].value: r[1].value for r in wb["about this export"].iter_rows(min_row=2)}
@@ -243,25 +255,66 @@ def test_the_workbook_has_the_header_sheet_and_text_cells(tmp_path: Path) -> Non
     assert all(c.data_type == "s" for row in wb["compliance matrix"].iter_rows() for c in row if c.value is not None)
 
 
-@pytest.mark.parametrize("newer", ["contracts/plan.yaml", "contracts/robot.rcl", "artifacts/evidence/x.json"])
-def test_a_report_older_than_its_inputs_or_the_last_verify_is_not_exported(tmp_path: Path, newer: str,
-                                                                           capsys: pytest.CaptureFixture[str]) -> None:
-    """A verify that failed at the plan left the previous report: the command refuses it in one line."""
-    _workspace(tmp_path)
-    (tmp_path / newer).write_text("changed\n", encoding="utf-8")
-    later = (tmp_path / "reports/assurance.json").stat().st_mtime + 10
-    os.utime(tmp_path / newer, (later, later))
+#: A workspace ``verify`` builds in seconds: one node, IEC 61508-3 at SIL 2 mapped.
+_PLAN = "name: s\ncontracts: [contracts/robot.rcl]\nstandards:\n  - {profile: iec61508-3, sil: 2}\n"
+_RCL = "node Base {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n  guarantee( out.y >= 0 )\n}\n"
+
+
+@pytest.fixture(scope="module")
+def verified(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    ws = tmp_path_factory.mktemp("standards_fresh") / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/plan.yaml").write_text(_PLAN, encoding="utf-8")
+    (ws / "contracts/robot.rcl").write_text(_RCL, encoding="utf-8")
+    assert main(["verify", "-w", str(ws)]) == 0
+    return ws
+
+
+def _refused(ws: Path, capsys: pytest.CaptureFixture[str]) -> str:
     capsys.readouterr()
-    assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv")]) == 1
+    assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "reports/assurance.json:1:1: error: the report is older than" in err[0]
-    assert "run `rclverify verify` and export again" in err[0] and not (tmp_path / "m.csv").exists()
+    assert len(err) == 1 and err[0].startswith(f"{ws / 'reports/assurance.json'}:1:1: error: ")
+    assert err[0].endswith("run `rclverify verify` and export again") and not (ws / "m.csv").exists()
+    return err[0]
 
 
-def test_control_a_report_newer_than_its_inputs_is_exported(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    _workspace(tmp_path)
-    assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv")]) == 0
-    assert (tmp_path / "m.csv").exists()
+def test_a_file_edited_and_given_back_an_older_time_is_caught_by_its_sha256(
+        verified: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The report records its inputs' sha256 (meta.inputs_sha256): a file restored with an older
+    modification time than the report's still differs in content."""
+    ws = Path(shutil.copytree(verified, tmp_path / "ws"))
+    rcl = ws / "contracts/robot.rcl"
+    older = (ws / "reports/assurance.json").stat().st_mtime - 100
+    rcl.write_text(_RCL.replace(">= 0", ">= 1"), encoding="utf-8")
+    os.utime(rcl, (older, older))
+    assert "built from other inputs than the workspace holds now" in _refused(ws, capsys)
+    # the control: the same bytes given back are the report's inputs again, whatever their time
+    rcl.write_text(_RCL, encoding="utf-8")
+    later = (ws / "reports/assurance.json").stat().st_mtime + 100
+    os.utime(rcl, (later, later))
+    assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 0 and (ws / "m.csv").exists()
+
+
+def test_a_plan_that_no_longer_loads_refuses_the_export(verified: Path, tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    """A verify that failed at the plan left the previous report: the command refuses it in one line."""
+    ws = Path(shutil.copytree(verified, tmp_path / "ws"))
+    (ws / "contracts/plan.yaml").write_text(_PLAN + "bogus_key: 1\n", encoding="utf-8")
+    assert "no longer build a report (contracts/plan.yaml:" in _refused(ws, capsys)
+
+
+def test_a_workspace_profile_file_changed_is_caught_and_the_report_as_verified_is_exported(
+        verified: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ws = Path(shutil.copytree(verified, tmp_path / "ws"))
+    assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 0  # the control
+    report = json.loads((ws / "reports/assurance.json").read_text(encoding="utf-8"))
+    report["standards"][0]["origin"] = {"kind": "workspace", "file": "std/mine.yaml", "sha256": "0" * 64}
+    (ws / "std").mkdir()
+    (ws / "std/mine.yaml").write_text("id: mine\n", encoding="utf-8")
+    (ws / "reports/assurance.json").write_text(json.dumps(report), encoding="utf-8")
+    (ws / "m.csv").unlink()
+    assert "built from another std/mine.yaml (sha256 000000000000..." in _refused(ws, capsys)
 
 
 def test_every_clause_of_the_stored_case_study_is_one_row_agreeing_with_the_json() -> None:

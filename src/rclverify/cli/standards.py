@@ -13,15 +13,19 @@ def cmd_standards(args: argparse.Namespace) -> int:
     ``reports/assurance.json``, and write the exports asked: ``--csv`` the compliance matrix, ``--trace``
     the trace matrix (CSV), ``--xlsx`` both as a workbook with a sheet saying what they were read from
     (each CSV starts with the same header rows).  Exit 0; 1 (one located line) when there is no report,
-    it is of another shape, it is older than the last ``verify`` or than its inputs
-    (:func:`~rclverify.report.standards_export.report_out_of_date`), or openpyxl is missing for
+    it is of another shape, it no longer says what the workspace's files and recorded evidence give
+    (:func:`~rclverify.report.standards_export.report_out_of_date`, by sha256), or openpyxl is missing for
     ``--xlsx``."""
     from rclverify.report.lastrun import located, read_report  # deferred: start-up (loads the report's readers only when called)
     from rclverify.report.standards_export import (REPORT, evidence_digests, export_header, gaps, matrix_rows,  # deferred: start-up (the exports, only when called)
                                                    report_out_of_date, trace_rows, write_csv, write_xlsx)
+    from rclverify.cli.common import workspace_of  # deferred: start-up
     root = Path(args.workspace)
     report = read_report(root)
-    why = report_out_of_date(root, report)
+    if args.xlsx:  # a missing extra is said before the report is built again for the freshness check
+        from rclverify.core.extras import require  # deferred: the optional extra is looked up only for an XLSX export
+        require("openpyxl", "an XLSX export of the compliance matrix")
+    why = report_out_of_date(workspace_of(args), report)
     if why:
         raise located(root / REPORT, why)
     lines = gaps(report)

@@ -5,8 +5,8 @@
 The tables are :mod:`rclverify.report.standards_sheets`' (the compliance matrix, the trace matrix, the
 header saying what they were read from).  Here:
 
-* :func:`report_out_of_date`: why the written report is older than the last ``verify`` or than its
-  inputs (``rclverify standards`` refuses to export it);
+* :func:`report_out_of_date`: why the written report no longer says what the workspace's files and
+  recorded evidence give, compared by sha256 (``rclverify standards`` refuses to export it);
 * :func:`export_header` and :func:`evidence_digests`: the header and each evidence record's sha256,
   read from the workspace's files;
 * :func:`write_csv` and :func:`write_xlsx`: the writers.  A CSV cell a spreadsheet would read as a
@@ -50,37 +50,49 @@ def _digest(path: Path) -> str:
         return "missing"
 
 
-def _inputs(root: Path, report: Mapping[str, Any]) -> list[str]:
-    """The workspace files the report was built from that can be named without rebuilding it: the plan,
-    its contract files, the workspace's own profile files and the review records."""
-    meta = report.get("meta") or {}
-    files = [str(meta.get("plan", "")), *(str(c) for c in meta.get("contracts") or ())]
-    files += [str((s.get("origin") or {}).get("file")) for s in report.get("standards") or ()
-              if (s.get("origin") or {}).get("kind") == "workspace"]
-    files += [str(e.get("tool_version")) for e in report.get("evidence") or () if e.get("backend") == "review"]
-    return [f for f in dict.fromkeys(files) if f and (root / f).is_file()]
-
-
-def report_out_of_date(root: Path, report: Mapping[str, Any]) -> str | None:
-    """Why ``reports/assurance.json`` of the workspace ``root`` is older than the last ``verify`` or than
-    its inputs, in one sentence, or ``None``: a file it was built from (:func:`_inputs`) or an evidence
-    record (``artifacts/evidence/*.json``, written by a ``verify`` that did not reach its report) was
-    modified after it."""
+def report_out_of_date(ws: Any, report: Mapping[str, Any]) -> str | None:
+    """Why ``reports/assurance.json`` of the workspace ``ws`` (a
+    :class:`~rclverify.stages.workspace.Workspace`) no longer says what the workspace's files give,
+    in one sentence, or ``None``.  Compared by content, never by modification time: each workspace
+    profile file's sha256 now with the one the report's ``standards[].origin`` records; then the
+    report built again in memory from the recorded artifacts (:func:`~rclverify.report.build.build_report`,
+    every evidence record's inputs hashed anew) with the written one: its ``meta.inputs_sha256`` (the
+    plan, contract and replacement files, the snapshots and model they give, each evidence record's
+    input hashes, the requirement checks) and each obligation's status.  So a file edited and then
+    given back an older modification time, and a ``verify`` that wrote evidence but stopped before its
+    report, are each caught, and a file only touched is not.  A plan or contract that no longer
+    builds a report is a reason too (the first of its errors)."""
+    from rclverify.lang.errors import RclError  # deferred: start-up (the rebuild only where an export is asked)
+    from rclverify.report.build import build_report  # deferred: start-up (loads the report's passes only when called)
+    for s in report.get("standards") or ():
+        origin = s.get("origin") or {}
+        if origin.get("kind") == "workspace":
+            was, now = str(origin.get("sha256")), _digest(ws.root / str(origin.get("file")))
+            if was != now:
+                return (f"the report was built from another {origin.get('file')} (sha256 {was[:12]}..., now "
+                        f"{now[:12]}...): {_AGAIN}")
+    was_inputs = (report.get("meta") or {}).get("inputs_sha256")
+    if not was_inputs:
+        return f"the report records no inputs sha256 (written by an earlier rclverify): {_AGAIN}"
     try:
-        written = (root / REPORT).stat().st_mtime_ns
-    except OSError:
-        return None
-    newer = [f for f in _inputs(root, report) if (root / f).stat().st_mtime_ns > written]
-    if newer:
-        return (f"the report is older than {', '.join(newer[:3])}{' ...' if len(newer) > 3 else ''} (modified "
-                "since it was written): run `rclverify verify` and export again")
-    records = sorted((root / "artifacts/evidence").glob("*.json")) if (root / "artifacts/evidence").is_dir() else []
-    late = [p.name for p in records if p.stat().st_mtime_ns > written]
-    if late:
-        return (f"the report is older than the last verify's evidence ({len(late)} record(s) written since, "
-                f"e.g. artifacts/evidence/{late[0]}): that verify did not write its report; run `rclverify "
-                "verify` and export again")
+        built = build_report(ws)
+    except RclError as e:
+        first = str(e.diagnostics[0]) if getattr(e, "diagnostics", None) else str(e)
+        return f"the workspace's files no longer build a report ({first.splitlines()[0]}): {_AGAIN}"
+    now_inputs = built["meta"]["inputs_sha256"]
+    if now_inputs != was_inputs:
+        return (f"the report was built from other inputs than the workspace holds now (inputs sha256 "
+                f"{str(was_inputs)[:12]}..., now {now_inputs[:12]}...): {_AGAIN}")
+    was = {str(o.get("id")): o.get("status") for o in report.get("obligations") or ()}
+    changed = sorted(str(o["id"]) for o in built["obligations"] if was.get(str(o["id"])) != o["status"])
+    if changed:
+        return (f"{len(changed)} obligation(s) have another status in the recorded evidence than in the report "
+                f"(e.g. {changed[0]}): {_AGAIN}")
     return None
+
+
+#: What a stale report's sentence ends with.
+_AGAIN = "run `rclverify verify` and export again"
 
 
 def evidence_digests(root: Path, report: Mapping[str, Any]) -> dict[str, str]:
