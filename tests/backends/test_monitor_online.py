@@ -256,7 +256,7 @@ def test_verdict_connections_get_tcp_nodelay() -> None:
     import socket
     from types import SimpleNamespace
 
-    from rclverify.runtime.live import _no_delay
+    from rclverify.runtime.live_ros1 import _no_delay
     server = socket.create_server(("127.0.0.1", 0))
     client = socket.create_connection(server.getsockname())
     peer, _ = server.accept()

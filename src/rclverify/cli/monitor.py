@@ -204,7 +204,8 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
 
     import os  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
 
-    from rclverify.runtime.live import LiveRun, run_ros1  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
+    from rclverify.runtime.live import LiveRun  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
+    from rclverify.runtime.live_ros1 import run_ros1  # deferred: start-up (loads rclverify.runtime.live and more only when called)
     from rclverify.runtime.ros1 import RosUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)

@@ -179,7 +179,7 @@ def start_proxy(rospy: Any, checked: Any, forwards: Mapping[str, str], dirs: Seq
 
 def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
                   dirs: Sequence[Path]) -> Callable[[Any, Any, Callable[[str], None]], ProxyRun] | None:
-    """The ``proxy`` argument of :func:`.live.run_ros1` for ``rclverify
+    """The ``proxy`` argument of :func:`.live_ros1.run_ros1` for ``rclverify
     monitor --live --forward SVC=REAL --interfaces DIR``: ``None`` when
     neither option is given; else a function that starts the proxy for the
     selected ``nodes`` with a deadline, writing to the live run's log

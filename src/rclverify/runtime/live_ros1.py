@@ -1,0 +1,209 @@
+"""A live monitoring run on a ROS 1 master: :func:`run_ros1`, what
+``rclverify monitor --live`` runs on ROS 1 around a :class:`~.live.LiveRun`.
+
+It registers the monitor's node and its verdict publishers with the master,
+subscribes to every topic the contracts name (``rospy.AnyMsg``, decoded on
+the engine thread with the class of each connection's type), starts the
+service proxy when asked, watches the run until it is stopped and writes the
+evidence record (:func:`~.live.stop_and_record`).  Every call to the master
+is bounded (:mod:`.ros1`, "A master is an external peer").
+
+docs/monitors.md ("Live monitoring") gives the decisions.
+"""
+from __future__ import annotations
+
+import json
+import threading
+import time as _time
+import warnings
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from rclverify.records.store import atomic_write_text
+from rclverify.lang.types import Checked, CheckedNode
+from rclverify.runtime.live import LiveRun, stop_and_record
+from rclverify.runtime.live_status import warm_bounds
+from rclverify.runtime.worker import EngineWorker
+from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, shutdown_limit, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
+
+
+def _no_delay(pub: Any) -> None:
+    """Turn Nagle's algorithm off on the verdict publisher's subscriber
+    connections (TCP_NODELAY), whether or not the subscriber asked for it:
+    with it on, a verdict written while the previous one is not yet
+    acknowledged waits for the subscriber's delayed ACK, up to 40 ms on
+    Linux (docs/monitors.md, "Live monitoring", "Threads").  Reaches rospy's publisher
+    connections (``impl.connections``, each with its ``socket``); a rospy
+    without them is left as it is."""
+    import socket  # deferred: start-up (loads socket only when called)
+    for c in list(getattr(getattr(pub, "impl", None), "connections", None) or ()):
+        sock = getattr(c, "socket", None)
+        if sock is not None:  # idempotent, one system call per connection every 0.1 s
+            try:
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            except (OSError, AttributeError):
+                pass
+
+
+def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
+             msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
+             duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
+             stop: threading.Event, out: Callable[[str], None],
+             proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None = None) -> dict[str, Any]:
+    """Run live monitoring on a ROS 1 master (``ROS_MASTER_URI``) until ``stop``
+    is set or ``duration`` seconds passed; returns the evidence record.
+
+    Subscribes with ``rospy.AnyMsg`` to every topic the contracts name and
+    decodes each message with the class of its connection's type
+    (:func:`~.ros1.message_class`); publishes every verdict as
+    ``std_msgs/String`` JSON on ``verdict_topic`` and each node's latest on
+    ``<last_prefix>/<node>/last_verdict`` (latched).  Raises
+    :class:`~.ros1.RosUnavailable` when rospy or a message class is missing.
+
+    ``proxy(rospy, live, publish)``, when given, starts the service proxy
+    and action subscriptions in this process (:mod:`.service_proxy`,
+    ``--forward``/``--interfaces``) and returns its run (``tick(now)``,
+    ``close()``): its events and deadline verdicts go to the same log and
+    verdict topic, its summary to the record's ``deadlines``.
+    """
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
+    rospy = import_rospy()
+    from std_msgs.msg import String  # deferred: start-up (loads std_msgs and more only when called)
+    topics = contract_topics(checked, nodes)
+    classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
+    import rosgraph  # deferred: start-up (loads rosgraph only when called)
+    uri = rosgraph.get_master_uri()
+    # every call to the master is bounded and the registration waits in short
+    # steps, so a master that hangs neither holds the monitor nor makes it deaf
+    # to SIGTERM/SIGINT (ros1.py, "A master is an external peer")
+    bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)
+    until = _time.monotonic() + REGISTER_TIMEOUT_S
+    pub, lasts = _register(rospy, String, stop, uri, node_name, verdict_topic, last_prefix, nodes)
+    live = run_factory(publish=lambda text: pub.publish(String(text)),
+                       publish_last=lambda n, text: lasts[n].publish(String(text)))
+    decode_errors: dict[str, int] = {}
+    # the callbacks only stamp and queue; one worker thread decodes, checks,
+    # publishes and runs the timer (worker.py: why)
+    worker = EngineWorker(live, _decoder(classes, decode_errors), rospy.get_time, tick_s=tick_s).start()
+    subs: list[Any] = []
+
+    def unsubscribe() -> None:
+        for s in list(subs):
+            s.unregister()
+    calls = _subscribe(rospy, String, stop, until, uri, topics, pub, live, worker, subs, unsubscribe, proxy)
+    out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
+    warm_bounds()  # the status line a stop prints need not wait for scipy (live_status.py)
+    try:
+        _watch(rospy, stop, duration, tick_s, status_s, calls, worker, pub, live, out)
+    finally:
+        # unregistering asks the master: bounded, so a master that hangs now cannot hold the exit
+        if not finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S):
+            out(f"rclverify monitor --live: warning: the master at {uri} did not confirm the unsubscriptions "
+                f"within {SHUTDOWN_TIMEOUT_S:g} s")
+        deadlines = calls.close() if calls is not None else None  # before the log closes
+        record = stop_and_record(worker, live, evidence, out)
+        if deadlines is not None:
+            record["deadlines"] = {"results": deadlines["results"], "false": deadlines["false"]}
+        record["decode_errors"] = decode_errors
+        record["not_judged"] = live.not_judged(record)  # silence is never green (judged.py)
+        if evidence is not None:
+            atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
+        out(live.status_line(wait=False))
+        finish_within(lambda: rospy.signal_shutdown("monitor stopped"), SHUTDOWN_TIMEOUT_S)
+    return record
+
+
+def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_name: str, verdict_topic: str,
+              last_prefix: str, nodes: list[CheckedNode]) -> tuple[Any, dict[str, Any]]:
+    """The monitor's node registered with the master at ``uri`` and its
+    publishers ``(verdict, {node: last verdict, latched})``; within
+    ``REGISTER_TIMEOUT_S`` and ``stop``, else rospy is shut down and
+    :class:`~.ros1.RosUnavailable` raised."""
+    from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
+
+    def register_node() -> tuple[Any, dict[str, Any]]:
+        check_master(uri, "/" + node_name, MASTER_TIMEOUT_S)
+        rospy.init_node(node_name, anonymous=False, disable_signals=True)
+        # synchronous: the engine thread writes each verdict to the subscribers'
+        # sockets itself; rospy's queued publisher hands every message to a writer
+        # thread and then yields the GIL (time.sleep(0)), which cost the engine
+        # thread a GIL hand-over per verdict (docs/monitors.md, "Live monitoring", "Threads")
+        with warnings.catch_warnings():  # rospy warns about queue_size=None; here it is the choice made above
+            warnings.simplefilter("ignore", SyntaxWarning)
+            pub = rospy.Publisher(verdict_topic, string, queue_size=None)
+        return pub, {n.name: rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", string, queue_size=1,
+                                             latch=True) for n in nodes}
+
+    try:
+        return run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}",  # type: ignore[no-any-return]
+                           register_node)
+    except RosUnavailable as exc:
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), shutdown_limit(exc))
+        raise
+
+
+def _decoder(classes: Mapping[str, type], decode_errors: dict[str, int]) -> Callable[[str, Any], Mapping[str, object] | None]:
+    """The engine thread's decoding of a ``rospy.AnyMsg``: with the class of
+    its connection's type, else the contract's; undecodable bytes are counted
+    per topic in ``decode_errors``."""
+    by_type: dict[str, type] = {getattr(c, "_type"): c for c in classes.values()}
+
+    def decode(topic: str, raw: Any) -> Mapping[str, object] | None:
+        typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
+        cls: Any = by_type.get(typ, classes[topic])
+        try:
+            msg = cls().deserialize(raw._buff)
+        except Exception:  # a publisher of another type on a contract topic: counted, never a crash
+            decode_errors[topic] = decode_errors.get(topic, 0) + 1
+            return None
+        return flatten(msg)  # type: ignore[no-any-return]
+    return decode
+
+
+def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri: str, topics: Mapping[str, str],
+               pub: Any, live: LiveRun, worker: EngineWorker, subs: list[Any], unsubscribe: Callable[[], None],
+               proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None) -> Any:
+    """Subscribe to every contract topic (into ``subs``) and start the
+    ``proxy``; returns the proxy's run or ``None``.  By the registration's
+    deadline ``until`` (monotonic s), else everything started is stopped and
+    :class:`~.ros1.RosUnavailable` raised."""
+
+    def register_topics() -> Any:
+        calls = proxy(rospy, live, lambda text: pub.publish(string(text))) if proxy is not None else None
+        for t in topics:
+            subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
+                                         queue_size=10000, tcp_nodelay=True))
+        return calls
+
+    try:
+        return run_bounded(stop, max(until - _time.monotonic(), 0.1), f"subscribing at the master at {uri}",
+                           register_topics)
+    except RosUnavailable as exc:
+        finish_within(unsubscribe, shutdown_limit(exc))
+        stop_and_record(worker, live, None, lambda _line: None)
+        finish_within(lambda: rospy.signal_shutdown("monitor not started"), shutdown_limit(exc))
+        raise
+
+
+def _watch(rospy: Any, stop: threading.Event, duration: float | None, tick_s: float, status_s: float, calls: Any,
+           worker: EngineWorker, pub: Any, live: LiveRun, out: Callable[[str], None]) -> None:
+    """Until ``stop``, rospy's shutdown, ``duration`` s or the engine
+    thread's death: the proxy's clock, the verdict publisher's sockets
+    (:func:`_no_delay`) and a status line every ``status_s`` s."""
+    t0 = _time.monotonic()
+    next_status = t0 + status_s
+    while not stop.is_set() and not rospy.is_shutdown():
+        if duration is not None and _time.monotonic() - t0 >= duration:
+            break
+        stop.wait(min(0.1, tick_s * 5))
+        if calls is not None:
+            calls.tick(rospy.get_time())  # an unanswered call is false once its deadline expired
+        if worker.error is not None:
+            break  # the engine thread died: stop and say so, never monitor on silently
+        _no_delay(pub)
+        if status_s > 0 and _time.monotonic() >= next_status:
+            out(live.status_line(wait=False))
+            next_status += status_s
+
+
+__all__ = ["run_ros1"]
