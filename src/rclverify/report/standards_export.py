@@ -83,8 +83,8 @@ def report_out_of_date(ws: Any, report: Mapping[str, Any]) -> str | None:
     if now_inputs != was_inputs:
         return (f"the report was built from other inputs than the workspace holds now (inputs sha256 "
                 f"{str(was_inputs)[:12]}..., now {now_inputs[:12]}...): {_AGAIN}")
-    was = {str(o.get("id")): o.get("status") for o in report.get("obligations") or ()}
-    changed = sorted(str(o["id"]) for o in built["obligations"] if was.get(str(o["id"])) != o["status"])
+    stated = {str(o.get("id")): o.get("status") for o in report.get("obligations") or ()}
+    changed = sorted(str(o["id"]) for o in built["obligations"] if stated.get(str(o["id"])) != o["status"])
     if changed:
         return (f"{len(changed)} obligation(s) have another status in the recorded evidence than in the report "
                 f"(e.g. {changed[0]}): {_AGAIN}")
