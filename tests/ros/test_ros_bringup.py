@@ -22,7 +22,8 @@ launch files and servers, on the project's own tree
 
 By hand, with the launch arguments' defaults: two launch files start three
 nodes, ``/rover/drive_server`` (publishes ``/rover/cmd_vel_raw``, subscribes
-``/rover/odom``, ``/rover/tf``, ``/rover/tf_static``, serves action
+``/rover/odom`` (its ``TransformListener(*tf_buffer_)``, given no node,
+subscribes ``/tf`` and ``/tf_static`` on tf2's own node, a note), serves action
 ``/rover/drive_to`` of ``rover_msgs/action/DriveTo``, calls action
 ``/rover/dock`` of ``rover_msgs/action/Dock``), ``/rover/dock`` (serves
 ``/rover/dock`` of ``Dock`` and ``/rover/undock`` of ``Undock``, subscribes
@@ -45,7 +46,6 @@ LAUNCH = WS / "src" / "rover_bringup" / "launch"
 NAV, LOC = LAUNCH / "navigation.launch.py", LAUNCH / "localization.launch.py"
 
 DRIVE = {("pub", "/rover/cmd_vel_raw", "geometry_msgs/msg/Twist"), ("sub", "/rover/odom", "nav_msgs/msg/Odometry"),
-         ("sub", "/rover/tf", "tf2_msgs/msg/TFMessage"), ("sub", "/rover/tf_static", "tf2_msgs/msg/TFMessage"),
          ("action_servers", "/rover/drive_to", "rover_msgs/action/DriveTo"),
          ("action_clients", "/rover/dock", "rover_msgs/action/Dock")}
 DOCK = {("action_servers", "/rover/dock", "rover_msgs/action/Dock"),
@@ -204,20 +204,20 @@ def test_the_first_screen_names_what_dropped_nodes_first(tmp_path: Path, capsys:
     lf = _many(tmp_path, 30)
     assert main(["ros", "scan", str(WS), "--launch", str(lf), "--json", str(tmp_path / "g.json")]) == 0
     err = capsys.readouterr().err.splitlines()
-    assert len(err) <= 20 and err[-1].endswith("0 error(s), 33 warning(s)"), err
-    assert err[0] == "33 warning(s) by cause (each located in the JSON's \"unresolved\"; --verbose lists them here):"
+    assert len(err) <= 20 and err[-1].endswith("0 error(s), 34 warning(s)"), err
+    assert err[0] == "34 warning(s) by cause (each located in the JSON's \"unresolved\"; --verbose lists them here):"
     assert err[1].startswith(f"    3  launch nodes dropped (not started in the graph): {lf}:7:9, {lf}:8:9, {lf}:9:9")
     assert err[2].startswith(f"   30  launch attributes not read (parameter files, conditions, remappings): {lf}:10:")
     assert err[2].endswith("(+27 more)")  # the launch file lies in no scanned package: no package named
     # --verbose: every warning, one a line
     assert main(["ros", "scan", str(WS), "--launch", str(lf), "--json", str(tmp_path / "g.json"), "--verbose"]) == 0
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 34 and sum("action skipped" in x for x in err) == 3
+    assert len(err) == 35 and sum("action skipped" in x for x in err) == 3
     # control: a few warnings are listed one a line, as they always were
     few = _many(tmp_path, 2)
     assert main(["ros", "scan", str(WS), "--launch", str(few), "--json", str(tmp_path / "g.json")]) == 0
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 6 and err[0] == f"{few}:7:9: warning: Node(...): package 'pkg_of(0)' (not a literal or a " \
+    assert len(err) == 7 and err[0] == f"{few}:7:9: warning: Node(...): package 'pkg_of(0)' (not a literal or a " \
                                        f"known substitution) cannot be read statically; action skipped", err
 
 
@@ -379,7 +379,7 @@ def test_init_from_ros_summarises_the_scans_warnings(tmp_path: Path, capsys: pyt
     lf = _many(tmp_path, 30)
     assert main(["init", str(tmp_path / "ws"), "--from-ros", str(WS), "--launch", str(lf)]) == 0
     err = capsys.readouterr().err.splitlines()
-    assert err[0].startswith("33 warning(s) by cause (`rclverify ros scan ") and "--verbose` lists each one" in err[0]
+    assert err[0].startswith("34 warning(s) by cause (`rclverify ros scan ") and "--verbose` lists each one" in err[0]
     assert err[1].startswith("    3  launch nodes dropped (not started in the graph): ") and \
         "many30.launch.py:7:9, " in err[1]
     assert not [x for x in err if "cannot be read statically; the node is read without them" in x]

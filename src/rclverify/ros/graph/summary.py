@@ -78,8 +78,6 @@ CAUSES: tuple[Cause, ...] = (
           _has("the plugin is loaded at run time")),
     Cause("endpoints-other", "endpoints or node names not read statically",
           lambda code, msg: code == "ROS-UNRESOLVED" and "not resolved statically" in msg and "type of" not in msg),
-    Cause("endpoints-own-node", "endpoints on a library's own node (tf2_ros' TransformListener given no node)",
-          lambda code, _msg: code == "ROS-TF-OWN-NODE"),
     Cause("interfaces", "interface packages or fields absent",
           lambda code, msg: code in ("ROS-INTERFACE-ABSENT", "ROS-FIELD-MISSING", "ROS-FIELD-TYPE")
           or "which no scanned package or standard package defines" in msg),
@@ -91,6 +89,8 @@ CAUSES: tuple[Cause, ...] = (
           lambda code, _msg: code == "ROS-LAUNCH"),
     Cause("parse", "sources read in part (syntax errors recovered, files skipped)",
           lambda code, _msg: code == "ROS-PARSE"),
+    Cause("endpoints-own-node", "endpoints on a library's own node (tf2_ros' TransformListener given no node)",
+          lambda code, _msg: code == "ROS-TF-OWN-NODE"),
     Cause("other", "other warnings", lambda _code, _msg: True),
 )
 
