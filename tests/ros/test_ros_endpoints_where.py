@@ -213,3 +213,61 @@ def test_a_subscription_made_by_a_default_member_initializer_is_the_nodes(tmp_pa
     # control: a member declared without an initializer creates nothing
     g = _looker(tmp_path, "*buffer_", '"seen"', polled="polled_;")
     assert "/looker/input/polled" not in {t for t, _ in _subs_at(g, "/looker")}
+
+
+# -- endpoints where Python puts them -----------------------------------------------
+
+BASE = """from rclpy.node import Node
+from std_msgs.msg import Int32, String
+
+
+class Joint(Node):
+    def __init__(self, name):
+        super().__init__(name)
+        self.state = self.create_publisher(String, 'state', 10)
+        self.setup()
+
+    def setup(self):
+        self.cmd = self.create_subscription(Int32, 'command', self.on_cmd, 10)
+
+    def on_cmd(self, msg):
+        pass
+"""
+SUBCLASS = """import rclpy
+from rclpy.node import Node
+from std_msgs.msg import String
+from limbs.base import Joint
+
+
+class {cls}({base}):
+    def __init__(self):
+        super().__init__('{node}')
+        self.extra = self.create_publisher(String, '{node}_extra', 10)
+
+
+def main():
+    rclpy.init()
+    rclpy.spin({cls}())
+"""
+LIMBS_SETUP = """from setuptools import setup
+setup(name='limbs', packages=['limbs'], entry_points={'console_scripts': [
+    'arm = limbs.arm:main', 'leg = limbs.leg:main', 'solo = limbs.solo:main']})
+"""
+
+
+def test_endpoints_a_python_base_class_makes_are_the_subclass_nodes(tmp_path: Path) -> None:
+    _write(tmp_path / "ws" / "limbs", {
+        "package.xml": PKG.format(name="limbs", tool="ament_python"), "setup.py": LIMBS_SETUP,
+        "limbs/__init__.py": "", "limbs/base.py": BASE,
+        "limbs/arm.py": SUBCLASS.format(cls="Arm", base="Joint", node="arm"),
+        "limbs/leg.py": SUBCLASS.format(cls="Leg", base="Joint", node="leg"),
+        # control: a node importing the base module without deriving from its class
+        "limbs/solo.py": SUBCLASS.format(cls="Solo", base="Node", node="solo")})
+    g = _scan(tmp_path)
+    assert sorted(g.nodes) == ["/arm", "/leg", "/solo"]
+    for n in ("arm", "leg"):
+        assert sorted((e.topic, str(e.src)) for e in g.nodes[f"/{n}"].publishes) == [
+            (f"/{n}_extra", f"ws/limbs/limbs/{n}.py:10:22"), ("/state", "ws/limbs/limbs/base.py:8:22")]
+        assert [(e.topic, e.msg_type) for e in g.nodes[f"/{n}"].subscribes] == [("/command", "std_msgs/msg/Int32")]
+    assert [e.topic for e in g.nodes["/solo"].publishes] == ["/solo_extra"] and not g.nodes["/solo"].subscribes
+    assert _said(g) == []

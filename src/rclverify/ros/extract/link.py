@@ -197,6 +197,27 @@ class Linker(LinkMembers, Values, Returns, Instances):
                     m = self.match(ident, u) if not ident.startswith(("std::", "ros::", "rclcpp::")) else None
                     if m is not None and m != u:
                         self._edge(f"U:{u}", f"U:{m}")
+            for b in info["bases"] if self.py else []:  # a Python base class of the package runs with it
+                m = self._py_base(u, b)
+                if m is not None and m != u:
+                    self._edge(f"U:{u}", f"U:{m}")
+
+    def _py_base(self, unit: str, base: str) -> str | None:
+        """The program's Python class that base ``base`` (as written in class
+        ``unit``'s ``class C(base)``) names: a class of the same file, else the
+        one the file imports under that name (``from pkg.base import Joint``,
+        ``import pkg.base`` then ``pkg.base.Joint``), found in the package."""
+        f = unit.split("::", 1)[0]
+        if f"{f}::{base}" in self.units:
+            return f"{f}::{base}"
+        head, _, rest = base.partition(".")
+        origins = [o for o in self.recs.get(f, {}).get("imports", [])
+                   if o.rsplit(".", 1)[-1] == head or o == head]
+        for o in origins[:1] if len(origins) == 1 else []:
+            hit = self.code.module(o + ("." + rest if rest else ""))
+            if hit is not None and hit[1] and f"{hit[0]}::{hit[1]}" in self.units:
+                return f"{hit[0]}::{hit[1]}"
+        return None
 
     # -- program structure
     def match(self, name: str, caller: str | None) -> str | None:

@@ -275,8 +275,9 @@ class _Finder:
         # files naming a node first, so the modules and headers they take in are theirs
         for f in sorted(py + cpp, key=lambda f: (not code.records[f].get("node_names"),
                                                   "." + f.rsplit(".", 1)[-1] in _HEADER, f)):
-            if f in held and not (f in py and code.records[f].get("node_names")):
-                continue  # a module or header a program takes in (a script naming a node also runs alone)
+            if f in held and not (f in py and code.records[f].get("nodes")):
+                continue  # a module or header a program takes in (a script naming a node also runs alone;
+                # a base class naming its node by its constructor's parameter does not)
             files = _closure(code, [f], self.listed)
             name = f.rsplit("/", 1)[-1]
             if f in py:

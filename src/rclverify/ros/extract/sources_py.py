@@ -44,7 +44,7 @@ from typing import Any
 from rclverify.ros.extract import emit, names, py_helpers, symbols
 from rclverify.ros.extract.cpp_types import action_type, service_type
 from rclverify.ros.extract.model import Endpoint, Note, Src, canon_type
-from rclverify.ros.extract.pyconst import PyScope
+from rclverify.ros.extract.pyconst import _ROS, PyScope
 from rclverify.ros.extract.pyrecords import PyCall, PyModule, PyVal
 from rclverify.ros.extract.sources_py_ast import ast_module
 
@@ -183,6 +183,8 @@ class _Extractor:
         f = sc.full(c.func) if c.func else ""
         last = c.func.rsplit(".", 1)[-1]
         if f in ("rospy.init_node", "rclpy.create_node", "rclpy.node.Node") or c.func == "super().__init__":
+            if c.func == "super().__init__":
+                self.base_init(c)
             self.node_name(c)
             return
         spec = _CTORS.get(f)
@@ -200,6 +202,26 @@ class _Extractor:
         type_v = c.kwargs.get(tk) or (c.args[ti] if len(c.args) > ti else None)
         if name_v is not None:
             self.add(kind, name_v, type_v, c)
+
+    def base_init(self, c: PyCall) -> None:
+        """``super().__init__(...)`` in a class whose first base is a class of this
+        file or one it imports from outside ROS (``class Arm(Joint)``): a call of
+        that base's constructor, for the linker, which runs the base's code (its
+        endpoints) with these arguments when the package holds it."""
+        mod, sc = self.mod, self.sc
+        cls = sc.class_at(c.src.line)
+        bases = mod.bases.get(cls.split(".")[-1], []) if cls else []
+        if not bases or bases[0].split(".")[-1] in ("Node", "LifecycleNode"):
+            return
+        b = bases[0]
+        if any(q == b for q, _a, _b in sc.cls):
+            callee = f"{self.shown}::{b}"
+        elif b.split(".")[0] in mod.imports and sc.full(b).split(".")[0] not in _ROS:
+            callee = f"ext:{sc.full(b)}"
+        else:
+            return
+        self.out["calls"].append(("call", callee, [sc.value(a) for a in c.args], sc.fn_key(c.src.line),
+                                  sc.unit_at(c.src.line), c.src, {k: sc.value(v) for k, v in c.kwargs.items()}))
 
     def node_name(self, c: PyCall) -> None:
         """``rospy.init_node(n)``, ``rclpy.create_node(n)``, ``Node(n)``, ``super().__init__(n)``."""
