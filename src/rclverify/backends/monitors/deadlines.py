@@ -59,7 +59,7 @@ from rclverify.traces.events import Event, to_ns
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
 from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.verdicts import names
-from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending, UNACCEPTED
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import ms, ms_ns
 
@@ -205,7 +205,7 @@ class DeadlineMonitor:
 
     def _refused(self, inputs: Mapping[str, object]) -> tuple[str, str] | None:
         """Why the node's assumption does not accept ``inputs`` (``(kind,
-        reason)``, kind one of :data:`UNACCEPTED`), ``None`` when it does."""
+        reason)``, kind one of :data:`~.deadline_records.UNACCEPTED`), ``None`` when it does."""
         for formula in self.assumption:
             j = judge(formula, self.checked, self.node, inputs, self.tolerance)
             if j.truth is True:
