@@ -169,6 +169,9 @@ def cmd_diff(args: argparse.Namespace) -> int:
     if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)))) != 1:
         print("error: ros diff needs exactly one running side: --master URI, --ros2 or --bag BAG", file=sys.stderr)
         return 2
+    if getattr(args, "namespace", None) and not getattr(args, "nodl", None):
+        print("error: ros diff --namespace NODE=NS places a NoDL document's instances: give --nodl DIR", file=sys.stderr)
+        return 2
     if getattr(args, "nodl", None):
         return _diff_nodl(args)
     if not args.paths and not args.launch:
