@@ -141,3 +141,5 @@ def test_namespaces_given_on_the_command_line(docs: tuple[Path, dict[str, Any]],
         assert main(["ros", "diff", "--nodl", str(folder), "--ros2", "--namespace", bad]) == 2
         err = capsys.readouterr().err
         assert said in err and "Traceback" not in err and err.count("\n") == 1
+    assert main(["ros", "diff", "--ros2", "--namespace", "Relay=/r1"]) == 2
+    assert "give --nodl DIR" in capsys.readouterr().err
