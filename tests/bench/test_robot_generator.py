@@ -132,10 +132,6 @@ def test_a_correct_robot_is_never_red(correct_run: dict[str, Any]) -> None:
 
 
 @pytest.mark.live
-@pytest.mark.xfail(strict=False, reason="rclverify fault (docs/monitors.md, 'Generated robots'): live, an answer "
-                   "carrying its reading's copied stamp and published after the next reading is inconclusive ('stamped "
-                   "247 ms before the question ..., within the transport skew of 0.02 s') where the offline check of "
-                   "the same log judges it satisfied (Relay1: 450 ms after a reading every 300 ms)")
 def test_a_correct_robot_is_judged_alike_live_and_on_its_log(correct_run: dict[str, Any]) -> None:
     res = correct_run
     for node in (n["name"] for n in res["spec"]["nodes"]):

@@ -8,8 +8,9 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   one (ROS 1 ``secs``/``nsecs``, ROS 2 ``sec``/``nanosec``, nested or
   flattened), else with its event time (the publisher's source timestamp on
   ROS 2, the receipt on ROS 1: :mod:`rclverify.traces.event_time`); messages
-  wait in a reorder buffer until the watermark (the clock less
-  ``reorder_window`` seconds, the lateness bound) passes them and are
+  wait in a reorder buffer until the watermark passes them (the clock less
+  ``reorder_window`` seconds, the lateness bound, held back by each writer
+  that could still send a message stamped before it: :meth:`OnlineEngine.watermark`) and are
   released to the monitors in stamp order (equal stamps by event time, then
   in arrival order), all held in the one reorder buffer
   (:mod:`rclverify.traces.reorder`).  A message stamped before the
@@ -91,6 +92,9 @@ class OnlineEngine:
     _clock: float = field(init=False, default=-math.inf)
     #: per writer (topic), its header stamps' offset from its source times (traces/event_time.py)
     clocks: WriterClocks = field(init=False, default_factory=WriterClocks)
+    #: per writer (topic): (the latest time heard on the run's clock, the most it published after its
+    #: stamp, s): its own watermark (:meth:`watermark`)
+    writers: dict[str, tuple[float, float]] = field(init=False, default_factory=dict)
 
     def __post_init__(self) -> None:
         self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict, self.tolerance)
@@ -118,6 +122,8 @@ class OnlineEngine:
         if stamp is not None and self.clocks.see(topic, stamp, received):
             stamp, fields = None, without_stamp(fields)  # another clock: placed at its source time
         t = received if stamp is None else stamp
+        last, lag = self.writers.get(topic, (-math.inf, 0.0))
+        self.writers[topic] = (max(last, t), max(lag, min(received - t, self.horizon)))
         self._buffer.push(t, received, (topic, fields, where))
         if self.reorder_window <= 0:
             self._release(math.inf)
@@ -127,14 +133,35 @@ class OnlineEngine:
         released: its time plus the reorder window (the watermark reaches it);
         ``inf`` with nothing buffered.  The live worker ticks then, so a
         verdict waits the lateness bound and not a timer period more."""
-        return self._buffer.head() + self.reorder_window
+        head = self._buffer.head()
+        return head + self.reorder_window + max((lag for last, lag in self.writers.values() if last < head),
+                                                default=0.0)
+
+    def watermark(self, now: float) -> float:
+        """The time (s, the run's clock) up to which every writer heard has been
+        heard at ``now`` (s): the clock less the lateness bound, and no further
+        than any writer whose message could still come stamped before it.  A
+        writer (topic) is past time ``T`` when a message of it was placed at
+        ``T`` or later, or when it has been silent for longer than the lateness
+        bound on its own clock: ``now`` less the most it published after its
+        stamp (a node copying its question's stamp onto an answer it publishes
+        later, capped at the horizon) less the bound.  A writer not heard yet
+        holds nothing: its first message, when it comes after the watermark
+        passed its stamp, is a late message (docs/semantics.md, "Event time")."""
+        upto = now - self.reorder_window
+        for last, lag in self.writers.values():
+            if last < upto:
+                upto = min(upto, max(last, now - self.reorder_window - lag))
+        return upto
 
     def tick(self, now: float) -> None:
-        """The timer: release messages older than the reorder window, resolve
-        obligations whose horizon has passed, report silent topics."""
-        self._release(now - self.reorder_window)
+        """The timer: release the messages every writer has been heard past
+        (:meth:`watermark`), resolve obligations whose horizon has passed,
+        report silent topics."""
+        upto = self.watermark(now)
+        self._release(upto)
         for m in self.monitors:
-            m.advance(max(self._clock, now - self.reorder_window))
+            m.advance(max(self._clock, upto))
         if self.silence_s > 0:
             for topic, st in self.topics.items():
                 if st.last is not None and not st.silent and now - st.last > self.silence_s:

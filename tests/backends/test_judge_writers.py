@@ -1,0 +1,148 @@
+"""Issue 106: a watermark per writer, offline and live alike.
+
+A relay copies its reading's header stamp onto an answer it publishes 450 ms
+later, after the next reading (one every 300 ms).  Offline, the stamp-order
+reader places each answer after its reading; live, the engine releases a
+reading only once every writer heard has been heard past its stamp or has
+been silent longer than the lateness bound on its own clock
+(:meth:`OnlineEngine.watermark`), so each answer is released after its
+reading and before the next one, as offline.  Each run is judged by the
+recorded path and by the online engine fed the same messages in the order
+they reached the monitor (1 ms after publication), its timer ticking every
+10 ms and a deadline monitor fed what the engine releases, as
+:mod:`rclverify.runtime.live` does.  The control: the relay adding 0.5 to
+every fourth reading stays red, live as offline.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.check import check_trace
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
+from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read
+from rclverify.lang.typecheck import load
+from rclverify.traces import read_trace
+from test_judge_event_time import _msg, _offline, _stamp, _workspace
+
+COPY = """
+node Relay {
+  inputs( x : REAL )
+  outputs( r : REAL )
+  topics( pkg/Reading x matches(in.x), pkg/Range r matches(out.r) )
+  assume( TRUE )
+  guarantee( out.r == in.x ) triggered by in.x within 950 ms
+}
+"""
+COPY_MAPPING = "topics:\n  x: {fields: [value]}\n  r: {fields: [range]}\n"
+WINDOW, PERIOD = 0.05, 0.3
+
+
+def _copying_relay(delay: float, defect: bool = False, n: int = 12) -> list[dict[str, Any]]:
+    """Readings 0, 1, 2 ... every 300 ms from 1 s, each copied ``delay`` s later onto an
+    answer carrying the reading's stamp (``defect``: every fourth answer 0.5 too high)."""
+    sent = []
+    for i in range(n):
+        t = 1.0 + i * PERIOD
+        sent.append(_msg("x", t, t, value=float(i)))
+        sent.append(_msg("r", t + delay, t, range=float(i) + (0.5 if defect and i % 4 == 3 else 0.0)))
+    sent.append(_msg("tick", 1.0 + n * PERIOD + 3.0, None, data=0))
+    return sorted(sent, key=lambda x: x["time"])
+
+
+def _verdicts_offline(ws: Path, run: Path) -> list[tuple[str, str]]:
+    """The relay's verdicts (where, verdict) as the recorded path judges the run (read again in stamp order)."""
+    checked = load([ws / "contracts" / "c.rcl"])
+    cfg = load_mapping(ws, "mapping.yaml")
+    watch = StampWatch(0.0)
+    for ev in read_trace(run):
+        watch.see(ev)
+    lag, _, _ = second_read(watch, str(run), True)
+    events = read_trace(run) if lag is None else in_stamp_order(read_trace(run), lag)
+    got: list[Any] = []
+    check_trace(checked, [checked.nodes["Relay"]], events, cfg.rules, 1.0, got.append)
+    return sorted((v.where, v.verdict) for v in got)
+
+
+def _verdicts_live(ws: Path, lines: list[dict[str, Any]]) -> tuple[list[tuple[str, str]], dict[str, int],
+                                                                      list[float]]:
+    """The online engine's verdicts, the deadline counts, and the watermark at each answer's arrival."""
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    got: list[Any] = []
+    dm = DeadlineMonitor(checked, checked.nodes["Relay"], rules, lambda v: None, horizon=1.0)
+    eng = OnlineEngine(checked, [checked.nodes["Relay"]], rules, 1.0, reorder_window=WINDOW, on_verdict=got.append,
+                       on_event=dm.feed)
+    now, marks = lines[0]["time"], []
+    for k, line in enumerate(lines):
+        while now + 0.01 <= line["time"] + 0.001:
+            now += 0.01
+            eng.tick(now)
+            dm.advance(now - WINDOW)
+        if line["topic"] == "r":
+            marks.append(eng.watermark(now))
+        eng.push(line["topic"], {x: v for x, v in line.items() if x not in ("topic", "time")}, line["time"],
+                 f"run.jsonl:{k + 1}")
+    eng.finish()
+    return sorted((v.where, v.verdict) for v in got), dict(dm.finish().counts), marks
+
+
+@pytest.mark.parametrize("delay", [0.35, 0.45, 0.59], ids=["after the next reading", "450 ms", "near two periods"])
+def test_a_stamp_copying_relay_answering_after_the_next_reading_is_green_live_as_offline(
+        tmp_path: Path, delay: float) -> None:
+    """Fault 3 of the robot generator: the correct relay was ``inconclusive`` live (the readings
+    disagree: its answer judged against the next reading too) and ``satisfied`` offline."""
+    lines = _copying_relay(delay)
+    ws, run = _workspace(tmp_path, COPY, lines, COPY_MAPPING)
+    statuses, deadlines = _offline(ws, run, "Relay")
+    assert statuses == ["discharged", "discharged"] and deadlines == [{"true": 12, "currently_false": 0, "false": 0}]
+    offline = _verdicts_offline(ws, run)
+    assert [v for _, v in offline] == ["satisfied"] * 12
+    live, counts, marks = _verdicts_live(ws, lines)
+    assert counts == deadlines[0]
+    # verdict by verdict, but for the first reading: superseded when the next was released, before the
+    # relay's first answer told how long after its stamp it publishes (its answer is then judged late)
+    assert [x for x in live if x != ("run.jsonl:1", "superseded")] == offline
+    # held: once the relay was heard, each answer arrives with the watermark at or before its stamp
+    assert all(m <= 1.0 + i * PERIOD + 1e-9 for i, m in enumerate(marks) if i >= 1), marks
+
+
+def test_the_control_a_stamp_copying_relay_with_a_defect_is_red_live_as_offline(tmp_path: Path) -> None:
+    lines = _copying_relay(0.45, defect=True)
+    ws, run = _workspace(tmp_path, COPY, lines, COPY_MAPPING)
+    statuses, deadlines = _offline(ws, run, "Relay")
+    assert statuses == ["failed", "failed"] and deadlines == [{"true": 9, "currently_false": 0, "false": 3}]
+    offline = _verdicts_offline(ws, run)
+    assert {w for w, v in offline if v == "violated"} == {"run.jsonl:9", "run.jsonl:17", "run.jsonl:24"}  # answers 3, 7, 11
+    live, counts, _ = _verdicts_live(ws, lines)
+    assert counts == deadlines[0]
+    assert [x for x in live if x != ("run.jsonl:1", "superseded")] == offline
+
+
+def test_a_writer_is_past_a_time_once_heard_past_it_or_silent_past_the_bound_on_its_own_clock(
+        tmp_path: Path) -> None:
+    """The watermark's rule itself: a reading at 1.3 s is held while the relay (publishing 450 ms
+    after its stamps) may still send an answer stamped before it, and released when the relay's
+    answer stamped 1.3 s comes, or when the relay has been silent past 1.3 s + 450 ms + the bound."""
+    ws, _ = _workspace(tmp_path, COPY, _copying_relay(0.45), COPY_MAPPING)
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    eng = OnlineEngine(checked, [checked.nodes["Relay"]], rules, 1.0, reorder_window=WINDOW)
+    eng.push("x", {"value": 0.0, **_stamp(1.0)}, 1.0)
+    eng.push("r", {"range": 0.0, **_stamp(1.0)}, 1.45)  # the relay: 450 ms after its stamp
+    eng.push("x", {"value": 1.0, **_stamp(1.3)}, 1.3)
+    assert eng.watermark(1.5) == pytest.approx(1.0)     # the relay was heard up to 1.0 s only
+    assert eng.watermark(1.75) == pytest.approx(1.25)   # silent: 1.75 - 0.45 - 0.05 on its own clock
+    assert eng.watermark(1.80) == pytest.approx(1.30)
+    eng.push("r", {"range": 1.0, **_stamp(1.3)}, 1.75)
+    assert eng.watermark(1.76) == pytest.approx(1.30)   # heard up to 1.3 s: it may still send one stamped later
+    assert eng.watermark(2.30) == pytest.approx(1.80)   # silent since: 2.3 - 0.45 - 0.05
+    # the control: a writer publishing at its stamps holds nothing beyond the bound
+    eng2 = OnlineEngine(checked, [checked.nodes["Relay"]], rules, 1.0, reorder_window=WINDOW)
+    eng2.push("x", {"value": 0.0, **_stamp(1.0)}, 1.0)
+    eng2.push("r", {"range": 0.0, **_stamp(1.01)}, 1.01)
+    assert eng2.watermark(1.5) == pytest.approx(1.45)
