@@ -57,14 +57,22 @@ def ros2_python() -> tuple[Path | None, str]:
     return exe, ""
 
 
-def live_counts(log: Path) -> dict[str, Counter[str]]:
+def live_counts(log: Path, links: dict[str, str] | None = None) -> dict[str, Counter[str]]:
     """Per node, the live verdicts the log's ``rclverify/verdict`` lines carry (first verdicts of
-    answers and deadlines; a deadline's ``update`` line replaces its first verdict)."""
+    answers and deadlines; a deadline's ``update`` line replaces its first verdict), and, ``links``
+    naming each service's and action's node (RCL name -> node), each endpoint the run said it could
+    not judge (a ``rclverify/call`` line of part ``unjudged``: the rclpy source without introspection)
+    as ``undecided`` and ``unjudged``, as the offline check counts it."""
     out: dict[str, Counter[str]] = {}
     for line in log.read_text(errors="replace").splitlines():
         try:
             rec = json.loads(line)
         except ValueError:
+            continue
+        if rec.get("topic") == "rclverify/call" and rec.get("part") == "unjudged" and str(rec.get("link")) in (links or {}):
+            c = out.setdefault((links or {})[str(rec["link"])], Counter())
+            c["undecided"] += 1
+            c["unjudged"] += 1
             continue
         if rec.get("topic") != "rclverify/verdict" or not isinstance(rec.get("verdict"), dict):
             continue
@@ -154,12 +162,12 @@ def _domain() -> tuple[int, int]:
 
 def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2: Path,
             kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src", source: str = "dds",
-            sim_clock: bool = False) -> dict[str, Any]:
+            sim_clock: bool = False, actions: bool = False) -> dict[str, Any]:
     """Run generated robot ``seed`` live and offline under ``tmp`` with rclverify's sources ``src``,
     the monitor hearing the robot through ``source`` (:data:`SOURCES`), the robot on a ``/clock`` of its
-    own with ``sim_clock``; returns the counts and findings (``other_clocks``: the live record's writers
+    own with ``sim_clock``, with Fibonacci action servers with ``actions``; returns the counts and findings (``other_clocks``: the live record's writers
     placed at their source times)."""
-    spec = generate(seed, nodes, defect, kinds, sim_clock)
+    spec = generate(seed, nodes, defect, kinds, sim_clock, actions)
     ws = write_workspace(spec, tmp / "ws")
     (ws / "runs").mkdir(exist_ok=True)
     (tmp / "cyclonedds.xml").write_text(CONFIG)
@@ -203,7 +211,8 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     except (OSError, ValueError):
         res["other_clocks"] = []
     WHY.clear()
-    res["live"] = live_counts(ws / "runs" / "live.jsonl")
+    res["live"] = live_counts(ws / "runs" / "live.jsonl", {n["rcl_topic"]: n["name"] for n in spec["nodes"]
+                                                           if n["kind"] in ("service", "action")})
     res["undecided_why"] = {k: sorted(set(v)) for k, v in WHY.items()}
     for name, (rows, err) in zip(("log", "bag"), _offline(ws, ["runs/live.jsonl", "runs/bag"], menv)):
         if err:
@@ -267,7 +276,7 @@ def findings(res: dict[str, Any]) -> list[str]:
                 out.append(f"{node}: live != {other}: " + ", ".join(f"{k} {a} live, {b} {other}"
                                                                     for k, (a, b) in diff.items()))
         judged = live.get("satisfied", 0) + live.get("violated", 0)
-        if judged == 0:
+        if judged == 0 and not live.get("unjudged"):  # an unjudged endpoint is said, as docs/ros2.md promises
             out.append(f"{node}: nothing judged live")
         if node == victim:
             if live.get("violated", 0) + live.get("deadline false", 0) == 0:
@@ -298,7 +307,7 @@ def _line(res: dict[str, Any]) -> str:
 
 def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: bool, burn: bool,
              keep: Path | None, kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src",
-             source: str = "dds", sim_clock: bool = False) -> int:
+             source: str = "dds", sim_clock: bool = False, actions: bool = False) -> int:
     """Run every seed (a node count drawn per seed in ``sizes``) through ``source``, on a ``/clock`` with
     ``sim_clock``; print one line per seed and the totals.  Returns 0 (the figures are the output; a
     finding is printed, not raised)."""
@@ -317,7 +326,8 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             n = random.Random(seed).randint(*sizes)
             with tempfile.TemporaryDirectory() as d:
                 try:
-                    res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src, source, sim_clock)
+                    res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src, source, sim_clock,
+                                  actions)
                 except RobotFailed as exc:
                     print(f"seed {seed}: GENERATOR FAULT: {exc}", flush=True)
                     failing.append(seed)

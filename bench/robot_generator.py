@@ -37,6 +37,11 @@ constants), ``contracts/plan.yaml``, ``mapping.yaml``, ``interfaces/`` (SetBool)
 every 20 ms at a real-time factor drawn from 0.5-2, from a simulated start of 0, 100 or 5000 s, and
 runs every other node with ``use_sim_time`` (their header stamps come from ``/clock``).
 
+``actions=True`` (``--actions``) turns each SetBool server, one time in two, into a
+``test_msgs/Fibonacci`` action server (with or without introspection, as drawn for the server),
+``out.final >= in.order - 1`` on the result's last number (equal at orders 2-4, always sent); its
+defect answers one short.
+
 CLI (from the repository root)::
 
     python3 bench/robot_generator.py --seeds 0-49 --nodes 5-8 --seconds 10 --burn
@@ -76,6 +81,9 @@ SETBOOL = "bool data\n---\nbool success\nstring message\n"
 #: robot's layout (``--interfaces interfaces``), whose type hash differs from the older definition's
 RANGE = ("std_msgs/Header header\nuint8 ULTRASOUND=0\nuint8 INFRARED=1\nuint8 radiation_type\n"
          "float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range\nfloat32 variance\n")
+FIBONACCI = "int32 order\n---\nint32[] sequence\n---\nint32[] sequence\n"
+#: the orders a Fibonacci action's client draws its goals from (2, 3 and 4 are always sent)
+FIB_ORDERS = (1, 2, 3, 4, 5, 6, 7, 8)
 HORIZON = 1.0
 #: the real-time factors a ``/clock`` robot draws from: simulated seconds per wall-clock second
 CLOCK_RATES = (0.5, 0.75, 1.0, 1.5, 2.0)
@@ -154,13 +162,15 @@ def _sensor(rng: random.Random, i: int, kinds: tuple[str, ...], kind: str | None
 
 
 def generate(seed: int, nodes: int = 5, defect: bool = False,
-             kinds: tuple[str, ...] = tuple(SENSORS), sim_clock: bool = False) -> dict[str, Any]:
+             kinds: tuple[str, ...] = tuple(SENSORS), sim_clock: bool = False,
+             actions: bool = False) -> dict[str, Any]:
     """The spec of generated robot ``seed``: ``{"seed", "defect", "clock", "nodes": [node spec, ...]}``,
     ``nodes`` contract nodes (at least 2: a sensor and one consumer); with ``defect``, exactly one node's
     spec holds ``"defect": True``; ``kinds``: the sensor kinds drawn from (keys of :data:`SENSORS`);
     ``sim_clock``: ``"clock"`` is ``{"rate", "start_s"}`` (a ``/clock`` node, :data:`CLOCK_RATES`),
-    else ``None``.  The nodes drawn do not depend on ``sim_clock``.  Deterministic in (seed, nodes,
-    defect, kinds, sim_clock)."""
+    else ``None``; ``actions``: each SetBool server becomes, one time in two, a Fibonacci action server
+    (its client sending :data:`FIB_ORDERS` goals one at a time).  The other nodes drawn depend on neither
+    option.  Deterministic in (seed, nodes, defect, kinds, sim_clock, actions)."""
     rng = random.Random(f"robot-{seed}-{nodes}" + ("" if kinds == tuple(SENSORS) else "-" + ",".join(kinds)))
     out: list[dict[str, Any]] = []
     sensors: list[dict[str, Any]] = []
@@ -217,12 +227,21 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
         out.append({**base, "kind": "service", "name": f"Switch{i}", "ros_name": f"switch{i}", "topic_base": f"srv{i}",
                     "introspection": rng.random() < 0.5, "period_ms": period, "phase_ms": rng.randrange(0, period),
                     "pattern": [rng.random() < 0.5 for _ in range(7)]})
+    if actions:
+        arng = random.Random(f"actions-{seed}-{nodes}")
+        for k, n in enumerate(out):
+            if n["kind"] == "service" and arng.random() < 0.5:
+                i = n["name"].removeprefix("Switch")
+                out[k] = {"name": f"Fib{i}", "ros_name": f"fib{i}", "namespace": n["namespace"], "kind": "action",
+                          "topic_base": f"fib{i}", "introspection": n["introspection"], "period_ms": n["period_ms"],
+                          "phase_ms": n["phase_ms"], "orders": _with_all(arng, [arng.choice(FIB_ORDERS)
+                                                                             for _ in range(4)], [2, 3, 4])}
     by_name = {n["name"]: n for n in out}
     for n in out:  # resolved names: the ROS topic (absolute), its RCL spelling, and each input's topic
         ns = n.get("namespace")
         rel = f"{ns}/{n['topic_base']}" if ns else n["topic_base"]
         n["rcl_topic"] = rel
-        if n["kind"] == "service":
+        if n["kind"] in ("service", "action"):
             n["service"] = "/" + rel
         else:
             n["topic"] = "/" + rel
@@ -268,7 +287,8 @@ def _consts(spec: dict[str, Any]) -> tuple[list[dict[str, str]], dict[str, dict[
 
 def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str, dict[str, str]]) -> dict[str, Any]:
     """One node's contract as the template's fields (inputs, outputs, topics, services, assume, guarantees)."""
-    c: dict[str, Any] = {"name": n["name"], "topics": [], "services": [], "assume": "TRUE", "inputs": [], "outputs": []}
+    c: dict[str, Any] = {"name": n["name"], "topics": [], "services": [], "actions": [], "assume": "TRUE",
+                         "inputs": [], "outputs": []}
     k = names.get(n["name"], {})
 
     def band(var: str, s: dict[str, Any]) -> str:
@@ -292,6 +312,15 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
         c["guarantees"] = [{"formula": "out.ok == in.on", "trigger": "triggered by in.on within 800 ms"}]
         c["comment"] = (f"a SetBool server, {'with' if n['introspection'] else 'without'} introspection"
                         + (" [seeded defect: every third answer wrong]" if n.get("defect") else ""))
+        return c
+    if n["kind"] == "action":
+        c["inputs"], c["outputs"] = ["order : INTEGER"], ["last : INTEGER", "final : INTEGER"]
+        c["actions"] = [f"test_msgs/Fibonacci {n['rcl_topic']} serves(in.order, out.last, out.final)"]
+        c["assume"] = "in.order >= 1"
+        # F(order) >= order - 1, equal at orders 2, 3 and 4 (every run sends them): the boundary is hit
+        c["guarantees"] = [{"formula": "out.final >= in.order - 1", "trigger": ""}]
+        c["comment"] = (f"a test_msgs/Fibonacci action server, {'with' if n['introspection'] else 'without'} "
+                        "introspection" + (" [seeded defect: its result one short]" if n.get("defect") else ""))
         return c
     deadline = n["delay_ms"] + 500
     if n["kind"] in ("alarm", "relay"):
@@ -356,6 +385,8 @@ def render(spec: dict[str, Any]) -> dict[str, str]:
             fields.append((n["rcl_topic"], SENSORS[n["sensor_kind"]][1]))
         elif n["kind"] == "service":
             fields += [(f"{n['rcl_topic']}/request", "data"), (f"{n['rcl_topic']}/response", "success")]
+        elif n["kind"] == "action":  # the last number of the feedback's and the result's sequence
+            fields += [(f"{n['rcl_topic']}/feedback", '"sequence[-1]"'), (f"{n['rcl_topic']}/result", '"sequence[-1]"')]
         elif n["kind"] == "relay":
             fields.append((n["rcl_topic"], "range"))
         else:
@@ -368,6 +399,7 @@ def render(spec: dict[str, Any]) -> dict[str, str]:
         "mapping.yaml": env.get_template("mapping.yaml.j2").render(fields=fields, horizon=HORIZON),
         "interfaces/std_srvs/srv/SetBool.srv": SETBOOL,
         "interfaces/sensor_msgs/msg/Range.msg": RANGE,
+        "interfaces/test_msgs/action/Fibonacci.action": FIBONACCI,
         "robot.py": env.get_template("robot.py.j2").render(
             seed=spec["seed"], count=len(spec["nodes"]), spec_json=json.dumps(robot_spec, sort_keys=True)),
         "spec.json": json.dumps(spec, indent=1, sort_keys=True) + "\n",
@@ -416,6 +448,8 @@ def main(argv: list[str] | None = None) -> int:
                    help="how the monitor hears the robot (rclverify monitor --source; default dds)")
     p.add_argument("--clock", action="store_true",
                    help="a /clock node at a real-time factor of 0.5-2 (drawn per seed), every node on use_sim_time")
+    p.add_argument("--actions", action="store_true",
+                   help="a Fibonacci action server in place of a SetBool server, one time in two")
     p.add_argument("--burn", action="store_true", help="one CPU-burning process beside each run (both cores busy)")
     p.add_argument("--write", metavar="DIR", help="write the workspaces under DIR/seed-N and stop (no live run)")
     p.add_argument("--keep", metavar="DIR", help="keep each run's workspace, log and bag under DIR/seed-N")
@@ -431,13 +465,13 @@ def main(argv: list[str] | None = None) -> int:
     if a.write:
         for seed in seeds:
             n = random.Random(seed).randint(*sizes)
-            ws = write_workspace(generate(seed, n, a.defect, kinds, a.clock), Path(a.write) / f"seed-{seed}")
+            ws = write_workspace(generate(seed, n, a.defect, kinds, a.clock, a.actions), Path(a.write) / f"seed-{seed}")
             print(f"seed {seed}: {n} nodes: {ws}")
         return 0
     sys.path.insert(0, str(ROOT / "bench"))
     from _robot_run import run_many
     return run_many(seeds, sizes, a.seconds, a.defect, a.burn, Path(a.keep) if a.keep else None, kinds,
-                    Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock)
+                    Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock, a.actions)
 
 
 def _smoke() -> int:

@@ -194,6 +194,24 @@ def test_a_simulated_clock_leaves_the_nodes_as_drawn() -> None:
     assert '"clock": null' in gen.render(gen.generate(3, 8))["robot.py"]
 
 
+def test_actions_replace_some_servers_and_type_check(tmp_path: Path) -> None:
+    """``actions`` turns SetBool servers, and only them, into Fibonacci action servers, with and without
+    introspection across seeds, whose contracts type-check; the control: without it there is none."""
+    seen = set()
+    for seed in range(30):
+        plain, act = gen.generate(seed, 9), gen.generate(seed, 9, actions=True)
+        assert not any(n["kind"] == "action" for n in plain["nodes"])
+        for a, b in zip(plain["nodes"], act["nodes"]):
+            assert a == b or (a["kind"] == "service" and b["kind"] == "action"), (seed, a["name"])
+            if b["kind"] == "action":
+                assert {2, 3, 4} <= set(b["orders"]) and min(b["orders"]) >= 1
+                seen.add(b["introspection"])
+    assert seen == {True, False}
+    spec = gen.generate(3, 6, actions=True)
+    assert any(n["kind"] == "action" for n in spec["nodes"])
+    assert "Fib1" in gen.check_workspace(gen.write_workspace(spec, tmp_path / "ws"))
+
+
 def _robot_kinds() -> tuple[str, ...]:
     import _robot_run
     return _robot_run.KINDS
