@@ -140,6 +140,10 @@ class RobotFailed(Exception):
     """The generated robot's process exited or hung before it said ``done`` (a fault of the generator)."""
 
 
+class MonitorFailed(Exception):
+    """The monitor did not say ``monitoring`` within 60 s (its output's end says why)."""
+
+
 def _source_args(source: str, ros2: Path) -> list[str]:
     """The monitor's ``--source`` arguments: the rclpy source runs in the robot's ROS 2 Python."""
     return ["--source", "dds"] if source == "dds" else ["--source", "rclpy", "--ros2-python", str(ros2)]
@@ -186,7 +190,11 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
                                cwd=ws, env=menv, stdout=(tmp / "monitor.out").open("wb"), stderr=subprocess.STDOUT,
                                start_new_session=True)
         procs.append(mon)
-        wait_text(tmp / "monitor.out", "monitoring", 60)
+        try:
+            wait_text(tmp / "monitor.out", "monitoring", 60)
+        except SystemExit:
+            raise MonitorFailed(f"seed {seed}: the monitor did not start within 60 s (exit {mon.poll()}): "
+                                + (tmp / "monitor.out").read_text(errors="replace")[-1500:]) from None
         robot = subprocess.Popen([str(ros2), str(ws / "robot.py"), str(seconds)], cwd=ws, env=env,
                                  stdout=(tmp / "robot.out").open("wb"), stderr=subprocess.STDOUT,
                                  start_new_session=True)
@@ -328,9 +336,12 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
                 try:
                     res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src, source, sim_clock,
                                   actions)
-                except RobotFailed as exc:
-                    print(f"seed {seed}: GENERATOR FAULT: {exc}", flush=True)
+                except (RobotFailed, MonitorFailed) as exc:
+                    what = "GENERATOR FAULT" if isinstance(exc, RobotFailed) else "MONITOR DID NOT START"
+                    print(f"seed {seed}: {what}: {exc}", flush=True)
                     failing.append(seed)
+                    if keep is not None:
+                        shutil.copytree(d, keep / f"seed-{seed}{'-defect' if defect else ''}", dirs_exist_ok=True)
                     continue
                 if keep is not None and (res["findings"] or res["errors"]):
                     shutil.copytree(d, keep / f"seed-{seed}{'-defect' if defect else ''}", dirs_exist_ok=True)
