@@ -169,7 +169,7 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self.engine.tick(now)
-                self.checks.advance(now - self.engine.reorder_window)  # the monitors' clock, as the engine's
+                self.checks.advance(self.engine.watermark(now))  # the monitors' clock, the engine's watermark
                 self._flush_last()
                 self._log.flush()
 
