@@ -82,7 +82,7 @@ def _verdicts_live(ws: Path, lines: list[dict[str, Any]]) -> tuple[list[tuple[st
         while now + 0.01 <= line["time"] + 0.001:
             now += 0.01
             eng.tick(now)
-            dm.advance(now - WINDOW)
+            dm.advance(eng.watermark(now))
         if line["topic"] == "r":
             marks.append(eng.watermark(now))
         eng.push(line["topic"], {x: v for x, v in line.items() if x not in ("topic", "time")}, line["time"],
