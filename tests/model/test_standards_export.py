@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 from typing import Any
 
@@ -115,57 +114,3 @@ def test_the_command_without_a_report_is_one_located_line(tmp_path: Path, capsys
     assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "reports/assurance.json:1:1: error:" in err[0] and not (tmp_path / "m.csv").exists()
-
-
-def test_the_command_writes_the_exports_of_the_last_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A report a run wrote, read by the command: gaps printed, files written; the stored case study's
-    report, whose files the workspace does not hold, is refused as not what the workspace gives."""
-    report = _verified(tmp_path)
-    capsys.readouterr()
-    assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv"),
-                 "--trace", str(tmp_path / "t.csv")]) == 0
-    out = capsys.readouterr().out
-    assert out.startswith("IEC 61508-3:2010 SIL 2 (built-in profile): ") and "\n  B.8 6c [HR] " in out
-    assert len(_read_csv(tmp_path / "m.csv")) == sum(len(s["clauses"]) for s in report["standards"])
-    assert {r["requirement"] for r in _read_csv(tmp_path / "t.csv")} >= {"R1"}
-    _stored_report(tmp_path)
-    assert main(["standards", "-w", str(tmp_path), "--csv", str(tmp_path / "n.csv")]) == 1
-    assert "run `rclverify verify` and export again" in capsys.readouterr().err and not (tmp_path / "n.csv").exists()
-
-
-def _verified(root: Path) -> dict[str, Any]:
-    """A one-node workspace with IEC 61508-3 SIL 2 mapped and a requirement, verified; its report."""
-    (root / "contracts").mkdir()
-    (root / "contracts/plan.yaml").write_text(
-        "name: s\ncontracts: [contracts/robot.rcl]\nstandards:\n  - {profile: iec61508-3, sil: 2}\n"
-        "requirements:\n  - {id: R1, text: y is never negative, supported_by: [{node: Base, guarantees: [1]}]}\n",
-        encoding="utf-8")
-    (root / "contracts/robot.rcl").write_text(
-        "node Base {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n  guarantee( out.y >= 0 )\n}\n", encoding="utf-8")
-    assert main(["verify", "-w", str(root)]) == 0
-    report: dict[str, Any] = json.loads((root / "reports/assurance.json").read_text(encoding="utf-8"))
-    return report
-
-
-def _stored_report(root: Path) -> dict[str, Any]:
-    """The stored case study's report (what a run writes), put in ``root/reports``."""
-    import gzip
-    repo = Path(__file__).resolve().parents[2]
-    with gzip.open(repo / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
-        report: dict[str, Any] = json.load(f)
-    (root / "reports").mkdir(exist_ok=True)
-    (root / "reports" / "assurance.json").write_text(json.dumps(report), encoding="utf-8")
-    return report
-
-
-def test_without_openpyxl_the_workbook_is_one_line_naming_the_extra(tmp_path: Path) -> None:
-    """In an interpreter that cannot import openpyxl: one line, exit 1, no workbook; the CSV still works."""
-    from _blocked import cli_without
-    report = _verified(tmp_path)
-    r = cli_without("openpyxl", "standards", "-w", str(tmp_path), "--xlsx", str(tmp_path / "w.xlsx"))
-    assert r.returncode == 1 and "Traceback" not in r.stderr and not (tmp_path / "w.xlsx").exists()
-    assert r.stderr.strip().splitlines() == [
-        "error: an XLSX export of the compliance matrix needs rclverify's [xlsx] extra (openpyxl is not installed): "
-        "pip install 'rclverify[xlsx]'"]
-    r = cli_without("openpyxl", "standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv"))
-    assert r.returncode == 0 and len(_read_csv(tmp_path / "m.csv")) == len(matrix_rows(report)) - 1

@@ -10,8 +10,6 @@ import csv
 import gzip
 import hashlib
 import json
-import os
-import shutil
 from pathlib import Path
 from typing import Any
 
@@ -253,68 +251,6 @@ def test_the_workbook_has_the_header_sheet_and_text_cells(tmp_path: Path) -> Non
     first = [c.value for c in next(wb["compliance matrix"].iter_rows(max_row=1))]
     assert first == list(MATRIX_COLUMNS)
     assert all(c.data_type == "s" for row in wb["compliance matrix"].iter_rows() for c in row if c.value is not None)
-
-
-#: A workspace ``verify`` builds in seconds: one node, IEC 61508-3 at SIL 2 mapped.
-_PLAN = "name: s\ncontracts: [contracts/robot.rcl]\nstandards:\n  - {profile: iec61508-3, sil: 2}\n"
-_RCL = "node Base {\n  inputs( x : INTEGER )\n  outputs( y : INTEGER )\n  guarantee( out.y >= 0 )\n}\n"
-
-
-@pytest.fixture(scope="module")
-def verified(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    ws = tmp_path_factory.mktemp("standards_fresh") / "ws"
-    (ws / "contracts").mkdir(parents=True)
-    (ws / "contracts/plan.yaml").write_text(_PLAN, encoding="utf-8")
-    (ws / "contracts/robot.rcl").write_text(_RCL, encoding="utf-8")
-    assert main(["verify", "-w", str(ws)]) == 0
-    return ws
-
-
-def _refused(ws: Path, capsys: pytest.CaptureFixture[str]) -> str:
-    capsys.readouterr()
-    assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 1
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith(f"{ws / 'reports/assurance.json'}:1:1: error: ")
-    assert err[0].endswith("run `rclverify verify` and export again") and not (ws / "m.csv").exists()
-    return err[0]
-
-
-def test_a_file_edited_and_given_back_an_older_time_is_caught_by_its_sha256(
-        verified: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """The report records its inputs' sha256 (meta.inputs_sha256): a file restored with an older
-    modification time than the report's still differs in content."""
-    ws = Path(shutil.copytree(verified, tmp_path / "ws"))
-    rcl = ws / "contracts/robot.rcl"
-    older = (ws / "reports/assurance.json").stat().st_mtime - 100
-    rcl.write_text(_RCL.replace(">= 0", ">= 1"), encoding="utf-8")
-    os.utime(rcl, (older, older))
-    assert "built from other inputs than the workspace holds now" in _refused(ws, capsys)
-    # the control: the same bytes given back are the report's inputs again, whatever their time
-    rcl.write_text(_RCL, encoding="utf-8")
-    later = (ws / "reports/assurance.json").stat().st_mtime + 100
-    os.utime(rcl, (later, later))
-    assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 0 and (ws / "m.csv").exists()
-
-
-def test_a_plan_that_no_longer_loads_refuses_the_export(verified: Path, tmp_path: Path,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
-    """A verify that failed at the plan left the previous report: the command refuses it in one line."""
-    ws = Path(shutil.copytree(verified, tmp_path / "ws"))
-    (ws / "contracts/plan.yaml").write_text(_PLAN + "bogus_key: 1\n", encoding="utf-8")
-    assert "no longer build a report (contracts/plan.yaml:" in _refused(ws, capsys)
-
-
-def test_a_workspace_profile_file_changed_is_caught_and_the_report_as_verified_is_exported(
-        verified: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    ws = Path(shutil.copytree(verified, tmp_path / "ws"))
-    assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 0  # the control
-    report = json.loads((ws / "reports/assurance.json").read_text(encoding="utf-8"))
-    report["standards"][0]["origin"] = {"kind": "workspace", "file": "std/mine.yaml", "sha256": "0" * 64}
-    (ws / "std").mkdir()
-    (ws / "std/mine.yaml").write_text("id: mine\n", encoding="utf-8")
-    (ws / "reports/assurance.json").write_text(json.dumps(report), encoding="utf-8")
-    (ws / "m.csv").unlink()
-    assert "built from another std/mine.yaml (sha256 000000000000..." in _refused(ws, capsys)
 
 
 def test_every_clause_of_the_stored_case_study_is_one_row_agreeing_with_the_json() -> None:
