@@ -271,3 +271,70 @@ def test_endpoints_a_python_base_class_makes_are_the_subclass_nodes(tmp_path: Pa
         assert [(e.topic, e.msg_type) for e in g.nodes[f"/{n}"].subscribes] == [("/command", "std_msgs/msg/Int32")]
     assert [e.topic for e in g.nodes["/solo"].publishes] == ["/solo_extra"] and not g.nodes["/solo"].subscribes
     assert _said(g) == []
+
+
+# -- interface-spec adaptors --------------------------------------------------------
+
+SPECS = """namespace specs
+{
+struct RouteState
+{
+  using Message = std_msgs::msg::String;
+  static constexpr char name[] = "/api/routing/state";
+  static constexpr size_t depth = 1;
+};
+struct SetRoute
+{
+  using Service = std_srvs::srv::Trigger;
+  static constexpr char name[] = "/api/routing/set_route";
+};
+}  // namespace specs
+"""
+ROUTER = """#include <rclcpp/rclcpp.hpp>
+#include <std_msgs/msg/string.hpp>
+#include <std_srvs/srv/trigger.hpp>
+SPECS
+class Router : public rclcpp::Node
+{
+public:
+  Router() : Node("router")
+  {
+    component_interface_utils::NodeAdaptor adaptor(this);
+    pub_ = adaptor.create_publisher<specs::RouteState>();
+    srv_ = adaptor.create_service<specs::SetRoute>(this, &Router::on_set);
+    sub_ = adaptor.create_subscription<specs::RouteState>(std::bind(&Router::on_state, this, std::placeholders::_1));
+  }
+};
+int main(int argc, char ** argv) { rclcpp::init(argc, argv); rclcpp::spin(std::make_shared<Router>()); }
+"""
+
+
+def _router(tmp: Path, specs: str) -> Graph:
+    _write(tmp / "ws" / "api", {
+        "package.xml": PKG.format(name="api", tool="ament_cmake"),
+        "CMakeLists.txt": CMAKE.format(name="api") + "add_executable(router src/router.cpp)\n",
+        "src/router.cpp": ROUTER.replace("SPECS\n", specs)})
+    return _scan(tmp)
+
+
+def test_an_interface_spec_adaptor_takes_name_and_type_from_the_spec(tmp_path: Path) -> None:
+    g = _router(tmp_path, SPECS)
+    r = g.nodes["/router"]
+    assert [(e.topic, e.msg_type, e.src.line) for e in r.publishes] == [
+        ("/api/routing/state", "std_msgs/msg/String", 24)]
+    assert [(e.topic, e.msg_type, e.src.line) for e in r.subscribes] == [
+        ("/api/routing/state", "std_msgs/msg/String", 26)]
+    assert [(e.topic, e.msg_type, e.src.line) for e in r.service_servers] == [
+        ("/api/routing/set_route", "std_srvs/srv/Trigger", 25)]
+    assert _said(g) == []
+
+
+def test_an_adaptor_of_a_spec_not_read_is_said_at_each_call(tmp_path: Path) -> None:
+    g = _router(tmp_path, "")  # control: the specs are defined elsewhere
+    r = g.nodes["/router"]
+    assert not r.publishes and not r.subscribes and not r.service_servers
+    said = sorted((n.src.line, n.message) for n in g.notes)
+    assert [line for line, _m in said] == [10, 11, 12], said
+    assert "interface spec specs::SetRoute" in said[1][1] and "interface spec specs::RouteState" in said[2][1]
+    assert "adaptor.create_publisher(...) takes no name (an interface-spec adaptor's, named and typed by " \
+           "specs::RouteState" in said[0][1]

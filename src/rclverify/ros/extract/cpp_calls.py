@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from rclverify.ros.extract import cpp_helpers, symbols, treesitter
+from rclverify.ros.extract import cpp_helpers, emit, symbols, treesitter
 from rclverify.ros.extract.cpp_scope import callee_parts
 from rclverify.ros.extract.cpp_types import action_type, callback_name, service_type
 from rclverify.ros.extract.model import Note, canon_type
@@ -80,6 +80,8 @@ class CallReader:
         is recorded for the linker."""
         s = self.scope
         kind = _CALLS.get(last)
+        if kind is not None and targs and last.startswith("create_") and self.interface_spec(n, kind, targs[0], args):
+            return
         if kind is None or not args:
             if not full.startswith(LIBRARY):
                 self.record("call", full, args, n)
@@ -121,6 +123,42 @@ class CallReader:
             self.emit(kind, args[0], canon_type(symbols.text(gt)) if gt and gt[0] == "str" else None, n, handle)
             return
         self.typed_endpoint(n, kind, last, targs, args, handle)
+
+    def interface_spec(self, n: Any, kind: str, spec: str, args: list[Any]) -> bool:
+        """``adaptor.create_publisher<Spec>()``, ``create_service<Spec>(this, &cb)``,
+        ``create_subscription<Spec>(cb)``: an interface-spec adaptor (Autoware's
+        component_interface_utils), whose template argument is a struct holding
+        the name (``static constexpr char name[] = "/api/..."``) and the type
+        (``using Message = ...`` / ``using Service = ...``).  A spec this file
+        defines is read (the endpoint emitted); a call of a spec it does not define whose
+        first argument is no name (``this``, a member pointer, a lambda,
+        ``std::bind``) is said at its line; one without arguments is followed
+        by the linker (a method of the program's own), else said there.  Returns whether the
+        call was handled."""
+        key = spec.replace(" ", "").lstrip(":")
+        hits = [k for k in self.spec_names if k == key or k.endswith("::" + key)]
+        if len(hits) == 1:
+            full = hits[0]
+            if kind in ("pub", "sub"):
+                t = self.msg(self.aliases.get(f"{full}::Message"))
+            else:
+                t = service_type(self.aliases.get(f"{full}::Service"))
+            name = self.spec_names[full]
+            self.emit(kind, None, t, n, None, name=symbols.lit(name), written=name)
+            return True
+        first = args[0] if args else None
+        if first is None:  # rclcpp's methods all take a name: a user's own method, else said by the linker
+            self.user_create(n, callee_parts(n.child_by_field_name("function"))[0], args,
+                             f"takes no name (an interface-spec adaptor's, named and typed by {spec}, "
+                             f"which the workspace does not define, or a method of the program's own)")
+            return True
+        if not (first.type in ("this", "lambda_expression", "pointer_expression")
+                or _T(first).startswith(("std::bind", "&"))):
+            return False
+        self.out["notes"].append(Note(self.src(n), f"{emit.WHAT[kind]} of interface spec {spec}: its name and type "
+                                                   f"are the spec's (static name[] and using Message/Service), which "
+                                                   f"this file does not define: not resolved statically"))
+        return True
 
     def user_create(self, n: Any, full: str, args: list[Any], *why: str) -> None:
         """A ``create_*`` call that is the program's own function or method:

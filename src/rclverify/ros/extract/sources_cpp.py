@@ -74,6 +74,7 @@ class _File(CallReader, MemberReader):
         self.nodes = list(treesitter.walk(root))
         self.aliases: dict[str, str] = adapters
         self._bare: dict[str, set[str]] = {}  # an alias's bare name -> the texts the file gives it
+        self.spec_names: dict[str, str] = {}  # interface spec struct -> its static name[] literal
         for n in self.nodes:
             self._index(n)
         self.scope = CppValues(self.nodes)
@@ -109,6 +110,12 @@ class _File(CallReader, MemberReader):
         elif t == "using_declaration" and not any(c.type == "namespace" for c in n.children) and n.named_children:
             full = _T(n.named_children[-1])
             self._alias(n, full.split("::")[-1], full)
+        elif t == "field_declaration" and n.parent is not None and n.parent.type == "field_declaration_list":
+            d, v = n.child_by_field_name("declarator"), n.child_by_field_name("default_value")
+            if d is not None and d.type == "array_declarator" and _T(d).replace(" ", "") == "name[]" \
+                    and v is not None and v.type == "string_literal" and "static" in _T(n).split():
+                nss, cls = namespaces_of(n)  # an interface spec: static constexpr char name[] = "/api/...";
+                self.spec_names["::".join(nss + cls)] = _T(v)[1:-1]
         elif t == "preproc_include":
             p = n.child_by_field_name("path")
             if p is not None:
