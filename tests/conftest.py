@@ -131,6 +131,7 @@ PIPELINE = frozenset({
     "test_example_ros2_robot",  # its one live test is marked in the module (the rest is offline)
     "test_margins_monitor", "test_margins_chain", "test_near_misses", "test_margin_targets",
     "test_margins_report", "test_near_miss_units_report",
+    "test_code_repairs", "test_standards_fresh",
 })
 
 #: The ``slow`` tier: every module measured above two CPU seconds, and the pipeline runs.
