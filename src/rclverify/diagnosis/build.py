@@ -42,6 +42,7 @@ import z3
 from rclverify.core.cache import Shelf, file_digest
 from rclverify.lang.errors import RclError
 from rclverify.diagnosis import blame, repairs as rep
+from rclverify.diagnosis.code_repair import checked_repairs
 from rclverify.diagnosis.constants import hoare_repair
 from rclverify.diagnosis.deadline import budget_repairs, deadline_record
 from rclverify.diagnosis.requirement import requirement_record
@@ -399,9 +400,16 @@ def _evidence(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson | 
         sentence = (f"Hypothesis found inputs on which {impl} "
                     f"violates {where}" + (f"; the implementation line where the failing example goes wrong is {cause}"
                                            if cause else "") + f"; replay: `{ce.get('replay', '')}`.")
+        repairs: list[Repair] = []
+        if isinstance(cause, str) and cause and e["status"] == "failed":  # the culprit is a line of the code
+            before = {str(x["obligation"]): str(x["status"]) for x in report["evidence"]
+                      if str(x["obligation"]).startswith(f"{node}.")}
+            repairs = cache.get(["code", e["obligation"], cause, before],
+                                lambda: checked_repairs(ws, node, e["obligation"], cause, before),
+                                cause.rpartition(":")[0]) or []
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
                        culprits=[{"what": where, "source": src, "text": text}],
-                       counterexample=counterexample_table(cex, node), guarantee=k)
+                       counterexample=counterexample_table(cex, node), guarantee=k, repairs=repairs)
     expl = str(e.get("explanation", ""))
     first = expl.split("; ")[0] if len(expl) > 300 else expl
     return _record(e["obligation"], "evidence", node, e["status"],

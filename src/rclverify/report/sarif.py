@@ -402,7 +402,9 @@ def _attach_diagnoses(report: Report, results: Sequence[SarifResult]) -> None:
         if res["partialFingerprints"]["rclverifyItem/v1"].startswith("side-condition:"):
             _at_the_culprit(res, d)
         # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
-        fixes = [sarif_fix(f"{r['summary']} Z3 shows: {r.get('proves') or 'the problem no longer follows'}; not shown: "
+        # a repair of the code is checked by the property tests (diagnosis/code_repair.py), not by Z3 alone
+        fixes = [sarif_fix(f"{r['summary']} {'The property tests show' if r['kind'] == 'code' else 'Z3 shows'}: "
+                           f"{r.get('proves') or 'the problem no longer follows'}; not shown: "
                            f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
                  for r in d.get("repairs", []) if r.get("edit")]
         if fixes:

@@ -1,0 +1,246 @@
+"""Checked repairs of a failing property test whose culprit is a line of the
+implementation (docs/diagnosis.md, "Repairs of the implementation").
+
+The property-tests backend names the implementation line where a failing
+example goes wrong (``counterexample.cause``: the line whose one-token
+correction makes the example meet the guarantee, else the line that
+computed the output; backends/property_tests/slips.py and cause.py).  Here
+the one-token corrections of that line are offered as repairs, each kept
+only when it was checked:
+
+1. *The candidates* (:func:`candidate_edits`): the corrections the culprit
+   search tries on the statement at that line (a comparison's strictness,
+   ``+``/``-``, ``*``/``/``, ``and``/``or``, a ``not`` dropped, a truth
+   value negated, a number moved by one or replaced by a number the
+   contract names: :func:`~rclverify.backends.property_tests.slips.mutations`),
+   and ``max``/``min`` swapped, each as a text edit of that line's
+   expression cut to the characters that change.  Smallest first (the
+   characters taken out and put in), then in source order.
+2. *The check* (:func:`checked_repairs`): the implementation's import
+   closure and the files the mapping reads are copied to a scratch folder,
+   the edit is made there (the workspace is never touched), and every
+   guarantee of the node is run again by the backend's own harness
+   (:func:`~rclverify.backends.property_tests.harness.run_guarantee`, the
+   plan entry's seed and budget), the failing guarantee first.  A
+   candidate is kept when every run is ``discharged``: an edit that
+   repairs the failing guarantee and breaks another is not offered.
+3. At most :data:`MAX_REPAIRS` are kept, of at most :data:`MAX_TRIED`
+   candidates tried.
+
+What the check shows is what the harness shows: the node's guarantees
+held on every example Hypothesis drew from the edited copy; not that the
+edit is the right one for the robot, nor any proof.  Nothing here raises
+for the user's code: a candidate whose run raises is not kept.
+"""
+from __future__ import annotations
+
+import ast
+import shutil
+import tempfile
+from fractions import Fraction
+from pathlib import Path
+from typing import Any, Iterable, Sequence
+
+from rclverify.diagnosis.edits import Edit
+from rclverify.records.stage_records import Repair
+
+#: Most repairs offered for one failure.
+MAX_REPAIRS = 3
+#: Most candidates run on a scratch copy for one failure (each runs every guarantee of the node).
+MAX_TRIED = 6
+#: The swapped names of a call: ``max`` for ``min`` and back.
+_SWAP = {"max": "min", "min": "max"}
+
+
+def _col(line_text: str, byte_offset: int) -> int:
+    """The 1-based character column of ``byte_offset`` (ast's UTF-8 offset) in ``line_text``."""
+    return len(line_text.encode("utf-8")[:byte_offset].decode("utf-8", errors="ignore")) + 1
+
+
+def _edit(file: str, lines: list[str], node: ast.AST, new: str) -> Edit | None:
+    """The edit putting ``new`` in place of ``node``'s text, cut to the characters that change; ``None``
+    when nothing changes or ``node`` has no span."""
+    line, end_line = getattr(node, "lineno", None), getattr(node, "end_lineno", None)
+    col, end_col = getattr(node, "col_offset", None), getattr(node, "end_col_offset", None)
+    if line is None or end_line is None or col is None or end_col is None:
+        return None
+    a, b = _col(lines[line - 1], col), _col(lines[end_line - 1], end_col)
+    old = Edit(file, line, a, end_line, b, "").deleted("".join(lines))
+    if old == new:
+        return None
+    p = 0  # the common prefix and suffix left as they are
+    while p < min(len(old), len(new)) and old[p] == new[p]:
+        p += 1
+    s = 0
+    while s < min(len(old), len(new)) - p and old[-1 - s] == new[-1 - s]:
+        s += 1
+    while 0 < p and _joined(old[p - 1], old[p:p + 1] or new[p:p + 1]) or 0 < p and _joined(old[p - 1], new[p:p + 1]):
+        p -= 1  # a token is changed whole: ``<`` for ``<=``, ``max`` for ``min``
+    while 0 < s and (_joined(old[len(old) - s], old[len(old) - s - 1:len(old) - s])
+                     or _joined(new[len(new) - s], new[len(new) - s - 1:len(new) - s])):
+        s -= 1
+    start_line, start_col = line, a
+    for ch in old[:p]:
+        start_line, start_col = (start_line + 1, 1) if ch == "\n" else (start_line, start_col + 1)
+    stop_line, stop_col = start_line, start_col
+    for ch in old[p:len(old) - s]:
+        stop_line, stop_col = (stop_line + 1, 1) if ch == "\n" else (stop_line, stop_col + 1)
+    return Edit(file, start_line, start_col, stop_line, stop_col, new[p:len(new) - s])
+
+
+def _kind(c: str) -> str:
+    """A character's token class: ``w`` (a name or number), ``o`` (an operator), ``""`` (anything else)."""
+    return "w" if c.isalnum() or c == "_" else "o" if c in "<>=!+-*/%&|^~" else ""
+
+
+def _joined(a: str, b: str) -> bool:
+    """Whether characters ``a`` and ``b`` (``b`` may be empty) belong to one token."""
+    return bool(b) and _kind(a) != "" and _kind(a) == _kind(b)
+
+
+def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fraction]) -> list[Edit]:
+    """The one-token corrections of the statement at ``line`` of ``source`` (the implementation file
+    ``file``, as the plan names it) inside a function (module docstring, step 1), each once, smallest
+    first; ``[]`` when the line holds no statement of a function or the file does not parse."""
+    from rclverify.backends.property_tests.slips import mutations  # deferred: start-up (the backend's search)
+    try:
+        tree = ast.parse(source, file)
+    except (SyntaxError, ValueError):
+        return []
+    lines = source.splitlines(keepends=True)
+    out: list[Edit] = []
+    for fdef in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))):
+        if not fdef.lineno <= line <= (fdef.end_lineno or fdef.lineno) or not isinstance(fdef, ast.FunctionDef):
+            continue
+        stmts = [s for s in ast.walk(fdef) if isinstance(s, ast.stmt) and s is not fdef and s.lineno == line
+                 and not isinstance(s, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))]
+        nodes = list(ast.walk(fdef))
+        for stmt in stmts:
+            for m in mutations(fdef, stmt, numbers):
+                old = nodes[m.index]
+                if getattr(old, "lineno", None) == line:
+                    out.append(_edit(file, lines, old, ast.unparse(m.new)) or _NONE)
+            for call in _calls(stmt):
+                assert isinstance(call.func, ast.Name)
+                out.append(_edit(file, lines, call.func, _SWAP[call.func.id]) or _NONE)
+    seen: set[tuple[int, int, int, int, str]] = set()
+    kept: list[Edit] = []
+    for e in out:
+        key = (e.line, e.col, e.end_line, e.end_col, e.text)
+        if e is not _NONE and key not in seen:
+            seen.add(key)
+            kept.append(e)
+    return sorted(kept, key=lambda e: (len(e.deleted(source)) + len(e.text), e.line, e.col))
+
+
+#: No edit (a mutation that changes no character).
+_NONE = Edit("", 0, 0, 0, 0, "")
+
+
+def _calls(stmt: ast.stmt) -> Iterable[ast.Call]:
+    """The ``max``/``min`` calls of ``stmt``'s own expressions on its first line."""
+    roots: list[ast.AST] = []
+    if isinstance(stmt, (ast.Return, ast.Assign, ast.AugAssign, ast.AnnAssign)) and stmt.value is not None:
+        roots = [stmt.value]
+    elif isinstance(stmt, (ast.If, ast.While)):
+        roots = [stmt.test]
+    for r in roots:
+        for n in ast.walk(r):
+            if isinstance(n, ast.Call) and isinstance(n.func, ast.Name) and n.func.id in _SWAP \
+                    and n.func.lineno == stmt.lineno:
+                yield n
+
+
+def _scratch(root: Path, files: Iterable[str], edited: str, text: str) -> Path:
+    """A scratch folder holding ``files`` (workspace-relative) copied from ``root`` and ``edited`` with
+    ``text``; the caller removes it."""
+    tmp = Path(tempfile.mkdtemp(prefix="rclverify-code-repair-"))
+    for f in files:
+        src = root / f
+        if src.is_file():
+            (tmp / f).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(src, tmp / f)
+    (tmp / edited).parent.mkdir(parents=True, exist_ok=True)
+    (tmp / edited).write_text(text, encoding="utf-8")
+    return tmp
+
+
+def _statuses(target: Any, cfg: Any, text: str, first: int) -> dict[int, str]:
+    """Each guarantee's status (``discharged``, ``failed``, ...) of the node of ``target`` run by the
+    harness on a scratch copy whose implementation file holds ``text``, guarantee ``first`` first; it
+    stops at the first run that is not ``discharged``."""
+    from rclverify.backends.property_tests.at_width import mapping_inputs  # deferred: start-up (the backend)
+    from rclverify.backends.property_tests.closure import resolve_closure  # deferred: start-up (the backend)
+    from rclverify.backends.property_tests.harness import run_guarantee  # deferred: start-up (hypothesis)
+    from rclverify.backends.timelimit import TimeLimitExceeded, wall_clock_limit  # deferred: start-up
+    root = Path(target.root)
+    files = [*resolve_closure(root, cfg.file).files, *mapping_inputs(root, target.mapping)]
+    if target.mapping:
+        files.append(target.mapping)
+    tmp = _scratch(root, files, cfg.file, text)
+    n = len(target.node.node.guarantees)
+    out: dict[int, str] = {}
+    try:
+        for k in [first, *(j for j in range(1, n + 1) if j != first)]:
+            try:
+                with wall_clock_limit(cfg.timeout_s):
+                    out[k] = run_guarantee(target.checked, target.node, k, cfg, tmp, target.facts, None,
+                                           target.mapping).status
+            except TimeLimitExceeded:
+                out[k] = "inconclusive"
+            except Exception:  # noqa: BLE001 - the edited code does not load or run: no repair
+                out[k] = "error"
+            if out[k] != "discharged":
+                break
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return out
+
+
+def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
+                    before: dict[str, str] | None = None) -> list[Repair]:
+    """The checked repairs (module docstring) of the failing property-test ``obligation``
+    (``Node.gK.property_tests.eI``) of ``node`` whose culprit is ``cause`` (``file:line``, the file as
+    the plan entry names it).  ``before``: obligation id -> status in the report, for each repair's
+    ``cost``.  ``[]`` when ``cause`` is not a line of the entry's implementation file, when no
+    candidate passes, or when the entry cannot be read."""
+    from rclverify.backends.property_tests.boundary import contract_numbers  # deferred: start-up (the backend)
+    from rclverify.backends.property_tests.harness import read_config, versions  # deferred: start-up (hypothesis)
+    from rclverify.diagnosis.repairs import _record  # deferred: start-up (z3 and the contract checks)
+    file, _, at = cause.rpartition(":")
+    parts = obligation.split(".")
+    if not at.isdigit() or len(parts) < 4 or not parts[-1][1:].isdigit() or not parts[1][1:].isdigit():
+        return []
+    index, failing = int(parts[-1][1:]), int(parts[1][1:])
+    try:
+        target = ws.target(node, index)
+        cfg = read_config(target.config, target.node, target.root)
+        source = (Path(target.root) / cfg.file).read_text(encoding="utf-8")
+    except Exception:  # noqa: BLE001 - an entry that no longer reads: the plan's checks say why
+        return []
+    if file != cfg.file:
+        return []
+    out: list[Repair] = []
+    ids = {k: f"{node}.g{k}.property_tests.e{index}" for k in range(1, len(target.node.node.guarantees) + 1)}
+    for edit in candidate_edits(source, file, int(at), contract_numbers(target.node))[:MAX_TRIED]:
+        got = _statuses(target, cfg, edit.apply(source), failing)
+        if len(got) != len(ids) or any(s != "discharged" for s in got.values()):
+            continue
+        old = source.splitlines()[edit.line - 1].strip()
+        new = edit.apply(source).splitlines()[edit.line - 1].strip()
+        checks = [{"check": ids[k], "status": got[k]} for k in sorted(got)]
+        cost = [{"check": ids[k], "before": (before or {}).get(ids[k], "absent"), "after": got[k]}
+                for k in sorted(got) if (before or {}).get(ids[k], "absent") != got[k]]
+        rec = _record("code", f"At {file}:{edit.line}, change `{old}` to `{new}`: a one-token correction of the "
+                      "line where the failing example goes wrong.", edit, source, checks, cost,
+                      proves=f"every guarantee of {node} ({len(ids)}) held again on every example the property "
+                      f"tests drew from a scratch copy with the edit (seed {cfg.seed})",
+                      not_shown="that the edit is right for the robot: the tests draw examples, they prove nothing")
+        rec["checked_by"] = versions()
+        out.append(rec)
+        if len(out) >= MAX_REPAIRS:
+            break
+    return out
+
+
+__all__ = ["MAX_REPAIRS", "MAX_TRIED", "candidate_edits", "checked_repairs"]
