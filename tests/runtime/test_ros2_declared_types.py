@@ -462,7 +462,7 @@ def test_a_type_with_no_local_definition_is_defined_from_the_ros2_python(tmp_pat
     """A contract type the monitor has no definition of: without one, the error names the file to give
     and the option; the ROS 2 Python's own description (the agent's --describe, checked against rosidl's
     hash) defines it, nested types included, and rclpy's bytes decode with it."""
-    from rclverify.runtime.rclpy_source.bus import installed_declarations
+    from rclverify.runtime.rclpy_source.describe import installed_declarations
     name = "type_description_interfaces/msg/FieldType"
     book = TypeBook([])
     with pytest.raises(DdsTypeError, match=f"message type {name} is neither in the workspace's interface files nor "

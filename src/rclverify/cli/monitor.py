@@ -291,7 +291,7 @@ def _run_ros2(args: argparse.Namespace, factory: Any, checked: Any, nodes: Any, 
         return None
     describe = None
     if bus_factory is not None:  # the rclpy source (partial(RclpyBus, ros2_python)): types its Python knows
-        from rclverify.runtime.rclpy_source.bus import installed_declarations  # deferred: optional or conditional (only --ros2)
+        from rclverify.runtime.rclpy_source.describe import installed_declarations  # deferred: optional or conditional (only --ros2)
         describe = partial(installed_declarations, bus_factory.args[0])
     # the bag records each contract type in the definition the monitor decodes it with (``--interfaces`` too)
     return run_dds(factory, checked, nodes, msg_dirs + interfaces, **common, enforce=guarded, record=rec,

@@ -14,12 +14,12 @@ pipe (:mod:`.wire`):
   ``sensor_msgs/msg/LaserScan``), its samples the serialized bytes rmw
   received, decoded by the monitor as the DDS path decodes them (every field
   at its width);
-* discovery is rclpy's graph API: each publisher's GID, node, type, ROS 2
+* discovery is rclpy's graph API (:mod:`.discovery`): each publisher's GID, node, type, ROS 2
   type hash (REP-2011) and QoS; a publisher of another type than the
   contract's is named in a located warning and never heard;
 * a publisher of the contract's type with **another type hash** than the
   monitor's definition (the robot's distribution changed the type: Kilted's
-  ``sensor_msgs/Range`` has ``variance``) is read in its own definition:
+  ``sensor_msgs/Range`` has ``variance``) is read in its own definition (:mod:`.declared`):
   the agent is asked for the type description it declares (``describe``:
   the ROS 2 Python's own when its hash is that one, else the publisher's
   node's type description service), each description found is checked to
@@ -54,7 +54,6 @@ start): one message.
 from __future__ import annotations
 
 import base64
-import io
 import json
 import subprocess
 import threading
@@ -62,10 +61,11 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import Any, Callable, IO, Mapping
 
-from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.live.dds_qos import QosProfile
 from rclverify.runtime.dds.bus import Tap
-from rclverify.runtime.dds.types import DdsTypeError, Declaration, Declared, declare
+from rclverify.runtime.rclpy_source.discovery import AgentDiscovery, ros_name, ros_type
+from rclverify.runtime.rclpy_source.declared import DeclaredTypes
+from rclverify.runtime.dds.types import Declaration, Declared
 from rclverify.runtime.rclpy_source.wire import parse_sample, read_frame
 
 AGENT = Path(__file__).with_name("agent.py")
@@ -78,55 +78,6 @@ HOLD_MAX = 10_000
 
 class RclpyUnavailable(Exception):
     """The rclpy source cannot run; ``str`` says why in one line."""
-
-
-def ros_name(dds_topic: str) -> str | None:
-    """The ROS name of a DDS topic of ROS 2's conventions (``rt/a/b`` -> ``/a/b``),
-    ``None`` for a service's request or reply topic (``rq/``, ``rr/``: rclpy cannot read them)."""
-    if dds_topic.startswith("rt/"):
-        return "/" + dds_topic[3:]
-    return None
-
-
-def ros_type(struct: type) -> str:
-    """``pkg/msg/T`` of a contract struct (``pkg::msg::dds_::T_``)."""
-    parts = [p for p in struct.__idl_typename__.split("::") if p != "dds_"]  # type: ignore[attr-defined]
-    return "/".join(parts[:-1] + [parts[-1].rstrip("_")])
-
-
-class _Discovery:
-    """The graph as the agent reports it, with the DDS discovery's face."""
-
-    def __init__(self) -> None:
-        self.topics: dict[str, list[dict[str, Any]]] = {}
-        self.services: dict[str, dict[str, list[str]]] = {}
-        self._node: dict[bytes, str] = {}
-
-    def update(self, graph: dict[str, Any]) -> None:
-        self.topics = graph.get("topics", {})
-        self.services = graph.get("services", {})
-        self._node = {bytes.fromhex(p["gid"]): (p["ns"].rstrip("/") + "/" + p["node"])
-                      for ps in self.topics.values() for p in ps}
-
-    def publishers(self, dds_topic: str) -> list[EndpointInfo]:
-        """The publishers on ``dds_topic`` (its ROS name), by GID."""
-        name = ros_name(dds_topic)
-        out = [EndpointInfo(bytes.fromhex(p["gid"]), bytes.fromhex(p["gid"])[:12], dds_topic, p["type"],
-                            QosProfile(reliable=p["reliable"], durability=p["durability"]))
-               for p in self.topics.get(name or "", [])]
-        return sorted(out, key=lambda e: e.guid)
-
-    def node_of(self, guid: bytes) -> str | None:
-        """The ROS node (``/ns/name``) of a publisher's GID, or ``None``."""
-        return self._node.get(guid)
-
-    def who(self, e: EndpointInfo) -> str:
-        n = self.node_of(e.guid)
-        return f"node {n}" if n else f"publisher {e.guid.hex()}"
-
-    def hash_of(self, dds_topic: str, guid: bytes) -> str:
-        name = ros_name(dds_topic) or ""
-        return next((p["hash"] for p in self.topics.get(name, []) if bytes.fromhex(p["gid"]) == guid), "")
 
 
 class _Writer:
@@ -144,7 +95,7 @@ class _Writer:
         self.bus._send({"op": "write", "id": self.wid, "raw": base64.b64encode(raw).decode()})
 
 
-class RclpyBus:
+class RclpyBus(DeclaredTypes):
     """The taps, writers and discovery of one live run over rclpy (module
     docstring).  ``python``: the ROS 2 Python the agent runs in;
     ``on_sample(tap, raw, info, received_ns)`` is called in the bus thread
@@ -160,7 +111,7 @@ class RclpyBus:
                  type_hash: Callable[[type], str | None] | None = None) -> None:
         self.python, self.on_sample, self.warn, self.on_reader = python, on_sample, warn, on_reader
         self.type_hash = type_hash or (lambda struct: None)
-        self.discovery = _Discovery()
+        self.discovery = AgentDiscovery()
         self.taps: list[Tap] = []
         self.deaf: list[Tap] = []
         self.watched: dict[str, tuple[str, str, str]] = {}
@@ -335,80 +286,6 @@ class RclpyBus:
         self.on_sample(t, raw, SimpleNamespace(source_timestamp=source_ns, writer_guid=gid, sequence=seq),
                        received_ns)
 
-    def _admit(self, t: Tap, gid: bytes) -> bool | Declaration | None:
-        """How publisher ``gid``'s samples are read: ``True`` in the contract's layout (its ROS 2 type
-        hash is the contract type's, REP-2011, or a hash is not known: taken at its type name), a
-        :class:`~rclverify.runtime.dds.types.Declaration` in the definition it declares, ``False``
-        not at all (no declaration checked out: warned once), ``None`` not known yet (asked for)."""
-        theirs, ours = self.discovery.hash_of(t.dds_topic, gid), self.type_hash(t.struct)
-        if not theirs or not ours or theirs == ours:
-            return True
-        key = (ros_type(t.struct), theirs)
-        if key not in self._declared:
-            self._ask(t, gid, key)
-            return None
-        decl = self._declared[key]
-        if decl is not None:
-            return decl
-        pkg, _, name = key[0].partition("/msg/")
-        self._warn_once(t.key, gid, "layout", f"{t.where}: warning: {t.key}: {self._who(t, gid)} publishes "
-                        f"{key[0]} with the type hash {theirs}, the monitor's definition of it hashes to {ours}, "
-                        f"and the publisher's own definition could not be had ({self._why[key]}): its messages "
-                        f"are not heard; give the robot's definition as DIR/{pkg}/msg/{name}.msg with "
-                        "--interfaces DIR (or the mapping's msg_dirs)")
-        return False
-
-    def _who(self, t: Tap, gid: bytes) -> str:
-        node = self.discovery.node_of(gid)
-        return f"node {node} (publisher {gid.hex()})" if node else f"publisher {gid.hex()}"
-
-    def _ask(self, t: Tap, gid: bytes, key: tuple[str, str]) -> None:
-        """Ask the agent, once per type and hash, for the description publisher ``gid`` declares."""
-        if key in self._asking or key in self._declared:
-            return
-        self._asking.add(key)
-        pub = next((p for p in self.discovery.topics.get(ros_name(t.dds_topic) or "", [])
-                    if bytes.fromhex(p["gid"]) == gid), {})
-        self._send({"op": "describe", "type": key[0], "hash": key[1], "node": pub.get("node", ""),
-                    "ns": pub.get("ns", "/")})
-
-    def _described(self, obj: dict[str, Any]) -> None:
-        """The agent's answer to a ``describe`` (:mod:`.wire`): the first candidate that hashes to
-        the publisher's hash is the type's declaration; each that does not is said; the samples held
-        for it are handed on (or dropped, with the warning, when none checks out)."""
-        key = (str(obj.get("type", "")), str(obj.get("hash", "")))
-        self._asking.discard(key)
-        decl: Declaration | None = None
-        why = [str(f) for f in obj.get("failures", [])]
-        for cand in obj.get("candidates", []):
-            try:
-                decl = declare(key[0], key[1], cand.get("description", {}), str(cand.get("from", "the agent")))
-                break
-            except DdsTypeError as exc:  # a stale or forged description: said where the contract names the type
-                why.append(str(exc))
-                for t in self.taps:
-                    if ros_type(t.struct) == key[0]:
-                        self.warn(f"{t.where}: warning: {t.key}: {exc}")
-        self._declared[key] = decl
-        self._why[key] = "; ".join(why) or "nothing answered"
-        for t in self.taps:  # refused: each such publisher said at once (the warning of _admit), not at its sample
-            if decl is None and ros_type(t.struct) == key[0]:
-                for p in self.discovery.publishers(t.dds_topic):
-                    if self.discovery.hash_of(t.dds_topic, p.guid) == key[1]:
-                        self._admit(t, p.guid)
-        if decl is not None:
-            for t in self.taps:
-                if ros_type(t.struct) == key[0]:
-                    self.warn(f"{t.where}: note: {t.key}: publishers of {key[0]} with the type hash {key[1]} (not "
-                              f"the monitor's {self.type_hash(t.struct)}) are read in their own definition, from "
-                              f"{decl.origin}")
-        for (k, gid), bodies in list(self._held.items()):
-            t = self.taps[k]
-            if ros_type(t.struct) == key[0] and self.discovery.hash_of(t.dds_topic, gid) == key[1]:
-                del self._held[(k, gid)]
-                for body in bodies:
-                    self._sample(body)
-
     def _json(self, obj: dict[str, Any]) -> None:
         what = obj.get("what")
         if what == "graph":
@@ -452,38 +329,6 @@ class RclpyBus:
                     self.warn(f"{where}: warning: /{key}: {who} writes on the {role} beside the monitor; what "
                               "it writes is not checked, and the evidence is not discharged while it does")
 
-    def _warn_once(self, key: str, gid: bytes, why: str, text: str) -> None:
-        if (key, gid, why) not in self._warned:
-            self._warned.add((key, gid, why))
-            self.warn(text)
 
 
-def installed_declarations(python: Path, names: list[str], timeout_s: float = 60.0) -> dict[str, Declaration]:
-    """The definitions the ROS 2 Python ``python`` has of message types ``names`` (``pkg/msg/T``), as
-    rosidl described them when the packages were built (the agent's ``--describe``), each checked to
-    hash to the hash rosidl gave it (:func:`~rclverify.runtime.dds.types.declare`): what a contract type
-    with no local definition is read with (:meth:`~rclverify.runtime.dds.types.TypeBook.add_declaration`).
-    A type the Python has no description of is left out.  Raises :class:`RclpyUnavailable` (one line)
-    when the agent cannot run or answer, or a description does not hash to its own hash."""
-    try:
-        proc = subprocess.run([str(python), str(AGENT), "--describe", *names], capture_output=True,
-                              timeout=timeout_s)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)}: {exc}") from None
-    frame = read_frame(io.BytesIO(proc.stdout))
-    if proc.returncode != 0 or frame is None or frame[0] != b"J":
-        last = proc.stderr.decode(errors="replace").strip().splitlines()[-1:]
-        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)} "
-                               f"(exit {proc.returncode}): {' '.join(last)}")
-    out: dict[str, Declaration] = {}
-    for name, found in json.loads(frame[1]).get("types", {}).items():
-        if found is None:
-            continue
-        try:
-            out[name] = declare(name, str(found["hash"]), found["description"], str(found["from"]))
-        except (DdsTypeError, KeyError, TypeError) as exc:
-            raise RclpyUnavailable(f"the ROS 2 Python {python}'s description of {name}: {exc}") from None
-    return out
-
-
-__all__ = ["AGENT", "RclpyBus", "RclpyUnavailable", "installed_declarations", "ros_name", "ros_type"]
+__all__ = ["AGENT", "RclpyBus", "RclpyUnavailable"]

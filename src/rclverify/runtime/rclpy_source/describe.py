@@ -1,0 +1,47 @@
+"""The message definitions a ROS 2 Python has, as rosidl described them when
+its packages were built: what the live monitor reads a contract type with
+when the workspace has no definition of it (docs/ros2.md, "Two sources").
+The agent (:mod:`.agent`, ``--describe``) is run once and each description
+it returns is checked to hash to its own hash.
+"""
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+from pathlib import Path
+
+from rclverify.runtime.dds.types import DdsTypeError, Declaration, declare
+from rclverify.runtime.rclpy_source.bus import AGENT, RclpyUnavailable
+from rclverify.runtime.rclpy_source.wire import read_frame
+
+
+def installed_declarations(python: Path, names: list[str], timeout_s: float = 60.0) -> dict[str, Declaration]:
+    """The definitions the ROS 2 Python ``python`` has of message types ``names`` (``pkg/msg/T``), as
+    rosidl described them when the packages were built (the agent's ``--describe``), each checked to
+    hash to the hash rosidl gave it (:func:`~rclverify.runtime.dds.types.declare`): what a contract type
+    with no local definition is read with (:meth:`~rclverify.runtime.dds.types.TypeBook.add_declaration`).
+    A type the Python has no description of is left out.  Raises :class:`RclpyUnavailable` (one line)
+    when the agent cannot run or answer, or a description does not hash to its own hash."""
+    try:
+        proc = subprocess.run([str(python), str(AGENT), "--describe", *names], capture_output=True,
+                              timeout=timeout_s)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)}: {exc}") from None
+    frame = read_frame(io.BytesIO(proc.stdout))
+    if proc.returncode != 0 or frame is None or frame[0] != b"J":
+        last = proc.stderr.decode(errors="replace").strip().splitlines()[-1:]
+        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)} "
+                               f"(exit {proc.returncode}): {' '.join(last)}")
+    out: dict[str, Declaration] = {}
+    for name, found in json.loads(frame[1]).get("types", {}).items():
+        if found is None:
+            continue
+        try:
+            out[name] = declare(name, str(found["hash"]), found["description"], str(found["from"]))
+        except (DdsTypeError, KeyError, TypeError) as exc:
+            raise RclpyUnavailable(f"the ROS 2 Python {python}'s description of {name}: {exc}") from None
+    return out
+
+
+__all__ = ["installed_declarations"]
