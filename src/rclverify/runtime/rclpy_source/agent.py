@@ -44,7 +44,7 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   each candidate's hash itself.  Run as ``agent.py --describe TYPE...``,
   the agent prints this Python's own descriptions of the types named (one
   ``descriptions`` frame) and exits: the definition of a contract type the
-  monitor has none of (:func:`.bus.installed_declarations`).
+  monitor has none of (:func:`.describe.installed_declarations`).
 
 SIGINT is ignored (the monitor stops the agent when it stops: ``stop`` or
 the end of stdin), so a Ctrl-C in a terminal does not cut the stream short.
