@@ -404,7 +404,8 @@ def _evidence(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson | 
         if isinstance(cause, str) and cause and e["status"] == "failed":  # the culprit is a line of the code
             before = {str(x["obligation"]): str(x["status"]) for x in report["evidence"]
                       if str(x["obligation"]).startswith(f"{node}.")}
-            repairs = cache.get(["code", e["obligation"], cause, before],
+            # one key per culprit line: the guarantees of a node failing at one line share their repairs
+            repairs = cache.get(["code", e["obligation"].rsplit(".", 1)[-1], node, cause, before],
                                 lambda: checked_repairs(ws, node, e["obligation"], cause, before),
                                 cause.rpartition(":")[0]) or []
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
