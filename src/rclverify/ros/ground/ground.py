@@ -63,6 +63,8 @@ RULES: dict[str, tuple[str, str]] = {
     "ROS-TOPIC-NOT-SUBSCRIBED": ("warning", "a contract input's topic that its node does not subscribe to"),
     "ROS-TYPE-UNKNOWN": ("error", "a contract topic's message type that no package defines"),
     "ROS-TYPE-DIFFERS": ("error", "a contract topic's message type differs from the graph's"),
+    "ROS-TYPE-CLASH": ("error", "a topic two programs make with different types, the contract matching its own "
+                                "node's code"),
     "ROS-TYPE-ALTERNATIVE": ("warning", "a contract topic's message type is one of several its node's code "
                                         "makes the topic with, chosen at run time"),
     "ROS-FIELD-MISSING": ("error", "a field path the topic's message does not have"),
@@ -307,6 +309,15 @@ class Grounder:
                          f"{', '.join(short_type(t) for t in sorted(own))} in {gn.name}'s code, one of them chosen "
                          f"at run time; the contract says {tp.msg_type}, checked as that", rcl_loc, type_src,
                          node.name, tp.field)
+            clash = [(name, pe) for name, pe in publishers.get(resolved, [])
+                     if name != gn.name and pe.msg_type in differs] if edge is not None and edge.msg_type == ctype else []
+            if clash and edge is not None:  # the contract matches its own node's code: another program differs
+                other_node, pe = clash[0]
+                self.add("ROS-TYPE-CLASH", f"topic {resolved} is made with {short_type(pe.msg_type)} by {other_node} "
+                         f"({pe.src}) and with {short_type(ctype)} by {gn.name} ({edge.src}), as {node.name}'s "
+                         f"contract says: the two programs differ, not the contract", rcl_loc, pe.src,
+                         node.name, tp.field)
+                continue
             if differs:
                 self.add("ROS-TYPE-DIFFERS", f"topic '{tp.field}' carries {', '.join(short_type(t) for t in differs)} "
                          f"in the code, the contract says {tp.msg_type}", rcl_loc, type_src, node.name, tp.field)
