@@ -185,7 +185,8 @@ def test_field_paths_are_kept_per_contract_when_one_topic_carries_two_types(
     main(["ros", "check", "-w", str(ws), "--json", str(out)])
     codes = [f["code"] for f in json.loads(out.read_text())["findings"]]
     assert "ROS-FIELD-MISSING" not in codes and "ROS-FIELD-TYPE" not in codes
-    assert "ROS-TYPE-DIFFERS" in codes  # the code disagrees with itself: that stays said
+    # the code disagrees with itself: that stays said, naming both programs, each contract matching its own code
+    assert "ROS-TYPE-CLASH" in codes and "ROS-TYPE-DIFFERS" not in codes
     # the grounding reads the contract's own entry (Contract.topic): a path Rumble's array lacks
     (ws / "contracts/plan.yaml").write_text(plan + "    Rumble.set_feedback: [kind]\n")
     main(["ros", "check", "-w", str(ws), "--json", str(out)])
