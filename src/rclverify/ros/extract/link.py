@@ -205,8 +205,8 @@ class Linker(LinkMembers, Values, Returns, Instances):
     def _py_base(self, unit: str, base: str) -> str | None:
         """The program's Python class that base ``base`` (as written in class
         ``unit``'s ``class C(base)``) names: a class of the same file, else the
-        one the file imports under that name (``from pkg.base import Joint``,
-        ``import pkg.base`` then ``pkg.base.Joint``), found in the package."""
+        one the file imports under that name (``from pkg.base import Joint``),
+        found in the package."""
         f = unit.split("::", 1)[0]
         if f"{f}::{base}" in self.units:
             return f"{f}::{base}"
