@@ -33,7 +33,11 @@ class Event:
                neither ``time`` nor ``stamp`` is it (``None`` otherwise): a
                message placed at a header stamp older than its publication
                (a stamp copied from an earlier question) may answer the
-               questions asked up to then (docs/semantics.md, "Event time").
+               questions asked up to then (docs/semantics.md, "Event time");
+    ``late``   how long after its time (``stamped``, s) the live monitor heard
+               it, where that was later than the lateness bound (0.0
+               otherwise): the questions asked before then read a value
+               the node may not have had, and decide no violation.
     """
 
     index: int
@@ -43,15 +47,18 @@ class Event:
     where: str
     stamp: float | None = None
     source: float | None = None
+    late: float = 0.0
 
     def __init__(self, index: int, time: float, topic: str, fields: Mapping[str, Any], where: str,
-                 stamp: float | None = None, source: float | None = None) -> None:
+                 stamp: float | None = None, source: float | None = None, late: float = 0.0) -> None:
         # Frozen: each attribute is set once, here, in the instance's dict (the dataclass's own
         # __init__ goes through object.__setattr__ per field, twice as slow, and a run has
         # millions of events)
         d = self.__dict__
         d["index"], d["time"], d["topic"], d["fields"], d["where"], d["stamp"] = index, time, topic, fields, where, stamp
         d["source"] = source
+        if late:
+            d["late"] = late  # else the class's 0.0: most messages are in order
 
     @property
     def stamped(self) -> float:

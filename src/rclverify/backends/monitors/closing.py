@@ -79,6 +79,20 @@ class Closing(EngineState):
 
     def _violation(self, ev: Event, k: int, values: Mapping[str, object], reason: str, semantics: str,
                    trigger: Event | None) -> None:
+        """Guarantee ``k`` false on ``values`` for output ``ev`` (or the question's own message)
+        answering the question raised by ``trigger``: ``violated``, or ``inconclusive`` where that
+        question reads an input heard later than the lateness bound (docs/semantics.md, "Event time")."""
+        cause = self._late_q.get(trigger.index) if trigger is not None and self._late_q else None
+        if cause is not None and trigger is not None:
+            self._verdict("inconclusive", ev, guarantee=k, values=self._rendered(values),
+                          reason=f"{reason}; but the question at {trigger.where} reads the input at {cause.where}, "
+                                 f"heard {cause.late * 1e3:.1f} ms after its time, later than the lateness bound, and "
+                                 "asked before then: the node may not have had it when it answered, and a "
+                                 "message later than the bound makes no violation; a header stamp copied from the "
+                                 "question onto the answer, service introspection or a trace of the node's "
+                                 "receipts would decide it (docs/semantics.md, \"Event time\")",
+                          semantics=semantics, question=trigger.where)
+            return
         result = self.result
         if self.on_verdict is None and result.first_violation is not None and \
                 len(result.violations) >= KEPT_VIOLATIONS:  # a record nobody keeps or receives: counted, not rendered

@@ -170,6 +170,11 @@ class NodeMonitor(Judging, Closing, Late):
         #: event index -> how far after its stamp (s) a question may be the one an output answers, where that is
         #: beyond the skew: published that long after its stamp (a stamp copied from an earlier question)
         self._wins: dict[int, float] = {}
+        #: input -> the message heard later than the lateness bound whose value is in force (``Event.late``),
+        #: and question event index -> that message, for the questions that read it: what they decide is
+        #: undecided, never violated (closing.py ``_violation``)
+        self._late_in: dict[str, Event] = {}
+        self._late_q: dict[int, Event] = {}
         #: input -> (stamp, why) of its latest unreadable message (a NaN) until a message stamped after it maps
         self._unread: dict[str, tuple[float, str]] = {}
         #: the latest stamp (s) of the node's messages judged so far: an input stamped before it was heard late
@@ -289,6 +294,12 @@ class NodeMonitor(Judging, Closing, Late):
             self._late_input(ev, trig, stamp)
             return
         self._hi = stamp
+        if ev.late or self._late_in:  # a message later than the bound: the questions reading its value
+            for k in trig:
+                if ev.late:
+                    self._late_in[k] = ev
+                else:
+                    self._late_in.pop(k, None)
         if self._unread:  # a message stamped after the unreadable one: readable values are in force again
             for k in trig:
                 self._unread.pop(k, None)
@@ -305,6 +316,12 @@ class NodeMonitor(Judging, Closing, Late):
                 self._verdict("incomplete input", ev, reason="no value yet for " + ", ".join(missing))
                 return
         owed, accepted, refusal = self._accept(ev, inputs)
+        if self._late_in:  # a question asked before a message later than the bound was heard: its own
+            for k, cause in list(self._late_in.items()):
+                if stamp < cause.stamped + cause.late:
+                    self._late_asked(ev, cause)
+                    break
+                del self._late_in[k]  # heard by then: the node had it
         self._raise(ev, Question(ev, stamp, inputs, owed, accepted), trig, refusal)
 
     def _raise(self, ev: Event, q: Question, trig: frozenset[str], refusal: str) -> None:

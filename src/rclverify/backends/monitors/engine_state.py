@@ -63,6 +63,8 @@ class EngineState:
     _held: deque[tuple[Any, ...]]
     _released: deque[Recent]
     _wins: dict[int, float]
+    _late_in: dict[str, Event]
+    _late_q: dict[int, Event]
     _unread: dict[str, tuple[float, str]]
     _in_force: dict[str, list[tuple[float, Any, Event]]]
     _open: Question | None
@@ -91,6 +93,15 @@ class EngineState:
             wins[ev.index] = lag
             return lag
         return self.stream.skew
+
+    def _late_asked(self, q_ev: Event, cause: Event) -> None:
+        """The question raised by ``q_ev`` reads the value of ``cause``, a message heard
+        later than the lateness bound: a violation found on it is ``inconclusive``
+        (closing.py ``_violation``; the last 1024 such questions are kept)."""
+        late = self._late_q
+        if len(late) >= 1024:
+            del late[next(iter(late))]
+        late[q_ev.index] = cause
 
     def _reach_of(self, ev: Event) -> float:
         """:meth:`_reach` of an output already judged or held."""

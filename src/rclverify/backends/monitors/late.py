@@ -61,6 +61,8 @@ class Late(EngineState):
         message of the node stamped later: raised at its stamp (module docstring)."""
         stream, values = self.stream, self.values
         mine = {k: values[k] for k in trig}
+        if ev.late:  # later than the bound: its own question, and those it is retold to, decide no violation
+            self._late_asked(ev, ev)
         # an unreadable message stamped after it is still the one in force: what reads it after is undecided
         unread = {k: u[1] for k in trig for u in (self._unread.get(k),) if u is not None and u[0] > stamp}
         kept = stream._questions
@@ -71,6 +73,10 @@ class Late(EngineState):
             for k in trig:
                 hist.setdefault(k, []).append((stamp, mine[k], ev))
         tainted, reset = self._tainted(ev, stamp, mine)
+        if ev.late:  # the questions asked before it was heard read it: they decide no violation
+            for qa in tainted:
+                if qa.stamp < stamp + ev.late:
+                    self._late_asked(qa.event, ev)
         for k in trig:  # the values in force now: a message stamped after it may have set them
             if last is not None and reset:
                 values[k] = last.inputs.get(k)

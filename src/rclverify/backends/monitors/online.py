@@ -180,7 +180,7 @@ class OnlineEngine:
         return self._buffer.max_late_s
 
     def _release(self, upto: float) -> None:
-        for t, src, (topic, fields, where), _ in self._buffer.release(upto):
+        for t, src, (topic, fields, where), late in self._buffer.release(upto):
             stamp = None
             source = published(t, src)  # published after its stamp: it may answer what was asked until then
             if t < self._clock:  # older than one released: checked at the clock; its own stamp decides what it answers
@@ -188,7 +188,9 @@ class OnlineEngine:
             elif source is not None:
                 stamp = t
             self._clock = t
-            ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp, source)
+            if late:  # heard after the watermark had passed it: about that much more than the bound after its time
+                late += self.reorder_window
+            ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp, source, late)
             self.released += 1
             if self.on_event is not None:
                 self.on_event(ev)

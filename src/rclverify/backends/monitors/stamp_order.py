@@ -187,7 +187,7 @@ def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
         if place:
             t, aside = placed_clock(ev)
             if aside:
-                ev = Event(ev.index, ev.time, ev.topic, without_stamp(ev.fields), ev.where)
+                ev = Event(ev.index, ev.time, ev.topic, without_stamp(ev.fields), ev.where, late=ev.late)
         else:
             t = run_clock(ev)
         latest = max(latest, t)
@@ -207,8 +207,8 @@ def _placed(index: int, t: float, source: float, ev: Event) -> Event:
     stamp: it is judged by the streaming engine, which reads both)."""
     src = published(t, source)
     if src is None:
-        return Event(index, t, ev.topic, ev.fields, ev.where)
-    return Event(index, t, ev.topic, ev.fields, ev.where, t, src)
+        return Event(index, t, ev.topic, ev.fields, ev.where, late=ev.late)
+    return Event(index, t, ev.topic, ev.fields, ev.where, t, src, ev.late)
 
 
 def stale_reason(watch: StampWatch, trace: str) -> str:
