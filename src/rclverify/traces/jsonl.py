@@ -96,7 +96,10 @@ def read_lines(path: Path, chunks: Iterable[bytes], lineno: int = 0, index: int 
                 del obj["topic"], obj["time"]  # the message's fields, in their order (the object is this line's own)
                 # a header's stamp is the message's own time: what it answers is decided by it (docs/semantics.md)
                 stamp = header_stamp(obj) if "header" in obj or flat[0] in obj or flat[1] in obj else None
-                yield Event(index, float(time), topic.lstrip("/"), obj, f"{name}:{lineno}", stamp)
+                # heard later than the live lateness bound (the live log says how long after its time)
+                late = obj.pop("late_s") if "late_s" in obj else 0.0
+                yield Event(index, float(time), topic.lstrip("/"), obj, f"{name}:{lineno}", stamp,
+                            late=late if type(late) is float and late > 0 else 0.0)
                 index += 1
     finally:
         if end is not None:
