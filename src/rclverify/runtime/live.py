@@ -120,8 +120,9 @@ class LiveRun:
 
     # -- engine callbacks (called under the lock) ----------------------------------
     def _event(self, ev: Event) -> None:
-        self._log.write(dumps({"topic": ev.topic, "time": ev.time, **{k: v for k, v in ev.fields.items()
-                                                                       if k not in ("topic", "time")}}) + "\n")
+        late = {"late_s": round(ev.late, 6)} if ev.late else {}  # at its source time, with how late it was heard
+        self._log.write(dumps({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time,
+                               **late, **{k: v for k, v in ev.fields.items() if k not in ("topic", "time")}}) + "\n")
         self.checks.event(ev)  # after its log line: a verdict it decides comes after it, as offline
 
     def _deadline(self, v: DeadlineVerdict, t: float) -> None:
