@@ -15,6 +15,7 @@ every fourth reading stays red, live as offline.
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
@@ -54,8 +55,8 @@ def _copying_relay(delay: float, defect: bool = False, n: int = 12) -> list[dict
     return sorted(sent, key=lambda x: x["time"])
 
 
-def _verdicts_offline(ws: Path, run: Path) -> list[tuple[str, str]]:
-    """The relay's verdicts (where, verdict) as the recorded path judges the run (read again in stamp order)."""
+def _verdicts_offline(ws: Path, run: Path, node: str = "Relay") -> list[tuple[str, str]]:
+    """The node's verdicts (where, verdict) as the recorded path judges the run (read again in stamp order)."""
     checked = load([ws / "contracts" / "c.rcl"])
     cfg = load_mapping(ws, "mapping.yaml")
     watch = StampWatch(0.0)
@@ -64,7 +65,7 @@ def _verdicts_offline(ws: Path, run: Path) -> list[tuple[str, str]]:
     lag, _, _ = second_read(watch, str(run), True)
     events = read_trace(run) if lag is None else in_stamp_order(read_trace(run), lag)
     got: list[Any] = []
-    check_trace(checked, [checked.nodes["Relay"]], events, cfg.rules, 1.0, got.append)
+    check_trace(checked, [checked.nodes[node]], events, cfg.rules, 1.0, got.append)
     return sorted((v.where, v.verdict) for v in got)
 
 
@@ -146,3 +147,91 @@ def test_a_writer_is_past_a_time_once_heard_past_it_or_silent_past_the_bound_on_
     eng2.push("x", {"value": 0.0, **_stamp(1.0)}, 1.0)
     eng2.push("r", {"range": 0.0, **_stamp(1.01)}, 1.01)
     assert eng2.watermark(1.5) == pytest.approx(1.45)
+
+
+# -- what the node had: an input heard later than the lateness bound decides no violation --------------------
+
+FLEET = """
+node Fleet {
+  inputs( a : REAL, b : REAL )
+  outputs( c : REAL )
+  topics( pkg/A a matches(in.a), pkg/B b matches(in.b), pkg/C c matches(out.c) )
+  assume( TRUE )
+  guarantee( out.c == in.a + in.b ) triggered by in.a within 500 ms
+}
+"""
+FLEET_MAPPING = "topics:\n  a: {fields: [value]}\n  b: {fields: [value]}\n  c: {fields: [value]}\n"
+
+
+def _fleet(b_delay: float, defect: bool = False) -> list[tuple[float, dict[str, Any]]]:
+    """A fleet manager answering each ``a`` (every 200 ms from 1.05 s) 10 ms later with
+    ``a + b`` for the ``b`` it has received; ``b`` changes from 1 to 2 at 1.43 s and reaches
+    the node and the monitor ``b_delay`` s after it was published (unstamped: each line's
+    time its source time).  ``defect``: the answer to the fifth ``a`` is 0.5 too high.
+    Returns (arrival, line) in arrival order."""
+    heard = [(1.001, _msg("b", 1.0, None, value=1.0)), (1.43 + b_delay, _msg("b", 1.43, None, value=2.0))]
+    for i in range(6):
+        ta = 1.05 + 0.2 * i
+        had = 1.0 if ta + 0.01 < 1.43 + b_delay else 2.0
+        heard.append((ta + 0.001, _msg("a", ta, None, value=float(i))))
+        heard.append((ta + 0.011, _msg("c", ta + 0.01, None, value=i + had + (0.5 if defect and i == 4 else 0.0))))
+    heard.append((4.0, _msg("tick", 4.0, None, data=0)))
+    return sorted(heard, key=lambda x: x[0])
+
+
+def _fleet_run(tmp: Path, heard: list[tuple[float, dict[str, Any]]]) -> tuple[list[tuple[str, str]],
+                                                                               list[tuple[str, str]], list[Any]]:
+    """The online engine fed ``heard`` in arrival order (timer every 10 ms), its released
+    messages logged as the live monitor logs them (runtime/live.py: a message heard later
+    than the bound at its source time with ``late_s``), and that log judged offline.
+    Returns (live verdicts, offline verdicts, the live verdicts' objects)."""
+    tmp.mkdir(exist_ok=True)
+    ws, _ = _workspace(tmp, FLEET, [], FLEET_MAPPING)
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    got: list[Any] = []
+    logged: list[str] = []
+
+    def log(ev: Any) -> None:  # the live log's line (runtime/live.py, _event)
+        late = {"late_s": round(ev.late, 6)} if ev.late else {}
+        logged.append(json.dumps({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time,
+                                  **late, **dict(ev.fields)}))
+    eng = OnlineEngine(checked, [checked.nodes["Fleet"]], rules, 1.0, reorder_window=WINDOW, on_verdict=got.append,
+                       on_event=log)
+    now = 1.0
+    for arrival, line in heard:
+        while now + 0.01 <= arrival:
+            now += 0.01
+            eng.tick(now)
+        eng.push(line["topic"], {x: v for x, v in line.items() if x not in ("topic", "time")}, line["time"])
+    eng.finish()
+    run = ws / "run.jsonl"
+    run.write_text("".join(x + "\n" for x in logged))
+    # live, a verdict names the message by the order released ("message 7"): the log's line 8
+    live = sorted((f"run.jsonl:{int(v.where.split()[-1]) + 1}", v.verdict) for v in got)
+    return live, _verdicts_offline(ws, run, "Fleet"), got
+
+
+def test_an_answer_judged_with_an_input_the_node_had_not_received_is_undecided_not_violated(tmp_path: Path) -> None:
+    """Issue 106's fleet manager: its second input reached it 70 ms late (past the 50 ms bound);
+    its answer to the next ``a``, computed with the ``b`` it had, was ``violated``.  Now
+    ``inconclusive``, saying what would decide it; the next answers (``b`` received) are judged."""
+    live, offline, got = _fleet_run(tmp_path, _fleet(0.07))
+    assert live == offline
+    undecided = [v for v in got if v.verdict == "inconclusive"]
+    assert [v.verdict for v in got].count("violated") == 0 and len(undecided) == 1, got
+    assert "later than the lateness bound" in undecided[0].reason and "copied" in undecided[0].reason
+    assert [v for _, v in live].count("satisfied") == 5
+
+
+def test_the_controls_an_input_in_time_and_a_defect_elsewhere_stay_red(tmp_path: Path) -> None:
+    # the same node whose b came within the bound and which answered with the old b anyway: violated
+    heard = [(a, x) for a, x in _fleet(0.07)]
+    heard = sorted([(a - 0.05 if x["topic"] == "b" and x["time"] == 1.43 else a, x) for a, x in heard],
+                   key=lambda h: h[0])
+    live, offline, got = _fleet_run(tmp_path / "in-time", heard)
+    assert live == offline and [v.verdict for v in got].count("violated") == 1, got
+    # a defect in an answer asked after the late input was heard: red, live as offline
+    live, offline, got = _fleet_run(tmp_path / "defect", _fleet(0.07, defect=True))
+    assert live == offline
+    assert [v.verdict for v in got].count("violated") == 1 and [v.verdict for v in got].count("inconclusive") == 1
