@@ -191,6 +191,23 @@ def _undecided(report: list[Mapping[str, object]]) -> list[Mapping[str, object]]
     return [e for e in report if e.get("status") == "inconclusive"]
 
 
+def _mapping_refused(cfg: Any, root: Path, checked: Any) -> bool:
+    """Whether the plan's mapping (``cfg.mapping``) names a field path the message definitions refuse:
+    the check ``doit verify`` makes (``check_field_paths``), with the robot's own types allowed.  Prints
+    each refusal (``file:line:col: error: ...``) on stderr; ``False`` when there is no mapping or when no
+    standard definition is known (rosbags missing: the run reads what comes)."""
+    if not cfg.mapping:
+        return False
+    from rclverify.backends.monitors.fieldpaths import check_field_paths  # deferred: start-up (only live)
+    try:
+        wrong = check_field_paths(root, cfg.mapping, cfg.msg_dirs, checked, robot_types=True)
+    except MissingExtra:
+        return False
+    if wrong:
+        print("\n".join(map(str, wrong)), file=sys.stderr)
+    return bool(wrong)
+
+
 def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -> int:
     """``--live``: monitor the running ROS 1 system (``--ros2``: ROS 2 over DDS) until
     SIGINT/SIGTERM or ``--duration``.
@@ -215,15 +232,8 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     nodes = selected_nodes(checked, args.nodes, "monitor")
     if nodes is None:
         return 2
-    if cfg.mapping:  # the mapping's field paths against the definitions: the check `doit verify` makes
-        from rclverify.backends.monitors.fieldpaths import check_field_paths  # deferred: start-up (only live)
-        try:
-            wrong = check_field_paths(root, cfg.mapping, cfg.msg_dirs, checked, robot_types=True)
-        except MissingExtra:  # without rosbags no standard definition is known: the run reads what comes
-            wrong = []
-        if wrong:
-            print("\n".join(map(str, wrong)), file=sys.stderr)
-            return 2
+    if _mapping_refused(cfg, root, checked):
+        return 2
     log = Path(args.log)
     ros = args.ros or os.environ.get("ROS_VERSION", "1")  # ROS's setup scripts set ROS_VERSION
     enforce_items, record = getattr(args, "enforce", []), getattr(args, "record", None)

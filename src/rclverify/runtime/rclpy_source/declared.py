@@ -33,13 +33,10 @@ class DeclaredTypes:
     _held: dict[tuple[int, bytes], list[bytes]]
     _warned: set[tuple[str, bytes, str]]
 
-    def _send(self, obj: Mapping[str, object]) -> None:
-        """One request to the agent (the bus's)."""
-        raise NotImplementedError
-
-    def _sample(self, body: bytes) -> None:
-        """One sample frame of the agent, handed on or held (the bus's)."""
-        raise NotImplementedError
+    #: one request to the agent (the bus's method)
+    _send: Callable[[Mapping[str, object]], None]
+    #: one sample frame of the agent, handed on or held (the bus's method)
+    _sample: Callable[[bytes], None]
 
     def _admit(self, t: Tap, gid: bytes) -> bool | Declaration | None:
         """How publisher ``gid``'s samples are read: ``True`` in the contract's layout (its ROS 2 type
