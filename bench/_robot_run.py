@@ -79,8 +79,10 @@ def live_counts(log: Path, links: dict[str, str] | None = None) -> dict[str, Cou
         v = rec["verdict"]
         c = out.setdefault(str(v.get("node")), Counter())
         if rec.get("kind") == "deadline":
-            if v.get("update"):  # a late answer to a deadline already counted false
+            if v.get("update"):  # a late answer stamped in time: the false already counted is withdrawn
                 c["deadline updates"] += 1
+                c["deadline false"] -= 1
+                c[f"deadline {v['verdict']}"] += 1
             else:
                 c[f"deadline {v['verdict']}"] += 1
         else:
@@ -253,7 +255,7 @@ def explain(ws: Path, res: dict[str, Any]) -> list[str]:
             continue
         heard = float(v["time"])
         left = max((t for topic, t in sent if topic == node["topic"] and t <= heard + 0.001), default=None)
-        inputs = [by_topic[k]["rcl_topic"] for k in ("source", "a_source", "b_source") if node.get(k)]
+        inputs = [by_topic[node[k]]["rcl_topic"] for k in ("source", "a_source", "b_source") if node.get(k)]
         stamps = [_stamp(r) for r in lines if r.get("topic") in inputs and _stamp(r) <= heard]
         question = max(stamps, default=None)
         if left is not None and question is not None:
@@ -305,7 +307,9 @@ def _line(res: dict[str, Any]) -> str:
             f"{res.get('source', 'dds')}, " + (f"/clock x{clock['rate']:g} from {clock['start_s']:g} s" if clock
                                                else "wall clock") + ": live satisfied "
             f"{tot['satisfied']}, violated {tot['violated']}, undecided {tot['undecided']}, deadlines true "
-            f"{tot['deadline true']} false {tot['deadline false']}; "
+            f"{tot['deadline true']} false {tot['deadline false']}"
+            + (f" ({tot['deadline updates']} false withdrawn by a late answer stamped in time)"
+               if tot["deadline updates"] else "") + "; "
             f"{'agree' if not res['findings'] else 'FINDINGS: ' + '; '.join(res['findings'])}"
             + ("; " + "; ".join(res["errors"]) if res["errors"] else "")
             + "".join(f"\n  other clock: {c}" for c in res.get("other_clocks", []))
