@@ -38,6 +38,7 @@ Source: the C++ standard's preprocessing and ``<cinttypes>`` macros (C99 7.8.1).
 from __future__ import annotations
 
 import re
+from typing import Any
 
 _CLASS_MACRO = re.compile(rb"\b(?:class|struct)\s+((?:[A-Z][A-Z0-9_]*[A-Z0-9]\s+)+)(?=[A-Za-z_]\w*\s*(?:final\s*)?[:{])")
 _SUFFIX = rb"(?:PUBLIC|EXPORT|EXPORTS|API|LOCAL|DECL|HIDDEN|VISIBLE|DLL|DLLAPI|PUBLIC_TYPE|IMPORT)"
@@ -170,6 +171,26 @@ def alternatives(a: tuple[tuple[int, int], ...], b: tuple[tuple[int, int], ...])
         if x[1] != y[1]:
             return True
     return False
+
+
+def one_per_branch(endpoints: list[Any], branch: dict[int, tuple[tuple[int, int], ...]]) -> list[Any]:
+    """``endpoints`` (:class:`~.model.Endpoint`) less those alike an earlier one
+    (role, name as written, type, parameter, handle, class, function, what
+    the linker reads) created in an alternative branch of one ``#if ... #elif
+    ... #else ... #endif`` group (``branch``: :func:`branches`): one of the
+    branches is compiled, so it is one edge, the first branch's."""
+    def key(e: Any) -> tuple[Any, ...]:
+        return (e.kind, e.topic, e.msg_type, e.param, e.handle, e.unit, e.func,
+                repr(e.pending[:5]) if e.pending else None)
+    if not branch:
+        return endpoints
+    kept: list[Any] = []
+    for e in endpoints:
+        here = branch.get(e.src.line, ())
+        if here and any(key(k) == key(e) and alternatives(branch.get(k.src.line, ()), here) for k in kept):
+            continue
+        kept.append(e)
+    return kept
 
 
 def prepare(data: bytes) -> bytes:

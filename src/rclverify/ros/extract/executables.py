@@ -14,7 +14,7 @@ is run; docs/ros.md, "Reading real code").
   EXECUTABLE exe)`` makes ``exe`` a node of class ``ns::C`` (also through a
   wrapper); ``rclcpp_components_register_nodes(target "ns::C" ...)`` registers
   plugins only (started by a launch file's composable node);
-* ``setup.py`` (read with ``ast``): ``console_scripts`` entries
+* ``setup.py`` (read with ``ast``, :mod:`setup_py`): ``console_scripts`` entries
   ``exe = module.path:func`` and ``scripts=[...]``, a module found where
   ``package_dir={'': 'src'}`` (or ``{'pkg': 'dir'}``) puts it, as setuptools does;
 * ``set_target_properties(t PROPERTIES OUTPUT_NAME name)`` names executable
@@ -26,10 +26,8 @@ from __future__ import annotations
 
 from rclverify.ros.extract import safefs
 
-import ast
 import fnmatch
 import os
-import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -37,8 +35,8 @@ from rclverify.ros.extract.cmake import Definitions, definitions_of, expand
 from rclverify.ros.extract.model import Note
 from rclverify.ros.extract.nodelets import plugin_classes
 from rclverify.ros.extract.plugins import PluginClass, described
+from rclverify.ros.extract.setup_py import entry_points, setup_py_executables
 
-_ENTRY = re.compile(r"^\s*([A-Za-z0-9_.\-]+)\s*=\s*([A-Za-z0-9_.]+)\s*:\s*[A-Za-z0-9_]+\s*$")
 _EXE = {"add_executable", "ament_auto_add_executable", "cs_add_executable"}
 _LIB = {"add_library", "ament_auto_add_library", "cs_add_library"}
 _KEYWORDS = {"WIN32", "MACOSX_BUNDLE", "EXCLUDE_FROM_ALL", "STATIC", "SHARED", "MODULE", "OBJECT", "PRIVATE",
@@ -158,10 +156,10 @@ def targets(root: Path, pkg: str, extra: Definitions | None = None) -> Targets:
     _rename(t)
     for exe, srcs in setup_py_executables(root).items():
         t.programs.setdefault(exe, srcs)
-    for d in entry_points(root):
-        t.declared.append(d)
-        if d.found:
-            t.programs.setdefault(d.name, [root / d.sources[0]])
+    for name, f, line, mod, found in entry_points(root):
+        t.declared.append(Declared("entry point", name, f, line, (mod,), found))
+        if found:
+            t.programs.setdefault(name, [root / mod])
     t.nodelets = plugin_classes(root)
     t.pluginlib, t.plugin_notes = described(root)
     for cls, lib in t.nodelets.values():
@@ -326,96 +324,6 @@ def cmake_components(root: Path, pkg: str) -> tuple[dict[str, tuple[str, int]], 
     ``rclcpp_components_register_node(s)`` (rclcpp_components' CMake API)."""
     t = targets(root, pkg)
     return t.components, list(t.plugins)
-
-
-def setup_py_executables(root: Path) -> dict[str, list[Path]]:
-    """``{executable: [module file]}`` from ``setup.py``'s ``console_scripts`` entries
-    and ``scripts=[...]`` (read with ``ast``, never run)."""
-    f = root / "setup.py"
-    out: dict[str, list[Path]] = {}
-    try:
-        tree = ast.parse(safefs.read_text(f))
-    except (OSError, SyntaxError, ValueError, RecursionError):
-        return out
-    dirs = _package_dirs(tree)
-    for n in ast.walk(tree):
-        if isinstance(n, ast.Constant) and isinstance(n.value, str):
-            m = _ENTRY.match(n.value)
-            if m:
-                mod = root / module_file(m.group(2), dirs)
-                if mod.is_file():
-                    out[m.group(1)] = [mod]
-        elif isinstance(n, ast.keyword) and n.arg == "scripts" and isinstance(n.value, (ast.List, ast.Tuple)):
-            for e in n.value.elts:
-                if isinstance(e, ast.Constant) and isinstance(e.value, str) and (root / e.value).is_file():
-                    p = root / e.value
-                    out.setdefault(p.name, [p])
-                    out.setdefault(p.stem, [p])
-    return out
-
-
-def entry_points(root: Path) -> list[Declared]:
-    """The ``console_scripts`` entry points ``setup.py`` and ``setup.cfg`` declare
-    (``exe = pkg.module:main``), each with its line and module file (setuptools'
-    "Entry points" specification); ``found`` is false when the module file is not
-    in the package.  Read as text, never run."""
-    out: list[Declared] = []
-    dirs: dict[str, str] = {}
-    for name in ("setup.py", "setup.cfg"):
-        f = root / name
-        try:
-            text = safefs.read_text(f)
-        except OSError:
-            continue
-        if name == "setup.py":
-            try:
-                dirs = _package_dirs(ast.parse(text))
-            except (SyntaxError, ValueError, RecursionError):
-                dirs = {}
-        in_scripts = name == "setup.py"
-        for i, line in enumerate(text.splitlines(), 1):
-            if name == "setup.cfg" and line.strip().startswith("console_scripts"):
-                in_scripts = True
-                line = line.split("=", 1)[1] if "=" in line else ""
-            elif name == "setup.cfg" and line[:1] not in (" ", "\t", ""):
-                in_scripts = False
-            if not in_scripts:
-                continue
-            for m in _ENTRY_IN.finditer(line):
-                mod = module_file(m.group(2), dirs)
-                if not any(d.name == m.group(1) for d in out):
-                    out.append(Declared("entry point", m.group(1), f, i, (mod,), (root / mod).is_file()))
-    return out
-
-
-def _package_dirs(tree: ast.AST) -> dict[str, str]:
-    """``setup(package_dir={...})``'s literal mapping ``{package prefix: directory}``
-    (``{'': 'src'}``: every package under ``src``); empty when absent or not a
-    literal dictionary of strings."""
-    for n in ast.walk(tree):
-        if isinstance(n, ast.keyword) and n.arg == "package_dir" and isinstance(n.value, ast.Dict):
-            out = {k.value: v.value for k, v in zip(n.value.keys, n.value.values)
-                   if isinstance(k, ast.Constant) and isinstance(k.value, str)
-                   and isinstance(v, ast.Constant) and isinstance(v.value, str)}
-            return out
-    return {}
-
-
-def module_file(dotted: str, dirs: dict[str, str]) -> str:
-    """The file of module ``dotted`` (``pkg.module``) relative to the package root,
-    where ``package_dir`` ``dirs`` puts it: the longest package prefix mapped
-    wins (setuptools' rule), ``''`` maps every package, none maps the root."""
-    parts = dotted.split(".")
-    for k in range(len(parts), -1, -1):
-        prefix = ".".join(parts[:k])
-        if prefix in dirs:
-            base = dirs[prefix].strip("/")
-            rest = parts[k:]
-            return "/".join(([base] if base and base != "." else []) + rest) + ".py"
-    return "/".join(parts) + ".py"
-
-
-_ENTRY_IN = re.compile(r"(?:^|[\"'\s])([A-Za-z0-9_.\-]+)\s*=\s*([A-Za-z_][A-Za-z0-9_.]*)\s*:\s*[A-Za-z_][A-Za-z0-9_]*")
 
 
 def executables(root: Path, pkg: str, py_nodes: list[Path]) -> dict[str, list[Path]]:

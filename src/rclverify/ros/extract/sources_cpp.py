@@ -39,7 +39,7 @@ from rclverify.ros.extract import cpp_helpers, emit, names, symbols, treesitter
 from rclverify.ros.extract.cpp_bases import node_base
 from rclverify.ros.extract.cpp_calls import LIBRARY, CallReader
 from rclverify.ros.extract.cpp_members import MemberReader
-from rclverify.ros.extract.cpp_prep import REGISTER, alternatives, blank_if0, branches, prepare
+from rclverify.ros.extract.cpp_prep import REGISTER, blank_if0, branches, one_per_branch, prepare
 from rclverify.ros.extract.nodelets import registered
 from rclverify.ros.extract.cpp_scope import base_name, namespaces_of
 from rclverify.ros.extract.cpp_values import CppValues
@@ -263,26 +263,13 @@ class _File(CallReader, MemberReader):
         return self.out
 
     def one_per_branch(self) -> None:
-        """Of endpoints alike (role, name, type, handle, function) created in
-        alternative branches of one ``#if ... #elif ... #else ... #endif`` group,
-        the first is kept: one of the branches is compiled, so it is one edge."""
-        def key(e: Any) -> tuple[Any, ...]:
-            return (e.kind, e.topic, e.msg_type, e.param, e.handle, e.unit, e.func,
-                    repr(e.pending[:5]) if e.pending else None)
-        if not self.branch:
-            return
-        kept: list[Any] = []
-        dropped: set[int] = set()
-        for e in self.out["endpoints"]:
-            here = self.branch.get(e.src.line, ())
-            if here and any(key(k) == key(e) and alternatives(self.branch.get(k.src.line, ()), here) for k in kept):
-                dropped.add(id(e))
-                continue
-            kept.append(e)
-        if dropped:
+        """Endpoints alike created in alternative ``#if`` branches: one (:func:`~.cpp_prep.one_per_branch`)."""
+        kept = one_per_branch(self.out["endpoints"], self.branch)
+        if len(kept) < len(self.out["endpoints"]):
+            ids = {id(e) for e in kept}
             self.out["endpoints"] = kept
             for c in self.out["classes"].values():
-                c["endpoints"] = [e for e in c["endpoints"] if id(e) not in dropped]
+                c["endpoints"] = [e for e in c["endpoints"] if id(e) in ids]
 
     def rclcpp_like(self, full: str, args: list[Any], n: Any) -> bool:
         """Whether qualified call ``full(args)`` may be rclcpp's (a create/advertise
