@@ -343,8 +343,8 @@ class _Run:
     def _quiet(self, t: float) -> bool:
         """Whether the engine would give no verdict of its own at an input at time ``t`` followed by its answer."""
         m = self.m
-        if m.now > t or m.invalid:  # an unreadable input makes the next questions undecided: the engine's
-            return False
+        if m.now > t or m.invalid or m._late_in:  # an unreadable input, or one heard later than the lateness
+            return False  # bound, makes the next questions undecided: the engine's
         o = m._open
         if o is not None and not (o.answered and not o.waiting and (o.followed or o.decided.issuperset(m._need))):
             return False
