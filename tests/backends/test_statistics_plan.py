@@ -26,11 +26,12 @@ TARGET = "violation probability <= 1e-2 at 95 % per run"
 
 
 def _run(path: Path, k: int, bad: bool = False) -> str:
-    """One run of Clamp: three questions and their answers (the last 31 when ``bad``); ``k`` makes it unique."""
+    """One run of Clamp: three questions and their answers (the last 31 when ``bad``); ``k`` makes it unique
+    (its values: a run's identity takes its times relative to its first, so a later start alone is no new run)."""
     t0 = 1000.0 + k
     lines = []
     for j, x in enumerate([5.0, 31.0 if bad else 20.0]):
-        lines.append({"topic": "a", "time": t0 + 0.1 * j, "data": float(j + k % 7)})
+        lines.append({"topic": "a", "time": t0 + 0.1 * j, "data": float(j + k)})
         lines.append({"topic": "x", "time": t0 + 0.1 * j + 0.01, "data": x})
     path.write_text("".join(json.dumps(x) + "\n" for x in lines))
     return path.as_posix()
@@ -230,7 +231,7 @@ def test_a_target_of_one_guarantee_counts_that_guarantee_alone(tmp_path: Path) -
                                                             "guarantee( out.x <= 30 )\n  guarantee( out.x >= 0 )"))
     (tmp_path / "runs").mkdir()
     for i in range(60):
-        lines = [{"topic": "a", "time": 10.0 + i, "data": 1.0},
+        lines = [{"topic": "a", "time": 10.0 + i, "data": 1.0 + i},  # its own value: a run of its own
                  {"topic": "x", "time": 10.01 + i, "data": -1.0 if i == 7 else 5.0}]  # run 7 breaks guarantee 2
         (tmp_path / f"runs/r{i:02d}.jsonl").write_text("".join(json.dumps(x) + "\n" for x in lines))
     traces = _traces(tmp_path, "runs")
