@@ -18,6 +18,9 @@ The kinds (docs/diagnosis.md), each in its module:
     a refuted requirement.
 ``constant`` (:mod:`.constants`)
     a refuted Hoare triple: the program's constants changed to the guarantee's.
+``code`` (:mod:`.code_repair`)
+    a failing property test: a one-token correction of the implementation's culprit line, checked by
+    running the node's property tests again on a scratch copy (not by Z3 alone).
 
 A suggestion is returned only when Z3 *showed* (``sat`` or ``proved``, never
 ``unknown``) that the problem is gone on the edited text.  That is all Z3
