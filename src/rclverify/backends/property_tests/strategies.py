@@ -133,7 +133,7 @@ class InputSpace:
         solved = sorted({float(t) for t in self.thresholds if Fraction(float(t)) == t
                          and (lo is None or float(t) > lo or (float(t) == lo and not no_lo))
                          and (hi is None or float(t) < hi or (float(t) == hi and not no_hi))})
-        branches = [st.sampled_from(xs) for xs in (solved, edges_in) if xs]
+        branches = [st.sampled_from(xs) for xs in (edges_in, solved) if xs]
         return st.one_of(*branches, floats) if branches else floats
 
     def integer(self, bd: Bound | None, natural: bool, small: bool = False) -> st.SearchStrategy[int]:
