@@ -309,32 +309,39 @@ int main(int argc, char ** argv) { rclcpp::init(argc, argv); rclcpp::spin(std::m
 """
 
 
-def _router(tmp: Path, specs: str) -> Graph:
+def _router(tmp: Path, specs: str, header: str = "") -> Graph:
     _write(tmp / "ws" / "api", {
         "package.xml": PKG.format(name="api", tool="ament_cmake"),
         "CMakeLists.txt": CMAKE.format(name="api") + "add_executable(router src/router.cpp)\n",
-        "src/router.cpp": ROUTER.replace("SPECS\n", specs)})
+        "src/router.cpp": ROUTER.replace("SPECS\n", specs), "include/api/specs.hpp": header})
     return _scan(tmp)
+
+
+def _router_edges(g: Graph) -> list[tuple[str, str, str | None, int]]:
+    r = g.nodes["/router"]
+    return sorted((role, e.topic, e.msg_type, e.src.line) for role, es in (
+        ("pub", r.publishes), ("sub", r.subscribes), ("srv", r.service_servers)) for e in es)
 
 
 def test_an_interface_spec_adaptor_takes_name_and_type_from_the_spec(tmp_path: Path) -> None:
     g = _router(tmp_path, SPECS)
-    r = g.nodes["/router"]
-    assert [(e.topic, e.msg_type, e.src.line) for e in r.publishes] == [
-        ("/api/routing/state", "std_msgs/msg/String", 24)]
-    assert [(e.topic, e.msg_type, e.src.line) for e in r.subscribes] == [
-        ("/api/routing/state", "std_msgs/msg/String", 26)]
-    assert [(e.topic, e.msg_type, e.src.line) for e in r.service_servers] == [
-        ("/api/routing/set_route", "std_srvs/srv/Trigger", 25)]
+    assert _router_edges(g) == [("pub", "/api/routing/state", "std_msgs/msg/String", 24),
+                                ("srv", "/api/routing/set_route", "std_srvs/srv/Trigger", 25),
+                                ("sub", "/api/routing/state", "std_msgs/msg/String", 26)]
+    assert _said(g) == []
+
+
+def test_an_interface_spec_of_a_header_is_read_by_the_linker(tmp_path: Path) -> None:
+    g = _router(tmp_path, '#include "api/specs.hpp"\n', SPECS)
+    assert _router_edges(g) == [("pub", "/api/routing/state", "std_msgs/msg/String", 11),
+                                ("srv", "/api/routing/set_route", "std_srvs/srv/Trigger", 12),
+                                ("sub", "/api/routing/state", "std_msgs/msg/String", 13)]
     assert _said(g) == []
 
 
 def test_an_adaptor_of_a_spec_not_read_is_said_at_each_call(tmp_path: Path) -> None:
-    g = _router(tmp_path, "")  # control: the specs are defined elsewhere
-    r = g.nodes["/router"]
-    assert not r.publishes and not r.subscribes and not r.service_servers
-    said = sorted((n.src.line, n.message) for n in g.notes)
-    assert [line for line, _m in said] == [10, 11, 12], said
-    assert "interface spec specs::SetRoute" in said[1][1] and "interface spec specs::RouteState" in said[2][1]
-    assert "adaptor.create_publisher(...) takes no name (an interface-spec adaptor's, named and typed by " \
-           "specs::RouteState" in said[0][1]
+    # control: the header defines RouteState only; SetRoute is nowhere, and no other class's name[] is taken
+    g = _router(tmp_path, '#include "api/specs.hpp"\n', SPECS[:SPECS.index("struct SetRoute")] + "}\n")
+    assert [x[:2] for x in _router_edges(g)] == [("pub", "/api/routing/state"), ("sub", "/api/routing/state")]
+    assert _said(g) == ["ws/api/src/router.cpp:12:12: warning: service server name is 'specs::SetRoute::name', "
+                        "not a string literal: not resolved statically"]

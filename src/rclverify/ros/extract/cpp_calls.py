@@ -129,12 +129,13 @@ class CallReader:
         ``create_subscription<Spec>(cb)``: an interface-spec adaptor (Autoware's
         component_interface_utils), whose template argument is a struct holding
         the name (``static constexpr char name[] = "/api/..."``) and the type
-        (``using Message = ...`` / ``using Service = ...``).  A spec this file
-        defines is read (the endpoint emitted); a call of a spec it does not define whose
-        first argument is no name (``this``, a member pointer, a lambda,
-        ``std::bind``) is said at its line; one without arguments is followed
-        by the linker (a method of the program's own), else said there.  Returns whether the
-        call was handled."""
+        (``using Message = ...`` / ``using Service = ...``), when the call
+        gives no name first (no argument, ``this``, a member pointer, a
+        lambda, ``std::bind``).  A spec this file defines is read here; one of
+        another file of the program (a header, another package's) is left to
+        the linker (``Spec::name`` as a class member, ``Spec::Message`` as an
+        alias), which says at the call what it cannot read.  Returns whether
+        the call was handled."""
         key = spec.replace(" ", "").lstrip(":")
         hits = [k for k in self.spec_names if k == key or k.endswith("::" + key)]
         if len(hits) == 1:
@@ -147,17 +148,13 @@ class CallReader:
             self.emit(kind, None, t, n, None, name=symbols.lit(name), written=name)
             return True
         first = args[0] if args else None
-        if first is None:  # rclcpp's methods all take a name: a user's own method, else said by the linker
-            self.user_create(n, callee_parts(n.child_by_field_name("function"))[0], args,
-                             f"takes no name (an interface-spec adaptor's, named and typed by {spec}, "
-                             f"which the workspace does not define, or a method of the program's own)")
-            return True
-        if not (first.type in ("this", "lambda_expression", "pointer_expression")
-                or _T(first).startswith(("std::bind", "&"))):
-            return False
-        self.out["notes"].append(Note(self.src(n), f"{emit.WHAT[kind]} of interface spec {spec}: its name and type "
-                                                   f"are the spec's (static name[] and using Message/Service), which "
-                                                   f"this file does not define: not resolved statically"))
+        if first is not None and not (first.type in ("this", "lambda_expression", "pointer_expression")
+                                      or _T(first).startswith(("std::bind", "&"))):
+            return False  # rclcpp's own form: the name first
+        # a spec of another file (a header, another package's): its name and type read by the linker
+        member = "Message" if kind in ("pub", "sub") else "Service"
+        self.emit(kind, None, None, n, None, cb=("spec", f"{key}::{member}"), name=("spec", key),
+                  written=f"{key}::name")
         return True
 
     def user_create(self, n: Any, full: str, args: list[Any], *why: str) -> None:

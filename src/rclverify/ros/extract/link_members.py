@@ -50,12 +50,19 @@ class LinkMembers:
 
     def cb_type(self, kind: str, cb: Any, unit: str | None = None) -> str | None:
         """The type a callback (C++: its name; Python: ``("cands", types)`` of a star
-        import) or a type text (``("type", text)``) gives an endpoint of role
+        import), a type text (``("type", text)``) or an interface spec's member
+        alias (``("spec", "ns::Spec::Message")``, read only where the program
+        declares it) gives an endpoint of role
         ``kind``; an alias in the text is read in the scopes of class ``unit``
         (:func:`~.cpp_types.alias_of`), never another class's of the same name."""
         if isinstance(cb, tuple) and cb and cb[0] == "cands":
             known = [t for t in cb[1] if self.known(t)]
             return known[0] if len(known) == 1 else None
+        if isinstance(cb, tuple) and cb and cb[0] == "spec":  # Spec::Message of an interface spec: only as defined
+            got = alias_of(cb[1], self.aliases, self.scopes(unit), self.alias_index)
+            if got is None:
+                return None
+            cb = ("type", got)
         if isinstance(cb, tuple) and cb and cb[0] == "type":
             text: str | None = cb[1]
             scopes = self.scopes(unit)

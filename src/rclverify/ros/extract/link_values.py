@@ -134,6 +134,10 @@ class Values:
             return limit(out)
         if k == "field":
             return self._field(v[1], v[2], depth)
+        if k == "spec":  # an interface spec's static name[] (ns::Spec), as the program's class declares it
+            units = [u for u, m in self.fields if m == "name" and (u == v[1] or u.endswith("::" + v[1]))]
+            return limit([x for b in self.fields[(units[0], "name")] for x in self.eval(b, {}, None, depth + 1)]) \
+                if len(units) == 1 else [None]
         if k == "ext":
             hit = self.code.module(v[1])
             rec = self.code.records.get(hit[0], {}) if hit else {}

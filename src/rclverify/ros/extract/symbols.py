@@ -30,6 +30,9 @@ A value is a tuple (hashable, picklable, so it lives in the parse cache):
 * ``("cat", parts)``: the concatenation of ``parts``;
 * ``("ext", dotted)``: a Python name imported from another module of the
   package (``from pkg.names import TOPIC``);
+* ``("spec", struct)``: the ``static constexpr char name[]`` of interface
+  spec ``struct`` (``ns::Spec``, an adaptor's template argument), read by the
+  linker from the program's class of that name, never from another's;
 * ``("each", param)``: one element of the string-array ROS 2 parameter
   ``param`` (``~observation_sources``), a C++ range-for's variable over it;
   its text is ``[~observation_sources]``, which the graph expands with the
