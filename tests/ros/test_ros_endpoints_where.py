@@ -345,3 +345,45 @@ def test_an_adaptor_of_a_spec_not_read_is_said_at_each_call(tmp_path: Path) -> N
     assert [x[:2] for x in _router_edges(g)] == [("pub", "/api/routing/state"), ("sub", "/api/routing/state")]
     assert _said(g) == ["ws/api/src/router.cpp:12:12: warning: service server name is 'specs::SetRoute::name', "
                         "not a string literal: not resolved statically"]
+
+
+ROUTER_HPP = """#include <rclcpp/rclcpp.hpp>
+#include "api/specs.hpp"
+class Router : public rclcpp::Node
+{
+public:
+  Router();
+  component_interface_utils::Publisher<specs::RouteState>::SharedPtr pub_;
+  component_interface_utils::Subscription<specs::RouteState>::SharedPtr sub_;
+  component_interface_utils::Service<specs::SetRoute>::SharedPtr srv_;
+};
+"""
+ROUTER_INIT = """#include "api/router.hpp"
+Router::Router() : Node("router")
+{
+  const auto adaptor = component_interface_utils::NodeAdaptor(this);
+  adaptor.init_pub(pub_);
+  adaptor.init_sub(sub_, this, &Router::on_state);
+  adaptor.init_srv(srv_, this, &Router::on_set);
+}
+int main(int argc, char ** argv) { rclcpp::init(argc, argv); rclcpp::spin(std::make_shared<Router>()); }
+"""
+
+
+def test_adaptor_init_methods_make_members_declared_with_a_spec(tmp_path: Path) -> None:
+    _write(tmp_path / "ws" / "api", {
+        "package.xml": PKG.format(name="api", tool="ament_cmake"),
+        "CMakeLists.txt": CMAKE.format(name="api") + "add_executable(router src/router.cpp)\n",
+        "src/router.cpp": ROUTER_INIT, "include/api/specs.hpp": SPECS, "include/api/router.hpp": ROUTER_HPP})
+    g = _scan(tmp_path)
+    assert _router_edges(g) == [("pub", "/api/routing/state", "std_msgs/msg/String", 5),
+                                ("srv", "/api/routing/set_route", "std_srvs/srv/Trigger", 7),
+                                ("sub", "/api/routing/state", "std_msgs/msg/String", 6)]
+    assert _said(g) == []
+    # control: a member declared with no spec is said at its init call, never named
+    (tmp_path / "ws" / "api" / "include" / "api" / "router.hpp").write_text(
+        ROUTER_HPP.replace("component_interface_utils::Service<specs::SetRoute>", "std::shared_ptr<Other>"))
+    g = _scan(tmp_path)
+    assert [x[0] for x in _router_edges(g)] == ["pub", "sub"]
+    assert _said(g) == ["ws/api/src/router.cpp:7:3: warning: service server name is 'srv_ (interface spec)', "
+                        "not a string literal: not resolved statically"]

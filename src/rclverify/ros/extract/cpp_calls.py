@@ -21,6 +21,8 @@ _CALLS = {"advertise": "pub", "subscribe": "sub", "create_publisher": "pub", "cr
           "advertiseService": "service_servers", "serviceClient": "service_clients",
           "create_service": "service_servers", "create_client": "service_clients",
           "create_generic_publisher": "pub", "create_generic_subscription": "sub"}
+#: component_interface_utils' NodeAdaptor methods, each making its member argument with its Spec
+_INIT = {"init_pub": "pub", "init_sub": "sub", "init_srv": "service_servers", "init_cli": "service_clients"}
 #: Prefixes of library names: a call of one is no call of the program's own code.
 LIBRARY = ("std::", "ros::", "rclcpp::", "boost::", "RCLCPP_", "ROS_", "tf2::", "Eigen::", "rcutils_", "rcl_")
 _T = treesitter.text
@@ -68,6 +70,8 @@ class CallReader:
             return
         if last in ("create_server", "create_client") and "rclcpp_action" in full:
             self.action2(last, targs, args, n)
+            return
+        if recv is not None and last in _INIT and args and self.init_spec(n, _INIT[last], args[0]):
             return
         if full in ("ros::service::call",) and len(args) >= 2:
             self.emit("service_clients", args[0], service_type(s.type_of(args[1])), n, None)
@@ -155,6 +159,19 @@ class CallReader:
         member = "Message" if kind in ("pub", "sub") else "Service"
         self.emit(kind, None, None, n, None, cb=("spec", f"{key}::{member}"), name=("spec", key),
                   written=f"{key}::name")
+        return True
+
+    def init_spec(self, n: Any, kind: str, member: Any) -> bool:
+        """``adaptor.init_pub(pub_)`` (``init_sub``, ``init_srv``, ``init_cli``) of
+        component_interface_utils: the member, declared ``Publisher<Spec>::SharedPtr``
+        in its class, is made with ``Spec``'s name and type; left to the linker
+        (``("specof", class, member)``), which reads the member's declaration."""
+        fn = self.scope.fn_of(n)
+        name = _T(member).replace("this->", "").strip()
+        if fn is None or not fn.in_class or not name.isidentifier():
+            return False
+        v = ("specof", fn.unit, name)
+        self.emit(kind, None, None, n, None, cb=v, name=v, written=f"{name} (interface spec)")
         return True
 
     def user_create(self, n: Any, full: str, args: list[Any], *why: str) -> None:

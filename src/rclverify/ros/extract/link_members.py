@@ -58,6 +58,11 @@ class LinkMembers:
         if isinstance(cb, tuple) and cb and cb[0] == "cands":
             known = [t for t in cb[1] if self.known(t)]
             return known[0] if len(known) == 1 else None
+        if isinstance(cb, tuple) and cb and cb[0] == "specof":  # a member declared Publisher<Spec>::SharedPtr
+            spec = getattr(self, "spec_of")(cb[1], cb[2])
+            if spec is None:
+                return None
+            cb = ("spec", f"{spec}::{'Message' if kind in ('pub', 'sub') else 'Service'}")
         if isinstance(cb, tuple) and cb and cb[0] == "spec":  # Spec::Message of an interface spec: only as defined
             got = alias_of(cb[1], self.aliases, self.scopes(unit), self.alias_index)
             if got is None:

@@ -14,12 +14,15 @@ is ``None``.
 """
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING, Any
 
 from rclverify.ros.extract import symbols
 from rclverify.ros.extract.cpp_scope import is_node_type
 
 MAX_DEPTH = 8
+#: a member declared with an interface spec: component_interface_utils::Publisher<ns::Spec>::SharedPtr
+_SPEC_MEMBER = re.compile(r"(?:^|::)(?:Publisher|Subscription|Service|Client)<([A-Za-z_:][\w:]*)>")
 MAX_VALUES = 32
 
 
@@ -134,6 +137,9 @@ class Values:
             return limit(out)
         if k == "field":
             return self._field(v[1], v[2], depth)
+        if k == "specof":  # a member declared Publisher<ns::Spec>::SharedPtr: that spec's name
+            spec = self.spec_of(v[1], v[2])
+            return self.eval(("spec", spec), env, fkey, depth + 1) if spec else [None]
         if k == "spec":  # an interface spec's static name[] (ns::Spec), as the program's class declares it
             units = [u for u, m in self.fields if m == "name" and (u == v[1] or u.endswith("::" + v[1]))]
             return limit([x for b in self.fields[(units[0], "name")] for x in self.eval(b, {}, None, depth + 1)]) \
@@ -180,6 +186,17 @@ class Values:
         f = self.fns.get(fkey)
         d = f[3][i] if f is not None and i < len(f[3]) else None
         return self.eval(d, {}, fkey, depth + 1) if d is not None else [None]
+
+    def spec_of(self, unit: str, member: str) -> str | None:
+        """The interface spec a member of class ``unit`` (or of a base of it) is
+        declared with: ``ns::Spec`` of ``component_interface_utils::Publisher<ns::Spec>::SharedPtr``
+        (also ``Subscription``, ``Service``, ``Client``); ``None`` otherwise."""
+        for u in [unit] + [b for b in (self.match(x, unit) for x in self.units.get(unit, {}).get("bases", [])) if b]:
+            ty = self.units.get(u, {}).get("members", {}).get(member)
+            m = _SPEC_MEMBER.search(ty.replace(" ", "")) if ty else None
+            if m is not None:
+                return m.group(1).lstrip(":")
+        return None
 
     def _field(self, unit: str, name: str, depth: int) -> list[Any]:
         ty, binds = None, None
