@@ -17,7 +17,12 @@ Recognised (roscpp and actionlib, ROS 1; rclcpp and rclcpp_action, ROS 2):
   node handle is skipped), ``rclcpp_action::create_server<T>`` /
   ``create_client<T>`` (node, name) or (four node interfaces, name);
 * library helpers (:mod:`cpp_helpers`): tf, message_filters,
-  image_transport, interactive markers, parameter events, ``waitForMessage``;
+  image_transport, interactive markers, parameter events, ``waitForMessage``,
+  also made by a default member initializer (``Sub<T> sub_{this, "t"}``);
+  interface-spec adaptors (``adaptor.create_publisher<Spec>()``,
+  ``adaptor.init_pub(pub_)``: :meth:`~.cpp_calls.CallReader.interface_spec`);
+* endpoints alike in alternative ``#if``/``#elif``/``#else`` branches: one
+  (:func:`~.cpp_prep.one_per_branch`);
 * names (:mod:`cpp_scope`): literals, constants, parameters (:mod:`cpp_params`),
   and what only the program knows (a constructor argument, a member),
   left to the linker (:mod:`link`); node handles' namespaces;

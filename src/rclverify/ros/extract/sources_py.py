@@ -29,9 +29,11 @@ rclpy, ROS 2):
 * node names from ``rospy.init_node(n)``, ``rclpy.create_node(n)``,
   ``Node(n)`` and ``super().__init__(n)`` (``n`` a literal, or any name in a
   class deriving from ``Node``);
-* for the linker: functions and their parameters, classes, the calls of the
-  package's own classes and functions with their argument values, attribute
-  bindings, module constants, imports.
+* for the linker: functions and their parameters, classes and their bases, the calls of the
+  package's own classes and functions with their argument values (a
+  ``super().__init__(...)`` of a class deriving from one of the package's is
+  a call of that base's constructor), attribute bindings, module constants,
+  imports.
 
 A name that is not read statically is reported unresolved at its location,
 never guessed.
