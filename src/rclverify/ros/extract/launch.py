@@ -337,37 +337,49 @@ class Interpreter:
                     finally:
                         scope.unsure = outer
         elif t == "node":
-            pkg = self._attr(el, "pkg", scope, path)
-            exe = self._attr(el, "type", scope, path) or self._attr(el, "exec", scope, path)
-            if not pkg or not exe:
-                raise Unresolved("node needs 'pkg' and 'type'/'exec'")
-            name = self._soft(el, "name", scope, path)
-            ns = self._soft(el, "ns", scope, path) or self._soft(el, "namespace", scope, path)
-            given = self._ros_args(el, scope, path, name)
-            name, ns = given.name or name, given.ns or ns
-            node_ns = names.join(scope.ns, ns) if ns else scope.ns
-            remaps, params = self._node_children(el, scope, path, node_ns, name)
-            remaps += [(frm, to, el.src) for frm, to in given.remaps]
-            params.update({"~" + k.lstrip("~/"): (v, el.src) for k, v in given.params.items()})
-            self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params,
-                                         self._attr(el, "args", scope, path) if pkg == "nodelet" else None,
-                                         scope.unsure))
+            self._node_element(el, scope, path)
         elif t == "include":
-            f = self._attr(el, "file", scope, path)
-            if not f:
-                raise Unresolved("include needs 'file'")
-            target = Path(f)
-            if not target.is_absolute():
-                target = path.parent / target
-            if not target.is_file():
-                raise Unresolved(f"included file {f} not found")
-            ns = self._attr(el, "ns", scope, path)
-            args: dict[str, str] = dict(scope.args) if el.attrs.get("pass_all_args") == "true" else {}
-            for c in el.children:
-                if c.tag == "arg" and self._cond(c, scope, path):
-                    n = self._attr(c, "name", scope, path)
-                    v = self._attr(c, "value", scope, path) or self._attr(c, "default", scope, path)
-                    if n and v is not None:
-                        args[n] = v
-            self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps, scope.unsure)
+            self._include_element(el, scope, path)
         # rosparam, env, machine, test, executable ...: not part of the topic graph
+
+    def _node_element(self, el: El, scope: _Scope, path: Path) -> None:
+        """A ``<node>`` (ROS 1) or ``<node>``/``<lifecycle_node>`` (ROS 2 XML, YAML) in ``scope``: one
+        :class:`LaunchNode` with its name, namespace, remaps and parameters as launch gives them.
+        Raises :class:`Unresolved` when its package or executable is not known."""
+        pkg = self._attr(el, "pkg", scope, path)
+        exe = self._attr(el, "type", scope, path) or self._attr(el, "exec", scope, path)
+        if not pkg or not exe:
+            raise Unresolved("node needs 'pkg' and 'type'/'exec'")
+        name = self._soft(el, "name", scope, path)
+        ns = self._soft(el, "ns", scope, path) or self._soft(el, "namespace", scope, path)
+        given = self._ros_args(el, scope, path, name)
+        name, ns = given.name or name, given.ns or ns
+        node_ns = names.join(scope.ns, ns) if ns else scope.ns
+        remaps, params = self._node_children(el, scope, path, node_ns, name)
+        remaps += [(frm, to, el.src) for frm, to in given.remaps]
+        params.update({"~" + k.lstrip("~/"): (v, el.src) for k, v in given.params.items()})
+        self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params,
+                                     self._attr(el, "args", scope, path) if pkg == "nodelet" else None,
+                                     scope.unsure))
+
+    def _include_element(self, el: El, scope: _Scope, path: Path) -> None:
+        """An ``<include>`` in ``scope``: the included file read with its arguments (``pass_all_args``
+        and its ``<arg>`` children) under the scope's namespace and remaps.  Raises
+        :class:`Unresolved` when the file is not named or not found."""
+        f = self._attr(el, "file", scope, path)
+        if not f:
+            raise Unresolved("include needs 'file'")
+        target = Path(f)
+        if not target.is_absolute():
+            target = path.parent / target
+        if not target.is_file():
+            raise Unresolved(f"included file {f} not found")
+        ns = self._attr(el, "ns", scope, path)
+        args: dict[str, str] = dict(scope.args) if el.attrs.get("pass_all_args") == "true" else {}
+        for c in el.children:
+            if c.tag == "arg" and self._cond(c, scope, path):
+                n = self._attr(c, "name", scope, path)
+                v = self._attr(c, "value", scope, path) or self._attr(c, "default", scope, path)
+                if n and v is not None:
+                    args[n] = v
+        self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps, scope.unsure)

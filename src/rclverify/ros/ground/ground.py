@@ -285,45 +285,7 @@ class Grounder:
                              f"no node of the graph publishes {resolved} ({node.name}'s input "
                              f"{var.qualified if var else tp.field})" + (f"; closest published topic: {close[0]}" if close else ""),
                              rcl_loc, where, node.name, tp.field)
-            # message type
-            info = self.table.get(ctype)
-            graph_types = {e.msg_type for e in ([edge] if edge else []) + [pe for _, pe in publishers.get(resolved, [])]
-                           if e.msg_type}
-            graph_types |= {t for _b, t in self.recorded.get(resolved, []) if t}
-            type_src = edge.src if edge else (publishers[resolved][0][1].src if publishers.get(resolved) else None)
-            if info is None:
-                self.add("ROS-TYPE-UNKNOWN", f"message type {tp.msg_type} of topic '{tp.field}' is defined by no "
-                         f"scanned or standard package" + (f"; the graph carries {', '.join(short_type(t) for t in sorted(graph_types))}"
-                                                           if graph_types else ""),
-                         rcl_loc, type_src, node.name, tp.field)
-                continue
-            assert ctype is not None  # the table knows no type without a name
-            # the node's own code may make the topic with several types, one chosen at run time (a
-            # parameter picks TwistStamped or Twist): the contract naming one of them is that choice
-            own = {e.msg_type for e in (gn.publishes if kind == "pub" else gn.subscribes)
-                   if edge is not None and e.topic == edge.topic and e.msg_type}
-            chosen = ctype in own and len(own) > 1
-            differs = sorted(t for t in graph_types if t != ctype and not (chosen and t in own))
-            if chosen and not differs:
-                self.add("ROS-TYPE-ALTERNATIVE", f"topic '{tp.field}' is made as "
-                         f"{', '.join(short_type(t) for t in sorted(own))} in {gn.name}'s code, one of them chosen "
-                         f"at run time; the contract says {tp.msg_type}, checked as that", rcl_loc, type_src,
-                         node.name, tp.field)
-            clash = [(name, pe) for name, pe in publishers.get(resolved, [])
-                     if name != gn.name and pe.msg_type in differs] if edge is not None and edge.msg_type == ctype else []
-            if clash and edge is not None:  # the contract matches its own node's code: another program differs
-                other_node, pe = clash[0]
-                self.add("ROS-TYPE-CLASH", f"topic {resolved} is made with {short_type(pe.msg_type)} by {other_node} "
-                         f"({pe.src}) and with {short_type(ctype)} by {gn.name} ({edge.src}), as {node.name}'s "
-                         f"contract says: the two programs differ, not the contract", rcl_loc, pe.src,
-                         node.name, tp.field)
-                continue
-            if differs:
-                self.add("ROS-TYPE-DIFFERS", f"topic '{tp.field}' carries {', '.join(short_type(t) for t in differs)} "
-                         f"in the code, the contract says {tp.msg_type}", rcl_loc, type_src, node.name, tp.field)
-                continue
-            if var is not None:
-                self._fields(cn, tp, var, ctype, rcl_loc)
+            self._topic_type(cn, gn, tp, kind, edge, resolved, publishers)
         for e in gn.publishes + gn.subscribes:
             # the client library's and other libraries' (tf, bond, diagnostics ...): no contract need name them
             if id(e) not in documented and library_of(e.topic, e.msg_type) is None:
@@ -331,6 +293,57 @@ class Grounder:
                 self.add("ROS-TOPIC-UNDOCUMENTED", f"{gn.name} {what} {e.topic} ({short_type(e.msg_type)}), which "
                          f"{node.name}'s contract leaves out of topics(...)", node.loc, e.src, node.name, e.written)
         ground_links(self.add, node, gn, self.graph_nodes, self.external, self.table)
+
+    def _topic_type(self, cn: Any, gn: GraphNode, tp: ast.Topic, kind: str, edge: GraphEdge | None,
+                    resolved: str, publishers: dict[str, list[tuple[str, GraphEdge]]]) -> None:
+        """The message type of contract topic ``tp`` of ``cn`` (``kind``: ``pub`` or ``sub`` of graph
+        node ``gn``, its own ``edge`` if the code makes it) against the types the graph, the other
+        programs (``publishers``: resolved topic -> (program, edge)) and the recorded runs carry on
+        ``resolved``; then its fields (:meth:`_fields`).  Adds ROS-TYPE-UNKNOWN, -ALTERNATIVE, -CLASH or
+        -DIFFERS findings."""
+        node: ast.Node = cn.node
+        var = tp.match
+        ctype = canon_type(tp.msg_type)
+        rcl_loc = tp.loc
+        # message type
+        info = self.table.get(ctype)
+        graph_types = {e.msg_type for e in ([edge] if edge else []) + [pe for _, pe in publishers.get(resolved, [])]
+                       if e.msg_type}
+        graph_types |= {t for _b, t in self.recorded.get(resolved, []) if t}
+        type_src = edge.src if edge else (publishers[resolved][0][1].src if publishers.get(resolved) else None)
+        if info is None:
+            self.add("ROS-TYPE-UNKNOWN", f"message type {tp.msg_type} of topic '{tp.field}' is defined by no "
+                     f"scanned or standard package" + (f"; the graph carries {', '.join(short_type(t) for t in sorted(graph_types))}"
+                                                       if graph_types else ""),
+                     rcl_loc, type_src, node.name, tp.field)
+            return
+        assert ctype is not None  # the table knows no type without a name
+        # the node's own code may make the topic with several types, one chosen at run time (a
+        # parameter picks TwistStamped or Twist): the contract naming one of them is that choice
+        own = {e.msg_type for e in (gn.publishes if kind == "pub" else gn.subscribes)
+               if edge is not None and e.topic == edge.topic and e.msg_type}
+        chosen = ctype in own and len(own) > 1
+        differs = sorted(t for t in graph_types if t != ctype and not (chosen and t in own))
+        if chosen and not differs:
+            self.add("ROS-TYPE-ALTERNATIVE", f"topic '{tp.field}' is made as "
+                     f"{', '.join(short_type(t) for t in sorted(own))} in {gn.name}'s code, one of them chosen "
+                     f"at run time; the contract says {tp.msg_type}, checked as that", rcl_loc, type_src,
+                     node.name, tp.field)
+        clash = [(name, pe) for name, pe in publishers.get(resolved, [])
+                 if name != gn.name and pe.msg_type in differs] if edge is not None and edge.msg_type == ctype else []
+        if clash and edge is not None:  # the contract matches its own node's code: another program differs
+            other_node, pe = clash[0]
+            self.add("ROS-TYPE-CLASH", f"topic {resolved} is made with {short_type(pe.msg_type)} by {other_node} "
+                     f"({pe.src}) and with {short_type(ctype)} by {gn.name} ({edge.src}), as {node.name}'s "
+                     f"contract says: the two programs differ, not the contract", rcl_loc, pe.src,
+                     node.name, tp.field)
+            return
+        if differs:
+            self.add("ROS-TYPE-DIFFERS", f"topic '{tp.field}' carries {', '.join(short_type(t) for t in differs)} "
+                     f"in the code, the contract says {tp.msg_type}", rcl_loc, type_src, node.name, tp.field)
+            return
+        if var is not None:
+            self._fields(cn, tp, var, ctype, rcl_loc)
 
     def _fields(self, cn: Any, tp: ast.Topic, var: ast.Var, ctype: str, rcl_loc: ast.Loc) -> None:
         info = self.table.get(ctype)
