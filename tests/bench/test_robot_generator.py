@@ -273,7 +273,8 @@ def test_a_trigger_before_every_input_has_a_value_gets_no_deadline_verdict(
 # between the two) judged from the bag gave one more deadline verdict (true 13 against 12) and one
 # more incomplete input (2 against 1) than from the log of the same run, which judged as live did.  In
 # event time (the stamp) in.x comes first: incomplete input, no deadline verdict (docs/semantics.md,
-# "Deadlines").  The bag (written by the recorder at each message's source time, the stamp in its
+# "Deadlines"); the bag, read out of stamp order within the transport skew only, is now read again in
+# stamp order as the log is.  The bag (written by the recorder at each message's source time, the stamp in its
 # header) and the log (at the stamp) of one run of that shape:
 RANGE_FUSE_RCL = FUSE_RCL.replace("std_msgs/Float32 s0", "sensor_msgs/Range s0")
 #: (topic, source time s, header stamp s or None, value)
@@ -332,9 +333,6 @@ def test_the_log_of_a_stamped_first_trigger_gets_no_deadline_verdict(
     assert answers["incomplete input"] == 1 and deadlines["true"] == 1, (answers, deadlines)
 
 
-@pytest.mark.xfail(strict=True, reason="rclverify fault (docs/monitors.md, 'Generated robots'): from the bag, a "
-                   "stamped trigger published after an input it was stamped before is judged in another order than "
-                   "from the log of the same run (deadlines true 2 against 1, incomplete input 2 against 1)")
 def test_a_bag_and_its_log_judge_a_stamped_first_trigger_alike(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     got = _range_fuse_verdicts(tmp_path, capsys)
@@ -345,9 +343,10 @@ def test_a_bag_and_its_log_judge_a_stamped_first_trigger_alike(
 # and bag agree): Relay2 and Relay3 copy the header stamp of the reading they answer (in /clock time,
 # the reading's own) and publish it 348 and 570 ms later, after the next reading (every 300 ms); each
 # was violated 16 times.  Their stamps, like the sensor's, run in another clock than the source times
-# and are set aside (docs/semantics.md, "Clocks"), so each answer is judged at its source time against
-# the newer reading, though the copied stamp says which reading it answers, in the clock both stamps
-# share.  One such run as a log (source times from 1000 s, stamps at half the rate from 100 s):
+# and were set aside, so each answer was judged at its source time against the newer reading; a copied
+# stamp equal to its reading's, in the clock both share, now places the answer at that reading's time
+# (docs/semantics.md, "Event time").  One such run as a log (source times from 1000 s, stamps at half
+# the rate from 100 s):
 RELAY_RCL = """\
 node Relay {
   inputs( x : REAL )
@@ -388,9 +387,6 @@ def test_a_stamp_copying_relay_in_the_wall_clock_is_satisfied(tmp_path: Path, ca
     assert counts["satisfied"] >= 2 and counts["violated"] == 0, counts
 
 
-@pytest.mark.xfail(strict=True, reason="rclverify fault (docs/monitors.md, 'Generated robots'): a stamp-copying "
-                   "relay on a /clock has its copied stamps set aside with the sensor's, and is judged violated at its "
-                   "source time against the newer reading")
 def test_a_stamp_copying_relay_on_a_simulated_clock_is_satisfied(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     counts = _relay_counts(tmp_path, RELAY_RUN, capsys)
     assert counts["violated"] == 0, counts

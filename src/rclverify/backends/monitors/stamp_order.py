@@ -44,7 +44,7 @@ from __future__ import annotations
 import math
 from typing import Any, Callable, Iterable, Iterator
 
-from rclverify.traces.event_time import WriterClocks, other_clock, published, without_stamp
+from rclverify.traces.event_time import CopiedStamps, WriterClocks, other_clock, published, without_stamp
 from rclverify.traces.events import Event, header_stamp
 from rclverify.traces.reorder import ReorderBuffer
 
@@ -62,7 +62,7 @@ class StampWatch:
     largest such ``lag`` in seconds; ``first``: where the first was read)."""
 
     __slots__ = ("skew", "latest", "count", "lag", "first", "stamped", "plain", "clocks", "placed_latest",
-                 "placed_lag")
+                 "placed_lag", "near", "copies")
 
     def __init__(self, skew: float) -> None:
         self.skew = skew
@@ -78,13 +78,18 @@ class StampWatch:
         #: the latest time and the largest lag with the stamps in another clock placed at their trace times
         self.placed_latest = -math.inf
         self.placed_lag = 0.0
+        #: the largest lag (s) of a message read after one stamped later by no more than the skew
+        self.near = 0.0
+        #: the stamps in another clock seen, to place a copy of one at its question's time (traces/event_time.py)
+        self.copies = CopiedStamps()
 
     def see(self, ev: Event) -> None:
         """Note event ``ev``'s place on the run's clock."""
         s = header_stamp(ev.fields) if ev.fields else None
         t = ev.time if s is None else s
         span = self.plain if s is None else self.stamped
-        p = ev.time if s is None or self.clocks.see(ev.topic, s, ev.time) else s
+        p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time) if self.clocks.see(
+            ev.topic, s, ev.time) else s
         if p >= self.placed_latest:
             self.placed_latest = p
         elif self.placed_latest - p > self.placed_lag:
@@ -96,7 +101,9 @@ class StampWatch:
         latest = self.latest
         if t >= latest:
             self.latest = t
-        elif latest - t > self.skew:
+        elif latest - t <= self.skew:
+            self.near = max(self.near, latest - t)
+        else:
             self.count += 1
             if latest - t > self.lag:
                 self.lag = latest - t
@@ -117,6 +124,7 @@ class StampWatch:
         ahead = np.maximum(np.maximum.accumulate(times), self.latest)  # the latest time heard up to each row
         behind = ahead - times
         late = behind > self.skew
+        self.near = max(self.near, float(np.where(late, 0.0, behind).max()))
         if late.any():
             self.count += int(late.sum())
             self.lag = max(self.lag, float(behind.max()))
@@ -160,15 +168,17 @@ class Reread(float):
         return self
 
 
-def placed_clock(ev: Event) -> tuple[float, bool]:
+def placed_clock(ev: Event, copies: CopiedStamps | None = None) -> tuple[float, bool]:
     """``(time, placed)``: the event's time on the run's clock when stamps in
-    another clock are placed at their trace times, and whether its stamp was
-    set aside so (the message is then judged as unstamped)."""
+    another clock are placed at their trace times (a stamp copied from another
+    writer's in that clock at that message's, through ``copies``:
+    :class:`~rclverify.traces.event_time.CopiedStamps`), and whether its stamp
+    was set aside so (the message is then judged as unstamped)."""
     s = header_stamp(ev.fields) if ev.fields else None
     if s is None:
         return ev.time, False
     if other_clock(s, ev.time):
-        return ev.time, True
+        return (ev.time if copies is None else copies.place(ev.topic, s, ev.time)), True
     return s, False
 
 
@@ -183,9 +193,10 @@ def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
     latest = -math.inf
     out = 0
     place = isinstance(lag, Reread) and lag.placed
+    copies = CopiedStamps()  # as the first pass placed them (StampWatch.see)
     for ev in events:
         if place:
-            t, aside = placed_clock(ev)
+            t, aside = placed_clock(ev, copies)
             if aside:
                 ev = Event(ev.index, ev.time, ev.topic, without_stamp(ev.fields), ev.where, late=ev.late)
         else:
@@ -244,8 +255,8 @@ def second_read(watch: StampWatch, trace: str, readable: bool) -> tuple[float | 
             note += (f"; judged in stamp order with those stamps placed (a lag of up to "
                      f"{watch.placed_lag * 1e3:.1f} ms)")
         return Reread(watch.placed_lag, placed=True), note, ""
-    if not watch.count:
-        return None, "", ""
+    if not watch.count:  # read out of stamp order within the skew only: read again in stamp order, said nowhere
+        return (watch.near, "", "") if watch.near and readable and not watch.two_clocks() else (None, "", "")
     if watch.two_clocks() or not readable:
         return None, "", stale_reason(watch, trace)
     return watch.lag, watch.note(), ""
