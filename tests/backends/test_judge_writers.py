@@ -124,6 +124,40 @@ def test_the_control_a_stamp_copying_relay_with_a_defect_is_red_live_as_offline(
     assert [x for x in live if x != ("run.jsonl:1", "superseded")] == offline
 
 
+
+def _on_simulated_time(lines: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """``lines`` with every header stamp on a /clock at half the wall clock's rate from 100 s (another
+    clock than the source times: traces/event_time.py), the relay's copies still its readings' stamps."""
+    out = []
+    for line in lines:
+        if "header" in line:
+            st = line["header"]["stamp"]
+            line = {**line, **_stamp(100.0 + (st["sec"] + st["nanosec"] / 1e9 - 1.0) * 0.5)}
+        out.append(line)
+    return out
+
+
+@pytest.mark.parametrize("defect", [False, True], ids=["correct", "control: defective"])
+def test_a_stamp_copying_relay_on_simulated_time_is_paired_by_its_copied_stamps_live_as_offline(
+        tmp_path: Path, defect: bool) -> None:
+    """Fault 5 of the robot generator: both writers' stamps run in another clock and were set aside,
+    so each answer, placed at its source time after the next reading, was judged against that reading:
+    the correct relay violated.  A copied stamp equal to its reading's, in the clock both share, names
+    that reading: the answer is placed at the reading's time.  The correct relay is satisfied, the
+    defective one violated on answers 3, 7 and 11 only, live verdict by verdict as offline."""
+    lines = _on_simulated_time(_copying_relay(0.45, defect=defect))
+    ws, run = _workspace(tmp_path, COPY, lines, COPY_MAPPING)
+    statuses, deadlines = _offline(ws, run, "Relay")
+    offline = _verdicts_offline(ws, run)
+    violated = {w for w, v in offline if v == "violated"}
+    assert violated == ({"run.jsonl:9", "run.jsonl:17", "run.jsonl:24"} if defect else set()), offline
+    assert len(offline) == 12 and {v for _, v in offline} <= {"satisfied", "violated"}, offline
+    assert statuses == (["failed", "failed"] if defect else ["discharged", "discharged"]), statuses
+    live, counts, _ = _verdicts_live(ws, lines)
+    assert counts == deadlines[0]
+    assert [x for x in live if x != ("run.jsonl:1", "superseded")] == offline
+
+
 def test_a_writer_is_past_a_time_once_heard_past_it_or_silent_past_the_bound_on_its_own_clock(
         tmp_path: Path) -> None:
     """The watermark's rule itself: a reading at 1.3 s is held while the relay (publishing 450 ms

@@ -100,6 +100,48 @@ def published(stamp: float, source: float) -> float | None:
     return source if source - stamp > STALE_S else None
 
 
+#: how long (s) a stamp in another clock is kept for a copy of it to name its message (a relay's answer
+#: published this long after its question at most)
+COPY_S = 60.0
+
+
+class CopiedStamps:
+    """Places the messages whose header stamps run in another clock
+    (:func:`other_clock`).  A message is placed at its source time, unless
+    its stamp equals the stamp of an earlier message of another writer in
+    that clock: a stamp copied from a question onto an answer, both in the
+    clock the two stamps share (simulated time), names that question, so the
+    answer is placed at the time its question was placed (and judged, like a
+    stale copied stamp in the run's clock, against that question and those
+    asked until it was published; docs/semantics.md, "Event time").
+    ``copied`` counts the messages so placed."""
+
+    __slots__ = ("_first", "copied")
+
+    def __init__(self) -> None:
+        self._first: dict[float, tuple[str, float]] = {}
+        self.copied = 0
+
+    def place(self, topic: str, stamp: float, source: float) -> float:
+        """The time (s, the run's clock) a message of ``topic`` with header
+        stamp ``stamp`` (s, another clock) and source time ``source`` (s) is
+        placed at: the source time of the first message of another writer
+        stamped ``stamp`` within :data:`COPY_S` before it, else ``source``."""
+        first = self._first
+        got = first.get(stamp)
+        if got is not None and got[0] != topic and 0.0 <= source - got[1] <= COPY_S:
+            self.copied += 1
+            return got[1]
+        if got is None:
+            first[stamp] = (topic, source)
+            while first:  # stamps too old to be copied any more are forgotten (insertion order: oldest first)
+                k = next(iter(first))
+                if first[k][1] >= source - COPY_S:
+                    break
+                del first[k]
+        return source
+
+
 class WriterClocks:
     """Per writer (a topic), the offset between its header stamps and its
     messages' source times, measured: ``offsets[topic] = [lo, hi, n,
@@ -140,7 +182,7 @@ class WriterClocks:
         out = []
         for t in self.others():
             lo, hi, n, other = self.offsets[t]
-            fate = ("placed at their source times" if placed else
+            fate = ("placed at their source times, a stamp copied from another writer's at that message's" if placed else
                     "not related to the run's clock")
             out.append(f"/{t}: header stamps {_signed(lo)} to {_signed(hi)} from its source times, another clock "
                        f"({other} of {n} stamped message(s) beyond -{STAMP_BEHIND_S:g} s .. +{STAMP_AHEAD_S:g} s, "

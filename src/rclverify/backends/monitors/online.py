@@ -45,7 +45,7 @@ from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.traces.event_time import WriterClocks, published, without_stamp
+from rclverify.traces.event_time import CopiedStamps, WriterClocks, published, without_stamp
 from rclverify.traces.events import Event, header_stamp, header_stamp_ns
 from rclverify.traces.reorder import ReorderBuffer
 from rclverify.traces.mapping import TopicRule
@@ -92,6 +92,8 @@ class OnlineEngine:
     _clock: float = field(init=False, default=-math.inf)
     #: per writer (topic), its header stamps' offset from its source times (traces/event_time.py)
     clocks: WriterClocks = field(init=False, default_factory=WriterClocks)
+    #: the stamps in another clock heard, to place a copy of one at its question's time
+    copies: CopiedStamps = field(init=False, default_factory=CopiedStamps)
     #: per writer (topic): (the latest time heard on the run's clock, the most it published after its
     #: stamp, s): its own watermark (:meth:`watermark`)
     writers: dict[str, tuple[float, float]] = field(init=False, default_factory=dict)
@@ -120,7 +122,8 @@ class OnlineEngine:
                 self.on_silence(topic, 0.0, False)
         stamp = header_stamp(fields)
         if stamp is not None and self.clocks.see(topic, stamp, received):
-            stamp, fields = None, without_stamp(fields)  # another clock: placed at its source time
+            # another clock: placed at its source time, a copied stamp at its question's (traces/event_time.py)
+            stamp, fields = self.copies.place(topic, stamp, received), without_stamp(fields)
         t = received if stamp is None else stamp
         last, lag = self.writers.get(topic, (-math.inf, 0.0))
         self.writers[topic] = (max(last, t), max(lag, min(received - t, self.horizon)))
