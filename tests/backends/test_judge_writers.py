@@ -122,6 +122,33 @@ def test_the_control_a_stamp_copying_relay_with_a_defect_is_red_live_as_offline(
     live, counts, _ = _verdicts_live(ws, lines)
     assert counts == deadlines[0]
     assert [x for x in live if x != ("run.jsonl:1", "superseded")] == offline
+    # the live log (runtime/live.py's lines: the copies' stamps carried to their readings' times) judged again
+    logged = tmp_path / "live" / "run.jsonl"
+    logged.parent.mkdir()
+    _workspace(logged.parent, COPY, _released(ws, lines), COPY_MAPPING)
+    again = _verdicts_offline(logged.parent, logged)
+    assert sorted(v for _, v in again) == sorted(v for _, v in offline), again
+
+
+def _released(ws: Path, lines: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """What the live monitor's log holds of ``lines`` heard 1 ms after publication (runtime/live.py, ``_event``)."""
+    checked = load([ws / "contracts" / "c.rcl"])
+    out: list[dict[str, Any]] = []
+
+    def log(ev: Any) -> None:
+        late = {"late_s": round(ev.late, 6)} if ev.late else {}
+        out.append({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time, **late,
+                    **dict(ev.fields)})
+    eng = OnlineEngine(checked, [checked.nodes["Relay"]], load_mapping(ws, "mapping.yaml").rules, 1.0,
+                       reorder_window=WINDOW, on_event=log)
+    now = lines[0]["time"]
+    for line in lines:
+        while now + 0.01 <= line["time"] + 0.001:
+            now += 0.01
+            eng.tick(now)
+        eng.push(line["topic"], {x: v for x, v in line.items() if x not in ("topic", "time")}, line["time"])
+    eng.finish()
+    return out
 
 
 
@@ -156,6 +183,33 @@ def test_a_stamp_copying_relay_on_simulated_time_is_paired_by_its_copied_stamps_
     live, counts, _ = _verdicts_live(ws, lines)
     assert counts == deadlines[0]
     assert [x for x in live if x != ("run.jsonl:1", "superseded")] == offline
+    # the live log (runtime/live.py's lines: the copies' stamps carried to their readings' times) judged again
+    logged = tmp_path / "live" / "run.jsonl"
+    logged.parent.mkdir()
+    _workspace(logged.parent, COPY, _released(ws, lines), COPY_MAPPING)
+    again = _verdicts_offline(logged.parent, logged)
+    assert sorted(v for _, v in again) == sorted(v for _, v in offline), again
+
+
+def _released(ws: Path, lines: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """What the live monitor's log holds of ``lines`` heard 1 ms after publication (runtime/live.py, ``_event``)."""
+    checked = load([ws / "contracts" / "c.rcl"])
+    out: list[dict[str, Any]] = []
+
+    def log(ev: Any) -> None:
+        late = {"late_s": round(ev.late, 6)} if ev.late else {}
+        out.append({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time, **late,
+                    **dict(ev.fields)})
+    eng = OnlineEngine(checked, [checked.nodes["Relay"]], load_mapping(ws, "mapping.yaml").rules, 1.0,
+                       reorder_window=WINDOW, on_event=log)
+    now = lines[0]["time"]
+    for line in lines:
+        while now + 0.01 <= line["time"] + 0.001:
+            now += 0.01
+            eng.tick(now)
+        eng.push(line["topic"], {x: v for x, v in line.items() if x not in ("topic", "time")}, line["time"])
+    eng.finish()
+    return out
 
 
 def test_a_writer_is_past_a_time_once_heard_past_it_or_silent_past_the_bound_on_its_own_clock(

@@ -87,6 +87,28 @@ def without_stamp(fields: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def with_stamp(fields: Mapping[str, Any], stamp: float) -> dict[str, Any]:
+    """``fields`` with the header's stamp (nested ``header.stamp`` or
+    ROSMonitoring's flattened ``header.stamp.*``, in the keys the message
+    has) made ``stamp`` (s, the run's clock): a stamp in another clock
+    carried into the run's clock at the time its message was placed
+    (:class:`CopiedStamps`), so a log of the run places it there again."""
+    sec = int(stamp)
+    ns = min(round((stamp - sec) * 1e9), 999_999_999)
+    out = dict(fields)
+    h = out.get("header")
+    old: Any = h.get("stamp") if isinstance(h, Mapping) else None
+    if isinstance(h, Mapping) and isinstance(old, Mapping):
+        keys = ("secs", "nsecs") if "secs" in old else ("sec", "nanosec")
+        out["header"] = {**h, "stamp": {**old, keys[0]: sec, keys[1]: ns}}
+    elif isinstance(h, Mapping) and old is not None:
+        out["header"] = {**h, "stamp": stamp}
+    else:
+        for k in [k for k in out if k.startswith("header.stamp.")]:
+            out[k] = sec if k.rsplit(".", 1)[1] in ("sec", "secs") else ns
+    return out
+
+
 #: a header stamp more than this (s) before its message's source time is older than its publication: the
 #: message may answer any question asked up to its source time (a stamp copied from an earlier question)
 STALE_S = 0.02
@@ -111,9 +133,10 @@ class CopiedStamps:
     its stamp equals the stamp of an earlier message of another writer in
     that clock: a stamp copied from a question onto an answer, both in the
     clock the two stamps share (simulated time), names that question, so the
-    answer is placed at the time its question was placed (and judged, like a
+    answer is placed at the time its question was placed, its stamp carried
+    into the run's clock there (:func:`with_stamp`), and judged, like a
     stale copied stamp in the run's clock, against that question and those
-    asked until it was published; docs/semantics.md, "Event time").
+    asked until it was published (docs/semantics.md, "Event time").
     ``copied`` counts the messages so placed."""
 
     __slots__ = ("_first", "copied")
@@ -122,16 +145,17 @@ class CopiedStamps:
         self._first: dict[float, tuple[str, float]] = {}
         self.copied = 0
 
-    def place(self, topic: str, stamp: float, source: float) -> float:
-        """The time (s, the run's clock) a message of ``topic`` with header
-        stamp ``stamp`` (s, another clock) and source time ``source`` (s) is
-        placed at: the source time of the first message of another writer
-        stamped ``stamp`` within :data:`COPY_S` before it, else ``source``."""
+    def place(self, topic: str, stamp: float, source: float) -> tuple[float, bool]:
+        """``(time, copied)``: the time (s, the run's clock) a message of
+        ``topic`` with header stamp ``stamp`` (s, another clock) and source
+        time ``source`` (s) is placed at, the source time of the first message
+        of another writer stamped ``stamp`` within :data:`COPY_S` before it
+        (``copied`` true), else ``source``."""
         first = self._first
         got = first.get(stamp)
         if got is not None and got[0] != topic and 0.0 <= source - got[1] <= COPY_S:
             self.copied += 1
-            return got[1]
+            return got[1], True
         if got is None:
             first[stamp] = (topic, source)
             while first:  # stamps too old to be copied any more are forgotten (insertion order: oldest first)
@@ -139,7 +163,7 @@ class CopiedStamps:
                 if first[k][1] >= source - COPY_S:
                     break
                 del first[k]
-        return source
+        return source, False
 
 
 class WriterClocks:

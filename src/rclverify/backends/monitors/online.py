@@ -23,7 +23,9 @@ a running system adds (docs/monitors.md, "Live monitoring"):
 * **clocks**: per writer (topic) the offset between its header stamps and
   its source times is measured (:attr:`clocks`); a stamp more than 0.1 s
   ahead of its message's source time or 1 s behind it runs in another
-  clock, and its message is placed at its source time, its stamp set aside,
+  clock, and its message is placed at its source time (a stamp copied from
+  another writer's in that clock at that message's time, its stamp carried
+  there: :class:`~rclverify.traces.event_time.CopiedStamps`), its stamp set aside,
   as a recorded run read again is (:mod:`.stamp_order`); :meth:`clock_lines`
   names each such writer;
 * **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
@@ -45,7 +47,7 @@ from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.traces.event_time import CopiedStamps, WriterClocks, published, without_stamp
+from rclverify.traces.event_time import CopiedStamps, WriterClocks, published, with_stamp, without_stamp
 from rclverify.traces.events import Event, header_stamp, header_stamp_ns
 from rclverify.traces.reorder import ReorderBuffer
 from rclverify.traces.mapping import TopicRule
@@ -123,7 +125,8 @@ class OnlineEngine:
         stamp = header_stamp(fields)
         if stamp is not None and self.clocks.see(topic, stamp, received):
             # another clock: placed at its source time, a copied stamp at its question's (traces/event_time.py)
-            stamp, fields = self.copies.place(topic, stamp, received), without_stamp(fields)
+            stamp, copied = self.copies.place(topic, stamp, received)
+            fields = with_stamp(fields, stamp) if copied else without_stamp(fields)
         t = received if stamp is None else stamp
         last, lag = self.writers.get(topic, (-math.inf, 0.0))
         self.writers[topic] = (max(last, t), max(lag, min(received - t, self.horizon)))

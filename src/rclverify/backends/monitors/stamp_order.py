@@ -18,7 +18,11 @@ stamps: two clocks, two answers.
 :class:`.judged.Counted`, which every offline path has) and counts the
 messages stamped more than the transport skew (:mod:`.skew`; the engine
 already judges both readings within it) before the latest stamp heard,
-keeping the largest such lag.  A run with none was judged on one clock.  A
+keeping the largest such lag.  A run with none was judged on one clock,
+unless a message was read after one stamped later by no more than the skew
+(``near``, its largest lag): that run is read again in stamp order too, and
+says nothing of it, so a bag (each message at its source time, a stamp a few
+ms before) is judged as its log (each at its stamp).  A
 run with some is read again through :func:`in_stamp_order`: a reorder
 buffer whose window is the largest lag the first pass measured releases
 every message in stamp order (no later message can be stamped before the
@@ -34,7 +38,9 @@ the offset between its header stamps and its messages' trace times
 and bag record each message's source time).  A stamp more than 0.1 s ahead
 of its message's trace time or 1 s behind it runs in another clock (:func:`~rclverify.traces.event_time.other_clock`: simulated
 time, a driver stamping seconds off); the run is read again with each such
-message placed at its trace time and its stamp set aside (:class:`Reread`,
+message placed at its trace time (a stamp copied from another writer's in
+that clock at that message's:
+:class:`~rclverify.traces.event_time.CopiedStamps`) and its stamp set aside (:class:`Reread`,
 :func:`placed_clock`), and the note names each writer in one line with its
 measured offsets, as the live engine places and names them
 (:mod:`.online`).  A stamp within those bounds is the message's time.
@@ -44,7 +50,7 @@ from __future__ import annotations
 import math
 from typing import Any, Callable, Iterable, Iterator
 
-from rclverify.traces.event_time import CopiedStamps, WriterClocks, other_clock, published, without_stamp
+from rclverify.traces.event_time import CopiedStamps, WriterClocks, other_clock, published, with_stamp, without_stamp
 from rclverify.traces.events import Event, header_stamp
 from rclverify.traces.reorder import ReorderBuffer
 
@@ -88,7 +94,7 @@ class StampWatch:
         s = header_stamp(ev.fields) if ev.fields else None
         t = ev.time if s is None else s
         span = self.plain if s is None else self.stamped
-        p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time) if self.clocks.see(
+        p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time)[0] if self.clocks.see(
             ev.topic, s, ev.time) else s
         if p >= self.placed_latest:
             self.placed_latest = p
@@ -168,18 +174,23 @@ class Reread(float):
         return self
 
 
-def placed_clock(ev: Event, copies: CopiedStamps | None = None) -> tuple[float, bool]:
-    """``(time, placed)``: the event's time on the run's clock when stamps in
-    another clock are placed at their trace times (a stamp copied from another
-    writer's in that clock at that message's, through ``copies``:
-    :class:`~rclverify.traces.event_time.CopiedStamps`), and whether its stamp
-    was set aside so (the message is then judged as unstamped)."""
+def placed_clock(ev: Event, copies: CopiedStamps | None = None) -> tuple[float, str]:
+    """``(time, how)``: the event's time on the run's clock when stamps in
+    another clock are placed at their trace times, and how its stamp was
+    placed: ``""`` (its own time), ``"aside"`` (set aside: the message is
+    then judged as unstamped) or ``"copied"`` (a stamp copied from another
+    writer's in that clock, through ``copies``:
+    :class:`~rclverify.traces.event_time.CopiedStamps`; carried into the
+    run's clock at that message's time)."""
     s = header_stamp(ev.fields) if ev.fields else None
     if s is None:
-        return ev.time, False
+        return ev.time, ""
     if other_clock(s, ev.time):
-        return (ev.time if copies is None else copies.place(ev.topic, s, ev.time)), True
-    return s, False
+        if copies is None:
+            return ev.time, "aside"
+        t, copied = copies.place(ev.topic, s, ev.time)
+        return t, "copied" if copied else "aside"
+    return s, ""
 
 
 def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
@@ -196,9 +207,10 @@ def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
     copies = CopiedStamps()  # as the first pass placed them (StampWatch.see)
     for ev in events:
         if place:
-            t, aside = placed_clock(ev, copies)
-            if aside:
-                ev = Event(ev.index, ev.time, ev.topic, without_stamp(ev.fields), ev.where, late=ev.late)
+            t, how = placed_clock(ev, copies)
+            if how:
+                ev = Event(ev.index, ev.time, ev.topic, with_stamp(ev.fields, t) if how == "copied" else
+                           without_stamp(ev.fields), ev.where, late=ev.late)
         else:
             t = run_clock(ev)
         latest = max(latest, t)
