@@ -194,7 +194,9 @@ class OnlineEngine:
             elif source is not None:
                 stamp = t
             self._clock = t
-            if late:  # heard after the watermark had passed it: about that much more than the bound after its time
+            if self.reorder_window <= 0:  # no lateness bound, no watermark: judged in the order heard, never late
+                late = 0.0
+            elif late:  # heard after the watermark had passed it: about that much more than the bound after its time
                 late += self.reorder_window
             ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp, source, late)
             self.released += 1
