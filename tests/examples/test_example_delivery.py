@@ -228,11 +228,19 @@ def test_each_first_repair_is_safe_and_is_what_the_fix_does(runs: dict[str, Any]
         assert rep["checked_by"].startswith("z3") and rep["proves"], name
         fix = (EXAMPLE / "fixes" / name).read_text(encoding="utf-8")
         assert all(line in _changed(fix) for line in _changed(rep["diff"])), (name, rep["diff"])
-    # the contract is right where the code is wrong: no contract edit is offered for those rows
+    # the contract is right where the code is wrong: no contract edit is offered for those rows; a repair
+    # offered there is a checked one-token edit of the node's code, the one the fix makes (the slow zone's
+    # `<` for `<=`); the stale command needs two lines changed, which no one-token edit is
+    offered = {}
     for name in ("02-stale-command.diff", "05-slow-zone.diff"):
-        assert _rows(report)[ROWS[name]]["repairs"] == []
+        reps = [_diag(report, r["diagnosis"])["repairs"][r["index"]] for r in _rows(report)[ROWS[name]]["repairs"]]
+        assert all(r["kind"] == "code" for r in reps), (name, reps)
         fix = (EXAMPLE / "fixes" / name).read_text(encoding="utf-8")
         assert "contracts/" not in fix and "nodes/" in fix
+        for r in reps:
+            assert all(line in _changed(fix) for line in _changed(r["diff"])), (name, r["diff"])
+        offered[name] = len(reps)
+    assert offered == {"02-stale-command.diff": 0, "05-slow-zone.diff": 1}
     for g in report["problems"]:  # never a widened consumer assumption first
         reps = [_diag(report, r["diagnosis"])["repairs"][r["index"]] for r in g["repairs"]]
         assert not reps or reps[0]["kind"] != "weaken-consumer"
