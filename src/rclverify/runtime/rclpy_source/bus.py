@@ -54,6 +54,7 @@ start): one message.
 from __future__ import annotations
 
 import base64
+import io
 import json
 import subprocess
 import threading
@@ -78,6 +79,23 @@ HOLD_MAX = 10_000
 
 class RclpyUnavailable(Exception):
     """The rclpy source cannot run; ``str`` says why in one line."""
+
+
+def agent_answer(python: Path, args: list[str], timeout_s: float, unreachable: str, failed: str) -> Any:
+    """The JSON answer of one run of the agent (:data:`AGENT`) in the ROS 2 Python ``python`` with
+    ``args`` (``--describe ...``, ``--graph S``): the body of its one ``J`` frame on stdout.  Raises
+    :class:`RclpyUnavailable` with ``unreachable: <why>`` when the process cannot start or outlives
+    ``timeout_s`` seconds, ``failed (exit N): <its last stderr line>`` when it fails or answers no
+    ``J`` frame."""
+    try:
+        proc = subprocess.run([str(python), str(AGENT), *args], capture_output=True, timeout=timeout_s)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        raise RclpyUnavailable(f"{unreachable}: {exc}") from None
+    frame = read_frame(io.BytesIO(proc.stdout))
+    if proc.returncode != 0 or frame is None or frame[0] != b"J":
+        last = proc.stderr.decode(errors="replace").strip().splitlines()[-1:]
+        raise RclpyUnavailable(f"{failed} (exit {proc.returncode}): {' '.join(last)}")
+    return json.loads(frame[1])
 
 
 class _Writer:
@@ -331,4 +349,4 @@ class RclpyBus(DeclaredTypes):
 
 
 
-__all__ = ["AGENT", "RclpyBus", "RclpyUnavailable"]
+__all__ = ["AGENT", "RclpyBus", "RclpyUnavailable", "agent_answer"]

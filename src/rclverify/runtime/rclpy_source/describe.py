@@ -6,14 +6,10 @@ it returns is checked to hash to its own hash.
 """
 from __future__ import annotations
 
-import io
-import json
-import subprocess
 from pathlib import Path
 
 from rclverify.runtime.dds.types import DdsTypeError, Declaration, declare
-from rclverify.runtime.rclpy_source.bus import AGENT, RclpyUnavailable
-from rclverify.runtime.rclpy_source.wire import read_frame
+from rclverify.runtime.rclpy_source.bus import RclpyUnavailable, agent_answer
 
 
 def installed_declarations(python: Path, names: list[str], timeout_s: float = 60.0) -> dict[str, Declaration]:
@@ -23,18 +19,10 @@ def installed_declarations(python: Path, names: list[str], timeout_s: float = 60
     with no local definition is read with (:meth:`~rclverify.runtime.dds.types.TypeBook.add_declaration`).
     A type the Python has no description of is left out.  Raises :class:`RclpyUnavailable` (one line)
     when the agent cannot run or answer, or a description does not hash to its own hash."""
-    try:
-        proc = subprocess.run([str(python), str(AGENT), "--describe", *names], capture_output=True,
-                              timeout=timeout_s)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)}: {exc}") from None
-    frame = read_frame(io.BytesIO(proc.stdout))
-    if proc.returncode != 0 or frame is None or frame[0] != b"J":
-        last = proc.stderr.decode(errors="replace").strip().splitlines()[-1:]
-        raise RclpyUnavailable(f"the ROS 2 Python {python} could not describe {', '.join(names)} "
-                               f"(exit {proc.returncode}): {' '.join(last)}")
+    what = f"the ROS 2 Python {python} could not describe {', '.join(names)}"
+    answer = agent_answer(python, ["--describe", *names], timeout_s, what, what)
     out: dict[str, Declaration] = {}
-    for name, found in json.loads(frame[1]).get("types", {}).items():
+    for name, found in answer.get("types", {}).items():
         if found is None:
             continue
         try:

@@ -15,17 +15,13 @@ reply endpoint of a GID made from its node and name.  Raises
 from __future__ import annotations
 
 import hashlib
-import io
-import json
-import subprocess
 from pathlib import Path
 from typing import Any
 
 from rclverify.ros.live.dds import NodeInfo, dds_type, reply_topic, request_topic, topic_name
 from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.live.dds_qos import INFINITE_NS, LIVELINESS, QosProfile
-from rclverify.runtime.rclpy_source.bus import AGENT, RclpyUnavailable
-from rclverify.runtime.rclpy_source.wire import read_frame
+from rclverify.runtime.rclpy_source.bus import agent_answer
 
 
 def _ns(value: object) -> int:
@@ -97,17 +93,9 @@ class RclpyDiscovery:
 
 def read_rclpy_graph(python: Path, wait_s: float) -> RclpyDiscovery:
     """The settled graph from the agent in ``python`` (module docstring)."""
-    try:
-        proc = subprocess.run([str(python), str(AGENT), "--graph", str(wait_s)], capture_output=True,
-                              timeout=wait_s + 60)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        raise RclpyUnavailable(f"the rclpy graph reader in {python} did not answer: {exc}") from None
-    frame = read_frame(io.BytesIO(proc.stdout))
-    if proc.returncode != 0 or frame is None or frame[0] != b"J":
-        last = proc.stderr.decode(errors="replace").strip().splitlines()[-1:]
-        raise RclpyUnavailable(f"the rclpy graph reader in {python} failed (exit {proc.returncode}): "
-                               f"{' '.join(last)}")
-    return RclpyDiscovery(json.loads(frame[1]))
+    return RclpyDiscovery(agent_answer(python, ["--graph", str(wait_s)], wait_s + 60,
+                                       f"the rclpy graph reader in {python} did not answer",
+                                       f"the rclpy graph reader in {python} failed"))
 
 
 __all__ = ["RclpyDiscovery", "read_rclpy_graph"]
