@@ -237,26 +237,28 @@ def _include(c: ast.Call, attrs: dict[str, str], src: Src, shown: str, notes: li
     return El("include", attrs, kids, src)
 
 
+#: action -> (element tag, (keyword, attribute) of its first and second argument, why one without them
+#: is not read): the scope-setting actions of two arguments
+_PAIRS: dict[str, tuple[str, tuple[str, str], tuple[str, str], str]] = {
+    "SetRemap": ("remap", ("src", "from"), ("dst", "to"), "a remap without src and dst"),
+    "SetLaunchConfiguration": ("let", ("name", "name"), ("value", "value"), "a configuration without name and value"),
+}
+
+
 def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, notes: list[Note]) -> El | None:
     """The actions other than nodes, arguments, groups and includes: remaps and
     configurations set in a scope, timers and event handlers (their actions
     started), ``OpaqueFunction`` and the launch file's own functions
     (evaluated, :func:`_function_actions`); any other call is named in a
     located note."""
-    if name == "SetRemap":
-        frm, to = _arg(c, 0, "src"), _arg(c, 1, "dst")
-        if frm is None or to is None:
-            raise _Unres("a remap without src and dst")
-        attrs.update({"from": _value(frm), "to": _value(to)})
+    if name in _PAIRS:  # two positional-or-keyword arguments set in the scope
+        tag, (k1, a1), (k2, a2), missing = _PAIRS[name]
+        x, y = _arg(c, 0, k1), _arg(c, 1, k2)
+        if x is None or y is None:
+            raise _Unres(missing)
+        attrs.update({a1: _value(x), a2: _value(y)})
         _condition(c, attrs, shown, notes)
-        return El("remap", attrs, [], src)
-    if name == "SetLaunchConfiguration":
-        n, v = _arg(c, 0, "name"), _arg(c, 1, "value")
-        if n is None or v is None:
-            raise _Unres("a configuration without name and value")
-        attrs.update({"name": _value(n), "value": _value(v)})
-        _condition(c, attrs, shown, notes)
-        return El("let", attrs, [], src)
+        return El(tag, attrs, [], src)
     acts: ast.expr | None = None
     if name in ("TimerAction", "RosTimer"):
         acts = _arg(c, 1, "actions")
