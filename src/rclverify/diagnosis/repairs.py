@@ -30,6 +30,7 @@ evidence it asks for), and ``cost`` what else changes status.
 """
 from __future__ import annotations
 
+import hashlib
 import itertools
 import re
 from typing import Any, Mapping, Sequence
@@ -77,12 +78,19 @@ def _record(kind: str, summary: str, edit: Edit, source: str, checks: list[dict[
     (what Z3 showed follows from the edited text: "Controller.sc2 follows
     from the edited contracts") and ``not_shown`` (what Z3 did not show:
     that the change is safe; the evidence it asks for), ``checked_by`` (Z3's
-    version)."""
+    version) and ``sha256`` (:func:`text_sha256` of ``source``: ``rclverify
+    repair --apply`` writes the edit only over that text)."""
     return {"kind": kind, "summary": summary, "file": edit.file, "edit": edit.to_json(source),
             "diff": edit.diff(source), "checks": checks, "cost": cost,
             "proves": proves or "the problem no longer follows from the edited text",
             "not_shown": not_shown or "that the change is right for the robot",
-            "checked_by": f"z3 {z3.get_version_string()}"}
+            "checked_by": f"z3 {z3.get_version_string()}", "sha256": text_sha256(source)}
+
+
+def text_sha256(text: str) -> str:
+    """The hex sha256 of ``text`` encoded as UTF-8: a file's text as :meth:`pathlib.Path.read_text` gives it
+    (universal newlines), the digest a repair records of the file it edits."""
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 def _disjuncts(e: ast.Expr) -> list[ast.Expr]:

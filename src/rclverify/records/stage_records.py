@@ -364,7 +364,9 @@ class EditJson(TypedDict):
 
 class Repair(TypedDict):
     """One repair Z3 checked (diagnosis/repairs.py ``_record``): the ``edit`` and its unified ``diff``, the
-    ``checks`` Z3 answered and the ``cost`` (status changes), each ``{"check"/"item", "status", ...}``."""
+    ``checks`` Z3 answered and the ``cost`` (status changes), each ``{"check"/"item", "status", ...}``;
+    ``sha256`` the hex sha256 of the file's text the edit was computed on (``rclverify repair --apply``
+    writes the edit only over that text)."""
     kind: str
     summary: str
     file: str
@@ -375,6 +377,7 @@ class Repair(TypedDict):
     proves: str
     not_shown: str
     checked_by: str
+    sha256: str
 
 
 class DiagnosisEntry(TypedDict):
