@@ -40,3 +40,19 @@ def test_refusals_name_the_name_and_the_reason() -> None:
     assert names.node_identity("relay", "/", [names.Remap.parse("relay:__node:=relay2"),
                                               names.Remap.parse("__ns:=/r2")]) == ("relay2", "/r2")
     assert names.node_identity("other", "/", [names.Remap.parse("relay:__node:=relay2")]) == ("other", "/")
+
+
+def test_the_code_scan_resolves_through_the_one_resolver() -> None:
+    """ros/extract/names.resolve (the scan's, ground's) gives rcl's answer for every name rcl accepts
+    (the table, with the scan's ``~x`` for ``~/x``; ``{node}`` substituted, where a plain join kept it),
+    and the plain rule for a name rcl refuses (control: a doubled ``/``, a program kept apart)."""
+    from rclverify.ros.extract import names as scan_names
+    for name, root, in_ns in TABLE[:-1]:  # the last: '{ns}' in '/' is '/', no topic
+        assert scan_names.resolve(name, "/", "/my_node") == root
+        assert scan_names.resolve(name, "/my_ns", "/my_ns/my_node") == in_ns
+    assert scan_names.resolve("~ping", "/my_ns", "/my_ns/my_node") == "/my_ns/my_node/ping"
+    assert scan_names.resolve("{node}/cmd", "/r2", "/r2/relay") == "/r2/relay/cmd"
+    assert scan_names.resolve("a//b/", "/r2", "/r2/relay") == "/r2/a/b"
+    assert scan_names.resolve("~status", "/", "/talker@pkg.exe") == "/talker@pkg.exe/status"
+    with pytest.raises(names.BadName):
+        names.expand("a//b/", "relay", "/r2")

@@ -1,10 +1,19 @@
-"""ROS name resolution (ROS 1 wiki "Names"; ROS 2 design "Topic and Service
-Names"): relative names resolve against the node's namespace, private names
-(``~x``) against the node's full name, global names (``/x``) stay.
+"""ROS name resolution for the code scan (ROS 1 wiki "Names"; ROS 2 design
+"Topic and Service Names"): relative names resolve against the node's
+namespace, private names (``~x``, the scan's written form of ROS 2's ``~/x``)
+against the node's full name, global names (``/x``) stay.
+
+A name ``rcl`` accepts is resolved by the project's one resolver,
+:func:`rclverify.model.names.expand` (so ``{node}`` and ``{ns}`` are
+substituted as rcl substitutes them); a name it refuses (a ROS 1 form, a
+doubled or trailing ``/``, a program kept apart as ``/talker@pkg.exe``) by the
+plain rule above with its ``/`` normalised.
 """
 from __future__ import annotations
 
 import re
+
+from rclverify.model import names as rcl_names
 
 
 def join(ns: str, name: str) -> str:
@@ -22,8 +31,17 @@ def normalise(name: str) -> str:
 
 def resolve(name: str, node_ns: str, node_name: str) -> str:
     """The fully resolved topic ``name`` for a node ``node_name`` (resolved,
-    e.g. ``/rover/sensor``) in namespace ``node_ns``."""
-    if name.startswith("~"):
+    e.g. ``/rover/sensor``) in namespace ``node_ns``: module docstring."""
+    private = name.startswith("~")
+    written = "~/" + name[1:].lstrip("/") if private and name != "~" else name
+    ns = split(node_name)[0] if private else node_ns
+    try:
+        out = rcl_names.expand(written, split(node_name)[1], ns)
+    except rcl_names.BadName:
+        out = ""
+    if out and rcl_names.full_name_problem(out) is None:
+        return out
+    if private:
         return join(node_name, name[1:].lstrip("/"))
     return join(node_ns, name)
 
