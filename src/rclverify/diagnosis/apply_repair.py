@@ -1,0 +1,178 @@
+"""A checked repair of the last report, found by id and written into the
+workspace on request (``rclverify repair ID [--apply]``; docs/diagnosis.md,
+"Applying a repair").
+
+* :func:`find_repairs`: the repairs the last report (``reports/assurance.json``,
+  a dict) offers for an id: a diagnosis's id (a problem's finding, side
+  condition, obligation, requirement or deadline id, as ``rclverify explain``
+  takes it: exact first, then up to case, ``_``, ``-`` and spaces) or a
+  problem's number (``3``, ``p3``, ``problem 3``, the numbers ``rclverify
+  status`` shows), whose repairs are its diagnoses' by reference.
+* :func:`none_offered`: why an id has no repair, from its diagnosis
+  (``not_offered``) or its kind.
+* :func:`apply_repair`: the repair's edit made to the workspace file it names,
+  written atomically (:func:`rclverify.core.atomic.atomic_write_bytes`, the
+  file's permission bits kept), and only when the file's text still has the
+  sha256 the repair was computed on (:attr:`Repair.sha256`,
+  :func:`rclverify.diagnosis.repairs.text_sha256`) and the region still holds
+  the text the edit deletes; else :class:`NotApplied`, nothing written.
+
+Nothing here runs a check: the re-check after an edit is the pipeline's own
+stage that produced the failing record (``rclverify.cli.repair``).
+"""
+from __future__ import annotations
+
+import re
+import stat
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+from rclverify.core.atomic import atomic_write_bytes
+from rclverify.core.within import outside
+from rclverify.diagnosis.edits import Edit
+from rclverify.diagnosis.repairs import text_sha256
+
+_PROBLEM = re.compile(r"^(?:problem\s*|p)?(?P<k>\d+)\.?$", re.IGNORECASE)
+
+
+class NotApplied(Exception):
+    """A repair that is not written: where (``file`` as the repair names it, 1-based ``line`` and ``col``
+    of its edit) and the one-line reason ``message``."""
+
+    def __init__(self, file: str, line: int, col: int, message: str) -> None:
+        super().__init__(f"{file}:{line}:{col}: error: {message}")
+        self.file, self.line, self.col, self.message = file, line, col, message
+
+
+@dataclass(frozen=True)
+class Offered:
+    """One repair offered for an id: the ``diagnosis`` record it belongs to, its 0-based ``index`` among
+    that diagnosis's repairs, and the ``repair`` record (records/stage_records.py ``Repair``)."""
+
+    diagnosis: Mapping[str, Any]
+    index: int
+    repair: Mapping[str, Any]
+
+
+@dataclass(frozen=True)
+class Found:
+    """What an id names in the report: ``subject`` (the diagnosis id, or ``problem N``), the diagnoses it
+    covers and the repairs they offer, in the report's order."""
+
+    subject: str
+    diagnoses: tuple[Mapping[str, Any], ...]
+    offered: tuple[Offered, ...]
+
+
+def _fold(text: str) -> str:
+    """An id up to case, ``_``/``-`` and spaces (as ``rclverify explain`` matches)."""
+    return re.sub(r"[\s_-]+", "", str(text)).lower()
+
+
+def find_repairs(report: Mapping[str, Any], wanted: str) -> Found | None:
+    """What ``wanted`` names in ``report`` (module docstring); ``None`` when it is neither a diagnosis's id
+    nor a problem's number.  A diagnosis id is matched exactly first, then up to case and separators."""
+    diagnoses = [d for d in report.get("diagnoses") or [] if isinstance(d, Mapping)]
+    by_id = {str(d.get("id")): d for d in diagnoses}
+    key = wanted if wanted in by_id else next((k for k in by_id if _fold(k) == _fold(wanted)), None)
+    if key is not None:
+        d = by_id[key]
+        return Found(key, (d,), tuple(Offered(d, k, r) for k, r in enumerate(d.get("repairs") or [])))
+    m = _PROBLEM.match(wanted.strip())
+    problems = [p for p in report.get("problems") or [] if isinstance(p, Mapping)]
+    if not m or not 1 <= int(m["k"]) <= len(problems):
+        return None
+    row = problems[int(m["k"]) - 1]
+    members = [by_id[str(x.get("id"))] for x in row.get("members") or [] if str(x.get("id")) in by_id]
+    offered = []
+    for ref in row.get("repairs") or []:
+        owner = by_id.get(str(ref.get("diagnosis")))
+        reps = (owner.get("repairs") or []) if owner is not None else []
+        k = int(ref.get("index", -1))
+        if owner is not None and 0 <= k < len(reps):
+            offered.append(Offered(owner, k, reps[k]))
+    return Found(f"problem {m['k']}", tuple(members), tuple(offered))
+
+
+def none_offered(found: Found) -> list[str]:
+    """Why ``found`` offers no repair, one sentence each: a diagnosis's ``not_offered`` sentences (the
+    repairs its checks showed do not work), else what kind of problem it is and that no edit tried passed
+    its checks, or that the id has no diagnosis at all."""
+    if not found.diagnoses:
+        return [f"{found.subject} has no diagnosis in the last report: nothing was searched"]
+    out: list[str] = []
+    for d in found.diagnoses:
+        said = [str(s) for s in d.get("not_offered") or []]
+        out += [f"{d.get('id')}: {s}" for s in said] or [
+            f"{d.get('id')} ({d.get('kind')}): no edit the diagnosis tried passed its checks "
+            "(docs/diagnosis.md says which edits are tried for this kind)"]
+    return out
+
+
+def _refused(repair: Mapping[str, Any], message: str) -> NotApplied:
+    e = repair.get("edit") or {}
+    return NotApplied(str(repair.get("file", "")), int(e.get("line", 1)), int(e.get("col", 1)), message)
+
+
+def apply_repair(root: Path, repair: Mapping[str, Any]) -> Path:
+    """Make ``repair``'s edit to its file under the workspace ``root`` and return the file's path.
+
+    The file's line ends are kept (the edit is made on its text as stored; positions are lines and
+    columns, the same whatever the line end).  Raises :class:`NotApplied` (nothing written) when the
+    file is outside ``root``, cannot be read, no longer has the sha256 the repair was computed on, or
+    the edit's region does not hold the text it deletes; ``OSError`` when the write fails."""
+    rel = str(repair.get("file", ""))
+    e = repair.get("edit") or {}
+    path = root / rel
+    if not rel or outside(root, path):
+        raise _refused(repair, f"the repair edits {rel!r}, which is not a file of the workspace {root}")
+    try:
+        raw = path.read_bytes().decode("utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _refused(repair, f"cannot read the file the repair edits: {exc}") from None
+    text = raw.replace("\r\n", "\n").replace("\r", "\n")  # as read_text gives it: what the digest is of
+    want, have = str(repair.get("sha256", "")), text_sha256(text)
+    if want != have:
+        raise _refused(repair, (f"{rel} changed since the last run checked this repair (sha256 {have[:12]}, "
+                                 f"the repair was checked on {want[:12] or 'an unrecorded text'}); nothing "
+                                 "written: run `rclverify verify` again, then `rclverify repair` on the new report"))
+    edit = Edit(rel, int(e["line"]), int(e["col"]), int(e["end_line"]), int(e["end_col"]), str(e["inserted"]))
+    if edit.deleted(raw) != e.get("deleted"):
+        raise _refused(repair, f"the region of the edit holds {edit.deleted(raw)!r}, not {e.get('deleted')!r}; "
+                                "nothing written")
+    mode = stat.S_IMODE(path.stat().st_mode)
+    atomic_write_bytes(path, edit.apply(raw).encode("utf-8"), mode=mode, within=root)
+    return path
+
+
+def obligation_checks(diagnosis: Mapping[str, Any], repair: Mapping[str, Any]) -> list[str]:
+    """The obligation ids (``Node.gK.<backend>.eI...``) a code or program repair was checked against, the
+    diagnosis's own first: the evidence to produce again after the edit."""
+    ids = [str(diagnosis.get("id", ""))] + [str(c.get("check", "")) for c in repair.get("checks") or []]
+    return list(dict.fromkeys(i for i in ids if re.match(r"^\w+\.g\d+\.\w+\.e\d+", i)))
+
+
+def statuses_before(report: Mapping[str, Any]) -> dict[str, str]:
+    """Every id's status in ``report``: obligations, evidence, side conditions, health findings,
+    requirements (their verdict) and deadlines (``REQ.deadline``, their verdict), for the before -> after of a re-check."""
+    out: dict[str, str] = {}
+    for key in ("findings", "side_conditions", "obligations"):
+        for x in report.get(key) or []:
+            out[str(x.get("id"))] = str(x.get("status"))
+    for ev in report.get("evidence") or []:
+        out[str(ev.get("obligation"))] = str(ev.get("status"))
+    for r in report.get("requirements") or []:
+        out[str(r.get("id"))] = str(r.get("verdict"))
+    for dl in report.get("deadlines") or []:
+        out[f"{dl.get('requirement')}.deadline"] = str(dl.get("verdict"))
+    return out
+
+
+def changed_lines(before: Mapping[str, str], after: Sequence[tuple[str, str]]) -> list[str]:
+    """``id: before -> after`` for each re-checked id (``absent`` for one the report did not have)."""
+    return [f"{i}: {before.get(i, 'absent')} -> {s}" for i, s in after]
+
+
+__all__ = ["Found", "NotApplied", "Offered", "apply_repair", "changed_lines", "find_repairs", "none_offered",
+           "obligation_checks", "statuses_before"]
