@@ -12,6 +12,7 @@
 ``rclverify verify [--strict] [--no-wait]``  the whole pipeline through doit (one run at a time per workspace)
 ``rclverify status``               the last run's summary and problems, running nothing
 ``rclverify explain ID``           what the last report says of any id an output shows
+``rclverify repair ID [--apply]``  a problem's checked repairs; --apply writes one and checks again
 ``rclverify refines A.rcl:N B.rcl:M``  may contract M replace contract N?
 ``rclverify quotient NODE [-o FILE]``  the weakest contract of NODE its neighbours need
 ``rclverify init DIR [--nodes A,B]``  write a new workspace that verifies at once
@@ -38,7 +39,7 @@ import sys
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from rclverify.cli import bundle, calculus, contracts, explain, requirements, runs, standards, verify, workspace
+from rclverify.cli import bundle, calculus, contracts, explain, repair, requirements, runs, standards, verify, workspace
 from rclverify.cli.common import AddCommand, print_diags
 from rclverify.core.extras import MissingExtra
 from rclverify.lang.errors import RclError
@@ -68,7 +69,7 @@ def _lsp(sub: Any) -> None:
 #: (or a group's) with ``add(name, fn, help, workspace)`` (:func:`main`).
 COMMANDS: tuple[Callable[[AddCommand], None], ...] = (
     contracts.add_check, contracts.add_latex_fmt, calculus.add_graph_to_export, verify.add_report,
-    requirements.add_requirements_deadlines, workspace.add_cache, explain.add_status_explain, verify.add_verify,
+    requirements.add_requirements_deadlines, workspace.add_cache, explain.add_status_explain, repair.add_repair, verify.add_verify,
     workspace.add_init, bundle.add_bundle, workspace.add_review, calculus.add_quotient_refines,
     standards.add_standards,
 )
