@@ -2,10 +2,13 @@
 
 * Quick fixes (:func:`quick_fixes`): each SARIF ``fix`` the last run wrote
   for a finding in the requested range (:mod:`.lastrun`; every one is a
-  repair the diagnosis checked with Z3 before the report showed it,
+  repair the diagnosis checked before the report showed it: with Z3, or a
+  repair of the code by running the node's property tests again,
   docs/diagnosis.md), as a ``quickfix`` code action whose workspace edit is
-  the fix's replacement.  Its title says what the repair does, what Z3
-  showed and what it did not, as the fix's description does.  A stale
+  the fix's replacement, in an RCL file or in the implementation file a
+  failing property test's finding is located in.  Its title says what the
+  repair does, what its check showed and what it did not, as the fix's
+  description does.  A stale
   finding offers no fix; nor does a fix whose file changed after the run.
 * Formatting (:func:`format_edits`): ``rclverify fmt``'s canonical RCL
   (:func:`rclverify.lang.printer.to_rcl`), clause by clause: each
@@ -40,14 +43,22 @@ from rclverify.tools.lsp.diagnostics import MAX_CHARS
 _COMMENT = re.compile(r"//|/\*")
 
 
+#: What checked a repair, as a fix description of :func:`rclverify.report.sarif._attach_diagnoses` says it:
+#: Z3 (a contract's or a program's repair), the property tests (a repair of the code, diagnosis/code_repair.py).
+_CHECKERS = ("Z3 shows", "The property tests show")
+
+
 def _title(description: str) -> str:
-    """``"<what it does> — Z3 shows: ...; not shown: ..."`` from a fix description of
-    :func:`rclverify.report.sarif._attach_diagnoses` (the whole description when it has another form)."""
-    head, sep, z3 = description.partition(" Z3 shows: ")
-    if not sep:
-        return description
-    what = head.split(": ")[0].rstrip(".")
-    return f"{what} \u2014 Z3 shows: {z3.rstrip('.')}"
+    """``"<what it does> — Z3 shows: ...; not shown: ..."`` (or ``— the property tests show: ...``) from a
+    fix description of :func:`rclverify.report.sarif._attach_diagnoses` (the whole description when it
+    has another form)."""
+    for checker in _CHECKERS:
+        head, sep, shown = description.partition(f" {checker}: ")
+        if sep:
+            what = head.split(": ")[0].rstrip(".")
+            said = checker if checker.startswith("Z3") else checker[0].lower() + checker[1:]
+            return f"{what} \u2014 {said}: {shown.rstrip('.')}"
+    return description
 
 
 def _pos(lines: list[str], line: int, col: int) -> lsp.Position:

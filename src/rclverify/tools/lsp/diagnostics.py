@@ -10,9 +10,10 @@ statements resolved against it.  The diagnostics are the command line's
 (:class:`rclverify.lang.errors.Diagnostic`: same message, same code, located
 in the same file, line and column); :func:`to_lsp` gives each its LSP range.
 
-One rule of the server's own (docs/editor.md): a text longer than
+Two rules of the server's own (docs/editor.md): a text longer than
 :data:`MAX_CHARS` characters is not analysed as you type (one ``E-lsp-size``
-error at its first line says so; ``rclverify check`` still checks it).
+error at its first line says so; ``rclverify check`` still checks it); a file
+that is not RCL (:func:`is_rcl`) is not analysed at all.
 """
 from __future__ import annotations
 
@@ -34,6 +35,14 @@ from rclverify.lang.lint import lint
 MAX_CHARS = 4_000_000
 
 _TOKEN = re.compile(r"(?:in|out)\.[A-Za-z_]\w*'*|[A-Za-z_][\w/]*'*|\d+(?:\.\d+)?|\S")
+
+
+def is_rcl(ws: LspWorkspace, rel: str) -> bool:
+    """Whether the server checks ``rel`` as RCL as you type: a ``.rcl`` file, a contract file the plan
+    names, or the plan.  Any other file of the workspace (the Python a property test runs, a Hoare
+    program) is not parsed: it shows the last run's findings located in it and offers their repairs
+    (docs/editor.md)."""
+    return rel.endswith(".rcl") or rel == ws.plan or rel in ws.contracts()
 
 
 @dataclass
@@ -67,6 +76,8 @@ def analyse(ws: LspWorkspace, rel: str, open_docs: Mapping[str, str]) -> Analysi
     (every problem is a diagnostic)."""
     files = ws.scope(rel)
     a = Analysis(rel, files)
+    if not is_rcl(ws, rel):  # an implementation file (a property test's finding): the last run's findings only
+        return a
     for f in files:
         try:
             a.texts[f] = for_parser(ws.text(f, open_docs))

@@ -12,7 +12,9 @@ this package (docs/editor.md).
 * ``hover``, ``definition``, ``references``, ``codeAction``,
   ``formatting``, ``completion``: :mod:`.hover`, :mod:`.navigate`,
   :mod:`.actions`, :mod:`.complete`, over the last analysis in which the
-  system type-checked.
+  system type-checked.  A file that is not RCL (:func:`.diagnostics.is_rcl`:
+  the Python a property test runs) is not checked as you type: it shows the
+  last run's findings in it, and ``codeAction`` offers their checked repairs.
 
 Every request for a document outside the workspace is refused
 (:class:`.workspace.Outside`: a JSON-RPC error -32602 whose message names
@@ -40,7 +42,7 @@ from lsprotocol import types as lsp
 from pygls.lsp.server import LanguageServer
 
 from rclverify import __version__
-from rclverify.tools.lsp.diagnostics import Analysis, analyse, to_lsp
+from rclverify.tools.lsp.diagnostics import Analysis, analyse, is_rcl, to_lsp
 from rclverify.tools.lsp.lastrun import LastRun
 from rclverify.tools.lsp.lines import split_lines
 from rclverify.tools.lsp.rpc import RclProtocol, Refused, guarded, log_one_line, one_line
@@ -342,6 +344,8 @@ def _references(ls: RclServer, params: lsp.ReferenceParams) -> list[lsp.Location
 @guarded(lsp.TEXT_DOCUMENT_COMPLETION)
 def _completion(ls: RclServer, params: lsp.CompletionParams) -> lsp.CompletionList:
     rel, text = text_of(ls, params.text_document.uri)
+    if not is_rcl(ls.ws, rel):  # the Python a property test runs: no RCL keywords in it
+        return lsp.CompletionList(is_incomplete=False, items=[])
     if ls.messages is None or ls.messages.root != ls.ws.root:
         ls.messages = MessageTypes(ls.ws.root)
     a = ls.analysis(rel) or ls.analysis(rel, good=False)
