@@ -95,7 +95,11 @@ def cmd_health(args: argparse.Namespace) -> int:
 
 
 def cmd_export(args: argparse.Namespace) -> int:
-    """Export every node's obligations to the plan's backends and print each one."""
+    """Export every node's obligations to the plan's backends and print each one; with a format
+    (``export autoware-design -o DIR``), write the workspace in that format instead."""
+    if getattr(args, "format", None):
+        from rclverify.cli.design import cmd_export_design  # deferred: start-up (loads rclverify.cli.design only when called)
+        return cmd_export_design(args)
     from rclverify.app.pipeline import stage_check, stage_export  # deferred: start-up (loads rclverify.app, rclverify.app.pipeline and more only when called)
     ws = workspace_of(args)
     stage_check(ws)
@@ -134,7 +138,9 @@ def add_graph_to_export(add: AddCommand) -> None:
     add("graph", cmd_graph, "write the system model as Graphviz DOT (and SVG)", True).add_argument("-o", "--output")
     add("compose", cmd_compose, "apply the calculus: side conditions and derived properties", True)
     add("health", cmd_health, "contract consistency and vacuity checks", True).add_argument("nodes", nargs="*")
-    add("export", cmd_export, "export obligations to the plan's backends", True)
+    from rclverify.cli.design import add_export_format  # deferred: start-up (loads rclverify.cli.design only when called)
+    add_export_format(add("export", cmd_export, "export obligations to the plan's backends; with a format, the "
+                          "workspace in another tool's format (autoware-design: docs/nodl.md)", True))
 
 
 def add_quotient_refines(add: AddCommand) -> None:

@@ -21,6 +21,7 @@
 ``rclverify ros scan PATH...``     the ROS computation graph from workspaces (docs/ros.md)
 ``rclverify ros check``            the plan's contracts against that graph
 ``rclverify nodl check``           the NoDL documents against the contracts (docs/nodl.md)
+``rclverify import autoware-design DIR -o WS``  an Autoware System Designer design as a workspace (docs/nodl.md)
 ``rclverify lsp``                  the RCL language server over stdio (docs/editor.md)
 
 Exit codes: 0 success, 1 errors in the input (or, for ``compose``/``verify
@@ -60,6 +61,11 @@ def _nodl(sub: Any) -> None:
     add_parsers(sub)
 
 
+def _import(sub: Any) -> None:
+    from rclverify.cli.design import add_import  # deferred: start-up (loads rclverify.cli.design only when called)
+    add_import(sub)
+
+
 def _lsp(sub: Any) -> None:
     from rclverify.cli.lsp import add_parsers  # deferred: start-up (loads rclverify.cli.lsp only when called)
     add_parsers(sub)
@@ -73,8 +79,8 @@ COMMANDS: tuple[Callable[[AddCommand], None], ...] = (
     workspace.add_init, bundle.add_bundle, workspace.add_review, calculus.add_quotient_refines,
     standards.add_standards,
 )
-#: The commands with subcommands of their own (``ros``, ``nodl``, ``generate``), and ``lsp``: each adds to the subparsers.
-SUBCOMMAND_GROUPS: tuple[Callable[[Any], None], ...] = (_ros, _nodl, _generate, _lsp)
+#: The commands with subcommands of their own (``ros``, ``nodl``, ``generate``, ``import``), and ``lsp``: each adds to the subparsers.
+SUBCOMMAND_GROUPS: tuple[Callable[[Any], None], ...] = (_ros, _nodl, _generate, _import, _lsp)
 #: Listed after them: monitoring recorded and live runs (docs/monitors.md).
 LAST_COMMANDS: tuple[Callable[[AddCommand], None], ...] = (runs.add_monitor, runs.add_oracle)
 
