@@ -41,6 +41,7 @@ from rclverify.model.plan.expected import check_expected
 from rclverify.model.plan.declarations import BACKEND_NAMES
 from rclverify.model.plan.entries import unknown_key_messages
 from rclverify.model.plan.standards.choice import read_standards
+from rclverify.model.plan.instances import read_instances
 
 __all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]
 
@@ -228,9 +229,17 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
     deadlines = _deadlines(data, loc, plan_rel)
     states = read_state(data, locs, blocks, plan_rel)
+    from rclverify.model.plan.fret.requirements import plan_additions  # deferred: start-up (only FRET's reads)
+    fret_reqs, fret_states = plan_additions(root, data, contracts)  # requirements_from: {fret: ...} (docs/requirements.md)
+    reqs += fret_reqs
+    states += fret_states
+    node_instances, wrong = read_instances(data.get("instances"), locs, plan_rel)
+    if wrong:
+        raise PlanError([d for l, msg in wrong for d in plan_error(l.file, l.line, l.col, msg, "E-instances").diagnostics])
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
                 str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
-                read_acknowledgements(data, locs, plan_rel), targets, read_standards(root, data, locs, plan_rel))
+                read_acknowledgements(data, locs, plan_rel), targets, read_standards(root, data, locs, plan_rel),
+                node_instances)
 
 
 def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:
@@ -272,6 +281,8 @@ def all_requirements(plan: Plan) -> tuple[Requirement, ...]:
     if plan.requirements_from:
         from rclverify.model.plan.doorstop import read_requirements  # deferred: optional or conditional (inside a block)
         for folder, l in plan.requirements_from:
+            if l == plan.locs.get(("requirements_from", "fret")):
+                continue  # a FRET export's requirements are the plan's own (.fret.requirements.plan_additions)
             out.extend(read_requirements(plan.root, folder, l))
     return tuple(out)
 
@@ -338,6 +349,7 @@ def resolve(plan: Plan, checked: Checked) -> None:
             if not refs.node_ok(n, d.loc):
                 break
     refs.connections(plan)
+    refs.instances(plan)
     refs.facts(plan)
     refs.entries(plan)
     diags.extend(check_targets(plan, checked))  # statistical targets, environment tags, run origins (docs/statistics.md)
@@ -392,6 +404,17 @@ class _References:
                     bad(c.loc, f"{c.to_node} has no input {c.to_var!r}")
                 if ot is not None and it is not None and ot != it:
                     bad(c.loc, f"connection joins {c.from_node}.{c.from_var} : {ot} to {c.to_node}.{c.to_var} : {it}")
+
+    def instances(self, plan: Plan) -> None:
+        """An instanced contract exists, and no instance takes the name of another contract's node."""
+        for contract, insts in plan.node_instances.items():
+            l = plan.locs.get(("instances", contract, KEY), insts[0].loc if insts else ast.Loc(plan.file, 1, 1))
+            if not self.node_ok(contract, l):
+                continue
+            for i in insts:
+                if i.name != contract and i.name in self.nodes:
+                    self.bad(i.loc, f"the instance of {contract} in {i.namespace} is named {i.name}, "
+                                    f"as a contract's node is: rename one")
 
     def facts(self, plan: Plan) -> None:
         """An environment fact is a well-typed formula of its node."""

@@ -14,6 +14,7 @@ from rclverify.model.plan.target_text import Target
 from rclverify.lang import ast
 from rclverify.model.plan.acknowledged import Acknowledgement
 from rclverify.model.plan.formal import Source
+from rclverify.model.plan.instances import Instance
 from rclverify.model.plan.state import StateVar
 from rclverify.model.plan.standards.choice import StandardChoice
 
@@ -136,3 +137,6 @@ class Plan:
     path_targets: Mapping[str, str] = field(default_factory=dict)
     #: the safety standards the evidence is mapped onto (``standards:``, docs/standards.md)
     standards: tuple[StandardChoice, ...] = ()
+    #: the contracts run as several nodes under namespaces (``instances:``, :mod:`.instances`;
+    #: docs/plan.md, "Instances"), per contract
+    node_instances: Mapping[str, tuple[Instance, ...]] = field(default_factory=dict)

@@ -1,0 +1,86 @@
+"""The plan's ``instances`` key read: which contract runs as which nodes under which namespaces
+(docs/plan.md, "Instances"; what an instance is to the rest of the tool: :mod:`rclverify.model.instances`).
+
+``instances: {Relay: [/r1, /r2]}`` or ``{Relay: {node: relay, namespaces: [/r1, /r2]}}``: each
+namespace one instance, its ROS node ``node`` (default: the contract's name in snake case), its
+namespace checked by rcl's rules (:mod:`rclverify.model.names`).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+from rclverify.lang import ast
+from rclverify.model import names
+
+
+@dataclass(frozen=True)
+class Instance:
+    """One node a contract runs as: ``contract`` the contract's node, ``namespace`` its ROS
+    namespace, ``node`` its ROS node name, ``name`` the instance's node in the system (an RCL
+    identifier), ``loc`` where the plan gives it."""
+
+    contract: str
+    namespace: str
+    node: str
+    name: str
+    loc: ast.Loc = ast.Loc("<plan>", 1, 1)
+
+    @property
+    def fqn(self) -> str:
+        """The ROS node's fully qualified name (``/r1/relay``)."""
+        return names.node_fqn(self.namespace, self.node)
+
+
+def snake(contract: str) -> str:
+    """A contract's node name as ROS writes node names: ``OdomSource`` -> ``odom_source``."""
+    return re.sub(r"(?<=[a-z0-9])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])", "_", contract).lower()
+
+
+def instance_name(contract: str, namespace: str) -> str:
+    """The instance's node in the system: ``Relay``, ``/r1`` -> ``Relay_r1``; ``/`` -> ``Relay``."""
+    return contract if namespace == "/" else "_".join([contract, *namespace.strip("/").split("/")])
+
+
+def read_instances(data: Any, locs: Mapping[tuple[Any, ...], ast.Loc],
+                   plan_rel: str) -> tuple[dict[str, tuple[Instance, ...]], list[tuple[ast.Loc, str]]]:
+    """The plan's ``instances`` value (schema-checked: contract -> list of namespaces, or ``{node,
+    namespaces}``) as ``{contract: instances}`` and its problems, each ``(location, message)``
+    (a namespace or node name rcl refuses, a namespace given twice, two instances of one name)."""
+    out: dict[str, tuple[Instance, ...]] = {}
+    problems: list[tuple[ast.Loc, str]] = []
+    seen: dict[str, str] = {}
+
+    def at(*path: Any) -> ast.Loc:
+        return locs.get(("instances", *path), locs.get(("instances",), ast.Loc(plan_rel, 1, 1)))
+    for contract, spec in (data or {}).items():
+        spaces = spec if isinstance(spec, list) else spec.get("namespaces", [])
+        base: tuple[Any, ...] = (contract,) if isinstance(spec, list) else (contract, "namespaces")
+        node = snake(contract) if isinstance(spec, list) else str(spec.get("node") or snake(contract))
+        why = names.node_name_problem(node)
+        if why is not None:
+            l = at(contract, "node") if isinstance(spec, dict) else at(contract)
+            problems.append((l, f"instances of {contract}: node name {node!r}: {why}"))
+            continue
+        got: list[Instance] = []
+        for k, raw in enumerate(spaces):
+            l = at(*base, k)
+            ns = str(raw).rstrip("/") or "/"
+            why = names.namespace_problem(ns)
+            name = instance_name(contract, ns)
+            if why is not None:
+                problems.append((l, f"instances of {contract}: namespace {raw!r}: {why}"))
+            elif any(i.namespace == ns for i in got):
+                problems.append((l, f"instances of {contract}: namespace {ns} is given twice"))
+            elif name in seen:
+                problems.append((l, f"instances of {contract}: the instance in {ns} is "
+                                f"named {name}, as {seen[name]} is"))
+            else:
+                seen[name] = f"{contract} in {ns}"
+                got.append(Instance(contract, ns, node, name, l))
+        out[contract] = tuple(got)
+    return out, problems
+
+
+__all__ = ["Instance", "instance_name", "read_instances", "snake"]
