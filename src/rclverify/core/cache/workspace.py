@@ -65,11 +65,15 @@ def _inputs(ws: Any, contracts: tuple[str, ...], known: dict[str, str] | None = 
 
 
 def _own_profiles(plan: Any) -> tuple[str, ...]:
-    """The workspace's own standard profile files the plan read (``standards:``, docs/standards.md):
-    hashed with the contract files, so an edited profile loads the plan anew; the built-in ones are
-    package data (``Profile.builtin``), covered by the code's salt."""
+    """The workspace's own standard profile files the plan read (``standards:``, docs/standards.md),
+    and a requirements file it read into itself (a FRET export, ``requirements_from: {fret: FILE}``;
+    a Doorstop folder is read anew on every use): hashed with the contract files, so an edited
+    profile or export loads the plan anew; the built-in profiles are package data
+    (``Profile.builtin``), covered by the code's salt."""
+    root = getattr(plan, "root", None)
+    read = tuple(str(f) for f, _ in getattr(plan, "requirements_from", ()) if root is not None and (root / f).is_file())
     return tuple(str(c.profile.file) for c in getattr(plan, "standards", ())
-                 if not getattr(c.profile, "builtin", False))
+                 if not getattr(c.profile, "builtin", False)) + read
 
 
 def _resolved(root: str, paths: Any) -> dict[str, str] | None:
