@@ -90,12 +90,14 @@ def cmd_check(args: argparse.Namespace) -> int:
               "(nodl check DIR|FILE...); --namespace also to a workspace's documents with --ros or --ros2", file=sys.stderr)
         return 2
     ws = Path(args.workspace or ".")
-    checked = Workspace(ws, args.plan).checked  # raises RclError, printed located by main
+    work = Workspace(ws, args.plan)
+    checked = work.checked  # raises RclError, printed located by main
     folder = Path(args.nodl) if args.nodl else None
     res = check(checked, ws, folder, [Path(p) for p in args.ament_prefix])
     from rclverify.model.nodl.match import parse_namespaces  # deferred: start-up (as above)
     try:
-        args.namespaces = parse_namespaces(args.namespace, res.documents)
+        from rclverify.model.instances import namespaces_of  # deferred: start-up (as above)
+        args.namespaces = {**namespaces_of(work.plan.node_instances), **parse_namespaces(args.namespace, res.documents)}
     except ValueError as exc:
         print(f"nodl check: error: {exc}", file=sys.stderr)
         return 2

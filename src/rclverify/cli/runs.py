@@ -14,8 +14,10 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     from rclverify.core.cache.startup import keeping  # deferred: start-up (loads rclverify.core.cache.store only when called)
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     with keeping():  # the parsed contracts, the plan's schema check, the compiled formulas: kept by content
-        checked = Workspace(Path(args.workspace), args.plan).checked  # raises RclError, printed located by main
-        return monitor_command(args, checked)
+        ws = Workspace(Path(args.workspace), args.plan)
+        checked = ws.checked  # raises RclError, printed located by main
+        from rclverify.model.instances import instantiate  # deferred: start-up (as above)
+        return monitor_command(args, instantiate(checked, ws.plan.node_instances))  # each instance its own node
 
 
 def cmd_oracle(args: argparse.Namespace) -> int:
