@@ -178,3 +178,25 @@ def test_the_nodl_documents_are_matched_per_instance_and_find_a_wire_to_the_othe
     assert found("/r2/odom") == []  # control: each relay reads its own robot's odometry
     wrong = found("/r1/odom")
     assert wrong and all("/r2/relay" in m for m in wrong) and any("/r1/odom" in m for m in wrong), wrong
+
+
+def test_rclverify_monitor_judges_each_instance_of_the_plan(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``rclverify monitor LOG`` over a workspace whose plan has instances: each is a node of the verdicts,
+    heard on its own topics; the same log judged without the instances (control) has only the contracts,
+    whose relative names (``odom``) no robot publishes."""
+    import json
+    from rclverify.cli.commands import main
+    log = tmp_path / "run.jsonl"
+    rows = [(0.9, "/fleet/limit", 3.0), (1.0, "/r1/odom", 1.0), (1.0, "/r2/odom", 2.0), (1.02, "/r1/relay/cmd", 1.0),
+            (1.03, "/r2/relay/cmd", 1.0)]
+    log.write_text("".join(json.dumps({"topic": t, "time": at, "data": v}) + "\n" for at, t, v in rows))
+
+    def judged(plan: str) -> dict[str, str]:
+        ws = _ws(tmp_path, plan, str(len(plan)))
+        code = main(["monitor", "-w", str(ws.root), "--horizon", "1", "--json", str(log)])
+        out = {n["node"]: n["status"] for n in json.loads(capsys.readouterr().out)}
+        assert code == (1 if "failed" in out.values() else 0), (code, out)
+        return out
+    fleet = judged(FLEET)
+    assert fleet["Relay_r2"] == "failed" and fleet["Relay_r1"] == "discharged", fleet
+    assert set(judged("")) == {"OdomSource", "Relay"}
