@@ -154,8 +154,11 @@ def read_requirements(root: Path, folder: str, loc: ast.Loc) -> tuple[Any, ...]:
 
 def doorstop_files(root: Path, folder: str) -> list[str]:
     """The workspace-relative files of the Doorstop documents under ``folder``
-    (a change to any of them re-checks the requirements)."""
+    (a change to any of them re-checks the requirements); a file (a FRET
+    export, ``requirements_from: {fret: ...}``) is itself."""
     base = root / folder
+    if base.is_file():
+        return [folder]
     if not base.is_dir():
         return []
     return sorted(str(p.relative_to(root)) for d in _documents(base) for p in d.iterdir() if p.is_file())

@@ -1,0 +1,40 @@
+"""``rclverify import fret EXPORT.json``: FRET requirements brought into the workspace
+(docs/requirements.md, "Requirements from FRET"; :mod:`rclverify.tools.fret.importer`)."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+
+def cmd_import_fret(args: argparse.Namespace) -> int:
+    """Import the export, print what could not be imported and what changed, then check the plan
+    with it.  Exit 1 on a malformed export or when the workspace no longer checks (the
+    imported statements' types against the contracts); a requirement not imported is no error."""
+    from rclverify.lang.errors import RclError  # deferred: start-up (every command module loads when rclverify starts)
+    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads the stages only when called)
+    from rclverify.tools.fret.importer import import_fret, render  # deferred: start-up (loads jinja2 only when called)
+    root = Path(args.workspace)
+    res = import_fret(root, args.plan, Path(args.export), args.export)
+    sys.stdout.write(render(res))
+    try:
+        Workspace(root, args.plan).checked  # the imported statements type-checked with the plan
+    except RclError as exc:
+        for d in exc.diagnostics:
+            print(d, file=sys.stderr)
+        print(f"{args.export}: error: the plan does not check with the imported requirements (above)",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+def add_fret(group: Any) -> None:
+    """Add ``fret`` to the subcommands ``group`` of ``rclverify import``."""
+    f = group.add_parser("fret", help="a FRET export (JSON): each requirement into the plan by its reqid",
+                         description="import a FRET export (JSON): each requirement becomes a requirement of the "
+                                     "plan, keyed by its reqid; a re-import updates them")
+    f.add_argument("export", help="the FRET export (FRET: Export, requirements and variables, JSON)")
+    f.add_argument("-w", "--workspace", default=".", help="workspace root (default: .)")
+    f.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
+    f.set_defaults(fn=cmd_import_fret)

@@ -1,0 +1,145 @@
+"""A FRET export read: its requirements and variables, each with its place in the file.
+
+FRET (NASA's Formal Requirements Elicitation Tool) exports a project as
+JSON: either an object ``{"requirements": [...], "variables": [...]}``
+(requirements and variables) or a list of requirements.  Each requirement
+has ``reqid``, ``fulltext``, and, once FRET has formalised it,
+``semantics`` (``scope``, ``condition``, ``timing``, ``response``, the
+conditions ``pre_condition``/``regular_condition``/``post_condition``/
+``stop_condition``, ``duration``, ``scope_mode``, ``component_name``, and
+FRET's formalisations ``ptExpanded``/``ftInfAUExpanded``).  A variable
+has ``component_name``, ``variable_name``, ``idType`` (``Input``,
+``Output``, ``Internal``, ``Mode``, ``Function``), ``dataType``
+(``boolean``, ``integer``, ``double`` ...) and, for an Internal one, its
+Lustre ``assignment``.  Entries of the variables list without ``idType``
+(the ports of an imported model) are not FRET variables and are left out.
+
+A file that is not JSON, or whose shape is not the above (a requirement
+without a ``reqid`` string, a ``reqid`` used twice), is a malformed export:
+:class:`~rclverify.model.plan.errors.PlanError` at its line and column.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+from rclverify.lang import ast
+from rclverify.model.plan.errors import PlanError, plan_error
+
+
+@dataclass(frozen=True)
+class FretRequirement:
+    """One requirement of an export: ``reqid``, ``fulltext``, FRET's
+    ``component`` name, its ``semantics`` as exported (empty: FRET did not
+    formalise it), ``loc`` where its ``reqid`` is written and ``digest``
+    the sha256 of its JSON (keys sorted): what a re-import compares."""
+
+    reqid: str
+    fulltext: str
+    component: str
+    semantics: Mapping[str, Any]
+    loc: ast.Loc
+    digest: str
+    raw: Mapping[str, Any]
+
+
+@dataclass(frozen=True)
+class FretVariable:
+    """A FRET variable of ``component``: ``name``, ``id_type``, ``data_type``, ``assignment``."""
+
+    component: str
+    name: str
+    id_type: str
+    data_type: str
+    assignment: str
+
+
+@dataclass(frozen=True)
+class FretExport:
+    """An export's ``requirements`` in file order and ``variables`` by ``(component, name)``."""
+
+    file: str
+    requirements: tuple[FretRequirement, ...]
+    variables: Mapping[tuple[str, str], FretVariable]
+
+
+def _line_col(text: str, pos: int) -> tuple[int, int]:
+    line = text.count("\n", 0, pos) + 1
+    return line, pos - (text.rfind("\n", 0, pos) + 1) + 1
+
+
+def _data_type(v: Any) -> str:
+    if isinstance(v, list):
+        v = v[0] if v else ""
+    return str(v or "")
+
+
+def digest(raw: Mapping[str, Any]) -> str:
+    """sha256 of a requirement's JSON with its keys sorted (the identity of its content)."""
+    return hashlib.sha256(json.dumps(raw, sort_keys=True, ensure_ascii=False).encode("utf-8")).hexdigest()
+
+
+def read_export(path: Path, rel: str) -> FretExport:
+    """The export at ``path`` (``rel`` its name in messages).  Raises
+    :class:`PlanError` (``E-fret``, located) for a malformed export,
+    ``E-io`` when it cannot be read."""
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise plan_error(rel, 1, 1, f"cannot read the FRET export: {getattr(exc, 'strerror', None) or exc}",
+                         "E-io") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise plan_error(rel, exc.lineno, exc.colno, f"the FRET export is not JSON: {exc.msg}", "E-fret") from None
+    vars_raw: Any
+    if isinstance(data, list):
+        reqs_raw, vars_raw = data, []
+    elif isinstance(data, dict) and isinstance(data.get("requirements"), list):
+        reqs_raw, vars_raw = data["requirements"], data.get("variables") or []
+    else:
+        raise plan_error(rel, 1, 1, "a FRET export is a list of requirements or an object with a 'requirements' "
+                                    "list (FRET: Export, requirements and variables)", "E-fret")
+    if not isinstance(vars_raw, list):
+        raise plan_error(rel, 1, 1, "the FRET export's 'variables' must be a list", "E-fret")
+    out: list[FretRequirement] = []
+    seen: dict[str, ast.Loc] = {}
+    pos = 0
+    for k, r in enumerate(reqs_raw):
+        if not isinstance(r, dict) or not isinstance(r.get("reqid"), str) or not r["reqid"].strip():
+            raise plan_error(rel, *_line_col(text, pos), f"requirement {k + 1} of the FRET export has no 'reqid' "
+                                                         "string", "E-fret")
+        rid = r["reqid"]
+        at = text.find(f'"reqid"', pos)
+        at = text.find(json.dumps(rid, ensure_ascii=False), at + len('"reqid"')) if at >= 0 else -1
+        if at >= 0:
+            pos = at
+        loc = ast.Loc(rel, *_line_col(text, max(at, 0)))
+        if rid in seen:
+            o = seen[rid]
+            raise plan_error(rel, loc.line, loc.col, f"reqid {rid!r} is used twice in the FRET export (first at "
+                                                     f"{o.line}:{o.col})", "E-fret")
+        seen[rid] = loc
+        sem = r.get("semantics")
+        if sem is not None and not isinstance(sem, dict):
+            raise plan_error(rel, loc.line, loc.col, f"{rid}: 'semantics' must be an object", "E-fret")
+        sem = sem or {}
+        comp = sem.get("component_name") or r.get("component_name") or sem.get("component") or ""
+        out.append(FretRequirement(rid, " ".join(str(r.get("fulltext") or "").split()), str(comp), sem, loc,
+                                   digest(r), r))
+    variables: dict[tuple[str, str], FretVariable] = {}
+    for v in vars_raw:
+        if isinstance(v, dict) and "idType" in v and isinstance(v.get("variable_name"), str):
+            fv = FretVariable(str(v.get("component_name") or ""), v["variable_name"], str(v.get("idType") or ""),
+                              _data_type(v.get("dataType")), str(v.get("assignment") or ""))
+            variables[(fv.component, fv.name)] = fv
+    return FretExport(rel, tuple(out), variables)
+
+
+def malformed(exc: PlanError) -> str:
+    """The first message of a :class:`PlanError` as ``file:line:col: error: message``."""
+    d = exc.diagnostics[0]
+    return f"{d.loc.file}:{d.loc.line}:{d.loc.col}: error: {d.message}"

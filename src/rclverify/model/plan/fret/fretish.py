@@ -1,0 +1,234 @@
+"""FRETish conditions and responses read, and written as RCL formulas.
+
+The Boolean and arithmetic expressions of a FRET requirement (its
+``pre_condition``, ``post_condition``, ``stop_condition`` and mode; FRET's
+field guide, "Condition": ``!``, ``&``, ``|``, ``=>``/``->``,
+``<=>``/``<->``, ``xor``, comparisons ``= != < <= > >=``, ``+ - * /``,
+numbers, ``TRUE``/``FALSE`` and function calls ``f(a, b)``) are parsed
+here into a small tree (:func:`parse`) and written back as RCL
+(:class:`Writer`), fully bracketed so that no precedence differs:
+
+=====================  =====================================================
+FRETish                RCL
+=====================  =====================================================
+``! a``, ``a & b``     ``not a``, ``a and b`` (``|``: ``or``)
+``a => b``, ``a <=> b``  ``a -> b``, ``a <=> b``
+``a xor b``            ``not (a <=> b)``
+``a = b``              ``a == b``
+``absReal(e)``, ``absInt(e)``, ``abs(e)``  ``abs(e)``
+``preBool(i, e)``, ``preReal(i, e)``, ``preInt(i, e)``  a state variable
+                       holding ``e`` of the step before, ``i`` at the first
+                       step (FRET's field guide, "builtin functions": Lustre's
+                       ``i -> pre e``), made by the writer's ``pre`` callback
+=====================  =====================================================
+
+Any other function, ``^`` and a name the caller cannot place raise
+:class:`Refusal` with the reason and what would make it importable.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Callable, Union
+
+#: A parsed expression: ("num", text) | ("bool", "TRUE"/"FALSE") | ("var", name) | ("not", e) |
+#: ("neg", e) | ("bin", op, a, b) | ("call", name, (args...)).
+Expr = tuple[object, ...]
+
+_TOKEN = re.compile(r"\s*(?:(?P<num>\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?)"
+                    r"|(?P<name>[A-Za-z_][A-Za-z0-9_]*)"
+                    r"|(?P<op><=>|<->|=>|->|!=|~=|<=|>=|[!&|=<>+\-*/^(),]))")
+#: Binary operators by precedence, loosest first (FRET's grammar; ``->`` and ``=>`` group to the right).
+_LEVELS: tuple[tuple[str, ...], ...] = (("<=>", "<->"), ("=>", "->"), ("xor",), ("|",), ("&",))
+_COMPARE = ("=", "!=", "~=", "<", "<=", ">", ">=")
+_RCL_OP = {"<=>": "<=>", "<->": "<=>", "=>": "->", "->": "->", "|": "or", "&": "and", "=": "==", "!=": "!=",
+           "~=": "!=", "<": "<", "<=": "<=", ">": ">", ">=": ">=", "+": "+", "-": "-", "*": "*", "/": "/"}
+ABS = ("absReal", "absInt", "abs")
+PRE = {"preBool": "BOOL", "preReal": "REAL", "preInt": "INTEGER"}
+
+
+class Refusal(Exception):
+    """A requirement that cannot be imported: ``reason`` (what is in the
+    way) and ``fix`` (what would make it importable)."""
+
+    def __init__(self, reason: str, fix: str) -> None:
+        super().__init__(f"{reason}; {fix}")
+        self.reason, self.fix = reason, fix
+
+
+def _tokens(text: str) -> list[str]:
+    out: list[str] = []
+    pos = 0
+    text = text.rstrip()
+    while pos < len(text):
+        m = _TOKEN.match(text, pos)
+        if m is None or m.end() == pos:
+            raise Refusal(f"FRETish expression {text!r} has a character rclverify does not read at "
+                          f"{text[pos:pos + 10].strip()!r}", "write the condition with FRETish operators")
+        out.append(m.group(m.lastgroup or "op"))
+        pos = m.end()
+    return out
+
+
+class _Parser:
+    def __init__(self, text: str) -> None:
+        self.text, self.toks, self.i = text, _tokens(text), 0
+
+    def peek(self) -> str | None:
+        return self.toks[self.i] if self.i < len(self.toks) else None
+
+    def take(self, want: str | None = None) -> str:
+        t = self.peek()
+        if t is None or (want is not None and t != want):
+            raise Refusal(f"FRETish expression {self.text!r} does not parse (expected {want or 'more'} at "
+                          f"{t or 'its end'})", "correct the requirement in FRET")
+        self.i += 1
+        return t
+
+    def level(self, k: int) -> Expr:
+        if k == len(_LEVELS):
+            return self.unary()
+        left = self.level(k + 1)
+        while self.peek() in _LEVELS[k]:
+            op = self.take()
+            right = self.level(k) if op in ("=>", "->") else self.level(k + 1)
+            left = ("bin", op, left, right)
+            if op in ("=>", "->"):
+                break
+        return left
+
+    def unary(self) -> Expr:
+        if self.peek() == "!":
+            self.take()
+            return ("not", self.unary())
+        return self.compare()
+
+    def compare(self) -> Expr:
+        left = self.sum()
+        if self.peek() in _COMPARE:
+            op = self.take()
+            left = ("bin", op, left, self.sum())
+        return left
+
+    def sum(self) -> Expr:
+        left = self.product()
+        while self.peek() in ("+", "-"):
+            op = self.take()
+            left = ("bin", op, left, self.product())
+        return left
+
+    def product(self) -> Expr:
+        left = self.atom()
+        while self.peek() in ("*", "/", "^"):
+            op = self.take()
+            if op == "^":
+                raise Refusal("FRETish '^' (a power) has no RCL counterpart", "write the power as a product")
+            left = ("bin", op, left, self.atom())
+        return left
+
+    def atom(self) -> Expr:
+        t = self.take()
+        if t == "-":
+            return ("neg", self.atom())
+        if t == "(":
+            e = self.level(0)
+            self.take(")")
+            return e
+        if t[0].isdigit() or t[0] == ".":
+            return ("num", t)
+        if t in ("TRUE", "true", "FALSE", "false"):
+            return ("bool", t.upper())
+        if not (t[0].isalpha() or t[0] == "_"):
+            raise Refusal(f"FRETish expression {self.text!r} does not parse at {t!r}", "correct the requirement in FRET")
+        if self.peek() == "(":
+            self.take("(")
+            args: list[Expr] = []
+            while self.peek() != ")":
+                args.append(self.level(0))
+                if self.peek() == ",":
+                    self.take(",")
+                elif self.peek() != ")":
+                    self.take(")")
+            self.take(")")
+            return ("call", t, tuple(args))
+        return ("var", t)
+
+
+def parse(text: str) -> Expr:
+    """The tree of FRETish expression ``text``.  Raises :class:`Refusal`
+    when it does not parse or uses ``^``."""
+    p = _Parser(text)
+    e = p.level(0)
+    if p.peek() is not None:
+        raise Refusal(f"FRETish expression {text!r} does not parse (unexpected {p.peek()!r})",
+                      "correct the requirement in FRET")
+    return e
+
+
+def names(e: Expr) -> list[str]:
+    """The variable names ``e`` reads, in order of first mention."""
+    out: list[str] = []
+
+    def walk(x: Expr) -> None:
+        if x[0] == "var":
+            out.append(str(x[1]))
+        for a in x[1:]:
+            if isinstance(a, tuple) and a and isinstance(a[0], str):
+                walk(a)
+            elif isinstance(a, tuple):
+                for b in a:
+                    walk(b)
+    walk(e)
+    return list(dict.fromkeys(out))
+
+
+#: ``var(name, local)``: the RCL text of a variable (``Node.in.x``, or ``in.x`` when ``local``), or
+#: the tree to write in its place (an Internal variable defined by a constant or a formula).
+VarText = Callable[[str, bool], Union[str, Expr]]
+#: ``pre(type, init, expr)``: the state variable's name holding ``expr`` (a tree) of the step before.
+PreVar = Callable[[str, Expr, Expr], str]
+
+
+@dataclass
+class Writer:
+    """Writes trees as RCL: ``var`` places a name, ``pre`` makes the state
+    variable of a ``pre*`` call, ``node`` is the component's node (for
+    ``Node.state.v``)."""
+
+    var: VarText
+    pre: PreVar
+    node: str
+
+    def rcl(self, e: Expr, local: bool = False) -> str:
+        """RCL text of ``e``: over ``Node.in.x``/``Node.out.y``/``Node.state.v``
+        or, ``local``, over ``in.x``/``out.y``/``state.v`` (a state
+        declaration's ``next``).  Raises :class:`Refusal`."""
+        kind = e[0]
+        if kind == "num":
+            t = str(e[1])
+            return "0" + t if t.startswith(".") else t
+        if kind == "bool":
+            return str(e[1])
+        if kind == "var":
+            got = self.var(str(e[1]), local)
+            return got if isinstance(got, str) else f"({self.rcl(got, local)})"
+        if kind == "not":
+            return f"(not {self.rcl(e[1], local)})"  # type: ignore[arg-type]
+        if kind == "neg":
+            return f"(-{self.rcl(e[1], local)})"  # type: ignore[arg-type]
+        if kind == "bin":
+            op, a, b = e[1], e[2], e[3]
+            la, lb = self.rcl(a, local), self.rcl(b, local)  # type: ignore[arg-type]
+            if op == "xor":
+                return f"(not ({la} <=> {lb}))"
+            return f"({la} {_RCL_OP[str(op)]} {lb})"
+        name, args = str(e[1]), e[2]
+        assert isinstance(args, tuple)
+        if name in ABS and len(args) == 1:
+            return f"abs({self.rcl(args[0], local)})"
+        if name in PRE and len(args) == 2:
+            state = self.pre(PRE[name], args[0], args[1])
+            return f"state.{state}" if local else f"{self.node}.state.{state}"
+        raise Refusal(f"it calls the FRET function {name}({', '.join('_' for _ in args)}), which has no RCL "
+                      "counterpart", f"write {name} as an RCL formula over the component's inputs and outputs"
+                                     " (rclverify translates absReal, absInt, preBool, preReal and preInt)")

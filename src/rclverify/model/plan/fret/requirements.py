@@ -1,0 +1,247 @@
+"""A FRET export as requirements and state declarations of the plan (docs/requirements.md, "Requirements from FRET").
+
+Each requirement of the export becomes a :class:`~rclverify.model.plan.model.Requirement`:
+``id`` its ``reqid``, ``text`` its ``fulltext``, ``origin`` the export's
+workspace-relative name, located where its ``reqid`` is written.  Its
+component is the node of the same name, or the one the plan's
+``fret: components:`` maps it to.  Its variables are placed by their
+``idType``: ``Input`` as ``Node.in.x``, ``Output`` as ``Node.out.x``; an
+``Internal`` variable whose Lustre ``assignment`` is a FRETish expression
+(a constant, or arithmetic over other variables) stands for that
+expression; a name the export does not declare is read as a constant of the
+contracts' contexts (an enumeration value), when the contracts are known.
+With the contracts' nodes at hand (:func:`ports_of`), the node, each input
+and output and its type (FRET ``boolean`` a ``BOOL``, a number type a
+``REAL``, ``INTEGER`` or ``NATURAL``) are checked here.
+
+Its formal statement and state variables are :func:`.translate.translate`'s.
+A requirement that cannot be translated is kept as an *informal*
+requirement (its text, nothing decides it) with its :class:`~.fretish.Refusal`,
+which ``rclverify import fret`` prints as ``EXPORT.json:reqid: reason; what
+would make it importable``: none is dropped.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+from typing import Any, Mapping
+
+from rclverify.lang import ast
+from rclverify.model.plan.formal import Source
+from rclverify.model.plan.model import Requirement
+from rclverify.model.plan.state import StateVar
+from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretVariable, read_export
+from rclverify.model.plan.fret.fretish import Expr, Refusal, names, parse
+from rclverify.model.plan.fret.translate import Translation, translate
+
+#: FRET data types read as numbers, and the RCL types a number may be.
+NUMBERS = ("double", "single", "float", "real", "integer", "int", "int8", "int16", "int32", "int64", "uint8",
+           "uint16", "uint32", "uint64", "unsigned integer")
+_NUMBER_TYPES = ("REAL", "INTEGER", "NATURAL")
+#: Lustre words in an Internal variable's assignment that FRETish does not have.
+_LUSTRE = re.compile(r"\b(pre|if|then|else|fby|when|current)\b|->")
+#: Lustre's word operators in an assignment, read as FRETish's.
+_LUSTRE_OPS = {"and": "&", "or": "|", "not": "!", "xor": "xor", "<>": "!="}
+_LUSTRE_WORDS = re.compile(r"\b(?:and|or|not)\b|<>")
+
+
+@dataclass(frozen=True)
+class Options:
+    """The plan's ``fret:`` section: ``components`` maps FRET's component
+    names to nodes; ``step`` the seconds of one step (durations in secs)."""
+
+    components: Mapping[str, str] = field(default_factory=dict)
+    step: Fraction | None = None
+
+
+@dataclass(frozen=True)
+class Ports:
+    """The contracts' nodes as parsed: ``nodes[node][name] = ("in"|"out", type name or None)``;
+    ``constants`` the names of context constants and enumeration values."""
+
+    nodes: Mapping[str, Mapping[str, tuple[str, str | None]]]
+    constants: frozenset[str]
+
+
+@dataclass(frozen=True)
+class Imported:
+    """One requirement of the export as the plan reads it: ``requirement``
+    (informal when ``refusal``), the ``states`` its statement reads."""
+
+    fret: FretRequirement
+    requirement: Requirement
+    states: tuple[StateVar, ...] = ()
+    refusal: Refusal | None = None
+
+
+def ports_of(specs: list[ast.Spec]) -> Ports:
+    """The :class:`Ports` of parsed contract files ``specs``."""
+    nodes: dict[str, dict[str, tuple[str, str | None]]] = {}
+    consts: set[str] = set()
+    for sp in specs:
+        for n in sp.nodes:
+            io = nodes.setdefault(n.name, {})
+            for prefix, vs in (("in", n.inputs), ("out", n.outputs)):
+                for v in vs:
+                    io[v.name] = (prefix, getattr(v.type, "name", None))
+        for c in sp.contexts:
+            for d in c.decls:
+                consts.add(d.name)
+                vals = getattr(d.type, "values", None)
+                consts.update(vals if isinstance(vals, tuple) else ())
+    return Ports(nodes, frozenset(consts))
+
+
+class _Places:
+    """Where each name of one requirement goes (``var`` of :class:`~.fretish.Writer`)."""
+
+    def __init__(self, exp: FretExport, fr: FretRequirement, node: str, ports: Ports | None) -> None:
+        self.exp, self.fr, self.node, self.ports = exp, fr, node, ports
+        self.depth = 0
+
+    def _declared(self, name: str) -> FretVariable | None:
+        return self.exp.variables.get((self.fr.component, name))
+
+    def __call__(self, name: str, local: bool) -> str | Expr:
+        v = self._declared(name)
+        kind = v.id_type if v is not None else ""
+        if kind in ("Input", "Output"):
+            assert v is not None
+            prefix = "in" if kind == "Input" else "out"
+            self._check_port(v, prefix)
+            return f"{prefix}.{name}" if local else f"{self.node}.{prefix}.{name}"
+        if kind == "Internal":
+            assert v is not None
+            a = v.assignment.strip()
+            if not a or _LUSTRE.search(a):
+                raise Refusal(f"{name} is an Internal variable defined in Lustre ({a or 'no assignment'})",
+                              f"make {name} an input or output of {self.node}, or define it in FRET by a "
+                              "FRETish expression over the component's variables")
+            self.depth += 1
+            if self.depth > 32:
+                raise Refusal(f"the Internal variable {name} is defined through itself", "break the cycle in FRET")
+            try:
+                tree = parse(_LUSTRE_WORDS.sub(lambda m: _LUSTRE_OPS[m.group(0)], a))
+            except Refusal as exc:
+                raise Refusal(f"{name}'s assignment: {exc.reason}", exc.fix) from None
+            for n in names(tree):
+                self(n, local)  # every name it reads is placed (or refused) now
+            self.depth -= 1
+            return tree
+        if kind in ("Mode", "Function"):
+            raise Refusal(f"{name} is a FRET {kind} variable", f"declare {name} as a boolean input or output of "
+                                                                f"{self.node}")
+        if self.ports is not None and name in self.ports.constants:
+            return name
+        why = "not declared in the export" if v is None else "declared without an idType"
+        raise Refusal(f"{name} is {why}", f"declare it in FRET as an Input or Output of {self.fr.component}, or "
+                                          "as a constant or enumeration value of the contracts' context")
+
+    def _check_port(self, v: FretVariable, prefix: str) -> None:
+        if self.ports is None:
+            return
+        io = self.ports.nodes.get(self.node, {})
+        want = "input" if prefix == "in" else "output"
+        got = io.get(v.name)
+        if got is None or got[0] != prefix:
+            has = ", ".join(sorted(n for n, (p, _) in io.items() if p == prefix)) or "none"
+            raise Refusal(f"{self.node} has no {want} named {v.name} (its {want}s: {has})",
+                          f"declare {v.name} as an {want} of {self.node}, or correct its idType in FRET")
+        dt, rt = v.data_type.lower(), got[1]
+        if rt is None:
+            return
+        ok = (rt == "BOOL") if dt == "boolean" else (rt in _NUMBER_TYPES or rt not in ("BOOL", "STRING")) \
+            if dt in NUMBERS else True
+        if not ok:
+            raise Refusal(f"{v.name} is a FRET {v.data_type} but {self.node}.{prefix}.{v.name} is a {rt}",
+                          f"make the types agree (FRET boolean is BOOL; a number is REAL, INTEGER or NATURAL)")
+
+
+def _states(t: Translation, loc: ast.Loc) -> tuple[StateVar, ...]:
+    def src(text: str) -> Source:
+        return Source(text, loc.line, loc.col, loc.file)
+    return tuple(StateVar(t.node, s.name, s.type_name, src(s.init), src(s.next), loc, loc) for s in t.states)
+
+
+def import_export(exp: FretExport, options: Options, ports: Ports | None = None) -> list[Imported]:
+    """Every requirement of ``exp`` as an :class:`Imported`, in file order
+    (module docstring).  ``ports`` the contracts' nodes (``None``: names
+    are not checked against them)."""
+    out: list[Imported] = []
+    used: set[str] = set()
+    for fr in exp.requirements:
+        node = options.components.get(fr.component, fr.component)
+        informal = Requirement(fr.reqid, fr.fulltext, (), fr.loc, origin=exp.file)
+        try:
+            if not fr.semantics or not fr.semantics.get("timing"):
+                raise Refusal("FRET has not formalised it (no semantics in the export)",
+                              "let FRET parse the requirement and export it again")
+            if not node:
+                raise Refusal("it names no component", "name the component in FRET")
+            if ports is not None and node not in ports.nodes:
+                known = ", ".join(sorted(ports.nodes)) or "none"
+                raise Refusal(f"no node named {node} in the contracts (nodes: {known})",
+                              f"map the component in the plan (fret: {{components: {{{fr.component}: Node}}}})")
+            t = translate(fr.reqid, fr.fulltext, fr.semantics, node, _Places(exp, fr, node, ports), options.step)
+        except Refusal as exc:
+            out.append(Imported(fr, informal, (), exc))
+            continue
+        names_ = [s.name for s in t.states]
+        if used.intersection(names_):  # two reqids with the same letters and digits: a distinct suffix
+            k = 2
+            while used.intersection(f"{n}_{k}" for n in names_):
+                k += 1
+            t = _renamed(t, k)
+        used.update(s.name for s in t.states)
+        req = Requirement(fr.reqid, fr.fulltext, (), fr.loc, Source(t.formal, fr.loc.line, fr.loc.col, exp.file),
+                          origin=exp.file)
+        out.append(Imported(fr, req, _states(t, fr.loc)))
+    return out
+
+
+def _renamed(t: Translation, k: int) -> Translation:
+    from rclverify.model.plan.fret.translate import NewState  # deferred: start-up (only on a clash of names)
+    pat = re.compile(r"\b(" + "|".join(re.escape(s.name) for s in t.states) + r")\b")
+    def sub(text: str) -> str:
+        return pat.sub(lambda m: f"{m.group(1)}_{k}", text)
+    return Translation(sub(t.formal), t.node, [NewState(f"{s.name}_{k}", s.type_name, sub(s.init), sub(s.next))
+                                               for s in t.states])
+
+
+def read_fret(root: Path, rel: str, options: Options, contracts: tuple[str, ...] = ()) -> list[Imported]:
+    """The export ``root/rel`` imported against the contract files
+    ``contracts`` (workspace-relative; those that do not parse are left out:
+    they are reported where they are checked).  Raises
+    :class:`~rclverify.model.plan.errors.PlanError` for a malformed export."""
+    from rclverify.lang.errors import RclError  # deferred: start-up (only a plan that reads FRET)
+    from rclverify.lang.parser import parse_file  # deferred: start-up (loads lark only when called)
+    specs = []
+    for c in contracts:
+        try:
+            specs.append(parse_file(root / c))
+        except RclError:
+            continue
+    return import_export(read_export(root / rel, rel), options, ports_of(specs) if contracts else None)
+
+
+def options_of(data: Mapping[str, Any]) -> Options:
+    """The plan's ``fret:`` section (schema-checked) as :class:`Options`; ``step`` a duration (``100 ms``)."""
+    spec = data.get("fret") or {}
+    step = None
+    if spec.get("step") is not None:
+        from rclverify.lang.timing import parse_duration  # deferred: start-up (only with fret: step:)
+        step = parse_duration(str(spec["step"]))
+    return Options(dict(spec.get("components") or {}), step)
+
+
+def plan_additions(root: Path, data: Mapping[str, Any], contracts: tuple[str, ...]
+                   ) -> tuple[list[Requirement], tuple[StateVar, ...]]:
+    """The requirements and state declarations the plan's ``requirements_from: {fret: EXPORT.json}``
+    adds (none without it).  Raises :class:`~rclverify.model.plan.errors.PlanError` for a malformed export."""
+    rel = (data.get("requirements_from") or {}).get("fret")
+    if not rel:
+        return [], ()
+    got = read_fret(root, str(rel), options_of(data), contracts)
+    return [i.requirement for i in got], tuple(s for i in got for s in i.states)

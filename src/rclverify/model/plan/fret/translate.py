@@ -1,0 +1,208 @@
+"""One FRET requirement translated to an RCL temporal statement and the state variables it needs.
+
+FRET gives each requirement a scope, a condition and a timing (FRET's
+field guide; the requirement's ``semantics``: ``scope.type``,
+``condition``, ``timing``).  Each combination below is translated to one
+of the decided shapes of :func:`rclverify.model.plan.temporal.shape`, its
+reading on finite traces equal to FRET's past-time formalisation
+(``ptExpanded``: a trace satisfies the requirement when the formula holds
+at its last step; tests/model/test_fret_differential.py compares the two on
+random traces).  ``P`` is the condition, ``Q`` the response, ``S`` the
+stop condition, ``N`` the duration in steps, ``M`` the mode; ``prev``,
+``since``, ``on`` and ``t`` are state variables of the component's node,
+named ``fret_<reqid>_<role>``:
+
+==============================  ================================================  ==========================
+scope, condition, timing        RCL                                               state
+==============================  ================================================  ==========================
+null, null, always / never      ``always Q`` / ``always not Q``
+null, null, immediately         ``eventually[<= 0] Q`` (Q at the first step)
+null, null, within N            ``eventually[<= N] Q``
+null, null, for N               ``always (state.t <= N -> Q)``                    ``t``: the step, capped at N + 1
+null, whenever, immediately     ``always (P -> Q)``
+null, whenever, next            ``always (P -> next Q)``
+null, upon, immediately         ``always ((P and not state.prev) -> Q)``          ``prev``: P at the step before
+null, upon, next                ``always ((P and not state.prev) -> next Q)``     ``prev``
+null, upon, always              ``always ((P or state.since) -> Q)``              ``since``: P held before
+null, upon, until S             ``always ((not S and (T or state.on)) -> Q)``     ``prev``, ``on``
+in M, null, always              ``always (M -> Q)``
+in M, null, immediately         ``always ((M and not state.prev) -> Q)``          ``prev`` of M
+==============================  ================================================  ==========================
+
+``T`` is the trigger ``P and not state.prev`` (FRET's "upon": P becomes
+true, or holds at the first step); ``on`` holds "a trigger came and S has
+not held since" of the step before.  A window cut short by the end of a
+finite run is FRET's "need not hold": ``next`` and ``eventually[<= N]``
+are not violated by a trace that ends first.  Whatever else raises
+:class:`~.fretish.Refusal` naming it.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any, Callable, Mapping
+
+from rclverify.model.plan.fret.fretish import Expr, Refusal, Writer, parse
+
+#: The timings translated for each (scope, condition) (module table).
+SUPPORTED = {
+    ("null", "null"): ("always", "never", "immediately", "within", "for"),
+    ("null", "holding"): ("immediately", "next"), ("null", "noTrigger"): ("immediately", "next"),
+    ("null", "regular"): ("immediately", "next", "always", "until"),
+    ("in", "null"): ("always", "immediately"),
+}
+_UNITS = re.compile(r"\b(?:within|for|after|before)\s+(\d+(?:\.\d+)?)\s*([A-Za-z]+)")
+
+
+@dataclass(frozen=True)
+class NewState:
+    """A state variable the statement reads: ``name`` of ``type_name``,
+    ``init``/``next`` RCL formulas over ``state.v``/``next.v``/``in.x``/``out.y``."""
+
+    name: str
+    type_name: str
+    init: str
+    next: str
+
+
+@dataclass
+class Translation:
+    """A requirement's RCL ``formal`` and the ``states`` it declares on ``node``."""
+
+    formal: str
+    node: str
+    states: list[NewState] = field(default_factory=list)
+
+
+def state_base(reqid: str) -> str:
+    """The prefix of the state variables made for requirement ``reqid``: ``fret_`` and its id with every
+    character that is not a letter, digit or ``_`` as ``_``."""
+    return "fret_" + re.sub(r"[^A-Za-z0-9_]", "_", reqid)
+
+
+def steps_of(sem: Mapping[str, Any], fulltext: str, step: Fraction | None) -> int:
+    """The duration of a ``within``/``for`` timing in steps: ``ticks`` as written; another unit of
+    time through ``step`` (the plan's ``fret: step:``, seconds per step), when it divides exactly.
+    Raises :class:`Refusal`."""
+    raw = sem.get("duration")
+    raw = raw[0] if isinstance(raw, list) and raw else raw
+    try:
+        n = Fraction(str(raw))
+    except (ValueError, ZeroDivisionError):
+        raise Refusal(f"its duration {raw!r} is not a number", "give the timing a number of ticks") from None
+    m = _UNITS.search(fulltext)
+    unit = m.group(2).lower() if m else "ticks"
+    if unit.startswith("tick"):
+        count = n
+    else:
+        from rclverify.lang.timing import parse_duration  # deferred: start-up (only a duration in seconds)
+        secs = parse_duration(f"{n} {_UNIT_NAMES.get(unit, unit)}")
+        if secs is None:
+            raise Refusal(f"its duration is in {unit!r}, not a unit of time rclverify reads",
+                          "write the duration in ticks or secs")
+        if step is None:
+            raise Refusal(f"its duration is {m.group(1) if m else n} {unit}, and the plan declares no step period",
+                          "declare the step period in the plan (fret: {step: 100 ms}) or write the duration in ticks")
+        count = secs / step
+    if count.denominator != 1 or count < 0:
+        raise Refusal(f"its duration is not a whole number of steps ({count})",
+                      "write a duration that is a whole number of steps")
+    return int(count)
+
+
+_UNIT_NAMES = {"sec": "s", "secs": "s", "second": "s", "seconds": "s", "msec": "ms", "msecs": "ms",
+               "millisecond": "ms", "milliseconds": "ms", "min": "min", "mins": "min", "minute": "min",
+               "minutes": "min", "hour": "h", "hours": "h", "usec": "us", "usecs": "us"}
+
+
+class _States:
+    """The state variables of one requirement, made as the writer asks."""
+
+    def __init__(self, base: str) -> None:
+        self.base = base
+        self.made: list[NewState] = []
+
+    def add(self, role: str, type_name: str, init: str, nxt: str) -> str:
+        """Declare ``fret_<reqid>_<role>``; in ``nxt`` ``@`` is its next value, ``$`` its current one."""
+        name = f"{self.base}_{role}"
+        self.made.append(NewState(name, type_name, f"state.{name} == {init}" if type_name != "BOOL"
+                                  else f"state.{name} <=> {init}",
+                                  nxt.replace("@", f"next.{name}").replace("$", f"state.{name}")))
+        return name
+
+
+def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
+              var: Callable[[str, bool], str | Expr], step: Fraction | None = None) -> Translation:
+    """Requirement ``reqid`` (``semantics`` ``sem``, FRET's export fields) as
+    an RCL statement over ``node`` (module table).  ``var(name, local)``
+    places a variable (:class:`~.fretish.Writer`); ``step`` the plan's
+    seconds per step for durations in seconds.  Raises :class:`Refusal`."""
+    scope = str((sem.get("scope") or {}).get("type", "null"))
+    cond, timing = str(sem.get("condition") or "null"), str(sem.get("timing") or "null")
+    if str(sem.get("response") or "satisfaction") != "satisfaction":
+        raise Refusal(f"its response is {sem.get('response')!r}", "write the response as 'satisfy'")
+    if scope == "in" and cond != "null":
+        raise Refusal("a trigger inside a mode interval (scope 'in', a condition) is not translated",
+                      "write the mode into the condition (whenever M & P ...) or split the requirement")
+    if timing not in SUPPORTED.get((scope, cond), ()):
+        known = ", ".join(f"{s}/{c}: {', '.join(t)}" for (s, c), t in SUPPORTED.items())
+        raise Refusal(f"the combination scope {scope}, condition {cond}, timing {timing} is not translated",
+                      f"write it as one of: {known}")
+    states = _States(state_base(reqid))
+
+    def pre(type_name: str, init: Expr, e: Expr) -> str:
+        init_text = w.rcl(init, True)
+        if type_name == "BOOL":
+            return states.add(f"pre{len(states.made) + 1}", type_name, init_text, f"@ <=> {w.rcl(e, True)}")
+        return states.add(f"pre{len(states.made) + 1}", type_name, init_text, f"@ == {w.rcl(e, True)}")
+    w = Writer(var, pre, node)
+
+    def field_expr(key: str, *alt: str) -> Expr:
+        for k in (key,) + alt:
+            v = sem.get(k)
+            if isinstance(v, str) and v.strip():
+                return parse(v)
+        raise Refusal(f"its semantics has no {key}", "let FRET formalise the requirement again and export it")
+
+    q = w.rcl(field_expr("post_condition"))
+    if scope == "in":
+        mode = sem.get("scope_mode")
+        if not isinstance(mode, str) or not mode.strip():
+            raise Refusal("its scope 'in' names no mode", "name the mode in FRET")
+        m = parse(mode)
+        if timing == "always":
+            return Translation(f"always ({w.rcl(m)} -> {q})", node, states.made)
+        prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {w.rcl(m, True)}")
+        return Translation(f"always (({w.rcl(m)} and not {node}.state.{prev}) -> {q})", node, states.made)
+    if cond == "null":
+        if timing == "always":
+            return Translation(f"always {q}", node, states.made)
+        if timing == "never":
+            return Translation(f"always (not {q})", node, states.made)
+        if timing == "immediately":
+            return Translation(f"eventually[<= 0] {q}", node, states.made)
+        n = steps_of(sem, fulltext, step)
+        if timing == "within":
+            return Translation(f"eventually[<= {n}] {q}", node, states.made)
+        t = states.add("t", "NATURAL", "0", f"($ <= {n} and @ == $ + 1) or ($ > {n} and @ == $)")
+        return Translation(f"always ({node}.state.{t} <= {n} -> {q})", node, states.made)
+    p_tree = field_expr("regular_condition", "pre_condition")
+    p = w.rcl(p_tree)
+    if cond in ("holding", "noTrigger"):
+        return Translation(f"always ({p} -> {q})" if timing == "immediately" else f"always ({p} -> next {q})",
+                           node, states.made)
+    if timing == "always":
+        since = states.add("since", "BOOL", "FALSE", f"@ <=> ($ or {w.rcl(p_tree, True)})")
+        return Translation(f"always (({p} or {node}.state.{since}) -> {q})", node, states.made)
+    prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {w.rcl(p_tree, True)}")
+    trig = f"({p} and not {node}.state.{prev})"
+    if timing == "immediately":
+        return Translation(f"always ({trig} -> {q})", node, states.made)
+    if timing == "next":
+        return Translation(f"always ({trig} -> next {q})", node, states.made)
+    s_tree = field_expr("stop_condition")
+    s, s_local, p_local = w.rcl(s_tree), w.rcl(s_tree, True), w.rcl(p_tree, True)
+    on = states.add("on", "BOOL", "FALSE", f"@ <=> ((not {s_local}) and (({p_local} and not state.{prev}) or $))")
+    return Translation(f"always (((not {s}) and ({trig} or {node}.state.{on})) -> {q})", node, states.made)
+

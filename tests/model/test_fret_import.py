@@ -1,0 +1,200 @@
+"""Requirements imported from a FRET export (docs/requirements.md, "Requirements from FRET").
+
+The exports are written here in FRET's format (``requirements`` with
+``reqid``, ``fulltext``, ``semantics``; ``variables`` with ``idType`` and
+``dataType``).  What is checked: each requirement becomes a plan
+requirement keyed by its reqid, with the state declarations its statement
+reads, type-checked with the contracts; what cannot be translated is kept
+informal with its reason and fix; a malformed export is a located error;
+a re-import reports added, changed and removed requirements, writes
+nothing when nothing changed, and keeps the plan's own requirements.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.cli.commands import _run
+from rclverify.cli.fret import cmd_import_fret
+from rclverify.model.plan.errors import PlanError
+from rclverify.model.plan.fret.export import read_export
+from rclverify.model.plan.fret.requirements import Options, import_export
+from rclverify.model.plan.load import all_requirements, load_plan
+from rclverify.stages.workspace import Workspace
+from rclverify.tools.fret.importer import import_fret, render
+
+CONTRACT = """node Rover {
+  inputs( obstacle : BOOL, asked : REAL )
+  outputs( speed : REAL, braking : BOOL )
+  assume( 0 <= in.asked and in.asked <= 2 )
+  guarantee( out.braking <=> in.obstacle )
+  guarantee( (in.obstacle -> out.speed == 0) and (not in.obstacle -> out.speed == in.asked) )
+  progress( within 0 steps )
+}
+"""
+PLAN = """name: fret test
+contracts:
+  - contracts/rover.rcl
+requirements:
+  - id: CAP
+    text: The rover never goes faster than 2 m/s.
+    formal: "Rover.out.speed <= 2"
+fret:
+  components: {rover: Rover}
+"""
+
+
+def _req(rid: str, text: str, timing: str, post: str, cond: str = "null", pre: str | None = None,
+         **extra: Any) -> dict[str, Any]:
+    sem: dict[str, Any] = {"type": "nasa", "scope": {"type": "null"}, "condition": cond, "timing": timing,
+                           "response": "satisfaction", "component_name": "rover", "post_condition": post, **extra}
+    if pre is not None:
+        sem.update(pre_condition=pre, regular_condition=pre)
+    return {"reqid": rid, "parent_reqid": "", "project": "Rover", "fulltext": text, "semantics": sem, "_id": rid}
+
+
+def _var(name: str, id_type: str, data_type: str, assignment: str = "") -> dict[str, Any]:
+    return {"project": "Rover", "component_name": "rover", "variable_name": name, "idType": id_type,
+            "dataType": data_type, "assignment": assignment, "modeRequirement": "", "_id": name}
+
+
+VARIABLES = [_var("obstacle", "Input", "boolean"), _var("asked", "Input", "double"),
+             _var("speed", "Output", "double"), _var("braking", "Output", "boolean"),
+             _var("limit", "Internal", "double", "2.0"), _var("filtered", "Internal", "double", "0.0 -> pre speed")]
+REQS = [
+    _req("R-1", "the rover shall always satisfy speed <= limit", "always", "(speed <= limit)"),
+    _req("R-2", "upon obstacle the rover shall immediately satisfy braking", "immediately", "(braking)",
+         "regular", "(obstacle)"),
+    _req("R-3", "the rover shall within 3 ticks satisfy speed <= asked", "within", "(speed <= asked)", duration=3),
+    _req("R-4", "the rover shall eventually satisfy ! braking", "eventually", "(! braking)"),
+]
+
+
+def _write(path: Path, reqs: list[dict[str, Any]], variables: list[dict[str, Any]] = VARIABLES) -> Path:
+    path.write_text(json.dumps({"requirements": reqs, "variables": variables}, indent=2), encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def ws(tmp_path: Path) -> Path:
+    (tmp_path / "contracts").mkdir()
+    (tmp_path / "contracts" / "rover.rcl").write_text(CONTRACT, encoding="utf-8")
+    (tmp_path / "contracts" / "plan.yaml").write_text(PLAN, encoding="utf-8")
+    return tmp_path
+
+
+def test_each_requirement_becomes_a_plan_requirement_by_reqid(ws: Path, tmp_path: Path) -> None:
+    res = import_fret(ws, "contracts/plan.yaml", _write(tmp_path / "export.json", REQS), "export.json")
+    assert res.added == ["R-1", "R-2", "R-3", "R-4"] and res.written and res.plan_edited
+    plan = load_plan(ws)
+    reqs = {r.id: r for r in all_requirements(plan)}
+    assert list(reqs) == ["CAP", "R-1", "R-2", "R-3", "R-4"]  # the plan's own first, then the export's
+    assert reqs["R-1"].text == "the rover shall always satisfy speed <= limit"
+    assert reqs["R-1"].origin == "fret/export.json" and reqs["R-1"].loc.file == "fret/export.json"
+    assert reqs["R-1"].formal is not None and reqs["R-1"].formal.text == "always (Rover.out.speed <= (2.0))"
+    assert reqs["R-2"].formal is not None and "Rover.state.fret_R_2_prev" in reqs["R-2"].formal.text
+    assert [s.name for s in plan.states] == ["fret_R_2_prev"]
+    assert reqs["R-3"].formal is not None and reqs["R-3"].formal.text.startswith("eventually[<= 3] ")
+    assert reqs["R-4"].formal is None  # not translated: informal, never dropped
+    Workspace(ws, "contracts/plan.yaml").checked  # every imported statement type-checks with the contract
+    out = render(res)
+    assert "export.json:R-4: the combination scope null, condition null, timing eventually is not translated; " \
+           "write it as one of:" in out
+    assert "3 translated to a decided temporal statement, 1 kept as informal" in out
+
+
+def test_reimport_reports_added_changed_removed_and_keeps_the_plans_own(ws: Path, tmp_path: Path) -> None:
+    first = _write(tmp_path / "export.json", REQS)
+    import_fret(ws, "contracts/plan.yaml", first, "export.json")
+    plan_text = (ws / "contracts" / "plan.yaml").read_text(encoding="utf-8")
+    copy = (ws / "fret" / "export.json").read_bytes()
+    again = import_fret(ws, "contracts/plan.yaml", first, "export.json")
+    assert (again.added, again.changed, again.removed) == ([], [], [])
+    assert again.unchanged == ["R-1", "R-2", "R-3", "R-4"] and not again.written and not again.plan_edited
+    assert (ws / "fret" / "export.json").read_bytes() == copy
+    edited = [dict(r) for r in REQS if r["reqid"] != "R-3"]
+    edited[0] = _req("R-1", "the rover shall always satisfy speed <= 1.5", "always", "(speed <= 1.5)")
+    edited.append(_req("R-5", "whenever obstacle the rover shall immediately satisfy speed = 0.0", "immediately",
+                       "(speed = 0.0)", "noTrigger", "(obstacle)"))
+    res = import_fret(ws, "contracts/plan.yaml", _write(tmp_path / "export.json", edited), "export.json")
+    assert (res.added, res.changed, res.removed) == (["R-5"], ["R-1"], ["R-3"])
+    assert (ws / "contracts" / "plan.yaml").read_text(encoding="utf-8") == plan_text  # the plan is not touched
+    ids = [r.id for r in all_requirements(load_plan(ws))]
+    assert ids == ["CAP", "R-1", "R-2", "R-4", "R-5"]
+    assert "  changed: R-1" in render(res) and "  removed: R-3" in render(res)
+
+
+def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
+    reqs = [
+        _req("LUSTRE", "the rover shall always satisfy filtered <= 2.0", "always", "(filtered <= 2.0)"),
+        _req("UNDECLARED", "the rover shall always satisfy ghost", "always", "(ghost)"),
+        _req("FUNCTION", "the rover shall always satisfy persisted(2, braking)", "always", "(persisted(2, braking))"),
+        _req("MODE-TRIGGER", "in manual mode upon obstacle the rover shall immediately satisfy braking", "immediately",
+             "(braking)", "regular", "(obstacle)", scope_mode="manual"),
+        {"reqid": "NOSEM", "fulltext": "not parsed by FRET"},
+        _req("OK", "the rover shall never satisfy speed > 2.0", "never", "(speed > 2.0)"),
+    ]
+    reqs[3]["semantics"]["scope"] = {"type": "in"}
+    got = {i.fret.reqid: i for i in import_export(read_export(_write(tmp_path / "e.json", reqs), "e.json"), Options())}
+    why = {k: (i.refusal.reason, i.refusal.fix) if i.refusal else None for k, i in got.items()}
+    assert why["LUSTRE"] == ("filtered is an Internal variable defined in Lustre (0.0 -> pre speed)",
+                             "make filtered an input or output of rover, or define it in FRET by a FRETish "
+                             "expression over the component's variables")
+    assert why["UNDECLARED"] is not None and why["UNDECLARED"][0] == "ghost is not declared in the export"
+    assert why["FUNCTION"] is not None and "FRET function persisted(_, _)" in why["FUNCTION"][0]
+    assert why["MODE-TRIGGER"] is not None and "a trigger inside a mode interval" in why["MODE-TRIGGER"][0]
+    assert why["NOSEM"] is not None and "FRET has not formalised it" in why["NOSEM"][0]
+    assert why["OK"] is None and got["OK"].requirement.formal is not None  # the control
+    assert got["OK"].requirement.formal.text == "always (not (rover.out.speed > 2.0))"
+
+
+def test_names_and_types_are_checked_against_the_contracts(ws: Path, tmp_path: Path) -> None:
+    wrong = [_var("obstacle", "Input", "double"), _var("speed", "Input", "double"), _var("braking", "Output", "boolean")]
+    reqs = [_req("TYPE", "whenever obstacle > 0.0 the rover shall immediately satisfy braking", "immediately",
+                 "(braking)", "noTrigger", "(obstacle > 0.0)"),
+            _req("SIDE", "the rover shall always satisfy speed <= 2.0", "always", "(speed <= 2.0)"),
+            _req("GOOD", "the rover shall always satisfy braking | ! braking", "always", "(braking | ! braking)")]
+    res = import_fret(ws, "contracts/plan.yaml", _write(tmp_path / "e.json", reqs, wrong), "e.json")
+    why = {i.fret.reqid: i.refusal.reason if i.refusal else None for i in res.imported}
+    assert why["TYPE"] == "obstacle is a FRET double but Rover.in.obstacle is a BOOL"
+    assert why["SIDE"] == "Rover has no input named speed (its inputs: asked, obstacle)"
+    assert why["GOOD"] is None
+    (ws / "contracts" / "plan.yaml").write_text(PLAN.replace("{rover: Rover}", "{rover: Robot}"), encoding="utf-8")
+    unmapped = import_fret(ws, "contracts/plan.yaml", tmp_path / "e.json", "e.json")
+    assert {i.refusal.reason for i in unmapped.imported if i.refusal} == {"no node named Robot in the contracts "
+                                                                         "(nodes: Rover)"}
+
+
+@pytest.mark.parametrize("text, where, message", [
+    ('{"requirements": [\n  {"reqid": "A", }\n]}', (2, 18), "the FRET export is not JSON"),
+    ('{"requirements": [{"fulltext": "no id"}]}', (1, 1), "requirement 1 of the FRET export has no 'reqid' string"),
+    ('[\n {"reqid": "A"},\n {"reqid": "A"}\n]', (3, 12), "reqid 'A' is used twice in the FRET export (first at 2:12)"),
+    ('{"reqs": []}', (1, 1), "a FRET export is a list of requirements or an object with a 'requirements' list"),
+])
+def test_a_malformed_export_is_a_located_error(tmp_path: Path, text: str, where: tuple[int, int], message: str) -> None:
+    p = tmp_path / "bad.json"
+    p.write_text(text, encoding="utf-8")
+    with pytest.raises(PlanError) as e:
+        read_export(p, "bad.json")
+    d = e.value.diagnostics[0]
+    assert (d.loc.file, d.loc.line, d.loc.col) == ("bad.json", *where) and d.message.startswith(message)
+
+
+def test_the_command_exits_1_only_on_a_malformed_export(ws: Path, tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    good = _write(tmp_path / "export.json", REQS)
+    args = argparse.Namespace(fn=cmd_import_fret, command="import", export=str(good), workspace=str(ws),
+                              plan="contracts/plan.yaml")
+    assert _run(args) == 0  # one requirement not imported is no error
+    assert "export.json:R-4: " in capsys.readouterr().out
+    bad = tmp_path / "bad.json"
+    bad.write_text("{", encoding="utf-8")
+    args.export = str(bad)
+    assert _run(args) == 1
+    err = capsys.readouterr().err
+    assert f"{bad}:1:2: error: the FRET export is not JSON" in err and "Traceback" not in err
+    assert not (ws / "fret" / "bad.json").exists()  # nothing is written for a malformed export
