@@ -119,7 +119,8 @@ def cmd_export_design(args: argparse.Namespace) -> int:
     checked = ws.checked  # raises RclError, printed located by main
     docs = check(checked, ws.root).documents if (ws.root / "nodl").is_dir() else {}
     name = ws.plan.name or ws.root.resolve().name
-    return 0 if _write(Path(args.output), design_files(name, checked, ws.model.links, docs), args.force) else 1
+    links = ws.plan.connections or ws.model.links  # the declared architecture, else what the model found
+    return 0 if _write(Path(args.output), design_files(name, checked, links, docs), args.force) else 1
 
 
 __all__ = ["FORMATS", "add_export_format", "add_import", "cmd_export_design", "cmd_import"]

@@ -12,7 +12,8 @@ reached through the components and the modules' instances is one
 (``object_recognition`` / ``tracker`` is ``object_recognition_tracker``), and
 every pair of a publisher and a subscriber (a server and a client) that
 the connections join, through any number of module boundaries, is one
-:class:`Wire`.
+:class:`Wire`; so is a reader wired to nothing whose name is a writer's (ROS joins two ends of
+one name: a ``global`` ``/tf``).
 
 Topic names: a publisher's is its ``global`` name, else the component's
 ``path`` (or ``/<component>``) followed by the instance names and the port
@@ -380,7 +381,29 @@ class _Flatten:
         for node in self.nodes.values():
             for p in node.ports:
                 node.topics.setdefault((p.role, p.name), node.own_topic(p))
+        out += self.by_name(out)
         return sorted(out, key=lambda w: (w.writer, w.writer_port, w.reader, w.reader_port))
+
+
+    def by_name(self, wired: list[Wire]) -> list[Wire]:
+        """The reader ports no connection wires whose name is a writer's topic: ROS joins them by that name
+        (a ``global`` name two nodes share, ``/tf``), so they are wires too, located at the reader's port."""
+        fed = {(w.reader, w.reader_port, w.role) for w in wired}
+        writers: dict[tuple[str, str], list[tuple[DesignNode, Port]]] = {}
+        for node in self.nodes.values():
+            for p in node.ports:
+                if p.role in WRITER:
+                    writers.setdefault((p.role, node.topics[(p.role, p.name)]), []).append((node, p))
+        out = []
+        for node in self.nodes.values():
+            for p in node.ports:
+                role = next((w for w, r in WRITER.items() if r == p.role), None)
+                if role is None or (node.name, p.name, role) in fed:
+                    continue
+                for w, wp in writers.get((role, node.topics[(p.role, p.name)]), []):
+                    if w is not node:
+                        out.append(Wire(w.name, wp.name, node.name, p.name, role, p.loc))
+        return out
 
 
 def read_design(root: Path, system: str | None = None) -> Design:

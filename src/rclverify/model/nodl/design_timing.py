@@ -18,7 +18,10 @@ checked as it now stands), and decides each field with exact rationals:
   located at the design's field and at each contract clause of the chain (the ``periodic`` and the
   ``within`` that add up to the bound);
 * no bound: ``design-undecided``, a warning at the field saying where the chain breaks;
-* the design's node or port has no contract node or input: ``design-missing``, an error at the design.
+* the design's node or port has no contract node or input: ``design-missing``, an error at the design;
+* an input the design wires to nothing and the system model feeds by an equal name (its rule for inputs
+  the plan's connections leave out, docs/plan.md): ``design-unwired``, a warning at the design's port and
+  the contract's input.
 """
 from __future__ import annotations
 
@@ -119,11 +122,31 @@ def _min(a: Bound | None, b: Bound | None) -> Bound | None:
     return a
 
 
+def _unwired(design: Design, checked: Checked, links: Sequence[Link]) -> list[Finding]:
+    """A link the system model found (by equal names or topics) that the design does not wire: a warning at the
+    design's port and the contract's input (the model's rule, docs/plan.md ``connections``, is not ROS's)."""
+    wired = {(w.reader, rcl_name_of(w.reader_port)) for w in design.wires if w.role == "publisher"}
+    out = []
+    for lk in links:
+        node = design.nodes.get(lk.to_node)
+        cn = checked.nodes.get(lk.to_node)
+        if node is None or cn is None or lk.via == "plan" or (lk.to_node, lk.to_var) in wired:
+            continue
+        port = next((p for p in node.ports if p.role == "subscriber" and rcl_name_of(p.name) == lk.to_var), None)
+        iv = next((v for v in cn.node.inputs if v.name == lk.to_var), None)
+        locs = tuple(x.loc for x in (port, iv) if x is not None)
+        findings_msg = (f"{lk.to_node}.in.{lk.to_var} is wired to nothing in the design, and the system model feeds "
+                        f"it from {lk.from_node}.out.{lk.from_var} by equal {lk.via}s; wire it in the design or "
+                        "name its producer under the plan's connections")
+        out.append(Finding("design-unwired", findings_msg, locs, "warning"))
+    return out
+
+
 def check_timing(design: Design, checked: Checked, links: Sequence[Link]) -> tuple[list[Finding], list[Decided]]:
     """Each monitoring field of ``design``'s ``on_input`` and ``periodic`` triggers decided against the deadlines
     of ``checked`` along ``links`` (module docstring): the findings and every decision, in design order."""
     gaps = _Gaps(checked, links)
-    findings: list[Finding] = []
+    findings: list[Finding] = _unwired(design, checked, links)
     decided: list[Decided] = []
     for node in design.nodes.values():
         cn = checked.nodes.get(node.name)

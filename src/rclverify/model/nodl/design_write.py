@@ -22,7 +22,8 @@ Export (:func:`design_files`): per contract node one ``<Node>.node.yaml`` whose 
 contract's topic entries (each with its resolved name as ``global``, its QoS and its services from
 the node's NoDL document when there is one) and whose processes are its triggered guarantees
 (``on_input`` with the deadline as ``timeout``) and its ``periodic`` declarations; one
-``<name>.system.yaml`` with one component per node and the system model's links as connections.
+``<name>.system.yaml`` with one component per node and the plan's connections (the system model's
+links when the plan declares none) as connections.
 An untriggered guarantee has no process (the format's processes all have a trigger) and is not
 exported.  Importing the export gives the same workspace (tests/model/test_design.py).
 """
@@ -43,6 +44,7 @@ from rclverify.lang.walk import subexpressions
 from rclverify.model.nodl.contract import GENERATED_QOS, full_type, rcl_name_of, type_key, yaml_text
 from rclverify.model.nodl.design import Design, DesignNode, Process
 from rclverify.model.nodl.document import Document
+from rclverify.model.plan.model import Connection
 from rclverify.model.system.model import Link
 
 #: The format version written by export.
@@ -209,11 +211,12 @@ def _dump(data: dict[str, Any]) -> str:
     return str(yaml.safe_dump(data, sort_keys=False, default_flow_style=False, width=120))
 
 
-def design_files(name: str, checked: Checked, links: Sequence[Link],
+def design_files(name: str, checked: Checked, links: Sequence[Link | Connection],
                  documents: Mapping[str, Document]) -> dict[str, str]:
     """The design of a workspace (module docstring), by path relative to the design folder: ``node/<Node>.node.yaml``
     per node of ``checked`` (its NoDL document from ``documents`` by node, when there is one) and
-    ``system/<name>.system.yaml`` with the system model's ``links`` as connections."""
+    ``system/<name>.system.yaml`` with ``links`` (the plan's connections, or the system model's links) as
+    connections."""
     files = {f"node/{n}.node.yaml": _dump(_node_yaml(n, checked, documents.get(n))) for n in checked.nodes}
     system = {"autoware_system_design_format": FORMAT, "name": f"{name}.system", "variables": [],
               "modes": [{"name": "default", "default": True}],

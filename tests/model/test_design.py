@@ -1,0 +1,317 @@
+"""Autoware System Designer designs read and written (docs/nodl.md, "Autoware System Designer"): a small design
+of our own (a lidar driver, a perception module of a filter and a tracker, a planner) imported into a workspace
+whose contracts check and whose NoDL documents agree; a filter's deadline too long for the tracker's timeout
+refuted at the design's field and at the contracts' clauses, with the design that fits as its control and the
+workspace's own deadlines read by ``--check``; an input nobody wires left undecided; export -> import giving the
+same workspace; malformed files each one located line."""
+from __future__ import annotations
+
+import textwrap
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+
+from rclverify.cli.commands import main
+from rclverify.model.nodl.design import read_design
+from rclverify.model.nodl.design_write import duration
+
+HEAD = "autoware_system_design_format: 0.3.0\n"
+NODES = {
+    "node/LidarDriver.node.yaml": """\
+        name: LidarDriver.node
+        package: {name: rover_sensing, provider: test}
+        launch: {plugin: rover::LidarDriver}
+        subscribers: []
+        publishers:
+          - name: points
+            message_type: sensor_msgs/msg/PointCloud2
+            qos: {reliability: best_effort, durability: volatile}
+        param_files: []
+        param_values: []
+        processes:
+          - name: scan
+            trigger_conditions:
+              - periodic: 10.0
+                timeout: 0.2
+            outcomes:
+              - to_output: points
+        """,
+    "node/Filter.node.yaml": """\
+        name: Filter.node
+        package: {name: rover_perception, provider: test}
+        launch: {plugin: rover::Filter}
+        subscribers:
+          - name: points
+            message_type: sensor_msgs/msg/PointCloud2
+            qos: {reliability: best_effort}
+        publishers:
+          - name: objects
+            message_type: rover_msgs/msg/Objects
+        param_files: []
+        param_values: []
+        processes:
+          - name: filter
+            trigger_conditions:
+              - on_input: points
+                timeout: FILTER_TIMEOUT
+            outcomes:
+              - to_output: objects
+        """,
+    "node/Tracker.node.yaml": """\
+        name: Tracker.node
+        package: {name: rover_perception, provider: test}
+        launch: {plugin: rover::Tracker}
+        subscribers:
+          - name: objects
+            message_type: rover_msgs/msg/Objects
+        publishers:
+          - name: tracks
+            message_type: rover_msgs/msg/Tracks
+            qos: {reliability: reliable, durability: transient_local}
+        servers:
+          - name: reset
+            message_type: std_srvs/srv/Trigger
+        param_files: []
+        param_values: []
+        processes:
+          - name: update
+            trigger_conditions:
+              - on_input: objects
+                timeout: 0.3
+                error_rate: 4
+            outcomes:
+              - to_trigger: publish
+          - name: publish
+            trigger_conditions:
+              - on_trigger: update
+            outcomes:
+              - to_output: tracks
+        """,
+    "node/Planner.node.yaml": """\
+        name: Planner.node
+        package: {name: rover_planning, provider: test}
+        launch: {plugin: rover::Planner}
+        subscribers:
+          - name: tracks
+            message_type: rover_msgs/msg/Tracks
+            qos: {reliability: reliable, durability: transient_local}
+          - name: goal
+            message_type: geometry_msgs/msg/PoseStamped
+        publishers:
+          - name: path
+            message_type: nav_msgs/msg/Path
+        clients:
+          - name: reset
+            message_type: std_srvs/srv/Trigger
+        param_files: []
+        param_values: []
+        processes:
+          - name: plan
+            trigger_conditions:
+              - and:
+                  - on_input: tracks
+                    timeout: 0.6
+                  - once: tracks
+            outcomes:
+              - to_output: path
+          - name: replan
+            trigger_conditions:
+              - on_input: goal
+                timeout: 1.0
+            outcomes:
+              - to_output: path
+        """,
+    "module/Perception.module.yaml": """\
+        name: Perception.module
+        instances:
+          - name: filter
+            entity: Filter.node
+          - name: tracker
+            entity: Tracker.node
+        subscribers:
+          - name: points
+        publishers:
+          - name: objects
+        servers:
+          - name: reset
+        connections:
+          - - subscriber.points
+            - filter.subscriber.points
+          - - filter.publisher.objects
+            - tracker.subscriber.objects
+          - - tracker.publisher.tracks
+            - publisher.objects
+          - - tracker.server.reset
+            - server.reset
+        """,
+    "system/Rover.system.yaml": """\
+        name: Rover.system
+        modes:
+          - name: default
+            default: true
+        components:
+          - name: lidar
+            entity: LidarDriver.node
+            path: /sensing/lidar
+          - name: perception
+            entity: Perception.module
+            path: /perception
+          - name: planner
+            entity: Planner.node
+        connections:
+          - - perception.subscriber.points
+            - lidar.publisher.points
+          - - perception.publisher.objects
+            - planner.subscriber.tracks
+          - - planner.client.reset
+            - perception.server.reset
+        """,
+}
+
+
+def _design(root: Path, filter_timeout: str = "0.15", edit: dict[str, tuple[str, str]] | None = None) -> Path:
+    for rel, text in NODES.items():
+        body = HEAD + textwrap.dedent(text).replace("FILTER_TIMEOUT", filter_timeout)
+        if edit and rel in edit:
+            body = body.replace(*edit[rel])
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_text(body, encoding="utf-8")
+    return root
+
+
+def _files(root: Path) -> dict[str, str]:
+    return {p.relative_to(root).as_posix(): p.read_text(encoding="utf-8") for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def _at(path: Path, text: str, nth: int = 1) -> str:
+    """``file:line:col`` of the ``nth`` line of ``path`` holding ``text``, as the messages show it."""
+    hits = [(i, ln.index(text) + 1) for i, ln in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if text in ln]
+    line, col = hits[nth - 1]
+    return f"{line}:{col}"
+
+
+def test_a_design_is_flattened_into_nodes_and_wires_through_module_boundaries(tmp_path: Path) -> None:
+    d = read_design(_design(tmp_path / "design"))
+    assert list(d.nodes) == ["lidar", "perception_filter", "perception_tracker", "planner"]
+    wires = {(w.writer, w.writer_port, w.reader, w.reader_port, w.role) for w in d.wires}
+    assert wires == {("lidar", "points", "perception_filter", "points", "publisher"),
+                     ("perception_filter", "objects", "perception_tracker", "objects", "publisher"),
+                     ("perception_tracker", "tracks", "planner", "tracks", "publisher"),  # through the module's boundary
+                     ("perception_tracker", "reset", "planner", "reset", "server")}
+    assert d.nodes["planner"].topics[("subscriber", "tracks")] == "/perception/tracker/tracks"
+    assert d.nodes["planner"].topics[("subscriber", "goal")] == "/planner/goal"  # wired to nothing: its own name
+    assert d.nodes["perception_filter"].topics[("subscriber", "points")] == "/sensing/lidar/points"
+
+
+def test_import_writes_a_workspace_that_checks_and_decides_each_monitoring_field(tmp_path: Path, capsys,
+                                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    _design(tmp_path / "design")
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 0
+    out, err = capsys.readouterr()
+    rcl = (tmp_path / "ws/contracts/design.rcl").read_text(encoding="utf-8")
+    assert "guarantee( out.objects == out.objects ) triggered by in.points within 150 ms" in rcl
+    assert "guarantee( out.tracks == out.tracks ) triggered by in.objects within 300 ms" in rcl  # via to_trigger
+    assert "periodic( out.points, 100 ms )" in rcl and "triggered by in.goal within 1000 ms" in rcl
+    plan = (tmp_path / "ws/contracts/plan.yaml").read_text(encoding="utf-8")
+    assert "{from: perception_tracker.tracks, to: planner.tracks}" in plan
+    assert "node perception_tracker: in.objects's timeout holds: the contracts let it wait at most 250 ms <= 300 ms" in out
+    assert "node planner: in.tracks's timeout holds: the contracts let it wait at most 550 ms <= 600 ms" in out
+    # the goal comes from outside the design: nothing bounds its gaps, which is said, not passed
+    assert "planner process replan's in.goal: timeout 1 s is not decided: planner.in.goal has no producer" in err
+    assert "[design-undecided]" in err and "Traceback" not in err
+    # the workspace written checks, and its NoDL documents agree with each other and its contracts
+    monkeypatch.chdir(tmp_path / "ws")
+    assert main(["check", "contracts/design.rcl"]) == 0
+    assert main(["nodl", "check", "nodl", "--external", "/planner/goal"]) == 0
+    assert main(["nodl", "check"]) == 0  # the services are in the documents only: warnings (nodl-extra)
+    # nothing is overwritten without --force
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 1
+    assert "exists; nothing is overwritten unless --force" in capsys.readouterr().err
+
+
+def test_a_deadline_the_next_timeout_cannot_meet_is_refuted_at_the_design_and_the_contracts(
+        tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    _design(tmp_path / "design", filter_timeout="0.25")
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 1
+    err = capsys.readouterr().err
+    tracker, rcl = tmp_path / "design/node/Tracker.node.yaml", tmp_path / "ws/contracts/design.rcl"
+    line, col = _at(tracker, "timeout: 0.3").split(":")
+    timeout_at = f"design/node/Tracker.node.yaml:{line}:{int(col) + len('timeout: ')}"  # the value
+    periodic_at = f"contracts/design.rcl:{_at(rcl, 'periodic( out.points')}"
+    filter_at = f"contracts/design.rcl:{_at(rcl, 'triggered by in.points').split(':')[0]}:3"  # the guarantee
+    refuted = [ln for ln in err.splitlines() if ln.startswith(timeout_at)]
+    assert len(refuted) == 1 and "[design-timeout]" in refuted[0], err
+    assert "timeout 0.3 s cannot be met: the contracts let it wait 350 ms > 300 ms" in refuted[0]
+    assert f"(also at {periodic_at}, {filter_at})" in refuted[0]  # the chain's two clauses, in the contract
+    assert any(ln.startswith(periodic_at) and "[design-timeout]" in ln for ln in err.splitlines())
+    assert "error_rate 4 Hz cannot be met: the contracts let it wait 350 ms > 250 ms" in err
+    # the control: the design whose filter answers within 150 ms holds, checked against this workspace as it
+    # stands (--check reads the contracts' deadlines: still 250 ms here, so still refuted) ...
+    _design(tmp_path / "fits")
+    assert main(["import", "autoware-design", "fits", "--check", "-w", "ws"]) == 1
+    capsys.readouterr()
+    # ... and once the contract's deadline is the design's 150 ms, nothing is refuted
+    rcl.write_text(rcl.read_text(encoding="utf-8").replace("in.points within 250 ms", "in.points within 150 ms"),
+                   encoding="utf-8")
+    assert main(["import", "autoware-design", "fits", "--check", "-w", "ws"]) == 0
+    out = capsys.readouterr().out
+    assert "in.objects's error_rate holds: the contracts let it wait at most 250 ms <= 250 ms" in out
+
+
+def test_export_then_import_gives_the_same_workspace(tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    _design(tmp_path / "design")
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws1"]) == 0
+    assert main(["export", "autoware-design", "-w", "ws1", "-o", "exported"]) == 0
+    exported = read_design(tmp_path / "exported")
+    assert list(exported.nodes) == ["lidar", "perception_filter", "perception_tracker", "planner"]
+    assert main(["import", "autoware-design", "exported", "-o", "ws2"]) == 0
+    assert _files(tmp_path / "ws1") == _files(tmp_path / "ws2")
+    # the control: an edited contract is carried by the export, so the round trip is not vacuous
+    rcl = tmp_path / "ws1/contracts/design.rcl"
+    rcl.write_text(rcl.read_text(encoding="utf-8").replace("within 150 ms", "within 100 ms"), encoding="utf-8")
+    assert main(["export", "autoware-design", "-w", "ws1", "-o", "exported", "--force"]) == 0
+    assert "timeout: 0.1" in (tmp_path / "exported/node/perception_filter.node.yaml").read_text(encoding="utf-8")
+    assert main(["import", "autoware-design", "exported", "-o", "ws2", "--force"]) == 0
+    assert _files(tmp_path / "ws1") == _files(tmp_path / "ws2")
+    assert "in.points within 100 ms" in (tmp_path / "ws2/contracts/design.rcl").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize(("rel", "old", "new", "where", "says"), [
+    ("node/Filter.node.yaml", "format: 0.3.0", "format: 1.0.0", "1:32", "autoware_system_design_format 1.0.0: read are"),
+    ("node/Filter.node.yaml", "name: Filter.node", "name: Filtre.node", "2:7", "a node file's name is its file name"),
+    ("module/Perception.module.yaml", "entity: Tracker.node", "entity: Tracer.node", "7:13", "entity 'Tracer.node' is no"),
+    ("module/Perception.module.yaml", "- filter.subscriber.points", "- filter.subscriber.cloud", "15:5",
+     "perception/filter has no subscriber 'cloud'"),
+    ("node/Filter.node.yaml", "on_input: points", "on_input: cloud", "17:19", "on_input 'cloud' names no subscriber"),
+    ("node/Filter.node.yaml", "timeout: 0.15", "timeout: -1", "18:18", "timeout is a positive number (s)"),
+    ("system/Rover.system.yaml", "- lidar.publisher.points", "- lidar.points", "17:7", "'lidar.points' is no port path"),
+    ("node/Tracker.node.yaml", "  - name: tracks\n", "  - name: [tracks\n", "10:17", "not YAML"),
+])
+def test_a_malformed_design_is_one_located_line(tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch,
+                                                rel: str, old: str, new: str, where: str, says: str) -> None:
+    _design(tmp_path / "design", edit={rel: (old, new)})
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"design/{rel}:{where}: error: ") and says in err, err
+    assert "Traceback" not in err and not (tmp_path / "ws").exists()
+
+
+def test_usage_errors_exit_2(tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    _design(tmp_path / "design")
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design"]) == 2  # neither -o nor --check
+    assert main(["import", "autoware-design", "missing", "-o", "ws"]) == 2
+    assert main(["export", "autoware-design"]) == 2  # no -o
+    assert "Traceback" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("s", "text"), [(Fraction(1, 10), "100 ms"), (Fraction(3, 10000), "300 us"),
+                                         (Fraction(10, 33), "303030303 ns")])
+def test_durations_are_written_exactly_where_a_unit_allows(s: Fraction, text: str) -> None:
+    assert duration(s) == text
