@@ -229,10 +229,11 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
     deadlines = _deadlines(data, loc, plan_rel)
     states = read_state(data, locs, blocks, plan_rel)
-    from rclverify.model.plan.fret.requirements import plan_additions  # deferred: start-up (only FRET's reads)
-    fret_reqs, fret_states = plan_additions(root, data, contracts)  # requirements_from: {fret: ...} (docs/requirements.md)
-    reqs += fret_reqs
-    states += fret_states
+    if (data.get("requirements_from") or {}).get("fret"):  # a FRET export's requirements (docs/requirements.md)
+        from rclverify.model.plan.fret.requirements import plan_additions  # deferred: optional or conditional (inside a block)
+        fret_reqs, fret_states = plan_additions(root, data, contracts)
+        reqs += fret_reqs
+        states += fret_states
     node_instances, wrong = read_instances(data.get("instances"), locs, plan_rel)
     if wrong:
         raise PlanError([d for l, msg in wrong for d in plan_error(l.file, l.line, l.col, msg, "E-instances").diagnostics])
