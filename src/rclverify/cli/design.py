@@ -23,7 +23,8 @@ FORMATS = ("autoware-design",)
 
 def add_import(sub: Any) -> None:
     """Add the ``import`` command with its ``autoware-design`` subcommand."""
-    g = sub.add_parser("import", help="read another tool's files into a workspace: autoware-design (docs/nodl.md)",
+    g = sub.add_parser("import", help="read another tool's files into a workspace: autoware-design (docs/nodl.md), "
+                                      "fret (docs/requirements.md)",
                        description="Read another tool's design files into a workspace (docs/nodl.md)")
     gs = g.add_subparsers(dest="import_format", required=True)
     a = gs.add_parser("autoware-design", help="an Autoware System Designer design folder (*.node.yaml, "
@@ -37,6 +38,8 @@ def add_import(sub: Any) -> None:
     a.add_argument("--system", metavar="NAME", help="the system to flatten when the folder holds several")
     a.add_argument("--force", action="store_true", help="overwrite files that exist (default: refuse)")
     a.set_defaults(fn=cmd_import)
+    from rclverify.cli.fret import add_fret  # deferred: start-up (loads rclverify.cli.fret only when called)
+    add_fret(gs)  # rclverify import fret EXPORT.json (docs/requirements.md, "Requirements from FRET")
 
 
 def add_export_format(p: argparse.ArgumentParser) -> None:
