@@ -1,0 +1,178 @@
+"""Managed (lifecycle) nodes judged by their state (docs/monitors.md, "Lifecycle nodes").
+
+A managed node (ROS 2 design, "Managed nodes"; ``rclcpp_lifecycle``, ``rclpy.lifecycle``)
+publishes each transition it completes on ``<node>/transition_event``
+(``lifecycle_msgs/msg/TransitionEvent``: ``timestamp`` in ns of the node's clock, ``transition``,
+``start_state``, ``goal_state``, each state an ``id`` and a ``label``).  Its contract's guarantees
+hold only while it is ``active``:
+
+* a managed node is ``unconfigured`` until its first transition event (every managed node starts
+  so); its state then is the ``goal_state`` of its latest event, in force from the event's
+  ``timestamp`` (the node's clock, seconds: on one machine the clock the monitor receives by);
+* an **input** heard while every monitored node reading it is managed and not ``active`` (the
+  latest event heard) is no question: it is held back from the guarantees' judge and counted;
+* an **output** of a managed node published outside ``active`` violates the lifecycle contract:
+  it is judged against the node's state at its receipt time less :attr:`LifecycleGate.skew`
+  (a message published just before a deactivation is not red), once :attr:`LifecycleGate.settle`
+  seconds have passed after its receipt (so a transition event heard after the output, on its own
+  topic, still counts), and at the end of the run for the rest.  Each violation names the node,
+  the topic, the time and the state;
+* the transition events themselves are the gate's: the guarantees' judge never sees them.
+
+:class:`LifecycleGate` is the gate a live run (:class:`rclverify.runtime.live.LiveRun`,
+``gate``) asks for every message before its judge; its :meth:`~LifecycleGate.record` is the
+run's ``lifecycle`` record.
+"""
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass, field
+from typing import Any, Mapping, Sequence
+
+from rclverify.lang.types import CheckedNode
+
+#: The message type a managed node publishes its transitions in.
+TRANSITION_TYPE = "lifecycle_msgs/msg/TransitionEvent"
+#: lifecycle_msgs/msg/State's ids: the primary states and the transition states.
+STATES = {0: "unknown", 1: "unconfigured", 2: "inactive", 3: "active", 4: "finalized", 10: "configuring",
+          11: "cleaningup", 12: "shuttingdown", 13: "activating", 14: "deactivating", 15: "errorprocessing"}
+ACTIVE = 3
+
+
+def event_topic(fqn: str) -> str:
+    """The topic a managed node of fully qualified name ``fqn`` publishes its transitions on, as the
+    judge keys topics (no leading ``/``): ``/r1/battery`` -> ``r1/battery/transition_event``."""
+    return f"{fqn.strip('/')}/transition_event"
+
+
+def _get(fields: Mapping[str, object], *path: str) -> object:
+    """A field of a message read nested (``{"goal_state": {"id": 3}}``) or flattened as the log
+    writes it (``{"goal_state.id": 3}``)."""
+    flat = fields.get(".".join(path))
+    if flat is not None:
+        return flat
+    cur: object = fields
+    for p in path:
+        cur = cur.get(p) if isinstance(cur, Mapping) else None
+    return cur
+
+
+@dataclass
+class _Managed:
+    """One managed node: its contract's name, its topics (judge keys), its states over time."""
+
+    node: str
+    fqn: str
+    outputs: set[str]
+    inputs: set[str]
+    times: list[float] = field(default_factory=lambda: [float("-inf")])
+    states: list[int] = field(default_factory=lambda: [1])
+    transitions: int = 0
+    judged: int = 0
+
+    def state_at(self, t: float) -> int:
+        return self.states[bisect.bisect_right(self.times, t) - 1]
+
+    def now(self) -> int:
+        return self.states[-1]
+
+
+class LifecycleGate:
+    """The lifecycle gate of a live run (module docstring).
+
+    ``managed`` maps each managed node's contract name to its fully qualified ROS name; ``nodes``
+    are the monitored nodes (their topics say which topics are a node's inputs and outputs).
+    ``skew`` and ``settle`` in seconds.  Raises :class:`ValueError` for a managed node that is
+    not monitored.  Not thread safe: the live run calls it under its lock.
+    """
+
+    def __init__(self, managed: Mapping[str, str], nodes: Sequence[CheckedNode], *, skew: float = 0.05,
+                 settle: float = 0.5) -> None:
+        by_name = {n.name: n for n in nodes}
+        unknown = sorted(set(managed) - set(by_name))
+        if unknown:
+            raise ValueError(f"managed node {unknown[0]!r} is not monitored (nodes: {', '.join(by_name)})")
+        self.skew, self.settle = skew, settle
+        self.managed: dict[str, _Managed] = {}
+        self.readers: dict[str, list[str]] = {}  # input topic -> every monitored node reading it
+        for n in nodes:
+            for t in n.node.topics:
+                if t.match is not None and (t.match.prefix == "in" or (t.match.prefix is None and t.match.name in n.inputs)):
+                    self.readers.setdefault(t.key, []).append(n.name)
+        for name, fqn in managed.items():
+            n = by_name[name]
+            outs = {t.key for t in n.node.topics if t.match is not None
+                    and (t.match.prefix == "out" or (t.match.prefix is None and t.match.name not in n.inputs))}
+            ins = {t.key for t in n.node.topics if name in self.readers.get(t.key, ())}
+            self.managed[name] = _Managed(name, fqn, outs, ins)
+        self.events = {event_topic(m.fqn): m for m in self.managed.values()}
+        self.pending: list[tuple[float, str, _Managed]] = []  # (received, topic, node): outputs not yet decided
+        self.violations: list[dict[str, Any]] = []
+        self.outputs_judged = 0
+        self.not_questions: dict[str, int] = {}
+
+    def topics(self) -> dict[str, str]:
+        """The transition topics to read (judge keys) and their message type."""
+        return {t: TRANSITION_TYPE for t in self.events}
+
+    def admit(self, topic: str, fields: Mapping[str, object], received: float) -> bool:
+        """Whether the message goes on to the guarantees' judge (module docstring); a transition
+        event updates its node's state and is the gate's; outputs older than ``settle`` are decided."""
+        self._decide(received - self.settle)
+        m = self.events.get(topic)
+        if m is not None:
+            goal, stamp = _get(fields, "goal_state", "id"), _get(fields, "timestamp")
+            if isinstance(goal, int):
+                at = stamp / 1e9 if isinstance(stamp, (int, float)) and stamp > 0 else received
+                k = bisect.bisect_right(m.times, at)
+                m.times.insert(k, at)
+                m.states.insert(k, goal)
+                m.transitions += 1
+            return False
+        for m in self.managed.values():
+            if topic in m.outputs:
+                self.pending.append((received, topic, m))
+        readers = self.readers.get(topic)
+        if readers and all(r in self.managed and self.managed[r].now() != ACTIVE for r in readers):
+            self.not_questions[topic] = self.not_questions.get(topic, 0) + 1
+            return False
+        return True
+
+    def _decide(self, before: float) -> None:
+        keep = []
+        for received, topic, m in self.pending:
+            if received > before:
+                keep.append((received, topic, m))
+                continue
+            self.outputs_judged += 1
+            m.judged += 1
+            state = m.state_at(received - self.skew)
+            if state != ACTIVE:
+                self.violations.append({"node": m.node, "ros_node": m.fqn, "topic": topic, "time": received,
+                                        "state": STATES.get(state, str(state)),
+                                        "reason": f"{m.fqn} published on /{topic} while {STATES.get(state, state)}, "
+                                                  f"not active: its guarantees hold only while active"})
+        self.pending = keep
+
+    def state(self, node: str) -> str:
+        """The latest state heard of managed node ``node`` (its contract's name), in words."""
+        s = self.managed[node].now()
+        return STATES.get(s, str(s))
+
+    def record(self) -> dict[str, Any]:
+        """Every pending output decided; the run's ``lifecycle`` record: per managed node its latest
+        state, transitions heard, outputs judged and violations, its ``status`` ``failed`` with a
+        violation, ``inconclusive`` with no output heard (silence is not green), else
+        ``discharged``; and the inputs held back as no question, per topic."""
+        self._decide(float("inf"))
+        nodes = []
+        for m in self.managed.values():
+            mine = [v for v in self.violations if v["node"] == m.node]
+            nodes.append({"node": m.node, "ros_node": m.fqn, "state": self.state(m.node),
+                          "transitions": m.transitions, "outputs_judged": m.judged, "violations": mine,
+                          "status": "failed" if mine else "discharged" if m.judged else "inconclusive"})
+        return {"outputs_judged": self.outputs_judged, "not_questions": dict(sorted(self.not_questions.items())),
+                "nodes": nodes}
+
+
+__all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITION_TYPE", "event_topic"]
