@@ -52,6 +52,7 @@ from rclverify.backends.monitors.check import NodeResult, Verdict
 from rclverify.backends.monitors.deadline_records import DeadlineVerdict
 from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
 from rclverify.backends.monitors.run_origin import unseen_links
+from rclverify.runtime.lifecycle import LifecycleGate
 from rclverify.runtime.live_status import LowMargins, least_margins, running_bound
 from rclverify.runtime.logchecks import LogChecks
 from rclverify.runtime.shapes import LiveCounts, SilenceNote
@@ -117,6 +118,8 @@ class LiveRun:
         self.orphans: dict[str, int] = {}
         self.results: list[NodeResult] | None = None
         self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
+        #: what every message passes before the judge: managed nodes' states (lifecycle.py), or ``None``
+        self.gate: LifecycleGate | None = None
 
     # -- engine callbacks (called under the lock) ----------------------------------
     def _event(self, ev: Event) -> None:
@@ -157,7 +160,7 @@ class LiveRun:
     def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
         """One message from the middleware (receipt time in seconds)."""
         with self.lock:
-            if self.results is None:
+            if self.results is None and (self.gate is None or self.gate.admit(topic, fields, received)):
                 self.engine.push(topic, fields, received)
 
     def due(self) -> float:
@@ -239,6 +242,8 @@ class LiveRun:
                   "max_late_s": round(self.engine.max_late_s, 6), "other_clocks": self.engine.clock_lines(),
                   "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
                   "silent_topics": self.silences, "nodes": nodes, **self.checks.record(self.log_path.name)}
+        if self.gate is not None:
+            record["lifecycle"] = self.gate.record()
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         return record
