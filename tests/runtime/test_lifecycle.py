@@ -1,0 +1,108 @@
+"""Managed nodes judged by their lifecycle state (runtime/lifecycle.py, docs/monitors.md "Lifecycle nodes"),
+in process through the live run's gate: an output published outside ``active`` is a violation of the
+lifecycle contract, an input heard while the node is not active is no question, a transition event heard
+after an output still decides it; each with its control.  tests/runtime/test_lifecycle_live.py holds the
+same against a real rclpy LifecycleNode."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.lang.parser import parse_text
+from rclverify.lang.typecheck import check
+from rclverify.runtime.lifecycle import LifecycleGate, event_topic
+from rclverify.runtime.live import LiveRun
+
+RCL = """\
+node Battery {
+  inputs( request : REAL )
+  outputs( level : REAL )
+  topics( std_msgs/Float64 request matches(in.request), std_msgs/Float64 level matches(out.level) )
+  assume( in.request >= 0 )
+  guarantee( out.level >= in.request )
+}
+"""
+EVENTS = event_topic("/battery")
+
+
+def _event(goal: int, at: float) -> dict[str, Any]:
+    """lifecycle_msgs/msg/TransitionEvent as the DDS reader decodes it (nested; timestamp in ns)."""
+    return {"timestamp": int(at * 1e9), "transition": {"id": 0, "label": ""}, "start_state": {"id": 0, "label": ""},
+            "goal_state": {"id": goal, "label": ""}}
+
+
+def _run(tmp: Path, script: list[tuple[float, str, Any]], gated: bool = True, horizon: float = 1.0) -> dict[str, Any]:
+    checked = check([parse_text(RCL, "sys.rcl")])
+    cfg = load_mapping(tmp, None, horizon)
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp / f"{len(script)}{gated}.jsonl",
+                   reorder_window=0.0)
+    if gated:
+        live.gate = LifecycleGate({"Battery": "/battery"}, live.nodes)
+    for t, topic, v in script:
+        live.tick(t)
+        live.push(topic, _event(v, t) if topic == EVENTS else {"data": v}, t)
+    live.tick(script[-1][0] + 2)
+    return live.stop()
+
+
+#: configured at 1 s (inactive), active from 2 s to 3 s, inactive after
+LIFE = [(1.0, EVENTS, 10), (1.0, EVENTS, 2), (2.0, EVENTS, 13), (2.0, EVENTS, 3), (3.0, EVENTS, 14), (3.0, EVENTS, 2)]
+
+
+def _merged(*parts: list[tuple[float, str, Any]]) -> list[tuple[float, str, Any]]:
+    return sorted((x for p in parts for x in p), key=lambda x: x[0])
+
+
+def test_an_output_outside_active_is_red_and_inside_is_not(tmp_path: Path) -> None:
+    quiet = [(2.2, "request", 1.0), (2.3, "level", 5.0)]
+    rec = _run(tmp_path, _merged(LIFE, quiet, [(1.5, "level", 5.0), (3.5, "level", 5.0)]))
+    [node] = rec["lifecycle"]["nodes"]
+    assert node["status"] == "failed" and node["outputs_judged"] == 3 and node["transitions"] == 6
+    assert [(v["time"], v["state"]) for v in node["violations"]] == [(1.5, "inactive"), (3.5, "inactive")]
+    assert "/battery published on /level while inactive" in node["violations"][0]["reason"]
+    # control: the node publishes only while active
+    ok = _run(tmp_path, _merged(LIFE, quiet))["lifecycle"]["nodes"][0]
+    assert ok["status"] == "discharged" and ok["outputs_judged"] == 1 and ok["violations"] == []
+
+
+def test_before_its_first_transition_a_managed_node_is_unconfigured(tmp_path: Path) -> None:
+    [node] = _run(tmp_path, [(0.5, "level", 5.0), (1.0, EVENTS, 10)])["lifecycle"]["nodes"]
+    assert [v["state"] for v in node["violations"]] == ["unconfigured"]
+
+
+def test_an_input_while_inactive_is_no_question(tmp_path: Path) -> None:
+    # a request of 1 while active, answered by 5; one of 9 after the deactivation, answered by nothing
+    script = _merged(LIFE, [(2.2, "request", 1.0), (2.3, "level", 5.0), (3.5, "request", 9.0)])
+    rec = _run(tmp_path, script, horizon=0.5)
+    assert rec["lifecycle"]["not_questions"] == {"request": 1}
+    [res] = rec["nodes"]
+    assert res["status"] == "discharged" and res["counts"]["satisfied"] == 1, res["counts"]
+    assert res["counts"]["inconclusive"] == 0, res["counts"]
+    # control: without the gate the inactive node's request is a question, unanswered: not green
+    [plain] = _run(tmp_path, script, gated=False, horizon=0.5)["nodes"]
+    assert plain["status"] == "inconclusive" and plain["counts"]["inconclusive"] == 1, plain["counts"]
+
+
+def test_a_transition_heard_after_the_output_still_decides_it(tmp_path: Path) -> None:
+    # activated at 2.0 (stamped so), the event heard at 2.1, the output at 2.08: within settle, not red
+    late = [(1.0, EVENTS, 2), (2.08, "level", 5.0)]
+    gate_run = _merged(late, [(2.1, EVENTS, 3)])
+    checked = check([parse_text(RCL, "sys.rcl")])
+    gate = LifecycleGate({"Battery": "/battery"}, list(checked.nodes.values()))
+    for t, topic, v in gate_run:
+        gate.admit(topic, _event(v, 2.0 if v == 3 else t) if topic == EVENTS else {"data": v}, t)
+    assert gate.record()["nodes"][0]["violations"] == []
+    # control: the same output with the event stamped at its receipt (2.1): red
+    gate = LifecycleGate({"Battery": "/battery"}, list(checked.nodes.values()))
+    for t, topic, v in gate_run:
+        gate.admit(topic, _event(v, t) if topic == EVENTS else {"data": v}, t)
+    assert [v["state"] for v in gate.record()["nodes"][0]["violations"]] == ["inactive"]
+
+
+def test_a_managed_node_that_is_not_monitored_is_refused(tmp_path: Path) -> None:
+    checked = check([parse_text(RCL, "sys.rcl")])
+    with pytest.raises(ValueError, match="managed node 'Batery' is not monitored"):
+        LifecycleGate({"Batery": "/battery"}, list(checked.nodes.values()))
