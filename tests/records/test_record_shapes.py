@@ -17,9 +17,16 @@ report/templates/parts/standards.{html,md}.j2) and a requirement's row
 (:class:`~rclverify.records.requirement_rows.RequirementRow`, ``requirements[]``, rendered by
 report/templates/assurance.{html,md}.j2).  Each check is also run on a definition with a field
 added, and must then fail.  In-process and cheap: no pipeline runs here.
+
+The renderers written in Python (SARIF: report/sarif.py, JUnit: report/junit.py, ``rclverify explain``:
+report/explain.py) are held to the same rule for a finding, an obligation and a problem (:data:`CODE`,
+:data:`CODE_RECORDS`): each field is read by each of them off the decoded row or named in the record
+module's ``INTERNAL_TO[<renderer>]`` with the reason (``"*"``: the renderer shows no row of that record).
+The reads are found in Python's parse tree as the templates' are in jinja2's (:func:`fields_read_code`).
 """
 from __future__ import annotations
 
+import ast as pyast
 import copy
 import typing
 from pathlib import Path
@@ -34,7 +41,7 @@ from _report_schema import SCHEMA
 from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
 from rclverify.records import deadline_rows, lint_rows, margin_rows, node_rows, problem_rows, verdict_rows
-from rclverify.records import derived_rows, side_condition_rows
+from rclverify.records import derived_rows, findings, side_condition_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
@@ -45,6 +52,13 @@ from rclverify.report.render import part_renderer
 from rclverify.report.fragments import FragmentCache
 
 PARTS = Path(__file__).resolve().parents[2] / "src" / "rclverify" / "report" / "templates" / "parts"
+#: The renderers written in Python, by the name the records' ``INTERNAL_TO`` tables give them: their modules.
+CODE: dict[str, tuple[Path, ...]] = {name: tuple(PARTS.parents[1] / f"{m}.py" for m in modules) for name, modules in (
+    ("sarif", ("sarif",)), ("junit", ("junit",)), ("explain", ("explain", "explain_items")))}
+
+
+def _code(renderer: str) -> list[str]:
+    return [p.read_text(encoding="utf-8") for p in CODE[renderer]]
 RENDERERS = ("findings.html.j2", "findings.md.j2")
 
 
@@ -120,12 +134,59 @@ def fields_read(source: str, filter_name: str = "findings") -> set[str]:
     return out
 
 
+def fields_read_code(source: str, record: type[msgspec.Struct]) -> set[str]:
+    """The attributes the Python module ``source`` reads on a name bound to a decoded row of ``record``,
+    found in Python's parse tree, function by function: a parameter or a variable annotated with the
+    class, the target of a ``for`` (or a comprehension) over the record module's ``rows_of`` (under any
+    alias it is imported as), a name assigned ``<Class>.of(...)``.  A name is one name per function: a
+    function that also binds it to something else reads that too (and a read of no field then shows)."""
+    tree = pyast.parse(source)
+    name = record.__name__
+    decoders = {a.asname or a.name for n in pyast.walk(tree) if isinstance(n, pyast.ImportFrom)
+                and n.module == record.__module__ for a in n.names if a.name == "rows_of"}
+
+    def typed(ann: pyast.expr | None) -> bool:
+        return ann is not None and any(isinstance(x, pyast.Name) and x.id == name or isinstance(x, pyast.Constant)
+                                       and isinstance(x.value, str) and name in x.value for x in pyast.walk(ann))
+
+    def decoded(x: pyast.expr) -> bool:
+        f = x.func if isinstance(x, pyast.Call) else None
+        return isinstance(f, pyast.Name) and f.id in decoders or (
+            isinstance(f, pyast.Attribute) and f.attr == "of" and isinstance(f.value, pyast.Name) and f.value.id == name)
+
+    out: set[str] = set()
+    for fn in pyast.walk(tree):
+        if not isinstance(fn, (pyast.FunctionDef, pyast.AsyncFunctionDef)):
+            continue
+        names = {a.arg for a in [*fn.args.args, *fn.args.kwonlyargs] if typed(a.annotation)}
+        for n in pyast.walk(fn):
+            if isinstance(n, pyast.AnnAssign) and isinstance(n.target, pyast.Name) and typed(n.annotation):
+                names.add(n.target.id)
+            elif isinstance(n, (pyast.For, pyast.comprehension)) and isinstance(n.target, pyast.Name) \
+                    and decoded(n.iter):
+                names.add(n.target.id)
+            elif isinstance(n, pyast.Assign) and decoded(n.value):
+                names |= {t.id for t in n.targets if isinstance(t, pyast.Name)}
+        out |= {n.attr for n in pyast.walk(fn) if isinstance(n, pyast.Attribute)
+                and isinstance(n.value, pyast.Name) and n.value.id in names}
+    return out
+
+
 def unaccounted(cls: type[msgspec.Struct], sources: Iterable[str], internal: Mapping[str, str],
-                filter_name: str = "findings") -> list[str]:
+                filter_name: str = "findings", code: type[msgspec.Struct] | None = None) -> list[str]:
     """What breaks the rule for ``cls``: a field no renderer reads and not internal, an internal name
-    that is no field, a field both internal and rendered, a read of a name that is no field."""
+    that is no field, a field both internal and rendered, a read of a name that is no field.  With
+    ``code`` (the record class the renderers decode into), ``sources`` are Python modules read by
+    :func:`fields_read_code`, a call of the class's own method (``to_json``) is no read of a field, and
+    ``internal`` may be ``{"*": why}``: the renderer shows no row of the record, and must read none."""
     fields = set(cls.__struct_fields__)
-    read = set().union(*(fields_read(s, filter_name) for s in sources))
+    if code is None:
+        read = set().union(*(fields_read(s, filter_name) for s in sources))
+    else:
+        read = {k for s in sources for k in fields_read_code(s, code)
+                if k in fields or not callable(getattr(cls, k, None))}
+        if "*" in internal:
+            return [f"{k}: rendered, but the renderer is declared to show no row" for k in sorted(read)]
     out = [f"{k}: neither rendered nor declared internal" for k in sorted(fields - read - set(internal))]
     out += [f"{k}: declared internal but no field" for k in sorted(set(internal) - fields)]
     out += [f"{k}: declared internal but rendered" for k in sorted(set(internal) & read)]
@@ -582,3 +643,93 @@ def test_a_node_section_shows_the_later_passes_fields_only_when_they_are_set() -
         assert "UNSET" not in plain + shown and "out.y" in plain
         for text in ("Confidence 0.25", "limit-label", "strength-kind", "culprit-sentence", "culprit of 1 problem"):
             assert text in shown and text not in plain, (name, text)
+
+
+#: The records the Python renderers show: each one's class and its module's per-renderer tables.
+CODE_RECORDS: dict[str, tuple[type[msgspec.Struct], Mapping[str, Mapping[str, str]]]] = {
+    "findings": (FindingRow, findings.INTERNAL_TO),
+    "obligations": (ObligationRow, obligations.INTERNAL_TO),
+    "problems": (problem_rows.ProblemRow, problem_rows.INTERNAL_TO),
+}
+
+
+@pytest.mark.parametrize("renderer", list(CODE))
+@pytest.mark.parametrize("key", list(CODE_RECORDS))
+def test_every_field_is_shown_by_each_code_renderer_or_internal_to_it(key: str, renderer: str) -> None:
+    cls, tables = CODE_RECORDS[key]
+    assert set(tables) == set(CODE)  # a table for each renderer, none for a renderer that is not there
+    assert unaccounted(cls, _code(renderer), tables[renderer], code=cls) == []
+    assert all(why for why in tables[renderer].values())  # each says why it is not shown
+
+
+class _ProblemWithMargin(problem_rows.ProblemRow, frozen=True, forbid_unknown_fields=True):
+    """The problem row with one field added, as a change to records/problem_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+#: Per renderer, a read of the finding's row put beside one it makes, as a change to the renderer would.
+_FINDING_READ = {"sarif": ('"check": f.check,', '"check": f.check, "m": f.margin_added_here,'),
+                 "junit": ('{"check": f.check,', '{"check": f.check, "m": f.margin_added_here,'),
+                 "explain": ('f"  {f.message}",', 'f"  {f.message}", f.margin_added_here,')}
+
+
+@pytest.mark.parametrize("renderer", list(CODE))
+def test_a_field_added_fails_until_each_code_renderer_shows_it_or_declares_it_internal(renderer: str) -> None:
+    sources = _code(renderer)
+    source = "\n".join(sources)
+    for added, (cls, tables) in ((_WithMargin, CODE_RECORDS["findings"]),
+                                 (_ObligationWithMargin, CODE_RECORDS["obligations"])):
+        internal = tables[renderer]
+        assert unaccounted(added, [source], internal, code=cls) == [
+            "margin_added_here: neither rendered nor declared internal"], (renderer, cls)
+        assert unaccounted(added, [source], {**internal, "margin_added_here": "why"}, code=cls) == []
+    # shown: one more read of the decoded row
+    old, new = _FINDING_READ[renderer]
+    shown = source.replace(old, new, 1)
+    assert shown != source
+    internal = findings.INTERNAL_TO[renderer]
+    assert unaccounted(_WithMargin, [shown], internal, code=FindingRow) == []
+    # a read of a name not bound to a decoded row does not count
+    assert unaccounted(_WithMargin, [source + "\ndef _x(row):\n    return row.margin_added_here\n"], internal,
+                       code=FindingRow) != []
+    # a renderer that shows no problem row needs nothing; one that shows them needs the new field
+    problems = problem_rows.INTERNAL_TO[renderer]
+    assert unaccounted(_ProblemWithMargin, [source], problems, code=problem_rows.ProblemRow) == (
+        [] if "*" in problems else ["margin_added_here: neither rendered nor declared internal"])
+    # and one declared to show none of a record must read none of it
+    assert unaccounted(FindingRow, [source], {"*": "why"}, code=FindingRow) != []
+    # a field declared internal to a renderer that shows it is refused
+    assert unaccounted(FindingRow, [source], {**internal, "check": "x"}, code=FindingRow) == [
+        "check: declared internal but rendered"]
+
+
+def _shown_by_code(renderer: str, row: Mapping[str, Any]) -> str:
+    """The text ``renderer`` writes for a report holding the one finding ``row`` (of node ``N``)."""
+    import xml.etree.ElementTree as ET
+    from rclverify.report import explain, junit, sarif
+    report: Any = {"nodes": [{"name": "N", "source": "a.rcl:1:1", "status": "failed", "guarantees": []}],
+                   "requirements": [], "findings": [row], "side_conditions": [], "obligations": [], "evidence": [],
+                   "pending": []}
+    if renderer == "sarif":
+        return str(sarif._finding_results(report))
+    if renderer == "junit":
+        suite = junit._suite(report["nodes"][0], {"items": {"findings": [row]}, "evidence": {}, "reasons": {}})[0]
+        return ET.tostring(suite, encoding="unicode")
+    return "\n".join(explain.explain(report, str(row["id"])) or [])
+
+
+@pytest.mark.parametrize("renderer", list(CODE))
+def test_each_code_renderer_shows_each_field_of_a_finding_it_reads(renderer: str) -> None:
+    """A finding with every field set to a value of its own: each field's value is in what the renderer
+    writes unless the field is internal to it (then it is not); the same row at status ``ok`` is the control
+    for SARIF, which lists no finding that is ok."""
+    row, shown = _full_row()
+    row = {**row, "status": "problem", "witness": {"out.y": "witness-value"}}
+    shown = {**shown, "witness": "witness-value", "model": "model-value"}
+    # and the same warning not acknowledged, which offers its sha256 to acknowledge it
+    text = _shown_by_code(renderer, row) + _shown_by_code(renderer, {**row, "acknowledged": None})
+    internal = findings.INTERNAL_TO[renderer]
+    assert [k for k, t in shown.items() if k not in internal and t not in text] == []
+    assert [k for k, t in shown.items() if k in internal and len(t) > 4 and t in text] == []
+    if renderer == "sarif":
+        assert _shown_by_code(renderer, {**row, "status": "ok"}) == "[]"

@@ -30,7 +30,9 @@ The rules (docs/decisions.md, "One definition per record"):
   fails when the file and the classes differ.
 * Every field of :class:`FindingRow` is read by a renderer of the report's
   finding rows (report/templates/parts/findings.*.j2) or named in
-  :data:`INTERNAL` with the reason it is not shown; tests/records/test_record_shapes.py
+  :data:`INTERNAL` with the reason it is not shown, and read by each
+  renderer written in Python (SARIF, JUnit, ``rclverify explain``) or named
+  in its table of :data:`INTERNAL_TO`; tests/records/test_record_shapes.py
   fails otherwise.
 """
 from __future__ import annotations
@@ -133,4 +135,32 @@ INTERNAL: dict[str, str] = {
 }
 
 
-__all__ = ["Acknowledged", "FindingRow", "HealthFinding", "INTERNAL", "rows_of"]
+#: For each renderer written in Python rather than a template (``sarif``: report/sarif.py, ``junit``:
+#: report/junit.py, ``explain``: report/explain.py), the fields of :class:`FindingRow` it does not show,
+#: each with the reason; every other field it reads off the decoded row (tests/records/test_record_shapes.py).
+INTERNAL_TO: dict[str, dict[str, str]] = {
+    "sarif": {
+        "duration_s": "a SARIF result carries no timing; the JUnit case and explain show it",
+        "smt2": "the path of a kept query; a SARIF result is located at the RCL text, explain names the query",
+        "witness": "SARIF lists only findings that are not ok, and a witness belongs to a realizable (ok) contract",
+        "witness_smt2": "the query of a witness, which belongs to an ok finding SARIF does not list",
+        "flagged": INTERNAL["flagged"],
+    },
+    "junit": {
+        "node": "the test suite is the node's, named after it",
+        "instances": "a verdict per instance; the case's message and text are the finding's own, explain lists "
+                     "them",
+        "smt2": "the path of a kept query; explain names it",
+        "witness": "the witness of a realizable contract, whose case passes with nothing to say; explain shows it",
+        "witness_smt2": "the query of a witness, whose case passes; explain names it",
+        "flagged": INTERNAL["flagged"],
+        "sha256": "what an acknowledgement binds; a CI reader acknowledges from explain, which prints the line "
+                  "to add to the plan",
+    },
+    "explain": {
+        "flagged": "the text an acknowledgement binds; explain prints its sha256 in the line to add to the plan",
+    },
+}
+
+
+__all__ = ["Acknowledged", "FindingRow", "HealthFinding", "INTERNAL", "INTERNAL_TO", "rows_of"]

@@ -21,7 +21,9 @@ The rules (docs/decisions.md, "One definition per record"):
 * Every field is read by a renderer of the obligations table
   (report/templates/parts/obligations.{html,md}.j2, which decode each row
   with the ``obligation_row`` filter) or named in :data:`INTERNAL` with the
-  reason it is not shown; tests/records/test_record_shapes.py fails otherwise.
+  reason it is not shown, and read by each renderer written in Python
+  (SARIF, JUnit, ``rclverify explain``) or named in its table of
+  :data:`INTERNAL_TO`; tests/records/test_record_shapes.py fails otherwise.
 """
 from __future__ import annotations
 
@@ -61,4 +63,17 @@ def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[ObligationRow]:
 INTERNAL: dict[str, str] = {}
 
 
-__all__ = ["INTERNAL", "ObligationRow", "rows_of"]
+#: For each renderer written in Python rather than a template (``sarif``: report/sarif.py, ``junit``:
+#: report/junit.py, ``explain``: report/explain.py), the fields of :class:`ObligationRow` it does not show,
+#: each with the reason; every other field it reads off the decoded row (tests/records/test_record_shapes.py).
+INTERNAL_TO: dict[str, dict[str, str]] = {
+    "sarif": {},
+    "junit": {
+        "node": "the test suite is the node's, named after it",
+        "instance": "the last part of the obligation's id, which is the test case's name",
+    },
+    "explain": {},
+}
+
+
+__all__ = ["INTERNAL", "INTERNAL_TO", "ObligationRow", "rows_of"]

@@ -28,7 +28,10 @@ The rules (docs/decisions.md, "One definition per record"):
 * Every field of :class:`ProblemRow` is read by the problems table's
   renderers (report/templates/assurance.{html,md}.j2, filter
   ``problem_rows``) or named in :data:`INTERNAL` with the reason it is not
-  shown; tests/records/test_record_shapes.py fails otherwise.
+  shown, and read by each renderer written in Python (``rclverify
+  explain``) or named in its table of :data:`INTERNAL_TO` (SARIF and JUnit
+  show no group, and say so there); tests/records/test_record_shapes.py
+  fails otherwise.
 """
 from __future__ import annotations
 
@@ -114,6 +117,19 @@ INTERNAL: dict[str, str] = {
 }
 
 
+#: For each renderer written in Python rather than a template (``sarif``: report/sarif.py, ``junit``:
+#: report/junit.py, ``explain``: report/explain.py), the fields of :class:`ProblemRow` it does not show, each
+#: with the reason (``"*"``: it shows no problem row at all, so none of its fields); every other field it reads
+#: off the decoded row (tests/records/test_record_shapes.py).
+INTERNAL_TO: dict[str, dict[str, str]] = {
+    "sarif": {"*": "a SARIF result is one item (an obligation, a side condition, a check) at its own place, "
+                   "not a group of them; each result carries the diagnosis that names its culprit"},
+    "junit": {"*": "a JUnit test case is one item (an obligation, a side condition, a check), not a group of "
+                   "them; the problems are the failing cases"},
+    "explain": {"key": INTERNAL["key"]},
+}
+
+
 #: Keys a report written before they existed lacks, with the value such a row is read with: a stored
 #: report of an earlier version still renders (its rows placed nowhere).
 EARLIER: dict[str, Any] = {"where": ""}
@@ -125,4 +141,4 @@ def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[ProblemRow]:
     return decode_rows(ProblemRow, ({**EARLIER, **r} for r in rows))
 
 
-__all__ = ["DiagnosisRow", "EARLIER", "INTERNAL", "ProblemMember", "ProblemRow", "RepairRef", "rows_of"]
+__all__ = ["DiagnosisRow", "EARLIER", "INTERNAL", "INTERNAL_TO", "ProblemMember", "ProblemRow", "RepairRef", "rows_of"]

@@ -12,6 +12,13 @@ assurance argument's elements (``G-system``).  An exact id wins; then the
 same id up to case, ``_`` and the separator between a node and its
 guarantee.  :func:`explain` gives the lines to print, :func:`near_ids` the
 closest ids (``difflib``) when nothing matches.
+
+The report's findings, obligations and problems are decoded into their
+definitions (records/findings.py, records/obligations.py,
+records/problem_rows.py) and printed by :mod:`.explain_items`: each field is
+printed or named in the record's ``INTERNAL_TO["explain"]`` with the reason
+(tests/records/test_record_shapes.py).  A row that does not decode raises
+:class:`msgspec.ValidationError` (a ``ValueError``).
 """
 from __future__ import annotations
 
@@ -19,10 +26,12 @@ import difflib
 import re
 from typing import Any, Iterable, Mapping, Sequence
 
-from rclverify.diagnosis.table import counterexample_table
-from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted, table_lines
+from rclverify.records.findings import rows_of as finding_rows_of
+from rclverify.records.obligations import rows_of as obligation_rows_of
+from rclverify.records.problem_rows import rows_of as problem_rows_of
+from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
+from rclverify.report.explain_items import finding_lines, obligation_lines, problem_lines, side_condition_lines
 from rclverify.records.records import SEVERITY
-from rclverify.report.summary import group_sentence
 
 #: At most this many obligations of one guarantee are listed one a line; more are counted.
 SHOWN_OBLIGATIONS = 6
@@ -81,17 +90,19 @@ class _Index:
         self.diagnoses = {d["id"]: d for d in report.get("diagnoses") or []}
         self.nodes = {n["name"]: n for n in report["nodes"]}
         self.requirements = {r["id"]: r for r in report["requirements"]}
-        self.items: dict[str, tuple[str, Mapping[str, Any]]] = {}
-        for key, kind in (("findings", "health check"), ("side_conditions", "side condition"),
-                          ("obligations", "obligation")):
-            for x in report[key]:
-                self.items[x["id"]] = (kind, x)
+        self.findings = {f.id: f for f in finding_rows_of(report["findings"])}
+        self.sides: dict[str, Mapping[str, Any]] = {str(x["id"]): x for x in report["side_conditions"]}
+        self.obligations = {o.id: o for o in obligation_rows_of(report["obligations"])}
+        self.items: dict[str, str] = {}  # id -> what it is, a later kind's winning as in the report's order
+        for kind, ids in (("health check", self.findings), ("side condition", self.sides),
+                          ("obligation", self.obligations)):
+            self.items.update(dict.fromkeys(ids, kind))
         self.evidence = {e.get("obligation"): e for e in report.get("evidence") or [] if isinstance(e, Mapping)}
-        self.problems = [g for g in report.get("problems") or [] if isinstance(g, Mapping)]
+        self.problems = problem_rows_of(g for g in report.get("problems") or [] if isinstance(g, Mapping))
         g = report.get("grounding") or {}
         self.ros: dict[str, list[Mapping[str, Any]]] = {}
-        for f in g.get("findings") or []:
-            self.ros.setdefault(str(f.get("code", "")), []).append(f)
+        for ros_finding in g.get("findings") or []:
+            self.ros.setdefault(str(ros_finding.get("code", "")), []).append(ros_finding)
         self.lint: dict[str, list[Mapping[str, Any]]] = {}
         for w in report.get("lint") or []:
             self.lint.setdefault(str(w.get("code", "")), []).append(w)
@@ -175,12 +186,7 @@ class _Index:
         m = _PROBLEM.match(wanted.strip())
         if not exact or not m or not 1 <= int(m["k"]) <= len(self.problems):
             return None
-        g = self.problems[int(m["k"]) - 1]
-        culprits = "; ".join(str(c.get("what") or c.get("source") or "") for c in g.get("culprits", [])) or "(no culprit named)"
-        out = [f"problem {m['k']} [{g.get('status')}]: {culprits}", f"  {clause_cut(group_sentence(g))}", "  findings:"]
-        for mem in g.get("members", []):
-            out.append(f"    {mem.get('id')} [{mem.get('status')}] ({mem.get('kind')}): `rclverify explain {mem.get('id')}`")
-        return out
+        return problem_lines(m["k"], self.problems[int(m["k"]) - 1])
 
     def _rule(self, wanted: str, exact: bool) -> list[str] | None:
         key = self._match(wanted, list(dict.fromkeys(list(self.rules) + list(self.results))), exact)
@@ -218,31 +224,13 @@ class _Index:
 
     # -- what is printed ---------------------------------------------------------
     def item_lines(self, key: str) -> list[str]:
-        kind, x = self.items[key]
-        text = x.get("statement") or x.get("conjunct") or x.get("message") or ""
-        out = [f"{key} [{x['status']}] ({kind} of {x['node']}" + (f", {x['source']}" if x.get("source") else "") + ")",
-               f"  {text}"]
+        kind, diagnosed = self.items[key], key in self.diagnoses
+        if kind == "health check":
+            return finding_lines(self.findings[key], diagnosed)
         if kind == "obligation":
-            ev = self.evidence.get(key) or {}
-            out.append(f"  backend: {x.get('backend')}" + (f"; {ev['explanation']}" if ev.get("explanation") else ""))
-        elif x.get("explanation"):
-            out.append(f"  {x['explanation']}")
-        ack = x.get("acknowledged")
-        if ack:  # a warning answered in the plan (model/plan/acknowledged.py)
-            out.append(f"  accepted risk, acknowledged in the plan ({ack['at']}): {ack['reason']}")
-        elif x.get("sha256"):
-            out.append(f"  to accept it, add under acknowledged: in the plan: "
-                       f"{{warning: {key}, sha256: {str(x['sha256'])[:16]}, reason: ...}}")
-        out += [f"  hypothesis: {h}" for h in x.get("hypotheses") or []]
-        out += [f"  core: {c}" for c in x.get("core") or []]
-        if x.get("model"):  # a health check's model when it holds is a witness, otherwise a counterexample
-            label = "witness" if x["status"] in ("discharged", "ok", "warning") else "counterexample"
-            out += [f"  {label}:"] + table_lines(counterexample_table(x["model"], x["node"]), "    ")
-        if kind == "obligation":
-            out += self._violation_ids(key)
-        if x["status"] in ("discharged", "ok", "warning") and key not in self.diagnoses:
-            out.append("  no problem to diagnose")
-        return out
+            return obligation_lines(self.obligations[key], self.evidence.get(key) or {}, self._violation_ids(key),
+                                    diagnosed)
+        return side_condition_lines(key, self.sides[key], diagnosed)
 
     def _violation_ids(self, key: str) -> list[str]:
         """The lines naming every violation a monitored run of obligation ``key`` kept."""
@@ -275,7 +263,7 @@ class _Index:
 
     def guarantee_lines(self, node: str, g: Mapping[str, Any], indent: str = "") -> list[str]:
         k = g["index"]
-        obs = [x for kind, x in self.items.values() if kind == "obligation" and x["node"] == node and x.get("guarantee") == k]
+        obs = [o for o in self.obligations.values() if o.node == node and o.guarantee == k]
         status = "unverified" if not obs and not g.get("obligations") else g["status"]  # no obligation covers it
         if g.get("culprit_of"):  # a problem's culprit reads that problem's status (report/culprits.py)
             status = g["status"]
@@ -284,22 +272,21 @@ class _Index:
         if not obs and not g.get("obligations"):
             out.append(f"{indent}  evidence: none: no evidence entry of the plan covers it (`unverified`; docs/plan.md)")
         if len(obs) <= SHOWN_OBLIGATIONS:
-            out += [f"{indent}  evidence: {o['id']} [{o['status']}] ({o.get('backend')})" for o in obs]
+            out += [f"{indent}  evidence: {o.id} [{o.status}] ({o.backend})" for o in obs]
         else:  # many instances (AJPF's one per waypoint): counted, the bad ones named
             groups: dict[tuple[str, str], int] = {}
             for o in obs:
-                groups[(o["status"], str(o.get("backend")))] = groups.get((o["status"], str(o.get("backend"))), 0) + 1
+                groups[(o.status, o.backend)] = groups.get((o.status, o.backend), 0) + 1
             out.append(f"{indent}  evidence: {len(obs)} obligations: " + ", ".join(
                 f"{n} {st} ({be})" for (st, be), n in sorted(groups.items(), key=lambda kv: -_rank(kv[0][0]))))
-            out += [f"{indent}    {o['id']} [{o['status']}]" for o in obs
-                    if o["status"] not in ("discharged", "pending")]
+            out += [f"{indent}    {o.id} [{o.status}]" for o in obs if o.status not in ("discharged", "pending")]
         supports = [r["id"] for r in self.requirements.values()
                     for s in r.get("support") or [] if s.get("node") == node and s.get("guarantee") == k]
         if supports:
             out.append(f"{indent}  supports: {', '.join(supports)}")
-        for f in self.report["findings"]:
-            if f["node"] == node and f.get("guarantee") == k and f["status"] not in ("ok", "warning"):
-                out.append(f"{indent}  health: {f['id']} [{f['status']}]: {clause_cut(f.get('message', ''), 300)}")
+        for f in self.findings.values():
+            if f.node == node and f.guarantee == k and f.status not in ("ok", "warning"):
+                out.append(f"{indent}  health: {f.id} [{f.status}]: {clause_cut(f.message, 300)}")
         problems = [d for d in natural_sorted(list(self.diagnoses)) if d.startswith(f"{node}.g{k}.")]
         if problems:
             out.append(f"{indent}  problems: {', '.join(problems)} (`rclverify explain ID`)")
@@ -315,20 +302,19 @@ class _Index:
             if vs:
                 out.append(f"  {label}: " + ", ".join(f"{v.get('name')} : {v.get('type')}" for v in vs))
         out += [f"  assumption: {a.get('text')}  ({a.get('source')})" for a in n.get("assumptions") or []]
-        whole = [x for kind, x in self.items.values()
-                 if kind == "obligation" and x["node"] == node and x.get("guarantee") in (0, None)]
-        out += [f"  evidence for the whole contract: {o['id']} [{o['status']}] ({o.get('backend')})" for o in whole]
+        whole = [o for o in self.obligations.values() if o.node == node and o.guarantee == 0]
+        out += [f"  evidence for the whole contract: {o.id} [{o.status}] ({o.backend})" for o in whole]
         for g in n.get("guarantees") or []:
             out += self.guarantee_lines(node, g, "  ")
-        sides = [x for kind, x in self.items.values() if kind == "side condition" and x["node"] == node]
+        sides = [x for x in self.sides.values() if x["node"] == node]
         if sides:
             proved = sum(x["status"] == "discharged" for x in sides)
             out.append(f"  side conditions: {proved}/{len(sides)} proved"
                        + "".join(f"; {x['id']} [{x['status']}]" for x in sides if x["status"] != "discharged"))
-        health = [x for kind, x in self.items.values() if kind == "health check" and x["node"] == node]
-        bad = [x for x in health if x["status"] not in ("ok", "warning")]
+        health = [f for f in self.findings.values() if f.node == node]
+        bad = [f for f in health if f.status not in ("ok", "warning")]
         if health:
-            out.append(f"  health: {len(health) - len(bad)}/{len(health)} ok" + "".join(f"; {x['id']} [{x['status']}]" for x in bad))
+            out.append(f"  health: {len(health) - len(bad)}/{len(health)} ok" + "".join(f"; {f.id} [{f.status}]" for f in bad))
         problems = [d for d in natural_sorted(list(self.diagnoses)) if d.split(".", 1)[0] == node]
         out.append(f"  problems: {', '.join(problems)} (`rclverify explain ID`)" if problems else "  problems: none")
         out += [f"  culprit of a problem [{c['status']}]: {clause_cut(c['sentence'], 300)}"

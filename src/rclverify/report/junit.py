@@ -60,6 +60,7 @@ from rclverify.report.fragments import FragmentCache
 from rclverify.records.sarif import split_location
 from rclverify.report.templating import model_text
 from rclverify.records.findings import rows_of
+from rclverify.records.obligations import rows_of as obligation_rows_of
 from rclverify.records.report_schema import Report
 from rclverify.report.severity import junit_outcome
 from rclverify.report.junit_suite import closed
@@ -249,18 +250,19 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         if bumped:
             counts[bumped] += 1
 
-    for o in items.get("obligations", ()):
-        ev = evidence.get(str(o["id"]))
+    for o in obligation_rows_of(items.get("obligations", ())):
+        ev = evidence.get(o.id)
         secs = ev["duration_s"] if ev is not None else 0.0
-        case = _case(suite, f"{name}.obligation", str(o["id"]), str(o["source"]), secs)
-        expl = str(ev["explanation"]) if ev is not None else reasons.get(str(o["id"]), "no evidence record yet")
+        case = _case(suite, f"{name}.obligation", o.id, o.source, secs)
+        expl = str(ev["explanation"]) if ev is not None else reasons.get(o.id, "no evidence record yet")
         cex = model_text(ev.get("counterexample")) if ev is not None else ""
         if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
-            _properties(props, str(o["id"]), {"strength": ev["strength"]["kind"],
-                                              "strength.detail": ev["strength"].get("detail", "")})
-        tally(case, str(o["status"]), expl.splitlines()[0] if expl else str(o["status"]),
-              _lines(f"obligation ({o['backend']}, {o['kind']}) of guarantee {o['guarantee']}: {o['statement']}",
-                     f"source: {o['source']}", expl, f"counterexample: {cex}" if cex else ""), secs)
+            _properties(props, o.id, {"strength": ev["strength"]["kind"],
+                                      "strength.detail": ev["strength"].get("detail", "")})
+        tally(case, o.status, expl.splitlines()[0] if expl else o.status,
+              _lines(f"obligation ({o.backend}, {o.kind}) of guarantee {o.guarantee}: {o.statement}",
+                     f"source: {o.source}", f"artifact: {o.artifact}" if o.artifact else "", expl,
+                     f"counterexample: {cex}" if cex else ""), secs)
     for sc in items.get("side_conditions", ()):
         case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
         model = model_text(sc.get("model"))
@@ -281,6 +283,7 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
         core = "; ".join(f.core or [])
         model = model_text(f.model)
         ack = f.acknowledged
+        _properties(props, f.id, {"check": f.check, **({"solvers": f.solvers.agreement} if f.solvers else {})})
         tally(case, "acknowledged" if ack else f.status,
               f.message + (f" (acknowledged at {ack.at}: {ack.reason})" if ack else ""),
               _lines(f.message, f.explanation, f"unsat core: {core}" if core else "",

@@ -192,7 +192,10 @@ def _obligation_results(report: Report) -> list[SarifResult]:
         if cex:
             words.append(f"Counterexample: {model_text(cex)}.")
         props: dict[str, object] = {"obligation": o.id, "node": o.node, "guarantee": o.guarantee,
-                                    "backend": o.backend, "status": o.status}
+                                    "backend": o.backend, "kind": o.kind, "status": o.status,
+                                    "artifact": o.artifact}
+        if o.instance:  # the part of the guarantee the obligation covers
+            props["instance"] = o.instance
         if cex:
             props["counterexample"] = dict(cex)
         if ev is not None and ev.strength:  # the evidence's kind (docs/confidence.md)
@@ -304,7 +307,13 @@ def _finding_results(report: Report) -> list[SarifResult]:
             words.append("Unsat core: " + "; ".join(f.core) + ".")
         if f.model:
             words.append(f"Counterexample: {model_text(f.model)}.")
-        props = {"finding": f.id, "node": f.node, "check": f.check, "status": f.status}
+        props: dict[str, object] = {"finding": f.id, "node": f.node, "check": f.check, "status": f.status}
+        if f.instances:  # the verdict per instance of a quantified premise
+            props["instances"] = dict(f.instances)
+        if f.solvers is not None:  # the second solver's agreement (docs/second-solver.md)
+            props["solvers"] = {"agreement": f.solvers.agreement, "why": f.solvers.why}
+        if f.sha256:  # what a plan acknowledgement of this warning binds (docs/plan.md, ``acknowledged``)
+            props["sha256"] = f.sha256
         res = sarif_result(rule, _level("health", f.status), " ".join(words), _finding_location(report, f),
                       f"health:{f.id}", props)
         out.append(_accepted(res, f.acknowledged.reason, f.acknowledged.at) if f.acknowledged else res)

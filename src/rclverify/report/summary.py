@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, Literal, Mapping, Sequence, TypeGuard, TypeVar
+from typing import IO, TYPE_CHECKING, Any, Iterable, Literal, Mapping, Sequence, TypeGuard, TypeVar
 
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
@@ -164,14 +164,18 @@ def _near_miss_lines(report: Report) -> list[str]:
 
 
 def group_sentence(group: Mapping[str, Any]) -> str:
-    """The first sentence of a problem group, whole: the report's row
-    (report/problems.py) cuts it to a length; the terminal cuts it only at
-    a clause boundary (:func:`rclverify.report.diagnosis_text.clause_cut`)."""
+    """The first sentence of a problem group (its JSON object), whole (:func:`whole_sentence`)."""
+    return whole_sentence(str(group.get("sentence", "")), [str(m.get("sentence", "")) for m in group.get("members", [])])
+
+
+def whole_sentence(short: str, members: Iterable[str]) -> str:
+    """The first sentence of a problem group whose row says ``short``, whole, found among its ``members``'
+    sentences: the report's row (report/problems.py) cuts it to a length; the terminal cuts it only at
+    a clause boundary (:func:`rclverify.report.diagnosis_text.clause_cut`).  ``short`` when none has it."""
     from rclverify.report.diagnosis_text import whole_first_sentence  # deferred: start-up (loads rclverify.report.diagnosis_text only when called)
-    short = str(group.get("sentence", ""))
     stem = short[:-4] if short.endswith(" ...") else None
-    for m in group.get("members", []):
-        whole = whole_first_sentence(m.get("sentence", ""))
+    for sentence in members:
+        whole = whole_first_sentence(sentence)
         if whole == short or (stem and whole.startswith(stem)):
             return whole
     return short

@@ -1,0 +1,111 @@
+"""What ``rclverify explain ID`` prints for one item of the report: a
+contract-health finding, an obligation, a side condition of the calculus,
+a problem grouped by root cause (:mod:`.explain` finds the item by its id).
+
+A finding, an obligation and a problem arrive decoded into their one
+definition (records/findings.py :class:`~rclverify.records.findings.FindingRow`,
+records/obligations.py :class:`~rclverify.records.obligations.ObligationRow`,
+records/problem_rows.py :class:`~rclverify.records.problem_rows.ProblemRow`)
+and are read as attributes mypy checks: each field is printed here or named
+in its record module's ``INTERNAL_TO["explain"]`` with the reason it is not
+(tests/records/test_record_shapes.py).  A side condition is still its
+report JSON object.  Each function returns the lines to print, two spaces
+indenting what belongs to the item's first line.
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+from rclverify.diagnosis.table import counterexample_table
+from rclverify.records.findings import Acknowledged, FindingRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.problem_rows import ProblemRow
+from rclverify.report.diagnosis_text import clause_cut, table_lines
+from rclverify.report.summary import whole_sentence
+
+#: The statuses of an item that holds: its model is a witness, and without a diagnosis there is no problem.
+HOLDS = ("discharged", "ok", "warning")
+
+
+def finding_lines(f: FindingRow, diagnosed: bool) -> list[str]:
+    """A health check's finding: every field but those ``INTERNAL_TO["explain"]`` names; ``diagnosed``:
+    whether a diagnosis of it follows (else one that holds says there is no problem to diagnose)."""
+    whom = f"guarantee {f.guarantee}" if f.guarantee is not None else "the whole contract"
+    out = [f"{f.id} [{f.status}] (health check of {f.node})", f"  {f.message}",
+           f"  check: {f.check}, of {whom}" + (f", decided in {f.duration_s:.3g} s" if f.duration_s else "")]
+    if f.explanation:
+        out.append(f"  {f.explanation}")
+    if f.solvers is not None:  # the second solver's agreement (docs/second-solver.md)
+        out.append(f"  second solver: {f.solvers.agreement}: {f.solvers.why}")
+    out += _acknowledgement(f.id, f.acknowledged, f.sha256)
+    out += [f"  core: {c}" for c in f.core or []]
+    out += [f"  instance {k}: {v}" for k, v in sorted((f.instances or {}).items())]
+    out += _model_lines(f.status, f.model, f.node)
+    out += [f"  witness: {k} = {v}" for k, v in sorted((f.witness or {}).items())]
+    out += [f"  {what}: {path}" for what, path in (("query", f.smt2), ("witness query", f.witness_smt2)) if path]
+    return out + _undiagnosed(f.status, diagnosed)
+
+
+def obligation_lines(o: ObligationRow, evidence: Mapping[str, Any], violations: list[str],
+                     diagnosed: bool) -> list[str]:
+    """An obligation with its ``evidence`` record's explanation (``{}`` when none) and ``violations``,
+    the lines naming what a monitored run of it kept; ``diagnosed`` as in :func:`finding_lines`."""
+    whom = f"guarantee {o.guarantee}" if o.guarantee else "the whole contract"
+    out = [f"{o.id} [{o.status}] (obligation of {o.node}" + (f", {o.source}" if o.source else "") + ")",
+           f"  {o.statement}",
+           f"  backend: {o.backend}" + (f"; {evidence['explanation']}" if evidence.get("explanation") else ""),
+           f"  {o.kind} of {whom}" + (f", instance {o.instance}" if o.instance else "")
+           + (f"; rendered to {o.artifact}" if o.artifact else "")]
+    return out + violations + _undiagnosed(o.status, diagnosed)
+
+
+def side_condition_lines(key: str, x: Mapping[str, Any], diagnosed: bool) -> list[str]:
+    """Side condition ``key`` (its report object ``x``): its conjunct, explanation, the upstream premises
+    it assumed and its counterexample; ``diagnosed`` as in :func:`finding_lines`."""
+    out = [f"{key} [{x['status']}] (side condition of {x['node']}"
+           + (f", {x['source']}" if x.get("source") else "") + ")", f"  {x.get('conjunct') or ''}"]
+    if x.get("explanation"):
+        out.append(f"  {x['explanation']}")
+    ack = x.get("acknowledged")
+    out += _acknowledgement(key, Acknowledged(str(ack["reason"]), str(ack["at"])) if ack else None,
+                            str(x.get("sha256") or ""))
+    out += [f"  hypothesis: {h}" for h in x.get("hypotheses") or []]
+    out += [f"  core: {c}" for c in x.get("core") or []]
+    return out + _model_lines(str(x["status"]), x.get("model"), str(x["node"])) + \
+        _undiagnosed(str(x["status"]), diagnosed)
+
+
+def problem_lines(number: str, p: ProblemRow) -> list[str]:
+    """Problem ``number`` (1-based, as ``rclverify status`` numbers them): its culprits, its whole first
+    sentence, where it is, its members and the repairs checked for it."""
+    culprits = "; ".join(str(c.get("what") or c.get("source") or "") for c in p.culprits) or "(no culprit named)"
+    out = [f"problem {number} [{p.status}]: {culprits}",
+           f"  {clause_cut(whole_sentence(p.sentence, [mem.sentence for mem in p.members]))}"]
+    if p.where:
+        out.append(f"  at {p.where}")
+    out.append("  findings:")
+    out += [f"    {mem.id} [{mem.status}] ({mem.kind}): `rclverify explain {mem.id}`" for mem in p.members]
+    out += [f"  repair {r.index + 1} of {r.diagnosis}, checked: `rclverify explain {r.diagnosis}`" for r in p.repairs]
+    return out
+
+
+def _acknowledgement(key: str, ack: Acknowledged | None, sha256: str) -> list[str]:
+    """A warning answered in the plan (model/plan/acknowledged.py), or the line that would answer it."""
+    if ack is not None:
+        return [f"  accepted risk, acknowledged in the plan ({ack.at}): {ack.reason}"]
+    if sha256:
+        return [f"  to accept it, add under acknowledged: in the plan: "
+                f"{{warning: {key}, sha256: {sha256[:16]}, reason: ...}}"]
+    return []
+
+
+def _model_lines(status: str, model: Mapping[str, Any] | None, node: str) -> list[str]:
+    """A model as a table: a witness when the item holds, otherwise a counterexample."""
+    if not model:
+        return []
+    label = "witness" if status in HOLDS else "counterexample"
+    return [f"  {label}:"] + table_lines(counterexample_table(dict(model), node), "    ")
+
+
+def _undiagnosed(status: str, diagnosed: bool) -> list[str]:
+    return ["  no problem to diagnose"] if status in HOLDS and not diagnosed else []
