@@ -102,8 +102,8 @@ def test_each_requirement_becomes_a_plan_requirement_by_reqid(ws: Path, tmp_path
     assert reqs["R-4"].formal is None  # not translated: informal, never dropped
     Workspace(ws, "contracts/plan.yaml").checked  # every imported statement type-checks with the contract
     out = render(res)
-    assert "export.json:R-4: the combination scope null, condition null, timing eventually is not translated; " \
-           "write it as one of:" in out
+    assert "export.json:R-4: the timing eventually with scope null and condition null is not translated; with " \
+           "this scope and condition rclverify translates the timings always, never, immediately, within, for" in out
     assert "3 translated to a decided temporal statement, 1 kept as informal" in out
 
 

@@ -146,9 +146,11 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
         raise Refusal("a trigger inside a mode interval (scope 'in', a condition) is not translated",
                       "write the mode into the condition (whenever M & P ...) or split the requirement")
     if timing not in SUPPORTED.get((scope, cond), ()):
-        known = ", ".join(f"{s}/{c}: {', '.join(t)}" for (s, c), t in SUPPORTED.items())
-        raise Refusal(f"the combination scope {scope}, condition {cond}, timing {timing} is not translated",
-                      f"write it as one of: {known}")
+        here = SUPPORTED.get((scope, cond))
+        raise Refusal(f"the timing {timing} with scope {scope} and condition {cond} is not translated",
+                      f"with this scope and condition rclverify translates the timings {', '.join(here)}" if here
+                      else "rclverify translates the scopes null and in (docs/requirements.md, "
+                           "'Requirements from FRET')")
     states = _States(state_base(reqid))
 
     def pre(type_name: str, init: Expr, e: Expr) -> str:

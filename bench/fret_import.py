@@ -1,0 +1,187 @@
+"""FRET exports imported and decided (issue 113): the figures of docs/requirements.md, "Requirements from FRET".
+
+Reads every ``*.json`` FRET export under DIR (FRET's ``caseStudies/``, for
+instance), imports each with rclverify's importer
+(:mod:`rclverify.model.plan.fret.requirements`) and prints, per export and
+in total: the requirements read, those translated to a decided temporal
+statement, those refused by reason.
+
+With ``--decide`` each export is then decided as a workspace of its own,
+written under a temporary folder (nothing of the export is kept): one
+contract per FRET component whose inputs and outputs are the component's
+FRET ``Input`` and ``Output`` variables (``boolean`` as ``BOOL``, an
+integer type as ``INTEGER``, another number as ``REAL``), ``assume(
+TRUE )``, ``guarantee( TRUE )`` and ``progress( within 0 steps )``, the
+plan reading a copy of the export through ``requirements_from: {fret:
+...}``.  A translated statement that does not type-check with these
+contracts is counted as refused (``type error``) and left out of the copy.
+Then ``rclverify requirements`` (``stage_requirements``) decides each
+one; a contract that guarantees nothing refutes almost every requirement,
+so the figure measures that the statement is decided (a verdict other than
+``inconclusive``), not that it holds.
+
+Usage::
+
+    python bench/fret_import.py DIR            # import figures only
+    python bench/fret_import.py DIR --decide   # and the verdicts (a minute or two)
+"""
+from __future__ import annotations
+
+if __name__ == "__main__":  # run as a script: a Python without the dependencies runs again under .venv/
+    import _venv  # noqa: F401
+
+import argparse
+import collections
+import json
+import re
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+from rclverify.model.plan.errors import PlanError  # noqa: E402
+from rclverify.model.plan.fret.export import FretExport, read_export  # noqa: E402
+from rclverify.model.plan.fret.requirements import Options, import_export  # noqa: E402
+
+#: Words RCL's grammar keeps for itself: a FRET variable so named gets no port in the generated contract.
+RESERVED = {"and", "or", "not", "in", "forall", "exists", "exists_unique", "TRUE", "FALSE", "REAL", "INTEGER",
+            "NATURAL", "BOOL", "STRING", "x", "set", "seq", "node", "context", "inputs", "outputs", "assume",
+            "guarantee", "topics", "abs", "out", "state", "next"}
+INTEGERS = ("integer", "int", "int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64")
+
+
+def reason_kind(reason: str) -> str:
+    """A refusal's reason without its names: the row it is counted in."""
+    for pat, kind in ((r"calls the FRET function (\w+)", r"FRET function \1"),
+                      (r"is an Internal variable defined in Lustre", "Internal variable defined in Lustre"),
+                      (r"is not declared in the export", "identifier not declared in the export"),
+                      (r"declared without an idType", "variable without an idType"),
+                      (r"a trigger inside a mode interval", "a trigger inside a mode interval"),
+                      (r"the timing (\w+) with scope (\w+) and condition (\w+)", r"timing \1 (scope \2, condition \3)"),
+                      (r"does not parse", "FRETish expression rclverify does not parse"),
+                      (r"has no (input|output) named", "variable not a port of the node"),
+                      (r"has not formalised it", "not formalised by FRET")):
+        m = re.search(pat, reason)
+        if m:
+            return m.expand(kind)
+    return reason
+
+
+def _ident(name: str) -> str:
+    out = re.sub(r"[^A-Za-z0-9_]", "_", name) or "Component"
+    return out if out[0].isalpha() else f"C_{out}"
+
+
+def _contracts(exp: FretExport) -> tuple[str, dict[str, str]]:
+    """One contract per component with its FRET Input and Output variables; the component -> node names."""
+    comps = sorted({c for c, _ in exp.variables} | {r.component for r in exp.requirements if r.component})
+    nodes = {c: _ident(c) for c in comps}
+    text = []
+    for c in comps:
+        ports: dict[str, list[str]] = {"Input": [], "Output": []}
+        for (vc, name), v in sorted(exp.variables.items()):
+            if vc == c and v.id_type in ports and name not in RESERVED and re.fullmatch(r"[A-Za-z_]\w*", name):
+                t = "BOOL" if v.data_type == "boolean" else "INTEGER" if v.data_type in INTEGERS else "REAL"
+                ports[v.id_type].append(f"{name} : {t}")
+        text.append(f"node {nodes[c]} {{\n  inputs( {', '.join(ports['Input'])} )\n"
+                    f"  outputs( {', '.join(ports['Output'])} )\n  assume( TRUE )\n  guarantee( TRUE )\n"
+                    f"  progress( within 0 steps )\n}}\n")
+    return "\n".join(text), nodes
+
+
+def exp_refused(exp: FretExport) -> set[str]:
+    """The reqids the import refuses without the contracts."""
+    return {i.fret.reqid for i in import_export(exp, Options()) if i.refusal is not None}
+
+
+def decide(export: Path, exp: FretExport, out: collections.Counter[str]) -> None:
+    """Decide the translated requirements of ``export`` in a workspace of their own (module docstring)."""
+    from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
+    from rclverify.lang.errors import RclError
+    raw = json.loads(export.read_text(encoding="utf-8-sig"))
+    reqs = raw if isinstance(raw, list) else raw["requirements"]
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        contracts, nodes = _contracts(exp)
+        (root / "contracts").mkdir()
+        (root / "fret").mkdir()
+        (root / "contracts" / "sys.rcl").write_text(contracts, encoding="utf-8")
+        (root / "contracts" / "plan.yaml").write_text(
+            "name: bench\ncontracts: [contracts/sys.rcl]\nrequirements_from: {fret: fret/export.json}\n"
+            f"fret:\n  components: {json.dumps(nodes)}\n", encoding="utf-8")
+        dropped: set[str] = set()
+        for _ in range(len(reqs) + 1):
+            kept = [r for r in reqs if r.get("reqid") not in dropped]
+            body = kept if isinstance(raw, list) else {**raw, "requirements": kept}
+            (root / "fret" / "export.json").write_text(json.dumps(body, indent=1), encoding="utf-8")
+            try:
+                Workspace(root, "contracts/plan.yaml").checked
+                break
+            except RclError as exc:
+                lines = {r.loc.line: r.reqid for r in read_export(root / "fret" / "export.json", "x").requirements}
+                bad = {lines[max(k for k in lines if k <= d.loc.line)] for d in exc.diagnostics
+                       if d.loc.file == "fret/export.json" and any(k <= d.loc.line for k in lines)}
+                if not bad:
+                    print(f"  {export.name}: the generated workspace does not check: {exc.diagnostics[0]}")
+                    return
+                for rid in sorted(bad - dropped):
+                    print(f"  {export.name}:{rid}: refused: type error with the generated contracts")
+                out["refused: type error"] += len(bad - dropped)
+                dropped |= bad
+        ws = Workspace(root, "contracts/plan.yaml")
+        from rclverify.model.plan.fret.requirements import options_of, read_fret
+        plan_data = {"fret": {"components": nodes}}
+        for i in read_fret(root, "fret/export.json", options_of(plan_data), ("contracts/sys.rcl",)):
+            if i.refusal is not None and i.fret.reqid not in exp_refused(exp):
+                print(f"  {export.name}:{i.fret.reqid}: refused with the contracts: {i.refusal.reason}")
+                out[f"refused: {reason_kind(i.refusal.reason)}"] += 1
+        stage_check(ws)
+        for rec, _ in stage_requirements(ws):
+            if rec.get("verdict") != "informal":
+                out[f"verdict {rec['verdict']}"] += 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("dir", type=Path, help="a folder of FRET exports (*.json)")
+    ap.add_argument("--decide", action="store_true", help="also decide each translated requirement")
+    args = ap.parse_args(argv)
+    total: collections.Counter[str] = collections.Counter()
+    reasons: collections.Counter[str] = collections.Counter()
+    start = time.perf_counter()
+    for export in sorted(args.dir.rglob("*.json")):
+        try:
+            exp = read_export(export, export.name)
+        except PlanError as exc:
+            print(f"{exc.diagnostics[0]}")
+            total["malformed exports"] += 1
+            continue
+        got = import_export(exp, Options())
+        refused = [i for i in got if i.refusal is not None]
+        for i in refused:
+            assert i.refusal is not None
+            reasons[reason_kind(i.refusal.reason)] += 1
+        total["requirements"] += len(got)
+        total["translated"] += len(got) - len(refused)
+        print(f"{export.name}: {len(got)} requirements, {len(got) - len(refused)} translated, {len(refused)} refused")
+        if args.decide:
+            verdicts: collections.Counter[str] = collections.Counter()
+            decide(export, exp, verdicts)
+            print("  " + ", ".join(f"{k}: {v}" for k, v in sorted(verdicts.items())))
+            total.update(verdicts)
+    print(f"\ntotal: {total['requirements']} requirements, {total['translated']} translated to a decided "
+          f"temporal statement, {total['requirements'] - total['translated']} refused")
+    for k, v in reasons.most_common():
+        print(f"  refused, {k}: {v}")
+    for k, v in sorted(total.items()):
+        if k.startswith(("verdict", "refused:", "malformed")):
+            print(f"  {k}: {v}")
+    print(f"({time.perf_counter() - start:.1f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
