@@ -15,6 +15,7 @@ import copy
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterator, Sequence
 
+from rclverify.traces.bag_late import of_reader
 from rclverify.traces.events import Event, TraceError, header_stamp
 
 if TYPE_CHECKING:  # rosbags is the optional ``ros`` extra: its types only for the checker
@@ -190,5 +191,7 @@ def bag_event(reader: Any, path: Path, index: int, conn: Any, stamp: int, raw: b
         raise TraceError(f"{path}: message {index} (topic {conn.topic}, {len(raw)} bytes): error: "
                          f"cannot decode {conn.msgtype}: {why}") from None
     fields = flatten(msg)  # its header's stamp, when it has one, is its own time (docs/semantics.md)
+    lates = of_reader(reader)  # heard late by the live monitor that recorded the bag (traces/bag_late.py)
     return Event(index, stamp / 1e9, conn.topic.lstrip("/"), fields, f"{path.name}: message {index}",
-                 header_stamp(fields) if "header" in fields else None)
+                 header_stamp(fields) if "header" in fields else None,
+                 late=lates.at(conn.topic, stamp) if lates else 0.0)

@@ -84,6 +84,9 @@ class OnlineEngine:
     on_verdict: Callable[[Verdict], None] | None = None
     on_silence: Callable[[str, float, bool], None] | None = None
     on_event: Callable[[Event], None] | None = None
+    #: ``on_late(topic, source, late)``: a message released late (its topic, its time as pushed and its
+    #: lateness, s), for what records the run beside the log (the bag: :mod:`rclverify.traces.bag_late`)
+    on_late: Callable[[str, float, float], None] | None = None
     #: the declared tolerance of recorded numbers (default: ``rules.tolerance``, see :class:`NodeMonitor`)
     tolerance: Tolerance | None = None
     monitors: list[NodeMonitor] = field(init=False)
@@ -198,6 +201,8 @@ class OnlineEngine:
                 late = 0.0
             elif late:  # heard after the watermark had passed it: about that much more than the bound after its time
                 late += self.reorder_window
+                if self.on_late is not None:
+                    self.on_late(topic, src, late)
             ev = Event(self.released, t, topic, fields, where or f"message {self.released}", stamp, source, late)
             self.released += 1
             if self.on_event is not None:

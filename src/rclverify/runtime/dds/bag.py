@@ -37,6 +37,7 @@ import threading
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 from rclverify.traces.bag import typestore
+from rclverify.traces.bag_late import KEY as LATE_KEY, encode as encode_late
 from rclverify.runtime.dds.bag_types import declared_store
 from rclverify.runtime.dds.types import Declaration
 from rclverify.traces.events import TraceError
@@ -94,6 +95,7 @@ class BagRecorder:
         self.count = self.call_count = self.failed = 0
         #: per contract topic whose connection is made: the declaration it records (``None``: the workspace's)
         self._declared: dict[str, Any] = {}
+        self._late: dict[str, list[tuple[float, float]]] = {}  # topic -> (time s, late s) of each late message
         self.error = ""
         self._queue: queue.SimpleQueue[tuple[str, int, bytes, Any] | None] = queue.SimpleQueue()
         self._opened = threading.Event()
@@ -161,6 +163,8 @@ class BagRecorder:
                     self.failed += 1
                     self.error = f"{type(exc).__name__}: {exc}"
         finally:
+            if self._late:  # what the live monitor heard late, as its log says it (traces/bag_late.py)
+                writer.set_custom_data(LATE_KEY, encode_late(self._late))
             for topic in self.topics:  # a topic without a message is in the bag too, in the workspace's definition
                 if topic not in connections:
                     try:
@@ -180,6 +184,15 @@ class BagRecorder:
             return writer.add_connection("/" + topic, _msg_name(self.topics[topic]), typestore=self._store)
         msg_type, msgdef, digest = self.calls[topic]
         return writer.add_connection("/" + topic, msg_type, msgdef=msgdef, rihs01=digest, typestore=self._store)
+
+    def late(self, topic: str, time_s: float, late_s: float) -> None:
+        """Note that the message of contract topic ``topic`` (no leading ``/``)
+        at ``time_s`` (s since the epoch: the time it is written at) was heard
+        ``late_s`` (s) late by the live monitor: the bag says so at its close
+        (:mod:`rclverify.traces.bag_late`).  Called from the engine's thread
+        before :meth:`close`."""
+        if topic in self.topics:
+            self._late.setdefault(topic, []).append((time_s, late_s))
 
     def write(self, topic: str, time_ns: int, raw: bytes) -> None:
         """Queue one message of ``topic`` (a contract topic or a call topic, no

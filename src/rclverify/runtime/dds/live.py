@@ -258,6 +258,8 @@ class _DdsRun(DdsRunEnd):
         def send_last(node: str, text: str) -> None:
             lasts[node].write(string(data=text))
         self.live = run_factory(publish=self.send, publish_last=send_last, **extra)
+        if self.recorder is not None:  # the bag keeps what was heard late, as the log does (traces/bag_late.py)
+            self.live.engine.on_late = self.recorder.late
         if self.links:
             rec, note = self.call_recorder, self.live.note
 
