@@ -3,8 +3,10 @@
 A managed node (ROS 2 design, "Managed nodes"; ``rclcpp_lifecycle``, ``rclpy.lifecycle``)
 publishes each transition it completes on ``<node>/transition_event``
 (``lifecycle_msgs/msg/TransitionEvent``: ``timestamp`` in ns of the node's clock, ``transition``,
-``start_state``, ``goal_state``, each state an ``id`` and a ``label``).  Its contract's guarantees
-hold only while it is ``active``:
+``start_state``, ``goal_state``, each state an ``id`` and a ``label``).  A contract declares its node managed by naming that topic with
+that type and no ``matches`` (``lifecycle_msgs/TransitionEvent battery/transition_event``: the node
+``/battery``; under an instance's namespace the name resolves as every other, docs/plan.md
+"Instances"): :func:`managed_of`.  Its guarantees hold only while it is ``active``:
 
 * a managed node is ``unconfigured`` until its first transition event (every managed node starts
   so); its state then is the ``goal_state`` of its latest event, in force from the event's
@@ -12,16 +14,20 @@ hold only while it is ``active``:
 * an **input** heard while every monitored node reading it is managed and not ``active`` (the
   latest event heard) is no question: it is held back from the guarantees' judge and counted;
 * an **output** of a managed node published outside ``active`` violates the lifecycle contract:
-  it is judged against the node's state at its receipt time less :attr:`LifecycleGate.skew`
-  (a message published just before a deactivation is not red), once :attr:`LifecycleGate.settle`
-  seconds have passed after its receipt (so a transition event heard after the output, on its own
-  topic, still counts), and at the end of the run for the rest.  Each violation names the node,
-  the topic, the time and the state;
+  it is judged against the node's states within :attr:`LifecycleGate.skew` of its time (the
+  time the live run places it at: its source time, else its receipt), and is red only when none
+  of them is ``active`` or a transition into or out of it (``activating``, ``deactivating``: a
+  managed publisher is enabled in ``on_activate``), so a message published just before a
+  deactivation is not red; it is decided once :attr:`LifecycleGate.settle` seconds have passed
+  after it (a transition event heard after the output, on its own topic, still counts), and at
+  the end of the run for the rest.  Each violation names the node, the topic, the time and the
+  state it was published in;
 * the transition events themselves are the gate's: the guarantees' judge never sees them.
 
 :class:`LifecycleGate` is the gate a live run (:class:`rclverify.runtime.live.LiveRun`,
-``gate``) asks for every message before its judge; its :meth:`~LifecycleGate.record` is the
-run's ``lifecycle`` record.
+``gate``, made by :func:`gate_of` from the monitored nodes) asks for every message before its
+judge; its :meth:`~LifecycleGate.record` is the run's ``lifecycle`` record.  The transport reads
+the transition topic as any topic a contract names.
 """
 from __future__ import annotations
 
@@ -37,12 +43,34 @@ TRANSITION_TYPE = "lifecycle_msgs/msg/TransitionEvent"
 STATES = {0: "unknown", 1: "unconfigured", 2: "inactive", 3: "active", 4: "finalized", 10: "configuring",
           11: "cleaningup", 12: "shuttingdown", 13: "activating", 14: "deactivating", 15: "errorprocessing"}
 ACTIVE = 3
+#: The states an output may be published in: ``active``, and the transitions into and out of it (a
+#: managed publisher is enabled in ``on_activate``, while the node is ``activating``).
+ACTIVE_LIKE = frozenset({3, 13, 14})
 
 
 def event_topic(fqn: str) -> str:
     """The topic a managed node of fully qualified name ``fqn`` publishes its transitions on, as the
     judge keys topics (no leading ``/``): ``/r1/battery`` -> ``r1/battery/transition_event``."""
     return f"{fqn.strip('/')}/transition_event"
+
+
+def managed_of(nodes: Sequence[CheckedNode]) -> dict[str, str]:
+    """The managed nodes among ``nodes``: ``{contract node: fully qualified ROS name}`` of each whose
+    contract names a ``lifecycle_msgs/TransitionEvent`` topic ``<ros node>/transition_event`` with no
+    ``matches`` (module docstring; ``battery/transition_event`` -> ``/battery``)."""
+    out: dict[str, str] = {}
+    for n in nodes:
+        for t in n.node.topics:
+            if t.match is None and t.msg_type.replace("/msg/", "/") == "lifecycle_msgs/TransitionEvent" \
+                    and t.key.endswith("/transition_event"):
+                out.setdefault(n.name, "/" + t.key[: -len("/transition_event")])
+    return out
+
+
+def gate_of(nodes: Sequence[CheckedNode]) -> "LifecycleGate | None":
+    """The lifecycle gate of a run monitoring ``nodes``, ``None`` when none is managed."""
+    managed = managed_of(nodes)
+    return LifecycleGate(managed, nodes) if managed else None
 
 
 def _get(fields: Mapping[str, object], *path: str) -> object:
@@ -70,8 +98,9 @@ class _Managed:
     transitions: int = 0
     judged: int = 0
 
-    def state_at(self, t: float) -> int:
-        return self.states[bisect.bisect_right(self.times, t) - 1]
+    def states_within(self, lo: float, hi: float) -> list[int]:
+        """The states in force at some time of ``[lo, hi]``, the one at ``lo`` first."""
+        return self.states[bisect.bisect_right(self.times, lo) - 1: bisect.bisect_right(self.times, hi)]
 
     def now(self) -> int:
         return self.states[-1]
@@ -146,8 +175,9 @@ class LifecycleGate:
                 continue
             self.outputs_judged += 1
             m.judged += 1
-            state = m.state_at(received - self.skew)
-            if state != ACTIVE:
+            states = m.states_within(received - self.skew, received + self.skew)
+            state = states[0]
+            if not ACTIVE_LIKE & set(states):
                 self.violations.append({"node": m.node, "ros_node": m.fqn, "topic": topic, "time": received,
                                         "state": STATES.get(state, str(state)),
                                         "reason": f"{m.fqn} published on /{topic} while {STATES.get(state, state)}, "
@@ -175,4 +205,4 @@ class LifecycleGate:
                 "nodes": nodes}
 
 
-__all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITION_TYPE", "event_topic"]
+__all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITION_TYPE", "event_topic", "gate_of", "managed_of"]
