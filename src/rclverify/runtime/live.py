@@ -52,7 +52,7 @@ from rclverify.backends.monitors.check import NodeResult, Verdict
 from rclverify.backends.monitors.deadline_records import DeadlineVerdict
 from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
 from rclverify.backends.monitors.run_origin import unseen_links
-from rclverify.runtime.lifecycle import LifecycleGate
+from rclverify.runtime.lifecycle import LifecycleGate, gate_of
 from rclverify.runtime.live_status import LowMargins, least_margins, running_bound
 from rclverify.runtime.logchecks import LogChecks
 from rclverify.runtime.shapes import LiveCounts, SilenceNote
@@ -119,7 +119,7 @@ class LiveRun:
         self.results: list[NodeResult] | None = None
         self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
         #: what every message passes before the judge: managed nodes' states (lifecycle.py), or ``None``
-        self.gate: LifecycleGate | None = None
+        self.gate: LifecycleGate | None = gate_of(nodes)
 
     # -- engine callbacks (called under the lock) ----------------------------------
     def _event(self, ev: Event) -> None:
