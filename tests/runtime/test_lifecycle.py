@@ -95,14 +95,44 @@ def test_a_transition_heard_after_the_output_still_decides_it(tmp_path: Path) ->
     for t, topic, v in gate_run:
         gate.admit(topic, _event(v, 2.0 if v == 3 else t) if topic == EVENTS else {"data": v}, t)
     assert gate.record()["nodes"][0]["violations"] == []
-    # control: the same output with the event stamped at its receipt (2.1): red
+    # control: the same output with the activation stamped at 2.2, after it and its skew: red
     gate = LifecycleGate({"Battery": "/battery"}, list(checked.nodes.values()))
     for t, topic, v in gate_run:
-        gate.admit(topic, _event(v, t) if topic == EVENTS else {"data": v}, t)
+        gate.admit(topic, _event(v, 2.2 if v == 3 else t) if topic == EVENTS else {"data": v}, t)
     assert [v["state"] for v in gate.record()["nodes"][0]["violations"]] == ["inactive"]
+
+
+def test_an_output_while_activating_is_not_red(tmp_path: Path) -> None:
+    """A managed publisher is enabled in on_activate, while the node is activating (rclpy, rclcpp)."""
+    steps = [(1.0, EVENTS, 2), (2.0, EVENTS, 13), (2.5, "level", 5.0), (3.0, EVENTS, 3), (4.0, EVENTS, 14),
+             (4.5, "level", 5.0), (5.0, EVENTS, 2), (5.5, "level", 5.0)]
+    [node] = _run(tmp_path, steps)["lifecycle"]["nodes"]
+    assert [(v["time"], v["state"]) for v in node["violations"]] == [(5.5, "inactive")]  # control: after it, red
 
 
 def test_a_managed_node_that_is_not_monitored_is_refused(tmp_path: Path) -> None:
     checked = check([parse_text(RCL, "sys.rcl")])
     with pytest.raises(ValueError, match="managed node 'Batery' is not monitored"):
         LifecycleGate({"Batery": "/battery"}, list(checked.nodes.values()))
+
+
+def test_a_contract_naming_its_transition_topic_is_a_managed_node(tmp_path: Path) -> None:
+    """``lifecycle_msgs/TransitionEvent battery/transition_event`` (no matches) declares the node managed,
+    and under an instance's namespace it resolves there; the contract without it is the control."""
+    from rclverify.model.instances import instantiate
+    from rclverify.model.plan.instances import read_instances
+    from rclverify.runtime.lifecycle import managed_of
+    managed = RCL.replace("matches(out.level) )", "matches(out.level),\n"
+                          "          lifecycle_msgs/TransitionEvent battery/transition_event )")
+    checked = check([parse_text(managed, "sys.rcl")])
+    cfg = load_mapping(tmp_path, None, 1.0)
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "m.jsonl")
+    assert live.gate is not None and {n: m.fqn for n, m in live.gate.managed.items()} == {"Battery": "/battery"}
+    live.stop()
+    fleet, _ = read_instances({"Battery": ["/r1", "/r2"]}, {}, "plan.yaml")
+    assert managed_of(list(instantiate(checked, fleet).nodes.values())) == {"Battery_r1": "/r1/battery",
+                                                                           "Battery_r2": "/r2/battery"}
+    plain = check([parse_text(RCL, "sys.rcl")])
+    control = LiveRun(plain, list(plain.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "p.jsonl")
+    assert control.gate is None
+    control.stop()
