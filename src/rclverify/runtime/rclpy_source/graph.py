@@ -44,6 +44,7 @@ class RclpyDiscovery:
     :class:`~rclverify.ros.live.dds_discovery.Discovery` (module docstring)."""
 
     def __init__(self, dump: dict[str, Any]) -> None:
+        self.dump = dump  # as the agent gave it: what nodl check --record-graph writes (model/nodl/graph_record.py)
         self.rmw = str(dump.get("rmw", ""))
         self.writers: dict[bytes, EndpointInfo] = {}
         self.readers: dict[bytes, EndpointInfo] = {}
