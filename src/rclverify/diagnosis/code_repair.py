@@ -14,8 +14,10 @@ only when it was checked:
    value negated, a number moved by one or replaced by a number the
    contract names: :func:`~rclverify.backends.property_tests.slips.mutations`),
    and ``max``/``min`` swapped, each as a text edit of that line's
-   expression cut to the characters that change.  Smallest first (the
-   characters taken out and put in), then in source order.
+   expression cut to the characters that change.  Ordered by class (an
+   operator or a name first, then a number moved by one, then a number the
+   contract names: :func:`_rank`), then smallest (the characters taken out
+   and put in), then in source order.
 2. *The check* (:func:`checked_repairs`): the implementation's import
    closure and the files the mapping reads are copied to a scratch folder,
    the edit is made there (the workspace is never touched), and every
@@ -47,7 +49,7 @@ from rclverify.records.stage_records import Repair
 #: Most repairs offered for one failure.
 MAX_REPAIRS = 3
 #: Most candidates run on a scratch copy for one failure (each runs every guarantee of the node).
-MAX_TRIED = 6
+MAX_TRIED = 12
 #: The swapped names of a call: ``max`` for ``min`` and back.
 _SWAP = {"max": "min", "min": "max"}
 
@@ -130,7 +132,19 @@ def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fractio
         if e is not _NONE and key not in seen:
             seen.add(key)
             kept.append(e)
-    return sorted(kept, key=lambda e: (len(e.deleted(source)) + len(e.text), e.line, e.col))
+    return sorted(kept, key=lambda e: (_rank(e.deleted(source), e.text), len(e.deleted(source)) + len(e.text),
+                                       e.line, e.col))
+
+
+def _rank(old: str, new: str) -> int:
+    """The class of a one-token correction, tried in this order: 0 an operator or a name (a comparison's
+    strictness, ``and``/``or``, ``+``/``-``, ``max``/``min``, a ``not`` dropped, a truth value), 1 a number
+    moved by one, 2 a number replaced by another the contract names."""
+    try:
+        a, b = Fraction(old), Fraction(new)
+    except (ValueError, ZeroDivisionError):
+        return 0
+    return 1 if abs(a - b) == 1 else 2
 
 
 #: No edit (a mutation that changes no character).
