@@ -40,6 +40,9 @@ from rclverify.ros.extract import names
 from rclverify.ros.extract.launch_readers import read_xml as read_xml, read_yaml as read_yaml
 from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
 from rclverify.ros.extract.launch_tree import ALIASES, SEP as SEP, UNREAD as UNREAD, El as El
+
+#: an include's argument whose value cannot be read statically: using it says so
+NOVALUE = "\x00novalue"
 from rclverify.ros.extract.launch_tree import Unresolved as Unresolved, evaluate as evaluate
 from rclverify.ros.extract.model import Note, Src
 
@@ -169,6 +172,9 @@ class Interpreter:
             if not parts:
                 raise Unresolved("empty substitution $()")
             kind, rest = parts[0], parts[1:]
+            if kind in ("var-default", "arg", "var") and rest and scope.args.get(rest[0]) == NOVALUE:
+                raise Unresolved(f"$({kind} {rest[0]}): argument '{rest[0]}' has no value read statically "
+                                 f"(the include giving it says why)")
             if kind == "var-default" and rest:  # a Python launch file's LaunchConfiguration(name, default=d)
                 return scope.args[rest[0]] if rest[0] in scope.args else " ".join(rest[1:])
             if kind in ("arg", "var") and len(rest) == 1:
@@ -379,6 +385,9 @@ class Interpreter:
         for c in el.children:
             if c.tag == "arg" and self._cond(c, scope, path):
                 n = self._attr(c, "name", scope, path)
+                if n and c.attrs.get("novalue"):  # a value its reader could not read (said there)
+                    args[n] = NOVALUE
+                    continue
                 v = self._attr(c, "value", scope, path) or self._attr(c, "default", scope, path)
                 if n and v is not None:
                     args[n] = v

@@ -10,10 +10,8 @@ executed): the evaluator :mod:`launch_ros2` reads actions with.
   tuple, ``range(n)`` or ``d.items()`` of known items is the list of its
   elements with the loop variables (a name or a tuple of names) put in
   (:func:`unroll`); a condition must evaluate (:func:`.launch.evaluate`);
-* a list of actions bound once and then grown in the function's own
-  statements, in order (``nodes.append(x)``, ``nodes.extend([...])``,
-  ``nodes += [...]``), is the list it holds at the end (:func:`grown`);
-  grown inside a block or a loop it is chosen at run time;
+* a list of actions bound once and then grown in order is read by
+  :mod:`launch_py_flow` (with the branches of ``if`` statements);
 * a string value (:func:`value`): a literal, an f-string of known parts, a
   launch substitution as the ``$(...)`` text :class:`~.launch.Interpreter`
   resolves: ``LaunchConfiguration('x'[, default=d])`` (``$(var x)``),
@@ -284,42 +282,3 @@ def once(stmts: list[ast.stmt] | list[ast.AST]) -> tuple[dict[str, ast.expr], di
             lines.setdefault(st.func.value.id, []).append(st.lineno)  # nodes.append(...): grown at run time
     twice = {k: sorted(set(v)) for k, v in lines.items() if len(set(v)) > 1}
     return {k: v for k, v in seen.items() if k not in twice}, twice
-
-
-def grown(fn: ast.FunctionDef, name: str) -> ast.List | str:
-    """The list variable ``name`` holds at the end of ``fn`` when it is bound
-    once to a list in ``fn``'s own statements and then grown there in order by
-    ``name.append(x)``, ``name.extend([...])`` or ``name += [...]``; else why
-    not (a binding inside a block or a loop: chosen at run time)."""
-    def binds(x: ast.AST) -> bool:
-        return isinstance(x, ast.Assign) and any(isinstance(t, ast.Name) and t.id == name for t in x.targets) \
-            or isinstance(x, ast.AugAssign) and isinstance(x.target, ast.Name) and x.target.id == name \
-            or isinstance(x, ast.Call) and isinstance(x.func, ast.Attribute) and x.func.attr in _GROW \
-            and isinstance(x.func.value, ast.Name) and x.func.value.id == name
-    top = [st.value if isinstance(st, ast.Expr) else st for st in fn.body]
-    mine = {id(x) for x in top}
-    nested = next((x for x in ast.walk(fn) if binds(x) and id(x) not in mine), None)
-    if nested is not None:
-        return f"is grown at line {getattr(nested, 'lineno', fn.lineno)} inside a block or a loop (chosen at run time)"
-    out: list[ast.expr] | None = None
-    for x in top:
-        if not binds(x):
-            continue
-        at = getattr(x, "lineno", fn.lineno)
-        if isinstance(x, ast.Assign):
-            v = expand(x.value)
-            if out is not None or not isinstance(v, (ast.List, ast.Tuple)):
-                return f"is bound at line {at} to what is not a list of actions"
-            out = list(v.elts)
-            continue
-        more = x.value if isinstance(x, ast.AugAssign) else x.args[-1] if isinstance(x, ast.Call) and x.args else None
-        if out is None or more is None:
-            return f"is grown at line {at} before it is bound"
-        if isinstance(x, ast.Call) and isinstance(x.func, ast.Attribute) and x.func.attr != "extend":
-            out.append(more)  # append(x), insert(i, x): the order of actions does not change the graph
-            continue
-        more = expand(more)
-        if not isinstance(more, (ast.List, ast.Tuple)):
-            return f"is grown at line {at} by '{ast.unparse(more)}', not a list"
-        out.extend(more.elts)
-    return ast.List(elts=out or [], ctx=ast.Load())

@@ -41,22 +41,18 @@ from rclverify.ros.extract.launch_tree import UNREAD, El
 from rclverify.ros.extract.launch_py_values import ENV as _ENV, HERE as _HERE, TWICE as _TWICE
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg, callee as _callee
 from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
-from rclverify.ros.extract.launch_py_values import grown as _grown, value as _value
+from rclverify.ros.extract.launch_py_values import value as _value
+from rclverify.ros.extract.launch_py_flow import added as _added, grown as _grown
+from rclverify.ros.extract.launch_py_actions import HANDLERS, PAIRS, QUIET
+from rclverify.ros.extract.launch_py_actions import at_shutdown as _shutdown, condition as _cond
+from rclverify.ros.extract.launch_py_actions import optional as _opt, required as _req
 from rclverify.ros.extract.launch_py_node import execute_process, node_kids as _node_kids, ros_args as _ros_args
 from rclverify.ros.extract.model import Note, Src
 
-#: actions that start no node and set nothing the graph reads (passed over without a note)
-QUIET = frozenset({"LogInfo", "SetEnvironmentVariable", "UnsetEnvironmentVariable", "AppendEnvironmentVariable",
-                   "PrependEnvironmentVariable", "ResetEnvironment", "SetParameter", "SetParametersFromFile",
-                   "SetUseSimTime", "SetROSLogDir", "Shutdown", "EmitEvent", "ResetLaunchConfigurations",
-                   "PopLaunchConfigurations", "PushLaunchConfigurations", "PopEnvironment", "PushEnvironment",
-                   "SetLaunchConfigurationIfUnset"})
-#: event handlers and the keyword holding the actions each starts
-HANDLERS = {"OnProcessExit": "on_exit", "OnProcessStart": "on_start", "OnExecutionComplete": "on_completion",
-            "OnProcessIO": "on_stdout", "OnStateTransition": "entities"}
 MAX_CALLS = 8  # functions of the launch file evaluated inside one another
 _FUNCS: dict[str, ast.FunctionDef] = {}  # the launch file's module-level functions, while it is read
 _CALLING: list[str] = []  # the functions being evaluated (a recursion stops)
+_FN: list[ast.FunctionDef] = []  # the function whose statements are read (innermost last)
 
 
 def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
@@ -67,6 +63,14 @@ def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
     if isinstance(e, ast.expr):
         e = _expand(e)
     elems = e.elts if isinstance(e, (ast.List, ast.Tuple)) else [e]
+    if len(elems) == 1 and isinstance(elems[0], ast.Name) and elems[0].id in _TWICE and _FN:
+        got = _grown(_FN[-1], elems[0].id)  # a list of actions grown before it is used
+        if isinstance(got, str):
+            v = elems[0]
+            notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"launch actions '{v.id}' {got}: not "
+                              f"resolved statically", "ROS-LAUNCH"))
+            return out
+        elems = got.elts
     for x in elems:
         if isinstance(x, ast.Starred) and isinstance(x.value, ast.ListComp):
             x = x.value  # *[... for ...] that did not unroll: said as a comprehension
@@ -88,71 +92,21 @@ def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
     return out
 
 
-def _required(c: ast.Call, attrs: dict[str, str], keys: tuple[tuple[str, str], ...]) -> None:
-    """The keyword arguments ``keys`` (``(python name, attribute)``) of action
-    ``c`` without which it starts nothing known (its package, executable or
-    plugin): one that cannot be read raises :class:`_Unres` naming it."""
-    for py, key in keys:
-        v = _kw(c, py)
-        if v is not None:
-            try:
-                attrs[key] = _value(v)
-            except _Unres as exc:
-                raise _Unres(f"{py} {exc}") from None
-
-
-def _optional(c: ast.Call, attrs: dict[str, str], keys: tuple[tuple[str, str], ...], shown: str,
-              notes: list[Note]) -> None:
-    """The keyword arguments ``keys`` (``(python name, attribute)``) of action
-    ``c`` that the node can do without: one that cannot be read is left out of
-    ``attrs``, said with a located note."""
-    what = _callee(c)
-    for py, key in keys:
-        v = _kw(c, py)
-        if v is None:
-            continue
-        try:
-            attrs[key] = _value(v)
-        except _Unres as exc:
-            notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"{what}(...): {py} {exc} cannot be read "
-                              f"statically; the {py} the code gives is kept", "ROS-LAUNCH"))
-
-
-def _condition(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note]) -> None:
-    """``condition=IfCondition(x)`` / ``UnlessCondition(x)`` of action ``c`` as
-    an ``if`` / ``unless`` attribute; one that cannot be read leaves the action
-    unconditional, said with a located note."""
-    cond = _kw(c, "condition")
-    if cond is None:
-        return
-    cond = _expand(cond)
-    at = Src(shown, cond.lineno, cond.col_offset + 1)
-    kind = _callee(cond) if isinstance(cond, ast.Call) else ""
-    try:
-        if kind not in ("IfCondition", "UnlessCondition") or not isinstance(cond, ast.Call) or len(cond.args) != 1:
-            raise _Unres(f"'{ast.unparse(cond)}' (not IfCondition(x) or UnlessCondition(x))")
-        attrs["if" if kind == "IfCondition" else "unless"] = _value(cond.args[0])
-    except _Unres as exc:
-        notes.append(Note(at, f"{_callee(c)}(...): condition {exc} cannot be read statically; the action is read "
-                              f"as if it held", "ROS-LAUNCH"))
-        attrs[UNREAD] = str(at)
-
-
 def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
     src = Src(shown, c.lineno, c.col_offset + 1)
     name = _callee(c)
     try:
         attrs: dict[str, str] = {}
         if name in ("Node", "LifecycleNode"):
-            _required(c, attrs, (("package", "pkg"), ("executable", "exec"), ("node_executable", "exec")))
-            _optional(c, attrs, (("name", "name"), ("namespace", "namespace"), ("node_name", "name"),
+            _req(c, attrs, (("package", "pkg"), ("executable", "exec"), ("node_executable", "exec")))
+            _opt(c, attrs, (("name", "name"), ("namespace", "namespace"), ("node_name", "name"),
                                  ("node_namespace", "namespace")), shown, notes)
             _ros_args(c, attrs, shown, notes)
-            _condition(c, attrs, shown, notes)
+            _cond(c, attrs, shown, notes)
             return El("node", attrs, _node_kids(c, shown, notes), src)
         if name == "ComposableNode":
-            _required(c, attrs, (("package", "pkg"), ("plugin", "plugin")))
-            _optional(c, attrs, (("name", "name"), ("namespace", "namespace")), shown, notes)
+            _req(c, attrs, (("package", "pkg"), ("plugin", "plugin")))
+            _opt(c, attrs, (("name", "name"), ("namespace", "namespace")), shown, notes)
             return El("composable_node", attrs, _node_kids(c, shown, notes), src)
         if name in ("ComposableNodeContainer", "LoadComposableNodes"):
             return _container(c, name, attrs, src, shown, notes)
@@ -168,17 +122,17 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
                     notes.append(Note(Src(shown, default.lineno, default.col_offset + 1), f"{name}(...): "
                                       f"default_value {exc} cannot be read statically; the argument has no value "
                                       f"unless one is given", "ROS-LAUNCH"))
-            _condition(c, attrs, shown, notes)
+            _cond(c, attrs, shown, notes)
             return El("arg", attrs, [], src)
         if name in ("PushRosNamespace", "PushROSNamespace"):
             n = c.args[0] if c.args else _kw(c, "namespace")
             if n is not None:
                 attrs["namespace"] = _value(n)
-            _condition(c, attrs, shown, notes)
+            _cond(c, attrs, shown, notes)
             return El("push-ros-namespace", attrs, [], src)
         if name == "GroupAction":
             acts = c.args[0] if c.args else _kw(c, "actions")
-            _condition(c, attrs, shown, notes)
+            _cond(c, attrs, shown, notes)
             return El("group", attrs, _actions(acts, shown, notes) if acts is not None else [], src)
         if name == "IncludeLaunchDescription":
             return _include(c, attrs, src, shown, notes)
@@ -206,7 +160,7 @@ def _container(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: s
                 notes.append(Note(Src(shown, d.lineno, d.col_offset + 1), f"composable node "
                                   f"'{ast.unparse(d)}' is not a literal ComposableNode(...): not resolved "
                                   f"statically", "ROS-LAUNCH"))
-    _condition(c, attrs, shown, notes)
+    _cond(c, attrs, shown, notes)
     tag = "node_container" if name == "ComposableNodeContainer" else "load_composable_node"
     return El(tag, attrs, kids, src)
 
@@ -221,28 +175,25 @@ def _include(c: ast.Call, attrs: dict[str, str], src: Src, shown: str, notes: li
             la = la.func.value
         la = _expand(la)
         if isinstance(la, ast.Dict):
-            for k, v in zip(la.keys, la.values):
-                if k is not None:
-                    kids.append(El("arg", {"name": _value(k), "value": _value(v)}, [], src))
+            pairs = [(k, v) for k, v in zip(la.keys, la.values) if k is not None]
         elif isinstance(la, (ast.List, ast.Tuple)):
-            for pair in la.elts:
-                if isinstance(pair, ast.Tuple) and len(pair.elts) == 2:
-                    kids.append(El("arg", {"name": _value(pair.elts[0]), "value": _value(pair.elts[1])}, [], src))
+            pairs = [(p.elts[0], p.elts[1]) for p in la.elts if isinstance(p, ast.Tuple) and len(p.elts) == 2]
         else:
             raise _Unres(f"launch_arguments '{ast.unparse(la)}'")
+        for k, v in pairs:
+            n = _value(k)
+            try:
+                kids.append(El("arg", {"name": n, "value": _value(v)}, [], src))
+            except _Unres as exc:  # the included file gets the argument without a value, never its default
+                notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"IncludeLaunchDescription(...): "
+                                  f"argument '{n}' {exc} cannot be read statically; the included file reads it "
+                                  f"without a value", "ROS-LAUNCH"))
+                kids.append(El("arg", {"name": n, "novalue": "1"}, [], src))
     if s is None:
         raise _Unres("an include without a source")
     attrs["file"] = _value(s)
-    _condition(c, attrs, shown, notes)
+    _cond(c, attrs, shown, notes)
     return El("include", attrs, kids, src)
-
-
-#: action -> (element tag, (keyword, attribute) of its first and second argument, why one without them
-#: is not read): the scope-setting actions of two arguments
-_PAIRS: dict[str, tuple[str, tuple[str, str], tuple[str, str], str]] = {
-    "SetRemap": ("remap", ("src", "from"), ("dst", "to"), "a remap without src and dst"),
-    "SetLaunchConfiguration": ("let", ("name", "name"), ("value", "value"), "a configuration without name and value"),
-}
 
 
 def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, notes: list[Note]) -> El | None:
@@ -251,27 +202,31 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
     started), ``OpaqueFunction`` and the launch file's own functions
     (evaluated, :func:`_function_actions`); any other call is named in a
     located note."""
-    if name in _PAIRS:  # two positional-or-keyword arguments set in the scope
-        tag, (k1, a1), (k2, a2), missing = _PAIRS[name]
+    if name in PAIRS:  # two positional-or-keyword arguments set in the scope
+        tag, (k1, a1), (k2, a2), missing = PAIRS[name]
         x, y = _arg(c, 0, k1), _arg(c, 1, k2)
         if x is None or y is None:
             raise _Unres(missing)
         attrs.update({a1: _value(x), a2: _value(y)})
-        _condition(c, attrs, shown, notes)
+        _cond(c, attrs, shown, notes)
         return El(tag, attrs, [], src)
     acts: ast.expr | None = None
-    if name in ("TimerAction", "RosTimer"):
+    if name in ("TimerAction", "RosTimer", "ROSTimer"):
         acts = _arg(c, 1, "actions")
     elif name == "RegisterEventHandler":
         h = _arg(c, 0, "event_handler")
         h = _expand(h) if h is not None else None
         kind = _callee(h) if isinstance(h, ast.Call) else ""
-        acts = _arg(h, 1, HANDLERS[kind]) if isinstance(h, ast.Call) and kind in HANDLERS else None
+        acts = next((a for k in HANDLERS.get(kind, ()) if isinstance(h, ast.Call)
+                     and (a := _kw(h, k)) is not None), None)  # the handlers' arguments are keyword-only
         if acts is None:
             raise _Unres(f"event handler '{ast.unparse(h) if h is not None else ''}' (not one of "
                          f"{', '.join(sorted(HANDLERS))} with its actions)")
-        if isinstance(_expand(acts), ast.Lambda):
+        if isinstance(_expand(acts), ast.Lambda) or kind == "OnProcessIO":
             raise _Unres(f"the actions of {kind}, a function run at the event,")
+        if kind == "OnShutdown":
+            _shutdown(_actions(acts, shown, notes), src, notes)
+            return None
     elif name == "OpaqueFunction" or name in _FUNCS:
         fn = _arg(c, 0, "function") if name == "OpaqueFunction" else c.func
         got = _function_actions(fn, c, name == "OpaqueFunction", shown, notes)
@@ -280,12 +235,12 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
                 else f"function {name}()"
             notes.append(Note(src, f"{what} not evaluated: {got}; the nodes it starts are unknown", "ROS-LAUNCH"))
             return None
-        _condition(c, attrs, shown, notes)
+        _cond(c, attrs, shown, notes)
         return El("group", {**attrs, "scoped": "false"}, got, src)
     elif name == "ExecuteProcess":
         el = execute_process(c, src, notes)
         if el is not None:
-            _condition(c, el.attrs, shown, notes)
+            _cond(c, el.attrs, shown, notes)
         return el
     elif name in QUIET:
         return None
@@ -293,7 +248,7 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
         notes.append(Note(src, f"launch action {name or ast.unparse(c.func)}(...) is not one the scan reads: the "
                                f"nodes it starts, if any, are unknown", "ROS-LAUNCH"))
         return None
-    _condition(c, attrs, shown, notes)
+    _cond(c, attrs, shown, notes)
     return El("group", {**attrs, "scoped": "false"}, _actions(acts, shown, notes) if acts is not None else [], src)
 
 
@@ -331,6 +286,7 @@ def _function_actions(fn: ast.expr | None, call: ast.Call, opaque: bool, shown: 
     mine, twice = _once(list(ast.walk(f)))
     saved, saved_twice = dict(_ENV), dict(_TWICE)
     _CALLING.append(fn.id)
+    _FN.append(f)
     try:
         for p in params:
             _ENV.pop(p, None)
@@ -349,6 +305,7 @@ def _function_actions(fn: ast.expr | None, call: ast.Call, opaque: bool, shown: 
         return _actions(ret, shown, notes)
     finally:
         _CALLING.pop()
+        _FN.pop()
         _ENV.clear()
         _ENV.update(saved)
         _TWICE.clear()
@@ -375,10 +332,12 @@ def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
     _FUNCS.update({f.name: f for f in tree.body if isinstance(f, ast.FunctionDef)
                    and f.name != "generate_launch_description"})
     _HERE[0] = path.name
+    _FN[:] = [fn] if fn is not None else []
     try:
         _bind(tree, fn)
         return _read(fn, shown, notes)
     finally:
+        _FN.clear()
         _ENV.clear()
         _TWICE.clear()
         _FUNCS.clear()
@@ -420,11 +379,16 @@ def _read(fn: ast.FunctionDef | None, shown: str, notes: list[Note]) -> tuple[El
                     elems = arg.elts if isinstance(arg, (ast.List, ast.Tuple)) else [arg]
                     resolved = [assigned.get(x.id, x) if isinstance(x, ast.Name) else x for x in elems]
                     kids.extend(_actions(ast.List(elts=resolved, ctx=ast.Load()), shown, notes))
-                # ld.add_action(x) calls
-            for call in ast.walk(fn):
-                if isinstance(call, ast.Call) and _callee(call) == "add_action" and call.args:
-                    a = call.args[0]
-                    a = assigned.get(a.id, a) if isinstance(a, ast.Name) else a
-                    kids.extend(_actions(a, shown, notes))
+            for call, under in _added(fn):  # ld.add_action(x) calls, in the statements that run
+                a = call.args[0]
+                a = assigned.get(a.id, a) if isinstance(a, ast.Name) else a
+                got = _actions(a, shown, notes)
+                if under is not None and got:
+                    at = Src(shown, under.lineno, under.col_offset + 1)
+                    notes.append(Note(Src(shown, call.lineno, call.col_offset + 1), f"add_action(...) under "
+                                      f"'if {ast.unparse(under.test)}' ({at}), a test not read statically: "
+                                      f"the actions are read as if it held", "ROS-LAUNCH"))
+                    got = [El("group", {UNREAD: str(at), "scoped": "false"}, got, at)]
+                kids.extend(got)
             break
     return El("launch", {}, kids, Src(shown, fn.lineno)), notes

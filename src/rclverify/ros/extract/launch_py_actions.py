@@ -1,0 +1,105 @@
+"""The launch actions a ROS 2 Python launch file's evaluator (:mod:`launch_ros2`)
+knows by name, and the keyword arguments every action reads alike: the actions
+that start no node (passed over), the event handlers and where their actions
+are, the scope-setting actions of two arguments; a node's required and
+optional keywords, an action's ``condition``; the actions of an
+``OnShutdown`` handler, which launch never starts as processes.
+
+Source: ``launch.actions``, ``launch.event_handlers``, ``launch_ros.actions``,
+``launch_ros.event_handlers`` (ros2/launch, ros2/launch_ros); launch's
+``ExecuteLocal.execute`` starts nothing once the launch context is shutting
+down.
+"""
+from __future__ import annotations
+
+import ast
+
+from rclverify.ros.extract.launch_tree import UNREAD, El
+from rclverify.ros.extract.launch_py_values import Unres as _Unres, callee as _callee, expand as _expand
+from rclverify.ros.extract.launch_py_values import kw as _kw, value as _value
+from rclverify.ros.extract.model import Note, Src
+
+#: actions that start no node and set nothing the graph reads (passed over without a note)
+QUIET = frozenset({"LogInfo", "SetEnvironmentVariable", "UnsetEnvironmentVariable", "AppendEnvironmentVariable",
+                   "PrependEnvironmentVariable", "ResetEnvironment", "SetParameter", "SetParametersFromFile",
+                   "SetUseSimTime", "SetROSLogDir", "Shutdown", "EmitEvent", "ResetLaunchConfigurations",
+                   "PopLaunchConfigurations", "PushLaunchConfigurations", "PopEnvironment", "PushEnvironment",
+                   "SetLaunchConfigurationIfUnset", "LifecycleTransition", "UnregisterEventHandler"})
+#: event handlers and the keywords holding the actions each starts (launch.event_handlers,
+#: launch_ros.event_handlers; OnProcessIO's are functions of the output, always run at the event)
+HANDLERS = {"OnProcessExit": ("on_exit",), "OnProcessStart": ("on_start",),
+            "OnExecutionComplete": ("on_completion",), "OnStateTransition": ("entities",),
+            "EventHandler": ("entities",), "OnShutdown": ("on_shutdown",),
+            "OnProcessIO": ("on_stdout", "on_stderr", "on_stdin")}
+#: the tags of the elements that start a node
+STARTS = ("node", "node_container", "load_composable_node", "composable_node", "include")
+
+#: action -> (element tag, (keyword, attribute) of its first and second argument, why one without them
+#: is not read): the scope-setting actions of two arguments
+PAIRS: dict[str, tuple[str, tuple[str, str], tuple[str, str], str]] = {
+    "SetRemap": ("remap", ("src", "from"), ("dst", "to"), "a remap without src and dst"),
+    "SetLaunchConfiguration": ("let", ("name", "name"), ("value", "value"), "a configuration without name and value"),
+}
+
+
+def required(c: ast.Call, attrs: dict[str, str], keys: tuple[tuple[str, str], ...]) -> None:
+    """The keyword arguments ``keys`` (``(python name, attribute)``) of action
+    ``c`` without which it starts nothing known (its package, executable or
+    plugin): one that cannot be read raises :class:`_Unres` naming it."""
+    for py, key in keys:
+        v = _kw(c, py)
+        if v is not None:
+            try:
+                attrs[key] = _value(v)
+            except _Unres as exc:
+                raise _Unres(f"{py} {exc}") from None
+
+
+def optional(c: ast.Call, attrs: dict[str, str], keys: tuple[tuple[str, str], ...], shown: str,
+              notes: list[Note]) -> None:
+    """The keyword arguments ``keys`` (``(python name, attribute)``) of action
+    ``c`` that the node can do without: one that cannot be read is left out of
+    ``attrs``, said with a located note."""
+    what = _callee(c)
+    for py, key in keys:
+        v = _kw(c, py)
+        if v is None:
+            continue
+        try:
+            attrs[key] = _value(v)
+        except _Unres as exc:
+            notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"{what}(...): {py} {exc} cannot be read "
+                              f"statically; the {py} the code gives is kept", "ROS-LAUNCH"))
+
+
+def condition(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note]) -> None:
+    """``condition=IfCondition(x)`` / ``UnlessCondition(x)`` of action ``c`` as
+    an ``if`` / ``unless`` attribute; one that cannot be read leaves the action
+    unconditional, said with a located note."""
+    cond = _kw(c, "condition")
+    if cond is None:
+        return
+    cond = _expand(cond)
+    at = Src(shown, cond.lineno, cond.col_offset + 1)
+    kind = _callee(cond) if isinstance(cond, ast.Call) else ""
+    try:
+        if kind not in ("IfCondition", "UnlessCondition") or not isinstance(cond, ast.Call) or len(cond.args) != 1:
+            raise _Unres(f"'{ast.unparse(cond)}' (not IfCondition(x) or UnlessCondition(x))")
+        attrs["if" if kind == "IfCondition" else "unless"] = _value(cond.args[0])
+    except _Unres as exc:
+        notes.append(Note(at, f"{_callee(c)}(...): condition {exc} cannot be read statically; the action is read "
+                              f"as if it held", "ROS-LAUNCH"))
+        attrs[UNREAD] = str(at)
+
+
+def at_shutdown(els: list[El], handler: Src, notes: list[Note]) -> None:
+    """The actions of an ``OnShutdown`` handler (``handler``): launch starts no
+    process once it is shutting down (``ExecuteLocal.execute`` returns when
+    ``context.is_shutdown``), so each node they would start is said at its
+    line, never a node of the graph."""
+    for el in els:
+        if el.tag in STARTS:
+            what = el.attrs.get("exec") or el.attrs.get("plugin") or el.attrs.get("file") or el.tag
+            notes.append(Note(el.src, f"{el.tag} '{what}' is started by OnShutdown ({handler}): launch starts no "
+                                      f"process once it is shutting down; not a node of the graph", "ROS-LAUNCH"))
+        at_shutdown(el.children, handler, notes)
