@@ -3,10 +3,13 @@
 ``arguments=[...]`` (XML/YAML ``args``) after ``--ros-args`` up to ``--``.
 
 * ``-r from:=to`` / ``--remap from:=to``: a remap of the node's names
-  (``node:from:=to`` applies to that node only: kept when it names the node
-  read, or when the node's name is not known);
+  (``node:from:=to`` is kept whole: the graph applies it to the node of that
+  name only, :func:`.namespaces.remap`, as rcl does, which also sorts out the
+  several nodes of one process);
 * ``-r __node:=n`` / ``__name:=n``: the node's name; ``-r __ns:=/ns``: its
-  namespace;
+  namespace (``node:__node:=n``: only when the launch file names the node
+  ``node`` or gives no name; rcl matches the code's name, which the launch
+  reader does not know);
 * ``-p name:=value`` / ``--param name:=value``: a private parameter;
 * the other flags (``--params-file f``, ``--log-level l``, ``-e enclave``,
   ``--enable-...`` ...) are not names and are passed over with their value.
@@ -68,16 +71,17 @@ def parse(tokens: list[str], node: str | None = None) -> RosArgs:
             if t in ("-p", "--param"):
                 got.params[left] = right
                 continue
-            if ":" in left and not left.startswith("/"):
-                only, left = left.split(":", 1)  # node:from:=to, for that node only
+            only, sep, bare = left.partition(":")
+            if sep and not left.startswith("/") and bare in ("__node", "__name", "__ns"):
                 if node is not None and only != node.rsplit("/", 1)[-1]:
-                    continue
+                    continue  # node:__node:=n renames that node only
+                left = bare
             if left in ("__node", "__name"):
                 got.name = right
             elif left == "__ns":
                 got.ns = right
             else:
-                got.remaps.append((left, right))
+                got.remaps.append((left, right))  # node:from:=to kept whole: the graph applies it to that node
         elif t in _VALUED:
             i += 2
         else:

@@ -23,12 +23,35 @@ from rclverify.ros.extract.symbols import under
 
 def remap(name: str, ns: str, full: str, remaps: list[tuple[str, str, Src]]) -> tuple[str, Src | None]:
     """``name`` (resolved) after the node's remaps (each ``from`` and ``to``
-    resolved in the node's namespace; the last match wins)."""
+    resolved in the node's namespace; the last match wins).  A rule written
+    ``node:from`` applies only to the node named ``node`` (its name without
+    namespace, after its own renaming: rcl's ``rcl_remap_topic_name`` matches
+    a rule's node name against the node's; ROS 2 design "ROS command line
+    arguments", "Node-specific rules")."""
     at = None
+    base = full.rsplit("/", 1)[-1]
     for frm, to, rsrc in remaps:
+        only, frm = rule(frm)
+        if only is not None and only != base:
+            continue
         if names.resolve(frm, ns, full) == name:
             name, at = names.resolve(to, ns, full), rsrc
     return name, at
+
+
+def rule(frm: str) -> tuple[str | None, str]:
+    """The ``from`` side of a remapping rule as ``(node, name)``: ``node:from``
+    names the node it applies to (``None``: every node); a ``rostopic://`` or
+    ``rosservice://`` scheme is dropped (a ROS name holds no colon; rcl's
+    remapping rule syntax)."""
+    only, sep, rest = frm.partition(":")
+    if not sep or not rest:
+        return None, frm
+    if only in ("rostopic", "rosservice") and rest.startswith("//"):
+        return None, rest[2:]
+    if only and not only.startswith(("/", "~")):
+        return only, rule(rest)[1]
+    return None, frm
 
 
 def resolve(written: str, handle: tuple[str, ...], ns: str, full: str,
