@@ -21,6 +21,8 @@ _CALLS = {"advertise": "pub", "subscribe": "sub", "create_publisher": "pub", "cr
           "advertiseService": "service_servers", "serviceClient": "service_clients",
           "create_service": "service_servers", "create_client": "service_clients",
           "create_generic_publisher": "pub", "create_generic_subscription": "sub"}
+#: rclcpp's node methods whose interface type is a template parameter no argument deduces
+_TEMPLATED = ("create_publisher", "create_subscription", "create_service", "create_client")
 #: component_interface_utils' NodeAdaptor methods, each making its member argument with its Spec
 _INIT = {"init_pub": "pub", "init_sub": "sub", "init_srv": "service_servers", "init_cli": "service_clients"}
 #: Prefixes of library names: a call of one is no call of the program's own code.
@@ -95,6 +97,12 @@ class CallReader:
                         (full, owner.unit if owner else None, owner.key if owner else None, len(args), targs))
             return
         if last == "create_server":
+            return
+        if recv is not None and last in _TEMPLATED and not targs:
+            # rclcpp cannot deduce the message or service type of these methods (a template parameter
+            # the call must give): one called without template arguments is a user's method of the
+            # same name (leds_[i]->create_subscription(nh_, "led")), followed by the linker
+            self.user_create(n, full, args)
             return
         if recv is not None and last.startswith("create_") and s.is_handle(args[0]):
             # rclcpp's node methods never take a node first: a user's method of the same name

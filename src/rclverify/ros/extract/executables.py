@@ -27,6 +27,7 @@ from __future__ import annotations
 from rclverify.ros.extract import safefs
 
 import fnmatch
+import re
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -224,8 +225,12 @@ def _read(cmds: list[tuple[str, list[str], int]], root: Path, t: Targets, auto_l
                     t.components[args[args.index("EXECUTABLE") + 1]] = (cls, line)
                 declare("component", cls, line, [])
         elif name == "rclcpp_components_register_nodes" and len(args) > 1:
-            for a in args[1:]:
-                if "::" in a:
+            # (target [RESOURCE_INDEX index] class...): each class, in a namespace or not
+            rest = args[1:]
+            if rest[0] == "RESOURCE_INDEX":
+                rest = rest[2:]
+            for a in rest:
+                if re.fullmatch(r":*[A-Za-z_]\w*(::[A-Za-z_]\w*)*", a):
                     t.plugins[a.lstrip(":")] = args[0]
                     declare("component", a.lstrip(":"), line, [])
         elif name in ("catkin_install_python", "install") and "PROGRAMS" in args:

@@ -271,6 +271,8 @@ class Linker(LinkMembers, Values, Returns, Instances):
     def _callee(self, kind: str, callee: str, unit: str | None) -> tuple[str | None, str | None]:
         if self.py:
             return self._py_callee(callee)
+        if kind == "own-node":  # a member made here that runs on a node of its own: no class of the program
+            return None, None
         if kind == "member":
             info = self.units.get(unit or "", {})
             ty = info.get("members", {}).get(callee)
@@ -301,7 +303,10 @@ class Linker(LinkMembers, Values, Returns, Instances):
             if cls is not None:
                 return self._ctor(cls), cls
         if recv is not None and recv.replace("this", "").strip("()*&") and unit:
-            ty = self.units.get(unit, {}).get("members", {}).get(recv.replace("this->", "").strip())
+            held = recv.replace("this->", "").strip()
+            if held.endswith("]") and "[" in held:  # an element of a member container: leds_[i]->on()
+                held = held[:held.index("[")]
+            ty = self.units.get(unit, {}).get("members", {}).get(held)
             cls = self.match(_held(ty), unit) if ty else None
             if ty is None and "->" not in recv and "." not in recv:  # a local (auto node = shared_from_this())
                 own = self.inherited(unit, meth)
@@ -645,6 +650,9 @@ def _held(ty: str | None) -> str:
     if not ty:
         return ""
     head, args = split_template(ty.replace(" ", ""))
-    if head.split("::")[-1] in ("shared_ptr", "unique_ptr", "weak_ptr", "Ptr", "SharedPtr", "vector", "optional") and args:
+    if head.split("::")[-1] in ("shared_ptr", "unique_ptr", "weak_ptr", "Ptr", "SharedPtr", "vector", "optional",
+                                "array", "deque", "list") and args:
         return _held(args[0])
+    if head.split("::")[-1] in ("map", "unordered_map") and len(args) == 2:  # a map's element is its value
+        return _held(args[1])
     return head

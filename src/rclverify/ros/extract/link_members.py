@@ -118,9 +118,12 @@ class LinkMembers:
             if not self.runs(unit, None):
                 continue
             last = split_template(m.replace(" ", ""))[0].split("::")[-1] if base else m
-            inits: list[tuple[Any, ...] | None] = [c for c in self.calls if c[0] == "member" and c[4] == unit and
+            inits: list[tuple[Any, ...] | None] = [c for c in self.calls if c[0] in ("member", "own-node")
+                                                   and c[4] == unit and
                      (c[1] == m or base and split_template(c[1].replace(" ", ""))[0].split("::")[-1] == last)]
             for c in inits or [None]:
+                if c is not None and c[0] == "own-node":  # a TransformListener given no node (said at it)
+                    continue
                 args = c[2] if c else []
                 at, fkey = (c[5], c[3]) if c else (src, None)
                 for kind, nv, t, hv in self.helper(ty, args) or []:

@@ -209,10 +209,7 @@ class _File(CallReader, MemberReader):
             self.actionlib(_ACTIONLIB[base], targs[0], args, at)
             return
         if cpp_helpers.own_node(type_text, args, self.ros2):
-            self.out["notes"].append(Note(self.src(at), "tf2_ros::TransformListener made without a node subscribes "
-                                                        "/tf and /tf_static on tf2's own node "
-                                                        "(transform_listener_impl_...), not on this one",
-                                          "ROS-TF-OWN-NODE"))
+            self.own_node(at)
             return
         specs = cpp_helpers.constructed(type_text, args, self.scope.value, self.ros2, self.aliases)
         if specs is not None:
@@ -220,6 +217,12 @@ class _File(CallReader, MemberReader):
             return
         if head and not head.startswith(LIBRARY):  # with its template arguments (a template's types)
             self.record("ctor", type_text.replace("typename", "").strip() if targs else head, args, at)
+
+    def own_node(self, at: Any) -> None:
+        self.out["notes"].append(Note(self.src(at), "tf2_ros::TransformListener made without a node subscribes "
+                                                    "/tf and /tf_static on tf2's own node "
+                                                    "(transform_listener_impl_...), not on this one",
+                                      "ROS-TF-OWN-NODE"))
 
     def actionlib(self, kind: str, ty: str, args: list[Any], at: Any) -> None:
         if not args:
@@ -351,6 +354,11 @@ class _File(CallReader, MemberReader):
                       "lifecycle" if kind == "lifecycle" else None, list(a))
             if "::" in h and "rclcpp" not in h:  # a workspace base (pkg_util::LifecycleNode): the linker runs it too
                 self.record("member", h, list(args.named_children), n)
+            return
+        ty = self.scope.type_of(head)  # a member tf_(buffer_) declared tf2_ros::TransformListener tf_;
+        if ty is not None and cpp_helpers.own_node(self.aliases.get(ty, ty), list(args.named_children), self.ros2):
+            self.own_node(n)
+            self.record("own-node", h, [], n)  # initialised here: the linker makes no default one
             return
         self.record("member", h, list(args.named_children), n)
 
