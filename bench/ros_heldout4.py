@@ -78,10 +78,15 @@ def measure(root: Path, truth: dict[str, Any], verbose: bool = False,
     confirmed that a row of ``rejudged`` with verdict ``real`` names: this
     tree's rows of ``ros_heldout4_rejudged.json``), ``missed``/``noted``,
     ``seconds`` (the scan's wall time) and ``lines`` (C++/Python lines scanned)."""
-    rejudged = rejudged or []
     t0 = time.perf_counter()
     g = scan([root / d for d in truth["scan"]], [], base=root).graph
-    seconds = time.perf_counter() - t0
+    return judge(g, root, truth, time.perf_counter() - t0, verbose, rejudged)
+
+
+def judge(g: Any, root: Path, truth: dict[str, Any], seconds: float, verbose: bool = False,
+          rejudged: list[list[str]] | None = None) -> dict[str, float]:
+    """:func:`measure`'s counts for graph ``g``, a scan of ``root`` that took ``seconds``."""
+    rejudged = rejudged or []
     own = tuple("" if d in (".", "") else d.rstrip("/") + "/" for d in truth["own"])
     lib = list(truth.get("library", []))
     nodes = [n for n in g.nodes.values() if any(s.startswith(own) for s in n.sources)]
