@@ -44,6 +44,7 @@ from rclverify.lang.errors import RclError
 from rclverify.diagnosis import blame, repairs as rep
 from rclverify.diagnosis.code_repair import checked_repairs
 from rclverify.diagnosis.constants import hoare_repair
+from rclverify.diagnosis.hoare_tokens import hoare_token_repairs
 from rclverify.diagnosis.deadline import budget_repairs, deadline_record
 from rclverify.diagnosis.requirement import requirement_record
 from rclverify.diagnosis.sidecond import side_condition_repairs
@@ -471,7 +472,11 @@ def _hoare(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson, cach
     # entry and guarantee gets the same repair, searched once; the case study's c2 and c3)
     reps = cache.get(["hoare", node, k, program, before],
                      lambda: hoare_repair(ws, node, k, program, before), extra_file=program)
+    # no change of constants: the one-token corrections of the program, each checked by Z3 the same way
+    tokens = [] if reps else cache.get(["hoare-token", node, k, program, before],
+                                       lambda: hoare_token_repairs(ws, node, k, program, before),
+                                       extra_file=program) or []
     return _record(e["obligation"], "hoare", node, e["status"], sentence,
                    culprits=[{"what": f"{program} line {c.split(':')[1]}", "source": c.split(': ', 1)[0], "text": c.split(': ', 1)[1]}
                              for c in prog_consts] + [{"what": f"conjunct of guarantee {k} of {node}", "source": conj_src, "text": conj}],
-                   counterexample=table, repairs=[reps] if reps else [], guarantee=k)
+                   counterexample=table, repairs=[reps] if reps else tokens, guarantee=k)

@@ -18,6 +18,9 @@ The kinds (docs/diagnosis.md), each in its module:
     a refuted requirement.
 ``constant`` (:mod:`.constants`)
     a refuted Hoare triple: the program's constants changed to the guarantee's.
+``program`` (:mod:`.hoare_tokens`)
+    a refuted Hoare triple no change of constants repairs: a one-token correction of the program (an
+    operator's strictness, ``and``/``or``, ``+``/``-``, a number moved by one), every triple proved again.
 ``code`` (:mod:`.code_repair`)
     a failing property test: a one-token correction of the implementation's culprit line, checked by
     running the node's property tests again on a scratch copy (not by Z3 alone).
