@@ -234,8 +234,11 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
     ws = live_workspace(tmp, RCL, MAPPING)
     env = ros2_env(tmp)
     system = monitor = nan = None
+    # the lateness bound of a loaded machine (three test workers on two cores: a reader's delivery was seen
+    # 97 ms late): a verdict given before a question heard later than the bound is not withdrawn
+    # (docs/semantics.md, "Not yet done"), so this run is heard within a bound its delays stay under
     common = ["--live", "--ros2", "--mapping", "mapping.yaml", "--horizon", "0.5", "--status", "0",
-              "--duration", "60", "--source", source, "--ros2-python", str(py)]
+              "--duration", "60", "--source", source, "--ros2-python", str(py), "--reorder-window", "0.3"]
     try:
         system = start_node(tmp, "system", SYSTEM, env)
         wait_for(tmp / "system.log", "before", 30)  # the publishers ran before any monitor
