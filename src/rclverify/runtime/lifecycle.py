@@ -22,7 +22,9 @@ that type and no ``matches`` (``lifecycle_msgs/TransitionEvent battery/transitio
   after it (a transition event heard after the output, on its own topic, still counts), and at
   the end of the run for the rest.  Each violation names the node, the topic, the time and the
   state it was published in;
-* the transition events themselves are the gate's: the guarantees' judge never sees them.
+* the transition events are the gate's, counted as heard (:attr:`LifecycleGate.heard`, what the
+  run's "not judged" list reads); the guarantees' judge never sees them, and the run's log does
+  not hold them.
 
 :class:`LifecycleGate` is the gate a live run (:class:`rclverify.runtime.live.LiveRun`,
 ``gate``, made by :func:`gate_of` from the monitored nodes) asks for every message before its
@@ -139,6 +141,8 @@ class LifecycleGate:
         self.violations: list[dict[str, Any]] = []
         self.outputs_judged = 0
         self.not_questions: dict[str, int] = {}
+        #: transition topic -> events heard on it
+        self.heard: dict[str, int] = {}
 
     def topics(self) -> dict[str, str]:
         """The transition topics to read (judge keys) and their message type."""
@@ -146,7 +150,7 @@ class LifecycleGate:
 
     def admit(self, topic: str, fields: Mapping[str, object], received: float) -> bool:
         """Whether the message goes on to the guarantees' judge (module docstring); a transition
-        event updates its node's state and is the gate's; outputs older than ``settle`` are decided."""
+        event updates its node's state; outputs older than ``settle`` are decided."""
         self._decide(received - self.settle)
         m = self.events.get(topic)
         if m is not None:
@@ -157,6 +161,7 @@ class LifecycleGate:
                 m.times.insert(k, at)
                 m.states.insert(k, goal)
                 m.transitions += 1
+            self.heard[topic] = self.heard.get(topic, 0) + 1
             return False
         for m in self.managed.values():
             if topic in m.outputs:
