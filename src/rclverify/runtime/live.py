@@ -255,7 +255,8 @@ class LiveRun:
         ``topic_deadlines``, ``decode_errors``, ``warnings``, ``qos``); each
         ``pending`` node of ``record["nodes"]`` gets the reason added to its
         explanation."""
-        heard = Heard({**{t: s.received for t, s in self.engine.topics.items()}, **self.calls_heard},
+        heard = Heard({**{t: s.received for t, s in self.engine.topics.items()}, **self.calls_heard,
+                       **(self.gate.heard if self.gate is not None else {})},
                       dict(self.orphans), dict(record.get("decode_errors") or {}), list(record.get("warnings") or ()),
                       {k: int(v.get("publishers_heard", 0)) for k, v in record["qos"].items()}
                       if isinstance(record.get("qos"), dict) else None, unseen_links(record))
