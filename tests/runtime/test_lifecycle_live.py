@@ -1,0 +1,126 @@
+"""A real rclpy LifecycleNode (``rclpy.lifecycle``) on Fast DDS, monitored live by ``rclverify monitor --live
+--ros2 --source rclpy`` (tests/_ros2.py; runtime/lifecycle.py, docs/monitors.md "Lifecycle nodes").
+
+The node ``/battery`` publishes its ``level`` every 50 ms from a timer; a second node sends a ``request``
+every 100 ms.  Its contract names ``battery/transition_event``, so the monitor reads its transitions: it is
+configured (inactive) for 1 s, active for 1 s, deactivated for 1 s.  The correct node publishes through a
+lifecycle publisher, which is silent outside ``active``: no lifecycle violation, and the requests sent while
+it is inactive are no questions.  The defective node publishes through a plain publisher, whatever its
+state: its outputs while inactive are red, with their state; those while active are not."""
+from __future__ import annotations
+
+import json
+import signal
+import time
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+
+from _procs import stop, wait_for
+from _ros2 import rclverify, ros2_env, ros2_python, start_node
+
+RCL = """\
+node Battery {
+  inputs( request : REAL )
+  outputs( level : REAL )
+  topics( std_msgs/Float64 request matches(in.request), std_msgs/Float64 level matches(out.level),
+          lifecycle_msgs/TransitionEvent battery/transition_event )
+  assume( in.request >= 0 )
+  guarantee( out.level >= in.request )
+}
+"""
+
+NODES = """\
+import sys, time
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.lifecycle import LifecycleNode
+from rclpy.node import Node
+from std_msgs.msg import Float64
+
+DEFECT = sys.argv[1] == "defect"
+rclpy.init()
+battery = LifecycleNode("battery")
+pub = (battery.create_publisher if DEFECT else battery.create_lifecycle_publisher)(Float64, "level", 10)
+battery.create_timer(0.05, lambda: pub.publish(Float64(data=10.0)))
+requester = Node("requester")
+req = requester.create_publisher(Float64, "request", 10)
+requester.create_timer(0.1, lambda: req.publish(Float64(data=1.0)))
+ex = SingleThreadedExecutor()
+ex.add_node(battery)
+ex.add_node(requester)
+print("ready", flush=True)
+until = time.monotonic() + 40  # the monitor's readers matched, the transition topic's too
+while time.monotonic() < until and not (pub.get_subscription_count() and req.get_subscription_count()
+                                        and battery.get_subscriptions_info_by_topic("/battery/transition_event")):
+    ex.spin_once(timeout_sec=0.05)
+steps = [(1.0, battery.trigger_configure), (2.0, battery.trigger_activate), (3.0, battery.trigger_deactivate),
+         (4.0, None)]
+t0 = time.monotonic()
+for at, step in steps:  # every transition and every publication in the executor's one thread
+    while time.monotonic() < t0 + at:
+        ex.spin_once(timeout_sec=0.01)
+    if step is not None:
+        print(step.__name__, step(), flush=True)
+print("done", flush=True)
+while rclpy.ok():
+    ex.spin_once(timeout_sec=0.1)
+"""
+
+
+def _run(tmp: Path, variant: str) -> dict[str, Any]:
+    py = ros2_python()  # skips, with the reason, without a ROS 2 Python
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/b.rcl").write_text(RCL)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/b.rcl]\n")
+    env = ros2_env(tmp)
+    node = monitor = None
+    try:
+        monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--status", "0", "--duration", "90",
+                             "--horizon", "1", "--source", "rclpy", "--ros2-python", str(py), "--log",
+                             str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json")], env, tmp, tmp / "monitor.out")
+        node = start_node(tmp, "battery", NODES.replace("sys.argv[1]", repr(variant)), env)
+        wait_for(tmp / "battery.log", "done", 80)
+        time.sleep(1.0)  # the last outputs heard, and settled
+        stop(monitor, signal.SIGINT)
+        out = (tmp / "monitor.out").read_text()
+        assert (tmp / "live.json").exists(), out + (tmp / "battery.log").read_text()
+        return {"out": out, "record": json.loads((tmp / "live.json").read_text()),
+                "node": (tmp / "battery.log").read_text()}
+    finally:
+        for p in (node, monitor):
+            if p is not None:
+                stop(p)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, dict[str, Any]]]:
+    yield {v: _run(tmp_path_factory.mktemp(v), v) for v in ("correct", "defect")}
+
+
+def _lifecycle(run: dict[str, Any]) -> dict[str, Any]:
+    rec = run["record"]
+    assert "lifecycle" in rec and "not judged: topic /battery/transition_event" not in run["out"], run["out"]
+    [node] = rec["lifecycle"]["nodes"]
+    assert node["ros_node"] == "/battery" and node["transitions"] >= 6, (node, run["node"])
+    assert node["state"] == "inactive", node
+    return node
+
+
+def test_a_lifecycle_publisher_is_green_and_requests_while_inactive_are_no_questions(runs: dict[str, Any]) -> None:
+    run = runs["correct"]
+    node = _lifecycle(run)
+    assert node["status"] == "discharged" and node["violations"] == [] and node["outputs_judged"] >= 5, node
+    assert run["record"]["lifecycle"]["not_questions"].get("request", 0) >= 5, run["record"]["lifecycle"]
+    [res] = run["record"]["nodes"]
+    assert res["counts"]["satisfied"] >= 3 and res["counts"]["violated"] == 0, res["counts"]
+
+
+def test_a_plain_publisher_of_a_lifecycle_node_is_red_while_inactive_only(runs: dict[str, Any]) -> None:
+    node = _lifecycle(runs["defect"])
+    assert node["status"] == "failed" and len(node["violations"]) >= 10, node
+    assert {v["state"] for v in node["violations"]} <= {"unconfigured", "inactive", "configuring"}, node
+    assert node["outputs_judged"] > len(node["violations"]), node  # its outputs while active are not red
+    assert all("/battery published on /level while" in v["reason"] for v in node["violations"])
