@@ -48,8 +48,7 @@ from rclverify.model.plan.fret.requirements import Options, import_export  # noq
 
 #: Words RCL's grammar keeps for itself: a FRET variable so named gets no port in the generated contract.
 RESERVED = {"and", "or", "not", "in", "forall", "exists", "exists_unique", "TRUE", "FALSE", "REAL", "INTEGER",
-            "NATURAL", "BOOL", "STRING", "x", "set", "seq", "node", "context", "inputs", "outputs", "assume",
-            "guarantee", "topics", "abs", "out", "state", "next"}
+            "NATURAL", "BOOL", "STRING"}
 INTEGERS = ("integer", "int", "int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64")
 
 
@@ -63,7 +62,8 @@ def reason_kind(reason: str) -> str:
                       (r"the timing (\w+) with scope (\w+) and condition (\w+)", r"timing \1 (scope \2, condition \3)"),
                       (r"does not parse", "FRETish expression rclverify does not parse"),
                       (r"has no (input|output) named", "variable not a port of the node"),
-                      (r"has not formalised it", "not formalised by FRET")):
+                      (r"has not formalised it", "not formalised by FRET"),
+                      (r"pre function's initial value", "a pre function whose initial value reads variables")):
         m = re.search(pat, reason)
         if m:
             return m.expand(kind)

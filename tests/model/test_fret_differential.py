@@ -77,6 +77,8 @@ CASES: list[tuple[str, str, str, str, str | None, str, dict[str, Any], str]] = [
      "(H ((manual & (Z (! manual))) -> braking))"),
     ("PREBOOL", "null", "noTrigger", "immediately", "(! obstacle & preBool ( false , obstacle ))", "(! braking)", {},
      "(H (((! obstacle) & (Y obstacle)) -> (! braking)))"),
+    ("NESTED-PRE", "null", "noTrigger", "immediately", "(preBool ( false , speed - preReal ( 0.0 , speed ) <= 1.0 ))",
+     "(braking)", {}, "(H ((Y ((speed - preReal(0.0,speed)) <= 1.0)) -> braking))"),
 ]
 
 
@@ -95,8 +97,8 @@ def _export(cases: list[Any]) -> FretExport:
 
 # ---- the oracle: FRET's past-time LTL over a finite trace, at its last step ----
 
-_TOK = re.compile(r"\s*(O\[\d+,\d+\]|H\[\d+,\d+\]|<->|->|<=|>=|\d+\.\d+|\d+|[A-Za-z_][A-Za-z0-9_]*|[()!&|=<>+\-*/])")
-_BIN = [("<->",), ("->",), ("|",), ("&",), ("S",), ("=", "<", "<=", ">", ">=")]
+_TOK = re.compile(r"\s*(O\[\d+,\d+\]|H\[\d+,\d+\]|<->|->|<=|>=|\d+\.\d+|\d+|[A-Za-z_][A-Za-z0-9_]*|[()!&|=<>+\-*/,])")
+_BIN = [("<->",), ("->",), ("|",), ("&",), ("S",), ("=", "<", "<=", ">", ">="), ("+", "-"), ("*", "/")]
 
 
 def _pt_parse(text: str) -> Any:
@@ -136,6 +138,13 @@ def _pt_parse(text: str) -> Any:
             return ("const", t == "TRUE")
         if t[0].isdigit():
             return ("const", Fraction(t))
+        if peek() == "(":  # preReal(init, e): FRET's pt keeps Lustre's "init -> pre e" as a call
+            take()
+            init = level(0)
+            assert take() == ","
+            e = level(0)
+            assert take() == ")"
+            return ("pre", init, e)
         return ("var", t)
     e = level(0)
     assert peek() is None, text
@@ -150,6 +159,11 @@ def _pt(e: Any, tr: list[dict[str, Any]], i: int) -> Any:
         return tr[i][e[1]]
     if op == "!":
         return not _pt(e[1], tr, i)
+    if op == "pre":
+        return _pt(e[1], tr, i) if i == 0 else _pt(e[2], tr, i - 1)
+    if op == "+" or op == "-" or op == "*" or op == "/":
+        a, b = _pt(e[1], tr, i), _pt(e[2], tr, i)
+        return {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else None}[op]
     if op == "Y":
         return i > 0 and _pt(e[1], tr, i - 1)
     if op == "Z":

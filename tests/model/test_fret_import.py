@@ -136,6 +136,9 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
         _req("MODE-TRIGGER", "in manual mode upon obstacle the rover shall immediately satisfy braking", "immediately",
              "(braking)", "regular", "(obstacle)", scope_mode="manual"),
         {"reqid": "NOSEM", "fulltext": "not parsed by FRET"},
+        _req("PRE-INIT", "whenever preBool(false, speed - preReal(speed, speed) <= 1.0) the rover shall immediately "
+                         "satisfy braking", "immediately", "(braking)", "noTrigger",
+             "(preBool ( false , speed - preReal ( speed , speed ) <= 1.0 ))"),
         _req("OK", "the rover shall never satisfy speed > 2.0", "never", "(speed > 2.0)"),
     ]
     reqs[3]["semantics"]["scope"] = {"type": "in"}
@@ -148,6 +151,8 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
     assert why["FUNCTION"] is not None and "FRET function persisted(_, _)" in why["FUNCTION"][0]
     assert why["MODE-TRIGGER"] is not None and "a trigger inside a mode interval" in why["MODE-TRIGGER"][0]
     assert why["NOSEM"] is not None and "FRET has not formalised it" in why["NOSEM"][0]
+    assert why["PRE-INIT"] == ("a pre function's initial value out.speed reads the component's variables",
+                               "give it a constant initial value (preReal(0.0, e))")
     assert why["OK"] is None and got["OK"].requirement.formal is not None  # the control
     assert got["OK"].requirement.formal.text == "always (not (rover.out.speed > 2.0))"
 

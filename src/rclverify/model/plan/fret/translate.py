@@ -154,10 +154,12 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
     states = _States(state_base(reqid))
 
     def pre(type_name: str, init: Expr, e: Expr) -> str:
-        init_text = w.rcl(init, True)
-        if type_name == "BOOL":
-            return states.add(f"pre{len(states.made) + 1}", type_name, init_text, f"@ <=> {w.rcl(e, True)}")
-        return states.add(f"pre{len(states.made) + 1}", type_name, init_text, f"@ == {w.rcl(e, True)}")
+        init_text, body = w.rcl(init, True), w.rcl(e, True)  # an inner pre is declared first
+        if re.search(r"(?<![A-Za-z0-9_])(in|out|state)\.", init_text):
+            raise Refusal(f"a pre function's initial value {init_text} reads the component's variables",
+                          "give it a constant initial value (preReal(0.0, e))")
+        return states.add(f"pre{len(states.made) + 1}", type_name, init_text,
+                          f"@ <=> {body}" if type_name == "BOOL" else f"@ == {body}")
     w = Writer(var, pre, node)
 
     def field_expr(key: str, *alt: str) -> Expr:
