@@ -99,7 +99,8 @@ def exp_refused(exp: FretExport) -> set[str]:
 
 def decide(export: Path, exp: FretExport, out: collections.Counter[str]) -> None:
     """Decide the translated requirements of ``export`` in a workspace of their own (module docstring)."""
-    from rclverify.app.pipeline import Workspace, stage_check, stage_requirements
+    from rclverify.app.pipeline import stage_check, stage_requirements
+    from rclverify.stages.workspace import Workspace
     from rclverify.lang.errors import RclError
     raw = json.loads(export.read_text(encoding="utf-8-sig"))
     reqs = raw if isinstance(raw, list) else raw["requirements"]
