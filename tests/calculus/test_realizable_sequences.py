@@ -18,7 +18,8 @@ from rclverify.lang.parser import parse_formula, parse_text
 from rclverify.lang.typecheck import check
 from rclverify.semantics import world
 from rclverify.stages.crosscheck.cvc5_decide import decide
-from rclverify.stages.workspace import Workspace, stage_inputs
+from rclverify.stages.provenance import stage_inputs
+from rclverify.stages.workspace import Workspace
 
 #: Every item at most the input, one item equal to it: realizable (``<in.x>``).
 ECHO = """

@@ -130,7 +130,8 @@ def test_an_edit_off_the_named_path_makes_the_recorded_deadline_stale(tmp_path) 
     from rclverify.stages.deadlines import read_deadlines
     from rclverify.stages.contract_texts import ContractTexts
     from rclverify.app.pipeline import stage_check, stage_deadlines
-    from rclverify.stages.workspace import Workspace, current_snapshot_hashes
+    from rclverify.stages.provenance import current_snapshot_hashes
+    from rclverify.stages.workspace import Workspace
     (tmp_path / "contracts").mkdir()
     rcl = tmp_path / "contracts/s.rcl"
     rcl.write_text(DIAMOND.replace("within 400 ms", "within 40 ms"))

@@ -1,4 +1,5 @@
-"""Every sealed record the stages write is its TypedDict (records/stage_records.py), key by key.
+"""Every sealed record the stages write is its TypedDict (records/stage_records.py, records/composition_records.py,
+records/crosscheck_records.py), key by key.
 
 The case study's stages run once on a copy of the repository root's workspace (contracts, backends'
 inputs, the robot's code): check, compose, health, export per node, deadlines, requirements, the second
@@ -19,7 +20,7 @@ from typing import Any, Iterator, NotRequired, TypedDict
 import msgspec
 import pytest
 
-from rclverify.records import stage_records as sr
+from rclverify.records import composition_records as cr, crosscheck_records as xr, stage_records as sr
 from rclverify.records.findings import HealthFinding
 from rclverify.records.records import Obligation
 from rclverify.records.sealed import read_sealed
@@ -141,14 +142,14 @@ def test_the_returned_records_are_their_types(run: tuple[Path, dict[str, Any]]) 
     verdicts = {r["id"]: r["verdict"] for r in out["requirements"]}
     assert verdicts["EXTRA-INFORMAL"] == "informal" and verdicts["EXTRA-REFUTED"] == "refuted"
     assert any(r["id"] == "EXTRA-REFUTED" and r.get("counterexample") for r in out["requirements"])
-    _check(out["check"], sr.CheckRecord, "check")
+    _check(out["check"], cr.CheckRecord, "check")
     for n in out["compose"]:
-        _check(out["compose"][n], sr.CompositionRecord, f"compose[{n}]")
+        _check(out["compose"][n], cr.CompositionRecord, f"compose[{n}]")
         assert out["health"][n] and all(type(f) is HealthFinding for f in out["health"][n]), n
         assert out["export"][n] and all(type(o) is Obligation for o in out["export"][n]), n
     _check(out["deadlines"], list[sr.DeadlineRecord], "deadlines")
     _check(out["requirements"], list[sr.RequirementRecord], "requirements")
-    _check(out["crosscheck"], sr.CrosscheckRecord, "crosscheck")
+    _check(out["crosscheck"], xr.CrosscheckRecord, "crosscheck")
     _check(out["ground"], sr.GroundingRecord, "ground")
     kinds = {d["kind"] for d in out["diagnosis"]["diagnoses"]}
     assert {"requirement", "vacuity", "refinement"} <= kinds, kinds  # EXTRA-REFUTED among them
@@ -158,9 +159,9 @@ def test_the_returned_records_are_their_types(run: tuple[Path, dict[str, Any]]) 
 def test_the_sealed_records_are_their_types(run: tuple[Path, dict[str, Any]]) -> None:
     from rclverify.stages.workspace import Workspace as W
     root, out = run
-    _check(_sealed(root, W.DIAGNOSTICS), sr.CheckRecord, W.DIAGNOSTICS)
+    _check(_sealed(root, W.DIAGNOSTICS), cr.CheckRecord, W.DIAGNOSTICS)
     for n in out["compose"]:
-        _check(_sealed(root, W.calculus(n)), sr.CompositionRecord, W.calculus(n))
+        _check(_sealed(root, W.calculus(n)), cr.CompositionRecord, W.calculus(n))
         health = _sealed(root, W.health(n))
         assert set(health) == {"node", "findings"} and health["node"] == n
         # the one definition decodes the record (an undeclared key or a value of another type is refused)
@@ -176,7 +177,7 @@ def test_the_sealed_records_are_their_types(run: tuple[Path, dict[str, Any]]) ->
     assert len(reqs) == len(out["requirements"])
     for p in reqs:
         _check(_sealed(root, f"artifacts/requirements/{p.name}"), sr.RequirementRecord, p.name)
-    _check(_sealed(root, "artifacts/crosscheck/index.json"), sr.CrosscheckRecord, "crosscheck")
+    _check(_sealed(root, "artifacts/crosscheck/index.json"), xr.CrosscheckRecord, "crosscheck")
     _check(_sealed(root, "artifacts/ros/grounding.json"), sr.GroundingRecord, "grounding")
     _check(_sealed(root, "artifacts/diagnosis/index.json"), sr.DiagnosisRecord, "diagnosis")
 
@@ -210,13 +211,13 @@ def test_the_checker_fails_on_an_unknown_key_a_missing_key_and_a_wrong_type(
         run: tuple[Path, dict[str, Any]]) -> None:
     _, out = run
     good = out["compose"]["Agent"]
-    _check(good, sr.CompositionRecord, "good")
+    _check(good, cr.CompositionRecord, "good")
     for bad, word in ((dict(good, extra=1), "'extra' is not declared"),
                       ({k: v for k, v in good.items() if k != "node"}, "required key 'node'"),
                       (dict(good, cone_size="4"), "is not int"),
                       (dict(good, side_conditions=[dict(good["side_conditions"][0], surprise=True)]),
                        "'surprise' is not declared")):
-        problems = list(_problems(bad, sr.CompositionRecord, "bad"))
+        problems = list(_problems(bad, cr.CompositionRecord, "bad"))
         assert any(word in p for p in problems), problems
     assert list(_problems({"rows": [{"n": 1}, {"n": 2, "note": None}], "by": {"a": 1, "b": 0.5}}, _Outer, "x")) == []
     assert list(_problems({"rows": [{"n": True}], "by": {}}, _Outer, "x")) == ["x.rows[0].n: True is not int"]

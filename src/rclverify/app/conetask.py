@@ -6,7 +6,7 @@ derived property), and, only when a side condition failed locally and was
 decided in context, every contract and fact of the cone (docs/calculus.md).
 ``check`` writes each node's cone digest, ``artifacts/cones/<Node>.sha256``:
 a line ``env <sha256>`` for the first and ``cone <sha256>`` for the second
-(:func:`rclverify.stages.workspace.cone_digests`).
+(:func:`rclverify.stages.cone_digests.cone_digests`).
 
 Making the digest file a file dependency of every node task would re-run the
 ``compose`` stage of every node downstream of an edit: after editing the

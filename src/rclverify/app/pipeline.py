@@ -39,10 +39,11 @@ from rclverify.records.ties import tie_query
 from rclverify.semantics.world import fresh as fresh_z3
 from rclverify.lang.errors import RclError, error
 # The workspace and what is derived from it without a stage live below the report
-# (rclverify.stages.workspace); re-exported here for the stages' callers.
-from rclverify.stages.workspace import (PLAN, REPORT_PARTS, TaskIndex, Workspace, cone_digests, current_model_hash,  # noqa: F401
-                        current_snapshot_hashes, drop_old_provenance, environment_sha, node_snapshots, read_artifact, record_provenance, stage_inputs, stale_stages,
-                        write_check_index)
+# (rclverify.stages.workspace, rclverify.stages.provenance); re-exported here for the stages' callers.
+from rclverify.stages.workspace import PLAN, REPORT_PARTS, TaskIndex, Workspace, read_artifact  # noqa: F401
+from rclverify.stages.cone_digests import cone_digests
+from rclverify.stages.provenance import (drop_old_provenance, environment_sha, node_snapshots, record_provenance,
+                                         stage_inputs, write_check_index)
 from rclverify.records.sealed import read_sealed
 
 if TYPE_CHECKING:
@@ -50,8 +51,8 @@ if TYPE_CHECKING:
     from rclverify.records.findings import HealthFinding
     from rclverify.model.plan.model import EvidenceEntry
     from rclverify.records.report_schema import Report
-    from rclverify.records.stage_records import (CheckRecord, CompositionRecord, DeadlineRecord, DiagnosisRecord,
-                                                 RequirementRecord)
+    from rclverify.records.composition_records import CheckRecord, CompositionRecord
+    from rclverify.records.stage_records import DeadlineRecord, DiagnosisRecord, RequirementRecord
 
 # The parser, type checker, calculus, health checks, lint and backends are
 # imported where a stage uses them: a doit run that reuses the cached

@@ -31,7 +31,8 @@ from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines
 from rclverify.app.shapes import DoitTask
 from rclverify.app.task_checks import (RecordIntact, TargetsAsWritten, entry_inputs, ros_fingerprint, strict_uptodate,
                                        tool_fingerprint, z3_version)
-from rclverify.stages.workspace import REPORT_PARTS, TaskIndex, Workspace, check_input_files
+from rclverify.stages.provenance import check_input_files
+from rclverify.stages.workspace import REPORT_PARTS, TaskIndex, Workspace
 from rclverify.records.sealed import TargetsSealed, obligation_list
 
 _F = TypeVar("_F", bound=Callable[..., Any])
@@ -363,7 +364,7 @@ class TaskTable:
         # The plan itself: the report shows its name, requirements and their tracing, which no
         # other artifact holds (a plan edit that changes only those re-renders the report).
         deps = [str(rootp / self.plan_file)] + [at(p) for p in (ws.MODEL, ws.DIAGNOSTICS)] + list(self.snap.values())
-        # The files meta.inputs_sha256 hashes (workspace.check_inputs): the contract and replacement files
+        # The files meta.inputs_sha256 hashes (provenance.check_inputs): the contract and replacement files
         # themselves, not only the snapshots they give. An edit that changes none of the snapshots (a comment
         # after the last node) left the report naming the old files' sha256, and the bundle then refused a
         # report `doit verify` called up to date.

@@ -60,7 +60,7 @@ from typing import Any, Mapping, Sequence, TypedDict
 import z3
 
 from rclverify.semantics.encode import Encoder
-from rclverify.records.stage_records import RuleInstance
+from rclverify.records.composition_records import RuleInstance
 from rclverify.semantics.nicemodel import nicer_model
 from rclverify.calculus.context import ConeContext
 from rclverify.calculus.side_condition import (IN_CONTEXT as IN_CONTEXT, STATUS as STATUS,

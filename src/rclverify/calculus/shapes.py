@@ -12,7 +12,7 @@ from typing import TypedDict
 
 from rclverify.records.stage_records import Premise, Traced
 # sealed in the compose stage's record, so defined with it (records/ is below calculus/)
-from rclverify.records.stage_records import ContextRecord as ContextRecord, LocalVerdict as LocalVerdict, ScaleMismatch as ScaleMismatch
+from rclverify.records.composition_records import ContextRecord as ContextRecord, LocalVerdict as LocalVerdict, ScaleMismatch as ScaleMismatch
 
 
 class IdleNode(TypedDict):

@@ -4,7 +4,7 @@ from __future__ import annotations
 import re
 
 from rclverify.records.report_schema import SideConditionJson
-from rclverify.records.stage_records import SideCondition
+from rclverify.records.composition_records import SideCondition
 
 
 def link_pairs(sc: SideConditionJson | SideCondition) -> list[tuple[str, str, str, str]]:

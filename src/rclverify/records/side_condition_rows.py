@@ -2,7 +2,7 @@
 
 The report's ``side_conditions[]`` holds every side condition of every
 node's composition (rules R1-R4, docs/calculus.md): the calculus stage's
-record (records/stage_records.py ``SideCondition``, sealed in
+record (records/composition_records.py ``SideCondition``, sealed in
 ``artifacts/calculus/<Node>.json``) as the report shows it
 (report/contract_rows.py): ``stale`` when made from another contract text,
 the second solver's agreement folded in (stages/crosscheck/apply.py), its

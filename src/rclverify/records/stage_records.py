@@ -1,5 +1,8 @@
 """The sealed records the stages write, as types: one TypedDict per stage record.
 
+The check and compose stages' records are in :mod:`.composition_records`,
+the second solver's in :mod:`.crosscheck_records`; the rest are here.
+
 Each stage of the pipeline (app/pipeline.py and the stages it calls) writes
 one JSON record under ``artifacts/`` (records/sealed.py seals it) and
 returns it; these TypedDicts are the static reading of those records, key
@@ -29,106 +32,6 @@ record the case study's stages return against these types.
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
 from typing import Any, NotRequired, TypedDict
-
-
-class LintWarning(TypedDict):
-    """One diagnostic of the check stage (lint, units across connections, unserved calls)."""
-    file: str
-    line: int
-    col: int
-    severity: str
-    code: str
-    message: str
-
-
-class CheckRecord(TypedDict):
-    """``artifacts/diagnostics.json``: the check stage's warnings."""
-    warnings: list[LintWarning]
-
-
-class EnvironmentAssumption(TypedDict):
-    """An assumption of a node that no producer in the system guarantees (rule R2's environment)."""
-    node: str
-    text: str
-    source: str
-
-
-class RuleInstance(TypedDict):
-    """One instance of a calculus rule (R1-R4) applied to the node."""
-    rule: str
-    shape: str
-    premises: list[str]
-    conclusion: str
-
-
-class LocalVerdict(TypedDict):
-    """A side condition's local verdict, kept when it is decided again in context."""
-    status: str
-    variant: str
-    model: dict[str, str] | None
-
-
-class ContextRecord(TypedDict):
-    """How a side condition's in-context check went (calculus/side_condition.py ``in_context``):
-    the cone's size, the premises and nodes the proof used, the links opened (rule R4), the nodes
-    whose assumption the counterexample violates, the joins read, the local verdict, and the
-    producers whose cone summaries the proof read."""
-    cone: int
-    used: list[str]
-    used_nodes: list[str]
-    opened: list[str]
-    violated: list[str]
-    joins: list[str]
-    local: LocalVerdict
-    summaries: NotRequired[list[str]]
-
-
-class ScaleMismatch(TypedDict):
-    """A probable scale mismatch behind a side condition (calculus/scale.py): both ends and their
-    ranges (text, ``-oo``/``+oo`` unbounded), the power of ten (0: a named conversion), the factor
-    and the sentence."""
-    producer: str
-    consumer: str
-    producer_range: list[str]
-    consumer_range: list[str]
-    power: int
-    factor: str
-    message: str
-
-
-class SideCondition(TypedDict):
-    """One side condition and its Z3 verdict (calculus/side_condition.py); ``duration_s`` in seconds."""
-    id: str
-    node: str
-    rule: str
-    conjunct: str
-    source: str
-    hypotheses: list[str]
-    status: str
-    duration_s: float
-    smt2: str
-    model: dict[str, str] | None
-    explanation: str
-    variant: str
-    links: list[str]
-    verdict: str
-    context: ContextRecord | None
-    scale_mismatch: NotRequired[list[ScaleMismatch]]
-
-
-class CompositionRecord(TypedDict):
-    """``artifacts/calculus/<Node>.json``: the calculus applied to one node."""
-    node: str
-    rules: list[str]
-    producers: list[str]
-    side_conditions: list[SideCondition]
-    environment_assumptions: list[EnvironmentAssumption]
-    instances: list[RuleInstance]
-    derived_property: str
-    loop_assumption: str | None
-    cone_size: int
-    cone_environment_assumptions: list[str]
-    guarantee: str
 
 
 class SourceRef(TypedDict):
@@ -288,47 +191,6 @@ class RequirementRecord(RequirementCheck):
     the side queries' ``*_smt2`` name the scripts kept beside it."""
     fingerprint: str
     inputs: dict[str, str]
-
-
-class SecondSolver(TypedDict):
-    """The second solver that decided the scripts again (cvc5; docs/second-solver.md)."""
-    name: str
-    version: str
-    rlimit: int
-
-
-class Cvc5Answer(TypedDict):
-    """cvc5's answer to one script (stages/crosscheck/cvc5_decide.py ``Decision.row``): ``sat``/``unsat``/
-    ``unknown``/``error``, the reason, whether its proof checked, its version, the time in seconds, and the
-    proof's path (``""`` without one)."""
-    answer: str
-    reason: str
-    proof_checked: bool
-    version: str
-    duration_s: float
-    proof: str
-
-
-class CrosscheckRow(TypedDict):
-    """One discharging item decided again: Z3's verdict, cvc5's answer (``cvc5``) and their agreement."""
-    kind: str
-    id: str
-    smt2: str
-    verdict: str
-    z3: str
-    sha256: str
-    key: str
-    cvc5: Cvc5Answer | None
-    agreement: str
-    why: str
-    via: NotRequired[str]
-
-
-class CrosscheckRecord(TypedDict):
-    """``artifacts/crosscheck/index.json``; ``solver`` is None when cvc5 is not installed."""
-    solver: SecondSolver | None
-    counts: dict[str, int]
-    items: list[CrosscheckRow]
 
 
 #: A function value's finite table (diagnosis/table.py ``function_table``): ``rows`` ``[args, value]``,
@@ -499,5 +361,5 @@ class NodlRecord(TypedDict):
     inputs: dict[str, str]
 
 
-__all__ = ["CheckRecord", "CompositionRecord", "CrosscheckRecord", "DeadlineRecord", "DiagnosisRecord", "GroundingRecord",
+__all__ = ["DeadlineRecord", "DiagnosisRecord", "GroundingRecord",
            "NodlRecord", "RequirementRecord"]

@@ -59,7 +59,8 @@ from rclverify.report.view import problem_items
 from rclverify.stages.crosscheck.apply import SecondSolver, load as load_second_solver
 from rclverify.stages.diagnoses import read_diagnoses
 from rclverify.stages.requirements import read_records
-from rclverify.stages.workspace import Workspace, current_snapshot_hashes, stale_stages
+from rclverify.stages.provenance import current_snapshot_hashes, stale_stages
+from rclverify.stages.workspace import Workspace
 
 
 class Inputs(NamedTuple):

@@ -78,7 +78,7 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
     """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
     docstring), each a :class:`~rclverify.records.deadline_rows.DeadlineRow`'s
     JSON object.  ``current``: path -> sha256 of the current snapshots and
-    model (:func:`rclverify.stages.workspace.current_snapshot_hashes`);
+    model (:func:`rclverify.stages.provenance.current_snapshot_hashes`);
     ``g_status(node, k)``: a guarantee's evidence status; ``ob_rows``: the
     report's obligation rows (``id``, ``node``, ``backend``, ``status``).
     ``second``: the second solver's verdicts (:class:`rclverify.stages.crosscheck.apply.SecondSolver`),

@@ -22,10 +22,10 @@ from rclverify.records.findings import HealthFinding
 from rclverify.records.records import Obligation, SourceRef
 from rclverify.records.sealed import obligation_list, read_sealed
 from rclverify.records.side_condition_rows import SideConditionRow
-from rclverify.records.stage_records import LintWarning
+from rclverify.records.composition_records import LintWarning
 from rclverify.stages.workspace import Workspace
 from rclverify.records.store import dumps
-from rclverify.stages.workspace import check_inputs
+from rclverify.stages.provenance import check_inputs
 
 
 def _error_side_conditions(node: str, body: dict[str, Any] | None, why: str) -> dict[str, Any]:
@@ -159,7 +159,7 @@ def inputs_sha256(ws: Workspace, made_from: Mapping[str, str], evidence_inputs: 
                   checks: Mapping[str, Mapping[str, object]], nodl: Mapping[str, object] | None = None) -> str:
     """One sha256 over what a report is built from, recorded in its
     ``meta.inputs_sha256``: the sha256 of the plan, contract and replacement
-    files (:func:`rclverify.stages.workspace.check_inputs`), of the contract
+    files (:func:`rclverify.stages.provenance.check_inputs`), of the contract
     snapshots and system model they give (``made_from``), the
     ``input_hashes`` of each obligation's evidence record
     (``evidence_inputs``: obligation id -> hashes, ``None`` without a

@@ -86,7 +86,7 @@ def read_deadlines(ws: "Workspace", current: Mapping[str, str] | None = None) ->
     shows every deadline ``error``); else the records, where one made from
     other inputs than ``current`` (path -> sha256 of the contract snapshots
     and model the current contracts and plan give,
-    :func:`rclverify.stages.workspace.current_snapshot_hashes`) has ``status``
+    :func:`rclverify.stages.provenance.current_snapshot_hashes`) has ``status``
     ``stale`` and its claim kept as ``recorded_status``."""
     body, why = read_sealed(ws.path(INDEX), "deadline record")
     if why:

@@ -166,7 +166,7 @@ def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict
       matches it): never the verdict it claims;
     * with ``current`` (path -> sha256 of the contract snapshots and model
       the current contracts and plan give,
-      :func:`rclverify.stages.workspace.current_snapshot_hashes`), a record made
+      :func:`rclverify.stages.provenance.current_snapshot_hashes`), a record made
       from other inputs (a hash differs, or it records none) is replaced by
       ``{"verdict": "stale", "recorded_verdict": ..., ...}``.
     """

@@ -188,7 +188,7 @@ def check_states(states: tuple[StateVar, ...], checked: Checked) -> list[Diagnos
 
 def state_key(node: str) -> str:
     """The key of ``node``'s state declarations among the hashes a
-    requirement record is compared with (``rclverify.stages.workspace.state_hashes``)."""
+    requirement record is compared with (``rclverify.stages.provenance.state_hashes``)."""
     return f"state:{node}"
 
 

@@ -36,7 +36,7 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from rclverify.records.stage_records import Cvc5Answer
+from rclverify.records.crosscheck_records import Cvc5Answer
 
 #: cvc5 resource units per check: some 150k units a second on the case
 #: study's heaviest quantified query, so about 10 s of work, the Z3 budget.

@@ -25,7 +25,7 @@ from typing import Any, Iterable, cast
 from rclverify.core import cpus as cpus_now
 from rclverify.core.forksafe import fork_is_safe
 from rclverify.records.sealed import read_sealed, write_sealed
-from rclverify.records.stage_records import CrosscheckRecord, Cvc5Answer
+from rclverify.records.crosscheck_records import CrosscheckRecord, Cvc5Answer
 from rclverify.records.store import atomic_write_text
 from rclverify.records.ties import proof_tie, tie_proof
 from rclverify.stages.crosscheck.cvc5_decide import RLIMIT, Decision, Session, decide, version
