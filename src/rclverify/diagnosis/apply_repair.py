@@ -36,6 +36,12 @@ from rclverify.diagnosis.repairs import text_sha256
 _PROBLEM = re.compile(r"^(?:problem\s*|p)?(?P<k>\d+)\.?$", re.IGNORECASE)
 
 
+#: The diagnosis kinds whose repairs are searched (docs/diagnosis.md, "Repairs"): a guard, a side
+#: condition's, a unit conversion, a requirement's, a deadline's, a Hoare program's, a code line's.
+SEARCHED = frozenset({"vacuity", "inconsistency", "side-condition", "unit", "requirement", "deadline", "hoare",
+                      "property-test"})
+
+
 class NotApplied(Exception):
     """A repair that is not written: where (``file`` as the repair names it, 1-based ``line`` and ``col``
     of its edit) and the one-line reason ``message``."""
@@ -98,15 +104,20 @@ def find_repairs(report: Mapping[str, Any], wanted: str) -> Found | None:
 def none_offered(found: Found) -> list[str]:
     """Why ``found`` offers no repair, one sentence each: a diagnosis's ``not_offered`` sentences (the
     repairs its checks showed do not work), else what kind of problem it is and that no edit tried passed
-    its checks, or that the id has no diagnosis at all."""
+    its checks (a kind in :data:`SEARCHED`) or that none is searched for its kind, or that the id has no
+    diagnosis at all."""
     if not found.diagnoses:
         return [f"{found.subject} has no diagnosis in the last report: nothing was searched"]
     out: list[str] = []
     for d in found.diagnoses:
-        said = [str(s) for s in d.get("not_offered") or []]
-        out += [f"{d.get('id')}: {s}" for s in said] or [
-            f"{d.get('id')} ({d.get('kind')}): no edit the diagnosis tried passed its checks "
-            "(docs/diagnosis.md says which edits are tried for this kind)"]
+        said = [f"{d.get('id')}: {s}" for s in d.get("not_offered") or []]
+        if not said and d.get("kind") in SEARCHED:
+            said = [f"{d.get('id')} ({d.get('kind')}): no edit the diagnosis tried passed its checks "
+                    "(docs/diagnosis.md, \"Repairs\", says which edits are tried for this kind)"]
+        elif not said:
+            said = [f"{d.get('id')} ({d.get('kind')}): no repair is searched for this kind of problem; "
+                    f"`rclverify explain {d.get('id')}` names its culprit"]
+        out += said
     return out
 
 
@@ -174,5 +185,5 @@ def changed_lines(before: Mapping[str, str], after: Sequence[tuple[str, str]]) -
     return [f"{i}: {before.get(i, 'absent')} -> {s}" for i, s in after]
 
 
-__all__ = ["Found", "NotApplied", "Offered", "apply_repair", "changed_lines", "find_repairs", "none_offered",
+__all__ = ["SEARCHED", "Found", "NotApplied", "Offered", "apply_repair", "changed_lines", "find_repairs", "none_offered",
            "obligation_checks", "statuses_before"]
