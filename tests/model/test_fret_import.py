@@ -203,3 +203,33 @@ def test_the_command_exits_1_only_on_a_malformed_export(ws: Path, tmp_path: Path
     err = capsys.readouterr().err
     assert f"{bad}:1:2: error: the FRET export is not JSON" in err and "Traceback" not in err
     assert not (ws / "fret" / "bad.json").exists()  # nothing is written for a malformed export
+
+
+def test_durations_in_ticks_are_steps_and_in_secs_go_through_the_step_period(tmp_path: Path) -> None:
+    from fractions import Fraction
+    reqs = [_req("TICKS", "the rover shall within 4 ticks satisfy braking", "within", "(braking)", duration=4),
+            _req("SECS", "the rover shall within 2 secs satisfy braking", "within", "(braking)", duration=2),
+            _req("MSECS", "the rover shall for 300 msecs satisfy braking", "for", "(braking)", duration=300),
+            _req("PART", "the rover shall within 150 msecs satisfy braking", "within", "(braking)", duration=150),
+            _req("MODE", "in manual mode the rover shall always satisfy braking", "always", "(braking)",
+                 scope_mode="manual")]
+    reqs[4]["semantics"]["scope"] = {"type": "in"}
+    variables = VARIABLES + [_var("manual", "Mode", "boolean")]
+    exp = read_export(_write(tmp_path / "e.json", reqs, variables), "e.json")
+
+    def read(step: Fraction | None) -> dict[str, Any]:
+        return {i.fret.reqid: i.requirement.formal.text if i.requirement.formal else i.refusal
+                for i in import_export(exp, Options(step=step))}
+    tenth = read(Fraction(1, 10))
+    assert tenth["TICKS"] == "eventually[<= 4] rover.out.braking"
+    assert tenth["SECS"] == "eventually[<= 20] rover.out.braking"
+    assert tenth["MSECS"] == "always (rover.state.fret_MSECS_t <= 3 -> rover.out.braking)"
+    assert tenth["PART"].reason == "its duration is not a whole number of steps (3/2)"
+    assert tenth["MODE"].reason == "manual is a FRET Mode variable"
+    bare = read(None)
+    assert bare["TICKS"] == "eventually[<= 4] rover.out.braking"  # ticks need no step period
+    assert bare["SECS"].reason == "its duration is 2 secs, and the plan declares no step period"
+    assert bare["SECS"].fix.startswith("declare the step period in the plan (fret: {step: 100 ms})")
+    from rclverify.model.plan.fret.requirements import options_of
+    assert options_of({"fret": {"step": "100 ms", "components": {"rover": "Rover"}}}) == \
+        Options({"rover": "Rover"}, Fraction(1, 10))  # the plan's fret: section
