@@ -8,9 +8,15 @@ control: reliable, transient-local ``/stop`` offering a 100 ms deadline, best-ef
 it would be a ``nodl-live-qos`` finding: the document offers it) and ``Base`` with one seeded mismatch of each
 kind: ``/speed`` published as ``std_msgs/Float32`` (the document: ``Float64``), ``/stop`` subscribed volatile (the
 document: transient-local), no ``/estop`` server, and a publisher ``/odom`` its document does not declare.
-``Dock`` does not run: a document matched to no running node is not compared."""
+``Dock`` does not run: a document matched to no running node is not compared.
+
+The graph rclpy's graph API gave is also recorded (``--record-graph``; docs/nodl.md, "A recorded graph": Kilted's
+``rosgraph_msgs`` has no graph message) and, once the nodes have stopped, checked again from the recording
+(``--graph``): the same findings as from the live sources, a graph difference seeded into the recording found,
+and a recording that is not one refused at its line."""
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 from pathlib import Path
@@ -64,8 +70,9 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         out: dict[str, Any] = {}
         for source in ("dds", "rclpy"):  # rclverify's own DDS participant, rclpy's graph API (as ros diff reads)
             log = tmp / f"check_{source}.log"
+            record = ["--record-graph", str(tmp / "graph.json")] if source == "rclpy" else []
             p = rclverify(["nodl", "check", "-w", str(ws), "--ros2", "--wait", "2", "--source", source,
-                           "--ros2-python", str(ros2_python())], env, ws, log)
+                           "--ros2-python", str(ros2_python()), *record], env, ws, log)
             procs.append(p)
             code = p.wait(120)
             out[source] = {"code": code, "log": log.read_text()}
@@ -74,6 +81,11 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                        "--ros2-python", str(ros2_python())], env, ws, log)
         procs.append(p)
         out["diff"] = {"code": p.wait(120), "log": log.read_text()}
+        stop(procs[0])  # the robot stops: the recording is read with no node running
+        log = tmp / "check_recorded.log"
+        p = rclverify(["nodl", "check", "-w", str(ws), "--graph", str(tmp / "graph.json")], env, ws, log)
+        procs.append(p)
+        out["recorded"] = {"code": p.wait(120), "log": log.read_text(), "graph": tmp / "graph.json", "ws": ws}
         yield out
     finally:
         for p in procs:
@@ -84,7 +96,7 @@ def _lines(log: str, node: str) -> list[str]:
     return [ln for ln in log.splitlines() if f"node /{node}" in ln and ln.startswith("nodl/")]
 
 
-SOURCES = {"dds": "DDS domain", "rclpy": "rclpy on rmw_fastrtps_cpp"}
+SOURCES = {"dds": "DDS domain", "rclpy": "rclpy on rmw_fastrtps_cpp", "recorded": "rclpy on rmw_fastrtps_cpp"}
 
 
 @pytest.mark.parametrize("source", SOURCES)
@@ -130,3 +142,39 @@ def test_ros_diff_takes_the_documents_as_its_expected_graph(run) -> None:
                "the running system" in i for i in items), items
     assert any("/Base publishes /odom" in i and "not in its NoDL document" in i for i in items), items
     assert "in the NoDL documents, not in the running system at rclpy on rmw_fastrtps_cpp:" in log
+
+
+def _places(log: str) -> list[tuple[str, str]]:
+    """Each finding line's first place and code."""
+    return sorted((ln.split(": ", 1)[0], ln.rsplit("[", 1)[1]) for ln in log.splitlines() if ln.startswith("nodl/"))
+
+
+def test_the_recorded_graph_gives_the_findings_of_the_live_sources(run) -> None:
+    recorded = run["recorded"]["log"]
+    assert "source: rclpy (the graph recorded in " in recorded and "Traceback" not in recorded
+    assert [ln for ln in recorded.splitlines() if ln.startswith("nodl/")] == \
+        [ln for ln in run["rclpy"]["log"].splitlines() if ln.startswith("nodl/")]  # the same lines as live
+    assert _places(recorded) == _places(run["dds"]["log"]) == _places(run["rclpy"]["log"])  # and as the DDS source
+    assert len(_places(recorded)) == 5  # the four seeded mismatches and Dock, not running, at its document
+
+
+def test_a_graph_difference_seeded_into_the_recording_is_found_and_a_bad_recording_refused(
+        run, tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Guard's /stop publisher made best-effort in the recording: a finding at Guard's document that the
+    recording as made (the control, above: no Guard line) does not have; a recording that is not one: one line."""
+    from rclverify.cli.commands import main
+    data = json.loads(run["recorded"]["graph"].read_text(encoding="utf-8"))
+    [stop_pub] = [e for e in data["endpoints"]["/stop"]["pubs"] if e["node"] == "Guard"]
+    stop_pub["reliable"] = False
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(data), encoding="utf-8")
+    monkeypatch.chdir(run["recorded"]["ws"])
+    assert main(["nodl", "check", "--graph", str(edited)]) == 1
+    guard = _lines(capsys.readouterr().err, "Guard")
+    assert guard and all("[nodl-live-qos]" in ln and "/stop's reliability is BEST_EFFORT" in ln for ln in guard), guard
+    stop_pub["reliable"] = "no"
+    edited.write_text(json.dumps(data, indent=1), encoding="utf-8")
+    assert main(["nodl", "check", "--graph", str(edited)]) == 1
+    err = capsys.readouterr().err
+    assert f"{edited}:" in err and "error: endpoints.'/stop'.pubs.0.reliable: is a bool" in err and "Traceback" not in err
+    assert main(["nodl", "check", "--graph", str(edited), "--ros2"]) == 2  # one graph at a time

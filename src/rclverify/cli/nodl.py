@@ -3,6 +3,7 @@
 ``rclverify nodl check``          the workspace's documents against its contracts and each other
                                   (``--ros PATH...``: and against the code's endpoints;
                                   ``--ros2``: and against the running ROS 2 graph)
+``rclverify nodl check --graph FILE``  (with ``-w``) against a graph recorded by ``--ros2 --record-graph FILE``
 ``rclverify nodl check DIR|FILE...`` (no ``-w``) a set of documents against each other, no contract
                                   (``--external NAME``, ``--namespace NODE=NS``, ``--sarif FILE``)
 ``rclverify nodl validate FILE...`` documents against the schema, their includes followed
@@ -62,6 +63,10 @@ def add_parsers(sub: Any) -> None:
                         "auto: rclpy where rclverify's Python imports it (as ros diff)")
     c.add_argument("--ros2-python", metavar="PYTHON",
                    help="--ros2 --source rclpy: the Python with rclpy (default: $RCLVERIFY_ROS2_PYTHON, else this one)")
+    c.add_argument("--record-graph", metavar="FILE",
+                   help="--ros2 --source rclpy: also write the graph read, to check against later with --graph")
+    c.add_argument("--graph", metavar="FILE", help="check against a recorded graph (--record-graph) instead of the "
+                                                  "running one (docs/nodl.md, 'A recorded graph')")
     c.add_argument("--json", metavar="FILE", help="also write the findings as JSON")
     c.add_argument("--strict", action="store_true", help="exit 1 on a warning too")
     common(c)
@@ -85,7 +90,11 @@ def cmd_check(args: argparse.Namespace) -> int:
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     if args.paths:
         return _check_set(args)
-    if args.external or (args.namespace and not (args.ros or args.ros2)):
+    if args.graph and (args.ros2 or args.record_graph) or args.record_graph and not args.ros2:
+        print("nodl check: error: --record-graph writes the graph --ros2 reads; --graph FILE reads one instead of "
+              "--ros2", file=sys.stderr)
+        return 2
+    if args.external or (args.namespace and not (args.ros or args.ros2 or args.graph)):
         print("nodl check: error: --external and --namespace apply to a set of documents named without -w "
               "(nodl check DIR|FILE...); --namespace also to a workspace's documents with --ros or --ros2", file=sys.stderr)
         return 2
@@ -109,7 +118,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         res.findings += found
         print(f"{len(matched)} document(s) matched to a node of the scanned code"
               + "".join(f"; {n} -> {g}" for n, g in sorted(matched.items())))
-    if args.ros2 and not _live(args, res):
+    if (args.ros2 or args.graph) and not _live(args, res):
         return 1
     for f in res.findings:
         for line in f.lines():
@@ -139,7 +148,8 @@ def _check_set(args: argparse.Namespace) -> int:
     from rclverify.model.nodl.check import read_all, shown  # deferred: start-up (loads jsonschema, yaml and more only when called)
     from rclverify.model.nodl.sets import check_set, namespace_of, set_files, set_resolver  # deferred: start-up (as above)
     alone = [o for o, given in (("-w", args.workspace), ("--ros", args.ros), ("--ros2", args.ros2), ("--nodl", args.nodl),
-                                ("--launch", args.launch)) if given]
+                                ("--launch", args.launch), ("--graph", args.graph),
+                                ("--record-graph", args.record_graph)) if given]
     if alone:
         print(f"nodl check: error: {', '.join(alone)} with DIR|FILE: a set of documents is checked against each "
               "other only (a workspace's documents: nodl check -w WS --nodl DIR)", file=sys.stderr)
@@ -211,18 +221,30 @@ def _write_sarif(path: Path, findings: Any, root: str) -> None:
 
 def _live(args: argparse.Namespace, res: Any) -> bool:
     """Add the findings of ``res.documents`` against the running graph to ``res``, read through the
-    source ``--source`` picks (as ``ros diff --ros2`` does); ``False`` after printing why it cannot be read."""
+    source ``--source`` picks (as ``ros diff --ros2`` does), or against the graph recorded in ``--graph``
+    (:mod:`rclverify.model.nodl.graph_record`; ``--record-graph`` writes the one read); ``False`` after
+    printing why it cannot be read."""
     from rclverify.ros.ground.nodl_code import check_code, live_qos_of  # deferred: start-up (loads the ROS layers only when called)
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.ros.live.diff_dds import graph_of, read_dds_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
-    from rclverify.runtime.rclpy_source.graph import read_rclpy_graph  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.graph import RclpyDiscovery, read_rclpy_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
+    from rclverify.model.nodl.graph_record import read_record, record_text  # deferred: start-up (loads the recording's reader only when called)
     try:
-        kind, py, why = pick_source(args.source, args.ros2_python)
+        if args.graph:
+            kind, py, why = "rclpy", None, f"the graph recorded in {args.graph}"
+        else:
+            kind, py, why = pick_source(args.source, args.ros2_python)
         print(f"source: {kind} ({why})", file=sys.stderr)
-        if kind == "rclpy" and py is not None:
-            rdisc = read_rclpy_graph(py, args.wait)
+        if args.record_graph and kind != "rclpy":
+            raise ValueError("--record-graph records the graph rclpy's graph API gives: give --source rclpy")
+        rdisc = RclpyDiscovery(read_record(Path(args.graph))) if args.graph else \
+            read_rclpy_graph(py, args.wait) if kind == "rclpy" and py is not None else None
+        if rdisc is not None:
+            if args.record_graph:
+                from rclverify.lang.output import write_atomic  # deferred: start-up (only when writing)
+                write_atomic(Path(args.record_graph), record_text(rdisc.dump))
             source = f"rclpy on {rdisc.rmw}"
             running = graph_of(rdisc, source)  # type: ignore[arg-type]  # the same shape as Discovery
             matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(rdisc),
