@@ -157,6 +157,48 @@ def test_a_service_client_and_an_action_client_nobody_serves(tmp_path: Path) -> 
     assert _codes(_check(tmp_path)) == ["nodl-no-server", "nodl-no-server"]
 
 
+def test_a_service_or_action_typed_differently_or_a_service_qos_that_never_connects(tmp_path: Path) -> None:
+    """#182's type and QoS cases for services and actions: a client and a server of one name typed differently
+    (nodl-connect-type at both types), a best-effort server answering a reliable client (nodl-qos, the reply's
+    direction); the controls: the same types, and the server reliable."""
+    arm = _write(tmp_path, "Arm", """\
+        nodl_version: 2
+        service_clients:
+          - name: /reset
+            type: std_srvs/srv/Trigger
+            qos: {history: KEEP_LAST, depth: 1, reliability: RELIABLE}
+        action_clients:
+          - name: /move
+            type: control_msgs/action/FollowJointTrajectory
+        """)
+    driver = _write(tmp_path, "Driver", """\
+        nodl_version: 2
+        service_servers:
+          - name: reset
+            type: std_srvs/srv/Empty
+            qos: {history: KEEP_LAST, depth: 1, reliability: RELIABLE}
+        action_servers:
+          - name: move
+            type: nav2_msgs/action/FollowPath
+        """)
+    found = _check(tmp_path).findings
+    assert _codes(_check(tmp_path)) == ["nodl-connect-type", "nodl-connect-type"]
+    assert sorted(f.message.split(":")[0] for f in found) == ["action /move", "service /reset"]
+    reset = next(f for f in found if f.message.startswith("service"))
+    assert {(loc.file, loc.line, loc.col) for loc in reset.locs} == {
+        ("Arm.nodl.yaml", *_line_col(arm, "std_srvs/srv/Trigger")), ("Driver.nodl.yaml", *_line_col(driver, "std_srvs/srv/Empty"))}
+    # the control of the types: the server's types made the clients'
+    text = driver.read_text(encoding="utf-8").replace("std_srvs/srv/Empty", "std_srvs/srv/Trigger") \
+        .replace("nav2_msgs/action/FollowPath", "control_msgs/action/FollowJointTrajectory")
+    driver.write_text(text, encoding="utf-8")
+    assert _check(tmp_path).findings == []
+    # a best-effort server: its replies never reach the reliable client
+    driver.write_text(text.replace("reliability: RELIABLE", "reliability: BEST_EFFORT"), encoding="utf-8")
+    [f] = _check(tmp_path).findings
+    assert f.code == "nodl-qos" and "/reset" in f.message and "BEST_EFFORT" in f.message
+    assert {loc.file for loc in f.locs} == {"Arm.nodl.yaml", "Driver.nodl.yaml"}
+
+
 # ---- names resolved before they are compared
 
 
