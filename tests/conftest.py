@@ -54,7 +54,7 @@ LIVE = frozenset({
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_names_rcl", "test_names_fleet_live", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
-    "test_live_stops", "test_lifecycle_live",
+    "test_live_stops", "test_lifecycle_live", "test_instances_live",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -116,6 +116,7 @@ WALL: dict[str, float] = {
     "test_example_manipulator": 32.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
     "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
     "test_live_stops": 45.0, "test_names_rcl": 5.0, "test_names_fleet_live": 17.0, "test_lifecycle_live": 35.0,
+    "test_instances_live": 35.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
