@@ -315,3 +315,49 @@ def test_usage_errors_exit_2(tmp_path: Path, capsys, monkeypatch: pytest.MonkeyP
                                          (Fraction(10, 33), "303030303 ns")])
 def test_durations_are_written_exactly_where_a_unit_allows(s: Fraction, text: str) -> None:
     assert duration(s) == text
+
+
+def test_an_unwired_input_the_model_feeds_by_name_and_a_node_without_contract_are_said(
+        tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The planner's goal renamed objects: the design wires it to nothing, the system model feeds it from the
+    filter's output of that name (design-unwired, a warning at the port and the contract's input); checked
+    against a workspace of other nodes, each design trigger with a monitoring field has no contract (an error)."""
+    _design(tmp_path / "design", edit={"node/Planner.node.yaml": ("goal", "objects")})
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 0
+    err = capsys.readouterr().err
+    planner = tmp_path / "design/node/Planner.node.yaml"
+    line = _at(planner, "- name: objects").split(":")[0]
+    unwired = [ln for ln in err.splitlines() if ln.startswith(f"design/node/Planner.node.yaml:{line}:")]
+    assert len(unwired) == 1 and "[design-unwired]" in unwired[0], err
+    assert "feeds it from perception_filter.out.objects by equal names" in unwired[0]
+    assert "(also at contracts/design.rcl:" in unwired[0]
+    # the control: the design as written (goal) has no such warning (above: only design-undecided)
+    _design(tmp_path / "plain")
+    assert main(["import", "autoware-design", "plain", "-o", "ws2"]) == 0
+    assert "design-unwired" not in capsys.readouterr().err
+    other = Path(__file__).parent.parent / "data" / "nodl" / "ws"
+    assert main(["import", "autoware-design", "plain", "--check", "-w", str(other)]) == 1
+    err = capsys.readouterr().err
+    assert "the design's node perception_tracker has no contract [design-missing]" in err
+
+
+def test_a_folder_with_two_systems_needs_one_named_and_nothing_is_read_from_outside(
+        tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    root = _design(tmp_path / "design")
+    (root / "system/Other.system.yaml").write_text(
+        (root / "system/Rover.system.yaml").read_text(encoding="utf-8").replace("Rover.system", "Other.system"),
+        encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 1
+    assert "the design needs one *.system.yaml (systems in the folder: Other, Rover; name one with --system)" \
+        in capsys.readouterr().err
+    assert main(["import", "autoware-design", "design", "-o", "ws", "--system", "Rover"]) == 0
+    capsys.readouterr()
+    outside = tmp_path / "Elsewhere.node.yaml"
+    outside.write_text(HEAD + "name: Elsewhere.node\n", encoding="utf-8")
+    (root / "node/Elsewhere.node.yaml").symlink_to(outside)
+    assert main(["import", "autoware-design", "design", "-o", "ws3", "--system", "Rover"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("design/node/Elsewhere.node.yaml:1:1: error: leads outside the design folder") and \
+        "Traceback" not in err
