@@ -297,3 +297,58 @@ def test_components_registered_in_no_namespace_are_programs(tmp_path: Path, cls:
     names = {p["name"] for p in g.programs}
     # a class in no namespace is registered; the namespaced name (control) names no class of the package
     assert ("Board" in names) == (cls == "Board") and "board_node" in names
+
+
+# -- XML and YAML actions ----------------------------------------------------------
+
+def test_xml_executables_and_timers_start_their_nodes(ws: Path) -> None:
+    lf = _file(ws, "exec.launch.xml", '<launch>\n'
+               '  <executable cmd="ros2 run demo listener --ros-args -r __node:=ears -r heard:=chatter"/>\n'
+               '  <timer period="2.0">\n    <node pkg="demo" exec="talker"/>\n  </timer>\n'
+               '  <set_env name="X" value="1"/>\n  <log message="up"/>\n</launch>\n')
+    g = _graph(ws, lf)
+    assert sorted(g.nodes) == ["/ears", "/talker"] and _subs(g, "/ears") == {"/chatter"} and _said(g) == []
+    # control: another program, and an element the scan does not know, are said at their lines
+    lf = _file(ws, "exec.launch.yaml", "launch:\n- executable:\n    cmd: gzserver --verbose\n"
+                                       "- my_action:\n    name: x\n")
+    g = _graph(ws, lf)
+    assert g.nodes == {}
+    assert _said(g) == ["ws/demo/launch/exec.launch.yaml:2:1: warning: <executable> runs 'gzserver --verbose', "
+                        "not 'ros2 run PKG EXE': the nodes it starts, if any, are unknown",
+                        "ws/demo/launch/exec.launch.yaml:4:1: warning: <my_action> is not an element the scan "
+                        "reads: the nodes it starts, if any, are unknown"]
+
+
+GAUGE = """#include <ros/ros.h>
+#include <std_msgs/Int32.h>
+int main(int argc, char ** argv)
+{
+  ros::init(argc, argv, "gauge");
+  ros::NodeHandle nh, pnh("~");
+  std::string topic;
+  pnh.param<std::string>("out_topic", topic, "level");
+  ros::Publisher pub = nh.advertise<std_msgs::Int32>(topic, 1);
+  ros::spin();
+}
+"""
+
+
+@pytest.mark.parametrize("rosparam", ['<rosparam command="load" file="$(find gauges)/config/gauge.yaml"/>',
+                                      '<rosparam command="load" file="$(find gauges)/config/gauge.yaml" ns="io"/>',
+                                      '<rosparam command="delete" param="out_topic"/>'])
+def test_a_rosparam_file_gives_the_nodes_parameters(tmp_path: Path, rosparam: str) -> None:
+    _write(tmp_path / "ws" / "gauges", {
+        "package.xml": PKG.format(name="gauges", tool="catkin", export="").replace("rclcpp", "roscpp"),
+        "CMakeLists.txt": "cmake_minimum_required(VERSION 3.0)\nproject(gauges)\nfind_package(catkin REQUIRED)\n"
+                          "add_executable(gauge src/gauge.cpp)\n",
+        "src/gauge.cpp": GAUGE, "config/gauge.yaml": "out_topic: tank/level\nrate: 10\n",
+        "launch/gauge.launch": f'<launch>\n  <node pkg="gauges" type="gauge" name="gauge">\n    {rosparam}\n'
+                               f'  </node>\n</launch>\n'})
+    g = scan([tmp_path / "ws"], [tmp_path / "ws/gauges/launch/gauge.launch"], base=tmp_path, standard=False).graph
+    # the file's out_topic names the topic; under ns="io" (control) it is io/out_topic, so the default holds
+    want = "/level" if 'ns="io"' in rosparam or "delete" in rosparam else "/tank/level"
+    assert {e.topic for e in g.nodes["/gauge"].publishes} == {want}
+    said = [n for n in _said(g) if "rosparam" in n]
+    assert said == ([] if "load" in rosparam else [
+        'ws/gauges/launch/gauge.launch:3:1: warning: <rosparam>: <rosparam command="delete"> without a file: the '
+        "parameters it loads are not read (a name the code takes from one keeps its default)"])

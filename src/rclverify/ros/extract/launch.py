@@ -36,13 +36,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from rclverify.ros.extract import names
+from rclverify.ros.extract import names, param_yaml
 from rclverify.ros.extract.launch_readers import read_xml as read_xml, read_yaml as read_yaml
 from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
 from rclverify.ros.extract.launch_tree import ALIASES, SEP as SEP, UNREAD as UNREAD, El as El
-
-#: an include's argument whose value cannot be read statically: using it says so
-NOVALUE = "\x00novalue"
+from rclverify.ros.extract.launch_tree import NOVALUE, QUIET_TAGS, UNREAD_TAGS as _UNREAD_TAGS
 from rclverify.ros.extract.launch_tree import Unresolved as Unresolved, evaluate as evaluate
 from rclverify.ros.extract.model import Note, Src
 
@@ -72,7 +70,6 @@ class _Scope:
     args: dict[str, str]
     remaps: list[tuple[str, str, Src]] = field(default_factory=list)
     unsure: Src | None = None  # a condition of an enclosing element read as holding without being evaluated
-
 
 
 _SUBST = re.compile(r"\$\(([^()]*)\)")
@@ -133,6 +130,9 @@ class Interpreter:
         remaps = list(scope.remaps)
         params: dict[str, tuple[str, Src]] = {}
         for c in el.children:
+            if c.tag == "rosparam" and self._cond(c, scope, path):
+                for k, v in self._rosparam(c, scope, path).items():
+                    params["~" + k.lstrip("~/")] = (v, c.src)
             if c.tag not in ("remap", "param"):
                 continue
             try:
@@ -151,6 +151,21 @@ class Interpreter:
             except Unresolved as exc:
                 self.notes.append(Note(c.src, f"<{c.tag}>: {exc}; element skipped", "ROS-LAUNCH"))
         return remaps, params
+
+    def _rosparam(self, el: El, scope: _Scope, path: Path) -> dict[str, str]:
+        """The parameters a ROS 1 ``<rosparam command="load" file="...">`` loads
+        (names relative to its ``ns``); any other form, or a file that cannot be
+        read, is said with a located note and loads nothing read."""
+        cmd = self._attr(el, "command", scope, path) or "load"
+        f = self._attr(el, "file", scope, path)
+        ns = (self._attr(el, "ns", scope, path) or "").strip("/")
+        got = param_yaml.rosparam_file(Path(f) if Path(f).is_absolute() else path.parent / f) \
+            if cmd == "load" and f else f"<rosparam command=\"{cmd}\"> without a file"
+        if isinstance(got, str):
+            self.notes.append(Note(el.src, f"<rosparam>: {f or ''} {got}: {_UNREAD_TAGS['rosparam']}".replace("  ", " "),
+                                   "ROS-LAUNCH"))
+            return {}
+        return {f"{ns}/{k}" if ns else k: v for k, v in got.items()}
 
     def _composable(self, el: El, scope: _Scope, path: Path) -> None:
         """A ``composable_node`` (ROS 2 XML/YAML, or ``ComposableNode`` read by
@@ -346,7 +361,15 @@ class Interpreter:
             self._node_element(el, scope, path)
         elif t == "include":
             self._include_element(el, scope, path)
-        # rosparam, env, machine, test, executable ...: not part of the topic graph
+        elif t == "rosparam":
+            for k, v in self._rosparam(el, scope, path).items():
+                self.params[names.join(scope.ns, k)] = (v, el.src)
+        elif t == "unread":
+            self.notes.append(Note(el.src, el.attrs.get("what", "element not read"), "ROS-LAUNCH"))
+        elif t not in QUIET_TAGS:
+            self.notes.append(Note(el.src, f"<{el.tag}> is not an element the scan reads: "
+                                           f"{_UNREAD_TAGS.get(t, 'the nodes it starts, if any, are unknown')}",
+                                   "ROS-LAUNCH"))
 
     def _node_element(self, el: El, scope: _Scope, path: Path) -> None:
         """A ``<node>`` (ROS 1) or ``<node>``/``<lifecycle_node>`` (ROS 2 XML, YAML) in ``scope``: one

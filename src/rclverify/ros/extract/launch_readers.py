@@ -1,16 +1,25 @@
 """ROS 1 and ROS 2 XML and ROS 2 YAML launch files read into the element
 tree of :mod:`launch_tree` (never executed).
 
+Two frontend actions become the elements the interpreter reads
+(:func:`lower`): ``<executable cmd="ros2 run PKG EXE ...">`` (launch's
+``ExecuteProcess``) is the node it starts, its ``--ros-args`` read as a
+node's; another command is an ``unread`` element naming it; ``<timer>`` /
+``<ros_timer>`` start their actions, unscoped, as launch runs a
+``TimerAction``.
+
 Source: roslaunch XML format (wiki.ros.org/roslaunch/XML), ROS 2 launch
 frontend design (design.ros2.org "ROS 2 Launch XML/YAML format").
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
 from rclverify.ros.extract import safefs
-from rclverify.ros.extract.launch_tree import El
+from rclverify.ros.extract.launch_rosargs import after_ros_args
+from rclverify.ros.extract.launch_tree import SEP, El
 from rclverify.ros.extract.model import Note, Src
 from rclverify.ros.extract.xmlsrc import line_of, parse_xml
 
@@ -27,7 +36,31 @@ def read_xml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
         return None, [note] if note else []
     if root.tag != "launch":
         return None, [Note(Src(shown, 1), f"root element is <{root.tag}>, not <launch>", "ROS-PARSE", "error")]
-    return _from_xml(root, shown), []
+    return lower(_from_xml(root, shown)), []
+
+
+_TOKEN = re.compile(r"(?:\$\([^)]*\)|[^\s$]+|\$)+")  # a command's words; a $(...) substitution stays whole
+_KEEP = ("if", "unless")
+
+
+def lower(el: El) -> El:
+    """``el`` with its ``executable`` and ``timer`` elements (at any depth) as
+    the elements they start (module docstring)."""
+    kids = [lower(c) for c in el.children]
+    kept = {k: v for k, v in el.attrs.items() if k in _KEEP}
+    if el.tag in ("timer", "ros_timer"):
+        return El("group", {**kept, "scoped": "false"}, kids, el.src)
+    if el.tag == "executable":
+        toks = _TOKEN.findall(el.attrs.get("cmd", ""))
+        if len(toks) >= 4 and toks[0].rsplit("/", 1)[-1] == "ros2" and toks[1] == "run":
+            attrs = {**kept, "pkg": toks[2], "exec": toks[3]}
+            ros = after_ros_args(toks[4:])
+            if ros:
+                attrs["ros_args"] = SEP.join(ros)
+            return El("node", attrs, kids, el.src)
+        return El("unread", {**kept, "what": f"<executable> runs '{el.attrs.get('cmd', '')}', not 'ros2 run PKG "
+                                             f"EXE': the nodes it starts, if any, are unknown"}, [], el.src)
+    return El(el.tag, el.attrs, kids, el.src)
 
 
 def _yaml_el(tag: str, body: Any, shown: str, line: int) -> El:
@@ -90,7 +123,7 @@ def read_yaml(path: Path, shown: str) -> tuple[El | None, list[Note]]:
         return None, [Note(Src(shown), f"cannot read: {exc}", "ROS-PARSE", "error")]
     if not isinstance(data, dict) or not isinstance(data.get("launch"), list):
         return None, [Note(Src(shown), "a YAML launch file is a mapping with a 'launch' list", "ROS-PARSE", "error")]
-    return El("launch", {}, _yaml_list(data["launch"], shown, 1), Src(shown, 1)), []
+    return lower(El("launch", {}, _yaml_list(data["launch"], shown, 1), Src(shown, 1))), []
 
 
 class _LineDict(dict):  # type: ignore[type-arg]

@@ -29,6 +29,16 @@ class El:
 UNREAD = "condition-unread"
 #: what joins the tokens of a node's ``ros_args`` attribute when a reader gives them one by one
 SEP = "\x1f"
+#: elements that start no node and set nothing the graph reads (passed over without a note): environment,
+#: logging, machines, ROS 1 tests (roslaunch does not run them), the use_sim_time and global parameters
+QUIET_TAGS = frozenset({"env", "set_env", "unset_env", "append_env", "prepend_env", "push_env", "pop_env",
+                        "reset_env", "push-env", "pop-env", "log", "shutdown", "machine", "test", "set_ros_log_dir",
+                        "set_use_sim_time", "set_parameter", "set_parameters_from_file"})
+#: what an element read no further leaves unknown
+UNREAD_TAGS = {"rosparam": "the parameters it loads are not read (a name the code takes from one keeps its "
+                            "default)"}
+#: an include's argument whose value cannot be read statically: using it says so
+NOVALUE = "\x00novalue"
 #: tags read as another: ROS 2's ``lifecycle_node`` is a node, ``set_remap`` a remap in its scope,
 #: ``push_ros_namespace`` (the YAML and later XML spelling) is ``push-ros-namespace``
 ALIASES = {"lifecycle_node": "node", "set_remap": "remap", "push_ros_namespace": "push-ros-namespace"}

@@ -168,3 +168,33 @@ def expand_each(eps: list[Endpoint], array: Callable[[str], Any], notes: list[No
             out.append(dataclasses.replace(e, param=param.replace(m.group(0), x),
                                            topic=e.topic.replace(m.group(0), x) if e.topic else e.topic))
     return out
+
+
+def rosparam_file(path: Path) -> dict[str, str] | str:
+    """The parameters a ROS 1 ``<rosparam command="load" file="...">`` loads from
+    the YAML file at ``path``: ``{name: value}``, nested mappings joined with
+    ``/`` (``a: {b: x}`` is ``a/b``; roslaunch's rosparam loads a mapping as
+    a parameter namespace), scalars as text, lists left out; or why it cannot
+    be read (a sentence).  Source: wiki.ros.org/roslaunch/XML/rosparam."""
+    import yaml  # deferred: start-up (loads yaml only when called)
+    try:
+        data = yaml.safe_load(safefs.read_text(path))
+    except (OSError, ValueError, yaml.YAMLError, RecursionError) as exc:
+        return f"cannot be read ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        return "is not a mapping of parameters"
+    out: dict[str, str] = {}
+
+    def walk(m: dict[Any, Any], prefix: str) -> None:
+        for k, v in m.items():
+            key = f"{prefix}{k}"
+            if isinstance(v, dict):
+                walk(v, key + "/")
+            elif isinstance(v, bool):
+                out[key] = str(v).lower()
+            elif isinstance(v, (str, int, float)):
+                out[key] = str(v)
+    walk(data, "")
+    return out
