@@ -99,9 +99,10 @@ def _said(g: Graph) -> list[str]:
 def test_nodes_of_an_on_shutdown_handler_are_said_never_started(ws: Path) -> None:
     lf = _py(ws, "shutdown.launch.py", "Node(package='demo', executable='talker'),\n"
                                        "RegisterEventHandler(OnShutdown(on_shutdown=[\n"
-                                       "    Node(package='demo', executable='listener', name='late')])),")
+                                       "    Node(package='demo', executable='listener', name='late'),\n"
+                                       "    OpaqueFunction(function=lambda _: os.remove('/tmp/x.sdf'))])),")
     g = _graph(ws, lf)
-    assert sorted(g.nodes) == ["/talker"]
+    assert sorted(g.nodes) == ["/talker"]  # and the OpaqueFunction run at shutdown starts nothing: not said
     assert _said(g) == ["ws/demo/launch/shutdown.launch.py:20:13: warning: node 'listener' is started by OnShutdown "
                         "(ws/demo/launch/shutdown.launch.py:19:9): launch starts no process once it is shutting "
                         "down; not a node of the graph"]

@@ -96,7 +96,9 @@ def at_shutdown(els: list[El], handler: Src, notes: list[Note]) -> None:
     """The actions of an ``OnShutdown`` handler (``handler``): launch starts no
     process once it is shutting down (``ExecuteLocal.execute`` returns when
     ``context.is_shutdown``), so each node they would start is said at its
-    line, never a node of the graph."""
+    line, never a node of the graph; what else they hold that the scan cannot
+    read (an ``OpaqueFunction`` removing a file) starts nothing either and is
+    not said."""
     for el in els:
         if el.tag in STARTS:
             what = el.attrs.get("exec") or el.attrs.get("plugin") or el.attrs.get("file") or el.tag

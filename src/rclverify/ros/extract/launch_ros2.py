@@ -224,8 +224,8 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
                          f"{', '.join(sorted(HANDLERS))} with its actions)")
         if isinstance(_expand(acts), ast.Lambda) or kind == "OnProcessIO":
             raise _Unres(f"the actions of {kind}, a function run at the event,")
-        if kind == "OnShutdown":
-            _shutdown(_actions(acts, shown, notes), src, notes)
+        if kind == "OnShutdown":  # nothing it starts runs: its nodes are said, what else it cannot read is moot
+            _shutdown(_actions(acts, shown, []), src, notes)
             return None
     elif name == "OpaqueFunction" or name in _FUNCS:
         fn = _arg(c, 0, "function") if name == "OpaqueFunction" else c.func
