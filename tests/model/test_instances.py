@@ -87,6 +87,18 @@ def test_an_instance_of_no_contract_is_refused_where_it_is_written(tmp_path: Pat
     assert d.loc.line == 3 and "no node named 'Relai'" in d.message, d
 
 
+def test_a_name_too_long_in_its_namespace_is_refused_at_the_instance(tmp_path: Path) -> None:
+    """rmw's 247 characters hold for the resolved name: a namespace that makes one longer is refused where
+    the plan gives it (control: the same tokens, shorter, load)."""
+    deep = "/" + "/".join(["n" * 60] * 4)
+    text = f"instances:\n  Relay: [/r1, {deep}]\n"
+    with pytest.raises(PlanError) as exc:
+        _ws(tmp_path, text).checked
+    [d] = exc.value.diagnostics
+    assert d.loc.line == 3 and "has at most 247 characters" in d.message and "Relay in " + deep in d.message, d
+    assert _ws(tmp_path, text.replace("n" * 60, "n" * 40), "short").checked
+
+
 def test_each_instance_is_a_node_with_its_names_resolved_and_fed_within_its_robot(tmp_path: Path) -> None:
     ws = _ws(tmp_path)
     inst, model = fleet_system(ws.checked, ws.plan.node_instances)

@@ -412,10 +412,16 @@ class _References:
             l = plan.locs.get(("instances", contract, KEY), insts[0].loc if insts else ast.Loc(plan.file, 1, 1))
             if not self.node_ok(contract, l):
                 continue
+            from rclverify.model.instances import instance_node  # deferred: only a plan with instances
+            from rclverify.model.names import BadName  # deferred: as above
             for i in insts:
                 if i.name != contract and i.name in self.nodes:
                     self.bad(i.loc, f"the instance of {contract} in {i.namespace} is named {i.name}, "
                                     f"as a contract's node is: rename one")
+                try:
+                    instance_node(self.nodes[contract], i)
+                except BadName as exc:
+                    self.bad(i.loc, f"the instance of {contract} in {i.namespace}: {exc}")
 
     def facts(self, plan: Plan) -> None:
         """An environment fact is a well-typed formula of its node."""
