@@ -42,7 +42,8 @@ from rclverify.lang.timing import parse_duration, seconds
 from rclverify.lang.types import Checked
 from rclverify.lang.walk import subexpressions
 from rclverify.model.nodl.contract import GENERATED_QOS, full_type, rcl_name_of, type_key, yaml_text
-from rclverify.model.nodl.design import Design, DesignNode, Process
+from rclverify.model.nodl.design import Design, DesignNode
+from rclverify.model.nodl.design_read import Process
 from rclverify.model.nodl.document import Document
 from rclverify.model.plan.model import Connection
 from rclverify.model.system.model import Link
