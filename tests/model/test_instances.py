@@ -212,3 +212,38 @@ def test_rclverify_monitor_judges_each_instance_of_the_plan(tmp_path: Path, caps
     fleet = judged(FLEET)
     assert fleet["Relay_r2"] == "failed" and fleet["Relay_r1"] == "discharged", fleet
     assert set(judged("")) == {"OdomSource", "Relay"}
+
+
+def test_nodl_check_matches_each_document_in_the_namespaces_of_the_plan(tmp_path: Path,
+                                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """``nodl check -w WS --graph FILE`` (a recorded graph, no node running) with the plan's instances: the
+    relay of /r2 wired to /r1/odom is a finding at /r2's relay; the fleet as documented (control) has none
+    about a relay; without instances (control) the documents match no node of the fleet at all."""
+    import json
+    from rclverify.cli.commands import main
+
+    def check_(plan: str, r2_odom: str) -> str:
+        ws = _ws(tmp_path, plan, f"{len(plan)}{r2_odom.count('r1')}")
+        (ws.root / "nodl").mkdir()
+        (ws.root / "nodl/OdomSource.nodl.yaml").write_text(ODOM, encoding="utf-8")
+        (ws.root / "nodl/Relay.nodl.yaml").write_text(RELAY, encoding="utf-8")
+        dump = _dump(r2_odom)
+        for ends in dump["endpoints"].values():
+            for e in ends["pubs"] + ends["subs"]:
+                e.update(deadline_ns=0, liveliness="automatic", lease_ns=0)
+        graph = ws.root / "graph.json"
+        graph.write_text(json.dumps({"kind": "rclverify-ros2-graph", "version": 1, "rmw": dump["rmw"],
+                                     "nodes": dump["nodes"], "endpoints": dump["endpoints"]}), encoding="utf-8")
+        main(["nodl", "check", "-w", str(ws.root), "--graph", str(graph)])
+        cap = capsys.readouterr()
+        assert "Traceback" not in cap.err, cap.err
+        return cap.out + cap.err
+    slip = check_(FLEET, "/r1/odom")
+    assert "node /r2/relay has /r1/odom (std_msgs/msg/Float64) in subscriptions in the running node" in slip, slip
+    assert "nodl/Relay.nodl.yaml:3:9: error: node /r2/relay's NoDL document declares /r2/odom" in slip, slip
+    live = [ln for ln in slip.splitlines() if "[nodl-live" in ln]
+    assert len(live) == 4 and all("node /r2/relay" in ln for ln in live), live  # /r1 and the sources: clean
+    own = check_(FLEET, "/r2/odom")
+    assert "nodl-live" not in own and "4 document(s) matched" in own, own
+    alone = check_("", "/r2/odom")
+    assert "the base name alone is ambiguous" in alone, alone
