@@ -33,9 +33,8 @@ from rclverify.lang import ast
 from rclverify.lang.timing import parse_duration, seconds
 from rclverify.lang.types import Checked
 from rclverify.lang.walk import subexpressions
-from rclverify.model.nodl.contract import rcl_name_of
 from rclverify.model.nodl.design import Design
-from rclverify.model.nodl.design_write import duration
+from rclverify.model.nodl.design_write import duration, var_of
 from rclverify.model.nodl.findings import Finding
 from rclverify.model.system.model import Link
 
@@ -125,14 +124,14 @@ def _min(a: Bound | None, b: Bound | None) -> Bound | None:
 def _unwired(design: Design, checked: Checked, links: Sequence[Link]) -> list[Finding]:
     """A link the system model found (by equal names or topics) that the design does not wire: a warning at the
     design's port and the contract's input (the model's rule, docs/plan.md ``connections``, is not ROS's)."""
-    wired = {(w.reader, rcl_name_of(w.reader_port)) for w in design.wires if w.role == "publisher"}
+    wired = {(w.reader, var_of(w.reader_port)) for w in design.wires if w.role == "publisher"}
     out = []
     for lk in links:
         node = design.nodes.get(lk.to_node)
         cn = checked.nodes.get(lk.to_node)
         if node is None or cn is None or lk.via == "plan" or (lk.to_node, lk.to_var) in wired:
             continue
-        port = next((p for p in node.ports if p.role == "subscriber" and rcl_name_of(p.name) == lk.to_var), None)
+        port = next((p for p in node.ports if p.role == "subscriber" and var_of(p.name) == lk.to_var), None)
         iv = next((v for v in cn.node.inputs if v.name == lk.to_var), None)
         locs = tuple(x.loc for x in (port, iv) if x is not None)
         findings_msg = (f"{lk.to_node}.in.{lk.to_var} is wired to nothing in the design, and the system model feeds "
@@ -154,20 +153,20 @@ def check_timing(design: Design, checked: Checked, links: Sequence[Link]) -> tup
             for t in proc.triggers:
                 if not t.fields or t.kind not in ("on_input", "periodic"):
                     continue
-                if cn is None or (t.kind == "on_input" and rcl_name_of(t.value) not in cn.inputs):
-                    what = f"node {node.name}" if cn is None else f"input {rcl_name_of(t.value)} of node {node.name}"
+                if cn is None or (t.kind == "on_input" and var_of(t.value) not in cn.inputs):
+                    what = f"node {node.name}" if cn is None else f"input {var_of(t.value)} of node {node.name}"
                     findings.append(Finding("design-missing", f"the design's {what} has no contract", (t.loc,)))
                     continue
                 if t.kind == "on_input":
-                    trigger = f"in.{rcl_name_of(t.value)}"
-                    bound = gaps.inp(node.name, rcl_name_of(t.value))
-                    why = gaps.why.get(("in", node.name, rcl_name_of(t.value)), "")
+                    trigger = f"in.{var_of(t.value)}"
+                    bound = gaps.inp(node.name, var_of(t.value))
+                    why = gaps.why.get(("in", node.name, var_of(t.value)), "")
                 else:
                     trigger = f"periodic {t.value} Hz"
                     outs = [o for k, o, _ in proc.outcomes if k == "to_output"]
                     bound = None
                     for o in outs:
-                        bound = _min(bound, gaps.out(node.name, rcl_name_of(o), frozenset()))
+                        bound = _min(bound, gaps.out(node.name, var_of(o), frozenset()))
                     why = f"no periodic declaration of {node.name} for the outputs of process {proc.name}"
                 for name, value, loc in t.fields:
                     limit = Fraction(str(value)) if name == "timeout" else 1 / Fraction(str(value))

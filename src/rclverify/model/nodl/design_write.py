@@ -30,6 +30,7 @@ exported.  Importing the export gives the same workspace (tests/model/test_desig
 from __future__ import annotations
 
 import json
+import re
 from fractions import Fraction
 from functools import lru_cache
 from typing import Any, Mapping, Sequence
@@ -72,8 +73,10 @@ def duration(s: Fraction) -> str:
     return f"{max(1, round(s * 1_000_000_000))} ns"
 
 
-def _var(port: str) -> str:
-    return rcl_name_of(port)
+def var_of(port: str) -> str:
+    """The contract variable of design port ``port``: its name as a contract reads a ROS name (:func:`rcl_name_of`:
+    ``concatenated/pointcloud`` is ``concatenated_pointcloud``), any other character no RCL name has read ``_``."""
+    return re.sub(r"\W", "_", rcl_name_of(port))
 
 
 def _reach(node: DesignNode, proc: Process, seen: frozenset[str] = frozenset()) -> list[str]:
@@ -94,7 +97,7 @@ def _clauses(node: DesignNode) -> tuple[list[dict[str, str]], list[str]]:
     guarantees: list[dict[str, str]] = []
     periods: dict[str, Fraction] = {}
     for proc in node.processes:
-        outs = [_var(o) for o in _reach(node, proc)]
+        outs = [var_of(o) for o in _reach(node, proc)]
         if not outs:
             continue
         for t in proc.triggers:
@@ -102,7 +105,7 @@ def _clauses(node: DesignNode) -> tuple[list[dict[str, str]], list[str]]:
                 timeout = next((v for k, v, _ in t.fields if k == "timeout"), None)
                 within = f" within {duration(Fraction(str(timeout)))}" if timeout is not None else ""
                 g = {"formula": " and ".join(f"out.{o} == out.{o}" for o in outs),
-                     "tail": f" triggered by in.{_var(t.value)}{within}"}
+                     "tail": f" triggered by in.{var_of(t.value)}{within}"}
                 if g not in guarantees:
                     guarantees.append(g)
             elif t.kind == "periodic":
@@ -111,7 +114,7 @@ def _clauses(node: DesignNode) -> tuple[list[dict[str, str]], list[str]]:
                     periods[o] = min(periods.get(o, period), period)
     periodic = [f"out.{o}, {duration(p)}" for o, p in sorted(periods.items())]
     answered = {o for p in node.processes for t in p.triggers if t.kind == "on_input" for o in _reach(node, p)}
-    rest = [_var(p.name) for p in node.ports if p.role == "publisher" and p.name not in answered]
+    rest = [var_of(p.name) for p in node.ports if p.role == "publisher" and p.name not in answered]
     if rest:  # an output no input starts (a periodic one, one never reached): published, unconstrained
         guarantees.append({"formula": " and ".join(f"out.{o} == out.{o}" for o in rest), "tail": ""})
     return guarantees or [{"formula": "TRUE", "tail": ""}], periodic
@@ -121,10 +124,10 @@ def _contract_view(node: DesignNode) -> dict[str, Any]:
     ins = [p for p in node.ports if p.role == "subscriber"]
     outs = [p for p in node.ports if p.role == "publisher"]
     topics = [f"{type_key(p.type)[0]}/{type_key(p.type)[1]} {node.topics[(p.role, p.name)]} "
-              f"matches({'in' if p.role == 'subscriber' else 'out'}.{_var(p.name)})" for p in ins + outs]
+              f"matches({'in' if p.role == 'subscriber' else 'out'}.{var_of(p.name)})" for p in ins + outs]
     guarantees, periodic = _clauses(node)
-    return {"name": node.name, "inputs": [f"{_var(p.name)} : BOOL" for p in ins],
-            "outputs": [f"{_var(p.name)} : BOOL" for p in outs], "topics": topics,
+    return {"name": node.name, "inputs": [f"{var_of(p.name)} : BOOL" for p in ins],
+            "outputs": [f"{var_of(p.name)} : BOOL" for p in outs], "topics": topics,
             "guarantees": guarantees,
             "periodic": periodic}
 
@@ -150,7 +153,7 @@ def workspace_texts(design: Design) -> dict[str, str]:
     one NoDL document per node (module docstring)."""
     nodes = [_contract_view(n) for n in design.nodes.values()]
     files = {CONTRACTS: _env().get_template("design.rcl.j2").render(name=design.name, nodes=nodes)}
-    wires = sorted({(f"{w.writer}.{_var(w.writer_port)}", f"{w.reader}.{_var(w.reader_port)}")
+    wires = sorted({(f"{w.writer}.{var_of(w.writer_port)}", f"{w.reader}.{var_of(w.reader_port)}")
                     for w in design.wires if w.role == "publisher"})
     files["contracts/plan.yaml"] = _env().get_template("design_plan.yaml.j2").render(
         name=json.dumps(design.name), contracts=CONTRACTS, connections=wires)
@@ -228,4 +231,4 @@ def design_files(name: str, checked: Checked, links: Sequence[Link | Connection]
     return files
 
 
-__all__ = ["CONTRACTS", "FORMAT", "design_files", "duration", "workspace_texts"]
+__all__ = ["CONTRACTS", "FORMAT", "design_files", "duration", "var_of", "workspace_texts"]
