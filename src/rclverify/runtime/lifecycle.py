@@ -194,11 +194,13 @@ class LifecycleGate:
         s = self.managed[node].now()
         return STATES.get(s, str(s))
 
-    def record(self) -> dict[str, Any]:
+    def record(self, verdicts: Sequence[dict[str, Any]] = ()) -> dict[str, Any]:
         """Every pending output decided; the run's ``lifecycle`` record: per managed node its latest
         state, transitions heard, outputs judged and violations, its ``status`` ``failed`` with a
         violation, ``inconclusive`` with no output heard (silence is not green), else
-        ``discharged``; and the inputs held back as no question, per topic."""
+        ``discharged``; and the inputs held back as no question, per topic.  Each of ``verdicts`` (the
+        run's node records: ``node``, ``status``, ``explanation``) whose managed node has a violation
+        is made ``failed``, its explanation saying so first: the lifecycle contract is part of the node's."""
         self._decide(float("inf"))
         nodes = []
         for m in self.managed.values():
@@ -206,6 +208,11 @@ class LifecycleGate:
             nodes.append({"node": m.node, "ros_node": m.fqn, "state": self.state(m.node),
                           "transitions": m.transitions, "outputs_judged": m.judged, "violations": mine,
                           "status": "failed" if mine else "discharged" if m.judged else "inconclusive"})
+            for v in verdicts:
+                if v.get("node") == m.node and mine:
+                    v["status"] = "failed"
+                    v["explanation"] = (f"{len(mine)} output(s) published outside active (lifecycle); the first: "
+                                        f"{mine[0]['reason']} (t = {mine[0]['time']:.3f} s). {v.get('explanation', '')}")
         return {"outputs_judged": self.outputs_judged, "not_questions": dict(sorted(self.not_questions.items())),
                 "nodes": nodes}
 
