@@ -243,7 +243,7 @@ class LiveRun:
                   "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
                   "silent_topics": self.silences, "nodes": nodes, **self.checks.record(self.log_path.name)}
         if self.gate is not None:
-            record["lifecycle"] = self.gate.record()
+            record["lifecycle"] = self.gate.record(nodes)
         if evidence is not None:
             atomic_write_text(evidence, json.dumps(record, indent=2, sort_keys=True) + "\n")
         return record
