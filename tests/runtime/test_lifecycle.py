@@ -63,9 +63,13 @@ def test_an_output_outside_active_is_red_and_inside_is_not(tmp_path: Path) -> No
     assert node["status"] == "failed" and node["outputs_judged"] == 3 and node["transitions"] == 6
     assert [(v["time"], v["state"]) for v in node["violations"]] == [(1.5, "inactive"), (3.5, "inactive")]
     assert "/battery published on /level while inactive" in node["violations"][0]["reason"]
+    assert rec["nodes"][0]["status"] == "failed" and "2 output(s) published outside active" in \
+        rec["nodes"][0]["explanation"], rec["nodes"][0]
     # control: the node publishes only while active
-    ok = _run(tmp_path, _merged(LIFE, quiet))["lifecycle"]["nodes"][0]
+    fine = _run(tmp_path, _merged(LIFE, quiet))
+    ok = fine["lifecycle"]["nodes"][0]
     assert ok["status"] == "discharged" and ok["outputs_judged"] == 1 and ok["violations"] == []
+    assert fine["nodes"][0]["status"] == "discharged", fine["nodes"][0]
 
 
 def test_before_its_first_transition_a_managed_node_is_unconfigured(tmp_path: Path) -> None:

@@ -116,11 +116,14 @@ def test_a_lifecycle_publisher_is_green_and_requests_while_inactive_are_no_quest
     assert run["record"]["lifecycle"]["not_questions"].get("request", 0) >= 5, run["record"]["lifecycle"]
     [res] = run["record"]["nodes"]
     assert res["counts"]["satisfied"] >= 3 and res["counts"]["violated"] == 0, res["counts"]
+    assert "lifecycle" not in res["explanation"], res
 
 
 def test_a_plain_publisher_of_a_lifecycle_node_is_red_while_inactive_only(runs: dict[str, Any]) -> None:
     node = _lifecycle(runs["defect"])
     assert node["status"] == "failed" and len(node["violations"]) >= 10, node
+    [res] = runs["defect"]["record"]["nodes"]
+    assert res["status"] == "failed" and "published outside active (lifecycle)" in res["explanation"], res
     assert {v["state"] for v in node["violations"]} <= {"unconfigured", "inactive", "configuring"}, node
     assert node["outputs_judged"] > len(node["violations"]), node  # its outputs while active are not red
     assert all("/battery published on /level while" in v["reason"] for v in node["violations"])
