@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 from rclverify.cli.common import AddCommand
 
@@ -28,9 +28,11 @@ PASSED = frozenset({"discharged", "ok", "proved"})
 HEALTH_KINDS = frozenset({"vacuity", "inconsistency", "unsatisfiable-assumption", "refinement"})
 
 
-def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, Any]) -> list[tuple[str, str]]:
+def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, Any],
+            also: Sequence[str] = ()) -> list[tuple[str, str]]:
     """Run again, on the workspace ``ws`` as it is now (the edit made), the check that produced the failing
-    record of ``diagnosis``: ``[(id, status or verdict), ...]``.
+    record of ``diagnosis``, and of the ids ``also`` of the same kind (the other members of a problem
+    asked for by its number): ``[(id, status or verdict), ...]``.
 
     * evidence (a property test's, a Hoare triple's): every obligation the repair was checked against
       (:func:`~rclverify.diagnosis.apply_repair.obligation_checks`), each run by its backend
@@ -52,10 +54,10 @@ def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, 
     pipeline.stage_check(ws)
     if kind in HEALTH_KINDS:
         found = {f.id: str(f.status) for f in pipeline.health_findings(ws, node)}
-        asked = [did] + [str(c.get("check", "")).split(" ")[0] for c in repair.get("checks") or []]
+        asked = [did, *also] + [str(c.get("check", "")).split(" ")[0] for c in repair.get("checks") or []]
         return [(i, found[i]) for i in dict.fromkeys(asked) if i in found]
     if kind in ("side-condition", "unit"):
-        wanted = [did] if kind == "side-condition" else [str(j) for j in diagnosis.get("joins") or []]
+        wanted = [did, *also] if kind == "side-condition" else [str(j) for j in diagnosis.get("joins") or []]
         wanted += [str(c.get("check", "")) for c in repair.get("checks") or []]
         wanted = [w for w in dict.fromkeys(wanted) if ".sc" in w]
         out: list[tuple[str, str]] = []
@@ -123,7 +125,8 @@ def cmd_repair(args: argparse.Namespace) -> int:
     print("\n".join(_repair_lines(args.index, n, chosen.diagnosis, chosen.repair)))
     print(f"applied: {chosen.repair.get('file')} written ({path.stat().st_size} bytes); the check that failed "
           "runs again:")
-    after = recheck(workspace_of(args), chosen.diagnosis, chosen.repair)
+    also = [str(d.get("id")) for d in found.diagnoses if d.get("kind") == chosen.diagnosis.get("kind")]
+    after = recheck(workspace_of(args), chosen.diagnosis, chosen.repair, also)
     if not after:
         print(f"  no stage re-checks a {chosen.diagnosis.get('kind')} problem alone: run `rclverify verify`")
         return 0
