@@ -30,6 +30,13 @@ CODES = {
     "nodl-code-qos": "the code (the running node) gives a topic another reliability or durability than the document",
     "nodl-code-unmatched": "no node of the code (of the running graph: an error there) is the document's: nothing "
                            "of it was compared",
+    # an Autoware System Designer design against the contracts (docs/nodl.md, "Autoware System Designer")
+    "design-timeout": "the gaps the contracts let a trigger's input leave are longer than the design's timeout",
+    "design-error-rate": "the gaps the contracts let a trigger's input leave are longer than 1/error_rate",
+    "design-warn-rate": "the gaps the contracts let a trigger's input leave are longer than 1/warn_rate",
+    "design-undecided": "nothing bounds a trigger's gaps (an input from outside, an untimed guarantee, a loop)",
+    "design-missing": "the design's node, or the input a trigger names, has no contract",
+    "design-unwired": "the design wires an input to nothing and the system model feeds it by an equal name",
 }
 
 
