@@ -4,7 +4,8 @@
 pipeline's own stage and its new verdict printed.
 
 One workspace, verified once: ``Gate`` (a ``<`` for ``<=`` slip in its code: a property test fails),
-``Router``/``Follower`` (a producer's bound over the consumer's assumption: a side condition fails) and
+``Router`` feeding ``Follower`` and ``Tail`` (a producer's bound over both consumers' assumption: two side
+conditions fail, one problem) and
 ``Odd`` (code no one-token edit repairs: no repair offered).  The controls: a file changed after the run is
 refused and left as it is; an unknown id and a problem with no repair end in one located line."""
 from __future__ import annotations
@@ -46,6 +47,13 @@ node Follower {
   outputs( done : BOOL )
   assume( in.n <= 50 )
   guarantee( out.done == TRUE )
+}
+
+node Tail {
+  inputs( n : NATURAL )
+  outputs( seen : BOOL )
+  assume( in.n <= 50 )
+  guarantee( out.seen == TRUE )
 }
 """
 GATE = '"""The gate (a seeded slip: < for <=)."""\n\n\ndef gate(x):\n    return {"ok": x < 3}\n'
@@ -127,11 +135,15 @@ def test_applied_and_the_property_tests_run_again(ws: Path, capsys: pytest.Captu
     assert (ws / "nodes/gate.py").read_text(encoding="utf-8") == GATE.replace("x < 3", "x <= 3")
 
 
-def test_a_contract_repair_is_applied_and_the_side_condition_composed_again(
+def test_a_contract_repair_is_applied_and_the_side_conditions_composed_again(
         ws: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Asked by the problem's number: the producer's repair, and both consumers' side conditions checked."""
+    report = json.loads((ws / "reports/assurance.json").read_text(encoding="utf-8"))
+    k = 1 + next(i for i, p in enumerate(report["problems"])
+                 if {"Follower.sc1", "Tail.sc1"} <= {m["id"] for m in p["members"]})
     before = (ws / "contracts/robot.rcl").read_text(encoding="utf-8")
-    code, out, err = _run(ws, capsys, "Follower.sc1", "--apply")
+    code, out, err = _run(ws, capsys, f"p{k}", "--apply")
     assert code == 0 and err == "", err
-    assert "Follower.sc1: failed -> discharged" in out
+    assert "  Follower.sc1: failed -> discharged" in out and "  Tail.sc1: failed -> discharged" in out
     after = (ws / "contracts/robot.rcl").read_text(encoding="utf-8")
     assert after != before and "out.n <= 64" not in after
