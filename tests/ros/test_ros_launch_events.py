@@ -28,6 +28,7 @@ import pytest
 from test_ros_launch_run import CMAKE, LISTENER, PKG, PY_HEAD, TALKER, _write
 
 from rclverify.ros.extract.model import Graph
+from rclverify.ros.graph import summary
 from rclverify.ros.graph.scan import scan
 
 DUO = """#include <rclcpp/rclcpp.hpp>
@@ -106,6 +107,7 @@ def test_nodes_of_an_on_shutdown_handler_are_said_never_started(ws: Path) -> Non
     assert _said(g) == ["ws/demo/launch/shutdown.launch.py:20:13: warning: node 'listener' is started by OnShutdown "
                         "(ws/demo/launch/shutdown.launch.py:19:9): launch starts no process once it is shutting "
                         "down; not a node of the graph"]
+    assert summary.cause_of("ROS-LAUNCH", g.notes[0].message).key == "nodes-at-shutdown"
     # control: the same node started when a process exits is a node
     lf = _py(ws, "exit.launch.py", "Node(package='demo', executable='talker'),\n"
                                    "RegisterEventHandler(OnProcessExit(on_exit=[\n"

@@ -71,6 +71,8 @@ CAUSES: tuple[Cause, ...] = (
     Cause("nodes-alternative", "launch nodes under a condition not evaluated (alternatives: the first kept)",
           _has("taken as alternatives")),
     Cause("nodes-twice", "launch nodes started twice (the last kept)", _has("is started twice")),
+    Cause("nodes-at-shutdown", "launch nodes of OnShutdown handlers (launch starts none: not nodes)",
+          _has("is started by OnShutdown")),
     Cause("endpoints-name", "endpoints dropped: name not read statically",
           lambda _code, msg: bool(_NAME.search(msg)) or "name of" in msg and "comes from parameter" in msg),
     Cause("endpoints-unbuilt", "endpoints of classes nothing the program runs constructs", _has("nothing this program runs")),
