@@ -126,7 +126,14 @@ def cmd_repair(args: argparse.Namespace) -> int:
     print(f"applied: {chosen.repair.get('file')} written ({path.stat().st_size} bytes); the check that failed "
           "runs again:")
     also = [str(d.get("id")) for d in found.diagnoses if d.get("kind") == chosen.diagnosis.get("kind")]
-    after = recheck(workspace_of(args), chosen.diagnosis, chosen.repair, also)
+    try:
+        after = recheck(workspace_of(args), chosen.diagnosis, chosen.repair, also)
+    except (RclError, OSError):
+        raise  # located lines, or the machine's fault in one line (cli/commands.py)
+    except Exception as exc:  # noqa: BLE001 - a backend that fails on the edited code: said, not a traceback
+        print(f"the edit is written, but the check could not run again: {type(exc).__name__}: {exc}; "
+              "`rclverify verify` runs every check")
+        return 1
     if not after:
         print(f"  no stage re-checks a {chosen.diagnosis.get('kind')} problem alone: run `rclverify verify`")
         return 0
