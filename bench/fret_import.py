@@ -143,6 +143,9 @@ def decide(export: Path, exp: FretExport, out: collections.Counter[str]) -> None
         for rec, _ in stage_requirements(ws):
             if rec.get("verdict") != "informal":
                 out[f"verdict {rec['verdict']}"] += 1
+            if rec.get("verdict") == "inconclusive":
+                detail = str((rec.get("temporal") or {}).get("detail") or rec.get("reason") or "")
+                print(f"  {export.name}:{rec['id']}: inconclusive: {detail[:160]}")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -132,7 +132,7 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
     reqs = [
         _req("LUSTRE", "the rover shall always satisfy filtered <= 2.0", "always", "(filtered <= 2.0)"),
         _req("UNDECLARED", "the rover shall always satisfy ghost", "always", "(ghost)"),
-        _req("FUNCTION", "the rover shall always satisfy persisted(2, braking)", "always", "(persisted(2, braking))"),
+        _req("FUNCTION", "the rover shall always satisfy sqrt(speed) < 2.0", "always", "(sqrt(speed) < 2.0)"),
         _req("MODE-TRIGGER", "in manual mode upon obstacle the rover shall immediately satisfy braking", "immediately",
              "(braking)", "regular", "(obstacle)", scope_mode="manual"),
         {"reqid": "NOSEM", "fulltext": "not parsed by FRET"},
@@ -148,7 +148,7 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
                              "make filtered an input or output of rover, or define it in FRET by a FRETish "
                              "expression over the component's variables")
     assert why["UNDECLARED"] is not None and why["UNDECLARED"][0] == "ghost is not declared in the export"
-    assert why["FUNCTION"] is not None and "FRET function persisted(_, _)" in why["FUNCTION"][0]
+    assert why["FUNCTION"] is not None and "FRET function sqrt(_)" in why["FUNCTION"][0]
     assert why["MODE-TRIGGER"] is not None and "a trigger inside a mode interval" in why["MODE-TRIGGER"][0]
     assert why["NOSEM"] is not None and "FRET has not formalised it" in why["NOSEM"][0]
     assert why["PRE-INIT"] == ("a pre function's initial value out.speed reads the component's variables",

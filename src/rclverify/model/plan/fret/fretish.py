@@ -20,6 +20,12 @@ FRETish                RCL
                        holding ``e`` of the step before, ``i`` at the first
                        step (FRET's field guide, "builtin functions": Lustre's
                        ``i -> pre e``), made by the writer's ``pre`` callback
+``persisted(n, p)``    ``(p and state.c >= n)``, ``c`` counting the steps in a
+                       row before this one at which p held, up to n (FRET:
+                       ``H[0,n] p & H[0,n-1] Y TRUE``)
+``occurred(n, p)``     ``(p or state.d <= n)``, ``d`` the steps since p last
+                       held before this one, n + 1 when not within n (FRET:
+                       ``O[0,n] p``)
 =====================  =====================================================
 
 Any other function, ``^`` and a name the caller cannot place raise
@@ -187,6 +193,13 @@ def names(e: Expr) -> list[str]:
 VarText = Callable[[str, bool], Union[str, Expr]]
 #: ``pre(type, init, expr)``: the state variable's name holding ``expr`` (a tree) of the step before.
 PreVar = Callable[[str, Expr, Expr], str]
+#: ``count(kind, n, expr)``: the state variable's name counting, for ``persisted(n, expr)`` (``kind``
+#: ``"persisted"``), the steps in a row before this one ``expr`` held (up to n), for ``occurred(n, expr)``
+#: the steps since it last held before this one (n + 1: not within n).
+CountVar = Callable[[str, int, Expr], str]
+#: FRET's past-time predicates (FRET's field guide, "temporal conditions"): ``persisted(n, p)``, p held at
+#: this step and the n before it; ``occurred(n, p)``, p held at this step or one of the n before it.
+COUNTED = ("persisted", "occurred")
 
 
 @dataclass
@@ -198,6 +211,7 @@ class Writer:
     var: VarText
     pre: PreVar
     node: str
+    count: CountVar | None = None
 
     def rcl(self, e: Expr, local: bool = False) -> str:
         """RCL text of ``e``: over ``Node.in.x``/``Node.out.y``/``Node.state.v``
@@ -229,6 +243,14 @@ class Writer:
         if name in PRE and len(args) == 2:
             state = self.pre(PRE[name], args[0], args[1])
             return f"state.{state}" if local else f"{self.node}.state.{state}"
+        if name in COUNTED and len(args) == 2 and self.count is not None:
+            n = args[0]
+            if n[0] != "num" or not str(n[1]).isdigit():
+                raise Refusal(f"{name}'s first argument must be a number of steps", f"write {name}(N, p), N a number")
+            state = self.count(name, int(str(n[1])), args[1])
+            ref = f"state.{state}" if local else f"{self.node}.state.{state}"
+            p = self.rcl(args[1], local)
+            return f"({p} and {ref} >= {n[1]})" if name == "persisted" else f"({p} or {ref} <= {n[1]})"
         raise Refusal(f"it calls the FRET function {name}({', '.join('_' for _ in args)}), which has no RCL "
                       "counterpart", f"write {name} as an RCL formula over the component's inputs and outputs"
-                                     " (rclverify translates absReal, absInt, preBool, preReal and preInt)")
+                                     " (rclverify translates absReal, absInt, preBool, preReal, preInt, persisted and occurred)")

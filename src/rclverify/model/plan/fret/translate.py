@@ -29,7 +29,9 @@ in M, null, always              ``always (M -> Q)``
 in M, null, immediately         ``always ((M and not state.prev) -> Q)``          ``prev`` of M
 ==============================  ================================================  ==========================
 
-``T`` is the trigger ``P and not state.prev`` (FRET's "upon": P becomes
+FRET's functions inside P, Q, S and M are :mod:`.fretish`'s (``preBool``
+and the other ``pre`` functions, ``persisted`` and ``occurred`` each a state
+variable ``fret_<reqid>_<function><k>``).  ``T`` is the trigger ``P and not state.prev`` (FRET's "upon": P becomes
 true, or holds at the first step); ``on`` holds "a trigger came and S has
 not held since" of the step before.  A window cut short by the end of a
 finite run is FRET's "need not hold": ``next`` and ``eventually[<= N]``
@@ -160,7 +162,16 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
                           "give it a constant initial value (preReal(0.0, e))")
         return states.add(f"pre{len(states.made) + 1}", type_name, init_text,
                           f"@ <=> {body}" if type_name == "BOOL" else f"@ == {body}")
-    w = Writer(var, pre, node)
+
+    def count(kind: str, n: int, e: Expr) -> str:
+        p = w.rcl(e, True)
+        role = f"{kind}{len(states.made) + 1}"
+        if kind == "persisted":
+            return states.add(role, "NATURAL", "0", f"({p} and $ < {n} and @ == $ + 1) or ({p} and $ >= {n} and "
+                                                     f"@ == $) or ((not {p}) and @ == 0)")
+        return states.add(role, "NATURAL", str(n + 1), f"({p} and @ == 1) or ((not {p}) and $ <= {n} and "
+                                                       f"@ == $ + 1) or ((not {p}) and $ > {n} and @ == $)")
+    w = Writer(var, pre, node, count)
 
     def field_expr(key: str, *alt: str) -> Expr:
         for k in (key,) + alt:
