@@ -291,6 +291,11 @@ def test_export_then_import_gives_the_same_workspace(tmp_path: Path, capsys, mon
     ("node/Filter.node.yaml", "timeout: 0.15", "timeout: -1", "18:18", "timeout is a positive number (s)"),
     ("system/Rover.system.yaml", "- lidar.publisher.points", "- lidar.points", "17:7", "'lidar.points' is no port path"),
     ("node/Tracker.node.yaml", "  - name: tracks\n", "  - name: [tracks\n", "10:17", "not YAML"),
+    ("node/Filter.node.yaml", "timeout: 0.15", "timeout: .inf", "18:18", "timeout is a positive number (s)"),
+    ("node/Filter.node.yaml", "on_input: points", "on_input: [points]", "17:19", "on_input names a port"),
+    ("node/Filter.node.yaml", "qos: {reliability: best_effort}", "qos: fast", "8:10", "qos is a mapping"),
+    ("module/Perception.module.yaml", "entity: Tracker.node", "entity: Perception.module", "6:5",
+     "Perception.module is an instance of itself (through Perception.module -> Perception.module)"),
 ])
 def test_a_malformed_design_is_one_located_line(tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch,
                                                 rel: str, old: str, new: str, where: str, says: str) -> None:

@@ -105,8 +105,12 @@ class _Flatten:
                              f"(known: {', '.join(sorted(self.entities)) or 'none'})")
         return self.entities[ref]
 
-    def place(self, ent: Entity, path: tuple[str, ...], ns: str, loc: ast.Loc) -> None:
-        """Instantiate ``ent`` at ``path``: a node is made, a module's instances placed and its connections joined."""
+    def place(self, ent: Entity, path: tuple[str, ...], ns: str, loc: ast.Loc, within: tuple[str, ...] = ()) -> None:
+        """Instantiate ``ent`` at ``path`` (inside the modules ``within``): a node is made, a module's instances
+        placed and its connections joined; a module inside itself is a located error."""
+        key = f"{ent.name}.{ent.kind}"
+        if key in within:
+            raise fail(loc, f"{key} is an instance of itself (through {' -> '.join(within + (key,))})")
         if ent.kind == "node":
             name = "_".join(path)
             if not _IDENT.match(name) or name in self.nodes:
@@ -124,7 +128,7 @@ class _Flatten:
         for i, inst in enumerate(entries(ent, "instances")):
             name = text_of(ent, inst, ("instances", i), "name")
             self.place(self.entity(inst.get("entity"), ent.loc("instances", i, "entity")), path + (name,), ns,
-                       ent.loc("instances", i))
+                       ent.loc("instances", i), within + (key,))
         self.connect(ent, path)
 
     def port_names(self, path: tuple[str, ...], role: str, ent: Entity | None) -> list[str]:

@@ -11,6 +11,7 @@ that is no positive number, YAML that does not parse, a file leading outside the
 """
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -157,9 +158,19 @@ def ports_of(ent: Entity) -> list[Port]:
                 raise fail(ent.loc(key, i, "message_type"), f"{key} {name}: message_type {typ!r} is "
                             f"pkg/{'|'.join(kinds)}/Name")
             qos = item.get("qos") or {}
+            if not isinstance(qos, dict):
+                raise fail(ent.loc(key, i, "qos"), f"{key} {name}: qos is a mapping (reliability, durability, ...)")
+            glob = item.get("global")
+            if glob is not None and (not isinstance(glob, str) or not glob.startswith("/")):
+                raise fail(ent.loc(key, i, "global"), f"{key} {name}: global is an absolute ROS name (/tf)")
             pairs = tuple(sorted((k, str(v).lower()) for k, v in qos.items() if k in ("reliability", "durability")))
-            out.append(Port(role, name, typ, pairs, item.get("global"), ent.loc(key, i)))
+            out.append(Port(role, name, typ, pairs, glob, ent.loc(key, i)))
     return out
+
+
+def _positive(v: Any) -> bool:
+    """Whether ``v`` is a finite positive number (a YAML bool, ``.inf`` and ``.nan`` are not)."""
+    return not isinstance(v, bool) and isinstance(v, (int, float)) and math.isfinite(v) and v > 0
 
 
 def _triggers(ent: Entity, cond: Any, path: Path_) -> Iterator[Trigger]:
@@ -167,7 +178,9 @@ def _triggers(ent: Entity, cond: Any, path: Path_) -> Iterator[Trigger]:
         raise fail(ent.loc(*path), "a trigger condition is a mapping (on_input, on_trigger, periodic, once, and, or)")
     for group in ("and", "or"):
         if group in cond:
-            for j, sub in enumerate(cond[group] or []):
+            if not isinstance(cond[group], list):
+                raise fail(ent.loc(*path, group), f"{group} is a list of trigger conditions")
+            for j, sub in enumerate(cond[group]):
                 yield from _triggers(ent, sub, path + (group, j))
             return
     kinds = [k for k in ("on_input", "on_trigger", "periodic", "once") if k in cond]
@@ -177,12 +190,15 @@ def _triggers(ent: Entity, cond: Any, path: Path_) -> Iterator[Trigger]:
     for name in ("timeout", "warn_rate", "error_rate"):
         if name in cond:
             v = cond[name]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or v <= 0:
+            if not _positive(v):
                 raise fail(ent.loc(*path, name), f"{name} is a positive number ({'s' if name == 'timeout' else 'Hz'})")
             fields.append((name, float(v), ent.loc(*path, name)))
     value = cond[kinds[0]]
-    if kinds[0] == "periodic" and (isinstance(value, bool) or not isinstance(value, (int, float)) or value <= 0):
+    if kinds[0] == "periodic" and not _positive(value):
         raise fail(ent.loc(*path, "periodic"), "periodic is a positive rate in Hz")
+    if kinds[0] in ("on_input", "on_trigger") and not (isinstance(value, str) and value) or \
+            kinds[0] == "once" and value is not None and not isinstance(value, str):
+        raise fail(ent.loc(*path, kinds[0]), f"{kinds[0]} names a {'process' if kinds[0] == 'on_trigger' else 'port'}")
     yield Trigger(kinds[0], value, ent.loc(*path, kinds[0]), tuple(fields))
 
 
@@ -191,11 +207,14 @@ def processes_of(ent: Entity, ports: list[Port]) -> list[Process]:
     :class:`RclError` at a condition or outcome of no known kind, one naming no port or process of ``ports``'s node,
     or a monitoring field that is no positive number."""
     out: list[Process] = []
-    names = {p.get("name") for p in entries(ent, "processes") if isinstance(p, dict)}
+    names = {p["name"] for p in entries(ent, "processes") if isinstance(p, dict) and isinstance(p.get("name"), str)}
     ins = {p.name for p in ports if p.role == "subscriber"}
     outs = {p.name for p in ports if p.role == "publisher"}
     for i, proc in enumerate(entries(ent, "processes")):
         name = text_of(ent, proc, ("processes", i), "name")
+        for key in ("trigger_conditions", "outcomes"):
+            if not isinstance(proc.get(key) or [], list):
+                raise fail(ent.loc("processes", i, key), f"process {name}: {key} is a list")
         triggers = [t for j, c in enumerate(proc.get("trigger_conditions") or [])
                     for t in _triggers(ent, c, ("processes", i, "trigger_conditions", j))]
         outcomes = []
@@ -203,6 +222,9 @@ def processes_of(ent: Entity, ports: list[Port]) -> list[Process]:
             kind = next((k for k in ("to_output", "to_trigger", "terminal") if isinstance(o, dict) and k in o), None)
             if kind is None:
                 raise fail(ent.loc("processes", i, "outcomes", j), "an outcome is to_output, to_trigger or terminal")
+            if kind != "terminal" and not (isinstance(o[kind], str) and o[kind]):
+                raise fail(ent.loc("processes", i, "outcomes", j, kind), f"{kind} names a "
+                           f"{'port' if kind == 'to_output' else 'process'}")
             outcomes.append((kind, o[kind], ent.loc("processes", i, "outcomes", j, kind)))
         for t in triggers:
             bad = (t.kind in ("on_input",) or (t.kind == "once" and t.value is not None)) and t.value not in ins
