@@ -205,7 +205,7 @@ def test_the_command_exits_1_only_on_a_malformed_export(ws: Path, tmp_path: Path
     assert not (ws / "fret" / "bad.json").exists()  # nothing is written for a malformed export
 
 
-def test_durations_in_ticks_are_steps_and_in_secs_go_through_the_step_period(tmp_path: Path) -> None:
+def test_durations_in_ticks_and_secs_and_modes(tmp_path: Path) -> None:
     from fractions import Fraction
     reqs = [_req("TICKS", "the rover shall within 4 ticks satisfy braking", "within", "(braking)", duration=4),
             _req("SECS", "the rover shall within 2 secs satisfy braking", "within", "(braking)", duration=2),
@@ -214,7 +214,11 @@ def test_durations_in_ticks_are_steps_and_in_secs_go_through_the_step_period(tmp
             _req("MODE", "in manual mode the rover shall always satisfy braking", "always", "(braking)",
                  scope_mode="manual")]
     reqs[4]["semantics"]["scope"] = {"type": "in"}
-    variables = VARIABLES + [_var("manual", "Mode", "boolean")]
+    defined = dict(_var("fast", "Mode", "boolean"), modeRequirement="speed > 1.0")
+    reqs.append(_req("DEFINED-MODE", "in fast mode the rover shall always satisfy braking", "always", "(braking)",
+                     scope_mode="fast"))
+    reqs[5]["semantics"]["scope"] = {"type": "in"}
+    variables = VARIABLES + [_var("manual", "Mode", "boolean"), defined]
     exp = read_export(_write(tmp_path / "e.json", reqs, variables), "e.json")
 
     def read(step: Fraction | None) -> dict[str, Any]:
@@ -225,7 +229,8 @@ def test_durations_in_ticks_are_steps_and_in_secs_go_through_the_step_period(tmp
     assert tenth["SECS"] == "eventually[<= 20] rover.out.braking"
     assert tenth["MSECS"] == "always (rover.state.fret_MSECS_t <= 3 -> rover.out.braking)"
     assert tenth["PART"].reason == "its duration is not a whole number of steps (3/2)"
-    assert tenth["MODE"].reason == "manual is a FRET Mode variable"
+    assert tenth["MODE"].reason == "manual is a FRET Mode variable without a mode requirement"
+    assert tenth["DEFINED-MODE"] == "always (((rover.out.speed > 1.0)) -> rover.out.braking)"  # the control
     bare = read(None)
     assert bare["TICKS"] == "eventually[<= 4] rover.out.braking"  # ticks need no step period
     assert bare["SECS"].reason == "its duration is 2 secs, and the plan declares no step period"

@@ -48,13 +48,15 @@ class FretRequirement:
 
 @dataclass(frozen=True)
 class FretVariable:
-    """A FRET variable of ``component``: ``name``, ``id_type``, ``data_type``, ``assignment``."""
+    """A FRET variable of ``component``: ``name``, ``id_type``, ``data_type``, ``assignment`` (an
+    Internal one's Lustre definition) and ``mode_requirement`` (a Mode's FRETish definition)."""
 
     component: str
     name: str
     id_type: str
     data_type: str
     assignment: str
+    mode_requirement: str = ""
 
 
 @dataclass(frozen=True)
@@ -134,7 +136,8 @@ def read_export(path: Path, rel: str) -> FretExport:
     for v in vars_raw:
         if isinstance(v, dict) and "idType" in v and isinstance(v.get("variable_name"), str):
             fv = FretVariable(str(v.get("component_name") or ""), v["variable_name"], str(v.get("idType") or ""),
-                              _data_type(v.get("dataType")), str(v.get("assignment") or ""))
+                              _data_type(v.get("dataType")), str(v.get("assignment") or ""),
+                              str(v.get("modeRequirement") or ""))
             variables[(fv.component, fv.name)] = fv
     return FretExport(rel, tuple(out), variables)
 

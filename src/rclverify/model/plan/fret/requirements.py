@@ -7,8 +7,8 @@ component is the node of the same name, or the one the plan's
 ``fret: components:`` maps it to.  Its variables are placed by their
 ``idType``: ``Input`` as ``Node.in.x``, ``Output`` as ``Node.out.x``; an
 ``Internal`` variable whose Lustre ``assignment`` is a FRETish expression
-(a constant, or arithmetic over other variables) stands for that
-expression; a name the export does not declare is read as a constant of the
+(a constant, or arithmetic over other variables) and a ``Mode`` defined by
+its ``modeRequirement`` stand for that expression; a name the export does not declare is read as a constant of the
 contracts' contexts (an enumeration value), when the contracts are known.
 With the contracts' nodes at hand (:func:`ports_of`), the node, each input
 and output and its type (FRET ``boolean`` a ``BOOL``, a number type a
@@ -112,6 +112,8 @@ class _Places:
             prefix = "in" if kind == "Input" else "out"
             self._check_port(v, prefix)
             return f"{prefix}.{name}" if local else f"{self.node}.{prefix}.{name}"
+        if kind == "Mode" and v is not None and v.mode_requirement.strip():
+            return self._defined(name, v.mode_requirement.strip(), local)
         if kind == "Internal":
             assert v is not None
             a = v.assignment.strip()
@@ -119,25 +121,32 @@ class _Places:
                 raise Refusal(f"{name} is an Internal variable defined in Lustre ({a or 'no assignment'})",
                               f"make {name} an input or output of {self.node}, or define it in FRET by a "
                               "FRETish expression over the component's variables")
-            self.depth += 1
-            if self.depth > 32:
-                raise Refusal(f"the Internal variable {name} is defined through itself", "break the cycle in FRET")
-            try:
-                tree = parse(_LUSTRE_WORDS.sub(lambda m: _LUSTRE_OPS[m.group(0)], a))
-            except Refusal as exc:
-                raise Refusal(f"{name}'s assignment: {exc.reason}", exc.fix) from None
-            for n in names(tree):
-                self(n, local)  # every name it reads is placed (or refused) now
-            self.depth -= 1
-            return tree
+            return self._defined(name, _LUSTRE_WORDS.sub(lambda m: _LUSTRE_OPS[m.group(0)], a), local)
         if kind in ("Mode", "Function"):
-            raise Refusal(f"{name} is a FRET {kind} variable", f"declare {name} as a boolean input or output of "
-                                                                f"{self.node}")
+            raise Refusal(f"{name} is a FRET {kind} variable" + (" without a mode requirement" if kind == "Mode"
+                                                                  else ""),
+                          f"declare {name} as a boolean input or output of {self.node}" + (
+                              ", or define the mode by a mode requirement in FRET" if kind == "Mode" else ""))
         if self.ports is not None and name in self.ports.constants:
             return name
         why = "not declared in the export" if v is None else "declared without an idType"
         raise Refusal(f"{name} is {why}", f"declare it in FRET as an Input or Output of {self.fr.component}, or "
                                           "as a constant or enumeration value of the contracts' context")
+
+    def _defined(self, name: str, text: str, local: bool) -> Expr:
+        """The tree of a variable defined by a FRETish expression (an Internal variable's assignment, a
+        Mode's mode requirement), every name it reads placed (or refused) now."""
+        self.depth += 1
+        if self.depth > 32:
+            raise Refusal(f"the variable {name} is defined through itself", "break the cycle in FRET")
+        try:
+            tree = parse(text)
+        except Refusal as exc:
+            raise Refusal(f"{name}'s definition: {exc.reason}", exc.fix) from None
+        for n in names(tree):
+            self(n, local)
+        self.depth -= 1
+        return tree
 
     def _check_port(self, v: FretVariable, prefix: str) -> None:
         if self.ports is None:
