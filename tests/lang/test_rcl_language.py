@@ -19,6 +19,7 @@ from rclverify.semantics.evaluate import evaluate
 from rclverify.model.plan.errors import PlanError
 from rclverify.model.plan.load import load_plan
 from rclverify.lang import ast
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError
 from rclverify.lang.latex import to_latex
 from rclverify.lang.lint import lint
@@ -100,8 +101,8 @@ def test_function_type_with_tuple_result() -> None:
                io="inputs(a : REAL, pos : Pos) outputs(o : REAL)")
     spec, c = checked(src)
     decl = spec.contexts[0].decls[0]
-    assert isinstance(decl, ast.TypeDecl) and isinstance(decl.type, ast.TFunc)
-    assert isinstance(decl.type.result, ast.TTuple)
+    assert isinstance(decl, ast.TypeDecl) and isinstance(decl.type, typeexpr.TFunc)
+    assert isinstance(decl.type.result, typeexpr.TTuple)
     assert str(c.env.types["Pos"]).endswith("(REAL, REAL)")
 
 

@@ -7,6 +7,8 @@ import pytest
 from lark import Lark
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError
 from rclverify.lang.parser import ast_from_tree, grammar_text, parse_file, parse_formula, parse_text
 
@@ -60,15 +62,15 @@ def test_context_listing_of_the_paper() -> None:
  SensorsType : {}; }"""
     (ctx,) = parse_text(src).contexts
     types = {d.name: d.type for d in ctx.decls}
-    R, Nat, B = ast.TBase("REAL"), ast.TBase("NATURAL"), ast.TBase("BOOL")
+    R, Nat, B = typeexpr.TBase("REAL"), typeexpr.TBase("NATURAL"), typeexpr.TBase("BOOL")
     assert types == {
-        "WayP": ast.TFunc((R, R), Nat),
-        "RadStat": ast.TEnum(("red", "orange", "green")),
-        "CommandSet": ast.TConstructors((ast.Constructor("move", (R, R)), ast.Constructor("inspect", (Nat,)))),
-        "PositionType": ast.TFunc((R, R), B),
-        "AtType": ast.TFunc((R, R), B),
-        "InspectedType": ast.TFunc((Nat,), B),
-        "SensorsType": ast.TEmpty(),
+        "WayP": typeexpr.TFunc((R, R), Nat),
+        "RadStat": typeexpr.TEnum(("red", "orange", "green")),
+        "CommandSet": typeexpr.TConstructors((typeexpr.Constructor("move", (R, R)), typeexpr.Constructor("inspect", (Nat,)))),
+        "PositionType": typeexpr.TFunc((R, R), B),
+        "AtType": typeexpr.TFunc((R, R), B),
+        "InspectedType": typeexpr.TFunc((Nat,), B),
+        "SensorsType": typeexpr.TEmpty(),
     }
 
 
@@ -160,17 +162,17 @@ def test_context_constants_and_collection_types() -> None:
       Waypoints = {0, 1, 2} ;
     }"""
     decls = {d.name: d for d in parse_text(src).contexts[0].decls}
-    R = ast.TBase("REAL")
+    R = typeexpr.TBase("REAL")
     assert decls["MaxLevel"] == ast.ConstDecl("MaxLevel", N("250"), None)
     assert decls["Low"] == ast.ConstDecl("Low", N("120.5"), R)
-    assert decls["Ids"].type == ast.TSet(ast.TBase("NATURAL"))
-    assert decls["Route"].type == ast.TSeq(ast.TTuple((R, R)))
-    assert decls["Pair"].type == ast.TTuple((R, ast.TBase("BOOL")))
-    assert decls["Speed"].type == ast.TFunc((R, R, ast.TBase("INTEGER")), R)
-    assert decls["Higher"].type == ast.TFunc((ast.TFunc((R,), R),), ast.TBase("BOOL"))
-    assert decls["Mode"].type == ast.TEnum(("go", "stop"))
-    assert decls["Cmd"].type == ast.TConstructors(
-        (ast.Constructor("move", (R, R)), ast.Constructor("stop", ())))
+    assert decls["Ids"].type == typeexpr.TSet(typeexpr.TBase("NATURAL"))
+    assert decls["Route"].type == typeexpr.TSeq(typeexpr.TTuple((R, R)))
+    assert decls["Pair"].type == typeexpr.TTuple((R, typeexpr.TBase("BOOL")))
+    assert decls["Speed"].type == typeexpr.TFunc((R, R, typeexpr.TBase("INTEGER")), R)
+    assert decls["Higher"].type == typeexpr.TFunc((typeexpr.TFunc((R,), R),), typeexpr.TBase("BOOL"))
+    assert decls["Mode"].type == typeexpr.TEnum(("go", "stop"))
+    assert decls["Cmd"].type == typeexpr.TConstructors(
+        (typeexpr.Constructor("move", (R, R)), typeexpr.Constructor("stop", ())))
     assert decls["Waypoints"].value == ast.SetLit((N("0"), N("1"), N("2")))  # type: ignore[union-attr]
 
 
@@ -202,7 +204,7 @@ def test_quantifier_forms(text: str, kind: str | None, sep: str | None) -> None:
             parse_formula(text)
         return
     q = parse_formula(text)
-    assert q == ast.Quant(kind, (ast.Binding(("x",), ast.TBase("REAL")),),  # type: ignore[arg-type]
+    assert q == ast.Quant(kind, (ast.Binding(("x",), typeexpr.TBase("REAL")),),  # type: ignore[arg-type]
                           ast.Compare(("==",), (V("x"), V("x"))))
 
 
@@ -212,8 +214,8 @@ def test_quantifier_domains() -> None:
     assert isinstance(q, ast.Quant)
     assert [b.names for b in q.bindings] == [("x", "y"), ("i",), ("c",), ("s",), ("q",), ("w",), ("v",)]
     assert [b.domain for b in q.bindings] == [
-        ast.TBase("REAL"), ast.TBase("NATURAL"), ast.TName("RadStat"), ast.SetLit((N("1"), N("2"))),
-        ast.TSet(ast.TBase("REAL")), ast.TSeq(ast.TBase("INTEGER")), V("points", "in")]
+        typeexpr.TBase("REAL"), typeexpr.TBase("NATURAL"), typeexpr.TName("RadStat"), ast.SetLit((N("1"), N("2"))),
+        typeexpr.TSet(typeexpr.TBase("REAL")), typeexpr.TSeq(typeexpr.TBase("INTEGER")), V("points", "in")]
 
 
 def test_precedence_loosest_first() -> None:

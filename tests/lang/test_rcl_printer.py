@@ -8,6 +8,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError
 from rclverify.lang.latex import expr_to_latex, to_latex, type_to_latex
 from rclverify.lang.parser import parse_file, parse_formula, parse_text
@@ -33,32 +35,32 @@ variables = st.builds(ast.Var, primed, prefixes)
 numbers = st.builds(ast.NumLit, st.from_regex(r"[0-9]{1,3}(\.[0-9]{1,2})?([eE][+-]?[0-9]{1,2})?", fullmatch=True))
 bools = st.builds(ast.BoolLit, st.booleans())
 
-base_types = st.builds(ast.TBase, st.sampled_from(["REAL", "INTEGER", "NATURAL", "BOOL"]))
-type_names = st.builds(ast.TName, plain_names)
+base_types = st.builds(typeexpr.TBase, st.sampled_from(["REAL", "INTEGER", "NATURAL", "BOOL"]))
+type_names = st.builds(typeexpr.TName, plain_names)
 
 
-def _extend_types(inner: st.SearchStrategy[ast.TypeExpr]) -> st.SearchStrategy[ast.TypeExpr]:
-    ctor = st.builds(ast.Constructor, plain_names, st.lists(inner, max_size=2).map(tuple))
-    with_args = st.builds(ast.Constructor, plain_names, st.lists(inner, min_size=1, max_size=2).map(tuple))
+def _extend_types(inner: st.SearchStrategy[typeexpr.TypeExpr]) -> st.SearchStrategy[typeexpr.TypeExpr]:
+    ctor = st.builds(typeexpr.Constructor, plain_names, st.lists(inner, max_size=2).map(tuple))
+    with_args = st.builds(typeexpr.Constructor, plain_names, st.lists(inner, min_size=1, max_size=2).map(tuple))
     return st.one_of(
-        st.builds(ast.TSet, inner),
-        st.builds(ast.TSeq, inner),
-        st.builds(ast.TTuple, st.lists(inner, min_size=2, max_size=3).map(tuple)),
-        st.builds(ast.TFunc, st.lists(inner, min_size=1, max_size=3).map(tuple), inner),
-        st.builds(lambda a, rest: ast.TConstructors((a, *rest)), with_args, st.lists(ctor, max_size=2)),
+        st.builds(typeexpr.TSet, inner),
+        st.builds(typeexpr.TSeq, inner),
+        st.builds(typeexpr.TTuple, st.lists(inner, min_size=2, max_size=3).map(tuple)),
+        st.builds(typeexpr.TFunc, st.lists(inner, min_size=1, max_size=3).map(tuple), inner),
+        st.builds(lambda a, rest: typeexpr.TConstructors((a, *rest)), with_args, st.lists(ctor, max_size=2)),
     )
 
 
-types: st.SearchStrategy[ast.TypeExpr] = st.recursive(
-    st.one_of(base_types, type_names, st.just(ast.TEmpty()),
-              st.builds(ast.TEnum, st.lists(plain_names, min_size=1, max_size=3).map(tuple))),
+types: st.SearchStrategy[typeexpr.TypeExpr] = st.recursive(
+    st.one_of(base_types, type_names, st.just(typeexpr.TEmpty()),
+              st.builds(typeexpr.TEnum, st.lists(plain_names, min_size=1, max_size=3).map(tuple))),
     _extend_types, max_leaves=6)
 
 
 def _domain(children: st.SearchStrategy[ast.Expr]) -> st.SearchStrategy[object]:
     # A bare unprefixed name as domain is a type name (TName), by definition.
     terms = children.filter(lambda e: not (isinstance(e, ast.Var) and e.prefix is None))
-    return st.one_of(base_types, type_names, st.builds(ast.TSet, types), st.builds(ast.TSeq, types), terms)
+    return st.one_of(base_types, type_names, st.builds(typeexpr.TSet, types), st.builds(typeexpr.TSeq, types), terms)
 
 
 def _extend_exprs(children: st.SearchStrategy[ast.Expr]) -> st.SearchStrategy[ast.Expr]:
@@ -176,13 +178,13 @@ def test_minimal_parentheses_examples() -> None:
 
 
 def test_type_printing() -> None:
-    R, B = ast.TBase("REAL"), ast.TBase("BOOL")
-    assert type_to_rcl(ast.TFunc((R, R), B)) == "REAL x REAL --> BOOL"
-    assert type_to_rcl(ast.TFunc((ast.TFunc((R,), R),), ast.TFunc((R,), B))) == "(REAL --> REAL) --> (REAL --> BOOL)"
-    assert type_to_rcl(ast.TConstructors((ast.Constructor("move", (R, R)), ast.Constructor("stop", ())))) == (
+    R, B = typeexpr.TBase("REAL"), typeexpr.TBase("BOOL")
+    assert type_to_rcl(typeexpr.TFunc((R, R), B)) == "REAL x REAL --> BOOL"
+    assert type_to_rcl(typeexpr.TFunc((typeexpr.TFunc((R,), R),), typeexpr.TFunc((R,), B))) == "(REAL --> REAL) --> (REAL --> BOOL)"
+    assert type_to_rcl(typeexpr.TConstructors((typeexpr.Constructor("move", (R, R)), typeexpr.Constructor("stop", ())))) == (
         "{move(REAL, REAL), stop}")
-    assert type_to_rcl(ast.TSeq(ast.TTuple((R, ast.TName("RadStat"))))) == "seq((REAL, RadStat))"
-    assert type_to_rcl(ast.TEmpty()) == "{}"
+    assert type_to_rcl(typeexpr.TSeq(typeexpr.TTuple((R, typeexpr.TName("RadStat"))))) == "seq((REAL, RadStat))"
+    assert type_to_rcl(typeexpr.TEmpty()) == "{}"
 
 
 def _paren_pairs(text: str) -> list[tuple[int, int]]:
@@ -227,7 +229,7 @@ def test_spec_round_trip(spec: ast.Spec) -> None:
 
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(types)
-def test_type_round_trip(t: ast.TypeExpr) -> None:
+def test_type_round_trip(t: typeexpr.TypeExpr) -> None:
     spec = parse_text(f"context {{ T : {type_to_rcl(t)} ; }}")
     assert spec.contexts[0].decls[0].type == t
 
@@ -301,7 +303,7 @@ def test_latex_escapes_and_numbers() -> None:
     assert expr_to_latex(parse_formula("s == {} and q == [1, 2] and (a, b) == t")) == (
         r"s = \emptyset \land q = \langle 1, 2 \rangle \land (a, b) = t")
     assert expr_to_latex(parse_formula("a and b -> c"), explicit=True) == r"(a \land b) \Rightarrow c"
-    assert type_to_latex(ast.TSet(ast.TBase("INTEGER"))) == r"\mathcal{P}(\mathbb{Z})"
+    assert type_to_latex(typeexpr.TSet(typeexpr.TBase("INTEGER"))) == r"\mathcal{P}(\mathbb{Z})"
     spec = parse_text("node my_node { inputs(a_b : REAL) outputs() topics(my_pkg/My_Type f_1 matches(in.a_b)) "
                       "guarantee(TRUE) }")
     tex = to_latex(spec, document=False)

@@ -10,6 +10,8 @@ from typing import Any
 import pytest
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.parser import parse_text as parse
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.visit import (EXPR_CLASSES, METHOD_NAMES, NODE_CLASSES, MissingVisit, Transformer, UnknownNode,
@@ -38,8 +40,9 @@ def formulas() -> list[ast.Expr]:
 
 
 def test_every_node_class_has_a_method_name() -> None:
-    defined = {c for c in vars(ast).values() if isinstance(c, type) and dataclasses.is_dataclass(c)
-               and c.__module__ == ast.__name__} - {ast.Loc}
+    defined = {c for m in (typeexpr, ast) for c in vars(m).values() if isinstance(c, type)
+               and dataclasses.is_dataclass(c) and c.__module__ == m.__name__}
+    assert ast.Loc not in defined and typeexpr.TBase in defined and ast.Spec in defined
     assert set(NODE_CLASSES) == defined
     assert set(METHOD_NAMES) == defined
     assert METHOD_NAMES[ast.Binary] == "visit_Binary"
@@ -133,13 +136,13 @@ def test_transformer_rebuilds_only_what_changed(formulas: list[ast.Expr]) -> Non
 
 def test_transformer_reaches_bindings_and_types() -> None:
     class Widen(Transformer):
-        def visit_TBase(self, t: ast.TBase) -> ast.TBase:
-            return ast.TBase("REAL", t.loc) if t.name == "INTEGER" else t
+        def visit_TBase(self, t: typeexpr.TBase) -> typeexpr.TBase:
+            return typeexpr.TBase("REAL", t.loc) if t.name == "INTEGER" else t
 
     spec = parse("node m { inputs(a : INTEGER) outputs(b : BOOL) topics() "
                  "guarantee(forall (k in INTEGER | k == k)) }", "m.rcl")
     out = Widen().visit(spec)
-    assert out.nodes[0].inputs[0].type == ast.TBase("REAL")
+    assert out.nodes[0].inputs[0].type == typeexpr.TBase("REAL")
     q = out.nodes[0].guarantees[0].formula
-    assert q.bindings[0].domain == ast.TBase("REAL")
-    assert spec.nodes[0].inputs[0].type == ast.TBase("INTEGER")  # the input is unchanged
+    assert q.bindings[0].domain == typeexpr.TBase("REAL")
+    assert spec.nodes[0].inputs[0].type == typeexpr.TBase("INTEGER")  # the input is unchanged

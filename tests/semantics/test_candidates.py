@@ -16,6 +16,7 @@ from hypothesis import example, given, settings, strategies as st
 from rclverify.semantics import floatsem
 from rclverify.semantics.concrete import check_concrete
 from rclverify.lang import ast
+from rclverify.lang import typeexpr
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
 from rclverify.semantics.values import FiniteFunction, Term
@@ -64,8 +65,8 @@ class _Grid(floatsem._Double):
         for bd in e.bindings:
             for n in bd.names:
                 names.append(n)
-                doms.append(GRID[bd.domain.name] if isinstance(bd.domain, ast.TBase) and bd.domain.name != "BOOL"
-                            else [False, True] if isinstance(bd.domain, ast.TBase) else list(self.collection(bd.domain, b)))
+                doms.append(GRID[bd.domain.name] if isinstance(bd.domain, typeexpr.TBase) and bd.domain.name != "BOOL"
+                            else [False, True] if isinstance(bd.domain, typeexpr.TBase) else list(self.collection(bd.domain, b)))
         hits = 0
         for combo in itertools.product(*doms):
             holds = bool(self.eval(e.body, dict(b) | dict(zip(names, combo))))

@@ -7,15 +7,15 @@ original (the round-trip property of the printer).
 Source of the syntax: the EBNF table and the listings of the paper
 (shared/reference, lines 499-555, 1131-1171 and appendix A, 1890-1983).
 
-Long module: the flat list of the syntax's node classes, one small frozen
-dataclass each; split, it would only gain a module that re-exports them all
-(the visitor's table, ``lang/visit.py``, names every class).
+The types are :mod:`rclverify.lang.typeexpr`'s and the location every node
+carries :mod:`rclverify.lang.loc`'s (:class:`Loc` and :data:`NOLOC` are
+named here too: a node's location is part of the tree a reader walks).
 
 Shapes
 ------
 * A :class:`Spec` is one RCL file: a tuple of :class:`Context` clauses and a
   tuple of :class:`Node` clauses, in source order.
-* Types are :data:`TypeExpr` values; formulas and terms are :data:`Expr`
+* Types are :data:`~rclverify.lang.typeexpr.TypeExpr` values; formulas and terms are :data:`Expr`
   values (one syntactic category, told apart by the type checker).
 """
 from __future__ import annotations
@@ -24,134 +24,8 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Literal, NoReturn, Union
 
-
-@dataclass(frozen=True, slots=True)
-class Loc:
-    """A source location: 1-based line and column of the first character.
-
-    ``end_line``/``end_col`` point one past the last character (0 when
-    unknown).  ``file`` is the path as given by the user.
-    """
-
-    file: str = "<string>"
-    line: int = 0
-    col: int = 0
-    end_line: int = 0
-    end_col: int = 0
-
-    def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.col}"
-
-    def __reduce__(self) -> tuple[type["Loc"], tuple[str, int, int, int, int]]:
-        """Pickle as a constructor call: the dataclass default for a frozen
-        class with slots looks its fields up on every object, which made
-        Locs (one per AST node and plan value) most of the cost of the
-        workspace cache (:mod:`rclverify.core.cache.workspace`): 4x faster to write, 1.7x to read."""
-        return (Loc, (self.file, self.line, self.col, self.end_line, self.end_col))
-
-
-NOLOC = Loc()
-
-
-def _loc() -> Loc:
-    return field(default=NOLOC, compare=False, repr=False)
-
-
-# --------------------------------------------------------------------------
-# Types
-# --------------------------------------------------------------------------
-
-BaseName = Literal["REAL", "INTEGER", "NATURAL", "BOOL", "STRING"]
-
-
-@dataclass(frozen=True)
-class TBase:
-    """A built-in scalar type: ``REAL``, ``INTEGER``, ``NATURAL``, ``BOOL``,
-    or ``STRING`` (character strings, e.g. values read from ROS ``string``
-    topics)."""
-
-    name: BaseName
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TName:
-    """A reference to a type declared in a ``context`` clause (e.g. ``RadStat``)."""
-
-    name: str
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TEnum:
-    """An enumeration ``{red, orange, green}``; ``values`` in source order."""
-
-    values: tuple[str, ...]
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class Constructor:
-    """One alternative ``move(REAL, REAL)`` of a constructor set."""
-
-    name: str
-    args: tuple["TypeExpr", ...]
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TConstructors:
-    """A constructor set ``{ move(REAL, REAL), inspect(NATURAL) }``.
-
-    Alternatives without arguments (``stop``) have ``args == ()``; a set of
-    only argument-less alternatives is written and parsed as a :class:`TEnum`.
-    """
-
-    ctors: tuple[Constructor, ...]
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TFunc:
-    """A function type ``REAL x REAL --> BOOL`` (``args`` are the domain factors)."""
-
-    args: tuple["TypeExpr", ...]
-    result: "TypeExpr"
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TEmpty:
-    """The empty type ``{}`` (used for hardware inputs, e.g. ``SensorsType``)."""
-
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TSet:
-    """``set(T)``: finite sets of ``T`` (also written ``P(T)``)."""
-
-    elem: "TypeExpr"
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TSeq:
-    """``seq(T)``: finite sequences of ``T``."""
-
-    elem: "TypeExpr"
-    loc: Loc = _loc()
-
-
-@dataclass(frozen=True)
-class TTuple:
-    """``(T1, T2, ...)``: tuples (at least two components)."""
-
-    elems: tuple["TypeExpr", ...]
-    loc: Loc = _loc()
-
-
-TypeExpr = Union[TBase, TName, TEnum, TConstructors, TFunc, TEmpty, TSet, TSeq, TTuple]
+from rclverify.lang.loc import NOLOC as NOLOC, Loc as Loc, loc_field
+from rclverify.lang.typeexpr import TypeExpr
 
 
 # --------------------------------------------------------------------------
@@ -170,7 +44,7 @@ class Var:
 
     name: str
     prefix: Prefix | None = None
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
     @property
     def qualified(self) -> str:
@@ -183,7 +57,7 @@ class BoolLit:
     """``TRUE`` / ``FALSE``."""
 
     value: bool
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -195,7 +69,7 @@ class UnitAnn:
     :func:`rclverify.lang.units.parse_unit` in the type checker."""
 
     text: str
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -207,7 +81,7 @@ class NumLit:
     in its own unit."""
 
     text: str
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     unit: UnitAnn | None = None
 
     @property
@@ -226,7 +100,7 @@ class Apply:
 
     func: Var
     args: tuple["Expr", ...]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 UnaryOp = Literal["not", "-", "abs"]
@@ -248,7 +122,7 @@ class Unary:
 
     op: UnaryOp
     operand: "Expr"
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 BinaryOp = Literal["<=>", "->", "or", "and", "+", "-", "*", "/"]
@@ -267,7 +141,7 @@ class Binary:
     op: BinaryOp
     left: "Expr"
     right: "Expr"
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     parenthesised: bool = field(default=False, compare=False)
 
 
@@ -281,7 +155,7 @@ class Compare:
 
     ops: tuple[CompareOp, ...]
     operands: tuple["Expr", ...]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -292,7 +166,7 @@ class Member:
     elem: "Expr"
     collection: "Expr"
     negated: bool = False
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -300,7 +174,7 @@ class SetLit:
     """``{a, b, c}``."""
 
     items: tuple["Expr", ...]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -308,7 +182,7 @@ class TupleLit:
     """``(a, b)`` with at least two items."""
 
     items: tuple["Expr", ...]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -316,7 +190,7 @@ class SeqLit:
     """``[a, b, c]``."""
 
     items: tuple["Expr", ...]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -329,7 +203,7 @@ class Binding:
 
     names: tuple[str, ...]
     domain: Union[TypeExpr, "Expr"]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     name_locs: tuple[Loc, ...] = field(default=(), compare=False, repr=False)
 
 
@@ -343,7 +217,7 @@ class Quant:
     kind: QuantKind
     bindings: tuple[Binding, ...]
     body: "Expr"
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
     @property
     def variables(self) -> tuple[str, ...]:
@@ -356,7 +230,7 @@ class StrLit:
     with the escapes ``\\"`` and ``\\\\`` resolved.  Type ``STRING``."""
 
     value: str
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -367,7 +241,7 @@ class SeqRange:
 
     lo: "Expr"
     hi: "Expr"
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -383,7 +257,7 @@ class TupleQuant:
     names: tuple[str, ...]
     domain: Union[TypeExpr, "Expr"]
     body: "Expr"
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     name_locs: tuple[Loc, ...] = field(default=(), compare=False, repr=False)
 
     @property
@@ -406,7 +280,7 @@ class TypeDecl:
 
     name: str
     type: TypeExpr
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -421,7 +295,7 @@ class ConstDecl:
     name: str
     value: Expr
     type: TypeExpr | None = None
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     unit: UnitAnn | None = None
 
 
@@ -430,7 +304,7 @@ class Context:
     """``context { ... }``: type and constant declarations in source order."""
 
     decls: tuple[Union[TypeDecl, ConstDecl], ...]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -441,7 +315,7 @@ class IOVar:
 
     name: str
     type: TypeExpr
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     unit: UnitAnn | None = None
 
 
@@ -459,8 +333,8 @@ class Topic:
     msg_type: str
     field: str
     match: Var | None = None
-    loc: Loc = _loc()
-    name_loc: Loc = _loc()
+    loc: Loc = loc_field()
+    name_loc: Loc = loc_field()
 
     @property
     def key(self) -> str:
@@ -482,7 +356,7 @@ class Deadline:
 
     amount: str
     unit: str | None
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -495,7 +369,7 @@ class Clause:
     them, so those keep their meaning."""
 
     formula: Expr
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     trigger: Var | None = None
     deadline: Deadline | None = None
 
@@ -515,8 +389,8 @@ class Link:
     name: str
     role: str
     parts: tuple[Var, ...]
-    loc: Loc = _loc()
-    name_loc: Loc = _loc()
+    loc: Loc = loc_field()
+    name_loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -530,7 +404,7 @@ class Progress:
 
     bound: str | None
     unit: str | None
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -543,7 +417,7 @@ class Periodic:
     output: Var
     amount: str
     unit: str | None
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -561,7 +435,7 @@ class Node:
     topics: tuple[Topic, ...]
     assumes: tuple[Clause, ...]
     guarantees: tuple[Clause, ...]
-    loc: Loc = _loc()
+    loc: Loc = loc_field()
     links: tuple[Link, ...] = ()
     initially: tuple[Clause, ...] = ()
     progress: tuple[Progress, ...] = ()

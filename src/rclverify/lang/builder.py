@@ -17,6 +17,8 @@ from typing import Any, Callable, cast
 from lark import Token, Transformer
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError, error
 
 # Terminals whose text is data; every other token (keywords, punctuation) is
@@ -237,39 +239,39 @@ class ToAst(Transformer[Token, Any]):
     def base_name(self, c: list[Token]) -> Token:
         return c[0]  # the BASE_TYPE token: its text and its position
 
-    def base_type(self, c: list[Any]) -> ast.TBase:
-        return ast.TBase(str(c[0]), self._span(c))  # type: ignore[arg-type]
+    def base_type(self, c: list[Any]) -> typeexpr.TBase:
+        return typeexpr.TBase(str(c[0]), self._span(c))  # type: ignore[arg-type]
 
-    def named_type(self, c: list[Any]) -> ast.TName:
-        return ast.TName(str(c[0]), self._span(c))
+    def named_type(self, c: list[Any]) -> typeexpr.TName:
+        return typeexpr.TName(str(c[0]), self._span(c))
 
-    def empty_type(self, c: list[Any]) -> ast.TEmpty:
-        return ast.TEmpty(self._span(c))
+    def empty_type(self, c: list[Any]) -> typeexpr.TEmpty:
+        return typeexpr.TEmpty(self._span(c))
 
-    def alt(self, c: list[Any]) -> ast.Constructor:
+    def alt(self, c: list[Any]) -> typeexpr.Constructor:
         v = _vals(c)
-        return ast.Constructor(str(v[0]), tuple(t for t in v[1:] if t is not None), self._span(c))
+        return typeexpr.Constructor(str(v[0]), tuple(t for t in v[1:] if t is not None), self._span(c))
 
-    def alt_type(self, c: list[Any]) -> ast.TypeExpr:
-        alts: list[ast.Constructor] = _vals(c)
+    def alt_type(self, c: list[Any]) -> typeexpr.TypeExpr:
+        alts: list[typeexpr.Constructor] = _vals(c)
         if all(not a.args for a in alts):
-            return ast.TEnum(tuple(a.name for a in alts), self._span(c))
-        return ast.TConstructors(tuple(alts), self._span(c))
+            return typeexpr.TEnum(tuple(a.name for a in alts), self._span(c))
+        return typeexpr.TConstructors(tuple(alts), self._span(c))
 
-    def func_type(self, c: list[Any]) -> ast.TFunc:
+    def func_type(self, c: list[Any]) -> typeexpr.TFunc:
         arrow = next(k for k, x in enumerate(c) if isinstance(x, Token) and x.value == "-->")
         args, res = _vals(c[:arrow]), _vals(c[arrow + 1:])
-        result = res[0] if len(res) == 1 else ast.TTuple(tuple(res), self._span(c[arrow + 1:]))
-        return ast.TFunc(tuple(args), result, self._span(c))
+        result = res[0] if len(res) == 1 else typeexpr.TTuple(tuple(res), self._span(c[arrow + 1:]))
+        return typeexpr.TFunc(tuple(args), result, self._span(c))
 
-    def set_type(self, c: list[Any]) -> ast.TSet:
-        return ast.TSet(_vals(c)[0], self._span(c))
+    def set_type(self, c: list[Any]) -> typeexpr.TSet:
+        return typeexpr.TSet(_vals(c)[0], self._span(c))
 
-    def seq_type(self, c: list[Any]) -> ast.TSeq:
-        return ast.TSeq(_vals(c)[0], self._span(c))
+    def seq_type(self, c: list[Any]) -> typeexpr.TSeq:
+        return typeexpr.TSeq(_vals(c)[0], self._span(c))
 
-    def tuple_type(self, c: list[Any]) -> ast.TTuple:
-        return ast.TTuple(tuple(_vals(c)), self._span(c))
+    def tuple_type(self, c: list[Any]) -> typeexpr.TTuple:
+        return typeexpr.TTuple(tuple(_vals(c)), self._span(c))
 
     def type_atom(self, c: list[Any]) -> Any:
         t = c[1]  # "(" type ")": the type itself, spanning its parentheses for its parent
@@ -386,7 +388,7 @@ class ToAst(Transformer[Token, Any]):
         locs = tuple(self._span([n]) for n in v[:-1])
         domain = v[-1]
         if isinstance(domain, ast.Var) and domain.prefix is None:
-            domain = ast.TName(domain.name, domain.loc)
+            domain = typeexpr.TName(domain.name, domain.loc)
         return ast.Binding(names, domain, self._span(c), locs)
 
     def bound_name(self, c: list[Token]) -> Token:
@@ -412,7 +414,7 @@ class ToAst(Transformer[Token, Any]):
         v = _vals(c)
         kind, names, domain, body = v[0], v[1], v[2], v[3]
         if isinstance(domain, ast.Var) and domain.prefix is None:
-            domain = ast.TName(domain.name, domain.loc)
+            domain = typeexpr.TName(domain.name, domain.loc)
         return ast.TupleQuant(str(kind), tuple(str(n) for n in names), domain, body,  # type: ignore[arg-type]
                               self._span(c), tuple(self._span([n]) for n in names))
 

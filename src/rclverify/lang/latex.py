@@ -28,6 +28,8 @@ from typing import Sequence, Union
 import jinja2
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.types import qualified_base
 from rclverify.lang.printer import (BINARY_LEVEL, FLAT_CHAINS, MINUS_LEVEL, NOT_LEVEL, SUM_LEVEL, chain_operands, clarifying_parens,
                       is_type, level, operand_levels, progress_to_rcl)
@@ -82,35 +84,35 @@ def _number(text: str) -> str:
 # Types
 # ---------------------------------------------------------------------------
 
-def type_to_latex(t: ast.TypeExpr) -> str:
+def type_to_latex(t: typeexpr.TypeExpr) -> str:
     """Math-mode LaTeX of a type, e.g. ``\\mathbb{R} \\times \\mathbb{R}
     \\rightarrow \\mathbb{N}`` for ``REAL x REAL --> NATURAL``.  Raises
     ``TypeError`` for a value that is not a type."""
-    if isinstance(t, ast.TBase):
+    if isinstance(t, typeexpr.TBase):
         return _BASE[t.name]
-    if isinstance(t, ast.TName):
+    if isinstance(t, typeexpr.TName):
         return _var(ast.Var(t.name, None, t.loc))
-    if isinstance(t, ast.TEnum):
+    if isinstance(t, typeexpr.TEnum):
         return r"\{" + ", ".join(name_to_latex(v) for v in t.values) + r"\}"
-    if isinstance(t, ast.TConstructors):
+    if isinstance(t, typeexpr.TConstructors):
         return r"\{" + ", ".join(_ctor(c) for c in t.ctors) + r"\}"
-    if isinstance(t, ast.TFunc):
-        def factor(a: ast.TypeExpr) -> str:
+    if isinstance(t, typeexpr.TFunc):
+        def factor(a: typeexpr.TypeExpr) -> str:
             s = type_to_latex(a)
-            return f"({s})" if isinstance(a, ast.TFunc) else s
+            return f"({s})" if isinstance(a, typeexpr.TFunc) else s
         return r" \times ".join(factor(a) for a in t.args) + r" \rightarrow " + factor(t.result)
-    if isinstance(t, ast.TEmpty):
+    if isinstance(t, typeexpr.TEmpty):
         return r"\emptyset"
-    if isinstance(t, ast.TSet):
+    if isinstance(t, typeexpr.TSet):
         return r"\mathcal{P}(" + type_to_latex(t.elem) + ")"
-    if isinstance(t, ast.TSeq):
+    if isinstance(t, typeexpr.TSeq):
         return r"\mathrm{seq}(" + type_to_latex(t.elem) + ")"
-    if isinstance(t, ast.TTuple):
+    if isinstance(t, typeexpr.TTuple):
         return "(" + ", ".join(type_to_latex(e) for e in t.elems) + ")"
     raise TypeError(f"not an RCL type: {t!r}")
 
 
-def _ctor(c: ast.Constructor) -> str:
+def _ctor(c: typeexpr.Constructor) -> str:
     if not c.args:
         return name_to_latex(c.name)
     return name_to_latex(c.name) + "(" + ", ".join(type_to_latex(a) for a in c.args) + ")"

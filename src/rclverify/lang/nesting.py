@@ -9,6 +9,8 @@ from itertools import accumulate
 from typing import Any
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError, error
 
 #: Deepest nesting of expressions and types the parser accepts (AST depth;
@@ -24,8 +26,8 @@ _CHILD_FIELDS: dict[type, tuple[str, ...]] = {
     ast.Member: ("elem", "collection"), ast.Apply: ("args",), ast.SetLit: ("items",), ast.SeqLit: ("items",),
     ast.TupleLit: ("items",), ast.Quant: ("bindings", "body"), ast.Binding: ("domain",),
     ast.TupleQuant: ("domain", "body"), ast.SeqRange: ("lo", "hi"), ast.ConstDecl: ("value", "type"),
-    ast.TypeDecl: ("type",), ast.IOVar: ("type",), ast.TFunc: ("args", "result"), ast.TSet: ("elem",),
-    ast.TSeq: ("elem",), ast.TTuple: ("elems",), ast.TConstructors: ("ctors",), ast.Constructor: ("args",),
+    ast.TypeDecl: ("type",), ast.IOVar: ("type",), typeexpr.TFunc: ("args", "result"), typeexpr.TSet: ("elem",),
+    typeexpr.TSeq: ("elem",), typeexpr.TTuple: ("elems",), typeexpr.TConstructors: ("ctors",), typeexpr.Constructor: ("args",),
 }
 
 

@@ -38,6 +38,8 @@ import itertools
 from typing import Union
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError
 
 #: Precedence level of each binary operator (higher binds tighter).
@@ -84,37 +86,37 @@ def operand_levels(e: ast.Binary) -> tuple[int, int]:
 # Types
 # ---------------------------------------------------------------------------
 
-def _type_atom(t: ast.TypeExpr) -> str:
+def _type_atom(t: typeexpr.TypeExpr) -> str:
     """A type in a position that admits only a type atom (function factors)."""
     s = type_to_rcl(t)
-    return f"({s})" if isinstance(t, ast.TFunc) else s
+    return f"({s})" if isinstance(t, typeexpr.TFunc) else s
 
 
-def type_to_rcl(t: ast.TypeExpr) -> str:
+def type_to_rcl(t: typeexpr.TypeExpr) -> str:
     """RCL text of a type: ``REAL``, ``RadStat``, ``{red, orange, green}``,
     ``{move(REAL, REAL), inspect(NATURAL)}``, ``REAL x REAL --> BOOL``, ``{}``,
     ``set(T)``, ``seq(T)``, ``(T1, T2)``.  Raises ``TypeError`` for a value
     that is not a type."""
-    if isinstance(t, (ast.TBase, ast.TName)):
+    if isinstance(t, (typeexpr.TBase, typeexpr.TName)):
         return t.name
-    if isinstance(t, ast.TEnum):
+    if isinstance(t, typeexpr.TEnum):
         return "{" + ", ".join(t.values) + "}"
-    if isinstance(t, ast.TConstructors):
+    if isinstance(t, typeexpr.TConstructors):
         return "{" + ", ".join(_ctor(c) for c in t.ctors) + "}"
-    if isinstance(t, ast.TFunc):
+    if isinstance(t, typeexpr.TFunc):
         return " x ".join(_type_atom(a) for a in t.args) + " --> " + _type_atom(t.result)
-    if isinstance(t, ast.TEmpty):
+    if isinstance(t, typeexpr.TEmpty):
         return "{}"
-    if isinstance(t, ast.TSet):
+    if isinstance(t, typeexpr.TSet):
         return f"set({type_to_rcl(t.elem)})"
-    if isinstance(t, ast.TSeq):
+    if isinstance(t, typeexpr.TSeq):
         return f"seq({type_to_rcl(t.elem)})"
-    if isinstance(t, ast.TTuple):
+    if isinstance(t, typeexpr.TTuple):
         return "(" + ", ".join(type_to_rcl(e) for e in t.elems) + ")"
     raise TypeError(f"not an RCL type: {t!r}")
 
 
-def _ctor(c: ast.Constructor) -> str:
+def _ctor(c: typeexpr.Constructor) -> str:
     if not c.args:
         return c.name
     return f"{c.name}(" + ", ".join(type_to_rcl(a) for a in c.args) + ")"
@@ -124,8 +126,8 @@ def _ctor(c: ast.Constructor) -> str:
 # Expressions
 # ---------------------------------------------------------------------------
 
-_TYPE_CLASSES = (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc, ast.TEmpty,
-                 ast.TSet, ast.TSeq, ast.TTuple)
+_TYPE_CLASSES = (typeexpr.TBase, typeexpr.TName, typeexpr.TEnum, typeexpr.TConstructors, typeexpr.TFunc, typeexpr.TEmpty,
+                 typeexpr.TSet, typeexpr.TSeq, typeexpr.TTuple)
 
 
 def is_type(d: object) -> bool:

@@ -31,6 +31,8 @@ from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
 from rclverify.lang import ast, liveness, timing
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError
 from rclverify.lang.typecheck_expr import CheckFailed, ExprChecker
 from rclverify.lang.types import BOOL, Checked, CheckedNode, Env, Type, assignable
@@ -56,7 +58,7 @@ class _Checker(ExprChecker):
                 # and as a set (`w in Wayp`), as in the original tool
                 # (docs/rcl-language.md).
                 items = tuple(i.name for i in d.value.items)  # type: ignore[union-attr]
-                self.type_decls[d.name] = ast.TypeDecl(d.name, ast.TEnum(items, d.value.loc), d.loc)
+                self.type_decls[d.name] = ast.TypeDecl(d.name, typeexpr.TEnum(items, d.value.loc), d.loc)
         for d in decls:
             if isinstance(d, ast.TypeDecl) and self.type_decls.get(d.name) is d:
                 try:
@@ -150,9 +152,9 @@ def _is_enum_constant(d: ast.TypeDecl | ast.ConstDecl, decls: Sequence[ast.TypeD
         return False
     declared = {x.name for x in decls}
     for x in decls:
-        if isinstance(x, ast.TypeDecl) and isinstance(x.type, ast.TEnum):
+        if isinstance(x, ast.TypeDecl) and isinstance(x.type, typeexpr.TEnum):
             declared.update(x.type.values)
-        elif isinstance(x, ast.TypeDecl) and isinstance(x.type, ast.TConstructors):
+        elif isinstance(x, ast.TypeDecl) and isinstance(x.type, typeexpr.TConstructors):
             declared.update(c.name for c in x.type.ctors)
     return not any(i.name in declared for i in d.value.items)  # type: ignore[union-attr]
 

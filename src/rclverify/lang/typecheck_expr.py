@@ -14,6 +14,8 @@ import difflib
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import Diagnostic, error
 from rclverify.lang.unitcheck import UnitChecker
 from rclverify.lang.types import (BASE_NAMES, BOOL, INTEGER, NATURAL, REAL, STRING, qualified_base, CheckedNode, DataT,
@@ -74,11 +76,11 @@ class ExprChecker:
         return Env(self.types, self.constants, self.enum_values, self.ctors, self.units.constants)
 
     # -- types ----------------------------------------------------------------------
-    def resolve(self, t: ast.TypeExpr, name: str) -> Type:
+    def resolve(self, t: typeexpr.TypeExpr, name: str) -> Type:
         """Resolve a type expression; ``name`` names enums/constructor sets."""
-        if isinstance(t, ast.TBase):
+        if isinstance(t, typeexpr.TBase):
             return Scalar(t.name)
-        if isinstance(t, ast.TName):
+        if isinstance(t, typeexpr.TName):
             if t.name in self.types:
                 return self.types[t.name]
             if t.name in self.type_decls:
@@ -90,7 +92,7 @@ class ExprChecker:
                 self.unknown_types.add(t.name)
                 self.err(t.loc, f"unknown type {t.name!r}" + candidates(t.name, list(self.type_decls) + list(BASE_NAMES)), "E-name")
             raise CheckFailed
-        if isinstance(t, ast.TEnum):
+        if isinstance(t, typeexpr.TEnum):
             enum = EnumT(name, t.values)
             seen: set[str] = set()
             for v in t.values:
@@ -101,7 +103,7 @@ class ExprChecker:
                 self._claim_value(v, t.loc)
                 self.enum_values[v] = enum
             return enum
-        if isinstance(t, ast.TConstructors):
+        if isinstance(t, typeexpr.TConstructors):
             ctors = []
             for c in t.ctors:
                 args = tuple(self.resolve(a, f"{name}_{c.name}") for a in c.args)
@@ -111,15 +113,15 @@ class ExprChecker:
                 self._claim_value(c.name, c.loc)
                 self.ctors[c.name] = data
             return data
-        if isinstance(t, ast.TFunc):
+        if isinstance(t, typeexpr.TFunc):
             return FuncT(tuple(self.resolve(a, name + "_arg") for a in t.args), self.resolve(t.result, name + "_res"))
-        if isinstance(t, ast.TEmpty):
+        if isinstance(t, typeexpr.TEmpty):
             return EmptyT(name)
-        if isinstance(t, ast.TSet):
+        if isinstance(t, typeexpr.TSet):
             return SetT(self.resolve(t.elem, name + "_elem"))
-        if isinstance(t, ast.TSeq):
+        if isinstance(t, typeexpr.TSeq):
             return SeqT(self.resolve(t.elem, name + "_elem"))
-        if isinstance(t, ast.TTuple):
+        if isinstance(t, typeexpr.TTuple):
             return TupleT(tuple(self.resolve(e, f"{name}_{k}") for k, e in enumerate(t.elems)))
         raise AssertionError(t)  # pragma: no cover
 
@@ -317,9 +319,9 @@ class ExprChecker:
 
     def domain(self, b: ast.Binding, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
         d = b.domain
-        if isinstance(d, ast.TName) and (product := qualified_base(d.name)) is not None:
+        if isinstance(d, typeexpr.TName) and (product := qualified_base(d.name)) is not None:
             return product
-        if isinstance(d, ast.TName) and d.name not in self.types and d.name not in self.type_decls:
+        if isinstance(d, typeexpr.TName) and d.name not in self.types and d.name not in self.type_decls:
             known = d.name in bound or d.name in self.constants or (
                 node is not None and (d.name in node.inputs or d.name in node.outputs))
             if not known:
@@ -332,8 +334,8 @@ class ExprChecker:
                              "E-name")
                 raise CheckFailed
             return self.collection(ast.Var(d.name, None, d.loc), node, bound).elem
-        if isinstance(d, (ast.TBase, ast.TName, ast.TEnum, ast.TConstructors, ast.TFunc, ast.TEmpty,
-                          ast.TSet, ast.TSeq, ast.TTuple)):
+        if isinstance(d, (typeexpr.TBase, typeexpr.TName, typeexpr.TEnum, typeexpr.TConstructors, typeexpr.TFunc, typeexpr.TEmpty,
+                          typeexpr.TSet, typeexpr.TSeq, typeexpr.TTuple)):
             return self.resolve(d, "_".join(b.names) + "_dom")
         return self.collection(d, node, bound).elem
 

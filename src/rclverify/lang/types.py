@@ -1,7 +1,7 @@
 """Semantic (resolved) RCL types and the typing environment.
 
 The type checker (:mod:`rclverify.lang.typecheck`) resolves every
-:data:`rclverify.lang.ast.TypeExpr` into a :data:`Type` below: context names
+:data:`rclverify.lang.typeexpr.TypeExpr` into a :data:`Type` below: context names
 are expanded, enumerations and constructor sets keep the context name they
 were declared under (it names the Z3 sort and the Dafny datatype).
 

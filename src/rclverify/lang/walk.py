@@ -13,6 +13,8 @@ import dataclasses
 from typing import Any, Callable, Iterable, Iterator, Union
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.printer import is_type
 
 
@@ -60,7 +62,7 @@ def subexpressions(e: ast.Expr) -> Iterator[ast.Expr]:
         stack.extend(reversed(list(children(cur))))
 
 
-def free_names(e: Union[ast.Expr, ast.TypeExpr], *, heads: bool = True, type_names: bool = True) -> set[str]:
+def free_names(e: Union[ast.Expr, typeexpr.TypeExpr], *, heads: bool = True, type_names: bool = True) -> set[str]:
     """Unprefixed names occurring free in ``e`` (bound variables of inner
     quantifiers excluded, shadowing respected; each binding's domain sees the
     bindings before it).
@@ -70,7 +72,7 @@ def free_names(e: Union[ast.Expr, ast.TypeExpr], *, heads: bool = True, type_nam
     ``type_names``  count a quantifier domain written as a name (``x in s``
                     may name an earlier bound variable or a set).
     """
-    if isinstance(e, ast.TName):
+    if isinstance(e, typeexpr.TName):
         return {e.name} if type_names else set()
     if is_type(e):
         return set()

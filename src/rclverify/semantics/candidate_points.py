@@ -8,6 +8,8 @@ from fractions import Fraction
 from typing import Any, Iterator, Mapping
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.semantics.values import FiniteFunction, Term, Value
 from rclverify.semantics.candidates import NotInFragment, Source, analyse
 from rclverify.semantics.eval_values import Undecided
@@ -160,8 +162,8 @@ def _between(a: float, b: float) -> int:
 
 def numeric_of(ev: Any, dom: Any) -> str | None:
     """``REAL``/``INTEGER``/``NATURAL`` when binding domain ``dom`` is that type, else None."""
-    name = dom.name if isinstance(dom, ast.TBase) else None
-    if isinstance(dom, ast.TName):
+    name = dom.name if isinstance(dom, typeexpr.TBase) else None
+    if isinstance(dom, typeexpr.TName):
         t = ev.env.types.get(dom.name)
         name = getattr(t, "name", None) if type(t).__name__ == "Scalar" else None
     return name if name in ("REAL", "INTEGER", "NATURAL") else None

@@ -15,6 +15,8 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang import types as T
 from rclverify.semantics.values import FiniteFunction, Term, Value
 from rclverify.semantics.eval_search import _Pin, _Preimage, _joint_groups, _plan, _preimage_group
@@ -49,14 +51,14 @@ class QuantifierEvaluation:
     def domain(self, binding: ast.Binding, name: str, body: ast.Expr, b: Mapping[str, Value],
                kind: str = "forall", qvars: tuple[str, ...] = ()) -> list[Any]:
         dom = binding.domain
-        if isinstance(dom, ast.TBase):
+        if isinstance(dom, typeexpr.TBase):
             base = dom.name
             typ: Any = T.Scalar(base) if base in _INFINITE or base == "BOOL" else None
-        elif isinstance(dom, ast.TName):
+        elif isinstance(dom, typeexpr.TName):
             typ = self.env.types.get(dom.name)
-        elif isinstance(dom, ast.TEnum):
+        elif isinstance(dom, typeexpr.TEnum):
             return list(dom.values)
-        elif isinstance(dom, ast.TypeExpr.__args__):  # type: ignore[attr-defined]
+        elif isinstance(dom, typeexpr.TypeExpr.__args__):  # type: ignore[attr-defined]
             raise Undecided(f"quantifier over a {type(dom).__name__} domain")
         else:
             return list(self.collection(dom, b))

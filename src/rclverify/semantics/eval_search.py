@@ -14,6 +14,8 @@ from __future__ import annotations
 from typing import Any, Mapping, cast
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.semantics.values import FiniteFunction, Term, Value
 from rclverify.semantics.eval_shapes import _STATIC, _conjuncts, _ctor_uses, _free, _only_as, _tuple_apps
 from rclverify.semantics.eval_values import _INFINITE, _fit
@@ -53,7 +55,7 @@ def _joint_groups(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: Any,
         kinds: list[str] = []
         for n in group:
             dom = bindings[n].domain
-            if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+            if not (isinstance(dom, typeexpr.TBase) and dom.name in _INFINITE):
                 break
             kinds.append(dom.name)
         else:
@@ -82,8 +84,8 @@ def _preimage_group(e: ast.Quant, bindings: Mapping[str, ast.Binding], ctors: An
     for side, other in _equalities(_guards(e)):
         names = _function_args(side, ctors, bindings)
         if (names is None or len(names) < 2 or len(set(names)) != len(names)
-                or not all(n in bindings and isinstance(bindings[n].domain, ast.TBase)
-                           and cast(ast.TBase, bindings[n].domain).name in _INFINITE for n in names)):
+                or not all(n in bindings and isinstance(bindings[n].domain, typeexpr.TBase)
+                           and cast(typeexpr.TBase, bindings[n].domain).name in _INFINITE for n in names)):
             continue
         used: set[str] = set()
         _free(other, set(names), used)
@@ -144,7 +146,7 @@ def _pin(guards: list[Any], names: tuple[str, ...], bindings: Mapping[str, ast.B
     kinds = []
     for n in names:
         dom = bindings[n].domain
-        if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+        if not (isinstance(dom, typeexpr.TBase) and dom.name in _INFINITE):
             return None
         kinds.append(dom.name)
     equalities = _equalities(guards)

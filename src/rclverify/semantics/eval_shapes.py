@@ -17,6 +17,8 @@ from fractions import Fraction
 from typing import Any, Iterable, cast
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.semantics.eval_values import _INFINITE
 from rclverify.semantics.operators import OPERATORS
 
@@ -172,7 +174,7 @@ def _unused(e: ast.Quant, name: str, binding: ast.Binding) -> bool:
     ``exists_unique``, where a true body has infinitely many witnesses).
     Memoised per AST node."""
     dom = binding.domain
-    if not (isinstance(dom, ast.TBase) and dom.name in _INFINITE):
+    if not (isinstance(dom, typeexpr.TBase) and dom.name in _INFINITE):
         return False
     key = (id(e), name, "unused")
     hit = _STATIC.get(key)

@@ -66,6 +66,8 @@ from fractions import Fraction
 from typing import Any, Callable, Mapping
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.candidate_points import quantify
@@ -401,12 +403,12 @@ def _enumerate(ev: Evaluator, e: ast.Quant, b: Mapping[str, Value]) -> bool:
 
 def _finite_domain(ev: Evaluator, e: ast.Quant, bd: ast.Binding, name: str, b: Mapping[str, Value]) -> list[Any]:
     dom = bd.domain
-    if isinstance(dom, ast.TEnum):
+    if isinstance(dom, typeexpr.TEnum):
         return list(dom.values)
     typ: Any = None
-    if isinstance(dom, ast.TBase):
+    if isinstance(dom, typeexpr.TBase):
         typ = T.Scalar(dom.name) if dom.name in ("REAL", "INTEGER", "NATURAL", "BOOL") else None
-    elif isinstance(dom, ast.TName):
+    elif isinstance(dom, typeexpr.TName):
         typ = ev.env.types.get(dom.name)
     elif isinstance(dom, (ast.SetLit, ast.Var)):
         return list(ev.collection(dom, b))

@@ -16,6 +16,8 @@ from fractions import Fraction
 from typing import Any, Mapping
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.visit import Visitor, children
@@ -52,36 +54,36 @@ class _Sensitive(Visitor[bool]):
         self.env, self.node, self.tolerant = env, node, tolerant
         self.seen: set[str] = set()
 
-    def generic_visit(self, e: Any, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
+    def generic_visit(self, e: Any, scope: Mapping[str, typeexpr.TypeExpr | ast.Expr]) -> bool:
         return any(self.visit(c, scope) for c in children(e))
 
-    def visit_NumLit(self, e: ast.NumLit, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
+    def visit_NumLit(self, e: ast.NumLit, scope: Mapping[str, typeexpr.TypeExpr | ast.Expr]) -> bool:
         v = e.value
         return v.denominator != 1 and Fraction(float(v)) != v
 
-    def visit_Var(self, e: ast.Var, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
+    def visit_Var(self, e: ast.Var, scope: Mapping[str, typeexpr.TypeExpr | ast.Expr]) -> bool:
         env = self.env
         if e.prefix is None and e.name not in scope and e.name in env.constants and e.name not in self.seen:
             self.seen.add(e.name)
             return self.visit(env.constants[e.name][1], {})
         return False
 
-    def visit_Binary(self, e: ast.Binary, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
+    def visit_Binary(self, e: ast.Binary, scope: Mapping[str, typeexpr.TypeExpr | ast.Expr]) -> bool:
         if OPERATORS[e.op].kind == "arithmetic" and (
                 e.op == "/" or _fractional(e.left, self.env, self.node, scope)
                 or _fractional(e.right, self.env, self.node, scope)):
             return True
         return self.generic_visit(e, scope)
 
-    def visit_Compare(self, e: ast.Compare, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
+    def visit_Compare(self, e: ast.Compare, scope: Mapping[str, typeexpr.TypeExpr | ast.Expr]) -> bool:
         if self.tolerant and any(_fractional(o, self.env, self.node, scope) for o in e.operands):
             return True
         return self.generic_visit(e, scope)
 
-    def visit_Quant(self, e: ast.Quant, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
+    def visit_Quant(self, e: ast.Quant, scope: Mapping[str, typeexpr.TypeExpr | ast.Expr]) -> bool:
         inner = dict(scope)
         for bd in e.bindings:
-            if not isinstance(bd.domain, (ast.TBase, ast.TName, ast.TEnum)) and self.visit(bd.domain, scope):
+            if not isinstance(bd.domain, (typeexpr.TBase, typeexpr.TName, typeexpr.TEnum)) and self.visit(bd.domain, scope):
                 return True
             for n in bd.names:
                 inner[n] = bd.domain
@@ -92,7 +94,7 @@ def _integral_type(t: Any) -> bool:
     return isinstance(t, T.Scalar) and t.name in ("INTEGER", "NATURAL")
 
 
-def _fractional(e: Any, env: Any, node: CheckedNode, scope: Mapping[str, ast.TypeExpr | ast.Expr]) -> bool:
+def _fractional(e: Any, env: Any, node: CheckedNode, scope: Mapping[str, typeexpr.TypeExpr | ast.Expr]) -> bool:
     """May ``e``'s value be a non-integer number?  (False only when its type
     is INTEGER/NATURAL or it is an integer literal; unknown is True.)"""
     if isinstance(e, ast.NumLit):
@@ -104,9 +106,9 @@ def _fractional(e: Any, env: Any, node: CheckedNode, scope: Mapping[str, ast.Typ
     if isinstance(e, ast.Var):
         if e.prefix is None and e.name in scope:
             dom = scope[e.name]
-            if isinstance(dom, ast.TBase):
+            if isinstance(dom, typeexpr.TBase):
                 return dom.name not in ("INTEGER", "NATURAL")
-            if isinstance(dom, ast.TName):
+            if isinstance(dom, typeexpr.TName):
                 return not _integral_type(env.types.get(dom.name))
             return True
         if e.prefix is None and e.name in env.constants:

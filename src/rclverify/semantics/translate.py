@@ -15,6 +15,8 @@ from typing import Any, Mapping, cast
 import z3
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.printer import FLAT_CHAINS, chain_operands, is_type
 from rclverify.lang.typecheck import domain_type
 from rclverify.lang.visit import Visitor
@@ -173,9 +175,9 @@ class _Ctx(Visitor[Any]):
     def _domain_collection(self, d: Any) -> ast.Expr | None:
         """The collection a quantifier domain stands for (a term, or a name
         that is not a declared type), else ``None``: a type needs no guard."""
-        if is_type(d) and not (isinstance(d, ast.TName) and d.name not in self.e.env.types):
+        if is_type(d) and not (isinstance(d, typeexpr.TName) and d.name not in self.e.env.types):
             return None
-        return ast.Var(d.name, None, d.loc) if isinstance(d, ast.TName) else cast(ast.Expr, d)
+        return ast.Var(d.name, None, d.loc) if isinstance(d, typeexpr.TName) else cast(ast.Expr, d)
 
     def visit_Compare(self, x: ast.Compare, b: Mapping[str, z3.ExprRef]) -> Any:
         vals = [None if _is_empty_literal(o) else self.enc(o, b) for o in x.operands]

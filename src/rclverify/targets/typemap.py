@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError, error
 from rclverify.targets import names
 from rclverify.lang.types import DataT, EmptyT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
@@ -91,12 +93,12 @@ class TypeMapper:
         self.loc: ast.Loc = ast.Loc("", 0, 0)
         self.who = ""
 
-    def field(self, section: Section, name: str, t: Type, texpr: ast.TypeExpr | None = None,
+    def field(self, section: Section, name: str, t: Type, texpr: typeexpr.TypeExpr | None = None,
               comment: str = "") -> None:
         """Add the field for RCL variable ``name`` of type ``t`` (declared as ``texpr``) to ``section``."""
-        hint = texpr.name if isinstance(texpr, ast.TName) else camel(name)
+        hint = texpr.name if isinstance(texpr, typeexpr.TName) else camel(name)
         ros_type = self.ros_type(t, hint, section)
-        note = f"RCL {texpr.name} = {t}" if isinstance(texpr, ast.TName) else f"RCL {t}"
+        note = f"RCL {texpr.name} = {t}" if isinstance(texpr, typeexpr.TName) else f"RCL {t}"
         section.add_field(Field(ros_type, names.field_name(name), "; ".join(x for x in (comment, note) if x)))
 
     def ros_type(self, t: Type, hint: str, holder: Section) -> str:

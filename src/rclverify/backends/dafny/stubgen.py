@@ -43,6 +43,8 @@ from typing import Mapping
 import jinja2
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import CheckedNode, DataT, EnumT, Env, Type
 from rclverify.targets.dafny.translate import Translator
@@ -230,7 +232,7 @@ def _param_type(env: Env, v: ast.IOVar, t: Type, kind: str, needed: list[Type], 
     name that is no datatype, the synonym it stands for in ``synonyms``."""
     text = dafny_type(t, v.loc, f"{kind} {v.name} of type {t}")
     needed.append(t)
-    if isinstance(v.type, ast.TName) and not isinstance(t, (EnumT, DataT)) and v.type.name in env.types:
+    if isinstance(v.type, typeexpr.TName) and not isinstance(t, (EnumT, DataT)) and v.type.name in env.types:
         syn = dafny_ident(v.type.name)
         synonyms[syn] = text
         return syn

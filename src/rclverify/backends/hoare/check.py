@@ -29,7 +29,7 @@ import difflib
 from dataclasses import dataclass
 from typing import Iterable, Mapping
 
-from rclverify.lang import ast as rast
+from rclverify.lang import typeexpr
 from rclverify.lang.ast import Loc, unhandled
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.types import (BOOL, INTEGER, NATURAL, REAL, DataT, EnumT, Env, FuncT, Scalar, Type, assignable,
@@ -81,16 +81,16 @@ class _Checker:
         self.diags.append(error(loc, msg, code))
 
     # -- declarations ---------------------------------------------------------------
-    def resolve(self, t: rast.TypeExpr) -> Type:
-        if isinstance(t, rast.TBase):
+    def resolve(self, t: typeexpr.TypeExpr) -> Type:
+        if isinstance(t, typeexpr.TBase):
             return Scalar(t.name)
-        if isinstance(t, rast.TName):
+        if isinstance(t, typeexpr.TName):
             if t.name in self.env.types:
                 return self.env.types[t.name]
             self.err(t.loc, f"unknown type {t.name!r}" + _candidates(t.name, list(self.env.types) + list(_BASES)),
                      "E-name")
             raise _Fail
-        if isinstance(t, rast.TFunc):
+        if isinstance(t, typeexpr.TFunc):
             return FuncT(tuple(self.resolve(a) for a in t.args), self.resolve(t.result))
         self.err(t.loc, "this type cannot be written in a program")
         raise _Fail

@@ -38,7 +38,7 @@ from typing import Any
 from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
 
-from rclverify.lang import ast as rast
+from rclverify.lang import typeexpr
 from rclverify.lang.ast import Loc, unhandled
 from rclverify.lang.parser import describe_terminal, lark_cache_file
 from rclverify.lang.errors import RclError, error
@@ -111,28 +111,28 @@ class _ToAst(Transformer[Token, Any]):
         return ("extern", tuple(ExternDecl(str(t), c[-1], self._loc(t)) for t in self._names(c)))
 
     @v_args(meta=True)
-    def real(self, meta: Any, c: list[Any]) -> rast.TBase:
-        return rast.TBase("REAL", self._loc(meta))
+    def real(self, meta: Any, c: list[Any]) -> typeexpr.TBase:
+        return typeexpr.TBase("REAL", self._loc(meta))
 
     @v_args(meta=True)
-    def integer(self, meta: Any, c: list[Any]) -> rast.TBase:
-        return rast.TBase("INTEGER", self._loc(meta))
+    def integer(self, meta: Any, c: list[Any]) -> typeexpr.TBase:
+        return typeexpr.TBase("INTEGER", self._loc(meta))
 
     @v_args(meta=True)
-    def natural(self, meta: Any, c: list[Any]) -> rast.TBase:
-        return rast.TBase("NATURAL", self._loc(meta))
+    def natural(self, meta: Any, c: list[Any]) -> typeexpr.TBase:
+        return typeexpr.TBase("NATURAL", self._loc(meta))
 
     @v_args(meta=True)
-    def bool(self, meta: Any, c: list[Any]) -> rast.TBase:
-        return rast.TBase("BOOL", self._loc(meta))
+    def bool(self, meta: Any, c: list[Any]) -> typeexpr.TBase:
+        return typeexpr.TBase("BOOL", self._loc(meta))
 
     @v_args(meta=True)
-    def named_type(self, meta: Any, c: list[Any]) -> rast.TName:
-        return rast.TName(str(c[0]), self._loc(meta))
+    def named_type(self, meta: Any, c: list[Any]) -> typeexpr.TName:
+        return typeexpr.TName(str(c[0]), self._loc(meta))
 
     @v_args(meta=True)
-    def func_type(self, meta: Any, c: list[Any]) -> rast.TFunc:
-        return rast.TFunc(tuple(c[:-1]), c[-1], self._loc(meta))
+    def func_type(self, meta: Any, c: list[Any]) -> typeexpr.TFunc:
+        return typeexpr.TFunc(tuple(c[:-1]), c[-1], self._loc(meta))
 
     # -- statements --------------------------------------------------------------
     def stmts(self, c: list[Any]) -> tuple[Stmt, ...]:
@@ -377,12 +377,12 @@ def expr_text(e: Expr, context: int = 0) -> str:
     return f"({s})" if p < context else s
 
 
-def _type_text(t: rast.TypeExpr) -> str:
-    if isinstance(t, rast.TBase):
+def _type_text(t: typeexpr.TypeExpr) -> str:
+    if isinstance(t, typeexpr.TBase):
         return t.name
-    if isinstance(t, rast.TName):
+    if isinstance(t, typeexpr.TName):
         return t.name
-    if isinstance(t, rast.TFunc):
+    if isinstance(t, typeexpr.TFunc):
         return " x ".join(_type_text(a) for a in t.args) + " --> " + _type_text(t.result)
     raise ValueError(f"type {t!r} has no concrete syntax in this language")
 

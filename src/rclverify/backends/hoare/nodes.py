@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal, Union
 
-from rclverify.lang import ast as rast
+from rclverify.lang import typeexpr
 from rclverify.lang.ast import Loc
 from rclverify.semantics.operators import COMPARISONS as OPERATORS_COMPARISONS
 from rclverify.semantics.operators import CONNECTIVES as OPERATORS_CONNECTIVES
@@ -153,7 +153,7 @@ class VarDecl:
     """``var name : type;`` (``type`` is an RCL type expression)."""
 
     name: str
-    type: rast.TypeExpr
+    type: typeexpr.TypeExpr
     loc: Loc = _loc()
 
 
@@ -162,7 +162,7 @@ class ExternDecl:
     """``extern name : T1 x ... --> T;``: an uninterpreted function."""
 
     name: str
-    type: rast.TypeExpr
+    type: typeexpr.TypeExpr
     loc: Loc = _loc()
 
 

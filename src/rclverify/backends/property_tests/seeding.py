@@ -42,6 +42,7 @@ from rclverify.semantics.encode import Encoder, EncodingError, sort_of
 from rclverify.semantics import wallclock
 from rclverify.semantics.retry import SAFETY_TIMEOUT_MS
 from rclverify.lang import ast
+from rclverify.lang import typeexpr
 from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, Type
 from rclverify.semantics.values import FiniteFunction, Term
 
@@ -120,7 +121,7 @@ def min_entries(formulas: tuple[ast.Expr, ...]) -> int:
     least = 0
     for f in formulas:
         if not (isinstance(f, ast.Quant) and f.kind == "forall" and len(f.bindings) == 1
-                and len(f.bindings[0].names) == 1 and isinstance(f.bindings[0].domain, ast.TBase)
+                and len(f.bindings[0].names) == 1 and isinstance(f.bindings[0].domain, typeexpr.TBase)
                 and f.bindings[0].domain.name == "NATURAL"):
             continue
         k = f.bindings[0].names[0]

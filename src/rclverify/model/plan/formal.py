@@ -29,6 +29,8 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import BOOL, Checked, CheckedNode, Type
 
@@ -199,7 +201,7 @@ def _rename(e: Any, names: Mapping[str, str]) -> Any:
     (recursive over the AST's dataclass fields; the parser bounds nesting)."""
     if isinstance(e, ast.Var):
         return dataclasses.replace(e, name=names[e.name]) if e.name in names else e
-    if isinstance(e, ast.TName) and e.name in names:  # a binder's domain `r in Node.in.xs`: the variable, not a type
+    if isinstance(e, typeexpr.TName) and e.name in names:  # a binder's domain `r in Node.in.xs`: the variable, not a type
         return ast.Var(names[e.name], None, e.loc)
     if isinstance(e, tuple):
         return tuple(_rename(x, names) for x in e)

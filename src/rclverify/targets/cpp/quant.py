@@ -32,6 +32,7 @@ from rclverify.semantics.candidates import NotInFragment, analyse
 from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
 from rclverify.semantics.floatsem import MAX_ENUMERATION
 from rclverify.lang import ast
+from rclverify.lang import typeexpr
 from rclverify.lang.types import EnumT, Scalar
 from rclverify.targets.cpp.candidates import candidate_code
 from rclverify.targets.names import cpp_local
@@ -123,8 +124,8 @@ def _candidates(tr: Any, e: ast.Quant, bd: ast.Binding, name: str, later: list[s
 
 
 def _numeric(tr: Any, dom: Any) -> str | None:
-    name = dom.name if isinstance(dom, ast.TBase) else None
-    if isinstance(dom, ast.TName):
+    name = dom.name if isinstance(dom, typeexpr.TBase) else None
+    if isinstance(dom, typeexpr.TName):
         t = tr.env.types.get(dom.name)
         name = t.name if isinstance(t, Scalar) else None
     return name if name in ("REAL", "INTEGER", "NATURAL") else None
@@ -139,15 +140,15 @@ def _domain(tr: Any, e: ast.Quant, bd: ast.Binding, name: str) -> tuple[str, tup
     (floatsem ``_finite_domain``'s cases, in its order); raises :class:`_Undecided`."""
     dom = bd.domain
     env = tr.env
-    if isinstance(dom, ast.TEnum):
+    if isinstance(dom, typeexpr.TEnum):
         t = env.enum_values.get(dom.values[0]) if dom.values else None
         if t is None:
             raise Untranslatable("a quantifier over an enumeration the context does not declare")
         return f"enum:{t.name}", ("values", [enum_const(t, v) for v in dom.values])
     typ: Any = None
-    if isinstance(dom, ast.TBase):
+    if isinstance(dom, typeexpr.TBase):
         typ = Scalar(dom.name) if dom.name in ("REAL", "INTEGER", "NATURAL", "BOOL") else None
-    elif isinstance(dom, ast.TName):
+    elif isinstance(dom, typeexpr.TName):
         typ = env.types.get(dom.name)
     elif isinstance(dom, ast.SetLit):
         return _set_domain(tr, dom.items)

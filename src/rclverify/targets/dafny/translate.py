@@ -43,6 +43,7 @@ from typing import Any, Mapping, cast
 
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
+from rclverify.lang import typeexpr
 from rclverify.semantics.operators import OPERATORS
 from rclverify.semantics.widths import at_widths
 from rclverify.lang.errors import error
@@ -282,7 +283,7 @@ class Translator:
         """The collection a quantifier domain stands for, or ``None`` for a type."""
         if not is_type(domain):
             return cast(ast.Expr, domain)
-        if isinstance(domain, ast.TName) and domain.name not in self.env.types:
+        if isinstance(domain, typeexpr.TName) and domain.name not in self.env.types:
             return ast.Var(domain.name, None, domain.loc)
         return None
 

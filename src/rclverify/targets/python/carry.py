@@ -39,6 +39,7 @@ from rclverify.semantics.floatsens import float_sensitive
 from rclverify.semantics.operators import OPERATORS, UNARY, Operator
 from rclverify.semantics.widths import at_widths
 from rclverify.lang import ast
+from rclverify.lang import typeexpr
 from rclverify.lang import types as T
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.printer import expr_to_rcl
@@ -122,12 +123,12 @@ class _Tree:
     def domain(self, e: ast.Quant, bd: ast.Binding, name: str, scope: frozenset[str]) -> list[Any]:
         """The finite domain of ``name`` as floatsem's ``_finite_domain`` finds it."""
         dom = bd.domain
-        if isinstance(dom, ast.TEnum):
+        if isinstance(dom, typeexpr.TEnum):
             return ["vals", list(dom.values)]
         typ: Any = None
-        if isinstance(dom, ast.TBase):
+        if isinstance(dom, typeexpr.TBase):
             typ = T.Scalar(dom.name) if dom.name in ("REAL", "INTEGER", "NATURAL", "BOOL") else None
-        elif isinstance(dom, ast.TName):
+        elif isinstance(dom, typeexpr.TName):
             typ = self.env.types.get(dom.name)
         elif isinstance(dom, ast.SetLit):
             return ["setlit", [self.expr(i, scope) for i in dom.items]]

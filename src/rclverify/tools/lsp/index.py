@@ -23,6 +23,8 @@ from dataclasses import dataclass
 from typing import Any, Iterator
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.tools.lsp.diagnostics import Analysis
 from rclverify.tools.lsp.lines import normalize, split_lines
 
@@ -110,11 +112,11 @@ def declarations(a: Analysis) -> dict[str, tuple[str, Any]]:
         for c in spec.contexts:
             for d in c.decls:
                 if isinstance(d, ast.TypeDecl):
-                    out.setdefault(d.name, ("function" if isinstance(d.type, ast.TFunc) else "type", d))
-                    if isinstance(d.type, ast.TEnum):
+                    out.setdefault(d.name, ("function" if isinstance(d.type, typeexpr.TFunc) else "type", d))
+                    if isinstance(d.type, typeexpr.TEnum):
                         for v in d.type.values:
                             out.setdefault(v, ("enumeration value", d))
-                    elif isinstance(d.type, ast.TConstructors):
+                    elif isinstance(d.type, typeexpr.TConstructors):
                         for ctor in d.type.ctors:
                             out.setdefault(ctor.name, ("constructor", d))
                 else:

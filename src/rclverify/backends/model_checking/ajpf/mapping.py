@@ -45,6 +45,8 @@ from dataclasses import dataclass, replace
 from typing import Any, Mapping, Iterable
 
 from rclverify.lang import ast
+
+from rclverify.lang import typeexpr
 from rclverify.lang.printer import expr_to_rcl, is_type
 from rclverify.lang.errors import RclError
 from rclverify.lang.parser import parse_formula
@@ -248,9 +250,9 @@ def show_form(f: Form) -> str:
 
 
 def _show_domain(d: Any) -> str:
-    if isinstance(d, ast.TBase):
+    if isinstance(d, typeexpr.TBase):
         return d.name
-    if isinstance(d, ast.TName):
+    if isinstance(d, typeexpr.TName):
         return d.name
     if is_type(d):
         return "<type>"
