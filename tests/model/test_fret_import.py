@@ -238,3 +238,20 @@ def test_durations_in_ticks_and_secs_and_modes(tmp_path: Path) -> None:
     from rclverify.model.plan.fret.requirements import options_of
     assert options_of({"fret": {"step": "100 ms", "components": {"rover": "Rover"}}}) == \
         Options({"rover": "Rover"}, Fraction(1, 10))  # the plan's fret: section
+
+
+def test_a_statement_that_does_not_type_check_is_an_error_at_the_export(ws: Path, tmp_path: Path,
+                                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    """Its names are the contract's, but ``braking = 1.0`` compares a BOOL with a number: the plan no longer
+    checks, the checker's message is at the requirement in the export, and the command exits 1."""
+    reqs = [_req("BAD-TYPE", "the rover shall always satisfy braking = 1.0", "always", "(braking = 1.0)")]
+    args = argparse.Namespace(fn=cmd_import_fret, command="import", export=str(_write(tmp_path / "t.json", reqs)),
+                              workspace=str(ws), plan="contracts/plan.yaml")
+    assert _run(args) == 1
+    err = capsys.readouterr().err
+    assert "fret/t.json:4:13: error: BAD-TYPE: cannot compare BOOL with REAL using '==' (column 30 of its " \
+           "translation: always (Rover.out.braking == 1.0))" in err  # at the reqid in the workspace's copy
+    assert "the plan does not check with the imported requirements" in err
+    reqs[0] = _req("BAD-TYPE", "the rover shall always satisfy braking", "always", "(braking)")  # the control
+    _write(tmp_path / "t.json", reqs)
+    assert _run(args) == 0

@@ -21,8 +21,16 @@ def cmd_import_fret(args: argparse.Namespace) -> int:
     try:
         Workspace(root, args.plan).checked  # the imported statements type-checked with the plan
     except RclError as exc:
+        at = {i.requirement.loc.line: i for i in res.imported if i.requirement.formal is not None}
         for d in exc.diagnostics:
-            print(d, file=sys.stderr)
+            i = at.get(d.loc.line) if d.loc.file == res.dest else None
+            if i is None or i.requirement.formal is None:
+                print(d, file=sys.stderr)
+                continue
+            # a column of the translated statement, not of the export: said so, at the reqid
+            loc = i.requirement.loc
+            print(f"{loc.file}:{loc.line}:{loc.col}: {d.severity}: {i.fret.reqid}: {d.message} (column "
+                  f"{d.loc.col - loc.col + 1} of its translation: {i.requirement.formal.text})", file=sys.stderr)
         print(f"{args.export}: error: the plan does not check with the imported requirements (above)",
               file=sys.stderr)
         return 1
