@@ -15,7 +15,8 @@ from sarif import loader
 from rclverify.report.ci import write_ci_reports
 from rclverify.report.junit import render_junit
 from rclverify.records.sarif import split_location
-from rclverify.report.sarif import lint_rule_id, render_sarif, sarif_log
+from rclverify.report.sarif import render_sarif, sarif_log
+from rclverify.report.sarif_rules import lint_rule_id
 
 SCHEMA = json.loads((Path(__file__).parent.parent / "data" / "sarif-schema-2.1.0.json").read_text(encoding="utf-8"))
 SRC = "contracts/n.rcl"
