@@ -7,7 +7,10 @@ combination (the shapes of FRET v3.1.0's case-study exports, over this
 test's variables).  On random finite traces the oracle evaluates that
 past-time LTL formula at the trace's last step (FRET's finite-trace
 reading: the requirement holds of a trace when the formula holds at its
-end), with the small evaluator below.  rclverify's side is the statement
+end), with the small evaluator below.  (The one named difference: FRET's
+``eventually`` is false on a trace that ends before its response, rclverify's
+``currently_false``, so there the two agree when FRET is true exactly when
+rclverify's verdict is ``true``.)  rclverify's side is the statement
 the importer produced, parsed and type-checked by rclverify
 (``parse_temporal``), its state formulas and the importer's state
 variables evaluated by rclverify's evaluator, under the finite-trace
@@ -73,6 +76,9 @@ CASES: list[tuple[str, str, str, str, str | None, str, dict[str, Any], str]] = [
      "(H ((H (! obstacle)) | (((! clear) S ((! clear) & (obstacle & (Z (! obstacle))))) -> braking)))"),
     ("IN-ALWAYS", "in", "null", "always", None, "(speed <= asked)", {"scope_mode": "manual"},
      "(H (manual -> (speed <= asked)))"),
+    ("EVENTUALLY", "null", "null", "eventually", None, "(! braking)", {}, "(O (! braking))"),
+    ("IN-NEVER", "in", "null", "never", None, "(speed <= asked)", {"scope_mode": "manual"},
+     "(H (manual -> (! (speed <= asked))))"),
     ("IN-IMMEDIATELY", "in", "null", "immediately", None, "(braking)", {"scope_mode": "manual"},
      "(H ((manual & (Z (! manual))) -> braking))"),
     ("PREBOOL", "null", "noTrigger", "immediately", "(! obstacle & preBool ( false , obstacle ))", "(! braking)", {},
@@ -242,6 +248,18 @@ def _holds(f: Formal, checked: Any, step: dict[str, Any], states: dict[str, Any]
     return got
 
 
+def _rcl_agrees(t: Temporal, checked: Any, tr: list[dict[str, Any]], run: list[dict[str, Any]],
+                fret_holds: bool) -> bool:
+    """Whether rclverify's finite-trace verdict on ``tr`` agrees with FRET's: FRET true exactly when the
+    verdict is not ``false``; for an unbounded ``eventually``, the named difference, exactly when it is
+    ``true`` (a trace that ends before Q is FRET's false, rclverify's ``currently_false``)."""
+    if shape(t, None) == "eventually" and t.bound is None:
+        f = t.args[0]
+        assert isinstance(f, Formal)
+        return fret_holds == any(_holds(f, checked, tr[i], run[i]) for i in range(len(tr)))
+    return fret_holds != _rcl_false(t, checked, tr, run)
+
+
 def _rcl_false(t: Temporal, checked: Any, tr: list[dict[str, Any]], run: list[dict[str, Any]]) -> bool:
     """Whether rclverify's finite-trace verdict on ``tr`` is ``false``."""
     kind = shape(t, None)
@@ -289,7 +307,7 @@ def _disagreements(imp: Any, checked: Any, pt_text: str, traces: int, seed: int)
     for _ in range(traces):
         tr = _trace(rng)
         fret_holds = bool(_pt(pt, tr, len(tr) - 1))
-        if fret_holds == _rcl_false(t, checked, tr, _state_run(svs, parsed, checked, tr)):
+        if not _rcl_agrees(t, checked, tr, _state_run(svs, parsed, checked, tr), fret_holds):
             out.append(tr)
     return out
 

@@ -17,6 +17,7 @@ scope, condition, timing        RCL                                             
 ==============================  ================================================  ==========================
 null, null, always / never      ``always Q`` / ``always not Q``
 null, null, immediately         ``eventually[<= 0] Q`` (Q at the first step)
+null, null, eventually (none)   ``eventually Q``
 null, null, within N            ``eventually[<= N] Q``
 null, null, for N               ``always (state.t <= N -> Q)``                    ``t``: the step, capped at N + 1
 null, whenever, immediately     ``always (P -> Q)``
@@ -25,7 +26,7 @@ null, upon, immediately         ``always ((P and not state.prev) -> Q)``        
 null, upon, next                ``always ((P and not state.prev) -> next Q)``     ``prev``
 null, upon, always              ``always ((P or state.since) -> Q)``              ``since``: P held before
 null, upon, until S             ``always ((not S and (T or state.on)) -> Q)``     ``prev``, ``on``
-in M, null, always              ``always (M -> Q)``
+in M, null, always / never      ``always (M -> Q)`` / ``always (M -> (not Q))``
 in M, null, immediately         ``always ((M and not state.prev) -> Q)``          ``prev`` of M
 ==============================  ================================================  ==========================
 
@@ -35,7 +36,11 @@ variable ``fret_<reqid>_<function><k>``).  ``T`` is the trigger ``P and not stat
 true, or holds at the first step); ``on`` holds "a trigger came and S has
 not held since" of the step before.  A window cut short by the end of a
 finite run is FRET's "need not hold": ``next`` and ``eventually[<= N]``
-are not violated by a trace that ends first.  Whatever else raises
+are not violated by a trace that ends first.  One difference is named:
+``eventually Q`` on a finite trace that ends before Q is FRET's false (its
+``O Q`` at the end) and rclverify's ``currently_false`` (a longer run may
+reach Q); over infinite runs, what rclverify proves, both are FRET's
+``F Q`` (``ftInfAUExpanded``).  Whatever else raises
 :class:`~.fretish.Refusal` naming it.
 """
 from __future__ import annotations
@@ -49,10 +54,10 @@ from rclverify.model.plan.fret.fretish import Expr, Refusal, Writer, parse
 
 #: The timings translated for each (scope, condition) (module table).
 SUPPORTED = {
-    ("null", "null"): ("always", "never", "immediately", "within", "for"),
+    ("null", "null"): ("always", "never", "immediately", "within", "for", "eventually", "null"),
     ("null", "holding"): ("immediately", "next"), ("null", "noTrigger"): ("immediately", "next"),
     ("null", "regular"): ("immediately", "next", "always", "until"),
-    ("in", "null"): ("always", "immediately"),
+    ("in", "null"): ("always", "never", "immediately"),
 }
 _UNITS = re.compile(r"\b(?:within|for|after|before)\s+(\d+(?:\.\d+)?)\s*([A-Za-z]+)")
 
@@ -188,6 +193,8 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
         m = parse(mode)
         if timing == "always":
             return Translation(f"always ({w.rcl(m)} -> {q})", node, states.made)
+        if timing == "never":
+            return Translation(f"always ({w.rcl(m)} -> (not {q}))", node, states.made)
         prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {w.rcl(m, True)}")
         return Translation(f"always (({w.rcl(m)} and not {node}.state.{prev}) -> {q})", node, states.made)
     if cond == "null":
@@ -195,6 +202,8 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
             return Translation(f"always {q}", node, states.made)
         if timing == "never":
             return Translation(f"always (not {q})", node, states.made)
+        if timing in ("eventually", "null"):  # FRET's default timing is eventually
+            return Translation(f"eventually {q}", node, states.made)
         if timing == "immediately":
             return Translation(f"eventually[<= 0] {q}", node, states.made)
         n = steps_of(sem, fulltext, step)
