@@ -90,6 +90,7 @@ CASES: list[tuple[str, str, str, str, str | None, str, dict[str, Any], str]] = [
     ("PERSISTED-PRE", "null", "regular", "immediately", "(persisted(1, preBool(false, obstacle)))", "(braking)", {},
      "(H ((((H[0,1] (Y obstacle)) & (H[0,0] (Y TRUE))) & (Z (! ((H[0,1] (Y obstacle)) & (H[0,0] (Y TRUE)))))) "
      "-> braking))"),
+    ("FTP-IF-THEN", "null", "null", "always", None, "(if FTP then braking)", {}, "(H ((Z FALSE) -> braking))"),
     ("NESTED-PRE", "null", "noTrigger", "immediately", "(preBool ( false , speed - preReal ( 0.0 , speed ) <= 1.0 ))",
      "(braking)", {}, "(H ((Y ((speed - preReal(0.0,speed)) <= 1.0)) -> braking))"),
 ]

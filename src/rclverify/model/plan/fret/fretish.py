@@ -14,6 +14,8 @@ FRETish                RCL
 ``! a``, ``a & b``     ``not a``, ``a and b`` (``|``: ``or``)
 ``a => b``, ``a <=> b``  ``a -> b``, ``a <=> b``
 ``a xor b``            ``not (a <=> b)``
+``if a then b``        ``a -> b``
+``FTP``                the first step: a state variable true only there
 ``a = b``              ``a == b``
 ``absReal(e)``, ``absInt(e)``, ``abs(e)``  ``abs(e)``
 ``preBool(i, e)``, ``preReal(i, e)``, ``preInt(i, e)``  a state variable
@@ -144,6 +146,10 @@ class _Parser:
             return ("num", t)
         if t in ("TRUE", "true", "FALSE", "false"):
             return ("bool", t.upper())
+        if t == "if" and self.peek() != "(" or t == "if" and "then" in self.toks[self.i:]:
+            cond = self.level(0)  # FRETish "if p then q": p => q
+            self.take("then")
+            return ("bin", "=>", cond, self.level(0))
         if not (t[0].isalpha() or t[0] == "_"):
             raise Refusal(f"FRETish expression {self.text!r} does not parse at {t!r}", "correct the requirement in FRET")
         if self.peek() == "(":

@@ -176,7 +176,14 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
                                                      f"@ == $) or ((not {p}) and @ == 0)")
         return states.add(role, "NATURAL", str(n + 1), f"({p} and @ == 1) or ((not {p}) and $ <= {n} and "
                                                        f"@ == $ + 1) or ((not {p}) and $ > {n} and @ == $)")
-    w = Writer(var, pre, node, count)
+
+    def placed(name: str, local: bool) -> str | Expr:
+        if name != "FTP":
+            return var(name, local)
+        ftp = next((x.name for x in states.made if x.name == f"{states.base}_ftp"), None) or \
+            states.add("ftp", "BOOL", "TRUE", "not @")  # FRET's first time point
+        return f"state.{ftp}" if local else f"{node}.state.{ftp}"
+    w = Writer(placed, pre, node, count)
 
     def field_expr(key: str, *alt: str) -> Expr:
         for k in (key,) + alt:
