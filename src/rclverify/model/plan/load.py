@@ -41,7 +41,7 @@ from rclverify.model.plan.expected import check_expected
 from rclverify.model.plan.declarations import BACKEND_NAMES
 from rclverify.model.plan.entries import unknown_key_messages
 from rclverify.model.plan.standards.choice import read_standards
-from rclverify.model.plan.instances import read_instances
+from rclverify.model.plan.instances import Instance, read_instances
 
 __all__ = ["KEY", "Plan", "load_plan", "read_plan_data", "resolve"]
 
@@ -167,11 +167,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         return locs.get(tuple(path), ast.Loc(plan_rel, 1, 1))
 
     targets = check_plan_paths(root, plan_rel, data, locs)
-    contracts = tuple(data["contracts"])
-    for i, c in enumerate(contracts):
-        if not (root / c).is_file():
-            l = loc("contracts", i)
-            raise plan_error(plan_rel, l.line, l.col, f"contract file {c!r} does not exist", "E-io")
+    contracts = _contract_files(root, plan_rel, data, loc)
     reqs = []
     for i, r in enumerate(data.get("requirements", [])):
         sup = tuple(Support(s["node"], tuple(s["guarantees"]), loc("requirements", i, "supported_by", j))
@@ -234,13 +230,29 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
         fret_reqs, fret_states = plan_additions(root, data, contracts)
         reqs += fret_reqs
         states += fret_states
-    node_instances, wrong = read_instances(data.get("instances"), locs, plan_rel)
-    if wrong:
-        raise PlanError([d for l, msg in wrong for d in plan_error(l.file, l.line, l.col, msg, "E-instances").diagnostics])
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
                 str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
                 read_acknowledgements(data, locs, plan_rel), targets, read_standards(root, data, locs, plan_rel),
-                node_instances)
+                instances_of(data.get("instances"), locs, plan_rel))
+
+
+def _contract_files(root: Path, plan_rel: str, data: Mapping[str, Any], loc: Any) -> tuple[str, ...]:
+    """The plan's contract files; one that does not exist is a located plan error (``E-io``)."""
+    contracts = tuple(data["contracts"])
+    for i, c in enumerate(contracts):
+        if not (root / c).is_file():
+            l = loc("contracts", i)
+            raise plan_error(plan_rel, l.line, l.col, f"contract file {c!r} does not exist", "E-io")
+    return contracts
+
+
+def instances_of(data: Any, locs: Mapping[Path_, ast.Loc], plan_rel: str) -> dict[str, tuple[Instance, ...]]:
+    """The plan's ``instances`` (:func:`.instances.read_instances`); raises :class:`PlanError` with
+    every problem located (``E-instances``)."""
+    got, wrong = read_instances(data, locs, plan_rel)
+    if wrong:
+        raise PlanError([d for l, msg in wrong for d in plan_error(l.file, l.line, l.col, msg, "E-instances").diagnostics])
+    return got
 
 
 def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:
