@@ -138,3 +138,35 @@ def test_control_a_correct_node_offers_nothing(verified: dict[str, Any]) -> None
     statuses = {e["obligation"]: e["status"] for e in verified["report"]["evidence"]}
     assert statuses["Fine.g1.property_tests.e0"] == statuses["Fine.g2.property_tests.e0"] == "discharged"
     assert not _fixes(verified["sarif"], "obligation:Fine.g1.property_tests.e0")
+
+
+def _apply_sarif(text: str, replacement: dict[str, Any]) -> str:
+    """``text`` with one SARIF 2.1.0 replacement made as a viewer makes it (§3.57: ``deletedRegion`` with
+    1-based lines and columns, ``endColumn`` one past the last character, then ``insertedContent``)."""
+    r = replacement["deletedRegion"]
+    lines = text.splitlines(keepends=True)
+    start = sum(len(x) for x in lines[:r["startLine"] - 1]) + r["startColumn"] - 1
+    end = sum(len(x) for x in lines[:r["endLine"] - 1]) + r["endColumn"] - 1
+    return text[:start] + replacement["insertedContent"]["text"] + text[end:]
+
+
+def test_the_sarif_fixes_are_valid_and_applied_give_the_repaired_code(verified: dict[str, Any]) -> None:
+    """The log with its code fixes is valid SARIF 2.1.0; each fix, applied by its region, gives the code of
+    its repair's diff; the control: the same replacement one column off gives other code."""
+    import jsonschema
+    schema = json.loads((Path(__file__).resolve().parents[2] / "tests/data/sarif-schema-2.1.0.json")
+                        .read_text(encoding="utf-8"))
+    jsonschema.validate(verified["sarif"], schema)
+    fixes = _fixes(verified["sarif"], "obligation:Gate.g1.property_tests.e0")
+    got = {_apply_sarif(CODE["gate"], f["artifactChanges"][0]["replacements"][0]) for f in fixes}
+    assert CODE["gate"].replace("x < 3", "x <= 3") in got
+    for f in fixes:
+        [change] = f["artifactChanges"]
+        assert change["artifactLocation"]["uri"] == "nodes/gate.py"
+        new = _apply_sarif(CODE["gate"], change["replacements"][0])
+        rep = next(r for r in verified["diagnoses"]["Gate.g1.property_tests.e0"]["repairs"]
+                   if r["edit"]["inserted"] == change["replacements"][0]["insertedContent"]["text"])
+        assert "+" + new.splitlines()[4] + "\n" in rep["diff"]
+        off = dict(change["replacements"][0], deletedRegion={**change["replacements"][0]["deletedRegion"],
+                                                             "startColumn": 20, "endColumn": 21})
+        assert _apply_sarif(CODE["gate"], off) != new
