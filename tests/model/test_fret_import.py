@@ -256,3 +256,18 @@ def test_a_statement_that_does_not_type_check_is_an_error_at_the_export(ws: Path
     reqs[0] = _req("BAD-TYPE", "the rover shall always satisfy braking", "always", "(braking)")  # the control
     _write(tmp_path / "t.json", reqs)
     assert _run(args) == 0
+
+
+def test_the_plan_gains_only_its_requirements_from_line(ws: Path, tmp_path: Path) -> None:
+    """A plan that reads a Doorstop tree gets the fret line under its requirements_from: (block style); one
+    written in flow style is left alone, with a located error naming the line to add."""
+    plan = ws / "contracts" / "plan.yaml"
+    plan.write_text(PLAN + "requirements_from:\n    doorstop: reqs\n", encoding="utf-8")
+    import_fret(ws, "contracts/plan.yaml", _write(tmp_path / "e.json", REQS), "e.json")
+    assert plan.read_text(encoding="utf-8") == PLAN + "requirements_from:\n    fret: fret/e.json\n    doorstop: reqs\n"
+    plan.write_text(PLAN + "requirements_from: {doorstop: reqs}\n", encoding="utf-8")
+    with pytest.raises(PlanError) as e:
+        import_fret(ws, "contracts/plan.yaml", _write(tmp_path / "f.json", REQS), "f.json")
+    assert not (ws / "fret" / "f.json").exists()  # nothing written
+    assert "add 'fret: fret/f.json' to it" in e.value.diagnostics[0].message
+    assert plan.read_text(encoding="utf-8") == PLAN + "requirements_from: {doorstop: reqs}\n"

@@ -122,14 +122,15 @@ def import_fret(root: Path, plan_rel: str, export: Path, shown: str) -> ImportRe
     res.changed = [r for r in now if r in old and old[r] != now[r]]
     res.removed = [r for r in old if r not in now]
     res.unchanged = [r for r in now if old.get(r) == now[r]]
-    if target.resolve() != export.resolve():
-        res.written = atomic_write_text(target, json.dumps(new, indent=1, ensure_ascii=False) + "\n", within=root)
-    if not (data.get("requirements_from") or {}).get("fret"):
-        plan_path = root / plan_rel
+    plan_path, edited = root / plan_rel, None
+    if not (data.get("requirements_from") or {}).get("fret"):  # decided before anything is written
         edited = _plan_with_fret(plan_path.read_text(encoding="utf-8"), dest)
         if edited is None:
             raise plan_error(plan_rel, 1, 1, f"requirements_from is written in flow style: add 'fret: {dest}' to it "
                                              "to read the imported requirements", "E-plan")
+    if target.resolve() != export.resolve():
+        res.written = atomic_write_text(target, json.dumps(new, indent=1, ensure_ascii=False) + "\n", within=root)
+    if edited is not None:
         res.plan_edited = atomic_write_text(plan_path, edited, within=root)
     specs = []
     for c in data.get("contracts") or []:
