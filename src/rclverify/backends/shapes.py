@@ -1,16 +1,19 @@
 """The backends' JSON records as types: an obligation's ``data`` and an evidence's ``details``.
 
 One TypedDict per record a backend writes into the evidence (docs/backends.md):
-the Hoare backend's triple (:class:`HoareData`, :class:`HoareDetails`), Dafny's
+the Hoare backend's triple (:class:`HoareData`, :class:`HoareTriple`), Dafny's
 diagnostics (:class:`DafnyDetails`), a review record's checklist
 (:class:`ReviewDetails`), an experiment's figures (:class:`ExperimentDetails`),
-a property test's counts and coverage (:class:`PropertyTestDetails`), the
+a property test's coverage (:class:`InputCoverage`), the
 declarations' verdict rows the property tests and the monitors share
 (:class:`DeclarationRow`), SPIN's lasso (:class:`SpinDetails`, :class:`Lasso`),
 an AJPF obligation (:class:`AjpfData`, :class:`AcceptingPath`), and the
 search tree the Promela template walks (:class:`PromelaLeaf`,
 :class:`PromelaSplit`).  The monitors' records are in
-:mod:`rclverify.backends.monitors.shapes`.
+:mod:`rclverify.backends.monitors.shapes`; the Hoare backend's and the
+property tests' evidence ``details`` are msgspec Structs declared beside
+them (``backends/hoare/payload.py``, ``backends/property_tests/payload.py``,
+decoded by ``backends/payloads.py``).
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
@@ -34,16 +37,6 @@ class HoareTriple(TypedDict):
     """A triple's pre- and postcondition as printed."""
     pre: str
     post: str
-
-
-class HoareDetails(TypedDict):
-    """A checked triple's evidence ``details``: the proof outline, each VC's status, the first refuted VC."""
-    outline: str
-    vcs: dict[str, str]
-    program: str
-    triple: HoareTriple
-    failed_vc: NotRequired[str]
-    notes: NotRequired[list[str]]
 
 
 class DafnyPlace(TypedDict):
@@ -264,23 +257,6 @@ class InputCoverage(TypedDict):
     covered: int | None
     fraction: float | None
     admitted: NotRequired[str]
-
-
-class PropertyTestDetails(TypedDict):
-    """A property test's evidence ``details``: its example counts, configuration and coverage."""
-    examples: dict[str, int]
-    seed: int
-    max_examples: int
-    implementation: str
-    deadline_ms: int | None
-    replay: str
-    facts: NotRequired[list[str]]
-    facts_not_used: NotRequired[list[str]]
-    coverage: NotRequired[dict[str, InputCoverage]]
-    unknown_reasons: NotRequired[list[str]]
-    health_check: NotRequired[str]
-    imports_not_hashed: NotRequired[list[str]]
-    declarations: NotRequired[list[DeclarationRow]]
 
 
 class AjpfData(TypedDict):

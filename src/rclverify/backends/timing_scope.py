@@ -9,9 +9,17 @@ for a timed guarantee says so in its explanation and in
 """
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Mapping, TypedDict
 
 from rclverify.lang.types import CheckedNode
+
+class TimingNote(TypedDict):
+    """``details["timing"]`` of an evidence record that checks a timed guarantee's formula only: never
+    ``checked``, the guarantee's timing clause as written, and the sentence saying so."""
+    checked: bool
+    clause: str
+    note: str
+
 
 #: Backends whose evidence checks triggers and deadlines against time stamps.
 TIMED_BACKENDS: frozenset[str] = frozenset({"monitors"})
@@ -45,5 +53,6 @@ def scope(backend: str, node: CheckedNode | None, guarantee: int, explanation: s
         return explanation, out
     note = (f"untimed part only: {backend} checks guarantee {guarantee}'s formula, not its timing "
             f"'{timing}' (checked by the monitors against message stamps)")
-    out["timing"] = {"checked": False, "clause": timing, "note": note}
+    note_json: TimingNote = {"checked": False, "clause": timing, "note": note}
+    out["timing"] = note_json
     return (f"{note}. {explanation}" if explanation else note), out

@@ -5,13 +5,17 @@ an input's sha256 changed since the evidence was produced, ``pending`` when
 there is no record, ``error`` when the record (or the node's obligation
 list) was altered outside rclverify (records/store.py), and a proof the
 second solver does not confirm is downgraded (stages/crosscheck/apply.py).
-The pass returns its part (:class:`EvidencePart`) and changes nothing it
+A record's ``details`` is decoded once into its backend's payload where the
+backend declares one (backends/payloads.py ``payload_of``); a record whose
+payload does not decode is ``error``, as an altered one.  The pass returns its part (:class:`EvidencePart`) and changes nothing it
 was given.
 """
 from __future__ import annotations
 
 from typing import Any, Mapping, Sequence, TypedDict, cast
 
+from rclverify.backends.payloads import Payload, payload_of
+from rclverify.backends.property_tests.payload import PropertyTestsPayload
 from rclverify.records.records import Obligation
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.evidence_rows import EvidenceRow
@@ -74,18 +78,20 @@ def _explanation(ev: Any, status: str, altered: str, solvers: Solvers | None) ->
     return expl
 
 
-def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Solvers | None) -> EvidenceJson:
+def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Solvers | None,
+                 payload: Payload | None = None) -> EvidenceJson:
     """The report's row of the evidence record ``ev`` shown with ``status``
     (``altered``: why the record is not believed, '' when it is;
-    ``solvers``: the second solver's agreement, ``None`` without one), as
-    the JSON object of :class:`~rclverify.records.evidence_rows.EvidenceRow`
-    (every field)."""
+    ``solvers``: the second solver's agreement, ``None`` without one;
+    ``payload``: its ``details`` decoded by :func:`~rclverify.backends.payloads.payload_of`,
+    ``None`` for a backend whose payload is no Struct), as the JSON object of
+    :class:`~rclverify.records.evidence_rows.EvidenceRow` (every field)."""
     d = ev.details if isinstance(ev.details, dict) else {}
     figures, svg = evidence_extras(ws, d)
     examples: dict[str, Any] = {}
-    if isinstance(d.get("examples"), dict):  # property tests: example counts and seed
-        examples = {**d["examples"], "seed": d.get("seed"), "replay": d.get("replay", ""),
-                    "facts": d.get("facts", []), "coverage": d.get("coverage") or {}}
+    if isinstance(payload, PropertyTestsPayload) and payload.examples:  # example counts, seed, replay
+        examples = {**payload.examples, "seed": payload.seed, "replay": payload.replay, "facts": payload.facts,
+                    "coverage": payload.coverage}
     return EvidenceRow(
         obligation=ev.obligation, backend=ev.backend, kind=ev.kind, status=cast(EvidenceStatus, status),
         tool=ev.tool, tool_version=ev.tool_version, started=ev.started, duration_s=ev.duration_s,
@@ -110,6 +116,13 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
                           "altered": [], "inputs": {}}
     for o in obligations:
         ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
+        payload: Payload | None = None
+        if ev is not None:
+            try:  # its backend's payload decoded once; one that does not decode is not believed
+                payload = payload_of(ev.backend, ev.details)
+            except ValueError as exc:
+                altered = f"its {ev.backend} details are not that backend's payload: {exc}"
+                ev = None
         part["inputs"][o.id] = dict(ev.input_hashes) if ev is not None else None
         status = "error" if altered else (store.current_status(ev, hashes) if ev else "pending")
         status, agreement = second.evidence(o.id, o.backend, status)
@@ -127,7 +140,7 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
             continue
         if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged
             part["declared"].setdefault(o.node, []).append((status, ev.details["declarations"]))
-        part["evidence"].append(evidence_row(ws, ev, status, altered, solvers))
+        part["evidence"].append(evidence_row(ws, ev, status, altered, solvers, payload))
         if status == "pending":
             part["pending"].append(PendingRow(o.id, o.backend, ev.explanation).to_json())
     return part

@@ -43,7 +43,8 @@ from rclverify.backends.hoare.obligations import Conjunct, EncodedTriple, HoareC
 from rclverify.backends.hoare.outline import OutlineLine, outline_text, render_outline, term_printer
 from rclverify.backends.hoare.solve import TripleResult, check_all
 from rclverify.backends.hoare.wp import VC, WP, ProgramModel, main_vc, wp
-from rclverify.backends.shapes import HoareData, HoareDetails
+from rclverify.backends.hoare.payload import HoarePayload
+from rclverify.backends.shapes import HoareData
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
 _DECLARED = declared_in(__file__)
@@ -248,7 +249,7 @@ class HoareBackend:
         artifacts = [target.rel(p.artifact)]
         if p.pending or p.triple is None:
             return evidence("pending", p.pending, artifacts=tuple(artifacts),
-                            details={"reason": p.pending, "uncovered": list(p.conjunct.uncovered)})
+                            details=HoarePayload(reason=p.pending, uncovered=list(p.conjunct.uncovered)).details())
         try:
             res = check_all(p.vcs, p.triple.background, p.model, p.config.timeout_ms, p.triple.observe,
                             p.triple.observe_final, p.triple.names, triple=(p.triple.pre, p.triple.post))
@@ -260,32 +261,28 @@ class HoareBackend:
         artifacts.append(target.rel(p.smt2))
         assert rendered.lines is not None
         outline = outline_text(rendered.lines)
-        details: HoareDetails = {
-            "outline": outline if len(outline) <= 8000 else outline[:8000] + "...\n",
-            "vcs": {r.vc.id: r.status for r in res.results},
-            "program": p.config.program,
-            "triple": {"pre": rendered.pre, "post": rendered.post},
-        }
+        failed = res.failed if res.status == "failed" else None
+        details = HoarePayload(
+            outline=outline if len(outline) <= 8000 else outline[:8000] + "...\n",
+            vcs={r.vc.id: r.status for r in res.results}, program=p.config.program,
+            triple={"pre": rendered.pre, "post": rendered.post}, failed_vc=failed.vc.id if failed else "",
+            notes=list(res.notes) if res.status != "discharged" else []).details()
         log = "\n".join(f"{r.vc.id}: {r.status}" + (f" ({r.reason})" if r.reason else "") for r in res.results)
         if res.status == "discharged":
             return evidence("discharged", f"Z3 proved all {len(res.results)} verification condition(s) of the "
                             f"triple over {p.config.program}", log=log, artifacts=tuple(artifacts), details=details)
         if res.status == "failed":
             assert res.failed is not None
-            details["failed_vc"] = res.failed.vc.id
-            if res.notes:
-                details["notes"] = list(res.notes)
             if res.failed.vc.id.startswith("defined"):
                 return evidence("failed", f"{p.config.program} does not meet the triple: a division by zero on this "
                                 f"run ({res.failed.vc.label}; verification condition {res.failed.vc.id}): "
                                 f"{_cex_text(res.counterexample or {})}", log=log,
                                 artifacts=tuple(artifacts), counterexample=res.counterexample, details=details)
             return evidence("failed", f"{p.config.program} does not meet the triple: the postcondition "
-                            f"{details['triple']['post']} fails on this run (verification condition "
+                            f"{rendered.post} fails on this run (verification condition "
                             f"{res.failed.vc.id}: {res.failed.vc.label}): {_cex_text(res.counterexample or {})}", log=log,
                             artifacts=tuple(artifacts), counterexample=res.counterexample, details=details)
         if res.notes:  # refuted verification conditions, but no run of the program that breaks the triple
-            details["notes"] = list(res.notes)
             return evidence("inconclusive", f"{p.config.program} is not proved to meet the triple, and no "
                             f"counterexample was shown: {'; '.join(res.notes)}", log=log,
                             artifacts=tuple(artifacts), details=details)

@@ -40,7 +40,8 @@ from rclverify.backends.property_tests.seeding import SeedingCut, split_facts
 from rclverify.backends.property_tests.at_width import mapping_inputs
 from rclverify.backends.property_tests.harness import Config, ConfigError, Outcome, load_implementation, read_config, run_guarantee, versions
 import inspect
-from rclverify.backends.shapes import DeclarationRow, PropertyTestDetails
+from rclverify.backends.property_tests.payload import PropertyTestsPayload
+from rclverify.backends.shapes import DeclarationRow
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
 _DECLARED = declared_in(__file__)
@@ -189,11 +190,12 @@ class PropertyTestsBackend:
         except TimeLimitExceeded as exc:
             return evidence("inconclusive", f"{cfg.implementation}: the run of guarantee {k} {exc} (timeout_s of "
                             f"the plan entry, {target.config_loc('timeout_s') if 'timeout_s' in target.config else 'default'}"
-                            "); does the implementation loop forever?", details={"timeout_s": cfg.timeout_s})
+                            "); does the implementation loop forever?",
+                            details=PropertyTestsPayload(timeout_s=cfg.timeout_s).details())
         except SeedingCut as exc:  # a loaded machine: no other seed in its place (docs/decisions.md)
             return evidence("inconclusive", f"{cfg.implementation}: the first example of guarantee {k} under the "
                             f"environment facts was not found: Z3's search for it {exc}",
-                            details={"seeding": str(exc)})
+                            details=PropertyTestsPayload(seeding=str(exc)).details())
         except ConfigError as exc:
             return evidence("error", f"{target.config_loc(*exc.path)}: error: {exc}")
         except PlanError as exc:  # the implementation no longer imports
@@ -203,30 +205,22 @@ class PropertyTestsBackend:
     @staticmethod
     def _evidence(evidence: Callable[..., Evidence], outcome: Outcome, cfg: Config, target: NodeTarget, path: Path, k: int) -> Evidence:
         replay = f"python3 -m pytest {target.rel(path)}::test_guarantee_{k}"
-        details: PropertyTestDetails = {
-            "examples": outcome.counts.as_dict(), "seed": cfg.seed, "max_examples": cfg.max_examples,
-            "implementation": cfg.implementation, "deadline_ms": cfg.deadline_ms, "replay": replay,
-        }
         used, unused = split_facts(target.facts, target.node)
-        if used:
-            details["facts"] = [f"{expr_to_rcl(f)} ({_source(target, f.loc)})" for f in used]
-        if unused:
-            details["facts_not_used"] = [f"{expr_to_rcl(f)} ({_source(target, f.loc)}): names an output"
-                                         for f in unused]
-        if outcome.coverage:  # the valid examples' coverage of the assumption's ranges (.coverage)
-            details["coverage"] = outcome.coverage
-        if outcome.unknown_reasons:
-            details["unknown_reasons"] = outcome.unknown_reasons
-        if outcome.health:
-            details["health_check"] = outcome.health
-        if outcome.unhashed:
-            details["imports_not_hashed"] = outcome.unhashed
         log = "; ".join(f"{a} {b}" for a, b in outcome.counts.as_dict().items())
         cex = outcome.counterexample
         if cex is not None:
             cex = {**cex, "replay": replay}
         status, message = outcome.status, outcome.message
+        declarations: list[DeclarationRow] | None = None
         if has_declarations(target.node):  # progress and initial values on the implementation (declared.py)
-            status, message, details["declarations"] = _declarations(outcome, cfg, target, k)
+            status, message, declarations = _declarations(outcome, cfg, target, k)
+        payload = PropertyTestsPayload(
+            examples=outcome.counts.as_dict(), seed=cfg.seed, max_examples=cfg.max_examples,
+            implementation=cfg.implementation, deadline_ms=cfg.deadline_ms, replay=replay,
+            facts=[f"{expr_to_rcl(f)} ({_source(target, f.loc)})" for f in used],
+            facts_not_used=[f"{expr_to_rcl(f)} ({_source(target, f.loc)}): names an output" for f in unused],
+            coverage=outcome.coverage,  # the valid examples' coverage of the assumption's ranges (.coverage)
+            unknown_reasons=list(outcome.unknown_reasons), health_check=outcome.health or "",
+            imports_not_hashed=list(outcome.unhashed), declarations=declarations)
         return evidence(status, message, log=log, artifacts=(target.rel(path),),
-                        counterexample=cex, details=details)
+                        counterexample=cex, details=payload.details())

@@ -1,0 +1,76 @@
+"""The Hoare backend's and the property tests' evidence payloads are Structs tagged by ``backend``
+(backends/hoare/payload.py, backends/property_tests/payload.py), decoded once by the report's evidence pass
+(backends/payloads.py ``payload_of``, report/evidence_rows.py): a record's ``details`` decodes into the one
+its backend names, a key that payload does not declare makes the record ``error`` in one sentence (the
+control: the same record without it is shown), and a backend whose payload is no Struct is read as before.
+In-process: evidence records written to a temporary workspace, no pipeline.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import msgspec
+import pytest
+
+from rclverify.backends.hoare.payload import HoarePayload
+from rclverify.backends.payloads import TYPED, payload_of
+from rclverify.backends.property_tests.payload import PropertyTestsPayload
+from rclverify.records.records import Evidence, Obligation, SourceRef, hash_inputs
+from rclverify.records.store import EvidenceStore
+from rclverify.report.evidence_rows import evidence_part
+from rclverify.stages.crosscheck.apply import SecondSolver
+from rclverify.stages.workspace import Workspace
+
+_RUN = PropertyTestsPayload(examples={"run": 100, "valid": 90, "rejected": 10, "failures": 0, "inconclusive": 0},
+                            seed=7, max_examples=100, implementation="impl.py:step", replay="replay-command",
+                            facts=["in.x >= 0 (plan.yaml:3:5)"])
+
+
+def test_a_payload_round_trips_through_its_details_and_its_tag() -> None:
+    assert TYPED == {"hoare", "property_tests"}
+    hoare = HoarePayload(vcs={"main": "valid"}, program="prog.imp", triple={"pre": "true", "post": "y > 0"})
+    for backend, payload in (("hoare", hoare), ("property_tests", _RUN)):
+        details = payload.details()
+        assert "backend" not in details  # the record names its backend itself
+        assert payload_of(backend, details) == payload
+    # a field at its default is left out of the record; a run cut short holds only what cut it
+    assert PropertyTestsPayload(timeout_s=0.05).details() == {"timeout_s": 0.05}
+    assert "deadline_ms" not in _RUN.details() and _RUN.details()["seed"] == 7
+    # another backend's payload is no Struct: read as its JSON object, never decoded here
+    assert payload_of("monitors", {"monitoring": {"trace": "t"}}) is None
+    # a key the backend's payload does not declare, or a value of another type, is refused
+    with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
+        payload_of("hoare", {**hoare.details(), "margin_added_here": "0.5 m"})
+    with pytest.raises(msgspec.ValidationError, match="seed"):
+        payload_of("property_tests", {**_RUN.details(), "seed": "seven"})
+
+
+def _evidence(root: Path, oid: str, backend: str, details: dict[str, Any]) -> Evidence:
+    return Evidence(obligation=oid, backend=backend, kind="testing", status="discharged", tool="hypothesis",
+                    tool_version="6", started="2026-01-01T00:00:00+00:00", duration_s=0.5,
+                    input_hashes=hash_inputs(root, ["impl.py"]), details=details)
+
+
+def _obligation(oid: str, backend: str) -> Obligation:
+    return Obligation(id=oid, node="N", guarantee=1, backend=backend, kind="testing", statement="out.y > 0",
+                      source=SourceRef("a.rcl", 3, 4))
+
+
+def test_the_evidence_pass_decodes_each_payload_once_and_refuses_an_undeclared_key(tmp_path: Path) -> None:
+    (tmp_path / "impl.py").write_text("def step(x): return x\n")
+    store = EvidenceStore(tmp_path)
+    good, bad = "N.g1.property_tests.ok", "N.g1.property_tests.bad"
+    store.put(_evidence(tmp_path, good, "property_tests", _RUN.details()))
+    store.put(_evidence(tmp_path, bad, "property_tests", {**_RUN.details(), "margin_added_here": "0.5 m"}))
+    part = evidence_part(Workspace(tmp_path), [_obligation(good, "property_tests"),
+                                               _obligation(bad, "property_tests")], {}, {}, SecondSolver({}))
+    # the control: the record whose payload decodes is shown, its examples from the decoded payload
+    assert part["status"] == {good: "discharged", bad: "error"}
+    [row] = part["evidence"]
+    assert row["obligation"] == good and row["examples"]["seed"] == 7 and row["examples"]["replay"] == "replay-command"
+    assert row["examples"]["facts"] == ["in.x >= 0 (plan.yaml:3:5)"] and row["examples"]["valid"] == 90
+    # the other is error, in one sentence naming the key
+    [said] = part["altered"]
+    assert said.startswith(f"Evidence {bad} is error: its property_tests details are not that backend's payload")
+    assert "margin_added_here" in said
