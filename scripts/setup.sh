@@ -85,17 +85,48 @@ VPY=$VENV/bin/python
 # keep each pin to the Pythons it was resolved for.
 extras=all
 if [ "${1:-}" = "--tests" ]; then extras=all,test,dev; fi
-echo "setup: installing rclverify[$extras] into $VENV"
-"$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[$extras]"
+# A run again installs nothing new when nothing it reads changed: each pip step below leaves a stamp in the
+# venv (this Python's version, the extras or requirements asked for, the sha256 of pyproject.toml and
+# constraints.txt, this checkout's src/), written only after the step succeeded, and a run whose stamp is
+# the same skips the step.  pip's own check of an installed environment still builds the editable package
+# in an isolated environment of its own and resolves every requirement again (about 9 CPU s and, on a
+# loaded machine, over a minute, to install nothing).  A changed input, another extra, a venv made anew
+# (no stamp) or a deleted stamp runs the step as before.
+stamp_of() {  # the stamp of a pip step: its name, then what it installs
+  printf '%s\n' "$@" "$("$VPY" -c 'import sys; print(sys.version)')" "$PWD/src" \
+    "$(sha256sum pyproject.toml constraints.txt | cut -d' ' -f1 | tr '\n' ' ')"
+}
+installed() {  # installed NAME STAMP: the step NAME last succeeded with STAMP, and rclverify imports from src/
+  [ -f "$VENV/.setup-$1" ] && [ "$(cat "$VENV/.setup-$1")" = "$2" ] \
+    && [ "$("$VPY" -c 'import rclverify, os; print(os.path.dirname(os.path.dirname(rclverify.__file__)))' 2>/dev/null)" = "$PWD/src" ]
+}
+stamp=$(stamp_of "rclverify[$extras]")
+if installed rclverify "$stamp"; then
+  echo "setup: rclverify[$extras] is installed in $VENV as pyproject.toml and constraints.txt say (unchanged since)"
+else
+  echo "setup: installing rclverify[$extras] into $VENV"
+  rm -f "$VENV/.setup-rclverify"
+  "$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[$extras]"
+  printf '%s' "$stamp" >"$VENV/.setup-rclverify"
+fi
 # --tests: the monitors' peers of the bench extra (RTAMT, Reelay, mstlo: pyproject.toml), at the versions
 # constraints.txt pins, which tests/semantics/test_margins_peers.py compares the margins with (RTAMT's parser runtime,
 # antlr4-python3-runtime 4.7, is a source archive: pip builds it, pure Python).  Optional: without them that
 # test is skipped with the reason.
 if [ "${1:-}" = "--tests" ]; then
-  echo "setup: installing RTAMT, Reelay and mstlo into $VENV"
-  "$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt \
-      "rtamt>=0.4.10,<0.5" "reelay>=25.0.0,<26" "mstlo-python>=0.2.2,<0.3" \
-    || echo "setup: RTAMT, Reelay or mstlo could not be installed; tests/semantics/test_margins_peers.py skips it with the reason"
+  PEERS=("rtamt>=0.4.10,<0.5" "reelay>=25.0.0,<26" "mstlo-python>=0.2.2,<0.3")
+  stamp=$(stamp_of "${PEERS[@]}")
+  if installed peers "$stamp"; then
+    echo "setup: RTAMT, Reelay and mstlo are installed in $VENV (unchanged since)"
+  else
+    echo "setup: installing RTAMT, Reelay and mstlo into $VENV"
+    rm -f "$VENV/.setup-peers"
+    if "$VPY" -m pip install --quiet --disable-pip-version-check -c constraints.txt "${PEERS[@]}"; then
+      printf '%s' "$stamp" >"$VENV/.setup-peers"
+    else
+      echo "setup: RTAMT, Reelay or mstlo could not be installed; tests/semantics/test_margins_peers.py skips it with the reason"
+    fi
+  fi
 fi
 # The package's bytecode, compiled once here: an editable install compiles nothing, and a shell
 # with PYTHONDONTWRITEBYTECODE set would otherwise compile every module in every doit process.
