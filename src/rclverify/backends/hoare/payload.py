@@ -13,8 +13,6 @@ JSON (``omit_defaults``); a key no field declares is refused.
 """
 from __future__ import annotations
 
-from typing import Any
-
 import msgspec
 
 from rclverify.backends.shapes import HoareTriple
@@ -35,10 +33,10 @@ class HoarePayload(msgspec.Struct, frozen=True, forbid_unknown_fields=True, omit
     uncovered: list[str] = []  #: the parts of a pending conjunct the triple does not cover
     timing: TimingNote | None = None  #: the timing part of the guarantee this evidence does not check
 
-    def details(self) -> dict[str, Any]:
+    def details(self) -> dict[str, object]:
         """The payload as an evidence record's ``details``: its fields not at their default, without the
         ``backend`` tag (the record names its backend itself)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
+        out: dict[str, object] = msgspec.to_builtins(self)
         del out["backend"]
         return out
 

@@ -15,8 +15,6 @@ a key no field declares is refused.
 """
 from __future__ import annotations
 
-from typing import Any
-
 import msgspec
 
 from rclverify.backends.shapes import DeclarationRow, InputCoverage
@@ -45,10 +43,10 @@ class PropertyTestsPayload(msgspec.Struct, frozen=True, forbid_unknown_fields=Tr
     seeding: str = ""  #: why Z3's search for the first example under the facts was cut
     timing: TimingNote | None = None  #: the timing part of the guarantee this evidence does not check
 
-    def details(self) -> dict[str, Any]:
+    def details(self) -> dict[str, object]:
         """The payload as an evidence record's ``details``: its fields not at their default, without the
         ``backend`` tag (the record names its backend itself)."""
-        out: dict[str, Any] = msgspec.to_builtins(self)
+        out: dict[str, object] = msgspec.to_builtins(self)
         del out["backend"]
         return out
 
