@@ -91,6 +91,30 @@ CASES: list[tuple[str, str, str, str, str | None, str, dict[str, Any], str]] = [
      "(H ((((H[0,1] (Y obstacle)) & (H[0,0] (Y TRUE))) & (Z (! ((H[0,1] (Y obstacle)) & (H[0,0] (Y TRUE)))))) "
      "-> braking))"),
     ("FTP-IF-THEN", "null", "null", "always", None, "(if FTP then braking)", {}, "(H ((Z FALSE) -> braking))"),
+    # the rest: FRET's templates (fret-electron/app/parser/semantics.json, its ptExpanded) over this test's names
+    ("NEXT", "null", "null", "next", None, "(braking)", {}, "(H ((Y (Z FALSE)) -> braking))"),
+    ("UNTIL", "null", "null", "until", None, "(braking)", {"stop_condition": "(clear)"},
+     "(H ((H (! clear)) -> braking))"),
+    ("BEFORE", "null", "null", "before", None, "(braking)", {"stop_condition": "(clear)"},
+     "(H (clear -> (Y (O braking))))"),
+    ("UPON-NEVER", "null", "regular", "never", "(obstacle)", "(braking)", {},
+     "(H ((H (! obstacle)) | (! braking)))"),
+    ("HOLDING-ALWAYS", "null", "holding", "always", "(obstacle)", "(braking)", {},
+     "(H ((H (! obstacle)) | braking))"),
+    ("UPON-WITHIN", "null", "regular", "within", "(obstacle)", "(braking)", {"duration": 2},
+     "(H ((O[=2] ((obstacle & (Z (! obstacle))) & (! braking))) -> (O[<2] ((Z FALSE) | braking))))"),
+    ("HOLDING-WITHIN", "null", "holding", "within", "(obstacle)", "(braking)", {"duration": 2},
+     "(H ((O[=2] (obstacle & (! braking))) -> (O[<2] ((Z FALSE) | braking))))"),
+    ("UPON-FOR", "null", "regular", "for", "(obstacle)", "(braking)", {"duration": 2},
+     "(H ((O[<=2] (obstacle & (Z (! obstacle)))) -> ((H (! obstacle)) | braking)))"),
+    ("HOLDING-FOR", "null", "holding", "for", "(obstacle)", "(braking)", {"duration": 1},
+     "(H ((O[<=1] obstacle) -> ((H (! obstacle)) | braking)))"),
+    ("UPON-EVENTUALLY", "null", "regular", "eventually", "(obstacle)", "(braking)", {},
+     "((H (! obstacle)) | (! ((! braking) S ((! braking) & (obstacle & (Z (! obstacle)))))))"),
+    ("HOLDING-EVENTUALLY", "null", "holding", "null", "(obstacle)", "(braking)", {},
+     "((H (! obstacle)) | (! ((! braking) S ((! braking) & obstacle))))"),
+    ("HOLDING-UNTIL", "null", "holding", "until", "(obstacle)", "(braking)", {"stop_condition": "(clear)"},
+     "(H ((H (! obstacle)) | (((! clear) S ((! clear) & obstacle)) -> braking)))"),
     ("NESTED-PRE", "null", "noTrigger", "immediately", "(preBool ( false , speed - preReal ( 0.0 , speed ) <= 1.0 ))",
      "(braking)", {}, "(H ((Y ((speed - preReal(0.0,speed)) <= 1.0)) -> braking))"),
 ]
@@ -111,7 +135,7 @@ def _export(cases: list[Any]) -> FretExport:
 
 # ---- the oracle: FRET's past-time LTL over a finite trace, at its last step ----
 
-_TOK = re.compile(r"\s*(O\[\d+,\d+\]|H\[\d+,\d+\]|<->|->|<=|>=|\d+\.\d+|\d+|[A-Za-z_][A-Za-z0-9_]*|[()!&|=<>+\-*/,])")
+_TOK = re.compile(r"\s*([OH]\[(?:\d+,\d+|<=\d+|<\d+|=\d+)\]|<->|->|<=|>=|\d+\.\d+|\d+|[A-Za-z_][A-Za-z0-9_]*|[()!&|=<>+\-*/,])")
 _BIN = [("<->",), ("->",), ("|",), ("&",), ("S",), ("=", "<", "<=", ">", ">="), ("+", "-"), ("*", "/")]
 
 
@@ -186,7 +210,9 @@ def _pt(e: Any, tr: list[dict[str, Any]], i: int) -> Any:
         vals = (_pt(e[1], tr, j) for j in range(i + 1))
         return all(vals) if op == "H" else any(vals)
     if op[:2] in ("O[", "H["):
-        lo, hi = map(int, op[2:-1].split(","))
+        w = op[2:-1]  # [a,b]: a..b steps ago; [=n]: n ago; [<n]: 0..n-1 ago; [<=n]: 0..n ago
+        lo, hi = (map(int, w.split(",")) if "," in w else (int(w[1:]), int(w[1:])) if w[0] == "=" else
+                  (0, int(w[2:])) if w[:2] == "<=" else (0, int(w[1:]) - 1))
         vals = (_pt(e[1], tr, j) for j in range(max(0, i - hi), i - lo + 1))
         return all(vals) if op[0] == "H" else any(vals)
     a = _pt(e[1], tr, i)
@@ -252,36 +278,53 @@ def _holds(f: Formal, checked: Any, step: dict[str, Any], states: dict[str, Any]
 def _rcl_agrees(t: Temporal, checked: Any, tr: list[dict[str, Any]], run: list[dict[str, Any]],
                 fret_holds: bool) -> bool:
     """Whether rclverify's finite-trace verdict on ``tr`` agrees with FRET's: FRET true exactly when the
-    verdict is not ``false``; for an unbounded ``eventually``, the named difference, exactly when it is
-    ``true`` (a trace that ends before Q is FRET's false, rclverify's ``currently_false``)."""
-    if shape(t, None) == "eventually" and t.bound is None:
-        f = t.args[0]
-        assert isinstance(f, Formal)
-        return fret_holds == any(_holds(f, checked, tr[i], run[i]) for i in range(len(tr)))
-    return fret_holds != _rcl_false(t, checked, tr, run)
+    verdict is not ``false``; for an unbounded ``eventually`` (alone or as a response), the named
+    difference, exactly when it is ``true`` (a trace that ends before the response is FRET's false,
+    rclverify's ``currently_false``)."""
+    verdict = _rcl_verdict(t, checked, tr, run)
+    inner = t.args[0].args[1] if shape(t, None) == "response" else t  # type: ignore[union-attr]
+    if isinstance(inner, Temporal) and inner.op == "eventually" and inner.bound is None:
+        return fret_holds == (verdict == "true")
+    return fret_holds == (verdict != "false")
 
 
-def _rcl_false(t: Temporal, checked: Any, tr: list[dict[str, Any]], run: list[dict[str, Any]]) -> bool:
-    """Whether rclverify's finite-trace verdict on ``tr`` is ``false``."""
+def _rcl_verdict(t: Temporal, checked: Any, tr: list[dict[str, Any]], run: list[dict[str, Any]]) -> str:
+    """rclverify's finite-trace verdict on ``tr`` (docs/requirements.md, "On recorded runs"): ``true``,
+    ``false`` or ``open`` (``currently_false`` or ``inconclusive``: not decided by this trace)."""
     kind = shape(t, None)
     n = len(tr)
+    at = (lambda f, i: _holds(f, checked, tr[i], run[i]))  # noqa: E731
     if kind == "always":
         f = t.args[0]
         assert isinstance(f, Formal)
-        return not all(_holds(f, checked, tr[i], run[i]) for i in range(n))
+        return "true" if all(at(f, i) for i in range(n)) else "false"
+    if kind == "next":
+        f = t.args[0]
+        assert isinstance(f, Formal)
+        return "open" if n < 2 else "true" if at(f, 1) else "false"
     if kind == "response":
         imp = t.args[0]
         assert isinstance(imp, Temporal)
         trig, resp = imp.args
-        assert isinstance(trig, Formal) and isinstance(resp, Temporal) and resp.op == "next"
+        assert isinstance(trig, Formal) and isinstance(resp, Temporal)
         q = resp.args[0]
         assert isinstance(q, Formal)
-        return any(_holds(trig, checked, tr[i], run[i]) and not _holds(q, checked, tr[i + 1], run[i + 1])
-                   for i in range(n - 1))
-    assert kind == "eventually" and t.bound is not None
+        if resp.op == "next":
+            return "false" if any(at(trig, i) and not at(q, i + 1) for i in range(n - 1)) else "true"
+        bound = n if resp.bound is None else resp.bound  # a trigger at i needs q at one of i..i+bound
+        verdict = "true"
+        for i in range(n):
+            if at(trig, i) and not any(at(q, j) for j in range(i, min(i + bound, n - 1) + 1)):
+                if i + bound <= n - 1:
+                    return "false"
+                verdict = "open"
+        return verdict
+    assert kind == "eventually"
     f = t.args[0]
     assert isinstance(f, Formal)
-    return n > t.bound and not any(_holds(f, checked, tr[i], run[i]) for i in range(t.bound + 1))
+    if any(at(f, i) for i in range(n if t.bound is None else min(n, t.bound + 1))):
+        return "true"
+    return "false" if t.bound is not None and n > t.bound else "open"
 
 
 def _trace(rng: random.Random) -> list[dict[str, Any]]:

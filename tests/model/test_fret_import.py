@@ -70,7 +70,7 @@ REQS = [
     _req("R-2", "upon obstacle the rover shall immediately satisfy braking", "immediately", "(braking)",
          "regular", "(obstacle)"),
     _req("R-3", "the rover shall within 3 ticks satisfy speed <= asked", "within", "(speed <= asked)", duration=3),
-    _req("R-4", "upon obstacle the rover shall within 2 ticks satisfy speed = 0.0", "within", "(speed = 0.0)",
+    _req("R-4", "upon obstacle the rover shall after 2 ticks satisfy speed = 0.0", "after", "(speed = 0.0)",
          "regular", "(obstacle)", duration=2),
 ]
 
@@ -103,8 +103,9 @@ def test_each_requirement_becomes_a_plan_requirement_by_reqid(ws: Path, tmp_path
     assert reqs["R-4"].formal is None  # not translated: informal, never dropped
     Workspace(ws, "contracts/plan.yaml").checked  # every imported statement type-checks with the contract
     out = render(res)
-    assert "export.json:R-4: the timing within with scope null and condition regular is not translated; with " \
-           "this scope and condition rclverify translates the timings immediately, next, always, until" in out
+    assert "export.json:R-4: the timing after with scope null and condition regular is not translated; with " \
+           "this scope and condition rclverify translates the timings immediately, next, within, for, eventually, " \
+           "always, never, until" in out
     assert "3 translated to a decided temporal statement, 1 kept as informal" in out
 
 

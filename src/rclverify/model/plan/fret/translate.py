@@ -17,30 +17,38 @@ scope, condition, timing        RCL                                             
 ==============================  ================================================  ==========================
 null, null, always / never      ``always Q`` / ``always not Q``
 null, null, immediately         ``eventually[<= 0] Q`` (Q at the first step)
+null, null, next                ``next Q`` (Q at the second step)
 null, null, eventually (none)   ``eventually Q``
 null, null, within N            ``eventually[<= N] Q``
 null, null, for N               ``always (state.t <= N -> Q)``                    ``t``: the step, capped at N + 1
-null, whenever, immediately     ``always (P -> Q)``
-null, whenever, next            ``always (P -> next Q)``
-null, upon, immediately         ``always ((P and not state.prev) -> Q)``          ``prev``: P at the step before
-null, upon, next                ``always ((P and not state.prev) -> next Q)``     ``prev``
-null, upon, always              ``always ((P or state.since) -> Q)``              ``since``: P held before
-null, upon, until S             ``always ((not S and (T or state.on)) -> Q)``     ``prev``, ``on``
+null, null, until S             ``always ((not S and not state.stopped) -> Q)``   ``stopped``: S held before
+null, null, before S            ``always (S -> state.held)``                      ``held``: Q held before
+null, C, immediately            ``always (T -> Q)``                               (``prev``)
+null, C, next                   ``always (T -> next Q)``                          (``prev``)
+null, C, within N               ``always (T -> eventually[<= N] Q)``              (``prev``)
+null, C, eventually (none)      ``always (T -> eventually Q)``                    (``prev``)
+null, C, for N                  ``always ((T or state.ago <= N) -> Q)``           (``prev``), ``ago``: steps
+                                                                                  since T, capped at N + 1
+null, C, always / never         ``always ((P or state.since) -> Q)`` / ``not Q``  ``since``: P held before
+null, C, until S                ``always ((not S and (T or state.on)) -> Q)``     (``prev``), ``on``
 in M, null, always / never      ``always (M -> Q)`` / ``always (M -> (not Q))``
 in M, null, immediately         ``always ((M and not state.prev) -> Q)``          ``prev`` of M
 ==============================  ================================================  ==========================
 
-FRET's functions inside P, Q, S and M are :mod:`.fretish`'s (``preBool``
-and the other ``pre`` functions, ``persisted`` and ``occurred`` each a state
-variable ``fret_<reqid>_<function><k>``).  ``T`` is the trigger ``P and not state.prev`` (FRET's "upon": P becomes
-true, or holds at the first step); ``on`` holds "a trigger came and S has
-not held since" of the step before.  A window cut short by the end of a
+C is a condition: FRET's ``regular`` ("upon", "when", "if": the trigger
+``T`` is ``P and not state.prev``, P becoming true or true at the first
+step, ``prev`` holding P of the step before) or ``holding``/``noTrigger``
+("whenever": ``T`` is P, no ``prev``).  ``on`` holds "a trigger came and S
+has not held since" of the step before.  FRET's functions inside P, Q, S
+and M are :mod:`.fretish`'s (``preBool`` and the other ``pre`` functions,
+``persisted`` and ``occurred``, each a state variable
+``fret_<reqid>_<function><k>``).  A window cut short by the end of a
 finite run is FRET's "need not hold": ``next`` and ``eventually[<= N]``
-are not violated by a trace that ends first.  One difference is named:
-``eventually Q`` on a finite trace that ends before Q is FRET's false (its
-``O Q`` at the end) and rclverify's ``currently_false`` (a longer run may
-reach Q); over infinite runs, what rclverify proves, both are FRET's
-``F Q`` (``ftInfAUExpanded``).  Whatever else raises
+are not violated by a trace that ends first.  One difference is named: an
+unbounded ``eventually`` on a finite trace that ends before its response is
+FRET's false (``O Q`` at the end) and rclverify's ``currently_false`` (a
+longer run may reach it); over infinite runs, what rclverify proves, both
+are FRET's ``F Q`` (``ftInfAUExpanded``).  Whatever else raises
 :class:`~.fretish.Refusal` naming it.
 """
 from __future__ import annotations
@@ -53,10 +61,11 @@ from typing import Any, Callable, Mapping
 from rclverify.model.plan.fret.fretish import Expr, Refusal, Writer, parse
 
 #: The timings translated for each (scope, condition) (module table).
+_CONDITIONED = ("immediately", "next", "within", "for", "eventually", "null", "always", "never", "until")
 SUPPORTED = {
-    ("null", "null"): ("always", "never", "immediately", "within", "for", "eventually", "null"),
-    ("null", "holding"): ("immediately", "next"), ("null", "noTrigger"): ("immediately", "next"),
-    ("null", "regular"): ("immediately", "next", "always", "until"),
+    ("null", "null"): ("always", "never", "immediately", "next", "within", "for", "eventually", "null", "until",
+                       "before"),
+    ("null", "holding"): _CONDITIONED, ("null", "noTrigger"): _CONDITIONED, ("null", "regular"): _CONDITIONED,
     ("in", "null"): ("always", "never", "immediately"),
 }
 _UNITS = re.compile(r"\b(?:within|for|after|before)\s+(\d+(?:\.\d+)?)\s*([A-Za-z]+)")
@@ -155,7 +164,8 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
     if timing not in SUPPORTED.get((scope, cond), ()):
         here = SUPPORTED.get((scope, cond))
         raise Refusal(f"the timing {timing} with scope {scope} and condition {cond} is not translated",
-                      f"with this scope and condition rclverify translates the timings {', '.join(here)}" if here
+                      "with this scope and condition rclverify translates the timings "
+                      f"{', '.join(t for t in here if t != 'null')}" if here
                       else "rclverify translates the scopes null and in (docs/requirements.md, "
                            "'Requirements from FRET')")
     states = _States(state_base(reqid))
@@ -192,48 +202,77 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
                 return parse(v)
         raise Refusal(f"its semantics has no {key}", "let FRET formalise the requirement again and export it")
 
-    q = w.rcl(field_expr("post_condition"))
+    q_tree = field_expr("post_condition")
+    q = w.rcl(q_tree)
+    made = states.made
     if scope == "in":
         mode = sem.get("scope_mode")
         if not isinstance(mode, str) or not mode.strip():
             raise Refusal("its scope 'in' names no mode", "name the mode in FRET")
         m = parse(mode)
         if timing == "always":
-            return Translation(f"always ({w.rcl(m)} -> {q})", node, states.made)
+            return Translation(f"always ({w.rcl(m)} -> {q})", node, made)
         if timing == "never":
-            return Translation(f"always ({w.rcl(m)} -> (not {q}))", node, states.made)
+            return Translation(f"always ({w.rcl(m)} -> (not {q}))", node, made)
         prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {w.rcl(m, True)}")
-        return Translation(f"always (({w.rcl(m)} and not {node}.state.{prev}) -> {q})", node, states.made)
+        return Translation(f"always (({w.rcl(m)} and not {node}.state.{prev}) -> {q})", node, made)
     if cond == "null":
-        if timing == "always":
-            return Translation(f"always {q}", node, states.made)
-        if timing == "never":
-            return Translation(f"always (not {q})", node, states.made)
-        if timing in ("eventually", "null"):  # FRET's default timing is eventually
-            return Translation(f"eventually {q}", node, states.made)
-        if timing == "immediately":
-            return Translation(f"eventually[<= 0] {q}", node, states.made)
+        return _unconditional(timing, q, q_tree, w, states, node, lambda: steps_of(sem, fulltext, step),
+                              lambda: field_expr("stop_condition"))
+    p_tree = field_expr("regular_condition", "pre_condition")
+    p, p_local = w.rcl(p_tree), w.rcl(p_tree, True)
+    if timing in ("always", "never"):  # from the first step P held on (FRET: H (H !P | Q))
+        since = states.add("since", "BOOL", "FALSE", f"@ <=> ($ or {p_local})")
+        return Translation(f"always (({p} or {node}.state.{since}) -> {q if timing == 'always' else f'(not {q})'})",
+                           node, made)
+    trig, trig_local = f"({p})", f"({p_local})"
+    if cond == "regular":  # FRET's "upon": P becoming true, or true at the first step
+        prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {p_local}")
+        trig, trig_local = f"({p} and not {node}.state.{prev})", f"({p_local} and not state.{prev})"
+    if timing == "immediately":
+        return Translation(f"always ({trig} -> {q})", node, made)
+    if timing == "next":
+        return Translation(f"always ({trig} -> next {q})", node, made)
+    if timing in ("eventually", "null"):
+        return Translation(f"always ({trig} -> eventually {q})", node, made)
+    if timing in ("within", "for"):
         n = steps_of(sem, fulltext, step)
         if timing == "within":
-            return Translation(f"eventually[<= {n}] {q}", node, states.made)
-        t = states.add("t", "NATURAL", "0", f"($ <= {n} and @ == $ + 1) or ($ > {n} and @ == $)")
-        return Translation(f"always ({node}.state.{t} <= {n} -> {q})", node, states.made)
-    p_tree = field_expr("regular_condition", "pre_condition")
-    p = w.rcl(p_tree)
-    if cond in ("holding", "noTrigger"):
-        return Translation(f"always ({p} -> {q})" if timing == "immediately" else f"always ({p} -> next {q})",
-                           node, states.made)
-    if timing == "always":
-        since = states.add("since", "BOOL", "FALSE", f"@ <=> ($ or {w.rcl(p_tree, True)})")
-        return Translation(f"always (({p} or {node}.state.{since}) -> {q})", node, states.made)
-    prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {w.rcl(p_tree, True)}")
-    trig = f"({p} and not {node}.state.{prev})"
-    if timing == "immediately":
-        return Translation(f"always ({trig} -> {q})", node, states.made)
-    if timing == "next":
-        return Translation(f"always ({trig} -> next {q})", node, states.made)
+            return Translation(f"always ({trig} -> eventually[<= {n}] {q})", node, made)
+        d = states.add("ago", "NATURAL", str(n + 1), f"({trig_local} and @ == 1) or ((not {trig_local}) and "
+                                                     f"$ <= {n} and @ == $ + 1) or ((not {trig_local}) and $ > {n} "
+                                                     "and @ == $)")
+        return Translation(f"always (({trig} or {node}.state.{d} <= {n}) -> {q})", node, made)
     s_tree = field_expr("stop_condition")
-    s, s_local, p_local = w.rcl(s_tree), w.rcl(s_tree, True), w.rcl(p_tree, True)
-    on = states.add("on", "BOOL", "FALSE", f"@ <=> ((not {s_local}) and (({p_local} and not state.{prev}) or $))")
-    return Translation(f"always (((not {s}) and ({trig} or {node}.state.{on})) -> {q})", node, states.made)
+    s, s_local = w.rcl(s_tree), w.rcl(s_tree, True)
+    on = states.add("on", "BOOL", "FALSE", f"@ <=> ((not {s_local}) and ({trig_local} or $))")
+    return Translation(f"always (((not {s}) and ({trig} or {node}.state.{on})) -> {q})", node, made)
 
+
+def _unconditional(timing: str, q: str, q_tree: Expr, w: Writer, states: _States, node: str,
+                   steps: Callable[[], int], stop: Callable[[], Expr]) -> Translation:
+    """The null condition's timings (module table)."""
+    made = states.made
+    if timing == "always":
+        return Translation(f"always {q}", node, made)
+    if timing == "never":
+        return Translation(f"always (not {q})", node, made)
+    if timing in ("eventually", "null"):  # FRET's default timing is eventually
+        return Translation(f"eventually {q}", node, made)
+    if timing == "immediately":
+        return Translation(f"eventually[<= 0] {q}", node, made)
+    if timing == "next":
+        return Translation(f"next {q}", node, made)
+    if timing in ("until", "before"):
+        s_tree = stop()
+        s, s_local = w.rcl(s_tree), w.rcl(s_tree, True)
+        if timing == "until":  # Q until S first holds (FRET: H (H !S -> Q))
+            seen = states.add("stopped", "BOOL", "FALSE", f"@ <=> ($ or {s_local})")
+            return Translation(f"always (((not {s}) and not {node}.state.{seen}) -> {q})", node, made)
+        held = states.add("held", "BOOL", "FALSE", f"@ <=> ($ or {w.rcl(q_tree, True)})")  # FRET: H (S -> Y O Q)
+        return Translation(f"always ({s} -> {node}.state.{held})", node, made)
+    n = steps()
+    if timing == "within":
+        return Translation(f"eventually[<= {n}] {q}", node, made)
+    t = states.add("t", "NATURAL", "0", f"($ <= {n} and @ == $ + 1) or ($ > {n} and @ == $)")
+    return Translation(f"always ({node}.state.{t} <= {n} -> {q})", node, made)
