@@ -169,31 +169,7 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
                       else "rclverify translates the scopes null and in (docs/requirements.md, "
                            "'Requirements from FRET')")
     states = _States(state_base(reqid))
-
-    def pre(type_name: str, init: Expr, e: Expr) -> str:
-        init_text, body = w.rcl(init, True), w.rcl(e, True)  # an inner pre is declared first
-        if re.search(r"(?<![A-Za-z0-9_])(in|out|state)\.", init_text):
-            raise Refusal(f"a pre function's initial value {init_text} reads the component's variables",
-                          "give it a constant initial value (preReal(0.0, e))")
-        return states.add(f"pre{len(states.made) + 1}", type_name, init_text,
-                          f"@ <=> {body}" if type_name == "BOOL" else f"@ == {body}")
-
-    def count(kind: str, n: int, e: Expr) -> str:
-        p = w.rcl(e, True)
-        role = f"{kind}{len(states.made) + 1}"
-        if kind == "persisted":
-            return states.add(role, "NATURAL", "0", f"({p} and $ < {n} and @ == $ + 1) or ({p} and $ >= {n} and "
-                                                     f"@ == $) or ((not {p}) and @ == 0)")
-        return states.add(role, "NATURAL", str(n + 1), f"({p} and @ == 1) or ((not {p}) and $ <= {n} and "
-                                                       f"@ == $ + 1) or ((not {p}) and $ > {n} and @ == $)")
-
-    def placed(name: str, local: bool) -> str | Expr:
-        if name != "FTP":
-            return var(name, local)
-        ftp = next((x.name for x in states.made if x.name == f"{states.base}_ftp"), None) or \
-            states.add("ftp", "BOOL", "TRUE", "not @")  # FRET's first time point
-        return f"state.{ftp}" if local else f"{node}.state.{ftp}"
-    w = Writer(placed, pre, node, count)
+    w = _writer(var, states, node)
 
     def field_expr(key: str, *alt: str) -> Expr:
         for k in (key,) + alt:
@@ -220,33 +196,8 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
         return _unconditional(timing, q, q_tree, w, states, node, lambda: steps_of(sem, fulltext, step),
                               lambda: field_expr("stop_condition"))
     p_tree = field_expr("regular_condition", "pre_condition")
-    p, p_local = w.rcl(p_tree), w.rcl(p_tree, True)
-    if timing in ("always", "never"):  # from the first step P held on (FRET: H (H !P | Q))
-        since = states.add("since", "BOOL", "FALSE", f"@ <=> ($ or {p_local})")
-        return Translation(f"always (({p} or {node}.state.{since}) -> {q if timing == 'always' else f'(not {q})'})",
-                           node, made)
-    trig, trig_local = f"({p})", f"({p_local})"
-    if cond == "regular":  # FRET's "upon": P becoming true, or true at the first step
-        prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {p_local}")
-        trig, trig_local = f"({p} and not {node}.state.{prev})", f"({p_local} and not state.{prev})"
-    if timing == "immediately":
-        return Translation(f"always ({trig} -> {q})", node, made)
-    if timing == "next":
-        return Translation(f"always ({trig} -> next {q})", node, made)
-    if timing in ("eventually", "null"):
-        return Translation(f"always ({trig} -> eventually {q})", node, made)
-    if timing in ("within", "for"):
-        n = steps_of(sem, fulltext, step)
-        if timing == "within":
-            return Translation(f"always ({trig} -> eventually[<= {n}] {q})", node, made)
-        d = states.add("ago", "NATURAL", str(n + 1), f"({trig_local} and @ == 1) or ((not {trig_local}) and "
-                                                     f"$ <= {n} and @ == $ + 1) or ((not {trig_local}) and $ > {n} "
-                                                     "and @ == $)")
-        return Translation(f"always (({trig} or {node}.state.{d} <= {n}) -> {q})", node, made)
-    s_tree = field_expr("stop_condition")
-    s, s_local = w.rcl(s_tree), w.rcl(s_tree, True)
-    on = states.add("on", "BOOL", "FALSE", f"@ <=> ((not {s_local}) and ({trig_local} or $))")
-    return Translation(f"always (((not {s}) and ({trig} or {node}.state.{on})) -> {q})", node, made)
+    return _conditioned(cond, timing, p_tree, q, w, states, node, lambda: steps_of(sem, fulltext, step),
+                        lambda: field_expr("stop_condition"))
 
 
 def _unconditional(timing: str, q: str, q_tree: Expr, w: Writer, states: _States, node: str,
@@ -276,3 +227,67 @@ def _unconditional(timing: str, q: str, q_tree: Expr, w: Writer, states: _States
         return Translation(f"eventually[<= {n}] {q}", node, made)
     t = states.add("t", "NATURAL", "0", f"($ <= {n} and @ == $ + 1) or ($ > {n} and @ == $)")
     return Translation(f"always ({node}.state.{t} <= {n} -> {q})", node, made)
+
+
+def _writer(var: Callable[[str, bool], str | Expr], states: _States, node: str) -> Writer:
+    """The :class:`~.fretish.Writer` of one requirement: its ``pre``, ``persisted``/``occurred`` and
+    ``FTP`` state variables declared in ``states`` as the expressions ask for them."""
+
+    def pre(type_name: str, init: Expr, e: Expr) -> str:
+        init_text, body = w.rcl(init, True), w.rcl(e, True)  # an inner pre is declared first
+        if re.search(r"(?<![A-Za-z0-9_])(in|out|state)\.", init_text):
+            raise Refusal(f"a pre function's initial value {init_text} reads the component's variables",
+                          "give it a constant initial value (preReal(0.0, e))")
+        return states.add(f"pre{len(states.made) + 1}", type_name, init_text,
+                          f"@ <=> {body}" if type_name == "BOOL" else f"@ == {body}")
+
+    def count(kind: str, n: int, e: Expr) -> str:
+        p = w.rcl(e, True)
+        role = f"{kind}{len(states.made) + 1}"
+        if kind == "persisted":
+            return states.add(role, "NATURAL", "0", f"({p} and $ < {n} and @ == $ + 1) or ({p} and $ >= {n} and "
+                                                     f"@ == $) or ((not {p}) and @ == 0)")
+        return states.add(role, "NATURAL", str(n + 1), f"({p} and @ == 1) or ((not {p}) and $ <= {n} and "
+                                                       f"@ == $ + 1) or ((not {p}) and $ > {n} and @ == $)")
+
+    def placed(name: str, local: bool) -> str | Expr:
+        if name != "FTP":
+            return var(name, local)
+        ftp = next((x.name for x in states.made if x.name == f"{states.base}_ftp"), None) or \
+            states.add("ftp", "BOOL", "TRUE", "not @")  # FRET's first time point
+        return f"state.{ftp}" if local else f"{node}.state.{ftp}"
+    w = Writer(placed, pre, node, count)
+    return w
+
+
+def _conditioned(cond: str, timing: str, p_tree: Expr, q: str, w: Writer, states: _States, node: str,
+                 steps: Callable[[], int], stop: Callable[[], Expr]) -> Translation:
+    """A condition's timings (module table)."""
+    made = states.made
+    p, p_local = w.rcl(p_tree), w.rcl(p_tree, True)
+    if timing in ("always", "never"):  # from the first step P held on (FRET: H (H !P | Q))
+        since = states.add("since", "BOOL", "FALSE", f"@ <=> ($ or {p_local})")
+        return Translation(f"always (({p} or {node}.state.{since}) -> {q if timing == 'always' else f'(not {q})'})",
+                           node, made)
+    trig, trig_local = f"({p})", f"({p_local})"
+    if cond == "regular":  # FRET's "upon": P becoming true, or true at the first step
+        prev = states.add("prev", "BOOL", "FALSE", f"@ <=> {p_local}")
+        trig, trig_local = f"({p} and not {node}.state.{prev})", f"({p_local} and not state.{prev})"
+    if timing == "immediately":
+        return Translation(f"always ({trig} -> {q})", node, made)
+    if timing == "next":
+        return Translation(f"always ({trig} -> next {q})", node, made)
+    if timing in ("eventually", "null"):
+        return Translation(f"always ({trig} -> eventually {q})", node, made)
+    if timing in ("within", "for"):
+        n = steps()
+        if timing == "within":
+            return Translation(f"always ({trig} -> eventually[<= {n}] {q})", node, made)
+        d = states.add("ago", "NATURAL", str(n + 1), f"({trig_local} and @ == 1) or ((not {trig_local}) and "
+                                                     f"$ <= {n} and @ == $ + 1) or ((not {trig_local}) and $ > {n} "
+                                                     "and @ == $)")
+        return Translation(f"always (({trig} or {node}.state.{d} <= {n}) -> {q})", node, made)
+    s_tree = stop()
+    s, s_local = w.rcl(s_tree), w.rcl(s_tree, True)
+    on = states.add("on", "BOOL", "FALSE", f"@ <=> ((not {s_local}) and ({trig_local} or $))")
+    return Translation(f"always (((not {s}) and ({trig} or {node}.state.{on})) -> {q})", node, made)
