@@ -61,6 +61,7 @@ from rclverify.records.sarif import split_location
 from rclverify.report.templating import model_text
 from rclverify.records.findings import rows_of
 from rclverify.records.obligations import rows_of as obligation_rows_of
+from rclverify.records.evidence_rows import rows_of as evidence_rows_of
 from rclverify.records.report_schema import Report
 from rclverify.report.severity import junit_outcome
 from rclverify.report.junit_suite import closed
@@ -213,7 +214,7 @@ def _suite_data(report: Report) -> list[tuple[Mapping[str, Any], dict[str, Any]]
     """Per node of ``report``, in order: the node and exactly what its
     ``<testsuite>`` is made from (its obligations, side conditions and
     findings, the evidence records and pending reasons of its obligations)."""
-    evidence = {str(e["obligation"]): e for e in report["evidence"]}
+    evidence = {str(e["obligation"]): e for e in report["evidence"]}  # JSON: the suite's fragment is keyed by it
     reasons: dict[str, str] = {}
     for p in report["pending"]:
         reasons.setdefault(str(p["obligation"]), str(p["reason"]))
@@ -236,7 +237,8 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
     """The ``<testsuite>`` of one node from :func:`_suite_data`, its counts
     (``tests``, ``failures``, ``errors``, ``skipped``) and its time in seconds."""
     name = str(node["name"])
-    items, evidence, reasons = data["items"], data["evidence"], data["reasons"]
+    items, reasons = data["items"], data["reasons"]
+    evidence = {e.obligation: e for e in evidence_rows_of(data["evidence"].values())}
     suite = ET.Element("testsuite", {"name": name})
     counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     props: list[tuple[str, str]] = []  # the test cases' strength and confidence (docs/confidence.md)
@@ -252,13 +254,13 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
 
     for o in obligation_rows_of(items.get("obligations", ())):
         ev = evidence.get(o.id)
-        secs = ev["duration_s"] if ev is not None else 0.0
+        secs = ev.duration_s if ev is not None else 0.0
         case = _case(suite, f"{name}.obligation", o.id, o.source, secs)
-        expl = str(ev["explanation"]) if ev is not None else reasons.get(o.id, "no evidence record yet")
-        cex = model_text(ev.get("counterexample")) if ev is not None else ""
-        if ev is not None and ev.get("strength"):  # the evidence's kind (docs/confidence.md)
-            _properties(props, o.id, {"strength": ev["strength"]["kind"],
-                                      "strength.detail": ev["strength"].get("detail", "")})
+        expl = ev.explanation if ev is not None else reasons.get(o.id, "no evidence record yet")
+        cex = model_text(ev.counterexample) if ev is not None else ""
+        if ev is not None and ev.strength is not None:  # the evidence's kind (docs/confidence.md)
+            _properties(props, o.id, {"strength": ev.strength.kind,
+                                      "strength.detail": ev.strength.detail or ""})
         tally(case, o.status, expl.splitlines()[0] if expl else o.status,
               _lines(f"obligation ({o.backend}, {o.kind}) of guarantee {o.guarantee}: {o.statement}",
                      f"source: {o.source}", f"artifact: {o.artifact}" if o.artifact else "", expl,
