@@ -355,3 +355,18 @@ def test_a_rosparam_file_gives_the_nodes_parameters(tmp_path: Path, rosparam: st
     assert said == ([] if "load" in rosparam else [
         'ws/gauges/launch/gauge.launch:3:1: warning: <rosparam>: <rosparam command="delete"> without a file: the '
         "parameters it loads are not read (a name the code takes from one keeps its default)"])
+
+
+@pytest.mark.parametrize("model, started", [("standard", ["/listener", "/talker"]), ("lite", ["/talker"])])
+def test_launch_configuration_equals_conditions_are_evaluated(ws: Path, model: str, started: list[str]) -> None:
+    # turtlebot4's robot.launch.py: the base node only for the standard model (the other model: the control)
+    lf = _py(ws, "model.launch.py", f"DeclareLaunchArgument('model', default_value='{model}'),\n"
+                                    "Node(package='demo', executable='talker'),\n"
+                                    "Node(package='demo', executable='listener',\n"
+                                    "     condition=LaunchConfigurationEquals('model', 'standard')),\n"
+                                    "Node(package='demo', executable='duo',\n"
+                                    "     condition=LaunchConfigurationNotEquals('model', model_name)),",
+             "from launch.conditions import LaunchConfigurationEquals, LaunchConfigurationNotEquals\n"
+             f"model_name = '{model}'\n\n\n")
+    g = _graph(ws, lf)
+    assert sorted(g.nodes) == started and _said(g) == []

@@ -16,7 +16,7 @@ import ast
 
 from rclverify.ros.extract.launch_tree import UNREAD, El
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, callee as _callee, expand as _expand
-from rclverify.ros.extract.launch_py_values import kw as _kw, value as _value
+from rclverify.ros.extract.launch_py_values import arg as _arg, kw as _kw, value as _value
 from rclverify.ros.extract.model import Note, Src
 
 #: actions that start no node and set nothing the graph reads (passed over without a note)
@@ -74,8 +74,10 @@ def optional(c: ast.Call, attrs: dict[str, str], keys: tuple[tuple[str, str], ..
 
 def condition(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note]) -> None:
     """``condition=IfCondition(x)`` / ``UnlessCondition(x)`` of action ``c`` as
-    an ``if`` / ``unless`` attribute; one that cannot be read leaves the action
-    unconditional, said with a located note."""
+    an ``if`` / ``unless`` attribute, ``LaunchConfigurationEquals(name, value)``
+    / ``LaunchConfigurationNotEquals`` as an ``if`` comparing the configuration's
+    value with ``value`` (launch.conditions); one that cannot be read leaves
+    the action unconditional, said with a located note."""
     cond = _kw(c, "condition")
     if cond is None:
         return
@@ -83,6 +85,15 @@ def condition(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note])
     at = Src(shown, cond.lineno, cond.col_offset + 1)
     kind = _callee(cond) if isinstance(cond, ast.Call) else ""
     try:
+        if kind in ("LaunchConfigurationEquals", "LaunchConfigurationNotEquals") and isinstance(cond, ast.Call):
+            n, v = _arg(cond, 0, "launch_configuration_name"), _arg(cond, 1, "expected_value")
+            if n is None or v is None:
+                raise _Unres(f"'{ast.unparse(cond)}' (a comparison without a name and a value)")
+            name, want = _value(n), _value(v)
+            if "'" in name + want or "\\" in name + want or " " in name:
+                raise _Unres(f"'{ast.unparse(cond)}' (a quote or a space in a compared value)")
+            attrs["if"] = f"$(eval '$(var {name})' {'==' if kind.endswith('Equals') and 'Not' not in kind else '!='} '{want}')"
+            return
         if kind not in ("IfCondition", "UnlessCondition") or not isinstance(cond, ast.Call) or len(cond.args) != 1:
             raise _Unres(f"'{ast.unparse(cond)}' (not IfCondition(x) or UnlessCondition(x))")
         attrs["if" if kind == "IfCondition" else "unless"] = _value(cond.args[0])
