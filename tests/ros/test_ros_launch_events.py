@@ -370,3 +370,20 @@ def test_launch_configuration_equals_conditions_are_evaluated(ws: Path, model: s
              f"model_name = '{model}'\n\n\n")
     g = _graph(ws, lf)
     assert sorted(g.nodes) == started and _said(g) == []
+
+
+def test_a_hostile_rosparam_file_is_refused_and_said(tmp_path: Path) -> None:
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{c}: &{c} [{', '.join(['*' + p] * 10)}]\n" for p, c in zip("abcdefgh", "bcdefghi"))
+    _write(tmp_path / "ws" / "gauges", {
+        "package.xml": PKG.format(name="gauges", tool="catkin", export="").replace("rclcpp", "roscpp"),
+        "CMakeLists.txt": "cmake_minimum_required(VERSION 3.0)\nproject(gauges)\nfind_package(catkin REQUIRED)\n"
+                          "add_executable(gauge src/gauge.cpp)\n",
+        "src/gauge.cpp": GAUGE, "config/gauge.yaml": bomb,
+        "launch/gauge.launch": '<launch>\n  <node pkg="gauges" type="gauge" name="gauge">\n'
+                               '    <rosparam command="load" file="$(find gauges)/config/gauge.yaml"/>\n'
+                               '  </node>\n</launch>\n'})
+    g = scan([tmp_path / "ws"], [tmp_path / "ws/gauges/launch/gauge.launch"], base=tmp_path, standard=False).graph
+    assert {e.topic for e in g.nodes["/gauge"].publishes} == {"/level"}  # the code's default
+    [said] = [n for n in _said(g) if "rosparam" in n]
+    assert said.startswith("ws/gauges/launch/gauge.launch:3:1: warning: <rosparam>: ") and "cannot be read (" in said

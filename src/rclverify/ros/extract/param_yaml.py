@@ -177,9 +177,13 @@ def rosparam_file(path: Path) -> dict[str, str] | str:
     a parameter namespace), scalars as text, lists left out; or why it cannot
     be read (a sentence).  Source: wiki.ros.org/roslaunch/XML/rosparam."""
     import yaml  # deferred: start-up (loads yaml only when called)
+    from rclverify.model.plan.errors import PlanError  # deferred: start-up (loads rclverify.lang only when called)
+    from rclverify.model.plan.yamlguard import compose_guarded  # deferred: start-up (as above)
     try:
-        data = yaml.safe_load(safefs.read_text(path))
-    except (OSError, ValueError, yaml.YAMLError, RecursionError) as exc:
+        text = safefs.read_text(path)
+        compose_guarded(text, str(path))  # alias bombs, cycles and depth refused before expansion
+        data = yaml.safe_load(text)
+    except (OSError, ValueError, yaml.YAMLError, RecursionError, PlanError) as exc:
         return f"cannot be read ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
     if data is None:
         return {}
