@@ -126,7 +126,7 @@ def _records(ws: Path) -> dict[str, dict]:
 
 def test_a_counter_that_stops_after_3_meets_nothing_and_strict_fails(tmp_path: Path) -> None:
     ws = _ws(tmp_path, COUNTER, GOALS)
-    from rclverify.report.summary import strict_reasons
+    from rclverify.report.strict import strict_reasons
     assert main(["verify", "-w", str(ws), "--strict"]) != 0
     report = json.loads((ws / "reports/assurance.json").read_text())
     assert strict_reasons(report) == ["4 formal requirements are not met (T1, T2, T3, T4)"]

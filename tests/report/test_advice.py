@@ -296,7 +296,8 @@ def test_every_finding_kind_has_one_severity_in_all_five_outputs(tmp_path: Path,
     from rclverify.report.severity import items
     ws = tmp_path / "severity"
     shutil.copytree(DATA / "severity", ws)
-    from rclverify.report.summary import read_summary, strict_sentence
+    from rclverify.report.strict import strict_sentence
+    from rclverify.report.summary import read_summary
     assert main(["verify", "-w", str(ws), "--strict"]) == 1
     capsys.readouterr()
     # the terminal: what `verify` ends with (`status` prints the same), the lint of `check`, --strict's sentence

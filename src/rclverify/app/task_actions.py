@@ -301,7 +301,8 @@ def act_verify(root: str, strict: bool) -> Any:
     (:func:`rclverify.report.summary.print_last_run`); with ``strict``, fail
     unless every item holds."""
     from rclverify.app.progress import PlainFailure  # deferred: start-up (loads doit, rclverify.app.doitstate and more only when called)
-    from rclverify.report.summary import print_last_run, strict_sentence  # deferred: start-up (loads rclverify.report, rclverify.report.summary only when called)
+    from rclverify.report.strict import strict_sentence  # deferred: start-up (loads rclverify.report, rclverify.report.strict only when called)
+    from rclverify.report.summary import print_last_run  # deferred: start-up (loads rclverify.report, rclverify.report.summary only when called)
     heap.executing()  # a task executes here (the other actions: _ws)
     try:
         data = print_last_run(Path(root))
