@@ -14,6 +14,7 @@ end to end on the issue's own cases.
 from __future__ import annotations
 
 import os
+import shutil
 import stat
 import subprocess
 import sys
@@ -188,3 +189,19 @@ def test_nodl_write_into_a_named_folder_refuses_a_fifo_there(ws: Path, tmp_path:
     (out / "Sensor.nodl.yaml").unlink()  # control
     assert main(["nodl", "write", "-w", str(ws), "-o", str(out), "Sensor"]) == 0
     assert (out / "Sensor.nodl.yaml").is_file()
+
+
+def test_graph_draws_its_svg_beside_a_named_file_only_as_a_regular_file(ws: Path, tmp_path: Path,
+                                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """``graph -o FILE`` names FILE, not ``FILE.svg`` beside it: a FIFO there is refused in one line, never
+    opened (the command would hang on it), and left as it was; the DOT is written."""
+    out, svg = tmp_path / "model.dot", tmp_path / "model.svg"
+    os.mkfifo(svg)
+    capsys.readouterr()
+    assert _bounded(lambda: main(["graph", "-w", str(ws), "-o", str(out)])) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "model.svg: is a FIFO, not a regular file" in err[0] and "Traceback" not in err[0], err
+    assert stat.S_ISFIFO(os.lstat(svg).st_mode) and out.read_text().lstrip().startswith(("digraph", "//", "/*"))
+    svg.unlink()  # control: nothing there, the SVG is drawn as a regular file (when Graphviz is installed)
+    assert _bounded(lambda: main(["graph", "-w", str(ws), "-o", str(out)])) == 0
+    assert not shutil.which("dot") or (svg.is_file() and "<svg" in svg.read_text())
