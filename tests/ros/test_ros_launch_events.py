@@ -387,3 +387,23 @@ def test_a_hostile_rosparam_file_is_refused_and_said(tmp_path: Path) -> None:
     assert {e.topic for e in g.nodes["/gauge"].publishes} == {"/level"}  # the code's default
     [said] = [n for n in _said(g) if "rosparam" in n]
     assert said.startswith("ws/gauges/launch/gauge.launch:3:1: warning: <rosparam>: ") and "cannot be read (" in said
+
+
+def test_an_opaque_function_returning_in_a_known_branch_is_evaluated(ws: Path,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("RCLVERIFY_TEST_SIM", raising=False)
+    setup = ("def launch_setup(context):\n"
+             "    if os.environ.get('RCLVERIFY_TEST_SIM', 'real') == 'sim':\n"
+             "        return [Node(package='demo', executable='talker')]\n"
+             "    else:\n"
+             "        return [Node(package='demo', executable='listener')]\n\n\n")
+    lf = _py(ws, "branchy.launch.py", "OpaqueFunction(function=launch_setup),", setup)
+    g = _graph(ws, lf)
+    assert sorted(g.nodes) == ["/listener"] and _said(g) == []
+    monkeypatch.setenv("RCLVERIFY_TEST_SIM", "sim")
+    assert sorted(_graph(ws, lf).nodes) == ["/talker"]
+    # control: a test only running decides leaves two returns, said
+    lf = _py(ws, "branchy.launch.py", "OpaqueFunction(function=launch_setup),",
+             setup.replace("os.environ.get('RCLVERIFY_TEST_SIM', 'real')", "context.perform_substitution(x)"))
+    g = _graph(ws, lf)
+    assert g.nodes == {} and len(_said(g)) == 1 and "it has 2 return statements" in _said(g)[0]

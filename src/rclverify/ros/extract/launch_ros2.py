@@ -42,7 +42,7 @@ from rclverify.ros.extract.launch_py_values import ENV as _ENV, HERE as _HERE, T
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg, callee as _callee
 from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
 from rclverify.ros.extract.launch_py_values import value as _value
-from rclverify.ros.extract.launch_py_flow import added as _added, grown as _grown
+from rclverify.ros.extract.launch_py_flow import added as _added, flat as _flat, grown as _grown
 from rclverify.ros.extract.launch_py_actions import HANDLERS, PAIRS, QUIET
 from rclverify.ros.extract.launch_py_actions import at_shutdown as _shutdown, condition as _cond
 from rclverify.ros.extract.launch_py_actions import optional as _opt, required as _req
@@ -257,18 +257,15 @@ def _function_actions(fn: ast.expr | None, call: ast.Call, opaque: bool, shown: 
     """The actions a function of the launch file returns, its parameters bound
     to the call's arguments (``OpaqueFunction(function=f, args=[...],
     kwargs={...})`` calls ``f(context, *args, **kwargs)``) and its own names
-    bound once read as in ``generate_launch_description()``; a function with
-    other than one ``return``, or returning what is not a list of actions,
-    gives why as a string."""
+    bound once read as in ``generate_launch_description()``; of its
+    ``return`` statements, those in the branches that run (an ``if`` of known
+    test runs one, :mod:`launch_py_flow`); a function with other than one, or
+    returning what is not a list of actions, gives why as a string."""
     if not isinstance(fn, ast.Name) or fn.id not in _FUNCS:
         return f"'{ast.unparse(fn) if fn is not None else ''}' is not a function defined in the launch file"
     f = _FUNCS[fn.id]
     if fn.id in _CALLING or len(_CALLING) >= MAX_CALLS:
         return "it is called inside itself"
-    rets = [r.value for r in ast.walk(f) if isinstance(r, ast.Return) and r.value is not None]
-    if len(rets) != 1:
-        return f"it has {len(rets)} return statements (which one runs is chosen at run time)" if rets \
-            else "it returns no actions"
     params = [a.arg for a in f.args.posonlyargs + f.args.args]
     given: dict[str, ast.expr] = dict(zip(params[len(params) - len(f.args.defaults):], f.args.defaults))
     pos: list[ast.expr] = list(call.args) if not opaque else []
@@ -297,6 +294,12 @@ def _function_actions(fn: ast.expr | None, call: ast.Call, opaque: bool, shown: 
         for k in mine:
             _TWICE.pop(k, None)
         _TWICE.update(twice)
+        # the returns of the statements that run: an if whose test is known runs its branch only
+        rets = [r.value for st in _flat(f.body, []) for r in ast.walk(st)
+                if isinstance(r, ast.Return) and r.value is not None]
+        if len(rets) != 1:
+            return f"it has {len(rets)} return statements (which one runs is chosen at run time)" if rets \
+                else "it returns no actions"
         ret = _expand(rets[0])
         if isinstance(ret, ast.Call) and _callee(ret) == "LaunchDescription" and ret.args:
             ret = _expand(ret.args[0])
