@@ -58,12 +58,14 @@ def ros2_python() -> tuple[Path | None, str]:
 
 
 def live_counts(log: Path, links: dict[str, str] | None = None) -> dict[str, Counter[str]]:
-    """Per node, the live verdicts the log's ``rclverify/verdict`` lines carry (first verdicts of
-    answers and deadlines; a deadline's ``update`` line replaces its first verdict), and, ``links``
+    """Per node, the live verdicts the log's ``rclverify/verdict`` lines carry (the latest verdict of
+    each message: a revision replaces the one given before, backends/monitors/late.py; a deadline's
+    ``update`` line replaces its first verdict), and, ``links``
     naming each service's and action's node (RCL name -> node), each endpoint the run said it could
     not judge (a ``rclverify/call`` line of part ``unjudged``: the rclpy source without introspection)
     as ``undecided`` and ``unjudged``, as the offline check counts it."""
     out: dict[str, Counter[str]] = {}
+    answers: dict[tuple[str, object, bool], str] = {}  # (node, message, a call) -> its latest verdict
     for line in log.read_text(errors="replace").splitlines():
         try:
             rec = json.loads(line)
@@ -87,6 +89,12 @@ def live_counts(log: Path, links: dict[str, str] | None = None) -> dict[str, Cou
                 c[f"deadline {v['verdict']}"] += 1
         else:
             verdict = str(v.get("verdict"))
+            key = (str(v.get("node")), v.get("event"), bool(v.get("call")))
+            before = answers.get(key)
+            if before is not None:  # a revision (a question heard late): the verdict given before is withdrawn
+                c["undecided" if before in UNDECIDED else before] -= 1
+                c["answer revisions"] += 1
+            answers[key] = verdict
             c["undecided" if verdict in UNDECIDED else verdict] += 1
             if verdict in UNDECIDED:
                 WHY.setdefault(str(v.get("node")), []).append(f"{verdict}: {v.get('reason') or '(no reason given)'}")

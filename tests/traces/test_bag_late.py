@@ -114,6 +114,45 @@ def test_a_recorded_bag_is_judged_as_the_live_run_and_its_log(tmp_path: Path,
         (e.topic, e.late) for e in read_bag(bag) if e.late]
 
 
+#: the same run, the wrong answer heard before the question it answers (the question's reader stalled longer):
+#: live judged it against the question before (false, answered false: satisfied), then, the question heard,
+#: against it (undecided: the node may not have had it)
+ANSWER_FIRST = [(0.50, "b", 0.50, True), (0.51, "o", 0.51, True), (0.60, "b", 0.60, False), (0.61, "o", 0.61, False),
+                (1.02, "o", 1.01, False), (1.40, "b", 1.00, True),
+                (2.00, "b", 2.00, False), (2.01, "o", 2.01, False)]
+
+
+def _last_per_message(log: Path) -> dict[str, int]:
+    """The live verdicts, the latest of each message (a later one replaces an earlier: late.py)."""
+    last: dict[int, str] = {}
+    for line in log.read_text().splitlines():
+        x = json.loads(line)
+        if x["topic"] == "rclverify/verdict" and "kind" not in x:
+            last[x["verdict"]["event"]] = x["verdict"]["verdict"]
+    counts: dict[str, int] = {}
+    for v in last.values():
+        counts[v] = counts.get(v, 0) + 1
+    return counts
+
+
+def test_a_verdict_given_before_its_question_was_heard_is_replaced(tmp_path: Path,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    ws = _workspace(tmp_path)
+    record, log, bag = _record(ws, heard=ANSWER_FIRST)
+    lines = [json.loads(x)["verdict"] for x in log.read_text().splitlines() if '"rclverify/verdict"' in x]
+    wrong = [v for v in lines if v["where"] == "message 4"]
+    # live said satisfied at once (against the question of 0.6 s), then, the question of 1.0 s heard, replaced it
+    assert [v["verdict"] for v in wrong] == ["satisfied", "inconclusive"], wrong
+    assert "replaces the satisfied one" in wrong[1]["reason"]
+    (node,) = record["nodes"]
+    final = {k: v for k, v in node["counts"].items() if v}
+    assert final == _last_per_message(log), (final, _last_per_message(log))
+    assert final.get("inconclusive") == 1 and final.get("satisfied", 0) < sum(
+        v["verdict"] == "satisfied" for v in lines)  # one satisfied fewer than given: withdrawn
+    assert _offline(ws, log, capsys) == final  # the log, in stamp order, judges as live finally did
+    assert _offline(ws, bag, capsys) == final
+
+
 def test_the_control_a_bag_without_its_lateness_is_judged_at_its_times(tmp_path: Path,
                                                                        capsys: pytest.CaptureFixture[str]) -> None:
     ws = _workspace(tmp_path)

@@ -424,6 +424,19 @@ class _Run:
                 del self.ghosts[0]
         return newest
 
+    def _remember_given(self, chunk: EventRows | BlockRows, at: np.ndarray, wrong: np.ndarray | None) -> None:
+        """The verdicts given to the latest answers of the pairs at ``at`` (``satisfied``,
+        ``exact``; ``violated`` where ``wrong``), as the engine keeps them for a revision to
+        withdraw (late.py); a chunk's rows are its events in order (row ``i`` is event
+        ``chunk[0].index + i``)."""
+        given = self.m._given
+        assert given.maxlen is not None  # the engine keeps a bounded deque
+        last = at[-given.maxlen:]
+        base = chunk[0].index
+        kinds = (np.where(wrong[-given.maxlen:], "violated", "satisfied").tolist() if wrong is not None
+                 else repeat("satisfied"))
+        given.extend(zip((last + 1 + base).tolist(), kinds, repeat("exact")))
+
     def _remember_outputs(self, chunk: EventRows | BlockRows, at: np.ndarray, times: np.ndarray,
                           wrong: np.ndarray | None, bad: int, newest: Question) -> None:
         """The engine's state after the pairs at ``at`` (``bad`` of them violated, where
@@ -443,6 +456,7 @@ class _Run:
             outs = at[-recent.maxlen:] + 1
         recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
                           repeat(ofield)))
+        self._remember_given(chunk, at, wrong)
         values = m.values
         for k in keys:
             values[k] = newest.inputs[k]

@@ -98,6 +98,7 @@ class Closing(EngineState):
                 len(result.violations) >= KEPT_VIOLATIONS:  # a record nobody keeps or receives: counted, not rendered
             result.violations_dropped += 1
             result.counts["violated"] += 1
+            self._given.append((ev.index, "violated", semantics))  # a revision withdraws it as any other (late.py)
             return
         record: Violation = {"event": ev.index, "time": ev.time, "where": ev.where, "guarantee": k,
                                   "formula": self._texts.get(k, ""), "values": self._rendered(values),

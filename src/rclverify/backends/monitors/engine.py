@@ -16,8 +16,8 @@ monitors).  Per node:
   within the transport skew after it, where both readings must agree), on
   the outputs published since that question (a topic the mapping declares a
   ``state`` with its current value); the guarantees over outputs only on
-  the outputs as they stand.  False: ``violated``, whatever comes later;
-  all that it decides true: ``satisfied``; undecided: ``inconclusive``.  A
+  the outputs as they stand.  False: ``violated`` (withdrawn only for a
+  question heard late, :mod:`.late`); all true: ``satisfied``; undecided: ``inconclusive``.  A
   guarantee that reads an output not published since the question waits
   for it (a partial answer, judged when the horizon passes);
 * a question whose owed guarantees its inputs alone decide is ``satisfied``
@@ -167,6 +167,7 @@ class NodeMonitor(Judging, Closing, Late):
         self._held_margins: dict[int, float | None] = {}
         #: outputs held for the skew and judged since, kept as ``_recent`` keeps those judged at once (late.py)
         self._released: deque[Recent] = deque(maxlen=64)
+        self._given: deque[tuple[int, str, str]] = deque(maxlen=256)  # (event, verdict, semantics): late.py
         #: event index -> how far after its stamp (s) a question may be the one an output answers, where that is
         #: beyond the skew: published that long after its stamp (a stamp copied from an earlier question)
         self._wins: dict[int, float] = {}
@@ -207,6 +208,7 @@ class NodeMonitor(Judging, Closing, Late):
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
                  reason: str = "", semantics: str = "", question: str = "") -> None:
         self.result.counts[verdict] += 1
+        self._given.append((ev.index, verdict, semantics))
         if verdict == "satisfied" and semantics in self.result.semantics:
             self.result.semantics[semantics] += 1
         if verdict == "inconclusive" and self.result.first_inconclusive is None:
@@ -401,6 +403,7 @@ class NodeMonitor(Judging, Closing, Late):
                 result = self.result
                 result.counts["satisfied"] += 1
                 result.semantics[q.info] += 1
+                self._given.append((ev.index, "satisfied", q.info))
                 if self.on_verdict is not None:
                     self.on_verdict(Verdict(self.node.name, "satisfied", ev.index, ev.time, ev.where, ev.topic,
                                             max(self.now, ev.time), 0, {}, "", q.info, q.event.where))

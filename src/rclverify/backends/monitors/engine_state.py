@@ -62,6 +62,7 @@ class EngineState:
     _recent: deque[Recent]
     _held: deque[tuple[Any, ...]]
     _released: deque[Recent]
+    _given: deque[tuple[int, str, str]]
     _wins: dict[int, float]
     _late_in: dict[str, Event]
     _late_q: dict[int, Event]

@@ -36,12 +36,20 @@ input at its stamp:
   more outputs after it than the engine remembers) is ``inconclusive`` with
   the reason, never judged against the wrong question.
 
-A verdict already given is not withdrawn: a ``violated`` given against the
-question before stays (the revision adds to it); the run is not discharged
-on the wrong question, but an output right for the question heard late keeps
-a ``violated`` given against the one before (docs/semantics.md).  Every
-input message pays one comparison (its stamp against the latest stamp
-judged) for this; the rest runs only for a message heard late.
+A verdict given against the wrong question is **withdrawn** by its
+revision (:meth:`Late._withdrawn`): the revision's verdict replaces it in
+the counts, the violation records and the semantics counted, and its reason
+says which it replaces; an output right for the question heard late is
+``satisfied`` in place of a ``violated`` or ``inconclusive`` given against
+the one before.  So the run's verdicts are those of the run judged in stamp
+order, whatever order it was heard in (docs/semantics.md, "Event time");
+the verdicts published before stay published, each followed by the one that
+replaces it (a consumer keeps the latest verdict of each node's message).
+A verdict the engine no longer holds (the last 256 given) or never gave
+one by one (an answer counted in a batch, :mod:`.batch`) is not withdrawn:
+the revision follows it.  Every input message pays one comparison (its
+stamp against the latest stamp judged) for this; the rest runs only for a
+message heard late.
 """
 from __future__ import annotations
 
@@ -243,7 +251,8 @@ class Late(EngineState):
             if id(qa) in self._lost:  # owed when it was judged; with the input heard late the assumption fails
                 self._verdict("inconclusive", out_ev, reason=f"the output at {out_ev.where} was judged against the "
                               f"question at {qa.event.where} without the input at {ev.where}; with it the assumption "
-                              "does not hold (false or undecided)" + why, question=qa.event.where)
+                              "does not hold (false or undecided)" + why + self._withdrawn(out_ev),
+                              question=qa.event.where)
             return
         got = self._question_outcome(qa, out_ev, self._touch[out_ev.topic][0], outs, dict(state or {}), False)
         self._late_verdict(out_ev, qa.event, got, why)
@@ -263,16 +272,56 @@ class Late(EngineState):
         self._late_verdict(out_ev, ev, got, why)
 
     def _late_verdict(self, out_ev: Event, qe: Event, got: Any, why: str) -> None:
-        """The verdict that follows the one given to ``out_ev``: judged again against the
-        question raised by ``qe``, false (``violated``) or undecided (``inconclusive``)."""
+        """The verdict that replaces the one given to ``out_ev`` (:meth:`_withdrawn`): judged
+        again against the question raised by ``qe``, false (``violated``), undecided
+        (``inconclusive``) or true (``satisfied``, where the one given was not)."""
         if got.kind == "violated":
             k = got.guarantee
             self._violation(out_ev, k, got.values, f"guarantee {k} is false on the output at {out_ev.where} answering "
-                            f"the question at {qe.where}" + (f": {got.reason}" if got.reason else "") + why,
-                            got.semantics, qe)
+                            f"the question at {qe.where}" + (f": {got.reason}" if got.reason else "") + why
+                            + self._withdrawn(out_ev), got.semantics, qe)
         elif got.kind == "inconclusive":
-            self._verdict("inconclusive", out_ev, guarantee=got.guarantee, reason=got.reason + why,
-                          question=qe.where)
+            self._verdict("inconclusive", out_ev, guarantee=got.guarantee,
+                          reason=got.reason + why + self._withdrawn(out_ev), question=qe.where)
+        elif got.kind == "satisfied" and self._given_to(out_ev) not in (None, "satisfied"):
+            self._verdict("satisfied", out_ev, semantics=got.semantics, question=qe.where,
+                          reason=f"the output at {out_ev.where} answers the question at {qe.where}" + why
+                          + self._withdrawn(out_ev))
+
+    def _given_to(self, out_ev: Event) -> str | None:
+        """The verdict last given to ``out_ev`` that a revision may withdraw (``None``: none held)."""
+        for idx, kind, _ in reversed(self._given):
+            if idx == out_ev.index:
+                return kind if kind in _REVISABLE else None
+        return None
+
+    def _withdrawn(self, out_ev: Event) -> str:
+        """Withdraw the verdict last given to ``out_ev`` (module docstring), just
+        before its replacement is given: its count, its semantics' count and its
+        violation record go.  Returns the words the replacement's reason ends with
+        (``""`` when no verdict is held to withdraw)."""
+        kind = self._given_to(out_ev)
+        if kind is None:
+            return ""
+        given = self._given
+        for i in range(len(given) - 1, -1, -1):
+            if given[i][0] == out_ev.index:
+                sem = given[i][2]
+                del given[i]
+                break
+        res = self.result
+        res.counts[kind] -= 1
+        if kind == "satisfied" and sem in res.semantics:
+            res.semantics[sem] -= 1
+        elif kind == "violated":
+            res.withdraw_violation(out_ev.index)
+        elif kind == "inconclusive" and not res.counts[kind]:
+            res.first_inconclusive = None
+        return f"; this verdict replaces the {kind} one given before (withdrawn)"
+
+
+#: the verdicts of an output a revision replaces
+_REVISABLE = frozenset({"satisfied", "violated", "inconclusive"})
 
 
 def _at(entries: Any, stamp: float) -> Any:

@@ -263,6 +263,17 @@ class NodeResult:
         (:meth:`GuaranteeMargin.to_json`; one whose answers had none: ``answers`` 0, ``margin`` null)."""
         return [m.to_json(trace) for _, m in sorted(self.margins.items())]
 
+    def withdraw_violation(self, event: int) -> None:
+        """Withdraw the ``violated`` verdict of message ``event`` (a revision
+        replaced it, late.py): its record leaves :attr:`violations` (or the
+        count of those dropped), and :attr:`first_violation` is the next kept."""
+        kept = [v for v in self.violations if v["event"] != event]
+        if len(kept) == len(self.violations) and self.violations_dropped:
+            self.violations_dropped -= 1
+        self.violations = kept
+        if self.first_violation is not None and self.first_violation["event"] == event:
+            self.first_violation = kept[0] if kept else None
+
     def add_violation(self, record: Violation) -> None:
         """Keep ``record`` (one ``violated`` verdict) in :attr:`violations`
         (bounded) and as :attr:`first_violation` when it is the first."""
