@@ -28,6 +28,14 @@ only when it was checked:
    repairs the failing guarantee and breaks another is not offered.
 3. At most :data:`MAX_REPAIRS` are kept, of at most :data:`MAX_TRIED`
    candidates tried.
+4. *Around the line* (:func:`around_lines`): when no candidate of the
+   culprit line passes, the one-token corrections of the other statements
+   of the same function are tried the same way, the nearest line first (an
+   earlier line before a later one at the same distance: a value is
+   computed before it is returned), at most :data:`MAX_AROUND` of them.  A
+   wrong value made on one line and returned on another (``worst =
+   min(...)`` then ``return {"ok": worst <= LIMIT}``), or a wrong branch
+   whose taken ``return`` was named, is repaired where it was made.
 
 What the check shows is what the harness shows: the node's guarantees
 held on every example Hypothesis drew from the edited copy; not that the
@@ -50,6 +58,8 @@ from rclverify.records.stage_records import Repair
 MAX_REPAIRS = 3
 #: Most candidates run on a scratch copy for one failure (each runs every guarantee of the node).
 MAX_TRIED = 12
+#: Most candidates tried around the culprit line (step 4) when none of the line passes.
+MAX_AROUND = 12
 #: The swapped names of a call: ``max`` for ``min`` and back.
 _SWAP = {"max": "min", "min": "max"}
 
@@ -111,6 +121,8 @@ def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fractio
         return []
     lines = source.splitlines(keepends=True)
     out: list[Edit] = []
+    named: list[Edit] = []  # class 2 (:func:`_rank`): an integer replaced by a number the contract names
+    other: list[Edit] = []  # class 3: an operand put for another, a slice dropped
     for fdef in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))):
         if not fdef.lineno <= line <= (fdef.end_lineno or fdef.lineno) or not isinstance(fdef, ast.FunctionDef):
             continue
@@ -125,21 +137,79 @@ def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fractio
             for call in _calls(stmt):
                 assert isinstance(call.func, ast.Name)
                 out.append(_edit(file, lines, call.func, _SWAP[call.func.id]) or _NONE)
+            for node, new in _operands(fdef, stmt, numbers):
+                (named if new[:1].isdigit() else other).append(_edit(file, lines, node, new) or _NONE)
     seen: set[tuple[int, int, int, int, str]] = set()
-    kept: list[Edit] = []
-    for e in out:
+    kept: list[tuple[int, Edit]] = []
+    for cls, e in [*((-1, e) for e in out), *((2, e) for e in named), *((3, e) for e in other)]:
         key = (e.line, e.col, e.end_line, e.end_col, e.text)
         if e is not _NONE and key not in seen:
             seen.add(key)
-            kept.append(e)
-    return sorted(kept, key=lambda e: (_rank(e.deleted(source), e.text), len(e.deleted(source)) + len(e.text),
-                                       e.line, e.col))
+            kept.append((cls if cls >= 0 else _rank(e.deleted(source), e.text), e))
+    return [e for _, e in sorted(kept, key=lambda ce: (ce[0], len(ce[1].deleted(source)) + len(ce[1].text),
+                                                       ce[1].line, ce[1].col))]
+
+
+def _operands(fdef: ast.FunctionDef, stmt: ast.stmt, numbers: Sequence[Fraction]) -> Iterable[tuple[ast.AST, str]]:
+    """The one-token corrections of ``stmt``'s own expressions on its first line that the culprit search
+    does not make: an integer replaced by a number the contract names that is not one (``273`` for
+    ``273.15``), a name or a truth value replaced by another name the function reads as a parameter or
+    assigns (``final = distance`` for ``final = remaining``, ``True`` for the input ``engage``), and a
+    slice dropped (``ranges[:-1]`` for ``ranges``); each as ``(node, its new text)``."""
+    roots: list[ast.AST] = []
+    if isinstance(stmt, (ast.Return, ast.Assign, ast.AugAssign, ast.AnnAssign)) and stmt.value is not None:
+        roots = [stmt.value]
+    elif isinstance(stmt, (ast.If, ast.While)):
+        roots = [stmt.test]
+    params = [a.arg for a in (*fdef.args.posonlyargs, *fdef.args.args, *fdef.args.kwonlyargs)]
+    stored = [n.id for n in ast.walk(fdef) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)]
+    own = {n.id for n in ast.walk(stmt) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
+    names = [x for x in dict.fromkeys([*params, *stored]) if x not in own]
+    called = {id(n.func) for r in roots for n in ast.walk(r) if isinstance(n, ast.Call)}
+    for r in roots:
+        for n in ast.walk(r):
+            if getattr(n, "lineno", None) != stmt.lineno:
+                continue
+            if isinstance(n, ast.Constant) and type(n.value) is int:
+                yield from ((n, repr(float(c))) for c in numbers if c.denominator != 1)
+            elif isinstance(n, ast.Constant) and isinstance(n.value, bool) or \
+                    isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load) and id(n) not in called:
+                yield from ((n, x) for x in names if x != getattr(n, "id", None))
+            elif isinstance(n, ast.Subscript) and isinstance(n.slice, ast.Slice):
+                yield n, ast.unparse(n.value)
+
+
+def around_lines(source: str, line: int) -> list[int]:
+    """The lines of the other statements of the function holding ``line`` in ``source`` (not of a nested
+    function, not its docstring), nearest ``line`` first, an earlier line first at the same distance;
+    ``[]`` when ``line`` is in no function or the file does not parse."""
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return []
+    fdefs = [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)
+             and n.lineno <= line <= (n.end_lineno or n.lineno)]
+    if not fdefs:
+        return []
+    fdef = max(fdefs, key=lambda n: n.lineno)  # the innermost
+    lines: set[int] = set()
+    todo: list[ast.stmt] = list(fdef.body)
+    while todo:
+        s = todo.pop()
+        if isinstance(s, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            continue
+        if not (isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant)):
+            lines.add(s.lineno)
+        todo.extend(c for c in ast.iter_child_nodes(s) if isinstance(c, ast.stmt))
+    lines.discard(line)
+    return sorted(lines, key=lambda k: (abs(k - line), k > line, k))
 
 
 def _rank(old: str, new: str) -> int:
     """The class of a one-token correction, tried in this order: 0 an operator or a name (a comparison's
     strictness, ``and``/``or``, ``+``/``-``, ``max``/``min``, a ``not`` dropped, a truth value), 1 a number
-    moved by one, 2 a number replaced by another the contract names."""
+    moved by one, 2 a number replaced by another the contract names; :func:`candidate_edits` puts an
+    operand replaced by another name and a slice dropped (:func:`_operands`) after them, class 3."""
     try:
         a, b = Fraction(old), Fraction(new)
     except (ValueError, ZeroDivisionError):
@@ -236,7 +306,12 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
         return []
     out: list[Repair] = []
     ids = {k: f"{node}.g{k}.property_tests.e{index}" for k in range(1, len(target.node.node.guarantees) + 1)}
-    for edit in candidate_edits(source, file, int(at), contract_numbers(target.node))[:MAX_TRIED]:
+    numbers = contract_numbers(target.node)
+    around = [e for k in around_lines(source, int(at)) for e in candidate_edits(source, file, k, numbers)]
+    tried = [(e, True) for e in candidate_edits(source, file, int(at), numbers)[:MAX_TRIED]]
+    for edit, at_line in [*tried, *((e, False) for e in around[:MAX_AROUND])]:
+        if not at_line and out:
+            break  # the culprit line's own repairs first; the lines around only when it has none
         got = _statuses(target, cfg, edit.apply(source), failing)
         if len(got) != len(ids) or any(s != "discharged" for s in got.values()):
             continue
@@ -245,8 +320,10 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
         checks = [{"check": ids[k], "status": got[k]} for k in sorted(got)]
         cost = [{"check": ids[k], "before": (before or {}).get(ids[k], "absent"), "after": got[k]}
                 for k in sorted(got) if (before or {}).get(ids[k], "absent") != got[k]]
-        rec = _record("code", f"At {file}:{edit.line}, change `{old}` to `{new}`: a one-token correction of the "
-                      "line where the failing example goes wrong.", edit, source, checks, cost,
+        where = "the line where the failing example goes wrong" if at_line else \
+            f"a statement of the same function as {file}:{at}, where the failing example goes wrong"
+        rec = _record("code", f"At {file}:{edit.line}, change `{old}` to `{new}`: a one-token correction of "
+                      f"{where}.", edit, source, checks, cost,
                       proves=f"every guarantee of {node} ({len(ids)}) held again on every example the property "
                       f"tests drew from a scratch copy with the edit (seed {cfg.seed})",
                       not_shown="that the edit is right for the robot: the tests draw examples, they prove nothing")
@@ -257,4 +334,4 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
     return out
 
 
-__all__ = ["MAX_REPAIRS", "MAX_TRIED", "candidate_edits", "checked_repairs"]
+__all__ = ["MAX_AROUND", "MAX_REPAIRS", "MAX_TRIED", "around_lines", "candidate_edits", "checked_repairs"]
