@@ -210,6 +210,8 @@ class Interpreter:
                 return v
             if kind == "optenv" and rest:
                 return os.environ.get(rest[0], " ".join(rest[1:]))
+            if kind == "as-bool":  # Nav2's LaunchConfigAsBool (nav2_common/launch/launch_config_as_bool.py)
+                return "True" if " ".join(rest).strip().lower() in ("true", "1", "yes", "on") else "False"
             if kind == "dirname":
                 return str(path.parent)
             if kind == "anon" and rest:
@@ -345,6 +347,8 @@ class Interpreter:
             if name and val is not None:
                 self.params[names.join(scope.ns, name)] = (val, el.src)
         elif t in ("node_container", "load_composable_node"):
+            if t == "node_container":
+                self._container_note(el, scope, path)
             for c in el.children:
                 if c.tag == "composable_node":
                     outer = scope.unsure
@@ -371,6 +375,21 @@ class Interpreter:
                                            f"{_UNREAD_TAGS.get(t, 'the nodes it starts, if any, are unknown')}",
                                    "ROS-LAUNCH"))
 
+    def _container_note(self, el: El, scope: _Scope, path: Path) -> None:
+        """The located ``ROS-CONTAINER`` note of a component container ``el`` starts (a
+        ``node_container`` element or a ``Node`` running ``rclcpp_components``'
+        ``component_container*``): no node of the graph, its components are."""
+        def read(key: str) -> str | None:  # the container's names are only shown: one not read is left out
+            try:
+                return self._attr(el, key, scope, path)
+            except Unresolved:
+                return None
+        name, ns = read("name"), read("ns") or read("namespace")
+        shown = names.join(names.join(scope.ns, ns) if ns else scope.ns, name) if name else "(name not read)"
+        self.notes.append(Note(el.src, f"component container '{shown}' is started here: a container is no "
+                                       f"node of the graph (its endpoints are rclcpp_components'); its "
+                                       f"components are", "ROS-CONTAINER"))
+
     def _node_element(self, el: El, scope: _Scope, path: Path) -> None:
         """A ``<node>`` (ROS 1) or ``<node>``/``<lifecycle_node>`` (ROS 2 XML, YAML) in ``scope``: one
         :class:`LaunchNode` with its name, namespace, remaps and parameters as launch gives them.
@@ -379,6 +398,9 @@ class Interpreter:
         exe = self._attr(el, "type", scope, path) or self._attr(el, "exec", scope, path)
         if not pkg or not exe:
             raise Unresolved("node needs 'pkg' and 'type'/'exec'")
+        if pkg == "rclcpp_components" and exe.startswith("component_container"):
+            self._container_note(el, scope, path)
+            return
         name = self._soft(el, "name", scope, path)
         ns = self._soft(el, "ns", scope, path) or self._soft(el, "namespace", scope, path)
         given = self._ros_args(el, scope, path, name)

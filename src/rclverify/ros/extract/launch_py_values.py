@@ -16,7 +16,10 @@ executed): the evaluator :mod:`launch_ros2` reads actions with.
   launch substitution as the ``$(...)`` text :class:`~.launch.Interpreter`
   resolves: ``LaunchConfiguration('x'[, default=d])`` (``$(var x)``),
   ``EnvironmentVariable('X'[, default_value=d])`` (``$(env X)`` /
-  ``$(optenv X d)``), ``TextSubstitution(text=t)`` (``t``),
+  ``$(optenv X d)``), ``TextSubstitution(text=t)`` (``t``), Nav2's
+  ``LaunchConfigAsBool('x')`` (``$(as-bool $(var x))``: ``True`` when the
+  value stripped and lower-cased is ``true``, ``1``, ``yes`` or ``on``, else
+  ``False``, as ``nav2_common.launch`` defines it),
   ``ThisLaunchFileDir()``, ``PythonExpression([...])`` (``$(eval ...)``),
   ``EqualsSubstitution`` / ``NotEqualsSubstitution``,
   ``get_package_share_directory`` / ``FindPackageShare``, ``os.path.join``,
@@ -234,6 +237,8 @@ def _call_value(e: ast.Call, depth: int) -> str:
         if n is not None:
             return f"$(optenv {value(n, depth + 1)} {value(d, depth + 1)})" if d is not None \
                 else f"$(env {value(n, depth + 1)})"
+    if name == "LaunchConfigAsBool" and len(e.args) == 1:  # Nav2's nav2_common.launch substitution
+        return f"$(as-bool $(var {value(e.args[0], depth + 1)}))"
     if name == "TextSubstitution":
         t = arg(e, 0, "text")
         if t is not None:

@@ -145,6 +145,8 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
 def _container(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, notes: list[Note]) -> El:
     """``ComposableNodeContainer`` / ``LoadComposableNodes`` with its
     ``composable_node_descriptions``; raises :class:`_Unres`."""
+    if name == "ComposableNodeContainer":
+        _opt(c, attrs, (("name", "name"), ("namespace", "namespace")), shown, notes)
     descs = _kw(c, "composable_node_descriptions")
     kids = []
     if descs is not None:

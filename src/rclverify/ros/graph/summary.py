@@ -73,6 +73,8 @@ CAUSES: tuple[Cause, ...] = (
     Cause("nodes-twice", "launch nodes started twice (the last kept)", _has("is started twice")),
     Cause("nodes-at-shutdown", "launch nodes of OnShutdown handlers (launch starts none: not nodes)",
           _has("is started by OnShutdown")),
+    Cause("containers", "component containers (the processes holding components: not nodes, their components are)",
+          lambda code, _msg: code == "ROS-CONTAINER"),
     Cause("endpoints-name", "endpoints dropped: name not read statically",
           lambda _code, msg: bool(_NAME.search(msg)) or "name of" in msg and "comes from parameter" in msg),
     Cause("endpoints-unbuilt", "endpoints of classes nothing the program runs constructs", _has("nothing this program runs")),
