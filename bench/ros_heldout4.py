@@ -17,9 +17,12 @@ name and type are written in the node's own code at the call), ``call``
 constructor, a free function, a member set in another method) or
 ``runtime`` (name null: only the running program knows it).
 
-A site is *found* as in ``ros_heldout.py``.  Precision: of the edges of every
-graph node holding a file under ``own`` (library names set aside), those a
-site of the same file, role, name and type confirms; printed as counted and, where
+A site is *found* as in ``ros_heldout.py``, or by an edge whose ``via`` is the
+site (a helper called at several sites makes it: the edge is at the helper's
+creating call and names the call at the site, docs/grounding.md).  Precision:
+of the edges of every graph node holding a file under ``own`` (library names
+set aside), those a site of the same file (or ``via`` the site), role, name and
+type confirms; printed as counted and, where
 ``ros_heldout4_rejudged.json`` names unconfirmed edges judged real after measuring (the
 hand count missed them), also re-judged, labelled so.  Printed per tree and per
 split: recall over all sites and per reach, precision, sites missed with and
@@ -83,6 +86,12 @@ def measure(root: Path, truth: dict[str, Any], verbose: bool = False,
     return judge(g, root, truth, time.perf_counter() - t0, verbose, rejudged)
 
 
+def _via(e: Any, f: str, line: int) -> bool:
+    """Whether edge ``e`` is made by a helper called at ``f:line`` (its ``via``: the call of the
+    helper whose argument gives the name, docs/grounding.md)."""
+    return e.via is not None and e.via.file == f and e.via.line == line
+
+
 def judge(g: Any, root: Path, truth: dict[str, Any], seconds: float, verbose: bool = False,
           rejudged: list[list[str]] | None = None) -> dict[str, float]:
     """:func:`measure`'s counts for graph ``g``, a scan of ``root`` that took ``seconds``."""
@@ -96,7 +105,7 @@ def judge(g: Any, root: Path, truth: dict[str, Any], seconds: float, verbose: bo
         c[k] = c["found_" + k] = 0
     for site in truth["sites"]:
         f, line, node, role, name, typ, _kind, reach = site
-        found = [e for n, r, e in edges if (f in n.sources or e.src.file == f)
+        found = [e for n, r, e in edges if (f in n.sources or e.src.file == f or _via(e, f, line))
                  and (node is None or n.name.split("@")[0] == node)
                  and r == role and e.topic == name and e.msg_type == typ] if name is not None else []
         c["sites"] += 1
@@ -111,7 +120,8 @@ def judge(g: Any, root: Path, truth: dict[str, Any], seconds: float, verbose: bo
                 print(f"    missed{'' if noted else ' (no note)'}: {site}")
     c["rejudged"] = 0
     for n, r, e in edges:
-        ok = any(s[3] == r and s[4] == e.topic and s[5] == e.msg_type and (s[0] == e.src.file or s[0] in n.sources)
+        ok = any(s[3] == r and s[4] == e.topic and s[5] == e.msg_type and (s[0] == e.src.file or s[0] in n.sources
+                                                                                        or _via(e, s[0], s[1]))
                  for s in truth["sites"])
         c["edges"] += 1
         c["right"] += ok

@@ -86,6 +86,19 @@ def _markers(ns: symbols.Val, h: symbols.Val, ros2: bool) -> list[Spec]:
     return out
 
 
+#: what is said at a ``tf2_ros::TransformListener`` made without a node (:func:`own_node`)
+OWN_NODE_SAID = ("tf2_ros::TransformListener made without a node subscribes /tf and /tf_static on tf2's own node "
+                 "(transform_listener_impl_...), not on this one")
+
+
+def own_node_of_values(type_text: str, args: list[Any]) -> bool:
+    """:func:`own_node` for a member initialised in a constructor the linker
+    reads (``args`` are argument values, the member's type from its class's
+    header): the buffer alone."""
+    head, _ = split_template(type_text.replace(" ", "").replace("\n", ""))
+    return head.split("::")[-1] == "TransformListener" and "tf2_ros" in head and len(args) == 1
+
+
 def own_node(type_text: str, args: list[Any], ros2: bool) -> bool:
     """Whether a ROS 2 ``tf2_ros::TransformListener`` made with syntax nodes
     ``args`` creates its own node for ``/tf`` and ``/tf_static``: given the

@@ -36,7 +36,7 @@ itself is already apart (:mod:`link_values`, :mod:`link_members`,
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
 from rclverify.ros.extract import emit, names, plugins, symbols
@@ -45,7 +45,7 @@ from rclverify.ros.extract.model import Endpoint, Note, Src
 from rclverify.ros.extract.link_members import LinkMembers
 from rclverify.ros.extract.link_returns import Returns
 from rclverify.ros.extract.link_types import Instances, is_template_param
-from rclverify.ros.extract.link_values import MAX_DEPTH, MAX_VALUES, Values
+from rclverify.ros.extract.link_values import MAX_DEPTH, MAX_VALUES, Values, _homes
 from rclverify.ros.extract.programs import PackageCode, Program
 from rclverify.ros.extract.unit_names import canonical
 
@@ -97,12 +97,14 @@ class Linker(LinkMembers, Values, Returns, Instances):
         self._by_meth: dict[str, set[str]] | None = None
         self._by_last: dict[str, list[str]] | None = None  # classes by last name part
         self._overs: dict[str, list[str]] | None = None  # function keys by key without '#N'
+        self.own_said: list[Note] = []
         self._free: dict[str, list[str]] | None = None  # free functions by last name part
         self._targs_at: dict[tuple[Any, ...], list[list[str]]] | None = None  # call_targs by their site
         self.py = bool(self.recs) and all(r.get("lang") == "py" for r in self.recs.values())
         self.classes = [] if self.py else sorted(self.units)
         self.entry = prog.units if prog.units is not None else entry_units
         self.sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]] = {}
+        self.site_at: dict[str, list[Src]] = {}  # where each of those call sites is
         self.site_targs: dict[str, list[tuple[list[str], str | None]]] = {}
         self._targ_seen: dict[tuple[str, str | None, str | None, int], int] = {}
         # what runs what: "U:class" (constructed: all its methods run) and "F:function" (called)
@@ -179,6 +181,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
                 if here is not None:
                     self._edge(here, f"F:{k}")
                 self.sites.setdefault(k, []).append((args, kwargs, fkey))
+                self.site_at.setdefault(k, []).append(_src)
                 self.record_site(k, callee, fkey, kind, unit, len(args))
         # a delegating constructor's call (Sensor(o) : Sensor("sensor", o)) is no construction read
         made_outside = {s.split("#")[0] for s, sites in self.sites.items()
@@ -190,6 +193,7 @@ class Linker(LinkMembers, Values, Returns, Instances):
         if prog.instance is not None:  # a plugin's methods its loader calls, given the instance's name
             for k, got in plugins.entry_sites(self.fns, set(prog.units or ()), set(self.sites), prog.instance).items():
                 self.sites[k] = list(got)
+                self.site_at.pop(k, None)  # a plugin's entry points: no call site to name
                 self.site_targs[k] = [([], None)] * len(got)
         for u, info in self.units.items():
             for ty in list(info["members"].values()) + info["bases"]:
@@ -446,6 +450,8 @@ class Linker(LinkMembers, Values, Returns, Instances):
                         unbuilt.append(e)
                     continue
                 raw.append((f, e))
+        for n in self.own_said:
+            note(n)
         named = self.named(note, out)
         unused = self.prog.exe is None and self.prog.units is None and not named and \
             all(f.rsplit(".", 1)[-1] in ("h", "hh", "hpp", "hxx") for f in self.prog.entry)
@@ -578,23 +584,44 @@ class Linker(LinkMembers, Values, Returns, Instances):
             t = types[0]
         argtype = cb if isinstance(cb, tuple) and cb[:1] == ("argtype",) else None
         got: list[Endpoint] = []
-        for env in self.contexts(fkey):
-            if argtype is not None:  # a Python helper's type parameter, read at each call site
-                types = [_py_typed(v, e.kind) for v in self.eval(("arg", argtype[1], argtype[2]), env, fkey)] or [None]
-                t = types[0] if all(types) else None
-            for n in self.eval(name, env, fkey):
-                for h in self.eval(handle, env, fkey) if handle is not None else [None]:
-                    if n is not None and n[0] == "ops":
-                        n = n[2]
-                    for ty in types:
-                        x, bad = emit.resolve(e.kind, n, h, ty, e.src, e.unit, written, nsrc, e.func)
-                        if bad is not None:
-                            note(bad)
-                        if x is not None and x not in got:
-                            got.append(x)
+        outer = self.pins
+        for via in self.name_sites(fkey, name):
+            if via is not None:  # read at that call site only, the edge naming it
+                self.pin({**outer, fkey: via[0]})
+            for env in self.contexts(fkey):
+                if argtype is not None:  # a Python helper's type parameter, read at each call site
+                    types = [_py_typed(v, e.kind) for v in self.eval(("arg", argtype[1], argtype[2]), env, fkey)] \
+                        or [None]
+                    t = types[0] if all(types) else None
+                for n in self.eval(name, env, fkey):
+                    for h in self.eval(handle, env, fkey) if handle is not None else [None]:
+                        if n is not None and n[0] == "ops":
+                            n = n[2]
+                        for ty in types:
+                            x, bad = emit.resolve(e.kind, n, h, ty, e.src, e.unit, written, nsrc, e.func)
+                            if bad is not None:
+                                note(bad)
+                            if x is not None and via is not None:
+                                x = replace(x, via=via[1])
+                            if x is not None and x not in got:
+                                got.append(x)
+        self.pin(outer)
         if got and t is None and not ambiguous:
             note(emit.type_note(got[0]))
         return got
+
+    def name_sites(self, fkey: str | None, name: Any) -> list[tuple[int, Src] | None]:
+        """The call sites an endpoint's name is read at one by one: ``[(index in
+        sites[fkey], where)]`` when the name reads a parameter of function ``fkey``
+        and ``fkey`` has several call sites that run (at most :data:`MAX_VALUES`,
+        none pinned already), so each edge names the call whose argument gives it;
+        else ``[None]`` (every call site at once)."""
+        at = self.site_at.get(fkey or "", [])
+        sites = self.sites.get(fkey or "", [])
+        if fkey is None or fkey in self.pins or len(at) != len(sites) or fkey not in _homes(name):
+            return [None]
+        live = [(i, at[i]) for i, (_a, _k, caller) in enumerate(sites) if caller is None or self.runs(None, caller)]
+        return list(live) if 1 < len(live) <= MAX_VALUES else [None]
 
     def uninstantiated(self, v: Any, depth: int = 0) -> bool:
         """Whether name value ``v`` reaches the program only through parameters of

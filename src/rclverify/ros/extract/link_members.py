@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, Callable
 from rclverify.ros.extract import cpp_helpers, symbols
 from rclverify.ros.extract.cpp_types import (action_type, action_type_in, alias_of, message_type, service_type,
                                              split_template)
-from rclverify.ros.extract.model import Endpoint
+from rclverify.ros.extract.model import Endpoint, Note
 
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
               "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
@@ -37,6 +37,7 @@ class LinkMembers:
     known: Callable[[str], bool]
     using_ns: list[str]  # the program's ``using namespace`` directives
     alias_index: dict[str, list[str]]  # the aliases' keys by last name part (cpp_types.alias_index)
+    own_said: list[Note]  # TransformListeners :meth:`members` found on tf2's own node, to be said
 
     if TYPE_CHECKING:  # provided by the class that mixes this one in
         def runs(self, unit: str | None, fkey: str | None, reach: set[str] | None = None) -> bool:
@@ -123,6 +124,10 @@ class LinkMembers:
                      (c[1] == m or base and split_template(c[1].replace(" ", ""))[0].split("::")[-1] == last)]
             for c in inits or [None]:
                 if c is not None and c[0] == "own-node":  # a TransformListener given no node (said at it)
+                    continue
+                if c is not None and r.get("ros2") and cpp_helpers.own_node_of_values(self.aliases.get(ty, ty), c[2]):
+                    # the same, initialised in a constructor of another file than the member's declaration
+                    self.own_said.append(Note(c[5], cpp_helpers.OWN_NODE_SAID, "ROS-TF-OWN-NODE"))
                     continue
                 args = c[2] if c else []
                 at, fkey = (c[5], c[3]) if c else (src, None)

@@ -94,6 +94,7 @@ class Endpoint:
     func: str | None = None
     affix: tuple[str, str] = ("", "")  # text around the parameter's value ('/' + value + '/pose')
     unread: Any = None  # the located note to give when no launch file sets that parameter
+    via: Src | None = None  # the call of the helper whose argument names it (of several such calls)
 
 
 # The four service/action roles an :class:`Endpoint` may have besides "pub"/"sub", each the
@@ -129,6 +130,7 @@ class GraphEdge:
     written: str = ""  # the name as the code writes it, before resolution and remapping
     param: str | None = None  # the parameter the code takes the name from (resolved), if any
     param_set_at: Src | None = None  # the launch file's value of that parameter, when it sets one
+    via: Src | None = None  # the call of the helper function whose argument gives the name, of several
 
     def to_json(self) -> EdgeJson:
         d: EdgeJson = {"topic": self.topic, "type": self.msg_type, "as_written": self.written or self.topic,
@@ -139,6 +141,8 @@ class GraphEdge:
             d["param"] = self.param
         if self.param_set_at is not None:
             d["param_set_at"] = self.param_set_at.to_json()
+        if self.via is not None:
+            d["via"] = self.via.to_json()
         return d
 
 

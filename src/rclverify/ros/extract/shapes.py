@@ -32,6 +32,7 @@ class EdgeJson(TypedDict):
     remapped_at: NotRequired[SourceRef]
     param: NotRequired[str]
     param_set_at: NotRequired[SourceRef]
+    via: NotRequired[SourceRef]
 
 
 class NodeJson(TypedDict):

@@ -219,10 +219,7 @@ class _File(CallReader, MemberReader):
             self.record("ctor", type_text.replace("typename", "").strip() if targs else head, args, at)
 
     def own_node(self, at: Any) -> None:
-        self.out["notes"].append(Note(self.src(at), "tf2_ros::TransformListener made without a node subscribes "
-                                                    "/tf and /tf_static on tf2's own node "
-                                                    "(transform_listener_impl_...), not on this one",
-                                      "ROS-TF-OWN-NODE"))
+        self.out["notes"].append(Note(self.src(at), cpp_helpers.OWN_NODE_SAID, "ROS-TF-OWN-NODE"))
 
     def actionlib(self, kind: str, ty: str, args: list[Any], at: Any) -> None:
         if not args:

@@ -391,7 +391,7 @@ class _Scan:
                                                 f"not resolved statically"))
                 return
         topic, at = namespaces.resolve(written, e.handle, ns, full, remaps)
-        edge = GraphEdge(topic, e.msg_type, e.src, at, namespaces.shown(written, e.handle), pname, set_at)
+        edge = GraphEdge(topic, e.msg_type, e.src, at, namespaces.shown(written, e.handle), pname, set_at, e.via)
         lst = node.edges_of(e.kind)
         # every call site keeps its own edge (the same name created twice is two edges)
         if not any(x.topic == edge.topic and x.msg_type == edge.msg_type and x.src == edge.src for x in lst):
