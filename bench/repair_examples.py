@@ -21,7 +21,10 @@ in process:
 The defects (:func:`defects`): the five patches of ``examples/ros2_robot/defects``, the delivery example's
 slow zone (``fixes/05-slow-zone.diff``) and stale wheel command (``02-stale-command.diff``, found by the
 recorded run; no property test fails), the contracts-first thermostat's 273 for 273.15, and the bench
-robots' slips.  The failing line is **exact** when it is the seeded line (the first line the fix changes).
+robots' slips.  The failing line is **exact** when the line the diagnosis names first is the seeded line
+(the first line the fix changes): the property test's culprit line, or the line the first checked repair
+edits when that repair was found around it (:func:`rclverify.diagnosis.code_repair.repaired_line`, as
+``diagnosis/build.py`` names it).
 
 Usage::
 
@@ -114,8 +117,8 @@ def defects() -> list[Defect]:
         for s in yaml.safe_load((robot / "slips.yaml").read_text(encoding="utf-8")):
             fixed = (robot / s["file"]).read_text(encoding="utf-8")
             assert fixed.count(s["fixed"] + "\n") == 1, (robot.name, s["name"])
-            out.append(Defect(robot, s["name"], s["node"], s["file"], fixed.replace(s["fixed"] + "\n", s["slipped"] + "\n"),
-                              fixed))
+            slipped = fixed.replace(s["fixed"] + "\n", s["slipped"] + "\n" if s["slipped"] else "")  # "": removed
+            out.append(Defect(robot, s["name"], s["node"], s["file"], slipped, fixed))
     return out
 
 
@@ -157,8 +160,10 @@ def statuses(root: Path, only: str | None = None) -> dict[str, tuple[str, str]]:
 
 @dataclass
 class Outcome:
-    """What the tool did on one defect (module docstring): the failing obligation and its ``cause``
-    (``""``: no property test failed), whether the line is ``exact``, the repairs offered (their
+    """What the tool did on one defect (module docstring): the failing obligation and the line the
+    diagnosis names first (``cause``: the property test's culprit line, or the line the first checked
+    repair edits when it was found around that line; ``""``: no property test failed), whether it is
+    ``exact`` (the seeded line), the repairs offered (their
     texts), the first repair's ``verdict`` (``equal``, ``equivalent``, ``miss``, ``none``), the
     obligations it ``breaks`` and the seconds taken."""
 
@@ -174,7 +179,7 @@ class Outcome:
 def run_defect(d: Defect, where: Path) -> Outcome:
     """Seed ``d`` in a copy of its workspace under ``where`` and run the tool on it (module docstring)."""
     from rclverify.app.pipeline import Workspace
-    from rclverify.diagnosis.code_repair import checked_repairs
+    from rclverify.diagnosis.code_repair import checked_repairs, repaired_line
     from rclverify.diagnosis.edits import Edit
     t0 = time.perf_counter()
     slipped = _workspace(d, where / "slipped", d.slipped)
@@ -186,15 +191,16 @@ def run_defect(d: Defect, where: Path) -> Outcome:
     reps = checked_repairs(Workspace(slipped), d.node, failing, cause, {k: v[0] for k, v in before.items()})
     offered = [Edit(r["file"], r["edit"]["line"], r["edit"]["col"], r["edit"]["end_line"], r["edit"]["end_col"],
                     r["edit"]["inserted"]).apply(d.slipped) for r in reps]
-    exact = cause == f"{d.file}:{d.line}"
+    named = repaired_line(cause, reps) or cause  # the line the diagnosis names first
+    exact = named == f"{d.file}:{d.line}"
     if not offered:
-        return Outcome(failing, cause, exact, [], "none", [], time.perf_counter() - t0)
+        return Outcome(failing, named, exact, [], "none", [], time.perf_counter() - t0)
     fixed = statuses(_workspace(d, where / "fixed", d.fixed))
     repaired = fixed if offered[0] == d.fixed else statuses(_workspace(d, where / "repaired", offered[0]))
     breaks = sorted(k for k, (s, _) in fixed.items() if s == "discharged" and repaired.get(k, ("absent",))[0] != s)
     same = {k: s for k, (s, _) in repaired.items()} == {k: s for k, (s, _) in fixed.items()}
     verdict = "equal" if offered[0] == d.fixed else "equivalent" if same else "miss"
-    return Outcome(failing, cause, exact, offered, verdict, breaks, time.perf_counter() - t0)
+    return Outcome(failing, named, exact, offered, verdict, breaks, time.perf_counter() - t0)
 
 
 def _change(old: str, new: str) -> str:

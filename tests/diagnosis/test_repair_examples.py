@@ -41,3 +41,18 @@ def test_control_another_fix_is_a_miss(battery_lt: repair_examples.Defect, tmp_p
     assert wrong != battery_lt.fixed
     out = repair_examples.run_defect(replace(battery_lt, fixed=wrong), tmp_path)
     assert out.exact and out.offered and out.verdict == "miss"
+
+
+def test_a_wrong_branch_is_repaired_where_it_is_made(tmp_path: Path) -> None:
+    # the bench arm's mode server answers the careful speed for every other mode (`!=` for `==`): the property
+    # test names the `return` the failing example takes (line 10); no edit there passes, the search around it
+    # finds `==` at line 8, which the diagnosis then names first
+    d = next(d for d in repair_examples.defects() if d.name == "mode_wrong_kind")
+    from rclverify.app.pipeline import Workspace
+    root = repair_examples._workspace(d, tmp_path / "ws", d.slipped)
+    assert repair_examples.statuses(root, "ModeServer")["ModeServer.g1.property_tests.e0"] == \
+        ("failed", "nodes/mode_server.py:10")  # control: the property test's own line is the return
+    assert Workspace(root).plan.evidence["ModeServer"][0].backend == "property_tests"
+    out = repair_examples.run_defect(d, tmp_path / "run")
+    assert out.cause == "nodes/mode_server.py:8" and out.exact
+    assert out.verdict == "equal" and out.breaks == []

@@ -42,7 +42,7 @@ import z3
 from rclverify.core.cache import Shelf, file_digest
 from rclverify.lang.errors import RclError
 from rclverify.diagnosis import blame, repairs as rep
-from rclverify.diagnosis.code_repair import checked_repairs
+from rclverify.diagnosis.code_repair import checked_repairs, repaired_line
 from rclverify.diagnosis.constants import hoare_repair
 from rclverify.diagnosis.hoare_tokens import hoare_token_repairs
 from rclverify.diagnosis.deadline import budget_repairs, deadline_record
@@ -409,8 +409,14 @@ def _evidence(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson | 
             repairs = cache.get(["code", e["obligation"].rsplit(".", 1)[-1], node, cause, before],
                                 lambda: checked_repairs(ws, node, e["obligation"], cause, before),
                                 cause.rpartition(":")[0]) or []
+        cul_pt: list[Culprit] = [{"what": where, "source": src, "text": text}]
+        made = repaired_line(cause, repairs) if isinstance(cause, str) else ""
+        if made:  # the checked repair edits another line of the function: the value is made there
+            sentence = (sentence[:-1] + f"; the first checked repair edits {made}, where the wrong value is made "
+                        f"({cause} is where the example goes wrong).")
+            cul_pt.insert(0, {"what": f"{made}: the line the first checked repair edits", "source": made, "text": ""})
         return _record(e["obligation"], "property-test", node, e["status"], sentence,
-                       culprits=[{"what": where, "source": src, "text": text}],
+                       culprits=cul_pt,
                        counterexample=counterexample_table(cex, node), guarantee=k, repairs=repairs)
     expl = str(e.get("explanation", ""))
     first = expl.split("; ")[0] if len(expl) > 300 else expl

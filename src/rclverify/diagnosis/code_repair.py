@@ -205,6 +205,19 @@ def around_lines(source: str, line: int) -> list[int]:
     return sorted(lines, key=lambda k: (abs(k - line), k > line, k))
 
 
+def repaired_line(cause: str, repairs: Sequence[Repair]) -> str:
+    """The implementation line (``file:line``) where the first of ``repairs`` (:func:`checked_repairs`,
+    of the failure whose culprit is ``cause``) edits, when that is another line than ``cause``'s: the
+    repair was found around it (module docstring, step 4), and the line it edits is where the wrong value
+    is made; ``""`` otherwise (no repair, or one at ``cause`` itself)."""
+    if not repairs:
+        return ""
+    first = repairs[0]
+    edit = first.get("edit") or {}
+    at = f"{first.get('file', '')}:{edit.get('line', '')}"
+    return at if at != cause and edit.get("line") else ""
+
+
 def _rank(old: str, new: str) -> int:
     """The class of a one-token correction, tried in this order: 0 an operator or a name (a comparison's
     strictness, ``and``/``or``, ``+``/``-``, ``max``/``min``, a ``not`` dropped, a truth value), 1 a number
@@ -334,4 +347,5 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
     return out
 
 
-__all__ = ["MAX_AROUND", "MAX_REPAIRS", "MAX_TRIED", "around_lines", "candidate_edits", "checked_repairs"]
+__all__ = ["MAX_AROUND", "MAX_REPAIRS", "MAX_TRIED", "around_lines", "candidate_edits", "checked_repairs",
+           "repaired_line"]
