@@ -215,7 +215,9 @@ class WriterClocks:
 
 
 def _signed(d: float) -> str:
-    return f"{d:+.3f} s" if abs(d) < 1e4 else f"{d:+.6g} s"
+    """An offset (s) to the millisecond at any size: a simulated clock's stamps lie about the epoch's
+    seconds from the wall clock's, and six significant digits made two different offsets read alike."""
+    return f"{d:+.3f} s"
 
 
 def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]:
