@@ -53,3 +53,22 @@ def test_repaired_line() -> None:
     # controls: a repair at the culprit line itself, or none, names nothing more
     assert repaired_line("n.py:8", [rep]) == ""  # type: ignore[list-item]
     assert repaired_line("n.py:11", []) == ""
+
+
+RATE = '''def step(count, dt, on):
+    if on:
+        return {"rate": 1.0, "ok": True}
+    return {"rate": count / dt, "ok": False}
+'''
+
+
+def test_a_guard_against_a_zero_divisor() -> None:
+    edits = candidate_edits(RATE, "r.py", 4, [])
+    guard = edits[-1]  # class 4: after every one-token correction
+    assert guard.deleted(RATE) == "" and (guard.line, guard.col) == (4, 1)
+    assert guard.text == "    if dt == 0:\n        return {'rate': 0.0, 'ok': False}\n"
+    assert "if dt == 0:" in guard.apply(RATE).splitlines()[3]
+    # controls: no division by a name, or a return that is not a dict of the same keys: no guard
+    assert not any("\n" in e.text for e in candidate_edits(RATE.replace("count / dt", "count * dt"), "r.py", 4, []))
+    other = RATE.replace('return {"rate": 1.0, "ok": True}', "return None")
+    assert not any("\n" in e.text for e in candidate_edits(other, "r.py", 4, []))

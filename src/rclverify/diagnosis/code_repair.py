@@ -14,7 +14,11 @@ only when it was checked:
    value negated, a number moved by one or replaced by a number the
    contract names: :func:`~rclverify.backends.property_tests.slips.mutations`),
    and ``max``/``min`` swapped, each as a text edit of that line's
-   expression cut to the characters that change.  Ordered by class (an
+   expression cut to the characters that change; then an integer replaced
+   by a non-integer number the contract names, an operand replaced by
+   another name of the function, a slice dropped (:func:`_operands`), and
+   last a guard against a zero divisor inserted before the statement
+   (:func:`_guards`).  Ordered by class (an
    operator or a name first, then a number moved by one, then a number the
    contract names: :func:`_rank`), then smallest (the characters taken out
    and put in), then in source order.
@@ -123,6 +127,7 @@ def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fractio
     out: list[Edit] = []
     named: list[Edit] = []  # class 2 (:func:`_rank`): an integer replaced by a number the contract names
     other: list[Edit] = []  # class 3: an operand put for another, a slice dropped
+    guards: list[Edit] = []  # class 4: a guard against a zero divisor
     for fdef in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))):
         if not fdef.lineno <= line <= (fdef.end_lineno or fdef.lineno) or not isinstance(fdef, ast.FunctionDef):
             continue
@@ -139,15 +144,45 @@ def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fractio
                 out.append(_edit(file, lines, call.func, _SWAP[call.func.id]) or _NONE)
             for node, new in _operands(fdef, stmt, numbers):
                 (named if new[:1].isdigit() else other).append(_edit(file, lines, node, new) or _NONE)
+            guards.extend(_guards(fdef, stmt, file, lines))
     seen: set[tuple[int, int, int, int, str]] = set()
     kept: list[tuple[int, Edit]] = []
-    for cls, e in [*((-1, e) for e in out), *((2, e) for e in named), *((3, e) for e in other)]:
+    for cls, e in [*((-1, e) for e in out), *((2, e) for e in named), *((3, e) for e in other),
+                   *((4, e) for e in guards)]:
         key = (e.line, e.col, e.end_line, e.end_col, e.text)
         if e is not _NONE and key not in seen:
             seen.add(key)
             kept.append((cls if cls >= 0 else _rank(e.deleted(source), e.text), e))
     return [e for _, e in sorted(kept, key=lambda ce: (ce[0], len(ce[1].deleted(source)) + len(ce[1].text),
                                                        ce[1].line, ce[1].col))]
+
+
+def _guards(fdef: ast.FunctionDef, stmt: ast.stmt, file: str, lines: list[str]) -> list[Edit]:
+    """A guard inserted before ``stmt`` for each divisor of its own expressions that is a name
+    (``count / dt``): ``if dt == 0:`` returning zero for every output (``0.0``, ``0`` or ``False`` as the
+    function's other returns have it), when every ``return`` of the function is a dict with the same keys;
+    ``[]`` otherwise.  The insertion is an edit of no characters at ``stmt``'s first column."""
+    roots = [stmt.value] if isinstance(stmt, (ast.Return, ast.Assign, ast.AugAssign, ast.AnnAssign)) \
+        and stmt.value is not None else []
+    divisors = list(dict.fromkeys(n.right.id for r in roots for n in ast.walk(r) if isinstance(n, ast.BinOp)
+                                  and isinstance(n.op, (ast.Div, ast.FloorDiv, ast.Mod))
+                                  and isinstance(n.right, ast.Name)))
+    rets = [n.value for n in ast.walk(fdef) if isinstance(n, ast.Return)]
+    dicts = [r for r in rets if isinstance(r, ast.Dict)]
+    if not divisors or not rets or len(dicts) != len(rets) or any(k is None for r in dicts for k in r.keys):
+        return []
+    keys = [ast.unparse(k) for k in dicts[0].keys if k is not None]
+    if any([ast.unparse(k) for k in r.keys if k is not None] != keys for r in dicts):
+        return []
+    zero: dict[str, str] = {k: "0.0" for k in keys}
+    for r in dicts:
+        for k, v in zip(r.keys, r.values):
+            if k is not None and isinstance(v, ast.Constant) and type(v.value) in (bool, int):
+                zero[ast.unparse(k)] = "False" if type(v.value) is bool else "0"
+    indent = lines[stmt.lineno - 1][:stmt.col_offset]
+    body = ", ".join(f"{k}: {zero[k]}" for k in keys)
+    return [Edit(file, stmt.lineno, 1, stmt.lineno, 1, f"{indent}if {d} == 0:\n{indent}    return {{{body}}}\n")
+            for d in divisors]
 
 
 def _operands(fdef: ast.FunctionDef, stmt: ast.stmt, numbers: Sequence[Fraction]) -> Iterable[tuple[ast.AST, str]]:
@@ -222,7 +257,8 @@ def _rank(old: str, new: str) -> int:
     """The class of a one-token correction, tried in this order: 0 an operator or a name (a comparison's
     strictness, ``and``/``or``, ``+``/``-``, ``max``/``min``, a ``not`` dropped, a truth value), 1 a number
     moved by one, 2 a number replaced by another the contract names; :func:`candidate_edits` puts an
-    operand replaced by another name and a slice dropped (:func:`_operands`) after them, class 3."""
+    operand replaced by another name and a slice dropped (:func:`_operands`) after them, class 3, and a
+    guard against a zero divisor (:func:`_guards`) last, class 4."""
     try:
         a, b = Fraction(old), Fraction(new)
     except (ValueError, ZeroDivisionError):
@@ -335,8 +371,10 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
                 for k in sorted(got) if (before or {}).get(ids[k], "absent") != got[k]]
         where = "the line where the failing example goes wrong" if at_line else \
             f"a statement of the same function as {file}:{at}, where the failing example goes wrong"
-        rec = _record("code", f"At {file}:{edit.line}, change `{old}` to `{new}`: a one-token correction of "
-                      f"{where}.", edit, source, checks, cost,
+        said = f"change `{old}` to `{new}`: a one-token correction of {where}"
+        if not edit.deleted(source) and "\n" in edit.text:  # a guard inserted (:func:`_guards`)
+            said = f"insert `{' '.join(x.strip() for x in edit.text.splitlines())}` before it: a guard of {where}"
+        rec = _record("code", f"At {file}:{edit.line}, {said}.", edit, source, checks, cost,
                       proves=f"every guarantee of {node} ({len(ids)}) held again on every example the property "
                       f"tests drew from a scratch copy with the edit (seed {cfg.seed})",
                       not_shown="that the edit is right for the robot: the tests draw examples, they prove nothing")
