@@ -24,6 +24,7 @@ Usage::
 
     python bench/fret_import.py DIR            # import figures only
     python bench/fret_import.py DIR --decide   # and the verdicts (a minute or two)
+    python bench/fret_import.py --smoke        # CI: the example's own export, decided
 """
 from __future__ import annotations
 
@@ -150,9 +151,15 @@ def decide(export: Path, exp: FretExport, out: collections.Counter[str]) -> None
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("dir", type=Path, help="a folder of FRET exports (*.json)")
+    ap.add_argument("dir", type=Path, nargs="?", help="a folder of FRET exports (*.json)")
     ap.add_argument("--decide", action="store_true", help="also decide each translated requirement")
+    ap.add_argument("--smoke", action="store_true",
+                    help="CI: the project's own example export (examples/fret_rover/fret), decided")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.dir, args.decide = Path(__file__).resolve().parents[1] / "examples" / "fret_rover" / "fret", True
+    if args.dir is None:
+        ap.error("a folder of FRET exports is needed (or --smoke)")
     total: collections.Counter[str] = collections.Counter()
     reasons: collections.Counter[str] = collections.Counter()
     start = time.perf_counter()

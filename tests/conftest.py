@@ -105,6 +105,9 @@ SECONDS: dict[str, float] = {
     "test_record_shapes": 4.3, "test_logic": 3.5, "test_candidates": 3.9, "test_gwendolen": 3.5,
     "test_temporal_traces": 3.0, "test_extras": 3.5, "test_evidence": 3.5, "test_generate_contract_layer": 3.1,
     "test_robustness": 3.0,
+    # this round's modules over two CPU seconds (run alone, one process, the import of pytest not counted)
+    "test_repair_examples": 30.0, "test_repair_oracle": 7.0, "test_repair_cli": 5.0, "test_hoare_token_repairs": 3.0,
+    "test_fret_example": 4.0, "test_instances": 3.5,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -122,7 +125,7 @@ WALL: dict[str, float] = {
     "test_example_manipulator": 32.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
     "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
     "test_live_stops": 45.0, "test_names_rcl": 5.0, "test_names_fleet_live": 17.0, "test_lifecycle_live": 35.0,
-    "test_instances_live": 35.0,
+    "test_instances_live": 35.0, "test_lsp_code_repair": 20.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
