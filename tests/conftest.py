@@ -54,7 +54,7 @@ LIVE = frozenset({
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_names_rcl", "test_names_fleet_live", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
-    "test_live_stops", "test_lifecycle_live", "test_instances_live",
+    "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
