@@ -26,6 +26,24 @@ def _texts(line: int, numbers: list[Fraction]) -> list[tuple[str, str]]:
     return [(e.deleted(SRC), e.text) for e in candidate_edits(SRC, "n.py", line, numbers)]
 
 
+GOVERNOR = '''def govern(clearance, cmd_vel, limit):
+    if clearance < 1.5:
+        return {"safe": min(cmd_vel, 0.3)}
+    return {"safe": cmd_vel}
+'''
+
+
+def test_a_name_is_never_put_for_one_of_another_unit() -> None:
+    # the delivery slow zone's second repair was `cmd_vel < SLOW_ZONE` for `clearance < SLOW_ZONE`: a speed
+    # compared with a distance, which the property tests passed (every drawn speed is under the zone)
+    kinds = {"clearance": "REAL [m]", "cmd_vel": "REAL [m/s]", "limit": "REAL [m]", "safe": "REAL [m/s]"}
+    got = [(e.deleted(GOVERNOR), e.text) for e in candidate_edits(GOVERNOR, "g.py", 2, [], kinds)]
+    assert ("clearance", "limit") in got  # a name of the same unit
+    assert ("clearance", "cmd_vel") not in got
+    # control: without the contract's kinds every name of the function is a candidate
+    assert ("clearance", "cmd_vel") in [(e.deleted(GOVERNOR), e.text) for e in candidate_edits(GOVERNOR, "g.py", 2, [])]
+
+
 def test_operands_slices_and_named_numbers() -> None:
     eight = _texts(8, [])
     assert ("[:-1]", "") in eight  # the slice dropped

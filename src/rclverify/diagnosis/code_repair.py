@@ -53,7 +53,7 @@ import shutil
 import tempfile
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 from rclverify.diagnosis.edits import Edit
 from rclverify.records.stage_records import Repair
@@ -114,10 +114,13 @@ def _joined(a: str, b: str) -> bool:
     return bool(b) and _kind(a) != "" and _kind(a) == _kind(b)
 
 
-def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fraction]) -> list[Edit]:
+def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fraction],
+                    kinds: Mapping[str, str] | None = None) -> list[Edit]:
     """The one-token corrections of the statement at ``line`` of ``source`` (the implementation file
     ``file``, as the plan names it) inside a function (module docstring, step 1), each once, smallest
-    first; ``[]`` when the line holds no statement of a function or the file does not parse."""
+    first; ``[]`` when the line holds no statement of a function or the file does not parse.
+    ``kinds``: a name of the contract's inputs and outputs -> its type and unit (:func:`contract_kinds`):
+    a name is never put for one of another type or unit (a speed for a distance)."""
     from rclverify.backends.property_tests.slips import mutations  # deferred: start-up (the backend's search)
     try:
         tree = ast.parse(source, file)
@@ -142,7 +145,7 @@ def candidate_edits(source: str, file: str, line: int, numbers: Sequence[Fractio
             for call in _calls(stmt):
                 assert isinstance(call.func, ast.Name)
                 out.append(_edit(file, lines, call.func, _SWAP[call.func.id]) or _NONE)
-            for node, new in _operands(fdef, stmt, numbers):
+            for node, new in _operands(fdef, stmt, numbers, kinds or {}):
                 (named if new[:1].isdigit() else other).append(_edit(file, lines, node, new) or _NONE)
             guards.extend(_guards(fdef, stmt, file, lines))
     seen: set[tuple[int, int, int, int, str]] = set()
@@ -185,7 +188,19 @@ def _guards(fdef: ast.FunctionDef, stmt: ast.stmt, file: str, lines: list[str]) 
             for d in divisors]
 
 
-def _operands(fdef: ast.FunctionDef, stmt: ast.stmt, numbers: Sequence[Fraction]) -> Iterable[tuple[ast.AST, str]]:
+def contract_kinds(node: Any) -> dict[str, str]:
+    """Each input's and output's name of the checked contract ``node`` -> its type and declared unit
+    (``"REAL [m]"``; an input's where a name is both), for :func:`candidate_edits`."""
+    out: dict[str, str] = {}
+    for prefix, table in (("out", node.outputs), ("in", node.inputs)):
+        for name, typ in table.items():
+            unit = node.unit_of(prefix, name)
+            out[name] = f"{typ} {unit}" if unit is not None else str(typ)
+    return out
+
+
+def _operands(fdef: ast.FunctionDef, stmt: ast.stmt, numbers: Sequence[Fraction],
+              kinds: Mapping[str, str]) -> Iterable[tuple[ast.AST, str]]:
     """The one-token corrections of ``stmt``'s own expressions on its first line that the culprit search
     does not make: an integer replaced by a number the contract names that is not one (``273`` for
     ``273.15``), a name or a truth value replaced by another name the function reads as a parameter or
@@ -209,7 +224,9 @@ def _operands(fdef: ast.FunctionDef, stmt: ast.stmt, numbers: Sequence[Fraction]
                 yield from ((n, repr(float(c))) for c in numbers if c.denominator != 1)
             elif isinstance(n, ast.Constant) and isinstance(n.value, bool) or \
                     isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load) and id(n) not in called:
-                yield from ((n, x) for x in names if x != getattr(n, "id", None))
+                was = kinds.get(getattr(n, "id", ""))  # a contract variable's kind: only a name of that kind
+                yield from ((n, x) for x in names if x != getattr(n, "id", None)
+                            and (was is None or kinds.get(x, was) == was))
             elif isinstance(n, ast.Subscript) and isinstance(n.slice, ast.Slice):
                 yield n, ast.unparse(n.value)
 
@@ -355,9 +372,9 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
         return []
     out: list[Repair] = []
     ids = {k: f"{node}.g{k}.property_tests.e{index}" for k in range(1, len(target.node.node.guarantees) + 1)}
-    numbers = contract_numbers(target.node)
-    around = [e for k in around_lines(source, int(at)) for e in candidate_edits(source, file, k, numbers)]
-    tried = [(e, True) for e in candidate_edits(source, file, int(at), numbers)[:MAX_TRIED]]
+    numbers, kinds = contract_numbers(target.node), contract_kinds(target.node)
+    around = [e for k in around_lines(source, int(at)) for e in candidate_edits(source, file, k, numbers, kinds)]
+    tried = [(e, True) for e in candidate_edits(source, file, int(at), numbers, kinds)[:MAX_TRIED]]
     for edit, at_line in [*tried, *((e, False) for e in around[:MAX_AROUND])]:
         if not at_line and out:
             break  # the culprit line's own repairs first; the lines around only when it has none
@@ -386,4 +403,4 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
 
 
 __all__ = ["MAX_AROUND", "MAX_REPAIRS", "MAX_TRIED", "around_lines", "candidate_edits", "checked_repairs",
-           "repaired_line"]
+           "contract_kinds", "repaired_line"]
