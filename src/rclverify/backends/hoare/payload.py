@@ -13,14 +13,12 @@ JSON (``omit_defaults``); a key no field declares is refused.
 """
 from __future__ import annotations
 
-import msgspec
-
 from rclverify.backends.shapes import HoareTriple
+from rclverify.backends.payload_base import EvidencePayload
 from rclverify.backends.timing_scope import TimingNote
 
 
-class HoarePayload(msgspec.Struct, frozen=True, forbid_unknown_fields=True, omit_defaults=True, tag="hoare",
-                   tag_field="backend"):
+class HoarePayload(EvidencePayload, frozen=True, tag="hoare"):
     """A Hoare triple's evidence payload (module docstring)."""
 
     outline: str = ""  #: the proof outline, cut at 8,000 characters
@@ -32,13 +30,6 @@ class HoarePayload(msgspec.Struct, frozen=True, forbid_unknown_fields=True, omit
     reason: str = ""  #: why the obligation is pending
     uncovered: list[str] = []  #: the parts of a pending conjunct the triple does not cover
     timing: TimingNote | None = None  #: the timing part of the guarantee this evidence does not check
-
-    def details(self) -> dict[str, object]:
-        """The payload as an evidence record's ``details``: its fields not at their default, without the
-        ``backend`` tag (the record names its backend itself)."""
-        out: dict[str, object] = msgspec.to_builtins(self)
-        del out["backend"]
-        return out
 
 
 __all__ = ["HoarePayload"]

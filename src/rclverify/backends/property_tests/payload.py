@@ -15,14 +15,12 @@ a key no field declares is refused.
 """
 from __future__ import annotations
 
-import msgspec
-
 from rclverify.backends.shapes import DeclarationRow, InputCoverage
+from rclverify.backends.payload_base import EvidencePayload
 from rclverify.backends.timing_scope import TimingNote
 
 
-class PropertyTestsPayload(msgspec.Struct, frozen=True, forbid_unknown_fields=True, omit_defaults=True,
-                           tag="property_tests", tag_field="backend"):
+class PropertyTestsPayload(EvidencePayload, frozen=True, tag="property_tests"):
     """A property test's evidence payload (module docstring)."""
 
     examples: dict[str, int] = {}  #: examples by outcome: run, valid, rejected, failures, inconclusive
@@ -42,13 +40,6 @@ class PropertyTestsPayload(msgspec.Struct, frozen=True, forbid_unknown_fields=Tr
     timeout_s: float | None = None  #: the run's time limit, seconds, when it was cut by it
     seeding: str = ""  #: why Z3's search for the first example under the facts was cut
     timing: TimingNote | None = None  #: the timing part of the guarantee this evidence does not check
-
-    def details(self) -> dict[str, object]:
-        """The payload as an evidence record's ``details``: its fields not at their default, without the
-        ``backend`` tag (the record names its backend itself)."""
-        out: dict[str, object] = msgspec.to_builtins(self)
-        del out["backend"]
-        return out
 
 
 __all__ = ["PropertyTestsPayload"]
