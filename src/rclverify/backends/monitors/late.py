@@ -283,16 +283,18 @@ class Late(EngineState):
         elif got.kind == "inconclusive":
             self._verdict("inconclusive", out_ev, guarantee=got.guarantee,
                           reason=got.reason + why + self._withdrawn(out_ev), question=qe.where)
-        elif got.kind == "satisfied" and self._given_to(out_ev) not in (None, "satisfied"):
+        elif got.kind == "satisfied" and (given := self._given_to(out_ev)) is not None and given[1] != "satisfied":
             self._verdict("satisfied", out_ev, semantics=got.semantics, question=qe.where,
                           reason=f"the output at {out_ev.where} answers the question at {qe.where}" + why
                           + self._withdrawn(out_ev))
 
-    def _given_to(self, out_ev: Event) -> str | None:
-        """The verdict last given to ``out_ev`` that a revision may withdraw (``None``: none held)."""
-        for idx, kind, _ in reversed(self._given):
-            if idx == out_ev.index:
-                return kind if kind in _REVISABLE else None
+    def _given_to(self, out_ev: Event) -> tuple[int, str, str] | None:
+        """Where in ``_given`` the verdict last given to ``out_ev`` is, its kind and semantics, when a
+        revision may withdraw it (``None``: none held)."""
+        given = self._given
+        for i in range(len(given) - 1, -1, -1):
+            if given[i][0] == out_ev.index:
+                return (i, given[i][1], given[i][2]) if given[i][1] in _REVISABLE else None
         return None
 
     def _withdrawn(self, out_ev: Event) -> str:
@@ -300,15 +302,11 @@ class Late(EngineState):
         before its replacement is given: its count, its semantics' count and its
         violation record go.  Returns the words the replacement's reason ends with
         (``""`` when no verdict is held to withdraw)."""
-        kind = self._given_to(out_ev)
-        if kind is None:
+        got = self._given_to(out_ev)
+        if got is None:
             return ""
-        given = self._given
-        for i in range(len(given) - 1, -1, -1):
-            if given[i][0] == out_ev.index:
-                sem = given[i][2]
-                del given[i]
-                break
+        i, kind, sem = got
+        del self._given[i]
         res = self.result
         res.counts[kind] -= 1
         if kind == "satisfied" and sem in res.semantics:
