@@ -128,15 +128,12 @@ def hoare_token_repairs(ws: Any, node: str, guarantee: int, program: str,
             continue
         old = source.splitlines()[edit.line - 1].strip()
         new = edit.apply(source).splitlines()[edit.line - 1].strip()
+        checks, counted = recheck.triple_checks(after)
         out.append(_record(
             "program",
             f"At {program}:{edit.line}, change `{old}` to `{new}`: a one-token correction of the program; Z3 "
-            f"then discharges every triple of it ({len(after)} in all, "
-            f"{sum(1 for s in after.values() if s == 'pending')} still pending for what the program does not "
-            "model).",
-            edit, source, [{"check": k, "status": v + (" (Z3: proved)" if v == "discharged" else "")}
-                           for k, v in sorted(after.items())],
-            recheck.changes(before, after),
+            f"then discharges every triple of it ({counted}).",
+            edit, source, checks, recheck.changes(before, after),
             proves=f"every triple of {program} holds of the edited program (Z3 proved its verification conditions)",
             not_shown=f"that the edit is right for the robot, nor that {program} still models the node's code"))
         if len(out) >= MAX_KEPT:

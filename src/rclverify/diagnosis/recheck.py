@@ -215,6 +215,15 @@ def hoare_statuses(ws: Any, node: str, index: int, program: str, new_text: str) 
         shutil.rmtree(tmp, ignore_errors=True)
 
 
+def triple_checks(after: Mapping[str, str]) -> tuple[list[dict[str, str]], str]:
+    """A Hoare program's triples judged again (:func:`hoare_statuses`): each as a repair's check (a
+    discharged one marked "Z3: proved"), and the words saying how many there are and how many stay
+    pending (``"3 in all, 1 still pending for what the program does not model"``)."""
+    checks = [{"check": k, "status": v + (" (Z3: proved)" if v == "discharged" else "")} for k, v in sorted(after.items())]
+    pending = sum(1 for s in after.values() if s == "pending")
+    return checks, f"{len(after)} in all, {pending} still pending for what the program does not model"
+
+
 def changes(before: Mapping[str, str], after: Mapping[str, str]) -> list[dict[str, str]]:
     """What changes status: ``[{"check", "before", "after"}]`` for every key
     of either mapping whose status differs (a check that disappears is
