@@ -176,12 +176,12 @@ def _domain() -> tuple[int, int]:
 
 def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2: Path,
             kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src", source: str = "dds",
-            sim_clock: bool = False, actions: bool = False) -> dict[str, Any]:
+            sim_clock: bool = False, actions: bool = False, driver_offset_s: float = 0.0) -> dict[str, Any]:
     """Run generated robot ``seed`` live and offline under ``tmp`` with rclverify's sources ``src``,
     the monitor hearing the robot through ``source`` (:data:`SOURCES`), the robot on a ``/clock`` of its
     own with ``sim_clock``, with Fibonacci action servers with ``actions``; returns the counts and findings (``other_clocks``: the live record's writers
     placed at their source times)."""
-    spec = generate(seed, nodes, defect, kinds, sim_clock, actions)
+    spec = generate(seed, nodes, defect, kinds, sim_clock, actions, driver_offset_s)
     ws = write_workspace(spec, tmp / "ws")
     (ws / "runs").mkdir(exist_ok=True)
     (tmp / "cyclonedds.xml").write_text(CONFIG)
@@ -327,7 +327,8 @@ def _line(res: dict[str, Any]) -> str:
 
 def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: bool, burn: bool,
              keep: Path | None, kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src",
-             source: str = "dds", sim_clock: bool = False, actions: bool = False) -> int:
+             source: str = "dds", sim_clock: bool = False, actions: bool = False,
+             driver_offset_s: float = 0.0) -> int:
     """Run every seed (a node count drawn per seed in ``sizes``) through ``source``, on a ``/clock`` with
     ``sim_clock``; print one line per seed and the totals.  Returns 0 (the figures are the output; a
     finding is printed, not raised)."""
@@ -347,7 +348,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             with tempfile.TemporaryDirectory() as d:
                 try:
                     res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src, source, sim_clock,
-                                  actions)
+                                  actions, driver_offset_s)
                 except (RobotFailed, MonitorFailed) as exc:
                     what = "GENERATOR FAULT" if isinstance(exc, RobotFailed) else "MONITOR DID NOT START"
                     print(f"seed {seed}: {what}: {exc}", flush=True)

@@ -163,14 +163,16 @@ def _sensor(rng: random.Random, i: int, kinds: tuple[str, ...], kind: str | None
 
 def generate(seed: int, nodes: int = 5, defect: bool = False,
              kinds: tuple[str, ...] = tuple(SENSORS), sim_clock: bool = False,
-             actions: bool = False) -> dict[str, Any]:
+             actions: bool = False, driver_offset_s: float = 0.0) -> dict[str, Any]:
     """The spec of generated robot ``seed``: ``{"seed", "defect", "clock", "nodes": [node spec, ...]}``,
     ``nodes`` contract nodes (at least 2: a sensor and one consumer); with ``defect``, exactly one node's
     spec holds ``"defect": True``; ``kinds``: the sensor kinds drawn from (keys of :data:`SENSORS`);
     ``sim_clock``: ``"clock"`` is ``{"rate", "start_s"}`` (a ``/clock`` node, :data:`CLOCK_RATES`),
     else ``None``; ``actions``: each SetBool server becomes, one time in two, a Fibonacci action server
-    (its client sending :data:`FIB_ORDERS` goals one at a time).  The other nodes drawn depend on neither
-    option.  Deterministic in (seed, nodes, defect, kinds, sim_clock, actions)."""
+    (its client sending :data:`FIB_ORDERS` goals one at a time); ``driver_offset_s``: every sensor's
+    header stamps run that many seconds off its clock (a driver's clock, negative: behind), its
+    ``"driver_offset_s"``.  The other nodes drawn depend on no option.  Deterministic in (seed, nodes,
+    defect, kinds, sim_clock, actions, driver_offset_s)."""
     rng = random.Random(f"robot-{seed}-{nodes}" + ("" if kinds == tuple(SENSORS) else "-" + ",".join(kinds)))
     out: list[dict[str, Any]] = []
     sensors: list[dict[str, Any]] = []
@@ -254,7 +256,7 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
     if sim_clock:
         crng = random.Random(f"clock-{seed}-{nodes}")
         clock = {"rate": crng.choice(CLOCK_RATES), "start_s": float(crng.choice([0, 100, 5000]))}
-    spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out}
+    spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out, "driver_offset_s": driver_offset_s}
     if defect:
         candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None]
         # a node whose defect shows on the values the run carries: an alarm or fuse is wrong only at its threshold
@@ -391,7 +393,8 @@ def render(spec: dict[str, Any]) -> dict[str, str]:
             fields.append((n["rcl_topic"], "range"))
         else:
             fields.append((n["rcl_topic"], "data"))
-    robot_spec = {"nodes": spec["nodes"], "clock": spec.get("clock"), "clock_step_ms": CLOCK_STEP_MS}
+    robot_spec = {"nodes": spec["nodes"], "clock": spec.get("clock"), "clock_step_ms": CLOCK_STEP_MS,
+                  "driver_offset_s": spec.get("driver_offset_s", 0.0)}
     return {
         "contracts/robot.rcl": env.get_template("contracts.rcl.j2").render(
             seed=spec["seed"], defect=spec["defect"], constants=consts, nodes=contracts),
@@ -450,6 +453,8 @@ def main(argv: list[str] | None = None) -> int:
                    help="a /clock node at a real-time factor of 0.5-2 (drawn per seed), every node on use_sim_time")
     p.add_argument("--actions", action="store_true",
                    help="a Fibonacci action server in place of a SetBool server, one time in two")
+    p.add_argument("--driver-offset", type=float, default=0.0, metavar="S",
+                   help="every sensor stamps its headers S seconds off its clock (a driver's clock; negative: behind)")
     p.add_argument("--burn", action="store_true", help="one CPU-burning process beside each run (both cores busy)")
     p.add_argument("--write", metavar="DIR", help="write the workspaces under DIR/seed-N and stop (no live run)")
     p.add_argument("--keep", metavar="DIR", help="keep each run's workspace, log and bag under DIR/seed-N")
@@ -471,7 +476,7 @@ def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(ROOT / "bench"))
     from _robot_run import run_many
     return run_many(seeds, sizes, a.seconds, a.defect, a.burn, Path(a.keep) if a.keep else None, kinds,
-                    Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock, a.actions)
+                    Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock, a.actions, a.driver_offset)
 
 
 def _smoke() -> int:
