@@ -229,8 +229,12 @@ def act_requirements(root: str) -> Any:
     """Check the requirements whose inputs changed (:mod:`rclverify.stages.requirements`)."""
     try:
         rows = stage_requirements(_ws(root))
+        from rclverify.stages.instances import stage_instances  # deferred: start-up; the plan's instances per robot
+        fleet = stage_instances(_ws(root))
     except RclError as exc:
         return _fail(exc)
+    if fleet is not None:
+        print(f"instances: {len(fleet['instances'])}, requirements per namespace: {len(fleet['requirements'])}")
     again = [rec["id"] for rec, now in rows if now]
     print(f"requirements: {len(again)} of {len(rows)} checked" + (f" ({', '.join(again[:10])}"
                                                                   + (", ..." if len(again) > 10 else "") + ")" if again else ""))
