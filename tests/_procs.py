@@ -2,11 +2,13 @@
 master, nodes, a monitor, each in a session of its own)."""
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
 import time
 from pathlib import Path
+from typing import Any, Callable
 
 
 def stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM, grace: float = 10) -> None:
@@ -31,3 +33,19 @@ def wait_for(path: Path, text: str, timeout: float) -> None:
             return
         time.sleep(0.05)
     raise AssertionError(f"{path.name} never said {text!r}: {path.read_text(errors='replace')[-2000:]}")
+
+
+def wait_logged(path: Path, done: Callable[[list[dict[str, Any]]], bool], timeout: float) -> None:
+    """Wait until ``done`` holds of the complete JSON lines of the log ``path``
+    (a live monitor's ``--log``, written as it runs): a condition on what the
+    monitor heard, where a sleep would assume an idle machine.
+    ``AssertionError`` with the log's last 2000 characters after ``timeout``
+    seconds."""
+    deadline = time.monotonic() + timeout
+    text = ""
+    while time.monotonic() < deadline:
+        text = path.read_text(errors="replace") if path.exists() else ""
+        if done([json.loads(x) for x in text[:text.rfind("\n") + 1].splitlines() if x.strip()]):
+            return
+        time.sleep(0.1)
+    raise AssertionError(f"{path.name} never held what was waited for: {text[-2000:]}")
