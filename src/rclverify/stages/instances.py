@@ -9,7 +9,7 @@ instance.  This stage writes what the fleet adds, as one sealed record
 * ``instances``: per instance its node (``Relay_r1``), contract, namespace, ROS node (``/r1/relay``),
   where the plan gives it, each topic, service and action name of the contract with the name it
   resolves to in the namespace (as rcl resolves it, :func:`rclverify.model.names.resolve`), and
-  each input with the node feeding it in the fleet's system model
+  each input with the output feeding it (``source``) in the fleet's system model
   (:func:`rclverify.model.instances.fleet_system`: ``via`` ``"instance"``, ``"topic"``,
   ``"name"`` or ``"plan"``) or ``null`` when it is the environment's;
 * ``requirements``: every requirement whose formal statement names an instanced contract is
@@ -102,7 +102,10 @@ def _decide(req: "Requirement", plan: "Plan", inst_checked: Any, model: Any,
         except RclError as exc:
             out.append({**row, "verdict": "error", "reason": str(exc)})
             continue
-        keep = {k: rec[k] for k in ("formal", "cone", "counterexample", "failed_to_prevent", "reason", "explanation")
+        cone = set(rec.get("cone") or ())
+        unfed = [f"{n}.in.{v}" for n, v, _t in model.env_inputs if n in cone]
+        keep = {"unfed": unfed} if unfed and rec["verdict"] != "proved" else {}
+        keep |= {k: rec[k] for k in ("formal", "cone", "counterexample", "failed_to_prevent", "reason", "explanation")
                 if rec.get(k) is not None}
         out.append({**row, "verdict": rec["verdict"], **keep})
     return out
@@ -124,7 +127,7 @@ def _instance_rows(plan: "Plan", checked: Any, inst_checked: Any, model: Any) ->
             inputs = []
             for var in icn.inputs:
                 l = feeds.get((i.name, var))
-                inputs.append({"var": var, "from": None if l is None else f"{l.from_node}.out.{l.from_var}",
+                inputs.append({"var": var, "source": None if l is None else f"{l.from_node}.out.{l.from_var}",
                                "via": None if l is None else l.via})
             rows.append({"node": i.name, "contract": contract, "namespace": i.namespace, "ros_node": i.fqn,
                          "source": f"{i.loc.file}:{i.loc.line}:{i.loc.col}", "names": names, "inputs": inputs})
@@ -175,9 +178,11 @@ def read_instances(ws: "Workspace") -> dict[str, Any] | None:
 
 
 def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> dict[str, Any] | None:
-    """The report's ``instances`` (:func:`read_instances`), each instance given the obligations of its
+    """The report's ``instances`` (:func:`read_instances`) as the JSON object of
+    :class:`~rclverify.records.instance_rows.InstancesRow`, each instance given the obligations of its
     contract with their current status (``obligations``: the report's rows, ``id``, ``node``,
-    ``status``): one obligation, every instance; ``None`` for a plan without instances."""
+    ``status``): one obligation, every instance; ``None`` for a plan without instances.  Raises
+    :class:`msgspec.ValidationError` for a record of another shape (a bug: the stage seals what it writes)."""
     rec = read_instances(ws)
     if rec is None:
         return None
@@ -185,7 +190,46 @@ def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> 
     for o in obligations:
         by_node.setdefault(str(o["node"]), []).append({"id": str(o["id"]), "status": str(o["status"])})
     rec["instances"] = [{**i, "obligations": by_node.get(i["contract"], [])} for i in rec["instances"]]
-    return rec
+    from rclverify.records.instance_rows import InstancesRow  # deferred: only a plan with instances
+    return InstancesRow.of(rec).to_json()
 
 
-__all__ = ["DIR", "INDEX", "instances_row", "read_instances", "stage_instances"]
+def instance_problems(row: Mapping[str, Any] | None) -> list[str]:
+    """The report's problem sentences of ``row`` (:func:`instances_row`): a stale or altered record,
+    each requirement not proved in a namespace, with where its statement is written."""
+    if row is None:
+        return []
+    out = [f"instances: {row[k]}" for k in ("altered", "stale") if row.get(k)]
+    for q in row["requirements"]:
+        if q["verdict"] != "proved":
+            why = q.get("reason") or "; ".join(
+                ([f"not prevented by {', '.join(str(f.get('label', '')) for f in q['failed_to_prevent'])}"]
+                 if q.get("failed_to_prevent") else [])
+                + ([f"fed by no node: {', '.join(q['unfed'])}"] if q.get("unfed") else []))
+            out.append(f"requirement {q['id']} is {q['verdict']} for the instances in {q['namespace']}"
+                       + (f" ({', '.join(f'{c} as {i}' for c, i in q['nodes'].items())})" if q["nodes"] else "")
+                       + (f": {why}" if why else ""))
+    return out
+
+
+#: A per-namespace verdict as an evidence status (records/statuses.py), for the report's overall status.
+_STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive", "error": "error"}
+
+
+def instance_statuses(row: Mapping[str, Any] | None) -> list[str]:
+    """The evidence statuses ``row`` adds to the report's overall status: each per-namespace verdict's
+    (:data:`_STATUS`), ``stale`` or ``error`` for a stale or altered record."""
+    if row is None:
+        return []
+    return ((["error"] if row.get("altered") else []) + (["stale"] if row.get("stale") else [])
+            + [_STATUS.get(q["verdict"], "error") for q in row["requirements"]])
+
+
+def blocks_strict(row: Mapping[str, Any] | None) -> bool:
+    """Whether ``row`` fails ``--strict``: a requirement not proved in some namespace, or a record
+    stale or altered."""
+    return bool(instance_problems(row))
+
+
+__all__ = ["DIR", "INDEX", "blocks_strict", "instance_problems", "instance_statuses", "instances_row", "read_instances",
+           "stage_instances"]
