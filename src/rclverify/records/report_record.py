@@ -20,6 +20,7 @@ from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssump
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow
 from rclverify.records.grounding_rows import GroundingRow
+from rclverify.records.instance_rows import InstancesRow
 from rclverify.records.lint_rows import AcknowledgementRow, LintRow
 from rclverify.records.margin_rows import MarginRow, NearMissRow
 from rclverify.records.node_rows import NodeRow, UnverifiedRow
@@ -54,6 +55,7 @@ class AssuranceReport(Row, frozen=True, forbid_unknown_fields=True):
     expected_verdicts: Annotated[list[ExpectedVerdictRow], DOC(description="Verdicts the plan expects.")]
     grounding: Annotated[GroundingRow | None, DOC(description="The grounding in the ROS code, null when the plan names none.")]
     nodl: Annotated[NodlRow | None, DOC(description="The NoDL documents checked against the contracts and each other (docs/nodl.md), null when the workspace has no document in nodl/.")]
+    instances: Annotated[InstancesRow | None, DOC(description="The plan's instances (a contract run under several namespaces) and the requirements naming them decided per namespace (docs/plan.md, \"Instances in the report\"), null for a plan without instances.")]
     unverified: Annotated[list[UnverifiedRow], DOC(description="Guarantees no obligation covers.")]
     deadlines: Annotated[list[DeadlineRow], DOC(description="End-to-end deadlines (rule D3).")]
     acknowledgements: Annotated[list[AcknowledgementRow], DOC(description="The plan's acknowledgements of warnings.")]

@@ -173,6 +173,8 @@ class Report(TypedDict):
     grounding: GroundingJson | None
     #: the NoDL documents' check (stages/nodl.py, report/nodl.py), ``None`` when the workspace has none
     nodl: NodlJson | None
+    #: the plan's instances (stages/instances.py, records/instance_rows.py), ``None`` for a plan without instances
+    instances: dict[str, Any] | None
     unverified: list[UnverifiedJson]
     deadlines: list[DeadlineJson]
     acknowledgements: list[AcknowledgementJson]

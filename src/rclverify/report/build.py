@@ -58,6 +58,7 @@ from rclverify.report.unverified import unverified_guarantees
 from rclverify.report.view import problem_items
 from rclverify.stages.crosscheck.apply import SecondSolver, load as load_second_solver
 from rclverify.stages.diagnoses import read_diagnoses
+from rclverify.stages.instances import blocks_strict as instances_block, instance_problems, instance_statuses, instances_row
 from rclverify.stages.requirements import read_records
 from rclverify.stages.provenance import current_snapshot_hashes, stale_stages
 from rclverify.stages.workspace import Workspace
@@ -131,7 +132,7 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
             "obligations": ev["obligations"], "evidence": ev["evidence"],
             "environment_assumptions": environment_rows(comps, names),
             "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
-            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
+            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "instances": instances_row(ws, ev["obligations"]), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
             "deadlines": deadlines, "acknowledgements": acknowledgements,
             "near_misses": near_miss_rows(ws, ev["obligations"]),
             "margins": margin_rows(ws, ev["obligations"])}, Facts(
@@ -145,10 +146,11 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
     node_status = facts.node_status
     counts = status_counts(rows["obligations"])
     overall = worst([r["status"] for r in rows["requirements"]] + list(node_status.values())
-                    + [d["status"] for d in rows["derived_properties"]])
+                    + [d["status"] for d in rows["derived_properties"]] + instance_statuses(rows["instances"]))
     strict_ok = strict_gate(rows, facts.guarantees_discharged, facts.deadlines_ok, rows["grounding"]) \
-        and not nodl_blocks(rows["nodl"])
-    problems = problem_sentences(rows, facts.altered) + grounding_problems(rows["grounding"]) + nodl_problems(rows["nodl"])
+        and not nodl_blocks(rows["nodl"]) and not instances_block(rows["instances"])
+    problems = problem_sentences(rows, facts.altered) + grounding_problems(rows["grounding"]) + nodl_problems(rows["nodl"]) \
+        + instance_problems(rows["instances"])
     plan = ws.plan
     return {
         "meta": Meta("rclverify", __version__, plan.name or ws.root.resolve().name, plan.file, list(plan.contracts),
