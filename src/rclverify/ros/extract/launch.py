@@ -24,6 +24,11 @@ interpreted here:
   each is a node of class ``plugin`` (the container process itself is not);
 * ``include`` (``file``, ``ns``, ``arg`` children, ``pass_all_args``), found
   relative to the packages of the scanned workspaces; include cycles stop.
+  A ROS 1 include gives the included file only its ``arg`` children (all with
+  ``pass_all_args``); a ROS 2 one (:func:`.launch_tree.ros2_file`) sets them
+  in the including scope and reads the file there, as launch does;
+* ``group`` ``scoped="false"`` / ``forwarding="false"`` with ``keep``
+  children, as launch's ``GroupAction``.
 
 Source: roslaunch XML format (wiki.ros.org/roslaunch/XML), ROS 2 launch
 frontend design (design.ros2.org "ROS 2 Launch XML/YAML format").
@@ -40,7 +45,7 @@ from rclverify.ros.extract import names, param_yaml
 from rclverify.ros.extract.launch_readers import read_xml as read_xml, read_yaml as read_yaml
 from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
 from rclverify.ros.extract.launch_tree import ALIASES, SEP as SEP, UNREAD as UNREAD, El as El
-from rclverify.ros.extract.launch_tree import NOVALUE, QUIET_TAGS, UNREAD_TAGS as _UNREAD_TAGS
+from rclverify.ros.extract.launch_tree import NOVALUE, QUIET_TAGS, UNREAD_TAGS as _UNREAD_TAGS, ros2_file
 from rclverify.ros.extract.launch_tree import Unresolved as Unresolved, evaluate as evaluate
 from rclverify.ros.extract.model import Note, Src
 
@@ -98,9 +103,18 @@ class Interpreter:
         self._stack: list[Path] = []
         self._cut = False
         self._guess: Src | None = None  # set by _cond when it takes an unevaluated condition as holding
+        self.ros2: dict[Path, bool] = {}  # whether a file read is a ROS 2 launch file (its includes share the scope)
 
     def run(self, path: Path, args: dict[str, str] | None = None, ns: str = "/",
-            remaps: list[tuple[str, str, Src]] | None = None, unsure: Src | None = None) -> None:
+            remaps: list[tuple[str, str, Src]] | None = None, unsure: Src | None = None,
+            shared: _Scope | None = None) -> None:
+        """Read launch file ``path`` with launch arguments ``args`` under namespace
+        ``ns`` and ``remaps``; with ``shared`` (a ROS 2 include), in the including
+        scope itself: ROS 2 launch sets an include's arguments as launch
+        configurations of the including context and reads the included file in
+        that context, so what it declares, pushes or remaps stays after it unless
+        a scoped group holds the include (launch's ``IncludeLaunchDescription``,
+        ``GroupAction``)."""
         path = path.resolve() if path.exists() else path
         if path in self._stack or len(self._stack) > MAX_INCLUDE_DEPTH:
             self.notes.append(Note(Src(self.show(path)), "include cycle: file already being read", "ROS-LAUNCH"))
@@ -118,8 +132,10 @@ class Interpreter:
         if root is None:
             return
         self._stack.append(path)
+        self.ros2[path] = ros2_file(path, root)
         try:
-            self._body(root.children, _Scope(ns, dict(args or {}), list(remaps or []), unsure), path)
+            self._body(root.children, shared if shared is not None
+                       else _Scope(ns, dict(args or {}), list(remaps or []), unsure), path)
         finally:
             self._stack.pop()
 
@@ -325,15 +341,7 @@ class Interpreter:
             if val is not None:
                 scope.args[name] = val
         elif t == "group":
-            ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
-            if el.attrs.get("scoped") == "false" and not ns:
-                # an unscoped group (OpaqueFunction's, an event handler's, a timer's actions): what it
-                # pushes (namespace, remaps, arguments) stays for the actions after it, as launch runs it
-                self._body(el.children, scope, path)
-                return
-            inner = _Scope(names.join(scope.ns, ns) if ns else scope.ns, scope.args if el.attrs.get("scoped") == "false"
-                           else dict(scope.args), list(scope.remaps), scope.unsure)
-            self._body(el.children, inner, path)
+            self._group(el, scope, path)
         elif t == "push-ros-namespace":
             ns = self._attr(el, "namespace", scope, path) or self._attr(el, "ns", scope, path) or ""
             scope.ns = names.join(scope.ns, ns)
@@ -374,6 +382,27 @@ class Interpreter:
             self.notes.append(Note(el.src, f"<{el.tag}> is not an element the scan reads: "
                                            f"{_UNREAD_TAGS.get(t, 'the nodes it starts, if any, are unknown')}",
                                    "ROS-LAUNCH"))
+
+    def _group(self, el: El, scope: _Scope, path: Path) -> None:
+        """A ``group`` (ROS 1 ``ns``; launch's ``GroupAction``): scoped unless
+        ``scoped="false"`` (what it sets stays after it: also OpaqueFunction's,
+        an event handler's or a timer's actions); ``forwarding="false"`` starts it
+        from its ``keep`` configurations alone, the namespace and remaps (launch
+        configurations too) cleared; ``keep`` children (``launch_configurations=``)
+        are set in it.  Source: launch's ``GroupAction.get_sub_entities``,
+        ``ResetLaunchConfigurations``."""
+        ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
+        keep = {self._attr(k, "name", scope, path) or "": self._attr(k, "value", scope, path) or ""
+                for k in el.children if k.tag == "keep"}
+        body = [k for k in el.children if k.tag != "keep"]
+        if el.attrs.get("scoped") == "false" and not ns:
+            scope.args.update(keep)
+            self._body(body, scope, path)
+        elif el.attrs.get("forwarding") == "false":
+            self._body(body, _Scope("/", keep, [], scope.unsure), path)
+        else:
+            self._body(body, _Scope(names.join(scope.ns, ns) if ns else scope.ns, {**scope.args, **keep},
+                                    list(scope.remaps), scope.unsure), path)
 
     def _container_note(self, el: El, scope: _Scope, path: Path) -> None:
         """The located ``ROS-CONTAINER`` note of a component container ``el`` starts (a
@@ -426,6 +455,9 @@ class Interpreter:
         if not target.is_file():
             raise Unresolved(f"included file {f} not found")
         ns = self._attr(el, "ns", scope, path)
+        if self.ros2.get(path.resolve() if path.exists() else path) and not ns:
+            self._include_ros2(el, target, scope, path)
+            return
         args: dict[str, str] = dict(scope.args) if el.attrs.get("pass_all_args") == "true" else {}
         for c in el.children:
             if c.tag == "arg" and self._cond(c, scope, path):
@@ -437,3 +469,21 @@ class Interpreter:
                 if n and v is not None:
                     args[n] = v
         self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps, scope.unsure)
+
+    def _include_ros2(self, el: El, target: Path, scope: _Scope, path: Path) -> None:
+        """A ROS 2 include: its arguments set, in order, as launch configurations of
+        ``scope`` (a later one reads an earlier one), then ``target`` read in ``scope``
+        itself: it sees every configuration set before it (a ``DeclareLaunchArgument``
+        default gives way to any), and what it sets stays after it (launch's
+        ``IncludeLaunchDescription.execute``, ``DeclareLaunchArgument.execute``)."""
+        for c in el.children:
+            if c.tag == "arg" and self._cond(c, scope, path):
+                n = self._attr(c, "name", scope, path)
+                if n and c.attrs.get("novalue"):  # a value its reader could not read (said there)
+                    scope.args[n] = NOVALUE
+                    continue
+                v = self._attr(c, "value", scope, path)
+                if n and v is not None:
+                    scope.args[n] = v
+        self.run(target, shared=scope)
+

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import ast
 
-from rclverify.ros.extract.launch_tree import UNREAD, El
+from rclverify.ros.extract.launch_tree import NOVALUE, UNREAD, El
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, callee as _callee, expand as _expand
 from rclverify.ros.extract.launch_py_values import arg as _arg, kw as _kw, value as _value
 from rclverify.ros.extract.model import Note, Src
@@ -116,3 +116,45 @@ def at_shutdown(els: list[El], handler: Src, notes: list[Note]) -> None:
             notes.append(Note(el.src, f"{el.tag} '{what}' is started by OnShutdown ({handler}): launch starts no "
                                       f"process once it is shutting down; not a node of the graph", "ROS-LAUNCH"))
         at_shutdown(el.children, handler, notes)
+
+
+def group_flags(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note]) -> dict[str, str]:
+    """``GroupAction``'s ``scoped=`` and ``forwarding=`` as the group's attributes
+    (a value not a literal bool is said; launch's default, ``True``, is kept)."""
+    for key in ("scoped", "forwarding"):
+        v = _kw(c, key)
+        if v is None:
+            continue
+        v = _expand(v)
+        if isinstance(v, ast.Constant) and isinstance(v.value, bool):
+            if not v.value:
+                attrs[key] = "false"
+        else:
+            notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"GroupAction(...): {key}="
+                              f"'{ast.unparse(v)}' is not a literal bool; read as True", "ROS-LAUNCH"))
+    return attrs
+
+
+def group_keep(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
+    """``GroupAction(launch_configurations={k: v})`` as ``keep`` elements (set in
+    the group; with ``forwarding=False`` the only configurations it starts with);
+    a value that cannot be read is set without a value, said at its line."""
+    lc = _kw(c, "launch_configurations")
+    if lc is None:
+        return []
+    lc = _expand(lc)
+    if not isinstance(lc, ast.Dict):
+        raise _Unres(f"launch_configurations '{ast.unparse(lc)}'")
+    out = []
+    for k, v in zip(lc.keys, lc.values):
+        if k is None:
+            continue
+        n = _value(k)
+        try:
+            out.append(El("keep", {"name": n, "value": _value(v)}, [], Src(shown, v.lineno, v.col_offset + 1)))
+        except _Unres as exc:
+            notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"GroupAction(...): launch configuration "
+                              f"'{n}' {exc} cannot be read statically; the group reads it without a value",
+                              "ROS-LAUNCH"))
+            out.append(El("keep", {"name": n, "value": NOVALUE}, [], Src(shown, v.lineno, v.col_offset + 1)))
+    return out

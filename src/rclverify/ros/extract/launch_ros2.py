@@ -43,7 +43,8 @@ from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg,
 from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
 from rclverify.ros.extract.launch_py_values import value as _value
 from rclverify.ros.extract.launch_py_flow import added as _added, flat as _flat, grown as _grown
-from rclverify.ros.extract.launch_py_actions import HANDLERS, PAIRS, QUIET
+from rclverify.ros.extract.launch_py_actions import HANDLERS, PAIRS, QUIET, group_flags as _group_flags
+from rclverify.ros.extract.launch_py_actions import group_keep as _group_keep
 from rclverify.ros.extract.launch_py_actions import at_shutdown as _shutdown, condition as _cond
 from rclverify.ros.extract.launch_py_actions import optional as _opt, required as _req
 from rclverify.ros.extract.launch_py_node import execute_process, node_kids as _node_kids, ros_args as _ros_args
@@ -133,7 +134,8 @@ def _action(c: ast.Call, shown: str, notes: list[Note]) -> El | None:
         if name == "GroupAction":
             acts = c.args[0] if c.args else _kw(c, "actions")
             _cond(c, attrs, shown, notes)
-            return El("group", attrs, _actions(acts, shown, notes) if acts is not None else [], src)
+            return El("group", _group_flags(c, attrs, shown, notes), _group_keep(c, shown, notes)
+                      + (_actions(acts, shown, notes) if acts is not None else []), src)
         if name == "IncludeLaunchDescription":
             return _include(c, attrs, src, shown, notes)
         return _more(c, name, attrs, src, shown, notes)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import ast
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from rclverify.ros.extract.model import Src
@@ -101,3 +102,25 @@ def evaluate(expr: str) -> str:
         return str(ev(tree))
     except TypeError as exc:  # 'x' in 3
         raise Unresolved(f"$(eval {expr}): {exc}") from None
+
+
+def ros2_file(path: Path, root: El) -> bool:
+    """Whether launch file ``path`` (read as ``root``) is a ROS 2 one: Python or
+    YAML, or XML using ROS 2's forms (``exec``, ``$(var)``, ``let``,
+    ``push-ros-namespace`` ...) and none of roslaunch's own (``type``,
+    ``$(arg)``, ``$(find)``, ``rosparam``).  Source: design.ros2.org "ROS 2
+    Launch XML/YAML format"; wiki.ros.org/roslaunch/XML."""
+    if path.suffix in (".py", ".yaml", ".yml"):
+        return True
+    two = one = False
+    stack = [root]
+    while stack and not (one and two):
+        e = stack.pop()
+        stack.extend(e.children)
+        text = " ".join(e.attrs.values())
+        two = two or "exec" in e.attrs or e.tag in ("let", "push-ros-namespace", "push_ros_namespace",
+                                                    "lifecycle_node", "set_remap", "node_container") \
+            or "$(var " in text or "$(find-pkg-share " in text
+        one = one or (e.tag == "node" and "type" in e.attrs) or e.tag == "rosparam" or "$(arg " in text \
+            or "$(find " in text
+    return two and not one
