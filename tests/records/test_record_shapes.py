@@ -28,6 +28,9 @@ from __future__ import annotations
 
 import ast as pyast
 import copy
+import inspect
+import subprocess
+import sys
 import typing
 from pathlib import Path
 from typing import Any, Iterable, Mapping, NamedTuple
@@ -733,3 +736,46 @@ def test_each_code_renderer_shows_each_field_of_a_finding_it_reads(renderer: str
     assert [k for k, t in shown.items() if k in internal and len(t) > 4 and t in text] == []
     if renderer == "sarif":
         assert _shown_by_code(renderer, {**row, "status": "ok"}) == "[]"
+
+
+#: The report's template filters written in Python that read a record's fields, each typed on the decoded
+#: record (its module under report/ -> the record class), so that mypy, not a rendered page, finds a read
+#: of a field the record no longer declares.
+TYPED_FILTERS: dict[str, type[msgspec.Struct]] = {"badges": RequirementRow}
+
+
+def _without_field(source: str, cls_name: str, field: str) -> str:
+    """``source`` (a record module) with ``field`` of class ``cls_name`` removed (its declaration's lines)."""
+    cls = next(n for n in pyast.walk(pyast.parse(source)) if isinstance(n, pyast.ClassDef) and n.name == cls_name)
+    decl = next(n for n in cls.body if isinstance(n, pyast.AnnAssign) and isinstance(n.target, pyast.Name)
+                and n.target.id == field)
+    lines = source.splitlines(keepends=True)
+    return "".join(lines[:decl.lineno - 1] + lines[decl.end_lineno or decl.lineno:])
+
+
+def _mypy(args: list[str], cache: Path) -> tuple[int, str]:
+    """mypy strict (the project's configuration, pyproject.toml) on ``args``, errors in the modules they
+    import left out; ``(exit status, output)``."""
+    root = PARTS.parents[3].parent
+    done = subprocess.run([sys.executable, "-m", "mypy", "--cache-dir", str(cache), "--follow-imports", "silent",
+                           "--no-error-summary", *args], cwd=root, capture_output=True, text=True, timeout=600)
+    return done.returncode, done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("module", sorted(TYPED_FILTERS))
+def test_a_typed_filter_reading_a_removed_field_fails_mypy(module: str, tmp_path: Path) -> None:
+    """Each field a typed filter reads off its record, removed from the record's class (mypy's
+    ``--shadow-file``, the checked-in file untouched), makes mypy strict fail at the filter's read; the
+    control, the record as it is, passes."""
+    cls = TYPED_FILTERS[module]
+    filt = PARTS.parents[1] / f"{module}.py"
+    read = sorted(fields_read_code(filt.read_text(encoding="utf-8"), cls) & set(cls.__struct_fields__))
+    assert read, f"{filt.name} reads no field of {cls.__name__}"
+    record = Path(inspect.getfile(sys.modules[cls.__module__]))
+    rc, out = _mypy([str(filt)], tmp_path / "cache")
+    assert rc == 0, out
+    for field in read:
+        shadow = tmp_path / f"without_{field}.py"
+        shadow.write_text(_without_field(record.read_text(encoding="utf-8"), cls.__name__, field), encoding="utf-8")
+        rc, out = _mypy(["--shadow-file", str(record), str(shadow), str(filt)], tmp_path / "cache")
+        assert rc == 1 and f'{filt.name}:' in out and f'"{cls.__name__}" has no attribute "{field}"' in out, out

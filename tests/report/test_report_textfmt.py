@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import re
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.render import environment
 from rclverify.report.svgfit import readable_svg, smallest_font
 from rclverify.report.textfmt import natural_key, natural_sorted, natural_within, prose
@@ -48,24 +50,37 @@ def test_a_drawing_gets_the_size_at_which_its_smallest_text_is_readable() -> Non
     assert str(readable_svg("<svg><g/></svg>")) == "<svg><g/></svg>"  # no text: unchanged
 
 
-def _badges(req: dict) -> list[tuple[str, str]]:
+def _req(status: str, verdict: str, note: str = "") -> RequirementRow:
+    return RequirementRow(id="R1", text="r", verdict=verdict, status=status, note=note,
+                          support=[], check={})
+
+
+def _badges(req: RequirementRow) -> list[tuple[str, str]]:
     html = environment().from_string("{{ req|reqbadges }}").render(req=req)
     return re.findall(r'<span class="badge st-([a-z]+)"[^>]*>([^<]*)</span>', html)
 
 
 def test_a_requirement_shows_its_proof_and_its_evidence_apart() -> None:
-    assert _badges({"status": "failed", "verdict": "proved, evidence outstanding"}) == [
+    assert _badges(_req("failed", "proved, evidence outstanding")) == [
         ("discharged", "proved"), ("failed", "evidence: failed")]
-    assert _badges({"status": "discharged", "verdict": "met"}) == [
+    assert _badges(_req("discharged", "met")) == [
         ("discharged", "proved"), ("discharged", "evidence: discharged")]
-    assert _badges({"status": "failed", "verdict": "proved vacuously", "note": "its premise <never> holds"}) == [
+    assert _badges(_req("failed", "proved vacuously", "its premise <never> holds")) == [
         ("warning", "proved vacuously")]
-    assert _badges({"status": "failed", "verdict": "refuted"}) == [("failed", "refuted")]
-    assert _badges({"status": "pending", "verdict": "informal"}) == [("pending", "informal")]
-    assert _badges({"status": "pending"}) == [("pending", "pending")]  # no verdict: the status
+    assert _badges(_req("failed", "refuted")) == [("failed", "refuted")]
+    assert _badges(_req("pending", "informal")) == [("pending", "informal")]
     html = environment().from_string("{{ req|reqbadges }}").render(
-        req={"status": "failed", "verdict": "proved vacuously", "note": "its premise <never> holds"})
+        req=_req("failed", "proved vacuously", "its premise <never> holds"))
     assert 'title="status: failed; its premise &lt;never&gt; holds"' in html
+
+
+def test_the_badges_read_a_decoded_row_only() -> None:
+    """The filter is typed on the row: a requirement's JSON object is refused in one sentence (the view
+    decodes what it hands the templates); the control, the same requirement decoded, renders."""
+    with pytest.raises(TypeError, match="reads a RequirementRow, not a dict"):
+        environment().from_string("{{ req|reqbadges }}").render(req=_req("failed", "refuted").to_json())
+    assert "refuted" in environment().from_string("{{ req|reqbadges }}").render(
+        req=RequirementRow.of(_req("failed", "refuted").to_json()))
 
 
 _ITEMS = st.lists(st.one_of(st.text(alphabet="ab <=>&|`*_\n(x)", max_size=160), st.integers()), max_size=5)

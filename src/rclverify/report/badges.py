@@ -10,7 +10,7 @@ status, ``evidence: <status>`` as a second.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Mapping
 
 import jinja2
 from markupsafe import Markup, escape
@@ -41,24 +41,20 @@ def _badge(text: str, style: str, title: str = "") -> Markup:
 
 
 @jinja2.pass_environment
-def requirement_badges(env: jinja2.Environment, req: Mapping[str, Any] | RequirementRow) -> Markup:
-    """The badges of a requirement of the report dict (``{"status",
-    "verdict"?, "note"?}``): without a verdict, its status badge; else the
-    proof badge (:data:`VERDICT_STYLE`) and, when the proof holds and the
-    status is the evidence's, ``evidence: <status>``.  The status word is
-    the badges' ``title`` and the note the proof badge's; text escaped.  A
-    decoded :class:`~rclverify.records.requirement_rows.RequirementRow` is
-    read as its JSON object."""
-    if isinstance(req, RequirementRow):
-        req = req.to_json()
-    status = str(req["status"])
-    verdict = req.get("verdict")
-    if verdict is None:
-        return Markup(env.filters["badge"](status))
-    word, style = VERDICT_STYLE.get(str(verdict), (str(verdict), env.filters["style"](status)))
-    note = str(req.get("note") or "")
+def requirement_badges(env: jinja2.Environment, req: RequirementRow) -> Markup:
+    """The badges of a requirement's row (its ``status``, ``verdict`` and
+    ``note``, read as the attributes mypy checks): the proof badge
+    (:data:`VERDICT_STYLE`) and, when the proof holds and the status is the
+    evidence's, ``evidence: <status>``.  The status word is the badges'
+    ``title`` and the note the proof badge's; text escaped.  Raises
+    ``TypeError`` for anything but a decoded row (the view decodes the
+    requirements it hands the templates, report/view.py)."""
+    if not isinstance(req, RequirementRow):
+        raise TypeError(f"reqbadges reads a RequirementRow, not a {type(req).__name__}")
+    status, verdict, note = req.status, req.verdict, req.note
+    word, style = VERDICT_STYLE.get(verdict, (verdict, env.filters["style"](status)))
     out = _badge(escape(word), style, f"status: {status}" + (f"; {note}" if note else ""))
-    if str(verdict) in _EVIDENCE_DECIDES:
+    if verdict in _EVIDENCE_DECIDES:
         out += Markup(" ") + _badge(Markup("evidence: %s") % status, env.filters["style"](status),
                                     f"status: {status}")
     return out

@@ -12,8 +12,9 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 # annotations (with string annotations every key would count as required).
 from typing import Any, NotRequired, TypedDict
 
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.report_schema import (DerivedPropertyJson, DiagnosisJson, EvidenceJson, FindingJson, NodeJson,
-                                             LimitedByJson, ObligationJson, PendingJson, ProblemJson, RequirementJson, SideConditionJson,
+                                             LimitedByJson, ObligationJson, PendingJson, ProblemJson, SideConditionJson,
                                              SummaryJson, SupportJson)
 
 
@@ -150,7 +151,7 @@ class TraceSupport(TypedDict):
 
 class TraceEntry(TypedDict):
     """A requirement's traceability rows; ``rowspan`` the rows it spans."""
-    req: RequirementJson
+    req: RequirementRow
     rows: list[TraceSupport]
     rowspan: int
 
@@ -197,7 +198,7 @@ class ReportView(TableRuns):
     outstanding: list[AttentionItem]
     outstanding_groups: list[AttentionGroup]
     pending_groups: list[PendingGroup]
-    unmet_requirements: list[RequirementJson]
+    unmet_requirements: list[RequirementRow]
     ev_anchor: list[str]
     evidence_of: dict[str, list[tuple[str, EvidenceJson]]]
     obligation: dict[str, ObligationJson]

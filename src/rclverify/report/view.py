@@ -14,6 +14,8 @@ from collections import defaultdict
 from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
 
 from rclverify.records.findings import rows_of
+from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.row import decode_rows
 from rclverify.records.report_schema import (DerivedPropertyJson, EvidenceJson, FindingJson, ObligationJson, ProblemJson,
                                              Report, SideConditionJson)
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
@@ -268,7 +270,7 @@ def _trace(report: Report, obligation: Mapping[str, ObligationJson],
                     "evidence": evidence_of.get(str(oid), []),
                 })
             rows.append({"support": sup, "obligations": obs})
-        trace.append({"req": req, "rows": rows, "rowspan": max(1, len(rows))})
+        trace.append({"req": RequirementRow.of(req), "rows": rows, "rowspan": max(1, len(rows))})
     return trace
 
 
@@ -357,7 +359,7 @@ def view(report: Report) -> ReportView:
         "diagnosis": {str(d["id"]): d for d in report.get("diagnoses") or []},
         "counts": counts, "problems": problems, "outstanding": outstanding,
         "outstanding_groups": group_items(outstanding), "pending_groups": _pending_groups(report),
-        "unmet_requirements": [r for r in report["requirements"] if rank(r["status"]) > 0],
+        "unmet_requirements": [q for q in decode_rows(RequirementRow, report["requirements"]) if rank(q.status) > 0],
         "ev_anchor": ev_anchor, "evidence_of": evidence_of, "obligation": obligation,
         "trace": _trace(report, obligation, evidence_of), "sections": _sections(report, obligation),
         "lint_errors": sum(1 for x in report["lint"] if str(x["severity"]).lower() == "error"),
