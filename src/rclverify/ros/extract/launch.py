@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from rclverify.ros.extract import names, param_yaml
+from rclverify.ros.extract import launch_subst, names, param_yaml
 from rclverify.ros.extract.launch_readers import read_xml as read_xml, read_yaml as read_yaml
 from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
 from rclverify.ros.extract.launch_tree import ALIASES, SEP as SEP, UNREAD as UNREAD, El as El
@@ -234,6 +234,9 @@ class Interpreter:
                 return rest[0]
             if kind == "eval" and rest:
                 return evaluate(m.group(1)[len("eval"):].strip())
+            got = launch_subst.perform(kind, rest, path)
+            if got is not None:
+                return got
             raise Unresolved(f"$({m.group(1)}) cannot be resolved statically")
         out = text
         for _ in range(10):

@@ -23,7 +23,8 @@ executed): the evaluator :mod:`launch_ros2` reads actions with.
   ``ThisLaunchFileDir()``, ``PythonExpression([...])`` (``$(eval ...)``),
   ``EqualsSubstitution`` / ``NotEqualsSubstitution``,
   ``get_package_share_directory`` / ``FindPackageShare``, ``os.path.join``,
-  ``PathJoinSubstitution``; ``x.perform(context)`` is ``x``.
+  ``PathJoinSubstitution``; ``x.perform(context)`` is ``x``; other
+  packages' substitution classes as :mod:`launch_subst` reads them.
 
 What cannot be read raises :class:`Unres` naming what it is.
 
@@ -36,6 +37,7 @@ from __future__ import annotations
 import ast
 import copy
 
+from rclverify.ros.extract.launch_subst import call_value as other_package
 from rclverify.ros.extract.launch_tree import Unresolved, evaluate
 
 
@@ -252,6 +254,9 @@ def _call_value(e: ast.Call, depth: int) -> str:
         if "'" in a + b or "\\" in a + b:
             raise Unres(f"'{ast.unparse(e)}' (a quote in a compared value)")
         return f"$(eval '{a}' {'==' if name == 'EqualsSubstitution' else '!='} '{b}')"
+    got = other_package(e, name, lambda x: value(x, depth + 1), Unres)
+    if got is not None:
+        return got
     args = [value(a, depth + 1) for a in e.args]
     if name in ("get_package_share_directory", "FindPackageShare") and len(args) == 1:
         return f"$(find-pkg-share {args[0]})"
