@@ -41,6 +41,7 @@ import pytest
 from jinja2 import nodes
 
 from _report_schema import SCHEMA
+from _typed_rows import typed_report
 from rclverify.records import report_schema, schema_gen, statuses
 from rclverify.records import evidence_rows, obligations, requirement_rows, standards_rows, statistics_rows
 from rclverify.records import deadline_rows, lint_rows, margin_rows, node_rows, problem_rows, verdict_rows
@@ -48,6 +49,7 @@ from rclverify.records import derived_rows, findings, side_condition_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import INTERNAL, FindingRow, HealthFinding
 from rclverify.records.obligations import ObligationRow
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.standards_rows import StandardRow
 from rclverify.records.statistics_rows import RequirementRuns, StatisticsRow
@@ -141,18 +143,22 @@ def fields_read_code(source: str, record: type[msgspec.Struct]) -> set[str]:
     """The attributes the Python module ``source`` reads on a name bound to a decoded row of ``record``,
     found in Python's parse tree, function by function: a parameter or a variable annotated with the
     class, the target of a ``for`` (or a comprehension) over the record module's ``rows_of`` (under any
-    alias it is imported as), a name assigned ``<Class>.of(...)``.  A name is one name per function: a
+    alias it is imported as) or over the decoded report's part of that record (``report.findings``), a name assigned ``<Class>.of(...)``.  A name is one name per function: a
     function that also binds it to something else reads that too (and a read of no field then shows)."""
     tree = pyast.parse(source)
     name = record.__name__
     decoders = {a.asname or a.name for n in pyast.walk(tree) if isinstance(n, pyast.ImportFrom)
                 and n.module == record.__module__ for a in n.names if a.name == "rows_of"}
+    # the decoded report's parts of this record (AssuranceReport.findings: list[FindingRow], ...)
+    parts = {k for k, t in typing.get_type_hints(AssuranceReport).items() if t == list[record]}
 
     def typed(ann: pyast.expr | None) -> bool:
         return ann is not None and any(isinstance(x, pyast.Name) and x.id == name or isinstance(x, pyast.Constant)
                                        and isinstance(x.value, str) and name in x.value for x in pyast.walk(ann))
 
     def decoded(x: pyast.expr) -> bool:
+        if isinstance(x, pyast.Attribute) and x.attr in parts:  # a loop over the decoded report's part
+            return True
         f = x.func if isinstance(x, pyast.Call) else None
         return isinstance(f, pyast.Name) and f.id in decoders or (
             isinstance(f, pyast.Attribute) and f.attr == "of" and isinstance(f.value, pyast.Name) and f.value.id == name)
@@ -714,7 +720,7 @@ def _shown_by_code(renderer: str, row: Mapping[str, Any]) -> str:
                    "requirements": [], "findings": [row], "side_conditions": [], "obligations": [], "evidence": [],
                    "pending": []}
     if renderer == "sarif":
-        return str(sarif._finding_results(report))
+        return str(sarif._finding_results(typed_report(report)))
     if renderer == "junit":
         suite = junit._suite(report["nodes"][0], {"items": {"findings": [row]}, "evidence": {}, "reasons": {}})[0]
         return ET.tostring(suite, encoding="unicode")

@@ -12,6 +12,8 @@ import jsonschema
 import junitparser
 from sarif import loader
 
+from _typed_rows import complete
+from rclverify.records.report_record import AssuranceReport
 from rclverify.report.ci import write_ci_reports
 from rclverify.report.junit import render_junit
 from rclverify.records.sarif import split_location
@@ -23,6 +25,7 @@ SRC = "contracts/n.rcl"
 
 
 def _report() -> dict[str, Any]:
+    """A report of one node, each kind of item once, completed into a whole report (tests/records/_typed_rows.py)."""
     def ob(i: str, status: str, line: int) -> dict[str, Any]:
         return {"id": i, "node": "N", "guarantee": 1, "backend": "hoare", "kind": "proof", "instance": "c1",
                 "statement": "out.x <= 3 & <tag>", "source": f"{SRC}:{line}:3", "artifact": "", "status": status}
@@ -31,7 +34,7 @@ def _report() -> dict[str, Any]:
         return {"obligation": i, "backend": "hoare", "kind": "proof", "status": status, "tool": "z3",
                 "tool_version": "4", "started": "t", "duration_s": 0.5, "explanation": f"{status} because <&>",
                 "counterexample": cex, "artifacts": [], "log_excerpt": ""}
-    return {
+    return complete(AssuranceReport, {
         "meta": {"tool": "rclverify", "version": "0.1.0", "workspace": "w", "plan": "contracts/plan.yaml",
                  "contracts": [SRC], "z3_version": "4", "strict_ok": False},
         "summary": {"status": "failed", "counts": {}, "headline": "", "problems": []},
@@ -44,9 +47,9 @@ def _report() -> dict[str, Any]:
         "pending": [{"obligation": "N.open", "backend": "hoare", "reason": "no program given"}],
         "side_conditions": [
             {"id": "N.sc1", "node": "N", "rule": "R1", "conjunct": "in.a > 0", "source": f"{SRC}:2:5", "status": "failed",
-             "explanation": "refuted", "model": {"in.a": 0}, "duration_s": 0.01, "smt2": "x", "hypotheses": []},
+             "verdict": "failed", "explanation": "refuted", "model": {"in.a": 0}, "duration_s": 0.01, "smt2": "x", "hypotheses": []},
             {"id": "N.sc2", "node": "N", "rule": "R1", "conjunct": "in.b > 0", "source": f"{SRC}:2:9",
-             "status": "inconclusive", "explanation": "timeout", "model": None, "duration_s": 1.0, "smt2": "x",
+             "status": "inconclusive", "verdict": "inconclusive", "explanation": "timeout", "model": None, "duration_s": 1.0, "smt2": "x",
              "hypotheses": []}],
         "findings": [
             {"id": "N.g1.non-vacuous", "node": "N", "check": "non-vacuous", "guarantee": 1, "status": "problem",
@@ -56,7 +59,7 @@ def _report() -> dict[str, Any]:
              "status": "ok", "message": "consistent", "explanation": "", "core": None, "model": {}, "duration_s": 0.1,
              "smt2": "", "instances": None}],
         "lint": [{"severity": "warning", "location": f"{SRC}:4:21", "message": "unused x'", "code": "W-unused-bound"}],
-    }
+    })
 
 
 def test_split_location() -> None:

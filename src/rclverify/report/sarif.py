@@ -1,8 +1,10 @@
 """The assurance report as a SARIF 2.1.0 log (``reports/assurance.sarif``).
 
 SARIF (OASIS Static Analysis Results Interchange Format 2.1.0) is what code
-scanning views read.  This module only lays out the report dict of
-:func:`rclverify.report.build.build_report`; it verifies nothing itself.
+scanning views read.  This module only lays out the report of
+:func:`rclverify.report.build.build_report`, decoded once into
+:class:`~rclverify.records.report_record.AssuranceReport` and read as the
+attributes mypy checks; it verifies nothing itself.
 
 One ``result`` per item that needs attention:
 
@@ -31,15 +33,17 @@ The decisions behind the mapping are in ``docs/ci.md``.
 """
 from __future__ import annotations
 
-from typing import Mapping, Sequence
+from typing import Any, Mapping, Sequence, cast
+
+import msgspec
 
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
-from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.evidence_rows import rows_of as evidence_rows_of
-from rclverify.records.obligations import rows_of as obligation_rows_of
-from rclverify.records.strength_rows import Strength
-from rclverify.records.report_schema import DiagnosisJson, LintJson, Report
+from rclverify.records.findings import FindingRow
+from rclverify.records.lint_rows import LintRow
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.report_schema import Report
 from rclverify.report.severity import of
 from rclverify.records.sarif import SRCROOT, sarif_fix, sarif_locations, sarif_result
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifResult, SarifRun,
@@ -55,15 +59,15 @@ def _level(kind: str, status: str) -> str:
     """The SARIF level of an item: its one severity (:mod:`.severity`)."""
     return of(kind, status) or "note"
 
-def _obligation_results(report: Report) -> list[SarifResult]:
-    """One result per obligation that is not discharged, its rows decoded into their definitions
-    (records/obligations.py, records/evidence_rows.py)."""
-    evidence = {ev.obligation: ev for ev in evidence_rows_of(report["evidence"])}
+def _obligation_results(report: AssuranceReport) -> list[SarifResult]:
+    """One result per obligation that is not discharged, with its evidence row (records/obligations.py,
+    records/evidence_rows.py)."""
+    evidence = {ev.obligation: ev for ev in report.evidence}
     reasons: dict[str, str] = {}
-    for p in report["pending"]:
-        reasons.setdefault(str(p["obligation"]), str(p["reason"]))
+    for p in report.pending:
+        reasons.setdefault(p.obligation, p.reason)
     out = []
-    for o in obligation_rows_of(report["obligations"]):
+    for o in report.obligations:
         rule = OBLIGATION_RULE.get(o.status)
         if rule is None:
             continue
@@ -100,58 +104,62 @@ def _obligation_results(report: Report) -> list[SarifResult]:
     return out
 
 
-def _unverified_results(report: Report) -> list[SarifResult]:
+def _unverified_results(report: AssuranceReport) -> list[SarifResult]:
     """One result per guarantee no obligation covers, at the guarantee (report/unverified.py)."""
     rule = RULES["RCL-GUARANTEE-UNVERIFIED"]
-    return [sarif_result(rule.id, _level("guarantee", "unverified"), f"Guarantee {u['guarantee']} of {u['node']} is unverified: {u['reason']}. "
-                    f"The guarantee: {u['text']}", str(u["source"]), f"guarantee:{u['id']}",
-                    {"guarantee": u["id"], "node": u["node"], "status": u["status"]})
-            for u in report.get("unverified") or ()]
+    return [sarif_result(rule.id, _level("guarantee", "unverified"), f"Guarantee {u.guarantee} of {u.node} is unverified: {u.reason}. "
+                    f"The guarantee: {u.text}", u.source, f"guarantee:{u.id}",
+                    {"guarantee": u.id, "node": u.node, "status": u.status})
+            for u in report.unverified]
 
 
-def _side_condition_results(report: Report) -> list[SarifResult]:
+def _set(value: Any) -> Any:
+    """``value``, ``None`` for a field the row leaves unset."""
+    return None if value is msgspec.UNSET else value
+
+
+def _side_condition_results(report: AssuranceReport) -> list[SarifResult]:
     out = []
-    for sc in report["side_conditions"]:
-        status = str(sc["status"])
-        verdict = str(sc.get("verdict") or status)
+    for sc in report.side_conditions:
+        status, verdict = sc.status, sc.verdict or sc.status
         if status == "discharged" and verdict != "discharged in context":
             continue
         rule = {"failed": "RCL-SC-REFUTED", "stale": "RCL-SC-STALE",
                 "discharged": "RCL-SC-IN-CONTEXT"}.get(status, "RCL-SC-INCONCLUSIVE")
         said = verdict if status == "discharged" else status
-        words = [f"Side condition {sc['id']} ({sc['rule']}) of {sc['node']} is {said}: {sc['conjunct']}."]
-        if sc.get("explanation"):
-            words.append(str(sc["explanation"]))
-        if sc.get("model"):
-            words.append(f"Counterexample: {model_text(sc['model'])}.")
-        props: dict[str, object] = {"sideCondition": sc["id"], "node": sc["node"], "rule": sc["rule"], "status": status,
-                                 "verdict": verdict}
-        if sc.get("strength"):
-            props["strength"] = Strength.of(sc["strength"]).to_json()
-        if sc.get("solvers"):
-            props["solvers"] = {k: sc["solvers"].get(k) for k in ("agreement", "why", "proof")}
-        ctx = sc.get("context")
+        words = [f"Side condition {sc.id} ({sc.rule}) of {sc.node} is {said}: {sc.conjunct}."]
+        if sc.explanation:
+            words.append(sc.explanation)
+        if sc.model:
+            words.append(f"Counterexample: {model_text(sc.model)}.")
+        props: dict[str, object] = {"sideCondition": sc.id, "node": sc.node, "rule": sc.rule, "status": status,
+                                    "verdict": verdict}
+        if sc.strength:
+            props["strength"] = sc.strength.to_json()
+        if sc.solvers:
+            props["solvers"] = {"agreement": sc.solvers.agreement, "why": sc.solvers.why, "proof": _set(sc.solvers.proof)}
+        ctx = sc.context
         if isinstance(ctx, Mapping):  # decided in context: the cone and the upstream premises used
             props["inContext"] = {"cone": ctx.get("cone"), "used": list(ctx.get("used") or []),
                                   "opened": list(ctx.get("opened") or []), "violated": list(ctx.get("violated") or [])}
         # one severity (report/severity.py): a side condition discharged in context holds (a note, not gating)
-        out.append(sarif_result(rule, _level("side-condition", status), " ".join(words), str(sc["source"]),
-                           f"side-condition:{sc['id']}", props))
+        out.append(sarif_result(rule, _level("side-condition", status), " ".join(words), sc.source,
+                                f"side-condition:{sc.id}", props))
     return out
 
 
-def _requirement_results(report: Report) -> list[SarifResult]:
+def _requirement_results(report: AssuranceReport) -> list[SarifResult]:
     """One result per requirement that is not met, at its formal statement
     (the plan, or the Doorstop item's file); a refuted one carries the
     counterexample node by node and the guarantees that did not prevent it."""
     out = []
-    for r in report.get("requirements", ()):
-        rule = REQUIREMENT_RULE.get(str(r.get("verdict")))
+    for r in report.requirements:
+        rule = REQUIREMENT_RULE.get(r.verdict)
         if rule is None:
             continue
-        c = r.get("check") or {}
-        words = [f"Requirement {r['id']} is {r['verdict']}" + (f": {c['formal']}." if c.get("formal") else ".")]
-        words.append(str(r["note"]) + ".")
+        c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
+        words = [f"Requirement {r.id} is {r.verdict}" + (f": {c['formal']}." if c.get("formal") else ".")]
+        words.append(r.note + ".")
         if c.get("counterexample"):
             words.append("Counterexample: " + "; ".join(
                 f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
@@ -161,25 +169,25 @@ def _requirement_results(report: Report) -> list[SarifResult]:
             words.append(temporal_words(c["temporal"]))
         for p in c.get("failed_to_prevent") or []:
             words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
-        props = {"requirement": r["id"], "verdict": r["verdict"], "status": r["status"]}
-        out.append(sarif_result(rule, _level("requirement", str(r.get("verdict"))), " ".join(words),
-                           str(c.get("source") or ""), f"requirement:{r['id']}", props))
+        props = {"requirement": r.id, "verdict": r.verdict, "status": r.status}
+        out.append(sarif_result(rule, _level("requirement", r.verdict), " ".join(words),
+                                str(c.get("source") or ""), f"requirement:{r.id}", props))
     return out
 
 
-def _finding_location(report: Report, f: FindingRow) -> str:
-    for n in report["nodes"]:
-        if n["name"] == f.node:
-            for g in n["guarantees"]:
-                if f.guarantee is not None and g["index"] == f.guarantee:
-                    return str(g["source"])
-            return str(n["source"])
+def _finding_location(report: AssuranceReport, f: FindingRow) -> str:
+    for n in report.nodes:
+        if n.name == f.node:
+            for g in n.guarantees:
+                if f.guarantee is not None and g.index == f.guarantee:
+                    return g.source
+            return n.source
     return ""
 
 
-def _finding_results(report: Report) -> list[SarifResult]:
+def _finding_results(report: AssuranceReport) -> list[SarifResult]:
     out = []
-    for f in rows_of(report["findings"]):
+    for f in report.findings:
         if f.status == "ok":
             continue
         rule = ("RCL-HEALTH-INCONCLUSIVE" if f.status == "inconclusive"
@@ -205,11 +213,11 @@ def _finding_results(report: Report) -> list[SarifResult]:
     return out
 
 
-def _suppressed(res: SarifResult, row: LintJson) -> SarifResult:
+def _suppressed(res: SarifResult, row: LintRow) -> SarifResult:
     """``res`` with a SARIF ``suppressions`` entry when the plan acknowledges
     the lint warning ``row`` (:func:`_accepted`; model/plan/acknowledged.py)."""
-    ack = row.get("acknowledged")
-    return _accepted(res, str(ack["reason"]), str(ack["at"])) if ack else res
+    ack = row.acknowledged
+    return _accepted(res, ack.reason, ack.at) if ack else res
 
 
 def _accepted(res: SarifResult, reason: str, at: str) -> SarifResult:
@@ -224,38 +232,38 @@ def _accepted(res: SarifResult, reason: str, at: str) -> SarifResult:
     return res
 
 
-def _acknowledgement_results(report: Report) -> list[SarifResult]:
+def _acknowledgement_results(report: AssuranceReport) -> list[SarifResult]:
     """Stale or refused plan acknowledgements, at their plan entry."""
-    return [sarif_result("RCL-ACK-STALE", _level("acknowledgement", str(a["status"])),
-                    f"Acknowledgement of {a['warning']} is {a['status']}: {a['message']}", str(a["at"]),
-                    f"ack:{a['at']}:{a['warning']}", {"status": a["status"]})
-            for a in report.get("acknowledgements") or () if a.get("status") != "ok"]
+    return [sarif_result("RCL-ACK-STALE", _level("acknowledgement", a.status),
+                         f"Acknowledgement of {a.warning} is {a.status}: {a.message}", a.at,
+                         f"ack:{a.at}:{a.warning}", {"status": a.status})
+            for a in report.acknowledgements if a.status != "ok"]
 
 
-def _lint_results(report: Report) -> tuple[list[SarifResult], list[Rule]]:
+def _lint_results(report: AssuranceReport) -> tuple[list[SarifResult], list[Rule]]:
     out: list[SarifResult] = []
     rules: dict[str, Rule] = {}
-    for k, d in enumerate(report["lint"]):
-        rid = lint_rule_id(str(d.get("code", "")))
-        level = _level("lint", str(d["severity"]))
+    for k, d in enumerate(report.lint):
+        rid = lint_rule_id(d.code)
+        level = _level("lint", d.severity)
         rules.setdefault(rid, Rule(rid, "Lint" + "".join(w.capitalize() for w in rid.split("-")[2:]), level,
                                    "RCL lint: a contract clause that is legal but probably not what was meant."))
-        out.append(_suppressed(sarif_result(rid, level, str(d["message"]), str(d["location"]),
-                                       f"lint:{d['location']}:{d.get('code', '')}:{k}", {"severity": d["severity"]}), d))
+        out.append(_suppressed(sarif_result(rid, level, d.message, d.location,
+                                            f"lint:{d.location}:{d.code}:{k}", {"severity": d.severity}), d))
     return out, sorted(rules.values(), key=lambda r: r.id)
 
 
-def _grounding_results(report: Report) -> tuple[list[SarifResult], list[Rule]]:
+def _grounding_results(report: AssuranceReport) -> tuple[list[SarifResult], list[Rule]]:
     """Grounding findings (docs/ros.md): located at the RCL line, with the
     software line it contradicts as a related location."""
-    g = report.get("grounding")
+    g = report.grounding
     if not g:
         return [], []
     from rclverify.ros.ground.ground import RULES as ROS_RULES  # deferred: start-up (loads rclverify.core.cache, rclverify.ros and more only when called)
     rules = [Rule(code, "Ros" + "".join(w.capitalize() for w in code.split("-")[1:]),
                   "error" if sev == "error" else "warning", text) for code, (sev, text) in ROS_RULES.items()]
     out = []
-    for k, f in enumerate(g["findings"]):
+    for k, f in enumerate(g.findings):  # each grounding finding as ros/ground/ground.py wrote it
         rcl, ros = f.get("rcl"), f.get("ros")
         main = rcl or ros
         where = f"{main['file']}:{main['line']}:{main['col']}" if main else ""
@@ -272,27 +280,27 @@ def _grounding_results(report: Report) -> tuple[list[SarifResult], list[Rule]]:
     return out, rules
 
 
-def _attach_diagnoses(report: Report, results: Sequence[SarifResult]) -> None:
+def _attach_diagnoses(report: AssuranceReport, results: Sequence[SarifResult]) -> None:
     """Give each result its diagnosis (``properties.diagnosis``: the
     sentence naming the culprit) and its repairs as SARIF ``fix`` objects
     (§3.55; each repair was checked by Z3 before it entered the report,
     docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
-    by_key: dict[str, DiagnosisJson] = {}
-    for dg in report.get("diagnoses", []):
-        if dg.get("kind") == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
-            by_key[f"unit:{dg.get('lint')}"] = dg
+    by_key: dict[str, DiagnosisRow] = {}
+    for dg in report.diagnoses:
+        if dg.kind == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
+            by_key[f"unit:{_set(dg.lint)}"] = dg
             continue
-        if dg.get("kind") == "deadline":
-            by_key[f"deadline:{dg.get('requirement')}"] = dg
+        if dg.kind == "deadline":
+            by_key[f"deadline:{_set(dg.requirement)}"] = dg
             continue
         for prefix in ("health", "side-condition", "obligation", "requirement"):
-            by_key[f"{prefix}:{dg['id']}"] = dg
+            by_key[f"{prefix}:{dg.id}"] = dg
     for res in results:
         fp = res["partialFingerprints"]["rclverifyItem/v1"]
         d = by_key.get(fp) or (by_key.get("unit:" + fp[5:].split(":E-unit-")[0]) if ":E-unit-" in fp else None)
         if d is None:
             continue
-        res["properties"]["diagnosis"] = d["sentence"]
+        res["properties"]["diagnosis"] = d.sentence
         if res["partialFingerprints"]["rclverifyItem/v1"].startswith("side-condition:"):
             _at_the_culprit(res, d)
         # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
@@ -300,17 +308,17 @@ def _attach_diagnoses(report: Report, results: Sequence[SarifResult]) -> None:
         fixes = [sarif_fix(f"{r['summary']} {'The property tests show' if r['kind'] == 'code' else 'Z3 shows'}: "
                            f"{r.get('proves') or 'the problem no longer follows'}; not shown: "
                            f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
-                 for r in d.get("repairs", []) if r.get("edit")]
+                 for r in d.repairs if r.get("edit")]
         if fixes:
             res["fixes"] = fixes
 
 
-def _at_the_culprit(res: SarifResult, d: DiagnosisJson) -> None:
+def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
     """A failed side condition is located at the guarantee its diagnosis blames
     (a producer that publishes what the consumer does not accept), so that a CI
     annotation lands on the node to repair; the consumer's assumption it fails
     becomes a related location (SARIF 2.1.0 §3.27.22)."""
-    guarantee = next((c for c in d.get("culprits") or () if isinstance(c, Mapping)
+    guarantee = next((c for c in d.culprits if isinstance(c, Mapping)
                       and str(c.get("what", "")).startswith("guarantee") and c.get("source")), None)
     if guarantee is None:
         return
@@ -331,45 +339,48 @@ def _descriptor(r: Rule) -> SarifDescriptor:
             "defaultConfiguration": {"level": r.level}}
 
 
-def sarif_log(report: Report) -> SarifLog:
+def sarif_log(report: Report | AssuranceReport) -> SarifLog:
     """The SARIF 2.1.0 log (a JSON-serialisable dict) of ``report``.
 
     ``report`` is the :class:`~rclverify.records.report_schema.Report` of
-    :func:`~rclverify.report.build.build_report` (it reads ``meta``,
-    ``obligations``, ``evidence``, ``pending``, ``side_conditions``,
-    ``findings``, ``nodes``, ``lint``).  Every rule of
-    :data:`RULES` is listed in the driver (so ids stay stable whether or not
-    they fire), results refer to their rule by ``ruleIndex`` too.  Raises
-    ``KeyError`` for a report dict without those keys.
+    :func:`~rclverify.report.build.build_report` or the report decoded,
+    :class:`~rclverify.records.report_record.AssuranceReport`; a dict is
+    decoded once (the deadlines', NoDL and near-miss results read it as
+    built).  Every rule of :data:`RULES` is listed in the driver (so ids
+    stay stable whether or not they fire), results refer to their rule by
+    ``ruleIndex`` too.  Raises :class:`msgspec.ValidationError` for a report
+    dict that is not of that shape.
     """
-    lint, lint_rules = _lint_results(report)
-    ground, ground_rules = _grounding_results(report)
+    typed = AssuranceReport.of(report)
+    built = report if isinstance(report, Mapping) else cast(Report, typed.to_json())
+    lint, lint_rules = _lint_results(typed)
+    ground, ground_rules = _grounding_results(typed)
     from rclverify.report.deadlines import SARIF_RULES, sarif_results  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report import near_misses  # deferred: start-up (loads rclverify.report.near_misses only when called)
     from rclverify.report import nodl  # deferred: start-up (loads rclverify.report.nodl only when called)
-    results = (_obligation_results(report) + _unverified_results(report) + _side_condition_results(report) + _finding_results(report) + lint + ground
-               + nodl.sarif_results(report, sarif_result, sarif_locations)
-               + _requirement_results(report) + sarif_results(report, sarif_result) + _acknowledgement_results(report)
-               + near_misses.sarif_results(report, sarif_result))
-    _attach_diagnoses(report, results)
+    results = (_obligation_results(typed) + _unverified_results(typed) + _side_condition_results(typed)
+               + _finding_results(typed) + lint + ground + nodl.sarif_results(built, sarif_result, sarif_locations)
+               + _requirement_results(typed) + sarif_results(built, sarif_result) + _acknowledgement_results(typed)
+               + near_misses.sarif_results(built, sarif_result))
+    _attach_diagnoses(typed, results)
     rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
                              + [Rule(*r) for r in near_misses.SARIF_RULES] + lint_rules + ground_rules)
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:
         res["ruleIndex"] = index[res["ruleId"]]
-    meta = report["meta"]
+    meta = typed.meta
     run: SarifRun = {
-        "tool": {"driver": {"name": "rclverify", "version": str(meta["version"]),
+        "tool": {"driver": {"name": "rclverify", "version": meta.version,
                             "rules": [_descriptor(r) for r in rules]}},
         "originalUriBaseIds": {SRCROOT: {"description": {"text": "the root of the rclverify workspace"}}},
         "columnKind": "unicodeCodePoints",
         "results": results,
-        "properties": {"workspace": meta["workspace"], "plan": meta["plan"], "status": report["summary"]["status"],
-                       "strictOk": bool(meta["strict_ok"])},
+        "properties": {"workspace": meta.workspace, "plan": meta.plan, "status": typed.summary.status,
+                       "strictOk": meta.strict_ok},
     }
     return {"$schema": SARIF_SCHEMA, "version": SARIF_VERSION, "runs": [run]}
 
 
-def render_sarif(report: Report) -> str:
+def render_sarif(report: Report | AssuranceReport) -> str:
     """:func:`sarif_log` as deterministic JSON text (sorted keys, final newline)."""
     return dumps(sarif_log(report))
