@@ -54,7 +54,7 @@ LIVE = frozenset({
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_names_rcl", "test_names_fleet_live", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
-    "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair",
+    "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair", "test_fleet_example_live",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -107,7 +107,7 @@ SECONDS: dict[str, float] = {
     "test_robustness": 3.0,
     # this round's modules over two CPU seconds (run alone, one process, the import of pytest not counted)
     "test_repair_examples": 30.0, "test_repair_oracle": 7.0, "test_repair_cli": 5.0, "test_hoare_token_repairs": 3.0,
-    "test_fret_example": 4.0, "test_instances": 3.5,
+    "test_fret_example": 4.0, "test_instances": 3.5, "test_fleet_example": 4.0,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -125,7 +125,7 @@ WALL: dict[str, float] = {
     "test_example_manipulator": 32.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
     "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
     "test_live_stops": 45.0, "test_names_rcl": 5.0, "test_names_fleet_live": 17.0, "test_lifecycle_live": 35.0,
-    "test_instances_live": 35.0, "test_lsp_code_repair": 20.0,
+    "test_instances_live": 35.0, "test_lsp_code_repair": 20.0, "test_fleet_example_live": 30.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
