@@ -722,7 +722,8 @@ def _shown_by_code(renderer: str, row: Mapping[str, Any]) -> str:
     if renderer == "sarif":
         return str(sarif._finding_results(typed_report(report)))
     if renderer == "junit":
-        suite = junit._suite(report["nodes"][0], {"items": {"findings": [row]}, "evidence": {}, "reasons": {}})[0]
+        node = typed_report(report).nodes[0].to_json()
+        suite = junit._suite(node, {"items": {"findings": [row]}, "evidence": {}, "reasons": {}})[0]
         return ET.tostring(suite, encoding="unicode")
     return "\n".join(explain.explain(report, str(row["id"])) or [])
 

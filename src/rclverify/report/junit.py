@@ -1,7 +1,8 @@
 """The assurance report as JUnit XML (``reports/assurance.junit.xml``).
 
 CI systems show JUnit XML in their test view.  This module lays out the
-report dict of :func:`rclverify.report.build.build_report`; it verifies
+report of :func:`rclverify.report.build.build_report`, its rows decoded
+into their records and read as the attributes mypy checks; it verifies
 nothing itself.  Layout (decisions in ``docs/ci.md``):
 
 * one ``<testsuite>`` per node (in the report's node order), named after
@@ -54,15 +55,21 @@ from __future__ import annotations
 
 import json
 import xml.etree.ElementTree as ET
-from typing import Any, Mapping
+from typing import Any, Mapping, cast
+
+import msgspec
 
 from rclverify.report.fragments import FragmentCache
 from rclverify.records.sarif import split_location
 from rclverify.report.templating import model_text
 from rclverify.records.findings import rows_of
+from rclverify.records.node_rows import NodeRow, UnverifiedRow
 from rclverify.records.obligations import rows_of as obligation_rows_of
 from rclverify.records.evidence_rows import rows_of as evidence_rows_of
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import Report
+from rclverify.records.row import decode_rows
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.severity import junit_outcome
 from rclverify.report.junit_suite import closed
 
@@ -115,14 +122,21 @@ def _lines(*parts: str) -> str:
     return "\n".join(p for p in parts if p)
 
 
-def junit_tree(report: Report) -> ET.Element:
+def _both(report: Report | AssuranceReport) -> tuple[AssuranceReport, Report]:
+    """``report`` decoded once, and as its JSON object (the node suites' kept fragments are keyed by their
+    JSON; the deadlines', near-miss and NoDL suites read the report as built)."""
+    typed = AssuranceReport.of(report)
+    return typed, report if isinstance(report, Mapping) else cast(Report, typed.to_json())
+
+
+def junit_tree(report: Report | AssuranceReport) -> ET.Element:
     """The ``<testsuites>`` element of ``report`` (see the module docstring).
 
-    Raises ``KeyError`` for a report dict without the keys ``nodes``,
-    ``obligations``, ``evidence``, ``pending``, ``side_conditions``,
-    ``findings`` and ``meta``.
+    Raises :class:`msgspec.ValidationError` for a report dict that is not
+    of the report's shape (:class:`~rclverify.records.report_record.AssuranceReport`).
     """
-    root = ET.Element("testsuites", {"name": f"rclverify: {report['meta']['workspace']}"})
+    typed, report = _both(report)
+    root = ET.Element("testsuites", {"name": f"rclverify: {typed.meta.workspace}"})
     totals = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     total_time = 0.0
     for node, data in _suite_data(report):
@@ -134,7 +148,7 @@ def junit_tree(report: Report) -> ET.Element:
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
-    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report),
+    for req in (_requirements_suite(typed), junit_suite(report, _case, _outcome), _lint_suite(typed),
                 near_misses_suite(report, _case, _outcome), nodl_suite(report, _case, _outcome)):
         if req is None:
             continue
@@ -148,10 +162,10 @@ def junit_tree(report: Report) -> ET.Element:
     return root
 
 
-def _requirements_suite(report: Report) -> tuple[ET.Element, dict[str, int], float] | None:
+def _requirements_suite(report: AssuranceReport) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``requirements`` ``<testsuite>`` (module docstring), its counts and
     time; ``None`` when the report has no requirements."""
-    reqs = report.get("requirements") or []
+    reqs = report.requirements
     if not reqs:
         return None
     suite = ET.Element("testsuite", {"name": "requirements"})
@@ -159,23 +173,23 @@ def _requirements_suite(report: Report) -> tuple[ET.Element, dict[str, int], flo
     props: list[tuple[str, str]] = []  # the test cases' strength and confidence (docs/confidence.md)
     time = 0.0
     for r in reqs:
-        c = r.get("check") or {}
+        c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
         secs = float(c.get("duration_s") or 0.0) if isinstance(c.get("duration_s"), (int, float)) else 0.0
-        case = _case(suite, "requirement", str(r["id"]), str(c.get("source") or ""), secs)
+        case = _case(suite, "requirement", r.id, str(c.get("source") or ""), secs)
         cex = "; ".join(f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
                         for row in c.get("counterexample") or [])
         used = "; ".join(f"{p['label']} ({p['source']})" for p in c.get("used") or [])
         prevent = "; ".join(f"{p['label']}: {p['text']} ({p['source']})" for p in c.get("failed_to_prevent") or [])
         counts["tests"] += 1
         time += secs
-        limited = r.get("limited_by")
-        if r.get("confidence") is not None and limited:
-            _properties(props, str(r["id"]), {"confidence": f"{r['confidence']:.6g}",
-                                              "limited_by": limited.get("sentence", "")})
-        bumped = _outcome(case, str(r["status"]), f"{r['verdict']}: {r['note']}",
-                          _lines(f"requirement {r['id']}: {r['text']}",
+        limited = r.limited_by
+        if r.confidence is not None and limited:
+            sentence = "" if limited.sentence is msgspec.UNSET else limited.sentence
+            _properties(props, r.id, {"confidence": f"{r.confidence:.6g}", "limited_by": sentence})
+        bumped = _outcome(case, r.status, f"{r.verdict}: {r.note}",
+                          _lines(f"requirement {r.id}: {r.text}",
                                  f"formal: {c['formal']}" if c.get("formal") else "",
-                                 f"verdict: {r['verdict']}", str(r["note"]),
+                                 f"verdict: {r.verdict}", r.note,
                                  f"used: {used}" if used else "", f"counterexample: {cex}" if cex else "",
                                  f"not prevented by: {prevent}" if prevent else ""))
         if bumped:
@@ -187,24 +201,24 @@ def _requirements_suite(report: Report) -> tuple[ET.Element, dict[str, int], flo
     return suite, counts, time
 
 
-def _lint_suite(report: Report) -> tuple[ET.Element, dict[str, int], float] | None:
+def _lint_suite(report: AssuranceReport) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``lint`` ``<testsuite>``: one ``<testcase>`` per lint diagnostic
     (``classname`` ``lint``, name its code and location, at its location), a
     ``<failure>`` of type ``warning`` or ``error`` (its one severity,
     :mod:`.severity`: ``--strict`` fails on it); ``None`` without lint."""
-    rows = report.get("lint") or []
+    rows = report.lint
     if not rows:
         return None
     suite = ET.Element("testsuite", {"name": "lint"})
     counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     for x in rows:
-        sev = str(x["severity"]).lower()
-        case = _case(suite, "lint", f"{x.get('code') or 'lint'} {x['location']}", str(x["location"]), 0.0)
+        sev = x.severity.lower()
+        case = _case(suite, "lint", f"{x.code or 'lint'} {x.location}", x.location, 0.0)
         counts["tests"] += 1
-        ack = x.get("acknowledged")
+        ack = x.acknowledged
         bumped = _outcome(case, "acknowledged" if ack else sev,
-                          str(x["message"]) + (f" (acknowledged at {ack['at']}: {ack['reason']})" if ack else ""),
-                          f"{x['location']}: {sev}: {x['message']}", kind="lint")
+                          x.message + (f" (acknowledged at {ack.at}: {ack.reason})" if ack else ""),
+                          f"{x.location}: {sev}: {x.message}", kind="lint")
         if bumped:
             counts[bumped] += 1
     return closed(suite, counts)
@@ -233,10 +247,11 @@ def _suite_data(report: Report) -> list[tuple[Mapping[str, Any], dict[str, Any]]
     return out
 
 
-def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], float]:
-    """The ``<testsuite>`` of one node from :func:`_suite_data`, its counts
-    (``tests``, ``failures``, ``errors``, ``skipped``) and its time in seconds."""
-    name = str(node["name"])
+def _suite(node_json: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element, dict[str, int], float]:
+    """The ``<testsuite>`` of one node from :func:`_suite_data` (its JSON, the kept fragment's key), its rows
+    decoded, its counts (``tests``, ``failures``, ``errors``, ``skipped``) and its time in seconds."""
+    node = NodeRow.of(node_json)
+    name = node.name
     items, reasons = data["items"], data["reasons"]
     evidence = {e.obligation: e for e in evidence_rows_of(data["evidence"].values())}
     suite = ET.Element("testsuite", {"name": name})
@@ -265,21 +280,21 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
               _lines(f"obligation ({o.backend}, {o.kind}) of guarantee {o.guarantee}: {o.statement}",
                      f"source: {o.source}", f"artifact: {o.artifact}" if o.artifact else "", expl,
                      f"counterexample: {cex}" if cex else ""), secs)
-    for sc in items.get("side_conditions", ()):
-        case = _case(suite, f"{name}.side_condition", str(sc["id"]), str(sc["source"]), sc.get("duration_s"))
-        model = model_text(sc.get("model"))
-        verdict = str(sc.get("verdict") or sc["status"])
-        if sc.get("strength"):
-            _properties(props, str(sc["id"]), {"strength": sc["strength"]["kind"],
-                                               "solvers": str(sc["strength"].get("solvers", 1))})
-        tally(case, str(sc["status"]), str(sc.get("explanation") or sc["status"]),
-              _lines(f"side condition ({sc['rule']}): {sc['conjunct']}", f"source: {sc['source']}",
-                     f"verdict: {verdict}", str(sc.get("explanation") or ""),
+    for sc in decode_rows(SideConditionRow, items.get("side_conditions", ())):
+        case = _case(suite, f"{name}.side_condition", sc.id, sc.source, sc.duration_s)
+        model = model_text(sc.model)
+        verdict = sc.verdict or sc.status
+        if sc.strength:
+            solvers = 1 if sc.strength.solvers is msgspec.UNSET else sc.strength.solvers
+            _properties(props, sc.id, {"strength": sc.strength.kind, "solvers": str(solvers)})
+        tally(case, sc.status, sc.explanation or sc.status,
+              _lines(f"side condition ({sc.rule}): {sc.conjunct}", f"source: {sc.source}",
+                     f"verdict: {verdict}", sc.explanation,
                      f"counterexample: {model}" if model else ""),
-              sc.get("duration_s"))
-        if sc["status"] == "discharged" and verdict != sc["status"]:  # a pass that rests on the upstream cone
+              sc.duration_s)
+        if sc.status == "discharged" and verdict != sc.status:  # a pass that rests on the upstream cone
             ET.SubElement(case, "system-out").text = _lines(
-                f"verdict: {verdict}", "upstream premises used: " + "; ".join(str(h) for h in sc.get("hypotheses") or []))
+                f"verdict: {verdict}", "upstream premises used: " + "; ".join(sc.hypotheses))
     for f in rows_of(items.get("findings", ())):
         case = _case(suite, f"{name}.health", f.id, _source_of(node, f.guarantee), f.duration_s)
         core = "; ".join(f.core or [])
@@ -290,11 +305,11 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
               f.message + (f" (acknowledged at {ack.at}: {ack.reason})" if ack else ""),
               _lines(f.message, f.explanation, f"unsat core: {core}" if core else "",
                      f"counterexample: {model}" if model else ""), f.duration_s)
-    for u in items.get("unverified", ()):
-        case = _case(suite, f"{name}.guarantee", str(u["id"]), str(u["source"]), 0.0)
-        tally(case, str(u["status"]), f"unverified: {u['reason']}",
-              _lines(f"guarantee {u['guarantee']} of {name}: {u['text']}", f"source: {u['source']}",
-                     f"unverified: {u['reason']}"), 0.0)
+    for u in decode_rows(UnverifiedRow, items.get("unverified", ())):
+        case = _case(suite, f"{name}.guarantee", u.id, u.source, 0.0)
+        tally(case, u.status, f"unverified: {u.reason}",
+              _lines(f"guarantee {u.guarantee} of {name}: {u.text}", f"source: {u.source}",
+                     f"unverified: {u.reason}"), 0.0)
     for k, v in counts.items():
         suite.set(k, str(v))
     suite.set("time", f"{time:.3f}")
@@ -302,25 +317,26 @@ def _suite(node: Mapping[str, Any], data: Mapping[str, Any]) -> tuple[ET.Element
     return suite, counts, time
 
 
-def _source_of(node: Mapping[str, Any], guarantee: int | None) -> str:
-    for g in node["guarantees"]:
-        if guarantee is not None and g["index"] == guarantee:
-            return str(g["source"])
-    return str(node["source"])
+def _source_of(node: NodeRow, guarantee: int | None) -> str:
+    for g in node.guarantees:
+        if guarantee is not None and g.index == guarantee:
+            return g.source
+    return node.source
 
 
 _DECLARATION = '<?xml version="1.0" encoding="utf-8"?>\n'
 
 
-def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
+def render_junit(report: Report | AssuranceReport, fragments: FragmentCache | None = None) -> str:
     """:func:`junit_tree` as indented UTF-8 XML text with a declaration.
 
     With ``fragments``, each node's ``<testsuite>`` (its indented text, its
     counts and time) is kept between runs, keyed by the data it is made
     from (:func:`_suite_data`; :mod:`rclverify.report.fragments`): the same
     text, without building and serialising the XML of unchanged nodes."""
-    if fragments is None or not report["nodes"]:
-        root = junit_tree(report)
+    typed, report = _both(report)
+    if fragments is None or not typed.nodes:
+        root = junit_tree(typed)
         ET.indent(root)
         return _DECLARATION + ET.tostring(root, encoding="unicode") + "\n"
     texts: list[str] = []
@@ -339,7 +355,7 @@ def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
-    for req in (_requirements_suite(report), junit_suite(report, _case, _outcome), _lint_suite(report),
+    for req in (_requirements_suite(typed), junit_suite(report, _case, _outcome), _lint_suite(typed),
                 near_misses_suite(report, _case, _outcome), nodl_suite(report, _case, _outcome)):
         if req is None:
             continue
@@ -348,7 +364,7 @@ def render_junit(report: Report, fragments: FragmentCache | None = None) -> str:
         for k, v in req[1].items():
             totals[k] += v
         total_time += req[2]
-    root = ET.Element("testsuites", {"name": f"rclverify: {report['meta']['workspace']}"})
+    root = ET.Element("testsuites", {"name": f"rclverify: {typed.meta.workspace}"})
     for k, v in totals.items():
         root.set(k, str(v))
     root.set("time", f"{total_time:.3f}")
