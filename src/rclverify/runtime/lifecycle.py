@@ -23,19 +23,30 @@ that type and no ``matches`` (``lifecycle_msgs/TransitionEvent battery/transitio
   the end of the run for the rest.  Each violation names the node, the topic, the time and the
   state it was published in;
 * the transition events are the gate's, counted as heard (:attr:`LifecycleGate.heard`, what the
-  run's "not judged" list reads); the guarantees' judge never sees them, and the run's log does
-  not hold them.
+  run's "not judged" list reads); the guarantees' judge never sees them.
+
+* a **transition deadline** (``deadlines``, per managed node: transition -> seconds, e.g.
+  ``{"Battery": {"activate": 0.2}}``) bounds each of the node's transitions of that name from the
+  event into its transition state to the event into the state it leads to (:data:`TRANSITIONS`:
+  ``activate`` from ``activating`` to ``active``): ``met`` within it, ``missed`` when the goal
+  came later, the transition ended elsewhere (a failed ``on_activate``: ``inactive``, or
+  ``errorprocessing``) or the run ended more than the deadline after its start with no end,
+  ``open`` when the run ended sooner.  A missed transition fails the node, as a violation does.
 
 :class:`LifecycleGate` is the gate a live run (:class:`rclverify.runtime.live.LiveRun`,
 ``gate``, made by :func:`gate_of` from the monitored nodes) asks for every message before its
 judge; its :meth:`~LifecycleGate.record` is the run's ``lifecycle`` record.  The transport reads
-the transition topic as any topic a contract names.
+the transition topic as any topic a contract names, and a bag the run records (``--record``) holds
+it.  :func:`judge_recorded` judges a recorded run (a bag, or a log holding the transition events:
+:mod:`rclverify.traces.lifecycle_events`) as the live run judges it: its messages, in the order
+read and at their recorded times, through the same gate and the same judge.
 """
 from __future__ import annotations
 
 import bisect
 from dataclasses import dataclass, field
-from typing import Any, Mapping, Sequence
+from pathlib import Path
+from typing import Any, Iterable, Mapping, Sequence
 
 from rclverify.lang.types import CheckedNode
 
@@ -48,6 +59,10 @@ ACTIVE = 3
 #: The states an output may be published in: ``active``, and the transitions into and out of it (a
 #: managed publisher is enabled in ``on_activate``, while the node is ``activating``).
 ACTIVE_LIKE = frozenset({3, 13, 14})
+#: A transition's name -> (its transition state, the primary state it leads to) (ROS 2 design,
+#: "Managed nodes"; lifecycle_msgs/msg/Transition's names).
+TRANSITIONS = {"configure": (10, 2), "activate": (13, 3), "deactivate": (14, 2), "cleanup": (11, 1),
+               "shutdown": (12, 4)}
 
 
 def event_topic(fqn: str) -> str:
@@ -69,10 +84,12 @@ def managed_of(nodes: Sequence[CheckedNode]) -> dict[str, str]:
     return out
 
 
-def gate_of(nodes: Sequence[CheckedNode]) -> "LifecycleGate | None":
-    """The lifecycle gate of a run monitoring ``nodes``, ``None`` when none is managed."""
+def gate_of(nodes: Sequence[CheckedNode], deadlines: Mapping[str, Mapping[str, float]] | None = None
+            ) -> "LifecycleGate | None":
+    """The lifecycle gate of a run monitoring ``nodes`` (with the transition ``deadlines``,
+    :class:`LifecycleGate`), ``None`` when none is managed."""
     managed = managed_of(nodes)
-    return LifecycleGate(managed, nodes) if managed else None
+    return LifecycleGate(managed, nodes, deadlines=deadlines) if managed else None
 
 
 def _get(fields: Mapping[str, object], *path: str) -> object:
@@ -113,16 +130,29 @@ class LifecycleGate:
 
     ``managed`` maps each managed node's contract name to its fully qualified ROS name; ``nodes``
     are the monitored nodes (their topics say which topics are a node's inputs and outputs).
-    ``skew`` and ``settle`` in seconds.  Raises :class:`ValueError` for a managed node that is
-    not monitored.  Not thread safe: the live run calls it under its lock.
+    ``skew`` and ``settle`` in seconds; ``deadlines``: per managed node, transition name
+    (:data:`TRANSITIONS`) -> seconds (module docstring).  Raises :class:`ValueError` for a managed
+    node that is not monitored, a deadline of a node that is not managed, of an unknown transition
+    or not a positive number.  Not thread safe: the live run calls it under its lock.
     """
 
     def __init__(self, managed: Mapping[str, str], nodes: Sequence[CheckedNode], *, skew: float = 0.05,
-                 settle: float = 0.5) -> None:
+                 settle: float = 0.5, deadlines: Mapping[str, Mapping[str, float]] | None = None) -> None:
         by_name = {n.name: n for n in nodes}
         unknown = sorted(set(managed) - set(by_name))
         if unknown:
             raise ValueError(f"managed node {unknown[0]!r} is not monitored (nodes: {', '.join(by_name)})")
+        for node, per in (deadlines or {}).items():
+            if node not in managed:
+                raise ValueError(f"a transition deadline for {node!r}, which is not a managed node "
+                                 f"(managed: {', '.join(managed) or 'none'})")
+            for name, secs in per.items():
+                if name not in TRANSITIONS:
+                    raise ValueError(f"{node}: no transition {name!r} (transitions: {', '.join(TRANSITIONS)})")
+                if isinstance(secs, bool) or not isinstance(secs, (int, float)) or not 0 < secs < float("inf"):
+                    raise ValueError(f"{node}: the {name} deadline must be a positive number of seconds, not {secs!r}")
+        self.deadlines = {n: dict(per) for n, per in (deadlines or {}).items()}
+        self.last = float("-inf")  # the latest time a message was heard (s): where the run ends
         self.skew, self.settle = skew, settle
         self.managed: dict[str, _Managed] = {}
         self.readers: dict[str, list[str]] = {}  # input topic -> every monitored node reading it
@@ -152,6 +182,7 @@ class LifecycleGate:
         """Whether the message goes on to the guarantees' judge (module docstring); a transition
         event updates its node's state; outputs older than ``settle`` are decided."""
         self._decide(received - self.settle)
+        self.last = max(self.last, received)
         m = self.events.get(topic)
         if m is not None:
             goal, stamp = _get(fields, "goal_state", "id"), _get(fields, "timestamp")
@@ -194,27 +225,95 @@ class LifecycleGate:
         s = self.managed[node].now()
         return STATES.get(s, str(s))
 
+    def transitions(self, node: str) -> list[dict[str, Any]]:
+        """The transitions of managed node ``node`` its deadlines bound, each judged (module
+        docstring): ``transition``, ``start`` and ``end`` (s; ``None``: none heard), ``seconds``,
+        ``within`` (s), ``status`` (``met``, ``missed``, ``open``) and ``reason``, in time order."""
+        m = self.managed[node]
+        out: list[dict[str, Any]] = []
+        for name, within in self.deadlines.get(node, {}).items():
+            into, goal = TRANSITIONS[name]
+            for k, (t, st) in enumerate(zip(m.times, m.states)):
+                if st != into or (k and m.states[k - 1] == into):
+                    continue
+                end = next(((t2, s2) for t2, s2 in zip(m.times[k + 1:], m.states[k + 1:]) if s2 != into), None)
+                row: dict[str, Any] = {"transition": name, "start": t, "end": None, "seconds": None, "within": within}
+                label = f"{m.fqn}'s {name} from {t:.3f} s"
+                if end is None:
+                    late = self.last - t > within
+                    row.update(status="missed" if late else "open",
+                               reason=f"{label}: no end heard, {'more' if late else 'less'} than {within:g} s "
+                                      f"before the run's end")
+                else:
+                    secs = end[0] - t
+                    row.update(end=end[0], seconds=round(secs, 6))
+                    if end[1] != goal:
+                        row.update(status="missed", reason=f"{label} ended in {STATES.get(end[1], end[1])}, not "
+                                                           f"{STATES[goal]}, after {secs:.3f} s")
+                    else:
+                        row.update(status="met" if secs <= within else "missed",
+                                   reason=f"{label} reached {STATES[goal]} after {secs:.3f} s "
+                                          f"({'within' if secs <= within else 'over'} its {within:g} s)")
+                out.append(row)
+        return sorted(out, key=lambda r: r["start"])
+
     def record(self, verdicts: Sequence[dict[str, Any]] = ()) -> dict[str, Any]:
         """Every pending output decided; the run's ``lifecycle`` record: per managed node its latest
         state, transitions heard, outputs judged and violations, its ``status`` ``failed`` with a
         violation, ``inconclusive`` with no output heard (silence is not green), else
         ``discharged``; and the inputs held back as no question, per topic.  Each of ``verdicts`` (the
         run's node records: ``node``, ``status``, ``explanation``) whose managed node has a violation
-        is made ``failed``, its explanation saying so first: the lifecycle contract is part of the node's."""
+        is made ``failed``, its explanation saying so first: the lifecycle contract is part of the node's.
+        A node with deadlines has its transitions judged (:meth:`transitions`) as ``deadlines``; one
+        missed fails it as a violation does."""
         self._decide(float("inf"))
         nodes = []
         for m in self.managed.values():
             mine = [v for v in self.violations if v["node"] == m.node]
+            timed = self.transitions(m.node)
+            missed = [t for t in timed if t["status"] == "missed"]
             nodes.append({"node": m.node, "ros_node": m.fqn, "state": self.state(m.node),
                           "transitions": m.transitions, "outputs_judged": m.judged, "violations": mine,
-                          "status": "failed" if mine else "discharged" if m.judged else "inconclusive"})
+                          **({"deadlines": timed} if m.node in self.deadlines else {}),
+                          "status": "failed" if mine or missed else "discharged" if m.judged else "inconclusive"})
             for v in verdicts:
-                if v.get("node") == m.node and mine:
+                if v.get("node") == m.node and (mine or missed):
                     v["status"] = "failed"
-                    v["explanation"] = (f"{len(mine)} output(s) published outside active (lifecycle); the first: "
-                                        f"{mine[0]['reason']} (t = {mine[0]['time']:.3f} s). {v.get('explanation', '')}")
+                    said = [f"{len(mine)} output(s) published outside active (lifecycle); the first: "
+                            f"{mine[0]['reason']} (t = {mine[0]['time']:.3f} s)."] if mine else []
+                    said += [f"{len(missed)} transition deadline(s) missed (lifecycle); the first: "
+                             f"{missed[0]['reason']}."] if missed else []
+                    v["explanation"] = " ".join([*said, str(v.get("explanation", ""))])
         return {"outputs_judged": self.outputs_judged, "not_questions": dict(sorted(self.not_questions.items())),
                 "nodes": nodes}
 
 
-__all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITION_TYPE", "event_topic", "gate_of", "managed_of"]
+def judge_recorded(checked: Any, nodes: Sequence[CheckedNode], rules: Any, horizon: float, events: Iterable[Any],
+                   log: Path, *, deadlines: Mapping[str, Mapping[str, float]] | None = None,
+                   evidence: Path | None = None) -> dict[str, Any]:
+    """A recorded run's ``events`` (:class:`rclverify.traces.events.Event`, in the order read: a
+    bag's or a log's, :func:`rclverify.traces.lifecycle_events.read_run`) judged as the live run
+    judges them (module docstring): each pushed to a :class:`rclverify.runtime.live.LiveRun` of
+    ``nodes`` (``rules``, ``horizon`` s: the monitor configuration's) at its recorded time, through
+    the lifecycle gate of ``nodes`` with ``deadlines``; the run's log written to ``log``.  Returns
+    the run's record (``nodes``, ``lifecycle``; written to ``evidence`` when given).  Raises
+    :class:`ValueError` when no node of ``nodes`` is managed, or for a deadline the gate refuses."""
+    from rclverify.runtime.live import LiveRun  # deferred: the live run imports this module
+    gate = gate_of(nodes, deadlines)
+    if gate is None:
+        raise ValueError(f"no managed node among {', '.join(n.name for n in nodes)}: no contract names a "
+                         f"{TRANSITION_TYPE.replace('/msg/', '/')} <node>/transition_event topic")
+    run = LiveRun(checked, list(nodes), rules, horizon, log, reorder_window=0.0)
+    run.gate = gate
+    last = float("-inf")
+    for e in events:
+        last = max(last, e.time)
+        run.tick(e.time)
+        run.push(e.topic, e.fields, e.time)
+    if last > float("-inf"):
+        run.tick(last + gate.settle + horizon)
+    return run.stop(evidence)
+
+
+__all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITIONS", "TRANSITION_TYPE", "event_topic", "gate_of",
+           "judge_recorded", "managed_of"]
