@@ -55,6 +55,7 @@ LIVE = frozenset({
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
     "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair", "test_fleet_example_live",
+    "test_run_repair_rclpy",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -126,6 +127,7 @@ WALL: dict[str, float] = {
     "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
     "test_live_stops": 45.0, "test_names_rcl": 5.0, "test_names_fleet_live": 17.0, "test_lifecycle_live": 35.0,
     "test_instances_live": 35.0, "test_lsp_code_repair": 20.0, "test_fleet_example_live": 30.0,
+    "test_run_repair_rclpy": 25.0,
 }
 
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
