@@ -42,10 +42,10 @@ class Row(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         return msgspec.convert(dict(row), cls)
 
 
-def decode_rows(cls: type[R], rows: Iterable[Mapping[str, Any]]) -> list[R]:
+def decode_rows(cls: type[R], rows: Iterable[R | Mapping[str, Any]]) -> list[R]:
     """``rows`` (JSON objects, as built or as read back from
-    ``reports/assurance.json``) decoded into ``cls``, in order (raises as
-    :meth:`Row.of`)."""
+    ``reports/assurance.json``, or records of ``cls`` already decoded)
+    decoded into ``cls``, in order (raises as :meth:`Row.of`)."""
     return [cls.of(r) for r in rows]
 
 

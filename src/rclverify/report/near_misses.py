@@ -25,6 +25,8 @@ import xml.etree.ElementTree as ET
 from typing import Any, Callable, Literal, Mapping, Sequence
 
 from rclverify.records.margin_rows import NearMissRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.row import decode_rows
 from rclverify.records.report_schema import NearMissJson, ObligationJson, Report
 from rclverify.records.sarif import SarifResult
 from rclverify.records.store import EvidenceStore
@@ -118,62 +120,64 @@ def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Nea
     return rows
 
 
-def describe(r: Mapping[str, Any]) -> str:
+def describe(r: NearMissRow) -> str:
     """One sentence: ``ScanGuard guarantee 1 held with margin 0.02 (r < 0.5), under the near-miss
     threshold 0.05, at robot: message 9 of runs/robot.jsonl``."""
-    if r["kind"] == "time":
-        what = (f"answered {r['margin'] * 1000:.3f} ms before its deadline, under the near-miss threshold "
-                f"{r['threshold'] * 1000:g} ms")
+    if r.kind == "time":
+        what = (f"answered {r.margin * 1000:.3f} ms before its deadline, under the near-miss threshold "
+                f"{r.threshold * 1000:g} ms")
     else:
-        unit = f" {r['unit']}" if r["unit"] else ""
-        atom = f" ({r['atom']})" if r["atom"] else ""
-        what = f"held with margin {r['margin']:g}{unit}{atom}, under the near-miss threshold {r['threshold']:g}{unit}"
-    return f"{r['node']} guarantee {r['guarantee']} {what}, at {r['where']} of {r['trace']}"
+        unit = f" {r.unit}" if r.unit else ""
+        atom = f" ({r.atom})" if r.atom else ""
+        what = f"held with margin {r.margin:g}{unit}{atom}, under the near-miss threshold {r.threshold:g}{unit}"
+    return f"{r.node} guarantee {r.guarantee} {what}, at {r.where} of {r.trace}"
 
 
-def sarif_results(report: Report, result: Callable[..., SarifResult]) -> list[SarifResult]:
+def sarif_results(report: AssuranceReport, result: Callable[..., SarifResult]) -> list[SarifResult]:
     """One SARIF result per near miss at its guarantee's line (level
     ``warning``); ``result(rule, level, text, where, key, props)`` is
     report/sarif.py's result maker."""
     from rclverify.report.severity import of  # deferred: start-up (one severity in every output)
     level = of("near-miss", "warning") or "note"
     out = []
-    for r in report.get("near_misses") or ():
-        props = {"node": r["node"], "guarantee": r["guarantee"], "kind": r["kind"], "margin": r["margin"],
-                 "threshold": r["threshold"], "unit": r["unit"], "obligation": r["obligation"],
-                 "threshold_source": r["threshold_source"]}
-        out.append(result("RCL-NEAR-MISS", level, f"Near miss: {describe(r)}.", r["source"] or r["threshold_source"],
-                          f"near-miss:{r['obligation']}:{r['guarantee']}:{r['kind']}", props))
+    for r in report.near_misses:
+        props = {"node": r.node, "guarantee": r.guarantee, "kind": r.kind, "margin": r.margin,
+                 "threshold": r.threshold, "unit": r.unit, "obligation": r.obligation,
+                 "threshold_source": r.threshold_source}
+        out.append(result("RCL-NEAR-MISS", level, f"Near miss: {describe(r)}.", r.source or r.threshold_source,
+                          f"near-miss:{r.obligation}:{r.guarantee}:{r.kind}", props))
     return out
 
 
-def summary_lines(rows: Sequence[Mapping[str, Any]], most: int = 5) -> list[str]:
-    """The summary's lines: ``near misses: N ...`` and one line per near miss (at most ``most``)."""
+def summary_lines(near_misses: Sequence[NearMissRow | Mapping[str, Any]], most: int = 5) -> list[str]:
+    """The summary's lines: ``near misses: N ...`` and one line per near miss (at most ``most``);
+    ``near_misses``: the report's rows, decoded here when given as JSON objects."""
+    rows = decode_rows(NearMissRow, near_misses)
     if not rows:
         return []
     out = [f"near misses: {len(rows)} guarantee margin{'s' if len(rows) != 1 else ''} under the plan's threshold "
            "(held on every run, by little):"]
-    out += [f"  {describe(r)} ({r['source']})" for r in rows[:most]]
+    out += [f"  {describe(r)} ({r.source})" for r in rows[:most]]
     if len(rows) > most:
         out.append(f"  ... and {len(rows) - most} more (reports/assurance.html)")
     return out
 
 
-def junit_suite(report: Report, case: Callable[..., ET.Element],
+def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
                 outcome: Callable[..., str]) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``near_misses`` ``<testsuite>``: one failing ``<testcase>`` per
     near miss (``classname`` ``near_miss``, name ``<obligation>.g<k>.<kind>``,
     at the guarantee); ``case`` and ``outcome`` are report/junit.py's.
     ``None`` without near misses."""
-    rows = list(report.get("near_misses") or ())
+    rows = report.near_misses
     if not rows:
         return None
     suite = ET.Element("testsuite", {"name": "near_misses"})
     counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     for r in rows:
-        c = case(suite, "near_miss", f"{r['obligation']}.g{r['guarantee']}.{r['kind']}", r["source"], 0.0)
+        c = case(suite, "near_miss", f"{r.obligation}.g{r.guarantee}.{r.kind}", r.source, 0.0)
         counts["tests"] += 1
-        bumped = outcome(c, "warning", f"near miss: {describe(r)}", f"threshold: {r['threshold_source']}", "near-miss")
+        bumped = outcome(c, "warning", f"near miss: {describe(r)}", f"threshold: {r.threshold_source}", "near-miss")
         if bumped:
             counts[bumped] += 1
     return closed(suite, counts)

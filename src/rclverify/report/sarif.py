@@ -361,7 +361,7 @@ def sarif_log(report: Report | AssuranceReport) -> SarifLog:
     results = (_obligation_results(typed) + _unverified_results(typed) + _side_condition_results(typed)
                + _finding_results(typed) + lint + ground + nodl.sarif_results(built, sarif_result, sarif_locations)
                + _requirement_results(typed) + sarif_results(built, sarif_result) + _acknowledgement_results(typed)
-               + near_misses.sarif_results(built, sarif_result))
+               + near_misses.sarif_results(typed, sarif_result))
     _attach_diagnoses(typed, results)
     rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
                              + [Rule(*r) for r in near_misses.SARIF_RULES] + lint_rules + ground_rules)
