@@ -103,6 +103,8 @@ class LiveRun:
         self.started = datetime.now(timezone.utc).isoformat(timespec="seconds")
         self.silences: list[SilenceNote] = []
         self.verdicts = 0
+        #: verdicts given as the run stopped, on times the watermark had not passed (OnlineEngine.early)
+        self.provisional = 0
         nodes = list(nodes)
         self.nodes = nodes
         self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
@@ -132,11 +134,16 @@ class LiveRun:
         line = {"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()}
         self._log.write(dumps(line) + "\n")
         self.checks.line(line, deadline=True)
+        # a `false` given as the run stopped, on a deadline the watermark had not passed: an answer stamped
+        # within it may have been in flight (docs/semantics.md, "Provisional verdicts")
+        early = v.verdict == "false" and self.engine.early(v.due)
+        self.provisional += early
         if self.publish is not None:
-            self.publish(dumps({"kind": "deadline", **v.to_json()}))
+            self.publish(dumps({"kind": "deadline", **v.to_json(), **({"provisional": True} if early else {})}))
 
     def _verdict(self, v: Verdict) -> None:
         self.verdicts += 1
+        self.provisional += v.provisional
         text = dumps(v.to_json())  # serialised once: the log line and the published message
         self._log.write(f'{{"topic": "{VERDICT_LOG_TOPIC}", "time": {v.decided_at!r}, "verdict": {text}}}\n')
         if self.checks.active:
@@ -241,6 +248,7 @@ class LiveRun:
                   "events": self.engine.released, "late_events": self.engine.late,
                   "max_late_s": round(self.engine.max_late_s, 6), "other_clocks": self.engine.clock_lines(),
                   "reorder_window_s": self.engine.reorder_window, "verdicts": self.verdicts,
+                  "provisional_verdicts": self.provisional,
                   "silent_topics": self.silences, "nodes": nodes, **self.checks.record(self.log_path.name)}
         if self.gate is not None:
             record["lifecycle"] = self.gate.record(nodes)

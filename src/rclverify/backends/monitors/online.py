@@ -34,13 +34,21 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   waiting for the next message;
 * **silence**: a contract topic that has not been received for
   ``silence_s`` seconds is reported once by :meth:`tick` (and again when it
-  comes back).
+  comes back);
+* **provisional verdicts**: with a lateness bound, a verdict is final once
+  the watermark has passed its time (every writer of the engine heard past
+  it, or silent for longer than the bound): what comes later is later than
+  the bound, and changes it only to undecided (docs/semantics.md).  The
+  verdicts :meth:`finish` gives on messages the watermark had not yet
+  passed when the run stopped go to ``on_verdict`` marked ``provisional``
+  (:meth:`early`): a message in flight may have been missed.
 
 Memory per node is the monitor's (state, bounded cache, obligations within
 the horizon) plus the reorder buffer (messages within the window).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Mapping
@@ -103,10 +111,33 @@ class OnlineEngine:
     #: stamp, s): its own watermark (:meth:`watermark`)
     writers: dict[str, tuple[float, float]] = field(init=False, default_factory=dict)
 
+    #: the watermark (s) the last :meth:`tick` reached: a verdict on a later time given by :meth:`finish` is
+    #: provisional (:meth:`early`)
+    _upto: float = field(init=False, default=-math.inf)
+    #: :meth:`finish` is releasing what the watermark had not passed
+    _stopping: bool = field(init=False, default=False)
+
     def __post_init__(self) -> None:
         self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict, self.tolerance)
                          for n in self.nodes]
         self.topics = {t: TopicStatus() for m in self.monitors for t in m.topics}
+        if self.on_verdict is not None and self.reorder_window > 0:
+            for m in self.monitors:
+                m.on_verdict = self._giver(self.on_verdict)
+
+    def early(self, t: float) -> bool:
+        """Whether a verdict decided at ``t`` (s, the run's clock) is given
+        early: by :meth:`finish`, on a time the watermark of the last
+        :meth:`tick` had not passed (the run stopped before every writer was
+        heard past ``t`` or silent for longer than the lateness bound).
+        Never without a lateness bound (messages judged in the order heard)."""
+        return self._stopping and self.reorder_window > 0 and t > self._upto
+
+    def _giver(self, emit: Callable[[Verdict], None]) -> Callable[[Verdict], None]:
+        """``emit`` for a node's monitor, marking a verdict :meth:`early` ``provisional``."""
+        def give(v: Verdict) -> None:
+            emit(dataclasses.replace(v, provisional=True) if self._stopping and v.decided_at > self._upto else v)
+        return give
 
     # -- input -------------------------------------------------------------------
     def push(self, topic: str, fields: Mapping[str, object], received: float, where: str = "") -> None:
@@ -168,6 +199,7 @@ class OnlineEngine:
         (:meth:`watermark`), resolve obligations whose horizon has passed,
         report silent topics."""
         upto = self.watermark(now)
+        self._upto = max(self._upto, upto)
         self._release(upto)
         for m in self.monitors:
             m.advance(max(self._clock, upto))
@@ -221,6 +253,7 @@ class OnlineEngine:
     def finish(self) -> list[NodeResult]:
         """Release what is buffered, close the horizons up to the last message,
         and give each node's result (obligations still within it are ``open``)."""
+        self._stopping = True
         self._release(math.inf)
         for m in self.monitors:
             m.advance(self._clock)

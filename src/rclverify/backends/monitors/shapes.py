@@ -114,6 +114,7 @@ class VerdictJson(TypedDict):
     semantics: str
     question: NotRequired[str]
     margin: NotRequired[float | None]
+    provisional: NotRequired[bool]
 
 
 class NodeResultJson(TypedDict):

@@ -62,7 +62,11 @@ class Verdict:
     docs/semantics.md, "Margins") when the run was judged with margins and
     the verdict is ``satisfied`` or ``violated`` on values that have one,
     else ``None`` (``inf``/``-inf`` when only atoms without a distance
-    decided).
+    decided); ``provisional`` True for a verdict a live monitor gave before
+    every writer (topic) of the node had been heard past ``decided_at``: it
+    went on once a writer had been silent for longer than the lateness
+    bound, or had not been heard at all, so a message of that writer still
+    to come may replace it (docs/semantics.md, "Provisional verdicts").
     """
 
     node: str
@@ -78,10 +82,12 @@ class Verdict:
     semantics: str = ""
     question: str = ""
     margin: float | None = None
+    provisional: bool = False
 
     def to_json(self) -> VerdictJson:
         """A JSON-ready dict (the live monitor's verdict message); ``margin``
-        only when there is one, an infinite one as ``null`` (JSON has no infinity)."""
+        only when there is one, an infinite one as ``null`` (JSON has no infinity);
+        ``provisional`` only when true."""
         out: VerdictJson = {"node": self.node, "verdict": self.verdict, "event": self.event, "time": self.time,
                             "where": self.where, "topic": self.topic, "decided_at": self.decided_at,
                             "guarantee": self.guarantee, "values": dict(self.values), "reason": self.reason,
@@ -90,6 +96,8 @@ class Verdict:
             out["question"] = self.question
         if self.margin is not None:
             out["margin"] = self.margin if math.isfinite(self.margin) else None
+        if self.provisional:
+            out["provisional"] = True
         return out
 
 
