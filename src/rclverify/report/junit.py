@@ -149,7 +149,7 @@ def junit_tree(report: Report | AssuranceReport) -> ET.Element:
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
     for req in (_requirements_suite(typed), junit_suite(report, _case, _outcome), _lint_suite(typed),
-                near_misses_suite(typed, _case, _outcome), nodl_suite(report, _case, _outcome)):
+                near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome)):
         if req is None:
             continue
         root.append(req[0])
@@ -356,7 +356,7 @@ def render_junit(report: Report | AssuranceReport, fragments: FragmentCache | No
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
     for req in (_requirements_suite(typed), junit_suite(report, _case, _outcome), _lint_suite(typed),
-                near_misses_suite(typed, _case, _outcome), nodl_suite(report, _case, _outcome)):
+                near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome)):
         if req is None:
             continue
         ET.indent(req[0], level=1)

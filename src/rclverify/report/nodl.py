@@ -19,7 +19,8 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping
 
-from rclverify.records.nodl_rows import NodlRow
+from rclverify.records.nodl_rows import NodlPlaceRow, NodlRow
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import NodlJson, Report
 from rclverify.records.sarif import SarifLocation, SarifResult
 from rclverify.report.shapes import GroundingBrief
@@ -61,6 +62,10 @@ def nodl_inputs(ws: Workspace, row: Mapping[str, Any] | None) -> dict[str, objec
 
 def _where(place: Mapping[str, Any]) -> str:
     return f"{place['file']}:{place['line']}:{place['col']}"
+
+
+def _at(place: NodlPlaceRow) -> str:
+    return f"{place.file}:{place.line}:{place.col}"
 
 
 def nodl_problems(row: Mapping[str, Any] | None) -> list[str]:
@@ -110,7 +115,7 @@ def terminal_brief(row: Mapping[str, Any] | None) -> GroundingBrief | None:
             "errors": errors}
 
 
-def junit_suite(report: Report, case: Callable[..., ET.Element],
+def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
                 outcome: Callable[..., str]) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``nodl`` ``<testsuite>`` (docs/nodl.md, "In doit verify's report"): one failing
     ``<testcase>`` per NoDL error (``classname`` ``nodl``, name its code and first place, at that
@@ -119,7 +124,7 @@ def junit_suite(report: Report, case: Callable[..., ET.Element],
     neither is one passing case, its warnings (which do not fail ``--strict``) in its
     ``<system-out>``.  ``case`` and ``outcome`` are report/junit.py's.  ``None`` for a workspace
     without a document."""
-    row = report.get("nodl")
+    row = report.nodl
     if row is None:
         return None
     suite = ET.Element("testsuite", {"name": "nodl"})
@@ -130,40 +135,40 @@ def junit_suite(report: Report, case: Callable[..., ET.Element],
         bumped = outcome(c, status, summary, detail, "nodl")
         if bumped:
             counts[bumped] += 1
-    for f in row["findings"]:
-        if f["severity"] != "error":
+    for f in row.findings:
+        if f.severity != "error":
             continue
-        places = [_where(p) for p in f["places"]]
+        places = [_at(p) for p in f.places]
         first = places[0] if places else ""
-        add(case(suite, "nodl", f"{f['code']} {first}".strip(), first, 0.0),
-            "error" if f["code"] == "nodl-record" else "failed", f"{f['message']} [{f['code']}]",
-            "\n".join(f"{p}: error: {f['message']}" for p in places))
-    if row.get("stale"):
-        add(case(suite, "nodl", "nodl-stale", "", 0.0), "stale", f"the NoDL check is stale: {row['stale']}",
+        add(case(suite, "nodl", f"{f.code} {first}".strip(), first, 0.0),
+            "error" if f.code == "nodl-record" else "failed", f"{f.message} [{f.code}]",
+            "\n".join(f"{p}: error: {f.message}" for p in places))
+    if row.stale:
+        add(case(suite, "nodl", "nodl-stale", "", 0.0), "stale", f"the NoDL check is stale: {row.stale}",
             "`doit verify` checks the current documents")
     if not counts["tests"]:
-        n = len(row["documents"])
+        n = len(row.documents)
         c = case(suite, "nodl", f"nodl check of {n} document{'s' if n != 1 else ''}", "", 0.0)
         add(c, "ok", "", "")
-        warned = [f"{_where(f['places'][0]) + ': ' if f['places'] else ''}warning: {f['message']} [{f['code']}]"
-                  for f in row["findings"] if f["severity"] == "warning"]
+        warned = [f"{_at(f.places[0]) + ': ' if f.places else ''}warning: {f.message} [{f.code}]"
+                  for f in row.findings if f.severity == "warning"]
         if warned:
             ET.SubElement(c, "system-out").text = "\n".join(warned)
     return closed(suite, counts)
 
 
-def sarif_results(report: Report, result: Callable[..., SarifResult],
+def sarif_results(report: AssuranceReport, result: Callable[..., SarifResult],
                   location: Callable[[str], list[SarifLocation]]) -> list[SarifResult]:
     """One SARIF result per NoDL finding, at its first place, the others as related locations;
     ``result(rule, level, text, where, key, props)`` and ``location(where)`` are report/sarif.py's."""
-    row = report.get("nodl")
+    row = report.nodl
     if row is None:
         return []
     out = []
-    for k, f in enumerate(row["findings"]):
-        places = [_where(p) for p in f["places"]]
-        res = result("RCL-NODL", "error" if f["severity"] == "error" else "warning", f"{f['message']} [{f['code']}]",
-                     places[0] if places else "", f"nodl:{f['code']}:{':'.join(places)}:{k}", {"code": f["code"]})
+    for k, f in enumerate(row.findings):
+        places = [_at(p) for p in f.places]
+        res = result("RCL-NODL", "error" if f.severity == "error" else "warning", f"{f.message} [{f.code}]",
+                     places[0] if places else "", f"nodl:{f.code}:{':'.join(places)}:{k}", {"code": f.code})
         related = [loc for p in places[1:] for loc in location(p)]
         for i, loc in enumerate(related):
             loc["id"] = i

@@ -359,7 +359,7 @@ def sarif_log(report: Report | AssuranceReport) -> SarifLog:
     from rclverify.report import near_misses  # deferred: start-up (loads rclverify.report.near_misses only when called)
     from rclverify.report import nodl  # deferred: start-up (loads rclverify.report.nodl only when called)
     results = (_obligation_results(typed) + _unverified_results(typed) + _side_condition_results(typed)
-               + _finding_results(typed) + lint + ground + nodl.sarif_results(built, sarif_result, sarif_locations)
+               + _finding_results(typed) + lint + ground + nodl.sarif_results(typed, sarif_result, sarif_locations)
                + _requirement_results(typed) + sarif_results(built, sarif_result) + _acknowledgement_results(typed)
                + near_misses.sarif_results(typed, sarif_result))
     _attach_diagnoses(typed, results)
