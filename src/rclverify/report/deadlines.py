@@ -46,6 +46,7 @@ from typing import Any, Callable, Mapping, Sequence, cast
 import msgspec
 
 from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import DeadlineJson, ObligationJson, Report
 from rclverify.records.solvers_rows import Solvers
 from rclverify.records.statuses import DeadlineVerdict, EvidenceStatus
@@ -257,9 +258,18 @@ def strict_reason(report: Report) -> list[str]:
     return out
 
 
-def _chain_text(row: DeadlineJson) -> str:
-    return " -> ".join(f"{h['node']} guarantee {h['guarantee']} ({h['trigger']} -> {', '.join(h['outputs'])} "
-                       f"within {h['within']}, {h['loc']})" for h in row["chain"]) or "no chain"
+def _chain(row: DeadlineRow) -> list[DeadlineHop]:
+    return [] if row.chain is msgspec.UNSET else row.chain
+
+
+def _chain_text(row: DeadlineRow) -> str:
+    return " -> ".join(f"{h.node} guarantee {h.guarantee} ({h.trigger} -> {', '.join(h.outputs)} "
+                       f"within {h.within}, {h.loc})" for h in _chain(row)) or "no chain"
+
+
+def _said(value: Any, empty: Any = None) -> Any:
+    """A row's field as its JSON object holds it, ``empty`` for one the row leaves unset."""
+    return empty if value is msgspec.UNSET else value
 
 
 #: SARIF rules of the deadlines (``id``, ``name``, ``level``, ``text``), listed by report/sarif.py.
@@ -273,27 +283,28 @@ SARIF_RULES = (
 )
 
 
-def sarif_results(report: Report, result: Callable[..., SarifResult]) -> list[SarifResult]:
+def sarif_results(report: AssuranceReport, result: Callable[..., SarifResult]) -> list[SarifResult]:
     """One SARIF result per deadline that is not proved, at the plan's
     ``deadline:`` entry; ``result(rule, level, text, where, key, props)``
     is report/sarif.py's result maker."""
     out = []
-    for r in report.get("deadlines") or ():
-        if r["verdict"] == "proved":
+    for r in report.deadlines:
+        if r.verdict == "proved":
             continue
         from rclverify.report.severity import of  # deferred: optional or conditional (inside a block)
-        rule = "RCL-DEADLINE-REFUTED" if r["verdict"] == "refuted" else "RCL-DEADLINE-INCONCLUSIVE"
-        level = of("deadline", str(r["verdict"])) or "note"  # one severity in every output (report/severity.py)
-        words = [f"End-to-end deadline of {r['requirement']} ({r['within']} along {' -> '.join(r['path'])}) is "
-                 f"{r['verdict']}: {r['reason']}."]
-        if r["chain"]:
-            words.append(f"Chain: {_chain_text(r)}; sum {r['total']}.")
-        if r["stamps"]:
+        rule = "RCL-DEADLINE-REFUTED" if r.verdict == "refuted" else "RCL-DEADLINE-INCONCLUSIVE"
+        level = of("deadline", r.verdict) or "note"  # one severity in every output (report/severity.py)
+        words = [f"End-to-end deadline of {r.requirement} ({r.within} along {' -> '.join(r.path)}) is "
+                 f"{r.verdict}: {_said(r.reason, '')}."]
+        if _chain(r):
+            words.append(f"Chain: {_chain_text(r)}; sum {_said(r.total)}.")
+        stamps = _said(r.stamps, [])  # each a late run's event and its time from the run's start (timing stage)
+        if stamps:
             words.append("A late run: " + ", ".join(f"{s['event']} at t0 + {float_text(s['t_s'])} s"
-                                                   for s in r["stamps"]) + ".")
-        props = {"requirement": r["requirement"], "verdict": r["verdict"], "within": r["within"],
-                 "total": r["total"], "chain": [f"{h['node']}.g{h['guarantee']}" for h in r["chain"]]}
-        out.append(result(rule, level, " ".join(words), r["source"], f"deadline:{r['requirement']}", props))
+                                                   for s in stamps) + ".")
+        props = {"requirement": r.requirement, "verdict": r.verdict, "within": r.within,
+                 "total": _said(r.total), "chain": [f"{h.node}.g{h.guarantee}" for h in _chain(r)]}
+        out.append(result(rule, level, " ".join(words), r.source, f"deadline:{r.requirement}", props))
     return out
 
 
@@ -306,23 +317,23 @@ def float_text(fraction: Any) -> str:
         return str(fraction)
 
 
-def junit_suite(report: Report, case: Callable[..., ET.Element],
+def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
                 outcome: Callable[..., str]) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``deadlines`` ``<testsuite>``: one ``<testcase>`` per deadline
     (``classname`` ``deadline``, name the requirement id, at the plan's
     entry), passing only when proved; ``case`` and ``outcome`` are
     report/junit.py's.  ``None`` without deadlines."""
-    rows = report.get("deadlines") or []
+    rows = report.deadlines
     if not rows:
         return None
     suite = ET.Element("testsuite", {"name": "deadlines"})
     counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     for r in rows:
-        c = case(suite, "deadline", str(r["requirement"]), str(r["source"]), 0.0)
+        c = case(suite, "deadline", r.requirement, r.source, 0.0)
         counts["tests"] += 1
-        bumped = outcome(c, str(r["status"]), f"{r['verdict']}: {r['reason']}",
-                         "\n".join([f"deadline {r['within']} along {' -> '.join(r['path'])}",
-                                    f"chain: {_chain_text(r)}", f"sum: {r['total']}", f"verdict: {r['verdict']}"]))
+        bumped = outcome(c, _said(r.status, ""), f"{r.verdict}: {_said(r.reason, '')}",
+                         "\n".join([f"deadline {r.within} along {' -> '.join(r.path)}",
+                                    f"chain: {_chain_text(r)}", f"sum: {_said(r.total)}", f"verdict: {r.verdict}"]))
         if bumped:
             counts[bumped] += 1
     return closed(suite, counts)

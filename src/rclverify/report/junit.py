@@ -124,7 +124,7 @@ def _lines(*parts: str) -> str:
 
 def _both(report: Report | AssuranceReport) -> tuple[AssuranceReport, Report]:
     """``report`` decoded once, and as its JSON object (the node suites' kept fragments are keyed by their
-    JSON; the deadlines', near-miss and NoDL suites read the report as built)."""
+    JSON, :func:`_suite_data`)."""
     typed = AssuranceReport.of(report)
     return typed, report if isinstance(report, Mapping) else cast(Report, typed.to_json())
 
@@ -148,7 +148,7 @@ def junit_tree(report: Report | AssuranceReport) -> ET.Element:
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
-    for req in (_requirements_suite(typed), junit_suite(report, _case, _outcome), _lint_suite(typed),
+    for req in (_requirements_suite(typed), junit_suite(typed, _case, _outcome), _lint_suite(typed),
                 near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome)):
         if req is None:
             continue
@@ -355,7 +355,7 @@ def render_junit(report: Report | AssuranceReport, fragments: FragmentCache | No
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
-    for req in (_requirements_suite(typed), junit_suite(report, _case, _outcome), _lint_suite(typed),
+    for req in (_requirements_suite(typed), junit_suite(typed, _case, _outcome), _lint_suite(typed),
                 near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome)):
         if req is None:
             continue

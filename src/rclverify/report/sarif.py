@@ -33,7 +33,7 @@ The decisions behind the mapping are in ``docs/ci.md``.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, cast
+from typing import Any, Mapping, Sequence
 
 import msgspec
 
@@ -345,14 +345,13 @@ def sarif_log(report: Report | AssuranceReport) -> SarifLog:
     ``report`` is the :class:`~rclverify.records.report_schema.Report` of
     :func:`~rclverify.report.build.build_report` or the report decoded,
     :class:`~rclverify.records.report_record.AssuranceReport`; a dict is
-    decoded once (the deadlines', NoDL and near-miss results read it as
-    built).  Every rule of :data:`RULES` is listed in the driver (so ids
+    decoded once, and every part is read off the decoded report (the
+    deadlines', NoDL and near-miss results too).  Every rule of :data:`RULES` is listed in the driver (so ids
     stay stable whether or not they fire), results refer to their rule by
     ``ruleIndex`` too.  Raises :class:`msgspec.ValidationError` for a report
     dict that is not of that shape.
     """
     typed = AssuranceReport.of(report)
-    built = report if isinstance(report, Mapping) else cast(Report, typed.to_json())
     lint, lint_rules = _lint_results(typed)
     ground, ground_rules = _grounding_results(typed)
     from rclverify.report.deadlines import SARIF_RULES, sarif_results  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
@@ -360,7 +359,7 @@ def sarif_log(report: Report | AssuranceReport) -> SarifLog:
     from rclverify.report import nodl  # deferred: start-up (loads rclverify.report.nodl only when called)
     results = (_obligation_results(typed) + _unverified_results(typed) + _side_condition_results(typed)
                + _finding_results(typed) + lint + ground + nodl.sarif_results(typed, sarif_result, sarif_locations)
-               + _requirement_results(typed) + sarif_results(built, sarif_result) + _acknowledgement_results(typed)
+               + _requirement_results(typed) + sarif_results(typed, sarif_result) + _acknowledgement_results(typed)
                + near_misses.sarif_results(typed, sarif_result))
     _attach_diagnoses(typed, results)
     rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
