@@ -26,10 +26,28 @@ robots' slips.  The failing line is **exact** when the line the diagnosis names 
 edits when that repair was found around it (:func:`rclverify.diagnosis.code_repair.repaired_line`, as
 ``diagnosis/build.py`` names it).
 
+The manipulator's seven defects (``examples/manipulator/robot.py --defects NAME``) are found by its live
+monitor, not by property tests (:func:`run_manipulator`, when a ROS 2 Python is there: ``.venv-ros2`` or
+``RCLVERIFY_ROS2_PYTHON``):
+
+1. the correct robot and each defect are run live once (``examples/manipulator/watch.py``: the robot under
+   ``rclverify monitor --live --ros2``, :data:`ROUNDS` rounds, the rclpy source), each run's log kept;
+2. on the defect's log, :func:`rclverify.diagnosis.run_repair.run_repairs` re-runs the defect's node
+   (``robot.py``'s ``build([NAME])``) on its recorded questions, each candidate judged again by the monitors
+   on the run, as the diagnosis of a monitor's violation does;
+3. the first repair is **equivalent** to the seeded fix when the run judged again with it equals the run
+   judged again with the node re-run as the correct robot (``build([])``), every node's verdicts and counts
+   (the defects are seeded by a flag, so no repair's text is the fix's: none is **equal**); else a miss;
+4. it **breaks** an obligation when a live run of the robot with the repair made (a copy of the example,
+   ``--defects NAME``) gives any node another status than the correct robot's live run;
+5. the seeded line is the line of ``robot.py`` that reads ``bad("NAME")``; the named line is the line the
+   first checked repair edits, else the callback's first line.
+
 Usage::
 
     python bench/repair_examples.py              # every defect, a table and the totals
     python bench/repair_examples.py --only battery_lt,odometer_minus
+    python bench/repair_examples.py --only manipulator   # the manipulator's seven (live runs)
 
 The figures are printed, not asserted (``tests/diagnosis/test_repair_examples.py`` asserts one defect).
 """
@@ -222,12 +240,120 @@ def run(only: set[str] | None = None) -> list[tuple[Defect, Outcome]]:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
+#: Rounds of a manipulator run: every input value of robot.py's drivers at least once.
+ROUNDS = 6
+MANIPULATOR = EXAMPLES / "manipulator"
+#: The manipulator's defects and the contract node each one breaks, whether by its calls (a service, an action).
+MANIPULATOR_DEFECTS = {"guard_last_beam": ("ObstacleGuard", False), "charge_lt": ("ChargeMonitor", False),
+                       "limiter_first_five": ("JointLimiter", False), "governor_cap": ("SpeedGovernor", False),
+                       "docking_threshold": ("Docking", False), "estop_always": ("EStop", True),
+                       "arm_spoilt": ("Arm", True)}
+
+
+def _ros2_python() -> Path | None:
+    import os
+    named = os.environ.get("RCLVERIFY_ROS2_PYTHON")
+    exe = Path(named) if named else ROOT / ".venv-ros2" / "bin" / "python"
+    return exe if exe.is_file() else None
+
+
+def _watch_module(folder: Path) -> Any:
+    """``watch.py`` of the manipulator copy in ``folder`` (its robot the copy's ``robot.py``)."""
+    import importlib.util
+    import sys
+    spec = importlib.util.spec_from_file_location(f"manipulator_watch_{abs(hash(str(folder)))}",
+                                                  folder / "watch.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _live(where: Path, robot_text: str | None, defects: str, python: Path) -> tuple[Path, dict[str, str]]:
+    """A live run of the manipulator (a copy under ``where`` with ``robot_text`` as its ``robot.py`` when
+    given): ``(its log, each contract node's status)``."""
+    ws = where / "examples" / "manipulator"
+    shutil.copytree(MANIPULATOR, ws, ignore=IGNORE)
+    shutil.copyfile(EXAMPLES / "ros2_recording.py", where / "examples" / "ros2_recording.py")
+    if robot_text is not None:
+        (ws / "robot.py").write_text(robot_text, encoding="utf-8")
+    w = _watch_module(ws)
+    run = where / "run"
+    run.mkdir()
+    got = w.watch(run, python, w.loopback_env(run), source="rclpy", defects=defects, burners=0, rounds=ROUNDS)
+    return run / "live.jsonl", w.node_status(got["record"])
+
+
+@dataclass
+class LiveOutcome:
+    """What the tool did on one manipulator defect: ``named`` the line it names, ``exact``, the
+    ``offered`` repairs' texts of ``robot.py``, the first's ``verdict``, the nodes whose live status it
+    ``breaks``, ``why`` none was offered and the seconds taken."""
+
+    named: str
+    exact: bool
+    offered: list[str]
+    verdict: str
+    breaks: list[str]
+    why: str
+    seconds: float
+
+
+def run_manipulator(tmp: Path, python: Path, only: set[str] | None = None) -> list[tuple[str, LiveOutcome]]:
+    """The manipulator's defects (module docstring), each ``(name, outcome)``."""
+    from rclverify.app.pipeline import Workspace
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.diagnosis.edits import Edit
+    from rclverify.diagnosis.run_repair import rejudged, run_repairs
+    names = [n for n in MANIPULATOR_DEFECTS if only is None or n in only or "manipulator" in only]
+    if not names:
+        return []
+    checked = Workspace(MANIPULATOR).checked
+    cfg = load_mapping(MANIPULATOR, "contracts/mapping.yaml", None)
+    text = (MANIPULATOR / "robot.py").read_text(encoding="utf-8")
+    _, correct = _live(tmp / "correct", None, "", python)
+    out = []
+    for name in names:
+        t0 = time.perf_counter()
+        node, calls = MANIPULATOR_DEFECTS[name]
+        log, _ = _live(tmp / name, None, name, python)
+        got = run_repairs(MANIPULATOR, checked, cfg, log, node, calls, "robot.py", "build", [[name]], python)
+        seeded = next(k for k, x in enumerate(text.splitlines(), 1) if f'bad("{name}")' in x)
+        exact = got.line == f"robot.py:{seeded}"
+        offered = [Edit(r["file"], r["edit"]["line"], r["edit"]["col"], r["edit"]["end_line"], r["edit"]["end_col"],
+                        r["edit"]["inserted"]).apply(text) for r in got.repairs]
+        if not offered:
+            out.append((name, LiveOutcome(got.line, exact, [], "none", [], got.why, time.perf_counter() - t0)))
+            continue
+        fixed = rejudged(MANIPULATOR, checked, cfg, log, node, calls, "robot.py", text, "build", [[]], python)
+        first = rejudged(MANIPULATOR, checked, cfg, log, node, calls, "robot.py", offered[0], "build", [[name]],
+                         python)
+        verdict = "equivalent" if first == fixed else "miss"
+        _, live = _live(tmp / f"{name}-repaired", offered[0], name, python)
+        breaks = sorted(n for n in correct if live.get(n) != correct[n])
+        out.append((name, LiveOutcome(got.line, exact, offered, verdict, breaks, "", time.perf_counter() - t0)))
+    return out
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--only", default="", help="comma-separated defect names")
     p.add_argument("--smoke", action="store_true", help="CI: one defect of one new robot (rover's odometer_minus)")
     a = p.parse_args()
-    results = run({"odometer_minus"} if a.smoke else ({x for x in a.only.split(",") if x} or None))
+    only = {"odometer_minus"} if a.smoke else ({x for x in a.only.split(",") if x} or None)
+    results = run(only)
+    live: list[tuple[str, LiveOutcome]] = []
+    python = _ros2_python()
+    if not a.smoke and (only is None or "manipulator" in only or only & set(MANIPULATOR_DEFECTS)):
+        if python is None:
+            print("manipulator: skipped, no ROS 2 Python (.venv-ros2, or RCLVERIFY_ROS2_PYTHON)")
+        else:
+            tmp = Path(tempfile.mkdtemp(prefix="rclverify-repair-manipulator-"))
+            try:
+                live = run_manipulator(tmp, python, only)
+            finally:
+                shutil.rmtree(tmp, ignore_errors=True)
     print(f"{'robot':<16} {'defect':<22} {'node':<15} {'line':<6} {'first repair':<10} breaks  s")
     for d, o in results:
         line = "exact" if o.exact else (o.cause.rpartition(":")[2] or "-") + f"/{d.line}"
@@ -236,14 +362,35 @@ def main() -> None:
         print(f"{'':<16} seeded fix:   {_change(d.slipped, d.fixed)}")
         if o.offered:
             print(f"{'':<16} first repair: {_change(d.slipped, o.offered[0])}")
-    n = len(results)
-    good = sum(1 for _, o in results if o.verdict in ("equal", "equivalent"))
-    exact = sum(1 for _, o in results if o.exact)
-    breaks = sum(1 for _, o in results if o.breaks)
+    text = (MANIPULATOR / "robot.py").read_text(encoding="utf-8")
+    for name, lo in live:
+        seeded = next(k for k, x in enumerate(text.splitlines(), 1) if f'bad("{name}")' in x)
+        line = "exact" if lo.exact else (lo.named.rpartition(":")[2] or "-") + f"/{seeded}"
+        print(f"{'manipulator':<16} {name:<22} {MANIPULATOR_DEFECTS[name][0]:<15} {line:<6} {lo.verdict:<10} "
+              f"{len(lo.breaks):>6}  {lo.seconds:.1f}")
+        if lo.offered:
+            print(f"{'':<16} first repair: {_change(text, lo.offered[0])}")
+        else:
+            print(f"{'':<16} none: {lo.why}")
+        if lo.breaks:
+            print(f"{'':<16} breaks (live): {', '.join(lo.breaks)}")
+    if live:
+        g = sum(1 for _, lo in live if lo.verdict == "equivalent")
+        print(f"manipulator: first repair equivalent to the seeded fix {g}/{len(live)}; repairs that break another "
+              f"obligation (live) {sum(1 for _, lo in live if lo.breaks)}; failing line exact "
+              f"{sum(1 for _, lo in live if lo.exact)}/{len(live)}")
+    n = len(results) + len(live)
+    good = sum(1 for _, o in results if o.verdict in ("equal", "equivalent")) + \
+        sum(1 for _, lo in live if lo.verdict == "equivalent")
+    exact = sum(1 for _, o in results if o.exact) + sum(1 for _, lo in live if lo.exact)
+    breaks = sum(1 for _, o in results if o.breaks) + sum(1 for _, lo in live if lo.breaks)
+    if not n:
+        print("no defect named")
+        return
     print(f"defects: {n}; first repair equal or equivalent to the seeded fix: {good}/{n} "
           f"({7 * good / n:.1f} of every 7, aim >= 5); repairs that break another obligation: {breaks} (aim 0); "
           f"failing line exact: {exact}/{n} ({7 * exact / n:.1f} of every 7, aim >= 6); "
-          f"seconds: {sum(o.seconds for _, o in results):.0f}")
+          f"seconds: {sum(o.seconds for _, o in results) + sum(lo.seconds for _, lo in live):.0f}")
 
 
 if __name__ == "__main__":
