@@ -64,6 +64,8 @@ def test_if_else_substitution_picks_its_value(ws: Path) -> None:
                   "     namespace=IfElseSubstitution(LaunchConfiguration('sim'), 'sim', 'real')),")
     assert sorted(_graph(ws, _py(ws, "ifelse.launch.py", body.format(sim="true", log="0"))).nodes) == ["/sim/talker"]
     assert sorted(_graph(ws, _py(ws, "ifelse.launch.py", body.format(sim="0", log="0"))).nodes) == ["/real/talker"]
+    picked = body.replace("'sim', 'real'", "LaunchConfiguration('log'), 'real'")
+    assert sorted(_graph(ws, _py(ws, "ifelse.launch.py", picked.format(sim="1", log="x1"))).nodes) == ["/x1/talker"]
     # control: an operand that is no bool is said, the node kept without the namespace
     g = _graph(ws, _py(ws, "ifelse.launch.py", body.format(sim="maybe", log="0")))
     assert sorted(g.nodes) == ["/talker"] and "'maybe' is not true, false, 1 or 0" in " ".join(_said(g))

@@ -36,6 +36,7 @@ ros-navigation/navigation2 ``nav2_common/launch``.
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 from typing import Callable
 
@@ -79,7 +80,7 @@ def call_value(e: ast.Call, name: str, value: Callable[[ast.AST], str], unres: t
         c, y, n = a(0, "condition"), a(1, "if_value"), a(2, "else_value")
         if c is not None:
             yes, no = (value(x) if x is not None else "" for x in (y, n))
-            if not any(ch in yes + no for ch in " ()$"):
+            if not any(ch in re.sub(r"\$\([^()]*\)", "", yes + no) for ch in " ()$"):  # one word each
                 return f"$(logic if {value(c)} {yes or '-'} {no or '-'})"
     if name == "StringJoinSubstitution":
         parts, sep = a(0, "substitutions"), a(1, "delimiter")
