@@ -337,7 +337,15 @@ def checked() -> Any:
     return check([parse_text(CONTRACT, "rover.rcl")])
 
 
-def _disagreements(imp: Any, checked: Any, pt_text: str, traces: int, seed: int) -> list[Any]:
+def _disagreements(imp: Any, checked: Any, pt_text: str, traces: int, seed: int,
+                   make: Callable[[random.Random], list[dict[str, Any]]] = _trace) -> list[Any]:
+    rng = random.Random(seed)
+    return _disagree_on(imp, checked, pt_text, [make(rng) for _ in range(traces)])
+
+
+def _disagree_on(imp: Any, checked: Any, pt_text: str, traces: list[list[dict[str, Any]]]) -> list[Any]:
+    """The traces of ``traces`` on which rclverify's verdict on ``imp``'s statement and FRET's ``pt_text`` at
+    the trace's end disagree."""
     stypes = state_types(imp.states, checked)
     assert imp.requirement.formal is not None, imp.refusal
     t = parse_temporal(imp.requirement.formal, checked, imp.fret.reqid, stypes)
@@ -346,10 +354,8 @@ def _disagreements(imp: Any, checked: Any, pt_text: str, traces: int, seed: int)
     svs = imp.states
     parsed = {sv.name: (parse_state_formula(sv, "init", checked, svs), parse_state_formula(sv, "next", checked, svs))
               for sv in svs}
-    rng = random.Random(seed)
     out = []
-    for _ in range(traces):
-        tr = _trace(rng)
+    for tr in traces:
         fret_holds = bool(_pt(pt, tr, len(tr) - 1))
         if not _rcl_agrees(t, checked, tr, _state_run(svs, parsed, checked, tr), fret_holds):
             out.append(tr)

@@ -65,13 +65,25 @@ def _var(name: str, id_type: str, data_type: str, assignment: str = "") -> dict[
 VARIABLES = [_var("obstacle", "Input", "boolean"), _var("asked", "Input", "double"),
              _var("speed", "Output", "double"), _var("braking", "Output", "boolean"),
              _var("limit", "Internal", "double", "2.0"), _var("filtered", "Internal", "double", "0.0 -> pre speed")]
+#: FRET's ptExpanded of R-4 (null scope, upon, after 2 ticks; FRET v3.1.0's formalisation of that combination).
+AFTER_PT = ("((H ((O[<=2] (obstacle & (Z (! obstacle)))) -> ((H (! obstacle)) | (! (speed = 0.0))))) & (H ((O[=3] "
+            "((obstacle & (Z (! obstacle))) & (! (speed = 0.0)))) -> (O[<3] ((Z FALSE) | (speed = 0.0))))))")
+#: FRET's ptExpanded of "in manual mode upon obstacle the rover shall immediately satisfy braking".
+MODE_TRIGGER_PT = (
+    "((H (((! manual) & (Y manual)) -> (Y (((obstacle & ((Y (! obstacle)) | (manual & (Z (! manual))))) -> braking) S "
+    "(((obstacle & ((Y (! obstacle)) | (manual & (Z (! manual))))) -> braking) & (manual & (Z (! manual)))))))) & "
+    "(((! ((! manual) & (Y manual))) S ((! ((! manual) & (Y manual))) & (manual & (Z (! manual))))) -> (((obstacle & "
+    "((Y (! obstacle)) | (manual & (Z (! manual))))) -> braking) S (((obstacle & ((Y (! obstacle)) | (manual & (Z (! "
+    "manual))))) -> braking) & (manual & (Z (! manual)))))))")
 REQS = [
     _req("R-1", "the rover shall always satisfy speed <= limit", "always", "(speed <= limit)"),
     _req("R-2", "upon obstacle the rover shall immediately satisfy braking", "immediately", "(braking)",
          "regular", "(obstacle)"),
     _req("R-3", "the rover shall within 3 ticks satisfy speed <= asked", "within", "(speed <= asked)", duration=3),
     _req("R-4", "upon obstacle the rover shall after 2 ticks satisfy speed = 0.0", "after", "(speed = 0.0)",
-         "regular", "(obstacle)", duration=2),
+         "regular", "(obstacle)", duration=2, ptExpanded=AFTER_PT),
+    _req("R-6", "upon obstacle the rover shall finally satisfy braking", "finally", "(braking)", "regular",
+         "(obstacle)", ptExpanded="((H (! obstacle)) | braking)"),
 ]
 
 
@@ -90,23 +102,23 @@ def ws(tmp_path: Path) -> Path:
 
 def test_each_requirement_becomes_a_plan_requirement_by_reqid(ws: Path, tmp_path: Path) -> None:
     res = import_fret(ws, "contracts/plan.yaml", _write(tmp_path / "export.json", REQS), "export.json")
-    assert res.added == ["R-1", "R-2", "R-3", "R-4"] and res.written and res.plan_edited
+    assert res.added == ["R-1", "R-2", "R-3", "R-4", "R-6"] and res.written and res.plan_edited
     plan = load_plan(ws)
     reqs = {r.id: r for r in all_requirements(plan)}
-    assert list(reqs) == ["CAP", "R-1", "R-2", "R-3", "R-4"]  # the plan's own first, then the export's
+    assert list(reqs) == ["CAP", "R-1", "R-2", "R-3", "R-4", "R-6"]  # the plan's own first, then the export's
     assert reqs["R-1"].text == "the rover shall always satisfy speed <= limit"
     assert reqs["R-1"].origin == "fret/export.json" and reqs["R-1"].loc.file == "fret/export.json"
     assert reqs["R-1"].formal is not None and reqs["R-1"].formal.text == "always (Rover.out.speed <= (2.0))"
     assert reqs["R-2"].formal is not None and "Rover.state.fret_R_2_prev" in reqs["R-2"].formal.text
-    assert [s.name for s in plan.states] == ["fret_R_2_prev"]
+    assert [s.name for s in plan.states][0] == "fret_R_2_prev"
     assert reqs["R-3"].formal is not None and reqs["R-3"].formal.text.startswith("eventually[<= 3] ")
-    assert reqs["R-4"].formal is None  # not translated: informal, never dropped
+    assert reqs["R-4"].formal is not None and reqs["R-4"].formal.text.startswith("always (")  # FRET's ptExpanded
+    assert {s.name for s in plan.states if s.name.startswith("fret_R_4_pt")}
+    assert reqs["R-6"].formal is None  # not translated: informal, never dropped
     Workspace(ws, "contracts/plan.yaml").checked  # every imported statement type-checks with the contract
     out = render(res)
-    assert "export.json:R-4: the timing after with scope null and condition regular is not translated; with " \
-           "this scope and condition rclverify translates the timings immediately, next, within, for, eventually, " \
-           "always, never, until" in out
-    assert "3 translated to a decided temporal statement, 1 kept as informal" in out
+    assert "export.json:R-6: the timing finally asks the response at the last step of the scope's interval" in out
+    assert "4 translated to a decided temporal statement, 1 kept as informal" in out
 
 
 def test_reimport_reports_added_changed_removed_and_keeps_the_plans_own(ws: Path, tmp_path: Path) -> None:
@@ -116,7 +128,7 @@ def test_reimport_reports_added_changed_removed_and_keeps_the_plans_own(ws: Path
     copy = (ws / "fret" / "export.json").read_bytes()
     again = import_fret(ws, "contracts/plan.yaml", first, "export.json")
     assert (again.added, again.changed, again.removed) == ([], [], [])
-    assert again.unchanged == ["R-1", "R-2", "R-3", "R-4"] and not again.written and not again.plan_edited
+    assert again.unchanged == ["R-1", "R-2", "R-3", "R-4", "R-6"] and not again.written and not again.plan_edited
     assert (ws / "fret" / "export.json").read_bytes() == copy
     edited = [dict(r) for r in REQS if r["reqid"] != "R-3"]
     edited[0] = _req("R-1", "the rover shall always satisfy speed <= 1.5", "always", "(speed <= 1.5)")
@@ -126,7 +138,7 @@ def test_reimport_reports_added_changed_removed_and_keeps_the_plans_own(ws: Path
     assert (res.added, res.changed, res.removed) == (["R-5"], ["R-1"], ["R-3"])
     assert (ws / "contracts" / "plan.yaml").read_text(encoding="utf-8") == plan_text  # the plan is not touched
     ids = [r.id for r in all_requirements(load_plan(ws))]
-    assert ids == ["CAP", "R-1", "R-2", "R-4", "R-5"]
+    assert ids == ["CAP", "R-1", "R-2", "R-4", "R-5", "R-6"]
     assert "  changed: R-1" in render(res) and "  removed: R-3" in render(res)
 
 
@@ -142,16 +154,24 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
                          "satisfy braking", "immediately", "(braking)", "noTrigger",
              "(preBool ( false , speed - preReal ( speed , speed ) <= 1.0 ))"),
         _req("OK", "the rover shall never satisfy speed > 2.0", "never", "(speed > 2.0)"),
+        _req("MODE-TRIGGER-PT", "in manual mode upon obstacle the rover shall immediately satisfy braking",
+             "immediately", "(braking)", "regular", "(obstacle)", scope_mode="manual", ptExpanded=MODE_TRIGGER_PT),
     ]
     reqs[3]["semantics"]["scope"] = {"type": "in"}
-    got = {i.fret.reqid: i for i in import_export(read_export(_write(tmp_path / "e.json", reqs), "e.json"), Options())}
+    reqs[-1]["semantics"]["scope"] = {"type": "in"}
+    variables = VARIABLES + [_var("manual", "Input", "boolean")]
+    got = {i.fret.reqid: i for i in import_export(read_export(_write(tmp_path / "e.json", reqs, variables), "e.json"),
+                                                   Options())}
     why = {k: (i.refusal.reason, i.refusal.fix) if i.refusal else None for k, i in got.items()}
     assert why["LUSTRE"] == ("filtered is an Internal variable defined in Lustre (0.0 -> pre speed)",
                              "make filtered an input or output of rover, or define it in FRET by a FRETish "
                              "expression over the component's variables")
     assert why["UNDECLARED"] is not None and why["UNDECLARED"][0] == "ghost is not declared in the export"
     assert why["FUNCTION"] is not None and "FRET function sqrt(_)" in why["FUNCTION"][0]
-    assert why["MODE-TRIGGER"] is not None and "a trigger inside a mode interval" in why["MODE-TRIGGER"][0]
+    assert why["MODE-TRIGGER"] == ("its export has no past-time formalisation (semantics.ptExpanded), which rclverify "
+                                   "states for the scope in with the timing immediately",
+                                   "export the requirement again from FRET")
+    assert why["MODE-TRIGGER-PT"] is None  # the same with FRET's formalisation: stated from it
     assert why["NOSEM"] is not None and "FRET has not formalised it" in why["NOSEM"][0]
     assert why["PRE-INIT"] == ("a pre function's initial value out.speed reads the component's variables",
                                "give it a constant initial value (preReal(0.0, e))")
@@ -197,7 +217,7 @@ def test_the_command_exits_1_only_on_a_malformed_export(ws: Path, tmp_path: Path
     args = argparse.Namespace(fn=cmd_import_fret, command="import", export=str(good), workspace=str(ws),
                               plan="contracts/plan.yaml")
     assert _run(args) == 0  # one requirement not imported is no error
-    assert "export.json:R-4: " in capsys.readouterr().out
+    assert "export.json:R-6: " in capsys.readouterr().out
     bad = tmp_path / "bad.json"
     bad.write_text("{", encoding="utf-8")
     args.export = str(bad)

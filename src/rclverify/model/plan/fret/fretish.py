@@ -79,8 +79,11 @@ def _tokens(text: str) -> list[str]:
 
 
 class _Parser:
-    def __init__(self, text: str) -> None:
-        self.text, self.toks, self.i = text, _tokens(text), 0
+    #: The binary levels read, loosest first (a subclass adds FRET's past-time ``S``).
+    levels: tuple[tuple[str, ...], ...] = _LEVELS
+
+    def __init__(self, text: str, toks: list[str] | None = None) -> None:
+        self.text, self.toks, self.i = text, _tokens(text) if toks is None else toks, 0
 
     def peek(self) -> str | None:
         return self.toks[self.i] if self.i < len(self.toks) else None
@@ -94,10 +97,10 @@ class _Parser:
         return t
 
     def level(self, k: int) -> Expr:
-        if k == len(_LEVELS):
+        if k == len(self.levels):
             return self.unary()
         left = self.level(k + 1)
-        while self.peek() in _LEVELS[k]:
+        while self.peek() in self.levels[k]:
             op = self.take()
             right = self.level(k) if op in ("=>", "->") else self.level(k + 1)
             left = ("bin", op, left, right)
@@ -218,6 +221,9 @@ class Writer:
     pre: PreVar
     node: str
     count: CountVar | None = None
+    #: ``temporal(e, local)``: the RCL text of a past-time node of FRET's formalisation (``("past", op, e)``,
+    #: ``("bin", "S", a, b)``; :mod:`.pasttime`), ``None`` where the expression has none.
+    temporal: Callable[[Expr, bool], str] | None = None
 
     def rcl(self, e: Expr, local: bool = False) -> str:
         """RCL text of ``e``: over ``Node.in.x``/``Node.out.y``/``Node.state.v``
@@ -236,6 +242,8 @@ class Writer:
             return f"(not {self.rcl(e[1], local)})"  # type: ignore[arg-type]
         if kind == "neg":
             return f"(-{self.rcl(e[1], local)})"  # type: ignore[arg-type]
+        if self.temporal is not None and (kind == "past" or kind == "bin" and e[1] == "S"):
+            return self.temporal(e, local)
         if kind == "bin":
             op, a, b = e[1], e[2], e[3]
             la, lb = self.rcl(a, local), self.rcl(b, local)  # type: ignore[arg-type]

@@ -59,6 +59,7 @@ from fractions import Fraction
 from typing import Any, Callable, Mapping
 
 from rclverify.model.plan.fret.fretish import Expr, Refusal, Writer, parse
+from rclverify.model.plan.fret.pasttime import CLOSED, PastTime, not_closed, parse_pt, statement
 
 #: The timings translated for each (scope, condition) (module table).
 _CONDITIONED = ("immediately", "next", "within", "for", "eventually", "null", "always", "never", "until")
@@ -158,16 +159,8 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
     cond, timing = str(sem.get("condition") or "null"), str(sem.get("timing") or "null")
     if str(sem.get("response") or "satisfaction") != "satisfaction":
         raise Refusal(f"its response is {sem.get('response')!r}", "write the response as 'satisfy'")
-    if scope == "in" and cond != "null":
-        raise Refusal("a trigger inside a mode interval (scope 'in', a condition) is not translated",
-                      "write the mode into the condition (whenever M & P ...) or split the requirement")
     if timing not in SUPPORTED.get((scope, cond), ()):
-        here = SUPPORTED.get((scope, cond))
-        raise Refusal(f"the timing {timing} with scope {scope} and condition {cond} is not translated",
-                      "with this scope and condition rclverify translates the timings "
-                      f"{', '.join(t for t in here if t != 'null')}" if here
-                      else "rclverify translates the scopes null and in (docs/requirements.md, "
-                           "'Requirements from FRET')")
+        return _compiled(scope, timing, fulltext, sem, node, var, step, state_base(reqid))
     states = _States(state_base(reqid))
     w = _writer(var, states, node)
 
@@ -198,6 +191,33 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
     p_tree = field_expr("regular_condition", "pre_condition")
     return _conditioned(cond, timing, p_tree, q, w, states, node, lambda: steps_of(sem, fulltext, step),
                         lambda: field_expr("stop_condition"))
+
+
+def _compiled(scope: str, timing: str, fulltext: str, sem: Mapping[str, Any], node: str,
+              var: Callable[[str, bool], str | Expr], step: Fraction | None, base: str) -> Translation:
+    """A combination the module table does not write: FRET's own ``ptExpanded`` stated with state variables
+    (:mod:`.pasttime`) when it is prefix-closed, else refused with the reason."""
+    if scope not in CLOSED:
+        raise Refusal(f"its scope {scope} is not one of FRET's scopes rclverify reads",
+                      f"write it with one of the scopes {', '.join(CLOSED)}")
+    if timing not in CLOSED[scope]:
+        raise Refusal(*not_closed(scope, timing))
+    pt = sem.get("ptExpanded")
+    if not isinstance(pt, str) or not pt.strip():
+        raise Refusal("its export has no past-time formalisation (semantics.ptExpanded), which rclverify states for "
+                      f"the scope {scope} with the timing {timing}", "export the requirement again from FRET")
+    raw = sem.get("duration")
+    raw = raw[0] if isinstance(raw, list) and raw else raw
+    if raw not in (None, "") and (m := _UNITS.search(fulltext)) and not m.group(2).lower().startswith("tick"):
+        n = steps_of(sem, fulltext, step)
+        if Fraction(str(raw)) != n:
+            raise Refusal(f"FRET's formalisation counts its duration {raw} {m.group(2)} as {raw} steps, and the plan's "
+                          f"step period makes it {n}", "write the duration in ticks")
+    states = _States(base)
+    w = _writer(var, states, node)
+    past = PastTime(states.add, node)
+    w.temporal, past.writer = past, w
+    return Translation(statement(parse_pt(pt), w), node, states.made)
 
 
 def _unconditional(timing: str, q: str, q_tree: Expr, w: Writer, states: _States, node: str,
