@@ -109,6 +109,7 @@ SECONDS: dict[str, float] = {
     # this round's modules over two CPU seconds (run alone, one process, the import of pytest not counted)
     "test_repair_examples": 30.0, "test_repair_oracle": 7.0, "test_repair_cli": 5.0, "test_hoare_token_repairs": 3.0,
     "test_fret_example": 4.0, "test_instances": 3.5, "test_fleet_example": 4.0,
+    "test_fret_scopes": 19.0,  # 191 FRET scope/timing combinations, each run against FRET's formula on 12 traces
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
