@@ -29,7 +29,7 @@ from typing import Any, Sequence
 #: The live monitor's own topics: a re-written run leaves out its verdicts.
 VERDICT_TOPIC = "rclverify/verdict"
 #: Seconds the agent may take beyond its texts' own bounds (rclpy's start).
-AGENT_TIMEOUT_S = 60.0
+AGENT_TIMEOUT_S = 120.0
 
 
 class RerunError(Exception):
