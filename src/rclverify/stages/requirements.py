@@ -79,6 +79,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple["R
     from rclverify.calculus.requirements.check import cone_of, fingerprint, state_text, statement_formals  # deferred: start-up (loads lark, yaml and more only when called)
     from rclverify.calculus.requirements.own_nodes import decide, fingerprint_inputs  # deferred: start-up (loads z3 and more only when called)
     from rclverify.backends.monitors.temporal_evidence import fingerprint_text, requirement_traces, trace_hashes, trace_rows  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.model.plan.fret.seal import compared, sealed_inputs  # deferred: start-up (only a plan that reads FRET)
     code = f"{code_stamp()} z3 {z3.get_version_string()}"
     checked, model, plan = ws.checked, ws.model, ws.plan
     model_text = (ws.root / ws.MODEL).read_text(encoding="utf-8") if (ws.root / ws.MODEL).is_file() else \
@@ -101,7 +102,8 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple["R
         # a temporal requirement also reads the state declarations of its cone (plan.states)
         traces = requirement_traces(req, checked, plan)  # recorded runs checked against it (docs/plan.md)
         th = trace_hashes(ws.root, traces)
-        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([fingerprint_text(ws.root, traces)] if traces else [])
+        fret = sealed_inputs(ws.root, plan, req)  # a FRET requirement's entry in the export (model/plan/fret/seal.py)
+        fp = fingerprint(req, [snap(n) for n in cone] + [state_text(plan, cone)] + ([fingerprint_text(ws.root, traces)] if traces else []) + compared(fret)
                          + (fingerprint_inputs(req, checked, model, plan) if formal is not None else []),
                          model_text if formal is not None else "", code)
         rel = record_path(req.id)
@@ -123,6 +125,7 @@ def stage_requirements(ws: "Workspace", *, force: bool = False) -> list[tuple["R
                     queries[made[key]] = (kind, text)
             rec = {**made, "fingerprint": fp,
                    "inputs": input_hashes(ws, cone, snap, model_hash) if formal is not None else {}}
+            rec["inputs"].update(fret)
             if traces:
                 rec["traces"] = trace_rows(req, checked, plan, ws.root)
                 rec["inputs"].update(th)
@@ -191,6 +194,8 @@ def read_records(ws: "Workspace", current: dict[str, str] | None = None) -> dict
             from rclverify.backends.monitors.temporal_evidence import trace_hashes  # deferred: optional or conditional (inside a block)
             current = {**current, **trace_hashes(ws.root, [(p[6:], None) for p in made
                                                            if p.startswith("trace:") and p not in current])}
+            from rclverify.model.plan.fret.seal import current as fret_now  # deferred: optional or conditional (inside a block)
+            current = {**current, **fret_now(ws.root, made)}
         if current is not None and rec.get("verdict") != "informal" and (
                 not isinstance(made, dict) or any(current.get(p) != h for p, h in made.items())):
             out[rid] = {**keep, "verdict": "stale", "recorded_verdict": rec.get("verdict"),
