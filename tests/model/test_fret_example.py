@@ -39,3 +39,37 @@ def test_the_example_decides_its_fret_requirements_and_rechecks_an_edited_one(tm
     again = _verdicts(root)
     assert again["ROVER-001"] == ("refuted", True)  # the edited requirement, checked again: the contract allows 2
     assert [k for k, (_, now) in again.items() if now] == ["ROVER-001"]  # only it
+
+
+def test_an_edited_export_makes_its_requirement_stale_until_checked_again(tmp_path: Path) -> None:
+    """Each imported requirement's record seals its entry of the export (``fret:<export>#<reqid>``) and
+    the export's hash: an edit of ROVER-002's text alone (its statement unchanged) makes its record stale
+    in the report, and only its; the next run checks it again, and then equals a clean run."""
+    from rclverify.report.build import read_inputs
+    from rclverify.stages.requirements import read_records
+
+    root = tmp_path / "ws"
+    shutil.copytree(EXAMPLE, root, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*"))
+    _verdicts(root)
+    rec = json.loads((root / "artifacts" / "requirements" / "ROVER-002.json").read_text(encoding="utf-8"))
+    export = "fret/rover_requirements.json"
+    assert set(rec["inputs"]) >= {f"fret:{export}#ROVER-002", f"fret:{export}"}
+    assert "fret:" not in json.dumps(json.loads((root / "artifacts" / "requirements" / "CAP.json").read_text(
+        encoding="utf-8"))["inputs"])  # the plan's own requirement reads no export
+
+    def stale() -> list[str]:
+        ws = Workspace(root, "contracts/plan.yaml")
+        return sorted(k for k, r in read_records(ws, read_inputs(ws).hashes).items() if r["verdict"] == "stale")
+    assert stale() == []  # the control: nothing edited, nothing stale
+    path = root / export
+    data = json.loads(path.read_text(encoding="utf-8"))
+    r2 = next(r for r in data["requirements"] if r["reqid"] == "ROVER-002")
+    r2["fulltext"] += " (reviewed)"
+    path.write_text(json.dumps(data, indent=1), encoding="utf-8")
+    assert stale() == ["ROVER-002"]
+    again = _verdicts(root)
+    assert [k for k, (_, now) in again.items() if now] == ["ROVER-002"]
+    assert stale() == []
+    clean = tmp_path / "clean"
+    shutil.copytree(root, clean, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*"))
+    assert {k: v for k, (v, _) in _verdicts(clean).items()} == {k: v for k, (v, _) in again.items()}
