@@ -8,6 +8,8 @@ what it does (docs/ros.md, "Other packages' substitutions"), with its control:
   ``RewrittenYaml`` (keys decided at run time) it is said, the node kept;
 * ``ParameterFile(RewrittenYaml(...))`` given to an include is a value (the
   include reads it), while a class nobody knows is said at its line;
+* ``HasNodeParams`` of a file the YAML guard refuses (an alias bomb) or a FIFO
+  is said and the node kept;
 * ``Command``, ``FindExecutable``, launch_ros' ``Parameter`` are named as
   known only at run time, the node kept without the attribute (control: a
   literal there is read).
@@ -16,6 +18,7 @@ Packages are written into a temporary directory and read by the scan.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -123,3 +126,26 @@ def test_run_time_substitutions_are_named_and_the_node_kept(ws: Path, sub: str, 
     # control: a literal in its place is read
     assert sorted(_graph(ws, _py(ws, "rt.launch.py", "Node(package='demo', executable='talker', "
                                                      "namespace='r9'),")).nodes) == ["/r9/talker"]
+
+
+BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{c}: &{c} [{', '.join(['*' + p] * 9)}]\n" for p, c in zip("abcdefgh", "bcdefghi"))
+
+
+@pytest.mark.parametrize("hostile", ["bomb", "fifo"])
+def test_has_node_params_of_a_hostile_file_is_said_and_the_node_kept(ws: Path, hostile: str) -> None:
+    cfg = ws / "ws/demo/config/p.yaml"
+    cfg.parent.mkdir(exist_ok=True)
+    cfg.unlink(missing_ok=True)
+    if hostile == "fifo":
+        os.mkfifo(cfg)  # never opened: the scan would block on it
+    else:
+        cfg.write_text(BOMB)
+    try:
+        g = _graph(ws, _py(ws, "has.launch.py", "Node(package='demo', executable='talker', condition=IfCondition("
+                                                "HasNodeParams(source_file=params, node_name='talker'))),"))
+    finally:
+        cfg.unlink()
+    assert sorted(g.nodes) == ["/talker"]
+    [said] = _said(g)
+    assert "has.launch.py:" in said and "HasNodeParams: p.yaml cannot be read" in said and "as if the condition held" in said
