@@ -292,3 +292,45 @@ def test_the_plan_gains_only_its_requirements_from_line(ws: Path, tmp_path: Path
     assert not (ws / "fret" / "f.json").exists()  # nothing written
     assert "add 'fret: fret/f.json' to it" in e.value.diagnostics[0].message
     assert plan.read_text(encoding="utf-8") == PLAN + "requirements_from: {doorstop: reqs}\n"
+
+
+UNIT_CONTRACT = """node Rover {
+  inputs( obstacle : BOOL, asked : REAL [m/s], gap : REAL )
+  outputs( speed : REAL [m/s], braking : BOOL )
+  assume( TRUE )
+  guarantee( TRUE )
+}
+"""
+
+
+def test_a_fret_unit_that_differs_from_the_ports_is_refused(tmp_path: Path) -> None:
+    """A FRET variable's unit (its ``unit`` field, or ``[unit]`` ending its description) is the port's
+    unit or the requirement is refused at its reqid with the reason; none said in FRET is not checked."""
+    from rclverify.lang.parser import parse_text
+    from rclverify.model.plan.fret.requirements import ports_of
+    ports = ports_of([parse_text(UNIT_CONTRACT, "rover.rcl")])
+
+    def imported(speed: dict[str, Any], gap: dict[str, Any] | None = None) -> Any:
+        variables = [_var("obstacle", "Input", "boolean"), {**_var("speed", "Output", "double"), **speed},
+                     {**_var("gap", "Input", "double"), **(gap or {})}, _var("asked", "Input", "double")]
+        reqs = [_req("U", "the rover shall always satisfy speed <= 2.0 & gap >= 0.0", "always",
+                     "(speed <= 2.0 & gap >= 0.0)")]
+        exp = read_export(_write(tmp_path / "u.json", reqs, variables), "u.json")
+        (got,) = import_export(exp, Options({"rover": "Rover"}), ports)
+        return got
+    km_h = imported({"unit": "km/h"})
+    assert km_h.refusal is not None and km_h.requirement.formal is None
+    assert (km_h.refusal.reason, km_h.refusal.fix) == (
+        "speed is in [km/h] in FRET but Rover.out.speed is in [m/s]",
+        "make the units agree: write [m/s] in FRET, or declare [km/h] on the port")
+    described = imported({"description": "commanded speed [mm/s]"})
+    assert described.refusal is not None and "[mm/s] in FRET" in described.refusal.reason
+    no_unit = imported({}, {"unit": "m"})
+    assert no_unit.refusal is not None and no_unit.refusal.reason == \
+        "gap is in [m] in FRET but Rover.in.gap declares no unit"
+    unknown = imported({"unit": "furlong"})
+    assert unknown.refusal is not None and "is not a unit rclverify reads" in unknown.refusal.reason
+    # the controls: the same unit however written, and no unit said in FRET
+    assert imported({"unit": "m / s"}).refusal is None
+    assert imported({"description": "commanded speed [m*s^-1]"}).refusal is None
+    assert imported({}).refusal is None

@@ -37,7 +37,7 @@ SEMANTICS_KEYS = ("type", "scope", "condition", "timing", "response", "variables
                   "pre_condition", "regular_condition", "post_condition", "stop_condition", "duration",
                   "scope_mode", "qualifier_word", "ptExpanded", "ftInfAUExpanded", "ftExpanded")
 VARIABLE_KEYS = ("project", "component_name", "variable_name", "idType", "dataType", "assignment",
-                 "modeRequirement", "description")
+                 "modeRequirement", "description", "unit")
 
 
 @dataclass

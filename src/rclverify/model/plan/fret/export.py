@@ -22,12 +22,17 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify.lang import ast
 from rclverify.model.plan.errors import PlanError, plan_error
+
+
+#: A unit in brackets at the end of a variable's description.
+_DESCRIBED_UNIT = re.compile(r"\[([^\[\]]+)\]\s*$")
 
 
 @dataclass(frozen=True)
@@ -49,7 +54,10 @@ class FretRequirement:
 @dataclass(frozen=True)
 class FretVariable:
     """A FRET variable of ``component``: ``name``, ``id_type``, ``data_type``, ``assignment`` (an
-    Internal one's Lustre definition) and ``mode_requirement`` (a Mode's FRETish definition)."""
+    Internal one's Lustre definition), ``mode_requirement`` (a Mode's FRETish definition) and ``unit``
+    (its unit of measure, ``m/s``; ``""`` when none is said): the variable's ``unit`` field, else a unit
+    written in brackets at the end of its ``description`` (``distance to the obstacle [m]``), FRET's
+    variables having no field of their own for it."""
 
     component: str
     name: str
@@ -57,6 +65,7 @@ class FretVariable:
     data_type: str
     assignment: str
     mode_requirement: str = ""
+    unit: str = ""
 
 
 @dataclass(frozen=True)
@@ -77,6 +86,15 @@ def _data_type(v: Any) -> str:
     if isinstance(v, list):
         v = v[0] if v else ""
     return str(v or "")
+
+
+def _unit(v: Mapping[str, Any]) -> str:
+    """A variable's unit (:class:`FretVariable`), blanks removed."""
+    u = v.get("unit")
+    if not isinstance(u, str) or not u.strip():
+        m = _DESCRIBED_UNIT.search(str(v.get("description") or ""))
+        u = m.group(1) if m else ""
+    return "".join(u.split())
 
 
 def digest(raw: Mapping[str, Any]) -> str:
@@ -137,7 +155,7 @@ def read_export(path: Path, rel: str) -> FretExport:
         if isinstance(v, dict) and "idType" in v and isinstance(v.get("variable_name"), str):
             fv = FretVariable(str(v.get("component_name") or ""), v["variable_name"], str(v.get("idType") or ""),
                               _data_type(v.get("dataType")), str(v.get("assignment") or ""),
-                              str(v.get("modeRequirement") or ""))
+                              str(v.get("modeRequirement") or ""), _unit(v))
             variables[(fv.component, fv.name)] = fv
     return FretExport(rel, tuple(out), variables)
 

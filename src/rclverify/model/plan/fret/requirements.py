@@ -59,10 +59,12 @@ class Options:
 @dataclass(frozen=True)
 class Ports:
     """The contracts' nodes as parsed: ``nodes[node][name] = ("in"|"out", type name or None)``;
-    ``constants`` the names of context constants and enumeration values."""
+    ``constants`` the names of context constants and enumeration values; ``units[node][name]`` the unit
+    written on a port (``m/s``), absent when it has none."""
 
     nodes: Mapping[str, Mapping[str, tuple[str, str | None]]]
     constants: frozenset[str]
+    units: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -79,6 +81,7 @@ class Imported:
 def ports_of(specs: list[ast.Spec]) -> Ports:
     """The :class:`Ports` of parsed contract files ``specs``."""
     nodes: dict[str, dict[str, tuple[str, str | None]]] = {}
+    units: dict[str, dict[str, str]] = {}
     consts: set[str] = set()
     for sp in specs:
         for n in sp.nodes:
@@ -86,12 +89,14 @@ def ports_of(specs: list[ast.Spec]) -> Ports:
             for prefix, vs in (("in", n.inputs), ("out", n.outputs)):
                 for v in vs:
                     io[v.name] = (prefix, getattr(v.type, "name", None))
+                    if v.unit is not None:
+                        units.setdefault(n.name, {})[v.name] = v.unit.text
         for c in sp.contexts:
             for d in c.decls:
                 consts.add(d.name)
                 vals = getattr(d.type, "values", None)
                 consts.update(vals if isinstance(vals, tuple) else ())
-    return Ports(nodes, frozenset(consts))
+    return Ports(nodes, frozenset(consts), units)
 
 
 class _Places:
@@ -158,6 +163,7 @@ class _Places:
             has = ", ".join(sorted(n for n, (p, _) in io.items() if p == prefix)) or "none"
             raise Refusal(f"{self.node} has no {want} named {v.name} (its {want}s: {has})",
                           f"declare {v.name} as an {want} of {self.node}, or correct its idType in FRET")
+        self._check_unit(v, prefix)
         dt, rt = v.data_type.lower(), got[1]
         if rt is None:
             return
@@ -166,6 +172,30 @@ class _Places:
         if not ok:
             raise Refusal(f"{v.name} is a FRET {v.data_type} but {self.node}.{prefix}.{v.name} is a {rt}",
                           f"make the types agree (FRET boolean is BOOL; a number is REAL, INTEGER or NATURAL)")
+
+    def _check_unit(self, v: FretVariable, prefix: str) -> None:
+        """FRET's unit of ``v`` (:attr:`FretVariable.unit`) against the port's (docs/rcl-language.md, "Units of
+        measure"): the same unit, or none said in FRET.  Raises :class:`Refusal`."""
+        if not v.unit or self.ports is None:
+            return
+        from rclverify.lang.units import UnitError, parse_unit  # deferred: start-up (only a FRET variable with a unit)
+        port = f"{self.node}.{prefix}.{v.name}"
+        try:
+            fret = parse_unit(v.unit)
+        except UnitError as exc:
+            raise Refusal(f"{v.name}'s unit [{v.unit}] in FRET is not a unit rclverify reads ({exc.message})",
+                          "write it as RCL writes units (m, m/s, rad/s^2, 1)") from None
+        have = self.ports.units.get(self.node, {}).get(v.name)
+        if have is None:
+            raise Refusal(f"{v.name} is in [{v.unit}] in FRET but {port} declares no unit",
+                          f"declare the unit on the port ({v.name} : ... [{v.unit}]) or correct it in FRET")
+        try:
+            same = parse_unit(have) == fret
+        except UnitError:
+            return  # the contract's own unit error, reported where the contracts are checked
+        if not same:
+            raise Refusal(f"{v.name} is in [{v.unit}] in FRET but {port} is in [{have}]",
+                          f"make the units agree: write [{have}] in FRET, or declare [{v.unit}] on the port")
 
 
 def _states(t: Translation, loc: ast.Loc) -> tuple[StateVar, ...]:
