@@ -77,6 +77,7 @@ def build(defects):
 
     def estop(req, resp):
         resp.success = True if "estop" in defects else req.data
+        n = defects.count("x")
         return resp
 '''
 
@@ -103,6 +104,7 @@ def test_a_lambdas_candidates_and_a_truth_value_put_to_a_field_the_callback_read
     got = _edits(15, "estop", ["defects"], [])
     assert (16, 'resp.success = req.data if "estop" in defects else req.data') in got
     assert (16, 'resp.success = False if "estop" in defects else req.data') in got
+    assert not any("defects.count" in text for _, text in got)  # control: only a parameter's fields
     assert _edits(99, "govern", [], []) == []  # control: no callback at that line
 
 

@@ -103,7 +103,8 @@ def rerun(python: Path, source: Path, texts: Sequence[str], factory: str, args: 
           asked: Sequence[dict[str, Any]], timeout_s: float = 60.0) -> dict[str, Any]:
     """The agent's answer (:mod:`.rerun_agent`: ``runs``, one per text, and ``callback``) for the node at
     ``ep`` of the robot that ``factory(*args)`` of ``source`` (each of ``texts``) makes, asked ``asked``, in
-    the ROS 2 Python ``python``, each text within ``timeout_s`` seconds.  Raises :class:`RerunError` when the agent does not answer."""
+    the ROS 2 Python ``python``, each text within ``timeout_s`` seconds.  Raises :class:`RerunError` when
+    the agent does not answer."""
     req = {"file": str(source), "texts": list(texts), "factory": factory, "args": list(args), "kind": ep.kind,
            "inputs": list(ep.inputs), "outputs": list(ep.outputs), "name": ep.name, "type": ep.ros_type,
            "questions": list(asked), "timeout_s": timeout_s}

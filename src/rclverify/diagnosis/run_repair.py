@@ -81,10 +81,10 @@ class RunRepairs:
     why: str = ""
 
 
-def _roots(tree: ast.Module, line: int, name: str, freevars: Sequence[str]) -> list[ast.expr]:
+def _roots(tree: ast.Module, line: int, name: str, freevars: Sequence[str]) -> tuple[list[ast.expr], set[str]]:
     """The expressions a repair of the callback at ``line`` (``name``: its code's name, ``<lambda>`` for a
     lambda) may edit: the callback's own and the values assigned, in the function enclosing it, to the
-    names it reads from there (``freevars``)."""
+    names it reads from there (``freevars``); and the callback's parameters."""
     found: list[tuple[ast.AST, ast.AST | None]] = []  # (callback, its enclosing function)
 
     def visit(n: ast.AST, outer: ast.AST | None) -> None:
@@ -97,13 +97,17 @@ def _roots(tree: ast.Module, line: int, name: str, freevars: Sequence[str]) -> l
             visit(c, c if isinstance(c, (ast.FunctionDef, ast.AsyncFunctionDef)) else outer)
     visit(tree, None)
     roots: list[ast.expr] = []
+    params: set[str] = set()
     for cb, outer in found:
+        args = getattr(cb, "args", None)
+        if isinstance(args, ast.arguments):
+            params |= {a.arg for a in (*args.posonlyargs, *args.args, *args.kwonlyargs)}
         roots.extend([cb.body] if isinstance(cb, ast.Lambda) else
                      [e for s in ast.walk(cb) if isinstance(s, ast.stmt) for e in _values(s)])
         for s in ast.walk(outer) if outer is not None else ():
             if isinstance(s, ast.Assign) and any(isinstance(t, ast.Name) and t.id in freevars for t in s.targets):
                 roots.append(s.value)
-    return roots
+    return roots, params
 
 
 def _values(s: ast.stmt) -> list[ast.expr]:
@@ -114,13 +118,14 @@ def _values(s: ast.stmt) -> list[ast.expr]:
     return []
 
 
-def _params(tree: ast.Module, roots: Sequence[ast.expr]) -> list[str]:
-    """The fields of messages the callback reads (``req.data``): attributes of a parameter of a lambda or
-    function among ``roots``' callbacks, each once, in source order."""
+def _params(roots: Sequence[ast.expr], params: set[str]) -> list[str]:
+    """The fields of messages the callback reads (``req.data``): attributes of its parameters ``params``
+    read in ``roots``, each once, in source order."""
     out: list[str] = []
     for r in roots:
         for n in ast.walk(r):
-            if isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name) and isinstance(n.ctx, ast.Load):
+            if isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name) and isinstance(n.ctx, ast.Load) \
+                    and n.value.id in params:
                 out.append(ast.unparse(n))
     return list(dict.fromkeys(out))
 
@@ -136,8 +141,8 @@ def candidate_edits(source: str, file: str, line: int, name: str, freevars: Sequ
     except (SyntaxError, ValueError):
         return []
     lines = source.splitlines(keepends=True)
-    roots = _roots(tree, line, name, freevars)
-    reads = _params(tree, roots)
+    roots, params = _roots(tree, line, name, freevars)
+    reads = _params(roots, params)
     ranked: list[tuple[int, Edit]] = []
     for root in roots:
         holder = ast.FunctionDef(name="_", args=ast.arguments(posonlyargs=[], args=[], kwonlyargs=[],
@@ -239,7 +244,8 @@ def run_repairs(root: Path, checked: Any, cfg: Any, trace: Path, node: str, call
     cb = first.get("callback") or {}
     run0 = (first.get("runs") or [{}])[0]
     if run0.get("error") or not cb:
-        return RunRepairs(why=f"{source} did not answer {node}'s questions when re-run: {run0.get('error') or 'no callback found'}")
+        said = run0.get("error") or "no callback found"
+        return RunRepairs(why=f"{source} did not answer {node}'s questions when re-run: {said}")
     at = f"{source}:{cb['line']}"
     if not reproduces(lines, ep, run0["answers"]):
         return RunRepairs(line=at, why=f"re-run on the run's questions, {source} does not give the recorded "
