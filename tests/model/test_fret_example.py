@@ -39,6 +39,28 @@ def test_the_example_decides_its_fret_requirements_and_rechecks_an_edited_one(tm
     again = _verdicts(root)
     assert again["ROVER-001"] == ("refuted", True)  # the edited requirement, checked again: the contract allows 2
     assert [k for k, (_, now) in again.items() if now] == ["ROVER-001"]  # only it
+    reqids = {r["reqid"] for r in data["requirements"]}
+    assert _matrix_ids(root) == reqids | {"CAP"}
+    removed = {**data, "requirements": [r for r in data["requirements"] if r["reqid"] != "ROVER-008"]}
+    edited.write_text(json.dumps(removed), encoding="utf-8")
+    assert import_fret(root, "contracts/plan.yaml", edited, "rover.json").removed == ["ROVER-008"]
+    _verdicts(root)
+    assert _matrix_ids(root) == reqids - {"ROVER-008"} | {"CAP"}  # the control: the matrix follows the export
+
+
+def _matrix_ids(root: Path) -> set[str]:
+    """The requirement ids of the trace matrix (``rclverify standards --trace``) of ``root``'s report; a
+    FRET requirement's is its reqid, and the assertion names any id that is neither the export's nor the
+    plan's own."""
+    from rclverify.report.build import undiagnosed_report
+    from rclverify.report.standards_sheets import trace_rows
+    rows = trace_rows(undiagnosed_report(Workspace(root, "contracts/plan.yaml")))
+    assert rows[0][:2] == ["requirement", "requirement verdict"]
+    ids = {r[0] for r in rows[1:] if r[0]}
+    export = json.loads((root / "fret" / "rover_requirements.json").read_text(encoding="utf-8"))
+    unknown = ids - {r["reqid"] for r in export["requirements"]} - {"CAP"}
+    assert not unknown, f"the trace matrix names requirements that are not in the export: {sorted(unknown)}"
+    return ids
 
 
 def test_an_edited_export_makes_its_requirement_stale_until_checked_again(tmp_path: Path) -> None:
