@@ -48,8 +48,11 @@ are not violated by a trace that ends first.  One difference is named: an
 unbounded ``eventually`` on a finite trace that ends before its response is
 FRET's false (``O Q`` at the end) and rclverify's ``currently_false`` (a
 longer run may reach it); over infinite runs, what rclverify proves, both
-are FRET's ``F Q`` (``ftInfAUExpanded``).  Whatever else raises
-:class:`~.fretish.Refusal` naming it.
+are FRET's ``F Q`` (``ftInfAUExpanded``).  A combination not in the table is
+stated from the export's own past-time formalisation when it is prefix-closed
+(:mod:`.pasttime`: the other scopes, the timings after and before, a
+trigger inside a mode); whatever else raises :class:`~.fretish.Refusal`
+naming it.
 """
 from __future__ import annotations
 
