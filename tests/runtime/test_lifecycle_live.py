@@ -41,7 +41,13 @@ from std_msgs.msg import Float64
 
 DEFECT = sys.argv[1] == "defect"
 rclpy.init()
-battery = LifecycleNode("battery")
+class Battery(LifecycleNode):
+    def on_activate(self, state):
+        time.sleep(0.3 if DEFECT else 0.0)  # the defective node is slow to activate
+        return super().on_activate(state)
+
+
+battery = Battery("battery")
 pub = (battery.create_publisher if DEFECT else battery.create_lifecycle_publisher)(Float64, "level", 10)
 battery.create_timer(0.05, lambda: pub.publish(Float64(data=10.0)))
 requester = Node("requester")
@@ -80,7 +86,8 @@ def _run(tmp: Path, variant: str) -> dict[str, Any]:
     try:
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--status", "0", "--duration", "90",
                              "--horizon", "1", "--source", "rclpy", "--ros2-python", str(py), "--log",
-                             str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json")], env, tmp, tmp / "monitor.out")
+                             str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json"), "--record",
+                             str(tmp / "run_bag")], env, tmp, tmp / "monitor.out")
         node = start_node(tmp, "battery", NODES.replace("sys.argv[1]", repr(variant)), env)
         wait_for(tmp / "battery.log", "done", 80)
         time.sleep(1.0)  # the last outputs heard, and settled
@@ -88,7 +95,7 @@ def _run(tmp: Path, variant: str) -> dict[str, Any]:
         out = (tmp / "monitor.out").read_text()
         assert (tmp / "live.json").exists(), out + (tmp / "battery.log").read_text()
         return {"out": out, "record": json.loads((tmp / "live.json").read_text()),
-                "node": (tmp / "battery.log").read_text()}
+                "node": (tmp / "battery.log").read_text(), "bag": tmp / "run_bag", "tmp": tmp}
     finally:
         for p in (node, monitor):
             if p is not None:
@@ -127,3 +134,66 @@ def test_a_plain_publisher_of_a_lifecycle_node_is_red_while_inactive_only(runs: 
     assert {v["state"] for v in node["violations"]} <= {"unconfigured", "inactive", "configuring"}, node
     assert node["outputs_judged"] > len(node["violations"]), node  # its outputs while active are not red
     assert all("/battery published on /level while" in v["reason"] for v in node["violations"])
+
+
+def _bag(run: dict[str, Any]) -> tuple[list[Any], list[Any]]:
+    from rclverify.traces.lifecycle_events import read_run
+    return read_run(run["bag"])
+
+
+def _offline(run: dict[str, Any], within: float) -> dict[str, Any]:
+    """The run's bag judged offline (runtime/lifecycle.judge_recorded) with an activation deadline."""
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    from rclverify.runtime.lifecycle import judge_recorded
+    checked = check([parse_text(RCL, "b.rcl")])
+    cfg = load_mapping(run["tmp"], None, 1.0)
+    events, transitions = _bag(run)
+    assert [STATES[t.goal] for t in transitions][:6] == ["configuring", "inactive", "activating", "active",
+                                                         "deactivating", "inactive"], transitions
+    return judge_recorded(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, events,
+                          run["tmp"] / "offline.jsonl", deadlines={"Battery": {"activate": within}})
+
+
+STATES = {1: "unconfigured", 2: "inactive", 3: "active", 10: "configuring", 13: "activating", 14: "deactivating"}
+
+
+def test_the_recorded_bag_is_judged_as_the_live_run_judged_it(runs: dict[str, Any]) -> None:
+    """The bag holds what the recorder heard between its start and its close, which need not be every
+    message the live judge heard at the run's two ends (a request or a level a few ms before or after):
+    the counts are compared on what the bag holds, at most the messages it lacks apart; a request heard at a
+    transition may be decided either way (below)."""
+    for variant in ("correct", "defect"):
+        live = runs[variant]["record"]
+        rec = _offline(runs[variant], 0.2)
+        def heard(r: dict[str, Any]) -> int:  # the messages judged, and those held back as no question
+            return int(r["events"]) + sum(r["lifecycle"]["not_questions"].values())
+        lacks = heard(live) - heard(rec)  # the messages the live judge heard and the bag lacks
+        assert 0 <= lacks <= 4, (heard(live), heard(rec))
+        [off], [on] = rec["lifecycle"]["nodes"], live["lifecycle"]["nodes"]
+        assert off["transitions"] == on["transitions"] and off["status"] == on["status"], (off, on)
+        for key in ("outputs_judged", "violations"):
+            n_off, n_on = (len(x[key]) if key == "violations" else x[key] for x in (off, on))
+            assert n_off <= n_on <= n_off + lacks, (variant, key, n_off, n_on, lacks)
+        # a request heard within 0.1 s of a transition may be held back live and asked offline, or the other way:
+        # live decides it by the transitions heard before it, the bag by its record order (docs/monitors.md)
+        events, transitions = _bag(runs[variant])
+        near = sum(1 for e in events if e.topic == "request" and any(abs(e.time - t.time) < 0.1 for t in transitions))
+        q_off, q_on = (x["lifecycle"]["not_questions"].get("request", 0) for x in (rec, live))
+        assert abs(q_on - q_off) <= lacks + near, (variant, q_off, q_on, lacks, near)
+        assert rec["nodes"][0]["status"] == live["nodes"][0]["status"]
+        v_off, v_on = (x["nodes"][0]["counts"]["violated"] for x in (rec, live))
+        assert v_off <= v_on <= v_off + lacks, (variant, v_off, v_on, lacks)
+
+
+def test_an_activation_deadline_met_by_the_quick_node_and_missed_by_the_slow_one(runs: dict[str, Any]) -> None:
+    [quick] = _offline(runs["correct"], 0.2)["lifecycle"]["nodes"][0]["deadlines"]
+    assert quick["status"] == "met" and quick["seconds"] < 0.2, quick
+    slow_rec = _offline(runs["defect"], 0.2)
+    [slow] = slow_rec["lifecycle"]["nodes"][0]["deadlines"]
+    assert slow["status"] == "missed" and slow["seconds"] >= 0.3, slow  # on_activate sleeps 0.3 s
+    assert "transition deadline(s) missed" in slow_rec["nodes"][0]["explanation"]
+    # control: the slow node within a deadline it can meet
+    [ok] = _offline(runs["defect"], 2.0)["lifecycle"]["nodes"][0]["deadlines"]
+    assert ok["status"] == "met", ok
