@@ -109,6 +109,7 @@ SECONDS: dict[str, float] = {
     # this round's modules over two CPU seconds (run alone, one process, the import of pytest not counted)
     "test_repair_examples": 30.0, "test_repair_oracle": 7.0, "test_repair_cli": 5.0, "test_hoare_token_repairs": 3.0,
     "test_fret_example": 4.0, "test_instances": 3.5, "test_fleet_example": 4.0,
+    "test_lifecycle_recorded": 2.6,  # seven replays of a recorded run through the live run's judge
     "test_fret_scopes": 19.0,  # 191 FRET scope/timing combinations, each run against FRET's formula on 12 traces
 }
 
@@ -126,7 +127,7 @@ WALL: dict[str, float] = {
     "test_ros_names_rclpy": 3.2, "test_ros2_bag_calls": 15.0, "test_ros2_event_time": 20.0,
     "test_example_manipulator": 32.0, "test_ros2_call_endpoints": 35.0, "test_ros2_declared_types": 27.0,
     "test_ros2_undefined_type": 6.0, "test_nodl_live": 17.0, "test_ros2_carried": 36.0,
-    "test_live_stops": 45.0, "test_names_rcl": 5.0, "test_names_fleet_live": 17.0, "test_lifecycle_live": 35.0,
+    "test_live_stops": 45.0, "test_names_rcl": 5.0, "test_names_fleet_live": 17.0, "test_lifecycle_live": 40.0,
     "test_instances_live": 35.0, "test_lsp_code_repair": 20.0, "test_fleet_example_live": 30.0,
     "test_run_repair_rclpy": 25.0,
 }
