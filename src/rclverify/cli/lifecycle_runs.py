@@ -1,0 +1,103 @@
+"""``rclverify monitor TRACE`` for managed nodes: a recorded run judged as the live run judges it
+(docs/monitors.md, "Lifecycle nodes in a recorded run").
+
+When a monitored node is managed (its contract names its ``lifecycle_msgs/TransitionEvent
+<node>/transition_event`` topic, :func:`rclverify.runtime.lifecycle.managed_of`), each trace is read
+with its transition events (:func:`rclverify.traces.lifecycle_events.read_run`) and judged by
+:func:`rclverify.runtime.lifecycle.judge_recorded`: the live run's gate and judge, the messages at their
+recorded times.  ``--transition-deadline NODE:TRANSITION=DURATION`` (repeatable; ``Battery:activate=200ms``,
+a duration in ``ms`` or ``s``, seconds when bare) bounds a managed node's transitions.
+
+Printed per trace and node: the node's status and explanation, then its lifecycle line (state,
+transitions heard, outputs judged, violations, deadlines met and missed) and the inputs held back as
+no question; ``--json`` prints the runs' records instead.  Exit 1 when a node failed, 2 for a usage
+error (a malformed or refused deadline) or a trace that cannot be read (one located line), else 0
+(``--strict``: 1 also when a node is not discharged).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any, Sequence
+
+_DEADLINE = re.compile(r"^([A-Za-z_]\w*):([a-z]+)=([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(ms|s)?$")
+
+
+def parse_deadlines(texts: Sequence[str]) -> dict[str, dict[str, float]]:
+    """``NODE:TRANSITION=DURATION`` options as ``{node: {transition: seconds}}``.  Raises
+    :class:`ValueError` naming the option for one not of that form."""
+    out: dict[str, dict[str, float]] = {}
+    for text in texts:
+        m = _DEADLINE.match(text.strip())
+        if m is None:
+            raise ValueError(f"--transition-deadline {text!r}: write NODE:TRANSITION=DURATION "
+                             f"(Battery:activate=200ms)")
+        value = float(m.group(3)) / (1000.0 if m.group(4) == "ms" else 1.0)
+        out.setdefault(m.group(1), {})[m.group(2)] = value
+    return out
+
+
+def _lines(trace: str, rec: dict[str, Any]) -> list[str]:
+    """The printed lines of one judged trace (module docstring)."""
+    out: list[str] = []
+    life = {n["node"]: n for n in rec["lifecycle"]["nodes"]}
+    for n in rec["nodes"]:
+        out.append(f"{trace}: {n['node']}: {n['status']}: {n['explanation']}")
+        m = life.get(n["node"])
+        if m is not None:
+            timed = m.get("deadlines") or []
+            said = ", ".join(f"{sum(t['status'] == s for t in timed)} {s}" for s in ("met", "missed", "open")
+                             if any(t["status"] == s for t in timed))
+            out.append(f"  lifecycle {m['ros_node']}: {m['transitions']} transition(s) heard, last {m['state']}; "
+                       f"{m['outputs_judged']} output(s) judged, {len(m['violations'])} outside active"
+                       + (f"; deadlines: {said}" if said else ""))
+            out += [f"    {t['status']}: {t['reason']}" for t in timed if t["status"] != "met"]
+    held = rec["lifecycle"]["not_questions"]
+    if held:
+        out.append(f"{trace}: no question (heard while its readers were not active): "
+                   + ", ".join(f"/{t} {k}" for t, k in held.items()))
+    return out
+
+
+def lifecycle_command(args: argparse.Namespace, checked: Any, nodes: Sequence[Any], cfg: Any, root: Path) -> int:
+    """Judge ``args.traces`` (module docstring) for ``nodes`` of ``checked`` under the monitor
+    configuration ``cfg`` (its message directories relative to ``root``); returns the exit code,
+    never raising for user input."""
+    from rclverify.runtime.lifecycle import judge_recorded  # deferred: loads the live run's judge
+    from rclverify.traces.events import TraceError
+    from rclverify.traces.lifecycle_events import read_run
+    try:
+        deadlines = parse_deadlines(getattr(args, "transition_deadline", None) or [])
+    except ValueError as exc:
+        print(f"rclverify monitor: error: {exc}", file=sys.stderr)
+        return 2
+    records: list[dict[str, Any]] = []
+    failed = undecided = False
+    with tempfile.TemporaryDirectory(prefix="rclverify-lifecycle-") as tmp:
+        for k, trace in enumerate(args.traces):
+            try:
+                events, _ = read_run(Path(trace), [root / d for d in cfg.msg_dirs])
+                rec = judge_recorded(checked, nodes, cfg.rules, cfg.horizon, events, Path(tmp) / f"run{k}.jsonl",
+                                     deadlines=deadlines)
+            except TraceError as exc:
+                print(str(exc), file=sys.stderr)
+                return 2
+            except ValueError as exc:  # a deadline the gate refuses
+                print(f"rclverify monitor: error: --transition-deadline: {exc}", file=sys.stderr)
+                return 2
+            rec["trace"] = trace
+            records.append(rec)
+            failed = failed or any(n["status"] == "failed" for n in rec["nodes"])
+            undecided = undecided or any(n["status"] != "discharged" for n in rec["nodes"])
+            if not args.json:
+                print("\n".join(_lines(trace, rec)))
+    if args.json:
+        print(json.dumps(records, indent=2, sort_keys=True))
+    return 1 if failed or (getattr(args, "strict", False) and undecided) else 0
+
+
+__all__ = ["lifecycle_command", "parse_deadlines"]
