@@ -74,6 +74,10 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     nodes = selected_nodes(checked, args.nodes, "monitor")
     if nodes is None:
         return 2
+    from rclverify.runtime.lifecycle import managed_of  # deferred: managed nodes' runs are judged as live (cli/lifecycle_runs.py)
+    if managed_of(nodes) or getattr(args, "transition_deadline", None):
+        from rclverify.cli.lifecycle_runs import lifecycle_command  # deferred: as above
+        return lifecycle_command(args, checked, nodes, cfg, root)
     violated = False
     unjudged: list[dict[str, str]] = []
     report: list[Mapping[str, object]] = []

@@ -39,6 +39,9 @@ def add_monitor(add: AddCommand) -> None:
     m.add_argument("--strict", action="store_true",
                    help="exit 1 also when a node, topic, service, action or deadline of the contracts was not "
                         "judged (nothing heard, not decoded, ...; docs/monitors.md, \"Silence is never green\")")
+    m.add_argument("--transition-deadline", action="append", metavar="NODE:TRANSITION=DURATION",
+                   help="a managed node's transition bound (Battery:activate=200ms; repeatable; recorded runs: "
+                        "docs/monitors.md, \"Lifecycle nodes in a recorded run\")")
     _live_options(m.add_argument_group("live monitoring (ROS 1, ROS 2 over DDS; docs/monitors.md)"))
 
 
