@@ -169,3 +169,32 @@ def test_deadlines_the_gate_refuses(tmp_path: Path) -> None:
                               "p.rcl")])
     with pytest.raises(ValueError, match="no managed node among Battery"):
         judge_recorded(plain, list(plain.nodes.values()), [], 1.0, [], tmp_path / "x.jsonl")
+
+
+def _workspace(tmp: Path) -> Path:
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/b.rcl").write_text(RCL, encoding="utf-8")
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/b.rcl]\n", encoding="utf-8")
+    return ws
+
+
+def test_rclverify_monitor_judges_a_managed_nodes_log_as_live(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from rclverify.cli.commands import main
+    ws = _workspace(tmp_path)
+    quiet = [x for x in TRAFFIC if x[1] == "request" and x[2] == 1.0 or 2.1 <= x[0] <= 3.0 and x[1] == "level"]
+    log = str(_log(tmp_path, _script(traffic=quiet)))
+    assert main(["monitor", "-w", str(ws), log, "--horizon", "1", "--transition-deadline", "Battery:activate=100ms"]) == 0
+    out = capsys.readouterr().out
+    assert f"{log}: Battery: discharged" in out and "lifecycle /battery: 6 transition(s) heard, last inactive; " \
+           "3 output(s) judged, 0 outside active; deadlines: 1 met" in out, out
+    assert "no question (heard while its readers were not active): /request 8" in out
+    # control: a deadline the activation (80 ms) does not meet; the node fails, the reason printed
+    assert main(["monitor", "-w", str(ws), log, "--horizon", "1", "--transition-deadline", "Battery:activate=50ms"]) == 1
+    out = capsys.readouterr().out
+    assert f"{log}: Battery: failed: 1 transition deadline(s) missed (lifecycle)" in out
+    assert "    missed: /battery's activate from 2.000 s reached active after 0.080 s (over its 0.05 s)" in out
+    for bad, said in (("Battery:activate", "write NODE:TRANSITION=DURATION"), ("Battery:wake=1s", "no transition 'wake'")):
+        assert main(["monitor", "-w", str(ws), log, "--transition-deadline", bad]) == 2
+        err = capsys.readouterr().err
+        assert said in err and err.count("\n") == 1 and "Traceback" not in err
