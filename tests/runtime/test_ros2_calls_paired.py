@@ -26,11 +26,10 @@ from __future__ import annotations
 
 import json
 import signal
-import time
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.backends.monitors.dds_calls import CallBook, replay
@@ -86,13 +85,16 @@ def right(req, resp):
     return resp
 
 def wrong(req, resp):
-    time.sleep(0.03)
+    time.sleep(0.3)  # dual_a's right answer first, the client's: 300 ms, more than a loaded machine adds
     resp.success = False
     return resp
 
+slow_answers = [0]
+
 def slow(req, resp):
-    time.sleep(0.15)  # the client's next call is written before this reply
+    time.sleep(0.5)  # the client's next call is written before this reply, however loaded the machine
     resp.success = True
+    slow_answers[0] += 1
     return resp
 
 nodes["base"].create_service(SetBool, "estop", estop)
@@ -132,10 +134,13 @@ print("estop", [call(teleop) for _ in range(6)], flush=True)
 dual = []
 for _ in range(3):
     dual.append(call(user))
-    spin(0.2)  # both servers' replies come before the next call
+    spin(0.6)  # both servers' replies come before the next call
 print("dual", dual, flush=True)
 print("pile", [call(stacker) for _ in range(3)], flush=True)
-spin(0.5)
+until = time.monotonic() + 10
+while time.monotonic() < until and slow_answers[0] < 3:  # pile_b's three late replies written
+    ex.spin_once(timeout_sec=0.05)
+spin(0.2)
 print("done", round(time.monotonic() - t0, 2), flush=True)
 while True:
     ex.spin_once(timeout_sec=0.1)
@@ -156,15 +161,17 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                           "--node", "Base", "--source", "rclpy", "--ros2-python", str(ros2_python()),
                           "--verdict-topic", "/deaf/verdict", "--status", "0", "--duration", "60", "--evidence",
                           str(tmp / "deaf.json")], env, tmp, tmp / "deaf.out")
+        # a 300 ms lateness bound: requests, replies and deadlines at their writers' source times (with none,
+        # at their receipt, in the order heard, which a loaded machine's delivery may change)
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--strict",
-                             "--horizon", "1.0", "--reorder-window", "0", "--status", "0", "--duration", "60",
+                             "--horizon", "1.0", "--reorder-window", "0.3", "--status", "0", "--duration", "60",
                              "--log", str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json")],
                             env, tmp, tmp / "monitor.out")
         wait_for(tmp / "monitor.out", "monitoring", 30)
         wait_for(tmp / "deaf.out", "monitoring", 30)
         system = start_node(tmp, "system", SYSTEM, env)
         wait_for(tmp / "system.log", "done", 40)
-        time.sleep(1.6)  # the horizon (1 s) and the monitor's settle (0.3 s) pass
+        wait_logged(tmp / "live.jsonl", _all_judged, 30)  # whatever the load, not a sleep
         stop(monitor, signal.SIGINT)
         stop(deaf, signal.SIGINT)
         yield {"ws": ws, "code": monitor.returncode, "out": (tmp / "monitor.out").read_text(),
@@ -177,6 +184,16 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         for p in (system, monitor, deaf):
             if p is not None:
                 stop(p)
+
+
+def _all_judged(log: list[dict[str, Any]]) -> bool:
+    """Every call of the run judged in ``log``: six of /estop and their deadlines (and call 5's late answer),
+    three of each /dual server, three of pile_a, pile_b's three replies logged unpaired."""
+    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
+             and x["verdict"].get("call")]
+    deadlines = [x for x in log if x.get("kind") == "deadline" and x["verdict"]["node"] == "Base"]
+    return calls.count("Base") >= 6 and calls.count("Dual") >= 6 and calls.count("Pile") >= 3 \
+        and len(deadlines) >= 7 and sum(x.get("link") == "pile" and bool(x.get("unpaired")) for x in log) >= 3
 
 
 def _verdicts(run: dict[str, Any], node: str) -> list[dict[str, Any]]:
