@@ -43,12 +43,11 @@ from __future__ import annotations
 import json
 import re
 import signal
-import time
 from pathlib import Path
 from typing import Any
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.backends.monitors.dds_calls import CallBook, replay
@@ -139,7 +138,7 @@ def execute(goal):
             return Fibonacci.Result(sequence=seq)
         seq.append(seq[i] + seq[i - 1])
         goal.publish_feedback(Fibonacci.Feedback(sequence=seq))
-        time.sleep(0.02)
+        time.sleep(0.04)  # order 40 runs 1.6 s: its cancel, sent after 0.15 s, is taken first on a loaded machine
     goal.succeed()
     return Fibonacci.Result(sequence=seq if goal.request.order < 4 else seq + [-1])  # the second is spoilt
 
@@ -163,16 +162,18 @@ pairs = {s: [nodes[f"{s}_{k}"].create_client(SetBool, s) for k in "ab"] for s in
 mission = ActionClient(nodes["mission"], Fibonacci, "fib")
 print("ready", flush=True)
 # the monitor's readers are made once it discovers the endpoints: wait for its verdict topic, then a little
-until = time.monotonic() + 20
-while time.monotonic() < until and (nodes["watch"].count_publishers("/rclverify/verdict") < 1
-                                   or not all(c.service_is_ready() for c in [teleop, *pairs["brake"],
-                                                                             *pairs["lamp"]])
-                                   or not mission.server_is_ready()):
+def matched():
+    return nodes["watch"].count_publishers("/rclverify/verdict") >= 1 and all(
+        c.service_is_ready() for c in [teleop, *pairs["brake"], *pairs["lamp"]]) and mission.server_is_ready()
+
+until = time.monotonic() + 40
+while time.monotonic() < until and not matched():
     ex.spin_once(timeout_sec=0.05)
+ready = matched()  # False: the services never became ready to their clients (the wait ran out)
 until = time.monotonic() + 1.5
 while time.monotonic() < until:
     ex.spin_once(timeout_sec=0.05)
-print("matched", round(time.monotonic() - t0, 2), flush=True)
+print("matched", round(time.monotonic() - t0, 2), ready, flush=True)
 answers = [done(teleop.call_async(SetBool.Request(data=True)))[0].success for _ in range(3)]
 print("estop", answers, flush=True)
 for s in ("brake", "lamp"):
@@ -219,8 +220,10 @@ def _watched(tmp: Path, monitors: dict[str, tuple[list[str], dict[str, str]]]) -
         for name in monitors:
             wait_for(tmp / f"{name}.out", "monitoring", 30)
         system = start_node(tmp, "system", SYSTEM, next(iter(monitors.values()))[1])
-        wait_for(tmp / "system.log", "done", 40)
-        time.sleep(1.6)  # the horizon (1 s) and the monitor's settle (0.3 s) pass: the last goal is judged
+        wait_for(tmp / "system.log", "done", 60)
+        for name in monitors:  # every call judged, the last goal too, however loaded the machine
+            if (tmp / f"{name}.jsonl").exists():
+                wait_logged(tmp / f"{name}.jsonl", lambda log, n=name: _all_judged(log, JUDGED[n]), 30)
         for p in procs.values():
             stop(p, signal.SIGINT)
         return {name: p.returncode for name, p in procs.items()}
@@ -231,9 +234,22 @@ def _watched(tmp: Path, monitors: dict[str, tuple[list[str], dict[str, str]]]) -
             stop(p)
 
 
+#: per monitor with a log, the calls it judges once the system is done: node -> call verdicts (the DDS source
+#: hears every service; the rclpy source, the introspected ones only)
+JUDGED = {"live": {"Base": 3, "Brake": 2, "Lamp": 2, "Fib": 3}, "via": {"Lamp": 2, "Fib": 3}}
+
+
+def _all_judged(log: list[dict[str, Any]], want: dict[str, int]) -> bool:
+    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
+             and x["verdict"].get("call")]
+    return all(calls.count(node) >= n for node, n in want.items())
+
+
 def _args(ws: Path, tmp: Path, name: str, *extra: str) -> list[str]:
+    # a 300 ms lateness bound: requests, replies and deadlines at their writers' source times (with none, at
+    # their receipt, in the order heard, which a loaded machine's delivery may change)
     return ["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces", "--mapping", "mapping.yaml",
-            "--horizon", "1.0", "--reorder-window", "0", "--status", "0", "--duration", "60", "--log",
+            "--horizon", "1.0", "--reorder-window", "0.3", "--status", "0", "--duration", "60", "--log",
             str(tmp / f"{name}.jsonl"), "--evidence", str(tmp / f"{name}.json"), *extra]
 
 
@@ -285,7 +301,7 @@ def _calls(run: dict[str, Any]) -> dict[str, dict[str, Any]]:
 def test_the_monitor_hides_no_service_from_its_clients(run: dict[str, Any]) -> None:
     """rmw_fastrtps counts request readers against reply writers: without its shadow reply writers the
     monitor's request readers made service_is_ready() false for good (wait_for_service() never returned)."""
-    assert "matched" in run["system"] and float(run["system"].split("matched ")[1].split()[0]) < 15, run["system"]
+    assert "matched" in run["system"] and run["system"].split("matched ")[1].split()[1] == "True", run["system"]
     assert "ready [True, True, True, True, True] True" in run["system"], run["system"]
 
 
