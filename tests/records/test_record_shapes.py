@@ -725,7 +725,7 @@ def _shown_by_code(renderer: str, row: Mapping[str, Any]) -> str:
         node = typed_report(report).nodes[0].to_json()
         suite = junit._suite(node, {"items": {"findings": [row]}, "evidence": {}, "reasons": {}})[0]
         return ET.tostring(suite, encoding="unicode")
-    return "\n".join(explain.explain(report, str(row["id"])) or [])
+    return "\n".join(explain.explain(typed_report(report).to_json(), str(row["id"])) or [])
 
 
 @pytest.mark.parametrize("renderer", list(CODE))

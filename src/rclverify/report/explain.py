@@ -13,9 +13,12 @@ same id up to case, ``_`` and the separator between a node and its
 guarantee.  :func:`explain` gives the lines to print, :func:`near_ids` the
 closest ids (``difflib``) when nothing matches.
 
-The report's findings, obligations and problems are decoded into their
-definitions (records/findings.py, records/obligations.py,
-records/problem_rows.py) and printed by :mod:`.explain_items`: each field is
+The report's nodes (their guarantees), side conditions, findings,
+obligations and problems are decoded into their definitions
+(records/node_rows.py, records/side_condition_rows.py, records/findings.py,
+records/obligations.py, records/problem_rows.py) and read as the
+attributes mypy checks; a finding, an obligation and a problem are printed
+by :mod:`.explain_items`: each field is
 printed or named in the record's ``INTERNAL_TO["explain"]`` with the reason
 (tests/records/test_record_shapes.py).  A row that does not decode raises
 :class:`msgspec.ValidationError` (a ``ValueError``).
@@ -26,7 +29,12 @@ import difflib
 import re
 from typing import Any, Iterable, Mapping, Sequence
 
+import msgspec
+
 from rclverify.records.findings import rows_of as finding_rows_of
+from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
+from rclverify.records.row import decode_rows
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.obligations import rows_of as obligation_rows_of
 from rclverify.records.problem_rows import rows_of as problem_rows_of
 from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
@@ -88,10 +96,10 @@ class _Index:
     def __init__(self, report: Mapping[str, Any], sarif: Any = None, argument: Any = None) -> None:
         self.report = report
         self.diagnoses = {d["id"]: d for d in report.get("diagnoses") or []}
-        self.nodes = {n["name"]: n for n in report["nodes"]}
+        self.nodes = {n.name: n for n in decode_rows(NodeRow, report["nodes"])}
         self.requirements = {r["id"]: r for r in report["requirements"]}
         self.findings = {f.id: f for f in finding_rows_of(report["findings"])}
-        self.sides: dict[str, Mapping[str, Any]] = {str(x["id"]): x for x in report["side_conditions"]}
+        self.sides = {x.id: x for x in decode_rows(SideConditionRow, report["side_conditions"])}
         self.obligations = {o.id: o for o in obligation_rows_of(report["obligations"])}
         self.items: dict[str, str] = {}  # id -> what it is, a later kind's winning as in the report's order
         for kind, ids in (("health check", self.findings), ("side condition", self.sides),
@@ -123,7 +131,7 @@ class _Index:
     def ids(self) -> list[str]:
         """Every id this index answers to, for suggestions."""
         out = list(self.requirements) + list(self.nodes)
-        out += [f"{n}.g{g['index']}" for n, node in self.nodes.items() for g in node.get("guarantees") or []]
+        out += [f"{n}.g{g.index}" for n, node in self.nodes.items() for g in node.guarantees]
         out += list(self.diagnoses) + list(self.items) + list(self.rules) + list(self.results)
         out += [f"{ob}#{k}" for ob, e in self.evidence.items() if ob
                 for k in range(1, len(((e.get("monitoring") or {}).get("violations") or [])) + 1)]
@@ -170,8 +178,8 @@ class _Index:
             return None
         if int(m["k"]) == 0:  # "guarantee 0" of obligation ids (Agent.g0.dafny.contract): the whole contract
             return self.node_lines(key)
-        for g in self.nodes[key].get("guarantees") or []:
-            if g["index"] == int(m["k"]):
+        for g in self.nodes[key].guarantees:
+            if g.index == int(m["k"]):
                 return self.guarantee_lines(key, g)
         return None
 
@@ -261,15 +269,15 @@ class _Index:
         out += [f"    {name} = {value}" for name, value in sorted((v.get("values") or {}).items())]
         return out
 
-    def guarantee_lines(self, node: str, g: Mapping[str, Any], indent: str = "") -> list[str]:
-        k = g["index"]
+    def guarantee_lines(self, node: str, g: GuaranteeRow, indent: str = "") -> list[str]:
+        k = g.index
         obs = [o for o in self.obligations.values() if o.node == node and o.guarantee == k]
-        status = "unverified" if not obs and not g.get("obligations") else g["status"]  # no obligation covers it
-        if g.get("culprit_of"):  # a problem's culprit reads that problem's status (report/culprits.py)
-            status = g["status"]
-        out = [f"{indent}{node}.g{k} [{status}] (guarantee {k} of {node}, {g.get('source', '')})",
-               f"{indent}  {g['text']}"]
-        if not obs and not g.get("obligations"):
+        status = "unverified" if not obs and not g.obligations else g.status  # no obligation covers it
+        if g.culprit_of:  # a problem's culprit reads that problem's status (report/culprits.py)
+            status = g.status
+        out = [f"{indent}{node}.g{k} [{status}] (guarantee {k} of {node}, {g.source})",
+               f"{indent}  {g.text}"]
+        if not obs and not g.obligations:
             out.append(f"{indent}  evidence: none: no evidence entry of the plan covers it (`unverified`; docs/plan.md)")
         if len(obs) <= SHOWN_OBLIGATIONS:
             out += [f"{indent}  evidence: {o.id} [{o.status}] ({o.backend})" for o in obs]
@@ -290,39 +298,42 @@ class _Index:
         problems = [d for d in natural_sorted(list(self.diagnoses)) if d.startswith(f"{node}.g{k}.")]
         if problems:
             out.append(f"{indent}  problems: {', '.join(problems)} (`rclverify explain ID`)")
-        out += [f"{indent}  culprit of a problem [{c['status']}]: {clause_cut(c['sentence'], 300)}"
-                for c in g.get("culprit_of") or ()]
+        out += [f"{indent}  culprit of a problem [{c.status}]: {clause_cut(c.sentence, 300)}" for c in _culprit_of(g)]
         return out
 
     def node_lines(self, node: str) -> list[str]:
         n = self.nodes[node]
-        out = [f"{node} [{n['status']}] (node, {n.get('source', '')})"]
-        for label, key in (("inputs", "inputs"), ("outputs", "outputs")):
-            vs = n.get(key) or []
+        out = [f"{node} [{n.status}] (node, {n.source})"]
+        for label, vs in (("inputs", n.inputs), ("outputs", n.outputs)):
             if vs:
-                out.append(f"  {label}: " + ", ".join(f"{v.get('name')} : {v.get('type')}" for v in vs))
-        out += [f"  assumption: {a.get('text')}  ({a.get('source')})" for a in n.get("assumptions") or []]
+                out.append(f"  {label}: " + ", ".join(f"{v.name} : {v.type}" for v in vs))
+        out += [f"  assumption: {a.text}  ({a.source})" for a in n.assumptions]
         whole = [o for o in self.obligations.values() if o.node == node and o.guarantee == 0]
         out += [f"  evidence for the whole contract: {o.id} [{o.status}] ({o.backend})" for o in whole]
-        for g in n.get("guarantees") or []:
+        for g in n.guarantees:
             out += self.guarantee_lines(node, g, "  ")
-        sides = [x for x in self.sides.values() if x["node"] == node]
+        sides = [x for x in self.sides.values() if x.node == node]
         if sides:
-            proved = sum(x["status"] == "discharged" for x in sides)
+            proved = sum(x.status == "discharged" for x in sides)
             out.append(f"  side conditions: {proved}/{len(sides)} proved"
-                       + "".join(f"; {x['id']} [{x['status']}]" for x in sides if x["status"] != "discharged"))
+                       + "".join(f"; {x.id} [{x.status}]" for x in sides if x.status != "discharged"))
         health = [f for f in self.findings.values() if f.node == node]
         bad = [f for f in health if f.status not in ("ok", "warning")]
         if health:
             out.append(f"  health: {len(health) - len(bad)}/{len(health)} ok" + "".join(f"; {f.id} [{f.status}]" for f in bad))
         problems = [d for d in natural_sorted(list(self.diagnoses)) if d.split(".", 1)[0] == node]
         out.append(f"  problems: {', '.join(problems)} (`rclverify explain ID`)" if problems else "  problems: none")
-        out += [f"  culprit of a problem [{c['status']}]: {clause_cut(c['sentence'], 300)}"
-                for c in n.get("culprit_of") or ()]  # report/culprits.py
+        out += [f"  culprit of a problem [{c.status}]: {clause_cut(c.sentence, 300)}"
+                for c in _culprit_of(n)]  # report/culprits.py
         for f in (g for fs in self.ros.values() for g in fs):
             if f.get("node") == node:
                 out.append(f"  ROS grounding {f.get('severity')}: {f.get('message')} ({f.get('code')})")
         return out
+
+
+def _culprit_of(item: NodeRow | GuaranteeRow) -> list[CulpritOf]:
+    """The problems ``item`` is the culprit of (report/culprits.py), none when the pass left it unset."""
+    return [] if item.culprit_of is msgspec.UNSET else item.culprit_of
 
 
 def _place(at: Any) -> str:

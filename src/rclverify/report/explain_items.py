@@ -20,6 +20,7 @@ from rclverify.diagnosis.table import counterexample_table
 from rclverify.records.findings import Acknowledged, FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.diagnosis_text import clause_cut, table_lines
 from rclverify.report.summary import whole_sentence
 
@@ -59,20 +60,15 @@ def obligation_lines(o: ObligationRow, evidence: Mapping[str, Any], violations: 
     return out + violations + _undiagnosed(o.status, diagnosed)
 
 
-def side_condition_lines(key: str, x: Mapping[str, Any], diagnosed: bool) -> list[str]:
-    """Side condition ``key`` (its report object ``x``): its conjunct, explanation, the upstream premises
+def side_condition_lines(key: str, x: SideConditionRow, diagnosed: bool) -> list[str]:
+    """Side condition ``key`` (its decoded row ``x``): its conjunct, explanation, the upstream premises
     it assumed and its counterexample; ``diagnosed`` as in :func:`finding_lines`."""
-    out = [f"{key} [{x['status']}] (side condition of {x['node']}"
-           + (f", {x['source']}" if x.get("source") else "") + ")", f"  {x.get('conjunct') or ''}"]
-    if x.get("explanation"):
-        out.append(f"  {x['explanation']}")
-    ack = x.get("acknowledged")
-    out += _acknowledgement(key, Acknowledged(str(ack["reason"]), str(ack["at"])) if ack else None,
-                            str(x.get("sha256") or ""))
-    out += [f"  hypothesis: {h}" for h in x.get("hypotheses") or []]
-    out += [f"  core: {c}" for c in x.get("core") or []]
-    return out + _model_lines(str(x["status"]), x.get("model"), str(x["node"])) + \
-        _undiagnosed(str(x["status"]), diagnosed)
+    out = [f"{key} [{x.status}] (side condition of {x.node}" + (f", {x.source}" if x.source else "") + ")",
+           f"  {x.conjunct}"]
+    if x.explanation:
+        out.append(f"  {x.explanation}")
+    out += [f"  hypothesis: {h}" for h in x.hypotheses]
+    return out + _model_lines(x.status, x.model, x.node) + _undiagnosed(x.status, diagnosed)
 
 
 def problem_lines(number: str, p: ProblemRow) -> list[str]:
