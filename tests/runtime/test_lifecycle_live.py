@@ -197,3 +197,15 @@ def test_an_activation_deadline_met_by_the_quick_node_and_missed_by_the_slow_one
     # control: the slow node within a deadline it can meet
     [ok] = _offline(runs["defect"], 2.0)["lifecycle"]["nodes"][0]["deadlines"]
     assert ok["status"] == "met", ok
+
+
+def test_rclverify_monitor_on_the_recorded_bags(runs: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
+    from rclverify.cli.commands import main
+    codes = {}
+    for variant in ("correct", "defect"):
+        run = runs[variant]
+        codes[variant] = main(["monitor", "-w", str(run["tmp"] / "ws"), str(run["bag"]), "--horizon", "1",
+                               "--transition-deadline", "Battery:activate=200ms"])
+        out = capsys.readouterr().out
+        assert "lifecycle /battery:" in out and (("missed: /battery's activate" in out) == (variant == "defect")), out
+    assert codes == {"correct": 0, "defect": 1}
