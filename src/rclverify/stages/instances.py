@@ -170,7 +170,8 @@ def read_instances(ws: "Workspace") -> dict[str, Any] | None:
         return None
     if problem or rec is None:
         return {"instances": [], "requirements": [], "environment_inputs": [], "inputs": {}, "altered": problem}
-    made = rec.get("inputs") if isinstance(rec.get("inputs"), dict) else {}
+    raw = rec.get("inputs")
+    made: dict[str, str] = raw if isinstance(raw, dict) else {}
     now = hash_inputs(ws.root, sorted(set(made) | set(_files(ws))))
     if now != made:
         rec["stale"] = f"{INDEX} was made from another text of the plan or contracts: run the requirements task again"
