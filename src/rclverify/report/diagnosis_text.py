@@ -4,6 +4,8 @@ from __future__ import annotations
 import re
 from typing import Any, Mapping, Sequence
 
+from rclverify.records.problem_rows import DiagnosisRow
+
 
 #: Longest diagnosis sentence ``status`` prints whole (``explain`` prints it
 #: whole always); a longer one is cut at a clause boundary (:func:`clause_cut`).
@@ -41,21 +43,22 @@ def table_lines(rows: Sequence[Mapping[str, Any]], indent: str = "  ") -> list[s
     return out
 
 
-def explain_lines(d: Mapping[str, Any]) -> list[str]:
-    """One diagnosis record as text: sentence, culprits, counterexample, repairs with their diffs and cost."""
-    out = [f"{d['id']} [{d['status']}] ({d['kind']})", f"  {d['sentence']}"]
-    if d.get("culprits"):
+def explain_lines(d: DiagnosisRow) -> list[str]:
+    """One diagnosis record (decoded) as text: sentence, culprits, counterexample, repairs with their diffs
+    and cost; the culprits, counterexample rows and repairs are the JSON objects diagnosis/ writes."""
+    out = [f"{d.id} [{d.status}] ({d.kind})", f"  {d.sentence}"]
+    if d.culprits:
         out.append("  culprits:")
         out += [f"    {c['what']}" + (f"  ({c['source']})" if c.get("source") and c["source"] not in c["what"] else "")
-                for c in d["culprits"]]
-    if d.get("counterexample"):
+                for c in d.culprits]
+    if d.counterexample:
         out.append("  counterexample:")
-        out += table_lines(d["counterexample"], "    ")
-    if d.get("related"):
-        out.append("  the same guarantee, found by: " + ", ".join(natural_sorted(d["related"])))
-    if not d.get("repairs"):
+        out += table_lines(d.counterexample, "    ")
+    if d.related:
+        out.append("  the same guarantee, found by: " + ", ".join(natural_sorted(d.related)))
+    if not d.repairs:
         out.append("  repairs: none that Z3 could check")
-    for k, r in enumerate(d.get("repairs", []), 1):
+    for k, r in enumerate(d.repairs, 1):
         out.append(f"  repair {k} ({r['kind']}): {r['summary']}")
         out.append(f"    Z3 ({r['checked_by']}) shows: {r.get('proves') or 'the problem no longer follows'}; "
                    f"not shown: {r.get('not_shown') or 'that the change is safe'}")
@@ -66,7 +69,7 @@ def explain_lines(d: Mapping[str, Any]) -> list[str]:
         else:
             out.append("    changes: no other check changes status")
         out += ["    " + line for line in r["diff"].rstrip("\n").splitlines()]
-    for why in d.get("not_offered") or ():
+    for why in d.not_offered or ():
         out.append(f"  not offered: {why}")
     return out
 

@@ -14,7 +14,7 @@ guarantee.  :func:`explain` gives the lines to print, :func:`near_ids` the
 closest ids (``difflib``) when nothing matches.
 
 The report's nodes (their guarantees), side conditions, findings,
-obligations and problems are decoded into their definitions
+obligations, diagnoses and problems are decoded into their definitions
 (records/node_rows.py, records/side_condition_rows.py, records/findings.py,
 records/obligations.py, records/problem_rows.py) and read as the
 attributes mypy checks; a finding, an obligation and a problem are printed
@@ -36,7 +36,7 @@ from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
 from rclverify.records.row import decode_rows
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.obligations import rows_of as obligation_rows_of
-from rclverify.records.problem_rows import rows_of as problem_rows_of
+from rclverify.records.problem_rows import DiagnosisRow, rows_of as problem_rows_of
 from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
 from rclverify.report.explain_items import finding_lines, obligation_lines, problem_lines, side_condition_lines
 from rclverify.records.records import SEVERITY
@@ -95,7 +95,7 @@ class _Index:
 
     def __init__(self, report: Mapping[str, Any], sarif: Any = None, argument: Any = None) -> None:
         self.report = report
-        self.diagnoses = {d["id"]: d for d in report.get("diagnoses") or []}
+        self.diagnoses = {d.id: d for d in decode_rows(DiagnosisRow, report.get("diagnoses") or [])}
         self.nodes = {n.name: n for n in decode_rows(NodeRow, report["nodes"])}
         self.requirements = {r["id"]: r for r in report["requirements"]}
         self.findings = {f.id: f for f in finding_rows_of(report["findings"])}
