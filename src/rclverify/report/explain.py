@@ -13,7 +13,7 @@ same id up to case, ``_`` and the separator between a node and its
 guarantee.  :func:`explain` gives the lines to print, :func:`near_ids` the
 closest ids (``difflib``) when nothing matches.
 
-The report's nodes (their guarantees), side conditions, findings,
+The report's requirements, nodes (their guarantees), side conditions, findings,
 obligations, diagnoses and problems are decoded into their definitions
 (records/node_rows.py, records/side_condition_rows.py, records/findings.py,
 records/obligations.py, records/problem_rows.py) and read as the
@@ -37,6 +37,7 @@ from rclverify.records.row import decode_rows
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.obligations import rows_of as obligation_rows_of
 from rclverify.records.problem_rows import DiagnosisRow, rows_of as problem_rows_of
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
 from rclverify.report.explain_items import finding_lines, obligation_lines, problem_lines, side_condition_lines
 from rclverify.records.records import SEVERITY
@@ -58,20 +59,22 @@ def _fold(text: str) -> str:
     return re.sub(r"[\s_-]+", "", str(text)).lower()
 
 
-def requirement_lines(r: Mapping[str, Any]) -> list[str]:
-    """One requirement of the report as text: id, verdict, status, source;
+def requirement_lines(row: RequirementRow | Mapping[str, Any]) -> list[str]:
+    """One requirement of the report (its row, decoded here when given as
+    its JSON object) as text: id, verdict, status, source;
     its statement, formal statement, assumptions, the note; the premises a
     proof used, those traced but not needed, an inconsistent or vacuity
     core; a counterexample node by node and the guarantees that did not
-    prevent it (docs/requirements.md)."""
-    c = r.get("check") or {}
-    out = [f"{r['id']}: {r.get('verdict') or 'traced'} [{r['status']}]  {c.get('source') or ''}".rstrip(),
-           f"  {r.get('text') or ''}"]
+    prevent it (docs/requirements.md).  Raises
+    :class:`msgspec.ValidationError` for a row of another shape."""
+    r = RequirementRow.of(row)
+    c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
+    out = [f"{r.id}: {r.verdict or 'traced'} [{r.status}]  {c.get('source') or ''}".rstrip(), f"  {r.text}"]
     if c.get("formal"):
         out.append(f"  formal: {c['formal']}")
     out += [f"  assuming: {a}" for a in c.get("assuming") or []]
-    if r.get("note"):
-        out.append(f"  {r['note']}")
+    if r.note:
+        out.append(f"  {r.note}")
     t = c.get("temporal") or {}
     if t.get("method"):  # how a temporal statement was decided; an IC3/PDR proof's certificate
         out.append(f"  temporal check: {t.get('status')} by {t['method']}" + (f"; {t['detail']}" if t.get("detail") else ""))
@@ -82,8 +85,8 @@ def requirement_lines(r: Mapping[str, Any]) -> list[str]:
     out += [f"    contradictory: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("inconsistent_core") or []]
     out += [f"    premise never holds with: {p['label']}: {p['text']}  ({p['source']})"
             for p in c.get("vacuity_core") or []]
-    for row in c.get("counterexample") or []:
-        out.append(f"    counterexample {row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items()))
+    for step in c.get("counterexample") or []:
+        out.append(f"    counterexample {step['node']}: " + ", ".join(f"{k} = {v}" for k, v in step["values"].items()))
     if c.get("counterexample_note"):
         out.append(f"    {c['counterexample_note']}")
     out += [f"    did not prevent it: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("failed_to_prevent") or []]
@@ -97,7 +100,7 @@ class _Index:
         self.report = report
         self.diagnoses = {d.id: d for d in decode_rows(DiagnosisRow, report.get("diagnoses") or [])}
         self.nodes = {n.name: n for n in decode_rows(NodeRow, report["nodes"])}
-        self.requirements = {r["id"]: r for r in report["requirements"]}
+        self.requirements = {r.id: r for r in decode_rows(RequirementRow, report["requirements"])}
         self.findings = {f.id: f for f in finding_rows_of(report["findings"])}
         self.sides = {x.id: x for x in decode_rows(SideConditionRow, report["side_conditions"])}
         self.obligations = {o.id: o for o in obligation_rows_of(report["obligations"])}
@@ -288,8 +291,7 @@ class _Index:
             out.append(f"{indent}  evidence: {len(obs)} obligations: " + ", ".join(
                 f"{n} {st} ({be})" for (st, be), n in sorted(groups.items(), key=lambda kv: -_rank(kv[0][0]))))
             out += [f"{indent}    {o.id} [{o.status}]" for o in obs if o.status not in ("discharged", "pending")]
-        supports = [r["id"] for r in self.requirements.values()
-                    for s in r.get("support") or [] if s.get("node") == node and s.get("guarantee") == k]
+        supports = [r.id for r in self.requirements.values() for s in r.support if s.node == node and s.guarantee == k]
         if supports:
             out.append(f"{indent}  supports: {', '.join(supports)}")
         for f in self.findings.values():
