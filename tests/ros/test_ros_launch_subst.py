@@ -11,8 +11,8 @@ what it does (docs/ros.md, "Other packages' substitutions"), with its control:
 * ``HasNodeParams`` of a file the YAML guard refuses (an alias bomb) or a FIFO
   is said and the node kept;
 * ``Command``, ``FindExecutable``, launch_ros' ``Parameter`` are named as
-  known only at run time, the node kept without the attribute (control: a
-  literal there is read).
+  known only at run time, the node kept without the attribute, a cause of
+  their own on the first screen (control: a literal there is read).
 
 Packages are written into a temporary directory and read by the scan.
 """
@@ -24,6 +24,8 @@ from pathlib import Path
 import pytest
 from test_ros_launch_args import _graph, _include, _said, ws  # noqa: F401  (the fixture)
 from test_ros_launch_run import PY_HEAD
+
+from rclverify.ros.graph import summary
 
 HEAD = PY_HEAD + ("from launch.actions import IncludeLaunchDescription\n"
                   "from launch.conditions import IfCondition\n"
@@ -111,18 +113,20 @@ def test_a_rewritten_parameter_file_is_a_value_an_include_passes(ws: Path) -> No
     assert sorted(g.nodes) == ["/r1/talker"]
     [said] = _said(g)
     assert said.startswith("ws/demo/launch/top.launch.py:") and "MyRewriter(params)" in said
+    assert [summary.cause_of(n.code, n.message).key for n in g.notes] == ["launch-attributes"]
 
 
 @pytest.mark.parametrize("sub, why", [
     ("Command(['xacro ', params])", "Command runs a program when launched"),
     ("FindExecutable(name='ros2')", "FindExecutable looks the program up"),
-    ("Parameter('robot')", "the value of a ROS parameter in the launch context"),
+    ("Parameter('robot')", "Parameter reads a ROS parameter of the launch context"),
 ])
 def test_run_time_substitutions_are_named_and_the_node_kept(ws: Path, sub: str, why: str) -> None:
     g = _graph(ws, _py(ws, "rt.launch.py", f"Node(package='demo', executable='talker', namespace={sub}),"))
     assert sorted(g.nodes) == ["/talker"]
     [said] = _said(g)
     assert said.startswith("ws/demo/launch/rt.launch.py:") and why in said and "known only at run time" in said
+    assert [summary.cause_of(n.code, n.message).key for n in g.notes] == ["launch-run-time"]  # its own cause
     # control: a literal in its place is read
     assert sorted(_graph(ws, _py(ws, "rt.launch.py", "Node(package='demo', executable='talker', "
                                                      "namespace='r9'),")).nodes) == ["/r9/talker"]

@@ -69,8 +69,8 @@ def call_value(e: ast.Call, name: str, value: Callable[[ast.AST], str], unres: t
     if name in RUN_TIME:
         raise unres(f"'{ast.unparse(e)}' ({name} {RUN_TIME[name]} is known only at run time)")
     if name == "Parameter" and len(e.args) + len(e.keywords) == 1:  # launch_ros.substitutions.Parameter
-        raise unres(f"'{ast.unparse(e)}' (the value of a ROS parameter in the launch context, known only at "
-                    f"run time)")
+        raise unres(f"'{ast.unparse(e)}' (Parameter reads a ROS parameter of the launch context; its value "
+                    f"is known only at run time)")
     if name in _LOGIC:
         ops = list(e.args) if name in ("AllSubstitution", "AnySubstitution") else \
             [x for x in (a(0, "value" if name == "NotSubstitution" else "left"), a(1, "right")) if x is not None]

@@ -89,6 +89,8 @@ CAUSES: tuple[Cause, ...] = (
           lambda code, msg: "type of" in msg or code in ("ROS-TYPE", "ROS-TYPE-UNKNOWN")),
     Cause("not-built", "programs not built (ROS 1 code no target of the ament package builds: listed apart, "
                        "not nodes)", lambda code, _msg: code == "ROS-NOT-BUILT"),
+    Cause("launch-run-time", "launch values known only at run time (Command, FindExecutable, a ROS parameter ...)",
+          lambda code, msg: code == "ROS-LAUNCH" and "is known only at run time" in msg),
     Cause("launch-attributes", "launch attributes not read (parameter files, conditions, remappings)",
           lambda code, _msg: code == "ROS-LAUNCH"),
     Cause("parse", "sources read in part (syntax errors recovered, files skipped)",
