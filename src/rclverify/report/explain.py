@@ -31,6 +31,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import msgspec
 
+from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import rows_of as finding_rows_of
 from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
 from rclverify.records.row import decode_rows
@@ -108,7 +109,7 @@ class _Index:
         for kind, ids in (("health check", self.findings), ("side condition", self.sides),
                           ("obligation", self.obligations)):
             self.items.update(dict.fromkeys(ids, kind))
-        self.evidence = {e.get("obligation"): e for e in report.get("evidence") or [] if isinstance(e, Mapping)}
+        self.evidence = {e.obligation: e for e in decode_rows(EvidenceRow, report.get("evidence") or [])}
         self.problems = problem_rows_of(g for g in report.get("problems") or [] if isinstance(g, Mapping))
         g = report.get("grounding") or {}
         self.ros: dict[str, list[Mapping[str, Any]]] = {}
@@ -137,7 +138,7 @@ class _Index:
         out += [f"{n}.g{g.index}" for n, node in self.nodes.items() for g in node.guarantees]
         out += list(self.diagnoses) + list(self.items) + list(self.rules) + list(self.results)
         out += [f"{ob}#{k}" for ob, e in self.evidence.items() if ob
-                for k in range(1, len(((e.get("monitoring") or {}).get("violations") or [])) + 1)]
+                for k in range(1, len(e.monitoring.get("violations") or []) + 1)]
         out += [c for c in self.ros if c] + [c for c in self.lint if c] + list(self.argument)
         return list(dict.fromkeys(out))
 
@@ -239,13 +240,13 @@ class _Index:
         if kind == "health check":
             return finding_lines(self.findings[key], diagnosed)
         if kind == "obligation":
-            return obligation_lines(self.obligations[key], self.evidence.get(key) or {}, self._violation_ids(key),
+            return obligation_lines(self.obligations[key], self.evidence.get(key), self._violation_ids(key),
                                     diagnosed)
         return side_condition_lines(key, self.sides[key], diagnosed)
 
     def _violation_ids(self, key: str) -> list[str]:
         """The lines naming every violation a monitored run of obligation ``key`` kept."""
-        m = (self.evidence.get(key) or {}).get("monitoring") or {}
+        m = self._monitoring(key)
         vs = m.get("violations") or []
         out = [f"  violation {key}#{k}: {v.get('where')} (t = {v.get('time')} s), guarantee {v.get('guarantee')}"
                for k, v in enumerate(vs, 1)]
@@ -253,13 +254,18 @@ class _Index:
             out.append(f"  and {m['violations_dropped']} more violation(s), counted, not kept")
         return (["", "violations (each: `rclverify explain ID`):"] + out) if out else []
 
+    def _monitoring(self, key: str) -> Mapping[str, Any]:
+        """The monitored run's record of obligation ``key``'s evidence (backends/monitors), ``{}`` without."""
+        ev = self.evidence.get(key)
+        return ev.monitoring if ev is not None else {}
+
     def _violation(self, wanted: str, exact: bool) -> list[str] | None:
         """``OBLIGATION#N``: the N-th violation a monitored run kept (1-based)."""
         ob, sep, n = wanted.strip().rpartition("#")
         if not sep or not n.isdigit():
             return None
         key = self._match(ob, [str(e) for e in self.evidence if e], exact)
-        m = ((self.evidence.get(key) or {}).get("monitoring") or {}) if key else {}
+        m = self._monitoring(key) if key else {}
         vs = m.get("violations") or []
         if not 1 <= int(n) <= len(vs):
             return None

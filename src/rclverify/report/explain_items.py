@@ -17,6 +17,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from rclverify.diagnosis.table import counterexample_table
+from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import Acknowledged, FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import ProblemRow
@@ -47,14 +48,14 @@ def finding_lines(f: FindingRow, diagnosed: bool) -> list[str]:
     return out + _undiagnosed(f.status, diagnosed)
 
 
-def obligation_lines(o: ObligationRow, evidence: Mapping[str, Any], violations: list[str],
+def obligation_lines(o: ObligationRow, evidence: EvidenceRow | None, violations: list[str],
                      diagnosed: bool) -> list[str]:
-    """An obligation with its ``evidence`` record's explanation (``{}`` when none) and ``violations``,
+    """An obligation with its ``evidence`` row's explanation (``None`` when it has none) and ``violations``,
     the lines naming what a monitored run of it kept; ``diagnosed`` as in :func:`finding_lines`."""
     whom = f"guarantee {o.guarantee}" if o.guarantee else "the whole contract"
     out = [f"{o.id} [{o.status}] (obligation of {o.node}" + (f", {o.source}" if o.source else "") + ")",
            f"  {o.statement}",
-           f"  backend: {o.backend}" + (f"; {evidence['explanation']}" if evidence.get("explanation") else ""),
+           f"  backend: {o.backend}" + (f"; {evidence.explanation}" if evidence and evidence.explanation else ""),
            f"  {o.kind} of {whom}" + (f", instance {o.instance}" if o.instance else "")
            + (f"; rendered to {o.artifact}" if o.artifact else "")]
     return out + violations + _undiagnosed(o.status, diagnosed)
