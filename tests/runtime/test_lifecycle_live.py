@@ -142,11 +142,11 @@ def _bag(run: dict[str, Any]) -> tuple[list[Any], list[Any]]:
 
 
 def _offline(run: dict[str, Any], within: float) -> dict[str, Any]:
-    """The run's bag judged offline (runtime/lifecycle.judge_recorded) with an activation deadline."""
+    """The run's bag judged offline (cli/lifecycle_runs.judge_recorded) with an activation deadline."""
     from rclverify.backends.monitors.config import load_mapping
     from rclverify.lang.parser import parse_text
     from rclverify.lang.typecheck import check
-    from rclverify.runtime.lifecycle import judge_recorded
+    from rclverify.cli.lifecycle_runs import judge_recorded
     checked = check([parse_text(RCL, "b.rcl")])
     cfg = load_mapping(run["tmp"], None, 1.0)
     events, transitions = _bag(run)

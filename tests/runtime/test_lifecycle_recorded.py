@@ -1,5 +1,5 @@
-"""A recorded run of a managed node judged as the live run judges it (runtime/lifecycle.py
-``judge_recorded``, traces/lifecycle_events.py; docs/monitors.md "Lifecycle nodes in a recorded run"):
+"""A recorded run of a managed node judged as the live run judges it (runtime/lifecycle.py, ``judge_recorded``
+in cli/lifecycle_runs.py, traces/lifecycle_events.py; docs/monitors.md "Lifecycle nodes in a recorded run"):
 a JSON-lines log holding the node's transition events, read back and replayed through the same gate and
 judge.  A guarantee is not asked while the node is inactive, an output while inactive is red, a
 transition deadline is met, missed or open; each with its control, and the log's verdicts equal the live
@@ -16,7 +16,8 @@ import pytest
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
-from rclverify.runtime.lifecycle import LifecycleGate, event_topic, judge_recorded
+from rclverify.cli.lifecycle_runs import judge_recorded
+from rclverify.runtime.lifecycle import LifecycleGate, event_topic
 from rclverify.runtime.live import LiveRun
 from rclverify.traces.lifecycle_events import read_run
 

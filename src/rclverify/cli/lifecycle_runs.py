@@ -4,7 +4,7 @@
 When a monitored node is managed (its contract names its ``lifecycle_msgs/TransitionEvent
 <node>/transition_event`` topic, :func:`rclverify.runtime.lifecycle.managed_of`), each trace is read
 with its transition events (:func:`rclverify.traces.lifecycle_events.read_run`) and judged by
-:func:`rclverify.runtime.lifecycle.judge_recorded`: the live run's gate and judge, the messages at their
+:func:`judge_recorded`: the live run's gate and judge, the messages at their
 recorded times.  ``--transition-deadline NODE:TRANSITION=DURATION`` (repeatable; ``Battery:activate=200ms``,
 a duration in ``ms`` or ``s``, seconds when bare) bounds a managed node's transitions.
 
@@ -22,7 +22,11 @@ import re
 import sys
 import tempfile
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Iterable, Mapping, Sequence
+
+from rclverify.lang.types import CheckedNode
+from rclverify.runtime.lifecycle import TRANSITION_TYPE, gate_of
+from rclverify.runtime.live import LiveRun
 
 _DEADLINE = re.compile(r"^([A-Za-z_]\w*):([a-z]+)=([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(ms|s)?$")
 
@@ -63,13 +67,39 @@ def _lines(trace: str, rec: dict[str, Any]) -> list[str]:
     return out
 
 
+def judge_recorded(checked: Any, nodes: Sequence[CheckedNode], rules: Any, horizon: float, events: Iterable[Any],
+                   log: Path, *, deadlines: Mapping[str, Mapping[str, float]] | None = None,
+                   evidence: Path | None = None) -> dict[str, Any]:
+    """A recorded run's ``events`` (:class:`rclverify.traces.events.Event`, in the order read: a
+    bag's or a log's, :func:`rclverify.traces.lifecycle_events.read_run`) judged as the live run
+    judges them (:mod:`rclverify.runtime.lifecycle`): each pushed to a :class:`rclverify.runtime.live.LiveRun` of
+    ``nodes`` (``rules``, ``horizon`` s: the monitor configuration's) at its recorded time, through
+    the lifecycle gate of ``nodes`` with ``deadlines``
+    (:class:`rclverify.runtime.lifecycle.LifecycleGate`); the run's log written to ``log``.  Returns
+    the run's record (``nodes``, ``lifecycle``; written to ``evidence`` when given).  Raises
+    :class:`ValueError` when no node of ``nodes`` is managed, or for a deadline the gate refuses."""
+    gate = gate_of(nodes, deadlines)
+    if gate is None:
+        raise ValueError(f"no managed node among {', '.join(n.name for n in nodes)}: no contract names a "
+                         f"{TRANSITION_TYPE.replace('/msg/', '/')} <node>/transition_event topic")
+    run = LiveRun(checked, list(nodes), rules, horizon, log, reorder_window=0.0)
+    run.gate = gate
+    last = float("-inf")
+    for e in events:
+        last = max(last, e.time)
+        run.tick(e.time)
+        run.push(e.topic, e.fields, e.time)
+    if last > float("-inf"):
+        run.tick(last + gate.settle + horizon)
+    return run.stop(evidence)
+
+
 def lifecycle_command(args: argparse.Namespace, checked: Any, nodes: Sequence[Any], cfg: Any, root: Path) -> int:
     """Judge ``args.traces`` (module docstring) for ``nodes`` of ``checked`` under the monitor
     configuration ``cfg`` (its message directories relative to ``root``); returns the exit code,
     never raising for user input."""
-    from rclverify.runtime.lifecycle import judge_recorded  # deferred: loads the live run's judge
-    from rclverify.traces.events import TraceError
-    from rclverify.traces.lifecycle_events import read_run
+    from rclverify.traces.events import TraceError  # deferred: start-up (the traces package only when called)
+    from rclverify.traces.lifecycle_events import read_run  # deferred: as above
     try:
         deadlines = parse_deadlines(getattr(args, "transition_deadline", None) or [])
     except ValueError as exc:
@@ -100,4 +130,4 @@ def lifecycle_command(args: argparse.Namespace, checked: Any, nodes: Sequence[An
     return 1 if failed or (getattr(args, "strict", False) and undecided) else 0
 
 
-__all__ = ["lifecycle_command", "parse_deadlines"]
+__all__ = ["judge_recorded", "lifecycle_command", "parse_deadlines"]

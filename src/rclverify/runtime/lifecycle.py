@@ -37,7 +37,7 @@ that type and no ``matches`` (``lifecycle_msgs/TransitionEvent battery/transitio
 ``gate``, made by :func:`gate_of` from the monitored nodes) asks for every message before its
 judge; its :meth:`~LifecycleGate.record` is the run's ``lifecycle`` record.  The transport reads
 the transition topic as any topic a contract names, and a bag the run records (``--record``) holds
-it.  :func:`judge_recorded` judges a recorded run (a bag, or a log holding the transition events:
+it.  :func:`rclverify.cli.lifecycle_runs.judge_recorded` judges a recorded run (a bag, or a log holding the transition events:
 :mod:`rclverify.traces.lifecycle_events`) as the live run judges it: its messages, in the order
 read and at their recorded times, through the same gate and the same judge.
 """
@@ -45,8 +45,7 @@ from __future__ import annotations
 
 import bisect
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 from rclverify.lang.types import CheckedNode
 
@@ -288,32 +287,5 @@ class LifecycleGate:
                 "nodes": nodes}
 
 
-def judge_recorded(checked: Any, nodes: Sequence[CheckedNode], rules: Any, horizon: float, events: Iterable[Any],
-                   log: Path, *, deadlines: Mapping[str, Mapping[str, float]] | None = None,
-                   evidence: Path | None = None) -> dict[str, Any]:
-    """A recorded run's ``events`` (:class:`rclverify.traces.events.Event`, in the order read: a
-    bag's or a log's, :func:`rclverify.traces.lifecycle_events.read_run`) judged as the live run
-    judges them (module docstring): each pushed to a :class:`rclverify.runtime.live.LiveRun` of
-    ``nodes`` (``rules``, ``horizon`` s: the monitor configuration's) at its recorded time, through
-    the lifecycle gate of ``nodes`` with ``deadlines``; the run's log written to ``log``.  Returns
-    the run's record (``nodes``, ``lifecycle``; written to ``evidence`` when given).  Raises
-    :class:`ValueError` when no node of ``nodes`` is managed, or for a deadline the gate refuses."""
-    from rclverify.runtime.live import LiveRun  # deferred: the live run imports this module
-    gate = gate_of(nodes, deadlines)
-    if gate is None:
-        raise ValueError(f"no managed node among {', '.join(n.name for n in nodes)}: no contract names a "
-                         f"{TRANSITION_TYPE.replace('/msg/', '/')} <node>/transition_event topic")
-    run = LiveRun(checked, list(nodes), rules, horizon, log, reorder_window=0.0)
-    run.gate = gate
-    last = float("-inf")
-    for e in events:
-        last = max(last, e.time)
-        run.tick(e.time)
-        run.push(e.topic, e.fields, e.time)
-    if last > float("-inf"):
-        run.tick(last + gate.settle + horizon)
-    return run.stop(evidence)
-
-
 __all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITIONS", "TRANSITION_TYPE", "event_topic", "gate_of",
-           "judge_recorded", "managed_of"]
+           "managed_of"]

@@ -8,7 +8,7 @@ topic (``rclverify monitor --live --record BAG``, ``ros2 bag record``) holds the
 flattened by the bag reader (``goal_state.id``); a JSON-lines log holds them as any message, nested
 or flattened.  :func:`transitions` reads them out of a run's events; :func:`read_run` reads the
 run (:func:`rclverify.traces.read_trace`) with its transitions, for
-:func:`rclverify.runtime.lifecycle.judge_recorded`, which judges it as the live run does.
+:func:`rclverify.cli.lifecycle_runs.judge_recorded`, which judges it as the live run does.
 """
 from __future__ import annotations
 
