@@ -14,7 +14,11 @@
   not); ``GroupAction(forwarding=False, launch_configurations={...})`` starts
   from the kept configurations alone, its namespace cleared (control:
   forwarding, the outer ones are seen); the XML forms ``<group
-  forwarding="false"><keep .../>``.
+  forwarding="false"><keep .../>``;
+* ``PushLaunchConfigurations`` / ``PopLaunchConfigurations`` restore what was
+  set between them (control: without them it stays; a pop with no push is
+  said), ``ResetLaunchConfigurations({k: v})`` keeps only ``k`` (control: no
+  reset).
 
 Packages are written into a temporary directory and read by the scan.
 """
@@ -29,6 +33,8 @@ from rclverify.ros.extract.model import Graph
 from rclverify.ros.graph.scan import scan
 
 HEAD = PY_HEAD + ("from launch.actions import IncludeLaunchDescription, SetLaunchConfiguration\n"
+                  "from launch.actions import PopLaunchConfigurations, PushLaunchConfigurations, "
+                  "ResetLaunchConfigurations\n"
                   "from launch.launch_description_sources import PythonLaunchDescriptionSource\n"
                   "from launch_ros.substitutions import FindPackageShare\n\n\n")
 INCLUDE = ("IncludeLaunchDescription(PythonLaunchDescriptionSource(\n"
@@ -164,3 +170,45 @@ def test_ros2_xml_includes_give_and_inherit_arguments(ws: Path) -> None:
     assert sorted(g.nodes) == ["/listener", "/r3/talker"]
     [said] = _said(g)
     assert said.startswith("ws/demo/launch/robot.launch.xml:4:") and "'fleet' has no value" in said
+
+
+
+def test_push_and_pop_of_launch_configurations_restore_them(ws: Path) -> None:
+    body = ("{push}SetLaunchConfiguration('fleet', 'green'),\n{pop}" + UNDECLARED)
+    g = _graph(ws, _py(ws, "stack.launch.py", body.format(push="PushLaunchConfigurations(),\n",
+                                                          pop="PopLaunchConfigurations(),\n")))
+    assert sorted(g.nodes) == ["/listener"]
+    [said] = _said(g)
+    assert "'fleet' has no value" in said
+    # control: without the push and the pop what is set stays
+    g = _graph(ws, _py(ws, "stack.launch.py", body.format(push="", pop="")))
+    assert sorted(g.nodes) == ["/green/listener"] and _said(g) == []
+    # a pop with no push before it is said at its line
+    g = _graph(ws, _py(ws, "stack.launch.py", body.format(push="", pop="PopLaunchConfigurations(),\n")))
+    assert sorted(g.nodes) == ["/green/listener"]
+    [said] = _said(g)
+    assert "stack.launch.py:" in said and "without a PushLaunchConfigurations" in said
+
+
+def test_reset_launch_configurations_keeps_only_the_ones_it_is_given(ws: Path) -> None:
+    body = ("DeclareLaunchArgument('fleet', default_value='blue'),\n"
+            "DeclareLaunchArgument('robot', default_value='outer'),\n"
+            "{reset}"
+            "Node(package='demo', executable='talker', namespace=LaunchConfiguration('robot')),\n" + UNDECLARED)
+    g = _graph(ws, _py(ws, "reset.launch.py", body.format(
+        reset="ResetLaunchConfigurations({'robot': LaunchConfiguration('fleet')}),\n")))
+    assert sorted(g.nodes) == ["/blue/talker", "/listener"]
+    [said] = _said(g)
+    assert "'fleet' has no value" in said
+    # control: no reset
+    g = _graph(ws, _py(ws, "reset.launch.py", body.format(reset="")))
+    assert sorted(g.nodes) == ["/blue/listener", "/outer/talker"] and _said(g) == []
+    # XML's <reset> with <keep> children alike
+    top = ws / "ws/demo/launch/reset.launch.xml"
+    top.write_text('<launch>\n<let name="fleet" value="blue"/>\n<reset>\n  <keep name="robot" value="$(var fleet)"/>\n'
+                   '</reset>\n<node pkg="demo" exec="talker" namespace="$(var robot)"/>\n'
+                   '<node pkg="demo" exec="listener" namespace="$(var fleet)"/>\n</launch>\n')
+    g = _graph(ws, top)
+    assert sorted(g.nodes) == ["/blue/talker", "/listener"]
+    [said] = _said(g)
+    assert said.startswith("ws/demo/launch/reset.launch.xml:7:") and "'fleet' has no value" in said

@@ -75,6 +75,8 @@ class _Scope:
     args: dict[str, str]
     remaps: list[tuple[str, str, Src]] = field(default_factory=list)
     unsure: Src | None = None  # a condition of an enclosing element read as holding without being evaluated
+    # what PushLaunchConfigurations saved (configurations, namespace, remaps: all launch configurations)
+    saved: list[tuple[dict[str, str], str, list[tuple[str, str, Src]]]] = field(default_factory=list)
 
 
 _SUBST = re.compile(r"\$\(([^()]*)\)")
@@ -343,8 +345,16 @@ class Interpreter:
                 return
             if val is not None:
                 scope.args[name] = val
-        elif t == "group":
+        elif t in ("group", "reset"):  # XML/YAML <reset> is launch's ResetLaunchConfigurations
             self._group(el, scope, path)
+        elif t == "push-configs":  # PushLaunchConfigurations / PopLaunchConfigurations (launch.actions)
+            scope.saved.append((dict(scope.args), scope.ns, list(scope.remaps)))
+        elif t == "pop-configs":
+            if not scope.saved:
+                raise Unresolved("PopLaunchConfigurations without a PushLaunchConfigurations before it in its scope")
+            args, scope.ns, scope.remaps[:] = scope.saved.pop()
+            scope.args.clear()
+            scope.args.update(args)
         elif t == "push-ros-namespace":
             ns = self._attr(el, "namespace", scope, path) or self._attr(el, "ns", scope, path) or ""
             scope.ns = names.join(scope.ns, ns)
@@ -392,13 +402,18 @@ class Interpreter:
         an event handler's or a timer's actions); ``forwarding="false"`` starts it
         from its ``keep`` configurations alone, the namespace and remaps (launch
         configurations too) cleared; ``keep`` children (``launch_configurations=``)
-        are set in it.  Source: launch's ``GroupAction.get_sub_entities``,
+        are set in it; ``reset="true"`` (``ResetLaunchConfigurations``) clears the
+        scope's configurations, namespace and remaps but its ``keep`` ones.  Source: launch's ``GroupAction.get_sub_entities``,
         ``ResetLaunchConfigurations``."""
         ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
         keep = {self._attr(k, "name", scope, path) or "": self._attr(k, "value", scope, path) or ""
                 for k in el.children if k.tag == "keep"}
         body = [k for k in el.children if k.tag != "keep"]
-        if el.attrs.get("scoped") == "false" and not ns:
+        if el.tag == "reset" or el.attrs.get("reset") == "true":  # ResetLaunchConfigurations: the kept ones stay
+            scope.args.clear()
+            scope.args.update(keep)
+            scope.ns, scope.remaps[:] = "/", []
+        elif el.attrs.get("scoped") == "false" and not ns:
             scope.args.update(keep)
             self._body(body, scope, path)
         elif el.attrs.get("forwarding") == "false":

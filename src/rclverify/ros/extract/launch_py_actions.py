@@ -22,8 +22,7 @@ from rclverify.ros.extract.model import Note, Src
 #: actions that start no node and set nothing the graph reads (passed over without a note)
 QUIET = frozenset({"LogInfo", "SetEnvironmentVariable", "UnsetEnvironmentVariable", "AppendEnvironmentVariable",
                    "PrependEnvironmentVariable", "ResetEnvironment", "SetParameter", "SetParametersFromFile",
-                   "SetUseSimTime", "SetROSLogDir", "Shutdown", "EmitEvent", "ResetLaunchConfigurations",
-                   "PopLaunchConfigurations", "PushLaunchConfigurations", "PopEnvironment", "PushEnvironment",
+                   "SetUseSimTime", "SetROSLogDir", "Shutdown", "EmitEvent", "PopEnvironment", "PushEnvironment",
                    "SetLaunchConfigurationIfUnset", "LifecycleTransition", "UnregisterEventHandler"})
 #: event handlers and the keywords holding the actions each starts (launch.event_handlers,
 #: launch_ros.event_handlers; OnProcessIO's are functions of the output, always run at the event)
@@ -31,6 +30,9 @@ HANDLERS = {"OnProcessExit": ("on_exit",), "OnProcessStart": ("on_start",),
             "OnExecutionComplete": ("on_completion",), "OnStateTransition": ("entities",),
             "EventHandler": ("entities",), "OnShutdown": ("on_shutdown",),
             "OnProcessIO": ("on_stdout", "on_stderr", "on_stdin")}
+#: launch's actions on the stack of launch configurations -> the element each is
+CONFIG_STACK = {"PushLaunchConfigurations": "push-configs", "PopLaunchConfigurations": "pop-configs",
+                "ResetLaunchConfigurations": "group"}
 #: the tags of the elements that start a node
 STARTS = ("node", "node_container", "load_composable_node", "composable_node", "include")
 
@@ -136,11 +138,14 @@ def group_flags(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note
 
 
 def group_keep(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
-    """``GroupAction(launch_configurations={k: v})`` as ``keep`` elements (set in
-    the group; with ``forwarding=False`` the only configurations it starts with);
+    """``GroupAction(launch_configurations={k: v})`` (``ResetLaunchConfigurations``'s
+    argument) as ``keep`` elements (set in the group; with ``forwarding=False`` or
+    a reset, the only configurations it starts with);
     a value that cannot be read is set without a value, said at its line."""
     lc = _kw(c, "launch_configurations")
-    if lc is None:
+    if lc is None and _callee(c) == "ResetLaunchConfigurations" and c.args:
+        lc = c.args[0]
+    if lc is None or isinstance(lc, ast.Constant) and lc.value is None:
         return []
     lc = _expand(lc)
     if not isinstance(lc, ast.Dict):

@@ -43,7 +43,7 @@ from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg,
 from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
 from rclverify.ros.extract.launch_py_values import value as _value
 from rclverify.ros.extract.launch_py_flow import added as _added, flat as _flat, grown as _grown
-from rclverify.ros.extract.launch_py_actions import HANDLERS, PAIRS, QUIET, group_flags as _group_flags
+from rclverify.ros.extract.launch_py_actions import CONFIG_STACK, HANDLERS, PAIRS, QUIET, group_flags as _group_flags
 from rclverify.ros.extract.launch_py_actions import group_keep as _group_keep
 from rclverify.ros.extract.launch_py_actions import at_shutdown as _shutdown, condition as _cond
 from rclverify.ros.extract.launch_py_actions import optional as _opt, required as _req
@@ -241,6 +241,11 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
             return None
         _cond(c, attrs, shown, notes)
         return El("group", {**attrs, "scoped": "false"}, got, src)
+    elif name in CONFIG_STACK:  # ResetLaunchConfigurations: an unscoped group without forwarding, its keeps
+        _cond(c, attrs, shown, notes)
+        if name != "ResetLaunchConfigurations":
+            return El(CONFIG_STACK[name], attrs, [], src)
+        return El("group", {**attrs, "scoped": "false", "reset": "true"}, _group_keep(c, shown, notes), src)
     elif name == "ExecuteProcess":
         el = execute_process(c, src, notes)
         if el is not None:
