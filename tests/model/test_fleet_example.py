@@ -16,6 +16,7 @@ from typing import Any
 
 import pytest
 
+from _report_schema import check_report
 from rclverify.app.pipeline import stage_check
 from rclverify.cli.commands import main
 from rclverify.stages.instances import INDEX, read_instances, stage_instances
@@ -46,6 +47,7 @@ def test_verify_is_green_and_the_report_lists_every_instance(tmp_path: Path, cap
     root = _copy(tmp_path)
     assert main(["verify", "-w", str(root)]) == 0, capsys.readouterr().out[-3000:]
     report = json.loads((root / "reports/assurance.json").read_text(encoding="utf-8"))
+    check_report(report, "fleet_robots")  # against docs/assurance.schema.json and the status vocabulary
     part = report["instances"]
     assert report["summary"]["status"] == "discharged" and report["meta"]["strict_ok"] is True
     assert [i["node"] for i in part["instances"]] == [
@@ -88,6 +90,21 @@ def test_a_fleet_topic_named_relative_is_refuted_per_robot_and_proved_for_the_ty
         ("BATTERY-GUARD", "/r1", "proved"), ("BATTERY-GUARD", "/r2", "proved"),
         ("FLEET-LIMIT", "/r1", "proved"), ("FLEET-LIMIT", "/r2", "proved")}
     assert fine["environment_inputs"] == []
+
+
+def test_verify_fails_when_a_requirement_is_refuted_for_a_robot(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    root = _copy(tmp_path)
+    rcl = root / "contracts/fleet.rcl"
+    rcl.write_text(rcl.read_text(encoding="utf-8").replace(
+        "std_msgs/Float64 /fleet/speed_limit matches(in.limit)", RELATIVE_LIMIT), encoding="utf-8")
+    main(["verify", "-w", str(root)])
+    capsys.readouterr()
+    report = json.loads((root / "reports/assurance.json").read_text(encoding="utf-8"))
+    check_report(report, "fleet_robots, the limit relative")
+    assert report["summary"]["status"] == "failed" and report["meta"]["strict_ok"] is False
+    assert "requirement FLEET-LIMIT is refuted for the instances in /r2 (Guard as Guard_r2): not prevented by " \
+           "SpeedLimit guarantee 1, Guard_r2 guarantee 1; fed by no node: Guard_r2.in.limit" in report["summary"]["problems"]
+    assert [r["status"] for r in report["requirements"] if r["id"] == "FLEET-LIMIT"] == ["discharged"]  # the types'
 
 
 def test_a_robot_without_an_instance_the_requirement_names_is_not_decided_there(tmp_path: Path) -> None:
