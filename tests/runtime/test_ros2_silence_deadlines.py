@@ -34,12 +34,11 @@ from __future__ import annotations
 
 import json
 import signal
-import time
 from pathlib import Path
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
@@ -163,7 +162,10 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
         readers = 2 if request.param == "dds" else 1
         system = start_node(tmp, "system", SYSTEM.replace("REQUEST_READERS", str(readers)), env)
         wait_for(tmp / "system.log", "done", 40)
-        time.sleep(0.3)  # the last answers reach the monitors
+        # the ten readings and their answers heard by the echo monitor and released past its watermark, however
+        # loaded the machine (a fixed 0.3 s assumed an idle one)
+        wait_logged(tmp / "echo.jsonl", lambda log: all(sum(x.get("topic") == t for x in log) >= 10
+                                                        for t in ("r", "out")), 30)
         codes = {}
         for name, p in procs.items():
             stop(p, signal.SIGINT)
