@@ -4,8 +4,9 @@ a monitor started AFTER the publishers (docs/semantics.md, "Widths" and
 
 One rclpy process runs for each source; it publishes for about 1.5 s
 before the monitors start, goes on publishing until their verdict writers
-are in the graph, and publishes 45 more rounds after (150 ms apart, about
-6.8 s: an answer later than that is heard after the next round's question).  The run
+are in the graph, and publishes 45 more rounds after (at least 150 ms apart,
+about 6.8 s, each once the node published the round before's answers: at
+their source times no answer lies after the next round's question).  The run
 is heard through each source, rclpy and DDS (docs/ros2.md, "Two sources"),
 with the same verdicts:
 
@@ -36,11 +37,10 @@ from __future__ import annotations
 
 import json
 import signal
-import time
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
@@ -152,24 +152,30 @@ latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, relia
 limit_pub = n.create_publisher(Int64, "limit", latched)
 limit_pub.publish(Int64(data=7))  # once, before anyone listens
 
+answered = {}  # input -> the round whose answer was published last (a round's number rides in a field no
+                # contract reads: the battery's voltage, the scan's range_max)
 n.create_subscription(BatteryState, "battery", lambda m: (
     pubs["home"].publish(Bool(data=m.percentage <= LIMIT)),
-    pubs["slip_home"].publish(Bool(data=m.percentage < LIMIT))), 10)
+    pubs["slip_home"].publish(Bool(data=m.percentage < LIMIT)), answered.__setitem__("battery", m.voltage)), 10)
 n.create_subscription(LaserScan, "scan", lambda m: (
     pubs["stop"].publish(Bool(data=any(r < 0.5 for r in m.ranges))),
-    pubs["blind_stop"].publish(Bool(data=any(r < 0.5 for r in m.ranges[:-1])))), 10)
-n.create_subscription(Int64, "x", lambda m: pubs["y"].publish(Int64(data=m.data)), 10)
+    pubs["blind_stop"].publish(Bool(data=any(r < 0.5 for r in m.ranges[:-1]))),
+    answered.__setitem__("scan", m.range_max)), 10)
+n.create_subscription(Int64, "x", lambda m: (pubs["y"].publish(Int64(data=m.data)),
+                                             answered.__setitem__("x", m.data)), 10)
 got = {}
 def fused(k, m):
     got[k] = m.data
     if len(got) == 2:
         pubs["fs"].publish(Int64(data=got["a"] + got["b"]))
+        answered["fs"] = got["a"]
         got.clear()
 n.create_subscription(Int64, "fa", lambda m: fused("a", m), 10)
 n.create_subscription(Int64, "fb", lambda m: fused("b", m), 10)
 limit = [None]
 n.create_subscription(Int64, "limit", lambda m: limit.__setitem__(0, m.data), latched)
-n.create_subscription(Int64, "cmd", lambda m: pubs["clamped"].publish(Int64(data=min(m.data, limit[0]))), 10)
+n.create_subscription(Int64, "cmd", lambda m: (pubs["clamped"].publish(Int64(data=min(m.data, limit[0]))),
+                                               answered.__setitem__("cmd", m.data)), 10)
 n.create_subscription(Float64, "nan", lambda m: pubs["nan_out"].publish(Float64(data=m.data)), 10)
 from std_msgs.msg import String
 import json as _json
@@ -190,17 +196,23 @@ print("ready", flush=True)
 levels = [0.5, 0.2, 0.1]
 scans = [[1.0, 2.0, 3.0], [1.0, 0.3, 3.0], [1.0, 2.0, 0.3]]
 
+OWN = {"battery", "scan", "x", "fa", "fb", "cmd", "nan"}  # the topics this node reads itself
+
+def readers_matched():  # every topic read by the monitor, /nan and /nan_out by the second one too
+    return all(p.get_subscription_count() >= (t in OWN) + 1 + (t in ("nan", "nan_out")) for t, p in pubs.items())
+
 def wait_monitors():
     print("before", flush=True)  # the monitors start now (the fixture), while this keeps publishing
-    until = time.monotonic() + 30
+    until = time.monotonic() + 60
     while time.monotonic() < until and (n.count_publishers("/rclverify/verdict") < 1
-                                       or n.count_publishers("/nan/verdict") < 1):
+                                       or n.count_publishers("/nan/verdict") < 1 or not readers_matched()):
         spin(0.05)
         publish_all(-1)
+    print("matched", readers_matched(), flush=True)
 
 def publish_all(k):
-    pubs["battery"].publish(BatteryState(percentage=levels[k % 3]))
-    pubs["scan"].publish(LaserScan(ranges=scans[k % 3]))
+    pubs["battery"].publish(BatteryState(percentage=levels[k % 3], voltage=float(k)))
+    pubs["scan"].publish(LaserScan(ranges=scans[k % 3], range_max=float(k)))
     pubs["x"].publish(Int64(data=k))
     pubs["fa"].publish(Int64(data=k))
     pubs["fb"].publish(Int64(data=2 * k))  # at the same instant as fa: one question
@@ -212,11 +224,19 @@ def publish_all(k):
 for k in range(20):  # about 1.4 s before any monitor
     publish_all(k)
     spin(0.07)
-wait_monitors()
-spin(1.0)  # the monitors' readers match their publishers one by one
+wait_monitors()  # the monitors' readers match their publishers one by one: the rounds once all did
+spin(0.3)
+def round_answered(k):
+    return answered == {"battery": float(k), "scan": float(k), "x": k, "fs": k, "cmd": k % 12}
+
 for k in range(20, 65):
     publish_all(k)
     spin(0.15)
+    # the next round's questions only once this round's answers were published: at their source times every
+    # answer lies before the next question, however late a loaded machine runs the node's callbacks
+    until = time.monotonic() + 5
+    while time.monotonic() < until and not round_answered(k):
+        ex.spin_once(timeout_sec=0.005)
 spin(0.5)
 print("released", sorted(set(released)), len(released), flush=True)
 print("done", len(heard), len([v for v in heard if v.get("verdict") == "violated"]), flush=True)
@@ -248,8 +268,10 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
                             env, tmp, tmp / "monitor.out")
         nan = rclverify(["monitor", "-w", str(ws), *common, "--node", "Sink", "--strict", "--verdict-topic",
                          "/nan/verdict", "--evidence", str(tmp / "nan.json")], env, tmp, tmp / "nan.out")
-        wait_for(tmp / "system.log", "done", 40)
-        time.sleep(1.0)
+        wait_for(tmp / "system.log", "done", 120)
+        # the last round's answers heard and released past the watermark, however loaded the machine
+        wait_logged(tmp / "live.jsonl", lambda log: {("y", 64), ("fs", 192)} <= {
+            (x.get("topic"), x.get("data")) for x in log}, 30)
         stop(monitor, signal.SIGINT)
         stop(nan, signal.SIGINT)
         yield {"source": source, "tmp": tmp, "ws": ws, "code": monitor.returncode,
@@ -360,6 +382,7 @@ def test_the_source_is_the_one_asked_and_said(run: dict[str, Any]) -> None:
     assert first["topic"] == "rclverify/run" and (first["source"], first["rmw"]) == (rec["source"], rec["rmw"])
     # the verdicts reach a ROS 2 subscriber on /rclverify/verdict, decoded (std_msgs/String JSON), either way
     heard, violated = (int(x) for x in run["system"].split("done ")[1].split()[:2])
+    assert "matched True" in run["system"], run["system"]  # the rounds began once every reader had matched
     assert heard > 50 and violated > 0, run["system"]
 
 
