@@ -111,6 +111,11 @@ SECONDS: dict[str, float] = {
     "test_fret_example": 4.0, "test_instances": 3.5, "test_fleet_example": 6.0,
     "test_lifecycle_recorded": 2.6,  # seven replays of a recorded run through the live run's judge
     "test_fret_scopes": 19.0,  # 191 FRET scope/timing combinations, each run against FRET's formula on 12 traces
+    # Out of the inner tier by the two-second rule (docs/ci.md, "Round sixteen"): over 2 CPU s in three inner-tier
+    # runs of round fifteen (the median) and again run alone, one process, at a fixed commit (load about 17).
+    "test_report_as_written": 3.4, "test_startup_imports": 3.1, "test_monitor_skew": 3.0, "test_monitor_order": 2.9,
+    "test_jobs": 2.6, "test_widths": 2.5, "test_summary_store": 2.4, "test_report_textfmt": 2.4,
+    "test_bag_blocks": 2.4, "test_evaluate_shortcuts": 2.3, "test_ros_bringup": 2.0,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
