@@ -10,6 +10,8 @@ from typing import Any
 import pytest
 import yaml
 
+from _typed_rows import complete
+from rclverify.records.summary_rows import Meta
 from rclverify.report.argument.build import build_argument
 from rclverify.report.argument.export import argument_view, to_dot, to_gsn_yaml, to_json_text, write_argument
 from rclverify.report.argument.model import Argument, ArgumentError, Element, propagate
@@ -35,8 +37,8 @@ def _report() -> dict[str, Any]:
     every piece of evidence is discharged except where a test changes it."""
     g = lambda k, text: {"index": k, "text": text, "source": f"c.rcl:{k}:3", "status": "discharged", "obligations": []}
     return {
-        "meta": {"tool": "rclverify", "version": "0", "workspace": "mini", "plan": "contracts/plan.yaml",
-                 "contracts": ["contracts/c.rcl"], "z3_version": "4", "strict_ok": True},
+        "meta": complete(Meta, {"tool": "rclverify", "version": "0", "workspace": "mini", "plan": "contracts/plan.yaml",
+                                "contracts": ["contracts/c.rcl"], "z3_version": "4", "strict_ok": True}),
         "summary": {"status": "discharged", "counts": {}, "headline": "", "problems": []},
         "system": {"nodes": [], "connections": [], "environment_inputs": [], "loops": []},
         "requirements": [

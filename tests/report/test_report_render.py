@@ -12,6 +12,8 @@ from typing import Any
 import msgspec
 import pytest
 
+from _typed_rows import complete
+from rclverify.records.summary_rows import Meta
 from rclverify.report import diagram, render
 
 
@@ -29,11 +31,11 @@ def _report() -> dict[str, Any]:
     an environment input, one failed evidence (with a hostile explanation),
     one pending, one refuted side condition and one health problem."""
     return {
-        "meta": {
+        "meta": complete(Meta, {
             "tool": "rclverify", "version": "0.1.0", "workspace": "mini",
             "plan": "contracts/plan.yaml", "contracts": ["contracts/mini.rcl"],
             "z3_version": "4.12.2", "strict_ok": False,
-        },
+        }),
         "summary": {
             "status": "failed",
             "counts": {"discharged": 1, "failed": 1, "pending": 1},

@@ -38,9 +38,17 @@ import hashlib
 import re
 from typing import Any, Iterable, Mapping, TypeVar
 
+import msgspec
+
+from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
+from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import (EnvironmentAssumptionJson, NodeJson, ObligationJson, Report,
-                                             RequirementJson, SideConditionJson)
+from rclverify.records.node_rows import NodeRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.report_schema import Report, RequirementJson
+from rclverify.records.row import decode_rows
+from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.records.summary_rows import Meta
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
@@ -51,7 +59,7 @@ from rclverify.report.argument.accepted import add_accepted_risks
 from rclverify.report.argument.claim_points import add_claim_points
 
 #: A report row that names its node.
-_Row = TypeVar("_Row", ObligationJson, SideConditionJson, EnvironmentAssumptionJson)
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, EnvironmentAssumptionRow)
 
 _FINDING_AS = {"ok": "discharged", "problem": "failed", "inconclusive": "inconclusive", "stale": "stale"}
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -89,7 +97,7 @@ _PROOF_STATUS = {"met": "discharged", "proved, evidence outstanding": "discharge
 
 
 def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mapping[tuple[str, int], str],
-                      sides: Mapping[str, list[SideConditionJson]], j_calc: str) -> str:
+                      sides: Mapping[str, list[SideConditionRow]], j_calc: str) -> str:
     """The goal of a requirement the report's requirement check decided
     (its ``verdict``): an informal one is an undeveloped goal; a formal one is
     supported by a formal-entailment strategy whose children are the Z3
@@ -115,7 +123,7 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
             if p["node"] not in nodes_used:
                 nodes_used.append(str(p["node"]))
     for name in nodes_used:
-        kids += [ident("G", "sc", sc["id"]) for sc in sides.get(name, [])]
+        kids += [ident("G", "sc", sc.id) for sc in sides.get(name, [])]
     kids += [_declaration_goal(b, d) for d in c.get("declarations") or []]
     ctx = [j_calc] + [b.add(Element(ident("A", rid, "assuming", k), "assumption",
                                     _clip(f"{rid} assumes: {a}"), ref=rid))
@@ -168,9 +176,9 @@ def build_argument(report: Report) -> Argument:
     top, top_ctx = ident("G", "system"), g.top_context()
     g.loop_assumptions()
     g.j_calc = g.b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
-    if any(sc.get("verdict") == "discharged in context" for sc in report["side_conditions"]):
+    if any(sc.verdict == "discharged in context" for scs in g.sides.values() for sc in scs):
         g.b.add(Element(g.j_context, "justification", IN_CONTEXT))
-    contract_goals = [g.contract_goal(n) for n in report["nodes"]]
+    contract_goals = [g.contract_goal(n) for n in decode_rows(NodeRow, report["nodes"])]
     req_goals = [g.requirement_goal(r) for r in report["requirements"]]
     b = g.b
     s_reqs = b.add(Element(ident("S", "requirements"), "strategy", "Argument over each requirement of the plan",
@@ -179,7 +187,7 @@ def build_argument(report: Report) -> Argument:
                                 "Argument over the node contracts: every node meets its contract (the premises of rules R1-R4)",
                                 supported_by=tuple(contract_goals), in_context_of=(g.a_persist, *g.loop_ids.values())))
     ids = ", ".join(str(r["id"]) for r in report["requirements"]) or "no requirement listed"
-    b.els = {top: Element(top, "goal", f"The system {report['meta']['workspace']} meets its requirements ({ids})",
+    b.els = {top: Element(top, "goal", f"The system {g.meta.workspace} meets its requirements ({ids})",
                           supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
     add_defeaters(b.els, report, ident)
     add_accepted_risks(b.els, report, ident, top)
@@ -191,7 +199,7 @@ def build_argument(report: Report) -> Argument:
 def _by_node(rows: Iterable[_Row]) -> dict[str, list[_Row]]:
     out: dict[str, list[_Row]] = {}
     for r in rows:
-        out.setdefault(str(r["node"]), []).append(r)
+        out.setdefault(r.node, []).append(r)
     return out
 
 
@@ -202,14 +210,16 @@ class _Goals:
 
     def __init__(self, report: Report) -> None:
         self.report, self.b = report, _Builder()
-        self.ev_of = {str(e["obligation"]): e for e in report["evidence"]}
+        self.meta = Meta.of(report["meta"])
+        self.ev_of = {e.obligation: e for e in decode_rows(EvidenceRow, report["evidence"])}
         # by node, still sorted by id: p1 < p2 < p10
-        self.obligations_of = _by_node(sorted(report["obligations"], key=lambda o: natural_key(o["id"])))
-        self.sides = _by_node(report["side_conditions"])
+        self.obligations_of = _by_node(sorted(decode_rows(ObligationRow, report["obligations"]),
+                                              key=lambda o: natural_key(o.id)))
+        self.sides = _by_node(decode_rows(SideConditionRow, report["side_conditions"]))
         self.findings: dict[str, list[FindingRow]] = {}
         for f in rows_of(report["findings"]):
             self.findings.setdefault(f.node, []).append(f)
-        self.env = _by_node(report["environment_assumptions"])
+        self.env = _by_node(decode_rows(EnvironmentAssumptionRow, report["environment_assumptions"]))
         self.loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
         self.loop_of: dict[str, str] = {}
         self.guarantee_goal: dict[tuple[str, int], str] = {}
@@ -219,10 +229,10 @@ class _Goals:
     def top_context(self) -> tuple[str, ...]:
         """The plan's context, the persistence assumption and the grounding's context (docs/ros.md:
         which software version the contracts were grounded in)."""
-        b, meta = self.b, self.report["meta"]
+        b, meta = self.b, self.meta
         c_plan = b.add(Element(ident("C", "plan"), "context",
-                               f"Verification plan {meta['plan']} and contracts {', '.join(map(str, meta['contracts']))} "
-                               f"of {meta['workspace']}", url=str(meta["plan"])))
+                               f"Verification plan {meta.plan} and contracts {', '.join(meta.contracts)} "
+                               f"of {meta.workspace}", url=meta.plan))
         self.a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
         grounding = self.report.get("grounding")
         if not grounding:
@@ -238,33 +248,33 @@ class _Goals:
 
     def loop_assumptions(self) -> None:
         """One assumption element per loop of rule R4 (its derived properties' loop assumption)."""
-        for d in self.report["derived_properties"]:
-            text = d.get("loop_assumption")
+        for d in decode_rows(DerivedPropertyRow, self.report["derived_properties"]):
+            text = d.loop_assumption
             if text:
                 if text not in self.loop_ids:
                     self.loop_ids[text] = self.b.add(Element(ident("A", "loop", len(self.loop_ids) + 1), "assumption",
-                                                             str(text)))
-                self.loop_of[str(d["node"])] = self.loop_ids[text]
+                                                             text))
+                self.loop_of[d.node] = self.loop_ids[text]
 
-    def _evidence(self, o: ObligationJson) -> str:
+    def _evidence(self, o: ObligationRow) -> str:
         """The solution of obligation ``o`` (its evidence record), or an undeveloped goal without one."""
-        oid = str(o["id"])
+        oid = o.id
         ev = self.ev_of.get(oid)
         if ev is None:
             return self.b.add(Element(ident("G", "ob", oid), "goal",
-                                      f"Obligation {oid} ({o['backend']}) is discharged: no evidence record yet",
+                                      f"Obligation {oid} ({o.backend}) is discharged: no evidence record yet",
                                       undeveloped=True, ref=oid))
-        tool = f"{ev['tool']} {ev['tool_version']}".strip()
+        tool = f"{ev.tool} {ev.tool_version}".strip()
+        strength = (f" [strength: {ev.strength.kind}; {'' if ev.strength.detail is msgspec.UNSET else ev.strength.detail}]"
+                    if ev.strength else "")
         return self.b.add(Element(
             ident("Sn", "ev", oid), "solution",
-            _clip(f"{ev['kind']} evidence ({ev['backend']}, {tool}) for {oid}: {ev['status']}"
-                  + (f" [strength: {ev['strength']['kind']}; {ev['strength']['detail']}]" if ev.get("strength") else "")
-                  + f". {ev['explanation']}"),
-            status=str(ev["status"]), ref=oid, url=f"artifacts/evidence/{oid}.json"))
+            _clip(f"{ev.kind} evidence ({ev.backend}, {tool}) for {oid}: {ev.status}{strength}. {ev.explanation}"),
+            status=ev.status, ref=oid, url=f"artifacts/evidence/{oid}.json"))
 
     def evidence_goals(self, node: str, k: int) -> list[str]:
         """Solutions and undeveloped goals under guarantee ``k`` of ``node``."""
-        mine = [o for o in self.obligations_of.get(node, []) if o["node"] == node and int(o["guarantee"]) in (k, 0)]
+        mine = [o for o in self.obligations_of.get(node, []) if o.node == node and o.guarantee in (k, 0)]
         kids = [self._evidence(o) for o in mine]
         if not mine:
             kids.append(self.b.add(Element(ident("G", node, f"g{k}", "evidence"), "goal",
@@ -278,44 +288,44 @@ class _Goals:
                     status=_FINDING_AS.get(f.status, "error"), ref=f.id, url=f.smt2)))
         return kids
 
-    def side_goal(self, sc: SideConditionJson) -> str:
+    def side_goal(self, sc: SideConditionRow) -> str:
         """The goal of side condition ``sc`` with its Z3 query as solution (in context: the weaker claim)."""
-        b, sid = self.b, str(sc["id"])
-        verdict = str(sc.get("verdict") or sc["status"])
+        b, sid = self.b, sc.id
+        verdict = sc.verdict or sc.status
         sn = b.add(Element(ident("Sn", "sc", sid), "solution",
-                           _clip(f"Z3 query {sc['smt2']}: {verdict}"
-                                 + (f" [{sc['solvers']['agreement']}]" if sc.get("solvers") else "")
-                                 + f". {sc['explanation']}"),
-                           status=str(sc["status"]), ref=sid, url=str(sc["smt2"])))
+                           _clip(f"Z3 query {sc.smt2}: {verdict}"
+                                 + (f" [{sc.solvers.agreement}]" if sc.solvers else "")
+                                 + f". {sc.explanation}"),
+                           status=sc.status, ref=sid, url=sc.smt2))
         if verdict == "discharged in context":  # the claim is the weaker one the proof supports (docs/calculus.md)
-            ctx = sc.get("context") or {}
+            ctx = sc.context or {}  # calculus/compose.py's record of the proof in context
             used = sorted({str(u).split(" ", 1)[0] for u in ctx.get("used_nodes") or []})
             return b.add(Element(ident("G", "sc", sid), "goal",
-                                 _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
-                                       f"{sc['conjunct']} of {sc['node']}'s assumption follows, in context, from the "
+                                 _clip(f"Side condition {sid} ({sc.rule}, {sc.source}): the conjunct "
+                                       f"{sc.conjunct} of {sc.node}'s assumption follows, in context, from the "
                                        f"guarantees of its upstream cone ({', '.join(used) or 'none'}), each under its "
                                        "own node's assumption, and the cone's environment assumptions and facts"),
                                  supported_by=(sn,), in_context_of=(self.j_context,), ref=sid))
         return b.add(Element(ident("G", "sc", sid), "goal",
-                             _clip(f"Side condition {sid} ({sc['rule']}, {sc['source']}): the conjunct "
-                                   f"{sc['conjunct']} of {sc['node']}'s assumption follows from its producers' guarantees"),
+                             _clip(f"Side condition {sid} ({sc.rule}, {sc.source}): the conjunct "
+                                   f"{sc.conjunct} of {sc.node}'s assumption follows from its producers' guarantees"),
                              supported_by=(sn,), ref=sid))
 
-    def contract_goal(self, n: NodeJson) -> str:
+    def contract_goal(self, n: NodeRow) -> str:
         """The goal that node ``n`` meets its contract: its guarantees' goals and its side conditions'."""
-        b, name = self.b, str(n["name"])
+        b, name = self.b, n.name
         g_ids = []
-        for g in n["guarantees"]:
-            k = int(g["index"])
+        for g in n.guarantees:
+            k = g.index
             gid = b.add(Element(ident("G", name, f"g{k}"), "goal",
-                                _clip(f"{name} guarantee {k} holds ({g['source']}): {g['text']}"),
+                                _clip(f"{name} guarantee {k} holds ({g.source}): {g.text}"),
                                 supported_by=tuple(self.evidence_goals(name, k)), ref=f"{name}.g{k}"))
             self.guarantee_goal[(name, k)] = gid
             g_ids.append(gid)
         sc_ids = [self.side_goal(sc) for sc in self.sides.get(name, [])]
-        c_node = b.add(Element(ident("C", name), "context", f"Contract of {name} ({n['source']})", ref=name))
+        c_node = b.add(Element(ident("C", name), "context", f"Contract of {name} ({n.source})", ref=name))
         ctx = [c_node] + [b.add(Element(ident("A", "env", name, i), "assumption",
-                                        _clip(f"Environment assumption of {name} ({a['source']}): {a['text']}"), ref=name))
+                                        _clip(f"Environment assumption of {name} ({a.source}): {a.text}"), ref=name))
                           for i, a in enumerate(self.env.get(name, []), 1)]
         return b.add(Element(
             ident("G", name), "goal",
@@ -337,7 +347,7 @@ class _Goals:
             if s["node"] not in nodes_used:
                 nodes_used.append(str(s["node"]))
         for name in nodes_used:
-            kids += [ident("G", "sc", sc["id"]) for sc in self.sides.get(name, [])]
+            kids += [ident("G", "sc", sc.id) for sc in self.sides.get(name, [])]
         ctx = [self.a_persist] + sorted({self.loop_of[x] for x in nodes_used if x in self.loop_of}) + [self.j_calc]
         strategy = b.add(Element(
             ident("S", rid), "strategy",
