@@ -199,13 +199,18 @@ def _write_sarif(path: Path, findings: Any, root: str) -> None:
     relative to ``%SRCROOT%``, described as ``root``."""
     from rclverify import __version__  # deferred: start-up (the package is loaded already)
     from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
-    from rclverify.records.report_schema import Report  # deferred: start-up (loads the report's records only when called)
+    import msgspec  # deferred: start-up (loads msgspec only when called)
+    from types import SimpleNamespace  # deferred: start-up (as above)
+    from rclverify.records.nodl_rows import NodlRow  # deferred: start-up (loads the report's records only when called)
+    from rclverify.records.report_record import AssuranceReport  # deferred: start-up (as above)
     from rclverify.records.sarif import SRCROOT, SarifDescriptor, SarifLog, sarif_locations, sarif_result  # deferred: start-up (as above)
     from rclverify.records.store import dumps  # deferred: start-up (as above)
     from rclverify.report import nodl as report_nodl  # deferred: start-up (loads the report layer only when called)
     from rclverify.report.sarif import SARIF_SCHEMA, SARIF_VERSION  # deferred: start-up (as above)
-    row = {"findings": [f.to_json() for f in findings]}
-    results = report_nodl.sarif_results(cast(Report, {"nodl": row}), sarif_result, sarif_locations)
+    row = msgspec.convert({"documents": {}, "parts": [], "findings": [f.to_json() for f in findings], "counts": {},
+                           "side_conditions": [], "inputs": {}}, NodlRow)
+    # the writer reads the report's nodl part only: a report holding that part alone
+    results = report_nodl.sarif_results(cast(AssuranceReport, SimpleNamespace(nodl=row)), sarif_result, sarif_locations)
     for res in results:
         res["ruleIndex"] = 0
     rules: list[SarifDescriptor] = [{"id": i, "name": n, "shortDescription": {"text": t}, "defaultConfiguration": {"level": lv}}
