@@ -28,7 +28,8 @@ interpreted here:
   ``pass_all_args``); a ROS 2 one (:func:`.launch_tree.ros2_file`) sets them
   in the including scope and reads the file there, as launch does;
 * ``group`` ``scoped="false"`` / ``forwarding="false"`` with ``keep``
-  children, as launch's ``GroupAction``.
+  children, as launch's ``GroupAction`` (groups and includes:
+  :mod:`launch_scope`).
 
 Source: roslaunch XML format (wiki.ros.org/roslaunch/XML), ROS 2 launch
 frontend design (design.ros2.org "ROS 2 Launch XML/YAML format").
@@ -43,6 +44,7 @@ from typing import Callable
 
 from rclverify.ros.extract import launch_subst, names, param_yaml
 from rclverify.ros.extract.launch_readers import read_xml as read_xml, read_yaml as read_yaml
+from rclverify.ros.extract.launch_scope import Scope as _Scope, ScopeActions
 from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
 from rclverify.ros.extract.launch_tree import ALIASES, SEP as SEP, UNREAD as UNREAD, El as El
 from rclverify.ros.extract.launch_tree import NOVALUE, QUIET_TAGS, UNREAD_TAGS as _UNREAD_TAGS, ros2_file
@@ -69,16 +71,6 @@ class LaunchNode:
     unsure: Src | None = None
 
 
-@dataclass
-class _Scope:
-    ns: str
-    args: dict[str, str]
-    remaps: list[tuple[str, str, Src]] = field(default_factory=list)
-    unsure: Src | None = None  # a condition of an enclosing element read as holding without being evaluated
-    # what PushLaunchConfigurations saved (configurations, namespace, remaps: all launch configurations)
-    saved: list[tuple[dict[str, str], str, list[tuple[str, str, Src]]]] = field(default_factory=list)
-
-
 _SUBST = re.compile(r"\$\(([^()]*)\)")
 
 
@@ -87,7 +79,7 @@ MAX_INCLUDE_DEPTH = 20      # nested <include>s
 MAX_SUBST_CHARS = 65_536    # length of one attribute after substitution
 
 
-class Interpreter:
+class Interpreter(ScopeActions):
     """Walk launch trees; ``pkg_dir(name)`` finds a package directory,
     ``load(path, shown)`` reads a launch file into ``(El | None, [Note])``,
     ``show(path)`` gives the path shown in locations."""
@@ -396,32 +388,6 @@ class Interpreter:
                                            f"{_UNREAD_TAGS.get(t, 'the nodes it starts, if any, are unknown')}",
                                    "ROS-LAUNCH"))
 
-    def _group(self, el: El, scope: _Scope, path: Path) -> None:
-        """A ``group`` (ROS 1 ``ns``; launch's ``GroupAction``): scoped unless
-        ``scoped="false"`` (what it sets stays after it: also OpaqueFunction's,
-        an event handler's or a timer's actions); ``forwarding="false"`` starts it
-        from its ``keep`` configurations alone, the namespace and remaps (launch
-        configurations too) cleared; ``keep`` children (``launch_configurations=``)
-        are set in it; ``reset="true"`` (``ResetLaunchConfigurations``) clears the
-        scope's configurations, namespace and remaps but its ``keep`` ones.  Source: launch's ``GroupAction.get_sub_entities``,
-        ``ResetLaunchConfigurations``."""
-        ns = self._attr(el, "ns", scope, path) or self._attr(el, "namespace", scope, path)
-        keep = {self._attr(k, "name", scope, path) or "": self._attr(k, "value", scope, path) or ""
-                for k in el.children if k.tag == "keep"}
-        body = [k for k in el.children if k.tag != "keep"]
-        if el.tag == "reset" or el.attrs.get("reset") == "true":  # ResetLaunchConfigurations: the kept ones stay
-            scope.args.clear()
-            scope.args.update(keep)
-            scope.ns, scope.remaps[:] = "/", []
-        elif el.attrs.get("scoped") == "false" and not ns:
-            scope.args.update(keep)
-            self._body(body, scope, path)
-        elif el.attrs.get("forwarding") == "false":
-            self._body(body, _Scope("/", keep, [], scope.unsure), path)
-        else:
-            self._body(body, _Scope(names.join(scope.ns, ns) if ns else scope.ns, {**scope.args, **keep},
-                                    list(scope.remaps), scope.unsure), path)
-
     def _container_note(self, el: El, scope: _Scope, path: Path) -> None:
         """The located ``ROS-CONTAINER`` note of a component container ``el`` starts (a
         ``node_container`` element or a ``Node`` running ``rclcpp_components``'
@@ -459,49 +425,3 @@ class Interpreter:
         self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params,
                                      self._attr(el, "args", scope, path) if pkg == "nodelet" else None,
                                      scope.unsure))
-
-    def _include_element(self, el: El, scope: _Scope, path: Path) -> None:
-        """An ``<include>`` in ``scope``: the included file read with its arguments (``pass_all_args``
-        and its ``<arg>`` children) under the scope's namespace and remaps.  Raises
-        :class:`Unresolved` when the file is not named or not found."""
-        f = self._attr(el, "file", scope, path)
-        if not f:
-            raise Unresolved("include needs 'file'")
-        target = Path(f)
-        if not target.is_absolute():
-            target = path.parent / target
-        if not target.is_file():
-            raise Unresolved(f"included file {f} not found")
-        ns = self._attr(el, "ns", scope, path)
-        if self.ros2.get(path.resolve() if path.exists() else path) and not ns:
-            self._include_ros2(el, target, scope, path)
-            return
-        args: dict[str, str] = dict(scope.args) if el.attrs.get("pass_all_args") == "true" else {}
-        for c in el.children:
-            if c.tag == "arg" and self._cond(c, scope, path):
-                n = self._attr(c, "name", scope, path)
-                if n and c.attrs.get("novalue"):  # a value its reader could not read (said there)
-                    args[n] = NOVALUE
-                    continue
-                v = self._attr(c, "value", scope, path) or self._attr(c, "default", scope, path)
-                if n and v is not None:
-                    args[n] = v
-        self.run(target, args, names.join(scope.ns, ns) if ns else scope.ns, scope.remaps, scope.unsure)
-
-    def _include_ros2(self, el: El, target: Path, scope: _Scope, path: Path) -> None:
-        """A ROS 2 include: its arguments set, in order, as launch configurations of
-        ``scope`` (a later one reads an earlier one), then ``target`` read in ``scope``
-        itself: it sees every configuration set before it (a ``DeclareLaunchArgument``
-        default gives way to any), and what it sets stays after it (launch's
-        ``IncludeLaunchDescription.execute``, ``DeclareLaunchArgument.execute``)."""
-        for c in el.children:
-            if c.tag == "arg" and self._cond(c, scope, path):
-                n = self._attr(c, "name", scope, path)
-                if n and c.attrs.get("novalue"):  # a value its reader could not read (said there)
-                    scope.args[n] = NOVALUE
-                    continue
-                v = self._attr(c, "value", scope, path)
-                if n and v is not None:
-                    scope.args[n] = v
-        self.run(target, shared=scope)
-
