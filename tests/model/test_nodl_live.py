@@ -10,10 +10,12 @@ kind: ``/speed`` published as ``std_msgs/Float32`` (the document: ``Float64``), 
 document: transient-local), no ``/estop`` server, and a publisher ``/odom`` its document does not declare.
 ``Dock`` does not run: a document matched to no running node is not compared.
 
-The graph rclpy's graph API gave is also recorded (``--record-graph``; docs/nodl.md, "A recorded graph": Kilted's
-``rosgraph_msgs`` has no graph message) and, once the nodes have stopped, checked again from the recording
-(``--graph``): the same findings as from the live sources, a graph difference seeded into the recording found,
-and a recording that is not one refused at its line."""
+The graph each source gave is also recorded (``--record-graph``; docs/nodl.md, "A recorded graph": Kilted's
+``rosgraph_msgs`` has no graph message): rclpy's graph API and rclverify's own DDS participant by ``nodl check``,
+the DDS source once more by ``ros diff --nodl``.  Once the nodes have stopped, each recording is checked again
+(``nodl check --graph``, ``ros diff --graph``): the same findings and items, line for line, as the live reading
+it was made from; a graph difference seeded into a recording found by both commands (the recording as made, the
+control, has none); a recording that is not one refused at its line."""
 from __future__ import annotations
 
 import json
@@ -70,7 +72,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         out: dict[str, Any] = {}
         for source in ("dds", "rclpy"):  # rclverify's own DDS participant, rclpy's graph API (as ros diff reads)
             log = tmp / f"check_{source}.log"
-            record = ["--record-graph", str(tmp / "graph.json")] if source == "rclpy" else []
+            record = ["--record-graph", str(tmp / ("graph.json" if source == "rclpy" else "graph_dds.json"))]
             p = rclverify(["nodl", "check", "-w", str(ws), "--ros2", "--wait", "2", "--source", source,
                            "--ros2-python", str(ros2_python()), *record], env, ws, log)
             procs.append(p)
@@ -81,11 +83,17 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                        "--ros2-python", str(ros2_python())], env, ws, log)
         procs.append(p)
         out["diff"] = {"code": p.wait(120), "log": log.read_text()}
+        log = tmp / "diff_dds.log"  # and through rclverify's own DDS participant, recorded
+        p = rclverify(["ros", "diff", "--nodl", str(ws / "nodl"), "--ros2", "--wait", "2", "--source", "dds",
+                       "--record-graph", str(tmp / "diff_graph_dds.json")], env, ws, log)
+        procs.append(p)
+        out["diff_dds"] = {"code": p.wait(120), "log": log.read_text()}
         stop(procs[0])  # the robot stops: the recording is read with no node running
         log = tmp / "check_recorded.log"
         p = rclverify(["nodl", "check", "-w", str(ws), "--graph", str(tmp / "graph.json")], env, ws, log)
         procs.append(p)
-        out["recorded"] = {"code": p.wait(120), "log": log.read_text(), "graph": tmp / "graph.json", "ws": ws}
+        out["recorded"] = {"code": p.wait(120), "log": log.read_text(), "graph": tmp / "graph.json", "ws": ws,
+                           "graph_dds": tmp / "graph_dds.json", "diff_graph_dds": tmp / "diff_graph_dds.json"}
         yield out
     finally:
         for p in procs:
@@ -151,7 +159,7 @@ def _places(log: str) -> list[tuple[str, str]]:
 
 def test_the_recorded_graph_gives_the_findings_of_the_live_sources(run) -> None:
     recorded = run["recorded"]["log"]
-    assert "source: rclpy (the graph recorded in " in recorded and "Traceback" not in recorded
+    assert "source: recorded (the graph recorded in " in recorded and "Traceback" not in recorded
     assert [ln for ln in recorded.splitlines() if ln.startswith("nodl/")] == \
         [ln for ln in run["rclpy"]["log"].splitlines() if ln.startswith("nodl/")]  # the same lines as live
     assert _places(recorded) == _places(run["dds"]["log"]) == _places(run["rclpy"]["log"])  # and as the DDS source
@@ -178,3 +186,79 @@ def test_a_graph_difference_seeded_into_the_recording_is_found_and_a_bad_recordi
     err = capsys.readouterr().err
     assert f"{edited}:" in err and "error: endpoints.'/stop'.pubs.0.reliable: is a bool" in err and "Traceback" not in err
     assert main(["nodl", "check", "--graph", str(edited), "--ros2"]) == 2  # one graph at a time
+
+
+def _finding_lines(log: str) -> list[str]:
+    return [ln for ln in log.splitlines() if ln.startswith("nodl/")]
+
+
+def _items(log: str) -> list[str]:
+    """ros diff's item lines and the headings of its lists."""
+    return [ln for ln in log.splitlines() if ln.startswith("  ") or ln.startswith("in the NoDL")]
+
+
+def test_the_two_sources_record_the_same_graph(run) -> None:
+    """The DDS source's recording (rclverify's own participant, rclverify.ros.live.dds_record) holds exactly what
+    rclpy's graph API gave: the same nodes with their topics and services, the same endpoints with their GIDs,
+    types, type hashes and QoS; only the source's label differs."""
+    rclpy, dds = (json.loads(run["recorded"][k].read_text(encoding="utf-8")) for k in ("graph", "graph_dds"))
+    assert rclpy["nodes"] == dds["nodes"] and [n["name"] for n in dds["nodes"]] == ["Base", "Guard"]
+    def ends(g: dict[str, Any]) -> dict[str, dict[str, list[str]]]:  # each role's endpoints in GID order
+        return {t: {r: sorted(json.dumps(e, sort_keys=True) for e in es) for r, es in roles.items()}
+                for t, roles in g["endpoints"].items()}
+    assert ends(rclpy) == ends(dds) and "/stop" in dds["endpoints"]
+    assert all(e.get("hash", "").startswith("RIHS01_") for roles in dds["endpoints"].values()
+               for es in roles.values() for e in es)
+    assert rclpy["rmw"] == "rmw_fastrtps_cpp" and "source" not in rclpy and dds["source"].startswith("DDS domain ")
+
+
+def test_the_dds_sources_recording_gives_its_findings(run, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    """nodl check --graph on the DDS source's recording: the DDS source's lines exactly (its source named
+    ``DDS domain N`` as live)."""
+    from rclverify.cli.commands import main
+    monkeypatch.chdir(run["recorded"]["ws"])
+    assert main(["nodl", "check", "--graph", str(run["recorded"]["graph_dds"])]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert _finding_lines(err) == _finding_lines(run["dds"]["log"]) and len(_finding_lines(err)) >= 5
+
+
+@pytest.mark.parametrize("live,graph", [("diff", "graph"), ("diff_dds", "diff_graph_dds")])
+def test_ros_diff_reads_a_recording_as_the_live_reading_it_was_made_from(
+        run, live: str, graph: str, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    """ros diff --nodl --graph FILE: the items of the live ros diff through the same source, line for line
+    (the rclpy recording was made by nodl check, the DDS one by ros diff itself)."""
+    from rclverify.cli.commands import main
+    monkeypatch.chdir(run["recorded"]["ws"])
+    assert run[live]["code"] == 1 and "Traceback" not in run[live]["log"]
+    assert main(["ros", "diff", "--nodl", "nodl", "--graph", str(run["recorded"][graph])]) == 1
+    out = capsys.readouterr()
+    assert "Traceback" not in out.err and "source: recorded (the graph recorded in " in out.err
+    assert _items(out.out) == _items(run[live]["log"]) and len(_items(out.out)) >= 5
+
+
+def test_ros_diff_finds_a_difference_seeded_into_a_recording(run, tmp_path: Path, capsys,
+                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    """Guard's /stop publisher made best-effort in the DDS recording: ros diff --graph gives an item at Guard's
+    document that the recording as made (the control) does not; a recording that is not one: one located line,
+    exit 1; --graph with --ros2: a usage error."""
+    from rclverify.cli.commands import main
+    monkeypatch.chdir(run["recorded"]["ws"])
+    made = run["recorded"]["diff_graph_dds"]
+    assert main(["ros", "diff", "--nodl", "nodl", "--graph", str(made)]) == 1
+    assert not [i for i in _items(capsys.readouterr().out) if "/Guard" in i]  # the control
+    data = json.loads(made.read_text(encoding="utf-8"))
+    assert data["source"].startswith("DDS domain ")
+    [stop_pub] = [e for e in data["endpoints"]["/stop"]["pubs"] if e["node"] == "Guard"]
+    stop_pub["reliable"] = False
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(data), encoding="utf-8")
+    assert main(["ros", "diff", "--nodl", "nodl", "--graph", str(edited)]) == 1
+    guard = [i for i in _items(capsys.readouterr().out) if "/Guard" in i]
+    assert guard and any("/stop" in i and "BEST_EFFORT" in i for i in guard), guard
+    data["endpoints"]["/stop"]["pubs"][0]["durability"] = "sometimes"
+    edited.write_text(json.dumps(data, indent=1), encoding="utf-8")
+    assert main(["ros", "diff", "--nodl", "nodl", "--graph", str(edited)]) == 1
+    err = capsys.readouterr().err
+    assert f"{edited}:" in err and "durability: is volatile or transient_local" in err and "Traceback" not in err
+    assert main(["ros", "diff", "--nodl", "nodl", "--graph", str(edited), "--ros2"]) == 2

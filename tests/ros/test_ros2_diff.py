@@ -268,14 +268,15 @@ def diff(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
             wait_for(tmp / f"{name}.log", "ready", 30)
         out, log = tmp / "diff.json", tmp / "diff.log"
         p = rclverify(["ros", "diff", "src", "--launch", "src/demo_pkg/launch/demo.launch.py", "--ros2",
-                       "--wait", "2", "--json", str(out)], env, tmp / "ws", log)
+                       "--wait", "2", "--json", str(out), "--record-graph", str(tmp / "graph_dds.json")], env,
+                      tmp / "ws", log)
         procs.append(p)
         code = p.wait(60)
         # the same diff with the graph read through rclpy's graph API (docs/ros2.md, "Two sources")
         out_r, log_r = tmp / "diff_rclpy.json", tmp / "diff_rclpy.log"
         pr = rclverify(["ros", "diff", "src", "--launch", "src/demo_pkg/launch/demo.launch.py", "--ros2",
                         "--source", "rclpy", "--ros2-python", str(ros2_python()), "--wait", "2", "--json",
-                        str(out_r)], env, tmp / "ws", log_r)
+                        str(out_r), "--record-graph", str(tmp / "graph_rclpy.json")], env, tmp / "ws", log_r)
         procs.append(pr)
         code_r = pr.wait(90)
         probe = subprocess.Popen([str(ros2_python()), "-c", textwrap.dedent(PROBE), *RUNNING], cwd=tmp, env=env,
@@ -286,7 +287,8 @@ def diff(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         yield {"code": code, "json": json.loads(out.read_text()), "log": log.read_text(), "domain": env["ROS_DOMAIN_ID"],
                "rclpy": {"code": code_r, "json": json.loads(out_r.read_text()) if out_r.exists() else None,
                          "log": log_r.read_text()},
-               "ros2": seen, "ours": ours}
+               "ros2": seen, "ours": ours, "ws": tmp / "ws",
+               "recorded": {"dds": tmp / "graph_dds.json", "rclpy": tmp / "graph_rclpy.json"}}
     finally:
         for p in procs:
             stop(p)
@@ -382,6 +384,34 @@ def test_the_running_graph_is_the_one_ros2_itself_sees(diff: dict[str, Any]) -> 
     assert set(ros2) == set(RUNNING), ros2  # the probe saw the whole system
     assert diff["ours"] == ros2
     assert ros2["/robot/talker"]["action_servers"] == [("/robot/count", "test_msgs/action/Fibonacci")]
+
+
+@pytest.mark.parametrize("source", ["dds", "rclpy"])
+def test_a_recording_of_the_running_graph_gives_the_live_diff(diff: dict[str, Any], source: str, tmp_path: Path,
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """``ros diff --graph FILE`` on the graph each source recorded while it compared (``--record-graph``), read
+    with no node needed: the live diff's JSON exactly (the same missing and extra items, at the same places,
+    the source named as live); the recording with the camera's publisher made reliable (a seeded graph
+    difference) loses the QoS conflict and the camera's drift from its code, and nothing else."""
+    from rclverify.cli.commands import main
+    live = diff["json"] if source == "dds" else diff["rclpy"]["json"]
+    assert live is not None and live["missing"] and live["extra"]
+    monkeypatch.chdir(diff["ws"])  # the code's places are shown from the workspace, as the live diff's were
+    out = tmp_path / "recorded.json"
+    args = ["ros", "diff", "src", "--launch", "src/demo_pkg/launch/demo.launch.py", "--json", str(out)]
+    assert main([*args, "--graph", str(diff["recorded"][source])]) == 1
+    assert json.loads(out.read_text()) == live
+    data = json.loads(diff["recorded"][source].read_text())
+    [cam] = data["endpoints"]["/sensors/image"]["pubs"]
+    cam["reliable"] = True
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(data))
+    main([*args, "--graph", str(edited)])
+    seeded = json.loads(out.read_text())
+    assert seeded["extra"] == live["extra"]
+    gone = [i for i in live["missing"] if i not in seeded["missing"]]
+    assert seeded["missing"] == [i for i in live["missing"] if i not in gone]
+    assert sorted(i["category"] for i in gone) == ["qos", "qos"] and all(i["name"] == "/sensors/image" for i in gone)
 
 
 # -- the namespaces of the static scan (no ROS 2 needed) ---------------------------------------

@@ -64,7 +64,7 @@ def add_parsers(sub: Any) -> None:
     c.add_argument("--ros2-python", metavar="PYTHON",
                    help="--ros2 --source rclpy: the Python with rclpy (default: $RCLVERIFY_ROS2_PYTHON, else this one)")
     c.add_argument("--record-graph", metavar="FILE",
-                   help="--ros2 --source rclpy: also write the graph read, to check against later with --graph")
+                   help="--ros2: also write the graph read (either source), to check against later with --graph")
     c.add_argument("--graph", metavar="FILE", help="check against a recorded graph (--record-graph) instead of the "
                                                   "running one (docs/nodl.md, 'A recorded graph')")
     c.add_argument("--json", metavar="FILE", help="also write the findings as JSON")
@@ -227,36 +227,38 @@ def _write_sarif(path: Path, findings: Any, root: str) -> None:
 def _live(args: argparse.Namespace, res: Any) -> bool:
     """Add the findings of ``res.documents`` against the running graph to ``res``, read through the
     source ``--source`` picks (as ``ros diff --ros2`` does), or against the graph recorded in ``--graph``
-    (:mod:`rclverify.model.nodl.graph_record`; ``--record-graph`` writes the one read); ``False`` after
-    printing why it cannot be read."""
+    (:mod:`rclverify.model.nodl.graph_record`; ``--record-graph`` writes the one read, from either source);
+    ``False`` after printing why it cannot be read (a recording that cannot be written raises
+    :class:`~rclverify.lang.errors.RclError`, located at its path)."""
     from rclverify.ros.ground.nodl_code import check_code, live_qos_of  # deferred: start-up (loads the ROS layers only when called)
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.ros.live.diff_dds import graph_of, read_dds_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.graph import RclpyDiscovery, read_rclpy_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
-    from rclverify.model.nodl.graph_record import read_record, record_text  # deferred: start-up (loads the recording's reader only when called)
+    from rclverify.model.nodl.graph_record import read_record, record_text, source_of  # deferred: start-up (loads the recording's reader only when called)
+    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
     try:
         if args.graph:
-            kind, py, why = "rclpy", None, f"the graph recorded in {args.graph}"
+            kind, py, why = "recorded", None, f"the graph recorded in {args.graph}"
         else:
             kind, py, why = pick_source(args.source, args.ros2_python)
         print(f"source: {kind} ({why})", file=sys.stderr)
-        if args.record_graph and kind != "rclpy":
-            raise ValueError("--record-graph records the graph rclpy's graph API gives: give --source rclpy")
         rdisc = RclpyDiscovery(read_record(Path(args.graph))) if args.graph else \
             read_rclpy_graph(py, args.wait) if kind == "rclpy" and py is not None else None
         if rdisc is not None:
             if args.record_graph:
-                from rclverify.lang.output import write_atomic  # deferred: start-up (only when writing)
                 write_atomic(Path(args.record_graph), record_text(rdisc.dump))
-            source = f"rclpy on {rdisc.rmw}"
+            source = source_of(rdisc.dump)
             running = graph_of(rdisc, source)  # type: ignore[arg-type]  # the same shape as Discovery
             matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(rdisc),
                                         namespaces=args.namespaces)
         else:
+            from rclverify.ros.live.dds_record import dds_dump  # deferred: start-up (loads the DDS layer only when called)
             running, disc, source, dp = read_dds_graph(args.wait)
             try:
+                if args.record_graph:
+                    write_atomic(Path(args.record_graph), record_text(dds_dump(disc, source)))
                 matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(disc),
                                             namespaces=args.namespaces)
             finally:

@@ -62,6 +62,10 @@ def add_parsers(sub: Any) -> None:
                    help="--ros2: seconds to listen to discovery before comparing (default 2), then up to 6 s "
                         "more while a ROS 2 participant's node list or endpoints are still on their way")
     d.add_argument("--bag", metavar="BAG", help="a recorded run: .bag, ROS 2 bag dir, .mcap (topics and types only)")
+    d.add_argument("--graph", metavar="FILE", help="a recorded ROS 2 graph (--ros2 --record-graph, nodl check "
+                   "--record-graph; docs/nodl.md, 'A recorded graph'), compared as the live reading it was made from")
+    d.add_argument("--record-graph", metavar="FILE",
+                   help="--ros2: also write the graph read (either source), to compare against later with --graph")
     d.add_argument("--json", metavar="FILE", help="write both lists as JSON (docs/ros.md)")
     d.add_argument("--nodl", metavar="DIR", help="the expected graph is the one the NoDL documents of DIR declare "
                    "(*.nodl.yaml|yml|json, QoS included; docs/nodl.md) instead of the code's")
@@ -166,8 +170,13 @@ def cmd_diff(args: argparse.Namespace) -> int:
     from rclverify.ros.graph.bag import bag_topics  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     from rclverify.ros.live.diff import diff_bag, diff_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
     from rclverify.ros.live.master import MasterError, read_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
-    if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)))) != 1:
-        print("error: ros diff needs exactly one running side: --master URI, --ros2 or --bag BAG", file=sys.stderr)
+    graph = getattr(args, "graph", None)
+    if sum((args.master is not None, args.bag is not None, bool(getattr(args, "ros2", False)), graph is not None)) != 1:
+        print("error: ros diff needs exactly one running side: --master URI, --ros2, --bag BAG or --graph FILE",
+              file=sys.stderr)
+        return 2
+    if getattr(args, "record_graph", None) and not getattr(args, "ros2", False):
+        print("error: ros diff --record-graph FILE writes the graph --ros2 reads: give --ros2", file=sys.stderr)
         return 2
     if getattr(args, "namespace", None) and not getattr(args, "nodl", None):
         print("error: ros diff --namespace NODE=NS places a NoDL document's instances: give --nodl DIR", file=sys.stderr)
@@ -192,7 +201,7 @@ def cmd_diff(args: argparse.Namespace) -> int:
         for n in running.notes:
             print(f"{args.master}: {n.severity}: {n.message}", file=sys.stderr)
         result = diff_master(res.graph, running, args.master)
-    elif getattr(args, "ros2", False):
+    elif getattr(args, "ros2", False) or graph is not None:
         got = _diff_ros2(args, res.graph)
         if got is None:
             return 1
@@ -232,8 +241,9 @@ def _diff_nodl(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"ros diff: error: {exc}", file=sys.stderr)
         return 2
-    if not args.ros2:
-        print("error: ros diff --nodl compares with the running ROS 2 system: give --ros2", file=sys.stderr)
+    if not args.ros2 and getattr(args, "graph", None) is None:
+        print("error: ros diff --nodl compares with the running ROS 2 system: give --ros2 (or a recording of it: "
+              "--graph FILE)", file=sys.stderr)
         return 2
     result = _diff_ros2(args, None, docs)
     if result is None:
@@ -261,28 +271,41 @@ def _shown(result: Any, json_path: str | None) -> bool:
 
 def _diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> Any:
     """``ros diff --ros2``: the running graph through the source ``--source`` picks (docs/ros2.md, "Two
-    sources": rclpy's graph API in the ROS 2 Python, or a DDS participant of rclverify's own), compared with
-    ``static`` (the code's graph) or, given ``documents`` (NoDL documents by node), with the graph they
-    declare; ``None`` after printing why it cannot be read."""
+    sources": rclpy's graph API in the ROS 2 Python, or a DDS participant of rclverify's own), or ``--graph``'s
+    recording of one (:mod:`rclverify.model.nodl.graph_record`, named as the reading it was made from),
+    compared with ``static`` (the code's graph) or, given ``documents`` (NoDL documents by node), with the
+    graph they declare; ``--record-graph`` writes the graph read.  ``None`` after printing why it cannot be
+    read; a recording that is not one, or cannot be written, raises :class:`~rclverify.lang.errors.RclError`
+    (located, printed by main)."""
+    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
+    from rclverify.model.nodl.graph_record import read_record, record_text, source_of  # deferred: start-up (loads the recording's reader only when called)
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.ros.live.diff_dds import diff_dds, graph_of, qos_conflicts, read_dds_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
-    from rclverify.runtime.rclpy_source.graph import read_rclpy_graph  # deferred: optional or conditional (inside a block)
+    from rclverify.runtime.rclpy_source.graph import RclpyDiscovery, read_rclpy_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
     from rclverify.ros.ground.diff_nodl import diff_nodl  # deferred: optional or conditional (inside a block)
-    try:
-        source_kind, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None))
-    except ValueError as exc:
-        print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
-        return None
-    print(f"source: {source_kind} ({why})", file=sys.stderr)
-    if source_kind == "rclpy" and py is not None:
+    recorded = getattr(args, "graph", None)
+    record = getattr(args, "record_graph", None)
+    if recorded is not None:
+        source_kind, py, why = "recorded", None, f"the graph recorded in {recorded}"
+    else:
         try:
-            rdisc = read_rclpy_graph(py, max(0.0, args.wait))
+            source_kind, py, why = pick_source(getattr(args, "source", "auto"), getattr(args, "ros2_python", None))
+        except ValueError as exc:
+            print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
+            return None
+    print(f"source: {source_kind} ({why})", file=sys.stderr)
+    if recorded is not None or source_kind == "rclpy" and py is not None:
+        try:
+            rdisc = RclpyDiscovery(read_record(Path(recorded))) if recorded is not None else \
+                read_rclpy_graph(py, max(0.0, args.wait))  # type: ignore[arg-type]  # py is not None here
         except RclpyUnavailable as exc:
             print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
             return None
-        source = f"rclpy on {rdisc.rmw}"
+        if record:
+            write_atomic(Path(record), record_text(rdisc.dump))
+        source = source_of(rdisc.dump)
         if documents is not None:
             return diff_nodl(documents, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc,  # type: ignore[arg-type]
                              args.namespaces)
@@ -295,6 +318,9 @@ def _diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> 
     try:
         for n in running.notes:
             print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
+        if record:
+            from rclverify.ros.live.dds_record import dds_dump  # deferred: optional or conditional (inside a block)
+            write_atomic(Path(record), record_text(dds_dump(disc, source)))
         if documents is not None:
             return diff_nodl(documents, running, source, qos_conflicts(disc), disc, args.namespaces)
         return diff_dds(static, running, source, qos_conflicts(disc), disc)

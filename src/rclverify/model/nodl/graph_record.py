@@ -9,13 +9,19 @@ graph API gives it, through the rclpy agent ``ros diff --ros2`` uses
 file of its own (``nodl check --ros2 --source rclpy --record-graph FILE`` writes one,
 ``nodl check --graph FILE`` reads it back):
 
-``{"kind": "rclverify-ros2-graph", "version": 1, "rmw": ..., "nodes": [...], "endpoints": {...}}``
+``{"kind": "rclverify-ros2-graph", "version": 1, "rmw": ..., "source": ..., "nodes": [...], "endpoints": {...}}``
 
 with ``nodes`` each ``{"name", "ns", "pubs", "subs", "servers", "clients"}`` (the by-node lists, each a
 list of ``[name, [types]]``) and ``endpoints`` each topic's ``{"pubs": [...], "subs": [...]}``, an
 endpoint ``{"gid" (hex), "node", "ns", "type", "hash", "reliable", "durability" (volatile or
-transient_local), "deadline_ns", "liveliness", "lease_ns"}``.  :func:`read_record` checks that
-shape and refuses anything else with one located error (``E-graph-record``) at the offending value.
+transient_local), "deadline_ns", "liveliness", "lease_ns"}`` (and ``"hash"``, the type hash, where the
+source gave one).  ``source`` (optional) is the label of the live reading the recording was made from: the
+DDS source's ``DDS domain N`` (``--source dds --record-graph``: the domain's graph in the same form,
+:func:`rclverify.ros.live.dds_record.dds_dump`); without it the label is ``rclpy on <rmw>``
+(:func:`source_of`).  Both ``nodl check --graph`` and ``ros diff --graph`` read a recording and name its
+source so, so their findings and items from a recording are those of the live reading.
+:func:`read_record` checks that shape and refuses anything else with one located error
+(``E-graph-record``) at the offending value.
 """
 from __future__ import annotations
 
@@ -43,6 +49,8 @@ def record_text(dump: dict[str, Any]) -> str:
     """The recording of ``dump`` (the agent's graph: ``rmw``, ``nodes``, ``endpoints``) as JSON text, keys sorted."""
     data = {"kind": KIND, "version": VERSION, "rmw": dump.get("rmw", ""), "nodes": dump.get("nodes", []),
             "endpoints": dump.get("endpoints", {})}
+    if dump.get("source"):
+        data["source"] = dump["source"]
     return json.dumps(data, indent=1, sort_keys=True) + "\n"
 
 
@@ -99,6 +107,7 @@ def read_record(path: Path, shown: str | None = None) -> dict[str, Any]:
     if data.get("kind") != KIND or data.get("version") != VERSION:
         raise c.fail(("kind",), f"a recorded graph has kind {KIND!r} and version {VERSION}")
     c.typed(data.get("rmw", ""), ("rmw",), str, "a text")
+    c.typed(data.get("source", ""), ("source",), str, "a text")
     for i, n in enumerate(c.typed(data.get("nodes"), ("nodes",), list, "a list of nodes")):
         c.typed(n, ("nodes", i), dict, "a node (name, ns, pubs, subs, servers, clients)")
         for key in ("name", "ns"):
@@ -110,7 +119,16 @@ def read_record(path: Path, shown: str | None = None) -> dict[str, Any]:
         for role in ("pubs", "subs"):
             for j, e in enumerate(c.typed(roles.get(role, []), ("endpoints", topic, role), list, "a list")):
                 c.endpoint(e, ("endpoints", topic, role, j))
-    return {"what": "graph_all", "rmw": data.get("rmw", ""), "nodes": data["nodes"], "endpoints": data["endpoints"]}
+    out = {"what": "graph_all", "rmw": data.get("rmw", ""), "nodes": data["nodes"], "endpoints": data["endpoints"]}
+    if data.get("source"):
+        out["source"] = data["source"]
+    return out
 
 
-__all__ = ["KIND", "VERSION", "read_record", "record_text"]
+def source_of(dump: dict[str, Any]) -> str:
+    """The label of the reading ``dump`` came from: its ``source`` (the DDS source's ``DDS domain N``),
+    else ``rclpy on <rmw>`` (module docstring)."""
+    return str(dump.get("source") or f"rclpy on {dump.get('rmw', '')}")
+
+
+__all__ = ["KIND", "VERSION", "read_record", "record_text", "source_of"]
