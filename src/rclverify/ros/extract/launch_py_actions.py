@@ -138,10 +138,11 @@ def group_flags(c: ast.Call, attrs: dict[str, str], shown: str, notes: list[Note
 
 
 def group_keep(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
-    """``GroupAction(launch_configurations={k: v})`` (``ResetLaunchConfigurations``'s
-    argument) as ``keep`` elements (set in the group; with ``forwarding=False`` or
-    a reset, the only configurations it starts with);
-    a value that cannot be read is set without a value, said at its line."""
+    """``GroupAction(launch_configurations={k: v})`` (and ``ResetLaunchConfigurations``'s
+    argument) as ``keep`` elements: set in the group, and with ``forwarding=False``
+    or a reset the only configurations kept.  A value that cannot be read is set
+    without a value, said at its line; raises :class:`_Unres` for a mapping that
+    is not a literal dict."""
     lc = _kw(c, "launch_configurations")
     if lc is None and _callee(c) == "ResetLaunchConfigurations" and c.args:
         lc = c.args[0]
@@ -158,7 +159,7 @@ def group_keep(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
         try:
             out.append(El("keep", {"name": n, "value": _value(v)}, [], Src(shown, v.lineno, v.col_offset + 1)))
         except _Unres as exc:
-            notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"GroupAction(...): launch configuration "
+            notes.append(Note(Src(shown, v.lineno, v.col_offset + 1), f"{_callee(c)}(...): launch configuration "
                               f"'{n}' {exc} cannot be read statically; the group reads it without a value",
                               "ROS-LAUNCH"))
             out.append(El("keep", {"name": n, "value": NOVALUE}, [], Src(shown, v.lineno, v.col_offset + 1)))

@@ -241,7 +241,7 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
             return None
         _cond(c, attrs, shown, notes)
         return El("group", {**attrs, "scoped": "false"}, got, src)
-    elif name in CONFIG_STACK:  # ResetLaunchConfigurations: an unscoped group without forwarding, its keeps
+    elif name in CONFIG_STACK:  # ResetLaunchConfigurations: an unscoped group marked reset, with its keeps
         _cond(c, attrs, shown, notes)
         if name != "ResetLaunchConfigurations":
             return El(CONFIG_STACK[name], attrs, [], src)
