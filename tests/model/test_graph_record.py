@@ -79,7 +79,8 @@ def test_a_difference_seeded_into_a_recording_is_found_by_both_commands(
     new = [i for i in got if i not in made]  # Guard at its document's line, and the connection DDS does not make
     assert len(new) == 2 and all(i in got for i in made), new
     assert new[1].startswith("nodl/Guard.nodl.yaml:10:") and "/stop's reliability is BEST_EFFORT" in new[1]
-    assert "/stop (std_msgs/Bool)" in new[0] and "DDS does not connect them (reliability" in new[0]
+    assert "/stop (std_msgs/Bool): node /Base subscribes with reliable" in new[0], new[0]
+    assert "node /Guard publishes with best_effort" in new[0] and "DDS does not connect them (reliability" in new[0]
 
 
 def test_ros_diff_gives_the_same_items_from_either_sources_recording(

@@ -81,7 +81,7 @@ def diff_nodl(documents: Mapping[str, Document], running: Graph, source: str, co
     raises nothing."""
     instances = match_instances(documents, running.nodes, namespaces)
     static = nodl_graph(documents, instances)
-    res = diff_dds(static, running, source, conflicts, None, NODL)
+    res = diff_dds(static, running, source, conflicts, None, NODL, names=disc)  # disc names the endpoints of a conflict
     res.not_compared = [n for n in res.not_compared if not n.startswith("the QoS the code asks for")]
     if disc is None:
         res.not_compared.append("the QoS the documents write (no discovery of the running endpoints' QoS)")

@@ -164,7 +164,7 @@ def read_dds_graph(wait_s: float = 2.0, domain: int | None = None,
 
 def diff_dds(static: Graph, running: Graph, source: str,
              conflicts: list[tuple[str, EndpointInfo, EndpointInfo, list[str]]] = (),  # type: ignore[assignment]
-             disc: Discovery | None = None, said: Expected = CODE) -> DiffResult:
+             disc: Discovery | None = None, said: Expected = CODE, names: Any = None) -> DiffResult:
     """Compare the code's graph with the running ROS 2 graph: what
     :func:`.diff.diff_master` compares, the service clients, and each QoS
     conflict as a ``qos`` item of the missing list (the connection the code
@@ -172,7 +172,9 @@ def diff_dds(static: Graph, running: Graph, source: str,
     durability each publisher and subscriber asks for in the code against
     its running endpoint (:func:`code_qos_items`; reads the code's files,
     relative to the current directory as the scan showed them).  ``said`` names the expected side
-    (the code, or the NoDL documents: :mod:`rclverify.ros.ground.diff_nodl`, which passes no ``disc``)."""
+    (the code, or the NoDL documents: :mod:`rclverify.ros.ground.diff_nodl`, which passes no ``disc``).
+    A QoS conflict names its endpoints' nodes as ``names`` (default ``disc``; anything with a
+    ``who(endpoint)``) gives them (``node /viewer``), else by GUID."""
     hidden = sorted(n for n in running.nodes if n.rsplit("/", 1)[-1].startswith(HIDDEN_PREFIX) and n not in static.nodes)
     if hidden:  # ROS 2's tools (the ros2cli daemon, ros2 topic echo): left out as `ros2 node list` leaves them out
         running = Graph(nodes={k: v for k, v in running.nodes.items() if k not in hidden}, notes=running.notes)
@@ -202,9 +204,10 @@ def diff_dds(static: Graph, running: Graph, source: str,
         for t in sorted(set(re_) - set(se)):
             res.extra.append(Item("service client", t, name, None, re_[t].msg_type, None, source,
                                   f"{name} calls {t}{_t(re_[t].msg_type)} in the running system, not {said.within}"))
+    namer = names if names is not None else disc
     for topic, w, r, why in conflicts:
-        who_w = disc.who(w) if disc is not None else w.label
-        who_r = disc.who(r) if disc is not None else r.label
+        who_w = namer.who(w) if namer is not None else w.label
+        who_r = namer.who(r) if namer is not None else r.label
         res.missing.append(Item("qos", topic, None, ros_type(w.type_name), None, None, source,
                                 f"{topic} ({short_type(ros_type(w.type_name))}): {who_r} subscribes with "
                                 f"{_announced(r.qos)}, {who_w} publishes with {_announced(w.qos)}; DDS does not "
