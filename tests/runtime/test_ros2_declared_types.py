@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import REPO, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
@@ -262,7 +262,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                              "--record", str(tmp / "run.mcap"), "--log", str(tmp / "live.jsonl"),
                              "--evidence", str(tmp / "live.json")], env, tmp, tmp / "monitor.out")
         wait_for(tmp / "ranger.log", "done", 60)
-        time.sleep(1.0)
+        # all N messages heard, however loaded the machine (a fixed 1 s before)
+        wait_logged(tmp / "live.jsonl", lambda log: sum(x.get("topic") == "range" for x in log) >= N, 30)
         stop(monitor, signal.SIGINT)
         yield {"tmp": tmp, "ws": ws, "out": (tmp / "monitor.out").read_text(),
                "record": json.loads((tmp / "live.json").read_text())}
@@ -435,13 +436,18 @@ def test_the_dds_source_says_what_to_do(tmp_path: Path) -> None:
     (ws / "mapping.yaml").write_text("topics:\n  range: {fields: [variance]}\n")
     env = ros2_env(tmp_path)
     publisher = start_node(tmp_path, "ranger", SPINNER.replace('"unheard"', '"range"'), env)
+    monitor = None
     try:
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml", "--status",
-                             "0", "--duration", "6", "--source", "dds", "--evidence", str(tmp_path / "live.json")],
+                             "0", "--duration", "60", "--source", "dds", "--evidence", str(tmp_path / "live.json")],
                             env, tmp_path, tmp_path / "monitor.out")
-        monitor.wait(120)
+        # stopped once it named the publisher (its whole line), not when a fixed duration ran out
+        wait_for(tmp_path / "monitor.out", "its messages are not heard", 60)
+        stop(monitor, signal.SIGINT)
     finally:
         stop(publisher)
+        if monitor is not None:
+            stop(monitor)
     warnings = json.loads((tmp_path / "live.json").read_text())["warnings"]
     (line,) = [w for w in warnings if ": warning: range:" in w]
     assert "publishes sensor_msgs::msg::dds_::Range_ with another layout than the contract's type: its ROS 2 type " \

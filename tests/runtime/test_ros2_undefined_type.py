@@ -12,7 +12,7 @@ import signal
 from pathlib import Path
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import rclverify, ros2_env, ros2_python, start_node
 
 RCL = """\
@@ -66,8 +66,11 @@ def test_a_type_the_workspace_lacks_is_read_as_the_ros2_python_describes_it(tmp_
     try:
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml", "--status",
                              "0", "--duration", "60", "--source", "rclpy", "--ros2-python", str(py),
-                             "--evidence", str(tmp_path / "live.json")], env, tmp_path, tmp_path / "monitor.out")
+                             "--log", str(tmp_path / "live.jsonl"), "--evidence", str(tmp_path / "live.json")],
+                            env, tmp_path, tmp_path / "monitor.out")
         wait_for(tmp_path / "system.log", "done", 60)
+        # the twenty messages heard before the monitor stops, however loaded the machine
+        wait_logged(tmp_path / "live.jsonl", lambda log: sum(x.get("topic") == "basic" for x in log) >= 20, 30)
         stop(monitor, signal.SIGINT)
     finally:
         for p in (system, monitor):
