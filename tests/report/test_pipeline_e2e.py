@@ -457,8 +457,15 @@ def _reports(ws: Path, sub: str = "reports") -> dict[str, bytes]:
     return {name: (ws / sub / name).read_bytes() for name in FILES if (ws / sub / name).exists()}
 
 
-def test_empty_and_warm_cache_give_the_uncached_report(workspace: Path, report: dict, tmp_path: Path) -> None:
-    plain = _render(workspace, tmp_path / "plain", None)
+@pytest.fixture(scope="module")
+def plain(workspace: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, bytes]:
+    """Every report file of the verified workspace rendered without kept pieces: one rendering read by
+    the two tests below (the workspace is as verified for both: the tests that edit it put it back)."""
+    return _render(workspace, tmp_path_factory.mktemp("plain"), None)
+
+
+def test_empty_and_warm_cache_give_the_uncached_report(workspace: Path, report: dict, plain: dict[str, bytes],
+                                                       tmp_path: Path) -> None:
     assert set(plain) >= set(FILES) - {"argument.svg"}
     empty = FragmentCache(tmp_path / "cache.pickle")
     assert _render(workspace, tmp_path / "empty", empty) == plain
@@ -471,9 +478,8 @@ def test_empty_and_warm_cache_give_the_uncached_report(workspace: Path, report: 
     assert cached_dumps(report, FragmentCache()) == dumps(report)
 
 
-def test_the_report_parts_write_disjoint_files_that_together_are_the_whole_report(workspace: Path,
-                                                                                 tmp_path: Path) -> None:
-    plain = _render(workspace, tmp_path / "plain", None)
+def test_the_report_parts_write_disjoint_files_that_together_are_the_whole_report(
+        workspace: Path, plain: dict[str, bytes], tmp_path: Path) -> None:
     built = build_report(Workspace(workspace))
     for part in reversed(PARTS):  # the order the two report tasks finish in does not matter
         written = [p.name for p in write_part(built, tmp_path / part, part)]
