@@ -233,7 +233,7 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
                 str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
                 read_acknowledgements(data, locs, plan_rel), targets, read_standards(root, data, locs, plan_rel),
-                instances_of(data.get("instances"), locs, plan_rel))
+                instances_of(data.get("instances"), locs, plan_rel), str(data.get("design") or ""))
 
 
 def _contract_files(root: Path, plan_rel: str, data: Mapping[str, Any], loc: Any) -> tuple[str, ...]:

@@ -140,3 +140,6 @@ class Plan:
     #: the contracts run as several nodes under namespaces (``instances:``, :mod:`.instances`;
     #: docs/plan.md, "Instances"), per contract
     node_instances: Mapping[str, tuple[Instance, ...]] = field(default_factory=dict)
+    #: ``design: DIR``: an Autoware System Designer design folder whose monitoring fields the design stage
+    #: decides against the contracts (docs/nodl.md, "The design stage"); empty when the plan names none
+    design: str = ""

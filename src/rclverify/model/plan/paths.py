@@ -5,7 +5,7 @@ bundle (``rclverify bundle``), which packs the workspace, contains every file
 the evidence rests on.  Checked when the plan is loaded (``rclverify
 check``/``compose``, doit's ``check`` task), before any task runs:
 
-* the ``contracts`` entries and the file part of ``nodes.<Node>.replacement``;
+* the ``contracts`` entries, ``design`` and the file part of ``nodes.<Node>.replacement``;
 * every value of a key an evidence entry's backend declares as a workspace
   path (:mod:`rclverify.model.plan.entries`: ``program``, ``implementation``
   -- the file part of ``<file>:<callable>`` --, ``record``, ``summary``,
@@ -89,6 +89,7 @@ def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any],
     """
     candidates: list[tuple[Path_, str]] = [(("contracts", i), c) for i, c in enumerate(data.get("contracts") or [])]
     candidates += [(("requirements_from", k), v) for k, v in (data.get("requirements_from") or {}).items()]
+    candidates += [(("design",), data["design"])] if isinstance(data.get("design"), str) else []
     for node, spec in (data.get("nodes") or {}).items():
         if isinstance(spec.get("replacement"), str):
             candidates.append((("nodes", node, "replacement"), spec["replacement"].rpartition(":")[0]))
