@@ -16,6 +16,7 @@ from __future__ import annotations
 from typing import Annotated
 
 from rclverify.records.deadline_rows import DeadlineRow
+from rclverify.records.design_rows import DesignRow
 from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow
@@ -56,6 +57,7 @@ class AssuranceReport(Row, frozen=True, forbid_unknown_fields=True):
     grounding: Annotated[GroundingRow | None, DOC(description="The grounding in the ROS code, null when the plan names none.")]
     nodl: Annotated[NodlRow | None, DOC(description="The NoDL documents checked against the contracts and each other (docs/nodl.md), null when the workspace has no document in nodl/.")]
     instances: Annotated[InstancesRow | None, DOC(description="The plan's instances (a contract run under several namespaces) and the requirements naming them decided per namespace (docs/plan.md, \"Instances in the report\"), null for a plan without instances.")]
+    design: Annotated[DesignRow | None, DOC(description="The monitoring fields of the Autoware System Designer design the plan names decided against the contracts (stages/design.py; docs/nodl.md, \"The design stage\"), null when the plan names no design.")]
     unverified: Annotated[list[UnverifiedRow], DOC(description="Guarantees no obligation covers.")]
     deadlines: Annotated[list[DeadlineRow], DOC(description="End-to-end deadlines (rule D3).")]
     acknowledgements: Annotated[list[AcknowledgementRow], DOC(description="The plan's acknowledgements of warnings.")]

@@ -175,6 +175,8 @@ class Report(TypedDict):
     nodl: NodlJson | None
     #: the plan's instances (stages/instances.py, records/instance_rows.py), ``None`` for a plan without instances
     instances: dict[str, Any] | None
+    #: the plan's design's monitoring fields decided (stages/design.py), ``None`` when the plan names no design
+    design: dict[str, Any] | None
     unverified: list[UnverifiedJson]
     deadlines: list[DeadlineJson]
     acknowledgements: list[AcknowledgementJson]

@@ -57,6 +57,7 @@ from rclverify.report.templating import anchor
 from rclverify.report.unverified import unverified_guarantees
 from rclverify.report.view import problem_items
 from rclverify.stages.crosscheck.apply import SecondSolver, load as load_second_solver
+from rclverify.stages.design import blocks_strict as design_blocks, design_problems, design_row
 from rclverify.stages.diagnoses import read_diagnoses
 from rclverify.stages.instances import blocks_strict as instances_block, instance_problems, instance_statuses, instances_row
 from rclverify.stages.requirements import read_records
@@ -132,7 +133,7 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
             "obligations": ev["obligations"], "evidence": ev["evidence"],
             "environment_assumptions": environment_rows(comps, names),
             "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
-            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "instances": instances_row(ws, ev["obligations"]), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
+            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "instances": instances_row(ws, ev["obligations"]), "design": design_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
             "deadlines": deadlines, "acknowledgements": acknowledgements,
             "near_misses": near_miss_rows(ws, ev["obligations"]),
             "margins": margin_rows(ws, ev["obligations"])}, Facts(
@@ -148,8 +149,9 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
     overall = worst([r["status"] for r in rows["requirements"]] + list(node_status.values())
                     + [d["status"] for d in rows["derived_properties"]] + instance_statuses(rows["instances"]))
     strict_ok = strict_gate(rows, facts.guarantees_discharged, facts.deadlines_ok, rows["grounding"]) \
-        and not nodl_blocks(rows["nodl"]) and not instances_block(rows["instances"])
+        and not nodl_blocks(rows["nodl"]) and not instances_block(rows["instances"]) and not design_blocks(rows["design"])
     problems = problem_sentences(rows, facts.altered) + grounding_problems(rows["grounding"]) + nodl_problems(rows["nodl"]) \
+        + design_problems(rows["design"]) \
         + instance_problems(rows["instances"])
     plan = ws.plan
     return {
