@@ -283,6 +283,23 @@ def act_ground(root: str) -> Any:
     return None
 
 
+def act_design(root: str) -> Any:
+    """The design stage (docs/nodl.md, "The design stage", :mod:`rclverify.stages.design`): the plan's design's
+    monitoring fields decided against the contracts; prints the counts, the record (findings located) goes to the report."""
+    from rclverify.stages.design import stage_design  # deferred: start-up (loads yaml and the design reader only when called)
+    try:
+        data = stage_design(_ws(root))
+    except RclError as exc:
+        return _fail(exc)
+    except OSError as exc:
+        return _io_fail(exc, root)
+    c = data["counts"]
+    print(f"design {data['design']}: {len(data['decided'])} monitoring field(s): {c['proved']} proved, {c['refuted']} "
+          f"refuted, {c['undecided']} undecided; {c['error']} error(s), {c['warning']} warning(s) "
+          f"(rclverify import autoware-design {data['design']} --check lists them)")
+    return None
+
+
 def act_nodl(root: str) -> Any:
     """The NoDL stage (docs/nodl.md, :mod:`rclverify.stages.nodl`): the workspace's documents
     against its contracts and each other; findings go to the report."""

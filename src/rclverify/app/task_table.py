@@ -26,8 +26,8 @@ from doit import create_after as _create_after
 from doit.tools import config_changed
 
 from rclverify.core.cache import code_stamp
-from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_diagnosis, act_graph, act_ground,
-                                        act_node, act_nodl, act_report, act_requirements, act_run, act_verify)
+from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_design, act_diagnosis, act_graph,
+                                        act_ground, act_node, act_nodl, act_report, act_requirements, act_run, act_verify)
 from rclverify.app.shapes import DoitTask
 from rclverify.app.task_checks import (RecordIntact, TargetsAsWritten, entry_inputs, ros_fingerprint, strict_uptodate,
                                        tool_fingerprint, z3_version)
@@ -76,6 +76,8 @@ DIAGNOSIS_INDEX = "artifacts/diagnosis/index.json"
 NODL_INDEX = "artifacts/nodl/index.json"
 NODL_FOLDER = "nodl"
 NODL_SUFFIXES = (".nodl.yaml", ".nodl.yml", ".nodl.json")
+#: The design stage's record (stages/design.py: ``INDEX``).
+DESIGN_INDEX = "artifacts/design/index.json"
 
 
 class TaskTable:
@@ -109,6 +111,7 @@ class TaskTable:
         self.deadline_nodes = list(index.deadline_nodes) if index is not None else []
         self.ros_section = dict(index.ros) if index is not None else {}  # from the index: a no-op run loads no contract
         self.nodl_files = self._nodl_files()
+        self.design = str(getattr(index, "design", "") or "") if index is not None else ""  # the plan's design folder
         self._exported: Exported | None = None
         self._report_deps: list[str] | None = None
 
@@ -248,6 +251,15 @@ class TaskTable:
                 "targets": [self.at(NODL_INDEX)], "uptodate": [self.code, self.sealed], "task_dep": ["check"],
                 "verbosity": 2, "clean": True}
 
+    def task_design(self) -> DoitTask:
+        """Decide the monitoring fields of the plan's design against the contracts (docs/nodl.md, "The design stage")."""
+        from rclverify.stages.design import design_inputs  # deferred: start-up (loads the design reader only when the plan names a design)
+        files = [str(self.rootp / f) for f in design_inputs(self.rootp, self.design)]
+        return {"actions": [(act_design, [self.r])],
+                "file_dep": [str(self.rootp / self.plan_file)] + list(self.snap.values()) + files,
+                "targets": [self.at(DESIGN_INDEX)], "uptodate": [self.code, self.sealed], "task_dep": ["check"],
+                "verbosity": 2, "clean": True}
+
     @create_after(executed="evidence")
     def task_diagnosis(self) -> DoitTask:
         """Explain every problem of the report, repairs checked by Z3, as a sealed record the report reads
@@ -285,7 +297,7 @@ class TaskTable:
         # rest, since the report and crosscheck (created after the evidence) are otherwise the only tasks
         # that reach them, which made them start after the evidence instead of beside it
         before = ([f"node:{n}" for n in self.nodes] + [f"health:{n}" for n in self.nodes] + ["requirements"]
-                  + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"] + (["ground"] if self.ros_section else []) + (["nodl"] if self.nodl_files else []) + ["diagnosis"])
+                  + (["deadlines"] if self.deadline_nodes else []) + ["crosscheck"] + (["ground"] if self.ros_section else []) + (["nodl"] if self.nodl_files else []) + (["design"] if self.design else []) + ["diagnosis"])
         ok = self.ok
         return {"actions": [(act_verify, [self.r])], "task_dep": ["check", *before, "report"] if ok else ["check"],
                 "file_dep": [str(self.rootp / REPORTS[2])] if ok else [],
@@ -296,7 +308,7 @@ class TaskTable:
     def creators(self) -> dict[str, Callable[[], Any]]:
         """The ``task_*`` creators of this run, by the names a ``dodo.py`` gives them: ``check`` and
         ``verify`` always; the rest when the workspace loaded (``ground`` with a ``ros:`` section,
-        ``deadlines`` with an end-to-end deadline, ``nodl`` with a NoDL document in nodl/)."""
+        ``deadlines`` with an end-to-end deadline, ``nodl`` with a NoDL document in nodl/, ``design`` with a plan naming a design)."""
         creators: dict[str, Callable[[], Any]] = {"task_check": self.task_check, "task_verify": self.task_verify}
         if self.ok:
             creators.update({"task_graph": self.task_graph, "task_node": self.task_node, "task_health": self.task_health,
@@ -309,6 +321,8 @@ class TaskTable:
                 creators["task_deadlines"] = self.task_deadlines
             if self.nodl_files:
                 creators["task_nodl"] = self.task_nodl
+            if self.design:
+                creators["task_design"] = self.task_design
         return creators
 
     def exported(self) -> Exported:
@@ -381,5 +395,7 @@ class TaskTable:
             deps.append(at(DEADLINES_INDEX))  # the deadlines task's target
         if self.nodl_files:
             deps.append(at(NODL_INDEX))  # the NoDL task's target
+        if self.design:
+            deps.append(at(DESIGN_INDEX))  # the design task's target
         deps.append(at(CROSSCHECK_INDEX))  # the second solver's verdicts
         return deps

@@ -90,6 +90,8 @@ class TaskIndex:
     #: Per node with an output sequence, the files its bounds are read from (the mapping and its ``.msg``
     #: files, :func:`rclverify.stages.interface_bounds.bound_inputs`): inputs of ``health:<node>``.
     bound_inputs: dict[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
+    #: The plan's ``design`` folder (docs/nodl.md, "The design stage"): what the ``design`` task reads; empty: no such task.
+    design: str = ""
 
 
 @dataclass
@@ -152,7 +154,8 @@ class Workspace:
             deadline_nodes=tuple(dict.fromkeys(n for d in plan.deadlines for n in nodes_between(model, d.path))),
             profiles=tuple(c.profile.file for c in plan.standards if not c.profile.builtin),
             bound_inputs={n: tuple(fs) for n, cn in self.checked.nodes.items()
-                          if (fs := bound_inputs(self.root, plan, cn))})
+                          if (fs := bound_inputs(self.root, plan, cn))},
+            design=plan.design)
 
     @cached_property
     def checked(self) -> Checked:
