@@ -132,13 +132,13 @@ def _norm(name: str) -> str:
 
 
 def _nodes(before: set[int]) -> list[Any]:
-    from rclpy.node import Node
+    from rclpy.node import Node  # deferred: rclpy exists only in the ROS 2 Python that runs this script
     return [o for o in gc.get_objects() if isinstance(o, Node) and id(o) not in before]
 
 
 def _find(req: dict[str, Any], nodes: list[Any]) -> tuple[Any, Any]:
     """``(node, endpoint)``: the subscription, service or action server that answers the questions."""
-    from rclpy.action import ActionServer
+    from rclpy.action import ActionServer  # deferred: rclpy exists only in the ROS 2 Python that runs this script
     kind = req["kind"]
     found = []
     for n in nodes:
@@ -158,14 +158,14 @@ def _find(req: dict[str, Any], nodes: list[Any]) -> tuple[Any, Any]:
 
 
 def _callback(endpoint: Any) -> Any:
-    from rclpy.action import ActionServer
+    from rclpy.action import ActionServer  # deferred: rclpy exists only in the ROS 2 Python that runs this script
     return endpoint._execute_callback if isinstance(endpoint, ActionServer) else endpoint.callback
 
 
 def _answer(req: dict[str, Any], node: Any, endpoint: Any, fields: dict[str, Any],
             published: list[tuple[str, Any]]) -> Any:
     """What the callback answers to one question (module docstring)."""
-    from rclpy.action import ActionServer
+    from rclpy.action import ActionServer  # deferred: rclpy exists only in the ROS 2 Python that runs this script
     if req["kind"] == "topic":
         del published[:]
         endpoint.callback(fill(endpoint.msg_type(), fields))
@@ -181,7 +181,7 @@ def _answer(req: dict[str, Any], node: Any, endpoint: Any, fields: dict[str, Any
 
 def run_text(req: dict[str, Any], k: int, text: str) -> tuple[dict[str, Any], dict[str, Any]]:
     """``(answer of this text, callback)``; ``callback`` is ``{}`` when it was not found."""
-    from rclpy.node import Node
+    from rclpy.node import Node  # deferred: rclpy exists only in the ROS 2 Python that runs this script
     before = {id(o) for o in gc.get_objects() if isinstance(o, Node)}
     made: list[Any] = []
     callback: dict[str, Any] = {}
@@ -221,7 +221,7 @@ def _late(_sig: int, _frame: Any) -> None:
 
 
 def main() -> int:
-    import rclpy
+    import rclpy  # deferred: rclpy exists only in the ROS 2 Python that runs this script
     signal.signal(signal.SIGALRM, _late)
     req = json.loads(sys.stdin.read())
     sys.path.insert(0, os.path.dirname(os.path.abspath(req["file"])))
