@@ -133,11 +133,12 @@ def test_plan_ros_paths_stay_in_the_workspace(tmp_path: Path, capsys: pytest.Cap
 
 
 def test_sarif_results_carry_both_locations(tmp_path: Path) -> None:
+    from _typed_rows import typed_report
     from rclverify.report.sarif import _grounding_results
     ws = _ws(tmp_path, [("geometry_msgs/Twist cmd_vel", "geometry_msgs/Point cmd_vel")])
     _check(ws)
     data = json.loads((ws / "findings.json").read_text())
-    results, rules = _grounding_results({"grounding": data})
+    results, rules = _grounding_results(typed_report({"grounding": data}))
     r = next(x for x in results if x["ruleId"] == "ROS-TYPE-DIFFERS")
     assert r["level"] == "error"
     assert r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == "contracts/rover.rcl"
