@@ -209,3 +209,40 @@ def test_rclverify_monitor_on_the_recorded_bags(runs: dict[str, Any], capsys: py
         out = capsys.readouterr().out
         assert "lifecycle /battery:" in out and (("missed: /battery's activate" in out) == (variant == "defect")), out
     assert codes == {"correct": 0, "defect": 1}
+
+
+def test_the_live_log_is_judged_as_the_live_run_judged_it(runs: dict[str, Any]) -> None:
+    """One judge: the gate decides in the engine's release order, after each message's log line, and the
+    log holds the transition events and the requests held back, so the run's own log, judged offline,
+    gives the live run's lifecycle record and counts exactly (no message lacking, none decided otherwise
+    near a transition).  The control: the same log without its transition events judges the node as
+    never configured, every output red."""
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.cli.lifecycle_runs import judge_recorded
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    from rclverify.traces.lifecycle_events import read_run
+    checked = check([parse_text(RCL, "b.rcl")])
+    for variant in ("correct", "defect"):
+        run = runs[variant]
+        live = run["record"]
+        cfg = load_mapping(run["tmp"], None, 1.0)
+        events, transitions = read_run(run["tmp"] / "live.jsonl")
+        assert len(transitions) == live["lifecycle"]["nodes"][0]["transitions"], (len(transitions), live["lifecycle"])
+        rec = judge_recorded(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, events,
+                             run["tmp"] / "relog.jsonl")
+        [off], [on] = rec["lifecycle"]["nodes"], live["lifecycle"]["nodes"]
+        for key in ("transitions", "outputs_judged", "state", "status"):
+            assert off[key] == on[key], (variant, key, off[key], on[key])
+        assert [(v["topic"], v["state"]) for v in off["violations"]] == \
+            [(v["topic"], v["state"]) for v in on["violations"]], variant
+        assert rec["lifecycle"]["not_questions"] == live["lifecycle"]["not_questions"], variant
+        assert rec["nodes"][0]["counts"] == live["nodes"][0]["counts"], variant
+        assert rec["events"] == live["events"], variant
+    # control: the log's transition events dropped, the node never leaves `unconfigured`: every output red
+    events, _ = read_run(runs["correct"]["tmp"] / "live.jsonl")
+    bare = [e for e in events if not e.topic.endswith("transition_event")]
+    rec = judge_recorded(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, bare,
+                         runs["correct"]["tmp"] / "bare.jsonl")
+    [node] = rec["lifecycle"]["nodes"]
+    assert node["status"] == "failed" and {v["state"] for v in node["violations"]} == {"unconfigured"}, node

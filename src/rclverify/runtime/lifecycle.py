@@ -35,7 +35,8 @@ that type and no ``matches`` (``lifecycle_msgs/TransitionEvent battery/transitio
 
 :class:`LifecycleGate` is the gate a live run (:class:`rclverify.runtime.live.LiveRun`,
 ``gate``, made by :func:`gate_of` from the monitored nodes) asks for every message before its
-judge; its :meth:`~LifecycleGate.record` is the run's ``lifecycle`` record.  The transport reads
+judge, in its engine's release order (the transition topics ordered with the rest,
+:attr:`rclverify.backends.monitors.online.OnlineEngine.gate_topics`), after the message's log line; its :meth:`~LifecycleGate.record` is the run's ``lifecycle`` record.  The transport reads
 the transition topic as any topic a contract names, and a bag the run records (``--record``) holds
 it.  :func:`rclverify.cli.lifecycle_runs.judge_recorded` judges a recorded run (a bag, or a log holding the transition events:
 :mod:`rclverify.traces.lifecycle_events`) as the live run judges it: its messages, in the order

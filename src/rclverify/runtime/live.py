@@ -109,6 +109,8 @@ class LiveRun:
         self.nodes = nodes
         self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
                                    on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
+        self._gate: LifecycleGate | None = None
+        self.gate = gate_of(nodes)
         #: margins (module docstring): computed when asked for or warned about; warned below ``warn_margin``
         self.low = None if warn_margin is None else LowMargins(self.engine.monitors, warn_margin, warn)
         for m in self.engine.monitors:
@@ -120,15 +122,35 @@ class LiveRun:
         self.orphans: dict[str, int] = {}
         self.results: list[NodeResult] | None = None
         self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
-        #: what every message passes before the judge: managed nodes' states (lifecycle.py), or ``None``
-        self.gate: LifecycleGate | None = gate_of(nodes)
 
     # -- engine callbacks (called under the lock) ----------------------------------
     def _event(self, ev: Event) -> None:
         late = {"late_s": round(ev.late, 6)} if ev.late else {}  # at its source time, with how late it was heard
         self._log.write(dumps({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time,
                                **late, **{k: v for k, v in ev.fields.items() if k not in ("topic", "time")}}) + "\n")
-        self.checks.event(ev)  # after its log line: a verdict it decides comes after it, as offline
+        if self.gate is None:
+            self.checks.event(ev)  # after its log line: a verdict it decides comes after it, as offline
+
+    @property
+    def gate(self) -> LifecycleGate | None:
+        """What every message passes before the judge: managed nodes' states (lifecycle.py), or
+        ``None``; asked in the engine's release order, after the message's log line
+        (:attr:`OnlineEngine.admit`), its transition topics ordered with the rest
+        (:attr:`OnlineEngine.gate_topics`).  Set before the first message."""
+        return self._gate
+
+    @gate.setter
+    def gate(self, gate: LifecycleGate | None) -> None:
+        self._gate = gate
+        self.engine.gate_topics = frozenset(gate.events) if gate is not None else frozenset()
+        self.engine.admit = self._admit if gate is not None else None
+
+    def _admit(self, ev: Event) -> bool:
+        """The lifecycle gate's word on a released message (:meth:`LifecycleGate.admit`)."""
+        ok = self.gate is None or self.gate.admit(ev.topic, ev.fields, ev.time)
+        if ok:
+            self.checks.event(ev)  # the deadline checks see the questions the guarantees' judge sees
+        return ok
 
     def _deadline(self, v: DeadlineVerdict, t: float) -> None:
         line = {"topic": VERDICT_LOG_TOPIC, "time": t, "kind": "deadline", "verdict": v.to_json()}
@@ -167,7 +189,7 @@ class LiveRun:
     def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
         """One message from the middleware (receipt time in seconds)."""
         with self.lock:
-            if self.results is None and (self.gate is None or self.gate.admit(topic, fields, received)):
+            if self.results is None:
                 self.engine.push(topic, fields, received)
 
     def due(self) -> float:

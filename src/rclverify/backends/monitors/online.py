@@ -97,6 +97,12 @@ class OnlineEngine:
     on_late: Callable[[str, float, float], None] | None = None
     #: the declared tolerance of recorded numbers (default: ``rules.tolerance``, see :class:`NodeMonitor`)
     tolerance: Tolerance | None = None
+    #: topics no contract maps a variable to that are still ordered with the rest and released to
+    #: ``on_event`` and ``admit`` (a managed node's transition events, :mod:`rclverify.runtime.lifecycle`)
+    gate_topics: frozenset[str] = frozenset()
+    #: ``admit(Event)``: whether a released message goes on to the monitors (after ``on_event``); it sees
+    #: every message in the order released, so what it decides is the same live and on the run's log
+    admit: Callable[[Event], bool] | None = None
     monitors: list[NodeMonitor] = field(init=False)
     topics: dict[str, TopicStatus] = field(init=False)
     released: int = field(init=False, default=0)
@@ -149,6 +155,10 @@ class OnlineEngine:
         topic = topic.lstrip("/")
         status = self.topics.get(topic)
         if status is None:
+            if topic in self.gate_topics:  # ordered with the rest for the gate, no writer of the contracts
+                self._buffer.push(received, received, (topic, fields, where))
+                if self.reorder_window <= 0:
+                    self._release(math.inf)
             return  # no contract names it
         status.received += 1
         status.last = received if status.last is None else max(status.last, received)
@@ -241,6 +251,8 @@ class OnlineEngine:
                 self.on_event(ev)
             for m in self.monitors:
                 m.advance(t)
+            if self.admit is not None and not self.admit(ev):
+                continue
             for m in self.monitors:
                 m.feed(ev)
 
