@@ -25,6 +25,7 @@ if __name__ == "__main__":  # run as a script: a Python without the dependencies
 
 import argparse
 import json
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -36,6 +37,10 @@ from rclverify.report.bundle.archive import verify_bundle, write_bundle
 from rclverify.records.store import SEAL, seal_of
 from rclverify.model.plan.load import load_plan
 from rclverify.report.diagram import render_dot
+from rclverify.records.report_record import AssuranceReport
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "records"))
+from _typed_rows import complete  # noqa: E402 - the tests' completion of a partial report into a whole one
 
 
 def synthetic_report(n: int) -> dict[str, Any]:
@@ -57,10 +62,12 @@ def synthetic_report(n: int) -> dict[str, Any]:
                       "status": "discharged", "smt2": f"artifacts/calculus/{name}.sc1.smt2", "explanation": "proved"})
         reqs.append({"id": f"REQ{i}", "text": "t", "status": "discharged",
                      "support": [{"node": name, "guarantee": 1}, {"node": name, "guarantee": 2}]})
-    return {"meta": {"workspace": "bench", "plan": "contracts/plan.yaml", "contracts": ["s.rcl"]},
+    # every field the synthetic rows leave out given an empty value of its type, as the report's record asks
+    return complete(AssuranceReport, {"meta": {"tool": "rclverify", "version": "bench", "workspace": "bench",
+                                               "plan": "contracts/plan.yaml", "contracts": ["s.rcl"]},
             "requirements": reqs, "nodes": nodes, "side_conditions": sides, "obligations": obligations,
             "evidence": evidence, "findings": [], "environment_assumptions": [],
-            "derived_properties": [{"node": "N0", "loop_assumption": None}]}
+            "derived_properties": [{"node": "N0", "loop_assumption": None}]})
 
 
 def cpu(fn: Any) -> tuple[float, Any]:
