@@ -11,6 +11,7 @@ Source: launch's ``IncludeLaunchDescription.execute``,
 """
 from __future__ import annotations
 
+from abc import abstractmethod
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,19 +36,23 @@ class ScopeActions:
 
     ros2: dict[Path, bool]  # whether a file read is a ROS 2 launch file (its includes share the scope)
 
+    @abstractmethod
     def _attr(self, el: El, key: str, scope: Scope, path: Path, default: str | None = None) -> str | None:
-        raise NotImplementedError
+        ...
 
+    @abstractmethod
     def _cond(self, el: El, scope: Scope, path: Path) -> bool:
-        raise NotImplementedError
+        ...
 
+    @abstractmethod
     def _body(self, els: list[El], scope: Scope, path: Path) -> None:
-        raise NotImplementedError
+        ...
 
+    @abstractmethod
     def run(self, path: Path, args: dict[str, str] | None = None, ns: str = "/",
             remaps: list[tuple[str, str, Src]] | None = None, unsure: Src | None = None,
             shared: Scope | None = None) -> None:
-        raise NotImplementedError
+        ...
 
     def _group(self, el: El, scope: Scope, path: Path) -> None:
         """A ``group`` (ROS 1 ``ns``; launch's ``GroupAction``): scoped unless
