@@ -108,7 +108,8 @@ class LiveRun:
         nodes = list(nodes)
         self.nodes = nodes
         self.engine = OnlineEngine(checked, nodes, rules, horizon, reorder_window, silence_s,
-                                   on_verdict=self._verdict, on_silence=self._silence, on_event=self._event)
+                                   on_verdict=self._verdict, on_silence=self._silence, on_event=self._event,
+                                   admit=self._admit)
         self._gate: LifecycleGate | None = None
         self.gate = gate_of(nodes)
         #: margins (module docstring): computed when asked for or warned about; warned below ``warn_margin``
@@ -128,8 +129,6 @@ class LiveRun:
         late = {"late_s": round(ev.late, 6)} if ev.late else {}  # at its source time, with how late it was heard
         self._log.write(dumps({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time,
                                **late, **{k: v for k, v in ev.fields.items() if k not in ("topic", "time")}}) + "\n")
-        if self.gate is None:
-            self.checks.event(ev)  # after its log line: a verdict it decides comes after it, as offline
 
     @property
     def gate(self) -> LifecycleGate | None:
@@ -143,13 +142,14 @@ class LiveRun:
     def gate(self, gate: LifecycleGate | None) -> None:
         self._gate = gate
         self.engine.gate_topics = frozenset(gate.events) if gate is not None else frozenset()
-        self.engine.admit = self._admit if gate is not None else None
 
     def _admit(self, ev: Event) -> bool:
-        """The lifecycle gate's word on a released message (:meth:`LifecycleGate.admit`)."""
+        """Whether a released message goes on to the judges: the lifecycle gate's word
+        (:meth:`LifecycleGate.admit`), every message without one; an admitted one goes to the deadline
+        checks here, after its log line, so they see the questions the guarantees' judge sees."""
         ok = self.gate is None or self.gate.admit(ev.topic, ev.fields, ev.time)
         if ok:
-            self.checks.event(ev)  # the deadline checks see the questions the guarantees' judge sees
+            self.checks.event(ev)
         return ok
 
     def _deadline(self, v: DeadlineVerdict, t: float) -> None:

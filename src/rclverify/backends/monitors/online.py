@@ -142,7 +142,7 @@ class OnlineEngine:
     def _giver(self, emit: Callable[[Verdict], None]) -> Callable[[Verdict], None]:
         """``emit`` for a node's monitor, marking a verdict :meth:`early` ``provisional``."""
         def give(v: Verdict) -> None:
-            emit(dataclasses.replace(v, provisional=True) if self._stopping and v.decided_at > self._upto else v)
+            emit(dataclasses.replace(v, provisional=True) if self.early(v.decided_at) else v)
         return give
 
     # -- input -------------------------------------------------------------------
