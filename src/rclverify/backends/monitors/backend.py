@@ -59,6 +59,28 @@ NAME, KIND = _DECLARED.name, _DECLARED.evidence_kind
 REORDER_WINDOW_MS = 50
 
 
+def _implementation(target: NodeTarget) -> str:
+    """The entry's ``implementation`` (``<file>.py:<function>``: a function of a workspace Python file
+    that, called without arguments, makes the robot's rclpy nodes; docs/plan.md), ``""`` when it names
+    none.  Raises :class:`PlanError` located at the key for a value of another shape or a file that
+    defines no such top-level function (the file's existence is the plan's path check)."""
+    import ast  # deferred: only an entry that names its implementation parses it
+    value = target.config.get("implementation")
+    if value is None:
+        return ""
+    file, _, name = value.rpartition(":") if isinstance(value, str) else ("", "", "")
+    if not file.endswith(".py") or not name.isidentifier():
+        raise target.config_error("implementation is '<file>.py:<function>', the function that makes the "
+                                  f"robot's rclpy nodes, not {value!r}", "implementation")
+    try:
+        tree = ast.parse((target.root / file).read_text(encoding="utf-8"), file)
+    except (OSError, UnicodeDecodeError, SyntaxError, ValueError) as exc:
+        raise target.config_error(f"implementation {file} cannot be read as Python: {exc}", "implementation") from None
+    if not any(isinstance(d, (ast.FunctionDef, ast.AsyncFunctionDef)) and d.name == name for d in tree.body):
+        raise target.config_error(f"implementation {file} defines no top-level function {name!r}", "implementation")
+    return value
+
+
 @functools.lru_cache(maxsize=1)  # one environment: each template compiled once per process, not once per trace
 def _templates() -> jinja2.Environment:
     return jinja2.Environment(loader=jinja2.PackageLoader("rclverify.backends.monitors", "templates"),
@@ -138,6 +160,7 @@ class MonitorsBackend:
         """Render the node's RML and the system's ROSMonitoring config; one
         obligation per trace.  Raises :class:`PlanError` (located) for a bad entry."""
         cfg = self._config(target)
+        made_by = _implementation(target)  # the code that made the runs: the diagnosis re-runs it (docs/plan.md)
         node = target.node
         try:
             fields = msg_fields(target.root, cfg)
@@ -168,7 +191,8 @@ class MonitorsBackend:
                 guarantees=[{"k": k, "rcl": expr_to_rcl(c.formula)} for k, c in enumerate(node.node.guarantees, 1)],
                 assumptions=[expr_to_rcl(c.formula) for c in node.node.assumes]))
             inputs = sorted({*trace_files(target.root, trace), *([cfg.mapping] if cfg.mapping else []),
-                             *cfg.msg_files(target.root), *target.contract_files, target.plan_file})
+                             *cfg.msg_files(target.root), *target.contract_files, target.plan_file,
+                             *([made_by.rpartition(":")[0]] if made_by else [])})
             out.append(Obligation(
                 id=oid, node=node.name, guarantee=0, backend=NAME, kind=KIND, statement=statement,
                 source=SourceRef(_rel(target, src.file), src.line, src.col), instance=stem,
@@ -176,6 +200,7 @@ class MonitorsBackend:
                 data={"trace": trace, "horizon": cfg.horizon, "mapping": cfg.mapping, "rml": target.rel(rml),
                       **({"tolerance": cfg.tolerance.to_json()} if cfg.tolerance else {}),
                       "config": target.rel(target.artifacts.parent / "config.yaml"),
+                      **({"implementation": made_by} if made_by else {}),
                       "not_expressible": [{"guarantee": t.guarantee, "part": t.part, "why": t.why}
                                           for t in spec.terms if not t.text]}))
         return out + runset_obligations(target, list(cfg.traces), out)  # a target: the run set's claim (runset.py)
