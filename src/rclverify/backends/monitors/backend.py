@@ -78,7 +78,7 @@ def _implementation(target: NodeTarget) -> str:
         raise target.config_error(f"implementation {file} cannot be read as Python: {exc}", "implementation") from None
     if not any(isinstance(d, (ast.FunctionDef, ast.AsyncFunctionDef)) and d.name == name for d in tree.body):
         raise target.config_error(f"implementation {file} defines no top-level function {name!r}", "implementation")
-    return value
+    return str(value)
 
 
 @functools.lru_cache(maxsize=1)  # one environment: each template compiled once per process, not once per trace
