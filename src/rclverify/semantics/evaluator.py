@@ -155,6 +155,13 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
 
     visit_SeqLit = visit_TupleLit
 
+    def visit_SeqRange(self, e: ast.SeqRange, b: Mapping[str, Value]) -> Any:
+        """``<lo upto hi>``: the integers from ``lo`` to ``hi`` in order (empty when ``hi < lo``)."""
+        lo, hi = self.eval(e.lo, b), self.eval(e.hi, b)
+        if type(lo) is not int or type(hi) is not int:
+            raise Undecided(f"<{lo} upto {hi}>: bounds that are not integers")
+        return tuple(range(lo, hi + 1))
+
     def visit_Quant(self, e: ast.Quant, b: Mapping[str, Value]) -> Any:
         return self.quant(e, b)
 
