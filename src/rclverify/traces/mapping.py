@@ -18,6 +18,12 @@ Which rule applies depends on the RCL variable's type:
   function is ``FALSE`` and any other function has the plan's ``default``
   (without one it is partial: an application outside the table equals no
   value);
+* **Window** (a function ``NATURAL --> T`` or ``INTEGER --> T`` of a
+  scalar or enumeration ``T`` whose message holds an array field): the
+  function from the offsets ``0, 1, ...`` to the array's items, read as
+  the sequence rule reads them, the message's whole table (a sampled time
+  window, ``in.x(k)`` the sample at offset ``k``: docs/semantics.md,
+  "Against the peers"); outside it the plan's ``default``.
 * **Constructor** (a constructor set such as ``CommandSet``): the first
   string field names the constructor; its arguments are the next fields of
   the argument types, in order.
@@ -252,6 +258,11 @@ def map_value(typ: T.Type, fields: Mapping[str, object], rule: TopicRule, previo
         if args is None:
             raise MappingError(f"{name!r} is not a constructor of {typ.name}")
         return Term(name, tuple(fs.take(a, f"argument {k} of {name}") for k, a in enumerate(args, 1)))
+    if isinstance(typ, T.FuncT) and len(typ.args) == 1 and isinstance(typ.args[0], T.Scalar) \
+            and typ.args[0].name in ("NATURAL", "INTEGER") and isinstance(typ.result, (T.Scalar, T.EnumT)) \
+            and any(isinstance(v, (list, tuple)) for _, v in fs.items):  # a window: offsets 0.. to the array's items
+        items = fs.take_seq(T.SeqT(typ.result), "the function's window")
+        return FiniteFunction({(k,): v for k, v in enumerate(items)}, rule.default, 1)
     if isinstance(typ, T.FuncT):
         key = tuple(fs.take(a, f"argument {k}") for k, a in enumerate(typ.args, 1))
         is_bool = isinstance(typ.result, T.Scalar) and typ.result.name == "BOOL"
