@@ -93,7 +93,8 @@ def test_why_none_by_kind() -> None:
         return " ".join(none_offered(found))
     assert "no edit the diagnosis tried passed its checks" in why("Odd.g1.property_tests.e0")
     assert "re-run" not in why("Odd.g1.property_tests.e0")  # control: only a monitor's violation says it
-    assert "no repair is searched for this kind" in why("Wheel.g0.monitors.run")
+    assert "no repair is searched" in why("Wheel.g0.monitors.run")
     assert "a node re-run on its recorded run" in why("Wheel.g0.monitors.run")  # where the search is said
+    assert "implementation: FILE.py:FUNCTION" in why("Wheel.g0.monitors.run")  # and the plan key it needs
     assert why("Follower.sc1") == "Follower.sc1: Strengthening Router leaves it unimplementable"
     assert "no edit the diagnosis tried" in why("1")

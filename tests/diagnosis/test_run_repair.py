@@ -118,3 +118,56 @@ def test_a_candidate_is_kept_only_when_the_node_is_repaired_and_no_other_verdict
     assert not _kept("A", before, {**fixed, "A call deadlines": ("failed", (("false", 1), ("true", 5)))})
     assert not _kept("B", before, before)  # a node with nothing failed is not repaired
     assert json.dumps(sorted(fixed)) == json.dumps(sorted(before))
+
+
+CHARGE_WS = Path(__file__).parent / "data" / "charge_ws"
+
+
+def test_the_report_asks_the_rerun_only_of_an_entry_naming_its_implementation_and_says_why_not() -> None:
+    """diagnosis/monitor_repair.py before any ROS 2 is started: no implementation named, nothing asked and
+    nothing said (the control); named without a ROS 2 Python, or on a bag, one sentence why none is searched."""
+    from rclverify.app.pipeline import Workspace
+    from rclverify.diagnosis.monitor_repair import MonitorRepairs, entry_of, monitor_repairs
+    ws = Workspace(CHARGE_WS)
+    data = {"entry": 0, "trace": "runs/charge.jsonl", "mapping": "contracts/mapping.yaml"}
+    assert monitor_repairs(ws, "ChargeMonitor", data, {}, Path("python3")) == MonitorRepairs()
+    named = {**data, "implementation": "charge.py:build"}
+    got = monitor_repairs(ws, "ChargeMonitor", named, {}, None)
+    assert got.repairs == [] and got.why.startswith("no repair is searched: re-running charge.py:build needs a "
+                                                    "Python with rclpy")
+    bag = monitor_repairs(ws, "ChargeMonitor", {**named, "trace": "runs/charge.mcap"}, {}, Path("python3"))
+    assert "runs/charge.mcap is not a JSON-lines log" in bag.why
+    entry = entry_of(ws, "ChargeMonitor", data)
+    assert entry is not None and entry.config["implementation"] == "charge.py:build"
+    assert entry_of(ws, "ChargeMonitor", {"entry": 5, "trace": "runs/other.jsonl"}) is None
+
+
+def test_a_call_violation_is_told_from_a_topic_violation() -> None:
+    from rclverify.diagnosis.monitor_repair import is_call_violation
+    fv = {"where": "run.jsonl:4", "guarantee": 1}
+    assert is_call_violation({"first_violation": fv, "calls": {"first_violation": dict(fv)}})
+    assert not is_call_violation({"first_violation": fv, "calls": {"counts": {}}})
+    assert not is_call_violation({"first_violation": fv})
+
+
+@pytest.mark.parametrize("value, said", [
+    ("charge.py:nope", "contracts/plan.yaml:13:25: error: implementation charge.py defines no top-level function 'nope'"),
+    ("charge.py", "13:25: error: implementation is '<file>.py:<function>', the function that makes the robot's rclpy nodes"),
+])
+def test_an_implementation_naming_no_function_of_a_python_file_is_a_located_plan_error(
+        tmp_path: Path, value: str, said: str) -> None:
+    import shutil
+
+    from rclverify.app.pipeline import Workspace
+    from rclverify.backends.monitors.backend import MonitorsBackend
+    from rclverify.lang.errors import RclError
+    work = tmp_path / "ws"
+    shutil.copytree(CHARGE_WS, work)
+    plan = work / "contracts/plan.yaml"
+    plan.write_text(plan.read_text(encoding="utf-8").replace("charge.py:build", value), encoding="utf-8")
+    with pytest.raises(RclError) as err:
+        MonitorsBackend().export(Workspace(work).target("ChargeMonitor", 0))
+    assert said in str(err.value)
+    plan.write_text(plan.read_text(encoding="utf-8").replace(value, "charge.py:build"), encoding="utf-8")
+    [ob] = MonitorsBackend().export(Workspace(work).target("ChargeMonitor", 0))  # the control: as named
+    assert ob.data["implementation"] == "charge.py:build" and "charge.py" in ob.inputs

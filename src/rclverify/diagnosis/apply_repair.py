@@ -115,11 +115,11 @@ def none_offered(found: Found) -> list[str]:
             said = [f"{d.get('id')} ({d.get('kind')}): no edit the diagnosis tried passed its checks "
                     "(docs/diagnosis.md, \"Repairs\", says which edits are tried for this kind)"]
         elif not said and d.get("kind") == "monitor":
-            said = [f"{d.get('id')} ({d.get('kind')}): no repair is searched for this kind of problem from the "
-                    "report: a node's code is repaired on a recorded run by re-running the node on the run's "
-                    "questions (docs/diagnosis.md, \"Monitor violations: a node re-run on its recorded run\"), "
-                    "which needs the function that makes its rclpy nodes, and a monitors evidence entry does not "
-                    f"name one; `rclverify explain {d.get('id')}` names its culprit"]
+            said = [f"{d.get('id')} ({d.get('kind')}): no repair is searched: a node's code is repaired on a "
+                    "recorded run by re-running the node on the run's questions (docs/diagnosis.md, \"Monitor "
+                    "violations: a node re-run on its recorded run\"), which needs the function that makes its "
+                    "rclpy nodes, and its monitors evidence entry names none (`implementation: FILE.py:FUNCTION`, "
+                    f"docs/plan.md); `rclverify explain {d.get('id')}` names its culprit"]
         elif not said:
             said = [f"{d.get('id')} ({d.get('kind')}): no repair is searched for this kind of problem; "
                     f"`rclverify explain {d.get('id')}` names its culprit"]

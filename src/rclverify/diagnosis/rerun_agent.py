@@ -190,7 +190,7 @@ def run_text(req: dict[str, Any], k: int, text: str) -> tuple[dict[str, Any], di
         module = types.ModuleType(f"rclverify_rerun_{k}")
         module.__file__ = req["file"]
         exec(compile(text, req["file"], "exec"), module.__dict__)  # noqa: S102 - the robot's own code, as it runs
-        getattr(module, req["factory"])(*req["args"])
+        robot = getattr(module, req["factory"])(*req["args"])  # held: a node only the result holds lives on
         made = _nodes(before)
         node, endpoint = _find(req, made)
         published: list[tuple[str, Any]] = []
@@ -204,6 +204,7 @@ def run_text(req: dict[str, Any], k: int, text: str) -> tuple[dict[str, Any], di
         t0 = time.monotonic()
         signal.setitimer(signal.ITIMER_REAL, float(req.get("timeout_s") or 60.0))
         answers = [_answer(req, node, endpoint, q, published) for q in req["questions"]]
+        del robot
         return {"error": "", "answers": answers, "seconds": time.monotonic() - t0}, callback
     except Exception as e:  # noqa: BLE001 - a text that does not load or answer: said, never a repair
         return {"error": f"{type(e).__name__}: {e}", "answers": [], "seconds": time.monotonic() - t0}, callback

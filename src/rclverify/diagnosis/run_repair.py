@@ -249,7 +249,8 @@ def run_repairs(root: Path, checked: Any, cfg: Any, trace: Path, node: str, call
     at = f"{source}:{cb['line']}"
     if not reproduces(lines, ep, run0["answers"]):
         return RunRepairs(line=at, why=f"re-run on the run's questions, {source} does not give the recorded "
-                          f"answers of {node} again: they depend on more than its questions")
+                          f"answers of {node} again: they depend on more than its questions, or the code changed "
+                          "since the run was recorded (record it again)")
     edits = candidate_edits(text, source, int(cb["line"]), str(cb["name"]), cb.get("freevars") or [],
                             contract_numbers(checked.nodes[node]))[:MAX_TRIED]
     tmp = Path(tempfile.mkdtemp(prefix="rclverify-run-repair-"))

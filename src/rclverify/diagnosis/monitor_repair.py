@@ -1,0 +1,85 @@
+"""The checked code repairs of a monitor's violation, as the diagnosis of a report asks them
+(docs/diagnosis.md, "Monitor violations: a node re-run on its recorded run").
+
+A ``monitors`` evidence entry that names its ``implementation`` (``<file>.py:<function>``, the function
+that, called without arguments, makes the robot's rclpy nodes; docs/plan.md) gives the diagnosis of a
+failed run what :func:`rclverify.diagnosis.run_repair.run_repairs` needs: the file, the factory, the run
+(the obligation's trace), the mapping the backend judged it with, and whether the violation is of the
+node's served calls or of its topics.  :func:`monitor_repairs` searches them in the ROS 2 Python
+(:func:`rclverify.runtime.rclpy_source.python.ros2_python`) and says, in one sentence, why none is
+offered when the search cannot run (no entry naming the code, no ROS 2 Python, a run that is not a
+JSON-lines log) or found none.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from rclverify.records.stage_records import Repair
+
+
+@dataclass
+class MonitorRepairs:
+    """What :func:`monitor_repairs` found: the checked ``repairs`` (best first, as JSON), the ``line``
+    (``file:line``) the diagnosis names (the first repair's, else the callback's first line; ``""`` when the
+    node was not re-run), and ``why`` none is offered (``""`` when one is, or when the entry names no
+    implementation: nothing was asked)."""
+
+    repairs: list[Repair] = field(default_factory=list)
+    line: str = ""
+    why: str = ""
+
+
+def entry_of(ws: Any, node: str, data: Mapping[str, Any]) -> Any:
+    """The plan's ``monitors`` evidence entry of ``node`` the obligation ``data`` (its record's ``data``:
+    ``entry``, ``trace``) was exported from, ``None`` when the plan no longer has it."""
+    entries = list(ws.plan.evidence.get(node, ()))
+    k = data.get("entry")
+    if isinstance(k, int) and 0 <= k < len(entries) and entries[k].backend == "monitors":
+        return entries[k]
+    return next((x for x in entries if x.backend == "monitors" and data.get("trace") in (x.config.get("traces") or ())),
+                None)
+
+
+def is_call_violation(monitoring: Mapping[str, Any]) -> bool:
+    """Whether the run's first violation (``monitoring["first_violation"]``) is one of the node's served
+    calls (a service's response, an action's feedback or result) rather than of its topics."""
+    calls = monitoring.get("calls")
+    fv = monitoring.get("first_violation")
+    return isinstance(calls, Mapping) and fv is not None and calls.get("first_violation") == fv
+
+
+def monitor_repairs(ws: Any, node: str, data: Mapping[str, Any], monitoring: Mapping[str, Any],
+                    python: Path | None) -> MonitorRepairs:
+    """The checked repairs of ``node``'s violation on the run of the obligation whose record's ``data`` is
+    ``data`` (``trace``, ``mapping``, ``implementation``), its evidence's ``monitoring`` part, re-run in the
+    ROS 2 Python ``python`` (``None``: there is none).  Nothing is asked, and ``why`` is ``""``, when the
+    obligation names no implementation.  Never raises for the user's code or run (each cause is ``why``)."""
+    impl = str(data.get("implementation") or "")
+    if not impl:
+        return MonitorRepairs()
+    source, _, factory = impl.rpartition(":")
+    if python is None:
+        return MonitorRepairs(why=f"no repair is searched: re-running {impl} needs a Python with rclpy (source "
+                              "ROS 2's setup.bash, or name one with RCLVERIFY_ROS2_PYTHON)")
+    trace = str(data.get("trace") or "")
+    if not trace.endswith(".jsonl"):
+        return MonitorRepairs(why=f"no repair is searched: {trace} is not a JSON-lines log (the re-run reads a "
+                              "live monitor's log: `rclverify monitor --live --log`)")
+    from rclverify.backends.monitors.config import ConfigError, load_mapping  # deferred: start-up (the monitors)
+    from rclverify.diagnosis.run_repair import run_repairs  # deferred: start-up (the property tests' search)
+    entry = entry_of(ws, node, data)
+    c = entry.config if entry is not None else {}
+    try:
+        cfg = load_mapping(ws.root, data.get("mapping"), c.get("horizon"), c.get("traces", ()), c.get("tolerance"))
+    except ConfigError as exc:
+        return MonitorRepairs(why=f"no repair is searched: the mapping does not load: {exc}")
+    got = run_repairs(Path(ws.root), ws.checked, cfg, ws.path(trace), node, is_call_violation(monitoring),
+                      source, factory, [], python)
+    if got.repairs:
+        return MonitorRepairs(list(got.repairs), got.line)
+    return MonitorRepairs(why=f"{impl} re-run on {trace}: {got.why}", line=got.line)
+
+
+__all__ = ["MonitorRepairs", "entry_of", "is_call_violation", "monitor_repairs"]
