@@ -353,7 +353,7 @@ def test_unexpected_end_of_input() -> None:
     loc, msg = syntax_error(text)
     assert (loc.line, loc.col) == (2, 19)  # just after the last token
     assert msg == ("unexpected end of input; expected one of 'A', 'G', 'assume', 'guarantee', 'initially', 'periodic', "
-                   "'progress', 'triggered', 'within', '}'")
+                   "'progress', 'ready', 'triggered', 'while', 'within', '}'")
 
 
 def test_keywords_are_listed_as_expected() -> None:

@@ -360,18 +360,41 @@ class Deadline:
 
 
 @dataclass(frozen=True)
+class Scope:
+    """``while active`` (``while inactive or active``) after a guarantee of a
+    lifecycle node (docs/rcl-language.md, "Lifecycle nodes"): the states, as
+    written, in which the guarantee is asked."""
+
+    states: tuple[str, ...]
+    loc: Loc = loc_field()
+
+
+@dataclass(frozen=True)
 class Clause:
     """One ``assume(...)`` or ``guarantee(...)`` clause.
 
     A guarantee may carry ``triggered by in.x`` (``trigger``: the output is
-    produced in response to input ``x``) and ``within N unit``
-    (``deadline``); both are ``None`` for every contract written before
-    them, so those keep their meaning."""
+    produced in response to input ``x``), ``within N unit`` (``deadline``)
+    and ``while S`` (``scope``: lifecycle states); all are ``None`` for every
+    contract written before them, so those keep their meaning."""
 
     formula: Expr
     loc: Loc = loc_field()
     trigger: Var | None = None
     deadline: Deadline | None = None
+    scope: Scope | None = None
+
+
+@dataclass(frozen=True)
+class TransitionDeadline:
+    """``ready within 200 ms of activate`` in a lifecycle node
+    (docs/rcl-language.md, "Lifecycle nodes"): the node reaches the state
+    ``transition`` leads to within ``deadline`` of entering its transition
+    state."""
+
+    transition: str
+    deadline: Deadline
+    loc: Loc = loc_field()
 
 
 @dataclass(frozen=True)
@@ -426,8 +449,9 @@ class Node:
 
     ``initially`` (formulas over the outputs before the node's first answer),
     ``progress`` and ``periodic`` are the temporal declarations of
-    docs/rcl-language.md; all three are empty for every contract written
-    before them, which keep their meaning."""
+    docs/rcl-language.md, ``transitions`` a lifecycle node's transition
+    deadlines; all four are empty for every contract written before them,
+    which keep their meaning."""
 
     name: str
     inputs: tuple[IOVar, ...]
@@ -440,6 +464,7 @@ class Node:
     initially: tuple[Clause, ...] = ()
     progress: tuple[Progress, ...] = ()
     periodic: tuple[Periodic, ...] = ()
+    transitions: tuple[TransitionDeadline, ...] = ()
 
 
 @dataclass(frozen=True)

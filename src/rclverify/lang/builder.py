@@ -156,7 +156,8 @@ class ToAst(Transformer[Token, Any]):
         return ast.Node(name, inputs, outputs, topics, assumes, guarantees, self._span(c), links,
                         tuple(cl for kind, cl in rest if kind == "initially"),
                         tuple(p for kind, p in rest if kind == "progress"),
-                        tuple(p for kind, p in rest if kind == "periodic"))
+                        tuple(p for kind, p in rest if kind == "periodic"),
+                        tuple(t for kind, t in rest if kind == "transition"))
 
     def inputs(self, c: list[Any]) -> tuple[ast.IOVar, ...]:
         return tuple(x for x in _vals(c) if x is not None)
@@ -185,7 +186,15 @@ class ToAst(Transformer[Token, Any]):
         v = _vals(c)
         trigger = v[1].value if len(v) > 1 and v[1] is not None else None
         deadline = v[2] if len(v) > 2 else None
-        return ("guarantee", ast.Clause(v[0], self._span([x for x in c if x is not None]), trigger, deadline))
+        scope = v[3] if len(v) > 3 else None
+        return ("guarantee", ast.Clause(v[0], self._span([x for x in c if x is not None]), trigger, deadline, scope))
+
+    def scope(self, c: list[Any]) -> ast.Scope:
+        return ast.Scope(tuple(str(x) for x in _vals(c)), self._span(c))
+
+    def transition_deadline(self, c: list[Any]) -> tuple[str, ast.TransitionDeadline]:
+        v = _vals(c)
+        return ("transition", ast.TransitionDeadline(str(v[1]), v[0], self._span(c)))
 
     def initially(self, c: list[Any]) -> tuple[str, ast.Clause]:
         return ("initially", ast.Clause(_vals(c)[0], self._span(c)))

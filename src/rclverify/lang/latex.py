@@ -283,12 +283,22 @@ def unit_to_latex(u: ast.UnitAnn | None, brackets: bool = False) -> str:
 
 
 def _timing(c: ast.Clause) -> str:
-    """`` triggered by $in.x$ within 200~ms`` after a guarantee (empty when untimed)."""
+    """`` triggered by $in.x$ within 200~ms while \\textsf{active}`` after a guarantee (empty when
+    untimed and unscoped)."""
     s = r" triggered by $" + _var(c.trigger) + "$" if c.trigger is not None else ""
     if c.deadline is not None:
         s += " within " + escape(c.deadline.amount) + (r"~\textrm{" + escape(c.deadline.unit) + "}"
                                                         if c.deadline.unit else "")
+    if c.scope is not None:
+        s += " while " + " or ".join(r"\textsf{" + escape(st) + "}" for st in c.scope.states)
     return s
+
+
+def _transition(t: ast.TransitionDeadline) -> str:
+    r"""``ready within 200~ms of \textsf{activate}``: a lifecycle node's transition deadline."""
+    d = t.deadline
+    return ("ready within " + escape(d.amount) + (r"~\textrm{" + escape(d.unit) + "}" if d.unit else "")
+            + r" of \textsf{" + escape(t.transition) + "}")
 
 
 def _link(lk: ast.Link) -> str:
@@ -338,6 +348,7 @@ def to_latex(spec: ast.Spec, document: bool = True, explicit: bool = False, head
         "progress": [escape(progress_to_rcl(p)) for p in n.progress],
         "periodic": ["$" + _var(p.output) + "$, " + escape(p.amount)
                      + (r"~\textrm{" + escape(p.unit) + "}" if p.unit else "") for p in n.periodic],
+        "transitions": [_transition(t) for t in n.transitions],
     } for n in spec.nodes]
     return _env().get_template("contracts.tex.j2").render(
         source=source, document=document, header=header, contexts=contexts, nodes=nodes)

@@ -24,6 +24,13 @@ raises and never changes what a contract means.  The rules:
     A node output that no guarantee mentions: the contract says nothing
     about it, so no obligation will constrain it.
 
+``W-lifecycle-unscoped``
+    A guarantee of a lifecycle node (its contract names its
+    ``lifecycle_msgs/TransitionEvent`` topic, :mod:`rclverify.lang.lifecycle`)
+    with no ``while`` scope: it keeps the meaning it has always had (judged
+    while the node is ``active``), and the warning says so, at the
+    guarantee, so that the contract can state it (``while active``).
+
 An input that no assumption or guarantee mentions is *not* reported: inputs
 may be passed through or consumed only by the implementation.
 """
@@ -31,6 +38,7 @@ from __future__ import annotations
 
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, warning
+from rclverify.lang.lifecycle import transition_topic
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.walk import free_names, subexpressions
 
@@ -44,7 +52,7 @@ def lint(spec: ast.Spec) -> list[Diagnostic]:
     ``spec``: a :class:`~rclverify.lang.ast.Spec` from the parser.
     Returns a list of :class:`~rclverify.lang.errors.Diagnostic` with
     severity ``"warning"`` and codes ``W-implication-precedence``,
-    ``W-unused-bound`` and ``W-unconstrained-output``."""
+    ``W-unused-bound``, ``W-unconstrained-output`` and ``W-lifecycle-unscoped``."""
     diags: list[Diagnostic] = []
     for ctx in spec.contexts:
         for decl in ctx.decls:
@@ -59,6 +67,7 @@ def lint(spec: ast.Spec) -> list[Diagnostic]:
                 diags += _implication_precedence(clause.formula, where)
                 diags += _unused_bound(clause.formula, where)
         diags += _unconstrained_outputs(node)
+        diags += _lifecycle_unscoped(node)
     return sorted(diags, key=lambda d: (d.loc.file, d.loc.line, d.loc.col, d.code))
 
 
@@ -181,3 +190,15 @@ def _unconstrained_outputs(node: ast.Node) -> list[Diagnostic]:
         for out in node.outputs
         if ("out", out.name) not in mentioned and (None, out.name) not in mentioned
     ]
+
+
+def _lifecycle_unscoped(node: ast.Node) -> list[Diagnostic]:
+    topic = transition_topic(node)
+    if topic is None:
+        return []
+    return [warning(clause.loc,
+                    f"guarantee {i} of {node.name}: {node.name} is a lifecycle node (it names its transition "
+                    f"topic {topic.field}); an unscoped guarantee is judged only while the node is active; "
+                    f"write 'while active' after it to say so, or the states it holds in",
+                    "W-lifecycle-unscoped")
+            for i, clause in enumerate(node.guarantees, 1) if clause.scope is None]

@@ -360,10 +360,12 @@ def _link(lk: ast.Link) -> str:
 
 
 def _timing(c: ast.Clause) -> str:
-    """`` triggered by in.x within N unit`` (empty for an untimed clause)."""
+    """`` triggered by in.x within N unit while active`` (empty for an untimed, unscoped clause)."""
     s = f" triggered by {c.trigger.qualified}" if c.trigger is not None else ""
     if c.deadline is not None:
         s += f" within {c.deadline.amount}" + (f" {c.deadline.unit}" if c.deadline.unit else "")
+    if c.scope is not None:
+        s += " while " + " or ".join(c.scope.states)
     return s
 
 
@@ -375,7 +377,8 @@ def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:
     """``node Name { inputs(...) outputs(...) topics(...) assume(...)* guarantee(...)* }``.
 
     Assumptions are printed before guarantees (the AST keeps them apart),
-    then ``initially``, ``progress`` and ``periodic`` in that order;
+    then ``initially``, ``progress``, ``periodic`` and the transition
+    deadlines (``ready within ...``) in that order;
     ``topics(...)`` is omitted when the node has none."""
     lines = [f"node {n.name} {{", f"  inputs( {_io(n.inputs)} )", f"  outputs( {_io(n.outputs)} )"]
     if n.topics:
@@ -391,6 +394,8 @@ def node_to_rcl(n: ast.Node, explicit: bool = False) -> str:
     lines += [f"  initially( {expr_to_rcl(c.formula, explicit)} )" for c in n.initially]
     lines += [f"  progress( {progress_to_rcl(p)} )" for p in n.progress]
     lines += [f"  periodic( {p.output.qualified}, {p.amount}{' ' + p.unit if p.unit else ''} )" for p in n.periodic]
+    lines += [f"  ready within {t.deadline.amount}{' ' + t.deadline.unit if t.deadline.unit else ''} of {t.transition}"
+              for t in n.transitions]
     return "\n".join(lines) + "\n}\n"
 
 

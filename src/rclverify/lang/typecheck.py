@@ -30,7 +30,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
-from rclverify.lang import ast, liveness, timing
+from rclverify.lang import ast, lifecycle, liveness, timing
 
 from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError
@@ -120,6 +120,9 @@ class _Checker(ExprChecker):
         for cl in n.guarantees:
             if (cl.trigger is not None or cl.deadline is not None) and not timing.check_clause(n, cl, self.err):
                 ok = False
+        if (n.transitions or any(cl.scope is not None for cl in n.guarantees)) and not lifecycle.check_node(
+                n, self.err, timing.seconds):
+            ok = False
         if (n.progress or n.periodic or n.initially) and not liveness.check_node(
                 n, set(inputs), set(outputs), self.err):
             ok = False
