@@ -45,7 +45,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 from rclverify.model.plan.errors import PlanError  # noqa: E402
 from rclverify.model.plan.fret.export import FretExport, read_export  # noqa: E402
-from rclverify.model.plan.fret.requirements import Options, import_export  # noqa: E402
+from rclverify.model.plan.fret.requirements import Options, import_export, options_of  # noqa: E402
 
 #: Words RCL's grammar keeps for itself: a FRET variable so named gets no port in the generated contract.
 RESERVED = {"and", "or", "not", "in", "forall", "exists", "exists_unique", "TRUE", "FALSE", "REAL", "INTEGER",
@@ -96,12 +96,12 @@ def _contracts(exp: FretExport) -> tuple[str, dict[str, str]]:
     return "\n".join(text), nodes
 
 
-def exp_refused(exp: FretExport) -> set[str]:
+def exp_refused(exp: FretExport, options: Options) -> set[str]:
     """The reqids the import refuses without the contracts."""
-    return {i.fret.reqid for i in import_export(exp, Options()) if i.refusal is not None}
+    return {i.fret.reqid for i in import_export(exp, options) if i.refusal is not None}
 
 
-def decide(export: Path, exp: FretExport, out: collections.Counter[str]) -> None:
+def decide(export: Path, exp: FretExport, out: collections.Counter[str], step: str | None = None) -> None:
     """Decide the translated requirements of ``export`` in a workspace of their own (module docstring)."""
     from rclverify.app.pipeline import stage_check, stage_requirements
     from rclverify.stages.workspace import Workspace
@@ -116,7 +116,7 @@ def decide(export: Path, exp: FretExport, out: collections.Counter[str]) -> None
         (root / "contracts" / "sys.rcl").write_text(contracts, encoding="utf-8")
         (root / "contracts" / "plan.yaml").write_text(
             "name: bench\ncontracts: [contracts/sys.rcl]\nrequirements_from: {fret: fret/export.json}\n"
-            f"fret:\n  components: {json.dumps(nodes)}\n", encoding="utf-8")
+            f"fret:\n  components: {json.dumps(nodes)}\n" + (f"  step: {step}\n" if step else ""), encoding="utf-8")
         dropped: set[str] = set()
         for _ in range(len(reqs) + 1):
             kept = [r for r in reqs if r.get("reqid") not in dropped]
@@ -138,9 +138,10 @@ def decide(export: Path, exp: FretExport, out: collections.Counter[str]) -> None
                 dropped |= bad
         ws = Workspace(root, "contracts/plan.yaml")
         from rclverify.model.plan.fret.requirements import options_of, read_fret
-        plan_data = {"fret": {"components": nodes}}
-        for i in read_fret(root, "fret/export.json", options_of(plan_data), ("contracts/sys.rcl",)):
-            if i.refusal is not None and i.fret.reqid not in exp_refused(exp):
+        plan_data: dict[str, Any] = {"fret": {"components": nodes, **({"step": step} if step else {})}}
+        options = options_of(plan_data)
+        for i in read_fret(root, "fret/export.json", options, ("contracts/sys.rcl",)):
+            if i.refusal is not None and i.fret.reqid not in exp_refused(exp, options):
                 print(f"  {export.name}:{i.fret.reqid}: refused with the contracts: {i.refusal.reason}")
                 out[f"refused: {reason_kind(i.refusal.reason)}"] += 1
         stage_check(ws)
@@ -156,6 +157,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("dir", type=Path, nargs="?", help="a folder of FRET exports (*.json)")
     ap.add_argument("--decide", action="store_true", help="also decide each translated requirement")
+    ap.add_argument("--step", help="the plan's fret: step: (the seconds of one step, '1 s'), for durations in secs")
     ap.add_argument("--smoke", action="store_true",
                     help="CI: the project's own example export (examples/fret_rover/fret), decided")
     args = ap.parse_args(argv)
@@ -173,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{exc.diagnostics[0]}")
             total["malformed exports"] += 1
             continue
-        got = import_export(exp, Options())
+        got = import_export(exp, options_of({"fret": {"step": args.step}} if args.step else {}))
         refused = [i for i in got if i.refusal is not None]
         for i in refused:
             assert i.refusal is not None
@@ -183,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{export.name}: {len(got)} requirements, {len(got) - len(refused)} translated, {len(refused)} refused")
         if args.decide:
             verdicts: collections.Counter[str] = collections.Counter()
-            decide(export, exp, verdicts)
+            decide(export, exp, verdicts, args.step)
             print("  " + ", ".join(f"{k}: {v}" for k, v in sorted(verdicts.items())))
             total.update(verdicts)
     print(f"\ntotal: {total['requirements']} requirements, {total['translated']} translated to a decided "

@@ -64,7 +64,9 @@ def _var(name: str, id_type: str, data_type: str, assignment: str = "") -> dict[
 
 VARIABLES = [_var("obstacle", "Input", "boolean"), _var("asked", "Input", "double"),
              _var("speed", "Output", "double"), _var("braking", "Output", "boolean"),
-             _var("limit", "Internal", "double", "2.0"), _var("filtered", "Internal", "double", "0.0 -> pre speed")]
+             _var("limit", "Internal", "double", "2.0"), _var("filtered", "Internal", "double", "0.0 -> pre speed"),
+             _var("unguarded", "Internal", "double", "pre speed"),
+             _var("sampled", "Internal", "double", "speed when braking")]
 #: FRET's ptExpanded of R-4 (null scope, upon, after 2 ticks; FRET v3.1.0's formalisation of that combination).
 AFTER_PT = ("((H ((O[<=2] (obstacle & (Z (! obstacle)))) -> ((H (! obstacle)) | (! (speed = 0.0))))) & (H ((O[=3] "
             "((obstacle & (Z (! obstacle))) & (! (speed = 0.0)))) -> (O[<3] ((Z FALSE) | (speed = 0.0))))))")
@@ -144,7 +146,9 @@ def test_reimport_reports_added_changed_removed_and_keeps_the_plans_own(ws: Path
 
 def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
     reqs = [
-        _req("LUSTRE", "the rover shall always satisfy filtered <= 2.0", "always", "(filtered <= 2.0)"),
+        _req("LUSTRE", "the rover shall always satisfy unguarded <= 2.0", "always", "(unguarded <= 2.0)"),
+        _req("LUSTRE-WHEN", "the rover shall always satisfy sampled <= 2.0", "always", "(sampled <= 2.0)"),
+        _req("LUSTRE-OK", "the rover shall always satisfy filtered <= 2.0", "always", "(filtered <= 2.0)"),
         _req("UNDECLARED", "the rover shall always satisfy ghost", "always", "(ghost)"),
         _req("FUNCTION", "the rover shall always satisfy sqrt(speed) < 2.0", "always", "(sqrt(speed) < 2.0)"),
         _req("MODE-TRIGGER", "in manual mode upon obstacle the rover shall immediately satisfy braking", "immediately",
@@ -157,15 +161,20 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
         _req("MODE-TRIGGER-PT", "in manual mode upon obstacle the rover shall immediately satisfy braking",
              "immediately", "(braking)", "regular", "(obstacle)", scope_mode="manual", ptExpanded=MODE_TRIGGER_PT),
     ]
-    reqs[3]["semantics"]["scope"] = {"type": "in"}
+    reqs[5]["semantics"]["scope"] = {"type": "in"}
     reqs[-1]["semantics"]["scope"] = {"type": "in"}
     variables = VARIABLES + [_var("manual", "Input", "boolean")]
     got = {i.fret.reqid: i for i in import_export(read_export(_write(tmp_path / "e.json", reqs, variables), "e.json"),
                                                    Options())}
     why = {k: (i.refusal.reason, i.refusal.fix) if i.refusal else None for k, i in got.items()}
-    assert why["LUSTRE"] == ("filtered is an Internal variable defined in Lustre (0.0 -> pre speed)",
-                             "make filtered an input or output of rover, or define it in FRET by a FRETish "
-                             "expression over the component's variables")
+    assert why["LUSTRE"] == ("unguarded's definition reads pre at the first step, where Lustre leaves it undefined",
+                             "give the pre an initial value in FRET (i -> pre e)")
+    assert why["LUSTRE-WHEN"] == ("sampled is defined with Lustre's when, which rclverify does not read",
+                                  "define sampled with ->, pre and if-then-else")
+    assert why["LUSTRE-OK"] is None and got["LUSTRE-OK"].requirement.formal is not None  # Lustre's 0.0 -> pre speed
+    assert got["LUSTRE-OK"].requirement.formal.text == (
+        "always ((rover.state.fret_LUSTRE_OK_ftp -> ((0.0) <= 2.0)) and ((not rover.state.fret_LUSTRE_OK_ftp) -> "
+        "((rover.state.fret_LUSTRE_OK_pre2) <= 2.0)))")
     assert why["UNDECLARED"] is not None and why["UNDECLARED"][0] == "ghost is not declared in the export"
     assert why["FUNCTION"] is not None and "FRET function sqrt(_)" in why["FUNCTION"][0]
     assert why["MODE-TRIGGER"] == ("its export has no past-time formalisation (semantics.ptExpanded), which rclverify "
@@ -173,8 +182,7 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
                                    "export the requirement again from FRET")
     assert why["MODE-TRIGGER-PT"] is None  # the same with FRET's formalisation: stated from it
     assert why["NOSEM"] is not None and "FRET has not formalised it" in why["NOSEM"][0]
-    assert why["PRE-INIT"] == ("a pre function's initial value out.speed reads the component's variables",
-                               "give it a constant initial value (preReal(0.0, e))")
+    assert why["PRE-INIT"] is None  # preReal(speed, speed): Lustre's speed -> pre speed, FRET's first time point
     assert why["OK"] is None and got["OK"].requirement.formal is not None  # the control
     assert got["OK"].requirement.formal.text == "always (not (rover.out.speed > 2.0))"
 

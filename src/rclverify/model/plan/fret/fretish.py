@@ -225,46 +225,141 @@ class Writer:
     #: ``("bin", "S", a, b)``; :mod:`.pasttime`), ``None`` where the expression has none.
     temporal: Callable[[Expr, bool], str] | None = None
 
+    #: ``table(length, local)``: the RCL text of the requirement's step counter (``state.v``, the steps
+    #: since the first, at least ``length - 1`` once it stops) for a Lustre table (:mod:`.lustre`).
+    table: Callable[[int, bool], str] | None = None
+
     def rcl(self, e: Expr, local: bool = False) -> str:
-        """RCL text of ``e``: over ``Node.in.x``/``Node.out.y``/``Node.state.v``
+        """RCL text of formula ``e``: over ``Node.in.x``/``Node.out.y``/``Node.state.v``
         or, ``local``, over ``in.x``/``out.y``/``state.v`` (a state
-        declaration's ``next``).  Raises :class:`Refusal`."""
+        declaration's ``next``).  A Lustre ``ite`` or table inside a comparison
+        is stated case by case there (:func:`lift`).  Raises :class:`Refusal`."""
+        return text(lift(self.resolve(e, local)))
+
+    def resolve(self, e: Expr, local: bool) -> Expr:
+        """``e`` with every name placed (``("text", rcl)`` or the tree it stands for, resolved), every
+        ``pre``, ``persisted``, ``occurred`` and past-time node replaced by the state variables' text."""
         kind = e[0]
-        if kind == "num":
-            t = str(e[1])
-            return "0" + t if t.startswith(".") else t
-        if kind == "bool":
-            return str(e[1])
+        if kind in ("num", "bool", "text"):
+            return e
         if kind == "var":
             got = self.var(str(e[1]), local)
-            return got if isinstance(got, str) else f"({self.rcl(got, local)})"
-        if kind == "not":
-            return f"(not {self.rcl(e[1], local)})"  # type: ignore[arg-type]
-        if kind == "neg":
-            return f"(-{self.rcl(e[1], local)})"  # type: ignore[arg-type]
+            return ("text", got) if isinstance(got, str) else ("paren", self.resolve(got, local))
         if self.temporal is not None and (kind == "past" or kind == "bin" and e[1] == "S"):
-            return self.temporal(e, local)
-        if kind == "bin":
-            op, a, b = e[1], e[2], e[3]
-            la, lb = self.rcl(a, local), self.rcl(b, local)  # type: ignore[arg-type]
-            if op == "xor":
-                return f"(not ({la} <=> {lb}))"
-            return f"({la} {_RCL_OP[str(op)]} {lb})"
+            return ("text", self.temporal(e, local))
+        if kind == "table":
+            if self.table is None:
+                raise Refusal("a Lustre table of constants is read only in a requirement", "define it in FRET")
+            consts = e[1]
+            assert isinstance(consts, tuple)
+            return ("table", self.table(len(consts), local), consts)
+        if kind != "call":
+            return (kind,) + tuple(x if isinstance(x, str) else self.resolve(x, local) for x in e[1:])  # type: ignore[arg-type]
         name, args = str(e[1]), e[2]
         assert isinstance(args, tuple)
         if name in ABS and len(args) == 1:
-            return f"abs({self.rcl(args[0], local)})"
+            return ("call", "abs", (self.resolve(args[0], local),))
         if name in PRE and len(args) == 2:
-            state = self.pre(PRE[name], args[0], args[1])
-            return f"state.{state}" if local else f"{self.node}.state.{state}"
+            init = args[0]
+            if not _constant(init):  # Lustre's i -> pre e: i at the first step, FRET's FTP
+                default: Expr = ("bool", "FALSE") if PRE[name] == "BOOL" else ("num", "0.0" if PRE[name] ==
+                                                                                     "REAL" else "0")
+                return self.resolve(("ite", ("var", "FTP"), init, ("call", name, (default, args[1]))), local)
+            state = self.pre(PRE[name], init, args[1])
+            return ("text", f"state.{state}" if local else f"{self.node}.state.{state}")
         if name in COUNTED and len(args) == 2 and self.count is not None:
             n = args[0]
             if n[0] != "num" or not str(n[1]).isdigit():
                 raise Refusal(f"{name}'s first argument must be a number of steps", f"write {name}(N, p), N a number")
             state = self.count(name, int(str(n[1])), args[1])
-            ref = f"state.{state}" if local else f"{self.node}.state.{state}"
-            p = self.rcl(args[1], local)
-            return f"({p} and {ref} >= {n[1]})" if name == "persisted" else f"({p} or {ref} <= {n[1]})"
+            ref = ("text", f"state.{state}" if local else f"{self.node}.state.{state}")
+            p = self.resolve(args[1], local)
+            return ("bin", "&", p, ("bin", ">=", ref, n)) if name == "persisted" else ("bin", "|", p, ("bin", "<=", ref, n))
         raise Refusal(f"it calls the FRET function {name}({', '.join('_' for _ in args)}), which has no RCL "
                       "counterpart", f"write {name} as an RCL formula over the component's inputs and outputs"
                                      " (rclverify translates absReal, absInt, preBool, preReal, preInt, persisted and occurred)")
+
+
+def _constant(e: Expr) -> bool:
+    return e[0] in ("num", "bool") or e[0] == "neg" and _constant(e[1])  # type: ignore[arg-type]
+
+
+#: FRETish's Boolean connectives: their operands are formulas, where an ``ite`` is stated as a case split.
+_CONNECTIVES = ("&", "|", "=>", "->", "<=>", "<->", "xor")
+
+
+def _split(e: Expr) -> tuple[Expr, Callable[[Expr], Expr]] | None:
+    """The first ``ite`` or table inside term-level tree ``e`` and the function putting a tree in its place;
+    ``None`` when it has none."""
+    if e[0] in ("ite", "table"):
+        return e, lambda x: x
+    for i, a in enumerate(e):
+        if i == 0 or not isinstance(a, tuple) or not a:
+            continue
+        if isinstance(a[0], str):
+            got = _split(a)
+            if got is not None:
+                node, put = got
+                return node, lambda x, i=i, put=put: e[:i] + (put(x),) + e[i + 1:]
+        else:
+            for j, b in enumerate(a):
+                got = _split(b)
+                if got is not None:
+                    node, put = got
+                    return node, (lambda x, i=i, j=j, put=put, a=a:
+                                  e[:i] + (a[:j] + (put(x),) + a[j + 1:],) + e[i + 1:])
+    return None
+
+
+def lift(e: Expr) -> Expr:
+    """Formula ``e`` (resolved) with each ``ite(c, a, b)`` and table stated where a formula reads it: an
+    ``ite`` formula as ``(c & a) | (!c & b)``, a comparison (or other atom) ``A`` reading ``ite(c, a, b)``
+    as ``(c => A[a]) & (!c => A[b])``, one reading table ``(v, c0..cN)`` as the conjunction of
+    ``v = k => A[ck]`` for k < N and ``v >= N => A[cN]`` (``("and*", items)``, written flat)."""
+    kind = e[0]
+    if kind in ("not", "paren"):
+        return (kind, lift(e[1]))  # type: ignore[arg-type]
+    if kind == "bin" and e[1] in _CONNECTIVES:
+        return ("bin", e[1], lift(e[2]), lift(e[3]))  # type: ignore[arg-type]
+    if kind == "ite":
+        c = lift(e[1])  # type: ignore[arg-type]
+        return ("bin", "|", ("bin", "&", c, lift(e[2])), ("bin", "&", ("not", c), lift(e[3])))  # type: ignore[arg-type]
+    got = _split(e)
+    if got is None:
+        return e
+    node, put = got
+    if node[0] == "ite":
+        c = lift(node[1])  # type: ignore[arg-type]
+        return ("bin", "&", ("bin", "=>", c, lift(put(node[2]))),  # type: ignore[arg-type]
+                ("bin", "=>", ("not", c), lift(put(node[3]))))  # type: ignore[arg-type]
+    counter, consts = ("text", str(node[1])), node[2]
+    assert isinstance(consts, tuple)
+    last = len(consts) - 1
+    return ("and*", tuple(("bin", "=>", ("bin", "=" if k < last else ">=", counter, ("num", str(k))), lift(put(c)))
+                          for k, c in enumerate(consts)))
+
+
+def text(e: Expr) -> str:
+    """RCL text of a resolved, lifted tree (:meth:`Writer.rcl`), fully bracketed."""
+    kind = e[0]
+    if kind == "num":
+        t = str(e[1])
+        return "0" + t if t.startswith(".") else t
+    if kind in ("bool", "text"):
+        return str(e[1])
+    if kind == "not":
+        return f"(not {text(e[1])})"  # type: ignore[arg-type]
+    if kind == "neg":
+        return f"(-{text(e[1])})"  # type: ignore[arg-type]
+    if kind == "paren":
+        return f"({text(e[1])})"  # type: ignore[arg-type]
+    if kind == "and*":
+        items = e[1]
+        assert isinstance(items, tuple)
+        return "(" + " and ".join(text(x) for x in items) + ")"
+    if kind == "call":
+        return f"abs({text(e[2][0])})"  # type: ignore[index]
+    op, la, lb = e[1], text(e[2]), text(e[3])  # type: ignore[arg-type]
+    if op == "xor":
+        return f"(not ({la} <=> {lb}))"
+    return f"({la} {_RCL_OP[str(op)]} {lb})"

@@ -33,15 +33,16 @@ from rclverify.model.plan.formal import Source
 from rclverify.model.plan.model import Requirement
 from rclverify.model.plan.state import StateVar
 from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretVariable, read_export
-from rclverify.model.plan.fret.fretish import Expr, Refusal, names, parse
+from rclverify.model.plan.fret.fretish import Expr, Refusal, parse
+from rclverify.model.plan.fret.lustre import LUSTRE, fretish, parse_lustre, self_reads
 from rclverify.model.plan.fret.translate import Translation, translate
 
 #: FRET data types read as numbers, and the RCL types a number may be.
 NUMBERS = ("double", "single", "float", "real", "integer", "int", "int8", "int16", "int32", "int64", "uint8",
            "uint16", "uint32", "uint64", "unsigned integer")
 _NUMBER_TYPES = ("REAL", "INTEGER", "NATURAL")
-#: Lustre words in an Internal variable's assignment that FRETish does not have.
-_LUSTRE = re.compile(r"\b(pre|if|then|else|fby|when|current)\b|->")
+_INTEGERS = ("integer", "int", "int8", "int16", "int32", "int64", "uint8", "uint16", "uint32", "uint64",
+             "unsigned integer")
 #: Lustre's word operators in an assignment, read as FRETish's.
 _LUSTRE_OPS = {"and": "&", "or": "|", "not": "!", "xor": "xor", "<>": "!="}
 _LUSTRE_WORDS = re.compile(r"\b(?:and|or|not)\b|<>")
@@ -105,6 +106,7 @@ class _Places:
     def __init__(self, exp: FretExport, fr: FretRequirement, node: str, ports: Ports | None) -> None:
         self.exp, self.fr, self.node, self.ports = exp, fr, node, ports
         self.depth = 0
+        self.defining: list[str] = []
 
     def _declared(self, name: str) -> FretVariable | None:
         return self.exp.variables.get((self.fr.component, name))
@@ -122,10 +124,12 @@ class _Places:
         if kind == "Internal":
             assert v is not None
             a = v.assignment.strip()
-            if not a or _LUSTRE.search(a):
-                raise Refusal(f"{name} is an Internal variable defined in Lustre ({a or 'no assignment'})",
+            if not a:
+                raise Refusal(f"{name} is an Internal variable without an assignment",
                               f"make {name} an input or output of {self.node}, or define it in FRET by a "
-                              "FRETish expression over the component's variables")
+                              "FRETish or Lustre expression over the component's variables")
+            if LUSTRE.search(a):
+                return self._defined(name, a, local, lustre=True)
             return self._defined(name, _LUSTRE_WORDS.sub(lambda m: _LUSTRE_OPS[m.group(0)], a), local)
         if kind in ("Mode", "Function"):
             raise Refusal(f"{name} is a FRET {kind} variable" + (" without a mode requirement" if kind == "Mode"
@@ -138,20 +142,38 @@ class _Places:
         raise Refusal(f"{name} is {why}", f"declare it in FRET as an Input or Output of {self.fr.component}, or "
                                           "as a constant or enumeration value of the contracts' context")
 
-    def _defined(self, name: str, text: str, local: bool) -> Expr:
+    def _defined(self, name: str, text: str, local: bool, lustre: bool = False) -> Expr:
         """The tree of a variable defined by a FRETish expression (an Internal variable's assignment, a
-        Mode's mode requirement), every name it reads placed (or refused) now."""
+        Mode's mode requirement) or a Lustre one (:mod:`.lustre`), every name it reads placed (or refused)
+        now; it may read its own value only under a ``pre``."""
         self.depth += 1
         if self.depth > 32:
             raise Refusal(f"the variable {name} is defined through itself", "break the cycle in FRET")
         try:
-            tree = parse(text)
+            tree = fretish(name, parse_lustre(name, text), self._type) if lustre else parse(text)
         except Refusal as exc:
-            raise Refusal(f"{name}'s definition: {exc.reason}", exc.fix) from None
-        for n in names(tree):
-            self(n, local)
+            raise Refusal(exc.reason if exc.reason.startswith(name) else f"{name}'s definition: {exc.reason}",
+                          exc.fix) from None
+        self.defining.append(name)
+        now, before = self_reads(tree)
+        for n in now:
+            if n in self.defining:
+                raise Refusal(f"the variable {n} is defined through itself (not under a pre)",
+                              "break the cycle in FRET")
+            if n != "FTP":
+                self(n, local)
+        for n in before:
+            if n not in self.defining:
+                self(n, local)
+        self.defining.pop()
         self.depth -= 1
         return tree
+
+    def _type(self, name: str) -> str:
+        """``BOOL``, ``REAL`` or ``INTEGER``: the RCL type of FRET variable ``name`` (its ``dataType``)."""
+        v = self._declared(name)
+        dt = v.data_type.lower() if v is not None else ""
+        return "BOOL" if dt == "boolean" else "INTEGER" if dt in _INTEGERS else "REAL"
 
     def _check_port(self, v: FretVariable, prefix: str) -> None:
         if self.ports is None:

@@ -136,12 +136,25 @@ _UNIT_NAMES = {"sec": "s", "secs": "s", "second": "s", "seconds": "s", "msec": "
                "minutes": "min", "hour": "h", "hours": "h", "usec": "us", "usecs": "us"}
 
 
+#: The step counter of a Lustre table (:mod:`.lustre`): the steps since the first, stopping at a bound.
+_STEP_BOUND = "\x01bound\x01"
+_STEP = f"($ < {_STEP_BOUND} and @ == $ + 1) or ($ >= {_STEP_BOUND} and @ == $)"
+
+
 class _States:
     """The state variables of one requirement, made as the writer asks."""
 
     def __init__(self, base: str) -> None:
         self.base = base
         self.made: list[NewState] = []
+        #: The last step a Lustre table of the requirement tells apart (its step counter stops there).
+        self.bound = 0
+
+    def finish(self, t: Translation) -> Translation:
+        """``t`` with its step counter (if a Lustre table made one) stopping at :attr:`bound`."""
+        t.states = [NewState(x.name, x.type_name, x.init, x.next.replace(_STEP_BOUND, str(self.bound)))
+                    for x in t.states]
+        return t
 
     def add(self, role: str, type_name: str, init: str, nxt: str) -> str:
         """Declare ``fret_<reqid>_<role>``; in ``nxt`` ``@`` is its next value, ``$`` its current one."""
@@ -158,13 +171,18 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
     an RCL statement over ``node`` (module table).  ``var(name, local)``
     places a variable (:class:`~.fretish.Writer`); ``step`` the plan's
     seconds per step for durations in seconds.  Raises :class:`Refusal`."""
+    states = _States(state_base(reqid))
+    return states.finish(_translate(fulltext, sem, node, var, step, states))
+
+
+def _translate(fulltext: str, sem: Mapping[str, Any], node: str, var: Callable[[str, bool], str | Expr],
+               step: Fraction | None, states: _States) -> Translation:
     scope = str((sem.get("scope") or {}).get("type", "null"))
     cond, timing = str(sem.get("condition") or "null"), str(sem.get("timing") or "null")
     if str(sem.get("response") or "satisfaction") != "satisfaction":
         raise Refusal(f"its response is {sem.get('response')!r}", "write the response as 'satisfy'")
     if timing not in SUPPORTED.get((scope, cond), ()):
-        return _compiled(scope, timing, fulltext, sem, node, var, step, state_base(reqid))
-    states = _States(state_base(reqid))
+        return _compiled(scope, timing, fulltext, sem, node, var, step, states)
     w = _writer(var, states, node)
 
     def field_expr(key: str, *alt: str) -> Expr:
@@ -197,7 +215,7 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
 
 
 def _compiled(scope: str, timing: str, fulltext: str, sem: Mapping[str, Any], node: str,
-              var: Callable[[str, bool], str | Expr], step: Fraction | None, base: str) -> Translation:
+              var: Callable[[str, bool], str | Expr], step: Fraction | None, states: _States) -> Translation:
     """A combination the module table does not write: FRET's own ``ptExpanded`` stated with state variables
     (:mod:`.pasttime`) when it is prefix-closed, else refused with the reason."""
     if scope not in CLOSED:
@@ -216,7 +234,6 @@ def _compiled(scope: str, timing: str, fulltext: str, sem: Mapping[str, Any], no
         if Fraction(str(raw)) != n:
             raise Refusal(f"FRET's formalisation counts its duration {raw} {m.group(2)} as {raw} steps, and the plan's "
                           f"step period makes it {n}", "write the duration in ticks")
-    states = _States(base)
     w = _writer(var, states, node)
     past = PastTime(states.add, node)
     w.temporal, past.writer = past, w
@@ -256,13 +273,32 @@ def _writer(var: Callable[[str, bool], str | Expr], states: _States, node: str) 
     """The :class:`~.fretish.Writer` of one requirement: its ``pre``, ``persisted``/``occurred`` and
     ``FTP`` state variables declared in ``states`` as the expressions ask for them."""
 
+    pending: dict[str, str] = {}
+    done: dict[str, str] = {}
+
     def pre(type_name: str, init: Expr, e: Expr) -> str:
-        init_text, body = w.rcl(init, True), w.rcl(e, True)  # an inner pre is declared first
-        if re.search(r"(?<![A-Za-z0-9_])(in|out|state)\.", init_text):
-            raise Refusal(f"a pre function's initial value {init_text} reads the component's variables",
-                          "give it a constant initial value (preReal(0.0, e))")
-        return states.add(f"pre{len(states.made) + 1}", type_name, init_text,
-                          f"@ <=> {body}" if type_name == "BOOL" else f"@ == {body}")
+        key = repr((type_name, init, e))
+        if key in done:  # the same pre read twice: one state variable
+            return done[key]
+        if key in pending:  # a pre of the variable being defined: its own value of the step before
+            return pending[key]
+        mark = pending[key] = f"\x00{len(states.made)}.{len(pending)}\x00"
+        init_text = w.rcl(init, True)
+        body = w.rcl(("bin", "<=>" if type_name == "BOOL" else "=", ("text", "@"), e), True)  # inner pres first
+        del pending[key]
+        body = body[1:-1] if body.startswith("(@ ") and body.endswith(")") else body
+        name = states.add(f"pre{len(states.made) + 1}", type_name, init_text, body)
+        if any(mark in x.next for x in states.made):
+            states.made[:] = [NewState(x.name, x.type_name, x.init, x.next.replace(mark, name)) for x in states.made]
+        done[key] = name
+        return name
+
+    def table(length: int, local: bool) -> str:
+        states.bound = max(states.bound, length - 1)
+        name = f"{states.base}_step"
+        if not any(x.name == name for x in states.made):
+            states.add("step", "NATURAL", "0", _STEP)
+        return f"state.{name}" if local else f"{node}.state.{name}"
 
     def count(kind: str, n: int, e: Expr) -> str:
         p = w.rcl(e, True)
@@ -279,7 +315,7 @@ def _writer(var: Callable[[str, bool], str | Expr], states: _States, node: str) 
         ftp = next((x.name for x in states.made if x.name == f"{states.base}_ftp"), None) or \
             states.add("ftp", "BOOL", "TRUE", "not @")  # FRET's first time point
         return f"state.{ftp}" if local else f"{node}.state.{ftp}"
-    w = Writer(placed, pre, node, count)
+    w = Writer(placed, pre, node, count, table=table)
     return w
 
 
