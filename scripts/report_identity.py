@@ -1,7 +1,8 @@
 """Whether a change to the report's code leaves its five files byte-identical on the bundled examples.
 
 The report's files (``assurance.html``, ``.md``, ``.json``, ``.sarif``,
-``.junit.xml``) are rendered in this process from verified copies of
+``.junit.xml``) and the summary ``verify`` prints from (``summary.json``, the
+sealed record's content without its seal) are rendered in this process from verified copies of
 ``examples/warehouse``, ``examples/delivery`` and ``examples/safety_stop``
 by the code of the working tree: the report built from the copy's
 artifacts (:func:`rclverify.report.build.build_report`) and rendered
@@ -33,7 +34,7 @@ EXAMPLES = ("warehouse", "delivery", "safety_stop")
 #: what a run writes in a workspace: left out of a copy
 GENERATED = ("artifacts", "reports", ".doit.db", ".doit.sqlite")
 #: the report's files, in the order printed
-FILES = ("assurance.html", "assurance.md", "assurance.json", "assurance.sarif", "assurance.junit.xml")
+FILES = ("assurance.html", "assurance.md", "assurance.json", "assurance.sarif", "assurance.junit.xml", "summary.json")
 
 
 def prepare(repo: Path, out: Path) -> int:
@@ -52,16 +53,18 @@ def prepare(repo: Path, out: Path) -> int:
 
 
 def texts(ws_root: Path) -> dict[str, str]:
-    """The five report files of the verified workspace ``ws_root``, rendered now (no kept pieces)."""
+    """The :data:`FILES` of the verified workspace ``ws_root``, rendered now (no kept pieces)."""
+    from rclverify.records.store import dumps
     from rclverify.report.build import build_report
     from rclverify.report.junit import render_junit
     from rclverify.report.render import render_html, render_json, render_markdown
     from rclverify.report.sarif import render_sarif
+    from rclverify.report.summary import summary_data
     from rclverify.stages.workspace import Workspace
     report = build_report(Workspace(ws_root))
     return {"assurance.html": render_html(report), "assurance.md": render_markdown(report),
             "assurance.json": render_json(report), "assurance.sarif": render_sarif(report),
-            "assurance.junit.xml": render_junit(report)}
+            "assurance.junit.xml": render_junit(report), "summary.json": dumps(summary_data(report))}
 
 
 def digest(out: Path, save: Path | None, compare: Path | None) -> int:
