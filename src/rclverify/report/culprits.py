@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Any, Iterable, Iterator, Mapping, Sequence, cast
 
 from rclverify.records.node_rows import CulpritOf
+from rclverify.records.problem_rows import ProblemRow
 from rclverify.records.records import SEVERITY, worst
 from rclverify.records.statuses import EvidenceStatus
 
@@ -20,9 +21,13 @@ def culprit_nodes(groups: Iterable[Any]) -> set[str]:
     screen blames the culprit, not its victims)."""
     out = set()
     for g in groups:
-        if not isinstance(g, Mapping):
+        if isinstance(g, ProblemRow):
+            culprits: Iterable[Any] = g.culprits
+        elif isinstance(g, Mapping):
+            culprits = g.get("culprits") or ()
+        else:
             continue  # a summary's problems are sentences, not groups
-        for c in g.get("culprits") or ():
+        for c in culprits:
             if not isinstance(c, Mapping):
                 continue
             kind, _, rest = str(c.get("id", "")).partition(":")

@@ -239,22 +239,21 @@ def strict_ok(rows: Sequence[Mapping[str, Any]]) -> bool:
     return all(r["verdict"] == "proved" and r.get("status", "discharged") == "discharged" for r in rows)
 
 
-def strict_reason(report: Report) -> list[str]:
-    """The clause ``verify --strict`` names for deadlines that are not
-    proved (``[]`` when every one is): "1 end-to-end deadline is refuted
-    (STOP)"."""
-    rows = list(report.get("deadlines") or ())
-    bad = [r for r in rows if r["verdict"] != "proved"]
+def strict_reason(rows: Sequence[DeadlineRow]) -> list[str]:
+    """The clause ``verify --strict`` names for the deadlines ``rows`` (the
+    report's ``deadlines``, decoded) that are not proved (``[]`` when every
+    one is): "1 end-to-end deadline is refuted (STOP)"."""
+    bad = [r for r in rows if r.verdict != "proved"]
     out = []
     if bad:
-        verdicts = sorted({str(r["verdict"]) for r in bad})
+        verdicts = sorted({r.verdict for r in bad})
         out.append(f"{len(bad)} end-to-end deadline{'s are' if len(bad) != 1 else ' is'} {' or '.join(verdicts)} ("
-                   + ", ".join(str(r["requirement"]) for r in bad[:4]) + (", ..." if len(bad) > 4 else "") + ")")
-    open_ = [r for r in rows if r["verdict"] == "proved" and r.get("status", "discharged") != "discharged"]
+                   + ", ".join(r.requirement for r in bad[:4]) + (", ..." if len(bad) > 4 else "") + ")")
+    open_ = [r for r in rows if r.verdict == "proved" and r.status not in (msgspec.UNSET, "discharged")]
     if open_:
         out.append(f"{len(open_)} end-to-end deadline{'s are' if len(open_) != 1 else ' is'} proved from a chain "
                    "whose evidence is outstanding (a hop unverified, or its deadline measured by no run: "
-                   + ", ".join(str(r["requirement"]) for r in open_[:4]) + (", ..." if len(open_) > 4 else "") + ")")
+                   + ", ".join(r.requirement for r in open_[:4]) + (", ..." if len(open_) > 4 else "") + ")")
     return out
 
 

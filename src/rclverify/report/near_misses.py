@@ -183,12 +183,12 @@ def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
     return closed(suite, counts)
 
 
-def strict_reason(report: Report) -> list[str]:
-    """The clause a failed ``--strict`` names for near misses (``[]`` without)."""
-    rows = list(report.get("near_misses") or ())
+def strict_reason(rows: Sequence[NearMissRow]) -> list[str]:
+    """The clause a failed ``--strict`` names for the near misses ``rows`` (the report's, decoded;
+    ``[]`` without)."""
     if not rows:
         return []
-    names = list(dict.fromkeys(f"{r['node']} guarantee {r['guarantee']}" for r in rows))
+    names = list(dict.fromkeys(f"{r.node} guarantee {r.guarantee}" for r in rows))
     return [f"{len(rows)} near miss{'es' if len(rows) != 1 else ''}: a margin under the plan's near_miss threshold ("
             + ", ".join(names[:4]) + (", ..." if len(names) > 4 else "") + ")"]
 

@@ -85,33 +85,32 @@ def blocks_strict(row: Mapping[str, Any] | None) -> bool:
     return row is not None and bool(row["counts"].get("error") or row.get("stale"))
 
 
-def strict_reason(report: Report) -> list[str]:
-    """The clause ``verify --strict`` names for the NoDL check (``[]`` when it passes)."""
-    row = report.get("nodl")
-    if not blocks_strict(row):
+def strict_reason(row: NodlRow | None) -> list[str]:
+    """The clause ``verify --strict`` names for the NoDL check ``row`` (the report's ``nodl``, decoded;
+    ``[]`` when it passes)."""
+    if row is None:
         return []
-    assert row is not None
-    n = int(row["counts"].get("error", 0))
+    n = int(row.counts.get("error", 0))
     out = [f"{n} NoDL error{'s' if n != 1 else ''} (`rclverify nodl check`)"] if n else []
-    return out + (["the NoDL check is stale"] if row.get("stale") else [])
+    return out + (["the NoDL check is stale"] if row.stale else [])
 
 
-def terminal_brief(row: Mapping[str, Any] | None) -> GroundingBrief | None:
-    """The NoDL check as the summary ``verify`` prints shows it, in the shape of the ROS grounding's
-    (report/summary.py): ``{"error": n, "warning": m, "errors": ["file:line:col: message [code]
-    (also at file:line:col, ...)", ...]}``, a stale record one more line; ``None`` for a workspace
-    without a document."""
+def terminal_brief(row: NodlRow | None) -> GroundingBrief | None:
+    """The NoDL check ``row`` (the report's ``nodl``, decoded) as the summary ``verify`` prints shows
+    it, in the shape of the ROS grounding's (report/summary.py): ``{"error": n, "warning": m,
+    "errors": ["file:line:col: message [code] (also at file:line:col, ...)", ...]}``, a stale record
+    one more line; ``None`` for a workspace without a document."""
     if row is None:
         return None
     errors: list[str] = []
-    for f in row["findings"]:
-        if f["severity"] == "error":
-            places = [_where(p) for p in f["places"]]
+    for f in row.findings:
+        if f.severity == "error":
+            places = [_at(p) for p in f.places]
             also = f" (also at {', '.join(places[1:])})" if len(places) > 1 else ""
-            errors.append(f"{places[0] + ': ' if places else ''}{f['message']} [{f['code']}]{also}")
-    if row.get("stale"):
-        errors.append(f"the NoDL check is stale: {row['stale']}")
-    return {"error": int(row["counts"].get("error", 0)), "warning": int(row["counts"].get("warning", 0)),
+            errors.append(f"{places[0] + ': ' if places else ''}{f.message} [{f.code}]{also}")
+    if row.stale:
+        errors.append(f"the NoDL check is stale: {row.stale}")
+    return {"error": int(row.counts.get("error", 0)), "warning": int(row.counts.get("warning", 0)),
             "errors": errors}
 
 

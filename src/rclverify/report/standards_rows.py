@@ -16,11 +16,12 @@ from __future__ import annotations
 
 from typing import Any, Collection, Mapping, Sequence, TypedDict
 
-from rclverify.records.report_schema import EvidenceJson, Report
+from rclverify.records.report_schema import EvidenceJson
 from rclverify.model.plan.standards.choice import StandardChoice
 from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
 from rclverify.model.plan.standards.profiles import Profile
-from rclverify.records.standards_rows import StandardRow
+from rclverify.records.row import decode_rows
+from rclverify.records.standards_rows import ProfileOrigin, StandardRow
 
 
 #: Where a profile comes from (``standards[].origin``) as its JSON object: the encoding of
@@ -45,17 +46,19 @@ def profile_origin(p: Profile) -> ProfileOriginJson:
             "edition": p.edition}
 
 
-def origin_text(origin: Mapping[str, Any]) -> str:
-    """``origin`` (a :class:`ProfileOrigin`) as one phrase: ``built-in profile`` or
+def origin_text(origin: ProfileOrigin | Mapping[str, Any]) -> str:
+    """``origin`` (a :class:`ProfileOrigin`, or its JSON object) as one phrase: ``built-in profile`` or
     ``workspace profile std/mine.yaml, sha256 <hex>``."""
-    if origin.get("kind") == "built-in":
+    kind, file, sha256 = ((origin.kind, origin.file, origin.sha256) if isinstance(origin, ProfileOrigin)
+                          else (origin.get("kind"), origin.get("file"), origin.get("sha256")))
+    if kind == "built-in":
         return "built-in profile"
-    return f"workspace profile {origin.get('file')}, sha256 {origin.get('sha256')}"
+    return f"workspace profile {file}, sha256 {sha256}"
 
 
-def _label(row: Mapping[str, Any]) -> str:
-    level = f" {str(row['level_name']).upper()} {row['level']}" if row.get("level") is not None else ""
-    return f"{row['edition']}{level}"
+def _label(row: StandardRow) -> str:
+    level = f" {row.level_name.upper()} {row.level}" if row.level is not None else ""
+    return f"{row.edition}{level}"
 
 
 def standards_part(choices: Sequence[StandardChoice],
@@ -78,49 +81,51 @@ def standards_part(choices: Sequence[StandardChoice],
     for c in choices:
         clauses = clause_rows(c.profile, c.level, report, c.clauses, unstated, c.people)
         missing = not_covered(clauses)
-        row = StandardRow.of({
+        record = StandardRow.of({
             "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,
             "level_name": c.profile.level_name, "level": c.level,
             "source": f"{c.loc.file}:{c.loc.line}:{c.loc.col}", "origin": profile_origin(c.profile),
             "clauses": clauses, "left_out": [{"id": i, "why": w} for i, w in c.profile.left_out],
             "open": [x["id"] for x in clauses if x["status"] == "open"],
             "counts": {s: sum(1 for x in clauses if x["status"] == s) for s in CLAUSE_STATUSES},
-            "required_not_covered": missing, "strict": c.strict}).to_json()
-        rows.append(row)
+            "required_not_covered": missing, "strict": c.strict})
+        rows.append(record.to_json())
         ok = ok and not (missing and c.strict)
         if missing:
-            problems.append(_missing_sentence(row, [x for x in clauses if x["id"] in missing]))
+            problems.append(_missing_sentence(record, [x for x in clauses if x["id"] in missing]))
     return {"rows": rows, "problems": problems, "ok": ok}
 
 
-def _missing_sentence(row: StandardJson, missing: Sequence[ClauseRow]) -> str:
+def _missing_sentence(row: StandardRow, missing: Sequence[ClauseRow]) -> str:
     """The summary's sentence for a standard's asked items not covered: each with
     its title and why (its clause row's ``why``), where the profile comes
     from, and where to read them."""
     items = "; ".join(f"{c['id']} {c['title'][:1].lower()}{c['title'][1:]} ({c['why']})" for c in missing)
-    return (f"Standard {_label(row)} ({origin_text(row['origin'])}): {len(missing)} {_asked(row)} "
+    return (f"Standard {_label(row)} ({origin_text(row.origin)}): {len(missing)} {_asked(row)} "
             f"item{'s' if len(missing) != 1 else ''} not covered: {items}; the report's section Safety "
             f"standards lists each item's scope and records")
 
 
-def _asked(row: Mapping[str, Any]) -> str:
+def _asked(row: StandardRow) -> str:
     """How the standard's asked items are called: highly recommended (a graded standard) or required."""
-    codes = {c["recommendation"] for c in row.get("clauses") or () if c["id"] in (row.get("required_not_covered") or ())}
+    codes = {c.recommendation for c in row.clauses if c.id in row.required_not_covered}
     return "highly recommended" if codes == {"HR"} else "required" if codes == {"required"} else "asked"
 
 
-def strict_reason(report: Report) -> list[str]:
-    """Why the chosen standards fail ``--strict`` on ``report``: one clause
-    per standard chosen with ``strict: true`` naming its asked items (``HR``
-    or ``required``) not covered (empty when none)."""
-    out = []
-    for row in report.get("standards") or ():
-        missing = list(row.get("required_not_covered") or ())
-        if missing and row.get("strict"):
-            out.append(f"{_label(row)}: {_asked(row)} item{'s' if len(missing) != 1 else ''} not covered ("
-                       + ", ".join(missing) + ")")
-    return out
+def strict_clauses(rows: Sequence[StandardRow]) -> list[str]:
+    """Why the chosen standards fail ``--strict``: one clause per standard
+    of ``rows`` (the report's ``standards``, decoded) chosen with ``strict:
+    true`` naming its asked items (``HR`` or ``required``) not covered
+    (empty when none)."""
+    return [f"{_label(row)}: {_asked(row)} item{'s' if len(row.required_not_covered) != 1 else ''} not covered ("
+            + ", ".join(row.required_not_covered) + ")" for row in rows if row.required_not_covered and row.strict]
+
+
+def strict_reason(report: Mapping[str, Any]) -> list[str]:
+    """:func:`strict_clauses` of ``report``'s ``standards`` (the report's JSON object, or a part of it
+    holding ``standards``), decoded into :class:`~rclverify.records.standards_rows.StandardRow`."""
+    return strict_clauses(decode_rows(StandardRow, report.get("standards") or ()))
 
 
 __all__ = ["ProfileOriginJson", "StandardJson", "StandardsPart", "origin_text", "profile_origin",
-           "standards_part", "strict_reason"]
+           "standards_part", "strict_clauses", "strict_reason"]

@@ -14,14 +14,17 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, Iterable, Literal, Mapping, Sequence, TypeGuard, TypeVar
+from typing import IO, TYPE_CHECKING, Any, Iterable, Literal, Mapping, Sequence, TypeVar
 
 if TYPE_CHECKING:  # rich is imported where a table is drawn: doit imports this module on every run
     from rich.table import Table
-from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import (ObligationJson, Report, SideConditionJson,
-                                             UnverifiedJson)
-from rclverify.report.shapes import GroundingBrief, NodeSummaryRow, SummaryData
+from rclverify.records.findings import FindingRow
+from rclverify.records.node_rows import UnverifiedRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.report.shapes import GroundingBrief, NodeSummaryRow, ProblemBrief, SummaryData
 from rclverify.records.records import SEVERITY
 from rclverify.report.strict import grounding_brief, strict_reasons
 
@@ -29,7 +32,7 @@ from rclverify.report.strict import grounding_brief, strict_reasons
 MAX_ROWS = 15
 
 #: A report row that names its node (an obligation, side condition, health finding, unverified guarantee).
-_Row = TypeVar("_Row", ObligationJson, SideConditionJson, UnverifiedJson)
+_Row = TypeVar("_Row", ObligationRow, SideConditionRow, UnverifiedRow, FindingRow)
 
 #: The counts of a node's summary row that a merged row sums.
 _Count = Literal["sc_proved", "sc_total", "health_problems", "health_open", "health_total", "health_warnings"]
@@ -42,8 +45,8 @@ def _rank(status: str) -> int:
     return SEVERITY.get(status, SEVERITY["error"])
 
 
-def node_rows(report: Report) -> list[NodeSummaryRow]:
-    """One row per node of ``report``: ``{"node", "status", "obligations"
+def node_rows(report: AssuranceReport) -> list[NodeSummaryRow]:
+    """One row per node of ``report`` (decoded once): ``{"node", "status", "obligations"
     (status -> count), "sc_proved", "sc_total", "health_problems",
     "health_open", "health_total", "health_warnings", "unverified" (``["g<k>"]``: the node's
     guarantees no obligation covers), "culprit" (its guarantee or contract is a problem's culprit,
@@ -52,30 +55,26 @@ def node_rows(report: Report) -> list[NodeSummaryRow]:
         # one pass per kind: a scan of every item per node was quadratic in the system size
         out: dict[str, list[_Row]] = {}
         for it in items:
-            out.setdefault(it["node"], []).append(it)
+            out.setdefault(it.node, []).append(it)
         return out
-    obligations, sides = by_node(report["obligations"]), by_node(report["side_conditions"])
-    findings: dict[str, list[FindingRow]] = {}
-    for f in rows_of(report["findings"]):
-        findings.setdefault(f.node, []).append(f)
-    unverified = by_node(list(report.get("unverified") or ()))
+    obligations, sides = by_node(report.obligations), by_node(report.side_conditions)
+    findings, unverified = by_node(report.findings), by_node(report.unverified)
     from rclverify.report.culprits import culprit_nodes  # deferred: start-up (loads rclverify.report.culprits only when called)
-    blamed = culprit_nodes(report.get("problems") or ())
+    blamed = culprit_nodes(report.problems)
     rows: list[NodeSummaryRow] = []
-    for k, n in enumerate(report["nodes"]):
-        name = n["name"]
+    for k, n in enumerate(report.nodes):
         obs: dict[str, int] = {}
-        for o in obligations.get(name, []):
-            obs[o["status"]] = obs.get(o["status"], 0) + 1
-        scs = sides.get(name, [])
-        fs = findings.get(name, [])
-        rows.append({"node": name, "status": n["status"], "obligations": obs, "order": k,
-                     "sc_proved": sum(sc["status"] == "discharged" for sc in scs), "sc_total": len(scs),
+        for o in obligations.get(n.name, []):
+            obs[o.status] = obs.get(o.status, 0) + 1
+        scs = sides.get(n.name, [])
+        fs = findings.get(n.name, [])
+        rows.append({"node": n.name, "status": n.status, "obligations": obs, "order": k,
+                     "sc_proved": sum(sc.status == "discharged" for sc in scs), "sc_total": len(scs),
                      "health_problems": sum(f.status in ("problem", "error") for f in fs),
                      "health_open": sum(f.status == "inconclusive" for f in fs), "health_total": len(fs),
                      "health_warnings": sum(f.status == "warning" for f in fs),
-                     "unverified": [f"g{u['guarantee']}" for u in unverified.get(name, [])],
-                     "culprit": name in blamed})
+                     "unverified": [f"g{u.guarantee}" for u in unverified.get(n.name, [])],
+                     "culprit": n.name in blamed})
     rows.sort(key=lambda r: (-_rank(r["status"]), r["order"]))
     return rows
 
@@ -127,9 +126,22 @@ def _culprit(c: Mapping[str, Any]) -> str:
     return f"{what} ({source})" if what and source else what or source or "?"
 
 
-def summary_data(report: Report) -> SummaryData:
-    """What ``doit verify`` prints at its end, taken from ``report``:
-    ``{"meta": {"workspace", "strict_ok"}, "summary": report["summary"],
+def _problem(g: ProblemRow) -> ProblemBrief:
+    """A problem row as the summary keeps it; a consequence says of what (one row per cause, its
+    consequences under it)."""
+    return {"status": g.status, "sentence": group_sentence(g), "culprits": [_culprit(c) for c in g.culprits],
+            "where": g.where,
+            "members": [m.id + (f" (a consequence of {', '.join(m.consequence_of)})" if m.consequence_of else "")
+                        for m in g.members],
+            "repairs": len(g.repairs)}
+
+
+def summary_data(report: AssuranceReport | Mapping[str, Any]) -> SummaryData:
+    """What ``doit verify`` prints at its end, taken from ``report`` (the
+    report, or its JSON object: decoded here once into
+    :class:`~rclverify.records.report_record.AssuranceReport`, which raises
+    :class:`msgspec.ValidationError` for a report of another shape):
+    ``{"meta": {"workspace", "strict_ok"}, "summary": the report's summary,
     "rows": node_rows(report), "requirements": [[id, verdict, status], ...],
     "problems": [{"status", "sentence", "culprits": ["what (file:line:col)"],
     "members": [finding ids], "repairs": int}, ...], "unverified", "deadlines",
@@ -137,35 +149,32 @@ def summary_data(report: Report) -> SummaryData:
     root cause, :mod:`rclverify.report.problems`).  The report task writes it next to the
     report (``artifacts/report/summary.json``), so ``verify`` reads a few
     kilobytes instead of the whole JSON report (6 MB at 1000 nodes)."""
-    return {"meta": {"workspace": report["meta"]["workspace"], "strict_ok": report["meta"]["strict_ok"]},
-            "summary": report["summary"], "rows": node_rows(report),
-            "unverified": [str(u["id"]) for u in report.get("unverified") or ()],
-            "requirements": [[r["id"], r.get("verdict", ""), r["status"]] for r in report.get("requirements", ())],
-            "deadlines": [[str(d.get("requirement", "?")), str(d.get("verdict", "")), str(d.get("total") or "?"),
-                           str(d.get("within") or "?"), str(d.get("evidence_status") or "")]
-                          for d in report.get("deadlines") or ()],
-            "problems": [{"status": g["status"], "sentence": group_sentence(g),
-                          "culprits": [_culprit(c) for c in g.get("culprits", [])], "where": g.get("where", ""),
-                          # a consequence says of what (one row per cause, its consequences under it)
-                          "members": [m["id"] + (f" (a consequence of {', '.join(m['consequence_of'])})"
-                                                 if m.get("consequence_of") else "") for m in g.get("members", [])],
-                          "repairs": len(g.get("repairs", []))}
-                         for g in report.get("problems", ())],
-            "grounding": grounding_brief(report.get("grounding")), "nodl": _nodl(report), "strict": strict_reasons(report),
-            # warnings answered in the plan (model/plan/acknowledged.py): named, so an accepted risk is never silent
-            "acknowledged": [f"{m} ({a['at']}: {a['reason']})" for a in report.get("acknowledgements") or ()
-                             if a.get("status") == "ok" for m in a.get("matched") or ()],
-            # guarantees held by less than the plan's near-miss threshold (report/near_misses.py)
-            "near_misses": _near_miss_lines(report)}
-
-
-def _near_miss_lines(report: Report) -> list[str]:
+    r = AssuranceReport.of(report)
     from rclverify.report.near_misses import summary_lines  # deferred: start-up (loads rclverify.report.near_misses only when called)
-    return summary_lines(report.get("near_misses") or ())
+    return {"meta": {"workspace": r.meta.workspace, "strict_ok": r.meta.strict_ok},
+            "summary": r.summary.to_json(), "rows": node_rows(r),
+            "unverified": [u.id for u in r.unverified],
+            "requirements": [[q.id, q.verdict, q.status] for q in r.requirements],
+            "deadlines": [[d.requirement, d.verdict, _text(d.total) or "?", d.within or "?", _text(d.evidence_status)]
+                          for d in r.deadlines],
+            "problems": [_problem(g) for g in r.problems],
+            "grounding": grounding_brief(r.grounding), "nodl": _nodl(r), "strict": strict_reasons(r),
+            # warnings answered in the plan (model/plan/acknowledged.py): named, so an accepted risk is never silent
+            "acknowledged": [f"{m} ({a.at}: {a.reason})" for a in r.acknowledgements if a.status == "ok"
+                             for m in a.matched],
+            # guarantees held by less than the plan's near-miss threshold (report/near_misses.py)
+            "near_misses": summary_lines(r.near_misses)}
 
 
-def group_sentence(group: Mapping[str, Any]) -> str:
-    """The first sentence of a problem group (its JSON object), whole (:func:`whole_sentence`)."""
+def _text(value: object) -> str:
+    """A text field that may be unset (``""``) as the summary's cell."""
+    return value if isinstance(value, str) else ""
+
+
+def group_sentence(group: ProblemRow | Mapping[str, Any]) -> str:
+    """The first sentence of a problem group (its row, or its JSON object), whole (:func:`whole_sentence`)."""
+    if isinstance(group, ProblemRow):
+        return whole_sentence(group.sentence, [m.sentence for m in group.members])
     return whole_sentence(str(group.get("sentence", "")), [str(m.get("sentence", "")) for m in group.get("members", [])])
 
 
@@ -182,13 +191,12 @@ def whole_sentence(short: str, members: Iterable[str]) -> str:
     return short
 
 
-def _nodl(report: Report) -> GroundingBrief | None:
+def _nodl(report: AssuranceReport) -> GroundingBrief | None:
     """The NoDL check as the terminal shows it (:func:`rclverify.report.nodl.terminal_brief`)."""
-    row = report.get("nodl")
-    if row is None:
+    if report.nodl is None:
         return None
     from rclverify.report.nodl import terminal_brief  # deferred: start-up (loads rclverify.report.nodl only when NoDL documents were checked)
-    return terminal_brief(row)
+    return terminal_brief(report.nodl)
 
 
 def status_text(data: SummaryData) -> list[str]:
@@ -224,25 +232,22 @@ def status_text(data: SummaryData) -> list[str]:
     return lines
 
 
-def _is_report(data: Report | SummaryData) -> TypeGuard[Report]:
-    """Whether ``data`` is a report (it has ``nodes``), not the summary made of one (:func:`summary_data`)."""
-    return "nodes" in data
-
-
-def summary_table(report: Report | SummaryData, colour: bool, rows: list[NodeSummaryRow] | None = None) -> Table:
-    """The summary table of ``report`` (at most :data:`MAX_ROWS` node rows +
-    total); ``rows`` are its :func:`node_rows` when already made."""
+def summary_table(report: AssuranceReport | SummaryData, colour: bool, rows: list[NodeSummaryRow] | None = None) -> Table:
+    """The summary table of ``report`` (the report decoded, or the summary made of one,
+    :func:`summary_data`; at most :data:`MAX_ROWS` node rows + total); ``rows`` are its
+    :func:`node_rows` when already made (a summary's must be given: ``KeyError`` otherwise)."""
     from rich import box  # deferred: start-up (loads rich only when called)
     from rich.markup import escape  # deferred: start-up (loads rich and more only when called)
     from rich.table import Table  # deferred: start-up (loads rich and more only when called)
     if rows is None:  # a summary's rows are given (print_last_run); a report is made into them
-        if not _is_report(report):
+        if not isinstance(report, AssuranceReport):
             raise KeyError("nodes")
         rows = node_rows(report)
+    workspace = report.meta.workspace if isinstance(report, AssuranceReport) else report["meta"]["workspace"]
     shown, rest = rows[:MAX_ROWS], rows[MAX_ROWS:]
     if rest:
         shown = shown + [_merge(rest, f"(+{len(rest)} more nodes)")]
-    table = Table(title=escape(f"rclverify: {report['meta']['workspace']}"), box=box.SIMPLE_HEAD if colour else box.ASCII,
+    table = Table(title=escape(f"rclverify: {workspace}"), box=box.SIMPLE_HEAD if colour else box.ASCII,
                   show_footer=True, title_justify="left")
     total = _merge(rows, "total")
     cols = [("node", total["node"]), ("status", total["status"]), ("obligations", _counts(total["obligations"], colour)),
@@ -271,7 +276,7 @@ def is_terminal() -> bool:
     return bool(out is not None and out.isatty())
 
 
-def print_summary(report: Report | SummaryData, report_path: str, file: IO[str] | None = None,
+def print_summary(report: AssuranceReport | SummaryData, report_path: str, file: IO[str] | None = None,
                   terminal: bool | None = None, rows: list[NodeSummaryRow] | None = None) -> None:
     """Print the summary table of ``report`` and the report's path to ``file``
     (default: the current ``sys.stdout``).  ``terminal`` (default
