@@ -7,30 +7,35 @@ from typing import Any
 
 from rclverify.app.progress import ProgressReporter, backend_of
 from rclverify.records.findings import HealthFinding
+from rclverify.records.report_record import AssuranceReport
 from rclverify.report.summary import MAX_ROWS, node_rows, print_summary
+
+from _typed_rows import complete
 
 
 def _report(n_nodes: int) -> dict[str, Any]:
+    """A report of ``n_nodes`` nodes, only the parts the summary counts given, completed into a whole one
+    (tests/records/_typed_rows.py: the summary reads the report decoded)."""
     nodes = [{"name": f"N{k}", "status": "failed" if k == 7 else "discharged"} for k in range(n_nodes)]
     obligations = [{"node": f"N{k}", "status": "failed" if k == 7 else "discharged"} for k in range(n_nodes)]
     obligations.append({"node": "N0", "status": "pending"})
     scs = [{"node": f"N{k}", "status": "discharged"} for k in range(1, n_nodes)]
     findings = [HealthFinding(f"{node}.consistent", node, "contract-consistent", None, status, "", "").to_json()
                 for node, status in (("N7", "problem"), ("N3", "inconclusive"), ("N1", "ok"))]
-    return {"meta": {"workspace": "w [x]"}, "nodes": nodes, "obligations": obligations, "side_conditions": scs,
-            "findings": findings}
+    return complete(AssuranceReport, {"meta": {"workspace": "w [x]"}, "nodes": nodes, "obligations": obligations,
+                                      "side_conditions": scs, "findings": findings})
 
 
 def test_summary_rows_put_the_worst_node_first() -> None:
-    rows = node_rows(_report(4))
+    rows = node_rows(AssuranceReport.of(_report(4)))
     assert [r["node"] for r in rows] == ["N0", "N1", "N2", "N3"]  # N0 pending ranks above discharged
-    rows = node_rows(_report(9))
+    rows = node_rows(AssuranceReport.of(_report(9)))
     assert rows[0]["node"] == "N7" and rows[0]["obligations"] == {"failed": 1} and rows[0]["health_problems"] == 1
 
 
 def test_plain_summary_fits_one_screen_and_has_no_escape_codes() -> None:
     out = io.StringIO()
-    print_summary(_report(40), "reports/assurance.html", file=out, terminal=False)
+    print_summary(AssuranceReport.of(_report(40)), "reports/assurance.html", file=out, terminal=False)
     text = out.getvalue()
     assert "\x1b[" not in text and "w [x]" in text
     lines = text.splitlines()
@@ -100,7 +105,8 @@ def test_verify_prints_the_summary_written_with_the_report(tmp_path: Any, capsys
     from rclverify.app.tasks import act_verify
     report = _report(3)
     report["meta"]["strict_ok"] = False
-    report["summary"] = {"status": "failed", "headline": "from the JSON report", "problems": ["N7 is bad"]}
+    report["summary"] = {**report["summary"], "status": "failed", "headline": "from the JSON report",
+                         "problems": ["N7 is bad"]}
     (tmp_path / "reports").mkdir()
     (tmp_path / "reports" / "assurance.json").write_text(json.dumps(report))
     # without the summary file (a report written by an earlier version): taken from the JSON report
