@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import shutil
 from pathlib import Path
+from typing import Any
 
 from rclverify.app.pipeline import stage_check, stage_requirements
 from rclverify.stages.workspace import Workspace
@@ -95,3 +96,50 @@ def test_an_edited_export_makes_its_requirement_stale_until_checked_again(tmp_pa
     clean = tmp_path / "clean"
     shutil.copytree(root, clean, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*"))
     assert {k: v for k, (v, _) in _verdicts(clean).items()} == {k: v for k, (v, _) in again.items()}
+
+
+def _compliance_ids(root: Path, export: dict[str, Any]) -> set[str]:
+    """The requirement ids the compliance matrix (``rclverify standards --csv``) names in its clause rows'
+    items of ``root``'s report; a FRET requirement's is its reqid.  An id that is neither ``export``'s nor
+    the plan's own fails the assertion at its row (``compliance matrix row N (clause C)``)."""
+    import re
+    from rclverify.report.build import undiagnosed_report
+    from rclverify.report.standards_sheets import matrix_rows
+    rows = matrix_rows(undiagnosed_report(Workspace(root, "contracts/plan.yaml")))
+    col, clause = rows[0].index("items in scope and their state"), rows[0].index("clause")
+    known = {r["reqid"] for r in export["requirements"]} | {"CAP"}
+    ids: set[str] = set()
+    for n, row in enumerate(rows[1:], start=2):
+        named = set(re.findall(r"(?:^|; )requirement (\S+):", row[col]))
+        unknown = named - known
+        assert not unknown, f"compliance matrix row {n} (clause {row[clause]}): {sorted(unknown)} not in the export"
+        ids |= named
+    return ids
+
+
+def test_the_compliance_matrix_names_the_export_reqids(tmp_path: Path) -> None:
+    """With a standard chosen (IEC 61508-3, SIL 2), the compliance matrix's clause rows about requirements
+    name each imported requirement by its reqid, and none that is not in the export or the plan; a
+    requirement removed from the export leaves every row; the control: checked against an export lacking
+    one reqid, the rows naming it fail at their row."""
+    root = tmp_path / "ws"
+    shutil.copytree(EXAMPLE, root, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*"))
+    plan = root / "contracts" / "plan.yaml"
+    plan.write_text(plan.read_text(encoding="utf-8") + "\nstandards:\n  - {profile: iec61508-3, sil: 2}\n",
+                    encoding="utf-8")
+    _verdicts(root)
+    data = json.loads((root / "fret" / "rover_requirements.json").read_text(encoding="utf-8"))
+    assert _compliance_ids(root, data) == {r["reqid"] for r in data["requirements"]} | {"CAP"}
+    short = {**data, "requirements": [r for r in data["requirements"] if r["reqid"] != "ROVER-009"]}
+    try:  # the control: checked against an export without ROVER-009, the rows naming it are errors
+        _compliance_ids(root, short)
+    except AssertionError as exc:
+        assert "['ROVER-009'] not in the export" in str(exc) and "compliance matrix row " in str(exc)
+    else:
+        raise AssertionError("a reqid not in the export was not found in the matrix")
+    removed = {**data, "requirements": [r for r in data["requirements"] if r["reqid"] != "ROVER-008"]}
+    edited = tmp_path / "rover.json"
+    edited.write_text(json.dumps(removed), encoding="utf-8")
+    assert import_fret(root, "contracts/plan.yaml", edited, "rover.json").removed == ["ROVER-008"]
+    _verdicts(root)
+    assert _compliance_ids(root, removed) == {r["reqid"] for r in removed["requirements"]} | {"CAP"}

@@ -168,7 +168,7 @@ def _verdicts(imp: Any, checked: Any, pt_text: str, traces: list[list[dict[str, 
 def test_lustre_internal_variables_read_as_fret_reads_them(case: Any, checked: Any) -> None:
     (imp,) = import_export(_export([case]), Options(components={"rover": "Rover"}))
     rng = random.Random(zlib.crc32(case[0].encode()))
-    got = _verdicts(imp, checked, case[-1], [_trace(rng) for _ in range(60)])
+    got = _verdicts(imp, checked, case[-1], [_trace(rng) for _ in range(40)])
     assert all(agree for _, agree in got)
     assert {fret for fret, _ in got} == {True, False}  # both verdicts met: the comparison can fail
 
