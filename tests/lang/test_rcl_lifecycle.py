@@ -26,7 +26,7 @@ def node(*items: str, topics: str = TOPICS) -> str:
             f"  assume( in.request >= 0 )\n  {body}\n}}\n")
 
 
-SCOPED = node("guarantee( out.level >= in.request ) while active",
+SCOPED = node("guarantee( out.level >= in.request ) while inactive or active",
               "G( out.level >= 0 ) triggered by in.request within 200 ms while inactive or active",
               "ready within 200 ms of activate", "ready within 1.5 s of configure")
 
@@ -40,7 +40,7 @@ def errors_of(text: str) -> list[str]:
 def test_scopes_and_transition_deadlines_are_read() -> None:
     n = parse_text(SCOPED, "f.rcl").nodes[0]
     g1, g2 = n.guarantees
-    assert g1.scope is not None and g1.scope.states == ("active",)
+    assert g1.scope is not None and g1.scope.states == ("inactive", "active")
     assert (g1.scope.loc.line, g1.scope.loc.col) == (7, 40)
     assert g2.scope is not None and g2.scope.states == ("inactive", "active")
     assert g2.deadline is not None and g2.trigger is not None  # the scope comes after the trigger and deadline
@@ -64,7 +64,7 @@ def test_an_unscoped_guarantee_keeps_its_meaning() -> None:
 def test_the_printer_round_trips_scopes_and_deadlines() -> None:
     spec = parse_text(SCOPED, "f.rcl")
     text = to_rcl(spec)
-    assert "guarantee( out.level >= in.request ) while active\n" in text
+    assert "guarantee( out.level >= in.request ) while inactive or active\n" in text
     assert "triggered by in.request within 200 ms while inactive or active\n" in text
     assert "  ready within 200 ms of activate\n  ready within 1.5 s of configure\n" in text
     assert parse_text(text, "f.rcl") == spec
@@ -132,3 +132,12 @@ def test_lint_names_an_unscoped_guarantee_of_a_lifecycle_node() -> None:
         "'while active' after it to say so, or the states it holds in"]
     plain = lint(parse_text(node("guarantee( out.level >= in.request )", topics=PLAIN), "f.rcl"))
     assert not [d for d in plain if d.code == "W-lifecycle-unscoped"]  # control: not a lifecycle node
+
+
+def test_the_guarantees_of_one_node_share_one_scope() -> None:
+    errs = errors_of(node("guarantee( out.level >= in.request )", "guarantee( out.level >= 0 ) while inactive or active"))
+    assert errs == ["f.rcl:8:31: error: guarantee 2 is judged while inactive or active, guarantee 1 while active: the "
+                    "guarantees of one lifecycle node share one scope (an unscoped one: while active), since the "
+                    "monitors ask a node's questions by its state"]
+    check([parse_text(node("guarantee( out.level >= in.request )", "guarantee( out.level >= 0 ) while active"),
+                      "f.rcl")])  # control: unscoped is while active

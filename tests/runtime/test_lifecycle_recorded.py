@@ -189,7 +189,7 @@ def test_rclverify_monitor_judges_a_managed_nodes_log_as_live(tmp_path: Path, ca
     out = capsys.readouterr().out
     assert f"{log}: Battery: discharged" in out and "lifecycle /battery: 6 transition(s) heard, last inactive; " \
            "3 output(s) judged, 0 outside active; deadlines: 1 met" in out, out
-    assert "no question (heard while its readers were not active): /request 8" in out
+    assert "no question (heard while its readers were outside their lifecycle scope: active): /request 8" in out
     # control: a deadline the activation (80 ms) does not meet; the node fails, the reason printed
     assert main(["monitor", "-w", str(ws), log, "--horizon", "1", "--transition-deadline", "Battery:activate=50ms"]) == 1
     out = capsys.readouterr().out
@@ -199,3 +199,65 @@ def test_rclverify_monitor_judges_a_managed_nodes_log_as_live(tmp_path: Path, ca
         assert main(["monitor", "-w", str(ws), log, "--transition-deadline", bad]) == 2
         err = capsys.readouterr().err
         assert said in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def _judge_rcl(tmp: Path, rcl: str, log: Path, deadlines: dict[str, dict[str, float]] | None = None) -> dict[str, Any]:
+    checked = check([parse_text(rcl, "sys.rcl")])
+    cfg = load_mapping(tmp, None, 1.0)
+    events, _ = read_run(log)
+    return judge_recorded(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, events,
+                          tmp / f"{log.stem}.scoped.jsonl", deadlines=deadlines)
+
+
+def test_a_guarantee_scoped_to_inactive_or_active_is_asked_while_inactive(tmp_path: Path) -> None:
+    """``while inactive or active``: the requests heard while the node is inactive are questions too, the
+    one of 9 at 1.0 s (answered 5) red beside the one at 2.5 s; ``while active`` is the unscoped meaning."""
+    log = _log(tmp_path, _script())
+    unscoped = _judge(tmp_path, log)
+    active = _judge_rcl(tmp_path, RCL.replace("in.request )\n}", "in.request ) while active\n}"), log)
+    wide = _judge_rcl(tmp_path, RCL.replace("in.request )\n}", "in.request ) while inactive or active\n}"), log)
+    for rec in (unscoped, active):  # the unscoped guarantee is judged while active
+        assert rec["lifecycle"]["not_questions"] == {"request": 9} and rec["nodes"][0]["counts"]["violated"] == 1
+        assert _node(rec)["scope"] == ["active"]
+    assert _node(wide)["scope"] == ["inactive", "active"]
+    # held back: the two requests before the node was configured (0.5, 0.75 s) and the one at 2.0 s, when it
+    # was activating; the 1.0 s one is asked (configured to inactive at 1.0 s), and so are those after 3.0 s
+    assert wide["lifecycle"]["not_questions"] == {"request": 3}, wide["lifecycle"]
+    assert wide["nodes"][0]["counts"]["violated"] == 2
+    # the outputs outside active are red whatever the scope: a managed node publishes only while active
+    assert _node(wide)["violations"] == _node(unscoped)["violations"]
+
+
+def test_a_transition_deadline_stated_in_rcl_is_judged(tmp_path: Path) -> None:
+    """``ready within 100 ms of activate`` met by the 80 ms activation, ``50 ms`` missed with the clause's
+    place; a ``--transition-deadline`` for the same transition replaces the contract's (control)."""
+    quiet = [x for x in TRAFFIC if x[1] == "request" or 2.1 <= x[0] <= 3.0]
+    log = _log(tmp_path, _script(traffic=quiet))
+    def within(bound: str) -> str:
+        return RCL.replace("in.request )\n}", f"in.request ) while active\n  ready within {bound} of activate\n}}")
+    met = _node(_judge_rcl(tmp_path, within("100 ms"), log))
+    [d] = met["deadlines"]
+    assert (d["status"], d["within"], d["stated"]) == ("met", 0.1, "sys.rcl:8:3") and met["status"] == "discharged"
+    rec = _judge_rcl(tmp_path, within("50 ms"), log)
+    [d] = _node(rec)["deadlines"]
+    assert (d["status"], d["within"], d["stated"]) == ("missed", 0.05, "sys.rcl:8:3")
+    assert rec["nodes"][0]["status"] == "failed" and "transition deadline(s) missed" in rec["nodes"][0]["explanation"]
+    [d] = _node(_judge_rcl(tmp_path, within("50 ms"), log, {"Battery": {"activate": 0.1}}))["deadlines"]
+    assert d["status"] == "met" and "stated" not in d
+    assert "deadlines" not in _node(_judge(tmp_path, log))  # control: no deadline stated, none judged
+
+
+def test_rclverify_monitor_prints_where_a_missed_deadline_is_stated(tmp_path: Path,
+                                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    from rclverify.cli.commands import main
+    ws = _workspace(tmp_path)
+    (ws / "contracts/b.rcl").write_text(RCL.replace("in.request )\n}", "in.request ) while active\n"
+                                                    "  ready within 50 ms of activate\n}"), encoding="utf-8")
+    quiet = [x for x in TRAFFIC if x[1] == "request" and x[2] == 1.0 or 2.1 <= x[0] <= 3.0 and x[1] == "level"]
+    log = str(_log(tmp_path, _script(traffic=quiet)))
+    assert main(["monitor", "-w", str(ws), log, "--horizon", "1"]) == 1
+    out = capsys.readouterr().out
+    assert "    missed: /battery's activate from 2.000 s reached active after 0.080 s (over its 0.05 s) (stated at " \
+           "contracts/b.rcl:8:3)\n" in out, out
+    assert main(["monitor", "-w", str(ws), log, "--horizon", "1", "--transition-deadline",
+                 "Battery:activate=100ms"]) == 0  # control: the command line's deadline replaces it

@@ -6,7 +6,9 @@ When a monitored node is managed (its contract names its ``lifecycle_msgs/Transi
 with its transition events (:func:`rclverify.traces.lifecycle_events.read_run`) and judged by
 :func:`judge_recorded`: the live run's gate and judge, the messages at their
 recorded times.  ``--transition-deadline NODE:TRANSITION=DURATION`` (repeatable; ``Battery:activate=200ms``,
-a duration in ``ms`` or ``s``, seconds when bare) bounds a managed node's transitions.
+a duration in ``ms`` or ``s``, seconds when bare) bounds a managed node's transitions, beside the
+deadlines its contract states (``ready within 200 ms of activate``), which it replaces for the same
+node and transition.
 
 Printed per trace and node: the node's status and explanation, then its lifecycle line (state,
 transitions heard, outputs judged, violations, deadlines met and missed) and the inputs held back as
@@ -59,10 +61,14 @@ def _lines(trace: str, rec: dict[str, Any]) -> list[str]:
             out.append(f"  lifecycle {m['ros_node']}: {m['transitions']} transition(s) heard, last {m['state']}; "
                        f"{m['outputs_judged']} output(s) judged, {len(m['violations'])} outside active"
                        + (f"; deadlines: {said}" if said else ""))
-            out += [f"    {t['status']}: {t['reason']}" for t in timed if t["status"] != "met"]
+            out += [f"    {t['status']}: {t['reason']}" + (f" (stated at {t['stated']})" if t.get("stated") else "")
+                    for t in timed if t["status"] != "met"]
     held = rec["lifecycle"]["not_questions"]
     if held:
-        out.append(f"{trace}: no question (heard while its readers were not active): "
+        scopes = sorted({s for n in rec["lifecycle"]["nodes"] for s in n["scope"]},
+                        key=["unconfigured", "inactive", "active", "finalized"].index)
+        out.append(f"{trace}: no question (heard while its readers were outside their lifecycle scope: "
+                   f"{' or '.join(scopes)}): "
                    + ", ".join(f"/{t} {k}" for t, k in held.items()))
     return out
 

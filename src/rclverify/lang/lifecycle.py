@@ -13,7 +13,8 @@ node's contract may
 
 The names follow the ROS 2 design article "Managed nodes" and ``lifecycle_msgs/msg/State`` and
 ``lifecycle_msgs/msg/Transition``.  The rules checked here (each violation a located diagnostic,
-nothing raised): the node is managed; each state and transition is known; a state is named once; a
+nothing raised): the node is managed; each state and transition is known; a state is named once;
+the guarantees of one node share one scope (an unscoped one's is :data:`DEFAULT_SCOPE`); a
 transition is bounded once; the bound has a unit of time, a positive amount.
 """
 from __future__ import annotations
@@ -78,6 +79,18 @@ def check_node(n: ast.Node, err: Report, seconds: Callable[[ast.Deadline], objec
         if twice:
             err(sc.loc, f"guarantee {k}: state {twice[0]} is named twice in its scope", "E-lifecycle")
             ok = False
+    if managed and n.guarantees:
+        first = scope_of(n, n.guarantees[0])
+        for k, cl in enumerate(n.guarantees[1:], 2):
+            mine = scope_of(n, cl)
+            if mine != first and ok:
+                err(cl.scope.loc if cl.scope is not None else cl.loc,
+                    f"guarantee {k} is judged while {' or '.join(mine or ())}, guarantee 1 while "
+                    f"{' or '.join(first or ())}: the guarantees of one lifecycle node share one scope (an "
+                    f"unscoped one: while active), since the monitors ask a node's questions by its state",
+                    "E-lifecycle")
+                ok = False
+                break
     seen: dict[str, ast.Loc] = {}
     for td in n.transitions:
         if not managed:

@@ -6,13 +6,16 @@ publishes each transition it completes on ``<node>/transition_event``
 ``start_state``, ``goal_state``, each state an ``id`` and a ``label``).  A contract declares its node managed by naming that topic with
 that type and no ``matches`` (``lifecycle_msgs/TransitionEvent battery/transition_event``: the node
 ``/battery``; under an instance's namespace the name resolves as every other, docs/plan.md
-"Instances"): :func:`managed_of`.  Its guarantees hold only while it is ``active``:
+"Instances"): :func:`managed_of`.  Its guarantees hold in their scope (``guarantee(...) while
+active``, one scope per node, an unscoped guarantee's ``active``: :func:`scope_ids`,
+:mod:`rclverify.lang.lifecycle`):
 
 * a managed node is ``unconfigured`` until its first transition event (every managed node starts
   so); its state then is the ``goal_state`` of its latest event, in force from the event's
   ``timestamp`` (the node's clock, seconds: on one machine the clock the monitor receives by);
-* an **input** heard while every monitored node reading it is managed and not ``active`` (the
-  latest event heard) is no question: it is held back from the guarantees' judge and counted;
+* an **input** heard while every monitored node reading it is managed and not in a state of its
+  scope (the latest event heard) is no question: it is held back from the guarantees' judge and
+  counted;
 * an **output** of a managed node published outside ``active`` violates the lifecycle contract:
   it is judged against the node's states within :attr:`LifecycleGate.skew` of its time (the
   time the live run places it at: its source time, else its receipt), and is red only when none
@@ -26,7 +29,8 @@ that type and no ``matches`` (``lifecycle_msgs/TransitionEvent battery/transitio
   run's "not judged" list reads); the guarantees' judge never sees them.
 
 * a **transition deadline** (``deadlines``, per managed node: transition -> seconds, e.g.
-  ``{"Battery": {"activate": 0.2}}``) bounds each of the node's transitions of that name from the
+  ``{"Battery": {"activate": 0.2}}``; the contract's ``ready within 200 ms of activate``,
+  :func:`stated_deadlines`, read by :func:`gate_of`, so a live run judges it) bounds each of the node's transitions of that name from the
   event into its transition state to the event into the state it leads to (:data:`TRANSITIONS`:
   ``activate`` from ``activating`` to ``active``): ``met`` within it, ``missed`` when the goal
   came later, the transition ended elsewhere (a failed ``on_activate``: ``inactive``, or
@@ -48,6 +52,8 @@ import bisect
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
+from rclverify.lang.lifecycle import DEFAULT_SCOPE, scope_of, transition_topic
+from rclverify.lang.timing import seconds
 from rclverify.lang.types import CheckedNode
 
 #: The message type a managed node publishes its transitions in.
@@ -77,19 +83,48 @@ def managed_of(nodes: Sequence[CheckedNode]) -> dict[str, str]:
     ``matches`` (module docstring; ``battery/transition_event`` -> ``/battery``)."""
     out: dict[str, str] = {}
     for n in nodes:
-        for t in n.node.topics:
-            if t.match is None and t.msg_type.replace("/msg/", "/") == "lifecycle_msgs/TransitionEvent" \
-                    and t.key.endswith("/transition_event"):
-                out.setdefault(n.name, "/" + t.key[: -len("/transition_event")])
+        t = transition_topic(n.node)
+        if t is not None:
+            out[n.name] = "/" + t.key[: -len("/transition_event")]
+    return out
+
+
+def scope_ids(node: CheckedNode) -> frozenset[int]:
+    """The state ids (:data:`STATES`) a managed node's questions are asked in: its guarantees' one scope
+    (``while active``; unscoped: ``active``; :func:`rclverify.lang.lifecycle.scope_of`, one per node by
+    the type checker's rule)."""
+    scope = next((scope_of(node.node, cl) for cl in node.node.guarantees), None) or DEFAULT_SCOPE
+    return frozenset(k for k, name in STATES.items() if name in scope)
+
+
+def stated_deadlines(nodes: Sequence[CheckedNode]) -> dict[str, dict[str, tuple[float, str]]]:
+    """The transition deadlines the contracts of ``nodes`` state (``ready within 200 ms of activate``):
+    ``{node: {transition: (seconds, "file:line:col")}}``."""
+    out: dict[str, dict[str, tuple[float, str]]] = {}
+    for n in nodes:
+        for td in n.node.transitions:
+            secs = seconds(td.deadline)
+            if secs is not None:
+                out.setdefault(n.name, {})[td.transition] = (float(secs), str(td.loc))
     return out
 
 
 def gate_of(nodes: Sequence[CheckedNode], deadlines: Mapping[str, Mapping[str, float]] | None = None
             ) -> "LifecycleGate | None":
-    """The lifecycle gate of a run monitoring ``nodes`` (with the transition ``deadlines``,
-    :class:`LifecycleGate`), ``None`` when none is managed."""
+    """The lifecycle gate of a run monitoring ``nodes``, ``None`` when none is managed: the transition
+    deadlines the contracts state (:func:`stated_deadlines`) and ``deadlines`` (per node, transition ->
+    seconds: the command line's, which replace a contract's for the same transition)
+    (:class:`LifecycleGate`)."""
     managed = managed_of(nodes)
-    return LifecycleGate(managed, nodes, deadlines=deadlines) if managed else None
+    if not managed:
+        return None
+    stated = stated_deadlines(nodes)
+    merged: dict[str, dict[str, float]] = {n: {t: v[0] for t, v in per.items()} for n, per in stated.items()}
+    for n, per in (deadlines or {}).items():
+        merged.setdefault(n, {}).update(per)
+    where = {n: {t: v[1] for t, v in per.items() if (deadlines or {}).get(n, {}).get(t) is None}
+             for n, per in stated.items()}
+    return LifecycleGate(managed, nodes, deadlines=merged, where=where)
 
 
 def _get(fields: Mapping[str, object], *path: str) -> object:
@@ -112,6 +147,7 @@ class _Managed:
     fqn: str
     outputs: set[str]
     inputs: set[str]
+    scope: frozenset[int] = frozenset({ACTIVE})
     times: list[float] = field(default_factory=lambda: [float("-inf")])
     states: list[int] = field(default_factory=lambda: [1])
     transitions: int = 0
@@ -131,13 +167,15 @@ class LifecycleGate:
     ``managed`` maps each managed node's contract name to its fully qualified ROS name; ``nodes``
     are the monitored nodes (their topics say which topics are a node's inputs and outputs).
     ``skew`` and ``settle`` in seconds; ``deadlines``: per managed node, transition name
-    (:data:`TRANSITIONS`) -> seconds (module docstring).  Raises :class:`ValueError` for a managed
+    (:data:`TRANSITIONS`) -> seconds (module docstring); ``where``: per node, transition -> the
+    contract clause stating that deadline (``file:line:col``, given in its rows as ``stated``).  Raises :class:`ValueError` for a managed
     node that is not monitored, a deadline of a node that is not managed, of an unknown transition
     or not a positive number.  Not thread safe: the live run calls it under its lock.
     """
 
     def __init__(self, managed: Mapping[str, str], nodes: Sequence[CheckedNode], *, skew: float = 0.05,
-                 settle: float = 0.5, deadlines: Mapping[str, Mapping[str, float]] | None = None) -> None:
+                 settle: float = 0.5, deadlines: Mapping[str, Mapping[str, float]] | None = None,
+                 where: Mapping[str, Mapping[str, str]] | None = None) -> None:
         by_name = {n.name: n for n in nodes}
         unknown = sorted(set(managed) - set(by_name))
         if unknown:
@@ -151,7 +189,9 @@ class LifecycleGate:
                     raise ValueError(f"{node}: no transition {name!r} (transitions: {', '.join(TRANSITIONS)})")
                 if isinstance(secs, bool) or not isinstance(secs, (int, float)) or not 0 < secs < float("inf"):
                     raise ValueError(f"{node}: the {name} deadline must be a positive number of seconds, not {secs!r}")
-        self.deadlines = {n: dict(per) for n, per in (deadlines or {}).items()}
+        self.deadlines = {n: dict(per) for n, per in (deadlines or {}).items() if per}
+        #: per node, transition -> the contract clause that states its deadline (``file:line:col``)
+        self.where = {n: dict(per) for n, per in (where or {}).items()}
         self.last = float("-inf")  # the latest time a message was heard (s): where the run ends
         self.skew, self.settle = skew, settle
         self.managed: dict[str, _Managed] = {}
@@ -165,7 +205,7 @@ class LifecycleGate:
             outs = {t.key for t in n.node.topics if t.match is not None
                     and (t.match.prefix == "out" or (t.match.prefix is None and t.match.name not in n.inputs))}
             ins = {t.key for t in n.node.topics if name in self.readers.get(t.key, ())}
-            self.managed[name] = _Managed(name, fqn, outs, ins)
+            self.managed[name] = _Managed(name, fqn, outs, ins, scope_ids(n))
         self.events = {event_topic(m.fqn): m for m in self.managed.values()}
         self.pending: list[tuple[float, str, _Managed]] = []  # (received, topic, node): outputs not yet decided
         self.violations: list[dict[str, Any]] = []
@@ -198,7 +238,7 @@ class LifecycleGate:
             if topic in m.outputs:
                 self.pending.append((received, topic, m))
         readers = self.readers.get(topic)
-        if readers and all(r in self.managed and self.managed[r].now() != ACTIVE for r in readers):
+        if readers and all(r in self.managed and self.managed[r].now() not in self.managed[r].scope for r in readers):
             self.not_questions[topic] = self.not_questions.get(topic, 0) + 1
             return False
         return True
@@ -237,7 +277,8 @@ class LifecycleGate:
                 if st != into or (k and m.states[k - 1] == into):
                     continue
                 end = next(((t2, s2) for t2, s2 in zip(m.times[k + 1:], m.states[k + 1:]) if s2 != into), None)
-                row: dict[str, Any] = {"transition": name, "start": t, "end": None, "seconds": None, "within": within}
+                row: dict[str, Any] = {"transition": name, "start": t, "end": None, "seconds": None, "within": within,
+                                       **({"stated": self.where[node][name]} if name in self.where.get(node, {}) else {})}
                 label = f"{m.fqn}'s {name} from {t:.3f} s"
                 if end is None:
                     late = self.last - t > within
@@ -273,6 +314,7 @@ class LifecycleGate:
             timed = self.transitions(m.node)
             missed = [t for t in timed if t["status"] == "missed"]
             nodes.append({"node": m.node, "ros_node": m.fqn, "state": self.state(m.node),
+                          "scope": [STATES[k] for k in sorted(m.scope)],
                           "transitions": m.transitions, "outputs_judged": m.judged, "violations": mine,
                           **({"deadlines": timed} if m.node in self.deadlines else {}),
                           "status": "failed" if mine or missed else "discharged" if m.judged else "inconclusive"})
@@ -289,4 +331,4 @@ class LifecycleGate:
 
 
 __all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITIONS", "TRANSITION_TYPE", "event_topic", "gate_of",
-           "managed_of"]
+           "managed_of", "scope_ids", "stated_deadlines"]
