@@ -305,7 +305,7 @@ def _attach_diagnoses(report: AssuranceReport, results: Sequence[SarifResult]) -
             _at_the_culprit(res, d)
         # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
         # a repair of the code is checked by the property tests (diagnosis/code_repair.py), not by Z3 alone
-        fixes = [sarif_fix(f"{r['summary']} {'The property tests show' if r['kind'] == 'code' else 'Z3 shows'}: "
+        fixes = [sarif_fix(f"{r['summary']} {_checker(r)} show{'' if _checker(r).endswith('tests') else 's'}: "
                            f"{r.get('proves') or 'the problem no longer follows'}; not shown: "
                            f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
                  for r in d.repairs if r.get("edit")]
@@ -337,6 +337,12 @@ def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
 def _descriptor(r: Rule) -> SarifDescriptor:
     return {"id": r.id, "name": r.name, "shortDescription": {"text": r.text},
             "defaultConfiguration": {"level": r.level}}
+
+
+def _checker(r: Mapping[str, Any]) -> str:
+    """What checked the repair ``r``: Z3, the property tests (a code repair), or what its ``checked_by`` names."""
+    by = str(r.get("checked_by") or "")
+    return "Z3" if r["kind"] != "code" else "The property tests" if "hypothesis" in by or not by else by[:1].upper() + by[1:]
 
 
 def sarif_log(report: Report | AssuranceReport) -> SarifLog:
