@@ -5,8 +5,10 @@ The node ``/battery`` publishes its ``level`` every 50 ms from a timer; a second
 every 100 ms.  Its contract names ``battery/transition_event``, so the monitor reads its transitions: it is
 configured (inactive) for 1 s, active for 1 s, deactivated for 1 s.  The correct node publishes through a
 lifecycle publisher, which is silent outside ``active``: no lifecycle violation, and the requests sent while
-it is inactive are no questions.  The defective node publishes through a plain publisher, whatever its
-state: its outputs while inactive are red, with their state; those while active are not."""
+it is inactive are no questions (its guarantee is scoped ``while active``).  The defective node publishes
+through a plain publisher, whatever its state: its outputs while inactive are red, with their state; those
+while active are not.  The contract states ``ready within 200 ms of activate``, judged live: the correct
+node activates in a few ms, the defective one sleeps 0.3 s in ``on_activate``."""
 from __future__ import annotations
 
 import json
@@ -27,7 +29,8 @@ node Battery {
   topics( std_msgs/Float64 request matches(in.request), std_msgs/Float64 level matches(out.level),
           lifecycle_msgs/TransitionEvent battery/transition_event )
   assume( in.request >= 0 )
-  guarantee( out.level >= in.request )
+  guarantee( out.level >= in.request ) while active
+  ready within 200 ms of activate
 }
 """
 
@@ -134,6 +137,21 @@ def test_a_plain_publisher_of_a_lifecycle_node_is_red_while_inactive_only(runs: 
     assert {v["state"] for v in node["violations"]} <= {"unconfigured", "inactive", "configuring"}, node
     assert node["outputs_judged"] > len(node["violations"]), node  # its outputs while active are not red
     assert all("/battery published on /level while" in v["reason"] for v in node["violations"])
+
+
+def test_the_stated_activation_deadline_is_judged_live(runs: dict[str, Any]) -> None:
+    """``ready within 200 ms of activate`` (the contract's line 8), judged by the live run: met by the node
+    that activates at once, missed by the one whose ``on_activate`` sleeps 0.3 s (a lower bound: the miss
+    does not depend on the machine's load); the live verdict fails the slow node, saying why."""
+    [quick] = _lifecycle(runs["correct"])["deadlines"]
+    assert (quick["transition"], quick["status"], quick["within"]) == ("activate", "met", 0.2), quick
+    assert quick["stated"].endswith("b.rcl:8:3") and quick["seconds"] < 0.2, quick
+    [slow] = _lifecycle(runs["defect"])["deadlines"]
+    assert slow["status"] == "missed" and slow["seconds"] >= 0.3 and slow["stated"].endswith("b.rcl:8:3"), slow
+    [res] = runs["defect"]["record"]["nodes"]
+    assert "1 transition deadline(s) missed (lifecycle)" in res["explanation"], res
+    [ok] = runs["correct"]["record"]["nodes"]
+    assert "transition deadline" not in ok["explanation"], ok  # control: the quick node's verdict says nothing of it
 
 
 def _bag(run: dict[str, Any]) -> tuple[list[Any], list[Any]]:
