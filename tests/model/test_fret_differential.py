@@ -176,13 +176,13 @@ def _pt_parse(text: str) -> Any:
             return ("const", t == "TRUE")
         if t[0].isdigit():
             return ("const", Fraction(t))
-        if peek() == "(":  # preReal(init, e): FRET's pt keeps Lustre's "init -> pre e" as a call
+        if peek() == "(":  # preReal(init, e): FRET's pt keeps Lustre's "init -> pre e" as a call; maxReal(a, b)
             take()
             init = level(0)
             assert take() == ","
             e = level(0)
             assert take() == ")"
-            return ("pre", init, e)
+            return (t[:3] if t[:3] in ("max", "min") else "pre", init, e)
         return ("var", t)
     e = level(0)
     assert peek() is None, text
@@ -199,6 +199,8 @@ def _pt(e: Any, tr: list[dict[str, Any]], i: int) -> Any:
         return not _pt(e[1], tr, i)
     if op == "pre":
         return _pt(e[1], tr, i) if i == 0 else _pt(e[2], tr, i - 1)
+    if op in ("max", "min"):  # FRET's maxReal/minReal (its field guide, "builtin functions")
+        return (max if op == "max" else min)(_pt(e[1], tr, i), _pt(e[2], tr, i))
     if op == "+" or op == "-" or op == "*" or op == "/":
         a, b = _pt(e[1], tr, i), _pt(e[2], tr, i)
         return {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else None}[op]

@@ -86,6 +86,8 @@ CASES: list[tuple[str, str, str, str, str | None, str, dict[str, Any], str]] = [
      "(H ((preReal(speed,speed) < speed) -> braking))"),
     ("L-IN-MODE", "in", "null", "always", None, "(speed <= held)", {"scope_mode": "manual"},
      "(H (manual -> (speed <= held)))"),
+    ("F-MAX-MIN", "null", "null", "always", None, "(maxReal(speed, asked) - minReal(speed, last) <= 2.0)", {},
+     "(H ((maxReal(speed,asked) - minReal(speed,last)) <= 2.0))"),
 ]
 
 

@@ -18,6 +18,9 @@ FRETish                RCL
 ``FTP``                the first step: a state variable true only there
 ``a = b``              ``a == b``
 ``absReal(e)``, ``absInt(e)``, ``abs(e)``  ``abs(e)``
+``maxReal(a, b)``      ``ite(a >= b, a, b)`` (``maxInt`` the same; ``minReal``,
+                       ``minInt`` with ``<=``), stated case by case where a
+                       formula reads it (:func:`lift`)
 ``preBool(i, e)``, ``preReal(i, e)``, ``preInt(i, e)``  a state variable
                        holding ``e`` of the step before, ``i`` at the first
                        step (FRET's field guide, "builtin functions": Lustre's
@@ -52,6 +55,8 @@ _COMPARE = ("=", "!=", "~=", "<", "<=", ">", ">=")
 _RCL_OP = {"<=>": "<=>", "<->": "<=>", "=>": "->", "->": "->", "|": "or", "&": "and", "=": "==", "!=": "!=",
            "~=": "!=", "<": "<", "<=": "<=", ">": ">", ">=": ">=", "+": "+", "-": "-", "*": "*", "/": "/"}
 ABS = ("absReal", "absInt", "abs")
+#: FRET's maxReal/maxInt and minReal/minInt (FRET's field guide, "builtin functions"): the comparison choosing a.
+EXTREMA = {"maxReal": ">=", "maxInt": ">=", "minReal": "<=", "minInt": "<="}
 PRE = {"preBool": "BOOL", "preReal": "REAL", "preInt": "INTEGER"}
 
 
@@ -259,6 +264,9 @@ class Writer:
         assert isinstance(args, tuple)
         if name in ABS and len(args) == 1:
             return ("call", "abs", (self.resolve(args[0], local),))
+        if name in EXTREMA and len(args) == 2:  # FRET's maxReal(a, b): if a >= b then a else b
+            a, b = (self.resolve(x, local) for x in args)
+            return ("ite", ("bin", EXTREMA[name], a, b), a, b)
         if name in PRE and len(args) == 2:
             init = args[0]
             if not _constant(init):  # Lustre's i -> pre e: i at the first step, FRET's FTP
@@ -277,7 +285,8 @@ class Writer:
             return ("bin", "&", p, ("bin", ">=", ref, n)) if name == "persisted" else ("bin", "|", p, ("bin", "<=", ref, n))
         raise Refusal(f"it calls the FRET function {name}({', '.join('_' for _ in args)}), which has no RCL "
                       "counterpart", f"write {name} as an RCL formula over the component's inputs and outputs"
-                                     " (rclverify translates absReal, absInt, preBool, preReal, preInt, persisted and occurred)")
+                                     " (rclverify translates absReal, absInt, maxReal, maxInt, minReal, minInt, preBool,"
+                                     " preReal, preInt, persisted and occurred)")
 
 
 def _constant(e: Expr) -> bool:
