@@ -82,4 +82,36 @@ def monitor_repairs(ws: Any, node: str, data: Mapping[str, Any], monitoring: Map
     return MonitorRepairs(why=f"{impl} re-run on {trace}: {got.why}", line=got.line)
 
 
-__all__ = ["MonitorRepairs", "entry_of", "is_call_violation", "monitor_repairs"]
+def rejudged_applied(ws: Any, diagnosis: Mapping[str, Any], repair: Mapping[str, Any],
+                     python: Path | None) -> list[tuple[str, str]]:
+    """After a repair of a monitored violation was written (``rclverify repair --apply``): the run of
+    ``diagnosis`` (a ``monitor`` record, its obligation's id; ``repair`` the one written, whose ``cost`` says
+    whether the node's calls or its topics failed) judged again with the node re-run from its
+    implementation file as it now reads, as the repair was checked (:func:`rclverify.diagnosis.run_repair.rejudged`):
+    ``[(obligation id, the node's status on the re-judged run)]``; ``[]`` when the obligation names no
+    implementation or there is no ROS 2 Python ``python``.  The evidence itself is the recorded run's until the
+    run is recorded again.  Raises :class:`rclverify.diagnosis.rerun.RerunError` when the file no longer answers
+    the run's questions, ``OSError`` when it cannot be read."""
+    from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (the monitors)
+    from rclverify.diagnosis.run_repair import rejudged  # deferred: start-up (the property tests' search)
+    from rclverify.records.sealed import obligation_list  # deferred: start-up (the records)
+    oid, node = str(diagnosis.get("id")), str(diagnosis.get("node"))
+    records, _ = obligation_list(ws.path(ws.obligations(node)))
+    data = next((dict(o.get("data") or {}) for o in records or [] if isinstance(o, dict) and o.get("id") == oid), {})
+    impl = str(data.get("implementation") or "")
+    if not impl or python is None:
+        return []
+    source, _, factory = impl.rpartition(":")
+    entry = entry_of(ws, node, data)
+    c = entry.config if entry is not None else {}
+    cfg = load_mapping(ws.root, data.get("mapping"), c.get("horizon"), c.get("traces", ()), c.get("tolerance"))
+    text = ws.path(source).read_text(encoding="utf-8")
+    calls = any(str(c.get("check")) == f"{node} calls" and c.get("before") == "failed" for c in repair.get("cost") or [])
+    got = rejudged(Path(ws.root), ws.checked, cfg, ws.path(str(data.get("trace"))), node, calls, source, text,
+                   factory, [], python)
+    mine = [v for k, v in got.items() if k == node or k.startswith(node + " ")]
+    bad = any(v[0] == "failed" or dict(v[1]).get("false", 0) > 0 for v in mine)
+    return [(oid, "failed" if bad else got[f"{node} calls" if calls else node][0])] if mine else []
+
+
+__all__ = ["MonitorRepairs", "entry_of", "is_call_violation", "monitor_repairs", "rejudged_applied"]
