@@ -41,7 +41,9 @@ def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, 
       checks name (:func:`~rclverify.app.pipeline.stage_compose`);
     * a health finding: the node's health checks (:func:`~rclverify.app.pipeline.health_findings`);
     * a requirement: the requirements stage; a deadline: the deadlines stage;
-    * a unit mismatch: the side conditions it explains (``joins``).
+    * a unit mismatch: the side conditions it explains (``joins``);
+    * a monitored violation: its recorded run judged again with the node re-run from the edited file
+      (:func:`~rclverify.diagnosis.monitor_repair.rejudged_applied`; the evidence stays the recorded run's).
 
     ``[]`` for a kind none of these produced.  Raises ``RclError`` when the edited contracts or plan do
     not check (a located error)."""
@@ -49,6 +51,10 @@ def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, 
     from rclverify.diagnosis.apply_repair import obligation_checks  # deferred: start-up (loads z3)
     did, kind, node = str(diagnosis.get("id")), str(diagnosis.get("kind")), str(diagnosis.get("node"))
     evidence = obligation_checks(diagnosis, repair)
+    if kind == "monitor":  # the recorded run judged again with the node re-run from the edited file
+        from rclverify.diagnosis.monitor_repair import rejudged_applied  # deferred: start-up (the re-run)
+        from rclverify.runtime.rclpy_source.python import ros2_python  # deferred: start-up (as above)
+        return rejudged_applied(ws, diagnosis, repair, ros2_python())
     if evidence:
         return [(oid, str(pipeline.stage_run(ws, oid.split(".", 1)[0], oid).status)) for oid in evidence]
     pipeline.stage_check(ws)
@@ -142,6 +148,10 @@ def cmd_repair(args: argparse.Namespace) -> int:
     if bad:
         print(f"the edit is written but {', '.join(bad)} still do{'es' if len(bad) == 1 else ''} not pass")
         return 1
+    if chosen.diagnosis.get("kind") == "monitor":
+        print("the recorded run passes with the node re-run from the edited file; its evidence stays the recorded "
+              "run's until the run is recorded again")
+        return 0
     print("every check run again passes; `doit verify` brings the report up to date")
     return 0
 
