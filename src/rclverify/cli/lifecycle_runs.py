@@ -2,7 +2,7 @@
 (docs/monitors.md, "Lifecycle nodes in a recorded run").
 
 When a monitored node is managed (its contract names its ``lifecycle_msgs/TransitionEvent
-<node>/transition_event`` topic, :func:`rclverify.runtime.lifecycle.managed_of`), each trace is read
+<node>/transition_event`` topic, :func:`rclverify.backends.monitors.lifecycle.managed_of`), each trace is read
 with its transition events (:func:`rclverify.traces.lifecycle_events.read_run`) and judged by
 :func:`judge_recorded`: the live run's gate and judge, the messages at their
 recorded times.  ``--transition-deadline NODE:TRANSITION=DURATION`` (repeatable; ``Battery:activate=200ms``,
@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
 from rclverify.lang.types import CheckedNode
-from rclverify.runtime.lifecycle import TRANSITION_TYPE, gate_of
+from rclverify.backends.monitors.lifecycle import TRANSITION_TYPE, gate_of
 from rclverify.runtime.live import LiveRun
 
 _DEADLINE = re.compile(r"^([A-Za-z_]\w*):([a-z]+)=([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(ms|s)?$")
@@ -78,10 +78,10 @@ def judge_recorded(checked: Any, nodes: Sequence[CheckedNode], rules: Any, horiz
                    evidence: Path | None = None) -> dict[str, Any]:
     """A recorded run's ``events`` (:class:`rclverify.traces.events.Event`, in the order read: a
     bag's or a log's, :func:`rclverify.traces.lifecycle_events.read_run`) judged as the live run
-    judges them (:mod:`rclverify.runtime.lifecycle`): each pushed to a :class:`rclverify.runtime.live.LiveRun` of
+    judges them (:mod:`rclverify.backends.monitors.lifecycle`): each pushed to a :class:`rclverify.runtime.live.LiveRun` of
     ``nodes`` (``rules``, ``horizon`` s: the monitor configuration's) at its recorded time, through
     the lifecycle gate of ``nodes`` with ``deadlines``
-    (:class:`rclverify.runtime.lifecycle.LifecycleGate`); the run's log written to ``log``.  Returns
+    (:class:`rclverify.backends.monitors.lifecycle.LifecycleGate`); the run's log written to ``log``.  Returns
     the run's record (``nodes``, ``lifecycle``; written to ``evidence`` when given).  Raises
     :class:`ValueError` when no node of ``nodes`` is managed, or for a deadline the gate refuses."""
     gate = gate_of(nodes, deadlines)

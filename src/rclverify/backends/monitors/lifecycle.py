@@ -1,4 +1,5 @@
-"""Managed (lifecycle) nodes judged by their state (docs/monitors.md, "Lifecycle nodes").
+"""Managed (lifecycle) nodes judged by their state (docs/monitors.md, "Lifecycle nodes"): the gate a live run, a
+recorded run (``rclverify monitor TRACE``) and the pipeline's monitors backend ask.
 
 A managed node (ROS 2 design, "Managed nodes"; ``rclcpp_lifecycle``, ``rclpy.lifecycle``)
 publishes each transition it completes on ``<node>/transition_event``
@@ -50,7 +51,7 @@ from __future__ import annotations
 
 import bisect
 from dataclasses import dataclass, field
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 from rclverify.lang.lifecycle import DEFAULT_SCOPE, scope_of, transition_topic
 from rclverify.lang.timing import seconds
@@ -260,6 +261,15 @@ class LifecycleGate:
                                                   f"not active: its guarantees hold only while active"})
         self.pending = keep
 
+    def counted(self, heard: Mapping[str, int]) -> dict[str, int]:
+        """``heard`` (messages per topic key the judge was fed) with the messages the gate kept from
+        it: the transition events and the inputs held back as no question, each heard."""
+        out = dict(heard)
+        for extra in (self.heard, self.not_questions):
+            for topic, k in extra.items():
+                out[topic] = out.get(topic, 0) + k
+        return out
+
     def state(self, node: str) -> str:
         """The latest state heard of managed node ``node`` (its contract's name), in words."""
         s = self.managed[node].now()
@@ -330,5 +340,26 @@ class LifecycleGate:
                 "nodes": nodes}
 
 
+def gated(events: Iterable[Any], gate: LifecycleGate) -> Iterator[Any]:
+    """The events of a recorded run (:class:`rclverify.traces.events.Event`, in the order read) the
+    ``gate`` admits, each asked at its recorded time: the pipeline's monitors backend judges a managed
+    node's run through the gate the live run asks (docs/monitors.md, "Lifecycle nodes in the
+    pipeline")."""
+    for ev in events:
+        if gate.admit(ev.topic, ev.fields, ev.time):
+            yield ev
+
+
+def with_lifecycle(gate: LifecycleGate, node: str, status: str, explanation: str
+                   ) -> tuple[str, str, dict[str, Any]]:
+    """A recorded run's verdict on managed node ``node`` (``status``, ``explanation``: the untimed
+    check's) combined with its lifecycle record (:meth:`LifecycleGate.record`): ``failed``, its
+    explanation first saying why, for an output outside ``active`` or a missed transition
+    deadline; returns ``(status, explanation, record)``."""
+    entry: dict[str, Any] = {"node": node, "status": status, "explanation": explanation}
+    record = gate.record([entry])
+    return str(entry["status"]), str(entry["explanation"]), record
+
+
 __all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITIONS", "TRANSITION_TYPE", "event_topic", "gate_of",
-           "managed_of", "scope_ids", "stated_deadlines"]
+           "gated", "managed_of", "scope_ids", "stated_deadlines", "with_lifecycle"]
