@@ -42,6 +42,7 @@ from rclverify.backends.monitors.deadline_text import deadline_status
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
 from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judged
+from rclverify.backends.monitors.lifecycle import gate_of, gated, with_lifecycle
 from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
@@ -237,6 +238,8 @@ class MonitorsBackend:
                                      cfg.tolerance, duration_s=span.seconds)
         status, explanation = verdict_status(res, trace)
         extra: dict[str, Any] = {}
+        if read.gate is not None:  # a managed node: judged in its lifecycle scope, as live (lifecycle.py)
+            status, explanation, extra["lifecycle"] = with_lifecycle(read.gate, res.node, status, explanation)
         finished = beside.finish()
         for name in ("deadlines", "periods", "declarations"):  # as above: the record's error, never a crash
             err = beside.errors.get(name)
@@ -264,7 +267,8 @@ class MonitorsBackend:
             extra.update(cpart)
         dl = finished.get("deadlines")
         # silence is never green: what the run did not judge, with the reason, beside the status
-        extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
+        fed = {**heard, **calls.messages}  # and a managed node's messages its lifecycle gate kept (lifecycle.py)
+        extra["not_judged"] = items = not_judged([target.node], Heard(read.gate.counted(fed) if read.gate else fed,
                                                                       dict(calls.orphans),
                                                                       unseen=unseen_links(read.origin)),
                                                  {res.node: [(status, explanation)]},
@@ -300,6 +304,7 @@ class _Read:
     summary: dict[str, Any] | None
     bag: BagCalls | None = None
     origin: RunSource | None = None
+    gate: Any = None
 
 
 def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None) -> _Read:
@@ -332,10 +337,13 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
         source = in_stamp_order(source, lag)
     inner = bag.tap(source) if bag is not None else calls.tap(source) if calls.active else source
     origin = RunOrigin()  # the source and middleware a live log says it was heard through (run_origin.py)
+    gate = gate_of([node])  # a managed node's messages judged in its lifecycle scope, as live (lifecycle.py)
+    if gate is not None:
+        inner = gated(inner, gate)
     events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(origin.tap(inner))), heard,
                                                                   watch), cfg.rules, cfg.horizon,
                                   tolerance=cfg.tolerance, margins=True)
-    return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag, origin.origin)
+    return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag, origin.origin, gate)
 
 
 class _Beside:
