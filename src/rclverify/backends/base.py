@@ -54,7 +54,10 @@ class NodeTarget:
     ``mapping``         the workspace-relative trace mapping file the plan names
                         for this entry (:func:`~rclverify.model.plan.mapping_file.plan_mapping`;
                         ``None``: none, the default path if present), where every
-                        backend reads what a field carries.
+                        backend reads what a field carries;
+    ``instances``       the nodes the plan runs this contract as
+                        (:class:`~rclverify.model.plan.instances.Instance`; empty: it
+                        runs once, as written), which the monitors judge one by one.
     """
 
     root: Path
@@ -68,6 +71,7 @@ class NodeTarget:
     index: int = 0
     plan_locs: Mapping[tuple[Any, ...], ast.Loc] = field(default_factory=dict)
     mapping: str | None = None
+    instances: tuple[Any, ...] = ()
 
     def config_loc(self, *path: Any, key: bool = False) -> ast.Loc:
         """Where ``nodes.<Node>.evidence[index].<path...>`` is written in the plan.

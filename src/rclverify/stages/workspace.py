@@ -273,7 +273,8 @@ class Workspace:
             root=self.root.resolve(), checked=self.checked, node=self.checked.nodes[node], config=entry.config,
             facts=tuple(f.expr for f in self.plan.facts.get(node, ())), contract_files=self.plan.contracts,
             plan_file=self.plan.file, artifacts=(self.root / "artifacts" / entry.backend / node).resolve(), index=index,
-            plan_locs=self.plan.locs, mapping=plan_mapping(self.plan, node, entry.config))
+            plan_locs=self.plan.locs, mapping=plan_mapping(self.plan, node, entry.config),
+            instances=tuple(self.plan.node_instances.get(node, ())))
 
 
 #: The report's files under ``reports/`` in two parts, each written by a doit task of its own
