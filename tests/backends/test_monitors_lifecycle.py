@@ -5,6 +5,7 @@ outside ``active`` are red, a transition deadline stated in RCL is judged.  Each
 run, the contract not naming its transition topic (a plain node), judged as before."""
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 from typing import Any
@@ -99,3 +100,50 @@ def test_the_transition_topic_counts_as_heard(tmp_path: Path) -> None:
     bare = _evidence(tmp_path, RCL.replace("50 ms", "100 ms"), "bare.jsonl")
     assert [i["name"] for i in bare.details["not_judged"]] == ["/battery/transition_event"]
     assert bare.status == "failed" and "while unconfigured" in bare.explanation
+
+
+def _fleet_log(tmp: Path) -> str:
+    """One run of two robots: /r1's battery as in :func:`_run` (answering only while active), /r2's the
+    same but answering while inactive too, every name under the robot's namespace."""
+    rows: list[str] = []
+    for ns, answer_inactive in (("/r1", False), ("/r2", True)):
+        for ln in (tmp / _run(tmp, answer_inactive)).read_text().splitlines():
+            row = json.loads(ln)
+            row["topic"] = f"{ns}/{row['topic']}"
+            rows.append(json.dumps(row))
+    (tmp / "fleet.jsonl").write_text("\n".join(sorted(rows, key=lambda r: json.loads(r)["time"])) + "\n",
+                                     encoding="utf-8")
+    return "fleet.jsonl"
+
+
+def test_a_fleets_run_is_judged_per_instance(tmp_path: Path) -> None:
+    """``instances: {Battery: [/r1, /r2]}``: each trace is one obligation per instance, judged on that
+    instance's names and lifecycle states; the control is the same run judged for the contract as written
+    (its root-namespace names): nothing of it is heard."""
+    from rclverify.model.plan.instances import Instance
+    trace = _fleet_log(tmp_path)
+    rcl = RCL.replace("50 ms", "100 ms")
+    (tmp_path / "contracts").mkdir(exist_ok=True)
+    (tmp_path / "contracts/b.rcl").write_text(rcl, encoding="utf-8")
+    checked = check([parse_text(rcl, "contracts/b.rcl")])
+    fleet = tuple(Instance("Battery", ns, "battery", f"Battery_{ns[1:]}") for ns in ("/r1", "/r2"))
+    t = NodeTarget(root=tmp_path, checked=checked, node=checked.nodes["Battery"],
+                   config={"backend": "monitors", "horizon": 1.0, "traces": [trace]},
+                   contract_files=("contracts/b.rcl",), plan_file="contracts/plan.yaml",
+                   artifacts=tmp_path / "artifacts" / "monitors" / "Battery", instances=fleet)
+    obs = MonitorsBackend().export(t)
+    assert [o.id for o in obs] == ["Battery.g0.monitors.fleet_jsonl_Battery_r1", "Battery.g0.monitors.fleet_jsonl_Battery_r2"]
+    assert "the contract of Battery as /r1/battery (instance Battery_r1)" in obs[0].statement
+    ev = {o.data["instance"]["name"]: MonitorsBackend().run(o, t) for o in obs}
+    assert ev["Battery_r1"].status == "discharged", ev["Battery_r1"].explanation
+    [r1] = ev["Battery_r1"].details["lifecycle"]["nodes"]
+    assert (r1["ros_node"], r1["transitions"], r1["violations"]) == ("/r1/battery", 6, [])
+    assert ev["Battery_r1"].details["lifecycle"]["not_questions"] == {"r1/request": 9}
+    assert ev["Battery_r2"].status == "failed"
+    assert ev["Battery_r2"].explanation.startswith("7 output(s) published outside active (lifecycle); the first: "
+                                                   "/r2/battery published on /r2/level while unconfigured")
+    # control: no instances, the contract's own names: the fleet's run holds none of them
+    plain = dataclasses.replace(t, instances=())
+    (ob,) = MonitorsBackend().export(plain)
+    bare = MonitorsBackend().run(ob, plain)
+    assert bare.status != "discharged" and {i["name"] for i in bare.details["not_judged"]} >= {"/request", "/level"}

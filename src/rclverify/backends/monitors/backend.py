@@ -43,6 +43,7 @@ from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
 from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judged
 from rclverify.backends.monitors.lifecycle import gate_of, gated, with_lifecycle
+from rclverify.backends.monitors.instances import instance_target, per_instance
 from rclverify.backends.monitors.recorded import decided_of
 from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
 from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
@@ -204,7 +205,8 @@ class MonitorsBackend:
                       **({"implementation": made_by} if made_by else {}),
                       "not_expressible": [{"guarantee": t.guarantee, "part": t.part, "why": t.why}
                                           for t in spec.terms if not t.text]}))
-        return out + runset_obligations(target, list(cfg.traces), out)  # a target: the run set's claim (runset.py)
+        # a contract the plan runs as instances: each trace judged once per instance (instances.py)
+        return per_instance(target, out) + runset_obligations(target, list(cfg.traces), out)
 
     def run(self, obligation: Obligation, target: NodeTarget) -> Evidence:
         """Check the obligation's trace against the node's contract (never raises
@@ -223,6 +225,7 @@ class MonitorsBackend:
             return evidence("error", f"the plan entry no longer loads: {exc}")
         trace = str(obligation.data.get("trace", ""))
         try:
+            target = instance_target(target, obligation)  # an instance's run: its names resolved (instances.py)
             read = _judge(target, cfg, trace, None)
             lag, note, stale = second_read(read.watch, trace, True)  # one clock, the stamps (stamp_order.py)
             if lag is not None:
