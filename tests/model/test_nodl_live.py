@@ -12,7 +12,8 @@ document: transient-local), no ``/estop`` server, and a publisher ``/odom`` its 
 
 The graph each source gave is also recorded (``--record-graph``; docs/nodl.md, "A recorded graph": Kilted's
 ``rosgraph_msgs`` has no graph message): rclpy's graph API and rclverify's own DDS participant by ``nodl check``,
-the DDS source once more by ``ros diff --nodl``.  Once the nodes have stopped, each recording is checked again
+the DDS source once more by ``ros diff --nodl``, and rclpy's graph API by ``ros diff --nodl`` as a
+``rosgraph_msgs/msg/Graph`` message in an MCAP bag (docs/nodl.md, "The graph message in a bag").  Once the nodes have stopped, each recording is checked again
 (``nodl check --graph``, ``ros diff --graph``): the same findings and items, line for line, as the live reading
 it was made from; a graph difference seeded into a recording found by both commands (the recording as made, the
 control, has none); a recording that is not one refused at its line."""
@@ -80,7 +81,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
             out[source] = {"code": code, "log": log.read_text()}
         log = tmp / "diff.log"  # the documents as ros diff's expected graph (rclpy's graph API, as above)
         p = rclverify(["ros", "diff", "--nodl", str(ws / "nodl"), "--ros2", "--wait", "2", "--source", "rclpy",
-                       "--ros2-python", str(ros2_python())], env, ws, log)
+                       "--ros2-python", str(ros2_python()), "--record-graph", str(tmp / "diff_graph.mcap")], env, ws, log)
         procs.append(p)
         out["diff"] = {"code": p.wait(120), "log": log.read_text()}
         log = tmp / "diff_dds.log"  # and through rclverify's own DDS participant, recorded
@@ -93,7 +94,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         p = rclverify(["nodl", "check", "-w", str(ws), "--graph", str(tmp / "graph.json")], env, ws, log)
         procs.append(p)
         out["recorded"] = {"code": p.wait(120), "log": log.read_text(), "graph": tmp / "graph.json", "ws": ws,
-                           "graph_dds": tmp / "graph_dds.json", "diff_graph_dds": tmp / "diff_graph_dds.json"}
+                           "graph_dds": tmp / "graph_dds.json", "diff_graph_dds": tmp / "diff_graph_dds.json",
+                           "bag": tmp / "diff_graph.mcap"}
         yield out
     finally:
         for p in procs:
@@ -262,3 +264,37 @@ def test_ros_diff_finds_a_difference_seeded_into_a_recording(run, tmp_path: Path
     err = capsys.readouterr().err
     assert f"{edited}:" in err and "durability: is volatile or transient_local" in err and "Traceback" not in err
     assert main(["ros", "diff", "--nodl", "nodl", "--graph", str(edited), "--ros2"]) == 2
+
+
+def test_the_graph_message_recorded_in_a_bag_gives_the_live_findings(run, tmp_path: Path, capsys,
+                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """The running graph recorded live as a rosgraph_msgs/msg/Graph message in an MCAP bag (ros diff --record-graph
+    X.mcap), and nodl check's JSON recording written as one in a SQLite 3 bag: nodl check --graph BAG gives the
+    live rclpy reading's finding lines exactly, ros diff --graph BAG the live diff's items; the two bags hold the
+    same graph.  Guard's /stop publisher made best-effort in the message: a finding at Guard that the bags as
+    made (the control) do not give."""
+    from rclverify.cli.commands import main
+    from rclverify.model.nodl.graph_record import read_record
+    from rclverify.ros.graph.graph_bag import read_graph, write_bag
+    monkeypatch.chdir(run["recorded"]["ws"])
+    live = run["recorded"]["bag"].with_suffix("")
+    assert (live / "metadata.yaml").is_file() and (live / "diff_graph.mcap").is_file()
+    sqlite = write_bag(tmp_path / "graph.db3", read_record(run["recorded"]["graph"]))
+    for bag in (live, sqlite):
+        assert main(["nodl", "check", "--graph", str(bag)]) == 1
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and _finding_lines(err) == _finding_lines(run["rclpy"]["log"])
+        assert not _lines(err, "Guard")  # the control
+        assert main(["ros", "diff", "--nodl", "nodl", "--graph", str(bag)]) == 1
+        assert _items(capsys.readouterr().out) == _items(run["diff"]["log"]) and len(_items(run["diff"]["log"])) >= 5
+    def shape(g: dict[str, Any]) -> Any:
+        return g["nodes"], {t: {r: sorted(json.dumps({k: v for k, v in e.items() if k != "gid"}, sort_keys=True)
+                                          for e in es) for r, es in roles.items()} for t, roles in g["endpoints"].items()}
+    assert shape(read_graph(live)) == shape(read_graph(sqlite)) and read_graph(live)["rmw"] == "rmw_fastrtps_cpp"
+    seeded = read_graph(live)
+    [stop_pub] = [e for e in seeded["endpoints"]["/stop"]["pubs"] if e["node"] == "Guard"]
+    stop_pub["reliable"] = False
+    bag = write_bag(tmp_path / "seeded.mcap", seeded)
+    assert main(["nodl", "check", "--graph", str(bag)]) == 1
+    guard = _lines(capsys.readouterr().err, "Guard")
+    assert guard and all("/stop's reliability is BEST_EFFORT" in ln for ln in guard), guard

@@ -236,19 +236,19 @@ def _live(args: argparse.Namespace, res: Any) -> bool:
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.graph import RclpyDiscovery, read_rclpy_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (inside a block)
-    from rclverify.model.nodl.graph_record import read_record, record_text, source_of  # deferred: start-up (loads the recording's reader only when called)
-    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
+    from rclverify.model.nodl.graph_record import source_of  # deferred: start-up (loads the recording's reader only when called)
+    from rclverify.ros.graph.graph_bag import read_graph, write_graph  # deferred: start-up (a recording is JSON or a bag)
     try:
         if args.graph:
             kind, py, why = "recorded", None, f"the graph recorded in {args.graph}"
         else:
             kind, py, why = pick_source(args.source, args.ros2_python)
         print(f"source: {kind} ({why})", file=sys.stderr)
-        rdisc = RclpyDiscovery(read_record(Path(args.graph))) if args.graph else \
+        rdisc = RclpyDiscovery(read_graph(Path(args.graph))) if args.graph else \
             read_rclpy_graph(py, args.wait) if kind == "rclpy" and py is not None else None
         if rdisc is not None:
             if args.record_graph:
-                write_atomic(Path(args.record_graph), record_text(rdisc.dump))
+                write_graph(Path(args.record_graph), rdisc.dump)
             source = source_of(rdisc.dump)
             running = graph_of(rdisc, source)  # type: ignore[arg-type]  # the same shape as Discovery
             matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(rdisc),
@@ -258,7 +258,7 @@ def _live(args: argparse.Namespace, res: Any) -> bool:
             running, disc, source, dp = read_dds_graph(args.wait)
             try:
                 if args.record_graph:
-                    write_atomic(Path(args.record_graph), record_text(dds_dump(disc, source)))
+                    write_graph(Path(args.record_graph), dds_dump(disc, source))
                 matched, found = check_code(res.documents, running.nodes, side="live", qos_of=live_qos_of(disc),
                                             namespaces=args.namespaces)
             finally:

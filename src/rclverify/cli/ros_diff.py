@@ -71,8 +71,8 @@ def diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> A
     graph they declare; ``--record-graph`` writes the graph read.  ``None`` after printing why it cannot be
     read; a recording that is not one, or cannot be written, raises :class:`~rclverify.lang.errors.RclError`
     (located, printed by main)."""
-    from rclverify.lang.output import write_atomic  # deferred: start-up (loads rclverify.lang.output only when called)
-    from rclverify.model.nodl.graph_record import read_record, record_text, source_of  # deferred: start-up (loads the recording's reader only when called)
+    from rclverify.model.nodl.graph_record import source_of  # deferred: start-up (loads the recording's reader only when called)
+    from rclverify.ros.graph.graph_bag import read_graph, write_graph  # deferred: start-up (a recording is JSON or a bag)
     from rclverify.ros.live.dds import DdsUnavailable  # deferred: optional or conditional (inside a block)
     from rclverify.ros.live.diff_dds import diff_dds, graph_of, qos_conflicts, read_dds_graph  # deferred: optional or conditional (inside a block)
     from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: optional or conditional (inside a block)
@@ -92,13 +92,13 @@ def diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> A
     print(f"source: {source_kind} ({why})", file=sys.stderr)
     if recorded is not None or source_kind == "rclpy" and py is not None:
         try:
-            rdisc = RclpyDiscovery(read_record(Path(recorded))) if recorded is not None else \
+            rdisc = RclpyDiscovery(read_graph(Path(recorded))) if recorded is not None else \
                 read_rclpy_graph(py, max(0.0, args.wait))  # type: ignore[arg-type]  # py is not None here
         except RclpyUnavailable as exc:
             print(f"ros diff --ros2: error: {exc}", file=sys.stderr)
             return None
         if record:
-            write_atomic(Path(record), record_text(rdisc.dump))
+            write_graph(Path(record), rdisc.dump)
         source = source_of(rdisc.dump)
         if documents is not None:
             return diff_nodl(documents, graph_of(rdisc, source), source, qos_conflicts(rdisc), rdisc,  # type: ignore[arg-type]
@@ -114,7 +114,7 @@ def diff_ros2(args: argparse.Namespace, static: Any, documents: Any = None) -> A
             print(f"{source}: {n.severity}: {n.message}", file=sys.stderr)
         if record:
             from rclverify.ros.live.dds_record import dds_dump  # deferred: optional or conditional (inside a block)
-            write_atomic(Path(record), record_text(dds_dump(disc, source)))
+            write_graph(Path(record), dds_dump(disc, source))
         if documents is not None:
             return diff_nodl(documents, running, source, qos_conflicts(disc), disc, args.namespaces)
         return diff_dds(static, running, source, qos_conflicts(disc), disc)

@@ -69,10 +69,12 @@ class FieldJson(TypedDict):
 
 
 class BagTopic(TypedDict):
-    """One topic of a recorded bag with its message count."""
+    """One topic of a recorded bag with its message count; ``graph``: the nodes of the bag's recorded
+    graph that publish it (``count`` 0: a topic of the recorded graph, ``ros/graph/bag.py``)."""
     name: str
     type: str
     count: int
+    graph: NotRequired[list[str]]
 
 
 class BagJson(TypedDict):

@@ -1,5 +1,11 @@
 """The topics and message types present in a recorded run: a ROS 1 ``.bag``
-or a ROS 2 bag (directory or ``.mcap``), through ``rosbags``' AnyReader."""
+or a ROS 2 bag (directory or ``.mcap``), through ``rosbags``' AnyReader.
+
+A ROS 2 bag holding ``rosgraph_msgs/msg/Graph`` messages (a recorded graph:
+:mod:`rclverify.ros.graph.graph_bag`) gives, besides its own topics, each topic
+the recorded graph's nodes publish, with its type, ``count`` 0 (no message of
+it is in the bag) and ``graph``: the publishing nodes (docs/nodl.md, "The graph
+message in a bag")."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -10,7 +16,9 @@ from rclverify.traces.events import TraceError
 from rclverify.traces.guard import check_trace_path
 
 if TYPE_CHECKING:
-    from rclverify.ros.extract.shapes import BagJson
+    from rclverify.ros.extract.shapes import BagJson, BagTopic
+
+GRAPH = "rosgraph_msgs/msg/Graph"
 
 
 def bag_topics(path: Path, shown: str) -> tuple[BagJson | None, list[Note]]:
@@ -35,8 +43,30 @@ def bag_topics(path: Path, shown: str) -> tuple[BagJson | None, list[Note]]:
     merged: dict[tuple[str, str], int] = {}
     for name, ty, count in topics:
         merged[(name, ty)] = merged.get((name, ty), 0) + count
-    return {"path": shown, "topics": [{"name": n, "type": ty, "count": c}
-                                      for (n, ty), c in sorted(merged.items())]}, warnings
+    out: list[BagTopic] = [{"name": n, "type": ty, "count": c} for (n, ty), c in sorted(merged.items())]
+    if any(ty == GRAPH for _n, ty, _c in topics):
+        graph, note = _graph_topics(path, shown)
+        out = sorted(out + graph, key=lambda t: (t["name"], t["type"], t["count"]))
+        warnings += note
+    return {"path": shown, "topics": out}, warnings
+
+
+def _graph_topics(path: Path, shown: str) -> tuple[list[BagTopic], list[Note]]:
+    """The topics the recorded graph in the bag at ``path`` has publishers on (module docstring), or an
+    error note when its graph cannot be read."""
+    from rclverify.lang.errors import RclError  # deferred: start-up
+    from rclverify.ros.graph.graph_bag import read_bag  # deferred: start-up (loads the graph message only when called)
+    from rclverify.ros.graph.graph_msg import fqn  # deferred: start-up
+    try:
+        dump = read_bag(path, shown)
+    except RclError as exc:
+        return [], [Note(Src(shown), d.message, "ROS-PARSE", "error") for d in exc.diagnostics]
+    found: dict[tuple[str, str], set[str]] = {}
+    for topic, roles in dump["endpoints"].items():
+        for e in roles.get("pubs", []):
+            ty = canon_type(e["type"]) or e["type"]
+            found.setdefault((topic, ty), set()).add(fqn(e["node"], e["ns"]))
+    return [{"name": t, "type": ty, "count": 0, "graph": sorted(nodes)} for (t, ty), nodes in sorted(found.items())], []
 
 
 def _entry_message(text: str, path: Path, severity: str) -> str:
