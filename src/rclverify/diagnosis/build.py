@@ -34,7 +34,6 @@ import json
 import os
 import re
 from contextlib import contextmanager
-from dataclasses import asdict
 from functools import partial
 from typing import Any, Callable, Iterator, Mapping, Sequence
 
@@ -46,6 +45,7 @@ from rclverify.diagnosis import blame, repairs as rep
 from rclverify.diagnosis.code_repair import checked_repairs, repaired_line
 from rclverify.diagnosis.constants import hoare_repair
 from rclverify.diagnosis.hoare_tokens import hoare_token_repairs
+from rclverify.diagnosis.monitor_repair import report_repairs
 from rclverify.diagnosis.deadline import budget_repairs, deadline_record
 from rclverify.diagnosis.requirement import requirement_record
 from rclverify.diagnosis.sidecond import side_condition_repairs
@@ -334,27 +334,6 @@ def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, object]) -> 
     return violating_handler(ws.root, node, entries, monitoring)
 
 
-def _run_repairs(ws: Any, e: EvidenceJson, node: str, mon: Mapping[str, Any], cache: _Cache) -> dict[str, Any]:
-    """The checked repairs of a failed run whose monitors entry names its implementation, the node re-run
-    on the run's questions (:func:`rclverify.diagnosis.monitor_repair.monitor_repairs`, as JSON: ``repairs``,
-    ``line``, ``why``); ``{}`` when the entry names none.  Kept in the cache, keyed by the run's and the
-    implementation's sha256 and the run's verdict counts, unless no ROS 2 Python was found."""
-    from rclverify.diagnosis.monitor_repair import monitor_repairs  # deferred: start-up (the re-run search)
-    from rclverify.runtime.rclpy_source.python import ros2_python  # deferred: start-up (only for a named implementation)
-    data = _obligation_record(ws, node, e["obligation"]).get("data") or {}
-    impl = str(data.get("implementation") or "")
-    if not impl:
-        return {}
-    python = ros2_python()
-    if python is None:
-        return asdict(monitor_repairs(ws, node, data, mon, None))
-    trace = str(data.get("trace") or "")
-    digest = file_digest(ws.path(trace)) if trace and ws.path(trace).is_file() else ""
-    key = ["run", e["obligation"], node, impl, trace, digest, mon.get("counts"), data.get("mapping")]
-    got = cache.get(key, lambda: asdict(monitor_repairs(ws, node, data, mon, python)), impl.rpartition(":")[0])
-    return dict(got) if isinstance(got, dict) else {}
-
-
 def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, object], binding: Mapping[str, object],
                           conj: str) -> list[Any]:
     """The last assignments to the outputs ``conj`` reads in the program's
@@ -413,7 +392,8 @@ def _evidence(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson | 
                 sentence = sentence[:-1] + f"; the value it published is computed at {computed} (the property test)."
                 cul.insert(0, {"what": f"{computed}: the line where the failing output goes wrong (property test)",
                                "source": computed, "text": ""})
-        found = _run_repairs(ws, e, node, mon, cache) if e["status"] == "failed" else {}
+        found = report_repairs(ws, e["obligation"], node, _obligation_record(ws, node, e["obligation"]).get("data")
+                               or {}, mon, cache) if e["status"] == "failed" else {}
         if found.get("line") and found.get("repairs"):  # the line the first checked repair edits: the slip's
             sentence = sentence[:-1] + f"; the first repair checked on the run edits {found['line']}."
             cul.insert(0, {"what": f"{found['line']}: the line the first checked repair edits (the node re-run on "

@@ -12,7 +12,7 @@ JSON-lines log) or found none.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -82,6 +82,28 @@ def monitor_repairs(ws: Any, node: str, data: Mapping[str, Any], monitoring: Map
     return MonitorRepairs(why=f"{impl} re-run on {trace}: {got.why}", line=got.line)
 
 
+def report_repairs(ws: Any, oid: str, node: str, data: Mapping[str, Any], monitoring: Mapping[str, Any],
+                   cache: Any) -> dict[str, Any]:
+    """:func:`monitor_repairs` as the report's diagnosis asks it, for the failed obligation ``oid`` of ``node``
+    (``data``: its record's ``data``), as JSON (``repairs``, ``line``, ``why``); ``{}`` when the obligation
+    names no implementation.  Kept in ``cache`` (the diagnosis cache: ``get(key, make, extra_file)``), keyed by
+    the run's and the implementation's sha256 and the run's verdict counts, unless no ROS 2 Python was found
+    (nothing is asked then, and the answer is the environment's)."""
+    from rclverify.core.cache import file_digest  # deferred: start-up (the cache layer)
+    from rclverify.runtime.rclpy_source.python import ros2_python  # deferred: start-up (only for a named implementation)
+    impl = str(data.get("implementation") or "")
+    if not impl:
+        return {}
+    python = ros2_python()
+    if python is None:
+        return asdict(monitor_repairs(ws, node, data, monitoring, None))
+    trace = str(data.get("trace") or "")
+    digest = file_digest(ws.path(trace)) if trace and ws.path(trace).is_file() else ""
+    key = ["run", oid, node, impl, trace, digest, monitoring.get("counts"), data.get("mapping")]
+    got = cache.get(key, lambda: asdict(monitor_repairs(ws, node, data, monitoring, python)), impl.rpartition(":")[0])
+    return dict(got) if isinstance(got, dict) else {}
+
+
 def rejudged_applied(ws: Any, diagnosis: Mapping[str, Any], repair: Mapping[str, Any],
                      python: Path | None) -> list[tuple[str, str]]:
     """After a repair of a monitored violation was written (``rclverify repair --apply``): the run of
@@ -114,4 +136,4 @@ def rejudged_applied(ws: Any, diagnosis: Mapping[str, Any], repair: Mapping[str,
     return [(oid, "failed" if bad else got[f"{node} calls" if calls else node][0])] if mine else []
 
 
-__all__ = ["MonitorRepairs", "entry_of", "is_call_violation", "monitor_repairs", "rejudged_applied"]
+__all__ = ["MonitorRepairs", "entry_of", "is_call_violation", "monitor_repairs", "rejudged_applied", "report_repairs"]
