@@ -83,4 +83,12 @@ def typed_report(parts: Mapping[str, Any]) -> AssuranceReport:
     return AssuranceReport.of(complete(AssuranceReport, parts))
 
 
-__all__ = ["complete", "empty", "typed_report"]
+def ungrouped_report(parts: Mapping[str, Any]) -> dict[str, Any]:
+    """``parts`` completed into a whole report's JSON object but for ``problems``: a report whose
+    problems the renderers group themselves (report/problems.py ``group_problems``)."""
+    out = complete(AssuranceReport, parts)
+    del out["problems"]
+    return out
+
+
+__all__ = ["complete", "empty", "typed_report", "ungrouped_report"]

@@ -11,7 +11,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from _typed_rows import complete
 from rclverify.cli.commands import main
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.report.problems_places import Member
 from rclverify.report.problems_shared import join_by_first_repair
 
 SYSTEM = """\
@@ -60,17 +63,19 @@ def test_consumers_of_one_loose_bound_are_one_row_with_one_first_repair(tmp_path
 
 
 def test_only_failed_side_conditions_with_the_same_first_repair_are_joined() -> None:
-    def m(i: str, kind: str = "side-condition", status: str = "failed") -> dict:
-        return {"id": i, "kind": kind, "status": status}
-    by_id = {"A.sc1": {"repairs": [{"diff": "d1"}]}, "B.sc1": {"repairs": [{"diff": "d1"}, {"diff": "x"}]},
-             "C.sc1": {"repairs": [{"diff": "d2"}]}, "D.sc1": {"repairs": []}, "E.sc1": {"repairs": []},
-             "R": {"repairs": [{"diff": "d1"}]}, "F.sc1": {"repairs": [{"diff": "d1"}]}}
+    def m(i: str, kind: str = "side-condition", status: str = "failed") -> Member:
+        return Member(i, kind, status, "", "", True)
+
+    def d(*diffs: str) -> DiagnosisRow:
+        return DiagnosisRow.of(complete(DiagnosisRow, {"repairs": [{"diff": x} for x in diffs]}))
+    by_id = {"A.sc1": d("d1"), "B.sc1": d("d1", "x"), "C.sc1": d("d2"), "D.sc1": d(), "E.sc1": d(), "R": d("d1"),
+             "F.sc1": d("d1")}
     members = [(m("A.sc1"), ["assumption:A:1", "guarantee:P:1"]), (m("B.sc1"), ["assumption:B:1", "guarantee:P:1"]),
                (m("C.sc1"), ["assumption:C:1", "guarantee:P:1"]), (m("D.sc1"), ["assumption:D:1"]),
                (m("E.sc1"), ["assumption:E:1"]), (m("R", "requirement"), ["guarantee:P:1"]),
                (m("F.sc1", status="unknown"), ["assumption:F:1", "guarantee:P:1"])]
     join_by_first_repair(members, by_id)
-    roots = {mm["id"]: r for mm, r in members}
+    roots = {mm.id: r for mm, r in members}
     assert roots["A.sc1"] == roots["B.sc1"] == ["assumption:A:1", "assumption:B:1", "guarantee:P:1"]
     assert roots["C.sc1"] == ["assumption:C:1", "guarantee:P:1"]  # another first repair
     assert roots["D.sc1"] == ["assumption:D:1"] and roots["E.sc1"] == ["assumption:E:1"]  # no repair: never joined

@@ -12,7 +12,7 @@ from typing import Any
 import msgspec
 import pytest
 
-from _typed_rows import complete
+from _typed_rows import complete, ungrouped_report
 from rclverify.records.summary_rows import Meta
 from rclverify.report import diagram, render
 
@@ -29,8 +29,9 @@ def _check(formal: str, source: str) -> dict[str, Any]:
 def _report() -> dict[str, Any]:
     """A small report in the shape the pipeline produces: two nodes in a loop,
     an environment input, one failed evidence (with a hostile explanation),
-    one pending, one refuted side condition and one health problem."""
-    return {
+    one pending, one refuted side condition and one health problem; the parts
+    it leaves out completed empty, its problems grouped by the renderers."""
+    return ungrouped_report({
         "meta": complete(Meta, {
             "tool": "rclverify", "version": "0.1.0", "workspace": "mini",
             "plan": "contracts/plan.yaml", "contracts": ["contracts/mini.rcl"],
@@ -156,7 +157,7 @@ def _report() -> dict[str, Any]:
                      "reason": "AJPF is not installed; run: ajpf-run artifacts/ajpf/Agent.g1.jpf"}],
         "lint": [{"severity": "warning", "location": "contracts/mini.rcl:20:3",
                   "message": "'->' mixed with 'and' without parentheses.", "code": "W-implication-precedence"}],
-    }
+    })
 
 
 def _section(text: str, start: str, end: str) -> str:
@@ -287,7 +288,7 @@ def test_json_is_deterministic_and_round_trips(tmp_path: Path) -> None:
     assert json.loads(text) == rep
     shuffled = {k: rep[k] for k in reversed(list(rep))}
     assert render.render_json(shuffled) == text
-    assert text.startswith('{\n  "derived_properties"')
+    assert text.startswith('{\n  "acknowledgements": [],\n  "deadlines": [],\n  "derived_properties"')  # keys sorted
 
 
 def test_missing_key_is_reported() -> None:

@@ -67,10 +67,14 @@ properties, lint errors) take the guarantee their obligation belongs to.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
-from rclverify.records.problem_rows import ProblemRow
-from rclverify.records.report_schema import ProblemJson, Report
+import msgspec
+
+from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.report_schema import ProblemJson
 from rclverify.report.shapes import AttentionItem
 from rclverify.report import problems_causes as pc
 from rclverify.report import problems_mc as mc
@@ -78,16 +82,35 @@ from rclverify.report import problems_places as pp
 from rclverify.report import problems_shared as ps
 from rclverify.report import problems_units as pu
 from rclverify.report.problems_places import (BAD_VERDICTS, DEADLINE_PREFIX, OUTSTANDING_WHOLE, SENTENCE_CHARS,
-                                              first_sentence)
+                                              Member, Rooted, first_sentence)
 from rclverify.report.problems_shared import producer_first
 from rclverify.report.textfmt import natural_sorted
 
-Member = tuple[dict[str, Any], list[str]]  # a problem of the report and its root culprit ids
+
+@dataclass
+class _Row:
+    """A problem row while it is made (the fields of :class:`~rclverify.records.problem_rows.ProblemRow`)."""
+    key: list[str]
+    status: str
+    sentence: str
+    culprits: list[dict[str, Any]]
+    members: list[Member] = field(default_factory=list)
+    repairs: list[dict[str, Any]] = field(default_factory=list)
+    where: str = ""
+
+    def to_json(self) -> ProblemJson:
+        """The row checked by decoding it into :class:`~rclverify.records.problem_rows.ProblemRow`, as its JSON
+        object (raises :class:`msgspec.ValidationError` for a row the class does not admit)."""
+        return ProblemRow.of({"key": self.key, "status": self.status, "sentence": self.sentence,
+                              "culprits": self.culprits, "members": [m.to_json() for m in self.members],
+                              "repairs": self.repairs, "where": self.where}).to_json()
 
 
-def group_problems(report: Report, items: Sequence[AttentionItem],
+def group_problems(report: AssuranceReport | Mapping[str, Any], items: Sequence[AttentionItem],
                    anchor: Callable[..., str]) -> list[ProblemJson]:
-    """The problems of ``report`` grouped by root cause (module docstring), each a
+    """The problems of ``report`` (the report, or its JSON object, which may lack ``problems``:
+    decoded here once into :class:`~rclverify.records.report_record.AssuranceReport`; the problems
+    it has are not read) grouped by root cause (module docstring), each a
     :class:`~rclverify.records.problem_rows.ProblemRow` written as its JSON object.
 
     ``items`` are the report's attention problems (``render.problem_items``:
@@ -106,10 +129,11 @@ def group_problems(report: Report, items: Sequence[AttentionItem],
                       "consequence_of": [ids of the members it follows from] (only on a consequence)}],
          "repairs": [{"diagnosis": id, "index": n}]  (distinct diffs, each checked by Z3)}
 
-    Raises ``KeyError`` for a report dict without ``nodes``, :class:`msgspec.ValidationError` for a
-    row the class does not decode (a bug of the grouping).
+    Raises :class:`msgspec.ValidationError` for a report of another shape, or a row the class does
+    not decode (a bug of the grouping).
     """
-    g = _Grouping(report, items, anchor)
+    typed = report if isinstance(report, AssuranceReport) else AssuranceReport.of({"problems": [], **report})
+    g = _Grouping(typed, items, anchor)
     g.diagnosis_members()
     g.requirement_members()
     g.item_members()
@@ -118,18 +142,23 @@ def group_problems(report: Report, items: Sequence[AttentionItem],
     g.deadline_rows(groups)
     g.model_checking_rows(groups)
     g.line_owners(groups)
-    where = pp.sources(report)
+    where = pp.sources(typed)
     for row in groups.values():  # where the problem is, for a row that names no culprit
-        row["where"] = next((where[m["id"]] for m in row["members"] if where.get(m["id"])), "")
+        row.where = next((where[m.id] for m in row.members if where.get(m.id)), "")
     for row in groups.values():
-        if not row["key"][0].startswith("unverified:"):
+        if not row.key[0].startswith("unverified:"):
             g.sentence_and_repairs(row)
     out = list(groups.values())
-    out.sort(key=lambda row: -pp.severity(row["status"]))  # stable: report order within a status
-    return [ProblemRow.of(row).to_json() for row in out]
+    out.sort(key=lambda row: -pp.severity(row.status))  # stable: report order within a status
+    return [row.to_json() for row in out]
 
 
-def _victim_of(node: Any, k: Any) -> str | None:
+def _set(value: str | msgspec.UnsetType) -> str | None:
+    """An optional text field of a diagnosis: ``None`` when it is not set."""
+    return None if isinstance(value, msgspec.UnsetType) else value
+
+
+def _victim_of(node: object, k: object) -> str | None:
     return f"guarantee:{node}:{k}" if node and k else None
 
 
@@ -139,50 +168,49 @@ class _Grouping:
     grouped only by the culprits they name (``direct``), and the rows of
     unit mismatches; each method is one step of the module docstring's rules."""
 
-    def __init__(self, report: Report, items: Sequence[AttentionItem],
+    def __init__(self, report: AssuranceReport, items: Sequence[AttentionItem],
                  anchor: Callable[..., str]) -> None:
         self.report, self.items, self.anchor = report, items, anchor
-        self.places = pp.Places(report)
-        self.diagnoses = list(report.get("diagnoses") or [])
-        self.by_id = {str(d["id"]): d for d in self.diagnoses}
+        self.places = pp.Places(report.nodes)
+        self.diagnoses = report.diagnoses
+        self.by_id = {d.id: d for d in self.diagnoses}
         self.item_anchor = {str(it["ref"]): str(it["anchor"]) for it in items}
-        self.members: list[Member] = []
+        self.members: list[Rooted] = []
         self.explains: dict[str, list[str]] = {}
         self.mc_obl = mc.mc_obligations(report)
         self.direct: set[str] = set()  # model-checking evidence: grouped only by the culprits it names (problems_mc)
         self.unit_of = pu.joins(self.diagnoses)  # a unit mismatch's row takes what it explains (problems_units)
         self.unit_roots: dict[str, list[str]] = {}
-        self.unverified = {str(u["id"]): u for u in report.get("unverified") or ()}
-        self.obligation = {str(o["id"]): o for o in report.get("obligations", [])}
+        self.unverified = {u.id: u for u in report.unverified}
+        self.obligation = {o.id: o for o in report.obligations}
 
-    def _diagnosis_roots(self, d: Mapping[str, Any]) -> list[str]:
+    def _diagnosis_roots(self, d: DiagnosisRow) -> list[str]:
         """The roots of the diagnosis ``d`` (rules 1, 2 and 5; a unit mismatch's, a model checker's)."""
-        roots = pp.roots(d.get("culprits", []), self.places, _victim_of(d.get("node"), d.get("guarantee")))
-        did = str(d["id"])
-        if d["kind"] == pu.KIND:
-            self.unit_roots[did] = roots = roots or [f"problem:{d['id']}"]
-            self.item_anchor.setdefault(did, self.item_anchor.get(str(d.get("lint")), ""))
-        if d["kind"] == pu.KIND or self.unit_of.get(did) in self.unit_roots:
-            roots = self.unit_roots[did if d["kind"] == pu.KIND else self.unit_of[did]]
+        roots = pp.roots(d.culprits, self.places, _victim_of(d.node, d.guarantee))
+        did = d.id
+        if d.kind == pu.KIND:
+            self.unit_roots[did] = roots = roots or [f"problem:{d.id}"]
+            self.item_anchor.setdefault(did, self.item_anchor.get(str(_set(d.lint)), ""))
+        if d.kind == pu.KIND or self.unit_of.get(did) in self.unit_roots:
+            roots = self.unit_roots[did if d.kind == pu.KIND else self.unit_of[did]]
             self.direct.add(did)
-        if d["kind"] == "deadline":  # its own row, whatever else its hops' guarantees are found in (rule 5)
-            roots = [f"{DEADLINE_PREFIX}{d.get('requirement')}"]
+        if d.kind == "deadline":  # its own row, whatever else its hops' guarantees are found in (rule 5)
+            roots = [f"{DEADLINE_PREFIX}{_set(d.requirement)}"]
         if did in self.mc_obl:
             self.direct.add(did)
-            roots = ([r for r in roots if r != _victim_of(d.get("node"), d.get("guarantee"))]
-                     or [mc.mc_key(self.mc_obl[did], str(d["status"]))])
+            roots = ([r for r in roots if r != _victim_of(d.node, d.guarantee)]
+                     or [mc.mc_key(self.mc_obl[did], d.status)])
         return roots
 
     def diagnosis_members(self) -> None:
         """One member per diagnosis, then the joins of problems_shared and problems_causes."""
         for d in self.diagnoses:
             roots = self._diagnosis_roots(d)
-            m: dict[str, Any] = {"id": str(d["id"]), "kind": str(d["kind"]), "status": str(d["status"]),
-                                 "sentence": str(d["sentence"]), "diagnosis": True,
-                                 "anchor": self.item_anchor.get(str(d["id"])) or pp.default_anchor(d, self.anchor)}
+            m = Member(id=d.id, kind=d.kind, status=d.status, sentence=d.sentence, diagnosis=True,
+                       anchor=self.item_anchor.get(d.id) or pp.default_anchor(d, self.anchor))
             self.members.append((m, roots))
-            victim = _victim_of(d.get("node"), d.get("guarantee"))
-            if d["kind"] in pp.CONTRACT_DEFECTS and victim and roots and victim not in roots:
+            victim = _victim_of(d.node, d.guarantee)
+            if d.kind in pp.CONTRACT_DEFECTS and victim and roots and victim not in roots:
                 self.explains.setdefault(victim, [])
                 self.explains[victim] += [r for r in roots if r not in self.explains[victim]]
         ps.join_by_first_repair(self.members, self.by_id)  # several consumers, one too loose producer: one row
@@ -191,33 +219,32 @@ class _Grouping:
 
     def requirement_members(self) -> None:
         """One member per requirement not met that no diagnosis covers, its roots from its check's cores."""
-        diagnosed = {str(d["id"]) for d in self.diagnoses}
-        for q in self.report.get("requirements", []):
-            if q.get("verdict") not in BAD_VERDICTS or str(q["id"]) in diagnosed:
+        diagnosed = {d.id for d in self.diagnoses}
+        for q in self.report.requirements:
+            if q.verdict not in BAD_VERDICTS or q.id in diagnosed:
                 continue
-            check = q.get("check") or {}
+            check = q.check
             core = [*(check.get("vacuity_core") or []), *(check.get("inconsistent_core") or []),
                     *(check.get("failed_to_prevent") or [])]
             roots = pp.roots([{"what": str(p.get("label", "")), "source": p.get("source", "")} for p in core],
                              self.places, None)
             if pp.by_deadline(q):  # not met because of its end-to-end deadline only: the deadline's row (rule 5)
-                roots = [f"{DEADLINE_PREFIX}{q['id']}"]
-            note = str(q.get("note") or "")
-            self.members.append(({"id": str(q["id"]), "kind": "requirement", "status": str(q["status"]),
-                                  "sentence": f"Requirement {q['id']} is {q['verdict']}" + (f": {note}" if note else "") + ".",
-                                  "anchor": self.anchor("req", q["id"]), "diagnosis": False}, roots))
+                roots = [f"{DEADLINE_PREFIX}{q.id}"]
+            self.members.append((Member(id=q.id, kind="requirement", status=q.status,
+                                        sentence=f"Requirement {q.id} is {q.verdict}" + (f": {q.note}" if q.note else "") + ".",
+                                        anchor=self.anchor("req", q.id), diagnosis=False), roots))
         pp.join_requirements_to_side_conditions(self.members)
 
     def _item_roots(self, it: AttentionItem, ref: str, roots_of: Mapping[str, list[str]]) -> tuple[str, list[str]]:
         """``(member id, roots)`` of the attention item ``it`` no diagnosis covers (rules 4 and 5)."""
         o = self.obligation.get(ref)
-        roots = [f"guarantee:{o['node']}:{o['guarantee']}"] if o is not None and o.get("guarantee") else []
+        roots = [f"guarantee:{o.node}:{o.guarantee}"] if o is not None and o.guarantee else []
         roots = [r for r in roots if r in self.places.info]
         if ref in self.mc_obl:  # model-checking evidence without a diagnosis (inconclusive): outstanding, by guarantee
             self.direct.add(ref)
             roots = [mc.mc_key(self.mc_obl[ref], str(it["status"]))]
-        elif o is not None and not o.get("guarantee") and str(it["status"]) in ("inconclusive", "pending"):
-            roots = [f"{OUTSTANDING_WHOLE}{o.get('backend')}:{o.get('node')}"]  # rule 5
+        elif o is not None and not o.guarantee and str(it["status"]) in ("inconclusive", "pending"):
+            roots = [f"{OUTSTANDING_WHOLE}{o.backend}:{o.node}"]  # rule 5
             self.direct.add(ref)
         if self.unit_of.get(ref) in self.unit_roots:  # explained by a unit mismatch: its row (problems_units)
             roots = self.unit_roots[self.unit_of[ref]]
@@ -232,130 +259,128 @@ class _Grouping:
     def item_members(self) -> None:
         """One member per attention item no diagnosis or requirement covers, then the assumption
         violations and the extra members of a unit mismatch (problems_causes, problems_units)."""
-        covered = {m["id"] for m, _ in self.members}
-        roots_of = {m["id"]: roots for m, roots in self.members}
+        covered = {m.id for m, _ in self.members}
+        roots_of = {m.id: roots for m, roots in self.members}
         for it in self.items:
             ref = str(it["ref"])
             if ref in covered:
                 continue
             if it["kind"] == "guarantee":  # unverified: no obligation covers it (rule 4 of the module docstring)
                 u = self.unverified.get(ref)
-                self.members.append(({"id": ref, "kind": "unverified guarantee", "status": str(it["status"]),
-                                      "sentence": f"Guarantee {ref} is unverified: {u['reason'] if u else it['message']}.",
-                                      "anchor": str(it["anchor"]), "diagnosis": False},
-                                     [f"unverified:{u['node'] if u else ref}"]))
+                self.members.append((Member(id=ref, kind="unverified guarantee", status=str(it["status"]),
+                                            sentence=f"Guarantee {ref} is unverified: {u.reason if u else it['message']}.",
+                                            anchor=str(it["anchor"]), diagnosis=False),
+                                     [f"unverified:{u.node if u else ref}"]))
                 covered.add(ref)
                 continue
             ref, roots = self._item_roots(it, ref, roots_of)
             roots_of[ref] = roots
-            self.members.append(({"id": ref, "kind": str(it["kind"]), "status": str(it["status"]),
-                                  "sentence": str(it["message"]) + (f" `{it['formula']}`" if it.get("formula") else ""),
-                                  "anchor": str(it["anchor"]), "diagnosis": False}, roots))
+            self.members.append((Member(id=ref, kind=str(it["kind"]), status=str(it["status"]),
+                                        sentence=str(it["message"]) + (f" `{it['formula']}`" if it.get("formula") else ""),
+                                        anchor=str(it["anchor"]), diagnosis=False), roots))
             covered.add(ref)
         pc.assumption_violations(self.report, self.members, self.anchor)  # a run's violation a failed side condition explains
         for m, uid in pu.extra_members(self.report, self.diagnoses, covered, self.anchor):  # a lint or health warning, a run
             if uid in self.unit_roots:
-                self.direct.add(m["id"])
+                self.direct.add(m.id)
                 self.members.append((m, self.unit_roots[uid]))
 
-    def groups(self) -> dict[tuple[str, ...], dict[str, Any]]:
+    def groups(self) -> dict[tuple[str, ...], _Row]:
         """The members grouped by their roots (or by what a contract defect explains of them: rule 3)."""
-        groups: dict[tuple[str, ...], dict[str, Any]] = {}
+        groups: dict[tuple[str, ...], _Row] = {}
         for m, roots in self.members:
             # an unverified guarantee stays a row of its own, even when a contract defect explains the guarantee;
             # so does a failed side condition: its culprits are the ones Z3 showed for it (diagnosis/blame.py)
-            explained = ([] if m["kind"] in ("unverified guarantee", "side-condition") or m["id"] in self.direct
+            explained = ([] if m.kind in ("unverified guarantee", "side-condition") or m.id in self.direct
                          or any(r.startswith(DEADLINE_PREFIX) for r in roots)
                          else [e for r in roots for e in self.explains.get(r, [])])
             if explained:
                 roots = list(dict.fromkeys(explained))
-            key = tuple(sorted(roots)) if roots else (f"problem:{m['id']}",)
+            key = tuple(sorted(roots)) if roots else (f"problem:{m.id}",)
             g = groups.get(key)
             if g is None:
-                g = groups[key] = {"key": list(key), "status": m["status"], "sentence": first_sentence(m["sentence"]),
-                                   # in natural order: a program's line 9 before its line 13; what
-                                   # to repair before the assumptions it fails (the producer, then its victims)
-                                   "culprits": [pp.culprit(r, self.places, self.anchor)
-                                                for r in producer_first(natural_sorted(key)) if r in self.places.info],
-                                   "members": [], "repairs": []}
-            g["members"].append(m)
-            if pp.severity(m["status"]) > pp.severity(g["status"]):
-                g["status"] = m["status"]
+                # in natural order: a program's line 9 before its line 13; what to repair before the
+                # assumptions it fails (the producer, then its victims)
+                g = groups[key] = _Row(list(key), m.status, first_sentence(m.sentence),
+                                       [pp.culprit(r, self.places, self.anchor)
+                                        for r in producer_first(natural_sorted(key)) if r in self.places.info])
+            g.members.append(m)
+            if pp.severity(m.status) > pp.severity(g.status):
+                g.status = m.status
         return groups
 
-    def unverified_rows(self, groups: Mapping[tuple[str, ...], dict[str, Any]]) -> None:
+    def unverified_rows(self, groups: Mapping[tuple[str, ...], _Row]) -> None:
         """A node's unverified guarantees: each one a culprit at its location, one sentence for them all."""
         for key, g in groups.items():
             if not key[0].startswith("unverified:"):
                 continue
             node = key[0].split(":", 1)[1]
-            ids = [m["id"] for m in g["members"]]
-            g["culprits"] = [pp.culprit(f"guarantee:{u['node']}:{u['guarantee']}", self.places, self.anchor)
-                             for u in (self.unverified.get(i) for i in ids) if u is not None
-                             and f"guarantee:{u['node']}:{u['guarantee']}" in self.places.info]
+            ids = [m.id for m in g.members]
+            g.culprits = [pp.culprit(f"guarantee:{u.node}:{u.guarantee}", self.places, self.anchor)
+                          for u in (self.unverified.get(i) for i in ids) if u is not None
+                          and f"guarantee:{u.node}:{u.guarantee}" in self.places.info]
             first = self.unverified.get(ids[0])
             if len(ids) > 1 and first is not None:
-                g["sentence"] = first_sentence(f"{len(ids)} guarantees of {node} are unverified "
-                                               f"({', '.join(ids)}): {first['reason'].replace('covers it', 'covers them')}.")
+                g.sentence = first_sentence(f"{len(ids)} guarantees of {node} are unverified "
+                                            f"({', '.join(ids)}): {first.reason.replace('covers it', 'covers them')}.")
 
-    def deadline_rows(self, groups: Mapping[tuple[str, ...], dict[str, Any]]) -> None:
+    def deadline_rows(self, groups: Mapping[tuple[str, ...], _Row]) -> None:
         """A deadline's row: the hops of its chain, each with its bound (rule 5)."""
         for key, g in groups.items():
             if not key[0].startswith(DEADLINE_PREFIX):
                 continue
-            d = next((self.by_id[m["id"]] for m in g["members"]
-                      if m["id"] in self.by_id and self.by_id[m["id"]]["kind"] == "deadline"), None)
-            g["culprits"] = []
-            for c in (d.get("culprits") or () if d is not None else ()):
+            d = next((self.by_id[m.id] for m in g.members
+                      if m.id in self.by_id and self.by_id[m.id].kind == "deadline"), None)
+            g.culprits = []
+            for c in (d.culprits if d is not None else ()):
                 rid = self.places.locate(str(c.get("source", "")))
                 if rid is not None and rid in self.places.info:
-                    g["culprits"].append({**pp.culprit(rid, self.places, self.anchor), "what": str(c["what"])})
+                    g.culprits.append({**pp.culprit(rid, self.places, self.anchor), "what": str(c["what"])})
 
-    def model_checking_rows(self, groups: Mapping[tuple[str, ...], dict[str, Any]]) -> None:
+    def model_checking_rows(self, groups: Mapping[tuple[str, ...], _Row]) -> None:
         """Model-checking rows: the Gwendolen lines the counterexamples pass through."""
         for key, g in groups.items():
             if key[0].startswith(mc.FAILED_PREFIX):
-                lines = [self.places.locate(src) for m in g["members"] for src in mc.trail_sources(self.by_id.get(m["id"]))]
-                g["culprits"] = [pp.culprit(r, self.places, self.anchor) for r in dict.fromkeys(lines) if r is not None]
+                lines = [self.places.locate(src) for m in g.members for src in mc.trail_sources(self.by_id.get(m.id))]
+                g.culprits = [pp.culprit(r, self.places, self.anchor) for r in dict.fromkeys(lines) if r is not None]
 
-    def line_owners(self, groups: Mapping[tuple[str, ...], dict[str, Any]]) -> None:
+    def line_owners(self, groups: Mapping[tuple[str, ...], _Row]) -> None:
         """A program line (a handler, an assignment) is the code of its findings' node, when they have one."""
         for g in groups.values():
-            owners = {str(self.by_id[m["id"]].get("node") or "") if m["id"] in self.by_id else "" for m in g["members"]}
+            owners = {self.by_id[m.id].node or "" if m.id in self.by_id else "" for m in g.members}
             if len(owners) == 1 and "" not in owners:
-                for c in g["culprits"]:
+                for c in g.culprits:
                     if str(c["id"]).startswith("line:"):
                         c["node"] = next(iter(owners))
 
-    def _counterexample(self, ident: str) -> list[Any]:
+    def _counterexample(self, ident: str) -> list[dict[str, Any]]:
         """The counterexample rows of the diagnosis ``ident`` (``[]`` without one)."""
         d = self.by_id.get(ident)
-        return (d.get("counterexample") or []) if d is not None else []
+        return d.counterexample if d is not None else []
 
-    def sentence_and_repairs(self, g: dict[str, Any]) -> None:
+    def sentence_and_repairs(self, g: _Row) -> None:
         """The row's sentence, from the diagnosis that says most about the cause (TELLING), the
         shortest; its distinct repairs; the summary sentence of an outstanding or model-checking row."""
-        worst = [m for m in g["members"] if pp.severity(m["status"]) == pp.severity(g["status"])]
-        told = [m for m in worst if m["diagnosis"]] or worst
-        best = min(told, key=lambda m: (pp.TELLING.get(m["kind"], pp.LEAST_TELLING), len(first_sentence(m["sentence"]))))
-        g["sentence"] = first_sentence(best["sentence"])
+        worst = [m for m in g.members if pp.severity(m.status) == pp.severity(g.status)]
+        told = [m for m in worst if m.diagnosis] or worst
+        best = min(told, key=lambda m: (pp.TELLING.get(m.kind, pp.LEAST_TELLING), len(first_sentence(m.sentence))))
+        g.sentence = first_sentence(best.sentence)
         diffs: set[object] = set()
-        for m in g["members"]:
-            dg = self.by_id.get(m["id"])
-            for k, rep in enumerate(dg.get("repairs", []) if dg is not None and m["diagnosis"] else []):
+        for m in g.members:
+            dg = self.by_id.get(m.id)
+            for k, rep in enumerate(dg.repairs if dg is not None and m.diagnosis else []):
                 if rep.get("diff") not in diffs:
                     diffs.add(rep.get("diff"))
-                    g["repairs"].append({"diagnosis": m["id"], "index": k})
-        if g["key"][0].startswith(OUTSTANDING_WHOLE) and len(g["members"]) > 1:
-            _, backend, node = g["key"][0].split(":", 2)
-            g["sentence"] = first_sentence(f"{len(g['members'])} {backend} obligations on the contract of {node} are "
-                                           f"{g['status']} (evidence outstanding): {g['sentence']}",
-                                           SENTENCE_CHARS // 2)  # a summary: each finding holds its whole text
-        if g["key"][0].startswith((mc.FAILED_PREFIX, mc.OUTSTANDING_PREFIX)):
-            cex = next((str(r.get("value", "")) for m in g["members"]
-                        for r in self._counterexample(m["id"]) if r.get("variable") == "lasso"), "")
-            g["sentence"] = first_sentence(mc.row_sentence(g["key"][0], g["members"],
-                                                           first_sentence(g["members"][0]["sentence"]), cex))
+                    g.repairs.append({"diagnosis": m.id, "index": k})
+        if g.key[0].startswith(OUTSTANDING_WHOLE) and len(g.members) > 1:
+            _, backend, node = g.key[0].split(":", 2)
+            g.sentence = first_sentence(f"{len(g.members)} {backend} obligations on the contract of {node} are "
+                                        f"{g.status} (evidence outstanding): {g.sentence}",
+                                        SENTENCE_CHARS // 2)  # a summary: each finding holds its whole text
+        if g.key[0].startswith((mc.FAILED_PREFIX, mc.OUTSTANDING_PREFIX)):
+            cex = next((str(r.get("value", "")) for m in g.members
+                        for r in self._counterexample(m.id) if r.get("variable") == "lasso"), "")
+            g.sentence = first_sentence(mc.row_sentence(g.key[0], g.members, first_sentence(g.members[0].sentence), cex))
 
 
 __all__ = ["BAD_VERDICTS", "DEADLINE_PREFIX", "OUTSTANDING_WHOLE", "SENTENCE_CHARS", "first_sentence", "group_problems"]

@@ -24,11 +24,13 @@ evidence is never explained by a vacuity or inconsistency of its guarantee
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Sequence
 
-from rclverify.records.report_schema import ObligationJson, Report
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.report_record import AssuranceReport
 from rclverify.model.plan.declarations import DECLARATIONS
+from rclverify.report.problems_places import Member
 
 #: Backends whose evidence is a model checker's verdict on a property instance.
 MC_BACKENDS = tuple(n for n, d in DECLARATIONS.items() if d.evidence_kind == "model checking")
@@ -37,25 +39,25 @@ OUTSTANDING_PREFIX = "outstanding:model-checking:"
 _TRAIL = re.compile(r"Gwendolen lines? ([\d, ]+) of (\S+)")
 
 
-def mc_obligations(report: Report) -> dict[str, ObligationJson]:
+def mc_obligations(report: AssuranceReport) -> dict[str, ObligationRow]:
     """``{obligation id: obligation}`` of the report's model-checking obligations."""
-    return {str(o["id"]): o for o in report.get("obligations", []) if o.get("backend") in MC_BACKENDS}
+    return {o.id: o for o in report.obligations if o.backend in MC_BACKENDS}
 
 
-def mc_key(o: ObligationJson, status: str) -> str:
+def mc_key(o: ObligationRow, status: str) -> str:
     """The group key of an instance of obligation ``o`` with ``status`` whose
     diagnosis names no culprit but its own guarantee (module docstring)."""
     prefix = OUTSTANDING_PREFIX if status in ("inconclusive", "pending", "stale") else FAILED_PREFIX
-    return f"{prefix}{o['node']}:{o.get('guarantee')}"
+    return f"{prefix}{o.node}:{o.guarantee}"
 
 
-def trail_sources(d: Mapping[str, Any] | None) -> list[str]:
+def trail_sources(d: DiagnosisRow | None) -> list[str]:
     """The ``file:line`` of every Gwendolen line the counterexample of
     diagnosis record ``d`` passes through (its ``lasso`` row: "...;
     Gwendolen lines 72, 74 of backends/ajpf/jackal.gwen"), in order; ``[]``
     when it names none."""
     out: list[str] = []
-    for row in (d or {}).get("counterexample") or []:
+    for row in d.counterexample if d is not None else ():
         if row.get("variable") != "lasso":
             continue
         for m in _TRAIL.finditer(str(row.get("value", ""))):
@@ -68,7 +70,7 @@ def checker(sentences: Sequence[str]) -> str:
     return "SPIN" if any("SPIN" in s for s in sentences) else "AJPF"
 
 
-def row_sentence(key: str, members: Sequence[Mapping[str, Any]], first: str, cex: str) -> str:
+def row_sentence(key: str, members: Sequence[Member], first: str, cex: str) -> str:
     """The sentence of a model-checking row ``key`` (module docstring):
     how many instances of which guarantee, the checker, and the first
     member's counterexample ``cex`` (failed) or first sentence ``first``
@@ -76,7 +78,7 @@ def row_sentence(key: str, members: Sequence[Mapping[str, Any]], first: str, cex
     outstanding = key.startswith(OUTSTANDING_PREFIX)
     node, k = key.rsplit(":", 2)[-2:]
     n = len(members)
-    what = (f"{n} AJPF/{checker([str(m['sentence']) for m in members])} property instance{'s' if n != 1 else ''} "
+    what = (f"{n} AJPF/{checker([m.sentence for m in members])} property instance{'s' if n != 1 else ''} "
             f"of guarantee {k} of {node}")
     if outstanding:
         return f"{what} {'are' if n != 1 else 'is'} inconclusive (evidence outstanding): {first}"

@@ -5,16 +5,24 @@ report/problems.py (grouping the report's problems by root cause).
 (guarantee, assumption, contract header) that starts there or before it;
 :func:`roots` gives a problem's root culprits from its diagnosis's culprits
 (rules 1 and 2 of report/problems.py); :func:`culprit` lays a root out as
-a row's culprit; :func:`first_sentence` cuts a row's sentence.
+a row's culprit; :func:`first_sentence` cuts a row's sentence.  A problem
+found on the way is a :class:`Member` (a
+:class:`~rclverify.records.problem_rows.ProblemMember` while its row is
+being made); the report is read decoded
+(:class:`~rclverify.records.report_record.AssuranceReport`).
 """
 from __future__ import annotations
 
 import bisect
 import re
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
-from rclverify.records.report_schema import Report
+from rclverify.records.node_rows import NodeRow
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.diagnosis_text import whole_first_sentence
 from rclverify.records.records import SEVERITY
 
@@ -41,12 +49,46 @@ AS_EVIDENCE = {"problem": "failed", "refuted": "failed", "unknown": "inconclusiv
 DEADLINE_PREFIX = "deadline:"
 
 
-def by_deadline(q: Mapping[str, Any]) -> bool:
+@dataclass
+class Member:
+    """A problem of the report as a member of its row (the fields of
+    :class:`~rclverify.records.problem_rows.ProblemMember`): the grouping
+    marks it a consequence of other members (``consequence_of``) on the way."""
+    id: str
+    kind: str
+    status: str
+    sentence: str
+    anchor: str
+    diagnosis: bool
+    consequence_of: list[str] | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        """The member as its JSON object (``consequence_of`` only on a consequence)."""
+        out: dict[str, Any] = {"id": self.id, "kind": self.kind, "status": self.status, "sentence": self.sentence,
+                               "anchor": self.anchor, "diagnosis": self.diagnosis}
+        if self.consequence_of is not None:
+            out["consequence_of"] = self.consequence_of
+        return out
+
+
+#: A member and its root culprit ids, as the grouping collects them.
+Rooted = tuple[Member, list[str]]
+
+
+@dataclass
+class Place:
+    """What a root culprit is (``what``), where (``source``, ``file:line:col``) and its anchor's parts
+    (``None``: no anchor in the report)."""
+    what: str
+    source: str
+    anchor: tuple[Any, ...] | None
+
+
+def by_deadline(q: RequirementRow) -> bool:
     """Is requirement row ``q`` not met only because of its end-to-end
     deadline (refuted or undecided), its own statement not refuted?"""
-    row = q.get("deadline") or {}
-    own = (q.get("without_deadline") or {}).get("verdict")
-    return row.get("verdict") in ("refuted", "inconclusive") and own not in BAD_VERDICTS
+    own = q.without_deadline.verdict if q.without_deadline is not None else None
+    return q.deadline is not None and q.deadline.verdict in ("refuted", "inconclusive") and own not in BAD_VERDICTS
 
 
 def severity(status: str) -> int:
@@ -54,27 +96,23 @@ def severity(status: str) -> int:
 
 
 class Places:
-    """Source locations of the contract members of ``report["nodes"]``."""
+    """Source locations of the contract members of ``nodes`` (the report's, decoded)."""
 
-    def __init__(self, report: Report) -> None:
-        self.by_file: dict[str, list[tuple[int, str, dict[str, Any]]]] = {}
-        for n in report["nodes"]:
-            name = str(n["name"])
-            self._add(n.get("source", ""), f"contract:{name}",
-                      {"what": f"the contract of {name}", "source": n.get("source", ""), "anchor": ("node", name)})
-            for k, a in enumerate(n.get("assumptions", []), 1):
-                self._add(a.get("source", ""), f"assumption:{name}:{k}",
-                          {"what": f"assumption {k} of {name}", "source": a.get("source", ""),
-                           "anchor": ("node", name)})
-            for g in n.get("guarantees", []):
-                self._add(g.get("source", ""), f"guarantee:{name}:{g['index']}",
-                          {"what": f"guarantee {g['index']} of {name}", "source": g.get("source", ""),
-                           "anchor": ("g", name, g["index"])})
+    def __init__(self, nodes: Sequence[NodeRow]) -> None:
+        self.by_file: dict[str, list[tuple[int, str, Place]]] = {}
+        for n in nodes:
+            self._add(n.source, f"contract:{n.name}", Place(f"the contract of {n.name}", n.source, ("node", n.name)))
+            for k, a in enumerate(n.assumptions, 1):
+                self._add(a.source, f"assumption:{n.name}:{k}",
+                          Place(f"assumption {k} of {n.name}", a.source, ("node", n.name)))
+            for g in n.guarantees:
+                self._add(g.source, f"guarantee:{n.name}:{g.index}",
+                          Place(f"guarantee {g.index} of {n.name}", g.source, ("g", n.name, g.index)))
         for rows in self.by_file.values():
             rows.sort(key=lambda r: r[0])
-        self.info: dict[str, dict[str, Any]] = {rid: info for rows in self.by_file.values() for _, rid, info in rows}
+        self.info: dict[str, Place] = {rid: info for rows in self.by_file.values() for _, rid, info in rows}
 
-    def _add(self, source: str, rid: str, info: dict[str, Any]) -> None:
+    def _add(self, source: str, rid: str, info: Place) -> None:
         m = _SOURCE.match(str(source))
         if m:
             self.by_file.setdefault(m.group(1), []).append((int(m.group(2)), rid, info))
@@ -89,22 +127,22 @@ class Places:
         rows = self.by_file.get(file)
         if rows is None:
             rid = f"line:{file}:{line}"
-            self.info.setdefault(rid, {"what": "", "source": f"{file}:{line}", "anchor": None})
+            self.info.setdefault(rid, Place("", f"{file}:{line}", None))
             return rid
         i = bisect.bisect_right([r[0] for r in rows], line) - 1
         return rows[i][1] if i >= 0 else None
 
 
-def join_requirements_to_side_conditions(members: list[tuple[dict[str, Any], list[str]]]) -> None:
+def join_requirements_to_side_conditions(members: list[Rooted]) -> None:
     """A refuted requirement whose culprits are all culprits of one failed
     side condition has that side condition's root cause: both rows read one
     problem, with one first repair (a service answering up to 64
     waypoints to a client whose buffer holds ``RouteBuffer = 50`` gave a
     side-condition row and a requirement row with two different first
     repairs).  Changes ``members`` (``(member, roots)``) in place."""
-    sides = [set(r) for m, r in members if m["kind"] == "side-condition" and r]
+    sides = [set(r) for m, r in members if m.kind == "side-condition" and r]
     for i, (m, roots) in enumerate(members):
-        if m["kind"] != "requirement" or not roots:
+        if m.kind != "requirement" or not roots:
             continue
         home = next((s for s in sides if set(roots) <= s), None)
         if home is not None:
@@ -121,7 +159,8 @@ def roots(culprits: Sequence[Mapping[str, Any]], places: Places, victim: str | N
         if rid is None:
             continue
         if what.startswith(("environment fact", "event ")):
-            places.info[rid] = {**places.info.get(rid, {}), "what": what.split(" `")[0], "anchor": None}
+            known = places.info.get(rid)
+            places.info[rid] = Place(what.split(" `")[0], known.source if known is not None else "", None)
             context.append(rid)
         elif rid not in roots:
             roots.append(rid)
@@ -144,12 +183,12 @@ def first_sentence(text: str, limit: int = SENTENCE_CHARS) -> str:
     return s
 
 
-def cone_side_conditions(report: Report, node: str) -> list[str]:
+def cone_side_conditions(report: AssuranceReport, node: str) -> list[str]:
     """The ids of the side conditions not discharged in the cone of ``node``:
     of the node and every node upstream of it along the system's
     connections (the cone a derived property rests on, paper section 4)."""
     upstream: dict[str, set[str]] = {}
-    for c in report.get("system", {}).get("connections", []):
+    for c in report.system.connections:
         upstream.setdefault(str(c["to_node"]), set()).add(str(c["from_node"]))
     cone, todo = {node}, [node]
     while todo:
@@ -157,52 +196,50 @@ def cone_side_conditions(report: Report, node: str) -> list[str]:
             if u not in cone:
                 cone.add(u)
                 todo.append(u)
-    return [str(sc["id"]) for sc in report.get("side_conditions", [])
-            if str(sc["node"]) in cone and sc["status"] != "discharged"]
+    return [sc.id for sc in report.side_conditions if sc.node in cone and sc.status != "discharged"]
 
 
-def sources(report: Report) -> dict[str, str]:
+def sources(report: AssuranceReport) -> dict[str, str]:
     """``{problem id: file:line:col}`` of the report's items: a side
     condition's conjunct, an obligation's clause, a health finding's
     guarantee (else its node), a requirement's statement, a derived
     property's node (``Node.derived``), a lint error's location."""
     out: dict[str, str] = {}
-    node_src = {str(n["name"]): str(n.get("source", "")) for n in report.get("nodes", [])}
-    g_src: dict[tuple[str, int | None], str] = {(str(n["name"]), g["index"]): str(g.get("source", ""))
-                                                 for n in report.get("nodes", [])
-             for g in n.get("guarantees", [])}
-    for sc in report.get("side_conditions", []):
-        out[str(sc["id"])] = str(sc.get("source", ""))
-    for o in report.get("obligations", []):
-        out[str(o["id"])] = str(o.get("source", ""))
-    for f in report.get("findings", []):
-        out[str(f["id"])] = g_src.get((str(f["node"]), f.get("guarantee")), node_src.get(str(f["node"]), ""))
-    for q in report.get("requirements", []):
-        out[str(q["id"])] = str((q.get("check") or {}).get("source") or "")
-    for d in report.get("derived_properties", []):
-        out[f"{d['node']}.derived"] = node_src.get(str(d["node"]), "")
-    for x in report.get("lint", []):
-        out[str(x["location"])] = str(x["location"])
-    for u in report.get("unverified") or ():
-        out[str(u["id"])] = str(u["source"])
+    node_src = {n.name: n.source for n in report.nodes}
+    g_src: dict[tuple[str, int | None], str] = {(n.name, g.index): g.source for n in report.nodes for g in n.guarantees}
+    for sc in report.side_conditions:
+        out[sc.id] = sc.source
+    for o in report.obligations:
+        out[o.id] = o.source
+    for f in report.findings:
+        out[f.id] = g_src.get((f.node, f.guarantee), node_src.get(f.node, ""))
+    for q in report.requirements:
+        out[q.id] = str(q.check.get("source") or "")
+    for d in report.derived_properties:
+        out[f"{d.node}.derived"] = node_src.get(d.node, "")
+    for x in report.lint:
+        out[x.location] = x.location
+    for u in report.unverified:
+        out[u.id] = u.source
     return out
 
 
-def default_anchor(d: Mapping[str, Any], anchor: Callable[..., str]) -> str:
-    if d["kind"] in ("side-condition",):
-        return anchor("sc", d["id"])
-    if d["kind"] in ("vacuity", "inconsistency", "unsatisfiable-assumption", "refinement"):
-        return anchor("finding", d["id"])
-    if d["kind"] == "requirement":  # a refuted requirement's diagnosis: its row in the requirements table
-        return anchor("req", d["id"])
-    if d["kind"] == "deadline":  # its row in the deadlines table
-        return anchor("deadline", d.get("requirement", ""))
-    return anchor("ev", d["id"])
+def default_anchor(d: DiagnosisRow, anchor: Callable[..., str]) -> str:
+    if d.kind in ("side-condition",):
+        return anchor("sc", d.id)
+    if d.kind in ("vacuity", "inconsistency", "unsatisfiable-assumption", "refinement"):
+        return anchor("finding", d.id)
+    if d.kind == "requirement":  # a refuted requirement's diagnosis: its row in the requirements table
+        return anchor("req", d.id)
+    if d.kind == "deadline":  # its row in the deadlines table
+        return anchor("deadline", d.requirement or "")
+    return anchor("ev", d.id)
 
 
 def culprit(rid: str, places: Places, anchor: Callable[..., str]) -> dict[str, Any]:
+    """The root ``rid`` as a row's culprit (:class:`~rclverify.records.problem_rows.ProblemRow`
+    ``culprits``): ``{"id", "what", "source", "file", "anchor"}``."""
     info = places.info[rid]
-    a = info.get("anchor")
-    m = _SOURCE.match(str(info["source"]))
-    return {"id": rid, "what": info["what"], "source": info["source"], "file": m.group(1) if m else "",
-            "anchor": anchor(*a) if a else ""}
+    m = _SOURCE.match(info.source)
+    return {"id": rid, "what": info.what, "source": info.source, "file": m.group(1) if m else "",
+            "anchor": anchor(*info.anchor) if info.anchor else ""}

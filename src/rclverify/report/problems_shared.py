@@ -23,33 +23,32 @@ property behind both joins the same row.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.report.problems_places import Rooted
 
 
-def first_diff(diagnosis: Mapping[str, Any] | None) -> str | None:
-    """The unified diff of the first repair of ``diagnosis`` (a diagnosis
-    record: ``{"repairs": [{"diff": str, ...}, ...]}``), ``None`` when it
-    has none."""
-    reps = (diagnosis or {}).get("repairs") or ()
+def first_diff(diagnosis: DiagnosisRow | None) -> str | None:
+    """The unified diff of the first repair of ``diagnosis`` (its ``repairs``: ``[{"diff": str, ...},
+    ...]``), ``None`` when it has none."""
+    reps = diagnosis.repairs if diagnosis is not None else []
     diff = reps[0].get("diff") if reps and isinstance(reps[0], Mapping) else None
     return str(diff) if diff else None
 
 
-def join_by_first_repair(members: list[tuple[dict[str, Any], list[str]]],
-                         by_id: Mapping[str, Mapping[str, Any]]) -> None:
+def join_by_first_repair(members: list[Rooted], by_id: Mapping[str, DiagnosisRow]) -> None:
     """Give the failed side conditions of ``members`` that share a first
     repair one key: the union of their roots (module docstring).
 
-    ``members`` is the grouping's list of ``(member, roots)`` (member
-    ``{"id", "kind", "status", ...}``, roots the root-culprit ids), changed
-    in place; ``by_id`` maps a diagnosis id to its record.  Members of other
-    kinds, and side conditions whose first repair no other shares, are left
-    as they are."""
+    ``members`` is the grouping's list of ``(member, roots)`` (roots the
+    root-culprit ids), changed in place; ``by_id`` maps a diagnosis id to
+    its record.  Members of other kinds, and side conditions whose first
+    repair no other shares, are left as they are."""
     by_diff: dict[str, list[int]] = {}
     for i, (m, roots) in enumerate(members):
-        if m.get("kind") != "side-condition" or not roots or m.get("status") != "failed":
+        if m.kind != "side-condition" or not roots or m.status != "failed":
             continue
-        diff = first_diff(by_id.get(str(m["id"])))
+        diff = first_diff(by_id.get(m.id))
         if diff is not None:
             by_diff.setdefault(diff, []).append(i)
     for idx in by_diff.values():
@@ -58,7 +57,6 @@ def join_by_first_repair(members: list[tuple[dict[str, Any], list[str]]],
         union: list[str] = sorted({r for i in idx for r in members[i][1]})
         for i in idx:
             members[i] = (members[i][0], list(union))
-
 
 
 def producer_first(roots: Sequence[str]) -> list[str]:

@@ -13,61 +13,59 @@ health warning, a run whose evidence holds) is listed in that row too.
 """
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Sequence
 
-from rclverify.records.report_schema import Report
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.report.problems_places import Member
 
 #: The kind of a unit mismatch's diagnosis record.
 KIND = "unit"
 
 
-def joins(diagnoses: Sequence[Mapping[str, Any]]) -> dict[str, str]:
+def joins(diagnoses: Sequence[DiagnosisRow]) -> dict[str, str]:
     """``{finding id: unit record id}`` of every unit record's ``joins``
     (the first record that names a finding keeps it)."""
     out: dict[str, str] = {}
     for d in diagnoses:
-        if d.get("kind") == KIND:
-            for j in d.get("joins") or ():
-                out.setdefault(str(j), str(d["id"]))
+        if d.kind == KIND:
+            for j in d.joins or ():
+                out.setdefault(j, d.id)
     return out
 
 
-def extra_members(report: Report, diagnoses: Sequence[Mapping[str, Any]], covered: set[str],
-                  anchor: Callable[..., str]) -> list[tuple[dict[str, Any], str]]:
+def _violation(j: str, first: dict[str, object]) -> str:
+    return (f"{j}: the assumption `{first.get('assumption', '')}` is violated at {first.get('where', '?')} "
+            f"(t = {first.get('time', '?')} s), blamed on the {first.get('blame', '?')}.")
+
+
+def extra_members(report: AssuranceReport, diagnoses: Sequence[DiagnosisRow], covered: set[str],
+                  anchor: Callable[..., str]) -> list[tuple[Member, str]]:
     """The joined findings not yet among the row's members, each
     ``(member, unit record id)``: a lint row (by location), a health
-    finding, an evidence record; members as ``group_problems`` makes them
-    (``id``, ``kind``, ``status``, ``sentence``, ``anchor``, ``diagnosis``)."""
-    lint = {str(x["location"]): (k, x) for k, x in enumerate(report.get("lint") or ())}
-    findings = {str(f["id"]): f for f in report.get("findings") or ()}
-    evidence = {str(e["obligation"]): e for e in report.get("evidence") or ()}
-    out: list[tuple[dict[str, Any], str]] = []
+    finding, an evidence record (members as ``group_problems`` makes them)."""
+    lint = {x.location: (k, x) for k, x in enumerate(report.lint)}
+    findings = {f.id: f for f in report.findings}
+    evidence = {e.obligation: e for e in report.evidence}
+    out: list[tuple[Member, str]] = []
     for d in diagnoses:
-        if d.get("kind") != KIND:
+        if d.kind != KIND:
             continue
-        for j in d.get("joins") or ():
-            j = str(j)
+        for j in d.joins or ():
             if j in covered:
                 continue
             covered.add(j)
             if j in lint:
                 k, x = lint[j]
-                m = {"id": j, "kind": "lint", "status": str(x["severity"]).lower(),
-                     "sentence": f"{x.get('code', '')}: {x['message']}", "anchor": anchor("lint", k + 1)}
+                m = Member(j, "lint", x.severity.lower(), f"{x.code}: {x.message}", anchor("lint", k + 1), False)
             elif j in findings:
                 f = findings[j]
-                m = {"id": j, "kind": f"contract health: {f['check']}", "status": str(f["status"]),
-                     "sentence": str(f["message"]), "anchor": anchor("finding", j)}
+                m = Member(j, f"contract health: {f.check}", f.status, f.message, anchor("finding", j), False)
             elif j in evidence:
                 e = evidence[j]
-                first = (e.get("monitoring") or {}).get("first_assumption_violation") or {}
-                m = {"id": j, "kind": "evidence", "status": str(e["status"]),
-                     "sentence": (f"{j}: the assumption `{first.get('assumption', '')}` is violated at "
-                                  f"{first.get('where', '?')} (t = {first.get('time', '?')} s), blamed on the "
-                                  f"{first.get('blame', '?')}."),
-                     "anchor": anchor("ev", j)}
+                first = (e.monitoring or {}).get("first_assumption_violation") or {}
+                m = Member(j, "evidence", e.status, _violation(j, first), anchor("ev", j), False)
             else:
                 continue
-            out.append(({**m, "diagnosis": False}, str(d["id"])))
+            out.append((m, d.id))
     return out
