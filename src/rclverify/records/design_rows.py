@@ -44,6 +44,7 @@ class DesignFieldRow(Row, frozen=True, forbid_unknown_fields=True):
     status: Annotated[Literal["proved", "refuted", "undecided"], DOC(description="bound <= limit: proved; bound > limit: refuted; no bound: undecided.")]
     why: Annotated[str, DOC(description="Undecided: where the chain breaks; else empty.")]
     steps: Annotated[list[DesignStepRow], DOC(description="The contract clauses the bound adds up, first to last.")]
+    at: Annotated[DesignPlaceRow | None, DOC(description="Where the field is written in the design; null when the record does not say.")] = None
 
 
 class DesignFindingRow(Row, frozen=True, forbid_unknown_fields=True):
