@@ -37,6 +37,8 @@ nothing itself.  Layout (decisions in ``docs/ci.md``):
   one failing ``<testcase>`` per diagnostic (:func:`_lint_suite`);
 * when the runs nearly missed a guarantee, a ``near_misses`` ``<testsuite>``
   with one failing ``<testcase>`` per near miss (:func:`.near_misses.junit_suite`);
+* when the plan names a design, a ``design`` ``<testsuite>``, one case per monitoring field
+  (:func:`.design.junit_suite`; docs/nodl.md, "The design stage");
 * when the workspace has NoDL documents, a ``nodl`` ``<testsuite>`` with one
   failing ``<testcase>`` per NoDL error, or one passing case for a check
   without one (:func:`.nodl.junit_suite`; docs/nodl.md).  The ROS grounding
@@ -148,8 +150,10 @@ def junit_tree(report: Report | AssuranceReport) -> ET.Element:
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
+    from rclverify.report.design import junit_suite as design_suite  # deferred: start-up (only when called)
     for req in (_requirements_suite(typed), junit_suite(typed, _case, _outcome), _lint_suite(typed),
-                near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome)):
+                near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome),
+                design_suite(typed, _case, _outcome)):
         if req is None:
             continue
         root.append(req[0])
@@ -355,8 +359,10 @@ def render_junit(report: Report | AssuranceReport, fragments: FragmentCache | No
     from rclverify.report.deadlines import junit_suite  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report.near_misses import junit_suite as near_misses_suite  # deferred: start-up (only when called)
     from rclverify.report.nodl import junit_suite as nodl_suite  # deferred: start-up (only when called)
+    from rclverify.report.design import junit_suite as design_suite  # deferred: start-up (only when called)
     for req in (_requirements_suite(typed), junit_suite(typed, _case, _outcome), _lint_suite(typed),
-                near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome)):
+                near_misses_suite(typed, _case, _outcome), nodl_suite(typed, _case, _outcome),
+                design_suite(typed, _case, _outcome)):
         if req is None:
             continue
         ET.indent(req[0], level=1)

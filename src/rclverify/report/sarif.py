@@ -363,12 +363,15 @@ def sarif_log(report: Report | AssuranceReport) -> SarifLog:
     from rclverify.report.deadlines import SARIF_RULES, sarif_results  # deferred: start-up (loads rclverify.lang.errors, rclverify.report.deadlines and more only when called)
     from rclverify.report import near_misses  # deferred: start-up (loads rclverify.report.near_misses only when called)
     from rclverify.report import nodl  # deferred: start-up (loads rclverify.report.nodl only when called)
+    from rclverify.report import design  # deferred: start-up (loads rclverify.report.design only when called)
     results = (_obligation_results(typed) + _unverified_results(typed) + _side_condition_results(typed)
                + _finding_results(typed) + lint + ground + nodl.sarif_results(typed, sarif_result, sarif_locations)
+               + design.sarif_results(typed, sarif_result, sarif_locations)
                + _requirement_results(typed) + sarif_results(typed, sarif_result) + _acknowledgement_results(typed)
                + near_misses.sarif_results(typed, sarif_result))
     _attach_diagnoses(typed, results)
     rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
+                             + [Rule(*r) for r in design.SARIF_RULES]
                              + [Rule(*r) for r in near_misses.SARIF_RULES] + lint_rules + ground_rules)
     index = {r.id: i for i, r in enumerate(rules)}
     for res in results:
