@@ -184,6 +184,14 @@ def _files(root: Path) -> dict[str, str]:
     return {p.relative_to(root).as_posix(): p.read_text(encoding="utf-8") for p in sorted(root.rglob("*")) if p.is_file()}
 
 
+PLAN = "contracts/plan.yaml"
+
+
+def _made(ws: Path) -> dict[str, str]:
+    """The files of workspace ``ws`` the import writes, the design's copy (design/) aside."""
+    return {k: v for k, v in _files(ws).items() if not k.startswith("design/")}
+
+
 def _at(path: Path, text: str, nth: int = 1) -> str:
     """``file:line:col`` of the ``nth`` line of ``path`` holding ``text``, as the messages show it."""
     hits = [(i, ln.index(text) + 1) for i, ln in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if text in ln]
@@ -270,15 +278,54 @@ def test_export_then_import_gives_the_same_workspace(tmp_path: Path, capsys, mon
     exported = read_design(tmp_path / "exported")
     assert list(exported.nodes) == ["lidar", "perception_filter", "perception_tracker", "planner"]
     assert main(["import", "autoware-design", "exported", "-o", "ws2"]) == 0
-    assert _files(tmp_path / "ws1") == _files(tmp_path / "ws2")
+    # every file the import makes is the same (the plan's design key too), and each workspace holds the design
+    # it was imported from (ws1 the hand-written one, ws2 the export), which its plan names
+    assert _made(tmp_path / "ws1") == _made(tmp_path / "ws2") and 'design: "design"' in _made(tmp_path / "ws1")[PLAN]
+    assert _files(tmp_path / "ws1/design") == _files(tmp_path / "design")
+    assert _files(tmp_path / "ws2/design") == _files(tmp_path / "exported")
+    assert main(["export", "autoware-design", "-w", "ws2", "-o", "exported2"]) == 0
+    assert _files(tmp_path / "exported2") == _files(tmp_path / "exported")  # export -> import -> export: equal
     # the control: an edited contract is carried by the export, so the round trip is not vacuous
     rcl = tmp_path / "ws1/contracts/design.rcl"
     rcl.write_text(rcl.read_text(encoding="utf-8").replace("within 150 ms", "within 100 ms"), encoding="utf-8")
     assert main(["export", "autoware-design", "-w", "ws1", "-o", "exported", "--force"]) == 0
     assert "timeout: 0.1" in (tmp_path / "exported/node/perception_filter.node.yaml").read_text(encoding="utf-8")
     assert main(["import", "autoware-design", "exported", "-o", "ws2", "--force"]) == 0
-    assert _files(tmp_path / "ws1") == _files(tmp_path / "ws2")
+    assert _made(tmp_path / "ws1") == _made(tmp_path / "ws2")
     assert "in.points within 100 ms" in (tmp_path / "ws2/contracts/design.rcl").read_text(encoding="utf-8")
+    assert _files(tmp_path / "ws2/design") == _files(tmp_path / "exported")  # the edited design, copied
+
+
+def test_import_names_the_design_in_the_plan_and_keeps_an_existing_plans_other_content(
+        tmp_path: Path, capsys, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A new plan names the design copied into the workspace (design: "design"), and the design stage's check
+    reads it; a design already inside the workspace is named where it is, not copied; an existing plan is never
+    replaced: its design key is set (replaced, or added) and every other line kept, comments and all."""
+    _design(tmp_path / "design")
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 0
+    from rclverify.stages.workspace import Workspace
+    assert Workspace(tmp_path / "ws", PLAN).plan.design == "design"
+    _design(tmp_path / "ws2" / "arch" / "rover")
+    assert main(["import", "autoware-design", "ws2/arch/rover", "-o", "ws2"]) == 0
+    assert 'design: "arch/rover"' in (tmp_path / "ws2" / PLAN).read_text(encoding="utf-8")
+    assert not (tmp_path / "ws2/design").exists()  # named where it lies
+    plan = tmp_path / "ws" / PLAN
+    own = ("# the robot's plan, edited by hand\nname: Rover\ncontracts:\n  - contracts/design.rcl\n"
+           "design: old/place\n  # a stray continuation\nros:\n  workspaces: [src]\n")
+    plan.write_text(own, encoding="utf-8")
+    capsys.readouterr()
+    assert main(["import", "autoware-design", "design", "-o", "ws", "--force"]) == 0
+    assert plan.read_text(encoding="utf-8") == own.replace("design: old/place\n  # a stray continuation\n",
+                                                           'design: "design"\n')
+    assert "the plan's other content kept" in capsys.readouterr().out
+    plan.write_text("name: Rover\ncontracts: [contracts/design.rcl]", encoding="utf-8")  # no key, no final newline
+    assert main(["import", "autoware-design", "design", "-o", "ws", "--force"]) == 0
+    assert plan.read_text(encoding="utf-8") == 'name: Rover\ncontracts: [contracts/design.rcl]\ndesign: "design"\n'
+    # the control: without --force nothing is written, the plan included
+    plan.write_text(own, encoding="utf-8")
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 1
+    assert plan.read_text(encoding="utf-8") == own
 
 
 @pytest.mark.parametrize(("rel", "old", "new", "where", "says"), [
@@ -366,3 +413,38 @@ def test_a_folder_with_two_systems_needs_one_named_and_nothing_is_read_from_outs
     err = capsys.readouterr().err
     assert err.startswith("design/node/Elsewhere.node.yaml:1:1: error: leads outside the design folder") and \
         "Traceback" not in err
+
+
+def test_the_design_stage_record_is_sarif_results_and_junit_cases_at_the_design_files_lines(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The stage's record of the refuted design (filter within 250 ms) as SARIF and JUnit: the tracker's timeout
+    an error result at its line in Tracker.node.yaml with the two contract clauses as related locations, and a
+    failing case there; the filter's own timeout (met: the control) a note and a passing case."""
+    import xml.etree.ElementTree as ET
+    from _typed_rows import typed_report
+    from rclverify.report.junit import junit_tree
+    from rclverify.report.sarif import sarif_log
+    from rclverify.stages.design import design_row, stage_design
+    from rclverify.stages.workspace import Workspace
+    _design(tmp_path / "design", filter_timeout="0.25")
+    monkeypatch.chdir(tmp_path)
+    assert main(["import", "autoware-design", "design", "-o", "ws"]) == 1
+    ws = Workspace(tmp_path / "ws", PLAN)
+    stage_design(ws)
+    report = typed_report({"design": design_row(ws)})
+    results = [r for r in sarif_log(report)["runs"][0]["results"] if r["ruleId"] == "RCL-DESIGN"]
+    by = {(r["properties"]["node"], r["properties"]["field"], r["properties"]["trigger"]): r for r in results}
+    tracker = by[("perception_tracker", "timeout", "in.objects")]
+    loc = tracker["locations"][0]["physicalLocation"]
+    line = int(_at(tmp_path / "ws/design/node/Tracker.node.yaml", "timeout: 0.3").split(":")[0])
+    assert (loc["artifactLocation"]["uri"], loc["region"]["startLine"]) == ("design/node/Tracker.node.yaml", line)
+    assert tracker["level"] == "error" and "[design-timeout]" in tracker["message"]["text"]
+    assert [r["physicalLocation"]["artifactLocation"]["uri"] for r in tracker["relatedLocations"]] == ["contracts/design.rcl"] * 2
+    met = by[("perception_filter", "timeout", "in.points")]
+    assert met["level"] == "note" and "holds" in met["message"]["text"]
+    [suite] = [s for s in junit_tree(report).iter("testsuite") if s.get("name") == "design"]
+    cases = {c.get("name"): c for c in suite.iter("testcase")}
+    failed = cases["perception_tracker in.objects timeout"]
+    assert failed.get("line") == str(line) and failed.find("failure") is not None
+    assert len(cases["perception_filter in.points timeout"]) == 0  # passes
+    assert suite.get("tests") == str(len(results)) and ET.tostring(suite).count(b"<failure") == int(suite.get("failures") or 0)

@@ -34,12 +34,10 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     root = tmp_path_factory.mktemp("design_verify")
     _design(root / "design")
     assert main(["import", "autoware-design", str(root / "design"), "-o", str(root / "ws")]) == 0
-    ws = root / "ws"
-    _design(ws / "design")
-    plan = ws / "contracts" / "plan.yaml"
-    plan.write_text(plan.read_text(encoding="utf-8").rstrip("\n") + "\ndesign: design\n", encoding="utf-8")
+    ws = root / "ws"  # the import copied the design into ws/design and named it in the plan (design: "design")
     out: dict[str, Any] = {"ws": ws, "code": main(["verify", "-w", str(ws)]), "clean": _read(ws),
-                           "clean_md": (ws / "reports" / "assurance.md").read_text(encoding="utf-8")}
+                           "clean_md": (ws / "reports" / "assurance.md").read_text(encoding="utf-8"),
+                           "clean_sarif": _design_results(ws), "clean_junit": _design_suite(ws)}
     made = (ws / INDEX).stat().st_mtime_ns
     out["again"] = main(["verify", "-w", str(ws)])
     out["rerun"] = (ws / INDEX).stat().st_mtime_ns != made
@@ -49,7 +47,21 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     out["strict"] = main(["verify", "-w", str(ws), "--strict"])
     out["seeded"] = _read(ws)
     out["seeded_md"] = (ws / "reports" / "assurance.md").read_text(encoding="utf-8")
+    out["seeded_sarif"], out["seeded_junit"] = _design_results(ws), _design_suite(ws)
     return out
+
+
+def _design_results(ws: Path) -> list[dict[str, Any]]:
+    """The RCL-DESIGN results of reports/assurance.sarif."""
+    log = json.loads((ws / "reports" / "assurance.sarif").read_text(encoding="utf-8"))
+    return [r for r in log["runs"][0]["results"] if r["ruleId"] == "RCL-DESIGN"]
+
+
+def _design_suite(ws: Path) -> Any:
+    """The ``design`` testsuite of reports/assurance.junit.xml."""
+    import xml.etree.ElementTree as ET
+    root = ET.parse(ws / "reports" / "assurance.junit.xml").getroot()
+    return next(s for s in root.iter("testsuite") if s.get("name") == "design")
 
 
 def test_the_design_that_fits_is_proved_by_verify(runs: dict[str, Any]) -> None:
@@ -85,3 +97,44 @@ def test_a_deadline_the_design_cannot_meet_is_refuted_in_the_report_and_fails_st
     assert any(p.startswith("design design-timeout at design/node/Tracker.node.yaml:") for p in report["summary"]["problems"])
     assert runs["strict"] != 0 and report["meta"]["strict_ok"] is False
     assert "| perception\\_tracker | in.objects | timeout | 300 ms | 350 ms | **refuted** |" in runs["seeded_md"]
+
+
+def _where(r: dict[str, Any]) -> tuple[str, int]:
+    loc = r["locations"][0]["physicalLocation"]
+    return loc["artifactLocation"]["uri"], loc["region"]["startLine"]
+
+
+def test_the_design_fields_are_sarif_results_and_junit_cases_at_the_design_files_lines(runs: dict[str, Any]) -> None:
+    """Each monitoring field is one SARIF result of RCL-DESIGN and one JUnit case, at its line in the design file:
+    in the clean run the tracker's timeout is met (a note, a passing case) and the goal's timeout undecided (a
+    warning, a skipped case); in the seeded run the tracker's timeout is refuted (an error with the contract
+    clauses as related locations, a failing case) and the suite counts three failures."""
+    ws = runs["ws"]
+    tracker_yaml = (ws / "design/node/Tracker.node.yaml").read_text(encoding="utf-8").splitlines()
+
+    def tracker_timeout(results: list[dict[str, Any]]) -> dict[str, Any]:
+        [r] = [r for r in results if r["properties"]["node"] == "perception_tracker"
+               and r["properties"]["field"] == "timeout"]
+        return r
+    clean, seeded = tracker_timeout(runs["clean_sarif"]), tracker_timeout(runs["seeded_sarif"])
+    assert len(runs["clean_sarif"]) == 6 == len(runs["seeded_sarif"])  # one per field, no finding twice
+    file, line = _where(clean)
+    assert file == "design/node/Tracker.node.yaml" and "timeout: 0.3" in tracker_yaml[line - 1]
+    assert clean["level"] == "note" and "holds" in clean["message"]["text"] and "250 ms <= 300 ms" in clean["message"]["text"]
+    assert "relatedLocations" in clean  # the chain it holds by
+    goal = [r for r in runs["clean_sarif"] if r["properties"]["status"] == "undecided"]
+    assert [r["level"] for r in goal] == ["warning"] and "[design-undecided]" in goal[0]["message"]["text"]
+    assert _where(seeded) == (file, line) and seeded["level"] == "error"
+    assert "350 ms > 300 ms" in seeded["message"]["text"] and "[design-timeout]" in seeded["message"]["text"]
+    assert {r["physicalLocation"]["artifactLocation"]["uri"] for r in seeded["relatedLocations"]} == {"contracts/design.rcl"}
+    assert sorted(r["level"] for r in runs["seeded_sarif"]) == ["error", "error", "error", "note", "note", "warning"]
+
+    def case(suite: Any) -> Any:
+        [c] = [c for c in suite.iter("testcase") if c.get("name") == "perception_tracker in.objects timeout"]
+        return c
+    clean_case, seeded_case = case(runs["clean_junit"]), case(runs["seeded_junit"])
+    assert clean_case.get("file") == file and clean_case.get("line") == str(line) and len(clean_case) == 0  # passes
+    failure = seeded_case.find("failure")
+    assert failure is not None and "350 ms > 300 ms" in failure.get("message", "")
+    assert runs["clean_junit"].get("failures") == "0" and runs["clean_junit"].get("skipped") == "1"
+    assert runs["seeded_junit"].get("failures") == "3" and runs["seeded_junit"].get("tests") == "6"

@@ -2,7 +2,10 @@
 designs read into a workspace and written from one (docs/nodl.md, "Autoware System Designer").
 
 ``rclverify import autoware-design DIR -o WS``   the design's contracts, plan and NoDL documents written
-                                                 into WS, then its monitoring fields decided against them
+                                                 into WS (the design copied to WS/design unless it lies in
+                                                 WS; the plan's ``design`` key names it; an existing plan
+                                                 keeps its other content), then its monitoring fields
+                                                 decided against them
 ``rclverify import autoware-design DIR --check [-w WS]``  only decide them against WS as it stands
 ``rclverify export autoware-design [-w WS] -o DIR``        the workspace written as a design
 
@@ -19,6 +22,8 @@ from typing import Any
 
 #: The formats ``import`` and ``export`` know.
 FORMATS = ("autoware-design",)
+#: The plan ``import`` writes (or, when it exists, whose ``design`` key it sets).
+PLAN = "contracts/plan.yaml"
 
 
 def add_import(sub: Any) -> None:
@@ -101,13 +106,36 @@ def cmd_import(args: argparse.Namespace) -> int:
     if args.check:
         return _timing(design, Workspace(Path(args.workspace), args.plan))
     out = Path(args.output)
-    texts = workspace_texts(design)
+    folder = _inside(root, out)
+    texts = workspace_texts(design, folder or "design")
+    if folder is None:  # the design is copied into the workspace, which the plan's design key names
+        from rclverify.model.nodl.design_read import design_files  # deferred: start-up (as above)
+        for path, _shown in design_files(root):
+            texts[f"design/{path.relative_to(root).as_posix()}"] = path.read_text(encoding="utf-8")
+    plan = out / PLAN
+    kept = plan.is_file()
+    if kept:  # an existing plan is never replaced: its design key is set, the rest kept
+        del texts[PLAN]
     if not (out / "dodo.py").exists():
         from rclverify.tools.scaffold import _env as scaffold_env  # deferred: start-up (the scaffold's templates)
         texts["dodo.py"] = scaffold_env().get_template("dodo.py.j2").render(name=design.name)
     if not _write(out, texts, args.force):
         return 1
-    return _timing(design, Workspace(out, "contracts/plan.yaml"))
+    if kept:
+        from rclverify.core.atomic import atomic_write_text  # deferred: start-up (only when writing)
+        from rclverify.model.nodl.design_write import with_design_key  # deferred: start-up (as above)
+        atomic_write_text(plan, with_design_key(plan.read_text(encoding="utf-8"), folder or "design"), within=out)
+        print(f"{plan} (design: {folder or 'design'}; the plan's other content kept)")
+    return _timing(design, Workspace(out, PLAN))
+
+
+def _inside(design: Path, ws: Path) -> str | None:
+    """``design``'s path relative to workspace ``ws`` (posix) when it lies inside it, else ``None``."""
+    try:
+        rel = design.resolve().relative_to(ws.resolve()).as_posix()
+    except ValueError:
+        return None
+    return rel if rel != "." else None
 
 
 def cmd_export_design(args: argparse.Namespace) -> int:

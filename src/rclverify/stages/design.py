@@ -13,7 +13,7 @@ Writes ``artifacts/design/index.json``: ``design`` (the folder), ``system`` (its
 ``wires`` (counts of the flattened design), ``decided`` (one row per field: ``node``, ``trigger``,
 ``field``, ``limit_s`` and ``bound_s`` as exact fractions in text, ``limit`` and ``bound`` in ms as the
 report shows them, ``status``, ``why``, ``steps``: the
-contract clauses the bound adds up, each ``text`` and ``at``), ``findings`` (code, severity, message,
+contract clauses the bound adds up, each ``text`` and ``at``; ``at``: the field's place in the design), ``findings`` (code, severity, message,
 ``places``), ``counts`` (per severity) and ``inputs``: the sha256 of the plan, its contract files and every
 design file.  Places are shown from the workspace root.  The record is sealed
 (:mod:`rclverify.records.sealed`); :func:`read_design_record` shows one whose seal does not hold as one
@@ -79,7 +79,8 @@ def stage_design(ws: "Workspace") -> dict[str, Any]:
     rows = [{"node": d.node, "trigger": d.trigger, "field": d.field, "limit_s": str(d.limit), "limit": _ms(d.limit),
              "bound_s": None if d.bound is None else str(d.bound.seconds),
              "bound": None if d.bound is None else _ms(d.bound.seconds), "status": d.status, "why": d.why,
-             "steps": [] if d.bound is None else [{"text": text, "at": _place(loc, prefix)} for text, loc in d.bound.steps]}
+             "steps": [] if d.bound is None else [{"text": text, "at": _place(loc, prefix)} for text, loc in d.bound.steps],
+             "at": None if d.loc is None else _place(d.loc, prefix)}
             for d in decided]
     errors = sum(f.severity == "error" for f in findings)
     record: dict[str, Any] = {

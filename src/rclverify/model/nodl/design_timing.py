@@ -55,7 +55,8 @@ class Bound:
 @dataclass(frozen=True)
 class Decided:
     """A monitoring field decided: the node, the trigger (``in.x`` or ``periodic``), the field, its limit
-    in seconds, the bound (``None``: undecided, ``why`` says why) and the verdict."""
+    in seconds, the bound (``None``: undecided, ``why`` says why), the verdict and where the field is written
+    in the design (``loc``)."""
 
     node: str
     trigger: str
@@ -64,6 +65,7 @@ class Decided:
     bound: Bound | None
     status: str
     why: str = ""
+    loc: ast.Loc | None = None
 
 
 class _Gaps:
@@ -174,13 +176,13 @@ def check_timing(design: Design, checked: Checked, links: Sequence[Link]) -> tup
                     shown = f"{name} {value:g} {'s' if name == 'timeout' else 'Hz'}"
                     where = f"{node.name} process {proc.name}'s {trigger}"
                     if bound is None:
-                        decided.append(Decided(node.name, trigger, name, limit, None, "undecided", why))
+                        decided.append(Decided(node.name, trigger, name, limit, None, "undecided", why, loc))
                         findings.append(Finding("design-undecided", f"{where}: {shown} is not decided: {why}",
                                                 (loc,), "warning"))
                     elif bound.seconds <= limit:
-                        decided.append(Decided(node.name, trigger, name, limit, bound, "proved"))
+                        decided.append(Decided(node.name, trigger, name, limit, bound, "proved", "", loc))
                     else:
-                        decided.append(Decided(node.name, trigger, name, limit, bound, "refuted"))
+                        decided.append(Decided(node.name, trigger, name, limit, bound, "refuted", "", loc))
                         chain = " -> ".join(s for s, _ in bound.steps)
                         findings.append(Finding(code, f"{where}: {shown} cannot be met: the contracts let it wait "
                                                 f"{duration(bound.seconds)} > {duration(limit)} ({chain})",

@@ -148,18 +148,42 @@ def _document(node: DesignNode) -> dict[str, object]:
             **{k: lists[k] for k in sorted(lists)}}
 
 
-def workspace_texts(design: Design) -> dict[str, str]:
-    """The workspace files of ``design``, by path relative to the workspace: the contracts, the plan, and
-    one NoDL document per node (module docstring)."""
+def workspace_texts(design: Design, folder: str = "design") -> dict[str, str]:
+    """The workspace files of ``design``, by path relative to the workspace: the contracts, the plan (its
+    ``design`` key ``folder``: where the design lies in the workspace), and one NoDL document per node
+    (module docstring)."""
     nodes = [_contract_view(n) for n in design.nodes.values()]
     files = {CONTRACTS: _env().get_template("design.rcl.j2").render(name=design.name, nodes=nodes)}
     wires = sorted({(f"{w.writer}.{var_of(w.writer_port)}", f"{w.reader}.{var_of(w.reader_port)}")
                     for w in design.wires if w.role == "publisher"})
     files["contracts/plan.yaml"] = _env().get_template("design_plan.yaml.j2").render(
-        name=json.dumps(design.name), contracts=CONTRACTS, connections=wires)
+        name=json.dumps(design.name), contracts=CONTRACTS, connections=wires, design=json.dumps(folder))
     for n in design.nodes.values():
         files[f"nodl/{n.name}.nodl.yaml"] = yaml_text(_document(n))
     return files
+
+
+def with_design_key(plan: str, folder: str) -> str:
+    """The text of plan ``plan`` with its top-level ``design`` key set to ``folder`` (replaced where the plan has
+    one, appended where not), every other line kept as it is."""
+    lines = plan.splitlines(keepends=True)
+    out, skipping, done = [], False, False
+    for line in lines:
+        top = bool(line[:1].strip()) and not line.startswith("#")
+        if top:
+            skipping = False
+        if top and re.match(r"design\s*:", line):
+            out.append(f"design: {json.dumps(folder)}\n")
+            skipping, done = True, True
+            continue
+        if skipping and not top:
+            continue  # the old value's continuation lines
+        out.append(line)
+    if not done:
+        if out and not out[-1].endswith("\n"):
+            out[-1] += "\n"
+        out.append(f"design: {json.dumps(folder)}\n")
+    return "".join(out)
 
 
 def _hz(period: Fraction) -> float | int:
