@@ -15,7 +15,7 @@ the engine reads it (a question left unanswered, ``closing.py``).
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Iterator, Mapping, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Union
 
 from rclverify.core.numeric import np
 
@@ -46,13 +46,16 @@ class AnsweredRun:
         i = int(self.at[j])
         qe, ev = chunk[i], chunk[i + 1]
         inputs = {}
-        for k in run.m._in_keys:  # a mapped value is the message's field itself (value_mapper's one-field rule)
+        mapped = plan.mapped  # a window's value is its mapper's; any other the message's field itself
+        for k in run.m._in_keys:  # (value_mapper's one-field rule)
             w = int(self.where[k][j])
-            inputs[k] = chunk[w].fields[run.fields[k]] if w >= 0 else self.seed[k]
+            inputs[k] = (mapped[k](chunk[w].fields) if k in mapped else chunk[w].fields[run.fields[k]]) \
+                if w >= 0 else self.seed[k]
         q = Question(qe, qe.time, inputs, True, "exact")
         q.answered = True
         q.last_out = ev
-        mine = {plan.output[1]: ev.fields[plan.output[2]]}
+        okey = plan.output[1]
+        mine = {okey: mapped[okey](ev.fields) if okey in mapped else ev.fields[plan.output[2]]}
         q.answer = mine
         view = dict(inputs)
         view.update(mine)
@@ -71,13 +74,16 @@ class RecentOutput:
     """An entry of the engine's ``_recent`` outputs, ``(event, stamp, {key: value}, {})``
     as ``engine.py`` appends it, for the answer at row ``i`` of a batch chunk
     (``rows[i]`` its event, made when an item other than the stamp is read);
-    ``stamp`` its time (s), ``key``/``field`` the output's variable and field.
+    ``stamp`` its time (s), ``key``/``field`` the output's variable and field, ``mapped`` its value from
+    the message's fields where that is not the field itself (a window).
     Compared by identity, as the engine's own entries (each a distinct event)."""
 
-    __slots__ = ("rows", "i", "stamp", "key", "field")
+    __slots__ = ("rows", "i", "stamp", "key", "field", "mapped")
 
-    def __init__(self, rows: EventRows | BlockRows, i: int, stamp: float, key: str, field: str) -> None:
+    def __init__(self, rows: EventRows | BlockRows, i: int, stamp: float, key: str, field: str,
+                 mapped: Callable[[Mapping[str, object]], Any] | None = None) -> None:
         self.rows, self.i, self.stamp, self.key, self.field = rows, i, stamp, key, field
+        self.mapped = mapped
 
     def __getitem__(self, k: int) -> Any:
         return self.stamp if k == 1 else self._entry()[k]
@@ -90,7 +96,8 @@ class RecentOutput:
 
     def _entry(self) -> tuple[Event, float, dict[str, object], dict[str, object]]:
         ev = self.rows[self.i]
-        return ev, self.stamp, {self.key: ev.fields[self.field]}, _EMPTY
+        value = ev.fields[self.field] if self.mapped is None else self.mapped(ev.fields)
+        return ev, self.stamp, {self.key: value}, _EMPTY
 
 
 _EMPTY: dict[str, object] = {}
