@@ -58,29 +58,32 @@ class MarginCompiler:
             links = [self._link(e, i) for i in range(len(e.ops))]
             if len(links) == 1:
                 return links[0]
+            axes = self.columns.axes
 
             def chain(c: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-                out = _truth(c, np.ones(_rows(c), dtype=bool))
+                out = _truth(c, np.ones((_rows(c),) + axes, dtype=bool), axes)
                 for link in links:
                     out = _min(out, link(c))
                 return out
             return chain
         truth = self.columns.compile(e)  # a BOOL literal or constant: no distance
-        return lambda c: _truth(c, truth(c)[0])
+        axes = self.columns.axes
+        return lambda c: _truth(c, truth(c)[0], axes)
 
     def _link(self, e: ast.Compare, i: int) -> ColumnMargin:
         op, x, y = e.ops[i], e.operands[i], e.operands[i + 1]
         cols = self.columns
         truth = cols._compare(op, x, y)
-        if cols._enum(x) is not None or cols._enum(y) is not None or not measures_the_run((x, y), self.io):
-            return lambda c: _truth(c, truth(c)[0])
+        axes = cols.axes
+        if cols._enum(x) is not None or cols._enum(y) is not None or not self.measures((x, y)):
+            return lambda c: _truth(c, truth(c)[0], axes)
         nx, ny = cols._num(x), cols._num(y)
         atom = len(self.atoms)
         self.atoms.append((e, i))
 
         def link(c: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
             vx, vy = nx(c)[0], ny(c)[0]
-            n = _rows(c)
+            shape = (_rows(c),) + axes
             with np.errstate(all="ignore"):
                 if op in ("<", "<="):
                     d = vy - vx
@@ -89,18 +92,22 @@ class MarginCompiler:
                 else:
                     d = np.abs(vx - vy)  # an equality holds without a distance: +inf (robustness.distance)
                     d = np.where(d == 0, np.inf, -d) if op == "==" else np.where(d == 0, -np.inf, d)
-            return np.broadcast_to(np.asarray(d, dtype=np.float64), (n,)) + 0.0, np.full(n, atom, dtype=np.int32)
+            return np.broadcast_to(np.asarray(d, dtype=np.float64), shape) + 0.0, np.full(shape, atom, dtype=np.int32)
         return link
+
+    def measures(self, terms: tuple[Any, Any]) -> bool:
+        """Whether a comparison of ``terms`` reads a value of the run (else it has no distance)."""
+        return measures_the_run(terms, self.io)
 
 
 def _rows(c: Mapping[str, np.ndarray]) -> int:
     return len(next(iter(c.values()))) if c else 0
 
 
-def _truth(c: Mapping[str, np.ndarray], truth: Any) -> tuple[np.ndarray, np.ndarray]:
-    """``+inf`` where ``truth`` holds, ``-inf`` elsewhere; no deciding atom."""
-    n = _rows(c)
-    return np.where(np.broadcast_to(truth, (n,)), np.inf, -np.inf), np.full(n, -1, dtype=np.int32)
+def _truth(c: Mapping[str, np.ndarray], truth: Any, axes: tuple[int, ...] = ()) -> tuple[np.ndarray, np.ndarray]:
+    """``+inf`` where ``truth`` holds, ``-inf`` elsewhere; no deciding atom (``axes``: as ColumnCompiler.axes)."""
+    shape = (_rows(c),) + axes
+    return np.where(np.broadcast_to(truth, shape), np.inf, -np.inf), np.full(shape, -1, dtype=np.int32)
 
 
 def _neg(a: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

@@ -80,6 +80,9 @@ class ColumnCompiler:
         self.env, self.node = checked.env, node
         self.codes = {name: k for k, name in enumerate(sorted(self.env.enum_values))}
         self._expanding: set[str] = set()
+        #: the lengths of the bound offsets' axes in scope (a window's quantifiers, :mod:`.column_windows`):
+        #: a term compiled inside them is an array of shape ``(rows,) + axes``; empty outside every quantifier
+        self.axes: tuple[int, ...] = ()
 
     def compile(self, formula: ast.Expr) -> Compiled:
         """``formula`` as a function of the columns (raises :class:`Unsupported`)."""
@@ -88,8 +91,8 @@ class ColumnCompiler:
     # -- booleans ------------------------------------------------------------------------
     def _bool(self, e: Any) -> Compiled:
         if isinstance(e, ast.BoolLit):
-            v = bool(e.value)
-            return lambda c: (_full(c, v), _full(c, True))
+            v, axes = bool(e.value), self.axes
+            return lambda c: (_full(c, v, axes), _full(c, True, axes))
         if isinstance(e, ast.Unary) and e.op == "not":
             f = self._bool(e.operand)
             return lambda c: _not(f(c))
@@ -122,8 +125,8 @@ class ColumnCompiler:
         if ex is not None or ey is not None:
             if ex is None or ey is None or op not in ("==", "!="):
                 raise Unsupported("an enumeration compared with a number or ordered")
-            cmp = _CMP[op]
-            return lambda c: (cmp(ex(c), ey(c)), _full(c, True))
+            cmp, axes = _CMP[op], self.axes
+            return lambda c: (cmp(ex(c), ey(c)), _full(c, True, axes))
         nx, ny = self._num(x), self._num(y)
         cmp = _CMP[op]
 
@@ -147,7 +150,7 @@ class ColumnCompiler:
                 return lambda c: code
             key = self._key(e)
             if key is not None and io_kind(self.node.io_type(e)) == "enum":
-                return lambda c: c[key]
+                return _io(key, self.axes)
         return None
 
     def _key(self, v: ast.Var) -> str | None:
@@ -170,7 +173,8 @@ class ColumnCompiler:
             key = self._key(e)
             if key is None or io_kind(self.node.io_type(e)) != "real":
                 raise Unsupported(f"the term {e.qualified}")
-            return lambda c: (c[key], 0.0)
+            value = _io(key, self.axes)
+            return lambda c: (value(c), 0.0)
         if isinstance(e, ast.Unary) and e.op == "-":
             f = self._num(e.operand)
             return lambda c: _neg(f(c))
@@ -193,9 +197,17 @@ class ColumnCompiler:
             self._expanding.discard(name)
 
 
-def _full(c: Mapping[str, np.ndarray], v: bool) -> np.ndarray:
+def _full(c: Mapping[str, np.ndarray], v: bool, axes: tuple[int, ...] = ()) -> np.ndarray:
     n = len(next(iter(c.values()))) if c else 0
-    return np.full(n, v, dtype=bool)
+    return np.full((n,) + axes, v, dtype=bool)
+
+
+def _io(key: str, axes: tuple[int, ...]) -> Callable[[Mapping[str, np.ndarray]], np.ndarray]:
+    """The column of ``key``, one value a row; inside quantifiers (``axes``) shaped to broadcast over them."""
+    if not axes:
+        return lambda c: c[key]
+    ones = (1,) * len(axes)
+    return lambda c: c[key].reshape((-1,) + ones)
 
 
 def _not(a: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

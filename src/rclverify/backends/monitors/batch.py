@@ -56,6 +56,7 @@ from rclverify.traces.questions import KEPT, Question, QuestionStream
 from rclverify.backends.monitors.answered import AnsweredRun, RecentOutput
 from rclverify.targets.columns import seed
 from rclverify.backends.monitors.batch_plan import BatchPlan, batch_plan
+from rclverify.backends.monitors.batch_window import window_column
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS, KEPT_VIOLATIONS, NodeResult, Verdict
@@ -183,12 +184,18 @@ class _Run:
         if unstamped is not None:
             ok &= unstamped
         cols: dict[str, np.ndarray] = {}
+        full: np.ndarray
         for topic, j, (key, field, kind_) in [(plan.output[0], -1, plan.output[1:])] + \
                 [(t, self.kinds[t], v) for t, v in plan.inputs.items()]:
             rows = np.flatnonzero(kind == j)
-            good, col = chunk.typed(rows, field, kind_, plan.enums.get(key, _EMPTY))
+            if kind_ == "window":  # a window: its message's array, (rows, width) (batch_window.py)
+                width = plan.widths[key]
+                good, col = window_column(chunk.values(rows, field), width)
+                full = np.zeros((n, width))
+            else:
+                good, col = chunk.typed(rows, field, kind_, plan.enums.get(key, _EMPTY))
+                full = np.zeros(n, dtype=np.float64 if kind_ == "real" else np.int64)
             ok[rows] &= good
-            full = np.zeros(n, dtype=np.float64 if kind_ == "real" else np.int64)
             full[rows] = col
             cols[key] = full
         # a pair: an input at i, its answer at i + 1, both mapped, stamped in order, the answer within the horizon
@@ -450,12 +457,12 @@ class _Run:
         if bad and wrong is not None and self.held:  # a violated output is held for the skew, then kept as released (engine.py)
             released = at[wrong][-recent.maxlen:] + 1
             m._released.extend(map(RecentOutput, repeat(chunk), released.tolist(), times[released].tolist(),
-                                   repeat(okey), repeat(ofield)))
+                                   repeat(okey), repeat(ofield), repeat(plan.mapped.get(okey))))
             outs = at[~wrong][-recent.maxlen:] + 1
         else:
             outs = at[-recent.maxlen:] + 1
         recent.extend(map(RecentOutput, repeat(chunk), outs.tolist(), times[outs].tolist(), repeat(okey),
-                          repeat(ofield)))
+                          repeat(ofield), repeat(plan.mapped.get(okey))))
         self._remember_given(chunk, at, wrong)
         values = m.values
         for k in keys:

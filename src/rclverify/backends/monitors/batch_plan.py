@@ -1,33 +1,36 @@
 """What the offline batch path needs of a node's monitor, and whether the
 node is eligible (:func:`batch_plan`; the rule is :mod:`.batch`'s module
-docstring, "Eligible")."""
+docstring, "Eligible"; windows: :mod:`.batch_window`)."""
 from __future__ import annotations
 
 from typing import Mapping
 
 from rclverify.traces.mapping import TopicRule
 from rclverify.semantics.robustness import atom_words
-from rclverify.targets.column_margins import ColumnMargin, MarginCompiler
-from rclverify.targets.columns import ColumnCompiler, Unsupported, io_kind
+from rclverify.targets.column_margins import ColumnMargin
+from rclverify.targets.column_windows import WindowCompiler, WindowMargins, is_window
+from rclverify.targets.columns import Unsupported, io_kind
+from rclverify.backends.monitors.batch_window import answer_only, mappers
 from rclverify.backends.monitors.engine import NodeMonitor
 
 
 class BatchPlan:
     """What the batch path needs of an eligible node's monitor ``m``: its input
     topics (topic -> (key, field, kind)), its output topic and key, the
-    compiled assumptions and guarantees."""
+    compiled assumptions and guarantees; ``widths``: each window variable's offsets read, ``mapped``: its
+    message's value as the engine maps it (:mod:`.batch_window`)."""
 
-    def __init__(self, m: NodeMonitor, rules: Mapping[str, TopicRule], compiler: ColumnCompiler) -> None:
+    def __init__(self, m: NodeMonitor, rules: Mapping[str, TopicRule], compiler: WindowCompiler) -> None:
         self.m = m
         self.inputs: dict[str, tuple[str, str, str]] = {}
         self.output: tuple[str, str, str, str] = ("", "", "", "")
         for topic, vs in m.topics.items():
             (key, typ, is_input), = vs
             rule = rules.get(topic)
-            kind = io_kind(typ)
+            kind = io_kind(typ) or ("window" if is_window(typ) else None)
             if rule is None or len(rule.fields) != 1 or not rule.fields[0].isidentifier() or rule.state or \
                     kind is None:  # a field path is read by the general mapper: every message would be streamed
-                raise Unsupported(f"topic {topic}: not one REAL/enumeration field named at the top level")
+                raise Unsupported(f"topic {topic}: not one REAL/enumeration/window field named at the top level")
             if is_input:
                 self.inputs[topic] = (key, rule.fields[0], kind)
             elif self.output[0]:
@@ -45,12 +48,21 @@ class BatchPlan:
                       for vs in m.topics.values() for key, typ, _ in vs if io_kind(typ) == "enum"}
         self.codes = compiler.codes
         self.formulas = [compiler.compile(f) for f in m.assumption + m.guarantees]
+        self.mapped = mappers(m.node, m.topics, rules)
+        #: window keys -> the offsets their column holds (every window variable is read: else the engine's)
+        self.widths = dict(compiler.widths)
+        if set(self.widths) != set(self.mapped):
+            raise Unsupported("a window variable no formula reads at an offset")
+        #: the question's evaluation decides nothing (needs_answer.py's Z3 answer, or batch_window.answer_only)
+        if m._ask_at_question and not (self.widths and all(answer_only(m.guarantees[k - 1], m.node)
+                                                            for k in m._asked)):
+            raise Unsupported("a question's inputs may decide a guarantee")
         self.asked = set(m._asked)
         #: with margins: each guarantee's margin over the columns, and the (text, unit) of each deciding comparison
         self.margins: list[ColumnMargin] = []
         self.atoms: list[tuple[str, str]] = []
         if m.margins:
-            margins = MarginCompiler(compiler)
+            margins = WindowMargins(compiler)
             self.margins = [margins.compile(g) for g in m.guarantees]
             self.atoms = [atom_words(m.checked, m.node, e, i) for e, i in margins.atoms]
 
@@ -60,11 +72,11 @@ def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | No
     node = m.node
     ks = range(1, len(m.guarantees) + 1)
     if node.node.links or m._trigger or m._state_outs or not m.has_inputs or m.unbound or \
-            m._ask_at_question or any(len(vs) != 1 for vs in m.topics.values()) or \
+            any(len(vs) != 1 for vs in m.topics.values()) or \
             any(not m._reads_out[k] for k in ks) or sorted(m._asked + m._alone) != list(ks):
         return None
     try:
-        plan = BatchPlan(m, rules, ColumnCompiler(m.checked, node))
+        plan = BatchPlan(m, rules, WindowCompiler(m.checked, node))
     except (Unsupported, ValueError):
         return None
     return plan
