@@ -82,6 +82,12 @@ and, unless ``--no-bags``, on the two bags) from an older source tree (e.g. ``gi
 and new/old: issue 44's "at least 3x today's samples/s" is that ratio, in
 one run on one machine.
 
+``--windowed`` runs only the windowed race (bench/_window_peers.py): the
+``rclverify monitor`` command with margins on ``G[0,2](x > 1)``, ``(x > 1)
+U[0,3] (y > 4)`` and a ``triggered by ... within`` deadline against RTAMT's,
+Reelay's and mstlo's robustness on ``--samples`` samples, every sample's
+verdict and margin compared (with ``--smoke``: 2,000 samples).
+
 ``--margins`` runs only the margins race (bench/_margin_peers.py): the
 batch path's space margins of ``G(x > 1)`` as a per-answer guarantee
 against RTAMT's, Reelay's and mstlo's robustness on ``--samples`` samples,
@@ -91,6 +97,7 @@ ends with it on 1,000 samples.
 Usage::
 
     python3 bench/monitor_peers.py --margins --samples 300000
+    python3 bench/monitor_peers.py --windowed --samples 300000 [--repeat K]
     python3 bench/monitor_peers.py [--samples 1000000] [--wrong 0.001] [--compare OLD_SRC] [--no-bags] [--repeat K]
     python3 bench/monitor_peers.py --smoke     # 2,000 samples: a few seconds
 """
@@ -401,6 +408,9 @@ def main() -> int:
     ap.add_argument("--smoke", action="store_true", help="2,000 samples (CI); then the margins race on 1,000")
     ap.add_argument("--margins", action="store_true",
                     help="only the margins race: G(x > 1) on --samples (bench/_margin_peers.py)")
+    ap.add_argument("--windowed", action="store_true",
+                    help="only the windowed race: G[0,2], U[0,3] and a deadline, the command against the peers "
+                         "(bench/_window_peers.py)")
     ap.add_argument("--skew", type=float, default=0.0, metavar="S",
                     help="with --margins: the mapping's transport skew for rclverify, s (the command's default: 0.02)")
     ap.add_argument("--no-bags", action="store_true", help="leave out the command on the sqlite3 and MCAP bags")
@@ -415,6 +425,9 @@ def main() -> int:
     args = ap.parse_args()
     if args.child:
         return child(args)
+    if args.windowed:  # bench/_window_peers.py: the command on windowed formulas against the peers
+        from _window_peers import race as windowed
+        return 0 if windowed(2_000 if args.smoke else args.samples, args.seed, args.wrong, args.repeat) else 1
     if args.margins:  # bench/_margin_peers.py: rclverify's margins against the peers' robustness
         from _margin_peers import race
         return 0 if race(1_000 if args.smoke else args.samples, args.seed, args.wrong, args.skew) else 1

@@ -1,0 +1,372 @@
+"""The windowed race of bench/monitor_peers.py (``--windowed``): the ``rclverify monitor`` command against
+RTAMT, Reelay and mstlo on windowed formulas, each reading the same samples.
+
+Three formulas over ``--samples`` samples 10 ms apart (``x`` uniform in
+[1, 4.5), below 1 with probability ``--wrong``; ``y`` uniform in [0, 8);
+a trigger at a sample with probability 1/2, an answer with probability
+0.7):
+
+* ``G[0,2](x > 1)``;
+* ``(x > 1) U[0,3] (y > 4)`` (RTAMT's and Reelay's until, ``x > 1`` on
+  ``[t, t')`` before ``y > 4`` at ``t'``; mstlo's closed until,
+  ``[t, t']``, is raced against its own RCL formula);
+* a deadline, ``G(trig -> F[0,3] ans)``: every trigger answered within
+  30 ms, RCL's ``triggered by in.a within 30 ms``.
+
+In RCL a time window is a value a message carries (docs/semantics.md,
+"Against the peers"): the log (a ROSMonitoring log, the command's input)
+holds, for every sample ``t`` whose window lies in the trace, a question
+and its answer, the answer's ``data`` the window ``[x(t), ..., x(t+h)]``
+(mapped to ``NATURAL --> REAL``: traces/mapping.py, the window rule), and
+STL's bounded ``G`` and ``F`` are ``forall`` and ``exists`` over ``<0 upto
+h>``.  The deadline's log holds the triggers and answers as they come, one
+message each.  The ``h`` last samples, whose window runs past the end of
+the trace, are not compared: RCL has no message for them (each message
+carries its whole window), and the peers give them partial or delayed
+figures.
+
+Timed (CPU seconds, the least of ``--repeat`` runs): the command, ``rclverify monitor --json --margins``, a
+process of its own reading the log (start, reading, judging, printing the
+JSON: the command's whole CPU; its start-up, the same command on ten
+samples, printed apart), and each peer judging the samples in this process
+after a first run on ten samples (RTAMT 0.4.10's offline ``evaluate`` on
+the whole signal, Reelay 25's discrete robustness monitor updated sample
+by sample, read past-time as test_margins_peers.py reads it, mstlo 0.2.2's
+``DelayedQuantitative`` monitor by its batch call 16,384 samples at a
+time).  Compared, untimed: every window's verdict and margin as the engine
+gives them (``check_trace`` with margins and a verdict callback on the same
+log; the deadline's per-trigger verdicts from its deadline monitor) against
+each peer's robustness at that sample within 1e-9 (the deadline: the sign,
+the met or missed trigger; its time margin, ``30 ms`` less the answer's
+delay, against the samples themselves: space robustness has no time
+margin), and the command's counts and smallest margin against them.  A
+disagreement exits 1.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+PERIOD = 0.01  # s between samples
+STEP = 16384  # mstlo's batch call: samples at a time
+TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class Formula:
+    """One windowed formula: the window ``h`` (samples), RCL's node, the peers' specifications, and how
+    Reelay reads it (``shift``: past time at t + h; ``reverse``: on the samples read backwards)."""
+
+    name: str
+    h: int
+    rcl: str
+    rtamt: str
+    reelay: str
+    reelay_read: str
+    mstlo: str
+    signals: tuple[str, ...]
+
+
+_G = """node Window {
+  inputs( r : REAL )
+  outputs( x : NATURAL --> REAL )
+  topics( std_msgs/Float64 limit matches(in.r), std_msgs/Float64MultiArray window matches(out.x) )
+  guarantee( forall(k in <0 upto 2> | out.x(k) > in.r) )
+}
+"""
+_U = """node Window {
+  inputs( x : NATURAL --> REAL )
+  outputs( y : NATURAL --> REAL )
+  topics( std_msgs/Float64MultiArray limit matches(in.x), std_msgs/Float64MultiArray window matches(out.y) )
+  guarantee( exists(j in <0 upto 3> | out.y(j) > 4 and forall(i in <0 upto 3> | i %s j -> in.x(i) > 1)) )
+}
+"""
+_D = """node Window {
+  inputs( a : REAL )
+  outputs( b : REAL )
+  topics( std_msgs/Float64 trig matches(in.a), std_msgs/Float64 ans matches(out.b) )
+  guarantee( out.b > in.a ) triggered by in.a within 30 ms
+}
+"""
+FORMULAS = [
+    Formula("G[0,2](x > 1)", 2, _G, "always[0,2](x > 1)", "historically[0:2]{x > 1}", "shift", "G[0,2](x > 1)",
+            ("x",)),
+    Formula("(x > 1) U[0,3] (y > 4)", 3, _U % "<", "(x > 1) until[0,3] (y > 4)", "{x > 1} since[0:3] {y > 4}",
+            "reverse", "", ("x", "y")),
+    Formula("(x > 1) U[0,3] (y > 4), closed", 3, _U % "<=", "", "", "", "(x > 1) U[0,3] (y > 4)", ("x", "y")),
+    Formula("G(trig -> F[0,3] ans)", 3, _D, "(trig > 0.5) implies (eventually[0,3](ans > 0.5))",
+            "{trig > 0.5} implies once[0:3]{ans > 0.5}", "reverse", "trig > 0.5 -> F[0,3](ans > 0.5)", ("trig", "ans")),
+]
+
+
+def signals(n: int, seed: int, wrong: float) -> dict[str, Any]:
+    """The samples: ``x``, ``y`` (float64) and ``trig``, ``ans`` (0.0 or 1.0)."""
+    import numpy as np
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(1.0, 4.5, n)
+    low = rng.random(n) < wrong
+    x[low] = rng.uniform(0.0, 1.0, int(low.sum()))
+    y = rng.uniform(0.0, 8.0, n)
+    trig = (rng.random(n) < 0.5).astype(np.float64)
+    ans = (rng.random(n) < 0.7).astype(np.float64)
+    return {"x": x, "y": y, "trig": trig, "ans": ans}
+
+
+def workspace(ws: Path, f: Formula, s: dict[str, Any], n: int) -> Path:
+    """The contract, plan, mapping and log of ``f`` on the first ``n`` samples, in ``ws``; returns the log."""
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "backends/monitors").mkdir(parents=True)
+    (ws / "contracts/w.rcl").write_text(f.rcl)
+    (ws / "contracts/plan.yaml").write_text("name: w\ncontracts: [contracts/w.rcl]\nnodes:\n  Window:\n"
+                                            "    evidence: []\n")
+    deadline = f.name.startswith("G(trig")
+    topics = ("trig", "ans") if deadline else ("limit", "window")
+    (ws / "backends/monitors/mapping.yaml").write_text(
+        f"horizon: 0.005\ntopics:\n  {topics[0]}: {{fields: [data]}}\n  {topics[1]}: {{fields: [data]}}\n")
+    log = ws / "run.jsonl"
+    h = f.h
+    with log.open("w") as out:
+        if deadline:
+            trig, ans = s["trig"][:n].tolist(), s["ans"][:n].tolist()
+            for i in range(n):
+                t = round(i * PERIOD, 6)
+                if trig[i]:
+                    out.write(f'{{"topic": "trig", "time": {t!r}, "data": 0.0}}\n')
+                if ans[i]:
+                    out.write(f'{{"topic": "ans", "time": {t!r}, "data": 1.0}}\n')
+        else:
+            x, y = s["x"][:n].tolist(), s["y"][:n].tolist()
+            until = "y" in f.signals
+            for i in range(n - h):
+                t = round(i * PERIOD, 6)
+                q = x[i:i + h + 1] if until else 1.0
+                a = y[i:i + h + 1] if until else x[i:i + h + 1]
+                out.write(f'{{"topic": "limit", "time": {t!r}, "data": {q!r}}}\n'
+                          f'{{"topic": "window", "time": {t!r}, "data": {a!r}}}\n')
+        out.write(f'{{"topic": "tick", "time": {round(n * PERIOD + 1.0, 6)!r}}}\n')
+    return log
+
+
+def command(ws: Path, log: Path, src: str) -> dict[str, Any]:
+    """``rclverify monitor --json --margins`` on ``log``: its CPU (user + system, of the waited child) and JSON."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([src] + ([os.environ["PYTHONPATH"]]
+                                                                if os.environ.get("PYTHONPATH") else []))}
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p = subprocess.run([sys.executable, "-c", "import sys; from rclverify.cli.commands import main; sys.exit(main())",
+                        "monitor", "--json", "--margins", "-w", str(ws), str(log)], capture_output=True, text=True,
+                       env=env)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode not in (0, 1) or not p.stdout:
+        raise SystemExit(f"rclverify monitor exited {p.returncode}:\n{p.stderr[-3000:]}")
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return {"cpu": cpu, "json": json.loads(p.stdout)}
+
+
+def engine(ws: Path, log: Path, f: Formula, n: int) -> tuple[list[float | None], dict[str, Any]]:
+    """Untimed: each sample's margin as the engine gives it (``None``: no verdict there; the deadline: the
+    time margin of each trigger, ``-inf`` when it was missed) and the result's counts, from the same log."""
+    from rclverify.backends.monitors.check import check_trace
+    from rclverify.backends.monitors.deadlines import DeadlineMonitor
+    from rclverify.lang.typecheck import load
+    from rclverify.traces.jsonl import read_jsonl
+    from rclverify.traces.mapping import load_rules
+    import yaml
+    checked = load([ws / "contracts/w.rcl"])
+    node = checked.nodes["Window"]
+    rules = load_rules(yaml.safe_load((ws / "backends/monitors/mapping.yaml").read_text())["topics"])
+    got: list[float | None] = [None] * n
+    if f.name.startswith("G(trig"):
+        late: list[float] = []  # the time margins of answers after their trigger's deadline (its update)
+
+        def timed(v: Any) -> None:
+            if v.update:
+                late.append(v.time_margin)
+            else:
+                got[round(v.trigger_stamp / PERIOD)] = v.time_margin if v.verdict == "true" else -math.inf
+        d = DeadlineMonitor(checked, node, rules, timed)
+        for ev in read_jsonl(log):
+            d.feed(ev)
+        d.advance(n * PERIOD + 1.0)
+        d.finish()
+        return got, {"late": late}
+
+    def seen(v: Any) -> None:
+        if v.margin is not None:
+            got[v.event // 2] = v.margin  # two lines a sample: the question, its answer
+    _, (res,) = check_trace(checked, [node], read_jsonl(log), rules, 0.005, seen, margins=True)
+    return got, dict(res.counts)
+
+
+def _rtamt(f: Formula, s: dict[str, Any], n: int) -> list[float]:
+    import rtamt  # type: ignore[import-not-found]
+    spec = rtamt.StlDiscreteTimeSpecification()
+    for v in f.signals:
+        spec.declare_var(v, "float")
+    spec.spec = f.rtamt
+    spec.parse()
+    data = {"time": list(range(n)), **{v: s[v][:n].tolist() for v in f.signals}}
+    return [float(r) for _, r in spec.evaluate(data)]
+
+
+def _reelay(f: Formula, s: dict[str, Any], n: int) -> list[float]:
+    import reelay  # type: ignore[import-not-found]
+    mon = reelay.discrete_timed_monitor(pattern=f.reelay, semantics="robustness", condense=False)
+    cols = [s[v][:n].tolist() for v in f.signals]
+    rows = list(zip(*cols))
+    if f.reelay_read == "reverse":
+        rows.reverse()
+    update = mon.update
+    names = f.signals
+    if len(names) == 1:
+        (a,) = names
+        out = [update({"time": i, a: r[0]})["value"] for i, r in enumerate(rows)]
+    else:
+        a, b = names
+        out = [update({"time": i, a: r[0], b: r[1]})["value"] for i, r in enumerate(rows)]
+    if f.reelay_read == "reverse":
+        out.reverse()
+        return [float(r) for r in out]
+    return [float(r) for r in out[f.h:]]
+
+
+def _mstlo(f: Formula, s: dict[str, Any], n: int) -> list[float]:
+    import mstlo_python  # type: ignore[import-not-found]
+    mon = mstlo_python.Monitor(mstlo_python.parse_formula(f.mstlo), semantics="DelayedQuantitative")
+    cols = {v: s[v][:n].tolist() for v in f.signals}
+    out: list[float] = []
+    for a in range(0, n, STEP):
+        b = min(n, a + STEP)
+        ts = [float(i) for i in range(a, b)]  # its bounds are in its time unit: a sample a unit
+        got = mon.update_batch({v: list(zip(c[a:b], ts)) for v, c in cols.items()}).verdicts()
+        out += [r for _, r in got]
+    return [float(r) for r in out]
+
+
+PEERS: dict[str, tuple[str, Callable[[Formula, dict[str, Any], int], list[float]]]] = {
+    "RTAMT": ("rtamt", _rtamt), "Reelay": ("reelay", _reelay), "mstlo": ("mstlo", _mstlo)}
+
+
+def _peer(name: str, f: Formula, s: dict[str, Any], n: int, repeat: int) -> tuple[float, list[float]] | str:
+    """(least CPU s of ``repeat`` runs, the robustness at each sample), or why the peer is skipped."""
+    attr, run = PEERS[name]
+    if not getattr(f, attr):
+        return ""
+    try:
+        run(f, s, 20)  # the set-up and first use, outside the timing
+    except ImportError as exc:
+        return f"not installed ({exc}); pip install '.[bench]'"
+    best, out = math.inf, []
+    for _ in range(max(repeat, 1)):
+        t0 = time.process_time()
+        out = run(f, s, n)
+        best = min(best, time.process_time() - t0)
+    return best, out
+
+
+def _agree(f: Formula, mine: list[float | None], theirs: list[float], n: int) -> tuple[int, int, str]:
+    """(samples compared, agreeing, the first difference) over the samples whose window lies in the trace."""
+    deadline = f.name.startswith("G(trig")
+    same, total, first = 0, 0, ""
+    for t in range(n - f.h):
+        a = mine[t]
+        if deadline and a is None:
+            continue  # no trigger here: the peers' vacuous truth has no RCL verdict
+        b = theirs[t] if t < len(theirs) else math.nan
+        total += 1
+        if a is None:
+            ok = False
+        elif deadline:
+            ok = (a >= 0) == (b >= 0)
+        else:
+            ok = abs(a - b) <= TOLERANCE * max(1.0, abs(a)) or a == b
+        same += ok
+        if not ok and not first:
+            first = f" (first difference at sample {t}: {a!r} against {b!r})"
+    return total, same, first
+
+
+def _time_margins(mine: list[float | None], s: dict[str, Any], n: int, h: int) -> tuple[int, int]:
+    """(triggers, those whose time margin is 30 ms less the delay of the first answer at or after them,
+    from the samples; ``-inf`` where none comes within 3 samples)."""
+    trig, ans = s["trig"], s["ans"]
+    right = total = 0
+    for t in range(n - h):
+        if not trig[t]:
+            continue
+        total += 1
+        k = next((k for k in range(h + 1) if ans[t + k]), None)
+        want = -math.inf if k is None else round((h - k) * PERIOD, 9)
+        got = mine[t]
+        right += got is not None and (got == want or (want != -math.inf and abs(got - want) < 1e-9))
+    return total, right
+
+
+def race(n: int, seed: int, wrong: float, repeat: int = 1, src: str | None = None) -> bool:
+    """Print, formula by formula, the command's and each peer's samples per CPU second and whether every
+    sample agrees; True when all agree."""
+    root = Path(__file__).resolve().parents[1]
+    src = src or str(root / "src")
+    sys.path.insert(0, src)
+    s = signals(n, seed, wrong)
+    ok = True
+    print(f"windowed formulas: {n} samples 10 ms apart, {wrong:g} of x below 1, seed {seed}; CPU s the least of "
+          f"{max(repeat, 1)} run(s)")
+    print(f"{'formula, tool':<52} {'samples/s':>10} {'CPU s':>7}  every sample's verdict and margin agree")
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, f in enumerate(FORMULAS):
+            ws = Path(tmp) / f"w{k}"
+            log = workspace(ws, f, s, n)
+            tiny = Path(tmp) / f"t{k}"
+            start = command(tiny, workspace(tiny, f, s, 10), src)["cpu"]
+            runs = [command(ws, log, src) for _ in range(max(repeat, 1))]
+            cmd = min(runs, key=lambda r: float(r["cpu"]))
+            mine, counts = engine(ws, log, f, n)
+            res = next(r for r in cmd["json"] if "counts" in r)
+            said = res.get("counts", {})
+            judged = [m for m in mine if m is not None]
+            if "late" not in counts:  # the command's counts and smallest margin are the engine's
+                agree_cmd = said == counts and res["margins"][0]["margin"] == min(judged)
+            else:  # the deadline's: its met and missed triggers and smallest time margin
+                dl = next(r["deadlines"] for r in cmd["json"] if "deadlines" in r)
+                met = [m for m in judged if m != -math.inf]
+                late = counts["late"]
+                counts = {"true": len(met), "false": len(judged) - len(met)}
+                agree_cmd = {k: dl["counts"][k] for k in counts} == counts and \
+                    abs(dl["time_margins"][0]["margin"] - min(met + late)) < 1e-9
+            print(f"{f.name + ', rclverify monitor':<52} {n / cmd['cpu']:>10.0f} {cmd['cpu']:>7.2f}  "
+                  f"(start-up {start:.2f} s; {n / max(cmd['cpu'] - start, 1e-3):.0f} samples/s without it); "
+                  f"command = engine: {'yes' if agree_cmd else 'NO'}; "
+                  + ", ".join(f"{v} {key}" for key, v in (counts or {}).items() if v))
+            ok = ok and agree_cmd
+            if f.name.startswith("G(trig"):
+                total, right = _time_margins(mine, s, n, f.h)
+                print(f"{'':<52} time margins: {right}/{total} triggers equal 30 ms less the first answer's delay")
+                ok = ok and right == total
+            for name in PEERS:
+                got = _peer(name, f, s, n, repeat)
+                if got == "":
+                    continue
+                if isinstance(got, str):
+                    print(f"{f.name + ', ' + name:<52} skipped: {got}")
+                    continue
+                cpu, theirs = got
+                total, same, first = _agree(f, mine, theirs, n)
+                ok = ok and same == total and total > 0
+                print(f"{f.name + ', ' + name:<52} {n / cpu:>10.0f} {cpu:>7.2f}  {same}/{total}{first}; "
+                      f"rclverify / {name} samples/s: {cpu / cmd['cpu']:.2f} ({cpu / max(cmd['cpu'] - start, 1e-3):.2f} "
+                      f"without the start-up)")
+    print(f"not compared: the last 2-3 samples of each formula, whose window runs past the end of the trace "
+          f"(no RCL message carries them; the peers give partial or delayed figures)")
+    return ok
+
+
+__all__ = ["FORMULAS", "race"]
