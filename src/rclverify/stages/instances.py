@@ -182,7 +182,9 @@ def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> 
     """The report's ``instances`` (:func:`read_instances`) as the JSON object of
     :class:`~rclverify.records.instance_rows.InstancesRow`, each instance given the obligations of its
     contract with their current status (``obligations``: the report's rows, ``id``, ``node``,
-    ``status``): one obligation, every instance; ``None`` for a plan without instances.  Raises
+    ``status``): one obligation, every instance, except an obligation of one instance (the monitors
+    judge a recorded run per instance: its id ends ``_<instance>``, ``Guard.g0.monitors.fleet_jsonl_Guard_r1``),
+    listed at that instance only; ``None`` for a plan without instances.  Raises
     :class:`msgspec.ValidationError` for a record of another shape (a bug: the stage seals what it writes)."""
     rec = read_instances(ws)
     if rec is None:
@@ -190,7 +192,12 @@ def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> 
     by_node: dict[str, list[dict[str, str]]] = {}
     for o in obligations:
         by_node.setdefault(str(o["node"]), []).append({"id": str(o["id"]), "status": str(o["status"])})
-    rec["instances"] = [{**i, "obligations": by_node.get(i["contract"], [])} for i in rec["instances"]]
+    # an obligation of one instance (the monitors' per-instance runs, ids ending ``_<instance>``) is that
+    # instance's only: its contract's other instances do not list it
+    names = {str(i["node"]) for i in rec["instances"]}
+    rec["instances"] = [{**i, "obligations": [o for o in by_node.get(i["contract"], [])
+                                              if not any(o["id"].endswith("_" + n) for n in names - {i["node"]})]}
+                        for i in rec["instances"]]
     from rclverify.records.instance_rows import InstancesRow  # deferred: only a plan with instances
     return InstancesRow.of(rec).to_json()
 
