@@ -59,7 +59,8 @@ def test_verify_is_green_and_the_report_lists_every_instance(tmp_path: Path, cap
         "cmd_vel": "/r2/cmd_vel"}
     assert {x["var"]: x["source"] for x in g2["inputs"]} == {
         "cmd_raw": "Planner_r2.out.cmd_raw", "level": "Battery_r2.out.level", "limit": "SpeedLimit.out.limit"}
-    assert [(o["id"], o["status"]) for o in g2["obligations"]] == [
+    assert [(o["id"], o["status"]) for o in g2["obligations"]] == [  # the recorded run judged for /r2's guard
+        ("Guard.g0.monitors.fleet_jsonl_Guard_r2", "discharged"),
         ("Guard.g1.property_tests.e0", "discharged"), ("Guard.g2.property_tests.e0", "discharged")]
     assert sorted((q["id"], q["namespace"], q["verdict"]) for q in part["requirements"]) == [
         ("BATTERY-GUARD", "/r1", "proved"), ("BATTERY-GUARD", "/r2", "proved"),
@@ -67,6 +68,28 @@ def test_verify_is_green_and_the_report_lists_every_instance(tmp_path: Path, cap
     md = (root / "reports/assurance.md").read_text(encoding="utf-8")
     assert "## Fleet: instances per namespace" in md and "`Battery_r2.out.level < 0.2 -> Guard_r2.out.cmd_vel == 0`" in md
     assert 'id="instances"' in (root / "reports/assurance.html").read_text(encoding="utf-8")
+
+
+def test_the_recorded_slip_is_red_at_r2s_guard_only(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``doit verify`` judges the run recorded live from nodes/robots.py --slip (runs/slip.jsonl) once per
+    robot: ``/r2``'s guard, reading ``/r1``'s battery, drives on below 0.2, red at Guard_r2 only, with the
+    11 violations the live monitor found; the control is the example's own run (runs/fleet.jsonl, above),
+    green at both guards."""
+    root = _copy(tmp_path)
+    plan = root / "contracts/plan.yaml"
+    plan.write_text(plan.read_text(encoding="utf-8").replace("runs/fleet.jsonl", "runs/slip.jsonl"), encoding="utf-8")
+    assert main(["verify", "-w", str(root), "--strict"]) == 1
+    capsys.readouterr()
+    report = json.loads((root / "reports/assurance.json").read_text(encoding="utf-8"))
+    check_report(report, "fleet_robots")
+    by_node = {i["node"]: {o["id"]: o["status"] for o in i["obligations"] if ".monitors." in o["id"]}
+               for i in report["instances"]["instances"] if i["contract"] == "Guard"}
+    assert by_node == {"Guard_r1": {"Guard.g0.monitors.slip_jsonl_Guard_r1": "discharged"},
+                       "Guard_r2": {"Guard.g0.monitors.slip_jsonl_Guard_r2": "failed"}}
+    ev = json.loads((root / "artifacts/evidence/Guard.g0.monitors.slip_jsonl_Guard_r2.json").read_text(encoding="utf-8"))
+    assert ev["explanation"].startswith("11 message(s) of runs/slip.jsonl violated Guard_r2's contract")
+    first = ev["details"]["monitoring"]["first_violation"]
+    assert first["guarantee"] == 2 and float(first["values"]["in.level"]) < 0.2 and first["values"]["out.cmd_vel"] == "1.0"
 
 
 def test_a_fleet_topic_named_relative_is_refuted_per_robot_and_proved_for_the_type(tmp_path: Path) -> None:
@@ -104,7 +127,13 @@ def test_verify_fails_when_a_requirement_is_refuted_for_a_robot(tmp_path: Path, 
     assert report["summary"]["status"] == "failed" and report["meta"]["strict_ok"] is False
     assert "requirement FLEET-LIMIT is refuted for the instances in /r2 (Guard as Guard_r2): not prevented by " \
            "SpeedLimit guarantee 1, Guard_r2 guarantee 1; fed by no node: Guard_r2.in.limit" in report["summary"]["problems"]
-    assert [r["status"] for r in report["requirements"] if r["id"] == "FLEET-LIMIT"] == ["discharged"]  # the types'
+    # the types' proof stands, but the recorded run cannot be judged for the guards: each reads its own
+    # /rN/speed_limit, which the fleet's run does not hold (the recorded run finds the slip too)
+    assert [r["status"] for r in report["requirements"] if r["id"] == "FLEET-LIMIT"] == ["pending"]
+    ev = json.loads((root / "artifacts/evidence/Guard.g0.monitors.fleet_jsonl_Guard_r1.json").read_text(encoding="utf-8"))
+    assert ev["status"] == "pending" and {"kind": "topic", "name": "/r1/speed_limit", "node": "Guard_r1",
+                                          "reason": "nothing heard", "detail": "no message on /r1/speed_limit in "
+                                          "runs/fleet.jsonl"} in ev["details"]["not_judged"]
 
 
 def test_a_robot_without_an_instance_the_requirement_names_is_not_decided_there(tmp_path: Path) -> None:
