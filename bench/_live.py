@@ -1,6 +1,6 @@
 """What the live monitor benches share (bench/monitor_live.py for ROS 1, bench/monitor_live_dds.py
 for DDS): the recorded run they publish, waiting for a process to say it is ready, stopping the
-processes they start, their CPU and the latencies' p99."""
+processes they start, their CPU, the latencies' p99 and CPU burners beside a run."""
 from __future__ import annotations
 
 import json
@@ -9,8 +9,9 @@ import signal
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 ROOT = Path(__file__).resolve().parents[1]
 RUN = ROOT / "backends" / "monitors" / "traces" / "nominal.jsonl"
@@ -50,6 +51,20 @@ def cpu_seconds(pid: int) -> float | None:
         return None
 
 
+def children_cpu_seconds(pid: int) -> float:
+    """User + system CPU seconds of the live child processes of ``pid`` (Linux ``/proc``; 0 elsewhere): the
+    rclpy source's agent, which the monitor starts in a session of its own."""
+    total = 0.0
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if len(fields) > 12 and fields[1] == str(pid):
+            total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    return total
+
+
 def p99(xs: list[float]) -> float:
     """The 99th percentile of ``xs`` (nearest rank)."""
     ys = sorted(xs)
@@ -62,3 +77,19 @@ def exit_on_sigterm() -> None:
     started (each in a session of its own): killed by the default handler,
     the bench left a 10-minute publisher running."""
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(128 + signal.SIGTERM))
+
+
+@contextmanager
+def burners(n: int) -> Iterator[list[subprocess.Popen[bytes]]]:
+    """``n`` processes spinning ``while True: pass`` (each in a session of its own) while the block
+    runs, every one stopped (SIGKILL) and reaped when it ends, however it ends: the load of other
+    work on the machine, beside a run."""
+    procs: list[subprocess.Popen[bytes]] = []
+    try:
+        for _ in range(n):
+            procs.append(subprocess.Popen([sys.executable, "-c", "while True: pass"], start_new_session=True,
+                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        yield procs
+    finally:
+        for p in procs:
+            stop(p, signal.SIGKILL)

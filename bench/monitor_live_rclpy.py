@@ -30,7 +30,12 @@ in the ROS 2 Python, docs/ros2.md "Two sources"), or each in turn;
 ``--listener dds|rclpy``: the latency run's verdicts heard by a Cyclone DDS
 reader (default) or by an rclpy subscriber, as a ROS 2 user hears them.
 
-Prints the figures, the load average and the core count; asserts nothing.
+``--burn N``: N processes spinning ``while True: pass`` beside each run
+(started before its processes, every one stopped after it), the load of
+other work on a shared machine.
+
+Prints the figures, the load average as each run ends and the core count;
+asserts nothing.
 ``--smoke`` (the test suite's): 1 s at 300 and 200 messages/s through the
 rclpy source only, unless ``--source`` names others (the suite's live
 tests hear rclpy nodes through both sources); without a ROS 2 Python it
@@ -137,8 +142,8 @@ def _workspace(ws: Path) -> None:
 
 
 def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool,
-         source: str = "dds", listener: str = "dds", lateness: float = 0.05) -> dict[str, Any]:
-    from _live import cpu_seconds, stop, wait_text
+         source: str = "dds", listener: str = "dds", lateness: float = 0.05, burn: int = 0) -> dict[str, Any]:
+    from _live import burners, cpu_seconds, stop, wait_text
     tag = f"{'lat' if latency else 'loss'}{int(rate)}{source}"
     procs: list[subprocess.Popen[bytes]] = []
 
@@ -147,37 +152,48 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
                              start_new_session=True)
         procs.append(p)
         return p
-    try:
-        lis = None
-        if latency and listener == "rclpy":
-            (tmp / "listener.py").write_text(RCLPY_LISTENER)
-            lis = start([str(ros2), str(tmp / "listener.py"), str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
-            wait_text(tmp / f"listener{tag}.out", "listening", 30)
-        elif latency:
-            lis = start([sys.executable, str(ROOT / "bench" / "monitor_live_dds.py"), "--listener",
-                         str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
-            wait_text(tmp / f"listener{tag}.out", "listening", 30)
-        mon = start([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
-                     "--mapping", "mapping.yaml", "--horizon", "1.0", "--reorder-window", str(lateness), "--status", "0",
-                     "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json"),
-                     "--source", source, "--ros2-python", str(ros2)],
-                    f"monitor{tag}.out")
-        wait_text(tmp / f"monitor{tag}.out", "monitoring", 30)
-        (tmp / "publisher.py").write_text(PUBLISHER)
-        pub = start([str(ros2), str(tmp / "publisher.py"), str(rate), str(seconds), str(tmp / f"sent{tag}.json"),
-                     str(ROOT / "bench")], f"publisher{tag}.out")
-        pub.wait(seconds * 3 + 60)
-        time.sleep(1.5)  # the last messages arrive and are judged
-        cpu = cpu_seconds(mon.pid)
-        stop(mon, signal.SIGINT)
-        if lis is not None:
-            stop(lis)
-    finally:
-        for p in procs:
-            stop(p)
+    with burners(burn):
+        try:
+            return _started(tmp, env, ros2, rate, seconds, latency, source, listener, lateness, tag, start, procs)
+        finally:
+            for p in procs:
+                stop(p)
+
+
+def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool, source: str,
+             listener: str, lateness: float, tag: str, start: Any, procs: list[subprocess.Popen[bytes]]
+             ) -> dict[str, Any]:
+    """One run's processes started by ``start`` (listener, monitor, publisher), waited for and stopped."""
+    from _live import children_cpu_seconds, cpu_seconds, stop, wait_text
+    lis = None
+    if latency and listener == "rclpy":
+        (tmp / "listener.py").write_text(RCLPY_LISTENER)
+        lis = start([str(ros2), str(tmp / "listener.py"), str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
+        wait_text(tmp / f"listener{tag}.out", "listening", 30)
+    elif latency:
+        lis = start([sys.executable, str(ROOT / "bench" / "monitor_live_dds.py"), "--listener",
+                     str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
+        wait_text(tmp / f"listener{tag}.out", "listening", 30)
+    mon = start([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
+                 "--mapping", "mapping.yaml", "--horizon", "1.0", "--reorder-window", str(lateness), "--status", "0",
+                 "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json"),
+                 "--source", source, "--ros2-python", str(ros2)],
+                f"monitor{tag}.out")
+    wait_text(tmp / f"monitor{tag}.out", "monitoring", 30)
+    (tmp / "publisher.py").write_text(PUBLISHER)
+    pub = start([str(ros2), str(tmp / "publisher.py"), str(rate), str(seconds), str(tmp / f"sent{tag}.json"),
+                 str(ROOT / "bench")], f"publisher{tag}.out")
+    pub.wait(seconds * 3 + 60)
+    time.sleep(1.5)  # the last messages arrive and are judged
+    cpu, agent_cpu = cpu_seconds(mon.pid), children_cpu_seconds(mon.pid)
+    stop(mon, signal.SIGINT)
+    if lis is not None:
+        stop(lis)
+    load = os.getloadavg()[0]  # the 1-minute load average as the run ends (burners and all)
     if not (tmp / f"sent{tag}.json").exists():
         raise SystemExit(f"the rclpy publisher failed:\n{(tmp / f'publisher{tag}.out').read_text()[-2000:]}")
-    res: dict[str, Any] = {"sent": json.loads((tmp / f"sent{tag}.json").read_text()), "cpu": cpu,
+    res: dict[str, Any] = {"sent": json.loads((tmp / f"sent{tag}.json").read_text()), "cpu": cpu, "agent_cpu": agent_cpu,
+                           "load": load,
                            "record": json.loads((tmp / f"evidence{tag}.json").read_text()),
                            "log_topics": [json.loads(x)["topic"] for x in
                                           (tmp / f"live{tag}.jsonl").read_text().splitlines()]}
@@ -187,20 +203,20 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
 
 
 def bench(total_rate: float, latency_rate: float, seconds: float, sources: tuple[str, ...] = ("dds", "rclpy"),
-          listener: str = "dds", lateness: float = 0.05) -> None:
-    """The benchmark (module docstring), once per source."""
+          listener: str = "dds", lateness: float = 0.05, burn: int = 0) -> None:
+    """The benchmark (module docstring), once per source, beside ``burn`` CPU burners."""
     ros2, why = ros2_python()
     if ros2 is None:
         print(f"rclpy: skipped: {why}")
         return
     for source in sources:
-        _bench(ros2, total_rate, latency_rate, seconds, source, listener, lateness)
+        _bench(ros2, total_rate, latency_rate, seconds, source, listener, lateness, burn)
 
 
 def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, source: str,
-           listener: str = "dds", lateness: float = 0.05) -> None:
+           listener: str = "dds", lateness: float = 0.05, burn: int = 0) -> None:
     from _live import p99
-    load = f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} core(s)"
+    beside = f"{burn} CPU burner(s), " if burn else ""
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         _workspace(tmp / "ws")
@@ -210,7 +226,8 @@ def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, s
                    ROS_DOMAIN_ID=str(random.SystemRandom().randint(1, 230)), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                    RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp / "ros_log"), PYTHONUNBUFFERED="1")
         res = _run(tmp, {**env, "PYTHONPATH": str(ROOT / "src")}, ros2, total_rate, seconds, latency=False,
-                   source=source, lateness=lateness)
+                   source=source, lateness=lateness, burn=burn)
+        load = f"{beside}load average {res['load']:.1f} on {os.cpu_count()} core(s)"
         sent, rec = res["sent"]["sent"], res["record"]
         per = {t: sum(1 for topic, _t in sent if topic == t) for t in TOPICS}
         heard = {t: rec["qos"][t]["samples"] for t in TOPICS}
@@ -218,23 +235,32 @@ def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, s
         print(f"rclpy publisher, {source} source: loss: {total_rate:.0f} msg/s asked over {len(TOPICS)} topics: published {len(sent)} in "
               f"{res['sent']['elapsed']:.2f} s ({len(sent) / res['sent']['elapsed']:.0f} msg/s); heard "
               f"{sum(heard.values())} ({', '.join(f'/{t} {heard[t]}/{per[t]}' for t in TOPICS)}); checked "
-              f"{rec['events']}; lost {lost}; decode errors {sum(rec['decode_errors'].values())}; {load}")
+              f"{rec['events']}; lost {lost}{f' ({lost / len(sent):.1%})' if lost else ''}; engine queue dropped "
+              f"{rec.get('dropped_messages', 0)}, longest {rec.get('backlog_max', 0)}; decode errors {sum(rec['decode_errors'].values())}; {load}")
         if res["cpu"] is not None:
             print(f"rclpy publisher, {source} source: loss: monitor CPU {res['cpu'] / max(1, len(sent)) * 1e6:.0f} us per message "
-                  f"(start-up included), engine thread {rec.get('engine_cpu_us_per_message', 0):.0f} us")
+                  f"(start-up included), engine thread {rec.get('engine_cpu_us_per_message', 0):.0f} us"
+                  + (f", the rclpy agent {res['agent_cpu'] / max(1, len(sent)) * 1e6:.0f} us" if source == "rclpy" else ""))
         res = _run(tmp, env, ros2, latency_rate, seconds, latency=True, source=source, listener=listener,
-                   lateness=lateness)
+                   lateness=lateness, burn=burn)
         lat = _latency(res)
         if lat:
             print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
                   f"verdict(s) decided on arrival: p50 {statistics.median(lat):.2f} ms, p99 {p99(lat):.2f} ms, "
                   f"max {lat[-1]:.2f} ms; checked {res['record']['events']} of {len(res['sent']['sent'])}; "
-                  f"late {res['record'].get('late_events', 0)}; lateness bound {lateness * 1e3:g} ms (p99 "
+                  f"late {res['record'].get('late_events', 0)}; {_cpu(res, source)}; lateness bound {lateness * 1e3:g} ms (p99 "
                   f"{'within' if p99(lat) <= lateness * 1e3 + 5 else 'beyond'} the bound + 5 ms); "
-                  f"load average {os.getloadavg()[0]:.1f}")
+                  f"{beside}load average {res['load']:.1f}")
         else:
             print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
                   f"(checked {res['record']['events']} of {len(res['sent']['sent'])})")
+
+
+def _cpu(res: dict[str, Any], source: str) -> str:
+    """The run's CPU per message published: the monitor's process (start-up included), the rclpy agent's."""
+    n = max(1, len(res["sent"]["sent"]))
+    mon = f"monitor {res['cpu'] / n * 1e6:.0f} us" if res["cpu"] is not None else "monitor CPU unknown"
+    return mon + (f", agent {res['agent_cpu'] / n * 1e6:.0f} us per message" if source == "rclpy" else " per message")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -250,13 +276,15 @@ def main(argv: list[str] | None = None) -> int:
                    help="who hears the verdicts in the latency run: a Cyclone DDS reader, or an rclpy subscriber")
     p.add_argument("--lateness", type=float, default=0.05,
                    help="the monitor's lateness bound, --reorder-window (s; default the CLI's 0.05; 0: none)")
+    p.add_argument("--burn", type=int, default=0, metavar="N",
+                   help="N processes spinning `while True: pass` beside each run (started before it, stopped after)")
     a = p.parse_args(argv)
     source = a.source or ("rclpy" if a.smoke else "both")
     sources = ("dds", "rclpy") if source == "both" else (source,)
     if a.smoke:
-        bench(300.0, 200.0, 1.0, sources, a.listener, a.lateness)
+        bench(300.0, 200.0, 1.0, sources, a.listener, a.lateness, a.burn)
     else:
-        bench(a.total_rate, a.latency_rate, a.seconds, sources, a.listener, a.lateness)
+        bench(a.total_rate, a.latency_rate, a.seconds, sources, a.listener, a.lateness, a.burn)
     return 0
 
 
