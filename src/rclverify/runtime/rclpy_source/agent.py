@@ -15,7 +15,12 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   of that type is in the graph, with the QoS every publisher can match
   (reliable only when all are, transient-local when all are: a latched
   message is delivered to it as to any late ROS 2 subscriber), and made
-  again when a publisher appears that it cannot match.
+  again when a publisher appears that it cannot match.  Keep-last
+  :data:`TAP_DEPTH` per publisher.  After each wake-up of the executor
+  every tap's subscription is drained (at most :data:`TAKE_MAX` messages
+  each a round) and the round's frames are written to the monitor in one
+  write: under load the agent takes messages in batches rather than one
+  executor turn each, and its history covers seconds at 5000 messages/s.
 * **The graph**: each tapped or watched topic's publishers
   (GID, node, namespace, type, type hash, reliability, durability) as the
   ROS 2 graph API reports them, sent when they change.  The agent's node is
@@ -89,8 +94,28 @@ SERVICE_PERIOD_S = 0.5
 DESCRIBE_TIMEOUT_S = 5.0
 
 
+#: the most messages taken from one tap's subscription in one round (:meth:`Agent.drain`), so a busy topic
+#: does not hold the others back
+TAKE_MAX = 1000
+#: the history depth of each tap's subscription (keep-last, per publisher): at 5000 messages/s over three
+#: topics, about 6 s of one topic's messages, should the agent be held off the CPU or its pipe be full
+TAP_DEPTH = 10_000
+
+_out: list[bytes] = []
+
+
 def _emit(frame: bytes) -> None:
-    view = memoryview(frame)
+    """Queue one frame for the monitor; :func:`_flush` writes the queued frames, in order."""
+    _out.append(frame)
+
+
+def _flush() -> None:
+    """Write every queued frame to stdout in one write (one system call for a batch of samples)."""
+    if not _out:
+        return
+    data = b"".join(_out)
+    _out.clear()
+    view = memoryview(data)
     while view:
         view = view[os.write(1, view):]
 
@@ -317,7 +342,7 @@ class Agent:
             if tap["sub"] is not None:
                 self.node.destroy_subscription(tap["sub"])
                 tap["changes"] += 1
-            qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
+            qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=TAP_DEPTH,
                              reliability=ReliabilityPolicy.RELIABLE if want[0] else ReliabilityPolicy.BEST_EFFORT,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL if want[1] else DurabilityPolicy.VOLATILE)
             tap["sub"] = self.node.create_subscription(tap["cls"], tap["topic"], _handler(k), qos, raw=True)
@@ -367,9 +392,31 @@ class Agent:
     def _said(self, k: int, tap: _Tap) -> None:
         qos = tap["qos"]
         assert qos is not None  # said only once the subscription is made
-        _emit(wire.json_frame({"what": "tap", "id": k, "reliable": qos[0],
+        _emit(wire.json_frame({"what": "tap", "id": k, "reliable": qos[0], "depth": TAP_DEPTH,
                                "durability": "transient_local" if qos[1] else "volatile",
                                "heard": tap["heard"], "changes": tap["changes"]}))
+
+    def drain(self) -> int:
+        """Take what waits in each tap's subscription (at most :data:`TAKE_MAX` each), as the executor
+        would one message per wake-up, and queue its frames; the number taken.  An rclpy without
+        ``take_message`` on its subscription handle leaves them to the executor (0)."""
+        taken = 0
+        for k, tap in self.taps.items():
+            sub = tap["sub"]
+            if sub is None:
+                continue
+            on_message = _handler(k)
+            try:
+                with sub.handle:
+                    for _ in range(TAKE_MAX):
+                        got = sub.handle.take_message(sub.msg_type, True)
+                        if got is None:
+                            break
+                        on_message(got[0], got[1])
+                        taken += 1
+            except (AttributeError, TypeError):  # an rclpy whose handle takes otherwise: the executor's callbacks
+                return taken
+        return taken
 
     def close(self) -> None:
         self.node.destroy_node()
@@ -508,11 +555,13 @@ def graph_dump(wait_s: float, settle_s: float = 8.0, quiet_s: float = 1.5) -> di
 def main() -> int:
     if len(sys.argv) == 3 and sys.argv[1] == "--graph":  # ``ros diff --ros2 --source rclpy``: one dump, then exit
         _emit(wire.json_frame(graph_dump(float(sys.argv[2]))))
+        _flush()
         return 0
     if len(sys.argv) >= 2 and sys.argv[1] == "--describe":  # this Python's own descriptions of the types named
         found = {t: installed_description(t) for t in sys.argv[2:]}
         _emit(wire.json_frame({"what": "descriptions", "types": {
             t: None if f is None else {"hash": f[0], "description": f[1], "from": f[2]} for t, f in found.items()}}))
+        _flush()
         return 0
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     q: queue.Queue[_Command | None] = queue.Queue()
@@ -520,10 +569,12 @@ def main() -> int:
         agent = Agent()
     except Exception as exc:  # noqa: BLE001 - said to the monitor as one line
         _emit(wire.json_frame({"what": "error", "text": f"rclpy could not start: {type(exc).__name__}: {exc}"}))
+        _flush()
         return 1
     wake = agent.node.create_guard_condition(lambda: None)  # a command ends the executor's wait at once
     threading.Thread(target=_commands, args=(q, wake), daemon=True).start()
     agent.hello()
+    _flush()
     started = False
     next_graph = 0.0
     try:
@@ -532,9 +583,11 @@ def main() -> int:
                 while True:
                     c = q.get_nowait() if started else q.get(timeout=0.05)
                     if c is None:
+                        _flush()
                         return 0
                     if c.get("op") == "stop":  # every sample taken is handed over: said, then the node leaves
                         _emit(wire.json_frame({"what": "stopped"}))
+                        _flush()
                         return 0
                     if c.get("op") == "start":
                         started = True
@@ -549,7 +602,11 @@ def main() -> int:
                 next_graph = now + GRAPH_PERIOD_S
             if agent.asked:
                 agent.describing()
+            _flush()
             agent.ex.spin_once(timeout_sec=GRAPH_PERIOD_S)
+            while agent.drain() >= TAKE_MAX:  # a backlog: taken in rounds, each round's frames written at once
+                _flush()
+            _flush()
     finally:
         agent.close()
 

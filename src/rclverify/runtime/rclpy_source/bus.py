@@ -7,7 +7,8 @@ heard through the ROS client library on whatever middleware it runs.
 call book, the log and the bag are the DDS path's, unchanged; only where
 the bytes come from differs.  Its data come from an agent process
 (:mod:`.agent`) run in a ROS 2 Python (:func:`.python.ros2_python`), over a
-pipe (:mod:`.wire`):
+pipe (:mod:`.wire`; asked to hold :data:`PIPE_BYTES`, read :data:`READ_CHUNK`
+bytes at a time, so one read hands over every frame waiting):
 
 * each tap becomes a raw subscription of the topic's ROS name and type
   (``rt/scan`` -> ``/scan``, ``sensor_msgs::msg::dds_::LaserScan_`` ->
@@ -67,7 +68,7 @@ from rclverify.runtime.dds.bus import Tap
 from rclverify.runtime.rclpy_source.discovery import AgentDiscovery, ros_name, ros_type
 from rclverify.runtime.rclpy_source.declared import DeclaredTypes
 from rclverify.runtime.dds.types import Declaration, Declared
-from rclverify.runtime.rclpy_source.wire import parse_sample, read_frame
+from rclverify.runtime.rclpy_source.wire import FrameBuffer, parse_sample, read_frame
 
 AGENT = Path(__file__).with_name("agent.py")
 #: seconds the agent has to say hello (rclpy's start-up)
@@ -75,6 +76,12 @@ HELLO_TIMEOUT_S = 30.0
 #: samples held per publisher while its type description is asked for (the agent answers within its
 #: DESCRIBE_TIMEOUT_S); past it, each further one is dropped and counted in the tap's ``dropped``
 HOLD_MAX = 10_000
+#: bytes read from the agent's pipe at once (what is there, up to this): one read hands over a batch of frames
+READ_CHUNK = 1 << 20
+#: the agent's pipe's capacity asked for (Linux ``F_SETPIPE_SZ``; an unprivileged process may ask up to
+#: ``/proc/sys/fs/pipe-max-size``, 1 MiB by default): about 4000 samples of a few hundred bytes, so the agent
+#: goes on taking messages while the monitor's reading thread waits for the interpreter
+PIPE_BYTES = 1 << 20
 
 
 class RclpyUnavailable(Exception):
@@ -152,6 +159,7 @@ class RclpyBus(DeclaredTypes):
         #: the agent said ``stopped``: every sample it took was handed over (:meth:`stop`)
         self.stopped = False
         self._lock = threading.Lock()
+        self._gone = False  # the agent's stdin is closed: nothing more is sent (:meth:`_send`)
         self._start()
 
     # -- the face of the DDS bus ---------------------------------------------------------------
@@ -235,6 +243,7 @@ class RclpyBus(DeclaredTypes):
         except OSError as exc:
             raise RclpyUnavailable(f"the ROS 2 Python {self.python} cannot run: {exc}") from None
         assert self._proc.stdout is not None
+        _widen(self._proc.stdout.fileno())
         first = read_frame(self._proc.stdout)
         if first is None or first[0] != b"J":
             raise RclpyUnavailable(f"the rclpy agent in {self.python} stopped before it started")
@@ -246,33 +255,37 @@ class RclpyBus(DeclaredTypes):
 
     def _send(self, obj: Mapping[str, object]) -> None:
         proc = self._proc
-        if proc is None or proc.stdin is None or proc.poll() is not None:
+        if proc is None or proc.stdin is None or self._gone:
             return
+        line = (json.dumps(obj) + "\n").encode()
         with self._lock:
             try:
-                proc.stdin.write((json.dumps(obj) + "\n").encode())
+                proc.stdin.write(line)
                 proc.stdin.flush()
-            except (BrokenPipeError, ValueError):
-                pass
+            except (BrokenPipeError, ValueError):  # the agent ended (its exit is the reading thread's to say)
+                self._gone = True
 
     def _run(self) -> None:
         proc = self._proc
         assert proc is not None and proc.stdout is not None
         stream: IO[bytes] = proc.stdout
+        frames = FrameBuffer()
         try:
             while True:
-                frame = read_frame(stream)
-                if frame is None:
+                chunk = stream.read1(READ_CHUNK)  # type: ignore[attr-defined]  # a BufferedReader: what is there
+                if not chunk:
                     break
-                kind, body = frame
-                if kind == b"S":
-                    self._sample(body)
-                    continue
-                obj = json.loads(body)
-                if obj.get("what") == "stopped":  # everything handed over (the agent's stop)
-                    self.stopped = True
-                    return
-                self._json(obj)
+                for kind, body in frames.feed(chunk):
+                    if kind == b"S":
+                        self._sample(body)
+                        continue
+                    obj = json.loads(body)
+                    if obj.get("what") == "stopped":  # everything handed over (the agent's stop)
+                        self.stopped = True
+                        return
+                    self._json(obj)
+            if frames.left():
+                raise ValueError("the agent's stream ended inside a frame")
             if proc.wait() not in (0, None):
                 raise RclpyUnavailable(f"the rclpy agent exited with status {proc.returncode}")
         except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead reader must be said
@@ -313,7 +326,8 @@ class RclpyBus(DeclaredTypes):
             t = self.taps[int(obj["id"])]
             first = t.reader is None
             t.reader, t.reader_changes = True, int(obj["changes"])
-            t.qos = QosProfile(reliable=bool(obj["reliable"]), durability=str(obj["durability"]), depth=1000)
+            t.qos = QosProfile(reliable=bool(obj["reliable"]), durability=str(obj["durability"]),
+                               depth=int(obj.get("depth", 1000)))
             t.heard = {bytes.fromhex(g) for g in obj["heard"]}
             if first and self.on_reader is not None:
                 self.on_reader(t, self.discovery.publishers(t.dds_topic))
@@ -347,6 +361,19 @@ class RclpyBus(DeclaredTypes):
                     self.warn(f"{where}: warning: /{key}: {who} writes on the {role} beside the monitor; what "
                               "it writes is not checked, and the evidence is not discharged while it does")
 
+
+
+def _widen(fd: int) -> None:
+    """Ask for :data:`PIPE_BYTES` of capacity on the pipe ``fd`` (Linux); elsewhere, or where the system
+    refuses, the pipe keeps its own (64 KiB on Linux) and the agent waits for the monitor sooner."""
+    import fcntl  # deferred: POSIX only
+    setsz = getattr(fcntl, "F_SETPIPE_SZ", None)
+    if setsz is None:
+        return
+    try:
+        fcntl.fcntl(fd, setsz, PIPE_BYTES)
+    except OSError:
+        pass
 
 
 __all__ = ["AGENT", "RclpyBus", "RclpyUnavailable", "agent_answer"]

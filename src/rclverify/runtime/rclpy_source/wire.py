@@ -63,6 +63,34 @@ def read_frame(stream: IO[bytes]) -> tuple[bytes, bytes] | None:
     return kind, body
 
 
+class FrameBuffer:
+    """Frames cut from a byte stream read in chunks of any size (the monitor reads the agent's pipe a
+    large chunk at a time, so one read hands over a batch of frames): :meth:`feed` a chunk, get the
+    whole frames it completes, in order; the rest waits for the next chunk."""
+
+    def __init__(self) -> None:
+        self._buf = bytearray()
+
+    def feed(self, chunk: bytes) -> list[tuple[bytes, bytes]]:
+        """The frames (kind, payload) complete once ``chunk`` is added."""
+        buf = self._buf
+        buf += chunk
+        out: list[tuple[bytes, bytes]] = []
+        at, end, head = 0, len(buf), HEADER.size
+        while end - at >= head:
+            kind, size = HEADER.unpack_from(buf, at)
+            if end - at - head < size:
+                break
+            out.append((kind, bytes(buf[at + head:at + head + size])))
+            at += head + size
+        del buf[:at]
+        return out
+
+    def left(self) -> int:
+        """Bytes of a frame not yet complete (0 when the stream ended on a frame boundary)."""
+        return len(self._buf)
+
+
 def parse_sample(body: bytes) -> tuple[int, int, int, int, bytes, bytes]:
     """An ``S`` frame's payload: (tap id, source ns, received ns, sequence number, gid, raw)."""
     tap, source_ns, received_ns, seq = SAMPLE.unpack_from(body)
@@ -81,4 +109,4 @@ def _read(stream: IO[bytes], n: int) -> bytes:
     return b"".join(parts)
 
 
-__all__ = ["GID_BYTES", "HEADER", "SAMPLE", "json_frame", "parse_sample", "read_frame", "sample_frame"]
+__all__ = ["FrameBuffer", "GID_BYTES", "HEADER", "SAMPLE", "json_frame", "parse_sample", "read_frame", "sample_frame"]
