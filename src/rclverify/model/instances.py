@@ -36,7 +36,7 @@ from rclverify.model.plan.model import Connection
 
 
 def _resolved(text: str, inst: Instance) -> str:
-    return names.resolve(text, inst.node, inst.namespace)
+    return names.resolve(text, inst.node, inst.namespace, inst.remaps)
 
 
 def instance_node(cn: CheckedNode, inst: Instance) -> CheckedNode:
