@@ -29,6 +29,7 @@ from rclverify.tools.lsp.lines import split_lines
 #: The words of rcl.lark that are keywords somewhere (reserved or contextual).
 KEYWORDS = ("context", "node", "inputs", "outputs", "topics", "matches", "assume", "guarantee", "triggered", "by",
             "within", "services", "actions", "serves", "calls", "initially", "progress", "eventually", "periodic",
+            "while", "ready", "of",
             "and", "or", "not", "in", "forall", "exists", "exists_unique", "TRUE", "FALSE", "REAL", "INTEGER",
             "NATURAL", "BOOL", "STRING", "set", "seq", "upto")
 
