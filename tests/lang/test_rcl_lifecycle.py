@@ -141,3 +141,16 @@ def test_the_guarantees_of_one_node_share_one_scope() -> None:
                     "monitors ask a node's questions by its state"]
     check([parse_text(node("guarantee( out.level >= in.request )", "guarantee( out.level >= 0 ) while active"),
                       "f.rcl")])  # control: unscoped is while active
+
+
+def test_the_editor_completes_every_keyword_of_the_grammar() -> None:
+    """The language server's completion (tools/lsp/complete.py ``KEYWORDS``) offers every word rcl.lark
+    quotes, the new ``while``, ``ready`` and ``of`` among them; the short forms ``A``/``G``, ``abs`` and
+    ``x`` (and a comment's example name) are the only words left out."""
+    import re
+
+    from rclverify.lang.parser import grammar_text
+    from rclverify.tools.lsp.complete import KEYWORDS
+    words = set(re.findall(r'"([A-Za-z_]+)"', grammar_text()))
+    assert {"while", "ready", "of"} <= words
+    assert words - set(KEYWORDS) == {"A", "G", "abs", "x", "RadStat"}
