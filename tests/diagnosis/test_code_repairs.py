@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from fractions import Fraction
 from typing import Any
 
 import pytest
@@ -40,6 +41,15 @@ node Clamp {
   guarantee( in.v <= 50 -> out.y == in.v )
 }
 
+// A band: open from 2 to 8, both ends included.
+node Band {
+  inputs( x : INTEGER )
+  outputs( ok : BOOL )
+  assume( 0 <= in.x and in.x <= 10 )
+  guarantee( 2 <= in.x and in.x <= 8 -> out.ok )
+  guarantee( in.x < 2 or in.x > 8 -> not out.ok )
+}
+
 node Fine {
   inputs( x : INTEGER )
   outputs( ok : BOOL )
@@ -51,6 +61,7 @@ node Fine {
 CODE = {
     "gate": '"""The gate (a seeded slip: < for <=)."""\n\n\ndef gate(x):\n    return {"ok": x < 3}\n',
     "clamp": '"""The clamp (a seeded slip: max for min)."""\n\n\ndef clamp(v):\n    y = max(v, 50)\n    return {"y": y}\n',
+    "band": '"""The band (two slips: both ends left out)."""\n\n\ndef band(x):\n    return {"ok": 2 < x and x < 8}\n',
     "fine": '"""The gate written right."""\n\n\ndef fine(x):\n    return {"ok": x <= 3}\n',
 }
 PLAN = "contracts: [contracts/robot.rcl]\nnodes:\n" + "".join(
@@ -170,3 +181,23 @@ def test_the_sarif_fixes_are_valid_and_applied_give_the_repaired_code(verified: 
         off = dict(change["replacements"][0], deletedRegion={**change["replacements"][0]["deletedRegion"],
                                                              "startColumn": 20, "endColumn": 21})
         assert _apply_sarif(CODE["gate"], off) != new
+
+
+def test_two_slips_on_one_line_get_a_two_token_repair_when_no_one_token_one_passes(verified: dict[str, Any]) -> None:
+    """diagnosis/pair_edits.py: each strictness alone still fails at the other end of the band; both together
+    pass every guarantee.  The control: Gate's one slip is repaired with one token (no pair is tried)."""
+    from rclverify.diagnosis.pair_edits import joined, pair_edits
+    d = verified["diagnoses"]["Band.g1.property_tests.e0"]
+    first = d["repairs"][0]
+    assert first["edit"]["line"] == 5 and "+    return {\"ok\": 2 <= x and x <= 8}" in first["diff"]
+    assert "a two-token correction" in first["summary"] and len(first["checks"]) == 2
+    assert all(c["status"] == "discharged" for c in first["checks"])
+    assert (verified["ws"] / "nodes/band.py").read_text(encoding="utf-8") == CODE["band"]  # never applied
+    assert all("one-token" in r["summary"] for r in verified["diagnoses"]["Gate.g1.property_tests.e0"]["repairs"])
+    source = CODE["band"]
+    singles = candidate_edits(source, "nodes/band.py", 5, [Fraction(2), Fraction(8)])
+    assert not any(e.apply(source).endswith('return {"ok": 2 <= x and x <= 8}\n') for e in singles)
+    pairs = pair_edits(source, singles)
+    assert pairs and pairs[0].apply(source).endswith('return {"ok": 2 <= x and x <= 8}\n')
+    a, b = sorted(singles[:2], key=lambda e: e.col)
+    assert joined(source, b, a) is None  # out of order (or overlapping): no one edit

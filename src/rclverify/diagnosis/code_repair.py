@@ -40,6 +40,9 @@ only when it was checked:
    wrong value made on one line and returned on another (``worst =
    min(...)`` then ``return {"ok": worst <= LIMIT}``), or a wrong branch
    whose taken ``return`` was named, is repaired where it was made.
+5. *Two tokens* (:mod:`.pair_edits`): when nothing of 1-4 passes, two of
+   the culprit line's one-token corrections made together, checked the
+   same way.
 
 What the check shows is what the harness shows: the node's guarantees
 held on every example Hypothesis drew from the edited copy; not that the
@@ -56,6 +59,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
 from rclverify.diagnosis.edits import Edit
+from rclverify.diagnosis.pair_edits import pair_edits
 from rclverify.records.stage_records import Repair
 
 #: Most repairs offered for one failure.
@@ -374,10 +378,12 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
     ids = {k: f"{node}.g{k}.property_tests.e{index}" for k in range(1, len(target.node.node.guarantees) + 1)}
     numbers, kinds = contract_numbers(target.node), contract_kinds(target.node)
     around = [e for k in around_lines(source, int(at)) for e in candidate_edits(source, file, k, numbers, kinds)]
-    tried = [(e, True) for e in candidate_edits(source, file, int(at), numbers, kinds)[:MAX_TRIED]]
-    for edit, at_line in [*tried, *((e, False) for e in around[:MAX_AROUND])]:
+    singles = candidate_edits(source, file, int(at), numbers, kinds)
+    pairs = [(e, None) for e in pair_edits(source, singles)]  # two tokens of the line: last (pair_edits.py)
+    for edit, at_line in [*((e, True) for e in singles[:MAX_TRIED]), *((e, False) for e in around[:MAX_AROUND]),
+                          *pairs]:
         if not at_line and out:
-            break  # the culprit line's own repairs first; the lines around only when it has none
+            break  # the culprit line's own repairs first; the lines around, then two tokens, only without one
         got = _statuses(target, cfg, edit.apply(source), failing)
         if len(got) != len(ids) or any(s != "discharged" for s in got.values()):
             continue
@@ -386,9 +392,9 @@ def checked_repairs(ws: Any, node: str, obligation: str, cause: str,
         checks = [{"check": ids[k], "status": got[k]} for k in sorted(got)]
         cost = [{"check": ids[k], "before": (before or {}).get(ids[k], "absent"), "after": got[k]}
                 for k in sorted(got) if (before or {}).get(ids[k], "absent") != got[k]]
-        where = "the line where the failing example goes wrong" if at_line else \
+        where = "the line where the failing example goes wrong" if at_line is not False else \
             f"a statement of the same function as {file}:{at}, where the failing example goes wrong"
-        said = f"change `{old}` to `{new}`: a one-token correction of {where}"
+        said = f"change `{old}` to `{new}`: a {'two' if at_line is None else 'one'}-token correction of {where}"
         if not edit.deleted(source) and "\n" in edit.text:  # a guard inserted (:func:`_guards`)
             said = f"insert `{' '.join(x.strip() for x in edit.text.splitlines())}` before it: a guard of {where}"
         rec = _record("code", f"At {file}:{edit.line}, {said}.", edit, source, checks, cost,
