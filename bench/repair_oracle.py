@@ -30,6 +30,7 @@ Usage::
     python bench/repair_oracle.py                 # 40 cases, seed 1
     python bench/repair_oracle.py --cases 100 --seed 7
     python bench/repair_oracle.py --smoke         # 3 cases, a few seconds
+    python bench/repair_oracle.py --two --cases 20  # two slips on one line: the two-token repairs
 
 The figures are printed, not asserted.
 """
@@ -40,6 +41,7 @@ if __name__ == "__main__":  # run as a script: a Python without the dependencies
 
 import argparse
 import random
+import re
 import shutil
 import tempfile
 import time
@@ -135,6 +137,48 @@ def generate(rng: random.Random) -> Case:
                  lambda i, o, f=f: f(i["x"], i["y"]) or o["ok"] is False])
 
 
+def generate_two(rng: random.Random) -> Case:
+    """One case with two slips on one line (``--two``): a comparison's strictness and its constant, both
+    ends of a band, an operator and its constant, ``max`` for ``min`` and its constant, or the two
+    operands of an order swapped; built on :func:`generate`'s case of the same family."""
+    while True:
+        c = generate(rng)
+        code = c.code
+        if c.family == "threshold":
+            op, k = re.search(r"x (<=|>=|<|>) (\d+)", code).groups()
+            return _two(c, f"x {op} {k}", f"x {_STRICT[op]} {int(k) + rng.choice([-1, 1])}", "strictness+constant")
+        if c.family == "band":
+            lo, hi = re.search(r"(\d+) <= x and x <= (\d+)", code).groups()
+            new, what = rng.choice([(f"{lo} < x and x < {hi}", "both ends"),
+                                    (f"{lo} < x and x <= {int(hi) + rng.choice([-1, 1])}", "strictness+constant"),
+                                    (f"{lo} <= x or x < {hi}", "and/or+strictness")])
+            return _two(c, f"{lo} <= x and x <= {hi}", new, what)
+        if c.family == "offset":
+            k = int(re.search(r"x \+ (\d+)", code).group(1))
+            return _two(c, f"x + {k}", f"x - {k + rng.choice([-1, 1])}", "operator+constant")
+        if c.family == "clamp":
+            k = int(re.search(r"min\(x, (\d+)\)", code).group(1))
+            return _two(c, f"min(x, {k})", f"max(x, {k + 1})", "max/min+constant")
+        op = re.search(r"x (<=|>=|<|>) y", code).group(1)
+        return _two(c, f"x {op} y", f"y {op} x", "operands")
+
+
+def _two(c: Case, old: str, new: str, what: str) -> Case:
+    return Case(c.family, c.contract, c.code, c.code.replace(old, new), what, c.domain, c.specs)
+
+
+def _one_token_fixes(case: Case) -> bool:
+    """Whether one token of the slipped line (the culprit search's corrections, ``max``/``min``) already makes
+    ``case`` right: then it is no two-slip case."""
+    from fractions import Fraction
+
+    from rclverify.diagnosis.code_repair import candidate_edits
+    line = next(k for k, x in enumerate(case.slipped.splitlines(), 1) if "x" in x and "def " not in x
+                and '"""' not in x)
+    nums = [Fraction(int(n)) for n in re.findall(r"\d+", case.contract)]
+    return any(right(case, e.apply(case.slipped)) for e in candidate_edits(case.slipped, "nodes/n.py", line, nums))
+
+
 def right(case: Case, code: str) -> bool:
     """The oracle: ``code``'s function ``n`` meets every guarantee of ``case`` on every input of its
     domain (brute force); a function that does not load or raises is wrong."""
@@ -153,13 +197,14 @@ def right(case: Case, code: str) -> bool:
     return True
 
 
-def cases(seed: int, n: int) -> list[Case]:
-    """``n`` cases from ``seed``, each right as written and wrong as slipped (both by the oracle)."""
+def cases(seed: int, n: int, two: bool = False) -> list[Case]:
+    """``n`` cases from ``seed``, each right as written and wrong as slipped (both by the oracle); ``two``:
+    two slips on one line, kept only when no one-token correction of the line makes the case right."""
     rng = random.Random(seed)
     out: list[Case] = []
     while len(out) < n:
-        c = generate(rng)
-        if right(c, c.code) and not right(c, c.slipped):
+        c = generate_two(rng) if two else generate(rng)
+        if right(c, c.code) and not right(c, c.slipped) and not (two and _one_token_fixes(c)):
             out.append(c)
     return out
 
@@ -205,11 +250,12 @@ def run_case(case: Case, where: Path) -> Outcome:
     return Outcome("", [], [], time.perf_counter() - t0)
 
 
-def run(seed: int, n: int) -> list[tuple[Case, Outcome]]:
-    """Every case of ``seed`` and ``n`` with the tool's outcome (workspaces in a temporary folder)."""
+def run(seed: int, n: int, two: bool = False) -> list[tuple[Case, Outcome]]:
+    """Every case of ``seed`` and ``n`` (``two``: two slips a line) with the tool's outcome (workspaces in a
+    temporary folder)."""
     tmp = Path(tempfile.mkdtemp(prefix="rclverify-repair-oracle-"))
     try:
-        return [(c, run_case(c, tmp / f"case{k}")) for k, c in enumerate(cases(seed, n))]
+        return [(c, run_case(c, tmp / f"case{k}")) for k, c in enumerate(cases(seed, n, two))]
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
@@ -219,9 +265,10 @@ def main() -> None:
     p.add_argument("--cases", type=int, default=40)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--smoke", action="store_true", help="3 cases")
+    p.add_argument("--two", action="store_true", help="two slips on one line (the two-token repairs)")
     a = p.parse_args()
     n = 3 if a.smoke else a.cases
-    results = run(a.seed, n)
+    results = run(a.seed, n, a.two)
     first = sum(1 for _, o in results if o.judged and o.judged[0])
     wrong = sum(1 for _, o in results for j in o.judged if not j)
     offered = sum(len(o.judged) for _, o in results)
