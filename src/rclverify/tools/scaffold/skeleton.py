@@ -103,6 +103,7 @@ class _Node:
     # message (pkg/Type) -> (the variables reading it, its fields left out: (path, ROS type, why))
     left: dict[str, tuple[list[str], list[tuple[str, str, str]]]] = field(default_factory=dict)
     named: dict[str, str] = field(default_factory=dict)  # RCL name of a topic, service or action -> its ROS name
+    lifecycle: bool = False  # a managed node: its transition topic named, its guarantee scoped `while active`
 
     def left_groups(self) -> list[tuple[str, list[str], list[tuple[str, str, str]]]]:
         """``(message, variables, fields left out)`` for the skeleton's comment, in order of use."""
@@ -299,6 +300,9 @@ def build_skeletons(res: ScanResult, library: bool = False
                 n.topics.append(f"{short_type(e.msg_type) if e.msg_type else 'std_msgs/Empty'} {topic_name} "
                                 f"matches({kind}.{var})")
                 uses.setdefault(topic_name, []).append((cname, e.msg_type, paths))
+        if gn.lifecycle:  # a managed node (docs/rcl-language.md, "Lifecycle nodes"): its ~/transition_event,
+            n.lifecycle = True  # written relative as the skeleton's other names (resolved in the node's namespace)
+            n.topics.append(f"lifecycle_msgs/TransitionEvent {gname.rsplit('/', 1)[-1]}/transition_event")
         _links(n, gn, table, taken, context, seen, library)
         nodes.append(n)
     for topic_name, got in uses.items():
