@@ -41,3 +41,14 @@ def test_control_the_oracle_rejects_the_slips_and_a_repair_that_breaks_a_guarant
     gate = next(c for c in cases(11, 30) if c.family == "threshold")
     assert not right(gate, gate.code.replace('{"ok": ', '{"ok": True or '))
     assert not right(gate, gate.code.replace('{"ok": ', '{"ok": False and '))
+
+
+def test_two_slips_on_one_line_are_repaired_with_two_tokens_and_never_wrongly() -> None:
+    """diagnosis/pair_edits.py on generated nodes with two slips on one line (``--two``): each case repaired,
+    no repair the oracle rejects.  The control: no one-token correction of the line makes any case right
+    (the generator keeps only those), so each repair offered is a pair."""
+    from repair_oracle import _one_token_fixes
+    got = run(5, 3, two=True)
+    assert all(not _one_token_fixes(c) for c, _ in got)
+    assert [(bool(o.cause), o.judged[:1]) for _, o in got] == [(True, [True])] * 3
+    assert all(all(o.judged) for _, o in got)
