@@ -8,7 +8,9 @@ failed run what :func:`rclverify.diagnosis.run_repair.run_repairs` needs: the fi
 node's served calls or of its topics.  :func:`monitor_repairs` searches them in the ROS 2 Python
 (:func:`rclverify.runtime.rclpy_source.python.ros2_python`) and says, in one sentence, why none is
 offered when the search cannot run (no entry naming the code, no ROS 2 Python, a run that is not a
-JSON-lines log) or found none.
+JSON-lines log) or found none.  :func:`report_repairs` is that search as the diagnosis stage asks it, kept
+in the diagnosis cache; :func:`rejudged_applied` the check ``rclverify repair --apply`` runs again once a
+repair is written.
 """
 from __future__ import annotations
 
