@@ -110,6 +110,7 @@ SECONDS: dict[str, float] = {
     "test_repair_examples": 30.0, "test_repair_oracle": 7.0, "test_repair_cli": 5.0, "test_hoare_token_repairs": 3.0,
     "test_fret_example": 10.0, "test_instances": 3.5, "test_fleet_example": 6.0,
     "test_lifecycle_recorded": 2.6,  # seven replays of a recorded run through the live run's judge
+    "test_ros_init_lifecycle": 3.8,  # init --from-ros, check and ros check on the bringup corpus
     "test_fret_scopes": 19.0,  # 191 FRET scope/timing combinations, each run against FRET's formula on 12 traces
     # Out of the inner tier by the two-second rule (docs/ci.md, "Round sixteen"): over 2 CPU s in three inner-tier
     # runs of round fifteen (the median) and again run alone, one process, at a fixed commit (load about 17).
