@@ -66,6 +66,8 @@ INTERNAL: list[tuple[str, str, str, Stream]] = [
     ("accel", "double", "0.0 -> (speed - pre speed) * 2.0",
      lambda tr, i: Fraction(0) if i == 0 else (tr[i]["speed"] - tr[i - 1]["speed"]) * 2),
     ("tbl", "double", "1.0 -> pre( 2.0 -> pre( 0.5 -> pre( 3.0 )))", lambda tr, i: _TABLE[min(i, 3)]),
+    ("dtbl", "double", "0.0 -> (tbl - pre tbl)", lambda tr, i: Fraction(0) if i == 0 else _TABLE[min(i, 3)] -
+     _TABLE[min(i - 1, 3)]),
     ("rose", "boolean", "false -> (obstacle and not pre obstacle)",
      lambda tr, i: i > 0 and tr[i]["obstacle"] and not tr[i - 1]["obstacle"]),
     ("sticky", "boolean", "false -> (pre sticky or obstacle)", _sticky),
@@ -79,6 +81,7 @@ CASES: list[tuple[str, str, str, str, str | None, str, dict[str, Any], str]] = [
     ("L-TABLE", "null", "null", "always", None, "(speed <= tbl)", {}, "(H (speed <= tbl))"),
     ("L-TABLE-FOR", "null", "null", "for", None, "(speed <= tbl)", {"duration": 2},
      "(H ((O[0,2] (! (Y TRUE))) -> (speed <= tbl)))"),
+    ("L-PRE-TABLE", "null", "null", "always", None, "(speed + dtbl <= 3.0)", {}, "(H ((speed + dtbl) <= 3.0))"),
     ("L-BOOL", "null", "regular", "immediately", "(rose)", "(braking)", {}, "(H ((rose & (Z (! rose))) -> braking))"),
     ("L-SELF-BOOL", "null", "noTrigger", "next", "(sticky)", "(braking)", {},
      "(H ((Y sticky) -> (braking | (! (Y TRUE)))))"),

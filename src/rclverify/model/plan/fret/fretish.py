@@ -273,6 +273,13 @@ class Writer:
                 default: Expr = ("bool", "FALSE") if PRE[name] == "BOOL" else ("num", "0.0" if PRE[name] ==
                                                                                      "REAL" else "0")
                 return self.resolve(("ite", ("var", "FTP"), init, ("call", name, (default, args[1]))), local)
+            body = args[1]
+            if body[0] == "var" and not isinstance(got := self.var(str(body[1]), local), str):
+                body = got
+            if body[0] == "table":  # the pre of a table is the table a step later: no state variable
+                consts = body[1]
+                assert isinstance(consts, tuple)
+                return self.resolve(("table", (init,) + consts), local)
             state = self.pre(PRE[name], init, args[1])
             return ("text", f"state.{state}" if local else f"{self.node}.state.{state}")
         if name in COUNTED and len(args) == 2 and self.count is not None:
@@ -323,8 +330,10 @@ def _split(e: Expr) -> tuple[Expr, Callable[[Expr], Expr]] | None:
 def lift(e: Expr) -> Expr:
     """Formula ``e`` (resolved) with each ``ite(c, a, b)`` and table stated where a formula reads it: an
     ``ite`` formula as ``(c & a) | (!c & b)``, a comparison (or other atom) ``A`` reading ``ite(c, a, b)``
-    as ``(c => A[a]) & (!c => A[b])``, one reading table ``(v, c0..cN)`` as the conjunction of
-    ``v = k => A[ck]`` for k < N and ``v >= N => A[cN]`` (``("and*", items)``, written flat)."""
+    as ``(c => A[a]) & (!c => A[b])``, one reading tables of step counter ``v`` (``(v, c0..cN)``) as the
+    conjunction of ``v = k => A[each table at k]`` for k < N and ``v >= N => A[each at N]``, N the longest
+    table's last step and a shorter table's last constant standing from its end on (``("and*", items)``,
+    written flat)."""
     kind = e[0]
     if kind in ("not", "paren"):
         return (kind, lift(e[1]))  # type: ignore[arg-type]
@@ -341,11 +350,38 @@ def lift(e: Expr) -> Expr:
         c = lift(node[1])  # type: ignore[arg-type]
         return ("bin", "&", ("bin", "=>", c, lift(put(node[2]))),  # type: ignore[arg-type]
                 ("bin", "=>", ("not", c), lift(put(node[3]))))  # type: ignore[arg-type]
-    counter, consts = ("text", str(node[1])), node[2]
-    assert isinstance(consts, tuple)
-    last = len(consts) - 1
-    return ("and*", tuple(("bin", "=>", ("bin", "=" if k < last else ">=", counter, ("num", str(k))), lift(put(c)))
-                          for k, c in enumerate(consts)))
+    counter = str(node[1])
+    last = _longest(e, counter) - 1
+    return ("and*", tuple(("bin", "=>", ("bin", "=" if k < last else ">=", ("text", counter), ("num", str(k))),
+                           lift(_at(e, counter, k))) for k in range(last + 1)))
+
+
+def _longest(e: Expr, counter: str) -> int:
+    """The length of the longest table of ``counter`` inside ``e``."""
+    if e[0] == "table":
+        consts = e[2]
+        assert isinstance(consts, tuple)
+        return len(consts) if e[1] == counter else 0
+    return max([_longest(a, counter) for a in _children(e)], default=0)
+
+
+def _at(e: Expr, counter: str, k: int) -> Expr:
+    """``e`` with every table of ``counter`` as its value at step ``k`` (its last from its end on)."""
+    if e[0] == "table" and e[1] == counter:
+        consts = e[2]
+        assert isinstance(consts, tuple)
+        return consts[min(k, len(consts) - 1)]  # type: ignore[no-any-return]
+    return tuple(a if i == 0 or not isinstance(a, tuple) or not a else
+                 _at(a, counter, k) if isinstance(a[0], str) else tuple(_at(b, counter, k) for b in a)
+                 for i, a in enumerate(e))
+
+
+def _children(e: Expr) -> list[Expr]:
+    out: list[Expr] = []
+    for a in e[1:]:
+        if isinstance(a, tuple) and a:
+            out.extend([a] if isinstance(a[0], str) else a)
+    return out
 
 
 def text(e: Expr) -> str:
