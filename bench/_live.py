@@ -31,12 +31,12 @@ def wait_text(path: Path, text: str, timeout: float) -> None:
         time.sleep(0.05)
 
 
-def stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
-    """Send ``sig`` to the process group of ``p`` (started in a session of its own), SIGKILL after 20 s."""
+def stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM, grace: float = 20.0) -> None:
+    """Send ``sig`` to the process group of ``p`` (started in a session of its own), SIGKILL after ``grace`` s."""
     if p.poll() is None:
         os.killpg(p.pid, sig)
         try:
-            p.wait(20)
+            p.wait(grace)
         except subprocess.TimeoutExpired:
             os.killpg(p.pid, signal.SIGKILL)
             p.wait(5)

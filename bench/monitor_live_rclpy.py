@@ -32,7 +32,10 @@ reader (default) or by an rclpy subscriber, as a ROS 2 user hears them.
 
 ``--burn N``: N processes spinning ``while True: pass`` beside each run
 (started before its processes, every one stopped after it), the load of
-other work on a shared machine.
+other work on a shared machine.  ``--nice N``: the monitor (and the
+rclpy agent it starts) at niceness N, as a robot's integrator may run it
+(``nice -n -5``, systemd's ``Nice=``; raising a priority needs the
+privilege); the publisher, the listener and the burners stay at 0.
 
 Prints the figures, the load average as each run ends and the core count;
 asserts nothing.
@@ -62,6 +65,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "bench"))
 from monitor_live_dds import CONFIG, _latency  # noqa: E402  (the loopback config; verdicts decided on arrival)
 
+#: seconds the monitor has, after SIGINT, to judge the messages still queued and write its evidence (on a
+#: loaded machine a backlog of 20,000 messages takes tens of seconds); SIGKILL after it
+STOP_GRACE_S = 180.0
 TOPICS = {"a": ("std_msgs/Float64", "data", "A"), "b": ("sensor_msgs/JointState", "position[0]", "B"),
           "c": ("geometry_msgs/PoseWithCovarianceStamped", "pose.pose.position.x", "C")}
 #: the verdicts as a ROS 2 user hears them: an rclpy subscriber of /rclverify/verdict (in the ROS 2 Python)
@@ -142,7 +148,8 @@ def _workspace(ws: Path) -> None:
 
 
 def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool,
-         source: str = "dds", listener: str = "dds", lateness: float = 0.05, burn: int = 0) -> dict[str, Any]:
+         source: str = "dds", listener: str = "dds", lateness: float = 0.05, burn: int = 0,
+         nice: int = 0) -> dict[str, Any]:
     from _live import burners, cpu_seconds, stop, wait_text
     tag = f"{'lat' if latency else 'loss'}{int(rate)}{source}"
     procs: list[subprocess.Popen[bytes]] = []
@@ -154,15 +161,16 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
         return p
     with burners(burn):
         try:
-            return _started(tmp, env, ros2, rate, seconds, latency, source, listener, lateness, tag, start, procs)
+            return _started(tmp, env, ros2, rate, seconds, latency, source, listener, lateness, tag, start, procs,
+                            nice)
         finally:
             for p in procs:
                 stop(p)
 
 
 def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool, source: str,
-             listener: str, lateness: float, tag: str, start: Any, procs: list[subprocess.Popen[bytes]]
-             ) -> dict[str, Any]:
+             listener: str, lateness: float, tag: str, start: Any, procs: list[subprocess.Popen[bytes]],
+             nice: int = 0) -> dict[str, Any]:
     """One run's processes started by ``start`` (listener, monitor, publisher), waited for and stopped."""
     from _live import children_cpu_seconds, cpu_seconds, stop, wait_text
     lis = None
@@ -174,7 +182,7 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
         lis = start([sys.executable, str(ROOT / "bench" / "monitor_live_dds.py"), "--listener",
                      str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
         wait_text(tmp / f"listener{tag}.out", "listening", 30)
-    mon = start([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
+    mon = start((["nice", "-n", str(nice)] if nice else []) + [sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
                  "--mapping", "mapping.yaml", "--horizon", "1.0", "--reorder-window", str(lateness), "--status", "0",
                  "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json"),
                  "--source", source, "--ros2-python", str(ros2)],
@@ -186,13 +194,15 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
     pub.wait(seconds * 3 + 60)
     time.sleep(1.5)  # the last messages arrive and are judged
     cpu, agent_cpu = cpu_seconds(mon.pid), children_cpu_seconds(mon.pid)
-    stop(mon, signal.SIGINT)
+    t_stop = time.monotonic()
+    stop(mon, signal.SIGINT, grace=STOP_GRACE_S)  # it judges what it heard and not yet judged, then exits
+    ended = time.monotonic() - t_stop
     if lis is not None:
         stop(lis)
     load = os.getloadavg()[0]  # the 1-minute load average as the run ends (burners and all)
     if not (tmp / f"sent{tag}.json").exists():
         raise SystemExit(f"the rclpy publisher failed:\n{(tmp / f'publisher{tag}.out').read_text()[-2000:]}")
-    res: dict[str, Any] = {"sent": json.loads((tmp / f"sent{tag}.json").read_text()), "cpu": cpu, "agent_cpu": agent_cpu,
+    res: dict[str, Any] = {"sent": json.loads((tmp / f"sent{tag}.json").read_text()), "cpu": cpu, "agent_cpu": agent_cpu, "ended": ended,
                            "load": load,
                            "record": json.loads((tmp / f"evidence{tag}.json").read_text()),
                            "log_topics": [json.loads(x)["topic"] for x in
@@ -203,20 +213,21 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
 
 
 def bench(total_rate: float, latency_rate: float, seconds: float, sources: tuple[str, ...] = ("dds", "rclpy"),
-          listener: str = "dds", lateness: float = 0.05, burn: int = 0) -> None:
-    """The benchmark (module docstring), once per source, beside ``burn`` CPU burners."""
+          listener: str = "dds", lateness: float = 0.05, burn: int = 0, nice: int = 0) -> None:
+    """The benchmark (module docstring), once per source, beside ``burn`` CPU burners, the monitor (and
+    its agent) at niceness ``nice``."""
     ros2, why = ros2_python()
     if ros2 is None:
         print(f"rclpy: skipped: {why}")
         return
     for source in sources:
-        _bench(ros2, total_rate, latency_rate, seconds, source, listener, lateness, burn)
+        _bench(ros2, total_rate, latency_rate, seconds, source, listener, lateness, burn, nice)
 
 
 def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, source: str,
-           listener: str = "dds", lateness: float = 0.05, burn: int = 0) -> None:
+           listener: str = "dds", lateness: float = 0.05, burn: int = 0, nice: int = 0) -> None:
     from _live import p99
-    beside = f"{burn} CPU burner(s), " if burn else ""
+    beside = (f"{burn} CPU burner(s), " if burn else "") + (f"monitor at nice {nice}, " if nice else "")
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         _workspace(tmp / "ws")
@@ -225,35 +236,38 @@ def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, s
         env.update(PYTHONPATH=str(ROOT / "src"), CYCLONEDDS_URI=(tmp / "cyclonedds.xml").as_uri(),
                    ROS_DOMAIN_ID=str(random.SystemRandom().randint(1, 230)), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                    RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp / "ros_log"), PYTHONUNBUFFERED="1")
-        res = _run(tmp, {**env, "PYTHONPATH": str(ROOT / "src")}, ros2, total_rate, seconds, latency=False,
-                   source=source, lateness=lateness, burn=burn)
-        load = f"{beside}load average {res['load']:.1f} on {os.cpu_count()} core(s)"
-        sent, rec = res["sent"]["sent"], res["record"]
-        per = {t: sum(1 for topic, _t in sent if topic == t) for t in TOPICS}
-        heard = {t: rec["qos"][t]["samples"] for t in TOPICS}
-        lost = len(sent) - rec["events"]
-        print(f"rclpy publisher, {source} source: loss: {total_rate:.0f} msg/s asked over {len(TOPICS)} topics: published {len(sent)} in "
-              f"{res['sent']['elapsed']:.2f} s ({len(sent) / res['sent']['elapsed']:.0f} msg/s); heard "
-              f"{sum(heard.values())} ({', '.join(f'/{t} {heard[t]}/{per[t]}' for t in TOPICS)}); checked "
-              f"{rec['events']}; lost {lost}{f' ({lost / len(sent):.1%})' if lost else ''}; engine queue dropped "
-              f"{rec.get('dropped_messages', 0)}, longest {rec.get('backlog_max', 0)}; decode errors {sum(rec['decode_errors'].values())}; {load}")
-        if res["cpu"] is not None:
-            print(f"rclpy publisher, {source} source: loss: monitor CPU {res['cpu'] / max(1, len(sent)) * 1e6:.0f} us per message "
-                  f"(start-up included), engine thread {rec.get('engine_cpu_us_per_message', 0):.0f} us"
-                  + (f", the rclpy agent {res['agent_cpu'] / max(1, len(sent)) * 1e6:.0f} us" if source == "rclpy" else ""))
-        res = _run(tmp, env, ros2, latency_rate, seconds, latency=True, source=source, listener=listener,
-                   lateness=lateness, burn=burn)
-        lat = _latency(res)
-        if lat:
-            print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
-                  f"verdict(s) decided on arrival: p50 {statistics.median(lat):.2f} ms, p99 {p99(lat):.2f} ms, "
-                  f"max {lat[-1]:.2f} ms; checked {res['record']['events']} of {len(res['sent']['sent'])}; "
-                  f"late {res['record'].get('late_events', 0)}; {_cpu(res, source)}; lateness bound {lateness * 1e3:g} ms (p99 "
-                  f"{'within' if p99(lat) <= lateness * 1e3 + 5 else 'beyond'} the bound + 5 ms); "
-                  f"{beside}load average {res['load']:.1f}")
-        else:
-            print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
-                  f"(checked {res['record']['events']} of {len(res['sent']['sent'])})")
+        if total_rate > 0:
+            res = _run(tmp, {**env, "PYTHONPATH": str(ROOT / "src")}, ros2, total_rate, seconds, latency=False,
+                       source=source, lateness=lateness, burn=burn, nice=nice)
+            load = f"{beside}load average {res['load']:.1f} on {os.cpu_count()} core(s)"
+            sent, rec = res["sent"]["sent"], res["record"]
+            per = {t: sum(1 for topic, _t in sent if topic == t) for t in TOPICS}
+            heard = {t: rec["qos"][t]["samples"] for t in TOPICS}
+            lost = len(sent) - rec["events"]
+            print(f"rclpy publisher, {source} source: loss: {total_rate:.0f} msg/s asked over {len(TOPICS)} topics: published {len(sent)} in "
+                  f"{res['sent']['elapsed']:.2f} s ({len(sent) / res['sent']['elapsed']:.0f} msg/s); heard "
+                  f"{sum(heard.values())} ({', '.join(f'/{t} {heard[t]}/{per[t]}' for t in TOPICS)}); checked "
+                  f"{rec['events']}; lost {lost}{f' ({lost / len(sent):.1%})' if lost else ''}; engine queue dropped "
+                  f"{rec.get('dropped_messages', 0)}, longest {rec.get('backlog_max', 0)}; decode errors {sum(rec['decode_errors'].values())}; {load}")
+            if res["cpu"] is not None:
+                print(f"rclpy publisher, {source} source: loss: monitor CPU {res['cpu'] / max(1, len(sent)) * 1e6:.0f} us per message "
+                      f"(start-up included), engine thread {rec.get('engine_cpu_us_per_message', 0):.0f} us"
+                      f"; the monitor exited {res['ended']:.1f} s after SIGINT"
+                      + (f", the rclpy agent {res['agent_cpu'] / max(1, len(sent)) * 1e6:.0f} us" if source == "rclpy" else ""))
+        if latency_rate > 0:
+            res = _run(tmp, env, ros2, latency_rate, seconds, latency=True, source=source, listener=listener,
+                       lateness=lateness, burn=burn, nice=nice)
+            lat = _latency(res)
+            if lat:
+                print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
+                      f"verdict(s) decided on arrival: p50 {statistics.median(lat):.2f} ms, p99 {p99(lat):.2f} ms, "
+                      f"max {lat[-1]:.2f} ms; checked {res['record']['events']} of {len(res['sent']['sent'])}; "
+                      f"late {res['record'].get('late_events', 0)}; {_cpu(res, source)}; lateness bound {lateness * 1e3:g} ms (p99 "
+                      f"{'within' if p99(lat) <= lateness * 1e3 + 5 else 'beyond'} the bound + 5 ms); "
+                      f"{beside}load average {res['load']:.1f}")
+            else:
+                print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
+                      f"(checked {res['record']['events']} of {len(res['sent']['sent'])})")
 
 
 def _cpu(res: dict[str, Any], source: str) -> str:
@@ -266,8 +280,8 @@ def _cpu(res: dict[str, Any], source: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     import argparse
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--total-rate", type=float, default=5000.0, help="messages/s over the three topics (loss run)")
-    p.add_argument("--latency-rate", type=float, default=1000.0, help="messages/s of the latency run")
+    p.add_argument("--total-rate", type=float, default=5000.0, help="messages/s over the three topics (loss run; 0: none)")
+    p.add_argument("--latency-rate", type=float, default=1000.0, help="messages/s of the latency run (0: none)")
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--smoke", action="store_true", help="CI: 1 s at 300 and 200 messages/s")
     p.add_argument("--source", choices=("dds", "rclpy", "both"), default=None,
@@ -278,13 +292,16 @@ def main(argv: list[str] | None = None) -> int:
                    help="the monitor's lateness bound, --reorder-window (s; default the CLI's 0.05; 0: none)")
     p.add_argument("--burn", type=int, default=0, metavar="N",
                    help="N processes spinning `while True: pass` beside each run (started before it, stopped after)")
+    p.add_argument("--nice", type=int, default=0, metavar="N",
+                   help="run the monitor (and its rclpy agent) at niceness N (`nice -n N`; below 0 needs the "
+                        "privilege to raise a priority); the publisher, the listener and the burners stay at 0")
     a = p.parse_args(argv)
     source = a.source or ("rclpy" if a.smoke else "both")
     sources = ("dds", "rclpy") if source == "both" else (source,)
     if a.smoke:
-        bench(300.0, 200.0, 1.0, sources, a.listener, a.lateness, a.burn)
+        bench(300.0, 200.0, 1.0, sources, a.listener, a.lateness, a.burn, a.nice)
     else:
-        bench(a.total_rate, a.latency_rate, a.seconds, sources, a.listener, a.lateness, a.burn)
+        bench(a.total_rate, a.latency_rate, a.seconds, sources, a.listener, a.lateness, a.burn, a.nice)
     return 0
 
 
