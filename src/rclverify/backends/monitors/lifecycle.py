@@ -350,15 +350,18 @@ def gated(events: Iterable[Any], gate: LifecycleGate) -> Iterator[Any]:
             yield ev
 
 
-def with_lifecycle(gate: LifecycleGate, node: str, status: str, explanation: str
+def with_lifecycle(gate: LifecycleGate | None, node: str, status: str, explanation: str
                    ) -> tuple[str, str, dict[str, Any]]:
     """A recorded run's verdict on managed node ``node`` (``status``, ``explanation``: the untimed
     check's) combined with its lifecycle record (:meth:`LifecycleGate.record`): ``failed``, its
     explanation first saying why, for an output outside ``active`` or a missed transition
-    deadline; returns ``(status, explanation, record)``."""
+    deadline; returns ``(status, explanation, {"lifecycle": record})``, the verdict unchanged and
+    ``{}`` without a ``gate`` (a node that is not managed)."""
+    if gate is None:
+        return status, explanation, {}
     entry: dict[str, Any] = {"node": node, "status": status, "explanation": explanation}
     record = gate.record([entry])
-    return str(entry["status"]), str(entry["explanation"]), record
+    return str(entry["status"]), str(entry["explanation"]), {"lifecycle": record}
 
 
 __all__ = ["ACTIVE", "LifecycleGate", "STATES", "TRANSITIONS", "TRANSITION_TYPE", "event_topic", "gate_of",
