@@ -240,9 +240,7 @@ class MonitorsBackend:
         details = monitoring_details(res, trace, events, trace_sha256(target.root, trace), versions, cfg.horizon,
                                      cfg.tolerance, duration_s=span.seconds)
         status, explanation = verdict_status(res, trace)
-        extra: dict[str, Any] = {}
-        if read.gate is not None:  # a managed node: judged in its lifecycle scope, as live (lifecycle.py)
-            status, explanation, extra["lifecycle"] = with_lifecycle(read.gate, res.node, status, explanation)
+        status, explanation, extra = with_lifecycle(read.gate, res.node, status, explanation)  # managed: lifecycle.py
         finished = beside.finish()
         for name in ("deadlines", "periods", "declarations"):  # as above: the record's error, never a crash
             err = beside.errors.get(name)
@@ -270,8 +268,7 @@ class MonitorsBackend:
             extra.update(cpart)
         dl = finished.get("deadlines")
         # silence is never green: what the run did not judge, with the reason, beside the status
-        fed = {**heard, **calls.messages}  # and a managed node's messages its lifecycle gate kept (lifecycle.py)
-        extra["not_judged"] = items = not_judged([target.node], Heard(read.gate.counted(fed) if read.gate else fed,
+        extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
                                                                       dict(calls.orphans),
                                                                       unseen=unseen_links(read.origin)),
                                                  {res.node: [(status, explanation)]},
@@ -346,6 +343,7 @@ def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None
     events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(origin.tap(inner))), heard,
                                                                   watch), cfg.rules, cfg.horizon,
                                   tolerance=cfg.tolerance, margins=True)
+    heard = gate.counted(heard) if gate is not None else heard  # the messages the gate kept count as heard
     return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag, origin.origin, gate)
 
 
