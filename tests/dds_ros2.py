@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
-from rclverify.ros.live.dds import (NodeInfo, discovery_struct, encode_participant_info, reply_topic, request_topic,
+from rclverify.ros.live.dds import (NodeInfo, discovery_struct, encode_participant_info, make_participant, reply_topic, request_topic,
                                topic_name, type_hash_user_data, write_raw)
 from rclverify.ros.live.dds_qos import QosProfile, to_dds
 
@@ -99,10 +99,11 @@ class Ros2Participant:
     """One ROS 2 context: a participant, its nodes, ``ros_discovery_info``."""
 
     def __init__(self, types: TypeBook, domain: int) -> None:
-        from cyclonedds.domain import DomainParticipant
         from cyclonedds.pub import DataWriter
         from cyclonedds.topic import Topic
-        self.types, self.dp = types, DomainParticipant(domain)
+        # made as rclverify makes its own (the domain configured first): the types announce Fast DDS's type
+        # objects (rclverify.ros.live.dds_xtypes), which the domain's compatibility settings accept
+        self.types, self.dp = types, make_participant(domain)
         self.nodes: list[NodeInfo] = []
         latched = to_dds(QosProfile(reliable=True, durability="transient_local", depth=1))
         self._info = DataWriter(self.dp, Topic(self.dp, "ros_discovery_info", discovery_struct()), qos=latched)

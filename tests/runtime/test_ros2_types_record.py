@@ -201,6 +201,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
             time.sleep(0.005)
         system = start_node(tmp, "system", SYSTEM, env)
         wait_for(tmp / "system.log", "done", 40)
+        announced = _announced_type_ids(env, {f"rt/{t}" for t in [*TOPICS, "ws"]})
         # every message heard by every monitor before it stops, however loaded the machine (a sleep was not)
         for name, topics in [*((n, [*TOPICS, "mislaid"]) for n in bags), ("wide", ["ws"])]:
             wait_logged(tmp / f"{name}.jsonl", lambda log, ts=topics: all(
@@ -211,7 +212,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
                "out": {n: (tmp / f"{n}.out").read_text() for n in procs},
                "record": {n: json.loads((tmp / f"{n}.json").read_text()) for n in procs},
                "wide_log": [json.loads(x) for x in (tmp / "wide.jsonl").read_text().splitlines()],
-               "system": (tmp / "system.log").read_text()}
+               "system": (tmp / "system.log").read_text(), "announced": announced}
     finally:
         if system is not None:
             stop(system)
@@ -220,6 +221,63 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         if cyclone is not None:
             cyclone.close()
         mp.undo()
+
+
+#: Prints, as JSON, DDS topic -> the repr of the complete XTypes type identifier announced by the one participant
+#: that has a writer on each topic of argv[1] (comma separated), read from DCPSPublication by a Cyclone
+#: participant of its own process: its domain takes Fast DDS's type information (the monitor's ignores it,
+#: ``rclverify.ros.live.dds.COMPATIBILITY``), only invalid try-construct flags allowed.
+ANNOUNCED = """\
+import json, os, sys, time
+from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication
+from cyclonedds.domain import Domain, DomainParticipant
+d = int(os.environ["ROS_DOMAIN_ID"])
+domain = Domain(d, os.environ["CYCLONEDDS_URI"] + ",<Compatibility><AllowInvalidTryConstruct>true</AllowInvalidTryConstruct></Compatibility>")
+dp = DomainParticipant(d)  # kept: a cyclonedds entity is deleted with its last Python reference
+reader = BuiltinDataReader(dp, BuiltinTopicDcpsPublication)
+topics, seen = set(sys.argv[1].split(",")), {}
+until = time.monotonic() + 20
+while time.monotonic() < until:
+    for s in reader.take(N=256):
+        if s.topic_name in topics and s.type_id is not None:
+            seen.setdefault(str(s.participant_key), {})[s.topic_name] = repr(s.type_id)
+    whole = [ids for ids in seen.values() if set(ids) == topics]
+    if whole:
+        print(json.dumps(whole[0]))
+        break
+    time.sleep(0.1)
+"""
+
+
+def _announced_type_ids(env: dict[str, str], topics: set[str]) -> dict[str, str]:
+    """DDS topic -> the repr of the type identifier the rclpy talker's (Fast DDS's) writer announces on it."""
+    import sys
+    r = subprocess.run([sys.executable, "-c", ANNOUNCED, ",".join(sorted(topics))], env=env, capture_output=True,
+                       text=True, timeout=60)
+    assert r.stdout.strip(), f"no participant announced a writer on each of {sorted(topics)}: {r.stderr[-2000:]}"
+    return dict(json.loads(r.stdout))
+
+
+def test_the_monitor_announces_the_type_identifiers_fast_dds_announces(run: dict[str, Any]) -> None:
+    """The monitor's DDS types announce the XTypes identifiers Fast DDS announces for the same ROS 2 types
+    (ros/live/dds_xtypes.py): on each of the talker's seven topics of TOPICS (sequences, arrays, bounded and
+    nested sequences, a nested fixed array), the identifier of the workspace's struct equals the one the real
+    rclpy writer announced, so no Fast DDS participant looks the monitor's types up.  Controls: the
+    identifiers cyclonedds' own builder gives (a try-construct flag on every collection element) differ on
+    each of them; and a type with a ``wstring`` differs (the binding has no wide string: the monitor reads
+    one as a sequence of uint32, so its identifier cannot be Fast DDS's; docs/ros2.md, "Type objects")."""
+    from cyclonedds.idl._xt_builder import XTBuilder
+    book = TypeBook([run["ws"] / "interfaces"])
+    announced = run["announced"]
+    assert set(announced) == {f"rt/{t}" for t in [*TOPICS, "ws"]}
+    stock_differs = []
+    for topic, (ros_type, *_rest) in TOPICS.items():
+        struct = book.message(ros_type)
+        assert repr(struct.__idl__.get_type_id()) == announced[f"rt/{topic}"], ros_type
+        stock = XTBuilder.process_type(struct)[0].complete.typeid_with_size.type_id
+        stock_differs.append(repr(stock) != announced[f"rt/{topic}"])
+    assert all(stock_differs), dict(zip(TOPICS, stock_differs))
+    assert repr(book.message("test_msgs/WStrings").__idl__.get_type_id()) != announced["rt/ws"]
 
 
 def _counts(record: dict[str, Any]) -> dict[str, tuple[int, int]]:

@@ -355,8 +355,9 @@ def discovery_struct() -> Any:
     node = make_idl_struct("NodeEntitiesInfo_", "rmw_dds_common::msg::dds_::NodeEntitiesInfo_", {
         "node_namespace": T.bounded_str[256], "node_name": T.bounded_str[256],  # type: ignore[misc]
         "reader_gid_seq": T.sequence[gid], "writer_gid_seq": T.sequence[gid]})  # type: ignore[misc]
-    return make_idl_struct("ParticipantEntitiesInfo_", DISCOVERY_TYPE, {
-        "gid": gid, "node_entities_info_seq": T.sequence[node]})  # type: ignore[misc]
+    from rclverify.ros.live.dds_xtypes import as_fast_dds  # deferred: loads cyclonedds' type-object builder
+    return as_fast_dds(make_idl_struct("ParticipantEntitiesInfo_", DISCOVERY_TYPE, {
+        "gid": gid, "node_entities_info_seq": T.sequence[node]}))  # type: ignore[misc]
 
 
 # -- raw samples ------------------------------------------------------------------------------

@@ -60,6 +60,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from rclverify.ros.live.dds import dds_type, import_cyclonedds
+from rclverify.ros.live.dds_xtypes import as_fast_dds
 from rclverify.ros.extract.interfaces import TypeTable
 from rclverify.ros.extract.interfaces import TypeInfo
 from rclverify.ros.live.dds import ros_type
@@ -248,7 +249,7 @@ class TypeBook:
                 nested[fname] = inner
         if not info.fields:
             fields[_EMPTY] = T.uint8
-        cls = make_idl_struct(name.rsplit("/", 1)[-1] + "_", dds_type(name), fields)
+        cls = as_fast_dds(make_idl_struct(name.rsplit("/", 1)[-1] + "_", dds_type(name), fields))
         setattr(cls, "deserialize", classmethod(_read))  # Declared bytes: read in their own definition
         wide = {f: d for f, d in ((f, _wide_depth(desc)) for f, desc in info.fields) if d is not None}
         if wide:
