@@ -46,6 +46,12 @@ class Failed(Exception):
     """A part of the recording failed; the message says which."""
 
 
+class NotConnected(Failed):
+    """The driver's ROS 2 endpoints never all matched within its wait (it printed ``not connected:`` and what
+    was missing): the middleware's discovery failed, so nothing of the robot was run or judged (docs/ros2.md,
+    "Type objects the monitor announces")."""
+
+
 def ros2_python(named: str | None, here: Path) -> Path:
     """The ROS 2 Python: ``named`` (``--ros2-python``), else
     ``$RCLVERIFY_ROS2_PYTHON``, else the ``.venv-ros2/bin/python`` of the
@@ -153,8 +159,9 @@ def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: lis
             try:
                 wait_for(tmp / "driver.out", "done", left, drv)
             except Failed:
-                raise Failed("the scenario failed:\n" + (tmp / "driver.out").read_text(errors="replace")[-2000:]) \
-                    from None
+                said = (tmp / "driver.out").read_text(errors="replace")
+                raise (NotConnected if "not connected:" in said else Failed)(
+                    "the scenario failed:\n" + said[-2000:]) from None
             for p in procs[1:-1]:  # the nodes, all at once
                 if p.poll() is None:
                     os.killpg(p.pid, signal.SIGTERM)

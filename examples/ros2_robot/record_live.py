@@ -42,7 +42,7 @@ NODES = {"ScanGuard": "scan_guard.py", "BatteryWatcher": "battery_watcher.py", "
 DRIVER = "simulator.py"
 INTERFACES = ["interfaces/robot_msgs"]
 MONITOR = ["--interfaces", "interfaces", "--mapping", "contracts/mapping.yaml"]
-TIMEOUT = 40.0  # s, one recording
+TIMEOUT = 75.0  # s, one recording at most (the simulator waits up to 45 s for discovery)
 
 
 def defects() -> list[str]:

@@ -174,17 +174,27 @@ def test_live_runs_are_judged_as_the_committed_recordings(tmp_path: Path) -> Non
     sys.path.insert(0, str(EXAMPLE))
     try:
         import record_live
-        from ros2_recording import build
+        from ros2_recording import NotConnected, build
     finally:
         sys.path.remove(str(EXAMPLE))
     build(py, ros2_env(tmp_path), EXAMPLE, record_live.INTERFACES)  # once (cached in .ros2/), before both runs
     runs = {None: EXAMPLE / "runs" / "robot.jsonl", "battery_lt": EXAMPLE / "defects" / "battery_lt" / "run.jsonl"}
     for defect, committed in runs.items():  # one after the other: two robots at once are too much for 2 cores
-        (tmp_path / (defect or "robot")).mkdir()
-        log = tmp_path / (defect or "robot") / "out" / "run.jsonl"
-        # scans 250 ms apart: at the example's 100 ms a guard stalled by the suite's load answered a scan after
-        # the next one was published, which the monitor rightly reads as a wrong answer to the later scan
-        env = {**ros2_env(tmp_path / (defect or "robot")), "SIMULATOR_PERIOD_S": "0.25"}
-        figures = record_live.record(py, tmp_path / (defect or "robot"), defect, log, env)
+        # A recording whose driver never saw every endpoint matched ran and judged nothing: Fast DDS's
+        # discovery, which now and then leaves a client unmatched with its server (docs/ros2.md, "Type objects
+        # the monitor announces"). It is made once more, in a domain of its own; a second such failure fails.
+        for attempt in (1, 2):
+            where = tmp_path / f"{defect or 'robot'}-{attempt}"
+            where.mkdir()
+            log = where / "out" / "run.jsonl"
+            # scans 250 ms apart: at the example's 100 ms a guard stalled by the suite's load answered a scan
+            # after the next one was published, which the monitor rightly reads as a wrong answer to the later one
+            env = {**ros2_env(where), "SIMULATOR_PERIOD_S": "0.25"}
+            try:
+                figures = record_live.record(py, where, defect, log, env)
+                break
+            except NotConnected:
+                if attempt == 2:
+                    raise
         assert figures["messages"] == 26 and figures["calls"] >= 20, figures
         assert _live_violated(log) == _live_violated(committed) == ({"BatteryWatcher"} if defect else set()), figures
