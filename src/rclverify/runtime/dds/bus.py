@@ -5,8 +5,8 @@ A :class:`Tap` is what the monitor wants to hear: a DDS topic, the struct
 of the contract's type, where the contract names it (for warnings).  Its
 reader is made when a publisher of the topic is discovered, with the QoS
 :func:`~rclverify.ros.live.dds_qos.reader_for` computes from every publisher's
-offer (so a best-effort sensor is heard), and made again when a publisher
-appears that the current reader cannot match (counted in
+offer (so a best-effort sensor is heard), keeping the last :data:`TAP_DEPTH`
+samples, and made again when a publisher appears that the current reader cannot match (counted in
 ``reader_changes``; messages published while the new reader is being
 matched may be missed, which the evidence says).  What cannot be heard is a
 located warning, once per publisher and reason, never silence:
@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
 from rclverify.ros.live.dds import take_raw
@@ -53,6 +53,12 @@ from rclverify.runtime.shapes import TapJson
 #: Seconds a warning about a publication waits for ros_discovery_info to name its node (a ROS 2 node
 #: announces itself after its endpoints are discovered); past it, the participant's id is named.
 NAME_GRACE_S = 2.0
+#: the history depth of a tap's reader (keep-last; a ROS 2 topic is keyless, one instance, so samples of the
+#: topic): at 5000 messages/s over three topics,
+#: about 6 s of one topic's messages, should the reading thread be held off the CPU or the interpreter (measured:
+#: the default 1000 lost 24 % at 5000 msg/s beside a CPU burner on a loaded machine).  Never keep-all: a monitor
+#: that stops reading must not slow a reliable publisher down (rclverify.ros.live.dds_qos)
+TAP_DEPTH = 10_000
 
 
 @dataclass
@@ -190,6 +196,7 @@ class Bus:
             if not same:
                 continue
             req, left = reader_for([p.qos for p in same])
+            req = replace(req, depth=max(req.depth or 0, TAP_DEPTH))
             for k in left:
                 p = same[k]
                 if (p.guid, "qos") in t.warned or not self._named(p.guid):

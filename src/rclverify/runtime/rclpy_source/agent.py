@@ -16,7 +16,7 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   (reliable only when all are, transient-local when all are: a latched
   message is delivered to it as to any late ROS 2 subscriber), and made
   again when a publisher appears that it cannot match.  Keep-last
-  :data:`TAP_DEPTH` per publisher.  After each wake-up of the executor
+  :data:`TAP_DEPTH`.  After each wake-up of the executor
   every tap's subscription is drained (at most :data:`TAKE_MAX` messages
   each a round) and the round's frames are written to the monitor in one
   write: under load the agent takes messages in batches rather than one
@@ -97,7 +97,8 @@ DESCRIBE_TIMEOUT_S = 5.0
 #: the most messages taken from one tap's subscription in one round (:meth:`Agent.drain`), so a busy topic
 #: does not hold the others back
 TAKE_MAX = 1000
-#: the history depth of each tap's subscription (keep-last, per publisher): at 5000 messages/s over three
+#: the history depth of each tap's subscription (keep-last; a ROS 2 topic is keyless, so samples of the
+#: topic): at 5000 messages/s over three
 #: topics, about 6 s of one topic's messages, should the agent be held off the CPU or its pipe be full
 TAP_DEPTH = 10_000
 
