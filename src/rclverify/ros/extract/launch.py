@@ -65,10 +65,13 @@ class LaunchNode:
     src: Src
     plugin: str | None = None  # a composable node's class (``ns::Class``); ``exe`` is then ""
     # the node's private parameters the launch file sets: ``~name`` -> (value, where set)
-    params: dict[str, tuple[str, Src]] = field(default_factory=dict)
+    params: dict[str, tuple[param_yaml.Value, Src]] = field(default_factory=dict)
     args: str | None = None  # the node's command-line ``args`` (a nodelet's ``load pkg/Type manager``)
     # where a condition guarding the node could not be evaluated (the node was read as if it held)
     unsure: Src | None = None
+    # the parameters of files given to a node this launch file does not name, for the name its code gives
+    # (``param_yaml.pending_for``)
+    pending: list[param_yaml.Entry] = field(default_factory=list)
 
 
 _SUBST = re.compile(r"\$\(([^()]*)\)")
@@ -134,11 +137,14 @@ class Interpreter(ScopeActions):
             self._stack.pop()
 
     def _node_children(self, el: El, scope: _Scope, path: Path, node_ns: str,
-                       name: str | None) -> tuple[list[tuple[str, str, Src]], dict[str, tuple[str, Src]]]:
+                       name: str | None) -> tuple[list[tuple[str, str, Src]], dict[str, tuple[param_yaml.Value, Src]],
+                                                   list[param_yaml.Entry]]:
         """A node's ``remap`` and ``param`` children (a node's ``param`` is private:
-        ``~name``, kept as ``~name`` when the node's name is not known here)."""
+        ``~name``, kept as ``~name`` when the node's name is not known here), and the parameters of the files
+        it is given that wait for its name (``pending``)."""
         remaps = list(scope.remaps)
-        params: dict[str, tuple[str, Src]] = {}
+        params: dict[str, tuple[param_yaml.Value, Src]] = {}
+        pending: list[param_yaml.Entry] = []
         for c in el.children:
             if c.tag == "rosparam" and self._cond(c, scope, path):
                 for k, v in self._rosparam(c, scope, path).items():
@@ -153,14 +159,29 @@ class Interpreter(ScopeActions):
                     if not frm or not to:
                         raise Unresolved("remap needs 'from' and 'to'")
                     remaps.append((frm, to, c.src))
+                elif "from" in c.attrs:  # a ROS 2 parameter file (param_yaml.launch_file_params)
+                    f = self._attr(c, "from", scope, path) or ""
+                    written = next((w for w in launch_subst.WRITTEN if f.startswith(w)), "")
+                    f = f[len(written):]
+                    if written:  # RewrittenYaml / ReplaceString: the source file, as written
+                        self.notes.append(Note(c.src, f"parameter file {self.show(Path(f))} is rewritten when launched: its values "
+                                                      f"are read as the source file writes them, the rewrites "
+                                                      f"(root_key, param_rewrites) are not applied", "ROS-LAUNCH"))
+                    if not Path(f).is_absolute():  # ros2 launch opens it from the directory it runs in
+                        raise Unresolved(f"parameter file '{f}' is a relative path, read from the directory "
+                                         f"ros2 launch runs in: not known statically; its parameters are not read")
+                    got, said = param_yaml.launch_file_params(Path(f), self.show(Path(f)), names.join(node_ns, name)
+                                                              if name else None, pending)
+                    self.notes.extend(said)
+                    params.update(got)
                 else:
                     pn, pv = self._attr(c, "name", scope, path), self._attr(c, "value", scope, path)
                     if not pn or pv is None:
-                        raise Unresolved("param needs 'name' and 'value' (a parameter file is not read)")
+                        raise Unresolved("param needs 'name' and 'value', or 'from' (a parameter file)")
                     params["~" + pn.lstrip("~/")] = (pv, c.src)
             except Unresolved as exc:
                 self.notes.append(Note(c.src, f"<{c.tag}>: {exc}; element skipped", "ROS-LAUNCH"))
-        return remaps, params
+        return remaps, params, pending
 
     def _rosparam(self, el: El, scope: _Scope, path: Path) -> dict[str, str]:
         """The parameters a ROS 1 ``<rosparam command="load" file="...">`` loads
@@ -186,9 +207,9 @@ class Interpreter(ScopeActions):
         name = self._soft(el, "name", scope, path)
         ns = self._soft(el, "namespace", scope, path) or self._soft(el, "ns", scope, path)
         node_ns = names.join(scope.ns, ns) if ns else scope.ns
-        remaps, params = self._node_children(el, scope, path, node_ns, name)
+        remaps, params, pending = self._node_children(el, scope, path, node_ns, name)
         self.nodes.append(LaunchNode(pkg, "", name, node_ns, remaps, el.src, plugin, params,
-                                     unsure=scope.unsure))
+                                     unsure=scope.unsure, pending=pending))
 
     # -- substitutions
     def sub(self, text: str, scope: _Scope, path: Path) -> str:
@@ -419,9 +440,9 @@ class Interpreter(ScopeActions):
         given = self._ros_args(el, scope, path, name)
         name, ns = given.name or name, given.ns or ns
         node_ns = names.join(scope.ns, ns) if ns else scope.ns
-        remaps, params = self._node_children(el, scope, path, node_ns, name)
+        remaps, params, pending = self._node_children(el, scope, path, node_ns, name)
         remaps += [(frm, to, el.src) for frm, to in given.remaps]
         params.update({"~" + k.lstrip("~/"): (v, el.src) for k, v in given.params.items()})
         self.nodes.append(LaunchNode(pkg, exe, name, node_ns, remaps, el.src, None, params,
                                      self._attr(el, "args", scope, path) if pkg == "nodelet" else None,
-                                     scope.unsure))
+                                     scope.unsure, pending))

@@ -56,7 +56,8 @@ def node_kids(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
     """``remappings=[(a, b)]`` and ``parameters=[{name: value}]`` of a ``Node`` or
     ``ComposableNode`` as ``remap`` and ``param`` elements, through names bound
     once and list concatenation (:func:`.launch_py_values.expand`); a parameter file (a path in
-    ``parameters``), an unreadable pair or value is left out with a located
+    ``parameters``, ``ParameterFile(path)``, a substitution giving one) as a ``param`` element
+    ``from`` that path; an unreadable pair, value or path is left out with a located
     note.  A parameter whose value is a list of literals (a string array) is
     no name and is not kept."""
     kids = []
@@ -82,9 +83,12 @@ def node_kids(c: ast.Call, shown: str, notes: list[Note]) -> list[El]:
     if isinstance(ps, (ast.List, ast.Tuple)):
         for item in ps.elts:
             at = Src(shown, item.lineno, item.col_offset + 1)
-            if not isinstance(item, ast.Dict):
-                notes.append(Note(at, f"parameters '{ast.unparse(item)}' are not a literal dict (a parameter "
-                                      f"file is not read): not resolved statically", "ROS-LAUNCH"))
+            if not isinstance(item, ast.Dict):  # a parameter file: its path (param_yaml.launch_file_params)
+                try:
+                    kids.append(El("param", {"from": _value(item)}, [], at))
+                except _Unres as exc:
+                    notes.append(Note(at, f"parameter file {exc} cannot be read statically: its parameters are "
+                                          f"not read", "ROS-LAUNCH"))
                 continue
             for k, v in zip(item.keys, item.values):
                 if k is None:

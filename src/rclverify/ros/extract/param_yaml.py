@@ -32,7 +32,7 @@ from __future__ import annotations
 import dataclasses
 import re
 from pathlib import Path
-from typing import Any, Callable, Union
+from typing import Any, Callable, Sequence, Union
 
 from rclverify.ros.extract import names, safefs
 from rclverify.ros.extract.model import Endpoint, Note, Src
@@ -168,6 +168,39 @@ def expand_each(eps: list[Endpoint], array: Callable[[str], Any], notes: list[No
             out.append(dataclasses.replace(e, param=param.replace(m.group(0), x),
                                            topic=e.topic.replace(m.group(0), x) if e.topic else e.topic))
     return out
+
+
+Entry = tuple[str, str, Value, Src]  # (node key pattern, "~key", value, where): one parameter of a file
+
+
+def launch_file_params(path: Path, shown: str, node: str | None,
+                       pending: list[Entry]) -> tuple[dict[str, tuple[Value, Src]], list[Note]]:
+    """The private parameters a ROS 2 launch file gives a node from the parameter file at ``path`` (Python
+    ``parameters=[path]`` or ``ParameterFile(path)``, XML ``<param from="path"/>``, YAML ``param: [{from:
+    path}]``): ``({"~key": (value, where)}, notes)`` of the entries whose node key matches the node's full
+    name ``node`` (:func:`matches`: the name, ``/**``, wildcards, as rcl matches them; a relative key is in
+    the root namespace); ``node`` ``None`` (its name not given in the launch file: the code's name, known
+    to the graph, applies): the keys that match every node (``/**``), the others appended to ``pending``
+    (:func:`pending_for` applies them once the name is known).  A file that cannot be read, or is not YAML, is one
+    located note and gives nothing.  The format is :func:`read_file`'s."""
+    try:
+        text = safefs.read_text(path)
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        return {}, [Note(Src(shown), f"cannot read parameter file: {exc}", "ROS-PARSE")]
+    entries, notes = read_file(text, shown)
+    out: dict[str, tuple[Value, Src]] = {}
+    for pattern, key, value, at in entries:
+        if node is None and names.normalise(pattern) not in ("/**", "/**/*"):
+            pending.append((pattern, key, value, at))
+        elif node is None or matches(pattern, node):
+            out[key] = (value, at)
+    return out, notes
+
+
+def pending_for(pending: Sequence[Entry], node: str) -> dict[str, tuple[Value, Src]]:
+    """The parameters of ``pending`` (:func:`launch_file_params`) whose node key matches node ``node``'s full
+    name, in file order (a later one wins)."""
+    return {key: (value, at) for pattern, key, value, at in pending if matches(pattern, node)}
 
 
 def rosparam_file(path: Path) -> dict[str, str] | str:

@@ -28,6 +28,7 @@ from rclverify.ros.extract.launch import LaunchNode
 from rclverify.ros.extract.link import Linked, Linker
 from rclverify.ros.extract.model import Endpoint, Graph, Note, Src
 from rclverify.ros.extract.packages import Package
+from rclverify.ros.extract.param_yaml import pending_for
 from rclverify.ros.extract.programs import PackageCode, Program, programs
 from rclverify.ros.graph.accounting import Ledger
 
@@ -315,7 +316,7 @@ class Assembly:
                 mine = [e for e, o in got.endpoints if o == i]
                 full = names.normalise(name) if name.startswith("/") else names.join(ns, name)
                 add_node(full, names.split(full)[0], ln.pkg, ln.exe or None, _files(prog, got, mine, None),
-                         ln.src, mine, ln.remaps, "launch", ln.params,
+                         ln.src, mine, ln.remaps, "launch", {**pending_for(ln.pending, full), **ln.params},
                          lifecycle=i < len(got.kinds) and got.kinds[i] == "lifecycle")
             return
         eps = [e for e, _o in got.endpoints]
@@ -330,8 +331,8 @@ class Assembly:
         else:
             full, ns = names.join(base, name), base
         files = _files(prog, got, eps, None) if prog is not None else []
-        add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch", ln.params,
-                 lifecycle="lifecycle" in got.kinds)
+        add_node(full, ns, ln.pkg, ln.exe or None, files, ln.src, eps, ln.remaps, "launch",
+                 {**pending_for(ln.pending, full), **ln.params}, lifecycle="lifecycle" in got.kinds)
 
 
 class LinkCache:
