@@ -140,3 +140,21 @@ def test_a_contract_naming_its_transition_topic_is_a_managed_node(tmp_path: Path
     control = LiveRun(plain, list(plain.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "p.jsonl")
     assert control.gate is None
     control.stop()
+
+
+def test_a_transition_event_heard_after_the_output_was_judged_withdraws_its_violation(tmp_path: Path) -> None:
+    """Activated at 2.0 (stamped so) but the event heard at 3.5, after the outputs at 2.3 and 2.9 were judged
+    (each 0.5 s after it): both were published while active, so the late event withdraws both violations, with
+    why, and the node is not red (a late message never adds a violation).  Control: the activation stamped at
+    2.4, after the first output and its skew: that violation stands (the node red), the second is withdrawn."""
+    checked = check([parse_text(RCL, "sys.rcl")])
+    run = [(1.0, EVENTS, 2), (2.3, "level", 5.0), (2.9, "level", 6.0), (3.5, EVENTS, 3)]
+    for activated, red, withdrawn in ((2.0, [], [2.3, 2.9]), (2.4, [2.3], [2.9])):
+        gate = LifecycleGate({"Battery": "/battery"}, list(checked.nodes.values()))
+        for t, topic, v in run:
+            gate.admit(topic, _event(v, activated if v == 3 else t) if topic == EVENTS else {"data": v}, t)
+        node = gate.record()["nodes"][0]
+        assert [v["time"] for v in node["violations"]] == red, node
+        assert node["status"] == ("failed" if red else "discharged"), node
+        assert [w["time"] for w in node["withdrawn"]] == withdrawn, node
+        assert "heard after that output was judged" in node["withdrawn"][0]["reason"]

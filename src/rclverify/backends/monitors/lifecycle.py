@@ -210,6 +210,8 @@ class LifecycleGate:
         self.events = {event_topic(m.fqn): m for m in self.managed.values()}
         self.pending: list[tuple[float, str, _Managed]] = []  # (received, topic, node): outputs not yet decided
         self.violations: list[dict[str, Any]] = []
+        #: violations a transition event heard late withdrew, each with why (:meth:`_rejudge`)
+        self.withdrawn: list[dict[str, Any]] = []
         self.outputs_judged = 0
         self.not_questions: dict[str, int] = {}
         #: transition topic -> events heard on it
@@ -260,6 +262,28 @@ class LifecycleGate:
                                         "reason": f"{m.fqn} published on /{topic} while {STATES.get(state, state)}, "
                                                   f"not active: its guarantees hold only while active"})
         self.pending = keep
+
+    def _rejudge(self) -> None:
+        """Each violation judged again on the node's whole state history: a transition event heard
+        more than :attr:`settle` after its own time (a loaded machine, a writer later than the
+        bound) reached the gate after the outputs it decides were judged.  A violation whose output
+        that late event places in ``active`` or a transition into or out of it is withdrawn, with
+        why (a late message never adds a violation: docs/semantics.md, "Event time"); the rest
+        stand, since the states they were judged on were all heard in time."""
+        kept = []
+        for v in self.violations:
+            m = self.managed[v["node"]]
+            t = float(v["time"])
+            states = m.states_within(t - self.skew, t + self.skew)
+            if ACTIVE_LIKE & set(states):
+                k = bisect.bisect_right(m.times, t + self.skew) - 1
+                self.withdrawn.append({**v, "reason": (
+                    f"withdrawn: {m.fqn}'s output on /{v['topic']} at {t:.3f} s was judged {v['state']}, but a "
+                    f"transition event stamped {m.times[k]:.3f} s, heard after that output was judged, puts it "
+                    f"in {STATES.get(states[-1], states[-1])}")})
+            else:
+                kept.append(v)
+        self.violations = kept
 
     def counted(self, heard: Mapping[str, int]) -> dict[str, int]:
         """``heard`` (messages per topic key the judge was fed) with the messages the gate kept from
@@ -318,6 +342,7 @@ class LifecycleGate:
         A node with deadlines has its transitions judged (:meth:`transitions`) as ``deadlines``; one
         missed fails it as a violation does."""
         self._decide(float("inf"))
+        self._rejudge()
         nodes = []
         for m in self.managed.values():
             mine = [v for v in self.violations if v["node"] == m.node]
@@ -326,6 +351,8 @@ class LifecycleGate:
             nodes.append({"node": m.node, "ros_node": m.fqn, "state": self.state(m.node),
                           "scope": [STATES[k] for k in sorted(m.scope)],
                           "transitions": m.transitions, "outputs_judged": m.judged, "violations": mine,
+                          **({"withdrawn": [v for v in self.withdrawn if v["node"] == m.node]}
+                             if any(v["node"] == m.node for v in self.withdrawn) else {}),
                           **({"deadlines": timed} if m.node in self.deadlines else {}),
                           "status": "failed" if mine or missed else "discharged" if m.judged else "inconclusive"})
             for v in verdicts:
