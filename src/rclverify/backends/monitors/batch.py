@@ -33,12 +33,15 @@ columns and that small state: flat in the trace's length.
 
 Eligible (:func:`batch_plan`), else the caller streams: one node; no
 service or action link, no ``triggered by``, no state topic; every topic
-carries one ``REAL`` or enumeration variable through a rule naming one
+carries one ``REAL``, enumeration or window (``NATURAL --> REAL`` from an
+array, :mod:`.batch_window`) variable through a rule naming one
 field; one output topic; every guarantee reads the output (one that reads no
 input is output-only: judged on each answer on the outputs as they stand,
 its margin on no question, as the engine judges it), and Z3 showed only an
-answer decides them (the engine evaluates nothing when a question comes);
-every formula compiled by :mod:`.columns`.
+answer decides them, or for a windowed node :func:`.batch_window.answer_only`
+showed it (the engine evaluates nothing when a question comes);
+every formula compiled by :mod:`rclverify.targets.columns` (windows:
+:mod:`rclverify.targets.column_windows`).
 """
 from __future__ import annotations
 
