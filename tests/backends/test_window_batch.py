@@ -153,7 +153,7 @@ def _brute(node: str, events: list[Event], verdicts: list[Any], margin: Callable
 def test_batch_equals_streaming_and_the_enumerated_window(node: str) -> None:
     rnd = random.Random(f"window-{node}")
     batched = compared = 0
-    for case in range(8):
+    for case in range(6):
         events = _trace(rnd, node, 0.005)
         skew = (0.0, 0.02)[case % 2]
         chunk = rnd.choice([2, 3, 7, 64, 4096])
@@ -199,3 +199,19 @@ def test_windows_the_columns_hold() -> None:
 ])
 def test_only_an_answer_decides(formula: str, only: bool) -> None:
     assert answer_only(parse_formula(formula), CHECKED.nodes["G"]) is only
+
+
+def test_a_window_is_read_from_an_array() -> None:
+    """traces/mapping.py's window rule: an array field is the function from the offsets 0.. to its items, the
+    message's whole table; a message with no array keeps the function rule (one entry, accumulated)."""
+    from rclverify.lang import types as T
+    from rclverify.semantics.values import FiniteFunction
+    from rclverify.traces.mapping import MappingError, TopicRule, map_value
+    typ = T.FuncT((T.Scalar("NATURAL"),), T.Scalar("REAL"))
+    before = FiniteFunction({(7,): 1.5}, None, 1)
+    got = map_value(typ, {"data": [2.5, 0.5]}, TopicRule(("data",)), before)
+    assert got.table == {(0,): 2.5, (1,): 0.5}  # the earlier entry is not kept: the window is the message's
+    kept = map_value(typ, {"k": 3, "v": 4.0}, TopicRule(("k", "v")), before)
+    assert kept.table == {(7,): 1.5, (3,): 4.0}  # the control: the function rule, accumulating
+    with pytest.raises(MappingError, match="not a finite number"):
+        map_value(typ, {"data": [2.5, math.nan]}, TopicRule(("data",)), None)
