@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from test_bench_smoke import BENCHES, HEAVY, run_smoke
+from test_bench_smoke import BENCHES, HEAVY, bench_cache, run_smoke  # noqa: F401  (bench_cache: a fixture)
 
 
 def test_every_heavy_bench_exists() -> None:
@@ -15,14 +15,14 @@ def test_every_heavy_bench_exists() -> None:
 
 
 @pytest.mark.parametrize("bench", [b for b in BENCHES if b in HEAVY and b != "monitor_live_rclpy.py"])
-def test_heavy_bench_runs_in_smoke_mode(bench: str, tmp_path: Path) -> None:
-    run_smoke(bench, tmp_path)
+def test_heavy_bench_runs_in_smoke_mode(bench: str, tmp_path: Path, bench_cache: Path) -> None:
+    run_smoke(bench, tmp_path, bench_cache)
 
 
-def test_the_rclpy_bench_runs_in_smoke_mode(tmp_path: Path) -> None:
+def test_the_rclpy_bench_runs_in_smoke_mode(tmp_path: Path, bench_cache: Path) -> None:
     """bench/monitor_live_rclpy.py needs ROS 2's Python (a real rclpy publisher): skipped, with the
     reason, without it; with it, the smoke run must hear every message it published."""
     from _ros2 import ros2_python
     ros2_python()
-    out = run_smoke("monitor_live_rclpy.py", tmp_path)
+    out = run_smoke("monitor_live_rclpy.py", tmp_path, bench_cache)
     assert "lost 0;" in out and "decode errors 0;" in out and "p99" in out, out
