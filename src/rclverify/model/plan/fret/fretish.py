@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from decimal import Decimal
 from typing import Callable, Union
 
 #: A parsed expression: ("num", text) | ("bool", "TRUE"/"FALSE") | ("var", name) | ("not", e) |
@@ -353,7 +354,32 @@ def lift(e: Expr) -> Expr:
     counter = str(node[1])
     last = _longest(e, counter) - 1
     return ("and*", tuple(("bin", "=>", ("bin", "=" if k < last else ">=", ("text", counter), ("num", str(k))),
-                           lift(_at(e, counter, k))) for k in range(last + 1)))
+                           lift(_fold(_at(e, counter, k)))) for k in range(last + 1)))
+
+
+def _value(e: Expr) -> Decimal | None:
+    """The number a constant tree (a numeral, its negation) stands for; ``None`` for another tree."""
+    if e[0] == "num":
+        return Decimal(str(e[1]))
+    if e[0] in ("neg", "paren"):
+        v = _value(e[1])  # type: ignore[arg-type]
+        return None if v is None else -v if e[0] == "neg" else v
+    return None
+
+
+def _fold(e: Expr) -> Expr:
+    """``e`` with each sum, difference and product of two numerals written as one (exactly: numerals are
+    decimals), so that a divisor that a table makes constant is a numeral."""
+    if e[0] == "bin" and e[1] in ("+", "-", "*"):
+        a, b = _fold(e[2]), _fold(e[3])  # type: ignore[arg-type]
+        va, vb = _value(a), _value(b)
+        if va is None or vb is None:
+            return ("bin", e[1], a, b)
+        v = va + vb if e[1] == "+" else va - vb if e[1] == "-" else va * vb
+        text = format(abs(v), "f")
+        return ("neg", ("num", text)) if v < 0 else ("num", text)
+    return tuple(a if i == 0 or not isinstance(a, tuple) or not a else
+                 _fold(a) if isinstance(a[0], str) else tuple(_fold(b) for b in a) for i, a in enumerate(e))
 
 
 def _longest(e: Expr, counter: str) -> int:
