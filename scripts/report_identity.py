@@ -18,15 +18,25 @@ Usage::
     python3 scripts/report_identity.py digest DIR --save before.json
     # ... change the report's code ...
     python3 scripts/report_identity.py digest DIR --compare before.json
+
+    # or in one step: the working tree against itself with PATHs as they were at REV
+    python3 scripts/report_identity.py against DIR REV PATH...
+
+``against`` takes its baseline from a copy of ``src/`` in which only the
+named files are their version at ``REV`` (so that what others changed in
+the tree counts on both sides), renders it in a process of its own and
+compares the working tree's files with it.
 """
 from __future__ import annotations
 
 import argparse
 import hashlib
 import json
+import os
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 #: the examples compared
@@ -85,6 +95,22 @@ def digest(out: Path, save: Path | None, compare: Path | None) -> int:
     return 0
 
 
+def against(repo: Path, out: Path, rev: str, paths: list[str]) -> int:
+    """Compare the working tree's files with those rendered by a copy of ``src/`` whose ``paths`` (relative
+    to the repository) are their version at ``rev`` (module docstring).  Returns the exit status."""
+    with tempfile.TemporaryDirectory(prefix="report-identity-") as tmp:
+        base = Path(tmp)
+        shutil.copytree(repo / "src", base / "src", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+        for rel in paths:
+            text = subprocess.run(["git", "show", f"{rev}:{rel}"], cwd=repo, check=True, capture_output=True).stdout
+            (base / rel).write_bytes(text)
+        saved = base / "before.json"
+        env = {**os.environ, "PYTHONPATH": str(base / "src")}
+        subprocess.run([sys.executable, __file__, "digest", str(out), "--save", str(saved)], check=True, env=env,
+                       stdout=subprocess.DEVNULL)
+        return digest(out, None, saved)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -94,9 +120,16 @@ def main(argv: list[str] | None = None) -> int:
     d.add_argument("dir", type=Path)
     d.add_argument("--save", type=Path, help="write the digests to this JSON file")
     d.add_argument("--compare", type=Path, help="compare with the digests of this JSON file (exit 1 when any differ)")
+    a = sub.add_parser("against", help="compare with the files rendered with PATHs as they were at REV")
+    a.add_argument("dir", type=Path)
+    a.add_argument("rev")
+    a.add_argument("paths", nargs="+", metavar="PATH", help="a file of src/, relative to the repository")
     args = ap.parse_args(argv)
+    repo = Path(__file__).resolve().parent.parent
     if args.cmd == "prepare":
-        return prepare(Path(__file__).resolve().parent.parent, args.dir)
+        return prepare(repo, args.dir)
+    if args.cmd == "against":
+        return against(repo, args.dir, args.rev, args.paths)
     return digest(args.dir, args.save, args.compare)
 
 
