@@ -187,6 +187,8 @@ def test_windows_the_columns_hold() -> None:
     good, col = window_column([[1.0, 2.0], [1.0], [1.0, math.nan], [1, 2.0], [True, 1.0], "ab", [3.5, -0.0]], 2)
     assert good.tolist() == [True, False, False, False, False, False, True]
     assert col[0].tolist() == [1.0, 2.0] and col[6].tolist() == [3.5, -0.0]
+    good, col = window_column([[1.0, 2.0], [math.inf, 0.5], [3.5, -0.0]], 2)  # every row a list of floats
+    assert good.tolist() == [True, False, True] and col[2].tolist() == [3.5, -0.0]
 
 
 @pytest.mark.parametrize("formula, only", [

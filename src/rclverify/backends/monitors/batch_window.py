@@ -50,18 +50,22 @@ def window_column(vals: list[Any], width: int) -> tuple[np.ndarray, np.ndarray]:
     """(rows the columns hold, the ``(rows, width)`` float64 column; NaN where not held) of the values
     ``vals`` (a message's field each): a row holds a list of ``width`` finite floats."""
     n = len(vals)
-    col = np.full((n, width), np.nan)
     if not n:
-        return np.zeros(0, dtype=bool), col
+        return np.zeros(0, dtype=bool), np.full((0, width), np.nan)
+    if set(map(type, vals)) == {list} and set(map(len, vals)) == {width} and \
+            set(map(type, chain.from_iterable(vals))) == {float}:  # every row a list of width floats: at C speed
+        col = np.fromiter(chain.from_iterable(vals), np.float64, n * width).reshape(n, width)
+        return np.isfinite(col).all(axis=1), col
+    col = np.full((n, width), np.nan)
     good = np.fromiter((type(v) is list and len(v) == width for v in vals), bool, n)
-    rows = vals if good.all() else [v for v, g in zip(vals, good.tolist()) if g]
+    rows = [v for v, g in zip(vals, good.tolist()) if g]
     if rows and set(map(type, chain.from_iterable(rows))) != {float}:  # an integer, a boolean, a string...
         ok = np.fromiter((all(type(x) is float for x in v) for v in rows), bool, len(rows))
         idx = np.flatnonzero(good)
         good[idx[~ok]] = False
         rows = [v for v, o in zip(rows, ok.tolist()) if o]
     if rows:
-        col[good] = np.array(rows, dtype=np.float64)
+        col[good] = np.fromiter(chain.from_iterable(rows), np.float64, len(rows) * width).reshape(len(rows), width)
     good &= np.isfinite(col).all(axis=1)
     return good, col
 
