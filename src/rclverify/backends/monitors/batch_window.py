@@ -55,7 +55,7 @@ def window_column(vals: list[Any], width: int) -> tuple[np.ndarray, np.ndarray]:
     if set(map(type, vals)) == {list} and set(map(len, vals)) == {width} and \
             set(map(type, chain.from_iterable(vals))) == {float}:  # every row a list of width floats: at C speed
         col = np.fromiter(chain.from_iterable(vals), np.float64, n * width).reshape(n, width)
-        return np.isfinite(col).all(axis=1), col
+        return np.asarray(np.isfinite(col).all(axis=1)), col
     col = np.full((n, width), np.nan)
     good = np.fromiter((type(v) is list and len(v) == width for v in vals), bool, n)
     rows = [v for v, g in zip(vals, good.tolist()) if g]
