@@ -202,3 +202,11 @@ def test_a_table_is_one_counter_not_a_chain_of_states() -> None:
     assert formal is not None and "(Rover.state.fret_L_VEC_step == 0) -> (Rover.out.speed <= (0.5))" in formal.text
     assert "(Rover.state.fret_L_VEC_step >= 200) -> (Rover.out.speed <= (0.0))" in formal.text
     assert "state.fret_L_VEC_step < 200" in imp.states[0].next.text
+
+
+def test_lustre_precedence() -> None:
+    """Lustre's, not FRETish's: ``not`` binds tighter than a comparison, ``pre`` tightest, ``->`` loosest."""
+    from rclverify.model.plan.fret.lustre import parse_lustre
+    assert parse_lustre("v", "not a = b") == ("bin", "=", ("not", ("var", "a")), ("var", "b"))
+    assert parse_lustre("v", "0.0 -> x - pre x * 2.0") == (
+        "arrow", ("num", "0.0"), ("bin", "-", ("var", "x"), ("bin", "*", ("lpre", ("var", "x")), ("num", "2.0"))))

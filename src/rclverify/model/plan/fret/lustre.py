@@ -34,7 +34,7 @@ from __future__ import annotations
 import re
 from typing import Callable
 
-from rclverify.model.plan.fret.fretish import Expr, PRE, Refusal, _Parser, _tokens
+from rclverify.model.plan.fret.fretish import _COMPARE, PRE, Expr, Refusal, _Parser, _tokens
 
 #: Lustre's word operators, read as FRETish's.
 _WORDS = {"and": "&", "or": "|", "not": "!", "<>": "!="}
@@ -52,8 +52,9 @@ _BOOL_OPS = ("&", "|", "=>", "->", "<=>", "<->", "xor", "=", "!=", "~=", "<", "<
 
 
 class _Lustre(_Parser):
-    """Lustre's precedence, loosest first: ``->`` (to the right), ``=>``, ``or``/``xor``, ``and``;
-    ``pre`` binds tightest; ``if c then a else b`` is an atom."""
+    """Lustre's precedence, loosest first: ``->`` (to the right), ``=>``, ``or``/``xor``, ``and``, the
+    comparisons, ``not``, ``+``/``-``, ``*``/``/``; ``pre`` binds tightest; ``if c then a else b`` is an
+    atom."""
 
     levels = (("->",), ("=>",), ("|", "xor"), ("&",))
 
@@ -65,6 +66,22 @@ class _Lustre(_Parser):
                 return ("arrow", left, self.level(0))
             return left
         return super().level(k)
+
+    def unary(self) -> Expr:
+        return self.compare()
+
+    def compare(self) -> Expr:  # Lustre's not binds tighter than a comparison: not a = b is (not a) = b
+        left = self.negated()
+        if self.peek() in _COMPARE:
+            op = self.take()
+            left = ("bin", op, left, self.negated())
+        return left
+
+    def negated(self) -> Expr:
+        if self.peek() == "!":
+            self.take()
+            return ("not", self.negated())
+        return self.sum()
 
     def atom(self) -> Expr:
         t = self.peek()
