@@ -145,6 +145,10 @@ WALL: dict[str, float] = {
     "test_robot_generator": 60.0,
 }
 
+#: Modules weighed by their wall-clock time (in :data:`WALL`) whose live tests are marked in the module
+#: itself (``@pytest.mark.live``), the rest of the module in the inner tier.
+MARKED_IN_MODULE = frozenset({"test_robot_generator"})
+
 #: Modules that run the whole pipeline although they cost less than two seconds: still ``slow``.
 PIPELINE = frozenset({
     "test_confidence", "test_deadlines", "test_deadlines_report", "test_evidence_staleness",

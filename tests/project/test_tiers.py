@@ -22,7 +22,10 @@ def test_the_slow_tier_holds_the_measured_and_the_pipeline_modules() -> None:
 
 
 def test_only_live_modules_are_weighed_by_their_wall_clock_time() -> None:
-    assert set(conftest.WALL) <= conftest.LIVE
+    assert set(conftest.WALL) <= conftest.LIVE | conftest.MARKED_IN_MODULE
+    for name in conftest.MARKED_IN_MODULE:  # each marks its live tests itself
+        (path,) = HERE.rglob(f"{name}.py")
+        assert "@pytest.mark.live" in path.read_text(), name
 
 
 def test_this_module_is_marked_by_neither_tier(request) -> None:  # type: ignore[no-untyped-def]
