@@ -38,6 +38,8 @@ from __future__ import annotations
 import hashlib
 from typing import Any
 
+from rclverify.core.numeric import import_numpy
+
 #: rmw's infinite duration (ns), the graph dump's "none" (as :data:`rclverify.ros.live.dds_qos.INFINITE_NS`)
 INFINITE_NS = 0x7FFFFFFFFFFFFFFF
 GRAPH_TYPE = "rosgraph_msgs/msg/Graph"
@@ -114,7 +116,7 @@ def _ns(d: Any) -> int:
 
 
 def _itype(store: Any, name: str, hash_text: str | None) -> Any:
-    import numpy  # deferred: start-up (loaded with rosbags)
+    numpy = import_numpy()  # deferred: start-up (loaded with rosbags), one OpenBLAS thread
     value = numpy.zeros(32, dtype=numpy.uint8)
     version = 0
     if hash_text and hash_text.startswith("RIHS01_") and len(hash_text) == 7 + 64:
