@@ -6,7 +6,8 @@ pipeline's own stage and its new verdict printed.
 One workspace, verified once: ``Gate`` (a ``<`` for ``<=`` slip in its code: a property test fails),
 ``Router`` feeding ``Follower`` and ``Tail`` (a producer's bound over both consumers' assumption: two side
 conditions fail, one problem) and
-``Odd`` (code no one-token edit repairs: no repair offered).  The controls: a file changed after the run is
+``Odd`` (code no one- or two-token edit repairs: its guarantee pins ``small`` to ``v <= 5`` both ways, where
+``in.v <= 5 -> out.small`` let a two-token edit make ``small`` always true: no repair offered).  The controls: a file changed after the run is
 refused and left as it is; an unknown id and a problem with no repair end in one located line."""
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ node Odd {
   inputs( v : INTEGER )
   outputs( small : BOOL )
   assume( 0 <= in.v and in.v <= 10 )
-  guarantee( in.v <= 5 -> out.small )
+  guarantee( out.small <=> in.v <= 5 )
 }
 
 node Router {
@@ -57,7 +58,7 @@ node Tail {
 }
 """
 GATE = '"""The gate (a seeded slip: < for <=)."""\n\n\ndef gate(x):\n    return {"ok": x < 3}\n'
-ODD = '"""No one-token edit makes this right."""\n\n\ndef odd(v):\n    return {"small": v % 2 == 1}\n'
+ODD = '"""No one- or two-token edit makes this right."""\n\n\ndef odd(v):\n    return {"small": v % 2 == 1}\n'
 PLAN = """contracts: [contracts/robot.rcl]
 nodes:
   Gate:
