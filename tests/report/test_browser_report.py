@@ -45,12 +45,14 @@ from rclverify.report.textfmt import natural_key
 REPO = Path(__file__).resolve().parents[2]
 #: Tallest the case study's HTML report may be at 1400 px (CSS px): 40% of the 79,000 px of issue 24.
 MAX_HEIGHT = 31_600
-#: The system diagram starts within the first two and a half screens (CSS px): "What needs attention"
+#: The system diagram starts within the first three screens (CSS px): "What needs attention"
 #: above it now has nine rows (the model checker's instances are rows of their own, not members of the
 #: guarantee-3 row), which put the diagram at 2,081 px; eleven since the Radiation Sensor's recorded runs
 #: are inconclusive (one row for the three), at 2,262 px; twelve since the Agent's contract is found
-#: unrealizable (a row of its own), at 2,353 px. Still within two and a half screens of 1,000 px.
-MAX_DIAGRAM_TOP = 2_450
+#: unrealizable (a row of its own), at 2,353 px; the margins part (the guarantees held by the smallest
+#: margins over the recorded runs, four rows) above it since the stored report was regenerated with it, at
+#: 2,755 px. Still within three screens of 1,000 px.
+MAX_DIAGRAM_TOP = 2_800
 #: The browser flags: no sandbox (containers), no GPU, nothing fetched from the network.
 FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
          "--disable-component-update", "--no-first-run", "--disable-sync", "--window-size=1400,1000")
