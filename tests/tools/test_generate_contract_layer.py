@@ -68,6 +68,13 @@ def test_generated_checks_agree_with_z3_on_every_warehouse_node(trees: dict) -> 
             if got["semantics"] in ("double", "tolerance"):  # holds only as the node computes: false to Z3
                 assert got["verdict"] == "satisfied" and want[0] != "satisfied", (values, want)
                 return
+            if got["verdict"] == want[0] == "violated" and got["guarantee"] != want[1]:
+                # an earlier guarantee false only in exact arithmetic (1 - 8.8e-101 is 1.0 in doubles) holds as the
+                # node computes, as the monitor judges it: the layer names the first false in both, which Z3 finds
+                # false too, later than Z3's first
+                assert got["guarantee"] > want[1] and got["guarantee"] in _z3_false(node_name, values), (values, want)
+                seen.add(got["verdict"])
+                return
             assert (got["verdict"], got["guarantee"]) == want, values
             seen.add(got["verdict"])
 
@@ -119,6 +126,13 @@ def test_generated_checks_agree_with_z3_on_the_case_study_where_both_decide(tree
     # monitor: few examples are decided by both (docs/generate.md, "The contract layer")
     assert compared >= 1
     assert kinds <= {"satisfied", "violated", "assumption violated"}, kinds
+
+
+def _z3_false(node_name: str, values: dict) -> list[int]:
+    """The guarantees (1-based) of ``node_name`` false on ``values`` in exact arithmetic."""
+    node = CHECKED.nodes[node_name]
+    return [k for k, c in enumerate(node.node.guarantees, 1)
+            if check_concrete(c.formula, CHECKED, node, values)[0] is False]
 
 
 def _z3_verdict_of(checked, node_name: str, values: dict) -> tuple[str, int]:  # type: ignore[no-untyped-def]
