@@ -23,7 +23,7 @@ from typing import Callable
 from rclverify.records.design_rows import DesignFieldRow, DesignFindingRow, DesignPlaceRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.sarif import SarifLocation, SarifResult
-from rclverify.report.junit_suite import closed
+from rclverify.report.junit_suite import FindingSuite
 
 #: The SARIF rule of a design result (id, name, level, text).
 SARIF_RULES = (
@@ -105,14 +105,8 @@ def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
     row = report.design
     if row is None:
         return None
-    suite = ET.Element("testsuite", {"name": "design"})
-    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
-
-    def add(c: ET.Element, status: str, summary: str, detail: str) -> None:
-        counts["tests"] += 1
-        bumped = outcome(c, status, summary, detail, "design")
-        if bumped:
-            counts[bumped] += 1
+    found = FindingSuite("design", outcome, "design")
+    suite, add = found.suite, found.add
     for d in row.decided:
         code, severity, text = _verdict(d)
         where = _at(d.at) if d.at is not None else ""
@@ -142,7 +136,7 @@ def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
             "`doit verify` checks the current design and contracts")
     if warned:
         ET.SubElement(suite, "system-out").text = "\n".join(warned)
-    return closed(suite, counts)
+    return found.closed()
 
 
 __all__ = ["SARIF_RULES", "junit_suite", "sarif_results"]

@@ -25,7 +25,7 @@ from rclverify.records.report_schema import NodlJson, Report
 from rclverify.records.sarif import SarifLocation, SarifResult
 from rclverify.report.shapes import GroundingBrief
 from rclverify.stages.workspace import Workspace
-from rclverify.report.junit_suite import closed
+from rclverify.report.junit_suite import FindingSuite
 
 #: SARIF rule of every NoDL finding: ``(id, name, level, text)`` (report/sarif.py ``Rule``).
 SARIF_RULES = (
@@ -126,14 +126,8 @@ def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
     row = report.nodl
     if row is None:
         return None
-    suite = ET.Element("testsuite", {"name": "nodl"})
-    counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
-
-    def add(c: ET.Element, status: str, summary: str, detail: str) -> None:
-        counts["tests"] += 1
-        bumped = outcome(c, status, summary, detail, "nodl")
-        if bumped:
-            counts[bumped] += 1
+    found = FindingSuite("nodl", outcome, "nodl")
+    suite, add = found.suite, found.add
     for f in row.findings:
         if f.severity != "error":
             continue
@@ -145,7 +139,7 @@ def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
     if row.stale:
         add(case(suite, "nodl", "nodl-stale", "", 0.0), "stale", f"the NoDL check is stale: {row.stale}",
             "`doit verify` checks the current documents")
-    if not counts["tests"]:
+    if not found.counts["tests"]:
         n = len(row.documents)
         c = case(suite, "nodl", f"nodl check of {n} document{'s' if n != 1 else ''}", "", 0.0)
         add(c, "ok", "", "")
@@ -153,7 +147,7 @@ def junit_suite(report: AssuranceReport, case: Callable[..., ET.Element],
                   for f in row.findings if f.severity == "warning"]
         if warned:
             ET.SubElement(c, "system-out").text = "\n".join(warned)
-    return closed(suite, counts)
+    return found.closed()
 
 
 def sarif_results(report: AssuranceReport, result: Callable[..., SarifResult],
