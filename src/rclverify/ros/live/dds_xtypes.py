@@ -28,9 +28,11 @@ domain allows it (``AllowInvalidTryConstruct``, :data:`.dds.COMPATIBILITY`).
 """
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 
+@functools.cache
 def _builder() -> Any:
     """The type-object builder: cyclonedds' own, collection elements without flags."""
     from cyclonedds.idl._typesupport.DDS import XTypes as xt  # deferred: start-up (loads cyclonedds and more only when called)
@@ -63,9 +65,6 @@ def _builder() -> Any:
     return FastDdsTypeObjects
 
 
-_BUILDER: list[Any] = []
-
-
 def as_fast_dds(cls: type) -> type:
     """Make the cyclonedds struct ``cls`` (made by ``make_idl_struct``) announce
     Fast DDS's type object for it (module docstring) and return ``cls``.  The
@@ -77,9 +76,7 @@ def as_fast_dds(cls: type) -> type:
         if idl._xt_data[0] is not None:
             return
         from cyclonedds.idl._support import Endianness  # deferred: start-up (loads cyclonedds and more only when called)
-        if not _BUILDER:
-            _BUILDER.append(_builder())
-        info, mapping = _BUILDER[0].process_type(idl.datatype)
+        info, mapping = _builder().process_type(idl.datatype)
         idl._xt_data = (info, mapping)
         idl._xt_bytedata = (info.serialize(endianness=Endianness.Little, use_version_2=True)[4:],
                             mapping.serialize(endianness=Endianness.Little, use_version_2=True)[4:])
