@@ -43,46 +43,38 @@ a step at which it holds is *accepted*.
   message and the run ending within the period ``inconclusive`` (too short
   to show a gap); none ``pending``.
 
-Each row's status is its verdict's (:data:`STATUS`: ``true`` discharged,
-``false`` failed, ``inconclusive``, ``pending``) and names the
-declaration's source, so a requirement resting on it
-(calculus/requirements/rollup.py) can read it.  The node's record folds
-them in by the rule of evidence (docs/semantics.md, "Verdicts and
-evidence"; :func:`declaration_status`, :func:`with_declarations`): a
-declaration pending or undecided never leaves the record ``discharged``.
-
-Long module: the monitor of the declarations on a run and the fold of their
-verdicts into the record's status (:func:`declaration_status`,
-:func:`with_declarations`) read the same rows and the same rule of
-evidence, and are read together by every engine that judges runs.
+Each row's status is its verdict's; the rows and their fold into the
+node's record by the rule of evidence are :mod:`.declaration_evidence`'s
+(:func:`declaration_status`, :func:`with_declarations`, re-exported here).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance, judge
 from rclverify.lang import ast
-from rclverify.lang.liveness import _steps, period_seconds
+from rclverify.lang.liveness import _steps
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import free_names, subexpressions
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
 from rclverify.backends.monitors.deadline_topics import topic_bindings
-from rclverify.backends.monitors.stamp_order import run_clock
 from rclverify.backends.monitors.periods import PeriodResult
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
-from rclverify.backends.monitors.shapes import DeclarationsPart
-from rclverify.backends.shapes import DeclarationRow
+from rclverify.backends.monitors.declaration_evidence import (STATUS, DeclarationResult, add_periods,
+                                                              declaration_row, declaration_status, source_text,
+                                                              with_declarations)
+
+__all__ = ["STATUS", "DeclarationMonitor", "DeclarationResult", "add_periods", "call_part", "check_declarations",
+           "declaration_status", "has_declarations", "with_declarations"]
 
 #: a first value that did not map (a missing field, NaN): an ``initially`` on it is undecided
 _UNMAPPED = object()
 #: at most this many cached assumption verdicts (then the cache starts again)
 _CACHE = 4096
-#: declaration verdict -> evidence status
-STATUS = {"true": "discharged", "false": "failed", "inconclusive": "inconclusive", "pending": "pending"}
 
 
 @dataclass
@@ -122,31 +114,10 @@ class _Initial:
     unobservable: bool = False
 
 
-@dataclass
-class DeclarationResult:
-    """The verdict rows of one node's declarations on one run."""
-
-    node: str
-    declarations: list[DeclarationRow] = field(default_factory=list)
-    #: the labels of the rows no run can decide (an ``initially`` whose first published value came after
-    #: an input: the property tests' to show): listed in the record's explanation, not folded into its status
-    unobservable: set[str] = field(default_factory=set)
-
-    def rows(self) -> list[DeclarationRow]:
-        """``[{"declaration", "premise", "index", "source", "verdict", "status", "reason"}]``:
-        ``premise`` the kind of premise the requirement check makes of it
-        (``"initial value"``, ``"progress"``, ``""`` for a period in time)."""
-        return [r.copy() for r in self.declarations]
-
-
 def has_declarations(node: CheckedNode) -> bool:
     """Whether ``node`` declares an initial value, progress or a period."""
     n = node.node
     return bool(n.initially or n.progress or n.periodic)
-
-
-def _src(loc: ast.Loc) -> str:
-    return f"{loc.file}:{loc.line}:{loc.col}"
 
 
 class DeclarationMonitor:
@@ -177,7 +148,7 @@ class DeclarationMonitor:
         self.values: dict[str, object] = {}
         self.first: dict[str, tuple[Any, str]] = {}
         self.first_input = ""  # where the first input event was (an output message after it may be an answer)
-        self.initials = [_Initial(k, c.formula, _src(c.loc), frozenset(
+        self.initials = [_Initial(k, c.formula, source_text(c.loc), frozenset(
             f"out.{e.name}" for e in subexpressions(c.formula) if isinstance(e, ast.Var) and e.prefix in ("out", None)
             and e.name in node.outputs)) for k, c in enumerate(node.node.initially, 1)]
         #: the outputs whose first value an ``initially`` reads and that were not published yet
@@ -185,12 +156,12 @@ class DeclarationMonitor:
         self.counts: list[_Count] = []
         for p in node.node.progress:
             k = _steps(p.bound) if p.bound is not None else None
-            self.counts.append(_Count("progress", _src(p.loc), k, frozenset(),
+            self.counts.append(_Count("progress", source_text(p.loc), k, frozenset(),
                                       f"progress( {'eventually' if p.bound is None else f'within {p.bound} steps'} )"))
         for per in node.node.periodic:
             n = _steps(per.amount) if per.unit in ("steps", "step") else None
             if n:
-                self.counts.append(_Count(f"periodic out.{per.output.name}", _src(per.loc), n - 1,
+                self.counts.append(_Count(f"periodic out.{per.output.name}", source_text(per.loc), n - 1,
                                           frozenset({f"out.{per.output.name}"}),
                                           f"periodic( out.{per.output.name}, {per.amount} {per.unit} )"))
 
@@ -349,12 +320,12 @@ class DeclarationMonitor:
             verdict, reason = (ini.verdict, ini.reason) if ini.verdict else (
                 "pending", "no message of " + ", ".join(sorted(o for o in ini.outs if o not in self.first) or ["an output"])
                 + ": its first value was not seen")
-            res.declarations.append(_row(f"initially {ini.index}", "initial value", ini.index, ini.source,
+            res.declarations.append(declaration_row(f"initially {ini.index}", "initial value", ini.index, ini.source,
                                               f"initially( {expr_to_rcl(ini.formula)} )", verdict, reason))
             if ini.unobservable:
                 res.unobservable.add(f"initially {ini.index}")
         for c in self.counts:
-            row = _row(c.label, c.premise, 0, c.source, c.text, *self._count_verdict(c))
+            row = declaration_row(c.label, c.premise, 0, c.source, c.text, *self._count_verdict(c))
             if row["verdict"] == "true" and c.bound is not None:
                 row["spare"] = c.bound - c.longest  # the steps to spare (docs/semantics.md, "Margins in steps")
             res.declarations.append(row)
@@ -410,106 +381,6 @@ def call_part(ev: Event) -> tuple[Event, Mapping[str, Any]] | None:
             or not isinstance(fields, Mapping):
         return None
     return Event(ev.index, ev.time, f"{link.strip('/')}/{part}", dict(fields), ev.where), fields
-
-
-def _row(label: str, premise: str, index: int, source: str, text: str, verdict: str, reason: str) -> DeclarationRow:
-    return {"declaration": label, "premise": premise, "index": index, "source": source, "text": text,
-            "verdict": verdict, "status": STATUS[verdict], "reason": reason}
-
-
-def add_periods(res: DeclarationResult, node: CheckedNode, periods: PeriodResult | None) -> DeclarationResult:
-    """``res`` with a row per period in time of ``node``, from the run's
-    :class:`~.periods.PeriodResult` (``None``: not checked, ``pending``)."""
-    for per in node.node.periodic:
-        if period_seconds(per) is not None:
-            res.declarations.append(_row(
-                f"periodic out.{per.output.name}", "", 0, _src(per.loc),
-                f"periodic( out.{per.output.name}, {per.amount} {per.unit} )",
-                *_period_verdict(periods, f"out.{per.output.name}")))
-    return res
-
-
-def _period_verdict(res: PeriodResult | None, key: str) -> tuple[str, str]:
-    if res is None or key not in res.periods:
-        return "pending", "the period was not checked"
-    late = res.late.get(key)
-    n = res.messages.get(key, 0)
-    if late is not None:
-        return "false", (f"a gap of {late['gap'] * 1000:.0f} ms after the message at {late['from']:.3f} s "
-                         f"({late['where']}), over the period of {late['period'] * 1000:.0f} ms")
-    if n == 0:
-        return "pending", "no message of the output: its period was not checked"
-    if n == 1:
-        return "inconclusive", "a single message and the run ends within the period: too short to show a gap"
-    return "true", f"{n} messages, no gap over {res.periods[key] * 1000:.0f} ms"
-
-
-def declaration_status(res: DeclarationResult, trace: str) -> tuple[str, str]:
-    """``(status, explanation)`` the declarations of ``res`` give on
-    ``trace``, by the rule of evidence (docs/semantics.md, "Verdicts and
-    evidence"): a ``false`` row -> ``failed`` (named, a declaration of the
-    contract before a period in time); else an ``inconclusive`` row, or a
-    ``pending`` row beside a ``true`` one -> ``inconclusive``; else every row
-    ``pending`` (or none) -> ``pending``; else ``discharged``.  A row no run
-    can decide (:attr:`DeclarationResult.unobservable`) is listed apart and
-    left out of the status.  The explanation lists the rows that held, those
-    not decided and those no run shows, each with its reason."""
-    status, words = _fold(res, trace)
-    return status or "pending", words
-
-
-def _fold(res: DeclarationResult, trace: str) -> tuple[str | None, str]:
-    """:func:`declaration_status`, with ``None`` for a status when every row
-    is one no run can decide (nothing for the record's status)."""
-    rows = [r for r in res.declarations if r["declaration"] not in res.unobservable]
-    bad = sorted((r for r in rows if r["verdict"] == "false"), key=lambda r: not r["premise"])
-    if bad:
-        r = bad[0]
-        return "failed", f"{res.node} declares {r['text']} ({r['source']}) but in {trace}: {r['reason']}"
-    open_ = [f"{r['text']}: {r['verdict']} ({r['reason']})" for r in rows if r["verdict"] not in ("true", "false")]
-    done = [r["text"] for r in rows if r["verdict"] == "true"]
-    apart = [f"{r['text']}: {r['verdict']} ({r['reason']})" for r in res.declarations
-             if r["declaration"] in res.unobservable]
-    words = "; ".join((["held: " + ", ".join(done)] if done else [])
-                      + (["not decided: " + "; ".join(open_)] if open_ else [])
-                      + (["not shown by a run (its first published value answers an input; the property tests "
-                          "show it): " + "; ".join(apart)] if apart else [])) or "none judged"
-    if not rows and res.declarations:
-        return None, words
-    if any(r["verdict"] == "inconclusive" for r in rows) or (open_ and done):
-        return "inconclusive", words
-    if not done:
-        return "pending", words
-    return "discharged", words
-
-
-def with_declarations(res: DeclarationResult, trace: str, status: str,
-                      explanation: str) -> tuple[str, str, DeclarationsPart]:
-    """The record's status from the other checks' ``status`` (with its
-    ``explanation``) and the node's declarations on the same run
-    (:func:`declaration_status`), by the rule of evidence (docs/semantics.md,
-    "Verdicts and evidence"): a false declaration fails the record (it is a
-    claim of the node's contract); a declaration pending or undecided keeps
-    a ``discharged`` record from ``discharged`` (``inconclusive``) and makes
-    a ``pending`` one ``inconclusive`` when one was undecided; ``failed``,
-    ``error``, ``stale`` and ``inconclusive`` stand; a row no run can decide
-    changes nothing but the explanation.  Returns ``(status, explanation,
-    {"declarations": rows})``."""
-    dstatus, dexpl = _fold(res, trace)
-    part: DeclarationsPart = {"declarations": res.rows()}
-    if dstatus == "failed":
-        late_period = not any(r["verdict"] == "false" and r["premise"] for r in res.declarations
-                              if r["declaration"] not in res.unobservable)
-        if late_period and status == "failed":  # a late period fails the record through periods.py: not said twice
-            return status, f"{explanation}; declarations: {dexpl}", part
-        return "failed", f"declarations: {dexpl}; {explanation}", part
-    if status == "discharged" and dstatus not in (None, "discharged"):
-        return "inconclusive", (f"{explanation}; but a declaration is not decided on this run, so the record is "
-                                f"not discharged (docs/semantics.md, \"Verdicts and evidence\"); declarations: "
-                                f"{dexpl}"), part
-    if status == "pending" and dstatus == "inconclusive":
-        return "inconclusive", f"{explanation}; declarations: {dexpl}", part
-    return status, f"{explanation}; declarations: {dexpl}", part
 
 
 def check_declarations(checked: Checked, node: CheckedNode, events: Iterable[Event],
