@@ -27,22 +27,20 @@ or not) the class that does; the rest to the node named outside any class.
 Values are evaluated by :mod:`link_values` (bounded: :data:`MAX_DEPTH` nested
 calls, :data:`MAX_VALUES` values).
 
-Long module: the walk over what a program runs and the evaluation of the
-names it leaves symbolic share one index of the program (classes, aliases,
-overloads, members by name), built once per program; the value evaluation
-itself is already apart (:mod:`link_values`, :mod:`link_members`,
-:mod:`link_types`).
+The program's index (its merged records and the lookups in them) is
+:mod:`link_index`'s, what runs what :mod:`link_reach`'s; the value
+evaluation :mod:`link_values`', :mod:`link_members`' and :mod:`link_types`'.
 """
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
-from rclverify.ros.extract import emit, names, plugins, symbols
-from rclverify.ros.extract.cpp_types import alias_index, alias_of, split_template
+from rclverify.ros.extract import emit, names, symbols
+from rclverify.ros.extract.cpp_types import alias_index
 from rclverify.ros.extract.model import Endpoint, Note, Src
 from rclverify.ros.extract.link_members import LinkMembers
+from rclverify.ros.extract.link_reach import LinkReach
 from rclverify.ros.extract.link_returns import Returns
 from rclverify.ros.extract.link_types import Instances, is_template_param
 from rclverify.ros.extract.link_values import MAX_DEPTH, MAX_VALUES, Values, _homes
@@ -50,7 +48,6 @@ from rclverify.ros.extract.programs import PackageCode, Program
 from rclverify.ros.extract.unit_names import canonical
 
 __all__ = ["Linked", "Linker", "MAX_DEPTH", "MAX_VALUES"]
-_IDENT = re.compile(r"[A-Za-z_][\w:]*")
 
 
 @dataclass
@@ -71,7 +68,7 @@ UNBUILT = ("nothing this program runs is read to construct the class (a construc
            "emplace_back/push_back or a factory the scan does not follow is not read): not in the graph")
 
 
-class Linker(LinkMembers, Values, Returns, Instances):
+class Linker(LinkReach, LinkMembers, Values, Returns, Instances):
     """Link one program of a package (see the module docstring); ``known(t)`` says
     whether the scan's type table defines message type ``t``."""
 
@@ -114,319 +111,6 @@ class Linker(LinkMembers, Values, Returns, Instances):
         self._memo: dict[str, list[dict[int, Any]]] = {}
         self._stack: set[str] = set()
         self.pins: dict[str, int] = {}
-
-    def _merge_records(self, prog: Program) -> set[str]:
-        """The program's files' records merged (a header read by several
-        files counted once); returns the units its entry files define."""
-        entry_units: set[str] = set()
-        bare_twice: set[str] = set()
-        for r in self.recs.values():  # a header read by several files: its definitions once
-            self.fn_tparams.update(r.get("fn_tparams", {}))
-            self.call_targs += [tuple(c) for c in r.get("call_targs", []) if tuple(c) not in self.call_targs]
-            for k, entries in r.get("returns", {}).items():
-                self.returns.setdefault(k, [])
-                self.returns[k] += [tuple(e) for e in entries if tuple(e) not in self.returns[k]]
-        for f, r in self.recs.items():
-            for k, (unit, params, ptypes, defaults) in r.get("fns", {}).items():
-                old = self.fns.get(k)
-                if old is not None and len(old[1]) == len(params):
-                    defaults = [d if d is not None else o for d, o in zip(defaults, old[3])]
-                self.fns[k] = (unit, params, ptypes, defaults)
-                if f in prog.entry:
-                    entry_units.add(unit)
-            for u, info in r.get("units", {}).items():
-                cur = self.units.setdefault(u, {"bases": [], "members": {}})
-                cur["bases"] += [b for b in info["bases"] if b not in cur["bases"]]
-                cur["members"].update(info["members"])
-                cur.setdefault("refs", []).extend(r for r in info.get("refs", []) if r not in cur["refs"])
-                if info.get("tparams"):
-                    cur["tparams"] = info["tparams"]
-                if f in prog.entry:
-                    entry_units.add(u)
-            for key, vals in r.get("fields", {}).items():
-                self.fields.setdefault(key, []).extend(vals)
-            for k, v in r.get("callbacks", {}).items():
-                self.callbacks.setdefault(k, v)
-            for k, v in r.get("aliases", {}).items():
-                if "::" not in k and self.aliases.get(k, v) != v:
-                    bare_twice.add(k)  # two files give one bare name two texts: read only in its scope
-                self.aliases.setdefault(k, v)
-            for c in r.get("calls", []):
-                self.calls.append(tuple(c) + (({},) if len(c) == 6 else ()))
-            if r.get("lang") == "py":
-                entry_units.add(f"{f}::<module>")  # a module's code runs when it is imported
-        for k in bare_twice:
-            self.aliases.pop(k, None)
-        return entry_units
-
-    def _link_calls(self, prog: Program) -> None:
-        """What runs what (:attr:`edges`) and the call sites of each function
-        (:attr:`sites`): a class's methods, the calls read, a plugin's entry
-        points, the classes a class holds or derives from."""
-        overloaded = {k.split("#")[0] for k in self.fns if "#" in k}  # constructors run only where called
-        for k, (unit, *_rest) in self.fns.items():
-            if (unit in self.units or unit == k) and "#" not in k and k not in overloaded:
-                self._edge(f"U:{unit}", f"F:{k}")
-            if unit == k:
-                self._edge(f"F:{k}", f"U:{unit}")
-        for c in self.calls:
-            kind, callee, args, fkey, unit, _src, kwargs = c
-            ck, cu = self._callee(kind, callee, unit)
-            here = f"F:{fkey}" if fkey else f"U:{unit}" if unit else None
-            made = kind in ("ctor", "member") or (ck is not None and cu is not None and (
-                ck.endswith(".__init__") or ck == self._ctor(cu)))
-            if here is not None and cu is not None and made:
-                self._edge(here, f"U:{cu}")
-            for k in self.overloads(ck, len(args)) if ck is not None else []:
-                if here is not None:
-                    self._edge(here, f"F:{k}")
-                self.sites.setdefault(k, []).append((args, kwargs, fkey))
-                self.site_at.setdefault(k, []).append(_src)
-                self.record_site(k, callee, fkey, kind, unit, len(args))
-        # a delegating constructor's call (Sensor(o) : Sensor("sensor", o)) is no construction read
-        made_outside = {s.split("#")[0] for s, sites in self.sites.items()
-                        if any((c or "").split("#")[0] != s.split("#")[0] for _a, _k, c in sites)}
-        for k, (unit, *_rest) in self.fns.items():  # an overload's class made where no call is read: all run
-            outside = k.split("#")[0] in made_outside
-            if ("#" in k or k in overloaded) and not outside:
-                self._edge(f"U:{unit}", f"F:{k}")
-        if prog.instance is not None:  # a plugin's methods its loader calls, given the instance's name
-            for k, got in plugins.entry_sites(self.fns, set(prog.units or ()), set(self.sites), prog.instance).items():
-                self.sites[k] = list(got)
-                self.site_at.pop(k, None)  # a plugin's entry points: no call site to name
-                self.site_targs[k] = [([], None)] * len(got)
-        for u, info in self.units.items():
-            for ty in list(info["members"].values()) + info["bases"]:
-                for ident in _IDENT.findall(ty):
-                    m = self.match(ident, u) if not ident.startswith(("std::", "ros::", "rclcpp::")) else None
-                    if m is not None and m != u:
-                        self._edge(f"U:{u}", f"U:{m}")
-            for b in info["bases"] if self.py else []:  # a Python base class of the package runs with it
-                m = self._py_base(u, b)
-                if m is not None and m != u:
-                    self._edge(f"U:{u}", f"U:{m}")
-
-    def _py_base(self, unit: str, base: str) -> str | None:
-        """The program's Python class that base ``base`` (as written in class
-        ``unit``'s ``class C(base)``) names: a class of the same file, else the
-        one the file imports under that name (``from pkg.base import Joint``),
-        found in the package."""
-        f = unit.split("::", 1)[0]
-        if f"{f}::{base}" in self.units:
-            return f"{f}::{base}"
-        head, _, rest = base.partition(".")
-        origins = [o for o in self.recs.get(f, {}).get("imports", [])
-                   if o.rsplit(".", 1)[-1] == head or o == head]
-        for o in origins[:1] if len(origins) == 1 else []:
-            hit = self.code.module(o + ("." + rest if rest else ""))
-            if hit is not None and hit[1] and f"{hit[0]}::{hit[1]}" in self.units:
-                return f"{hit[0]}::{hit[1]}"
-        return None
-
-    # -- program structure
-    def match(self, name: str, caller: str | None) -> str | None:
-        """The program's class a C++ type name (``Sensor``, ``ns::Sensor``) names."""
-        t = split_template(name.replace("*", "").replace("&", "").strip())[0].strip(":")
-        if not t:
-            return None
-        cands = self._classes_named(t)
-        for _ in range(4):  # using Filter = ns::FilterNode<Ekf>; make_shared<Filter>(...), or ns::Filter
-            if cands:
-                break
-            alias = alias_of(t, self.aliases, self.scopes(caller), self.alias_index) or \
-                alias_of(t.split("::")[-1], self.aliases, (), self.alias_index)
-            if alias is None:
-                break
-            t = split_template(alias.replace(" ", ""))[0].strip(":")
-            cands = self._classes_named(t)
-        if not cands:
-            return None
-        if len(cands) > 1 and caller:
-            ns = caller.rsplit("::", 1)[0]
-            near = [u for u in cands if u.startswith(ns + "::")]
-            cands = near or cands
-        return sorted(cands, key=len)[0]
-
-    def callee(self, kind: str, callee: str, unit: str | None, nargs: int | None = None) -> tuple[str | None, str | None]:
-        """``(callable key, unit)`` a call record names in this program; of a
-        constructor's overloads (keys ``Cls::Cls#N``), the one whose parameters
-        take ``nargs`` arguments when exactly one does."""
-        ck, cu = self._callee(kind, callee, unit)
-        if ck is None or nargs is None:
-            return ck, cu
-        fit = self.overloads(ck, nargs)
-        return (fit[0] if len(fit) == 1 else ck), cu
-
-    def overloads(self, ck: str, nargs: int) -> list[str]:
-        """The keys of the overloads of ``ck`` (``Cls::Cls``, ``Cls::Cls#N``) a call with
-        ``nargs`` arguments may run: those whose parameters, less the defaulted ones,
-        take that many; when several do (their argument types would decide), all of
-        them; ``[ck]`` when none does or ``ck`` has no overload."""
-        if self._overs is None:
-            self._overs = {}
-            for k in self.fns:
-                self._overs.setdefault(k.split("#")[0], []).append(k)
-        over = [k for k in self._overs.get(ck.split("#")[0], []) if k == ck or k.startswith(ck + "#")]
-        if len(over) <= 1:
-            return [ck]
-        fit = [k for k in over if len(self.fns[k][1]) - self.optional.get(k, 0) <= nargs <= len(self.fns[k][1])]
-        return fit or [ck]
-
-    def _callee(self, kind: str, callee: str, unit: str | None) -> tuple[str | None, str | None]:
-        if self.py:
-            return self._py_callee(callee)
-        if kind == "own-node":  # a member made here that runs on a node of its own: no class of the program
-            return None, None
-        if kind == "member":
-            info = self.units.get(unit or "", {})
-            ty = info.get("members", {}).get(callee)
-            cls = self.match(_held(ty), unit) if ty else None
-            if cls is not None and callee in info.get("refs", []):
-                return None, cls  # a reference member bound to what the constructor is given: nothing made
-            if cls is not None and _held(ty) != split_template(ty.replace(" ", ""))[0].replace("*", "").strip():
-                return None, cls  # a pointer member: made by the new/make_shared it is given
-            base = callee.split("<")[0].split("::")[-1]  # ClientBase<ServiceT>(node, name): a template base
-            if cls is None and any(b.split("<")[0].split("::")[-1] == base for b in info.get("bases", [])):
-                cls = self.match(callee, unit)
-            if cls is None and unit and base == unit.split("::")[-1]:  # a delegating constructor
-                cls = unit
-            return (self._ctor(cls), cls) if cls else (None, None)
-        if kind == "ctor":
-            cls = self.match(callee, unit)
-            return (self._ctor(cls), cls) if cls else (None, None)
-        meth, recv = callee, None
-        for sep in ("->", "."):
-            if sep in meth:
-                recv, meth = meth.rsplit(sep, 1)
-        if "::" in meth and recv is None:
-            head, last = meth.rsplit("::", 1)
-            cls = self.match(head, unit)
-            if cls is not None and f"{cls}::{last}" in self.fns:
-                return f"{cls}::{last}", cls
-            cls = self.match(meth, unit)
-            if cls is not None:
-                return self._ctor(cls), cls
-        if recv is not None and recv.replace("this", "").strip("()*&") and unit:
-            held = recv.replace("this->", "").strip()
-            if held.endswith("]") and "[" in held:  # an element of a member container: leds_[i]->on()
-                held = held[:held.index("[")]
-            ty = self.units.get(unit, {}).get("members", {}).get(held)
-            cls = self.match(_held(ty), unit) if ty else None
-            if ty is None and "->" not in recv and "." not in recv:  # a local (auto node = shared_from_this())
-                own = self.inherited(unit, meth)
-                if own is not None and self.methods_named(meth) == {own}:
-                    return own, self.fns[own][0]
-            return (f"{cls}::{meth}", cls) if cls and f"{cls}::{meth}" in self.fns else (None, None)
-        if unit and (own := self.inherited(unit, meth)) is not None:
-            return own, self.fns[own][0]
-        cls = self.match(meth, unit)
-        if cls is not None and recv is None:
-            return self._ctor(cls), cls
-        if self._free is None:
-            self._free = {}
-            for k, v in self.fns.items():
-                if v[0] == k:
-                    self._free.setdefault(k.rsplit("::", 1)[-1], []).append(k)
-        free = [k for k in self._free.get(meth.rsplit("::", 1)[-1], []) if k == meth or k.endswith("::" + meth)]
-        return (free[0], free[0]) if len(free) == 1 else (None, None)
-
-    def _classes_named(self, t: str) -> list[str]:
-        """The program's classes named ``t`` or ending in ``::t``."""
-        if self._by_last is None:
-            self._by_last = {}
-            for u in self.classes:
-                self._by_last.setdefault(u.rsplit("::", 1)[-1], []).append(u)
-        return [u for u in self._by_last.get(t.rsplit("::", 1)[-1], []) if u == t or u.endswith("::" + t)]
-
-    def methods_named(self, meth: str) -> set[str]:
-        """The keys of the program's class methods (not free functions) named ``meth``."""
-        if self._by_meth is None:
-            self._by_meth = {}
-            for k, v in self.fns.items():
-                if v[0] != k and "::" in k:
-                    self._by_meth.setdefault(k.split("#")[0].rsplit("::", 1)[1], set()).add(k)
-        return self._by_meth.get(meth, set())
-
-    def inherited(self, unit: str, meth: str, depth: int = 0) -> str | None:
-        """The key of method ``meth`` as class ``unit`` has it: its own, else the
-        nearest base class's of the program (a derived node calling its base's
-        ``create_action_server<T>("name", ...)`` unqualified); ``None`` when
-        neither defines it."""
-        if f"{unit}::{meth}" in self.fns:
-            return f"{unit}::{meth}"
-        if depth > 8 or not self.methods_named(meth):
-            return None
-        if (unit, meth) in self._inherited:
-            return self._inherited[(unit, meth)]
-        self._inherited[(unit, meth)] = None  # a cycle of bases finds nothing
-        got = None
-        for b in self.units.get(unit, {}).get("bases", []):
-            cls = self.match(b, unit)
-            got = self.inherited(cls, meth, depth + 1) if cls is not None and cls != unit else None
-            if got is not None:
-                break
-        self._inherited[(unit, meth)] = got
-        return got
-
-    def scopes(self, unit: str | None) -> list[str]:
-        """The scopes a name written in class ``unit`` is looked up in, innermost
-        first: the class, its base classes of the program, then its enclosing
-        classes and namespaces (``a::B`` -> ``a::B``, bases, ``a``)."""
-        if not unit:
-            return []
-        if unit in self._scopes:
-            return self._scopes[unit]
-        self._scopes[unit] = [unit]  # while its bases are matched (a base named through an alias)
-        out = [unit] + [b for b in (self.match(x, None) for x in self.units.get(unit, {}).get("bases", [])) if b]
-        parts = unit.split("::")
-        out += ["::".join(parts[:i]) for i in range(len(parts) - 1, 0, -1)]
-        self._scopes[unit] = list(dict.fromkeys(out))
-        return self._scopes[unit]
-
-    def _ctor(self, cls: str) -> str:
-        return f"{cls}::{cls.split('::')[-1]}"
-
-    def _py_callee(self, callee: str) -> tuple[str | None, str | None]:
-        if callee.startswith("ext:"):
-            hit = self.code.module(callee[4:])
-            if hit is None or not hit[1]:
-                return None, None
-            callee = f"{hit[0]}::{hit[1]}"
-        if callee in self.units:
-            return f"{callee}.__init__", callee
-        if callee in self.fns:
-            return callee, self.fns[callee][0]
-        return None, None
-
-    def never_made(self, e: Endpoint) -> bool:
-        """Whether endpoint ``e`` lies in a class of the program that nothing the program
-        runs constructs, and in none of its methods that run anyway (not an overload
-        nobody calls: that is left out by design)."""
-        u = e.unit
-        if u is None or u not in self.units or "#" in (e.func or "") or f"U:{u}" in self.reach:
-            return False
-        return not any(f"F:{k}" in self.reach for k, v in self.fns.items() if v[0] == u)
-
-    def _edge(self, a: str, b: str) -> None:
-        self.edges.setdefault(a, set()).add(b)
-
-    def runs(self, unit: str | None, fkey: str | None, reach: set[str] | None = None) -> bool:
-        """Whether code of function ``fkey`` (else of unit ``unit``) runs in the program
-        (or in ``reach``, a set of reached ``U:``/``F:`` items)."""
-        reach = self.reach if reach is None else reach
-        if fkey is not None and fkey in self.fns:
-            return f"F:{fkey}" in reach
-        return unit is not None and f"U:{unit}" in reach
-
-    def _reach(self, start: set[str]) -> set[str]:
-        seen, todo = set(), list(start)
-        while todo:
-            u = todo.pop()
-            if u in seen:
-                continue
-            seen.add(u)
-            todo.extend(self.edges.get(u, ()))
-        return seen
 
     # -- the program's endpoints and nodes
     def run(self) -> Linked:
@@ -670,16 +354,3 @@ def _py_typed(v: Any, kind: str) -> str | None:
     """The ROS type a Python value names (``("ext", "std_srvs.srv.Trigger")``) for role ``kind``."""
     from rclverify.ros.extract.sources_py import _typed  # deferred: start-up (loads rclverify.ros.extract and more only when called)
     return _typed(v[1], kind) if v is not None and v[0] == "ext" and isinstance(v[1], str) else None
-
-
-def _held(ty: str | None) -> str:
-    """The class a member's type holds: ``std::shared_ptr<ns::Sensor>`` -> ``ns::Sensor``."""
-    if not ty:
-        return ""
-    head, args = split_template(ty.replace(" ", ""))
-    if head.split("::")[-1] in ("shared_ptr", "unique_ptr", "weak_ptr", "Ptr", "SharedPtr", "vector", "optional",
-                                "array", "deque", "list") and args:
-        return _held(args[0])
-    if head.split("::")[-1] in ("map", "unordered_map") and len(args) == 2:  # a map's element is its value
-        return _held(args[1])
-    return head
