@@ -125,6 +125,21 @@ class Unary:
     loc: Loc = loc_field()
 
 
+@dataclass(frozen=True)
+class First:
+    """``first(in.x)``: TRUE exactly when the message of input ``in.x`` the
+    node reads is the first one published on that input in the run (in a
+    requirement, ``first(Node.in.x)``: TRUE at the step whose value of the
+    input is the first published on it).  ``arg`` is the input as written
+    (a requirement's ``Node.in.x`` is a bare name of the system's pseudo
+    node, :mod:`rclverify.model.plan.formal`).  A formula (BOOL); its
+    meaning in every reading: docs/semantics.md, "The first published
+    value"."""
+
+    arg: Var
+    loc: Loc = loc_field()
+
+
 BinaryOp = Literal["<=>", "->", "or", "and", "+", "-", "*", "/"]
 
 
@@ -266,7 +281,7 @@ class TupleQuant:
 
 
 Expr = Union[Var, BoolLit, NumLit, Apply, Unary, Binary, Compare, Member, SetLit, TupleLit, SeqLit, Quant,
-             StrLit, SeqRange, TupleQuant]
+             StrLit, SeqRange, TupleQuant, First]
 
 
 # --------------------------------------------------------------------------

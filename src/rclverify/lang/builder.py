@@ -329,6 +329,9 @@ class ToAst(Transformer[Token, Any]):
     def minus(self, c: list[Any]) -> ast.Unary:
         return ast.Unary("-", c[1], self._span(c))
 
+    def first_value(self, c: list[Any]) -> ast.First:
+        return ast.First(c[2], self._span(c))
+
     def abs_value(self, c: list[Any]) -> ast.Unary:
         return ast.Unary("abs", c[2], self._span(c))
 

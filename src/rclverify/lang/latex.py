@@ -154,6 +154,8 @@ class _Tex:
             return _number(e.text) + unit_to_latex(e.unit)
         if isinstance(e, ast.Apply):
             return f"{_var(e.func)}({self.items(e.args)})"
+        if isinstance(e, ast.First):
+            return rf"\mathit{{first}}({_var(e.arg)})"
         if isinstance(e, ast.Unary):
             if e.op == "not":
                 return r"\lnot " + self.expr(e.operand, NOT_LEVEL, open_right)

@@ -254,6 +254,8 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
         return e.text + unit_to_rcl(e.unit)
     if isinstance(e, ast.Apply):
         return f"{e.func.qualified}({p.items(e.args)})"
+    if isinstance(e, ast.First):
+        return f"first({e.arg.qualified})"
     if isinstance(e, ast.Unary):
         if e.op == "not":
             return "not " + p.wrap(e.operand, NOT_LEVEL)

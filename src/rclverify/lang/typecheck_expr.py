@@ -204,6 +204,29 @@ class ExprChecker:
             raise CheckFailed
         return self.var(e, node, bound)
 
+    def _first(self, e: ast.First, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
+        """``first(in.x)`` is a formula (BOOL) whose argument is an input of
+        the node (in a requirement, ``Node.in.x``); anything else is an
+        ``E-type`` error at the argument naming what it is (docs/semantics.md,
+        "The first published value")."""
+        v = e.arg
+        usage = "first(...) takes an input of the node: first(in.x) in a contract, first(Node.in.x) in a requirement"
+        if v.prefix is None and v.name in bound:
+            why = f"{v.name} is a bound variable, not an input"
+        elif node is not None and ".state." in v.name and v.name in node.inputs:
+            why = f"{v.name} is a state variable, which no node publishes"
+        elif node is not None and (v.prefix == "out" or (v.prefix is None and v.name in node.outputs
+                                                         and v.name not in node.inputs)):
+            why = f"{v.qualified} is an output; first(...) speaks of the messages a node receives"
+        elif node is not None and v.prefix != "out" and v.name in node.inputs:
+            self.var(v, node, bound)  # an input whose declaration failed reports nothing more
+            return BOOL
+        else:
+            self.var(v, node, bound)  # an unknown name: its own E-name error
+            why = f"{v.qualified} is not an input" if node is not None else "a context has no inputs"
+        self.err(v.loc, f"{usage}; {why}")
+        raise CheckFailed
+
     def _unary(self, e: ast.Unary, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:
         t = self.infer(e.operand, node, bound)
         if e.op == "not":
@@ -379,4 +402,5 @@ _RULES: dict[type, _Rule] = {
     ast.SetLit: ExprChecker._collection_lit, ast.SeqLit: ExprChecker._collection_lit,
     ast.TupleLit: ExprChecker._tuple_lit, ast.SeqRange: ExprChecker._seq_range,
     ast.TupleQuant: ExprChecker._tuple_quant, ast.Quant: ExprChecker._quant,
+    ast.First: ExprChecker._first,
 }

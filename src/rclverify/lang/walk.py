@@ -41,6 +41,7 @@ _CHILDREN: dict[type, Callable[[Any], Iterable[ast.Expr]]] = {
     ast.Member: lambda e: (e.elem, e.collection), ast.SetLit: lambda e: e.items,
     ast.SeqLit: lambda e: e.items, ast.TupleLit: lambda e: e.items, ast.Quant: _quant_children,
     ast.SeqRange: lambda e: (e.lo, e.hi), ast.TupleQuant: _tuple_quant_children,
+    ast.First: lambda e: (e.arg,),
 }
 
 
