@@ -103,7 +103,11 @@ class Apply:
     loc: Loc = loc_field()
 
 
-UnaryOp = Literal["not", "-", "abs"]
+UnaryOp = Literal["not", "-", "abs", "sqrt", "sin", "cos"]
+
+#: the mathematical functions of one real argument (``sqrt(t)``, ``sin(t)``, ``cos(t)``; radians), read as
+#: :class:`Unary` operators beside ``abs`` (docs/semantics.md, "Mathematical functions")
+MATH_FUNCTIONS: tuple[UnaryOp, ...] = ("sqrt", "sin", "cos")
 
 
 def unhandled(op: NoReturn) -> NoReturn:
@@ -118,7 +122,8 @@ def unhandled(op: NoReturn) -> NoReturn:
 
 @dataclass(frozen=True)
 class Unary:
-    """``not f``, ``- t`` or ``abs(t)`` (the absolute value)."""
+    """``not f``, ``- t``, ``abs(t)`` (the absolute value) or a mathematical
+    function of :data:`MATH_FUNCTIONS` (``sqrt(t)``, ``sin(t)``, ``cos(t)``)."""
 
     op: UnaryOp
     operand: "Expr"

@@ -335,6 +335,15 @@ class ToAst(Transformer[Token, Any]):
     def abs_value(self, c: list[Any]) -> ast.Unary:
         return ast.Unary("abs", c[2], self._span(c))
 
+    def sqrt_value(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("sqrt", c[2], self._span(c))
+
+    def sin_value(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("sin", c[2], self._span(c))
+
+    def cos_value(self, c: list[Any]) -> ast.Unary:
+        return ast.Unary("cos", c[2], self._span(c))
+
     def compare(self, c: list[Any]) -> ast.Compare:
         ops = cast("tuple[ast.CompareOp, ...]", tuple(str(t) for t in c[1::2]))
         return ast.Compare(ops, tuple(c[0::2]), self._span(c))

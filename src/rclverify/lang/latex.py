@@ -163,6 +163,9 @@ class _Tex:
                 return "-" + self.expr(e.operand, MINUS_LEVEL, open_right)
             if e.op == "abs":
                 return r"\lvert " + self.expr(e.operand, 0, False) + r" \rvert"
+            if e.op == "sqrt" or e.op == "sin" or e.op == "cos":
+                inner = self.expr(e.operand, 0, False)
+                return rf"\sqrt{{{inner}}}" if e.op == "sqrt" else rf"\{e.op}\left({inner}\right)"
             ast.unhandled(e.op)
         if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
             ops = chain_operands(e)

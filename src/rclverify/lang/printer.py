@@ -65,7 +65,7 @@ def level(e: ast.Expr) -> int:
             return NOT_LEVEL
         if e.op == "-":
             return MINUS_LEVEL
-        if e.op == "abs":
+        if e.op == "abs" or e.op == "sqrt" or e.op == "sin" or e.op == "cos":
             return ATOM_LEVEL
         ast.unhandled(e.op)
     if isinstance(e, (ast.Compare, ast.Member)):
@@ -262,8 +262,8 @@ def _expr(p: _Printer, e: ast.Expr) -> str:
         if e.op == "-":
             inner = p.wrap(e.operand, MINUS_LEVEL)
             return "-" + inner if not inner.startswith("-") else "- " + inner
-        if e.op == "abs":
-            return f"abs({p.wrap(e.operand, 0)})"
+        if e.op == "abs" or e.op == "sqrt" or e.op == "sin" or e.op == "cos":
+            return f"{e.op}({p.wrap(e.operand, 0)})"
         ast.unhandled(e.op)
     if isinstance(e, ast.Binary) and e.op in FLAT_CHAINS:
         ops = chain_operands(e)

@@ -237,6 +237,12 @@ class ExprChecker:
                 self.err(e.operand.loc, f"{'unary -' if e.op == '-' else 'abs'} needs a number, found {t}")
                 raise CheckFailed
             return REAL if t == REAL else INTEGER
+        # a real argument, a real value (docs/semantics.md, "Mathematical functions")
+        if e.op == "sqrt" or e.op == "sin" or e.op == "cos":
+            if not is_numeric(t):
+                self.err(e.operand.loc, f"{e.op} needs a number, found {t}")
+                raise CheckFailed
+            return REAL
         ast.unhandled(e.op)
 
     def _binary(self, e: ast.Binary, node: CheckedNode | None, bound: Mapping[str, Type]) -> Type:

@@ -31,7 +31,7 @@ KEYWORDS = ("context", "node", "inputs", "outputs", "topics", "matches", "assume
             "within", "services", "actions", "serves", "calls", "initially", "progress", "eventually", "periodic",
             "while", "ready", "of",
             "and", "or", "not", "in", "forall", "exists", "exists_unique", "TRUE", "FALSE", "REAL", "INTEGER",
-            "NATURAL", "BOOL", "STRING", "set", "seq", "upto")
+            "NATURAL", "BOOL", "STRING", "set", "seq", "upto", "first")
 
 _IO = re.compile(r"\b(in|out)\.\w*$")
 _UNIT = re.compile(r"\[[^\[\]]*$")
