@@ -55,8 +55,8 @@ def test_a_new_unary_operator_is_named_by_the_type_checker_at_every_translation(
     pytest.importorskip("mypy", reason="mypy is installed by the test setup (scripts/setup.sh --tests)")
     text = (SRC / "rclverify/lang/ast.py").read_text()
     shadow = tmp_path / "ast.py"
-    shadow.write_text(text.replace('UnaryOp = Literal["not", "-", "abs"]',
-                                   'UnaryOp = Literal["not", "-", "abs", "sgn"]'))
+    shadow.write_text(text.replace('UnaryOp = Literal["not", "-", "abs", "sqrt", "sin", "cos"]',
+                                   'UnaryOp = Literal["not", "-", "abs", "sqrt", "sin", "cos", "sgn"]'))
     assert shadow.read_text() != text
     cache = tmp_path / "cache"
     if (SRC.parent / ".mypy_cache").is_dir():  # the project's own run's cache (CI runs mypy first): a warm start

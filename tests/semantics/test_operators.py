@@ -36,7 +36,7 @@ def _numbers(rng: random.Random, n: int) -> list[Any]:
 
 def test_the_table_is_complete() -> None:
     assert set(OPERATORS) == {"<=>", "->", "or", "and", "+", "-", "*", "/", "==", "!=", "<", "<=", ">", ">="}
-    assert set(UNARY) == {"not", "-", "abs"}
+    assert set(UNARY) == {"not", "-", "abs", "sqrt", "sin", "cos"}
     assert CONNECTIVES | COMPARISONS | ARITHMETIC == set(OPERATORS)
 
 

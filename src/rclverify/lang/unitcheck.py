@@ -34,6 +34,7 @@ scale and same offset, :class:`~rclverify.lang.units.Unit`):
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Callable, Mapping, cast
@@ -41,7 +42,7 @@ from typing import Callable, Mapping, cast
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import CheckedNode, Scalar, Type, is_numeric
-from rclverify.lang.units import BASE_DIMENSIONS, Unit, UnitError, best_name, describe, dimension_name, factor_text, parse_unit
+from rclverify.lang.units import BASE_DIMENSIONS, ONE, Unit, UnitError, best_name, describe, dimension_name, factor_text, parse_unit
 from rclverify.lang.printer import level, is_type
 from rclverify.lang.units import ratio
 
@@ -210,6 +211,8 @@ class UnitChecker:
                 return Q(q.kind, q.unit, e)
             if e.op == "not":
                 return UNKNOWN
+            if e.op == "sqrt" or e.op == "sin" or e.op == "cos":
+                return self.math(e, q)
             ast.unhandled(e.op)
         if isinstance(e, ast.Binary):
             a, b = self.term(e.left, node, bound), self.term(e.right, node, bound)
@@ -276,6 +279,37 @@ class UnitChecker:
             return Q("unit", self.constants[v.name], v)
         return UNKNOWN
 
+    def math(self, e: ast.Unary, q: Q) -> Q:
+        """``sqrt``: each dimension's exponent halved (an odd exponent, a scale
+        that is no rational square or an affine unit is ``E-unit-dimension``);
+        ``sin``/``cos``: a dimensionless or ``[rad]`` argument (another angle
+        unit ``E-unit-scale`` with the factor, any other dimension
+        ``E-unit-dimension``), a dimensionless value."""
+        u = q.unit if q.kind == "unit" else None
+        if e.op == "sqrt":
+            if q.kind == "number":
+                return Q("number", None, e)
+            if u is None:
+                return UNKNOWN
+            root = _square_root(u)
+            if root is None:
+                self.err(e.operand.loc, f"sqrt of {_show(e.operand)} in {describe(u)}: the unit has no square root "
+                                        f"(an odd exponent, an affine scale or a scale that is no rational square)",
+                         "E-unit-dimension")
+                return UNKNOWN
+            name = best_name(root)
+            return Q("unit", Unit(root.dims, root.factor, root.pi, None, name or f"sqrt({u.text})"), e)
+        if u is not None and u.dims != ONE.dims:
+            rad = parse_unit("rad")
+            if u.dims == rad.dims:
+                if u != rad:
+                    self.err(e.operand.loc, f"{e.op} takes radians; {_show(e.operand)} is {describe(u)}: "
+                                            f"{factor_text(u, rad)}; convert it to [rad]", "E-unit-scale")
+            else:
+                self.err(e.operand.loc, f"{e.op} takes a dimensionless or [rad] argument; {_show(e.operand)} is "
+                                        f"{describe(u)}", "E-unit-dimension")
+        return Q("number", None, e)
+
     def product(self, e: ast.Binary, a: Q, b: Q) -> Q:
         for side, q in ((e.left, a), (e.right, b)):
             if q.kind == "unit" and q.unit is not None and q.unit.offset is not None:
@@ -298,6 +332,17 @@ class UnitChecker:
         assert u is not None
         name = best_name(u)  # [mm/m]*[m] is shown as [mm]
         return Q("unit", Unit(u.dims, u.factor, u.pi, u.offset, name) if name else u, e)
+
+
+def _square_root(u: Unit) -> Unit | None:
+    """The unit whose square is ``u``, or ``None`` (an odd exponent, an odd
+    power of pi, an affine unit or a factor that is no rational square)."""
+    if u.offset is not None or u.pi % 2 or any(d % 2 for d in u.dims):
+        return None
+    n, d = math.isqrt(u.factor.numerator), math.isqrt(u.factor.denominator)
+    if n * n != u.factor.numerator or d * d != u.factor.denominator:
+        return None
+    return Unit(tuple(k // 2 for k in u.dims), Fraction(n, d), u.pi // 2, None)
 
 
 def _conversion(a: Q, b: Q) -> str:

@@ -1,7 +1,8 @@
 """The well-definedness conditions of an RCL formula, generated from the semantics table.
 
-A formula that applies a partial operator outside its domain (RCL's one
-partial operator is ``/``: a zero divisor) has no truth value: the
+A formula that applies a partial operator outside its domain (RCL's
+partial operators are ``/``, a zero divisor, and ``sqrt``, a negative
+argument) has no truth value: the
 reference evaluator raises :class:`~rclverify.semantics.operators.Undecided`,
 the property tests and monitors cannot decide it, and a proof must not
 discharge it.  Z3 reads ``x / 0`` as an unspecified total function, so a
@@ -13,8 +14,10 @@ specifications"; Why3's ``div`` precondition; SPARK's division check,
 "Run-time checks" of the SPARK user's guide):
 
 * every application of a partial operator (:attr:`Operator.partial` in
-  :data:`~rclverify.semantics.operators.OPERATORS`) gives one condition:
-  the restricted operand differs from the excluded value (``d != 0``);
+  :data:`~rclverify.semantics.operators.OPERATORS` and
+  :data:`~rclverify.semantics.operators.UNARY`) gives one condition:
+  the restricted operand differs from the excluded value (``d != 0``), or
+  for ``sqrt`` is at least 0 (``in.a >= 0``);
 * a condition holds under the guards that precede it: the connectives are
   read left to right with their short circuit
   (:attr:`Operator.decisive`): in ``a and b`` and ``a -> b`` the right
@@ -41,7 +44,7 @@ division written inside a clause is a problem of that clause
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
+from typing import Union, cast
 
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, error
@@ -49,7 +52,7 @@ from rclverify.lang.printer import expr_to_rcl, is_type
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import children, subexpressions
 from rclverify.semantics.evaluator import Evaluator
-from rclverify.semantics.operators import OPERATORS, Operator, Undecided
+from rclverify.semantics.operators import OPERATORS, UNARY, Operator, Undecided
 from rclverify.semantics.values import render
 
 #: what a condition is read under: a guard formula, or a quantifier whose variables it holds for
@@ -85,7 +88,8 @@ class Condition:
 
     def describe(self) -> str:
         """One phrase for messages: ``the division at f.rcl:3:9 needs in.d != 0``."""
-        return f"the {OPERATORS[self.op].name} at {self.where} needs {self.text}"
+        entry = UNARY[self.op] if self.op in UNARY and self.op not in OPERATORS else OPERATORS[self.op]
+        return f"the {entry.name} at {self.where} needs {self.text}"
 
 
 def right_guard(entry: Operator, left: ast.Expr) -> ast.Expr | None:
@@ -135,6 +139,14 @@ def _walk(e: ast.Expr, frames: tuple[Frame, ...], out: list[Condition]) -> None:
         if not is_type(e.domain):
             _walk(e.domain, frames, out)  # type: ignore[arg-type]
         _walk(e.body, (*frames, e), out)
+        return
+    if isinstance(e, ast.Unary):
+        _walk(e.operand, frames, out)
+        p = UNARY[e.op].partial
+        if p is not None:
+            cmp = cast(ast.CompareOp, p.relation)
+            requires = ast.Compare((cmp,), (e.operand, ast.NumLit(str(p.excluded), e.loc)), e.loc)
+            out.append(Condition(e.op, p.failure, e.loc, requires, _close(requires, frames)))
         return
     for c in children(e):
         _walk(c, frames, out)

@@ -1,8 +1,9 @@
 """The semantics table: one entry per RCL operator giving its meaning.
 
 RCL's operators (docs/rcl-language.md; the connectives and arithmetic of
-the paper's EBNF, shared/reference lines 499-555) are ``not``, unary ``-``
-and ``abs(t)`` (an extension: the absolute value),
+the paper's EBNF, shared/reference lines 499-555) are ``not``, unary ``-``,
+``abs(t)`` (an extension: the absolute value), ``sqrt(t)``, ``sin(t)`` and
+``cos(t)`` (extensions: the mathematical functions, radians),
 ``and or -> <=>``, ``== != < <= > >=`` and ``+ - * /``.  Each has ONE
 :class:`Operator` entry in :data:`OPERATORS` (binary) or :data:`UNARY`;
 every evaluator and compiler reads its operator's meaning from that entry
@@ -36,7 +37,8 @@ instead of restating it:
   conditions every proof path proves are generated from it
   (:mod:`rclverify.semantics.definedness`), with the connectives'
   short circuit (:attr:`Operator.decisive`) as their guards.  Division is
-  RCL's only partial operator: RCL has no modulo and no sequence indexing
+  RCL's only partial binary operator and ``sqrt`` (an argument below 0) its
+  only partial unary one: RCL has no modulo and no sequence indexing
   (docs/semantics.md, "Definedness").
 * :attr:`Operator.identity` is the neutral element (``and`` TRUE, ``+`` 0, ...)
   when there is one; :attr:`Operator.converse` and :attr:`Operator.negation`
@@ -68,11 +70,15 @@ class Partial:
     (0 the left, 1 the right) must differ from ``excluded``; ``failure``
     names what happens otherwise (``"division by zero"``).  The condition
     is Why3's, Dafny's and SPARK's for the operator (their ``div``/``/``
-    checks: the divisor is not zero)."""
+    checks: the divisor is not zero); ``relation`` ``">="`` states the
+    domain of ``sqrt`` (its argument is at least 0: C's and Python's ``sqrt``
+    domain, a NaN or ``ValueError`` outside it)."""
 
     operand: int
     excluded: int
     failure: str
+    #: how the operand must relate to ``excluded``: ``"!="`` (a divisor), ``">="`` (``sqrt``'s argument)
+    relation: str = "!="
 
 
 @dataclass(frozen=True)
@@ -143,6 +149,50 @@ def _double_div(x: Any, y: Any) -> Any:
     return x / y
 
 
+def _exact_math(fn: Callable[[float], float], name: str) -> Callable[[Any], Any]:
+    """A mathematical function's exact-reading meaning: exact where the value is
+    rational (``sqrt`` of a rational square, ``sin(0)``, ``cos(0)``), else the
+    binary64 value of Python's ``math`` taken as the rational it denotes (no
+    real number of the result is representable: docs/semantics.md,
+    "Mathematical functions"); outside the domain :class:`Undecided`."""
+    def meaning(x: Any) -> Any:
+        x = _exact_number(x)
+        if name == "sqrt":
+            if x < 0:
+                raise Undecided("square root of a negative number")
+            q = Fraction(x)
+            n, d = math.isqrt(q.numerator), math.isqrt(q.denominator)
+            if n * n == q.numerator and d * d == q.denominator:
+                return Fraction(n, d)
+        elif x == 0:
+            return Fraction(0) if name == "sin" else Fraction(1)
+        return Fraction(_double_math(fn, name)(x))
+    return meaning
+
+
+def _double_math(fn: Callable[[float], float], name: str) -> Callable[[Any], Any]:
+    """A mathematical function on the double a ROS node holds (Python's
+    ``math``, i.e. the C library's ``sqrt``/``sin``/``cos``): a negative
+    ``sqrt`` argument is :class:`Undecided` (C gives NaN, Python raises), as is
+    ``sin``/``cos`` of an infinity; a NaN argument gives NaN."""
+    def meaning(x: Any) -> Any:
+        v = float(x)
+        if name == "sqrt" and v < 0:
+            raise Undecided("square root of a negative number")
+        try:
+            return fn(v)
+        except (ValueError, OverflowError):
+            raise Undecided(f"{name} of {v!r}") from None
+    return meaning
+
+
+def _math_entry(name: str, fn: Callable[[float], float], word: str, partial: Partial | None = None) -> Operator:
+    python = (f"(math.sqrt({{x}}) if {{x}} >= 0 else _undecided({partial.failure!r}))" if partial is not None
+              else f"math.{name}({{x}})")
+    return Operator(name, word, "arithmetic", 1, _exact_math(fn, name), _double_math(fn, name), python=python, cpp=f"std::{name}({{x}})", z3=None, numpy=name, smtlib=None,
+                    partial=partial)
+
+
 def _double_cmp(raw: Callable[[Any, Any], bool]) -> Callable[[Any, Any], bool]:
     def meaning(x: Any, y: Any) -> bool:  # _double_number inlined
         return bool(raw(float(x) if type(x) is Fraction else x, float(y) if type(y) is Fraction else y))
@@ -211,6 +261,11 @@ UNARY: Mapping[str, Operator] = {
     # SMT-LIB's ``abs`` is of the Ints theory only, so the solvers get ``ite`` (targets/smtlib.py, semantics/translate.py)
     "abs": Operator("abs", "absolute value", "arithmetic", 1, abs, abs, python="abs({x})",
                     cpp="std::abs({x})", z3=None, numpy="absolute", smtlib=None),
+    # the mathematical functions (docs/semantics.md, "Mathematical functions"): Z3 reads them as uninterpreted
+    # functions with true facts (semantics/mathfacts.py); sqrt is partial: its argument must be >= 0
+    "sqrt": _math_entry("sqrt", math.sqrt, "square root", Partial(0, 0, "square root of a negative number", ">=")),
+    "sin": _math_entry("sin", math.sin, "sine"),
+    "cos": _math_entry("cos", math.cos, "cosine"),
 }
 
 CONNECTIVES = frozenset(s for s, o in OPERATORS.items() if o.kind == "connective")

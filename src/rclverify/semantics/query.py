@@ -10,7 +10,10 @@ Every query:
   from the one the budget finds);
 * maps Z3's answer to the tool's verdicts without ever upgrading an
   ``unknown``: validity -> ``proved`` (negation unsat) / ``refuted`` (sat,
-  with a model) / ``inconclusive`` (unknown or timeout); satisfiability ->
+  with a model) / ``inconclusive`` (unknown or timeout); a query applying
+  ``sqrt``/``sin``/``cos`` gets their facts, and a model reading ``sin``/``cos``
+  as unknown functions counts only when :func:`.mathfacts.unconfirmed`
+  confirms it (else ``inconclusive`` with the reason); satisfiability ->
   ``sat`` (with a model) / ``unsat`` (with an unsat core of the labelled
   formulas) / ``inconclusive``;
 * keeps its SMT-LIB2 text so a second solver can re-check it
@@ -32,7 +35,7 @@ from rclverify.semantics.encode import Encoder, term_to_rcl, value_to_rcl
 from rclverify.semantics.functable import finite_table
 from rclverify.semantics.retry import (DEFAULT, TABLES, attempts, bounded_solver, load_canonical, reasons_text, retry_order,
                     strategy_solver, variants)
-from rclverify.semantics import wallclock
+from rclverify.semantics import mathfacts, wallclock
 from rclverify.semantics.wallclock import STEPS_PER_MS as STEPS_PER_MS, check, cut_reason, steps as steps
 
 DEFAULT_TIMEOUT_MS = 10_000
@@ -237,11 +240,13 @@ def prove(goal: z3.BoolRef, hypotheses: Sequence[z3.BoolRef], enc: Encoder | Non
     order ``likely_sat`` gives (not asked again when it is the same search).
     """
     hyps = list(hypotheses) + (enc.axioms() if enc else [])
-    formulas = hyps + [z3.Not(goal)]
+    stated = hyps + [z3.Not(goal)]
+    formulas = stated + mathfacts.facts(stated)
     script = smt2_script(formulas, comment or "validity query: unsat means the goal follows from the hypotheses")
     ladder = first_ms is not None and (deterministic or not _SESSIONS)
     q = _Validity(formulas, script, enc, deterministic, timeout_ms)
     q.models = models
+    q.confirm = stated if mathfacts.transcendental(stated) else None
     with ExitStack() as scope:
         if ladder or deterministic:
             s = q.default(first_ms if ladder else None)
@@ -288,6 +293,8 @@ class _Validity:
         self.formulas, self.script, self.enc = formulas, script, enc
         self.deterministic, self.timeout_ms = deterministic, timeout_ms
         self.models = True  # render a refuting model (prove's ``models``)
+        #: the stated formulas a refuting model must be confirmed on (:func:`.mathfacts.unconfirmed`), or ``None``
+        self.confirm: list[z3.BoolRef] | None = None
         self.t0 = time.perf_counter()
 
     def elapsed(self) -> float:
@@ -299,6 +306,10 @@ class _Validity:
         retry that gave it), or ``None`` when ``r`` is unknown."""
         if r == z3.unsat:
             return QueryResult("proved", self.script, self.elapsed(), strategy=strategy)
+        if r == z3.sat and self.confirm is not None:
+            why = mathfacts.unconfirmed(self.confirm, s.model())
+            if why is not None:
+                return QueryResult("inconclusive", self.script, self.elapsed(), reason=why, strategy=strategy)
         if r == z3.sat:
             return QueryResult("refuted", self.script, self.elapsed(),
                                model=render_model(s.model(), self.enc) if self.models else None,
@@ -327,6 +338,9 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
     (the encoder's typing axioms are unlabelled background).
     """
     background = enc.axioms() if enc else []
+    stated = background + [f for _, f in labelled]
+    confirm = stated if mathfacts.transcendental(stated) else None
+    background = background + mathfacts.facts(stated)
     with query_solver(timeout_ms, cores=True) as s:
         s.add(*background)
         trackers = {}
@@ -341,6 +355,8 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
         script = smt2_script(background + [f for _, f in labelled], comment or "satisfiability query")
         if wallclock.cuts() != seen:  # the clock, not the budget: no retry may answer in its place
             return QueryResult("inconclusive", script, dt, reason=cut_reason())
+        if r == z3.sat and confirm is not None and (why := mathfacts.unconfirmed(confirm, s.model())) is not None:
+            return QueryResult("inconclusive", script, dt, reason=why)
         if r == z3.sat:
             return QueryResult("sat", script, dt, model=render_model(s.model(), enc))
         if r == z3.unsat:
@@ -358,6 +374,8 @@ def satisfiable(labelled: Sequence[tuple[str, z3.BoolRef]], enc: Encoder | None 
                 dt = round(time.perf_counter() - t0, 4)
                 if wallclock.cuts() != seen:
                     return QueryResult("inconclusive", script, dt, reason=cut_reason())
+                if r == z3.sat and confirm is not None and (why := mathfacts.unconfirmed(confirm, s2.model())):
+                    return QueryResult("inconclusive", script, dt, reason=why, strategy=name)
                 if r == z3.sat:
                     return QueryResult("sat", script, dt, model=render_model(s2.model(), enc), strategy=name)
                 if r == z3.unsat:

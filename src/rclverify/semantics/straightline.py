@@ -233,6 +233,8 @@ class _Gen(Visitor[str]):
         return f"_call(({args}), {self.var(f)}, {f.qualified!r})"
 
     def visit_Unary(self, e: ast.Unary) -> str:
+        if e.op == "sqrt" or e.op == "sin" or e.op == "cos":  # the table's exact meaning itself (no Python operator)
+            return f"{self.const(UNARY[e.op].exact)}({self.expr(e.operand)})"
         return cast(str, UNARY[e.op].python).format(x=self.expr(e.operand))
 
     def visit_Binary(self, e: ast.Binary) -> str:

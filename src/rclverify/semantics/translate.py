@@ -22,6 +22,7 @@ from rclverify.lang.typecheck import domain_type
 from rclverify.lang.visit import Visitor
 from rclverify.lang.types import BOOL, NATURAL, CheckedNode, EmptyT, FuncT, Scalar, TupleT, Type, qualified_base
 from rclverify.semantics.connectives import conj, disj
+from rclverify.semantics.mathfacts import math_function
 from rclverify.semantics.sorts import _join_sort, _tuple_fields, apply_operator, coerce, sort_of, tuple_sort, widen
 from rclverify.semantics.symbols import EncodingError, smt_symbol
 
@@ -34,13 +35,17 @@ def unary_z3(op: ast.UnaryOp, v: Any) -> Any:
     """The Z3 term of unary operator ``op`` applied to ``v`` (a ``z3`` Bool for
     ``not``, an arithmetic term otherwise): ``Not``, ``-v``, ``If(v >= 0, v, -v)``
     (docs/rcl-language.md; the one Z3 reading of a unary operator, the
-    experiment criterion's too)."""
+    experiment criterion's too); ``sqrt``, ``sin``, ``cos`` the uninterpreted
+    function of :func:`~rclverify.semantics.mathfacts.math_function` applied
+    to ``v`` as a real (their facts: :mod:`rclverify.semantics.mathfacts`)."""
     if op == "not":
         return z3.Not(v)
     if op == "-":
         return -v
     if op == "abs":
         return z3.If(v >= 0, v, -v)
+    if op == "sqrt" or op == "sin" or op == "cos":
+        return math_function(op)(z3.ToReal(v) if z3.is_int(v) else v)
     ast.unhandled(op)
 
 
@@ -110,6 +115,13 @@ class _Ctx(Visitor[Any]):
         if z3.is_array(fn):  # a function-typed variable given as an array (a step of calculus/requirements/transition.py)
             return z3.Select(fn, *[widen(a, fn.sort().domain_n(k)) for k, a in enumerate(args)])
         raise EncodingError(x.loc, f"{f.qualified} cannot be applied")
+
+    def visit_First(self, x: ast.First, b: Mapping[str, z3.ExprRef]) -> Any:
+        """``first(in.x)``: the term the caller gives as ``first(in.x)`` (a state's flag in the requirements'
+        transition system), else the query's free Boolean of that input (:meth:`Encoder.first_symbol`)."""
+        key = f"first(in.{x.arg.name})"
+        given = self.symbols.get(key)
+        return given if given is not None else self.e.first_symbol(self.node, x.arg.name)
 
     def visit_Unary(self, x: ast.Unary, b: Mapping[str, z3.ExprRef]) -> Any:
         return unary_z3(x.op, self.enc(x.operand, b))

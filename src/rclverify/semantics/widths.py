@@ -366,7 +366,12 @@ class _AtWidths(Transformer):
             return self.value(self.constants[e.name][1], width, frozenset(), (*seen, e.name))
         elif isinstance(e, ast.Unary) and e.op != "not":
             x = self.value(e.operand, width, bound, seen)
-            return None if x is None else Fraction(UNARY[e.op].exact(x))  # exact at every width
+            if x is None or e.op == "-" or e.op == "abs":
+                return None if x is None else Fraction(UNARY[e.op].exact(x))  # exact at every width
+            try:  # sqrt, sin, cos: rounded to the width below
+                v = Fraction(UNARY[e.op].exact(x))
+            except Undecided:
+                return None
         elif isinstance(e, ast.Binary) and OPERATORS[e.op].kind == "arithmetic":
             x, y = self.value(e.left, width, bound, seen), self.value(e.right, width, bound, seen)
             if x is None or y is None:

@@ -93,6 +93,8 @@ def _term(e: ast.Expr, node: CheckedNode, symbol: Mapping[tuple[str, str], str],
             return f"(- {inner})"
         if e.op == "abs":  # SMT-LIB's abs is of the Ints theory only: one ite for both sorts
             return f"(ite (>= {inner} 0) {inner} (- {inner}))"
+        if e.op == "sqrt" or e.op == "sin" or e.op == "cos":  # no SMT-LIB theory symbol: the encoder's facts
+            raise Outside
         ast.unhandled(e.op)
     if isinstance(e, ast.Binary):
         op = OPERATORS[e.op].smtlib  # the semantics table's SMT-LIB symbol (semantics/operators.py)

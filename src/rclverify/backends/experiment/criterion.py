@@ -83,6 +83,9 @@ def dimension(expr: ast.Expr, dims: Mapping[str, str]) -> str:
                 want = "bool"
             elif e.op == "-" or e.op == "abs":
                 want = inner
+            elif e.op == "sqrt" or e.op == "sin" or e.op == "cos":
+                raise CriterionError(e.loc, f"{e.op} is not part of an experiment criterion (a comparison of "
+                                            f"measured quantities with + - * / and abs)")
             else:
                 ast.unhandled(e.op)
             if (e.op == "not") != (inner == "bool"):

@@ -53,8 +53,8 @@ def _plain(e: ast.Expr) -> bool:
     """Quantifier-free, division-free, function-free scalar formula?"""
     if isinstance(e, (ast.BoolLit, ast.NumLit, ast.Var)):
         return True
-    if isinstance(e, ast.Unary):
-        return _plain(e.operand)
+    if isinstance(e, ast.Unary):  # sqrt/sin/cos: functions
+        return e.op in ("not", "-", "abs") and _plain(e.operand)
     if isinstance(e, ast.Binary):
         return e.op in _OPS and _plain(e.left) and _plain(e.right)
     if isinstance(e, ast.Compare):

@@ -118,6 +118,10 @@ class CppTranslator(Visitor[tuple[str, str]]):
             if kind not in ("int", "double"):
                 raise Untranslatable(f"{UNARY[e.op].name} on {kind}")
             return text.format(x=code), kind
+        if e.op == "sqrt" or e.op == "sin" or e.op == "cos":  # <cmath> on a double; a negative sqrt gives NaN
+            if kind not in ("int", "double"):
+                raise Untranslatable(f"{UNARY[e.op].name} on {kind}")
+            return text.format(x=f"static_cast<double>({code})"), "double"
         ast.unhandled(e.op)
 
     def visit_Binary(self, e: ast.Binary) -> tuple[str, str]:

@@ -44,7 +44,7 @@ from typing import Any, Mapping, cast
 from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
 from rclverify.lang import typeexpr
-from rclverify.semantics.operators import OPERATORS
+from rclverify.semantics.operators import OPERATORS, UNARY
 from rclverify.semantics.widths import at_widths
 from rclverify.lang.errors import error
 from rclverify.lang.printer import is_type
@@ -205,6 +205,9 @@ class Translator:
             if e.op == "abs":
                 zero = "0.0" if t == REAL else "0"
                 return f"(if {wrap(s)} >= {zero} then {wrap(s)} else -{wrap(s)})", (REAL if t == REAL else INTEGER)
+            if e.op == "sqrt" or e.op == "sin" or e.op == "cos":
+                raise self._err(e.loc, f"{e.op} has no Dafny counterpart (Dafny's reals have no {UNARY[e.op].name}); "
+                                       f"the obligation is left to the Z3 calculus")
             ast.unhandled(e.op)
         if isinstance(e, ast.Binary):
             return self.binary(e, scope)
