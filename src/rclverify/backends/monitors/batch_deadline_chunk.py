@@ -1,0 +1,221 @@
+"""One chunk of a run judged by the batch deadline judge, or declined (:mod:`.batch_deadlines`:
+what a clean chunk is, in what order its verdicts are given, the state it leaves)."""
+from __future__ import annotations
+
+from operator import attrgetter
+from typing import TYPE_CHECKING, Callable
+
+from rclverify.core.numeric import np
+
+from rclverify.traces.events import Event
+from rclverify.targets.column_deadlines import expiries, first_answers, ns_column
+from rclverify.targets.columns import column, field_values
+from rclverify.backends.monitors.deadline_records import Pending
+from rclverify.backends.monitors.time_margins import TimeMargin
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.batch_deadlines import BatchDeadlines
+
+_FIELDS, _TIME, _TOPIC = attrgetter("fields"), attrgetter("time"), attrgetter("topic")
+
+
+def _headed(fields: list[object]) -> bool:
+    """Whether a message carries a header stamp (the monitor's clock would read it)."""
+    for f in fields:
+        if "header" in f or "header.stamp.secs" in f or "header.stamp.sec" in f:  # type: ignore[operator]
+            return True
+    return False
+
+
+def judge_chunk(mon: BatchDeadlines, evs: list[Event]) -> bool:
+    """Judge the events ``evs`` as the streaming monitor would, over columns, and leave its state;
+    ``False`` (nothing changed) when the chunk is not clean."""
+    plan = mon.plan
+    n = len(evs)
+    fields = list(map(_FIELDS, evs))
+    if _headed(fields):
+        return False
+    topics = list(map(_TOPIC, evs))
+    lut = {t: plan.kind_of(t) for t in set(topics)}
+    kind = np.fromiter(map(lut.__getitem__, topics), np.int8, n)
+    ns = ns_column(np.fromiter(map(_TIME, evs), np.float64, n))
+    if ns is None or bool((kind == 2).any()) or (n > 1 and bool((np.diff(ns) < 0).any())) or \
+            (mon.now_ns is not None and int(ns[0]) < mon.now_ns):
+        return False
+    in_rows, out_rows = np.flatnonzero(kind == 1), np.flatnonzero(kind == -1)
+    ik, ok = plan.in_key, plan.out_key
+    good_in, col_in = column(field_values(fields, in_rows, plan.in_field), plan.in_kind, plan.codes.get(ik, {}))
+    good_out, col_out = column(field_values(fields, out_rows, plan.out_field), plan.out_kind,
+                               plan.codes.get(ok, {}))
+    if not (bool(good_in.all()) and bool(good_out.all())):
+        return False
+    accepted = np.ones(len(in_rows), dtype=bool)
+    for a in plan.assumptions:
+        truth, sure = a({ik: col_in})
+        if not bool(np.broadcast_to(sure, accepted.shape).all()):
+            return False
+        accepted &= np.broadcast_to(truth, accepted.shape)
+    refused = in_rows[~accepted]
+    first_refused = None
+    if refused.size and mon.result.first_unaccepted is None:
+        first_refused = mon._refused({ik: mon.mapped(evs[int(refused[0])], ik)})
+        if first_refused is None or first_refused[0] != "assumption violated":
+            return False
+    # the obligations: the expired ones kept (oldest expiry first), the open ones, then each accepted trigger's
+    carried_exp, carried_open = list(mon.expired), list(mon.pending)
+    carried = carried_exp + carried_open
+    seeds = [plan.seed(ik, p.inputs.get(ik)) for p in carried]
+    if any(s is None for s in seeds):
+        return False
+    T, L0 = len(plan.timed), len(carried_exp)
+    acc_rows = in_rows[accepted]
+    rows = np.concatenate([np.full(len(carried), -1, dtype=np.int64), np.repeat(acc_rows, T)])
+    which = np.concatenate([np.array([plan.place[p.k] for p in carried], dtype=np.int64),
+                            np.tile(np.arange(T, dtype=np.int64), len(acc_rows))])
+    bounds = np.array([b for _, b, _, _ in plan.timed], dtype=np.int64)
+    stamp = np.concatenate([np.array([p.stamp_ns for p in carried], dtype=np.int64), ns[rows[len(carried):]]])
+    due = np.concatenate([np.array([p.due_ns for p in carried], dtype=np.int64),
+                          stamp[len(carried):] + bounds[which[len(carried):]]])
+    inputs = np.concatenate([np.array(seeds, dtype=col_in.dtype), np.repeat(col_in[accepted], T)])
+    answer = first_answers(rows, out_rows, which, inputs, col_out, [j for _, _, _, j in plan.timed], ik, ok)
+    if answer is None:
+        return False
+    m = len(rows)
+    expiry = expiries(ns, due)
+    is_open = np.arange(m) >= L0
+    met = is_open & (answer >= 0) & ((expiry >= n) | (answer <= expiry))
+    lapsed = is_open & ~met & (expiry < n)
+    late = (~is_open | lapsed) & (answer >= 0)
+    order = np.arange(m) - L0  # an open obligation's place in the monitor's list (the expired: below 0)
+    # each verdict as (row, phase, place): late answers of expired obligations (0), answers (1), expiries (2)
+    ev_at = np.concatenate([answer[late], answer[met], expiry[lapsed]])
+    ev_phase = np.concatenate([np.zeros(int(late.sum()), np.int64), np.ones(int(met.sum()), np.int64),
+                               np.full(int(lapsed.sum()), 2, np.int64)])
+    queue = np.where(is_open, expiry * (m + 1) + order + 1, order)  # the expired list's order
+    ev_place = np.concatenate([queue[late], order[met], order[lapsed]])
+    ev_ob = np.concatenate([np.flatnonzero(late), np.flatnonzero(met), np.flatnonzero(lapsed)])
+    sort = np.lexsort((ev_place, ev_phase, ev_at))
+    ev_at, ev_phase, ev_ob = ev_at[sort], ev_phase[sort], ev_ob[sort]
+    step = np.where(ev_phase == 2, 1, np.where(ev_phase == 0, -1, 0))
+    held = L0 + np.cumsum(step)
+    if held.size and int(held[ev_phase == 2].max(initial=0)) > (mon.expired.maxlen or 0):
+        return False  # the monitor would drop an expired obligation: its own judging
+    _apply(mon, evs, ns, rows, which, due, out_rows, carried, L0, answer, expiry, met, lapsed,
+           (ev_at, ev_phase, ev_ob), refused, first_refused)
+    return True
+
+
+def _apply(mon: BatchDeadlines, evs: list[Event], ns: np.ndarray, rows: np.ndarray, which: np.ndarray,
+           due: np.ndarray, out_rows: np.ndarray, carried: list[Pending], L0: int, answer: np.ndarray,
+           expiry: np.ndarray, met: np.ndarray, lapsed: np.ndarray,
+           verdicts: tuple[np.ndarray, np.ndarray, np.ndarray], refused: np.ndarray,
+           first_refused: tuple[str, str] | None) -> None:
+    """Give a clean chunk's verdicts in order and leave the monitor's state (module docstring of
+    :mod:`.batch_deadlines`)."""
+    plan, result = mon.plan, mon.result
+    ik, ok = plan.in_key, plan.out_key
+    n, T, C = len(evs), len(plan.timed), len(carried)
+    if refused.size:
+        result.unaccepted["assumption violated"] += int(refused.size) * T
+        if first_refused is not None:
+            r = int(refused[0])
+            result.first_unaccepted = {"guarantee": plan.timed[0][0], "where": evs[r].where, "stamp": int(ns[r]) / 1e9,
+                                       "why": first_refused[0], "reason": first_refused[1]}
+    made: dict[int, Pending] = {}
+    trig_inputs: dict[int, dict[str, object]] = {}
+
+    def ob(i: int) -> Pending:
+        """Obligation ``i`` as the monitor's record (a trigger's made when first needed)."""
+        if i < C:
+            return carried[i]
+        p = made.get(i)
+        if p is None:
+            r = int(rows[i])
+            got = trig_inputs.get(r)
+            if got is None:
+                got = trig_inputs[r] = {ik: mon.mapped(evs[r], ik)}
+            k, bound, _, _ = plan.timed[int(which[i])]
+            s = int(ns[r])
+            p = made[i] = Pending(k, evs[r], s / 1e9, (s + bound) / 1e9, got, stamp_ns=s, due_ns=s + bound)
+        return p
+
+    def last_output(i: int, upto: int) -> int:
+        """The last output row after obligation ``i``'s row and at or before row ``upto`` (-1: none)."""
+        j = int(np.searchsorted(out_rows, upto, side="right")) - 1
+        return int(out_rows[j]) if j >= 0 and int(out_rows[j]) > int(rows[i]) else -1
+
+    quiet = mon.on_verdict is None
+    trues = 0
+    at, phase, obs = verdicts
+    for r, ph, i in zip(at.tolist(), phase.tolist(), obs.tolist()):
+        if ph == 1:
+            a = int(ns[r])
+            if quiet and a <= int(due[i]):
+                trues += 1
+                continue
+            mon._emit(mon.answered_verdict(ob(i), a, evs[r], plan.timed[int(which[i])][2]))
+        elif ph == 0:
+            mon._emit(mon.late_verdict(ob(i), int(ns[r]), evs[r]))
+        else:
+            p = ob(i)
+            j = last_output(i, r)
+            if j >= 0 and plan.timed[int(which[i])][3] is not None:
+                p.rejected = mon.rejection(p.k, p.inputs, ok, evs[j])
+            mon._emit(mon.expired_verdict(p, int(ns[r])))
+    result.counts["true"] += trues
+    _note_margins(mon, evs, ns, which, due, ob, verdicts)
+    # the state: the open obligations left (in order), the expired ones not answered (in the expired list's order)
+    last_out = int(out_rows[-1]) if out_rows.size else -1
+    out_value = mon.mapped(evs[last_out], ok) if last_out >= 0 else None
+    every = np.arange(len(rows))
+    still = np.flatnonzero((every >= L0) & ~met & (expiry >= n))
+    gone = np.flatnonzero((answer < 0) & (lapsed | (every < L0)))
+    keyed = sorted(gone.tolist(), key=lambda i: (-1, i) if i < L0 else (int(expiry[i]), i))
+    pending = [ob(i) for i in still.tolist()]
+    expired = [ob(i) for i in keyed]
+    for i, p in zip(still.tolist() + keyed, pending + expired):
+        if out_value is not None and last_out > int(rows[i]):
+            p.outs[ok] = out_value
+    for i, p in zip(still.tolist(), pending):
+        j = last_output(i, n - 1)
+        if j >= 0 and plan.timed[int(which[i])][3] is not None:
+            p.rejected = mon.rejection(p.k, p.inputs, ok, evs[j])
+    values: dict[str, object] = {}
+    in_rows = rows[C:]
+    if len(in_rows) or refused.size:
+        r = max(int(in_rows.max()) if len(in_rows) else -1, int(refused.max()) if refused.size else -1)
+        values[ik] = mon.mapped(evs[r], ik)
+    if out_value is not None:
+        values[ok] = out_value
+    heard = [(int(ns[j]), evs[j], {ok}, {ok: mon.mapped(evs[j], ok)}) for j in out_rows[-64:].tolist()]
+    mon.take_state(pending, expired, values, heard, int(ns[-1]))
+
+
+def _note_margins(mon: BatchDeadlines, evs: list[Event], ns: np.ndarray, which: np.ndarray, due: np.ndarray,
+                  ob: Callable[[int], Pending],
+                  verdicts: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+    """Each guarantee's time margins of the chunk's verdicts, as :func:`.time_margins.note` counts them one by
+    one in their order: answers and late answers counted with their margin (a late one no longer
+    unanswered), expiries unanswered, the first smallest margin kept with its places."""
+    at, phase, obs = verdicts
+    kept = mon.result.time_margins
+    g_of = which[obs]
+    margin = due[obs] - ns[at]
+    for g, (k, _, _, _) in enumerate(mon.plan.timed):
+        mine = g_of == g
+        if not bool(mine.any()):
+            continue
+        ph = phase[mine]
+        tm = kept.setdefault(k, TimeMargin(k))
+        tm.unanswered += int((ph == 2).sum()) - int((ph == 0).sum())
+        answered = np.flatnonzero(ph != 2)
+        if not answered.size:
+            continue
+        got = margin[mine][answered]
+        best = int(np.argmin(got))
+        low = int(got[best])
+        if not tm.answers or low < tm.margin_ns:
+            i, r = int(obs[mine][answered][best]), int(at[mine][answered][best])
+            tm.margin_ns, tm.trigger_where, tm.answer_where, tm.answer = low, ob(i).trigger.where, evs[r].where, \
+                int(ns[r]) / 1e9
+        tm.answers += int(answered.size)
