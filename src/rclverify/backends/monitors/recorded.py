@@ -19,6 +19,7 @@ from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.deadline_records import DeadlineResult
 from rclverify.backends.monitors.deadline_topics import has_deadlines
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
+from rclverify.backends.monitors.batch_deadlines import deadline_monitor
 from rclverify.backends.monitors.declarations import (DeclarationMonitor, DeclarationResult, add_periods,
                                                       has_declarations)
 from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
@@ -130,8 +131,8 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     judged = [judged_at_widths(checked, n, cfg.rules, dirs) for n in nodes]  # the live monitor's route too
     sources = [(k, s) for _, f in judged for k, s in f.items()]
     nodes = [n for n, _ in judged]
-    dmons = [DeadlineMonitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
-             for n in nodes if has_deadlines(n)]
+    dmons = [deadline_monitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
+             for n in nodes if has_deadlines(n)]  # in batch where eligible (batch_deadlines.py)
     pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
     decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes if has_declarations(n)]
     calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
