@@ -54,10 +54,10 @@ call book's clock runs that far behind.  An answer whose request has not been
 heard waits up to :data:`EARLY_S` seconds for it before it counts as an
 answer without a call.
 
-Long module: one state per link reads both wire forms (the request and
-reply topics, the introspection events) and an action's five parts, and
-decides per endpoint which it hears; its methods share that state, and a
-split along the parts would hand the same tables between modules.
+An action's parts are read by :mod:`.action_taps`, whose introspection
+side pairs a link's calls and which endpoints go unheard by
+:mod:`.event_sides`, the seconds waited are :mod:`.call_times`'; both
+mixins share this class's state.
 """
 from __future__ import annotations
 
@@ -66,11 +66,13 @@ from typing import Any, Iterable, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode
-from rclverify.ros.live.dds import ACTION_INFIX
 from rclverify.runtime.dds.bus import NAME_GRACE_S, Tap
 from rclverify.backends.monitors.dds_calls import CallBook
+from rclverify.runtime.dds.action_taps import GOAL_STATUS, ActionTaps
 from rclverify.runtime.dds.call_plan import CallPlan
-from rclverify.runtime.dds.introspection import EVENT_SUFFIX, SIDES, event_key, side_of, uncovered
+from rclverify.runtime.dds.call_times import EARLY_S, LATE_S, SETTLE_S
+from rclverify.runtime.dds.event_sides import EventSides
+from rclverify.runtime.dds.introspection import SIDES, event_key
 from rclverify.runtime.dds.order import OrderPairer, Pending
 from rclverify.runtime.dds.shadow import REPLY_OF, SHADOW, Shadows
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
@@ -78,26 +80,8 @@ from rclverify.runtime.dds.wire import framed_rmw, has_header, vendor
 from rclverify.traces.event_time import event_s
 from rclverify.traces.reorder import ReorderBuffer
 
-#: seconds an answer waits for its request (or goal) to be heard
-EARLY_S = 2.0
-#: seconds a sample waits after its source stamp, so that samples are taken in the stamps' order
-SETTLE_S = 0.3
-#: seconds after its receipt a sample is taken whatever its stamp says (a writer whose clock runs ahead)
-LATE_S = 1.0
-#: seconds an endpoint goes unheard with contents before it is said not judged (the graph's reading of a node
-#: that just appeared may list its service before its event publisher)
-ENDPOINT_GRACE_S = 1.5
-#: seconds before a sample's stamp the endpoints last read still count for it (the graph is read each 0.5 s and a
-#: sample is taken 0.3 s after its stamp or later: an endpoint that left meanwhile was there when it was written)
-RECENT_S = 1.0
-#: the introspection event parts of an action that tell its goals and results (cancel's only tell cancels)
-_GOAL_EVENTS = ("goal_event", "result_event")
-#: action_msgs/msg/GoalStatus values (ROS 2 design "Actions")
-GOAL_STATUS = {0: "unknown", 1: "accepted", 2: "executing", 3: "canceling", 4: "succeeded", 5: "canceled",
-               6: "aborted"}
 
-
-class CallTaps:
+class CallTaps(EventSides, ActionTaps):
     """The taps of every monitored link and the decoding of their samples
     (module docstring).  Raises :class:`~.dds_types.DdsTypeError` (with the
     link's location) for a link type the interface files do not define."""
@@ -282,121 +266,6 @@ class CallTaps:
         else:
             self._action(name, part, s, stamp, now, framed, writer)
 
-    def unheard(self) -> dict[str, str]:
-        """Events only (module docstring): each link (``/s``) with what the
-        run could not hear of it: no introspection event of its server or of
-        every client (none of its calls), or only events at metadata level
-        (counted: heard, but without a request or response to judge), and each endpoint said not judged
-        (:meth:`_coverage`: its calls not all heard with contents); ``{}`` on
-        the DDS source."""
-        if not self.events:
-            return {}
-        out = {}
-        for name, kind in sorted(self.kinds.items()):
-            metadata_only = self.metadata_events.get(name, 0) > 0 and not self.content_events.get(name)
-            said = [] if name in self.sided and not metadata_only else [self._silence(name, kind)]
-            said += list(self.unjudged.get(name, {}).values())
-            if said:
-                out[name] = "; ".join(said)
-        return out
-
-    def _silence(self, name: str, kind: str) -> str:
-        """Why no call of link ``name`` (a ``service`` or an action) was paired: no introspection event
-        was heard of it, or only events at metadata level (counted), which carry no request or response."""
-        topics = (f"{name}{EVENT_SUFFIX}" if kind == "service" else
-                  f"{name}{ACTION_INFIX}send_goal{EVENT_SUFFIX}, get_result's, cancel_goal's")
-        calls = "calls" if kind == "service" else "goals or results"
-        n = self.metadata_events.get(name, 0)
-        if n:
-            return (f"{n} introspection event(s) of it were heard ({topics}), all at metadata level: their "
-                    f"request and response contents are not introspected, so none of its {calls} could be "
-                    "judged; configure its server's (or every client's) introspection with CONTENTS "
-                    "(ServiceIntrospectionState.CONTENTS; docs/ros2.md, \"Enabling service introspection\")")
-        if kind == "service":
-            return (f"no introspection event of its server or of every client was heard ({topics}): none of its "
-                    "calls was heard")
-        return (f"no introspection event of its own services was heard ({topics}): none of its goals or results "
-                "was heard (its feedback and status topics are)")
-
-    # -- endpoints -------------------------------------------------------------------------------
-    def _owner(self, guid: bytes) -> str:
-        """The endpoint a writer belongs to: its ROS node (``/ns/name``), else its participant."""
-        return self._node_of(bytes(guid)) or bytes(guid[:12]).hex()
-
-    def _level(self, name: str, writer: bytes | None, s: Any) -> None:
-        """Note an event without the request or response it is about: its endpoint publishes metadata only."""
-        kind = int(s.info.event_type)
-        body = s.request if kind in (SIDES["server"][0], SIDES["client"][0]) else s.response
-        counts = self.content_events if body else self.metadata_events
-        counts[name] = counts.get(name, 0) + 1
-        if writer is not None and not body:
-            self._levels[(name, self._owner(writer))] = "metadata"
-
-    def _publishing(self, name: str, part: str) -> set[str]:
-        """The endpoints that publish the introspection events of tap ``part`` of ``name`` (an action's
-        goal and result events both, for ``goal_event``/``result_event``): the graph API's report of the
-        event publishers (the rclpy source) and the writers the tap hears, by owner."""
-        parts = _GOAL_EVENTS if part in _GOAL_EVENTS else (part,)
-        graph = (getattr(self._disc, "services", None) or {}) if self._ends is not None else {}
-        reported = graph.get(name, {}).get("events") if part != "cancel_event" else None
-        found: set[str] | None = None
-        for p in parts:
-            ev = self.taps.get(f"call:{name}:{p}")
-            heard = {self._owner(g) for g in ev.heard} if ev is not None else set()
-            found = heard if found is None else found & heard
-        return (found or set()) | set(reported or ())
-
-    def _contents(self, name: str, part: str) -> set[str]:
-        """:meth:`_publishing` without the endpoints seen publishing metadata only."""
-        return {o for o in self._publishing(name, part) if self._levels.get((name, o)) != "metadata"}
-
-    def _read_shadows(self) -> None:
-        """The DDS source: each reply topic's shadow writers (:mod:`.shadow`, this monitor's and any
-        other's), which are no servers, as discovery shows them now."""
-        if self.events or self._disc is None:
-            return
-        for key, (_name, _struct, _header, part) in self.specs.items():
-            if part != "reply":
-                continue
-            try:
-                topic = self.taps[key].dds_topic
-                self._shadow_guids[topic] = {p.guid for p in self._disc.publishers(topic)
-                                             if SHADOW in p.qos.user_data}
-            except (RuntimeError, KeyError):  # discovery changed under us (the DDS thread): next time
-                continue
-
-    def _coverage(self, now: float) -> None:
-        """Events only: every endpoint of each link not heard with contents for
-        :data:`ENDPOINT_GRACE_S` s (:func:`~.introspection.uncovered`: its
-        introspection off or metadata, from the graph API's endpoints and
-        event publishers, read again at each look) is told to the book as not
-        judged (:meth:`~.dds_calls.CallBook.unjudged`), once per reason."""
-        if not self.events or self._ends is None:
-            return
-        now_uncovered: set[tuple[str, str, str]] = set()
-        for name, kind in self.kinds.items():
-            servers, clients = self._ends(name)
-            part = "event" if kind == "service" else "goal_event"
-            pubs = self._publishing(name, part)
-            parts = ("event",) if kind == "service" else ("goal_event", "result_event", "cancel_event")
-            for what, ends in (("servers", servers), ("clients", clients),
-                               *((p, pubs if p == part else self._publishing(name, p)) for p in parts)):
-                seen = self._ends_seen.setdefault((name, what), {})
-                seen.update(dict.fromkeys(ends, now))
-                for gone in [e for e, t in seen.items() if t < now - 10 * RECENT_S]:
-                    del seen[gone]
-            levels = {o: self._levels.get((name, o), "contents") for o in pubs}
-            for end, why in uncovered(set(servers), set(clients), levels).items():
-                k = (name, end, why)
-                now_uncovered.add(k)
-                since = self._uncovered.setdefault(k, now)
-                said = self.unjudged.setdefault(name, {})
-                if now - since >= ENDPOINT_GRACE_S and said.get(end) != why:
-                    said[end] = why
-                    self.book.unjudged(name, end, why, max(self.book.now, now - SETTLE_S))
-        for k in [k for k in self._uncovered if k not in now_uncovered]:
-            del self._uncovered[k]
-
     # -- services ------------------------------------------------------------------------------
     def _request(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
         if framed:
@@ -462,56 +331,6 @@ class CallTaps:
                     self.book.unpaired(p.key, now, why)
             self._servers_seen[pname] = (frozenset(rr.heard), frozenset(pairer.servers))
 
-    def _side(self, name: str, stamp: float, part: str = "event", writer: bytes | None = None) -> str | None:
-        """Which side's introspection events (tap ``part``) pair the calls of
-        service or action ``name`` at the sample stamped ``stamp``
-        (:func:`~.introspection.side_of` on the endpoints that publish them
-        with contents).  The DDS source takes a side only when it hears every
-        call (every server publishes, or every client), else it pairs the
-        request and reply topics; the rclpy source, which hears nothing else,
-        takes the side some endpoint publishes (the others are said not
-        judged: :meth:`_coverage`), the endpoints read up to :data:`RECENT_S`
-        s before the sample's stamp and the event's own ``writer`` counted
-        (a node that left since was there).  When the side changes (an event writer
-        discovered after calls began, gone, or seen to publish metadata only),
-        the calls the other source opened can no longer be answered by it:
-        they are unpaired."""
-        ev = self.taps.get(f"call:{name}:{part}")
-        if ev is None:
-            side = None
-        elif self._ends is not None:
-            servers, clients = self._ends(name)
-            recent = {what: {e for e, t in self._ends_seen.get((name, what), {}).items() if t >= stamp - RECENT_S}
-                      for what in ("servers", "clients", part)}
-            pubs = self._contents(name, part) | {o for o in recent[part] if self._levels.get((name, o)) != "metadata"}
-            if writer is not None and self._levels.get((name, self._owner(writer))) != "metadata":
-                pubs.add(self._owner(writer))
-            side = side_of(pubs, set(servers) | recent["servers"], set(clients) | recent["clients"],
-                           partial=self.events)
-        else:
-            rep, req = (self.taps.get(f"call:{name}:{p}") for p in ("reply", "request"))
-            if rep is None or req is None:
-                side = None
-            else:
-                shadows = self._shadow_guids.get(rep.dds_topic, set())
-                side = side_of(self._contents(name, part), {self._owner(g) for g in rep.heard if g not in shadows},
-                               {self._owner(g) for g in req.heard})
-        memo = f"{name}:{part}"
-        if side is not None:
-            self.sided.add(name)
-        if self._sides.setdefault(memo, side) == side:
-            return side
-        was, self._sides[memo] = self._sides[memo], side
-        why = (f"{name}'s introspection events {'began' if was is None else 'changed or stopped'} while this call "
-               "was open: its answer may come through the other source, and the two cannot be matched")
-        link = name.strip("/")
-        keys = [k for k, c in self.book.calls.items()
-                if c.name == link and k and (part != "event" or k[0] in ("ev", "w"))]
-        for k in keys:
-            self.book.unpaired(k, stamp, why, "response" if part == "event" else "result")
-        self._pairers.pop(name, None)
-        return side
-
     def _event(self, name: str, s: Any, stamp: float, now: float, writer: bytes | None = None) -> None:
         self._level(name, writer, s)
         side = self._side(name, stamp, writer=writer)
@@ -541,107 +360,6 @@ class CallTaps:
         elif kind == told and s.response:
             self._answer(key, "response", to_fields(s.response[0]), stamp, True, name, now)
 
-    # -- actions -------------------------------------------------------------------------------
-    def _action_event(self, name: str, part: str, s: Any, stamp: float, now: float,
-                      writer: bytes | None = None) -> None:
-        """An introspection event of one of action ``name``'s own services (module docstring, events only)."""
-        self._level(name, writer, s)
-        side = self._side(name, stamp, part, writer)
-        if side is None:
-            return
-        asked, told = SIDES[side]
-        kind, key = int(s.info.event_type), ("ev", *event_key(s))
-        body = s.request if kind == asked else s.response if kind == told else None
-        if body is None:
-            return
-        if not body:
-            self.counts["no_contents"] += 1
-            return  # introspection without CONTENTS: nothing to judge (docs/ros2.md)
-        r, link = body[0], name.strip("/")
-        if part == "cancel_event":
-            self.book.note({"link": link, "part": "cancel", "time": stamp,
-                            "key": [bytes(r.goal_info.goal_id.uuid).hex()]} if kind == asked else
-                           {"link": link, "part": "canceling", "time": stamp, "return_code": int(r.return_code),
-                            "key": [bytes(g.goal_id.uuid).hex() for g in r.goals_canceling]})
-        elif kind == asked:
-            gid = self._goal_of[key] = bytes(r.goal_id.uuid).hex()
-            while len(self._goal_of) > 10_000:
-                self._goal_of.pop(next(iter(self._goal_of)))
-            if part == "goal_event":
-                self._open(name, (gid,), f"{link} goal {gid}", to_fields(r.goal), stamp, "goal")
-        else:
-            gid = self._goal_of.pop(key, "")
-            if not gid:
-                self.counts["unknown_writer"] += 1  # its request's event was not heard: which goal, unknown
-            elif part == "goal_event" and not r.accepted:
-                self.book.reject((gid,), stamp)
-            elif part == "result_event":
-                self._answer((gid,), "result", to_fields(r.result), stamp, True, name, now)
-                self._note_status(name, gid, int(r.status), stamp)
-
-    def _action(self, name: str, part: str, s: Any, stamp: float, now: float, framed: bool,
-                writer: bytes | None) -> None:
-        if part == "goal_request":
-            gid = bytes(s.goal_id.uuid).hex()
-            self._ask(name, "send_goal", s, gid, stamp, framed, writer)
-            self._open(name, (gid,), f"{name.strip('/')} goal {gid}", to_fields(s.goal), stamp, "goal")
-        elif part == "result_request":
-            self._ask(name, "get_result", s, bytes(s.goal_id.uuid).hex(), stamp, framed, writer)
-        elif part == "goal_reply":
-            self._goal_reply(name, s, stamp, framed, writer)
-        elif part == "result_reply":
-            gid, undecided, why = self._told(name, "get_result", s, stamp, framed, writer)
-            for g in undecided:
-                self.book.unpaired((g,), stamp, f"its result cannot be told apart: {why}", "result")
-            if gid:
-                self._answer((gid,), "result", to_fields(s.result), stamp, True, name, now)
-                self._note_status(name, gid, int(s.status), stamp)
-        elif part == "feedback":
-            self._answer((bytes(s.goal_id.uuid).hex(),), "feedback", to_fields(s.feedback), stamp, False, name, now)
-        elif part == "status":
-            for st in s.status_list:
-                self._note_status(name, bytes(st.goal_info.goal_id.uuid).hex(), int(st.status), stamp)
-        elif part == "cancel_request":  # a zero goal id (and stamp) asks to cancel every goal (before it)
-            self.book.note({"link": name.strip("/"), "part": "cancel", "time": stamp,
-                            "key": [bytes(s.goal_info.goal_id.uuid).hex()]})
-        elif part == "cancel_reply":  # the goals the server accepted to cancel: their ids, no pairing needed
-            self.book.note({"link": name.strip("/"), "part": "canceling", "time": stamp, "return_code":
-                            int(s.return_code), "key": [bytes(g.goal_id.uuid).hex() for g in s.goals_canceling]})
-
-    def _ask(self, name: str, svc: str, s: Any, gid: str, stamp: float, framed: bool,
-             writer: bytes | None = None) -> None:
-        """A send-goal or get-result request about goal ``gid``: remember which goal its reply is about."""
-        if framed:
-            self._goal_of[request_id(s)] = gid
-            while len(self._goal_of) > 10_000:
-                self._goal_of.pop(next(iter(self._goal_of)))
-        else:
-            self._pairer(f"{name}/_action/{svc}").request(Pending((gid,), stamp, f"goal {gid}", writer))
-
-    def _told(self, name: str, svc: str, s: Any, stamp: float, framed: bool,
-              writer: bytes | None) -> tuple[str, list[str], str]:
-        """The goal a send-goal or get-result reply is about (``""``: unknown), the
-        goals it leaves undecided and why."""
-        if framed:
-            return self._goal_of.pop(request_id(s), ""), [], ""
-        pairer = self._pairer(f"{name}/_action/{svc}")
-        out = pairer.reply(stamp, writer)
-        return (str(out.answers.key[0]) if out.answers else "", [str(p.key[0]) for p in out.undecided],
-                out.reason)
-
-    def _goal_reply(self, name: str, s: Any, stamp: float, framed: bool, writer: bytes | None) -> None:
-        pool = [str(p.key[0]) for p in self._pairers[f"{name}/_action/send_goal"].pool] \
-            if f"{name}/_action/send_goal" in self._pairers else []
-        gid, undecided, why = self._told(name, "send_goal", s, stamp, framed, writer)
-        if s.accepted:
-            return
-        if gid:
-            self.book.reject((gid,), stamp)
-            return
-        for g in dict.fromkeys(undecided + pool):  # one of them was refused: none can be judged
-            self.book.unpaired((g,), stamp, f"a goal was refused and which one cannot be told: "
-                               f"{why or 'its request is one of several unanswered'}", "result")
-
     # -- the book --------------------------------------------------------------------------------
     def _open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, object], stamp: float,
               part: str = "request", count: bool = True) -> None:
@@ -655,15 +373,5 @@ class CallTaps:
             self.book.answer(key, part, fields, stamp, final, name)
         else:
             self._early.setdefault(key, []).append((part, fields, stamp, final, now, name))
-
-    def _note_status(self, name: str, gid: str, status: int, stamp: float) -> None:
-        if self._status.get(gid) == status:
-            return
-        self._status[gid] = status
-        while len(self._status) > 10_000:
-            self._status.pop(next(iter(self._status)))
-        self.book.note({"link": name.strip("/"), "part": "status", "time": stamp, "key": [gid],
-                        "status": GOAL_STATUS.get(status, str(status))})
-
 
 __all__ = ["CallTaps", "EARLY_S", "GOAL_STATUS", "LATE_S", "SETTLE_S"]
