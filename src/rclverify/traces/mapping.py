@@ -314,14 +314,19 @@ def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
     if len(names) != 1:
         return mapper
     only = names[0]
+    steps = parse_path(only) if is_path(only) else None  # a path read once, not at every message
+    path = steps if steps is not None and EVERY not in steps else None
 
     def one_field(fields: Mapping[str, object], previous: Any) -> Any:
-        # one named field (the common rule) holding a finite float or a string: the value itself; anything
-        # else (a path, a missing field, another type, NaN) goes the general way above, with its errors
+        # one named field (the common rule) holding a finite float or a string, or a path of plain dicts and
+        # lists to one: the value itself; anything else (a missing field, another type, NaN) goes the
+        # general way above, with its errors
         try:
             v = fields[only]
         except (KeyError, TypeError, IndexError):
-            return mapper(fields, previous)
+            v = _MISSING if path is None else _quick_follow(fields, path)
+            if v is _MISSING:
+                return mapper(fields, previous)
         if real:
             if type(v) is float and isfinite(v):
                 return v
@@ -329,6 +334,26 @@ def value_mapper(typ: T.Type, rule: TopicRule) -> Any:
             return v
         return mapper(fields, previous)
     return one_field
+
+
+_MISSING = object()
+
+
+def _quick_follow(cur: Any, steps: tuple[str | int, ...]) -> Any:
+    """What :func:`_follow` reads at ``steps`` (no :data:`EVERY`) through plain dicts and lists, or
+    :data:`_MISSING` where it is anything else or raises (the general reading then gives its error)."""
+    for step in steps:
+        if type(step) is int:
+            if (type(cur) is list or type(cur) is tuple) and -len(cur) <= step < len(cur):
+                cur = cur[step]
+                continue
+            return _MISSING
+        if type(cur) is not dict:
+            return _MISSING
+        cur = cur.get(step, _MISSING)
+        if cur is _MISSING:
+            return _MISSING
+    return cur
 
 
 def initial_value(typ: T.Type, rule: TopicRule) -> Any:
