@@ -74,8 +74,8 @@ class EvidenceRow(Row, frozen=True, forbid_unknown_fields=True):
         description="How strong the evidence is (docs/confidence.md), null until the report rates it.")] = None
 
 
-def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[EvidenceRow]:
-    """The report's ``evidence[]`` (JSON objects) decoded, in order
+def rows_of(rows: Iterable[EvidenceRow | Mapping[str, Any]]) -> list[EvidenceRow]:
+    """The report's ``evidence[]`` (JSON objects, or records already decoded: returned as they are) decoded, in order
     (:meth:`EvidenceRow.of` for what raises)."""
     return decode_rows(EvidenceRow, rows)
 

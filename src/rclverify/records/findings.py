@@ -121,9 +121,9 @@ class FindingRow(HealthFinding, frozen=True, forbid_unknown_fields=True):
         return msgspec.convert(data, cls)
 
 
-def rows_of(findings: Iterable[Mapping[str, Any]]) -> list[FindingRow]:
+def rows_of(findings: Iterable[FindingRow | Mapping[str, Any]]) -> list[FindingRow]:
     """The report's ``findings[]`` (JSON objects, as built or as read back
-    from ``reports/assurance.json``) decoded, in order, so that a reader
+    from ``reports/assurance.json``, or records already decoded) decoded, in order, so that a reader
     reads attributes mypy checks.  Raises :class:`msgspec.ValidationError`
     for a key no field declares or a value of another type."""
     return [FindingRow.of(f) for f in findings]

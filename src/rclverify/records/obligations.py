@@ -53,8 +53,8 @@ class ObligationRow(Row, frozen=True, forbid_unknown_fields=True):
                                                        "changed; pending without a record).")]
 
 
-def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[ObligationRow]:
-    """The report's ``obligations[]`` (JSON objects) decoded, in order
+def rows_of(rows: Iterable[ObligationRow | Mapping[str, Any]]) -> list[ObligationRow]:
+    """The report's ``obligations[]`` (JSON objects, or records already decoded: returned as they are) decoded, in order
     (:meth:`ObligationRow.of` for what raises)."""
     return decode_rows(ObligationRow, rows)
 

@@ -135,10 +135,10 @@ INTERNAL_TO: dict[str, dict[str, str]] = {
 EARLIER: dict[str, Any] = {"where": ""}
 
 
-def rows_of(rows: Iterable[Mapping[str, Any]]) -> list[ProblemRow]:
-    """The report's ``problems[]`` (JSON objects) decoded, in order, a key of :data:`EARLIER` a row lacks
+def rows_of(rows: Iterable[ProblemRow | Mapping[str, Any]]) -> list[ProblemRow]:
+    """The report's ``problems[]`` (JSON objects, or records already decoded: returned as they are) decoded, in order, a key of :data:`EARLIER` a row lacks
     read as its value there (:meth:`ProblemRow.of` for what raises)."""
-    return decode_rows(ProblemRow, ({**EARLIER, **r} for r in rows))
+    return decode_rows(ProblemRow, (r if isinstance(r, ProblemRow) else {**EARLIER, **r} for r in rows))
 
 
 __all__ = ["DiagnosisRow", "EARLIER", "INTERNAL", "INTERNAL_TO", "ProblemMember", "ProblemRow", "RepairRef", "rows_of"]

@@ -10,12 +10,18 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import Any, NotRequired, TypedDict
+from typing import NotRequired, TypedDict
 
-from rclverify.records.requirement_rows import RequirementRow
-from rclverify.records.report_schema import (DerivedPropertyJson, DiagnosisJson, EvidenceJson, FindingJson, NodeJson,
-                                             LimitedByJson, ObligationJson, PendingJson, ProblemJson, SideConditionJson,
-                                             SummaryJson, SupportJson)
+from rclverify.records.derived_rows import DerivedPropertyRow
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.findings import FindingRow
+from rclverify.records.node_rows import NodeRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
+from rclverify.records.report_schema import LimitedByJson, SummaryJson
+from rclverify.records.requirement_rows import RequirementRow, SupportRow
+from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.records.verdict_rows import PendingRow
 
 
 
@@ -107,7 +113,7 @@ class PendingGroup(TypedDict):
     """The pending rows of one backend with one reason, numbers aside."""
     backend: str
     reason: str
-    items: list[PendingJson]
+    items: list[PendingRow]
 
 
 class DashboardCell(TypedDict):
@@ -140,12 +146,12 @@ class TraceObligation(TypedDict):
     known: bool
     status: str
     backend: str
-    evidence: list[tuple[str, EvidenceJson]]
+    evidence: list[tuple[str, EvidenceRow]]
 
 
 class TraceSupport(TypedDict):
     """A guarantee that supports a requirement, with its obligations."""
-    support: SupportJson
+    support: SupportRow
     obligations: list[TraceObligation]
 
 
@@ -160,28 +166,28 @@ class Section(TypedDict):
     """A node's section (``node`` ``None`` for a name only the calculus knows); ``ob_status`` the status of
     each obligation its guarantees list."""
     name: str
-    node: NodeJson | None
-    derived: list[DerivedPropertyJson]
-    side: list[SideConditionJson]
-    findings: list[FindingJson]
+    node: NodeRow | None
+    derived: list[DerivedPropertyRow]
+    side: list[SideConditionRow]
+    findings: list[FindingRow]
     ob_status: NotRequired[dict[str, str]]
 
 
 class ObligationRun(TypedDict):
     """An obligation's row of the obligations table: the fragment ids of its evidence records."""
-    obligation: ObligationJson
+    obligation: ObligationRow
     evidence: list[str]
 
 
 class EvidenceRun(TypedDict):
     """An evidence record with its fragment id."""
     anchor: str
-    record: EvidenceJson
+    record: EvidenceRow
 
 
 class TableRuns(TypedDict):
     """The health, obligations and evidence tables' rows cut into runs of one node each."""
-    finding_runs: list[list[FindingJson]]
+    finding_runs: list[list[FindingRow]]
     obligation_runs: list[list[ObligationRun]]
     evidence_runs: list[list[EvidenceRun]]
 
@@ -191,8 +197,8 @@ class ReportView(TableRuns):
     by root cause (the report's rows, or grouped now), ``diagnosis`` id -> record, ``counts``
     ``[(status, n)]`` worst first, ``evidence_of`` obligation id -> ``[(anchor, record)]``."""
     dashboard: Dashboard
-    problem_groups: list[ProblemJson] | list[dict[str, Any]]
-    diagnosis: dict[str, DiagnosisJson]
+    problem_groups: list[ProblemRow]
+    diagnosis: dict[str, DiagnosisRow]
     counts: list[tuple[str, int]]
     problems: list[AttentionItem]
     outstanding: list[AttentionItem]
@@ -200,8 +206,8 @@ class ReportView(TableRuns):
     pending_groups: list[PendingGroup]
     unmet_requirements: list[RequirementRow]
     ev_anchor: list[str]
-    evidence_of: dict[str, list[tuple[str, EvidenceJson]]]
-    obligation: dict[str, ObligationJson]
+    evidence_of: dict[str, list[tuple[str, EvidenceRow]]]
+    obligation: dict[str, ObligationRow]
     trace: list[TraceEntry]
     sections: list[Section]
     lint_errors: int

@@ -24,7 +24,7 @@ from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.lint_rows import LintRow
 from rclverify.records.margin_rows import MarginRow, NearMissRow
 from rclverify.records.node_rows import GuaranteeRow, NodeRow, UnverifiedRow
-from rclverify.records.problem_rows import rows_of as problem_rows_of
+from rclverify.records.problem_rows import DiagnosisRow, rows_of as problem_rows_of
 from rclverify.records.row import decode_rows
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.verdict_rows import PendingRow
@@ -278,6 +278,7 @@ def environment() -> jinja2.Environment:
         lint_rows=partial(decode_rows, LintRow), unverified_rows=partial(decode_rows, UnverifiedRow),
         pending_rows=partial(decode_rows, PendingRow), near_miss_rows=partial(decode_rows, NearMissRow),
         margin_rows=partial(decode_rows, MarginRow), problem_rows=problem_rows_of,
+        diagnosis_rows=partial(decode_rows, DiagnosisRow),
     )
     env.globals.update(anchor=anchor, rank=rank)
     htmlfilters.register(env)  # prose, natsort, readable_svg, reqbadges, latex_frame

@@ -1,5 +1,5 @@
 """The report's view model: the lookups, lists and tables the templates lay out, a pure function of the
-report dict.
+report, read off the decoded :class:`~rclverify.records.report_record.AssuranceReport`.
 
 What needs attention comes first: problems (worse than pending) and
 outstanding items (pending), worst first (:func:`_attention`); the
@@ -11,13 +11,19 @@ from __future__ import annotations
 
 import re
 from collections import defaultdict
-from typing import Any, Callable, Literal, Mapping, Sequence, TypeVar
+from typing import Callable, Mapping, Sequence, TypeVar
 
-from rclverify.records.findings import rows_of
-from rclverify.records.requirement_rows import RequirementRow
+import msgspec
+
+from rclverify.records.derived_rows import DerivedPropertyRow
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.findings import FindingRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.report_schema import Report
 from rclverify.records.row import decode_rows
-from rclverify.records.report_schema import (DerivedPropertyJson, EvidenceJson, FindingJson, ObligationJson, ProblemJson,
-                                             Report, SideConditionJson)
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
 from rclverify.model.plan.declarations import BACKEND_NAMES
@@ -28,7 +34,9 @@ from rclverify.report.templating import COUNT_ORDER, anchor, rank
 from rclverify.report.textfmt import natural_key, natural_sorted, natural_within
 
 _T = TypeVar("_T")
-_Row = TypeVar("_Row", DerivedPropertyJson, SideConditionJson, FindingJson)
+_Row = TypeVar("_Row", DerivedPropertyRow, SideConditionRow, FindingRow)
+#: the report as a caller may hand it over: the decoded record, or its JSON object (decoded once on entry)
+ReportIn = AssuranceReport | Report
 
 #: Top-level keys every report dict carries.
 REPORT_KEYS: tuple[str, ...] = (
@@ -49,14 +57,14 @@ def validate(report: Report) -> None:
         raise ValueError("report dict lacks key(s): " + ", ".join(missing))
 
 
-def _by(items: Sequence[_Row], key: Literal["node"]) -> dict[str, list[_Row]]:
+def _by_node(items: Sequence[_Row]) -> dict[str, list[_Row]]:
     out: dict[str, list[_Row]] = defaultdict(list)
     for it in items:
-        out[str(it[key])].append(it)
+        out[it.node].append(it)
     return out
 
 
-def _attention(report: Report, ev_anchor: Sequence[str]) -> tuple[list[AttentionItem], list[AttentionItem]]:
+def _attention(report: AssuranceReport, ev_anchor: Sequence[str]) -> tuple[list[AttentionItem], list[AttentionItem]]:
     """Items needing attention: (problems, outstanding).
 
     Problems are everything worse than pending (failed, error, stale,
@@ -75,52 +83,48 @@ def _attention(report: Report, ev_anchor: Sequence[str]) -> tuple[list[Attention
                       "where": where, "message": message, "formula": formula})
 
     reasons: dict[str, list[str]] = defaultdict(list)
-    for p in report["pending"]:
-        reasons[str(p["obligation"])].append(str(p["reason"]))
+    for p in report.pending:
+        reasons[p.obligation].append(p.reason)
     evidenced: set[str] = set()
-    for ev, aid in zip(report["evidence"], ev_anchor):
-        ob = str(ev["obligation"])
+    for ev, aid in zip(report.evidence, ev_anchor):
+        ob = ev.obligation
         evidenced.add(ob)
-        if rank(ev["status"]) == 0:
+        if rank(ev.status) == 0:
             continue
-        msg = str(ev["explanation"])
-        if ev["status"] == "pending" and reasons.get(ob):
+        msg = ev.explanation
+        if ev.status == "pending" and reasons.get(ob):
             msg = " ".join(dict.fromkeys([*reasons[ob], msg] if msg else reasons[ob]))
-        add(ev["status"], "evidence", ob, aid, f"{ev['backend']} ({ev['kind']})", msg)
-    for p in report["pending"]:
-        ob = str(p["obligation"])
+        add(ev.status, "evidence", ob, aid, f"{ev.backend} ({ev.kind})", msg)
+    for p in report.pending:
+        ob = p.obligation
         if ob not in evidenced:
-            add("pending", "obligation", ob, anchor("ob", ob), str(p["backend"]), str(p["reason"]))
+            add("pending", "obligation", ob, anchor("ob", ob), p.backend, p.reason)
             evidenced.add(ob)
-    for o in report["obligations"]:
-        if o["id"] not in evidenced and rank(o["status"]) > 0:
-            add(o["status"], "obligation", o["id"], anchor("ob", o["id"]), str(o["backend"]),
+    for o in report.obligations:
+        if o.id not in evidenced and rank(o.status) > 0:
+            add(o.status, "obligation", o.id, anchor("ob", o.id), o.backend,
                 "No evidence record for this obligation.")
-    for u in report.get("unverified") or ():  # a guarantee no obligation covers (report/unverified.py)
-        add(str(u["status"]), "guarantee", str(u["id"]), anchor("g", u["node"], u["guarantee"]), str(u["source"]),
-            f"Unverified: {u['reason']}.")
-    for sc in report["side_conditions"]:
-        if rank(sc["status"]) > 0:
-            add(sc["status"], "side condition", sc["id"], anchor("sc", sc["id"]),
-                f"{sc['node']}, {sc['rule']}, {sc['source']}",
-                str(sc["explanation"]) or "Assumption conjunct not established:", str(sc["conjunct"]))
-    for f in rows_of(report["findings"]):
+    for u in report.unverified:  # a guarantee no obligation covers (report/unverified.py)
+        add(u.status, "guarantee", u.id, anchor("g", u.node, u.guarantee), u.source, f"Unverified: {u.reason}.")
+    for sc in report.side_conditions:
+        if rank(sc.status) > 0:
+            add(sc.status, "side condition", sc.id, anchor("sc", sc.id), f"{sc.node}, {sc.rule}, {sc.source}",
+                sc.explanation or "Assumption conjunct not established:", sc.conjunct)
+    for f in report.findings:
         if rank(f.status) > 0 and not f.acknowledged:  # an accepted risk is listed with its reason
             where = f.node + (f", guarantee {f.guarantee}" if f.guarantee is not None else "")
             msg = f.message + (f" {f.explanation}" if f.explanation else "")
             add(f.status, f"contract health: {f.check}", f.id, anchor("finding", f.id), where, msg)
-    for d in report["derived_properties"]:
-        if rank(d["status"]) > SEVERITY["pending"]:
-            add(d["status"], "derived property", d["node"], anchor("derived", d["node"]),
-                ", ".join(d["rules"]), f"Derived property {d.get('derivation', 'not established')} "
-                "(a side condition of its cone is not discharged):", str(d["property"]))
-    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (model/plan/acknowledged.py)
-        if a.get("status") != "ok":
-            add(str(a["status"]), "acknowledgement", str(a["warning"]), "acknowledged", str(a["at"]), str(a["message"]))
-    for k, lint in enumerate(report["lint"]):
-        if str(lint["severity"]).lower() == "error":
-            add("error", "lint", str(lint["location"]), anchor("lint", k + 1), str(lint["location"]),
-                str(lint["message"]))
+    for d in report.derived_properties:
+        if rank(d.status) > SEVERITY["pending"]:
+            add(d.status, "derived property", d.node, anchor("derived", d.node), ", ".join(d.rules),
+                f"Derived property {d.derivation} (a side condition of its cone is not discharged):", d.property)
+    for a in report.acknowledgements:  # a stale or refused acknowledgement (model/plan/acknowledged.py)
+        if a.status != "ok":
+            add(a.status, "acknowledgement", a.warning, "acknowledged", a.at, a.message)
+    for k, lint in enumerate(report.lint):
+        if lint.severity.lower() == "error":
+            add("error", "lint", lint.location, anchor("lint", k + 1), lint.location, lint.message)
 
     kind_order = {"evidence": 0, "obligation": 1, "guarantee": 1, "side condition": 2, "derived property": 4, "lint": 5}
     items.sort(key=lambda it: (-rank(it["status"]), kind_order.get(it["kind"], 3), it["kind"], natural_key(it["ref"])))
@@ -150,32 +154,52 @@ def group_items(items: Sequence[AttentionItem]) -> list[AttentionGroup]:
     return list(groups.values())
 
 
-def evidence_anchors(report: Report) -> list[str]:
-    """One fragment id per evidence record of ``report``, in order:
+def evidence_anchors(report: ReportIn) -> list[str]:
+    """One fragment id per evidence record of ``report`` (decoded on entry), in order:
     ``ev-<obligation>``, then ``ev-<obligation>-2`` ... for further records
     of the same obligation."""
     seen: dict[str, int] = defaultdict(int)
     out = []
-    for ev in report["evidence"]:
-        ob = str(ev["obligation"])
+    for ev in _rows_decoded(report).evidence:
+        ob = ev.obligation
         seen[ob] += 1
         out.append(anchor("ev", ob) if seen[ob] == 1 else anchor("ev", ob, seen[ob]))
     return out
 
 
-def problem_items(report: Report) -> list[AttentionItem]:
-    """The attention items of ``report`` that are problems (worse than
+def _rows_decoded(report: ReportIn) -> AssuranceReport:
+    """``report`` decoded for a reader of its rows, which reads no ``problems`` (a JSON object may lack them)."""
+    return report if isinstance(report, AssuranceReport) else AssuranceReport.of({"problems": [], **report})
+
+
+def decoded_report(report: ReportIn) -> AssuranceReport:
+    """``report`` decoded once into :class:`~rclverify.records.report_record.AssuranceReport`
+    (returned unchanged when it is one); a JSON object without ``problems``
+    gets them grouped by root cause here
+    (:func:`rclverify.report.problems.group_problems`).  Raises
+    :class:`msgspec.ValidationError` (a ``ValueError``) for a report of
+    another shape."""
+    if isinstance(report, AssuranceReport):
+        return report
+    if "problems" in report:
+        return AssuranceReport.of(report)
+    draft = AssuranceReport.of({**report, "problems": []})
+    groups = group_problems(draft, _attention(draft, evidence_anchors(draft))[0], anchor)
+    return msgspec.structs.replace(draft, problems=decode_rows(ProblemRow, groups))
+
+
+def problem_items(report: ReportIn) -> list[AttentionItem]:
+    """The attention items of ``report`` (decoded on entry) that are problems (worse than
     pending), worst first (see :func:`_attention`)."""
-    return _attention(report, evidence_anchors(report))[0]
+    decoded = _rows_decoded(report)
+    return _attention(decoded, evidence_anchors(decoded))[0]
 
 
-def problem_groups(report: Report) -> list[ProblemJson] | list[dict[str, Any]]:
+def problem_groups(report: ReportIn) -> list[ProblemRow]:
     """The report's problems grouped by root cause
-    (:func:`rclverify.report.problems.group_problems`): the report dict's
-    ``problems`` when it has them, else computed from ``report``."""
-    if report.get("problems") is not None:
-        return list(report["problems"])
-    return group_problems(report, problem_items(report), anchor)
+    (:func:`rclverify.report.problems.group_problems`): the report's
+    ``problems`` (decoded on entry)."""
+    return list(decoded_report(report).problems)
 
 
 #: The techniques of the dashboard's columns, in order: contract health, the
@@ -191,8 +215,7 @@ TECHNIQUES: tuple[str, ...] = ("health", "side conditions", *BACKEND_NAMES)
 _HEALTH_AS: Mapping[str, str] = {"ok": "discharged", "problem": "failed", "unknown": "inconclusive"}
 
 
-def dashboard(report: Report, evidence_of: Mapping[str, Sequence[tuple[str, object]]],
-              groups: Sequence[object] | None = None) -> Dashboard:
+def dashboard(report: AssuranceReport, evidence_of: Mapping[str, Sequence[tuple[str, object]]]) -> Dashboard:
     """The dashboard's matrix of nodes (rows) against techniques (columns).
 
     Each cell is the WORST status of the node's items of that technique
@@ -214,23 +237,22 @@ def dashboard(report: Report, evidence_of: Mapping[str, Sequence[tuple[str, obje
     "cells": [cell], "culprit" (a problem's culprit is its guarantee or
     contract, :func:`culprit_nodes`)}]}``."""
     items: dict[tuple[str, str], list[tuple[str, str]]] = defaultdict(list)
-    for o in report["obligations"]:
-        evs = evidence_of.get(str(o["id"]), [])
-        items[(str(o["node"]), str(o["backend"]))].append(
-            (str(o["status"]), evs[0][0] if evs else anchor("ob", o["id"])))
-    for f in rows_of(report["findings"]):
+    for o in report.obligations:
+        evs = evidence_of.get(o.id, [])
+        items[(o.node, o.backend)].append((o.status, evs[0][0] if evs else anchor("ob", o.id)))
+    for f in report.findings:
         items[(f.node, "health")].append((_HEALTH_AS.get(f.status, f.status), anchor("finding", f.id)))
-    for sc in report["side_conditions"]:
-        items[(str(sc["node"]), "side conditions")].append((str(sc["status"]), anchor("sc", sc["id"])))
-    for u in report.get("unverified") or ():  # no obligation at all: a column of its own, after the techniques
-        items[(str(u["node"]), "no evidence")].append((str(u["status"]), anchor("g", u["node"], u["guarantee"])))
-    culprits = culprit_nodes(groups if groups is not None else report.get("problems") or ())
+    for sc in report.side_conditions:
+        items[(sc.node, "side conditions")].append((sc.status, anchor("sc", sc.id)))
+    for u in report.unverified:  # no obligation at all: a column of its own, after the techniques
+        items[(u.node, "no evidence")].append((u.status, anchor("g", u.node, u.guarantee)))
+    culprits = culprit_nodes(report.problems)
     extra = sorted({b for _, b in items} - set(TECHNIQUES) - {"no evidence"})
     extra += ["no evidence"] if any(b == "no evidence" for _, b in items) else []
     columns = [*TECHNIQUES, *extra]
     rows: list[DashboardRow] = []
-    for n in report["nodes"]:
-        name = str(n["name"])
+    for n in report.nodes:
+        name = n.name
         cells: list[DashboardCell | None] = []
         for col in columns:
             got = items.get((name, col))
@@ -245,46 +267,46 @@ def dashboard(report: Report, evidence_of: Mapping[str, Sequence[tuple[str, obje
             counts = sorted(tally.items(), key=lambda kv: (-rank(kv[0]), kv[0]))
             cells.append({"status": first[0], "worst": tally[first[0]], "total": len(got), "counts": counts,
                           "anchor": first[1]})
-        rows.append({"node": name, "status": n["status"], "cells": cells, "culprit": name in culprits})
+        rows.append({"node": name, "status": n.status, "cells": cells, "culprit": name in culprits})
     return {"columns": columns, "rows": rows}
 
 
 
 
-def _trace(report: Report, obligation: Mapping[str, ObligationJson],
-           evidence_of: Mapping[str, list[tuple[str, EvidenceJson]]]) -> list[TraceEntry]:
+def _trace(report: AssuranceReport, obligation: Mapping[str, ObligationRow],
+           evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> list[TraceEntry]:
     """The traceability rows: per requirement, its supporting guarantees with
     each obligation's status and evidence (``rowspan``: rows it spans)."""
     trace: list[TraceEntry] = []
-    for req in report["requirements"]:
+    for req in report.requirements:
         rows: list[TraceSupport] = []
-        for sup in req["support"]:
+        for sup in req.support:
             obs: list[TraceObligation] = []
-            for oid in sup["obligations"]:
-                o = obligation.get(str(oid))
+            for oid in sup.obligations:
+                o = obligation.get(oid)
                 obs.append({
                     "id": oid,
                     "known": o is not None,
-                    "status": o["status"] if o is not None else "pending",
-                    "backend": o["backend"] if o is not None else "",
-                    "evidence": evidence_of.get(str(oid), []),
+                    "status": o.status if o is not None else "pending",
+                    "backend": o.backend if o is not None else "",
+                    "evidence": evidence_of.get(oid, []),
                 })
             rows.append({"support": sup, "obligations": obs})
-        trace.append({"req": RequirementRow.of(req), "rows": rows, "rowspan": max(1, len(rows))})
+        trace.append({"req": req, "rows": rows, "rowspan": max(1, len(rows))})
     return trace
 
 
-def _sections(report: Report, obligation: Mapping[str, ObligationJson]) -> list[Section]:
+def _sections(report: AssuranceReport, obligation: Mapping[str, ObligationRow]) -> list[Section]:
     """Per node (then per name only the calculus knows): the node, its derived
     property, side conditions, findings and ``ob_status`` (the status of each
     obligation its guarantees list)."""
-    derived = _by(report["derived_properties"], "node")
-    sides = _by(natural_sorted(report["side_conditions"], key=lambda sc: sc["id"]), "node")
-    findings = _by(natural_sorted(report["findings"], key=lambda f: f["id"]), "node")
+    derived = _by_node(report.derived_properties)
+    sides = _by_node(natural_sorted(report.side_conditions, key=lambda sc: sc.id))
+    findings = _by_node(natural_sorted(report.findings, key=lambda f: f.id))
     sections: list[Section] = []
-    named = [str(n["name"]) for n in report["nodes"]]
-    for n in report["nodes"]:
-        name = str(n["name"])
+    named = [n.name for n in report.nodes]
+    for n in report.nodes:
+        name = n.name
         sections.append({"name": name, "node": n, "derived": derived.get(name, []),
                          "side": sides.get(name, []), "findings": findings.get(name, [])})
     for name in sorted((set(derived) | set(sides)) - set(named)):
@@ -292,40 +314,40 @@ def _sections(report: Report, obligation: Mapping[str, ObligationJson]) -> list[
                          "side": sides.get(name, []), "findings": findings.get(name, [])})
     for sec in sections:
         node = sec["node"]
-        ids = [str(oid) for g in (node.get("guarantees", []) if node else []) for oid in g["obligations"]]
-        sec["ob_status"] = {oid: obligation[oid]["status"] for oid in ids if oid in obligation}
+        ids = [oid for g in (node.guarantees if node else []) for oid in g.obligations]
+        sec["ob_status"] = {oid: obligation[oid].status for oid in ids if oid in obligation}
     return sections
 
 
-def _pending_groups(report: Report) -> list[PendingGroup]:
+def _pending_groups(report: AssuranceReport) -> list[PendingGroup]:
     """The pending rows grouped by backend and reason (the same reason, numbers aside: one row)."""
     groups: dict[tuple[str, str], PendingGroup] = {}
-    for p in natural_sorted(report["pending"], key=lambda p: p["obligation"]):
-        key = (str(p["backend"]), _NUMBERS.sub("#", str(p["reason"])))
-        groups.setdefault(key, {"backend": p["backend"], "reason": p["reason"], "items": []})["items"].append(p)
+    for p in natural_sorted(report.pending, key=lambda p: p.obligation):
+        key = (p.backend, _NUMBERS.sub("#", p.reason))
+        groups.setdefault(key, {"backend": p.backend, "reason": p.reason, "items": []})["items"].append(p)
     return list(groups.values())
 
 
-def _table_runs(report: Report, ev_anchor: Sequence[str], obligation: Mapping[str, ObligationJson],
-                evidence_of: Mapping[str, list[tuple[str, EvidenceJson]]]) -> TableRuns:
+def _table_runs(report: AssuranceReport, ev_anchor: Sequence[str], obligation: Mapping[str, ObligationRow],
+                evidence_of: Mapping[str, list[tuple[str, EvidenceRow]]]) -> TableRuns:
     """``finding_runs``, ``obligation_runs`` and ``evidence_runs`` of :func:`view`."""
     def node_of_evidence(item: EvidenceRun) -> str:
-        o = obligation.get(str(item["record"]["obligation"]))
-        return str(o["node"]) if o is not None else ""
+        o = obligation.get(item["record"].obligation)
+        return o.node if o is not None else ""
 
     return {
-        "finding_runs": runs(natural_within(report["findings"], lambda f: str(f["node"]), lambda f: f["id"]),
-                             lambda f: str(f["node"])),
-        "obligation_runs": runs([{"obligation": o, "evidence": [aid for aid, _ in evidence_of.get(str(o["id"]), [])]}
-                                 for o in natural_within(report["obligations"], lambda o: str(o["node"]),
-                                                         lambda o: o["id"])], lambda row: str(row["obligation"]["node"])),
-        "evidence_runs": runs(natural_within([{"anchor": aid, "record": ev} for aid, ev in zip(ev_anchor, report["evidence"])],
-                                             node_of_evidence, lambda it: it["record"]["obligation"]), node_of_evidence),
+        "finding_runs": runs(natural_within(report.findings, lambda f: f.node, lambda f: f.id), lambda f: f.node),
+        "obligation_runs": runs([{"obligation": o, "evidence": [aid for aid, _ in evidence_of.get(o.id, [])]}
+                                 for o in natural_within(report.obligations, lambda o: o.node, lambda o: o.id)],
+                                lambda row: row["obligation"].node),
+        "evidence_runs": runs(natural_within([{"anchor": aid, "record": ev} for aid, ev in zip(ev_anchor, report.evidence)],
+                                             node_of_evidence, lambda it: it["record"].obligation), node_of_evidence),
     }
 
 
-def view(report: Report) -> ReportView:
-    """Derived lookups the templates need (pure function of ``report``).
+def view(report: ReportIn) -> ReportView:
+    """Derived lookups the templates need (pure function of ``report``, decoded on entry:
+    :func:`decoded_report`; every row in it is its decoded record).
 
     Keys: ``dashboard`` (:func:`dashboard`), ``problem_groups`` (the
     problems grouped by root cause, :func:`problem_groups`), ``diagnosis``
@@ -342,28 +364,28 @@ def view(report: Report) -> ReportView:
     the health table, the obligations table and the evidence records, in
     report order, cut into runs of one node each (:func:`runs`).
     """
-    validate(report)
-    ev_anchor = evidence_anchors(report)
-    evidence_of: dict[str, list[tuple[str, EvidenceJson]]] = defaultdict(list)
-    for aid, ev in zip(ev_anchor, report["evidence"]):
-        evidence_of[str(ev["obligation"])].append((aid, ev))
-    obligation = {str(o["id"]): o for o in report["obligations"]}
-    counts_in = report["summary"]["counts"]
+    if not isinstance(report, AssuranceReport):
+        validate(report)
+    typed = decoded_report(report)
+    ev_anchor = evidence_anchors(typed)
+    evidence_of: dict[str, list[tuple[str, EvidenceRow]]] = defaultdict(list)
+    for aid, ev in zip(ev_anchor, typed.evidence):
+        evidence_of[ev.obligation].append((aid, ev))
+    obligation = {o.id: o for o in typed.obligations}
+    counts_in: dict[str, int] = {str(k): n for k, n in typed.summary.counts.items()}
     counts = [(s, counts_in[s]) for s in COUNT_ORDER if s in counts_in]
     counts += [(s, counts_in[s]) for s in sorted(counts_in) if s not in SEVERITY]
-    problems, outstanding = _attention(report, ev_anchor)
-    groups = (list(report["problems"]) if report.get("problems") is not None
-              else group_problems(report, problems, anchor))
+    problems, outstanding = _attention(typed, ev_anchor)
     return {
-        "dashboard": dashboard(report, evidence_of, groups), "problem_groups": groups,
-        "diagnosis": {str(d["id"]): d for d in report.get("diagnoses") or []},
+        "dashboard": dashboard(typed, evidence_of), "problem_groups": list(typed.problems),
+        "diagnosis": {d.id: d for d in typed.diagnoses},
         "counts": counts, "problems": problems, "outstanding": outstanding,
-        "outstanding_groups": group_items(outstanding), "pending_groups": _pending_groups(report),
-        "unmet_requirements": [q for q in decode_rows(RequirementRow, report["requirements"]) if rank(q.status) > 0],
+        "outstanding_groups": group_items(outstanding), "pending_groups": _pending_groups(typed),
+        "unmet_requirements": [q for q in typed.requirements if rank(q.status) > 0],
         "ev_anchor": ev_anchor, "evidence_of": evidence_of, "obligation": obligation,
-        "trace": _trace(report, obligation, evidence_of), "sections": _sections(report, obligation),
-        "lint_errors": sum(1 for x in report["lint"] if str(x["severity"]).lower() == "error"),
-        **_table_runs(report, ev_anchor, obligation, evidence_of),
+        "trace": _trace(typed, obligation, evidence_of), "sections": _sections(typed, obligation),
+        "lint_errors": sum(1 for x in typed.lint if x.severity.lower() == "error"),
+        **_table_runs(typed, ev_anchor, obligation, evidence_of),
     }
 
 
