@@ -22,7 +22,7 @@ import z3
 
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
-from rclverify.lang.types import Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
+from rclverify.lang.types import BOOL, Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 from rclverify.semantics.connectives import conj
 from rclverify.semantics.definedness import defined
 from rclverify.semantics.values import FiniteFunction, Term, exact
@@ -94,6 +94,8 @@ def finite_interpretation(value: FiniteFunction, typ: FuncT, enc: Encoder) -> z3
 
 
 def _io_type(node: CheckedNode, qualified: str) -> Type:
+    if qualified.startswith("first(in.") and qualified.endswith(")") and qualified[9:-1] in node.inputs:
+        return BOOL  # whether the message on that input is the first published on it (docs/semantics.md)
     prefix, _, name = qualified.partition(".")
     table = node.inputs if prefix == "in" else node.outputs if prefix == "out" else None
     if table is None or name not in table:

@@ -35,7 +35,7 @@ from typing import Any, Mapping
 import z3
 
 from rclverify.lang import ast
-from rclverify.lang.types import NATURAL, CheckedNode, DataT, Env, FuncT, SeqT, SetT, TupleT, Type
+from rclverify.lang.types import BOOL, NATURAL, CheckedNode, DataT, Env, FuncT, SeqT, SetT, TupleT, Type
 from rclverify.semantics.natural import natural_typing
 from rclverify.semantics.modeltext import _render, _term_parts, _term_to_rcl_reference, _value_parts, term_to_rcl, value_to_rcl
 from rclverify.semantics.sorts import (_ctor, _join_sort, _recogniser, _tuple_fields, apply_operator, coerce, enum_const, sort_of,
@@ -89,6 +89,19 @@ class Encoder:
             decl = z3.Const(name, sort_of(t))
         self.symbols[name] = Symbol(name, display, t, decl)
         return decl
+
+    def first_symbol(self, node: CheckedNode, var: str) -> z3.ExprRef:
+        """The Boolean ``first(in.var)`` of ``node`` in a one-step query: whether
+        the step's message on that input is the first published on it.  Free
+        (docs/semantics.md, "The first published value": over one step either
+        value is possible, every rule is asked for both), one symbol per
+        input as the encoder names it (a consumer's input aliased to its
+        producer's output shares the producer's)."""
+        owner, _, rest = self.symbol_name(node.name, "in", var).partition(".")
+        name = f"{owner}.first({rest})"  # "<Node>.first(in.x)": the qualified name after the node, as an I/O symbol's
+        if name not in self.symbols:
+            self.symbols[name] = Symbol(name, f"first({node.name}.in.{var})", BOOL, z3.Bool(name))
+        return self.symbols[name].decl
 
     def fresh(self, z3name: str, display: str, t: Type) -> z3.ExprRef:
         """A new free constant (e.g. a Skolem witness) shown as ``display`` in models."""

@@ -128,6 +128,18 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
             raise Undecided(f"{e.func.qualified} is not a function value")
         return f(*args)
 
+    def visit_First(self, e: ast.First, b: Mapping[str, Value]) -> Any:
+        """``first(in.x)``: the Boolean given as ``first(in.x)`` (the monitors: whether this message is the
+        first the run published on that input; docs/semantics.md, "The first published value"); without
+        one, :class:`Undecided`."""
+        key = f"first(in.{e.arg.name})"
+        value = self.values.get(key)
+        if isinstance(value, str):  # why it is not known (backends/monitors/first_messages.py)
+            raise Undecided(value)
+        if not isinstance(value, bool):
+            raise Undecided(f"no record of whether this message is the first published on in.{e.arg.name}")
+        return value
+
     def visit_Unary(self, e: ast.Unary, b: Mapping[str, Value]) -> Any:
         return UNARY[e.op].exact(self.eval(e.operand, b))
 

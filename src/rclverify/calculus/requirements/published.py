@@ -15,6 +15,13 @@ message, so in the transition system of :mod:`.transition`:
 * a node answers only when every fed input its contract reads has been
   heard (its question exists): ``answers -> ready``; its progress
   (``progress(...)`` and fairness) is owed only then;
+* every input a ``first(...)`` of the statement or the cone's contracts
+  reads has a flag ``Consumer.first.x`` (docs/semantics.md, "The first
+  published value"): for an input another node of the cone feeds, false at
+  step 0 and, at each later step, whether the input is heard now and was
+  not at the step before (the producer's first published value arrives);
+  for an input of the environment, which gives a value at every step, true
+  at step 0 only;
 * a requirement's state formula is evaluated only on published values: the
   flags of the outputs and fed inputs it reads (:meth:`Publication.defined`)
   guard it, as ``defined -> F`` under ``always`` and ``defined and F``
@@ -43,13 +50,16 @@ class Publication:
     ``published`` node -> its flag's variable name; ``heard`` consumer input
     (``C.in.x``) -> its flag's name; ``producer`` consumer input -> producer
     node; ``fed`` node -> the heard flags of the fed inputs its contract
-    reads; ``initial`` the nodes that declare ``initially``."""
+    reads; ``initial`` the nodes that declare ``initially``; ``first`` consumer
+    input -> its ``first(...)`` flag's name (only the inputs a ``first``
+    reads)."""
 
     published: dict[str, str] = field(default_factory=dict)
     heard: dict[str, str] = field(default_factory=dict)
     producer: dict[str, str] = field(default_factory=dict)
     fed: dict[str, list[str]] = field(default_factory=dict)
     initial: frozenset[str] = frozenset()
+    first: dict[str, str] = field(default_factory=dict)
 
     def variables(self) -> Iterable[tuple[str, tuple[str, str, str]]]:
         """``(flag name, (node, "run", what))`` for every flag."""
@@ -58,6 +68,9 @@ class Publication:
         for c, name in self.heard.items():
             node, _, var = c.split(".", 2)
             yield name, (node, "run", f"heard.{var}")
+        for c, name in self.first.items():
+            node, _, var = c.split(".", 2)
+            yield name, (node, "run", f"first.{var}")
 
     def ready(self, n: str, s: State) -> z3.BoolRef:
         """Every fed input node ``n`` reads has been heard in state ``s``."""
@@ -69,6 +82,7 @@ class Publication:
         parts = [s[f] == (z3.BoolVal(True) if n in self.initial else answers(n, s))
                  for n, f in self.published.items()]
         parts += [z3.Not(s[f]) for f in self.heard.values()]
+        parts += [s[f] == z3.BoolVal(c not in self.heard) for c, f in self.first.items()]
         return conj(*parts) if parts else z3.BoolVal(True)
 
     def trans(self, s: State, t: State, answers: Callable[[str, State], z3.BoolRef]) -> z3.BoolRef:
@@ -76,6 +90,8 @@ class Publication:
         an input is heard when its producer had published at the step before."""
         parts = [t[f] == disj(s[f], answers(n, t)) for n, f in self.published.items()]
         parts += [t[f] == s[self.published[self.producer[c]]] for c, f in self.heard.items()]
+        parts += [t[f] == (conj(s[self.published[self.producer[c]]], z3.Not(s[self.heard[c]])) if c in self.heard
+                           else z3.BoolVal(False)) for c, f in self.first.items()]
         return conj(*parts) if parts else z3.BoolVal(True)
 
     def defined(self, mentions: Iterable[tuple[str, str, str]], s: State) -> z3.BoolRef:
@@ -139,6 +155,19 @@ def publication(answering: Sequence[str], links: Sequence[tuple[str, str]], read
     return pub
 
 
+def first_inputs(exprs: Iterable[Any], node: str | None = None) -> list[str]:
+    """The inputs ``C.in.x`` the ``first(...)`` terms of ``exprs`` read, in
+    order: a requirement's ``first(C.in.x)`` names its input whole; a
+    contract's ``first(in.x)`` is ``node``'s."""
+    from rclverify.lang import ast, walk  # deferred: the flags need the syntax only where a formula is read
+    out: dict[str, None] = {}
+    for e in exprs:
+        for x in walk.subexpressions(e):
+            if isinstance(x, ast.First):
+                out.setdefault(x.arg.name if node is None else f"{node}.in.{x.arg.name}", None)
+    return list(out)
+
+
 def confirm_flags(trace: Sequence[Mapping[str, Any]], pub: Publication, answers: Callable[[Mapping[str, Any], str], bool]
                   ) -> str | None:
     """The flags of a lasso's trace follow the rules (module docstring), or
@@ -153,10 +182,15 @@ def confirm_flags(trace: Sequence[Mapping[str, Any]], pub: Publication, answers:
             want = False if i == 0 else trace[i - 1][pub.published[pub.producer[c]]] is True
             if st.get(f) is not want:
                 return f"step {i}: {f} is {st.get(f)}, not {want}"
+        for c, f in pub.first.items():
+            want = (c not in pub.heard) if i == 0 else (
+                c in pub.heard and st.get(pub.heard[c]) is True and trace[i - 1].get(pub.heard[c]) is not True)
+            if st.get(f) is not want:
+                return f"step {i}: {f} is {st.get(f)}, not {want}"
         for n, flags in pub.fed.items():
             if answers(st, n) and not all(st.get(f) is True for f in flags):
                 return f"step {i}: {n} answers before every input it reads was published"
     return None
 
 
-__all__ = ["Publication", "confirm_flags", "publication"]
+__all__ = ["Publication", "confirm_flags", "first_inputs", "publication"]

@@ -71,6 +71,7 @@ from rclverify.calculus.requirements.initial_needed import initially_not_needed
 from rclverify.calculus.requirements.exercised import NON_VACUOUS, vacuity
 from rclverify.calculus.requirements.progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
 from rclverify.calculus.requirements.transition import ComposedSystem, build_system, variable_types
+from rclverify.calculus.requirements.published import first_inputs
 from rclverify.semantics.definedness import guarded
 from rclverify.semantics.encode import Encoder
 from rclverify.lang.types import FuncT
@@ -344,7 +345,8 @@ class _System:
 
     def __init__(self, q: _Question, without: Collection[str]) -> None:
         self.q = q
-        self.sys = build_system(q.cone, q.checked, q.model, q.plan, without_initially=without)
+        firsts = first_inputs([f.expr for f in [*operands(q.t), *q.assuming]])  # each first(C.in.x): a flag
+        self.sys = build_system(q.cone, q.checked, q.model, q.plan, without_initially=without, firsts=firsts)
         self.enc = Encoder(q.checked.env)
         if q.assuming:  # the requirement's own assumptions hold in every state
             self.assume()

@@ -57,7 +57,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, Checked, DataT, EmptyT, FuncT, Type
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.compose import free_io
-from rclverify.calculus.requirements.published import Publication, publication
+from rclverify.calculus.requirements.published import Publication, first_inputs, publication
 from rclverify.calculus.requirements.temporal import State, TransitionSystem
 from rclverify.calculus.requirements.tsys import Fairness, Pred
 from rclverify.semantics import wallclock
@@ -169,6 +169,8 @@ class ComposedSystem:
         out = {}
         for name, (_, p, _) in self.variables.items():
             out[f"{'out' if p == 'out' else 'in'}.{name}"] = s[name]
+        for c, f in self.pub.first.items():  # first(Node.in.x): its flag (.published)
+            out[f"first(in.{c})"] = s[f]
         return out
 
 
@@ -186,16 +188,20 @@ def variable_types(sys: ComposedSystem, checked: Checked, plan: Plan) -> dict[st
 
 
 def build_system(cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan, *,
-                 without_initially: Collection[str] = ()) -> ComposedSystem:
+                 without_initially: Collection[str] = (), firsts: Collection[str] = ()) -> ComposedSystem:
     """The transition system of ``cone`` (module docstring); the nodes of
     ``without_initially`` are built as if they declared no ``initially``
     (nothing published before their first answer), to ask whether a proof
-    needs their declarations (:mod:`.temporal_check`).
+    needs their declarations (:mod:`.temporal_check`); ``firsts`` the inputs
+    (``C.in.x``) a statement's ``first(...)`` reads, each given a flag
+    (:mod:`.published`) beside those the cone's contracts read.
 
     Raises :class:`~rclverify.lang.errors.RclError` for a state declaration
     that does not check (the plan's ``resolve`` reports those first).
     """
-    return _Builder(cone, checked, model, plan, without_initially).build()
+    b = _Builder(cone, checked, model, plan, without_initially)
+    b.firsts = firsts
+    return b.build()
 
 
 def _where(e: Any) -> str:
@@ -213,6 +219,7 @@ class _Builder:
                  without_initially: Collection[str]) -> None:
         self.cone, self.checked, self.model, self.plan = cone, checked, model, plan
         self.without_initially = without_initially
+        self.firsts: Collection[str] = ()
         self.enc = Encoder(checked.env)
         self.sorts: dict[str, z3.SortRef] = {}
         self.types: dict[str, Type] = {}
@@ -241,6 +248,9 @@ class _Builder:
         reads = {n: {v for f in [*self.internal[n], *self.env[n], *self.guarantees[n]] for p, v in free_io(f)
                      if p in ("in", None) and v in checked.nodes[n].inputs} for n in cone}
         self.pub = publication(self.answering, self.links, reads, [n for n in self.answering if self.initially[n]])
+        contracts = [first_inputs([*self.internal[n], *self.env[n], *self.guarantees[n]], n) for n in cone]
+        for c in dict.fromkeys([*(c for cs in contracts for c in cs), *self.firsts]):
+            self.pub.first[c] = "{}.first.{}".format(*c.split(".in.", 1))
         for name, var in self.pub.variables():
             self.add(name, z3.BoolSort(), BOOL, var)
         declared = tuple(self.progress_of(n) for n in self.answering if fair(checked.nodes[n].node))
@@ -320,7 +330,9 @@ class _Builder:
     # -- the encodings ----------------------------------------------------------------------
     def node_symbols(self, n: str, s: State) -> dict[str, z3.ExprRef]:
         cn = self.checked.nodes[n]
-        return {**{f"in.{v}": s[f"{n}.in.{v}"] for v in cn.inputs if f"{n}.in.{v}" in s},
+        return {**{f"first(in.{c.split('.in.', 1)[1]})": s[f] for c, f in self.pub.first.items()
+                   if c.startswith(f"{n}.in.") and f in s},
+                **{f"in.{v}": s[f"{n}.in.{v}"] for v in cn.inputs if f"{n}.in.{v}" in s},
                 **{f"out.{v}": s[f"{n}.out.{v}"] for v in cn.outputs if f"{n}.out.{v}" in s}}
 
     def holds(self, n: str, e: Any, s: State) -> z3.BoolRef:
