@@ -43,6 +43,8 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, initial_value, rule_for, value_mapper
 from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.closing import Closing
+from rclverify.backends.monitors.first_messages import FirstMessages
+from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC
 from rclverify.backends.monitors.judging import Judging
 from rclverify.backends.monitors.late import Late
 from rclverify.backends.monitors.needs_answer import answer_decides
@@ -110,6 +112,9 @@ class NodeMonitor(Judging, Closing, Late):
         self._trigger = {k: f"in.{c.trigger.name}" for k, c in enumerate(node.node.guarantees, 1)
                          if c.trigger is not None}
         self._triggers = frozenset(self._trigger.values())
+        #: ``first(in.x)`` of the contract: its value per message (first_messages.py)
+        self.first = FirstMessages(self.assumption + self.guarantees)
+        self.values.update(dict.fromkeys(self.first.keys))
         self._texts = {k: expr_to_rcl(f) for k, f in enumerate(self.guarantees, 1)}
         self._renders: dict[int, tuple[Any, str]] = {}
         needed: set[str] = set()
@@ -130,12 +135,13 @@ class NodeMonitor(Judging, Closing, Late):
         #: outputs on state topics: their current value stands in for every question
         self._state_outs = [k for k in outputs if k not in event_outs]
         self._state_set = frozenset(self._state_outs)
-        self._in_keys = [k for k in self.values if k.startswith("in.")]
+        self._in_keys = [k for k in self.values if k.startswith("in.")] + list(self.first.keys)
         self._deps: dict[Any, tuple[str, ...]] = {}
         for k, f in [(("A", j), f) for j, f in enumerate(self.assumption)] + list(enumerate(self.guarantees, 1)):
             mentioned: set[str] = set()
             reads(f, mentioned)
-            self._deps[k] = tuple(v for v in sorted(self.values) if v in mentioned or v.split(".", 1)[1] in mentioned)
+            self._deps[k] = tuple(v for v in sorted(self.values) if v in mentioned or v.split(".", 1)[1] in mentioned
+                                  or v in self.first.keys)
         ks = range(1, len(self.guarantees) + 1)
         #: guarantees judged against a question (they read an input or answer a trigger) and those judged alone
         self._asked = [k for k in ks if self.has_inputs and (k in self._trigger or
@@ -234,6 +240,8 @@ class NodeMonitor(Judging, Closing, Late):
             self._expire(self.now)
         vs = self._feeds.get(ev.topic)
         if vs is None:
+            if ev.topic == ORIGIN_TOPIC and ev.fields.get("kind") == "run":
+                self.first.start()
             return
         self.result.events += 1
         values = self.values
@@ -264,6 +272,8 @@ class NodeMonitor(Judging, Closing, Late):
             if self.invalid:
                 self.invalid.pop(key, None)
         trig, changed = self._topic_io[ev.topic]
+        if trig and self.first.keys:
+            self.first.mark(trig, values)
         if changed:
             self.heard_answer = True
             self._output(ev, changed)

@@ -1,0 +1,66 @@
+"""``first(in.x)`` judged on recorded runs (issue 113; docs/semantics.md, "The
+first published value"): a log that starts with the run's start-of-run
+marker decides it on its first message of the topic (the control: a node
+that answers its first message as it answers every other one is violated
+there), a log without the marker makes what it decides ``inconclusive``,
+naming why.  Small workspaces written here, judged through the recorded
+path (``rclverify monitor LOG``'s)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from rclverify.backends.monitors import recorded
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.backends.monitors.run_origin import origin_line
+from rclverify.lang.typecheck import load
+
+# Hold answers 0 to the first command it hears and echoes every later one.
+HOLD = """
+node Hold {
+  inputs( cmd : REAL )
+  outputs( out : REAL )
+  topics( std_msgs/Float64 cmd matches(in.cmd), std_msgs/Float64 out matches(out.out) )
+  guarantee( (first(in.cmd) -> out.out == 0) and (not first(in.cmd) -> out.out == in.cmd) )
+}
+"""
+MAPPING = "topics:\n  cmd: {fields: [data]}\n  out: {fields: [data]}\n"
+
+
+def _judge(tmp: Path, lines: list[dict[str, Any]]) -> tuple[dict[str, int], Any]:
+    (tmp / "contracts").mkdir(exist_ok=True)
+    (tmp / "contracts" / "c.rcl").write_text(HOLD)
+    (tmp / "mapping.yaml").write_text(MAPPING)
+    run = tmp / "run.jsonl"
+    run.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    checked = load([tmp / "contracts" / "c.rcl"])
+    cfg = load_mapping(tmp, "mapping.yaml")
+    got = recorded.check_recorded(checked, [checked.nodes["Hold"]], cfg, tmp, str(run), lambda w: None)
+    return dict(got.results[0].counts), got.results[0]
+
+
+def _run(first_answer: float) -> list[dict[str, Any]]:
+    return [{"topic": "cmd", "time": 1.0, "data": 5.0}, {"topic": "out", "time": 1.01, "data": first_answer},
+            {"topic": "cmd", "time": 2.0, "data": 7.0}, {"topic": "out", "time": 2.01, "data": 7.0}]
+
+
+def _start() -> dict[str, Any]:
+    return dict(origin_line(0.5, "rclpy", "rmw_fastrtps_cpp", "Fast DDS"))
+
+
+def test_the_first_message_of_a_run_with_its_start_marker_decides_first(tmp_path: Path) -> None:
+    counts, _ = _judge(tmp_path, [_start(), *_run(0.0)])
+    assert counts["satisfied"] == 2 and counts["violated"] == 0 and counts["inconclusive"] == 0
+    # control: the first command echoed like every other one breaks the guarantee on that message only
+    (tmp_path / "b").mkdir()
+    counts, res = _judge(tmp_path / "b", [_start(), *_run(5.0)])
+    assert counts["violated"] == 1 and counts["satisfied"] == 1
+    assert res.first_violation is not None and res.first_violation["time"] == 1.01
+
+
+def test_a_log_without_the_start_marker_leaves_first_inconclusive_and_says_why(tmp_path: Path) -> None:
+    counts, res = _judge(tmp_path, _run(0.0))
+    assert counts["satisfied"] == 0 and counts["violated"] == 0 and counts["inconclusive"] == 2
+    why = res.first_inconclusive["reason"]
+    assert "no start-of-run marker" in why and "in.cmd" in why, why
