@@ -20,6 +20,14 @@ one; a contract that guarantees nothing refutes almost every requirement,
 so the figure measures that the statement is decided (a verdict other than
 ``inconclusive``), not that it holds.
 
+With ``--plan FILE`` (a YAML file with a plan's ``fret:`` section; only
+its ``variables`` and ``functions`` are read, e.g.
+``bench/data/fret_case_studies.yaml``) the declarations a FRET export does
+not carry are added; the totals then say how many requirements are
+translated only with them.  With ``--decide`` the generated contract gives
+a variable the plan declares an ``input``/``output`` a port (REAL unless
+FRET says boolean or an integer type).
+
 Usage::
 
     python bench/fret_import.py DIR            # import figures only
@@ -44,6 +52,7 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 from rclverify.model.plan.errors import PlanError  # noqa: E402
+from rclverify.model.plan.fret.declared import ID_TYPES  # noqa: E402
 from rclverify.model.plan.fret.export import FretExport, read_export  # noqa: E402
 from rclverify.model.plan.fret.requirements import Options, import_export, options_of  # noqa: E402
 
@@ -56,6 +65,7 @@ INTEGERS = ("integer", "int", "int8", "int16", "int32", "int64", "uint8", "uint1
 def reason_kind(reason: str) -> str:
     """A refusal's reason without its names: the row it is counted in."""
     for pat, kind in ((r"calls the FRET function (\w+)", r"FRET function \1"),
+                      (r"it calls (\w+) with \d+ arguments", r"\1 called with another count of arguments than the plan's"),
                       (r"is an Internal variable defined in Lustre", "Internal variable defined in Lustre"),
                       (r"is not declared in the export", "identifier not declared in the export"),
                       (r"declared without an idType", "variable without an idType"),
@@ -79,17 +89,19 @@ def _ident(name: str) -> str:
     return out if out[0].isalpha() else f"C_{out}"
 
 
-def _contracts(exp: FretExport) -> tuple[str, dict[str, str]]:
-    """One contract per component with its FRET Input and Output variables; the component -> node names."""
+def _contracts(exp: FretExport, declared: dict[str, str] | None = None) -> tuple[str, dict[str, str]]:
+    """One contract per component with its FRET Input and Output variables (and those without an idType
+    that ``declared``, the plan's ``fret: variables``, places); the component -> node names."""
     comps = sorted({c for c, _ in exp.variables} | {r.component for r in exp.requirements if r.component})
     nodes = {c: _ident(c) for c in comps}
     text = []
     for c in comps:
         ports: dict[str, list[str]] = {"Input": [], "Output": []}
         for (vc, name), v in sorted(exp.variables.items()):
-            if vc == c and v.id_type in ports and name not in RESERVED and re.fullmatch(r"[A-Za-z_]\w*", name):
+            kind = v.id_type or ID_TYPES.get((declared or {}).get(name, ""), "")
+            if vc == c and kind in ports and name not in RESERVED and re.fullmatch(r"[A-Za-z_]\w*", name):
                 t = "BOOL" if v.data_type == "boolean" else "INTEGER" if v.data_type in INTEGERS else "REAL"
-                ports[v.id_type].append(f"{name} : {t}")
+                ports[kind].append(f"{name} : {t}")
         text.append(f"node {nodes[c]} {{\n  inputs( {', '.join(ports['Input'])} )\n"
                     f"  outputs( {', '.join(ports['Output'])} )\n  assume( TRUE )\n  guarantee( TRUE )\n"
                     f"  progress( within 0 steps )\n}}\n")
@@ -101,7 +113,8 @@ def exp_refused(exp: FretExport, options: Options) -> set[str]:
     return {i.fret.reqid for i in import_export(exp, options) if i.refusal is not None}
 
 
-def decide(export: Path, exp: FretExport, out: collections.Counter[str], step: str | None = None) -> None:
+def decide(export: Path, exp: FretExport, out: collections.Counter[str], step: str | None = None,
+           extra: dict[str, Any] | None = None) -> None:
     """Decide the translated requirements of ``export`` in a workspace of their own (module docstring)."""
     from rclverify.app.pipeline import stage_check, stage_requirements
     from rclverify.stages.workspace import Workspace
@@ -110,13 +123,15 @@ def decide(export: Path, exp: FretExport, out: collections.Counter[str], step: s
     reqs = raw if isinstance(raw, list) else raw["requirements"]
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
-        contracts, nodes = _contracts(exp)
+        extra = extra or {}
+        contracts, nodes = _contracts(exp, extra.get("variables"))
         (root / "contracts").mkdir()
         (root / "fret").mkdir()
         (root / "contracts" / "sys.rcl").write_text(contracts, encoding="utf-8")
         (root / "contracts" / "plan.yaml").write_text(
             "name: bench\ncontracts: [contracts/sys.rcl]\nrequirements_from: {fret: fret/export.json}\n"
-            f"fret:\n  components: {json.dumps(nodes)}\n" + (f"  step: {step}\n" if step else ""), encoding="utf-8")
+            f"fret:\n  components: {json.dumps(nodes)}\n" + (f"  step: {step}\n" if step else "")
+            + "".join(f"  {k}: {json.dumps(v)}\n" for k, v in sorted(extra.items())), encoding="utf-8")
         dropped: set[str] = set()
         for _ in range(len(reqs) + 1):
             kept = [r for r in reqs if r.get("reqid") not in dropped]
@@ -138,7 +153,7 @@ def decide(export: Path, exp: FretExport, out: collections.Counter[str], step: s
                 dropped |= bad
         ws = Workspace(root, "contracts/plan.yaml")
         from rclverify.model.plan.fret.requirements import options_of, read_fret
-        plan_data: dict[str, Any] = {"fret": {"components": nodes, **({"step": step} if step else {})}}
+        plan_data: dict[str, Any] = {"fret": {"components": nodes, **({"step": step} if step else {}), **extra}}
         options = options_of(plan_data)
         for i in read_fret(root, "fret/export.json", options, ("contracts/sys.rcl",)):
             if i.refusal is not None and i.fret.reqid not in exp_refused(exp, options):
@@ -158,6 +173,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("dir", type=Path, nargs="?", help="a folder of FRET exports (*.json)")
     ap.add_argument("--decide", action="store_true", help="also decide each translated requirement")
     ap.add_argument("--step", help="the plan's fret: step: (the seconds of one step, '1 s'), for durations in secs")
+    ap.add_argument("--plan", type=Path, help="a YAML file whose fret: variables and functions are added")
     ap.add_argument("--smoke", action="store_true",
                     help="CI: the project's own example export (examples/fret_rover/fret), decided")
     args = ap.parse_args(argv)
@@ -165,6 +181,12 @@ def main(argv: list[str] | None = None) -> int:
         args.dir, args.decide = Path(__file__).resolve().parents[1] / "examples" / "fret_rover" / "fret", True
     if args.dir is None:
         ap.error("a folder of FRET exports is needed (or --smoke)")
+    extra: dict[str, Any] = {}
+    if args.plan is not None:
+        import yaml
+        section = (yaml.safe_load(args.plan.read_text(encoding="utf-8")) or {}).get("fret") or {}
+        extra = {k: section[k] for k in ("variables", "functions") if k in section}
+    base = {"step": args.step} if args.step else {}
     total: collections.Counter[str] = collections.Counter()
     reasons: collections.Counter[str] = collections.Counter()
     start = time.perf_counter()
@@ -175,8 +197,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{exc.diagnostics[0]}")
             total["malformed exports"] += 1
             continue
-        got = import_export(exp, options_of({"fret": {"step": args.step}} if args.step else {}))
+        got = import_export(exp, options_of({"fret": {**base, **extra}}))
         refused = [i for i in got if i.refusal is not None]
+        if extra:  # those translated only with the plan's declarations
+            without = {i.fret.reqid for i in import_export(exp, options_of({"fret": base})) if i.refusal is not None}
+            total["translated with the plan's declarations only"] += len(without - {i.fret.reqid for i in refused})
         for i in refused:
             assert i.refusal is not None
             reasons[reason_kind(i.refusal.reason)] += 1
@@ -185,7 +210,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{export.name}: {len(got)} requirements, {len(got) - len(refused)} translated, {len(refused)} refused")
         if args.decide:
             verdicts: collections.Counter[str] = collections.Counter()
-            decide(export, exp, verdicts, args.step)
+            decide(export, exp, verdicts, args.step, extra)
             print("  " + ", ".join(f"{k}: {v}" for k, v in sorted(verdicts.items())))
             total.update(verdicts)
     print(f"\ntotal: {total['requirements']} requirements, {total['translated']} translated to a decided "
@@ -193,7 +218,7 @@ def main(argv: list[str] | None = None) -> int:
     for k, v in reasons.most_common():
         print(f"  refused, {k}: {v}")
     for k, v in sorted(total.items()):
-        if k.startswith(("verdict", "refused:", "malformed")):
+        if k.startswith(("verdict", "refused:", "malformed", "translated with")):
             print(f"  {k}: {v}")
     print(f"({time.perf_counter() - start:.1f} s)")
     return 0

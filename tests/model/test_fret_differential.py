@@ -23,6 +23,7 @@ control: it disagrees with FRET on some trace.
 """
 from __future__ import annotations
 
+import math
 import random
 import re
 import zlib
@@ -117,6 +118,12 @@ CASES: list[tuple[str, str, str, str, str | None, str, dict[str, Any], str]] = [
      "(H ((H (! obstacle)) | (((! clear) S ((! clear) & obstacle)) -> braking)))"),
     ("NESTED-PRE", "null", "noTrigger", "immediately", "(preBool ( false , speed - preReal ( 0.0 , speed ) <= 1.0 ))",
      "(braking)", {}, "(H ((Y ((speed - preReal(0.0,speed)) <= 1.0)) -> braking))"),
+    # FRET's sqrt, sin, cos (RCL's own; the oracle evaluates them with Python's math)
+    ("SQRT", "null", "null", "always", None, "(speed <= sqrt(asked))", {}, "(H (speed <= sqrt(asked)))"),
+    ("SIN-COS", "null", "noTrigger", "immediately", "(sin(asked) > 0.5)", "(cos(speed) < 0.5 | braking)", {},
+     "(H ((sin(asked) > 0.5) -> ((cos(speed) < 0.5) | braking)))"),
+    ("UPON-SQRT", "null", "regular", "next", "(sqrt(asked + speed) >= 2.0)", "(! braking)", {},
+     "(H ((Y ((sqrt((asked + speed)) >= 2.0) & (Z (! (sqrt((asked + speed)) >= 2.0))))) -> ((! braking) | (Z FALSE))))"),
 ]
 
 
@@ -176,6 +183,11 @@ def _pt_parse(text: str) -> Any:
             return ("const", t == "TRUE")
         if t[0].isdigit():
             return ("const", Fraction(t))
+        if peek() == "(" and t in ("sqrt", "sin", "cos"):  # FRET's math functions: Python's math in the oracle
+            take()
+            arg = level(0)
+            assert take() == ")"
+            return ("math", t, arg)
         if peek() == "(":  # preReal(init, e): FRET's pt keeps Lustre's "init -> pre e" as a call; maxReal(a, b)
             take()
             init = level(0)
@@ -199,6 +211,8 @@ def _pt(e: Any, tr: list[dict[str, Any]], i: int) -> Any:
         return not _pt(e[1], tr, i)
     if op == "pre":
         return _pt(e[1], tr, i) if i == 0 else _pt(e[2], tr, i - 1)
+    if op == "math":
+        return getattr(math, e[1])(float(_pt(e[2], tr, i)))
     if op in ("max", "min"):  # FRET's maxReal/minReal (its field guide, "builtin functions")
         return (max if op == "max" else min)(_pt(e[1], tr, i), _pt(e[2], tr, i))
     if op == "+" or op == "-" or op == "*" or op == "/":
@@ -388,3 +402,12 @@ def test_the_oracle_reads_fret_operators() -> None:
     assert at("(a S b)", 1) is True and at("(a S b)", 2) is False
     assert at("(O[0,1] a)", 1) is True and at("(O[0,1] a)", 2) is False
     assert at("(H[0,1] (! a))", 2) is True and at("(H (! a))", 2) is False
+
+
+def test_a_function_read_as_another_disagrees_with_fret(checked: Any) -> None:
+    """The control of the math cases: ``sin`` imported as ``cos`` differs from FRET's formalisation (Python's
+    math in the oracle) on some trace, so the agreement of SIN-COS above is not vacuous."""
+    case = next(c for c in CASES if c[0] == "SIN-COS")
+    swapped = case[:4] + (str(case[4]).replace("sin", "cos"),) + case[5:]
+    (imp,) = import_export(_export([swapped]), Options(components={"rover": "Rover"}))
+    assert _disagreements(imp, checked, case[-1], 100, 11) != []

@@ -150,7 +150,7 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
         _req("LUSTRE-WHEN", "the rover shall always satisfy sampled <= 2.0", "always", "(sampled <= 2.0)"),
         _req("LUSTRE-OK", "the rover shall always satisfy filtered <= 2.0", "always", "(filtered <= 2.0)"),
         _req("UNDECLARED", "the rover shall always satisfy ghost", "always", "(ghost)"),
-        _req("FUNCTION", "the rover shall always satisfy sqrt(speed) < 2.0", "always", "(sqrt(speed) < 2.0)"),
+        _req("FUNCTION", "the rover shall always satisfy cbrt(speed) < 2.0", "always", "(cbrt(speed) < 2.0)"),
         _req("MODE-TRIGGER", "in manual mode upon obstacle the rover shall immediately satisfy braking", "immediately",
              "(braking)", "regular", "(obstacle)", scope_mode="manual"),
         {"reqid": "NOSEM", "fulltext": "not parsed by FRET"},
@@ -176,7 +176,7 @@ def test_refusals_name_the_reason_and_the_fix(tmp_path: Path) -> None:
         "always ((rover.state.fret_LUSTRE_OK_ftp -> ((0.0) <= 2.0)) and ((not rover.state.fret_LUSTRE_OK_ftp) -> "
         "((rover.state.fret_LUSTRE_OK_pre2) <= 2.0)))")
     assert why["UNDECLARED"] is not None and why["UNDECLARED"][0] == "ghost is not declared in the export"
-    assert why["FUNCTION"] is not None and "FRET function sqrt(_)" in why["FUNCTION"][0]
+    assert why["FUNCTION"] is not None and "FRET function cbrt(_)" in why["FUNCTION"][0]
     assert why["MODE-TRIGGER"] == ("its export has no past-time formalisation (semantics.ptExpanded), which rclverify "
                                    "states for the scope in with the timing immediately",
                                    "export the requirement again from FRET")

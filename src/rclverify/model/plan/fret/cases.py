@@ -149,7 +149,7 @@ def text(e: Expr) -> str:
         assert isinstance(items, tuple)
         return "(" + " and ".join(text(x) for x in items) + ")"
     if kind == "call":
-        return f"abs({text(e[2][0])})"  # type: ignore[index]
+        return f"{e[1]}({text(e[2][0])})"  # type: ignore[index]
     op, la, lb = e[1], text(e[2]), text(e[3])  # type: ignore[arg-type]
     if op == "xor":
         return f"(not ({la} <=> {lb}))"

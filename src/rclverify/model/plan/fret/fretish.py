@@ -18,6 +18,7 @@ FRETish                RCL
 ``FTP``                the first step: a state variable true only there
 ``a = b``              ``a == b``
 ``absReal(e)``, ``absInt(e)``, ``abs(e)``  ``abs(e)``
+``sqrt(e)``, ``sin(e)``, ``cos(e)``  the same (RCL's, radians)
 ``maxReal(a, b)``      ``ite(a >= b, a, b)`` (``maxInt`` the same; ``minReal``,
                        ``minInt`` with ``<=``), stated case by case where a
                        formula reads it (:func:`.cases.lift`)
@@ -33,16 +34,21 @@ FRETish                RCL
                        ``O[0,n] p``)
 =====================  =====================================================
 
-Any other function, ``^`` and a name the caller cannot place raise
-:class:`Refusal` with the reason and what would make it importable.
+A function the plan defines (``fret: functions:``, :mod:`.declared`) is
+its RCL term with the arguments in place.  Any other function, ``^`` and a
+name the caller cannot place raise :class:`Refusal` with the reason and
+what would make it importable.
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Callable, Union
+from typing import TYPE_CHECKING, Callable, Mapping, Union
 
 from rclverify.model.plan.fret.cases import Expr as Expr, lift, text  # Expr: a parsed expression (its shapes there)
+
+if TYPE_CHECKING:
+    from rclverify.model.plan.fret.declared import DeclaredFunction
 
 _TOKEN = re.compile(r"\s*(?:(?P<num>\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?)"
                     r"|(?P<name>[A-Za-z_][A-Za-z0-9_]*)"
@@ -51,6 +57,8 @@ _TOKEN = re.compile(r"\s*(?:(?P<num>\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][
 _LEVELS: tuple[tuple[str, ...], ...] = (("<=>", "<->"), ("=>", "->"), ("xor",), ("|",), ("&",))
 _COMPARE = ("=", "!=", "~=", "<", "<=", ">", ">=")
 ABS = ("absReal", "absInt", "abs")
+#: FRET's (and Lustre's math library's) sqrt, sin, cos of one real: RCL's own (docs/semantics.md, "Mathematical functions")
+MATH = ("sqrt", "sin", "cos")
 #: FRET's maxReal/maxInt and minReal/minInt (FRET's field guide, "builtin functions"): the comparison choosing a.
 EXTREMA = {"maxReal": ">=", "maxInt": ">=", "minReal": "<=", "minInt": "<="}
 PRE = {"preBool": "BOOL", "preReal": "REAL", "preInt": "INTEGER"}
@@ -229,6 +237,8 @@ class Writer:
     #: ``table(length, local)``: the RCL text of the requirement's step counter (``state.v``, the steps
     #: since the first, at least ``length - 1`` once it stops) for a Lustre table (:mod:`.lustre`).
     table: Callable[[int, bool], str] | None = None
+    #: the plan's ``fret: functions:`` by name (:mod:`.declared`)
+    functions: "Mapping[str, DeclaredFunction] | None" = None
 
     def rcl(self, e: Expr, local: bool = False) -> str:
         """RCL text of formula ``e``: over ``Node.in.x``/``Node.out.y``/``Node.state.v``
@@ -260,6 +270,8 @@ class Writer:
         assert isinstance(args, tuple)
         if name in ABS and len(args) == 1:
             return ("call", "abs", (self.resolve(args[0], local),))
+        if name in MATH and len(args) == 1:
+            return ("call", name, (self.resolve(args[0], local),))
         if name in EXTREMA and len(args) == 2:  # FRET's maxReal(a, b): if a >= b then a else b
             a, b = (self.resolve(x, local) for x in args)
             return ("ite", ("bin", EXTREMA[name], a, b), a, b)
@@ -286,10 +298,13 @@ class Writer:
             ref = ("text", f"state.{state}" if local else f"{self.node}.state.{state}")
             p = self.resolve(args[1], local)
             return ("bin", "&", p, ("bin", ">=", ref, n)) if name == "persisted" else ("bin", "|", p, ("bin", "<=", ref, n))
+        if self.functions and name in self.functions:
+            return ("text", self.functions[name].call([text(lift(self.resolve(a, local))) for a in args]))
         raise Refusal(f"it calls the FRET function {name}({', '.join('_' for _ in args)}), which has no RCL "
-                      "counterpart", f"write {name} as an RCL formula over the component's inputs and outputs"
-                                     " (rclverify translates absReal, absInt, maxReal, maxInt, minReal, minInt, preBool,"
-                                     " preReal, preInt, persisted and occurred)")
+                      "counterpart", f"define {name} in the plan's fret: functions as an RCL term over its arguments,"
+                                     " or write it as an RCL formula over the component's inputs and outputs"
+                                     " (rclverify translates absReal, absInt, maxReal, maxInt, minReal, minInt, sqrt, sin,"
+                                     " cos, preBool, preReal, preInt, persisted and occurred)")
 
 
 def _constant(e: Expr) -> bool:

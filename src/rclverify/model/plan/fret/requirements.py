@@ -22,6 +22,7 @@ would make it importable``: none is dropped.
 """
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -32,6 +33,7 @@ from rclverify.lang import ast
 from rclverify.model.plan.formal import Source
 from rclverify.model.plan.model import Requirement
 from rclverify.model.plan.state import StateVar
+from rclverify.model.plan.fret.declared import DeclaredFunction, functions_of, variables_of
 from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretVariable, read_export
 from rclverify.model.plan.fret.fretish import Expr, Refusal, parse
 from rclverify.model.plan.fret.lustre import LUSTRE, fretish, parse_lustre, self_reads
@@ -51,10 +53,15 @@ _LUSTRE_WORDS = re.compile(r"\b(?:and|or|not)\b|<>")
 @dataclass(frozen=True)
 class Options:
     """The plan's ``fret:`` section: ``components`` maps FRET's component
-    names to nodes; ``step`` the seconds of one step (durations in secs)."""
+    names to nodes; ``step`` the seconds of one step (durations in secs);
+    ``variables`` the idType (``Input``/``Output``) of a variable the export
+    gives none, ``functions`` the model functions defined in RCL
+    (:mod:`.declared`)."""
 
     components: Mapping[str, str] = field(default_factory=dict)
     step: Fraction | None = None
+    variables: Mapping[str, str] = field(default_factory=dict)
+    functions: Mapping[str, DeclaredFunction] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -103,8 +110,10 @@ def ports_of(specs: list[ast.Spec]) -> Ports:
 class _Places:
     """Where each name of one requirement goes (``var`` of :class:`~.fretish.Writer`)."""
 
-    def __init__(self, exp: FretExport, fr: FretRequirement, node: str, ports: Ports | None) -> None:
+    def __init__(self, exp: FretExport, fr: FretRequirement, node: str, ports: Ports | None,
+                 declared: Mapping[str, str] | None = None) -> None:
         self.exp, self.fr, self.node, self.ports = exp, fr, node, ports
+        self.declared = declared or {}  # the plan's fret: variables (name -> Input/Output)
         self.depth = 0
         self.defining: list[str] = []
 
@@ -114,6 +123,10 @@ class _Places:
     def __call__(self, name: str, local: bool) -> str | Expr:
         v = self._declared(name)
         kind = v.id_type if v is not None else ""
+        if not kind and name in self.declared and (self.ports is None or name not in self.ports.constants):
+            kind = self.declared[name]
+            v = v if v is not None else FretVariable(self.fr.component, name, "", "", "")
+            v = dataclasses.replace(v, id_type=kind)
         if kind in ("Input", "Output"):
             assert v is not None
             prefix = "in" if kind == "Input" else "out"
@@ -139,8 +152,9 @@ class _Places:
         if self.ports is not None and name in self.ports.constants:
             return name
         why = "not declared in the export" if v is None else "declared without an idType"
-        raise Refusal(f"{name} is {why}", f"declare it in FRET as an Input or Output of {self.fr.component}, or "
-                                          "as a constant or enumeration value of the contracts' context")
+        raise Refusal(f"{name} is {why}", f"declare it in FRET as an Input or Output of {self.fr.component}, in "
+                                          f"the plan's fret: variables ({{{name}: input}} or output), or as a "
+                                          "constant or enumeration value of the contracts' context")
 
     def _defined(self, name: str, text: str, local: bool, lustre: bool = False) -> Expr:
         """The tree of a variable defined by a FRETish expression (an Internal variable's assignment, a
@@ -245,7 +259,8 @@ def import_export(exp: FretExport, options: Options, ports: Ports | None = None)
                 known = ", ".join(sorted(ports.nodes)) or "none"
                 raise Refusal(f"no node named {node} in the contracts (nodes: {known})",
                               f"map the component in the plan (fret: {{components: {{{fr.component}: Node}}}})")
-            t = translate(fr.reqid, fr.fulltext, fr.semantics, node, _Places(exp, fr, node, ports), options.step)
+            t = translate(fr.reqid, fr.fulltext, fr.semantics, node, _Places(exp, fr, node, ports, options.variables),
+                          options.step, options.functions)
         except Refusal as exc:
             out.append(Imported(fr, informal, (), exc))
             continue
@@ -294,7 +309,7 @@ def options_of(data: Mapping[str, Any]) -> Options:
     if spec.get("step") is not None:
         from rclverify.lang.timing import parse_duration  # deferred: start-up (only with fret: step:)
         step = parse_duration(str(spec["step"]))
-    return Options(dict(spec.get("components") or {}), step)
+    return Options(dict(spec.get("components") or {}), step, variables_of(spec), functions_of(spec))
 
 
 def plan_additions(root: Path, data: Mapping[str, Any], contracts: tuple[str, ...]

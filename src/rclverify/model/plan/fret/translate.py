@@ -61,6 +61,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Callable, Mapping
 
+from rclverify.model.plan.fret.declared import DeclaredFunction
 from rclverify.model.plan.fret.fretish import Expr, Refusal, Writer, parse
 from rclverify.model.plan.fret.pasttime import CLOSED, PastTime, not_closed, parse_pt, statement
 
@@ -149,6 +150,8 @@ class _States:
         self.made: list[NewState] = []
         #: The last step a Lustre table of the requirement tells apart (its step counter stops there).
         self.bound = 0
+        #: the plan's ``fret: functions:`` (:mod:`.declared`), by name
+        self.functions: Mapping[str, DeclaredFunction] = {}
 
     def finish(self, t: Translation) -> Translation:
         """``t`` with its step counter (if a Lustre table made one) stopping at :attr:`bound`."""
@@ -166,12 +169,15 @@ class _States:
 
 
 def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
-              var: Callable[[str, bool], str | Expr], step: Fraction | None = None) -> Translation:
+              var: Callable[[str, bool], str | Expr], step: Fraction | None = None,
+              functions: Mapping[str, DeclaredFunction] | None = None) -> Translation:
     """Requirement ``reqid`` (``semantics`` ``sem``, FRET's export fields) as
     an RCL statement over ``node`` (module table).  ``var(name, local)``
     places a variable (:class:`~.fretish.Writer`); ``step`` the plan's
-    seconds per step for durations in seconds.  Raises :class:`Refusal`."""
+    seconds per step for durations in seconds; ``functions`` the plan's
+    ``fret: functions:`` (:mod:`.declared`).  Raises :class:`Refusal`."""
     states = _States(state_base(reqid))
+    states.functions = functions or {}
     return states.finish(_translate(fulltext, sem, node, var, step, states))
 
 
@@ -315,7 +321,7 @@ def _writer(var: Callable[[str, bool], str | Expr], states: _States, node: str) 
         ftp = next((x.name for x in states.made if x.name == f"{states.base}_ftp"), None) or \
             states.add("ftp", "BOOL", "TRUE", "not @")  # FRET's first time point
         return f"state.{ftp}" if local else f"{node}.state.{ftp}"
-    w = Writer(placed, pre, node, count, table=table)
+    w = Writer(placed, pre, node, count, table=table, functions=states.functions)
     return w
 
 
