@@ -10,8 +10,8 @@ ROS 2 layer (:mod:`.ros2`) only move messages in and verdicts out.  It
   so ``rclverify monitor LOG`` re-checks the messages and skips them);
 * hands each verdict, as JSON text, to ``publish`` (node, guarantee,
   verdict, time, the first violation's values ...), and each node's latest
-  verdict to ``publish_last`` (a latched topic) at every timer tick where
-  it changed;
+  verdict to ``publish_last`` (a latched topic) when it changed, at a
+  timer tick at most every :data:`FLUSH_S` (20 ms) and when the run stops;
 * keeps a one-line status per node (:meth:`status_line`);
 * runs each node's timed guarantees (``triggered by ... within ...``)
   and periodic outputs through the offline check's monitors, fed the very
@@ -60,6 +60,9 @@ from rclverify.backends.monitors.online import OnlineEngine
 from rclverify.runtime.worker import EngineWorker
 
 VERDICT_LOG_TOPIC = "rclverify/verdict"
+#: the least time (s, the run's clock) between two publications of the latched last verdicts and two
+#: flushes of the log: the engine worker ticks at each message's release at a high rate (runtime/worker.py)
+FLUSH_S = 0.02
 
 
 def _json_safe(v: Any) -> Any:
@@ -72,11 +75,15 @@ def _json_safe(v: Any) -> Any:
     return v
 
 
+#: the one encoder of the log's and the verdicts' JSON (made once: ``json.dumps`` with options makes one a call)
+_ENCODER = json.JSONEncoder(allow_nan=False, separators=(", ", ": "))
+
+
 def dumps(obj: Any) -> str:
     """Compact JSON; a NaN or an infinity (no JSON number) is written as its
     string (``"nan"``), so every line stays readable by the log reader."""
     try:
-        return json.dumps(obj, allow_nan=False, separators=(", ", ": "))
+        return _ENCODER.encode(obj)
     except ValueError:
         return json.dumps(_json_safe(obj), separators=(", ", ": "))
 
@@ -123,6 +130,7 @@ class LiveRun:
         self.orphans: dict[str, int] = {}
         self.results: list[NodeResult] | None = None
         self._last: dict[str, str] = {}  # node -> latest verdict not yet published as its last verdict
+        self._flushed = -math.inf  # the tick time (s) of the last publication of the last verdicts and log flush
 
     # -- engine callbacks (called under the lock) ----------------------------------
     def _event(self, ev: Event) -> None:
@@ -198,13 +206,16 @@ class LiveRun:
             return self.engine.due() if self.results is None else math.inf
 
     def tick(self, now: float) -> None:
-        """The timer (see :meth:`OnlineEngine.tick`)."""
+        """The timer (see :meth:`OnlineEngine.tick`); the latched last verdicts
+        published and the log flushed once per :data:`FLUSH_S` of ``now``."""
         with self.lock:
             if self.results is None:
                 self.engine.tick(now)
                 self.checks.advance(self.engine.watermark(now))  # the monitors' clock, the engine's watermark
-                self._flush_last()
-                self._log.flush()
+                if not now < self._flushed + FLUSH_S:
+                    self._flushed = now
+                    self._flush_last()
+                    self._log.flush()
 
     def note(self, obj: Mapping[str, object]) -> None:
         """One more line of the log (the service proxy's events and deadline
@@ -225,8 +236,9 @@ class LiveRun:
             count_call_line(obj, self.calls_heard, self.orphans)
 
     def _flush_last(self) -> None:
-        """Publish each node's latest verdict (latched), once per timer tick
-        rather than at every event: the topic holds the last one either way."""
+        """Publish each node's latest verdict (latched), at most once per
+        :data:`FLUSH_S` rather than at every event: the topic holds the last
+        one either way."""
         if self.publish_last is not None:
             for node, text in self._last.items():
                 self.publish_last(node, text)
