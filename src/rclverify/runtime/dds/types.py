@@ -462,20 +462,40 @@ def _units(text: Any, depth: int) -> Any:
     return [ord(c) for c in str(text)] if isinstance(text, str) else list(text)
 
 
+#: the types a received value is as it is (a number, a text, a Boolean)
+_PLAIN = frozenset((float, int, str, bool, type(None)))
+#: per struct class, its fields as :func:`to_fields` gives them: (name, wstring depth or None); None: no struct
+_PLANS: dict[type, tuple[tuple[str, int | None], ...] | None] = {}
+
+
+def _plan(cls: type) -> tuple[tuple[str, int | None], ...] | None:
+    fs = getattr(cls, "__dataclass_fields__", None)
+    wide = getattr(cls, WIDE, {})
+    plan = None if fs is None else tuple((k, wide.get(k)) for k in fs if k not in HEADER_FIELDS and k != _EMPTY)
+    _PLANS[cls] = plan
+    return plan
+
+
 def to_fields(sample: Any) -> Any:
     """A received struct as JSON-ready data: a dict per struct (the request
     header and rosidl's placeholder member left out), lists for arrays and
     sequences (an array of bytes as a list of ints), as the bag reader
-    gives a ROS 2 bag's message (``traces/bag.py``)."""
-    fs = getattr(sample, "__dataclass_fields__", None)
-    if fs is not None:
-        wide = getattr(type(sample), WIDE, {})
-        return {k: _text(getattr(sample, k), wide[k]) if k in wide else to_fields(getattr(sample, k))
-                for k in fs if k not in HEADER_FIELDS and k != _EMPTY}
+    gives a ROS 2 bag's message (``traces/bag.py``).  A struct's fields are
+    listed once per class (the live monitor decodes every sample)."""
+    cls = type(sample)
+    if cls in _PLAIN:
+        return sample
+    plan = _PLANS[cls] if cls in _PLANS else _plan(cls)
+    if plan is not None:
+        out: dict[str, Any] = {}
+        for k, depth in plan:
+            v = getattr(sample, k)
+            out[k] = _text(v, depth) if depth is not None else v if type(v) in _PLAIN else to_fields(v)
+        return out
     if isinstance(sample, (bytes, bytearray)):
         return list(sample)
     if isinstance(sample, (list, tuple)):
-        return [to_fields(x) for x in sample]
+        return [x if type(x) in _PLAIN else to_fields(x) for x in sample]
     return sample
 
 
