@@ -147,8 +147,10 @@ def fields_read_code(source: str, record: type[msgspec.Struct]) -> set[str]:
     function that also binds it to something else reads that too (and a read of no field then shows)."""
     tree = pyast.parse(source)
     name = record.__name__
+    # the record module's rows_of, when it decodes this record (a module of several records decodes one)
+    decodes = typing.get_type_hints(getattr(sys.modules[record.__module__], "rows_of", lambda: None)).get("return")
     decoders = {a.asname or a.name for n in pyast.walk(tree) if isinstance(n, pyast.ImportFrom)
-                and n.module == record.__module__ for a in n.names if a.name == "rows_of"}
+                and n.module == record.__module__ for a in n.names if a.name == "rows_of"} if decodes == list[record] else set()
     # the decoded report's parts of this record (AssuranceReport.findings: list[FindingRow], ...)
     parts = {k for k, t in typing.get_type_hints(AssuranceReport).items() if t == list[record]}
 
@@ -786,3 +788,41 @@ def test_a_typed_filter_reading_a_removed_field_fails_mypy(module: str, tmp_path
         shadow.write_text(_without_field(record.read_text(encoding="utf-8"), cls.__name__, field), encoding="utf-8")
         rc, out = _mypy(["--shadow-file", str(record), str(shadow), str(filt)], tmp_path / "cache")
         assert rc == 1 and f'{filt.name}:' in out and f'"{cls.__name__}" has no attribute "{field}"' in out, out
+
+
+#: The standards exports (the CSV/XLSX compliance matrix and its header, the gaps): their modules.
+EXPORTS: tuple[Path, ...] = tuple(PARTS.parents[1] / f"{m}.py" for m in ("standards_sheets", "standards_export"))
+#: The records the exports show, each with its table of the fields they do not show.
+EXPORT_RECORDS: dict[str, tuple[type[msgspec.Struct], Mapping[str, str]]] = {
+    "standards": (StandardRow, standards_rows.EXPORTS_INTERNAL),
+    "standards.clauses": (standards_rows.ClauseRow, standards_rows.CLAUSE_EXPORTS_INTERNAL),
+}
+
+
+class _StandardWithMargin(StandardRow, frozen=True, forbid_unknown_fields=True):
+    """The standard row with one field added, as a change to records/standards_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+@pytest.mark.parametrize("key", list(EXPORT_RECORDS))
+def test_every_field_is_shown_by_the_exports_or_internal_to_them(key: str) -> None:
+    cls, internal = EXPORT_RECORDS[key]
+    assert unaccounted(cls, [p.read_text(encoding="utf-8") for p in EXPORTS], internal, code=cls) == []
+    assert all(why for why in internal.values())
+
+
+def test_a_field_added_to_a_standard_fails_until_the_exports_show_it_or_declare_it_internal() -> None:
+    source = "\n".join(p.read_text(encoding="utf-8") for p in EXPORTS)
+    internal = standards_rows.EXPORTS_INTERNAL
+    assert unaccounted(_StandardWithMargin, [source], internal, code=StandardRow) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_StandardWithMargin, [source], {**internal, "margin_added_here": "why"}, code=StandardRow) == []
+    old = '[standard.edition, level, standard.profile,'
+    shown = source.replace(old, '[standard.edition, standard.margin_added_here, level, standard.profile,', 1)
+    assert shown != source
+    assert unaccounted(_StandardWithMargin, [shown], internal, code=StandardRow) == []
+    # a read of an undecoded row (a JSON object read by key) does not count
+    raw = source + "\ndef _x(s):\n    return s.get('margin_added_here')\n"
+    assert unaccounted(_StandardWithMargin, [raw], internal, code=StandardRow) != []
+    assert unaccounted(StandardRow, [source], {**internal, "edition": "x"}, code=StandardRow) == [
+        "edition: declared internal but rendered"]

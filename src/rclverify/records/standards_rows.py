@@ -176,5 +176,24 @@ INTERNAL: dict[str, str] = {
 }
 
 
-__all__ = ["About", "ClauseEvidence", "ClauseRow", "ClauseStatus", "INTERNAL", "Independence", "LeftOut",
+#: The fields of :class:`StandardRow` the standards exports (report/standards_sheets.py, the CSV and XLSX
+#: compliance matrix with its header; report/standards_export.py, the gaps) do not show, each with the reason.
+EXPORTS_INTERNAL: dict[str, str] = {
+    "title": "a standard is named by its edition and profile in each row; its title heads the report's section",
+    "source": "where the plan names the standard; the export's header names the plan file with its sha256",
+    "left_out": "a clause the profile does not list is no row of the matrix; the report lists each with why",
+    "open": "each open clause is a row of the matrix with its status open",
+    "strict": "whether --strict gates on the standard: the gate's, not a column an assessor decides on",
+}
+#: The fields of :class:`ClauseRow` the compliance matrix does not show, each with the reason.
+CLAUSE_EXPORTS_INTERNAL: dict[str, str] = {
+    "strength": "the least strength the clause asks is shown in the report's clause table; the matrix gives the "
+                "state of each item in scope and the clause's status and why",
+    "evidence": "each covering record is shown once, in 'evidence that covers it' (with its sha256 and start), "
+                "and each item's state in 'items in scope and their state'",
+}
+
+
+__all__ = ["About", "CLAUSE_EXPORTS_INTERNAL", "ClauseEvidence", "ClauseRow", "ClauseStatus", "EXPORTS_INTERNAL",
+           "INTERNAL", "Independence", "LeftOut",
            "PlanNote", "ProfileOrigin", "Recommendation", "ScopeItem", "ScopeKind", "StandardRow", "rows_of"]

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify.core.atomic import atomic_write_bytes, atomic_write_text
+from rclverify.records.standards_rows import rows_of as standard_rows
 from rclverify.report.standards_rows import origin_text
 from rclverify.report.standards_sheets import (MATRIX_COLUMNS, TRACE_COLUMNS, header_rows, matrix_rows,
                                                trace_rows)
@@ -164,14 +165,15 @@ def gaps(report: Mapping[str, Any]) -> list[str]:
     """The standards' gaps in a few lines: per standard, its counts and the clauses it asks at the level
     that are not covered, each with its why (empty when the report maps no standard)."""
     out = []
-    for s in report.get("standards") or ():
-        level = "" if s.get("level") is None else f" {str(s.get('level_name', '')).upper()} {s['level']}"
-        counts = ", ".join(f"{n} {k}" for k, n in (s.get("counts") or {}).items() if n)
-        out.append(f"{s.get('edition')}{level} ({origin_text(s.get('origin') or {})}): {counts}")
-        clauses = {str(c["id"]): c for c in s.get("clauses") or ()}
-        for cid in s.get("required_not_covered") or ():
-            c = clauses.get(str(cid), {})
-            out.append(f"  {cid} [{c.get('recommendation', '')}] {c.get('title', '')}: {c.get('why', '')}")
+    for standard in standard_rows(report.get("standards") or ()):
+        level = "" if standard.level is None else f" {standard.level_name.upper()} {standard.level}"
+        counts = ", ".join(f"{n} {k}" for k, n in standard.counts.items() if n)
+        out.append(f"{standard.edition}{level} ({origin_text(standard.origin)}): {counts}")
+        clauses = {clause.id: clause for clause in standard.clauses}
+        for cid in standard.required_not_covered:
+            clause = clauses.get(cid)
+            out.append(f"  {cid} [{clause.recommendation if clause else ''}] {clause.title if clause else ''}: "
+                       f"{clause.why if clause else ''}")
     return out
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from rclverify.model.plan.standards.field_data import figures
+from rclverify.records.standards_rows import ClauseRow, ProfileOrigin, StandardRow, rows_of as standard_rows
 
 #: The compliance matrix's columns.
 MATRIX_COLUMNS: tuple[str, ...] = (
@@ -37,11 +38,11 @@ TRACE_COLUMNS: tuple[str, ...] = (
     "kind", "evidence status", "tool", "premises used", "clauses it supports")
 
 
-def origin_cell(o: Mapping[str, Any]) -> str:
+def origin_cell(o: ProfileOrigin) -> str:
     """A profile's origin (``standards[].origin``) as one cell."""
-    if o.get("kind") == "built-in":
-        return f"built-in ({o.get('edition')})"
-    return f"workspace file {o.get('file')} sha256 {o.get('sha256')}"
+    if o.kind == "built-in":
+        return f"built-in ({o.edition})"
+    return f"workspace file {o.file} sha256 {o.sha256}"
 
 
 def header_rows(report: Mapping[str, Any], report_sha256: str, written: str,
@@ -59,31 +60,30 @@ def header_rows(report: Mapping[str, Any], report_sha256: str, written: str,
             ["plan", f"{meta.get('plan', '')} sha256 {files_sha256.get(str(meta.get('plan', '')), 'missing')}"]]
     rows += [["contract", f"{c} sha256 {files_sha256.get(str(c), 'missing')}"] for c in meta.get("contracts") or ()]
     rows.append(["inputs sha256", str(meta.get("inputs_sha256", ""))])
-    for s in report.get("standards") or ():
-        o = s.get("origin") or {}
-        rows.append(["standard", f"{s.get('edition')} ({s.get('profile')}): {origin_cell(o)}, profile sha256 "
-                                 f"{o.get('sha256', '')}"])
+    for standard in standard_rows(report.get("standards") or ()):
+        rows.append(["standard", f"{standard.edition} ({standard.profile}): {origin_cell(standard.origin)}, "
+                                 f"profile sha256 {standard.origin.sha256}"])
     rows.append(["note", "a traceability aid, not a compliance claim (docs/standards.md)"])
     return rows
 
 
-def _statistics(report: Mapping[str, Any], scope: list[Mapping[str, Any]]) -> dict[str, str]:
+def _statistics(report: Mapping[str, Any], clause: ClauseRow) -> dict[str, str]:
     """The figures of the statistical targets in ``scope``, column by column, ``"; "``-joined."""
     evidence = {str(e.get("obligation")): e for e in report.get("evidence") or ()}
     req_runs = {f"target of requirement {rq.get('id')} ({t.get('environment')}, {t.get('origin')})": t
                 for rq in report.get("requirements") or () for t in rq.get("statistics") or ()}
     found: list[dict[str, str]] = []
-    for x in scope:
-        if x.get("kind") != "target":
+    for x in clause.scope:
+        if x.kind != "target":
             continue
-        item = str(x.get("item"))
+        item = x.item
         stats = req_runs.get(item) or (evidence.get(item.removeprefix("target ")) or {}).get("statistics")
         if isinstance(stats, Mapping):
             found.append(figures(stats))
     return {k: "; ".join(f[k] for f in found) for k in STAT_KEYS}
 
 
-def _covering(report: Mapping[str, Any], covered_by: list[Any], digests: Mapping[str, str]) -> str:
+def _covering(report: Mapping[str, Any], covered_by: list[str], digests: Mapping[str, str]) -> str:
     """The evidence that covers a clause: each record with its sha256 and the date its tool started."""
     evidence = {str(e.get("obligation")): e for e in report.get("evidence") or ()}
     out = []
@@ -101,35 +101,37 @@ def matrix_rows(report: Mapping[str, Any], digests: Mapping[str, str] | None = N
     of its evidence record file, shown beside each record that covers a clause with the time its tool
     started (an obligation without a digest is shown without one)."""
     out = [list(MATRIX_COLUMNS)]
-    for s in report.get("standards") or ():
-        level = "" if s.get("level") is None else f"{str(s.get('level_name', '')).upper()} {s['level']}"
-        for c in s.get("clauses") or ():
-            scope = c.get("scope") or []
-            plan = c.get("plan") or {}
-            stats = _statistics(report, scope)
-            out.append([
-                str(s.get("edition", "")), level, str(s.get("profile", "")), origin_cell(s.get("origin") or {}),
-                str(c["id"]), str(c.get("title", "")), str(c.get("recommendation", "")), str(c.get("about", "")),
-                ", ".join(str(k) for k in c.get("accepts") or ()), str(c.get("independence", "")),
-                str(len(scope)), str(sum(1 for x in scope if x.get("covered"))),
-                "; ".join(f"{x['item']}: {x.get('state', '')}" for x in scope),
-                "; ".join(f"{x['item']}: {x.get('detail', x.get('state', ''))}" for x in scope if not x.get("covered")),
-                _covering(report, list(c.get("covered_by") or ()), digests or {}),
-                "; ".join(str(x) for x in c.get("checked_by") or ()),
-                *(stats[k] for k in STAT_KEYS),
-                str(c.get("status", "")), str(c.get("why", "")), str(plan.get("justification", "")),
-                str(plan.get("at", "")), "", ""])
+    for standard in standard_rows(report.get("standards") or ()):
+        out += [_clause_row(report, standard, clause, digests or {}) for clause in standard.clauses]
     return out
+
+
+def _clause_row(report: Mapping[str, Any], standard: StandardRow, clause: ClauseRow,
+                digests: Mapping[str, str]) -> list[str]:
+    """A clause's row of the compliance matrix (:data:`MATRIX_COLUMNS`)."""
+    level = "" if standard.level is None else f"{standard.level_name.upper()} {standard.level}"
+    scope = clause.scope
+    stats = _statistics(report, clause)
+    return [standard.edition, level, standard.profile, origin_cell(standard.origin),
+            clause.id, clause.title, clause.recommendation, clause.about,
+            ", ".join(clause.accepts), clause.independence,
+            str(len(scope)), str(sum(1 for x in scope if x.covered)),
+            "; ".join(f"{x.item}: {x.state}" for x in scope),
+            "; ".join(f"{x.item}: {x.detail}" for x in scope if not x.covered),
+            _covering(report, clause.covered_by, digests), "; ".join(clause.checked_by),
+            *(stats[k] for k in STAT_KEYS),
+            clause.status, clause.why, "" if clause.plan is None else str(clause.plan.justification),
+            "" if clause.plan is None else str(clause.plan.at), "", ""]
 
 
 def _supports(report: Mapping[str, Any]) -> dict[str, list[str]]:
     """What covers an item of a clause (an obligation, a side condition, ``requirement <id>``) -> the
     clauses it helps cover, each as ``<edition> <clause>``."""
     out: dict[str, list[str]] = {}
-    for s in report.get("standards") or ():
-        for c in s.get("clauses") or ():
-            for ob in c.get("covered_by") or ():
-                out.setdefault(str(ob), []).append(f"{s.get('edition')} {c['id']}")
+    for standard in standard_rows(report.get("standards") or ()):
+        for clause in standard.clauses:
+            for ob in clause.covered_by:
+                out.setdefault(ob, []).append(f"{standard.edition} {clause.id}")
     return out
 
 
