@@ -38,7 +38,9 @@ GOOD = [b'{"topic": "reading", "time": 0.5, "data": 1.5}', b'{"topic": "status",
         b'{"topic": "reading", "time": 1e-320, "data": -0.0}', b'{"topic":"reading","time":2.0,"data":null}',
         b'  {"topic": "reading", "time": 4.0, "data": [1, {"y": 2.5}]}  ', b'{"topic": "status", "time": 5.0, "data": true}',
         '{"topic": "st\u00e4tus", "time": 6.0, "data": "\u00e9\\ud83d\\ude00"}'.encode(),
-        b'{"topic": "\\/reading", "time": 6.5, "data": 2.0}', b'{"topic": "\\u002Freading", "time": 7.0, "data": 3.0}']
+        b'{"topic": "\\/reading", "time": 6.5, "data": 2.0}', b'{"topic": "\\u002Freading", "time": 7.0, "data": 3.0}',
+        b'{"topic": "window", "time": 7.5, "data": [1.5, 2, -0.0, 123456789012345678901234567890, "x}{", null, true]}',
+        b'{"topic": "window", "time": 8.0, "data": [], "seq": [4.0, 1e-320]}']
 ODD = [b'{"topic": "reading", "time": 1.0, "data": 1, "data": "x"}', b'{"topic": "a", "topic": "reading", "time": 2.0}',
        b'{"t\\u006fpic": "reading", "time": 2.0, "data": 3.0}', b'{"topic": "reading", "time": 7, "data": 1.0}',
        b'{"topic": "reading", "time": 8.0, "data": 123456789012345678901234567890}', b'{"topic": "reading", "time": 2.5e308}',
@@ -47,7 +49,10 @@ ODD = [b'{"topic": "reading", "time": 1.0, "data": 1, "data": "x"}', b'{"topic":
        b'{"topic": "reading", "time": 1.0, "x": "\xff"}', b'{"topic": "reading", "time": 1.0, "x": "\xed\xa0\x80"}',
        b'{"topic": "reading", "time": 1.0, "data": 2.0}\x00', b'\x0c{"topic": "reading", "time": 1.0}',
        b'{"topic": "reading", "time": 1.0, "x": ' + b'[' * 3000 + b']' * 3000 + b'}', b'{"topic": "reading", "time": -0.0}',
-       b'{"topic": "reading", "time": 1.0, "data": 1E400}', b'{"topic": "reading", "time": 1.0, "seq": 2, "seq": null}']
+       b'{"topic": "reading", "time": 1.0, "data": 1E400}', b'{"topic": "reading", "time": 1.0, "seq": 2, "seq": null}',
+       b'{"topic": "window", "time": 1.0, "data": [[1.0], [2.0]]}', b'{"topic": "window", "time": 1.0, "data": [1.0, 1E400]}',
+       b'{"topic": "window", "time": 1.0, "data": [1.0, NaN]}', b'{"topic": "window", "time": 1.0, "data": [1.0,',
+       b'2.0]}']
 HOSTILE = [line.encode("utf-8", "surrogatepass") for line in LINES]
 FIELDS = [["data"], ["data", "seq"], ["time", "data"], [], ["x", "topic"]]
 
@@ -133,6 +138,27 @@ def test_an_integer_time_keeps_its_block_exact(tmp_path: Path) -> None:
     p.write_text('{"topic": "r", "time": 9007199254740993, "data": 1.0}\n{"topic": "r", "time": 1.0, "data": 1.0}\n')
     (block,) = JsonlLog(p).blocks(["data"], 10)
     assert isinstance(block, list) and [e.time for e in block] == [9007199254740992.0, 1.0]
+
+
+def test_a_log_of_arrays_is_decoded_at_once_and_an_object_inside_one_is_not(tmp_path: Path,
+                                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """A window or a ROS array field (an array of scalars) keeps a read on the at-once path (one
+    ``decode_lines`` call), with the exact reader's events and columns; an array holding an object or an
+    array sends the read to the line-by-line paths, with the same events."""
+    lines = [f'{{"topic": "window", "time": {i / 100!r}, "data": [{i * 0.5!r}, {i}, -0.0, "s", null, true]}}'
+             for i in range(50)]
+    p = tmp_path / "run.jsonl"
+    flat = jsonl_blocks._flat
+    at_once: list[bool] = []
+    monkeypatch.setattr(jsonl_blocks, "_flat", lambda *a: at_once.append((got := flat(*a)) is not None) or got)
+    for odd, want in ((None, [True]), ('{"topic": "window", "time": 9.0, "data": [1.0, {"x": 2.0}]}', [False]),
+                      ('{"topic": "window", "time": 9.0, "data": [[1.0], [2.0]]}', [False])):
+        p.write_text("\n".join(lines + ([odd] if odd else [])) + "\n")
+        at_once.clear()
+        seen = {"fast": 0, "exact": 0}
+        assert _outcome(_blockwise(p, ["data"], 1000, random.Random(1), seen)) == _outcome(read_jsonl(p))
+        assert at_once == want, odd
+        assert seen == {"fast": 1, "exact": 0}  # either way a fast block: at once, else line by line
 
 
 # -- the command, with and without the fast path ------------------------------------------------------

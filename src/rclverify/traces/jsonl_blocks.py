@@ -33,22 +33,27 @@ reader splits them: after ``\\n``, and at a bare ``\\r``.
 Before that, a whole read (:data:`BLOCK_BYTES`, cut after its last
 ``\\n``) is tried **at once**: one msgspec ``decode_lines``
 call into a *flat* struct (the same keys, every value but the topic and
-the time a JSON scalar: string, number, boolean or null; the time a
-number), taken only when the read has no ``\\r``, every line begins with
-``{`` and ends with ``}`` (the bytes around each ``\\n``, found with numpy)
-and the call gives one object per line.  Then each line is one object and
-nothing else, so each object is the one that line decodes to alone:
-strings cannot hold a raw line end (JSON forbids control characters in
-them, msgspec refuses them), so a line's last ``}`` is outside any string;
-values being scalars, it closes the object its line's first ``{`` opened;
-no object spans two lines and no line holds two, as there are as many
-objects as lines.  (``decode_lines`` alone is lax: it reads two objects on
-one line, or one over two lines; a block read as one JSON array was refused
-for the same reason, docs/scale.md.)  As on the line-by-line fast path,
-every time must be a finite ``float``.
-Anything else (an integer time, a nested value, a new key, a ``\\r``, bad bytes, a line
-msgspec refuses) sends the read to the line-by-line paths above, which
-give the same events and the same located error.  No line is split off
+the time a JSON scalar -- string, number, boolean or null -- or an array
+of scalars, a ROS array field or a window; the time a number), taken only
+when the read has no ``\\r``, every line begins with ``{`` and ends with
+``}`` (the bytes around each ``\\n``, found with numpy) and the call gives
+one object per line.  Then each line is one object and nothing else, so
+each object is the one that line decodes to alone: strings cannot hold a
+raw line end (JSON forbids control characters in them, msgspec refuses
+them), so every line begins and ends outside any string; no value holding
+an object, the only braces outside strings are the top-level objects', so
+each line's first ``{`` opens one and its last ``}`` closes one; with as
+many objects as lines, each line opens exactly one, and the object it
+opens is closed before the next line's opens: at that line's own end.
+(``decode_lines`` alone is lax: it reads two objects on one line, or one
+over two lines; a block read as one JSON array was refused for the same
+reason, docs/scale.md.)  The typed decoder reads a scalar or an array's
+items to the values the untyped one gives (integers of any size exact).
+As on the line-by-line fast path, every time must be a finite ``float``.
+Anything else (an integer time, an object or an array of arrays as a
+value, a new key, a ``\\r``, bad bytes, a line msgspec refuses) sends the
+read to the line-by-line paths above, which give the same events and the
+same located error.  No line is split off
 as a ``bytes`` object unless a row's event is asked for.
 """
 from __future__ import annotations
@@ -69,8 +74,11 @@ BLOCK_BYTES = 1 << 20
 #: The most keys the fast path's struct names (a log with more distinct keys reads the rest exactly).
 MAX_KEYS = 64
 _TOPIC, _TIME = attrgetter("f0"), attrgetter("f1")
-#: A flat line's values (module docstring): a nested array or object is refused by the decoder.
+#: A JSON scalar as the untyped decoder reads it.
 _SCALAR = Union[str, float, int, bool, None]
+#: A flat line's values (module docstring): a scalar or an array of scalars; an object, or an array
+#: holding an array or an object, is refused by the decoder.
+_FLAT = Union[str, float, int, bool, None, list[_SCALAR]]
 
 
 class JsonlLog:
@@ -112,7 +120,7 @@ class _Decoder:
                                  rename={f"f{j}": k for j, k in enumerate(self.keys)},
                                  forbid_unknown_fields=True, gc=False)
         self.decode = msgspec.json.Decoder(line).decode
-        flat = msgspec.defstruct("FlatLine", [("f0", str), ("f1", Union[float, int])] + [(f"f{j}", _SCALAR, None)
+        flat = msgspec.defstruct("FlatLine", [("f0", str), ("f1", Union[float, int])] + [(f"f{j}", _FLAT, None)
                                                                           for j in range(2, len(self.keys))],
                                  rename={f"f{j}": k for j, k in enumerate(self.keys)},
                                  forbid_unknown_fields=True, gc=False)
