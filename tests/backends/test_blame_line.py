@@ -300,7 +300,7 @@ def test_the_traced_line_agrees_with_python_on_random_functions(tmp_path: Path) 
 
 
 def test_a_run_and_a_property_test_of_one_step_name_the_line_that_computed_it() -> None:
-    from rclverify.diagnosis.build import _computed_line
+    from rclverify.diagnosis.evidence_records import _computed_line
     report = {"obligations": [{"id": "T.g1.property_tests.e0", "node": "T", "guarantee": 1},
                               {"id": "T.g2.property_tests.e0", "node": "T", "guarantee": 2}],
               "evidence": [{"obligation": "T.g1.property_tests.e0", "backend": "property_tests", "status": "failed",

@@ -15,7 +15,8 @@ import pytest
 import z3
 
 from rclverify.cli.commands import main
-from rclverify.diagnosis.build import CACHE, diagnose
+from rclverify.diagnosis.build import diagnose
+from rclverify.diagnosis.repair_cache import CACHE
 from rclverify.diagnosis.table import counterexample_table, decimals, function_table
 from rclverify.semantics.values import decimal_text
 from rclverify.report.diagnosis_text import natural_sorted
@@ -367,7 +368,7 @@ def test_parallel_report_tasks_diagnose_one_at_a_time(newcomer: Path) -> None:
     waits on the diagnosis lock, then finds the first's repairs in the cache instead of computing them again."""
     import fcntl
     import threading
-    from rclverify.diagnosis.build import LOCK
+    from rclverify.diagnosis.repair_cache import LOCK
     ws, report = _run(newcomer)
     ws.path(CACHE).unlink(missing_ok=True)
     fd = os.open(ws.path(LOCK), os.O_RDWR | os.O_CREAT)

@@ -36,7 +36,7 @@ def requirement_record(ws: Any, report: ReportRows, q: RequirementJson, cache: A
     with that strengthening as a repair; the counterexample shown for the
     nodes involved only (the nodes the statement mentions, the culprits'
     nodes and the nodes between them).  ``cache`` keeps the culprits
-    (``build._Cache``); ``guarantee_source(report, node, k)`` gives a
+    (``repair_cache.RepairCache``); ``guarantee_source(report, node, k)`` gives a
     guarantee's (text, source)."""
     check = q.get("check") or {}
     cone = [str(n) for n in check.get("cone") or []]
