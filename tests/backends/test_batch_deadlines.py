@@ -11,21 +11,26 @@ deadline).  Runs the batch cannot judge (a stamp going back, a header stamp, NaN
 topic written with ``/``, a value near a boundary) must still equal the streaming monitor's, in
 chunks of both kinds.  Controls: a brute force reading ``within`` as strictly before the deadline
 differs on a run answered at the deadline itself, and a batch judge whose expiry includes the
-deadline's own stamp is caught.
+deadline's own stamp is caught.  The bundled warehouse and delivery runs (a recorded log and two live
+monitors' logs, their eligible nodes' deadlines) give the streaming monitor's verdicts too.
 """
 from __future__ import annotations
 
 import random
 from fractions import Fraction
+from pathlib import Path
 from typing import Any, Callable
 
 import pytest
 
 from rclverify.backends.monitors import batch_deadline_chunk
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.backends.monitors.deadline_topics import has_deadlines
 from rclverify.backends.monitors.batch_deadlines import BatchDeadlines, deadline_monitor
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.lang.parser import parse_text
-from rclverify.lang.typecheck import check
+from rclverify.lang.typecheck import check, load
+from rclverify.traces import read_trace
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import load_rules
@@ -50,6 +55,7 @@ node Two {
 """
 CHECKED = check([parse_text(NODES)])
 NODE = CHECKED.nodes["D"]
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 RULES = load_rules({"trig": {"fields": ["data"]}, "ans": {"fields": ["data"]}, "other": {"fields": ["data"]}})
 HORIZON = 0.04
 #: guarantee -> (its test on (a, b) in exact rationals, its bound in ms); the third's bound is the horizon
@@ -193,3 +199,25 @@ def test_only_eligible_nodes_are_judged_in_batch() -> None:
     assert type(two) is DeadlineMonitor
     tolerant = deadline_monitor(CHECKED, NODE, RULES, tolerance=Tolerance(abs=Fraction(1, 1000)))
     assert type(tolerant) is DeadlineMonitor
+
+
+@pytest.mark.parametrize("example, trace", [("warehouse", "traces/run.jsonl"), ("warehouse", "live/monitor.jsonl"),
+                                            ("delivery", "live/monitor.jsonl")])
+def test_bundled_runs_judged_in_batch_equal_the_streaming_monitor(example: str, trace: str) -> None:
+    root = EXAMPLES / example
+    checked = load(sorted(root.rglob("*.rcl")))
+    cfg = load_mapping(root, None)
+    run = list(read_trace(root / "backends/monitors" / trace, [root / d for d in cfg.msg_dirs]))
+    batched = judged = 0
+    for node in (n for n in checked.nodes.values() if has_deadlines(n)):
+        mon = deadline_monitor(checked, node, cfg.rules, None, cfg.horizon, cfg.tolerance, chunk=7)
+        if not isinstance(mon, BatchDeadlines):
+            continue
+        seen: list[Any] = []
+        stream = _judge(DeadlineMonitor(checked, node, cfg.rules, seen.append, cfg.horizon, cfg.tolerance), run, seen)
+        got: list[Any] = []
+        mon.on_verdict = got.append
+        assert _judge(mon, run, got) == stream, node.name
+        judged += len(got)
+        batched += mon.stats["batched"]
+    assert batched > 0 and judged > 0
