@@ -16,7 +16,8 @@ from rclverify.backends.hoare import lang
 from rclverify.backends.hoare.check import check_program
 from rclverify.backends.hoare.outline import render_outline, outline_text, z3_text
 from rclverify.backends.hoare.solve import check_all
-from rclverify.backends.hoare.wp import ProgramModel, main_vc, wp
+from rclverify.backends.hoare.program_model import ProgramModel
+from rclverify.backends.hoare.wp import main_vc, wp
 from rclverify.records.records import Obligation
 from rclverify.semantics.encode import Encoder
 from rclverify.model.plan.errors import PlanError

@@ -42,7 +42,8 @@ from rclverify.backends.hoare.defined import definedness_vcs
 from rclverify.backends.hoare.obligations import Conjunct, EncodedTriple, HoareConfig, conjuncts, encode_triple, load_program, statement
 from rclverify.backends.hoare.outline import OutlineLine, outline_text, render_outline, term_printer
 from rclverify.backends.hoare.solve import TripleResult, check_all
-from rclverify.backends.hoare.wp import VC, WP, ProgramModel, main_vc, wp
+from rclverify.backends.hoare.program_model import ProgramModel
+from rclverify.backends.hoare.wp import VC, WP, main_vc, wp
 from rclverify.backends.hoare.payload import HoarePayload
 from rclverify.backends.shapes import HoareData
 

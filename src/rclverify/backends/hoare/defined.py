@@ -30,7 +30,8 @@ from rclverify.lang.ast import Loc
 from rclverify.semantics.operators import OPERATORS
 from rclverify.backends.hoare import lang
 from rclverify.backends.hoare.obligations import EncodedTriple
-from rclverify.backends.hoare.wp import VC, ProgramModel, main_vc, partial_applications, requirement_text, wp
+from rclverify.backends.hoare.program_model import ProgramModel
+from rclverify.backends.hoare.wp import VC, main_vc, partial_applications, requirement_text, wp
 
 
 def _prefixed(prefix: str, label: str, vcs: tuple[VC, ...]) -> list[VC]:

@@ -49,7 +49,7 @@ from rclverify.lang.types import NATURAL, CheckedNode, FuncT, Type, assignable
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.hoare import lang
 from rclverify.backends.hoare.check import ProgramTypes, check_program, expr_type
-from rclverify.backends.hoare.wp import ProgramModel
+from rclverify.backends.hoare.program_model import ProgramModel
 
 
 DEFAULT_TIMEOUT_MS = 10_000

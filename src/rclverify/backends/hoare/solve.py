@@ -26,7 +26,8 @@ import z3
 from rclverify.semantics.query import query_solver, solver_session
 from rclverify.backends.hoare import lang
 from rclverify.backends.hoare.outline import z3_text
-from rclverify.backends.hoare.wp import VC, ProgramModel, iter_terms
+from rclverify.backends.hoare.program_model import ProgramModel, iter_terms
+from rclverify.backends.hoare.wp import VC
 
 #: Statement executions allowed when replaying a counterexample (loops).
 MAX_STEPS = 100_000
