@@ -267,7 +267,8 @@ class CppTranslator(Visitor[tuple[str, str]]):
 
 _CONSTRUCTS = {"TupleQuant": "a quantifier with a tuple binder", "Apply": "a function or constructor term",
                "SetLit": "a set", "SeqLit": "a sequence", "TupleLit": "a tuple", "StrLit": "a string",
-               "SeqRange": "a sequence range"}
+               "SeqRange": "a sequence range",
+               "First": "first(...), which needs the run's history of an input (docs/semantics.md)"}
 _CMP_NAMES = {"==": "kEq", "!=": "kNe", "<": "kLt", "<=": "kLe", ">": "kGt", ">=": "kGe"}
 
 

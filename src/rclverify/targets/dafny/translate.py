@@ -232,6 +232,9 @@ class Translator:
             return dafny_string(e.value, e.loc), STRING
         if isinstance(e, ast.SeqRange):
             return self.seq_range(e, scope)
+        if isinstance(e, ast.First):  # docs/semantics.md, "The first published value"
+            raise self._err(e.loc, "first(...) has no Dafny counterpart: a method's contract sees one call, not "
+                                   "the run's history of an input")
         raise self._err(getattr(e, "loc", ast.NOLOC), f"unsupported expression {type(e).__name__}")  # pragma: no cover
 
     def seq_range(self, e: ast.SeqRange, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
