@@ -35,7 +35,6 @@ from rclverify.backends.property_tests.hypothesis_lib import (FailedHealthCheck,
 
 from rclverify.semantics.concrete import check_concrete
 from rclverify.semantics.decide import decide
-from rclverify.semantics.floatsem import judge
 from rclverify.semantics.encode import EncodingError
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
@@ -48,6 +47,7 @@ from rclverify.backends.property_tests.strategies import assumption_bounds, conj
 from rclverify.backends.property_tests.thresholds import drawn_thresholds, solved_thresholds
 from rclverify.backends.property_tests.config import Config, ConfigError, load_implementation, read_config
 from rclverify.backends.property_tests.closure import resolve_closure
+from rclverify.backends.property_tests.first_calls import judge_first
 from rclverify.backends.property_tests.importpath import on_harness_path
 from rclverify.backends.monitors.widths import at_carried_widths
 from rclverify.backends.property_tests.at_width import carried_in, input_strategies
@@ -271,7 +271,7 @@ class GuaranteeRun:
             values = {k: narrow(v, widths[k]) if k in widths else v for k, v in values.items()}
         g = self.node.node.guarantees[self.guarantee - 1]
         for c in conjuncts(g.formula):
-            judged = judge(c, self.checked, self.node, values)
+            judged, firsts = judge_first(c, self.checked, self.node, values, step)  # first(in.x): first_calls.py
             ok, why = judged.truth, judged.reason
             if ok and judged.semantics == "double":
                 self.counts.double += 1
@@ -282,7 +282,7 @@ class GuaranteeRun:
                 self.unknown.add(why)
                 return
             if not ok:
-                return self._fail(inputs, outputs, f"the outputs violate guarantee {self.guarantee} "
+                return self._fail({**inputs, **firsts}, outputs, f"the outputs violate guarantee {self.guarantee} "
                            f"({expr_to_rcl(c)})", c, step)
 
     def body(self, example: Any) -> None:
