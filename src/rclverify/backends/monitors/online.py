@@ -62,6 +62,10 @@ from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 
 
+#: a writer not heard yet: (the latest time heard, the most it published after its stamp)
+_UNHEARD = (-math.inf, 0.0)
+
+
 @dataclass
 class TopicStatus:
     """Per contract topic: messages received, last receipt time (s), silent now?"""
@@ -108,6 +112,7 @@ class OnlineEngine:
     released: int = field(init=False, default=0)
     #: the reorder buffer (traces/reorder.py, the one every path uses): (topic, fields, where) by stamp
     _buffer: ReorderBuffer[tuple[str, Mapping[str, object], str]] = field(init=False, default_factory=ReorderBuffer)
+    _readers: dict[str, list[NodeMonitor]] = field(init=False)
     _clock: float = field(init=False, default=-math.inf)
     #: per writer (topic), its header stamps' offset from its source times (traces/event_time.py)
     clocks: WriterClocks = field(init=False, default_factory=WriterClocks)
@@ -127,6 +132,9 @@ class OnlineEngine:
         self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict, self.tolerance)
                          for n in self.nodes]
         self.topics = {t: TopicStatus() for m in self.monitors for t in m.topics}
+        #: per topic, the monitors that read it: a released message is fed to those only (every monitor's
+        #: clock is moved to it first, which is all a message off its topics does to a monitor)
+        self._readers = {t: [m for m in self.monitors if t in m.topics] for t in self.topics}
         if self.on_verdict is not None and self.reorder_window > 0:
             for m in self.monitors:
                 m.on_verdict = self._giver(self.on_verdict)
@@ -172,8 +180,11 @@ class OnlineEngine:
             stamp, copied = self.copies.place(topic, stamp, received)
             fields = with_stamp(fields, stamp) if copied else without_stamp(fields)
         t = received if stamp is None else stamp
-        last, lag = self.writers.get(topic, (-math.inf, 0.0))
-        self.writers[topic] = (max(last, t), max(lag, min(received - t, self.horizon)))
+        last, lag = self.writers.get(topic, _UNHEARD)
+        after = received - t  # how long after its stamp it was published, at most the horizon
+        if self.horizon < after:
+            after = self.horizon
+        self.writers[topic] = (t if t > last else last, after if after > lag else lag)
         self._buffer.push(t, received, (topic, fields, where))
         if self.reorder_window <= 0:
             self._release(math.inf)
@@ -184,8 +195,13 @@ class OnlineEngine:
         ``inf`` with nothing buffered.  The live worker ticks then, so a
         verdict waits the lateness bound and not a timer period more."""
         head = self._buffer.head()
-        return head + self.reorder_window + max((lag for last, lag in self.writers.values() if last < head),
-                                                default=0.0)
+        if head == math.inf:
+            return head
+        most = 0.0  # the most any writer not yet heard past it published after its stamp
+        for last, lag in self.writers.values():
+            if last < head and lag > most:
+                most = lag
+        return head + self.reorder_window + most
 
     def watermark(self, now: float) -> float:
         """The time (s, the run's clock) up to which every writer heard has been
@@ -231,6 +247,7 @@ class OnlineEngine:
         return self._buffer.max_late_s
 
     def _release(self, upto: float) -> None:
+        monitors, readers = self.monitors, self._readers
         for t, src, (topic, fields, where), late in self._buffer.release(upto):
             stamp = None
             source = published(t, src)  # published after its stamp: it may answer what was asked until then
@@ -249,11 +266,11 @@ class OnlineEngine:
             self.released += 1
             if self.on_event is not None:
                 self.on_event(ev)
-            for m in self.monitors:
+            for m in monitors:
                 m.advance(t)
             if self.admit is not None and not self.admit(ev):
                 continue
-            for m in self.monitors:
+            for m in readers.get(topic, ()):
                 m.feed(ev)
 
     def clock_lines(self) -> list[str]:
