@@ -41,7 +41,8 @@ from _procs import stop, wait_for, wait_logged
 from _ros2 import REPO, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
-from rclverify.runtime.dds.types import DdsTypeError, Declared, TypeBook, declare, to_fields
+from rclverify.runtime.dds.type_descriptions import declare
+from rclverify.runtime.dds.types import DdsTypeError, Declared, TypeBook, to_fields
 
 N = 40
 VARIANCES = (0.25, 0.75, 0.5, 1.0)

@@ -10,7 +10,8 @@ from __future__ import annotations
 from typing import Any, Callable, Mapping
 
 from rclverify.runtime.dds.bus import Tap
-from rclverify.runtime.dds.types import DdsTypeError, Declaration, declare
+from rclverify.runtime.dds.type_descriptions import declare
+from rclverify.runtime.dds.types import DdsTypeError, Declaration
 from rclverify.runtime.rclpy_source.discovery import AgentDiscovery, ros_name, ros_type
 
 

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rclverify.runtime.dds.types import DdsTypeError, Declaration, declare
+from rclverify.runtime.dds.type_descriptions import declare
+from rclverify.runtime.dds.types import DdsTypeError, Declaration
 from rclverify.runtime.rclpy_source.bus import RclpyUnavailable, agent_answer
 
 
