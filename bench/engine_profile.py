@@ -12,9 +12,9 @@ what the engine worker does (``runtime/worker.py``): decode (CDR to
 fields), :meth:`~rclverify.runtime.live.LiveRun.push`, and
 :meth:`~rclverify.runtime.live.LiveRun.tick` whenever the watermark
 reaches the earliest buffered message (``due()``) or the 20 ms timer comes
-round, with the CLI's lateness bound (``--lateness``, 50 ms).  Each verdict
-is serialized as the DDS writer's ``std_msgs/String`` sample (its
-``write`` into Cyclone is not included); the log is written to a
+round, with the CLI's lateness bound (``--lateness``, 50 ms).  Each verdict,
+and each latched last verdict, is serialized as the DDS writer's
+``std_msgs/String`` sample (its ``write`` into Cyclone is not included); the log is written to a
 temporary file.
 
 ``--log FILE``: the messages of a recorded live log instead (JSON lines of
@@ -111,7 +111,8 @@ def bench_workspace(ws: Path) -> None:
 
 def make_run(ws: Path, mapping: str | None, log: Path, lateness: float,
              publish: Callable[[str], None]) -> Any:
-    """A :class:`~rclverify.runtime.live.LiveRun` on the workspace's monitored nodes."""
+    """A :class:`~rclverify.runtime.live.LiveRun` on the workspace's monitored nodes, its verdicts and
+    its latched last verdicts given to ``publish``."""
     from rclverify.backends.monitors.config import load_mapping
     from rclverify.lang.typecheck import load
     from rclverify.runtime.live import LiveRun
@@ -120,7 +121,7 @@ def make_run(ws: Path, mapping: str | None, log: Path, lateness: float,
     checked = load(files)
     cfg = load_mapping(ws, mapping)
     return LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=lateness,
-                   publish=publish, publish_last=lambda node, text: None)
+                   publish=publish, publish_last=lambda node, text: publish(text))
 
 
 def drive(run: Any, msgs: list[Message], decode: Callable[[str, bytes], Any] | None) -> int:
@@ -182,7 +183,7 @@ def main(argv: list[str] | None = None) -> int:
             n = drive(run, msgs, decode)
             best = min(best, time.thread_time() - t0)
             run.stop()
-        print(f"engine thread: {n} message(s), {len(sent)} verdict(s): {best / max(n, 1) * 1e6:.1f} us CPU per "
+        print(f"engine thread: {n} message(s), {len(sent)} verdict sample(s): {best / max(n, 1) * 1e6:.1f} us CPU per "
               f"message (best of {max(1, a.repeat)}; decode, push, ticks, log, verdict samples)")
         run = make_run(ws, mapping, tmp / "profiled.jsonl", a.lateness, publish)
         prof = cProfile.Profile()

@@ -274,7 +274,9 @@ def _cpu(res: dict[str, Any], source: str) -> str:
     """The run's CPU per message published: the monitor's process (start-up included), the rclpy agent's."""
     n = max(1, len(res["sent"]["sent"]))
     mon = f"monitor {res['cpu'] / n * 1e6:.0f} us" if res["cpu"] is not None else "monitor CPU unknown"
-    return mon + (f", agent {res['agent_cpu'] / n * 1e6:.0f} us per message" if source == "rclpy" else " per message")
+    engine = f" (engine thread {res['record'].get('engine_cpu_us_per_message', 0):.0f} us)"
+    return mon + engine + (f", agent {res['agent_cpu'] / n * 1e6:.0f} us per message" if source == "rclpy"
+                           else " per message")
 
 
 def main(argv: list[str] | None = None) -> int:
