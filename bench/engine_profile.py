@@ -29,6 +29,7 @@ cumulative time.  Usage::
 
     python3 bench/engine_profile.py [--messages 5000] [--rate 1000] [--lateness 0.05] [--top 25]
     python3 bench/engine_profile.py --log live.jsonl --workspace WS [--mapping mapping.yaml]
+    python3 bench/engine_profile.py --smoke     # 300 messages, one pass (CI)
 """
 from __future__ import annotations
 
@@ -156,7 +157,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--log", type=Path, help="a recorded live log's messages instead of the bench's")
     p.add_argument("--workspace", type=Path, help="with --log: the workspace of its contracts")
     p.add_argument("--mapping", default=None, help="with --log: the mapping file, relative to the workspace")
+    p.add_argument("--smoke", action="store_true", help="CI: 300 messages, one timed pass, the top 5")
     a = p.parse_args(argv)
+    if a.smoke:
+        a.messages, a.repeat, a.top = 300, 1, 5
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         serialize: Callable[[str], bytes] = str.encode
