@@ -24,7 +24,7 @@ import pytest
 import yaml
 
 from rclverify.backends.model_checking.ajpf import psl
-from rclverify.backends.model_checking.ajpf.backend import DEFAULT_TIMEOUT_S as AJPF_TIMEOUT_S
+from rclverify.backends.model_checking.ajpf.config import DEFAULT_TIMEOUT_S as AJPF_TIMEOUT_S
 from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
 from rclverify.backends.bounded import ToolInterrupted, run_bounded
 from rclverify.backends.model_checking import backend as mc
