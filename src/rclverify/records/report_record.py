@@ -13,7 +13,9 @@ to these fields.
 """
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Any
+
+import msgspec
 
 from rclverify.records.deadline_rows import DeadlineRow
 from rclverify.records.design_rows import DesignRow
@@ -67,6 +69,19 @@ class AssuranceReport(Row, frozen=True, forbid_unknown_fields=True):
     standards: Annotated[list[StandardRow], DOC(description="The evidence mapped onto the standards the plan names (docs/standards.md); empty when it names none.")]
     diagnoses: Annotated[list[DiagnosisRow], DOC(description="One diagnosis per problem.")]
     problems: Annotated[list[ProblemRow], DOC(description="The problems grouped by root cause.")]
+
+    def __getitem__(self, key: str) -> Any:
+        """The part ``key`` as its JSON value (``report["summary"]["headline"]``), built anew on each
+        call: what a reader of the report's JSON object reads when handed the decoded report (the readers
+        that still read it so are listed in docs/records.md).  Raises ``KeyError`` for a key that is no
+        field."""
+        if key not in self.__struct_fields__:
+            raise KeyError(key)
+        return msgspec.to_builtins(getattr(self, key))
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """:meth:`__getitem__`, or ``default`` for a key that is no field."""
+        return self[key] if key in self.__struct_fields__ else default
 
 
 #: The report's top-level keys, in the order the report writes them.

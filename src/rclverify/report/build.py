@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, NamedTuple
 
+import msgspec
 import z3
 
 from rclverify import __version__
@@ -31,7 +32,10 @@ from rclverify.model.plan.load import all_requirements
 from rclverify.model.plan.standards.field_data import unstated_origins
 from rclverify.model.system.model import cycles_kept
 from rclverify.records.records import Obligation, worst
-from rclverify.records.report_schema import Report
+from rclverify.records.node_rows import NodeRow
+from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.row import decode_rows
 from rclverify.records.summary_rows import Meta, SystemView
 from rclverify.report import assemble
 from rclverify.report.confidence_rows import confidence_part
@@ -195,27 +199,32 @@ def undiagnosed_report(ws: Workspace) -> dict[str, Any]:
                                 and standards["ok"])
 
 
-def diagnosed_report(report: dict[str, Any], diagnoses: list[dict[str, Any]] | None, why: str = "") -> Report:
-    """The finished report: ``report`` (:func:`undiagnosed_report`) with
+def diagnosed_report(report: dict[str, Any], diagnoses: list[dict[str, Any]] | None,
+                     why: str = "") -> AssuranceReport:
+    """The finished report, decoded once into its record: ``report`` (:func:`undiagnosed_report`) with
     ``diagnoses`` (the diagnosis stage's records for it,
     :func:`rclverify.stages.diagnoses.read_diagnoses`), the problems grouped
     by root cause (report/problems.py) and the culprit nodes marked
     (report/culprits.py).  ``diagnoses`` is ``None`` when they are not
     current: the report then explains no problem and ``why`` (one
-    sentence) is among ``summary.problems``."""
+    sentence) is among ``summary.problems``.  Raises
+    :class:`msgspec.ValidationError` (a ``ValueError``) for a part of
+    another shape: a bug of the build, never shown."""
     if diagnoses is None:
         summary = {**report["summary"], "problems": list(report["summary"]["problems"]) + [f"Diagnoses: {why}"]}
         report = {**report, "summary": summary}
     report = assemble.with_diagnoses(report, list(diagnoses or []))
-    draft = assemble.finished(report, [], report["nodes"])  # every part but the problems, checked as a Report
+    # every part but the problems, decoded once; the grouping and the marked nodes then replace two parts
+    draft = AssuranceReport.of(assemble.finished(report, [], report["nodes"]))
     problems = group_problems(draft, problem_items(draft), anchor)
-    return assemble.finished(report, problems, marked_nodes(report["nodes"], problems))
+    return msgspec.structs.replace(draft, problems=decode_rows(ProblemRow, problems),
+                                   nodes=decode_rows(NodeRow, marked_nodes(report["nodes"], problems)))
 
 
-def build_report(ws: Workspace) -> Report:
+def build_report(ws: Workspace) -> AssuranceReport:
     """Read every artifact of ``ws`` and return the report (see render.py):
-    a :class:`~rclverify.records.report_schema.Report`, the shape
-    docs/assurance.schema.json publishes: :func:`undiagnosed_report` with
+    an :class:`~rclverify.records.report_record.AssuranceReport`, the record
+    docs/assurance.schema.json is generated from: :func:`undiagnosed_report` with
     the diagnosis stage's sealed record (artifacts/diagnosis/index.json)
     when it was made from that report, else with no diagnosis and a
     sentence saying why among ``summary.problems`` (the report diagnoses

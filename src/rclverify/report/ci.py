@@ -11,15 +11,16 @@ from rclverify.records.published import write_published
 from rclverify.report.fragments import FragmentCache
 from rclverify.report.junit import render_junit
 from rclverify.report.sarif import render_sarif
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import Report
 
 #: File names written under ``reports/``, in the order :func:`write_ci_reports` returns them.
 CI_FILES: tuple[str, ...] = ("assurance.sarif", "assurance.junit.xml")
 
 
-def write_ci_reports(report: Report, out_dir: Path, fragments: FragmentCache | None = None,
+def write_ci_reports(report: Report | AssuranceReport, out_dir: Path, fragments: FragmentCache | None = None,
                      within: Path | None = None) -> list[Path]:
-    """Render ``report`` (the dict of ``build_report``) as SARIF 2.1.0 and JUnit
+    """Render ``report`` (what ``build_report`` returns, or its JSON object) as SARIF 2.1.0 and JUnit
     XML and write both to ``out_dir``; ``fragments`` keeps the JUnit text of
     each node between runs (:func:`rclverify.report.junit.render_junit`).
 

@@ -30,6 +30,7 @@ from rclverify.stages.workspace import REPORT_PARTS
 from rclverify.report.ci import CI_FILES, write_ci_reports
 from rclverify.report.fragments import FragmentCache
 from rclverify.report.render import REPORT_FILES, render_files
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import Report
 
 #: Each part's files under ``reports/`` (``argument.svg`` only when the argument is laid out).
@@ -39,7 +40,7 @@ PARTS = REPORT_PARTS
 FRAGMENTS = {part: f"artifacts/cache/report-fragments.{part}.pickle" for part in PARTS}
 
 
-def write_part(report: Report, out_dir: Path, part: str, fragments: FragmentCache | None = None,
+def write_part(report: Report | AssuranceReport, out_dir: Path, part: str, fragments: FragmentCache | None = None,
                within: Path | None = None) -> list[Path]:
     """Render and write the files of ``part`` (a key of :data:`PARTS`) for
     ``report`` into ``out_dir``; ``fragments`` keeps rendered pieces

@@ -80,12 +80,12 @@ def report_out_of_date(ws: Any, report: Mapping[str, Any]) -> str | None:
     except RclError as e:
         first = str(e.diagnostics[0]) if getattr(e, "diagnostics", None) else str(e)
         return f"the workspace's files no longer build a report ({first.splitlines()[0]}): {_AGAIN}"
-    now_inputs = built["meta"]["inputs_sha256"]
+    now_inputs = built.meta.inputs_sha256
     if now_inputs != was_inputs:
         return (f"the report was built from other inputs than the workspace holds now (inputs sha256 "
                 f"{str(was_inputs)[:12]}..., now {now_inputs[:12]}...): {_AGAIN}")
     stated = {str(o.get("id")): o.get("status") for o in report.get("obligations") or ()}
-    changed = sorted(str(o["id"]) for o in built["obligations"] if stated.get(str(o["id"])) != o["status"])
+    changed = sorted(o.id for o in built.obligations if stated.get(o.id) != o.status)
     if changed:
         return (f"{len(changed)} obligation(s) have another status in the recorded evidence than in the report "
                 f"(e.g. {changed[0]}): {_AGAIN}")

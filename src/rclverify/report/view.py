@@ -9,7 +9,9 @@ traceability rows requirement -> guarantee -> obligation -> evidence
 """
 from __future__ import annotations
 
+import functools
 import re
+import typing
 from collections import defaultdict
 from typing import Callable, Mapping, Sequence, TypeVar
 
@@ -19,7 +21,7 @@ from rclverify.records.derived_rows import DerivedPropertyRow
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import FindingRow
 from rclverify.records.obligations import ObligationRow
-from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.problem_rows import EARLIER, ProblemRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import Report
 from rclverify.records.row import decode_rows
@@ -167,23 +169,44 @@ def evidence_anchors(report: ReportIn) -> list[str]:
     return out
 
 
+@functools.cache
+def _later_parts() -> dict[str, object]:
+    """The parts a report written by an earlier version may lack (beyond :data:`REPORT_KEYS`), each with
+    the empty value it is read as: ``[]`` for a list, ``None`` for a part that may be null."""
+    hints = typing.get_type_hints(AssuranceReport)
+    return {k: [] if typing.get_origin(hints[k]) is list else None
+            for k in AssuranceReport.__struct_fields__ if k not in REPORT_KEYS}
+
+
+def _earlier(report: Report | Mapping[str, object]) -> dict[str, object]:
+    """``report``, a JSON object, with each part :func:`_later_parts` names that it lacks at its empty
+    value and each problem row's keys of :data:`~rclverify.records.problem_rows.EARLIER` that it lacks:
+    a stored report of an earlier version still decodes (its rows placed nowhere)."""
+    out: dict[str, object] = {**_later_parts(), **report}
+    problems = out["problems"]
+    if isinstance(problems, list):
+        out["problems"] = [{**EARLIER, **p} if isinstance(p, Mapping) else p for p in problems]
+    return out
+
+
 def _rows_decoded(report: ReportIn) -> AssuranceReport:
     """``report`` decoded for a reader of its rows, which reads no ``problems`` (a JSON object may lack them)."""
-    return report if isinstance(report, AssuranceReport) else AssuranceReport.of({"problems": [], **report})
+    return report if isinstance(report, AssuranceReport) else AssuranceReport.of(_earlier(report))
 
 
 def decoded_report(report: ReportIn) -> AssuranceReport:
     """``report`` decoded once into :class:`~rclverify.records.report_record.AssuranceReport`
     (returned unchanged when it is one); a JSON object without ``problems``
     gets them grouped by root cause here
-    (:func:`rclverify.report.problems.group_problems`).  Raises
+    (:func:`rclverify.report.problems.group_problems`); one written by an
+    earlier version is read with the parts it lacks empty (:func:`_earlier`).  Raises
     :class:`msgspec.ValidationError` (a ``ValueError``) for a report of
     another shape."""
     if isinstance(report, AssuranceReport):
         return report
     if "problems" in report:
-        return AssuranceReport.of(report)
-    draft = AssuranceReport.of({**report, "problems": []})
+        return AssuranceReport.of(_earlier(report))
+    draft = AssuranceReport.of(_earlier(report))
     groups = group_problems(draft, _attention(draft, evidence_anchors(draft))[0], anchor)
     return msgspec.structs.replace(draft, problems=decode_rows(ProblemRow, groups))
 

@@ -34,7 +34,8 @@ from typing import Any, Callable, Mapping
 
 import jinja2
 
-from rclverify.records.report_schema import Report
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.report_schema import Report, as_report
 from rclverify.records.published import write_published
 from rclverify.records.store import dumps
 from rclverify.core.cache.memo import last_call
@@ -215,11 +216,12 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
 
 
 @last_call
-def _built(report: Report) -> Argument:
+def _built(report: Report | AssuranceReport) -> Argument:
     """The argument of ``report``.  One report run shows the argument several
-    times (HTML, Markdown, ``reports/argument.*``) from the same report
-    dict, which no renderer changes; it is built once for that dict."""
-    return build_argument(report)
+    times (HTML, Markdown, ``reports/argument.*``) from the same report,
+    which no renderer changes; it is built once for that report (from its
+    JSON object, which the argument's passes read)."""
+    return build_argument(as_report(report.to_json()) if isinstance(report, AssuranceReport) else report)
 
 
 def too_large(arg: Argument) -> bool:
@@ -227,18 +229,18 @@ def too_large(arg: Argument) -> bool:
     return len(arg.elements) > MAX_LAYOUT_ELEMENTS
 
 
-def argument_dot(report: Report, fragments: FragmentCache | None = None) -> str:
+def argument_dot(report: Report | AssuranceReport, fragments: FragmentCache | None = None) -> str:
     """The DOT text of ``report``'s argument, made once per report dict
     (``fragments`` as for :func:`to_dot`)."""
     return _dot_text(report, fragments=fragments)
 
 
 @last_call
-def _dot_text(report: Report, *, fragments: FragmentCache | None) -> str:
+def _dot_text(report: Report | AssuranceReport, *, fragments: FragmentCache | None) -> str:
     return to_dot(_built(report), f"assurance argument of {report['meta']['workspace']}", fragments=fragments)
 
 
-def argument_layout(report: Report, fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
+def argument_layout(report: Report | AssuranceReport, fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
     """What lays the argument of ``report`` out: a call that returns
     :func:`layout`'s rendering.  The DOT text is made now, by the caller
     (the fragment cache is not shared between threads), and only when the
@@ -249,7 +251,7 @@ def argument_layout(report: Report, fragments: FragmentCache | None = None) -> C
     return lambda: layout(arg, dot)
 
 
-def argument_view(report: Report, rendering: diagram.Rendering | None = None,
+def argument_view(report: Report | AssuranceReport, rendering: diagram.Rendering | None = None,
                   fragments: FragmentCache | None = None) -> dict[str, Any]:
     """What the report templates show of the argument: ``dot`` (``None``
     when the argument is too large to lay out: no report shows it then),
@@ -269,7 +271,7 @@ def argument_view(report: Report, rendering: diagram.Rendering | None = None,
             "goals": [{"id": g.id, "text": g.text, "status": g.status, "undeveloped": g.undeveloped} for g in goals]}
 
 
-def write_argument(report: Report, out_dir: Path, fragments: FragmentCache | None = None,
+def write_argument(report: Report | AssuranceReport, out_dir: Path, fragments: FragmentCache | None = None,
                    files: tuple[str, ...] = FILES, rendering: diagram.Rendering | None = None,
                    within: Path | None = None) -> list[Path]:
     """Write the :data:`FILES` named in ``files`` for ``report`` into ``out_dir`` (``reports/``).

@@ -39,15 +39,15 @@ def report_out_of_date(ws: Any) -> list[str]:
         report = build_report(ws)
     except RclError:
         return []
-    now = {o["id"]: o["status"] for o in report["obligations"]}
+    now: dict[str, str] = {o.id: o.status for o in report.obligations}
     changed = sorted(k for k in now if was.get(k) != now[k])
     if changed:
         shown = ", ".join(f"{k} ({was.get(k, 'absent')} -> {now[k]})" for k in changed[:5])
         return [f"reports/assurance.json is out of date: {len(changed)} obligation(s) have another status now: "
                 f"{shown}{' ...' if len(changed) > 5 else ''}; {_RUN}"]
-    if was_inputs != report["meta"]["inputs_sha256"]:
+    if was_inputs != report.meta.inputs_sha256:
         why = ("it records no input hashes (written by an earlier rclverify)" if was_inputs is None else
                "it was built from other inputs than the recorded evidence, requirement checks, contracts and plan "
-               f"(inputs sha256 {str(was_inputs)[:12]}..., now {report['meta']['inputs_sha256'][:12]}...)")
+               f"(inputs sha256 {str(was_inputs)[:12]}..., now {report.meta.inputs_sha256[:12]}...)")
         return [f"reports/assurance.json is out of date: {why}; {_RUN}"]
     return []
