@@ -50,7 +50,7 @@ if TYPE_CHECKING:
     from rclverify.calculus.health.checks import Finding
     from rclverify.records.findings import HealthFinding
     from rclverify.model.plan.model import EvidenceEntry
-    from rclverify.records.report_schema import Report
+    from rclverify.records.report_record import AssuranceReport
     from rclverify.records.composition_records import CheckRecord, CompositionRecord
     from rclverify.records.stage_records import DeadlineRecord, DiagnosisRecord, RequirementRecord
 
@@ -319,8 +319,8 @@ def stage_diagnosis(ws: Workspace, report: Mapping[str, object] | None = None) -
     return write_diagnoses(ws, digest, diagnose(ws, report_rows(report)))
 
 
-def diagnosed(ws: Workspace, report: dict[str, Any] | None = None) -> Report:
-    """The report dict of ``ws``: ``report`` (the report without diagnoses,
+def diagnosed(ws: Workspace, report: dict[str, Any] | None = None) -> AssuranceReport:
+    """The report of ``ws``, decoded: ``report`` (the report without diagnoses,
     else built now) with the diagnosis stage's record for it, the stage run
     first when that record is missing, altered or made from another report
     (:func:`rclverify.stages.diagnoses.read_diagnoses`): every report the
@@ -337,8 +337,8 @@ def diagnosed(ws: Workspace, report: dict[str, Any] | None = None) -> Report:
 
 
 def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
-                 report: Report | None = None, undiagnosed: dict[str, Any] | None = None) -> tuple[Report, list[Path]]:
-    """Build the report dict of ``ws`` (unless ``report`` gives it: from
+                 report: AssuranceReport | None = None, undiagnosed: dict[str, Any] | None = None) -> tuple[AssuranceReport, list[Path]]:
+    """Build the report of ``ws`` (unless ``report`` gives it: from
     ``undiagnosed``, the report without diagnoses, when given, with the
     diagnosis stage's record, the stage run first when it is not current:
     :func:`diagnosed`) and write
@@ -347,7 +347,7 @@ def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
     SVG; ``text`` is ``assurance.md`` and the rest of the argument).  Graphviz
     layouts, compiled templates and rendered pieces of the report are kept
     under ``artifacts/cache/`` for the next run (a pure speed-up: the files
-    are the same without them, docs/scale.md).  Returns the report dict and
+    are the same without them, docs/scale.md).  Returns the report (decoded) and
     the paths written; raises ``RclError`` for contracts or a plan that do
     not check, ``KeyError`` for an unknown part and ``OSError`` when a file
     cannot be written."""

@@ -26,7 +26,7 @@ from rclverify.records.store import atomic_write_text
 from rclverify.app import pipeline
 
 if TYPE_CHECKING:
-    from rclverify.records.report_schema import Report
+    from rclverify.records.report_record import AssuranceReport
 
 
 #: The workspace of each root loaded for this run (:func:`_ws`); :func:`rclverify.app.tasks.build_tasks` seeds it.
@@ -174,7 +174,7 @@ def act_run(root: str, node: str, obligation_id: str) -> Any:
 
 #: The report dict built by the first report part of a run, for the other parts the same process
 #: runs (a serial run): keyed by workspace root, valid for the workspace object of that run.
-_REPORTS: dict[str, tuple[Workspace, Report]] = {}
+_REPORTS: dict[str, tuple[Workspace, AssuranceReport]] = {}
 #: The report dict without diagnoses the diagnosis task built, for the report part the same process runs
 #: next (a serial run: no task between them changes an artifact the report reads); as :data:`_REPORTS`.
 _UNDIAGNOSED: dict[str, tuple[Workspace, dict[str, Any]]] = {}
