@@ -13,7 +13,7 @@ counterexample's, shown beside its inputs.
 from __future__ import annotations
 
 from itertools import product
-from typing import Mapping
+from typing import Callable, Mapping
 
 from rclverify.lang import ast, walk
 from rclverify.lang.types import Checked, CheckedNode
@@ -27,21 +27,22 @@ def first_keys(formula: ast.Expr) -> list[str]:
 
 
 def judge_first(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object],
-                step: int | None) -> tuple[Judgement, dict[str, object]]:
+                step: int | None, judge_fn: Callable[..., Judgement] = judge) -> tuple[Judgement, dict[str, object]]:
     """The judgement of ``formula`` on ``values`` (module docstring) and the
     ``first(...)`` values it was decided with (``{}`` when it reads none):
-    ``step`` is the stateful step (1 the first), ``None`` for a function.
+    ``step`` is the stateful step (1 the first), ``None`` for a function;
+    ``judge_fn`` judges one reading (:func:`~rclverify.semantics.floatsem.judge`).
     False on the first combination that fails; else undecided on the first
     that is undecided; else true."""
     keys = first_keys(formula)
     if not keys:
-        return judge(formula, checked, node, values), {}
+        return judge_fn(formula, checked, node, values), {}
     combos = [dict.fromkeys(keys, step == 1)] if step is not None else \
         [dict(zip(keys, bits)) for bits in product((True, False), repeat=len(keys))]
     undecided: tuple[Judgement, dict[str, object]] | None = None
     last: tuple[Judgement, dict[str, object]] | None = None
     for combo in combos:
-        j = judge(formula, checked, node, {**values, **combo})
+        j = judge_fn(formula, checked, node, {**values, **combo})
         if j.truth is False:
             return j, dict(combo)
         if j.truth is None and undecided is None:

@@ -35,6 +35,7 @@ from rclverify.backends.property_tests.hypothesis_lib import (FailedHealthCheck,
 
 from rclverify.semantics.concrete import check_concrete
 from rclverify.semantics.decide import decide
+from rclverify.semantics.floatsem import judge
 from rclverify.semantics.encode import EncodingError
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
@@ -271,7 +272,7 @@ class GuaranteeRun:
             values = {k: narrow(v, widths[k]) if k in widths else v for k, v in values.items()}
         g = self.node.node.guarantees[self.guarantee - 1]
         for c in conjuncts(g.formula):
-            judged, firsts = judge_first(c, self.checked, self.node, values, step)  # first(in.x): first_calls.py
+            judged, firsts = judge_first(c, self.checked, self.node, values, step, judge)  # first(in.x): first_calls.py
             ok, why = judged.truth, judged.reason
             if ok and judged.semantics == "double":
                 self.counts.double += 1
