@@ -68,11 +68,14 @@ class Options:
 class Ports:
     """The contracts' nodes as parsed: ``nodes[node][name] = ("in"|"out", type name or None)``;
     ``constants`` the names of context constants and enumeration values; ``units[node][name]`` the unit
-    written on a port (``m/s``), absent when it has none."""
+    written on a port (``m/s``), absent when it has none; ``fed[node]`` the node's inputs another node
+    publishes (a topic matched to one node's input and another's output, as the system model reads
+    :attr:`~rclverify.lang.ast.Topic.key`)."""
 
     nodes: Mapping[str, Mapping[str, tuple[str, str | None]]]
     constants: frozenset[str]
     units: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
+    fed: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -91,6 +94,21 @@ def ports_of(specs: list[ast.Spec]) -> Ports:
     nodes: dict[str, dict[str, tuple[str, str | None]]] = {}
     units: dict[str, dict[str, str]] = {}
     consts: set[str] = set()
+    published: dict[str, set[str]] = {}  # topic key -> the nodes matching an output to it
+    for sp in specs:
+        for n in sp.nodes:
+            for tp in n.topics:
+                outs = {o.name for o in n.outputs}
+                if tp.match is not None and (tp.match.prefix == "out" or (tp.match.prefix is None
+                                                                         and tp.match.name in outs)):
+                    published.setdefault(tp.key, set()).add(n.name)
+    fed: dict[str, tuple[str, ...]] = {}
+    for sp in specs:
+        for n in sp.nodes:
+            ins = {v.name for v in n.inputs}
+            fed[n.name] = tuple(dict.fromkeys(
+                tp.match.name for tp in n.topics if tp.match is not None and tp.match.prefix != "out"
+                and tp.match.name in ins and published.get(tp.key, set()) - {n.name}))
     for sp in specs:
         for n in sp.nodes:
             io = nodes.setdefault(n.name, {})
@@ -104,7 +122,7 @@ def ports_of(specs: list[ast.Spec]) -> Ports:
                 consts.add(d.name)
                 vals = getattr(d.type, "values", None)
                 consts.update(vals if isinstance(vals, tuple) else ())
-    return Ports(nodes, frozenset(consts), units)
+    return Ports(nodes, frozenset(consts), units, {n: f for n, f in fed.items() if f})
 
 
 class _Places:
@@ -260,7 +278,7 @@ def import_export(exp: FretExport, options: Options, ports: Ports | None = None)
                 raise Refusal(f"no node named {node} in the contracts (nodes: {known})",
                               f"map the component in the plan (fret: {{components: {{{fr.component}: Node}}}})")
             t = translate(fr.reqid, fr.fulltext, fr.semantics, node, _Places(exp, fr, node, ports, options.variables),
-                          options.step, options.functions)
+                          options.step, options.functions, fed=ports.fed.get(node, ()) if ports is not None else ())
         except Refusal as exc:
             out.append(Imported(fr, informal, (), exc))
             continue

@@ -59,7 +59,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.model.plan.fret.declared import DeclaredFunction
 from rclverify.model.plan.fret.fretish import Expr, Refusal, Writer, parse
@@ -152,6 +152,8 @@ class _States:
         self.bound = 0
         #: the plan's ``fret: functions:`` (:mod:`.declared`), by name
         self.functions: Mapping[str, DeclaredFunction] = {}
+        #: the node's inputs another node publishes (:func:`translate`)
+        self.fed: tuple[str, ...] = ()
 
     def finish(self, t: Translation) -> Translation:
         """``t`` with its step counter (if a Lustre table made one) stopping at :attr:`bound`."""
@@ -170,15 +172,27 @@ class _States:
 
 def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
               var: Callable[[str, bool], str | Expr], step: Fraction | None = None,
-              functions: Mapping[str, DeclaredFunction] | None = None) -> Translation:
+              functions: Mapping[str, DeclaredFunction] | None = None, fed: Sequence[str] = ()) -> Translation:
     """Requirement ``reqid`` (``semantics`` ``sem``, FRET's export fields) as
     an RCL statement over ``node`` (module table).  ``var(name, local)``
     places a variable (:class:`~.fretish.Writer`); ``step`` the plan's
     seconds per step for durations in seconds; ``functions`` the plan's
-    ``fret: functions:`` (:mod:`.declared`).  Raises :class:`Refusal`."""
+    ``fret: functions:`` (:mod:`.declared`); ``fed`` the node's inputs
+    another node publishes, whose first values are FRET's first time point
+    (:func:`_writer`).  Raises :class:`Refusal`."""
     states = _States(state_base(reqid))
     states.functions = functions or {}
-    return states.finish(_translate(fulltext, sem, node, var, step, states))
+    states.fed = tuple(fed)
+    t = states.finish(_translate(fulltext, sem, node, var, step, states))
+    if any(_LOCAL_FTP in s.init or _LOCAL_FTP in s.next for s in t.states):
+        raise Refusal(f"FRET's first time point is read inside a pre on {node}, which another node feeds: its "
+                      "state variables step with the system, whose first step is not the node's",
+                      "write the -> (or the initial value) outside the pre")
+    return t
+
+
+#: FRET's first time point placed inside a state variable of a node another node feeds (refused, :func:`translate`)
+_LOCAL_FTP = "\x00first time point\x00"
 
 
 def _translate(fulltext: str, sem: Mapping[str, Any], node: str, var: Callable[[str, bool], str | Expr],
@@ -318,6 +332,10 @@ def _writer(var: Callable[[str, bool], str | Expr], states: _States, node: str) 
     def placed(name: str, local: bool) -> str | Expr:
         if name != "FTP":
             return var(name, local)
+        if states.fed:  # the node's first step is where its inputs first have values (docs/requirements.md)
+            if local:  # refused if a state variable's next value reads it (:func:`translate`)
+                return _LOCAL_FTP
+            return "(" + " or ".join(f"first({node}.in.{x})" for x in states.fed) + ")"
         ftp = next((x.name for x in states.made if x.name == f"{states.base}_ftp"), None) or \
             states.add("ftp", "BOOL", "TRUE", "not @")  # FRET's first time point
         return f"state.{ftp}" if local else f"{node}.state.{ftp}"
