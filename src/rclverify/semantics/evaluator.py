@@ -137,7 +137,8 @@ class Evaluator(QuantifierEvaluation, Visitor[Any]):
         if isinstance(value, str):  # why it is not known (backends/monitors/first_messages.py)
             raise Undecided(value)
         if not isinstance(value, bool):
-            raise Undecided(f"no record of whether this message is the first published on in.{e.arg.name}")
+            raise Undecided(f"no record of whether this message is the first published on "
+                            f"{e.arg.name if '.in.' in e.arg.name else 'in.' + e.arg.name}")
         return value
 
     def visit_Unary(self, e: ast.Unary, b: Mapping[str, Value]) -> Any:

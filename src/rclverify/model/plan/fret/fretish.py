@@ -15,7 +15,8 @@ FRETish                RCL
 ``a => b``, ``a <=> b``  ``a -> b``, ``a <=> b``
 ``a xor b``            ``not (a <=> b)``
 ``if a then b``        ``a -> b``
-``FTP``                the first step: a state variable true only there
+``FTP``                the first step: a state variable true only there; on a node another
+                       node feeds, ``(first(Node.in.x) or ...)`` over its fed inputs (translate.py)
 ``a = b``              ``a == b``
 ``absReal(e)``, ``absInt(e)``, ``abs(e)``  ``abs(e)``
 ``sqrt(e)``, ``sin(e)``, ``cos(e)``  the same (RCL's, radians)
