@@ -7,9 +7,11 @@ uninterpreted functions' facts, a real refutation kept and a spurious one made `
 reason."""
 from __future__ import annotations
 
+import json
 import math
 import random
 from fractions import Fraction
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -165,3 +167,49 @@ def test_each_backend_translates_or_refuses_with_a_reason() -> None:
         ColumnCompiler(checked, node).compile(f)
     with pytest.raises(CriterionError, match="sqrt is not part of an experiment criterion"):
         dimension(parse_formula("sqrt(error) <= 0.5"), {"error": "1"})
+
+
+MONITORED = """node Root {
+  inputs( r : REAL )
+  outputs( d : REAL )
+  topics( std_msgs/Float64 r matches(in.r), std_msgs/Float64 d matches(out.d) )
+  assume( TRUE )
+  guarantee( out.d == sqrt(in.r) + sin(0.5 * in.r) ) triggered by in.r within 100 ms
+}
+"""
+
+
+def test_a_monitor_judges_a_log_with_python_math(tmp_path: Path) -> None:
+    """The node's own double computation satisfies the guarantee, a wrong answer violates it, a negative
+    argument leaves the answer inconclusive, naming the square root's condition."""
+    from rclverify.backends.monitors.check import check_trace
+    from rclverify.lang.typecheck import load
+    from rclverify.traces import read_trace
+    (tmp_path / "root.rcl").write_text(MONITORED)
+    checked = load([tmp_path / "root.rcl"])
+    run = [{"topic": "r", "time": 0.0, "data": 2.0}, {"topic": "d", "time": 0.01, "data": math.sqrt(2.0) + math.sin(1.0)},
+           {"topic": "r", "time": 1.0, "data": 3.0}, {"topic": "d", "time": 1.01, "data": 1.5},
+           {"topic": "r", "time": 2.0, "data": -1.0}, {"topic": "d", "time": 2.01, "data": 0.0},
+           {"topic": "clock", "time": 9.0}]
+    log = tmp_path / "run.jsonl"
+    log.write_text("".join(json.dumps(x) + "\n" for x in run))
+    seen: list[Any] = []
+    _, (res,) = check_trace(checked, [checked.nodes["Root"]], read_trace(log), {}, 5.0, seen.append)
+    assert [v.verdict for v in seen[:3]] == ["satisfied", "violated", "inconclusive"]
+    assert "run.jsonl:4" in seen[1].reason
+    assert "in.r >= 0 does not hold (a square root of a negative number)" in seen[2].reason
+
+
+def test_a_concrete_check_is_decided_only_where_python_math_agrees() -> None:
+    """Z3 with values for every input and output (semantics/concrete.py): true or false where the
+    formula keeps its truth around Python's math value, undecided on the boundary itself."""
+    from rclverify.semantics.concrete import check_concrete
+    checked, node, f = _checked("out.y <= sin(in.th)")
+    assert check_concrete(f, checked, node, {"in.th": 2.0, "out.y": 0.5, "in.a": 0, "in.k": 0, "out.d": 0}) \
+        == (True, "")
+    assert check_concrete(f, checked, node, {"in.th": 2.0, "out.y": 0.95, "in.a": 0, "in.k": 0, "out.d": 0}) \
+        == (False, "")
+    ok, why = check_concrete(f, checked, node, {"in.th": 2.0, "out.y": math.sin(2.0), "in.a": 0, "in.k": 0,
+                                                "out.d": 0})
+    assert ok is None and "unknown functions" in why
+

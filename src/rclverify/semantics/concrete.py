@@ -24,10 +24,10 @@ from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import BOOL, Checked, CheckedNode, DataT, EnumT, FuncT, Scalar, SeqT, SetT, TupleT, Type
 from rclverify.semantics.connectives import conj
-from rclverify.semantics.definedness import defined
+from rclverify.semantics.definedness import conditions, defined
 from rclverify.semantics.values import FiniteFunction, Term, exact
 from rclverify.semantics.encode import Encoder, sort_of, widen
-from rclverify.semantics import wallclock
+from rclverify.semantics import mathfacts, wallclock
 from rclverify.semantics.retry import SAFETY_TIMEOUT_MS
 from rclverify.semantics.world import on_fresh
 
@@ -182,8 +182,9 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     if cond is not None:  # a partial operator: the formula has a truth value only where it is defined
         ok, why = check_concrete(cond, checked, node, values, timeout_ms=timeout_ms, rlimit=rlimit)
         if ok is not True:
+            failures = " or ".join(sorted({f"a {c.failure}" for c in conditions(formula)}))
             return None, (why if ok is None else
-                          f"undefined on these values: {expr_to_rcl(cond)} does not hold (a division by zero)")
+                          f"undefined on these values: {expr_to_rcl(cond)} does not hold ({failures})")
     phi, free = _encoded(formula, checked, node)
     consts: list[tuple[z3.ExprRef, z3.ExprRef]] = []
     funcs: list[tuple[z3.FuncDeclRef, z3.ExprRef]] = []
@@ -210,10 +211,15 @@ def check_concrete(formula: ast.Expr, checked: Checked, node: CheckedNode, value
     s = z3.Solver()
     s.set("rlimit", int(rlimit))
     wallclock.note_limit(s, timeout_ms)  # a safety net: its firing is told apart
-    s.add(z3.Not(phi))
+    s.add(z3.Not(phi), *mathfacts.facts([phi]))
     r, cut = wallclock.check_cut(s)
     if r == z3.unsat:
         return True, ""
+    if r == z3.sat and mathfacts.transcendental([phi]):  # the model may give sin/cos a value no real one takes:
+        # with every value given, the formula is decided when it keeps one truth value around Python's math values
+        unsure = mathfacts.unconfirmed([z3.Not(phi)], s.model())
+        if unsure is not None:
+            return (True, "") if mathfacts.unconfirmed([phi], s.model()) is None else (None, unsure)
     if r == z3.sat:
         return False, ""
     return None, wallclock.why_unknown(s, cut) or "unknown"

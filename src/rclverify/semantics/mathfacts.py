@@ -124,6 +124,14 @@ def facts(formulas: Sequence[z3.ExprRef]) -> list[z3.BoolRef]:
     return out
 
 
+def applies_math(formulas: Sequence[z3.ExprRef]) -> bool:
+    """Whether ``formulas`` apply ``sqrt``, ``sin`` or ``cos`` anywhere (a
+    query that does not add :func:`facts` nor confirm its models then reads
+    them as unknown functions: its refutation is not a verdict)."""
+    apps, bound = applications(formulas)
+    return bound or bool(apps)
+
+
 def transcendental(formulas: Sequence[z3.ExprRef]) -> bool:
     """Whether a model of ``formulas`` must be confirmed (:func:`unconfirmed`):
     they apply ``sin``/``cos``, or one of the three inside a quantifier."""
@@ -226,4 +234,4 @@ def _constants(f: z3.ExprRef) -> list[z3.ExprRef]:
     return out
 
 
-__all__ = ["CONFIRM_RLIMIT", "TOLERANCE", "applications", "facts", "math_function", "transcendental", "unconfirmed"]
+__all__ = ["CONFIRM_RLIMIT", "TOLERANCE", "applications", "applies_math", "facts", "math_function", "transcendental", "unconfirmed"]

@@ -67,6 +67,7 @@ from rclverify.calculus.requirements.temporal import (TemporalVerdict, Transitio
                        check_eventually_within, check_next, check_until, find_lasso, with_flag)
 from rclverify.calculus.requirements.lasso import find_table_lasso
 from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
+from rclverify.calculus.requirements import math_runs
 from rclverify.calculus.requirements.initial_needed import initially_not_needed
 from rclverify.calculus.requirements.exercised import NON_VACUOUS, vacuity
 from rclverify.calculus.requirements.progress_gap import EVEN_SO, explain_idle, stuck_in_loop, stuck_words
@@ -350,8 +351,10 @@ class _System:
         self.enc = Encoder(q.checked.env)
         if q.assuming:  # the requirement's own assumptions hold in every state
             self.assume()
+        self.sys.ts = math_runs.with_facts(self.sys.ts, [self.raw(f) for f in operands(q.t)])
         self.types = variable_types(self.sys, q.checked, q.plan)
         self.points = max([points_for(q.plan.instances.get(n)) for n in q.cone] or [points_for(None)])
+        self.confirmed: list[dict[str, str]] | None = None  # the trace of a lasso confirmed on its values
 
     def raw(self, f: Formal) -> Callable[[Any], Any]:
         """``f`` in a state; a statement's formula counts only where it is defined (its definedness
@@ -399,6 +402,7 @@ class _System:
                                    detail=f"{v.detail}; a lasso with {points}-point tables was found but not "
                                           f"confirmed on its values ({why})")
         n = len(found.values) - 1
+        self.confirmed = [{k: render(x) for k, x in st.items()} for st in found.values]
         return TemporalVerdict("refuted", "lasso", bound=n, loop=found.loop,
                                trace=[{k: render(x) for k, x in st.items()} for st in found.values],
                                detail=f"a run whose step {n} returns to step {found.loop} and never reaches it "
@@ -414,4 +418,4 @@ class _System:
                    invariant=inv_pred, checked=q.checked, gaps=missing,
                    tables_first=any(isinstance(ty, FuncT) for ty in self.types.values()), reach=self.reach,
                    hint_text=" ".join(q.req.invariant.text.split()) if q.req.invariant is not None else "")
-        return sys, v, missing
+        return sys, math_runs.unconfirmed(v, sys.ts, [self.raw(f) for f in operands(q.t)], self.confirmed), missing
