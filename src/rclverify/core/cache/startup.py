@@ -3,23 +3,26 @@ runs in the user's cache (the command's start-up, docs/scale.md).
 
 Before it reads a trace the command parsed the contracts (lark), checked
 the plan against its JSON schema (jsonschema), rendered each monitored
-formula's straight-line code (jinja2) and asked Z3 which guarantees only an
-answer decides: about a third of its start-up, the same result on every
+formula's straight-line code (jinja2), asked Z3 which guarantees only an
+answer decides and loaded rosbags' message definitions (the widths its
+topics carry): most of its start-up, the same result on every
 run with the same files.  A process that keeps its start-up
 (:func:`keeping`, entered by the command) finds each of these under the key
 of exactly what it was computed from and computes it only on a miss:
 
-===================  ====================================================  ===========
-part                 keyed by                                              library
-===================  ====================================================  ===========
-``contract``         the file's workspace-relative name and text           lark
-``plan-schema``      the plan's data (:func:`.keys.fingerprint`); only a   jsonschema
-                     pass is kept: a failing plan is validated again and
-                     its errors come from jsonschema
-``straightline``     what the template was given (name, comment, loads,    jinja2
-                     body; the template is rclverify's code)
-``needs-answer``     the pickled environment, node and formulas            Z3
-===================  ====================================================  ===========
+=========================  ====================================================  ===========
+part                       keyed by                                              library
+=========================  ====================================================  ===========
+``contract``               the file's workspace-relative name and text           lark
+``plan-schema``            the plan's data (:func:`.keys.fingerprint`); only a   jsonschema
+                           pass is kept: a failing plan is validated again and
+                           its errors come from jsonschema
+``straightline``           what the template was given (name, comment, loads,    jinja2
+                           body; the template is rclverify's code)
+``needs-answer``           the pickled environment, node and formulas            Z3
+``message-definitions``    the message types a node's topics name and the name   rosbags
+                           and text of each workspace ``.msg``
+=========================  ====================================================  ===========
 
 Every key also holds the part's salt (:func:`.keys.salt`: the cache
 format, :func:`.keys.code_stamp` -- every file of rclverify, the schema and
@@ -48,7 +51,8 @@ from rclverify.core.cache.store import read_stream, write_stream
 
 KIND = "start-up"
 #: Each part and the library whose result it keeps (its version is in the part's salt).
-PARTS = {"contract": "lark", "plan-schema": "jsonschema", "straightline": "jinja2", "needs-answer": "z3"}
+PARTS = {"contract": "lark", "plan-schema": "jsonschema", "straightline": "jinja2", "needs-answer": "z3",
+         "message-definitions": "rosbags"}
 
 
 class Kept:
