@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import copy
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
 
 from rclverify.traces.bag_late import of_reader
 from rclverify.traces.events import Event, TraceError, header_stamp
@@ -103,6 +103,47 @@ def typestore(msg_dirs: Sequence[Path]) -> Any:
         _STORES.pop(next(iter(_STORES)))
     _STORES[key] = store
     return _copy(store)
+
+
+def field_definitions(msg_dirs: Sequence[Path], names: Iterable[str]) -> dict[str, Any]:
+    """``{type name: (constants, fields)}`` (rosbags' ``fielddefs`` form) of the message types
+    ``names`` (``pkg/msg/Type``) and of every type their fields name, nested or in arrays, as
+    :func:`typestore` defines them; a name it does not know is left out.
+
+    In a process that keeps its start-up (:mod:`rclverify.core.cache.startup`, the
+    ``message-definitions`` part) the result is kept under the names and the name and text of
+    every ``.msg`` under ``msg_dirs``: the standard store alone costs about 0.2 CPU s to load
+    (rosbags builds it from each older distribution's), which a run on a log would pay on
+    every start.  Raises :class:`TraceError` as :func:`custom_types` does (a definition rosbags
+    refuses is never kept)."""
+    wanted = sorted(set(names))
+    definitions = _definitions(msg_dirs)
+    from rclverify.core.cache.startup import active  # deferred: start-up (loads rclverify.core.cache.store only when called)
+    kept = active()
+    contents = ("\0".join(wanted), *(f"{name}\0{text}" for name, text, _ in definitions))
+    got = kept.get("message-definitions", *contents) if kept is not None else None
+    if isinstance(got, dict):
+        return got
+    defs = typestore(msg_dirs).fielddefs
+    out: dict[str, Any] = {}
+    todo = [n for n in wanted if n in defs]
+    while todo:
+        name = todo.pop()
+        if name in out:
+            continue
+        out[name] = defs[name]
+        todo += [n for _, kind in defs[name][1] for n in _named(kind) if n in defs and n not in out]
+    if kept is not None:
+        kept.put("message-definitions", out, *contents)
+    return out
+
+
+def _named(kind: Any) -> Iterator[str]:
+    """The message type names a rosbags field kind refers to (a nested message, an array's items)."""
+    if kind[0].name == "NAME":
+        yield kind[1]
+    elif kind[0].name in ("ARRAY", "SEQUENCE"):
+        yield from _named(kind[1][0])
 
 
 def flatten(msg: Any) -> dict[str, object]:
