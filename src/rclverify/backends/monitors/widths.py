@@ -184,9 +184,9 @@ def carried_fields(node: CheckedNode, rules: Mapping[str, TopicRule],
     read a bag)."""
     if not node.node.topics or not installed("rosbags"):
         return {}
-    from rclverify.traces.bag import typestore  # deferred: start-up (loads rosbags only when called)
-    try:
-        defs = typestore(list(msg_dirs)).fielddefs
+    from rclverify.traces.bag import field_definitions  # deferred: start-up (loads rosbags only when called)
+    try:  # the topics' types and those they name, kept between runs by the command (traces/bag.py)
+        defs = field_definitions(list(msg_dirs), [_store_name(t.msg_type) for t in node.node.topics])
     except Exception:  # noqa: BLE001 - a definition rosbags refuses: the monitors report it where they read a bag
         return {}
     out: dict[str, FieldSource] = {}
