@@ -30,59 +30,61 @@ mistake prints ``file:line:col: error: message`` lines, never a traceback.
 
 This module holds :func:`main` and the table of commands
 (:data:`COMMANDS`); each command group is a module of its own beside it,
-parsing and printing only.
+parsing and printing only, imported only when one of its commands runs
+(or when the help lists them all): ``rclverify monitor`` loads the
+parsers and modules of ``monitor`` alone (docs/scale.md, "Start-up").
 """
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Sequence, cast
 
-from rclverify.cli import bundle, calculus, contracts, explain, repair, requirements, runs, standards, verify, workspace
 from rclverify.cli.common import AddCommand, print_diags
 from rclverify.core.extras import MissingExtra
 from rclverify.lang.errors import RclError
 
+#: One entry of the command table: the command group's module under ``rclverify.cli``, the function of it
+#: that adds the parsers, and the commands that function adds.
+Entry = tuple[str, str, tuple[str, ...]]
 
-def _ros(sub: Any) -> None:
-    from rclverify.cli.ros import add_parsers  # deferred: start-up (loads rclverify.cli.ros only when called)
-    add_parsers(sub)
-
-
-def _generate(sub: Any) -> None:
-    from rclverify.cli.generate import add_parsers  # deferred: start-up (loads rclverify.cli.generate only when called)
-    add_parsers(sub)
-
-
-def _nodl(sub: Any) -> None:
-    from rclverify.cli.nodl import add_parsers  # deferred: start-up (loads rclverify.cli.nodl only when called)
-    add_parsers(sub)
-
-
-def _import(sub: Any) -> None:
-    from rclverify.cli.design import add_import  # deferred: start-up (loads rclverify.cli.design only when called)
-    add_import(sub)
-
-
-def _lsp(sub: Any) -> None:
-    from rclverify.cli.lsp import add_parsers  # deferred: start-up (loads rclverify.cli.lsp only when called)
-    add_parsers(sub)
-
-
-#: The commands, in the order ``rclverify --help`` lists them: each entry adds its command's parser
+#: The commands, in the order ``rclverify --help`` lists them: each function adds its command's parser
 #: (or a group's) with ``add(name, fn, help, workspace)`` (:func:`main`).
-COMMANDS: tuple[Callable[[AddCommand], None], ...] = (
-    contracts.add_check, contracts.add_latex_fmt, calculus.add_graph_to_export, verify.add_report,
-    requirements.add_requirements_deadlines, workspace.add_cache, explain.add_status_explain, repair.add_repair, verify.add_verify,
-    workspace.add_init, bundle.add_bundle, workspace.add_review, calculus.add_quotient_refines,
-    standards.add_standards,
+COMMANDS: tuple[Entry, ...] = (
+    ("contracts", "add_check", ("check",)), ("contracts", "add_latex_fmt", ("latex", "fmt")),
+    ("calculus", "add_graph_to_export", ("graph", "compose", "health", "export")), ("verify", "add_report", ("report",)),
+    ("requirements", "add_requirements_deadlines", ("requirements", "deadlines")), ("workspace", "add_cache", ("cache",)),
+    ("explain", "add_status_explain", ("status", "explain")), ("repair", "add_repair", ("repair",)),
+    ("verify", "add_verify", ("verify",)), ("workspace", "add_init", ("init",)), ("bundle", "add_bundle", ("bundle",)),
+    ("workspace", "add_review", ("review",)), ("calculus", "add_quotient_refines", ("quotient", "refines")),
+    ("standards", "add_standards", ("standards",)),
 )
-#: The commands with subcommands of their own (``ros``, ``nodl``, ``generate``, ``import``), and ``lsp``: each adds to the subparsers.
-SUBCOMMAND_GROUPS: tuple[Callable[[Any], None], ...] = (_ros, _nodl, _generate, _import, _lsp)
+#: The commands with subcommands of their own (``ros``, ``nodl``, ``generate``, ``import``), and ``lsp``: each
+#: function adds to the subparsers.
+SUBCOMMAND_GROUPS: tuple[Entry, ...] = (
+    ("ros", "add_parsers", ("ros",)), ("nodl", "add_parsers", ("nodl",)), ("generate", "add_parsers", ("generate",)),
+    ("design", "add_import", ("import",)), ("lsp", "add_parsers", ("lsp",)),
+)
 #: Listed after them: monitoring recorded and live runs (docs/monitors.md).
-LAST_COMMANDS: tuple[Callable[[AddCommand], None], ...] = (runs.add_monitor, runs.add_oracle)
+LAST_COMMANDS: tuple[Entry, ...] = (("runs", "add_monitor", ("monitor",)), ("runs", "add_oracle", ("oracle",)))
+#: Every command's name, in the table's order.
+NAMES = tuple(name for _, _, names in COMMANDS + SUBCOMMAND_GROUPS + LAST_COMMANDS for name in names)
+
+
+def _adder(entry: Entry) -> Callable[[Any], None]:
+    """The function of ``entry`` (:data:`COMMANDS`), its module imported now."""
+    module, function, _ = entry
+    return cast("Callable[[Any], None]", getattr(importlib.import_module(f"rclverify.cli.{module}"), function))
+
+
+def chosen(argv: Sequence[str]) -> str | None:
+    """The command ``argv`` (the arguments after the program's name) runs when its first argument
+    names one, else ``None`` (``--help``, ``--version``, nothing, a mistake): then every command's
+    parser is made, so that the help and argparse's errors list them all."""
+    return argv[0] if argv and argv[0] in NAMES else None
 
 
 #: Exit code when standard output's reader left (128 + SIGPIPE, what a
@@ -110,7 +112,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
     from rclverify import __version__  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
     p.add_argument("--version", action="version", version=f"rclverify {__version__}")
-    sub = p.add_subparsers(dest="command", required=True)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    name = chosen(argv)  # only the command run has its parser made, and its module imported (start-up)
+    # with one command's parser, the usage still names every command, as argparse writes them all
+    sub = p.add_subparsers(dest="command", required=True,
+                           **({"metavar": "{" + ",".join(NAMES) + "}"} if name is not None else {}))
 
     def add(name: str, fn: Callable[[argparse.Namespace], int], help: str, workspace: bool = False) -> argparse.ArgumentParser:
         sp = sub.add_parser(name, help=help, description=help)
@@ -120,12 +126,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             sp.add_argument("--plan", default="contracts/plan.yaml", help="plan file, relative to the workspace")
         return sp
 
-    for add_parsers in COMMANDS:
-        add_parsers(add)
-    for add_group in SUBCOMMAND_GROUPS:
-        add_group(sub)
-    for add_parsers in LAST_COMMANDS:
-        add_parsers(add)
+    for entries, target in ((COMMANDS, add), (SUBCOMMAND_GROUPS, sub), (LAST_COMMANDS, add)):
+        for entry in entries:
+            if name is None or name in entry[2]:
+                _adder(entry)(target)
     args = p.parse_args(argv)
     return _run(args)
 

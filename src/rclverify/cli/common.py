@@ -2,10 +2,10 @@
 writing a command's output, the workspace's run lock.
 
 Parsing and printing only; what a command computes lives in the layers
-below (stages, report, calculus).  Every command module is imported when
-``rclverify`` starts, so each one imports the layers below inside the
-function that needs them: a command pays only for its own imports
-(docs/scale.md, start-up).
+below (stages, report, calculus).  A command group's module is imported
+when one of its commands runs (and every one for ``rclverify --help``),
+and each imports the layers below inside the function that needs them: a
+command pays only for its own imports (docs/scale.md, start-up).
 """
 from __future__ import annotations
 
