@@ -19,7 +19,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.calculus.health.checks import _NodeHealth
+from rclverify.calculus.health.node_health import NodeHealth
 from rclverify.calculus.health.witness import extend, finite_witness, points_for
 from rclverify.semantics import world
 from rclverify.lang.parser import parse_text
@@ -63,7 +63,7 @@ def test_extension_holds_exactly_where_an_instance_fires(seed: int) -> None:
     text, a = _contract(rng)
     checked = check([parse_text(text, "w.rcl")])
     world.fresh()
-    h = _NodeHealth(checked, checked.nodes["n"], (), None, 2000)
+    h = NodeHealth(checked, checked.nodes["n"], (), None, 2000)
     w = finite_witness(h.enc, [f for _, f in h.labelled()], points_for(None))
     if w.status != "sat":
         assert w.found is None
@@ -91,7 +91,7 @@ def test_a_witness_with_an_untabled_function_is_not_extended() -> None:
             "  guarantee( forall(i in INTEGER | in.g(i) > 0 -> out.y == in.f(red)) ) }\n")
     checked = check([parse_text(text, "w.rcl")])
     world.fresh()
-    h = _NodeHealth(checked, checked.nodes["n"], (), None, 2000)
+    h = NodeHealth(checked, checked.nodes["n"], (), None, 2000)
     w = finite_witness(h.enc, [f for _, f in h.labelled()], points_for(None))
     assert w.status == "sat" and w.found is None
     premise = h.premise(1)
@@ -107,7 +107,7 @@ def test_a_simplified_witness_meets_the_contract_and_loses_none(seed: int) -> No
     found = {}
     for simplified in (False, True):
         world.fresh()
-        h = _NodeHealth(checked, checked.nodes["n"], (), None, 2000)
+        h = NodeHealth(checked, checked.nodes["n"], (), None, 2000)
         found[simplified] = finite_witness(h.enc, [f for _, f in h.labelled()], points_for(None),
                                            simplified=simplified)
     if found[False].status == "sat":

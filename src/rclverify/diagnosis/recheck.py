@@ -75,7 +75,7 @@ def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | 
     check is not asked again.  ``known``: statuses of checks the caller has
     just asked Z3 on the same ``checked`` (``{"Agent.g1.non-vacuous":
     "ok"}``), taken as they are instead of being asked twice."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
+    from rclverify.calculus.health.vacuity import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     from rclverify.calculus.health.shape import shape_findings  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     as_status = {"sat": "ok", "unsat": "problem"}
     known = known or {}
@@ -97,10 +97,11 @@ def health(ws: Any, checked: Checked, node: str, instances: Mapping[int, int] | 
 
 
 def _health(ws: Any, checked: Checked, node: str) -> Any:
-    from rclverify.calculus.health.checks import _NodeHealth, INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
+    from rclverify.calculus.health.node_health import NodeHealth  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
+    from rclverify.calculus.health.vacuity import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     world.fresh()
     facts = [(f.expr, f.loc) for f in ws.plan.facts.get(node, ())]
-    return _NodeHealth(checked, checked.nodes[node], facts, None, INSTANCE_TIMEOUT_MS)
+    return NodeHealth(checked, checked.nodes[node], facts, None, INSTANCE_TIMEOUT_MS)
 
 
 def finite_witness(h: Any, extra: list[tuple[str, z3.BoolRef]], points: int) -> str:
@@ -151,7 +152,7 @@ def premise_fires(ws: Any, checked: Checked, node: str, k: int, at: int | None =
     shape :func:`finite_witness` looks for (asked first), or for the query
     of the health check ``non-vacuous``; else that query's ``unsat`` or
     ``inconclusive``."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
+    from rclverify.calculus.health.vacuity import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     h = _health(ws, checked, node)
     var = h.natural_vars(k)
     prem = h.premise(k, {var[0]: at} if at is not None and var else None)
@@ -170,7 +171,7 @@ def consistent(ws: Any, checked: Checked, node: str) -> str:
     """Can the assumption, every guarantee and the facts of ``node`` hold
     together?  ``sat`` (a witness: the general query or :func:`finite_witness`),
     ``unsat`` or ``inconclusive``."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
+    from rclverify.calculus.health.vacuity import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.compose, rclverify.calculus.context and more only when called)
     h = _health(ws, checked, node)
     if finite_witness(h, [], _points(ws, node)) == "sat":  # first, as in premise_fires
         return "sat"

@@ -185,7 +185,7 @@ def _weakest_first(ws: Any, node: str, guards: list[str], var_types: Mapping[str
     strictly weaker than, one without quantifiers comes first (Z3 decides
     the checks of the guarded contract more easily; of two equivalent
     guards either is the weakest)."""
-    from rclverify.calculus.health.checks import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.health, rclverify.calculus.refine_timing and more only when called)
+    from rclverify.calculus.health.vacuity import INSTANCE_TIMEOUT_MS  # deferred: start-up (loads rclverify.calculus.health, rclverify.calculus.refine_timing and more only when called)
     if len(guards) < 2:
         return guards, {g: [] for g in guards}
     checked = ws.checked
