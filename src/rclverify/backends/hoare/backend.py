@@ -39,7 +39,8 @@ from rclverify.semantics.encode import EncodingError, Encoder
 from rclverify.lang.errors import RclError, error
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.hoare.defined import definedness_vcs
-from rclverify.backends.hoare.obligations import Conjunct, EncodedTriple, HoareConfig, conjuncts, encode_triple, load_program, statement
+from rclverify.backends.hoare.config import HoareConfig, load_program
+from rclverify.backends.hoare.obligations import Conjunct, EncodedTriple, conjuncts, encode_triple, statement
 from rclverify.backends.hoare.outline import OutlineLine, outline_text, render_outline, term_printer
 from rclverify.backends.hoare.solve import TripleResult, check_all
 from rclverify.backends.hoare.program_model import ProgramModel
