@@ -32,6 +32,8 @@ FORMALS = [
     "eventually first(Mid.in.v)",                  # T4 the first value arrives
     "always (first(Src.in.r) -> Src.out.v == 0)",  # T5 the environment's first value: step 0
     "next (not first(Src.in.r))",                  # T6 true once only
+    "first(Src.in.r) -> Src.out.v == 0",           # T7 a state requirement: its first and the contract's are one
+    "first(Src.in.r) -> Src.out.v == 1",           # T8 its control
 ]
 
 
@@ -46,7 +48,7 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict]:
     w = Workspace(ws)
     stage_check(w)
     stage_requirements(w)
-    return {r["id"]: r["check"]["temporal"] for r in build_report(w)["requirements"]}
+    return {r["id"]: r["check"]["temporal"] or {"status": r["verdict"]} for r in build_report(w)["requirements"]}
 
 
 def test_the_first_published_value_is_proved_and_a_wrong_one_refuted_where_it_arrives(report) -> None:
@@ -81,3 +83,9 @@ def test_first_of_what_is_not_an_input_is_a_located_error(arg: str, why: str) ->
         check([parse_text(src, "f.rcl")])
     assert str(e.value).startswith("f.rcl:3:20: error:") and why in str(e.value), str(e.value)
     check([parse_text(src.replace(f"first({arg})", "first(in.x)"), "f.rcl")])  # control
+
+
+def test_a_state_requirement_reads_the_first_flag_its_contract_reads(report) -> None:
+    """One step: first(Src.in.r) is one Boolean for the requirement and for Src's guarantee."""
+    assert report["T7"]["status"].startswith("proved")
+    assert report["T8"]["status"] == "refuted"

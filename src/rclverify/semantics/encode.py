@@ -97,10 +97,11 @@ class Encoder:
         value is possible, every rule is asked for both), one symbol per
         input as the encoder names it (a consumer's input aliased to its
         producer's output shares the producer's)."""
-        owner, _, rest = self.symbol_name(node.name, "in", var).partition(".")
+        who, _, x = var.partition(".in.") if ".in." in var else (node.name, "", var)  # a requirement's Node.in.x
+        owner, _, rest = self.symbol_name(who, "in", x).partition(".")
         name = f"{owner}.first({rest})"  # "<Node>.first(in.x)": the qualified name after the node, as an I/O symbol's
         if name not in self.symbols:
-            self.symbols[name] = Symbol(name, f"first({node.name}.in.{var})", BOOL, z3.Bool(name))
+            self.symbols[name] = Symbol(name, f"first({who}.in.{x})", BOOL, z3.Bool(name))
         return self.symbols[name].decl
 
     def fresh(self, z3name: str, display: str, t: Type) -> z3.ExprRef:
