@@ -162,7 +162,7 @@ def evidence_anchors(report: ReportIn) -> list[str]:
     of the same obligation."""
     seen: dict[str, int] = defaultdict(int)
     out = []
-    for ev in _rows_decoded(report).evidence:
+    for ev in decoded_parts(report).evidence:
         ob = ev.obligation
         seen[ob] += 1
         out.append(anchor("ev", ob) if seen[ob] == 1 else anchor("ev", ob, seen[ob]))
@@ -181,16 +181,22 @@ def _later_parts() -> dict[str, object]:
 def _earlier(report: Report | Mapping[str, object]) -> dict[str, object]:
     """``report``, a JSON object, with each part :func:`_later_parts` names that it lacks at its empty
     value and each problem row's keys of :data:`~rclverify.records.problem_rows.EARLIER` that it lacks:
-    a stored report of an earlier version still decodes (its rows placed nowhere)."""
+    a stored report of an earlier version still decodes (its rows placed nowhere), and so does the report
+    before its diagnoses (report/build.py ``undiagnosed_report``: no ``diagnoses``, in the summary too)."""
     out: dict[str, object] = {**_later_parts(), **report}
+    summary = out["summary"]
+    if isinstance(summary, Mapping) and "diagnoses" not in summary:
+        out["summary"] = {**summary, "diagnoses": []}
     problems = out["problems"]
     if isinstance(problems, list):
         out["problems"] = [{**EARLIER, **p} if isinstance(p, Mapping) else p for p in problems]
     return out
 
 
-def _rows_decoded(report: ReportIn) -> AssuranceReport:
-    """``report`` decoded for a reader of its rows, which reads no ``problems`` (a JSON object may lack them)."""
+def decoded_parts(report: ReportIn) -> AssuranceReport:
+    """``report`` decoded for a reader of its rows, which reads no ``problems`` and no diagnoses (a JSON
+    object may lack them: :func:`_earlier`).  Raises :class:`msgspec.ValidationError` for a report of
+    another shape."""
     return report if isinstance(report, AssuranceReport) else AssuranceReport.of(_earlier(report))
 
 
@@ -214,7 +220,7 @@ def decoded_report(report: ReportIn) -> AssuranceReport:
 def problem_items(report: ReportIn) -> list[AttentionItem]:
     """The attention items of ``report`` (decoded on entry) that are problems (worse than
     pending), worst first (see :func:`_attention`)."""
-    decoded = _rows_decoded(report)
+    decoded = decoded_parts(report)
     return _attention(decoded, evidence_anchors(decoded))[0]
 
 
