@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from _chain import chain_rcl
-from rclverify.calculus import summary
+from rclverify.calculus import summary, summary_store
 from rclverify.calculus.compose import environment_conjuncts
 from rclverify.lang.parser import parse_formula, parse_text
 from rclverify.lang.typecheck import check
@@ -24,7 +24,7 @@ N = 12
 def _fresh_process() -> None:
     """What a new process holds: no summary in memory."""
     summary._MEMO.update({"key": None, "summaries": {}, "keys": {}})
-    summary._blobs.forget()
+    summary_store._blobs.forget()
 
 
 def _computed(directory: Path | None, **chain: object) -> tuple[dict[str, summary.Summary | None], dict[str, bytes]]:
@@ -56,7 +56,7 @@ def test_kept_summaries_are_read_and_equal_the_ones_made(tmp_path: Path, referen
     made = _summaries(tmp_path)
     assert made == reference and all(s is not None for s in made.values())
     assert len(list(tmp_path.glob("*.json"))) == N  # N0 .. N11: each one its file
-    monkeypatch.setattr(summary, "_made", lambda made: pytest.fail(f"{made.node}'s summary made again"))
+    monkeypatch.setattr(summary_store, "_made", lambda made: pytest.fail(f"{made.node}'s summary made again"))
     assert _summaries(tmp_path) == reference  # every one read from its file
 
 
@@ -94,5 +94,5 @@ def test_the_compose_stage_keeps_its_summaries_in_its_workspace_only(tmp_path: P
     stage_check(ws)
     for n in ws.node_names():
         stage_compose(ws, n)
-    assert summary._blobs.directory is None
+    assert summary_store._blobs.directory is None
     assert len(list((tmp_path / "ws/artifacts/cache/summaries").glob("*.json"))) == 3  # N0, N1, N2: read by N1-N3
