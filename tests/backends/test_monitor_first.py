@@ -64,3 +64,45 @@ def test_a_log_without_the_start_marker_leaves_first_inconclusive_and_says_why(t
     assert counts["satisfied"] == 0 and counts["violated"] == 0 and counts["inconclusive"] == 2
     why = res.first_inconclusive["reason"]
     assert "no start-of-run marker" in why and "in.cmd" in why, why
+
+
+# -- a requirement's first(Node.in.x) on a recorded run: Inc answers each a with a + 1 -----------------------
+
+INC = """node Inc { inputs( a : NATURAL ) outputs( b : NATURAL )
+  topics( std_msgs/Int32 a matches(in.a), std_msgs/Int32 b matches(out.b) )
+  guarantee( out.b == in.a + 1 ) }
+"""
+RUN = [("a", 1), ("b", 2), ("a", 2), ("b", 3), ("a", 5), ("b", 6)]
+
+
+def _requirement(tmp: Path, formal: str, start: bool) -> Any:
+    from rclverify.backends.monitors.temporal_trace import check_temporal_trace
+    from rclverify.model.plan.formal import Source
+    from rclverify.model.plan.temporal import parse_temporal
+    from rclverify.traces import read_trace
+    checked = load_text(INC)
+    p = tmp / "run.jsonl"
+    lines = ([_start()] if start else []) + [{"topic": t, "time": round(1 + 0.1 * k, 1), "data": v}
+                                             for k, (t, v) in enumerate(RUN)]
+    p.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    t = parse_temporal(Source(formal, 1, 1, "plan.yaml"), checked, "T", {})
+    return check_temporal_trace(t, checked, (), read_trace(p), {})
+
+
+def load_text(rcl: str) -> Any:
+    from rclverify.lang.parser import parse_text
+    from rclverify.lang.typecheck import check
+    return check([parse_text(rcl, "n.rcl")])
+
+
+def test_a_requirement_reads_the_first_value_on_a_run_with_its_start_marker(tmp_path: Path) -> None:
+    assert _requirement(tmp_path, "always (first(Inc.in.a) -> Inc.in.a == 1)", True).verdict == "true"
+    # control: the later values are not 1, and the first is not 2
+    assert _requirement(tmp_path, "always Inc.in.a == 1", True).verdict == "false"
+    v = _requirement(tmp_path, "always (first(Inc.in.a) -> Inc.in.a == 2)", True)
+    assert (v.verdict, v.step) == ("false", 0)
+
+
+def test_a_requirement_over_first_on_a_run_without_the_marker_is_inconclusive(tmp_path: Path) -> None:
+    v = _requirement(tmp_path, "always (first(Inc.in.a) -> Inc.in.a == 1)", False)
+    assert v.verdict == "inconclusive" and "no start-of-run marker" in v.reason, v.reason

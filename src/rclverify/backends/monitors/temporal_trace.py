@@ -75,6 +75,8 @@ from rclverify.backends.monitors.response_trace import ResponseTracker
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
 from rclverify.backends.monitors.declarations import call_part
 from rclverify.backends.monitors.trace_states import StepClock, TraceStates, cone_of
+from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC
+from rclverify.calculus.requirements.published import first_inputs
 from rclverify.lang.types import Checked
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
@@ -123,7 +125,7 @@ def _truth(f: Formal, checked: Checked, values: Mapping[str, object], tolerance:
     double arithmetic, then a declared ``tolerance``); the semantics that
     decided goes to ``semantics[id(f)]``."""
     mine = {k: v for k, v in values.items() if k.partition(".")[2] in f.scope.inputs or
-            k.partition(".")[2] in f.scope.outputs}
+            k.partition(".")[2] in f.scope.outputs or k.startswith("first(")}
     try:
         j = judge(f.expr, checked, f.scope, mine, tolerance)
     except (KeyError, ValueError, TypeError, EncodingError, z3.Z3Exception):
@@ -168,13 +170,18 @@ class _Run:
     i: int = -1
     last: Event | None = None
     vals: Mapping[str, object] = field(default_factory=dict)
+    #: why a first(...) the statement reads is unknown on this run (first_messages.py), once an operand needed it
+    first_why: str = ""
 
     def decide(self, f: Formal, unpublished: bool | None) -> bool | None:
         """``f``'s truth at this step: undecided when a value it reads was unreadable in its last message,
         ``unpublished`` when one was never published, else judged."""
         if any(f"{p}.{n}.{p}.{v}" in self.st.unreadable for n, p, v in f.mentions):
             return None
-        return _truth(f, self.checked, self.vals, self.tol, self.sems) if _published(f, self.vals) else unpublished
+        got = _truth(f, self.checked, self.vals, self.tol, self.sems) if _published(f, self.vals) else unpublished
+        if got is None and not self.first_why:
+            self.first_why = next((v for k, v in self.vals.items() if k.startswith("first(") and isinstance(v, str)), "")
+        return got
 
     def wit(self, f: Formal, holds: bool | None) -> Witness:
         """The witness of operand ``f`` at this step."""
@@ -305,7 +312,7 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     nodes = list(dict.fromkeys(n for f in ops for n in f.nodes))
     for sv in states:
         state_type(sv, checked)
-    st = TraceStates(checked, nodes, states, rules)
+    st = TraceStates(checked, nodes, states, rules, first_inputs([f.expr for f in ops]))
     # the steps of the composed system, over the statement's cone (trace_states.StepClock)
     clock = StepClock(checked, cone_of(checked, nodes), getattr(rules, "skew", None) or 0.0)
     # the mapping's tolerance of recorded numbers
@@ -321,6 +328,8 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
             ev, part = call
         got = clock.tick(ev)
         if got is None:
+            if ev.topic == ORIGIN_TOPIC and ev.fields.get("kind") == "run":  # first(...) is decided after it
+                st.start()
             continue
         k, later = got
         while 0 <= now < k:  # the steps before this message's are over: each judged on its last state
@@ -363,7 +372,8 @@ def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
                                                f"{', '.join(nodes)}: nothing was checked")
     if undecided is not None and r.kind != "eventually":
         why = (f"a value it reads could not be read ({undecided['unreadable'][0]}), and the value before never "
-               "stands in" if undecided.get("unreadable") else "a value it reads is not observed or not decidable there")
+               "stands in" if undecided.get("unreadable") else
+               r.first_why or "a value it reads is not observed or not decidable there")
         return TraceVerdict("inconclusive", n, f"an operand is undecided at step {undecided['step']} "
                                                f"({undecided['where']}): {why}", undecided["step"], undecided["time"],
                             undecided["where"], [undecided])

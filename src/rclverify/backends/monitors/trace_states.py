@@ -29,6 +29,7 @@ from rclverify.semantics.values import FiniteFunction
 from rclverify.semantics import wallclock
 from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
+from rclverify.backends.monitors.first_messages import NO_START
 
 #: :func:`solve_value`'s answer when a value the formula reads is not observed yet.
 MISSING = object()
@@ -286,8 +287,15 @@ class TraceStates:
     ``"in.Node.state.v"``)."""
 
     def __init__(self, checked: Checked, nodes: Iterable[str], states: tuple[StateVar, ...],
-                 rules: Mapping[str, TopicRule]) -> None:
+                 rules: Mapping[str, TopicRule], firsts: Iterable[str] = ()) -> None:
         self.checked, self.rules = checked, rules
+        #: the inputs (``Node.in.x``) a ``first(...)`` of the statement reads, and which of them took their first
+        #: message in this step (docs/semantics.md, "The first published value"; decided only after the
+        #: run's start-of-run marker, :meth:`start`)
+        self.firsts = {tuple(c.split(".in.", 1)) for c in firsts}
+        self.fresh: set[tuple[str, str]] = set()
+        self.heard: set[tuple[str, str]] = set()
+        self.from_start = False
         self.nodes = list(nodes)
         #: topic -> [(node, "in.x", type, part)]: ``part`` the action message part that carries it (``""``: the
         #: whole message); a link's parts are on ``link/request`` ... ``link/result``, as a live log's call lines
@@ -355,9 +363,16 @@ class TraceStates:
             now = True
         return now
 
+    def start(self) -> None:
+        """The run's start-of-run marker was read: a topic's first message after it is its first."""
+        self.from_start = True
+
     def _set(self, n: str, key: str, value: object, bad: str | None) -> None:
         p, _, name = key.partition(".")
         self.io[n][key] = value
+        if p == "in" and value is not None and (n, name) in self.firsts and (n, name) not in self.heard:
+            self.heard.add((n, name))
+            self.fresh.add((n, name))
         if bad is None:
             self.unreadable.pop(f"{p}.{n}.{p}.{name}", None)
         else:
@@ -374,6 +389,7 @@ class TraceStates:
             v = solve_value(self.formulas[(sv.node, sv.name)][1], self.checked, f"next.{sv.name}", before[sv.node])
             if v is not MISSING:
                 self.state[(sv.node, sv.name)] = v
+        self.fresh.clear()  # the step judged is over: its first messages are behind
         for (n, key), (value, bad) in self.pending.items():
             self._set(n, key, value, bad)
         self.pending.clear()
@@ -391,6 +407,10 @@ class TraceStates:
         for (n, v), x in self.state.items():
             if x is not None:
                 out[f"in.{n}.state.{v}"] = x
+        for n, x in self.firsts:  # first(Node.in.x): a Boolean, or why it is unknown (first_messages.py)
+            if (n, x) in self.heard:
+                out[f"first(in.{n}.in.{x})"] = (n, x) in self.fresh if self.from_start else NO_START.format(
+                    k=f"{n}.in.{x}")
         return out
 
 
