@@ -137,14 +137,23 @@ def test_z3_refutes_a_false_sqrt_claim_and_a_negative_argument() -> None:
 
 
 def test_a_spurious_sine_counterexample_is_inconclusive_and_a_real_one_refutes() -> None:
-    """sin(2) = 0.909...: ``sin(in.th) >= 0.5`` holds at 2, but the facts allow the unknown function any
-    value in [-1, 1], so Z3 finds a model; Python's math does not reproduce it: ``inconclusive`` with the
-    reason.  The control: ``sin(in.th) <= 0.5`` at 2 is false for the real sine, and stays refuted."""
-    spurious = _prove("in.th == 2", "sin(in.th) >= 0.5")
+    """sin(2) is irrational, so ``sin(in.th) != 0.9092974268256817`` (its double) holds at 2; the facts allow
+    the unknown function that very value, Z3 finds the model, Python's math does not reproduce the violation
+    within the tolerance and cvc5 does not decide it within its limit: ``inconclusive`` with the reason.
+    The control: ``sin(in.th) <= 0.5`` at 2 is false for the real sine, and stays refuted."""
+    spurious = _prove("in.th == 2", "sin(in.th) != 0.9092974268256817")
     assert spurious.status == "inconclusive"
     assert "sqrt/sin/cos as unknown functions" in spurious.reason and "does not hold" in spurious.reason
     real = _prove("in.th == 2", "sin(in.th) <= 0.5")
-    assert real.status == "refuted" and real.model["n.in.th"] == "2"
+    assert real.status == "refuted" and real.model is not None and real.model["n.in.th"] == "2"
+
+
+def test_cvc5_proves_what_the_unknown_sine_could_not() -> None:
+    """``sin(in.th) >= 0.5`` at 2 (sin(2) = 0.909...): Z3's model gives the unknown function a smaller value,
+    unconfirmed; cvc5, deciding the real sine, proves it (the strategy names it)."""
+    from rclverify.semantics.query import CVC5
+    r = _prove("in.th == 2", "sin(in.th) >= 0.5")
+    assert r.status == "proved" and r.strategy == CVC5
 
 
 def test_each_backend_translates_or_refuses_with_a_reason() -> None:

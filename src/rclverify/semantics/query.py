@@ -13,7 +13,9 @@ Every query:
   with a model) / ``inconclusive`` (unknown or timeout); a query applying
   ``sqrt``/``sin``/``cos`` gets their facts, and a model reading ``sin``/``cos``
   as unknown functions counts only when :func:`.mathfacts.unconfirmed`
-  confirms it (else ``inconclusive`` with the reason); satisfiability ->
+  confirms it; unconfirmed, a validity query is asked of cvc5
+  (:mod:`.cvc5_math`: its ``unsat`` is ``proved``, strategy :data:`CVC5`),
+  else ``inconclusive`` with the reason; satisfiability ->
   ``sat`` (with a model) / ``unsat`` (with an unsat core of the labelled
   formulas) / ``inconclusive``;
 * keeps its SMT-LIB2 text so a second solver can re-check it
@@ -35,10 +37,12 @@ from rclverify.semantics.encode import Encoder, term_to_rcl, value_to_rcl
 from rclverify.semantics.functable import finite_table
 from rclverify.semantics.retry import (DEFAULT, TABLES, attempts, bounded_solver, load_canonical, reasons_text, retry_order,
                     strategy_solver, variants)
-from rclverify.semantics import mathfacts, wallclock
+from rclverify.semantics import cvc5_math, mathfacts, wallclock
 from rclverify.semantics.wallclock import STEPS_PER_MS as STEPS_PER_MS, check, cut_reason, steps as steps
 
 DEFAULT_TIMEOUT_MS = 10_000
+#: the strategy of a validity cvc5 proved where Z3's model read sin/cos as unknown functions (:mod:`.cvc5_math`)
+CVC5 = "cvc5 on the real sqrt/sin/cos"
 
 
 @dataclass(frozen=True)
@@ -308,6 +312,8 @@ class _Validity:
             return QueryResult("proved", self.script, self.elapsed(), strategy=strategy)
         if r == z3.sat and self.confirm is not None:
             why = mathfacts.unconfirmed(self.confirm, s.model())
+            if why is not None and cvc5_math.refutes_negation(self.script()):  # cvc5 decides the real functions
+                return QueryResult("proved", self.script, self.elapsed(), strategy=CVC5)
             if why is not None:
                 return QueryResult("inconclusive", self.script, self.elapsed(), reason=why, strategy=strategy)
         if r == z3.sat:
