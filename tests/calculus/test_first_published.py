@@ -89,3 +89,47 @@ def test_a_state_requirement_reads_the_first_flag_its_contract_reads(report) -> 
     """One step: first(Src.in.r) is one Boolean for the requirement and for Src's guarantee."""
     assert report["T7"]["status"].startswith("proved")
     assert report["T8"]["status"] == "refuted"
+
+
+# A lasso found with finite tables is confirmed on its values, first(...) flags included (lasso_confirm.py):
+# Hold answers the first level it hears with 0 and echoes every later one.
+TABLES = """context { Levels : REAL --> NATURAL ; }
+node Pick { inputs( f : Levels ) outputs( k : NATURAL )
+  guarantee( exists(x in REAL | in.f(x) == out.k) )
+  progress( within 0 steps ) }
+node Hold { inputs( k : NATURAL ) outputs( last : NATURAL )
+  guarantee( (first(in.k) -> out.last == 0) and (not first(in.k) -> out.last == in.k) )
+  progress( within 0 steps ) }
+"""
+
+
+def test_a_table_lasso_over_first_is_confirmed_and_a_wrong_flag_is_not(tmp_path) -> None:
+    from rclverify.calculus.requirements.lasso import find_table_lasso
+    from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
+    from rclverify.calculus.requirements.temporal_check import statement
+    from rclverify.calculus.requirements.transition import build_system, variable_types
+    from rclverify.model.plan.temporal import operands
+    from rclverify.semantics.encode import Encoder
+    ws = tmp_path / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/p.rcl").write_text(TABLES)
+    (ws / "contracts/plan.yaml").write_text(
+        'contracts: [contracts/p.rcl]\nrequirements:\n  - id: L1\n    text: reaches 7\n'
+        '    formal: "eventually Hold.out.last == 7"\n'
+        'environment:\n  Pick:\n    facts:\n      - "forall(x in REAL | in.f(x) <= 9)"\n')
+    w = Workspace(ws)
+    checked, model, plan = w.checked, w.model, w.plan
+    goal = operands(statement(plan.requirements[0], checked, plan))[0]
+    cone = list(model.nodes)
+    sys = build_system(cone, checked, model, plan)
+    assert sys.pub.first == {"Hold.in.k": "Hold.first.k"}  # the contract's first(in.k) has its flag
+    enc = Encoder(checked.env)
+    types = variable_types(sys, checked, plan)
+    found = find_table_lasso(sys.ts, lambda s: enc.formula(goal.expr, goal.scope, sys.statement_symbols(s)),
+                             types, bound=4, points=4)
+    assert not isinstance(found, str), found
+    assert confirm_lasso(found.values, found.loop, cone, sys.variables, types, checked, model, plan, goal, [],
+                         pub=sys.pub) is None
+    bad = [dict(st, **{"Hold.first.k": True}) for st in found.values]  # control: first at every step
+    why = confirm_lasso(bad, found.loop, cone, sys.variables, types, checked, model, plan, goal, [], pub=sys.pub)
+    assert why is not None and "Hold.first.k" in why, why

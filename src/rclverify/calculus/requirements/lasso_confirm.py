@@ -56,7 +56,8 @@ class _Unconfirmed(Exception):
 
 def _holds(e: ast.Expr, checked: Checked, scope: CheckedNode, values: Mapping[str, Any], what: str) -> bool:
     vals = {k: v for k, v in values.items()
-            if (k.startswith("in.") and k[3:] in scope.inputs) or (k.startswith("out.") and k[4:] in scope.outputs)}
+            if (k.startswith("in.") and k[3:] in scope.inputs) or (k.startswith("out.") and k[4:] in scope.outputs)
+            or k.startswith("first(")}
     try:
         r, why = decide(e, checked, scope, vals, timeout_ms=CONFIRM_TIMEOUT_MS)
     except Exception as exc:  # noqa: BLE001 - a value the evaluator refuses is an unconfirmed trace, not a crash
@@ -107,6 +108,8 @@ def _node_values(state: Mapping[str, Any], node: str) -> dict[str, Any]:
         n, _, rest = name.partition(".")
         if n == node:
             out[rest] = v  # "in.x" / "out.y" / "state.v"
+            if rest.startswith("first."):  # a first(in.x) flag (published.py)
+                out[f"first(in.{rest[6:]})"] = v
     return out
 
 
@@ -178,6 +181,7 @@ class _Lasso:
         # the statement's pseudo node names Node.out.y an output, every other variable an input (model/plan/formal.py)
         pseudo = {f"{'out' if variables[name][1] == 'out' else 'in'}.{name}": v
                   for name, v in st.items() if name in variables}
+        pseudo.update({f"first(in.{c})": st[f] for c, f in pub.first.items() if f in st})  # first(Node.in.x)
         for k, a in enumerate(self.assuming, 1):
             if all(st.get(f) is True for f in pub.flags_of(a.mentions)) and \
                     not _holds(a.expr, checked, a.scope, pseudo, f"step {i}: assuming {k}"):
