@@ -145,7 +145,7 @@ def test_the_guarantees_of_one_node_share_one_scope() -> None:
 
 def test_the_editor_completes_every_keyword_of_the_grammar() -> None:
     """The language server's completion (tools/lsp/complete.py ``KEYWORDS``) offers every word rcl.lark
-    quotes, the new ``while``, ``ready`` and ``of`` among them; the short forms ``A``/``G``, ``abs`` and
+    quotes, the new ``while``, ``ready`` and ``of`` among them; the short forms ``A``/``G``, ``abs``, ``sqrt``, ``sin``, ``cos`` and
     ``x`` (and a comment's example name) are the only words left out."""
     import re
 
@@ -153,4 +153,4 @@ def test_the_editor_completes_every_keyword_of_the_grammar() -> None:
     from rclverify.tools.lsp.complete import KEYWORDS
     words = set(re.findall(r'"([A-Za-z_]+)"', grammar_text()))
     assert {"while", "ready", "of"} <= words
-    assert words - set(KEYWORDS) == {"A", "G", "abs", "x", "RadStat"}
+    assert words - set(KEYWORDS) == {"A", "G", "abs", "sqrt", "sin", "cos", "x", "RadStat"}
