@@ -222,3 +222,15 @@ def test_a_concrete_check_is_decided_only_where_python_math_agrees() -> None:
                                                 "out.d": 0})
     assert ok is None and "unknown functions" in why
 
+
+
+def test_the_carried_evaluator_of_generated_packages_reads_the_table() -> None:
+    """contract_eval.py, written from the semantics table (targets/python/carry.py): Python's math, and a
+    negative square root undecided as in the reference evaluator."""
+    from rclverify.targets.python.carry import evaluator_text
+    ns: dict[str, Any] = {}
+    exec(compile(evaluator_text("# test"), "contract_eval.py", "exec"), ns)  # noqa: S102 - the project's own text
+    unary = ns["_UNARY"]
+    assert unary["sqrt"](2.0) == math.sqrt(2.0) and unary["sin"](1.0) == math.sin(1.0) and unary["cos"](0) == 1
+    with pytest.raises(ns["Undecided"], match="square root of a negative number"):
+        unary["sqrt"](-1.0)

@@ -234,4 +234,5 @@ def _constants(f: z3.ExprRef) -> list[z3.ExprRef]:
     return out
 
 
-__all__ = ["CONFIRM_RLIMIT", "TOLERANCE", "applications", "applies_math", "facts", "math_function", "transcendental", "unconfirmed"]
+__all__ = ["CONFIRM_RLIMIT", "TOLERANCE", "applications", "applies_math", "facts", "math_function", "transcendental",
+           "unconfirmed"]

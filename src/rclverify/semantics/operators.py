@@ -189,7 +189,8 @@ def _double_math(fn: Callable[[float], float], name: str) -> Callable[[Any], Any
 def _math_entry(name: str, fn: Callable[[float], float], word: str, partial: Partial | None = None) -> Operator:
     python = (f"(math.sqrt({{x}}) if {{x}} >= 0 else _undecided({partial.failure!r}))" if partial is not None
               else f"math.{name}({{x}})")
-    return Operator(name, word, "arithmetic", 1, _exact_math(fn, name), _double_math(fn, name), python=python, cpp=f"std::{name}({{x}})", z3=None, numpy=name, smtlib=None,
+    return Operator(name, word, "arithmetic", 1, _exact_math(fn, name), _double_math(fn, name), python=python,
+                    cpp=f"std::{name}({{x}})", z3=None, numpy=name, smtlib=None,
                     partial=partial)
 
 

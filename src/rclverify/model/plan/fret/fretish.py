@@ -58,7 +58,7 @@ _TOKEN = re.compile(r"\s*(?:(?P<num>\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][
 _LEVELS: tuple[tuple[str, ...], ...] = (("<=>", "<->"), ("=>", "->"), ("xor",), ("|",), ("&",))
 _COMPARE = ("=", "!=", "~=", "<", "<=", ">", ">=")
 ABS = ("absReal", "absInt", "abs")
-#: FRET's (and Lustre's math library's) sqrt, sin, cos of one real: RCL's own (docs/semantics.md, "Mathematical functions")
+#: FRET's sqrt, sin, cos of one real: RCL's own (docs/semantics.md, "Mathematical functions")
 MATH = ("sqrt", "sin", "cos")
 #: FRET's maxReal/maxInt and minReal/minInt (FRET's field guide, "builtin functions"): the comparison choosing a.
 EXTREMA = {"maxReal": ">=", "maxInt": ">=", "minReal": "<=", "minInt": "<="}
