@@ -5,8 +5,8 @@ engine, its log, its verdict sink, margins on) a fixed stream as the engine
 worker does (the timer before each message, every 10 ms of the stream's
 clock), stops it, and digests what it wrote: the log's bytes (every
 released message and every verdict line, margins included), the verdict
-texts it published, the latched last verdicts and each node's status and
-counts.  The digests in ``tests/data/online_verdicts.json`` were written by
+texts it published, what each latched last-verdict topic holds at the end
+and each node's status and counts.  The digests in ``tests/data/online_verdicts.json`` were written by
 the engine before its per-topic plans and cheaper bookkeeping
 (``python tests/backends/test_online_same_verdicts.py --write COMMIT``
 with that commit's ``src`` first on ``PYTHONPATH``; the file names it); the test fails on any byte that differs.
@@ -17,7 +17,8 @@ and missing fields (lateness bound 50 ms), and a two-input node with
 header stamps, copied stale stamps, arrivals out of order and later than
 the bound, a NaN, a deadline (``triggered by ... within``) and an output
 state, on three seeds.  The control: the same stream with one value
-changed gives another digest.
+changed gives another digest.  And a verdict's ``std_msgs/String`` sample,
+made without the struct's serializer, is the bytes the serializer gives.
 """
 from __future__ import annotations
 
@@ -162,10 +163,10 @@ def digest(tmp: Path, name: str, change: Callable[[Heard], None] | None = None) 
         change(heard)
     checked, cfg, window = _workspace(tmp, kind)
     published: list[str] = []
-    lasts: list[str] = []
+    lasts: dict[str, str] = {}  # what each latched last-verdict topic holds
     log = tmp / f"{name}.jsonl"
     live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, log, reorder_window=window,
-                   silence_s=0.5, publish=published.append, publish_last=lambda n, t: lasts.append(f"{n} {t}"),
+                   silence_s=0.5, publish=published.append, publish_last=lasts.__setitem__,
                    margins=True)
     now = heard[0][0]
     for arrival, topic, fields in heard:
@@ -178,7 +179,7 @@ def digest(tmp: Path, name: str, change: Callable[[Heard], None] | None = None) 
     record = live.stop()
     nodes = [{k: n.get(k) for k in ("node", "status", "explanation", "counts")} for n in record["nodes"]]
     h = hashlib.sha256()
-    for part in (log.read_bytes(), "\n".join(published).encode(), "\n".join(lasts).encode(),
+    for part in (log.read_bytes(), "\n".join(published).encode(), json.dumps(lasts, sort_keys=True).encode(),
                  json.dumps([nodes, record["events"], record["late_events"], record["verdicts"],
                              record.get("topic_deadlines"), record["silent_topics"]], sort_keys=True).encode()):
         h.update(hashlib.sha256(part).digest())
@@ -199,6 +200,15 @@ def test_the_control_one_value_changed_is_another_digest(tmp_path: Path) -> None
     got = digest(tmp_path, "fuse-1", flip)
     assert got["sha256"] != want["sha256"]
     assert digest(tmp_path, "fuse-1") == want  # the unchanged stream, after the changed one, is the fixture's
+
+
+@pytest.mark.parametrize("text", ["", "abc", '{"node": "A", "verdict": "satisfied", "time": 1.5}', "\u00e9\u2603x"])
+def test_a_verdict_is_sent_as_the_bytes_the_string_struct_serializes(text: str) -> None:
+    from rclverify.runtime.dds.live import string_cdr
+    from rclverify.runtime.dds.types import TypeBook
+    string = TypeBook().message("std_msgs/msg/String")
+    assert string_cdr(text) == string(data=text).serialize(use_version_2=False)
+    assert string_cdr(text + "x") != string(data=text).serialize(use_version_2=False)  # the control
 
 
 def _write(commit: str) -> None:

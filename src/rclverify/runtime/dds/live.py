@@ -55,6 +55,19 @@ from rclverify.runtime.dds.trust import VERDICT_KEY
 from rclverify.runtime.dds.live_end import DdsRunEnd
 
 
+#: the encapsulation header of plain little-endian CDR (XCDR1), as rmw writes ROS 2 messages
+_CDR_LE = b"\x00\x01\x00\x00"
+
+
+def string_cdr(text: str) -> bytes:
+    """``std_msgs/String(data=text)`` as plain little-endian CDR, its encapsulation
+    header included: the bytes the struct's serializer gives (a ``uint32``
+    length counting the closing NUL, the UTF-8 text, the NUL), made without
+    it, since a verdict is sent for every message."""
+    data = text.encode()
+    return _CDR_LE + (len(data) + 1).to_bytes(4, "little") + data + b"\0"
+
+
 class _Sink:
     """What the engine thread feeds: the run's engine, and the call book's clock."""
 
@@ -256,7 +269,7 @@ class _DdsRun(DdsRunEnd):
         extra = {"release": release} if enforce else {}
 
         def send_last(node: str, text: str) -> None:
-            lasts[node].write(string(data=text))
+            self.write_text(lasts[node], text)
         self.live = run_factory(publish=self.send, publish_last=send_last, **extra)
         if self.recorder is not None:  # the bag keeps what was heard late, as the log does (traces/bag_late.py)
             self.live.engine.on_late = self.recorder.late
@@ -284,7 +297,19 @@ class _DdsRun(DdsRunEnd):
                      "introspection events only, never their request and reply topics (docs/ros2.md)")
 
     def send(self, text: str) -> None:
-        self.pub.write(self.string(data=text))
+        self.write_text(self.pub, text)
+
+    def write_text(self, w: Any, text: str) -> None:
+        """Write ``std_msgs/String(data=text)`` with writer ``w``: its plain CDR made by :func:`string_cdr`
+        where the writer writes plain CDR (the rclpy source's writers; a Cyclone writer whose data
+        representation is XCDR1, as ``writer_profile``'s are), else the struct serialized by the writer."""
+        own = getattr(w, "write_raw", None)  # the rclpy source's writer: plain CDR, as rmw writes
+        if own is not None:
+            own(string_cdr(text))
+        elif getattr(w, "_use_version_2", None) is False:  # cyclonedds' DataWriter of XCDR1
+            write_raw(w, string_cdr(text))
+        else:
+            w.write(self.string(data=text))
 
     def on_call_verdict(self, v: Any) -> None:
         key = (v.node, v.verdict)
