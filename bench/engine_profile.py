@@ -13,7 +13,7 @@ fields), :meth:`~rclverify.runtime.live.LiveRun.push`, and
 :meth:`~rclverify.runtime.live.LiveRun.tick` whenever the watermark
 reaches the earliest buffered message (``due()``) or the 20 ms timer comes
 round, with the CLI's lateness bound (``--lateness``, 50 ms).  Each verdict,
-and each latched last verdict, is serialized as the DDS writer's
+and each latched last verdict, is serialized as the DDS run makes its
 ``std_msgs/String`` sample (its ``write`` into Cyclone is not included); the log is written to a
 temporary file.
 
@@ -83,9 +83,12 @@ def bench_messages(n: int, rate: float, start: float) -> tuple[list[Message], Ca
     def decode(topic: str, data: bytes) -> Any:
         return to_fields(structs[topic].deserialize(data))
 
-    def serialize(text: str) -> bytes:
-        out: bytes = string(data=text).serialize()
-        return out
+    try:  # the verdict's bytes as the DDS run makes them (runtime/dds/live.py), else the struct's serializer
+        from rclverify.runtime.dds.live import string_cdr as serialize
+    except ImportError:
+        def serialize(text: str) -> bytes:
+            out: bytes = string(data=text).serialize()
+            return out
     return msgs, decode, serialize
 
 
