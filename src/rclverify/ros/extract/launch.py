@@ -32,22 +32,22 @@ interpreted here:
   :mod:`launch_scope`).
 
 Source: roslaunch XML format (wiki.ros.org/roslaunch/XML), ROS 2 launch
-frontend design (design.ros2.org "ROS 2 Launch XML/YAML format").
+frontend design (design.ros2.org "ROS 2 Launch XML/YAML format").  An
+element's attributes (substitutions, conditions, ROS arguments) are read by
+:mod:`launch_attrs`.
 """
 from __future__ import annotations
 
-import os
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
 from rclverify.ros.extract import launch_subst, names, param_yaml
+from rclverify.ros.extract.launch_attrs import AttrReading
 from rclverify.ros.extract.launch_readers import read_xml as read_xml, read_yaml as read_yaml
 from rclverify.ros.extract.launch_scope import Scope as _Scope, ScopeActions
-from rclverify.ros.extract.launch_rosargs import RosArgs, after_ros_args, parse as parse_ros_args
 from rclverify.ros.extract.launch_tree import ALIASES, SEP as SEP, UNREAD as UNREAD, El as El
-from rclverify.ros.extract.launch_tree import NOVALUE, QUIET_TAGS, UNREAD_TAGS as _UNREAD_TAGS, ros2_file
+from rclverify.ros.extract.launch_tree import QUIET_TAGS, UNREAD_TAGS as _UNREAD_TAGS, ros2_file
 from rclverify.ros.extract.launch_tree import Unresolved as Unresolved, evaluate as evaluate
 from rclverify.ros.extract.model import Note, Src
 
@@ -74,15 +74,11 @@ class LaunchNode:
     pending: list[param_yaml.Entry] = field(default_factory=list)
 
 
-_SUBST = re.compile(r"\$\(([^()]*)\)")
-
-
 MAX_LAUNCH_FILES = 256      # launch files read per scan (all includes together)
 MAX_INCLUDE_DEPTH = 20      # nested <include>s
-MAX_SUBST_CHARS = 65_536    # length of one attribute after substitution
 
 
-class Interpreter(ScopeActions):
+class Interpreter(AttrReading, ScopeActions):
     """Walk launch trees; ``pkg_dir(name)`` finds a package directory,
     ``load(path, shown)`` reads a launch file into ``(El | None, [Note])``,
     ``show(path)`` gives the path shown in locations."""
@@ -210,123 +206,6 @@ class Interpreter(ScopeActions):
         remaps, params, pending = self._node_children(el, scope, path, node_ns, name)
         self.nodes.append(LaunchNode(pkg, "", name, node_ns, remaps, el.src, plugin, params,
                                      unsure=scope.unsure, pending=pending))
-
-    # -- substitutions
-    def sub(self, text: str, scope: _Scope, path: Path) -> str:
-        def one(m: re.Match[str]) -> str:
-            parts = m.group(1).split()
-            if not parts:
-                raise Unresolved("empty substitution $()")
-            kind, rest = parts[0], parts[1:]
-            if kind in ("var-default", "arg", "var") and rest and scope.args.get(rest[0]) == NOVALUE:
-                raise Unresolved(f"$({kind} {rest[0]}): argument '{rest[0]}' has no value read statically "
-                                 f"(the include giving it says why)")
-            if kind == "var-default" and rest:  # a Python launch file's LaunchConfiguration(name, default=d)
-                return scope.args[rest[0]] if rest[0] in scope.args else " ".join(rest[1:])
-            if kind in ("arg", "var") and len(rest) == 1:
-                if rest[0] not in scope.args:
-                    raise Unresolved(f"$({kind} {rest[0]}): argument '{rest[0]}' has no value")
-                return scope.args[rest[0]]
-            if kind in ("find", "find-pkg-share", "find-pkg-prefix") and len(rest) == 1:
-                d = self.pkg_dir(rest[0])
-                if d is None:
-                    raise Unresolved(f"$({kind} {rest[0]}): package '{rest[0]}' is not in the scanned workspaces")
-                return str(d)
-            if kind == "env" and len(rest) >= 1:
-                v = os.environ.get(rest[0])
-                if v is None:
-                    if len(rest) > 1:
-                        return " ".join(rest[1:])
-                    raise Unresolved(f"$(env {rest[0]}): not set")
-                return v
-            if kind == "optenv" and rest:
-                return os.environ.get(rest[0], " ".join(rest[1:]))
-            if kind == "as-bool":  # Nav2's LaunchConfigAsBool (nav2_common/launch/launch_config_as_bool.py)
-                return "True" if " ".join(rest).strip().lower() in ("true", "1", "yes", "on") else "False"
-            if kind == "dirname":
-                return str(path.parent)
-            if kind == "anon" and rest:
-                return rest[0]
-            if kind == "eval" and rest:
-                return evaluate(m.group(1)[len("eval"):].strip())
-            got = launch_subst.perform(kind, rest, path)
-            if got is not None:
-                return got
-            raise Unresolved(f"$({m.group(1)}) cannot be resolved statically")
-        out = text
-        for _ in range(10):
-            new = _SUBST.sub(one, out)
-            if len(new) > MAX_SUBST_CHARS:
-                raise Unresolved(f"substitution expands beyond {MAX_SUBST_CHARS} characters")
-            if new == out:
-                break
-            out = new
-        return out
-
-    def _attr(self, el: El, key: str, scope: _Scope, path: Path, default: str | None = None) -> str | None:
-        v = el.attrs.get(key)
-        return default if v is None else self.sub(v, scope, path)
-
-    def _soft(self, el: El, key: str, scope: _Scope, path: Path) -> str | None:
-        """Attribute ``key`` of a node the node can do without (its name,
-        namespace): one that cannot be resolved is dropped, said with a located
-        note; the node is kept."""
-        try:
-            return self._attr(el, key, scope, path)
-        except Unresolved as exc:
-            self.notes.append(Note(el.src, f"<{el.tag}>: {key}: {exc}; the node is kept without it", "ROS-LAUNCH"))
-            return None
-
-    def _ros_args(self, el: El, scope: _Scope, path: Path, name: str | None) -> RosArgs:
-        """A ROS 2 node's ROS arguments (``ros_args``, and ``args`` after
-        ``--ros-args``; :mod:`launch_rosargs`); what cannot be resolved or read
-        leaves them out, said with a located note."""
-        toks: list[str] = []
-        for key in ("ros_args", "args"):
-            raw = el.attrs.get(key)
-            if raw is None or (key == "args" and "--ros-args" not in raw):
-                continue
-            try:
-                got = [self.sub(t, scope, path) for t in (raw.split(SEP) if SEP in raw else raw.split())]
-            except Unresolved as exc:
-                self.notes.append(Note(el.src, f"<{el.tag}>: {key}: {exc}; its ROS arguments (remaps) are left "
-                                               f"out", "ROS-LAUNCH"))
-                continue
-            toks += got if key == "ros_args" else after_ros_args(got)
-        out = parse_ros_args(toks, name)
-        for p in out.problems:
-            self.notes.append(Note(el.src, f"<{el.tag}>: ROS argument {p}; left out", "ROS-LAUNCH"))
-        return out
-
-    def _cond(self, el: El, scope: _Scope, path: Path) -> bool:
-        """Whether ``el``'s ``if`` / ``unless`` hold; a condition that cannot be
-        evaluated statically is taken to hold (the element is read), said with a
-        located note: an unknown condition never drops what it guards."""
-        if UNREAD in el.attrs:  # a Python launch file's condition its reader could not read (noted there)
-            self._guess = el.src
-        for key, want in (("if", True), ("unless", False)):
-            try:
-                v = self._attr(el, key, scope, path)
-            except Unresolved as exc:
-                self.notes.append(Note(el.src, f"<{el.tag}>: {key}: {exc}; read as if the condition held",
-                                       "ROS-LAUNCH"))
-                self._guess = el.src
-                continue
-            if v is None:
-                continue
-            lv = v.strip().lower()
-            if lv in ("true", "1"):
-                val = True
-            elif lv in ("false", "0"):
-                val = False
-            else:
-                self.notes.append(Note(el.src, f"<{el.tag}>: {key}=\"{v}\" is not true/false/1/0; read as if "
-                                               f"the condition held", "ROS-LAUNCH"))
-                self._guess = el.src
-                continue
-            if val != want:
-                return False
-        return True
 
     def _body(self, els: list[El], scope: _Scope, path: Path) -> None:
         for el in els:
