@@ -310,9 +310,15 @@ def _time_margins(mine: list[float | None], s: dict[str, Any], n: int, h: int) -
     return total, right
 
 
-def race(n: int, seed: int, wrong: float, repeat: int = 1, src: str | None = None) -> bool:
+def _counts(out: list[dict[str, Any]]) -> list[Any]:
+    """What the command said of a run, its counts, margins and deadlines (the parts both trees print)."""
+    return [(r.get("counts"), r.get("margins"), r.get("deadlines")) for r in out]
+
+
+def race(n: int, seed: int, wrong: float, repeat: int = 1, src: str | None = None, old: str | None = None) -> bool:
     """Print, formula by formula, the command's and each peer's samples per CPU second and whether every
-    sample agrees; True when all agree."""
+    sample agrees; True when all agree.  ``old``: an older source tree whose command is run too (its own
+    row: before -> after in one run)."""
     root = Path(__file__).resolve().parents[1]
     src = src or str(root / "src")
     sys.path.insert(0, src)
@@ -347,6 +353,13 @@ def race(n: int, seed: int, wrong: float, repeat: int = 1, src: str | None = Non
                   f"command = engine: {'yes' if agree_cmd else 'NO'}; "
                   + ", ".join(f"{v} {key}" for key, v in (counts or {}).items() if v))
             ok = ok and agree_cmd
+            if old:  # the same command from the older tree, its counts the engine's too
+                was = min((command(ws, log, old) for _ in range(max(repeat, 1))), key=lambda r: float(r["cpu"]))
+                same = _counts(was["json"]) == _counts(cmd["json"])
+                print(f"{f.name + ', rclverify monitor (old)':<52} {n / was['cpu']:>10.0f} {was['cpu']:>7.2f}  "
+                      f"new / old samples/s: {was['cpu'] / cmd['cpu']:.2f}; the same counts and margins: "
+                      f"{'yes' if same else 'NO'}")
+                ok = ok and same
             if f.name.startswith("G(trig"):
                 total, right = _time_margins(mine, s, n, f.h)
                 print(f"{'':<52} time margins: {right}/{total} triggers equal 30 ms less the first answer's delay")

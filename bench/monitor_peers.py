@@ -86,7 +86,8 @@ one run on one machine.
 ``rclverify monitor`` command with margins on ``G[0,2](x > 1)``, ``(x > 1)
 U[0,3] (y > 4)`` and a ``triggered by ... within`` deadline against RTAMT's,
 Reelay's and mstlo's robustness on ``--samples`` samples, every sample's
-verdict and margin compared (with ``--smoke``: 2,000 samples).
+verdict and margin compared (with ``--smoke``: 2,000 samples); with ``--compare OLD_SRC`` the command
+from the older tree too, on the same logs in the same run (before -> after).
 
 ``--margins`` runs only the margins race (bench/_margin_peers.py): the
 batch path's space margins of ``G(x > 1)`` as a per-answer guarantee
@@ -427,7 +428,8 @@ def main() -> int:
         return child(args)
     if args.windowed:  # bench/_window_peers.py: the command on windowed formulas against the peers
         from _window_peers import race as windowed
-        return 0 if windowed(2_000 if args.smoke else args.samples, args.seed, args.wrong, args.repeat) else 1
+        return 0 if windowed(2_000 if args.smoke else args.samples, args.seed, args.wrong, args.repeat,
+                             old=args.compare) else 1
     if args.margins:  # bench/_margin_peers.py: rclverify's margins against the peers' robustness
         from _margin_peers import race
         return 0 if race(1_000 if args.smoke else args.samples, args.seed, args.wrong, args.skew) else 1
