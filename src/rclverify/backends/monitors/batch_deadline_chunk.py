@@ -3,7 +3,7 @@ what a clean chunk is, in what order its verdicts are given, the state it leaves
 from __future__ import annotations
 
 from operator import attrgetter
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from rclverify.core.numeric import np
 
@@ -19,10 +19,10 @@ if TYPE_CHECKING:
 _FIELDS, _TIME, _TOPIC = attrgetter("fields"), attrgetter("time"), attrgetter("topic")
 
 
-def _headed(fields: list[object]) -> bool:
-    """Whether a message carries a header stamp (the monitor's clock would read it)."""
+def _headed(fields: list[Mapping[str, Any]]) -> bool:
+    """Whether a message carries a header stamp, nested or flattened (the monitor's clock would read it)."""
     for f in fields:
-        if "header" in f or "header.stamp.secs" in f or "header.stamp.sec" in f:  # type: ignore[operator]
+        if "header" in f or "header.stamp.secs" in f or "header.stamp.sec" in f:
             return True
     return False
 

@@ -43,14 +43,14 @@ is counted); every ``false`` and late answer goes through the monitor's own
 from __future__ import annotations
 
 from collections import deque
-from typing import Any, Callable, Mapping
+from typing import Callable, Mapping
 
 from rclverify.core.extras import installed
 from rclverify.semantics.floatsem import Tolerance, judge
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule, map_value, rule_for
-from rclverify.backends.monitors.deadline_records import DeadlineVerdict, Pending
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_text import ms, ms_ns
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 
@@ -98,14 +98,17 @@ class BatchDeadlines(DeadlineMonitor):
             stream(ev)
 
     def advance(self, now: float) -> None:
+        """The events taken judged, then the clock moved to ``now`` (s) as the streaming monitor moves it."""
         self.flush()
         super().advance(now)
 
     def pending_verdicts(self) -> list[DeadlineVerdict]:
+        """The events taken judged, then the open obligations' ``currently_false`` verdicts."""
         self.flush()
         return super().pending_verdicts()
 
-    def finish(self) -> Any:
+    def finish(self) -> DeadlineResult:
+        """The events taken judged, then the run ended (:meth:`~.deadlines.DeadlineMonitor.finish`)."""
         self.flush()
         return super().finish()
 
