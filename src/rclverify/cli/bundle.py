@@ -66,7 +66,7 @@ def cmd_bundle(args: argparse.Namespace) -> int:
 def _report_out_of_date(ws: Any) -> list[str]:
     """Why the written report no longer says what the recorded artifacts say
     (:func:`rclverify.report.bundle.fresh.report_out_of_date`)."""
-    from rclverify.report.bundle.fresh import report_out_of_date  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.report.bundle.fresh import report_out_of_date  # deferred: start-up (imported where it is used)
     return report_out_of_date(ws)
 
 

@@ -110,7 +110,7 @@ def _reader_left() -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rclverify`` console script; returns the exit code."""
     p = argparse.ArgumentParser(prog="rclverify", description="Compositional verification from RCL contracts.")
-    from rclverify import __version__  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify import __version__  # deferred: start-up (imported where it is used)
     p.add_argument("--version", action="version", version=f"rclverify {__version__}")
     argv = list(sys.argv[1:] if argv is None else argv)
     name = chosen(argv)  # only the command run has its parser made, and its module imported (start-up)

@@ -63,7 +63,7 @@ def workspace_of(args: argparse.Namespace) -> Workspace:
 def io_error(path: Path, message: str) -> Any:
     """A located ``E-io`` diagnostic at line 1 of ``path``."""
     from rclverify.lang.ast import Loc  # deferred: start-up (loads rclverify.lang.ast, fractions only when called)
-    from rclverify.lang.errors import error  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.lang.errors import error  # deferred: start-up (imported where it is used)
     return error(Loc(str(path), 1, 1), message, "E-io")
 
 
@@ -76,7 +76,7 @@ def run_lock(args: argparse.Namespace) -> Iterator[None]:
     make it exit 1 instead (:class:`~rclverify.core.runlock.RunInProgress`,
     printed by :func:`main`).  Released at the end of the block; a lock this
     process already held stays held."""
-    from rclverify.core import runlock  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.core import runlock  # deferred: start-up (imported where it is used)
     root = Path(args.workspace)
     took = False
     # no workspace or no plan: the command fails with its own located error, and no

@@ -15,7 +15,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     :func:`rclverify.model.plan.scopes.group_files` (the plan's system together,
     a replacement contract in its own scope; docs/rcl-language.md).  Every
     scope is checked; exit 1 when one has an error."""
-    from rclverify.model.plan.scopes import group_files, plan_diagnostics  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.model.plan.scopes import group_files, plan_diagnostics  # deferred: start-up (imported where it is used)
     from rclverify.lang.filewarn import file_warnings  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.filewarn and more only when called)
     from rclverify.lang.lint import lint  # deferred: start-up (loads rclverify.lang.ast, rclverify.lang.lint and more only when called)
     from rclverify.lang.parser import parse_files  # deferred: start-up (loads lark, rclverify.core and more only when called)
@@ -24,7 +24,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     grouped = group_files(args.files, args.workspace, args.plan)
     for note in grouped.notes:
         print(note, file=sys.stderr)
-    from rclverify.lang.errors import Diagnostic  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.lang.errors import Diagnostic  # deferred: start-up (imported where it is used)
     errors: list[Diagnostic] = []
     warnings: list[Diagnostic] = []
     for scope in grouped.scopes:

@@ -12,7 +12,7 @@ def cmd_import_fret(args: argparse.Namespace) -> int:
     """Import the export, print what could not be imported and what changed, then check the plan
     with it.  Exit 1 on a malformed export or when the workspace no longer checks (the
     imported statements' types against the contracts); a requirement not imported is no error."""
-    from rclverify.lang.errors import RclError  # deferred: start-up (every command module loads when rclverify starts)
+    from rclverify.lang.errors import RclError  # deferred: start-up (imported where it is used)
     from rclverify.stages.workspace import Workspace  # deferred: start-up (loads the stages only when called)
     from rclverify.tools.fret.importer import import_fret, render  # deferred: start-up (loads jinja2 only when called)
     root = Path(args.workspace)

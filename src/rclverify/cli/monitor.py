@@ -59,7 +59,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     except ConfigError as exc:
         print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify monitor'}: error: {exc}", file=sys.stderr)
         return 2
-    from rclverify.backends.monitors.shared_topics import shared_topic_errors  # two variables on one topic read distinct fields; deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.backends.monitors.shared_topics import shared_topic_errors  # two variables on one topic read distinct fields; deferred: start-up (imported where it is used)
     shared = [d for n in checked.nodes for d in shared_topic_errors(checked, n, cfg.rules, cfg.mapping or
                                                                    "backends/monitors/mapping.yaml")]
     if shared:
@@ -221,15 +221,15 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     status 1 when a contract was violated (a topic, a call, a deadline), 0
     otherwise, 2 when ROS 1, the DDS domain or a message type is unavailable
     (one message on stderr)."""
-    from functools import partial  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from functools import partial  # deferred: start-up (imported where it is used)
 
-    import os  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    import os  # deferred: start-up (imported where it is used)
 
     from rclverify.runtime.live import LiveRun  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
     from rclverify.runtime.live_ros1 import run_ros1  # deferred: start-up (loads rclverify.runtime.live and more only when called)
-    from rclverify.runtime.ros1 import RosUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
-    from rclverify.ros.live.dds import DdsUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
-    from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.runtime.ros1 import RosUnavailable  # deferred: start-up (imported where it is used)
+    from rclverify.ros.live.dds import DdsUnavailable  # deferred: start-up (imported where it is used)
+    from rclverify.runtime.rclpy_source.bus import RclpyUnavailable  # deferred: start-up (imported where it is used)
     if args.traces:
         print("rclverify monitor: error: --live takes no TRACE (it monitors the running system)", file=sys.stderr)
         return 2
@@ -317,7 +317,7 @@ def _source(args: argparse.Namespace) -> Any:
     source's, ``None`` for the DDS source, ``False`` after printing why it cannot be had (exit 2). Says
     which source on the first line.  Raises :class:`~rclverify.ros.live.dds.DdsUnavailable` (its subclass
     ``DdsExtraMissing`` without the ``[ros2]`` extra) before that line when the DDS source cannot load."""
-    from functools import partial  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from functools import partial  # deferred: start-up (imported where it is used)
 
     from rclverify.runtime.rclpy_source.bus import RclpyBus  # deferred: optional or conditional (only --ros2)
     from rclverify.runtime.rclpy_source.python import pick_source  # deferred: optional or conditional (only --ros2)

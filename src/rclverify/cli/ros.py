@@ -86,7 +86,7 @@ def add_parsers(sub: Any) -> None:
 
 def _seconds(text: str) -> float:
     """A time limit in seconds: a finite number > 0 (argparse type; a usage error otherwise)."""
-    import math  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    import math  # deferred: start-up (imported where it is used)
     try:
         x = float(text)
     except ValueError:
@@ -167,7 +167,7 @@ def cmd_diff(args: argparse.Namespace) -> int:
     """``rclverify ros diff``: print the missing and extra lists (docs/ros.md,
     "Expected against observed"); exit 0 equal, 1 they differ (or the master or
     the DDS domain cannot be read, or a scanned file cannot be), 2 usage."""
-    from rclverify.ros.graph.bag import bag_topics  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    from rclverify.ros.graph.bag import bag_topics  # deferred: start-up (imported where it is used)
     from rclverify.ros.live.diff import diff_bag, diff_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
     from rclverify.ros.live.master import MasterError, read_master  # deferred: start-up (loads rclverify.ros, rclverify.ros.extract and more only when called)
     graph = getattr(args, "graph", None)
@@ -271,7 +271,7 @@ def _shown_base(paths: list[Path]) -> Path | None:
     holds every path (as ``ros scan`` does), else the directory above the paths'
     common one, so that no absolute path of this machine goes into the skeletons'
     comments (``robot_driver/src/driver.cpp:12``); ``None`` for the current one."""
-    import os  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    import os  # deferred: start-up (imported where it is used)
     real = [os.path.realpath(p) for p in paths]
     here = os.path.realpath(os.getcwd())
     if all(r == here or r.startswith(here.rstrip(os.sep) + os.sep) for r in real):
@@ -319,7 +319,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     such program, or an absent interface package (a located ``ROS-SCAN`` warning of
     the grounding), is exit 1 too."""
     from rclverify.app.ros_stage import GRAPH, run_check  # deferred: start-up (loads rclverify.app, rclverify.app.ros_stage and more only when called)
-    import time  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    import time  # deferred: start-up (imported where it is used)
     start = time.time()
     rc = run_check(Path(args.workspace), args.plan, args.strict, args.json)
     path = Path(args.workspace) / GRAPH

@@ -47,7 +47,7 @@ def add_monitor(add: AddCommand) -> None:
 
 def _margin(text: str) -> float:
     """``--warn-margin``'s VALUE: a finite number > 0 (a space margin, in the deciding comparison's unit)."""
-    import math  # deferred: start-up (every command module loads when rclverify starts: cli/common.py)
+    import math  # deferred: start-up (imported where it is used)
     try:
         v = float(text)
     except ValueError:
