@@ -101,15 +101,6 @@ EvidenceJson = dict[str, Any]
 #: ``RequirementRow.of`` to read its fields as attributes.
 RequirementJson = dict[str, Any]
 
-#: A guarantee a requirement is traced to (``requirements[].support[]``) as its JSON object: the encoding
-#: of :class:`rclverify.records.requirement_rows.SupportRow`.
-SupportJson = dict[str, Any]
-
-#: Where the report comes from (``meta``) as the report's JSON object: the encoding of
-#: :class:`rclverify.records.summary_rows.Meta`, the one definition of its fields (the schema's ``meta``
-#: is generated from it, records/schema_gen.py).
-MetaJson = dict[str, Any]
-
 #: The one-screen summary (``summary``) as the report's JSON object: the encoding of
 #: :class:`rclverify.records.summary_rows.Summary` (its diagnoses in short
 #: :class:`~rclverify.records.summary_rows.DiagnosisBrief`); decode it with ``Summary.of``.
@@ -135,10 +126,6 @@ LintJson = dict[str, Any]
 #: :class:`rclverify.records.lint_rows.AcknowledgementRow`.
 AcknowledgementJson = dict[str, Any]
 
-#: One problem explained (``diagnoses[]``) as its JSON object: the encoding of
-#: :class:`rclverify.records.problem_rows.DiagnosisRow`; decode it with ``DiagnosisRow.of``.
-DiagnosisJson = dict[str, Any]
-
 #: Problems grouped by one root cause (``problems[]``) as its JSON object: the encoding of
 #: :class:`rclverify.records.problem_rows.ProblemRow` (its members
 #: :class:`~rclverify.records.problem_rows.ProblemMember`, its repairs
@@ -156,7 +143,8 @@ NodlJson = dict[str, Any]
 
 class Report(TypedDict):
     """``reports/assurance.json`` (docs/assurance.schema.json)."""
-    meta: MetaJson
+    #: the encoding of :class:`rclverify.records.summary_rows.Meta`
+    meta: dict[str, Any]
     summary: SummaryJson
     system: SystemJson
     requirements: list[RequirementJson]
@@ -187,7 +175,8 @@ class Report(TypedDict):
     statistics: list[dict[str, Any]]
     #: the evidence mapped onto the plan's standard profiles (report/standards_rows.py, docs/standards.md)
     standards: list[dict[str, Any]]
-    diagnoses: list[DiagnosisJson]
+    #: each the encoding of :class:`rclverify.records.problem_rows.DiagnosisRow`
+    diagnoses: list[dict[str, Any]]
     problems: list[ProblemJson]
 
 
