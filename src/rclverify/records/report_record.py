@@ -5,11 +5,12 @@ them, each typed by the record defined once for it (the modules beside
 this one) and described.  docs/assurance.schema.json is generated from it
 whole (records/schema_gen.py): the top-level keys, which are required and
 which refuse others, each key's part.  The report's passes (report/build.py)
-build the JSON object pass by pass; :data:`REPORT_KEYS` is what
-:func:`rclverify.records.report_schema.as_report` checks they wrote, and
-tests/records/test_record_shapes.py holds the dict-shaped view
-(:class:`rclverify.records.report_schema.Report`, which the renderers read)
-to these fields.
+build the JSON object pass by pass (:data:`REPORT_KEYS` is what
+:func:`rclverify.records.report_schema.as_report` checks they wrote) and
+decode the finished one into :class:`AssuranceReport`, which the renderers
+read (docs/records.md); tests/records/test_record_shapes.py holds the
+dict-shaped view the passes write
+(:class:`rclverify.records.report_schema.Report`) to these fields.
 """
 from __future__ import annotations
 

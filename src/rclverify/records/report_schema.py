@@ -1,11 +1,12 @@
-"""The assurance report as the renderers read it: :class:`Report`, the dict-shaped view of
+"""The assurance report as its passes write it: :class:`Report`, the dict-shaped view of
 :class:`rclverify.records.report_record.AssuranceReport`, and a JSON alias per part.
 
 Every part of the report is defined once as a msgspec Struct (the modules
 beside this one: :mod:`rclverify.records.findings`, ``node_rows``,
 ``deadline_rows`` and the others), and docs/assurance.schema.json is
 generated from them (:mod:`rclverify.records.schema_gen`).  The report is
-built and read as its JSON object, pass by pass (report/build.py): here each
+built as its JSON object, pass by pass (report/build.py), then decoded once
+into :class:`~rclverify.records.report_record.AssuranceReport`: here each
 part appears as that object (``FindingJson``, ``NodeJson``, ...), an alias
 naming the Struct whose ``of`` decodes it to read its fields as attributes.
 :class:`Report` lists the top-level keys with those aliases, for mypy; its
@@ -14,7 +15,7 @@ fields by tests/records/test_record_shapes.py.
 
 :func:`as_report` is the one place a report dict built pass by pass
 (report/build.py) becomes a :class:`Report`: it checks the top-level keys
-and the summary status, so a renderer typed on :class:`Report` never reads
+and the summary status, so a reader typed on :class:`Report` never reads
 a report that lacks a part.
 """
 from typing import Any, Mapping, TypedDict, cast
