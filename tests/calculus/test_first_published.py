@@ -70,6 +70,9 @@ def test_first_prints_back_as_written() -> None:
     for text in ("first(in.x) -> out.y == 0", "not first(x) and in.x > 1"):
         assert expr_to_rcl(parse_formula(text)) == text
     assert parse_formula("first(in.x)") != parse_formula("first(in.z)")  # control: the argument counts
+    from rclverify.lang.latex import expr_to_latex
+    assert expr_to_latex(parse_formula("first(in.x) -> out.y == 0")) == \
+        r"\mathit{first}(\mathit{in.x}) \Rightarrow \mathit{out.y} = 0"
 
 
 @pytest.mark.parametrize("arg,why", [
