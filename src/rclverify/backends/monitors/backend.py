@@ -12,13 +12,14 @@
   ``discharged`` (assumption violations are counted and blamed on the
   environment or the upstream node, not on this node).  An unreadable trace
   is ``error`` with the located message.
+
+One read of a run feeds every monitor of a node (:mod:`.run_read`).
 """
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator, Mapping
+from typing import Any, Mapping
 
 import jinja2
 
@@ -27,31 +28,28 @@ from rclverify.records.records import Evidence, Obligation, SourceRef, make_obli
 from rclverify.records.store import atomic_write_text
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.traces import TraceError, read_trace
+from rclverify.traces import TraceError
 from rclverify.traces.bag import custom_types
 from rclverify.traces.files import trace_files, trace_sha256
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
-from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
-from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.run_origin import RunOrigin, unseen_links
-from rclverify.backends.monitors.shapes import DeadlinesPart, RunSource
+from rclverify.backends.monitors.run_origin import unseen_links
+from rclverify.backends.monitors.shapes import DeadlinesPart
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.deadline_records import DeadlineResult
-from rclverify.backends.monitors.deadline_topics import has_deadlines
 from rclverify.backends.monitors.deadline_text import deadline_status
-from rclverify.backends.monitors.deadlines import DeadlineMonitor
-from rclverify.backends.monitors.declarations import DeclarationMonitor, add_periods, has_declarations, with_declarations
-from rclverify.backends.monitors.judged import Counted, Heard, explain, not_judged
-from rclverify.backends.monitors.lifecycle import gate_of, gated, with_lifecycle
+from rclverify.backends.monitors.declarations import add_periods, with_declarations
+from rclverify.backends.monitors.judged import Heard, explain, not_judged
+from rclverify.backends.monitors.lifecycle import with_lifecycle
 from rclverify.backends.monitors.instances import instance_target, per_instance
 from rclverify.backends.monitors.recorded import decided_of
-from rclverify.backends.monitors.log_calls import LogCalls, merge_deadlines
-from rclverify.backends.monitors.periods import PeriodMonitor, has_periods, with_periods
+from rclverify.backends.monitors.log_calls import merge_deadlines
+from rclverify.backends.monitors.periods import with_periods
 from rclverify.targets.rml import Spec, rml_id, translate
-from rclverify.backends.monitors.widths import carried_fields, float_widths, judged_at_widths, refuse_out_of_range
-from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
+from rclverify.backends.monitors.widths import carried_fields, float_widths
+from rclverify.backends.monitors.stamp_order import second_read, unless_stale
 from rclverify.backends.monitors.runset import run_counts, run_runset, runset_obligations
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions, verdict_status
+from rclverify.backends.monitors.run_read import read_run
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
 _DECLARED = declared_in(__file__)
@@ -226,10 +224,10 @@ class MonitorsBackend:
         trace = str(obligation.data.get("trace", ""))
         try:
             target = instance_target(target, obligation)  # an instance's run: its names resolved (instances.py)
-            read = _judge(target, cfg, trace, None)
+            read = read_run(target, cfg, trace, None)
             lag, note, stale = second_read(read.watch, trace, True)  # one clock, the stamps (stamp_order.py)
             if lag is not None:
-                read = _judge(target, cfg, trace, lag)
+                read = read_run(target, cfg, trace, lag)
         except TraceError as exc:
             return evidence("error", f"the trace could not be read: {exc}", log=str(exc))
         except Exception as exc:  # a recorded run is user input: whatever the checker meets is this record's error
@@ -290,105 +288,6 @@ class MonitorsBackend:
                         log=summary_line(res))
 
 
-@dataclass
-class _Read:
-    """One pass of the monitors over a run (:func:`_judge`)."""
-
-    beside: "_Beside"
-    calls: LogCalls
-    span: "TraceSpan"
-    heard: dict[str, int]
-    watch: StampWatch
-    events: int
-    results: list[Any]
-    summary: dict[str, Any] | None
-    bag: BagCalls | None = None
-    origin: RunSource | None = None
-    gate: Any = None
-
-
-def _judge(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | None) -> _Read:
-    """One read of the run at ``trace`` feeding the untimed check, the deadlines, the periods, the
-    declarations and a live log's calls; in stamp order when ``lag`` (s, :func:`.stamp_order.in_stamp_order`)
-    is given.  Raises what the readers and the checkers raise (the caller reports it)."""
-    # the contract's constants compared as the fields carry them (widths.py)
-    node, fields = judged_at_widths(target.checked, target.node, cfg.rules, [target.root / d for d in cfg.msg_dirs])
-    beside = _Beside()
-    if has_deadlines(node):
-        beside.add("deadlines", lambda: DeadlineMonitor(target.checked, node, cfg.rules,
-                                                        horizon=cfg.horizon, tolerance=cfg.tolerance))
-    if has_periods(node):  # periodic outputs on the same run (periods.py)
-        beside.add("periods", lambda: PeriodMonitor(node))
-    if has_declarations(node):  # initially, progress, periodic judged on the same run (declarations.py)
-        beside.add("declarations", lambda: DeclarationMonitor(target.checked, node, cfg.rules,
-                                                              tolerance=cfg.tolerance))
-    # a live log's service calls and action goals, judged as the live run judged them (log_calls.py)
-    calls = LogCalls(target.checked, [node], cfg.rules, cfg.horizon, trace)
-    span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
-    heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
-    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
-    dirs = [target.root / d for d in cfg.msg_dirs]
-    path = target.root / trace
-    source: Iterable[Any] = read_trace(path, dirs)
-    bag = BagCalls([node], calls, trace, bag_connections(path, dirs)) \
-        if calls.active and is_ros2_bag(path) else None  # a bag's recorded calls, as `monitor BAG` reads them
-    source = refuse_out_of_range(source, path, fields.items())  # a value no field carries
-    if lag is not None:
-        source = in_stamp_order(source, lag)
-    inner = bag.tap(source) if bag is not None else calls.tap(source) if calls.active else source
-    origin = RunOrigin()  # the source and middleware a live log says it was heard through (run_origin.py)
-    gate = gate_of([node])  # a managed node's messages judged in its lifecycle scope, as live (lifecycle.py)
-    if gate is not None:
-        inner = gated(inner, gate)
-    events, results = check_trace(target.checked, [node], Counted(span.tap(beside.tap(origin.tap(inner))), heard,
-                                                                  watch), cfg.rules, cfg.horizon,
-                                  tolerance=cfg.tolerance, margins=True)
-    heard = gate.counted(heard) if gate is not None else heard  # the messages the gate kept count as heard
-    return _Read(beside, calls, span, heard, watch, events, results, calls.finish(), bag, origin.origin, gate)
-
-
-class _Beside:
-    """The deadline and period monitors of a node fed from the untimed
-    check's read of a run (:meth:`tap`), so a run is read once.  An error of
-    one of them is kept under its name (its evidence's error, as when it read
-    the run itself) and that monitor is fed no more; the read goes on."""
-
-    def __init__(self) -> None:
-        self.monitors: dict[str, Any] = {}
-        self.errors: dict[str, Exception] = {}
-
-    def add(self, name: str, make: Callable[[], Any]) -> None:
-        """The monitor ``make()`` makes, fed under ``name`` (its error kept)."""
-        try:
-            self.monitors[name] = make()
-        except Exception as exc:  # noqa: BLE001 - reported as that check's error
-            self.errors[name] = exc
-
-    def tap(self, events: Iterable[Any]) -> Iterator[Any]:
-        """``events`` unchanged, each fed to the monitors first."""
-        if not self.monitors:
-            yield from events
-            return
-        for ev in events:
-            for name, m in list(self.monitors.items()):
-                try:
-                    m.feed(ev)
-                except Exception as exc:  # noqa: BLE001 - reported as that check's error
-                    self.errors[name] = exc
-                    del self.monitors[name]
-            yield ev
-
-    def finish(self) -> dict[str, Any]:
-        """Each monitor's result (after the run), by name; a failing finish is an error too."""
-        out: dict[str, Any] = {}
-        for name, m in self.monitors.items():
-            try:
-                out[name] = m.finish()
-            except Exception as exc:  # noqa: BLE001
-                self.errors[name] = exc
-        return out
-
-
 def with_calls(entries: list[dict[str, Any]], summary: dict[str, Any], status: str,
                explanation: str) -> tuple[str, str, dict[str, Any]]:
     """The untimed verdict on the node's topics combined with its calls'
@@ -420,27 +319,6 @@ def with_deadlines(target: NodeTarget, res: DeadlineResult, trace: str, status: 
     said = (f"untimed: {explanation}; deadlines: {dexpl}" if worse == status != dstatus else
             f"deadlines: {dexpl}; untimed: {explanation}")  # what decided the status first
     return worse, said, {"deadlines": res.to_json()}
-
-
-class TraceSpan:
-    """The span of a run in trace time: :meth:`tap` passes the events on and
-    notes the first and last event's ``time``; :attr:`seconds` is their
-    difference (``None`` before any event)."""
-
-    def __init__(self) -> None:
-        self.first: float | None = None
-        self.last: float | None = None
-
-    def tap(self, events: Any) -> Any:
-        for ev in events:
-            if self.first is None:
-                self.first = ev.time
-            self.last = ev.time
-            yield ev
-
-    @property
-    def seconds(self) -> float | None:
-        return None if self.first is None or self.last is None else round(self.last - self.first, 6)
 
 
 def _rel(target: NodeTarget, file: str) -> str:
