@@ -11,7 +11,8 @@ deadline).  Runs the batch cannot judge (a stamp going back, a header stamp, NaN
 topic written with ``/``, a value near a boundary) must still equal the streaming monitor's, in
 chunks of both kinds.  Controls: a brute force reading ``within`` as strictly before the deadline
 differs on a run answered at the deadline itself, and a batch judge whose expiry includes the
-deadline's own stamp is caught.  The bundled warehouse and delivery runs (a recorded log and two live
+deadline's own stamp is caught.  An enumeration output (a value of no other type now and then) is judged
+in batch to the streaming monitor's verdicts too.  The bundled warehouse and delivery runs (a recorded log and two live
 monitors' logs, their eligible nodes' deadlines) give the streaming monitor's verdicts too.
 """
 from __future__ import annotations
@@ -36,6 +37,7 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import load_rules
 
 NODES = """
+context { Level : {lo, hi} ; }
 node D {
   inputs( a : REAL )
   outputs( b : REAL )
@@ -44,6 +46,12 @@ node D {
   guarantee( out.b > in.a ) triggered by in.a within 30 ms
   guarantee( out.b >= in.a + 1 ) triggered by in.a within 50 ms
   guarantee( out.b < 100 ) triggered by in.a
+}
+node E {
+  inputs( r : REAL )
+  outputs( s : Level )
+  topics( std_msgs/Float64 trig matches(in.r), std_msgs/String ans matches(out.s) )
+  guarantee( (in.r < 5 -> out.s == hi) and (in.r >= 5 -> out.s == lo) ) triggered by in.r within 20 ms
 }
 node Two {
   inputs( a : REAL, c : REAL )
@@ -175,6 +183,24 @@ def test_runs_the_batch_declines_are_streamed_to_the_same_verdicts() -> None:
         for key in stats:
             stats[key] += mon.stats[key]
     assert stats["batched"] > 350 and stats["streamed"] > 350  # chunks of both kinds, one after the other
+
+
+def test_an_enumeration_output_is_judged_in_batch_too() -> None:
+    rng = random.Random(113)
+    node, batched = CHECKED.nodes["E"], 0
+    for case in range(40):
+        run, ms = [], 0
+        for i in range(rng.randrange(1, 30)):
+            ms += rng.choice([0, 1, 10, 20, 21, 60])
+            if rng.random() < 0.45:
+                run.append(Event(i, ms / 1000, "trig", {"data": rng.choice([0.0, 4.5, 5.0, 7.25])}, f"run:{i + 1}"))
+            else:  # a value of another type or no value of Level now and then: that chunk is streamed
+                value = rng.choice(["mid", 3.0]) if rng.random() < 0.05 else rng.choice(["lo", "hi"])
+                run.append(Event(i, ms / 1000, "ans", {"data": value}, f"run:{i + 1}"))
+        stream, batch, mon = _both(run, rng.randrange(1, 8), node)
+        assert batch == stream, f"case {case}"
+        batched += mon.stats["batched"]
+    assert batched > 200
 
 
 def test_controls_a_misread_deadline_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
