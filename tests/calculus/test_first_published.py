@@ -136,3 +136,13 @@ def test_a_table_lasso_over_first_is_confirmed_and_a_wrong_flag_is_not(tmp_path)
     bad = [dict(st, **{"Hold.first.k": True}) for st in found.values]  # control: first at every step
     why = confirm_lasso(bad, found.loop, cone, sys.variables, types, checked, model, plan, goal, [], pub=sys.pub)
     assert why is not None and "Hold.first.k" in why, why
+
+
+def test_first_stays_a_name_where_no_parenthesis_follows() -> None:
+    """An enumeration value (or constant, node, input) named first is still written as before; first( is the
+    built-in (the control: the same text with the parenthesis)."""
+    src = ("context { Phase : {first, second}; }\nnode first { inputs( x : REAL ) outputs( p : Phase )\n"
+           "  guarantee( out.p == first and in.x > 0 ) }\n")
+    g = check([parse_text(src, "f.rcl")]).nodes["first"].node.guarantees[0].formula
+    assert expr_to_rcl(g) == "out.p == first and in.x > 0"
+    assert "First(" in repr(parse_formula("out.p == first and first(in.first)"))
