@@ -1,6 +1,6 @@
-"""examples/fret_rover decided in-process: nine FRET requirements proved from the rover's contract (one of
+"""examples/fret_rover decided in-process: ten FRET requirements proved from the rover's contract (one of
 them, a trigger inside a mode, from FRET's ptExpanded; one over an Internal variable defined in Lustre;
-ROVER-008 not translated, informal), and an
+ROVER-008 over FRET's sqrt, RCL's own), and an
 edited export re-checked by reqid (docs/requirements.md, "Requirements from FRET")."""
 from __future__ import annotations
 
@@ -29,7 +29,7 @@ def test_the_example_decides_its_fret_requirements_and_rechecks_an_edited_one(tm
     assert {k: v for k, (v, _) in first.items()} == {
         "CAP": "proved", "ROVER-001": "proved", "ROVER-002": "proved", "ROVER-003": "proved",
         "ROVER-004": "proved", "ROVER-005": "proved", "ROVER-006": "proved", "ROVER-007": "proved",
-        "ROVER-008": "informal", "ROVER-009": "proved",
+        "ROVER-008": "proved", "ROVER-009": "proved",
         "ROVER-010": "proved"}
     data = json.loads((root / "fret" / "rover_requirements.json").read_text(encoding="utf-8"))
     r1 = next(r for r in data["requirements"] if r["reqid"] == "ROVER-001")
