@@ -123,13 +123,6 @@ class _Ctx(Visitor[Any]):
         given = self.symbols.get(key)
         return given if given is not None else self.e.first_symbol(self.node, x.arg.name)
 
-    def visit_First(self, x: ast.First, b: Mapping[str, z3.ExprRef]) -> Any:
-        """``first(in.x)``: the term the caller gives as ``first(in.x)`` (a state's flag in the requirements'
-        transition system), else the query's free Boolean of that input (:meth:`Encoder.first_symbol`)."""
-        key = f"first(in.{x.arg.name})"
-        given = self.symbols.get(key)
-        return given if given is not None else self.e.first_symbol(self.node, x.arg.name)
-
     def visit_Unary(self, x: ast.Unary, b: Mapping[str, z3.ExprRef]) -> Any:
         return unary_z3(x.op, self.enc(x.operand, b))
 
