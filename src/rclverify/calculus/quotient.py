@@ -44,45 +44,26 @@ from typing import Any, Callable, Mapping, Sequence
 
 import z3
 
-from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import Encoder
-from rclverify.semantics.query import prove
 from rclverify.semantics.subterms import subterms
 from rclverify.lang import ast
-from rclverify.lang.parser import parse_formula, parse_text
-from rclverify.lang.printer import expr_to_rcl, node_to_rcl
+from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked
 from rclverify.model.system.model import SystemModel
-from rclverify.calculus.compose import compose_node, split_assumption
+from rclverify.calculus.compose import split_assumption
 from rclverify.calculus.context import opened_links
 from rclverify.calculus.linear import clauses_under, eliminate, to_rcl
 from rclverify.model.plan.load import all_requirements
 from rclverify.lang.walk import subexpressions
-from rclverify.semantics import world
 from rclverify.lang.typecheck import check
-from rclverify.model.system.model import build
 from rclverify.semantics import wallclock
+from rclverify.calculus.quotient_targets import PROVED, Target, compare_contract, confirmed, conj_all, node_block, recheck_targets
 
 ARITH = (BOOL, INTEGER, NATURAL, REAL)
 
 
 class QuotientError(Exception):
     """No contract can be given (the message says why); the command exits 1."""
-
-
-@dataclass(frozen=True)
-class Target:
-    """What the quotient must make hold: ``kind`` ``side condition`` or
-    ``requirement``, ``id`` (``N2.sc1``, ``REQ1``), ``text`` (RCL), the
-    premises ``P_t`` and goal as Z3 formulas."""
-
-    kind: str
-    id: str
-    text: str
-    premises: tuple[z3.BoolRef, ...]
-    goal: z3.BoolRef
-    consumer: str = ""
-    conjunct: ast.Expr | None = None
 
 
 @dataclass(frozen=True)
@@ -106,10 +87,6 @@ class Quotient:
     solvers: tuple[tuple[str, str, str], ...] = ()
 
 
-def _conj(fs: Sequence[z3.BoolRef]) -> z3.BoolRef:
-    return conj(*fs) if len(fs) > 1 else fs[0] if fs else z3.BoolVal(True)
-
-
 class _System:
     """The premises of the system with ``node``'s contract set aside."""
 
@@ -131,7 +108,7 @@ class _System:
         parts = [enc.formula(a.formula, cn) for a in cn.node.assumes
                  if not (isinstance(a.formula, ast.BoolLit) and a.formula.value)]
         gs = [enc.formula(g.formula, cn) for g in cn.node.guarantees]
-        return [z3.Implies(_conj(parts), g) for g in gs] if conditional and parts else gs
+        return [z3.Implies(conj_all(parts), g) for g in gs] if conditional and parts else gs
 
     def cone_premises(self, cone: Sequence[str], consumer: str, enc: Encoder) -> list[z3.BoolRef]:
         """The premises of a side condition of ``consumer`` decided in context (:mod:`.context`)."""
@@ -202,10 +179,6 @@ class _Beyond(Exception):
     """The computation leaves linear arithmetic."""
 
 
-#: Re-check verdicts that rest on a proof (Z3's unsat), which a second solver confirms.
-PROVED = ("discharged", "discharged in context", "proved")
-#: Agreements of the second solver that make a proved re-check inconclusive (stages/crosscheck/stage.py).
-NOT_CONFIRMED = ("disagree", "inconclusive")
 
 
 def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
@@ -244,8 +217,8 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
         a_text, g_text = "TRUE", _approximate(sysm, tgts)
         how = (f"a sound approximation, not the weakest contract ({why}): assumption TRUE; guarantee: what the "
                "direct consumers assume of its outputs")
-    block = _node_block(cn.node, a_text, g_text)
-    recheck, said = _confirmed(_recheck(checked, plan, node, block, tgts), confirm)
+    block = node_block(cn.node, a_text, g_text)
+    recheck, said = confirmed(recheck_targets(checked, plan, node, block, tgts), confirm)
     bad = [f"{i} {v}" for i, v in recheck if v not in PROVED]
     if bad:
         raise QuotientError(f"the contract computed for {node} ({how}) does not re-check"
@@ -254,7 +227,7 @@ def quotient(checked: Checked, model: SystemModel, plan: Any, node: str,
         notes.append(f"{node} lies on the loop {{{', '.join(loop)}}}: computed with the loop opened as rule R4 opens it "
                      "(the loop's other guarantees, each under its node's assumption, with this node's outputs "
                      "hidden; paper lines 717-768) and re-checked with the loop composed")
-    notes += _compare(cn, a_text, g_text, checked, model, plan)
+    notes += compare_contract(cn, a_text, g_text, checked, model, plan)
     return Quotient(node, a_text, g_text, how.startswith("exact"), how,
                     tuple(f"{t.kind} {t.id}: {t.text}" for t in tgts), tuple(recheck), tuple(notes), block,
                     tuple(said))
@@ -278,13 +251,13 @@ def _exact(sysm: _System, model: SystemModel, node: str, tgts: Sequence[Target])
     keep = set(names)
     inputs = {str(x) for x in ins.values()}
     hidden = [c for n, c in sorted(_constants(p_up).items()) if n not in inputs]  # outputs too: A is over i
-    a = eliminate(z3.Exists(hidden, _conj(p_up)) if hidden else _conj(p_up))
+    a = eliminate(z3.Exists(hidden, conj_all(p_up)) if hidden else conj_all(p_up))
     parts = []
     for t in tgts:
-        body = z3.Implies(_conj(list(t.premises)), t.goal)
+        body = z3.Implies(conj_all(list(t.premises)), t.goal)
         hid = [c for n, c in sorted(_constants([body]).items()) if n not in keep]
         parts.append(z3.ForAll(hid, body) if hid else body)
-    g = eliminate(_conj(parts))
+    g = eliminate(conj_all(parts))
     if a is None or g is None:
         raise _Beyond("Z3's quantifier elimination left a quantifier")
     _no_answer(sysm, a, g, list(outs.values()), names)
@@ -294,24 +267,6 @@ def _exact(sysm: _System, model: SystemModel, node: str, tgts: Sequence[Target])
     if a_text is None or g_text is None:
         raise _Beyond("the eliminated formula is not linear arithmetic RCL can print")
     return a_text, g_text
-
-
-def _confirmed(decided: Sequence[tuple[str, str, str]], confirm: Callable[[str], tuple[str, str]] | None
-               ) -> tuple[list[tuple[str, str]], list[tuple[str, str, str]]]:
-    """The re-check's ``(id, verdict)`` pairs and the second solver's
-    ``(id, agreement, why)`` sayings: a proved verdict ``confirm`` does not
-    confirm becomes inconclusive (``decided``: ``(id, verdict, SMT-LIB2
-    script)`` from :func:`_recheck`)."""
-    said: list[tuple[str, str, str]] = []
-    recheck: list[tuple[str, str]] = []
-    for i, v, script in decided:
-        if confirm is not None and v in PROVED and script:
-            agreement, why = confirm(script)
-            said.append((i, agreement, why))
-            if agreement in NOT_CONFIRMED:
-                v = f"inconclusive (second solver: {why})"
-        recheck.append((i, v))
-    return recheck, said
 
 
 def render(q: Quotient, target_texts: Mapping[str, str] | None = None) -> str:
@@ -336,7 +291,7 @@ def _no_answer(sysm: _System, a: z3.BoolRef, g: z3.BoolRef, outs: Sequence[z3.Ex
     unrealizable, :mod:`rclverify.calculus.health.realizable`), and the input is
     named."""
     facts = sysm.env(sysm.node, sysm.enc)
-    body = _conj([g] + facts)
+    body = conj_all([g] + facts)
     s = z3.Solver()
     wallclock.limit(s, 20_000)  # steps decide, the clock is a net
     s.add(a, z3.ForAll(list(outs), z3.Not(body)) if outs else z3.Not(body))
@@ -391,68 +346,3 @@ def _rename(e: Any, to: Mapping[str, tuple[str, str]]) -> Any:
                 kw[f.name] = _rename(v, to)
         return dataclasses.replace(e, **kw) if kw else e
     return e
-
-
-def _node_block(n: ast.Node, a_text: str, g_text: str) -> str:
-    """RCL of ``n``'s interface with the computed clauses (parsed, so the
-    canonical printer writes them)."""
-    clauses = ([] if a_text == "TRUE" else [ast.Clause(parse_formula(a_text))])
-    node = ast.Node(n.name, n.inputs, n.outputs, n.topics, tuple(clauses) or (ast.Clause(ast.BoolLit(True)),),
-                    (ast.Clause(parse_formula(g_text)),), n.loc, n.links)
-    return node_to_rcl(node)
-
-
-def _recheck(checked: Checked, plan: Any, node: str, block: str,
-             tgts: Sequence[Target]) -> list[tuple[str, str, str]]:
-    """Every target's verdict with ``block`` in place of ``node`` (module
-    docstring): ``(id, verdict, the SMT-LIB2 script it was decided from)``."""
-    from rclverify.calculus.requirements.check import check_requirement  # deferred: start-up (loads rclverify.calculus.health, rclverify.calculus.requirements and more only when called)
-    file = checked.nodes[node].node.loc.file
-    [new] = parse_text(block, file).nodes
-    specs = [ast.Spec(s.contexts, tuple(new if x.name == node else x for x in s.nodes), s.file) for s in checked.specs]
-    checked2 = check(specs)
-    model2 = build(checked2, plan.connections)
-    facts = {m: [f.expr for f in fs] for m, fs in plan.facts.items()}
-    out: list[tuple[str, str, str]] = []
-    consumers = sorted({t.consumer for t in tgts if t.kind == "side condition"} | {node},
-                       key=list(checked2.nodes).index)
-    verdicts: dict[str, tuple[str, str]] = {}
-    for d in consumers:
-        world.fresh()
-        for sc in compose_node(checked2, model2, d, facts=facts).side_conditions:
-            verdicts[sc.id] = (sc.verdict or sc.status, sc.smt2 or "")
-    out += [(sid, v, smt2) for sid, (v, smt2) in verdicts.items() if sid.startswith(f"{node}.")]
-    for t in tgts:
-        if t.kind == "side condition":
-            out.append((t.id, *verdicts.get(t.id, ("absent", ""))))
-    reqs = {r.id: r for r in all_requirements(plan)}
-    for t in tgts:
-        if t.kind == "requirement":
-            world.fresh()
-            rec = check_requirement(reqs[t.id], checked2, model2, plan)
-            v = str(rec.get("verdict"))
-            if v == "proved" and rec.get("consistency") == "inconsistent":
-                v = "proved from an inconsistency"
-            out.append((t.id, v, str(rec.get("smt2") or "")))
-    world.fresh()
-    return out
-
-
-def _compare(cn: Any, a_text: str, g_text: str, checked: Checked, model: SystemModel, plan: Any) -> list[str]:
-    """For a node that has a contract (one being replaced): does the
-    context discharge its assumption, and does its guarantee give what the
-    neighbours need (Z3, both where the computed assumption holds)?"""
-    n = cn.node
-    if not n.assumes and not n.guarantees:
-        return []
-    world.fresh()
-    enc = Encoder(checked.env, model.alias())
-    a_new, g_new = enc.formula(parse_formula(a_text), cn), enc.formula(parse_formula(g_text), cn)
-    a_cur = _conj([enc.formula(c.formula, cn) for c in n.assumes])
-    g_cur = _conj([enc.formula(c.formula, cn) for c in n.guarantees])
-    r1 = prove(a_cur, [a_new], enc)
-    r2 = prove(g_new, [a_new, a_cur, g_cur], enc)
-    say = {"proved": "yes", "refuted": "no", "inconclusive": "undecided"}
-    world.fresh()
-    return [f"the current assumption of {n.name} holds wherever the computed one does: {say[r1.status]}",
-            f"the current guarantee of {n.name} gives what the neighbours need: {say[r2.status]}"]
