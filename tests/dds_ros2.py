@@ -31,8 +31,9 @@ from pathlib import Path
 from typing import Any, Callable
 
 from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
-from rclverify.ros.live.dds import (NodeInfo, discovery_struct, encode_participant_info, make_participant, reply_topic, request_topic,
-                               topic_name, type_hash_user_data, write_raw)
+from rclverify.ros.live.dds import (make_participant, reply_topic, request_topic, topic_name, type_hash_user_data,
+                               write_raw)
+from rclverify.ros.live.discovery_info import NodeInfo, discovery_struct, encode_participant_info
 from rclverify.ros.live.dds_qos import QosProfile, to_dds
 
 CONFIG = """<?xml version="1.0" encoding="UTF-8"?>

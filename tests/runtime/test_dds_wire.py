@@ -24,7 +24,7 @@ import pytest
 pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed (pip install cyclonedds)")
 
 from rclverify.runtime.dds.types import DdsTypeError, TypeBook, request_id, to_fields  # noqa: E402
-from rclverify.ros.live import dds  # noqa: E402
+from rclverify.ros.live import dds, discovery_info  # noqa: E402
 from rclverify.ros.live.dds_qos import (DURABILITY, INFINITE_NS, LIVELINESS, XCDR1, XCDR2, QosProfile,  # noqa: E402
                                    from_dds, mismatches, reader_for, to_dds)
 from rclverify.traces.bag import typestore  # noqa: E402
@@ -141,19 +141,19 @@ def test_ros_discovery_info_decodes_both_gid_layouts(layout: str) -> None:
     for _ in range(25):
         part = _gid(rng)
         gids = lambda: [_gid(rng) for _ in range(rng.randint(0, 3))]  # noqa: E731
-        nodes = [dds.NodeInfo(rng.choice(["/", "/robot", "/a/b"]), f"n{rng.randrange(100)}", gids(), gids())
+        nodes = [discovery_info.NodeInfo(rng.choice(["/", "/robot", "/a/b"]), f"n{rng.randrange(100)}", gids(), gids())
                  for _ in range(rng.randint(0, 3))]
         g = lambda b: Gid(data=np.frombuffer(b.ljust(size, b"\0"), dtype=np.uint8))  # noqa: E731
         msg = Info(gid=g(part), node_entities_info_seq=[
             Node(node_namespace=n.namespace, node_name=n.name, reader_gid_seq=[g(x) for x in n.readers],
                  writer_gid_seq=[g(x) for x in n.writers]) for n in nodes])
         raw = bytes(store.serialize_cdr(msg, "rmw_dds_common/msg/ParticipantEntitiesInfo"))
-        gid, got, found = dds.decode_participant_info(raw)
+        gid, got, found = discovery_info.decode_participant_info(raw)
         assert (gid, got, found) == (part, nodes, size)
-        ours = dds.encode_participant_info(part, nodes, size)
+        ours = discovery_info.encode_participant_info(part, nodes, size)
         assert ours[:len(raw)] == raw and not any(ours[len(raw):])  # the same bytes, up to padding
     with pytest.raises(ValueError, match="not a ParticipantEntitiesInfo"):
-        dds.decode_participant_info(b"\x00\x01\x00\x00" + bytes(17))
+        discovery_info.decode_participant_info(b"\x00\x01\x00\x00" + bytes(17))
 
 
 def _random_qos(rng: random.Random, wild: bool = True) -> QosProfile:

@@ -19,7 +19,8 @@ import uuid
 from dataclasses import dataclass, field
 from typing import Any
 
-from rclverify.ros.live.dds import DISCOVERY_TOPIC, NodeInfo, decode_participant_info, discovery_struct, take_raw
+from rclverify.ros.live.dds import DISCOVERY_TOPIC, take_raw
+from rclverify.ros.live.discovery_info import NodeInfo, decode_participant_info, discovery_struct
 from rclverify.ros.live.dds_qos import QosProfile, from_dds, to_dds
 
 ALIVE = 16  # DDS_ALIVE_INSTANCE_STATE

@@ -18,7 +18,8 @@ import hashlib
 from pathlib import Path
 from typing import Any
 
-from rclverify.ros.live.dds import NodeInfo, dds_type, reply_topic, request_topic, topic_name
+from rclverify.ros.live.dds import dds_type, reply_topic, request_topic, topic_name
+from rclverify.ros.live.discovery_info import NodeInfo
 from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.live.dds_qos import INFINITE_NS, LIVELINESS, QosProfile
 from rclverify.runtime.rclpy_source.bus import agent_answer
