@@ -6,7 +6,8 @@ one up only for an event stamped before the latest question.  The batch path
 makes the newest at once and the others, from this record, only then: the
 fields are those the engine sets on a question answered by one output that
 decided every guarantee (``answered``, ``answer``, ``view``, ``decided``,
-``due``; ``followed`` when the next question came within its horizon, else
+``due``; a ``triggered by`` node's ``triggers`` and ``answered_triggers``, its
+trigger; ``followed`` when the next question came within its horizon, else
 ``reported``: it was closed, answered in full, when its horizon passed).
 
 :class:`RecentOutput` is likewise one of the 64 answers the engine remembers
@@ -34,11 +35,13 @@ class AnsweredRun:
     :meth:`question` takes the batch run (``run.m`` the engine, ``run.plan`` its
     plan, ``run.fields`` each input key's field)."""
 
-    __slots__ = ("chunk", "at", "where", "seed")
+    __slots__ = ("chunk", "at", "where", "seed", "carried")
 
     def __init__(self, chunk: EventRows | BlockRows, at: np.ndarray, where: dict[str, np.ndarray],
-                 seed: dict[str, object]) -> None:
+                 seed: dict[str, object], carried: Mapping[str, Event] | None = None) -> None:
         self.chunk, self.at, self.where, self.seed = chunk, at, where, seed
+        #: ``triggered by``: the triggers the first question took from the one before it (the earliest message each)
+        self.carried = carried or {}
 
     def question(self, j: int, run: Any) -> Question:
         """The ``j``-th pair's question as the engine leaves it once answered (questions.py's fields)."""
@@ -62,6 +65,10 @@ class AnsweredRun:
         q.view = view
         q.decided = set(plan.asked)
         q.due = qe.time + h
+        trigger = plan.trigger
+        if trigger:  # its own trigger (or the one carried to it), answered by its output: carried no further
+            q.triggers = {trigger: self.carried.get(trigger, qe) if j == 0 else qe}
+            q.mark("answered_triggers", trigger)
         if j + 1 < len(self.at):  # the next question of the run followed it within its horizon, or it expired first
             if chunk[int(self.at[j + 1])].time <= qe.time + h:
                 q.followed = True

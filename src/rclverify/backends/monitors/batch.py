@@ -29,17 +29,28 @@ verdicts are the engine's fast path's (``satisfied``, ``exact``, no
 reason); after them the engine's small state is set as feeding them would
 have set it (the values, the clock, the counts, the last questions and
 recent outputs it keeps, the watched question).  Memory is the chunk's
-columns and that small state: flat in the trace's length.
+columns and that small state: flat in the trace's length.  A chunk whose
+pairs come in many short runs (fewer than :data:`MIN_RUN` pairs a run on
+average) is fed to the engine whole: there a run costs more than the engine.
 
 Eligible (:func:`batch_plan`), else the caller streams: one node; no
-service or action link, no ``triggered by``, no state topic; every topic
+service or action link, no state topic; every ``triggered by`` guarantee
+triggered by one and the same input (a pair whose input is that one owes
+every guarantee: batched; a pair another input raises owes a triggered
+guarantee only as carried from the question before it: the engine's;
+the first batched question takes the triggers the question before it left
+unanswered, as :meth:`~rclverify.traces.questions.QuestionStream.ask`
+carries them, and each batched question's trigger is answered by its
+pair's output; the deadline part is :mod:`.batch_deadlines`'); every topic
 carries one ``REAL``, enumeration or window (``NATURAL --> REAL`` from an
 array, :mod:`.batch_window`) variable through a rule naming one
 field; one output topic; every guarantee reads the output (one that reads no
 input is output-only: judged on each answer on the outputs as they stand,
 its margin on no question, as the engine judges it), and Z3 showed only an
 answer decides them, or for a windowed node :func:`.batch_window.answer_only`
-showed it (the engine evaluates nothing when a question comes);
+showed it (the engine evaluates nothing when a question comes; a triggered
+node's questions the engine evaluates without asking Z3, and finds nothing
+decided when Z3 showed it: the batch path asks);
 every formula compiled by :mod:`rclverify.targets.columns` (windows:
 :mod:`rclverify.targets.column_windows`).
 """
@@ -66,13 +77,20 @@ from rclverify.backends.monitors.verdicts import KEPT_MARGINS, KEPT_VIOLATIONS, 
 
 #: Events read per chunk: the columns held at once.
 CHUNK = 16384
+#: The fewest pairs per run of pairs back to back, on average, for which a chunk of more than one run is judged
+#: in batch: a run costs the batch path about 300 microseconds (its columns sliced, its formulas and margins
+#: evaluated, the engine's state set), the engine about 50 a message, reading included (the windowed race's
+#: deadline log, 100,000 samples in runs of one or two pairs: 13.0 CPU s batched, 6.2 fed whole); a chunk of
+#: shorter runs is fed to the engine whole, which is its verdicts by construction.
+MIN_RUN = 8
 _EMPTY: Mapping[str, int] = {}
 
 
 def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], rules: Mapping[str, TopicRule],
                 horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
                 tolerance: Tolerance | None = None, end: float | None = None, chunk: int = CHUNK,
-                stats: dict[str, int] | None = None, margins: bool = False) -> tuple[int, NodeResult] | None:
+                stats: dict[str, int] | None = None, margins: bool = False,
+                min_run: int = MIN_RUN) -> tuple[int, NodeResult] | None:
     """:func:`~.check.check_trace` for one node, in batches: (events read, the
     node's result), the same verdicts in the same order to ``on_verdict``;
     ``None`` before reading any event when the node is not eligible (module
@@ -82,13 +100,15 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
     (:func:`~.check.check_trace`; a batch row's in float64 columns,
     :mod:`rclverify.targets.column_margins`, where every guarantee's is
     positive, as the engine computes it in doubles; every other row is the
-    engine's).  Raises what the event source raises."""
+    engine's).  ``min_run``: a chunk whose pairs come in shorter runs on average
+    is fed to the engine whole (:data:`MIN_RUN`; 0 batches every run).  Raises what the event source raises."""
     m = NodeMonitor(checked, node, rules, horizon, on_verdict, tolerance)
     m.margins = margins
     plan = batch_plan(m, rules)
     if plan is None:
         return None
     run = _Run(plan)
+    run.min_run = min_run
     count, last_time = 0, 0.0
     carry: list[Event] = []
     was = gc.isenabled()
@@ -133,6 +153,7 @@ class _Run:
         self.kinds = {t: j for j, t in enumerate(plan.inputs, 1)}
         self.kinds[plan.output[0]] = -1
         self.batched = self.streamed = 0
+        self.min_run = MIN_RUN
         #: runs of batch pairs whose older questions the stream keeps unmade (None), oldest first
         self.ghosts: list[AnsweredRun] = []
         self.fields = {key: field for key, field, _ in plan.inputs.values()}
@@ -144,6 +165,8 @@ class _Run:
         self.wrong = len(m.guarantees) == 1 and m.on_verdict is None
         #: a violated answer of a guarantee on a question is held for the skew (an output-only one is not)
         self.held = bool(m.stream.skew) and not m._alone
+        #: ``triggered by``: the column code of the input every triggered guarantee answers (0: no trigger)
+        self.owing = next((self.kinds[t] for t, (key, _, _) in plan.inputs.items() if key == plan.trigger), 0)
 
     def _full(self) -> bool:
         """Whether the run's violation records are full: a further violation is only counted."""
@@ -182,6 +205,10 @@ class _Run:
         if kind is None:
             kind = self._kind(chunk.topics)
         times = chunk.times
+        if n > 1 and not self._long_runs(kind, times):
+            for ev in chunk[0:n]:
+                self.feed(ev)
+            return []
         ok = kind != 0
         unstamped = chunk.unstamped()
         if unstamped is not None:
@@ -227,6 +254,17 @@ class _Run:
             feed(ev)
         return keep
 
+    def _long_runs(self, kind: np.ndarray, times: np.ndarray) -> bool:
+        """Whether the chunk's pairs (an input, then an output stamped within the horizon after it; whether
+        both map is not read) are one run back to back, or runs of :attr:`min_run` or more pairs on average."""
+        t0, t1 = times[:-1], times[1:]
+        start = (kind[:-1] > 0) & (kind[1:] == -1) & (t0 <= t1) & (t1 <= t0 + self.m.horizon)
+        pairs = np.flatnonzero(start)
+        if not len(pairs):
+            return False
+        runs = 1 + int(np.count_nonzero(pairs[1:] != pairs[:-1] + 2))
+        return len(pairs) >= self.min_run * (runs - 1)  # (one run: its cost is paid once)
+
     def _kind(self, topics: list[str]) -> np.ndarray:
         """Each event's topic as its column code: an input topic's number, -1 the output's, 0 another topic."""
         n = len(topics)
@@ -266,6 +304,8 @@ class _Run:
                     col = col.copy()
                     col[before] = first
             columns[key] = col
+        if self.owing:  # a question another input raises owes a triggered guarantee only as carried: the engine's
+            seen &= tkind == self.owing
         sure = seen.copy()
         judged = [f(columns) for f in plan.formulas]
         for truth, certain in judged:
@@ -384,6 +424,12 @@ class _Run:
         last = m.stream.latest
         if last is not None and t_first <= last.event.time + h:
             last.followed = True
+        carried: dict[str, Event] = {}
+        if last is not None and last.triggers:  # its triggers no output answered go to the first new question
+            for t, tev in last.triggers.items():  # (questions.py, ``ask``)
+                if t not in last.answered_triggers:
+                    carried[t] = tev
+                    last.mark("passed", t)
         if m._open is not None and m._open.followed:
             m._open, m._due = None, float("inf")
         result = m.result
@@ -402,13 +448,14 @@ class _Run:
                 qe, ev = chunk[i], chunk[i + 1]
                 emit(Verdict(name, "satisfied", ev.index, ev.time, ev.where, ev.topic, ev.time, 0, {}, "", "exact",
                              qe.where, float(least[j]) if least is not None else None))
-        newest = self._keep_questions(chunk, at, src, times)
+        newest = self._keep_questions(chunk, at, src, times, carried)
         self._remember_outputs(chunk, at, times, wrong, bad, newest)
 
     def _keep_questions(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
-                        times: np.ndarray) -> Question:
+                        times: np.ndarray, carried: dict[str, Event]) -> Question:
         """The stream's questions after the pairs at ``at``, as feeding them keeps them (the
-        newest made now, the older ones when the engine may look them up); returns the newest."""
+        newest made now, the older ones when the engine may look them up; ``carried``: the
+        triggers the first of them takes from the question before it); returns the newest."""
         m, n = self.m, len(at)
         stream = m.stream  # the older questions are made when the engine may look them up: _materialise
         old = len(stream._questions)
@@ -417,7 +464,7 @@ class _Run:
         tail = at[-min(n, keptn, 2 * KEPT):]
         where = {k: v[len(at) - len(tail):] for k, v in src.items()}
         seed = {k: m.values[k] for k in m._in_keys}
-        ghost = AnsweredRun(chunk, tail, where, seed)
+        ghost = AnsweredRun(chunk, tail, where, seed, carried if len(tail) == n else {})
         newest = ghost.question(len(tail) - 1, self)
         drop = max(0, old + len(tail) - keptn)
         # an output held for the skew: its release reads the questions within the skew after it, so they are made
@@ -482,4 +529,4 @@ class _Run:
             m._hi = last_out
 
 
-__all__ = ["CHUNK", "BatchPlan", "batch_plan", "check_batch"]
+__all__ = ["CHUNK", "MIN_RUN", "BatchPlan", "batch_plan", "check_batch"]

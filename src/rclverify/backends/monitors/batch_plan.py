@@ -12,6 +12,7 @@ from rclverify.targets.column_windows import WindowCompiler, WindowMargins, is_w
 from rclverify.targets.columns import Unsupported, io_kind
 from rclverify.backends.monitors.batch_window import answer_only, mappers
 from rclverify.backends.monitors.engine import NodeMonitor
+from rclverify.backends.monitors.needs_answer import answer_decides
 
 
 class BatchPlan:
@@ -53,9 +54,20 @@ class BatchPlan:
         self.widths = dict(compiler.widths)
         if set(self.widths) != set(self.mapped):
             raise Unsupported("a window variable no formula reads at an offset")
-        #: the question's evaluation decides nothing (needs_answer.py's Z3 answer, or batch_window.answer_only)
+        #: ``triggered by``: the one input every triggered guarantee answers (a question its message raises owes
+        #: every guarantee; one another input raises owes what is carried to it: the engine's), else ""
+        self.trigger = ""
+        if m._trigger:
+            tks = set(m._trigger.values())
+            if len(tks) != 1 or next(iter(tks)) not in self.keys:
+                raise Unsupported("guarantees triggered by different inputs")
+            self.trigger = next(iter(tks))
+        #: the question's evaluation decides nothing (needs_answer.py's Z3 answer, or batch_window.answer_only);
+        #: the engine evaluates a triggered node's questions without asking Z3: asked here (a trigger only
+        #: narrows which guarantees a question owes, so no input deciding any of them decides none it owes)
         if m._ask_at_question and not (self.widths and all(answer_only(m.guarantees[k - 1], m.node)
-                                                            for k in m._asked)):
+                                                            for k in m._asked)) and \
+                not (self.trigger and not self.widths and answer_decides(m.checked, m.node, m.guarantees)):
             raise Unsupported("a question's inputs may decide a guarantee")
         self.asked = set(m._asked)
         #: with margins: each guarantee's margin over the columns, and the (text, unit) of each deciding comparison
@@ -71,7 +83,7 @@ def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | No
     """The batch plan of monitor ``m`` when its node is eligible (module docstring), else ``None``."""
     node = m.node
     ks = range(1, len(m.guarantees) + 1)
-    if node.node.links or m._trigger or m._state_outs or not m.has_inputs or m.unbound or \
+    if node.node.links or m._state_outs or not m.has_inputs or m.unbound or \
             any(len(vs) != 1 for vs in m.topics.values()) or \
             any(not m._reads_out[k] for k in ks) or sorted(m._asked + m._alone) != list(ks):
         return None
