@@ -123,6 +123,7 @@ SECONDS: dict[str, float] = {
     "test_bag_blocks": 2.4, "test_evaluate_shortcuts": 2.3, "test_ros_bringup": 2.0,
     # a pipeline module (slow already) measured in round seventeen (docs/ci.md)
     "test_example_fleet_trials": 8.5,
+    "test_batch_triggered": 7.0,  # a triggered node's batch judgement against the engine on 80 random runs
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
