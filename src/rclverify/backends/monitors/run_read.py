@@ -17,7 +17,7 @@ from rclverify.backends.monitors.run_origin import RunOrigin
 from rclverify.backends.monitors.shapes import RunSource
 from rclverify.backends.monitors.config import MonitorConfig
 from rclverify.backends.monitors.deadline_topics import has_deadlines
-from rclverify.backends.monitors.deadlines import DeadlineMonitor
+from rclverify.backends.monitors.batch_deadlines import deadline_monitor
 from rclverify.backends.monitors.declarations import DeclarationMonitor, has_declarations
 from rclverify.backends.monitors.judged import Counted
 from rclverify.backends.monitors.lifecycle import gate_of, gated
@@ -52,8 +52,8 @@ def read_run(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | No
     node, fields = judged_at_widths(target.checked, target.node, cfg.rules, [target.root / d for d in cfg.msg_dirs])
     beside = Beside()
     if has_deadlines(node):
-        beside.add("deadlines", lambda: DeadlineMonitor(target.checked, node, cfg.rules,
-                                                        horizon=cfg.horizon, tolerance=cfg.tolerance))
+        beside.add("deadlines", lambda: deadline_monitor(target.checked, node, cfg.rules,
+                                                         horizon=cfg.horizon, tolerance=cfg.tolerance))
     if has_periods(node):  # periodic outputs on the same run (periods.py)
         beside.add("periods", lambda: PeriodMonitor(node))
     if has_declarations(node):  # initially, progress, periodic judged on the same run (declarations.py)
