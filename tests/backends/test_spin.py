@@ -14,7 +14,7 @@ import yaml
 
 from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.base import NodeTarget
-from rclverify.backends.model_checking import backend as mc
+from rclverify.backends.model_checking import backend as mc, spin_config
 from rclverify.backends.model_checking import spin
 from rclverify.backends.model_checking.graph import MentalState, StateGraph, Transition
 from rclverify.backends.model_checking.ltl import Propositions, parse_psl_text, to_spin
@@ -225,11 +225,11 @@ def test_spin_missing_gives_pending_with_the_install_command(tmp_path: Path, mon
 
 def test_default_checker_is_spin_only_without_mcapl_and_with_an_environment() -> None:
     env = {"environment": {"percepts": ["a"]}}
-    assert mc.chosen_checker(env, {}) == "spin"
-    assert mc.chosen_checker(env, {"MCAPL_HOME": "/opt/mcapl"}) == "ajpf"
-    assert mc.chosen_checker({}, {}) == "ajpf"
-    assert mc.chosen_checker({**env, "model_checker": "ajpf"}, {}) == "ajpf"
-    assert mc.chosen_checker({"model_checker": "spin"}, {"MCAPL_HOME": "x"}) == "spin"
+    assert spin_config.chosen_checker(env, {}) == "spin"
+    assert spin_config.chosen_checker(env, {"MCAPL_HOME": "/opt/mcapl"}) == "ajpf"
+    assert spin_config.chosen_checker({}, {}) == "ajpf"
+    assert spin_config.chosen_checker({**env, "model_checker": "ajpf"}, {}) == "ajpf"
+    assert spin_config.chosen_checker({"model_checker": "spin"}, {"MCAPL_HOME": "x"}) == "spin"
 
 
 # -- the case study (needs stage one, the explorer) -------------------------

@@ -27,7 +27,7 @@ from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.model_checking.ajpf.config import DEFAULT_TIMEOUT_S as AJPF_TIMEOUT_S
 from rclverify.backends.model_checking.ajpf.backend import AjpfBackend
 from rclverify.backends.bounded import ToolInterrupted, run_bounded
-from rclverify.backends.model_checking import backend as mc
+from rclverify.backends.model_checking import backend as mc, spin_config
 from rclverify.backends.model_checking import spin
 from rclverify.backends.model_checking.environment import environment_from_plan
 from rclverify.backends.model_checking.explore import explore
@@ -488,7 +488,7 @@ def test_a_build_past_its_time_limit_is_inconclusive_and_says_so(tmp_path: Path,
 
 def test_every_tool_runs_with_a_time_limit_of_minutes() -> None:
     assert spin.DEFAULT_TIMEOUT_S <= 600 and AJPF_TIMEOUT_S <= 600
-    assert mc.spin_timeout({}) == spin.DEFAULT_TIMEOUT_S and mc.spin_timeout({"timeout_s": 20}) == 20
+    assert spin_config.spin_timeout({}) == spin.DEFAULT_TIMEOUT_S and spin_config.spin_timeout({"timeout_s": 20}) == 20
 
 
 # -- the plan -----------------------------------------------------------------------------------

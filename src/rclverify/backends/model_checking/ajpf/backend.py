@@ -228,7 +228,8 @@ class AjpfBackend:
                 explanation=("no AJPF property: " + "; ".join(data.get("unmapped", []))
                              + " -- add mapping rows for these atoms to the plan"),
                 details={"unmapped": list(data.get("unmapped", []))})
-        from rclverify.backends.model_checking.backend import chosen_checker, run_spin, spin_timeout  # deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
+        from rclverify.backends.model_checking.backend import run_spin  # deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
+        from rclverify.backends.model_checking.spin_config import chosen_checker, spin_timeout  # deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
         if chosen_checker(target.config) == "spin":
             return run_spin(obligation, target, str(target.config["model"]), spin_timeout(target.config))
         if "log" not in data:  # a property of the plan's `properties` files

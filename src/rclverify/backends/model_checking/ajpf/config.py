@@ -40,7 +40,7 @@ class AjpfConfig:
     timeout_s: float = DEFAULT_TIMEOUT_S
     results: str = DEFAULT_RESULTS
     log_info: tuple[str, ...] = DEFAULT_LOG_INFO
-    spin: Any = None  # model_checking.backend.SpinConfig: the SPIN keys, checked
+    spin: Any = None  # model_checking.spin_config.SpinConfig: the SPIN keys, checked
 
 
 def read_config(target: NodeTarget) -> AjpfConfig:
@@ -76,7 +76,7 @@ def read_config(target: NodeTarget) -> AjpfConfig:
     if not isinstance(log_info, list) or not all(isinstance(x, str) and _JAVA_CLASS.match(x) for x in log_info):
         raise target.config_error("'log_info' must be a list of logger (class) names", "log_info")
     rows = _rows(cfg.get("mapping", []), target, agent, domains)
-    from rclverify.backends.model_checking.backend import read_spin_config  # lazily: model_checking imports ajpf.psl; deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
+    from rclverify.backends.model_checking.spin_config import read_spin_config  # lazily: model_checking imports ajpf.psl; deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
     return AjpfConfig(agent, model, domains, rows, env_class, home, float(timeout), results.rstrip("/"),
                       tuple(log_info), read_spin_config(target))
 
