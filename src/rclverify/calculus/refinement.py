@@ -32,6 +32,8 @@ Conditions (docs/decisions.md, "Refinement"):
 
 ``refines_main`` implements the command ``rclverify refines A.rcl:Node
 B.rcl:Node [--assume FORMULA ...]``.
+
+The interface check and the merged environments are :mod:`.interfaces`'.
 """
 from __future__ import annotations
 
@@ -46,13 +48,14 @@ from rclverify.semantics.connectives import conj
 from rclverify.semantics.encode import EncodingError, Encoder
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, prove
 from rclverify.lang import ast
-from rclverify.lang.errors import Diagnostic, RclError, error
+from rclverify.lang.errors import RclError, error
 from rclverify.lang.parser import parse_formula
 from rclverify.calculus.compose import free_io
 from rclverify.calculus.refine_timing import timing_side
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.typecheck import load
 from rclverify.lang.types import Checked, CheckedNode, Env
+from rclverify.calculus.interfaces import check_interface, io_loc, merge_envs
 
 
 @dataclass(frozen=True)
@@ -112,86 +115,6 @@ class RefinementResult:
         return {"a": self.a, "b": self.b, "verdict": self.verdict,
                 "assumption": side(self.assumption), "guarantee": side(self.guarantee),
                 "conditions": list(self.conditions), **({"timing": side(self.timing)} if self.timing else {})}
-
-
-# ---------------------------------------------------------------------------
-# Interface and environments
-# ---------------------------------------------------------------------------
-
-def _io_loc(node: CheckedNode, prefix: str, name: str) -> ast.Loc:
-    group = node.node.inputs if prefix == "in" else node.node.outputs
-    return next((v.loc for v in group if v.name == name), node.node.loc)
-
-
-def check_interface(a: CheckedNode, b: CheckedNode, extra_inputs_ok: bool = False) -> None:
-    """Raise :class:`RclError` (one diagnostic per difference, located in B,
-    or at B's node when B lacks a variable) unless A and B have the same
-    inputs and outputs with the same types.  ``extra_inputs_ok``: B may have
-    inputs A lacks (their values are constrained by given conditions)."""
-    diags: list[Diagnostic] = []
-    for prefix, kind, ta, tb in (("in", "input", a.inputs, b.inputs), ("out", "output", a.outputs, b.outputs)):
-        for name, t in ta.items():
-            if name not in tb:
-                diags.append(error(b.node.loc, f"node {b.name} has no {kind} {name!r}, which {a.name} "
-                                               f"({_io_loc(a, prefix, name)}) has; a replacement needs the same "
-                                               f"interface", "E-refines-interface"))
-            elif tb[name] != t:
-                diags.append(error(_io_loc(b, prefix, name), f"{kind} {name!r} has type {tb[name]} here but "
-                                                             f"{t} in {a.name} ({_io_loc(a, prefix, name)})",
-                                   "E-refines-interface"))
-        for name in tb:
-            if name not in ta and not (prefix == "in" and extra_inputs_ok):
-                diags.append(error(_io_loc(b, prefix, name), f"{kind} {name!r} of {b.name} is not an {kind} of "
-                                                             f"{a.name} ({a.node.loc}); a replacement needs the "
-                                                             f"same interface" + ("" if prefix == "out" else
-                                                             ", or a condition on the extra input (--assume, or "
-                                                             "the plan's environment facts)"),
-                                   "E-refines-interface"))
-    if diags:
-        raise RclError(diags)
-
-
-def merge_envs(a: Checked, b: Checked) -> Env:
-    """One environment for two separately checked systems.
-
-    Context names both declare must mean the same (same type, same constant
-    value, same enumeration values and constructors); otherwise an
-    :class:`RclError` located at B's declaration is raised.
-    """
-    diags: list[Diagnostic] = []
-    types, consts = dict(a.env.types), dict(a.env.constants)
-    enums, ctors = dict(a.env.enum_values), dict(a.env.ctors)
-    locs = _decl_locs(b)
-    for name, t in b.env.types.items():
-        if name in types and types[name] != t:
-            diags.append(error(locs.get(name, ast.NOLOC), f"context type {name} is {t} here but "
-                                                          f"{types[name]} in the other contract", "E-refines-context"))
-        types.setdefault(name, t)
-    for name, (t, v) in b.env.constants.items():
-        if name in consts and (consts[name][0] != t or consts[name][1] != v):
-            diags.append(error(locs.get(name, ast.NOLOC), f"constant {name} differs from the other contract's",
-                               "E-refines-context"))
-        consts.setdefault(name, (t, v))
-    anywhere = next(iter(locs.values()), ast.NOLOC)
-    for value, enum in b.env.enum_values.items():
-        if value in enums and enums[value] != enum:
-            diags.append(error(locs.get(enum.name, anywhere), f"value {value} belongs to {enum} here but to "
-                                                              f"{enums[value]} in the other contract",
-                               "E-refines-context"))
-        enums.setdefault(value, enum)
-    for cname, data in b.env.ctors.items():
-        if cname in ctors and ctors[cname] != data:
-            diags.append(error(locs.get(data.name, anywhere), f"constructor {cname} belongs to {data} here but "
-                                                              f"to {ctors[cname]} in the other contract",
-                               "E-refines-context"))
-        ctors.setdefault(cname, data)
-    if diags:
-        raise RclError(diags)
-    return Env(types, consts, enums, ctors)
-
-
-def _decl_locs(c: Checked) -> dict[str, ast.Loc]:
-    return {d.name: d.loc for s in c.specs for ctx in s.contexts for d in ctx.decls}
 
 
 # ---------------------------------------------------------------------------
@@ -278,7 +201,7 @@ def check_refinement(a: CheckedNode, b: CheckedNode, env: Env, *,
     s_assume = f"{_conj(a.node.assumes)} -> {_conj(b.node.assumes)}"
     s_guar = f"{_conj(a.node.assumes)} and {_conj(b.node.guarantees)} -> {_conj(a.node.guarantees)}"
     if extra and not any(n in {v for _, v in _io_names(f)} for f in list(conditions) + list(facts) for n in extra):
-        raise RclError([error(_io_loc(b, "in", extra[0]), f"input {extra[0]!r} of {b.name} is not an input of {a.name} "
+        raise RclError([error(io_loc(b, "in", extra[0]), f"input {extra[0]!r} of {b.name} is not an input of {a.name} "
                                                           "and no condition mentions it; give one with --assume",
                               "E-refines-interface")])
     # decide first with what decides: each side's first attempt gets a small budget; when it
