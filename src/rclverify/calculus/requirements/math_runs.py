@@ -18,9 +18,12 @@ functions").  Two rules keep their verdicts sound:
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Sequence
+import dataclasses
+from fractions import Fraction
+from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.calculus.requirements.tsys import TemporalVerdict, TransitionSystem
+from rclverify.lang import ast
 from rclverify.semantics import mathfacts
 from rclverify.semantics.connectives import conj
 
@@ -31,6 +34,31 @@ Prop = Callable[[Any], Any]
 def _terms(ts: TransitionSystem, props: Sequence[Prop]) -> list[Any]:
     s0, s1 = ts.state(0, "math"), ts.state(1, "math")
     return [ts.init(s0), ts.trans(s0, s1), *[p(s0) for p in props]]
+
+
+def mentions_math(*roots: object) -> bool:
+    """Whether a ``sqrt``, ``sin`` or ``cos`` (:data:`rclverify.lang.ast.MATH_FUNCTIONS`) is written
+    anywhere in ``roots`` (ASTs, checked nodes, formal statements, the environment, and the
+    dataclasses, mappings and sequences holding them).  Read from the syntax, so asking builds no
+    Z3 term: a query of a system without them is the query it was, term for term."""
+    seen: set[int] = set()
+    stack: list[object] = list(roots)
+    while stack:
+        o = stack.pop()
+        if o is None or isinstance(o, (str, bytes, int, float, Fraction)) or id(o) in seen:
+            continue
+        seen.add(id(o))
+        if isinstance(o, ast.Unary) and o.op in ast.MATH_FUNCTIONS:
+            return True
+        if dataclasses.is_dataclass(o) and not isinstance(o, type):
+            stack.extend(getattr(o, f.name) for f in dataclasses.fields(o))
+        elif isinstance(o, Mapping):
+            stack.extend(o.values())
+        elif isinstance(o, (list, tuple, set, frozenset)):
+            stack.extend(o)
+        elif hasattr(o, "__dict__") and type(o).__module__.startswith("rclverify."):
+            stack.extend(vars(o).values())
+    return False
 
 
 def with_facts(ts: TransitionSystem, props: Sequence[Prop]) -> TransitionSystem:
@@ -62,4 +90,4 @@ def unconfirmed(v: TemporalVerdict, ts: TransitionSystem, props: Sequence[Prop],
                                   f"functions and is not confirmed on its values")
 
 
-__all__ = ["unconfirmed", "with_facts"]
+__all__ = ["mentions_math", "unconfirmed", "with_facts"]

@@ -351,7 +351,9 @@ class _System:
         self.enc = Encoder(q.checked.env)
         if q.assuming:  # the requirement's own assumptions hold in every state
             self.assume()
-        self.sys.ts = math_runs.with_facts(self.sys.ts, [self.raw(f) for f in operands(q.t)])
+        if math_runs.mentions_math([q.checked.nodes[n] for n in q.cone if n in q.checked.nodes], q.checked.env,
+                                   q.t, q.assuming, q.inv):  # else no term is built: the query stays as it was
+            self.sys.ts = math_runs.with_facts(self.sys.ts, [self.raw(f) for f in operands(q.t)])
         self.types = variable_types(self.sys, q.checked, q.plan)
         self.points = max([points_for(q.plan.instances.get(n)) for n in q.cone] or [points_for(None)])
         self.confirmed: list[dict[str, str]] | None = None  # the trace of a lasso confirmed on its values
