@@ -37,7 +37,7 @@ def check_trace(checked: Checked, nodes: Iterable[CheckedNode], events: Iterable
     before it were processed.
 
     One node whose contract the batch path takes (:mod:`.batch`: quantifier-free
-    REAL/enumeration contracts, one output topic, no state, trigger or link) is
+    REAL/enumeration contracts, one output topic, no state or link, triggers on one input) is
     judged by it, unless ``batch`` is false: the same verdicts, in the same
     order, the same result (tests/backends/test_monitor_batch.py).  Without numpy (the
     ``fast`` extra) every node is streamed.  A live monitor never comes here:
