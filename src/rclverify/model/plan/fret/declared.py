@@ -29,7 +29,7 @@ import re
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from rclverify.model.plan.fret.fretish import Refusal
+from rclverify.model.plan.fret.refusal import Refusal
 
 #: the plan's word for a variable's place -> FRET's idType
 ID_TYPES = {"input": "Input", "output": "Output"}
@@ -53,8 +53,8 @@ class DeclaredFunction:
                           f"{self.name}({', '.join(self.params)}) with {len(self.params)}",
                           f"call {self.name} with {len(self.params)} arguments in FRET, or define it to match")
         from rclverify.lang.errors import RclError  # deferred: start-up (only a plan that defines functions)
-        from rclverify.lang.parser import parse_formula
-        from rclverify.lang.walk import free_names
+        from rclverify.lang.parser import parse_formula  # deferred: start-up, as above
+        from rclverify.lang.walk import free_names  # deferred: start-up, as above
         try:
             body = parse_formula(self.rcl, f"fret: functions: {self.name}")
         except RclError as exc:

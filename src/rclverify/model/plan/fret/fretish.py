@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Mapping, Union
 
 from rclverify.model.plan.fret.cases import Expr as Expr, lift, text  # Expr: a parsed expression (its shapes there)
+from rclverify.model.plan.fret.refusal import Refusal as Refusal  # the readers' refusal, named here too
 
 if TYPE_CHECKING:
     from rclverify.model.plan.fret.declared import DeclaredFunction
@@ -63,15 +64,6 @@ MATH = ("sqrt", "sin", "cos")
 #: FRET's maxReal/maxInt and minReal/minInt (FRET's field guide, "builtin functions"): the comparison choosing a.
 EXTREMA = {"maxReal": ">=", "maxInt": ">=", "minReal": "<=", "minInt": "<="}
 PRE = {"preBool": "BOOL", "preReal": "REAL", "preInt": "INTEGER"}
-
-
-class Refusal(Exception):
-    """A requirement that cannot be imported: ``reason`` (what is in the
-    way) and ``fix`` (what would make it importable)."""
-
-    def __init__(self, reason: str, fix: str) -> None:
-        super().__init__(f"{reason}; {fix}")
-        self.reason, self.fix = reason, fix
 
 
 def _tokens(text: str) -> list[str]:
