@@ -19,34 +19,11 @@ from lark import Token, Transformer
 from rclverify.lang import ast
 
 from rclverify.lang import typeexpr
+from rclverify.lang.builder_types import TypeRules
 from rclverify.lang.errors import RclError, error
+from rclverify.lang.lark_children import _Spanned, _is_syntax, _vals
 
-# Terminals whose text is data; every other token (keywords, punctuation) is
-# syntax, kept in the children only for its position.  "QUANT" is the
-# quantifier-kind token the transformer itself makes.
-_VALUE_TERMINALS = frozenset({"NAME", "IO_NAME", "NUMBER", "ROS_TYPE", "CMP_OP", "BASE_TYPE", "EXISTS_BANG",
-                              "QUANT", "STRING_LIT", "QUALIFIED_BASE", "UNIT", "GLOBAL_NAME", "PRIVATE_NAME"})
-
-
-class _Spanned:
-    """An intermediate value with the location of the text it came from."""
-
-    __slots__ = ("value", "loc")
-
-    def __init__(self, value: Any, loc: ast.Loc) -> None:
-        self.value, self.loc = value, loc
-
-
-def _is_syntax(x: Any) -> bool:
-    return isinstance(x, Token) and x.type not in _VALUE_TERMINALS
-
-
-def _vals(c: list[Any]) -> list[Any]:
-    """The data children of a rule (syntax tokens dropped, placeholders kept)."""
-    return [x for x in c if not (isinstance(x, Token) and x.type not in _VALUE_TERMINALS)]  # _is_syntax, inlined
-
-
-class ToAst(Transformer[Token, Any]):
+class ToAst(TypeRules, Transformer[Token, Any]):
     """Builds the immutable AST while the LALR parser reduces.
 
     Children arrive with all tokens kept; a node's location runs from the
@@ -243,49 +220,6 @@ class ToAst(Transformer[Token, Any]):
 
     def action_link(self, c: list[Any]) -> ast.Link:
         return self._link("action", c)
-
-    # -- types ---------------------------------------------------------------
-    def base_name(self, c: list[Token]) -> Token:
-        return c[0]  # the BASE_TYPE token: its text and its position
-
-    def base_type(self, c: list[Any]) -> typeexpr.TBase:
-        return typeexpr.TBase(str(c[0]), self._span(c))  # type: ignore[arg-type]
-
-    def named_type(self, c: list[Any]) -> typeexpr.TName:
-        return typeexpr.TName(str(c[0]), self._span(c))
-
-    def empty_type(self, c: list[Any]) -> typeexpr.TEmpty:
-        return typeexpr.TEmpty(self._span(c))
-
-    def alt(self, c: list[Any]) -> typeexpr.Constructor:
-        v = _vals(c)
-        return typeexpr.Constructor(str(v[0]), tuple(t for t in v[1:] if t is not None), self._span(c))
-
-    def alt_type(self, c: list[Any]) -> typeexpr.TypeExpr:
-        alts: list[typeexpr.Constructor] = _vals(c)
-        if all(not a.args for a in alts):
-            return typeexpr.TEnum(tuple(a.name for a in alts), self._span(c))
-        return typeexpr.TConstructors(tuple(alts), self._span(c))
-
-    def func_type(self, c: list[Any]) -> typeexpr.TFunc:
-        arrow = next(k for k, x in enumerate(c) if isinstance(x, Token) and x.value == "-->")
-        args, res = _vals(c[:arrow]), _vals(c[arrow + 1:])
-        result = res[0] if len(res) == 1 else typeexpr.TTuple(tuple(res), self._span(c[arrow + 1:]))
-        return typeexpr.TFunc(tuple(args), result, self._span(c))
-
-    def set_type(self, c: list[Any]) -> typeexpr.TSet:
-        return typeexpr.TSet(_vals(c)[0], self._span(c))
-
-    def seq_type(self, c: list[Any]) -> typeexpr.TSeq:
-        return typeexpr.TSeq(_vals(c)[0], self._span(c))
-
-    def tuple_type(self, c: list[Any]) -> typeexpr.TTuple:
-        return typeexpr.TTuple(tuple(_vals(c)), self._span(c))
-
-    def type_atom(self, c: list[Any]) -> Any:
-        t = c[1]  # "(" type ")": the type itself, spanning its parentheses for its parent
-        self.wrapped[id(t)] = (t, self._span(c))
-        return t
 
     # -- expressions -----------------------------------------------------------
     def _bin(self, op: ast.BinaryOp, c: list[Any]) -> ast.Binary:
