@@ -111,12 +111,10 @@ MATH_FUNCTIONS: tuple[UnaryOp, ...] = ("sqrt", "sin", "cos")
 
 
 def unhandled(op: NoReturn) -> NoReturn:
-    """The end of an operator dispatch that handled every operator: the type
-    checker (mypy strict) rejects a call it can reach with an operator value
-    left, so an operator added to :data:`UnaryOp` (or another operator set)
-    is listed at every translation that must give it a meaning; at run time
-    (an unchecked caller) raises ``AssertionError`` naming it, never a silent
-    reading as another operator."""
+    """The end of an operator dispatch that handled every operator: mypy strict rejects a call it
+    can reach with an operator value left, so an operator added to :data:`UnaryOp` (or another set) is
+    listed at every translation that must give it a meaning; at run time (an unchecked caller) raises
+    ``AssertionError`` naming it, never a silent reading as another operator."""
     raise AssertionError(f"operator {op!r} is not handled here")
 
 
