@@ -106,3 +106,43 @@ def test_a_requirement_reads_the_first_value_on_a_run_with_its_start_marker(tmp_
 def test_a_requirement_over_first_on_a_run_without_the_marker_is_inconclusive(tmp_path: Path) -> None:
     v = _requirement(tmp_path, "always (first(Inc.in.a) -> Inc.in.a == 1)", False)
     assert v.verdict == "inconclusive" and "no start-of-run marker" in v.reason, v.reason
+
+
+# -- live: the start-of-run marker a live monitor notes decides first(in.x) as its log does ----------------
+
+def _live(tmp: Path, start: bool, first_answer: float) -> tuple[list[str], Path]:
+    from rclverify.runtime.live import LiveRun
+    checked = load([_workspace(tmp)])
+    cfg = load_mapping(tmp, "mapping.yaml")
+    published: list[str] = []
+    live = LiveRun(checked, [checked.nodes["Hold"]], cfg.rules, cfg.horizon, tmp / "live.jsonl",
+                   reorder_window=0.0, publish=published.append)
+    if start:
+        live.note(_start())
+    for x in _run(first_answer):
+        live.tick(float(x["time"]))
+        live.push(str(x["topic"]), {"data": x["data"]}, float(x["time"]))
+    live.tick(10.0)
+    live.stop()
+    return [json.loads(p)["verdict"] for p in published if json.loads(p).get("node")], tmp / "live.jsonl"
+
+
+def _workspace(tmp: Path) -> Path:
+    (tmp / "contracts").mkdir(exist_ok=True)
+    (tmp / "contracts" / "c.rcl").write_text(HOLD)
+    (tmp / "mapping.yaml").write_text(MAPPING)
+    return tmp / "contracts" / "c.rcl"
+
+
+def test_a_live_run_decides_first_after_its_start_marker_as_its_log_is_judged(tmp_path: Path) -> None:
+    verdicts, log = _live(tmp_path, True, 0.0)
+    assert verdicts == ["satisfied", "satisfied"], verdicts
+    (tmp_path / "offline").mkdir()
+    counts, _ = _judge(tmp_path / "offline", [json.loads(x) for x in log.read_text().splitlines()
+                                              if json.loads(x).get("topic") in ("cmd", "out", "rclverify/run")])
+    assert counts["satisfied"] == 2 and counts["inconclusive"] == 0  # live = log
+    (tmp_path / "v").mkdir()
+    assert _live(tmp_path / "v", True, 5.0)[0] == ["violated", "satisfied"]  # control: the first answer wrong
+    (tmp_path / "n").mkdir()
+    unknown = _live(tmp_path / "n", False, 0.0)[0]  # control: no marker noted, so first(in.cmd) is unknown
+    assert unknown and set(unknown) == {"inconclusive"}, unknown
