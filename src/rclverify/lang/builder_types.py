@@ -4,7 +4,7 @@ made into :mod:`rclverify.lang.typeexpr` values: the lark callbacks of
 :class:`~rclverify.lang.builder.ToAst` for types, as a mixin."""
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Callable
 
 from lark import Token
 
@@ -18,9 +18,7 @@ class TypeRules:
     span with its parentheses, by id)."""
 
     wrapped: dict[int, tuple[Any, ast.Loc]]
-
-    def _span(self, c: list[Any]) -> ast.Loc:
-        raise NotImplementedError  # the builder's own
+    _span: Callable[[list[Any]], ast.Loc]
 
     # -- types ---------------------------------------------------------------
     def base_name(self, c: list[Token]) -> Token:
