@@ -158,7 +158,7 @@ def test_counting_what_a_log_holds_keeps_the_batch_path(tmp_path: Path, monkeypa
     stats: dict[str, int] = {}
     rules = load_rules({"r": {"fields": ["data"]}, "out": {"fields": ["data"]}})
     got = check_batch(node, node.nodes["Lim"], Counted(read_trace(log, streams=True), heard), rules, 5.0,
-                      chunk=64, stats=stats)
+                      chunk=64, stats=stats, min_run=0)  # (runs of one pair: batched only when asked)
     assert got is not None and got[1].counts["satisfied"] == 300
     assert stats["batched"] == 300 and heard == {"r": 300, "out": 300, "noise": 300}
     assert kinds and set(kinds) == {"LogBlock"}, kinds  # the log's blocks, never events made one by one
