@@ -21,7 +21,7 @@ from rclverify.lang import ast
 from rclverify.lang import typeexpr
 from rclverify.lang.builder_types import TypeRules
 from rclverify.lang.errors import RclError, error
-from rclverify.lang.lark_children import _Spanned, _is_syntax, _vals
+from rclverify.lang.lark_children import _Spanned, _vals
 
 class ToAst(TypeRules, Transformer[Token, Any]):
     """Builds the immutable AST while the LALR parser reduces.

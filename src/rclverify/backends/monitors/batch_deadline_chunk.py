@@ -14,7 +14,7 @@ from rclverify.backends.monitors.deadline_records import Pending
 from rclverify.backends.monitors.time_margins import TimeMargin
 
 if TYPE_CHECKING:
-    from rclverify.backends.monitors.batch_deadlines import BatchDeadlines
+    from rclverify.backends.monitors.batch_deadline_state import ChunkSide
 
 _FIELDS, _TIME, _TOPIC = attrgetter("fields"), attrgetter("time"), attrgetter("topic")
 
@@ -27,7 +27,7 @@ def _headed(fields: list[Mapping[str, Any]]) -> bool:
     return False
 
 
-def judge_chunk(mon: BatchDeadlines, evs: list[Event]) -> bool:
+def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
     """Judge the events ``evs`` as the streaming monitor would, over columns, and leave its state;
     ``False`` (nothing changed) when the chunk is not clean."""
     plan = mon.plan
@@ -105,7 +105,7 @@ def judge_chunk(mon: BatchDeadlines, evs: list[Event]) -> bool:
     return True
 
 
-def _apply(mon: BatchDeadlines, evs: list[Event], ns: np.ndarray, rows: np.ndarray, which: np.ndarray,
+def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, which: np.ndarray,  # long: verdicts and state share ob
            due: np.ndarray, out_rows: np.ndarray, carried: list[Pending], L0: int, answer: np.ndarray,
            expiry: np.ndarray, met: np.ndarray, lapsed: np.ndarray,
            verdicts: tuple[np.ndarray, np.ndarray, np.ndarray], refused: np.ndarray,
@@ -191,7 +191,7 @@ def _apply(mon: BatchDeadlines, evs: list[Event], ns: np.ndarray, rows: np.ndarr
     mon.take_state(pending, expired, values, heard, int(ns[-1]))
 
 
-def _note_margins(mon: BatchDeadlines, evs: list[Event], ns: np.ndarray, which: np.ndarray, due: np.ndarray,
+def _note_margins(mon: ChunkSide, evs: list[Event], ns: np.ndarray, which: np.ndarray, due: np.ndarray,
                   ob: Callable[[int], Pending],
                   verdicts: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
     """Each guarantee's time margins of the chunk's verdicts, as :func:`.time_margins.note` counts them one by

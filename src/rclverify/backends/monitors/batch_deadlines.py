@@ -42,23 +42,22 @@ is counted); every ``false`` and late answer goes through the monitor's own
 """
 from __future__ import annotations
 
-from collections import deque
 from typing import Callable, Mapping
 
 from rclverify.core.extras import installed
-from rclverify.semantics.floatsem import Tolerance, judge
+from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
-from rclverify.traces.mapping import TopicRule, map_value, rule_for
-from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
-from rclverify.backends.monitors.deadline_text import ms, ms_ns
+from rclverify.traces.mapping import TopicRule
+from rclverify.backends.monitors.batch_deadline_state import ChunkSide
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 
 #: Events judged at once: the columns held.
 CHUNK = 16384
 
 
-class BatchDeadlines(DeadlineMonitor):
+class BatchDeadlines(ChunkSide):
     """A :class:`~.deadlines.DeadlineMonitor` that judges clean chunks over columns
     (module docstring); made by :func:`deadline_monitor` for an eligible node.
     ``stats``: ``batched`` and ``streamed`` events so far."""
@@ -111,63 +110,6 @@ class BatchDeadlines(DeadlineMonitor):
         """The events taken judged, then the run ended (:meth:`~.deadlines.DeadlineMonitor.finish`)."""
         self.flush()
         return super().finish()
-
-    # -- what the chunk judge gives the monitor ---------------------------------------------
-    def mapped(self, ev: Event, key: str) -> object:
-        """The value variable ``key`` takes from message ``ev`` as :meth:`feed` maps it."""
-        typ = self.node.inputs[key[3:]] if key.startswith("in.") else self.node.outputs[key[4:]]
-        fields = {k: v for k, v in ev.fields.items() if k != "header"}
-        return map_value(typ, fields, rule_for(self.rules, ev.topic, key), None)
-
-    def rejection(self, k: int, inputs: Mapping[str, object], out_key: str, out: Event) -> str:
-        """Why output ``out`` did not answer an obligation of guarantee ``k`` on ``inputs``
-        (:meth:`~.deadlines.DeadlineMonitor._try`'s words)."""
-        cl = self.node.node.guarantees[k - 1]
-        values = {**inputs, out_key: self.mapped(out, out_key)}
-        j = judge(cl.formula, self.checked, self.node, values, self.tolerance)
-        return f"the output at {out.where} did not satisfy guarantee {k}" + (
-            f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
-            f" ({j.reason})" if j.truth is None and j.reason else "")
-
-    def expired_verdict(self, p: Pending, now_ns: int) -> DeadlineVerdict:
-        """Obligation ``p``'s ``false``: the clock passed its deadline at ``now_ns`` unanswered."""
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                               f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
-                               f"(clock at {now_ns / 1e9:.3f} s)" + (f"; {p.rejected}" if p.rejected else ""))
-
-    def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float) -> DeadlineVerdict:
-        """Open obligation ``p`` answered by output ``ev`` stamped ``ns``: ``true`` within the deadline ``d``
-        (s), else ``false`` with the answer."""
-        if ns <= p.due_ns:
-            return DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                                   ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms(d)})",
-                                   semantics="exact", time_margin=(p.due_ns - ns) / 1e9)
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                               f"{ms_ns(ns - p.due_ns)} past the deadline of {ms(d)}",
-                               semantics="exact", time_margin=(p.due_ns - ns) / 1e9)
-
-    def late_verdict(self, p: Pending, ns: int, ev: Event) -> DeadlineVerdict:
-        """Expired obligation ``p``'s late answer ``ev`` stamped ``ns`` (an update of its ``false``)."""
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                               f"{ms_ns(ns - p.due_ns)} past the deadline of "
-                               f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
-                               time_margin=(p.due_ns - ns) / 1e9)
-
-    def take_state(self, pending: list[Pending], expired: list[Pending], values: Mapping[str, object],
-                   heard: list[tuple[int, Event, set[str], dict[str, object]]], now_ns: int) -> None:
-        """The state a clean chunk leaves: open and expired obligations, the latest values, the last
-        outputs heard, the clock."""
-        self.pending = pending
-        self.expired = deque(expired, maxlen=self.expired.maxlen)
-        for key, v in values.items():
-            self.values[key] = v
-            self.invalid.pop(key, None)
-        self.heard.extend(heard)
-        if self.now_ns is None or now_ns > self.now_ns:
-            self.now_ns = now_ns
-            self.now = now_ns / 1e9
 
 
 def deadline_monitor(checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
