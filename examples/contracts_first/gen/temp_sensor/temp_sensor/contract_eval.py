@@ -30,13 +30,21 @@ class Undecided(Exception):
     """The clause cannot be decided here (the reason in ``str``)."""
 
 
+def _undecided(reason):
+    """Raise :class:`Undecided` (a partial operator outside its domain: ``sqrt`` of a negative number)."""
+    raise Undecided(reason)
+
+
 # The operators, written from rclverify's semantics table (semantics/operators.py) when this
 # package was generated: each one's Python text, the connectives' short circuit, which
 # divisors of zero leave a formula undecided.
 _UNARY = {
     '-': lambda x: (-x),
     'abs': lambda x: abs(x),
+    'cos': lambda x: math.cos(x),
     'not': lambda x: (not x),
+    'sin': lambda x: math.sin(x),
+    'sqrt': lambda x: (math.sqrt(x) if x >= 0 else _undecided('square root of a negative number')),
 }
 _CMP = {
     '!=': lambda l, r: (l != r),
