@@ -159,3 +159,17 @@ def test_a_warm_run_on_a_plain_log_loads_no_heavy_part_and_a_cold_one_does(tmp_p
     code, printed_cold, loaded = _loaded(root, tmp_path / "cold")
     assert code == 1 and printed_cold == printed
     assert {"lark", "jsonschema", "rosbags.typesys.stores"} <= set(_heavy(loaded))
+
+
+def test_a_distributions_folder_is_found_by_its_normalised_name_on_the_first_path_entry(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A wheel's lower-case ``pyyaml-6.0.4.dist-info`` is ``PyYAML``'s, and the first ``sys.path`` entry
+    holding one decides, as importlib.metadata decides (an older ``PyYAML-6.0.dist-info`` on a later
+    entry, a system's, is not read); the control: the two entries the other way round."""
+    new, old = tmp_path / "venv", tmp_path / "system"
+    (new / "pyyaml-6.0.4.dist-info").mkdir(parents=True)
+    (old / "PyYAML-6.0.dist-info").mkdir(parents=True)
+    monkeypatch.setattr(sys, "path", [str(new), str(old)])
+    assert distribution_version("PyYAML") == "6.0.4"
+    monkeypatch.setattr(sys, "path", [str(old), str(new)])
+    assert distribution_version("PyYAML") == "6.0"

@@ -9,6 +9,7 @@ none of the evidence builder's dependencies (templates, bag readers).
 from __future__ import annotations
 
 import os
+import re
 import sys
 from typing import Any, Mapping
 
@@ -23,22 +24,35 @@ def tool_versions() -> str:
     return f"rclverify {__version__}, rosbags {found or '(not installed)'}"
 
 
+def _normal(name: str) -> str:
+    """A distribution's name as the binary distribution format compares it: runs of ``-``, ``_``
+    and ``.`` one ``_``, lower case (``PyYAML`` and a wheel's ``pyyaml-6.0.4.dist-info`` alike)."""
+    return re.sub(r"[-_.]+", "_", name).lower()
+
+
 def distribution_version(name: str) -> str | None:
-    """The version of the installed distribution ``name`` (a plain name: letters, digits, ``_``),
-    ``None`` when none is: the first ``<name>-<version>.dist-info`` folder on ``sys.path``, which is
-    how a wheel names it (the Python Packaging Authority's binary distribution format) and where
-    :func:`importlib.metadata.version` finds it first; else :func:`importlib.metadata.version`
-    itself (an egg or another finder), whose import and search cost about 0.04 CPU s of the
-    command's start-up, paid only then."""
-    prefix = f"{name}-"
+    """The version of the installed distribution ``name``, ``None`` when none is: from the first
+    ``sys.path`` entry holding its metadata, names compared normalised (:func:`_normal`), as
+    :func:`importlib.metadata.version` searches: a ``<name>-<version>.dist-info`` folder gives the
+    version (how a wheel names it, the Python Packaging Authority's binary distribution format);
+    an egg's metadata there, or none on any entry, is left to :func:`importlib.metadata.version`
+    itself, whose import and search cost about 0.04 CPU s of the command's start-up, paid only then."""
+    want = _normal(name)
     for entry in sys.path:
         try:
             names = os.listdir(entry or ".")
         except OSError:  # not a folder (a zip), or gone
             continue
         for n in names:
-            if n.startswith(prefix) and n.endswith(".dist-info") and "-" not in n[len(prefix):-10]:
-                return n[len(prefix):-10]
+            stem, dot, kind = n.rpartition(".")
+            dist, dash, ver = stem.partition("-")
+            if dot and dash and kind in ("dist-info", "egg-info") and _normal(dist) == want:
+                if kind == "dist-info" and "-" not in ver:
+                    return ver
+                break  # an egg's metadata: importlib.metadata reads it
+        else:
+            continue
+        break
     from importlib.metadata import PackageNotFoundError, version  # deferred: start-up (the distributions' search, only where no dist-info folder named it)
     try:
         return version(name)
