@@ -41,6 +41,8 @@ from typing import Callable, Sequence
 
 import z3
 
+from rclverify.semantics.subterms import subterms
+
 #: the relative (and absolute) half-width of the box around Python's ``math`` value in which a model's
 #: violation must persist to be confirmed (:func:`unconfirmed`)
 TOLERANCE = 1e-9
@@ -92,19 +94,7 @@ def applications(formulas: Sequence[z3.ExprRef]) -> tuple[list[z3.ExprRef], bool
 
 
 def _has_var(e: z3.ExprRef) -> bool:
-    stack, seen = [e], set()
-    while stack:
-        x = stack.pop()
-        if x.get_id() in seen:
-            continue
-        seen.add(x.get_id())
-        if z3.is_var(x):
-            return True
-        if z3.is_quantifier(x):
-            stack.append(x.body())
-        elif z3.is_app(x):
-            stack.extend(x.children())
-    return False
+    return any(z3.is_var(x) for x in subterms([e]))
 
 
 def facts(formulas: Sequence[z3.ExprRef]) -> list[z3.BoolRef]:
@@ -180,7 +170,7 @@ def unconfirmed(formulas: Sequence[z3.BoolRef], model: z3.ModelRef) -> str | Non
     subst: list[tuple[z3.ExprRef, z3.ExprRef]] = []
     box: list[z3.BoolRef] = []
     for k, app in enumerate(apps):
-        if any(_op(x) is not None for x in _subterms(app.arg(0))):
+        if any(_op(x) is not None for x in subterms([app.arg(0)])):
             return f"{why} and one is applied to another's value"
         x = _value(fixed.eval(app.arg(0), model_completion=True))
         op = _op(app)
@@ -208,30 +198,9 @@ def unconfirmed(formulas: Sequence[z3.BoolRef], model: z3.ModelRef) -> str | Non
     return f"{why}; confirming the model with Python's math values was undecided ({s.reason_unknown()})"
 
 
-def _subterms(e: z3.ExprRef) -> list[z3.ExprRef]:
-    out, stack = [], [e]
-    while stack:
-        x = stack.pop()
-        out.append(x)
-        if z3.is_app(x):
-            stack.extend(x.children())
-    return out
-
-
 def _constants(f: z3.ExprRef) -> list[z3.ExprRef]:
-    out, seen, stack = [], set(), [f]
-    while stack:
-        x = stack.pop()
-        if x.get_id() in seen:
-            continue
-        seen.add(x.get_id())
-        if z3.is_quantifier(x):
-            stack.append(x.body())
-        elif z3.is_app(x):
-            if x.num_args() == 0 and x.decl().kind() == z3.Z3_OP_UNINTERPRETED:
-                out.append(x)
-            stack.extend(x.children())
-    return out
+    return [x for x in subterms([f])
+            if z3.is_app(x) and x.num_args() == 0 and x.decl().kind() == z3.Z3_OP_UNINTERPRETED]
 
 
 __all__ = ["CONFIRM_RLIMIT", "TOLERANCE", "applications", "applies_math", "facts", "math_function", "transcendental",
