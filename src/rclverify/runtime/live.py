@@ -51,7 +51,7 @@ from rclverify.backends.monitors.summary import monitoring_details, summary_line
 from rclverify.backends.monitors.check import NodeResult, Verdict
 from rclverify.backends.monitors.deadline_records import DeadlineVerdict
 from rclverify.backends.monitors.judged import Heard, count_call_line, explain, not_judged
-from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC, unseen_links
+from rclverify.backends.monitors.run_origin import is_run_start, unseen_links
 from rclverify.runtime.lifecycle import LifecycleGate, gate_of
 from rclverify.runtime.live_status import LowMargins, least_margins, running_bound
 from rclverify.runtime.logchecks import LogChecks
@@ -226,7 +226,7 @@ class LiveRun:
         with self.lock:
             if self.results is None:
                 self._log.write(dumps(dict(obj)) + "\n")
-                if obj.get("topic") == ORIGIN_TOPIC and obj.get("kind") == "run":
+                if is_run_start(str(obj.get("topic")), obj):
                     for m in self.engine.monitors:  # first(in.x) decided from here on, as on the log (first_messages.py)
                         m.first.start()
                 self.checks.line(obj)

@@ -43,7 +43,7 @@ from rclverify.traces.mapping import MappingError, TopicRule, initial_value, rul
 from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.closing import Closing
 from rclverify.backends.monitors.engine_contract import ContractReading
-from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC
+from rclverify.backends.monitors.run_origin import is_run_start
 from rclverify.backends.monitors.judging import Judging
 from rclverify.backends.monitors.late import Late
 from rclverify.backends.monitors.needs_answer import answer_decides
@@ -182,7 +182,7 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
             self._expire(self.now)
         vs = self._feeds.get(ev.topic)
         if vs is None:
-            if ev.topic == ORIGIN_TOPIC and ev.fields.get("kind") == "run":
+            if is_run_start(ev.topic, ev.fields):
                 self.first.start()
             return
         self.result.events += 1

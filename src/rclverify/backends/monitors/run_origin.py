@@ -30,6 +30,12 @@ def origin_line(time: float, source: str, rmw: str, middleware: str) -> OriginLi
             "middleware": middleware}
 
 
+def is_run_start(topic: str, fields: Mapping[str, Any]) -> bool:
+    """Whether a log line of ``topic`` with ``fields`` is the start-of-run marker (:func:`origin_line`):
+    every message after it is in the recording, so ``first(in.x)`` is decided from it on."""
+    return topic == ORIGIN_TOPIC and fields.get("kind") == "run"
+
+
 def unseen_line(time: float, unseen: list[str]) -> UnseenLine:
     """The line a live run writes before it stops: ``unseen``, one sentence per link it could not hear."""
     return {"topic": ORIGIN_TOPIC, "time": time, "kind": "unseen", "unseen": list(unseen)}
@@ -78,4 +84,4 @@ def unseen_links(origin: Mapping[str, object] | None) -> dict[str, str]:
     return out
 
 
-__all__ = ["ORIGIN_TOPIC", "RunOrigin", "origin_line", "unseen_line", "unseen_links"]
+__all__ = ["ORIGIN_TOPIC", "RunOrigin", "is_run_start", "origin_line", "unseen_line", "unseen_links"]

@@ -75,7 +75,7 @@ from rclverify.backends.monitors.response_trace import ResponseTracker
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
 from rclverify.backends.monitors.declarations import call_part
 from rclverify.backends.monitors.trace_states import StepClock, TraceStates, cone_of
-from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC
+from rclverify.backends.monitors.run_origin import is_run_start
 from rclverify.calculus.requirements.published import first_inputs
 from rclverify.lang.types import Checked
 from rclverify.traces.events import Event
@@ -328,7 +328,7 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
             ev, part = call
         got = clock.tick(ev)
         if got is None:
-            if ev.topic == ORIGIN_TOPIC and ev.fields.get("kind") == "run":  # first(...) is decided after it
+            if is_run_start(ev.topic, ev.fields):  # first(...) is decided after it
                 st.start()
             continue
         k, later = got
