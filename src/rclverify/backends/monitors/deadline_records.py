@@ -7,7 +7,9 @@ Verdicts in ROSMonitoring's terms (:data:`DEADLINE_VERDICTS`; docs/monitors.md):
 ``true`` answered in time, ``false`` the deadline expired or the answer came
 late, ``currently_false`` not answered yet and the deadline not yet expired.
 A trigger the node's assumption does not accept gets no verdict and is
-counted by why (:data:`UNACCEPTED`).
+counted by why (:data:`UNACCEPTED`); so is an obligation left unanswered whose
+answer may be an output stamped within the transport skew before its trigger
+(``undecided``, :attr:`Pending.maybe`).
 """
 from __future__ import annotations
 
@@ -18,7 +20,8 @@ from rclverify.backends.monitors.shapes import DeadlineResultJson, DeadlineVerdi
 from rclverify.backends.monitors.time_margins import TimeMargin, note
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
-#: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`).
+#: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`): its assumption was false of
+#: its inputs, an input had no value yet, or its assumption or (the transport skew) its answer undecided.
 UNACCEPTED = ("assumption violated", "incomplete input", "undecided")
 
 
@@ -72,6 +75,10 @@ class Pending:
     #: the trigger's stamp and its deadline in integer nanoseconds: what the deadline is compared in
     stamp_ns: int = 0
     due_ns: int = 0
+    #: why an output stamped within the transport skew before the trigger may be its answer (it satisfies the
+    #: guarantee on the trigger's inputs); ``""``: none is.  Unanswered by its deadline, such an obligation is
+    #: ``undecided``, never ``false`` (docs/semantics.md, "Deadlines")
+    maybe: str = ""
 
 
 @dataclass

@@ -12,7 +12,10 @@ ROSMonitoring's terms:
 * ``true``: answered with a stamp ``<= t + d``;
 * ``false``: the deadline expired, the clock (the latest stamp seen, or a
   live monitor's timer) passed ``t + d`` with no answer; a late answer's
-  stamp is given when it came;
+  stamp is given when it came.  Where an output stamped within the
+  transport skew before the trigger satisfies the guarantee on its inputs
+  (it may be the trigger's answer), the obligation is ``undecided`` instead,
+  counted with the unaccepted triggers (:mod:`.deadline_skew`);
 * ``currently_false``: not answered yet and the deadline not yet expired (a
   run that ends then, or a live query before the deadline).
 
@@ -62,6 +65,7 @@ from rclverify.backends.monitors.verdicts import names
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import ms, ms_ns
+from rclverify.backends.monitors import deadline_skew
 
 
 class DeadlineMonitor:
@@ -118,6 +122,9 @@ class DeadlineMonitor:
         self.heard: deque[tuple[int, Event, set[str], dict[str, object]]] = deque(maxlen=64)
         self.now = float("-inf")
         self.now_ns: int | None = None
+        #: the mapping's transport skew in integer ns: an output stamped this much before a trigger may be its
+        #: answer (:mod:`.deadline_skew`; 0: none)
+        self.skew_ns = deadline_skew.skew_ns(rules)
         self.result = DeadlineResult(node.name)
         #: the ``false`` verdicts given, in order, by (trigger where, guarantee): the first still standing is
         #: the result's first (a false withdrawn by an answer stamped in time, :meth:`_met_late`)
@@ -195,6 +202,8 @@ class DeadlineMonitor:
                 d_ns = self.bounds_ns[k]
                 p = Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
                 if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
+                    if self.skew_ns:
+                        deadline_skew.scan_heard(self, p)
                     self.pending.append(p)
                 continue
             why, reason = refused
@@ -225,6 +234,8 @@ class DeadlineMonitor:
                 if ns <= p.due_ns:  # stamped within the deadline, heard after the clock passed it
                     self._met_late(p, ev, ns)
                     continue
+                if p.maybe:  # answered late, or in time by the output within the skew before it: still undecided
+                    continue
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
                                            ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
                                            f"{ms_ns(ns - p.due_ns)} past the deadline of "
@@ -242,6 +253,14 @@ class DeadlineMonitor:
         own stamp, as a run read in stamp order finds it (docs/semantics.md,
         "Event time": lateness never makes a violation).  The ``false`` given
         is withdrawn from the counts; the verdict that follows says why."""
+        if p.maybe:  # counted undecided, not false: now met on its own answer's stamp
+            deadline_skew.decided_late(self, p)
+            self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                                       ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline "
+                                       f"{ms_ns(p.due_ns - p.stamp_ns)}), heard after the clock had passed the "
+                                       "deadline: met on the answer's own stamp", time_margin=(p.due_ns - ns) / 1e9))
+            self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9)
+            return
         counts = self.result.counts
         counts["false"] -= 1
         counts["true"] += 1
@@ -265,7 +284,11 @@ class DeadlineMonitor:
         """Whether output ``ev`` (stamp ``ns``, setting ``outs``) answers obligation ``p``:
         its verdict given (``true``, or ``false`` when late), else ``False`` (still pending)."""
         k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
-        if not (gouts & outs) or ns < p.stamp_ns:
+        if not (gouts & outs):
+            return False
+        if ns < p.stamp_ns:  # stamped before the trigger: within the skew, it may be its answer (deadline_skew)
+            if deadline_skew.within_skew_before(self, p, ns):
+                deadline_skew.mark_early(self, p, ev, ns, {c: self.values[c] for c in outs if c not in self.state_outs})
             return False
         stamp = ns / 1e9
         j = judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance)
@@ -333,7 +356,10 @@ class DeadlineMonitor:
         now = self.now = now_ns / 1e9
         keep = []
         for p in self.pending:
-            if p.due_ns < now_ns:
+            if p.due_ns < now_ns and p.maybe:  # its answer may be the output within the skew before it
+                deadline_skew.undecided(self, p)
+                self.expired.append(p)
+            elif p.due_ns < now_ns:
                 self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
                                            f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
                                            f"(clock at {now:.3f} s)" + (f"; {p.rejected}" if p.rejected else "")))

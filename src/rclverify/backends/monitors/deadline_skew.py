@@ -1,0 +1,96 @@
+"""The transport skew in the deadline rule: an answer stamped just before its trigger.
+
+A monitor hears each topic over its own connection and stamps an unstamped
+message when its callback runs, so a node's answer can be stamped a little
+before the trigger it answers (seed 331 of the robot generator: a relay's
+``sensor_msgs/Range``, stamped by the relay as it published, 0.2-0.3 ms
+before the monitor received the unstamped reading it answers).  The
+mapping's ``skew`` (:mod:`.skew`) bounds how far apart two messages may be
+stamped in the other order than they were published, and the deadline rule
+reads it as the guarantee's pairing does (docs/semantics.md, "Transport
+skew" and "Deadlines"): a trigger stamped in ``(s, s + skew]`` after an
+output stamped ``s``, or at ``s`` but heard after it, may be the question that
+output answers.
+
+So an obligation (:class:`~.deadline_records.Pending`) for which such an output
+satisfies the guarantee, judged on the trigger's inputs, is marked
+(:attr:`~.deadline_records.Pending.maybe`): answered by an output of its own
+(stamped at or after the trigger) within the deadline it is ``true`` as
+before; left unanswered when the clock passes its deadline it is
+``undecided`` (counted with the unaccepted triggers, with why), never
+``false``: the skew makes no red and no green.  An output stamped more than
+the skew before the trigger is never its answer, and an obligation with no
+such output that goes unanswered is ``false`` as before.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Mapping
+
+from rclverify.semantics.floatsem import judge
+from rclverify.traces.events import Event
+from rclverify.backends.monitors.deadline_records import Pending
+from rclverify.backends.monitors.deadline_text import ms_ns
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.deadlines import DeadlineMonitor
+
+
+def skew_ns(rules: object) -> int:
+    """The transport skew the mapping's rules declare (``rules.skew``, s; none: 0), in integer ns."""
+    skew = getattr(rules, "skew", None)
+    return round(skew * 1_000_000_000) if isinstance(skew, (int, float)) and skew > 0 else 0
+
+
+def within_skew_before(mon: "DeadlineMonitor", p: Pending, ns: int) -> bool:
+    """Whether an output stamped ``ns`` (integer ns), heard before obligation ``p``'s trigger or stamped
+    before it, lies within the transport skew before the trigger: ``p.stamp_ns - skew <= ns <= p.stamp_ns``."""
+    return mon.skew_ns > 0 and p.stamp_ns - mon.skew_ns <= ns <= p.stamp_ns
+
+
+def mark_early(mon: "DeadlineMonitor", p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
+    """Output ``ev`` (stamped ``ns``, within the skew before ``p``'s trigger; ``fresh`` the outputs it set) may be
+    ``p``'s answer: mark ``p`` (:attr:`~.deadline_records.Pending.maybe`) when it satisfies ``p``'s guarantee on
+    the trigger's inputs.  The first such output is the one named."""
+    if p.maybe:
+        return
+    k, cl, _, gouts, _ = next(t for t in mon.timed if t[0] == p.k)
+    if not (gouts & set(fresh)):
+        return
+    values = mon._visible(p, ns / 1e9)
+    values.update(fresh)
+    if judge(cl.formula, mon.checked, mon.node, values, mon.tolerance).truth is True:
+        p.maybe = (f"the output at {ev.where}, stamped {ms_ns(p.stamp_ns - ns)} before the trigger (within the "
+                   f"transport skew of {ms_ns(mon.skew_ns)}), satisfies guarantee {k} on the trigger's inputs and may "
+                   "be its answer")
+
+
+def scan_heard(mon: "DeadlineMonitor", p: Pending) -> None:
+    """Mark ``p`` from the outputs already heard (the last 64 kept) stamped within the skew before its trigger."""
+    for ns, ev, _, fresh in mon.heard:
+        if within_skew_before(mon, p, ns):
+            mark_early(mon, p, ev, ns, fresh)
+            if p.maybe:
+                return
+
+
+def undecided(mon: "DeadlineMonitor", p: Pending) -> None:
+    """Obligation ``p``, marked, unanswered when the clock passed its deadline: ``undecided`` with why."""
+    res = mon.result
+    res.unaccepted["undecided"] += 1
+    if res.first_unaccepted is None:
+        res.first_unaccepted = {"guarantee": p.k, "where": p.trigger.where, "stamp": p.stamp, "why": "undecided",
+                                "reason": f"no answer of its own within the deadline of "
+                                          f"{ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}"}
+
+
+def decided_late(mon: "DeadlineMonitor", p: Pending) -> None:
+    """Marked obligation ``p``, counted ``undecided`` when its deadline passed, answered by an output of its own
+    stamped in time: no longer undecided (its ``true`` is given by the caller)."""
+    res = mon.result
+    res.unaccepted["undecided"] -= 1
+    first = res.first_unaccepted
+    if first is not None and first["where"] == p.trigger.where and first["why"] == "undecided":
+        res.first_unaccepted = None
+
+
+__all__ = ["decided_late", "mark_early", "scan_heard", "skew_ns", "undecided", "within_skew_before"]
