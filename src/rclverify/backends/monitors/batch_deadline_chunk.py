@@ -86,6 +86,8 @@ def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
     met = is_open & (answer >= 0) & ((expiry >= n) | (answer <= expiry))
     lapsed = is_open & ~met & (expiry < n)
     late = (~is_open | lapsed) & (answer >= 0)
+    if mon.skew_ns and _skew_early(mon, ns, rows, which, inputs, out_rows, col_out, carried, ~met, lapsed | late):
+        return False  # an answer within the transport skew before its trigger: the streaming monitor's (deadline_skew)
     order = np.arange(m) - L0  # an open obligation's place in the monitor's list (the expired: below 0)
     # each verdict as (row, phase, place): late answers of expired obligations (0), answers (1), expiries (2)
     ev_at = np.concatenate([answer[late], answer[met], expiry[lapsed]])
@@ -103,6 +105,42 @@ def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
     _apply(mon, evs, ns, rows, which, due, out_rows, carried, L0, answer, expiry, met, lapsed,
            (ev_at, ev_phase, ev_ob), refused, first_refused)
     return True
+
+
+def _skew_early(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, which: np.ndarray, inputs: np.ndarray,
+                out_rows: np.ndarray, col_out: np.ndarray, carried: list[Pending], unmet: np.ndarray,
+                decided: np.ndarray) -> bool:
+    """Whether the transport skew's rule (:mod:`.deadline_skew`) touches the chunk: an obligation carried in
+    marked as maybe answered before its trigger is decided in it, or a trigger of the chunk not met in it has an
+    output stamped within the skew before it (an earlier chunk's, or one of the chunk's on which its guarantee
+    holds or is not surely decided).  Such a chunk is streamed."""
+    if any(p.maybe for i, p in enumerate(carried) if bool(decided[i])):
+        return True
+    idx = np.flatnonzero(unmet & (rows >= 0))
+    if not idx.size:
+        return False
+    trig = rows[idx]
+    lo_ns = ns[trig] - mon.skew_ns
+    if mon.heard and mon.heard[-1][0] >= int(lo_ns.min()):
+        return True
+    lo = np.searchsorted(ns[out_rows], lo_ns, side="left")
+    hi = np.searchsorted(out_rows, trig, side="left")
+    ik, ok = mon.plan.in_key, mon.plan.out_key
+    step = 0
+    while True:
+        pos = lo + step
+        has = pos < hi
+        if not bool(has.any()):
+            return False
+        at, obs = pos[has], idx[has]
+        for g, (_, _, _, judge) in enumerate(mon.plan.timed):
+            sel = np.flatnonzero(which[obs] == g)
+            if judge is None or not sel.size:
+                continue
+            truth, sure = judge({ik: inputs[obs[sel]], ok: col_out[at[sel]]})
+            if bool(np.broadcast_to(truth, sel.shape).any()) or not bool(np.broadcast_to(sure, sel.shape).all()):
+                return True
+        step += 1
 
 
 def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, which: np.ndarray,  # long: verdicts and state share ob
