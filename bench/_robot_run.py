@@ -119,6 +119,12 @@ def offline_counts(rows: list[dict[str, Any]]) -> dict[str, Counter[str]]:
             if key in r:
                 c["deadline true"] += r[key]["counts"].get("true", 0)
                 c["deadline false"] += r[key]["counts"].get("false", 0) + r[key]["counts"].get("currently_false", 0)
+                # no verdict, with why (an answer within the transport skew before its trigger; a call's
+                # deadline not yet due): no live line says it, so it is counted offline only
+                c["deadline undecided"] += (r[key].get("unaccepted") or {}).get("undecided", 0)
+                first = r[key].get("first_unaccepted") or {}
+                if first.get("why") == "undecided":
+                    c["deadline undecided why: " + str(first.get("reason"))] += 0
     return out
 
 
@@ -310,6 +316,9 @@ def _line(res: dict[str, Any]) -> str:
     tot = Counter[str]()
     for c in res["live"].values():
         tot.update(c)
+    undecided = {n: c["deadline undecided"] for n, c in res.get("log", {}).items() if c.get("deadline undecided")}
+    why = sorted({k.split(": ", 1)[1] for c in res.get("log", {}).values() for k in c
+                  if k.startswith("deadline undecided why: ")})
     clock = res.get("clock")
     return (f"seed {res['seed']}{' defect' if res['defect'] else ''}: {res['nodes']} nodes, source "
             f"{res.get('source', 'dds')}, " + (f"/clock x{clock['rate']:g} from {clock['start_s']:g} s" if clock
@@ -317,11 +326,14 @@ def _line(res: dict[str, Any]) -> str:
             f"{tot['satisfied']}, violated {tot['violated']}, undecided {tot['undecided']}, deadlines true "
             f"{tot['deadline true']} false {tot['deadline false']}"
             + (f" ({tot['deadline updates']} false withdrawn by a late answer stamped in time)"
-               if tot["deadline updates"] else "") + "; "
+               if tot["deadline updates"] else "")
+            + (f", undecided {sum(undecided.values())} (log: " + ", ".join(f"{n} {k}" for n, k in undecided.items())
+               + ")" if undecided else "") + "; "
             f"{'agree' if not res['findings'] else 'FINDINGS: ' + '; '.join(res['findings'])}"
             + ("; " + "; ".join(res["errors"]) if res["errors"] else "")
             + "".join(f"\n  other clock: {c}" for c in res.get("other_clocks", []))
             + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items())
+            + "".join(f"\n  deadline undecided (first, log): {w}" for w in why)
             + "".join(f"\n  violated: {e}" for e in res.get("explained", [])))
 
 
@@ -340,6 +352,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
     if burn:
         burner = subprocess.Popen([sys.executable, "-c", "while True: pass"], start_new_session=True)
     total = Counter[str]()
+    undecided = 0  # deadlines given no verdict, counted offline on the logs
     failing: list[int] = []
     agree = 0
     try:
@@ -361,6 +374,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             print(_line(res), flush=True)
             for c in res["live"].values():
                 total.update(c)
+            undecided += sum(c["deadline undecided"] for c in res["log"].values())
             if res["findings"] or res["errors"]:
                 failing.append(seed)
             agree += not any(" != " in f for f in res["findings"]) and not res["errors"]
@@ -370,6 +384,6 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
     print(f"robot generator: {len(seeds)} system(s){' with a seeded defect' if defect else ''}, "
           f"{'one CPU burner beside, ' if burn else ''}load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} "
           f"core(s): live satisfied {total['satisfied']}, violated {total['violated']}, undecided "
-          f"{total['undecided']}, deadlines true {total['deadline true']} false {total['deadline false']}; "
-          f"seeds with findings: {failing or 'none'}; live = log = bag on {agree} of {len(seeds)}")
+          f"{total['undecided']}, deadlines true {total['deadline true']} false {total['deadline false']} "
+          f"(undecided on the logs: {undecided}); seeds with findings: {failing or 'none'}; live = log = bag on {agree} of {len(seeds)}")
     return 0
