@@ -55,9 +55,9 @@ def _matrix_ids(root: Path) -> set[str]:
     """The requirement ids of the trace matrix (``rclverify standards --trace``) of ``root``'s report; a
     FRET requirement's is its reqid, and the assertion names any id that is neither the export's nor the
     plan's own."""
-    from rclverify.report.build import undiagnosed_report
+    from rclverify.report.build import build_report
     from rclverify.report.standards_sheets import trace_rows
-    rows = trace_rows(undiagnosed_report(Workspace(root, "contracts/plan.yaml")))
+    rows = trace_rows(build_report(Workspace(root, "contracts/plan.yaml")))
     assert rows[0][:2] == ["requirement", "requirement verdict"]
     ids = {r[0] for r in rows[1:] if r[0]}
     export = json.loads((root / "fret" / "rover_requirements.json").read_text(encoding="utf-8"))
@@ -105,9 +105,9 @@ def _compliance_ids(root: Path, export: dict[str, Any]) -> set[str]:
     items of ``root``'s report; a FRET requirement's is its reqid.  An id that is neither ``export``'s nor
     the plan's own fails the assertion at its row (``compliance matrix row N (clause C)``)."""
     import re
-    from rclverify.report.build import undiagnosed_report
+    from rclverify.report.build import build_report
     from rclverify.report.standards_sheets import matrix_rows
-    rows = matrix_rows(undiagnosed_report(Workspace(root, "contracts/plan.yaml")))
+    rows = matrix_rows(build_report(Workspace(root, "contracts/plan.yaml")))
     col, clause = rows[0].index("items in scope and their state"), rows[0].index("clause")
     known = {r["reqid"] for r in export["requirements"]} | {"CAP"}
     ids: set[str] = set()

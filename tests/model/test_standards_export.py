@@ -18,6 +18,7 @@ from rclverify.report.standards_export import (MATRIX_COLUMNS, TRACE_COLUMNS, ga
 from rclverify.report.standards_rows import standards_part
 
 from test_standards_scope import Report
+from _typed_rows import typed_report
 
 #: a workspace profile whose title reads like a spreadsheet formula
 FORMULA = parse_profile("""id: t
@@ -54,7 +55,7 @@ def _read_csv(path: Path) -> list[dict[str, str]]:
 
 def test_the_compliance_matrix_reads_back_from_csv(tmp_path: Path) -> None:
     report = _report()
-    write_csv(tmp_path / "m.csv", matrix_rows(report))
+    write_csv(tmp_path / "m.csv", matrix_rows(typed_report(report)))
     rows = _read_csv(tmp_path / "m.csv")
     assert list(rows[0]) == list(MATRIX_COLUMNS)
     iec = load_builtin("iec61508-3")
@@ -74,13 +75,14 @@ def test_the_compliance_matrix_reads_back_from_csv(tmp_path: Path) -> None:
 
 
 def test_the_trace_matrix_reads_back_from_csv(tmp_path: Path) -> None:
-    write_csv(tmp_path / "t.csv", trace_rows(_report()))
+    write_csv(tmp_path / "t.csv", trace_rows(typed_report(_report())))
     rows = _read_csv(tmp_path / "t.csv")
     assert list(rows[0]) == list(TRACE_COLUMNS)
     stop = [(r["node"], r["guarantee"], r["obligation"], r["evidence status"]) for r in rows if r["requirement"] == "STOP"]
     assert stop == [("Lidar", "g1", "Lidar.g1.property_tests.e0", "discharged"),
                     ("Base", "g1", "Base.g1.property_tests.e1", "discharged"),
-                    ("Base", "g1", "Base.g1.review.e3", "discharged")]
+                    ("Base", "g1", "Base.g1.review.e3", "discharged"),
+                    ("", "", "requirement STOP", "discharged")]  # its own check's row (every row has a check record)
     untraced = [(r["node"], r["guarantee"], r["evidence status"]) for r in rows if r["requirement"] == ""]
     assert untraced == [("Base", "g2", "failed")]  # a guarantee no requirement names is still traced to its evidence
 
@@ -88,25 +90,25 @@ def test_the_trace_matrix_reads_back_from_csv(tmp_path: Path) -> None:
 def test_the_workbook_opens_with_openpyxl_and_keeps_text_as_text(tmp_path: Path) -> None:
     openpyxl = pytest.importorskip("openpyxl")
     report = _report()
-    write_xlsx(tmp_path / "w.xlsx", {"compliance matrix": matrix_rows(report), "trace matrix": trace_rows(report)})
+    write_xlsx(tmp_path / "w.xlsx", {"compliance matrix": matrix_rows(typed_report(report)), "trace matrix": trace_rows(typed_report(report))})
     wb = openpyxl.load_workbook(tmp_path / "w.xlsx")
     assert wb.sheetnames == ["compliance matrix", "trace matrix"]
     sheet = wb["compliance matrix"]
     got = [[("" if c.value is None else str(c.value)) for c in row] for row in sheet.iter_rows()]
-    assert got == matrix_rows(report)
+    assert got == matrix_rows(typed_report(report))
     cell = sheet.cell(row=sheet.max_row, column=MATRIX_COLUMNS.index("what it asks") + 1)
     assert cell.value == '=HYPERLINK("x")' and cell.data_type == "s"  # never a formula
     assert [[("" if c.value is None else str(c.value)) for c in row] for row in wb["trace matrix"].iter_rows()] == (
-        trace_rows(report))
+        trace_rows(typed_report(report)))
 
 
 def test_the_gaps_name_each_clause_asked_and_not_covered() -> None:
-    lines = gaps(_report())
+    lines = gaps(typed_report(_report()))
     assert lines[0].startswith("IEC 61508-3:2010 SIL 2 (built-in profile): ")
     assert any(line.startswith("  B.8 6c [HR] Design review (a static analysis technique; by the tool's rule, by someone other than "
                               "the author): open: ")
                for line in lines)
-    assert gaps({"standards": []}) == []
+    assert gaps(typed_report({"standards": []})) == []
 
 
 def test_the_command_without_a_report_is_one_located_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -16,6 +16,7 @@ import pytest
 
 from rclverify.cli.commands import main
 from rclverify.report.standards_export import matrix_rows
+from _typed_rows import typed_report
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -121,11 +122,19 @@ def test_a_workspace_profile_file_changed_is_caught_and_the_report_as_verified_i
     ws = Path(shutil.copytree(verified, tmp_path / "ws"))
     assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 0  # the control
     report = json.loads((ws / "reports/assurance.json").read_text(encoding="utf-8"))
+    edition = report["standards"][0]["origin"]["edition"]
     report["standards"][0]["origin"] = {"kind": "workspace", "file": "std/mine.yaml", "sha256": "0" * 64}
     (ws / "std").mkdir()
     (ws / "std/mine.yaml").write_text("id: mine\n", encoding="utf-8")
-    (ws / "reports/assurance.json").write_text(json.dumps(report), encoding="utf-8")
     (ws / "m.csv").unlink()
+    # an origin without its edition is no standard's row: refused in one line before anything is compared
+    (ws / "reports/assurance.json").write_text(json.dumps(report), encoding="utf-8")
+    capsys.readouterr()
+    assert main(["standards", "-w", str(ws), "--csv", str(ws / "m.csv")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not an rclverify report" in err[0] and "edition" in err[0] and "Traceback" not in err[0]
+    report["standards"][0]["origin"]["edition"] = edition
+    (ws / "reports/assurance.json").write_text(json.dumps(report), encoding="utf-8")
     assert "built from another std/mine.yaml (sha256 000000000000..." in _refused(ws, capsys)
 
 
@@ -139,4 +148,4 @@ def test_without_openpyxl_the_workbook_is_one_line_naming_the_extra(tmp_path: Pa
         "error: an XLSX export of the compliance matrix needs rclverify's [xlsx] extra (openpyxl is not installed): "
         "pip install 'rclverify[xlsx]'"]
     r = cli_without("openpyxl", "standards", "-w", str(tmp_path), "--csv", str(tmp_path / "m.csv"))
-    assert r.returncode == 0 and len(_read_csv(tmp_path / "m.csv")) == len(matrix_rows(report)) - 1
+    assert r.returncode == 0 and len(_read_csv(tmp_path / "m.csv")) == len(matrix_rows(typed_report(report))) - 1

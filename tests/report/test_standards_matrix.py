@@ -25,6 +25,7 @@ from rclverify.report.standards_export import (FORMULA_START, escape_cell, evide
                                                matrix_rows, trace_rows, write_csv, write_xlsx)
 from rclverify.report.standards_rows import standards_part
 from rclverify.report.standards_sheets import MATRIX_COLUMNS, TRACE_COLUMNS
+from _typed_rows import typed_report
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -160,7 +161,7 @@ def test_a_plan_justification_starting_with_a_formula_reaches_the_csv_escaped(tm
     report["standards"] = standards_part([StandardChoice(load_builtin("iec61508-3"), "2",
                                                          Loc("contracts/plan.yaml", 4, 5),
                                                          clauses={"B.8 6c": note})], report)["rows"]
-    write_csv(tmp_path / "m.csv", matrix_rows(report))
+    write_csv(tmp_path / "m.csv", matrix_rows(typed_report(report)))
     with (tmp_path / "m.csv").open(newline="", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
     b86c = next(r for r in rows if r["clause"] == "B.8 6c")
@@ -188,15 +189,15 @@ def _export(root: Path, report: dict[str, Any], csv_: Path | None = None, trace:
             xlsx: Path | None = None) -> None:
     """What ``rclverify standards`` writes for ``report`` (cli/standards.py), without its freshness check,
     which a hand-made report cannot pass (tested below on a verified workspace)."""
-    header = export_header(root, report)
-    matrix = matrix_rows(report, evidence_digests(root, report))
+    header = export_header(root, typed_report(report))
+    matrix = matrix_rows(typed_report(report), evidence_digests(root, typed_report(report)))
     if csv_:
         write_csv(csv_, matrix, header)
     if trace:
-        write_csv(trace, trace_rows(report), header)
+        write_csv(trace, trace_rows(typed_report(report)), header)
     if xlsx:
         write_xlsx(xlsx, {"about this export": [["what", "value"], *header], "compliance matrix": matrix,
-                          "trace matrix": trace_rows(report)})
+                          "trace matrix": trace_rows(typed_report(report))})
 
 
 def _blocks(path: Path) -> tuple[list[list[str]], list[list[str]]]:
@@ -256,12 +257,12 @@ def test_the_workbook_has_the_header_sheet_and_text_cells(tmp_path: Path) -> Non
 def test_every_clause_of_the_stored_case_study_is_one_row_agreeing_with_the_json() -> None:
     with gzip.open(REPO / "tests" / "data" / "case-study-report.json.gz", "rt", encoding="utf-8") as f:
         report = json.load(f)
-    rows = matrix_rows(report)
+    rows = matrix_rows(typed_report(report))
     assert rows[0] == list(MATRIX_COLUMNS) and all(len(r) == len(MATRIX_COLUMNS) for r in rows)
     want = [(c["id"], c["status"], c["why"]) for s in report["standards"] for c in s["clauses"]]
     col = MATRIX_COLUMNS.index
     assert [(r[col("clause")], r[col("status")], r[col("why")]) for r in rows[1:]] == want
-    assert trace_rows(report)[0] == list(TRACE_COLUMNS)
+    assert trace_rows(typed_report(report))[0] == list(TRACE_COLUMNS)
 
 
 # --- the tool classification per chosen profile and level ----------------------------------------------------

@@ -5,6 +5,8 @@
 The tables are :mod:`rclverify.report.standards_sheets`' (the compliance matrix, the trace matrix, the
 header saying what they were read from).  Here:
 
+* :func:`read_typed`: the workspace's ``reports/assurance.json`` decoded once into the
+  :class:`~rclverify.records.report_record.AssuranceReport` every function here reads;
 * :func:`report_out_of_date`: why the written report no longer says what the workspace's files and
   recorded evidence give, compared by sha256 (``rclverify standards`` refuses to export it);
 * :func:`export_header` and :func:`evidence_digests`: the header and each evidence record's sha256,
@@ -26,7 +28,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify.core.atomic import atomic_write_bytes, atomic_write_text
-from rclverify.records.standards_rows import rows_of as standard_rows
+from rclverify.records.report_record import AssuranceReport
 from rclverify.report.standards_rows import origin_text
 from rclverify.report.standards_sheets import (MATRIX_COLUMNS, TRACE_COLUMNS, header_rows, matrix_rows,
                                                trace_rows)
@@ -51,7 +53,22 @@ def _digest(path: Path) -> str:
         return "missing"
 
 
-def report_out_of_date(ws: Any, report: Mapping[str, Any]) -> str | None:
+def read_typed(root: Path) -> AssuranceReport:
+    """``reports/assurance.json`` of the workspace ``root``, shape-checked
+    (:func:`rclverify.report.lastrun.read_report`) and decoded once.  Raises
+    :class:`~rclverify.lang.errors.RclError` located at the report when there is none, it is of another
+    shape, or a part does not decode into its record."""
+    import msgspec  # deferred: start-up (loads msgspec only when called)
+    from rclverify.report.lastrun import located, read_report  # deferred: start-up (the report's readers only when called)
+    data = read_report(root)
+    try:
+        return AssuranceReport.of(data)
+    except msgspec.ValidationError as exc:
+        raise located(root / REPORT, f"not an rclverify report: {exc}; run `rclverify verify` (or `doit verify`) "
+                                     "to write it again") from None
+
+
+def report_out_of_date(ws: Any, report: AssuranceReport) -> str | None:
     """Why ``reports/assurance.json`` of the workspace ``ws`` (a
     :class:`~rclverify.stages.workspace.Workspace`) no longer says what the workspace's files give,
     in one sentence, or ``None``.  Compared by content, never by modification time: each workspace
@@ -65,14 +82,14 @@ def report_out_of_date(ws: Any, report: Mapping[str, Any]) -> str | None:
     builds a report is a reason too (the first of its errors)."""
     from rclverify.lang.errors import RclError  # deferred: start-up (the rebuild only where an export is asked)
     from rclverify.report.build import build_report  # deferred: start-up (loads the report's passes only when called)
-    for s in report.get("standards") or ():
-        origin = s.get("origin") or {}
-        if origin.get("kind") == "workspace":
-            was, now = str(origin.get("sha256")), _digest(ws.root / str(origin.get("file")))
+    for s in report.standards:
+        origin = s.origin
+        if origin.kind == "workspace":
+            was, now = origin.sha256, _digest(ws.root / origin.file)
             if was != now:
-                return (f"the report was built from another {origin.get('file')} (sha256 {was[:12]}..., now "
+                return (f"the report was built from another {origin.file} (sha256 {was[:12]}..., now "
                         f"{now[:12]}...): {_AGAIN}")
-    was_inputs = (report.get("meta") or {}).get("inputs_sha256")
+    was_inputs = report.meta.inputs_sha256
     if not was_inputs:
         return f"the report records no inputs sha256 (written by an earlier rclverify): {_AGAIN}"
     try:
@@ -83,8 +100,8 @@ def report_out_of_date(ws: Any, report: Mapping[str, Any]) -> str | None:
     now_inputs = built.meta.inputs_sha256
     if now_inputs != was_inputs:
         return (f"the report was built from other inputs than the workspace holds now (inputs sha256 "
-                f"{str(was_inputs)[:12]}..., now {now_inputs[:12]}...): {_AGAIN}")
-    stated = {str(o.get("id")): o.get("status") for o in report.get("obligations") or ()}
+                f"{was_inputs[:12]}..., now {now_inputs[:12]}...): {_AGAIN}")
+    stated = {o.id: o.status for o in report.obligations}
     changed = sorted(o.id for o in built.obligations if stated.get(o.id) != o.status)
     if changed:
         return (f"{len(changed)} obligation(s) have another status in the recorded evidence than in the report "
@@ -96,14 +113,13 @@ def report_out_of_date(ws: Any, report: Mapping[str, Any]) -> str | None:
 _AGAIN = "run `rclverify verify` and export again"
 
 
-def evidence_digests(root: Path, report: Mapping[str, Any]) -> dict[str, str]:
+def evidence_digests(root: Path, report: AssuranceReport) -> dict[str, str]:
     """Obligation -> hex sha256 of its evidence record file ``artifacts/evidence/<id>.json`` (``missing``
     when it cannot be read), for each evidence row of ``report``."""
-    return {str(e.get("obligation")): _digest(root / "artifacts/evidence" / f"{e.get('obligation')}.json")
-            for e in report.get("evidence") or ()}
+    return {e.obligation: _digest(root / "artifacts/evidence" / f"{e.obligation}.json") for e in report.evidence}
 
 
-def export_header(root: Path, report: Mapping[str, Any]) -> list[list[str]]:
+def export_header(root: Path, report: AssuranceReport) -> list[list[str]]:
     """The header of an export of the workspace ``root``'s ``report`` (:func:`~.standards_sheets.header_rows`),
     with the report file's sha256 and modification time and the plan's and contracts' sha256."""
     path = root / REPORT
@@ -111,8 +127,7 @@ def export_header(root: Path, report: Mapping[str, Any]) -> list[list[str]]:
         when = datetime.fromtimestamp(path.stat().st_mtime, timezone.utc).isoformat(timespec="seconds")
     except OSError:
         when = "unknown"
-    meta = report.get("meta") or {}
-    files = [str(meta.get("plan", "")), *(str(c) for c in meta.get("contracts") or ())]
+    files = [report.meta.plan, *report.meta.contracts]
     return header_rows(report, _digest(path), when, {f: _digest(root / f) for f in files if f})
 
 
@@ -161,11 +176,11 @@ def write_xlsx(path: Path, sheets: Mapping[str, list[list[str]]]) -> None:
     atomic_write_bytes(path, buf.getvalue(), named=True)
 
 
-def gaps(report: Mapping[str, Any]) -> list[str]:
+def gaps(report: AssuranceReport) -> list[str]:
     """The standards' gaps in a few lines: per standard, its counts and the clauses it asks at the level
     that are not covered, each with its why (empty when the report maps no standard)."""
     out = []
-    for standard in standard_rows(report.get("standards") or ()):
+    for standard in report.standards:
         level = "" if standard.level is None else f" {standard.level_name.upper()} {standard.level}"
         counts = ", ".join(f"{n} {k}" for k, n in standard.counts.items() if n)
         out.append(f"{standard.edition}{level} ({origin_text(standard.origin)}): {counts}")
@@ -177,5 +192,5 @@ def gaps(report: Mapping[str, Any]) -> list[str]:
     return out
 
 
-__all__ = ["FORMULA_START", "MATRIX_COLUMNS", "REPORT", "TRACE_COLUMNS", "escape_cell", "evidence_digests",
+__all__ = ["FORMULA_START", "MATRIX_COLUMNS", "REPORT", "TRACE_COLUMNS", "escape_cell", "evidence_digests", "read_typed",
            "export_header", "gaps", "matrix_rows", "report_out_of_date", "trace_rows", "write_csv", "write_xlsx"]

@@ -13,15 +13,21 @@ that identifies what they were read from (docs/standards.md, "Exports").
   the guarantees no requirement names, each requirement's own proof with the premises it used, and each
   side condition; every row names the standards' clauses it helps cover.
 
-Pure readings of a report dict (``reports/assurance.json``) and of the digests given; nothing raises for
-a well-formed report.
+Pure readings of the decoded report (:class:`~rclverify.records.report_record.AssuranceReport`, the
+attributes mypy checks) and of the digests given; nothing raises.  The fields of a standard's row and of
+a clause's row the exports do not show are named, with the reason, in
+:data:`~rclverify.records.standards_rows.EXPORTS_INTERNAL` and ``CLAUSE_EXPORTS_INTERNAL``
+(tests/records/test_record_shapes.py).
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Mapping
 
 from rclverify.model.plan.standards.field_data import figures
-from rclverify.records.standards_rows import ClauseRow, ProfileOrigin, StandardRow, rows_of as standard_rows
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.standards_rows import ClauseRow, ProfileOrigin, StandardRow
 
 #: The compliance matrix's columns.
 MATRIX_COLUMNS: tuple[str, ...] = (
@@ -45,68 +51,74 @@ def origin_cell(o: ProfileOrigin) -> str:
     return f"workspace file {o.file} sha256 {o.sha256}"
 
 
-def header_rows(report: Mapping[str, Any], report_sha256: str, written: str,
+def header_rows(report: AssuranceReport, report_sha256: str, written: str,
                 files_sha256: Mapping[str, str]) -> list[list[str]]:
     """The header of an export of ``report``: ``[what, value]`` rows (the module docstring).
     ``report_sha256``: the hex sha256 of the report file's bytes; ``written``: when it was written
     (ISO 8601, UTC); ``files_sha256``: workspace-relative file -> hex sha256 of the plan and contract
     files now (``"missing"`` for one that is gone)."""
-    meta = report.get("meta") or {}
-    solvers = (report.get("summary") or {}).get("solvers") or {}
+    meta = report.meta
+    solvers = report.summary.solvers
     rows = [["read from", "reports/assurance.json"], ["report sha256", report_sha256],
-            ["report written (UTC)", written], ["rclverify version", str(meta.get("version", ""))],
-            ["Z3 version", str(meta.get("z3_version", ""))],
+            ["report written (UTC)", written], ["rclverify version", meta.version],
+            ["Z3 version", meta.z3_version],
             ["second solver (cvc5)", ", ".join(f"{k}: {v}" for k, v in solvers.items()) or "not run"],
-            ["plan", f"{meta.get('plan', '')} sha256 {files_sha256.get(str(meta.get('plan', '')), 'missing')}"]]
-    rows += [["contract", f"{c} sha256 {files_sha256.get(str(c), 'missing')}"] for c in meta.get("contracts") or ()]
-    rows.append(["inputs sha256", str(meta.get("inputs_sha256", ""))])
-    for standard in standard_rows(report.get("standards") or ()):
+            ["plan", f"{meta.plan} sha256 {files_sha256.get(meta.plan, 'missing')}"]]
+    rows += [["contract", f"{c} sha256 {files_sha256.get(c, 'missing')}"] for c in meta.contracts]
+    rows.append(["inputs sha256", meta.inputs_sha256])
+    for standard in report.standards:
         rows.append(["standard", f"{standard.edition} ({standard.profile}): {origin_cell(standard.origin)}, "
                                  f"profile sha256 {standard.origin.sha256}"])
     rows.append(["note", "a traceability aid, not a compliance claim (docs/standards.md)"])
     return rows
 
 
-def _statistics(report: Mapping[str, Any], clause: ClauseRow) -> dict[str, str]:
+def _statistics(report: AssuranceReport, clause: ClauseRow) -> dict[str, str]:
     """The figures of the statistical targets in ``scope``, column by column, ``"; "``-joined."""
-    evidence = {str(e.get("obligation")): e for e in report.get("evidence") or ()}
-    req_runs = {f"target of requirement {rq.get('id')} ({t.get('environment')}, {t.get('origin')})": t
-                for rq in report.get("requirements") or () for t in rq.get("statistics") or ()}
+    evidence = _evidence(report)
+    req_runs = {f"target of requirement {rq.id} ({t.environment}, {t.origin})": t.to_json()
+                for rq in report.requirements for t in rq.statistics}
     found: list[dict[str, str]] = []
     for x in clause.scope:
         if x.kind != "target":
             continue
         item = x.item
-        stats = req_runs.get(item) or (evidence.get(item.removeprefix("target ")) or {}).get("statistics")
-        if isinstance(stats, Mapping):
+        ev = evidence.get(item.removeprefix("target "))
+        stats = req_runs.get(item) or (None if ev is None else ev.statistics)
+        if stats is not None:
             found.append(figures(stats))
     return {k: "; ".join(f[k] for f in found) for k in STAT_KEYS}
 
 
-def _covering(report: Mapping[str, Any], covered_by: list[str], digests: Mapping[str, str]) -> str:
+def _evidence(report: AssuranceReport) -> dict[str, EvidenceRow]:
+    """Obligation id -> its evidence row."""
+    return {e.obligation: e for e in report.evidence}
+
+
+def _covering(report: AssuranceReport, covered_by: list[str], digests: Mapping[str, str]) -> str:
     """The evidence that covers a clause: each record with its sha256 and the date its tool started."""
-    evidence = {str(e.get("obligation")): e for e in report.get("evidence") or ()}
+    evidence = _evidence(report)
     out = []
     for ob in covered_by:
-        e = evidence.get(str(ob))
-        said = [] if e is None else ([f"sha256 {digests[str(ob)]}"] if str(ob) in digests else []) + (
-            [f"started {e['started']}"] if e.get("started") else [])
-        out.append(f"{ob} ({', '.join(said)})" if said else str(ob))
+        e = evidence.get(ob)
+        said = [] if e is None else ([f"sha256 {digests[ob]}"] if ob in digests else []) + (
+            [f"started {e.started}"] if e.started else [])
+        out.append(f"{ob} ({', '.join(said)})" if said else ob)
     return "; ".join(out)
 
 
-def matrix_rows(report: Mapping[str, Any], digests: Mapping[str, str] | None = None) -> list[list[str]]:
+def matrix_rows(report: AssuranceReport, digests: Mapping[str, str] | None = None) -> list[list[str]]:
     """The compliance matrix of ``report``: :data:`MATRIX_COLUMNS` then one row per clause, standard by
     standard in the plan's order, clause by clause in the profile's.  ``digests``: obligation -> hex sha256
     of its evidence record file, shown beside each record that covers a clause with the time its tool
     started (an obligation without a digest is shown without one)."""
     out = [list(MATRIX_COLUMNS)]
-    for standard in standard_rows(report.get("standards") or ()):
+    for standard in report.standards:
         out += [_clause_row(report, standard, clause, digests or {}) for clause in standard.clauses]
     return out
 
 
-def _clause_row(report: Mapping[str, Any], standard: StandardRow, clause: ClauseRow,
+def _clause_row(report: AssuranceReport, standard: StandardRow, clause: ClauseRow,
                 digests: Mapping[str, str]) -> list[str]:
     """A clause's row of the compliance matrix (:data:`MATRIX_COLUMNS`)."""
     level = "" if standard.level is None else f"{standard.level_name.upper()} {standard.level}"
@@ -124,67 +136,67 @@ def _clause_row(report: Mapping[str, Any], standard: StandardRow, clause: Clause
             "" if clause.plan is None else str(clause.plan.at), "", ""]
 
 
-def _supports(report: Mapping[str, Any]) -> dict[str, list[str]]:
+def _supports(report: AssuranceReport) -> dict[str, list[str]]:
     """What covers an item of a clause (an obligation, a side condition, ``requirement <id>``) -> the
     clauses it helps cover, each as ``<edition> <clause>``."""
     out: dict[str, list[str]] = {}
-    for standard in standard_rows(report.get("standards") or ()):
+    for standard in report.standards:
         for clause in standard.clauses:
             for ob in clause.covered_by:
                 out.setdefault(ob, []).append(f"{standard.edition} {clause.id}")
     return out
 
 
-def trace_rows(report: Mapping[str, Any]) -> list[list[str]]:
+def trace_rows(report: AssuranceReport) -> list[list[str]]:
     """The trace matrix of ``report``: :data:`TRACE_COLUMNS` then requirement -> guarantee -> obligation ->
     evidence rows (a guarantee without an obligation, or an obligation without a record, is one row with
     the missing cells empty), the obligations of guarantees no requirement names, each requirement's
     proof by Z3 with the premises it used, and each side condition; each row with the clauses it helps
     cover."""
-    evidence = {str(e.get("obligation")): e for e in report.get("evidence") or ()}
-    guarantee_status = {(str(n.get("name")), int(g.get("index", 0))): str(g.get("status", ""))
-                        for n in report.get("nodes") or () for g in n.get("guarantees") or ()}
-    obligations: dict[tuple[str, int], list[Mapping[str, Any]]] = {}
-    for o in report.get("obligations") or ():
-        obligations.setdefault((str(o.get("node")), int(o.get("guarantee", 0))), []).append(o)
+    evidence = _evidence(report)
+    guarantee_status = {(n.name, g.index): g.status for n in report.nodes for g in n.guarantees}
+    obligations: dict[tuple[str, int], list[ObligationRow]] = {}
+    for o in report.obligations:
+        obligations.setdefault((o.node, o.guarantee), []).append(o)
     supports = _supports(report)
-    z3 = f"Z3 {(report.get('meta') or {}).get('z3_version', '')}".strip()
+    z3 = f"Z3 {report.meta.z3_version}".strip()
     out = [list(TRACE_COLUMNS)]
     traced: set[tuple[str, int]] = set()
 
     def rows_of(rid: str, verdict: str, key: tuple[str, int]) -> None:
-        obs = obligations.get(key, []) + ([] if key[1] == 0 else obligations.get((key[0], 0), []))
-        for o in obs or [{}]:
-            e = evidence.get(str(o.get("id")), {}) if o else {}
-            out.append([rid, verdict, key[0], f"g{key[1]}", guarantee_status.get(key, ""), str(o.get("id", "")),
-                        str(o.get("backend", "")), str(o.get("kind", "")), str(e.get("status", "")),
-                        _tool(e), "", "; ".join(supports.get(str(o.get("id", "")), []))])
+        obs: list[ObligationRow | None] = [*obligations.get(key, []),
+                                           *([] if key[1] == 0 else obligations.get((key[0], 0), []))]
+        for o in obs or [None]:
+            e = None if o is None else evidence.get(o.id)
+            oid = "" if o is None else o.id
+            out.append([rid, verdict, key[0], f"g{key[1]}", guarantee_status.get(key, ""), oid,
+                        "" if o is None else o.backend, "" if o is None else o.kind, "" if e is None else e.status,
+                        _tool(e), "", "; ".join(supports.get(oid, []))])
 
-    for rq in report.get("requirements") or ():
-        for sp in rq.get("support") or ():
-            key = (str(sp.get("node")), int(sp.get("guarantee", 0)))
+    for rq in report.requirements:
+        for sp in rq.support:
+            key = (sp.node, sp.guarantee)
             traced.add(key)
-            rows_of(str(rq.get("id")), str(rq.get("verdict", "")), key)
+            rows_of(rq.id, rq.verdict, key)
     for key in sorted(set(guarantee_status) - traced):
         rows_of("", "", key)
-    for rq in report.get("requirements") or ():
-        check = rq.get("check")
-        if not isinstance(check, Mapping):
-            continue
+    for rq in report.requirements:
+        check = rq.check  # the requirement check's record (calculus/requirements/check.py), JSON as written
         used = "; ".join(f"{u.get('label') or u.get('kind')}: {u.get('text', '')}" for u in check.get("used") or ()
                          if isinstance(u, Mapping))
-        out.append([str(rq.get("id")), str(rq.get("verdict", "")), ", ".join(map(str, check.get("cone") or ())), "",
-                    "", f"requirement {rq.get('id')}", "z3", "proof", str(rq.get("status", "")), z3, used,
-                    "; ".join(supports.get(f"requirement {rq.get('id')}", []))])
-    for sc in report.get("side_conditions") or ():
-        out.append(["", "", str(sc.get("node", "")), "", "", f"side condition {sc.get('id')}", "z3", "proof",
-                    str(sc.get("status", "")), z3, "", "; ".join(supports.get(str(sc.get("id")), []))])
+        out.append([rq.id, rq.verdict, ", ".join(map(str, check.get("cone") or ())), "",
+                    "", f"requirement {rq.id}", "z3", "proof", rq.status, z3, used,
+                    "; ".join(supports.get(f"requirement {rq.id}", []))])
+    for sc in report.side_conditions:
+        out.append(["", "", sc.node, "", "", f"side condition {sc.id}", "z3", "proof",
+                    sc.status, z3, "", "; ".join(supports.get(sc.id, []))])
     return out
 
 
-def _tool(e: Mapping[str, Any]) -> str:
-    """An evidence record's tool and version, the tool named once when the version starts with it."""
-    tool, version = str(e.get("tool", "")), str(e.get("tool_version", ""))
+def _tool(e: EvidenceRow | None) -> str:
+    """An evidence record's tool and version, the tool named once when the version starts with it
+    (``""`` without a record)."""
+    tool, version = ("", "") if e is None else (e.tool, e.tool_version)
     return version if version.startswith(tool) else f"{tool} {version}".strip()
 
 
