@@ -16,12 +16,12 @@ def cmd_standards(args: argparse.Namespace) -> int:
     it is of another shape, it no longer says what the workspace's files and recorded evidence give
     (:func:`~rclverify.report.standards_export.report_out_of_date`, by sha256), or openpyxl is missing for
     ``--xlsx``."""
-    from rclverify.report.lastrun import located, read_report  # deferred: start-up (loads the report's readers only when called)
+    from rclverify.report.lastrun import located  # deferred: start-up (loads the report's readers only when called)
     from rclverify.report.standards_export import (REPORT, evidence_digests, export_header, gaps, matrix_rows,  # deferred: start-up (the exports, only when called)
-                                                   report_out_of_date, trace_rows, write_csv, write_xlsx)
+                                                   read_typed, report_out_of_date, trace_rows, write_csv, write_xlsx)
     from rclverify.cli.common import workspace_of  # deferred: start-up
     root = Path(args.workspace)
-    report = read_report(root)
+    report = read_typed(root)
     if args.xlsx:  # a missing extra is said before the report is built again for the freshness check
         from rclverify.core.extras import require  # deferred: the optional extra is looked up only for an XLSX export
         require("openpyxl", "an XLSX export of the compliance matrix")
