@@ -377,8 +377,9 @@ def test_the_severity_table() -> None:
         "pass", "failure", "error", "failure", "skipped"]
     assert junit_outcome("health", "warning") == "failure" and junit_outcome("requirement", "informal") == "skipped"
     # a ROS grounding warning names software the contracts need not describe: it does not fail --strict
-    report = {"grounding": {"findings": [{"severity": "warning", "code": "ROS-NODE-NO-CONTRACT"},
-                                         {"severity": "error", "code": "ROS-NODE-NOT-IN-GRAPH"}]}}
+    from _typed_rows import typed_report
+    report = typed_report({"grounding": {"findings": [{"severity": "warning", "code": "ROS-NODE-NO-CONTRACT"},
+                                                      {"severity": "error", "code": "ROS-NODE-NOT-IN-GRAPH"}]}})
     assert blocking(report) == [("grounding", "ROS-NODE-NOT-IN-GRAPH", "error", "error")]
 
 

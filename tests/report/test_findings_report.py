@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import random
 
+from _typed_rows import typed_report
+
 from rclverify.records.records import SEVERITY, worst
 from rclverify.report.cones import CONE_NAMES, ConeEvidence
 from rclverify.report.summary_rows import headline as _headline
@@ -13,8 +15,9 @@ def test_headline_has_no_empty_fragments():
     h = _headline([], {}, [], [])
     assert h == "no obligations; no side conditions; no contract health problem."
     assert ": ;" not in h and "0 obligations" not in h
-    rows = [{"status": "pending"}]
-    h = _headline(rows, {"pending": 1}, [{"status": "discharged"}], [{"status": "problem"}])
+    r = typed_report({"obligations": [{"status": "pending"}], "side_conditions": [{"status": "discharged"}],
+                      "findings": [{"status": "problem"}]})
+    h = _headline(r.obligations, {"pending": 1}, r.side_conditions, r.findings)
     assert h == "1 obligation: 1 pending; 1/1 side conditions discharged; 1 contract health problem."
 
 

@@ -9,8 +9,11 @@ import json
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import pytest
 
+from _typed_rows import typed_report
+from rclverify.records.node_rows import CulpritOf
 from rclverify.report.argument.model import Argument, Element, propagate
 from rclverify.cli.commands import main
 from rclverify.report.culprits import marked_nodes
@@ -59,18 +62,19 @@ def test_no_culprit_reads_discharged(report: dict[str, Any]) -> None:
 
 
 def test_marked_nodes_raises_only_what_a_row_names() -> None:
-    rep: dict[str, Any] = {
+    rep = typed_report({
         "nodes": [{"name": "A", "status": "discharged", "guarantees": [{"index": 1, "status": "discharged"},
                                                                       {"index": 2, "status": "discharged"}]},
                   {"name": "B", "status": "discharged", "guarantees": [{"index": 1, "status": "discharged"}]}],
         "problems": [{"status": "problem", "sentence": "s", "culprits": [{"id": "guarantee:A:2"}]},
-                     {"status": "inconclusive", "sentence": "t", "culprits": [{"id": "assumption:B:1"}]}]}
-    given = json.dumps(rep, sort_keys=True)
-    a, b = marked_nodes(rep["nodes"], rep["problems"])
-    assert json.dumps(rep, sort_keys=True) == given  # new rows: the report's own rows are left as they were
-    assert a["status"] == "failed" and a["guarantees"][1]["status"] == "failed"
-    assert a["guarantees"][0]["status"] == "discharged" and "culprit_of" not in a["guarantees"][0]
-    assert b["status"] == "discharged"  # an assumption is where the victim is, not a culprit node
+                     {"status": "inconclusive", "sentence": "t", "culprits": [{"id": "assumption:B:1"}]}]})
+    given = msgspec.json.encode(rep.nodes)
+    a, b = marked_nodes(rep.nodes, rep.problems)
+    assert msgspec.json.encode(rep.nodes) == given  # new rows: the report's own are left as they were
+    assert a.status == "failed" and a.guarantees[1].status == "failed"
+    assert a.culprit_of == a.guarantees[1].culprit_of == [CulpritOf(status="failed", sentence="s")]
+    assert a.guarantees[0].status == "discharged" and a.guarantees[0].culprit_of is msgspec.UNSET
+    assert b == rep.nodes[1]  # an assumption is where the victim is, not a culprit node
 
 
 def test_a_defeated_goal_is_never_better_than_its_defeater() -> None:

@@ -22,9 +22,10 @@ docs/assurance.schema.json (records/report_schema.py).
 """
 from __future__ import annotations
 
-from typing import Any, Callable, NamedTuple
+from typing import Any, Callable, Mapping, NamedTuple, Sequence
 
 import msgspec
+from msgspec.structs import replace
 import z3
 
 from rclverify import __version__
@@ -36,7 +37,7 @@ from rclverify.records.node_rows import NodeRow
 from rclverify.records.problem_rows import ProblemRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.row import decode_rows
-from rclverify.records.summary_rows import Meta, SystemView
+from rclverify.records.summary_rows import Meta, Summary, SystemView
 from rclverify.report import assemble
 from rclverify.report.confidence_rows import confidence_part
 from rclverify.report.contract_rows import (GuaranteeStatuses, contract_records, derived_rows, environment_rows,
@@ -59,7 +60,7 @@ from rclverify.report.statistics import statistics_part
 from rclverify.report.summary_rows import grounding_problems, headline, problem_sentences, status_counts, strict_gate
 from rclverify.report.templating import anchor
 from rclverify.report.unverified import unverified_guarantees
-from rclverify.report.view import problem_items
+from rclverify.report.view import decoded_parts, problem_items
 from rclverify.stages.crosscheck.apply import SecondSolver, load as load_second_solver
 from rclverify.stages.design import blocks_strict as design_blocks, design_problems, design_row
 from rclverify.stages.diagnoses import read_diagnoses
@@ -146,36 +147,39 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
                     for k in range(1, len(cn.node.guarantees) + 1)))
 
 
-def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts) -> dict[str, Any]:
-    """The report of the row passes: meta, summary and system around ``rows``."""
-    node_status = facts.node_status
-    counts = status_counts(rows["obligations"])
-    overall = worst([r["status"] for r in rows["requirements"]] + list(node_status.values())
-                    + [d["status"] for d in rows["derived_properties"]] + instance_statuses(rows["instances"]))
-    strict_ok = strict_gate(rows, facts.guarantees_discharged, facts.deadlines_ok, rows["grounding"]) \
+#: The summary before the passes that write it: :func:`_first_report` puts its status, counts, problems
+#: and headline in, report/assemble.py the rest.
+_NO_SUMMARY = Summary(status="discharged", counts={}, problems=[], headline="", solvers={}, diagnoses=[])
+
+
+def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts) -> AssuranceReport:
+    """The report of the row passes: meta, summary and system around ``rows`` (the parts after them
+    empty, the summary's second solver and diagnoses too, until report/assemble.py puts them in)."""
+    plan = ws.plan
+    meta = Meta("rclverify", __version__, plan.name or ws.root.resolve().name, plan.file, list(plan.contracts),
+                z3.get_version_string(), False,
+                inputs_sha256(ws, inp.made_from, facts.evidence_inputs, facts.checks, nodl_inputs(ws, rows["nodl"])))
+    system = SystemView.of(ws.model.view(
+        facts.node_status, cycles_kept(ws.model, ws.path("artifacts/cache/system-cycles.pickle"))))
+    draft = AssuranceReport.of({"meta": meta, "summary": _NO_SUMMARY, "system": system, **rows, "statistics": [],
+                                "standards": [], "diagnoses": [], "problems": []})
+    counts = status_counts(draft.obligations)
+    overall = worst([r.status for r in draft.requirements] + list(facts.node_status.values())
+                    + [d.status for d in draft.derived_properties] + instance_statuses(rows["instances"]))
+    strict_ok = strict_gate(draft, facts.guarantees_discharged, facts.deadlines_ok) \
         and not nodl_blocks(rows["nodl"]) and not instances_block(rows["instances"]) and not design_blocks(rows["design"])
-    problems = problem_sentences(rows, facts.altered) + grounding_problems(rows["grounding"]) + nodl_problems(rows["nodl"]) \
+    problems = problem_sentences(draft, facts.altered) + grounding_problems(draft.grounding) + nodl_problems(rows["nodl"]) \
         + design_problems(rows["design"]) \
         + instance_problems(rows["instances"])
-    plan = ws.plan
-    return {
-        "meta": Meta("rclverify", __version__, plan.name or ws.root.resolve().name, plan.file, list(plan.contracts),
-                     z3.get_version_string(), strict_ok,
-                     inputs_sha256(ws, inp.made_from, facts.evidence_inputs, facts.checks,
-                                   nodl_inputs(ws, rows["nodl"]))).to_json(),
-        "summary": {"status": overall, "counts": counts, "problems": problems,
-                    "headline": headline(rows["obligations"], counts, rows["side_conditions"], rows["findings"],
-                                         rows["unverified"])},
-        "system": SystemView.of(ws.model.view(
-            node_status, cycles_kept(ws.model, ws.path("artifacts/cache/system-cycles.pickle")))).to_json(),
-        **rows,
-    }
+    summary = replace(_NO_SUMMARY, status=overall, counts=counts, problems=problems,
+                      headline=headline(draft.obligations, counts, draft.side_conditions, draft.findings,
+                                        draft.unverified))
+    return replace(draft, meta=replace(meta, strict_ok=strict_ok), summary=summary)
 
 
-def undiagnosed_report(ws: Workspace) -> dict[str, Any]:
-    """Read every artifact of ``ws`` and return the report dict up to its
-    diagnoses (what the diagnosis stage explains,
-    :func:`rclverify.app.pipeline.stage_diagnosis`).  The passes, in order:
+def undiagnosed_record(ws: Workspace) -> AssuranceReport:
+    """Read every artifact of ``ws`` and return the report up to its
+    diagnoses (``diagnoses``, ``problems`` and ``summary.diagnoses`` empty).  The passes, in order:
     the rows (:func:`_rows`), the summary around them, the statistics table
     (report/statistics.py, docs/statistics.md), the second solver's counts,
     strength and confidence (report/confidence_rows.py), the evidence
@@ -194,14 +198,31 @@ def undiagnosed_report(ws: Workspace) -> dict[str, Any]:
                                unstated_origins(e for es in plan.evidence.values() for e in es))
     report = assemble.with_standards(report, standards)
     # one severity per finding: --strict fails on every error and warning, health and lint warnings included
-    return assemble.with_strict(report, bool(report["meta"]["strict_ok"]) and confidence["ok"]
+    return assemble.with_strict(report, report.meta.strict_ok and confidence["ok"]
                                 and not inp.second.problem and not blocking(report)
                                 and standards["ok"])
 
 
-def diagnosed_report(report: dict[str, Any], diagnoses: list[dict[str, Any]] | None,
+def undiagnosed_json(report: AssuranceReport) -> dict[str, Any]:
+    """``report`` (:func:`undiagnosed_record`) as the JSON object the diagnosis stage reads and digests
+    (:func:`rclverify.stages.diagnoses.report_digest`): without ``diagnoses``, ``problems`` and
+    ``summary.diagnoses``."""
+    out: dict[str, Any] = msgspec.to_builtins(report)
+    del out["diagnoses"], out["problems"], out["summary"]["diagnoses"]
+    return out
+
+
+def undiagnosed_report(ws: Workspace) -> dict[str, Any]:
+    """The JSON object of :func:`undiagnosed_record` (:func:`undiagnosed_json`): what the diagnosis stage
+    explains (:func:`rclverify.app.pipeline.stage_diagnosis`).  Raises ``RclError`` for contracts or a
+    plan that do not check."""
+    return undiagnosed_json(undiagnosed_record(ws))
+
+
+def diagnosed_report(report: AssuranceReport | Mapping[str, Any], diagnoses: Sequence[Mapping[str, Any]] | None,
                      why: str = "") -> AssuranceReport:
-    """The finished report, decoded once into its record: ``report`` (:func:`undiagnosed_report`) with
+    """The finished report: ``report`` (:func:`undiagnosed_record`, or its JSON object
+    :func:`undiagnosed_report`, decoded here) with
     ``diagnoses`` (the diagnosis stage's records for it,
     :func:`rclverify.stages.diagnoses.read_diagnoses`), the problems grouped
     by root cause (report/problems.py) and the culprit nodes marked
@@ -210,26 +231,23 @@ def diagnosed_report(report: dict[str, Any], diagnoses: list[dict[str, Any]] | N
     sentence) is among ``summary.problems``.  Raises
     :class:`msgspec.ValidationError` (a ``ValueError``) for a part of
     another shape: a bug of the build, never shown."""
+    draft = decoded_parts(report)
     if diagnoses is None:
-        summary = {**report["summary"], "problems": list(report["summary"]["problems"]) + [f"Diagnoses: {why}"]}
-        report = {**report, "summary": summary}
-    report = assemble.with_diagnoses(report, list(diagnoses or []))
-    # every part but the problems, decoded once; the grouping and the marked nodes then replace two parts
-    draft = AssuranceReport.of(assemble.finished(report, [], report["nodes"]))
-    problems = group_problems(draft, problem_items(draft), anchor)
-    return msgspec.structs.replace(draft, problems=decode_rows(ProblemRow, problems),
-                                   nodes=decode_rows(NodeRow, marked_nodes(report["nodes"], problems)))
+        draft = replace(draft, summary=replace(draft.summary, problems=[*draft.summary.problems, f"Diagnoses: {why}"]))
+    draft = assemble.with_diagnoses(replace(draft, problems=[]), list(diagnoses or []))
+    problems = decode_rows(ProblemRow, group_problems(draft, problem_items(draft), anchor))
+    return replace(draft, problems=problems, nodes=marked_nodes(draft.nodes, problems))
 
 
 def build_report(ws: Workspace) -> AssuranceReport:
     """Read every artifact of ``ws`` and return the report (see render.py):
     an :class:`~rclverify.records.report_record.AssuranceReport`, the record
-    docs/assurance.schema.json is generated from: :func:`undiagnosed_report` with
+    docs/assurance.schema.json is generated from: :func:`undiagnosed_record` with
     the diagnosis stage's sealed record (artifacts/diagnosis/index.json)
     when it was made from that report, else with no diagnosis and a
     sentence saying why among ``summary.problems`` (the report diagnoses
     nothing itself: :func:`rclverify.app.pipeline.stage_report` runs the
     stage first).  Raises ``RclError`` for contracts or a plan that do not
     check."""
-    report = undiagnosed_report(ws)
-    return diagnosed_report(report, *read_diagnoses(ws, report))
+    report = undiagnosed_record(ws)
+    return diagnosed_report(report, *read_diagnoses(ws, undiagnosed_json(report)))

@@ -16,10 +16,12 @@ The rules and their sources: :mod:`rclverify.report.argument.confidence`, docs/c
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, TypedDict
+from typing import Mapping, TypedDict, cast
 
 import msgspec
 
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_rows import RequirementRow, StrengthKind
 from rclverify.records.strength_rows import LimitedBy, Strength
 from rclverify.report.shapes import Confidence, RequirementConfidence
 from rclverify.report.argument.confidence import (Claim, Premise, derived_claims, guarantee_premise, node_claims,
@@ -46,9 +48,8 @@ class ConfidencePart(TypedDict):
     """What the confidence pass adds to the report's rows (module docstring),
     by row: ``evidence``/``side_conditions``: one ``strength`` per row, in
     the report's order; ``guarantees``: node -> one ``strength`` per
-    guarantee (report/assemble.py writes each as its JSON object);
-    ``nodes``/``derived``/``requirements``: name or id -> the keys the row
-    gains, as JSON (``confidence``, ``limited_by``; a requirement also
+    guarantee; ``nodes``/``derived``/``requirements``: name or id -> the fields the row
+    gains (``confidence``, ``limited_by``; a requirement also
     ``required_strength`` and ``strength_shortfall``); ``problems``: one
     sentence per requirement short of its required strength; ``confidence``:
     the least confidence of the formal requirements (``None``: none);
@@ -64,7 +65,7 @@ class ConfidencePart(TypedDict):
     ok: bool
 
 
-def confidence_part(report: Mapping[str, Any], links: list[tuple[str, str]],
+def confidence_part(report: AssuranceReport, links: list[tuple[str, str]],
                     required: dict[str, str] | None = None) -> ConfidencePart:
     """The strength and confidence of ``report``'s rows (module docstring),
     as a part: the report is read, not changed (report/assemble.py puts the
@@ -75,22 +76,22 @@ def confidence_part(report: Mapping[str, Any], links: list[tuple[str, str]],
     part: ConfidencePart = {"evidence": [], "side_conditions": [], "guarantees": {}, "nodes": {}, "derived": {},
                             "requirements": {}, "problems": [], "confidence": None, "ok": True}
     by_ob: dict[str, list[Strength]] = {}
-    for e in report.get("evidence", []):
-        part["evidence"].append(evidence_strength(e))
-        by_ob.setdefault(str(e.get("obligation")), []).append(part["evidence"][-1])
-    status = {str(o.get("id")): str(o.get("status")) for o in report.get("obligations", [])}
+    for e in report.evidence:
+        part["evidence"].append(evidence_strength(e.to_json()))
+        by_ob.setdefault(e.obligation, []).append(part["evidence"][-1])
+    status = {o.id: str(o.status) for o in report.obligations}
     sc_premises: dict[str, list[Premise]] = {}
-    for sc in report.get("side_conditions", []):
-        part["side_conditions"].append(side_condition_strength(sc))
-        sc_premises.setdefault(str(sc.get("node")), []).append(
-            Premise(f"side condition {sc['id']}", "proof", part["side_conditions"][-1].doubt))
+    for sc in report.side_conditions:
+        part["side_conditions"].append(side_condition_strength(sc.to_json()))
+        sc_premises.setdefault(sc.node, []).append(
+            Premise(f"side condition {sc.id}", "proof", part["side_conditions"][-1].doubt))
     own: dict[str, list[Premise]] = {}
     guarantee: dict[tuple[str, int], Premise] = {}
-    for n in report.get("nodes", []):
-        name, ps = n["name"], []
-        for g in n.get("guarantees", []):
-            p = guarantee_premise(f"{name} guarantee {g['index']}", _legs(g.get("obligations", []), by_ob, status))
-            guarantee[(name, int(g["index"]))] = p
+    for n in report.nodes:
+        name, ps = n.name, []
+        for g in n.guarantees:
+            p = guarantee_premise(f"{name} guarantee {g.index}", _legs(g.obligations, by_ob, status))
+            guarantee[(name, g.index)] = p
             part["guarantees"].setdefault(name, []).append(Strength(kind=p.kind, doubt=p.doubt))
             ps.append(p)
         own[name] = ps + sc_premises.get(name, [])
@@ -99,23 +100,22 @@ def confidence_part(report: Mapping[str, Any], links: list[tuple[str, str]],
         if b in producers and a in own:
             producers[b].add(a)
     claims = node_claims(own)
-    part["nodes"] = {n["name"]: _put(claims[n["name"]]) for n in report.get("nodes", [])}
+    part["nodes"] = {n.name: _put(claims[n.name]) for n in report.nodes}
     derived = derived_claims(own, producers)
-    part["derived"] = {d["node"]: _put(derived[d["node"]]) for d in report.get("derived_properties", [])
-                       if d.get("node") in derived}
-    lows = [_requirement(rq, guarantee, sc_premises, (required or {}).get(str(rq["id"])), part)
-            for rq in report.get("requirements", []) if (rq.get("check") or {}).get("formal")]
+    part["derived"] = {d.node: _put(derived[d.node]) for d in report.derived_properties if d.node in derived}
+    lows = [_requirement(rq, guarantee, sc_premises, (required or {}).get(rq.id), part)
+            for rq in report.requirements if rq.check.get("formal")]
     if lows:
         part["confidence"] = min(lows)
     return part
 
 
-def _requirement(rq: Mapping[str, Any], guarantee: Mapping[tuple[str, int], Premise],
+def _requirement(rq: RequirementRow, guarantee: Mapping[tuple[str, int], Premise],
                  sc_premises: Mapping[str, list[Premise]], need: str | None, part: ConfidencePart) -> float:
     """Put a formal requirement's confidence (C5) and its shortfall of ``need`` into ``part``; its confidence."""
-    check = rq.get("check") or {}
+    check = rq.check  # the check record (free-form: calculus/requirements/check.py)
     two = (check.get("solvers") or {}).get("agreement") == "two solvers"
-    proof = Premise(f"the proof of {rq['id']}", "proof", DOUBT["proof2" if two else "proof"])
+    proof = Premise(f"the proof of {rq.id}", "proof", DOUBT["proof2" if two else "proof"])
     used: list[Premise] = []
     rests: list[Premise] = []  # the guarantees the proof used
     for p in check.get("used") or []:
@@ -125,23 +125,22 @@ def _requirement(rq: Mapping[str, Any], guarantee: Mapping[tuple[str, int], Prem
             used.extend(sc_premises.get(p["node"], []))
         else:
             used.append(Premise(str(p.get("label", p.get("kind"))), "assumed", DOUBT["assumed"]))
-    c = requirement_claim(rq.get("verdict") in _PROVED, proof, used)
-    row: RequirementConfidence = {}
+    c = requirement_claim(rq.verdict in _PROVED, proof, used)
+    required: StrengthKind | None = None
+    shortfall: list[str] = []
     if need in KINDS:
         short = [g for g in rests if g.doubt >= 1.0 or g.kind not in KINDS or KINDS.index(g.kind) > KINDS.index(need)]
-        row["required_strength"] = need
-        row["strength_shortfall"] = [f"{g.label} ({g.kind if g.doubt < 1.0 else 'nothing discharged'})" for g in short]
+        required = cast(StrengthKind, need)
+        shortfall = [f"{g.label} ({g.kind if g.doubt < 1.0 else 'nothing discharged'})" for g in short]
         if short:
             part["ok"] = False
-            part["problems"].append(f"Requirement {rq['id']} requires {need} evidence; " + ", ".join(
+            part["problems"].append(f"Requirement {rq.id} requires {need} evidence; " + ", ".join(
                 f"{g.label} rests on {g.kind if g.doubt < 1.0 else 'no discharged'} evidence" for g in short))
-    if c.limits is not None and rq.get("verdict") not in _PROVED:  # a claim always has its proof as a premise
-        conf = _put(c, f"{rq['id']} is {rq.get('verdict')}: no confidence rests on it")
+    if c.limits is not None and rq.verdict not in _PROVED:  # a claim always has its proof as a premise
+        conf = _put(c, f"{rq.id} is {rq.verdict}: no confidence rests on it")
     else:
-        conf = _put(c, None if c.limits is None else limit_sentence(rq["id"], c.limits))
-    row["confidence"] = conf["confidence"]
-    row["limited_by"] = conf["limited_by"]
-    part["requirements"][str(rq["id"])] = row
+        conf = _put(c, None if c.limits is None else limit_sentence(rq.id, c.limits))
+    part["requirements"][rq.id] = RequirementConfidence(conf.confidence, conf.limited_by, required, shortfall)
     return float(c.confidence)
 
 
@@ -168,9 +167,7 @@ def _legs(obligations: list[str], by_ob: dict[str, list[Strength]],
 
 def _put(c: Claim, sentence: str | None = None) -> Confidence:
     """A claim's ``confidence`` and ``limited_by`` (the premise with the largest doubt, named in
-    ``sentence`` when given: a requirement's) as row keys, their JSON."""
+    ``sentence`` when given: a requirement's), the row fields they set."""
     lim = c.limits
-    return {"confidence": c.confidence,
-            "limited_by": None if lim is None else LimitedBy(
-                label=lim.label, kind=lim.kind, doubt=lim.doubt,
-                sentence=msgspec.UNSET if sentence is None else sentence).to_json()}
+    return Confidence(c.confidence, None if lim is None else LimitedBy(
+        label=lim.label, kind=lim.kind, doubt=lim.doubt, sentence=msgspec.UNSET if sentence is None else sentence))

@@ -6,9 +6,11 @@ culprit are where the repair goes; the dashboard of the HTML report and the term
 """
 from __future__ import annotations
 
-from typing import Any, Iterable, Iterator, Mapping, Sequence, cast
+from typing import Any, Iterable, Iterator, Mapping, Sequence, TypeVar, cast
 
-from rclverify.records.node_rows import CulpritOf
+from msgspec.structs import replace
+
+from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
 from rclverify.records.problem_rows import ProblemRow
 from rclverify.records.records import SEVERITY, worst
 from rclverify.records.statuses import EvidenceStatus
@@ -47,31 +49,34 @@ def _status(word: Any) -> EvidenceStatus | None:
     return cast(EvidenceStatus, s) if s in SEVERITY else None  # SEVERITY ranks the evidence statuses
 
 
-def _blamed(problems: Iterable[Mapping[str, Any]]) -> Iterator[tuple[str, str, str, dict[str, Any]]]:
-    """``(kind, node, guarantee index or '', {"status", "sentence"})`` for each culprit a problem row blames
-    (the last a :class:`~rclverify.records.node_rows.CulpritOf`'s JSON object)."""
+def _blamed(problems: Iterable[ProblemRow]) -> Iterator[tuple[str, str, str, CulpritOf]]:
+    """``(kind, node, guarantee index or '', the problem as a culprit_of entry)`` for each culprit a problem
+    row blames."""
     for g in problems:
-        st = _status(g.get("status"))
-        if st is None or st == "discharged" or str((g.get("key") or [""])[0]).startswith("unverified:"):
+        st = _status(g.status)
+        if st is None or st == "discharged" or (g.key or [""])[0].startswith("unverified:"):
             continue  # an unverified guarantee's row: the guarantee reads "unverified" already
-        for c in g.get("culprits") or ():
+        for c in g.culprits:  # a culprit (free-form: report/problems_causes.py)
             kind, _, rest = str(c.get("id", "")).partition(":")
             name, _, k = rest.partition(":")
             if kind == "line":  # a line of a node's code: the node, no guarantee (problems.py)
                 kind, name = "contract", str(c.get("node") or "")
             if kind in ("guarantee", "contract"):
-                yield kind, name, k, CulpritOf(status=st, sentence=str(g.get("sentence", ""))).to_json()
+                yield kind, name, k, CulpritOf(status=st, sentence=g.sentence)
 
 
-def _marked(row: Mapping[str, Any], blame: Mapping[str, Any]) -> dict[str, Any]:
+R = TypeVar("R", NodeRow, GuaranteeRow)
+
+
+def _marked(row: R, blame: CulpritOf) -> R:
     """``row`` (a node or guarantee) with the status of the problem ``blame`` and the problem in ``culprit_of``."""
-    seen = list(row.get("culprit_of") or [])
+    seen = list(row.culprit_of or [])
     if blame not in seen:
-        seen.append(dict(blame))
-    return {**row, "status": worst([str(row.get("status") or "discharged"), blame["status"]]), "culprit_of": seen}
+        seen.append(blame)
+    return replace(row, status=worst([row.status, blame.status]), culprit_of=seen)
 
 
-def marked_nodes(nodes: Sequence[Mapping[str, Any]], problems: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
+def marked_nodes(nodes: Sequence[NodeRow], problems: Iterable[ProblemRow]) -> list[NodeRow]:
     """``nodes`` (the report's node rows) with every node and guarantee a
     problem blames given the status of that problem (a culprit
     never reads "discharged"; its own evidence may all hold, the problem it
@@ -79,18 +84,19 @@ def marked_nodes(nodes: Sequence[Mapping[str, Any]], problems: Iterable[Mapping[
     (:func:`rclverify.report.problems.group_problems`) and each culprit
     ``guarantee:Node:k`` or ``contract:Node`` of it (or a program line with
     its ``node``), the node's ``status`` (and the guarantee's) becomes the
-    worse of its own and the row's, and ``culprit_of`` lists ``{"status",
-    "sentence"}`` of the rows that name it.  New rows: ``nodes`` is left as
+    worse of its own and the row's, and ``culprit_of`` lists the
+    :class:`~rclverify.records.node_rows.CulpritOf` of the rows that name it.  New rows: ``nodes`` is left as
     it is; a row without culprits, or naming a node not in ``nodes``,
     changes nothing."""
-    out = {str(n["name"]): dict(n) for n in nodes}
+    out = {n.name: n for n in nodes}
     for kind, name, k, blame in _blamed(problems):
         n = out.get(name)
         if n is None:
             continue
-        out[name] = n = _marked(n, blame)
+        n = _marked(n, blame)
         if kind == "guarantee":
-            n["guarantees"] = [_marked(x, blame) if str(x.get("index")) == k else x for x in n.get("guarantees") or ()]
+            n = replace(n, guarantees=[_marked(x, blame) if str(x.index) == k else x for x in n.guarantees])
+        out[name] = n
     return list(out.values())
 
 

@@ -43,7 +43,9 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-from rclverify.records.findings import rows_of
+import msgspec
+
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.statuses import SEVERITIES
 
 #: The three severities (the vocabulary's set, records/statuses.py).
@@ -95,66 +97,76 @@ def junit_outcome(kind: str, status: str) -> str:
     return "failure"
 
 
-def items(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
-    """Every finding of ``report`` as ``(kind, id, status, severity)``, in
+def _decoded(report: AssuranceReport | Mapping[str, Any]) -> AssuranceReport:
+    """``report``, or its JSON object decoded (report/view.py ``decoded_parts``: a stored report of an
+    earlier version reads the parts it lacks as empty)."""
+    if isinstance(report, AssuranceReport):
+        return report
+    from rclverify.report.view import decoded_parts  # deferred: view reads the passes that read this table
+    return decoded_parts(report)
+
+
+def items(report: AssuranceReport | Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
+    """Every finding of ``report`` (decoded on entry) as ``(kind, id, status, severity)``, in
     the report's order (obligations, guarantees no obligation covers, side
     conditions, health checks, requirements, deadlines, lint,
     acknowledgements, near misses); items that hold are left out."""
+    r = _decoded(report)
     out: list[tuple[str, str, str, str]] = []
 
     def add(kind: str, ident: str, status: str) -> None:
         sev = of(kind, status)
         if sev is not None:
             out.append((kind, ident, status, sev))
-    for o in report.get("obligations") or ():
-        add("obligation", str(o["id"]), str(o["status"]))
-    for u in report.get("unverified") or ():
-        add("guarantee", str(u["id"]), "unverified")
-    for sc in report.get("side_conditions") or ():
-        add("side-condition", str(sc["id"]), str(sc["status"]))
-    for f in rows_of(report.get("findings") or ()):
+    for o in r.obligations:
+        add("obligation", o.id, o.status)
+    for u in r.unverified:
+        add("guarantee", u.id, "unverified")
+    for sc in r.side_conditions:
+        add("side-condition", sc.id, sc.status)
+    for f in r.findings:
         add("health", f.id, f.status)
-    for r in report.get("requirements") or ():
-        add("requirement", str(r["id"]), str(r.get("verdict", "informal")))
-    for d in report.get("deadlines") or ():  # proved from a chain whose evidence is outstanding: not a pass
-        open_ = d["verdict"] == "proved" and d.get("status", "discharged") != "discharged"
-        add("deadline", f"{d['requirement']}.deadline", "proved, evidence outstanding" if open_ else str(d["verdict"]))
-    for x in report.get("lint") or ():
-        add("lint", f"{x['location']}:{x.get('code', '')}", str(x["severity"]))
-    for a in report.get("acknowledgements") or ():  # a stale or refused acknowledgement (model/plan/acknowledged.py)
-        add("acknowledgement", f"{a['at']}:{a['warning']}", str(a["status"]))
-    for n in report.get("near_misses") or ():  # held by less than the plan's threshold (report/near_misses.py)
-        add("near-miss", f"{n['obligation']}:g{n['guarantee']}:{n['kind']}", "warning")
+    for rq in r.requirements:
+        add("requirement", rq.id, rq.verdict)
+    for d in r.deadlines:  # proved from a chain whose evidence is outstanding: not a pass
+        open_ = d.verdict == "proved" and d.status not in (msgspec.UNSET, "discharged")
+        add("deadline", f"{d.requirement}.deadline", "proved, evidence outstanding" if open_ else str(d.verdict))
+    for x in r.lint:
+        add("lint", f"{x.location}:{x.code}", x.severity)
+    for a in r.acknowledgements:  # a stale or refused acknowledgement (model/plan/acknowledged.py)
+        add("acknowledgement", f"{a.at}:{a.warning}", a.status)
+    for n in r.near_misses:  # held by less than the plan's threshold (report/near_misses.py)
+        add("near-miss", f"{n.obligation}:g{n.guarantee}:{n.kind}", "warning")
     return out
 
 
-def acknowledged(report: Mapping[str, Any]) -> set[tuple[str, str]]:
+def acknowledged(report: AssuranceReport | Mapping[str, Any]) -> set[tuple[str, str]]:
     """The ``(kind, id)`` of :func:`items` that a plan acknowledgement
     answers (a warning accepted as a risk with a reason, docs/plan.md): they
     keep their severity in every output but do not fail ``--strict``."""
-    out = {("health", f.id) for f in rows_of(report.get("findings") or ()) if f.acknowledged}
-    return out | {("lint", f"{x['location']}:{x.get('code', '')}") for x in report.get("lint") or ()
-                  if x.get("acknowledged")}
+    r = _decoded(report)
+    out = {("health", f.id) for f in r.findings if f.acknowledged}
+    return out | {("lint", f"{x.location}:{x.code}") for x in r.lint if x.acknowledged}
 
 
-def blocking(report: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
+def blocking(report: AssuranceReport | Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
     """The findings that fail ``--strict`` (severity ``error`` or
     ``warning``), as :func:`items` gives them, plus the ROS grounding
     errors (``("grounding", code, "error", "error")``) and a stale grounding, and likewise the NoDL
     errors (``("nodl", code, "error", "error")``) and a stale or altered NoDL record."""
-    answered = acknowledged(report)
-    out = [x for x in items(report) if gates(x[3]) and not (x[3] == WARNING and (x[0], x[1]) in answered)]
-    g = report.get("grounding")
-    if isinstance(g, Mapping):
-        for f in g.get("findings") or ():
+    r = _decoded(report)
+    answered = acknowledged(r)
+    out = [x for x in items(r) if gates(x[3]) and not (x[3] == WARNING and (x[0], x[1]) in answered)]
+    g = r.grounding
+    if g is not None:
+        for f in g.findings:  # a grounding finding (free-form: ros/check.py)
             if f.get("severity") == "error":
                 out.append(("grounding", str(f.get("code", "")), "error", ERROR))
-        if g.get("stale"):
+        if g.stale:
             out.append(("grounding", "stale", "stale", WARNING))
-    nodl = report.get("nodl")
-    if isinstance(nodl, Mapping):
-        out += [("nodl", str(f.get("code", "")), "error", ERROR) for f in nodl.get("findings") or ()
-                if f.get("severity") == "error"]
-        if nodl.get("stale"):
+    nodl = r.nodl
+    if nodl is not None:
+        out += [("nodl", f.code, "error", ERROR) for f in nodl.findings if f.severity == "error"]
+        if nodl.stale:
             out.append(("nodl", "stale", "stale", WARNING))
     return out

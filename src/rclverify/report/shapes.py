@@ -10,7 +10,7 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import NotRequired, TypedDict
+from typing import NamedTuple, NotRequired, TypedDict
 
 from rclverify.records.derived_rows import DerivedPropertyRow
 from rclverify.records.evidence_rows import EvidenceRow
@@ -18,9 +18,10 @@ from rclverify.records.findings import FindingRow
 from rclverify.records.node_rows import NodeRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
-from rclverify.records.report_schema import LimitedByJson, SummaryJson
-from rclverify.records.requirement_rows import RequirementRow, SupportRow
+from rclverify.records.report_schema import SummaryJson
+from rclverify.records.requirement_rows import RequirementRow, StrengthKind, SupportRow
 from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.records.strength_rows import LimitedBy
 from rclverify.records.verdict_rows import PendingRow
 
 
@@ -220,19 +221,21 @@ class RunGroupBound(TypedDict):
     level: float
 
 
-class Confidence(TypedDict):
-    """A claim's confidence (docs/confidence.md) as the row keys it adds; ``limited_by`` ``None`` without premises."""
+class Confidence(NamedTuple):
+    """A claim's confidence (docs/confidence.md) as the row fields it sets: ``limited_by`` ``None`` without
+    premises."""
     confidence: float
-    limited_by: LimitedByJson | None
+    limited_by: LimitedBy | None
 
 
-class RequirementConfidence(TypedDict, total=False):
-    """What the confidence pass adds to a formal requirement's row: :class:`Confidence`'s keys and, when the
-    plan asks a least strength of its proof's guarantees, that strength and the guarantees short of it."""
-    required_strength: str
+class RequirementConfidence(NamedTuple):
+    """What the confidence pass sets on a formal requirement's row: :class:`Confidence`'s fields and, when
+    the plan asks a least strength of its proof's guarantees, that strength and the guarantees short of it
+    (``None`` and ``[]`` otherwise: the row's defaults)."""
+    confidence: float
+    limited_by: LimitedBy | None
+    required_strength: StrengthKind | None
     strength_shortfall: list[str]
-    confidence: float
-    limited_by: LimitedByJson | None
 
 
 class ElementJson(TypedDict):

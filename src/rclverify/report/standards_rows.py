@@ -16,6 +16,9 @@ from __future__ import annotations
 
 from typing import Any, Collection, Mapping, Sequence, TypedDict
 
+import msgspec
+
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import EvidenceJson
 from rclverify.model.plan.standards.choice import StandardChoice
 from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
@@ -62,10 +65,10 @@ def _label(row: StandardRow) -> str:
 
 
 def standards_part(choices: Sequence[StandardChoice],
-                   report: Mapping[str, Any] | Sequence[EvidenceJson],
+                   report: AssuranceReport | Mapping[str, Any] | Sequence[EvidenceJson],
                    unstated: Collection[tuple[str, str]] = ()) -> StandardsPart:
     """The ``standards`` part of the plan's ``choices`` over ``report`` (the
-    report dict so far: its evidence rows with their strength, obligations,
+    report so far, or its JSON object: its evidence rows with their strength, obligations,
     nodes, side conditions, requirements, findings, unverified guarantees,
     system and summary; a bare list of evidence rows reads as a report of
     those rows alone); ``unstated``: the (node, environment) of the run
@@ -78,8 +81,12 @@ def standards_part(choices: Sequence[StandardChoice],
     rows: list[StandardJson] = []
     problems: list[str] = []
     ok = True
+    # the mapping (model/plan/standards/) reads the report's JSON object
+    rep: Mapping[str, Any] | Sequence[EvidenceJson] = (
+        msgspec.to_builtins(report) if isinstance(report, AssuranceReport) and choices
+        else {} if isinstance(report, AssuranceReport) else report)
     for c in choices:
-        clauses = clause_rows(c.profile, c.level, report, c.clauses, unstated, c.people)
+        clauses = clause_rows(c.profile, c.level, rep, c.clauses, unstated, c.people)
         missing = not_covered(clauses)
         record = StandardRow.of({
             "profile": c.profile.id, "title": c.profile.title, "edition": c.profile.edition,

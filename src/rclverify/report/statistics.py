@@ -20,7 +20,9 @@ from typing import Any, Mapping, TypedDict
 
 import msgspec
 
-from rclverify.records.report_schema import EvidenceJson
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.statistics_rows import RequirementRuns, StatisticsRow
 from rclverify.report.shapes import RunGroupBound
 
@@ -70,13 +72,13 @@ def _group_row(node: str, env: str, origin: str, rows: list[dict[str, Any]]) -> 
                                      else "no judged run: no bound")})
 
 
-def _target_row(e: EvidenceJson) -> StatisticsRow:
-    s = e["statistics"]
+def _target_row(e: EvidenceRow) -> StatisticsRow:
+    s = e.statistics  # the record's statistics (free-form: backends/monitors/runset.py, backends/experiment/)
     d = s.get("decision") or {}
     return StatisticsRow.of({
-        "node": _node(str(e.get("obligation"))), "environment": s.get("environment", UNSTATED),
-        "origin": s.get("origin", "operation"), "kind": "target", "obligation": e["obligation"],
-        "backend": e["backend"], "status": e["status"], "target": (s.get("target") or {}).get("text"),
+        "node": _node(e.obligation), "environment": s.get("environment", UNSTATED),
+        "origin": s.get("origin", "operation"), "kind": "target", "obligation": e.obligation,
+        "backend": e.backend, "status": e.status, "target": (s.get("target") or {}).get("text"),
         "counts": s.get("counts"), "recorded": s.get("recorded", {}), "level": d.get("level"),
         "bound": d.get("bound"), "runs_needed": d.get("runs_needed"),
         "sprt": (d.get("sprt") or {}).get("decision")})
@@ -93,13 +95,12 @@ def _trace_environments(plan: Plan) -> dict[str, tuple[str, str]]:
     return out
 
 
-def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[str, tuple[str, str]]) -> list[RequirementRuns]:
+def requirement_statistics(req: RequirementRow, target: Any, where: Mapping[str, tuple[str, str]]) -> list[RequirementRuns]:
     """A requirement's runs (its record's ``traces``) grouped by environment
     tag: one row each with the counts, the bound (at the target's level, else
     95 %) and, with a ``target``, its decision."""
     groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
-    check = req.get("check") if isinstance(req.get("check"), Mapping) else {}
-    for t in (check or {}).get("traces") or req.get("traces") or []:
+    for t in req.check.get("traces") or []:
         env, origin = where.get(str(t.get("trace")), (UNSTATED, "operation"))
         status = str(t.get("status"))
         groups.setdefault((env, origin), []).append({
@@ -125,23 +126,22 @@ def requirement_statistics(req: Mapping[str, Any], target: Any, where: Mapping[s
 class StatisticsPart(TypedDict):
     """The statistics pass's part: the report's ``statistics`` table;
     ``groups``: index of a per-run evidence row -> its ``statistics.group``;
-    ``requirements``: requirement id -> its ``statistics`` rows; each row
-    as its JSON object (records/statistics_rows.py: every field)."""
-    table: list[dict[str, Any]]
+    ``requirements``: requirement id -> its ``statistics`` rows."""
+    table: list[StatisticsRow]
     groups: dict[int, RunGroupBound]
-    requirements: dict[str, list[dict[str, Any]]]
+    requirements: dict[str, list[RequirementRuns]]
 
 
-def _per_run(e: EvidenceJson) -> bool:
+def _per_run(e: EvidenceRow) -> bool:
     """``e`` (an evidence row) is a believed monitored run of a run set (not a target's decision)."""
-    s = e.get("statistics")
-    return isinstance(s, dict) and "decision" not in s and e.get("backend") == "monitors" and "sha256" in s \
-        and e.get("status") not in _UNBELIEVED
+    s = e.statistics
+    return bool(s) and "decision" not in s and e.backend == "monitors" and "sha256" in s \
+        and e.status not in _UNBELIEVED
 
 
-def _group_key(e: EvidenceJson) -> tuple[str, str, str]:
-    s = e["statistics"]
-    return _node(str(e.get("obligation"))), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation"))
+def _group_key(e: EvidenceRow) -> tuple[str, str, str]:
+    s = e.statistics
+    return _node(e.obligation), str(s.get("environment", UNSTATED)), str(s.get("origin", "operation"))
 
 
 def _requirement_row(rid: str, runs: RequirementRuns) -> StatisticsRow:
@@ -149,7 +149,7 @@ def _requirement_row(rid: str, runs: RequirementRuns) -> StatisticsRow:
     return StatisticsRow.of({"requirement": rid, "kind": "requirement", **runs.to_json()})
 
 
-def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str, Any]) -> StatisticsPart:
+def statistics_part(report: AssuranceReport, plan: Plan, targets: Mapping[str, Any]) -> StatisticsPart:
     """The report's ``statistics`` table (module docstring), each per-run
     evidence row's group bound and each requirement's runs, as a part: the
     report is read, not changed (report/assemble.py puts the part in).
@@ -157,24 +157,23 @@ def statistics_part(report: Mapping[str, Any], plan: Plan, targets: Mapping[str,
     :class:`~rclverify.records.statistics.Target` (or ``None``)."""
     groups: dict[tuple[str, str, str], list[dict[str, Any]]] = {}
     decisions: list[StatisticsRow] = []
-    for e in report.get("evidence", []):
-        if isinstance(e.get("statistics"), dict) and "decision" in e["statistics"]:
+    for e in report.evidence:
+        if "decision" in e.statistics:
             decisions.append(_target_row(e))
         elif _per_run(e):
-            groups.setdefault(_group_key(e), []).append(e["statistics"])
+            groups.setdefault(_group_key(e), []).append(e.statistics)
     by_key = {key: _group_row(*key, rows) for key, rows in groups.items()}
-    part: StatisticsPart = {"table": [r.to_json() for r in [by_key[k] for k in sorted(by_key)] + decisions],
-                            "groups": {}, "requirements": {}}
-    for i, e in enumerate(report.get("evidence", [])):
+    part: StatisticsPart = {"table": [by_key[k] for k in sorted(by_key)] + decisions, "groups": {}, "requirements": {}}
+    for i, e in enumerate(report.evidence):
         if _per_run(e):
             g = by_key[_group_key(e)]
             part["groups"][i] = {"runs": int((g.counts or {})["runs"]), "bound": g.bound, "level": LEVEL}
     where = _trace_environments(plan)
-    for rq in report.get("requirements", []):
-        rows = requirement_statistics(rq, targets.get(str(rq.get("id"))), where)
+    for rq in report.requirements:
+        rows = requirement_statistics(rq, targets.get(rq.id), where)
         if rows:
-            part["requirements"][str(rq["id"])] = [r.to_json() for r in rows]
-            part["table"].extend(_requirement_row(rq["id"], r).to_json() for r in rows)
+            part["requirements"][rq.id] = rows
+            part["table"].extend(_requirement_row(rq.id, r) for r in rows)
     return part
 
 

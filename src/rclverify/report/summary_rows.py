@@ -10,9 +10,16 @@ it was given.
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
+from rclverify.records.findings import FindingRow
+from rclverify.records.grounding_rows import GroundingRow
+from rclverify.records.node_rows import UnverifiedRow
+from rclverify.records.obligations import ObligationRow
 from rclverify.records.records import SEVERITY
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.side_condition_rows import SideConditionRow
+from rclverify.records.statuses import EvidenceStatus
 
 #: Requirement verdicts that are a problem of their own.
 _REQUIREMENT_PROBLEMS = ("refuted", "proved from an inconsistency", "proved vacuously", "error", "stale")
@@ -27,65 +34,64 @@ def brief(text: str, limit: int = 300) -> str:
     return cut + " ... (in full in the evidence record)"
 
 
-def _health_problems(findings: Sequence[Mapping[str, Any]]) -> list[str]:
+def _health_problems(findings: Sequence[FindingRow]) -> list[str]:
     out = []
     for f in findings:
-        if f["status"] == "problem":
-            out.append(f"Contract health: {f['message']}")
-        elif f["status"] == "error":
-            out.append(f"Contract health of {f['node']} is error: {f['message']}")
-        elif f["status"] == "stale":
-            out.append(f"Contract health of {f['node']} is stale: made for another text of its contract or plan "
+        if f.status == "problem":
+            out.append(f"Contract health: {f.message}")
+        elif f.status == "error":
+            out.append(f"Contract health of {f.node} is error: {f.message}")
+        elif f.status == "stale":
+            out.append(f"Contract health of {f.node} is stale: made for another text of its contract or plan "
                        "(run `doit verify`)")
     return out
 
 
-def problem_sentences(rows: Mapping[str, Sequence[Mapping[str, Any]]], altered: Sequence[str]) -> list[str]:
+def problem_sentences(report: AssuranceReport, altered: Sequence[str]) -> list[str]:
     """The sentences of ``summary.problems`` (module docstring), in the
-    report's order.  ``rows``: the report's ``findings``, ``requirements``,
+    report's order, from ``report``'s ``findings``, ``requirements``,
     ``side_conditions``, ``acknowledgements``, ``unverified``, ``evidence``
     and ``expected_verdicts`` rows; ``altered``: the sentences of records
     altered outside rclverify (report/evidence_rows.py)."""
-    out = _health_problems(rows["findings"])
-    out += [f"Requirement {rq['id']} is {rq['verdict']}: {brief(rq['note'])}" for rq in rows["requirements"]
-            if rq["verdict"] in _REQUIREMENT_PROBLEMS]
-    for sc in rows["side_conditions"]:
-        if sc["status"] != "discharged":
-            where = " (checked in context too)" if sc.get("context") and sc["status"] != "stale" else ""
-            out.append(f"Side condition {sc['id']} is {sc['status']}{where}: {sc['conjunct']}")
+    out = _health_problems(report.findings)
+    out += [f"Requirement {rq.id} is {rq.verdict}: {brief(rq.note)}" for rq in report.requirements
+            if rq.verdict in _REQUIREMENT_PROBLEMS]
+    for sc in report.side_conditions:
+        if sc.status != "discharged":
+            where = " (checked in context too)" if sc.context and sc.status != "stale" else ""
+            out.append(f"Side condition {sc.id} is {sc.status}{where}: {sc.conjunct}")
     out += altered
-    out += [f"Acknowledgement {a['at']} is {a['status']}: {a['message']}" for a in rows["acknowledgements"]
-            if a["status"] != "ok"]
-    out += [u["message"] for u in rows["unverified"]]
-    out += [f"Evidence {e['obligation']} is {e['status']}: {brief(e['explanation'])}" for e in rows["evidence"]
-            if e["status"] in ("failed", "error", "stale")]
-    out += [f"Expected verdict mismatch: {x['obligation']} is {x['actual']}, the plan expects "
-            f"{x['expected']} ({x['source']})" + (f": {x['reason']}" if x["reason"] else "")
-            for x in rows["expected_verdicts"] if x["outcome"] == "MISMATCH"]
+    out += [f"Acknowledgement {a.at} is {a.status}: {a.message}" for a in report.acknowledgements
+            if a.status != "ok"]
+    out += [u.message for u in report.unverified]
+    out += [f"Evidence {e.obligation} is {e.status}: {brief(e.explanation)}" for e in report.evidence
+            if e.status in ("failed", "error", "stale")]
+    out += [f"Expected verdict mismatch: {x.obligation} is {x.actual}, the plan expects "
+            f"{x.expected} ({x.source})" + (f": {x.reason}" if x.reason else "")
+            for x in report.expected_verdicts if x.outcome == "MISMATCH"]
     return out
 
 
-def grounding_problems(grounding: Mapping[str, Any] | None) -> list[str]:
+def grounding_problems(grounding: GroundingRow | None) -> list[str]:
     """The problems of the grounding in the robot's software (docs/ros.md): stale, or contract-vs-ROS errors."""
     out = []
-    if grounding is not None and grounding.get("stale"):
-        out.append(f"Grounding is stale: {grounding['stale']}")
-    if grounding is not None and grounding["counts"]["error"]:
-        out.append(f"Grounding: {grounding['counts']['error']} contract(s)-vs-ROS error(s) (rclverify ros check)")
+    if grounding is not None and grounding.stale:
+        out.append(f"Grounding is stale: {grounding.stale}")
+    if grounding is not None and grounding.counts.error:
+        out.append(f"Grounding: {grounding.counts.error} contract(s)-vs-ROS error(s) (rclverify ros check)")
     return out
 
 
-def status_counts(obligations: Sequence[Mapping[str, Any]]) -> dict[str, int]:
+def status_counts(obligations: Sequence[ObligationRow]) -> dict[EvidenceStatus, int]:
     """How many obligations have each status (``summary.counts``), in order of first appearance."""
-    counts: dict[str, int] = {}
+    counts: dict[EvidenceStatus, int] = {}
     for row in obligations:
-        counts[row["status"]] = counts.get(row["status"], 0) + 1
+        counts[row.status] = counts.get(row.status, 0) + 1
     return counts
 
 
-def strict_gate(rows: Mapping[str, Sequence[Mapping[str, Any]]], guarantees_discharged: Callable[[], bool],
-                deadlines_ok: bool, grounding: Mapping[str, Any] | None) -> bool:
-    """The ``--strict`` gate before strength, the second solver's record and
+def strict_gate(report: AssuranceReport, guarantees_discharged: Callable[[], bool], deadlines_ok: bool) -> bool:
+    """The ``--strict`` gate of ``report``'s rows before strength, the second solver's record and
     severities are weighed (report/build.py): every obligation discharged,
     every side condition proved, no health check that found a problem or
     could not decide, no guarantee left without evidence
@@ -93,20 +99,21 @@ def strict_gate(rows: Mapping[str, Sequence[Mapping[str, Any]]], guarantees_disc
     (docs/requirements.md, "--strict"; an informal one is listed only),
     every end-to-end deadline proved (``deadlines_ok``) and no grounding
     error or stale grounding (docs/ros.md: findings never change a verdict)."""
-    ok = (all(o["status"] == "discharged" for o in rows["obligations"])
-          and all(sc["status"] == "discharged" for sc in rows["side_conditions"])
-          and all(f["status"] in ("ok", "warning") for f in rows["findings"])
+    ok = (all(o.status == "discharged" for o in report.obligations)
+          and all(sc.status == "discharged" for sc in report.side_conditions)
+          and all(f.status in ("ok", "warning") for f in report.findings)
           and guarantees_discharged()
-          and all(rq["verdict"] in ("met", "informal") for rq in rows["requirements"])
+          and all(rq.verdict in ("met", "informal") for rq in report.requirements)
           and deadlines_ok)
+    grounding = report.grounding
     if grounding is not None:
-        ok = ok and not grounding["counts"]["error"] and not grounding.get("stale")
+        ok = ok and not grounding.counts.error and not grounding.stale
     return ok
 
 
-def headline(ob_rows: Sequence[Mapping[str, Any]], counts: Mapping[str, int],
-             side_conditions: Sequence[Mapping[str, Any]], findings: Sequence[Mapping[str, Any]],
-             unverified: Sequence[Mapping[str, Any]] = ()) -> str:
+def headline(ob_rows: Sequence[ObligationRow], counts: Mapping[EvidenceStatus, int],
+             side_conditions: Sequence[SideConditionRow], findings: Sequence[FindingRow],
+             unverified: Sequence[UnverifiedRow] = ()) -> str:
     """The one-line summary, without empty fragments: a kind with nothing
     in it is said in words ("no obligations"), never as "0 obligations: ;".
     Guarantees no obligation covers (``unverified``) are counted after the
@@ -121,16 +128,16 @@ def headline(ob_rows: Sequence[Mapping[str, Any]], counts: Mapping[str, int],
         parts.append(f"{len(unverified)} guarantee{'s' if len(unverified) != 1 else ''} unverified "
                      "(no obligation covers " + ("it" if len(unverified) == 1 else "them") + ")")
     if side_conditions:
-        in_context = sum(1 for sc in side_conditions if sc["status"] == "discharged"
-                         and sc.get("verdict") == "discharged in context")
-        parts.append(f"{sum(1 for sc in side_conditions if sc['status'] == 'discharged')}/{len(side_conditions)} "
+        discharged = [sc for sc in side_conditions if sc.status == "discharged"]
+        in_context = sum(1 for sc in discharged if sc.verdict == "discharged in context")
+        parts.append(f"{len(discharged)}/{len(side_conditions)} "
                      "side conditions discharged" + (f" ({in_context} in context)" if in_context else ""))
     else:
         parts.append("no side conditions")
-    problems = sum(1 for f in findings if f["status"] == "problem")
+    problems = sum(1 for f in findings if f.status == "problem")
     parts.append(f"{problems} contract health problem{'s' if problems != 1 else ''}" if problems
                  else "no contract health problem")
-    altered = sum(1 for f in findings if f["status"] == "error")
+    altered = sum(1 for f in findings if f.status == "error")
     if altered:
         parts.append(f"{altered} contract health record{'s' if altered != 1 else ''} altered outside rclverify")
     return "; ".join(parts) + "."

@@ -13,7 +13,7 @@ import functools
 import re
 import typing
 from collections import defaultdict
-from typing import Callable, Mapping, Sequence, TypeVar
+from typing import Any, Callable, Mapping, Sequence, TypeVar
 
 import msgspec
 
@@ -23,7 +23,6 @@ from rclverify.records.findings import FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import EARLIER, ProblemRow
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import Report
 from rclverify.records.row import decode_rows
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
@@ -38,7 +37,7 @@ from rclverify.report.textfmt import natural_key, natural_sorted, natural_within
 _T = TypeVar("_T")
 _Row = TypeVar("_Row", DerivedPropertyRow, SideConditionRow, FindingRow)
 #: the report as a caller may hand it over: the decoded record, or its JSON object (decoded once on entry)
-ReportIn = AssuranceReport | Report
+ReportIn = AssuranceReport | Mapping[str, Any]
 
 #: Top-level keys every report dict carries.
 REPORT_KEYS: tuple[str, ...] = (
@@ -48,7 +47,7 @@ REPORT_KEYS: tuple[str, ...] = (
 )
 
 
-def validate(report: Report) -> None:
+def validate(report: Mapping[str, Any]) -> None:
     """Check the top-level shape of ``report``.
 
     Raises ``ValueError`` naming every missing top-level key (the templates
@@ -178,7 +177,7 @@ def _later_parts() -> dict[str, object]:
             for k in AssuranceReport.__struct_fields__ if k not in REPORT_KEYS}
 
 
-def _earlier(report: Report | Mapping[str, object]) -> dict[str, object]:
+def _earlier(report: Mapping[str, object]) -> dict[str, object]:
     """``report``, a JSON object, with each part :func:`_later_parts` names that it lacks at its empty
     value and each problem row's keys of :data:`~rclverify.records.problem_rows.EARLIER` that it lacks:
     a stored report of an earlier version still decodes (its rows placed nowhere), and so does the report
