@@ -76,8 +76,8 @@ def _discharged(record: dict[str, Any]) -> tuple[str, str, str]:
 
 def _strict(verdict: str) -> bool:
     """The ``--strict`` gate of a run whose only open item is a requirement of ``verdict``."""
-    rows = {"obligations": [], "side_conditions": [], "findings": [], "requirements": [{"verdict": verdict}]}
-    return strict_gate(rows, lambda: True, True, None)
+    from _typed_rows import typed_report
+    return strict_gate(typed_report({"requirements": [{"verdict": verdict}]}), lambda: True, True)
 
 
 def test_a_loop_that_never_starts_proves_nothing(stuck: dict[str, dict[str, Any]]) -> None:
