@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 import yaml
 
-from _typed_rows import complete, ungrouped_report
+from _typed_rows import complete, typed_report, ungrouped_report
 from rclverify.records.summary_rows import Meta
 from rclverify.report.argument.build import build_argument
 from rclverify.report.argument.export import argument_view, to_dot, to_gsn_yaml, to_json_text, write_argument
@@ -289,6 +289,7 @@ def _claim_points_obey_v09(data: dict[str, Any]) -> list[tuple[str, str]]:
 
 
 def test_assurance_claim_points_mark_where_confidence_is_argued() -> None:
+    import msgspec
     from rclverify.report.assemble import with_confidence
     from rclverify.report.confidence_rows import confidence_part
     rep = _report()
@@ -296,7 +297,8 @@ def test_assurance_claim_points_mark_where_confidence_is_argued() -> None:
     rep["obligations"][0]["status"] = "failed"
     rep["nodes"][0]["guarantees"][0]["obligations"] = ["Sensor.g1.hoare"]
     rep["nodes"][0]["guarantees"][1]["obligations"] = ["Sensor.g2.review"]
-    rep = with_confidence(rep, confidence_part(rep, [("Sensor", "Planner")]))
+    typed = typed_report(rep)  # the confidence pass reads and gives the decoded report
+    rep = msgspec.to_builtins(with_confidence(typed, confidence_part(typed, [("Sensor", "Planner")])))
     data = yaml.safe_load(to_gsn_yaml(build_argument(rep), "mini"))
     points = dict(_claim_points_obey_v09(data))
     # each requirement goal has one (these requirements are argued by the calculus: no confidence of their own)
