@@ -142,6 +142,16 @@ class UnverifiedRow(Row, frozen=True, forbid_unknown_fields=True):
 #: The fields of :class:`NodeRow` no node renderer shows, each with the reason.
 INTERNAL: dict[str, str] = {}
 
+#: The fields of :class:`NodeRow` the LaTeX appendix (parts/latex.{html,md}.j2) does not show, each with the
+#: reason: it typesets each node's contract (``latex``) under the node's name, and the node's section shows
+#: the rest (tests/records/test_record_shapes.py holds the appendix to this table).
+LATEX_INTERNAL: dict[str, str] = {k: f"the appendix typesets the contract alone; the node's section shows its {what}"
+                                  for k, what in (("source", "source"), ("status", "status"), ("inputs", "inputs"),
+                                                  ("outputs", "outputs"), ("assumptions", "assumptions"),
+                                                  ("guarantees", "guarantees"), ("confidence", "confidence"),
+                                                  ("limited_by", "weakest premise"),
+                                                  ("culprit_of", "problems it is the culprit of"))}
+
 #: The fields of :class:`GuaranteeRow` no guarantees-table renderer shows, each with the reason.
 GUARANTEE_INTERNAL: dict[str, str] = {}
 
@@ -153,4 +163,4 @@ UNVERIFIED_INTERNAL: dict[str, str] = {
 
 
 __all__ = ["AssumptionRow", "Confidence", "CulpritOf", "GUARANTEE_INTERNAL", "GuaranteeRow", "INTERNAL", "InputRow",
-           "NodeRow", "OutputRow", "UNVERIFIED_INTERNAL", "UnverifiedRow"]
+           "LATEX_INTERNAL", "NodeRow", "OutputRow", "UNVERIFIED_INTERNAL", "UnverifiedRow"]
