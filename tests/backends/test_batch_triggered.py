@@ -220,10 +220,110 @@ def test_bench_shaped_runs_equal_the_enumeration() -> None:
         assert b[1].counts["violated"] == sum(1 for _, v, _ in got if v == "violated") > 0
 
 
+def _slots_run(rng: random.Random, node: str, n: int, wrong: float, odd: bool) -> list[Event]:
+    """The bench's shape for the lone slots (batch_lone.py): a trigger at a sample with probability 1/2, an
+    answer with 0.7 (after the trigger, at its stamp), right but with probability ``wrong``; ``odd``: samples
+    now and then 0-6 ms apart (within the horizon), an answer before its trigger at one stamp, a NaN trigger,
+    a foreign topic."""
+    out: list[Event] = []
+    a, ms = 0.0, 0
+
+    def add(topic: str, value: Any) -> None:
+        out.append(Event(len(out), ms / 1000, topic, {"data": value}, f"run.jsonl:{len(out) + 1}"))
+
+    for _ in range(n):
+        ms += rng.choice([10, 10, 10, 10, 20, 5, 6, 4, 0]) if odd else 10
+        swap = odd and rng.random() < 0.05
+        if rng.random() < 0.5:
+            a = rng.choice([0.0, 0.25, 1.0, 2.5, 7.75])
+            if not swap:
+                add("trig", float("nan") if odd and rng.random() < 0.01 else a)
+        if rng.random() < 0.7:
+            if node == "E":
+                right = "hi" if a < 5 else "lo"
+                add("ans", {"hi": "lo", "lo": "hi"}[right] if rng.random() < wrong else right)
+            else:
+                add("ans", a + (rng.choice([0.0, -0.5]) if rng.random() < wrong else rng.choice([0.25, 1.0])))
+        if swap:
+            add("trig", a)
+        if odd and rng.random() < 0.01:
+            add("tick", 0.0)
+    if rng.random() < 0.5:
+        ms += 1000
+        add("tick", 0.0)
+    return out
+
+
+@pytest.mark.parametrize("node", ["D", "E"])
+def test_lone_slots_equal_streaming(node: str) -> None:
+    """Chunks of lone triggers and answers judged in batch (batch_lone.py), by default (``MIN_RUN``): the
+    verdict list (verdicts, order, reasons, margins) and result equal the streaming engine's on runs of the
+    bench's shape, the transport skew 0, 3 or 20 ms, margins on and off, chunks of 7 events up, answers all
+    right or now and then wrong, samples regular or not (then most chunks are the engine's)."""
+    rng = random.Random(f"lone-{node}")
+    batched = 0
+    for case in range(14):
+        rules = load_rules(RULES)
+        rules.skew = rng.choice([0.0, 0.003, 0.02, 0.02])
+        wrong = 0.0 if case % 3 else rng.choice([0.001, 0.01])
+        events = _slots_run(rng, node, rng.choice([60, 300, 900]), wrong, case % 4 == 3)
+        chunk = rng.choice([7, 64, 500, 16384])
+        margins = case % 2 == 0
+        end = events[-1].time + rng.choice([0.0, 1.0]) if rng.random() < 0.3 else None
+        s, b, stats = _both(node, events, rules, 0.005, chunk, margins, end, MIN_RUN)
+        where = f"case {case}: skew {rules.skew}, chunk {chunk}, margins {margins}, {len(events)} events"
+        assert b[2] == s[2], where
+        assert b[1] == s[1], where
+        assert b[0] == s[0], where
+        batched += stats["batched"]
+    assert batched > 1000, batched  # the lone slots ran
+
+
+def test_lone_slots_are_batched_and_a_wrong_answer_is_the_engines() -> None:
+    """The bench's shape with every answer right is judged in batch (no event fed to the engine past each
+    chunk's first few), to the engine's verdicts and the enumeration's; the same run with one answer wrong
+    (the control) has that answer's chunk fed to the engine, its violation found."""
+    rules = load_rules(RULES)
+    run = _slots_run(random.Random(7), "D", 600, 0.0, False)
+    s, b, stats = _both("D", run, rules, 0.005, 16384, True, None, MIN_RUN)
+    assert b == s and stats["streamed"] <= 16 and stats["batched"] > 300
+    got = [(v.event, v.verdict, v.margin) for v in b[2] if v.topic == "ans"]
+    assert got == _enumerate(run) and all(v == "satisfied" for _, v, _ in got)
+    lone = sum(1 for v in b[2] if v.verdict == "inconclusive")
+    assert lone > 50 and lone == b[1].counts["inconclusive"]  # the lone triggers, closed unanswered
+    k = next(i for i, ev in enumerate(run) if ev.topic == "ans" and i > 300)
+    bad = list(run)
+    bad[k] = Event(k, run[k].time, "ans", {"data": -1.0}, run[k].where)
+    s, b, stats = _both("D", bad, rules, 0.005, 16384, True, None, MIN_RUN)
+    assert b == s and stats["streamed"] > 300 and b[1].counts["violated"] == 1
+    assert [v.event for v in b[2] if v.verdict == "violated"] == [k]
+
+
+def test_control_lone_slots_misreading_the_carried_trigger_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Control: a lone-slots judge that closes a lone trigger's question silently (as if answered) gives a
+    result the engine does not (the ``inconclusive`` count), on the bench's shape."""
+    from rclverify.backends.monitors import batch_lone
+    rules = load_rules(RULES)
+    run = _slots_run(random.Random(8), "D", 400, 0.0, False)
+    right = _both("D", run, rules, 0.005, 16384, True, None, MIN_RUN)
+    assert right[0] == right[1]
+    apply = batch_lone.LoneSlots._apply
+
+    def silent(self: Any, chunk: Any, s: int, k: Any, t: Any, in_rows: Any, out_rows: Any, qidx: Any,
+               answered: Any, paired_out: Any, close_q: list[int], close_at: list[int], *rest: Any) -> None:
+        apply(self, chunk, s, k, t, in_rows, out_rows, qidx, answered, paired_out, [], [], [], *rest[1:])
+
+    with monkeypatch.context() as patch:
+        patch.setattr(batch_lone.LoneSlots, "_apply", silent)
+        wrong = _both("D", run, rules, 0.005, 16384, True, None, MIN_RUN)
+    assert wrong[0][1].counts["inconclusive"] > wrong[1][1].counts["inconclusive"]
+
+
 def test_short_runs_of_pairs_are_streamed_whole() -> None:
-    """The bench's shape (runs of one or two pairs between lone triggers and answers) costs the batch path
-    more than the engine: by default such a chunk is fed to the engine whole, to the same verdicts; a run
-    of long stretches of pairs (the control) is batched."""
+    """The bench's shape (runs of one or two pairs between lone triggers and answers) with answers now and
+    then wrong costs the batch path more than the engine: by default such a chunk is fed to the engine
+    whole (the lone slots decline a chunk holding a wrong answer), to the same verdicts; a run of long
+    stretches of pairs (the control) is batched."""
     rules = load_rules(RULES)
     run = _bench_run(random.Random(7), 600)
     s, b, stats = _both("D", run, rules, 0.005, 16384, True, None, MIN_RUN)

@@ -69,6 +69,7 @@ from rclverify.traces.mapping import TopicRule
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.answered import AnsweredRun
 from rclverify.targets.columns import seed
+from rclverify.backends.monitors.batch_lone import LoneSlots, lone_eligible
 from rclverify.backends.monitors.batch_plan import BatchPlan, batch_plan
 from rclverify.backends.monitors.batch_state import PairsState, _kept
 from rclverify.backends.monitors.batch_window import window_column
@@ -141,7 +142,7 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
     return count, m.finish()
 
 
-class _Run(PairsState):
+class _Run(PairsState, LoneSlots):
     """The batch path over one trace: the shared engine and the chunk loop."""
 
     def __init__(self, plan: BatchPlan) -> None:
@@ -163,6 +164,8 @@ class _Run(PairsState):
         self.held = bool(m.stream.skew) and not m._alone
         #: ``triggered by``: the column code of the input every triggered guarantee answers (0: no trigger)
         self.owing = next((self.kinds[t] for t, (key, _, _) in plan.inputs.items() if key == plan.trigger), 0)
+        #: a chunk of short runs of lone triggers and answers judged in batch where clean (batch_lone.py)
+        self.lone = lone_eligible(m, plan)
 
     def _full(self) -> bool:
         """Whether the run's violation records are full: a further violation is only counted."""
@@ -202,7 +205,8 @@ class _Run(PairsState):
             kind = self._kind(chunk.topics)
         times = chunk.times
         if n > 1 and not self._long_runs(kind, times):
-            for ev in chunk[0:n]:
+            i = self._lone(chunk, kind, times) if self.lone else 0
+            for ev in chunk[i:n]:
                 self.feed(ev)
             return []
         ok = kind != 0
