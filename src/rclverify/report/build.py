@@ -37,11 +37,13 @@ from rclverify.records.node_rows import NodeRow
 from rclverify.records.problem_rows import ProblemRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.row import decode_rows
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.summary_rows import Meta, Summary, SystemView
 from rclverify.report import assemble
 from rclverify.report.confidence_rows import confidence_part
+from rclverify.report.cex_cone import side_condition_view
 from rclverify.report.contract_rows import (GuaranteeStatuses, contract_records, derived_rows, environment_rows,
-                                          involved_model, node_part)
+                                          node_part)
 from rclverify.stages.contract_texts import ContractTexts
 from rclverify.report.culprits import marked_nodes
 from rclverify.report.deadlines import deadline_rows, fold_into, strict_ok as deadlines_ok
@@ -122,7 +124,8 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
     ev = evidence_part(ws, inp.obligations, inp.altered, inp.hashes, inp.second)
     comps, health = contract_records(ws, names, inp.stale, inp.second)
     # a counterexample shows the nodes involved only: the consumer and the producers of the linked variables
-    side_conditions = [involved_model(sc) for n in names for sc in comps[n].get("side_conditions", [])]
+    views = [side_condition_view(sc) for n in names for sc in comps[n].get("side_conditions", [])]
+    side_conditions = decode_rows(SideConditionRow, views)
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
                  for n in names}
     g_status = GuaranteeStatuses(inp.obligations, ev["status"], health)
@@ -131,14 +134,14 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
     checks = {k: inp.second.requirement(v) or v for k, v in checks.items()}
     deadlines = deadline_rows(ws, inp.hashes, g_status, ev["obligations"], inp.second)  # rule D3
     requirements = fold_into(requirement_rows(ws, inp.texts, checks, g_status, sc_status, ev["declared"]), deadlines)
-    findings, lint, acknowledgements = acknowledged_rows(ws, finding_rows(names, health, side_conditions),
+    findings, lint, acknowledgements = acknowledged_rows(ws, finding_rows(names, health, views),
                                                           lint_rows(ws))
     return {"requirements": requirements, "nodes": nodes["nodes"], "side_conditions": side_conditions,
             "derived_properties": derived_rows(ws, comps, nodes, sc_status), "findings": findings,
             "obligations": ev["obligations"], "evidence": ev["evidence"],
             "environment_assumptions": environment_rows(comps, names),
             "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
-            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "instances": instances_row(ws, ev["obligations"]), "design": design_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
+            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "instances": instances_row(ws, [o.to_json() for o in ev["obligations"]]), "design": design_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
             "deadlines": deadlines, "acknowledgements": acknowledgements,
             "near_misses": near_miss_rows(ws, ev["obligations"]),
             "margins": margin_rows(ws, ev["obligations"])}, Facts(
@@ -167,8 +170,8 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
     overall = worst([r.status for r in draft.requirements] + list(facts.node_status.values())
                     + [d.status for d in draft.derived_properties] + instance_statuses(rows["instances"]))
     strict_ok = strict_gate(draft, facts.guarantees_discharged, facts.deadlines_ok) \
-        and not nodl_blocks(rows["nodl"]) and not instances_block(rows["instances"]) and not design_blocks(rows["design"])
-    problems = problem_sentences(draft, facts.altered) + grounding_problems(draft.grounding) + nodl_problems(rows["nodl"]) \
+        and not nodl_blocks(draft.nodl) and not instances_block(rows["instances"]) and not design_blocks(rows["design"])
+    problems = problem_sentences(draft, facts.altered) + grounding_problems(draft.grounding) + nodl_problems(draft.nodl) \
         + design_problems(rows["design"]) \
         + instance_problems(rows["instances"])
     summary = replace(_NO_SUMMARY, status=overall, counts=counts, problems=problems,

@@ -24,11 +24,8 @@ from rclverify.records.findings import FindingRow, HealthFinding
 from rclverify.records.records import Obligation, worst
 from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
 from rclverify.records.node_rows import AssumptionRow, GuaranteeRow, InputRow, NodeRow, OutputRow
-from rclverify.records.report_schema import (DerivedPropertyJson, EnvironmentAssumptionJson, NodeJson,
-                                             SideConditionJson)
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.statuses import EvidenceStatus, HealthStatus
-from rclverify.report.cex_cone import side_condition_view
 from rclverify.report.cones import DERIVATION, ConeEvidence
 from rclverify.stages.contract_texts import ContractTexts
 from rclverify.report.records import node_records
@@ -89,16 +86,6 @@ def contract_records(ws: Workspace, nodes: Sequence[str], stale: Mapping[str, se
     return comps, rows
 
 
-def involved_model(sc: Mapping[str, Any]) -> SideConditionJson:
-    """``sc`` (a side-condition row of the calculus, as :func:`contract_records` shows it) with its Z3
-    ``model`` cut to the nodes its conjunct involves (:func:`.cex_cone.side_condition_view`: the consumer,
-    the producers of its links and, decided in context, the nodes whose assumption the counterexample
-    violates), as the report's row (decoded into
-    :class:`~rclverify.records.side_condition_rows.SideConditionRow`, which report/records.py checked the
-    record's rows against)."""
-    return SideConditionRow.of(side_condition_view(sc)).to_json()
-
-
 class GuaranteeStatuses:
     """The status of each guarantee (module docstring), callable as
     ``(node, k) -> status`` (``k`` 1-based); guarantee 0 of an obligation
@@ -125,9 +112,9 @@ class GuaranteeStatuses:
 
 
 class NodesPart(TypedDict):
-    """The node rows (each :class:`~rclverify.records.node_rows.NodeRow`'s JSON object) and, by node name,
+    """The node rows (each a :class:`~rclverify.records.node_rows.NodeRow`) and, by node name,
     each node's status and the worst status of its guarantees."""
-    nodes: list[NodeJson]
+    nodes: list[NodeRow]
     status: dict[str, str]
     evidence: dict[str, str]
 
@@ -168,18 +155,18 @@ def node_part(ws: Workspace, texts: ContractTexts, comps: Mapping[str, Mapping[s
             name=name, source=str(cn.node.loc), status=cast(EvidenceStatus, status), inputs=inputs, outputs=outputs,
             assumptions=[AssumptionRow(text=text, source=src, environment=text in env_texts)
                          for text, src in tx["assumptions"]],
-            guarantees=guarantees, latex=tx["latex"]).to_json())
+            guarantees=guarantees, latex=tx["latex"]))
     return part
 
 
 def derived_rows(ws: Workspace, comps: Mapping[str, Mapping[str, Any]], nodes: NodesPart,
-                 sc_status: Mapping[str, str]) -> list[DerivedPropertyJson]:
+                 sc_status: Mapping[str, str]) -> list[DerivedPropertyRow]:
     """One row per node the calculus derived a property for: its rules,
     instances, the cone's environment assumptions, and its two statuses
     (derivation and evidence, report/cones.py)."""
     model = ws.model
     cones, cone_of = ConeEvidence(model.nodes, nodes["evidence"], sc_status), model.upstream_masks()
-    rows: list[DerivedPropertyJson] = []
+    rows: list[DerivedPropertyRow] = []
     for n in ws.checked.nodes:
         c = comps[n]
         if not c:
@@ -192,13 +179,13 @@ def derived_rows(ws: Workspace, comps: Mapping[str, Mapping[str, Any]], nodes: N
             status=cast(EvidenceStatus, derivation), derivation=DERIVATION.get(derivation, "undecided"),
             # what the rules' premises (the node contracts) rest on
             evidence_status=cast(EvidenceStatus, ev_status), evidence_note=ev_note,
-            loop_assumption=c["loop_assumption"]).to_json())
+            loop_assumption=c["loop_assumption"]))
     return rows
 
 
-def environment_rows(comps: Mapping[str, Mapping[str, Any]], nodes: Sequence[str]) -> list[EnvironmentAssumptionJson]:
+def environment_rows(comps: Mapping[str, Mapping[str, Any]], nodes: Sequence[str]) -> list[EnvironmentAssumptionRow]:
     """The environment assumptions of the calculus records ``comps`` (node -> record), node by node in the
-    order of ``nodes``, each an :class:`~rclverify.records.derived_rows.EnvironmentAssumptionRow`'s JSON
-    object (``KeyError`` for a record's assumption without ``node``, ``text`` or ``source``)."""
-    return [EnvironmentAssumptionRow(node=str(e["node"]), text=str(e["text"]), source=str(e["source"])).to_json()
+    order of ``nodes``, each an :class:`~rclverify.records.derived_rows.EnvironmentAssumptionRow`
+    (``KeyError`` for a record's assumption without ``node``, ``text`` or ``source``)."""
+    return [EnvironmentAssumptionRow(node=str(e["node"]), text=str(e["text"]), source=str(e["source"]))
             for n in nodes for e in comps[n].get("environment_assumptions", [])]

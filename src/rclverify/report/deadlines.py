@@ -44,10 +44,12 @@ import xml.etree.ElementTree as ET
 from typing import Any, Callable, Mapping, Sequence, cast
 
 import msgspec
+from msgspec.structs import replace
 
 from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import DeadlineJson, ObligationJson, Report
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.requirement_rows import RequirementRow, WithoutDeadline
 from rclverify.records.solvers_rows import Solvers
 from rclverify.records.statuses import DeadlineVerdict, EvidenceStatus
 from rclverify.records.sarif import SarifResult
@@ -75,10 +77,9 @@ def _spec_of(rec: Mapping[str, Any], spec: Any) -> bool:
 
 
 def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[[str, int], str],
-                  ob_rows: Sequence[ObligationJson], second: Any = None) -> list[DeadlineJson]:
+                  ob_rows: Sequence[ObligationRow], second: Any = None) -> list[DeadlineRow]:
     """One row per ``deadline:`` of ``ws``'s plan, in plan order (module
-    docstring), each a :class:`~rclverify.records.deadline_rows.DeadlineRow`'s
-    JSON object.  ``current``: path -> sha256 of the current snapshots and
+    docstring), each a :class:`~rclverify.records.deadline_rows.DeadlineRow`.  ``current``: path -> sha256 of the current snapshots and
     model (:func:`rclverify.stages.provenance.current_snapshot_hashes`);
     ``g_status(node, k)``: a guarantee's evidence status; ``ob_rows``: the
     report's obligation rows (``id``, ``node``, ``backend``, ``status``).
@@ -93,7 +94,7 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
     records, why = read_deadlines(ws, current)
     by_req = {str(r.get("requirement")): r for r in records or []}
     monitors = _monitor_verdicts(ws, ob_rows, {n for s in specs for n in s.path})
-    rows: list[DeadlineJson] = []
+    rows: list[DeadlineRow] = []
     for spec in specs:
         rec = by_req.get(spec.requirement)
         rec = rec if not why and rec is not None and _spec_of(rec, spec) else None  # None: no decision shown
@@ -113,7 +114,7 @@ def deadline_rows(ws: Workspace, current: Mapping[str, str], g_status: Callable[
             evidence_status=evidence_status, reason=reason, chain=chain, total=(rec or {}).get("total"),
             time_margin=None if measured is None else f"{measured / 1e6:.3f} ms", time_margin_ns=measured,
             stamps=list((rec or {}).get("stamps") or []), smt2=str((rec or {}).get("smt2") or ""),
-            solvers=msgspec.UNSET if rec is None else _solvers(rec.get("solvers"))).to_json())
+            solvers=msgspec.UNSET if rec is None else _solvers(rec.get("solvers"))))
     return rows
 
 
@@ -169,7 +170,7 @@ def _timing_measured(status: str, monitors: Sequence[Mapping[str, Any]],
                        "guarantee's formula only (a monitors entry on a recorded or live run times it)")
 
 
-def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationJson],
+def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationRow],
                       nodes: set[str]) -> dict[str, list[dict[str, Any]]]:
     """node -> the deadline verdicts of its monitors' evidence records
     (``details["deadlines"]``, backends/monitors/deadlines.py):
@@ -177,66 +178,61 @@ def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationJson],
     store = EvidenceStore(ws.root)
     out: dict[str, list[dict[str, Any]]] = {}
     for o in ob_rows:
-        if o["backend"] != "monitors" or o["node"] not in nodes:
+        if o.backend != "monitors" or o.node not in nodes:
             continue
-        ev, problem = store.read(str(o["id"]))
+        ev, problem = store.read(o.id)
         d = ev.details.get("deadlines") if ev is not None and not problem and isinstance(ev.details, dict) else None
         if isinstance(d, dict):
-            out.setdefault(str(o["node"]), []).append({"obligation": o["id"], "status": o["status"],
+            out.setdefault(o.node, []).append({"obligation": o.id, "status": o.status,
                                                        "counts": dict(d.get("counts") or {}),
                                                        "first_false": d.get("first_false"),
                                                        "time_margins": list(d.get("time_margins") or ())})
     return out
 
 
-def fold_into(requirements: Sequence[Mapping[str, Any]], rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+def fold_into(requirements: Sequence[RequirementRow], rows: Sequence[DeadlineRow]) -> list[RequirementRow]:
     """``requirements`` with each deadline row of ``rows`` rolled into its
     requirement row (module docstring): a new row with the requirement's
     ``deadline`` (the row), ``without_deadline`` (its own verdict, status
     and note) and, unless the deadline is proved from discharged evidence,
     its ``verdict``, ``status`` and ``note``.  The rows given are left as
     they are; a requirement without a deadline is returned as it is."""
-    by_req = {str(r["requirement"]): r for r in rows}
-    return [_with_deadline(rq, by_req[str(rq["id"])]) if str(rq["id"]) in by_req else dict(rq)
-            for rq in requirements]
+    by_req = {r.requirement: r for r in rows}
+    return [_with_deadline(rq, by_req[rq.id]) if rq.id in by_req else rq for rq in requirements]
 
 
-def _with_deadline(own: Mapping[str, Any], row: Mapping[str, Any]) -> dict[str, Any]:
+def _with_deadline(own: RequirementRow, row: DeadlineRow) -> RequirementRow:
     """The requirement row ``own`` with the deadline ``row`` rolled in (:func:`fold_into`)."""
-    rq = {**own, "deadline": row,
-          # the requirement as its own check left it: its own argument is built from it (report/argument/deadlines.py)
-          "without_deadline": {k: own.get(k) for k in ("verdict", "status", "note")}}
-    v, st = row["verdict"], row["status"]
+    # the requirement as its own check left it: its own argument is built from it (report/argument/deadlines.py)
+    rq = replace(own, deadline=row, without_deadline=WithoutDeadline(own.verdict, own.status, own.note))
+    v, st = row.verdict, "discharged" if row.status is msgspec.UNSET else row.status
     if v == "proved":
         if st != "discharged":  # the chain's evidence is outstanding: not met yet
-            if rq.get("verdict") == "met":
-                rq["verdict"] = "proved, evidence outstanding"
-            rq["status"] = worst([str(rq.get("status", "pending")), st])
-            open_steps = [f"{c['node']} guarantee {c['guarantee']} ({c['status']})"
-                          for c in row.get("chain", []) if c.get("status") != "discharged"]
-            rq["note"] = (f"end-to-end deadline proved, evidence of its chain {st}"
-                          + (f": {', '.join(open_steps)}" if open_steps else "")
-                          + (f"; without the deadline: {rq['note']}" if rq.get("note") else ""))
+            open_steps = [f"{c.node} guarantee {c.guarantee} ({c.status})"
+                          for c in row.chain or () if c.status != "discharged"]
+            rq = replace(rq, verdict="proved, evidence outstanding" if own.verdict == "met" else own.verdict,
+                         status=worst([own.status, st]),
+                         note=(f"end-to-end deadline proved, evidence of its chain {st}"
+                               + (f": {', '.join(open_steps)}" if open_steps else "")
+                               + (f"; without the deadline: {own.note}" if own.note else "")))
         return rq
-    said = f"end-to-end deadline {row['within']} along {' -> '.join(row['path'])} {v}: {row['reason']}"
-    old = rq.get("verdict")
-    note = str(rq.get("note") or "")
+    said = f"end-to-end deadline {row.within} along {' -> '.join(row.path)} {v}: {row.reason}"
+    old, verdict = own.verdict, own.verdict
     if v == "refuted" and old != "error":
-        rq["verdict"] = "refuted"
+        verdict = "refuted"
     elif v in ("stale", "error") and old not in _WORSE:
-        rq["verdict"] = v
+        verdict = v
     elif v in ("inconclusive", "pending") and old not in _WORSE and old != "stale":
-        rq["verdict"] = "inconclusive"
-    rq["status"] = worst([str(rq.get("status", "pending")), st])
-    rq["note"] = said + (f"; {note}" if note and old != "informal" else "")
-    return rq
+        verdict = "inconclusive"
+    return replace(rq, verdict=verdict, status=worst([own.status, st]),
+                   note=said + (f"; {own.note}" if own.note and old != "informal" else ""))
 
 
-def strict_ok(rows: Sequence[Mapping[str, Any]]) -> bool:
+def strict_ok(rows: Sequence[DeadlineRow]) -> bool:
     """``--strict`` holds for the deadlines: every one is proved, and every
     hop of its chain discharged with its deadline measured on a run
     (:func:`_timing_measured`)."""
-    return all(r["verdict"] == "proved" and r.get("status", "discharged") == "discharged" for r in rows)
+    return all(r.verdict == "proved" and r.status in (msgspec.UNSET, "discharged") for r in rows)
 
 
 def strict_reason(rows: Sequence[DeadlineRow]) -> list[str]:

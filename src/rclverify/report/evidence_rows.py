@@ -19,7 +19,6 @@ from rclverify.backends.property_tests.payload import PropertyTestsPayload
 from rclverify.records.records import Obligation
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.evidence_rows import EvidenceRow
-from rclverify.records.report_schema import EvidenceJson, ObligationJson, PendingJson
 from rclverify.records.solvers_rows import Solvers
 from rclverify.records.verdict_rows import PendingRow
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
@@ -38,9 +37,9 @@ class EvidencePart(TypedDict):
     declarations; ``altered``: one problem sentence per record
     that cannot be read as rclverify wrote it; ``inputs``: obligation id ->
     the input sha256s its evidence was made from (``None``: no record)."""
-    obligations: list[ObligationJson]
-    evidence: list[EvidenceJson]
-    pending: list[PendingJson]
+    obligations: list[ObligationRow]
+    evidence: list[EvidenceRow]
+    pending: list[PendingRow]
     status: dict[str, str]
     declared: dict[str, list[tuple[str, Any]]]
     altered: list[str]
@@ -79,13 +78,13 @@ def _explanation(ev: Any, status: str, altered: str, solvers: Solvers | None) ->
 
 
 def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Solvers | None,
-                 payload: Payload | None = None) -> EvidenceJson:
+                 payload: Payload | None = None) -> EvidenceRow:
     """The report's row of the evidence record ``ev`` shown with ``status``
     (``altered``: why the record is not believed, '' when it is;
     ``solvers``: the second solver's agreement, ``None`` without one;
     ``payload``: its ``details`` decoded by :func:`~rclverify.backends.payloads.payload_of`,
-    ``None`` for a backend whose payload is no Struct), as the JSON object of
-    :class:`~rclverify.records.evidence_rows.EvidenceRow` (every field)."""
+    ``None`` for a backend whose payload is no Struct), an
+    :class:`~rclverify.records.evidence_rows.EvidenceRow`."""
     d = ev.details if isinstance(ev.details, dict) else {}
     figures, svg = evidence_extras(ws, d)
     examples: dict[str, Any] = {}
@@ -99,7 +98,7 @@ def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Sol
         artifacts=list(ev.artifacts), log_excerpt=ev.log[-2000:], figures=figures, plot_svg=svg, solvers=solvers,
         examples=examples, monitoring=d["monitoring"] if d.get("monitoring") else {},
         statistics=compact_statistics(d["statistics"]) if isinstance(d.get("statistics"), dict) else {},
-    ).to_json()
+    )
 
 
 def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_lists: Mapping[str, str],
@@ -131,16 +130,16 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
         part["obligations"].append(ObligationRow(
             id=o.id, node=o.node, guarantee=o.guarantee, backend=o.backend, kind=cast(EvidenceKind, o.kind),
             instance=o.instance, statement=o.statement, source=str(o.source), artifact=o.artifact,
-            status=cast(EvidenceStatus, status)).to_json())  # the record's words: the vocabulary's (records/statuses.py)
+            status=cast(EvidenceStatus, status)))  # the record's words: the vocabulary's (records/statuses.py)
         if ev is None:
             if altered:
                 part["altered"].append(f"Evidence {o.id} is error: {altered}")
             else:
-                part["pending"].append(PendingRow(o.id, o.backend, "no evidence record yet: run `doit verify`").to_json())
+                part["pending"].append(PendingRow(o.id, o.backend, "no evidence record yet: run `doit verify`"))
             continue
         if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged
             part["declared"].setdefault(o.node, []).append((status, ev.details["declarations"]))
         part["evidence"].append(evidence_row(ws, ev, status, altered, solvers, payload))
         if status == "pending":
-            part["pending"].append(PendingRow(o.id, o.backend, ev.explanation).to_json())
+            part["pending"].append(PendingRow(o.id, o.backend, ev.explanation))
     return part

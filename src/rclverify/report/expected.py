@@ -24,7 +24,7 @@ from typing import Mapping, Sequence
 
 from rclverify.model.plan.expected import VERDICTS
 from rclverify.model.plan.load import Plan
-from rclverify.records.report_schema import ExpectedVerdictJson, ObligationJson
+from rclverify.records.obligations import ObligationRow
 from rclverify.records.verdict_rows import ExpectedVerdictRow
 
 
@@ -36,11 +36,11 @@ def _loc(plan: Plan, node: str, index: int, k: int) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
-def expected_rows(plan: Plan, ob_rows: Sequence[ObligationJson]) -> list[ExpectedVerdictJson]:
+def expected_rows(plan: Plan, ob_rows: Sequence[ObligationRow]) -> list[ExpectedVerdictRow]:
     """One :class:`~rclverify.records.verdict_rows.ExpectedVerdictRow` per (expectation, matching
-    obligation) of every evidence entry, as its JSON object; ``actual``/``obligation`` are ``None`` when
+    obligation) of every evidence entry; ``actual``/``obligation`` are ``None`` when
     nothing matches or the expectation is malformed (``outcome`` then says why)."""
-    rows: list[ExpectedVerdictJson] = []
+    rows: list[ExpectedVerdictRow] = []
     for node, entries in plan.evidence.items():
         for e in entries:
             exp = e.config.get("expected")
@@ -53,20 +53,20 @@ def expected_rows(plan: Plan, ob_rows: Sequence[ObligationJson]) -> list[Expecte
                         and item.get("verdict") in VERDICTS):
                     rows.append(ExpectedVerdictRow(
                         node, e.backend, src, None, None, None, None, None, "",
-                        "invalid expectation: give guarantee (a number) and verdict (discharged or failed)").to_json())
+                        "invalid expectation: give guarantee (a number) and verdict (discharged or failed)"))
                     continue
                 g, verdict = int(item["guarantee"]), str(item["verdict"])
                 inst = item.get("instance")
                 reason = str(item.get("reason", ""))
-                matches = [o for o in ob_rows if o["node"] == node and o["backend"] == e.backend
-                           and o["guarantee"] == g and (inst is None or o["instance"] == inst)]
+                matches = [o for o in ob_rows if o.node == node and o.backend == e.backend
+                           and o.guarantee == g and (inst is None or o.instance == inst)]
                 if not matches:
                     rows.append(ExpectedVerdictRow(node, e.backend, src, None, None, g, inst, verdict, reason,
-                                                   "no obligation matches").to_json())
+                                                   "no obligation matches"))
                 for o in matches:
-                    actual = o["status"]
+                    actual = o.status
                     outcome = ("as expected" if actual == verdict
                                else "MISMATCH" if actual in VERDICTS else "not yet decided")
-                    rows.append(ExpectedVerdictRow(node, e.backend, src, o["id"], actual, g, inst, verdict, reason,
-                                                   outcome).to_json())
+                    rows.append(ExpectedVerdictRow(node, e.backend, src, o.id, actual, g, inst, verdict, reason,
+                                                   outcome))
     return rows

@@ -13,7 +13,6 @@ from rclverify.model.plan.acknowledged import apply_acknowledgements
 from rclverify.records.findings import FindingRow
 from rclverify.records.grounding_rows import GroundingRow
 from rclverify.records.lint_rows import AcknowledgementRow, LintRow
-from rclverify.records.report_schema import AcknowledgementJson, FindingJson, GroundingJson, LintJson
 from rclverify.report.records import diagnostics as read_diagnostics, grounding as read_grounding
 from rclverify.stages.workspace import Workspace
 
@@ -32,9 +31,8 @@ def lint_rows(ws: Workspace) -> list[dict[str, Any]]:
 
 
 def acknowledged_rows(ws: Workspace, findings: Sequence[FindingRow], lint: Sequence[Mapping[str, Any]]
-                      ) -> tuple[list[FindingJson], list[LintJson], list[AcknowledgementJson]]:
-    """``(findings, lint, acknowledgements)``: the finding rows as the
-    report's JSON objects and new lint rows, each marked with what a warning
+                      ) -> tuple[list[FindingRow], list[LintRow], list[AcknowledgementRow]]:
+    """``(findings, lint, acknowledgements)``: new finding and lint rows, each marked with what a warning
     flags (``flagged``, ``sha256``) and the plan's answer to it
     (``acknowledged``), and one row per acknowledgement of the plan with its
     status (model/plan/acknowledged.py; docs/plan.md).  Each marked row
@@ -42,17 +40,18 @@ def acknowledged_rows(ws: Workspace, findings: Sequence[FindingRow], lint: Seque
     :class:`~rclverify.records.lint_rows.LintRow`,
     :class:`~rclverify.records.lint_rows.AcknowledgementRow`), so the report
     holds no key the class does not declare (:class:`msgspec.ValidationError`
-    otherwise: a bug of the build)."""
+    otherwise: a bug of the build).  The acknowledgements' matching (model/plan/acknowledged.py) marks
+    the rows' JSON objects."""
     f_rows, l_rows = [f.to_json() for f in findings], [dict(x) for x in lint]
     acks = apply_acknowledgements(ws.plan.acknowledged, f_rows, l_rows, ws.checked)
-    return ([FindingRow.of(f).to_json() for f in f_rows], [LintRow.of(r).to_json() for r in l_rows],
-            [AcknowledgementRow.of(a).to_json() for a in acks])
+    return ([FindingRow.of(f) for f in f_rows], [LintRow.of(r) for r in l_rows],
+            [AcknowledgementRow.of(a) for a in acks])
 
 
-def grounding_row(ws: Workspace) -> GroundingJson | None:
+def grounding_row(ws: Workspace) -> GroundingRow | None:
     """The grounding in the robot's software (docs/ros.md) with its drawing's
     SVG text (``svg_text``, ``None`` when unreadable), decoded into
-    :class:`~rclverify.records.grounding_rows.GroundingRow`, as its JSON object;
+    :class:`~rclverify.records.grounding_rows.GroundingRow`;
     ``None`` when the plan names no ROS software.  Raises
     :class:`msgspec.ValidationError` for a record of another shape (a bug:
     the stage seals what it writes)."""
@@ -66,4 +65,4 @@ def grounding_row(ws: Workspace) -> GroundingJson | None:
         svg_text = ws.path(svg_rel).read_text(encoding="utf-8") if svg_rel else None
     except OSError:
         svg_text = None
-    return GroundingRow.of({**grounding, "svg_text": svg_text}).to_json()
+    return GroundingRow.of({**grounding, "svg_text": svg_text})

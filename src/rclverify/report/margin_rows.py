@@ -35,7 +35,7 @@ from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.report.chain_margins import hop_margin
 from rclverify.records.deadline_rows import HopTimeMargin
 from rclverify.records.margin_rows import MarginBounds, MarginRow
-from rclverify.records.report_schema import MarginJson, ObligationJson
+from rclverify.records.obligations import ObligationRow
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
 
@@ -122,35 +122,35 @@ def _formula(ws: Workspace, node: str, k: int) -> str:
         else ""
 
 
-def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[MarginJson]:
+def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginRow]:
     """The report's ``margins`` (module docstring), by node and guarantee, each a
-    :class:`~rclverify.records.margin_rows.MarginRow`'s JSON object."""
+    :class:`~rclverify.records.margin_rows.MarginRow`."""
     runs: dict[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]] = {}
     timed: dict[tuple[str, int], list[dict[str, Any]]] = {}  # the runs' deadline records, as hop_margin reads them
     seen: dict[str, set[str]] = {}  # node -> the identities of its runs read so far
     store: EvidenceStore | None = None
     for o in ob_rows:
-        if o["backend"] != "monitors" or o["status"] == "error":
+        if o.backend != "monitors" or o.status == "error":
             continue
         store = store or EvidenceStore(ws.root)
-        ev, problem = store.read(str(o["id"]))
+        ev, problem = store.read(o.id)
         if ev is None or problem or not isinstance(ev.details, dict):
             continue
-        if _seen_before(seen.setdefault(str(o["node"]), set()), ev.details, str(o["id"])):
+        if _seen_before(seen.setdefault(o.node, set()), ev.details, o.id):
             continue  # another form or copy of a run already read: one run, counted once
         mon = ev.details.get("monitoring") or {}
         for m in mon.get("margins") or () if isinstance(mon, dict) else ():
             if isinstance(m, dict) and isinstance(m.get("guarantee"), int):
-                runs.setdefault((str(o["node"]), m["guarantee"]), []).append(
-                    (str(o["id"]), str(m.get("trace") or mon.get("trace", "")), m))
+                runs.setdefault((o.node, m["guarantee"]), []).append(
+                    (o.id, str(m.get("trace") or mon.get("trace", "")), m))
         dl = ev.details.get("deadlines")
         for t in (dl.get("time_margins") or ()) if isinstance(dl, dict) else ():
             if isinstance(t, dict) and isinstance(t.get("guarantee"), int):
-                timed.setdefault((str(o["node"]), t["guarantee"]), []).append(
-                    {"obligation": str(o["id"]), "time_margins": [t]})
+                timed.setdefault((o.node, t["guarantee"]), []).append(
+                    {"obligation": o.id, "time_margins": [t]})
     rows = [_row(ws, node, k, runs.get((node, k), []), hop_margin(k, timed.get((node, k), [])))
             for node, k in sorted(set(runs) | set(timed))]
-    return [r.to_json() for r in _plots(rows, runs)]
+    return _plots(rows, runs)
 
 
 def _seen_before(seen: set[str], details: Mapping[str, Any], obligation: str) -> bool:

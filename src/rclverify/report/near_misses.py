@@ -27,7 +27,7 @@ from typing import Any, Callable, Literal, Mapping, Sequence
 from rclverify.records.margin_rows import NearMissRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.row import decode_rows
-from rclverify.records.report_schema import NearMissJson, ObligationJson, Report
+from rclverify.records.obligations import ObligationRow
 from rclverify.records.sarif import SarifResult
 from rclverify.records.store import EvidenceStore
 from rclverify.stages.workspace import Workspace
@@ -70,21 +70,21 @@ def _guarantee_place(ws: Workspace, node: str, k: int) -> str:
     return f"{l.file}:{l.line}:{l.col}"
 
 
-def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[NearMissJson]:
+def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[NearMissRow]:
     """The report's ``near_misses`` (module docstring), in obligation order,
     space margins before time margins, guarantees in order, each a
-    :class:`~rclverify.records.margin_rows.NearMissRow`'s JSON object."""
-    rows: list[NearMissJson] = []
-    nodes = {str(o["node"]) for o in ob_rows if o["backend"] == "monitors"}
+    :class:`~rclverify.records.margin_rows.NearMissRow`."""
+    rows: list[NearMissRow] = []
+    nodes = {o.node for o in ob_rows if o.backend == "monitors"}
     wanted = {n: _entries(ws, n) for n in nodes}
     if not any(wanted.values()):
         return rows
     store = EvidenceStore(ws.root)
     for o in ob_rows:
-        node = str(o["node"])
-        if o["backend"] != "monitors" or not wanted.get(node) or o["status"] in ("failed", "error"):
+        node = o.node
+        if o.backend != "monitors" or not wanted.get(node) or o.status in ("failed", "error"):
             continue
-        ev, problem = store.read(str(o["id"]))
+        ev, problem = store.read(o.id)
         if ev is None or problem or not isinstance(ev.details, dict):
             continue
         mon = ev.details.get("monitoring") or {}
@@ -96,13 +96,13 @@ def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationJson]) -> list[Nea
         t, plan_place = hit[1], hit[2]
 
         def row(m: Mapping[str, Any], kind: Literal["value", "time"], margin: float, threshold: float, unit: str,
-                atom: str, where: str, at: Any, node: str = node, o: ObligationJson = o, trace: str = trace,
-                plan_place: str = plan_place) -> NearMissJson:
+                atom: str, where: str, at: Any, node: str = node, o: ObligationRow = o, trace: str = trace,
+                plan_place: str = plan_place) -> NearMissRow:
             k = int(m["guarantee"])
             return NearMissRow(node=node, guarantee=k, kind=kind, margin=margin, threshold=threshold, unit=unit,
                                atom=atom, where=where, time=float(at) if isinstance(at, (int, float)) else None,
-                               trace=trace, obligation=str(o["id"]), source=_guarantee_place(ws, node, k),
-                               threshold_source=plan_place).to_json()
+                               trace=trace, obligation=o.id, source=_guarantee_place(ws, node, k),
+                               threshold_source=plan_place)
         if t.value is not None:
             for m in mon.get("margins") or ():
                 v = m.get("margin")

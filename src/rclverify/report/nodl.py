@@ -21,7 +21,6 @@ from typing import Any, Callable, Mapping
 
 from rclverify.records.nodl_rows import NodlPlaceRow, NodlRow
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import NodlJson, Report
 from rclverify.records.sarif import SarifLocation, SarifResult
 from rclverify.report.shapes import GroundingBrief
 from rclverify.stages.workspace import Workspace
@@ -36,18 +35,17 @@ SARIF_RULES = (
 )
 
 
-def nodl_row(ws: Workspace) -> NodlJson | None:
+def nodl_row(ws: Workspace) -> NodlRow | None:
     """The report's ``nodl``: the stage's record as :func:`rclverify.stages.nodl.read_nodl` reads
-    it (stale or altered said) decoded into :class:`~rclverify.records.nodl_rows.NodlRow`, as its
-    JSON object; ``None`` when the workspace has no NoDL document.  Raises
+    it (stale or altered said) decoded into :class:`~rclverify.records.nodl_rows.NodlRow`; ``None`` when the workspace has no NoDL document.  Raises
     :class:`msgspec.ValidationError` for a record of another shape (a bug: the stage seals what it
     writes)."""
     from rclverify.stages.nodl import read_nodl  # deferred: start-up (loads jsonschema and yaml only when called)
     record = read_nodl(ws)
-    return None if record is None else NodlRow.of(record).to_json()
+    return None if record is None else NodlRow.of(record)
 
 
-def nodl_inputs(ws: Workspace, row: Mapping[str, Any] | None) -> dict[str, object] | None:
+def nodl_inputs(ws: Workspace, row: NodlRow | None) -> dict[str, object] | None:
     """What ``meta.inputs_sha256`` takes of the NoDL check (:func:`rclverify.report.records.inputs_sha256`):
     the sha256 the record was made from (``made_from``) and those of the same files and the current
     documents now (``now``), so a report built before a document changed is not the one built after;
@@ -56,33 +54,29 @@ def nodl_inputs(ws: Workspace, row: Mapping[str, Any] | None) -> dict[str, objec
         return None
     from rclverify.records.records import hash_inputs  # deferred: start-up (loads rclverify.records only when called)
     from rclverify.stages.nodl import documents  # deferred: start-up (loads jsonschema and yaml only when called)
-    made = dict(row.get("inputs") or {})
+    made = dict(row.inputs)
     return {"made_from": made, "now": hash_inputs(ws.root, sorted(set(made) | set(documents(ws.root))))}
-
-
-def _where(place: Mapping[str, Any]) -> str:
-    return f"{place['file']}:{place['line']}:{place['col']}"
 
 
 def _at(place: NodlPlaceRow) -> str:
     return f"{place.file}:{place.line}:{place.col}"
 
 
-def nodl_problems(row: Mapping[str, Any] | None) -> list[str]:
+def nodl_problems(row: NodlRow | None) -> list[str]:
     """The report's problem sentences of ``row``: a stale or altered record, each NoDL error."""
     if row is None:
         return []
-    out = [f"NoDL check is stale: {row['stale']}"] if row.get("stale") else []
-    for f in row["findings"]:
-        if f["severity"] == "error":
-            at = f" at {', '.join(_where(p) for p in f['places'])}" if f["places"] else ""
-            out.append(f"NoDL {f['code']}{at}: {f['message']}")
+    out = [f"NoDL check is stale: {row.stale}"] if row.stale else []
+    for f in row.findings:
+        if f.severity == "error":
+            at = f" at {', '.join(_at(p) for p in f.places)}" if f.places else ""
+            out.append(f"NoDL {f.code}{at}: {f.message}")
     return out
 
 
-def blocks_strict(row: Mapping[str, Any] | None) -> bool:
+def blocks_strict(row: NodlRow | None) -> bool:
     """Whether ``row`` fails ``--strict``: a NoDL error, or a record stale or altered."""
-    return row is not None and bool(row["counts"].get("error") or row.get("stale"))
+    return row is not None and bool(row.counts.get("error") or row.stale)
 
 
 def strict_reason(row: NodlRow | None) -> list[str]:

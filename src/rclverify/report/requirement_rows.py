@@ -14,7 +14,6 @@ from typing import Any, Callable, Mapping
 from rclverify.calculus.requirements.rollup import declaration_evidence, declaration_statuses, roll_up
 from rclverify.model.plan.load import all_requirements
 from rclverify.records.records import worst
-from rclverify.records.report_schema import RequirementJson
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.cex_cone import with_trace_view  # a temporal trace cut to what matters
 from rclverify.report.contract_rows import GuaranteeStatuses
@@ -63,17 +62,17 @@ def requirement_check(record: Mapping[str, Any] | None, traced_status: str, g_st
 
 
 def requirement_rows(ws: Workspace, texts: ContractTexts, checks: Mapping[str, Any], g_status: GuaranteeStatuses,
-                     sc_status: Mapping[str, str], declared: Mapping[str, list[tuple[str, Any]]]) -> list[RequirementJson]:
+                     sc_status: Mapping[str, str], declared: Mapping[str, list[tuple[str, Any]]]) -> list[RequirementRow]:
     """One row per requirement of ``ws``'s plan (module docstring), each
-    :class:`~rclverify.records.requirement_rows.RequirementRow` as its JSON
-    object (every field; the later passes' at their defaults): its support
+    a :class:`~rclverify.records.requirement_rows.RequirementRow` (the later passes' fields at their
+    defaults): its support
     (the guarantees it is traced to, with their statuses), then its check's
     fields (:func:`requirement_check`).  ``checks``: requirement id -> its
     check record (sealed, stale and second solver applied); ``declared``:
     node -> the records that judged its declarations.  Raises
     :class:`msgspec.ValidationError` when a check's verdict or status is
     outside the vocabulary (a bug of the roll-up)."""
-    rows: list[RequirementJson] = []
+    rows: list[RequirementRow] = []
     for r in all_requirements(ws.plan):
         support: list[dict[str, Any]] = []  # SupportRow's fields, checked when the row is decoded below
         for s in r.support:
@@ -86,5 +85,5 @@ def requirement_rows(ws: Workspace, texts: ContractTexts, checks: Mapping[str, A
                                 declaration_statuses(declared, ws.checked))
         rows.append(RequirementRow.of({"id": r.id, "text": r.text, "verdict": got["verdict"], "status": got["status"],
                                        "note": got["note"], "support": support,
-                                       "check": got["check"]}).to_json())
+                                       "check": got["check"]}))
     return rows

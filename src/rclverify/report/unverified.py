@@ -16,8 +16,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
-from rclverify.records.node_rows import UnverifiedRow
-from rclverify.records.report_schema import UnverifiedJson
+from rclverify.records.node_rows import NodeRow, UnverifiedRow
 
 #: The status of a guarantee without any obligation.
 UNVERIFIED: Literal["unverified"] = "unverified"
@@ -28,11 +27,9 @@ def guarantee_id(node: str, k: int) -> str:
     return f"{node}.g{k}"
 
 
-def unverified_guarantees(plan: Any, nodes: Sequence[Mapping[str, Any]]) -> list[UnverifiedJson]:
-    """One row per guarantee of ``nodes`` (the report's node rows, each with
-    ``name`` and ``guarantees``: ``[{"index", "text", "source",
-    "obligations"}]``) that no obligation covers, in report order, each an
-    :class:`~rclverify.records.node_rows.UnverifiedRow`'s JSON object::
+def unverified_guarantees(plan: Any, nodes: Sequence[NodeRow]) -> list[UnverifiedRow]:
+    """One row per guarantee of ``nodes`` (the report's node rows) that no obligation covers, in report
+    order, each an :class:`~rclverify.records.node_rows.UnverifiedRow`::
 
         {"id": "Node.g<k>", "node", "guarantee": k, "text", "source" (file:line:col),
          "status": "unverified", "reason", "message"}
@@ -42,24 +39,24 @@ def unverified_guarantees(plan: Any, nodes: Sequence[Mapping[str, Any]]) -> list
     obligation for this guarantee.  ``message`` is the one-line problem
     (summary ``problems``).  ``plan.evidence`` maps node names to their
     entries (:class:`rclverify.model.plan.model.EvidenceEntry`)."""
-    out: list[UnverifiedJson] = []
+    out: list[UnverifiedRow] = []
     for n in nodes:
-        name = str(n["name"])
+        name = n.name
         entries = tuple(getattr(plan, "evidence", {}).get(name, ()))
         backends = sorted({str(e.backend) for e in entries})
-        for g in n["guarantees"]:
-            if g["obligations"]:
+        for g in n.guarantees:
+            if g.obligations:
                 continue
-            k = int(g["index"])
+            k = g.index
             if not entries:
                 reason = f"the plan lists no evidence for {name} (nodes.{name}.evidence), so no obligation covers it"
             else:
                 reason = (f"none of the plan's evidence entries for {name} ({', '.join(backends)}) "
                           "exports an obligation for it")
             gid = guarantee_id(name, k)
-            out.append(UnverifiedRow(id=gid, node=name, guarantee=k, text=str(g["text"]), source=str(g["source"]),
+            out.append(UnverifiedRow(id=gid, node=name, guarantee=k, text=g.text, source=g.source,
                                      status=UNVERIFIED, reason=reason,
-                                     message=f"Guarantee {gid} ({g['source']}) is unverified: {reason}.").to_json())
+                                     message=f"Guarantee {gid} ({g.source}) is unverified: {reason}."))
     return out
 
 
