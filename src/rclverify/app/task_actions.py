@@ -218,7 +218,7 @@ def act_report(root: str, part: str) -> Any:
         return _io_fail(exc, root, "reports/")
     _REPORTS[root] = (ws, report)
     if part == "html":
-        print(f"report: reports/assurance.html  ({report['summary']['headline']})")
+        print(f"report: reports/assurance.html  ({report.summary.headline})")
     else:
         print("report: reports/assurance.md, reports/argument.{json,gsn.yaml,dot}")
     return None

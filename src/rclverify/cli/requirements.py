@@ -26,9 +26,9 @@ def show_requirements(ws: "Workspace", out: TextIO) -> int:
     from rclverify.report.explain import requirement_lines  # deferred: start-up (loads rclverify.diagnosis, rclverify.diagnosis.table and more only when called)
     report = build_report(ws)
     bad = 0
-    for r in report["requirements"]:
+    for r in report.requirements:
         out.write("".join(line + "\n" for line in requirement_lines(r)))
-        bad += r["verdict"] in BAD
+        bad += r.verdict in BAD
     return 1 if bad else 0
 
 

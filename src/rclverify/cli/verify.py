@@ -17,7 +17,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         report, paths = stage_report(workspace_of(args))
     for p in paths:
         print(p)
-    print(report["summary"]["headline"])
+    print(report.summary.headline)
     return 0
 
 
