@@ -247,3 +247,70 @@ def test_bundled_runs_judged_in_batch_equal_the_streaming_monitor(example: str, 
         judged += len(got)
         batched += mon.stats["batched"]
     assert batched > 0 and judged > 0
+
+
+def _skewed(skew: float) -> Any:
+    rules = load_rules({"trig": {"fields": ["data"]}, "ans": {"fields": ["data"]}, "other": {"fields": ["data"]}})
+    rules.skew = skew
+    return rules
+
+
+def _bench_shaped(rng: random.Random, n: int) -> list[Event]:
+    """The windowed race's deadline log: at each 10 ms sample a trigger with probability 1/2 and an answer
+    (after it, at its stamp) with 0.7, every answer right."""
+    out: list[Event] = []
+    for i in range(n):
+        if rng.random() < 0.5:
+            out.append(Event(len(out), i / 100, "trig", {"data": 0.0}, f"run:{len(out) + 1}"))
+        if rng.random() < 0.7:
+            out.append(Event(len(out), i / 100, "ans", {"data": 2.0}, f"run:{len(out) + 1}"))
+    return out
+
+
+def test_the_transport_skew_is_judged_in_batch_to_the_streaming_verdicts() -> None:
+    """With the mapping's skew (deadline_skew.py: an obligation left unanswered for which an output stamped
+    within the skew before its trigger satisfies the guarantee is undecided, its late answer no verdict), the
+    batch judge marks the unmet obligations as the monitor does and judges the chunk in batch: the verdicts
+    and result equal the streaming monitor's on random runs (skew 3 and 20 ms, chunks of 1 event up) and on
+    the race's shape, where every chunk is judged in batch.  Control: a batch judge that ignores the skew
+    (marks nothing) gives ``false`` where the monitor is undecided."""
+    rng = random.Random("skew-batch")
+    undecided = batched = 0
+    for case in range(30):
+        rules = _skewed(rng.choice([0.003, 0.02]))
+        run = _run(rng, rng.choice([40, 300]), case % 3 == 0)
+        node = CHECKED.nodes[rng.choice(["D", "E"])] if case % 2 else NODE
+        if node.name == "E":
+            run = [Event(e.index, e.time, e.topic, {"data": "hi" if e.fields.get("data", 0) else "lo"}, e.where)
+                   if e.topic == "ans" else e for e in run]
+        seen: list[Any] = []
+        stream = _judge(DeadlineMonitor(CHECKED, node, rules, seen.append, HORIZON), run, seen)
+        got: list[Any] = []
+        mon = deadline_monitor(CHECKED, node, rules, got.append, HORIZON, chunk=rng.choice([1, 3, 16, 4096]))
+        assert isinstance(mon, BatchDeadlines)
+        assert _judge(mon, run, got) == stream, f"case {case}"
+        undecided += stream["result"]["unaccepted"]["undecided"]
+        batched += mon.stats["batched"]
+    assert undecided > 20 and batched > 1000, (undecided, batched)
+    rules = _skewed(0.02)
+    run = _bench_shaped(random.Random(5), 3000)
+    seen = []
+    stream = _judge(DeadlineMonitor(CHECKED, NODE, rules, seen.append, HORIZON), run, seen)
+    got = []
+    mon = deadline_monitor(CHECKED, NODE, rules, got.append, HORIZON, chunk=512)
+    assert isinstance(mon, BatchDeadlines)
+    assert _judge(mon, run, got) == stream and mon.stats["streamed"] == 0
+    assert stream["result"]["unaccepted"]["undecided"] > 5
+
+
+def test_control_a_batch_judge_ignoring_the_skew_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    rules = _skewed(0.02)
+    run = _bench_shaped(random.Random(5), 3000)
+    seen: list[Any] = []
+    stream = _judge(DeadlineMonitor(CHECKED, NODE, rules, seen.append, HORIZON), run, seen)
+    monkeypatch.setattr(batch_deadline_chunk, "_mark", lambda *a: False)
+    got: list[Any] = []
+    mon = deadline_monitor(CHECKED, NODE, rules, got.append, HORIZON, chunk=512)
+    wrong = _judge(mon, run, got)
+    assert wrong["result"]["counts"]["false"] > stream["result"]["counts"]["false"]
+    assert wrong["result"]["unaccepted"]["undecided"] < stream["result"]["unaccepted"]["undecided"]

@@ -10,6 +10,7 @@ from rclverify.core.numeric import np
 from rclverify.traces.events import Event
 from rclverify.targets.column_deadlines import expiries, first_answers, ns_column
 from rclverify.targets.columns import column, field_values
+from rclverify.backends.monitors import deadline_skew
 from rclverify.backends.monitors.deadline_records import Pending
 from rclverify.backends.monitors.time_margins import TimeMargin
 
@@ -86,8 +87,12 @@ def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
     met = is_open & (answer >= 0) & ((expiry >= n) | (answer <= expiry))
     lapsed = is_open & ~met & (expiry < n)
     late = (~is_open | lapsed) & (answer >= 0)
-    if mon.skew_ns and _skew_early(mon, ns, rows, which, inputs, out_rows, col_out, carried, ~met, lapsed | late):
-        return False  # an answer within the transport skew before its trigger: the streaming monitor's (deadline_skew)
+    skewed = np.zeros(0, dtype=np.int64)
+    if mon.skew_ns:  # the obligations left unmet whose answer may be an output within the skew before them
+        got = _skew_window(mon, ns, rows, out_rows, ~met & (np.arange(m) >= len(carried)))
+        if got is None or (refused.size and mon.result.first_unaccepted is None and bool(lapsed.any())):
+            return False  # a window past the 64 outputs the monitor keeps; or which unaccepted trigger is first
+        skewed = got
     order = np.arange(m) - L0  # an open obligation's place in the monitor's list (the expired: below 0)
     # each verdict as (row, phase, place): late answers of expired obligations (0), answers (1), expiries (2)
     ev_at = np.concatenate([answer[late], answer[met], expiry[lapsed]])
@@ -103,51 +108,53 @@ def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
     if held.size and int(held[ev_phase == 2].max(initial=0)) > (mon.expired.maxlen or 0):
         return False  # the monitor would drop an expired obligation: its own judging
     _apply(mon, evs, ns, rows, which, due, out_rows, carried, L0, answer, expiry, met, lapsed,
-           (ev_at, ev_phase, ev_ob), refused, first_refused)
+           (ev_at, ev_phase, ev_ob), refused, first_refused, skewed)
     return True
 
 
-def _skew_early(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, which: np.ndarray, inputs: np.ndarray,
-                out_rows: np.ndarray, col_out: np.ndarray, carried: list[Pending], unmet: np.ndarray,
-                decided: np.ndarray) -> bool:
-    """Whether the transport skew's rule (:mod:`.deadline_skew`) touches the chunk: an obligation carried in
-    marked as maybe answered before its trigger is decided in it, or a trigger of the chunk not met in it has an
-    output stamped within the skew before it (an earlier chunk's, or one of the chunk's on which its guarantee
-    holds or is not surely decided).  Such a chunk is streamed."""
-    if any(p.maybe for i, p in enumerate(carried) if bool(decided[i])):
-        return True
+def _skew_window(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, out_rows: np.ndarray, unmet: np.ndarray
+                 ) -> np.ndarray | None:
+    """The obligations ``unmet`` (new ones, not met in the chunk) with an output stamped within the transport
+    skew before their trigger (the chunk's, or one the monitor heard before it): those :func:`_mark` reads;
+    ``None`` when such a window holds more than the 64 outputs the monitor keeps (its own judging)."""
     idx = np.flatnonzero(unmet & (rows >= 0))
     if not idx.size:
-        return False
+        return idx
     trig = rows[idx]
     lo_ns = ns[trig] - mon.skew_ns
-    if mon.heard and mon.heard[-1][0] >= int(lo_ns.min()):
-        return True
     lo = np.searchsorted(ns[out_rows], lo_ns, side="left")
     hi = np.searchsorted(out_rows, trig, side="left")
-    ik, ok = mon.plan.in_key, mon.plan.out_key
-    step = 0
-    while True:
-        pos = lo + step
-        has = pos < hi
-        if not bool(has.any()):
-            return False
-        at, obs = pos[has], idx[has]
-        for g, (_, _, _, judge) in enumerate(mon.plan.timed):
-            sel = np.flatnonzero(which[obs] == g)
-            if judge is None or not sel.size:
-                continue
-            truth, sure = judge({ik: inputs[obs[sel]], ok: col_out[at[sel]]})
-            if bool(np.broadcast_to(truth, sel.shape).any()) or not bool(np.broadcast_to(sure, sel.shape).all()):
-                return True
-        step += 1
+    count = np.maximum(hi - lo, 0)
+    heard = np.array([h[0] for h in mon.heard], dtype=np.int64)
+    before = np.where(lo == 0, len(heard) - np.searchsorted(heard, lo_ns, side="left"), 0) if heard.size else 0
+    count = count + before
+    if bool((count > (mon.heard.maxlen or 64)).any()):
+        return None
+    out: np.ndarray = idx[count > 0]
+    return out
+
+
+def _mark(mon: ChunkSide, p: Pending, evs: list[Event], ns: np.ndarray, out_rows: np.ndarray, r: int) -> bool:
+    """Mark obligation ``p`` (its trigger at row ``r``) as :func:`.deadline_skew.scan_heard` marks it when the
+    trigger comes: the outputs heard before the chunk, then the chunk's before row ``r``, oldest first, within
+    the skew; whether it is marked."""
+    deadline_skew.scan_heard(mon, p)
+    if not p.maybe:
+        ok = mon.plan.out_key
+        lo = int(np.searchsorted(ns[out_rows], p.stamp_ns - mon.skew_ns, side="left"))
+        hi = int(np.searchsorted(out_rows, r, side="left"))
+        for j in out_rows[lo:hi].tolist():
+            deadline_skew.mark_early(mon, p, evs[j], int(ns[j]), {ok: mon.mapped(evs[j], ok)})
+            if p.maybe:
+                break
+    return bool(p.maybe)
 
 
 def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, which: np.ndarray,  # long: verdicts and state share ob
            due: np.ndarray, out_rows: np.ndarray, carried: list[Pending], L0: int, answer: np.ndarray,
            expiry: np.ndarray, met: np.ndarray, lapsed: np.ndarray,
            verdicts: tuple[np.ndarray, np.ndarray, np.ndarray], refused: np.ndarray,
-           first_refused: tuple[str, str] | None) -> None:
+           first_refused: tuple[str, str] | None, skewed: np.ndarray) -> None:
     """Give a clean chunk's verdicts in order and leave the monitor's state (module docstring of
     :mod:`.batch_deadlines`)."""
     plan, result = mon.plan, mon.result
@@ -182,6 +189,14 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
         j = int(np.searchsorted(out_rows, upto, side="right")) - 1
         return int(out_rows[j]) if j >= 0 and int(out_rows[j]) > int(rows[i]) else -1
 
+    # the transport skew (deadline_skew): a marked obligation unanswered by its deadline is undecided, its late
+    # answer gives no verdict
+    maybe = np.zeros(len(rows), dtype=bool)
+    if mon.skew_ns:
+        for i, p in enumerate(carried):
+            maybe[i] = bool(p.maybe)
+        for i in skewed.tolist():
+            maybe[i] = _mark(mon, ob(i), evs, ns, out_rows, int(rows[i]))
     quiet = mon.on_verdict is None
     trues = 0
     at, phase, obs = verdicts
@@ -193,15 +208,20 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
                 continue
             mon._emit(mon.answered_verdict(ob(i), a, evs[r], plan.timed[int(which[i])][2]))
         elif ph == 0:
-            mon._emit(mon.late_verdict(ob(i), int(ns[r]), evs[r]))
+            if not maybe[i]:
+                mon._emit(mon.late_verdict(ob(i), int(ns[r]), evs[r]))
         else:
             p = ob(i)
             j = last_output(i, r)
             if j >= 0 and plan.timed[int(which[i])][3] is not None:
                 p.rejected = mon.rejection(p.k, p.inputs, ok, evs[j])
-            mon._emit(mon.expired_verdict(p, int(ns[r])))
+            if maybe[i]:
+                deadline_skew.undecided(mon, p)
+            else:
+                mon._emit(mon.expired_verdict(p, int(ns[r])))
     result.counts["true"] += trues
-    _note_margins(mon, evs, ns, which, due, ob, verdicts)
+    counted = ~(maybe[obs] & (phase != 1))  # a marked obligation's expiry and late answer count no time margin
+    _note_margins(mon, evs, ns, which, due, ob, (at[counted], phase[counted], obs[counted]))
     # the state: the open obligations left (in order), the expired ones not answered (in the expired list's order)
     last_out = int(out_rows[-1]) if out_rows.size else -1
     out_value = mon.mapped(evs[last_out], ok) if last_out >= 0 else None

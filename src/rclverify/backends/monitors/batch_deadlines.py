@@ -28,6 +28,15 @@ contract binds it); every trigger's assumption and every pair the search
 judges is surely decided in exact arithmetic (:mod:`rclverify.targets.columns`);
 no answer search passes :data:`~rclverify.targets.column_deadlines.PASSES`
 outputs; the expired obligations never exceed the 256 the monitor keeps.
+With the mapping's transport skew (:mod:`.deadline_skew`), each obligation
+the chunk leaves unmet is marked as the monitor marks it when its trigger
+comes (the outputs heard before the chunk, then the chunk's before the
+trigger, within the skew, the first on which the guarantee holds exactly,
+judged by the monitor's own code); a marked one unanswered by its deadline is
+counted ``undecided`` (no verdict, no time margin), its late answer gives
+none; a chunk where such a window holds more than the 64 outputs the monitor
+keeps, or where an assumption's refusal and an undecided trigger would race
+to be the first unaccepted, is streamed.
 A late or out-of-order stamp, a header, a value near a boundary: the
 chunk is streamed.
 
