@@ -5,6 +5,7 @@ import re
 from typing import Any, Mapping, Sequence
 
 from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.report_record import AssuranceReport
 
 
 #: Longest diagnosis sentence ``status`` prints whole (``explain`` prints it
@@ -136,24 +137,27 @@ def same_file_lines(culprits: Sequence[str]) -> list[str]:
     return out
 
 
-def finding_lines(report: Mapping[str, Any], wanted: str) -> list[str]:
+def finding_lines(report: AssuranceReport | Mapping[str, Any], wanted: str) -> list[str]:
     """A finding of the report's problems by root cause that has no
     diagnosis record of its own (an unverified guarantee ``Node.g<k>``, a
     derived property ``Node.derived``, a requirement): its id, status and
     kind, its sentence, the row it is in (culprits or where it was found)
-    and the other findings of that row; ``[]`` when ``wanted`` is none."""
-    for g in report.get("problems") or ():
-        for m in g.get("members", ()):
-            if m.get("id") != wanted:
+    and the other findings of that row; ``[]`` when ``wanted`` is none.
+    ``report``: the decoded report, or its JSON object (decoded here; raises
+    :class:`msgspec.ValidationError` when it does not decode)."""
+    for g in AssuranceReport.of(report).problems:
+        for m in g.members:
+            if m.id != wanted:
                 continue
-            out = [f"{wanted} [{m['status']}] ({m['kind']})", f"  {m['sentence']}"]
+            out = [f"{wanted} [{m.status}] ({m.kind})", f"  {m.sentence}"]
+            # a culprit: diagnosis/'s JSON object (what, source)
             cs = [f"{c['what']} ({c['source']})" if c.get("what") else str(c.get("source", ""))
-                  for c in g.get("culprits", ())]
+                  for c in g.culprits]
             if cs:
                 out += ["  culprits:"] + [f"    {c}" for c in cs]
-            elif g.get("where"):
-                out.append(f"  found at {g['where']}")
-            others = [x["id"] for x in g.get("members", ()) if x["id"] != wanted]
+            elif g.where:
+                out.append(f"  found at {g.where}")
+            others = [x.id for x in g.members if x.id != wanted]
             if others:
                 out.append("  the same root cause, found by: " + ", ".join(others))
             return out

@@ -13,15 +13,18 @@ same id up to case, ``_`` and the separator between a node and its
 guarantee.  :func:`explain` gives the lines to print, :func:`near_ids` the
 closest ids (``difflib``) when nothing matches.
 
-The report's requirements, nodes (their guarantees), side conditions, findings,
-obligations, diagnoses and problems are decoded into their definitions
-(records/node_rows.py, records/side_condition_rows.py, records/findings.py,
-records/obligations.py, records/problem_rows.py) and read as the
-attributes mypy checks; a finding, an obligation and a problem are printed
-by :mod:`.explain_items`: each field is
-printed or named in the record's ``INTERNAL_TO["explain"]`` with the reason
-(tests/records/test_record_shapes.py).  A row that does not decode raises
-:class:`msgspec.ValidationError` (a ``ValueError``).
+The report is decoded once into its record
+(:class:`~rclverify.records.report_record.AssuranceReport`; a JSON object given
+is decoded here) and read as the attributes mypy checks: its requirements,
+nodes (their guarantees), side conditions, findings, obligations, evidence,
+lint, diagnoses and problems.  What the records still keep as JSON is read by
+key: a requirement check's record, a monitored run's violations (the monitors'
+payload), a ROS grounding finding, and the SARIF log and the argument, which
+are files of their own.  A finding, an obligation and a problem are printed by
+:mod:`.explain_items`: each field is printed or named in the record's
+``INTERNAL_TO["explain"]`` with the reason (tests/records/test_record_shapes.py).
+A report that does not decode raises :class:`msgspec.ValidationError` (a
+``ValueError``).
 """
 from __future__ import annotations
 
@@ -31,13 +34,9 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import msgspec
 
-from rclverify.records.evidence_rows import EvidenceRow
-from rclverify.records.findings import rows_of as finding_rows_of
+from rclverify.records.lint_rows import LintRow
 from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
-from rclverify.records.row import decode_rows
-from rclverify.records.side_condition_rows import SideConditionRow
-from rclverify.records.obligations import rows_of as obligation_rows_of
-from rclverify.records.problem_rows import DiagnosisRow, rows_of as problem_rows_of
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
 from rclverify.report.explain_items import finding_lines, obligation_lines, problem_lines, side_condition_lines
@@ -97,27 +96,25 @@ def requirement_lines(row: RequirementRow | Mapping[str, Any]) -> list[str]:
 class _Index:
     """The report's items by id (see the module docstring)."""
 
-    def __init__(self, report: Mapping[str, Any], sarif: Any = None, argument: Any = None) -> None:
-        self.report = report
-        self.diagnoses = {d.id: d for d in decode_rows(DiagnosisRow, report.get("diagnoses") or [])}
-        self.nodes = {n.name: n for n in decode_rows(NodeRow, report["nodes"])}
-        self.requirements = {r.id: r for r in decode_rows(RequirementRow, report["requirements"])}
-        self.findings = {f.id: f for f in finding_rows_of(report["findings"])}
-        self.sides = {x.id: x for x in decode_rows(SideConditionRow, report["side_conditions"])}
-        self.obligations = {o.id: o for o in obligation_rows_of(report["obligations"])}
+    def __init__(self, report: AssuranceReport, sarif: Any = None, argument: Any = None) -> None:
+        self.diagnoses = {d.id: d for d in report.diagnoses}
+        self.nodes = {n.name: n for n in report.nodes}
+        self.requirements = {r.id: r for r in report.requirements}
+        self.findings = {f.id: f for f in report.findings}
+        self.sides = {x.id: x for x in report.side_conditions}
+        self.obligations = {o.id: o for o in report.obligations}
         self.items: dict[str, str] = {}  # id -> what it is, a later kind's winning as in the report's order
         for kind, ids in (("health check", self.findings), ("side condition", self.sides),
                           ("obligation", self.obligations)):
             self.items.update(dict.fromkeys(ids, kind))
-        self.evidence = {e.obligation: e for e in decode_rows(EvidenceRow, report.get("evidence") or [])}
-        self.problems = problem_rows_of(g for g in report.get("problems") or [] if isinstance(g, Mapping))
-        g = report.get("grounding") or {}
-        self.ros: dict[str, list[Mapping[str, Any]]] = {}
-        for ros_finding in g.get("findings") or []:
+        self.evidence = {e.obligation: e for e in report.evidence}
+        self.problems = report.problems
+        self.ros: dict[str, list[Mapping[str, Any]]] = {}  # a grounding finding: ros/ground's JSON object
+        for ros_finding in report.grounding.findings if report.grounding is not None else []:
             self.ros.setdefault(str(ros_finding.get("code", "")), []).append(ros_finding)
-        self.lint: dict[str, list[Mapping[str, Any]]] = {}
-        for w in report.get("lint") or []:
-            self.lint.setdefault(str(w.get("code", "")), []).append(w)
+        self.lint: dict[str, list[LintRow]] = {}
+        for w in report.lint:
+            self.lint.setdefault(w.code, []).append(w)
         self.rules: dict[str, Mapping[str, Any]] = {}
         self.results: dict[str, list[Mapping[str, Any]]] = {}
         try:  # the SARIF log and the argument are optional: one of another shape is left out
@@ -219,7 +216,7 @@ class _Index:
         key = self._match(wanted, [c for c in self.lint if c], exact)
         if key is not None:
             return [f"{key}: {len(self.lint[key])} lint warning(s):"] + [
-                f"  {w.get('location')}: {w.get('message')}" for w in self.lint[key]]
+                f"  {w.location}: {w.message}" for w in self.lint[key]]
         return None
 
     def _argument(self, wanted: str, exact: bool) -> list[str] | None:
@@ -364,19 +361,22 @@ def _first_line(text: str) -> str:
     return str(text).strip().splitlines()[0] if str(text).strip() else ""
 
 
-def explain(report: Mapping[str, Any], wanted: str, sarif: Any = None, argument: Any = None) -> list[str] | None:
+def explain(report: AssuranceReport | Mapping[str, Any], wanted: str, sarif: Any = None,
+            argument: Any = None) -> list[str] | None:
     """The lines ``rclverify explain wanted`` prints from ``report`` (the
-    JSON report, shape-checked by :mod:`rclverify.report.lastrun`), the
-    parsed ``reports/assurance.sarif`` and ``reports/argument.json`` (either
-    may be ``None``); ``None`` when no id matches."""
-    return _Index(report, sarif, argument).find(wanted)
+    decoded report, or its JSON object as :mod:`rclverify.report.lastrun`
+    reads it, decoded here), the parsed ``reports/assurance.sarif`` and
+    ``reports/argument.json`` (either may be ``None``); ``None`` when no id
+    matches.  Raises :class:`msgspec.ValidationError` for a report that does
+    not decode."""
+    return _Index(AssuranceReport.of(report), sarif, argument).find(wanted)
 
 
-def near_ids(report: Mapping[str, Any], wanted: str, sarif: Any = None, argument: Any = None,
+def near_ids(report: AssuranceReport | Mapping[str, Any], wanted: str, sarif: Any = None, argument: Any = None,
              n: int = 5) -> list[str]:
-    """At most ``n`` ids of ``report`` close to ``wanted``: ``difflib``'s
-    closest (case-folded), then those containing it."""
-    ids = _Index(report, sarif, argument).ids()
+    """At most ``n`` ids of ``report`` (as :func:`explain` takes it) close to
+    ``wanted``: ``difflib``'s closest (case-folded), then those containing it."""
+    ids = _Index(AssuranceReport.of(report), sarif, argument).ids()
     folded: dict[str, str] = {}
     for i in ids:
         folded.setdefault(i.lower(), i)
@@ -385,13 +385,15 @@ def near_ids(report: Mapping[str, Any], wanted: str, sarif: Any = None, argument
     return list(dict.fromkeys(close + contains))[:n]
 
 
-def id_kinds(report: Mapping[str, Any]) -> str:
-    """A few ids of each kind, for the message when nothing matches."""
-    reqs = [r["id"] for r in report["requirements"]]
-    nodes = [n["name"] for n in report["nodes"]]
+def id_kinds(report: AssuranceReport | Mapping[str, Any]) -> str:
+    """A few ids of each kind of ``report`` (as :func:`explain` takes it), for the message when nothing
+    matches."""
+    typed = AssuranceReport.of(report)
+    reqs = [r.id for r in typed.requirements]
+    nodes = [n.name for n in typed.nodes]
     parts: list[tuple[str, Sequence[str]]] = [("requirements", reqs), ("nodes", nodes)]
-    if nodes and report["nodes"][0].get("guarantees"):
+    if nodes and typed.nodes[0].guarantees:
         parts.append(("guarantees", [f"{nodes[0]}.g1"]))
-    parts.append(("problems", natural_sorted([d["id"] for d in report.get("diagnoses") or []])))
+    parts.append(("problems", natural_sorted([d.id for d in typed.diagnoses])))
     shown = [f"{what} {', '.join(list(xs)[:4])}{', ...' if len(xs) > 4 else ''}" for what, xs in parts if xs]
     return "; ".join(shown)
