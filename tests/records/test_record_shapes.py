@@ -656,6 +656,35 @@ def test_a_node_section_shows_the_later_passes_fields_only_when_they_are_set() -
             assert text in shown and text not in plain, (name, text)
 
 
+#: The LaTeX appendix (the contracts typeset, a piece of the HTML and Markdown reports): its parts.
+LATEX = ("latex.html.j2", "latex.md.j2")
+
+
+class _NodeWithMargin(node_rows.NodeRow, frozen=True, forbid_unknown_fields=True):
+    """The node row with one field added, as a change to records/node_rows.py would add it."""
+    margin_added_here: str = ""
+
+
+def test_every_field_of_a_node_is_typeset_by_the_latex_appendix_or_internal_to_it() -> None:
+    """The LaTeX appendix shows a subset of a node's row on purpose (its name and its contract typeset); the
+    rest is named in node_rows.LATEX_INTERNAL with the reason.  A field added to the row fails until the
+    appendix shows it or the table names it; a field shown may not also be named."""
+    sources = _sources(LATEX)
+    internal = node_rows.LATEX_INTERNAL
+    assert unaccounted(node_rows.NodeRow, sources, internal, "node_rows") == []
+    assert all(why for why in internal.values())
+    assert unaccounted(_NodeWithMargin, sources, internal, "node_rows") == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_NodeWithMargin, sources, {**internal, "margin_added_here": "why"}, "node_rows") == []
+    shown = [x.replace("n.latex", "n.latex ~ n.margin_added_here", 1) for x in sources]
+    assert shown != sources and unaccounted(_NodeWithMargin, shown, internal, "node_rows") == []
+    # a read outside the loop over the decoded rows does not count
+    assert unaccounted(_NodeWithMargin, [sources[0] + "{{ n.margin_added_here }}", sources[1]], internal,
+                       "node_rows") != []
+    assert unaccounted(node_rows.NodeRow, sources, {**internal, "latex": "x"}, "node_rows") == [
+        "latex: declared internal but rendered"]
+
+
 #: The records the Python renderers show: each one's class and its module's per-renderer tables.
 CODE_RECORDS: dict[str, tuple[type[msgspec.Struct], Mapping[str, Mapping[str, str]]]] = {
     "findings": (FindingRow, findings.INTERNAL_TO),
