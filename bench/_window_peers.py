@@ -177,21 +177,22 @@ def engine(ws: Path, log: Path, f: Formula, n: int) -> tuple[list[float | None],
     from rclverify.backends.monitors.check import check_trace
     from rclverify.backends.monitors.deadlines import DeadlineMonitor
     from rclverify.lang.typecheck import load
+    from rclverify.backends.monitors.config import load_mapping
     from rclverify.traces.jsonl import read_jsonl
-    from rclverify.traces.mapping import load_rules
-    import yaml
     checked = load([ws / "contracts/w.rcl"])
     node = checked.nodes["Window"]
-    rules = load_rules(yaml.safe_load((ws / "backends/monitors/mapping.yaml").read_text())["topics"])
+    rules = load_mapping(ws, None).rules  # as the command reads the mapping (its default transport skew too)
     got: list[float | None] = [None] * n
     if f.name.startswith("G(trig"):
-        late: list[float] = []  # the time margins of answers after their trigger's deadline (its update)
+        late: list[float] = []  # the time margins of answers past their trigger's deadline (an update, or a false)
 
         def timed(v: Any) -> None:
             if v.update:
                 late.append(v.time_margin)
             else:
                 got[round(v.trigger_stamp / PERIOD)] = v.time_margin if v.verdict == "true" else -math.inf
+                if v.verdict == "false" and v.time_margin is not None:  # answered, after the deadline
+                    late.append(v.time_margin)
         d = DeadlineMonitor(checked, node, rules, timed)
         for ev in read_jsonl(log):
             d.feed(ev)
@@ -279,7 +280,7 @@ def _agree(f: Formula, mine: list[float | None], theirs: list[float], n: int) ->
     for t in range(n - f.h):
         a = mine[t]
         if deadline and a is None:
-            continue  # no trigger here: the peers' vacuous truth has no RCL verdict
+            continue  # no trigger here (the peers' vacuous truth has no RCL verdict), or an undecided one
         b = theirs[t] if t < len(theirs) else math.nan
         total += 1
         if a is None:
@@ -294,20 +295,24 @@ def _agree(f: Formula, mine: list[float | None], theirs: list[float], n: int) ->
     return total, same, first
 
 
-def _time_margins(mine: list[float | None], s: dict[str, Any], n: int, h: int) -> tuple[int, int]:
-    """(triggers, those whose time margin is 30 ms less the delay of the first answer at or after them,
-    from the samples; ``-inf`` where none comes within 3 samples)."""
+def _time_margins(mine: list[float | None], s: dict[str, Any], n: int, h: int) -> tuple[int, int, int]:
+    """(triggers with a verdict, those whose time margin is 30 ms less the delay of the first answer at or
+    after them, from the samples, ``-inf`` where none comes within 3 samples; triggers with none: undecided,
+    an answer stamped within the transport skew before them, docs/semantics.md "Deadlines")."""
     trig, ans = s["trig"], s["ans"]
-    right = total = 0
+    right = total = undecided = 0
     for t in range(n - h):
         if not trig[t]:
+            continue
+        if mine[t] is None:
+            undecided += 1
             continue
         total += 1
         k = next((k for k in range(h + 1) if ans[t + k]), None)
         want = -math.inf if k is None else round((h - k) * PERIOD, 9)
         got = mine[t]
         right += got is not None and (got == want or (want != -math.inf and abs(got - want) < 1e-9))
-    return total, right
+    return total, right, undecided
 
 
 def _counts(out: list[dict[str, Any]]) -> list[Any]:
@@ -361,8 +366,10 @@ def race(n: int, seed: int, wrong: float, repeat: int = 1, src: str | None = Non
                       f"{'yes' if same else 'NO'}")
                 ok = ok and same
             if f.name.startswith("G(trig"):
-                total, right = _time_margins(mine, s, n, f.h)
-                print(f"{'':<52} time margins: {right}/{total} triggers equal 30 ms less the first answer's delay")
+                total, right, undecided = _time_margins(mine, s, n, f.h)
+                print(f"{'':<52} time margins: {right}/{total} triggers equal 30 ms less the first answer's delay; "
+                      f"{undecided} trigger(s) undecided (no answer of their own in time, one within the transport "
+                      f"skew before them: no verdict, not compared; the peers call them missed)")
                 ok = ok and right == total
             for name in PEERS:
                 got = _peer(name, f, s, n, repeat)
