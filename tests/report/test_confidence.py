@@ -11,6 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from _report_schema import check_report
+from _typed_rows import complete
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.argument.confidence import Premise, claim, cones, derived_claims, requirement_claim
 from rclverify.report.argument.strength import BACKEND_KIND, KINDS, evidence_strength, one_sided_bound
 from rclverify.cli.commands import main
@@ -34,8 +37,8 @@ def test_every_backend_has_a_strength() -> None:
     assert set(BACKEND_NAMES) == set(BACKEND_KIND)
     assert set(BACKEND_KIND.values()) <= set(KINDS)
     for b in BACKEND_NAMES:  # any status but discharged gives no confidence
-        assert evidence_strength({"backend": b, "status": "failed"}).doubt == 1.0
-        s = evidence_strength({"backend": b, "status": "discharged", "figures": [["count", "60"]]})
+        assert evidence_strength(complete(EvidenceRow, {"backend": b, "status": "failed"})).doubt == 1.0
+        s = evidence_strength(complete(EvidenceRow, {"backend": b, "status": "discharged", "figures": [["count", "60"]]}))
         assert s.kind == BACKEND_KIND[b] and 0 < s.doubt < 1
 
 
@@ -44,7 +47,8 @@ def test_the_experiment_bound_is_clopper_pearson_with_no_failure() -> None:
     for n in (1, 10, 47, 300):
         p = one_sided_bound(n)
         assert abs((1 - p) ** n - 0.05) < 1e-12
-    s = evidence_strength({"backend": "experiment", "status": "discharged", "figures": [["count", "10"]]})
+    s = evidence_strength(complete(EvidenceRow, {"backend": "experiment", "status": "discharged",
+                                                 "figures": [["count", "10"]]}))
     assert s.doubt == pytest.approx(one_sided_bound(10)) and "10 trials" in str(s.detail)
 
 
@@ -214,10 +218,10 @@ def test_a_side_condition_read_from_cone_summaries_is_not_two_solvers() -> None:
     one two solvers agreed on (its doubt must not be the two-solver one)."""
     from rclverify.report.argument.strength import DOUBT, side_condition_strength
     sc = {"status": "discharged", "solvers": {"agreement": "two solvers"}, "context": {"summaries": ["Planner"]}}
-    s = side_condition_strength(sc)
+    s = side_condition_strength(SideConditionRow.of(complete(SideConditionRow, sc)))
     assert s.solvers == 1 and s.doubt == DOUBT["proof"] and "summaries" in str(s.detail), s
     sc["context"] = {"summaries": []}
-    assert side_condition_strength(sc).doubt == DOUBT["proof2"]
+    assert side_condition_strength(complete(SideConditionRow, sc)).doubt == DOUBT["proof2"]
 
 
 def test_the_observed_detail_counts_judged_messages_not_questions() -> None:
@@ -225,5 +229,5 @@ def test_the_observed_detail_counts_judged_messages_not_questions() -> None:
     alone decide; docs/semantics.md): a node without inputs has no question, yet its 5 outputs read
     "5 questions answered"."""
     row = {"backend": "monitors", "status": "discharged", "monitoring": {"counts": {"satisfied": 5}, "events_read": 5}}
-    d = str(evidence_strength(row).detail)
+    d = str(evidence_strength(EvidenceRow.of(complete(EvidenceRow, row))).detail)
     assert d.startswith("5 verdicts on messages (satisfied or violated)") and "question" not in d, d

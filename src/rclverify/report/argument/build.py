@@ -1,7 +1,8 @@
-"""Build the GSN goal structure from the assurance report dict.
+"""Build the GSN goal structure from the assurance report.
 
-The argument is built from the report dict of :func:`rclverify.report.build.build_report`
-(the same data the report shows), so it needs no other artifact and works
+The argument is built from the :class:`~rclverify.records.report_record.AssuranceReport`
+of :func:`rclverify.report.build.build_report` (the same data the report shows, read
+by attribute), so it needs no other artifact and works
 with any backend and any evidence kind: a solution is one evidence record,
 whatever produced it.  Structure (docs/argument.md)::
 
@@ -40,15 +41,13 @@ from typing import Any, Iterable, Mapping, TypeVar
 
 import msgspec
 
-from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
-from rclverify.records.evidence_rows import EvidenceRow
-from rclverify.records.findings import FindingRow, rows_of
+from rclverify.records.derived_rows import EnvironmentAssumptionRow
+from rclverify.records.findings import FindingRow
 from rclverify.records.node_rows import NodeRow
 from rclverify.records.obligations import ObligationRow
-from rclverify.records.report_schema import Report, RequirementJson
-from rclverify.records.row import decode_rows
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.side_condition_rows import SideConditionRow
-from rclverify.records.summary_rows import Meta
 from rclverify.report.argument.deadlines import own_check, with_deadline
 from rclverify.report.argument.statistics import with_statistics
 from rclverify.report.argument.model import Argument, Element, propagate
@@ -96,25 +95,25 @@ _PROOF_STATUS = {"met": "discharged", "proved, evidence outstanding": "discharge
                  "stale": "stale", "error": "error"}
 
 
-def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mapping[tuple[str, int], str],
+def _requirement_goal(b: "_Builder", r: RequirementRow, guarantee_goal: Mapping[tuple[str, int], str],
                       sides: Mapping[str, list[SideConditionRow]], j_calc: str) -> str:
     """The goal of a requirement the report's requirement check decided
     (its ``verdict``): an informal one is an undeveloped goal; a formal one is
     supported by a formal-entailment strategy whose children are the Z3
     proof (a solution with the check's verdict) and the goals of the
     guarantees the proof used, with the side conditions of their nodes."""
-    rid = str(r["id"])
-    c = r.get("check") or {}
-    if r["verdict"] == "informal":
-        traced = ", ".join(f"{s['node']} guarantee {s['guarantee']}" for s in r["support"]) or "no guarantee"
+    rid = r.id
+    c = r.check  # the requirements stage's check record (calculus/requirements/check.py), its own shape
+    if r.verdict == "informal":
+        traced = ", ".join(f"{s.node} guarantee {s.guarantee}" for s in r.support) or "no guarantee"
         return b.add(Element(ident("G", rid), "goal",
-                             _clip(f"{rid}: {r['text']} (informal: no formal statement; traced to {traced})"),
+                             _clip(f"{rid}: {r.text} (informal: no formal statement; traced to {traced})"),
                              undeveloped=True, ref=rid))
     sn = b.add(Element(ident("Sn", "req", rid), "solution",
-                       _clip(f"Z3 {('proof' if r['verdict'] in ('met', 'proved, evidence outstanding') else 'check')} "
-                             f"of {rid} ({c.get('smt2') or _temporal_what(c) or 'not checked yet'}): {r['verdict']}. "
-                             f"{r['note']}"),
-                       status=_PROOF_STATUS.get(str(r["verdict"]), "pending"), ref=rid, url=str(c.get("smt2") or "")))
+                       _clip(f"Z3 {('proof' if r.verdict in ('met', 'proved, evidence outstanding') else 'check')} "
+                             f"of {rid} ({c.get('smt2') or _temporal_what(c) or 'not checked yet'}): {r.verdict}. "
+                             f"{r.note}"),
+                       status=_PROOF_STATUS.get(r.verdict, "pending"), ref=rid, url=str(c.get("smt2") or "")))
     kids = [sn]
     nodes_used: list[str] = []
     for p in c.get("used") or []:
@@ -135,7 +134,7 @@ def _requirement_goal(b: "_Builder", r: Mapping[str, Any], guarantee_goal: Mappi
               + ". " + ENTAILMENT),
         supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
     # its confidence is stated at its assurance claim point (.claim_points)
-    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
+    return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r.text}"), supported_by=(strategy,), ref=rid))
 
 
 def _declaration_goal(b: "_Builder", d: Mapping[str, Any]) -> str:
@@ -162,15 +161,13 @@ class _Builder:
         return e.id
 
 
-def build_argument(report: Report) -> Argument:
-    """The goal structure of ``report`` (a report dict, see
-    :data:`rclverify.report.render.REPORT_KEYS`), statuses propagated.
+def build_argument(report: AssuranceReport) -> Argument:
+    """The goal structure of ``report`` (the decoded report, read by attribute), statuses propagated.
 
     Returns an :class:`Argument` whose element order is deterministic
     (requirements and nodes in report order, obligations in natural order
     of their ids: ``p1_i0 < p2_i1 < p10_i9``).
-    Raises ``KeyError`` for a missing report key and
-    :class:`.model.ArgumentError` if the result were malformed.
+    Raises :class:`.model.ArgumentError` if the result were malformed.
     """
     g = _Goals(report)
     top, top_ctx = ident("G", "system"), g.top_context()
@@ -178,15 +175,15 @@ def build_argument(report: Report) -> Argument:
     g.j_calc = g.b.add(Element(ident("J", "calculus"), "justification", CALCULUS))
     if any(sc.verdict == "discharged in context" for scs in g.sides.values() for sc in scs):
         g.b.add(Element(g.j_context, "justification", IN_CONTEXT))
-    contract_goals = [g.contract_goal(n) for n in decode_rows(NodeRow, report["nodes"])]
-    req_goals = [g.requirement_goal(r) for r in report["requirements"]]
+    contract_goals = [g.contract_goal(n) for n in report.nodes]
+    req_goals = [g.requirement_goal(r) for r in report.requirements]
     b = g.b
     s_reqs = b.add(Element(ident("S", "requirements"), "strategy", "Argument over each requirement of the plan",
                            supported_by=tuple(req_goals), undeveloped=not req_goals))
     s_contracts = b.add(Element(ident("S", "contracts"), "strategy",
                                 "Argument over the node contracts: every node meets its contract (the premises of rules R1-R4)",
                                 supported_by=tuple(contract_goals), in_context_of=(g.a_persist, *g.loop_ids.values())))
-    ids = ", ".join(str(r["id"]) for r in report["requirements"]) or "no requirement listed"
+    ids = ", ".join(r.id for r in report.requirements) or "no requirement listed"
     b.els = {top: Element(top, "goal", f"The system {g.meta.workspace} meets its requirements ({ids})",
                           supported_by=(s_reqs, s_contracts), in_context_of=top_ctx), **b.els}
     add_defeaters(b.els, report, ident)
@@ -208,18 +205,17 @@ class _Goals:
     order is the output's): the report's rows by node, and the ids of the
     context elements the goals refer to."""
 
-    def __init__(self, report: Report) -> None:
+    def __init__(self, report: AssuranceReport) -> None:
         self.report, self.b = report, _Builder()
-        self.meta = Meta.of(report["meta"])
-        self.ev_of = {e.obligation: e for e in decode_rows(EvidenceRow, report["evidence"])}
+        self.meta = report.meta
+        self.ev_of = {e.obligation: e for e in report.evidence}
         # by node, still sorted by id: p1 < p2 < p10
-        self.obligations_of = _by_node(sorted(decode_rows(ObligationRow, report["obligations"]),
-                                              key=lambda o: natural_key(o.id)))
-        self.sides = _by_node(decode_rows(SideConditionRow, report["side_conditions"]))
+        self.obligations_of = _by_node(sorted(report.obligations, key=lambda o: natural_key(o.id)))
+        self.sides = _by_node(report.side_conditions)
         self.findings: dict[str, list[FindingRow]] = {}
-        for f in rows_of(report["findings"]):
+        for f in report.findings:
             self.findings.setdefault(f.node, []).append(f)
-        self.env = _by_node(decode_rows(EnvironmentAssumptionRow, report["environment_assumptions"]))
+        self.env = _by_node(report.environment_assumptions)
         self.loop_ids: dict[str, str] = {}  # R4's assumption text -> its element (one per loop)
         self.loop_of: dict[str, str] = {}
         self.guarantee_goal: dict[tuple[str, int], str] = {}
@@ -234,21 +230,21 @@ class _Goals:
                                f"Verification plan {meta.plan} and contracts {', '.join(meta.contracts)} "
                                f"of {meta.workspace}", url=meta.plan))
         self.a_persist = b.add(Element(ident("A", "persist"), "assumption", PERSIST))
-        grounding = self.report.get("grounding")
+        grounding = self.report.grounding
         if not grounding:
             return (c_plan,)
-        ctx = grounding["context"]
+        ctx = grounding.context  # stages/grounding's context record (its own shape): packages and files
         digest = hashlib.sha256("".join(f"{f['path']}\0{f['sha256']}\n" for f in ctx["files"]).encode()).hexdigest()
         return (c_plan, b.add(Element(ident("C", "ros"), "context", _clip(
             "Contracts grounded in the ROS software: "
             + ", ".join(f"{p['name']} {p['version']}" for p in ctx["packages"])
             + f"; {len(ctx['files'])} scanned files (sha256 of their sha256 list {digest[:16]}, each in "
-              f"artifacts/ros/graph.json); {grounding['counts']['error']} grounding error(s), "
-              f"{grounding['counts']['warning']} warning(s)"), url="artifacts/ros/graph.json")))
+              f"artifacts/ros/graph.json); {grounding.counts.error} grounding error(s), "
+              f"{grounding.counts.warning} warning(s)"), url="artifacts/ros/graph.json")))
 
     def loop_assumptions(self) -> None:
         """One assumption element per loop of rule R4 (its derived properties' loop assumption)."""
-        for d in decode_rows(DerivedPropertyRow, self.report["derived_properties"]):
+        for d in self.report.derived_properties:
             text = d.loop_assumption
             if text:
                 if text not in self.loop_ids:
@@ -333,19 +329,20 @@ class _Goals:
             f"eventually an output satisfying its guarantees (paper lines 462-495)",
             supported_by=tuple(g_ids + sc_ids), in_context_of=tuple(ctx), ref=name))
 
-    def requirement_goal(self, r: RequirementJson) -> str:
-        """The goal of requirement ``r``: Z3's entailment when it was checked, else the calculus over its support."""
-        b, rid = self.b, str(r["id"])
-        if "verdict" in r:  # checked by Z3 (docs/requirements.md): entailment, or undeveloped
+    def requirement_goal(self, r: RequirementRow) -> str:
+        """The goal of requirement ``r``: Z3's entailment when it was checked (it has a check record),
+        else the calculus over its support."""
+        b, rid = self.b, r.id
+        if r.check:  # checked by the requirements stage (docs/requirements.md): entailment, or undeveloped
             gid = _requirement_goal(b, own_check(r), self.guarantee_goal, self.sides, self.j_calc)
             # its deadline (rule D3) and its recorded runs' bounds and targets (statistics.py)
             return with_statistics(b.els, with_deadline(b.els, gid, r, self.guarantee_goal), r)
         kids: list[str] = []
         nodes_used: list[str] = []
-        for s in r["support"]:
-            kids.append(self.guarantee_goal[(str(s["node"]), int(s["guarantee"]))])
-            if s["node"] not in nodes_used:
-                nodes_used.append(str(s["node"]))
+        for s in r.support:
+            kids.append(self.guarantee_goal[(s.node, s.guarantee)])
+            if s.node not in nodes_used:
+                nodes_used.append(s.node)
         for name in nodes_used:
             kids += [ident("G", "sc", sc.id) for sc in self.sides.get(name, [])]
         ctx = [self.a_persist] + sorted({self.loop_of[x] for x in nodes_used if x in self.loop_of}) + [self.j_calc]
@@ -355,9 +352,9 @@ class _Goals:
             f"{', '.join(nodes_used) or 'no node'} once the side conditions of their assumptions are discharged",
             supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
         if kids:
-            return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']}"), supported_by=(strategy,), ref=rid))
+            return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r.text}"), supported_by=(strategy,), ref=rid))
         del b.els[strategy]  # no supporting guarantee listed: nothing argues for it
-        return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r['text']} (no supporting guarantee listed)"),
+        return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r.text} (no supporting guarantee listed)"),
                              undeveloped=True, ref=rid))
 
 

@@ -30,10 +30,12 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
-from typing import Any, Callable, Mapping
+from typing import Any, Callable
 
-from rclverify.records.report_schema import Report
-from rclverify.records.strength_rows import Strength
+import msgspec
+
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.strength_rows import LimitedBy
 from rclverify.report.argument.model import Element
 
 _GUARANTEE = re.compile(r"^(?P<node>\S+) guarantee (?P<k>\d+)$")
@@ -70,70 +72,72 @@ def _linked(e: Element, target: str) -> bool:
     return target in e.supported_by or target in e.in_context_of
 
 
-def add_claim_points(els: dict[str, Element], report: Report, ident: Callable[..., str]) -> None:
+def _limit(lim: LimitedBy) -> str:
+    """The weakest premise's kind and doubt, as a claim point states them."""
+    return f"{lim.kind}, doubt {lim.doubt:g}"
+
+
+def add_claim_points(els: dict[str, Element], report: AssuranceReport, ident: Callable[..., str]) -> None:
     """Mark the assurance claim points of ``report``'s argument in ``els``
     (element id -> element, changed in place; the module docstring says
     where).  ``ident`` makes element ids (:func:`.build.ident`).  Every
     reference is the element itself or one of its ``supportedBy`` /
     ``inContextOf`` targets (gsn2x V09); claims the argument does not show
     are skipped.  Call after the defeaters are added."""
-    for r in report.get("requirements", []):
-        rid = str(r["id"])
+    for r in report.requirements:
+        rid = r.id
         gid = ident("G", rid)
         if gid not in els:
             continue
         goal, name = els[gid], ident("ACP", rid)
-        conf = r.get("confidence")
-        lim: Mapping[str, object] = r.get("limited_by") or {}
+        conf, lim = r.confidence, r.limited_by
         if conf is None:
-            why = ("informal: no formal statement to compute a confidence for" if r.get("verdict") == "informal"
+            why = ("informal: no formal statement to compute a confidence for" if r.verdict == "informal"
                    else "no confidence computed: the calculus's requirements are argued by their guarantees' goals")
             _mark(els, gid, name, (gid,), why)
             continue
         strategy = ident("S", rid)
-        sentence = lim.get("sentence") or ""
+        sentence = lim.sentence if lim is not None and lim.sentence is not msgspec.UNSET else ""
         _mark(els, gid, name, (strategy,) if _linked(goal, strategy) else (gid,),
               f"confidence {_conf(conf)} by rule C5" + (f"; {sentence}" if sentence else ""))
-        limit = _premise_element(str(lim.get("label", "")), rid, ident)
-        if strategy in els and limit and _linked(els[strategy], limit):
-            _mark(els, strategy, ident("ACP", rid, "limit"), (limit,),
-                  f"{lim['label']} limits {rid} ({lim.get('kind')}, doubt {lim.get('doubt'):g}; rule C5)")
-    derived = {str(d.get("node")): d for d in report.get("derived_properties", []) if d.get("confidence") is not None}
-    for n in report.get("nodes", []):
-        name = str(n["name"])
+        limit = _premise_element(lim.label, rid, ident) if lim is not None else ""
+        if lim is not None and strategy in els and limit and _linked(els[strategy], limit):
+            _mark(els, strategy, ident("ACP", rid, "limit"), (limit,), f"{lim.label} limits {rid} ({_limit(lim)}; rule C5)")
+    derived = {d.node: d.confidence for d in report.derived_properties if d.confidence is not msgspec.UNSET}
+    for n in report.nodes:
+        name = n.name
         gid = ident("G", name)
-        if gid not in els or n.get("confidence") is None:
+        if gid not in els or n.confidence is msgspec.UNSET:
             continue
-        lim = n.get("limited_by") or {}
-        limit = _premise_element(str(lim.get("label", "")), "", ident)
+        node_lim = n.limited_by or None
+        limit = _premise_element(node_lim.label, "", ident) if node_lim is not None else ""
         refs = (limit,) if limit and _linked(els[gid], limit) else (gid,)
-        text = f"confidence {_conf(n['confidence'])} by rule C3"
-        if lim:
-            text += f", limited by {lim['label']} ({lim.get('kind')}, doubt {lim.get('doubt'):g})"
+        text = f"confidence {_conf(n.confidence)} by rule C3"
+        if node_lim is not None:
+            text += f", limited by {node_lim.label} ({_limit(node_lim)})"
         d = derived.get(name)
         if d is not None:
-            text += f"; its derived property (rules R1-R4): confidence {_conf(d['confidence'])} by rule C4"
+            text += f"; its derived property (rules R1-R4): confidence {_conf(d)} by rule C4"
         _mark(els, gid, ident("ACP", name), refs, text)
     _challenged(els, report, ident)
 
 
-def _challenged(els: dict[str, Element], report: Report, ident: Callable[..., str]) -> None:
+def _challenged(els: dict[str, Element], report: AssuranceReport, ident: Callable[..., str]) -> None:
     """A claim point on every claim a counter solution challenges (on the
     claim itself), with the confidence the calculus gives that claim."""
     confidence: dict[str, tuple[float, str]] = {}  # goal id -> (confidence, rule)
-    for n in report.get("nodes", []):
-        for g in n.get("guarantees", []):
-            s = g.get("strength")
-            if s is not None and "doubt" in s:
-                confidence[ident("G", n["name"], f"g{g['index']}")] = (
-                    1.0 - float(s["doubt"]), "C0" if s.get("kind") == "defeated" else "C1")
-    for sc in report.get("side_conditions", []):
-        if sc.get("strength"):
-            doubt = float(Strength.of(sc["strength"]).doubt)
-            confidence[ident("G", "sc", sc["id"])] = (1.0 - doubt, "C0" if doubt >= 1.0 else "strength")
-    for r in report.get("requirements", []):
-        if r.get("confidence") is not None:
-            confidence[ident("G", r["id"])] = (float(r["confidence"]), "C5")
+    for n in report.nodes:
+        for g in n.guarantees:
+            s = g.strength
+            if s is not msgspec.UNSET:
+                confidence[ident("G", n.name, f"g{g.index}")] = (1.0 - s.doubt, "C0" if s.kind == "defeated" else "C1")
+    for sc in report.side_conditions:
+        if sc.strength is not msgspec.UNSET:
+            doubt = sc.strength.doubt
+            confidence[ident("G", "sc", sc.id)] = (1.0 - doubt, "C0" if doubt >= 1.0 else "strength")
+    for r in report.requirements:
+        if r.confidence is not None:
+            confidence[ident("G", r.id)] = (r.confidence, "C5")
     challengers: dict[str, list[str]] = {}
     for cs in els.values():
         if cs.type == "counter_solution":

@@ -27,9 +27,11 @@ reads the status of the problem it causes.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any, Mapping
+from typing import Any
 
-from rclverify.records.report_schema import Report
+import msgspec
+
+from rclverify.records.report_record import AssuranceReport
 from rclverify.report.argument.model import Element
 
 
@@ -37,7 +39,7 @@ def _clip(text: str, n: int = 300) -> str:
     return text if len(text) <= n else text[:n - 3] + "..."
 
 
-def add_defeaters(els: dict[str, Element], report: Report, ident: Any) -> None:
+def add_defeaters(els: dict[str, Element], report: AssuranceReport, ident: Any) -> None:
     """Add a counter solution per piece of counter-evidence of ``report`` to
     ``els`` (element id -> element, changed in place) and mark the claims
     it defeats; ``ident`` makes element ids (:func:`.build.ident`).  A
@@ -49,44 +51,43 @@ def add_defeaters(els: dict[str, Element], report: Report, ident: Any) -> None:
         if defeats:
             els[target] = replace(els[target], defeated=True)
 
-    for ev in report.get("evidence", []):
-        oid, st = str(ev["obligation"]), str(ev["status"])
+    for ev in report.evidence:
+        oid, st = ev.obligation, ev.status
         parts = oid.split(".")
         target = ident("G", parts[0], parts[1]) if len(parts) > 1 and parts[1][1:].isdigit() else ""
         url = f"artifacts/evidence/{oid}.json"
         if st == "failed":
-            challenge(ident("CSn", "ev", oid), target, f"Counter-evidence {oid} ({ev['backend']}): "
-                      f"{ev.get('explanation', '')}", "failed", True, url)
+            challenge(ident("CSn", "ev", oid), target, f"Counter-evidence {oid} ({ev.backend}): "
+                      f"{ev.explanation}", "failed", True, url)
         elif st == "stale":
             challenge(ident("CSn", "ev", oid), target, f"Stale evidence {oid}: an input changed since it was produced",
                       "stale", False, url)
-        elif "PARTIAL COVERAGE" in str(ev.get("explanation", "")):
-            challenge(ident("CSn", "ev", oid), target, f"Partial coverage {oid}: {ev.get('explanation', '')}",
+        elif "PARTIAL COVERAGE" in ev.explanation:
+            challenge(ident("CSn", "ev", oid), target, f"Partial coverage {oid}: {ev.explanation}",
                       st, False, url)
-    for sc in report.get("side_conditions", []):
-        s: Mapping[str, object] = sc.get("solvers") or {}
-        if s.get("agreement") in ("disagree", "inconclusive"):
-            challenge(ident("CSn", "solvers", sc["id"]), ident("G", "sc", sc["id"]),
-                      f"The second solver does not confirm {sc['id']}: {s.get('why', '')}", "inconclusive", True,
-                      str(s.get("smt2") or ""))
-    for n in report.get("nodes", []):  # a problem's culprit: its goal is never "discharged"
-        name = str(n["name"])
-        for index, culprit_of in [*((g["index"], g.get("culprit_of") or []) for g in n.get("guarantees", [])),
-                                  (None, n.get("culprit_of") or [])]:  # the guarantees, then the contract
+    for sc in report.side_conditions:
+        s = sc.solvers
+        if s and s.agreement in ("disagree", "inconclusive"):
+            challenge(ident("CSn", "solvers", sc.id), ident("G", "sc", sc.id),
+                      f"The second solver does not confirm {sc.id}: {s.why}", "inconclusive", True,
+                      "" if s.smt2 is msgspec.UNSET else s.smt2)
+    for n in report.nodes:  # a problem's culprit: its goal is never "discharged"
+        name = n.name
+        for index, culprit_of in [*((g.index, g.culprit_of or []) for g in n.guarantees),
+                                  (None, n.culprit_of or [])]:  # the guarantees, then the contract
             target = ident("G", name, f"g{index}") if index is not None else ident("G", name)
             for k, row in enumerate(culprit_of, 1):
-                if row["status"] not in ("failed", "error"):
+                if row.status not in ("failed", "error"):
                     continue  # outstanding evidence is no counter-evidence: the goal reads it already
                 what = f"guarantee {index} of {name}" if index is not None else f"the contract of {name}"
                 challenge(ident("CSn", "culprit", target, k), target,
-                          f"Problem caused by {what}: {row['sentence']}", str(row["status"]),
-                          row["status"] == "failed")
-    for r in report.get("requirements", []):
-        rid, verdict = str(r["id"]), str(r.get("verdict"))
-        s = (r.get("check") or {}).get("solvers") or {}
-        if s.get("agreement") in ("disagree", "inconclusive"):
+                          f"Problem caused by {what}: {row.sentence}", row.status, row.status == "failed")
+    for r in report.requirements:
+        rid, verdict = r.id, r.verdict
+        checked = r.check.get("solvers") or {}  # the check record's second solver (stages/crosscheck/apply.py)
+        if checked.get("agreement") in ("disagree", "inconclusive"):
             challenge(ident("CSn", "solvers", rid), ident("G", rid),
-                      f"The second solver does not confirm {rid}: {s.get('why', '')}", "inconclusive", True)
+                      f"The second solver does not confirm {rid}: {checked.get('why', '')}", "inconclusive", True)
         if verdict in ("proved vacuously", "proved from an inconsistency"):
-            challenge(ident("CSn", "vacuous", rid), ident("G", rid), f"{rid} is {verdict}: {r.get('note', '')}",
+            challenge(ident("CSn", "vacuous", rid), ident("G", rid), f"{rid} is {verdict}: {r.note}",
                       "failed", True)

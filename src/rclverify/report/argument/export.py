@@ -30,12 +30,12 @@ import json
 import textwrap
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable
 
 import jinja2
 
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import Report, as_report
+from rclverify.records.report_schema import Report
 from rclverify.records.published import write_published
 from rclverify.records.store import dumps
 from rclverify.core.cache.memo import last_call
@@ -43,6 +43,7 @@ from rclverify.report import diagram
 from rclverify.core.cache import fingerprint
 from rclverify.report.fragments import FragmentCache
 from rclverify.report.textfmt import plain
+from rclverify.report.view import decoded_parts
 from rclverify.report.argument.build import build_argument
 from rclverify.report.argument.model import Argument, Element
 
@@ -216,12 +217,22 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
 
 
 @last_call
+def _typed(report: Report | AssuranceReport) -> AssuranceReport:
+    """``report`` decoded once when it is a JSON object (:func:`rclverify.report.view.decoded_parts`)."""
+    return decoded_parts(report)
+
+
+@last_call
 def _built(report: Report | AssuranceReport) -> Argument:
     """The argument of ``report``.  One report run shows the argument several
     times (HTML, Markdown, ``reports/argument.*``) from the same report,
-    which no renderer changes; it is built once for that report (from its
-    JSON object, which the argument's passes read)."""
-    return build_argument(as_report(report.to_json()) if isinstance(report, AssuranceReport) else report)
+    which no renderer changes; it is built once for that report."""
+    return build_argument(_typed(report))
+
+
+def _title(report: Report | AssuranceReport) -> str:
+    """The argument's title: ``assurance argument of <workspace>``."""
+    return f"assurance argument of {_typed(report).meta.workspace}"
 
 
 def too_large(arg: Argument) -> bool:
@@ -237,7 +248,7 @@ def argument_dot(report: Report | AssuranceReport, fragments: FragmentCache | No
 
 @last_call
 def _dot_text(report: Report | AssuranceReport, *, fragments: FragmentCache | None) -> str:
-    return to_dot(_built(report), f"assurance argument of {report['meta']['workspace']}", fragments=fragments)
+    return to_dot(_built(report), _title(report), fragments=fragments)
 
 
 def argument_layout(report: Report | AssuranceReport, fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
@@ -284,13 +295,13 @@ def write_argument(report: Report | AssuranceReport, out_dir: Path, fragments: F
     without it); ``rendering`` is the argument's layout when already made
     (:func:`argument_layout`); ``within`` (the workspace) bounds where the
     files may lead (:func:`rclverify.records.published.write_published`).
-    Returns the paths written, in :data:`FILES` order.  Raises ``KeyError``
-    for a malformed report and ``OSError`` when ``out_dir`` cannot be
+    Returns the paths written, in :data:`FILES` order.  Raises
+    :class:`msgspec.ValidationError` for a malformed report and ``OSError`` when ``out_dir`` cannot be
     written (:class:`~rclverify.core.within.Refused` for a special file or
     a link out of ``within`` at a file's place).
     """
     arg = _built(report)
-    title = f"assurance argument of {report['meta']['workspace']}"
+    title = _title(report)
     texts: dict[str, str] = {}
     if FILES[0] in files:
         texts[FILES[0]] = to_json_text(arg, fragments)

@@ -19,6 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Mapping
 
+import msgspec
+
 from rclverify.report.shapes import ArgumentJson, ElementJson
 
 from rclverify.records.records import SEVERITY, worst
@@ -39,6 +41,32 @@ UNDEVELOPED_STATUS = "pending"
 class ArgumentError(ValueError):
     """A malformed goal structure: an unknown link target, a link of the
     wrong type, a cycle, or a status that is not an evidence status."""
+
+
+class ElementRecord(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """A GSN element as ``reports/argument.json`` holds it (:meth:`Element.to_json` writes it):
+    ``challenges`` and ``defeated`` written only for counter-evidence, ``acp`` (claim point name ->
+    references) only with claim points; what a reader decodes it with (:meth:`Element.from_json`)."""
+
+    id: str
+    type: str
+    text: str
+    status: str | None = None
+    supported_by: list[str] = []
+    in_context_of: list[str] = []
+    undeveloped: bool = False
+    ref: str = ""
+    url: str = ""
+    challenges: list[str] = []
+    defeated: bool = False
+    acp: dict[str, list[str]] = {}
+
+
+class ArgumentRecord(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """``reports/argument.json``: the top goal's id and every element in order (:meth:`Argument.to_json`)."""
+
+    top: str
+    elements: list[ElementRecord]
 
 
 @dataclass(frozen=True)
@@ -82,12 +110,14 @@ class Element:
         return out
 
     @staticmethod
-    def from_json(d: ElementJson) -> "Element":
-        return Element(id=d["id"], type=d["type"], text=d["text"], status=d.get("status"),
-                       supported_by=tuple(d.get("supported_by", ())), in_context_of=tuple(d.get("in_context_of", ())),
-                       undeveloped=bool(d.get("undeveloped", False)), ref=d.get("ref", ""), url=d.get("url", ""),
-                       challenges=tuple(d.get("challenges", ())), defeated=bool(d.get("defeated", False)),
-                       acp=tuple((str(n), tuple(r)) for n, r in (d.get("acp") or {}).items()))
+    def from_json(d: ElementJson | ElementRecord) -> "Element":
+        """The element of its JSON object (decoded as an :class:`ElementRecord`; raises
+        :class:`msgspec.ValidationError` for one of another shape)."""
+        r = d if isinstance(d, ElementRecord) else msgspec.convert(d, ElementRecord)
+        return Element(id=r.id, type=r.type, text=r.text, status=r.status, supported_by=tuple(r.supported_by),
+                       in_context_of=tuple(r.in_context_of), undeveloped=r.undeveloped, ref=r.ref, url=r.url,
+                       challenges=tuple(r.challenges), defeated=r.defeated,
+                       acp=tuple((n, tuple(refs)) for n, refs in r.acp.items()))
 
 
 @dataclass(frozen=True)
@@ -104,7 +134,10 @@ class Argument:
 
     @staticmethod
     def from_json(d: ArgumentJson) -> "Argument":
-        return Argument(d["top"], {e["id"]: Element.from_json(e) for e in d["elements"]})
+        """The argument of ``reports/argument.json``'s object (decoded as an :class:`ArgumentRecord`;
+        raises :class:`msgspec.ValidationError` for one of another shape)."""
+        r = msgspec.convert(d, ArgumentRecord)
+        return Argument(r.top, {e.id: Element.from_json(e) for e in r.elements})
 
     def status(self, element_id: str) -> str | None:
         """The status of one element (``KeyError`` for an unknown id)."""

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Mapping
 
-from rclverify.records.report_schema import Report
+from rclverify.records.report_record import AssuranceReport
 from rclverify.report.argument.model import Element
 from rclverify.report.standards_rows import origin_text
 
@@ -37,23 +37,23 @@ def _solutions_under(els: Mapping[str, Element], start: str) -> set[str]:
     return out
 
 
-def add_standard_links(els: dict[str, Element], report: Report, ident: Any) -> None:
+def add_standard_links(els: dict[str, Element], report: AssuranceReport, ident: Any) -> None:
     """Add one context per standard clause with supporting evidence to ``els``
     (changed in place) and put it in the context of every strategy that
     addresses the clause (the module docstring); ``ident`` makes element
     ids.  A report without ``standards`` rows changes nothing."""
     clauses: list[tuple[str, set[str]]] = []
-    for row in report.get("standards") or ():
-        level = f" {str(row['level_name']).upper()} {row['level']}" if row.get("level") is not None else ""
-        for c in row["clauses"]:
-            obligations = {str(e["obligation"]) for e in c["evidence"]}
+    for row in report.standards:
+        level = f" {row.level_name.upper()} {row.level}" if row.level is not None else ""
+        for c in row.clauses:
+            obligations = {e.obligation for e in c.evidence}
             if not obligations:
                 continue
-            cid = ident("C", "std", row["profile"], c["id"])
-            els[cid] = Element(cid, "context", f"{row['edition']}{level} ({origin_text(row.get('origin') or {})}), "
-                               f"{c['id']}: {c['title']} (recommendation {c['recommendation']}; {c['status']}: "
-                               f"{c.get('why', '')}; a traceability aid, not a compliance claim)",
-                               ref=f"{row['profile']}:{c['id']}")
+            cid = ident("C", "std", row.profile, c.id)
+            els[cid] = Element(cid, "context", f"{row.edition}{level} ({origin_text(row.origin)}), "
+                               f"{c.id}: {c.title} (recommendation {c.recommendation}; {c.status}: "
+                               f"{c.why}; a traceability aid, not a compliance claim)",
+                               ref=f"{row.profile}:{c.id}")
             clauses.append((cid, obligations))
     if not clauses:
         return

@@ -2,7 +2,8 @@
 argument (docs/statistics.md, docs/argument.md).
 
 Under the goal of a requirement whose recorded runs the report counted
-(``requirements[i]["statistics"]``, :mod:`rclverify.report.statistics`),
+(its row's ``statistics``, :class:`~rclverify.records.statistics_rows.RequirementRuns`
+each, :mod:`rclverify.report.statistics`),
 one row per environment tag:
 
     G-<REQ>                      the requirement
@@ -23,8 +24,10 @@ goal is pending while a tag's runs fall short.
 from __future__ import annotations
 
 import re
-from typing import Any, Mapping, MutableMapping
+from typing import Any, MutableMapping
 
+from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.statistics_rows import RequirementRuns
 from rclverify.report.argument.model import Element
 
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.\-]+")
@@ -40,27 +43,25 @@ def _id(prefix: str, *parts: Any) -> str:
     return prefix + "-" + _ID_BAD.sub("_", ".".join(str(p) for p in parts))
 
 
-def _counts(row: Mapping[str, Any]) -> str:
-    c = row.get("counts") or {}
-    bound = row.get("bound")
-    b = f"; one-sided {float(row.get('level') or 0.95) * 100:g} % upper bound {bound:.3g}" \
-        if isinstance(bound, (int, float)) else ""
-    return f"{c.get('runs', 0)} run(s) under {row.get('environment')} ({row.get('origin')}), " \
+def _counts(row: RequirementRuns) -> str:
+    c = row.counts
+    b = f"; one-sided {float(row.level or 0.95) * 100:g} % upper bound {row.bound:.3g}"
+    return f"{c.get('runs', 0)} run(s) under {row.environment} ({row.origin}), " \
            f"{c.get('violating_runs', 0)} violating, {c.get('undecided_runs', 0)} undecided{b}"
 
 
-def with_statistics(els: MutableMapping[str, Element], goal: str, r: Mapping[str, Any]) -> str:
+def with_statistics(els: MutableMapping[str, Element], goal: str, r: RequirementRow) -> str:
     """Add requirement row ``r``'s run statistics under its goal ``goal``
     in ``els`` (module docstring); returns ``goal``."""
-    rows = r.get("statistics")
-    if not isinstance(rows, list) or not rows or goal not in els:
+    rows = r.statistics
+    if not rows or goal not in els:
         return goal
-    rid = str(r["id"])
+    rid = r.id
     kids: list[str] = []
     ctx: list[str] = []
     for row in rows:
-        env = str(row.get("environment"))
-        if not row.get("target"):
+        env = row.environment
+        if not row.target:
             c = _id("C", "runs", rid, env)
             els[c] = Element(c, "context", f"Recorded runs of {rid}: {_counts(row)}", ref=rid)
             ctx.append(c)
@@ -69,12 +70,12 @@ def with_statistics(els: MutableMapping[str, Element], goal: str, r: Mapping[str
         if j not in els:
             els[j] = Element(j, "justification", JUSTIFICATION)
         sn = _id("Sn", "runs", rid, env)
-        needed = (f"; {row.get('runs_needed')} further clean run(s) needed" if row.get("status") != "discharged"
-                  and row.get("runs_needed") is not None else "")
-        els[sn] = Element(sn, "solution", f"Recorded runs of {rid}: {_counts(row)}{needed}; SPRT {row.get('sprt')}",
-                          status=str(row.get("status") or "pending"), ref=rid)
+        needed = (f"; {row.runs_needed} further clean run(s) needed" if row.status != "discharged"
+                  and row.runs_needed is not None else "")
+        els[sn] = Element(sn, "solution", f"Recorded runs of {rid}: {_counts(row)}{needed}; SPRT {row.sprt}",
+                          status=row.status or "pending", ref=rid)
         g = _id("G", rid, "target", env)
-        els[g] = Element(g, "goal", f"{rid}: under {env}, {row.get('target')}", supported_by=(sn,),
+        els[g] = Element(g, "goal", f"{rid}: under {env}, {row.target}", supported_by=(sn,),
                          in_context_of=(j,), ref=rid)
         kids.append(g)
     top = els[goal]

@@ -35,7 +35,11 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
+import msgspec
+
 from rclverify.model.plan.declarations import DECLARATIONS, STRENGTHS
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.strength_rows import Strength
 
 #: The kinds, strongest first (the report orders and compares by this).
@@ -58,48 +62,52 @@ def one_sided_bound(n: int, level: float = 0.95) -> float:
     return 1.0 if n <= 0 else 1.0 - (1.0 - level) ** (1.0 / n)
 
 
-def _figure(row: Mapping[str, Any], name: str) -> str | None:
-    for pair in row.get("figures") or []:
-        if isinstance(pair, (list, tuple)) and len(pair) == 2 and pair[0] == name:
-            return str(pair[1])
+def _figure(row: EvidenceRow, name: str) -> str | None:
+    for pair in row.figures:
+        if len(pair) == 2 and pair[0] == name:
+            return pair[1]
     return None
 
 
-def evidence_strength(row: Mapping[str, Any]) -> Strength:
-    """The strength of one evidence row of the report (``backend``,
-    ``status``, and the backend's figures: ``examples``, ``monitoring``,
-    ``figures``): a :class:`~rclverify.records.strength_rows.Strength` with
-    its ``kind``, ``detail`` and ``doubt``; an unknown backend is ``assumed``."""
-    backend = str(row.get("backend", ""))
+def evidence_strength(row: EvidenceRow | Mapping[str, Any]) -> Strength:
+    """The strength of one evidence row of the report (an
+    :class:`~rclverify.records.evidence_rows.EvidenceRow`, or its JSON object, decoded here:
+    ``backend``, ``status``, and the backend's figures: ``examples``, ``monitoring``,
+    ``figures``, ``statistics``): a :class:`~rclverify.records.strength_rows.Strength` with
+    its ``kind``, ``detail`` and ``doubt``; an unknown backend is ``assumed``.  Raises
+    :class:`msgspec.ValidationError` for a JSON object of another shape."""
+    if not isinstance(row, EvidenceRow):
+        row = EvidenceRow.of(row)
+    backend = row.backend
     kind = BACKEND_KIND.get(backend, "assumed")
     detail, doubt = "", DOUBT[kind]
-    stats = row.get("statistics") if isinstance(row.get("statistics"), Mapping) else None
+    stats = row.statistics or None  # the run counts a backend's payload carries (its own shape)
     if stats is not None and "decision" in stats:  # a target's record: its bound is the doubt
         return target_strength(row, stats)
     if backend == "hoare":
-        two = (row.get("solvers") or {}).get("agreement") == "two solvers"
+        two = row.solvers is not None and row.solvers.agreement == "two solvers"
         detail = f"Z3{' and cvc5' if two else ' (one solver)'} on the verification conditions"
         doubt = DOUBT["proof2" if two else "proof"]
     elif backend in DECLARATIONS and DECLARATIONS[backend].strength_detail:
         detail = str(DECLARATIONS[backend].strength_detail)
     elif kind == "bounded":
-        partial = "PARTIAL COVERAGE" in str(row.get("explanation", ""))
-        detail = f"{row.get('tool') or backend} over an abstraction" + ("; partial coverage" if partial else "")
+        partial = "PARTIAL COVERAGE" in row.explanation
+        detail = f"{row.tool or backend} over an abstraction" + ("; partial coverage" if partial else "")
     elif kind == "statistical":
         n = _figure(row, "count")
         k = int(n) if n and n.isdigit() else 0
         bound = one_sided_bound(k)
-        detail = ("sample size not stated" if not k else f"{k} trials" if row.get("status") != "discharged" else
+        detail = ("sample size not stated" if not k else f"{k} trials" if row.status != "discharged" else
                   f"{k} trials, all within the criterion: a one-sided 95 % bound of {bound:.1%} on the rate of trials "
                   "missing it")
         doubt = max(DOUBT["statistical"], bound) if k else 1.0
     elif kind == "tested":
-        ex = row.get("examples") or {}
+        ex = row.examples  # the property tests' payload (backends/property_tests, its own shape)
         detail = f"{ex.get('valid', 0)} examples within the assumption (of {ex.get('run', 0)} run)"
         cov = coverage_text(ex.get("coverage") or {})
         detail += f"; coverage of the assumption's ranges: {cov}" if cov else ""
     elif kind == "observed":
-        m = row.get("monitoring") or {}
+        m = row.monitoring  # the monitors' run summary (docs/monitors.md, its own shape)
         c = m.get("counts") or {}
         answered = int(c.get("satisfied", 0) or 0) + int(c.get("violated", 0) or 0)
         detail = f"{answered} verdicts on messages (satisfied or violated), {m.get('events_read', 0)} events read"
@@ -115,12 +123,12 @@ def evidence_strength(row: Mapping[str, Any]) -> Strength:
     elif kind == "reviewed":
         who = (_figure(row, "reviewer") or "").split(";")[0].strip()
         detail = f"review by {who[:60] or 'an unnamed reviewer'}"
-    if row.get("status") != "discharged":
+    if row.status != "discharged":
         doubt = 1.0
     return Strength(kind=kind, detail=detail, doubt=doubt)
 
 
-def target_strength(row: Mapping[str, Any], stats: Mapping[str, Any]) -> Strength:
+def target_strength(row: EvidenceRow, stats: Mapping[str, Any]) -> Strength:
     """The strength of a target's record (a run set's or an experiment's,
     docs/statistics.md): ``statistical``, its detail the counts and the
     bound at the target's level, its doubt that bound when ``discharged``
@@ -133,7 +141,7 @@ def target_strength(row: Mapping[str, Any], stats: Mapping[str, Any]) -> Strengt
               + (f", {d['undecided']} undecided" if d.get("undecided") else "")
               + (f": a one-sided {float(d.get('level', 0.95)) * 100:g} % bound of {bound:.3g} on the probability "
                  f"that a {per} violates it" if isinstance(bound, (int, float)) else ""))
-    doubt = float(bound) if row.get("status") == "discharged" and isinstance(bound, (int, float)) else 1.0
+    doubt = float(bound) if row.status == "discharged" and isinstance(bound, (int, float)) else 1.0
     return Strength(kind="statistical", detail=detail, doubt=doubt)
 
 
@@ -154,18 +162,23 @@ def coverage_text(cov: Mapping[str, Any]) -> str:
     return "; ".join(parts)
 
 
-def side_condition_strength(sc: Mapping[str, Any]) -> Strength:
-    """The strength of a side-condition row: a ``proof`` by one or two
+def side_condition_strength(sc: SideConditionRow | Mapping[str, Any]) -> Strength:
+    """The strength of a side-condition row (a
+    :class:`~rclverify.records.side_condition_rows.SideConditionRow`, or its JSON object, decoded
+    here): a ``proof`` by one or two
     solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``.  One
     discharged from its producers' cone summaries (``context.summaries``,
     calculus/summary.py) is one solver's: cvc5 decides the last query only,
-    the summaries were each proved implied by their cone by Z3 alone."""
-    two = (sc.get("solvers") or {}).get("agreement") == "two solvers"
+    the summaries were each proved implied by their cone by Z3 alone.  Raises
+    :class:`msgspec.ValidationError` for a JSON object of another shape."""
+    if not isinstance(sc, SideConditionRow):
+        sc = SideConditionRow.of(sc)
+    two = sc.solvers is not msgspec.UNSET and sc.solvers.agreement == "two solvers"
     detail = "Z3 and cvc5" if two else "Z3 (one solver)"
-    if two and ((sc.get("context") or {}).get("summaries")):
+    if two and ((sc.context or {}).get("summaries")):  # calculus/compose.py's record of the proof in context
         # cvc5 decided the query over the cone summaries; each summary's own proof (implied by its cone) is Z3's
         two, detail = False, "Z3 and cvc5 on the query over the cone summaries, the summaries by Z3 alone"
-    doubt = DOUBT["proof2" if two else "proof"] if sc.get("status") == "discharged" else 1.0
+    doubt = DOUBT["proof2" if two else "proof"] if sc.status == "discharged" else 1.0
     return Strength(kind="proof", detail=detail, solvers=2 if two else 1, doubt=doubt)
 
 
