@@ -25,7 +25,7 @@ def _report() -> dict:
 
 def _groups() -> dict[tuple[str, ...], dict]:
     report = _report()
-    return {tuple(g["key"]): g for g in group_problems(report, render.problem_items(report), render.anchor)}
+    return {tuple(g.key): g.to_json() for g in group_problems(report, render.problem_items(report), render.anchor)}
 
 
 def test_guarantee_3_row_keeps_only_findings_proved_to_come_from_its_flaw() -> None:
@@ -70,6 +70,6 @@ def test_an_instance_whose_diagnosis_names_another_culprit_is_grouped_under_it()
     report = _report()
     d = next(x for x in report["diagnoses"] if x["id"] == "Agent.g2.ajpf.p14_i0")
     d["culprits"].append({"what": "assumption 1 of Agent", "source": report["nodes"][0]["source"], "text": ""})
-    groups = {tuple(g["key"]): g for g in group_problems(report, render.problem_items(report), render.anchor)}
+    groups = {tuple(g.key): g.to_json() for g in group_problems(report, render.problem_items(report), render.anchor)}
     assert "Agent.g2.ajpf.p14_i0" not in [m["id"] for m in groups[("model-checking:Agent:2",)]["members"]]
     assert any("Agent.g2.ajpf.p14_i0" in [m["id"] for m in g["members"]] for g in groups.values())

@@ -13,7 +13,7 @@ import msgspec
 import pytest
 
 from _typed_rows import complete, ungrouped_report
-from rclverify.records.summary_rows import Meta
+from rclverify.records.summary_rows import Meta, SystemView
 from rclverify.report import diagram, render
 
 
@@ -323,7 +323,7 @@ def test_dot_has_every_node_and_connection() -> None:
 
 def test_dot_quotes_hostile_names() -> None:
     system = {"nodes": [{"name": 'A"] ; x -> y [label="', "status": "discharged"}],
-              "connections": [], "environment_inputs": [], "loops": []}
+              "connections": [], "environment_inputs": [], "loops": [], "loop_components": []}
     dot = diagram.system_dot(system)
     assert '"A\\"] ; x -> y [label=\\""' in dot
     assert "\n  x -> y" not in dot
@@ -358,8 +358,9 @@ def test_a_system_too_large_to_draw_is_not_laid_out(tmp_path: Path, monkeypatch:
     thousand nodes, and whether the diagram appeared then depended on the machine's speed); it says
     why and how to draw it, inlines no source in the HTML, and the Markdown keeps the source."""
     rep = _report()
-    n = diagram.system_elements(rep["system"])
-    assert diagram.system_layout(rep["system"], "digraph { this is not dot").note  # at the limit: dot runs
+    system = SystemView.of(rep["system"])
+    n = diagram.system_elements(system)
+    assert diagram.system_layout(system, "digraph { this is not dot").note  # at the limit: dot runs
     monkeypatch.setattr(diagram, "MAX_SYSTEM_LAYOUT_ELEMENTS", n - 1)
     def render_dot(dot: str, *a: Any, **k: Any) -> diagram.Rendering:
         assert "digraph system {" not in dot, "dot must not run on the system"
@@ -505,7 +506,7 @@ def test_problems_with_the_same_culprit_are_one_row() -> None:
     from rclverify.report.problems import group_problems
     rep = _grouping_report()
     rep["diagnoses"][1]["sentence"] = "G3 excludes it. More to read."
-    groups = group_problems(rep, render.problem_items(rep), render.anchor)
+    groups = [g.to_json() for g in group_problems(rep, render.problem_items(rep), render.anchor)]
     by_key = {tuple(g["key"]): g for g in groups}
     agent = by_key[("guarantee:Agent:3",)]
     assert [m["id"] for m in agent["members"]] == ["Agent.g1.non-vacuous", "Agent.g2.non-vacuous",
@@ -558,7 +559,7 @@ def test_the_diagram_marks_the_culprit_and_the_failing_edge() -> None:
                         {"name": "Plan", "status": "failed"}],
               "connections": [{"from_node": "Gnss", "from_var": "h", "to_node": "Loc", "to_var": "h", "via": ""},
                               {"from_node": "Loc", "from_var": "p", "to_node": "Plan", "to_var": "p", "via": ""}],
-              "environment_inputs": [], "loops": []}
+              "environment_inputs": [], "loops": [], "loop_components": []}
     dot = system_dot(system, culprits={"Gnss"}, failing={("Gnss", "Loc")})
     lines = dot.splitlines()
     gnss = next(l for l in lines if l.strip().startswith('"Gnss" ['))

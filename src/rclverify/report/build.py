@@ -33,8 +33,6 @@ from rclverify.model.plan.load import all_requirements
 from rclverify.model.plan.standards.field_data import unstated_origins
 from rclverify.model.system.model import cycles_kept
 from rclverify.records.records import Obligation, worst
-from rclverify.records.node_rows import NodeRow
-from rclverify.records.problem_rows import ProblemRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.row import decode_rows
 from rclverify.records.side_condition_rows import SideConditionRow
@@ -238,7 +236,7 @@ def diagnosed_report(report: AssuranceReport | Mapping[str, Any], diagnoses: Seq
     if diagnoses is None:
         draft = replace(draft, summary=replace(draft.summary, problems=[*draft.summary.problems, f"Diagnoses: {why}"]))
     draft = assemble.with_diagnoses(replace(draft, problems=[]), list(diagnoses or []))
-    problems = decode_rows(ProblemRow, group_problems(draft, problem_items(draft), anchor))
+    problems = group_problems(draft, problem_items(draft), anchor)
     return replace(draft, problems=problems, nodes=marked_nodes(draft.nodes, problems))
 
 

@@ -24,7 +24,6 @@ from rclverify.records.findings import FindingRow, HealthFinding
 from rclverify.records.records import Obligation, worst
 from rclverify.records.derived_rows import DerivedPropertyRow, EnvironmentAssumptionRow
 from rclverify.records.node_rows import AssumptionRow, GuaranteeRow, InputRow, NodeRow, OutputRow
-from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.statuses import EvidenceStatus, HealthStatus
 from rclverify.report.cones import DERIVATION, ConeEvidence
 from rclverify.stages.contract_texts import ContractTexts

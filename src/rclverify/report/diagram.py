@@ -20,7 +20,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import jinja2
 
-from rclverify.records.report_schema import SystemJson
+from rclverify.records.summary_rows import SystemView
 from rclverify.report import layoutcache
 
 #: Fill and border colour of a node box, by (normalised) status.
@@ -94,11 +94,12 @@ def _loop_edges(loops: Sequence[Sequence[str]]) -> set[tuple[str, str]]:
     return pairs
 
 
-def system_dot(system: Mapping[str, Any], title: str = "system model", culprits: Iterable[str] = (),
+def system_dot(system: SystemView | Mapping[str, Any], title: str = "system model", culprits: Iterable[str] = (),
                failing: Iterable[tuple[str, str]] = ()) -> str:
     """Graphviz DOT text of the system model.
 
-    ``system`` is ``report["system"]``: ``nodes`` (``[{"name", "status"}]``),
+    ``system`` is the report's ``system`` (:class:`~rclverify.records.summary_rows.SystemView`, or its
+    JSON object, decoded here: ``ValidationError`` for one of another shape): ``nodes`` (name, status),
     ``connections`` (``[{"from_node", "from_var", "to_node", "to_var",
     "via"}]``), ``environment_inputs`` (``[{"node", "var", "type"}]``) and
     ``loops`` (``[[node, ...]]``, each a cycle in order).  ``title`` names the
@@ -114,15 +115,16 @@ def system_dot(system: Mapping[str, Any], title: str = "system model", culprits:
     condition that is not discharged) is drawn red and dashed: the failing
     edge (the diagram blames the culprit, not only its victims).
     Everything is sorted, so equal inputs give byte-equal output.
-    Raises ``KeyError`` when a required key is missing.
+    Raises ``KeyError`` when a connection or environment input lacks a key.
     """
+    system = SystemView.of(system)
     blamed, bad = set(culprits), set(failing)
-    loop_pairs = _loop_edges(system["loops"])
-    names = {n["name"] for n in system["nodes"]}
-    status = {n["name"]: n["status"] for n in system["nodes"]}
-    for c in system["connections"]:
+    loop_pairs = _loop_edges(system.loops)
+    names = {n.name for n in system.nodes}
+    status: dict[str, str] = {n.name: n.status for n in system.nodes}
+    for c in system.connections:  # the model's links (model/system/model.py ``Link``)
         names.update((c["from_node"], c["to_node"]))
-    for e in system["environment_inputs"]:
+    for e in system.environment_inputs:
         names.add(e["node"])
 
     nodes = []
@@ -135,7 +137,7 @@ def system_dot(system: Mapping[str, Any], title: str = "system model", culprits:
 
     edges = []
     conns = sorted(
-        system["connections"],
+        system.connections,
         key=lambda c: (c["from_node"], c["from_var"], c["to_node"], c["to_var"], str(c.get("via") or "")),
     )
     for c in conns:
@@ -152,7 +154,7 @@ def system_dot(system: Mapping[str, Any], title: str = "system model", culprits:
         })
 
     sources = []
-    for e in sorted(system["environment_inputs"], key=lambda e: (e["node"], e["var"])):
+    for e in sorted(system.environment_inputs, key=lambda e: (e["node"], e["var"])):
         typ = str(e.get("type") or "")
         sources.append({
             "id": dot_string(f"env:{e['node']}.{e['var']}"),
@@ -178,28 +180,27 @@ class Rendering:
     note: str
 
 
-def system_elements(system: SystemJson) -> int:
-    """How many elements the diagram of ``report["system"]`` draws: its
-    nodes, connections and environment inputs.  Raises ``KeyError`` when a
-    key :func:`system_dot` needs is missing."""
-    return len(system["nodes"]) + len(system["connections"]) + len(system["environment_inputs"])
+def system_elements(system: SystemView) -> int:
+    """How many elements the diagram of the report's ``system`` draws: its
+    nodes, connections and environment inputs."""
+    return len(system.nodes) + len(system.connections) + len(system.environment_inputs)
 
 
-def system_too_large(system: SystemJson) -> bool:
+def system_too_large(system: SystemView) -> bool:
     """More than :data:`MAX_SYSTEM_LAYOUT_ELEMENTS` elements: the report does not lay the system out."""
     return system_elements(system) > MAX_SYSTEM_LAYOUT_ELEMENTS
 
 
-def system_layout(system: SystemJson, dot: str) -> Rendering:
+def system_layout(system: SystemView, dot: str) -> Rendering:
     """The SVG of the system diagram's DOT text ``dot`` (:func:`render_dot`)
-    for ``report["system"]``, or, for a system of more than
+    for the report's ``system``, or, for a system of more than
     :data:`MAX_SYSTEM_LAYOUT_ELEMENTS` elements, no SVG and a note saying
     why and how to draw it anyway (``dot`` is then not run).  Never raises
     for Graphviz trouble."""
     if not system_too_large(system):
         return render_dot(dot)
-    return Rendering(None, f"the system has {len(system['nodes'])} nodes, {len(system['connections'])} connections "
-                           f"and {len(system['environment_inputs'])} environment inputs, more than the "
+    return Rendering(None, f"the system has {len(system.nodes)} nodes, {len(system.connections)} connections "
+                           f"and {len(system.environment_inputs)} environment inputs, more than the "
                            f"{MAX_SYSTEM_LAYOUT_ELEMENTS} elements the report lays out (Graphviz needs minutes for "
                            "a few thousand, and a diagram of that size is not legible); its nodes, connections "
                            "and loops are in the tables below, its Graphviz source in assurance.md; to draw it "

@@ -17,7 +17,7 @@ locations, so a code-scanning view marks both files' lines.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import Any, Callable, Mapping
+from typing import Callable
 
 from rclverify.records.nodl_rows import NodlPlaceRow, NodlRow
 from rclverify.records.report_record import AssuranceReport

@@ -74,7 +74,6 @@ import msgspec
 
 from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import ProblemJson
 from rclverify.report.shapes import AttentionItem
 from rclverify.report import problems_causes as pc
 from rclverify.report import problems_mc as mc
@@ -98,20 +97,20 @@ class _Row:
     repairs: list[dict[str, Any]] = field(default_factory=list)
     where: str = ""
 
-    def to_json(self) -> ProblemJson:
-        """The row checked by decoding it into :class:`~rclverify.records.problem_rows.ProblemRow`, as its JSON
-        object (raises :class:`msgspec.ValidationError` for a row the class does not admit)."""
+    def record(self) -> ProblemRow:
+        """The row checked by decoding it into :class:`~rclverify.records.problem_rows.ProblemRow` (raises
+        :class:`msgspec.ValidationError` for a row the class does not admit)."""
         return ProblemRow.of({"key": self.key, "status": self.status, "sentence": self.sentence,
                               "culprits": self.culprits, "members": [m.to_json() for m in self.members],
-                              "repairs": self.repairs, "where": self.where}).to_json()
+                              "repairs": self.repairs, "where": self.where})
 
 
 def group_problems(report: AssuranceReport | Mapping[str, Any], items: Sequence[AttentionItem],
-                   anchor: Callable[..., str]) -> list[ProblemJson]:
+                   anchor: Callable[..., str]) -> list[ProblemRow]:
     """The problems of ``report`` (the report, or its JSON object, which may lack ``problems``:
     decoded here once into :class:`~rclverify.records.report_record.AssuranceReport`; the problems
     it has are not read) grouped by root cause (module docstring), each a
-    :class:`~rclverify.records.problem_rows.ProblemRow` written as its JSON object.
+    :class:`~rclverify.records.problem_rows.ProblemRow`.
 
     ``items`` are the report's attention problems (``render.problem_items``:
     dicts with ``status``, ``kind``, ``ref``, ``anchor``, ``message``);
@@ -150,7 +149,7 @@ def group_problems(report: AssuranceReport | Mapping[str, Any], items: Sequence[
             g.sentence_and_repairs(row)
     out = list(groups.values())
     out.sort(key=lambda row: -pp.severity(row.status))  # stable: report order within a status
-    return [row.to_json() for row in out]
+    return [row.record() for row in out]
 
 
 def _set(value: str | msgspec.UnsetType) -> str | None:

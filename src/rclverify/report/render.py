@@ -16,14 +16,15 @@ of rendering; evidence records show their own start times.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Sequence
 
 import msgspec
 from markupsafe import Markup
 
 from rclverify.records.links import link_pairs
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import Report, SystemJson, as_report
+from rclverify.records.report_schema import Report, as_report
+from rclverify.records.summary_rows import SystemView
 from rclverify.core.cache.memo import last_call
 from rclverify.records.published import write_published
 from rclverify.records.store import dumps
@@ -100,8 +101,8 @@ def _argument(report: AssuranceReport, rendering: diagram.Rendering | None,
 
 
 @last_call  # the system model as the diagram reads it (the HTML report's layout and page, the Markdown report)
-def _system(report: AssuranceReport) -> SystemJson:
-    return report.system.to_json()
+def _system(report: AssuranceReport) -> SystemView:
+    return report.system
 
 
 @last_call  # the HTML report's layout and page both show it

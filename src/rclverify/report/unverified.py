@@ -13,7 +13,7 @@ inconclusive); docs/reading-the-report.md, "Unverified guarantees".
 """
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any, Literal
 
 from rclverify.records.node_rows import NodeRow, UnverifiedRow

@@ -23,7 +23,6 @@ from rclverify.records.findings import FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import EARLIER, ProblemRow
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.row import decode_rows
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, Dashboard, DashboardCell, DashboardRow, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
@@ -213,7 +212,7 @@ def decoded_report(report: ReportIn) -> AssuranceReport:
         return AssuranceReport.of(_earlier(report))
     draft = AssuranceReport.of(_earlier(report))
     groups = group_problems(draft, _attention(draft, evidence_anchors(draft))[0], anchor)
-    return msgspec.structs.replace(draft, problems=decode_rows(ProblemRow, groups))
+    return msgspec.structs.replace(draft, problems=groups)
 
 
 def problem_items(report: ReportIn) -> list[AttentionItem]:
