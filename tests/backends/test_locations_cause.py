@@ -143,5 +143,5 @@ def test_the_problem_row_lists_program_lines_in_natural_order() -> None:
     items = [{"status": "failed", "kind": "hoare", "ref": "N.g1.hoare.p.c1", "anchor": "x", "message": "s."}]
     from _typed_rows import ungrouped_report  # the grouping reads the report decoded: the parts left out completed empty
     groups = group_problems(ungrouped_report(report), items, lambda *a: "-".join(map(str, a)))
-    g = next(g for g in groups if any(c["source"].startswith("p.imp") for c in g["culprits"]))
-    assert [c["source"] for c in g["culprits"]] == ["p.imp:9", "p.imp:13"]
+    g = next(g for g in groups if any(c["source"].startswith("p.imp") for c in g.culprits))
+    assert [c["source"] for c in g.culprits] == ["p.imp:9", "p.imp:13"]
