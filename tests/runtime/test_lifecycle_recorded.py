@@ -261,3 +261,23 @@ def test_rclverify_monitor_prints_where_a_missed_deadline_is_stated(tmp_path: Pa
            "contracts/b.rcl:8:3)\n" in out, out
     assert main(["monitor", "-w", str(ws), log, "--horizon", "1", "--transition-deadline",
                  "Battery:activate=100ms"]) == 0  # control: the command line's deadline replaces it
+
+
+def test_the_judged_run_decodes_as_its_printer_reads_it(tmp_path: Path) -> None:
+    """``rclverify monitor`` prints a managed run from backends/monitors/lifecycle_record.py's classes: the
+    gate's record decodes whole, a transition deadline with where it is stated; a record of another shape
+    is refused, never read by key."""
+    import msgspec
+    from rclverify.backends.monitors.lifecycle_record import LifecycleRun
+    quiet = [x for x in TRAFFIC if x[1] == "request" or 2.1 <= x[0] <= 3.0]
+    rec = _judge(tmp_path, _log(tmp_path, _script(traffic=quiet)), {"Battery": {"activate": 0.05}})
+    run = LifecycleRun.of(rec)
+    [m] = run.lifecycle.nodes
+    [d] = m.deadlines
+    assert (m.node, m.ros_node, m.status, d.transition, d.status, d.within) == (
+        "Battery", "/battery", "failed", "activate", "missed", 0.05)
+    assert run.nodes[0].status == "failed" and d.stated is None  # given on the command line: stated nowhere
+    assert run.lifecycle.not_questions == rec["lifecycle"]["not_questions"]
+    broken = {**rec, "lifecycle": {**rec["lifecycle"], "nodes": [{**_node(rec), "transitions": "six"}]}}
+    with pytest.raises(msgspec.ValidationError, match="transitions"):
+        LifecycleRun.of(broken)

@@ -28,6 +28,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from rclverify.lang.types import CheckedNode
 from rclverify.backends.monitors.lifecycle import TRANSITION_TYPE, gate_of
+from rclverify.backends.monitors.lifecycle_record import LifecycleRun
 from rclverify.runtime.live import LiveRun
 
 _DEADLINE = re.compile(r"^([A-Za-z_]\w*):([a-z]+)=([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(ms|s)?$")
@@ -47,25 +48,25 @@ def parse_deadlines(texts: Sequence[str]) -> dict[str, dict[str, float]]:
     return out
 
 
-def _lines(trace: str, rec: dict[str, Any]) -> list[str]:
+def _lines(trace: str, run: LifecycleRun) -> list[str]:
     """The printed lines of one judged trace (module docstring)."""
     out: list[str] = []
-    life = {n["node"]: n for n in rec["lifecycle"]["nodes"]}
-    for n in rec["nodes"]:
-        out.append(f"{trace}: {n['node']}: {n['status']}: {n['explanation']}")
-        m = life.get(n["node"])
+    life = {n.node: n for n in run.lifecycle.nodes}
+    for n in run.nodes:
+        out.append(f"{trace}: {n.node}: {n.status}: {n.explanation}")
+        m = life.get(n.node)
         if m is not None:
-            timed = m.get("deadlines") or []
-            said = ", ".join(f"{sum(t['status'] == s for t in timed)} {s}" for s in ("met", "missed", "open")
-                             if any(t["status"] == s for t in timed))
-            out.append(f"  lifecycle {m['ros_node']}: {m['transitions']} transition(s) heard, last {m['state']}; "
-                       f"{m['outputs_judged']} output(s) judged, {len(m['violations'])} outside active"
+            timed = m.deadlines
+            said = ", ".join(f"{sum(t.status == s for t in timed)} {s}" for s in ("met", "missed", "open")
+                             if any(t.status == s for t in timed))
+            out.append(f"  lifecycle {m.ros_node}: {m.transitions} transition(s) heard, last {m.state}; "
+                       f"{m.outputs_judged} output(s) judged, {len(m.violations)} outside active"
                        + (f"; deadlines: {said}" if said else ""))
-            out += [f"    {t['status']}: {t['reason']}" + (f" (stated at {t['stated']})" if t.get("stated") else "")
-                    for t in timed if t["status"] != "met"]
-    held = rec["lifecycle"]["not_questions"]
+            out += [f"    {t.status}: {t.reason}" + (f" (stated at {t.stated})" if t.stated else "")
+                    for t in timed if t.status != "met"]
+    held = run.lifecycle.not_questions
     if held:
-        scopes = sorted({s for n in rec["lifecycle"]["nodes"] for s in n["scope"]},
+        scopes = sorted({s for n in run.lifecycle.nodes for s in n.scope},
                         key=["unconfigured", "inactive", "active", "finalized"].index)
         out.append(f"{trace}: no question (heard while its readers were outside their lifecycle scope: "
                    f"{' or '.join(scopes)}): "
@@ -127,10 +128,11 @@ def lifecycle_command(args: argparse.Namespace, checked: Any, nodes: Sequence[An
                 return 2
             rec["trace"] = trace
             records.append(rec)
-            failed = failed or any(n["status"] == "failed" for n in rec["nodes"])
-            undecided = undecided or any(n["status"] != "discharged" for n in rec["nodes"])
+            run = LifecycleRun.of(rec)
+            failed = failed or any(n.status == "failed" for n in run.nodes)
+            undecided = undecided or any(n.status != "discharged" for n in run.nodes)
             if not args.json:
-                print("\n".join(_lines(trace, rec)))
+                print("\n".join(_lines(trace, run)))
     if args.json:
         print(json.dumps(records, indent=2, sort_keys=True))
     return 1 if failed or (getattr(args, "strict", False) and undecided) else 0
