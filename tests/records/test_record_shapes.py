@@ -819,6 +819,47 @@ def test_a_typed_filter_reading_a_removed_field_fails_mypy(module: str, tmp_path
         assert rc == 1 and f'{filt.name}:' in out and f'"{cls.__name__}" has no attribute "{field}"' in out, out
 
 
+#: The renderers written in Python, each with the records it reads off the decoded report (its module under
+#: report/ -> the record classes): mypy, not a rendered file, finds a read of a field the record no longer
+#: declares.
+TYPED_CODE: dict[str, tuple[type[msgspec.Struct], ...]] = {
+    "standards_sheets": (StandardRow, standards_rows.ClauseRow),
+    "explain": (node_rows.NodeRow, node_rows.GuaranteeRow),
+    "sarif": (FindingRow,),
+}
+
+
+@pytest.fixture(scope="module")
+def mypy_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One mypy cache for the module's runs (the record modules are read once, then only the shadow differs)."""
+    return tmp_path_factory.mktemp("mypy_cache")
+
+
+@pytest.mark.parametrize("module", sorted(TYPED_CODE))
+def test_a_code_renderer_reading_a_removed_field_fails_mypy(module: str, mypy_cache: Path, tmp_path: Path) -> None:
+    """For each record a Python renderer reads, every field it reads removed from the record's class at once
+    (mypy's ``--shadow-file``, one run a class) makes mypy strict name each of those reads in the renderer;
+    the control, the records as they are, passes."""
+    renderer = PARTS.parents[1] / f"{module}.py"
+    source = renderer.read_text(encoding="utf-8")
+    rc, out = _mypy([str(renderer)], mypy_cache)
+    assert rc == 0, out
+    for cls in TYPED_CODE[module]:
+        read = sorted(fields_read_code(source, cls) & set(cls.__struct_fields__))
+        assert read, f"{renderer.name} reads no field of {cls.__name__}"
+        record = Path(inspect.getfile(sys.modules[cls.__module__]))
+        text = record.read_text(encoding="utf-8")
+        for field in read:  # from the class that declares it (a base class's field: the base's declaration)
+            owner = next(c for c in cls.__mro__ if field in vars(c).get("__annotations__", {}))
+            text = _without_field(text, owner.__name__, field)
+        shadow = tmp_path / f"{cls.__name__}_without_{len(read)}_fields.py"
+        shadow.write_text(text, encoding="utf-8")
+        rc, out = _mypy(["--shadow-file", str(record), str(shadow), str(renderer)], mypy_cache)
+        lines = [x for x in out.splitlines() if x.startswith(str(renderer)) or f"{renderer.name}:" in x]
+        assert rc == 1 and [f for f in read if not any(f'"{cls.__name__}"' in x and f'attribute "{f}"' in x
+                                                         for x in lines)] == [], (cls.__name__, out)
+
+
 #: The standards exports (the CSV/XLSX compliance matrix and its header, the gaps): their modules.
 EXPORTS: tuple[Path, ...] = tuple(PARTS.parents[1] / f"{m}.py" for m in ("standards_sheets", "standards_export"))
 #: The records the exports show, each with its table of the fields they do not show.
