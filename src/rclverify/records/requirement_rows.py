@@ -123,4 +123,39 @@ INTERNAL: dict[str, str] = {
 }
 
 
-__all__ = ["INTERNAL", "RequirementRow", "StrengthKind", "SupportRow", "WithoutDeadline", "rows_of"]
+_DEADLINE = "a deadline is its own item: a SARIF result and a JUnit test case of its own (report/deadlines.py), the " \
+            "report's end-to-end deadlines section; its effect on the verdict is the note shown"
+_WITHOUT = "for the argument (report/argument/deadlines.py) and the diagnoses; the note shown says the verdict without " \
+           "the deadline"
+_RUNS = "the statistical target's rows are shown in the report's statistics section (statistics[])"
+_STRENGTH = "what the plan asks of the evidence's strength and what falls short of it are shown in the HTML and " \
+            "Markdown requirements list; a shortfall is also one of the summary's problems (report/confidence_rows.py)"
+_CONFIDENCE = "a confidence over the argument, shown by the HTML and Markdown reports and JUnit's properties; this " \
+              "output states the verdict and its check"
+
+#: Per renderer written in Python (SARIF: report/sarif.py, JUnit: report/junit.py, ``rclverify explain``:
+#: report/explain.py and explain_items.py), the fields of :class:`RequirementRow` it does not show, each with
+#: the reason (tests/records/test_record_shapes.py holds each renderer to its table).
+INTERNAL_TO: dict[str, dict[str, str]] = {
+    "sarif": {
+        "text": "a result is located at the requirement's formal statement (check.source), where its words are; "
+                "the message says the verdict and the formal statement",
+        "support": "a result is the requirement's; a guarantee it is traced to has results of its own when it fails",
+        "deadline": _DEADLINE, "without_deadline": _WITHOUT, "statistics": _RUNS,
+        "confidence": _CONFIDENCE, "limited_by": _CONFIDENCE,
+        "required_strength": _STRENGTH, "strength_shortfall": _STRENGTH,
+    },
+    "junit": {
+        "support": "each guarantee it is traced to is a test case of its node's suite",
+        "deadline": _DEADLINE, "without_deadline": _WITHOUT, "statistics": _RUNS,
+        "required_strength": _STRENGTH, "strength_shortfall": _STRENGTH,
+    },
+    "explain": {
+        "deadline": _DEADLINE, "without_deadline": _WITHOUT, "statistics": _RUNS,
+        "confidence": _CONFIDENCE, "limited_by": _CONFIDENCE,
+        "required_strength": _STRENGTH, "strength_shortfall": _STRENGTH,
+    },
+}
+
+
+__all__ = ["INTERNAL", "INTERNAL_TO", "RequirementRow", "StrengthKind", "SupportRow", "WithoutDeadline", "rows_of"]
