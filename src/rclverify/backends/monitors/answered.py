@@ -63,12 +63,15 @@ class AnsweredRun:
         view = dict(inputs)
         view.update(mine)
         q.view = view
-        q.decided = set(plan.asked)
         q.due = qe.time + h
-        trigger = plan.trigger
-        if trigger:  # its own trigger (or the one carried to it), answered by its output: carried no further
-            q.triggers = {trigger: self.carried.get(trigger, qe) if j == 0 else qe}
-            q.mark("answered_triggers", trigger)
+        if plan.triggers:  # its own trigger (or the one carried to it), answered by its output: carried no further
+            own = next(k for k in run.m._in_keys if int(self.where[k][j]) == i)  # the input its message set
+            q.decided = {k for k in plan.asked if plan.triggers.get(k, own) == own}  # the guarantees it owes
+            if own in plan.triggers.values():
+                q.triggers = {own: self.carried.get(own, qe) if j == 0 else qe}
+                q.mark("answered_triggers", own)
+        else:
+            q.decided = set(plan.asked)
         if j + 1 < len(self.at):  # the next question of the run followed it within its horizon, or it expired first
             if chunk[int(self.at[j + 1])].time <= qe.time + h:
                 q.followed = True

@@ -163,7 +163,12 @@ class _Run(PairsState, LoneSlots):
         #: a violated answer of a guarantee on a question is held for the skew (an output-only one is not)
         self.held = bool(m.stream.skew) and not m._alone
         #: ``triggered by``: the column code of the input every triggered guarantee answers (0: no trigger)
-        self.owing = next((self.kinds[t] for t, (key, _, _) in plan.inputs.items() if key == plan.trigger), 0)
+        codes = {key: self.kinds[t] for t, (key, _, _) in plan.inputs.items()}
+        #: ``triggered by``: per guarantee in order, the column code of the input triggering it (0: untriggered);
+        #: empty when none is triggered
+        self.owing = [codes[plan.triggers[k]] if k in plan.triggers else 0 for k in range(1, len(m.guarantees) + 1)] \
+            if plan.triggers else []
+        self.trigger_of = {c: k for k, c in codes.items()}
         #: a chunk of short runs of lone triggers and answers judged in batch where clean (batch_lone.py)
         self.lone = lone_eligible(m, plan)
 
@@ -304,15 +309,20 @@ class _Run(PairsState, LoneSlots):
                     col = col.copy()
                     col[before] = first
             columns[key] = col
-        if self.owing:  # a question another input raises owes a triggered guarantee only as carried: the engine's
-            seen &= tkind == self.owing
+        owed: list[np.ndarray] | None = None
+        if self.owing:  # a question owes a triggered guarantee its own message triggers (another only as carried:
+            # the first pair's, _carries_own); one owing none is settled with no answer: the engine's
+            owed = [tkind == c if c else np.ones(len(at), dtype=bool) for c in self.owing]
+            seen &= np.logical_or.reduce(owed)
         sure = seen.copy()
         judged = [f(columns) for f in plan.formulas]
-        for truth, certain in judged:
-            sure &= np.broadcast_to(truth & certain, sure.shape)
+        na = len(m.assumption)
+        for j, (truth, certain) in enumerate(judged):
+            holds = np.broadcast_to(truth & certain, sure.shape)
+            sure &= holds if owed is None or j < na else holds | ~owed[j - na]
         margins = [g(columns) for g in plan.margins]
-        for value, _ in margins:  # a margin the engine would compute in exact arithmetic (0, not positive): its row
-            sure &= value > 0
+        for j, (value, _) in enumerate(margins):  # a margin the engine would compute in exact arithmetic (0, not
+            sure &= value > 0 if owed is None else (value > 0) | ~owed[j]  # positive): its row
         wrong: np.ndarray | None = None
         bad = np.flatnonzero(~sure)
         loose = bad
@@ -340,10 +350,10 @@ class _Run(PairsState, LoneSlots):
                 b = p + int(np.searchsorted(times[at[p:b] + 1], limit, side="right"))
             if b > p and full and wrong is not None and self.held:
                 b = self._released(at, times, wrong, p, b)
-            if b > p and self._quiet(times[at[p]]):
+            if b > p and self._quiet(times[at[p]]) and self._carries_own(int(tkind[p])):
                 self._satisfied(chunk, at[p:b], {k: v[p:b] for k, v in src.items()}, times,
                                 [(v[p:b], a[p:b]) for v, a in margins], wrong[p:b] if full and wrong is not None
-                                else None)
+                                else None, [o[p:b] for o in owed] if owed is not None else None)
                 p = b
                 if p >= total:
                     break
@@ -368,13 +378,29 @@ class _Run(PairsState, LoneSlots):
             b = p + int(held[0])
         return b
 
+    def _carries_own(self, code: int) -> bool:
+        """Whether the triggers the latest question left unanswered (carried to the next question,
+        questions.py ``ask``) are only the trigger of a pair raised by the input of column code ``code``."""
+        last = self.m.stream.latest
+        if last is None or not last.triggers:
+            return True
+        own = self.trigger_of.get(code)
+        return all(t == own or t in last.answered_triggers for t in last.triggers)
+
     def _margins(self, chunk: EventRows | BlockRows, at: np.ndarray,
-                 margins: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
-        """Each guarantee's smallest margin over the pairs at ``at`` counted in the
-        result, as the engine counts them one by one; returns each pair's message margin."""
+                 margins: list[tuple[np.ndarray, np.ndarray]], owed: list[np.ndarray] | None = None) -> np.ndarray:
+        """Each guarantee's smallest margin over the pairs at ``at`` owing it (``owed``: per guarantee, which
+        pairs; ``None``: all) counted in the result, as the engine counts them one by one; returns each pair's
+        message margin (the least of the guarantees it owes)."""
         m, plan = self.m, self.plan
         kept_all = m.result.margins
+        every = at
         for k, (value, atom) in enumerate(margins, 1):
+            if owed is not None:
+                sel = owed[k - 1]
+                if not bool(sel.any()):
+                    continue
+                value, atom, at = value[sel], atom[sel], every[sel]
             j = int(np.argmin(value))
             kept = kept_all.get(k)
             if kept is not None and kept.answers and not value[j] < kept.value and \
@@ -387,7 +413,8 @@ class _Run(PairsState, LoneSlots):
             few = value if len(value) <= KEPT_MARGINS else np.partition(value, KEPT_MARGINS - 1)[:KEPT_MARGINS]
             m.result.note_margins(k, m._texts[k], float(value[j]), unit, text, "double",
                                   (ev.index, ev.time, ev.where, asker), len(at), few.tolist())
-        least: np.ndarray = np.minimum.reduce([v for v, _ in margins])
+        values = [v for v, _ in margins] if owed is None else [np.where(o, v, np.inf) for (v, _), o in zip(margins, owed)]
+        least: np.ndarray = np.minimum.reduce(values)
         return least
 
     def _quiet(self, t: float) -> bool:
@@ -407,7 +434,7 @@ class _Run(PairsState, LoneSlots):
 
     def _satisfied(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
                    times: np.ndarray, margins: list[tuple[np.ndarray, np.ndarray]] | None = None,
-                   wrong: np.ndarray | None = None) -> None:
+                   wrong: np.ndarray | None = None, owed: list[np.ndarray] | None = None) -> None:
         """The pairs at ``at`` are surely satisfied, or surely violated where ``wrong``
         (then only counted: :attr:`wrong`): their verdicts (with their margins,
         ``margins``: per guarantee its values and deciding atoms), and the engine's state as feeding them sets it."""
@@ -441,7 +468,7 @@ class _Run(PairsState, LoneSlots):
             result.counts["violated"] += bad
             result.violations_dropped += bad
         result.accepted += n
-        least = self._margins(chunk, at, margins) if margins else None
+        least = self._margins(chunk, at, margins, owed) if margins else None
         if m.on_verdict is not None:
             name, emit = m.node.name, m.on_verdict
             for j, i in enumerate(at.tolist()):

@@ -54,20 +54,23 @@ class BatchPlan:
         self.widths = dict(compiler.widths)
         if set(self.widths) != set(self.mapped):
             raise Unsupported("a window variable no formula reads at an offset")
-        #: ``triggered by``: the one input every triggered guarantee answers (a question its message raises owes
-        #: every guarantee; one another input raises owes what is carried to it: the engine's), else ""
+        #: ``triggered by``: the one input every triggered guarantee answers, when one input triggers them all, else ""
         self.trigger = ""
+        #: ``triggered by``: guarantee -> its trigger input (several inputs may trigger: a question owes a guarantee
+        #: its own message triggers, any other only as carried, which the engine decides: batch.py)
+        self.triggers: dict[int, str] = dict(m._trigger)
         if m._trigger:
             tks = set(m._trigger.values())
-            if len(tks) != 1 or next(iter(tks)) not in self.keys:
-                raise Unsupported("guarantees triggered by different inputs")
-            self.trigger = next(iter(tks))
+            if not tks <= set(self.keys):
+                raise Unsupported("a guarantee triggered by no input of its own topic")
+            if len(tks) == 1:
+                self.trigger = next(iter(tks))
         #: the question's evaluation decides nothing (needs_answer.py's Z3 answer, or batch_window.answer_only);
         #: the engine evaluates a triggered node's questions without asking Z3: asked here (a trigger only
         #: narrows which guarantees a question owes, so no input deciding any of them decides none it owes)
         if m._ask_at_question and not (self.widths and all(answer_only(m.guarantees[k - 1], m.node)
                                                             for k in m._asked)) and \
-                not (self.trigger and not self.widths and answer_decides(m.checked, m.node, m.guarantees)):
+                not (self.triggers and not self.widths and answer_decides(m.checked, m.node, m.guarantees)):
             raise Unsupported("a question's inputs may decide a guarantee")
         self.asked = set(m._asked)
         #: with margins: each guarantee's margin over the columns, and the (text, unit) of each deciding comparison
