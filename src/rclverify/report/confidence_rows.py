@@ -77,12 +77,12 @@ def confidence_part(report: AssuranceReport, links: list[tuple[str, str]],
                             "requirements": {}, "problems": [], "confidence": None, "ok": True}
     by_ob: dict[str, list[Strength]] = {}
     for e in report.evidence:
-        part["evidence"].append(evidence_strength(e.to_json()))
+        part["evidence"].append(evidence_strength(e))
         by_ob.setdefault(e.obligation, []).append(part["evidence"][-1])
     status = {o.id: str(o.status) for o in report.obligations}
     sc_premises: dict[str, list[Premise]] = {}
     for sc in report.side_conditions:
-        part["side_conditions"].append(side_condition_strength(sc.to_json()))
+        part["side_conditions"].append(side_condition_strength(sc))
         sc_premises.setdefault(sc.node, []).append(
             Premise(f"side condition {sc.id}", "proof", part["side_conditions"][-1].doubt))
     own: dict[str, list[Premise]] = {}

@@ -10,7 +10,7 @@ A value only passed on to JSON (a result's ``properties``) is ``object``.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import NamedTuple, NotRequired, TypedDict
+from typing import Any, NamedTuple, NotRequired, TypedDict
 
 from rclverify.records.derived_rows import DerivedPropertyRow
 from rclverify.records.evidence_rows import EvidenceRow
@@ -18,7 +18,6 @@ from rclverify.records.findings import FindingRow
 from rclverify.records.node_rows import NodeRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
-from rclverify.records.report_schema import SummaryJson
 from rclverify.records.requirement_rows import RequirementRow, StrengthKind, SupportRow
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.strength_rows import LimitedBy
@@ -75,7 +74,8 @@ class SummaryData(TypedDict):
     ``requirements`` rows are ``[id, verdict, status]``, ``deadlines`` rows ``[requirement, verdict,
     total, bound, evidence status]``; ``strict`` the clauses a failed ``--strict`` names."""
     meta: SummaryMeta
-    summary: SummaryJson
+    #: the report's summary as its JSON object (:class:`~rclverify.records.summary_rows.Summary`)
+    summary: dict[str, Any]
     rows: list[NodeSummaryRow]
     unverified: list[str]
     requirements: list[list[str]]
