@@ -10,6 +10,7 @@ import gzip
 import json
 from pathlib import Path
 
+import pytest
 from _typed_rows import ungrouped_report
 from rclverify.report import render
 from rclverify.report.problems import group_problems
@@ -23,13 +24,14 @@ def _report() -> dict:
     return ungrouped_report(json.loads(gzip.decompress(DATA.read_bytes())))
 
 
-def _groups() -> dict[tuple[str, ...], dict]:
+@pytest.fixture(scope="module")
+def groups() -> dict[tuple[str, ...], dict]:
+    """The stored report's problems by root cause, grouped once for the tests that only read them."""
     report = _report()
     return {tuple(g.key): g.to_json() for g in group_problems(report, render.problem_items(report), render.anchor)}
 
 
-def test_guarantee_3_row_keeps_only_findings_proved_to_come_from_its_flaw() -> None:
-    groups = _groups()
+def test_guarantee_3_row_keeps_only_findings_proved_to_come_from_its_flaw(groups: dict[tuple[str, ...], dict]) -> None:
     g3 = groups[("guarantee:Agent:3",)]
     ids = [m["id"] for m in g3["members"]]
     assert ids == ["Agent.g1.non-vacuous", "Agent.g2.non-vacuous", "Agent.g0.monitors.nominal_jsonl",
@@ -37,8 +39,7 @@ def test_guarantee_3_row_keeps_only_findings_proved_to_come_from_its_flaw() -> N
     assert not any(".ajpf." in i for i in ids)
 
 
-def test_failed_instances_are_one_row_per_guarantee_at_the_trail_lines() -> None:
-    groups = _groups()
+def test_failed_instances_are_one_row_per_guarantee_at_the_trail_lines(groups: dict[tuple[str, ...], dict]) -> None:
     g2 = groups[("model-checking:Agent:2",)]
     assert g2["status"] == "failed"
     assert [m["id"] for m in g2["members"]] == [f"Agent.g2.ajpf.p{14 + i}_i{i}" for i in range(13)]
@@ -51,8 +52,8 @@ def test_failed_instances_are_one_row_per_guarantee_at_the_trail_lines() -> None
     assert [m["id"] for m in g3["members"]] == ["Agent.g3.ajpf.p28_i12"]
 
 
-def test_inconclusive_instances_are_outstanding_rows_not_members_of_a_failed_row() -> None:
-    groups = _groups()
+def test_inconclusive_instances_are_outstanding_rows_not_members_of_a_failed_row(
+        groups: dict[tuple[str, ...], dict]) -> None:
     g1 = groups[("outstanding:model-checking:Agent:1",)]
     assert g1["status"] == "inconclusive"
     assert [m["id"] for m in g1["members"]] == [f"Agent.g1.ajpf.p{1 + i}_i{i}" for i in range(13)]
