@@ -40,6 +40,7 @@ from rclverify.records.report_record import AssuranceReport
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
 from rclverify.report.explain_items import finding_lines, obligation_lines, problem_lines, side_condition_lines
+from rclverify.report.explain_items import requirement_lines as requirement_lines  # rclverify requirements prints it
 from rclverify.records.records import SEVERITY
 
 #: At most this many obligations of one guarantee are listed one a line; more are counted.
@@ -57,40 +58,6 @@ _PROBLEM = re.compile(r"^(?:problem\s*|p)?(?P<k>\d+)\.?$", re.IGNORECASE)
 def _fold(text: str) -> str:
     """An id up to case, ``_``/``-`` and spaces (``battery_monitor`` ~ ``BatteryMonitor``)."""
     return re.sub(r"[\s_-]+", "", str(text)).lower()
-
-
-def requirement_lines(row: RequirementRow | Mapping[str, Any]) -> list[str]:
-    """One requirement of the report (its row, decoded here when given as
-    its JSON object) as text: id, verdict, status, source;
-    its statement, formal statement, assumptions, the note; the premises a
-    proof used, those traced but not needed, an inconsistent or vacuity
-    core; a counterexample node by node and the guarantees that did not
-    prevent it (docs/requirements.md).  Raises
-    :class:`msgspec.ValidationError` for a row of another shape."""
-    r = RequirementRow.of(row)
-    c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
-    out = [f"{r.id}: {r.verdict or 'traced'} [{r.status}]  {c.get('source') or ''}".rstrip(), f"  {r.text}"]
-    if c.get("formal"):
-        out.append(f"  formal: {c['formal']}")
-    out += [f"  assuming: {a}" for a in c.get("assuming") or []]
-    if r.note:
-        out.append(f"  {r.note}")
-    t = c.get("temporal") or {}
-    if t.get("method"):  # how a temporal statement was decided; an IC3/PDR proof's certificate
-        out.append(f"  temporal check: {t.get('status')} by {t['method']}" + (f"; {t['detail']}" if t.get("detail") else ""))
-        if t.get("certificate"):
-            out.append(f"    certificate (inductive invariant, re-checked): {t['certificate']}")
-    out += [f"    used: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("used") or []]
-    out += [f"    traced, not needed: {p['label']}" for p in c.get("traced_not_needed") or []]
-    out += [f"    contradictory: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("inconsistent_core") or []]
-    out += [f"    premise never holds with: {p['label']}: {p['text']}  ({p['source']})"
-            for p in c.get("vacuity_core") or []]
-    for step in c.get("counterexample") or []:
-        out.append(f"    counterexample {step['node']}: " + ", ".join(f"{k} = {v}" for k, v in step["values"].items()))
-    if c.get("counterexample_note"):
-        out.append(f"    {c['counterexample_note']}")
-    out += [f"    did not prevent it: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("failed_to_prevent") or []]
-    return out
 
 
 class _Index:
@@ -294,7 +261,7 @@ class _Index:
             out.append(f"{indent}  evidence: {len(obs)} obligations: " + ", ".join(
                 f"{n} {st} ({be})" for (st, be), n in sorted(groups.items(), key=lambda kv: -_rank(kv[0][0]))))
             out += [f"{indent}    {o.id} [{o.status}]" for o in obs if o.status not in ("discharged", "pending")]
-        supports = [r.id for r in self.requirements.values() for s in r.support if s.node == node and s.guarantee == k]
+        supports = self._supporting(node, k)
         if supports:
             out.append(f"{indent}  supports: {', '.join(supports)}")
         for f in self.findings.values():
@@ -304,6 +271,14 @@ class _Index:
         if problems:
             out.append(f"{indent}  problems: {', '.join(problems)} (`rclverify explain ID`)")
         out += [f"{indent}  culprit of a problem [{c.status}]: {clause_cut(c.sentence, 300)}" for c in _culprit_of(g)]
+        return out
+
+    def _supporting(self, node: str, k: int) -> list[str]:
+        """The requirements traced to guarantee ``k`` of ``node``, once per trace."""
+        out: list[str] = []
+        r: RequirementRow
+        for r in self.requirements.values():
+            out += [r.id for s in r.support if s.node == node and s.guarantee == k]
         return out
 
     def node_lines(self, node: str) -> list[str]:

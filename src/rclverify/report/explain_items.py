@@ -1,6 +1,6 @@
 """What ``rclverify explain ID`` prints for one item of the report: a
-contract-health finding, an obligation, a side condition of the calculus,
-a problem grouped by root cause (:mod:`.explain` finds the item by its id).
+requirement, a contract-health finding, an obligation, a side condition of
+the calculus, a problem grouped by root cause (:mod:`.explain` finds the item by its id).
 
 A finding, an obligation and a problem arrive decoded into their one
 definition (records/findings.py :class:`~rclverify.records.findings.FindingRow`,
@@ -21,12 +21,47 @@ from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import Acknowledged, FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.diagnosis_text import clause_cut, table_lines
 from rclverify.report.summary import whole_sentence
 
 #: The statuses of an item that holds: its model is a witness, and without a diagnosis there is no problem.
 HOLDS = ("discharged", "ok", "warning")
+
+
+def requirement_lines(row: RequirementRow | Mapping[str, Any]) -> list[str]:
+    """One requirement of the report (its row, decoded here when given as
+    its JSON object) as text: id, verdict, status, source;
+    its statement, formal statement, assumptions, the note; the premises a
+    proof used, those traced but not needed, an inconsistent or vacuity
+    core; a counterexample node by node and the guarantees that did not
+    prevent it (docs/requirements.md).  Raises
+    :class:`msgspec.ValidationError` for a row of another shape."""
+    r = RequirementRow.of(row)
+    c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
+    out = [f"{r.id}: {r.verdict or 'traced'} [{r.status}]  {c.get('source') or ''}".rstrip(), f"  {r.text}"]
+    if c.get("formal"):
+        out.append(f"  formal: {c['formal']}")
+    out += [f"  assuming: {a}" for a in c.get("assuming") or []]
+    if r.note:
+        out.append(f"  {r.note}")
+    t = c.get("temporal") or {}
+    if t.get("method"):  # how a temporal statement was decided; an IC3/PDR proof's certificate
+        out.append(f"  temporal check: {t.get('status')} by {t['method']}" + (f"; {t['detail']}" if t.get("detail") else ""))
+        if t.get("certificate"):
+            out.append(f"    certificate (inductive invariant, re-checked): {t['certificate']}")
+    out += [f"    used: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("used") or []]
+    out += [f"    traced, not needed: {p['label']}" for p in c.get("traced_not_needed") or []]
+    out += [f"    contradictory: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("inconsistent_core") or []]
+    out += [f"    premise never holds with: {p['label']}: {p['text']}  ({p['source']})"
+            for p in c.get("vacuity_core") or []]
+    for step in c.get("counterexample") or []:
+        out.append(f"    counterexample {step['node']}: " + ", ".join(f"{k} = {v}" for k, v in step["values"].items()))
+    if c.get("counterexample_note"):
+        out.append(f"    {c['counterexample_note']}")
+    out += [f"    did not prevent it: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("failed_to_prevent") or []]
+    return out
 
 
 def finding_lines(f: FindingRow, diagnosed: bool) -> list[str]:

@@ -169,14 +169,13 @@ def junit_tree(report: Report | AssuranceReport) -> ET.Element:
 def _requirements_suite(report: AssuranceReport) -> tuple[ET.Element, dict[str, int], float] | None:
     """The ``requirements`` ``<testsuite>`` (module docstring), its counts and
     time; ``None`` when the report has no requirements."""
-    reqs = report.requirements
-    if not reqs:
+    if not report.requirements:
         return None
     suite = ET.Element("testsuite", {"name": "requirements"})
     counts = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     props: list[tuple[str, str]] = []  # the test cases' strength and confidence (docs/confidence.md)
     time = 0.0
-    for r in reqs:
+    for r in report.requirements:
         c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
         secs = float(c.get("duration_s") or 0.0) if isinstance(c.get("duration_s"), (int, float)) else 0.0
         case = _case(suite, "requirement", r.id, str(c.get("source") or ""), secs)
