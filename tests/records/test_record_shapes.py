@@ -690,6 +690,7 @@ CODE_RECORDS: dict[str, tuple[type[msgspec.Struct], Mapping[str, Mapping[str, st
     "findings": (FindingRow, findings.INTERNAL_TO),
     "obligations": (ObligationRow, obligations.INTERNAL_TO),
     "problems": (problem_rows.ProblemRow, problem_rows.INTERNAL_TO),
+    "requirements": (RequirementRow, requirement_rows.INTERNAL_TO),
 }
 
 
@@ -741,6 +742,32 @@ def test_a_field_added_fails_until_each_code_renderer_shows_it_or_declares_it_in
     # a field declared internal to a renderer that shows it is refused
     assert unaccounted(FindingRow, [source], {**internal, "check": "x"}, code=FindingRow) == [
         "check: declared internal but rendered"]
+
+
+#: Per renderer, a read of the requirement's row put beside one it makes, as a change to the renderer would.
+_REQUIREMENT_READ = {"sarif": ('props = {"requirement": r.id,', 'props = {"m": r.margin_added_here, "requirement": r.id,'),
+                     "junit": ('f"verdict: {r.verdict}", r.note,', 'f"verdict: {r.verdict}", r.note, r.margin_added_here,'),
+                     "explain": ('out.append(f"  {r.note}")', 'out.append(f"  {r.note} {r.margin_added_here}")')}
+
+
+@pytest.mark.parametrize("renderer", list(CODE))
+def test_a_field_added_to_a_requirement_fails_until_each_code_renderer_shows_it_or_declares_it_internal(
+        renderer: str) -> None:
+    source = "\n".join(_code(renderer))
+    internal = requirement_rows.INTERNAL_TO[renderer]
+    assert unaccounted(_RequirementWithMargin, [source], internal, code=RequirementRow) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_RequirementWithMargin, [source], {**internal, "margin_added_here": "why"},
+                       code=RequirementRow) == []
+    old, new = _REQUIREMENT_READ[renderer]
+    shown = source.replace(old, new, 1)
+    assert shown != source
+    assert unaccounted(_RequirementWithMargin, [shown], internal, code=RequirementRow) == []
+    # a read of the requirement check's JSON (a key of r.check) is no read of a field of the row
+    raw = source + "\ndef _x(r: RequirementRow) -> object:\n    return r.check.get('margin_added_here')\n"
+    assert unaccounted(_RequirementWithMargin, [raw], internal, code=RequirementRow) != []
+    assert unaccounted(RequirementRow, [source], {**internal, "verdict": "x"}, code=RequirementRow) == [
+        "verdict: declared internal but rendered"]
 
 
 def _shown_by_code(renderer: str, row: Mapping[str, Any]) -> str:
