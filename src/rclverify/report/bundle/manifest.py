@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 from importlib import import_module
 
+import msgspec
 import z3
 
 from rclverify import __version__
@@ -43,6 +44,7 @@ from rclverify.model.plan.declarations import DECLARATIONS
 from rclverify.model.plan.load import Plan
 from rclverify.model.plan.paths import config_strings, escape_reason, looks_like_path
 from rclverify.model.plan.entries import declared_paths
+from rclverify.records.standards_rows import StandardRow, rows_of as standard_rows
 
 #: Format tag of the manifest.
 FORMAT = "rclverify-bundle/1"
@@ -224,12 +226,12 @@ def build_manifest(root: Path, plan: Plan, files: list[str], missing: list[str],
     verdict: dict[str, Any] = {}
     standards: list[dict[str, Any]] = []
     if "reports/assurance.json" in contents:
-        try:
+        try:  # a stored report of any version: its summary read by key, its standards decoded into their rows
             report = json.loads(contents["reports/assurance.json"].decode("utf-8"))
             summary = report["summary"]
             verdict = {"status": summary["status"], "headline": summary["headline"]}
-            standards = [_standard_brief(row) for row in report.get("standards") or ()]
-        except (ValueError, KeyError, TypeError, AttributeError):
+            standards = [_standard_brief(row) for row in standard_rows(report.get("standards") or ())]
+        except (ValueError, KeyError, TypeError, AttributeError):  # msgspec.ValidationError is a ValueError
             verdict, standards = {}, []
     out: dict[str, Any] = {
         "format": FORMAT,
@@ -247,18 +249,17 @@ def build_manifest(root: Path, plan: Plan, files: list[str], missing: list[str],
     return out
 
 
-def _standard_brief(row: Mapping[str, Any]) -> dict[str, Any]:
-    """A report ``standards[]`` row as the manifest carries it: the profile,
+def _standard_brief(row: StandardRow) -> dict[str, Any]:
+    """A report ``standards[]`` row (decoded) as the manifest carries it: the profile,
     where it comes from (``origin``: built-in with its edition, or the
     workspace file with its sha256), its level, and each clause's status,
     recommendation, why, what the plan says of it, the evidence in its scope
     and what covers it."""
-    return {"profile": str(row["profile"]), "edition": str(row["edition"]), "level": row.get("level"),
-            "origin": dict(row.get("origin") or {}),
-            "clauses": {str(c["id"]): {"status": str(c["status"]), "recommendation": str(c["recommendation"]),
-                                       "why": str(c.get("why", "")),
-                                       "plan": c.get("plan"),
-                                       "evidence": sorted({str(e["obligation"]) for e in c["evidence"]}),
-                                       "covered_by": [str(x) for x in c.get("covered_by") or ()]}
-                        for c in row["clauses"]},
-            "required_not_covered": [str(x) for x in row.get("required_not_covered") or ()]}
+    return {"profile": row.profile, "edition": row.edition, "level": row.level,
+            "origin": msgspec.to_builtins(row.origin),
+            "clauses": {c.id: {"status": c.status, "recommendation": c.recommendation, "why": c.why,
+                               "plan": msgspec.to_builtins(c.plan),
+                               "evidence": sorted({e.obligation for e in c.evidence}),
+                               "covered_by": list(c.covered_by)}
+                        for c in row.clauses},
+            "required_not_covered": list(row.required_not_covered)}
