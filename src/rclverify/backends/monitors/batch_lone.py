@@ -42,6 +42,7 @@ verdicts given, the counts and margins).
 """
 from __future__ import annotations
 
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 from rclverify.core.numeric import np
@@ -51,6 +52,8 @@ from rclverify.traces.questions import KEPT, Question
 from rclverify.targets.columns import seed
 from rclverify.backends.monitors.answered import RecentOutput
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS, Verdict
+
+_SOURCE, _LATE = attrgetter("source"), attrgetter("late")
 
 if TYPE_CHECKING:
     from rclverify.backends.monitors.batch_plan import BatchPlan
@@ -136,8 +139,10 @@ class LoneSlots:
         if unstamped is not None and not bool(unstamped[s:e].all()):
             return s
         rows = getattr(chunk, "events", None)
-        if rows is not None and any(ev.source is not None or ev.late for ev in rows[s:e]):
-            return s
+        if rows is not None:  # a source time or a lateness of its own: the engine's (event_time.py, late.py)
+            part = rows[s:e]
+            if list(map(_SOURCE, part)).count(None) != L or any(map(_LATE, part)):
+                return s
         new = np.ones(L, dtype=bool)
         new[1:] = t[1:] != t[:-1]
         starts = np.flatnonzero(new)
@@ -251,31 +256,34 @@ class LoneSlots:
             self._note(chunk, s, order, margin, atom, out_rows, paired_out, qidx, in_rows, er, prior, no)
         reason = (f"unanswered: no output within {m.horizon} s of the question at {{}} (a finite run cannot show the "
                   "answer never comes; a deadline `triggered by ... within` would fail)")
-        # the verdicts in order: (position, kind, row or question)
-        acts = sorted([(int(p), 1, int(r)) for p, r in zip(pos_out.tolist(), out_rows.tolist())] +
-                      [(int(p), 0, q) for p, q in zip(pos_close.tolist(), close_q)])
+        # the verdicts in order: (position, kind 1 an output's / 0 a closed question's, its row or question)
+        pos_all = np.concatenate([pos_out, pos_close])
+        what_all = np.concatenate([np.ones(no, dtype=np.int64), np.zeros(len(close_q), dtype=np.int64)])
+        x_all = np.concatenate([out_rows, np.array(close_q, dtype=np.int64)])
+        order_all = np.argsort(pos_all, kind="stable")
         base = s
 
         def qev(j: int) -> Event:
             """Question ``j``'s trigger message (-1: the question before the chunk's)."""
             got: Event = q0.event if j < 0 else chunk[base + int(in_rows[j])]
             return got
-        closed = [a for a in acts if a[1] == 0]
         result.counts["satisfied"] += no
         if "exact" in result.semantics:
             result.semantics["exact"] += no
-        if closed:
-            result.counts["inconclusive"] += len(closed)
+        if close_q:
+            result.counts["inconclusive"] += len(close_q)
             if result.first_inconclusive is None:
-                e = qev(closed[0][2])
+                e = qev(close_q[0])  # (closed in the order they were raised)
                 result.first_inconclusive = {"event": e.index, "time": e.time, "where": e.where,
                                              "reason": reason.format(e.where)}
         emit = m.on_verdict
-        tail = acts[-(m._given.maxlen or 256):]
+        tail = order_all[-(m._given.maxlen or 256):]
+        acts = zip(pos_all[order_all].tolist(), what_all[order_all].tolist(), x_all[order_all].tolist()) \
+            if emit is not None else iter(())
         least = margin[:no] if margin is not None else None
         out_at = {r: j for j, r in enumerate(out_rows.tolist())} if emit is not None else {}
         if emit is not None:
-            for p, what, x in acts:
+            for p, what, x in acts:  # (int, int, int)
                 if what:
                     ev = chunk[base + x]
                     j = out_at[x]
@@ -288,7 +296,7 @@ class LoneSlots:
                                  max(float(t[p // 2]), e.time), 0, {}, reason.format(e.where), "", "", None))
         first_index = chunk[base].index if len(chunk) > base else 0
         m._given.extend((first_index + x, "satisfied", "exact") if what else (qev(x).index, "inconclusive", "")
-                        for _, what, x in tail)
+                        for what, x in zip(what_all[tail].tolist(), x_all[tail].tolist()))
         self._questions_after(chunk, s, k, t, in_rows, out_rows, qidx, answered, paired_out)
         # the values, the clock, the outputs remembered, the counts
         values = m.values
