@@ -1,0 +1,93 @@
+"""A requirement's check record as the report's readers decode it: :class:`RequirementCheckRow`.
+
+The report's ``requirements[].check`` is the requirements stage's record
+(calculus/requirements/check.py, temporal_check.py and stages/requirements.py;
+its keys typed in :class:`rclverify.records.stage_records.RequirementCheck`),
+kept in :class:`rclverify.records.requirement_rows.RequirementRow` as its
+JSON object because its shape belongs to that stage.  A reader that reads it
+by attribute decodes it with :meth:`RequirementCheckRow.of`.
+
+The rules:
+
+* The classes declare the keys their readers read, each at the default a
+  record without it has (``None``, ``[]``, ``{}``; a check's key written
+  ``null`` reads as its default too); a key they do not declare is
+  ignored, not refused (the record keeps keys of its own: the premises
+  used, the side queries, the declarations).  A value of another type
+  raises :class:`msgspec.ValidationError`.
+* A number is kept as the record wrote it (an ``int`` stays an ``int``, a
+  ``float`` a ``float``), so that a reader printing it prints the text the
+  record had.
+* The temporal check's own record (``temporal``: its trace, lasso and the
+  gaps it rests on, :class:`rclverify.calculus.shapes.Gaps`) stays a
+  mapping, read as that stage writes it.
+
+Readers: the diagnosis of a refuted requirement (diagnosis/requirement.py).
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import msgspec
+
+
+class CexNodeRow(msgspec.Struct, frozen=True):
+    """One node's values in Z3's counterexample of a requirement (calculus/requirements/check.py):
+    ``values`` by ``in.x`` / ``out.y``, each as Z3's model gives it."""
+
+    node: str
+    values: dict[str, Any] = {}
+
+
+class WitnessRow(msgspec.Struct, frozen=True):
+    """One operand of a temporal statement at one step of a recorded run
+    (backends/monitors/temporal_trace.py; :class:`rclverify.records.stage_records.Witness`)."""
+
+    operand: str | None = None
+    holds: bool | None = None
+    step: int | None = None
+    where: str | None = None
+    values: dict[str, Any] | None = None
+
+
+class TraceVerdictRow(msgspec.Struct, frozen=True):
+    """A temporal statement's verdict on one recorded run, or the run's failure to be checked
+    (:class:`rclverify.records.stage_records.TraceVerdictJson`, ``TraceFailure``): ``time`` in seconds."""
+
+    verdict: str | None = None
+    reason: str | None = ""
+    step: int | None = None
+    time: int | float | None = None
+    where: str | None = None
+    witness: list[WitnessRow] | None = None
+
+
+class TraceCheckRow(msgspec.Struct, frozen=True):
+    """One recorded run checked against a temporal requirement
+    (:class:`rclverify.records.stage_records.TraceRow`): the trace, the evidence status, the verdict."""
+
+    trace: str | None = None
+    status: str | None = None
+    verdict: TraceVerdictRow | None = None
+
+
+class RequirementCheckRow(msgspec.Struct, frozen=True):
+    """A requirement's check record (``requirements[].check``), the keys its readers read: the formal
+    statement and its ``file:line:col``, the cone, Z3's counterexample, the temporal check's record and
+    the recorded runs checked."""
+
+    formal: str | None = None
+    source: str | None = None
+    cone: list[str] = []
+    counterexample: list[CexNodeRow] = []
+    temporal: dict[str, Any] | None = None
+    traces: list[TraceCheckRow] = []
+
+    @classmethod
+    def of(cls, check: Mapping[str, Any]) -> RequirementCheckRow:
+        """``check`` (a requirement row's ``check``) decoded, a key written ``null`` at its default;
+        raises :class:`msgspec.ValidationError` for a declared key whose value has another type."""
+        return msgspec.convert({k: v for k, v in check.items() if v is not None}, cls)
+
+
+__all__ = ["CexNodeRow", "RequirementCheckRow", "TraceCheckRow", "TraceVerdictRow", "WitnessRow"]
