@@ -301,12 +301,16 @@ def test_the_traced_line_agrees_with_python_on_random_functions(tmp_path: Path) 
 
 def test_a_run_and_a_property_test_of_one_step_name_the_line_that_computed_it() -> None:
     from rclverify.diagnosis.evidence_records import _computed_line
-    report = {"obligations": [{"id": "T.g1.property_tests.e0", "node": "T", "guarantee": 1},
-                              {"id": "T.g2.property_tests.e0", "node": "T", "guarantee": 2}],
-              "evidence": [{"obligation": "T.g1.property_tests.e0", "backend": "property_tests", "status": "failed",
-                            "counterexample": {"cause": "gen/t/t/logic.py:18"}},
-                           {"obligation": "T.g2.property_tests.e0", "backend": "property_tests", "status": "failed",
-                            "counterexample": {"cause": "gen/t/t/other.py:3"}}]}
-    assert _computed_line(report, "T", 1, "gen/t/t/logic.py") == "gen/t/t/logic.py:18"
-    assert _computed_line(report, "T", 2, "gen/t/t/logic.py") == ""  # another file: not this handler's code
-    assert _computed_line(report, "U", 1, "gen/t/t/logic.py") == ""
+    from rclverify.records.evidence_rows import EvidenceRow
+    from rclverify.records.obligations import ObligationRow
+
+    def ob(k: int) -> ObligationRow:
+        return ObligationRow(f"T.g{k}.property_tests.e0", "T", k, "property_tests", "testing", "e0", "", "", "", "failed")
+
+    def ev(k: int, cause: str) -> EvidenceRow:
+        return EvidenceRow(f"T.g{k}.property_tests.e0", "property_tests", "testing", "failed", "", "", "", 0.0, "",
+                           {"cause": cause}, [], "")
+    obligations, evidence = [ob(1), ob(2)], [ev(1, "gen/t/t/logic.py:18"), ev(2, "gen/t/t/other.py:3")]
+    assert _computed_line(obligations, evidence, "T", 1, "gen/t/t/logic.py") == "gen/t/t/logic.py:18"
+    assert _computed_line(obligations, evidence, "T", 2, "gen/t/t/logic.py") == ""  # another file: not this handler's code
+    assert _computed_line(obligations, evidence, "U", 1, "gen/t/t/logic.py") == ""

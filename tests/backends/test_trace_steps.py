@@ -208,12 +208,12 @@ def test_a_refuted_run_is_never_worded_as_a_run_of_no_state() -> None:
     get: "a run of 0 states ... The state it repeats: ."); the control: one that kept its states names
     them, a loop as the state it repeats, a run that stops by its last state."""
     from rclverify.diagnosis.requirement import _temporal_record
-    q: Any = {"id": "R"}
+    from rclverify.records.requirement_check import RequirementCheckRow
 
     def sentence(trace: list[Any], loop: Any) -> str:
         check = {"formal": "eventually A.out.y", "source": "plan.yaml:1:1",
                  "temporal": {"trace": trace, "loop": loop, "method": "bmc", "detail": "k = 3"}}
-        return str(_temporal_record(q, check, lambda: [])["sentence"])
+        return _temporal_record("R", RequirementCheckRow.of(check), lambda: []).sentence
     empty = sentence([], None)
     assert "0 states" not in empty and "The state it repeats" not in empty and "state: ." not in empty, empty
     states = [{"nodes": [{"node": "A", "values": {"out.y": "false"}}]}] * 2

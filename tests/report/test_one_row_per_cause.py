@@ -147,17 +147,20 @@ def test_a_temporal_requirement_names_the_off_by_one(tmp_path: Path) -> None:
 
 def test_a_counterexample_through_a_refuted_side_condition_says_so(report: dict[str, Any]) -> None:
     from rclverify.diagnosis.requirement import _passes_through
+    from rclverify.diagnosis.shapes import report_rows
+    from rclverify.records.requirement_check import RequirementCheckRow
     from rclverify.stages.workspace import Workspace
     ws = Workspace(Path(report["_ws"]), "contracts/plan.yaml")
     cone = ["Supervisor", "GripperDriver"]
+    rows = report_rows(report)
 
-    def q(force: str) -> dict[str, Any]:
-        return {"id": "R", "check": {"counterexample": [
+    def q(force: str) -> RequirementCheckRow:
+        return RequirementCheckRow.of({"counterexample": [
             {"node": "Supervisor", "values": {"in.request": "0", "out.force": force}},
-            {"node": "GripperDriver", "values": {"in.force": force, "out.applied": force}}]}}
-    assert [sc["id"] for sc in _passes_through(ws, report, q("41"), cone)] == ["GripperDriver.sc2"]
-    assert _passes_through(ws, report, q("35"), cone) == []  # the driver's assumption holds there
-    assert _passes_through(ws, report, q("4x"), cone) == []  # a value that does not read shows nothing
+            {"node": "GripperDriver", "values": {"in.force": force, "out.applied": force}}]})
+    assert [sc.id for sc in _passes_through(ws, rows, q("41"), cone)] == ["GripperDriver.sc2"]
+    assert _passes_through(ws, rows, q("35"), cone) == []  # the driver's assumption holds there
+    assert _passes_through(ws, rows, q("4x"), cone) == []  # a value that does not read shows nothing
 
 
 MONITORED = """\

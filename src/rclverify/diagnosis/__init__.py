@@ -1,6 +1,6 @@
 """Diagnosis of every problem the report lists, and repairs checked by Z3.
 
-For each problem of the report dict (a health finding that is a problem, a
+For each problem of the report (a health finding that is a problem, a
 side condition that is not discharged, a refuted requirement, an end-to-end
 deadline refuted or not decided, a failed or erroneous evidence record)
 :func:`rclverify.diagnosis.build.diagnose` gives one *diagnosis record*: a

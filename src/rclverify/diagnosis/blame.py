@@ -44,7 +44,7 @@ from rclverify.diagnosis.bounds import FLIP, bound_literals, thresholds, value
 from rclverify.diagnosis.edits import Edit
 from rclverify.records.links import link_pairs
 from rclverify.diagnosis.shapes import ReportRows, Strengthening
-from rclverify.records.report_schema import SideConditionJson
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.diagnosis.repairs import _numbers, _peel, _rename
 from rclverify.model.plan.load import all_requirements
 from rclverify.calculus.requirements.check import check_requirement, formals_of
@@ -84,16 +84,16 @@ def conclusion_edit(ws: Any, node: str, k: int, extra: str) -> Edit | None:
     return Edit(g.loc.file, *span, f"({old}) and ({extra})")
 
 
-def side_condition_culprits(ws: Any, sc: SideConditionJson) -> tuple[list[tuple[str, int]], int]:
+def side_condition_culprits(ws: Any, sc: SideConditionRow) -> tuple[list[tuple[str, int]], int]:
     """``([(producer, guarantee index)], undecided)`` of the failed side
-    condition ``sc`` (a report row with ``id``, ``node``, ``conjunct``,
+    condition ``sc`` (the report's record, its ``id``, ``node``, ``conjunct`` and
     ``links``): the producer guarantees on the linked outputs whose
     conclusion, strengthened by the conjunct, makes Z3 discharge ``sc``
     (module docstring), and how many candidates could not be decided (Z3
     answered unknown, or the strengthened text does not type-check)."""
     pairs = link_pairs(sc)
     to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in pairs]
-    extra = _rename(str(sc["conjunct"]), to_producer)
+    extra = _rename(sc.conjunct, to_producer)
     out: list[tuple[str, int]] = []
     trials = undecided = 0
     for p in sorted({p for p, _, _, _ in pairs}):
@@ -110,7 +110,7 @@ def side_condition_culprits(ws: Any, sc: SideConditionJson) -> tuple[list[tuple[
             if system is None:  # the conjunct does not read in the producer's names: nothing shown either way
                 undecided += 1
                 continue
-            status = recheck.side_conditions(*system, sc["node"], ws).get(str(sc["id"]))
+            status = recheck.side_conditions(*system, sc.node, ws).get(sc.id)
             if status == "discharged":
                 out.append((p, k))
             elif status != "failed":
@@ -118,13 +118,13 @@ def side_condition_culprits(ws: Any, sc: SideConditionJson) -> tuple[list[tuple[
     return out, undecided
 
 
-def fixed_side_condition(ws: Any, sc: SideConditionJson, producer: str, k: int) -> Edit | None:
+def fixed_side_condition(ws: Any, sc: SideConditionRow, producer: str, k: int) -> Edit | None:
     """The edit that discharges the failed side condition ``sc`` through
     guarantee ``k`` of ``producer`` (one of :func:`side_condition_culprits`):
     its conclusion strengthened by the consumer's conjunct in the producer's
     names; ``None`` without an exact location."""
     to_producer = [(f"in.{iv}", f"out.{ov}") for _, ov, _, iv in link_pairs(sc)]
-    return conclusion_edit(ws, producer, k, _rename(str(sc["conjunct"]), to_producer))
+    return conclusion_edit(ws, producer, k, _rename(sc.conjunct, to_producer))
 
 
 def proved_with(ws: Any, req_id: str, edit: Edit) -> bool:
@@ -178,9 +178,10 @@ def threshold_edit(ws: Any, cmp: ast.Compare) -> tuple[Edit, str, str] | None:
 
 def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Strengthening]:
     """The guarantees of ``cone`` (node names) to blame for the refuted
-    requirement ``req_id`` (module docstring), each ``{"node", "guarantee",
-    "edit": Edit, "how": "bound" | "threshold" | "conclusion", "old", "new"}`` with the
-    strengthening Z3 checked and ``"implementable"`` (``proved`` or
+    requirement ``req_id`` (module docstring), each a
+    :class:`~rclverify.diagnosis.shapes.Strengthening` (``how`` ``bound`` |
+    ``threshold`` | ``conclusion``) with the strengthening Z3 checked and
+    whether the node stays ``implementable`` (``proved`` or
     ``inconclusive``).  ``[]`` when no single strengthening proves it."""
     req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
     if req is None:
@@ -203,9 +204,9 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Stre
                 system = recheck.edited_system(ws, flip[0])
                 impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
                 if impl:
-                    found.append({"node": n, "guarantee": k, "edit": flip[0], "how": "threshold",
-                                  "old": flip[1], "new": flip[2], "implementable": impl, "threshold": lit.text,
-                                  "inclusive": flip[0].text in ("<=", ">=")})
+                    found.append(Strengthening(node=n, guarantee=k, edit=flip[0], how="threshold",
+                                               old=flip[1], new=flip[2], implementable=impl, threshold=lit.text,
+                                               inclusive=flip[0].text in ("<=", ">=")))
                     hit = True
                     break
             if hit:
@@ -220,8 +221,8 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Stre
                     system = recheck.edited_system(ws, edit)
                     impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
                     if impl:
-                        found.append({"node": n, "guarantee": k, "edit": edit, "how": "bound",
-                                      "old": lit.text, "new": c, "implementable": impl})
+                        found.append(Strengthening(node=n, guarantee=k, edit=edit, how="bound",
+                                                   old=lit.text, new=c, implementable=impl))
                         break
     if found:
         return found
@@ -240,8 +241,8 @@ def requirement_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Stre
         system = recheck.edited_system(ws, added) if added is not None else None
         impl = _implementable(ws, system, n) if system is not None and _proved(req, system, ws.plan) else ""
         if impl and added is not None:
-            found.append({"node": n, "guarantee": k, "edit": added, "how": "conclusion", "old": "", "new": extra,
-                          "implementable": impl})
+            found.append(Strengthening(node=n, guarantee=k, edit=added, how="conclusion", old="", new=extra,
+                                       implementable=impl))
     return found
 
 
@@ -263,8 +264,8 @@ def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Strengt
     names the threshold (as :func:`requirement_culprits`), or an index
     offset (a summand ``+ 1``) moved by one either way -- lets Z3's temporal
     check prove the requirement (the pipeline's own check, on an edited copy)
-    and the edited node stays implementable.  Each ``{"node", "guarantee",
-    "edit", "how": "threshold" | "offset", "old", "new", "implementable"}``;
+    and the edited node stays implementable.  Each a
+    :class:`~rclverify.diagnosis.shapes.Strengthening` (``how`` ``threshold`` | ``offset``);
     ``[]`` when no such edit does it within :data:`TEMPORAL_TRIALS`."""
     req = next((r for r in all_requirements(ws.plan) if r.id == req_id), None)
     if req is None or req.formal is None:
@@ -294,8 +295,8 @@ def temporal_culprits(ws: Any, req_id: str, cone: Sequence[str]) -> list[Strengt
                 trials += 1
                 impl = holds(edit, n)
                 if impl:
-                    found.append({"node": n, "guarantee": k, "edit": edit, "how": how, "old": old, "new": new,
-                                  "implementable": impl})
+                    found.append(Strengthening(node=n, guarantee=k, edit=edit, how=how, old=old, new=new,
+                                               implementable=impl))
                     break
     return found
 
@@ -312,7 +313,7 @@ def cost(ws: Any, report: ReportRows, node: str, edit: Edit) -> list[dict[str, s
     after: dict[str, str] = {}
     for n in consumers:
         after.update(recheck.side_conditions(*system, n, ws))
-    before = {str(sc["id"]): str(sc["status"]) for sc in report["side_conditions"] if str(sc["id"]) in after}
+    before = {sc.id: str(sc.status) for sc in report.side_conditions if sc.id in after}
     h_before = recheck.health(ws, ws.checked, node)
     h_after = recheck.health(ws, system[0], node)
     return recheck.changes({**before, **h_before}, {**after, **h_after})

@@ -1,6 +1,6 @@
-"""One diagnosis record per problem of the report dict.
+"""One diagnosis record per problem of the report.
 
-:func:`diagnose` reads the report dict without diagnoses
+:func:`diagnose` reads the report without diagnoses
 (:func:`rclverify.report.build.undiagnosed_report`) and the workspace and
 returns ``[record, ...]``, each (the diagnosis stage seals them into
 ``artifacts/diagnosis/index.json``, :mod:`rclverify.stages.diagnoses`, and
@@ -32,10 +32,12 @@ import re
 from functools import partial
 from typing import Any, Callable, Mapping
 
+import msgspec
+
 from rclverify.diagnosis import blame, repairs as rep
 from rclverify.diagnosis.deadline import budget_repairs, deadline_record
 from rclverify.diagnosis.evidence_records import evidence_record
-from rclverify.diagnosis.record import diagnosis_record, guarantee_source
+from rclverify.diagnosis.record import diagnosis_record, entry, guarantee_source
 from rclverify.diagnosis.repair_cache import RepairCache, one_at_a_time
 from rclverify.diagnosis.requirement import requirement_record
 from rclverify.diagnosis.sidecond import side_condition_repairs
@@ -43,27 +45,33 @@ from rclverify.diagnosis.culprits import culprits, parse_core, plan_facts
 from rclverify.records.links import link_pairs
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
-from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows
-from rclverify.records.findings import FindingRow, rows_of
-from rclverify.records.report_schema import SideConditionJson
+from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows, report_rows
+from rclverify.records.findings import FindingRow
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.stage_records import Culprit, DiagnosisEntry, Repair
 
 
-def diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
+def diagnose(ws: Any, report: ReportRows | AssuranceReport | Mapping[str, Any]) -> list[DiagnosisEntry]:
     """The diagnosis records of every problem of ``report`` (see the module
     docstring), in the order of the report's problems list: health
-    findings, side conditions, evidence.  One process at a time per
-    workspace (:func:`one_at_a_time`), so parallel report tasks compute
+    findings, side conditions, evidence.  ``report`` is read as its
+    :class:`~rclverify.diagnosis.shapes.ReportRows` (a report's JSON object
+    is decoded first, :func:`~rclverify.diagnosis.shapes.report_rows`, which
+    raises ``ValueError`` for one that lacks a part).  One process at a time
+    per workspace (:func:`one_at_a_time`), so parallel report tasks compute
     each repair once."""
+    rows = report_rows(report)
     with one_at_a_time(ws):
-        return _diagnose(ws, report)
+        return _diagnose(ws, rows)
 
 
 def _diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
     cache = RepairCache(ws)
-    out: list[DiagnosisEntry] = []
+    out: list[DiagnosisRow] = []
     health_by_node: dict[str, dict[str, str]] = {}
-    findings = rows_of(report["findings"])
+    findings = report.findings
     for f in findings:
         health_by_node.setdefault(f.node, {})[f.id] = f.status
     # which guarantees of a node each culprit guarantee makes vacuous (one guard repair for all of them)
@@ -90,38 +98,37 @@ def _diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
         if f.status != "problem":
             continue
         out.append(_finding(ws, report, f, guard))
-    sc_before = {sc["id"]: sc["status"] for sc in report["side_conditions"]}
-    for sc in report["side_conditions"]:
-        if sc["status"] in ("failed", "inconclusive"):
+    sc_before = {sc.id: sc.status for sc in report.side_conditions}
+    for sc in report.side_conditions:
+        if sc.status in ("failed", "inconclusive"):
             out.append(_side_condition(ws, report, sc, cache, sc_before))
-    for q in report.get("requirements", []):
+    for q in report.requirements:
         # a requirement refuted only by its end-to-end deadline is the deadline's problem (below), not its formula's
-        own = (q.get("without_deadline") or {}).get("verdict", q.get("verdict")) if q.get("deadline") else q.get("verdict")
-        if q.get("verdict") == "refuted" and own == "refuted":
+        own = q.without_deadline.verdict if q.deadline and q.without_deadline else q.verdict
+        if q.verdict == "refuted" and own == "refuted":
             out.append(requirement_record(ws, report, q, cache, guarantee_source))
-    for row in report.get("deadlines") or ():
-        if row.get("verdict") in ("refuted", "inconclusive"):
-            chain = row.get("chain")
-            key = ["deadline", row["requirement"], row.get("path"), row.get("within"),
-                   [[h["node"], h["guarantee"], h["within_s"]] for h in chain] if chain else chain]
+    for row in report.deadlines:
+        if row.verdict in ("refuted", "inconclusive"):
+            chain = row.chain if row.chain is not msgspec.UNSET else None
+            key = ["deadline", row.requirement, row.path, row.within,
+                   [[h.node, h.guarantee, h.within_s] for h in chain] if chain else chain]
             reps: list[Repair] = ((cache.get(key, partial(budget_repairs, ws, row)) or [])
-                                  if row["verdict"] == "refuted" else [])
+                                  if row.verdict == "refuted" else [])
             out.append(deadline_record(ws, report, row, reps))
-    obligations = {o["id"]: o for o in report["obligations"]}
-    for e in report["evidence"]:
-        if e["status"] in ("failed", "error"):
-            out.append(evidence_record(ws, report, e, obligations.get(e["obligation"]), cache))
+    obligations = {o.id: o for o in report.obligations}
+    for e in report.evidence:
+        if e.status in ("failed", "error"):
+            out.append(evidence_record(ws, report, e, obligations.get(e.obligation), cache))
     # the same node and guarantee found by several techniques: each record names the others
-    by_key: dict[tuple[str, Any], list[str]] = {}
+    by_key: dict[tuple[str, int | None], list[str]] = {}
     for d in out:
-        by_key.setdefault((d["node"], d.get("guarantee")), []).append(d["id"])
-    for d in out:
-        d["related"] = [x for x in by_key[(d["node"], d.get("guarantee"))] if x != d["id"]] if d.get("guarantee") else []
+        by_key.setdefault((d.node, d.guarantee), []).append(d.id)
     cache.save()
-    return out
+    return [entry(msgspec.structs.replace(d, related=[x for x in by_key[(d.node, d.guarantee)] if x != d.id]
+                                          if d.guarantee else [])) for d in out]
 
 
-def _finding(ws: Any, report: ReportRows, f: FindingRow, guard: Callable[[str, int], Repair | None]) -> DiagnosisEntry:
+def _finding(ws: Any, report: ReportRows, f: FindingRow, guard: Callable[[str, int], Repair | None]) -> DiagnosisRow:
     node, k = f.node, f.guarantee
     facts = plan_facts(ws, node)
     members = parse_core(f.core, facts)
@@ -160,50 +167,49 @@ def _and(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _side_condition(ws: Any, report: ReportRows, sc: SideConditionJson, cache: RepairCache,
-                    sc_before: Mapping[str, str]) -> DiagnosisEntry:
+def _side_condition(ws: Any, report: ReportRows, sc: SideConditionRow, cache: RepairCache,
+                    sc_before: Mapping[str, str]) -> DiagnosisRow:
     pairs = link_pairs(sc)
-    cul: list[Culprit] = [{"what": f"assumption of {sc['node']}: `{sc['conjunct']}`", "source": sc["source"], "text": sc["conjunct"]}]
+    cul: list[Culprit] = [{"what": f"assumption of {sc.node}: `{sc.conjunct}`", "source": sc.source, "text": sc.conjunct}]
     said = []
     # a producer guarantee is named only when strengthening it discharges the side condition (blame.py)
     def find() -> ProducerCulprits:
         found, undecided = blame.side_condition_culprits(ws, sc)
         return {"culprits": [list(x) for x in found], "undecided": undecided}
     got: ProducerCulprits | None = \
-        cache.get(["sc-culprits", sc["id"], sc["conjunct"]], find) if sc["status"] == "failed" else None
+        cache.get(["sc-culprits", sc.id, sc.conjunct], find) if sc.status == "failed" else None
     shown: ProducerCulprits = got or {"culprits": [], "undecided": 1}
     blamed = {(str(p), int(k)) for p, k in shown["culprits"]}
     for p, ov, _, _ in pairs:
-        for n in report["nodes"]:
-            if n["name"] != p:
+        for n in report.nodes:
+            if n.name != p:
                 continue
-            for g in n["guarantees"]:
-                if not re.search(rf"out\.{re.escape(ov)}(?!\w)", g["text"]):
+            for g in n.guarantees:
+                if not re.search(rf"out\.{re.escape(ov)}(?!\w)", g.text):
                     continue
-                if sc["status"] == "failed" and (p, int(g["index"])) not in blamed:
+                if sc.status == "failed" and (p, g.index) not in blamed:
                     continue
-                if any(c["source"] == g["source"] for c in cul):
+                if any(c["source"] == g.source for c in cul):
                     continue
-                cul.append({"what": f"guarantee {g['index']} of {p}: `{g['text']}`", "source": g["source"],
-                            "text": g["text"]})
-                said.append(f"{p}'s guarantee {g['index']} ({g['source']}) `{g['text']}`")
-    involved = {str(sc["node"])} | {p for p, _, _, _ in pairs}
-    table = [r for r in counterexample_table(sc.get("model"), sc["node"]) if str(r["node"]) in involved]
+                cul.append({"what": f"guarantee {g.index} of {p}: `{g.text}`", "source": g.source,
+                            "text": g.text})
+                said.append(f"{p}'s guarantee {g.index} ({g.source}) `{g.text}`")
+    involved = {sc.node} | {p for p, _, _, _ in pairs}
+    table = [r for r in counterexample_table(sc.model, sc.node) if r["node"] in involved]
     cex = ", ".join(f"{r['node']}.{r['variable']} = {r['value']}" for r in table)
     together = ("its producers' guarantees (Z3 could not show which)" if shown["undecided"]
                 else "its producers' guarantees (together: strengthening any one of them alone does not discharge it)")
-    sentence = (f"{sc['node']} assumes `{sc['conjunct']}` ({sc['source']}), but "
+    sentence = (f"{sc.node} assumes `{sc.conjunct}` ({sc.source}), but "
                 + (_and(said) if said else together)
                 + (" allows" if len(said) == 1 else " allow") + " values outside it"
                 + (f": Z3's counterexample {cex}" if cex else "") + ".")
-    if sc["status"] == "inconclusive":
-        sentence = f"Z3 could not decide whether {sc['node']}'s assumption `{sc['conjunct']}` ({sc['source']}) follows from " \
+    if sc.status == "inconclusive":
+        sentence = f"Z3 could not decide whether {sc.node}'s assumption `{sc.conjunct}` ({sc.source}) follows from " \
                    + (_and(said) if said else "its producers' guarantees") + "."
     # what a weakened assumption of the consumer invalidates: its evidence, established under the old one
-    evidence = [f"{o['id']} ({o['status']})" for o in report["obligations"] if o["node"] == sc["node"]]
-    found = (cache.get(["side-condition", sc["id"], sc["conjunct"], dict(sc_before), evidence],
-                       lambda: side_condition_repairs(ws, sc, sc_before, evidence)) or {}) if sc["status"] == "failed" else {}
-    rec = diagnosis_record(sc["id"], "side-condition", sc["node"], sc["status"], sentence, culprits=cul,
-                  counterexample=table, repairs=list(found.get("repairs") or []))
-    rec["not_offered"] = list(found.get("not_offered") or [])
-    return rec
+    evidence = [f"{o.id} ({o.status})" for o in report.obligations if o.node == sc.node]
+    found = (cache.get(["side-condition", sc.id, sc.conjunct, dict(sc_before), evidence],
+                       lambda: side_condition_repairs(ws, sc, sc_before, evidence)) or {}) if sc.status == "failed" else {}
+    return diagnosis_record(sc.id, "side-condition", sc.node, sc.status, sentence, culprits=cul,
+                            counterexample=table, repairs=list(found.get("repairs") or []),
+                            not_offered=list(found.get("not_offered") or []))

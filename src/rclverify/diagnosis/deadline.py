@@ -24,13 +24,18 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import Any, Mapping, Sequence
 
+import msgspec
+
 from rclverify.calculus.deadlines import chains, decide, show_seconds
 from rclverify.lang.timing import UNITS
 from rclverify.diagnosis import recheck
 from rclverify.diagnosis.bounds import number_text
 from rclverify.diagnosis.shapes import ReportRows
-from rclverify.records.report_schema import DeadlineJson
-from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
+from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow
+from rclverify.diagnosis.record import diagnosis_record
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.stage_records import CexRow, Culprit, Repair
+from rclverify.records.statuses import AnyStatus
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
 
@@ -60,8 +65,8 @@ def _amount(seconds: Fraction, unit: str, floor: bool) -> tuple[str, str] | None
     return (text, "ns") if text else None
 
 
-def _hop_clause(ws: Any, hop: Mapping[str, Any]) -> Any:
-    return ws.checked.nodes[str(hop["node"])].node.guarantees[int(hop["guarantee"]) - 1]
+def _hop_clause(ws: Any, hop: DeadlineHop) -> Any:
+    return ws.checked.nodes[hop.node].node.guarantees[hop.guarantee - 1]
 
 
 def _decide_all(ws: Any, checked: Any, model: Any) -> dict[str, str]:
@@ -69,20 +74,20 @@ def _decide_all(ws: Any, checked: Any, model: Any) -> dict[str, str]:
             for d in ws.plan.deadlines}
 
 
-def budget_repairs(ws: Any, row: DeadlineJson) -> list[Repair]:
-    """The repairs of the refuted deadline ``row`` (a report row of
+def budget_repairs(ws: Any, row: DeadlineRow) -> list[Repair]:
+    """The repairs of the refuted deadline ``row`` (the report's record of
     :func:`rclverify.report.deadlines.deadline_rows`), each checked by Z3
     (module docstring), in the order shown."""
-    spec = _spec(ws, str(row["requirement"]))
-    hops = list(row.get("chain") or [])
+    spec = _spec(ws, row.requirement)
+    hops = _hops(row)
     if spec is None or not hops:
         return []
-    bounds = [Fraction(str(h["within_s"])) for h in hops]
+    bounds = [Fraction(h.within_s) for h in hops]
     total, budget = sum(bounds, Fraction(0)), spec.within
     excess = total - budget
     if excess <= 0:
         return []
-    req = str(row["requirement"])
+    req = row.requirement
     before = _decide_all(ws, ws.checked, ws.model)
     out: list[Repair] = []
     single: list[tuple[Fraction, Repair]] = []
@@ -101,14 +106,14 @@ def budget_repairs(ws: Any, row: DeadlineJson) -> list[Repair]:
         if rec is None:
             continue
         new = Fraction(amount[0]) * UNITS[amount[1]]
-        summary = (f"Make {h['node']} answer within {show_seconds(new)} instead of {h['within']}: guarantee "
-                   f"{h['guarantee']} of {h['node']} ({h['loc']}) `{edit.deleted(recheck.source_text(ws, loc.file))}` "
+        summary = (f"Make {h.node} answer within {show_seconds(new)} instead of {h.within}: guarantee "
+                   f"{h.guarantee} of {h.node} ({h.loc}) `{edit.deleted(recheck.source_text(ws, loc.file))}` "
                    f"becomes `{edit.text}`; the chain then sums to {show_seconds(total - b + new)}, within the "
                    f"{show_seconds(budget)} of {req}.")
         single.append((excess / b, _record(
             "tighten-hop", summary, edit, recheck.source_text(ws, loc.file), rec[0], rec[1],
             proves=f"the end-to-end deadline of {req} follows from the chain (rule D3)",
-            not_shown=(f"that {h['node']} can answer within {show_seconds(new)}: its evidence (the monitors' "
+            not_shown=(f"that {h.node} can answer within {show_seconds(new)}: its evidence (the monitors' "
                        "deadline verdicts on its recorded runs) must show it"))))
     out += [r for _, r in sorted(single, key=lambda x: x[0])]
     split = _split(ws, req, hops, bounds, total, budget, before)
@@ -117,7 +122,7 @@ def budget_repairs(ws: Any, row: DeadlineJson) -> list[Repair]:
     return out
 
 
-def _split(ws: Any, req: str, hops: Sequence[Mapping[str, Any]], bounds: Sequence[Fraction], total: Fraction,
+def _split(ws: Any, req: str, hops: Sequence[DeadlineHop], bounds: Sequence[Fraction], total: Fraction,
            budget: Fraction, before: Mapping[str, str]) -> Repair | None:
     """Every hop scaled by ``budget / total``, rounded down (module docstring)."""
     clauses = [_hop_clause(ws, h) for h in hops]
@@ -147,7 +152,7 @@ def _split(ws: Any, req: str, hops: Sequence[Mapping[str, Any]], bounds: Sequenc
     rec = _checked(ws, req, edit, before, budget)
     if rec is None:
         return None
-    said = ", ".join(f"{h['node']} {h['within']} -> {show_seconds(n)}" for h, (_, _, n) in zip(hops, new_texts))
+    said = ", ".join(f"{h.node} {h.within} -> {show_seconds(n)}" for h, (_, _, n) in zip(hops, new_texts))
     new_total = sum((n for _, _, n in new_texts), Fraction(0))
     return _record(
         "split-budget",
@@ -183,41 +188,50 @@ def break_node(ws: Any, path: Sequence[str]) -> str | None:
     return None
 
 
-def deadline_record(ws: Any, report: ReportRows, row: DeadlineJson,
-                    repairs: Sequence[Repair]) -> DiagnosisEntry:
+def deadline_record(ws: Any, report: ReportRows, row: DeadlineRow,
+                    repairs: Sequence[Repair]) -> DiagnosisRow:
     """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the
     refuted or inconclusive deadline ``row``: id ``<REQ>.deadline``, kind
     ``deadline``; the sentence names the chain, each hop's bound and the
     budget; the culprits are the hops' guarantees (or, with no chain, the
     node where the path breaks); the counterexample is the late run's
     stamps; ``repairs`` from :func:`budget_repairs`."""
-    req = str(row["requirement"])
-    path = " -> ".join(str(n) for n in row.get("path") or [])
-    head = f"The end-to-end deadline of {req} ({row['within']} along {path}, {row['source']})"
-    g_text = {(str(n["name"]), int(g["index"])): str(g["text"]) for n in report["nodes"] for g in n["guarantees"]}
-    hops = list(row.get("chain") or [])
-    culprits: list[Culprit] = [{"what": f"guarantee {h['guarantee']} of {h['node']}: within {h['within']}", "source": str(h["loc"]),
-                 "text": g_text.get((str(h["node"]), int(h["guarantee"])), "")} for h in hops]
-    if row["verdict"] == "refuted":
+    req = row.requirement
+    path = " -> ".join(row.path)
+    head = f"The end-to-end deadline of {req} ({row.within} along {path}, {row.source})"
+    g_text = {(n.name, g.index): g.text for n in report.nodes for g in n.guarantees}
+    hops = _hops(row)
+    culprits: list[Culprit] = [{"what": f"guarantee {h.guarantee} of {h.node}: within {h.within}", "source": h.loc,
+                 "text": g_text.get((h.node, h.guarantee), "")} for h in hops]
+    if row.verdict == "refuted":
         spec = _spec(ws, req)
-        total = sum((Fraction(str(h["within_s"])) for h in hops), Fraction(0))
+        total = sum((Fraction(h.within_s) for h in hops), Fraction(0))
         over = f", {show_seconds(total - spec.within)} over the budget" if spec is not None and total > spec.within else ""
-        chain = " -> ".join(f"{h['node']} guarantee {h['guarantee']} within {h['within']} ({h['loc']})" for h in hops)
-        sentence = (f"{head} is refuted: its chain {chain} sums to {row['total']}{over}; a hop must answer faster "
+        chain = " -> ".join(f"{h.node} guarantee {h.guarantee} within {h.within} ({h.loc})" for h in hops)
+        sentence = (f"{head} is refuted: its chain {chain} sums to {row.total}{over}; a hop must answer faster "
                     f"or the budget be larger.")
-        status = "failed"
+        status: AnyStatus = "failed"
     else:
-        broken = break_node(ws, [str(n) for n in row.get("path") or []])
+        broken = break_node(ws, row.path)
         if broken is not None:
-            src = next((str(n.get("source", "")) for n in report["nodes"] if n["name"] == broken), "")
+            src = next((n.source for n in report.nodes if n.name == broken), "")
             culprits = [{"what": f"the contract of {broken}", "source": src, "text": ""}]
-        sentence = f"{head} is not decided: {row['reason']}."
+        sentence = f"{head} is not decided: {row.reason}."
         status = "inconclusive"
     stamps: list[CexRow] = [{"node": str(s["event"]).split(".", 1)[0], "variable": str(s["event"]).split(".", 1)[-1],
-               "value": f"t0 + {_seconds_text(s['t_s'])} s", "table": None} for s in row.get("stamps") or []]
-    return {"id": f"{req}.deadline", "kind": "deadline", "node": "", "status": status, "sentence": sentence,
-            "culprits": culprits, "counterexample": stamps, "repairs": list(repairs), "guarantee": None,
-            "related": [], "requirement": req}
+               "value": f"t0 + {_seconds_text(s['t_s'])} s", "table": None} for s in _stamps(row)]
+    return diagnosis_record(f"{req}.deadline", "deadline", "", status, sentence, culprits=culprits,
+                            counterexample=stamps, repairs=repairs, requirement=req)
+
+
+def _hops(row: DeadlineRow) -> list[DeadlineHop]:
+    """The hops of ``row``'s chain, ``[]`` without one."""
+    return list(row.chain) if row.chain is not msgspec.UNSET else []
+
+
+def _stamps(row: DeadlineRow) -> list[Any]:
+    """The late run's stamps of ``row`` (``{"event", "t_s"}`` each, calculus/deadlines.py), ``[]`` without them."""
+    return list(row.stamps) if row.stamps is not msgspec.UNSET else []
 
 
 def _seconds_text(t: Any) -> str:

@@ -6,7 +6,9 @@ proof's constant or token, a monitor's or property test's code line).
 from __future__ import annotations
 
 import re
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
+
+import msgspec
 
 from rclverify.diagnosis.code_repair import checked_repairs, repaired_line
 from rclverify.diagnosis.constants import hoare_repair
@@ -16,22 +18,26 @@ from rclverify.diagnosis.record import diagnosis_record, guarantee_source
 from rclverify.diagnosis.repair_cache import RepairCache
 from rclverify.diagnosis.shapes import ReportRows
 from rclverify.diagnosis.table import counterexample_table
-from rclverify.records.report_schema import EvidenceJson, ObligationJson
-from rclverify.records.stage_records import Culprit, DiagnosisEntry, Repair
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.stage_records import Culprit, Repair
 
 _META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source", "cause", "boundary"}
 
 
-def _computed_line(report: ReportRows, node: str, k: object, file: str) -> str:
+def _computed_line(obligations: Sequence[ObligationRow], evidence: Sequence[EvidenceRow], node: str, k: object,
+                   file: str) -> str:
     """``file:line`` a failed property test of guarantee ``k`` of ``node``
-    names as computing the failing output, when it is a line of ``file``
-    (the generated node's logic.py); ``""`` otherwise."""
-    obligations = {str(o["id"]): o for o in report.get("obligations") or ()}
-    for e in report.get("evidence") or ():
-        o = obligations.get(str(e["obligation"]))
-        cause = str((e.get("counterexample") or {}).get("cause") or "") if isinstance(e.get("counterexample"), dict) else ""
-        if e.get("backend") == "property_tests" and e.get("status") == "failed" and o is not None and o["node"] == node \
-                and o["guarantee"] == k and cause.rsplit(":", 1)[0] == file:
+    (among the report's ``obligations`` and ``evidence``) names as computing
+    the failing output, when it is a line of ``file`` (the generated node's
+    logic.py); ``""`` otherwise."""
+    by_id = {o.id: o for o in obligations}
+    for e in evidence:
+        o = by_id.get(e.obligation)
+        cause = str((e.counterexample or {}).get("cause") or "")
+        if e.backend == "property_tests" and e.status == "failed" and o is not None and o.node == node \
+                and o.guarantee == k and cause.rsplit(":", 1)[0] == file:
             return cause
     return ""
 
@@ -70,17 +76,23 @@ def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
     return {}
 
 
-def evidence_record(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson | None,
-              cache: RepairCache) -> DiagnosisEntry:
-    node = o["node"] if o is not None else e["obligation"].split(".", 1)[0]
-    k = o["guarantee"] if o is not None else 0
-    backend = e["backend"]
-    text, src = guarantee_source(report, node, k) if k else ("", o["source"] if o is not None else "")
-    where = f"guarantee {k} of {node} ({src})" if k else f"the contract of {node} ({o['source'] if o is not None else ''})"
-    if backend == "hoare" and e["status"] == "failed" and o is not None:
+def evidence_record(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow | None,
+              cache: RepairCache) -> DiagnosisRow:
+    """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the failed
+    or erroneous evidence ``e`` of obligation ``o`` (``None``: not in the
+    report's obligations): a monitor's first violation, a property test's
+    example and code line, a Hoare proof's constants, else the backend's
+    explanation; the backends' payloads (``monitoring``, ``counterexample``,
+    the obligation's ``data``) are read as the mappings they write."""
+    node = o.node if o is not None else e.obligation.split(".", 1)[0]
+    k = o.guarantee if o is not None else 0
+    backend = e.backend
+    text, src = guarantee_source(report, node, k) if k else ("", o.source if o is not None else "")
+    where = f"guarantee {k} of {node} ({src})" if k else f"the contract of {node} ({o.source if o is not None else ''})"
+    if backend == "hoare" and e.status == "failed" and o is not None:
         return _hoare(ws, report, e, o, cache)
-    mon = e.get("monitoring") or {}
-    fv = mon.get("first_violation") if isinstance(mon, dict) else None
+    mon = e.monitoring
+    fv = mon.get("first_violation")
     if backend == "monitors" and fv:
         gk = fv.get("guarantee")
         gtext, gsrc = guarantee_source(report, node, gk) if gk else ("", "")
@@ -98,38 +110,35 @@ def evidence_record(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJ
             cul.insert(0, {"what": f"handler {h.name} of {h.file} (called for {h.variable}{said})",
                            "source": f"{h.file}:{h.line}", "text": h.name})
             # the same guarantee's property test found the line of that logic.py computing the value: it first
-            computed = _computed_line(report, node, gk, h.file)
+            computed = _computed_line(report.obligations, report.evidence, node, gk, h.file)
             if computed:
                 sentence = sentence[:-1] + f"; the value it published is computed at {computed} (the property test)."
                 cul.insert(0, {"what": f"{computed}: the line where the failing output goes wrong (property test)",
                                "source": computed, "text": ""})
-        found = report_repairs(ws, e["obligation"], node, _obligation_record(ws, node, e["obligation"]).get("data")
-                               or {}, mon, cache) if e["status"] == "failed" else {}
+        found = report_repairs(ws, e.obligation, node, _obligation_record(ws, node, e.obligation).get("data")
+                               or {}, mon, cache) if e.status == "failed" else {}
         if found.get("line") and found.get("repairs"):  # the line the first checked repair edits: the slip's
             sentence = sentence[:-1] + f"; the first repair checked on the run edits {found['line']}."
             cul.insert(0, {"what": f"{found['line']}: the line the first checked repair edits (the node re-run on "
                            "the run's questions)", "source": found["line"], "text": ""})
-        rec = diagnosis_record(e["obligation"], "monitor", node, e["status"], sentence, culprits=cul,
-                      counterexample=counterexample_table(fv.get("values"), node), guarantee=gk,
-                      repairs=list(found.get("repairs") or []))
-        if found.get("why"):
-            rec["not_offered"] = [str(found["why"])]
-        return rec
-    ce = e.get("counterexample")
-    if backend == "property_tests" and isinstance(ce, dict):
+        return diagnosis_record(e.obligation, "monitor", node, e.status, sentence, culprits=cul,
+                                counterexample=counterexample_table(fv.get("values"), node), guarantee=gk,
+                                repairs=list(found.get("repairs") or []),
+                                not_offered=[str(found["why"])] if found.get("why") else msgspec.UNSET)
+    ce = e.counterexample
+    if backend == "property_tests" and ce is not None:
         cex = {kk: v for kk, v in ce.items() if kk not in _META_KEYS}
-        impl = _obligation_record(ws, node, e["obligation"]).get("data", {}).get("implementation", "the implementation")
+        impl = _obligation_record(ws, node, e.obligation).get("data", {}).get("implementation", "the implementation")
         cause = ce.get("cause")  # the implementation line the example takes
         sentence = (f"Hypothesis found inputs on which {impl} "
                     f"violates {where}" + (f"; the implementation line where the failing example goes wrong is {cause}"
                                            if cause else "") + f"; replay: `{ce.get('replay', '')}`.")
         repairs: list[Repair] = []
-        if isinstance(cause, str) and cause and e["status"] == "failed":  # the culprit is a line of the code
-            before = {str(x["obligation"]): str(x["status"]) for x in report["evidence"]
-                      if str(x["obligation"]).startswith(f"{node}.")}
+        if isinstance(cause, str) and cause and e.status == "failed":  # the culprit is a line of the code
+            before = {x.obligation: str(x.status) for x in report.evidence if x.obligation.startswith(f"{node}.")}
             # one key per culprit line: the guarantees of a node failing at one line share their repairs
-            repairs = cache.get(["code", e["obligation"].rsplit(".", 1)[-1], node, cause, before],
-                                lambda: checked_repairs(ws, node, e["obligation"], cause, before),
+            repairs = cache.get(["code", e.obligation.rsplit(".", 1)[-1], node, cause, before],
+                                lambda: checked_repairs(ws, node, e.obligation, cause, before),
                                 cause.rpartition(":")[0]) or []
         cul_pt: list[Culprit] = [{"what": where, "source": src, "text": text}]
         made = repaired_line(cause, repairs) if isinstance(cause, str) else ""
@@ -137,23 +146,23 @@ def evidence_record(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJ
             sentence = (sentence[:-1] + f"; the first checked repair edits {made}, where the wrong value is made "
                         f"({cause} is where the example goes wrong).")
             cul_pt.insert(0, {"what": f"{made}: the line the first checked repair edits", "source": made, "text": ""})
-        return diagnosis_record(e["obligation"], "property-test", node, e["status"], sentence,
+        return diagnosis_record(e.obligation, "property-test", node, e.status, sentence,
                        culprits=cul_pt,
                        counterexample=counterexample_table(cex, node), guarantee=k, repairs=repairs)
-    expl = str(e.get("explanation", ""))
+    expl = e.explanation
     first = expl.split("; ")[0] if len(expl) > 300 else expl
-    return diagnosis_record(e["obligation"], "evidence", node, e["status"],
-                   f"{backend} evidence for {where} is {e['status']}: {first}",
+    return diagnosis_record(e.obligation, "evidence", node, e.status,
+                   f"{backend} evidence for {where} is {e.status}: {first}",
                    culprits=[{"what": where, "source": src, "text": text}],
-                   counterexample=counterexample_table(e.get("counterexample") if isinstance(e.get("counterexample"), dict) else None, node),
+                   counterexample=counterexample_table(e.counterexample, node),
                    guarantee=k)
 
 
-def _hoare(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson, cache: RepairCache) -> DiagnosisEntry:
+def _hoare(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow, cache: RepairCache) -> DiagnosisRow:
     from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
     from rclverify.backends.hoare.culprit_lines import compared_constants  # deferred: start-up (loads jinja2, z3 and more only when called)
-    node, k = o["node"], o["guarantee"]
-    rec = _obligation_record(ws, node, e["obligation"])
+    node, k = o.node, o.guarantee
+    rec = _obligation_record(ws, node, e.obligation)
     data = rec.get("data", {})
     program = data.get("program", "")
     conj, conj_src = data.get("conjunct_rcl", ""), data.get("conjunct_source", "")
@@ -170,15 +179,15 @@ def _hoare(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson, cach
     gtext, gsrc = guarantee_source(report, node, k)
     conj_nums = sorted(set(re.findall(r"(?<![\w.])\d+(?:\.\d+)?(?![\w.])", gtext)) - set(prog_texts) - {"0"},
                        key=float)
-    cex = e.get("counterexample") or {}
+    cex = e.counterexample or {}
     table = counterexample_table({kk: v for kk, v in cex.items() if "(final)" not in kk}, node)
     inputs = ", ".join(f"{kk} = {v}" for kk, v in cex.items() if kk.startswith("in."))
     outputs = ", ".join(f"{kk} = {v}" for kk, v in cex.items() if kk.startswith("out."))
     zero = re.search(r"a division by zero on this run \((.+?); verification condition (defined\S*)\)",
-                     str(e.get("explanation", "")))
+                     e.explanation)
     if zero:  # a definedness VC refuted (backends/hoare/defined.py): the division is the culprit, not a constant
         at = re.search(r"division at (\S+?:\d+:\d+)", zero.group(1))
-        return diagnosis_record(e["obligation"], "hoare", node, e["status"],
+        return diagnosis_record(e.obligation, "hoare", node, e.status,
                        f"{program} can divide by zero under guarantee {k} of {node} ({gsrc}): {zero.group(1)} does "
                        f"not hold on {inputs or 'the counterexample'} (verification condition {zero.group(2)}).",
                        culprits=[{"what": "the division", "source": at.group(1) if at else conj_src,
@@ -194,8 +203,8 @@ def _hoare(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson, cach
                     + ", then ".join(f"`{a.text}` ({program}:{a.line})" for a in assigned)
                     + f", giving {outputs or 'its output'}, which the conjunct `{conj}` ({conj_src}) of guarantee "
                     f"{k} of {node} ({gsrc}) rules out: the value assigned there breaks the post-condition.")
-    before = {ob["id"]: ob["status"] for ob in report["obligations"]
-              if ob["node"] == node and ob["backend"] == "hoare" and ob["instance"].split(".c")[0] == e["obligation"].split(".hoare.", 1)[-1].split(".c")[0]}
+    before = {ob.id: ob.status for ob in report.obligations
+              if ob.node == node and ob.backend == "hoare" and ob.instance.split(".c")[0] == e.obligation.split(".hoare.", 1)[-1].split(".c")[0]}
     # keyed by what the repair is computed from (not the obligation: every failed triple of one program
     # entry and guarantee gets the same repair, searched once; the case study's c2 and c3)
     reps = cache.get(["hoare", node, k, program, before],
@@ -204,7 +213,7 @@ def _hoare(ws: Any, report: ReportRows, e: EvidenceJson, o: ObligationJson, cach
     tokens = [] if reps else cache.get(["hoare-token", node, k, program, before],
                                        lambda: hoare_token_repairs(ws, node, k, program, before),
                                        extra_file=program) or []
-    return diagnosis_record(e["obligation"], "hoare", node, e["status"], sentence,
+    return diagnosis_record(e.obligation, "hoare", node, e.status, sentence,
                    culprits=[{"what": f"{program} line {c.split(':')[1]}", "source": c.split(': ', 1)[0], "text": c.split(': ', 1)[1]}
                              for c in prog_consts] + [{"what": f"conjunct of guarantee {k} of {node}", "source": conj_src, "text": conj}],
                    counterexample=table, repairs=[reps] if reps else tokens, guarantee=k)

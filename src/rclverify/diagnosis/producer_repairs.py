@@ -22,7 +22,7 @@ from rclverify.diagnosis.bounds import coefficient_literals, number_text, value
 from rclverify.diagnosis.edits import Edit
 from rclverify.records.links import link_pairs
 from rclverify.diagnosis.repairs import _record
-from rclverify.records.report_schema import SideConditionJson
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.stage_records import Repair
 from rclverify.diagnosis.units import declared_unit, literal_si, literal_in
 from rclverify.semantics.operators import OPERATORS
@@ -44,7 +44,7 @@ def implementable_check(status: str, node: str) -> dict[str, str]:
         "inconclusive": "not decided (Z3 could not say in its budget)"}.get(status, status)}
 
 
-def strengthen(ws: Any, sc: SideConditionJson, p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
+def strengthen(ws: Any, sc: SideConditionRow, p: str, new_g: str, cost_of: Any, discharged: dict[str, str],
                 not_offered: list[str], inplace: tuple[Edit, int, str] | None = None) -> list[Repair]:
     """1. the consumer's conjunct as a new guarantee of ``p``, or a bound of
     ``p`` tightened to it in place (``inplace``: :func:`inplace_edit`; module docstring)."""
@@ -77,18 +77,18 @@ def strengthen(ws: Any, sc: SideConditionJson, p: str, new_g: str, cost_of: Any,
     impl, witness = realize.implementable(ws, system[0], p)
     if impl == "refuted":
         at = ", ".join(f"{k} = {v}" for k, v in witness.items()) or "an input"
-        not_offered.append(f"Strengthening {p} by `{new_g}` discharges {sc['id']} but leaves {p} unimplementable: "
+        not_offered.append(f"Strengthening {p} by `{new_g}` discharges {sc.id} but leaves {p} unimplementable: "
                            f"for {at}, which its assumption allows, no output meets its guarantees.")
         return []
     undecided = " (Z3 could not decide whether it stays implementable)" if impl != "proved" else ""
     return [_record(
         "strengthen-producer",
         f"Strengthen {p}: {how}, the weakest strengthening of {p}'s guarantees that "
-        f"entails {sc['node']}'s assumption `{sc['conjunct']}`; {p} stays consistent{' and implementable' if not undecided else ''}"
+        f"entails {sc.node}'s assumption `{sc.conjunct}`; {p} stays consistent{' and implementable' if not undecided else ''}"
         f"{undecided}. {p}'s evidence must then establish the new guarantee.",
         edit, recheck.source_text(ws, rel),
         [discharged, {"check": f"{p}.contract-consistent", "status": "ok (Z3: sat)"}, implementable_check(impl, p)],
-        cost, proves=f"{sc['id']} follows from the edited contracts",
+        cost, proves=f"{sc.id} follows from the edited contracts",
         not_shown=f"that {p} can be made to meet `{new_g}`: its evidence must establish it")]
 
 
@@ -178,7 +178,7 @@ def _trigger_of(node: ast.Node, outs: set[str]) -> str:
     return ""
 
 
-def rescale(ws: Any, sc: SideConditionJson, p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,
+def rescale(ws: Any, sc: SideConditionRow, p: str, ov: str, k: int, extreme: Fraction, cost_of: Any,
              discharged: dict[str, str]) -> list[Repair]:
     """2. a coefficient of ``p``'s guarantees on ``out.ov`` divided by ``10**k`` (module docstring)."""
     factor = Fraction(10) ** k
@@ -218,16 +218,16 @@ def rescale(ws: Any, sc: SideConditionJson, p: str, ov: str, k: int, extreme: Fr
             bigger = "larger" if k > 0 else "smaller"
             return [_record(
                 "rescale-producer",
-                f"{p}'s contract lets `out.{ov}` reach {number_text(extreme) or extreme} where {sc['node']} assumes "
-                f"`{sc['conjunct']}`: a factor of {number_text(abs(factor) if k > 0 else 1 / factor)}, so {p} "
+                f"{p}'s contract lets `out.{ov}` reach {number_text(extreme) or extreme} where {sc.node} assumes "
+                f"`{sc.conjunct}`: a factor of {number_text(abs(factor) if k > 0 else 1 / factor)}, so {p} "
                 f"probably publishes `{ov}` in a unit {number_text(factor if k > 0 else 1 / factor)} times {bigger} "
-                f"than {sc['node']} reads (millimetres against metres). Convert it in {p}: `{old}` becomes "
+                f"than {sc.node} reads (millimetres against metres). Convert it in {p}: `{old}` becomes "
                 f"`{new_text}`. This is a unit conversion, not a bound: {p}'s implementation must publish in "
-                f"{sc['node']}'s unit.",
+                f"{sc.node}'s unit.",
                 edit, source,
                 [discharged, {"check": f"{p}.contract-consistent", "status": "ok (Z3: sat)"},
                  implementable_check(impl, p)],
-                cost, proves=f"{sc['id']} follows from the edited contracts",
-                not_shown=(f"which unit is right: {p}'s code must publish `{ov}` in the unit {sc['node']} reads, "
+                cost, proves=f"{sc.id} follows from the edited contracts",
+                not_shown=(f"which unit is right: {p}'s code must publish `{ov}` in the unit {sc.node} reads, "
                            f"and {p}'s evidence be established again for the rescaled guarantee"))]
     return []

@@ -29,7 +29,7 @@ from rclverify.diagnosis import recheck
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
 from rclverify.calculus.shapes import Gaps
-from rclverify.records.report_schema import RequirementJson
+from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.stage_records import Repair
 from rclverify.model.plan.load import all_requirements
 from rclverify.calculus.requirements.check import check_requirement
@@ -68,16 +68,16 @@ def _declaration_edit(ws: Any, node: Any, k: int) -> Edit | None:
     return Edit(node.loc.file, end_line, 1, end_line, 1, f"  {text}\n")
 
 
-def progress_repairs(ws: Any, q: RequirementJson, temporal: Gaps) -> list[Repair]:
+def progress_repairs(ws: Any, q: RequirementRow, temporal: Gaps) -> list[Repair]:
     """The repairs (:func:`.repairs._record` dicts, kind
-    ``declare-progress``) for the refuted temporal requirement ``q`` (a
-    report row) whose record ``temporal`` names ``missing_progress``: for
+    ``declare-progress``) for the refuted temporal requirement ``q`` (the
+    report's record) whose check ``temporal`` names ``missing_progress``: for
     each such node (at most :data:`MAX_NODES`), the weakest ``progress(
     within K steps )`` (:data:`BOUNDS`) with which the requirement check
     proves ``q`` on the edited contracts.  ``[]`` when none does, when the
     requirement or a node cannot be found, or the edited text does not
     check."""
-    req = next((r for r in all_requirements(ws.plan) if r.id == q["id"]), None)
+    req = next((r for r in all_requirements(ws.plan) if r.id == q.id), None)
     if req is None:
         return []
     out = []
@@ -101,12 +101,12 @@ def progress_repairs(ws: Any, q: RequirementJson, temporal: Gaps) -> list[Repair
             node = str(gap["node"])
             summary = (f"Declare on {node} ({gap['source']}) `progress( within {k} steps )`: it answers every input "
                        f"its assumption accepts within {k} step{'s' if k != 1 else ''}, the weakest such claim of "
-                       f"those tried ({', '.join(str(b) for b in BOUNDS)}) with which {q['id']} is proved. Declare "
+                       f"those tried ({', '.join(str(b) for b in BOUNDS)}) with which {q.id} is proved. Declare "
                        f"it only if {node}'s implementation does answer so: it is a claim its evidence must show.")
             out.append(_record("declare-progress", summary, edit, recheck.source_text(ws, edit.file),
-                               [{"check": str(q["id"]), "status": f"proved (temporal check: {how})"}],
-                               [{"check": str(q["id"]), "before": "refuted", "after": "proved"}],
-                               proves=f"{q['id']} follows from the edited contracts (every run reaches it)",
+                               [{"check": q.id, "status": f"proved (temporal check: {how})"}],
+                               [{"check": q.id, "before": "refuted", "after": "proved"}],
+                               proves=f"{q.id} follows from the edited contracts (every run reaches it)",
                                not_shown=f"that {node} answers within {k} step{'s' if k != 1 else ''}: a claim "
                                          "about its implementation, which no backend checks yet (declared, not "
                                          "verified)"))

@@ -2,56 +2,87 @@
 
 What a diagnosis writes (the record, its culprits, counterexample rows and
 repairs) is sealed, so its types are :mod:`rclverify.records.stage_records`'
-(``DiagnosisEntry``, ``Culprit``, ``CexRow``, ``Repair``); the report rows
-it reads are :mod:`rclverify.records.report_schema`'s (:class:`ReportRows`:
-the parts of the report it reads).  Here too are the parts only the
-diagnosis passes between its own functions and its cache
+(``DiagnosisEntry``, ``Culprit``, ``CexRow``, ``Repair``); the report parts
+it reads are the report's records (:class:`ReportRows`: the parts of
+:class:`~rclverify.records.report_record.AssuranceReport` it reads, each
+decoded into its Struct and read by attribute).  Here too are the parts
+only the diagnosis passes between its own functions and its cache
 (``artifacts/cache/diagnosis.pickle``, kept as JSON).
 """
-# No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
-# annotations (with string annotations every key would count as required).
+from __future__ import annotations
+
 from collections.abc import Mapping
-from typing import NotRequired, TypedDict, cast
+from typing import Any, TypedDict, cast
+
+import msgspec
 
 from rclverify.diagnosis.edits import Edit
-from rclverify.records.report_schema import (DeadlineJson, EvidenceJson, FindingJson, LintJson, NodeJson, ObligationJson,
-                                             RequirementJson, SideConditionJson, SystemJson)
+from rclverify.records.deadline_rows import DeadlineRow
+from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.findings import FindingRow
+from rclverify.records.lint_rows import LintRow
+from rclverify.records.node_rows import NodeRow
+from rclverify.records.obligations import ObligationRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_rows import RequirementRow
+from rclverify.records.row import decode_rows
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.stage_records import Repair
+from rclverify.records.summary_rows import SystemView
 
 
-class ReportRows(TypedDict):
-    """The parts of the report dict the diagnosis reads (the report without diagnoses,
-    report/build.py ``undiagnosed_report``; a whole :class:`~rclverify.records.report_schema.Report`
-    is one too)."""
-    system: SystemJson
-    requirements: list[RequirementJson]
-    nodes: list[NodeJson]
-    side_conditions: list[SideConditionJson]
-    findings: list[FindingJson]
-    obligations: list[ObligationJson]
-    evidence: list[EvidenceJson]
-    lint: list[LintJson]
-    deadlines: list[DeadlineJson]
+class ReportRows(msgspec.Struct, frozen=True):
+    """The parts of the report the diagnosis reads, decoded (:func:`report_rows`): the fields of
+    :class:`~rclverify.records.report_record.AssuranceReport` of the same names."""
+    system: SystemView
+    requirements: list[RequirementRow]
+    nodes: list[NodeRow]
+    side_conditions: list[SideConditionRow]
+    findings: list[FindingRow]
+    obligations: list[ObligationRow]
+    evidence: list[EvidenceRow]
+    lint: list[LintRow]
+    deadlines: list[DeadlineRow]
 
 
-#: The keys of :class:`ReportRows`.
-ROW_KEYS: tuple[str, ...] = tuple(ReportRows.__annotations__)
+#: The fields of :class:`ReportRows`.
+ROW_KEYS: tuple[str, ...] = ReportRows.__struct_fields__
 
 
-def report_rows(report: Mapping[str, object]) -> ReportRows:
-    """``report`` (a report dict, without diagnoses or with) as the :class:`ReportRows` the
-    diagnosis reads.  Raises ``ValueError`` naming the parts it lacks."""
+def report_rows(report: ReportRows | AssuranceReport | Mapping[str, Any]) -> ReportRows:
+    """The :class:`ReportRows` of ``report``: itself; the parts of an
+    :class:`~rclverify.records.report_record.AssuranceReport`; or the parts
+    of a report's JSON object (the report without diagnoses, report/build.py
+    ``undiagnosed_report``, or a whole one) decoded into their records.
+    Raises ``ValueError`` naming the parts a JSON object lacks,
+    :class:`msgspec.ValidationError` (a ``ValueError``) for a part of
+    another shape."""
+    if isinstance(report, ReportRows):
+        return report
+    if isinstance(report, AssuranceReport):
+        return ReportRows(*(getattr(report, k) for k in ROW_KEYS))
     missing = [k for k in ROW_KEYS if k not in report]
     if missing:
         raise ValueError(f"report lacks {', '.join(missing)}")
-    return cast(ReportRows, report)
+    return ReportRows(
+        system=SystemView.of(report["system"]),
+        requirements=decode_rows(RequirementRow, report["requirements"]),
+        nodes=decode_rows(NodeRow, report["nodes"]),
+        side_conditions=decode_rows(SideConditionRow, report["side_conditions"]),
+        findings=decode_rows(FindingRow, report["findings"]),
+        obligations=decode_rows(ObligationRow, report["obligations"]),
+        evidence=decode_rows(EvidenceRow, report["evidence"]),
+        lint=decode_rows(LintRow, report["lint"]),
+        deadlines=decode_rows(DeadlineRow, report["deadlines"]))
 
 
-class Strengthening(TypedDict):
+class Strengthening(msgspec.Struct, frozen=True, kw_only=True):
     """A guarantee whose one edit lets Z3 prove a refuted requirement (diagnosis/blame.py
-    ``requirement_culprits``, ``temporal_culprits``): ``how`` ``bound`` | ``threshold`` | ``conclusion``
-    | ``offset``, the text ``old`` and ``new``, ``implementable`` ``proved`` or ``inconclusive``;
-    a threshold's edit also names the ``threshold`` and whether it is now ``inclusive``."""
+    ``requirement_culprits``, ``temporal_culprits``): guarantee ``guarantee`` (1-based) of ``node``,
+    ``how`` ``bound`` | ``threshold`` | ``conclusion`` | ``offset``, the text ``old`` and ``new``,
+    ``implementable`` ``proved`` or ``inconclusive``; a threshold's edit also names the ``threshold``
+    and whether it is now ``inclusive`` (``""`` and ``False`` for the others).  Passed between the
+    diagnosis' functions only, never kept."""
     node: str
     guarantee: int
     edit: Edit
@@ -59,13 +90,15 @@ class Strengthening(TypedDict):
     old: str
     new: str
     implementable: str
-    threshold: NotRequired[str]
-    inclusive: NotRequired[bool]
+    threshold: str = ""
+    inclusive: bool = False
 
 
-class CulpritRow(TypedDict):
+class CulpritRow(msgspec.Struct, frozen=True):
     """A :class:`Strengthening` as the diagnosis cache keeps it (diagnosis/requirement.py): the
-    guarantee's ``text`` and ``source``, the edit as a ``repair`` Z3 checked."""
+    guarantee's ``text`` and ``source``, the edit as a ``repair`` Z3 checked
+    (:class:`~rclverify.records.stage_records.Repair`).  Kept as its JSON object
+    (:func:`culprit_rows_json`) and read back with :func:`culprit_rows`."""
     node: str
     guarantee: int
     how: str
@@ -73,7 +106,23 @@ class CulpritRow(TypedDict):
     new: str
     text: str
     source: str
-    repair: Repair
+    repair: dict[str, Any]
+
+    def repair_record(self) -> Repair:
+        """:attr:`repair` as the diagnosis record's repair."""
+        return cast(Repair, self.repair)
+
+
+def culprit_rows_json(rows: list[CulpritRow]) -> list[object]:
+    """``rows`` as the JSON objects the diagnosis cache keeps."""
+    out: list[object] = msgspec.to_builtins(rows)
+    return out
+
+
+def culprit_rows(kept: object) -> list[CulpritRow]:
+    """The rows the diagnosis cache gave back (:func:`culprit_rows_json`; ``None``: none) decoded.
+    Raises :class:`msgspec.ValidationError` for a kept value of another shape."""
+    return msgspec.convert(kept or [], list[CulpritRow])
 
 
 class ProducerCulprits(TypedDict):

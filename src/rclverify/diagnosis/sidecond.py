@@ -60,7 +60,7 @@ from rclverify.diagnosis.edits import Edit
 from rclverify.records.links import link_pairs
 from rclverify.diagnosis.repairs import MAX_CANDIDATES, _and_text, _record, _rename
 from rclverify.diagnosis.shapes import SideConditionRepairs
-from rclverify.records.report_schema import SideConditionJson
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.stage_records import Repair
 from rclverify.model.plan.errors import PlanError
 from rclverify.model.plan.load import all_requirements
@@ -83,9 +83,9 @@ def _bound_shape(target: ast.Expr, inputs: set[str]) -> tuple[str, bool, ast.Num
     return None
 
 
-def side_condition_repairs(ws: Any, sc: SideConditionJson, before_sc: Mapping[str, str],
+def side_condition_repairs(ws: Any, sc: SideConditionRow, before_sc: Mapping[str, str],
                            consumer_evidence: Sequence[str] = ()) -> SideConditionRepairs:
-    """The repairs of the failed side condition ``sc`` (a report row), in
+    """The repairs of the failed side condition ``sc`` (the report's record), in
     the order of the module docstring: ``{"repairs": [repair records],
     "not_offered": [sentences]}``.  ``before_sc`` maps every side condition
     id of the system to its status before the edit; ``consumer_evidence``
@@ -95,13 +95,13 @@ def side_condition_repairs(ws: Any, sc: SideConditionJson, before_sc: Mapping[st
     pairs = link_pairs(sc)
     if not pairs:
         return out
-    consumer = str(sc["node"])
+    consumer = sc.node
     producers = sorted({p for p, _, _, _ in pairs})
     cons = ws.checked.nodes[consumer].node
     target = None
     for a in cons.assumes:
         for c in conjuncts(a.formula):
-            if expr_to_rcl(c) == sc["conjunct"] and c.loc.end_line:
+            if expr_to_rcl(c) == sc.conjunct and c.loc.end_line:
                 target = c
     if target is None:
         return out
@@ -112,7 +112,7 @@ def side_condition_repairs(ws: Any, sc: SideConditionJson, before_sc: Mapping[st
         after: dict[str, str] = {}
         for n in nodes:
             after.update(recheck.side_conditions(checked, model, n, ws))
-        if after.get(sc["id"]) != "discharged":
+        if after.get(sc.id) != "discharged":
             return None
         h_before: dict[str, str] = {}
         h_after: dict[str, str] = {}
@@ -133,10 +133,10 @@ def side_condition_repairs(ws: Any, sc: SideConditionJson, before_sc: Mapping[st
         extreme = realize.extreme(ws, ws.checked, producers[0], pairs[0][1], shape[1])
         b = value(shape[2].text)
         scale = power_of_ten(extreme, b) if extreme is not None and b is not None else None
-    discharged = {"check": str(sc["id"]), "status": "discharged (Z3: proved)"}
+    discharged = {"check": sc.id, "status": "discharged (Z3: proved)"}
 
     if single:
-        new_g = _rename(str(sc["conjunct"]), to_producer)
+        new_g = _rename(sc.conjunct, to_producer)
         inplace = inplace_edit(ws, producers[0], pairs[0][1], target)
         tightened = strengthen(ws, sc, producers[0], new_g, cost_of, discharged, [], inplace) if inplace else []
         # the bound tightened in place, else (no such bound, or its edit not shown) the guarantee added
@@ -149,7 +149,7 @@ def side_condition_repairs(ws: Any, sc: SideConditionJson, before_sc: Mapping[st
     return out
 
 
-def _stems_from(ws: Any, sc: SideConditionJson, pairs: Sequence[tuple[str, str, str, str]],
+def _stems_from(ws: Any, sc: SideConditionRow, pairs: Sequence[tuple[str, str, str, str]],
                 target: ast.Expr) -> list[str]:
     """The ids of the plan's requirements the consumer's assumption ``target``
     stems from: a formal statement that reads the linked value
@@ -170,7 +170,7 @@ def _stems_from(ws: Any, sc: SideConditionJson, pairs: Sequence[tuple[str, str, 
     return out
 
 
-def _requirement_guard(out: SideConditionRepairs, sc: SideConditionJson, reqs: Sequence[str]) -> None:
+def _requirement_guard(out: SideConditionRepairs, sc: SideConditionRow, reqs: Sequence[str]) -> None:
     """Weakening a consumer's assumption that stems from a requirement is
     never the first repair: when it would be the only one it is
     withdrawn into ``not_offered`` with the reason; after a safe repair it
@@ -184,7 +184,7 @@ def _requirement_guard(out: SideConditionRepairs, sc: SideConditionJson, reqs: S
     if out["repairs"][0]["kind"] == "weaken-consumer":
         out["repairs"] = [r for r in out["repairs"] if r["kind"] != "weaken-consumer"]
         out["not_offered"].append(
-            f"Weakening {sc['node']}'s assumption `{sc['conjunct']}` is not offered: its bound stems from "
+            f"Weakening {sc.node}'s assumption `{sc.conjunct}` is not offered: its bound stems from "
             f"requirement {ids}, and no safe repair (tightening the producer) was shown, so widening it would "
             f"trade the requirement for a green side condition. Repair the producer, or revise {ids} first.")
         return
@@ -202,12 +202,12 @@ def _conjunct_after(target: ast.Expr, edit: Edit, source: str) -> str:
     return Edit(edit.file, loc.line, loc.col, loc.end_line, loc.end_col + delta, "").deleted(edit.apply(source))
 
 
-def _weaken(ws: Any, sc: SideConditionJson, target: ast.Expr, shape: tuple[str, bool, ast.NumLit] | None,
+def _weaken(ws: Any, sc: SideConditionRow, target: ast.Expr, shape: tuple[str, bool, ast.NumLit] | None,
             extreme: Fraction | None, scale: int | None, producers: Sequence[str],
             to_consumer: Sequence[tuple[str, str]], cost_of: Any, discharged: dict[str, str],
             consumer_evidence: Sequence[str]) -> list[Repair]:
     """3. the consumer's conjunct widened to what the producers guarantee, last (module docstring)."""
-    consumer = str(sc["node"])
+    consumer = sc.node
     cons = ws.checked.nodes[consumer].node
     rel = target.loc.file
     source = recheck.source_text(ws, rel)
@@ -219,11 +219,11 @@ def _weaken(ws: Any, sc: SideConditionJson, target: ast.Expr, shape: tuple[str, 
                 t = expr_to_rcl(c)
                 if any(re.search(rf"(?<![\w.']){re.escape(v)}(?![\w'])", t) for v in linked):
                     t2 = _rename(t, to_consumer)
-                    if "out." not in t2 and t2 != sc["conjunct"] and t2 not in cands:
+                    if "out." not in t2 and t2 != sc.conjunct and t2 not in cands:
                         cands.append(t2)
     already = {expr_to_rcl(c) for a in cons.assumes for c in conjuncts(a.formula)}
     cands = [t for t in cands if t not in already]
-    cands.sort(key=lambda t: -difflib.SequenceMatcher(None, t, sc["conjunct"]).ratio())
+    cands.sort(key=lambda t: -difflib.SequenceMatcher(None, t, sc.conjunct).ratio())
     loc = target.loc
     # the producers' own conjuncts first (their words), then the consumer's bound moved to the producer's extreme
     edits = [Edit(rel, loc.line, loc.col, loc.end_line, loc.end_col, t) for t in cands]
@@ -243,7 +243,7 @@ def _weaken(ws: Any, sc: SideConditionJson, target: ast.Expr, shape: tuple[str, 
         if impl == "refuted":
             continue
         wider = _conjunct_after(target, edit, source)
-        evidence = (f"{consumer}'s evidence was established under `{sc['conjunct']}` and no longer covers the wider "
+        evidence = (f"{consumer}'s evidence was established under `{sc.conjunct}` and no longer covers the wider "
                     f"inputs: {', '.join(consumer_evidence)} must be established again"
                     if consumer_evidence else
                     f"{consumer} has no evidence yet; whatever it gets must cover the wider inputs")
@@ -253,7 +253,7 @@ def _weaken(ws: Any, sc: SideConditionJson, target: ast.Expr, shape: tuple[str, 
                   "them." if scale is not None else "")
         return [_record(
             "weaken-consumer",
-            f"Weaken {consumer}'s assumption (last resort): `{sc['conjunct']}` becomes "
+            f"Weaken {consumer}'s assumption (last resort): `{sc.conjunct}` becomes "
             f"`{wider}`, what {_and_text(list(producers))} "
             f"guarantee{'s' if len(producers) == 1 else ''}; {consumer} stays consistent. It invalidates what was "
             f"shown for the narrower inputs: {consumer}'s {_and_text(reads) if reads else 'guarantees'} must then hold "
@@ -261,7 +261,7 @@ def _weaken(ws: Any, sc: SideConditionJson, target: ast.Expr, shape: tuple[str, 
             edit, source,
             [discharged, {"check": f"{consumer}.contract-consistent", "status": "ok (Z3: sat)"},
              implementable_check(impl, consumer)],
-            cost, proves=f"{sc['id']} follows from the edited contracts",
+            cost, proves=f"{sc.id} follows from the edited contracts",
             not_shown=(f"that {consumer} behaves correctly on the wider inputs: its evidence must be established "
                        "again" + ("; the ranges suggest a unit mismatch, which widening does not convert"
                               if scale is not None else "")))]

@@ -37,7 +37,9 @@ from rclverify.lang.units import UnitError, parse_unit
 from fractions import Fraction
 from rclverify.diagnosis.bounds import number_text
 from rclverify.diagnosis.shapes import ReportRows
-from rclverify.records.stage_records import Culprit, DiagnosisEntry, Repair
+from rclverify.diagnosis.record import diagnosis_record
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.stage_records import Culprit, Repair
 
 
 def _loc(loc: Any) -> str:
@@ -49,20 +51,19 @@ def _joins(report: ReportRows, m: Mismatch) -> list[str]:
     (module docstring), in the report's order."""
     (p, _, v), (c, _, w) = m.writer, m.reader
     out = [_loc(m.at), _loc(m.writer_decl)]
-    out += [str(x["location"]) for x in report.get("lint") or () if str(x.get("code", "")).startswith("W-unit")
-            and x["location"] == _loc(m.reader_decl)]
-    scs = [sc for sc in report.get("side_conditions") or () if sc.get("status") != "discharged"
-           and (p, v, c, w) in link_pairs(sc)]
-    out += [str(sc["id"]) for sc in scs]
-    out += [str(f["id"]) for f in report.get("findings") or () if f.get("check") == "probable-scale-mismatch"
-            and any(str(f["id"]).startswith(f"{sc['id']}.scale") for sc in scs)]
-    obligations = {str(o["id"]): o for o in report.get("obligations") or ()}
-    for e in report.get("evidence") or ():
-        first = (e.get("monitoring") or {}).get("first_assumption_violation") if isinstance(e.get("monitoring"), dict) else None
-        o = obligations.get(str(e.get("obligation")))
-        node = o["node"] if o is not None else None
+    out += [x.location for x in report.lint if x.code.startswith("W-unit") and x.location == _loc(m.reader_decl)]
+    scs = [sc for sc in report.side_conditions if sc.status != "discharged" and (p, v, c, w) in link_pairs(sc)]
+    out += [sc.id for sc in scs]
+    out += [f.id for f in report.findings if f.check == "probable-scale-mismatch"
+            and any(f.id.startswith(f"{sc.id}.scale") for sc in scs)]
+    obligations = {o.id: o for o in report.obligations}
+    for e in report.evidence:
+        # the monitors' payload (backends/monitors): its first violated assumption, blamed on a producer
+        first = e.monitoring.get("first_assumption_violation")
+        o = obligations.get(e.obligation)
+        node = o.node if o is not None else None
         if first and node == c and re.search(rf"\b{re.escape(p)}\b", str(first.get("blame", ""))):
-            out.append(str(e["obligation"]))
+            out.append(e.obligation)
     return list(dict.fromkeys(out))
 
 
@@ -79,14 +80,14 @@ def _sentence(m: Mismatch, joined: list[str], report: ReportRows) -> str:
             f"{m.reader_unit} ({_loc(m.reader_decl)}){factor}{seen}. Convert in {p}.")
 
 
-def unit_records(ws: Any, report: ReportRows, cached: Callable[[Any, Callable[[], Any]], Any]) -> list[DiagnosisEntry]:
+def unit_records(ws: Any, report: ReportRows, cached: Callable[[Any, Callable[[], Any]], Any]) -> list[DiagnosisRow]:
     """One record per unit mismatch of the workspace ``ws`` (module
     docstring), in link order: ``{"id": "<P>.out.<v>.unit", "kind": "unit",
     "node": P, "status": "failed", "sentence", "culprits", "counterexample":
     [], "repairs", "guarantee", "joins": [ids], "lint": the location of its
     lint row}``.  ``cached(key, make)`` keeps the repairs between runs (the
     diagnosis cache).  Never raises for a system that type-checked."""
-    out: list[DiagnosisEntry] = []
+    out: list[DiagnosisRow] = []
     for m in mismatches(ws.checked, ws.model.links):
         joined = _joins(report, m)
         p = m.writer[0]
@@ -98,11 +99,10 @@ def unit_records(ws: Any, report: ReportRows, cached: Callable[[Any, Callable[[]
             culprit = {"what": f"output {m.writer[2]} of {p}", "source": _loc(m.writer_decl), "text": str(m.writer_unit)}
         key = ["unit", m.name, str(m.writer_unit), str(m.reader_unit), _loc(m.at)]
         reps = cached(key, lambda: conversion_repair(ws, m)) or []
-        out.append({"id": f"{'.'.join(m.writer)}.unit", "kind": "unit", "node": p, "status": "failed",
-                    "sentence": _sentence(m, joined, report), "culprits": [culprit], "counterexample": [],
-                    "repairs": [r for r in reps if r],
-                    "guarantee": m.inferred.guarantee if m.inferred is not None else None,
-                    "related": [], "joins": joined, "lint": _loc(m.at)})
+        out.append(diagnosis_record(f"{'.'.join(m.writer)}.unit", "unit", p, "failed", _sentence(m, joined, report),
+                                    culprits=[culprit], counterexample=[], repairs=reps,
+                                    guarantee=m.inferred.guarantee if m.inferred is not None else None,
+                                    joins=joined, lint=_loc(m.at)))
     return out
 
 
