@@ -152,6 +152,26 @@ LATEX_INTERNAL: dict[str, str] = {k: f"the appendix typesets the contract alone;
                                                   ("limited_by", "weakest premise"),
                                                   ("culprit_of", "problems it is the culprit of"))}
 
+_WHY_ROLLED_UP = "the worst of the node's guarantees and side conditions, each of which is an item of its own here"
+_WHY_DECLARED = "the contract's declarations; an item is located at its own text in the contract (file:line:col), and " \
+            "explain and the HTML and Markdown reports list them"
+_WHY_TYPESET = "the contract typeset for the LaTeX appendix"
+_WHY_CONFIDENCE = "a confidence over the argument, shown by the node's section of the HTML and Markdown reports"
+_WHY_CULPRIT = "the problems it is the culprit of are the diagnoses, each with the item it explains; explain prints them"
+
+#: Per renderer written in Python (SARIF: report/sarif.py, JUnit: report/junit.py, ``rclverify explain``:
+#: report/explain.py and explain_items.py), the fields of :class:`NodeRow` it does not show, each with the
+#: reason (tests/records/test_record_shapes.py holds each renderer to its table).
+INTERNAL_TO: dict[str, dict[str, str]] = {
+    "sarif": {"status": _WHY_ROLLED_UP, "inputs": _WHY_DECLARED, "outputs": _WHY_DECLARED,
+              "assumptions": _WHY_DECLARED, "latex": _WHY_TYPESET, "confidence": _WHY_CONFIDENCE,
+              "limited_by": _WHY_CONFIDENCE, "culprit_of": _WHY_CULPRIT},
+    "junit": {"status": _WHY_ROLLED_UP, "inputs": _WHY_DECLARED, "outputs": _WHY_DECLARED,
+              "assumptions": _WHY_DECLARED, "latex": _WHY_TYPESET, "confidence": _WHY_CONFIDENCE,
+              "limited_by": _WHY_CONFIDENCE, "culprit_of": _WHY_CULPRIT},
+    "explain": {"latex": _WHY_TYPESET, "confidence": _WHY_CONFIDENCE, "limited_by": _WHY_CONFIDENCE},
+}
+
 #: The fields of :class:`GuaranteeRow` no guarantees-table renderer shows, each with the reason.
 GUARANTEE_INTERNAL: dict[str, str] = {}
 
@@ -162,5 +182,5 @@ UNVERIFIED_INTERNAL: dict[str, str] = {
 }
 
 
-__all__ = ["AssumptionRow", "Confidence", "CulpritOf", "GUARANTEE_INTERNAL", "GuaranteeRow", "INTERNAL", "InputRow",
-           "LATEX_INTERNAL", "NodeRow", "OutputRow", "UNVERIFIED_INTERNAL", "UnverifiedRow"]
+__all__ = ["AssumptionRow", "Confidence", "CulpritOf", "GUARANTEE_INTERNAL", "GuaranteeRow", "INTERNAL", "INTERNAL_TO",
+           "InputRow", "LATEX_INTERNAL", "NodeRow", "OutputRow", "UNVERIFIED_INTERNAL", "UnverifiedRow"]
