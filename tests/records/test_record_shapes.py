@@ -691,6 +691,7 @@ CODE_RECORDS: dict[str, tuple[type[msgspec.Struct], Mapping[str, Mapping[str, st
     "obligations": (ObligationRow, obligations.INTERNAL_TO),
     "problems": (problem_rows.ProblemRow, problem_rows.INTERNAL_TO),
     "requirements": (RequirementRow, requirement_rows.INTERNAL_TO),
+    "nodes": (node_rows.NodeRow, node_rows.INTERNAL_TO),
 }
 
 
@@ -768,6 +769,18 @@ def test_a_field_added_to_a_requirement_fails_until_each_code_renderer_shows_it_
     assert unaccounted(_RequirementWithMargin, [raw], internal, code=RequirementRow) != []
     assert unaccounted(RequirementRow, [source], {**internal, "verdict": "x"}, code=RequirementRow) == [
         "verdict: declared internal but rendered"]
+
+
+@pytest.mark.parametrize("renderer", list(CODE))
+def test_a_field_added_to_a_node_fails_until_each_code_renderer_shows_it_or_declares_it_internal(renderer: str) -> None:
+    source = "\n".join(_code(renderer))
+    internal = node_rows.INTERNAL_TO[renderer]
+    assert unaccounted(_NodeWithMargin, [source], internal, code=node_rows.NodeRow) == [
+        "margin_added_here: neither rendered nor declared internal"]
+    assert unaccounted(_NodeWithMargin, [source], {**internal, "margin_added_here": "why"},
+                       code=node_rows.NodeRow) == []
+    shown = source + "\ndef _x(n: NodeRow) -> object:\n    return n.margin_added_here\n"
+    assert unaccounted(_NodeWithMargin, [shown], internal, code=node_rows.NodeRow) == []
 
 
 def _shown_by_code(renderer: str, row: Mapping[str, Any]) -> str:

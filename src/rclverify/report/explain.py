@@ -282,7 +282,7 @@ class _Index:
         return out
 
     def node_lines(self, node: str) -> list[str]:
-        n = self.nodes[node]
+        n: NodeRow = self.nodes[node]
         out = [f"{node} [{n.status}] (node, {n.source})"]
         for label, vs in (("inputs", n.inputs), ("outputs", n.outputs)):
             if vs:
