@@ -22,13 +22,17 @@ The rules:
   gaps it rests on, :class:`rclverify.calculus.shapes.Gaps`) stays a
   mapping, read as that stage writes it.
 
-Readers: the diagnosis of a refuted requirement (diagnosis/requirement.py).
+Readers: the diagnosis of a refuted requirement (diagnosis/requirement.py); the
+GSN argument (report/argument/build.py: the Z3 proof's script, the premises used, the
+declarations with their evidence, the ``assuming`` formulas; defeaters.py: the second solver).
 """
 from __future__ import annotations
 
 from typing import Any, Mapping
 
 import msgspec
+
+from rclverify.records.solvers_rows import Solvers
 
 
 class CexNodeRow(msgspec.Struct, frozen=True):
@@ -71,10 +75,34 @@ class TraceCheckRow(msgspec.Struct, frozen=True):
     verdict: TraceVerdictRow | None = None
 
 
+class PremiseRow(msgspec.Struct, frozen=True):
+    """A premise the check used (:class:`rclverify.records.stage_records.Premise`): its label, its kind
+    (``guarantee``, ``assumption``, ``fact``, ``initial value``, ``progress`` ...), its node (``None`` for
+    the requirement's own ``assuming``) and 1-based index."""
+
+    label: str
+    kind: str
+    node: str | None = None
+    index: int = 0
+
+
+class DeclarationRow(msgspec.Struct, frozen=True):
+    """A declaration the proof used, with its evidence
+    (calculus/requirements/rollup.py ``declaration_evidence``): the evidence status and its words."""
+
+    label: str
+    node: str
+    status: str
+    source: str = ""
+    text: str = ""
+    words: str = ""
+
+
 class RequirementCheckRow(msgspec.Struct, frozen=True):
     """A requirement's check record (``requirements[].check``), the keys its readers read: the formal
     statement and its ``file:line:col``, the cone, Z3's counterexample, the temporal check's record and
-    the recorded runs checked."""
+    the recorded runs checked; the proof's script (``smt2``), the ``assuming`` formulas, the premises
+    used, the declarations with their evidence and the second solver's agreement."""
 
     formal: str | None = None
     source: str | None = None
@@ -82,6 +110,11 @@ class RequirementCheckRow(msgspec.Struct, frozen=True):
     counterexample: list[CexNodeRow] = []
     temporal: dict[str, Any] | None = None
     traces: list[TraceCheckRow] = []
+    smt2: str | None = None
+    assuming: list[str] = []
+    used: list[PremiseRow] = []
+    declarations: list[DeclarationRow] = []
+    solvers: Solvers | None = None
 
     @classmethod
     def of(cls, check: Mapping[str, Any]) -> RequirementCheckRow:
@@ -90,4 +123,4 @@ class RequirementCheckRow(msgspec.Struct, frozen=True):
         return msgspec.convert({k: v for k, v in check.items() if v is not None}, cls)
 
 
-__all__ = ["CexNodeRow", "RequirementCheckRow", "TraceCheckRow", "TraceVerdictRow", "WitnessRow"]
+__all__ = ["CexNodeRow", "DeclarationRow", "PremiseRow", "RequirementCheckRow", "TraceCheckRow", "TraceVerdictRow", "WitnessRow"]
