@@ -139,18 +139,16 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
             "obligations": ev["obligations"], "evidence": ev["evidence"],
             "environment_assumptions": environment_rows(comps, names),
             "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
-            "grounding": grounding_row(ws), "nodl": nodl_row(ws), "instances": instances_row(ws, [o.to_json() for o in ev["obligations"]]), "design": design_row(ws), "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
+            "grounding": grounding_row(ws), "nodl": nodl_row(ws),
+            # the instances stage reads the obligations' JSON objects
+            "instances": instances_row(ws, [o.to_json() for o in ev["obligations"]]), "design": design_row(ws),
+            "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
             "deadlines": deadlines, "acknowledgements": acknowledgements,
             "near_misses": near_miss_rows(ws, ev["obligations"]),
             "margins": margin_rows(ws, ev["obligations"])}, Facts(
         nodes["status"], ev["altered"], checks, ev["inputs"], deadlines_ok(deadlines),
         lambda: all(g_status(name, k) == "discharged" for name, cn in ws.checked.nodes.items()
                     for k in range(1, len(cn.node.guarantees) + 1)))
-
-
-#: The summary before the passes that write it: :func:`_first_report` puts its status, counts, problems
-#: and headline in, report/assemble.py the rest.
-_NO_SUMMARY = Summary(status="discharged", counts={}, problems=[], headline="", solvers={}, diagnoses=[])
 
 
 def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts) -> AssuranceReport:
@@ -162,7 +160,9 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
                 inputs_sha256(ws, inp.made_from, facts.evidence_inputs, facts.checks, nodl_inputs(ws, rows["nodl"])))
     system = SystemView.of(ws.model.view(
         facts.node_status, cycles_kept(ws.model, ws.path("artifacts/cache/system-cycles.pickle"))))
-    draft = AssuranceReport.of({"meta": meta, "summary": _NO_SUMMARY, "system": system, **rows, "statistics": [],
+    # the summary written below; the second solver's counts and the diagnoses by report/assemble.py
+    unsaid = Summary(status="pending", counts={}, problems=[], headline="", solvers={}, diagnoses=[])
+    draft = AssuranceReport.of({"meta": meta, "summary": unsaid, "system": system, **rows, "statistics": [],
                                 "standards": [], "diagnoses": [], "problems": []})
     counts = status_counts(draft.obligations)
     overall = worst([r.status for r in draft.requirements] + list(facts.node_status.values())
@@ -172,7 +172,7 @@ def _first_report(ws: Workspace, inp: Inputs, rows: dict[str, Any], facts: Facts
     problems = problem_sentences(draft, facts.altered) + grounding_problems(draft.grounding) + nodl_problems(draft.nodl) \
         + design_problems(rows["design"]) \
         + instance_problems(rows["instances"])
-    summary = replace(_NO_SUMMARY, status=overall, counts=counts, problems=problems,
+    summary = replace(unsaid, status=overall, counts=counts, problems=problems,
                       headline=headline(draft.obligations, counts, draft.side_conditions, draft.findings,
                                         draft.unverified))
     return replace(draft, meta=replace(meta, strict_ok=strict_ok), summary=summary)
