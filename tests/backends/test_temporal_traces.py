@@ -147,10 +147,10 @@ def test_state_edit_shows_the_requirement_record_stale_before_the_stage_ran(tmp_
     w = Workspace(tmp_path)
     stage_check(w)
     stage_requirements(w)
-    before = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
+    before = {r["id"]: r for r in build_report(Workspace(tmp_path)).to_json()["requirements"]}
     assert before["T1"]["verdict"] != "stale"
     (tmp_path / "contracts/plan.yaml").write_text(plan.replace("state.n + 1", "state.n"))
-    after = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
+    after = {r["id"]: r for r in build_report(Workspace(tmp_path)).to_json()["requirements"]}
     assert after["T1"]["verdict"] == "stale"
 
 
@@ -173,7 +173,7 @@ def test_recorded_runs_are_evidence_of_the_temporal_requirement_in_the_report(tm
     md, html = render_markdown(report), render_html(report)
     assert "recorded run `run.jsonl`: failed (trace verdict false, step 2 at t = 0.5 s)" in md
     assert "recorded run <code>run.jsonl</code>" in html
-    reqs = {r["id"]: r for r in report["requirements"]}
+    reqs = {r["id"]: r for r in report.to_json()["requirements"]}
     t1, t2 = reqs["T1"], reqs["T2"]
     row = t1["check"]["traces"][0]
     assert (row["trace"], row["status"], row["verdict"]["verdict"], row["verdict"]["step"]) == \
@@ -183,9 +183,9 @@ def test_recorded_runs_are_evidence_of_the_temporal_requirement_in_the_report(tm
     assert t2["check"]["traces"][0]["status"] == "discharged" and t2["status"] != "discharged"
     # an edited trace: the record is stale before the stage ran again
     _trace(w, "run.jsonl", [("b", 1)] + RUN[:4])
-    assert {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}["T1"]["verdict"] == "stale"
+    assert {r["id"]: r for r in build_report(Workspace(tmp_path)).to_json()["requirements"]}["T1"]["verdict"] == "stale"
     stage_requirements(Workspace(tmp_path))
-    again = {r["id"]: r for r in build_report(Workspace(tmp_path))["requirements"]}
+    again = {r["id"]: r for r in build_report(Workspace(tmp_path)).to_json()["requirements"]}
     assert again["T1"]["check"]["traces"][0]["verdict"]["verdict"] == "true"
     # doit re-runs the requirements stage when a recorded run changes
     from rclverify.app.tasks import build_tasks

@@ -48,7 +48,7 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict]:
     w = Workspace(ws)
     stage_check(w)
     stage_requirements(w)
-    return {r["id"]: r["check"]["temporal"] or {"status": r["verdict"]} for r in build_report(w)["requirements"]}
+    return {r["id"]: r["check"]["temporal"] or {"status": r["verdict"]} for r in build_report(w).to_json()["requirements"]}
 
 
 def test_the_first_published_value_is_proved_and_a_wrong_one_refuted_where_it_arrives(report) -> None:

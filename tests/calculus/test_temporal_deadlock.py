@@ -121,7 +121,7 @@ def _records(ws: Path) -> dict[str, dict]:
     w = Workspace(ws)
     stage_check(w)
     stage_requirements(w)
-    return {r["id"]: r for r in build_report(w)["requirements"]}
+    return {r["id"]: r for r in build_report(w).to_json()["requirements"]}
 
 
 def test_a_counter_that_stops_after_3_meets_nothing_and_strict_fails(tmp_path: Path) -> None:

@@ -59,7 +59,7 @@ def _records(ws: Path) -> dict[str, dict]:
     w = Workspace(ws)
     stage_check(w)
     stage_requirements(w)
-    return {r["id"]: r for r in build_report(w)["requirements"]}
+    return {r["id"]: r for r in build_report(w).to_json()["requirements"]}
 
 
 def _node(step: dict, name: str) -> dict[str, str]:

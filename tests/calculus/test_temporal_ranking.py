@@ -46,7 +46,7 @@ def _temporal(ws: Path) -> dict[str, dict]:
     w = Workspace(ws)
     stage_check(w)
     stage_requirements(w)
-    return {r["id"]: r for r in build_report(w)["requirements"]}
+    return {r["id"]: r for r in build_report(w).to_json()["requirements"]}
 
 
 C0 = "eventually Cnt.state.c == 0"

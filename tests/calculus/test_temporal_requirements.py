@@ -50,7 +50,7 @@ def _check(ws: Path) -> dict[str, dict]:
     w = Workspace(ws)
     stage_check(w)
     stage_requirements(w)
-    return {r["id"]: r for r in build_report(w)["requirements"]}
+    return {r["id"]: r for r in build_report(w).to_json()["requirements"]}
 
 
 @pytest.fixture(scope="module")

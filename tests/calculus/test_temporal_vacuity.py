@@ -47,7 +47,7 @@ def _records(root: Path, rcl: str, formals: dict[str, str]) -> dict[str, dict[st
     w = Workspace(ws)
     stage_check(w)
     records = {rec["id"]: rec for rec, _ in stage_requirements(w)}
-    return {r["id"]: {**r, "record": records[r["id"]]} for r in build_report(w)["requirements"]}
+    return {r["id"]: {**r, "record": records[r["id"]]} for r in build_report(w).to_json()["requirements"]}
 
 
 @pytest.fixture(scope="module")

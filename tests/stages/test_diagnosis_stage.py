@@ -14,13 +14,13 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 from rclverify.app.pipeline import (Workspace, diagnosed, stage_check, stage_compose, stage_diagnosis, stage_export,
                                     stage_health, stage_report)
 from rclverify.diagnosis.build import diagnose
+from rclverify.records.report_record import AssuranceReport
 from rclverify.records.sealed import is_sealed_path, read_sealed
 from rclverify.report.build import build_report, undiagnosed_report
 from rclverify.stages.diagnoses import INDEX, report_digest
@@ -46,8 +46,8 @@ def _stages(root: Path) -> Workspace:
     return ws
 
 
-def _problems(report: Any) -> list[str]:
-    return [p for p in report["summary"]["problems"] if p.startswith("Diagnoses: ")]
+def _problems(report: AssuranceReport) -> list[str]:
+    return [p for p in report.summary.problems if p.startswith("Diagnoses: ")]
 
 
 def test_the_stage_seals_the_diagnoses_of_the_report_and_the_report_reads_them(newcomer: Path) -> None:
@@ -63,14 +63,14 @@ def test_the_stage_seals_the_diagnoses_of_the_report_and_the_report_reads_them(n
     assert record["diagnoses"] == want and [d["id"] for d in want][:1] == ["Controller.sc2"]
     assert want[0]["repairs"]  # Z3 checked repairs: the stage did the analysis
     report = build_report(ws)
-    assert report["diagnoses"] == want and _problems(report) == []
+    assert report.to_json()["diagnoses"] == want and _problems(report) == []
     assert report == diagnosed(ws)  # the orchestrator's report is the same when the record is current
 
 
 def test_a_missing_record_is_said_never_shown_as_no_problem(newcomer: Path) -> None:
     ws = _stages(newcomer)
     report = build_report(ws)
-    assert report["diagnoses"] == [] and report["summary"]["diagnoses"] == []
+    assert report.diagnoses == [] and report.summary.diagnoses == []
     (said,) = _problems(report)
     assert "the diagnosis stage has not run" in said and INDEX in said and "doit verify" in said
 
@@ -84,12 +84,12 @@ def test_a_record_of_another_report_is_stale_and_the_orchestrator_makes_it_again
     ws = _stages(newcomer)  # the edited contract checked and composed again, the diagnosis not
     report = build_report(ws)
     (said,) = _problems(report)
-    assert "made from other artifacts than this report" in said and report["diagnoses"] == []
+    assert "made from other artifacts than this report" in said and report.diagnoses == []
     again, paths = stage_report(ws, ("text",))  # the orchestrator runs the stage first
-    assert paths and _problems(again) == [] and again["diagnoses"]
+    assert paths and _problems(again) == [] and again.diagnoses
     new = read_sealed(ws.path(INDEX))[0]
     assert new is not None and old is not None and new["report_sha256"] != old["report_sha256"]
-    assert "1.25" in json.dumps(again["diagnoses"]) and build_report(ws) == again
+    assert "1.25" in json.dumps(again.to_json()["diagnoses"]) and build_report(ws) == again
 
 
 def test_an_altered_record_is_not_believed(newcomer: Path) -> None:
@@ -99,7 +99,7 @@ def test_an_altered_record_is_not_believed(newcomer: Path) -> None:
     path.write_text(path.read_text(encoding="utf-8").replace("Controller", "Planner", 1), encoding="utf-8")
     report = build_report(ws)
     (said,) = _problems(report)
-    assert "altered outside rclverify" in said and report["diagnoses"] == []
+    assert "altered outside rclverify" in said and report.diagnoses == []
 
 
 def test_the_report_loads_no_diagnosis_analysis(newcomer: Path) -> None:
@@ -129,14 +129,14 @@ def test_doit_runs_the_stage_as_a_task_again_only_when_its_inputs_change(newcome
     first = _verify(newcomer)
     assert "diagnosis: " in first and "problem(s) explained" in first
     report = json.loads((newcomer / "reports" / "assurance.json").read_text(encoding="utf-8"))
-    assert report["diagnoses"] and not _problems(report)
+    assert report["diagnoses"] and not _problems(AssuranceReport.of(report))
     assert "diagnosis: " not in _verify(newcomer)  # nothing changed: the task is up to date
     rcl = newcomer / RCL
     rcl.write_text(rcl.read_text(encoding="utf-8").replace("1.5", "1.25"), encoding="utf-8")
     third = _verify(newcomer)
     assert "diagnosis: " in third
     edited = json.loads((newcomer / "reports" / "assurance.json").read_text(encoding="utf-8"))
-    assert "1.25" in json.dumps(edited["diagnoses"]) and not _problems(edited)
+    assert "1.25" in json.dumps(edited["diagnoses"]) and not _problems(AssuranceReport.of(edited))
 
 
 def test_the_digest_leaves_out_when_and_how_long_a_run_took() -> None:
