@@ -38,4 +38,4 @@ def verify(root: Path) -> tuple[Workspace, dict[str, Any]]:
             stage_run(ws, n, o.id)
     stage_requirements(ws)
     report, _ = stage_report(ws)
-    return ws, report
+    return ws, report.to_json()

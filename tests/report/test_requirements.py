@@ -174,7 +174,7 @@ def _check(ws: Path) -> dict:
     w = Workspace(ws)
     stage_check(w)
     stage_requirements(w)
-    return build_report(w)["requirements"][0]
+    return build_report(w).to_json()["requirements"][0]
 
 
 def test_a_proof_from_inconsistent_guarantees_is_not_met(tmp_path: Path) -> None:
@@ -206,7 +206,7 @@ def test_doorstop_items_are_read_checked_and_shown_per_uid(tmp_path: Path) -> No
     assert main(["requirements", "-w", str(ws), "--plan", "contracts/plan_doorstop.yaml"]) == 1
     from rclverify.report.build import build_report
     w = Workspace(ws, "contracts/plan_doorstop.yaml")
-    rows = {r["id"]: r for r in build_report(w)["requirements"]}
+    rows = {r["id"]: r for r in build_report(w).to_json()["requirements"]}
     assert list(rows) == ["SYS001", "SYS002", "SYS003"]
     assert rows["SYS001"]["verdict"] == "proved, evidence outstanding"  # no evidence run here
     assert rows["SYS001"]["check"]["source"] == "reqs/SYS001.yml:7:6"
