@@ -66,11 +66,11 @@ def test_the_evidence_pass_decodes_each_payload_once_and_refuses_an_undeclared_k
     part = evidence_part(Workspace(tmp_path), [_obligation(good, "property_tests"),
                                                _obligation(bad, "property_tests")], {}, {}, SecondSolver({}))
     # the control: the record whose payload decodes is shown, its examples from the decoded payload
-    assert part["status"] == {good: "discharged", bad: "error"}
-    [row] = part["evidence"]
+    assert part.status == {good: "discharged", bad: "error"}
+    [row] = part.evidence
     assert row.obligation == good and row.examples["seed"] == 7 and row.examples["replay"] == "replay-command"
     assert row.examples["facts"] == ["in.x >= 0 (plan.yaml:3:5)"] and row.examples["valid"] == 90
     # the other is error, in one sentence naming the key
-    [said] = part["altered"]
+    [said] = part.altered
     assert said.startswith(f"Evidence {bad} is error: its property_tests details are not that backend's payload")
     assert "margin_added_here" in said

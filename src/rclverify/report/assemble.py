@@ -28,11 +28,11 @@ def with_statistics(report: AssuranceReport, part: StatisticsPart) -> AssuranceR
     """``report`` with the statistics pass's ``part``: the ``statistics``
     table, each per-run evidence row's ``statistics.group`` and each
     requirement's ``statistics`` rows."""
-    groups, by_req = part["groups"], part["requirements"]
+    groups, by_req = part.groups, part.requirements
     evidence = [replace(e, statistics={**e.statistics, "group": groups[i]}) if i in groups else e
                 for i, e in enumerate(report.evidence)]
     requirements = [replace(rq, statistics=by_req[rq.id]) if rq.id in by_req else rq for rq in report.requirements]
-    return replace(report, evidence=evidence, requirements=requirements, statistics=part["table"])
+    return replace(report, evidence=evidence, requirements=requirements, statistics=part.table)
 
 
 def with_solvers(report: AssuranceReport, counts: Mapping[str, int], problem: str) -> AssuranceReport:
@@ -47,9 +47,9 @@ def with_solvers(report: AssuranceReport, counts: Mapping[str, int], problem: st
 def _nodes_with_confidence(nodes: Sequence[NodeRow], part: ConfidencePart) -> list[NodeRow]:
     out = []
     for n in nodes:
-        strengths = part["guarantees"].get(n.name, [])
+        strengths = part.guarantees.get(n.name, [])
         guarantees = [replace(g, strength=s) for g, s in zip(n.guarantees, strengths)]
-        conf = part["nodes"].get(n.name)
+        conf = part.nodes.get(n.name)
         row = replace(n, guarantees=guarantees + list(n.guarantees[len(strengths):]))
         out.append(row if conf is None else replace(row, confidence=conf.confidence, limited_by=conf.limited_by))
     return out
@@ -61,14 +61,14 @@ def with_confidence(report: AssuranceReport, part: ConfidencePart) -> AssuranceR
     on nodes, derived properties and requirements, ``summary.confidence``
     and the requirements short of their required strength among the problems."""
     s = report.summary
-    summary = replace(s, problems=[*s.problems, *part["problems"]])
-    if part["confidence"] is not None:
-        summary = replace(summary, confidence=part["confidence"])
-    derived, reqs = part["derived"], part["requirements"]
+    summary = replace(s, problems=[*s.problems, *part.problems])
+    if part.confidence is not None:
+        summary = replace(summary, confidence=part.confidence)
+    derived, reqs = part.derived, part.requirements
     return replace(
         report, summary=summary,
-        evidence=[replace(e, strength=st) for e, st in zip(report.evidence, part["evidence"])],
-        side_conditions=[replace(sc, strength=st) for sc, st in zip(report.side_conditions, part["side_conditions"])],
+        evidence=[replace(e, strength=st) for e, st in zip(report.evidence, part.evidence)],
+        side_conditions=[replace(sc, strength=st) for sc, st in zip(report.side_conditions, part.side_conditions)],
         nodes=_nodes_with_confidence(report.nodes, part),
         derived_properties=[replace(d, confidence=derived[d.node].confidence, limited_by=derived[d.node].limited_by)
                             if d.node in derived else d for d in report.derived_properties],

@@ -126,27 +126,27 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
     side_conditions = decode_rows(SideConditionRow, views)
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
                  for n in names}
-    g_status = GuaranteeStatuses(inp.obligations, ev["status"], health)
+    g_status = GuaranteeStatuses(inp.obligations, ev.status, health)
     nodes = node_part(ws, inp.texts, comps, g_status, sc_status)
     checks = read_records(ws, inp.hashes)  # sealed and hashed: altered -> error, other inputs -> stale
     checks = {k: inp.second.requirement(v) or v for k, v in checks.items()}
-    deadlines = deadline_rows(ws, inp.hashes, g_status, ev["obligations"], inp.second)  # rule D3
-    requirements = fold_into(requirement_rows(ws, inp.texts, checks, g_status, sc_status, ev["declared"]), deadlines)
+    deadlines = deadline_rows(ws, inp.hashes, g_status, ev.obligations, inp.second)  # rule D3
+    requirements = fold_into(requirement_rows(ws, inp.texts, checks, g_status, sc_status, ev.declared), deadlines)
     findings, lint, acknowledgements = acknowledged_rows(ws, finding_rows(names, health, views),
                                                           lint_rows(ws))
-    return {"requirements": requirements, "nodes": nodes["nodes"], "side_conditions": side_conditions,
+    return {"requirements": requirements, "nodes": nodes.nodes, "side_conditions": side_conditions,
             "derived_properties": derived_rows(ws, comps, nodes, sc_status), "findings": findings,
-            "obligations": ev["obligations"], "evidence": ev["evidence"],
+            "obligations": ev.obligations, "evidence": ev.evidence,
             "environment_assumptions": environment_rows(comps, names),
-            "pending": ev["pending"], "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev["obligations"]),
+            "pending": ev.pending, "lint": lint, "expected_verdicts": expected_rows(ws.plan, ev.obligations),
             "grounding": grounding_row(ws), "nodl": nodl_row(ws),
             # the instances stage reads the obligations' JSON objects
-            "instances": instances_row(ws, [o.to_json() for o in ev["obligations"]]), "design": design_row(ws),
-            "unverified": unverified_guarantees(ws.plan, nodes["nodes"]),
+            "instances": instances_row(ws, [o.to_json() for o in ev.obligations]), "design": design_row(ws),
+            "unverified": unverified_guarantees(ws.plan, nodes.nodes),
             "deadlines": deadlines, "acknowledgements": acknowledgements,
-            "near_misses": near_miss_rows(ws, ev["obligations"]),
-            "margins": margin_rows(ws, ev["obligations"])}, Facts(
-        nodes["status"], ev["altered"], checks, ev["inputs"], deadlines_ok(deadlines),
+            "near_misses": near_miss_rows(ws, ev.obligations),
+            "margins": margin_rows(ws, ev.obligations)}, Facts(
+        nodes.status, ev.altered, checks, ev.inputs, deadlines_ok(deadlines),
         lambda: all(g_status(name, k) == "discharged" for name, cn in ws.checked.nodes.items()
                     for k in range(1, len(cn.node.guarantees) + 1)))
 
@@ -199,7 +199,7 @@ def undiagnosed_record(ws: Workspace) -> AssuranceReport:
                                unstated_origins(e for es in plan.evidence.values() for e in es))
     report = assemble.with_standards(report, standards)
     # one severity per finding: --strict fails on every error and warning, health and lint warnings included
-    return assemble.with_strict(report, report.meta.strict_ok and confidence["ok"]
+    return assemble.with_strict(report, report.meta.strict_ok and confidence.ok
                                 and not inp.second.problem and not blocking(report)
                                 and standards["ok"])
 

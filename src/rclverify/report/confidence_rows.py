@@ -16,7 +16,8 @@ The rules and their sources: :mod:`rclverify.report.argument.confidence`, docs/c
 """
 from __future__ import annotations
 
-from typing import Mapping, TypedDict, cast
+from dataclasses import dataclass, field
+from typing import Mapping, cast
 
 import msgspec
 
@@ -44,7 +45,8 @@ def limit_sentence(req_id: str, p: Premise) -> str:
     return f"{req_id} rests on {_WORDS.get(p.kind, p.kind)} for {p.label} (doubt {p.doubt:g})"
 
 
-class ConfidencePart(TypedDict):
+@dataclass
+class ConfidencePart:
     """What the confidence pass adds to the report's rows (module docstring),
     by row: ``evidence``/``side_conditions``: one ``strength`` per row, in
     the report's order; ``guarantees``: node -> one ``strength`` per
@@ -54,15 +56,15 @@ class ConfidencePart(TypedDict):
     sentence per requirement short of its required strength; ``confidence``:
     the least confidence of the formal requirements (``None``: none);
     ``ok``: no requirement is short of its required strength."""
-    evidence: list[Strength]
-    side_conditions: list[Strength]
-    guarantees: dict[str, list[Strength]]
-    nodes: dict[str, Confidence]
-    derived: dict[str, Confidence]
-    requirements: dict[str, RequirementConfidence]
-    problems: list[str]
-    confidence: float | None
-    ok: bool
+    evidence: list[Strength] = field(default_factory=list)
+    side_conditions: list[Strength] = field(default_factory=list)
+    guarantees: dict[str, list[Strength]] = field(default_factory=dict)
+    nodes: dict[str, Confidence] = field(default_factory=dict)
+    derived: dict[str, Confidence] = field(default_factory=dict)
+    requirements: dict[str, RequirementConfidence] = field(default_factory=dict)
+    problems: list[str] = field(default_factory=list)
+    confidence: float | None = None
+    ok: bool = True
 
 
 def confidence_part(report: AssuranceReport, links: list[tuple[str, str]],
@@ -73,18 +75,17 @@ def confidence_part(report: AssuranceReport, links: list[tuple[str, str]],
     model; ``required``: requirement id -> the least strength the plan asks
     of the guarantees its proof uses; a requirement short of it makes
     ``ok`` false (then ``--strict`` fails) and is one of ``problems``."""
-    part: ConfidencePart = {"evidence": [], "side_conditions": [], "guarantees": {}, "nodes": {}, "derived": {},
-                            "requirements": {}, "problems": [], "confidence": None, "ok": True}
+    part = ConfidencePart()
     by_ob: dict[str, list[Strength]] = {}
     for e in report.evidence:
-        part["evidence"].append(evidence_strength(e))
-        by_ob.setdefault(e.obligation, []).append(part["evidence"][-1])
+        part.evidence.append(evidence_strength(e))
+        by_ob.setdefault(e.obligation, []).append(part.evidence[-1])
     status = {o.id: str(o.status) for o in report.obligations}
     sc_premises: dict[str, list[Premise]] = {}
     for sc in report.side_conditions:
-        part["side_conditions"].append(side_condition_strength(sc))
+        part.side_conditions.append(side_condition_strength(sc))
         sc_premises.setdefault(sc.node, []).append(
-            Premise(f"side condition {sc.id}", "proof", part["side_conditions"][-1].doubt))
+            Premise(f"side condition {sc.id}", "proof", part.side_conditions[-1].doubt))
     own: dict[str, list[Premise]] = {}
     guarantee: dict[tuple[str, int], Premise] = {}
     for n in report.nodes:
@@ -92,7 +93,7 @@ def confidence_part(report: AssuranceReport, links: list[tuple[str, str]],
         for g in n.guarantees:
             p = guarantee_premise(f"{name} guarantee {g.index}", _legs(g.obligations, by_ob, status))
             guarantee[(name, g.index)] = p
-            part["guarantees"].setdefault(name, []).append(Strength(kind=p.kind, doubt=p.doubt))
+            part.guarantees.setdefault(name, []).append(Strength(kind=p.kind, doubt=p.doubt))
             ps.append(p)
         own[name] = ps + sc_premises.get(name, [])
     producers: dict[str, set[str]] = {n: set() for n in own}
@@ -100,13 +101,13 @@ def confidence_part(report: AssuranceReport, links: list[tuple[str, str]],
         if b in producers and a in own:
             producers[b].add(a)
     claims = node_claims(own)
-    part["nodes"] = {n.name: _put(claims[n.name]) for n in report.nodes}
+    part.nodes = {n.name: _put(claims[n.name]) for n in report.nodes}
     derived = derived_claims(own, producers)
-    part["derived"] = {d.node: _put(derived[d.node]) for d in report.derived_properties if d.node in derived}
+    part.derived = {d.node: _put(derived[d.node]) for d in report.derived_properties if d.node in derived}
     lows = [_requirement(rq, guarantee, sc_premises, (required or {}).get(rq.id), part)
             for rq in report.requirements if rq.check.get("formal")]
     if lows:
-        part["confidence"] = min(lows)
+        part.confidence = min(lows)
     return part
 
 
@@ -133,14 +134,14 @@ def _requirement(rq: RequirementRow, guarantee: Mapping[tuple[str, int], Premise
         required = cast(StrengthKind, need)
         shortfall = [f"{g.label} ({g.kind if g.doubt < 1.0 else 'nothing discharged'})" for g in short]
         if short:
-            part["ok"] = False
-            part["problems"].append(f"Requirement {rq.id} requires {need} evidence; " + ", ".join(
+            part.ok = False
+            part.problems.append(f"Requirement {rq.id} requires {need} evidence; " + ", ".join(
                 f"{g.label} rests on {g.kind if g.doubt < 1.0 else 'no discharged'} evidence" for g in short))
     if c.limits is not None and rq.verdict not in _PROVED:  # a claim always has its proof as a premise
         conf = _put(c, f"{rq.id} is {rq.verdict}: no confidence rests on it")
     else:
         conf = _put(c, None if c.limits is None else limit_sentence(rq.id, c.limits))
-    part["requirements"][rq.id] = RequirementConfidence(conf.confidence, conf.limited_by, required, shortfall)
+    part.requirements[rq.id] = RequirementConfidence(conf.confidence, conf.limited_by, required, shortfall)
     return float(c.confidence)
 
 

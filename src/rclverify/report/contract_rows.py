@@ -15,7 +15,8 @@ Each function returns its rows and changes nothing it was given.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, TypedDict, cast
+from dataclasses import dataclass, field
+from typing import Any, Mapping, Sequence, cast
 
 from msgspec.structs import replace
 
@@ -110,12 +111,13 @@ class GuaranteeStatuses:
         return s
 
 
-class NodesPart(TypedDict):
+@dataclass
+class NodesPart:
     """The node rows (each a :class:`~rclverify.records.node_rows.NodeRow`) and, by node name,
     each node's status and the worst status of its guarantees."""
-    nodes: list[NodeRow]
-    status: dict[str, str]
-    evidence: dict[str, str]
+    nodes: list[NodeRow] = field(default_factory=list)
+    status: dict[str, str] = field(default_factory=dict)
+    evidence: dict[str, str] = field(default_factory=dict)
 
 
 def _ports(to_node: Sequence[Any], from_node: Sequence[Any],
@@ -134,7 +136,7 @@ def node_part(ws: Workspace, texts: ContractTexts, comps: Mapping[str, Mapping[s
               g_status: GuaranteeStatuses, sc_status: Mapping[str, str]) -> NodesPart:
     """One row per node of ``ws``'s contracts: its ports, assumptions,
     guarantees with their statuses, LaTeX, and its status (module docstring)."""
-    part: NodesPart = {"nodes": [], "status": {}, "evidence": {}}
+    part = NodesPart()
     links_to: dict[str, list[Any]] = {}
     links_from: dict[str, list[Any]] = {}
     for l in ws.model.links:
@@ -147,10 +149,10 @@ def node_part(ws: Workspace, texts: ContractTexts, comps: Mapping[str, Mapping[s
                                    obligations=g_status.obligations(name, k))
                       for k, (text, src) in enumerate(tx["guarantees"], 1)]
         status = worst([g.status for g in guarantees] + [sc_status[name]])
-        part["status"][name] = status
-        part["evidence"][name] = worst([g.status for g in guarantees], empty="pending")
+        part.status[name] = status
+        part.evidence[name] = worst([g.status for g in guarantees], empty="pending")
         inputs, outputs = _ports(links_to.get(name, []), links_from.get(name, []), tx)
-        part["nodes"].append(NodeRow(
+        part.nodes.append(NodeRow(
             name=name, source=str(cn.node.loc), status=cast(EvidenceStatus, status), inputs=inputs, outputs=outputs,
             assumptions=[AssumptionRow(text=text, source=src, environment=text in env_texts)
                          for text, src in tx["assumptions"]],
@@ -164,7 +166,7 @@ def derived_rows(ws: Workspace, comps: Mapping[str, Mapping[str, Any]], nodes: N
     instances, the cone's environment assumptions, and its two statuses
     (derivation and evidence, report/cones.py)."""
     model = ws.model
-    cones, cone_of = ConeEvidence(model.nodes, nodes["evidence"], sc_status), model.upstream_masks()
+    cones, cone_of = ConeEvidence(model.nodes, nodes.evidence, sc_status), model.upstream_masks()
     rows: list[DerivedPropertyRow] = []
     for n in ws.checked.nodes:
         c = comps[n]

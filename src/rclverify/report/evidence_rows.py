@@ -12,7 +12,8 @@ was given.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence, TypedDict, cast
+from dataclasses import dataclass, field
+from typing import Any, Mapping, Sequence, cast
 
 from rclverify.backends.payloads import Payload, payload_of
 from rclverify.backends.property_tests.payload import PropertyTestsPayload
@@ -28,7 +29,8 @@ from rclverify.stages.crosscheck.apply import SecondSolver
 from rclverify.stages.workspace import Workspace
 
 
-class EvidencePart(TypedDict):
+@dataclass
+class EvidencePart:
     """What the evidence pass gives the report and the later passes.
 
     ``obligations``/``evidence``/``pending``: the report's rows;
@@ -37,13 +39,13 @@ class EvidencePart(TypedDict):
     declarations; ``altered``: one problem sentence per record
     that cannot be read as rclverify wrote it; ``inputs``: obligation id ->
     the input sha256s its evidence was made from (``None``: no record)."""
-    obligations: list[ObligationRow]
-    evidence: list[EvidenceRow]
-    pending: list[PendingRow]
-    status: dict[str, str]
-    declared: dict[str, list[tuple[str, Any]]]
-    altered: list[str]
-    inputs: dict[str, object]
+    obligations: list[ObligationRow] = field(default_factory=list)
+    evidence: list[EvidenceRow] = field(default_factory=list)
+    pending: list[PendingRow] = field(default_factory=list)
+    status: dict[str, str] = field(default_factory=dict)
+    declared: dict[str, list[tuple[str, Any]]] = field(default_factory=dict)
+    altered: list[str] = field(default_factory=list)
+    inputs: dict[str, object] = field(default_factory=dict)
 
 
 def evidence_extras(ws: Workspace, details: Any) -> tuple[list[list[str]], str]:
@@ -111,8 +113,7 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
     the files do not change while the report is built); ``second``: the
     second solver's verdicts."""
     store = EvidenceStore(ws.root)
-    part: EvidencePart = {"obligations": [], "evidence": [], "pending": [], "status": {}, "declared": {},
-                          "altered": [], "inputs": {}}
+    part = EvidencePart()
     for o in obligations:
         ev, altered = (None, altered_lists[o.id]) if o.id in altered_lists else store.read(o.id)
         payload: Payload | None = None
@@ -122,24 +123,24 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
             except ValueError as exc:
                 altered = f"its {ev.backend} details are not that backend's payload: {exc}"
                 ev = None
-        part["inputs"][o.id] = dict(ev.input_hashes) if ev is not None else None
+        part.inputs[o.id] = dict(ev.input_hashes) if ev is not None else None
         status = "error" if altered else (store.current_status(ev, hashes) if ev else "pending")
         status, agreement = second.evidence(o.id, o.backend, status)
         solvers = None if agreement is None else Solvers.of(agreement)  # stages/crosscheck/apply.py builds it
-        part["status"][o.id] = status
-        part["obligations"].append(ObligationRow(
+        part.status[o.id] = status
+        part.obligations.append(ObligationRow(
             id=o.id, node=o.node, guarantee=o.guarantee, backend=o.backend, kind=cast(EvidenceKind, o.kind),
             instance=o.instance, statement=o.statement, source=str(o.source), artifact=o.artifact,
             status=cast(EvidenceStatus, status)))  # the record's words: the vocabulary's (records/statuses.py)
         if ev is None:
             if altered:
-                part["altered"].append(f"Evidence {o.id} is error: {altered}")
+                part.altered.append(f"Evidence {o.id} is error: {altered}")
             else:
-                part["pending"].append(PendingRow(o.id, o.backend, "no evidence record yet: run `doit verify`"))
+                part.pending.append(PendingRow(o.id, o.backend, "no evidence record yet: run `doit verify`"))
             continue
         if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged
-            part["declared"].setdefault(o.node, []).append((status, ev.details["declarations"]))
-        part["evidence"].append(evidence_row(ws, ev, status, altered, solvers, payload))
+            part.declared.setdefault(o.node, []).append((status, ev.details["declarations"]))
+        part.evidence.append(evidence_row(ws, ev, status, altered, solvers, payload))
         if status == "pending":
-            part["pending"].append(PendingRow(o.id, o.backend, ev.explanation))
+            part.pending.append(PendingRow(o.id, o.backend, ev.explanation))
     return part

@@ -16,7 +16,8 @@
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, TypedDict
+from dataclasses import dataclass, field
+from typing import Any, Mapping
 
 import msgspec
 
@@ -123,13 +124,14 @@ def requirement_statistics(req: RequirementRow, target: Any, where: Mapping[str,
     return out
 
 
-class StatisticsPart(TypedDict):
+@dataclass
+class StatisticsPart:
     """The statistics pass's part: the report's ``statistics`` table;
     ``groups``: index of a per-run evidence row -> its ``statistics.group``;
     ``requirements``: requirement id -> its ``statistics`` rows."""
     table: list[StatisticsRow]
-    groups: dict[int, RunGroupBound]
-    requirements: dict[str, list[RequirementRuns]]
+    groups: dict[int, RunGroupBound] = field(default_factory=dict)
+    requirements: dict[str, list[RequirementRuns]] = field(default_factory=dict)
 
 
 def _per_run(e: EvidenceRow) -> bool:
@@ -163,17 +165,17 @@ def statistics_part(report: AssuranceReport, plan: Plan, targets: Mapping[str, A
         elif _per_run(e):
             groups.setdefault(_group_key(e), []).append(e.statistics)
     by_key = {key: _group_row(*key, rows) for key, rows in groups.items()}
-    part: StatisticsPart = {"table": [by_key[k] for k in sorted(by_key)] + decisions, "groups": {}, "requirements": {}}
+    part = StatisticsPart([by_key[k] for k in sorted(by_key)] + decisions)
     for i, e in enumerate(report.evidence):
         if _per_run(e):
             g = by_key[_group_key(e)]
-            part["groups"][i] = {"runs": int((g.counts or {})["runs"]), "bound": g.bound, "level": LEVEL}
+            part.groups[i] = {"runs": int((g.counts or {})["runs"]), "bound": g.bound, "level": LEVEL}
     where = _trace_environments(plan)
     for rq in report.requirements:
         rows = requirement_statistics(rq, targets.get(rq.id), where)
         if rows:
-            part["requirements"][rq.id] = rows
-            part["table"].extend(_requirement_row(rq.id, r) for r in rows)
+            part.requirements[rq.id] = rows
+            part.table.extend(_requirement_row(rq.id, r) for r in rows)
     return part
 
 
