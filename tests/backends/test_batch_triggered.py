@@ -281,11 +281,11 @@ def test_lone_slots_equal_streaming(node: str) -> None:
     right or now and then wrong, samples regular or not (then most chunks are the engine's)."""
     rng = random.Random(f"lone-{node}")
     batched = 0
-    for case in range(14):
+    for case in range(10):
         rules = load_rules(RULES)
         rules.skew = rng.choice([0.0, 0.003, 0.02, 0.02])
         wrong = 0.0 if case % 3 else rng.choice([0.001, 0.01])
-        events = _slots_run(rng, node, rng.choice([60, 300, 900]), wrong, case % 4 == 3)
+        events = _slots_run(rng, node, rng.choice([60, 300, 600]), wrong, case % 4 == 3)
         chunk = rng.choice([7, 64, 500, 16384])
         margins = case % 2 == 0
         end = events[-1].time + rng.choice([0.0, 1.0]) if rng.random() < 0.3 else None
@@ -295,7 +295,7 @@ def test_lone_slots_equal_streaming(node: str) -> None:
         assert b[1] == s[1], where
         assert b[0] == s[0], where
         batched += stats["batched"]
-    assert batched > 1000, batched  # the lone slots ran
+    assert batched > 500, batched  # the lone slots ran
 
 
 def test_lone_slots_are_batched_and_a_wrong_answer_is_the_engines() -> None:
@@ -404,7 +404,7 @@ def test_batch_equals_streaming_on_random_several_trigger_runs(node: str) -> Non
     pairs of both triggers, skew 0, 3 and 20 ms, margins on and off, chunks of 2 events up)."""
     rng = random.Random(f"several-{node}")
     batched = streamed = 0
-    for case in range(24):
+    for case in range(16):
         horizon = rng.choice([0.005, 0.02, 0.04])
         rules = load_rules(RULES)
         rules.skew = rng.choice([0.0, 0.0, 0.003, 0.02])
@@ -420,7 +420,7 @@ def test_batch_equals_streaming_on_random_several_trigger_runs(node: str) -> Non
         assert b[0] == s[0], where
         batched += stats["batched"]
         streamed += stats["streamed"]
-    assert batched > 100 and streamed > 100, (batched, streamed)
+    assert batched > 50 and streamed > 100, (batched, streamed)
 
 
 def test_control_several_triggers_owed_by_every_pair_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
