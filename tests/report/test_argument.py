@@ -366,3 +366,29 @@ def test_a_report_json_object_gives_the_argument_of_the_decoded_report(tmp_path:
     bad["nodes"][0]["guarantees"][0]["index"] = "one"
     with pytest.raises(msgspec.ValidationError, match="index"):
         write_argument(bad, tmp_path / "b", files=files)
+
+
+def test_a_check_record_is_read_through_its_record_class() -> None:
+    """A requirement's check (records/requirement_check.py RequirementCheckRow): its declarations become
+    goals with their evidence, its ``assuming`` formulas assumptions, a second solver that disagrees a
+    defeater (one that agrees none: the control); a check of another shape is refused."""
+    import msgspec
+    check = {"formal": "out.x > 0", "smt2": "artifacts/requirements/REQ1.smt2", "assuming": ["in.y > 1"],
+             "used": [{"kind": "guarantee", "node": "Sensor", "index": 1, "label": "Sensor guarantee 1"}],
+             "declarations": [{"label": "Sensor progress", "node": "Sensor", "kind": "progress", "index": 0,
+                               "text": "progress", "source": "c.rcl:3:3", "status": "pending",
+                               "words": "declared, not verified"}],
+             "solvers": {"agreement": "disagree", "why": "cvc5 found a model", "cvc5": None}}
+    rep = _report()
+    rep["requirements"][0].update({"verdict": "met", "note": "proved", "check": check})
+    els = _build(rep).elements
+    assert els["G-decl.Sensor_progress"].status == "pending" and "G-decl.Sensor_progress" in els["S-REQ1"].supported_by
+    assert "(c.rcl:3:3): pending (declared, not verified)" in els["Sn-decl.Sensor_progress"].text
+    assert "REQ1 assumes: in.y > 1" in els["A-REQ1.assuming.1"].text and "A-REQ1.assuming.1" in els["S-REQ1"].in_context_of
+    assert "cvc5 found a model" in els["CSn-solvers.REQ1"].text and els["G-REQ1"].defeated
+    rep["requirements"][0]["check"] = {**check, "solvers": {"agreement": "two solvers", "why": "", "cvc5": None}}
+    els = _build(rep).elements
+    assert "CSn-solvers.REQ1" not in els and not els["G-REQ1"].defeated
+    rep["requirements"][0]["check"] = {**check, "used": [{"kind": "guarantee", "node": "Sensor", "index": "1"}]}
+    with pytest.raises(msgspec.ValidationError, match="used"):
+        _build(rep)

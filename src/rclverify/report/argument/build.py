@@ -46,6 +46,7 @@ from rclverify.records.findings import FindingRow
 from rclverify.records.node_rows import NodeRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_check import DeclarationRow, RequirementCheckRow
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.argument.deadlines import own_check, with_deadline
@@ -103,51 +104,51 @@ def _requirement_goal(b: "_Builder", r: RequirementRow, guarantee_goal: Mapping[
     proof (a solution with the check's verdict) and the goals of the
     guarantees the proof used, with the side conditions of their nodes."""
     rid = r.id
-    c = r.check  # the requirements stage's check record (calculus/requirements/check.py), its own shape
     if r.verdict == "informal":
         traced = ", ".join(f"{s.node} guarantee {s.guarantee}" for s in r.support) or "no guarantee"
         return b.add(Element(ident("G", rid), "goal",
                              _clip(f"{rid}: {r.text} (informal: no formal statement; traced to {traced})"),
                              undeveloped=True, ref=rid))
+    c = RequirementCheckRow.of(r.check)  # the requirements stage's check record, decoded
     sn = b.add(Element(ident("Sn", "req", rid), "solution",
                        _clip(f"Z3 {('proof' if r.verdict in ('met', 'proved, evidence outstanding') else 'check')} "
-                             f"of {rid} ({c.get('smt2') or _temporal_what(c) or 'not checked yet'}): {r.verdict}. "
+                             f"of {rid} ({c.smt2 or _temporal_what(c.temporal) or 'not checked yet'}): {r.verdict}. "
                              f"{r.note}"),
-                       status=_PROOF_STATUS.get(r.verdict, "pending"), ref=rid, url=str(c.get("smt2") or "")))
+                       status=_PROOF_STATUS.get(r.verdict, "pending"), ref=rid, url=c.smt2 or ""))
     kids = [sn]
     nodes_used: list[str] = []
-    for p in c.get("used") or []:
-        if p.get("kind") == "guarantee" and (str(p["node"]), int(p["index"])) in guarantee_goal:
-            kids.append(guarantee_goal[(str(p["node"]), int(p["index"]))])
-            if p["node"] not in nodes_used:
-                nodes_used.append(str(p["node"]))
+    for p in c.used:
+        if p.kind == "guarantee" and (str(p.node), p.index) in guarantee_goal:
+            kids.append(guarantee_goal[(str(p.node), p.index)])
+            if p.node not in nodes_used:
+                nodes_used.append(str(p.node))
     for name in nodes_used:
         kids += [ident("G", "sc", sc.id) for sc in sides.get(name, [])]
-    kids += [_declaration_goal(b, d) for d in c.get("declarations") or []]
+    kids += [_declaration_goal(b, d) for d in c.declarations]
     ctx = [j_calc] + [b.add(Element(ident("A", rid, "assuming", k), "assumption",
                                     _clip(f"{rid} assumes: {a}"), ref=rid))
-                      for k, a in enumerate(c.get("assuming") or [], 1)]
+                      for k, a in enumerate(c.assuming, 1)]
     strategy = b.add(Element(
         ident("S", rid), "strategy",
-        _clip(f"Argument by formal entailment: {c.get('formal')} follows from the premises Z3 used"
-              + (f" ({', '.join(p['label'] for p in c.get('used') or [])})" if c.get("used") else "")
+        _clip(f"Argument by formal entailment: {c.formal} follows from the premises Z3 used"
+              + (f" ({', '.join(p.label for p in c.used)})" if c.used else "")
               + ". " + ENTAILMENT),
         supported_by=tuple(dict.fromkeys(kids)), in_context_of=tuple(ctx), ref=rid))
     # its confidence is stated at its assurance claim point (.claim_points)
     return b.add(Element(ident("G", rid), "goal", _clip(f"{rid}: {r.text}"), supported_by=(strategy,), ref=rid))
 
 
-def _declaration_goal(b: "_Builder", d: Mapping[str, Any]) -> str:
+def _declaration_goal(b: "_Builder", d: DeclarationRow) -> str:
     """The goal that a declaration a proof used holds of its node's
     implementation, supported by its evidence as the roll-up
     reads it (requirements/rollup.declaration_evidence): the monitors' runs,
     the property tests, or the declarations it follows from."""
-    label = str(d["label"])
+    label = d.label
     sn = b.add(Element(ident("Sn", "decl", label), "solution",
-                       _clip(f"Evidence of {label} ({d.get('source', '')}): {d['status']} ({d.get('words', '')})"),
-                       status=str(d["status"]), ref=label))
+                       _clip(f"Evidence of {label} ({d.source}): {d.status} ({d.words})"),
+                       status=d.status, ref=label))
     return b.add(Element(ident("G", "decl", label), "goal",
-                         _clip(f"{d['node']} keeps its declaration {d.get('text', '')}".rstrip()),
+                         _clip(f"{d.node} keeps its declaration {d.text}".rstrip()),
                          supported_by=(sn,), ref=label))
 
 
@@ -358,10 +359,10 @@ class _Goals:
                              undeveloped=True, ref=rid))
 
 
-def _temporal_what(c: Mapping[str, Any]) -> str:
-    """How a temporal requirement was decided (calculus/requirements/temporal_check.py), for its solution's text."""
-    t = c.get("temporal")
-    if not isinstance(t, Mapping):
+def _temporal_what(t: Mapping[str, Any] | None) -> str:
+    """How a temporal requirement was decided (its check's ``temporal`` record,
+    calculus/requirements/temporal_check.py's own shape), for its solution's text."""
+    if t is None:
         return ""
     steps = "no step checked" if t.get("bound") is None else f"{t['bound']} steps checked"
     return f"temporal, {t.get('method')}, {steps}"

@@ -32,6 +32,7 @@ from typing import Any
 import msgspec
 
 from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.report.argument.model import Element
 
 
@@ -84,10 +85,10 @@ def add_defeaters(els: dict[str, Element], report: AssuranceReport, ident: Any) 
                           f"Problem caused by {what}: {row.sentence}", row.status, row.status == "failed")
     for r in report.requirements:
         rid, verdict = r.id, r.verdict
-        checked = r.check.get("solvers") or {}  # the check record's second solver (stages/crosscheck/apply.py)
-        if checked.get("agreement") in ("disagree", "inconclusive"):
+        checked = RequirementCheckRow.of(r.check).solvers  # the second solver (stages/crosscheck/apply.py)
+        if checked is not None and checked.agreement in ("disagree", "inconclusive"):
             challenge(ident("CSn", "solvers", rid), ident("G", rid),
-                      f"The second solver does not confirm {rid}: {checked.get('why', '')}", "inconclusive", True)
+                      f"The second solver does not confirm {rid}: {checked.why}", "inconclusive", True)
         if verdict in ("proved vacuously", "proved from an inconsistency"):
             challenge(ident("CSn", "vacuous", rid), ident("G", rid), f"{rid} is {verdict}: {r.note}",
                       "failed", True)
