@@ -87,12 +87,10 @@ def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
     met = is_open & (answer >= 0) & ((expiry >= n) | (answer <= expiry))
     lapsed = is_open & ~met & (expiry < n)
     late = (~is_open | lapsed) & (answer >= 0)
-    skewed = np.zeros(0, dtype=np.int64)
-    if mon.skew_ns:  # the obligations left unmet whose answer may be an output within the skew before them
-        got = _skew_window(mon, ns, rows, out_rows, ~met & (np.arange(m) >= len(carried)))
-        if got is None or (refused.size and mon.result.first_unaccepted is None and bool(lapsed.any())):
-            return False  # a window past the 64 outputs the monitor keeps; or which unaccepted trigger is first
-        skewed = got
+    skewed = _skew_window(mon, ns, rows, out_rows, ~met & (np.arange(m) >= len(carried)),
+                          bool(refused.size) and bool(lapsed.any()))
+    if skewed is None:
+        return False  # a window past the 64 outputs the monitor keeps, or which unaccepted trigger is first
     order = np.arange(m) - L0  # an open obligation's place in the monitor's list (the expired: below 0)
     # each verdict as (row, phase, place): late answers of expired obligations (0), answers (1), expiries (2)
     ev_at = np.concatenate([answer[late], answer[met], expiry[lapsed]])
@@ -112,11 +110,17 @@ def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
     return True
 
 
-def _skew_window(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, out_rows: np.ndarray, unmet: np.ndarray
-                 ) -> np.ndarray | None:
-    """The obligations ``unmet`` (new ones, not met in the chunk) with an output stamped within the transport
-    skew before their trigger (the chunk's, or one the monitor heard before it): those :func:`_mark` reads;
-    ``None`` when such a window holds more than the 64 outputs the monitor keeps (its own judging)."""
+def _skew_window(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, out_rows: np.ndarray, unmet: np.ndarray,
+                 race: bool) -> np.ndarray | None:
+    """With the transport skew, the obligations ``unmet`` (new ones, not met in the chunk) with an output
+    stamped within the skew before their trigger (the chunk's, or one the monitor heard before it): those
+    :func:`_mark` reads; ``None`` (the chunk is the monitor's) when such a window holds more than the 64
+    outputs the monitor keeps, or when ``race`` (a trigger refused by the assumption and an obligation
+    lapsing in the chunk) and no unaccepted trigger is first yet (which one would be first)."""
+    if not mon.skew_ns:
+        return np.zeros(0, dtype=np.int64)
+    if race and mon.result.first_unaccepted is None:
+        return None
     idx = np.flatnonzero(unmet & (rows >= 0))
     if not idx.size:
         return idx

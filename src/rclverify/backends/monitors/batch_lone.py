@@ -125,7 +125,8 @@ class LoneSlots:
     def _codes_in(self) -> dict[str, int] | None:
         return self.plan.enums.get(self.plan.trigger)
 
-    def _slots(self, chunk: EventRows | BlockRows, kind: np.ndarray, times: np.ndarray, s: int) -> int:
+    def _slots(self, chunk: EventRows | BlockRows, kind: np.ndarray, times: np.ndarray,  # long: the clean
+               s: int) -> int:  # checks and the readings share the chunk's columns, one pass
         """Judge rows ``s:e`` of ``chunk`` when clean (module docstring; ``e`` the first row of another topic, else
         the end) and set the engine's state; returns ``e``, or ``s`` (nothing changed) when not clean."""
         m, plan = self.m, self.plan
@@ -234,7 +235,8 @@ class LoneSlots:
                     er, margin, atom, prior)
         return e
 
-    def _apply(self, chunk: EventRows | BlockRows, s: int, k: np.ndarray, t: np.ndarray, in_rows: np.ndarray,
+    def _apply(self, chunk: EventRows | BlockRows, s: int, k: np.ndarray, t: np.ndarray,  # long: the order,
+               in_rows: np.ndarray,  # the verdicts and the state read the same arrays
                out_rows: np.ndarray, qidx: np.ndarray, answered: np.ndarray, paired_out: np.ndarray,
                close_q: list[int], close_at: list[int], early_q: list[int], er: np.ndarray,
                margin: np.ndarray | None, atom: np.ndarray | None, prior: Any) -> None:
