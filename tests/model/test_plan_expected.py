@@ -122,7 +122,8 @@ def test_whole_contract_backends_expect_guarantee_0(tmp_path: Path) -> None:
     (tmp_path / PLAN).write_text(head + "          - {guarantee: 0, verdict: failed}\n", encoding="utf-8")
     plan = load_plan(tmp_path)
     resolve(plan, load([tmp_path / c for c in plan.contracts]))
-    ob = {"node": "RadiationSensor", "backend": "monitors", "guarantee": 0, "instance": None, "status": "failed",
-          "id": "RadiationSensor.g0.monitors.run"}
-    (row,) = expected_rows(plan, [ob])
-    assert row["outcome"] == "as expected" and row["obligation"] == "RadiationSensor.g0.monitors.run"
+    from _typed_rows import typed_report
+    obs = typed_report({"obligations": [{"node": "RadiationSensor", "backend": "monitors", "guarantee": 0,
+                                         "status": "failed", "id": "RadiationSensor.g0.monitors.run"}]}).obligations
+    (row,) = expected_rows(plan, obs)
+    assert row.outcome == "as expected" and row.obligation == "RadiationSensor.g0.monitors.run"
