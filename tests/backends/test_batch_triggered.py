@@ -12,6 +12,10 @@ every answer's verdict and margin must be the enumeration's: the guarantee on th
 or before it and the answer's value, in exact rationals (nothing of rclverify's).  Controls: a batch
 path that takes every input's pairs as owing the triggered guarantee gives verdicts the engine does
 not, and an enumeration judging an answer against the trigger before the latest differs.
+
+The lone slots (batch_lone.py: chunks of lone triggers and lone answers judged in batch) and nodes whose
+guarantees several inputs trigger have their own random runs against the engine, each with a control: a
+judge closing a lone trigger's question silently, a batch path owing every guarantee to every pair.
 """
 from __future__ import annotations
 
