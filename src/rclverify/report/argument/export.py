@@ -35,7 +35,6 @@ from typing import Any, Callable
 import jinja2
 
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import Report
 from rclverify.records.published import write_published
 from rclverify.records.store import dumps
 from rclverify.core.cache.memo import last_call
@@ -43,7 +42,7 @@ from rclverify.report import diagram
 from rclverify.core.cache import fingerprint
 from rclverify.report.fragments import FragmentCache
 from rclverify.report.textfmt import plain
-from rclverify.report.view import decoded_parts
+from rclverify.report.view import ReportIn, decoded_parts
 from rclverify.report.argument.build import build_argument
 from rclverify.report.argument.model import Argument, Element
 
@@ -217,20 +216,20 @@ def to_dot(arg: Argument, title: str = "assurance argument", link_prefix: str = 
 
 
 @last_call
-def _typed(report: Report | AssuranceReport) -> AssuranceReport:
+def _typed(report: ReportIn) -> AssuranceReport:
     """``report`` decoded once when it is a JSON object (:func:`rclverify.report.view.decoded_parts`)."""
     return decoded_parts(report)
 
 
 @last_call
-def _built(report: Report | AssuranceReport) -> Argument:
+def _built(report: ReportIn) -> Argument:
     """The argument of ``report``.  One report run shows the argument several
     times (HTML, Markdown, ``reports/argument.*``) from the same report,
     which no renderer changes; it is built once for that report."""
     return build_argument(_typed(report))
 
 
-def _title(report: Report | AssuranceReport) -> str:
+def _title(report: ReportIn) -> str:
     """The argument's title: ``assurance argument of <workspace>``."""
     return f"assurance argument of {_typed(report).meta.workspace}"
 
@@ -240,18 +239,18 @@ def too_large(arg: Argument) -> bool:
     return len(arg.elements) > MAX_LAYOUT_ELEMENTS
 
 
-def argument_dot(report: Report | AssuranceReport, fragments: FragmentCache | None = None) -> str:
+def argument_dot(report: ReportIn, fragments: FragmentCache | None = None) -> str:
     """The DOT text of ``report``'s argument, made once per report dict
     (``fragments`` as for :func:`to_dot`)."""
     return _dot_text(report, fragments=fragments)
 
 
 @last_call
-def _dot_text(report: Report | AssuranceReport, *, fragments: FragmentCache | None) -> str:
+def _dot_text(report: ReportIn, *, fragments: FragmentCache | None) -> str:
     return to_dot(_built(report), _title(report), fragments=fragments)
 
 
-def argument_layout(report: Report | AssuranceReport, fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
+def argument_layout(report: ReportIn, fragments: FragmentCache | None = None) -> Callable[[], diagram.Rendering]:
     """What lays the argument of ``report`` out: a call that returns
     :func:`layout`'s rendering.  The DOT text is made now, by the caller
     (the fragment cache is not shared between threads), and only when the
@@ -262,7 +261,7 @@ def argument_layout(report: Report | AssuranceReport, fragments: FragmentCache |
     return lambda: layout(arg, dot)
 
 
-def argument_view(report: Report | AssuranceReport, rendering: diagram.Rendering | None = None,
+def argument_view(report: ReportIn, rendering: diagram.Rendering | None = None,
                   fragments: FragmentCache | None = None) -> dict[str, Any]:
     """What the report templates show of the argument: ``dot`` (``None``
     when the argument is too large to lay out: no report shows it then),
@@ -282,7 +281,7 @@ def argument_view(report: Report | AssuranceReport, rendering: diagram.Rendering
             "goals": [{"id": g.id, "text": g.text, "status": g.status, "undeveloped": g.undeveloped} for g in goals]}
 
 
-def write_argument(report: Report | AssuranceReport, out_dir: Path, fragments: FragmentCache | None = None,
+def write_argument(report: ReportIn, out_dir: Path, fragments: FragmentCache | None = None,
                    files: tuple[str, ...] = FILES, rendering: diagram.Rendering | None = None,
                    within: Path | None = None) -> list[Path]:
     """Write the :data:`FILES` named in ``files`` for ``report`` into ``out_dir`` (``reports/``).
