@@ -31,3 +31,15 @@ def test_only_live_modules_are_weighed_by_their_wall_clock_time() -> None:
 def test_this_module_is_marked_by_neither_tier(request) -> None:  # type: ignore[no-untyped-def]
     names = {m.name for m in request.node.iter_markers()}
     assert not names & {"slow", "live"}
+
+
+def test_a_module_is_left_unimported_only_when_the_expression_deselects_its_tier_whatever_else() -> None:
+    """``-m`` leaves a slow or live module unimported only when no test in it could be selected; the
+    controls: a mark the expression also names, an expression with arguments, a tier it selects."""
+    assert conftest._never_selected("not slow and not live", {"slow"})
+    assert conftest._never_selected("not slow and not live", {"live"})
+    assert conftest._never_selected("not live", {"slow", "live"})
+    assert not conftest._never_selected("slow and not live", {"slow"})  # the slow tier itself
+    assert not conftest._never_selected("not slow or hypothesis", {"slow"})  # a test of it may carry the other
+    assert not conftest._never_selected("not slow and not live", set())
+    assert not conftest._never_selected("not slow(reason=1)", {"slow"})
