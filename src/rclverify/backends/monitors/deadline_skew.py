@@ -24,15 +24,30 @@ such output that goes unanswered is ``false`` as before.
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Mapping
+from collections import deque
+from typing import Mapping, Protocol
 
-from rclverify.semantics.floatsem import judge
+from rclverify.semantics.floatsem import Tolerance, judge
+from rclverify.lang import ast
+from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
-from rclverify.backends.monitors.deadline_records import Pending
+from rclverify.backends.monitors.deadline_records import DeadlineResult, Pending
 from rclverify.backends.monitors.deadline_text import ms_ns
 
-if TYPE_CHECKING:
-    from rclverify.backends.monitors.deadlines import DeadlineMonitor
+
+class DeadlineMonitor(Protocol):
+    """What the skew rule reads of :class:`~.deadlines.DeadlineMonitor` (declared here, so that this
+    module stays below the monitor that calls it)."""
+
+    skew_ns: int
+    timed: list[tuple[int, ast.Clause, str, frozenset[str], float]]
+    heard: deque[tuple[int, Event, set[str], dict[str, object]]]
+    checked: Checked
+    node: CheckedNode
+    tolerance: Tolerance | None
+    result: DeadlineResult
+
+    def _visible(self, p: Pending, stamp: float | None = None) -> dict[str, object]: ...
 
 
 def skew_ns(rules: object) -> int:
@@ -41,13 +56,13 @@ def skew_ns(rules: object) -> int:
     return round(skew * 1_000_000_000) if isinstance(skew, (int, float)) and skew > 0 else 0
 
 
-def within_skew_before(mon: "DeadlineMonitor", p: Pending, ns: int) -> bool:
+def within_skew_before(mon: DeadlineMonitor, p: Pending, ns: int) -> bool:
     """Whether an output stamped ``ns`` (integer ns), heard before obligation ``p``'s trigger or stamped
     before it, lies within the transport skew before the trigger: ``p.stamp_ns - skew <= ns <= p.stamp_ns``."""
     return mon.skew_ns > 0 and p.stamp_ns - mon.skew_ns <= ns <= p.stamp_ns
 
 
-def mark_early(mon: "DeadlineMonitor", p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
+def mark_early(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
     """Output ``ev`` (stamped ``ns``, within the skew before ``p``'s trigger; ``fresh`` the outputs it set) may be
     ``p``'s answer: mark ``p`` (:attr:`~.deadline_records.Pending.maybe`) when it satisfies ``p``'s guarantee on
     the trigger's inputs.  The first such output is the one named."""
@@ -64,7 +79,7 @@ def mark_early(mon: "DeadlineMonitor", p: Pending, ev: Event, ns: int, fresh: Ma
                    "be its answer")
 
 
-def scan_heard(mon: "DeadlineMonitor", p: Pending) -> None:
+def scan_heard(mon: DeadlineMonitor, p: Pending) -> None:
     """Mark ``p`` from the outputs already heard (the last 64 kept) stamped within the skew before its trigger."""
     for ns, ev, _, fresh in mon.heard:
         if within_skew_before(mon, p, ns):
@@ -73,7 +88,7 @@ def scan_heard(mon: "DeadlineMonitor", p: Pending) -> None:
                 return
 
 
-def undecided(mon: "DeadlineMonitor", p: Pending) -> None:
+def undecided(mon: DeadlineMonitor, p: Pending) -> None:
     """Obligation ``p``, marked, unanswered when the clock passed its deadline: ``undecided`` with why."""
     res = mon.result
     res.unaccepted["undecided"] += 1
@@ -83,7 +98,7 @@ def undecided(mon: "DeadlineMonitor", p: Pending) -> None:
                                           f"{ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}"}
 
 
-def decided_late(mon: "DeadlineMonitor", p: Pending) -> None:
+def decided_late(mon: DeadlineMonitor, p: Pending) -> None:
     """Marked obligation ``p``, counted ``undecided`` when its deadline passed, answered by an output of its own
     stamped in time: no longer undecided (its ``true`` is given by the caller)."""
     res = mon.result
