@@ -2,15 +2,16 @@
 requirement, a contract-health finding, an obligation, a side condition of
 the calculus, a problem grouped by root cause (:mod:`.explain` finds the item by its id).
 
-A finding, an obligation and a problem arrive decoded into their one
-definition (records/findings.py :class:`~rclverify.records.findings.FindingRow`,
-records/obligations.py :class:`~rclverify.records.obligations.ObligationRow`,
-records/problem_rows.py :class:`~rclverify.records.problem_rows.ProblemRow`)
-and are read as attributes mypy checks: each field is printed here or named
-in its record module's ``INTERNAL_TO["explain"]`` with the reason it is not
-(tests/records/test_record_shapes.py).  A side condition is still its
-report JSON object.  Each function returns the lines to print, two spaces
-indenting what belongs to the item's first line.
+A requirement, a finding, an obligation, a side condition and a problem
+arrive decoded into their one definition (records/requirement_rows.py,
+records/findings.py, records/obligations.py, records/side_condition_rows.py,
+records/problem_rows.py) and are read as attributes mypy checks; for a
+requirement, a finding, an obligation and a problem each field is printed
+here or named in its record module's ``INTERNAL_TO["explain"]`` with the
+reason it is not (tests/records/test_record_shapes.py).  What a record keeps
+as JSON (a requirement's check, a counterexample) is read by key.  Each
+function returns the lines to print, two spaces indenting what belongs to
+the item's first line.
 """
 from __future__ import annotations
 
