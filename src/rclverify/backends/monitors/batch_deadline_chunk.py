@@ -28,26 +28,38 @@ def _headed(fields: list[Mapping[str, Any]]) -> bool:
     return False
 
 
-def judge_chunk(mon: ChunkSide, evs: list[Event]) -> bool:
-    """Judge the events ``evs`` as the streaming monitor would, over columns, and leave its state;
-    ``False`` (nothing changed) when the chunk is not clean."""
-    plan = mon.plan
-    n = len(evs)
+def _columns(evs: list[Event] | Any) -> tuple[list[str], np.ndarray, Callable[[np.ndarray, str], list[Any]]] | None:
+    """The chunk's topics, times (float64 s) and a field's values at some rows (``None`` where a message has
+    none); ``None`` when a message carries a header stamp.  ``evs``: a list of events, or a log block
+    (:class:`~rclverify.traces.jsonl_blocks.LogBlock`: its columns, no row with a header)."""
+    if not isinstance(evs, list):
+        return evs.topics, evs.times, evs.values
     fields = list(map(_FIELDS, evs))
     if _headed(fields):
+        return None
+    return list(map(_TOPIC, evs)), np.fromiter(map(_TIME, evs), np.float64, len(evs)), \
+        lambda rows, key: field_values(fields, rows, key)
+
+
+def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
+    """Judge the events ``evs`` (a list, or a log block: :func:`_columns`) as the streaming monitor
+    would, over columns, and leave its state; ``False`` (nothing changed) when the chunk is not clean."""
+    plan = mon.plan
+    n = len(evs)
+    got = _columns(evs)
+    if got is None:
         return False
-    topics = list(map(_TOPIC, evs))
+    topics, times, values = got
     lut = {t: plan.kind_of(t) for t in set(topics)}
     kind = np.fromiter(map(lut.__getitem__, topics), np.int8, n)
-    ns = ns_column(np.fromiter(map(_TIME, evs), np.float64, n))
+    ns = ns_column(times)
     if ns is None or bool((kind == 2).any()) or (n > 1 and bool((np.diff(ns) < 0).any())) or \
             (mon.now_ns is not None and int(ns[0]) < mon.now_ns):
         return False
     in_rows, out_rows = np.flatnonzero(kind == 1), np.flatnonzero(kind == -1)
     ik, ok = plan.in_key, plan.out_key
-    good_in, col_in = column(field_values(fields, in_rows, plan.in_field), plan.in_kind, plan.codes.get(ik, {}))
-    good_out, col_out = column(field_values(fields, out_rows, plan.out_field), plan.out_kind,
-                               plan.codes.get(ok, {}))
+    good_in, col_in = column(values(in_rows, plan.in_field), plan.in_kind, plan.codes.get(ik, {}))
+    good_out, col_out = column(values(out_rows, plan.out_field), plan.out_kind, plan.codes.get(ok, {}))
     if not (bool(good_in.all()) and bool(good_out.all())):
         return False
     accepted = np.ones(len(in_rows), dtype=bool)

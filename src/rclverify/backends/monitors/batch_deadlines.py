@@ -2,9 +2,11 @@
 
 :class:`BatchDeadlines` is the deadline monitor (:class:`~.deadlines.DeadlineMonitor`,
 the rules of docs/semantics.md "Deadlines") with the same state and the
-same results; it takes the run's events :data:`CHUNK` at a time and judges
-a chunk over its columns when the chunk is **clean**, else feeds its
-events to the streaming monitor one by one, as today.  Either way the
+same results; it takes the run's events :data:`CHUNK` at a time, or a
+log's blocks as the batch path reads them (:meth:`BatchDeadlines.feed_block`,
+the offline check's reading: :mod:`.recorded`), and judges a chunk over its
+columns when the chunk is **clean**, else feeds its events to the
+streaming monitor one by one.  Either way the
 monitor's state after the chunk is the one streaming it leaves (its open
 and expired obligations with their outputs and the last output that did
 not satisfy them, the values, the clock, the outputs heard, the counts, the
@@ -51,7 +53,7 @@ is counted); every ``false`` and late answer goes through the monitor's own
 """
 from __future__ import annotations
 
-from typing import Callable, Mapping
+from typing import Any, Callable, Mapping
 
 from rclverify.core.extras import installed
 from rclverify.semantics.floatsem import Tolerance
@@ -104,6 +106,20 @@ class BatchDeadlines(ChunkSide):
         stream = super().feed
         for ev in evs:
             stream(ev)
+
+    def feed_block(self, block: Any) -> None:
+        """Take a log's block (:class:`~rclverify.traces.jsonl_blocks.LogBlock`, rows in the order read):
+        the events taken before it judged, then the block judged over its columns when clean, else its rows'
+        events streamed one by one; the same verdicts and state as :meth:`feed` of each row's event."""
+        self.flush()
+        from rclverify.backends.monitors.batch_deadline_chunk import judge_chunk  # deferred: numpy
+        if judge_chunk(self, block):
+            self.stats["batched"] += len(block)
+            return
+        self.stats["streamed"] += len(block)
+        stream = super().feed
+        for i in range(len(block)):
+            stream(block[i])
 
     def advance(self, now: float) -> None:
         """The events taken judged, then the clock moved to ``now`` (s) as the streaming monitor moves it."""

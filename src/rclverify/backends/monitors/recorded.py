@@ -19,7 +19,7 @@ from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.deadline_records import DeadlineResult
 from rclverify.backends.monitors.deadline_topics import has_deadlines
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
-from rclverify.backends.monitors.batch_deadlines import deadline_monitor
+from rclverify.backends.monitors.batch_deadlines import BatchDeadlines, deadline_monitor
 from rclverify.backends.monitors.declarations import (DeclarationMonitor, DeclarationResult, add_periods,
                                                       has_declarations)
 from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
@@ -137,23 +137,14 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes if has_declarations(n)]
     calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
     heard: dict[str, int] = {}
-
-    def tap(events: Iterable[Any]) -> Iterator[Any]:
-        for ev in events:
-            for m in dmons:
-                m.feed(ev)
-            for p in pmons:
-                p.feed(ev)
-            for dm in decl:
-                dm.feed(ev)
-            yield ev
     run: Iterable[Any] = read_trace(Path(trace), [root / d for d in cfg.msg_dirs], streams=True, on_warning=on_warning)
     bag = BagCalls(nodes, calls, trace, bag_connections(Path(trace), dirs)) \
         if calls.active and is_ros2_bag(Path(trace)) else None  # a bag's recorded calls (bag_calls.py)
     run = refuse_out_of_range(run, Path(trace), sources)  # a hand-made log's value no field carries (widths.py)
     if lag is not None:
         run = in_stamp_order(run, lag)
-    source = tap(run) if dmons or pmons or decl else run  # untapped, a log keeps its columnar reading (batch path)
+    tapped: list[Any] = [*dmons, *pmons, *decl]
+    source = _Tapped(run, tapped) if tapped else run  # a log keeps its columnar reading where it can (_Tapped)
     if bag is not None:
         source = bag.tap(source)
     elif calls.active:
@@ -162,6 +153,46 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     events, results = check_trace(checked, nodes, Counted(source, heard, watch), cfg.rules, cfg.horizon,
                                   tolerance=cfg.tolerance, margins=margins)
     return _Pass(dmons, pmons, decl, calls, heard, watch, events, results, bag=bag)
+
+
+class _Tapped:
+    """The run's events, each fed to the deadline, period and declaration monitors ``monitors`` before it is
+    passed on.  A log's blocks (``blocks``, the batch path's reading: rows.py) are passed on whole when every
+    monitor takes a block (:meth:`.batch_deadlines.BatchDeadlines.feed_block`): each block is fed to them
+    first, so the log is read in blocks, not event by event; the monitors' verdicts and results are those of
+    their events fed one by one (tests/backends/test_recorded_blocks.py).  A bag is fed event by event
+    (its blocks may hold messages with a header stamp, which the batch deadline judge's columns do not read)."""
+
+    def __init__(self, events: Iterable[Any], monitors: Sequence[Any]) -> None:
+        self.events, self.monitors = events, monitors
+
+    def __iter__(self) -> Iterator[Any]:
+        feeds = [m.feed for m in self.monitors]
+        for ev in self.events:
+            for feed in feeds:
+                feed(ev)
+            yield ev
+
+    def blocks(self, fields: Sequence[str], rows: int) -> Iterator[Any] | None:
+        """The log's blocks of at most ``rows`` lines (``fields``: the keys the reader asks for, with the
+        monitors' own), each fed to the monitors first; ``None`` when the source is no log read in blocks
+        (:class:`~rclverify.traces.jsonl_blocks.JsonlLog`) or a monitor takes no block."""
+        from rclverify.traces.jsonl_blocks import JsonlLog  # deferred: optional or conditional (numpy, as read_trace)
+        if not isinstance(self.events, JsonlLog) or not all(isinstance(m, BatchDeadlines) for m in self.monitors):
+            return None
+        own = [f for m in self.monitors for f in (m.plan.in_field, m.plan.out_field)]
+        got = self.events.blocks(list(dict.fromkeys([*fields, *own])), rows)
+        return None if got is None else self._fed(got)
+
+    def _fed(self, blocks: Iterator[Any]) -> Iterator[Any]:
+        for block in blocks:
+            for m in self.monitors:
+                if isinstance(block, list):  # the log's exact path: its events
+                    for ev in block:
+                        m.feed(ev)
+                else:
+                    m.feed_block(block)
+            yield block
 
 
 def _decided(res: NodeResult) -> int:
