@@ -138,7 +138,7 @@ def test_ids_sort_naturally() -> None:
 
 def test_newcomer_speed_mismatch_gets_side_condition_repairs(newcomer: Path) -> None:
     ws, report = _run(newcomer)
-    d = next(x for x in report["diagnoses"] if x["id"] == "Controller.sc2")
+    d = next(x.to_json() for x in report.diagnoses if x.id == "Controller.sc2")
     assert d["kind"] == "side-condition"
     assert "in.speed <= 1.5" in d["sentence"] and "Planner's guarantee 1" in d["sentence"]
     assert "contracts/rover.rcl:15:29" in d["sentence"] and "contracts/rover.rcl:9:3" in d["sentence"]
@@ -196,7 +196,7 @@ def test_a_checker_that_answers_sat_to_everything_shows_no_repair(newcomer: Path
 
 def test_appendix_b_refutations_name_the_constants_and_get_the_change(sensor: Path) -> None:
     ws, report = _run(sensor)
-    hoare = [d for d in report["diagnoses"] if d["kind"] == "hoare"]
+    hoare = [d.to_json() for d in report.diagnoses if d.kind == "hoare"]
     assert {d["id"].rsplit(".", 1)[1] for d in hoare} == {"c2", "c3"}
     for d in hoare:
         assert "10/20" in d["sentence"] and "120/250" in d["sentence"]
@@ -215,7 +215,7 @@ def test_appendix_b_refutations_name_the_constants_and_get_the_change(sensor: Pa
 
 def test_vacuity_names_the_other_guarantee_and_gets_a_guard(vacuous: Path) -> None:
     ws, report = _run(vacuous)
-    d = next(x for x in report["diagnoses"] if x["id"] == "N.g1.non-vacuous")
+    d = next(x.to_json() for x in report.diagnoses if x.id == "N.g1.non-vacuous")
     assert d["kind"] == "vacuity"
     assert "guarantee 2 (contracts/n.rcl:6:3)" in d["sentence"]
     assert [c["source"] for c in d["culprits"]] == ["contracts/n.rcl:6:3"]
@@ -264,7 +264,7 @@ def test_vacuity_repair_restricts_i_to_waypoints_with_a_successor(tmp_path: Path
     (root / "contracts" / "w.rcl").write_text(SUCCESSOR, encoding="utf-8")
     (root / "contracts" / "plan.yaml").write_text(SUCCESSOR_PLAN, encoding="utf-8")
     ws, report = _run(root)
-    d = next(x for x in report["diagnoses"] if x["id"] == "W.g1.non-vacuous")
+    d = next(x.to_json() for x in report.diagnoses if x.id == "W.g1.non-vacuous")
     assert "guarantee 2" in d["sentence"]
     [r] = d["repairs"]
     assert r["kind"] == "guard"
