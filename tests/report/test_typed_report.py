@@ -41,15 +41,19 @@ def report() -> AssuranceReport:
     return typed_report(_PARTS)
 
 
-def test_a_part_read_by_key_is_its_json_value_and_an_unknown_key_raises(report: AssuranceReport) -> None:
-    assert report["summary"]["headline"] == "one failed" == report.summary.headline
-    assert report["nodes"] == [n.to_json() for n in report.nodes] and isinstance(report["nodes"][0], dict)
-    assert report.get("grounding") is None and report.get("no_such_part", "absent") == "absent"
-    with pytest.raises(KeyError, match="no_such_part"):
-        report["no_such_part"]
-    # a value read by key is built anew: changing it leaves the report as it was
-    report["nodes"][0]["status"] = "discharged"
-    assert report.nodes[0].status == "failed"
+def test_a_part_is_read_by_attribute_and_its_json_object_is_a_copy(report: AssuranceReport) -> None:
+    """The report is read by attribute; its JSON object (``to_json``) is made anew, and reading the report
+    by key is no longer possible (issue 112: the readers read records)."""
+    body = report.to_json()
+    assert body["summary"]["headline"] == "one failed" == report.summary.headline
+    assert body["nodes"] == [n.to_json() for n in report.nodes] and isinstance(body["nodes"][0], dict)
+    assert body["grounding"] is None is report.grounding
+    with pytest.raises(TypeError, match="not subscriptable"):
+        report["summary"]  # type: ignore[index]
+    assert not hasattr(report, "get")
+    # the JSON object is built anew: changing it leaves the report as it was
+    body["nodes"][0]["status"] = "discharged"
+    assert report.nodes[0].status == "failed" and report.to_json()["nodes"][0]["status"] == "failed"
 
 
 def test_the_files_are_the_same_from_the_decoded_report_and_from_its_json(report: AssuranceReport) -> None:

@@ -5,18 +5,15 @@ them, each typed by the record defined once for it (the modules beside
 this one) and described.  docs/assurance.schema.json is generated from it
 whole (records/schema_gen.py): the top-level keys, which are required and
 which refuse others, each key's part.  The report's passes (report/build.py)
-build the JSON object pass by pass (:data:`REPORT_KEYS` is what
-:func:`rclverify.records.report_schema.as_report` checks they wrote) and
-decode the finished one into :class:`AssuranceReport`, which the renderers
-read (docs/records.md); tests/records/test_record_shapes.py holds the
-dict-shaped view the passes write
-(:class:`rclverify.records.report_schema.Report`) to these fields.
+build and return its parts' records and the report is one from the first
+pass to the renderers, which read its attributes (docs/records.md); its JSON
+object (:meth:`~rclverify.records.row.Row.to_json`) is made when it is
+written, and :data:`REPORT_KEYS` is what
+:func:`rclverify.records.report_schema.as_report` checks such an object has.
 """
 from __future__ import annotations
 
-from typing import Annotated, Any
-
-import msgspec
+from typing import Annotated
 
 from rclverify.records.deadline_rows import DeadlineRow
 from rclverify.records.design_rows import DesignRow
@@ -70,19 +67,6 @@ class AssuranceReport(Row, frozen=True, forbid_unknown_fields=True):
     standards: Annotated[list[StandardRow], DOC(description="The evidence mapped onto the standards the plan names (docs/standards.md); empty when it names none.")]
     diagnoses: Annotated[list[DiagnosisRow], DOC(description="One diagnosis per problem.")]
     problems: Annotated[list[ProblemRow], DOC(description="The problems grouped by root cause.")]
-
-    def __getitem__(self, key: str) -> Any:
-        """The part ``key`` as its JSON value (``report["summary"]["headline"]``), built anew on each
-        call: what a reader of the report's JSON object reads when handed the decoded report (the readers
-        that still read it so are listed in docs/records.md).  Raises ``KeyError`` for a key that is no
-        field."""
-        if key not in self.__struct_fields__:
-            raise KeyError(key)
-        return msgspec.to_builtins(getattr(self, key))
-
-    def get(self, key: str, default: Any = None) -> Any:
-        """:meth:`__getitem__`, or ``default`` for a key that is no field."""
-        return self[key] if key in self.__struct_fields__ else default
 
 
 #: The report's top-level keys, in the order the report writes them.
