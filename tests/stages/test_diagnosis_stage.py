@@ -109,7 +109,7 @@ def test_the_report_loads_no_diagnosis_analysis(newcomer: Path) -> None:
     stage_diagnosis(ws)
     code = ("import sys; from pathlib import Path; from rclverify.stages.workspace import Workspace; "
             "from rclverify.report.build import build_report; r = build_report(Workspace(Path(sys.argv[1]))); "
-            "assert r['diagnoses'], 'no diagnoses read'; "
+            "assert r.diagnoses, 'no diagnoses read'; "
             "print(sorted(m for m in sys.modules if m.startswith('rclverify.diagnosis.')))")
     out = subprocess.run([sys.executable, "-c", code, str(newcomer)], capture_output=True, text=True, check=True)
     loaded = set(json.loads(out.stdout.replace("'", '"')))
