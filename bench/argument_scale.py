@@ -40,10 +40,10 @@ from rclverify.report.diagram import render_dot
 from rclverify.records.report_record import AssuranceReport
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "records"))
-from _typed_rows import complete  # noqa: E402 - the tests' completion of a partial report into a whole one
+from _typed_rows import typed_report  # noqa: E402 - the tests' completion of a partial report into a whole one, decoded
 
 
-def synthetic_report(n: int) -> dict[str, Any]:
+def synthetic_report(n: int) -> AssuranceReport:
     nodes, obligations, evidence, sides, reqs = [], [], [], [], []
     for i in range(n):
         name = f"N{i}"
@@ -63,7 +63,7 @@ def synthetic_report(n: int) -> dict[str, Any]:
         reqs.append({"id": f"REQ{i}", "text": "t", "status": "discharged",
                      "support": [{"node": name, "guarantee": 1}, {"node": name, "guarantee": 2}]})
     # every field the synthetic rows leave out given an empty value of its type, as the report's record asks
-    return complete(AssuranceReport, {"meta": {"tool": "rclverify", "version": "bench", "workspace": "bench",
+    return typed_report({"meta": {"tool": "rclverify", "version": "bench", "workspace": "bench",
                                                "plan": "contracts/plan.yaml", "contracts": ["s.rcl"]},
             "requirements": reqs, "nodes": nodes, "side_conditions": sides, "obligations": obligations,
             "evidence": evidence, "findings": [], "environment_assumptions": [],
