@@ -133,7 +133,7 @@ def test_the_coverage_of_a_bounded_range_is_the_buckets_the_examples_hit(tmp_pat
                                                                          "coverage": ev.details["coverage"]}}
     # r's assumption bounds it below only: the fraction is of the plan's [0, 500], and the detail says so
     assert (f"in.r {c['fraction']:.0%} of [0, 500] (drawn {c['drawn']}, the plan's bounds; the assumption admits "
-            "[0, inf])") in str(evidence_strength(complete(EvidenceRow, row)).detail)
+            "[0, inf])") in str(evidence_strength(EvidenceRow.of(complete(EvidenceRow, row))).detail)
 
 
 def test_off_by_one_threshold_caught_with_shrunk_counterexample(tmp_path: Path) -> None:

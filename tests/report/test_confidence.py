@@ -37,8 +37,9 @@ def test_every_backend_has_a_strength() -> None:
     assert set(BACKEND_NAMES) == set(BACKEND_KIND)
     assert set(BACKEND_KIND.values()) <= set(KINDS)
     for b in BACKEND_NAMES:  # any status but discharged gives no confidence
-        assert evidence_strength(complete(EvidenceRow, {"backend": b, "status": "failed"})).doubt == 1.0
-        s = evidence_strength(complete(EvidenceRow, {"backend": b, "status": "discharged", "figures": [["count", "60"]]}))
+        assert evidence_strength(EvidenceRow.of(complete(EvidenceRow, {"backend": b, "status": "failed"}))).doubt == 1.0
+        s = evidence_strength(EvidenceRow.of(complete(EvidenceRow, {"backend": b, "status": "discharged",
+                                                               "figures": [["count", "60"]]})))
         assert s.kind == BACKEND_KIND[b] and 0 < s.doubt < 1
 
 
@@ -47,8 +48,8 @@ def test_the_experiment_bound_is_clopper_pearson_with_no_failure() -> None:
     for n in (1, 10, 47, 300):
         p = one_sided_bound(n)
         assert abs((1 - p) ** n - 0.05) < 1e-12
-    s = evidence_strength(complete(EvidenceRow, {"backend": "experiment", "status": "discharged",
-                                                 "figures": [["count", "10"]]}))
+    s = evidence_strength(EvidenceRow.of(complete(EvidenceRow, {"backend": "experiment", "status": "discharged",
+                                                                "figures": [["count", "10"]]})))
     assert s.doubt == pytest.approx(one_sided_bound(10)) and "10 trials" in str(s.detail)
 
 
@@ -221,7 +222,7 @@ def test_a_side_condition_read_from_cone_summaries_is_not_two_solvers() -> None:
     s = side_condition_strength(SideConditionRow.of(complete(SideConditionRow, sc)))
     assert s.solvers == 1 and s.doubt == DOUBT["proof"] and "summaries" in str(s.detail), s
     sc["context"] = {"summaries": []}
-    assert side_condition_strength(complete(SideConditionRow, sc)).doubt == DOUBT["proof2"]
+    assert side_condition_strength(SideConditionRow.of(complete(SideConditionRow, sc))).doubt == DOUBT["proof2"]
 
 
 def test_the_observed_detail_counts_judged_messages_not_questions() -> None:

@@ -69,15 +69,12 @@ def _figure(row: EvidenceRow, name: str) -> str | None:
     return None
 
 
-def evidence_strength(row: EvidenceRow | Mapping[str, Any]) -> Strength:
+def evidence_strength(row: EvidenceRow) -> Strength:
     """The strength of one evidence row of the report (an
-    :class:`~rclverify.records.evidence_rows.EvidenceRow`, or its JSON object, decoded here:
-    ``backend``, ``status``, and the backend's figures: ``examples``, ``monitoring``,
-    ``figures``, ``statistics``): a :class:`~rclverify.records.strength_rows.Strength` with
-    its ``kind``, ``detail`` and ``doubt``; an unknown backend is ``assumed``.  Raises
-    :class:`msgspec.ValidationError` for a JSON object of another shape."""
-    if not isinstance(row, EvidenceRow):
-        row = EvidenceRow.of(row)
+    :class:`~rclverify.records.evidence_rows.EvidenceRow`: ``backend``, ``status``, and the
+    backend's figures: ``examples``, ``monitoring``, ``figures``, ``statistics``): a
+    :class:`~rclverify.records.strength_rows.Strength` with its ``kind``, ``detail`` and
+    ``doubt``; an unknown backend is ``assumed``."""
     backend = row.backend
     kind = BACKEND_KIND.get(backend, "assumed")
     detail, doubt = "", DOUBT[kind]
@@ -162,17 +159,13 @@ def coverage_text(cov: Mapping[str, Any]) -> str:
     return "; ".join(parts)
 
 
-def side_condition_strength(sc: SideConditionRow | Mapping[str, Any]) -> Strength:
+def side_condition_strength(sc: SideConditionRow) -> Strength:
     """The strength of a side-condition row (a
-    :class:`~rclverify.records.side_condition_rows.SideConditionRow`, or its JSON object, decoded
-    here): a ``proof`` by one or two
+    :class:`~rclverify.records.side_condition_rows.SideConditionRow`): a ``proof`` by one or two
     solvers (its ``solvers.agreement``), doubt 1 unless ``discharged``.  One
     discharged from its producers' cone summaries (``context.summaries``,
     calculus/summary.py) is one solver's: cvc5 decides the last query only,
-    the summaries were each proved implied by their cone by Z3 alone.  Raises
-    :class:`msgspec.ValidationError` for a JSON object of another shape."""
-    if not isinstance(sc, SideConditionRow):
-        sc = SideConditionRow.of(sc)
+    the summaries were each proved implied by their cone by Z3 alone."""
     two = sc.solvers is not msgspec.UNSET and sc.solvers.agreement == "two solvers"
     detail = "Z3 and cvc5" if two else "Z3 (one solver)"
     if two and ((sc.context or {}).get("summaries")):  # calculus/compose.py's record of the proof in context
