@@ -51,6 +51,7 @@ from rclverify.traces.events import Event
 from rclverify.traces.questions import KEPT, Question
 from rclverify.targets.columns import seed
 from rclverify.backends.monitors.answered import RecentOutput
+from rclverify.backends.monitors.skew import within_before
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS, Verdict
 
 _SOURCE, _LATE = attrgetter("source"), attrgetter("late")
@@ -211,7 +212,7 @@ class LoneSlots:
                 else:
                     r, stamp = int(last_out[int(in_rows[j])]), float(t[int(in_rows[j])])
                 at = float(t[r]) if r >= 0 else (float(prior[1]) if prior is not None else None)
-                if at is not None and stamp - skew <= at <= stamp:
+                if at is not None and within_before(at, stamp, skew):
                     early_q.append(c)
                     early_row.append(r)
         # the readings: each output on its question's input, each early answer on its question's

@@ -33,6 +33,7 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.backends.monitors.deadline_records import DeadlineResult, Pending
 from rclverify.backends.monitors.deadline_text import ms_ns
+from rclverify.backends.monitors.skew import within_before
 
 
 class DeadlineMonitor(Protocol):
@@ -59,7 +60,7 @@ def skew_ns(rules: object) -> int:
 def within_skew_before(mon: DeadlineMonitor, p: Pending, ns: int) -> bool:
     """Whether an output stamped ``ns`` (integer ns), heard before obligation ``p``'s trigger or stamped
     before it, lies within the transport skew before the trigger: ``p.stamp_ns - skew <= ns <= p.stamp_ns``."""
-    return mon.skew_ns > 0 and p.stamp_ns - mon.skew_ns <= ns <= p.stamp_ns
+    return mon.skew_ns > 0 and within_before(ns, p.stamp_ns, mon.skew_ns)
 
 
 def mark_early(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:

@@ -33,4 +33,11 @@ def parse_skew(value: Any) -> float | None:
     return v if math.isfinite(v) and v >= 0 else None
 
 
-__all__ = ["DEFAULT_SKEW_S", "parse_skew"]
+def within_before(at: float, stamp: float, skew: float) -> bool:
+    """Whether a message stamped ``at`` lies within the transport skew ``skew`` before one stamped ``stamp``
+    (all three in one unit): ``stamp - skew <= at <= stamp``, the window the guarantee's early answer
+    (closing.py ``_early``) and the deadline rule (:mod:`.deadline_skew`) read."""
+    return stamp - skew <= at <= stamp
+
+
+__all__ = ["DEFAULT_SKEW_S", "parse_skew", "within_before"]
