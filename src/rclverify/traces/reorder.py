@@ -75,10 +75,6 @@ class ReorderBuffer(Generic[T]):
         """The earliest stamp held (s); ``inf`` when nothing is."""
         return self._heap[0][0] if self._heap else math.inf
 
-    def head_source(self) -> float:
-        """The source time (s) of the earliest message held; ``inf`` when nothing is."""
-        return self._heap[0][1] if self._heap else math.inf
-
     def release(self, upto: float, strict: bool = False) -> Iterator[Released[T]]:
         """The held messages stamped at or before ``upto`` (s; before it when
         ``strict``), in order, each removed as it is given."""
