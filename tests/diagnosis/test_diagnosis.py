@@ -16,6 +16,7 @@ import z3
 
 from rclverify.cli.commands import main
 from rclverify.diagnosis.build import diagnose
+from rclverify.diagnosis.shapes import report_rows
 from rclverify.diagnosis.repair_cache import CACHE
 from rclverify.diagnosis.table import counterexample_table, decimals, function_table
 from rclverify.semantics.values import decimal_text
@@ -173,7 +174,7 @@ def test_a_broken_checker_shows_no_repair(newcomer: Path, monkeypatch: pytest.Mo
     ws, report = _run(newcomer)
     ws.path(CACHE).unlink(missing_ok=True)
     monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: z3.unknown)
-    ds = diagnose(ws, report)
+    ds = diagnose(ws, report_rows(report))
     d = next(x for x in ds if x["id"] == "Controller.sc2")
     assert "Controller assumes `in.speed <= 1.5`" in d["sentence"] and "Planner's guarantee 1" not in d["sentence"]
     assert "Z3 could not show which" in d["sentence"]
@@ -188,7 +189,7 @@ def test_a_checker_that_answers_sat_to_everything_shows_no_repair(newcomer: Path
     ws.path(CACHE).unlink(missing_ok=True)
     real_check = z3.Solver.check
     monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: (real_check(self, *a, **k), z3.sat)[1])
-    assert next(x for x in diagnose(ws, report) if x["id"] == "Controller.sc2")["repairs"] == []
+    assert next(x for x in diagnose(ws, report_rows(report)) if x["id"] == "Controller.sc2")["repairs"] == []
 
 
 # ---------------------------------------------------------------------------------------------
@@ -359,7 +360,7 @@ def test_a_broken_checker_shows_no_guard(vacuous: Path, monkeypatch: pytest.Monk
     ws, report = _run(vacuous)
     ws.path(CACHE).unlink(missing_ok=True)
     monkeypatch.setattr(z3.Solver, "check", lambda self, *a, **k: z3.unknown)
-    d = next(x for x in diagnose(ws, report) if x["id"] == "N.g1.non-vacuous")
+    d = next(x for x in diagnose(ws, report_rows(report)) if x["id"] == "N.g1.non-vacuous")
     assert "guarantee 2 (contracts/n.rcl:6:3)" in d["sentence"] and d["repairs"] == []
 
 
@@ -374,7 +375,7 @@ def test_parallel_report_tasks_diagnose_one_at_a_time(newcomer: Path) -> None:
     fd = os.open(ws.path(LOCK), os.O_RDWR | os.O_CREAT)
     fcntl.flock(fd, fcntl.LOCK_EX)  # another process diagnosing
     done: list[Any] = []
-    t = threading.Thread(target=lambda: done.append(diagnose(ws, report)))
+    t = threading.Thread(target=lambda: done.append(diagnose(ws, report_rows(report))))
     t.start()
     t.join(1.0)
     assert not done and not ws.path(CACHE).exists()  # waiting, nothing computed

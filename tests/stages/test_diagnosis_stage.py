@@ -20,6 +20,7 @@ import pytest
 from rclverify.app.pipeline import (Workspace, diagnosed, stage_check, stage_compose, stage_diagnosis, stage_export,
                                     stage_health, stage_report)
 from rclverify.diagnosis.build import diagnose
+from rclverify.diagnosis.shapes import report_rows
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.sealed import is_sealed_path, read_sealed
 from rclverify.report.build import build_report, undiagnosed_report
@@ -59,7 +60,7 @@ def test_the_stage_seals_the_diagnoses_of_the_report_and_the_report_reads_them(n
     on_disk, why = read_sealed(ws.path(INDEX))
     assert not why and on_disk == record
     assert record["report_sha256"] == report_digest(pre) == report_digest(undiagnosed_report(ws))
-    want = json.loads(json.dumps(diagnose(ws, pre), sort_keys=True))
+    want = json.loads(json.dumps(diagnose(ws, report_rows(pre)), sort_keys=True))
     assert record["diagnoses"] == want and [d["id"] for d in want][:1] == ["Controller.sc2"]
     assert want[0]["repairs"]  # Z3 checked repairs: the stage did the analysis
     report = build_report(ws)

@@ -45,26 +45,23 @@ from rclverify.diagnosis.culprits import culprits, parse_core, plan_facts
 from rclverify.records.links import link_pairs
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.diagnosis.units import unit_records
-from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows, report_rows
+from rclverify.diagnosis.shapes import ProducerCulprits, ReportRows
 from rclverify.records.findings import FindingRow
 from rclverify.records.problem_rows import DiagnosisRow
-from rclverify.records.report_record import AssuranceReport
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.stage_records import Culprit, DiagnosisEntry, Repair
 
 
-def diagnose(ws: Any, report: ReportRows | AssuranceReport | Mapping[str, Any]) -> list[DiagnosisEntry]:
+def diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
     """The diagnosis records of every problem of ``report`` (see the module
     docstring), in the order of the report's problems list: health
-    findings, side conditions, evidence.  ``report`` is read as its
-    :class:`~rclverify.diagnosis.shapes.ReportRows` (a report's JSON object
-    is decoded first, :func:`~rclverify.diagnosis.shapes.report_rows`, which
-    raises ``ValueError`` for one that lacks a part).  One process at a time
-    per workspace (:func:`one_at_a_time`), so parallel report tasks compute
-    each repair once."""
-    rows = report_rows(report)
+    findings, side conditions, evidence.  ``report`` is the report's
+    :class:`~rclverify.diagnosis.shapes.ReportRows`
+    (:func:`~rclverify.diagnosis.shapes.report_rows` decodes a report or its JSON object
+    into them).  One process at a time per workspace (:func:`one_at_a_time`), so parallel
+    report tasks compute each repair once."""
     with one_at_a_time(ws):
-        return _diagnose(ws, rows)
+        return _diagnose(ws, report)
 
 
 def _diagnose(ws: Any, report: ReportRows) -> list[DiagnosisEntry]:
