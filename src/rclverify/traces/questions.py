@@ -40,6 +40,12 @@ KEPT = 64
 _NO_SET: Any = frozenset()
 
 
+def kept_after(total: int) -> int:
+    """How many questions a stream keeps of ``total``: those it keeps now and those then asked in stamp
+    order (:meth:`QuestionStream.ask`: past ``2 * KEPT``, the oldest ``KEPT`` forgotten at a time)."""
+    return total if total <= 2 * KEPT else KEPT + 1 + (total - 2 * KEPT - 1) % KEPT
+
+
 class Question:
     """One question of one node.
 
@@ -190,4 +196,4 @@ class QuestionStream:
         return [q for q in qs[i:j] if q.stamp >= stamp]
 
 
-__all__ = ["KEPT", "Question", "QuestionStream"]
+__all__ = ["KEPT", "Question", "QuestionStream", "kept_after"]

@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING, Any
 from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event
-from rclverify.traces.questions import KEPT, Question
+from rclverify.traces.questions import KEPT, Question, kept_after
 from rclverify.targets.columns import seed
 from rclverify.backends.monitors.answered import RecentOutput
 from rclverify.backends.monitors.skew import within_before
@@ -379,7 +379,7 @@ class LoneSlots:
         holder = np.maximum.accumulate(np.where(np.concatenate([[True], answered[:-1]]), own, -1))
         first_carry = ik in q0.triggers and ik not in q0.answered_triggers
         total = len(stream._questions) + nq
-        keptn = total if total <= 2 * KEPT else KEPT + 1 + (total - 2 * KEPT - 1) % KEPT
+        keptn = kept_after(total)
         tail = list(range(max(0, nq - min(nq, keptn)), nq))
         out_of = {int(qidx[r]): r for r, p in zip(out_rows.tolist(), paired_out.tolist()) if p}
         made: list[Question] = []

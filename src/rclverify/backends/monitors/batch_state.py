@@ -13,7 +13,7 @@ from typing import cast
 from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event
-from rclverify.traces.questions import KEPT, Question, QuestionStream
+from rclverify.traces.questions import KEPT, Question, QuestionStream, kept_after
 from rclverify.backends.monitors.answered import AnsweredRun, RecentOutput
 from rclverify.backends.monitors.batch_plan import BatchPlan
 from rclverify.backends.monitors.engine import NodeMonitor
@@ -46,7 +46,7 @@ class PairsState:
         stream = m.stream  # the older questions are made when the engine may look them up: _materialise
         old = len(stream._questions)
         total = old + n
-        keptn = total if total <= 2 * KEPT else KEPT + 1 + (total - 2 * KEPT - 1) % KEPT
+        keptn = kept_after(total)
         tail = at[-min(n, keptn, 2 * KEPT):]
         where = {k: v[len(at) - len(tail):] for k, v in src.items()}
         seed = {k: m.values[k] for k in m._in_keys}
