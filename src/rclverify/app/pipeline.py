@@ -324,16 +324,19 @@ def diagnosed(ws: Workspace, report: dict[str, Any] | None = None) -> AssuranceR
     else built now) with the diagnosis stage's record for it, the stage run
     first when that record is missing, altered or made from another report
     (:func:`rclverify.stages.diagnoses.read_diagnoses`): every report the
-    orchestrator builds explains its problems.  Raises as
+    orchestrator builds explains its problems.  The report built now is
+    finished from its record, its JSON object only digested and diagnosed.  Raises as
     :func:`stage_diagnosis`."""
-    from rclverify.report.build import diagnosed_report, undiagnosed_report  # deferred: start-up (loads jinja2, lark and more only when called)
+    from rclverify.report.build import diagnosed_report, undiagnosed_json, undiagnosed_record  # deferred: start-up (loads jinja2, lark and more only when called)
     from rclverify.stages.diagnoses import read_diagnoses  # deferred: start-up (loads rclverify.stages.diagnoses only when called)
+    record: AssuranceReport | None = None
     if report is None:
-        report = undiagnosed_report(ws)
+        record = undiagnosed_record(ws)
+        report = undiagnosed_json(record)
     diagnoses, _ = read_diagnoses(ws, report)
     if diagnoses is None:
         diagnoses = cast("list[dict[str, Any]]", stage_diagnosis(ws, report)["diagnoses"])
-    return diagnosed_report(report, diagnoses)
+    return diagnosed_report(report if record is None else record, diagnoses)
 
 
 def stage_report(ws: Workspace, parts: Sequence[str] = tuple(REPORT_PARTS),
