@@ -1,6 +1,7 @@
 """What the batch deadline judge's chunk side (:mod:`.batch_deadline_chunk`) asks of
 the deadline monitor it judges for (:class:`~.batch_deadlines.BatchDeadlines`): a
-message's mapped value, the streaming monitor's words for each verdict, and
+message's mapped value, the streaming monitor's words for a rejected output (its
+verdicts it builds as the streaming monitor does: :class:`~.deadlines.DeadlineMonitor`), and
 the state a clean chunk leaves (docs/semantics.md, "Deadlines")."""
 from __future__ import annotations
 
@@ -10,9 +11,8 @@ from typing import TYPE_CHECKING, Mapping
 from rclverify.semantics.floatsem import judge
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import map_value, rule_for
-from rclverify.backends.monitors.deadline_records import DeadlineVerdict, Pending
-from rclverify.backends.monitors.deadline_text import ms, ms_ns
-from rclverify.backends.monitors.deadlines import DeadlineMonitor
+from rclverify.backends.monitors.deadline_records import Pending
+from rclverify.backends.monitors.deadlines import DeadlineMonitor, rejected
 
 if TYPE_CHECKING:
     from rclverify.backends.monitors.batch_deadline_plan import DeadlinePlan
@@ -36,36 +36,7 @@ class ChunkSide(DeadlineMonitor):
         (:meth:`~.deadlines.DeadlineMonitor._try`'s words)."""
         cl = self.node.node.guarantees[k - 1]
         values = {**inputs, out_key: self.mapped(out, out_key)}
-        j = judge(cl.formula, self.checked, self.node, values, self.tolerance)
-        return f"the output at {out.where} did not satisfy guarantee {k}" + (
-            f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
-            f" ({j.reason})" if j.truth is None and j.reason else "")
-
-    def expired_verdict(self, p: Pending, now_ns: int) -> DeadlineVerdict:
-        """Obligation ``p``'s ``false``: the clock passed its deadline at ``now_ns`` unanswered."""
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                               f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
-                               f"(clock at {now_ns / 1e9:.3f} s)" + (f"; {p.rejected}" if p.rejected else ""))
-
-    def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float) -> DeadlineVerdict:
-        """Open obligation ``p`` answered by output ``ev`` stamped ``ns``: ``true`` within the deadline ``d``
-        (s), else ``false`` with the answer."""
-        if ns <= p.due_ns:
-            return DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                                   ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms(d)})",
-                                   semantics="exact", time_margin=(p.due_ns - ns) / 1e9)
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                               f"{ms_ns(ns - p.due_ns)} past the deadline of {ms(d)}",
-                               semantics="exact", time_margin=(p.due_ns - ns) / 1e9)
-
-    def late_verdict(self, p: Pending, ns: int, ev: Event) -> DeadlineVerdict:
-        """Expired obligation ``p``'s late answer ``ev`` stamped ``ns`` (an update of its ``false``)."""
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                               f"{ms_ns(ns - p.due_ns)} past the deadline of "
-                               f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
-                               time_margin=(p.due_ns - ns) / 1e9)
+        return rejected(k, out, judge(cl.formula, self.checked, self.node, values, self.tolerance))
 
     def take_state(self, pending: list[Pending], expired: list[Pending], values: Mapping[str, object],
                    heard: list[tuple[int, Event, set[str], dict[str, object]]], now_ns: int) -> None:

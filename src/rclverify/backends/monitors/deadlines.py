@@ -52,7 +52,7 @@ from __future__ import annotations
 from collections import deque
 from typing import Callable, Iterable, Mapping
 
-from rclverify.semantics.floatsem import Tolerance, judge
+from rclverify.semantics.floatsem import Judgement, Tolerance, judge
 from rclverify.lang import ast
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.timing import seconds
@@ -66,6 +66,13 @@ from rclverify.backends.monitors.deadline_records import DeadlineResult, Deadlin
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import ms, ms_ns
 from rclverify.backends.monitors import deadline_skew
+
+
+def rejected(k: int, out: Event, j: Judgement) -> str:
+    """Why output ``out`` did not answer an obligation of guarantee ``k``, judged ``j`` on its inputs."""
+    return f"the output at {out.where} did not satisfy guarantee {k}" + (
+        f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
+        f" ({j.reason})" if j.truth is None and j.reason else "")
 
 
 class DeadlineMonitor:
@@ -226,6 +233,33 @@ class DeadlineMonitor:
             return "undecided", f"assumption {expr_to_rcl(formula)} undecided: {j.reason}"
         return None
 
+    # -- the verdicts' words (the batch deadline judge's too: batch_deadline_chunk.py) -------------
+    def expired_verdict(self, p: Pending, now_ns: int) -> DeadlineVerdict:
+        """Obligation ``p``'s ``false``: the clock passed its deadline at ``now_ns`` unanswered."""
+        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
+                               f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
+                               f"(clock at {now_ns / 1e9:.3f} s)" + (f"; {p.rejected}" if p.rejected else ""))
+
+    def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
+        """Open obligation ``p`` answered by output ``ev`` stamped ``ns``: ``true`` within the deadline ``d``
+        (s; at it is in time, integer ns), else ``false`` with the answer."""
+        if ns <= p.due_ns:
+            return DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                                   ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms(d)})",
+                                   semantics=semantics, time_margin=(p.due_ns - ns) / 1e9)
+        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
+                               f"{ms_ns(ns - p.due_ns)} past the deadline of {ms(d)}",
+                               semantics=semantics, time_margin=(p.due_ns - ns) / 1e9)
+
+    def late_verdict(self, p: Pending, ns: int, ev: Event) -> DeadlineVerdict:
+        """Expired obligation ``p``'s late answer ``ev`` stamped ``ns`` (an update of its ``false``)."""
+        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
+                               f"{ms_ns(ns - p.due_ns)} past the deadline of "
+                               f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
+                               time_margin=(p.due_ns - ns) / 1e9)
+
     def _answer(self, ev: Event, ns: int, outs: set[str]) -> None:
         stamp = ns / 1e9
         for p in list(self.expired):
@@ -236,11 +270,7 @@ class DeadlineMonitor:
                     continue
                 if p.maybe:  # answered late, or in time by the output within the skew before it: still undecided
                     continue
-                self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
-                                           ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                                           f"{ms_ns(ns - p.due_ns)} past the deadline of "
-                                           f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
-                                           time_margin=(p.due_ns - ns) / 1e9))
+                self._emit(self.late_verdict(p, ns, ev))
                 self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp, was_unanswered=True)
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
         self.heard.append((ns, ev, outs, {c: self.values[c] for c in outs if c not in self.state_outs}))
@@ -293,19 +323,9 @@ class DeadlineMonitor:
         stamp = ns / 1e9
         j = judge(cl.formula, self.checked, self.node, self._visible(p, stamp), self.tolerance)
         if j.truth is not True:
-            p.rejected = f"the output at {ev.where} did not satisfy guarantee {k}" + (
-                f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
-                f" ({j.reason})" if j.truth is None and j.reason else "")
+            p.rejected = rejected(k, ev, j)
             return False
-        if ns <= p.due_ns:  # "within": at the deadline is in time (integer ns, no rounding)
-            self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, stamp,
-                                       ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms(d)})",
-                                       semantics=j.semantics, time_margin=(p.due_ns - ns) / 1e9))
-        else:
-            self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, stamp,
-                                       ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                                       f"{ms_ns(ns - p.due_ns)} past the deadline of {ms(d)}",
-                                       semantics=j.semantics, time_margin=(p.due_ns - ns) / 1e9))
+        self._emit(self.answered_verdict(p, ns, ev, d, j.semantics))
         self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp)
         return True
 
@@ -353,16 +373,14 @@ class DeadlineMonitor:
         if self.now_ns is not None and now_ns <= self.now_ns:
             return
         self.now_ns = now_ns
-        now = self.now = now_ns / 1e9
+        self.now = now_ns / 1e9
         keep = []
         for p in self.pending:
             if p.due_ns < now_ns and p.maybe:  # its answer may be the output within the skew before it
                 deadline_skew.undecided(self, p)
                 self.expired.append(p)
             elif p.due_ns < now_ns:
-                self._emit(DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                                           f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
-                                           f"(clock at {now:.3f} s)" + (f"; {p.rejected}" if p.rejected else "")))
+                self._emit(self.expired_verdict(p, now_ns))
                 self.result.note_time_margin(p.k, None, p.trigger.where, "", 0.0)  # until a late answer comes
                 self.expired.append(p)
             else:
