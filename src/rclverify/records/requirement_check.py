@@ -78,12 +78,13 @@ class TraceCheckRow(msgspec.Struct, frozen=True):
 class PremiseRow(msgspec.Struct, frozen=True):
     """A premise the check used (:class:`rclverify.records.stage_records.Premise`): its label, its kind
     (``guarantee``, ``assumption``, ``fact``, ``initial value``, ``progress`` ...), its node (``None`` for
-    the requirement's own ``assuming``) and 1-based index."""
+    the requirement's own ``assuming``), 1-based index and its text (RCL)."""
 
     label: str
     kind: str
     node: str | None = None
     index: int = 0
+    text: str = ""
 
 
 class DeclarationRow(msgspec.Struct, frozen=True):
