@@ -55,7 +55,6 @@ from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, P
 from rclverify.model.plan.standards.field_data import target_items
 from rclverify.model.plan.standards.identity import Person
 from rclverify.model.plan.standards.reviews import independence_of, review_as_stated, review_identity
-from rclverify.records.report_schema import EvidenceJson
 from rclverify.records.standards_rows import About, ClauseStatus, Independence, Recommendation, ScopeKind
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 
@@ -333,7 +332,7 @@ def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], i
     return f"{status}: {done} of {n} in scope covered; {head}{extra}"
 
 
-def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[EvidenceJson],
+def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[Mapping[str, Any]],
                 notes: Mapping[str, Any] | None = None,
                 unstated: Collection[tuple[str, str]] = (), people: Sequence[Person] = ()) -> list[ClauseRow]:
     """The clause rows of ``profile`` at ``level`` (``None`` for a profile
