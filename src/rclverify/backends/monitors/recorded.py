@@ -9,12 +9,13 @@ silence is never green).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces import read_trace
+from rclverify.traces.events import header_stamp_ns
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.deadline_records import DeadlineResult
 from rclverify.backends.monitors.deadline_topics import has_deadlines
@@ -68,19 +69,27 @@ class RecordedRun:
 
 
 def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
-                   on_warning: Callable[[str], None], margins: bool = False) -> RecordedRun:
+                   on_warning: Callable[[str], None], margins: bool = False,
+                   on_verdict: Callable[[str, Any, float | None], None] | None = None) -> RecordedRun:
     """Check the run at path ``trace`` against ``nodes`` under the monitor
     configuration ``cfg`` (:func:`.config.load_mapping`; its message
     directories relative to the workspace ``root``); ``on_warning`` gets
     the reader's warnings; ``margins``: the untimed check also computes the
-    space margins (:func:`.check.check_trace`; the run is then streamed).
+    space margins (:func:`.check.check_trace`; the run is then streamed);
+    ``on_verdict(kind, verdict, stamp)``, when given, receives every verdict
+    of the pass the result is of, once the run is read, in the order decided:
+    ``("guarantee", Verdict)`` for a topic's message, ``("call", Verdict)``
+    for a call's or a goal's message and ``("deadline", DeadlineVerdict)``
+    for a trigger's deadline (a topic's or a call's); ``stamp`` the judged
+    message's header stamp (s; ``None``: it has none, or a deadline's).
     Raises :class:`rclverify.traces.TraceError` for
     a run that cannot be read, and whatever a malformed run makes the
     readers raise (the caller reports either, located)."""
-    one = _pass(checked, nodes, cfg, root, trace, on_warning, None, margins)
+    keep = on_verdict is not None
+    one = _pass(checked, nodes, cfg, root, trace, on_warning, None, margins, keep)
     lag, note, stale = second_read(one.watch, trace, _readable_again(Path(trace)))  # one clock (stamp_order.py)
-    if lag is not None:
-        one = _pass(checked, nodes, cfg, root, trace, on_warning, lag, margins)
+    if lag is not None:  # the first pass's verdicts are dropped with it
+        one = _pass(checked, nodes, cfg, root, trace, on_warning, lag, margins, keep)
         one.note = note
     dmons, pmons, decl, calls, heard, events, results = (one.dmons, one.pmons, one.decl, one.calls, one.heard,
                                                          one.events, one.results)
@@ -103,6 +112,9 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
                        f"in {trace}", decided_of(results, centries))
     if one.bag is not None:  # a bag without a link's call topics: say what it lacks (bag_calls.py)
         one.bag.explain(items)
+    if on_verdict is not None:
+        for kind, v in one.verdicts:
+            on_verdict(kind, v, None if kind == "deadline" else one.stamps.get((v.topic.strip("/"), v.time)))
     return RecordedRun(events, results, dres, pres, decl_res, summary, centries, dentries,
                        calls.missed() if summary is not None else (0, 0), items, one.note, stale)
 
@@ -121,21 +133,31 @@ class _Pass:
     results: list[NodeResult]
     note: str = ""
     bag: BagCalls | None = None
+    #: every verdict decided, ``(kind, verdict)`` (:func:`check_recorded`'s ``on_verdict``); empty unless kept
+    verdicts: list[tuple[str, Any]] = field(default_factory=list)
+    #: (topic, time) -> header stamp (s) of each message read that has one; empty unless verdicts are kept
+    stamps: dict[tuple[str, float], float] = field(default_factory=dict)
 
 
 def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, trace: str,
-          on_warning: Callable[[str], None], lag: float | None, margins: bool = False) -> _Pass:
+          on_warning: Callable[[str], None], lag: float | None, margins: bool = False, keep: bool = False) -> _Pass:
     """One read of the run feeding every monitor; in stamp order when ``lag`` is given
-    (:func:`.stamp_order.in_stamp_order`); each node's constants compared as its fields carry them (widths.py)."""
+    (:func:`.stamp_order.in_stamp_order`); each node's constants compared as its fields carry them (widths.py);
+    ``keep``: every verdict kept in :attr:`_Pass.verdicts`."""
+    kept: list[tuple[str, Any]] = []
+    answer = (lambda v: kept.append(("guarantee", v))) if keep else None
+    deadline = (lambda v: kept.append(("deadline", v))) if keep else None
     dirs = [root / d for d in cfg.msg_dirs]
     judged = [judged_at_widths(checked, n, cfg.rules, dirs) for n in nodes]  # the live monitor's route too
     sources = [(k, s) for _, f in judged for k, s in f.items()]
     nodes = [n for n, _ in judged]
-    dmons = [deadline_monitor(checked, n, cfg.rules, horizon=cfg.horizon, tolerance=cfg.tolerance)
+    dmons = [deadline_monitor(checked, n, cfg.rules, deadline, horizon=cfg.horizon, tolerance=cfg.tolerance)
              for n in nodes if has_deadlines(n)]  # in batch where eligible (batch_deadlines.py)
     pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
     decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes if has_declarations(n)]
     calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
+    if calls.book is not None and keep:
+        calls.book.on_verdict, calls.book.on_deadline = (lambda v: kept.append(("call", v))), deadline
     heard: dict[str, int] = {}
     run: Iterable[Any] = read_trace(Path(trace), [root / d for d in cfg.msg_dirs], streams=True, on_warning=on_warning)
     bag = BagCalls(nodes, calls, trace, bag_connections(Path(trace), dirs)) \
@@ -150,9 +172,21 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     elif calls.active:
         source = calls.tap(source)  # only nodes with links: never the batch path
     watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
+    stamps: dict[tuple[str, float], float] = {}
+    if keep:  # each message's header stamp, what every path shares (the run is then streamed)
+        source = _stamped(source, stamps)
     events, results = check_trace(checked, nodes, Counted(source, heard, watch), cfg.rules, cfg.horizon,
-                                  tolerance=cfg.tolerance, margins=margins)
-    return _Pass(dmons, pmons, decl, calls, heard, watch, events, results, bag=bag)
+                                  answer, tolerance=cfg.tolerance, margins=margins)
+    return _Pass(dmons, pmons, decl, calls, heard, watch, events, results, bag=bag, verdicts=kept, stamps=stamps)
+
+
+def _stamped(events: Iterable[Any], stamps: dict[tuple[str, float], float]) -> Iterator[Any]:
+    """``events`` unchanged, each one's header stamp (s) put in ``stamps`` under its (topic, time)."""
+    for ev in events:
+        ns = header_stamp_ns(ev.fields)
+        if ns is not None:
+            stamps[(ev.topic.strip("/"), ev.time)] = ns / 1e9
+        yield ev
 
 
 class _Tapped:
