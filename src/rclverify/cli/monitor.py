@@ -34,6 +34,7 @@ from rclverify.backends.monitors.judged import explain, strict_line
 from rclverify.backends.monitors.declarations import declaration_status
 from rclverify.backends.monitors.periods import period_status
 from rclverify.backends.monitors.recorded import RecordedRun, check_recorded
+from rclverify.backends.monitors.verdict_lines import log_records, verdict_record, write_records
 from rclverify.core.extras import MissingExtra
 
 
@@ -81,10 +82,13 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     violated = False
     unjudged: list[dict[str, str]] = []
     report: list[Mapping[str, object]] = []
+    records: list[dict[str, Any]] = []  # --verdicts: every verdict, one line each (verdict_lines.py)
     for trace in args.traces:
+        keep = (lambda kind, v, stamp, t=trace: records.append({**verdict_record(kind, v, stamp), "trace": t})) \
+            if getattr(args, "verdicts", None) else None
         try:
             run = check_recorded(checked, nodes, cfg, root, trace, lambda w: print(w, file=sys.stderr),
-                                 margins=args.json)  # the margins (docs/semantics.md) are in the JSON only
+                                 margins=args.json, on_verdict=keep)  # the margins (docs/semantics.md): JSON only
         except TraceError as exc:
             _emit(report, args.json)
             print(str(exc), file=sys.stderr)
@@ -95,6 +99,8 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
             return 2
         unjudged += run.not_judged
         violated = _report_run(report, run, trace, cfg, args.json) or violated
+    if getattr(args, "verdicts", None):
+        write_records(Path(args.verdicts), records)
     _emit(report, args.json)
     return 1 if violated else _strict(args, unjudged, _undecided(report))
 
@@ -285,6 +291,8 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
             print(text if ": error: " in text else f"rclverify monitor --live: error: {text}", file=sys.stderr)
             return 1 if isinstance(exc, MissingExtra) else 2  # a missing extra exits 1 (docs/install.md)
         _print_live(log, record_)
+        if getattr(args, "verdicts", None):  # the log's verdict lines, as a recorded run's are written
+            write_records(Path(args.verdicts), log_records(log))
         return _live_exit(args, record_)
     finally:
         stop.close()  # the stop request's pipe given back (an in-process caller runs many)
