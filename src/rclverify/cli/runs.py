@@ -36,6 +36,8 @@ def add_monitor(add: AddCommand) -> None:
     m.add_argument("--mapping", help="mapping file (default: backends/monitors/mapping.yaml if present)")
     m.add_argument("--horizon", type=seconds, help="seconds an input event may wait for its answer (default 5.0)")
     m.add_argument("--json", action="store_true", help="print the verdicts as JSON")
+    m.add_argument("--verdicts", metavar="FILE", help="write every verdict, one JSON line each (node, item, message "
+                   "topic and time, verdict, reason), recorded or live (docs/monitors.md, \"Verdicts one by one\")")
     m.add_argument("--strict", action="store_true",
                    help="exit 1 also when a node, topic, service, action or deadline of the contracts was not "
                         "judged (nothing heard, not decoded, ...; docs/monitors.md, \"Silence is never green\")")
