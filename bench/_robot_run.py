@@ -1,18 +1,21 @@
 """The runner of bench/robot_generator.py: one generated robot run live and judged three ways.
 
 For one seed: the workspace is written, ``rclverify monitor --live --ros2 --source dds`` (or
-``--source rclpy --ros2-python`` the robot's Python) starts with ``--log`` and ``--record`` (a ROS 2
-bag, MCAP), then the robot (one process of rclpy nodes, ROS 2's
+``--source rclpy --ros2-python`` the robot's Python) starts with ``--log``, ``--record`` (a ROS 2
+bag, MCAP) and ``--verdicts``, then the robot (one process of rclpy nodes, ROS 2's
 Python); after its sensing it says ``done`` and both are stopped.  The log and the bag are then
-checked offline (``rclverify monitor --json``), and per node the verdicts are counted three ways:
-live (the log's ``rclverify/verdict`` lines), offline on the log, offline on the bag:
+checked offline (``rclverify monitor --json --verdicts``), and the three paths' verdicts are compared
+verdict by verdict (bench/_robot_verdicts.py): each message's final verdict live against its verdict
+offline on the log and on the bag, identified by node, item (guarantee, call, deadline), topic and
+header stamp (else source time); a verdict that differs, or that one path gave and another did not,
+is a disagreement, named with both sides' verdicts and reasons (a live verdict still provisional
+apart).  On a correct robot any final ``violated`` answer or ``false`` deadline, on any path, is
+false (the node is correct by construction); on a robot with one seeded defect the defect's node
+must be red live and every other node not.  Per node the live final verdicts are counted:
 
 * ``satisfied`` / ``violated`` / ``undecided`` (inconclusive, incomplete input, open) answers of the
-  topic guarantees and of the calls, and ``true`` / ``false`` deadlines;
-
-a difference between live and either offline count is a disagreement.  On a correct robot any
-``violated`` answer or ``false`` deadline is false (the node is correct by construction); on a robot
-with one seeded defect the defect's node must be violated and every other node not.
+  topic guarantees and of the calls, and ``true`` / ``false`` deadlines; an endpoint the run could
+  not judge (the rclpy source without introspection) is ``undecided`` and ``unjudged``.
 
 Everything on loopback (Cyclone's loopback configuration for the monitor,
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` for the nodes), a random ``ROS_DOMAIN_ID``, every
@@ -38,9 +41,8 @@ sys.path.insert(0, str(ROOT / "bench"))
 from _live import stop, wait_text  # noqa: E402
 from monitor_live_dds import CONFIG  # noqa: E402
 from robot_generator import SENSORS, generate, write_workspace  # noqa: E402
+from _robot_verdicts import UNDECIDED, false_verdicts, read_records, tally, three_way  # noqa: E402
 
-KINDS = ("satisfied", "violated", "undecided", "deadline true", "deadline false")
-UNDECIDED = ("inconclusive", "incomplete input", "open")
 SOURCES = ("dds", "rclpy")
 
 
@@ -57,98 +59,59 @@ def ros2_python() -> tuple[Path | None, str]:
     return exe, ""
 
 
-def live_counts(log: Path, links: dict[str, str] | None = None) -> dict[str, Counter[str]]:
-    """Per node, the live verdicts the log's ``rclverify/verdict`` lines carry (the latest verdict of
-    each message: a revision replaces the one given before, backends/monitors/late.py; a deadline's
-    ``update`` line replaces its first verdict), and, ``links``
-    naming each service's and action's node (RCL name -> node), each endpoint the run said it could
-    not judge (a ``rclverify/call`` line of part ``unjudged``: the rclpy source without introspection)
-    as ``undecided`` and ``unjudged``, as the offline check counts it."""
-    out: dict[str, Counter[str]] = {}
-    answers: dict[tuple[str, object, bool], str] = {}  # (node, message, a call) -> its latest verdict
+def unjudged(log: Path, links: dict[str, str]) -> Counter[str]:
+    """Per node (``links``: each service's and action's RCL name -> its node), the endpoints the live
+    run said it could not judge: its log's ``rclverify/call`` lines of part ``unjudged`` (the rclpy
+    source without introspection; docs/ros2.md)."""
+    out = Counter[str]()
     for line in log.read_text(errors="replace").splitlines():
+        if '"unjudged"' not in line:
+            continue
         try:
             rec = json.loads(line)
         except ValueError:
             continue
-        if rec.get("topic") == "rclverify/call" and rec.get("part") == "unjudged" and str(rec.get("link")) in (links or {}):
-            c = out.setdefault((links or {})[str(rec["link"])], Counter())
-            c["undecided"] += 1
-            c["unjudged"] += 1
-            continue
-        if rec.get("topic") != "rclverify/verdict" or not isinstance(rec.get("verdict"), dict):
-            continue
-        v = rec["verdict"]
-        c = out.setdefault(str(v.get("node")), Counter())
-        if rec.get("kind") == "deadline":
-            if v.get("update"):  # a late answer stamped in time: the false already counted is withdrawn
-                c["deadline updates"] += 1
-                c["deadline false"] -= 1
-                c[f"deadline {v['verdict']}"] += 1
-            else:
-                c[f"deadline {v['verdict']}"] += 1
-        else:
-            verdict = str(v.get("verdict"))
-            key = (str(v.get("node")), v.get("event"), bool(v.get("call")))
-            before = answers.get(key)
-            if before is not None:  # a revision (a question heard late): the verdict given before is withdrawn
-                c["undecided" if before in UNDECIDED else before] -= 1
-                c["answer revisions"] += 1
-            answers[key] = verdict
-            c["undecided" if verdict in UNDECIDED else verdict] += 1
-            if verdict in UNDECIDED:
-                WHY.setdefault(str(v.get("node")), []).append(f"{verdict}: {v.get('reason') or '(no reason given)'}")
+        if rec.get("topic") == "rclverify/call" and rec.get("part") == "unjudged" and str(rec.get("link")) in links:
+            out[links[str(rec["link"])]] += 1
     return out
 
 
-#: the reason of each live undecided verdict, per node, of the last log read by :func:`live_counts`
-WHY: dict[str, list[str]] = {}
-
-
 def offline_counts(rows: list[dict[str, Any]]) -> dict[str, Counter[str]]:
-    """Per node, the verdict counts of ``rclverify monitor --json`` (topic answers, calls, deadlines)."""
+    """Per node, what ``rclverify monitor --json`` says that no verdict line carries: the deadlines given
+    no verdict, with why (``deadline undecided``: an answer within the transport skew before its trigger,
+    a call's deadline not yet due), and each declaration's and period's row by its status
+    (``declarations <status>``)."""
     out: dict[str, Counter[str]] = {}
     for r in rows:
         c = out.setdefault(str(r["node"]), Counter())
-        for key in ("counts",):
-            if key in r:
-                _answers(c, r[key])
-        if "calls" in r:
-            _answers(c, r["calls"]["counts"])
         for key in ("deadlines", "call_deadlines"):
             if key in r:
-                c["deadline true"] += r[key]["counts"].get("true", 0)
-                c["deadline false"] += r[key]["counts"].get("false", 0) + r[key]["counts"].get("currently_false", 0)
-                # no verdict, with why (an answer within the transport skew before its trigger; a call's
-                # deadline not yet due): no live line says it, so it is counted offline only
                 c["deadline undecided"] += (r[key].get("unaccepted") or {}).get("undecided", 0)
                 first = r[key].get("first_unaccepted") or {}
                 if first.get("why") == "undecided":
                     c["deadline undecided why: " + str(first.get("reason"))] += 0
+        if "declarations" in r or "periods" in r:
+            c[f"declarations {r['status']}"] += 1
     return out
 
 
-def _answers(c: Counter[str], counts: dict[str, int]) -> None:
-    c["satisfied"] += counts.get("satisfied", 0)
-    c["violated"] += counts.get("violated", 0)
-    c["undecided"] += sum(counts.get(k, 0) for k in UNDECIDED)
-
-
-def _offline(ws: Path, traces: list[str], env: dict[str, str]) -> list[tuple[list[dict[str, Any]], str]]:
-    """``rclverify monitor --json TRACE`` on each trace, the checks run side by side: per trace the rows
-    and ``""``, or what went wrong."""
-    procs = [subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(ws), "--mapping",
-                               "mapping.yaml", "--horizon", "1.0", "--json", t], cwd=ws, env=env,
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for t in traces]
-    out: list[tuple[list[dict[str, Any]], str]] = []
-    for p in procs:
+def _offline(ws: Path, traces: dict[str, str], env: dict[str, str]) -> dict[str, tuple[list[dict[str, Any]], str]]:
+    """``rclverify monitor --json --verdicts runs/NAME.verdicts.jsonl TRACE`` on each trace of ``traces``
+    (name -> path), the checks run side by side: per name the rows and ``""``, or what went wrong."""
+    procs = {name: subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(ws),
+                                     "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "--verdicts",
+                                     f"runs/{name}.verdicts.jsonl", t], cwd=ws, env=env,
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for name, t in traces.items()}
+    out: dict[str, tuple[list[dict[str, Any]], str]] = {}
+    for name, p in procs.items():
         stdout, stderr = p.communicate(timeout=300)
         try:
             rows = json.loads(stdout)
         except ValueError:
-            out.append(([], f"exit {p.returncode}: {(stdout + stderr)[-1500:]}"))
+            out[name] = ([], f"exit {p.returncode}: {(stdout + stderr)[-1500:]}")
             continue
-        out.append((rows, f"exit {p.returncode}: {stderr[-1500:]}" if p.returncode not in (0, 1) else ""))
+        out[name] = (rows, f"exit {p.returncode}: {stderr[-1500:]}" if p.returncode not in (0, 1) else "")
     return out
 
 
@@ -202,7 +165,8 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
         mon = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2",
                                 "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--status", "0",
                                 "--silence", "0", *_source_args(source, ros2), "--interfaces", "interfaces", "--log", "runs/live.jsonl",
-                                "--evidence", str(tmp / "evidence.json"), "--record", "runs/bag", "--record-storage", "mcap"],
+                                "--evidence", str(tmp / "evidence.json"), "--record", "runs/bag", "--record-storage", "mcap",
+                                "--verdicts", "runs/live.verdicts.jsonl"],
                                cwd=ws, env=menv, stdout=(tmp / "monitor.out").open("wb"), stderr=subprocess.STDOUT,
                                start_new_session=True)
         procs.append(mon)
@@ -234,14 +198,28 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
         res["other_clocks"] = json.loads((tmp / "evidence.json").read_text()).get("other_clocks", [])
     except (OSError, ValueError):
         res["other_clocks"] = []
-    WHY.clear()
-    res["live"] = live_counts(ws / "runs" / "live.jsonl", {n["rcl_topic"]: n["name"] for n in spec["nodes"]
-                                                           if n["kind"] in ("service", "action")})
-    res["undecided_why"] = {k: sorted(set(v)) for k, v in WHY.items()}
-    for name, (rows, err) in zip(("log", "bag"), _offline(ws, ["runs/live.jsonl", "runs/bag"], menv)):
+    runs = ws / "runs"
+    links = {n["rcl_topic"]: n["name"] for n in spec["nodes"] if n["kind"] in ("service", "action")}
+    paths = {"live": read_records(runs / "live.verdicts.jsonl")}
+    if not (runs / "live.verdicts.jsonl").exists():
+        res["errors"].append("live: the monitor wrote no --verdicts file")
+    for name, (rows, err) in _offline(ws, {"log": "runs/live.jsonl", "bag": "runs/bag"}, menv).items():
         if err:
             res["errors"].append(f"offline {name}: {err}")
         res[name] = offline_counts(rows)
+        paths[name] = read_records(runs / f"{name}.verdicts.jsonl")
+    res["finals"], lines = three_way(paths)
+    res["disagreements"] = [x for x in lines if not x.startswith("provisional: ")]
+    res["provisional"] = [x for x in lines if x.startswith("provisional: ")]
+    res["live"] = tally(res["finals"]["live"])
+    for node, n in unjudged(runs / "live.jsonl", links).items():
+        res["live"].setdefault(node, Counter()).update({"undecided": n, "unjudged": n})
+    res["undecided_why"] = {}
+    for (node, _, _, _), rs in res["finals"]["live"].items():
+        for r in rs:
+            if r["verdict"] in UNDECIDED:
+                res["undecided_why"].setdefault(node, set()).add(f"{r['verdict']}: {r['reason'] or '(no reason given)'}")
+    res["undecided_why"] = {k: sorted(v) for k, v in res["undecided_why"].items()}
     res["findings"] = findings(res)
     res["explained"] = explain(ws, res)
     return res
@@ -287,29 +265,32 @@ def _stamp(rec: dict[str, Any]) -> float:
 
 
 def findings(res: dict[str, Any]) -> list[str]:
-    """What is wrong in one run: live against log and bag, false reds, a defect not red at its node."""
-    out: list[str] = []
+    """What is wrong in one run: each verdict live and offline disagree on (final verdicts), each final
+    false verdict of a correct node on any path, a node judged nothing live, a defect not red at its node."""
+    out = list(res["disagreements"])
     names = [n["name"] for n in res["spec"]["nodes"]]
     victim = next((n["name"] for n in res["spec"]["nodes"] if n.get("defect")), None)
+    correct = {n for n in names if n != victim}
+    for path, f in res["finals"].items():
+        wrong = Counter(f"{r['node']}: {'deadline false' if r['item'] == 'deadline' else r['item'] + ' violated'}"
+                        for r in false_verdicts(f, correct))
+        out += [f"{k} x{n} {path} (false: the node is correct)" for k, n in sorted(wrong.items())]
     for node in names:
         live = res["live"].get(node, Counter())
-        for other in ("log", "bag"):
-            off = res[other].get(node, Counter())
-            diff = {k: (live.get(k, 0), off.get(k, 0)) for k in KINDS if live.get(k, 0) != off.get(k, 0)}
-            if diff:
-                out.append(f"{node}: live != {other}: " + ", ".join(f"{k} {a} live, {b} {other}"
-                                                                    for k, (a, b) in diff.items()))
         judged = live.get("satisfied", 0) + live.get("violated", 0)
         if judged == 0 and not live.get("unjudged"):  # an unjudged endpoint is said, as docs/ros2.md promises
             out.append(f"{node}: nothing judged live")
-        if node == victim:
-            if live.get("violated", 0) + live.get("deadline false", 0) == 0:
-                out.append(f"{node}: seeded defect not red live")
-        elif live.get("violated", 0):
-            out.append(f"{node}: {live['violated']} violated (false: the node is correct)")
-        elif live.get("deadline false", 0) and node != victim:
-            out.append(f"{node}: {live['deadline false']} false deadline(s) (false: the node answers in time)")
+        if node == victim and live.get("violated", 0) + live.get("deadline false", 0) == 0:
+            out.append(f"{node}: seeded defect not red live")
     return out
+
+
+def _declarations(res: dict[str, Any]) -> str:
+    """The declaration and period rows of the offline check of the log, by status (``0``: none)."""
+    c = Counter[str]()
+    for node in res.get("log", {}).values():
+        c.update({k.split(" ", 1)[1]: n for k, n in node.items() if k.startswith("declarations ")})
+    return ", ".join(f"{n} {k}" for k, n in sorted(c.items())) or "0"
 
 
 def _line(res: dict[str, Any]) -> str:
@@ -325,12 +306,16 @@ def _line(res: dict[str, Any]) -> str:
                                                else "wall clock") + ": live satisfied "
             f"{tot['satisfied']}, violated {tot['violated']}, undecided {tot['undecided']}, deadlines true "
             f"{tot['deadline true']} false {tot['deadline false']}"
-            + (f" ({tot['deadline updates']} false withdrawn by a late answer stamped in time)"
-               if tot["deadline updates"] else "")
             + (f", undecided {sum(undecided.values())} (log: " + ", ".join(f"{n} {k}" for n, k in undecided.items())
-               + ")" if undecided else "") + "; "
+               + ")" if undecided else "")
+            + f", declarations {_declarations(res)}; verdicts compared: " + ", ".join(
+                f"{k} {sum(len(x) for x in f.values())}" for k, f in res["finals"].items())
+            + f", {len(res['disagreements'])} disagreement(s)"
+            + (f", {len(res['provisional'])} on a provisional verdict" if res["provisional"] else "")
+            + (f", {tot['provisional']} live verdict(s) left provisional" if tot["provisional"] else "") + "; "
             f"{'agree' if not res['findings'] else 'FINDINGS: ' + '; '.join(res['findings'])}"
             + ("; " + "; ".join(res["errors"]) if res["errors"] else "")
+            + "".join(f"\n  {x}" for x in res["provisional"])
             + "".join(f"\n  other clock: {c}" for c in res.get("other_clocks", []))
             + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items())
             + "".join(f"\n  deadline undecided (first, log): {w}" for w in why)
@@ -354,7 +339,9 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
     total = Counter[str]()
     undecided = 0  # deadlines given no verdict, counted offline on the logs
     failing: list[int] = []
-    agree = 0
+    agree, compared, disagreements, provisional = 0, Counter[str](), 0, 0
+    declarations = Counter[str]()
+    loads: list[float] = []
     try:
         for seed in seeds:
             n = random.Random(seed).randint(*sizes)
@@ -375,9 +362,15 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             for c in res["live"].values():
                 total.update(c)
             undecided += sum(c["deadline undecided"] for c in res["log"].values())
+            for c in res["log"].values():
+                declarations.update({k: n for k, n in c.items() if k.startswith("declarations ")})
+            compared.update({k: sum(len(x) for x in f.values()) for k, f in res["finals"].items()})
+            disagreements += len(res["disagreements"])
+            provisional += len(res["provisional"])
+            loads.append(os.getloadavg()[0])
             if res["findings"] or res["errors"]:
                 failing.append(seed)
-            agree += not any(" != " in f for f in res["findings"]) and not res["errors"]
+            agree += not res["disagreements"] and not res["errors"]
     finally:
         if burner is not None:
             stop(burner, signal.SIGKILL)
@@ -385,5 +378,9 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           f"{'one CPU burner beside, ' if burn else ''}load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} "
           f"core(s): live satisfied {total['satisfied']}, violated {total['violated']}, undecided "
           f"{total['undecided']}, deadlines true {total['deadline true']} false {total['deadline false']} "
-          f"(undecided on the logs: {undecided}); seeds with findings: {failing or 'none'}; live = log = bag on {agree} of {len(seeds)}")
+          f"(undecided on the logs: {undecided}); declarations: {sum(declarations.values())} "
+          f"{dict(declarations) or ''}; verdicts compared: live {compared['live']}, log {compared['log']}, bag "
+          f"{compared['bag']}; disagreements {disagreements} (and {provisional} on a verdict still provisional); "
+          f"load average after each run {min(loads, default=0):.1f}-{max(loads, default=0):.1f}; seeds with "
+          f"findings: {failing or 'none'}; live = log = bag verdict by verdict on {agree} of {len(seeds)}")
     return 0

@@ -1,0 +1,142 @@
+"""Live = log = bag, verdict by verdict: the comparison of bench/_robot_run.py.
+
+Each path's verdicts are the records ``rclverify monitor --verdicts FILE`` writes
+(src/rclverify/backends/monitors/verdict_lines.py): the live run's (its log's
+verdict lines), and the offline checks' of its log and of its bag.  A verdict is
+identified by what every path shares: its node, its item (``guarantee``,
+``call``, ``deadline``), the message it judges (topic and event time: the header
+stamp, else the source time; a deadline's trigger stamp and guarantee), never
+by where it sits in the run (a log's line, a bag's index differ).
+
+Per path, the **final** verdict of each message is its last record (a live
+revision, a question heard late, replaces the verdict given before; a
+deadline's ``update`` line, a late answer, replaces its first verdict).  A
+live verdict still ``provisional`` at the end is not final: it is compared,
+and a difference is reported apart (``provisional``), never as a final
+disagreement.  Two paths **disagree** on a message when their final verdicts
+differ or one gave a verdict and the other none; each disagreement names both
+sides' verdicts and reasons.
+"""
+from __future__ import annotations
+
+import json
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable
+
+#: two paths' times of one message differ by float rounding only (a bag's integer nanoseconds, a log's
+#: decimal text); messages of one topic are at least a sensor period (150 ms) apart
+TOL_S = 1e-5
+UNDECIDED = ("inconclusive", "incomplete input", "open")
+Bucket = tuple[str, str, str, int]  # node, item, topic, guarantee (a deadline's)
+
+
+def read_records(path: Path) -> list[dict[str, Any]]:
+    """The records of a ``--verdicts`` file (one JSON object a line); ``[]`` when there is none."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError:
+        return []
+    return [json.loads(line) for line in text.splitlines() if line.strip()]
+
+
+def finals(records: Iterable[dict[str, Any]]) -> dict[Bucket, list[dict[str, Any]]]:
+    """Per (node, item, topic, guarantee), each message's final record, by time: the last record of
+    each message (equal time: one path gives one message one event time) stands."""
+    last: dict[tuple[Bucket, float], dict[str, Any]] = {}
+    for r in records:
+        b: Bucket = (r["node"], r["item"], r["topic"], int(r.get("guarantee", 0)) if r["item"] == "deadline" else 0)
+        last[(b, float(r["time"]))] = r
+    out: dict[Bucket, list[dict[str, Any]]] = {}
+    for (b, _), r in last.items():
+        out.setdefault(b, []).append(r)
+    for rs in out.values():
+        rs.sort(key=lambda r: float(r["time"]))
+    return out
+
+
+@dataclass(frozen=True)
+class Disagreement:
+    """One message the two paths judged differently: ``a``/``b`` each side's record (``None``: no verdict)."""
+
+    node: str
+    item: str
+    topic: str
+    time: float
+    a: dict[str, Any] | None
+    b: dict[str, Any] | None
+
+    @property
+    def provisional(self) -> bool:
+        """Whether a side's verdict is provisional (not final: reported apart)."""
+        return any(r is not None and r.get("provisional") for r in (self.a, self.b))
+
+    def text(self, names: tuple[str, str]) -> str:
+        def side(name: str, r: dict[str, Any] | None) -> str:
+            if r is None:
+                return f"{name}: no verdict"
+            return (f"{name}: {r['verdict']}" + (" (provisional)" if r.get("provisional") else "")
+                    + (f" ({r['reason']})" if r.get("reason") else ""))
+        what = f"deadline {self.topic or 'of the trigger'}" if self.item == "deadline" else f"{self.item} {self.topic}"
+        return f"{self.node}: {what} at {self.time:.6f}: {side(names[0], self.a)}; {side(names[1], self.b)}"
+
+
+def compare(a: dict[Bucket, list[dict[str, Any]]], b: dict[Bucket, list[dict[str, Any]]]) -> list[Disagreement]:
+    """The messages on which the final verdicts ``a`` and ``b`` (:func:`finals`) differ, in time order."""
+    out: list[Disagreement] = []
+    for bucket in sorted(set(a) | set(b)):
+        xs, ys = a.get(bucket, []), b.get(bucket, [])
+        i = j = 0
+        while i < len(xs) or j < len(ys):
+            tx = float(xs[i]["time"]) if i < len(xs) else float("inf")
+            ty = float(ys[j]["time"]) if j < len(ys) else float("inf")
+            x = y = None
+            if abs(tx - ty) <= TOL_S:
+                x, y = xs[i], ys[j]
+                i, j = i + 1, j + 1
+                if x["verdict"] == y["verdict"]:
+                    continue
+            elif tx < ty:
+                x, i = xs[i], i + 1
+            else:
+                y, j = ys[j], j + 1
+            topic = bucket[2] if bucket[1] != "deadline" else f"(guarantee {bucket[3]})"
+            out.append(Disagreement(bucket[0], bucket[1], topic, min(tx, ty), x, y))
+    return sorted(out, key=lambda d: (d.time, d.node))
+
+
+def tally(f: dict[Bucket, list[dict[str, Any]]]) -> dict[str, Counter[str]]:
+    """Per node, its final verdicts counted: ``satisfied``, ``violated``, ``undecided`` (inconclusive,
+    incomplete input, open) answers of topics and calls, other question verdicts by name, ``deadline
+    <verdict>``, and ``provisional`` (final verdicts still provisional)."""
+    out: dict[str, Counter[str]] = {}
+    for (node, item, _, _), rs in f.items():
+        c = out.setdefault(node, Counter())
+        for r in rs:
+            v = r["verdict"]
+            c[f"deadline {v}" if item == "deadline" else ("undecided" if v in UNDECIDED else v)] += 1
+            c["provisional"] += bool(r.get("provisional"))
+            if item == "call":
+                c["call " + ("undecided" if v in UNDECIDED else v)] += 1
+    return out
+
+
+def false_verdicts(f: dict[Bucket, list[dict[str, Any]]], correct: set[str]) -> list[dict[str, Any]]:
+    """The final, not provisional, ``violated`` answers and ``false`` deadlines of the nodes ``correct``."""
+    return [r for (node, item, _, _), rs in f.items() if node in correct for r in rs
+            if not r.get("provisional") and r["verdict"] in ("violated", "false")]
+
+
+def three_way(paths: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, Any], list[str]]:
+    """``paths`` ``{"live", "log", "bag"}`` -> records: the finals of each and the lines of every
+    disagreement of live with log and with bag (a provisional one marked so)."""
+    f = {name: finals(rs) for name, rs in paths.items()}
+    lines: list[str] = []
+    for other in ("log", "bag"):
+        for d in compare(f["live"], f[other]):
+            lines.append(("provisional: " if d.provisional else "") + f"live != {other}: " + d.text(("live", other)))
+    return f, lines
+
+
+__all__ = ["Disagreement", "compare", "false_verdicts", "finals", "read_records", "tally", "three_way"]

@@ -1,0 +1,148 @@
+"""Live = log = bag, verdict by verdict (issue 106): the comparison of the robot generator's runner
+(bench/_robot_verdicts.py) and the records it compares (``rclverify monitor --verdicts``,
+backends/monitors/verdict_lines.py).
+
+A hand-made live log: a relay copying each reading's header stamp onto an answer published 120 ms
+later (a reading every 300 ms), its verdict lines the ones the online engine gives when fed the
+messages in the order they reached the monitor, written as the live monitor writes them.  The
+recorded path (``rclverify monitor --verdicts FILE LOG``) judges the same log's messages; its records
+and the log's verdict lines are the same, message by message, identified by topic and header stamp
+(the answers' event time in the log is their copied stamp; a bag's would be its receipt).  The
+controls: one verdict line changed is found, named with both sides' verdicts and reasons, and one
+verdict line left out is found as a verdict the live run did not give.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
+from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.backends.monitors.verdict_lines import VERDICT_TOPIC, log_records, verdict_record
+from rclverify.cli.commands import main
+from rclverify.lang.typecheck import load
+from test_judge_event_time import _msg, _workspace
+from test_judge_writers import COPY, COPY_MAPPING
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+from _robot_verdicts import compare, finals, tally, three_way  # noqa: E402
+
+PERIOD, DELAY, N = 0.3, 0.12, 8
+
+
+def _sent() -> list[dict[str, Any]]:
+    """Readings 1.0, 1.5 ... every 300 ms from 1 s, each copied 120 ms later onto an answer with its stamp."""
+    out = []
+    for i in range(N):
+        t = 1.0 + i * PERIOD
+        out.append(_msg("x", t, t, value=float(i) + 0.5))
+        out.append(_msg("r", t + DELAY, t, range=float(i) + 0.5))
+    return out
+
+
+def _live_log(ws: Path) -> list[dict[str, Any]]:
+    """The log the live monitor writes of ``_sent()`` heard 1 ms after publication: each message at its
+    event time (its header stamp), each verdict as the online engine and the deadline monitor gave it."""
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    lines: list[dict[str, Any]] = []
+    deadline = lambda v: lines.append({"topic": VERDICT_TOPIC, "time": v.trigger_stamp, "kind": "deadline",  # noqa: E731
+                                       "verdict": v.to_json()})
+    dm = DeadlineMonitor(checked, checked.nodes["Relay"], rules, deadline, horizon=1.0)
+
+    def released(ev: Any) -> None:
+        lines.append({"topic": ev.topic, "time": ev.time, **dict(ev.fields)})
+        dm.feed(ev)
+    eng = OnlineEngine(checked, [checked.nodes["Relay"]], rules, 1.0, reorder_window=0.05,
+                       on_verdict=lambda v: lines.append({"topic": VERDICT_TOPIC, "time": v.decided_at,
+                                                          "verdict": v.to_json()}), on_event=released)
+    now = 1.0
+    for k, m in enumerate(sorted(_sent(), key=lambda m: m["time"])):
+        while now + 0.01 <= m["time"] + 0.001:
+            now += 0.01
+            eng.tick(now)
+            dm.advance(eng.watermark(now))
+        eng.push(m["topic"], {x: v for x, v in m.items() if x not in ("topic", "time")}, m["time"], f"heard {k}")
+    eng.finish()
+    dm.finish()
+    return lines
+
+
+def _offline(ws: Path, log: Path, capsys: pytest.CaptureFixture[str]) -> list[dict[str, Any]]:
+    out = ws / "offline.verdicts.jsonl"
+    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "--verdicts", str(out),
+          str(log)])
+    capsys.readouterr()
+    return [json.loads(x) for x in out.read_text().splitlines()]
+
+
+@pytest.fixture()
+def run(tmp_path: Path) -> tuple[Path, Path]:
+    ws, _ = _workspace(tmp_path, COPY, [], COPY_MAPPING)
+    log = ws / "live.jsonl"
+    log.write_text("".join(json.dumps(x) + "\n" for x in _live_log(ws)))
+    return ws, log
+
+
+def test_the_live_verdicts_of_a_log_are_its_offline_verdicts_one_by_one(
+        run: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    ws, log = run
+    live, offline = log_records(log), _offline(ws, log, capsys)
+    f = finals(live)
+    # each answer satisfied, each reading's deadline met, every message identified by its header stamp
+    assert tally(f)["Relay"]["satisfied"] == N and tally(f)["Relay"]["deadline true"] == N
+    assert sorted(r["time"] for r in f[("Relay", "guarantee", "r", 0)]) == pytest.approx(
+        [1.0 + i * PERIOD for i in range(N)])
+    assert compare(f, finals(offline)) == []
+    assert three_way({"live": live, "log": offline, "bag": offline})[1] == []
+
+
+def test_the_control_one_changed_verdict_is_found_with_both_sides(
+        run: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    ws, log = run
+    offline = _offline(ws, log, capsys)
+    lines = [json.loads(x) for x in log.read_text().splitlines()]
+    fourth = [x for x in lines if x["topic"] == VERDICT_TOPIC and "kind" not in x][3]
+    fourth["verdict"].update(verdict="violated", reason="out.r == in.x is false")
+    log.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    found = compare(finals(log_records(log)), finals(offline))
+    assert len(found) == 1, found
+    d = found[0]
+    assert (d.node, d.item, d.topic) == ("Relay", "guarantee", "r") and d.time == pytest.approx(1.0 + 3 * PERIOD)
+    assert d.a is not None and d.b is not None and (d.a["verdict"], d.b["verdict"]) == ("violated", "satisfied")
+    assert "live: violated (out.r == in.x is false); log: satisfied" in d.text(("live", "log"))
+
+
+def test_the_control_a_verdict_one_path_did_not_give_is_found(
+        run: tuple[Path, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    ws, log = run
+    offline = _offline(ws, log, capsys)
+    lines = [json.loads(x) for x in log.read_text().splitlines()]
+    dropped = [x for x in lines if x.get("kind") == "deadline"][2]
+    log.write_text("".join(json.dumps(x) + "\n" for x in lines if x is not dropped))
+    found = compare(finals(log_records(log)), finals(offline))
+    assert [(d.item, d.a, d.b is not None and d.b["verdict"]) for d in found] == [("deadline", None, "true")]
+    assert found[0].time == pytest.approx(1.0 + 2 * PERIOD)
+
+
+def _rec(verdict: str, time: float, **more: Any) -> dict[str, Any]:
+    return verdict_record("guarantee", {"node": "N", "topic": "t", "time": time, "verdict": verdict, **more})
+
+
+def test_a_revision_replaces_the_verdict_given_before_and_a_provisional_one_is_told_apart() -> None:
+    """The last verdict of a message stands (a live revision); a verdict still provisional at the end is
+    marked so when it differs; times a float's rounding apart are one message, a period apart two."""
+    live = [_rec("inconclusive", 1.0), _rec("satisfied", 1.0), _rec("satisfied", 1.3, provisional=True)]
+    offline = [_rec("satisfied", 1.0 + 4e-9), _rec("violated", 1.3 + 4e-9)]
+    found = compare(finals(live), finals(offline))
+    assert [(d.time, d.provisional) for d in found] == [(pytest.approx(1.3), True)]
+    # the control: the revision left out, the first verdict differs and is found, not provisional
+    found = compare(finals(live[:1] + live[2:]), finals(offline))
+    assert [(round(d.time, 6), d.provisional) for d in found] == [(1.0, False), (1.3, True)]
+    # a message 2 ms off is another message: each side's verdict has no counterpart
+    assert len(compare(finals([_rec("satisfied", 1.0)]), finals([_rec("satisfied", 1.002)]))) == 2
