@@ -39,6 +39,7 @@ from typing import Any, Iterable, Mapping, MutableMapping
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, error
 from rclverify.lang.types import Checked
+from rclverify.model.plan.document import PlanDocument
 from rclverify.model.plan.errors import plan_error
 from rclverify.lang.printer import to_rcl, expr_to_rcl
 
@@ -89,8 +90,8 @@ def health_node(warning: str) -> str | None:
     return m["node"] if m else None
 
 
-def read_acknowledgements(data: Mapping[str, Any], locs: Mapping[Any, ast.Loc], plan_rel: str) -> tuple[Acknowledgement, ...]:
-    """The plan's ``acknowledged:`` entries (schema-checked: each has
+def read_acknowledgements(doc: PlanDocument, locs: Mapping[Any, ast.Loc], plan_rel: str) -> tuple[Acknowledgement, ...]:
+    """The plan's ``acknowledged:`` entries (``doc``: the plan's typed sections; each has
     ``warning`` and ``reason``).  Raises :class:`~.errors.PlanError`, located
     at the entry, for an entry that gives neither or both of ``text`` and
     ``sha256``, a lint code without ``file:`` (it would answer the same
@@ -99,30 +100,29 @@ def read_acknowledgements(data: Mapping[str, Any], locs: Mapping[Any, ast.Loc], 
     letters: ``reason: "..."`` says nothing a reviewer can weigh).  Rule:
     docs/plan.md, "Acknowledged warnings"."""
     out = []
-    for i, a in enumerate(data.get("acknowledged") or ()):
+    for i, a in enumerate(doc.acknowledged):
         at = locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1))
-        if ("text" in a) == ("sha256" in a):
-            raise plan_error(plan_rel, at.line, at.col, f"acknowledged[{i}] ({a['warning']}): give the flagged text "
+        if (a.text is None) == (a.sha256 is None):
+            raise plan_error(plan_rel, at.line, at.col, f"acknowledged[{i}] ({a.warning}): give the flagged text "
                              "it accepts as text: or its digest as sha256: (one of the two; the report shows both "
                              "for every warning)", "E-acknowledged")
-        if len(re.findall(r"[A-Za-z]{2,}", str(a["reason"]))) < 3:
+        if len(re.findall(r"[A-Za-z]{2,}", a.reason)) < 3:
             r = locs.get(("acknowledged", i, "reason"), at)
-            raise plan_error(plan_rel, r.line, r.col, f"acknowledged[{i}] ({a['warning']}): the reason must say why "
-                             f"the warning is accepted, in words a reviewer can weigh, not {a['reason']!r}",
+            raise plan_error(plan_rel, r.line, r.col, f"acknowledged[{i}] ({a.warning}): the reason must say why "
+                             f"the warning is accepted, in words a reviewer can weigh, not {a.reason!r}",
                              "E-acknowledged")
-        owner = health_node(str(a["warning"]))
-        if owner is None and "file" not in a:
-            raise plan_error(plan_rel, at.line, at.col, f"acknowledged[{i}] ({a['warning']}): a lint code is raised "
+        owner = health_node(a.warning)
+        if owner is None and a.file is None:
+            raise plan_error(plan_rel, at.line, at.col, f"acknowledged[{i}] ({a.warning}): a lint code is raised "
                              "wherever the same text is written, so this would answer it in every file; give the "
                              "contract file of the one warning it answers as file: (and node: when that file holds "
                              "more than one node)", "E-acknowledged")
-        if owner is not None and a.get("node", owner) != owner:
+        if owner is not None and a.node is not None and a.node != owner:
             n = locs.get(("acknowledged", i, "node"), at)
-            raise plan_error(plan_rel, n.line, n.col, f"acknowledged[{i}] ({a['warning']}): node: {a['node']} is not "
+            raise plan_error(plan_rel, n.line, n.col, f"acknowledged[{i}] ({a.warning}): node: {a.node} is not "
                              f"the node the finding's id names ({owner})", "E-acknowledged")
-        out.append(Acknowledgement(str(a["warning"]), normal(a["reason"]),
-                                   locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1)),
-                                   a.get("text"), a.get("sha256"), a.get("file"), a.get("node")))
+        out.append(Acknowledgement(a.warning, normal(a.reason), locs.get(("acknowledged", i), ast.Loc(plan_rel, 1, 1)),
+                                   a.text, a.sha256, a.file, a.node))
     return tuple(out)
 
 

@@ -15,12 +15,13 @@ import difflib
 import json
 from importlib import resources
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import yaml
 
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
+from rclverify.model.plan.document import EnvironmentEntry, PlanDocument, RequirementEntry, plan_document
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.formal import Source
 from rclverify.model.plan.targets import requirement_target
@@ -37,7 +38,7 @@ from rclverify.model.plan.standards.choice import read_standards
 from rclverify.model.plan.instances import Instance, read_instances
 from rclverify.model.plan.resolve import all_requirements, resolve
 
-__all__ = ["KEY", "Plan", "all_requirements", "load_plan", "read_plan_data", "resolve"]
+__all__ = ["KEY", "Plan", "all_requirements", "load_plan", "read_plan_data", "read_plan_document", "resolve"]
 
 
 def _schema() -> dict[str, Any]:
@@ -51,6 +52,13 @@ def read_plan_data(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path
     """
     data, locs, _ = _read_plan_source(root, plan_rel)
     return data, locs
+
+
+def read_plan_document(root: Path, plan_rel: str) -> tuple[PlanDocument, dict[Path_, ast.Loc]]:
+    """Read ``root/plan_rel`` into its typed sections (:class:`~.document.PlanDocument`) plus a location
+    for every value path.  Raises :class:`PlanError` on a missing file, bad YAML or a schema violation."""
+    data, locs, _ = _read_plan_source(root, plan_rel)
+    return plan_document(data, locs, plan_rel), locs
 
 
 def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[Path_, ast.Loc], Blocks]:
@@ -156,83 +164,91 @@ def load_plan(root: Path, plan_rel: str = "contracts/plan.yaml") -> Plan:
     checked to validate the references into them.
     """
     data, locs, blocks = _read_plan_source(root, plan_rel)
+    doc = plan_document(data, locs, plan_rel)
 
     def loc(*path: Any) -> ast.Loc:
         return locs.get(tuple(path), ast.Loc(plan_rel, 1, 1))
 
-    targets = check_plan_paths(root, plan_rel, data, locs)
-    contracts = _contract_files(root, plan_rel, data, loc)
-    reqs = []
-    for i, r in enumerate(data.get("requirements", [])):
-        sup = tuple(Support(s["node"], tuple(s["guarantees"]), loc("requirements", i, "supported_by", j))
-                    for j, s in enumerate(r.get("supported_by", [])))
-        formal = _source(("requirements", i, "formal"), r, "formal", locs, blocks, plan_rel)
-        assuming = r.get("assuming", [])
-        assuming = [assuming] if isinstance(assuming, str) else assuming
-        srcs = tuple(_source(("requirements", i, "assuming") + ((j,) if isinstance(r["assuming"], list) else ()),
-                             {"v": a}, "v", locs, blocks, plan_rel) for j, a in enumerate(assuming))
-        reqs.append(Requirement(str(r["id"]), str(r["text"]).strip(), sup, loc("requirements", i), formal,
-                                tuple(x for x in srcs if x is not None),
-                                ranking=_source(("requirements", i, "ranking"), r, "ranking", locs, blocks, plan_rel),
-                                invariant=_source(("requirements", i, "invariant"), r, "invariant", locs, blocks,
-                                                  plan_rel),
-                                strength=r.get("strength"),
-                                target=requirement_target(r.get("target"), loc("requirements", i, "target"))))
+    targets = check_plan_paths(root, plan_rel, doc, locs)
+    contracts = _contract_files(root, plan_rel, doc, loc)
+    reqs = [_requirement(i, r, loc, locs, blocks, plan_rel) for i, r in enumerate(doc.requirements)]
     conns = []
-    for i, c in enumerate(data.get("connections", []) or []):
-        fn, fv = c["from"].split(".", 1)
-        tn, tv = c["to"].split(".", 1)
+    for i, c in enumerate(doc.connections or ()):
+        fn, fv = c.source.split(".", 1)
+        tn, tv = c.to.split(".", 1)
         conns.append(Connection(fn, fv, tn, tv, loc("connections", i)))
     facts: dict[str, tuple[Fact, ...]] = {}
     instances: dict[str, tuple[int, int]] = {}
-    for node, spec in (data.get("environment") or {}).items():
-        if isinstance(spec, list):
-            spec = {"facts": spec}
-            base: Path_ = ("environment", node)
-        else:
-            base = ("environment", node, "facts")
-        out = []
-        for i, text in enumerate(spec.get("facts", [])):
-            l = loc(*base, i)
-            block = blocks.get(tuple(base) + (i,))
-            from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark; only a plan with environment facts parses a formula here)
-            try:
-                if block is not None:
-                    expr = parse_formula(block[1], plan_rel, block[0], 1)
-                    l = ast.Loc(plan_rel, block[0], len(block[1]) - len(block[1].lstrip()) + 1)
-                else:
-                    expr = parse_formula(text, plan_rel, l.line, l.col)
-            except RclError as exc:
-                raise PlanError(exc.diagnostics) from None
-            out.append(Fact(node, text, expr, l))
-        facts[node] = tuple(out)
-        if "instances" in spec:
-            lo, hi = spec["instances"]
+    for node, spec in (doc.environment or {}).items():
+        facts[node] = _facts(node, spec, loc, blocks, plan_rel)
+        if isinstance(spec, EnvironmentEntry) and spec.instances is not None:
+            lo, hi = spec.instances
             instances[node] = (int(lo), int(hi))
     evidence: dict[str, tuple[EvidenceEntry, ...]] = {}
     replacements: dict[str, tuple[str, ast.Loc]] = {}
-    for node, spec in (data.get("nodes") or {}).items():
+    for node, entry in (doc.nodes or {}).items():
         evidence[node] = tuple(EvidenceEntry(node, i, e["backend"], e, loc("nodes", node, "evidence", i))
-                               for i, e in enumerate(spec.get("evidence", [])))
-        if "replacement" in spec:
-            replacements[node] = (spec["replacement"], loc("nodes", node, "replacement"))
-    rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in (data.get("requirements_from") or {}).items())
-    deadlines = _deadlines(data, loc, plan_rel)
-    states = read_state(data, locs, blocks, plan_rel)
-    if (data.get("requirements_from") or {}).get("fret"):  # a FRET export's requirements (docs/requirements.md)
+                               for i, e in enumerate(entry.evidence))
+        if entry.replacement is not None:
+            replacements[node] = (entry.replacement, loc("nodes", node, "replacement"))
+    rfrom = tuple((str(v), loc("requirements_from", k)) for k, v in doc.requirements_from.items())
+    deadlines = _deadlines(doc, loc, plan_rel)
+    states = read_state(doc, locs, blocks, plan_rel)
+    if doc.fret_export:  # a FRET export's requirements (docs/requirements.md)
         from rclverify.model.plan.fret.requirements import plan_additions  # deferred: optional or conditional (inside a block)
-        fret_reqs, fret_states = plan_additions(root, data, contracts)
+        fret_reqs, fret_states = plan_additions(root, doc, contracts)
         reqs += fret_reqs
         states += fret_states
     return Plan(plan_rel, root, contracts, tuple(reqs), tuple(conns), facts, instances, evidence, replacements, locs,
-                str(data.get("name", "")), dict(data.get("ros") or {}), rfrom, deadlines, states,
-                read_acknowledgements(data, locs, plan_rel), targets, read_standards(root, data, locs, plan_rel),
-                instances_of(data.get("instances"), locs, plan_rel), str(data.get("design") or ""))
+                doc.name, dict(doc.ros or {}), rfrom, deadlines, states,
+                read_acknowledgements(doc, locs, plan_rel), targets, read_standards(root, doc, locs, plan_rel),
+                instances_of(doc.instances, locs, plan_rel), doc.design)
 
 
-def _contract_files(root: Path, plan_rel: str, data: Mapping[str, Any], loc: Any) -> tuple[str, ...]:
+def _requirement(i: int, r: RequirementEntry, loc: Callable[..., ast.Loc], locs: Mapping[Path_, ast.Loc],
+                 blocks: Blocks, plan_rel: str) -> Requirement:
+    """The plan's ``requirements[i]`` (``r``) as a :class:`Requirement`: its formulas' sources located in
+    the plan (block scalars read from their lines)."""
+    sup = tuple(Support(s.node, s.guarantees, loc("requirements", i, "supported_by", j))
+                for j, s in enumerate(r.supported_by))
+    base: Path_ = ("requirements", i)
+    assuming = (r.assuming,) if isinstance(r.assuming, str) else r.assuming or ()
+    srcs = tuple(_source(base + ("assuming",) + ((j,) if isinstance(r.assuming, tuple) else ()), a, locs, blocks,
+                         plan_rel) for j, a in enumerate(assuming))
+    return Requirement(r.id, r.text.strip(), sup, loc(*base), _source(base + ("formal",), r.formal, locs, blocks,
+                                                                         plan_rel),
+                       tuple(x for x in srcs if x is not None),
+                       ranking=_source(base + ("ranking",), r.ranking, locs, blocks, plan_rel),
+                       invariant=_source(base + ("invariant",), r.invariant, locs, blocks, plan_rel),
+                       strength=r.strength, target=requirement_target(r.target, loc(*base, "target")))
+
+
+def _facts(node: str, spec: tuple[str, ...] | EnvironmentEntry, loc: Callable[..., ast.Loc], blocks: Blocks,
+           plan_rel: str) -> tuple[Fact, ...]:
+    """``environment.<node>``'s facts parsed (written as a list, or under ``facts:``); raises
+    :class:`PlanError` with the parser's located diagnostics."""
+    base: Path_ = ("environment", node) if isinstance(spec, tuple) else ("environment", node, "facts")
+    texts = spec if isinstance(spec, tuple) else spec.facts
+    out = []
+    for i, text in enumerate(texts):
+        l = loc(*base, i)
+        block = blocks.get(tuple(base) + (i,))
+        from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark; only a plan with environment facts parses a formula here)
+        try:
+            if block is not None:
+                expr = parse_formula(block[1], plan_rel, block[0], 1)
+                l = ast.Loc(plan_rel, block[0], len(block[1]) - len(block[1].lstrip()) + 1)
+            else:
+                expr = parse_formula(text, plan_rel, l.line, l.col)
+        except RclError as exc:
+            raise PlanError(exc.diagnostics) from None
+        out.append(Fact(node, text, expr, l))
+    return tuple(out)
+
+
+def _contract_files(root: Path, plan_rel: str, doc: PlanDocument, loc: Callable[..., ast.Loc]) -> tuple[str, ...]:
     """The plan's contract files; one that does not exist is a located plan error (``E-io``)."""
-    contracts = tuple(data["contracts"])
+    contracts = doc.contracts
     for i, c in enumerate(contracts):
         if not (root / c).is_file():
             l = loc("contracts", i)
@@ -249,32 +265,33 @@ def instances_of(data: Any, locs: Mapping[Path_, ast.Loc], plan_rel: str) -> dic
     return got
 
 
-def _deadlines(data: Mapping[str, Any], loc: Any, plan_rel: str) -> tuple[DeadlineSpec, ...]:
+def _deadlines(doc: PlanDocument, loc: Callable[..., ast.Loc], plan_rel: str) -> tuple[DeadlineSpec, ...]:
     """The requirements' ``deadline:`` entries (rule D3); a duration without
     a unit is a located plan error."""
     out = []
-    for i, r in enumerate(data.get("requirements", [])):
-        d = r.get("deadline")
+    for i, r in enumerate(doc.requirements):
+        d = r.deadline
         if d is None:
             continue
-        within = parse_duration(d["within"])
+        within = parse_duration(str(d.within))
         if within is None:
             l = loc("requirements", i, "deadline", "within")
-            raise plan_error(plan_rel, l.line, l.col, f"deadline 'within: {d['within']}' must be a positive number "
+            raise plan_error(plan_rel, l.line, l.col, f"deadline 'within: {d.within}' must be a positive number "
                              f"and a unit, e.g. '500 ms' (units: {', '.join(UNITS)})", "E-deadline")
-        out.append(DeadlineSpec(str(r["id"]), tuple(d["path"]), within, loc("requirements", i, "deadline")))
+        out.append(DeadlineSpec(r.id, d.path, within, loc("requirements", i, "deadline")))
     return tuple(out)
 
 
-def _source(path: Path_, holder: Mapping[str, Any], key: str, locs: Mapping[Path_, ast.Loc], blocks: Blocks,
+def _source(path: Path_, text: str | None, locs: Mapping[Path_, ast.Loc], blocks: Blocks,
             file: str) -> Source | None:
-    """The :class:`~.formal.Source` of a formula written at ``path`` of the
-    plan (``holder[key]``), or ``None`` when absent: a block scalar is read
-    from its source lines, so every diagnostic maps onto the plan file."""
-    if key not in holder:
+    """The :class:`~.formal.Source` of a formula ``text`` written at ``path``
+    of the plan, or ``None`` when absent (``text`` is ``None``): a block
+    scalar is read from its source lines, so every diagnostic maps onto the
+    plan file."""
+    if text is None:
         return None
     block = blocks.get(path)
     if block is not None:
         return Source(block[1], block[0], 1, file)
     l = locs.get(path, ast.Loc(file, 1, 1))
-    return Source(str(holder[key]), l.line, l.col, file)
+    return Source(text, l.line, l.col, file)

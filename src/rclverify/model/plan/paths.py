@@ -45,6 +45,7 @@ from rclverify.core.cache.keys import resolved_paths
 from rclverify.core.within import escape_reason
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic
+from rclverify.model.plan.document import PlanDocument
 from rclverify.model.plan.entries import TOOL_KEYS, TOOL_PATH_KINDS, declared_paths
 from rclverify.model.plan.errors import PlanError, plan_error
 
@@ -78,24 +79,25 @@ def config_strings(value: Any, path: Path_ = ()) -> Iterator[tuple[Path_, str]]:
             yield from config_strings(v, path + (i,))
 
 
-def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any],
+def check_plan_paths(root: Path, plan_rel: str, doc: PlanDocument,
                      locs: Mapping[Path_, ast.Loc]) -> dict[str, str]:
-    """Check every path in the schema-valid plan ``data`` (see the module docstring).
+    """Check every path in the plan's typed sections ``doc`` (see the module docstring).
 
     ``locs`` maps value paths to their locations in ``plan_rel``.  Returns
     ``{value: absolute path it leads to}`` of every path checked
     (:func:`~rclverify.core.cache.keys.resolved_paths`).  Raises
     :class:`PlanError` listing every path that leaves the workspace.
     """
-    candidates: list[tuple[Path_, str]] = [(("contracts", i), c) for i, c in enumerate(data.get("contracts") or [])]
-    candidates += [(("requirements_from", k), v) for k, v in (data.get("requirements_from") or {}).items()]
-    candidates += [(("design",), data["design"])] if isinstance(data.get("design"), str) else []
-    for node, spec in (data.get("nodes") or {}).items():
-        if isinstance(spec.get("replacement"), str):
-            candidates.append((("nodes", node, "replacement"), spec["replacement"].rpartition(":")[0]))
+    candidates: list[tuple[Path_, str]] = [(("contracts", i), c) for i, c in enumerate(doc.contracts)]
+    candidates += [(("requirements_from", k), v) for k, v in doc.requirements_from.items()]
+    candidates += [(("design",), doc.design)] if doc.design else []
+    nodes = doc.nodes or {}
+    for node, spec in nodes.items():
+        if spec.replacement is not None:
+            candidates.append((("nodes", node, "replacement"), spec.replacement.rpartition(":")[0]))
     backslashed: set[Path_] = {p for p, v in candidates if "\\" in v}
-    for node, spec in (data.get("nodes") or {}).items():
-        for i, entry in enumerate(spec.get("evidence") or []):
+    for node, spec in nodes.items():
+        for i, entry in enumerate(spec.evidence):
             base = ("nodes", node, "evidence", i)
             declared = {base + p: v for p, v in declared_paths(entry)} if isinstance(entry, Mapping) else {}
             candidates += list(declared.items())
@@ -113,8 +115,8 @@ def check_plan_paths(root: Path, plan_rel: str, data: Mapping[str, Any],
         elif path in backslashed:
             diags.extend(plan_error(l.file, l.line, l.col, f"path {value!r} uses '\\' as a separator; write plan "
                                     "paths with '/'", "E-path").diagnostics)
-    for node, spec in (data.get("nodes") or {}).items():
-        for i, entry in enumerate(spec.get("evidence") or []):
+    for node, spec in nodes.items():
+        for i, entry in enumerate(spec.evidence):
             if isinstance(entry, Mapping):
                 for key, kind in TOOL_PATH_KINDS.items():
                     why = tool_path_problem(root, entry.get(key), kind)

@@ -82,19 +82,19 @@ def group_files(files: Sequence[str], workspace: str = ".", plan_rel: str = "con
     if found is None:
         return Scopes([Scope(files)])
     root, rel = found
-    from rclverify.model.plan.load import read_plan_data  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
+    from rclverify.model.plan.load import read_plan_document  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
     shown = str(root / rel)
     try:
-        data, _ = read_plan_data(root, rel)
+        doc, _ = read_plan_document(root, rel)
     except RclError as exc:
         why = exc.diagnostics[0].message if exc.diagnostics else "cannot read it"
         return Scopes([Scope(files)], None, [f"{shown}: note: files checked together, as without a plan: "
                                              f"the plan cannot be read ({why})"])
-    system = {_key(root / str(c)) for c in data.get("contracts") or [] if isinstance(c, str)}
+    system = {_key(root / c) for c in doc.contracts}
     replaced: dict[str, str] = {}
-    for node, spec in (data.get("nodes") or {}).items():
-        if isinstance(spec, dict) and isinstance(spec.get("replacement"), str):
-            replaced[_key(root / spec["replacement"].rpartition(":")[0])] = str(node)
+    for node, spec in (doc.nodes or {}).items():
+        if spec.replacement is not None:
+            replaced[_key(root / spec.replacement.rpartition(":")[0])] = node
     together = [f for f in files if _key(Path(f)) in system]
     scopes = [Scope(together, "the plan's system")] if together else []
     for f in files:
@@ -124,12 +124,12 @@ def plan_diagnostics(files: Sequence[str], checked: object, workspace: str = "."
     if found is None:
         return [], ""
     root, rel = found
-    from rclverify.model.plan.load import load_plan, read_plan_data, resolve  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
+    from rclverify.model.plan.load import load_plan, read_plan_document, resolve  # deferred: start-up (loads yaml, rclverify.lang.ast and more only when called)
     try:
-        data, _ = read_plan_data(root, rel)
+        doc, _ = read_plan_document(root, rel)
     except RclError:
         return [], ""  # group_files said so already
-    system = {_key(root / str(c)) for c in data.get("contracts") or [] if isinstance(c, str)}
+    system = {_key(root / c) for c in doc.contracts}
     given = {_key(Path(f)) for f in files}
     if not system or not system <= given:
         return [], (f"{root / rel}: note: the plan's statements are checked when every file of its contracts: "

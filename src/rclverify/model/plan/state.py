@@ -41,6 +41,7 @@ from typing import Any, Mapping
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, STRING, Checked, CheckedNode, Type
+from rclverify.model.plan.document import PlanDocument
 from rclverify.model.plan.formal import Source, _loc_at, _rename
 import json
 
@@ -73,23 +74,23 @@ class StateFormula:
     scope: CheckedNode
 
 
-def read_state(data: Mapping[str, Any], locs: Mapping[tuple[Any, ...], ast.Loc], blocks: Mapping[tuple[Any, ...], tuple[int, str]],
+def read_state(doc: PlanDocument, locs: Mapping[tuple[Any, ...], ast.Loc], blocks: Mapping[tuple[Any, ...], tuple[int, str]],
                file: str) -> tuple[StateVar, ...]:
-    """The plan's ``state:`` section (already schema-checked) as values, in
+    """The plan's ``state:`` section (``doc``: the plan's typed sections) as values, in
     order of writing.  ``locs``/``blocks`` are the loader's locations."""
     out = []
-    for node, vars_ in (data.get("state") or {}).items():
-        for name, spec in (vars_ or {}).items():
+    for node, vars_ in (doc.state or {}).items():
+        for name, spec in vars_.items():
             base = ("state", node, name)
             loc = locs.get(base, ast.Loc(file, 1, 1))
 
-            def src(key: str) -> Source:
+            def src(key: str, text: str) -> Source:
                 block = blocks.get(base + (key,))
                 if block is not None:
                     return Source(block[1], block[0], 1, file)
                 l = locs.get(base + (key,), loc)
-                return Source(str(spec[key]), l.line, l.col, file)
-            out.append(StateVar(str(node), str(name), str(spec["type"]), src("init"), src("next"), loc,
+                return Source(text, l.line, l.col, file)
+            out.append(StateVar(node, name, spec.type, src("init", spec.init), src("next", spec.next), loc,
                                 locs.get(base + ("type",), loc)))
     return tuple(out)
 

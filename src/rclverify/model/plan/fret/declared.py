@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Any, Mapping
 
+from rclverify.model.plan.document import Fret
 from rclverify.model.plan.fret.refusal import Refusal
 
 #: the plan's word for a variable's place -> FRET's idType
@@ -71,16 +71,14 @@ class DeclaredFunction:
         return f"({text})"
 
 
-def functions_of(spec: Mapping[str, Any]) -> dict[str, DeclaredFunction]:
-    """The ``functions`` entries of a plan's ``fret:`` section (schema-checked)."""
-    raw = spec.get("functions") or {}
-    return {str(k): DeclaredFunction(str(k), tuple(str(a) for a in v.get("args") or ()), str(v["rcl"]))
-            for k, v in raw.items()}
+def functions_of(spec: Fret) -> dict[str, DeclaredFunction]:
+    """The ``functions`` entries of a plan's ``fret:`` section (its typed value)."""
+    return {k: DeclaredFunction(k, v.args, v.rcl) for k, v in spec.functions.items()}
 
 
-def variables_of(spec: Mapping[str, Any]) -> dict[str, str]:
+def variables_of(spec: Fret) -> dict[str, str]:
     """The ``variables`` entries of a plan's ``fret:`` section as FRET idTypes (``Input``, ``Output``)."""
-    return {str(k): ID_TYPES[str(v)] for k, v in (spec.get("variables") or {}).items()}
+    return {k: ID_TYPES[v] for k, v in spec.variables.items()}
 
 
 __all__ = ["DeclaredFunction", "ID_TYPES", "functions_of", "variables_of"]

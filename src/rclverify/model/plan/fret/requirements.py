@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify.lang import ast
+from rclverify.model.plan.document import Fret, PlanDocument, plan_document
 from rclverify.model.plan.formal import Source
 from rclverify.model.plan.model import Requirement
 from rclverify.model.plan.state import StateVar
@@ -320,22 +321,24 @@ def read_fret(root: Path, rel: str, options: Options, contracts: tuple[str, ...]
     return import_export(read_export(root / rel, rel), options, ports_of(specs) if contracts else None)
 
 
-def options_of(data: Mapping[str, Any]) -> Options:
-    """The plan's ``fret:`` section (schema-checked) as :class:`Options`; ``step`` a duration (``100 ms``)."""
-    spec = data.get("fret") or {}
+def options_of(data: PlanDocument | Mapping[str, Any]) -> Options:
+    """The plan's ``fret:`` section as :class:`Options` (``data``: the plan's typed sections, or its
+    schema-checked data); ``step`` a duration (``100 ms``)."""
+    spec = (data if isinstance(data, PlanDocument) else plan_document(data)).fret or Fret()
     step = None
-    if spec.get("step") is not None:
+    if spec.step is not None:
         from rclverify.lang.timing import parse_duration  # deferred: start-up (only with fret: step:)
-        step = parse_duration(str(spec["step"]))
-    return Options(dict(spec.get("components") or {}), step, variables_of(spec), functions_of(spec))
+        step = parse_duration(spec.step)
+    return Options(dict(spec.components), step, variables_of(spec), functions_of(spec))
 
 
-def plan_additions(root: Path, data: Mapping[str, Any], contracts: tuple[str, ...]
+def plan_additions(root: Path, doc: PlanDocument, contracts: tuple[str, ...]
                    ) -> tuple[list[Requirement], tuple[StateVar, ...]]:
     """The requirements and state declarations the plan's ``requirements_from: {fret: EXPORT.json}``
-    adds (none without it).  Raises :class:`~rclverify.model.plan.errors.PlanError` for a malformed export."""
-    rel = (data.get("requirements_from") or {}).get("fret")
+    adds (none without it; ``doc``: the plan's typed sections).  Raises
+    :class:`~rclverify.model.plan.errors.PlanError` for a malformed export."""
+    rel = doc.fret_export
     if not rel:
         return [], ()
-    got = read_fret(root, str(rel), options_of(data), contracts)
+    got = read_fret(root, rel, options_of(doc), contracts)
     return [i.requirement for i in got], tuple(s for i in got for s in i.states)

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from rclverify.lang import ast
+from rclverify.model.plan.document import PlanDocument, plan_document
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.yamlguard import KEY, Path_
 from rclverify.model.plan.standards.identity import Person, confusable, is_person, person_keys
@@ -58,16 +59,15 @@ class StandardChoice:
     people: tuple[Person, ...] = ()
 
 
-def read_people(data: Mapping[str, Any], locs: Mapping[Path_, ast.Loc], file: str) -> tuple[Person, ...]:
-    """The plan's ``people:`` list (``data``: the schema-checked plan data) as :class:`~.identity.Person`
-    values, in order.  Raises :class:`PlanError` at the entry for a name that names nobody or holds mixed
+def read_people(data: PlanDocument | Mapping[str, Any], locs: Mapping[Path_, ast.Loc], file: str) -> tuple[Person, ...]:
+    """The plan's ``people:`` list (``data``: the plan's typed sections, or its schema-checked data) as
+    :class:`~.identity.Person` values, in order.  Raises :class:`PlanError` at the entry for a name that names nobody or holds mixed
     scripts or invisible characters (:func:`~.identity.confusable`), and for two entries that name one
     person (their names' keys meet: they would be one entry)."""
     out: list[Person] = []
-    for i, entry in enumerate(data.get("people") or []):
+    for i, entry in enumerate(_document(data).people):
         at = locs.get(("people", i), ast.Loc(file, 1, 1))
-        p = Person(str(entry["name"]), tuple(str(a) for a in entry.get("aliases") or ()),
-                   tuple(str(e) for e in entry.get("emails") or ()), (at.file, at.line, at.col))
+        p = Person(entry.name, entry.aliases, entry.emails, (at.file, at.line, at.col))
         for n in p.names():
             bad = confusable(n)
             if bad or not is_person(n):
@@ -184,9 +184,14 @@ def _clauses(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Pa
     return out
 
 
-def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast.Loc],
+def _document(data: PlanDocument | Mapping[str, Any]) -> PlanDocument:
+    """``data`` as the plan's typed sections (a mapping is converted, :func:`~..document.plan_document`)."""
+    return data if isinstance(data, PlanDocument) else plan_document(data)
+
+
+def read_standards(root: Path, data: PlanDocument | Mapping[str, Any], locs: Mapping[Path_, ast.Loc],
                    file: str) -> tuple[StandardChoice, ...]:
-    """The plan's ``standards:`` (``data``: the schema-checked plan data,
+    """The plan's ``standards:`` (``data``: the plan's typed sections, or its schema-checked data;
     ``locs``: its locations, ``file``: the plan's name) as
     :class:`StandardChoice` values, in order.  Raises :class:`PlanError`
     for an unknown profile (naming the profiles there are), a bad profile
@@ -194,8 +199,9 @@ def read_standards(root: Path, data: Mapping[str, Any], locs: Mapping[Path_, ast
     ``clauses:`` entry (:func:`_clauses`) or ``people:`` entry (:func:`read_people`).
     Each choice carries the plan's ``people``."""
     out: list[StandardChoice] = []
-    people = read_people(data, locs, file)
-    for i, entry in enumerate(data.get("standards") or []):
+    doc = _document(data)
+    people = read_people(doc, locs, file)
+    for i, entry in enumerate(doc.standards):
         base: Path_ = ("standards", i)
         at = locs.get(base + ("profile",), ast.Loc(file, 1, 1))
         p = _profile(root, str(entry["profile"]), at)
