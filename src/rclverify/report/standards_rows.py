@@ -19,7 +19,6 @@ from typing import Any, Collection, Mapping, Sequence, TypedDict
 import msgspec
 
 from rclverify.records.report_record import AssuranceReport
-from rclverify.records.report_schema import EvidenceJson
 from rclverify.model.plan.standards.choice import StandardChoice
 from rclverify.model.plan.standards.mapping import CLAUSE_STATUSES, ClauseRow, clause_rows, not_covered
 from rclverify.model.plan.standards.profiles import Profile
@@ -27,9 +26,6 @@ from rclverify.records.row import decode_rows
 from rclverify.records.standards_rows import ProfileOrigin, StandardRow
 
 
-#: Where a profile comes from (``standards[].origin``) as its JSON object: the encoding of
-#: :class:`rclverify.records.standards_rows.ProfileOrigin`.
-ProfileOriginJson = dict[str, Any]
 #: A chosen standard's row (``standards[]``) as the report's JSON object: the encoding of
 #: :class:`rclverify.records.standards_rows.StandardRow`, the one definition of its fields.
 StandardJson = dict[str, Any]
@@ -43,20 +39,17 @@ class StandardsPart(TypedDict):
     ok: bool
 
 
-def profile_origin(p: Profile) -> ProfileOriginJson:
-    """Where the profile ``p`` comes from (records/standards_rows.py :class:`ProfileOrigin`'s fields)."""
-    return {"kind": "built-in" if p.builtin else "workspace", "file": p.file, "sha256": p.sha256,
-            "edition": p.edition}
+def profile_origin(p: Profile) -> ProfileOrigin:
+    """Where the profile ``p`` comes from: ``built-in`` with its edition, or ``workspace`` with its file and sha256."""
+    return ProfileOrigin(kind="built-in" if p.builtin else "workspace", file=p.file, sha256=p.sha256,
+                         edition=p.edition)
 
 
-def origin_text(origin: ProfileOrigin | Mapping[str, Any]) -> str:
-    """``origin`` (a :class:`ProfileOrigin`, or its JSON object) as one phrase: ``built-in profile`` or
-    ``workspace profile std/mine.yaml, sha256 <hex>``."""
-    kind, file, sha256 = ((origin.kind, origin.file, origin.sha256) if isinstance(origin, ProfileOrigin)
-                          else (origin.get("kind"), origin.get("file"), origin.get("sha256")))
-    if kind == "built-in":
+def origin_text(origin: ProfileOrigin) -> str:
+    """``origin`` as one phrase: ``built-in profile`` or ``workspace profile std/mine.yaml, sha256 <hex>``."""
+    if origin.kind == "built-in":
         return "built-in profile"
-    return f"workspace profile {file}, sha256 {sha256}"
+    return f"workspace profile {origin.file}, sha256 {origin.sha256}"
 
 
 def _label(row: StandardRow) -> str:
@@ -65,7 +58,7 @@ def _label(row: StandardRow) -> str:
 
 
 def standards_part(choices: Sequence[StandardChoice],
-                   report: AssuranceReport | Mapping[str, Any] | Sequence[EvidenceJson],
+                   report: AssuranceReport | Mapping[str, Any] | Sequence[Mapping[str, Any]],
                    unstated: Collection[tuple[str, str]] = ()) -> StandardsPart:
     """The ``standards`` part of the plan's ``choices`` over ``report`` (the
     report so far, or its JSON object: its evidence rows with their strength, obligations,
@@ -82,7 +75,7 @@ def standards_part(choices: Sequence[StandardChoice],
     problems: list[str] = []
     ok = True
     # the mapping (model/plan/standards/) reads the report's JSON object
-    rep: Mapping[str, Any] | Sequence[EvidenceJson] = (
+    rep: Mapping[str, Any] | Sequence[Mapping[str, Any]] = (
         msgspec.to_builtins(report) if isinstance(report, AssuranceReport) and choices
         else {} if isinstance(report, AssuranceReport) else report)
     for c in choices:
@@ -134,5 +127,5 @@ def strict_reason(report: Mapping[str, Any]) -> list[str]:
     return strict_clauses(decode_rows(StandardRow, report.get("standards") or ()))
 
 
-__all__ = ["ProfileOriginJson", "StandardJson", "StandardsPart", "origin_text", "profile_origin",
+__all__ = ["StandardJson", "StandardsPart", "origin_text", "profile_origin",
            "standards_part", "strict_clauses", "strict_reason"]

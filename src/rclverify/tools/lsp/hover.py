@@ -12,18 +12,20 @@
 * a context name: what it is and its declaration.
 
 The text is Markdown from ``templates/hover.md.j2``.  Statuses come from
-the last run's ``reports/assurance.json`` (:mod:`.lastrun`); without one the
-contract parts are shown alone.
+the last run's ``reports/assurance.json`` decoded into its record
+(:class:`~rclverify.records.report_record.AssuranceReport`, :mod:`.lastrun`),
+read by attribute; without one the contract parts are shown alone.
 """
 from __future__ import annotations
 
-from typing import Mapping
-
 import jinja2
+import msgspec
 from lsprotocol import types as lsp
 
 from rclverify.lang import ast
-from rclverify.records.report_schema import GuaranteeJson, NodeJson, Report
+from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
+from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.tools.lsp.diagnostics import Analysis
 from rclverify.tools.lsp.index import Symbol, all_nodes, declarations
 from rclverify.lang.printer import node_to_rcl, type_to_rcl
@@ -32,14 +34,16 @@ _ENV = jinja2.Environment(loader=jinja2.PackageLoader("rclverify.tools.lsp", "te
                           keep_trailing_newline=False, undefined=jinja2.StrictUndefined)
 
 
-def _report_node(report: Report | None, name: str) -> NodeJson | None:
-    for n in report.get("nodes", ()) if report else ():
-        if isinstance(n, Mapping) and n.get("name") == name:
-            return n
-    return None
+def _report_node(report: AssuranceReport | None, name: str) -> NodeRow | None:
+    return next((n for n in report.nodes if n.name == name), None) if report else None
 
 
-def hover_text(a: Analysis, sym: Symbol, report: Report | None) -> str | None:
+def _culprits(row: NodeRow | GuaranteeRow | None) -> list[CulpritOf]:
+    """The problems ``row`` is the culprit of (``[]`` without a row or when none)."""
+    return [] if row is None or row.culprit_of is msgspec.UNSET else list(row.culprit_of)
+
+
+def hover_text(a: Analysis, sym: Symbol, report: AssuranceReport | None) -> str | None:
     """The Markdown hover of ``sym`` in the analysis ``a`` with the last
     ``report`` (``None``: no last run); ``None`` when there is nothing to say."""
     nodes = all_nodes(a)
@@ -47,10 +51,8 @@ def hover_text(a: Analysis, sym: Symbol, report: Report | None) -> str | None:
     if sym.kind == "node" and sym.name in nodes:
         rn = _report_node(report, sym.name)
         model = a.model
-        return t.render(kind="node", name=sym.name, status=rn.get("status") if rn else None,
-                        culprit_of=(rn.get("culprit_of") if rn else None) or [],
-                        contract=node_to_rcl(nodes[sym.name]).rstrip(),
-                        guarantees=(rn.get("guarantees") if rn else None) or [],
+        return t.render(kind="node", name=sym.name, status=rn.status if rn else None, culprit_of=_culprits(rn),
+                        contract=node_to_rcl(nodes[sym.name]).rstrip(), guarantees=rn.guarantees if rn else [],
                         producers=model.producers(sym.name) if model else [],
                         consumers=model.consumers(sym.name) if model else [])
     if sym.kind == "io" and sym.node in nodes:
@@ -74,24 +76,22 @@ def hover_text(a: Analysis, sym: Symbol, report: Report | None) -> str | None:
             return None
         from rclverify.lang.printer import expr_to_rcl  # deferred: optional or conditional (inside a block)
         rn = _report_node(report, sym.node)
-        g: GuaranteeJson | None = next((x for x in (rn.get("guarantees") if rn else None) or ()
-                                       if x.get("index") == sym.index), None)
-        obligations = [o for o in (report.get("obligations", ()) if report else ())
-                       if o.get("node") == sym.node and o.get("guarantee") == sym.index]
-        findings = [f for f in (report.get("findings", ()) if report else ())
-                    if f.get("node") == sym.node and f.get("guarantee") == sym.index]
-        return t.render(kind="guarantee", node=sym.node, index=sym.index, status=g.get("status") if g else None,
-                        culprit_of=(g.get("culprit_of") if g else None) or [],
+        g = next((x for x in (rn.guarantees if rn else ()) if x.index == sym.index), None)
+        obligations = [o for o in (report.obligations if report else ())
+                       if o.node == sym.node and o.guarantee == sym.index]
+        findings = [f for f in (report.findings if report else ())
+                    if f.node == sym.node and f.guarantee == sym.index]
+        return t.render(kind="guarantee", node=sym.node, index=sym.index, status=g.status if g else None,
+                        culprit_of=_culprits(g),
                         text=expr_to_rcl(n.guarantees[sym.index - 1].formula), obligations=obligations, findings=findings)
     if sym.kind == "requirement":
-        r = next((x for x in (report.get("requirements", ()) if report else ()) if x.get("id") == sym.name), None)
+        r = next((x for x in (report.requirements if report else ()) if x.id == sym.name), None)
         req = next((x for x in (a.plan.requirements if a.plan else ()) if x.id == sym.name), None)
         if r is None and req is None:
             return None
-        check = (r.get("check") if r else None) or {}
-        return t.render(kind="requirement", name=sym.name, verdict=r.get("verdict") if r else None,
-                        status=r.get("status") if r else None,
-                        text=(r.get("text") if r else None) or (req.text if req else ""), used=check.get("used") or [])
+        return t.render(kind="requirement", name=sym.name, verdict=r.verdict if r else None,
+                        status=r.status if r else None, text=(r.text if r else None) or (req.text if req else ""),
+                        used=RequirementCheckRow.of(r.check).used if r else [])
     if sym.kind == "decl":
         found = declarations(a).get(sym.name)
         if found is None:
@@ -106,7 +106,7 @@ def hover_text(a: Analysis, sym: Symbol, report: Report | None) -> str | None:
     return None
 
 
-def hover(a: Analysis, sym: Symbol, report: Report | None) -> lsp.Hover | None:
+def hover(a: Analysis, sym: Symbol, report: AssuranceReport | None) -> lsp.Hover | None:
     """The LSP hover of ``sym`` (see :func:`hover_text`)."""
     text = hover_text(a, sym, report)
     if text is None:

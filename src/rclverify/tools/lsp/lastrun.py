@@ -5,8 +5,11 @@ workspace, never computed here: ``reports/assurance.sarif``
 (:mod:`rclverify.report.sarif`: every failed side condition located at the
 guarantee its diagnosis blames, health problems, failed or outstanding
 evidence, lint, each with its rule id and the repairs Z3 checked as SARIF
-``fixes``) and ``reports/assurance.json`` (the report dict, read with its
-shape checked by :func:`rclverify.report.lastrun.read_report`, for hover).
+``fixes``) and ``reports/assurance.json`` (for hover: read with its shape
+checked by :func:`rclverify.report.lastrun.read_report` and decoded into its
+record, :class:`~rclverify.records.report_record.AssuranceReport`, by
+:func:`rclverify.report.view.decoded_parts`, which reads a report of an
+earlier version with the parts it lacks empty).
 Both are read again when their modification time changes.
 
 A finding is *stale* (docs/editor.md) when its file was saved after the
@@ -17,15 +20,15 @@ offered (their regions may no longer hold the text Z3 checked).
 """
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import cast
 
+import msgspec
 from lsprotocol import types as lsp
 
 from rclverify.lang.errors import RclError
-from rclverify.records.report_schema import Report
+from rclverify.records.report_record import AssuranceReport
 from rclverify.tools.lsp.diagnostics import utf16_col
 from rclverify.tools.lsp.lines import split_lines
 from rclverify.records.sarif import SarifFix
@@ -65,7 +68,7 @@ class LastRun:
     def __init__(self, root: Path) -> None:
         self.root = root
         self._sarif: tuple[float | None, list[Finding]] = (None, [])
-        self._report: tuple[float | None, Report | None] = (None, None)
+        self._report: tuple[float | None, AssuranceReport | None] = (None, None)
 
     def findings(self) -> list[Finding]:
         """Every located result of the SARIF log; ``[]`` without a readable one."""
@@ -78,16 +81,16 @@ class LastRun:
         """When the SARIF log was written (``None``: no last run)."""
         return _stamp(self.root / SARIF)
 
-    def report(self) -> Report | None:
-        """The report dict of the last run (its shape checked by
-        :func:`rclverify.report.lastrun.read_report`), ``None`` when there is
-        none or it is not of the report's shape."""
+    def report(self) -> AssuranceReport | None:
+        """The report of the last run as its record (see the module docstring), ``None`` when there is
+        none, it is not of the report's shape or a part does not decode into its record."""
         stamp = _stamp(self.root / REPORT)
         if stamp != self._report[0]:
             from rclverify.report.lastrun import read_report  # deferred: optional or conditional (inside a block)
+            from rclverify.report.view import decoded_parts  # deferred: optional or conditional (inside a block)
             try:
-                rep: Report | None = cast(Report, read_report(self.root))  # shape-checked as it is read
-            except RclError:
+                rep: AssuranceReport | None = decoded_parts(read_report(self.root))
+            except (RclError, msgspec.ValidationError):
                 rep = None
             self._report = (stamp, rep)
         return self._report[1]
@@ -121,23 +124,66 @@ class LastRun:
         return out
 
 
+class _Region(msgspec.Struct, frozen=True, rename="camel"):
+    start_line: int = 1
+    start_column: int = 1
+
+
+class _Uri(msgspec.Struct, frozen=True):
+    uri: str
+
+
+class _Physical(msgspec.Struct, frozen=True, rename="camel"):
+    artifact_location: _Uri
+    region: _Region | None = None
+
+
+class _Located(msgspec.Struct, frozen=True, rename="camel"):
+    physical_location: _Physical
+
+
+class _Text(msgspec.Struct, frozen=True):
+    text: str
+
+
+class _Result(msgspec.Struct, frozen=True, rename="camel"):
+    """What the language server reads of a SARIF ``result`` (§3.27; :class:`rclverify.records.sarif.SarifResult`
+    is the object written): rule id, level, message, its first location and its fixes (the objects kept)."""
+
+    rule_id: str
+    message: _Text
+    locations: list[_Located]
+    level: str = "warning"
+    fixes: list[object] | None = None
+
+
+class _Run(msgspec.Struct, frozen=True):
+    results: object
+
+
+class _Log(msgspec.Struct, frozen=True):
+    runs: list[_Run]
+
+
 def _read_sarif(path: Path) -> list[Finding]:
     """The located results of the SARIF log at ``path``; ``[]`` when it
-    cannot be read or is not a SARIF log (a later run writes it again)."""
+    cannot be read or is not a SARIF log (a later run writes it again); a
+    result of another shape or without a location is left out."""
     try:
-        log = json.loads(path.read_text(encoding="utf-8"))
-        results = log["runs"][0]["results"]
-    except (OSError, ValueError, KeyError, IndexError, TypeError):
+        results = msgspec.json.decode(path.read_bytes(), type=_Log).runs[0].results
+    except (OSError, msgspec.DecodeError, IndexError):
         return []
     out = []
     for r in results if isinstance(results, list) else ():
         try:
-            phys = r["locations"][0]["physicalLocation"]
-            region = phys.get("region") or {}
-            fixes = tuple(cast(SarifFix, x) for x in r.get("fixes") or () if isinstance(x, dict))
-            out.append(Finding(str(phys["artifactLocation"]["uri"]), int(region.get("startLine", 1)),
-                               int(region.get("startColumn", 1)), str(r["ruleId"]), str(r.get("level", "warning")),
-                               str(r["message"]["text"]), fixes))
-        except (KeyError, IndexError, TypeError, ValueError):
+            res = msgspec.convert(r, _Result, strict=False)
+        except msgspec.ValidationError:
             continue
+        if not res.locations:
+            continue
+        phys = res.locations[0].physical_location
+        region = phys.region or _Region()
+        fixes = tuple(cast(SarifFix, x) for x in res.fixes or () if isinstance(x, dict))
+        out.append(Finding(phys.artifact_location.uri, region.start_line, region.start_column, res.rule_id,
+                           res.level, res.message.text, fixes))
     return out
