@@ -3,17 +3,15 @@ from __future__ import annotations
 
 import re
 
-from rclverify.records.report_schema import SideConditionJson
-from rclverify.records.composition_records import SideCondition
 from rclverify.records.side_condition_rows import SideConditionRow
 
 
-def link_pairs(sc: SideConditionRow | SideConditionJson | SideCondition) -> list[tuple[str, str, str, str]]:
-    """``(producer, out var, consumer, in var)`` of each of a side condition
-    record's ``links`` (``Planner.out.speed -> Controller.in.speed (via
+def link_pairs(sc: SideConditionRow) -> list[tuple[str, str, str, str]]:
+    """``(producer, out var, consumer, in var)`` of each of the side condition
+    row's ``links`` (``Planner.out.speed -> Controller.in.speed (via
     name)``), in order; a link of another shape is left out."""
     out = []
-    for l in sc.links if isinstance(sc, SideConditionRow) else sc.get("links", []):
+    for l in sc.links:
         m = re.match(r"^(\w+)\.out\.(\w+) -> (\w+)\.in\.(\w+)", l)
         if m:
             out.append((m.group(1), m.group(2), m.group(3), m.group(4)))

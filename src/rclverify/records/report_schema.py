@@ -11,9 +11,7 @@ pass to the renderers (docs/records.md); its JSON object is made once, when
 it is written (report/render.py ``render_json``), or read from a stored
 report.  :class:`Report` lists the top-level keys of that object, held to
 :class:`~rclverify.records.report_record.AssuranceReport`'s fields by
-tests/report/test_report_vocabulary.py.  Four aliases name a part's JSON
-object for the readers outside report/ that still read it so (the language
-server's hover, records/links.py, the standards' mapping).
+tests/report/test_report_vocabulary.py.
 
 :func:`as_report` checks a report's JSON object (its top-level keys and the
 summary status) and gives it as a :class:`Report`, so a reader typed on
@@ -25,24 +23,6 @@ from rclverify.records import report_record
 from rclverify.records.statuses import EVIDENCE_STATUSES
 
 
-#: A node's row (``nodes[]``) as the report's JSON object: the encoding of
-#: :class:`rclverify.records.node_rows.NodeRow` (read so by the language server's hover, tools/lsp/hover.py).
-NodeJson = dict[str, Any]
-
-#: A guarantee of a node's row (``nodes[].guarantees[]``) as its JSON object: the encoding of
-#: :class:`rclverify.records.node_rows.GuaranteeRow` (tools/lsp/hover.py).
-GuaranteeJson = dict[str, Any]
-
-#: A side condition's row (``side_conditions[]``) as the report's JSON object: the encoding of
-#: :class:`rclverify.records.side_condition_rows.SideConditionRow` (records/links.py reads its links so).
-SideConditionJson = dict[str, Any]
-
-#: An evidence record's row (``evidence[]``) as the report's JSON object: the encoding of
-#: :class:`rclverify.records.evidence_rows.EvidenceRow` (the standards' mapping,
-#: model/plan/standards/mapping.py, reads the report so).
-EvidenceJson = dict[str, Any]
-
-
 class Report(TypedDict):
     """``reports/assurance.json`` (docs/assurance.schema.json) as its JSON object: each part the encoding
     of its record (:class:`~rclverify.records.report_record.AssuranceReport`'s field of the same name)."""
@@ -50,12 +30,12 @@ class Report(TypedDict):
     summary: dict[str, Any]
     system: dict[str, Any]
     requirements: list[dict[str, Any]]
-    nodes: list[NodeJson]
-    side_conditions: list[SideConditionJson]
+    nodes: list[dict[str, Any]]
+    side_conditions: list[dict[str, Any]]
     derived_properties: list[dict[str, Any]]
     findings: list[dict[str, Any]]
     obligations: list[dict[str, Any]]
-    evidence: list[EvidenceJson]
+    evidence: list[dict[str, Any]]
     environment_assumptions: list[dict[str, Any]]
     pending: list[dict[str, Any]]
     lint: list[dict[str, Any]]
