@@ -24,14 +24,15 @@ such output that goes unanswered is ``false`` as before.
 """
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
-from typing import Mapping, Protocol
+from typing import Callable, Mapping, Protocol
 
 from rclverify.semantics.floatsem import Tolerance, judge
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
-from rclverify.backends.monitors.deadline_records import DeadlineResult, Pending
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_text import ms_ns
 from rclverify.backends.monitors.skew import within_before
 
@@ -47,8 +48,12 @@ class DeadlineMonitor(Protocol):
     node: CheckedNode
     tolerance: Tolerance | None
     result: DeadlineResult
+    on_verdict: Callable[[DeadlineVerdict], None] | None
+    now_ns: int | None
 
     def _visible(self, p: Pending, stamp: float | None = None) -> dict[str, object]: ...
+
+    def _withdraw_false(self, p: Pending) -> None: ...
 
 
 def skew_ns(rules: object) -> int:
@@ -99,6 +104,35 @@ def undecided(mon: DeadlineMonitor, p: Pending) -> None:
                                           f"{ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}"}
 
 
+def revise_false(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
+    """Obligation ``p`` was judged ``false`` when the clock passed its deadline; output ``ev``, stamped ``ns``
+    within the skew before its trigger (``fresh``: the outputs it set), was heard only then (later than the
+    lateness bound).  Where it satisfies the guarantee on the trigger's inputs (:func:`mark_early`, judged as
+    when the trigger came: on none of the outputs published after it), ``p`` is what the run read in stamp
+    order makes it, ``undecided``: the ``false`` is withdrawn (its count, the first ``false``, its unanswered
+    time margin) and counted ``undecided`` (:func:`undecided`); an update verdict ``undecided`` says why."""
+    probe = dataclasses.replace(p, outs={})
+    mark_early(mon, probe, ev, ns, fresh)
+    if not probe.maybe:
+        return
+    p.maybe = probe.maybe
+    mon._withdraw_false(p)
+    margins = mon.result.time_margins
+    m = margins.get(p.k)
+    if m is not None:  # counted unanswered when it expired; an undecided trigger counts no time margin
+        m.unanswered -= 1
+        if not m.answers and not m.unanswered:
+            del margins[p.k]
+    undecided(mon, p)
+    if mon.on_verdict is not None:
+        behind = ms_ns(mon.now_ns - ns) if mon.now_ns is not None else "?"
+        mon.on_verdict(DeadlineVerdict(
+            mon.node.name, p.k, "undecided", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
+            f"no answer of its own within the deadline of {ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}; heard "
+            f"after the clock had passed the deadline (at {behind} behind it): undecided, and the false given "
+            "when the clock passed is withdrawn", update=True))
+
+
 def decided_late(mon: DeadlineMonitor, p: Pending) -> None:
     """Marked obligation ``p``, counted ``undecided`` when its deadline passed, answered by an output of its own
     stamped in time: no longer undecided (its ``true`` is given by the caller)."""
@@ -109,4 +143,4 @@ def decided_late(mon: DeadlineMonitor, p: Pending) -> None:
         res.first_unaccepted = None
 
 
-__all__ = ["decided_late", "mark_early", "scan_heard", "skew_ns", "undecided", "within_skew_before"]
+__all__ = ["decided_late", "mark_early", "revise_false", "scan_heard", "skew_ns", "undecided", "within_skew_before"]

@@ -15,12 +15,14 @@ from rclverify.backends.monitors.verdicts import LINK_TOPICS
 def event_stamp_ns(ev: Event) -> int:
     """The event's time on the stamps' clock in integer nanoseconds: a header's
     ``secs``/``nsecs`` (ROS 1) or ``sec``/``nanosec`` (ROS 2, builtin_interfaces/Time)
-    exactly, else :func:`~rclverify.traces.events.to_ns` of the time the trace gives it.
+    exactly, else :func:`~rclverify.traces.events.to_ns` of its own time (:attr:`Event.stamped
+    <rclverify.traces.events.Event.stamped>`: the time the trace gives it, or, for a message the live
+    engine heard too late to order and released at its clock, the time it was published at).
     Deadlines are compared in these integers (docs/semantics.md, "Deadlines"):
     ``0.7 + 0.2`` in doubles is ``0.8999999999999999``, and an answer stamped at
     0.9 s was reported "0 ms past the deadline"."""
     s = header_stamp_ns(ev.fields)
-    return to_ns(ev.time) if s is None else s
+    return to_ns(ev.stamped) if s is None else s
 
 
 def topic_bindings(node: CheckedNode) -> dict[str, list[tuple[str, str]]]:

@@ -263,6 +263,11 @@ class DeadlineMonitor:
     def _answer(self, ev: Event, ns: int, outs: set[str]) -> None:
         stamp = ns / 1e9
         for p in list(self.expired):
+            if ns < p.stamp_ns:  # stamped before its trigger, heard after the clock passed its deadline
+                if not p.maybe and deadline_skew.within_skew_before(self, p, ns):
+                    deadline_skew.revise_false(self, p, ev, ns, {c: self.values[c] for c in outs
+                                                                  if c not in self.state_outs})
+                continue
             if self._answers(p, ns, outs):
                 self.expired.remove(p)
                 if ns <= p.due_ns:  # stamped within the deadline, heard after the clock passed it
@@ -291,15 +296,8 @@ class DeadlineMonitor:
                                        "deadline: met on the answer's own stamp", time_margin=(p.due_ns - ns) / 1e9))
             self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9)
             return
-        counts = self.result.counts
-        counts["false"] -= 1
-        counts["true"] += 1
-        key = (p.trigger.where, p.k)
-        self._falses.pop(key, None)
-        first = self.result.first_false
-        if first is not None and (first.trigger_where, first.guarantee) == key:
-            self.result.first_false = next(iter(self._falses.values()), None) or (
-                self._last_false if counts["false"] else None)
+        self._withdraw_false(p)
+        self.result.counts["true"] += 1
         late = ms_ns(self.now_ns - ns) if self.now_ns is not None else "?"
         v = DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
                             f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms_ns(p.due_ns - p.stamp_ns)}), "
@@ -309,6 +307,18 @@ class DeadlineMonitor:
         if self.on_verdict is not None:
             self.on_verdict(v)
         self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True)
+
+    def _withdraw_false(self, p: Pending) -> None:
+        """The ``false`` obligation ``p`` was given when the clock passed its deadline, withdrawn from the
+        counts and, where it was the first, from the result's first ``false`` (its replacement: the caller's)."""
+        counts = self.result.counts
+        counts["false"] -= 1
+        key = (p.trigger.where, p.k)
+        self._falses.pop(key, None)
+        first = self.result.first_false
+        if first is not None and (first.trigger_where, first.guarantee) == key:
+            self.result.first_false = next(iter(self._falses.values()), None) or (
+                self._last_false if counts["false"] else None)
 
     def _try(self, p: Pending, ev: Event, ns: int, outs: set[str]) -> bool:
         """Whether output ``ev`` (stamp ``ns``, setting ``outs``) answers obligation ``p``:
