@@ -17,7 +17,10 @@ the engine gives a verdict only where both readings agree
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
+
+if TYPE_CHECKING:
+    from numpy.typing import NDArray
 
 #: The default transport skew (s): five of CPython's 5 ms thread switch
 #: intervals, the time a receiving thread may wait for the interpreter on a
@@ -33,11 +36,21 @@ def parse_skew(value: Any) -> float | None:
     return v if math.isfinite(v) and v >= 0 else None
 
 
-def within_before(at: float, stamp: float, skew: float) -> bool:
+@overload
+def within_before(at: float, stamp: float, skew: float) -> bool: ...
+
+
+@overload
+def within_before(at: NDArray[Any], stamp: NDArray[Any], skew: float) -> NDArray[Any]: ...
+
+
+def within_before(at: Any, stamp: Any, skew: float) -> Any:
     """Whether a message stamped ``at`` lies within the transport skew ``skew`` before one stamped ``stamp``
     (all three in one unit): ``stamp - skew <= at <= stamp``, the window the guarantee's early answer
-    (closing.py ``_early``) and the deadline rule (:mod:`.deadline_skew`) read."""
-    return stamp - skew <= at <= stamp
+    (closing.py ``_early``) and the deadline rule (:mod:`.deadline_skew`) read.  ``at`` and ``stamp`` may be
+    numpy arrays (the batch path's columns, float64 as the doubles above): then a boolean array, element by
+    element (NaN is never within)."""
+    return (stamp - skew <= at) & (at <= stamp)
 
 
 __all__ = ["DEFAULT_SKEW_S", "parse_skew", "within_before"]
