@@ -78,13 +78,14 @@ class TraceCheckRow(msgspec.Struct, frozen=True):
 class PremiseRow(msgspec.Struct, frozen=True):
     """A premise the check used (:class:`rclverify.records.stage_records.Premise`): its label, its kind
     (``guarantee``, ``assumption``, ``fact``, ``initial value``, ``progress`` ...), its node (``None`` for
-    the requirement's own ``assuming``), 1-based index and its text (RCL)."""
+    the requirement's own ``assuming``), 1-based index, its text (RCL) and ``file:line:col``."""
 
     label: str
     kind: str
     node: str | None = None
     index: int = 0
     text: str = ""
+    source: str = ""
 
 
 class DeclarationRow(msgspec.Struct, frozen=True):
@@ -101,9 +102,11 @@ class DeclarationRow(msgspec.Struct, frozen=True):
 
 class RequirementCheckRow(msgspec.Struct, frozen=True):
     """A requirement's check record (``requirements[].check``), the keys its readers read: the formal
-    statement and its ``file:line:col``, the cone, Z3's counterexample, the temporal check's record and
-    the recorded runs checked; the proof's script (``smt2``), the ``assuming`` formulas, the premises
-    used, the declarations with their evidence and the second solver's agreement."""
+    statement and its ``file:line:col``, the cone, Z3's counterexample (with the note on values outside
+    the assumptions), the temporal check's record and the recorded runs checked; the proof's script
+    (``smt2``), the ``assuming`` formulas, the premises used, those traced but not needed, the cores (of
+    an inconsistency, of a vacuous premise), the guarantees that did not prevent a counterexample, the
+    declarations with their evidence and the second solver's agreement."""
 
     formal: str | None = None
     source: str | None = None
@@ -114,6 +117,11 @@ class RequirementCheckRow(msgspec.Struct, frozen=True):
     smt2: str | None = None
     assuming: list[str] = []
     used: list[PremiseRow] = []
+    traced_not_needed: list[PremiseRow] = []
+    inconsistent_core: list[PremiseRow] = []
+    vacuity_core: list[PremiseRow] = []
+    failed_to_prevent: list[PremiseRow] = []
+    counterexample_note: str | None = None
     declarations: list[DeclarationRow] = []
     solvers: Solvers | None = None
 
