@@ -29,6 +29,7 @@ from rclverify.traces.events import Event, to_ns
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.verdicts import KEPT_VIOLATIONS, WEAK as _WEAK, in_all, link_of, names, producers
 from rclverify.backends.monitors.shapes import Violation
+from rclverify.backends.monitors.skew import within_before
 from rclverify.backends.monitors.engine_state import EngineState
 
 
@@ -184,8 +185,10 @@ class Closing(EngineState):
 
     def _early(self, q: Question) -> list[Any]:
         """The outputs judged at once (``_recent``) that were received before
-        question ``q`` and stamped within the transport skew before it."""
-        return [r for r in self._recent if q.stamp - self._reach_of(r[0]) <= r[1] <= q.stamp
+        question ``q`` and stamped within the transport skew before it (the one
+        window, :func:`.skew.within_before`, as wide as the output reaches: the
+        skew, or how long after its stamp it was published)."""
+        return [r for r in self._recent if within_before(r[1], q.stamp, self._reach_of(r[0]))
                 and r[0].index < q.event.index]
 
     def _forget(self, used: list[Any]) -> None:
