@@ -55,33 +55,54 @@ def verdict_record(item: str, v: Any, stamp: float | None = None) -> dict[str, A
 
 def log_records(path: Path) -> list[dict[str, Any]]:
     """The records of the verdict lines of the live log at ``path``, in the
-    log's order, each message's header stamp read from its own line (lines
-    that are not JSON are passed over: a log cut short by a stop ends
-    mid-line).  Raises :class:`OSError` when the log cannot be read."""
-    stamps: dict[tuple[str, float], float] = {}
+    log's order.  A verdict on message ``N`` (its ``where``) is on the log's
+    N-th message line (0-based; the lines of topics ``rclverify/...`` are no
+    messages), whose header stamp, else its time, names the message: the
+    time a recorded run gives it, also for a message the live run heard late
+    and placed at its watermark.  Lines that are not JSON are passed over (a
+    log cut short by a stop ends mid-line).  Raises :class:`OSError` when the
+    log cannot be read."""
+    messages: list[str] = []
     verdicts: list[tuple[str, dict[str, Any]]] = []
     with path.open(encoding="utf-8", errors="replace") as f:
         for line in f:
-            verdict = VERDICT_TOPIC in line
-            if not verdict and '"stamp"' not in line:
+            if not line.startswith(_OWN) and not line.startswith(_OWN_COMPACT):
+                messages.append(line)
+                continue
+            if VERDICT_TOPIC not in line:
                 continue
             try:
                 rec = json.loads(line)
             except ValueError:
                 continue
-            if not isinstance(rec, dict):
-                continue
-            v = rec.get("verdict") if rec.get("topic") == VERDICT_TOPIC else None
+            v = rec.get("verdict") if isinstance(rec, dict) and rec.get("topic") == VERDICT_TOPIC else None
             if isinstance(v, dict):
                 verdicts.append(("deadline" if rec.get("kind") == "deadline" else
                                  ("call" if v.get("call") else "guarantee"), v))
-            elif not verdict and isinstance(rec.get("time"), (int, float)):
-                ns = header_stamp_ns(rec)
-                if ns is not None:
-                    stamps[(str(rec.get("topic", "")).strip("/"), float(rec["time"]))] = ns / 1e9
-    return [verdict_record(item, v, None if item == "deadline" else
-                           stamps.get((str(v.get("topic", "")).strip("/"), float(v.get("time", 0.0)))))
+    return [verdict_record(item, v, None if item != "guarantee" else _message_time(messages, v))
             for item, v in verdicts]
+
+
+#: how a log's own lines (``rclverify/verdict``, ``rclverify/call``, ``rclverify/run`` ...) begin
+_OWN, _OWN_COMPACT = '{"topic": "rclverify/', '{"topic":"rclverify/'
+
+
+def _message_time(messages: list[str], v: dict[str, Any]) -> float | None:
+    """The header stamp, else the time, of the log's message line verdict ``v`` is on (``where``:
+    ``message N``); ``None`` when it names no message line of its topic."""
+    where = str(v.get("where", ""))
+    n = where.removeprefix("message ")
+    if n == where or not n.isdigit() or int(n) >= len(messages):
+        return None
+    try:
+        rec = json.loads(messages[int(n)])
+    except ValueError:
+        return None
+    if not isinstance(rec, dict) or str(rec.get("topic", "")).strip("/") != str(v.get("topic", "")).strip("/"):
+        return None
+    ns = header_stamp_ns(rec)
+    t = rec.get("time")
+    return ns / 1e9 if ns is not None else (float(t) if isinstance(t, (int, float)) else None)
 
 
 def write_records(path: Path, records: Iterable[dict[str, Any]]) -> None:
