@@ -33,21 +33,27 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 from _robot_verdicts import compare, finals, tally, three_way  # noqa: E402
 
 PERIOD, DELAY, N = 0.3, 0.12, 8
+#: the answer heard later than the lateness bound (50 ms): 200 ms after its publication
+LATE, LATE_S = 5, 0.2
 
 
 def _sent() -> list[dict[str, Any]]:
-    """Readings 1.0, 1.5 ... every 300 ms from 1 s, each copied 120 ms later onto an answer with its stamp."""
+    """Readings every 300 ms from 1 s, each copied 120 ms later onto an answer with its stamp; each
+    message with the time it reaches the monitor (``heard``): 1 ms after publication, answer
+    :data:`LATE` 200 ms."""
     out = []
     for i in range(N):
         t = 1.0 + i * PERIOD
-        out.append(_msg("x", t, t, value=float(i) + 0.5))
-        out.append(_msg("r", t + DELAY, t, range=float(i) + 0.5))
+        out.append({**_msg("x", t, t, value=float(i) + 0.5), "heard": t + 0.001})
+        out.append({**_msg("r", t + DELAY, t, range=float(i) + 0.5),
+                    "heard": t + DELAY + (LATE_S if i == LATE else 0.001)})
     return out
 
 
 def _live_log(ws: Path) -> list[dict[str, Any]]:
-    """The log the live monitor writes of ``_sent()`` heard 1 ms after publication: each message at its
-    event time (its header stamp), each verdict as the online engine and the deadline monitor gave it."""
+    """The log the live monitor writes of ``_sent()``: each message at its event time (its header stamp),
+    one heard later than the bound at its source time with its lateness (runtime/live.py), each verdict as
+    the online engine and the deadline monitor gave it."""
     checked = load([ws / "contracts" / "c.rcl"])
     rules = load_mapping(ws, "mapping.yaml").rules
     lines: list[dict[str, Any]] = []
@@ -56,18 +62,20 @@ def _live_log(ws: Path) -> list[dict[str, Any]]:
     dm = DeadlineMonitor(checked, checked.nodes["Relay"], rules, deadline, horizon=1.0)
 
     def released(ev: Any) -> None:
-        lines.append({"topic": ev.topic, "time": ev.time, **dict(ev.fields)})
+        late = {"late_s": round(ev.late, 6)} if ev.late else {}
+        lines.append({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time, **late,
+                      **dict(ev.fields)})
         dm.feed(ev)
     eng = OnlineEngine(checked, [checked.nodes["Relay"]], rules, 1.0, reorder_window=0.05,
                        on_verdict=lambda v: lines.append({"topic": VERDICT_TOPIC, "time": v.decided_at,
                                                           "verdict": v.to_json()}), on_event=released)
     now = 1.0
-    for k, m in enumerate(sorted(_sent(), key=lambda m: m["time"])):
-        while now + 0.01 <= m["time"] + 0.001:
+    for m in sorted(_sent(), key=lambda m: m["heard"]):
+        while now + 0.01 <= m["heard"]:
             now += 0.01
             eng.tick(now)
             dm.advance(eng.watermark(now))
-        eng.push(m["topic"], {x: v for x, v in m.items() if x not in ("topic", "time")}, m["time"], f"heard {k}")
+        eng.push(m["topic"], {x: v for x, v in m.items() if x not in ("topic", "time", "heard")}, m["time"])
     eng.finish()
     dm.finish()
     return lines
@@ -100,6 +108,11 @@ def test_the_live_verdicts_of_a_log_are_its_offline_verdicts_one_by_one(
         [1.0 + i * PERIOD for i in range(N)])
     assert compare(f, finals(offline)) == []
     assert three_way({"live": live, "log": offline, "bag": offline})[1] == []
+    # the answer heard late: placed live at the watermark, not at its stamp, and named by its stamp
+    late = next(json.loads(x)["verdict"] for x in log.read_text().splitlines()
+                if '"verdict"' in x and json.loads(x)["verdict"].get("topic") == "r"
+                and json.loads(x)["verdict"]["time"] > 1.0 + LATE * PERIOD + 0.05)
+    assert late["verdict"] == "satisfied"
 
 
 def test_the_control_one_changed_verdict_is_found_with_both_sides(
@@ -146,3 +159,26 @@ def test_a_revision_replaces_the_verdict_given_before_and_a_provisional_one_is_t
     assert [(round(d.time, 6), d.provisional) for d in found] == [(1.0, False), (1.3, True)]
     # a message 2 ms off is another message: each side's verdict has no counterpart
     assert len(compare(finals([_rec("satisfied", 1.0)]), finals([_rec("satisfied", 1.002)]))) == 2
+
+
+def test_a_live_verdict_names_its_message_by_the_log_line_it_is_on(tmp_path: Path) -> None:
+    """Seed 516 of the robot generator: a relay's first answer, heard 219 ms late, was placed live at
+    the watermark (749.98484), neither its stamp (749.928117) nor its log line's time (its source time,
+    750.1597): its verdict names it by the log's message line it is on (``message 1``), its header stamp.
+    The control: an unstamped message is named by its line's time, and a verdict whose ``where`` names
+    no message line of its topic keeps its own time."""
+    stamp = {"header": {"stamp": {"sec": 749, "nanosec": 928117200}}}
+    lines = [{"topic": "s0", "time": 749.9281172, **stamp, "range": 2.95},
+             {"topic": "rclverify/call", "time": 749.95, "kind": "call", "part": "unjudged", "link": "x"},
+             {"topic": "r4", "time": 750.2609477, "late_s": 0.219456, **stamp, "range": 2.95},
+             {"topic": "a5", "time": 749.98484, "data": True},
+             {"topic": VERDICT_TOPIC, "time": 750.26, "verdict": {"node": "Relay4", "verdict": "satisfied", "event": 1,
+                                                                  "time": 749.98484, "where": "message 1", "topic": "r4"}},
+             {"topic": VERDICT_TOPIC, "time": 750.27, "verdict": {"node": "Alarm5", "verdict": "satisfied", "event": 2,
+                                                                  "time": 749.98484, "where": "message 2", "topic": "a5"}},
+             {"topic": VERDICT_TOPIC, "time": 750.28, "verdict": {"node": "Alarm5", "verdict": "satisfied", "event": 2,
+                                                                  "time": 749.98484, "where": "message 0", "topic": "a5"}}]
+    log = tmp_path / "live.jsonl"
+    log.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    assert [(r["node"], r["time"]) for r in log_records(log)] == [
+        ("Relay4", pytest.approx(749.9281172, abs=1e-9)), ("Alarm5", 749.98484), ("Alarm5", 749.98484)]
