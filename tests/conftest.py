@@ -133,6 +133,7 @@ SECONDS: dict[str, float] = {
     # run alone too, once its three readers shared it
     "test_statistics": 2.3, "test_batch_deadlines": 2.3, "test_monitors": 2.5, "test_units": 2.1,
     "test_witness": 2.1, "test_problems_model_checking": 2.3,
+    "test_generated_seed_faults": 6.0,  # two generated robots' recorded runs judged offline, one replayed online
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
