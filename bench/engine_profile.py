@@ -17,6 +17,13 @@ and each latched last verdict, is serialized as the DDS run makes its
 ``std_msgs/String`` sample (its ``write`` into Cyclone is not included); the log is written to a
 temporary file.
 
+``--worker``: the messages offered in real time instead, at ``--rate``
+(the wall clock's), to the live monitor's engine thread itself
+(:class:`~rclverify.runtime.worker.EngineWorker`, its queue, its wake-ups
+and its timer on ``time.time``), as the middleware's thread offers them:
+the thread's CPU a message with what waking for each message and each
+release costs (``EngineWorker.cpu_s``), and its profile.
+
 ``--log FILE``: the messages of a recorded live log instead (JSON lines of
 ``rclverify monitor --live``'s ``--log``, each line's ``topic``, ``time``
 and fields; verdict lines skipped), pushed as decoded fields at their
@@ -28,6 +35,7 @@ then, under ``cProfile``, the ``--top`` functions by own time and by
 cumulative time.  Usage::
 
     python3 bench/engine_profile.py [--messages 5000] [--rate 1000] [--lateness 0.05] [--top 25]
+    python3 bench/engine_profile.py --worker [--messages 5000] [--rate 1000]
     python3 bench/engine_profile.py --log live.jsonl --workspace WS [--mapping mapping.yaml]
     python3 bench/engine_profile.py --smoke     # 300 messages, one pass (CI)
 """
@@ -65,7 +73,8 @@ Message = tuple[str, "Mapping[str, object] | None", bytes, float]
 def bench_messages(n: int, rate: float, start: float) -> tuple[list[Message], Callable[[str, bytes], Any],
                                                                   Callable[[str], bytes]]:
     """``n`` messages of the rclpy bench's publisher, serialized, ``1 / rate`` s apart from ``start`` (s);
-    the decoder the DDS and rclpy sources share (CDR to fields) and the verdict sample's serializer."""
+    the decoder the DDS and rclpy sources share (CDR to fields, :func:`~rclverify.runtime.dds.cdr_fields.read_fields`)
+    and the verdict sample's serializer."""
     from rclverify.runtime.dds.types import TypeBook, to_fields
     book = TypeBook()
     structs = {t: book.message(typ) for t, typ in TYPES.items()}
@@ -80,8 +89,14 @@ def bench_messages(n: int, rate: float, start: float) -> tuple[list[Message], Ca
         t = "abc"[k % 3]
         msgs.append((t, None, raw[t], start + k / rate))
 
+    try:  # the DDS run's decoder (runtime/dds/live.py), else the struct's deserializer and to_fields
+        from rclverify.runtime.dds.cdr_fields import read_fields
+    except ImportError:
+        def read_fields(cls: Any, data: bytes) -> Any:
+            return to_fields(cls.deserialize(data))
+
     def decode(topic: str, data: bytes) -> Any:
-        return to_fields(structs[topic].deserialize(data))
+        return read_fields(structs[topic], data)
 
     try:  # the verdict's bytes as the DDS run makes them (runtime/dds/live.py), else the struct's serializer
         from rclverify.runtime.dds.live import string_cdr as serialize
@@ -150,6 +165,38 @@ def drive(run: Any, msgs: list[Message], decode: Callable[[str, bytes], Any] | N
     return len(msgs)
 
 
+def drive_worker(run: Any, msgs: list[Message], decode: Callable[[str, bytes], Any] | None, rate: float,
+                 lateness: float, prof: cProfile.Profile | None = None, linger: float = 0.0) -> float:
+    """``msgs`` offered to a real :class:`~rclverify.runtime.worker.EngineWorker` feeding ``run``, one every
+    ``1 / rate`` s of the wall clock, each at its offer time (``time.time``); waits the lateness bound
+    and a little more, stops the worker.  Returns its thread's CPU seconds per message; ``prof``, when
+    given, profiles that thread; ``linger`` is the worker's ``linger_s``."""
+    from rclverify.runtime.worker import EngineWorker
+
+    class Profiled(EngineWorker):
+        def _loop(self) -> None:
+            if prof is None:
+                return super()._loop()
+            prof.enable()
+            try:
+                return super()._loop()
+            finally:
+                prof.disable()
+
+    def fields_of(topic: str, payload: Any) -> Any:
+        return payload if not isinstance(payload, bytes) else decode(topic, payload) if decode else {}
+    worker = Profiled(run, fields_of, time.time, tick_s=TICK_S, linger_s=linger).start()
+    start = time.monotonic()
+    for k, (topic, fields, raw, _t) in enumerate(msgs):
+        wait = start + k / rate - time.monotonic()
+        if wait > 0:
+            time.sleep(wait)
+        worker.offer(topic, fields if fields is not None else raw, time.time())
+    time.sleep(lateness + 0.2)  # the last release
+    worker.stop()
+    return worker.cpu_s / max(worker.handled, 1)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--messages", type=int, default=5000)
@@ -157,6 +204,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--lateness", type=float, default=0.05, help="the lateness bound, --reorder-window (s)")
     p.add_argument("--repeat", type=int, default=3, help="timed passes (the best is printed)")
     p.add_argument("--top", type=int, default=25)
+    p.add_argument("--worker", action="store_true",
+                   help="offer the messages in real time to the live engine thread (EngineWorker) at --rate")
+    p.add_argument("--linger", type=float, default=None,
+                   help="with --worker: the worker's linger_s (s; default the live DDS run's, LINGER_S)")
     p.add_argument("--log", type=Path, help="a recorded live log's messages instead of the bench's")
     p.add_argument("--workspace", type=Path, help="with --log: the workspace of its contracts")
     p.add_argument("--mapping", default=None, help="with --log: the mapping file, relative to the workspace")
@@ -183,6 +234,23 @@ def main(argv: list[str] | None = None) -> int:
             sent.append(serialize(text))
 
         best = math.inf
+        if a.worker:
+            prof = cProfile.Profile()
+            run = make_run(ws, mapping, tmp / "worker.jsonl", a.lateness, publish)
+            from rclverify.runtime.worker import LINGER_S
+            linger = LINGER_S if a.linger is None else a.linger
+            per = drive_worker(run, msgs, decode, a.rate, a.lateness, linger=linger)
+            run.stop()
+            given = len(sent)
+            run = make_run(ws, mapping, tmp / "worker_profiled.jsonl", a.lateness, publish)
+            drive_worker(run, msgs, decode, a.rate, a.lateness, prof, linger)
+            run.stop()
+            print(f"engine thread (EngineWorker, offered at {a.rate:g} msg/s of the wall clock, linger "
+                  f"{linger * 1e3:g} ms): {len(msgs)} "
+                  f"message(s), {given} verdict sample(s): {per * 1e6:.1f} us CPU per message (wake-ups, "
+                  "decode, push, ticks, log, verdict samples)")
+            _print_profile(prof, a.top)
+            return 0
         for i in range(max(1, a.repeat)):
             sent.clear()
             run = make_run(ws, mapping, tmp / f"live{i}.jsonl", a.lateness, publish)
@@ -198,13 +266,20 @@ def main(argv: list[str] | None = None) -> int:
         drive(run, msgs, decode)
         prof.disable()
         run.stop()
+    _print_profile(prof, a.top)
+    return 0
+
+
+def _print_profile(prof: cProfile.Profile, top: int) -> None:
+    """The ``top`` functions of ``prof`` by own time, then by cumulative time."""
+    if top <= 0:
+        return
     for key in ("tottime", "cumulative"):
         s = io.StringIO()
-        pstats.Stats(prof, stream=s).sort_stats(key).print_stats(a.top)
+        pstats.Stats(prof, stream=s).sort_stats(key).print_stats(top)
         text = s.getvalue()
-        print(f"-- top {a.top} by {key} --")
+        print(f"-- top {top} by {key} --")
         print(text[text.find("   ncalls"):].rstrip())
-    return 0
 
 
 if __name__ == "__main__":
