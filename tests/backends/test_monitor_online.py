@@ -305,3 +305,38 @@ def test_a_message_arriving_as_the_first_tick_reads_the_clock_does_not_stop_the_
     record = live.stop()
     assert worker.error is None and record["events"] == len(events)
     assert ticks and all(math.isfinite(t) for t in ticks), ticks
+
+
+@pytest.mark.parametrize("linger", [1.5, 0.0])
+def test_a_lingering_engine_thread_lets_messages_gather_before_taking_them(
+        case_study: tuple[Any, Any], tmp_path: Path, linger: float) -> None:
+    """With ``linger_s`` the worker, having taken a message, takes the next one only once the linger is over
+    (the timer and the release far away); without it (the control) at once."""
+    from rclverify.runtime.live import LiveRun
+    from rclverify.runtime.worker import EngineWorker
+    checked, cfg = case_study
+    live = LiveRun(checked, list(checked.nodes.values()), cfg.rules, cfg.horizon, tmp_path / "l.jsonl",
+                   reorder_window=100.0, publish=lambda _: None)
+    events = list(read_trace(TRACES / "nominal.jsonl", MSG))[:2]
+    worker = EngineWorker(live, lambda topic, fields: fields, lambda: 0.0, tick_s=100.0, linger_s=linger).start()
+
+    def handled(n: int, within: float) -> float:
+        t0 = time.monotonic()
+        while worker.handled < n and time.monotonic() - t0 < within:
+            time.sleep(0.005)
+        assert worker.handled >= n
+        return time.monotonic() - t0
+    try:
+        worker.offer(events[0].topic, events[0].fields, 0.0)
+        handled(1, 10.0)
+        time.sleep(0.2)  # the worker is past its batch: napping (linger) or waiting on the queue
+        worker.offer(events[1].topic, events[1].fields, 0.0)
+        if linger:
+            time.sleep(0.3)
+            assert worker.handled == 1  # gathering
+            handled(2, 10.0)
+        else:
+            assert handled(2, 10.0) < 1.0
+    finally:
+        worker.stop()
+        live.stop()

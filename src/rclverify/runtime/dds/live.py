@@ -21,7 +21,12 @@ messages in and verdicts out over DDS (:mod:`rclverify.ros.live.dds`):
 
 Threads: Cyclone's own (C, no GIL), the bus thread (takes raw samples,
 queues them), the engine thread (decodes, checks, logs, publishes, runs
-the timer), and the caller's (status lines, the stop).  The wait for the
+the timer; with a lateness bound it lets messages gather for
+:data:`~rclverify.runtime.worker.LINGER_S` rather than waking for each),
+and the caller's (status lines, the stop).  While the run lasts the
+interpreter's switch interval is :data:`SWITCH_INTERVAL_S` (Python's
+default is 5 ms): the engine thread, woken for a release, waits at most
+that long for the bus thread to hand the interpreter over.  The wait for the
 stop and the evidence record are :mod:`.live_end`'s: the ROS 1 record
 (``live.stop_and_record``) with ``calls`` (per node the call-by-call
 verdicts' status), ``deadlines``, ``qos`` (per topic the reader's QoS and
@@ -30,6 +35,7 @@ what it heard), ``warnings``, ``enforce`` and ``bag``.
 from __future__ import annotations
 
 import math
+import sys
 import time as _time
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -42,12 +48,13 @@ from rclverify.runtime.dds.bag import BagRecorder
 from rclverify.runtime.dds.bag_calls import CallRecorder
 from rclverify.backends.monitors.dds_calls import CallBook
 from rclverify.runtime.dds.services import CallTaps
-from rclverify.runtime.dds.types import DdsTypeError, TypeBook, to_fields
+from rclverify.runtime.dds.cdr_fields import read_fields
+from rclverify.runtime.dds.types import DdsTypeError, TypeBook
 from rclverify.runtime.dds.wire import WriterIds
 from rclverify.runtime.live import VERDICT_LOG_TOPIC, LiveRun, dumps
 from rclverify.runtime.live_status import warm_bounds
 from rclverify.runtime.ros1 import contract_topics
-from rclverify.runtime.worker import EngineWorker
+from rclverify.runtime.worker import LINGER_S, EngineWorker
 from rclverify.runtime.dds.bag import BagError
 from rclverify.traces.event_time import event_ns
 from rclverify.runtime.dds.bus import Bus
@@ -55,6 +62,8 @@ from rclverify.runtime.dds.trust import VERDICT_KEY
 from rclverify.runtime.dds.live_end import DdsRunEnd
 
 
+#: the interpreter's switch interval during a run (s; module docstring)
+SWITCH_INTERVAL_S = 0.001
 #: the encapsulation header of plain little-endian CDR (XCDR1), as rmw writes ROS 2 messages
 _CDR_LE = b"\x00\x01\x00\x00"
 
@@ -71,8 +80,10 @@ def string_cdr(text: str) -> bytes:
 class _Sink:
     """What the engine thread feeds: the run's engine, and the call book's clock."""
 
-    def __init__(self, live: LiveRun, book: CallBook | None, taps: CallTaps | None, window: float) -> None:
+    def __init__(self, live: LiveRun, book: CallBook | None, taps: CallTaps | None, window: float,
+                 flush_writes: Callable[[], None] | None = None) -> None:
         self.live, self.book, self.taps, self.window = live, book, taps, window
+        self.flush_writes = flush_writes
 
     def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
         self.live.push(topic, fields, received)
@@ -84,6 +95,11 @@ class _Sink:
         self.live.tick(now)
         if self.book is not None and self.taps is not None:
             self.taps.tick(now, self.window)  # the book's clock as far behind as the topic engine's, or more
+
+    def flush(self) -> None:
+        """Hand on the verdicts the bus holds (the rclpy source's writes to its agent; the DDS bus writes each)."""
+        if self.flush_writes is not None:
+            self.flush_writes()
 
 
 def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[CheckedNode],
@@ -114,14 +130,17 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
     dp = make_participant() if bus_factory is None else None
     run.join(dp, run_factory, verdict_topic, last_prefix, bus_factory)
     run.live.note(origin_line(_time.time(), *run.origin()))  # the log says which source heard it (run_origin.py)
-    worker = EngineWorker(_Sink(run.live, run.book, run.calls, reorder_window), run.decode, _time.time,
-                          tick_s=tick_s)
+    worker = EngineWorker(_Sink(run.live, run.book, run.calls, reorder_window, getattr(run.bus, "flush_writes", None)),
+                          run.decode, _time.time,
+                          tick_s=tick_s, linger_s=LINGER_S if reorder_window > 0 else 0.0)
     run.worker_box.append(worker.start())
     run.bus.start()
     via = f"through rclpy on {run.source_rmw()}" if dp is None else f"on DDS domain {domain_id()}"
     out(f"monitoring {len(run.structs)} topic(s) and {len(run.calls.specs) if run.calls else 0} service/action "
         f"topic(s) for {len(nodes)} node(s) {via}; verdicts on {verdict_topic}")
     warm_bounds()  # the status line a stop prints need not wait for scipy (live_status.py)
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(SWITCH_INTERVAL_S)
     try:
         run.wait(worker, stop, duration, tick_s, status_s)
     finally:
@@ -129,6 +148,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
         run.bus.close()
         if dp is not None:
             dp.__del__()
+        sys.setswitchinterval(switch)
     return record_
 
 
@@ -335,7 +355,7 @@ class _DdsRun(DdsRunEnd):
                     self.call_recorder.sample(key, raw, source_ns, payload[3])
                 calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9, payload[3])
                 return None
-            fields: Mapping[str, object] = to_fields(self.structs[key].deserialize(raw))
+            fields: Mapping[str, object] = read_fields(self.structs[key], raw)  # to_fields(deserialize(raw))
         except Exception:  # bytes that are not the contract's type: counted, never a crash
             self.decode_errors[key] = self.decode_errors.get(key, 0) + 1
             return None

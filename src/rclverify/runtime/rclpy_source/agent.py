@@ -21,6 +21,15 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   each a round) and the round's frames are written to the monitor in one
   write: under load the agent takes messages in batches rather than one
   executor turn each, and its history covers seconds at 5000 messages/s.
+  After a round that took messages the agent lets the next ones gather
+  for :data:`LINGER_S` before it waits again: at 1000 messages/s an
+  executor turn a message (its wait set built anew, about 200 us) was most
+  of its CPU.  A message is then handed over at most that much later; its
+  time is its source timestamp, which the wait does not change.
+* **A lean node**: no parameter services, no rosout publisher, and no
+  default QoS event callbacks on its subscriptions and publishers (the
+  monitor compares the publishers' QoS itself): the executor waits on the
+  taps, the writers' nothing, and its guard condition only.
 * **The graph**: each tapped or watched topic's publishers
   (GID, node, namespace, type, type hash, reliability, durability) as the
   ROS 2 graph API reports them, sent when they change.  The agent's node is
@@ -82,6 +91,10 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+try:  # Iron and later
+    from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
+except ImportError:  # Humble
+    from rclpy.qos_event import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import get_rmw_implementation_identifier
 
@@ -97,6 +110,13 @@ else:  # run as a script: its folder is on sys.path (module docstring)
     from agent_graph import Endpoint, GraphReading, endpoint, graph_dump, matches
 
 GRAPH_PERIOD_S = 0.1
+#: seconds the agent lets messages gather after a round that took some (module docstring); a fraction of
+#: the monitor's lateness bound (the CLI's 50 ms)
+LINGER_S = 0.002
+#: the interpreter's switch interval in the agent (s; Python's default 5 ms): the thread reading the
+#: monitor's commands (a verdict to publish per message) holds the main thread off the samples at most
+#: this long
+SWITCH_INTERVAL_S = 0.0005
 #: seconds between two readings of the services' and actions' servers and clients (one query per node each)
 SERVICE_PERIOD_S = 0.5
 
@@ -179,7 +199,7 @@ class Agent(GraphReading, Describing):
     def __init__(self) -> None:
         rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
         self.name = f"_rclverify_monitor_{os.getpid()}"
-        self.node = Node(self.name)
+        self.node = Node(self.name, start_parameter_services=False, enable_rosout=False)  # lean (docstring)
         self.ex = SingleThreadedExecutor()
         self.ex.add_node(self.node)
         self.taps: dict[int, _Tap] = {}
@@ -222,7 +242,9 @@ class Agent(GraphReading, Describing):
                              else ReliabilityPolicy.BEST_EFFORT,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL if c.get("transient_local")
                              else DurabilityPolicy.VOLATILE)
-            self.writers[int(c["id"])] = self.node.create_publisher(_class(c["type"]), c["topic"], qos)
+            self.writers[int(c["id"])] = self.node.create_publisher(
+                _class(c["type"]), c["topic"], qos,
+                event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
         elif op == "write":
             self.writers[int(c["id"])].publish(base64.b64decode(c["raw"]))
         elif op == "describe":
@@ -258,7 +280,9 @@ class Agent(GraphReading, Describing):
             qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=TAP_DEPTH,
                              reliability=ReliabilityPolicy.RELIABLE if want[0] else ReliabilityPolicy.BEST_EFFORT,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL if want[1] else DurabilityPolicy.VOLATILE)
-            tap["sub"] = self.node.create_subscription(tap["cls"], tap["topic"], _handler(k), qos, raw=True)
+            tap["sub"] = self.node.create_subscription(
+                tap["cls"], tap["topic"], _handler(k), qos, raw=True,
+                event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
             tap["qos"], tap["heard"] = want, heard
             self._said(k, tap)
 
@@ -296,8 +320,13 @@ class Agent(GraphReading, Describing):
         rclpy.try_shutdown()
 
 
+#: samples taken so far (the executor's callbacks and :meth:`Agent.drain`'s), for the round's linger
+_TAKEN = [0]
+
+
 def _handler(k: int) -> Any:
     def on_message(raw: bytes, info: dict[str, Any]) -> None:
+        _TAKEN[0] += 1
         gid = (info.get("publisher_gid") or {}).get("data") or b""
         # receipt: when the agent takes the message (as the DDS bus stamps it), never rmw's own receipt stamp: the
         # executor takes each subscription's messages in turn, so rmw's stamps would go back and forth across
@@ -320,6 +349,7 @@ def main() -> int:
         flush()
         return 0
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.setswitchinterval(SWITCH_INTERVAL_S)
     q: queue.Queue[_Command | None] = queue.Queue()
     try:
         agent = Agent()
@@ -359,10 +389,13 @@ def main() -> int:
             if agent.asked:
                 agent.describing()
             flush()
+            before = _TAKEN[0]
             agent.ex.spin_once(timeout_sec=GRAPH_PERIOD_S)
             while agent.drain() >= TAKE_MAX:  # a backlog: taken in rounds, each round's frames written at once
                 flush()
             flush()
+            if _TAKEN[0] > before:  # messages come: let the next ones gather (module docstring)
+                time.sleep(LINGER_S)
     finally:
         agent.close()
 

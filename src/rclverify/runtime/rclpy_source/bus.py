@@ -35,6 +35,9 @@ bytes at a time, so one read hands over every frame waiting):
   warning says what was heard, what the monitor knows, why the publisher's
   own definition could not be had, and what to do (the robot's ``.msg``
   with ``--interfaces``); the publisher is never heard;
+* the monitor's writes (its verdicts) are command lines to the agent,
+  held in the pipe's buffer and handed over in one write per batch of the
+  engine thread (:meth:`RclpyBus.flush_writes`), in the order written;
 * a sample carries its writer's GID and sequence number: the messages a
   publisher wrote before the monitor heard it are counted
   (``published_before_heard``);
@@ -117,7 +120,7 @@ class _Writer:
     def write_raw(self, raw: bytes) -> None:
         """Publish serialized bytes (encapsulation header included) as they are: the gate's release of a
         message it held back (``--enforce``), byte for byte."""
-        self.bus._send({"op": "write", "id": self.wid, "raw": base64.b64encode(raw).decode()})
+        self.bus._send({"op": "write", "id": self.wid, "raw": base64.b64encode(raw).decode()}, hold=True)
 
 
 class RclpyBus(DeclaredTypes):
@@ -253,7 +256,9 @@ class RclpyBus(DeclaredTypes):
             raise RclpyUnavailable(f"{obj.get('text', 'the rclpy agent could not start')} (in {self.python})")
         self.hello = obj
 
-    def _send(self, obj: Mapping[str, object]) -> None:
+    def _send(self, obj: Mapping[str, object], hold: bool = False) -> None:
+        """One command line to the agent; with ``hold`` (a write) kept in the pipe's buffer until
+        :meth:`flush_writes` or the next command not held, in the order sent."""
         proc = self._proc
         if proc is None or proc.stdin is None or self._gone:
             return
@@ -261,8 +266,22 @@ class RclpyBus(DeclaredTypes):
         with self._lock:
             try:
                 proc.stdin.write(line)
-                proc.stdin.flush()
+                if not hold:
+                    proc.stdin.flush()
             except (BrokenPipeError, ValueError):  # the agent ended (its exit is the reading thread's to say)
+                self._gone = True
+
+    def flush_writes(self) -> None:
+        """Hand the agent the writes held since the last flush, in one write (the engine thread calls it
+        after each batch of messages and each timer run: a verdict a message would otherwise cost a
+        system call here and a wake-up of the agent's command thread there)."""
+        proc = self._proc
+        if proc is None or proc.stdin is None or self._gone:
+            return
+        with self._lock:
+            try:
+                proc.stdin.flush()
+            except (BrokenPipeError, ValueError):
                 self._gone = True
 
     def _run(self) -> None:
