@@ -17,10 +17,13 @@ The report is decoded once into its record
 (:class:`~rclverify.records.report_record.AssuranceReport`; a JSON object given
 is decoded here) and read as the attributes mypy checks: its requirements,
 nodes (their guarantees), side conditions, findings, obligations, evidence,
-lint, diagnoses and problems.  What the records still keep as JSON is read by
-key: a requirement check's record, a monitored run's violations (the monitors'
-payload), a ROS grounding finding, and the SARIF log and the argument, which
-are files of their own.  A finding, an obligation and a problem are printed by
+lint, diagnoses and problems.  A requirement check's record is decoded into
+:class:`~rclverify.records.requirement_check.RequirementCheckRow`, a ROS
+grounding finding into :class:`_RosFinding` (the keys printed), the SARIF log
+into :mod:`.sarif_view`'s runs and the argument's elements into
+:class:`~rclverify.report.argument.model.ElementRecord` (files of their own: an
+element, rule or result of another shape is left out).  A monitored run's
+violations (the monitors' payload) by :class:`~.explain_items.MonitoredRun`.  A finding, an obligation and a problem are printed by
 :mod:`.explain_items`: each field is printed or named in the record's
 ``INTERNAL_TO["explain"]`` with the reason (tests/records/test_record_shapes.py).
 A report that does not decode raises :class:`msgspec.ValidationError` (a
@@ -38,10 +41,13 @@ from rclverify.records.lint_rows import LintRow
 from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.requirement_rows import RequirementRow
+from rclverify.report.argument.model import ElementRecord
 from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
-from rclverify.report.explain_items import finding_lines, obligation_lines, problem_lines, side_condition_lines
+from rclverify.report.explain_items import (MonitoredRun, finding_lines, obligation_lines, problem_lines,
+                                            side_condition_lines, violation_id_lines, violation_lines)
 from rclverify.report.explain_items import requirement_lines as requirement_lines  # rclverify requirements prints it
 from rclverify.records.records import SEVERITY
+from rclverify.report.sarif_view import ResultView, RuleView, runs_of
 
 #: At most this many obligations of one guarantee are listed one a line; more are counted.
 SHOWN_OBLIGATIONS = 6
@@ -60,6 +66,39 @@ def _fold(text: str) -> str:
     return re.sub(r"[\s_-]+", "", str(text)).lower()
 
 
+class _Place(msgspec.Struct, frozen=True):
+    """A place of a ROS grounding finding (``rcl`` or ``ros``): ``file`` and 1-based line and column."""
+
+    file: str = ""
+    line: int = 1
+    col: int = 1
+
+
+class _RosFinding(msgspec.Struct, frozen=True):
+    """What ``rclverify explain`` prints of a ROS grounding finding
+    (:class:`rclverify.records.stage_records.GroundingFinding`, ros/ground/ground.py ``Finding.to_json``)."""
+
+    code: str = ""
+    severity: str | None = None
+    message: str | None = None
+    node: str | None = None
+    rcl: _Place | None = None
+    ros: _Place | None = None
+
+
+def _elements(argument: object) -> dict[str, ElementRecord]:
+    """The elements of ``argument`` (the parsed ``reports/argument.json``, or ``None``) by id; an element
+    of another shape is left out."""
+    out: dict[str, ElementRecord] = {}
+    for e in argument.get("elements") or [] if isinstance(argument, Mapping) else []:
+        try:
+            el = msgspec.convert(e, ElementRecord)
+        except msgspec.ValidationError:
+            continue
+        out[el.id] = el
+    return out
+
+
 class _Index:
     """The report's items by id (see the module docstring)."""
 
@@ -76,25 +115,21 @@ class _Index:
             self.items.update(dict.fromkeys(ids, kind))
         self.evidence = {e.obligation: e for e in report.evidence}
         self.problems = report.problems
-        self.ros: dict[str, list[Mapping[str, Any]]] = {}  # a grounding finding: ros/ground's JSON object
+        self.ros: dict[str, list[_RosFinding]] = {}  # a grounding finding: ros/ground's record
         for ros_finding in report.grounding.findings if report.grounding is not None else []:
-            self.ros.setdefault(str(ros_finding.get("code", "")), []).append(ros_finding)
+            rf = msgspec.convert(ros_finding, _RosFinding)
+            self.ros.setdefault(rf.code, []).append(rf)
         self.lint: dict[str, list[LintRow]] = {}
         for w in report.lint:
             self.lint.setdefault(w.code, []).append(w)
-        self.rules: dict[str, Mapping[str, Any]] = {}
-        self.results: dict[str, list[Mapping[str, Any]]] = {}
-        try:  # the SARIF log and the argument are optional: one of another shape is left out
-            for run in sarif.get("runs", []) if isinstance(sarif, Mapping) else []:
-                for rule in run.get("tool", {}).get("driver", {}).get("rules", []):
-                    self.rules[str(rule.get("id"))] = rule
-                for res in run.get("results", []):
-                    self.results.setdefault(str(res.get("ruleId")), []).append(res)
-        except (AttributeError, TypeError):
-            self.rules, self.results = {}, {}
-        elements = argument.get("elements") if isinstance(argument, Mapping) else None
-        self.argument = {str(e["id"]): e for e in elements if isinstance(e, Mapping) and "id" in e} \
-            if isinstance(elements, list) else {}
+        self.rules: dict[str, RuleView] = {}
+        self.results: dict[str, list[ResultView]] = {}
+        for run in runs_of(sarif):  # the SARIF log and the argument are optional: of another shape, left out
+            for rule in run.rules:
+                self.rules[str(rule.id)] = rule
+            for res in run.results:
+                self.results.setdefault(str(res.rule_id), []).append(res)
+        self.argument = _elements(argument)
 
     def ids(self) -> list[str]:
         """Every id this index answers to, for suggestions."""
@@ -102,7 +137,7 @@ class _Index:
         out += [f"{n}.g{g.index}" for n, node in self.nodes.items() for g in node.guarantees]
         out += list(self.diagnoses) + list(self.items) + list(self.rules) + list(self.results)
         out += [f"{ob}#{k}" for ob, e in self.evidence.items() if ob
-                for k in range(1, len(e.monitoring.get("violations") or []) + 1)]
+                for k in range(1, len(MonitoredRun.of(e.monitoring).violations) + 1)]
         out += [c for c in self.ros if c] + [c for c in self.lint if c] + list(self.argument)
         return list(dict.fromkeys(out))
 
@@ -167,19 +202,18 @@ class _Index:
     def _rule(self, wanted: str, exact: bool) -> list[str] | None:
         key = self._match(wanted, list(dict.fromkeys(list(self.rules) + list(self.results))), exact)
         if key is not None:
-            rule = self.rules.get(key, {})
-            text = (rule.get("fullDescription") or rule.get("shortDescription") or {}).get("text", "")
+            rule = self.rules.get(key, RuleView())
             results = self.results.get(key, [])
-            out = [f"{key} ({rule.get('name', 'SARIF rule')}): {text}".rstrip(": "),
+            out = [f"{key} ({rule.name}): {rule.description()}".rstrip(": "),
                    f"  {len(results)} result{'s' if len(results) != 1 else ''} in reports/assurance.sarif"
                    + (":" if results else "")]
             for res in results:
-                out.append(f"  {_sarif_place(res)}{clause_cut(_first_line(res.get('message', {}).get('text', '')))}")
+                out.append(f"  {_sarif_place(res)}{clause_cut(_first_line(res.message.text))}")
             return out
         key = self._match(wanted, [c for c in self.ros if c], exact)
         if key is not None:
             return [f"{key}: {len(self.ros[key])} ROS grounding finding(s) (`rclverify ros check`, docs/ros.md):"] + [
-                f"  {_place(f.get('rcl') or f.get('ros'))}{f.get('severity')}: {f.get('message')}" for f in self.ros[key]]
+                f"  {_place(f.rcl or f.ros)}{f.severity}: {f.message}" for f in self.ros[key]]
         key = self._match(wanted, [c for c in self.lint if c], exact)
         if key is not None:
             return [f"{key}: {len(self.lint[key])} lint warning(s):"] + [
@@ -191,11 +225,11 @@ class _Index:
         if key is None:
             return None
         e = self.argument[key]
-        out = [f"{key} [{e.get('status') or '-'}] (argument {e.get('type')})", f"  {e.get('text', '')}"]
-        if e.get("supported_by"):
-            out.append("  supported by: " + ", ".join(e["supported_by"]))
-        if e.get("in_context_of"):
-            out.append("  in context of: " + ", ".join(e["in_context_of"]))
+        out = [f"{key} [{e.status or '-'}] (argument {e.type})", f"  {e.text}"]
+        if e.supported_by:
+            out.append("  supported by: " + ", ".join(e.supported_by))
+        if e.in_context_of:
+            out.append("  in context of: " + ", ".join(e.in_context_of))
         return out
 
     # -- what is printed ---------------------------------------------------------
@@ -210,18 +244,12 @@ class _Index:
 
     def _violation_ids(self, key: str) -> list[str]:
         """The lines naming every violation a monitored run of obligation ``key`` kept."""
-        m = self._monitoring(key)
-        vs = m.get("violations") or []
-        out = [f"  violation {key}#{k}: {v.get('where')} (t = {v.get('time')} s), guarantee {v.get('guarantee')}"
-               for k, v in enumerate(vs, 1)]
-        if m.get("violations_dropped"):
-            out.append(f"  and {m['violations_dropped']} more violation(s), counted, not kept")
-        return (["", "violations (each: `rclverify explain ID`):"] + out) if out else []
+        return violation_id_lines(key, self._monitoring(key))
 
-    def _monitoring(self, key: str) -> Mapping[str, Any]:
-        """The monitored run's record of obligation ``key``'s evidence (backends/monitors), ``{}`` without."""
+    def _monitoring(self, key: str) -> MonitoredRun:
+        """The monitored run of obligation ``key``'s evidence (backends/monitors), empty without."""
         ev = self.evidence.get(key)
-        return ev.monitoring if ev is not None else {}
+        return MonitoredRun.of(ev.monitoring if ev is not None else {})
 
     def _violation(self, wanted: str, exact: bool) -> list[str] | None:
         """``OBLIGATION#N``: the N-th violation a monitored run kept (1-based)."""
@@ -229,18 +257,7 @@ class _Index:
         if not sep or not n.isdigit():
             return None
         key = self._match(ob, [str(e) for e in self.evidence if e], exact)
-        m = self._monitoring(key) if key else {}
-        vs = m.get("violations") or []
-        if not 1 <= int(n) <= len(vs):
-            return None
-        v = vs[int(n) - 1]
-        out = [f"violation {key}#{n} of {len(vs)} on {m.get('trace')}: {v.get('where')} (t = {v.get('time')} s)",
-               f"  guarantee {v.get('guarantee')}: {v.get('formula', '')}"]
-        if v.get("trigger_where"):
-            out.append(f"  answering the question at {v['trigger_where']} (t = {v.get('trigger_time')} s)")
-        out.append(f"  {v.get('reason', '')}")
-        out += [f"    {name} = {value}" for name, value in sorted((v.get("values") or {}).items())]
-        return out
+        return violation_lines(key, int(n), self._monitoring(key)) if key else None
 
     def guarantee_lines(self, node: str, g: GuaranteeRow, indent: str = "") -> list[str]:
         k = g.index
@@ -306,8 +323,8 @@ class _Index:
         out += [f"  culprit of a problem [{c.status}]: {clause_cut(c.sentence, 300)}"
                 for c in _culprit_of(n)]  # report/culprits.py
         for f in (g for fs in self.ros.values() for g in fs):
-            if f.get("node") == node:
-                out.append(f"  ROS grounding {f.get('severity')}: {f.get('message')} ({f.get('code')})")
+            if f.node == node:
+                out.append(f"  ROS grounding {f.severity}: {f.message} ({f.code})")
         return out
 
 
@@ -316,20 +333,13 @@ def _culprit_of(item: NodeRow | GuaranteeRow) -> list[CulpritOf]:
     return [] if item.culprit_of is msgspec.UNSET else item.culprit_of
 
 
-def _place(at: Any) -> str:
-    if isinstance(at, Mapping) and at.get("file"):
-        return f"{at['file']}:{at.get('line', 1)}:{at.get('col', 1)}: "
-    return ""
+def _place(at: _Place | None) -> str:
+    return f"{at.file}:{at.line}:{at.col}: " if at is not None and at.file else ""
 
 
-def _sarif_place(res: Mapping[str, Any]) -> str:
-    for loc in res.get("locations") or []:
-        phys = loc.get("physicalLocation") or {}
-        uri = (phys.get("artifactLocation") or {}).get("uri")
-        region = phys.get("region") or {}
-        if uri:
-            return f"{uri}:{region.get('startLine', 1)}:{region.get('startColumn', 1)}: "
-    return ""
+def _sarif_place(res: ResultView) -> str:
+    place = res.place()
+    return f"{place[0]}:{place[1].start_line}:{place[1].start_column}: " if place else ""
 
 
 def _first_line(text: str) -> str:

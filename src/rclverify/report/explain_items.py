@@ -9,7 +9,9 @@ records/problem_rows.py) and are read as attributes mypy checks; for a
 requirement, a finding, an obligation and a problem each field is printed
 here or named in its record module's ``INTERNAL_TO["explain"]`` with the
 reason it is not (tests/records/test_record_shapes.py).  What a record keeps
-as JSON (a requirement's check, a counterexample) is read by key.  Each
+as JSON is decoded into the reader's Struct: a requirement's check into
+:class:`~rclverify.records.requirement_check.RequirementCheckRow`, its temporal
+check into :class:`_Temporal`, a monitored run's record into :class:`MonitoredRun`.  Each
 function returns the lines to print, two spaces indenting what belongs to
 the item's first line.
 """
@@ -17,11 +19,14 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+import msgspec
+
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import Acknowledged, FindingRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import ProblemRow
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.diagnosis_text import clause_cut, table_lines
@@ -29,6 +34,16 @@ from rclverify.report.summary import whole_sentence
 
 #: The statuses of an item that holds: its model is a witness, and without a diagnosis there is no problem.
 HOLDS = ("discharged", "ok", "warning")
+
+
+class _Temporal(msgspec.Struct, frozen=True):
+    """What is printed of a temporal check's record (``check.temporal``, calculus/shapes.py
+    ``TemporalVerdictJson``): its status, the method that decided it, the detail and a proof's certificate."""
+
+    status: str | None = None
+    method: str | None = None
+    detail: str | None = None
+    certificate: str | None = None
 
 
 def requirement_lines(row: RequirementRow | Mapping[str, Any]) -> list[str]:
@@ -40,28 +55,83 @@ def requirement_lines(row: RequirementRow | Mapping[str, Any]) -> list[str]:
     prevent it (docs/requirements.md).  Raises
     :class:`msgspec.ValidationError` for a row of another shape."""
     r = RequirementRow.of(row)
-    c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
-    out = [f"{r.id}: {r.verdict or 'traced'} [{r.status}]  {c.get('source') or ''}".rstrip(), f"  {r.text}"]
-    if c.get("formal"):
-        out.append(f"  formal: {c['formal']}")
-    out += [f"  assuming: {a}" for a in c.get("assuming") or []]
+    c = RequirementCheckRow.of(r.check)  # the requirement check's record (calculus/requirements/check.py)
+    out = [f"{r.id}: {r.verdict or 'traced'} [{r.status}]  {c.source or ''}".rstrip(), f"  {r.text}"]
+    if c.formal:
+        out.append(f"  formal: {c.formal}")
+    out += [f"  assuming: {a}" for a in c.assuming]
     if r.note:
         out.append(f"  {r.note}")
-    t = c.get("temporal") or {}
-    if t.get("method"):  # how a temporal statement was decided; an IC3/PDR proof's certificate
-        out.append(f"  temporal check: {t.get('status')} by {t['method']}" + (f"; {t['detail']}" if t.get("detail") else ""))
-        if t.get("certificate"):
-            out.append(f"    certificate (inductive invariant, re-checked): {t['certificate']}")
-    out += [f"    used: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("used") or []]
-    out += [f"    traced, not needed: {p['label']}" for p in c.get("traced_not_needed") or []]
-    out += [f"    contradictory: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("inconsistent_core") or []]
-    out += [f"    premise never holds with: {p['label']}: {p['text']}  ({p['source']})"
-            for p in c.get("vacuity_core") or []]
-    for step in c.get("counterexample") or []:
-        out.append(f"    counterexample {step['node']}: " + ", ".join(f"{k} = {v}" for k, v in step["values"].items()))
-    if c.get("counterexample_note"):
-        out.append(f"    {c['counterexample_note']}")
-    out += [f"    did not prevent it: {p['label']}: {p['text']}  ({p['source']})" for p in c.get("failed_to_prevent") or []]
+    t = msgspec.convert(c.temporal or {}, _Temporal)
+    if t.method:  # how a temporal statement was decided; an IC3/PDR proof's certificate
+        out.append(f"  temporal check: {t.status} by {t.method}" + (f"; {t.detail}" if t.detail else ""))
+        if t.certificate:
+            out.append(f"    certificate (inductive invariant, re-checked): {t.certificate}")
+    out += [f"    used: {p.label}: {p.text}  ({p.source})" for p in c.used]
+    out += [f"    traced, not needed: {p.label}" for p in c.traced_not_needed]
+    out += [f"    contradictory: {p.label}: {p.text}  ({p.source})" for p in c.inconsistent_core]
+    out += [f"    premise never holds with: {p.label}: {p.text}  ({p.source})" for p in c.vacuity_core]
+    for step in c.counterexample:
+        out.append(f"    counterexample {step.node}: " + ", ".join(f"{k} = {v}" for k, v in step.values.items()))
+    if c.counterexample_note:
+        out.append(f"    {c.counterexample_note}")
+    out += [f"    did not prevent it: {p.label}: {p.text}  ({p.source})" for p in c.failed_to_prevent]
+    return out
+
+
+class Violation(msgspec.Struct, frozen=True):
+    """A violation a monitored run kept (backends/monitors/shapes.py ``Violation``), as printed: where and
+    when (``time`` in seconds, as written), the guarantee (1-based) and its formula, why, the values read,
+    and the question it answered when there was one."""
+
+    where: str | None = None
+    time: int | float | None = None
+    guarantee: int | None = None
+    formula: str = ""
+    reason: str = ""
+    values: dict[str, object] | None = None
+    trigger_where: str | None = None
+    trigger_time: int | float | None = None
+
+
+class MonitoredRun(msgspec.Struct, frozen=True):
+    """What is printed of an evidence row's ``monitoring`` (the monitors backend's record of a run,
+    backends/monitors/summary.py): the run, the violations it kept and how many more it counted."""
+
+    trace: str | None = None
+    violations: list[Violation] = []
+    violations_dropped: int = 0
+
+    @classmethod
+    def of(cls, monitoring: Mapping[str, Any]) -> MonitoredRun:
+        """``monitoring`` (``{}`` for a record of another backend) decoded, a key written ``null`` at its
+        default; raises :class:`msgspec.ValidationError` for a value of another type."""
+        return msgspec.convert({k: v for k, v in monitoring.items() if v is not None}, cls)
+
+
+def violation_id_lines(key: str, m: MonitoredRun) -> list[str]:
+    """The lines naming every violation the monitored run ``m`` of obligation ``key`` kept, each by its id
+    ``key#N``, and how many more it counted; ``[]`` without one."""
+    out = [f"  violation {key}#{k}: {v.where} (t = {v.time} s), guarantee {v.guarantee}"
+           for k, v in enumerate(m.violations, 1)]
+    if m.violations_dropped:
+        out.append(f"  and {m.violations_dropped} more violation(s), counted, not kept")
+    return (["", "violations (each: `rclverify explain ID`):"] + out) if out else []
+
+
+def violation_lines(key: str, n: int, m: MonitoredRun) -> list[str] | None:
+    """Violation ``key#n`` (1-based) of the monitored run ``m``: where, when, the guarantee, the question
+    it answered, why and the values read; ``None`` when the run kept no such violation."""
+    vs = m.violations
+    if not 1 <= n <= len(vs):
+        return None
+    v = vs[n - 1]
+    out = [f"violation {key}#{n} of {len(vs)} on {m.trace}: {v.where} (t = {v.time} s)",
+           f"  guarantee {v.guarantee}: {v.formula}"]
+    if v.trigger_where:
+        out.append(f"  answering the question at {v.trigger_where} (t = {v.trigger_time} s)")
+    out.append(f"  {v.reason}")
+    out += [f"    {name} = {value}" for name, value in sorted((v.values or {}).items())]
     return out
 
 

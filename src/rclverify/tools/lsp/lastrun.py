@@ -124,66 +124,22 @@ class LastRun:
         return out
 
 
-class _Region(msgspec.Struct, frozen=True, rename="camel"):
-    start_line: int = 1
-    start_column: int = 1
-
-
-class _Uri(msgspec.Struct, frozen=True):
-    uri: str
-
-
-class _Physical(msgspec.Struct, frozen=True, rename="camel"):
-    artifact_location: _Uri
-    region: _Region | None = None
-
-
-class _Located(msgspec.Struct, frozen=True, rename="camel"):
-    physical_location: _Physical
-
-
-class _Text(msgspec.Struct, frozen=True):
-    text: str
-
-
-class _Result(msgspec.Struct, frozen=True, rename="camel"):
-    """What the language server reads of a SARIF ``result`` (§3.27; :class:`rclverify.records.sarif.SarifResult`
-    is the object written): rule id, level, message, its first location and its fixes (the objects kept)."""
-
-    rule_id: str
-    message: _Text
-    locations: list[_Located]
-    level: str = "warning"
-    fixes: list[object] | None = None
-
-
-class _Run(msgspec.Struct, frozen=True):
-    results: object
-
-
-class _Log(msgspec.Struct, frozen=True):
-    runs: list[_Run]
-
-
 def _read_sarif(path: Path) -> list[Finding]:
-    """The located results of the SARIF log at ``path``; ``[]`` when it
-    cannot be read or is not a SARIF log (a later run writes it again); a
-    result of another shape or without a location is left out."""
+    """The located results of the SARIF log at ``path`` (its first run; :func:`rclverify.report.sarif_view.runs_of`);
+    ``[]`` when it cannot be read or is not a SARIF log (a later run writes it again); a result of another
+    shape, without a rule id or naming no file is left out."""
+    from rclverify.report.sarif_view import runs_of  # deferred: start-up (the report's reader only when a log is read)
     try:
-        results = msgspec.json.decode(path.read_bytes(), type=_Log).runs[0].results
-    except (OSError, msgspec.DecodeError, IndexError):
+        runs = runs_of(msgspec.json.decode(path.read_bytes()))
+    except (OSError, msgspec.DecodeError):
         return []
     out = []
-    for r in results if isinstance(results, list) else ():
-        try:
-            res = msgspec.convert(r, _Result, strict=False)
-        except msgspec.ValidationError:
+    for res in runs[0].results if runs else ():
+        place = res.place()
+        if place is None or res.rule_id is None:
             continue
-        if not res.locations:
-            continue
-        phys = res.locations[0].physical_location
-        region = phys.region or _Region()
-        fixes = tuple(cast(SarifFix, x) for x in res.fixes or () if isinstance(x, dict))
-        out.append(Finding(phys.artifact_location.uri, region.start_line, region.start_column, res.rule_id,
-                           res.level, res.message.text, fixes))
+        file, region = place
+        fixes = tuple(cast(SarifFix, x) for x in res.fixes if isinstance(x, dict))
+        out.append(Finding(file, region.start_line, region.start_column, res.rule_id, res.level,
+                           res.message.text, fixes))
     return out
