@@ -209,8 +209,9 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
         res[name] = offline_counts(rows)
         paths[name] = read_records(runs / f"{name}.verdicts.jsonl")
     res["finals"], lines = three_way(paths)
-    res["disagreements"] = [x for x in lines if not x.startswith("provisional: ")]
+    res["disagreements"] = [x for x in lines if not x.startswith(("provisional: ", "placed apart: "))]
     res["provisional"] = [x for x in lines if x.startswith("provisional: ")]
+    res["placed_apart"] = [x for x in lines if x.startswith("placed apart: ")]
     res["live"] = tally(res["finals"]["live"])
     for node, n in unjudged(runs / "live.jsonl", links).items():
         res["live"].setdefault(node, Counter()).update({"undecided": n, "unjudged": n})
@@ -312,10 +313,11 @@ def _line(res: dict[str, Any]) -> str:
                 f"{k} {sum(len(x) for x in f.values())}" for k, f in res["finals"].items())
             + f", {len(res['disagreements'])} disagreement(s)"
             + (f", {len(res['provisional'])} on a provisional verdict" if res["provisional"] else "")
+            + (f", {len(res['placed_apart'])} message(s) placed apart" if res["placed_apart"] else "")
             + (f", {tot['provisional']} live verdict(s) left provisional" if tot["provisional"] else "") + "; "
             f"{'agree' if not res['findings'] else 'FINDINGS: ' + '; '.join(res['findings'])}"
             + ("; " + "; ".join(res["errors"]) if res["errors"] else "")
-            + "".join(f"\n  {x}" for x in res["provisional"])
+            + "".join(f"\n  {x}" for x in res["provisional"] + res["placed_apart"])
             + "".join(f"\n  other clock: {c}" for c in res.get("other_clocks", []))
             + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items())
             + "".join(f"\n  deadline undecided (first, log): {w}" for w in why)
@@ -339,7 +341,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
     total = Counter[str]()
     undecided = 0  # deadlines given no verdict, counted offline on the logs
     failing: list[int] = []
-    agree, compared, disagreements, provisional = 0, Counter[str](), 0, 0
+    agree, compared, disagreements, provisional, apart = 0, Counter[str](), 0, 0, 0
     declarations = Counter[str]()
     loads: list[float] = []
     try:
@@ -367,6 +369,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             compared.update({k: sum(len(x) for x in f.values()) for k, f in res["finals"].items()})
             disagreements += len(res["disagreements"])
             provisional += len(res["provisional"])
+            apart += len(res["placed_apart"])
             loads.append(os.getloadavg()[0])
             if res["findings"] or res["errors"]:
                 failing.append(seed)
@@ -380,7 +383,8 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           f"{total['undecided']}, deadlines true {total['deadline true']} false {total['deadline false']} "
           f"(undecided on the logs: {undecided}); declarations: {sum(declarations.values())} "
           f"{dict(declarations) or ''}; verdicts compared: live {compared['live']}, log {compared['log']}, bag "
-          f"{compared['bag']}; disagreements {disagreements} (and {provisional} on a verdict still provisional); "
+          f"{compared['bag']}; disagreements {disagreements} (and {provisional} on a verdict still provisional, {apart} "
+          f"message(s) given one verdict but placed apart); "
           f"load average after each run {min(loads, default=0):.1f}-{max(loads, default=0):.1f}; seeds with "
           f"findings: {failing or 'none'}; live = log = bag verdict by verdict on {agree} of {len(seeds)}")
     return 0

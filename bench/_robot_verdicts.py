@@ -28,6 +28,9 @@ from typing import Any, Iterable
 #: two paths' times of one message differ by float rounding only (a bag's integer nanoseconds, a log's
 #: decimal text); messages of one topic are at least a sensor period (150 ms) apart
 TOL_S = 1e-5
+#: a record left without a counterpart within :data:`TOL_S` and one of the other path within this many
+#: seconds are one message the two paths placed apart (a generated topic's messages are 150 ms or more apart)
+APART_S = 0.005
 UNDECIDED = ("inconclusive", "incomplete input", "open")
 Bucket = tuple[str, str, str, int]  # node, item, topic, guarantee (a deadline's)
 
@@ -66,6 +69,13 @@ class Disagreement:
     time: float
     a: dict[str, Any] | None
     b: dict[str, Any] | None
+    #: how far apart (s) the two paths placed the message (0: at one time)
+    apart: float = 0.0
+
+    @property
+    def placed_apart(self) -> bool:
+        """One message, one verdict, placed at two times (no disagreement on its verdict)."""
+        return self.apart > 0 and self.a is not None and self.b is not None and self.a["verdict"] == self.b["verdict"]
 
     @property
     def provisional(self) -> bool:
@@ -79,11 +89,39 @@ class Disagreement:
             return (f"{name}: {r['verdict']}" + (" (provisional)" if r.get("provisional") else "")
                     + (f" ({r['reason']})" if r.get("reason") else ""))
         what = f"deadline {self.topic or 'of the trigger'}" if self.item == "deadline" else f"{self.item} {self.topic}"
-        return f"{self.node}: {what} at {self.time:.6f}: {side(names[0], self.a)}; {side(names[1], self.b)}"
+        apart = (f" ({names[0]} placed it at {float(self.a['time']):.6f}, {names[1]} at {float(self.b['time']):.6f})"
+                 if self.apart and self.a is not None and self.b is not None else "")
+        return f"{self.node}: {what} at {self.time:.6f}{apart}: {side(names[0], self.a)}; {side(names[1], self.b)}"
 
 
 def compare(a: dict[Bucket, list[dict[str, Any]]], b: dict[Bucket, list[dict[str, Any]]]) -> list[Disagreement]:
-    """The messages on which the final verdicts ``a`` and ``b`` (:func:`finals`) differ, in time order."""
+    """The messages on which the final verdicts ``a`` and ``b`` (:func:`finals`) differ, in time order,
+    and those the two placed apart (:attr:`Disagreement.placed_apart`: a record of each left without a
+    counterpart, within :data:`APART_S` of each other)."""
+    out: list[Disagreement] = []
+    for d in _matched(a, b):
+        if d.a is None or d.b is None:
+            near = [e for e in out if e.b is None and d.a is None and e.a is not None and d.b is not None
+                    and (e.node, e.item, e.topic) == (d.node, d.item, d.topic)
+                    and abs(float(e.a["time"]) - float(d.b["time"])) <= APART_S]
+            near += [e for e in out if e.a is None and d.b is None and e.b is not None and d.a is not None
+                     and (e.node, e.item, e.topic) == (d.node, d.item, d.topic)
+                     and abs(float(e.b["time"]) - float(d.a["time"])) <= APART_S]
+            if near:
+                e = near[0]
+                out.remove(e)
+                x, y = e.a or d.a, e.b or d.b
+                assert x is not None and y is not None
+                out.append(Disagreement(d.node, d.item, d.topic, min(e.time, d.time), x, y,
+                                        abs(float(x["time"]) - float(y["time"]))))
+                continue
+        out.append(d)
+    return sorted(out, key=lambda d: (d.time, d.node))
+
+
+def _matched(a: dict[Bucket, list[dict[str, Any]]], b: dict[Bucket, list[dict[str, Any]]]) -> list[Disagreement]:
+    """The records of ``a`` and ``b`` matched within :data:`TOL_S`, each pair whose verdicts differ and
+    each record left without a counterpart, in time order."""
     out: list[Disagreement] = []
     for bucket in sorted(set(a) | set(b)):
         xs, ys = a.get(bucket, []), b.get(bucket, [])
@@ -130,12 +168,14 @@ def false_verdicts(f: dict[Bucket, list[dict[str, Any]]], correct: set[str]) -> 
 
 def three_way(paths: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, Any], list[str]]:
     """``paths`` ``{"live", "log", "bag"}`` -> records: the finals of each and the lines of every
-    disagreement of live with log and with bag (a provisional one marked so)."""
+    disagreement of live with log and with bag (one on a provisional verdict begins ``provisional: ``,
+    one message with one verdict placed at two times ``placed apart: ``)."""
     f = {name: finals(rs) for name, rs in paths.items()}
     lines: list[str] = []
     for other in ("log", "bag"):
         for d in compare(f["live"], f[other]):
-            lines.append(("provisional: " if d.provisional else "") + f"live != {other}: " + d.text(("live", other)))
+            lines.append(("placed apart: " if d.placed_apart else "provisional: " if d.provisional else "")
+                         + f"live != {other}: " + d.text(("live", other)))
     return f, lines
 
 

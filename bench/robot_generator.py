@@ -1,6 +1,6 @@
 """A generator of correct robots (issue 106): random ROS 2 systems of real rclpy nodes, each node
 written for the RCL contract generated with it, judged live by ``rclverify monitor --live --ros2``
-and offline on the run's log and bag, verdict counts compared node by node.
+and offline on the run's log and bag, the three compared verdict by verdict (bench/_robot_verdicts.py).
 
 Given a seed, :func:`generate` draws a system of N nodes from five templates (the spec is plain data):
 

@@ -149,7 +149,7 @@ def _rec(verdict: str, time: float, **more: Any) -> dict[str, Any]:
 
 def test_a_revision_replaces_the_verdict_given_before_and_a_provisional_one_is_told_apart() -> None:
     """The last verdict of a message stands (a live revision); a verdict still provisional at the end is
-    marked so when it differs; times a float's rounding apart are one message, a period apart two."""
+    marked so when it differs; times a float's rounding apart are one message, 10 ms apart two."""
     live = [_rec("inconclusive", 1.0), _rec("satisfied", 1.0), _rec("satisfied", 1.3, provisional=True)]
     offline = [_rec("satisfied", 1.0 + 4e-9), _rec("violated", 1.3 + 4e-9)]
     found = compare(finals(live), finals(offline))
@@ -157,8 +157,9 @@ def test_a_revision_replaces_the_verdict_given_before_and_a_provisional_one_is_t
     # the control: the revision left out, the first verdict differs and is found, not provisional
     found = compare(finals(live[:1] + live[2:]), finals(offline))
     assert [(round(d.time, 6), d.provisional) for d in found] == [(1.0, False), (1.3, True)]
-    # a message 2 ms off is another message: each side's verdict has no counterpart
-    assert len(compare(finals([_rec("satisfied", 1.0)]), finals([_rec("satisfied", 1.002)]))) == 2
+    # a message 10 ms off is another message: each side's verdict has no counterpart
+    assert [(d.a is None, d.b is None) for d in compare(finals([_rec("satisfied", 1.0)]),
+                                                        finals([_rec("satisfied", 1.01)]))] == [(False, True), (True, False)]
 
 
 def test_a_live_verdict_names_its_message_by_the_log_line_it_is_on(tmp_path: Path) -> None:
@@ -182,3 +183,19 @@ def test_a_live_verdict_names_its_message_by_the_log_line_it_is_on(tmp_path: Pat
     log.write_text("".join(json.dumps(x) + "\n" for x in lines))
     assert [(r["node"], r["time"]) for r in log_records(log)] == [
         ("Relay4", pytest.approx(749.9281172, abs=1e-9)), ("Alarm5", 749.98484), ("Alarm5", 749.98484)]
+
+
+def test_one_message_placed_apart_with_one_verdict_is_told_apart_from_a_disagreement() -> None:
+    """Seed 530 (a ``/clock`` robot): a relay's answer in another clock, placed live at its source time and
+    by the bag's reader 0.2 ms earlier, satisfied on both: one message placed apart, not two verdicts
+    without a counterpart.  The controls: placed apart with different verdicts is a disagreement; two
+    records 10 ms apart are two messages."""
+    live, bag = [_rec("satisfied", 242.8070235)], [_rec("satisfied", 242.8068178)]
+    found = compare(finals(live), finals(bag))
+    assert [(d.placed_apart, round(d.apart, 7)) for d in found] == [(True, 0.0002057)]
+    assert "placed it at 242.807024, log at 242.806818" in found[0].text(("live", "log"))
+    assert three_way({"live": live, "log": bag, "bag": live})[1][0].startswith("placed apart: live != log")
+    differ = compare(finals(live), finals([_rec("violated", 242.8068178)]))
+    assert [(d.placed_apart, d.a and d.a["verdict"], d.b and d.b["verdict"]) for d in differ] == [
+        (False, "satisfied", "violated")]
+    assert len(compare(finals(live), finals([_rec("satisfied", 242.817)]))) == 2
