@@ -20,8 +20,8 @@ from __future__ import annotations
 
 from typing import Any, Collection, Iterable, Mapping
 
-#: The JSON object of a scope item (records/standards_rows.py ``ScopeItem``).
-ScopeItem = dict[str, Any]
+from rclverify.model.plan.standards.report_view import ReportView, report_view
+from rclverify.records.standards_rows import ScopeItem
 
 
 def figures(s: Mapping[str, Any]) -> dict[str, str]:
@@ -80,46 +80,48 @@ def unstated_origins(entries: Iterable[Any]) -> frozenset[tuple[str, str]]:
                      if e.backend == "monitors" and "origin" not in e.config)
 
 
-def target_items(report: Mapping[str, Any], about: str, min_runs: int,
+def target_items(report: ReportView | Mapping[str, Any], about: str, min_runs: int,
                  unstated: Collection[tuple[str, str]] = ()) -> list[ScopeItem]:
-    """The targets of ``report`` in the scope of a clause about ``about`` (``field-data`` or ``trials``)
-    that asks ``min_runs`` independent runs (0: no minimum), each with its state and figures (the module
-    docstring); ``unstated``: the (node, environment) of the run sets whose plan entry states no origin
-    (:func:`unstated_origins`)."""
+    """The targets of ``report`` (its :class:`~.report_view.ReportView`, or its JSON object) in the scope of
+    a clause about ``about`` (``field-data`` or ``trials``) that asks ``min_runs`` independent runs (0: no
+    minimum), each a :class:`~rclverify.records.standards_rows.ScopeItem` with its state and figures (the
+    module docstring); ``unstated``: the (node, environment) of the run sets whose plan entry states no
+    origin (:func:`unstated_origins`)."""
     field_data = about == "field-data"
     origins = ("operation",) if field_data else ("operation", "simulation")
     out: list[ScopeItem] = []
     envs_unstated = {env for _, env in unstated}
-    for e in report.get("evidence") or ():
-        s = e.get("statistics")
-        if not (isinstance(s, Mapping) and "decision" in s):
+    rep = report_view(report)
+    for e in rep.evidence:
+        s = e.statistics
+        if not (s is not None and "decision" in s):
             continue
-        monitors = e.get("backend") == "monitors"
-        if not ((monitors and s.get("origin") in origins) or (not field_data and e.get("backend") == "experiment")):
+        monitors = e.backend == "monitors"
+        if not ((monitors and s.get("origin") in origins) or (not field_data and e.backend == "experiment")):
             continue
         f = figures(s)
         d = _part(s, "decision")
-        node = str(e.get("obligation")).split(".", 1)[0]
+        node = e.obligation.split(".", 1)[0]
         stated = not monitors or (node, str(s.get("environment", ""))) not in unstated
-        state, why = _state(str(e.get("status")), d.get("n"), min_runs, stated, field_data)
-        out.append(_target(f"target {e.get('obligation')}", state, why, f, str(e.get("obligation"))))
-    for rq in report.get("requirements") or ():
-        for t in rq.get("statistics") or ():
+        state, why = _state(str(e.status), d.get("n"), min_runs, stated, field_data)
+        out.append(_target(f"target {e.obligation}", state, why, f, e.obligation))
+    for rq in rep.requirements:
+        for t in rq.statistics or ():
             if not (t.get("target") and t.get("origin") in origins):
                 continue
             f = figures(t)
             counts = _part(t, "counts")
             stated = t.get("origin") != "operation" or str(t.get("environment", "")) not in envs_unstated
             state, why = _state(str(t.get("status") or "pending"), counts.get("runs"), min_runs, stated, field_data)
-            out.append(_target(f"target of requirement {rq.get('id')} ({t.get('environment')}, {t.get('origin')})",
-                               state, why, f, f"requirement {rq.get('id')}"))
+            out.append(_target(f"target of requirement {rq.id} ({t.get('environment')}, {t.get('origin')})",
+                               state, why, f, f"requirement {rq.id}"))
     return out
 
 
 def _target(item: str, state: str, why: str, f: Mapping[str, str], evidence: str) -> ScopeItem:
     ok = state == "covered"
-    return {"item": item, "kind": "target", "covered": ok, "state": state,
-            "detail": sentence(f) if ok else f"{why}: {sentence(f)}", "evidence": [evidence] if ok else []}
+    return ScopeItem(item, "target", ok, state, sentence(f) if ok else f"{why}: {sentence(f)}",
+                     [evidence] if ok else [])
 
 
 __all__ = ["figures", "sentence", "target_items", "unstated_origins"]

@@ -51,11 +51,19 @@ from __future__ import annotations
 from collections import Counter
 from typing import Any, Callable, Collection, Iterable, Mapping, Sequence, cast, get_args
 
+import msgspec
+
+from rclverify.model.plan.standards import clause_words
+from rclverify.model.plan.standards.clause_words import WORST, adds, checked_by
 from rclverify.model.plan.standards.profiles import ASKED, INDEPENDENCE, Item, Profile
 from rclverify.model.plan.standards.field_data import target_items
 from rclverify.model.plan.standards.identity import Person
+from rclverify.model.plan.standards.report_view import (EvidenceView, FindingView, ReportView, RequirementView,
+                                                         SideConditionView, report_view)
 from rclverify.model.plan.standards.reviews import independence_of, review_as_stated, review_identity
-from rclverify.records.standards_rows import About, ClauseStatus, Independence, Recommendation, ScopeKind
+from rclverify.records.standards_rows import (About, ClauseEvidence, ClauseRow as ClauseRecord, ClauseStatus,
+                                              Independence, PlanNote as PlanNoteRecord, Recommendation, ScopeItem,
+                                              ScopeKind)
 from rclverify.records.statuses import EvidenceKind, EvidenceStatus
 
 #: A clause's status (the module docstring).
@@ -78,147 +86,138 @@ CLAUSE_STATUSES: tuple[ClauseStatus, ...] = get_args(ClauseStatus)
 
 #: A side condition's verdicts that count as proved.
 _PROVED = ("discharged", "discharged in context")
-#: The states of an item not covered, worst first (what the clause's ``why`` counts).
-_WORST: tuple[str, ...] = ("failed", "problem", "error", "stale", "inconclusive", "pending", "unverified",
-                           "not counted", "no evidence")
-#: What an empty scope lacks, by ``about``.
-_NOTHING: Mapping[str, str] = {
-    "guarantees": "guarantees", "interfaces": "connections between nodes", "requirements": "requirements",
-    "system": "nodes", "field-data": "target decided over runs whose plan entry states origin: operation",
-    "trials": "target decided over runs or trials"}
 #: Health check outcomes that leave a guarantee covered (``warning`` is shown, not a failure).
 _HEALTH_OK = ("ok", "warning")
 
 
-#: The JSON objects of a clause row and its parts, as the report carries them: the encodings of
-#: :mod:`rclverify.records.standards_rows` ``ClauseEvidence``, ``ScopeItem``, ``PlanNote`` and ``ClauseRow``,
-#: the one definition of their fields (the standards pass decodes each standard's row into them).
-Support = dict[str, Any]
-ScopeItem = dict[str, Any]
-PlanNote = dict[str, Any]
+#: The JSON object of a clause row as the report carries it: the encoding of
+#: :class:`rclverify.records.standards_rows.ClauseRow` (:func:`clause_records` builds the records).
 ClauseRow = dict[str, Any]
+#: The records of a clause's evidence, its scope items and the plan's note (records/standards_rows.py).
+Support = ClauseEvidence
+PlanNote = PlanNoteRecord
 
 
-def kinds_of(row: Mapping[str, Any]) -> set[str]:
-    """The profile evidence kinds the evidence ``row`` (a report ``evidence[]`` row) supports, by :data:`SUPPORTS`."""
-    strength = row.get("strength")
-    values = {"kind": row.get("kind"), "strength": strength.get("kind") if isinstance(strength, Mapping) else None}
+def kinds_of(row: EvidenceView | Mapping[str, Any]) -> set[str]:
+    """The profile evidence kinds the evidence ``row`` (a report ``evidence[]`` row, or its view) supports,
+    by :data:`SUPPORTS`."""
+    r = row if isinstance(row, EvidenceView) else report_view([row]).evidence[0]
+    values = {"kind": r.kind, "strength": r.strength.kind if r.strength is not None else None}
     return {kind for (field, value), kind in SUPPORTS.items() if values[field] == value}
 
 
-def _harness(row: Mapping[str, Any]) -> bool:
-    s = row.get("statistics")
-    return isinstance(s, Mapping) and s.get("origin") == "harness"
+def _harness(row: EvidenceView) -> bool:
+    return row.statistics is not None and row.statistics.get("origin") == "harness"
 
 
-def _support(row: Mapping[str, Any], asked: str, people: Sequence[Person] = ()) -> Support:
+def _support(row: EvidenceView, asked: str, people: Sequence[Person] = ()) -> ClauseEvidence:
     note = ""
     if _harness(row):
         note = "origin: harness: shown, never counted"
-    elif row.get("kind") == "review" and asked != "none":
+    elif row.kind == "review" and asked != "none":
         level, why = independence_of(row, people)
         if INDEPENDENCE.index(level) < INDEPENDENCE.index(asked):
             note = why or f"independence {level}; the clause asks {asked}"
-    return {"obligation": str(row["obligation"]), "backend": str(row["backend"]),
-            "kind": cast(EvidenceKind, str(row["kind"])), "status": cast(EvidenceStatus, str(row["status"])),
-            "counts": not note, "note": note}
+    return ClauseEvidence(row.obligation, row.backend, cast(EvidenceKind, str(row.kind)),
+                          cast(EvidenceStatus, str(row.status)), not note, note)
 
 
 class _Index:
     """The report read once for every clause: each guarantee's evidence rows and status, its health checks."""
 
-    def __init__(self, report: Mapping[str, Any], unstated: Collection[tuple[str, str]] = (),
+    def __init__(self, report: ReportView, unstated: Collection[tuple[str, str]] = (),
                  people: Sequence[Person] = ()) -> None:
         self.report = report
         self.people = people  # the plan's people: (identity.Person), for a review's independence
         self.unstated = unstated  # (node, environment) of the run sets whose plan entry states no origin
-        where = {str(o["id"]): (str(o["node"]), int(o["guarantee"])) for o in report.get("obligations") or ()}
+        where = {o.id: (o.node, o.guarantee) for o in report.obligations}
         self.guarantees: list[tuple[str, int, str]] = [
-            (str(n["name"]), int(g["index"]), str(g["status"]))
-            for n in report.get("nodes") or () for g in n.get("guarantees") or ()]
-        self.rows: dict[tuple[str, int], list[Mapping[str, Any]]] = {}
-        for e in report.get("evidence") or ():
-            node, k = where.get(str(e.get("obligation")), ("", -1))
+            (n.name, g.index, g.status) for n in report.nodes for g in n.guarantees or ()]
+        self.rows: dict[tuple[str, int], list[EvidenceView]] = {}
+        for e in report.evidence:
+            node, k = where.get(e.obligation, ("", -1))
             if k == 0:  # an obligation of the whole contract is evidence for each of its guarantees
                 for n, g, _ in self.guarantees:
                     if n == node:
                         self.rows.setdefault((n, g), []).append(e)
             elif node:
                 self.rows.setdefault((node, k), []).append(e)
-        self.health: dict[tuple[str, int | None], list[Mapping[str, Any]]] = {}
-        for f in report.get("findings") or ():
-            self.health.setdefault((str(f.get("node")), f.get("guarantee")), []).append(f)
+        self.health: dict[tuple[str, int | None], list[FindingView]] = {}
+        for f in report.findings:
+            self.health.setdefault((str(f.node), f.guarantee), []).append(f)
 
 
-def _counted(rows: Iterable[Mapping[str, Any]], accepts: set[str], asked: str,
-             people: Sequence[Person] = ()) -> list[tuple[Mapping[str, Any], Support]]:
+def _counted(rows: Iterable[EvidenceView], accepts: set[str], asked: str,
+             people: Sequence[Person] = ()) -> list[tuple[EvidenceView, ClauseEvidence]]:
     return [(r, _support(r, asked, people)) for r in rows if kinds_of(r) & accepts]
 
 
 def _guarantee_item(ix: _Index, node: str, k: int, status: str, accepts: set[str], asked: str) -> ScopeItem:
     supports = [s for _, s in _counted(ix.rows.get((node, k), ()), accepts, asked, ix.people)]
-    counting = [s for s in supports if s["counts"]]
-    bad = [s for s in counting if s["status"] != "discharged"]
+    counting = [s for s in supports if s.counts]
+    bad = [s for s in counting if s.status != "discharged"]
     health = [f for f in ix.health.get((node, k), []) + ix.health.get((node, None), [])
-              if str(f.get("status")) not in _HEALTH_OK]
+              if str(f.status) not in _HEALTH_OK]
     state, detail = "covered", "covered"
     if not counting:
         state = "not counted" if supports else "no evidence"
         detail = (f"no {' or '.join(sorted(accepts))} evidence that counts"
-                  + (f" ({len(supports)} shown: {supports[0]['note']})" if supports else ""))
+                  + (f" ({len(supports)} shown: {supports[0].note})" if supports else ""))
     elif bad:
-        counts = Counter(b["status"] for b in bad)
-        state = min(counts, key=lambda x: _WORST.index(x) if x in _WORST else len(_WORST))
+        counts = Counter[str](b.status for b in bad)
+        state = min(counts, key=lambda x: WORST.index(x) if x in WORST else len(WORST))
         detail = (", ".join(f"{n} {st}" for st, n in sorted(counts.items()))
                   + f" of its {len(counting)} record{'s' if len(counting) != 1 else ''}")
     elif status != "discharged":
         state, detail = status, f"the guarantee is {status} by its other evidence"
     elif health:
-        state, detail = "problem", f"health check {health[0].get('check')}: {health[0].get('status')}"
+        state, detail = "problem", f"health check {health[0].check}: {health[0].status}"
     ok = state == "covered"
-    return {"item": f"{node} g{k}", "kind": "guarantee", "covered": ok, "state": state, "detail": detail,
-            "evidence": [s["obligation"] for s in counting] if ok else []}
+    return ScopeItem(f"{node} g{k}", "guarantee", ok, state, detail, [s.obligation for s in counting] if ok else [])
 
 
 def _item(item: str, kind: ScopeKind, state: str, detail: str, evidence: list[str]) -> ScopeItem:
     ok = state == "covered"
-    return {"item": item, "kind": kind, "covered": ok, "state": state, "detail": detail if not ok else "covered",
-            "evidence": evidence if ok else []}
+    return ScopeItem(item, kind, ok, state, detail if not ok else "covered", evidence if ok else [])
 
 
-def _side_condition_item(sc: Mapping[str, Any]) -> ScopeItem:
-    ok = sc.get("verdict") in _PROVED and sc.get("status") == "discharged"
-    return _item(f"side condition {sc.get('id')}", "side condition", "covered" if ok else str(sc.get("status")),
-                 f"side condition {sc.get('verdict')}", [str(sc.get("id"))])
+def _proved(sc: SideConditionView) -> bool:
+    return sc.verdict in _PROVED and sc.status == "discharged"
 
 
-def _requirement_item(rq: Mapping[str, Any], ix: _Index, accepts: set[str], asked: str) -> ScopeItem:
+def _side_condition_item(sc: SideConditionView) -> ScopeItem:
+    return _item(f"side condition {sc.id}", "side condition", "covered" if _proved(sc) else str(sc.status),
+                 f"side condition {sc.verdict}", [str(sc.id)])
+
+
+def _requirement_item(rq: RequirementView, ix: _Index, accepts: set[str], asked: str) -> ScopeItem:
     state, detail = "covered", ""
-    if rq.get("status") != "discharged":
-        state, detail = str(rq.get("status")), f"verdict: {rq.get('verdict')}"
-    deadline = rq.get("deadline")
-    if state == "covered" and isinstance(deadline, Mapping) and deadline.get("verdict") != "proved":
-        state, detail = "pending", f"deadline {deadline.get('verdict')}"
-    targets = [t for t in rq.get("statistics") or () if t.get("target") and t.get("status") != "discharged"]
+    if rq.status != "discharged":
+        state, detail = str(rq.status), f"verdict: {rq.verdict}"
+    if state == "covered" and rq.deadline is not None and rq.deadline.verdict != "proved":
+        state, detail = "pending", f"deadline {rq.deadline.verdict}"
+    targets = [t for t in rq.statistics or () if t.get("target") and t.get("status") != "discharged"]
     if state == "covered" and targets:
         state = str(targets[0].get("status") or "pending")
         detail = f"target {state} ({targets[0].get('origin')} runs)"
     if state == "covered" and "proof" not in accepts:
-        support = [(str(s["node"]), int(s["guarantee"])) for s in rq.get("support") or ()]
-        if not any(sp["counts"] and sp["status"] == "discharged" for key in support
+        support = [(s.node, s.guarantee) for s in rq.support or ()]
+        if not any(sp.counts and sp.status == "discharged" for key in support
                    for _, sp in _counted(ix.rows.get(key, ()), accepts, asked, ix.people)):
             state, detail = "no evidence", f"no {' or '.join(sorted(accepts))} evidence of its supporting guarantees"
-    return _item(f"requirement {rq.get('id')}", "requirement", state, detail, [f"requirement {rq.get('id')}"])
+    return _item(f"requirement {rq.id}", "requirement", state, detail, [f"requirement {rq.id}"])
 
 
-def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _Index | None = None,
+def scope_items(item: Item, level: str | None, report: ReportView | Mapping[str, Any], ix: _Index | None = None,
                 narrowed: Sequence[str] | None = None) -> list[ScopeItem]:
-    """The items of ``report`` (a report dict, or the parts of it it has) in the scope of the profile
-    ``item`` at ``level``, each with its state (the module docstring).  ``narrowed``: the nodes the plan
-    narrows the scope to (their guarantees, their side conditions, the requirements they support; a
-    node the workspace does not have is an item never covered), ``None`` for every item.  Pure;
-    raises nothing for a well-formed report."""
-    ix = ix or _Index(report)
+    """The items of ``report`` (a report dict, or the parts of it it has, or its
+    :class:`~.report_view.ReportView`) in the scope of the profile ``item`` at ``level``, each a
+    :class:`~rclverify.records.standards_rows.ScopeItem` with its state (the module docstring).
+    ``narrowed``: the nodes the plan narrows the scope to (their guarantees, their side conditions, the
+    requirements they support; a node the workspace does not have is an item never covered), ``None`` for
+    every item.  Pure; raises nothing for a well-formed report."""
+    ix = ix or _Index(report_view(report))
+    rep = ix.report
     accepts, asked = set(item.evidence), item.independence_at(level)
     keep = None if narrowed is None else set(narrowed)
 
@@ -228,18 +227,17 @@ def scope_items(item: Item, level: str | None, report: Mapping[str, Any], ix: _I
 
     # a side condition's check is a Z3 proof: it covers only a clause that accepts proofs; for another
     # clause a side condition not proved is still in scope, a defect of the interface that keeps it uncovered
-    scs = [_side_condition_item(sc) for sc in report.get("side_conditions") or ()
-           if (keep is None or str(sc.get("node")) in keep)
-           and ("proof" in accepts or not (sc.get("verdict") in _PROVED and sc.get("status") == "discharged"))]
-    reqs = [_requirement_item(rq, ix, accepts, asked) for rq in report.get("requirements") or ()
-            if keep is None or any(str(x.get("node")) in keep for x in rq.get("support") or ())]
+    scs = [_side_condition_item(sc) for sc in rep.side_conditions
+           if (keep is None or str(sc.node) in keep) and ("proof" in accepts or not _proved(sc))]
+    reqs = [_requirement_item(rq, ix, accepts, asked) for rq in rep.requirements
+            if keep is None or any(x.node in keep for x in rq.support or ())]
     known = {n for n, _, _ in ix.guarantees}
     unknown = [_item(f"node {n}", "guarantee", "no evidence", "the plan names this node; the workspace has no such "
                      "node", []) for n in sorted(keep or ()) if n not in known]
-    return unknown + _scope(item, report, ix, guarantees, scs, reqs, keep)
+    return unknown + _scope(item, rep, ix, guarantees, scs, reqs, keep)
 
 
-def _scope(item: Item, report: Mapping[str, Any], ix: _Index, guarantees: Callable[..., list[ScopeItem]],
+def _scope(item: Item, report: ReportView, ix: _Index, guarantees: Callable[..., list[ScopeItem]],
            scs: list[ScopeItem], reqs: list[ScopeItem], keep: set[str] | None) -> list[ScopeItem]:
     """The scope of ``item`` by its ``about`` (:func:`scope_items`); ``keep`` the nodes it is narrowed to."""
     def kept(node: object) -> bool:
@@ -248,88 +246,82 @@ def _scope(item: Item, report: Mapping[str, Any], ix: _Index, guarantees: Callab
     if item.about == "guarantees":
         return guarantees()
     if item.about == "interfaces":
-        linked = {str(c.get(k)) for c in (report.get("system") or {}).get("connections") or ()
-                  for k in ("from_node", "to_node")}
+        linked = {str(node) for c in report.system.connections or () for node in (c.from_node, c.to_node)}
         return scs + guarantees(linked)
     if item.about == "requirements":
-        supporting = {str(s["node"]) for rq in report.get("requirements") or () for s in rq.get("support") or ()}
+        supporting = {s.node for rq in report.requirements for s in rq.support or ()}
         return reqs + guarantees(supporting)
     if item.about in ("field-data", "trials"):
         targets = target_items(report, item.about, item.min_runs, ix.unstated)
-        return [t for t in targets if kept(t["item"].removeprefix("target ").split(".")[0])
-                or t["item"].startswith("target of requirement")]
+        return [t for t in targets if kept(t.item.removeprefix("target ").split(".")[0])
+                or t.item.startswith("target of requirement")]
     # system: everything, the health checks and the workspace's own status
-    health = [_item(f"health check {f.get('id')}", "health check", str(f.get("status")),
-                    f"health check {f.get('check')}: {f.get('status')}", []) for f in report.get("findings") or ()
-              if str(f.get("status")) not in _HEALTH_OK and kept(f.get("node"))]
+    health = [_item(f"health check {f.id}", "health check", str(f.status),
+                    f"health check {f.check}: {f.status}", []) for f in report.findings
+              if str(f.status) not in _HEALTH_OK and kept(f.node)]
     known = {(n, k) for n, k, _ in ix.guarantees}
-    unverified = [_item(f"{u.get('node')} g{u.get('guarantee')}", "guarantee", "unverified",
-                        "no obligation covers the guarantee", []) for u in report.get("unverified") or ()
-                  if (str(u.get("node")), int(u.get("guarantee") or 0)) not in known and kept(u.get("node"))]
-    status = str((report.get("summary") or {}).get("status", "pending"))
+    unverified = [_item(f"{u.node} g{u.guarantee}", "guarantee", "unverified",
+                        "no obligation covers the guarantee", []) for u in report.unverified
+                  if (str(u.node), int(u.guarantee or 0)) not in known and kept(u.node)]
+    status = report.summary.status
     whole = [] if status == "discharged" else [_item("workspace", "workspace", status,
                                                      f"the workspace's status is {status}", [])]
     return guarantees() + scs + reqs + health + unverified + whole
 
 
-def _evidence_in_scope(item: Item, level: str | None, scope: Sequence[ScopeItem], ix: _Index) -> list[Support]:
+def _evidence_in_scope(item: Item, level: str | None, scope: Sequence[ScopeItem], ix: _Index) -> list[ClauseEvidence]:
     """The evidence rows of an accepted kind in the clause's scope (the guarantees', the targets'), once each."""
     accepts, asked = set(item.evidence), item.independence_at(level)
-    keys = {tuple(s["item"].rsplit(" g", 1)) for s in scope if s["kind"] == "guarantee"}
+    keys = {tuple(s.item.rsplit(" g", 1)) for s in scope if s.kind == "guarantee"}
     seen: set[str] = set()
-    out: list[Support] = []
-    rows: list[Mapping[str, Any]] = [r for (n, k), rs in ix.rows.items() if (n, f"{k}") in keys for r in rs]
-    targets = {s["item"][len("target "):] for s in scope if s["kind"] == "target"}
-    rows += [e for e in ix.report.get("evidence") or () if str(e.get("obligation")) in targets]
+    out: list[ClauseEvidence] = []
+    rows: list[EvidenceView] = [r for (n, k), rs in ix.rows.items() if (n, f"{k}") in keys for r in rs]
+    targets = {s.item[len("target "):] for s in scope if s.kind == "target"}
+    rows += [e for e in ix.report.evidence if e.obligation in targets]
     for r in rows:
-        if str(r["obligation"]) in seen or not (kinds_of(r) & accepts or str(r["obligation"]) in targets):
+        if r.obligation in seen or not (kinds_of(r) & accepts or r.obligation in targets):
             continue
-        seen.add(str(r["obligation"]))
+        seen.add(r.obligation)
         out.append(_support(r, asked, ix.people))
     return out
 
 
-def _checked_by(scope: Sequence[ScopeItem], ix: _Index) -> list[str]:
-    """Who checked what covers the clause's covered items: each backend with its tool and version, each
-    review's reviewer and author, Z3 for side conditions and requirement checks."""
-    rows = {str(e.get("obligation")): e for e in ix.report.get("evidence") or ()}
-    out: list[str] = []
-    for s in scope:
-        if not s["covered"]:
-            continue
-        for ob in s["evidence"]:
-            r = rows.get(ob)
-            if r is None:
-                who = f"Z3 ({s['kind']} check)"
-            elif r.get("kind") == "review":
-                reviewer, author, _ = review_identity(r)
-                stated = review_as_stated(r)
-                who = (f"review by {reviewer or 'an unnamed reviewer'} (author: {author or 'not named'}"
-                       + (f"; {stated})" if stated else ")"))
-            else:
-                tool, version = str(r.get("tool", "")), str(r.get("tool_version", ""))
-                who = f"{r.get('backend')} ({version if version.startswith(tool) else f'{tool} {version}'.strip()})"
-            if who not in out:
-                out.append(who)
+def clause_records(profile: Profile, level: str | None,
+                   report: ReportView | Mapping[str, Any] | Sequence[Mapping[str, Any]],
+                   notes: Mapping[str, Any] | None = None, unstated: Collection[tuple[str, str]] = (),
+                   people: Sequence[Person] = ()) -> list[ClauseRecord]:
+    """The clause rows of ``profile`` at ``level`` as records
+    (:class:`rclverify.records.standards_rows.ClauseRow`), in the profile's order: :func:`clause_rows`
+    gives the arguments' meaning.  Pure: reads nothing else, raises nothing for well-formed rows."""
+    ix = _Index(report_view(report), unstated, people)
+    out: list[ClauseRecord] = []
+    for item in profile.items:
+        code = item.at(level)
+        note = (notes or {}).get(item.id)
+        scope = scope_items(item, level, ix.report, ix, None if note is None else note.nodes)
+        evidence = _evidence_in_scope(item, level, scope, ix)
+        done = sum(1 for s in scope if s.covered)
+        status: ClauseStatus
+        if code == "NR":
+            status = "not recommended"
+        elif scope and done == len(scope) and not item.safety_case_adds:
+            status = "covered"
+        elif done:
+            status = "partial"
+        elif any(e.counts for e in evidence) or any(s.kind != "guarantee" for s in scope):
+            status = "not covered"
+        else:
+            status = "open"
+        why = (clause_words.why(status, scope, evidence, item) + adds(item)
+               + ("" if note is None or note.nodes is None else
+                  f"; scope narrowed by the plan to {', '.join(note.nodes)} ({note.reason})"))
+        out.append(ClauseRecord(
+            item.id, item.title, cast(Recommendation, code), list(item.evidence), item.strength,
+            cast(About, item.about), cast(Independence, item.independence_at(level)), evidence, scope,
+            list(dict.fromkeys(ob for x in scope if x.covered for ob in x.evidence)), checked_by(scope, ix.report.evidence),
+            status, why, None if note is None else PlanNoteRecord(
+                None if note.nodes is None else list(note.nodes), note.reason, note.justification, note.at)))
     return out
-
-
-def _why(status: str, scope: Sequence[ScopeItem], evidence: Sequence[Support], item: Item, code: str,
-         level: str | None) -> str:
-    if status == "not recommended":
-        return "not recommended at this level: the evidence is listed, nothing is asked"
-    if not scope:
-        return f"nothing in scope: the workspace has no {_NOTHING.get(item.about, item.about)}"
-    n, done = len(scope), sum(1 for s in scope if s["covered"])
-    if status == "covered":
-        return f"all {n} item{'s' if n != 1 else ''} in scope covered"
-    left = Counter(s["state"] for s in scope if not s["covered"])
-    if not left:  # every item covered, the clause asking more than the tool holds (_adds says what)
-        return f"{status}: {done} of {n} in scope covered"
-    head = ", ".join(f"{left[st]} {st}" for st in sorted(left, key=lambda x: _WORST.index(x) if x in _WORST else 0))
-    shown = [e for e in evidence if not e["counts"]]
-    extra = f"; {len(shown)} record{'s' if len(shown) != 1 else ''} shown, not counted ({shown[0]['note']})" if shown else ""
-    return f"{status}: {done} of {n} in scope covered; {head}{extra}"
 
 
 def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] | Sequence[Mapping[str, Any]],
@@ -340,7 +332,8 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
     ``obligations``, ``nodes``, ``side_conditions``, ``requirements``,
     ``findings``, ``unverified``, ``system`` and ``summary`` as far as it
     has them; a bare list of evidence rows reads as a report of those rows
-    alone), in the profile's order.  ``notes``: clause id -> what the plan
+    alone), in the profile's order, each the JSON object of its record
+    (:func:`clause_records`).  ``notes``: clause id -> what the plan
     says of it (a :class:`~rclverify.model.plan.standards.choice.ClauseNote`:
     ``nodes``, ``reason``, ``justification``, ``at``): the scope narrowed to
     those nodes, and the note shown.  ``unstated``: the (node, environment)
@@ -349,54 +342,17 @@ def clause_rows(profile: Profile, level: str | None, report: Mapping[str, Any] |
     entries (:class:`~.identity.Person`), names of one person for a review's
     independence (:func:`~.reviews.independence_of`).  Pure: reads nothing else,
     raises nothing for well-formed rows."""
-    rep: Mapping[str, Any] = report if isinstance(report, Mapping) else {"evidence": list(report)}
-    ix = _Index(rep, unstated, people)
-    out: list[ClauseRow] = []
-    for item in profile.items:
-        code = item.at(level)
-        note = (notes or {}).get(item.id)
-        scope = scope_items(item, level, rep, ix, None if note is None else note.nodes)
-        evidence = _evidence_in_scope(item, level, scope, ix)
-        done = sum(1 for s in scope if s["covered"])
-        status: ClauseStatus
-        if code == "NR":
-            status = "not recommended"
-        elif scope and done == len(scope) and not item.safety_case_adds:
-            status = "covered"
-        elif done:
-            status = "partial"
-        elif any(e["counts"] for e in evidence) or any(s["kind"] != "guarantee" for s in scope):
-            status = "not covered"
-        else:
-            status = "open"
-        out.append({"id": item.id, "title": item.title, "recommendation": cast(Recommendation, code),
-                    "accepts": list(item.evidence), "strength": item.strength, "about": cast(About, item.about),
-                    "independence": cast(Independence, item.independence_at(level)),
-                    "evidence": evidence, "scope": scope,
-                    "covered_by": list(dict.fromkeys(ob for x in scope if x["covered"] for ob in x["evidence"])),
-                    "checked_by": _checked_by(scope, ix),
-                    "status": status, "why": _why(status, scope, evidence, item, code, level)
-                    + _adds(item)
-                    + ("" if note is None or note.nodes is None else
-                       f"; scope narrowed by the plan to {', '.join(note.nodes)} ({note.reason})"),
-                    "plan": None if note is None else {"nodes": None if note.nodes is None else list(note.nodes),
-                                                       "reason": note.reason, "justification": note.justification,
-                                                       "at": note.at}})
-    return out
+    rows: list[ClauseRow] = msgspec.to_builtins(clause_records(profile, level, report, notes, unstated, people))
+    return rows
 
 
-def _adds(item: Item) -> str:
-    """What a clause the tool never covers alone (its item's ``safety_case_adds``) leaves to the safety case."""
-    if not item.safety_case_adds:
-        return ""
-    return f"; never covered by the tool alone: the safety case must add {item.safety_case_adds}"
+def not_covered(rows: Sequence[ClauseRecord | Mapping[str, Any]], codes: Sequence[str] = ASKED) -> list[str]:
+    """The ids of the clause rows (records, or their JSON objects) whose recommendation is one of ``codes``
+    (default: ``HR`` and ``required``) that are not ``covered`` (the ``--strict`` reading)."""
+    records = [r if isinstance(r, ClauseRecord) else msgspec.convert(r, ClauseRecord) for r in rows]
+    return [r.id for r in records if r.recommendation in codes and r.status != "covered"]
 
 
-def not_covered(rows: Sequence[ClauseRow], codes: Sequence[str] = ASKED) -> list[str]:
-    """The ids of the clause rows whose recommendation is one of ``codes`` (default: ``HR`` and
-    ``required``) that are not ``covered`` (the ``--strict`` reading)."""
-    return [r["id"] for r in rows if r["recommendation"] in codes and r["status"] != "covered"]
-
-
-__all__ = ["About", "CLAUSE_STATUSES", "ClauseRow", "ClauseStatus", "Independence", "Recommendation", "ScopeKind", "SUPPORTS", "ScopeItem", "Support", "clause_rows", "independence_of",
-           "kinds_of", "not_covered", "PlanNote", "review_as_stated", "review_identity", "scope_items"]
+__all__ = ["About", "CLAUSE_STATUSES", "ClauseRow", "ClauseStatus", "Independence", "Recommendation", "ScopeKind",
+           "SUPPORTS", "ScopeItem", "Support", "clause_records", "clause_rows", "independence_of", "kinds_of",
+           "not_covered", "PlanNote", "review_as_stated", "review_identity", "scope_items"]

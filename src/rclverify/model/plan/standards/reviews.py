@@ -12,9 +12,18 @@ from typing import Any, Iterable, Mapping
 
 from rclverify.model.plan.standards.identity import Person, is_person, same_person, with_people
 from rclverify.model.plan.standards.profiles import INDEPENDENCE
+from rclverify.model.plan.standards.report_view import EvidenceView, evidence_view
+
+#: A review evidence row: its view (:mod:`.report_view`), or its JSON object.
+Review = EvidenceView | Mapping[str, Any]
 
 
-def review_identity(row: Mapping[str, Any]) -> tuple[str, str, str]:
+def _figures(row: Review) -> tuple[Any, ...]:
+    """The row's ``figures`` rows (empty when it has none)."""
+    return evidence_view(row).figures or ()
+
+
+def review_identity(row: Review) -> tuple[str, str, str]:
     """(reviewer, author, independence) a review evidence row names in its ``figures`` rows
     (backends/review: ``reviewer``, ``author``, ``independence``); ``""`` for what it does not name."""
     said = _said(row)
@@ -25,22 +34,22 @@ def review_identity(row: Mapping[str, Any]) -> tuple[str, str, str]:
     return named("reviewer"), named("author"), named("independence")
 
 
-def _said(row: Mapping[str, Any]) -> dict[str, str]:
+def _said(row: Review) -> dict[str, str]:
     """A review row's ``figures`` as field -> value (the first of each field)."""
     out: dict[str, str] = {}
-    for r in row.get("figures") or ():
+    for r in _figures(row):
         if isinstance(r, (list, tuple)) and len(r) == 2:
             out.setdefault(str(r[0]), str(r[1]).strip())
     return out
 
 
-def _aliases(row: Mapping[str, Any], who: str) -> tuple[str, ...]:
+def _aliases(row: Review, who: str) -> tuple[str, ...]:
     """The aliases the review record declares for its ``who`` (``author`` or ``reviewer``)."""
     text = _said(row).get(f"{who} aliases", "")
     return tuple(a.strip() for a in text.split(";") if a.strip())
 
 
-def review_as_stated(row: Mapping[str, Any]) -> str:
+def review_as_stated(row: Review) -> str:
     """What a review row states of itself, as the record states it: its independence, date and scope
     (the tool checks none of them) and the files it lists as reviewed (their sha256 is checked, not
     that they are the node's code), ``"; "``-joined (``""`` when it states none)."""
@@ -48,14 +57,14 @@ def review_as_stated(row: Mapping[str, Any]) -> str:
     parts = [f"{label} {said[k]}" for k, label in (("independence", "independence as stated:"),
                                                     ("date", "dated"), ("scope", "scope as stated:"))
              if said.get(k) and not (said[k].startswith("(") and said[k].endswith(")"))]
-    files = [str(r[1]).split(" sha256 ", 1)[0] for r in row.get("figures") or ()
+    files = [str(r[1]).split(" sha256 ", 1)[0] for r in _figures(row)
              if isinstance(r, (list, tuple)) and len(r) == 2 and r[0] == "file"]
     if files:
         parts.append(f"files reviewed: {', '.join(files)}")
     return "; ".join(parts)
 
 
-def independence_of(row: Mapping[str, Any], people: Iterable[Person] = ()) -> tuple[str, str]:
+def independence_of(row: Review, people: Iterable[Person] = ()) -> tuple[str, str]:
     """(the independence level a review row shows, one of :data:`~.profiles.INDEPENDENCE`; why it is
     ``none`` or ``""``): ``none`` when the record does not name a person as its reviewer and as its author
     (an empty name, ``-``, ``unknown``... names nobody), or they are one person as
