@@ -22,6 +22,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
 
+import msgspec
 import yaml
 
 from rclverify.lang import ast
@@ -194,6 +195,48 @@ def _check_schema(data: object, locs: Mapping[Path_, ast.Loc], file: str) -> Non
         raise plan_error(l.file, l.line, l.col, f"standard profile: {where}: {e.message}", "E-profile")
 
 
+class _Written(msgspec.Struct, frozen=True, kw_only=True):
+    """A part of a profile file as written, once its schema (``profile.schema.json``) has passed."""
+
+
+class _ItemWritten(_Written, frozen=True, kw_only=True):
+    """An ``items[]`` entry; a per-level map's keys as YAML reads them (``1:`` a number)."""
+
+    id: str
+    title: str
+    evidence: tuple[str, ...]
+    strength: str
+    recommendation: str | dict[Any, str]
+    about: str = "guarantees"
+    independence: str | dict[Any, str] = "none"
+    min_runs: int = 0
+    safety_case_adds: str = ""
+
+
+class _LeftOutWritten(_Written, frozen=True, kw_only=True):
+    """A ``left_out[]`` entry: a clause the profile does not list, and why."""
+
+    id: str
+    why: str
+
+
+class _ProfileWritten(_Written, frozen=True, kw_only=True):
+    """A profile file's document."""
+
+    id: str
+    title: str
+    edition: str
+    level_name: str = "level"
+    levels: tuple[str, ...] = ()
+    items: tuple[_ItemWritten, ...]
+    left_out: tuple[_LeftOutWritten, ...] = ()
+
+
+def _per_level(value: str | dict[Any, str]) -> str | dict[str, str]:
+    """One code (or level of independence) for every level, or level -> code with the levels as text."""
+    return value if isinstance(value, str) else {str(k): str(v) for k, v in value.items()}
+
+
 def parse_profile(text: str, file: str, builtin: bool = False) -> Profile:
     """The profile written in the YAML ``text`` of ``file`` (``builtin``: one of the package's).
 
@@ -207,38 +250,35 @@ def parse_profile(text: str, file: str, builtin: bool = False) -> Profile:
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise plan_error(file, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     _check_schema(data, locs, file)
-    assert isinstance(data, dict)
-    levels = tuple(str(x) for x in data.get("levels", []))
+    doc = msgspec.convert(data, _ProfileWritten)
+    levels = doc.levels
     items: list[Item] = []
     seen: dict[str, int] = {}
-    for i, it in enumerate(data["items"]):
-        iid = str(it["id"])
+    for i, it in enumerate(doc.items):
+        iid = it.id
         if iid in seen:
             raise _bad(locs, ("items", i, "id"), file, f"standard profile: item id {iid!r} is used twice "
                        f"(first at line {_at(locs, ('items', seen[iid], 'id'), file).line})")
         seen[iid] = i
-        rec = it["recommendation"]
+        rec = _per_level(it.recommendation)
         if isinstance(rec, dict):
-            rec = {str(k): str(v) for k, v in rec.items()}
             if set(rec) != set(levels):
                 raise _bad(locs, ("items", i, "recommendation"), file,
                            f"standard profile: item {iid!r}: the recommendation names levels "
                            f"{', '.join(sorted(rec)) or 'none'}; the profile's levels are "
                            f"{', '.join(levels) or 'none (write one code)'}")
-        ind = it.get("independence", "none")
+        ind = _per_level(it.independence)
         if isinstance(ind, dict):
-            ind = {str(k): str(v) for k, v in ind.items()}
             if set(ind) != set(levels):
                 raise _bad(locs, ("items", i, "independence"), file,
                            f"standard profile: item {iid!r}: the independence names levels "
                            f"{', '.join(sorted(ind)) or 'none'}; the profile's levels are "
                            f"{', '.join(levels) or 'none (write one level of independence)'}")
-        items.append(Item(iid, str(it["title"]), tuple(it["evidence"]), str(it["strength"]), rec,
-                          str(it.get("about", "guarantees")), ind, int(it.get("min_runs", 0)),
-                          str(it.get("safety_case_adds", "")).strip()))
-    left = tuple((str(x["id"]), str(x["why"])) for x in data.get("left_out", []))
-    return Profile(str(data["id"]), str(data["title"]), str(data["edition"]), str(data.get("level_name", "level")),
-                   levels, tuple(items), file, builtin, hashlib.sha256(text.encode("utf-8")).hexdigest(), left)
+        items.append(Item(iid, it.title, it.evidence, it.strength, rec, it.about, ind, it.min_runs,
+                          it.safety_case_adds.strip()))
+    left = tuple((x.id, x.why) for x in doc.left_out)
+    return Profile(doc.id, doc.title, doc.edition, doc.level_name, levels, tuple(items), file, builtin,
+                   hashlib.sha256(text.encode("utf-8")).hexdigest(), left)
 
 
 __all__ = ["ABOUT", "ASKED", "BUILTIN_DIR", "CODES", "INDEPENDENCE", "Item", "Profile", "builtin_names", "edition_key",
