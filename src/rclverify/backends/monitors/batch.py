@@ -77,8 +77,9 @@ from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS, KEPT_VIOLATIONS, NodeResult, Verdict
 
-#: Events read per chunk: the columns held at once.
-CHUNK = 16384
+#: Events read per chunk: the columns held at once (a log's read of about 1 MiB is one chunk when it holds fewer
+#: lines: each chunk costs the state set after it and the questions and outputs it keeps, whatever its length).
+CHUNK = 65536
 #: The fewest pairs per run of pairs back to back, on average, for which a chunk of more than one run is judged
 #: in batch: a run costs the batch path about 300-450 microseconds whatever its length (its columns sliced, its
 #: formulas and margins evaluated, the engine's state set), the engine about 20 a message; measured on runs of L

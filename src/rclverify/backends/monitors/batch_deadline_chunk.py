@@ -150,11 +150,14 @@ def _skew_window(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, out_rows: np.
     return out
 
 
-def _mark(mon: ChunkSide, p: Pending, evs: list[Event], ns: np.ndarray, out_rows: np.ndarray, r: int) -> bool:
+def _mark(mon: ChunkSide, p: Pending, evs: list[Event], ns: np.ndarray, out_rows: np.ndarray, r: int,
+          heard_hi: int | None) -> bool:
     """Mark obligation ``p`` (its trigger at row ``r``) as :func:`.deadline_skew.scan_heard` marks it when the
     trigger comes: the outputs heard before the chunk, then the chunk's before row ``r``, oldest first, within
-    the skew; whether it is marked."""
-    deadline_skew.scan_heard(mon, p)
+    the skew; whether it is marked.  ``heard_hi``: the latest stamp (ns) among the outputs heard before the
+    chunk (``None``: none); none of them is scanned when it lies before the skew's window."""
+    if heard_hi is not None and heard_hi >= p.stamp_ns - mon.skew_ns:
+        deadline_skew.scan_heard(mon, p)
     if not p.maybe:
         ok = mon.plan.out_key
         lo = int(np.searchsorted(ns[out_rows], p.stamp_ns - mon.skew_ns, side="left"))
@@ -211,18 +214,17 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
     if mon.skew_ns:
         for i, p in enumerate(carried):
             maybe[i] = bool(p.maybe)
+        heard_hi = max((h[0] for h in mon.heard), default=None)
         for i in skewed.tolist():
-            maybe[i] = _mark(mon, ob(i), evs, ns, out_rows, int(rows[i]))
-    quiet = mon.on_verdict is None
-    trues = 0
+            maybe[i] = _mark(mon, ob(i), evs, ns, out_rows, int(rows[i]), heard_hi)
     at, phase, obs = verdicts
-    for r, ph, i in zip(at.tolist(), phase.tolist(), obs.tolist()):
+    # with no verdict callback an answer within its deadline is only counted: the loop visits the rest, in order
+    plain = (phase == 1) & (ns[at] <= due[obs]) if mon.on_verdict is None else np.zeros(len(at), dtype=bool)
+    trues = int(np.count_nonzero(plain))
+    rest = ~plain
+    for r, ph, i in zip(at[rest].tolist(), phase[rest].tolist(), obs[rest].tolist()):
         if ph == 1:
-            a = int(ns[r])
-            if quiet and a <= int(due[i]):
-                trues += 1
-                continue
-            mon._emit(mon.answered_verdict(ob(i), a, evs[r], plan.timed[int(which[i])][2]))
+            mon._emit(mon.answered_verdict(ob(i), int(ns[r]), evs[r], plan.timed[int(which[i])][2]))
         elif ph == 0:
             if not maybe[i]:
                 mon._emit(mon.late_verdict(ob(i), int(ns[r]), evs[r]))

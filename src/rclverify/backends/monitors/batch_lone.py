@@ -205,19 +205,18 @@ class LoneSlots:
         out_full[out_rows] = col_out
         early_q: list[int] = []  # (into close_q) those with an early answer
         early_row: list[int] = []  # its row (-1: the engine's last remembered output)
-        if skew:
-            for c, j in enumerate(close_q):
-                if j < 0:
-                    r, stamp = -1, q0.stamp
-                else:
-                    r, stamp = int(last_out[int(in_rows[j])]), float(t[int(in_rows[j])])
-                at = float(t[r]) if r >= 0 else (float(prior[1]) if prior is not None else None)
-                if at is not None and within_before(at, stamp, skew):
-                    early_q.append(c)
-                    early_row.append(r)
+        cq = np.array(close_q, dtype=np.int64)
+        if skew and len(cq):  # over columns, in doubles
+            own = cq >= 0
+            trig = in_rows[np.maximum(cq, 0)] if nq else np.zeros(len(cq), dtype=np.int64)
+            r_at = np.where(own, last_out[trig], -1)
+            stamp = np.where(own, t[trig], q0.stamp)
+            at = np.where(r_at >= 0, t[np.maximum(r_at, 0)], float(prior[1]) if prior is not None else np.nan)
+            hit = within_before(at, stamp, skew)  # (NaN: no output remembered, never within)
+            early_q, early_row = np.flatnonzero(hit).tolist(), r_at[hit].tolist()
         # the readings: each output on its question's input, each early answer on its question's
         r_in = np.concatenate([qin[qidx[out_rows] + 1],
-                               qin[np.array([close_q[c] for c in early_q], dtype=np.int64) + 1]])
+                               qin[cq[np.array(early_q, dtype=np.int64)] + 1]])
         er = np.array(early_row, dtype=np.int64)
         r_out = np.concatenate([col_out, np.where(er >= 0, out_full[np.maximum(er, 0)],
                                                   prior_v if prior_v is not None else 0)]).astype(col_out.dtype)
@@ -298,7 +297,9 @@ class LoneSlots:
                     emit(Verdict(name, "inconclusive", e.index, e.time, e.where, e.topic,
                                  max(float(t[p // 2]), e.time), 0, {}, reason.format(e.where), "", "", None))
         first_index = chunk[base].index if len(chunk) > base else 0
-        m._given.extend((first_index + x, "satisfied", "exact") if what else (qev(x).index, "inconclusive", "")
+        q0_index = q0.event.index  # row r is event first_index + r (a chunk's rows are its events in order)
+        m._given.extend((first_index + x, "satisfied", "exact") if what else
+                        (first_index + int(in_rows[x]) if x >= 0 else q0_index, "inconclusive", "")
                         for what, x in zip(what_all[tail].tolist(), x_all[tail].tolist()))
         self._questions_after(chunk, s, k, t, in_rows, out_rows, qidx, answered, paired_out)
         # the values, the clock, the outputs remembered, the counts
@@ -381,7 +382,8 @@ class LoneSlots:
         total = len(stream._questions) + nq
         keptn = kept_after(total)
         tail = list(range(max(0, nq - min(nq, keptn)), nq))
-        out_of = {int(qidx[r]): r for r, p in zip(out_rows.tolist(), paired_out.tolist()) if p}
+        out_of = np.full(nq, -1, dtype=np.int64)  # each answered question's answer row
+        out_of[qidx[out_rows[paired_out]]] = out_rows[paired_out]
         made: list[Question] = []
         h = m.horizon
         for j in tail:
@@ -395,7 +397,7 @@ class LoneSlots:
             if j + 1 < nq and not answered[j]:
                 q.mark("passed", ik)
             if answered[j]:
-                oev = chunk[s + out_of[j]]
+                oev = chunk[s + int(out_of[j])]
                 v = self._value(oev, okey)
                 q.answered, q.last_out, q.answer = True, oev, {okey: v}
                 q.view = {ik: q.inputs[ik], okey: v}
