@@ -101,10 +101,10 @@ def import_fret(root: Path, plan_rel: str, export: Path, shown: str) -> ImportRe
     be written."""
     from rclverify.lang.errors import RclError  # deferred: start-up (loads rclverify.lang only when called)
     from rclverify.lang.parser import parse_file  # deferred: start-up (loads lark only when called)
-    from rclverify.model.plan.load import read_plan_data  # deferred: start-up (loads yaml only when called)
+    from rclverify.model.plan.load import read_plan_document  # deferred: start-up (loads yaml only when called)
     exp = read_export(export, shown)  # a malformed export stops here, before anything is written
-    data, _ = read_plan_data(root, plan_rel)
-    dest = str((data.get("requirements_from") or {}).get("fret") or f"fret/{export.name}")
+    doc, _ = read_plan_document(root, plan_rel)
+    dest = doc.fret_export or f"fret/{export.name}"
     raw = json.loads(export.read_text(encoding="utf-8-sig"))
     new = normalised(raw)
     target = root / dest
@@ -123,7 +123,7 @@ def import_fret(root: Path, plan_rel: str, export: Path, shown: str) -> ImportRe
     res.removed = [r for r in old if r not in now]
     res.unchanged = [r for r in now if old.get(r) == now[r]]
     plan_path, edited = root / plan_rel, None
-    if not (data.get("requirements_from") or {}).get("fret"):  # decided before anything is written
+    if not doc.fret_export:  # decided before anything is written
         edited = _plan_with_fret(plan_path.read_text(encoding="utf-8"), dest)
         if edited is None:
             raise plan_error(plan_rel, 1, 1, f"requirements_from is written in flow style: add 'fret: {dest}' to it "
@@ -133,13 +133,13 @@ def import_fret(root: Path, plan_rel: str, export: Path, shown: str) -> ImportRe
     if edited is not None:
         res.plan_edited = atomic_write_text(plan_path, edited, within=root)
     specs = []
-    for c in data.get("contracts") or []:
+    for c in doc.contracts:
         try:
-            specs.append(parse_file(root / str(c)))
+            specs.append(parse_file(root / c))
         except RclError:
             continue
     copy = read_export(target, dest)
-    res.imported = import_export(FretExport(shown, copy.requirements, copy.variables), options_of(data),
+    res.imported = import_export(FretExport(shown, copy.requirements, copy.variables), options_of(doc),
                                  ports_of(specs))
     return res
 
