@@ -1,5 +1,5 @@
-"""The Hoare backend's and the property tests' evidence payloads are Structs tagged by ``backend``
-(backends/hoare/payload.py, backends/property_tests/payload.py), decoded once by the report's evidence pass
+"""The Hoare backend's, the property tests' and the monitors' evidence payloads are Structs tagged by ``backend``
+(backends/hoare/payload.py, backends/property_tests/payload.py, backends/monitors/payload.py), decoded once by the report's evidence pass
 (backends/payloads.py ``payload_of``, report/evidence_rows.py): a record's ``details`` decodes into the one
 its backend names, a key that payload does not declare makes the record ``error`` in one sentence (the
 control: the same record without it is shown), and a backend whose payload is no Struct is read as before.
@@ -28,7 +28,7 @@ _RUN = PropertyTestsPayload(examples={"run": 100, "valid": 90, "rejected": 10, "
 
 
 def test_a_payload_round_trips_through_its_details_and_its_tag() -> None:
-    assert TYPED == {"hoare", "property_tests"}
+    assert TYPED == {"hoare", "property_tests", "monitors"}
     hoare = HoarePayload(vcs={"main": "valid"}, program="prog.imp", triple={"pre": "true", "post": "y > 0"})
     for backend, payload in (("hoare", hoare), ("property_tests", _RUN)):
         details = payload.details()
@@ -38,7 +38,7 @@ def test_a_payload_round_trips_through_its_details_and_its_tag() -> None:
     assert PropertyTestsPayload(timeout_s=0.05).details() == {"timeout_s": 0.05}
     assert "deadline_ms" not in _RUN.details() and _RUN.details()["seed"] == 7
     # another backend's payload is no Struct: read as its JSON object, never decoded here
-    assert payload_of("monitors", {"monitoring": {"trace": "t"}}) is None
+    assert payload_of("experiment", {"figures_table": [["runs", "3"]]}) is None
     # a key the backend's payload does not declare, or a value of another type, is refused
     with pytest.raises(msgspec.ValidationError, match="margin_added_here"):
         payload_of("hoare", {**hoare.details(), "margin_added_here": "0.5 m"})

@@ -29,6 +29,8 @@ import dataclasses
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+import msgspec
+
 from rclverify.records.records import Evidence, Obligation, SourceRef, make_obligation_id
 from rclverify.records.statistics import count_runs, decide
 from rclverify.model.plan.targets import entry_environment, entry_origin, entry_target
@@ -36,6 +38,7 @@ from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.verdicts import NodeResult
 from rclverify.backends.monitors.shapes import RunCounts
 from rclverify.backends.monitors.margin_target import of_margin
+from rclverify.backends.monitors.payload import MonitorsPayload, RunStatistics
 from rclverify.backends.monitors.run_identity import BAG_SUFFIXES, read_fields, run_digest
 from rclverify.traces.mapping import TopicRule
 
@@ -190,9 +193,9 @@ def run_runset(check_one: Callable[[Obligation, NodeTarget], Evidence], obligati
         explanation += f"; {counts['duplicates']} run file(s) repeat a run already counted (same sha256)"
     if origin == "simulation":
         explanation += "; the runs are simulated (origin: simulation): the bound holds for the simulator's runs"
-    details = {"statistics": {"environment": env, "origin": origin, "target": t.to_json(), "counts": counts,
-                              "decision": verdict, "runs": rows}}
-    return evidence(status, explanation, details=details, log=explanation)
+    stats = msgspec.convert({"environment": env, "origin": origin, "target": t.to_json(), "counts": counts,
+                             "decision": verdict, "runs": rows}, RunStatistics)
+    return evidence(status, explanation, details=MonitorsPayload(statistics=stats).details(), log=explanation)
 
 
 __all__ = ["BAG_SUFFIXES", "recorded_as", "run_counts", "run_digest", "run_runset", "runset_obligations"]
