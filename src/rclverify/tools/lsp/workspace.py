@@ -103,10 +103,10 @@ class LspWorkspace:
         except OSError:
             return ()
         if self._plan_cache is None or self._plan_cache[0] != stamp:
-            from rclverify.model.plan.load import read_plan_data  # deferred: optional or conditional (inside a block)
+            from rclverify.model.plan.load import read_plan_document  # deferred: optional or conditional (inside a block)
             try:
-                data, _ = read_plan_data(self.root, self.plan)
-                files = tuple(str(c) for c in data.get("contracts") or [] if isinstance(c, str))
+                doc, _ = read_plan_document(self.root, self.plan)
+                files = doc.contracts
             except RclError:
                 files = ()
             self._plan_cache = (stamp, files)
