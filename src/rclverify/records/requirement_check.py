@@ -106,7 +106,7 @@ class RequirementCheckRow(msgspec.Struct, frozen=True):
     the assumptions), the temporal check's record and the recorded runs checked; the proof's script
     (``smt2``), the ``assuming`` formulas, the premises used, those traced but not needed, the cores (of
     an inconsistency, of a vacuous premise), the guarantees that did not prevent a counterexample, the
-    declarations with their evidence and the second solver's agreement."""
+    declarations with their evidence, the second solver's agreement and the check's time."""
 
     formal: str | None = None
     source: str | None = None
@@ -122,6 +122,7 @@ class RequirementCheckRow(msgspec.Struct, frozen=True):
     vacuity_core: list[PremiseRow] = []
     failed_to_prevent: list[PremiseRow] = []
     counterexample_note: str | None = None
+    duration_s: int | float = 0  #: Z3's time on the check, seconds (as written: an int stays an int)
     declarations: list[DeclarationRow] = []
     solvers: Solvers | None = None
 
