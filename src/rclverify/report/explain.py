@@ -19,7 +19,8 @@ is decoded here) and read as the attributes mypy checks: its requirements,
 nodes (their guarantees), side conditions, findings, obligations, evidence,
 lint, diagnoses and problems.  A requirement check's record is decoded into
 :class:`~rclverify.records.requirement_check.RequirementCheckRow`, a ROS
-grounding finding into :class:`_RosFinding` (the keys printed), the SARIF log
+grounding finding into
+:class:`~rclverify.records.grounding_findings.GroundingFindingRow`, the SARIF log
 into :mod:`.sarif_view`'s runs and the argument's elements into
 :class:`~rclverify.report.argument.model.ElementRecord` (files of their own: an
 element, rule or result of another shape is left out).  A monitored run's
@@ -37,6 +38,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import msgspec
 
+from rclverify.records.grounding_findings import GroundingFindingRow, PlaceRow
 from rclverify.records.lint_rows import LintRow
 from rclverify.records.node_rows import CulpritOf, GuaranteeRow, NodeRow
 from rclverify.records.report_record import AssuranceReport
@@ -64,26 +66,6 @@ _PROBLEM = re.compile(r"^(?:problem\s*|p)?(?P<k>\d+)\.?$", re.IGNORECASE)
 def _fold(text: str) -> str:
     """An id up to case, ``_``/``-`` and spaces (``battery_monitor`` ~ ``BatteryMonitor``)."""
     return re.sub(r"[\s_-]+", "", str(text)).lower()
-
-
-class _Place(msgspec.Struct, frozen=True):
-    """A place of a ROS grounding finding (``rcl`` or ``ros``): ``file`` and 1-based line and column."""
-
-    file: str = ""
-    line: int = 1
-    col: int = 1
-
-
-class _RosFinding(msgspec.Struct, frozen=True):
-    """What ``rclverify explain`` prints of a ROS grounding finding
-    (:class:`rclverify.records.stage_records.GroundingFinding`, ros/ground/ground.py ``Finding.to_json``)."""
-
-    code: str = ""
-    severity: str | None = None
-    message: str | None = None
-    node: str | None = None
-    rcl: _Place | None = None
-    ros: _Place | None = None
 
 
 def _elements(argument: object) -> dict[str, ElementRecord]:
@@ -115,9 +97,9 @@ class _Index:
             self.items.update(dict.fromkeys(ids, kind))
         self.evidence = {e.obligation: e for e in report.evidence}
         self.problems = report.problems
-        self.ros: dict[str, list[_RosFinding]] = {}  # a grounding finding: ros/ground's record
+        self.ros: dict[str, list[GroundingFindingRow]] = {}  # a grounding finding: ros/ground's record
         for ros_finding in report.grounding.findings if report.grounding is not None else []:
-            rf = msgspec.convert(ros_finding, _RosFinding)
+            rf = GroundingFindingRow.of(ros_finding)
             self.ros.setdefault(rf.code, []).append(rf)
         self.lint: dict[str, list[LintRow]] = {}
         for w in report.lint:
@@ -333,8 +315,8 @@ def _culprit_of(item: NodeRow | GuaranteeRow) -> list[CulpritOf]:
     return [] if item.culprit_of is msgspec.UNSET else item.culprit_of
 
 
-def _place(at: _Place | None) -> str:
-    return f"{at.file}:{at.line}:{at.col}: " if at is not None and at.file else ""
+def _place(at: PlaceRow | None) -> str:
+    return f"{at.text()}: " if at is not None and at.file else ""
 
 
 def _sarif_place(res: ResultView) -> str:

@@ -70,6 +70,7 @@ from rclverify.records.obligations import rows_of as obligation_rows_of
 from rclverify.records.evidence_rows import rows_of as evidence_rows_of
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import Report
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.records.row import decode_rows
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.severity import junit_outcome
@@ -176,13 +177,13 @@ def _requirements_suite(report: AssuranceReport) -> tuple[ET.Element, dict[str, 
     props: list[tuple[str, str]] = []  # the test cases' strength and confidence (docs/confidence.md)
     time = 0.0
     for r in report.requirements:
-        c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
-        secs = float(c.get("duration_s") or 0.0) if isinstance(c.get("duration_s"), (int, float)) else 0.0
-        case = _case(suite, "requirement", r.id, str(c.get("source") or ""), secs)
-        cex = "; ".join(f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
-                        for row in c.get("counterexample") or [])
-        used = "; ".join(f"{p['label']} ({p['source']})" for p in c.get("used") or [])
-        prevent = "; ".join(f"{p['label']}: {p['text']} ({p['source']})" for p in c.get("failed_to_prevent") or [])
+        c = RequirementCheckRow.of(r.check)  # the requirement check's record (calculus/requirements/check.py)
+        secs = float(c.duration_s)
+        case = _case(suite, "requirement", r.id, c.source or "", secs)
+        cex = "; ".join(f"{row.node}: " + ", ".join(f"{k} = {v}" for k, v in row.values.items())
+                        for row in c.counterexample)
+        used = "; ".join(f"{p.label} ({p.source})" for p in c.used)
+        prevent = "; ".join(f"{p.label}: {p.text} ({p.source})" for p in c.failed_to_prevent)
         counts["tests"] += 1
         time += secs
         limited = r.limited_by
@@ -191,7 +192,7 @@ def _requirements_suite(report: AssuranceReport) -> tuple[ET.Element, dict[str, 
             _properties(props, r.id, {"confidence": f"{r.confidence:.6g}", "limited_by": sentence})
         bumped = _outcome(case, r.status, f"{r.verdict}: {r.note}",
                           _lines(f"requirement {r.id}: {r.text}",
-                                 f"formal: {c['formal']}" if c.get("formal") else "",
+                                 f"formal: {c.formal}" if c.formal else "",
                                  f"verdict: {r.verdict}", r.note,
                                  f"used: {used}" if used else "", f"counterexample: {cex}" if cex else "",
                                  f"not prevented by: {prevent}" if prevent else ""))

@@ -40,14 +40,16 @@ import msgspec
 from rclverify.records.store import dumps
 from rclverify.report.templating import model_text
 from rclverify.records.findings import FindingRow
+from rclverify.records.grounding_findings import GroundingFindingRow
 from rclverify.records.lint_rows import LintRow
-from rclverify.records.problem_rows import DiagnosisRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.report_schema import Report
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.report.severity import of
-from rclverify.records.sarif import SRCROOT, sarif_fix, sarif_locations, sarif_result
+from rclverify.records.sarif import SRCROOT, sarif_locations, sarif_result
 from rclverify.records.sarif import (SarifDescriptor, SarifLocation, SarifLog, SarifResult, SarifRun,
                                      SarifSuppression)
+from rclverify.report.sarif_diagnoses import attach_diagnoses
 from rclverify.report.sarif_rules import HEALTH_RULE, OBLIGATION_RULE, REQUIREMENT_RULE, RULES, Rule, lint_rule_id
 
 #: The SARIF version written and the schema it validates against.
@@ -138,14 +140,29 @@ def _side_condition_results(report: AssuranceReport) -> list[SarifResult]:
             props["strength"] = sc.strength.to_json()
         if sc.solvers:
             props["solvers"] = {"agreement": sc.solvers.agreement, "why": sc.solvers.why, "proof": _set(sc.solvers.proof)}
-        ctx = sc.context
-        if isinstance(ctx, Mapping):  # decided in context: the cone and the upstream premises used
-            props["inContext"] = {"cone": ctx.get("cone"), "used": list(ctx.get("used") or []),
-                                  "opened": list(ctx.get("opened") or []), "violated": list(ctx.get("violated") or [])}
+        if sc.context is not None:  # decided in context: the cone and the upstream premises used
+            ctx = _InContext.of(sc.context)
+            props["inContext"] = {"cone": ctx.cone, "used": ctx.used, "opened": ctx.opened, "violated": ctx.violated}
         # one severity (report/severity.py): a side condition discharged in context holds (a note, not gating)
         out.append(sarif_result(rule, _level("side-condition", status), " ".join(words), sc.source,
                                 f"side-condition:{sc.id}", props))
     return out
+
+
+class _InContext(msgspec.Struct, frozen=True):
+    """What SARIF shows of a side condition's in-context check (``context``, calculus/side_condition.py
+    :class:`~rclverify.records.composition_records.ContextRecord`): the cone's size, the premises used,
+    the links opened (rule R4) and the nodes whose assumption the counterexample violates."""
+
+    cone: int | None = None
+    used: list[str] = []
+    opened: list[str] = []
+    violated: list[str] = []
+
+    @classmethod
+    def of(cls, context: Mapping[str, Any]) -> _InContext:
+        """``context`` decoded, a key written ``null`` at its default."""
+        return msgspec.convert({k: v for k, v in context.items() if v is not None}, cls)
 
 
 def _requirement_results(report: AssuranceReport) -> list[SarifResult]:
@@ -157,21 +174,21 @@ def _requirement_results(report: AssuranceReport) -> list[SarifResult]:
         rule = REQUIREMENT_RULE.get(r.verdict)
         if rule is None:
             continue
-        c = r.check  # the requirement check's record (calculus/requirements/check.py), JSON as its stage wrote it
-        words = [f"Requirement {r.id} is {r.verdict}" + (f": {c['formal']}." if c.get("formal") else ".")]
+        c = RequirementCheckRow.of(r.check)  # the requirement check's record (calculus/requirements/check.py)
+        words = [f"Requirement {r.id} is {r.verdict}" + (f": {c.formal}." if c.formal else ".")]
         words.append(r.note + ".")
-        if c.get("counterexample"):
+        if c.counterexample:
             words.append("Counterexample: " + "; ".join(
-                f"{row['node']}: " + ", ".join(f"{k} = {v}" for k, v in row["values"].items())
-                for row in c["counterexample"]) + ".")
-        if c.get("temporal"):  # a temporal requirement: its method, bound and trace step by step
+                f"{row.node}: " + ", ".join(f"{k} = {v}" for k, v in row.values.items())
+                for row in c.counterexample) + ".")
+        if c.temporal:  # a temporal requirement: its method, bound and trace step by step
             from rclverify.report.temporal import temporal_words  # deferred: optional or conditional (inside a block)
-            words.append(temporal_words(c["temporal"]))
-        for p in c.get("failed_to_prevent") or []:
-            words.append(f"Not prevented by {p['label']} ({p['text']}, {p['source']}).")
+            words.append(temporal_words(c.temporal))
+        for p in c.failed_to_prevent:
+            words.append(f"Not prevented by {p.label} ({p.text}, {p.source}).")
         props = {"requirement": r.id, "verdict": r.verdict, "status": r.status}
         out.append(sarif_result(rule, _level("requirement", r.verdict), " ".join(words),
-                                str(c.get("source") or ""), f"requirement:{r.id}", props))
+                                c.source or "", f"requirement:{r.id}", props))
     return out
 
 
@@ -263,15 +280,14 @@ def _grounding_results(report: AssuranceReport) -> tuple[list[SarifResult], list
     rules = [Rule(code, "Ros" + "".join(w.capitalize() for w in code.split("-")[1:]),
                   "error" if sev == "error" else "warning", text) for code, (sev, text) in ROS_RULES.items()]
     out = []
-    for k, f in enumerate(g.findings):  # each grounding finding as ros/ground/ground.py wrote it
-        rcl, ros = f.get("rcl"), f.get("ros")
+    for k, f in enumerate(map(GroundingFindingRow.of, g.findings)):  # as ros/ground/ground.py wrote it
+        rcl, ros = f.rcl, f.ros
         main = rcl or ros
-        where = f"{main['file']}:{main['line']}:{main['col']}" if main else ""
-        res = sarif_result(str(f["code"]), "error" if f["severity"] == "error" else "warning", str(f["message"]), where,
-                      f"grounding:{f['code']}:{f.get('node', '')}:{f.get('topic', '')}:{k}",
-                      {"node": f.get("node", ""), "topic": f.get("topic", "")})
+        where = main.text() if main else ""
+        res = sarif_result(f.code, "error" if f.severity == "error" else "warning", str(f.message), where,
+                           f"grounding:{f.code}:{f.node}:{f.topic}:{k}", {"node": f.node, "topic": f.topic})
         if rcl and ros:
-            rel = sarif_locations(f"{ros['file']}:{ros['line']}:{ros['col']}")
+            rel = sarif_locations(ros.text())
             for i, loc in enumerate(rel):
                 loc["id"] = i
                 loc["message"] = {"text": "the software this contradicts"}
@@ -280,69 +296,9 @@ def _grounding_results(report: AssuranceReport) -> tuple[list[SarifResult], list
     return out, rules
 
 
-def _attach_diagnoses(report: AssuranceReport, results: Sequence[SarifResult]) -> None:
-    """Give each result its diagnosis (``properties.diagnosis``: the
-    sentence naming the culprit) and its repairs as SARIF ``fix`` objects
-    (§3.55; each repair was checked by Z3 before it entered the report,
-    docs/diagnosis.md).  A report without ``diagnoses`` is left as it is."""
-    by_key: dict[str, DiagnosisRow] = {}
-    for dg in report.diagnoses:
-        if dg.kind == "unit":  # a unit mismatch: the lint error at the producer (diagnosis/units.py)
-            by_key[f"unit:{_set(dg.lint)}"] = dg
-            continue
-        if dg.kind == "deadline":
-            by_key[f"deadline:{_set(dg.requirement)}"] = dg
-            continue
-        for prefix in ("health", "side-condition", "obligation", "requirement"):
-            by_key[f"{prefix}:{dg.id}"] = dg
-    for res in results:
-        fp = res["partialFingerprints"]["rclverifyItem/v1"]
-        d = by_key.get(fp) or (by_key.get("unit:" + fp[5:].split(":E-unit-")[0]) if ":E-unit-" in fp else None)
-        if d is None:
-            continue
-        res["properties"]["diagnosis"] = d.sentence
-        if res["partialFingerprints"]["rclverifyItem/v1"].startswith("side-condition:"):
-            _at_the_culprit(res, d)
-        # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
-        # a repair of the code is checked by the property tests (diagnosis/code_repair.py), not by Z3 alone
-        fixes = [sarif_fix(f"{r['summary']} {_checker(r)} show{'' if _checker(r).endswith('tests') else 's'}: "
-                           f"{r.get('proves') or 'the problem no longer follows'}; not shown: "
-                           f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
-                 for r in d.repairs if r.get("edit")]
-        if fixes:
-            res["fixes"] = fixes
-
-
-def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
-    """A failed side condition is located at the guarantee its diagnosis blames
-    (a producer that publishes what the consumer does not accept), so that a CI
-    annotation lands on the node to repair; the consumer's assumption it fails
-    becomes a related location (SARIF 2.1.0 §3.27.22)."""
-    guarantee = next((c for c in d.culprits if isinstance(c, Mapping)
-                      and str(c.get("what", "")).startswith("guarantee") and c.get("source")), None)
-    if guarantee is None:
-        return
-    at = sarif_locations(str(guarantee["source"]))
-    if not at:
-        return
-    rel = res.get("locations") or []
-    res["locations"] = at
-    for i, loc in enumerate(rel):
-        loc["id"] = i
-        loc["message"] = {"text": "the assumption it fails"}
-    if rel:
-        res["relatedLocations"] = rel
-
-
 def _descriptor(r: Rule) -> SarifDescriptor:
     return {"id": r.id, "name": r.name, "shortDescription": {"text": r.text},
             "defaultConfiguration": {"level": r.level}}
-
-
-def _checker(r: Mapping[str, Any]) -> str:
-    """What checked the repair ``r``: Z3, the property tests (a code repair), or what its ``checked_by`` names."""
-    by = str(r.get("checked_by") or "")
-    return "Z3" if r["kind"] != "code" else "The property tests" if "hypothesis" in by or not by else by[:1].upper() + by[1:]
 
 
 def sarif_log(report: Report | AssuranceReport) -> SarifLog:
@@ -369,7 +325,7 @@ def sarif_log(report: Report | AssuranceReport) -> SarifLog:
                + design.sarif_results(typed, sarif_result, sarif_locations)
                + _requirement_results(typed) + sarif_results(typed, sarif_result) + _acknowledgement_results(typed)
                + near_misses.sarif_results(typed, sarif_result))
-    _attach_diagnoses(typed, results)
+    attach_diagnoses(typed, results)
     rules: Sequence[Rule] = (list(RULES.values()) + [Rule(*r) for r in SARIF_RULES] + [Rule(*r) for r in nodl.SARIF_RULES]
                              + [Rule(*r) for r in design.SARIF_RULES]
                              + [Rule(*r) for r in near_misses.SARIF_RULES] + lint_rules + ground_rules)

@@ -43,14 +43,14 @@ from rclverify.tools.lsp.diagnostics import MAX_CHARS
 _COMMENT = re.compile(r"//|/\*")
 
 
-#: What checked a repair, as a fix description of :func:`rclverify.report.sarif._attach_diagnoses` says it:
+#: What checked a repair, as a fix description of :func:`rclverify.report.sarif_diagnoses.attach_diagnoses` says it:
 #: Z3 (a contract's or a program's repair), the property tests (a repair of the code, diagnosis/code_repair.py).
 _CHECKERS = ("Z3 shows", "The property tests show")
 
 
 def _title(description: str) -> str:
     """``"<what it does> — Z3 shows: ...; not shown: ..."`` (or ``— the property tests show: ...``) from a
-    fix description of :func:`rclverify.report.sarif._attach_diagnoses` (the whole description when it
+    fix description of :func:`rclverify.report.sarif_diagnoses.attach_diagnoses` (the whole description when it
     has another form)."""
     for checker in _CHECKERS:
         head, sep, shown = description.partition(f" {checker}: ")
