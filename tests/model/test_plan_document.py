@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -77,7 +78,8 @@ def test_absent_sections_are_empty(tmp_path: Path) -> None:
 
 
 def test_a_value_the_sections_do_not_admit_is_located() -> None:
-    data = {"contracts": ["a.rcl"], "requirements": [{"id": "R1", "text": "t", "deadline": {"path": "A", "within": 1}}]}
+    data: dict[str, Any] = {"contracts": ["a.rcl"],
+                            "requirements": [{"id": "R1", "text": "t", "deadline": {"path": "A", "within": 1}}]}
     locs = {("requirements", 0): Loc("plan.yaml", 4, 5), ("requirements", 0, "deadline"): Loc("plan.yaml", 6, 15)}
     with pytest.raises(PlanError) as exc:
         plan_document(data, locs, "plan.yaml")

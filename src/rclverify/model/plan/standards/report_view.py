@@ -151,7 +151,7 @@ class ReportView(_View, frozen=True, kw_only=True):
     summary: SummaryView = SummaryView()
 
 
-def _present(report: Mapping[str, Any]) -> dict[str, Any]:
+def _present(report: Mapping[str, Any]) -> dict[str, object]:
     """``report`` without the parts written as ``null`` (read as absent, as the mapping always has)."""
     return {k: v for k, v in report.items() if v is not None}
 
