@@ -165,6 +165,22 @@ class CopiedStamps:
                 del first[k]
         return source, False
 
+    def copy_of(self, topic: str, stamp: float, source: float) -> float | None:
+        """The time (s, the run's clock) a message of ``topic`` whose header
+        stamp ``stamp`` (s) runs in the run's clock by its own offset, with
+        source time ``source`` (s), is placed at when that stamp equals the
+        stamp in another clock of an earlier message of another writer within
+        :data:`COPY_S` before it: that message's source time (a relay copying
+        a driver's stamp 0.3 s ahead and publishing 0.22 s later carries a
+        stamp only 0.08 s ahead of its own publication, within the bounds, yet
+        copied from its question); ``None`` when it copies none (its stamp
+        stands).  Counted in ``copied``."""
+        got = self._first.get(stamp)
+        if got is not None and got[0] != topic and 0.0 <= source - got[1] <= COPY_S:
+            self.copied += 1
+            return got[1]
+        return None
+
 
 class WriterClocks:
     """Per writer (a topic), the offset between its header stamps and its

@@ -179,6 +179,10 @@ class OnlineEngine:
             # another clock: placed at its source time, a copied stamp at its question's (traces/event_time.py)
             stamp, copied = self.copies.place(topic, stamp, received)
             fields = with_stamp(fields, stamp) if copied else without_stamp(fields)
+        elif stamp is not None:
+            at = self.copies.copy_of(topic, stamp, received)
+            if at is not None:  # a copy of a stamp set aside in another clock: at its question's time (event_time.py)
+                stamp, fields = at, with_stamp(fields, at)
         t = received if stamp is None else stamp
         last, lag = self.writers.get(topic, _UNHEARD)
         after = received - t  # how long after its stamp it was published, at most the horizon

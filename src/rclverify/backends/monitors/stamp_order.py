@@ -95,7 +95,7 @@ class StampWatch:
         t = ev.time if s is None else s
         span = self.plain if s is None else self.stamped
         p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time)[0] if self.clocks.see(
-            ev.topic, s, ev.time) else s
+            ev.topic, s, ev.time) else _own_or_copied(self.copies, ev.topic, s, ev.time)
         if p >= self.placed_latest:
             self.placed_latest = p
         elif self.placed_latest - p > self.placed_lag:
@@ -179,7 +179,8 @@ def placed_clock(ev: Event, copies: CopiedStamps | None = None) -> tuple[float, 
     another clock are placed at their trace times, and how its stamp was
     placed: ``""`` (its own time), ``"aside"`` (set aside: the message is
     then judged as unstamped) or ``"copied"`` (a stamp copied from another
-    writer's in that clock, through ``copies``:
+    writer's in that clock, whether or not the copy's own offset is within
+    the bounds, through ``copies``:
     :class:`~rclverify.traces.event_time.CopiedStamps`; carried into the
     run's clock at that message's time)."""
     s = header_stamp(ev.fields) if ev.fields else None
@@ -190,7 +191,15 @@ def placed_clock(ev: Event, copies: CopiedStamps | None = None) -> tuple[float, 
             return ev.time, "aside"
         t, copied = copies.place(ev.topic, s, ev.time)
         return t, "copied" if copied else "aside"
-    return s, ""
+    at = None if copies is None else copies.copy_of(ev.topic, s, ev.time)
+    return (s, "") if at is None else (at, "copied")
+
+
+def _own_or_copied(copies: CopiedStamps, topic: str, stamp: float, time: float) -> float:
+    """A stamp in the run's clock (s), or, a copy of a stamp set aside in another clock, its question's time
+    (:meth:`~rclverify.traces.event_time.CopiedStamps.copy_of`)."""
+    at = copies.copy_of(topic, stamp, time)
+    return stamp if at is None else at
 
 
 def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
