@@ -101,13 +101,20 @@ class DeclarationRow(msgspec.Struct, frozen=True):
 
 
 class RequirementCheckRow(msgspec.Struct, frozen=True):
-    """A requirement's check record (``requirements[].check``), the keys its readers read: the formal
-    statement and its ``file:line:col``, the cone, Z3's counterexample (with the note on values outside
-    the assumptions), the temporal check's record and the recorded runs checked; the proof's script
+    """A requirement's check record (``requirements[].check``, or the stage's record the roll-up reads,
+    calculus/requirements/rollup.py), the keys its readers read: Z3's verdict, its reason and the verdict
+    recorded before the second solver or the seal changed it; the formal statement and its
+    ``file:line:col``, the cone, Z3's counterexample (with the note on values outside the assumptions),
+    the temporal check's record and the recorded runs checked; the proof's script
     (``smt2``), the ``assuming`` formulas, the premises used, those traced but not needed, the cores (of
     an inconsistency, of a vacuous premise), the guarantees that did not prevent a counterexample, the
-    declarations with their evidence, the second solver's agreement and the check's time."""
+    declarations with their evidence, the second solver's agreement and the check's time; whether the
+    premises used are consistent and whether the requirement's premise can hold (vacuity), each with
+    its reason."""
 
+    verdict: str | None = None
+    reason: str | None = None
+    recorded_verdict: str | None = None
     formal: str | None = None
     source: str | None = None
     cone: list[str] = []
@@ -122,6 +129,10 @@ class RequirementCheckRow(msgspec.Struct, frozen=True):
     vacuity_core: list[PremiseRow] = []
     failed_to_prevent: list[PremiseRow] = []
     counterexample_note: str | None = None
+    consistency: str | None = None
+    consistency_reason: str | None = None
+    vacuity: str | None = None
+    vacuity_reason: str | None = None
     duration_s: int | float = 0  #: Z3's time on the check, seconds (as written: an int stays an int)
     declarations: list[DeclarationRow] = []
     solvers: Solvers | None = None
