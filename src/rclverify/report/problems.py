@@ -74,6 +74,7 @@ import msgspec
 
 from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
 from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.report.shapes import AttentionItem
 from rclverify.report import problems_causes as pc
 from rclverify.report import problems_mc as mc
@@ -222,11 +223,9 @@ class _Grouping:
         for q in self.report.requirements:
             if q.verdict not in BAD_VERDICTS or q.id in diagnosed:
                 continue
-            check = q.check
-            core = [*(check.get("vacuity_core") or []), *(check.get("inconsistent_core") or []),
-                    *(check.get("failed_to_prevent") or [])]
-            roots = pp.roots([{"what": str(p.get("label", "")), "source": p.get("source", "")} for p in core],
-                             self.places, None)
+            check = RequirementCheckRow.of(q.check)
+            core = [*check.vacuity_core, *check.inconsistent_core, *check.failed_to_prevent]
+            roots = pp.roots([{"what": p.label, "source": p.source} for p in core], self.places, None)
             if pp.by_deadline(q):  # not met because of its end-to-end deadline only: the deadline's row (rule 5)
                 roots = [f"{DEADLINE_PREFIX}{q.id}"]
             self.members.append((Member(id=q.id, kind="requirement", status=q.status,

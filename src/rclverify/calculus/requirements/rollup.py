@@ -49,7 +49,10 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping, Sequence
 
+import msgspec
+
 from rclverify.records.records import worst
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.records.statuses import REQUIREMENT_VERDICTS
 from rclverify.calculus.shapes import DeclarationEvidence
 
@@ -144,18 +147,45 @@ def declaration_statuses(records: Mapping[str, Sequence[tuple[str, Sequence[Mapp
     return status
 
 
-def _premise_statuses(record: Mapping[str, Any], g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
+class _Stuck(msgspec.Struct, frozen=True):
+    """A producer that keeps a lasso stuck (:class:`rclverify.calculus.shapes.StuckProducer`)."""
+
+    node: str
+    output: str = ""
+    value: str = ""
+    consumer: str = ""
+
+
+class _Gap(msgspec.Struct, frozen=True):
+    """A node whose progress declaration a lasso shows missing (:class:`rclverify.calculus.shapes.MissingProgress`)."""
+
+    node: str
+
+
+class _Temporal(msgspec.Struct, frozen=True):
+    """What the roll-up reads of a temporal check's record (``temporal``, calculus/shapes.py
+    ``TemporalVerdictJson`` with its ``Gaps``): the method (``deadlock`` among its parts for a run that
+    stops), the bound (steps) and what a lasso shows missing."""
+
+    method: str | None = None
+    bound: int | None = None
+    missing_progress: list[_Gap] = []
+    missing_initially: list[_Stuck] = []
+
+
+def _premise_statuses(record: RequirementCheckRow, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
                       d_status: DeclStatus | None) -> dict[str, str]:
     """The evidence status of each premise the proof used, by its words in the note."""
     statuses: dict[str, str] = {}
-    for p in record.get("used", []):
-        if p["kind"] == "guarantee":
-            statuses[p["label"]] = g_status(p["node"], p["index"])
-            statuses[f"side conditions of {p['node']}"] = sc_status.get(p["node"], "discharged")
-        elif p["kind"] in ("progress", "initial value"):  # declared of the implementation: its own evidence
-            st, words = d_status(p["node"], p["kind"], int(p.get("index", 0))) if d_status is not None else (
+    for p in record.used:
+        node = p.node or ""
+        if p.kind == "guarantee":
+            statuses[p.label] = g_status(node, p.index)
+            statuses[f"side conditions of {node}"] = sc_status.get(node, "discharged")
+        elif p.kind in ("progress", "initial value"):  # declared of the implementation: its own evidence
+            st, words = d_status(node, p.kind, p.index) if d_status is not None else (
                 "pending", "declared, not verified")
-            statuses[f"{p['label']} ({words})"] = st
+            statuses[f"{p.label} ({words})"] = st
     return statuses
 
 
@@ -164,26 +194,33 @@ def declaration_evidence(record: Mapping[str, Any] | None, d_status: DeclStatus 
     ``[{"label", "node", "kind", "index", "text", "source", "status",
     "words"}]`` (``d_status`` as for :func:`roll_up`; ``[]`` without a
     record).  The report carries them in the requirement's ``check`` and
-    the argument makes a goal of each (report/argument/build.py)."""
+    the argument makes a goal of each (report/argument/build.py).  Raises
+    :class:`msgspec.ValidationError` for a record of another shape."""
     out: list[DeclarationEvidence] = []
-    for p in (record or {}).get("used") or []:
-        if p.get("kind") in ("progress", "initial value"):
-            st, words = d_status(p["node"], p["kind"], int(p.get("index", 0))) if d_status is not None else (
+    for p in RequirementCheckRow.of(record or {}).used:
+        if p.kind in ("progress", "initial value"):
+            node = p.node or ""
+            st, words = d_status(node, p.kind, p.index) if d_status is not None else (
                 "pending", "declared, not verified")
-            out.append({"label": p["label"], "node": p["node"], "kind": p["kind"], "index": int(p.get("index", 0)),
-                        "text": f"initially( {p.get('text', '')} )" if p["kind"] == "initial value" else p.get("text", ""),
-                        "source": p.get("source", ""), "status": st, "words": words})
+            out.append({"label": p.label, "node": node, "kind": p.kind, "index": p.index,
+                        "text": f"initially( {p.text} )" if p.kind == "initial value" else p.text,
+                        "source": p.source, "status": st, "words": words})
     return out
 
 
-def _vacuous_note(record: Mapping[str, Any]) -> str:
+def _vacuous_note(record: RequirementCheckRow) -> str:
     """The note of a requirement proved vacuously: its premise and the premises that exclude it (a state
     requirement, :mod:`.check`), or the reason no run exercises a temporal proof (:mod:`.exercised`)."""
-    if record.get("vacuity_reason"):
-        return f"proved only because it never applies: {record['vacuity_reason']}"
-    core = ", ".join(p["label"] for p in record.get("vacuity_core", []))
+    if record.vacuity_reason:
+        return f"proved only because it never applies: {record.vacuity_reason}"
+    core = ", ".join(p.label for p in record.vacuity_core)
     why = f"together with the premises of its cone ({core})" if core else "(it contradicts itself)"
     return f"the requirement's premise can never hold {why}: it is proved only because it never applies"
+
+
+def _or(value: str | None, default: str) -> str:
+    """``value``, or ``default`` when the record does not have it."""
+    return default if value is None else value
 
 
 def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str], sc_status: Mapping[str, str],
@@ -191,75 +228,80 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
     """``(verdict, status, note)`` of one requirement.
 
     ``record`` is the requirement's check record (:func:`.check.check_requirement`;
-    ``None`` when not checked yet), ``g_status(node, k)`` a guarantee's
+    ``None`` when not checked yet), read decoded
+    (:class:`~rclverify.records.requirement_check.RequirementCheckRow`, its temporal part
+    :class:`_Temporal`), ``g_status(node, k)`` a guarantee's
     evidence status, ``sc_status[node]`` the worst of a node's side
     conditions, ``traced_status`` the worst status of the traced guarantees
     (the roll-up of an informal requirement), ``d_status`` the status of a
     declaration (:func:`declaration_statuses`; ``None``: none verified).
+    Raises :class:`msgspec.ValidationError` for a record of another shape.
     """
     if record is None:
         return "inconclusive", "pending", "not checked yet: run `rclverify requirements` or `doit verify`"
-    v = record.get("verdict")
+    c = RequirementCheckRow.of(record)
+    v = c.verdict
     if v == "error":  # the seal does not hold (requirements/stage.read_records): what it claims is not shown
-        return "error", "error", f"error: {record.get('reason', 'record altered outside rclverify')}; run `doit verify`"
+        return "error", "error", f"error: {_or(c.reason, 'record altered outside rclverify')}; run `doit verify`"
     if v == "stale":
-        return "stale", "stale", (f"STALE: {record.get('reason', 'made from other inputs')} than the current one "
-                                  f"(recorded verdict {record.get('recorded_verdict')}); run `doit verify`")
+        return "stale", "stale", (f"STALE: {_or(c.reason, 'made from other inputs')} than the current one "
+                                  f"(recorded verdict {c.recorded_verdict}); run `doit verify`")
     if v == "informal":
         return "informal", "pending", (f"no formal statement: traced only, never shown as met (its traced guarantees: "
                                        f"{traced_status})")
-    bad = [t for t in record.get("traces") or [] if t.get("status") == "failed"]
+    bad = [t for t in c.traces if t.status == "failed"]
     if bad:  # a recorded run refutes it: never met, whatever Z3 says (backends/monitors/temporal_evidence.py)
-        w = bad[0].get("verdict", {})
-        return "refuted", "failed", f"the recorded run {bad[0]['trace']} refutes it: {w.get('reason', '')} (Z3: {v})"
-    if v == "refuted" and "deadlock" in str((record.get("temporal") or {}).get("method")).split(" + "):
-        t = record["temporal"]
-        return "refuted", "failed", (f"a run of the system stops at step {t.get('bound')}: no next state satisfies the "
+        w = bad[0].verdict
+        return "refuted", "failed", (f"the recorded run {bad[0].trace} refutes it: {w.reason if w else ''} "
+                                     f"(Z3: {v})")
+    t = msgspec.convert(c.temporal or {}, _Temporal)
+    if v == "refuted" and "deadlock" in str(t.method).split(" + "):
+        return "refuted", "failed", (f"a run of the system stops at step {t.bound}: no next state satisfies the "
                                      "premises of its cone (a deadlock), and the runs of the system must not stop")
-    gaps = (record.get("temporal") or {}).get("missing_progress") or []
+    gaps = t.missing_progress
     if v == "refuted" and gaps:
-        return "refuted", "failed", (f"a run that never reaches it, because {gaps[0]['node']} never answers in its loop "
+        return "refuted", "failed", (f"a run that never reaches it, because {gaps[0].node} never answers in its loop "
                                      f"although its assumption holds there: no progress declared on "
-                                     + ", ".join(g["node"] for g in gaps)
+                                     + ", ".join(g.node for g in gaps)
                                      + " excludes it (declare progress( eventually ) or progress( within K steps ) "
                                        "on a node that does answer)")
-    stuck = (record.get("temporal") or {}).get("missing_initially") or []
+    stuck = t.missing_initially
     if v == "refuted" and stuck:
-        names = ", ".join(dict.fromkeys(r["node"] for r in stuck))
+        names = ", ".join(dict.fromkeys(r.node for r in stuck))
         first = stuck[0]
-        why = (f"{first['consumer']} never has a value: {first['node']} never publishes {first['node']}.{first['output']}"
-               if str(first["value"]).startswith("none") else
-               f"{first['consumer']} keeps the value {first['node']}.{first['output']} had before the run")
+        why = (f"{first.consumer} never has a value: {first.node} never publishes {first.node}.{first.output}"
+               if first.value.startswith("none") else
+               f"{first.consumer} keeps the value {first.node}.{first.output} had before the run")
         return "refuted", "failed", (f"a run that never reaches it, in which no node waiting on {names} ever has a "
                                      f"question it owes an answer: {why}, and no initial value is declared "
                                      f"(declare initially( ... ) on {names})")
     if v == "refuted":
-        who = ", ".join(p["label"] for p in record.get("failed_to_prevent", [])) or "no guarantee of the cone"
+        who = ", ".join(p.label for p in c.failed_to_prevent) or "no guarantee of the cone"
         return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"
-    if v != "proved" and record.get("recorded_verdict") == "proved" and isinstance(record.get("solvers"), dict):
+    if v != "proved" and c.recorded_verdict == "proved" and c.solvers is not None:
         return "inconclusive", "inconclusive", (f"Z3 proved it, but the second solver does not confirm it "
-                                                f"({record['solvers'].get('why')}): not proved (docs/second-solver.md)")
-    if v != "proved" and record.get("temporal"):  # the detail says what was tried and the next step
-        return "inconclusive", "inconclusive", f"not proved: {record.get('reason', 'undecided')}"
+                                                f"({c.solvers.why}): not proved (docs/second-solver.md)")
+    if v != "proved" and c.temporal:  # the detail says what was tried and the next step
+        return "inconclusive", "inconclusive", f"not proved: {_or(c.reason, 'undecided')}"
     if v != "proved":
-        return "inconclusive", "inconclusive", f"Z3 could not decide it ({record.get('reason', 'unknown')}); not proved"
-    if record.get("consistency") == "inconsistent":
-        core = ", ".join(p["label"] for p in record.get("inconsistent_core", []))
+        return "inconclusive", "inconclusive", f"Z3 could not decide it ({_or(c.reason, 'unknown')}); not proved"
+    if c.consistency == "inconsistent":
+        core = ", ".join(p.label for p in c.inconsistent_core)
         return INCONSISTENT, "failed", (f"the premises the proof used contradict each other ({core}): the "
                                         "requirement follows vacuously, not because the system meets it")
-    if record.get("vacuity") == "vacuous":
-        return VACUOUS, "failed", _vacuous_note(record)
-    statuses = _premise_statuses(record, g_status, sc_status, d_status)
+    if c.vacuity == "vacuous":
+        return VACUOUS, "failed", _vacuous_note(c)
+    statuses = _premise_statuses(c, g_status, sc_status, d_status)
     ev = worst(list(statuses.values()), empty="discharged")
-    if record.get("consistency") != "consistent":  # the worst of that and the evidence, as the argument has it
+    if c.consistency != "consistent":  # the worst of that and the evidence, as the argument has it
         return "inconclusive", worst(["inconclusive", ev]), (
             "proved, but it is not decided whether the premises it used are consistent "
-            f"({record.get('consistency_reason', 'unknown')})")
-    if record.get("vacuity") not in (None, "non-vacuous"):  # undecided: never met (it may hold only vacuously)
+            f"({_or(c.consistency_reason, 'unknown')})")
+    if c.vacuity not in (None, "non-vacuous"):  # undecided: never met (it may hold only vacuously)
         return "inconclusive", worst(["inconclusive", ev]), (
             "proved, but it is not decided whether the requirement's premise can ever hold together with the "
             "premises of its cone: it may be proved only because it never applies (vacuity undecided"
-            + (f": {record['vacuity_reason']})" if record.get("vacuity_reason") else ")"))
+            + (f": {c.vacuity_reason})" if c.vacuity_reason else ")"))
     if ev == "discharged":
         return MET, "discharged", "proved from the used premises, and all the evidence they rest on is discharged"
     open_ = ", ".join(f"{k} ({s})" for k, s in statuses.items() if s != "discharged")
