@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 
 from _report_schema import check_report
+from rclverify.backends.monitors.payload import SpaceMargin
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.cli.commands import main
 from rclverify.records.margin_rows import MarginBounds
@@ -91,15 +92,15 @@ def test_the_distribution_over_runs_is_plotted(report: dict[str, Any]) -> None:
 
 def test_a_quantile_the_kept_margins_do_not_decide_is_given_by_its_bounds() -> None:
     # run A judged 1000 answers and kept its 256 smallest (0 .. 255): the other 744 are at least 255
-    a = {"guarantee": 1, "answers": 1000, "lowest": [float(i) for i in range(KEPT_MARGINS)]}
-    b = {"guarantee": 1, "answers": 10, "lowest": [1000.0 + i for i in range(10)]}
+    a = SpaceMargin(guarantee=1, answers=1000, lowest=[float(i) for i in range(KEPT_MARGINS)])
+    b = SpaceMargin(guarantee=1, answers=10, lowest=[1000.0 + i for i in range(10)])
     count, kept, fig = figures([a, b])
     assert (count, kept) == (1010, KEPT_MARGINS + 10)
     assert fig["min"] == MarginBounds(low=0.0, high=0.0)
     assert fig["p5"] == MarginBounds(low=50.0, high=50.0)  # rank 51: decided by the kept margins
     assert fig["p50"] == MarginBounds(low=255.0, high=None)  # rank 505: past the kept, at least run A's largest
     # a run that kept fewer than it judged without being full: the rest held without a distance (+inf)
-    count, kept, fig = figures([{"guarantee": 1, "answers": 3, "lowest": [0.5]}])
+    count, kept, fig = figures([SpaceMargin(guarantee=1, answers=3, lowest=[0.5])])
     assert (count, kept, fig["p50"]) == (3, 3, MarginBounds(low=None, high=None))
 
 

@@ -46,6 +46,7 @@ from typing import Any, Callable, Mapping, Sequence, cast
 import msgspec
 from msgspec.structs import replace
 
+from rclverify.backends.monitors.payload import monitors_payload
 from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.obligations import ObligationRow
@@ -181,12 +182,12 @@ def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationRow],
         if o.backend != "monitors" or o.node not in nodes:
             continue
         ev, problem = store.read(o.id)
-        d = ev.details.get("deadlines") if ev is not None and not problem and isinstance(ev.details, dict) else None
-        if isinstance(d, dict):
-            out.setdefault(o.node, []).append({"obligation": o.id, "status": o.status,
-                                                       "counts": dict(d.get("counts") or {}),
-                                                       "first_false": d.get("first_false"),
-                                                       "time_margins": list(d.get("time_margins") or ())})
+        payload = monitors_payload(ev.backend, ev.details) if ev is not None and not problem else None
+        d = payload.deadlines if payload is not None else None
+        if d is not None:  # the hop's row holds them as JSON objects (records/deadline_rows.py DeadlineHop.monitors)
+            out.setdefault(o.node, []).append({"obligation": o.id, "status": o.status, "counts": dict(d.counts),
+                                               "first_false": d.first_false,
+                                               "time_margins": [msgspec.to_builtins(t) for t in d.time_margins]})
     return out
 
 

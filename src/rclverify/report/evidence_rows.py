@@ -15,6 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence, cast
 
+import msgspec
+
+from rclverify.backends.monitors.payload import MonitorsPayload
 from rclverify.backends.payloads import Payload, payload_of
 from rclverify.backends.property_tests.payload import PropertyTestsPayload
 from rclverify.records.records import Obligation
@@ -84,23 +87,43 @@ def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Sol
     """The report's row of the evidence record ``ev`` shown with ``status``
     (``altered``: why the record is not believed, '' when it is;
     ``solvers``: the second solver's agreement, ``None`` without one;
-    ``payload``: its ``details`` decoded by :func:`~rclverify.backends.payloads.payload_of`,
-    ``None`` for a backend whose payload is no Struct), an
-    :class:`~rclverify.records.evidence_rows.EvidenceRow`."""
+    ``payload``: its ``details`` decoded by :func:`~rclverify.backends.payloads.payload_of`, decoded
+    here when not given), an :class:`~rclverify.records.evidence_rows.EvidenceRow`.  Raises
+    :class:`msgspec.ValidationError` for details that are not the backend's payload."""
     d = ev.details if isinstance(ev.details, dict) else {}
+    if payload is None:
+        payload = payload_of(ev.backend, d)
     figures, svg = evidence_extras(ws, d)
     examples: dict[str, Any] = {}
     if isinstance(payload, PropertyTestsPayload) and payload.examples:  # example counts, seed, replay
         examples = {**payload.examples, "seed": payload.seed, "replay": payload.replay, "facts": payload.facts,
                     "coverage": payload.coverage}
+    # the row holds the monitors' run and its statistics as JSON objects (records/evidence_rows.py): the payload's
+    # parts encoded, the keys the record has; an experiment's statistics are its JSON object (no Struct yet)
+    monitoring: dict[str, Any] = {}
+    stats: Mapping[str, Any] | None = None
+    if isinstance(payload, MonitorsPayload):
+        if payload.monitoring is not None:
+            monitoring = msgspec.to_builtins(payload.monitoring)
+        if payload.statistics is not None:
+            stats = msgspec.to_builtins(payload.statistics)
+    elif isinstance(d.get("statistics"), dict):
+        stats = d["statistics"]
     return EvidenceRow(
         obligation=ev.obligation, backend=ev.backend, kind=ev.kind, status=cast(EvidenceStatus, status),
         tool=ev.tool, tool_version=ev.tool_version, started=ev.started, duration_s=ev.duration_s,
         explanation=_explanation(ev, status, altered, solvers), counterexample=ev.counterexample,
         artifacts=list(ev.artifacts), log_excerpt=ev.log[-2000:], figures=figures, plot_svg=svg, solvers=solvers,
-        examples=examples, monitoring=d["monitoring"] if d.get("monitoring") else {},
-        statistics=compact_statistics(d["statistics"]) if isinstance(d.get("statistics"), dict) else {},
+        examples=examples, monitoring=monitoring, statistics=compact_statistics(stats) if stats is not None else {},
     )
+
+
+def _declarations(payload: Payload | None) -> list[Any] | None:
+    """The node's declarations the record judged (each a row of backends/shapes.py ``DeclarationRow``):
+    the property tests' and the monitors' payloads hold them; ``None`` when the record judged none."""
+    if isinstance(payload, (PropertyTestsPayload, MonitorsPayload)) and payload.declarations is not None:
+        return list(payload.declarations)
+    return None
 
 
 def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_lists: Mapping[str, str],
@@ -138,8 +161,9 @@ def evidence_part(ws: Workspace, obligations: Sequence[Obligation], altered_list
             else:
                 part.pending.append(PendingRow(o.id, o.backend, "no evidence record yet: run `doit verify`"))
             continue
-        if isinstance(ev.details.get("declarations"), list):  # a node's declarations judged
-            part.declared.setdefault(o.node, []).append((status, ev.details["declarations"]))
+        declared = _declarations(payload)
+        if declared is not None:  # a node's declarations judged
+            part.declared.setdefault(o.node, []).append((status, declared))
         part.evidence.append(evidence_row(ws, ev, status, altered, solvers, payload))
         if status == "pending":
             part.pending.append(PendingRow(o.id, o.backend, ev.explanation))

@@ -29,8 +29,10 @@ from __future__ import annotations
 import math
 from typing import Any, Iterable, Mapping, Sequence
 
+import msgspec
 from msgspec.structs import replace
 
+from rclverify.backends.monitors.payload import RunStatistics, SpaceMargin, monitors_payload
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.report.chain_margins import hop_margin
 from rclverify.records.deadline_rows import HopTimeMargin
@@ -53,19 +55,19 @@ def _number(v: float) -> float | None:
     return v if math.isfinite(v) else None
 
 
-def _run_margins(m: Mapping[str, Any]) -> tuple[list[float], int, float | None]:
+def _run_margins(m: SpaceMargin) -> tuple[list[float], int, float | None]:
     """One run's record of one guarantee as ``(known, unknown, floor)``: the
     margins known exactly (the kept ones, ``null`` read as ``-inf``, and the
     answers the record dropped as ``+inf``), how many answers' margins are
     unknown, and the least those can be (the largest kept margin)."""
-    answers = int(m.get("answers") or 0)
-    if "lowest" in m:
-        kept = [-math.inf if v is None else float(v) for v in m.get("lowest") or ()]
+    answers = m.answers
+    if m.lowest is not msgspec.UNSET:
+        kept = [-math.inf if v is None else float(v) for v in m.lowest]
     else:  # a record that kept only the smallest
-        v, holds = m.get("margin"), m.get("holds")
+        v, holds = m.margin, m.holds
         kept = [] if not answers else [float(v) if v is not None else math.inf if holds else -math.inf]
     rest = max(answers - len(kept), 0)
-    if "lowest" in m and len(kept) < KEPT_MARGINS:  # to_json drops +inf: an answer not listed held without distance
+    if m.lowest is not msgspec.UNSET and len(kept) < KEPT_MARGINS:  # to_json drops +inf: an answer not listed held without distance
         return kept + [math.inf] * rest, 0, None
     return kept, rest, (kept[-1] if kept else None)
 
@@ -74,7 +76,7 @@ def _kth(values: Sequence[float], k: int) -> float:
     return sorted(values)[k - 1]
 
 
-def figures(runs: Iterable[Mapping[str, Any]]) -> tuple[int, int, dict[str, MarginBounds]]:
+def figures(runs: Iterable[SpaceMargin]) -> tuple[int, int, dict[str, MarginBounds]]:
     """``(count, kept, quantiles)`` of one guarantee's margins over ``runs``
     (each a ``details.monitoring.margins`` item).
 
@@ -125,7 +127,7 @@ def _formula(ws: Workspace, node: str, k: int) -> str:
 def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginRow]:
     """The report's ``margins`` (module docstring), by node and guarantee, each a
     :class:`~rclverify.records.margin_rows.MarginRow`."""
-    runs: dict[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]] = {}
+    runs: dict[tuple[str, int], list[tuple[str, str, SpaceMargin]]] = {}
     timed: dict[tuple[str, int], list[dict[str, Any]]] = {}  # the runs' deadline records, as hop_margin reads them
     seen: dict[str, set[str]] = {}  # node -> the identities of its runs read so far
     store: EvidenceStore | None = None
@@ -134,48 +136,46 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginR
             continue
         store = store or EvidenceStore(ws.root)
         ev, problem = store.read(o.id)
-        if ev is None or problem or not isinstance(ev.details, dict):
+        payload = monitors_payload(ev.backend, ev.details) if ev is not None and not problem else None
+        if payload is None:  # no record, an altered one, or one whose payload does not decode (shown as error)
             continue
-        if _seen_before(seen.setdefault(o.node, set()), ev.details, o.id):
+        if _seen_before(seen.setdefault(o.node, set()), payload.statistics, o.id):
             continue  # another form or copy of a run already read: one run, counted once
-        mon = ev.details.get("monitoring") or {}
-        for m in mon.get("margins") or () if isinstance(mon, dict) else ():
-            if isinstance(m, dict) and isinstance(m.get("guarantee"), int):
-                runs.setdefault((o.node, m["guarantee"]), []).append(
-                    (o.id, str(m.get("trace") or mon.get("trace", "")), m))
-        dl = ev.details.get("deadlines")
-        for t in (dl.get("time_margins") or ()) if isinstance(dl, dict) else ():
-            if isinstance(t, dict) and isinstance(t.get("guarantee"), int):
-                timed.setdefault((o.node, t["guarantee"]), []).append(
-                    {"obligation": o.id, "time_margins": [t]})
+        mon = payload.monitoring
+        for m in mon.margins if mon is not None else ():
+            trace = m.trace if m.trace is not msgspec.UNSET and m.trace else mon.trace if mon is not None else ""
+            runs.setdefault((o.node, m.guarantee), []).append((o.id, trace, m))
+        for t in payload.deadlines.time_margins if payload.deadlines is not None else ():
+            # hop_margin (report/chain_margins.py) reads a deadline record's JSON object
+            timed.setdefault((o.node, t.guarantee), []).append(
+                {"obligation": o.id, "time_margins": [msgspec.to_builtins(t)]})
     rows = [_row(ws, node, k, runs.get((node, k), []), hop_margin(k, timed.get((node, k), [])))
             for node, k in sorted(set(runs) | set(timed))]
     return _plots(rows, runs)
 
 
-def _seen_before(seen: set[str], details: Mapping[str, Any], obligation: str) -> bool:
-    """Whether the run of a record with ``details`` is among the identities ``seen`` (which it joins):
-    its ``statistics.sha256``; a record without one (written before runs had an identity) is a run of
-    its own, by its obligation."""
-    stats = details.get("statistics")
-    sha = stats.get("sha256") if isinstance(stats, Mapping) else None
-    key = str(sha) if isinstance(sha, str) and sha else "obligation:" + obligation
+def _seen_before(seen: set[str], stats: RunStatistics | None, obligation: str) -> bool:
+    """Whether the run of a record with the statistics ``stats`` is among the identities ``seen`` (which it
+    joins): its ``sha256``; a record without one (written before runs had an identity) is a run of its own,
+    by its obligation."""
+    sha = stats.sha256 if stats is not None else msgspec.UNSET
+    key = sha if isinstance(sha, str) and sha else "obligation:" + obligation
     if key in seen:
         return True
     seen.add(key)
     return False
 
 
-def _order(r: tuple[str, str, Mapping[str, Any]]) -> float:
+def _order(r: tuple[str, str, SpaceMargin]) -> float:
     """A run's smallest margin of a guarantee as a number (``inf`` for one held without a distance, ``nan``
     when no answer gave one)."""
-    v, holds, answers = r[2].get("margin"), r[2].get("holds"), r[2].get("answers")
+    v, holds, answers = r[2].margin, r[2].holds, r[2].answers
     if not answers:
         return math.nan
     return float(v) if v is not None else math.inf if holds else -math.inf
 
 
-def _row(ws: Workspace, node: str, k: int, got: Sequence[tuple[str, str, Mapping[str, Any]]],
+def _row(ws: Workspace, node: str, k: int, got: Sequence[tuple[str, str, SpaceMargin]],
          time_margin: HopTimeMargin | None) -> MarginRow:
     """Guarantee ``k`` of ``node``'s row over the runs ``got`` (``[(obligation, trace, margins item)]``) with
     its smallest time margin ``time_margin`` (module docstring)."""
@@ -190,19 +190,19 @@ def _row(ws: Workspace, node: str, k: int, got: Sequence[tuple[str, str, Mapping
     m = least[2]
     count, kept, fig = figures(r[2] for r in got)
     v = _order(least)
-    return MarginRow(node=node, guarantee=k, formula=str(m.get("formula", "")), source=place,
+    return MarginRow(node=node, guarantee=k, formula=m.formula, source=place,
                      margin=None if math.isnan(v) else _number(v), holds=(v > 0) if math.isinf(v) else None,
-                     unit=str(m.get("unit", "")), atom=str(m.get("atom", "")), trace=least[1], obligation=least[0],
-                     time=float(m["time"]) if measured and isinstance(m.get("time"), (int, float)) else None,
-                     where=str(m.get("where", "")) if measured else "", runs=len(got),
-                     answers=sum(int(r[2].get("answers") or 0) for r in got),
-                     undefined=sum(int(r[2].get("undefined") or 0) for r in got), count=count, kept=kept,
+                     unit=m.unit, atom=m.atom, trace=least[1], obligation=least[0],
+                     time=float(m.time) if measured and m.time is not None else None,
+                     where=m.where if measured else "", runs=len(got),
+                     answers=sum(r[2].answers for r in got),
+                     undefined=sum(r[2].undefined for r in got), count=count, kept=kept,
                      min=fig.get("min", _NONE), p5=fig.get("p5", _NONE), p50=fig.get("p50", _NONE),
                      time_margin=time_margin)
 
 
 def _plots(rows: list[MarginRow],
-           runs: Mapping[tuple[str, int], list[tuple[str, str, Mapping[str, Any]]]]) -> list[MarginRow]:
+           runs: Mapping[tuple[str, int], list[tuple[str, str, SpaceMargin]]]) -> list[MarginRow]:
     """``rows`` with the distribution of every row measured on two runs or more drawn (``plot_svg``, at most
     :data:`MAX_PLOTS`) or why not (``plot_note``)."""
     from rclverify.core.extras import MissingExtra  # deferred: start-up (only where a plot is drawn)
@@ -216,7 +216,8 @@ def _plots(rows: list[MarginRow],
             continue
         try:
             from rclverify.report.margin_plot import render_svg  # deferred: start-up (matplotlib only when drawn)
-            per_run = [(trace, [-math.inf if v is None else float(v) for v in m.get("lowest") or ()])
+            per_run = [(trace, [-math.inf if v is None else float(v)
+                                for v in (m.lowest if m.lowest is not msgspec.UNSET else ())])
                        for _, trace, m in runs[(r.node, r.guarantee)]]
             drawn[id(r)] = replace(r, plot_svg=render_svg(r, per_run))
         except MissingExtra as exc:  # the plot illustrates; the figures above do not rest on it

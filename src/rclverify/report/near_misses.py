@@ -24,6 +24,7 @@ import math
 import xml.etree.ElementTree as ET
 from typing import Any, Callable, Literal, Mapping, Sequence
 
+from rclverify.backends.monitors.payload import monitors_payload
 from rclverify.records.margin_rows import NearMissRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.row import decode_rows
@@ -85,38 +86,36 @@ def near_miss_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[Near
         if o.backend != "monitors" or not wanted.get(node) or o.status in ("failed", "error"):
             continue
         ev, problem = store.read(o.id)
-        if ev is None or problem or not isinstance(ev.details, dict):
+        payload = monitors_payload(ev.backend, ev.details) if ev is not None and not problem else None
+        if payload is None:  # no record, an altered one, or one whose payload does not decode (shown as error)
             continue
-        mon = ev.details.get("monitoring") or {}
-        trace = str(mon.get("trace", ""))
+        mon = payload.monitoring
+        trace = mon.trace if mon is not None else ""
         n_monitors = sum(1 for e in ws.plan.evidence.get(node, ()) if e.backend == "monitors")
         hit = _entry_of(wanted[node], trace, n_monitors)
         if hit is None:
             continue
         t, plan_place = hit[1], hit[2]
 
-        def row(m: Mapping[str, Any], kind: Literal["value", "time"], margin: float, threshold: float, unit: str,
-                atom: str, where: str, at: Any, node: str = node, o: ObligationRow = o, trace: str = trace,
+        def row(k: int, kind: Literal["value", "time"], margin: float, threshold: float, unit: str,
+                atom: str, where: str, at: float | None, node: str = node, o: ObligationRow = o, trace: str = trace,
                 plan_place: str = plan_place) -> NearMissRow:
-            k = int(m["guarantee"])
             return NearMissRow(node=node, guarantee=k, kind=kind, margin=margin, threshold=threshold, unit=unit,
-                               atom=atom, where=where, time=float(at) if isinstance(at, (int, float)) else None,
+                               atom=atom, where=where, time=None if at is None else float(at),
                                trace=trace, obligation=o.id, source=_guarantee_place(ws, node, k),
                                threshold_source=plan_place)
-        if t.value is not None:
-            for m in mon.get("margins") or ():
-                v = m.get("margin")
-                limit = t.value_in(str(m.get("unit", "")))  # in the margin's unit (0.1 mm on a margin in m: 0.0001)
-                if limit is not None and isinstance(v, (int, float)) and math.isfinite(v) and 0 <= v < limit:
-                    rows.append(row(m, "value", float(v), limit, str(m.get("unit", "")), str(m.get("atom", "")),
-                                    str(m.get("where", "")), m.get("time")))
-        dl = ev.details.get("deadlines") or {}
-        if t.time_ns is not None and isinstance(dl, dict):
-            for m in dl.get("time_margins") or ():
-                ns = m.get("margin_ns")
-                if isinstance(ns, int) and 0 <= ns < t.time_ns:
-                    rows.append(row(m, "time", ns / 1e9, t.time_ns / 1e9, "s", "", str(m.get("answer_where", "")),
-                                    m.get("answer")))
+        if t.value is not None and mon is not None:
+            for m in mon.margins:
+                v = m.margin
+                limit = t.value_in(m.unit)  # in the margin's unit (0.1 mm on a margin in m: 0.0001)
+                if limit is not None and v is not None and math.isfinite(v) and 0 <= v < limit:
+                    rows.append(row(m.guarantee, "value", float(v), limit, m.unit, m.atom, m.where, m.time))
+        if t.time_ns is not None and payload.deadlines is not None:
+            for tm in payload.deadlines.time_margins:
+                ns = tm.margin_ns
+                if ns is not None and 0 <= ns < t.time_ns:
+                    rows.append(row(tm.guarantee, "time", ns / 1e9, t.time_ns / 1e9, "s", "", tm.answer_where,
+                                    tm.answer))
     return rows
 
 
