@@ -46,6 +46,7 @@ from rclverify.ros.extract.link_types import Instances, is_template_param
 from rclverify.ros.extract.link_values import MAX_DEPTH, MAX_VALUES, Values, _homes
 from rclverify.ros.extract.programs import PackageCode, Program
 from rclverify.ros.extract.unit_names import canonical
+from rclverify.ros.extract.link_units import UnitInfo, unit_of
 
 __all__ = ["Linked", "Linker", "MAX_DEPTH", "MAX_VALUES"]
 
@@ -76,7 +77,7 @@ class Linker(LinkReach, LinkMembers, Values, Returns, Instances):
         self.prog, self.code, self.known = prog, code, known
         self.recs = canonical({f: code.records[f] for f in prog.files if f in code.records})
         self.fns: dict[str, tuple[str, list[str], list[str], list[Any]]] = {}
-        self.units: dict[str, dict[str, Any]] = {}
+        self.units: dict[str, UnitInfo] = {}
         self.fields: dict[tuple[str, str], list[Any]] = {}
         self.callbacks: dict[str, str] = {}
         self.aliases: dict[str, str] = {}
@@ -329,7 +330,7 @@ class Linker(LinkReach, LinkMembers, Values, Returns, Instances):
         if not live:
             unit = self.fns[key][0]
             return bool(self.fn_tparams.get(key) or self.fn_tparams.get(key.split("#")[0])
-                        or self.units.get(unit, {}).get("tparams"))
+                        or unit_of(self.units, unit).tparams)
         return all(v[2] < len(a) and self.uninstantiated(a[v[2]], depth + 1) for a, _c in live)
 
     def owners(self, units: list[str | None], eps: list[Endpoint]) -> list[int]:

@@ -19,6 +19,7 @@ from typing import Any
 
 from rclverify.ros.extract.cpp_types import alias_of, split_template
 from rclverify.ros.extract.link_returns import Entry
+from rclverify.ros.extract.link_units import UnitInfo, unit_of
 from rclverify.ros.extract.programs import PackageCode, Program
 
 
@@ -28,7 +29,7 @@ class LinkIndex:
     recs: dict[str, dict[str, Any]]
     code: PackageCode
     fns: dict[str, tuple[str, list[str], list[str], list[Any]]]
-    units: dict[str, dict[str, Any]]
+    units: dict[str, UnitInfo]
     fields: dict[tuple[str, str], list[Any]]
     callbacks: dict[str, str]
     aliases: dict[str, str]
@@ -67,12 +68,12 @@ class LinkIndex:
                 if f in prog.entry:
                     entry_units.add(unit)
             for u, info in r.get("units", {}).items():
-                cur = self.units.setdefault(u, {"bases": [], "members": {}})
-                cur["bases"] += [b for b in info["bases"] if b not in cur["bases"]]
-                cur["members"].update(info["members"])
-                cur.setdefault("refs", []).extend(r for r in info.get("refs", []) if r not in cur["refs"])
+                cur = self.units.setdefault(u, UnitInfo())
+                cur.bases += [b for b in info["bases"] if b not in cur.bases]
+                cur.members.update(info["members"])
+                cur.refs.extend(r for r in info.get("refs", []) if r not in cur.refs)
                 if info.get("tparams"):
-                    cur["tparams"] = info["tparams"]
+                    cur.tparams = info["tparams"]
                 if f in prog.entry:
                     entry_units.add(u)
             for key, vals in r.get("fields", {}).items():
@@ -145,15 +146,15 @@ class LinkIndex:
         if kind == "own-node":  # a member made here that runs on a node of its own: no class of the program
             return None, None
         if kind == "member":
-            info = self.units.get(unit or "", {})
-            ty = info.get("members", {}).get(callee)
+            info = unit_of(self.units, unit)
+            ty = info.members.get(callee)
             cls = self.match(_held(ty), unit) if ty else None
-            if cls is not None and callee in info.get("refs", []):
+            if cls is not None and callee in info.refs:
                 return None, cls  # a reference member bound to what the constructor is given: nothing made
-            if cls is not None and _held(ty) != split_template(ty.replace(" ", ""))[0].replace("*", "").strip():
+            if cls is not None and ty and _held(ty) != split_template(ty.replace(" ", ""))[0].replace("*", "").strip():
                 return None, cls  # a pointer member: made by the new/make_shared it is given
             base = callee.split("<")[0].split("::")[-1]  # ClientBase<ServiceT>(node, name): a template base
-            if cls is None and any(b.split("<")[0].split("::")[-1] == base for b in info.get("bases", [])):
+            if cls is None and any(b.split("<")[0].split("::")[-1] == base for b in info.bases):
                 cls = self.match(callee, unit)
             if cls is None and unit and base == unit.split("::")[-1]:  # a delegating constructor
                 cls = unit
@@ -177,7 +178,7 @@ class LinkIndex:
             held = recv.replace("this->", "").strip()
             if held.endswith("]") and "[" in held:  # an element of a member container: leds_[i]->on()
                 held = held[:held.index("[")]
-            ty = self.units.get(unit, {}).get("members", {}).get(held)
+            ty = unit_of(self.units, unit).members.get(held)
             cls = self.match(_held(ty), unit) if ty else None
             if ty is None and "->" not in recv and "." not in recv:  # a local (auto node = shared_from_this())
                 own = self.inherited(unit, meth)
@@ -227,7 +228,7 @@ class LinkIndex:
             return self._inherited[(unit, meth)]
         self._inherited[(unit, meth)] = None  # a cycle of bases finds nothing
         got = None
-        for b in self.units.get(unit, {}).get("bases", []):
+        for b in unit_of(self.units, unit).bases:
             cls = self.match(b, unit)
             got = self.inherited(cls, meth, depth + 1) if cls is not None and cls != unit else None
             if got is not None:
@@ -244,7 +245,7 @@ class LinkIndex:
         if unit in self._scopes:
             return self._scopes[unit]
         self._scopes[unit] = [unit]  # while its bases are matched (a base named through an alias)
-        out = [unit] + [b for b in (self.match(x, None) for x in self.units.get(unit, {}).get("bases", [])) if b]
+        out = [unit] + [b for b in (self.match(x, None) for x in unit_of(self.units, unit).bases) if b]
         parts = unit.split("::")
         out += ["::".join(parts[:i]) for i in range(len(parts) - 1, 0, -1)]
         self._scopes[unit] = list(dict.fromkeys(out))

@@ -22,6 +22,7 @@ from rclverify.ros.extract import cpp_helpers, symbols
 from rclverify.ros.extract.cpp_types import (action_type, action_type_in, alias_of, message_type, service_type,
                                              split_template)
 from rclverify.ros.extract.model import Endpoint, Note
+from rclverify.ros.extract.link_units import UnitInfo, unit_of
 
 _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_servers",
               "SimpleActionClient": "action_clients", "ActionClient": "action_clients"}
@@ -30,7 +31,7 @@ _ACTIONLIB = {"SimpleActionServer": "action_servers", "ActionServer": "action_se
 class LinkMembers:
     """Members, bases and callback types of a linked program (see the module docstring)."""
 
-    units: dict[str, dict[str, Any]]
+    units: dict[str, UnitInfo]
     calls: list[tuple[Any, ...]]
     callbacks: dict[str, str]
     aliases: dict[str, str]
@@ -91,17 +92,17 @@ class LinkMembers:
         (``make_unique<Caller<pkg::srv::T>>(...)``, a derived template's base
         initialiser ``ClientBase<ServiceT>(...)`` followed to its own
         constructions), in call order; ``[]`` when none is found."""
-        tps = self.units.get(unit or "", {}).get("tparams", [])
+        tps = unit_of(self.units, unit).tparams
         if param not in tps or depth > 4:
             return []
         i, out = tps.index(param), []
         for kind, callee, _args, _fkey, cunit, *_rest in self.calls:
             if kind == "member":  # a member initialised in a constructor: its declared type's arguments
-                callee = self.units.get(cunit or "", {}).get("members", {}).get(callee, callee)
+                callee = unit_of(self.units, cunit).members.get(callee, callee)
             targs = split_template(callee.replace(" ", ""))[1] if kind in ("ctor", "member") else []
             if len(targs) <= i or self.match(callee, cunit) != unit:
                 continue
-            own = self.units.get(cunit or "", {}).get("tparams", [])
+            own = unit_of(self.units, cunit).tparams
             for x in self.template_types(cunit, targs[i], depth + 1) if targs[i] in own else [targs[i]]:
                 if x not in out:
                     out.append(x)
@@ -145,10 +146,10 @@ class LinkMembers:
         for unit, m, meth, args, texts, src, fkey in r.get("member_calls", []):
             if not self.runs(unit, fkey):
                 continue
-            ty = self.units.get(unit, {}).get("members", {}).get(m)
-            for b in self.units.get(unit, {}).get("bases", []):
+            ty = unit_of(self.units, unit).members.get(m)
+            for b in unit_of(self.units, unit).bases:
                 cls = self.match(b, unit)
-                ty = ty or (self.units.get(cls, {}).get("members", {}).get(m) if cls else None)
+                ty = ty or (unit_of(self.units, cls).members.get(m) if cls else None)
             specs = cpp_helpers.method(ty, meth, args, [], lambda x: x, None, self.aliases) if ty else None
             for kind, nv, t, hv in specs or []:
                 k = 1 if kind == "sub" and meth == "subscribe" else 0

@@ -75,12 +75,12 @@ class LinkReach(LinkIndex):
                 self.site_at.pop(k, None)  # a plugin's entry points: no call site to name
                 self.site_targs[k] = [([], None)] * len(got)
         for u, info in self.units.items():
-            for ty in list(info["members"].values()) + info["bases"]:
+            for ty in list(info.members.values()) + info.bases:
                 for ident in _IDENT.findall(ty):
                     m = self.match(ident, u) if not ident.startswith(("std::", "ros::", "rclcpp::")) else None
                     if m is not None and m != u:
                         self._edge(f"U:{u}", f"U:{m}")
-            for b in info["bases"] if self.py else []:  # a Python base class of the package runs with it
+            for b in info.bases if self.py else []:  # a Python base class of the package runs with it
                 m = self._py_base(u, b)
                 if m is not None and m != u:
                     self._edge(f"U:{u}", f"U:{m}")

@@ -31,6 +31,7 @@ from itertools import product
 from typing import TYPE_CHECKING, Any
 
 from rclverify.ros.extract import symbols
+from rclverify.ros.extract.link_units import UnitInfo, unit_of
 
 Entry = tuple[int, int, list[Any], list[Any], list[bool]]  # parameters, defaulted ones, defaults, returned
 # values, per parameter whether it may take a string literal
@@ -42,7 +43,7 @@ class Returns:
 
     returns: dict[str, list[Entry]]
     reading: set[tuple[str, int]]  # the definitions whose returns are being read (a recursion reads nothing)
-    units: dict[str, dict[str, Any]]
+    units: dict[str, UnitInfo]
     fn_tparams: dict[str, list[str]]
     call_targs: list[tuple[str, str | None, str | None, int, list[str]]]
 
@@ -138,7 +139,7 @@ class Returns:
             seen.append(u)
             if self._returning(f"{u}::{meth}"):
                 return f"{u}::{meth}"
-            todo += [b for b in (self.match(x, u) for x in self.units.get(u, {}).get("bases", [])) if b]
+            todo += [b for b in (self.match(x, u) for x in unit_of(self.units, u).bases) if b]
         return None
 
 

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any, Callable
 from rclverify.ros.extract import emit
 from rclverify.ros.extract.cpp_types import alias_of, split_template
 from rclverify.ros.extract.model import Endpoint, Note
+from rclverify.ros.extract.link_units import UnitInfo, unit_of
 
 #: instantiations read per endpoint at most (bounded work)
 MAX_INSTANCES = 32
@@ -34,7 +35,7 @@ class Instances:
     """Template arguments per construction or call site (see the module docstring)."""
 
     fns: dict[str, tuple[str, list[str], list[str], list[Any]]]
-    units: dict[str, dict[str, Any]]
+    units: dict[str, UnitInfo]
     fn_tparams: dict[str, list[str]]
     aliases: dict[str, str]
     alias_index: dict[str, list[str]]
@@ -106,7 +107,7 @@ class Instances:
         (``halt_(this, "halt")``) has those of its declared type (``Client<Trigger>
         halt_;``), a function template's call those the file read for it, in order."""
         if kind == "member":
-            callee = self.units.get(unit or "", {}).get("members", {}).get(callee, callee)
+            callee = unit_of(self.units, unit).members.get(callee, callee)
         elif kind == "call" and "<" not in callee:
             same = (callee, unit, caller, nargs)
             k = self._targ_seen.get(same, 0)
@@ -139,7 +140,7 @@ class Instances:
         site writes it."""
         if depth > 4:
             return []
-        cls_tps = self.units.get(unit or "", {}).get("tparams", [])
+        cls_tps = unit_of(self.units, unit).tparams
         fn_base = (fkey or "").split("#")[0]
         fn_tps = self.fn_tparams.get(fkey or "", self.fn_tparams.get(fn_base, []))
         if param in fn_tps and fkey:
@@ -191,5 +192,5 @@ class Instances:
 def is_template_param(arg: str, unit: str | None, fkey: str | None, lk: Instances) -> bool:
     """Whether type text ``arg`` is a template parameter of class ``unit`` or
     function ``fkey`` (not a type); ``lk`` the linker holding their tables."""
-    return arg in lk.units.get(unit or "", {}).get("tparams", []) or \
+    return arg in unit_of(lk.units, unit).tparams or \
         arg in lk.fn_tparams.get(fkey or "", lk.fn_tparams.get((fkey or "").split("#")[0], []))

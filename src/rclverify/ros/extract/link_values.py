@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from rclverify.ros.extract import symbols
 from rclverify.ros.extract.cpp_scope import is_node_type
+from rclverify.ros.extract.link_units import UnitInfo, unit_of
 
 MAX_DEPTH = 8
 #: a member declared with an interface spec: component_interface_utils::Publisher<ns::Spec>::SharedPtr
@@ -42,7 +43,7 @@ class Values:
 
     fns: dict[str, tuple[str, list[str], list[str], list[Any]]]
     sites: dict[str, list[tuple[list[Any], dict[str, Any], str | None]]]
-    units: dict[str, dict[str, Any]]
+    units: dict[str, UnitInfo]
     fields: dict[tuple[str, str], list[Any]]
     recs: dict[str, dict[str, Any]]
     code: Any
@@ -191,8 +192,8 @@ class Values:
         """The interface spec a member of class ``unit`` (or of a base of it) is
         declared with: ``ns::Spec`` of ``component_interface_utils::Publisher<ns::Spec>::SharedPtr``
         (also ``Subscription``, ``Service``, ``Client``); ``None`` otherwise."""
-        for u in [unit] + [b for b in (self.match(x, unit) for x in self.units.get(unit, {}).get("bases", [])) if b]:
-            ty = self.units.get(u, {}).get("members", {}).get(member)
+        for u in [unit] + [b for b in (self.match(x, unit) for x in unit_of(self.units, unit).bases) if b]:
+            ty = unit_of(self.units, u).members.get(member)
             m = _SPEC_MEMBER.search(ty.replace(" ", "")) if ty else None
             if m is not None:
                 return m.group(1).lstrip(":")
@@ -200,8 +201,8 @@ class Values:
 
     def _field(self, unit: str, name: str, depth: int) -> list[Any]:
         ty, binds = None, None
-        for u in [unit] + [b for b in (self.match(x, unit) for x in self.units.get(unit, {}).get("bases", [])) if b]:
-            ty = ty or self.units.get(u, {}).get("members", {}).get(name)
+        for u in [unit] + [b for b in (self.match(x, unit) for x in unit_of(self.units, unit).bases) if b]:
+            ty = ty or unit_of(self.units, u).members.get(name)
             binds = binds or self.fields.get((u, name))
         handle = ty is not None and is_node_type(ty)
         if not binds:
