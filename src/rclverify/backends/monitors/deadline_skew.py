@@ -42,7 +42,7 @@ class DeadlineMonitor(Protocol):
     module stays below the monitor that calls it)."""
 
     skew_ns: int
-    timed: list[tuple[int, ast.Clause, str, frozenset[str], float]]
+    timed_k: dict[int, tuple[int, ast.Clause, str, frozenset[str], float]]
     heard: deque[tuple[int, Event, set[str], dict[str, object]]]
     checked: Checked
     node: CheckedNode
@@ -74,7 +74,7 @@ def mark_early(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapp
     the trigger's inputs.  The first such output is the one named."""
     if p.maybe:
         return
-    k, cl, _, gouts, _ = next(t for t in mon.timed if t[0] == p.k)
+    k, cl, _, gouts, _ = mon.timed_k[p.k]
     if not (gouts & set(fresh)):
         return
     values = mon._visible(p, ns / 1e9)
@@ -86,12 +86,15 @@ def mark_early(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapp
 
 
 def scan_heard(mon: DeadlineMonitor, p: Pending) -> None:
-    """Mark ``p`` from the outputs already heard (the last 64 kept) stamped within the skew before its trigger."""
-    for ns, ev, _, fresh in mon.heard:
-        if within_skew_before(mon, p, ns):
-            mark_early(mon, p, ev, ns, fresh)
-            if p.maybe:
-                return
+    """Mark ``p`` from the outputs already heard (the last 64 kept) stamped within the skew before its trigger
+    (:func:`within_skew_before`), oldest first."""
+    skew, stamp = mon.skew_ns, p.stamp_ns
+    if skew <= 0:
+        return
+    for ns, ev, _, fresh in [h for h in mon.heard if within_before(h[0], stamp, skew)]:
+        mark_early(mon, p, ev, ns, fresh)
+        if p.maybe:
+            return
 
 
 def undecided(mon: DeadlineMonitor, p: Pending) -> None:

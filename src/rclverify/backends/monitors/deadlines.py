@@ -105,6 +105,8 @@ class DeadlineMonitor:
                              if isinstance(e, ast.Var) and e.prefix == "out")
             self.timed.append((k, cl, f"in.{cl.trigger.name}", outs, float(bound)))
             self.bounds_ns[k] = round(bound * 1_000_000_000)  # exact: `within 200 ms` is 200_000_000 ns
+        #: guarantee -> its entry of ``timed``: what an obligation reads of its guarantee, found by its number
+        self.timed_k = {t[0]: t for t in self.timed}
         # an output whose every topic the mapping declares a state may stand in
         # with its current value; any other answers only triggers before it
         event_outs = {key for topic, keys in self.bindings.items() for key, part in keys
@@ -323,7 +325,7 @@ class DeadlineMonitor:
     def _try(self, p: Pending, ev: Event, ns: int, outs: set[str]) -> bool:
         """Whether output ``ev`` (stamp ``ns``, setting ``outs``) answers obligation ``p``:
         its verdict given (``true``, or ``false`` when late), else ``False`` (still pending)."""
-        k, cl, _, gouts, d = next(t for t in self.timed if t[0] == p.k)
+        k, cl, _, gouts, d = self.timed_k[p.k]
         if not (gouts & outs):
             return False
         if ns < p.stamp_ns:  # stamped before the trigger: within the skew, it may be its answer (deadline_skew)
@@ -352,7 +354,7 @@ class DeadlineMonitor:
 
     def _answers(self, p: Pending, ns: int, outs: set[str]) -> bool:
         """Whether outputs ``outs`` now (stamp ``ns``, integer ns) answer obligation ``p``."""
-        _, cl, _, gouts, _ = next(t for t in self.timed if t[0] == p.k)
+        _, cl, _, gouts, _ = self.timed_k[p.k]
         if not (gouts & outs) or ns < p.stamp_ns:
             return False
         return judge(cl.formula, self.checked, self.node, self._visible(p, ns / 1e9), self.tolerance).truth is True
@@ -367,7 +369,7 @@ class DeadlineMonitor:
         and the outputs published since its trigger."""
         q = self.stream.at(stamp) if stamp is not None else None
         values = dict(q.inputs if q is not None and q.owed and q.stamp >= p.stamp else p.inputs)
-        trig = next(t[2] for t in self.timed if t[0] == p.k)
+        trig = self.timed_k[p.k][2]
         if trig in p.inputs:
             values[trig] = p.inputs[trig]
         values.update({key: v for key, v in self.values.items() if key in self.state_outs and v is not None})
