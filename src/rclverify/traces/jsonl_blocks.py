@@ -282,13 +282,15 @@ class LogBlock:
     the exact reader skip a row's line (a defect: the fast path takes only
     lines with a string topic and a finite float time, which it reads)."""
 
-    __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made")
+    __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made", "_columns")
 
     def __init__(self, path: Path, lines: Sequence[bytes] | _Slice, structs: list[Any], attr: dict[str, str], topics: list[str],
                  times: np.ndarray, lineno: int, index: int) -> None:
         self.path, self.lines, self.structs, self.attr = path, lines, structs, attr
         self.topics, self.times, self.lineno, self.index = topics, times, lineno, index
         self._made: dict[int, Event] = {}
+        #: a key's value at every row (an object column), made when a reader asks for many rows of it
+        self._columns: dict[str, np.ndarray] = {}
 
     def __len__(self) -> int:
         return len(self.structs)
@@ -312,7 +314,13 @@ class LogBlock:
             first, last, step = int(rows[0]), int(rows[-1]), int(rows[1] - rows[0])
             if step > 0 and last == first + step * (len(rows) - 1) and bool((np.diff(rows) == step).all()):
                 return list(map(attrgetter(attr), structs[first:last + 1:step]))
-        return [getattr(structs[i], attr) for i in rows.tolist()]
+        col = self._columns.get(attr)
+        if col is None:
+            if 8 * len(rows) < len(structs):  # a few rows: read alone
+                return [getattr(structs[i], attr) for i in rows.tolist()]
+            col = self._columns[attr] = np.fromiter(map(attrgetter(attr), structs), dtype=object, count=len(structs))
+        picked: list[Any] = col[rows].tolist()  # (an object column gives back the values themselves)
+        return picked
 
     def __getitem__(self, i: Any) -> Any:
         if isinstance(i, slice):
