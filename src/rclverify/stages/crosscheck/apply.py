@@ -13,10 +13,12 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping, TypeVar
 
+import msgspec
+
 from rclverify.stages.crosscheck.items import witness_query
 from rclverify.stages.crosscheck.stage import DOWNGRADES
 import hashlib
-from rclverify.stages.crosscheck.stage import read_crosscheck
+from rclverify.stages.crosscheck.stage import CrosscheckSeen, read_crosscheck
 from rclverify.stages.crosscheck.items import SIDE_ANSWERS
 
 #: A record the second solver's verdict is folded into (a side-condition row, a health finding, a
@@ -34,7 +36,7 @@ class SecondSolver:
     """The stage's rows by ``(kind, id)`` and the record's problem ('' when
     its seal holds or it does not exist yet)."""
 
-    def __init__(self, rows: Mapping[tuple[str, str], dict[str, Any]], problem: str = "") -> None:
+    def __init__(self, rows: Mapping[tuple[str, str], CrosscheckSeen], problem: str = "") -> None:
         self.rows = dict(rows)
         self.problem = problem
 
@@ -43,16 +45,16 @@ class SecondSolver:
         whose query text is not the one the item names now (another
         ``smt2`` path) is not believed."""
         r = self.rows.get((kind, item_id))
-        if r is None or (smt2 is not None and r.get("smt2") != smt2):
+        if r is None or (smt2 is not None and r.smt2 != smt2):
             why = f"second-solver record: {self.problem}" if self.problem else _STAGE_MISSING
             return {"agreement": "one solver", "why": why, "cvc5": None, "proof": "", "smt2": smt2 or ""}
-        if r.get("other_text"):
-            return {"agreement": "one solver", "why": _OTHER_TEXT, "cvc5": None, "proof": "",
-                    "smt2": str(r.get("smt2", ""))}
-        c = r.get("cvc5") if isinstance(r.get("cvc5"), dict) else None
-        return {"agreement": str(r.get("agreement")), "why": str(r.get("why", "")),
-                "cvc5": None if c is None else {k: c.get(k) for k in ("answer", "reason", "version", "proof_checked")},
-                "proof": (c or {}).get("proof", ""), "smt2": str(r.get("smt2", ""))}
+        if r.other_text:
+            return {"agreement": "one solver", "why": _OTHER_TEXT, "cvc5": None, "proof": "", "smt2": str(r.smt2 or "")}
+        c = r.cvc5
+        return {"agreement": str(r.agreement), "why": r.why,
+                "cvc5": None if c is None else {"answer": c.answer, "reason": c.reason, "version": c.version,
+                                                "proof_checked": c.proof_checked},
+                "proof": c.proof if c is not None else "", "smt2": str(r.smt2 or "")}
 
     def _fold(self, row: Row | None, kind: str, id_key: str, status_key: str, good: str,
               downgraded: Callable[[Row, dict[str, Any]], dict[str, str]],
@@ -128,7 +130,7 @@ class SecondSolver:
         """How many items each agreement has (the report's headline)."""
         out: dict[str, int] = {}
         for r in self.rows.values():
-            a = "one solver" if r.get("other_text") else str(r.get("agreement"))
+            a = "one solver" if r.other_text else str(r.agreement)
             out[a] = out.get(a, 0) + 1
         return dict(sorted(out.items()))
 
@@ -142,12 +144,12 @@ def load(root: Any) -> SecondSolver:
 
     rows, problem = read_crosscheck(root)
     for key, r in list(rows.items()):
-        rel = r.get("smt2")
+        rel = r.smt2
         try:
-            text = (root / str(rel)).read_text(encoding="utf-8") if isinstance(rel, str) and rel else None
+            text = (root / rel).read_text(encoding="utf-8") if rel else None
             now = hashlib.sha256(text.encode("utf-8")).hexdigest() if text is not None else ""  # as the stage hashes
         except (OSError, UnicodeDecodeError):
             now = ""
-        if now != r.get("sha256"):
-            rows[key] = {**r, "other_text": True}
+        if now != r.sha256:
+            rows[key] = msgspec.structs.replace(r, other_text=True)
     return SecondSolver(rows, problem)

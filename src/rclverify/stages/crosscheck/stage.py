@@ -22,6 +22,8 @@ import os
 from pathlib import Path
 from typing import Any, Iterable, cast
 
+import msgspec
+
 from rclverify.core import cpus as cpus_now
 from rclverify.core.forksafe import fork_is_safe
 from rclverify.records.sealed import read_sealed, write_sealed
@@ -241,11 +243,48 @@ def _counts(rows: list[dict[str, Any]]) -> dict[str, int]:
     return dict(sorted(out.items()))
 
 
-def read_crosscheck(root: Path) -> tuple[dict[tuple[str, str], dict[str, Any]], str]:
+class Cvc5Seen(msgspec.Struct, frozen=True):
+    """cvc5's answer in a row of the stage's record as its readers read it back
+    (:class:`~rclverify.records.crosscheck_records.Cvc5Answer`): a key the row lacks at ``None``
+    (``proof``: ``""``)."""
+
+    answer: str | None = None
+    reason: str | None = None
+    version: str | None = None
+    proof_checked: bool | None = None
+    proof: str = ""
+
+
+class CrosscheckSeen(msgspec.Struct, frozen=True):
+    """One row of the stage's record as its readers read it back
+    (:class:`~rclverify.records.crosscheck_records.CrosscheckRow`): the item, the script's path and the
+    sha256 of the text cvc5 decided, the agreement and why, cvc5's answer; ``other_text``: the script at
+    that path now holds another text (stages/crosscheck/apply.py ``load``)."""
+
+    kind: str = ""
+    id: str = ""
+    smt2: str | None = None
+    sha256: str | None = None
+    agreement: str | None = None
+    why: str = ""
+    cvc5: Cvc5Seen | None = None
+    other_text: bool = False
+
+
+def read_crosscheck(root: Path) -> tuple[dict[tuple[str, str], CrosscheckSeen], str]:
     """``(rows by (kind, id), problem)`` of the stage's record: ``({}, "")``
     before it ran; ``({}, why)`` when its seal does not hold (the caller
-    then reads every item as decided by one solver and says why)."""
+    then reads every item as decided by one solver and says why).  A row
+    that does not decode into :class:`CrosscheckSeen` is left out (its item
+    then reads as one the stage did not decide)."""
     body, why = read_sealed(root / INDEX, "second-solver record")
     if why or body is None:
         return {}, why
-    return {(str(r.get("kind")), str(r.get("id"))): r for r in body.get("items", []) if isinstance(r, dict)}, ""
+    out: dict[tuple[str, str], CrosscheckSeen] = {}
+    for r in body.get("items", []):
+        try:
+            row = msgspec.convert(r, CrosscheckSeen)
+        except msgspec.ValidationError:
+            continue
+        out[(row.kind, row.id)] = row
+    return out, ""
