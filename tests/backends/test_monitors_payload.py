@@ -83,7 +83,7 @@ def test_an_undeclared_key_is_refused_and_the_same_details_without_it_decode() -
     assert monitors_payload("monitors", bad) is None  # a reader skips it; the evidence pass shows it as error
     assert monitors_payload("hoare", details) is None  # another backend's record is not read as the monitors'
     # the backend refuses to write a part its payload does not declare, instead of dropping it
-    with pytest.raises(ValueError, match="no part window"):
+    with pytest.raises(msgspec.ValidationError, match="window"):
         run_payload({"trace": "t.jsonl"}, {"trace": "t.jsonl"}, {"window": {}})
     d = run_payload({"trace": "t.jsonl"}, {"trace": "t.jsonl"}, {"not_judged": []}).details()
     assert d["statistics"] == {"trace": "t.jsonl"} and d["not_judged"] == [] and d["monitoring"]["trace"] == "t.jsonl"

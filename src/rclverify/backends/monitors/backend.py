@@ -34,7 +34,7 @@ from rclverify.traces.bag import custom_types
 from rclverify.traces.files import trace_files, trace_sha256
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.run_origin import unseen_links
-from rclverify.backends.monitors.payload import DeadlineBlock, MonitoringBlock, MonitorsPayload, RunStatistics
+from rclverify.backends.monitors.payload import MonitorsPayload
 from rclverify.backends.monitors.shapes import DeadlinesPart
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.deadline_records import DeadlineResult
@@ -294,18 +294,10 @@ def run_payload(monitoring: Mapping[str, Any], stats: Mapping[str, Any], extra: 
     """One run's evidence payload: the ``monitoring`` block (:func:`.summary.monitoring_details`, the shape
     ``rclverify monitor`` and the live run print too), the run's ``stats`` (:func:`.runset.run_counts`) and
     the parts the other monitors added (``extra``: ``calls``, ``lifecycle``, ``deadlines``, ``periods``,
-    ``declarations``, ``not_judged``).  Raises :class:`msgspec.ValidationError` for a part of another shape
-    and ``ValueError`` for a part the payload does not declare (a monitor's bug: the record's payload would
-    not decode)."""
-    undeclared = sorted(set(extra) - set(MonitorsPayload.__struct_fields__))
-    if undeclared:
-        raise ValueError(f"the monitors' payload declares no part {', '.join(undeclared)}")
-    dl = extra.get("deadlines")
-    return MonitorsPayload(
-        monitoring=msgspec.convert(monitoring, MonitoringBlock), statistics=msgspec.convert(stats, RunStatistics),
-        deadlines=None if dl is None else msgspec.convert(dl, DeadlineBlock), calls=extra.get("calls"),
-        periods=extra.get("periods"), declarations=extra.get("declarations"), lifecycle=extra.get("lifecycle"),
-        not_judged=extra.get("not_judged"))
+    ``declarations``, ``not_judged``), each part converted once into its Struct.  Raises
+    :class:`msgspec.ValidationError` for a part the payload does not declare or one of another shape (a
+    monitor's bug: the record's payload would not decode)."""
+    return msgspec.convert({**extra, "monitoring": monitoring, "statistics": stats}, MonitorsPayload)
 
 
 def with_calls(entries: list[dict[str, Any]], summary: dict[str, Any], status: str,
