@@ -89,3 +89,14 @@ def test_a_value_the_sections_do_not_admit_is_located() -> None:
     assert "requirements.0.deadline" in d.message and "Expected `array`" in d.message
     data["requirements"][0]["deadline"] = {"path": ["A"], "within": 1}  # control: the same data, well formed
     assert plan_document(data, locs, "plan.yaml").requirements[0].deadline is not None
+
+
+def test_an_integer_written_as_a_whole_float_reads_as_the_schema_admits_it(tmp_path: Path) -> None:
+    text = PLAN.replace("guarantees: [1, 2]", "guarantees: [1.0, 2]").replace("instances: [0, 3]", "instances: [0, 3.0]")
+    doc, _ = read_plan_document(_workspace(tmp_path, text), "contracts/plan.yaml")  # JSON Schema's integer admits 1.0
+    assert doc.requirements[0].supported_by[0].guarantees == (1, 2)
+    b = (doc.environment or {})["B"]
+    assert isinstance(b, EnvironmentEntry) and b.instances == (0, 3)
+    with pytest.raises(PlanError):  # control: a number that is no integer is refused (by the schema)
+        (tmp_path / "contracts" / "plan.yaml").write_text(text.replace("[1.0, 2]", "[1.5, 2]"), encoding="utf-8")
+        read_plan_document(tmp_path, "contracts/plan.yaml")

@@ -173,7 +173,8 @@ def plan_document(data: Mapping[str, Any], locs: Mapping[tuple[Any, ...], ast.Lo
     :class:`PlanError` (``E-plan``) at the nearest located value, naming what was expected (only a value
     the schema admits and the sections do not, e.g. a key that is not text, reaches it)."""
     try:
-        return msgspec.convert(data, PlanDocument)
+        # not strict: a number the schema calls an integer may be written 1.0 (JSON Schema's integer)
+        return msgspec.convert(data, PlanDocument, strict=False)
     except msgspec.ValidationError as exc:
         m = _WHERE.search(str(exc))
         path = _path(m.group(1)) if m else ()

@@ -250,7 +250,7 @@ def parse_profile(text: str, file: str, builtin: bool = False) -> Profile:
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise plan_error(file, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
     _check_schema(data, locs, file)
-    doc = msgspec.convert(data, _ProfileWritten)
+    doc = msgspec.convert(data, _ProfileWritten, strict=False)  # an integer may be written 2.0 (JSON Schema's)
     levels = doc.levels
     items: list[Item] = []
     seen: dict[str, int] = {}
