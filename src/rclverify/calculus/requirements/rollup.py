@@ -218,6 +218,33 @@ def _vacuous_note(record: RequirementCheckRow) -> str:
     return f"the requirement's premise can never hold {why}: it is proved only because it never applies"
 
 
+def _temporal_refutation(t: _Temporal) -> str | None:
+    """The note of a temporal requirement refuted by a run that stops (a deadlock) or by a lasso that never
+    reaches it (a node that never answers in its loop, or producers that never give a value); ``None``
+    for another refutation."""
+    if "deadlock" in str(t.method).split(" + "):
+        return (f"a run of the system stops at step {t.bound}: no next state satisfies the "
+                "premises of its cone (a deadlock), and the runs of the system must not stop")
+    gaps = t.missing_progress
+    if gaps:
+        return (f"a run that never reaches it, because {gaps[0].node} never answers in its loop "
+                f"although its assumption holds there: no progress declared on "
+                + ", ".join(g.node for g in gaps)
+                + " excludes it (declare progress( eventually ) or progress( within K steps ) "
+                  "on a node that does answer)")
+    stuck = t.missing_initially
+    if stuck:
+        names = ", ".join(dict.fromkeys(r.node for r in stuck))
+        first = stuck[0]
+        why = (f"{first.consumer} never has a value: {first.node} never publishes {first.node}.{first.output}"
+               if first.value.startswith("none") else
+               f"{first.consumer} keeps the value {first.node}.{first.output} had before the run")
+        return (f"a run that never reaches it, in which no node waiting on {names} ever has a "
+                f"question it owes an answer: {why}, and no initial value is declared "
+                f"(declare initially( ... ) on {names})")
+    return None
+
+
 def _or(value: str | None, default: str) -> str:
     """``value``, or ``default`` when the record does not have it."""
     return default if value is None else value
@@ -254,27 +281,9 @@ def roll_up(record: Mapping[str, Any] | None, g_status: Callable[[str, int], str
         w = bad[0].verdict
         return "refuted", "failed", (f"the recorded run {bad[0].trace} refutes it: {w.reason if w else ''} "
                                      f"(Z3: {v})")
-    t = msgspec.convert(c.temporal or {}, _Temporal)
-    if v == "refuted" and "deadlock" in str(t.method).split(" + "):
-        return "refuted", "failed", (f"a run of the system stops at step {t.bound}: no next state satisfies the "
-                                     "premises of its cone (a deadlock), and the runs of the system must not stop")
-    gaps = t.missing_progress
-    if v == "refuted" and gaps:
-        return "refuted", "failed", (f"a run that never reaches it, because {gaps[0].node} never answers in its loop "
-                                     f"although its assumption holds there: no progress declared on "
-                                     + ", ".join(g.node for g in gaps)
-                                     + " excludes it (declare progress( eventually ) or progress( within K steps ) "
-                                       "on a node that does answer)")
-    stuck = t.missing_initially
-    if v == "refuted" and stuck:
-        names = ", ".join(dict.fromkeys(r.node for r in stuck))
-        first = stuck[0]
-        why = (f"{first.consumer} never has a value: {first.node} never publishes {first.node}.{first.output}"
-               if first.value.startswith("none") else
-               f"{first.consumer} keeps the value {first.node}.{first.output} had before the run")
-        return "refuted", "failed", (f"a run that never reaches it, in which no node waiting on {names} ever has a "
-                                     f"question it owes an answer: {why}, and no initial value is declared "
-                                     f"(declare initially( ... ) on {names})")
+    lasso = _temporal_refutation(msgspec.convert(c.temporal or {}, _Temporal)) if v == "refuted" else None
+    if lasso is not None:
+        return "refuted", "failed", lasso
     if v == "refuted":
         who = ", ".join(p.label for p in c.failed_to_prevent) or "no guarantee of the cone"
         return "refuted", "failed", f"Z3 found a counterexample that every premise allows; it is not prevented by: {who}"
