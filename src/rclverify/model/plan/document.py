@@ -11,8 +11,8 @@ settings), each profile's own (a ``standards:`` entry's level key), or read
 by a reader of its own shapes (``instances:``, ``ros:``) is kept as written.
 
 The locations of the values stay in the loader's location map (value path
--> ``file:line:col``, :func:`.yamlguard.to_data`), so every located error is
-written from the same places as before the values were typed.
+-> ``file:line:col``, :func:`.yamlguard.to_data`): every located error of a
+reader points at the value it read in the plan file.
 """
 from __future__ import annotations
 
@@ -170,8 +170,9 @@ def plan_document(data: Mapping[str, Any], locs: Mapping[tuple[Any, ...], ast.Lo
     """The plan's ``data`` (a mapping its schema admits: ``read_plan_data``'s) as a :class:`PlanDocument`.
 
     ``locs`` (value path -> location) and ``file`` locate a value the document does not admit: a
-    :class:`PlanError` (``E-plan``) at the nearest located value, naming what was expected (only a value
-    the schema admits and the sections do not, e.g. a key that is not text, reaches it)."""
+    :class:`PlanError` (``E-plan``) at the nearest located value, naming what was expected.  A plan its
+    schema admits always converts (an integer written ``1.0`` reads as ``1``, as JSON Schema's integer
+    admits it); the error is met by data no schema checked (a mapping a caller builds)."""
     try:
         # not strict: a number the schema calls an integer may be written 1.0 (JSON Schema's integer)
         return msgspec.convert(data, PlanDocument, strict=False)
