@@ -51,6 +51,24 @@ def cpu_seconds(pid: int) -> float | None:
         return None
 
 
+def thread_cpu_seconds(pid: int) -> dict[str, float]:
+    """User + system CPU seconds of each thread of process ``pid`` by its name (``/proc/<pid>/task``; the
+    threads of one name summed, but Python's own, which carry the interpreter's name and are keyed
+    ``python/<tid>``; empty elsewhere): the monitor's engine, bus and middleware threads."""
+    out: dict[str, float] = {}
+    for stat in Path(f"/proc/{pid}/task").glob("*/stat"):
+        try:
+            head, rest = stat.read_text().rsplit(")", 1)
+        except OSError:
+            continue
+        fields = rest.split()
+        name = head.split("(", 1)[1]
+        if name.startswith("python"):
+            name = f"python/{stat.parent.name}"
+        out[name] = out.get(name, 0.0) + (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    return out
+
+
 def children_cpu_seconds(pid: int) -> float:
     """User + system CPU seconds of the live child processes of ``pid`` (Linux ``/proc``; 0 elsewhere): the
     rclpy source's agent, which the monitor starts in a session of its own."""

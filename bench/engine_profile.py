@@ -92,8 +92,8 @@ def bench_messages(n: int, rate: float, start: float) -> tuple[list[Message], Ca
     try:  # the DDS run's decoder (runtime/dds/live.py), else the struct's deserializer and to_fields
         from rclverify.runtime.dds.cdr_fields import read_fields
     except ImportError:
-        def read_fields(cls: Any, data: bytes) -> Any:
-            return to_fields(cls.deserialize(data))
+        def read_fields(cls: Any, raw: bytes) -> Any:
+            return to_fields(cls.deserialize(raw))
 
     def decode(topic: str, data: bytes) -> Any:
         return read_fields(structs[topic], data)
@@ -185,7 +185,8 @@ def drive_worker(run: Any, msgs: list[Message], decode: Callable[[str, bytes], A
 
     def fields_of(topic: str, payload: Any) -> Any:
         return payload if not isinstance(payload, bytes) else decode(topic, payload) if decode else {}
-    worker = Profiled(run, fields_of, time.time, tick_s=TICK_S, linger_s=linger).start()
+    worker = (Profiled(run, fields_of, time.time, tick_s=TICK_S, linger_s=linger) if linger
+              else Profiled(run, fields_of, time.time, tick_s=TICK_S)).start()
     start = time.monotonic()
     for k, (topic, fields, raw, _t) in enumerate(msgs):
         wait = start + k / rate - time.monotonic()
@@ -237,7 +238,10 @@ def main(argv: list[str] | None = None) -> int:
         if a.worker:
             prof = cProfile.Profile()
             run = make_run(ws, mapping, tmp / "worker.jsonl", a.lateness, publish)
-            from rclverify.runtime.worker import LINGER_S
+            try:
+                from rclverify.runtime.worker import LINGER_S
+            except ImportError:  # a worker that wakes for every message
+                LINGER_S = 0.0
             linger = LINGER_S if a.linger is None else a.linger
             per = drive_worker(run, msgs, decode, a.rate, a.lateness, linger=linger)
             run.stop()

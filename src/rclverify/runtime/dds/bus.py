@@ -35,7 +35,11 @@ taps (discovery at most every ``period_s``, so a busy topic does not make
 it read discovery at every sample), and hands each sample to ``on_sample(tap, raw bytes, sample info,
 receipt time)`` (receipt: ``time.time_ns()``, an integer, so a recorded bag
 holds the very time the engine used); it never decodes or checks (the
-engine thread does, :mod:`.worker`).
+engine thread does, :mod:`.worker`).  With ``linger_s`` (the live run's
+lateness bound is set: a message's time is its publisher's source
+timestamp, which the wait does not change) the thread, after a round that
+took samples, lets the next ones gather in the readers that long before it
+waits again, rather than waking for every sample.
 """
 from __future__ import annotations
 
@@ -92,14 +96,16 @@ class Bus:
     ``warn(text)`` receives each warning line; ``period_s`` bounds a wait;
     ``on_reader(tap, publishers)`` is told each time a tap's reader is made
     (in the bus thread), with the publishers it was made for; ``type_hash(struct)``
-    the ROS 2 type hash of a contract struct (:meth:`.dds_types.TypeBook.type_hash`)."""
+    the ROS 2 type hash of a contract struct (:meth:`.dds_types.TypeBook.type_hash`); ``linger_s`` (s, 0:
+    none) how long samples gather after a round that took some (module docstring)."""
 
     def __init__(self, dp: Any, on_sample: Callable[[Tap, bytes, Any, int], None],
                  warn: Callable[[str], None], period_s: float = 0.05,
                  on_reader: Callable[[Tap, list[Any]], None] | None = None,
-                 type_hash: Callable[[type], str | None] | None = None) -> None:
+                 type_hash: Callable[[type], str | None] | None = None, linger_s: float = 0.0) -> None:
         from cyclonedds.core import WaitSet  # deferred: start-up (loads cyclonedds and more only when called)
         self.dp, self.on_sample, self.warn, self.period_s = dp, on_sample, warn, period_s
+        self.linger_s = linger_s
         self.on_reader = on_reader
         self.layouts = LayoutJudge(dp, type_hash or (lambda struct: None))
         self._pending = False  # a publisher's type object not yet resolved: update again next period
@@ -164,14 +170,17 @@ class Bus:
                     if self.discovery.poll() or self._pending \
                             or any(now - t0 >= NAME_GRACE_S for t0 in self._unnamed.values()):
                         self._update()
-                self._drain()
+                if self._drain() and self.linger_s > 0:
+                    time.sleep(self.linger_s)  # let the next samples gather (module docstring)
             self._final = True  # a warning still waiting for its node's name is said now, with the participant's
             self._update()
             self._drain(every=True)
         except BaseException as exc:  # noqa: BLE001 - kept for stop(): a dead reader thread must be said
             self.error = exc
 
-    def _drain(self, every: bool = False) -> None:
+    def _drain(self, every: bool = False) -> int:
+        """Take what waits in each triggered tap's reader (each when ``every``) and hand it on; how many."""
+        taken = 0
         for t in self.taps:
             if t.reader is None or not (every or t.condition.triggered):
                 continue
@@ -180,8 +189,10 @@ class Bus:
                 if not got:
                     break
                 self._hand_on(t, got)
+                taken += len(got)
                 if len(got) < 256:
                     break
+        return taken
 
     def _update(self) -> None:
         """Make or remake each tap's reader for the publishers discovered now; warn."""

@@ -62,6 +62,9 @@ from rclverify.runtime.dds.trust import VERDICT_KEY
 from rclverify.runtime.dds.live_end import DdsRunEnd
 
 
+#: how long the DDS bus thread lets samples gather after a round that took some (s), with a lateness bound
+#: (:class:`~rclverify.runtime.dds.bus.Bus`; the rclpy source's agent waits its own ``LINGER_S``)
+BUS_LINGER_S = 0.002
 #: the interpreter's switch interval during a run (s; module docstring)
 SWITCH_INTERVAL_S = 0.001
 #: the encapsulation header of plain little-endian CDR (XCDR1), as rmw writes ROS 2 messages
@@ -275,7 +278,8 @@ class _DdsRun(DdsRunEnd):
             self.bus = bus = bus_factory(on_sample, self.warn, on_reader=self.on_reader,
                                          type_hash=self.types.type_hash)
         else:
-            self.bus = bus = Bus(dp, on_sample, self.warn, on_reader=self.on_reader, type_hash=self.types.type_hash)
+            self.bus = bus = Bus(dp, on_sample, self.warn, on_reader=self.on_reader, type_hash=self.types.type_hash,
+                                 linger_s=0.0 if self.by_receipt else BUS_LINGER_S)
         user = type_hash_user_data("std_msgs/msg/String")
         self.pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
         latched = writer_profile(transient_local=True, depth=1)
