@@ -33,7 +33,7 @@ the callers, so it is not a program of its own (:func:`library_programs`).
 """
 from __future__ import annotations
 
-from rclverify.ros.extract.programs import _SOURCE, PackageCode, Program, _closure
+from rclverify.ros.extract.programs import _SOURCE, NO_FILE, PackageCode, Program, _closure
 
 MAX_FILES = 2000  # files of other packages one program may take in
 
@@ -77,7 +77,7 @@ def extend(prog: Program, codes: dict[str, PackageCode]) -> dict[str, str]:
     own = codes.get(prog.package)
     if own is None:
         return {}
-    python = any(own.records.get(f, {}).get("lang") == "py" for f in prog.entry)
+    python = any(own.facts.get(f, NO_FILE).py for f in prog.entry)
     added: dict[str, str] = {}
     todo = list(prog.files)
     seen = set(todo)
@@ -98,7 +98,7 @@ def _included(codes: dict[str, PackageCode], pkg_of_f: str, f: str, own: str) ->
     """``[(package, files to start from)]``: the other packages' headers C++ file ``f``
     includes, each with its implementation."""
     out = []
-    for inc in codes[pkg_of_f].records.get(f, {}).get("includes", []):
+    for inc in codes[pkg_of_f].facts.get(f, NO_FILE).includes:
         hit = _other(inc, pkg_of_f, codes)
         if hit is not None and hit[0] != own:
             out.append((hit[0], [hit[1]] + _implementations(codes[hit[0]], hit[1])))
@@ -108,7 +108,7 @@ def _included(codes: dict[str, PackageCode], pkg_of_f: str, f: str, own: str) ->
 def _imported(codes: dict[str, PackageCode], pkg_of_f: str, f: str, own: str) -> list[tuple[str, list[str]]]:
     """``[(package, [module file])]``: the other packages' modules Python file ``f`` imports."""
     out = []
-    for origin in codes[pkg_of_f].records.get(f, {}).get("imports", []):
+    for origin in codes[pkg_of_f].facts.get(f, NO_FILE).imports:
         pkg = origin.split(".", 1)[0]
         hit = codes[pkg].module(origin) if pkg in codes and pkg != own else None
         if hit is not None:
@@ -122,10 +122,10 @@ def view(prog: Program, codes: dict[str, PackageCode], added: dict[str, str]) ->
     own = codes[prog.package]
     if not added:
         return own
-    records = dict(own.records)
+    records, facts = dict(own.records), dict(own.facts)
     for f, pkg in added.items():
-        records[f] = codes[pkg].records[f]
-    return PackageCode(own.name, own.root, records, own.show)
+        records[f], facts[f] = codes[pkg].records[f], codes[pkg].facts[f]
+    return PackageCode(own.name, own.root, records, own.show, facts)
 
 
 def library_programs(progs: dict[str, list[Program]], used: dict[str, set[str]],
@@ -138,7 +138,7 @@ def library_programs(progs: dict[str, list[Program]], used: dict[str, set[str]],
         files = used.get(pkg, set())
         if not files:
             continue
-        recs = codes[pkg].records
+        facts = codes[pkg].facts
         lst[:] = [p for p in lst if not (p.exe is None and p.units is None and p.entry and
                                          all(f in files for f in p.entry) and
-                                         not any(recs.get(f, {}).get("nodes") for f in p.entry))]
+                                         not any(facts.get(f, NO_FILE).makes_node for f in p.entry))]

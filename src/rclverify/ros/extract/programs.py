@@ -65,13 +65,49 @@ def module_names(shown: str, pkg_shown: str) -> list[str]:
     return out
 
 
+@dataclass(frozen=True)
+class FileFacts:
+    """What finding a package's programs reads of one file's source record (sources_cpp.py,
+    sources_py.py): whether it is Python, the classes (``units``), functions and constants it defines,
+    the modules it imports and the files it includes (in the order written), the nodelets it registers
+    (``(class, lookup name, at)``), whether it names a node, makes one, or makes endpoints."""
+
+    py: bool = False
+    units: frozenset[str] = frozenset()
+    fns: frozenset[str] = frozenset()
+    consts: frozenset[str] = frozenset()
+    imports: tuple[str, ...] = ()
+    includes: tuple[str, ...] = ()
+    nodelets: tuple[tuple[str, str | None, Any], ...] = ()
+    names_node: bool = False
+    makes_node: bool = False
+    endpoints: bool = False
+
+    @staticmethod
+    def of(r: dict[str, Any]) -> FileFacts:
+        """The facts of the source record ``r``."""
+        return FileFacts(py=r.get("lang") == "py", units=frozenset(r.get("units", {})), fns=frozenset(r.get("fns", {})),
+                         consts=frozenset(r.get("consts", {})), imports=tuple(r.get("imports", [])),
+                         includes=tuple(r.get("includes", [])),
+                         nodelets=tuple((cls, lookup, at) for cls, lookup, at in r.get("nodelets", [])),
+                         names_node=bool(r.get("node_names")), makes_node=bool(r.get("nodes")),
+                         endpoints=bool(r.get("endpoints")))
+
+
+#: the facts of a file the package has no record of
+NO_FILE = FileFacts()
+
+
 class PackageCode:
     """What :func:`programs` needs of one package: its directory as shown, its
-    source records (``records[shown]``), and how a ``Path`` is shown."""
+    source records (``records[shown]``) and what programs are found by of each
+    (``facts[shown]``, :class:`FileFacts`), and how a ``Path`` is shown."""
 
     def __init__(self, name: str, root_shown: str, records: dict[str, dict[str, Any]],
-                 show: Callable[[Path], str]) -> None:
+                 show: Callable[[Path], str], facts: dict[str, FileFacts] | None = None) -> None:
+        """``facts``: those of some of ``records`` already read (another view of the same records)."""
         self.name, self.root, self.records, self.show = name, root_shown, records, show
+        self.facts = {shown: (facts or {}).get(shown) or FileFacts.of(r) for shown, r in records.items()}
         self.modules: dict[str, str] = {}
         for shown in sorted(records):
             for m in module_names(shown, root_shown):
@@ -101,12 +137,11 @@ class PackageCode:
     def _reexported(self, f: str, attr: str, dotted: str) -> str | None:
         """The origin module file ``f`` imports ``attr``'s first name from, when ``f``
         does not define it (no class, function or constant of that name)."""
-        r = self.records.get(f, {})
+        r = self.facts.get(f, NO_FILE)
         head, _, rest = attr.partition(".")
-        if r.get("lang") != "py" or f"{f}::{head}" in r.get("units", {}) or f"{f}::{head}" in r.get("fns", {}) \
-                or head in r.get("consts", {}):
+        if not r.py or f"{f}::{head}" in r.units or f"{f}::{head}" in r.fns or head in r.consts:
             return None
-        origins = [o for o in r.get("imports", []) if o.rsplit(".", 1)[-1] == head and o != dotted]
+        origins = [o for o in r.imports if o.rsplit(".", 1)[-1] == head and o != dotted]
         if len(origins) != 1:
             return None
         return str(origins[0]) + ("." + rest if rest else "")
@@ -130,14 +165,14 @@ def _closure(code: PackageCode, start: list[str], listed: set[str]) -> list[str]
         if f in seen or f not in code.records:
             continue
         seen.append(f)
-        r = code.records[f]
-        if r.get("lang") == "py":
-            for origin in r.get("imports", []):
+        r = code.facts[f]
+        if r.py:
+            for origin in r.imports:
                 hit = code.module(origin)
                 if hit is not None and hit[0] not in seen:
                     todo.append(hit[0])
             continue
-        for inc in r.get("includes", []):
+        for inc in r.includes:
             h = code.include(inc, f)
             if h is None or h in seen:
                 continue
@@ -157,7 +192,7 @@ def _class_named(code: PackageCode, cls: str) -> str:
     plugin description writes it) names: itself, else the one class whose
     qualified name ends with it."""
     cls = cls.strip().lstrip(":")
-    units = {u for r in code.records.values() if r.get("lang") != "py" for u in r.get("units", {})}
+    units = {u for r in code.facts.values() if not r.py for u in r.units}
     if cls in units:
         return cls
     ends = sorted(u for u in units if u.endswith("::" + cls.split("::")[-1]) and
@@ -214,8 +249,8 @@ class _Finder:
         code, t, show = self.code, self.t, self.show
         lookups = {c: k for k, (c, _lib) in t.nodelets.items()}
         plugins = dict(t.plugins)
-        for f, r in sorted(code.records.items()):  # nodelets registered in code, with no plugin description read
-            for cls, lookup, _at in r.get("nodelets", []):
+        for f, r in sorted(code.facts.items()):  # nodelets registered in code, with no plugin description read
+            for cls, lookup, _at in r.nodelets:
                 if _class_named(code, cls) not in {_class_named(code, c) for c in plugins}:
                     lib = next((n for n, ps in sorted(t.libraries.items()) if f in {show(p) for p in ps}), None)
                     plugins[cls] = lib or f"file:{f}"
@@ -239,13 +274,13 @@ class _Finder:
         for pc in t.pluginlib:
             cls = _class_named(code, pc.type)
             srcs = [show(p) for p in t.libraries.get(pc.library or "", [])] or sorted(
-                f for f, r in code.records.items() if r.get("lang") != "py" and cls in r.get("units", {}))
-            if srcs and any(cls in r.get("units", {}) for r in code.records.values() if r.get("lang") != "py"):
+                f for f, r in code.facts.items() if not r.py and cls in r.units)
+            if srcs and any(cls in r.units for r in code.facts.values() if not r.py):
                 target = pc.library if pc.library in t.libraries else None
                 files = _closure(code, srcs + (self.linked(target, {target}) if target else []),
                                  self.listed if target else set())
                 self.out.append(Program(code.name, None, srcs, files, {cls}, plugin=pc.type))
-                self.held.update(f for f in files if not code.records.get(f, {}).get("node_names"))
+                self.held.update(f for f in files if not code.facts.get(f, NO_FILE).names_node)
 
     def scripts(self) -> None:
         """One program per installed script (its other installed names as aliases)."""
@@ -263,19 +298,19 @@ class _Finder:
         a program each, unless another program takes them in."""
         code, held = self.code, self.held
         entries = {p.entry[0] for p in self.out if p.entry and p.exe is not None
-                   and code.records.get(p.entry[0], {}).get("lang") == "py"}
+                   and code.facts.get(p.entry[0], NO_FILE).py}
 
         def content(f: str) -> bool:
-            r = code.records[f]
-            return bool(r.get("nodes") or r.get("node_names") or r.get("endpoints"))
+            r = code.facts[f]
+            return r.makes_node or r.names_node or r.endpoints
 
         loose = [f for f in sorted(code.records) if f not in entries and content(f)]
-        py = [f for f in loose if code.records[f].get("lang") == "py"]
-        cpp = [f for f in loose if code.records[f].get("lang") != "py"]
+        py = [f for f in loose if code.facts[f].py]
+        cpp = [f for f in loose if not code.facts[f].py]
         # files naming a node first, so the modules and headers they take in are theirs
-        for f in sorted(py + cpp, key=lambda f: (not code.records[f].get("node_names"),
+        for f in sorted(py + cpp, key=lambda f: (not code.facts[f].names_node,
                                                   "." + f.rsplit(".", 1)[-1] in _HEADER, f)):
-            if f in held and not (f in py and code.records[f].get("nodes")):
+            if f in held and not (f in py and code.facts[f].makes_node):
                 continue  # a module or header a program takes in (a script naming a node also runs alone;
                 # a base class naming its node by its constructor's parameter does not)
             files = _closure(code, [f], self.listed)
