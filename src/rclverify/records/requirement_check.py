@@ -78,10 +78,11 @@ class TraceCheckRow(msgspec.Struct, frozen=True):
 class PremiseRow(msgspec.Struct, frozen=True):
     """A premise the check used (:class:`rclverify.records.stage_records.Premise`): its label, its kind
     (``guarantee``, ``assumption``, ``fact``, ``initial value``, ``progress`` ...), its node (``None`` for
-    the requirement's own ``assuming``), 1-based index, its text (RCL) and ``file:line:col``."""
+    the requirement's own ``assuming``), 1-based index, its text (RCL) and ``file:line:col``; a key the
+    premise lacks is at its default (a core's premise is printed by its label, text and place only)."""
 
     label: str
-    kind: str
+    kind: str = ""
     node: str | None = None
     index: int = 0
     text: str = ""
