@@ -33,22 +33,19 @@ The translation keeps the meaning the Z3 encoding gives a formula
   value or constructor whose name is shadowed is qualified (``RadStat.red``).
 
 Quantifying over functions is rejected with a located
-:class:`~rclverify.model.plan.errors.PlanError`.
+:class:`~rclverify.model.plan.errors.PlanError`.  The quantifiers are
+translated by :mod:`rclverify.targets.dafny.quantifiers`, mixed into
+:class:`Translator`.
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Any, Mapping, cast
+from typing import Mapping
 
-from rclverify.model.plan.errors import PlanError
 from rclverify.lang import ast
-from rclverify.lang import typeexpr
 from rclverify.semantics.operators import OPERATORS, UNARY
 from rclverify.semantics.widths import at_widths
-from rclverify.lang.errors import error
-from rclverify.lang.printer import is_type
-from rclverify.lang.typecheck import domain_type
 from rclverify.lang.types import (
     BOOL,
     INTEGER,
@@ -68,25 +65,18 @@ from rclverify.lang.types import (
     numeric_join,
     qualified_base,
 )
+from rclverify.targets.dafny.quantifiers import Bound, QuantifierTranslation
 from rclverify.targets.dafny.text import dafny_string, real_literal, strip_parens, value_join, wrap
-from rclverify.targets.dafny.types import dafny_ident, dafny_type
+from rclverify.targets.dafny.types import dafny_ident
 
 _BASE_NAMES = {"REAL": REAL, "INTEGER": INTEGER, "NATURAL": NATURAL, "BOOL": BOOL}
 _INT_LIT = re.compile(r"\A(\(?)(-?\d+)(\)?)\Z")
-#: Largest number of instances a quantifier over literal collections is expanded into.
-_EXPANSION_LIMIT = 64
 #: Most items a literal range `<a upto b>` is spelled out to.
 _RANGE_LIMIT = 1000
 
 
 @dataclass
-class _Bound:
-    dafny: str
-    type: Type
-
-
-@dataclass
-class Translator:
+class Translator(QuantifierTranslation):
     """Translates the formulas of one node into Dafny expressions.
 
     ``env``     the checked environment (contexts);
@@ -127,11 +117,7 @@ class Translator:
         return self.tr(e, {})
 
     # -- internals ------------------------------------------------------------------------
-    @staticmethod
-    def _err(loc: ast.Loc, msg: str) -> PlanError:
-        return PlanError([error(loc, msg, "E-dafny")])
-
-    def _names_in_scope(self, scope: Mapping[str, _Bound]) -> set[str]:
+    def _names_in_scope(self, scope: Mapping[str, Bound]) -> set[str]:
         return set(self.io.values()) | set(self.consts.values()) | set(self.taken) | {b.dafny for b in scope.values()}
 
     def _value_names(self) -> set[str]:
@@ -146,7 +132,7 @@ class Translator:
             return self.io.get(f"out.{v.name}")
         return None
 
-    def _value(self, name: str, owner: EnumT | DataT, scope: Mapping[str, _Bound]) -> str:
+    def _value(self, name: str, owner: EnumT | DataT, scope: Mapping[str, Bound]) -> str:
         d = dafny_ident(name)
         shadowed = d in set(self.io.values()) | set(self.consts.values()) | {b.dafny for b in scope.values()}
         return f"{dafny_ident(owner.name)}.{d}" if shadowed else d
@@ -177,7 +163,7 @@ class Translator:
         return [self.conv(s, it, t) for s, it in items], t
 
     # -- the translation --------------------------------------------------------------
-    def tr(self, e: ast.Expr, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+    def tr(self, e: ast.Expr, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         """``(text, type)`` of ``e`` with bound variables ``scope``; records the
         type in :attr:`used_types` (the stub declares the datatypes used)."""
         text, t = self._tr(e, scope)
@@ -185,7 +171,7 @@ class Translator:
             self.used_types.append(t)
         return text, t
 
-    def _tr(self, e: ast.Expr, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+    def _tr(self, e: ast.Expr, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         if isinstance(e, ast.BoolLit):
             return ("true" if e.value else "false"), BOOL
         if isinstance(e, ast.NumLit):
@@ -237,7 +223,7 @@ class Translator:
                                    "the run's history of an input")
         raise self._err(getattr(e, "loc", ast.NOLOC), f"unsupported expression {type(e).__name__}")  # pragma: no cover
 
-    def seq_range(self, e: ast.SeqRange, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+    def seq_range(self, e: ast.SeqRange, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         """``<a upto b>`` with literal bounds, as the sequence it stands for
         (at most :data:`_RANGE_LIMIT` items; Dafny 2 has no sequence
         constructor).  With other bounds it is expressible only on the right
@@ -250,50 +236,7 @@ class Translator:
         raise self._err(e.loc, f"a range is expressible in the Dafny contract stub only on the right of 'in' or "
                                f"with literal bounds at most {_RANGE_LIMIT} apart")
 
-    def tuple_quant(self, e: ast.TupleQuant, scope: Mapping[str, _Bound]) -> str:
-        """``Q((u, v) in S | body)``: one Dafny variable ``u_v`` of the tuple
-        type, ``u`` and ``v`` read as ``u_v.0`` and ``u_v.1``, guarded by
-        ``u_v in S`` unless ``S`` is a tuple type."""
-        rcl_bound = {k: b.type for k, b in scope.items()}
-        t = domain_type(ast.Binding(("_tuple",), e.domain, e.loc), self.node, self.env, rcl_bound)
-        if isinstance(t, EmptyT):
-            return "true" if e.kind == "forall" else "false"
-        if not isinstance(t, TupleT) or len(t.elems) != len(e.names):
-            raise self._err(e.loc, f"{len(e.names)} names cannot take apart an element of type {t}")
-        dt = dafny_type(t, e.loc, f"the domain of ({', '.join(e.names)})")
-        if t not in self.used_types:
-            self.used_types.append(t)
-        coll = self._domain_collection(e.domain)
-        taken = self._names_in_scope(scope) | self._value_names()
-
-        def parts(var: str) -> tuple[str, str]:
-            inner = dict(scope)
-            inner.update({nm: _Bound(f"{var}.{k}", ct) for k, (nm, ct) in enumerate(zip(e.names, t.elems))})
-            guard = self.member((var, t), coll, scope) if coll is not None else ""
-            body = self.tr(e.body, inner)[0]
-            return guard, body
-
-        d = dafny_ident("_".join(e.names), taken)
-        guard, body = parts(d)
-        if e.kind == "forall":
-            return f"(forall {d}: {dt} :: {guard} ==> {body})" if guard else f"(forall {d}: {dt} :: {body})"
-        core = f"{guard} && {body}" if guard else body
-        if e.kind == "exists":
-            return f"(exists {d}: {dt} :: {core})"
-        y = dafny_ident(f"{d}_u", taken | {d})
-        yguard, ybody = parts(y)
-        ycore = f"{yguard} && {ybody}" if yguard else ybody
-        return f"(exists {d}: {dt} :: {core} && (forall {y}: {dt} :: ({ycore}) ==> ({y} == {d})))"
-
-    def _domain_collection(self, domain: Any) -> ast.Expr | None:
-        """The collection a quantifier domain stands for, or ``None`` for a type."""
-        if not is_type(domain):
-            return cast(ast.Expr, domain)
-        if isinstance(domain, typeexpr.TName) and domain.name not in self.env.types:
-            return ast.Var(domain.name, None, domain.loc)
-        return None
-
-    def var(self, v: ast.Var, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+    def var(self, v: ast.Var, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         if v.prefix is None and v.name in scope:
             b = scope[v.name]
             return b.dafny, b.type
@@ -318,7 +261,7 @@ class Translator:
                 return self._value(v.name, data, scope), data
         raise self._err(v.loc, f"unknown name {v.qualified!r} in node {self.node.name}")
 
-    def apply(self, e: ast.Apply, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+    def apply(self, e: ast.Apply, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         f = e.func
         is_var = f.prefix is not None or f.name in scope or self._io_name(f) is not None or f.name in self.env.constants
         args = [self.tr(a, scope) for a in e.args]
@@ -333,7 +276,7 @@ class Translator:
         texts = [self.conv(s, t, p) for (s, t), p in zip(args, ft.args)]
         return f"{fs}({', '.join(texts)})", ft.result
 
-    def binary(self, e: ast.Binary, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+    def binary(self, e: ast.Binary, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         (ls, lt), (rs, rt) = self.tr(e.left, scope), self.tr(e.right, scope)
         entry = OPERATORS[e.op]
         if entry.kind == "connective":
@@ -346,7 +289,7 @@ class Translator:
         t: Type = INTEGER if (e.op == "-" and j == NATURAL) else j
         return f"({self.conv(ls, lt, j)} {entry.dafny} {self.conv(rs, rt, j)})", t
 
-    def compare(self, e: ast.Compare, scope: Mapping[str, _Bound]) -> tuple[str, Type]:
+    def compare(self, e: ast.Compare, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         vals = [self.tr(o, scope) for o in e.operands]
         parts = []
         for op, (a, at), (b, bt) in zip(e.ops, vals, vals[1:]):
@@ -356,7 +299,7 @@ class Translator:
             parts.append(f"({a} {OPERATORS[op].dafny} {b})")
         return (parts[0] if len(parts) == 1 else "(" + " && ".join(parts) + ")"), BOOL
 
-    def _type_name(self, c: ast.Expr, scope: Mapping[str, _Bound]) -> Type | None:
+    def _type_name(self, c: ast.Expr, scope: Mapping[str, Bound]) -> Type | None:
         """The type a bare name used as a collection denotes (``RadStat``, ``NATURAL``), if any."""
         if not isinstance(c, ast.Var) or c.prefix is not None or c.name in scope or self._io_name(c) is not None:
             return None
@@ -366,7 +309,7 @@ class Translator:
             return product  # `REAL.REAL`: the pairs of reals
         return self.env.types.get(c.name)
 
-    def member(self, elem: tuple[str, Type], coll: ast.Expr, scope: Mapping[str, _Bound]) -> str:
+    def member(self, elem: tuple[str, Type], coll: ast.Expr, scope: Mapping[str, Bound]) -> str:
         es, et = elem
         if isinstance(coll, ast.SeqRange):
             # `e in <lo upto hi>`: an integer between the bounds
@@ -408,93 +351,3 @@ class Translator:
             return "false"
         return "true"
 
-    def _expand_literal(self, e: ast.Quant, scope: Mapping[str, _Bound]) -> str | None:
-        """``forall``/``exists`` whose every binding ranges over a set or sequence
-        literal, as a finite conjunction/disjunction of instances (at most
-        :data:`_EXPANSION_LIMIT`).  Equivalent to the guarded quantifier, and
-        gives Dafny nothing to trigger on to get wrong.  ``None`` otherwise."""
-        if e.kind == "exists_unique" or not all(isinstance(b.domain, (ast.SetLit, ast.SeqLit)) for b in e.bindings):
-            return None
-        choices: list[list[tuple[str, str, Type]]] = []  # per bound name: (rcl name, text, type) options
-        for bd in e.bindings:
-            coll = bd.domain
-            assert isinstance(coll, (ast.SetLit, ast.SeqLit))
-            texts, t = self._join([self.tr(i, scope) for i in coll.items])
-            for nm in bd.names:
-                choices.append([(nm, wrap(x), t) for x in texts])
-        total = 1
-        for c in choices:
-            total *= len(c)
-        if total > _EXPANSION_LIMIT:
-            return None
-        if total == 0:
-            return "true" if e.kind == "forall" else "false"
-        instances: list[str] = []
-
-        def walk(k: int, sc: dict[str, _Bound]) -> None:
-            if k == len(choices):
-                instances.append(self.tr(e.body, sc)[0])
-                return
-            for nm, text, t in choices[k]:
-                walk(k + 1, {**sc, nm: _Bound(text, t)})
-
-        walk(0, dict(scope))
-        joiner = " && " if e.kind == "forall" else " || "
-        return "(" + joiner.join(instances) + ")"
-
-    def quant(self, e: ast.Quant, scope: Mapping[str, _Bound]) -> str:
-        expanded = self._expand_literal(e, scope)
-        if expanded is not None:
-            return expanded
-        inner = dict(scope)
-        decls: list[str] = []
-        guards: list[str] = []
-        news: list[tuple[str, str, Type, str]] = []  # (rcl name, dafny name, type, dafny type)
-        rcl_bound = {k: b.type for k, b in scope.items()}
-        for bd in e.bindings:
-            t = domain_type(bd, self.node, self.env, rcl_bound)
-            if isinstance(t, EmptyT):
-                return "true" if e.kind == "forall" else "false"
-            if isinstance(t, FuncT):
-                raise self._err(bd.loc, f"quantifying over functions ({', '.join(bd.names)} in {t}) cannot be "
-                                        "expressed in the Dafny contract stub")
-            dt = dafny_type(t, bd.loc, f"the domain of {', '.join(bd.names)}")
-            if t not in self.used_types:
-                self.used_types.append(t)
-            coll = self._domain_collection(bd.domain)
-            for nm in bd.names:
-                taken = self._names_in_scope(inner) | self._value_names()
-                d = dafny_ident(nm, taken)
-                decls.append(f"{d}: {dt}")
-                news.append((nm, d, t, dt))
-                inner[nm] = _Bound(d, t)
-                if coll is not None:
-                    guards.append(self.member((d, t), coll, scope))
-                rcl_bound[nm] = t
-        body, bt = self.tr(e.body, inner)
-        guard = " && ".join(guards)
-        binders = ", ".join(decls)
-        if e.kind == "forall":
-            return f"(forall {binders} :: {guard} ==> {body})" if guard else f"(forall {binders} :: {body})"
-        core = f"{guard} && {body}" if guard else body
-        if e.kind == "exists":
-            return f"(exists {binders} :: {core})"
-        # exists_unique: the tuple of bound values is unique
-        again = dict(scope)
-        ydecls, yguards, eqs = [], [], []
-        taken = self._names_in_scope(inner) | self._value_names()
-        for nm, d, t, dt in news:
-            y = dafny_ident(f"{d}_u", taken)
-            taken.add(y)
-            again[nm] = _Bound(y, t)
-            ydecls.append(f"{y}: {dt}")
-            eqs.append(f"({y} == {d})")
-        for bd in e.bindings:
-            coll = self._domain_collection(bd.domain)
-            if coll is not None:
-                for nm in bd.names:
-                    yguards.append(self.member((again[nm].dafny, again[nm].type), coll, scope))
-        ybody, _ = self.tr(e.body, again)
-        ycore = " && ".join(yguards + [ybody])
-        unique = f"(forall {', '.join(ydecls)} :: ({ycore}) ==> ({' && '.join(eqs)}))"
-        return f"(exists {binders} :: {core} && {unique})"
