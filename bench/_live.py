@@ -83,6 +83,20 @@ def children_cpu_seconds(pid: int) -> float:
     return total
 
 
+def children_thread_cpu_seconds(pid: int) -> dict[str, float]:
+    """:func:`thread_cpu_seconds` of each live child process of ``pid`` (the rclpy agent's threads), merged."""
+    out: dict[str, float] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if len(fields) > 12 and fields[1] == str(pid):
+            for k, v in thread_cpu_seconds(int(stat.parent.name)).items():
+                out[k] = out.get(k, 0.0) + v
+    return out
+
+
 def p99(xs: list[float]) -> float:
     """The 99th percentile of ``xs`` (nearest rank)."""
     ys = sorted(xs)

@@ -178,7 +178,8 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
              listener: str, lateness: float, tag: str, start: Any, procs: list[subprocess.Popen[bytes]],
              nice: int = 0) -> dict[str, Any]:
     """One run's processes started by ``start`` (listener, monitor, publisher), waited for and stopped."""
-    from _live import children_cpu_seconds, cpu_seconds, stop, thread_cpu_seconds, wait_text
+    from _live import children_cpu_seconds, children_thread_cpu_seconds, cpu_seconds, stop, thread_cpu_seconds, \
+        wait_text
     lis = None
     if latency and listener == "rclpy":
         (tmp / "listener.py").write_text(RCLPY_LISTENER)
@@ -196,6 +197,7 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
     wait_text(tmp / f"monitor{tag}.out", "monitoring", 30)
     time.sleep(0.5)  # the monitor's start-up ends (its agent's taps matched): its CPU from here on is the run's
     cpu0, agent_cpu0, threads0 = cpu_seconds(mon.pid), children_cpu_seconds(mon.pid), thread_cpu_seconds(mon.pid)
+    agent_threads0 = children_thread_cpu_seconds(mon.pid)
     (tmp / "publisher.py").write_text(PUBLISHER)
     pub = start([str(ros2), str(tmp / "publisher.py"), str(rate), str(seconds), str(tmp / f"sent{tag}.json"),
                  str(ROOT / "bench")], f"publisher{tag}.out")
@@ -204,6 +206,7 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
     cpu, agent_cpu = cpu_seconds(mon.pid), children_cpu_seconds(mon.pid)
     run_cpu = None if cpu is None or cpu0 is None else cpu - cpu0
     threads = {k: v - threads0.get(k, 0.0) for k, v in thread_cpu_seconds(mon.pid).items()}
+    agent_threads = {k: v - agent_threads0.get(k, 0.0) for k, v in children_thread_cpu_seconds(mon.pid).items()}
     t_stop = time.monotonic()
     stop(mon, signal.SIGINT, grace=STOP_GRACE_S)  # it judges what it heard and not yet judged, then exits
     ended = time.monotonic() - t_stop
@@ -214,6 +217,7 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
         raise SystemExit(f"the rclpy publisher failed:\n{(tmp / f'publisher{tag}.out').read_text()[-2000:]}")
     res: dict[str, Any] = {"sent": json.loads((tmp / f"sent{tag}.json").read_text()), "cpu": cpu, "agent_cpu": agent_cpu, "ended": ended,
                            "run_cpu": run_cpu, "agent_run_cpu": agent_cpu - agent_cpu0, "threads": threads,
+                           "agent_threads": agent_threads,
                            "load": load,
                            "record": json.loads((tmp / f"evidence{tag}.json").read_text()),
                            "log_topics": [json.loads(x)["topic"] for x in
@@ -287,10 +291,12 @@ def _traffic(res: dict[str, Any]) -> str:
     n = max(1, len(res["sent"]["sent"]))
     if res.get("run_cpu") is None:
         return "traffic alone unknown"
-    busy = sorted(((v, k) for k, v in (res.get("threads") or {}).items() if v / n * 1e6 >= 5), reverse=True)
-    return (f"traffic alone {res['run_cpu'] / n * 1e6:.0f} us"
-            + (" [" + ", ".join(f"{k} {v / n * 1e6:.0f}" for v, k in busy) + "]" if busy else "")
-            + (f", agent {res['agent_run_cpu'] / n * 1e6:.0f} us" if res.get("agent_run_cpu") else ""))
+    def split(threads: dict[str, float]) -> str:
+        busy = sorted(((v, k) for k, v in threads.items() if v / n * 1e6 >= 5), reverse=True)
+        return " [" + ", ".join(f"{k} {v / n * 1e6:.0f}" for v, k in busy) + "]" if busy else ""
+    return (f"traffic alone {res['run_cpu'] / n * 1e6:.0f} us" + split(res.get("threads") or {})
+            + (f", agent {res['agent_run_cpu'] / n * 1e6:.0f} us" + split(res.get("agent_threads") or {})
+               if res.get("agent_run_cpu") else ""))
 
 
 def _cpu(res: dict[str, Any], source: str) -> str:

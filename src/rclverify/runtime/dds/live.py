@@ -22,7 +22,8 @@ messages in and verdicts out over DDS (:mod:`rclverify.ros.live.dds`):
 Threads: Cyclone's own (C, no GIL), the bus thread (takes raw samples,
 queues them), the engine thread (decodes, checks, logs, publishes, runs
 the timer; with a lateness bound it lets messages gather for
-:data:`~rclverify.runtime.worker.LINGER_S` rather than waking for each),
+:data:`~rclverify.runtime.worker.LINGER_S` rather than waking for each, and
+the source lets samples gather for :func:`source_linger`),
 and the caller's (status lines, the stop).  While the run lasts the
 interpreter's switch interval is :data:`SWITCH_INTERVAL_S` (Python's
 default is 5 ms): the engine thread, woken for a release, waits at most
@@ -62,9 +63,16 @@ from rclverify.runtime.dds.trust import VERDICT_KEY
 from rclverify.runtime.dds.live_end import DdsRunEnd
 
 
-#: how long the DDS bus thread lets samples gather after a round that took some (s), with a lateness bound
-#: (:class:`~rclverify.runtime.dds.bus.Bus`; the rclpy source's agent waits its own ``LINGER_S``)
-BUS_LINGER_S = 0.002
+#: the most a source (the DDS bus thread, the rclpy agent) lets samples gather after a round that took some
+#: (s; :func:`source_linger`)
+SOURCE_LINGER_S = 0.004
+
+
+def source_linger(reorder_window: float) -> float:
+    """How long the source lets samples gather (s) under the lateness bound ``reorder_window`` (s): a
+    tenth of the bound, at most :data:`SOURCE_LINGER_S`; none without a bound.  A sample held there is
+    not yet in the engine's queue, so the wait is kept well inside the bound that makes a message late."""
+    return min(SOURCE_LINGER_S, reorder_window / 10) if reorder_window > 0 else 0.0
 #: the interpreter's switch interval during a run (s; module docstring)
 SWITCH_INTERVAL_S = 0.001
 #: the encapsulation header of plain little-endian CDR (XCDR1), as rmw writes ROS 2 messages
@@ -137,6 +145,7 @@ def run_dds(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[C
                           run.decode, _time.time,
                           tick_s=tick_s, linger_s=LINGER_S if reorder_window > 0 else 0.0)
     run.worker_box.append(worker.start())
+    run.bus.linger_s = source_linger(reorder_window)
     run.bus.start()
     via = f"through rclpy on {run.source_rmw()}" if dp is None else f"on DDS domain {domain_id()}"
     out(f"monitoring {len(run.structs)} topic(s) and {len(run.calls.specs) if run.calls else 0} service/action "
@@ -278,8 +287,7 @@ class _DdsRun(DdsRunEnd):
             self.bus = bus = bus_factory(on_sample, self.warn, on_reader=self.on_reader,
                                          type_hash=self.types.type_hash)
         else:
-            self.bus = bus = Bus(dp, on_sample, self.warn, on_reader=self.on_reader, type_hash=self.types.type_hash,
-                                 linger_s=0.0 if self.by_receipt else BUS_LINGER_S)
+            self.bus = bus = Bus(dp, on_sample, self.warn, on_reader=self.on_reader, type_hash=self.types.type_hash)
         user = type_hash_user_data("std_msgs/msg/String")
         self.pub = bus.writer(topic_name(verdict_topic), string, writer_profile(depth=1000), user)
         latched = writer_profile(transient_local=True, depth=1)
@@ -376,4 +384,4 @@ def _full(typ: str) -> str:
     return f"{pkg}/msg/{name}"
 
 
-__all__ = ["run_dds"]
+__all__ = ["SOURCE_LINGER_S", "run_dds", "source_linger"]

@@ -22,7 +22,8 @@ rclverify, so any ROS 2 Python can run it: a sourced apt installation's
   write: under load the agent takes messages in batches rather than one
   executor turn each, and its history covers seconds at 5000 messages/s.
   After a round that took messages the agent lets the next ones gather
-  for :data:`LINGER_S` before it waits again: at 1000 messages/s an
+  for the ``linger`` the monitor's ``start`` names (:data:`LINGER_S`
+  when it names none) before it waits again: at 1000 messages/s an
   executor turn a message (its wait set built anew, about 200 us) was most
   of its CPU.  A message is then handed over at most that much later; its
   time is its source timestamp, which the wait does not change.
@@ -110,8 +111,8 @@ else:  # run as a script: its folder is on sys.path (module docstring)
     from agent_graph import Endpoint, GraphReading, endpoint, graph_dump, matches
 
 GRAPH_PERIOD_S = 0.1
-#: seconds the agent lets messages gather after a round that took some (module docstring); a fraction of
-#: the monitor's lateness bound (the CLI's 50 ms)
+#: seconds the agent lets messages gather after a round that took some, when the monitor's ``start`` names
+#: no ``linger`` (module docstring)
 LINGER_S = 0.002
 #: the interpreter's switch interval in the agent (s; Python's default 5 ms): the thread reading the
 #: monitor's commands (a verdict to publish per message) holds the main thread off the samples at most
@@ -155,6 +156,7 @@ class _Command(TypedDict, total=False):
     hash: str
     node: str
     ns: str
+    linger: float
 
 
 class _Tap(TypedDict):
@@ -362,6 +364,7 @@ def main() -> int:
     agent.hello()
     flush()
     started = False
+    linger = LINGER_S
     next_graph = 0.0
     try:
         while True:
@@ -377,6 +380,7 @@ def main() -> int:
                         return 0
                     if c.get("op") == "start":
                         started = True
+                        linger = float(c.get("linger", LINGER_S))
                     agent.command(c)
             except queue.Empty:
                 pass
@@ -395,7 +399,7 @@ def main() -> int:
                 flush()
             flush()
             if _TAKEN[0] > before:  # messages come: let the next ones gather (module docstring)
-                time.sleep(LINGER_S)
+                time.sleep(linger)
     finally:
         agent.close()
 

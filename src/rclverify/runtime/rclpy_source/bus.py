@@ -159,6 +159,9 @@ class RclpyBus(DeclaredTypes):
         self._proc: subprocess.Popen[bytes] | None = None
         self._thread = threading.Thread(target=self._run, name="rclverify-rclpy", daemon=True)
         self._hello = threading.Event()
+        #: seconds the agent lets samples gather after a round that took some (``None``: its own default),
+        #: set before :meth:`start` (:func:`~rclverify.runtime.dds.live.source_linger`)
+        self.linger_s: float | None = None
         #: the agent said ``stopped``: every sample it took was handed over (:meth:`stop`)
         self.stopped = False
         self._lock = threading.Lock()
@@ -208,7 +211,7 @@ class RclpyBus(DeclaredTypes):
         return bytes(info.writer_guid) or None
 
     def start(self) -> RclpyBus:
-        self._send({"op": "start"})
+        self._send({"op": "start", **({"linger": self.linger_s} if self.linger_s is not None else {})})
         self._thread.start()
         return self
 

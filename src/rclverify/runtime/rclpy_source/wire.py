@@ -21,7 +21,8 @@ a top-level module (its folder is the script's); the monitor imports it as
   ``.json`` form) and ``failures`` (why other sources gave none, as text).
 * **monitor -> agent**: JSON lines (``op``: ``tap``, ``watch``,
   ``writer``, ``write``, ``describe`` (``type``, ``hash``, and the
-  publisher's ``node`` and ``ns``), ``start``, ``stop``).
+  publisher's ``node`` and ``ns``), ``start`` (``linger``: the seconds the
+  agent lets samples gather after a round that took some), ``stop``).
 """
 from __future__ import annotations
 
