@@ -53,7 +53,7 @@ tolerance has no margin here (the tolerance is a relation, not a distance).
 whose distance min and max select, :attr:`Margin.atom`); its unit is that
 comparison's (docs/rcl-language.md, "Units of measure": both sides have one
 unit; the type checker's :class:`rclverify.lang.unitcheck.UnitChecker`
-gives it), ``""`` when neither side declares one.  Distances of different
+gives it; :mod:`rclverify.semantics.margin_atoms` names the atom), ``""`` when neither side declares one.  Distances of different
 units meet in min and max as numbers, as in the standard semantics; the
 atom and its unit say which one a margin is.
 """
@@ -66,11 +66,10 @@ from fractions import Fraction
 from typing import Any, Callable, Mapping
 
 from rclverify.lang import ast
-from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.lang.unitcheck import UnitChecker
-from rclverify.lang.units import best_name, canonical_text
 from rclverify.semantics.eval_closures import _compile
+from rclverify.semantics.margin_atoms import atom_words, measured_terms
+from rclverify.semantics.margin_atoms import measures_the_run as measures_the_run
 from rclverify.semantics.evaluator import Evaluator
 from rclverify.semantics.floatsem import MAX_ENUMERATION, _Double, _finite_domain
 from rclverify.semantics.operators import OPERATORS, Undecided
@@ -150,8 +149,8 @@ class _Margins:
         return hit[2]
 
     def measured(self, terms: Any, b: Mapping[str, Value], idx: frozenset[str]) -> bool:
-        """Whether ``terms`` read a value of the run (:func:`_measured`)."""
-        return _measured(terms, b, idx, self.ev.io_names)
+        """Whether ``terms`` read a value of the run (:func:`rclverify.semantics.margin_atoms.measured_terms`)."""
+        return measured_terms(terms, b, idx, self.ev.io_names)
 
     def compare(self, e: ast.Compare, b: Mapping[str, Value], idx: frozenset[str]) -> _R:
         """A comparison chain: the ``and`` of its links."""
@@ -261,17 +260,6 @@ class _Margins:
         return best
 
 
-def _measured(terms: Any, b: Any, idx: frozenset[str], io: frozenset[str]) -> bool:
-    """Whether ``terms`` read a value of the run: an input or output (``io``:
-    the node's I/O names), or a variable bound (``b``: the bound names) to an
-    element of a collection (not one ranging over a type, ``idx``)."""
-    for t in terms:
-        for v in _vars(t):
-            if v.prefix is not None or (v.name in b and v.name not in idx) or (v.name not in b and v.name in io):
-                return True
-    return False
-
-
 @dataclass(frozen=True)
 class _Static:
     """What a closure is built for: the node's I/O names ``io``, the contract's
@@ -311,7 +299,7 @@ def _build(e: ast.Expr, scope: frozenset[str], idx: frozenset[str], st: _Static)
         op, (o1, o2) = e.ops[0], e.operands
         atom = (e, 0, scope)
         f1, f2 = _compile(o1, st.env, st.node, st.mode), _compile(o2, st.env, st.node, st.mode)
-        if not _measured(e.operands, scope, idx, io):
+        if not measured_terms(e.operands, scope, idx, io):
             return lambda m, b: (INF if m.ev.compare(cmp_, b, op, f1(m.ev, b), f2(m.ev, b)) else -INF, None)
 
         def compare(m: _Margins, b: Mapping[str, Value]) -> _R:
@@ -346,34 +334,6 @@ def _iff(left: _R, right: _R) -> _R:
 _CLOSURES: dict[tuple[Any, ...], tuple[Any, Any, Callable[..., _R]]] = {}
 
 
-def _vars(e: Any) -> list[ast.Var]:
-    """The variables of term ``e``, an applied function's name among them
-    (``in.x(k)`` reads the run's ``in.x``; a constructor's name is no I/O value)."""
-    hit = _VARS.get(id(e))
-    if hit is not None and hit[0] is e:
-        return hit[1]
-    out: list[ast.Var] = []
-    stack = [e]
-    while stack:
-        x = stack.pop()
-        if isinstance(x, ast.Var):
-            out.append(x)
-        elif isinstance(x, ast.Apply):
-            stack.append(x.func)
-            stack.extend(x.args)
-        elif isinstance(x, tuple):
-            stack.extend(x)
-        elif hasattr(x, "__dataclass_fields__") and not isinstance(x, ast.Loc):
-            stack.extend(getattr(x, f) for f in x.__dataclass_fields__ if f not in ("loc", "name_locs"))
-    if len(_VARS) >= 10_000:
-        _VARS.clear()
-    _VARS[id(e)] = (e, out)
-    return out
-
-
-_VARS: dict[int, tuple[Any, list[ast.Var]]] = {}
-
-
 def _min(x: _R, y: _R) -> _R:
     return y if y[0] < x[0] else x
 
@@ -394,22 +354,6 @@ def _to_float(v: Any) -> float:
         return math.nextafter(0.0, 1.0 if v > 0 else -1.0)
     return f
 
-
-def _unit(checked: Checked, node: CheckedNode, e: Any, i: int, bound: frozenset[str]) -> str:
-    """The unit text of the compared terms of atom ``e`` (operands ``i`` and ``i + 1``
-    of a comparison; the element and items of a membership), ``""`` when none is known."""
-    units = UnitChecker(lambda *_: None)
-    units.constants = dict(checked.env.units)
-    if isinstance(e, ast.Compare):
-        terms = [e.operands[i], e.operands[i + 1]]
-    else:
-        terms = [e.elem, e.collection]
-    for t in terms:
-        q = units.term(t, node, bound)
-        if q.kind == "unit" and q.unit is not None:
-            u = q.unit
-            return u.text or best_name(u) or canonical_text(u)
-    return ""
 
 
 def margin(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object],
@@ -436,33 +380,6 @@ def margin(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappi
     atom, i, bound = at
     text, unit = atom_words(checked, node, atom, i, bound)
     return Margin(_to_float(value), unit, text, arithmetic)
-
-
-def atom_words(checked: Checked, node: CheckedNode, atom: ast.Compare | ast.Member, i: int,
-               bound: frozenset[str] = frozenset()) -> tuple[str, str]:
-    """``(text, unit)`` of a deciding atom: link ``i`` of comparison ``atom``
-    (its RCL text, ``a <= b``) or membership ``atom``, under the bound names
-    ``bound``, and the unit of its terms (``""``: none declared); computed once per atom."""
-    key = (id(atom), i, bound, id(node), id(checked))
-    hit = _ATOMS.get(key)
-    if hit is None or hit[0] is not atom:
-        text = expr_to_rcl(atom) if not isinstance(atom, ast.Compare) or len(atom.ops) == 1 else \
-            expr_to_rcl(ast.Compare((atom.ops[i],), (atom.operands[i], atom.operands[i + 1])))
-        if len(_ATOMS) >= 4096:
-            _ATOMS.clear()
-        hit = _ATOMS[key] = (atom, text, _unit(checked, node, atom, i, bound))
-    return hit[1], hit[2]
-
-
-#: (atom id, link, bound names, node id, contract id) -> (the atom, its text, its unit): computed once per atom
-_ATOMS: dict[tuple[Any, ...], tuple[Any, str, str]] = {}
-
-
-def measures_the_run(terms: Any, io: frozenset[str]) -> bool:
-    """Whether the terms of a comparison outside every quantifier read a value
-    of the run (an input or output; ``io``: the node's I/O names): else the
-    comparison has no distance (``+inf`` or ``-inf``; module docstring)."""
-    return _measured(terms, frozenset(), frozenset(), io)
 
 
 __all__ = ["ARITHMETICS", "INF", "Margin", "MarginUndefined", "atom_words", "margin", "measures_the_run"]
