@@ -187,6 +187,8 @@ def engine(ws: Path, log: Path, f: Formula, n: int) -> tuple[list[float | None],
         late: list[float] = []  # the time margins of answers past their trigger's deadline (an update, or a false)
 
         def timed(v: Any) -> None:
+            if v.verdict == "undecided":  # no verdict either way (the transport skew): not compared
+                return
             if v.update:
                 late.append(v.time_margin)
             else:
