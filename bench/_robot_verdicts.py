@@ -10,7 +10,9 @@ by where it sits in the run (a log's line, a bag's index differ).
 
 Per path, the **final** verdict of each message is its last record (a live
 revision, a question heard late, replaces the verdict given before; a
-deadline's ``update`` line, a late answer, replaces its first verdict).  A
+deadline's ``update`` line, a late answer, replaces its first verdict); a
+last record ``withdrawn`` (a live ``superseded`` whose answer came late)
+leaves the message no verdict.  A
 live verdict still ``provisional`` at the end is not final: it is compared,
 and a difference is reported apart (``provisional``), never as a final
 disagreement.  Two paths **disagree** on a message when their final verdicts
@@ -32,6 +34,8 @@ TOL_S = 1e-5
 #: seconds are one message the two paths placed apart (a generated topic's messages are 150 ms or more apart)
 APART_S = 0.005
 UNDECIDED = ("inconclusive", "incomplete input", "open")
+#: a live revision that withdraws the verdict given before, leaving the message none (backends/monitors/late.py)
+WITHDRAWN = "withdrawn"
 Bucket = tuple[str, str, str, int]  # node, item, topic, guarantee (a deadline's)
 
 
@@ -46,14 +50,16 @@ def read_records(path: Path) -> list[dict[str, Any]]:
 
 def finals(records: Iterable[dict[str, Any]]) -> dict[Bucket, list[dict[str, Any]]]:
     """Per (node, item, topic, guarantee), each message's final record, by time: the last record of
-    each message (equal time: one path gives one message one event time) stands."""
+    each message (equal time: one path gives one message one event time) stands; none where it is
+    ``withdrawn``."""
     last: dict[tuple[Bucket, float], dict[str, Any]] = {}
     for r in records:
         b: Bucket = (r["node"], r["item"], r["topic"], int(r.get("guarantee", 0)) if r["item"] == "deadline" else 0)
         last[(b, float(r["time"]))] = r
     out: dict[Bucket, list[dict[str, Any]]] = {}
     for (b, _), r in last.items():
-        out.setdefault(b, []).append(r)
+        if r["verdict"] != WITHDRAWN:
+            out.setdefault(b, []).append(r)
     for rs in out.values():
         rs.sort(key=lambda r: float(r["time"]))
     return out

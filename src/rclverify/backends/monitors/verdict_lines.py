@@ -19,7 +19,8 @@ that a live run, its log and its bag can be compared verdict by verdict
   run gave before every writer had been heard past it (not final).
 
 A message judged twice (a live revision: a question heard late) has two
-records; the later one stands.  Where a verdict sits in the run (a log's
+records; the later one stands (``withdrawn``: a live ``superseded`` whose
+question an answer heard late answered, the message left no verdict).  Where a verdict sits in the run (a log's
 line, a bag's message index) differs between the paths and is left out.
 """
 from __future__ import annotations
