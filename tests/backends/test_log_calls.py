@@ -18,6 +18,8 @@ import pytest
 from rclverify.backends.base import NodeTarget
 from rclverify.backends.monitors.backend import MonitorsBackend
 from rclverify.backends.monitors.dds_calls import CallBook
+from rclverify.backends.monitors.payload import monitors_payload
+from rclverify.diagnosis.monitor_repair import is_call_violation
 from rclverify.runtime.live import dumps
 from rclverify.cli.commands import main
 from rclverify.lang.typecheck import load
@@ -158,6 +160,8 @@ def test_doit_verifys_monitors_evidence_judges_a_live_logs_calls(wrong: bool, tm
         assert [(i["name"], i["reason"]) for i in ev.details["not_judged"]] == \
             ([] if node == "Mover" else [("/estop", "not paired")]), (node, ev.details["not_judged"])
         assert ev.details["calls"]["counts"] == {r["node"]: r["counts"] for r in live["nodes"]}[node]
+        payload = monitors_payload(ev.backend, ev.details)  # the repair search re-runs the calls it failed by
+        assert payload is not None and is_call_violation(payload) == (ev.status == "failed"), (node, ev.status)
     if wrong:  # Base: a wrong answer and a late one; Mover: a negative feedback; Teleop: the undecided answer
         assert status == {"Base": "failed", "Teleop": "inconclusive", "Mover": "failed"}, status
     else:  # Base's unpaired call is inconclusive, never guessed; Mover's rejected goal was left open, as live

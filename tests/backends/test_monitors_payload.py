@@ -18,6 +18,7 @@ from rclverify.backends.monitors.backend import MonitorsBackend, run_payload
 from rclverify.backends.monitors.payload import MonitorsPayload, SpaceMargin, monitors_payload
 from rclverify.backends.payloads import payload_of
 from rclverify.core.atomic import dumps
+from rclverify.diagnosis.monitor_repair import is_call_violation
 from rclverify.lang.typecheck import load
 from rclverify.report.margin_rows import figures
 
@@ -53,6 +54,8 @@ def test_a_monitored_run_writes_its_payload_and_it_decodes_back(tmp_path: Path) 
     assert isinstance(fv, MonitorsPayload) and fv.monitoring is not None and fv.monitoring.first_violation
     assert fv.monitoring.counts["violated"] > 0 and fv.statistics is not None and fv.statistics.violations == \
         fv.monitoring.counts["violated"]
+    assert not is_call_violation(fv)  # a topic's violation: the repair search re-runs the topics (the control of
+    # tests/backends/test_log_calls.py, where a served call's violation is told)
 
 
 def test_only_the_keys_written_are_in_the_json_and_an_old_record_still_decodes() -> None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 from fractions import Fraction
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -127,15 +128,17 @@ def test_the_report_asks_the_rerun_only_of_an_entry_naming_its_implementation_an
     """diagnosis/monitor_repair.py before any ROS 2 is started: no implementation named, nothing asked and
     nothing said (the control); named without a ROS 2 Python, or on a bag, one sentence why none is searched."""
     from rclverify.app.pipeline import Workspace
+    from rclverify.backends.monitors.payload import MonitorsPayload
     from rclverify.diagnosis.monitor_repair import MonitorRepairs, entry_of, monitor_repairs
     ws = Workspace(CHARGE_WS)
     data = {"entry": 0, "trace": "runs/charge.jsonl", "mapping": "contracts/mapping.yaml"}
-    assert monitor_repairs(ws, "ChargeMonitor", data, {}, Path("python3")) == MonitorRepairs()
+    assert monitor_repairs(ws, "ChargeMonitor", data, MonitorsPayload(), Path("python3")) == MonitorRepairs()
     named = {**data, "implementation": "charge.py:build"}
-    got = monitor_repairs(ws, "ChargeMonitor", named, {}, None)
+    got = monitor_repairs(ws, "ChargeMonitor", named, MonitorsPayload(), None)
     assert got.repairs == [] and got.why.startswith("no repair is searched: re-running charge.py:build needs a "
                                                     "Python with rclpy")
-    bag = monitor_repairs(ws, "ChargeMonitor", {**named, "trace": "runs/charge.mcap"}, {}, Path("python3"))
+    bag = monitor_repairs(ws, "ChargeMonitor", {**named, "trace": "runs/charge.mcap"}, MonitorsPayload(),
+                          Path("python3"))
     assert "runs/charge.mcap is not a JSON-lines log" in bag.why
     entry = entry_of(ws, "ChargeMonitor", data)
     assert entry is not None and entry.config["implementation"] == "charge.py:build"
@@ -143,11 +146,21 @@ def test_the_report_asks_the_rerun_only_of_an_entry_naming_its_implementation_an
 
 
 def test_a_call_violation_is_told_from_a_topic_violation() -> None:
+    """The payload as the monitors backend writes it: the first violation in ``monitoring``, the calls'
+    own in the ``calls`` part beside it (a real run's: tests/backends/test_log_calls.py)."""
+    from rclverify.backends.monitors.payload import monitors_payload
     from rclverify.diagnosis.monitor_repair import is_call_violation
     fv = {"where": "run.jsonl:4", "guarantee": 1}
-    assert is_call_violation({"first_violation": fv, "calls": {"first_violation": dict(fv)}})
-    assert not is_call_violation({"first_violation": fv, "calls": {"counts": {}}})
-    assert not is_call_violation({"first_violation": fv})
+
+    def payload(details: dict[str, object]) -> Any:
+        p = monitors_payload("monitors", details)
+        assert p is not None
+        return p
+    assert is_call_violation(payload({"monitoring": {"first_violation": fv}, "calls": {"first_violation": dict(fv)}}))
+    assert not is_call_violation(payload({"monitoring": {"first_violation": fv}, "calls": {"counts": {}}}))
+    assert not is_call_violation(payload({"monitoring": {"first_violation": fv}}))
+    # calls inside the monitoring part (where the report's evidence row holds the run) is no payload's shape
+    assert monitors_payload("monitors", {"monitoring": {"first_violation": fv, "calls": {}}}) is None
 
 
 @pytest.mark.parametrize("value, said", [

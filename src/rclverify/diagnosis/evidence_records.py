@@ -6,7 +6,7 @@ proof's constant or token, a monitor's or property test's code line).
 from __future__ import annotations
 
 import re
-from typing import Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import msgspec
 
@@ -22,6 +22,9 @@ from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import DiagnosisRow
 from rclverify.records.stage_records import Culprit, Repair
+
+if TYPE_CHECKING:  # a type only: decoded where a failed monitored run is diagnosed (_monitors_payload)
+    from rclverify.backends.monitors.payload import MonitorsPayload
 
 _META_KEYS = {"conjunct", "facts", "guarantee", "reason", "replay", "source", "cause", "boundary"}
 
@@ -76,6 +79,27 @@ def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
     return {}
 
 
+def _monitors_payload(ws: Any, oid: str) -> MonitorsPayload | None:
+    """The monitors' evidence payload of obligation ``oid``, read from its record (the report's row holds
+    its ``monitoring`` part only; the repair search needs its ``calls`` too); ``None`` when the record is
+    missing, altered or not the monitors' payload."""
+    from rclverify.backends.monitors.payload import monitors_payload  # deferred: start-up (a failed monitored run)
+    from rclverify.records.store import EvidenceStore  # deferred: start-up (only for a failed monitored run)
+    ev, problem = EvidenceStore(ws.root).read(oid)
+    return monitors_payload(ev.backend, ev.details) if ev is not None and not problem else None
+
+
+def _run_repairs(ws: Any, e: EvidenceRow, node: str, cache: RepairCache) -> dict[str, Any]:
+    """The checked code repairs of the failed monitored run ``e`` of ``node`` (:func:`report_repairs`, its
+    record's payload and its obligation's ``data``); ``{}`` for a run that did not fail or whose record is
+    not the monitors' payload."""
+    payload = _monitors_payload(ws, e.obligation) if e.status == "failed" else None
+    if payload is None:
+        return {}
+    return report_repairs(ws, e.obligation, node, _obligation_record(ws, node, e.obligation).get("data") or {},
+                          payload, cache)
+
+
 def evidence_record(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow | None,
               cache: RepairCache) -> DiagnosisRow:
     """The diagnosis record (:mod:`rclverify.diagnosis.build`) of the failed
@@ -115,8 +139,7 @@ def evidence_record(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRo
                 sentence = sentence[:-1] + f"; the value it published is computed at {computed} (the property test)."
                 cul.insert(0, {"what": f"{computed}: the line where the failing output goes wrong (property test)",
                                "source": computed, "text": ""})
-        found = report_repairs(ws, e.obligation, node, _obligation_record(ws, node, e.obligation).get("data")
-                               or {}, mon, cache) if e.status == "failed" else {}
+        found = _run_repairs(ws, e, node, cache)
         if found.get("line") and found.get("repairs"):  # the line the first checked repair edits: the slip's
             sentence = sentence[:-1] + f"; the first repair checked on the run edits {found['line']}."
             cul.insert(0, {"what": f"{found['line']}: the line the first checked repair edits (the node re-run on "

@@ -16,9 +16,12 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.records.stage_records import Repair
+
+if TYPE_CHECKING:  # a type only: the monitors' payload is imported by whoever decoded it
+    from rclverify.backends.monitors.payload import MonitorsPayload
 
 
 @dataclass
@@ -44,18 +47,18 @@ def entry_of(ws: Any, node: str, data: Mapping[str, Any]) -> Any:
                 None)
 
 
-def is_call_violation(monitoring: Mapping[str, Any]) -> bool:
-    """Whether the run's first violation (``monitoring["first_violation"]``) is one of the node's served
-    calls (a service's response, an action's feedback or result) rather than of its topics."""
-    calls = monitoring.get("calls")
-    fv = monitoring.get("first_violation")
-    return isinstance(calls, Mapping) and fv is not None and calls.get("first_violation") == fv
+def is_call_violation(payload: MonitorsPayload) -> bool:
+    """Whether the run's first violation (the evidence payload's ``monitoring.first_violation``) is one of
+    the node's served calls (a service's response, an action's feedback or result: the payload's ``calls``
+    part names the same one) rather than of its topics."""
+    fv = payload.monitoring.first_violation if payload.monitoring is not None else None
+    return fv is not None and payload.calls is not None and payload.calls.get("first_violation") == fv
 
 
-def monitor_repairs(ws: Any, node: str, data: Mapping[str, Any], monitoring: Mapping[str, Any],
+def monitor_repairs(ws: Any, node: str, data: Mapping[str, Any], payload: MonitorsPayload,
                     python: Path | None) -> MonitorRepairs:
     """The checked repairs of ``node``'s violation on the run of the obligation whose record's ``data`` is
-    ``data`` (``trace``, ``mapping``, ``implementation``), its evidence's ``monitoring`` part, re-run in the
+    ``data`` (``trace``, ``mapping``, ``implementation``), its evidence's ``payload``, re-run in the
     ROS 2 Python ``python`` (``None``: there is none).  Nothing is asked, and ``why`` is ``""``, when the
     obligation names no implementation.  Never raises for the user's code or run (each cause is ``why``)."""
     impl = str(data.get("implementation") or "")
@@ -77,17 +80,17 @@ def monitor_repairs(ws: Any, node: str, data: Mapping[str, Any], monitoring: Map
         cfg = load_mapping(ws.root, data.get("mapping"), c.get("horizon"), c.get("traces", ()), c.get("tolerance"))
     except ConfigError as exc:
         return MonitorRepairs(why=f"no repair is searched: the mapping does not load: {exc}")
-    got = run_repairs(Path(ws.root), ws.checked, cfg, ws.path(trace), node, is_call_violation(monitoring),
+    got = run_repairs(Path(ws.root), ws.checked, cfg, ws.path(trace), node, is_call_violation(payload),
                       source, factory, [], python)
     if got.repairs:
         return MonitorRepairs(list(got.repairs), got.line)
     return MonitorRepairs(why=f"{impl} re-run on {trace}: {got.why}", line=got.line)
 
 
-def report_repairs(ws: Any, oid: str, node: str, data: Mapping[str, Any], monitoring: Mapping[str, Any],
+def report_repairs(ws: Any, oid: str, node: str, data: Mapping[str, Any], payload: MonitorsPayload,
                    cache: Any) -> dict[str, Any]:
     """:func:`monitor_repairs` as the report's diagnosis asks it, for the failed obligation ``oid`` of ``node``
-    (``data``: its record's ``data``), as JSON (``repairs``, ``line``, ``why``); ``{}`` when the obligation
+    (``data``: its record's ``data``; ``payload``: its evidence record's), as JSON (``repairs``, ``line``, ``why``); ``{}`` when the obligation
     names no implementation.  Kept in ``cache`` (the diagnosis cache: ``get(key, make, extra_file)``), keyed by
     the run's and the implementation's sha256 and the run's verdict counts, unless no ROS 2 Python was found
     (nothing is asked then, and the answer is the environment's)."""
@@ -98,11 +101,12 @@ def report_repairs(ws: Any, oid: str, node: str, data: Mapping[str, Any], monito
         return {}
     python = ros2_python()
     if python is None:
-        return asdict(monitor_repairs(ws, node, data, monitoring, None))
+        return asdict(monitor_repairs(ws, node, data, payload, None))
     trace = str(data.get("trace") or "")
     digest = file_digest(ws.path(trace)) if trace and ws.path(trace).is_file() else ""
-    key = ["run", oid, node, impl, trace, digest, monitoring.get("counts"), data.get("mapping")]
-    got = cache.get(key, lambda: asdict(monitor_repairs(ws, node, data, monitoring, python)), impl.rpartition(":")[0])
+    counts = dict(payload.monitoring.counts) if payload.monitoring is not None else None
+    key = ["run", oid, node, impl, trace, digest, counts, data.get("mapping")]
+    got = cache.get(key, lambda: asdict(monitor_repairs(ws, node, data, payload, python)), impl.rpartition(":")[0])
     return dict(got) if isinstance(got, dict) else {}
 
 
