@@ -20,7 +20,10 @@ next reading was released first, and the live engine gave the first reading ``su
 input at message 13 came before any output answered the question raised at message 5"); the late
 answer, then judged against that reading by its copied stamp, is ``satisfied`` live as offline.  The
 log and the bag, read in stamp order, give the first reading no verdict: live != log on two verdicts
-of 413, the only ones (docs/monitors.md, "Generated robots").  The run's bag is replayed here through
+of 413, the only ones (docs/monitors.md, "Generated robots", fault 8).  That ``superseded`` is now
+given provisional (the relay's writer not heard past the reading yet) and withdrawn when the late
+answer pairs with the reading (backends/monitors/late.py, ``_answers_superseded``): live = log on
+every verdict.  The run's bag is replayed here through
 the online engine in process for the sensor and its two relays (each message at its recorded time, the
 timer every 10 ms, as runtime/live.py), and compared verdict by verdict with the recorded path's
 verdicts of the log.  (A fuse is left out of the replay: the bag keeps a message's receipt, not the
@@ -174,22 +177,25 @@ def test_seed_518_the_log_and_the_bag_agree_verdict_by_verdict_and_no_answer_is_
     assert all(c["deadline false"] == 0 for c in counts.values()), counts
 
 
-def test_seed_518_live_differs_from_the_log_only_on_the_first_reading_its_copying_relays_answered_late(
+def test_seed_518_the_first_reading_superseded_early_is_withdrawn_when_its_late_answer_comes(
         online_518: list[dict[str, Any]]) -> None:
-    """What the strict xfail below is about, pinned: the only differences are the two ``superseded``
-    verdicts of Sensor0's first reading, one per relay copying its stamp; every other verdict agrees."""
-    found = compare(finals(online_518), finals(_offline(SEED_518, "runs/live.jsonl", RELAYS_518)))
-    assert [(d.node, d.topic, d.a and d.a["verdict"], d.b) for d in found] == [
-        ("Relay1", "s0", "superseded", None), ("Relay2", "s0", "superseded", None)], [d.text(("live", "log")) for d in found]
+    """What made live differ from the log: Sensor0's first reading ``superseded`` for each relay copying
+    its stamp, given before the relay's writer was heard (provisional), then withdrawn by the late answer
+    its stamp pairs with the reading; no other ``superseded`` of the replay is provisional, none else withdrawn."""
+    first = min(r["time"] for r in online_518 if r["topic"] == "s0")
+    on_it = [(r["node"], r["verdict"], r["provisional"]) for r in online_518
+             if r["topic"] == "s0" and r["time"] == first and r["node"] != "Sensor0"]
+    assert sorted(on_it) == [("Relay1", "superseded", True), ("Relay1", "withdrawn", False),
+                             ("Relay2", "superseded", True), ("Relay2", "withdrawn", False)], on_it
+    early = [r for r in online_518
+             if r["verdict"] == "withdrawn" or (r["verdict"] == "superseded" and r["provisional"])]
+    assert len(early) == 4 and all(r["time"] == first for r in early), early
     assert sum(len(x) for x in finals(online_518).values()) > 100
 
 
-@pytest.mark.xfail(strict=True, reason="rclverify fault (online engine, backends/monitors/engine.py and late.py): "
-                   "a stamp-copying relay's first answer, heard later than the lateness bound from a writer not "
-                   "heard before, arrives after the next reading was released: the reading it answers stays "
-                   "`superseded` live while the log, in stamp order, gives it no verdict (seed 518)")
 def test_seed_518_live_equals_the_log_verdict_by_verdict(online_518: list[dict[str, Any]]) -> None:
-    assert compare(finals(online_518), finals(_offline(SEED_518, "runs/live.jsonl", RELAYS_518))) == []
+    found = compare(finals(online_518), finals(_offline(SEED_518, "runs/live.jsonl", RELAYS_518)))
+    assert [d.text(("live", "log")) for d in found] == []
 
 
 def test_seed_543_a_relay_copying_a_stamp_of_another_clock_within_the_bounds_is_satisfied() -> None:

@@ -75,6 +75,11 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
 
     #: Evaluations remembered per (formula, inputs, outputs); 0 turns the cache off.
     cache_size = 4096
+    #: live (set by :mod:`.online`): whether every writer of the node's outputs has been heard past a time
+    #: (s, the run's clock); a ``superseded`` given before is provisional, and an output heard later whose
+    #: stamp pairs it with that question withdraws it (docs/semantics.md, "Provisional verdicts").
+    #: ``None`` offline: the run is read whole, every writer heard.
+    answers_heard_past: Callable[[float], bool] | None = None
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
                  horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
@@ -137,6 +142,10 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
         #: newer question within its horizon, which owes what it lacks, or was closed when its horizon passed)
         self._open: Question | None = None
         self._due = _NEVER
+        #: the questions (their event index, the last 1024) given ``superseded`` before every writer of the
+        #: node's outputs had been heard past them (:attr:`answers_heard_past`): an answer its stamp pairs with
+        #: one withdraws that verdict (late.py ``_answers_superseded``)
+        self._early_superseded: dict[int, None] = {}
 
     def _make_judges(self, checked: Checked, node: CheckedNode) -> None:
         """One compiled judge per formula, the evaluation cache, and whether a
@@ -154,7 +163,7 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
             and answer_decides(checked, node, self.guarantees))
 
     def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
-                 reason: str = "", semantics: str = "", question: str = "") -> None:
+                 reason: str = "", semantics: str = "", question: str = "", provisional: bool = False) -> None:
         self.result.counts[verdict] += 1
         self._given.append((ev.index, verdict, semantics))
         if verdict == "satisfied" and semantics in self.result.semantics:
@@ -165,7 +174,7 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
         if self.on_verdict is not None:
             self.on_verdict(Verdict(self.node.name, verdict, ev.index, ev.time, ev.where, ev.topic,
                                     max(self.now, ev.time), guarantee, dict(values or {}), reason, semantics,
-                                    question, self._message_margin(ev, verdict)))
+                                    question, self._message_margin(ev, verdict), provisional))
 
     # -- streaming ---------------------------------------------------------------
     def feed(self, ev: Event) -> None:
@@ -291,8 +300,15 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
             old.reported = True
             if (self.stream.skew or self._wins) and self._recent:
                 self._early_answer(old)
+            early = self.answers_heard_past is not None and not self.answers_heard_past(old.event.time)
+            if early:  # a writer of its answers not heard past it yet: withdrawn if its answer comes (late.py)
+                kept = self._early_superseded
+                if len(kept) >= 1024:
+                    del kept[next(iter(kept))]  # the oldest: long superseded, its question forgotten
+                kept[old.event.index] = None
             self._verdict("superseded", old.event, reason=f"the input at {ev.where} came before any output "
-                          f"answered the question raised at {old.event.where}: the node owes the latest one an answer")
+                          f"answered the question raised at {old.event.where}: the node owes the latest one an answer",
+                          provisional=early)
         if refusal:
             self._verdict("inconclusive", ev, reason=refusal)
         if not owed:
@@ -319,6 +335,8 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
         q = self.stream.at(stamped)
         if q is not None:
             if ev.time <= q.due or self._at_due(ev.time, q.due):  # an output after the horizon is judged, but is no part of the question's answer
+                if q.reported and not q.answered and self._early_superseded:
+                    self._answers_superseded(q, ev)  # given superseded early: withdrawn (late.py)
                 q.answered = True
                 q.last_out = ev
                 answer = q.answer

@@ -71,6 +71,7 @@ class EngineState:
     _open: Question | None
     _due: float
     _lost: set[int]
+    _early_superseded: dict[int, None]
     # the judges (``_make_judges``)
     _cache: dict[tuple[Any, tuple[Any, ...]], Judgement]
     _assumed: list[tuple[tuple[str, int], ast.Expr]]
@@ -130,7 +131,7 @@ class EngineState:
 
     if TYPE_CHECKING:  # the helpers one part calls of another (defined in engine.py and the parts)
         def _verdict(self, verdict: str, ev: Event, guarantee: int = 0, values: Mapping[str, str] | None = None,
-                     reason: str = "", semantics: str = "", question: str = "") -> None: ...
+                     reason: str = "", semantics: str = "", question: str = "", provisional: bool = False) -> None: ...
 
         def _state(self) -> dict[str, object]: ...
 

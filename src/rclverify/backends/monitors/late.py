@@ -59,6 +59,7 @@ from typing import Any
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.engine_state import EngineState
+from rclverify.backends.monitors.verdicts import Verdict
 
 
 class Late(EngineState):
@@ -317,9 +318,35 @@ class Late(EngineState):
             res.first_inconclusive = None
         return f"; this verdict replaces the {kind} one given before (withdrawn)"
 
+    def _answers_superseded(self, q: Question, out_ev: Event) -> None:
+        """Output ``out_ev`` answers ``q`` by its stamp, heard after the question that
+        superseded ``q``; when ``q``'s ``superseded`` was given early (before every
+        writer of the node's outputs had been heard past it: :meth:`~.engine.NodeMonitor.superseded_early`),
+        it is withdrawn: out of the counts, and a :data:`WITHDRAWN` verdict on ``q``'s
+        message follows it, leaving ``q`` no verdict of its own, as the run read in
+        stamp order gives an answered question none (docs/semantics.md,
+        "Provisional verdicts").  A ``superseded`` given once every writer was heard
+        past ``q`` stands."""
+        qe = q.event
+        if qe.index not in self._early_superseded:
+            return
+        del self._early_superseded[qe.index]
+        self.result.counts["superseded"] -= 1
+        self.stream.superseded -= 1
+        if self.on_verdict is not None:
+            self.on_verdict(Verdict(
+                self.node.name, WITHDRAWN, qe.index, qe.time, qe.where, qe.topic, max(self.now, out_ev.time),
+                reason=f"the output at {out_ev.where}, heard after the question that superseded the one raised at "
+                       f"{qe.where}, answers that one by its header stamp: the superseded verdict given before the "
+                       "output's writer was heard past the question is withdrawn (an answered question has no "
+                       "verdict of its own)"))
+
 
 #: the verdicts of an output a revision replaces
 _REVISABLE = frozenset({"satisfied", "violated", "inconclusive"})
+#: the verdict of a revision that withdraws the one given before and leaves the message without one (a
+#: ``superseded`` given early whose question an answer heard late pairs with: :meth:`Late._answers_superseded`)
+WITHDRAWN = "withdrawn"
 
 
 def _at(entries: Any, stamp: float) -> Any:
@@ -331,4 +358,4 @@ def _at(entries: Any, stamp: float) -> Any:
     return None if best is None else best[1]
 
 
-__all__ = ["Late"]
+__all__ = ["WITHDRAWN", "Late"]

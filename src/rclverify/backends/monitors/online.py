@@ -125,6 +125,8 @@ class OnlineEngine:
     #: the watermark (s) the last :meth:`tick` reached: a verdict on a later time given by :meth:`finish` is
     #: provisional (:meth:`early`)
     _upto: float = field(init=False, default=-math.inf)
+    #: the clock (s) of the last :meth:`tick`
+    _now: float = field(init=False, default=-math.inf)
     #: :meth:`finish` is releasing what the watermark had not passed
     _stopping: bool = field(init=False, default=False)
 
@@ -135,9 +137,11 @@ class OnlineEngine:
         #: per topic, the monitors that read it: a released message is fed to those only (every monitor's
         #: clock is moved to it first, which is all a message off its topics does to a monitor)
         self._readers = {t: [m for m in self.monitors if t in m.topics] for t in self.topics}
-        if self.on_verdict is not None and self.reorder_window > 0:
+        if self.reorder_window > 0:
             for m in self.monitors:
-                m.on_verdict = self._giver(self.on_verdict)
+                m.answers_heard_past = self._heard_past([t for t, vs in m.topics.items() if any(not i for *_, i in vs)])
+                if self.on_verdict is not None:
+                    m.on_verdict = self._giver(self.on_verdict)
 
     def early(self, t: float) -> bool:
         """Whether a verdict decided at ``t`` (s, the run's clock) is given
@@ -150,8 +154,24 @@ class OnlineEngine:
     def _giver(self, emit: Callable[[Verdict], None]) -> Callable[[Verdict], None]:
         """``emit`` for a node's monitor, marking a verdict :meth:`early` ``provisional``."""
         def give(v: Verdict) -> None:
-            emit(dataclasses.replace(v, provisional=True) if self.early(v.decided_at) else v)
+            emit(dataclasses.replace(v, provisional=True) if not v.provisional and self.early(v.decided_at) else v)
         return give
+
+    def _heard_past(self, answers: list[str]) -> Callable[[float], bool]:
+        """Whether every writer of ``answers`` (a node's output topics) has been
+        heard past ``t`` (s) at the last :meth:`tick`: a message of it placed at
+        ``t`` or later, or silent for longer than the lateness bound on its own
+        clock (as :meth:`watermark` counts it); a writer not heard yet has not.
+        A ``superseded`` given before is provisional (:attr:`NodeMonitor.answers_heard_past`)."""
+        writers = self.writers
+
+        def past(t: float) -> bool:
+            for topic in answers:
+                heard = writers.get(topic)
+                if heard is None or (heard[0] < t and self._now - self.reorder_window - heard[1] < t):
+                    return False
+            return True
+        return past
 
     # -- input -------------------------------------------------------------------
     def push(self, topic: str, fields: Mapping[str, object], received: float, where: str = "") -> None:
@@ -230,6 +250,8 @@ class OnlineEngine:
         report silent topics."""
         upto = self.watermark(now)
         self._upto = max(self._upto, upto)
+        if now > self._now:
+            self._now = now
         self._release(upto)
         for m in self.monitors:
             m.advance(max(self._clock, upto))
