@@ -321,7 +321,7 @@ class Late(EngineState):
     def _answers_superseded(self, q: Question, out_ev: Event) -> None:
         """Output ``out_ev`` answers ``q`` by its stamp, heard after the question that
         superseded ``q``; when ``q``'s ``superseded`` was given early (before every
-        writer of the node's outputs had been heard past it: :meth:`~.engine.NodeMonitor.superseded_early`),
+        writer of the node's outputs had been heard past it: :attr:`~.engine.NodeMonitor.answers_heard_past`),
         it is withdrawn: out of the counts, and a :data:`WITHDRAWN` verdict on ``q``'s
         message follows it, leaving ``q`` no verdict of its own, as the run read in
         stamp order gives an answered question none (docs/semantics.md,
