@@ -74,3 +74,29 @@ def test_the_evidence_pass_decodes_each_payload_once_and_refuses_an_undeclared_k
     [said] = part.altered
     assert said.startswith(f"Evidence {bad} is error: its property_tests details are not that backend's payload")
     assert "margin_added_here" in said
+
+
+def test_a_monitored_runs_row_is_encoded_from_its_payload_and_an_undeclared_key_is_error(tmp_path: Path) -> None:
+    """The monitors' record: the row's ``monitoring`` and ``statistics`` are the decoded payload's parts
+    encoded (the keys the record has, an unset one absent); a margin with a key its Struct does not declare
+    makes the record error (the control: the same record without it is shown)."""
+    (tmp_path / "impl.py").write_text("def step(x): return x\n")
+    store = EvidenceStore(tmp_path)
+    run: dict[str, Any] = {"monitoring": {"trace": "runs/a.jsonl", "counts": {"satisfied": 3},
+                                          "margins": [{"guarantee": 1, "margin": 0.25, "answers": 3,
+                                                       "lowest": [0.25]}]},
+                           "statistics": {"trace": "runs/a.jsonl", "sha256": "ab" * 32, "answers": 3, "violations": 0}}
+    good, bad = "N.g0.monitors.ok", "N.g0.monitors.bad"
+    store.put(_evidence(tmp_path, good, "monitors", run))
+    margin = {**run["monitoring"]["margins"][0], "margin_added_here": 1}
+    store.put(_evidence(tmp_path, bad, "monitors", {**run, "monitoring": {**run["monitoring"], "margins": [margin]}}))
+    part = evidence_part(Workspace(tmp_path), [_obligation(good, "monitors"), _obligation(bad, "monitors")], {}, {},
+                         SecondSolver({}))
+    assert part.status == {good: "discharged", bad: "error"}
+    [row] = part.evidence
+    assert row.monitoring["trace"] == "runs/a.jsonl" and row.monitoring["margins"][0]["lowest"] == [0.25]
+    assert "trace" not in row.monitoring["margins"][0]  # unset in the record: absent in the row
+    assert row.statistics == run["statistics"]
+    [said] = part.altered
+    assert said.startswith(f"Evidence {bad} is error: its monitors details are not that backend's payload")
+    assert "margin_added_here" in said
