@@ -1,5 +1,5 @@
 """Every operator reaches every translation: the operator sets are closed
-(``Literal`` types in lang/ast.py), the semantics table has exactly one
+(``Literal`` types in lang/exprs.py), the semantics table has exactly one
 entry per operator, and each translation that dispatches on a unary
 operator ends in :func:`rclverify.lang.ast.unhandled`, so that the type
 checker names every place a new operator must reach, instead of one being
@@ -48,13 +48,13 @@ def test_unhandled_raises_naming_the_operator() -> None:
 
 @pytest.mark.slow
 def test_a_new_unary_operator_is_named_by_the_type_checker_at_every_translation(tmp_path: Path) -> None:
-    """mypy strict over the package with lang/ast.py's ``UnaryOp`` given one more operator (a shadow
+    """mypy strict over the package with lang/exprs.py's ``UnaryOp`` given one more operator (a shadow
     file: the sources are not touched): an error at each dispatch of :data:`DISPATCHES`, and nowhere else.
     mypy starts from a copy of the project's cache where there is one (it checks again whatever the
     shadow file or an edit since changed, so the verdict is the cold run's, in a quarter of the time)."""
     pytest.importorskip("mypy", reason="mypy is installed by the test setup (scripts/setup.sh --tests)")
-    text = (SRC / "rclverify/lang/ast.py").read_text()
-    shadow = tmp_path / "ast.py"
+    text = (SRC / "rclverify/lang/exprs.py").read_text()
+    shadow = tmp_path / "exprs.py"
     shadow.write_text(text.replace('UnaryOp = Literal["not", "-", "abs", "sqrt", "sin", "cos"]',
                                    'UnaryOp = Literal["not", "-", "abs", "sqrt", "sin", "cos", "sgn"]'))
     assert shadow.read_text() != text
@@ -62,7 +62,7 @@ def test_a_new_unary_operator_is_named_by_the_type_checker_at_every_translation(
     if (SRC.parent / ".mypy_cache").is_dir():  # the project's own run's cache (CI runs mypy first): a warm start
         shutil.copytree(SRC.parent / ".mypy_cache", cache)
     r = subprocess.run([sys.executable, "-m", "mypy", "--cache-dir", str(cache), "--shadow-file",
-                        str(SRC / "rclverify/lang/ast.py"), str(shadow), str(SRC / "rclverify")],
+                        str(SRC / "rclverify/lang/exprs.py"), str(shadow), str(SRC / "rclverify")],
                        capture_output=True, text=True, cwd=SRC.parent, timeout=300)
     errors = [ln for ln in r.stdout.splitlines() if ": error:" in ln]
     found: dict[str, int] = {}

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.lang import ast
+from rclverify.lang import ast, exprs
 
 from rclverify.lang import typeexpr
 from rclverify.lang.parser import parse_text as parse
@@ -40,7 +40,7 @@ def formulas() -> list[ast.Expr]:
 
 
 def test_every_node_class_has_a_method_name() -> None:
-    defined = {c for m in (typeexpr, ast) for c in vars(m).values() if isinstance(c, type)
+    defined = {c for m in (typeexpr, exprs, ast) for c in vars(m).values() if isinstance(c, type)
                and dataclasses.is_dataclass(c) and c.__module__ == m.__name__}
     assert ast.Loc not in defined and typeexpr.TBase in defined and ast.Spec in defined
     assert set(NODE_CLASSES) == defined

@@ -28,16 +28,17 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, Callable, ClassVar, Generic, Iterator, TypeVar
 
-from rclverify.lang import ast, typeexpr
+from rclverify.lang import ast, exprs, typeexpr
 from rclverify.lang import walk
 
 T = TypeVar("T")
 
 #: Every class of the RCL abstract syntax (a frozen dataclass of
-#: :mod:`rclverify.lang.typeexpr`, the types, or :mod:`rclverify.lang.ast`,
-#: the rest), in the order the modules define them.
+#: :mod:`rclverify.lang.typeexpr`, the types, :mod:`rclverify.lang.exprs`,
+#: the expressions, or :mod:`rclverify.lang.ast`, the declarations), in the
+#: order the modules define them.
 NODE_CLASSES: tuple[type, ...] = tuple(
-    c for m in (typeexpr, ast) for c in vars(m).values()
+    c for m in (typeexpr, exprs, ast) for c in vars(m).values()
     if isinstance(c, type) and dataclasses.is_dataclass(c) and c.__module__ == m.__name__)
 
 #: The expression classes (the members of :data:`rclverify.lang.ast.Expr`).
