@@ -23,10 +23,9 @@ hold on its inputs and its outputs violate the conjunct.
 from __future__ import annotations
 
 import inspect
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping
+from typing import Any, Callable, Mapping
 
 import z3
 
@@ -54,60 +53,13 @@ from rclverify.backends.monitors.widths import at_carried_widths
 from rclverify.backends.property_tests.at_width import carried_in, input_strategies
 from rclverify.semantics.widths import Carried, carried_fault, edges_at_width, narrow
 from rclverify.traces.typed_text import render_as
-from rclverify.backends.shapes import InputCoverage
+from rclverify.backends.property_tests.local_constants import no_local_constants
+from rclverify.backends.property_tests.outcome import Counts, Outcome
 
-# The plan entry's reading lives in .config; its names stay importable from here (the backend, replay, the tests
-# and the benchmark import them with the run).
+# The plan entry's reading lives in .config and the outcome's records in .outcome; their names stay importable
+# from here (the backend, replay, the tests and the benchmark import them with the run).
 __all__ = ["Config", "ConfigError", "Counts", "GuaranteeRun", "Outcome", "load_implementation", "read_config",
            "run_guarantee", "versions"]
-
-
-@dataclass
-class Counts:
-    """Example counts of one run (shrinking steps included in ``valid``)."""
-
-    drawn: int = 0
-    valid: int = 0
-    rejected: int = 0
-    rejected_by_facts: int = 0
-    assumption_unknown: int = 0
-    failures: int = 0
-    inconclusive: int = 0
-    steps: int = 0
-    #: conjunct checks that held only in the implementation's double arithmetic (false as exact rationals)
-    double: int = 0
-
-    def as_dict(self) -> dict[str, int]:
-        out = {"run": self.drawn, "valid": self.valid, "rejected": self.rejected,
-               "rejected_by_facts": self.rejected_by_facts,
-               "assumption_unknown": self.assumption_unknown, "failures": self.failures,
-               "inconclusive": self.inconclusive, "steps_checked": self.steps}
-        if self.double:
-            out["double"] = self.double
-        return out
-
-
-@dataclass
-class Outcome:
-    """Result of :func:`run_guarantee`.
-
-    ``status``: ``discharged`` (every valid example passed, none
-    inconclusive), ``failed`` (a counterexample, shrunk), ``inconclusive``
-    (no failure, but Z3 answered unknown on some example), ``error``
-    (health check or configuration).  ``counterexample`` maps ``in.x`` /
-    ``out.y`` / ``guarantee`` / ``source`` / ``reason`` to RCL text.
-    """
-
-    status: str
-    message: str
-    counts: Counts
-    counterexample: dict[str, str] | None = None
-    unknown_reasons: list[str] = field(default_factory=list)
-    health: str = ""
-    #: per input, how much of the assumption's range the valid examples covered (:mod:`.coverage`)
-    coverage: dict[str, InputCoverage] = field(default_factory=dict)
-    #: ``file:line: why`` of each import whose code is not hashed (:class:`.closure.Closure`); then no run
-    unhashed: list[str] = field(default_factory=list)
 
 
 class _Violation(AssertionError):
@@ -348,12 +300,12 @@ class GuaranteeRun:
     def _run(self) -> Outcome:
         test = hypothesis.seed(self.cfg.seed)(self.settings()(given(self.strategy())(self.body)))
         try:
-            with _no_local_constants():
+            with no_local_constants():
                 test()
         except _Violation:
             assert self.last_failure is not None
             from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line; deferred: optional or conditional (inside a block)
-            with _no_local_constants():  # it draws neighbour examples as the run drew its own
+            with no_local_constants():  # it draws neighbour examples as the run drew its own
                 moved = readable_failure(self, _Violation)
             unconfirmed = self._unconfirmed()
             if unconfirmed is not None:
@@ -390,41 +342,6 @@ class GuaranteeRun:
                        f"{self.first_double[1]})")
         return Outcome("discharged", f"all {self.counts.valid} valid example(s) met guarantee {self.guarantee}"
                        + inexact, self.counts, None, [])
-
-
-@contextmanager
-def _no_local_constants() -> Iterator[None]:
-    """Within the block, Hypothesis draws no constants from this process's
-    own modules.
-
-    Hypothesis (6.13x and later) mixes into about 5% of its draws numbers
-    and strings it finds in the source of every *local* module loaded in
-    the process (``hypothesis.internal.conjecture.providers``).  Which of
-    rclverify's modules are loaded depends on what the process ran before
-    (a ``doit`` worker that ran the health checks first, a lone evidence
-    task, the generated pytest file), so the same seed drew different
-    examples: the case study's Agent guarantee 1 drew 210, 103 or 90 inputs
-    in three cold runs of the same code.  With the pool of local constants
-    empty (Hypothesis's own fixed pool stays) the examples depend on the
-    seed, the strategy and the implementation only; reading the modules'
-    source is saved too.  A Hypothesis without this pool is left as it is.
-    """
-    try:
-        from hypothesis.internal.conjecture import providers  # deferred: optional or conditional (inside a block)
-        from hypothesis.internal.constants_ast import Constants  # deferred: optional or conditional (inside a block)
-        get = providers._get_local_constants
-        cache = providers.CONSTANTS_CACHE.cache
-    except (ImportError, AttributeError):
-        yield
-        return
-    empty = Constants()
-    cache.clear()  # allowed constants worked out with another pool
-    providers._get_local_constants = lambda: empty
-    try:
-        yield
-    finally:
-        providers._get_local_constants = get
-        cache.clear()
 
 
 def _example_text(cex: Mapping[str, str]) -> str:
