@@ -11,8 +11,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from msgspec.structs import replace
 
 from rclverify.backends.monitors.margin_target import of_margin
+from rclverify.backends.monitors.payload import SpaceMargin
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.cli.commands import main
 from rclverify.model.plan.target_text import parse_target
@@ -93,18 +95,18 @@ def test_the_control_with_a_larger_margin_misses_it(report) -> None:
 
 def test_one_run_s_counts() -> None:
     row = {"status": "discharged", "answers": 5, "violations": 0, "inconclusive": 1}
-    m = [{"guarantee": 1, "answers": 5, "undefined": 2, "lowest": [None, 0.05, 0.2, 0.3, 0.4]}]
+    m = [SpaceMargin(guarantee=1, answers=5, undefined=2, lowest=[None, 0.05, 0.2, 0.3, 0.4])]
     got = of_margin(row, m, 1, 0.25, "answer")
     assert (got["answers"], got["violations"], got["inconclusive"]) == (5, 3, 3)  # -inf, 0.05, 0.2 below
     assert (of_margin(row, m, 1, 0.25, "run")["violations"], of_margin(row, m, 1, 0.01, "run")["violations"]) == (1, 1)
-    clean = of_margin(row, [{**m[0], "lowest": [0.3, 0.4], "undefined": 0}], 1, 0.25, "run")
+    clean = of_margin(row, [replace(m[0], lowest=[0.3, 0.4], undefined=0)], 1, 0.25, "run")
     assert (clean["violations"], clean["inconclusive"]) == (0, 1)
     # more answers than kept, every kept one below: the others are undecided, never clean
-    full = [{"guarantee": 1, "answers": 1000, "undefined": 0, "lowest": [0.1] * KEPT_MARGINS}]
+    full = [SpaceMargin(guarantee=1, answers=1000, undefined=0, lowest=[0.1] * KEPT_MARGINS)]
     got = of_margin({**row, "inconclusive": 0}, full, 1, 0.5, "answer")
     assert (got["answers"], got["violations"], got["inconclusive"]) == (KEPT_MARGINS, KEPT_MARGINS, 1000 - KEPT_MARGINS)
     # a record that kept only its smallest margin: clean when it is, else one below and the others undecided
-    only = [{"guarantee": 1, "answers": 10, "undefined": 0, "margin": 0.3, "holds": None}]
+    only = [SpaceMargin(guarantee=1, answers=10, undefined=0, margin=0.3, holds=None)]
     assert of_margin({**row, "inconclusive": 0}, only, 1, 0.25, "answer")["violations"] == 0
     got = of_margin({**row, "inconclusive": 0}, only, 1, 0.5, "answer")
     assert (got["answers"], got["violations"], got["inconclusive"]) == (1, 1, 9)

@@ -28,25 +28,28 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
+import msgspec
+
+from rclverify.backends.monitors.payload import SpaceMargin
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 
 
-def of_margin(row: Mapping[str, Any], margins: Sequence[Mapping[str, Any]], guarantee: int, least: float,
+def of_margin(row: Mapping[str, Any], margins: Sequence[SpaceMargin], guarantee: int, least: float,
               per: str) -> dict[str, Any]:
     """The run ``row`` (its ``details.statistics``) counted for the margin
     target ``margin of guarantee {guarantee} >= {least}`` ``per`` answer or
-    run, from the run's ``details.monitoring.margins`` (module docstring)."""
-    m = next((x for x in margins if int(x.get("guarantee", 0)) == guarantee), None)
+    run, from the run's space margins (its payload's ``monitoring.margins``; module docstring)."""
+    m = next((x for x in margins if x.guarantee == guarantee), None)
     unsure = int(row.get("inconclusive") or 0)
     if m is None:  # the guarantee judged on no answer of this run: nothing counted beside its undecided answers
         return {**row, "answers": 0, "violations": 0, "inconclusive": unsure}
-    answers, undefined = int(m.get("answers") or 0), int(m.get("undefined") or 0)
-    if "lowest" in m:
-        lowest = list(m.get("lowest") or ())
+    answers, undefined = m.answers, m.undefined
+    if m.lowest is not msgspec.UNSET:
+        lowest = list(m.lowest)
         below = sum(1 for v in lowest if v is None or v < least)
         unknown = answers - len(lowest) if lowest and below == len(lowest) and len(lowest) >= KEPT_MARGINS else 0
     else:  # a record that kept only the smallest: all clean when it is clean, else the others unknown
-        v, holds = m.get("margin"), m.get("holds")
+        v, holds = m.margin, m.holds
         clean = holds is True if v is None else v >= least
         below, unknown = (0, 0) if clean or not answers else (1, answers - 1)
     if per == "run":

@@ -38,7 +38,7 @@ from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
 from rclverify.backends.monitors.verdicts import NodeResult
 from rclverify.backends.monitors.shapes import RunCounts
 from rclverify.backends.monitors.margin_target import of_margin
-from rclverify.backends.monitors.payload import MonitorsPayload, RunStatistics
+from rclverify.backends.monitors.payload import MonitorsPayload, RunStatistics, monitors_payload
 from rclverify.backends.monitors.run_identity import BAG_SUFFIXES, read_fields, run_digest
 from rclverify.traces.mapping import TopicRule
 
@@ -169,10 +169,12 @@ def run_runset(check_one: Callable[[Obligation, NodeTarget], Evidence], obligati
         # and its entry seen with this trace only (the entry's check of every trace is done once, at export)
         one = dataclasses.replace(target, config={**target.config, "traces": [trace]})
         ev = check_one(dataclasses.replace(obligation, data={**own, "trace": trace}, inputs=()), one)
-        stats = (ev.details or {}).get("statistics")
-        if t.margin is not None and isinstance(stats, dict):  # a margin target: the answers below its margin
-            mon = (ev.details or {}).get("monitoring") or {}
-            stats = of_margin(stats, mon.get("margins") or (), t.guarantee, t.margin, t.per)
+        payload = monitors_payload(ev.backend, ev.details)  # the run's record, decoded once
+        seen = payload.statistics if payload is not None else None
+        stats = msgspec.to_builtins(seen) if seen is not None else None
+        if t.margin is not None and stats is not None and payload is not None:  # a margin target: the answers below
+            margins = payload.monitoring.margins if payload.monitoring is not None else []
+            stats = of_margin(stats, margins, t.guarantee, t.margin, t.per)
         rows.append(stats if isinstance(stats, dict) else
                     {"trace": trace, "sha256": f"unread:{trace}", "status": ev.status, "answers": 0,
                      "violations": 0, "inconclusive": 0, "seconds": 0.0, "reason": ev.explanation})
