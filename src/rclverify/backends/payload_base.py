@@ -1,5 +1,5 @@
 """The base of every backend's evidence payload (``hoare/payload.py``,
-``property_tests/payload.py``): one msgspec configuration (frozen, unknown
+``property_tests/payload.py``, ``monitors/payload.py``): one msgspec configuration (frozen, unknown
 keys refused, defaults left out of the JSON, the ``backend`` tag field) and
 the one way a payload becomes an evidence record's ``details``."""
 from __future__ import annotations

@@ -17,7 +17,8 @@ builds a :class:`MonitorsPayload` and writes :meth:`MonitorsPayload.details`:
   run did not judge, as their JSON objects (docs/monitors.md).
 
 A reader decodes the record's ``details`` once, by its ``backend``
-(``backends/payloads.py`` :func:`~rclverify.backends.payloads.payload_of`),
+(``backends/payloads.py`` :func:`~rclverify.backends.payloads.payload_of`, or
+:func:`monitors_payload`, ``None`` for a record that is not this payload),
 and reads attributes mypy checks.  A top-level part the run did not produce
 is left out of the JSON (``None``); inside a part, a key written on some
 records only is :data:`msgspec.UNSET` when absent (so the JSON holds exactly
