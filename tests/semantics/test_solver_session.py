@@ -1,4 +1,4 @@
-"""Queries sharing one incremental solver (semantics/query.py, ``solver_session``):
+"""Queries sharing one incremental solver (semantics/solvers.py, ``solver_session``):
 the same verdicts and cores as fresh solvers, nothing left behind by a
 query, and the same answers every time a unit of work is repeated."""
 from __future__ import annotations
@@ -9,7 +9,7 @@ import z3
 
 from rclverify.calculus.compose import compose_node
 from rclverify.calculus.health.checks import check_node
-from rclverify.semantics import query
+from rclverify.semantics import solvers
 from rclverify.semantics.query import prove, satisfiable, solver_session
 from rclverify.semantics.world import fresh as fresh_z3
 from rclverify.model.plan.load import load_plan
@@ -47,15 +47,15 @@ def test_a_session_gives_the_verdicts_and_cores_of_fresh_solvers() -> None:
 def test_a_query_leaves_no_assertion_behind_and_sessions_nest() -> None:
     x = z3.Real("x")
     with solver_session():
-        outer = query._SESSIONS[-1].solver
+        outer = solvers._SESSIONS[-1].solver
         assert satisfiable([("neg", x < 0)]).status == "sat"
         with solver_session():
-            assert query._SESSIONS[-1].solver is not outer
+            assert solvers._SESSIONS[-1].solver is not outer
             assert satisfiable([("pos", x > 0)]).status == "sat"  # not in the scope of `neg`
-        assert query._SESSIONS[-1].solver is outer
+        assert solvers._SESSIONS[-1].solver is outer
         assert len(outer.assertions()) == 0 and outer.num_scopes() == 0
         assert prove(x * x >= 0, []).status == "proved"
-    assert query._SESSIONS == []
+    assert solvers._SESSIONS == []
 
 
 def _verdicts(findings: list) -> list:
