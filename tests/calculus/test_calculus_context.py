@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 
 from _chain import chain_rcl
 from rclverify.calculus.compose import IN_CONTEXT, compose_node, split_assumption
-from rclverify.calculus.context import ConeContext, opened_links
+from rclverify.calculus.cone_paths import opened_links
+from rclverify.calculus.context import ConeContext
 from rclverify.semantics import world
 from rclverify.lang.parser import parse_formula, parse_text
 from rclverify.lang.typecheck import check

@@ -1,5 +1,5 @@
 """The calculus's test for cones without joins (calculus/context.py, ``single_paths``; issue 67):
-when it holds, the path count over the cone (``_multi_path``, the reference) finds no node with two
+when it holds, the path count over the cone (``multi_path``, the reference) finds no node with two
 paths, with or without links cut; checked on random graphs, loops and repeated links included, and
 against a brute-force count of the paths."""
 from __future__ import annotations
@@ -10,7 +10,7 @@ import networkx as nx
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rclverify.calculus.context import _multi_path, single_paths
+from rclverify.calculus.cone_paths import multi_path, single_paths
 from rclverify.model.system.model import Link, SystemModel
 
 
@@ -43,7 +43,7 @@ def test_single_paths_means_no_node_with_two_paths(sm) -> None:
         kept.add_edges_from((k[0], k[2]) for k in keys if k not in cut)
         acyclic = nx.is_directed_acyclic_graph(kept)
         for node in model.nodes:
-            got = _multi_path(model, node, model.upstream(node), cut)
+            got = multi_path(model, node, model.upstream(node), cut)
             if single_paths(model, node):
                 assert got == set()
             if acyclic:  # the reference itself, against the enumeration
@@ -56,8 +56,8 @@ def test_a_join_is_seen() -> None:
         [("A", "B"), ("A", "C"), ("B", "D"), ("C", "D")]))
     model = SystemModel(("A", "B", "C", "D"), links, (), ())
     assert [single_paths(model, n) for n in model.nodes] == [True, True, True, False]
-    assert _multi_path(model, "D", model.upstream("D"), set()) == {"A"}
+    assert multi_path(model, "D", model.upstream("D"), set()) == {"A"}
     chain = SystemModel(tuple(f"N{i}" for i in range(5)),
                         tuple(Link(f"N{i}", "o", f"N{i + 1}", "i", "name") for i in range(4)), (), ())
     assert all(single_paths(chain, n) for n in chain.nodes)
-    assert not list(itertools.chain.from_iterable(_multi_path(chain, n, chain.upstream(n), set()) for n in chain.nodes))
+    assert not list(itertools.chain.from_iterable(multi_path(chain, n, chain.upstream(n), set()) for n in chain.nodes))

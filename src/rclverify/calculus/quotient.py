@@ -51,7 +51,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, Checked
 from rclverify.model.system.model import SystemModel
 from rclverify.calculus.compose import split_assumption
-from rclverify.calculus.context import opened_links
+from rclverify.calculus.cone_paths import opened_links
 from rclverify.calculus.linear import clauses_under, eliminate, to_rcl
 from rclverify.model.plan.load import all_requirements
 from rclverify.lang.walk import subexpressions

@@ -64,7 +64,8 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import NATURAL, Checked
 from rclverify.semantics.query import query_solver
 from rclverify.model.system.model import SystemModel
-from rclverify.calculus.context import NEGATED, ContextResult, _multi_path, single_paths
+from rclverify.calculus.cone_paths import multi_path, single_paths
+from rclverify.calculus.context import NEGATED, ContextResult
 from rclverify.calculus.premises import node_premises
 from rclverify.targets.smtlib import SORTS, quote, to_smt
 from rclverify.calculus.summary_store import (MadeFrom, Summary, forget_texts, kept_summary, summary_key,
@@ -225,7 +226,7 @@ def decide(checked: Checked, model: SystemModel, node: str, conjunct: ast.Expr,
     used = _core_premises(checked, model, node, environment, facts, q, core)
     node_of = {u[0]: model.nodes[u[2][0]] for u in used}
     nodes = tuple(dict.fromkeys(node_of[u[0]] for u in used if " guarantee " in u[0]))
-    joins = (_multi_path(model, node, model.upstream(node), set())
+    joins = (multi_path(model, node, model.upstream(node), set())
              if (q.joined or nodes) and not single_paths(model, node) else set())
     header = "".join(f"; {line}\n" for line in comment.splitlines())
     script = (header + f"; premises: the summaries of the cones of {', '.join(q.top)} (each proved implied by its "
