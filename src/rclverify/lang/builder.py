@@ -2,17 +2,15 @@
 immutable AST (:mod:`rclverify.lang.ast`) while the LALR(1) automaton of
 ``rcl.lark`` reduces, so no parse tree is ever built.
 
-It also holds the limits a literal is checked against as it is read
-(:func:`numeral_problem`, ``E-number``), the balanced tree an ``and``/``or``
-chain becomes (:func:`balanced`, shared with the printer) and string
-unquoting.  :mod:`rclverify.lang.parser` drives it; the grammar follows the
+A literal is checked as it is read (:mod:`rclverify.lang.literals`,
+``E-number``) and an ``and``/``or`` chain becomes a balanced tree
+(:mod:`rclverify.lang.chains`, shared with the printer).  :mod:`rclverify.lang.parser` drives it; the grammar follows the
 paper's EBNF table and appendix A (see ``rcl.lark``).
 """
 from __future__ import annotations
 
 import dataclasses
-import re
-from typing import Any, Callable, cast
+from typing import Any, cast
 
 from lark import Token, Transformer
 
@@ -20,8 +18,10 @@ from rclverify.lang import ast
 
 from rclverify.lang import typeexpr
 from rclverify.lang.builder_types import TypeRules
+from rclverify.lang.chains import balanced
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.lark_children import _Spanned, _vals
+from rclverify.lang.literals import numeral_problem, unquote
 
 class ToAst(TypeRules, Transformer[Token, Any]):
     """Builds the immutable AST while the LALR parser reduces.
@@ -360,7 +360,7 @@ class ToAst(TypeRules, Transformer[Token, Any]):
         return ast.SeqRange(v[0], v[1], self._span(c))
 
     def string(self, c: list[Any]) -> ast.StrLit:
-        return ast.StrLit(_unquote(str(c[0])), self._span(c))
+        return ast.StrLit(unquote(str(c[0])), self._span(c))
 
     def tuple_binder(self, c: list[Any]) -> list[Token]:
         return [t for t in _vals(c)]
@@ -382,65 +382,3 @@ class ToAst(TypeRules, Transformer[Token, Any]):
             e = dataclasses.replace(e, parenthesised=True)
         self.wrapped[id(e)] = (e, self._span(c))
         return e
-
-
-#: Most digits a numeral may have (before and after its point) and largest
-#: magnitude of its exponent.  A literal within both limits has an exact value
-#: of at most 2,001 digits, so every stage (Fraction arithmetic, Z3, printing
-#: the value in JSON or text: Python refuses to print integers above 4,300
-#: digits) handles it; a longer one is a located ``E-number`` error at parse
-#: time (docs/rcl-language.md, "Robustness limits").
-NUMERAL_DIGITS_LIMIT = 1000
-NUMERAL_EXPONENT_LIMIT = 1000
-
-
-def numeral_problem(text: str) -> str | None:
-    """Why the numeral ``text`` (the ``NUMBER`` terminal of ``rcl.lark``:
-    digits, an optional fraction, an optional exponent) is refused, or
-    ``None`` when it is within :data:`NUMERAL_DIGITS_LIMIT` digits and its
-    exponent within :data:`NUMERAL_EXPONENT_LIMIT` in magnitude."""
-    mantissa, _, exponent = text.lower().partition("e")
-    digits = len(mantissa) - ("." in mantissa)
-    if digits > NUMERAL_DIGITS_LIMIT:
-        return f"numeral too long: {digits} digits (limit {NUMERAL_DIGITS_LIMIT})"
-    exp_digits = exponent.lstrip("+-").lstrip("0")
-    if len(exp_digits) > 4 or (exp_digits and int(exp_digits) > NUMERAL_EXPONENT_LIMIT):
-        return f"numeral's exponent too large (limit {NUMERAL_EXPONENT_LIMIT} in magnitude)"
-    return None
-
-
-#: Deepest nesting of expressions and types the parser accepts (AST depth;
-#: parentheses alone do not count, a balanced ``and``/``or`` chain of n
-#: operands counts log2(n)).  Deeper input is a located ``E-depth`` error
-#: instead of a ``RecursionError`` in a later stage (docs/rcl-language.md).
-NESTING_LIMIT = 200
-
-
-def balanced(op: ast.BinaryOp, operands: list[Any], span: Callable[[Any, Any], ast.Loc]) -> Any:
-    """The balanced tree of ``op`` over ``operands`` (n >= 1): the first
-    ceil(n/2) operands form the left subtree, the rest the right one, so two
-    and three operands give the left-nested tree a left-associative grammar
-    gives.  ``span(first, last)`` is the location of a subtree.  Also used by
-    the printer's round-trip check (printer.py); iterative (no recursion)."""
-    if len(operands) == 1:
-        return operands[0]
-    # Build bottom-up over (lo, hi) ranges with an explicit post-order stack.
-    result: dict[tuple[int, int], Any] = {}
-    stack: list[tuple[int, int, bool]] = [(0, len(operands), False)]
-    while stack:
-        lo, hi, ready = stack.pop()
-        if hi - lo == 1:
-            result[(lo, hi)] = operands[lo]
-            continue
-        mid = lo + (hi - lo + 1) // 2
-        if not ready:
-            stack += [(lo, hi, True), (mid, hi, False), (lo, mid, False)]
-            continue
-        left, right = result.pop((lo, mid)), result.pop((mid, hi))
-        result[(lo, hi)] = ast.Binary(op, left, right, span(operands[lo], operands[hi - 1]))
-    return result[(0, len(operands))]
-
-
-def _unquote(text: str) -> str:
-    """The value of a ``STRING_LIT`` token: quotes removed, ``\\x`` -> ``x``."""
-    return re.sub(r"\\(.)", r"\1", text[1:-1])
