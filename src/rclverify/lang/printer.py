@@ -1,7 +1,7 @@
 """Pretty-printer from the RCL AST back to RCL text.
 
 ``to_rcl(spec)`` prints a whole file, ``expr_to_rcl(e)`` one formula or
-term, ``type_to_rcl(t)`` one type.  Parentheses are written only where the
+term, ``type_to_rcl(t)`` one type (:mod:`rclverify.lang.type_printer`).  Parentheses are written only where the
 fixed precedence of RCL requires them, so that
 
     parse_text(to_rcl(parse_text(src))) == parse_text(src)
@@ -38,9 +38,8 @@ import itertools
 from typing import Union
 
 from rclverify.lang import ast
-
-from rclverify.lang import typeexpr
 from rclverify.lang.errors import RclError
+from rclverify.lang.type_printer import is_type as is_type, type_to_rcl as type_to_rcl
 
 #: Precedence level of each binary operator (higher binds tighter).
 BINARY_LEVEL: dict[str, int] = {
@@ -83,60 +82,11 @@ def operand_levels(e: ast.Binary) -> tuple[int, int]:
 
 
 # ---------------------------------------------------------------------------
-# Types
-# ---------------------------------------------------------------------------
-
-def _type_atom(t: typeexpr.TypeExpr) -> str:
-    """A type in a position that admits only a type atom (function factors)."""
-    s = type_to_rcl(t)
-    return f"({s})" if isinstance(t, typeexpr.TFunc) else s
-
-
-def type_to_rcl(t: typeexpr.TypeExpr) -> str:
-    """RCL text of a type: ``REAL``, ``RadStat``, ``{red, orange, green}``,
-    ``{move(REAL, REAL), inspect(NATURAL)}``, ``REAL x REAL --> BOOL``, ``{}``,
-    ``set(T)``, ``seq(T)``, ``(T1, T2)``.  Raises ``TypeError`` for a value
-    that is not a type."""
-    if isinstance(t, (typeexpr.TBase, typeexpr.TName)):
-        return t.name
-    if isinstance(t, typeexpr.TEnum):
-        return "{" + ", ".join(t.values) + "}"
-    if isinstance(t, typeexpr.TConstructors):
-        return "{" + ", ".join(_ctor(c) for c in t.ctors) + "}"
-    if isinstance(t, typeexpr.TFunc):
-        return " x ".join(_type_atom(a) for a in t.args) + " --> " + _type_atom(t.result)
-    if isinstance(t, typeexpr.TEmpty):
-        return "{}"
-    if isinstance(t, typeexpr.TSet):
-        return f"set({type_to_rcl(t.elem)})"
-    if isinstance(t, typeexpr.TSeq):
-        return f"seq({type_to_rcl(t.elem)})"
-    if isinstance(t, typeexpr.TTuple):
-        return "(" + ", ".join(type_to_rcl(e) for e in t.elems) + ")"
-    raise TypeError(f"not an RCL type: {t!r}")
-
-
-def _ctor(c: typeexpr.Constructor) -> str:
-    if not c.args:
-        return c.name
-    return f"{c.name}(" + ", ".join(type_to_rcl(a) for a in c.args) + ")"
-
-
-# ---------------------------------------------------------------------------
 # Expressions
 # ---------------------------------------------------------------------------
 
-_TYPE_CLASSES = (typeexpr.TBase, typeexpr.TName, typeexpr.TEnum, typeexpr.TConstructors, typeexpr.TFunc, typeexpr.TEmpty,
-                 typeexpr.TSet, typeexpr.TSeq, typeexpr.TTuple)
-
-
-def is_type(d: object) -> bool:
-    """Whether ``d`` is a type (a quantifier domain is a type or a term)."""
-    return isinstance(d, _TYPE_CLASSES)
-
-
 #: Associative connectives whose chains print flat (the parser reads a flat
-#: chain as a balanced tree, parser.balanced).
+#: chain as a balanced tree, chains.balanced).
 FLAT_CHAINS = frozenset({"and", "or"})
 
 
@@ -183,7 +133,7 @@ def _opens(x: ast.Expr, op: str) -> bool:
 
 def is_balanced_chain(e: ast.Binary, n: int) -> bool:
     """Whether ``e`` is exactly the tree the parser builds for a flat chain
-    of its ``n`` operands (parser.balanced: the first ceil(k/2) operands on
+    of its ``n`` operands (chains.balanced: the first ceil(k/2) operands on
     the left at every level).  Iterative."""
     if n < 2:
         return False
