@@ -15,7 +15,8 @@ stay ``false`` live and offline.
 Each run goes through the live run (:class:`rclverify.runtime.live.LiveRun`:
 the online engine with its lateness bound, its timer ticking every 10 ms,
 the deadline monitors fed what it releases and writes to its log), and the
-offline check reads both the run as published and the live run's own log.
+offline check reads both the run as published and the live run's own log: the same deadline
+counts and, trigger by trigger, the same final verdict (an undecided trigger's is ``undecided``).
 """
 from __future__ import annotations
 
@@ -60,13 +61,24 @@ def _workspace(tmp: Path) -> Path:
     return tmp
 
 
-def _offline(ws: Path, run: Path) -> tuple[dict[str, int], dict[str, int]]:
-    """The deadline counts and the triggers given no verdict, as ``rclverify monitor RUN`` judges ``run``."""
+def _final(verdicts: list[dict[str, Any]]) -> dict[float, str]:
+    """Each trigger's final deadline verdict (its last record: an update replaces the verdict before it)."""
+    return {v["trigger_stamp"]: v["verdict"] for v in verdicts}
+
+
+def _offline(ws: Path, run: Path) -> tuple[dict[str, int], dict[str, int], dict[float, str]]:
+    """The deadline counts, the triggers given no verdict and each trigger's final verdict, as
+    ``rclverify monitor RUN`` judges ``run``."""
     checked = load([ws / "contracts" / "c.rcl"])
+    seen: list[dict[str, Any]] = []
+
+    def verdict(kind: str, v: Any, _: float | None) -> None:
+        if kind == "deadline":
+            seen.append(v.to_json())
     got = recorded.check_recorded(checked, [checked.nodes["Relay"]], load_mapping(ws, "mapping.yaml"), ws, str(run),
-                                  lambda w: None)
+                                  lambda w: None, on_verdict=verdict)
     (res,) = got.deadlines
-    return dict(res.counts), dict(res.unaccepted)
+    return dict(res.counts), dict(res.unaccepted), _final(seen)
 
 
 def _live(ws: Path, heard: list[tuple[float, dict[str, Any]]]) -> tuple[dict[str, int], dict[str, int],
@@ -101,16 +113,17 @@ def _judged(tmp: Path, lines: list[dict[str, Any]], heard_at: list[float]) -> di
     published = ws / "run.jsonl"
     published.write_text("".join(json.dumps(x) + "\n" for x in sorted(lines, key=lambda x: x["time"])))
     counts, unaccepted, verdicts, log = _live(ws, sorted(zip(heard_at, lines), key=lambda x: x[0]))
-    return {"live": (counts, unaccepted), "offline": _offline(ws, published), "log": _offline(ws, log),
-            "verdicts": verdicts}
+    return {"live": (counts, unaccepted, _final(verdicts)), "offline": _offline(ws, published),
+            "log": _offline(ws, log), "verdicts": verdicts}
 
 
+#: (deadline counts, triggers given no verdict, the trigger's final verdict) of each outcome
 UNDECIDED = ({"true": 0, "currently_false": 0, "false": 0},
-             {"assumption violated": 0, "incomplete input": 0, "undecided": 1})
+             {"assumption violated": 0, "incomplete input": 0, "undecided": 1}, {1.0: "undecided"})
 MET = ({"true": 1, "currently_false": 0, "false": 0},
-       {"assumption violated": 0, "incomplete input": 0, "undecided": 0})
+       {"assumption violated": 0, "incomplete input": 0, "undecided": 0}, {1.0: "true"})
 FALSE = ({"true": 0, "currently_false": 0, "false": 1},
-         {"assumption violated": 0, "incomplete input": 0, "undecided": 0})
+         {"assumption violated": 0, "incomplete input": 0, "undecided": 0}, {1.0: "false"})
 
 
 def _relay(answer_source: float, answer_stamp: float | None, value: bool = True,

@@ -9,7 +9,9 @@ late, ``currently_false`` not answered yet and the deadline not yet expired.
 A trigger the node's assumption does not accept gets no verdict and is
 counted by why (:data:`UNACCEPTED`); so is an obligation left unanswered whose
 answer may be an output stamped within the transport skew before its trigger
-(``undecided``, :attr:`Pending.maybe`).
+(``undecided``, :attr:`Pending.maybe`), which is also given to the monitor's
+``on_verdict`` as a :class:`DeadlineVerdict` ``undecided`` (not in the counts),
+so that every trigger past its deadline has a verdict record on every path.
 """
 from __future__ import annotations
 
@@ -27,7 +29,8 @@ UNACCEPTED = ("assumption violated", "incomplete input", "undecided")
 
 @dataclass(frozen=True)
 class DeadlineVerdict:
-    """One trigger event's deadline verdict.  Times in seconds on the stamps'
+    """One trigger event's deadline verdict: one of :data:`DEADLINE_VERDICTS`, or ``undecided`` (a
+    trigger counted with the unaccepted ones: :mod:`.deadline_skew`).  Times in seconds on the stamps'
     clock; ``answer`` is the answering message's stamp (``None``: none)."""
 
     node: str

@@ -97,14 +97,20 @@ def scan_heard(mon: DeadlineMonitor, p: Pending) -> None:
             return
 
 
-def undecided(mon: DeadlineMonitor, p: Pending) -> None:
-    """Obligation ``p``, marked, unanswered when the clock passed its deadline: ``undecided`` with why."""
+def undecided(mon: DeadlineMonitor, p: Pending, revised: str = "") -> None:
+    """Obligation ``p``, marked, unanswered when the clock passed its deadline: ``undecided`` with why,
+    counted with the unaccepted triggers (not in the verdict counts) and given to ``on_verdict`` as a
+    verdict ``undecided``, so that every trigger past its deadline has a verdict record on every path;
+    ``revised``: the words of a ``false`` it replaces (:func:`revise_false`; the verdict is then an update)."""
     res = mon.result
     res.unaccepted["undecided"] += 1
+    reason = f"no answer of its own within the deadline of {ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}"
     if res.first_unaccepted is None:
         res.first_unaccepted = {"guarantee": p.k, "where": p.trigger.where, "stamp": p.stamp, "why": "undecided",
-                                "reason": f"no answer of its own within the deadline of "
-                                          f"{ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}"}
+                                "reason": reason}
+    if mon.on_verdict is not None:
+        mon.on_verdict(DeadlineVerdict(mon.node.name, p.k, "undecided", p.trigger.where, p.stamp, p.due, None, "",
+                                       reason + revised, update=bool(revised)))
 
 
 def revise_false(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
@@ -113,7 +119,7 @@ def revise_false(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Ma
     lateness bound).  Where it satisfies the guarantee on the trigger's inputs (:func:`mark_early`, judged as
     when the trigger came: on none of the outputs published after it), ``p`` is what the run read in stamp
     order makes it, ``undecided``: the ``false`` is withdrawn (its count, the first ``false``, its unanswered
-    time margin) and counted ``undecided`` (:func:`undecided`); an update verdict ``undecided`` says why."""
+    time margin) and counted ``undecided`` by :func:`undecided`, whose verdict is an update saying so."""
     probe = dataclasses.replace(p, outs={})
     mark_early(mon, probe, ev, ns, fresh)
     if not probe.maybe:
@@ -126,14 +132,9 @@ def revise_false(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Ma
         m.unanswered -= 1
         if not m.answers and not m.unanswered:
             del margins[p.k]
-    undecided(mon, p)
-    if mon.on_verdict is not None:
-        behind = ms_ns(mon.now_ns - ns) if mon.now_ns is not None else "?"
-        mon.on_verdict(DeadlineVerdict(
-            mon.node.name, p.k, "undecided", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
-            f"no answer of its own within the deadline of {ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}; heard "
-            f"after the clock had passed the deadline (at {behind} behind it): undecided, and the false given "
-            "when the clock passed is withdrawn", update=True))
+    behind = ms_ns(mon.now_ns - ns) if mon.now_ns is not None else "?"
+    undecided(mon, p, f"; heard after the clock had passed the deadline (at {behind} behind it): the false given "
+                      "when the clock passed is withdrawn")
 
 
 def decided_late(mon: DeadlineMonitor, p: Pending) -> None:
