@@ -34,6 +34,7 @@ class EngineState:
     checked: Checked
     node: CheckedNode
     horizon: float
+    now: float
     tolerance: Tolerance | None
     result: NodeResult
     on_verdict: Callable[[Verdict], None] | None
