@@ -106,13 +106,13 @@ def test_build_tasks_installs_the_release_in_order(tmp_path) -> None:
 
 
 def test_the_digested_config_is_the_value_doit_stores_for_the_config() -> None:
-    """``_digested`` hands doit the digest it would take itself: a workspace verified before keeps its
+    """``digested`` hands doit the digest it would take itself: a workspace verified before keeps its
     tasks up to date, and a changed value is a changed digest."""
     from doit.tools import config_changed
-    from rclverify.app.task_table import _digested
+    from rclverify.app.doit_glue import digested
     rnd = random.Random(11)
     for _ in range(200):
         config = {f"k{rnd.randrange(9)}": rnd.choice([None, rnd.random(), "v" * rnd.randrange(4), [1, "é"]])
                   for _ in range(rnd.randrange(6))}
-        assert _digested(config)._calc_digest() == config_changed(config)._calc_digest()
-    assert _digested({"a": 1})._calc_digest() != _digested({"a": 2})._calc_digest()
+        assert digested(config)._calc_digest() == config_changed(config)._calc_digest()
+    assert digested({"a": 1})._calc_digest() != digested({"a": 2})._calc_digest()

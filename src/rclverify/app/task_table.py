@@ -10,24 +10,22 @@ creator is defined, so the methods stand in the order the tasks run:
 check, graph, node, health, requirements, deadlines, evidence, crosscheck, ground,
 nodl, diagnosis, report, verify.  The actions the tasks run are in
 :mod:`rclverify.app.task_actions`, the ``uptodate`` checks in
-:mod:`rclverify.app.task_checks`.
+:mod:`rclverify.app.task_checks`, the hand-over to doit in
+:mod:`rclverify.app.doit_glue`.
 """
 from __future__ import annotations
 
-import hashlib
-import inspect
-import json
 import os
 import shutil
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping, TypeVar, cast
+from typing import Any, Callable, Iterator
 
-from doit import create_after as _create_after
 from doit.tools import config_changed
 
 from rclverify.core.cache import code_stamp
 from rclverify.app.task_actions import (act_check, act_crosscheck, act_deadlines, act_design, act_diagnosis, act_graph,
                                         act_ground, act_node, act_nodl, act_report, act_requirements, act_run, act_verify)
+from rclverify.app.doit_glue import create_after, digested, signed
 from rclverify.app.shapes import DoitTask
 from rclverify.app.task_checks import (RecordIntact, TargetsAsWritten, entry_inputs, ros_fingerprint, strict_uptodate,
                                        tool_fingerprint, z3_version)
@@ -35,34 +33,8 @@ from rclverify.stages.provenance import check_input_files
 from rclverify.stages.workspace import REPORT_PARTS, TaskIndex, Workspace
 from rclverify.records.sealed import TargetsSealed, obligation_list
 
-_F = TypeVar("_F", bound=Callable[..., Any])
-_C = TypeVar("_C", bound=Callable[..., Any])
-
 #: One exported obligation: its node and its JSON object (artifacts/obligations/<Node>.json).
 Exported = list[tuple[str, dict[str, Any]]]
-
-
-def _signed(check: _C) -> _C:
-    """``check`` (a doit ``uptodate`` callable) with its signature computed once: doit calls
-    ``inspect.signature`` on every uptodate callable of every task on every run, and an object's own
-    ``__signature__`` (PEP 362) answers it at once (about 20 us a call, 4,000 tasks at 1000 nodes)."""
-    check.__signature__ = inspect.signature(check)  # type: ignore[attr-defined]
-    return check
-
-
-def _digested(config: Mapping[str, object]) -> config_changed:
-    """doit's ``config_changed(config)`` given the digest doit would take of
-    ``config`` (the md5 of its JSON, keys sorted: doit 0.36-0.37's
-    ``_calc_digest``), so the same value is stored and compared, but the
-    JSON is encoded once per run instead of once per task and run (4,300
-    tasks at 1000 nodes: 0.1 s of a no-op run)."""
-    digest = hashlib.md5(json.dumps(config, sort_keys=True).encode("utf-8")).hexdigest()
-    return config_changed(digest)
-
-
-def create_after(executed: str) -> Callable[[_F], _F]:
-    """doit's ``create_after`` (delayed task creation), typed."""
-    return cast(Callable[[_F], _F], _create_after(executed=executed))
 
 
 REPORTS = ["reports/assurance.html", "reports/assurance.md", "reports/assurance.json"]
@@ -100,12 +72,12 @@ class TaskTable:
         # Every task that makes a result depends on the rclverify code that makes it: another version
         # (an upgrade, a changed module) makes every result again, as a clean run would.
         self.code_version = {"rclverify": code_stamp(), "z3": z3_version()}
-        self.code = _signed(_digested(self.code_version))
+        self.code = signed(digested(self.code_version))
         # Only files that exist are file dependencies (doit refuses a missing one with a DependencyError):
         # a missing plan or contract makes `check` run, and fail with the located message, every time.
         named = [str(self.rootp / plan_file)] + contract_deps
         self.check_deps = [d for d in named if os.path.isfile(d)]
-        self.sealed = _signed(TargetsSealed())
+        self.sealed = signed(TargetsSealed())
         self.check_uptodate: list[Any] = [False] if len(self.check_deps) < len(named) or not self.ok \
             else [self.code, self.sealed]
         self.deadline_nodes = list(index.deadline_nodes) if index is not None else []
@@ -206,7 +178,7 @@ class TaskTable:
         # `__signature__` (PEP 362) answers it at once.
         # One config_changed per task: doit saves every config_changed of a task under one key, so a
         # second one would overwrite the first's value and the task would never be up to date.
-        tools_unchanged = _signed(_digested({**tool_fingerprint(), **self.code_version}))
+        tools_unchanged = signed(digested({**tool_fingerprint(), **self.code_version}))
         record_intact = RecordIntact()
         input_file: dict[str, str | None] = {}  # input -> its absolute path when it is a file (one stat per input)
         ws, at, r = self.ws, self.at, self.r
