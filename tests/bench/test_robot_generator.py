@@ -135,7 +135,7 @@ def test_a_correct_robot_is_never_red(correct_run: dict[str, Any]) -> None:
 @pytest.mark.live
 def test_a_correct_robot_is_judged_alike_live_and_on_its_log(correct_run: dict[str, Any]) -> None:
     """Verdict by verdict: every message's final verdict live is its verdict offline on the log.  Seed 0's
-    stamp-copying relay meets fault 8 on its first answer, heard late: the reading it answers is given
+    stamp-copying relay may meet fault 8 on its first answer, heard late: the reading it answers is given
     ``superseded`` live, provisional, and the answer withdraws it (tests/backends/test_superseded_withdrawn.py)."""
     res = correct_run
     assert sum(len(x) for x in res["finals"]["live"].values()) > 50
