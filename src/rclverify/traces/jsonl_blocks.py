@@ -282,7 +282,7 @@ class LogBlock:
     the exact reader skip a row's line (a defect: the fast path takes only
     lines with a string topic and a finite float time, which it reads)."""
 
-    __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made", "_columns")
+    __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made", "_columns", "_codes")
 
     def __init__(self, path: Path, lines: Sequence[bytes] | _Slice, structs: list[Any], attr: dict[str, str], topics: list[str],
                  times: np.ndarray, lineno: int, index: int) -> None:
@@ -291,6 +291,7 @@ class LogBlock:
         self._made: dict[int, Event] = {}
         #: a key's value at every row (an object column), made when a reader asks for many rows of it
         self._columns: dict[str, np.ndarray] = {}
+        self._codes: tuple[np.ndarray, list[str]] | None = None
 
     def __len__(self) -> int:
         return len(self.structs)
@@ -302,6 +303,20 @@ class LogBlock:
         if len(distinct) > 16:
             return dict(Counter(topics))
         return {t: topics.count(t) for t in distinct}
+
+    def topic_codes(self) -> tuple[np.ndarray, list[str]]:
+        """(each row's topic as an index into the list, the distinct topics as ``topics`` names them, in the
+        order they first come), made once per block: a reader classifying the rows reads the few names."""
+        if self._codes is None:
+            topics = self.topics
+            names = list(dict.fromkeys(topics))
+            index = {t: j for j, t in enumerate(names)}
+            if len(names) <= 256:  # one byte a row, made at C speed
+                codes: np.ndarray = np.frombuffer(bytes(map(index.__getitem__, topics)), np.uint8)
+            else:
+                codes = np.fromiter(map(index.__getitem__, topics), np.int64, len(topics))
+            self._codes = (codes, names)
+        return self._codes
 
     def values(self, rows: np.ndarray, key: str) -> list[Any]:
         """The value of ``key`` in the messages at ``rows`` (``None`` where a message
