@@ -65,6 +65,7 @@ from rclverify.core.numeric import np
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
+from rclverify.traces.jsonl_blocks import LogBlock
 from rclverify.traces.mapping import TopicRule
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.answered import AnsweredRun
@@ -206,9 +207,16 @@ class _Run(PairsState, LoneSlots):
         """Judge ``chunk``; returns the events to carry to the next chunk (a last input whose answer may follow)."""
         plan, m = self.plan, self.m
         n = len(chunk)
-        kind = chunk.kinds(self.kinds) if isinstance(chunk, BlockRows) else None  # (from a block's topic codes)
+        block = chunk if isinstance(chunk, BlockRows) else None
+        kind = None
+        if block is not None and not isinstance(block.block, LogBlock):
+            kind = block.kinds(self.kinds)  # a bag block's topic codes are its reader's: no string a row
         if kind is None:
-            kind = self._kind(chunk.topics)
+            kind = self._alternating(chunk.topics)  # two counts, where the node's two topics take turns
+        if kind is None and block is not None:
+            kind = block.kinds(self.kinds)  # a log block's topic codes, made once (the deadline judge reads them)
+        if kind is None:
+            kind = np.fromiter(map(self.kinds.get, chunk.topics, repeat(0)), np.int8, n)
         times = chunk.times
         if n > 1 and not self._long_runs(kind, times):
             i = self._lone(chunk, kind, times) if self.lone else 0
@@ -271,10 +279,11 @@ class _Run(PairsState, LoneSlots):
         runs = 1 + int(np.count_nonzero(pairs[1:] != pairs[:-1] + 2))
         return len(pairs) >= self.min_run * (runs - 1)  # (one run: its cost is paid once)
 
-    def _kind(self, topics: list[str]) -> np.ndarray:
-        """Each event's topic as its column code: an input topic's number, -1 the output's, 0 another topic."""
+    def _alternating(self, topics: list[str]) -> np.ndarray | None:
+        """Each event's topic as its column code (an input topic's number, -1 the output's) where the node's one
+        input topic and its output topic take turns (the common case, read by two counts), else ``None``."""
         n = len(topics)
-        if len(self.kinds) == 2 and n > 1:  # one input topic: a log where the two take turns is the common case
+        if len(self.kinds) == 2 and n > 1:
             (a, ka), (b, kb) = self.kinds.items()
             even, odd = topics[0::2], topics[1::2]
             for x, kx, y, ky in ((a, ka, b, kb), (b, kb, a, ka)):
@@ -282,7 +291,7 @@ class _Run(PairsState, LoneSlots):
                     kind = np.empty(n, dtype=np.int8)
                     kind[0::2], kind[1::2] = kx, ky
                     return kind
-        return np.fromiter(map(self.kinds.get, topics, repeat(0)), np.int8, n)
+        return None
 
     def _pairs(self, chunk: EventRows | BlockRows, at: np.ndarray, kind: np.ndarray, times: np.ndarray,
                cols: dict[str, np.ndarray]) -> int:

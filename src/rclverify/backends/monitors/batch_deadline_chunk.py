@@ -50,8 +50,13 @@ def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
     if got is None:
         return False
     topics, times, values = got
-    lut = {t: plan.kind_of(t) for t in set(topics)}
-    kind = np.fromiter(map(lut.__getitem__, topics), np.int8, n)
+    codes = getattr(evs, "topic_codes", None)  # a log block's topics as codes: each distinct name classified once
+    if codes is not None:
+        at, names = codes()
+        kind = np.array([plan.kind_of(t) for t in names] or [0], dtype=np.int8)[at]
+    else:
+        lut = {t: plan.kind_of(t) for t in set(topics)}
+        kind = np.fromiter(map(lut.__getitem__, topics), np.int8, n)
     ns = ns_column(times)
     if ns is None or bool((kind == 2).any()) or (n > 1 and bool((np.diff(ns) < 0).any())) or \
             (mon.now_ns is not None and int(ns[0]) < mon.now_ns):
