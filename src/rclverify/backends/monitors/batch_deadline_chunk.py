@@ -41,6 +41,19 @@ def _columns(evs: list[Event] | Any) -> tuple[list[str], np.ndarray, Callable[[n
         lambda rows, key: field_values(fields, rows, key)
 
 
+def _kinds(mon: ChunkSide, evs: list[Event] | Any, topics: list[str]) -> np.ndarray:
+    """Each row's topic as the plan's column code (:meth:`~.batch_deadline_plan.DeadlinePlan.kind_of`), int8;
+    a log block's from its topic codes, each distinct name classified once."""
+    kind_of = mon.plan.kind_of
+    codes = getattr(evs, "topic_codes", None)
+    if codes is not None:
+        at, names = codes()
+        by_code: np.ndarray = np.array([kind_of(t) for t in names] or [0], dtype=np.int8)[at]
+        return by_code
+    lut = {t: kind_of(t) for t in set(topics)}
+    return np.fromiter(map(lut.__getitem__, topics), np.int8, len(topics))
+
+
 def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
     """Judge the events ``evs`` (a list, or a log block: :func:`_columns`) as the streaming monitor
     would, over columns, and leave its state; ``False`` (nothing changed) when the chunk is not clean."""
@@ -50,13 +63,7 @@ def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
     if got is None:
         return False
     topics, times, values = got
-    codes = getattr(evs, "topic_codes", None)  # a log block's topics as codes: each distinct name classified once
-    if codes is not None:
-        at, names = codes()
-        kind = np.array([plan.kind_of(t) for t in names] or [0], dtype=np.int8)[at]
-    else:
-        lut = {t: plan.kind_of(t) for t in set(topics)}
-        kind = np.fromiter(map(lut.__getitem__, topics), np.int8, n)
+    kind = _kinds(mon, evs, topics)
     ns = ns_column(times)
     if ns is None or bool((kind == 2).any()) or (n > 1 and bool((np.diff(ns) < 0).any())) or \
             (mon.now_ns is not None and int(ns[0]) < mon.now_ns):
