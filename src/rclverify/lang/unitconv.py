@@ -25,7 +25,8 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from rclverify.lang.units import _NAMES, Dims, Unit, _scale_text, parse_unit, ratio
+from rclverify.lang.unit_algebra import _NAMES, Dims, Unit, _scale_text
+from rclverify.lang.units import parse_unit, ratio
 from rclverify.lang.units import short_decimal as short_decimal  # re-exported
 
 #: Compound units a contract may declare, besides the symbols and prefixed symbols of the table.
