@@ -28,9 +28,15 @@ them (``<service>/_service_event`` ...), with the live call book's pairing
 (:mod:`.bag_calls`): their connections carry the definitions and type
 hashes :mod:`.bag_types` makes, so ``rclverify monitor BAG`` judges the calls
 as the live run did (tests/runtime/test_ros2_bag_calls.py).
+
+The bag carries the run's end (:meth:`BagRecorder.end`): one message, written last, on
+``/rclverify/run_end`` (``builtin_interfaces/msg/Time``) at the time the
+live run's deadline clock reached, so a deadline the live clock passed is
+``false`` on the bag as on the log (:mod:`rclverify.traces.bag_end`).
 """
 from __future__ import annotations
 
+import math
 import queue
 import shutil
 import threading
@@ -38,6 +44,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 from rclverify.traces.bag import typestore
 from rclverify.traces.bag_late import KEY as LATE_KEY, encode as encode_late
+from rclverify.traces import bag_end
 from rclverify.runtime.dds.bag_types import declared_store
 from rclverify.runtime.dds.types import Declaration
 from rclverify.traces.events import TraceError
@@ -96,6 +103,7 @@ class BagRecorder:
         #: per contract topic whose connection is made: the declaration it records (``None``: the workspace's)
         self._declared: dict[str, Any] = {}
         self._late: dict[str, list[tuple[float, float]]] = {}  # topic -> (time s, late s) of each late message
+        self._end_ns: int | None = None  # the run's end (ns since the epoch), written last (:meth:`end`)
         self.error = ""
         self._queue: queue.SimpleQueue[tuple[str, int, bytes, Any] | None] = queue.SimpleQueue()
         self._opened = threading.Event()
@@ -163,6 +171,12 @@ class BagRecorder:
                     self.failed += 1
                     self.error = f"{type(exc).__name__}: {exc}"
         finally:
+            if self._end_ns is not None:  # the run's end, its last message (traces/bag_end.py)
+                try:
+                    self._write_end(writer, self._end_ns)
+                except Exception as exc:  # noqa: BLE001 - said in close()'s record
+                    self.failed += 1
+                    self.error = f"{type(exc).__name__}: {exc}"
             if self._late:  # what the live monitor heard late, as its log says it (traces/bag_late.py)
                 writer.set_custom_data(LATE_KEY, encode_late(self._late))
             for topic in self.topics:  # a topic without a message is in the bag too, in the workspace's definition
@@ -184,6 +198,21 @@ class BagRecorder:
             return writer.add_connection("/" + topic, _msg_name(self.topics[topic]), typestore=self._store)
         msg_type, msgdef, digest = self.calls[topic]
         return writer.add_connection("/" + topic, msg_type, msgdef=msgdef, rihs01=digest, typestore=self._store)
+
+    def _write_end(self, writer: Any, time_ns: int) -> None:
+        """The end-of-run message at ``time_ns`` (:mod:`rclverify.traces.bag_end`), in the writer's thread."""
+        conn = writer.add_connection("/" + bag_end.TOPIC, bag_end.TYPE, typestore=self._store)
+        sec, nanosec = bag_end.split_ns(time_ns)
+        writer.write(conn, time_ns, bytes(self._store.serialize_cdr(self._store.types[bag_end.TYPE](sec=sec, nanosec=nanosec),
+                                                                bag_end.TYPE)))
+
+    def end(self, time_s: float) -> None:
+        """Note the run's end: ``time_s`` (s since the epoch, the time line of the run's log) is the time the
+        live run's clock reached when it stopped; the bag's last message says it at its close
+        (:mod:`rclverify.traces.bag_end`).  Called before :meth:`close`; a time that is not finite
+        and >= 0 is ignored (no end is written)."""
+        if isinstance(time_s, (int, float)) and math.isfinite(time_s) and time_s >= 0:
+            self._end_ns = round(time_s * 1e9)
 
     def late(self, topic: str, time_s: float, late_s: float) -> None:
         """Note that the message of contract topic ``topic`` (no leading ``/``)

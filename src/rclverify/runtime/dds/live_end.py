@@ -10,7 +10,8 @@ the bus and the engine thread and makes the evidence record: the ROS 1 one
 ``middleware`` (:meth:`~DdsRunEnd.origin`), ``calls`` (per node the
 call-by-call verdicts' status), ``deadlines``, ``qos`` (per topic the
 reader's QoS and what it heard), ``warnings``, ``enforce``, ``bypass`` and
-``bag`` (docs/ros2.md).
+``bag`` (docs/ros2.md), the recorded bag ending at the time the live
+deadline clock reached (:func:`deadline_clock`, :mod:`rclverify.traces.bag_end`).
 """
 from __future__ import annotations
 
@@ -162,6 +163,9 @@ class DdsRunEnd:
         downgrade(record_["nodes"], {n.name: [t.field.strip("/") for t in n.node.topics] for n in self.nodes},
                   bypass, {t.key: t.reader_changes for t in bus.taps})
         if self.recorder is not None:
+            end = deadline_clock(live)
+            if end is not None:  # the bag ends where the live clock did (traces/bag_end.py)
+                self.recorder.end(end)
             record_["bag"] = self.recorder.close()
             if self.call_recorder is not None and self.call_recorder.failed:
                 record_["bag"]["calls_failed"] = self.call_recorder.failed
@@ -170,6 +174,14 @@ class DdsRunEnd:
             atomic_write_text(evidence, json.dumps(record_, indent=2, sort_keys=True) + "\n")
         self.out(status_line(live, self.call_counts))
         return record_
+
+
+def deadline_clock(live: LiveRun) -> float | None:
+    """The time (s since the epoch, the log's time line) the live run's deadline checks' clock reached
+    (:mod:`rclverify.runtime.logchecks`: the run's clock less the reorder window, and every line the log
+    carries), or ``None`` when no node has a timed guarantee or the clock never moved."""
+    clocks = [d.now for d in live.checks.deadlines if d.now_ns is not None]
+    return max(clocks) if clocks else None
 
 
 def _calls_record(summary: Mapping[str, object], book: CallBook, calls: CallTaps | None) -> dict[str, Any]:
@@ -184,4 +196,4 @@ def _calls_record(summary: Mapping[str, object], book: CallBook, calls: CallTaps
     return out
 
 
-__all__ = ["DdsRunEnd", "status_line"]
+__all__ = ["DdsRunEnd", "deadline_clock", "status_line"]
