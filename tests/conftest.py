@@ -134,6 +134,7 @@ SECONDS: dict[str, float] = {
     "test_statistics": 2.3, "test_batch_deadlines": 2.3, "test_monitors": 2.5, "test_units": 2.1,
     "test_witness": 2.1, "test_problems_model_checking": 2.3,
     "test_generated_seed_faults": 6.0,  # two generated robots' recorded runs judged offline, one replayed online
+    "test_bag_run_end": 9.0,  # seed 545's bag recorded again three times (both storages, one without the end), judged
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
