@@ -8,6 +8,14 @@ monitor's recorder (:class:`~rclverify.runtime.dds.bag.BagRecorder`, both storag
 time, the late ones said late), once told the run's end (the time the log's last line carries, where
 the live clock had gone) and once not: with the end, the bag's verdicts equal the log's, verdict by
 verdict; without it (the control; the reader's path is one for both storages), the bag differs from the log on that one deadline, ``currently_false``.
+
+Seed 545 run live again with the new recorder (tests/data/robot_seed545_end: the same 8-node robot and
+contracts, ``bench/robot_generator.py --seeds 545 --nodes 8 --defect --actions``, DDS source, wall clock;
+its log, its MCAP bag and the live run's ``--verdicts``): its bag ends 2 s after its last message, and
+the defective relay's last ``false`` deadline, due after the clock of every recorded message, is decided
+on the bag by that end, as live and on the log: live = log = bag verdict by verdict.  (The same seed
+judged by the sources before the change: live != bag on that one deadline, 2 runs of 2; after: 0
+disagreements, 3 runs of 3, docs/monitors.md fault 9.)
 """
 from __future__ import annotations
 
@@ -30,9 +38,11 @@ from rclverify.traces.bag import typestore
 from rclverify.traces.bag_late import KEY as LATE_KEY
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
-from _robot_verdicts import compare, finals  # noqa: E402
+from _robot_verdicts import compare, finals, read_records  # noqa: E402
 
 SEED_545 = Path(__file__).resolve().parents[1] / "data" / "robot_seed545"
+#: seed 545 recorded live again by the recorder that writes the run's end
+SEED_545_END = Path(__file__).resolve().parents[1] / "data" / "robot_seed545_end"
 
 
 def _offline(ws: Path, trace: str) -> list[dict[str, Any]]:
@@ -104,3 +114,20 @@ def test_control_the_same_bag_without_the_end_leaves_the_deadline_currently_fals
     found = compare(log, finals(_offline(ws, again)))
     assert [(d.node, d.item, d.a and d.a["verdict"], d.b and d.b["verdict"]) for d in found] == [
         ("Relay6", "deadline", "false", "currently_false")], [d.text(("log", "bag")) for d in found]
+
+
+def test_seed_545_recorded_live_with_its_end_gives_live_equal_log_equal_bag_verdict_by_verdict() -> None:
+    ws = SEED_545_END
+    events = list(read_trace(ws / "runs" / "bag", [ws / "interfaces"]))
+    ends = [ev for ev in events if ev.topic == bag_end.TOPIC]
+    assert len(ends) == 1 and ends[0].time == max(ev.time for ev in events)
+    bag_records = _offline(ws, "runs/bag")
+    # the case of fault 9 is there: a false deadline decided only by the run's end (the bag's clock at it)
+    clock = f"(clock at {ends[0].time:.3f} s)"
+    decided_at_end = [r for r in bag_records if r["item"] == "deadline" and r["verdict"] == "false"
+                      and clock in r["reason"]]
+    assert [r["node"] for r in decided_at_end] == ["Relay6"], decided_at_end
+    live, log, bag = (finals(read_records(ws / "runs" / "live.verdicts.jsonl")),
+                      finals(_offline(ws, "runs/live.jsonl")), finals(bag_records))
+    assert [d.text(("log", "bag")) for d in compare(log, bag)] == []
+    assert [d.text(("live", "bag")) for d in compare(live, bag)] == []
