@@ -72,7 +72,8 @@ def _elements(argument: object) -> dict[str, ElementRecord]:
     """The elements of ``argument`` (the parsed ``reports/argument.json``, or ``None``) by id; an element
     of another shape is left out."""
     out: dict[str, ElementRecord] = {}
-    for e in argument.get("elements") or [] if isinstance(argument, Mapping) else []:
+    items = argument.get("elements") if isinstance(argument, Mapping) else None
+    for e in items if isinstance(items, list) else []:
         try:
             el = msgspec.convert(e, ElementRecord)
         except msgspec.ValidationError:
