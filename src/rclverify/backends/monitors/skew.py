@@ -20,7 +20,7 @@ import math
 from typing import TYPE_CHECKING, Any, overload
 
 if TYPE_CHECKING:
-    from numpy.typing import NDArray
+    from rclverify.core.numeric import np
 
 #: The default transport skew (s): five of CPython's 5 ms thread switch
 #: intervals, the time a receiving thread may wait for the interpreter on a
@@ -41,7 +41,7 @@ def within_before(at: float, stamp: float, skew: float) -> bool: ...
 
 
 @overload
-def within_before(at: NDArray[Any], stamp: NDArray[Any], skew: float) -> NDArray[Any]: ...
+def within_before(at: np.ndarray, stamp: np.ndarray, skew: float) -> np.ndarray: ...
 
 
 def within_before(at: Any, stamp: Any, skew: float) -> Any:
