@@ -7,6 +7,9 @@ from __future__ import annotations
 from contextlib import contextmanager
 from typing import Iterator
 
+# Hypothesis loaded as the one module loads it (without its plugins) before its internals are read below
+from rclverify.backends.property_tests.hypothesis_lib import hypothesis as hypothesis
+
 
 @contextmanager
 def no_local_constants() -> Iterator[None]:
