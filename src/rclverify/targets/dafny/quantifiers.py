@@ -22,6 +22,7 @@ Quantifying over functions raises a located
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any, Mapping, cast
 
@@ -48,7 +49,7 @@ class Bound:
     type: Type
 
 
-class QuantifierTranslation:
+class QuantifierTranslation(ABC):
     """The quantifier half of the translator, mixed into
     :class:`~rclverify.targets.dafny.translate.Translator`, which supplies the
     attributes and the methods declared here (the term translation
@@ -63,22 +64,25 @@ class QuantifierTranslation:
     def _err(loc: ast.Loc, msg: str) -> PlanError:
         return PlanError([error(loc, msg, "E-dafny")])
 
+    @abstractmethod
     def tr(self, e: ast.Expr, scope: Mapping[str, Bound]) -> tuple[str, Type]:
         """``(text, type)`` of ``e``: the host's term translation."""
-        raise NotImplementedError
 
+    @abstractmethod
     def member(self, elem: tuple[str, Type], coll: ast.Expr, scope: Mapping[str, Bound]) -> str:
         """Dafny text of ``elem in coll``: the host's membership translation."""
-        raise NotImplementedError
 
+    @abstractmethod
     def _join(self, items: list[tuple[str, Type]]) -> tuple[list[str], Type]:
-        raise NotImplementedError
+        """The items' texts joined at one numeric type, and that type: the host's."""
 
+    @abstractmethod
     def _names_in_scope(self, scope: Mapping[str, Bound]) -> set[str]:
-        raise NotImplementedError
+        """The Dafny names the bound variables of ``scope`` take: the host's."""
 
+    @abstractmethod
     def _value_names(self) -> set[str]:
-        raise NotImplementedError
+        """The parameters', constants' and datatype values' names: the host's."""
 
     def tuple_quant(self, e: ast.TupleQuant, scope: Mapping[str, Bound]) -> str:
         """``Q((u, v) in S | body)``: one Dafny variable ``u_v`` of the tuple
