@@ -69,31 +69,30 @@ def thread_cpu_seconds(pid: int) -> dict[str, float]:
     return out
 
 
-def children_cpu_seconds(pid: int) -> float:
-    """User + system CPU seconds of the live child processes of ``pid`` (Linux ``/proc``; 0 elsewhere): the
-    rclpy source's agent, which the monitor starts in a session of its own."""
-    total = 0.0
+def _children(pid: int) -> Iterator[tuple[int, list[str]]]:
+    """Each live child process of ``pid`` (Linux ``/proc``; none elsewhere): its pid and the fields of its
+    ``stat`` after the command name (field 1 the parent's pid, 11 and 12 user and system clock ticks)."""
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
             fields = stat.read_text().rsplit(")", 1)[1].split()
         except OSError:
             continue
         if len(fields) > 12 and fields[1] == str(pid):
-            total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-    return total
+            yield int(stat.parent.name), fields
+
+
+def children_cpu_seconds(pid: int) -> float:
+    """User + system CPU seconds of the live child processes of ``pid`` (Linux ``/proc``; 0 elsewhere): the
+    rclpy source's agent, which the monitor starts in a session of its own."""
+    return sum((int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK") for _, f in _children(pid))
 
 
 def children_thread_cpu_seconds(pid: int) -> dict[str, float]:
     """:func:`thread_cpu_seconds` of each live child process of ``pid`` (the rclpy agent's threads), merged."""
     out: dict[str, float] = {}
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if len(fields) > 12 and fields[1] == str(pid):
-            for k, v in thread_cpu_seconds(int(stat.parent.name)).items():
-                out[k] = out.get(k, 0.0) + v
+    for child, _ in _children(pid):
+        for k, v in thread_cpu_seconds(child).items():
+            out[k] = out.get(k, 0.0) + v
     return out
 
 
