@@ -66,6 +66,14 @@ from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 _UNHEARD = (-math.inf, 0.0)
 
 
+def _heard_upto(last: float, lag: float, now: float, window: float) -> float:
+    """The time (s, the run's clock) a writer has been heard past at ``now`` (s): the time its last message
+    was placed at (``last``), or, once it has been silent for longer than the lateness bound ``window`` on its
+    own clock (``lag``: the most it published after its stamp), ``now - window - lag``; the one rule
+    :meth:`OnlineEngine.watermark` and a node's ``answers_heard_past`` read."""
+    return max(last, now - window - lag)
+
+
 @dataclass
 class TopicStatus:
     """Per contract topic: messages received, last receipt time (s), silent now?"""
@@ -168,7 +176,7 @@ class OnlineEngine:
         def past(t: float) -> bool:
             for topic in answers:
                 heard = writers.get(topic)
-                if heard is None or (heard[0] < t and self._now - self.reorder_window - heard[1] < t):
+                if heard is None or _heard_upto(*heard, self._now, self.reorder_window) < t:
                     return False
             return True
         return past
@@ -241,7 +249,7 @@ class OnlineEngine:
         upto = now - self.reorder_window
         for last, lag in self.writers.values():
             if last < upto:
-                upto = min(upto, max(last, now - self.reorder_window - lag))
+                upto = min(upto, _heard_upto(last, lag, now, self.reorder_window))
         return upto
 
     def tick(self, now: float) -> None:
