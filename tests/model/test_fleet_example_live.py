@@ -15,11 +15,16 @@ from typing import Any, Iterator
 
 import pytest
 
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import rclverify, ros2_env, ros2_python
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fleet_robots"
 STEPS = 60  # /r2's battery is low (below 0.2) at steps 36 to 45
+
+
+def _answered(log: list[dict[str, Any]]) -> bool:
+    """Each guard's answer to the last round's command is in the monitor's log."""
+    return all(sum(x.get("topic") == f"{r}/cmd_vel" for x in log) >= STEPS for r in ("r1", "r2"))
 
 
 def _run(tmp: Path, slip: bool) -> dict[str, Any]:
@@ -35,6 +40,7 @@ def _run(tmp: Path, slip: bool) -> dict[str, Any]:
                                       *(["--slip"] if slip else [])], cwd=tmp, env=env, stdout=fh,
                                      stderr=subprocess.STDOUT, start_new_session=True)
         wait_for(tmp / "robots.log", "done", 100)
+        wait_logged(tmp / "monitor_live.jsonl", _answered, 30)  # the last commands' answers heard, whatever the load
         stop(monitor, signal.SIGINT)
         out = (tmp / "monitor.out").read_text()
         assert (tmp / "live.json").exists(), out + (tmp / "robots.log").read_text()

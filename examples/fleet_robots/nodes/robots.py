@@ -12,7 +12,7 @@ the two are low at different times.  ``--slip`` runs ``/r2``'s guard with the ab
 Prints ``ready`` once the nodes exist, publishes one round every 0.1 s (the limit and the
 batteries' levels, then, 50 ms later, once the guards have heard them, the planners' commands) (``--steps`` rounds, 0:
 until stopped; with ``--readers N``, first until each topic has N readers besides the fleet's own,
-as a monitor's), prints ``done`` after the last, and spins until SIGINT or SIGTERM.
+as a monitor's), prints ``done`` once the guards have answered the last, and spins until SIGINT or SIGTERM.
 """
 import argparse
 import signal
@@ -39,7 +39,7 @@ def robot(ns, battery_topic, ex, charged):
     level = battery_node.create_publisher(Float64, "battery/level", 10)
     cmd = guard_node.create_publisher(Float64, "cmd_vel", 10)
     seen = {"cmd_raw": 0.0, "level": 1.0, "limit": 0.0}
-    heard = {"level": 0}
+    heard = {"level": 0, "answered": 0}
 
     def on(key):
         def cb(msg):
@@ -47,6 +47,7 @@ def robot(ns, battery_topic, ex, charged):
             heard[key] = heard.get(key, 0) + 1
             if key == "cmd_raw":  # one command per planner message
                 cmd.publish(Float64(data=float(guard(**seen)["cmd_vel"])))
+                heard["answered"] += 1
         return cb
     guard_node.create_subscription(Float64, "cmd_raw", on("cmd_raw"), 10)
     guard_node.create_subscription(Float64, battery_topic, on("level"), 10)
@@ -63,7 +64,7 @@ def robot(ns, battery_topic, ex, charged):
 
     def then():
         raw.publish(Float64(data=float(plan.step()["cmd_raw"])))
-    return first, then, lambda: heard["level"]
+    return first, then, lambda: heard["level"], lambda: heard["answered"]
 
 
 def main():
@@ -96,17 +97,20 @@ def main():
         while not stop:
             if not args.steps or k < args.steps:
                 limit.publish(Float64(data=float(speed_limit()["limit"])))
-                before = [first() for first, _, _ in rounds]
+                before = [first() for first, _, _, _ in rounds]
                 # the guards hear the levels (at most 1 s) before the planners' commands they answer
                 until = time.monotonic() + 1.0
                 while (time.monotonic() < t0 + PERIOD * (k + 0.5) or any(
-                        heard() <= b for (_, _, heard), b in zip(rounds, before))) \
+                        heard() <= b for (_, _, heard, _), b in zip(rounds, before))) \
                         and time.monotonic() < until and not stop:
                     ex.spin_once(timeout_sec=0.01)
-                for _, then, _ in rounds:
+                for _, then, _, _ in rounds:
                     then()
                 k += 1
-                if k == args.steps:
+                if k == args.steps:  # done once each guard has answered the last command (at most 1 s)
+                    until = time.monotonic() + 1.0
+                    while any(answered() < k for *_, answered in rounds) and time.monotonic() < until and not stop:
+                        ex.spin_once(timeout_sec=0.01)
                     print("done", flush=True)
             while time.monotonic() < t0 + PERIOD * k and not stop:
                 ex.spin_once(timeout_sec=0.01)
