@@ -69,15 +69,13 @@ At ``stop`` the agent says ``stopped`` once every sample it took is handed
 over, then leaves the graph (its node destroyed, rclpy shut down) on its own:
 the monitor need not wait for that to end its run.
 
-The agent's output queue is :mod:`agent_frames`, its readings of the graph
+The agent's command lines are read by :mod:`agent_commands`, its output queue is :mod:`agent_frames`, its readings of the graph
 :mod:`agent_graph`, the type descriptions :mod:`agent_describe`: modules
 beside this script, imported as top-level modules like :mod:`wire`.
 """
 from __future__ import annotations
 
 import base64
-import importlib
-import json
 import os
 import queue
 import signal
@@ -102,10 +100,12 @@ from rclpy.utilities import get_rmw_implementation_identifier
 import wire  # type: ignore[import-not-found]  # beside this script (module docstring)
 
 if TYPE_CHECKING:  # mypy reads the siblings as the package's modules
+    from rclverify.runtime.rclpy_source.agent_commands import Command, message_class, read_commands
     from rclverify.runtime.rclpy_source.agent_describe import Describing, installed_description
     from rclverify.runtime.rclpy_source.agent_frames import emit, flush
     from rclverify.runtime.rclpy_source.agent_graph import Endpoint, GraphReading, endpoint, graph_dump, matches
 else:  # run as a script: its folder is on sys.path (module docstring)
+    from agent_commands import Command, message_class, read_commands
     from agent_describe import Describing, installed_description
     from agent_frames import emit, flush
     from agent_graph import Endpoint, GraphReading, endpoint, graph_dump, matches
@@ -130,35 +130,6 @@ TAKE_MAX = 1000
 #: topics, about 6 s of one topic's messages, should the agent be held off the CPU or its pipe be full
 TAP_DEPTH = 10_000
 
-def _class(type_name: str) -> Any:
-    """The message class of ``pkg/kind/Name``; an action's feedback message
-    (``pkg/action/A_FeedbackMessage``) is ``A.Impl.FeedbackMessage`` in rosidl's Python."""
-    pkg, kind, name = type_name.strip("/").split("/")
-    module = importlib.import_module(f"{pkg}.{kind}")
-    if not hasattr(module, name) and kind == "action" and "_" in name:
-        base, _, part = name.rpartition("_")
-        return getattr(getattr(module, base).Impl, part)
-    return getattr(module, name)
-
-
-class _Command(TypedDict, total=False):
-    """One command line of the monitor (module docstring): ``op`` and the keys of that op."""
-    op: str
-    id: int
-    topic: str
-    type: str
-    name: str
-    action: bool
-    depth: int
-    reliable: bool
-    transient_local: bool
-    raw: str
-    hash: str
-    node: str
-    ns: str
-    linger: float
-
-
 class _Tap(TypedDict):
     """A tap's state: its topic and type, the message class (``None``: not importable), the
     subscription and its QoS (reliable, transient-local) once made, how often it was remade,
@@ -170,29 +141,6 @@ class _Tap(TypedDict):
     qos: tuple[bool, bool] | None
     changes: int
     heard: list[str]
-
-
-def _commands(q: queue.Queue[_Command | None], wake: Any, agent: Agent) -> None:
-    """Queue each command line, and wake the executor (a guard condition) so it is done at once; but
-    publish a write to a writer already made here at once, without waking the executor (a verdict
-    then costs the agent no executor turn: at 1000 messages/s, one message a turn, the two turns a
-    message were most of its CPU).  A writer's writes go through the queue for the whole run when its
-    first write came before it was made, so each writer's writes keep the order sent."""
-    queued: set[int] = set()  # writers whose writes go through the queue
-    for line in sys.stdin:
-        if line.strip():
-            c = json.loads(line)
-            if c.get("op") == "write":
-                w = int(c["id"])
-                writer = agent.writers.get(w) if w not in queued else None
-                if writer is not None:
-                    writer.publish(base64.b64decode(c["raw"]))
-                    continue
-                queued.add(w)
-            q.put(c)
-            wake.trigger()
-    q.put(None)
-    wake.trigger()
 
 
 class Agent(GraphReading, Describing):
@@ -224,11 +172,11 @@ class Agent(GraphReading, Describing):
                                "python": sys.version.split()[0], "node": self.name}))
 
     # -- commands ------------------------------------------------------------------------------
-    def command(self, c: _Command) -> None:
+    def command(self, c: Command) -> None:
         op = c.get("op")
         if op == "tap":
             try:
-                cls = _class(c["type"])
+                cls = message_class(c["type"])
             except Exception as exc:  # noqa: BLE001 - said to the monitor, the tap stays deaf
                 emit(wire.json_frame({"what": "error", "id": c["id"], "text": f"{type(exc).__name__}: {exc}"}))
                 cls = None
@@ -245,7 +193,7 @@ class Agent(GraphReading, Describing):
                              durability=DurabilityPolicy.TRANSIENT_LOCAL if c.get("transient_local")
                              else DurabilityPolicy.VOLATILE)
             self.writers[int(c["id"])] = self.node.create_publisher(
-                _class(c["type"]), c["topic"], qos,
+                message_class(c["type"]), c["topic"], qos,
                 event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
         elif op == "write":
             self.writers[int(c["id"])].publish(base64.b64decode(c["raw"]))
@@ -352,7 +300,7 @@ def main() -> int:
         return 0
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     sys.setswitchinterval(SWITCH_INTERVAL_S)
-    q: queue.Queue[_Command | None] = queue.Queue()
+    q: queue.Queue[Command | None] = queue.Queue()
     try:
         agent = Agent()
     except Exception as exc:  # noqa: BLE001 - said to the monitor as one line
@@ -360,7 +308,7 @@ def main() -> int:
         flush()
         return 1
     wake = agent.node.create_guard_condition(lambda: None)  # a command ends the executor's wait at once
-    threading.Thread(target=_commands, args=(q, wake, agent), daemon=True).start()
+    threading.Thread(target=read_commands, args=(q, wake, agent), daemon=True).start()
     agent.hello()
     flush()
     started = False
