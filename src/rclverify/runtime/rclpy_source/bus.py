@@ -7,7 +7,7 @@ heard through the ROS client library on whatever middleware it runs.
 call book, the log and the bag are the DDS path's, unchanged; only where
 the bytes come from differs.  Its data come from an agent process
 (:mod:`.agent`) run in a ROS 2 Python (:func:`.python.ros2_python`), over a
-pipe (:mod:`.wire`; asked to hold :data:`PIPE_BYTES`, read :data:`READ_CHUNK`
+pipe (:mod:`.wire`; asked to hold :data:`.agent_process.PIPE_BYTES`, read :data:`READ_CHUNK`
 bytes at a time, so one read hands over every frame waiting):
 
 * each tap becomes a raw subscription of the topic's ROS name and type
@@ -52,13 +52,13 @@ bytes at a time, so one read hands over every frame waiting):
   (:meth:`RclpyBus.service_nodes`) come from the graph API: they tell whose
   events pair a call (the server's, else every client's).
 
-Errors: :class:`RclpyUnavailable` (no ROS 2 Python, the agent could not
-start): one message.
+Errors: :class:`~.agent_process.RclpyUnavailable` (no ROS 2 Python, the agent could not
+start): one message.  The agent's process (its script, its one-shot answers, its pipe's capacity) is
+:mod:`.agent_process`.
 """
 from __future__ import annotations
 
 import base64
-import io
 import json
 import subprocess
 import threading
@@ -71,41 +71,16 @@ from rclverify.runtime.dds.bus import Tap
 from rclverify.runtime.rclpy_source.discovery import AgentDiscovery, ros_name, ros_type
 from rclverify.runtime.rclpy_source.declared import DeclaredTypes
 from rclverify.runtime.dds.types import Declaration, Declared
+from rclverify.runtime.rclpy_source.agent_process import AGENT, RclpyUnavailable, agent_answer, widen
 from rclverify.runtime.rclpy_source.wire import FrameBuffer, parse_sample, read_frame
 
-AGENT = Path(__file__).with_name("agent.py")
+#: bytes read from the agent's pipe at once (what is there, up to this): one read hands over a batch of frames
+READ_CHUNK = 1 << 20
 #: seconds the agent has to say hello (rclpy's start-up)
 HELLO_TIMEOUT_S = 30.0
 #: samples held per publisher while its type description is asked for (the agent answers within its
 #: DESCRIBE_TIMEOUT_S); past it, each further one is dropped and counted in the tap's ``dropped``
 HOLD_MAX = 10_000
-#: bytes read from the agent's pipe at once (what is there, up to this): one read hands over a batch of frames
-READ_CHUNK = 1 << 20
-#: the agent's pipe's capacity asked for (Linux ``F_SETPIPE_SZ``; an unprivileged process may ask up to
-#: ``/proc/sys/fs/pipe-max-size``, 1 MiB by default): about 4000 samples of a few hundred bytes, so the agent
-#: goes on taking messages while the monitor's reading thread waits for the interpreter
-PIPE_BYTES = 1 << 20
-
-
-class RclpyUnavailable(Exception):
-    """The rclpy source cannot run; ``str`` says why in one line."""
-
-
-def agent_answer(python: Path, args: list[str], timeout_s: float, unreachable: str, failed: str) -> Any:
-    """The JSON answer of one run of the agent (:data:`AGENT`) in the ROS 2 Python ``python`` with
-    ``args`` (``--describe ...``, ``--graph S``): the body of its one ``J`` frame on stdout.  Raises
-    :class:`RclpyUnavailable` with ``unreachable: <why>`` when the process cannot start or outlives
-    ``timeout_s`` seconds, ``failed (exit N): <its last stderr line>`` when it fails or answers no
-    ``J`` frame."""
-    try:
-        proc = subprocess.run([str(python), str(AGENT), *args], capture_output=True, timeout=timeout_s)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        raise RclpyUnavailable(f"{unreachable}: {exc}") from None
-    frame = read_frame(io.BytesIO(proc.stdout))
-    if proc.returncode != 0 or frame is None or frame[0] != b"J":
-        last = proc.stderr.decode(errors="replace").strip().splitlines()[-1:]
-        raise RclpyUnavailable(f"{failed} (exit {proc.returncode}): {' '.join(last)}")
-    return json.loads(frame[1])
 
 
 class _Writer:
@@ -249,7 +224,7 @@ class RclpyBus(DeclaredTypes):
         except OSError as exc:
             raise RclpyUnavailable(f"the ROS 2 Python {self.python} cannot run: {exc}") from None
         assert self._proc.stdout is not None
-        _widen(self._proc.stdout.fileno())
+        widen(self._proc.stdout.fileno())
         first = read_frame(self._proc.stdout)
         if first is None or first[0] != b"J":
             raise RclpyUnavailable(f"the rclpy agent in {self.python} stopped before it started")
@@ -382,20 +357,6 @@ class RclpyBus(DeclaredTypes):
                     self.bypass[key].add(who)
                     self.warn(f"{where}: warning: /{key}: {who} writes on the {role} beside the monitor; what "
                               "it writes is not checked, and the evidence is not discharged while it does")
-
-
-
-def _widen(fd: int) -> None:
-    """Ask for :data:`PIPE_BYTES` of capacity on the pipe ``fd`` (Linux); elsewhere, or where the system
-    refuses, the pipe keeps its own (64 KiB on Linux) and the agent waits for the monitor sooner."""
-    import fcntl  # deferred: POSIX only
-    setsz = getattr(fcntl, "F_SETPIPE_SZ", None)
-    if setsz is None:
-        return
-    try:
-        fcntl.fcntl(fd, setsz, PIPE_BYTES)
-    except OSError:
-        pass
 
 
 __all__ = ["AGENT", "RclpyBus", "RclpyUnavailable", "agent_answer"]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from rclverify.runtime.dds.type_descriptions import declare
 from rclverify.runtime.dds.types import DdsTypeError, Declaration
-from rclverify.runtime.rclpy_source.bus import RclpyUnavailable, agent_answer
+from rclverify.runtime.rclpy_source.agent_process import RclpyUnavailable, agent_answer
 
 
 def installed_declarations(python: Path, names: list[str], timeout_s: float = 60.0) -> dict[str, Declaration]:

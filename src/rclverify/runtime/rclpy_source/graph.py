@@ -22,7 +22,7 @@ from rclverify.ros.live.dds import dds_type, reply_topic, request_topic, topic_n
 from rclverify.ros.live.discovery_info import NodeInfo
 from rclverify.ros.live.dds_discovery import EndpointInfo
 from rclverify.ros.live.dds_qos import INFINITE_NS, LIVELINESS, QosProfile
-from rclverify.runtime.rclpy_source.bus import agent_answer
+from rclverify.runtime.rclpy_source.agent_process import agent_answer
 
 
 def _ns(value: object) -> int:
