@@ -30,7 +30,7 @@ from __future__ import annotations
 import struct
 from typing import Any, Callable
 
-from rclverify.runtime.dds.types import HEADER_FIELDS, WIDE, _EMPTY, _text, to_fields
+from rclverify.runtime.dds.sample_fields import HEADER_FIELDS, PLACEHOLDER, WIDE, to_fields, wide_text
 
 #: a reader: (the sample's bytes, the position) -> (the value as :func:`~.types.to_fields` gives it, the next position)
 Reader = Callable[[bytes, int], "tuple[Any, int]"]
@@ -211,7 +211,7 @@ def _struct(m: Any, e: str) -> Reader:
     if names != list(getattr(m.type, "__dataclass_fields__", {})):
         raise _Declined("struct members")
     wide = getattr(m.type, WIDE, {})
-    keep = [n not in HEADER_FIELDS and n != _EMPTY for n in names]
+    keep = [n not in HEADER_FIELDS and n != PLACEHOLDER for n in names]
     machines = list(m.members_machines.values())
     fused = _fused(names, keep, machines, e) if not wide else None
     if fused is not None:
@@ -223,7 +223,7 @@ def _struct(m: Any, e: str) -> Reader:
         for name, kept, depth, sub in members:
             v, p = sub(d, p)
             if kept:
-                out[name] = v if depth is None else _text(v, depth)
+                out[name] = v if depth is None else wide_text(v, depth)
         return out, p
     return read
 

@@ -40,7 +40,8 @@ hash is not the book's definition's is handed on as :class:`Declared`
 bytes, and every struct of a book reads those with their declaration's
 struct (:meth:`TypeBook.struct`); the declaration is made from the
 publisher's type description by :mod:`.type_descriptions` (docs/ros2.md,
-"The publisher's own definition").
+"The publisher's own definition").  A received sample is read as fields by
+:mod:`.sample_fields` (:func:`to_fields`, :func:`request_id`, re-exported here).
 """
 from __future__ import annotations
 
@@ -55,13 +56,12 @@ from rclverify.ros.extract.interfaces import TypeTable
 from rclverify.ros.extract.interfaces import TypeInfo
 from rclverify.ros.live.dds import ros_type
 from rclverify.ros.live.type_hash import UnknownType, rihs01
+from rclverify.runtime.dds.sample_fields import (HEADER_FIELDS, PLACEHOLDER, WIDE, request_id, to_fields, wide_depth,
+                                                 wide_units)
 
-#: rmw_cyclonedds' request header, as the first members of a service part's struct
-HEADER_FIELDS = ("client_guid_", "sequence_number_")
 _BASE = {"bool": "bool", "byte": "uint8", "octet": "uint8", "char": "uint8", "int8": "int8", "uint8": "uint8",
          "int16": "int16", "uint16": "uint16", "int32": "int32", "uint32": "uint32", "int64": "int64",
          "uint64": "uint64", "float32": "float32", "float64": "float64"}
-_EMPTY = "structure_needs_at_least_one_member"
 
 
 class DdsTypeError(Exception):
@@ -208,7 +208,7 @@ class TypeBook:
                 return (bool if base == "bool" else getattr(T, _BASE[base])), None
             raise DdsTypeError(f"{owner}: field {fname} has type {base}, which Cyclone's Python binding cannot carry")
         if kind == 2:
-            if _wide_depth(desc) == 0:
+            if wide_depth(desc) == 0:
                 return T.sequence[T.uint32], None  # type: ignore[misc]  # a wstring's wire form (module docstring)
             cls = self.struct(str(detail), owner)
             return cls, cls
@@ -238,10 +238,10 @@ class TypeBook:
             if inner is not None:
                 nested[fname] = inner
         if not info.fields:
-            fields[_EMPTY] = T.uint8
+            fields[PLACEHOLDER] = T.uint8
         cls = as_fast_dds(make_idl_struct(name.rsplit("/", 1)[-1] + "_", dds_type(name), fields))
         setattr(cls, "deserialize", classmethod(_read))  # Declared bytes: read in their own definition
-        wide = {f: d for f, d in ((f, _wide_depth(desc)) for f, desc in info.fields) if d is not None}
+        wide = {f: d for f, d in ((f, wide_depth(desc)) for f, desc in info.fields) if d is not None}
         if wide:
             setattr(cls, WIDE, wide)
         self._structs[key] = cls
@@ -318,7 +318,7 @@ class TypeBook:
                 continue
             v = data[fname]
             if fname in wide:
-                v = _units(v, wide[fname])
+                v = wide_units(v, wide[fname])
             if inner is not None:
                 v = [self.build(inner, x) for x in v] if isinstance(v, (list, tuple)) else self.build(inner, v)
             kw[fname] = v
@@ -349,78 +349,6 @@ def _read(cls: Any, data: bytes, has_header: bool = True, use_version_2: bool | 
     if decl is not None and decl.struct is not cls:
         return decl.struct.deserialize(bytes(data), has_header=has_header, use_version_2=use_version_2)
     return cls.__idl__.deserialize(data, has_header=has_header, use_version_2=use_version_2)
-
-
-#: the class attribute naming a struct's wstring fields: field -> how many arrays or sequences hold the text
-WIDE = "__rclverify_wstrings__"
-
-
-def _wide_depth(desc: Any) -> int | None:
-    """0 for a ``wstring`` field description, 1 for an array or sequence of them; ``None`` otherwise."""
-    kind, detail = int(desc[0]), desc[1]
-    if kind == 2:
-        return 0 if str(detail).endswith("/wstring") else None
-    if kind in (3, 4):
-        inner = _wide_depth(detail[0])
-        return None if inner is None else inner + 1
-    return None
-
-
-def _text(units: Any, depth: int) -> Any:
-    """A wstring's code units as text (``depth`` arrays or sequences of them: lists of text)."""
-    if depth:
-        return [_text(u, depth - 1) for u in units]
-    return "".join(chr(c) if 0 <= c <= 0x10FFFF and not 0xD800 <= c <= 0xDFFF else "\ufffd" for c in units)
-
-
-def _units(text: Any, depth: int) -> Any:
-    """The inverse of :func:`_text`."""
-    if depth:
-        return [_units(t, depth - 1) for t in text]
-    return [ord(c) for c in str(text)] if isinstance(text, str) else list(text)
-
-
-#: the types a received value is as it is (a number, a text, a Boolean)
-_PLAIN = frozenset((float, int, str, bool, type(None)))
-#: per struct class, its fields as :func:`to_fields` gives them: (name, wstring depth or None); None: no struct
-_PLANS: dict[type, tuple[tuple[str, int | None], ...] | None] = {}
-
-
-def _plan(cls: type) -> tuple[tuple[str, int | None], ...] | None:
-    fs = getattr(cls, "__dataclass_fields__", None)
-    wide = getattr(cls, WIDE, {})
-    plan = None if fs is None else tuple((k, wide.get(k)) for k in fs if k not in HEADER_FIELDS and k != _EMPTY)
-    _PLANS[cls] = plan
-    return plan
-
-
-def to_fields(sample: Any) -> Any:
-    """A received struct as JSON-ready data: a dict per struct (the request
-    header and rosidl's placeholder member left out), lists for arrays and
-    sequences (an array of bytes as a list of ints), as the bag reader
-    gives a ROS 2 bag's message (``traces/bag.py``).  A struct's fields are
-    listed once per class (the live monitor decodes every sample)."""
-    cls = type(sample)
-    if cls in _PLAIN:
-        return sample
-    plan = _PLANS[cls] if cls in _PLANS else _plan(cls)
-    if plan is not None:
-        out: dict[str, Any] = {}
-        for k, depth in plan:
-            v = getattr(sample, k)
-            out[k] = _text(v, depth) if depth is not None else v if type(v) in _PLAIN else to_fields(v)
-        return out
-    if isinstance(sample, (bytes, bytearray)):
-        return list(sample)
-    if isinstance(sample, (list, tuple)):
-        return [x if type(x) in _PLAIN else to_fields(x) for x in sample]
-    return sample
-
-
-def request_id(sample: Any) -> tuple[int, int]:
-    """``(client writer handle, sequence number)`` of a request or reply struct:
-    the identity that pairs a reply with its request."""
-    return int(getattr(sample, HEADER_FIELDS[0])), int(getattr(sample, HEADER_FIELDS[1]))
 
 
 __all__ = ["ActionTypes", "DdsTypeError", "Declaration", "Declared", "HEADER_FIELDS", "TypeBook", "request_id",
