@@ -58,26 +58,20 @@ from typing import Any, Sequence
 import z3
 
 from rclverify.calculus.requirements.exercised import antecedent as _premise  # the condition a requirement demands under
-from rclverify.calculus.compose import split_assumption
+from rclverify.calculus.requirements.premises import NEGATED, Query, ask, first_undefined, where
 from rclverify.calculus.shapes import TraceNode
 from rclverify.records.stage_records import RequirementBase
-from rclverify.semantics.definedness import Condition, conditions, conjoin
 from rclverify.semantics.encode import Encoder
 from rclverify.calculus.health.witness import finite_witness, has_tables, points_for
 from rclverify.semantics.query import DEFAULT_TIMEOUT_MS, QueryResult, satisfiable, solver_session
 from rclverify.model.plan.formal import Formal, parse_formal
 from rclverify.model.plan.model import Plan, Requirement
-from rclverify.lang import ast
-from rclverify.lang.printer import expr_to_rcl
-from rclverify.lang.types import Checked, CheckedNode
-from rclverify.lang.walk import subexpressions
+from rclverify.lang.types import Checked
 from rclverify.model.system.model import SystemModel
 from rclverify.model.plan.ranking import parse_hints
 from rclverify.model.plan.state import state_types
 from rclverify.model.plan.temporal import operands, parse_temporal
-from rclverify.lang.walk import free_names
 
-NEGATED = "negated requirement"
 #: The first attempt's budget of the consistency and vacuity queries, which
 #: look for a model (sat): Z3's default strategy rarely finds a model of a
 #: quantified formula it did not find at once, while the retries of
@@ -91,10 +85,6 @@ MODEL_TIMEOUT_MS = 1_000
 #: inputs), then to the general query with :data:`MODEL_TIMEOUT_MS` and its
 #: retries, as before.
 FIRST_LOOK_MS = 50
-
-
-def _where(l: ast.Loc) -> str:
-    return f"{l.file}:{l.line}:{l.col}"
 
 
 def cone_of(formals: Sequence[Formal], model: SystemModel) -> list[str]:
@@ -156,24 +146,11 @@ def fingerprint(req: Requirement, cone_snapshots: Sequence[str], model_json: str
     return h.hexdigest()
 
 
-def _io_symbols(e: ast.Expr, cn: CheckedNode, enc: Encoder) -> set[str]:
-    """The Z3 symbol names of the I/O variables formula ``e`` of ``cn`` mentions (bound names excluded)."""
-    free = free_names(e)
-    out = set()
-    for v in subexpressions(e):
-        if isinstance(v, ast.Var):
-            if v.prefix is not None:
-                out.add(enc.symbol_name(cn.name, v.prefix, v.name))
-            elif v.name in free and (v.name in cn.inputs or v.name in cn.outputs):
-                out.add(enc.symbol_name(cn.name, "in" if v.name in cn.inputs else "out", v.name))
-    return out
-
-
 def _base(req: Requirement) -> RequirementBase:
     """The keys of a requirement's record that come from the plan alone."""
     return {
         "id": req.id, "text": req.text, "origin": req.origin,
-        "source": _where(req.formal.loc if req.formal else req.loc),
+        "source": where(req.formal.loc if req.formal else req.loc),
         "formal": " ".join(req.formal.text.split()) if req.formal else None,
         "assuming": [" ".join(a.text.split()) for a in req.assuming],
         "ranking": " ".join(req.ranking.text.split()) if req.ranking else None,
@@ -217,7 +194,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return {**base, "verdict": "informal", "cone": [], "used": [], "traced_not_needed": [],
                 "explanation": "No formal statement: the requirement is traced to guarantees, never checked, never met."}
     cone = cone_of([formal, *assuming], model)
-    q, symbols, goal, r = _ask(base, cone, formal, assuming, checked, model, plan, timeout_ms)  # goal held: _ask
+    q, symbols, goal, r = ask(base, cone, formal, assuming, checked, model, plan, timeout_ms)  # goal held: ask
     enc = q.enc
     out: dict[str, Any] = {**base, "cone": cone, "premises": len(q.premises), "smt2": r.smt2,
                            "duration_s": r.duration_s}
@@ -230,7 +207,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
         return out
     out.update(used=[], traced_not_needed=[])
     if r.status == "sat":
-        undefined = _undefined(q, formal, assuming, symbols, req.id, timeout_ms)
+        undefined = first_undefined(q, formal, assuming, symbols, req.id, timeout_ms)
         refuting = q.labelled
         if undefined is not None:  # not defined where the premises allow: that condition and its model
             cond, refuting, r = undefined
@@ -250,104 +227,7 @@ def check_requirement(req: Requirement, checked: Checked, model: SystemModel, pl
     return out
 
 
-def definedness(formal: Formal, assuming: Sequence[Formal], enc: Encoder, symbols: dict[str, z3.AstRef]
-                ) -> list[tuple[Condition, z3.BoolRef]]:
-    """The well-definedness conditions of a requirement's ``assuming:``
-    formulas (each under the ones before it) and of its statement
-    (:func:`rclverify.semantics.definedness.conditions`), each with its Z3
-    formula over the statements' ``symbols``; empty when nothing divides."""
-    out: list[tuple[Condition, z3.BoolRef]] = []
-    before: list[ast.Expr] = []
-    for f in (*assuming, formal):
-        for c in conditions(f.expr):
-            closed = c.formula if not before else ast.Binary("->", conjoin(before, f.expr.loc), c.formula, c.loc)
-            out.append((c, enc.formula(closed, f.scope, symbols)))
-        before.append(f.expr)
-    return out
-
-
-def _undefined(q: "_Query", formal: Formal, assuming: Sequence[Formal], symbols: dict[str, z3.AstRef], rid: str,
-               timeout_ms: int) -> tuple[Condition, list[tuple[str, z3.BoolRef]], QueryResult] | None:
-    """The first definedness condition of the statement the query's
-    premises do not ensure, with the labelled query that breaks it (the
-    premises and the condition negated) and its answer (``sat``, with the
-    model); ``None`` when each is ensured or undecided."""
-    premises = [(lbl, f) for lbl, f in q.labelled if lbl != NEGATED]
-    for cond, f in definedness(formal, assuming, q.enc, symbols):
-        asked = [*premises, ("undefined", z3.Not(f))]
-        r = satisfiable(asked, q.enc, timeout_ms=timeout_ms,
-                        comment=f"rclverify requirement {rid}: is {cond.text} ({cond.where}) ensured? sat means not")
-        if r.status == "sat":
-            return cond, asked, r
-    return None
-
-
-def _ask(base: RequirementBase, nodes: Sequence[str], formal: Formal, assuming: Sequence[Formal], checked: Checked,
-         model: SystemModel, plan: Plan, timeout_ms: int,
-         note: str = "") -> tuple["_Query", dict[str, z3.AstRef], z3.BoolRef, QueryResult]:
-    """The labelled query ``premises of nodes and assuming and not formal``
-    (``base``: the record's plan keys; ``note`` a line added to the script's
-    comment).  Returns the query, the statements' symbols, the statement's
-    term and Z3's answer.  The caller holds the term while it reads the
-    answer's scripts and asks its other queries: Z3's printer names (``let``)
-    a term that other references share, and a freed term's id goes to the
-    next new one, so the scripts depend on which terms Python still holds."""
-    q = _Query(Encoder(checked.env, model.alias()))
-    q.cone_premises(nodes, checked, model, plan)
-    # the statements' variables are named Node.in.x in their pseudo node (model/plan/formal.py); the encoder looks
-    # an input/output up as "<in|out>.<name>", here "in.Node.in.x", and takes the node's own symbol
-    enc = q.enc
-    symbols = {f"{p}.{n}.{p}.{v}": enc.io_symbol(checked.nodes[n], p, v)
-               for f in (formal, *assuming) for n, p, v in f.mentions}
-    for k, a in enumerate(assuming, 1):
-        q.add(f"assuming {k}", "assuming", None, k, a.expr, enc.formula(a.expr, a.scope, symbols))
-    defined = [f for _, f in definedness(formal, assuming, enc, symbols)]
-    goal = enc.formula(formal.expr, formal.scope, symbols)
-    if defined:  # the statement and its definedness (docs/semantics.md, "Definedness")
-        goal = z3.And(*defined, goal)
-    q.labelled.append((NEGATED, z3.Not(goal)))
-    head = (f"rclverify requirement {base['id']}: {base['formal']}\nsource {base['source']}; "
-            "unsat means the requirement follows from the premises" + note)
-    return q, symbols, goal, satisfiable(q.labelled, enc, timeout_ms=timeout_ms, comment=head)
-
-
-class _Query:
-    """The premises of one requirement's query: each listed for the record
-    (``premises``, ``by_label``) and labelled for Z3's unsat core
-    (``labelled``); ``g_symbols`` the inputs and outputs each guarantee reads."""
-
-    def __init__(self, enc: Encoder) -> None:
-        self.enc = enc
-        self.premises: list[dict[str, Any]] = []
-        self.by_label: dict[str, dict[str, Any]] = {}
-        self.labelled: list[tuple[str, z3.BoolRef]] = []
-        self.g_symbols: dict[str, set[str]] = {}
-
-    def add(self, label: str, kind: str, node: str | None, index: int, e: ast.Expr, f: z3.BoolRef,
-            text: str | None = None) -> None:
-        row = {"label": label, "kind": kind, "node": node, "index": index,
-               "text": text if text is not None else expr_to_rcl(e), "source": _where(e.loc)}
-        self.premises.append(row)
-        self.by_label[label] = row
-        self.labelled.append((label, f))
-
-    def cone_premises(self, cone: Sequence[str], checked: Checked, model: SystemModel, plan: Plan) -> None:
-        """The guarantees, environment assumptions and environment facts of the cone's nodes."""
-        enc = self.enc
-        for n in cone:
-            cn = checked.nodes[n]
-            for k, g in enumerate(cn.node.guarantees, 1):
-                label = f"{n} guarantee {k}"
-                self.add(label, "guarantee", n, k, g.formula, enc.formula(g.formula, cn))
-                self.g_symbols[label] = _io_symbols(g.formula, cn, enc)
-            for k, c in enumerate(split_assumption(checked, model, n)[1], 1):
-                self.add(f"{n} environment assumption {k}", "environment assumption", n, k, c, enc.formula(c, cn))
-            for k, fact in enumerate(plan.facts.get(n, ()), 1):
-                self.add(f"{n} environment fact {k}", "environment fact", n, k, fact.expr,
-                         enc.formula(fact.expr, cn))
-
-
-def _proved(out: dict[str, Any], r: QueryResult, q: _Query, traced: list[str], rid: str, model_ms: int,
+def _proved(out: dict[str, Any], r: QueryResult, q: Query, traced: list[str], rid: str, model_ms: int,
             points: int) -> None:
     """A proved requirement's record: the premises its proof used (the unsat
     core), the traced guarantees it did not need, and whether the used
@@ -373,7 +253,7 @@ def _proved(out: dict[str, Any], r: QueryResult, q: _Query, traced: list[str], r
         out.update(consistency="undecided", consistency_reason=r2.reason)
 
 
-def _vacuity(out: dict[str, Any], q: _Query, premise: z3.BoolRef, rid: str, model_ms: int, points: int) -> None:
+def _vacuity(out: dict[str, Any], q: Query, premise: z3.BoolRef, rid: str, model_ms: int, points: int) -> None:
     """A proved implication's vacuity: can its premise hold with every premise of the cone?"""
     r3 = _model_query([(lbl, f) for lbl, f in q.labelled if lbl != NEGATED] + [("requirement premise", premise)],
                       q.enc, model_ms, points,

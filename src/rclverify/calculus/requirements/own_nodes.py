@@ -47,8 +47,9 @@ from typing import Any
 
 import z3
 
-from rclverify.calculus.requirements.check import (MODEL_TIMEOUT_MS, NEGATED, _ask, _base, _points, _proved,
-                                                   _Query, check_requirement, cone_of, formals_of)
+from rclverify.calculus.requirements.check import (MODEL_TIMEOUT_MS, _base, _points, _proved, check_requirement,
+                                                   cone_of, formals_of)
+from rclverify.calculus.requirements.premises import NEGATED, Query, ask
 from rclverify.calculus.requirements.exercised import antecedent as _premise
 from rclverify.lang.types import Checked
 from rclverify.model.plan.formal import Formal
@@ -114,7 +115,7 @@ def _decide_system(checked: Checked, model: SystemModel, plan: Plan, timeout_ms:
     """Z3's answer for the premises of every node (no script kept: the answer only picks a path).  Asked
     of Z3's incremental SMT core, as a solver session's queries are (semantics/query.py): at 1000 nodes it
     finds the model in 15 ms where the default solver's preprocessing took 0.8 s and ran out of budget."""
-    q = _Query(Encoder(checked.env, model.alias()))
+    q = Query(Encoder(checked.env, model.alias()))
     q.cone_premises(list(model.nodes), checked, model, plan)
     s = wallclock.limit(z3.SimpleSolver(), timeout_ms)
     s.add(*q.enc.axioms(), *(f for _, f in q.labelled))
@@ -173,7 +174,7 @@ def _decide_own(req: Requirement, checked: Checked, model: SystemModel, plan: Pl
     base = _base(req)
     note = (f"\npremises: those of {', '.join(own.nodes)} alone, part of its cone (a proof from part of the "
             "premises is a proof from all of them)")
-    q, _, goal, r = _ask(base, own.nodes, own.formal, [], checked, model, plan, timeout_ms, note)  # goal held: _ask
+    q, _, goal, r = ask(base, own.nodes, own.formal, [], checked, model, plan, timeout_ms, note)  # goal held: ask
     if r.status != "unsat" or NEGATED not in (r.core or []):
         return None
     out: dict[str, Any] = {**base, "cone": own.cone, "premises_of": own.nodes, "premises": len(q.premises),
