@@ -243,7 +243,8 @@ def at_carried_widths(node: CheckedNode, widths: Mapping[str, str],
     def clauses(cs: tuple[ast.Clause, ...]) -> tuple[ast.Clause, ...]:
         return tuple(dataclasses.replace(c, formula=at_widths(c.formula, widths, constants)) for c in cs)
     return dataclasses.replace(node, node=dataclasses.replace(n, assumes=clauses(n.assumes),
-                                                              guarantees=clauses(n.guarantees)))
+                                                              guarantees=clauses(n.guarantees),
+                                                              initially=clauses(n.initially)))
 
 
 def judged_at_widths(checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
