@@ -42,7 +42,12 @@ Seed 545 (8 nodes, DDS source, one seeded defect: Relay6 adds 0.5 to every fourt
 the bag of one run differ on one deadline of the defective relay, due 0.4 s after the bag's last
 message: ``false`` live and on the log (the live clock went on past it), ``currently_false`` on the bag,
 which was recorded before the recorder wrote the run's end and so cannot say the run went on (kept as it
-is: docs/monitors.md, fault 9; the same messages recorded with the end: tests/backends/test_bag_run_end.py)."""
+is: docs/monitors.md, fault 9; the same messages recorded with the end: tests/backends/test_bag_run_end.py).
+
+Seed 820 (5 nodes, DDS source, wall clock, one seeded defect): Sensor0's ``initially`` of its band, its
+first reading its upper bound as its float32 field carries it, judged ``false`` on every path: the
+contract's constants were read at the field's width in assumptions and guarantees, not in initial
+values (docs/monitors.md, "Generated robots", fault 10)."""
 from __future__ import annotations
 
 import json
@@ -224,3 +229,45 @@ def test_seed_545_a_bag_without_the_runs_end_leaves_the_deadline_after_it_curren
     assert [(d.node, d.item, d.a and d.a["verdict"], d.b and d.b["verdict"]) for d in found] == [
         ("Relay6", "deadline", "false", "currently_false")], [d.text(("log", "bag")) for d in found]
     assert {n for n, c in tally(log).items() if c["violated"] or c["deadline false"]} == {"Relay6"}
+
+
+SEED_820 = Path(__file__).resolve().parents[1] / "data" / "robot_seed820"
+
+
+def _declarations_820(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str],
+                      first: float | None = None) -> dict[tuple[str, str], dict[str, Any]]:
+    """Seed 820's log judged offline: its declaration rows by (node, declaration); ``first``: Sensor0's
+    first reading replaced by this value (as its float32 field carries it)."""
+    ws = tmp_path / "ws"
+    shutil.copytree(SEED_820, ws)
+    if first is not None:
+        log = ws / "runs" / "live.jsonl"
+        lines = log.read_text().splitlines()
+        k = next(i for i, ln in enumerate(lines) if json.loads(ln).get("topic") == "arm/ns3/s0")
+        rec = json.loads(lines[k])
+        rec["range"] = first
+        lines[k] = json.dumps(rec)
+        log.write_text("\n".join(lines) + "\n")
+    monkeypatch.chdir(ws)
+    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/live.jsonl"])
+    rows: list[Any] = json.loads(capsys.readouterr().out)
+    return {(r["node"], d["declaration"]): d for r in rows for d in r.get("declarations", [])}
+
+
+def test_seed_820_an_initial_value_at_its_bound_is_read_as_its_float32_field_carries_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """Seed 820 (5 nodes, DDS source, wall clock; its seeded defect Alarm3 answering none of 4 readings):
+    Sensor0 publishes ``SENSOR0_HI = 2.2`` first, as its ``sensor_msgs/Range`` float32 field carries it
+    (2.2000000477).  Its guarantee, the band, read the constant at the field's width and was satisfied;
+    its ``initially`` of the same band read the decimal and was ``false`` live, on the log and on the
+    bag: the widths reached assumptions and guarantees, not initial values
+    (backends/monitors/widths.py, ``at_carried_widths``).  The control: the next float32 above it is
+    beyond the band, ``false``; the seeded defect stays red through its ``progress``."""
+    rows = _declarations_820(tmp_path, monkeypatch, capsys)
+    assert rows[("Sensor0", "initially 1")]["verdict"] == "true", rows[("Sensor0", "initially 1")]
+    assert rows[("Alarm3", "progress")]["verdict"] == "false"
+    assert all(d["verdict"] == "true" for (node, _), d in rows.items() if node != "Alarm3")
+    import numpy as np
+    over = float(np.nextafter(np.float32(2.2), np.float32(np.inf)))
+    control = _declarations_820(tmp_path / "control", monkeypatch, capsys, first=over)
+    assert control[("Sensor0", "initially 1")]["verdict"] == "false"
