@@ -59,7 +59,7 @@ LIVE = frozenset({
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
     "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair", "test_fleet_example_live",
-    "test_run_repair_rclpy",
+    "test_run_repair_rclpy", "test_ros2_run_end",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
