@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import json
 import signal
-import time
 from pathlib import Path
 from typing import Any, Iterator
 
 import pytest
 
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import rclverify, ros2_env, ros2_python, start_node
 
 RCL = """\
@@ -33,6 +32,7 @@ node Relay {
   guarantee( out.cmd == in.odom )
 }
 """
+ROUNDS = 20  # each source's odom, once every 0.1 s, each answered by its robot's relay
 PLAN = "contracts: [contracts/fleet.rcl]\ninstances:\n  OdomSource: [/r1, /r2]\n  Relay: [/r1, /r2]\n"
 
 NODES = """\
@@ -61,7 +61,7 @@ while time.monotonic() < until and not all(p.get_subscription_count() and c.get_
                                            for p, _v, c in pubs):
     ex.spin_once(timeout_sec=0.05)
 t0 = time.monotonic()
-for k in range(20):
+for k in range(ROUNDS):
     for pub, value, _c in pubs:
         pub.publish(Float64(data=value))
     while time.monotonic() < t0 + 0.1 * (k + 1):
@@ -69,7 +69,13 @@ for k in range(20):
 print("done", flush=True)
 while rclpy.ok():
     ex.spin_once(timeout_sec=0.1)
-"""
+""".replace("ROUNDS", str(ROUNDS))
+
+
+def _heard(log: list[dict[str, Any]]) -> bool:
+    """Every odom and every relay's answer to the last of them is in the monitor's log."""
+    return all(sum(x.get("topic") == f"{r}/{t}" for x in log) >= ROUNDS
+               for r in ("r1", "r2") for t in ("odom", "relay/cmd"))
 
 
 def _run(tmp: Path, r2_odom: str) -> dict[str, Any]:
@@ -86,7 +92,7 @@ def _run(tmp: Path, r2_odom: str) -> dict[str, Any]:
                              "--evidence", str(tmp / "live.json")], env, tmp, tmp / "monitor.out")
         nodes = start_node(tmp, "fleet", NODES.replace('R2_ODOM = "odom"', f"R2_ODOM = {r2_odom!r}"), env)
         wait_for(tmp / "fleet.log", "done", 80)
-        time.sleep(1.0)
+        wait_logged(tmp / "monitor_live.jsonl", _heard, 30)  # the relays' last answers heard, whatever the load
         stop(monitor, signal.SIGINT)
         out = (tmp / "monitor.out").read_text()
         assert (tmp / "live.json").exists(), out + (tmp / "fleet.log").read_text()
