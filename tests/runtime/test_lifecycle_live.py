@@ -13,15 +13,15 @@ from __future__ import annotations
 
 import json
 import signal
-import time
 from pathlib import Path
 from typing import Any, Iterator
 
 import pytest
 
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import rclverify, ros2_env, ros2_python, start_node
 
+HORIZON = 1.0  # seconds: the monitor's --horizon
 RCL = """\
 node Battery {
   inputs( request : REAL )
@@ -78,6 +78,15 @@ while rclpy.ok():
 """
 
 
+def _settled(log: list[dict[str, Any]]) -> bool:
+    """The node's six transition events (configure, activate, deactivate: two each) are in the monitor's log,
+    and a request released more than the horizon after the last of them: the last question asked while
+    active (at the latest with the deactivation) is decided, not left open by the stop."""
+    events = [x for x in log if x.get("topic") == "battery/transition_event"]
+    return len(events) >= 6 and any(x.get("topic") == "request" and x["time"] > events[5]["time"] + HORIZON
+                                    for x in log)
+
+
 def _run(tmp: Path, variant: str) -> dict[str, Any]:
     py = ros2_python()  # skips, with the reason, without a ROS 2 Python
     ws = tmp / "ws"
@@ -88,12 +97,12 @@ def _run(tmp: Path, variant: str) -> dict[str, Any]:
     node = monitor = None
     try:
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--status", "0", "--duration", "90",
-                             "--horizon", "1", "--source", "rclpy", "--ros2-python", str(py), "--log",
+                             "--horizon", str(HORIZON), "--source", "rclpy", "--ros2-python", str(py), "--log",
                              str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json"), "--record",
                              str(tmp / "run_bag")], env, tmp, tmp / "monitor.out")
         node = start_node(tmp, "battery", NODES.replace("sys.argv[1]", repr(variant)), env)
         wait_for(tmp / "battery.log", "done", 80)
-        time.sleep(1.0)  # the last outputs heard, and settled
+        wait_logged(tmp / "live.jsonl", _settled, 30)  # the last transition heard and passed, whatever the load
         stop(monitor, signal.SIGINT)
         out = (tmp / "monitor.out").read_text()
         assert (tmp / "live.json").exists(), out + (tmp / "battery.log").read_text()
