@@ -24,11 +24,10 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
@@ -166,7 +165,9 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
         wait_for(tmp / "system.log", "rounds", 60)
         procs += [subprocess.Popen([sys.executable, "-c", BURN], start_new_session=True) for _ in range(BURNERS)]
         wait_for(tmp / "system.log", "done", 60)
-        time.sleep(1.0)
+        # the last round's answers heard and judged by each monitor, whatever the load
+        wait_logged(tmp / "live.jsonl", lambda log: _judged(log, {"y": ROUNDS, "q": 2 * ROUNDS, "traj": ROUNDS}), 30)
+        wait_logged(tmp / "monitor_live.jsonl", lambda log: _judged(log, {"b": ROUNDS + 1}), 30)  # Faulty's log
         stop(monitor, signal.SIGINT)
         stop(faulty, signal.SIGINT)
         yield {"source": source, "tmp": tmp, "ws": ws, "code": monitor.returncode,
@@ -177,6 +178,15 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
     finally:
         for p in procs:
             stop(p)
+
+
+def _judged(log: list[dict[str, Any]], last: dict[str, float]) -> bool:
+    """Each answer of ``last`` (topic -> its value in the last round: ``data``, or ``point.x``) is in the
+    monitor's ``log`` with its verdict."""
+    judged = {(x["verdict"]["topic"], x["verdict"]["time"]) for x in log if x.get("topic") == "rclverify/verdict"
+              and "verdict" in x}
+    return all(any((t, x["time"]) in judged for x in log if x.get("topic") == t
+                   and x.get("data", x.get("point", {}).get("x")) == value) for t, value in last.items())
 
 
 def _counts(record: dict[str, Any], node: str) -> dict[str, int]:
