@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 
 from rclverify.backends.monitors.check import check_trace
 from rclverify.backends.monitors.config import load_mapping
@@ -80,7 +80,9 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             late = _start([str(SCRIPT), "listen", "/rclverify/RadiationSensor/last_verdict",
                            "--out", str(tmp / "last.jsonl"), "--count", "1"], env, tmp / "late.out")
             procs.append(late)
-            time.sleep(HORIZON + 0.5)
+            # the sensor's answers to the six readings heard, and the monitor's timer past the horizon of the last
+            # message (what was still waiting then decided), whatever the load
+            wait_logged(tmp / "live.jsonl", _resolved, 30)
             assert late.wait(20) == 0
             stop(monitor, signal.SIGINT)  # the monitor's own stop: evidence written
             rc = monitor.returncode
@@ -94,6 +96,15 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             for p in procs:
                 stop(p)
     return {"tmp": tmp, "rc": rc, "monitor_out": (tmp / "monitor.out").read_text()}
+
+
+def _resolved(log: list[dict[str, Any]]) -> bool:
+    """The sensor's answer (``radiationStatus``, ``inspected``) to each of the replay's six readings is in
+    the monitor's ``log``, and a verdict decided by its timer at least the horizon after the last message."""
+    heard = [x for x in log if x["topic"] != VERDICT_LOG_TOPIC]
+    count = {t: sum(x["topic"] == t for x in heard) for t in ("r", "radiationStatus", "inspected")}
+    return min(count.values()) >= 6 and any(x["verdict"].get("decided_at", 0) >= heard[-1]["time"] + HORIZON
+                                            for x in log if x["topic"] == VERDICT_LOG_TOPIC)
 
 
 def _topic_verdicts(path: Path) -> list[dict[str, Any]]:
