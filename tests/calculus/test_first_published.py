@@ -110,7 +110,8 @@ def test_a_table_lasso_over_first_is_confirmed_and_a_wrong_flag_is_not(tmp_path)
     from rclverify.calculus.requirements.lasso import find_table_lasso
     from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
     from rclverify.calculus.requirements.temporal_check import statement
-    from rclverify.calculus.requirements.transition import build_system, variable_types
+    from rclverify.calculus.requirements.composed import variable_types
+    from rclverify.calculus.requirements.transition import build_system
     from rclverify.model.plan.temporal import operands
     from rclverify.semantics.encode import Encoder
     ws = tmp_path / "ws"

@@ -18,7 +18,8 @@ from rclverify.calculus.requirements.check import check_requirement
 from rclverify.calculus.requirements.lasso import find_table_lasso
 from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
 from rclverify.calculus.requirements.temporal_check import statement
-from rclverify.calculus.requirements.transition import build_system, variable_types
+from rclverify.calculus.requirements.composed import variable_types
+from rclverify.calculus.requirements.transition import build_system
 from rclverify.semantics.encode import Encoder
 from rclverify.semantics.values import FiniteFunction
 

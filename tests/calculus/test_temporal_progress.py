@@ -159,7 +159,8 @@ def test_a_table_lasso_that_breaks_fairness_is_not_confirmed(tmp_path: Path) -> 
     from rclverify.model.plan.temporal import operands
     from rclverify.calculus.requirements.lasso_confirm import confirm_lasso
     from rclverify.calculus.requirements.temporal_check import statement
-    from rclverify.calculus.requirements.transition import build_system, variable_types
+    from rclverify.calculus.requirements.composed import variable_types
+    from rclverify.calculus.requirements.transition import build_system
     from rclverify.model.plan.formal import parse_formal
     ws = _ws(tmp_path, "progress( within 0 steps )", "initially( out.pose == 0 )")
     w = Workspace(ws)

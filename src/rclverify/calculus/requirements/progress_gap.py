@@ -7,10 +7,10 @@ node answers at none: it *could* be the run of a node that hangs, but it is
 more often a declaration the user left out.  :func:`explain_idle` asks the
 lasso search again over the same system with every node answering every
 input it accepts at once (as if each declared ``progress( within 0 steps
-)``, :meth:`.transition.ComposedSystem.synchronous`: the easiest query for
+)``, :meth:`.composed.ComposedSystem.synchronous`: the easiest query for
 Z3, and the reading before progress could be declared), then, if that finds
 none, with every node held to fairness (as if each declared ``progress(
-eventually )``, :meth:`.transition.ComposedSystem.fair_everywhere`):
+eventually )``, :meth:`.composed.ComposedSystem.fair_everywhere`):
 
 * a lasso there too: the goal is missed even though every node answers
   what it accepts; that lasso is the counterexample (it is a run of the
@@ -38,7 +38,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 from rclverify.lang.liveness import progress_words
 from rclverify.lang.types import Checked
-from rclverify.calculus.requirements.transition import ComposedSystem
+from rclverify.calculus.requirements.composed import ComposedSystem
 from rclverify.calculus.requirements.tsys import TemporalVerdict, TransitionSystem
 from rclverify.calculus.shapes import Gaps, IdleNode, MissingProgress, StuckProducer
 
