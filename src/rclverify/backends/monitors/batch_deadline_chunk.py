@@ -111,7 +111,8 @@ def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
     met = is_open & (answer >= 0) & ((expiry >= n) | (answer <= expiry))
     lapsed = is_open & ~met & (expiry < n)
     late = (~is_open | lapsed) & (answer >= 0)
-    skewed = _skew_window(mon, ns, rows, out_rows, ~met & (np.arange(m) >= len(carried)),
+    in_time = met & (ns[np.maximum(answer, 0)] <= due)  # a marked one answered after its deadline: undecided
+    skewed = _skew_window(mon, ns, rows, out_rows, ~in_time & (np.arange(m) >= len(carried)),
                           bool(refused.size) and bool(lapsed.any()))
     if skewed is None:
         return False  # a window past the 64 outputs the monitor keeps, or which unaccepted trigger is first
@@ -136,7 +137,7 @@ def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
 
 def _skew_window(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, out_rows: np.ndarray, unmet: np.ndarray,
                  race: bool) -> np.ndarray | None:
-    """With the transport skew, the obligations ``unmet`` (new ones, not met in the chunk) with an output
+    """With the transport skew, the obligations ``unmet`` (new ones, not met in time in the chunk) with an output
     stamped within the skew before their trigger (the chunk's, or one the monitor heard before it): those
     :func:`_mark` reads; ``None`` (the chunk is the monitor's) when such a window holds more than the 64
     outputs the monitor keeps, or when ``race`` (a trigger refused by the assumption and an obligation
@@ -236,7 +237,10 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
     rest = ~plain
     for r, ph, i in zip(at[rest].tolist(), phase[rest].tolist(), obs[rest].tolist()):
         if ph == 1:
-            mon._emit(mon.answered_verdict(ob(i), int(ns[r]), evs[r], plan.timed[int(which[i])][2]))
+            if maybe[i] and int(ns[r]) > int(due[i]):  # a marked obligation's own answer after its deadline
+                deadline_skew.undecided(mon, ob(i))
+            else:
+                mon._emit(mon.answered_verdict(ob(i), int(ns[r]), evs[r], plan.timed[int(which[i])][2]))
         elif ph == 0:
             if not maybe[i]:
                 mon._emit(mon.late_verdict(ob(i), int(ns[r]), evs[r]))
@@ -250,7 +254,7 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
             else:
                 mon._emit(mon.expired_verdict(p, int(ns[r])))
     result.counts["true"] += trues
-    counted = ~(maybe[obs] & (phase != 1))  # a marked obligation's expiry and late answer count no time margin
+    counted = ~(maybe[obs] & ((phase != 1) | (ns[at] > due[obs])))  # a marked one's answer after it counts none
     _note_margins(mon, evs, ns, which, due, ob, (at[counted], phase[counted], obs[counted]))
     # the state: the open obligations left (in order), the expired ones not answered (in the expired list's order)
     last_out = int(out_rows[-1]) if out_rows.size else -1
