@@ -31,8 +31,9 @@ as the live run did (tests/runtime/test_ros2_bag_calls.py).
 
 The bag carries the run's end (:meth:`BagRecorder.end`): one message, written last, on
 ``/rclverify/run_end`` (``builtin_interfaces/msg/Time``) at the time the
-live run's deadline clock reached, so a deadline the live clock passed is
-``false`` on the bag as on the log (:mod:`rclverify.traces.bag_end`).
+live run's monitors' clock reached, so a question whose horizon the live
+clock passed is closed, and a deadline it passed is ``false``, on the bag
+as on the log (:mod:`rclverify.traces.bag_end`).
 """
 from __future__ import annotations
 

@@ -11,11 +11,13 @@ the bus and the engine thread and makes the evidence record: the ROS 1 one
 call-by-call verdicts' status), ``deadlines``, ``qos`` (per topic the
 reader's QoS and what it heard), ``warnings``, ``enforce``, ``bypass`` and
 ``bag`` (docs/ros2.md), the recorded bag ending at the time the live
-deadline clock reached (:func:`deadline_clock`, :mod:`rclverify.traces.bag_end`).
+run's clock reached (:func:`run_clock`, :mod:`rclverify.traces.bag_end`), whatever
+its contracts are.
 """
 from __future__ import annotations
 
 import json
+import math
 import time as _time
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -163,7 +165,7 @@ class DdsRunEnd:
         downgrade(record_["nodes"], {n.name: [t.field.strip("/") for t in n.node.topics] for n in self.nodes},
                   bypass, {t.key: t.reader_changes for t in bus.taps})
         if self.recorder is not None:
-            end = deadline_clock(live)
+            end = run_clock(live)
             if end is not None:  # the bag ends where the live clock did (traces/bag_end.py)
                 self.recorder.end(end)
             record_["bag"] = self.recorder.close()
@@ -176,11 +178,15 @@ class DdsRunEnd:
         return record_
 
 
-def deadline_clock(live: LiveRun) -> float | None:
-    """The time (s since the epoch, the log's time line) the live run's deadline checks' clock reached
-    (:mod:`rclverify.runtime.logchecks`: the run's clock less the reorder window, and every line the log
-    carries), or ``None`` when no node has a timed guarantee or the clock never moved."""
-    clocks = [d.now for d in live.checks.deadlines if d.now_ns is not None]
+def run_clock(live: LiveRun) -> float | None:
+    """The time (s since the epoch, the log's time line) the live run's monitors' clock reached when it
+    stopped: the latest of every node monitor's (moved by each message released and by the timer to the
+    engine's watermark, :meth:`~rclverify.backends.monitors.online.OnlineEngine.tick`) and of the deadline
+    checks' (:mod:`rclverify.runtime.logchecks`: the same watermark, and every line the log carries); a
+    question whose horizon that clock passed was closed live, and a deadline it passed is ``false``.
+    ``None`` when no clock moved (nothing heard, no timer run)."""
+    clocks = [m.now for m in live.engine.monitors if math.isfinite(m.now)]
+    clocks += [d.now for d in live.checks.deadlines if d.now_ns is not None]
     return max(clocks) if clocks else None
 
 
@@ -196,4 +202,4 @@ def _calls_record(summary: Mapping[str, object], book: CallBook, calls: CallTaps
     return out
 
 
-__all__ = ["DdsRunEnd", "deadline_clock", "status_line"]
+__all__ = ["DdsRunEnd", "run_clock", "status_line"]
