@@ -43,6 +43,19 @@ def _start(args: list[str], env: dict[str, str], out: Path) -> subprocess.Popen[
                             stderr=subprocess.STDOUT, start_new_session=True)
 
 
+def _subscribed(master: str, topic: str, timeout: float) -> None:
+    """Wait until the ROS 1 master at ``master`` lists a subscriber of ``topic`` (``getSystemState``);
+    ``AssertionError`` after ``timeout`` seconds."""
+    import xmlrpc.client
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        _code, _msg, (_pubs, subs, _srvs) = xmlrpc.client.ServerProxy(master).getSystemState("/test")
+        if any(name == topic and nodes for name, nodes in subs):
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"nothing subscribed to {topic} within {timeout} s")
+
+
 @pytest.fixture(scope="module")
 def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     tmp = tmp_path_factory.mktemp("svc")
@@ -69,7 +82,7 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             echo = subprocess.Popen(["rostopic", "echo", "/rclverify/verdict"], env=env, stdout=(tmp / "echo.out").open("wb"),
                                     stderr=subprocess.STDOUT, start_new_session=True)
             procs.append(echo)
-            time.sleep(1.0)  # subscribed before the first call
+            _subscribed(env["ROS_MASTER_URI"], "/rclverify/verdict", 30)  # before the first call, whatever the load
             teleop = _start([str(NODES), "teleop", "--call", "/estop", "--count", "2", "--every", "0.3"],
                             env, tmp / "teleop.out")
             mission = _start([str(NODES), "mission", "--target", "2.0"], env, tmp / "mission.out")
