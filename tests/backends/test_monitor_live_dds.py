@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop
+from _procs import stop, wait_logged
 
 pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed (pip install cyclonedds)")
 
@@ -126,10 +126,10 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
             time.sleep(0.05)
         replies = [call({"data": True}, 5.0) for _ in range(3)]
         feedbacks, result = send({"target": 2.0}, 5.0)
-        time.sleep(1.5)  # the horizon (1 s) passes: the wrong answer is judged
+        wait_logged(tmp / "live.jsonl", _judged, 30)  # every call, goal and limit judged, whatever the load
         # the sensor goes on publishing: the recorded bag, checked offline, reaches past the horizon too
         rng.write(F32(data=4.0))
-        time.sleep(0.1)
+        wait_logged(tmp / "live.jsonl", lambda log: sum(x.get("topic") == "range" for x in log) >= 4, 30)
         got: list[float] = []
         wait_until(lambda: got.extend(s.data for s in heard.take(N=16)) or len(got) >= 2, 5, "the released speeds")
         time.sleep(0.3)
@@ -156,6 +156,21 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     yield {"tmp": tmp, "code": code, "out": out.read_text(), "log": log, "consumer": got, "replies": replies,
            "echoed": echoed, "latched": json.loads(latched[-1].data), "imposter": imposter_heard,
            "feedbacks": feedbacks, "result": result, "record": json.loads((tmp / "live.json").read_text())}
+
+
+def _judged(log: list[dict[str, Any]]) -> bool:
+    """The run's end in the monitor's ``log``: /estop's three calls judged and its late answer's deadline
+    line (an update), /move's goal answered and its deadline, Limiter's verdict on the last limit (1.3)."""
+    calls = [v["node"] for v in _verdicts(log) if v.get("call")]
+    deadlines = [x["verdict"] for x in log if x.get("kind") == "deadline"]
+    return calls.count("Base") >= 3 and "Mover" in calls and any(v["node"] == "Mover" for v in deadlines) \
+        and any(v["node"] == "Base" and v.get("update") for v in deadlines) \
+        and any(v["node"] == "Limiter" and v.get("values", {}).get("in.limit") == "1.3" for v in _verdicts(log))
+
+
+def _verdicts(log: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The verdicts of ``log``'s verdict lines that are not deadline lines."""
+    return [x["verdict"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x]
 
 
 def _call_verdicts(log: list[dict[str, Any]], node: str) -> list[dict[str, Any]]:
