@@ -98,6 +98,12 @@ class DeadlineResult:
     first_unaccepted: Unaccepted | None = None
     #: guarantee -> its smallest time margin on the run (:class:`TimeMargin`)
     time_margins: dict[int, TimeMargin] = field(default_factory=dict)
+    #: guarantee -> the smallest margin among those no revision can withdraw (every one noted here but the
+    #: late answers still held, :mod:`.deadline_late`): (margin ns, order noted, trigger, answer, answer s),
+    #: the first of equals; what the smallest becomes when a held one is withdrawn
+    floor: dict[int, tuple[int, int, str, str, float]] = field(default_factory=dict, repr=False)
+    #: how many margins were noted (the order of each, :attr:`floor`)
+    noted: int = field(default=0, repr=False)
 
     def to_json(self) -> DeadlineResultJson:
         return {"node": self.node, "counts": dict(self.counts),
@@ -106,7 +112,19 @@ class DeadlineResult:
                 "time_margins": [m.to_json() for _, m in sorted(self.time_margins.items())]}
 
     def note_time_margin(self, k: int, margin_ns: int | None, trigger_where: str, answer_where: str,
-                         answer: float, was_unanswered: bool = False) -> None:
-        """Count guarantee ``k``'s time margin on one trigger (:func:`.time_margins.note`)."""
+                         answer: float, was_unanswered: bool = False, held: bool = False) -> int:
+        """Count guarantee ``k``'s time margin on one trigger (:func:`.time_margins.note`); ``held``: a
+        late answer a revision may still withdraw (kept out of :attr:`floor` until :meth:`settle`).
+        Returns the order it was noted in."""
         note(self.time_margins, k, margin_ns, trigger_where, answer_where, answer, was_unanswered)
+        self.noted += 1
+        if margin_ns is not None and not held:
+            self.settle(k, (margin_ns, self.noted, trigger_where, answer_where, answer))
+        return self.noted
+
+    def settle(self, k: int, entry: tuple[int, int, str, str, float]) -> None:
+        """Guarantee ``k``'s margin ``entry`` (:attr:`floor`'s shape) can no longer be withdrawn."""
+        low = self.floor.get(k)
+        if low is None or entry[:2] < low[:2]:
+            self.floor[k] = entry
 

@@ -113,28 +113,32 @@ def undecided(mon: DeadlineMonitor, p: Pending, revised: str = "") -> None:
                                        reason + revised, update=bool(revised)))
 
 
-def revise_false(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
-    """Obligation ``p`` was judged ``false`` when the clock passed its deadline; output ``ev``, stamped ``ns``
+def revise_false(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapping[str, object],
+                 answered: bool = False) -> bool:
+    """Obligation ``p`` was judged ``false`` when the clock passed its deadline (``answered``: and answered
+    since by an output of its own stamped after it, :mod:`.deadline_late`); output ``ev``, stamped ``ns``
     within the skew before its trigger (``fresh``: the outputs it set), was heard only then (later than the
     lateness bound).  Where it satisfies the guarantee on the trigger's inputs (:func:`mark_early`, judged as
     when the trigger came: on none of the outputs published after it), ``p`` is what the run read in stamp
     order makes it, ``undecided``: the ``false`` is withdrawn (its count, the first ``false``, its unanswered
-    time margin) and counted ``undecided`` by :func:`undecided`, whose verdict is an update saying so."""
+    time margin, unless ``answered``: the caller withdraws the late answer's) and counted ``undecided`` by
+    :func:`undecided`, whose verdict is an update saying so.  Returns whether it did."""
     probe = dataclasses.replace(p, outs={})
     mark_early(mon, probe, ev, ns, fresh)
     if not probe.maybe:
-        return
+        return False
     p.maybe = probe.maybe
     mon._withdraw_false(p)
     margins = mon.result.time_margins
     m = margins.get(p.k)
-    if m is not None:  # counted unanswered when it expired; an undecided trigger counts no time margin
+    if m is not None and not answered:  # counted unanswered when it expired; an undecided trigger counts none
         m.unanswered -= 1
         if not m.answers and not m.unanswered:
             del margins[p.k]
     behind = ms_ns(mon.now_ns - ns) if mon.now_ns is not None else "?"
     undecided(mon, p, f"; heard after the clock had passed the deadline (at {behind} behind it): the false given "
-                      "when the clock passed is withdrawn")
+                      "when the clock passed is withdrawn" + (", and its late answer's with it" if answered else ""))
+    return True
 
 
 def decided_late(mon: DeadlineMonitor, p: Pending) -> None:

@@ -65,7 +65,7 @@ from rclverify.backends.monitors.verdicts import names
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import ms, ms_ns
-from rclverify.backends.monitors import deadline_skew
+from rclverify.backends.monitors import deadline_late, deadline_skew
 
 
 def rejected(k: int, out: Event, j: Judgement) -> str:
@@ -126,6 +126,9 @@ class DeadlineMonitor:
         self.invalid: dict[str, str] = {}
         self.pending: list[Pending] = []
         self.expired: deque[Pending] = deque(maxlen=256)  # judged false, waiting for a late answer to show
+        #: judged false and answered late since, kept for an output within the skew before the trigger
+        #: heard later still (:mod:`.deadline_late`)
+        self.answered_late: deque[deadline_late.Answered] = deque()
         #: the last outputs heard: (stamp ns, event, outputs it set, their values): a trigger heard after them
         #: but stamped before them is answered by them
         self.heard: deque[tuple[int, Event, set[str], dict[str, object]]] = deque(maxlen=64)
@@ -278,7 +281,9 @@ class DeadlineMonitor:
                 if p.maybe:  # answered late, or in time by the output within the skew before it: still undecided
                     continue
                 self._emit(self.late_verdict(p, ns, ev))
-                self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp, was_unanswered=True)
+                deadline_late.hold(self, p, ns, ev)  # an output within the skew before it may still come
+        if self.answered_late:
+            deadline_late.revise(self, ev, ns, {c: self.values[c] for c in outs if c not in self.state_outs})
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
         self.heard.append((ns, ev, outs, {c: self.values[c] for c in outs if c not in self.state_outs}))
 
@@ -337,6 +342,9 @@ class DeadlineMonitor:
         if j.truth is not True:
             p.rejected = rejected(k, ev, j)
             return False
+        if p.maybe and ns > p.due_ns:  # its own answer after the deadline: undecided, as when the clock passed first
+            deadline_skew.undecided(self, p)
+            return True
         self._emit(self.answered_verdict(p, ns, ev, d, j.semantics))
         self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp)
         return True

@@ -1,0 +1,95 @@
+"""A deadline's late answer that an output heard later still revises (docs/semantics.md, "Deadlines").
+
+Live, an obligation judged ``false`` when the watermark passed its deadline
+and then answered by an output of its own stamped after the deadline keeps
+its ``false`` (an update names the late answer).  An output stamped within
+the transport skew before its trigger that satisfies the guarantee on the
+trigger's inputs may still be heard after both (later than the lateness
+bound); the run read in stamp order puts it before the trigger and finds
+the deadline ``undecided`` (:mod:`.deadline_skew`).  So such an obligation
+is kept with its late answer (the last :data:`KEPT`), and an output of that
+kind heard later makes it ``undecided`` as
+:func:`.deadline_skew.revise_false` does an unanswered one: its ``false``
+and its late answer's time margin are withdrawn, and the verdict that
+follows says so.  Offline a run is read in stamp order, so that output
+comes first and nothing is kept here to revise.
+
+A late answer's margin is counted when it comes, marked withdrawable
+(:meth:`~.deadline_records.DeadlineResult.note_time_margin`, ``held``);
+withdrawn, the guarantee's smallest margin becomes the smallest of those
+no revision can withdraw (:attr:`~.deadline_records.DeadlineResult.floor`)
+and of the late answers still kept, the first noted of equals, as if the
+withdrawn one had never been counted.
+"""
+from __future__ import annotations
+
+from collections import deque
+from typing import Mapping, Protocol
+
+from rclverify.traces.events import Event
+from rclverify.backends.monitors import deadline_skew
+from rclverify.backends.monitors.deadline_records import DeadlineResult, Pending
+
+#: how many late-answered obligations are kept for a revision (as many as the expired ones, deadlines.py)
+KEPT = 256
+
+#: one kept obligation: (the obligation, its late answer's margin in ns, the order that margin was noted in,
+#: the answer's place, its stamp s)
+Answered = tuple[Pending, int, int, str, float]
+
+
+class LateAnswers(deadline_skew.DeadlineMonitor, Protocol):
+    """What this module reads of :class:`~.deadlines.DeadlineMonitor` beyond the skew rule's."""
+
+    answered_late: deque[Answered]
+    result: DeadlineResult
+
+
+def hold(mon: LateAnswers, p: Pending, ns: int, ev: Event) -> None:
+    """Expired obligation ``p`` (judged ``false``, not marked by the skew) answered by output ``ev`` stamped
+    ``ns``, after its deadline: its margin counted (withdrawable) and ``p`` kept for :func:`revise`; the
+    oldest kept one past :data:`KEPT` leaves, its margin no longer withdrawable."""
+    margin = p.due_ns - ns
+    order = mon.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True,
+                                        held=True)
+    kept = mon.answered_late
+    if len(kept) >= KEPT:
+        gone = kept.popleft()
+        mon.result.settle(gone[0].k, (gone[1], gone[2], gone[0].trigger.where, gone[3], gone[4]))
+    kept.append((p, margin, order, ev.where, ns / 1e9))
+
+
+def revise(mon: LateAnswers, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
+    """Output ``ev`` stamped ``ns`` (``fresh``: the outputs it set): each kept obligation whose trigger it is
+    stamped within the skew before, and whose guarantee it satisfies on the trigger's inputs, is
+    ``undecided`` (:func:`.deadline_skew.revise_false`), its late answer's margin withdrawn."""
+    for entry in list(mon.answered_late):
+        p = entry[0]
+        if ns < p.stamp_ns and deadline_skew.within_skew_before(mon, p, ns) and \
+                deadline_skew.revise_false(mon, p, ev, ns, fresh, answered=True):
+            mon.answered_late.remove(entry)
+            _withdraw_margin(mon, entry)
+
+
+def _withdraw_margin(mon: LateAnswers, entry: Answered) -> None:
+    """The late answer's margin of ``entry`` out of its guarantee's time margins (module docstring)."""
+    p, margin = entry[0], entry[1]
+    margins = mon.result.time_margins
+    m = margins.get(p.k)
+    if m is None:
+        return
+    m.answers -= 1
+    if not m.answers:
+        if not m.unanswered:
+            del margins[p.k]
+        return
+    if (m.margin_ns, m.trigger_where) != (margin, p.trigger.where):
+        return  # not the smallest: the smallest stands
+    rest = [(e[1], e[2], e[0].trigger.where, e[3], e[4]) for e in mon.answered_late if e[0].k == p.k]
+    low = mon.result.floor.get(p.k)
+    best = min(rest + ([low] if low is not None else []), default=None, key=lambda e: e[:2])
+    if best is not None:
+        m.margin_ns, _, m.trigger_where, m.answer_where, m.answer = best
+
+
+__all__ = ["KEPT", "Answered", "LateAnswers", "hold", "revise"]
