@@ -75,11 +75,6 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
 
     #: Evaluations remembered per (formula, inputs, outputs); 0 turns the cache off.
     cache_size = 4096
-    #: live (set by :mod:`.online`): whether every writer of the node's outputs has been heard past a time
-    #: (s, the run's clock); a ``superseded`` given before is provisional, and an output heard later whose
-    #: stamp pairs it with that question withdraws it (docs/semantics.md, "Provisional verdicts").
-    #: ``None`` offline: the run is read whole, every writer heard.
-    answers_heard_past: Callable[[float], bool] | None = None
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
                  horizon: float, on_verdict: Callable[[Verdict], None] | None = None,
@@ -300,15 +295,10 @@ class NodeMonitor(ContractReading, Judging, Closing, Late):
             old.reported = True
             if (self.stream.skew or self._wins) and self._recent:
                 self._early_answer(old)
-            early = self.answers_heard_past is not None and not self.answers_heard_past(old.event.time)
-            if early:  # a writer of its answers not heard past it yet: withdrawn if its answer comes (late.py)
-                kept = self._early_superseded
-                if len(kept) >= 1024:
-                    del kept[next(iter(kept))]  # the oldest: long superseded, its question forgotten
-                kept[old.event.index] = None
+            # a writer of its answers not heard past it yet: provisional, withdrawn if its answer comes (late.py)
             self._verdict("superseded", old.event, reason=f"the input at {ev.where} came before any output "
                           f"answered the question raised at {old.event.where}: the node owes the latest one an answer",
-                          provisional=early)
+                          provisional=self._superseded_early(old.event, old.event.time))
         if refusal:
             self._verdict("inconclusive", ev, reason=refusal)
         if not owed:

@@ -54,7 +54,7 @@ message heard late.
 from __future__ import annotations
 
 import bisect
-from typing import Any
+from typing import Any, Callable
 
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
@@ -64,6 +64,26 @@ from rclverify.backends.monitors.verdicts import Verdict
 
 class Late(EngineState):
     """The late-input part of :class:`~.engine.NodeMonitor` (module docstring)."""
+
+    #: live (set by :mod:`.online`): whether every writer of the node's outputs has been heard past a time
+    #: (s, the run's clock); a ``superseded`` given before is provisional, and an output heard later whose
+    #: stamp pairs it with that question withdraws it (docs/semantics.md, "Provisional verdicts").
+    #: ``None`` offline: the run is read whole, every writer heard.
+    answers_heard_past: Callable[[float], bool] | None = None
+
+    def _superseded_early(self, qe: Event, at: float) -> bool:
+        """Whether the ``superseded`` about to be given to the question raised by ``qe``, placed at
+        ``at`` (s, the run's clock), is given early: a writer of the node's outputs not yet heard past
+        ``at`` (:attr:`answers_heard_past`), so an answer stamped at it may still come.  Such a
+        question is kept (its event index, the last 1024) for :meth:`_answers_superseded` to withdraw
+        the verdict; the verdict goes out ``provisional``."""
+        if self.answers_heard_past is None or self.answers_heard_past(at):
+            return False
+        kept = self._early_superseded
+        if len(kept) >= 1024:
+            del kept[next(iter(kept))]  # the oldest: long superseded, its question forgotten
+        kept[qe.index] = None
+        return True
 
     def _late_input(self, ev: Event, trig: frozenset[str], stamp: float) -> None:
         """Input ``ev`` (it set the inputs ``trig``), stamped ``stamp`` (s), heard after a
@@ -147,10 +167,14 @@ class Late(EngineState):
         q.reported = True  # only the latest question is watched for its horizon
         if not q.answered and not q.settled:
             gap = nxt[0].stamp - stamp
-            self._verdict("superseded" if gap <= self.horizon else "inconclusive", ev,
-                          reason=f"heard after messages stamped later; the question at {nxt[0].event.where} came "
-                                 f"{gap:.9g} s after it, before any output answered it" +
-                                 ("" if gap <= self.horizon else f" and after its horizon of {self.horizon} s"))
+            if gap > self.horizon:
+                self._verdict("inconclusive", ev, reason=f"heard after messages stamped later; the question at "
+                              f"{nxt[0].event.where} came {gap:.9g} s after it, before any output answered it and "
+                              f"after its horizon of {self.horizon} s")
+                return
+            self._verdict("superseded", ev, reason=f"heard after messages stamped later; the question at "
+                          f"{nxt[0].event.where} came {gap:.9g} s after it, before any output answered it",
+                          provisional=self._superseded_early(ev, stamp))
 
     def _completed(self, stamp: float, first: float) -> list[tuple[float, Event, dict[str, object], frozenset[str]]]:
         """A message stamped ``stamp``, before the first question (stamped ``first``),
