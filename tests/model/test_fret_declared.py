@@ -6,10 +6,12 @@ from __future__ import annotations
 
 from typing import Any
 
+import msgspec
+
 from rclverify.lang import ast
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
-from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretVariable
+from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretSemantics, FretVariable
 from rclverify.model.plan.fret.requirements import Imported, import_export, options_of
 from rclverify.model.plan.state import state_types
 from rclverify.model.plan.temporal import Temporal, parse_temporal
@@ -29,7 +31,8 @@ VARS = {"a": "Input", "b": "Input", "c": "Input", "d": "Input", "theta": "Input"
 def _import(post: str, fret: dict[str, Any] | None = None) -> Imported:
     sem = {"scope": {"type": "null"}, "condition": "null", "timing": "always", "response": "satisfaction",
            "component_name": "arm", "post_condition": post}
-    req = FretRequirement("R-1", f"arm shall always satisfy {post}", "arm", sem, ast.Loc("x.json", 3, 1), "", {})
+    req = FretRequirement("R-1", f"arm shall always satisfy {post}", "arm", msgspec.convert(sem, FretSemantics),
+                          ast.Loc("x.json", 3, 1), "", {})
     variables = {("arm", n): FretVariable("arm", n, k, "boolean" if n == "ok" else "double", "") for n, k in VARS.items()}
     (imp,) = import_export(FretExport("x.json", (req,), variables), options_of({"fret": {"components": {"arm": "Arm"},
                                                                                              **(fret or {})}}))

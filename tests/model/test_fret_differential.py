@@ -30,12 +30,13 @@ import zlib
 from fractions import Fraction
 from typing import Any, Callable
 
+import msgspec
 import pytest
 
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
 from rclverify.model.plan.formal import Formal
-from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretVariable
+from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretSemantics, FretVariable
 from rclverify.model.plan.fret.requirements import Options, import_export
 from rclverify.model.plan.state import parse_state_formula, state_types
 from rclverify.model.plan.temporal import Temporal, parse_temporal, shape
@@ -135,7 +136,8 @@ def _export(cases: list[Any]) -> FretExport:
                                "ptExpanded": pt, **extra}
         if pre is not None:
             sem.update(pre_condition=pre, regular_condition=pre)
-        reqs.append(FretRequirement(rid, rid, "rover", sem, ast.Loc("x.json", k + 1, 1), "", {}))
+        reqs.append(FretRequirement(rid, rid, "rover", msgspec.convert(sem, FretSemantics), ast.Loc("x.json", k + 1, 1),
+                                    "", {}))
     variables = {("rover", n): FretVariable("rover", n, i, d, "") for n, (i, d) in VARS.items()}
     return FretExport("x.json", tuple(reqs), variables)
 

@@ -209,6 +209,10 @@ def test_names_and_types_are_checked_against_the_contracts(ws: Path, tmp_path: P
     ('{"requirements": [{"fulltext": "no id"}]}', (1, 1), "requirement 1 of the FRET export has no 'reqid' string"),
     ('[\n {"reqid": "A"},\n {"reqid": "A"}\n]', (3, 12), "reqid 'A' is used twice in the FRET export (first at 2:12)"),
     ('{"reqs": []}', (1, 1), "a FRET export is a list of requirements or an object with a 'requirements' list"),
+    ('[\n {"reqid": "A", "semantics": {"timing": 3}}\n]', (2, 12),
+     "requirement A of the FRET export: Expected `str | null`, got `int` - at `$.semantics.timing`"),
+    ('{"requirements": [],\n "variables": [{"variable_name": "v", "idType": "Input", "dataType": 1}]}', (2, 34),
+     "variable \"v\" of the FRET export: Expected `str | array | null`, got `int` - at `$.dataType`"),
 ])
 def test_a_malformed_export_is_a_located_error(tmp_path: Path, text: str, where: tuple[int, int], message: str) -> None:
     p = tmp_path / "bad.json"

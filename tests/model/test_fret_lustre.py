@@ -21,12 +21,13 @@ import zlib
 from fractions import Fraction
 from typing import Any, Callable
 
+import msgspec
 import pytest
 
 from rclverify.lang import ast
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
-from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretVariable
+from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretSemantics, FretVariable
 from rclverify.model.plan.fret.requirements import Options, import_export
 from rclverify.model.plan.state import parse_state_formula, state_types
 from rclverify.model.plan.temporal import Temporal, parse_temporal
@@ -102,7 +103,8 @@ def _export(cases: list[Any], internal: list[tuple[str, str, str, Stream]] = INT
                                "ptExpanded": pt, **extra}
         if pre is not None:
             sem.update(pre_condition=pre, regular_condition=pre)
-        reqs.append(FretRequirement(rid, rid, "rover", sem, ast.Loc("x.json", k + 1, 1), "", {}))
+        reqs.append(FretRequirement(rid, rid, "rover", msgspec.convert(sem, FretSemantics), ast.Loc("x.json", k + 1, 1),
+                                    "", {}))
     variables = {("rover", n): FretVariable("rover", n, i, d, "") for n, (i, d) in PORTS.items()}
     variables.update({("rover", n): FretVariable("rover", n, "Internal", d, a) for n, d, a, _ in internal})
     return FretExport("x.json", tuple(reqs), variables)

@@ -14,13 +14,14 @@ from __future__ import annotations
 import random
 from typing import Any
 
+import msgspec
 import pytest
 
 from rclverify.lang import ast
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
 from rclverify.model.plan.formal import Formal
-from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretVariable
+from rclverify.model.plan.fret.export import FretExport, FretRequirement, FretSemantics, FretVariable
 from rclverify.model.plan.fret.requirements import Options, import_export, ports_of
 from rclverify.model.plan.state import parse_state_formula, state_types
 from rclverify.model.plan.temporal import Temporal, parse_temporal, shape
@@ -52,7 +53,8 @@ def _export() -> FretExport:
                                "ptExpanded": pt}
         if pre is not None:
             sem.update(pre_condition=pre, regular_condition=pre)
-        reqs.append(FretRequirement(rid, rid, "rover", sem, ast.Loc("x.json", k + 1, 1), "", {}))
+        reqs.append(FretRequirement(rid, rid, "rover", msgspec.convert(sem, FretSemantics), ast.Loc("x.json", k + 1, 1),
+                                    "", {}))
     variables = {("rover", n): FretVariable("rover", n, i, d, "") for n, (i, d) in VARS.items()}
     return FretExport("x.json", tuple(reqs), variables)
 
@@ -161,7 +163,9 @@ def test_ftp_inside_a_pre_on_a_fed_node_is_refused_with_the_reason() -> None:
     sem: dict[str, Any] = {"scope": {"type": "null"}, "condition": "null", "timing": "always",
                            "response": "satisfaction", "component_name": "rover", "post_condition": case[4],
                            "ptExpanded": case[5]}
-    exp = FretExport("x.json", (FretRequirement("FTP-PRE", "FTP-PRE", "rover", sem, ast.Loc("x.json", 1, 1), "", {}),),
+    req = FretRequirement("FTP-PRE", "FTP-PRE", "rover", msgspec.convert(sem, FretSemantics), ast.Loc("x.json", 1, 1),
+                          "", {})
+    exp = FretExport("x.json", (req,),
                      {("rover", n): FretVariable("rover", n, i, d, "") for n, (i, d) in VARS.items()})
     ports = ports_of([parse_text(CONTRACT, "rover.rcl")])
     (imp,) = import_export(exp, Options(components={"rover": "Rover"}), ports)

@@ -14,8 +14,12 @@ has ``component_name``, ``variable_name``, ``idType`` (``Input``,
 Lustre ``assignment``.  Entries of the variables list without ``idType``
 (the ports of an imported model) are not FRET variables and are left out.
 
-A file that is not JSON, or whose shape is not the above (a requirement
-without a ``reqid`` string, a ``reqid`` used twice), is a malformed export:
+Each requirement's fields and each variable's are decoded once into
+:class:`FretSemantics` and :class:`FretVariableEntry` (msgspec Structs: the
+fields rclverify reads, typed; FRET's other fields ignored) and read by
+attribute after.  A file that is not JSON, or whose shape is not the above
+(a requirement without a ``reqid`` string, a ``reqid`` used twice, a field of
+another type than FRET writes), is a malformed export:
 :class:`~rclverify.model.plan.errors.PlanError` at its line and column.
 """
 from __future__ import annotations
@@ -27,12 +31,66 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
+import msgspec
+
 from rclverify.lang import ast
 from rclverify.model.plan.errors import PlanError, plan_error
 
 
 #: A unit in brackets at the end of a variable's description.
 _DESCRIBED_UNIT = re.compile(r"\[([^\[\]]+)\]\s*$")
+
+
+class FretScope(msgspec.Struct, frozen=True, kw_only=True):
+    """A requirement's ``semantics.scope``: its ``type`` (``null``, ``in``, ``before``, ``after`` ...)."""
+
+    type: str = "null"
+
+
+class FretSemantics(msgspec.Struct, frozen=True, kw_only=True):
+    """What FRET formalised of a requirement (its export's ``semantics``; every field ``None`` when FRET did
+    not formalise it): the ``scope``, ``condition`` (``null``, ``regular``, ``noTrigger`` ...), ``timing``
+    (``always``, ``within`` ...), ``response`` (``satisfaction``), the FRETish conditions (``pre_condition``,
+    ``regular_condition``, ``post_condition``, ``stop_condition``), the ``duration`` (a number, or a list
+    whose first item is one), the mode of an ``in`` scope (``scope_mode``), the component
+    (``component_name``, older exports ``component``) and FRET's past-time formula ``ptExpanded``."""
+
+    scope: FretScope | None = None
+    condition: str | None = None
+    timing: str | None = None
+    response: str | None = None
+    pre_condition: str | None = None
+    regular_condition: str | None = None
+    post_condition: str | None = None
+    stop_condition: str | None = None
+    duration: str | int | float | list[str | int | float] | None = None
+    scope_mode: str | None = None
+    component_name: str | None = None
+    component: str | None = None
+    ptExpanded: str | None = None
+
+
+class _RequirementEntry(msgspec.Struct, frozen=True, kw_only=True):
+    """The fields of a requirement of the export rclverify reads besides ``reqid`` (checked first)."""
+
+    fulltext: str | None = None
+    component_name: str | None = None
+    semantics: FretSemantics | None = None
+
+
+class FretVariableEntry(msgspec.Struct, frozen=True, kw_only=True):
+    """A FRET variable as exported (the fields rclverify reads): ``variable_name``, ``component_name``,
+    ``idType``, ``dataType`` (a name, or a list whose first item is one), ``assignment``,
+    ``modeRequirement``, ``unit`` and ``description``."""
+
+    variable_name: str
+    component_name: str | None = None
+    idType: str | None = None
+    dataType: str | list[str] | None = None
+    assignment: str | None = None
+    modeRequirement: str | None = None
+    unit: str | None = None
+    description: str | None = None
 
 
 @dataclass(frozen=True)
@@ -45,7 +103,7 @@ class FretRequirement:
     reqid: str
     fulltext: str
     component: str
-    semantics: Mapping[str, Any]
+    semantics: FretSemantics
     loc: ast.Loc
     digest: str
     raw: Mapping[str, Any]
@@ -82,19 +140,28 @@ def _line_col(text: str, pos: int) -> tuple[int, int]:
     return line, pos - (text.rfind("\n", 0, pos) + 1) + 1
 
 
-def _data_type(v: Any) -> str:
+def _data_type(v: str | list[str] | None) -> str:
     if isinstance(v, list):
         v = v[0] if v else ""
     return str(v or "")
 
 
-def _unit(v: Mapping[str, Any]) -> str:
+def _unit(v: FretVariableEntry) -> str:
     """A variable's unit (:class:`FretVariable`), blanks removed."""
-    u = v.get("unit")
-    if not isinstance(u, str) or not u.strip():
-        m = _DESCRIBED_UNIT.search(str(v.get("description") or ""))
+    u = v.unit
+    if u is None or not u.strip():
+        m = _DESCRIBED_UNIT.search(v.description or "")
         u = m.group(1) if m else ""
     return "".join(u.split())
+
+
+def _decoded(rel: str, text: str, at: int, what: str, raw: Any, type_: type[msgspec.Struct]) -> Any:
+    """``raw`` (a requirement's or variable's JSON object) as ``type_``; raises :class:`PlanError`
+    (``E-fret``) at offset ``at`` of ``text`` naming ``what`` and the field of another type."""
+    try:
+        return msgspec.convert(raw, type_)
+    except msgspec.ValidationError as exc:
+        raise plan_error(rel, *_line_col(text, at), f"{what} of the FRET export: {exc}", "E-fret") from None
 
 
 def digest(raw: Mapping[str, Any]) -> str:
@@ -143,19 +210,20 @@ def read_export(path: Path, rel: str) -> FretExport:
             raise plan_error(rel, loc.line, loc.col, f"reqid {rid!r} is used twice in the FRET export (first at "
                                                      f"{o.line}:{o.col})", "E-fret")
         seen[rid] = loc
-        sem = r.get("semantics")
-        if sem is not None and not isinstance(sem, dict):
+        if r.get("semantics") is not None and not isinstance(r["semantics"], dict):
             raise plan_error(rel, loc.line, loc.col, f"{rid}: 'semantics' must be an object", "E-fret")
-        sem = sem or {}
-        comp = sem.get("component_name") or r.get("component_name") or sem.get("component") or ""
-        out.append(FretRequirement(rid, " ".join(str(r.get("fulltext") or "").split()), str(comp), sem, loc,
-                                   digest(r), r))
+        e: _RequirementEntry = _decoded(rel, text, max(at, 0), f"requirement {rid}", r, _RequirementEntry)
+        sem = e.semantics or FretSemantics()
+        comp = sem.component_name or e.component_name or sem.component or ""
+        out.append(FretRequirement(rid, " ".join((e.fulltext or "").split()), comp, sem, loc, digest(r), r))
     variables: dict[tuple[str, str], FretVariable] = {}
     for v in vars_raw:
         if isinstance(v, dict) and "idType" in v and isinstance(v.get("variable_name"), str):
-            fv = FretVariable(str(v.get("component_name") or ""), v["variable_name"], str(v.get("idType") or ""),
-                              _data_type(v.get("dataType")), str(v.get("assignment") or ""),
-                              str(v.get("modeRequirement") or ""), _unit(v))
+            name = json.dumps(v["variable_name"], ensure_ascii=False)
+            ve: FretVariableEntry = _decoded(rel, text, max(text.find(name), 0), f"variable {name}", v,
+                                             FretVariableEntry)
+            fv = FretVariable(ve.component_name or "", ve.variable_name, ve.idType or "", _data_type(ve.dataType),
+                              ve.assignment or "", ve.modeRequirement or "", _unit(ve))
             variables[(fv.component, fv.name)] = fv
     return FretExport(rel, tuple(out), variables)
 

@@ -269,7 +269,7 @@ def import_export(exp: FretExport, options: Options, ports: Ports | None = None)
         node = options.components.get(fr.component, fr.component)
         informal = Requirement(fr.reqid, fr.fulltext, (), fr.loc, origin=exp.file)
         try:
-            if not fr.semantics or not fr.semantics.get("timing"):
+            if not fr.semantics.timing:
                 raise Refusal("FRET has not formalised it (no semantics in the export)",
                               "let FRET parse the requirement and export it again")
             if not node:

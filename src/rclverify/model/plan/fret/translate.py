@@ -59,9 +59,10 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any, Callable, Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 from rclverify.model.plan.fret.declared import DeclaredFunction
+from rclverify.model.plan.fret.export import FretSemantics
 from rclverify.model.plan.fret.fretish import Expr, Refusal, Writer, parse
 from rclverify.model.plan.fret.pasttime import CLOSED, PastTime, not_closed, parse_pt, statement
 
@@ -102,12 +103,11 @@ def state_base(reqid: str) -> str:
     return "fret_" + re.sub(r"[^A-Za-z0-9_]", "_", reqid)
 
 
-def steps_of(sem: Mapping[str, Any], fulltext: str, step: Fraction | None) -> int:
+def steps_of(sem: FretSemantics, fulltext: str, step: Fraction | None) -> int:
     """The duration of a ``within``/``for`` timing in steps: ``ticks`` as written; another unit of
     time through ``step`` (the plan's ``fret: step:``, seconds per step), when it divides exactly.
     Raises :class:`Refusal`."""
-    raw = sem.get("duration")
-    raw = raw[0] if isinstance(raw, list) and raw else raw
+    raw = _duration(sem)
     try:
         n = Fraction(str(raw))
     except (ValueError, ZeroDivisionError):
@@ -170,7 +170,7 @@ class _States:
         return name
 
 
-def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
+def translate(reqid: str, fulltext: str, sem: FretSemantics, node: str,
               var: Callable[[str, bool], str | Expr], step: Fraction | None = None,
               functions: Mapping[str, DeclaredFunction] | None = None, fed: Sequence[str] = ()) -> Translation:
     """Requirement ``reqid`` (``semantics`` ``sem``, FRET's export fields) as
@@ -195,29 +195,35 @@ def translate(reqid: str, fulltext: str, sem: Mapping[str, Any], node: str,
 _LOCAL_FTP = "\x00first time point\x00"
 
 
-def _translate(fulltext: str, sem: Mapping[str, Any], node: str, var: Callable[[str, bool], str | Expr],
+def _duration(sem: FretSemantics) -> str | int | float | list[str | int | float] | None:
+    """The ``duration`` of ``sem``: its first item when FRET wrote a list."""
+    raw = sem.duration
+    return raw[0] if isinstance(raw, list) and raw else raw
+
+
+def _translate(fulltext: str, sem: FretSemantics, node: str, var: Callable[[str, bool], str | Expr],
                step: Fraction | None, states: _States) -> Translation:
-    scope = str((sem.get("scope") or {}).get("type", "null"))
-    cond, timing = str(sem.get("condition") or "null"), str(sem.get("timing") or "null")
-    if str(sem.get("response") or "satisfaction") != "satisfaction":
-        raise Refusal(f"its response is {sem.get('response')!r}", "write the response as 'satisfy'")
+    scope = sem.scope.type if sem.scope is not None else "null"
+    cond, timing = sem.condition or "null", sem.timing or "null"
+    if (sem.response or "satisfaction") != "satisfaction":
+        raise Refusal(f"its response is {sem.response!r}", "write the response as 'satisfy'")
     if timing not in SUPPORTED.get((scope, cond), ()):
         return _compiled(scope, timing, fulltext, sem, node, var, step, states)
     w = _writer(var, states, node)
 
-    def field_expr(key: str, *alt: str) -> Expr:
-        for k in (key,) + alt:
-            v = sem.get(k)
-            if isinstance(v, str) and v.strip():
+    def field_expr(key: str, *values: str | None) -> Expr:
+        """The first of ``values`` written (``key`` the first one's name, for the refusal), parsed."""
+        for v in values:
+            if v is not None and v.strip():
                 return parse(v)
         raise Refusal(f"its semantics has no {key}", "let FRET formalise the requirement again and export it")
 
-    q_tree = field_expr("post_condition")
+    q_tree = field_expr("post_condition", sem.post_condition)
     q = w.rcl(q_tree)
     made = states.made
     if scope == "in":
-        mode = sem.get("scope_mode")
-        if not isinstance(mode, str) or not mode.strip():
+        mode = sem.scope_mode
+        if mode is None or not mode.strip():
             raise Refusal("its scope 'in' names no mode", "name the mode in FRET")
         m = parse(mode)
         if timing == "always":
@@ -228,13 +234,13 @@ def _translate(fulltext: str, sem: Mapping[str, Any], node: str, var: Callable[[
         return Translation(f"always (({w.rcl(m)} and not {node}.state.{prev}) -> {q})", node, made)
     if cond == "null":
         return _unconditional(timing, q, q_tree, w, states, node, lambda: steps_of(sem, fulltext, step),
-                              lambda: field_expr("stop_condition"))
-    p_tree = field_expr("regular_condition", "pre_condition")
+                              lambda: field_expr("stop_condition", sem.stop_condition))
+    p_tree = field_expr("regular_condition", sem.regular_condition, sem.pre_condition)
     return _conditioned(cond, timing, p_tree, q, w, states, node, lambda: steps_of(sem, fulltext, step),
-                        lambda: field_expr("stop_condition"))
+                        lambda: field_expr("stop_condition", sem.stop_condition))
 
 
-def _compiled(scope: str, timing: str, fulltext: str, sem: Mapping[str, Any], node: str,
+def _compiled(scope: str, timing: str, fulltext: str, sem: FretSemantics, node: str,
               var: Callable[[str, bool], str | Expr], step: Fraction | None, states: _States) -> Translation:
     """A combination the module table does not write: FRET's own ``ptExpanded`` stated with state variables
     (:mod:`.pasttime`) when it is prefix-closed, else refused with the reason."""
@@ -243,12 +249,11 @@ def _compiled(scope: str, timing: str, fulltext: str, sem: Mapping[str, Any], no
                       f"write it with one of the scopes {', '.join(CLOSED)}")
     if timing not in CLOSED[scope]:
         raise Refusal(*not_closed(scope, timing))
-    pt = sem.get("ptExpanded")
-    if not isinstance(pt, str) or not pt.strip():
+    pt = sem.ptExpanded
+    if pt is None or not pt.strip():
         raise Refusal("its export has no past-time formalisation (semantics.ptExpanded), which rclverify states for "
                       f"the scope {scope} with the timing {timing}", "export the requirement again from FRET")
-    raw = sem.get("duration")
-    raw = raw[0] if isinstance(raw, list) and raw else raw
+    raw = _duration(sem)
     if raw not in (None, "") and (m := _UNITS.search(fulltext)) and not m.group(2).lower().startswith("tick"):
         n = steps_of(sem, fulltext, step)
         if Fraction(str(raw)) != n:
