@@ -23,9 +23,15 @@ Given a seed, :func:`generate` draws a system of N nodes from five templates (th
 * **service**: a ``std_srvs/SetBool`` server, ``out.ok == in.on`` within a deadline, with or without
   service introspection, called one call at a time by a client in the same process.
 
+Each node declares what it keeps (bench/_robot_declarations.py): a sensor ``initially`` its band and
+``periodic( out.x, P ms )`` (P two periods and 1 s; a stamped sensor only on the wall clock), an
+alarm, a relay and a fuse ``progress( within K steps )``; a sensor declared periodic publishes until
+the robot is stopped.
+
 Nodes get a namespace at random.  ``defect=True`` seeds one defect in one node: ``<`` for ``<=``
 (``>`` for ``>=``, ``<=`` for ``<``), a relay adding 0.5 to every fourth reading, a server
-answering every third call wrongly, a sensor publishing just beyond its band; the runner
+answering every third call wrongly, a sensor publishing just beyond its band or skipping one
+publication for longer than its declared period, an alarm answering none of K + 2 readings; the runner
 (``bench/_robot_run.py``) checks it is red at that node and only there.
 
 :func:`write_workspace` renders the workspace from the jinja2 templates of
@@ -65,6 +71,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _robot_declarations import can_skip, declare, defect_kind  # bench/ is on sys.path (run as a script, the tests)
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATES = ROOT / "bench" / "templates" / "robot_generator"
@@ -257,11 +264,13 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
         crng = random.Random(f"clock-{seed}-{nodes}")
         clock = {"rate": crng.choice(CLOCK_RATES), "start_s": float(crng.choice([0, 100, 5000]))}
     spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out, "driver_offset_s": driver_offset_s}
+    declare(spec)
     if defect:
-        candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None]
+        candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None or can_skip(n, spec)]
         # a node whose defect shows on the values the run carries: an alarm or fuse is wrong only at its threshold
         victim = random.Random(f"defect-{seed}-{nodes}").choice(candidates)
         victim["defect"] = True
+        victim["defect_kind"] = defect_kind(victim, spec)
     return spec
 
 
@@ -290,7 +299,8 @@ def _consts(spec: dict[str, Any]) -> tuple[list[dict[str, str]], dict[str, dict[
 def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str, dict[str, str]]) -> dict[str, Any]:
     """One node's contract as the template's fields (inputs, outputs, topics, services, assume, guarantees)."""
     c: dict[str, Any] = {"name": n["name"], "topics": [], "services": [], "actions": [], "assume": "TRUE",
-                         "inputs": [], "outputs": []}
+                         "inputs": [], "outputs": [], "declarations": (
+                             [f"progress( within {n['progress_steps']} steps )"] if n.get("progress_steps") else [])}
     k = names.get(n["name"], {})
 
     def band(var: str, s: dict[str, Any]) -> str:
@@ -304,9 +314,13 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
         c["outputs"] = [f"{var} : {rcl}"]
         c["topics"] = [f"{typ} {n['rcl_topic']} matches(out.{var})"]
         c["guarantees"] = [{"formula": band(f"out.{var}", n), "trigger": ""}]
+        c["declarations"] = ([f"initially( {band(f'out.{var}', n)} )"] if n.get("initially") else []) + (
+            [f"periodic( out.{var}, {n['periodic_ms']} ms )"] if n.get("periodic_ms") else [])
         c["comment"] = (f"a sensor publishing every {n['period_ms']} ms, {'stamped' if stamped else 'unstamped'}"
                         + (f", its stamp {n['back_ms']} ms before it publishes" if n["back_ms"] else "")
-                        + (" [seeded defect: publishes beyond its band]" if n.get("defect") else ""))
+                        + (" [seeded defect: skips one publication for longer than its declared period]"
+                           if n.get("defect") and n.get("defect_kind") == "skip" else
+                           " [seeded defect: publishes beyond its band]" if n.get("defect") else ""))
         return c
     if n["kind"] == "service":
         c["inputs"], c["outputs"] = ["on : BOOL"], ["ok : BOOL"]
@@ -345,7 +359,9 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
             c["topics"].append(f"std_msgs/Bool {n['rcl_topic']} matches(out.{out})")
             c["guarantees"] = [{"formula": f"out.{out} <=> ({cond})", "trigger": f"triggered by in.{var} within {deadline} ms"}]
             c["comment"] = (f"an alarm at a threshold, answering after {n['delay_ms']} ms"
-                            + (" [seeded defect: the strict comparison for the other]" if n.get("defect") else ""))
+                            + (f" [seeded defect: answers none of {n['progress_steps'] + 2} readings in a row once]"
+                               if n.get("defect") and n.get("defect_kind") == "mute" else
+                               " [seeded defect: the strict comparison for the other]" if n.get("defect") else ""))
         if n.get("assume_band"):
             c["assume"] = band(f"in.{var}", s)
         return c
