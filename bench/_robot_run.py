@@ -15,7 +15,11 @@ must be red live and every other node not.  Per node the live final verdicts are
 
 * ``satisfied`` / ``violated`` / ``undecided`` (inconclusive, incomplete input, open) answers of the
   topic guarantees and of the calls, and ``true`` / ``false`` deadlines; an endpoint the run could
-  not judge (the rclpy source without introspection) is ``undecided`` and ``unjudged``.
+  not judge (the rclpy source without introspection) is ``undecided`` and ``unjudged``;
+* ``declaration <verdict>``: the node's declarations (``initially``, ``progress``, ``periodic``;
+  bench/_robot_declarations.py), one row each, from the live record (``--evidence``); the log's and the
+  bag's rows (``rclverify monitor --json``) are compared with them declaration by declaration, and a
+  ``false`` declaration of a correct node on any path is false, as a violated answer is.
 
 Everything on loopback (Cyclone's loopback configuration for the monitor,
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` for the nodes), a random ``ROS_DOMAIN_ID``, every
@@ -41,7 +45,8 @@ sys.path.insert(0, str(ROOT / "bench"))
 from _live import stop, wait_text  # noqa: E402
 from monitor_live_dds import CONFIG  # noqa: E402
 from robot_generator import SENSORS, generate, write_workspace  # noqa: E402
-from _robot_verdicts import UNDECIDED, false_verdicts, read_records, tally, three_way  # noqa: E402
+from _robot_verdicts import (UNDECIDED, compare_declarations, declaration_verdicts, false_verdicts,  # noqa: E402
+                             read_records, tally, tally_declarations, three_way)
 
 SOURCES = ("dds", "rclpy")
 
@@ -195,9 +200,12 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     res: dict[str, Any] = {"seed": seed, "nodes": nodes, "defect": defect, "spec": spec, "errors": [],
                            "source": source, "clock": spec.get("clock")}
     try:
-        res["other_clocks"] = json.loads((tmp / "evidence.json").read_text()).get("other_clocks", [])
+        evidence = json.loads((tmp / "evidence.json").read_text())
     except (OSError, ValueError):
-        res["other_clocks"] = []
+        evidence = {}
+        res["errors"].append("live: the monitor wrote no --evidence record")
+    res["other_clocks"] = evidence.get("other_clocks", [])
+    decl = {"live": declaration_verdicts(evidence.get("declarations", []))}
     runs = ws / "runs"
     links = {n["rcl_topic"]: n["name"] for n in spec["nodes"] if n["kind"] in ("service", "action")}
     paths = {"live": read_records(runs / "live.verdicts.jsonl")}
@@ -208,11 +216,16 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
             res["errors"].append(f"offline {name}: {err}")
         res[name] = offline_counts(rows)
         paths[name] = read_records(runs / f"{name}.verdicts.jsonl")
+        decl[name] = declaration_verdicts(rows)
     res["finals"], lines = three_way(paths)
+    res["declarations"] = decl
     res["disagreements"] = [x for x in lines if not x.startswith(("provisional: ", "placed apart: "))]
+    res["disagreements"] += compare_declarations(decl)
     res["provisional"] = [x for x in lines if x.startswith("provisional: ")]
     res["placed_apart"] = [x for x in lines if x.startswith("placed apart: ")]
     res["live"] = tally(res["finals"]["live"])
+    for node, c in tally_declarations(decl["live"]).items():
+        res["live"].setdefault(node, Counter()).update(c)
     for node, n in unjudged(runs / "live.jsonl", links).items():
         res["live"].setdefault(node, Counter()).update({"undecided": n, "unjudged": n})
     res["undecided_why"] = {}
@@ -276,22 +289,27 @@ def findings(res: dict[str, Any]) -> list[str]:
         wrong = Counter(f"{r['node']}: {'deadline false' if r['item'] == 'deadline' else r['item'] + ' violated'}"
                         for r in false_verdicts(f, correct))
         out += [f"{k} x{n} {path} (false: the node is correct)" for k, n in sorted(wrong.items())]
+    for path, d in res.get("declarations", {}).items():
+        out += [f"{node}: {what} ({src}) false on the {path} (false: the node is correct): {row.get('reason', '')}"
+                for (node, what, src), row in sorted(d.items()) if node in correct and row["verdict"] == "false"]
     for node in names:
         live = res["live"].get(node, Counter())
         judged = live.get("satisfied", 0) + live.get("violated", 0)
         if judged == 0 and not live.get("unjudged"):  # an unjudged endpoint is said, as docs/ros2.md promises
             out.append(f"{node}: nothing judged live")
-        if node == victim and live.get("violated", 0) + live.get("deadline false", 0) == 0:
+        red = live.get("violated", 0) + live.get("deadline false", 0) + live.get("declaration false", 0)
+        if node == victim and red == 0:
             out.append(f"{node}: seeded defect not red live")
     return out
 
 
 def _declarations(res: dict[str, Any]) -> str:
-    """The declaration and period rows of the offline check of the log, by status (``0``: none)."""
-    c = Counter[str]()
-    for node in res.get("log", {}).values():
-        c.update({k.split(" ", 1)[1]: n for k, n in node.items() if k.startswith("declarations ")})
-    return ", ".join(f"{n} {k}" for k, n in sorted(c.items())) or "0"
+    """The declarations' verdicts on each path (``live 12 true, 1 false; log ...``; ``0``: none)."""
+    parts = []
+    for path, d in res.get("declarations", {}).items():
+        c = Counter(str(row["verdict"]) for row in d.values())
+        parts.append(f"{path} " + (", ".join(f"{n} {k}" for k, n in sorted(c.items())) or "0"))
+    return "; ".join(parts) or "0"
 
 
 def _line(res: dict[str, Any]) -> str:
@@ -309,7 +327,7 @@ def _line(res: dict[str, Any]) -> str:
             f"{tot['deadline true']} false {tot['deadline false']}"
             + (f", undecided {sum(undecided.values())} (log: " + ", ".join(f"{n} {k}" for n, k in undecided.items())
                + ")" if undecided else "")
-            + f", declarations {_declarations(res)}; verdicts compared: " + ", ".join(
+            + f", declarations ({_declarations(res)}); verdicts compared: " + ", ".join(
                 f"{k} {sum(len(x) for x in f.values())}" for k, f in res["finals"].items())
             + f", {len(res['disagreements'])} disagreement(s)"
             + (f", {len(res['provisional'])} on a provisional verdict" if res["provisional"] else "")
@@ -364,8 +382,11 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             for c in res["live"].values():
                 total.update(c)
             undecided += sum(c["deadline undecided"] for c in res["log"].values())
-            for c in res["log"].values():
-                declarations.update({k: n for k, n in c.items() if k.startswith("declarations ")})
+            victim = next((x["name"] for x in res["spec"]["nodes"] if x.get("defect")), None)
+            for path, d in res["declarations"].items():
+                declarations.update(f"{path} {row['verdict']}" for row in d.values())
+                declarations.update(f"{path} false at a correct node" for (node, _, _), row in d.items()
+                                    if row["verdict"] == "false" and node != victim)
             compared.update({k: sum(len(x) for x in f.values()) for k, f in res["finals"].items()})
             disagreements += len(res["disagreements"])
             provisional += len(res["provisional"])
@@ -381,8 +402,12 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           f"{'one CPU burner beside, ' if burn else ''}load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} "
           f"core(s): live satisfied {total['satisfied']}, violated {total['violated']}, undecided "
           f"{total['undecided']}, deadlines true {total['deadline true']} false {total['deadline false']} "
-          f"(undecided on the logs: {undecided}); declarations: {sum(declarations.values())} "
-          f"{dict(declarations) or ''}; verdicts compared: live {compared['live']}, log {compared['log']}, bag "
+          f"(undecided on the logs: {undecided}); declarations: " + "; ".join(
+              f"{path} " + ", ".join(f"{declarations[k]} {k.split(' ', 1)[1]}" for k in sorted(declarations)
+                                     if k.startswith(path + " ") and "correct" not in k)
+              for path in ("live", "log", "bag")) + ", false declarations (at a correct node): " + ", ".join(
+              f"{path} {declarations[path + ' false at a correct node']}" for path in ("live", "log", "bag"))
+          + f"; verdicts compared: live {compared['live']}, log {compared['log']}, bag "
           f"{compared['bag']}; disagreements {disagreements} (and {provisional} on a verdict still provisional, {apart} "
           f"message(s) given one verdict but placed apart); "
           f"load average after each run {min(loads, default=0):.1f}-{max(loads, default=0):.1f}; seeds with "

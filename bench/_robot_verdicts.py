@@ -18,6 +18,11 @@ and a difference is reported apart (``provisional``), never as a final
 disagreement.  Two paths **disagree** on a message when their final verdicts
 differ or one gave a verdict and the other none; each disagreement names both
 sides' verdicts and reasons.
+
+Declarations (``initially``, ``progress``, ``periodic``) are judged once per run, a row each, not
+message by message: the live record's rows (``--evidence``, its ``declarations``) are compared with the
+offline check's rows of the log and of the bag, by node, declaration and source
+(:func:`compare_declarations`).
 """
 from __future__ import annotations
 
@@ -185,4 +190,50 @@ def three_way(paths: dict[str, list[dict[str, Any]]]) -> tuple[dict[str, Any], l
     return f, lines
 
 
-__all__ = ["Disagreement", "compare", "false_verdicts", "finals", "read_records", "tally", "three_way"]
+#: one declaration of one node: its node, its row's name (``progress``, ``initially 1``, ``periodic out.x``)
+#: and its source (``contracts/robot.rcl:21:3``)
+DeclKey = tuple[str, str, str]
+
+
+def declaration_verdicts(parts: Iterable[dict[str, Any]]) -> dict[DeclKey, dict[str, Any]]:
+    """The declaration rows of one path by :data:`DeclKey`: ``parts`` are the live record's
+    ``declarations`` items, or the rows of ``rclverify monitor --json``; each part with a
+    ``declarations`` list ``[{"declaration", "source", "verdict", "reason", ...}]``
+    (docs/monitors.md, "Declarations on recorded and live runs") gives its rows."""
+    out: dict[DeclKey, dict[str, Any]] = {}
+    for part in parts:
+        rows = part.get("declarations")
+        if not isinstance(rows, list):
+            continue
+        for row in rows:
+            out[(str(part["node"]), str(row["declaration"]), str(row.get("source", "")))] = row
+    return out
+
+
+def compare_declarations(paths: dict[str, dict[DeclKey, dict[str, Any]]]) -> list[str]:
+    """Each declaration the live path (``paths["live"]``) and the log's or the bag's judged differently,
+    or that one judged and the other did not, named with both sides' verdicts and reasons."""
+    out: list[str] = []
+    live = paths["live"]
+    for other in ("log", "bag"):
+        them = paths.get(other, {})
+        for key in sorted(set(live) | set(them)):
+            a, b = live.get(key), them.get(key)
+            if a is not None and b is not None and a["verdict"] == b["verdict"]:
+                continue
+            side = lambda name, r: f"{name}: no verdict" if r is None else f"{name}: {r['verdict']} ({r.get('reason', '')})"  # noqa: E731
+            out.append(f"live != {other}: {key[0]}: declaration {key[1]} ({key[2]}): {side('live', a)}; "
+                       f"{side(other, b)}")
+    return out
+
+
+def tally_declarations(d: dict[DeclKey, dict[str, Any]]) -> dict[str, Counter[str]]:
+    """Per node, its declarations counted by verdict (``declaration true``, ``declaration false`` ...)."""
+    out: dict[str, Counter[str]] = {}
+    for (node, _, _), row in d.items():
+        out.setdefault(node, Counter())[f"declaration {row['verdict']}"] += 1
+    return out
+
+
+__all__ = ["DeclKey", "Disagreement", "compare", "compare_declarations", "declaration_verdicts", "false_verdicts",
+           "finals", "read_records", "tally", "tally_declarations", "three_way"]
