@@ -102,15 +102,14 @@ def can_skip(n: dict[str, Any], spec: dict[str, Any]) -> bool:
 
 def defect_kind(victim: dict[str, Any], spec: dict[str, Any]) -> str:
     """Which defect the node ``victim`` of ``spec`` is seeded with: ``"skip"`` (a sensor that
-    :func:`can_skip`, one time in two, or always when it has no value beyond its band), ``"beyond"`` (a
-    sensor publishing just beyond its band), ``"mute"`` (an alarm, one time in two), else ``"wrong"``
-    (the node's guarantee broken as bench/robot_generator.py's docstring says).  Deterministic in the
-    spec's seed and node count."""
+    :func:`can_skip`, one time in two), ``"beyond"`` (a sensor publishing just beyond its band),
+    ``"mute"`` (an alarm, one time in two), else ``"wrong"`` (the node's guarantee broken as
+    bench/robot_generator.py's docstring says).  The node itself is drawn as before declarations
+    were drawn (a sensor with a value beyond its band, or any other node), so a seed's victim stays.
+    Deterministic in the spec's seed and node count."""
     rng = random.Random(f"defect-kind-{spec['seed']}-{len(spec['nodes'])}")
     if victim["kind"] == "sensor":
-        if can_skip(victim, spec) and (victim.get("beyond") is None or rng.random() < 0.5):
-            return "skip"
-        return "beyond"
+        return "skip" if can_skip(victim, spec) and rng.random() < 0.5 else "beyond"
     if victim["kind"] == "alarm" and rng.random() < 0.5:
         return "mute"
     return "wrong"

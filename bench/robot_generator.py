@@ -71,7 +71,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _robot_declarations import can_skip, declare, defect_kind  # bench/ is on sys.path (run as a script, the tests)
+from _robot_declarations import declare, defect_kind  # bench/ is on sys.path (run as a script, the tests)
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATES = ROOT / "bench" / "templates" / "robot_generator"
@@ -266,7 +266,7 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
     spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out, "driver_offset_s": driver_offset_s}
     declare(spec)
     if defect:
-        candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None or can_skip(n, spec)]
+        candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None]
         # a node whose defect shows on the values the run carries: an alarm or fuse is wrong only at its threshold
         victim = random.Random(f"defect-{seed}-{nodes}").choice(candidates)
         victim["defect"] = True
