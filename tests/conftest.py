@@ -54,7 +54,7 @@ LIVE = frozenset({
     "test_lsp_fuzz", "test_lsp_hostile", "test_lsp_invalid", "test_lsp_nvim", "test_lsp_server",
     "test_monitor_live_dds", "test_monitor_live_hostile", "test_monitor_live_ros1", "test_monitor_oracle",
     "test_ros2_diff", "test_ros2_generated", "test_ros2_services_actions", "test_ros2_silence_deadlines",
-    "test_ros2_declarations", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
+    "test_ros2_declarations", "test_robot_generator_declarations_live", "test_ros2_sequences", "test_ros2_types_record", "test_ros_diff_dds", "test_ros_diff_live", "test_ros_live",
     "test_ros_master_hostile", "test_services_live_ros1", "test_ros_names_rclpy", "test_names_rcl", "test_names_fleet_live", "test_ros2_calls_paired", "test_ros2_carried",
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
