@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from rclverify.ros.extract import cpp_helpers, emit, symbols, treesitter
-from rclverify.ros.extract.cpp_scope import callee_parts
+from rclverify.ros.extract.cpp_names import callee_parts
 from rclverify.ros.extract.cpp_types import action_type, callback_name, service_type
 from rclverify.ros.extract.model import Note, canon_type
 

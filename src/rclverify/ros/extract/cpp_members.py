@@ -21,7 +21,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from rclverify.ros.extract import cpp_helpers, treesitter
-from rclverify.ros.extract.cpp_scope import namespaces_of
+from rclverify.ros.extract.cpp_names import namespaces_of
 from rclverify.ros.extract.cpp_types import split_template
 from rclverify.ros.extract.model import Src
 from rclverify.ros.extract.cpp_params import string_value

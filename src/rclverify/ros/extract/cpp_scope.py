@@ -12,16 +12,17 @@ Indexed once per file from tree-sitter's syntax tree:
   with (an expression, a ``ros::NodeHandle``'s constructor arguments, a
   parameter read by reference).
 
-The value of an expression in these scopes is :mod:`cpp_values`' job.
+The value of an expression in these scopes is :mod:`cpp_values`' job; the
+names the syntax writes (a callee, a declarator, the enclosing namespaces and
+classes) are read by :mod:`cpp_names`.
 Local variables are scoped by function; members by class.
 """
 from __future__ import annotations
 
-import re
-
 from typing import Any
 
 from rclverify.ros.extract import symbols, treesitter
+from rclverify.ros.extract.cpp_names import base_name, declarator_name, namespaces_of, untemplated
 from rclverify.ros.extract.cpp_params import param_read
 
 _HANDLE_TYPES = ("NodeHandle",)
@@ -43,83 +44,6 @@ class Fn:
         self.ptypes: list[str] = []
         self.pconst: list[bool] = []  # per parameter: declared const
         self.defaults: list[Any] = []
-
-
-def callee_parts(fn: Any) -> tuple[str, str, list[str]]:
-    """A call's function ``fn`` as ``(its text without template arguments, the last
-    part of its name, the template arguments' texts)``."""
-    f = fn.child_by_field_name("field") if fn.type == "field_expression" else fn
-    if f is not None and f.type == "dependent_name" and f.named_children:  # node->template create_service<T>
-        f = f.named_children[-1]
-    while f is not None and f.type == "qualified_identifier" and f.child_by_field_name("name") is not None:
-        f = f.child_by_field_name("name")
-    targs: list[str] = []
-    if f is not None and f.type in ("template_method", "template_function"):
-        a = f.child_by_field_name("arguments")
-        targs = [_T(x) for x in a.named_children] if a is not None else []
-        name = _T(f.child_by_field_name("name"))
-    else:
-        name = _T(f)
-    full = _T(fn).replace("template ", "")
-    head = full.split("<")[0].strip()
-    if "<" in full and ">::" in full:  # rclcpp::Node::make_shared / X<T>::create
-        head = head + full[full.rindex(">") + 1:]
-    return head, name.split("::")[-1], targs
-
-
-def is_node_type(type_text: str) -> bool:
-    """Whether a declared type is a node handle or a node (``ros::NodeHandle``,
-    ``rclcpp::Node::SharedPtr``, ``rclcpp_lifecycle::LifecycleNode *``,
-    ``std::shared_ptr<rclcpp::Node>`` ...)."""
-    t = type_text.replace(" ", "")
-    if "NodeOptions" in t:  # rclcpp::NodeOptions: a node's settings, not a node
-        return False
-    return "NodeHandle" in t or "rclcpp::Node" in t or "LifecycleNode" in t or t.split("<")[0].endswith("Node")
-
-
-def _untemplated(name: str) -> str:
-    """A function's declarator name without template argument lists:
-    ``RosFilter<T>::initialize`` -> ``RosFilter::initialize`` (an out-of-line member
-    of a class template), ``make<T>`` -> ``make``."""
-    for _ in range(8):
-        new = re.sub(r"<[^<>()]*>", "", name)
-        if new == name:
-            break
-        name = new
-    return name.split("<")[0]
-
-
-def base_name(type_text: str) -> str:
-    """``const ros::NodeHandle &`` -> ``NodeHandle``; ``std::shared_ptr<X>`` -> ``shared_ptr``."""
-    return type_text.split("<")[0].replace("&", " ").replace("*", " ").split()[-1].split("::")[-1] \
-        if type_text.strip() else ""
-
-
-def namespaces_of(n: Any) -> tuple[list[str], list[str]]:
-    """``(enclosing namespaces, enclosing class names)`` of syntax node ``n``, outermost first."""
-    cls: list[str] = []
-    nss: list[str] = []
-    p = n.parent
-    while p is not None:
-        if p.type in ("class_specifier", "struct_specifier") and p.child_by_field_name("body") is not None:
-            nm = p.child_by_field_name("name")
-            if nm is not None:
-                cls.insert(0, _T(nm).split("<")[0])
-        elif p.type == "namespace_definition" and p.child_by_field_name("name") is not None:
-            nss.insert(0, _T(p.child_by_field_name("name")))
-        p = p.parent
-    return nss, cls
-
-
-def _declarator_name(d: Any) -> Any:
-    while d is not None and d.type in ("pointer_declarator", "reference_declarator", "init_declarator",
-                                       "array_declarator", "function_declarator", "parenthesized_declarator"):
-        nxt = d.child_by_field_name("declarator")
-        if nxt is None:
-            nxt = next((c for c in d.named_children if c.type in ("identifier", "field_identifier",
-                                                                   "qualified_identifier")), None)
-        d = nxt
-    return d
 
 
 class CppScope:
@@ -154,7 +78,7 @@ class CppScope:
             if n.type == "declaration":
                 self._declaration(n)
             elif n.type == "for_range_loop":  # for (auto & s : sources): s is each element
-                nm, fn = _declarator_name(n.child_by_field_name("declarator")), self.fn_of(n)
+                nm, fn = declarator_name(n.child_by_field_name("declarator")), self.fn_of(n)
                 d = n.child_by_field_name("declarator")
                 while d is not None and d.type in ("reference_declarator", "pointer_declarator"):
                     d = next((c for c in d.named_children if c.type == "structured_binding_declarator"), None) \
@@ -231,7 +155,7 @@ class CppScope:
             fd = fd.child_by_field_name("declarator")
         if fd is None:
             return
-        name = _untemplated(_T(fd.child_by_field_name("declarator")).replace(" ", ""))
+        name = untemplated(_T(fd.child_by_field_name("declarator")).replace(" ", ""))
         nss, cls = namespaces_of(n)
         pre = "::".join(nss + cls)
         key = f"{pre}::{name}" if pre else name
@@ -248,7 +172,7 @@ class CppScope:
         for p in params.named_children if params is not None else []:
             if p.type not in ("parameter_declaration", "optional_parameter_declaration"):
                 continue
-            d = _declarator_name(p.child_by_field_name("declarator"))
+            d = declarator_name(p.child_by_field_name("declarator"))
             fn.params.append(_T(d) if d is not None else "")
             fn.ptypes.append(_T(p.child_by_field_name("type")) + (
                 " &" if "&" in _T(p.child_by_field_name("declarator") or p) else ""))
@@ -284,7 +208,7 @@ class CppScope:
             for d in f.children_by_field_name("declarator"):
                 if d.type == "function_declarator":
                     continue
-                nm = _declarator_name(d)
+                nm = declarator_name(d)
                 if nm is None:
                     continue
                 info["members"][_T(nm)] = ty
@@ -310,7 +234,7 @@ class CppScope:
         params = fd.child_by_field_name("parameters")
         for p in params.named_children if params is not None else []:
             if p.type in ("parameter_declaration", "optional_parameter_declaration"):
-                d = _declarator_name(p.child_by_field_name("declarator"))
+                d = declarator_name(p.child_by_field_name("declarator"))
                 fn.params.append(_T(d) if d is not None else "")
                 fn.ptypes.append(_T(p.child_by_field_name("type")))
                 fn.defaults.append(p.child_by_field_name("default_value"))
@@ -320,7 +244,7 @@ class CppScope:
         fn = self.fn_of(n)
         ty = _T(n.child_by_field_name("type"))
         for d in n.children_by_field_name("declarator"):
-            nm = _declarator_name(d)
+            nm = declarator_name(d)
             if nm is None or nm.type not in ("identifier", "field_identifier"):
                 continue
             v = d.child_by_field_name("value") if d.type == "init_declarator" else None

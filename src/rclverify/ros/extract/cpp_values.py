@@ -25,7 +25,8 @@ from typing import Any
 
 from rclverify.ros.extract import symbols, treesitter
 from rclverify.ros.extract.cpp_params import KEY, param_read, string_value
-from rclverify.ros.extract.cpp_scope import _HANDLE_TYPES, MAX_DEPTH, CppScope, Fn, base_name, is_node_type
+from rclverify.ros.extract.cpp_names import base_name, is_node_type
+from rclverify.ros.extract.cpp_scope import _HANDLE_TYPES, MAX_DEPTH, CppScope, Fn
 
 _T = treesitter.text
 #: namespaces of libraries whose functions the workspace does not define: their calls are not followed

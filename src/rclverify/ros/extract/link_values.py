@@ -18,7 +18,7 @@ import re
 from typing import TYPE_CHECKING, Any
 
 from rclverify.ros.extract import symbols
-from rclverify.ros.extract.cpp_scope import is_node_type
+from rclverify.ros.extract.cpp_names import is_node_type
 from rclverify.ros.extract.link_units import UnitInfo, unit_of
 
 MAX_DEPTH = 8
