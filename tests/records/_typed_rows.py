@@ -51,12 +51,11 @@ def complete(cls: type[msgspec.Struct], given: Mapping[str, Any]) -> dict[str, A
     """``given`` (part of a JSON object of ``cls``) with each required field it lacks set to
     :func:`empty`, and each record within it (a field typed by a record, or a list of them) completed."""
     hints = typing.get_type_hints(cls)
-    required = {f.name for f in msgspec.structs.fields(cls) if f.required}
     out = dict(given)
-    for name in cls.__struct_fields__:
-        tp = _strip(hints[name])
+    for f in msgspec.structs.fields(cls):  # by the key the JSON object has (a field renamed: its encoded name)
+        name, tp = f.encode_name, _strip(hints[f.name])
         if name not in out:
-            if name in required:
+            if f.required:
                 out[name] = empty(tp)
             continue
         out[name] = _completed(tp, out[name])

@@ -478,10 +478,15 @@ def _grouping_report() -> dict[str, Any]:
     def d(id: str, kind: str, node: str, k: Any, culprits: list[dict[str, str]], repairs: Any = ()) -> dict[str, Any]:
         return {"id": id, "kind": kind, "node": node, "status": "failed", "sentence": f"{id} is wrong. More.",
                 "culprits": culprits, "counterexample": [], "repairs": list(repairs), "guarantee": k, "related": []}
+    said = {"proves": "the problem no longer follows from the edited text", "not_shown": "that the change is safe"}
     guard = {"kind": "guard", "checked_by": "z3", "summary": "Guard guarantee 3.", "checks": [], "cost": [],
-             "diff": "--- a\n+++ b\n"}
+             "diff": "--- a\n+++ b\n", "file": "contracts/mini.rcl", **said,
+             "edit": {"file": "contracts/mini.rcl", "line": 22, "col": 5, "end_line": 22, "end_col": 5,
+                      "inserted": "x > 0 -> ", "deleted": ""}}
     const = {"kind": "constant", "checked_by": "z3", "summary": "10 -> 120.", "checks": [], "cost": [],
-             "diff": "--- p\n+++ p\n"}
+             "diff": "--- p\n+++ p\n", "file": "backends/hoare/s.imp", **said,
+             "edit": {"file": "backends/hoare/s.imp", "line": 3, "col": 9, "end_line": 3, "end_col": 11,
+                      "inserted": "120", "deleted": "10"}}
     rep["diagnoses"] = [
         d("Agent.g1.non-vacuous", "vacuity", "Agent", 1, [fact, g3, fact2], [guard]),
         d("Agent.g2.non-vacuous", "vacuity", "Agent", 2, [fact, g3], [guard]),

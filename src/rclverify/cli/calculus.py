@@ -63,10 +63,10 @@ def cmd_compose(args: argparse.Namespace) -> int:
                 for h in sc.get("hypotheses", []):
                     print(f"      producer: {h}")
             if sc["model"]:
-                from rclverify.diagnosis.table import counterexample_table  # deferred: optional or conditional (inside a block)
+                from rclverify.diagnosis.table import counterexample_rows  # deferred: optional or conditional (inside a block)
                 from rclverify.report.diagnosis_text import table_lines  # deferred: optional or conditional (inside a block)
                 print("      counterexample:")
-                print("\n".join(table_lines(counterexample_table(sc["model"], n), "        ")))
+                print("\n".join(table_lines(counterexample_rows(sc["model"], n), "        ")))
             bad += sc["status"] != "discharged"
         for inst in c["instances"]:
             print(f"  {inst['rule']} instance conclusion: {inst['conclusion']}")

@@ -3,23 +3,31 @@ the text and source of the guarantee a record names.
 
 A record is built as the report's
 :class:`~rclverify.records.problem_rows.DiagnosisRow` (its culprits,
-counterexample rows and repairs the diagnosis stage's own records,
-:mod:`rclverify.records.stage_records`' ``Culprit``, ``CexRow`` and
-``Repair``, which that row leaves open) and handed to the stage as its JSON
-object (:func:`entry`).
+counterexample rows and repairs built by the producers as the diagnosis
+stage's JSON objects, :mod:`rclverify.records.stage_records`' ``Culprit``,
+``CexRow`` and ``Repair``, and decoded here into
+:mod:`rclverify.records.repair_rows`' records) and handed to the stage as its
+JSON object (:func:`entry`).
 """
 from __future__ import annotations
 
-from typing import Any, Sequence, cast
+from typing import Sequence, TypeVar, cast
 
 import msgspec
 
 from rclverify.diagnosis.shapes import ReportRows
 from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.repair_rows import CexTableRow, CulpritRow, RepairRow
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 from rclverify.records.statuses import AnyStatus
 
-_OPEN = list[dict[str, Any]]  # a DiagnosisRow's culprits, counterexample and repairs: the stage's records
+P = TypeVar("P", CulpritRow, CexTableRow, RepairRow)
+
+
+def _decoded(cls: type[P], items: Sequence[Culprit] | Sequence[CexRow] | Sequence[Repair]) -> list[P]:
+    """``items`` (the producers' JSON objects) decoded into ``cls``; raises
+    :class:`msgspec.ValidationError` for an item of another shape (a producer's defect)."""
+    return [msgspec.convert(x, cls) for x in items]
 
 
 def guarantee_source(report: ReportRows, node: str, k: int | None) -> tuple[str, str]:
@@ -45,9 +53,9 @@ def diagnosis_record(id: str, kind: str, node: str, status: AnyStatus, sentence:
     (:class:`~rclverify.records.problem_rows.DiagnosisRow`); the repairs that are ``None`` left
     out; ``related`` is filled in by :func:`rclverify.diagnosis.build.diagnose`."""
     return DiagnosisRow(id, kind, node, status, sentence,
-                        culprits=cast(_OPEN, list(culprits or [])),
-                        counterexample=cast(_OPEN, list(counterexample or [])),
-                        repairs=cast(_OPEN, [r for r in repairs if r]), guarantee=guarantee, related=[],
+                        culprits=_decoded(CulpritRow, culprits or []),
+                        counterexample=_decoded(CexTableRow, counterexample or []),
+                        repairs=_decoded(RepairRow, [r for r in repairs if r]), guarantee=guarantee, related=[],
                         not_offered=not_offered, joins=joins, lint=lint, passes_through=passes_through,
                         consequence_of=consequence_of, requirement=requirement)
 
@@ -55,8 +63,8 @@ def diagnosis_record(id: str, kind: str, node: str, status: AnyStatus, sentence:
 def with_culprits(rec: DiagnosisRow, node: str, sentence: str, culprits: Sequence[Culprit],
                   repairs: Sequence[Repair]) -> DiagnosisRow:
     """``rec`` naming ``culprits`` of ``node`` in ``sentence``, with their ``repairs``."""
-    return msgspec.structs.replace(rec, node=node, sentence=sentence, culprits=cast(_OPEN, list(culprits)),
-                                   repairs=cast(_OPEN, list(repairs)))
+    return msgspec.structs.replace(rec, node=node, sentence=sentence, culprits=_decoded(CulpritRow, culprits),
+                                   repairs=_decoded(RepairRow, repairs))
 
 
 def entry(rec: DiagnosisRow) -> DiagnosisEntry:

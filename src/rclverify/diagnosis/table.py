@@ -17,6 +17,9 @@ import re
 from fractions import Fraction
 from typing import Mapping
 
+import msgspec
+
+from rclverify.records.repair_rows import CexTableRow
 from rclverify.records.stage_records import CexRow, FunctionTable
 from rclverify.semantics.values import decimal_text
 
@@ -206,3 +209,9 @@ def counterexample_table(model: Mapping[str, object] | None, default_node: str =
             text = "{" + shown + (f", ... {more} more" if more > 0 else "") + (", " if shown else "") + f"else -> {table['else']}" + "}"
         rows.append({"node": node, "variable": var, "value": _short(text), "table": table})
     return rows
+
+
+def counterexample_rows(model: Mapping[str, object] | None, default_node: str = "") -> list[CexTableRow]:
+    """:func:`counterexample_table`'s rows decoded into their record
+    (:class:`~rclverify.records.repair_rows.CexTableRow`), for a reader that prints them."""
+    return msgspec.convert(counterexample_table(model, default_node), list[CexTableRow])

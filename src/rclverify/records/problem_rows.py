@@ -17,10 +17,11 @@ The rules (docs/decisions.md, "One definition per record"):
   :class:`ProblemRow` and writes :meth:`~rclverify.records.row.Row.to_json`
   (the fields in the order declared).  A field whose default is ``UNSET``
   is absent from the JSON when the record has nothing to say.
-* The culprits, counterexample rows and repairs of a diagnosis, and a
-  problem row's culprits, are the diagnosis stage's own records
-  (records/stage_records.py ``Culprit``, ``CexRow``, ``Repair``;
-  report/problems_places.py ``culprit``), left open here.
+* The culprits, counterexample rows and repairs of a diagnosis are
+  records/repair_rows.py's :class:`~rclverify.records.repair_rows.CulpritRow`,
+  :class:`~rclverify.records.repair_rows.CexTableRow` and
+  :class:`~rclverify.records.repair_rows.RepairRow`; a problem row's culprits
+  (report/problems_places.py ``culprit``) are left open here.
 * The ``diagnoses`` and ``problems`` items of docs/assurance.schema.json
   are generated from them (records/schema_gen.py);
   tests/records/test_record_shapes.py fails when the file and the classes
@@ -39,6 +40,7 @@ from typing import Annotated, Any, Iterable, Mapping
 
 import msgspec
 
+from rclverify.records.repair_rows import CexTableRow, CulpritRow, RepairRow
 from rclverify.records.row import DOC, Row, decode_rows
 from rclverify.records.statuses import AnyStatus
 
@@ -55,10 +57,9 @@ class DiagnosisRow(Row, frozen=True, forbid_unknown_fields=True, omit_defaults=T
     node: Annotated[str, _DOC(description="The node's name as the contracts declare it.")]
     status: Annotated[AnyStatus, _DOC(description="Its status.")]
     sentence: Annotated[str, _DOC(description="One sentence for a reader.")]
-    culprits: Annotated[list[dict[str, Any]], _DOC(description="The items to repair.")]
-    counterexample: Annotated[list[dict[str, Any]], _DOC(description="The counterexample, as rows a reader "
-                                                                     "follows.")]
-    repairs: Annotated[list[dict[str, Any]], _DOC(description="Repairs, each checked by Z3 before it is offered.")]
+    culprits: Annotated[list[CulpritRow], _DOC(description="The items to repair.")]
+    counterexample: Annotated[list[CexTableRow], _DOC(description="The counterexample, as rows a reader follows.")]
+    repairs: Annotated[list[RepairRow], _DOC(description="Repairs, each checked by Z3 before it is offered.")]
     guarantee: Annotated[int | None, _DOC(description="1-based guarantee index, null when it concerns the whole "
                                                       "contract.")]
     related: Annotated[list[str], _DOC(description="Other problems it relates to.")]

@@ -11,7 +11,7 @@ result's ``properties``) is ``object``.
 # annotations (with string annotations every key would count as required).
 from typing import Mapping, NotRequired, TypedDict
 
-from rclverify.records.stage_records import EditJson
+from rclverify.records.repair_rows import EditRow
 
 
 class SarifText(TypedDict):
@@ -125,17 +125,17 @@ class SarifRun(TypedDict):
 SarifLog = TypedDict("SarifLog", {"$schema": str, "version": str, "runs": list[SarifRun]})
 
 
-def sarif_fix(description: str, edit: EditJson) -> SarifFix:
-    """A SARIF 2.1.0 ``fix`` object (§3.55) for an edit in its JSON form
-    (:meth:`rclverify.diagnosis.edits.Edit.to_json`): one ``artifactChange`` (§3.56) with one
+def sarif_fix(description: str, edit: EditRow) -> SarifFix:
+    """A SARIF 2.1.0 ``fix`` object (§3.55) for a repair's edit (decoded,
+    :class:`~rclverify.records.repair_rows.EditRow`): one ``artifactChange`` (§3.56) with one
     ``replacement`` (§3.57)."""
     return {"description": {"text": description},
             "artifactChanges": [{
-                "artifactLocation": {"uri": edit["file"]},
+                "artifactLocation": {"uri": edit.file},
                 "replacements": [{
-                    "deletedRegion": {"startLine": edit["line"], "startColumn": edit["col"],
-                                      "endLine": edit["end_line"], "endColumn": edit["end_col"]},
-                    "insertedContent": {"text": edit["inserted"]}}]}]}
+                    "deletedRegion": {"startLine": edit.line, "startColumn": edit.col,
+                                      "endLine": edit.end_line, "endColumn": edit.end_col},
+                    "insertedContent": {"text": edit.inserted}}]}]}
 
 
 #: Base id of every artifact location: the workspace root.

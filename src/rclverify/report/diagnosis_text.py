@@ -5,6 +5,7 @@ import re
 from typing import Any, Mapping, Sequence
 
 from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.repair_rows import CexTableRow
 from rclverify.records.report_record import AssuranceReport
 
 
@@ -22,35 +23,35 @@ def natural_sorted(ids: Sequence[str]) -> list[str]:
     return sorted(ids, key=_natural_key)
 
 
-def table_lines(rows: Sequence[Mapping[str, Any]], indent: str = "  ") -> list[str]:
-    """A counterexample table (:func:`rclverify.diagnosis.table.counterexample_table`)
+def table_lines(rows: Sequence[CexTableRow], indent: str = "  ") -> list[str]:
+    """A counterexample table (:func:`rclverify.diagnosis.table.counterexample_table`, decoded)
     as aligned text: node, variable, value; a function's finite table below it."""
     if not rows:
         return []
-    w_node = max(len("node"), *(len(str(r["node"])) for r in rows))
-    w_var = max(len("variable"), *(len(str(r["variable"])) for r in rows))
+    w_node = max(len("node"), *(len(r.node) for r in rows))
+    w_var = max(len("variable"), *(len(r.variable) for r in rows))
     out = [f"{indent}{'node':<{w_node}}  {'variable':<{w_var}}  value"]
     for r in rows:
-        t = r.get("table")
+        t = r.table
         if t:
-            out.append(f"{indent}{r['node']:<{w_node}}  {r['variable']:<{w_var}}  function:")
-            for args, v in t["rows"]:
+            out.append(f"{indent}{r.node:<{w_node}}  {r.variable:<{w_var}}  function:")
+            for args, v in t.rows:
                 out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    {args} -> {v}")
-            if t.get("more"):
-                out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    ... {t['more']} more points")
-            out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    elsewhere -> {t['else']}")
+            if t.more:
+                out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    ... {t.more} more points")
+            out.append(f"{indent}{'':<{w_node}}  {'':<{w_var}}    elsewhere -> {t.elsewhere}")
         else:
-            out.append(f"{indent}{r['node']:<{w_node}}  {r['variable']:<{w_var}}  {r['value']}")
+            out.append(f"{indent}{r.node:<{w_node}}  {r.variable:<{w_var}}  {r.value}")
     return out
 
 
 def explain_lines(d: DiagnosisRow) -> list[str]:
     """One diagnosis record (decoded) as text: sentence, culprits, counterexample, repairs with their diffs
-    and cost; the culprits, counterexample rows and repairs are the JSON objects diagnosis/ writes."""
+    and cost."""
     out = [f"{d.id} [{d.status}] ({d.kind})", f"  {d.sentence}"]
     if d.culprits:
         out.append("  culprits:")
-        out += [f"    {c['what']}" + (f"  ({c['source']})" if c.get("source") and c["source"] not in c["what"] else "")
+        out += [f"    {c.what}" + (f"  ({c.source})" if c.source and c.source not in c.what else "")
                 for c in d.culprits]
     if d.counterexample:
         out.append("  counterexample:")
@@ -60,16 +61,16 @@ def explain_lines(d: DiagnosisRow) -> list[str]:
     if not d.repairs:
         out.append("  repairs: none that Z3 could check")
     for k, r in enumerate(d.repairs, 1):
-        out.append(f"  repair {k} ({r['kind']}): {r['summary']}")
-        out.append(f"    Z3 ({r['checked_by']}) shows: {r.get('proves') or 'the problem no longer follows'}; "
-                   f"not shown: {r.get('not_shown') or 'that the change is safe'}")
-        for c in r.get("checks", []):
-            out.append(f"    checked: {c['check']}: {c['status']}")
-        if r.get("cost"):
-            out += [f"    changes: {c['check']}: {c['before']} -> {c['after']}" for c in r["cost"]]
+        out.append(f"  repair {k} ({r.kind}): {r.summary}")
+        out.append(f"    Z3 ({r.checked_by}) shows: {r.proves or 'the problem no longer follows'}; "
+                   f"not shown: {r.not_shown or 'that the change is safe'}")
+        for c in r.checks:
+            out.append(f"    checked: {c.check}: {c.status}")
+        if r.cost:
+            out += [f"    changes: {c.check}: {c.before} -> {c.after}" for c in r.cost]
         else:
             out.append("    changes: no other check changes status")
-        out += ["    " + line for line in r["diff"].rstrip("\n").splitlines()]
+        out += ["    " + line for line in r.diff.rstrip("\n").splitlines()]
     for why in d.not_offered or ():
         out.append(f"  not offered: {why}")
     return out

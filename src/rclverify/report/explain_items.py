@@ -21,7 +21,7 @@ from typing import Any, Mapping
 
 import msgspec
 
-from rclverify.diagnosis.table import counterexample_table
+from rclverify.diagnosis.table import counterexample_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import Acknowledged, FindingRow
 from rclverify.records.obligations import ObligationRow
@@ -207,7 +207,7 @@ def _model_lines(status: str, model: Mapping[str, Any] | None, node: str) -> lis
     if not model:
         return []
     label = "witness" if status in HOLDS else "counterexample"
-    return [f"  {label}:"] + table_lines(counterexample_table(dict(model), node), "    ")
+    return [f"  {label}:"] + table_lines(counterexample_rows(dict(model), node), "    ")
 
 
 def _undiagnosed(status: str, diagnosed: bool) -> list[str]:

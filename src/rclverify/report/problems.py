@@ -73,6 +73,7 @@ from typing import Any
 import msgspec
 
 from rclverify.records.problem_rows import DiagnosisRow, ProblemRow
+from rclverify.records.repair_rows import CexTableRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.report.shapes import AttentionItem
@@ -186,7 +187,7 @@ class _Grouping:
 
     def _diagnosis_roots(self, d: DiagnosisRow) -> list[str]:
         """The roots of the diagnosis ``d`` (rules 1, 2 and 5; a unit mismatch's, a model checker's)."""
-        roots = pp.roots(d.culprits, self.places, _victim_of(d.node, d.guarantee))
+        roots = pp.roots([(c.what, c.source) for c in d.culprits], self.places, _victim_of(d.node, d.guarantee))
         did = d.id
         if d.kind == pu.KIND:
             self.unit_roots[did] = roots = roots or [f"problem:{d.id}"]
@@ -225,7 +226,7 @@ class _Grouping:
                 continue
             check = RequirementCheckRow.of(q.check)
             core = [*check.vacuity_core, *check.inconsistent_core, *check.failed_to_prevent]
-            roots = pp.roots([{"what": p.label, "source": p.source} for p in core], self.places, None)
+            roots = pp.roots([(p.label, p.source) for p in core], self.places, None)
             if pp.by_deadline(q):  # not met because of its end-to-end deadline only: the deadline's row (rule 5)
                 roots = [f"{DEADLINE_PREFIX}{q.id}"]
             self.members.append((Member(id=q.id, kind="requirement", status=q.status,
@@ -331,9 +332,9 @@ class _Grouping:
                       if m.id in self.by_id and self.by_id[m.id].kind == "deadline"), None)
             g.culprits = []
             for c in (d.culprits if d is not None else ()):
-                rid = self.places.locate(str(c.get("source", "")))
+                rid = self.places.locate(c.source)
                 if rid is not None and rid in self.places.info:
-                    g.culprits.append({**pp.culprit(rid, self.places, self.anchor), "what": str(c["what"])})
+                    g.culprits.append({**pp.culprit(rid, self.places, self.anchor), "what": c.what})
 
     def model_checking_rows(self, groups: Mapping[tuple[str, ...], _Row]) -> None:
         """Model-checking rows: the Gwendolen lines the counterexamples pass through."""
@@ -351,7 +352,7 @@ class _Grouping:
                     if str(c["id"]).startswith("line:"):
                         c["node"] = next(iter(owners))
 
-    def _counterexample(self, ident: str) -> list[dict[str, Any]]:
+    def _counterexample(self, ident: str) -> list[CexTableRow]:
         """The counterexample rows of the diagnosis ``ident`` (``[]`` without one)."""
         d = self.by_id.get(ident)
         return d.counterexample if d is not None else []
@@ -367,8 +368,8 @@ class _Grouping:
         for m in g.members:
             dg = self.by_id.get(m.id)
             for k, rep in enumerate(dg.repairs if dg is not None and m.diagnosis else []):
-                if rep.get("diff") not in diffs:
-                    diffs.add(rep.get("diff"))
+                if rep.diff not in diffs:
+                    diffs.add(rep.diff)
                     g.repairs.append({"diagnosis": m.id, "index": k})
         if g.key[0].startswith(OUTSTANDING_WHOLE) and len(g.members) > 1:
             _, backend, node = g.key[0].split(":", 2)
@@ -376,8 +377,7 @@ class _Grouping:
                                         f"{g.status} (evidence outstanding): {g.sentence}",
                                         SENTENCE_CHARS // 2)  # a summary: each finding holds its whole text
         if g.key[0].startswith((mc.FAILED_PREFIX, mc.OUTSTANDING_PREFIX)):
-            cex = next((str(r.get("value", "")) for m in g.members
-                        for r in self._counterexample(m.id) if r.get("variable") == "lasso"), "")
+            cex = next((r.value for m in g.members for r in self._counterexample(m.id) if r.variable == "lasso"), "")
             g.sentence = first_sentence(mc.row_sentence(g.key[0], g.members, first_sentence(g.members[0].sentence), cex))
 
 

@@ -58,9 +58,9 @@ def trail_sources(d: DiagnosisRow | None) -> list[str]:
     when it names none."""
     out: list[str] = []
     for row in d.counterexample if d is not None else ():
-        if row.get("variable") != "lasso":
+        if row.variable != "lasso":
             continue
-        for m in _TRAIL.finditer(str(row.get("value", ""))):
+        for m in _TRAIL.finditer(row.value):
             out += [f"{m.group(2)}:{n.strip()}" for n in m.group(1).split(",") if n.strip().isdigit()]
     return list(dict.fromkeys(out))
 

@@ -149,13 +149,13 @@ def join_requirements_to_side_conditions(members: list[Rooted]) -> None:
             members[i] = (m, sorted(home))
 
 
-def roots(culprits: Sequence[Mapping[str, Any]], places: Places, victim: str | None) -> list[str]:
-    """Root culprit ids of one problem (rules 1 and 2 of the module docstring)."""
+def roots(culprits: Sequence[tuple[str, str]], places: Places, victim: str | None) -> list[str]:
+    """Root culprit ids of one problem (rules 1 and 2 of the module docstring); ``culprits``: each
+    ``(what, source)``, a culprit in words and its ``file:line:col``."""
     roots: list[str] = []
     context: list[str] = []
-    for c in culprits:
-        what = str(c.get("what", ""))
-        rid = places.locate(str(c.get("source", "")))
+    for what, source in culprits:
+        rid = places.locate(source)
         if rid is None:
             continue
         if what.startswith(("environment fact", "event ")):

@@ -29,11 +29,9 @@ from rclverify.report.problems_places import Rooted
 
 
 def first_diff(diagnosis: DiagnosisRow | None) -> str | None:
-    """The unified diff of the first repair of ``diagnosis`` (its ``repairs``: ``[{"diff": str, ...},
-    ...]``), ``None`` when it has none."""
+    """The unified diff of the first repair of ``diagnosis``, ``None`` when it has none."""
     reps = diagnosis.repairs if diagnosis is not None else []
-    diff = reps[0].get("diff") if reps and isinstance(reps[0], Mapping) else None
-    return str(diff) if diff else None
+    return reps[0].diff or None if reps else None
 
 
 def join_by_first_repair(members: list[Rooted], by_id: Mapping[str, DiagnosisRow]) -> None:

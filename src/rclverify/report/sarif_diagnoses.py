@@ -11,11 +11,12 @@ consumer's assumption it fails a related location (§3.27.22).
 """
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Any, Sequence
 
 import msgspec
 
 from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.repair_rows import RepairRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.sarif import SarifResult, sarif_fix, sarif_locations
 
@@ -50,10 +51,10 @@ def attach_diagnoses(report: AssuranceReport, results: Sequence[SarifResult]) ->
             _at_the_culprit(res, d)
         # what Z3 showed and what it did not, with each fix: "checked by Z3" is no safety claim (docs/diagnosis.md)
         # a repair of the code is checked by the property tests (diagnosis/code_repair.py), not by Z3 alone
-        fixes = [sarif_fix(f"{r['summary']} {_checker(r)} show{'' if _checker(r).endswith('tests') else 's'}: "
-                           f"{r.get('proves') or 'the problem no longer follows'}; not shown: "
-                           f"{r.get('not_shown') or 'that the change is safe'}.", r["edit"])
-                 for r in d.repairs if r.get("edit")]
+        fixes = [sarif_fix(f"{r.summary} {_checker(r)} show{'' if _checker(r).endswith('tests') else 's'}: "
+                           f"{r.proves or 'the problem no longer follows'}; not shown: "
+                           f"{r.not_shown or 'that the change is safe'}.", r.edit)
+                 for r in d.repairs]
         if fixes:
             res["fixes"] = fixes
 
@@ -63,11 +64,10 @@ def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
     (a producer that publishes what the consumer does not accept), so that a CI
     annotation lands on the node to repair; the consumer's assumption it fails
     becomes a related location (SARIF 2.1.0 §3.27.22)."""
-    guarantee = next((c for c in d.culprits if isinstance(c, Mapping)
-                      and str(c.get("what", "")).startswith("guarantee") and c.get("source")), None)
+    guarantee = next((c for c in d.culprits if c.what.startswith("guarantee") and c.source), None)
     if guarantee is None:
         return
-    at = sarif_locations(str(guarantee["source"]))
+    at = sarif_locations(guarantee.source)
     if not at:
         return
     rel = res.get("locations") or []
@@ -79,10 +79,10 @@ def _at_the_culprit(res: SarifResult, d: DiagnosisRow) -> None:
         res["relatedLocations"] = rel
 
 
-def _checker(r: Mapping[str, Any]) -> str:
+def _checker(r: RepairRow) -> str:
     """What checked the repair ``r``: Z3, the property tests (a code repair), or what its ``checked_by`` names."""
-    by = str(r.get("checked_by") or "")
-    return "Z3" if r["kind"] != "code" else "The property tests" if "hypothesis" in by or not by else by[:1].upper() + by[1:]
+    by = r.checked_by
+    return "Z3" if r.kind != "code" else "The property tests" if "hypothesis" in by or not by else by[:1].upper() + by[1:]
 
 
 __all__ = ["attach_diagnoses"]
