@@ -14,42 +14,44 @@ clause's ``min_runs`` independent runs (each run counted once by its
 digest, docs/statistics.md "A run's identity").  Each item's detail shows
 the figures an assessor checks: the runs counted, the violating runs, the
 bound, its confidence, the target, the environment and the origin
-(:func:`figures`).  Pure functions of the report's rows; nothing raises.
+(:func:`figures`).  Pure functions of the report's rows, read as
+:class:`~.report_view.StatisticsView`; nothing raises on a report's rows.
 """
 from __future__ import annotations
 
 from typing import Any, Collection, Iterable, Mapping
 
-from rclverify.model.plan.standards.report_view import ReportView, report_view
+from rclverify.model.plan.standards.report_view import (CountsView, DecisionView, ReportView, StatisticsView,
+                                                        report_view, statistics_view)
 from rclverify.records.standards_rows import ScopeItem
 
 
-def figures(s: Mapping[str, Any]) -> dict[str, str]:
-    """The figures of a target's ``statistics`` (an evidence row's, or a requirement's runs row): ``n``
-    (runs counted), ``violations``, ``target`` and ``confidence`` (percent), ``bound``, ``environment`` and
-    ``origin``, each as text (``""`` for what it does not hold)."""
-    d = _part(s, "decision")
-    counts = _part(s, "counts")
-    target = _part(d, "target")
-    n = d.get("n", counts.get("runs", ""))
-    k = d.get("k", counts.get("violating_runs", ""))
-    bound = d.get("bound", s.get("bound"))
-    level = d.get("level", s.get("level"))
-    limit = target.get("bound")
-    text = s.get("target") if isinstance(s.get("target"), str) else target.get("text", "")
+def figures(stats: StatisticsView | Mapping[str, Any]) -> dict[str, str]:
+    """The figures of a target's ``statistics`` (an evidence row's, or a requirement's runs row; its JSON
+    object or its :class:`~.report_view.StatisticsView`): ``n`` (runs counted), ``violations``, ``target``
+    and ``confidence`` (percent), ``bound``, ``environment`` and ``origin``, each as text (``""`` for what
+    it does not hold)."""
+    s = statistics_view(stats)
+    d = s.decision or DecisionView()
+    counts = s.counts or CountsView()
+    n = _first(d.n, counts.runs)
+    k = _first(d.k, counts.violating_runs)
+    bound = d.bound if d.bound is not None else s.bound
+    level = d.level if d.level is not None else s.level
+    limit = d.target.bound
+    text = s.target if isinstance(s.target, str) else d.target.text
 
-    def pct(x: Any) -> str:
-        return "" if not isinstance(x, (int, float)) else f"{100 * float(x):.4g} %"
-    return {"n": str(n), "violations": str(k),
+    def pct(x: float | None) -> str:
+        return "" if x is None else f"{100 * float(x):.4g} %"
+    return {"n": n, "violations": k,
             "target": (pct(limit) if limit is not None else str(text or "")),
-            "confidence": pct(level), "bound": pct(bound), "environment": str(s.get("environment", "")),
-            "origin": str(s.get("origin", ""))}
+            "confidence": pct(level), "bound": pct(bound), "environment": s.environment, "origin": s.origin}
 
 
-def _part(s: Mapping[str, Any], key: str) -> Mapping[str, Any]:
-    """``s[key]`` when it is an object, else an empty one."""
-    v = s.get(key)
-    return v if isinstance(v, Mapping) else {}
+def _first(decided: int | None, counted: int | None) -> str:
+    """The decision's figure, else the counts' one, as text (``""`` when neither states it)."""
+    x = decided if decided is not None else counted
+    return "" if x is None else str(x)
 
 
 def sentence(f: Mapping[str, str]) -> str:
@@ -59,14 +61,14 @@ def sentence(f: Mapping[str, str]) -> str:
             f"environment {f['environment'] or 'unstated'}, origin {f['origin'] or 'unstated'}")
 
 
-def _state(status: str, n: Any, min_runs: int, stated: bool, field_data: bool) -> tuple[str, str]:
+def _state(status: str, n: int | None, min_runs: int, stated: bool, field_data: bool) -> tuple[str, str]:
     """(state, why not covered) of a target whose decision is ``status`` over ``n`` runs."""
     if field_data and not stated:
         return "not counted", ("the plan entry states no origin: a run set counts as field data only when it "
                                "says origin: operation")
     if status != "discharged":
         return status, f"target {status}"
-    if min_runs and (not isinstance(n, int) or n < min_runs):
+    if min_runs and (n is None or n < min_runs):
         return "not counted", f"{n} independent runs; the clause asks at least {min_runs}"
     return "covered", ""
 
@@ -94,27 +96,24 @@ def target_items(report: ReportView | Mapping[str, Any], about: str, min_runs: i
     rep = report_view(report)
     for e in rep.evidence:
         s = e.statistics
-        if not (s is not None and "decision" in s):
+        if s is None or s.decision is None:
             continue
         monitors = e.backend == "monitors"
-        if not ((monitors and s.get("origin") in origins) or (not field_data and e.backend == "experiment")):
+        if not ((monitors and s.origin in origins) or (not field_data and e.backend == "experiment")):
             continue
-        f = figures(s)
-        d = _part(s, "decision")
         node = e.obligation.split(".", 1)[0]
-        stated = not monitors or (node, str(s.get("environment", ""))) not in unstated
-        state, why = _state(str(e.status), d.get("n"), min_runs, stated, field_data)
-        out.append(_target(f"target {e.obligation}", state, why, f, e.obligation))
+        stated = not monitors or (node, s.environment) not in unstated
+        state, why = _state(str(e.status), s.decision.n, min_runs, stated, field_data)
+        out.append(_target(f"target {e.obligation}", state, why, figures(s), e.obligation))
     for rq in rep.requirements:
         for t in rq.statistics or ():
-            if not (t.get("target") and t.get("origin") in origins):
+            if not (t.target and t.origin in origins):
                 continue
-            f = figures(t)
-            counts = _part(t, "counts")
-            stated = t.get("origin") != "operation" or str(t.get("environment", "")) not in envs_unstated
-            state, why = _state(str(t.get("status") or "pending"), counts.get("runs"), min_runs, stated, field_data)
-            out.append(_target(f"target of requirement {rq.id} ({t.get('environment')}, {t.get('origin')})",
-                               state, why, f, f"requirement {rq.id}"))
+            counts = t.counts or CountsView()
+            stated = t.origin != "operation" or t.environment not in envs_unstated
+            state, why = _state(t.status or "pending", counts.runs, min_runs, stated, field_data)
+            out.append(_target(f"target of requirement {rq.id} ({t.environment}, {t.origin})",
+                               state, why, figures(t), f"requirement {rq.id}"))
     return out
 
 

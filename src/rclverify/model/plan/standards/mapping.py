@@ -107,7 +107,7 @@ def kinds_of(row: EvidenceView | Mapping[str, Any]) -> set[str]:
 
 
 def _harness(row: EvidenceView) -> bool:
-    return row.statistics is not None and row.statistics.get("origin") == "harness"
+    return row.statistics is not None and row.statistics.origin == "harness"
 
 
 def _support(row: EvidenceView, asked: str, people: Sequence[Person] = ()) -> ClauseEvidence:
@@ -196,10 +196,10 @@ def _requirement_item(rq: RequirementView, ix: _Index, accepts: set[str], asked:
         state, detail = str(rq.status), f"verdict: {rq.verdict}"
     if state == "covered" and rq.deadline is not None and rq.deadline.verdict != "proved":
         state, detail = "pending", f"deadline {rq.deadline.verdict}"
-    targets = [t for t in rq.statistics or () if t.get("target") and t.get("status") != "discharged"]
+    targets = [t for t in rq.statistics or () if t.target and t.status != "discharged"]
     if state == "covered" and targets:
-        state = str(targets[0].get("status") or "pending")
-        detail = f"target {state} ({targets[0].get('origin')} runs)"
+        state = targets[0].status or "pending"
+        detail = f"target {state} ({targets[0].origin} runs)"
     if state == "covered" and "proof" not in accepts:
         support = [(s.node, s.guarantee) for s in rq.support or ()]
         if not any(sp.counts and sp.status == "discharged" for key in support

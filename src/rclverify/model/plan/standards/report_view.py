@@ -7,9 +7,10 @@ of evidence rows): :func:`report_view` converts it once into
 mapping reads, each defaulted, so a part the report does not hold reads
 as empty; every other key is ignored.  The fields' names and meanings are
 the report records' (records/evidence_rows.py, records/findings.py,
-records/requirement_rows.py, ...); an evidence row's ``statistics`` is
-kept as its backend wrote it (docs/statistics.md), read by
-:func:`.field_data.figures`.  Raises :class:`msgspec.ValidationError` for
+records/requirement_rows.py, ...); an evidence row's ``statistics`` and a
+requirement's runs rows are read as :class:`StatisticsView` (the fields of a
+statistical target's decision, docs/statistics.md, that
+:func:`.field_data.figures` shows).  Raises :class:`msgspec.ValidationError` for
 a value of another type than the report's (a bug of the caller).
 """
 from __future__ import annotations
@@ -29,6 +30,49 @@ class StrengthView(_View, frozen=True, kw_only=True):
     kind: str | None = None
 
 
+class TargetView(_View, frozen=True, kw_only=True):
+    """A statistical target as its decision states it (records/statistics.py ``TargetJson``): the
+    violation probability ``bound`` it asks and the target in words."""
+
+    bound: float | None = None
+    text: str = ""
+
+
+class DecisionView(_View, frozen=True, kw_only=True):
+    """A target's decision (records/statistics.py ``decide``): ``n`` trials counted, ``k`` violating, the
+    upper ``bound`` at confidence ``level``, and the ``target``."""
+
+    n: int | None = None
+    k: int | None = None
+    bound: float | None = None
+    level: float | None = None
+    target: TargetView = TargetView()
+
+
+class CountsView(_View, frozen=True, kw_only=True):
+    """The counts of a set of runs (records/statistics.py ``count_runs``): the runs and the violating ones."""
+
+    runs: int | None = None
+    violating_runs: int | None = None
+
+
+class StatisticsView(_View, frozen=True, kw_only=True):
+    """An evidence row's ``statistics`` (as its backend wrote it) or a requirement's runs row
+    (records/statistics_rows.py ``RequirementRuns``): the runs' ``environment`` and ``origin``, their
+    ``counts``, the ``decision`` against a target (an evidence row's), the ``target`` (a requirement's in
+    words, an evidence row's as its JSON), the ``bound`` and ``level`` (a requirement's) and ``status``
+    (a requirement's target decided)."""
+
+    environment: str = ""
+    origin: str = ""
+    counts: CountsView | None = None
+    decision: DecisionView | None = None
+    target: str | TargetView | None = None
+    bound: float | None = None
+    level: float | None = None
+    status: str | None = None
+
+
 class EvidenceView(_View, frozen=True, kw_only=True):
     """An ``evidence[]`` row: the obligation, who produced it, its kind and status, what it states."""
 
@@ -42,7 +86,7 @@ class EvidenceView(_View, frozen=True, kw_only=True):
     figures: tuple[Any, ...] | None = None
     strength: StrengthView | None = None
     #: as the backend wrote it (docs/statistics.md); ``None`` when absent
-    statistics: dict[str, Any] | None = None
+    statistics: StatisticsView | None = None
 
 
 class ObligationView(_View, frozen=True, kw_only=True):
@@ -107,7 +151,7 @@ class RequirementView(_View, frozen=True, kw_only=True):
     verdict: str | None = None
     deadline: DeadlineView | None = None
     #: its targets over recorded runs, as the statistics pass wrote them (docs/statistics.md)
-    statistics: tuple[dict[str, Any], ...] | None = None
+    statistics: tuple[StatisticsView, ...] | None = None
     support: tuple[SupportView, ...] | None = None
 
 
@@ -165,11 +209,17 @@ def report_view(report: ReportView | Mapping[str, Any] | Sequence[Mapping[str, A
     return msgspec.convert(data, ReportView)
 
 
+def statistics_view(s: StatisticsView | Mapping[str, Any]) -> StatisticsView:
+    """A target's statistics (its JSON object, or its view) as a :class:`StatisticsView`."""
+    return s if isinstance(s, StatisticsView) else msgspec.convert(_present(s), StatisticsView)
+
+
 def evidence_view(row: EvidenceView | Mapping[str, Any]) -> EvidenceView:
     """An evidence row (its JSON object, or its view) as an :class:`EvidenceView`."""
     return row if isinstance(row, EvidenceView) else msgspec.convert(_present(row), EvidenceView)
 
 
-__all__ = ["ConnectionView", "DeadlineView", "EvidenceView", "FindingView", "GuaranteeView", "NodeView",
-           "ObligationView", "ReportView", "RequirementView", "SideConditionView", "StrengthView", "SummaryView",
-           "SupportView", "SystemView", "UnverifiedView", "evidence_view", "report_view"]
+__all__ = ["ConnectionView", "CountsView", "DeadlineView", "DecisionView", "EvidenceView", "FindingView",
+           "GuaranteeView", "NodeView", "ObligationView", "ReportView", "RequirementView", "SideConditionView",
+           "StatisticsView", "StrengthView", "SummaryView", "SupportView", "SystemView", "TargetView",
+           "UnverifiedView", "evidence_view", "report_view", "statistics_view"]
