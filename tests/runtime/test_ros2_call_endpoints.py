@@ -36,12 +36,11 @@ import contextlib
 import io
 import json
 import signal
-import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import pytest
-from _procs import stop, wait_for
+from _procs import stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 SERVICES = ("ctl", "two", "both", "meta", "half", "rs", "early")
@@ -210,7 +209,11 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     ws = _workspace(tmp)
     return _watched(tmp, ws, {"all": _args(ws, tmp, "all", "--record", str(tmp / "bag")),
                               "ctl": _args(ws, tmp, "ctl", "--node", "Ctl", "--record", str(tmp / "ctl_bag"))},
-                    {**{f"/{s}/_service_event": 1 for s in SERVICES}, "/ctl/_service_event": 2})
+                    {**{f"/{s}/_service_event": 1 for s in SERVICES}, "/ctl/_service_event": 2},
+                    # the last call heard (/rs's, before its server's restart) judged, the restarted server named
+                    {"all": lambda log: _judged(log, {"Rs": 1, "Ctl": 6}) and any(
+                        x.get("part") == "unjudged" and x.get("endpoint") == "server /rs_s" for x in log),
+                     "ctl": lambda log: _judged(log, {"Ctl": 6})})  # four calls: a request of False is judged too
 
 
 @pytest.fixture(scope="module")
@@ -222,13 +225,23 @@ def dds(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     ws = _workspace(tmp)
     # the DDS source reads /two's and /both's request topics on the wire, beside their two servers
     return _watched(tmp, ws, {"all": _args(ws, tmp, "all", source="dds")},
-                    {"/ctl/_service_event": 1, "rq/twoRequest": 3, "rq/bothRequest": 3})
+                    {"/ctl/_service_event": 1, "rq/twoRequest": 3, "rq/bothRequest": 3},
+                    {"all": lambda log: _judged(log, {"Rs": 3})})  # /rs's last calls, on the wire, judged
 
 
-def _watched(tmp: Path, ws: Path, monitors: dict[str, list[str]], readers: dict[str, int]) -> dict[str, Any]:
+def _judged(log: list[dict[str, Any]], least: dict[str, int]) -> bool:
+    """``log`` holds at least ``least[node]`` call verdicts of each node."""
+    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
+             and x["verdict"].get("call")]
+    return all(calls.count(node) >= n for node, n in least.items())
+
+
+def _watched(tmp: Path, ws: Path, monitors: dict[str, list[str]], readers: dict[str, int],
+             done: dict[str, Callable[[list[dict[str, Any]]], bool]]) -> dict[str, Any]:
     """The system started first (its early request made before any monitor), then the monitors; stopped
-    once the system is done; per monitor its exit code, output, log and record.  ``readers``: topic (a ROS
-    name, or a raw DDS one) -> the readers, the monitors' with the system's own, it waits for before its calls."""
+    once the system is done and each monitor's log holds what ``done[name]`` waits for (its run's last calls
+    judged); per monitor its exit code, output, log and record.  ``readers``: topic (a ROS name, or a raw DDS
+    one) -> the readers, the monitors' with the system's own, it waits for before its calls."""
     env = ros2_env(tmp)
     procs: dict[str, Any] = {}
     system = None
@@ -240,7 +253,8 @@ def _watched(tmp: Path, ws: Path, monitors: dict[str, list[str]], readers: dict[
         for name in monitors:
             wait_for(tmp / f"{name}.out", "monitoring", 60)
         wait_for(tmp / "system.log", "done", 90)
-        time.sleep(1.6)  # the horizon (1 s) and the monitor's settle (0.3 s) pass
+        for name in monitors:  # whatever the load, not a fixed horizon and settle
+            wait_logged(tmp / f"{name}.jsonl", done[name], 30)
         for p in procs.values():
             stop(p, signal.SIGINT)
         codes = {name: p.returncode for name, p in procs.items()}
