@@ -42,18 +42,15 @@ from rclverify.ros.extract.launch_py_values import ENV as _ENV, HERE as _HERE, T
 from rclverify.ros.extract.launch_py_values import Unres as _Unres, arg as _arg, callee as _callee
 from rclverify.ros.extract.launch_py_values import expand as _expand, kw as _kw, once as _once, unroll as _unroll
 from rclverify.ros.extract.launch_py_values import value as _value
-from rclverify.ros.extract.launch_py_flow import added as _added, flat as _flat, grown as _grown
+from rclverify.ros.extract.launch_py_flow import added as _added, grown as _grown
 from rclverify.ros.extract.launch_py_actions import CONFIG_STACK, HANDLERS, PAIRS, QUIET, group_flags as _group_flags
 from rclverify.ros.extract.launch_py_actions import group_keep as _group_keep
 from rclverify.ros.extract.launch_py_actions import at_shutdown as _shutdown, condition as _cond
 from rclverify.ros.extract.launch_py_actions import optional as _opt, required as _req
+from rclverify.ros.extract.launch_py_functions import FN as _FN, FUNCS as _FUNCS, called as _called
 from rclverify.ros.extract.launch_py_node import execute_process, node_kids as _node_kids, ros_args as _ros_args
 from rclverify.ros.extract.model import Note, Src
 
-MAX_CALLS = 8  # functions of the launch file evaluated inside one another
-_FUNCS: dict[str, ast.FunctionDef] = {}  # the launch file's module-level functions, while it is read
-_CALLING: list[str] = []  # the functions being evaluated (a recursion stops)
-_FN: list[ast.FunctionDef] = []  # the function whose statements are read (innermost last)
 
 
 def _actions(e: ast.AST, shown: str, notes: list[Note]) -> list[El]:
@@ -263,65 +260,10 @@ def _more(c: ast.Call, name: str, attrs: dict[str, str], src: Src, shown: str, n
 
 def _function_actions(fn: ast.expr | None, call: ast.Call, opaque: bool, shown: str,
                       notes: list[Note]) -> list[El] | str:
-    """The actions a function of the launch file returns, its parameters bound
-    to the call's arguments (``OpaqueFunction(function=f, args=[...],
-    kwargs={...})`` calls ``f(context, *args, **kwargs)``) and its own names
-    bound once read as in ``generate_launch_description()``; of its
-    ``return`` statements, those in the branches that run (an ``if`` of known
-    test runs one, :mod:`launch_py_flow`); a function with other than one, or
-    returning what is not a list of actions, gives why as a string."""
-    if not isinstance(fn, ast.Name) or fn.id not in _FUNCS:
-        return f"'{ast.unparse(fn) if fn is not None else ''}' is not a function defined in the launch file"
-    f = _FUNCS[fn.id]
-    if fn.id in _CALLING or len(_CALLING) >= MAX_CALLS:
-        return "it is called inside itself"
-    params = [a.arg for a in f.args.posonlyargs + f.args.args]
-    given: dict[str, ast.expr] = dict(zip(params[len(params) - len(f.args.defaults):], f.args.defaults))
-    pos: list[ast.expr] = list(call.args) if not opaque else []
-    named = {k.arg: k.value for k in call.keywords if k.arg} if not opaque else {}
-    if opaque:
-        more, kwmore = _kw(call, "args"), _kw(call, "kwargs")
-        more, kwmore = _expand(more) if more is not None else None, _expand(kwmore) if kwmore is not None else None
-        pos = list(more.elts) if isinstance(more, (ast.List, ast.Tuple)) else []
-        if isinstance(kwmore, ast.Dict):
-            named = {k.value: v for k, v in zip(kwmore.keys, kwmore.values)
-                     if isinstance(k, ast.Constant) and isinstance(k.value, str)}
-        params = params[1:]  # the launch context
-    given.update({p: _expand(v) for p, v in zip(params, pos)})
-    given.update({p: _expand(v) for p, v in named.items() if p in params})
-    mine, twice = _once(list(ast.walk(f)))
-    saved, saved_twice = dict(_ENV), dict(_TWICE)
-    _CALLING.append(fn.id)
-    _FN.append(f)
-    try:
-        for p in params:
-            _ENV.pop(p, None)
-        _ENV.update(given)
-        _ENV.update(mine)
-        for k in twice:
-            _ENV.pop(k, None)
-        for k in mine:
-            _TWICE.pop(k, None)
-        _TWICE.update(twice)
-        # the returns of the statements that run: an if whose test is known runs its branch only
-        rets = [r.value for st in _flat(f.body, []) for r in ast.walk(st)
-                if isinstance(r, ast.Return) and r.value is not None]
-        if len(rets) != 1:
-            return f"it has {len(rets)} return statements (which one runs is chosen at run time)" if rets \
-                else "it returns no actions"
-        ret = _expand(rets[0])
-        if isinstance(ret, ast.Call) and _callee(ret) == "LaunchDescription" and ret.args:
-            ret = _expand(ret.args[0])
-        if not isinstance(ret, (ast.List, ast.Tuple)):
-            return f"it returns '{ast.unparse(rets[0])}', not a list of actions read statically"
-        return _actions(ret, shown, notes)
-    finally:
-        _CALLING.pop()
-        _FN.pop()
-        _ENV.clear()
-        _ENV.update(saved)
-        _TWICE.clear()
-        _TWICE.update(saved_twice)
+    """The actions a function of the launch file returns (:func:`~.launch_py_functions.called`), or why
+    they are not read (a string)."""
+    with _called(fn, call, opaque) as ret:
+        return ret if isinstance(ret, str) else _actions(ret, shown, notes)
 
 
 def read_python(path: Path, shown: str) -> tuple[El | None, list[Note]]:
