@@ -8,18 +8,21 @@ import stat
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import pytest
 
 from rclverify.diagnosis.apply_repair import NotApplied, apply_repair, find_repairs, none_offered
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import _record
+from rclverify.records.repair_rows import RepairRow
+from tests.records._typed_rows import typed_report
 
 CODE = "def gate(x):\n    return {\"ok\": x < 3}\n"
 
 
-def _repair(text: str, rel: str = "nodes/gate.py") -> dict[str, Any]:
+def _repair(text: str, rel: str = "nodes/gate.py") -> RepairRow:
     edit = Edit(rel, 2, 21, 2, 22, "<=")
-    return dict(_record("code", "x < 3 to x <= 3", edit, text, [], []))
+    return RepairRow.of(_record("code", "x < 3 to x <= 3", edit, text, [], []))
 
 
 def _ws(tmp_path: Path, data: bytes) -> Path:
@@ -52,14 +55,14 @@ def test_refused_outside_the_workspace_and_on_a_region_that_moved(tmp_path: Path
     with pytest.raises(NotApplied, match="not a file of the workspace"):
         apply_repair(ws, _repair(CODE, "../elsewhere.py"))
     moved = _repair(CODE)
-    moved["edit"] = {**moved["edit"], "deleted": "<="}  # a record whose region does not hold what it deletes
+    moved = msgspec.structs.replace(moved, edit=msgspec.structs.replace(moved.edit, deleted="<="))  # a record whose region does not hold what it deletes
     with pytest.raises(NotApplied, match="holds '<', not '<='"):
         apply_repair(ws, moved)
     assert (ws / "nodes/gate.py").read_text(encoding="utf-8") == CODE
     assert (tmp_path / "elsewhere.py").read_text(encoding="utf-8") == CODE
 
 
-REPORT: dict[str, Any] = {
+REPORT = typed_report({
     "diagnoses": [
         {"id": "Gate.g1.property_tests.e0", "kind": "property-test", "repairs": [{"kind": "code"}, {"kind": "code"}]},
         {"id": "Odd.g1.property_tests.e0", "kind": "property-test", "repairs": []},
@@ -72,7 +75,7 @@ REPORT: dict[str, Any] = {
         {"members": [{"id": "Gate.g1.property_tests.e0"}], "repairs": [{"diagnosis": "Gate.g1.property_tests.e0",
                                                                          "index": 1}]},
     ],
-}
+})
 
 
 def test_ids_exact_folded_and_problem_numbers() -> None:

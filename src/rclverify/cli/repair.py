@@ -15,11 +15,13 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Sequence
 
 from rclverify.cli.common import AddCommand
 
 if TYPE_CHECKING:
+    from rclverify.records.problem_rows import DiagnosisRow
+    from rclverify.records.repair_rows import RepairRow
     from rclverify.stages.workspace import Workspace
 
 #: Statuses and verdicts of a re-checked item that are a pass.
@@ -28,7 +30,7 @@ PASSED = frozenset({"discharged", "ok", "proved"})
 HEALTH_KINDS = frozenset({"vacuity", "inconsistency", "unsatisfiable-assumption", "refinement"})
 
 
-def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, Any],
+def recheck(ws: "Workspace", diagnosis: "DiagnosisRow", repair: "RepairRow",
             also: Sequence[str] = ()) -> list[tuple[str, str]]:
     """Run again, on the workspace ``ws`` as it is now (the edit made), the check that produced the failing
     record of ``diagnosis``, and of the ids ``also`` of the same kind (the other members of a problem
@@ -49,7 +51,7 @@ def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, 
     not check (a located error)."""
     from rclverify.app import pipeline  # deferred: start-up (loads the stages, z3 and the backends)
     from rclverify.diagnosis.apply_repair import obligation_checks  # deferred: start-up (loads z3)
-    did, kind, node = str(diagnosis.get("id")), str(diagnosis.get("kind")), str(diagnosis.get("node"))
+    did, kind, node = diagnosis.id, diagnosis.kind, diagnosis.node
     evidence = obligation_checks(diagnosis, repair)
     if kind == "monitor":  # the recorded run judged again with the node re-run from the edited file
         from rclverify.diagnosis.monitor_repair import rejudged_applied  # deferred: start-up (the re-run)
@@ -60,11 +62,11 @@ def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, 
     pipeline.stage_check(ws)
     if kind in HEALTH_KINDS:
         found = {f.id: str(f.status) for f in pipeline.health_findings(ws, node)}
-        asked = [did, *also] + [str(c.get("check", "")).split(" ")[0] for c in repair.get("checks") or []]
+        asked = [did, *also] + [c.check.split(" ")[0] for c in repair.checks]
         return [(i, found[i]) for i in dict.fromkeys(asked) if i in found]
     if kind in ("side-condition", "unit"):
-        wanted = [did, *also] if kind == "side-condition" else [str(j) for j in diagnosis.get("joins") or []]
-        wanted += [str(c.get("check", "")) for c in repair.get("checks") or []]
+        wanted = [did, *also] if kind == "side-condition" else list(diagnosis.joins or [])
+        wanted += [c.check for c in repair.checks]
         wanted = [w for w in dict.fromkeys(wanted) if ".sc" in w]
         out: list[tuple[str, str]] = []
         for n in dict.fromkeys(w.split(".", 1)[0] for w in wanted):
@@ -80,12 +82,12 @@ def recheck(ws: "Workspace", diagnosis: Mapping[str, Any], repair: Mapping[str, 
     return []
 
 
-def _repair_lines(k: int, n: int, d: Mapping[str, Any], r: Mapping[str, Any]) -> list[str]:
-    out = [f"repair {k} of {n} for {d.get('id')} ({r.get('kind')}): {r.get('summary')}",
-           f"  checked by {r.get('checked_by')}: {r.get('proves')}", f"  not shown: {r.get('not_shown')}"]
-    out += [f"  checked: {c.get('check')}: {c.get('status')}" for c in r.get("checks") or []]
-    out += [f"  changes: {c.get('check')}: {c.get('before')} -> {c.get('after')}" for c in r.get("cost") or []]
-    return out + ["  " + line for line in str(r.get("diff", "")).rstrip("\n").splitlines()]
+def _repair_lines(k: int, n: int, d: "DiagnosisRow", r: "RepairRow") -> list[str]:
+    out = [f"repair {k} of {n} for {d.id} ({r.kind}): {r.summary}",
+           f"  checked by {r.checked_by}: {r.proves}", f"  not shown: {r.not_shown}"]
+    out += [f"  checked: {c.check}: {c.status}" for c in r.checks]
+    out += [f"  changes: {c.check}: {c.before} -> {c.after}" for c in r.cost]
+    return out + ["  " + line for line in r.diff.rstrip("\n").splitlines()]
 
 
 def cmd_repair(args: argparse.Namespace) -> int:
@@ -100,7 +102,13 @@ def cmd_repair(args: argparse.Namespace) -> int:
     from rclverify.lang.errors import RclError, error  # deferred: start-up (as above)
     root = Path(args.workspace)
     report_path = root / "reports/assurance.json"
-    report = read_report(root)
+    import msgspec  # deferred: start-up (loads msgspec only when called)
+    from rclverify.records.report_record import AssuranceReport  # deferred: start-up (the records)
+    try:
+        report = AssuranceReport.of(read_report(root))
+    except msgspec.ValidationError as exc:  # a report of another shape below what read_report checks
+        raise located(report_path, f"not an rclverify report: {exc}; run `rclverify verify` (or `doit verify`) "
+                                   "to write it again") from None
     found = find_repairs(report, args.id)
     if found is None:
         near = near_ids(report, args.id)
@@ -129,9 +137,9 @@ def cmd_repair(args: argparse.Namespace) -> int:
     except NotApplied as exc:
         raise RclError([error(Loc(str(root / exc.file), exc.line, exc.col), exc.message, "E-repair")]) from None
     print("\n".join(_repair_lines(args.index, n, chosen.diagnosis, chosen.repair)))
-    print(f"applied: {chosen.repair.get('file')} written ({path.stat().st_size} bytes); the check that failed "
+    print(f"applied: {chosen.repair.file} written ({path.stat().st_size} bytes); the check that failed "
           "runs again:")
-    also = [str(d.get("id")) for d in found.diagnoses if d.get("kind") == chosen.diagnosis.get("kind")]
+    also = [d.id for d in found.diagnoses if d.kind == chosen.diagnosis.kind]
     try:
         after = recheck(workspace_of(args), chosen.diagnosis, chosen.repair, also)
     except (RclError, OSError):
@@ -141,14 +149,14 @@ def cmd_repair(args: argparse.Namespace) -> int:
               "`rclverify verify` runs every check")
         return 1
     if not after:
-        print(f"  no stage re-checks a {chosen.diagnosis.get('kind')} problem alone: run `rclverify verify`")
+        print(f"  no stage re-checks a {chosen.diagnosis.kind} problem alone: run `rclverify verify`")
         return 0
     print("\n".join(f"  {line}" for line in changed_lines(statuses_before(report), after)))
     bad = [i for i, s in after if s not in PASSED]
     if bad:
         print(f"the edit is written but {', '.join(bad)} still do{'es' if len(bad) == 1 else ''} not pass")
         return 1
-    if chosen.diagnosis.get("kind") == "monitor":
+    if chosen.diagnosis.kind == "monitor":
         print("the recorded run passes with the node re-run from the edited file; its evidence stays the recorded "
               "run's until the run is recorded again")
         return 0

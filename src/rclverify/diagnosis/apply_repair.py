@@ -3,7 +3,7 @@ workspace on request (``rclverify repair ID [--apply]``; docs/diagnosis.md,
 "Applying a repair").
 
 * :func:`find_repairs`: the repairs the last report (``reports/assurance.json``,
-  a dict) offers for an id: a diagnosis's id (a problem's finding, side
+  decoded: :class:`~rclverify.records.report_record.AssuranceReport`) offers for an id: a diagnosis's id (a problem's finding, side
   condition, obligation, requirement or deadline id, as ``rclverify explain``
   takes it: exact first, then up to case, ``_``, ``-`` and spaces) or a
   problem's number (``3``, ``p3``, ``problem 3``, the numbers ``rclverify
@@ -26,12 +26,15 @@ import re
 import stat
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 from rclverify.core.atomic import atomic_write_bytes
 from rclverify.core.within import outside
 from rclverify.diagnosis.edits import Edit
 from rclverify.diagnosis.repairs import text_sha256
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.repair_rows import RepairRow
+from rclverify.records.report_record import AssuranceReport
 
 _PROBLEM = re.compile(r"^(?:problem\s*|p)?(?P<k>\d+)\.?$", re.IGNORECASE)
 
@@ -54,11 +57,11 @@ class NotApplied(Exception):
 @dataclass(frozen=True)
 class Offered:
     """One repair offered for an id: the ``diagnosis`` record it belongs to, its 0-based ``index`` among
-    that diagnosis's repairs, and the ``repair`` record (records/stage_records.py ``Repair``)."""
+    that diagnosis's repairs, and the ``repair`` record."""
 
-    diagnosis: Mapping[str, Any]
+    diagnosis: DiagnosisRow
     index: int
-    repair: Mapping[str, Any]
+    repair: RepairRow
 
 
 @dataclass(frozen=True)
@@ -67,7 +70,7 @@ class Found:
     covers and the repairs they offer, in the report's order."""
 
     subject: str
-    diagnoses: tuple[Mapping[str, Any], ...]
+    diagnoses: tuple[DiagnosisRow, ...]
     offered: tuple[Offered, ...]
 
 
@@ -76,28 +79,24 @@ def _fold(text: str) -> str:
     return re.sub(r"[\s_-]+", "", str(text)).lower()
 
 
-def find_repairs(report: Mapping[str, Any], wanted: str) -> Found | None:
+def find_repairs(report: AssuranceReport, wanted: str) -> Found | None:
     """What ``wanted`` names in ``report`` (module docstring); ``None`` when it is neither a diagnosis's id
     nor a problem's number.  A diagnosis id is matched exactly first, then up to case and separators."""
-    diagnoses = [d for d in report.get("diagnoses") or [] if isinstance(d, Mapping)]
-    by_id = {str(d.get("id")): d for d in diagnoses}
+    by_id = {d.id: d for d in report.diagnoses}
     key = wanted if wanted in by_id else next((k for k in by_id if _fold(k) == _fold(wanted)), None)
     if key is not None:
         d = by_id[key]
-        return Found(key, (d,), tuple(Offered(d, k, r) for k, r in enumerate(d.get("repairs") or [])))
+        return Found(key, (d,), tuple(Offered(d, k, r) for k, r in enumerate(d.repairs)))
     m = _PROBLEM.match(wanted.strip())
-    problems = [p for p in report.get("problems") or [] if isinstance(p, Mapping)]
-    if not m or not 1 <= int(m["k"]) <= len(problems):
+    if not m or not 1 <= int(m["k"]) <= len(report.problems):
         return None
-    row = problems[int(m["k"]) - 1]
-    members = [by_id[str(x.get("id"))] for x in row.get("members") or [] if str(x.get("id")) in by_id]
+    row = report.problems[int(m["k"]) - 1]
+    members = [by_id[x.id] for x in row.members if x.id in by_id]
     offered = []
-    for ref in row.get("repairs") or []:
-        owner = by_id.get(str(ref.get("diagnosis")))
-        reps = (owner.get("repairs") or []) if owner is not None else []
-        k = int(ref.get("index", -1))
-        if owner is not None and 0 <= k < len(reps):
-            offered.append(Offered(owner, k, reps[k]))
+    for ref in row.repairs:
+        owner = by_id.get(ref.diagnosis)
+        if owner is not None and 0 <= ref.index < len(owner.repairs):
+            offered.append(Offered(owner, ref.index, owner.repairs[ref.index]))
     return Found(f"problem {m['k']}", tuple(members), tuple(offered))
 
 
@@ -110,37 +109,35 @@ def none_offered(found: Found) -> list[str]:
         return [f"{found.subject} has no diagnosis in the last report: nothing was searched"]
     out: list[str] = []
     for d in found.diagnoses:
-        said = [f"{d.get('id')}: {s}" for s in d.get("not_offered") or []]
-        if not said and d.get("kind") in SEARCHED:
-            said = [f"{d.get('id')} ({d.get('kind')}): no edit the diagnosis tried passed its checks "
+        said = [f"{d.id}: {s}" for s in d.not_offered or []]
+        if not said and d.kind in SEARCHED:
+            said = [f"{d.id} ({d.kind}): no edit the diagnosis tried passed its checks "
                     "(docs/diagnosis.md, \"Repairs\", says which edits are tried for this kind)"]
-        elif not said and d.get("kind") == "monitor":
-            said = [f"{d.get('id')} ({d.get('kind')}): no repair is searched: a node's code is repaired on a "
+        elif not said and d.kind == "monitor":
+            said = [f"{d.id} ({d.kind}): no repair is searched: a node's code is repaired on a "
                     "recorded run by re-running the node on the run's questions (docs/diagnosis.md, \"Monitor "
                     "violations: a node re-run on its recorded run\"), which needs the function that makes its "
                     "rclpy nodes, and its monitors evidence entry names none (`implementation: FILE.py:FUNCTION`, "
-                    f"docs/plan.md); `rclverify explain {d.get('id')}` names its culprit"]
+                    f"docs/plan.md); `rclverify explain {d.id}` names its culprit"]
         elif not said:
-            said = [f"{d.get('id')} ({d.get('kind')}): no repair is searched for this kind of problem; "
-                    f"`rclverify explain {d.get('id')}` names its culprit"]
+            said = [f"{d.id} ({d.kind}): no repair is searched for this kind of problem; "
+                    f"`rclverify explain {d.id}` names its culprit"]
         out += said
     return out
 
 
-def _refused(repair: Mapping[str, Any], message: str) -> NotApplied:
-    e = repair.get("edit") or {}
-    return NotApplied(str(repair.get("file", "")), int(e.get("line", 1)), int(e.get("col", 1)), message)
+def _refused(repair: RepairRow, message: str) -> NotApplied:
+    return NotApplied(repair.file, repair.edit.line, repair.edit.col, message)
 
 
-def apply_repair(root: Path, repair: Mapping[str, Any]) -> Path:
+def apply_repair(root: Path, repair: RepairRow) -> Path:
     """Make ``repair``'s edit to its file under the workspace ``root`` and return the file's path.
 
     The file's line ends are kept (the edit is made on its text as stored; positions are lines and
     columns, the same whatever the line end).  Raises :class:`NotApplied` (nothing written) when the
     file is outside ``root``, cannot be read, no longer has the sha256 the repair was computed on, or
     the edit's region does not hold the text it deletes; ``OSError`` when the write fails."""
-    rel = str(repair.get("file", ""))
-    e = repair.get("edit") or {}
+    rel, e = repair.file, repair.edit
     path = root / rel
     if not rel or outside(root, path):
         raise _refused(repair, f"the repair edits {rel!r}, which is not a file of the workspace {root}")
@@ -149,40 +146,43 @@ def apply_repair(root: Path, repair: Mapping[str, Any]) -> Path:
     except (OSError, UnicodeDecodeError) as exc:
         raise _refused(repair, f"cannot read the file the repair edits: {exc}") from None
     text = raw.replace("\r\n", "\n").replace("\r", "\n")  # as read_text gives it: what the digest is of
-    want, have = str(repair.get("sha256", "")), text_sha256(text)
+    want, have = repair.sha256, text_sha256(text)
     if want != have:
         raise _refused(repair, (f"{rel} changed since the last run checked this repair (sha256 {have[:12]}, "
                                  f"the repair was checked on {want[:12] or 'an unrecorded text'}); nothing "
                                  "written: run `rclverify verify` again, then `rclverify repair` on the new report"))
-    edit = Edit(rel, int(e["line"]), int(e["col"]), int(e["end_line"]), int(e["end_col"]), str(e["inserted"]))
-    if edit.deleted(raw) != e.get("deleted"):
-        raise _refused(repair, f"the region of the edit holds {edit.deleted(raw)!r}, not {e.get('deleted')!r}; "
+    edit = Edit(rel, e.line, e.col, e.end_line, e.end_col, e.inserted)
+    if edit.deleted(raw) != e.deleted:
+        raise _refused(repair, f"the region of the edit holds {edit.deleted(raw)!r}, not {e.deleted!r}; "
                                 "nothing written")
     mode = stat.S_IMODE(path.stat().st_mode)
     atomic_write_bytes(path, edit.apply(raw).encode("utf-8"), mode=mode, within=root)
     return path
 
 
-def obligation_checks(diagnosis: Mapping[str, Any], repair: Mapping[str, Any]) -> list[str]:
+def obligation_checks(diagnosis: DiagnosisRow, repair: RepairRow) -> list[str]:
     """The obligation ids (``Node.gK.<backend>.eI...``) a code or program repair was checked against, the
     diagnosis's own first: the evidence to produce again after the edit."""
-    ids = [str(diagnosis.get("id", ""))] + [str(c.get("check", "")) for c in repair.get("checks") or []]
+    ids = [diagnosis.id] + [c.check for c in repair.checks]
     return list(dict.fromkeys(i for i in ids if re.match(r"^\w+\.g\d+\.\w+\.e\d+", i)))
 
 
-def statuses_before(report: Mapping[str, Any]) -> dict[str, str]:
+def statuses_before(report: AssuranceReport) -> dict[str, str]:
     """Every id's status in ``report``: obligations, evidence, side conditions, health findings,
     requirements (their verdict) and deadlines (``REQ.deadline``, their verdict), for the before -> after of a re-check."""
     out: dict[str, str] = {}
-    for key in ("findings", "side_conditions", "obligations"):
-        for x in report.get(key) or []:
-            out[str(x.get("id"))] = str(x.get("status"))
-    for ev in report.get("evidence") or []:
-        out[str(ev.get("obligation"))] = str(ev.get("status"))
-    for r in report.get("requirements") or []:
-        out[str(r.get("id"))] = str(r.get("verdict"))
-    for dl in report.get("deadlines") or []:
-        out[f"{dl.get('requirement')}.deadline"] = str(dl.get("verdict"))
+    for f in report.findings:
+        out[f.id] = str(f.status)
+    for sc in report.side_conditions:
+        out[sc.id] = str(sc.status)
+    for o in report.obligations:
+        out[o.id] = str(o.status)
+    for ev in report.evidence:
+        out[ev.obligation] = str(ev.status)
+    for r in report.requirements:
+        out[r.id] = str(r.verdict)
+    for dl in report.deadlines:
+        out[f"{dl.requirement}.deadline"] = str(dl.verdict)
     return out
 
 

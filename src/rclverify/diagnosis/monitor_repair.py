@@ -18,6 +18,8 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
+from rclverify.records.problem_rows import DiagnosisRow
+from rclverify.records.repair_rows import RepairRow
 from rclverify.records.stage_records import Repair
 
 if TYPE_CHECKING:  # a type only: the monitors' payload is imported by whoever decoded it
@@ -110,7 +112,7 @@ def report_repairs(ws: Any, oid: str, node: str, data: Mapping[str, Any], payloa
     return dict(got) if isinstance(got, dict) else {}
 
 
-def rejudged_applied(ws: Any, diagnosis: Mapping[str, Any], repair: Mapping[str, Any],
+def rejudged_applied(ws: Any, diagnosis: DiagnosisRow, repair: RepairRow,
                      python: Path | None) -> list[tuple[str, str]]:
     """After a repair of a monitored violation was written (``rclverify repair --apply``): the run of
     ``diagnosis`` (a ``monitor`` record, its obligation's id; ``repair`` the one written, whose ``cost`` says
@@ -123,7 +125,7 @@ def rejudged_applied(ws: Any, diagnosis: Mapping[str, Any], repair: Mapping[str,
     from rclverify.backends.monitors.config import load_mapping  # deferred: start-up (the monitors)
     from rclverify.diagnosis.run_repair import rejudged  # deferred: start-up (the property tests' search)
     from rclverify.records.sealed import obligation_list  # deferred: start-up (the records)
-    oid, node = str(diagnosis.get("id")), str(diagnosis.get("node"))
+    oid, node = diagnosis.id, diagnosis.node
     records, _ = obligation_list(ws.path(ws.obligations(node)))
     data = next((dict(o.get("data") or {}) for o in records or [] if isinstance(o, dict) and o.get("id") == oid), {})
     impl = str(data.get("implementation") or "")
@@ -134,7 +136,7 @@ def rejudged_applied(ws: Any, diagnosis: Mapping[str, Any], repair: Mapping[str,
     c = entry.config if entry is not None else {}
     cfg = load_mapping(ws.root, data.get("mapping"), c.get("horizon"), c.get("traces", ()), c.get("tolerance"))
     text = ws.path(source).read_text(encoding="utf-8")
-    calls = any(str(c.get("check")) == f"{node} calls" and c.get("before") == "failed" for c in repair.get("cost") or [])
+    calls = any(c.check == f"{node} calls" and c.before == "failed" for c in repair.cost)
     got = rejudged(Path(ws.root), ws.checked, cfg, ws.path(str(data.get("trace"))), node, calls, source, text,
                    factory, [], python)
     mine = [v for k, v in got.items() if k == node or k.startswith(node + " ")]
