@@ -21,7 +21,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.backends.monitors.trace_states import StepClock, cone_of
+from rclverify.backends.monitors.step_clock import StepClock, cone_of
 from rclverify.cli.commands import main
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check

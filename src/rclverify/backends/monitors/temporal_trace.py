@@ -6,9 +6,9 @@ The statement is one of the decided shapes of
 ``Node.in.x``/``Node.out.y``/``Node.state.v``.
 
 **Steps of a trace.**  A step is a step of the composed system, as in the
-proofs (docs/semantics.md, "Steps"): :class:`~.trace_states.StepClock`
+proofs (docs/semantics.md, "Steps"): :class:`~.step_clock.StepClock`
 gives each message on a topic of the statement's cone
-(:func:`~.trace_states.cone_of`: the nodes it reads and every node
+(:func:`~.step_clock.cone_of`: the nodes it reads and every node
 upstream of them; other messages are no step) its step: a question and
 its answer are one step, a node reads another node's output in the step
 after it, inputs that come at once are one instant.  The nodes the
@@ -37,7 +37,8 @@ published values only, ``eventually F`` (``next``, the right of ``until``)
 needs ``F`` on published values; a declared state variable without a value
 leaves what reads it undecided.
 
-**Finite-trace verdicts** (docs/requirements.md, "Temporal requirements"):
+**Finite-trace verdicts** (docs/requirements.md, "Temporal requirements";
+what each shape checks at a step: :mod:`.temporal_steps`):
 
 ===============  ===========================================================
 ``false``        ``always``/``always next``: F false at a step; ``next``: F
@@ -61,229 +62,23 @@ from __future__ import annotations
 
 import math
 
-from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
-import z3
-
-from rclverify.semantics.floatsem import judge
-from rclverify.semantics.encode import EncodingError
-from rclverify.model.plan.formal import Formal
 from rclverify.model.plan.state import StateVar, state_type
 from rclverify.model.plan.temporal import Temporal, shape
 from rclverify.backends.monitors.response_trace import ResponseTracker
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
 from rclverify.backends.monitors.declarations import call_part
-from rclverify.backends.monitors.trace_states import StepClock, TraceStates, cone_of
+from rclverify.backends.monitors.step_clock import StepClock, cone_of
+from rclverify.backends.monitors.temporal_steps import STEPS, VERDICTS, StepRun, TraceVerdict, operand_text
+from rclverify.backends.monitors.trace_states import TraceStates
 from rclverify.backends.monitors.run_origin import is_run_start
 from rclverify.calculus.requirements.published import first_inputs
 from rclverify.lang.types import Checked
+from rclverify.model.plan.formal import Formal
 from rclverify.traces.events import Event
 from rclverify.traces.mapping import TopicRule
-from rclverify.semantics.values import render
-from rclverify.lang.printer import expr_to_rcl
-from rclverify.backends.monitors.shapes import StepPlace, TraceVerdictJson, Witness
-
-VERDICTS = ("true", "false", "currently_false", "inconclusive")
-
-
-@dataclass
-class TraceVerdict:
-    """The verdict of one temporal statement on one trace (module table).
-
-    ``verdict`` one of :data:`VERDICTS`; ``step``/``time``/``where`` where it
-    was decided (``None`` when at the end of the trace); ``steps`` the
-    number of steps; ``witness`` ``[{"step", "time", "where", "operand",
-    "holds", "values"}]``; ``reason`` one sentence; ``spare`` the steps to
-    spare of a bounded ``eventually[<= N]`` (N less the step it held at) or
-    response (N less the longest wait of an answered trigger) judged
-    ``true``, else ``None`` (docs/semantics.md, "Margins in steps").
-    """
-
-    verdict: str
-    steps: int
-    reason: str
-    step: int | None = None
-    time: float | None = None
-    where: str = ""
-    witness: list[Witness] = field(default_factory=list)
-    spare: int | None = None
-
-    def to_json(self) -> TraceVerdictJson:
-        out: TraceVerdictJson = {"verdict": self.verdict, "steps": self.steps, "reason": self.reason,
-                                 "step": self.step, "time": self.time, "where": self.where, "witness": self.witness}
-        if self.spare is not None:
-            out["spare"] = self.spare
-        return out
-
-
-
-def _truth(f: Formal, checked: Checked, values: Mapping[str, object], tolerance: Any = None,
-           semantics: dict[int, str] | None = None) -> bool | None:
-    """Operand ``f``'s truth on the step's values, judged as the node monitors
-    judge (:func:`rclverify.semantics.floatsem.judge`: exact, then the nodes'
-    double arithmetic, then a declared ``tolerance``); the semantics that
-    decided goes to ``semantics[id(f)]``."""
-    mine = {k: v for k, v in values.items() if k.partition(".")[2] in f.scope.inputs or
-            k.partition(".")[2] in f.scope.outputs or k.startswith("first(")}
-    try:
-        j = judge(f.expr, checked, f.scope, mine, tolerance)
-    except (KeyError, ValueError, TypeError, EncodingError, z3.Z3Exception):
-        return None
-    if semantics is not None:
-        semantics[id(f)] = j.semantics
-    return j.truth
-
-
-def _published(f: Formal, values: Mapping[str, object]) -> bool:
-    """Whether every input and output operand ``f`` mentions has been
-    published on this trace (docs/semantics.md: a state formula over a value
-    never published is not evaluated; a state variable without a value stays
-    undecided instead)."""
-    for n, p, v in f.mentions:
-        if p in ("in", "out") and f"{p}.{n}.{p}.{v}" not in values:
-            return False
-    return True
-
-
-def _shown(f: Formal, values: Mapping[str, object]) -> dict[str, str]:
-    names = {f"{n}.{p}.{v}" for n, p, v in f.mentions}
-    return {k.partition(".")[2]: render(v) for k, v in sorted(values.items()) if k.partition(".")[2] in names}
-
-
-@dataclass
-class _Run:
-    """One statement's check on one trace, step by step: the operands
-    ``ops``, the state of the run so far (the trace states ``st``, the step
-    ``i`` and its event ``last``, the values ``vals`` at it) and the first
-    undecided operand's witness (``undecided``)."""
-
-    kind: str
-    ops: list[Formal]
-    bound: int | None
-    checked: Checked
-    st: TraceStates
-    tol: Any
-    tracker: ResponseTracker | None = None
-    sems: dict[int, str] = field(default_factory=dict)
-    undecided: Witness | None = None
-    i: int = -1
-    last: Event | None = None
-    vals: Mapping[str, object] = field(default_factory=dict)
-    #: why a first(...) the statement reads is unknown on this run (first_messages.py), once an operand needed it
-    first_why: str = ""
-
-    def decide(self, f: Formal, unpublished: bool | None) -> bool | None:
-        """``f``'s truth at this step: undecided when a value it reads was unreadable in its last message,
-        ``unpublished`` when one was never published, else judged."""
-        if any(f"{p}.{n}.{p}.{v}" in self.st.unreadable for n, p, v in f.mentions):
-            return None
-        got = _truth(f, self.checked, self.vals, self.tol, self.sems) if _published(f, self.vals) else unpublished
-        if got is None and not self.first_why:
-            self.first_why = next((v for k, v in self.vals.items() if k.startswith("first(") and isinstance(v, str)), "")
-        return got
-
-    def wit(self, f: Formal, holds: bool | None) -> Witness:
-        """The witness of operand ``f`` at this step."""
-        ev = self.last
-        assert ev is not None
-        out: Witness = {"step": self.i, "time": ev.time, "where": ev.where, "operand": _text(f),
-               "holds": holds, "values": _shown(f, self.vals)}
-        bad = [self.st.unreadable[k] for n, p, v in f.mentions if (k := f"{p}.{n}.{p}.{v}") in self.st.unreadable]
-        if bad:
-            out["unreadable"] = bad
-        if holds and self.sems.get(id(f), "exact") != "exact":  # held only in double arithmetic or the tolerance
-            out["semantics"] = self.sems[id(f)]
-        return out
-
-    def at(self, verdict: str, why: str, w: list[Witness]) -> TraceVerdict:
-        """The verdict decided at this step."""
-        ev = self.last
-        assert ev is not None
-        return TraceVerdict(verdict, self.i + 1, why, self.i, ev.time, ev.where, w)
-
-    def note(self, f: Formal, h: bool | None) -> None:
-        """Remember ``f`` as the first undecided operand when ``h`` is undecided and none was before."""
-        if h is None and self.undecided is None:
-            self.undecided = self.wit(f, None)
-
-    def where(self) -> str:
-        ev = self.last
-        assert ev is not None
-        return f"{ev.where}, t = {ev.time} s"
-
-
-def _step_always(r: _Run) -> TraceVerdict | None:
-    """``always F`` and ``always next F``: false at the first step where F is false."""
-    if r.kind == "always next" and r.i == 0:
-        return None
-    f = r.ops[0]
-    h = r.decide(f, True)  # a value it reads never published: not evaluated (docs/semantics.md)
-    if h is False:
-        return r.at("false", f"{_text(f)} is false at step {r.i} ({r.where()})", [r.wit(f, False)])
-    r.note(f, h)
-    return None
-
-
-def _step_response(r: _Run) -> TraceVerdict | None:
-    """The response pattern (response_trace.py): false when a trigger goes unanswered in time."""
-    assert r.tracker is not None
-    said = r.tracker.step(r.i, r.decide(r.ops[0], False), r.decide(r.ops[1], False))
-    if said is not None and said[0] == "false":
-        return r.at("false", f"{_text(r.ops[0])} held at step {said[1]} and {_text(r.ops[1])} did not hold in "
-                             f"time, by step {r.i} ({r.where()})", [r.wit(r.ops[1], False)])
-    if said is not None and r.undecided is None:
-        r.undecided = r.wit(r.ops[said[1]], None)
-    return None
-
-
-def _step_next(r: _Run) -> TraceVerdict | None:
-    """``next F``: decided at step 1."""
-    if r.i != 1:
-        return None
-    h = r.decide(r.ops[0], False)
-    v = {True: "true", False: "false", None: "inconclusive"}[h]
-    return r.at(v, f"{_text(r.ops[0])} is {v if h is not None else 'undecided'} at step 1", [r.wit(r.ops[0], h)])
-
-
-def _step_eventually(r: _Run) -> TraceVerdict | None:
-    """``eventually[<= N] F``: true at the first step where F holds (reached only on published values)."""
-    f = r.ops[0]
-    h = r.decide(f, False)
-    if h is True:
-        v = r.at("true", f"{_text(f)} holds at step {r.i} ({r.where()})", [r.wit(f, True)])
-        v.spare = None if r.bound is None else r.bound - r.i
-        return v
-    r.note(f, h)
-    if r.bound is not None and r.i >= r.bound:
-        if r.undecided is not None:
-            return r.at("inconclusive", f"not met within {r.bound} steps, but undecided at step "
-                                        f"{r.undecided['step']}", [r.undecided])
-        return r.at("false", f"{_text(f)} does not hold at any step 0..{r.bound}: the bound passed "
-                             f"at step {r.i} ({r.where()})", [r.wit(f, False)])
-    return None
-
-
-def _step_until(r: _Run) -> TraceVerdict | None:
-    """``F until G``: true when G holds with F at every step before, false when F fails first."""
-    f_op, g_op = r.ops[0], r.ops[1]
-    g = r.decide(g_op, False)
-    if g is True and r.undecided is None:
-        return r.at("true", f"{_text(g_op)} holds at step {r.i}, {_text(f_op)} at every step before",
-                    [r.wit(g_op, True)])
-    r.note(g_op, g)
-    if g is not True:
-        f = r.decide(f_op, True)
-        if f is False and r.undecided is None:
-            return r.at("false", f"{_text(f_op)} is false at step {r.i} before {_text(g_op)} held",
-                        [r.wit(f_op, False)])
-        r.note(f_op, f)
-    return None
-
-
-#: What each decided shape (model/plan/temporal.py, ``shape``) checks at one step.
-_STEPS = {"always": _step_always, "always next": _step_always, "response": _step_response, "next": _step_next,
-          "eventually": _step_eventually, "until": _step_until}
+from rclverify.backends.monitors.shapes import StepPlace
 
 
 def _operands(t: Temporal, kind: str) -> tuple[list[Formal], ResponseTracker | None]:
@@ -313,11 +108,11 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     for sv in states:
         state_type(sv, checked)
     st = TraceStates(checked, nodes, states, rules, first_inputs([f.expr for f in ops]))
-    # the steps of the composed system, over the statement's cone (trace_states.StepClock)
+    # the steps of the composed system, over the statement's cone (step_clock.StepClock)
     clock = StepClock(checked, cone_of(checked, nodes), getattr(rules, "skew", None) or 0.0)
     # the mapping's tolerance of recorded numbers
-    r = _Run(kind, ops, t.bound, checked, st, getattr(rules, "tolerance", None), tracker)
-    step = _STEPS[kind]
+    r = StepRun(kind, ops, t.bound, checked, st, getattr(rules, "tolerance", None), tracker)
+    step = STEPS[kind]
     now = -1  # the step the messages read so far end in
     for ev in events:
         part: Mapping[str, Any] | None = None
@@ -354,14 +149,14 @@ def check_temporal_trace(t: Temporal, checked: Checked, states: tuple[StateVar, 
     return _at_end(r, nodes)
 
 
-def _close(r: _Run, step: Any, i: int) -> TraceVerdict | None:
+def _close(r: StepRun, step: Any, i: int) -> TraceVerdict | None:
     """Step ``i`` judged on its state: the values after its last message."""
     r.i, r.vals = i, r.st.values()
     verdict: TraceVerdict | None = step(r)
     return verdict
 
 
-def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
+def _at_end(r: StepRun, nodes: list[str]) -> TraceVerdict:
     """The verdict when the trace ended undecided (module table)."""
     ops, tracker, undecided, last = r.ops, r.tracker, r.undecided, r.last
     n = r.i + 1
@@ -378,27 +173,23 @@ def _at_end(r: _Run, nodes: list[str]) -> TraceVerdict:
                                                f"({undecided['where']}): {why}", undecided["step"], undecided["time"],
                             undecided["where"], [undecided])
     if r.kind in ("always", "always next"):
-        return TraceVerdict("true", n, f"{_text(ops[0])} holds at every step of this trace ({n} steps): "
+        return TraceVerdict("true", n, f"{operand_text(ops[0])} holds at every step of this trace ({n} steps): "
                                        "evidence for the requirement, not a proof", **end)
     if tracker is not None and tracker.pending is None:
-        return TraceVerdict("true", n, f"every step where {_text(ops[0])} held was answered by {_text(ops[1])} in "
+        return TraceVerdict("true", n, f"every step where {operand_text(ops[0])} held was answered by {operand_text(ops[1])} in "
                                        f"time in this trace ({n} steps): evidence for the requirement, not a proof",
                             **end, spare=tracker.spare())
     if tracker is not None:
-        return TraceVerdict("currently_false", n, f"{_text(ops[0])} held at step {tracker.pending} and {_text(ops[1])} has "
+        return TraceVerdict("currently_false", n, f"{operand_text(ops[0])} held at step {tracker.pending} and {operand_text(ops[1])} has "
                                                   f"not held since when the trace ended after {n} steps (a longer run "
                                                   "may still answer it in time): inconclusive", **end)
     if r.kind == "next":
         return TraceVerdict("inconclusive", n, "the trace ended before step 1", **end)
     also = (f"; undecided at some steps, the first {undecided['step']} ({undecided['where']})"
             if undecided is not None else "")
-    return TraceVerdict("currently_false", n, f"{_text(ops[-1])} has not held when the trace ended after {n} "
+    return TraceVerdict("currently_false", n, f"{operand_text(ops[-1])} has not held when the trace ended after {n} "
                                               f"steps (a longer run may still reach it): inconclusive{also}",
                         **end, witness=[undecided] if undecided else [])
-
-
-def _text(f: Formal) -> str:
-    return expr_to_rcl(f.expr)
 
 
 __all__ = ["TraceVerdict", "VERDICTS", "check_temporal_trace"]
