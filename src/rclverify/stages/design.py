@@ -129,22 +129,28 @@ def design_row(ws: "Workspace") -> dict[str, Any] | None:
     return None if record is None else DesignRow.of(record).to_json()
 
 
-def design_problems(row: Mapping[str, Any] | None) -> list[str]:
-    """The report's problem sentences of ``row`` (:func:`read_design_record`): a stale or altered record, each
-    design error (a refuted timeout or error rate, a design node or port without contract) at its places."""
+def design_problems(row: DesignRow | Mapping[str, Any] | None) -> list[str]:
+    """The report's problem sentences of ``row`` (:func:`design_row`, or its JSON object): a stale or altered
+    record, each design error (a refuted timeout or error rate, a design node or port without contract) at its
+    places.  Raises :class:`msgspec.ValidationError` for a row of another shape."""
     if row is None:
         return []
-    out = [f"design: {row[k]}" for k in ("altered", "stale") if row.get(k)]
-    for f in row["findings"]:
-        if f["severity"] == "error" and f["code"] != "design-record":
-            at = ", ".join(f"{p['file']}:{p['line']}:{p['col']}" for p in f["places"])
-            out.append(f"design {f['code']}{' at ' + at if at else ''}: {f['message']}")
+    d = DesignRow.of(row)
+    out = [f"design: {why}" for why in (d.altered, d.stale) if why]
+    for f in d.findings:
+        if f.severity == "error" and f.code != "design-record":
+            at = ", ".join(f"{p.file}:{p.line}:{p.col}" for p in f.places)
+            out.append(f"design {f.code}{' at ' + at if at else ''}: {f.message}")
     return out
 
 
-def blocks_strict(row: Mapping[str, Any] | None) -> bool:
-    """Whether ``row`` fails ``--strict``: a design error, or a record stale or altered."""
-    return row is not None and bool(row["counts"].get("error") or row.get("stale") or row.get("altered"))
+def blocks_strict(row: DesignRow | Mapping[str, Any] | None) -> bool:
+    """Whether ``row`` (:func:`design_row`, or its JSON object) fails ``--strict``: a design error, or a record
+    stale or altered."""
+    if row is None:
+        return False
+    d = DesignRow.of(row)
+    return bool(d.counts.get("error") or d.stale or d.altered)
 
 
 __all__ = ["DIR", "INDEX", "blocks_strict", "design_inputs", "design_problems", "design_row", "read_design_record",

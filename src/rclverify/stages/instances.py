@@ -41,6 +41,7 @@ from rclverify.records.sealed import read_sealed, write_sealed
 if TYPE_CHECKING:
     from rclverify.model.plan.instances import Instance
     from rclverify.model.plan.model import Plan, Requirement
+    from rclverify.records.instance_rows import InstancesRow
     from rclverify.stages.workspace import Workspace
 
 DIR = "artifacts/instances"
@@ -202,20 +203,23 @@ def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> 
     return InstancesRow.of(rec).to_json()
 
 
-def instance_problems(row: Mapping[str, Any] | None) -> list[str]:
-    """The report's problem sentences of ``row`` (:func:`instances_row`): a stale or altered record,
-    each requirement not proved in a namespace, with where its statement is written."""
+def instance_problems(row: InstancesRow | Mapping[str, Any] | None) -> list[str]:
+    """The report's problem sentences of ``row`` (:func:`instances_row`, or its JSON object): a stale or
+    altered record, each requirement not proved in a namespace, with where its statement is written.
+    Raises :class:`msgspec.ValidationError` for a row of another shape."""
     if row is None:
         return []
-    out = [f"instances: {row[k]}" for k in ("altered", "stale") if row.get(k)]
-    for q in row["requirements"]:
-        if q["verdict"] != "proved":
-            why = q.get("reason") or "; ".join(
-                ([f"not prevented by {', '.join(str(f.get('label', '')) for f in q['failed_to_prevent'])}"]
-                 if q.get("failed_to_prevent") else [])
-                + ([f"fed by no node: {', '.join(q['unfed'])}"] if q.get("unfed") else []))
-            out.append(f"requirement {q['id']} is {q['verdict']} for the instances in {q['namespace']}"
-                       + (f" ({', '.join(f'{c} as {i}' for c, i in q['nodes'].items())})" if q["nodes"] else "")
+    from rclverify.records.instance_rows import InstancesRow  # deferred: only a plan with instances
+    r = InstancesRow.of(row)
+    out = [f"instances: {why}" for why in (r.altered, r.stale) if why]
+    for q in r.requirements:
+        if q.verdict != "proved":
+            why = q.reason or "; ".join(
+                ([f"not prevented by {', '.join(str(f.get('label', '')) for f in q.failed_to_prevent)}"]
+                 if q.failed_to_prevent else [])
+                + ([f"fed by no node: {', '.join(q.unfed)}"] if q.unfed else []))
+            out.append(f"requirement {q.id} is {q.verdict} for the instances in {q.namespace}"
+                       + (f" ({', '.join(f'{c} as {i}' for c, i in q.nodes.items())})" if q.nodes else "")
                        + (f": {why}" if why else ""))
     return out
 
@@ -224,16 +228,19 @@ def instance_problems(row: Mapping[str, Any] | None) -> list[str]:
 _STATUS = {"proved": "discharged", "refuted": "failed", "inconclusive": "inconclusive", "error": "error"}
 
 
-def instance_statuses(row: Mapping[str, Any] | None) -> list[str]:
-    """The evidence statuses ``row`` adds to the report's overall status: each per-namespace verdict's
-    (:data:`_STATUS`), ``stale`` or ``error`` for a stale or altered record."""
+def instance_statuses(row: InstancesRow | Mapping[str, Any] | None) -> list[str]:
+    """The evidence statuses ``row`` (:func:`instances_row`, or its JSON object) adds to the report's overall
+    status: each per-namespace verdict's (:data:`_STATUS`), ``stale`` or ``error`` for a stale or altered
+    record."""
     if row is None:
         return []
-    return ((["error"] if row.get("altered") else []) + (["stale"] if row.get("stale") else [])
-            + [_STATUS.get(q["verdict"], "error") for q in row["requirements"]])
+    from rclverify.records.instance_rows import InstancesRow  # deferred: only a plan with instances
+    r = InstancesRow.of(row)
+    return ((["error"] if r.altered else []) + (["stale"] if r.stale else [])
+            + [_STATUS.get(q.verdict, "error") for q in r.requirements])
 
 
-def blocks_strict(row: Mapping[str, Any] | None) -> bool:
+def blocks_strict(row: InstancesRow | Mapping[str, Any] | None) -> bool:
     """Whether ``row`` fails ``--strict``: a requirement not proved in some namespace, or a record
     stale or altered."""
     return bool(instance_problems(row))
