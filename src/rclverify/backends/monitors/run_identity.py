@@ -17,15 +17,16 @@ run once per identity.
 """
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 import math
 from decimal import Decimal
 from pathlib import Path
-from typing import IO, Any, Callable, Iterator, Mapping
+from typing import IO, Any, Iterator, Mapping
 
 from rclverify.traces.mapping import EVERY, TopicRule, parse_path
+from rclverify.backends.monitors.canonical_fields import (canonical_json, field_names, flat, flat_message, is_stamp,
+                                                          only_read, sorted_pairs)
 
 #: The suffixes of a bag file (a directory is a ROS 2 bag too).
 BAG_SUFFIXES = (".bag", ".mcap", ".db3")
@@ -128,8 +129,6 @@ def run_digest(root: Path, trace: str, read: ReadFields | None = None) -> str:
 #: The topics of rclverify's own lines and messages (verdicts, the run's origin, its calls as the live call
 #: book wrote them, blocked messages, the call decisions of a bag): no message of the robot.
 _OWN = "rclverify/"
-#: The member rosidl gives a message without fields (rosbags decodes it; the live monitor leaves it out).
-_EMPTY_MEMBER = "structure_needs_at_least_one_member"
 #: Top-level fields a ROSMonitoring log cannot hold beside its own ``topic`` and ``time``.
 _LOG_KEYS = frozenset(("topic", "time"))
 
@@ -159,7 +158,7 @@ def _relative(pending: list[Pending]) -> list[bytes]:
     sha, out = hashlib.sha256, []
     for topic, ns, t, payload, raw in pending:
         when: list[Any] = ["stamp", ns - s0] if ns is not None else ["time", str((_decimal(t) - t0).normalize())]
-        out.append(sha(_ENCODE([topic, when, *payload] if raw else [topic, when, payload])).digest())
+        out.append(sha(canonical_json([topic, when, *payload] if raw else [topic, when, payload])).digest())
     return out
 
 
@@ -246,7 +245,7 @@ def _bag_identity(path: Path, read: ReadFields) -> str | None:
     reader = open_bag(path, typestore([]))
     messages: list[Pending] = []
     held: list[tuple[Any, int, bytes]] = []  # the call topics' messages, decoded only for a run without others
-    names = _field_names(reader.typestore)
+    names = field_names(reader.typestore)
 
     def one(index: int, conn: Any, stamp: int, raw: bytes) -> Pending:
         try:
@@ -254,15 +253,15 @@ def _bag_identity(path: Path, read: ReadFields) -> str | None:
         except Exception:  # noqa: BLE001 - a type the bag does not define: the message as every form stores it
             return (conn.topic.lstrip("/"), None, stamp / 1e9, [conn.msgtype, hashlib.sha256(raw).hexdigest()], True)
         pairs: list[tuple[str, Any]] = []
-        _flat_message("", msg, names, pairs)
+        flat_message("", msg, names, pairs)
         t: Any = getattr(getattr(msg, "header", None), "stamp", None)
         # as bag_event: its header's stamp, when it has one, is its source time
         own = header_stamp({"header": {"stamp": {"sec": t.sec, "nanosec": t.nanosec}}}) \
             if hasattr(t, "sec") and hasattr(t, "nanosec") else None
         name = conn.topic.lstrip("/")
-        kept = [kv for kv in pairs if kv[0] not in _LOG_KEYS and (own is None or not _is_stamp(kv[0]))]
+        kept = [kv for kv in pairs if kv[0] not in _LOG_KEYS and (own is None or not is_stamp(kv[0]))]
         return (name, None if own is None else int(t.sec) * 1_000_000_000 + int(t.nanosec), stamp / 1e9,
-                _sorted(_only_read(kept, read.get(name))), False)
+                sorted_pairs(only_read(kept, read.get(name))), False)
     try:
         for index, (conn, stamp, raw) in enumerate(reader.messages()):
             if _is_call_topic(conn.topic.lstrip("/")):
@@ -275,166 +274,22 @@ def _bag_identity(path: Path, read: ReadFields) -> str | None:
     return _identity(messages, calls)
 
 
-def _flat_message(prefix: str, msg: Any, names: Callable[[Any], tuple[str, ...]],
-                  out: list[tuple[str, Any]]) -> None:
-    """A decoded bag message's fields into ``out`` as :func:`_flat` puts the same message's fields
-    read from a log (``names``: a message's field names): rosbags' message classes also hold the
-    type's constants and name as dataclass fields, which are not the message's, and the live
-    monitor's log, decoded with other classes, does not hold them."""
-    for n in names(msg):
-        if n == _EMPTY_MEMBER:
-            continue
-        x = getattr(msg, n)
-        p = prefix + n
-        t = type(x)
-        if t is float:
-            out.append((p, int(x) if x.is_integer() else x if -_INF < x < _INF else repr(x)))
-        elif t is int or t is str or t is bool:
-            out.append((p, x))
-        elif hasattr(x, "__dataclass_fields__"):
-            k = len(out)
-            _flat_message(p + ".", x, names, out)
-            if len(out) == k:
-                out.append((p, {}))
-        else:
-            out.append((p, _message_value(x, names)))
-
-
-def _message_value(v: Any, names: Callable[[Any], tuple[str, ...]]) -> Any:
-    """A decoded field's value that is no scalar and no message, as :func:`_value` gives it from a log:
-    an array as a list, a message in a sequence as its sorted flattened pairs."""
-    if hasattr(v, "tolist"):
-        return _value(v.tolist())
-    if isinstance(v, (list, tuple)):
-        out = []
-        for x in v:
-            if hasattr(x, "__dataclass_fields__"):
-                pairs: list[tuple[str, Any]] = []
-                _flat_message("", x, names, pairs)
-                out.append(_sorted(pairs))
-            else:
-                out.append(_message_value(x, names))
-        return out
-    return _value(v)
-
-
-def _field_names(store: Any) -> Callable[[Any], tuple[str, ...]]:
-    """A decoded message's field names, as its type's definition in ``store`` (a rosbags type store)
-    lists them (not its constants), each type's looked up once."""
-    known: dict[str, tuple[str, ...]] = {}
-
-    def names(msg: Any) -> tuple[str, ...]:
-        t = getattr(msg, "__msgtype__", "")
-        got = known.get(t)
-        if got is None:
-            defs = store.fielddefs.get(t)
-            got = known[t] = (tuple(f[0] for f in defs[1]) if defs is not None else
-                              tuple(f.name for f in dataclasses.fields(msg) if f.default is dataclasses.MISSING))
-        return got
-    return names
-
-
 def _record(topic: str, stamp_ns: int | None, time: float, fields: Any, read: ReadFields | None = None) -> Pending:
     """One message's pending record (:data:`Pending`): the topic without its leading ``/``, its header
-    stamp ``stamp_ns`` or else its ``time``, its fields flattened (:func:`_flat`; a top-level ``topic``
+    stamp ``stamp_ns`` or else its ``time``, its fields flattened (:func:`flat`; a top-level ``topic``
     or ``time``, which a log cannot hold beside its own, left out, and the header stamp, which is its
     time, left out when it has one; with ``read``, the fields it names for the topic only) and sorted by
     path (:func:`run_digest`)."""
     pairs: list[tuple[str, Any]] = []
-    _flat("", fields, pairs)
+    flat("", fields, pairs)
     if "topic" in fields or "time" in fields:
         pairs = [kv for kv in pairs if kv[0] not in _LOG_KEYS]
     if stamp_ns is not None:
-        pairs = [kv for kv in pairs if not _is_stamp(kv[0])]
+        pairs = [kv for kv in pairs if not is_stamp(kv[0])]
     name = topic.lstrip("/")
     if read:
-        pairs = _only_read(pairs, read.get(name))
-    return (name, stamp_ns, time, _sorted(pairs), False)
-
-
-def _is_stamp(path: str) -> bool:
-    """Whether a flattened field's ``path`` is the header stamp or below it."""
-    return path == "header.stamp" or path.startswith("header.stamp.")
-
-
-def _only_read(pairs: list[tuple[str, Any]], paths: tuple[str, ...] | None) -> list[tuple[str, Any]]:
-    """The flattened ``pairs`` a rule reading ``paths`` reads (all of them for ``None``): a pair at a path,
-    below it or above it (a value the path's steps go into)."""
-    if not paths:
-        return pairs
-    return [kv for kv in pairs
-            if any(kv[0] == p or kv[0].startswith(p + ".") or p.startswith(kv[0] + ".") for p in paths)]
-
-
-def _flat(prefix: str, fields: Any, out: list[tuple[str, Any]]) -> None:
-    """The fields of mapping ``fields`` into ``out`` as ``(path, value)``: a field's path is
-    ``prefix.name`` (``name`` at the top), a nested mapping's fields are flattened (an empty one, or
-    one holding rosidl's placeholder member alone, is ``{}`` at its path), any other value is
-    :func:`_value`'s."""
-    for k, x in fields.items():
-        if k == _EMPTY_MEMBER:
-            continue
-        p = f"{prefix}.{k}" if prefix else str(k)
-        t = type(x)
-        if t is float:
-            out.append((p, int(x) if x.is_integer() else x if -_INF < x < _INF else repr(x)))
-        elif t is int or t is str or t is bool:
-            out.append((p, x))
-        elif isinstance(x, dict):
-            n = len(out)
-            _flat(p, x, out)
-            if len(out) == n:
-                out.append((p, {}))
-        else:
-            out.append((p, _value(x)))
-
-
-def _value(v: Any) -> Any:
-    """``v`` canonical: a float that is an integer as that integer, a NaN or an infinity as the text the
-    live monitor writes for it (``"nan"``, ``"inf"``, ``"-inf"``), bytes and arrays as lists, a mapping
-    as its sorted flattened pairs; booleans, integers, other floats and text as they are."""
-    t = type(v)
-    if t is float:
-        if v.is_integer():
-            return int(v)
-        return v if -_INF < v < _INF else repr(v)
-    if t is list or t is tuple:
-        return [_value(x) for x in v]
-    if isinstance(v, dict):
-        pairs: list[tuple[str, Any]] = []
-        _flat("", v, pairs)
-        return _sorted(pairs)
-    if isinstance(v, (bytes, bytearray)):
-        return list(v)
-    if hasattr(v, "tolist"):  # an array, or a numpy scalar
-        return _value(v.tolist())
-    return v
-
-
-def _sorted(pairs: list[tuple[str, Any]]) -> list[list[Any]]:
-    """``pairs`` sorted by path; two of one path (a log naming ``a.b`` and ``a: {b}``) by their JSON."""
-    pairs.sort(key=_first)
-    if len({p for p, _ in pairs}) != len(pairs):
-        pairs.sort(key=lambda kv: (kv[0], _ENCODE(kv[1])))
-    return [[p, x] for p, x in pairs]
-
-
-def _first(kv: tuple[str, Any]) -> str:
-    return kv[0]
-
-
-_INF = float("inf")
-
-
-def _encode(v: Any) -> bytes:
-    """Compact JSON of a canonical record (msgspec: floats by their shortest repr, integers exact)."""
-    global _ENCODE
-    import msgspec  # deferred: start-up (only where a run is counted)
-    _ENCODE = msgspec.json.Encoder(order="sorted").encode
-    return _ENCODE(v)
-
-
-_ENCODE: Callable[[Any], bytes] = _encode
+        pairs = only_read(pairs, read.get(name))
+    return (name, stamp_ns, time, sorted_pairs(pairs), False)
 
 
 __all__ = ["BAG_SUFFIXES", "ReadFields", "read_fields", "run_digest"]
