@@ -321,7 +321,8 @@ def test_the_bag_is_a_ros2_bag_rosbags_reads(run: dict[str, Any], storage: str) 
     from rclverify.traces.bag import typestore
     bag = run["bags"][storage]
     meta = (bag / "metadata.yaml").read_text()
-    assert f"storage_identifier: {storage}" in meta and "message_count: %d" % (N * (len(TOPICS) + 1)) in meta, meta
+    # the contract's messages and the run's end, written last (traces/bag_end.py)
+    assert f"storage_identifier: {storage}" in meta and "message_count: %d" % (N * (len(TOPICS) + 1) + 1) in meta, meta
     store = typestore([run["ws"] / "interfaces"])
     with AnyReader([bag], default_typestore=store) as reader:
         counts: dict[str, int] = {}
@@ -329,7 +330,7 @@ def test_the_bag_is_a_ros2_bag_rosbags_reads(run: dict[str, Any], storage: str) 
         for conn, _t, raw in reader.messages():
             counts[conn.topic] = counts.get(conn.topic, 0) + 1
             last[conn.topic] = reader.deserialize(raw, conn.msgtype)
-    assert counts == {**{f"/{t}": N for t in TOPICS}, "/mislaid": N}, counts  # the Cyclone publisher's only
+    assert counts == {**{f"/{t}": N for t in TOPICS}, "/mislaid": N, "/rclverify/run_end": 1}, counts  # the Cyclone publisher's only
     assert list(last["/arr"].data) == [N - 1.0, 2.0 * (N - 1), 0.5] and last["/arr"].layout.dim[0].label == "x"
     assert list(last["/joints"].name) == ["a", "b"]
     assert last["/nested"].unbounded_sequence_of_unbounded_sequences[1].int32_values.tolist() == [5, N - 1]
