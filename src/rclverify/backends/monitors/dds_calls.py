@@ -61,13 +61,12 @@ from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
+from rclverify.backends.monitors.call_notes import NAMED, CallNotes, key_json
 
 #: the ``topic`` of a call's log lines: no contract names it; ``rclverify monitor LOG`` replays them (:func:`replay`)
 CALL_LOG_TOPIC = "rclverify/call"
 #: seconds an unanswered call is kept after its horizon and deadlines passed (a late answer still shown)
 LINGER_S = 10.0
-#: undecided answers named one by one (client gid and sequence number); the rest are counted
-NAMED = 5
 
 
 def link_view(node: CheckedNode, link: ast.Link) -> CheckedNode:
@@ -103,7 +102,7 @@ class _Call:
     first: int = -1  # the index of the request's (the goal's) event
 
 
-class CallBook:
+class CallBook(CallNotes):
     """The calls and goals in flight and what was concluded of those closed.
 
     ``links`` are the monitored links: ``(node, link)`` pairs (a link name
@@ -172,7 +171,7 @@ class CallBook:
         call = self.calls.get(key)
         if call is None:
             if final:
-                self._log({"link": name.strip("/"), "part": part, "time": stamp, "key": _key(key), "orphan": True,
+                self._log({"link": name.strip("/"), "part": part, "time": stamp, "key": key_json(key), "orphan": True,
                            "fields": dict(fields)})
                 self.orphan(name, key, stamp)
             return False
@@ -187,7 +186,7 @@ class CallBook:
         obligations are closed as they stand (``open``), not judged."""
         if key in self.calls:
             self.counts["rejected"] += 1
-            self._log({"link": self.calls[key].name, "part": "rejected", "time": stamp, "key": _key(key)})
+            self._log({"link": self.calls[key].name, "part": "rejected", "time": stamp, "key": key_json(key)})
             self._close(key)
 
     def unpaired(self, key: tuple[Any, ...], stamp: float, reason: str, part: str = "response") -> None:
@@ -205,7 +204,7 @@ class CallBook:
             return
         self.counts["unpaired"] += 1
         self._log({"link": call.name, "part": part, "unpaired": True, "orphan": True, "time": stamp,
-                   "key": _key(key), "reason": reason})
+                   "key": key_json(key), "reason": reason})
         for m in call.monitors:
             res = m.result
             if not m.pending:  # decided on the request alone (an answer could not change it)
@@ -229,76 +228,6 @@ class CallBook:
                                           "guarantee": d.pending[0].k, "why": "undecided", "reason": reason}
             d.pending = []
 
-    def orphan(self, name: str, key: tuple[Any, ...], stamp: float) -> None:
-        """An answer (reply or result) of link ``name`` stamped ``stamp`` (s)
-        whose request was not heard (made before the monitor started, or of
-        an endpoint it does not hear): counted (``orphan_answers``), its key
-        named among the first :data:`NAMED` (``undecided``), and every node of
-        the link kept from ``discharged``: one more ``inconclusive`` answer,
-        the reason naming the count and the first keys (docs/monitors.md,
-        "Every endpoint of a call accounted for")."""
-        link = name.strip("/")
-        self.counts["orphan_answers"] += 1
-        if link not in self.links:
-            return
-        u = self.undecided.setdefault(link, {"count": 0, "first": []})
-        u["count"] += 1
-        if len(u["first"]) < NAMED:
-            u["first"].append(_key(key))
-        self._mark(link, f"{link} answer {_named(_key(key))}", stamp, self._said(link, "undecided"))
-
-    def unjudged(self, name: str, endpoint: str, why: str, stamp: float) -> None:
-        """Endpoint ``endpoint`` (``"server /ns/n"``, ``"client /ns/n"``) of
-        link ``name`` was not heard with contents from ``stamp`` (s), ``why``:
-        the link is not judged for it; every node of the link is kept from
-        ``discharged`` (one more ``inconclusive``, with ``why``), and the line
-        (``part`` ``unjudged``) goes to the log and the bag."""
-        link = name.strip("/")
-        ends = self.unjudged_ends.setdefault(link, {})
-        if ends.get(endpoint) == why or link not in self.links:
-            return
-        ends[endpoint] = why
-        self._log({"link": link, "part": "unjudged", "time": stamp, "endpoint": endpoint, "reason": why})
-        self._mark(link, f"{link} {endpoint}", stamp, self._said(link, "not judged"))
-
-    def _said(self, link: str, which: str) -> str:
-        """The sentence of :meth:`notes` about ``link``'s undecided answers or its endpoints not judged."""
-        if which == "undecided":
-            u = self.undecided[link]
-            named = ", ".join(_named(k) for k in u["first"]) + (", ..." if u["count"] > len(u["first"]) else "")
-            return (f"{u['count']} answer(s) of /{link} whose request the monitor did not hear (made before it "
-                    f"started, or by an endpoint it does not hear) are undecided: {named}")
-        ends = self.unjudged_ends[link]
-        return f"/{link} is not judged for {len(ends)} endpoint(s): " + "; ".join(ends.values())
-
-    def notes(self, node: str) -> list[str]:
-        """What ``node``'s calls leave undecided whatever else of them was
-        judged, one sentence per link it serves or calls: the answers whose
-        request was not heard (:meth:`orphan`: their count and the first
-        :data:`NAMED` keys) and the endpoints not heard with contents
-        (:meth:`unjudged`)."""
-        out = []
-        for link, views in self.links.items():
-            if node not in {n.name for n, _v, _t in views}:
-                continue
-            out += [self._said(link, w) for w, have in (("undecided", self.undecided), ("not judged",
-                                                                                       self.unjudged_ends))
-                    if have.get(link)]
-        return out
-
-    def with_notes(self, node: str, explanation: str) -> str:
-        """``explanation`` (a status's, :func:`.summary.verdict_status`) with each of :meth:`notes` it does
-        not already say, so a failed or inconclusive status names them too."""
-        extra = [n for n in self.notes(node) if n not in explanation]
-        return explanation + "".join(f"; {n}" for n in extra)
-
-    def _mark(self, link: str, where: str, stamp: float, reason: str) -> None:
-        """Keep each node of ``link`` from ``discharged``: one more ``inconclusive``, ``reason`` its first."""
-        for node in dict.fromkeys(view.name for view, _v, _t in self.links[link]):
-            res = self.results.setdefault(node, NodeResult(node))
-            res.counts["inconclusive"] += 1
-            res.first_inconclusive = {"event": self.index, "time": stamp, "where": where, "reason": reason}
-
     def note(self, obj: dict[str, Any]) -> None:
         """A line for the log about a call (a status change) that no monitor reads."""
         self._log(obj)
@@ -308,7 +237,7 @@ class CallBook:
         topic = f"{call.name}/{part}"
         ev = Event(self.index, stamp, topic, dict(fields), f"{call.label} {part}")
         self.index += 1
-        self._log({"index": ev.index, "link": call.name, "part": part, "time": stamp, "key": _key(call.key),
+        self._log({"index": ev.index, "link": call.name, "part": part, "time": stamp, "key": key_json(call.key),
                    "where": ev.where, "fields": dict(fields), **(extra or {})})
         for m in call.monitors:
             m.advance(stamp)
@@ -381,17 +310,6 @@ class CallBook:
     def _log(self, obj: dict[str, Any]) -> None:
         if self.on_event is not None:
             self.on_event({"topic": CALL_LOG_TOPIC, "kind": "call", **obj})
-
-
-def _key(key: tuple[Any, ...]) -> list[Any]:
-    return [k.hex() if isinstance(k, bytes) else k for k in key]
-
-
-def _named(key: list[Any]) -> str:
-    """A call's key as a person reads it: ``client gid G seq N`` for an introspection event's."""
-    if key[:1] == ["ev"] and len(key) >= 3:
-        return f"client gid {key[1]} seq {key[2]}"
-    return ":".join(str(k) for k in key)
 
 
 def _add(total: NodeResult, one: NodeResult) -> None:
