@@ -78,12 +78,37 @@ def _wait(path: Path, text: str, timeout: float, proc: subprocess.Popen[bytes]) 
         time.sleep(0.05)
 
 
+#: the calls robot.py makes once its rounds are published: six of /estop, three goals of /arm
+CALLS = 9
+
+
+def _judged(log: list[dict[str, Any]]) -> bool:
+    """The robot's last calls in the monitor's log: each /estop response and /arm result with its verdict,
+    and each /estop call's deadline line."""
+    ends = [x["where"] for x in log if x.get("kind") == "call" and x.get("part") in ("response", "result")]
+    judged = {x["verdict"].get("where") for x in log if x.get("topic") == "rclverify/verdict"}
+    return len(ends) >= CALLS and set(ends) <= judged and sum(x.get("kind") == "deadline" for x in log) >= 6
+
+
+def _logged(path: Path, done: Callable[[list[dict[str, Any]]], bool], timeout: float) -> None:
+    """Wait until ``done`` holds of the complete lines of the monitor's log ``path`` (what it heard and
+    judged, whatever the machine's load); ``RuntimeError`` with the log's end after ``timeout`` seconds."""
+    until = time.monotonic() + timeout
+    text = ""
+    while time.monotonic() < until:
+        text = path.read_text(errors="replace") if path.exists() else ""
+        if done([json.loads(x) for x in text[:text.rfind("\n") + 1].splitlines() if x.strip()]):
+            return
+        time.sleep(0.1)
+    raise RuntimeError(f"{path.name} never held the robot's last calls judged:\n{text[-2000:]}")
+
+
 def watch(tmp: Path, ros2_python: Path, env: dict[str, str], *, source: str, defects: str = "",
           record: bool = False, burners: int = 2, rounds: int = 40,
           after: Callable[[], Any] | None = None) -> dict[str, Any]:
-    """One live run (module docstring); ``after()``, when given, is called once the robot is done and
-    the monitor stopped, while the robot's nodes still run, and what it returns is the result's
-    ``"after"``."""
+    """One live run (module docstring): the monitor is stopped once the robot says ``done`` and the
+    monitor's log holds each of its calls judged (:func:`_judged`); ``after()``, when given, is called
+    then, while the robot's nodes still run, and what it returns is the result's ``"after"``."""
     procs: list[subprocess.Popen[bytes]] = []
 
     def start(cmd: list[str], out: str, extra: dict[str, str] | None = None) -> subprocess.Popen[bytes]:
@@ -104,6 +129,7 @@ def watch(tmp: Path, ros2_python: Path, env: dict[str, str], *, source: str, def
         _wait(tmp / "robot.log", "rounds", 60, robot)
         burning = [start([sys.executable, "-c", BURN], f"burn{k}.out") for k in range(burners)]
         _wait(tmp / "robot.log", "done", 90, robot)
+        _logged(tmp / "live.jsonl", _judged, 30)
         stop(monitor, signal.SIGINT)
         for p in burning:
             stop(p)
