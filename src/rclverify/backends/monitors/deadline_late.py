@@ -1,4 +1,9 @@
-"""A deadline's late answer that an output heard later still revises (docs/semantics.md, "Deadlines").
+"""Answers a deadline monitor hears after the clock passed the deadline (docs/semantics.md, "Deadlines").
+
+An answer stamped within the deadline and heard after the clock passed it
+(later than the lateness bound, or a stamp the node copied from its
+question) meets it on its own stamp, the ``false`` given withdrawn
+(:func:`met_late`).
 
 Live, an obligation judged ``false`` when the watermark passed its deadline
 and then answered by an output of its own stamped after the deadline keeps
@@ -28,7 +33,8 @@ from typing import Mapping, Protocol
 
 from rclverify.traces.events import Event
 from rclverify.backends.monitors import deadline_skew
-from rclverify.backends.monitors.deadline_records import DeadlineResult, Pending
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
+from rclverify.backends.monitors.deadline_text import ms_ns
 
 #: how many late-answered obligations are kept for a revision (as many as the expired ones, deadlines.py)
 KEPT = 256
@@ -43,6 +49,8 @@ class LateAnswers(deadline_skew.DeadlineMonitor, Protocol):
 
     answered_late: deque[Answered]
     result: DeadlineResult
+
+    def _emit(self, v: DeadlineVerdict) -> None: ...
 
 
 def hold(mon: LateAnswers, p: Pending, ns: int, ev: Event) -> None:
@@ -71,6 +79,35 @@ def revise(mon: LateAnswers, ev: Event, ns: int, fresh: Mapping[str, object]) ->
             _withdraw_margin(mon, entry)
 
 
+def met_late(mon: LateAnswers, p: Pending, ev: Event, ns: int) -> None:
+    """Obligation ``p`` was judged ``false`` when the clock passed its deadline;
+    output ``ev``, stamped ``ns`` (within it), answers it, heard after the
+    clock passed (a message later than the lateness bound, or a stamp the
+    node copied from its question): the deadline is met, on the answer's
+    own stamp, as a run read in stamp order finds it (docs/semantics.md,
+    "Event time": lateness never makes a violation).  The ``false`` given
+    is withdrawn from the counts; the verdict that follows says why."""
+    if p.maybe:  # counted undecided, not false: now met on its own answer's stamp
+        deadline_skew.decided_late(mon, p)
+        mon._emit(DeadlineVerdict(mon.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                                  ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline "
+                                  f"{ms_ns(p.due_ns - p.stamp_ns)}), heard after the clock had passed the "
+                                  "deadline: met on the answer's own stamp", time_margin=(p.due_ns - ns) / 1e9))
+        mon.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9)
+        return
+    mon._withdraw_false(p)
+    mon.result.counts["true"] += 1
+    late = ms_ns(mon.now_ns - ns) if mon.now_ns is not None else "?"
+    v = DeadlineVerdict(mon.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
+                        f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms_ns(p.due_ns - p.stamp_ns)}), "
+                        f"heard after the clock had passed the deadline (at {late} behind it): met on the "
+                        "answer's own stamp; the false given when the clock passed is withdrawn",
+                        update=True, time_margin=(p.due_ns - ns) / 1e9)
+    if mon.on_verdict is not None:
+        mon.on_verdict(v)
+    mon.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True)
+
+
 def _withdraw_margin(mon: LateAnswers, entry: Answered) -> None:
     """The late answer's margin of ``entry`` out of its guarantee's time margins (module docstring)."""
     p, margin = entry[0], entry[1]
@@ -92,4 +129,4 @@ def _withdraw_margin(mon: LateAnswers, entry: Answered) -> None:
         m.margin_ns, _, m.trigger_where, m.answer_where, m.answer = best
 
 
-__all__ = ["KEPT", "Answered", "LateAnswers", "hold", "revise"]
+__all__ = ["KEPT", "Answered", "LateAnswers", "hold", "met_late", "revise"]

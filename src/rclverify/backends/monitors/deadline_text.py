@@ -1,13 +1,19 @@
 """The text of the deadline monitor's verdicts (:mod:`.deadlines`): durations
-as its reasons show them (:func:`ms`, :func:`ms_ns`) and the evidence status
-and explanation of one node's deadline verdicts on a trace
-(:func:`deadline_status`; docs/monitors.md).
+as its reasons show them (:func:`ms`, :func:`ms_ns`), the verdicts an
+obligation gets when its deadline expires or an answer comes
+(:class:`VerdictWords`, the batch deadline judge's too), why an output did
+not answer one (:func:`rejected`), and the evidence status and explanation
+of one node's deadline verdicts on a trace (:func:`deadline_status`;
+docs/monitors.md).
 """
 from __future__ import annotations
 
 from typing import Mapping
 
-from rclverify.backends.monitors.deadline_records import DeadlineResult
+from rclverify.semantics.floatsem import Judgement
+from rclverify.lang.types import CheckedNode
+from rclverify.traces.events import Event
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 
 
 def ms(x: float) -> str:
@@ -22,6 +28,45 @@ def ms_ns(ns: int) -> str:
     if 0 < abs(ns) < 500_000:
         return f"{ns / 1000:.0f} us" if abs(ns) >= 500 else f"{ns} ns"
     return ms(ns / 1e9)
+
+
+def rejected(k: int, out: Event, j: Judgement) -> str:
+    """Why output ``out`` did not answer an obligation of guarantee ``k``, judged ``j`` on its inputs."""
+    return f"the output at {out.where} did not satisfy guarantee {k}" + (
+        f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
+        f" ({j.reason})" if j.truth is None and j.reason else "")
+
+
+class VerdictWords:
+    """The verdicts of :class:`~.deadlines.DeadlineMonitor`'s obligations, in its words (its ``node``)."""
+
+    node: CheckedNode
+
+    def expired_verdict(self, p: Pending, now_ns: int) -> DeadlineVerdict:
+        """Obligation ``p``'s ``false``: the clock passed its deadline at ``now_ns`` unanswered."""
+        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
+                               f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
+                               f"(clock at {now_ns / 1e9:.3f} s)" + (f"; {p.rejected}" if p.rejected else ""))
+
+    def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
+        """Open obligation ``p`` answered by output ``ev`` stamped ``ns``: ``true`` within the deadline ``d``
+        (s; at it is in time, integer ns), else ``false`` with the answer."""
+        if ns <= p.due_ns:
+            return DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                                   ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms(d)})",
+                                   semantics=semantics, time_margin=(p.due_ns - ns) / 1e9)
+        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
+                               f"{ms_ns(ns - p.due_ns)} past the deadline of {ms(d)}",
+                               semantics=semantics, time_margin=(p.due_ns - ns) / 1e9)
+
+    def late_verdict(self, p: Pending, ns: int, ev: Event) -> DeadlineVerdict:
+        """Expired obligation ``p``'s late answer ``ev`` stamped ``ns`` (an update of its ``false``)."""
+        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
+                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
+                               f"{ms_ns(ns - p.due_ns)} past the deadline of "
+                               f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
+                               time_margin=(p.due_ns - ns) / 1e9)
 
 
 def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:

@@ -64,18 +64,11 @@ from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.verdicts import names
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
-from rclverify.backends.monitors.deadline_text import ms, ms_ns
+from rclverify.backends.monitors.deadline_text import VerdictWords, ms_ns, rejected
 from rclverify.backends.monitors import deadline_late, deadline_skew
 
 
-def rejected(k: int, out: Event, j: Judgement) -> str:
-    """Why output ``out`` did not answer an obligation of guarantee ``k``, judged ``j`` on its inputs."""
-    return f"the output at {out.where} did not satisfy guarantee {k}" + (
-        f" (false in {j.semantics} arithmetic)" if j.truth is False and "double" in j.semantics else
-        f" ({j.reason})" if j.truth is None and j.reason else "")
-
-
-class DeadlineMonitor:
+class DeadlineMonitor(VerdictWords):
     """Streams events through the timed guarantees of one node.
 
     ``feed(ev)`` one event; ``advance(now)`` the clock (expires deadlines);
@@ -139,7 +132,7 @@ class DeadlineMonitor:
         self.skew_ns = deadline_skew.skew_ns(rules)
         self.result = DeadlineResult(node.name)
         #: the ``false`` verdicts given, in order, by (trigger where, guarantee): the first still standing is
-        #: the result's first (a false withdrawn by an answer stamped in time, :meth:`_met_late`)
+        #: the result's first (a false withdrawn by an answer stamped in time, :func:`.deadline_late.met_late`)
         self._falses: dict[tuple[str, int], DeadlineVerdict] = {}
         self._last_false: DeadlineVerdict | None = None
 
@@ -155,7 +148,7 @@ class DeadlineMonitor:
         self.result.counts[v.verdict] += 1
         if v.verdict == "false":
             self._last_false = v
-            if len(self._falses) < 1024:  # bounded; past it the latest false stands in (_met_late)
+            if len(self._falses) < 1024:  # bounded; past it the latest false stands in (deadline_late.met_late)
                 self._falses[(v.trigger_where, v.guarantee)] = v
             if self.result.first_false is None:
                 self.result.first_false = v
@@ -238,33 +231,6 @@ class DeadlineMonitor:
             return "undecided", f"assumption {expr_to_rcl(formula)} undecided: {j.reason}"
         return None
 
-    # -- the verdicts' words (the batch deadline judge's too: batch_deadline_chunk.py) -------------
-    def expired_verdict(self, p: Pending, now_ns: int) -> DeadlineVerdict:
-        """Obligation ``p``'s ``false``: the clock passed its deadline at ``now_ns`` unanswered."""
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                               f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
-                               f"(clock at {now_ns / 1e9:.3f} s)" + (f"; {p.rejected}" if p.rejected else ""))
-
-    def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
-        """Open obligation ``p`` answered by output ``ev`` stamped ``ns``: ``true`` within the deadline ``d``
-        (s; at it is in time, integer ns), else ``false`` with the answer."""
-        if ns <= p.due_ns:
-            return DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                                   ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms(d)})",
-                                   semantics=semantics, time_margin=(p.due_ns - ns) / 1e9)
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                               f"{ms_ns(ns - p.due_ns)} past the deadline of {ms(d)}",
-                               semantics=semantics, time_margin=(p.due_ns - ns) / 1e9)
-
-    def late_verdict(self, p: Pending, ns: int, ev: Event) -> DeadlineVerdict:
-        """Expired obligation ``p``'s late answer ``ev`` stamped ``ns`` (an update of its ``false``)."""
-        return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                               ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
-                               f"{ms_ns(ns - p.due_ns)} past the deadline of "
-                               f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
-                               time_margin=(p.due_ns - ns) / 1e9)
-
     def _answer(self, ev: Event, ns: int, outs: set[str]) -> None:
         stamp = ns / 1e9
         for p in list(self.expired):
@@ -276,7 +242,7 @@ class DeadlineMonitor:
             if self._answers(p, ns, outs):
                 self.expired.remove(p)
                 if ns <= p.due_ns:  # stamped within the deadline, heard after the clock passed it
-                    self._met_late(p, ev, ns)
+                    deadline_late.met_late(self, p, ev, ns)
                     continue
                 if p.maybe:  # answered late, or in time by the output within the skew before it: still undecided
                     continue
@@ -286,34 +252,6 @@ class DeadlineMonitor:
             deadline_late.revise(self, ev, ns, {c: self.values[c] for c in outs if c not in self.state_outs})
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
         self.heard.append((ns, ev, outs, {c: self.values[c] for c in outs if c not in self.state_outs}))
-
-    def _met_late(self, p: Pending, ev: Event, ns: int) -> None:
-        """Obligation ``p`` was judged ``false`` when the clock passed its deadline;
-        output ``ev``, stamped ``ns`` (within it), answers it, heard after the
-        clock passed (a message later than the lateness bound, or a stamp the
-        node copied from its question): the deadline is met, on the answer's
-        own stamp, as a run read in stamp order finds it (docs/semantics.md,
-        "Event time": lateness never makes a violation).  The ``false`` given
-        is withdrawn from the counts; the verdict that follows says why."""
-        if p.maybe:  # counted undecided, not false: now met on its own answer's stamp
-            deadline_skew.decided_late(self, p)
-            self._emit(DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
-                                       ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline "
-                                       f"{ms_ns(p.due_ns - p.stamp_ns)}), heard after the clock had passed the "
-                                       "deadline: met on the answer's own stamp", time_margin=(p.due_ns - ns) / 1e9))
-            self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9)
-            return
-        self._withdraw_false(p)
-        self.result.counts["true"] += 1
-        late = ms_ns(self.now_ns - ns) if self.now_ns is not None else "?"
-        v = DeadlineVerdict(self.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
-                            f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms_ns(p.due_ns - p.stamp_ns)}), "
-                            f"heard after the clock had passed the deadline (at {late} behind it): met on the "
-                            "answer's own stamp; the false given when the clock passed is withdrawn",
-                            update=True, time_margin=(p.due_ns - ns) / 1e9)
-        if self.on_verdict is not None:
-            self.on_verdict(v)
-        self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True)
 
     def _withdraw_false(self, p: Pending) -> None:
         """The ``false`` obligation ``p`` was given when the clock passed its deadline, withdrawn from the
@@ -435,3 +373,6 @@ def check_deadlines(checked: Checked, nodes: Iterable[CheckedNode], events: Iter
         for m in monitors:
             m.feed(ev)
     return [m.finish() for m in monitors]
+
+
+__all__ = ["DeadlineMonitor", "check_deadlines", "rejected"]
