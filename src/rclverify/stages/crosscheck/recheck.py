@@ -99,7 +99,7 @@ def recheck_members(members: dict[str, bytes]) -> Recheck:
         data = members.get(it.smt2)
         if i in untied or data is None:
             continue
-        if hashlib.sha256(data).hexdigest() != row.get("sha256") or row.get("smt2") != it.smt2:
+        if hashlib.sha256(data).hexdigest() != row.sha256 or row.smt2 != it.smt2:
             problems.append(f"{label}: its query {it.smt2} was edited after it was decided "
                             f"(sha256 differs from {INDEX})")
             continue
@@ -108,7 +108,7 @@ def recheck_members(members: dict[str, bytes]) -> Recheck:
         if z != it.expects:
             (notes if z in ("unknown", "error") else problems).append(
                 f"{label}: recorded {it.verdict} (Z3 {it.expects}); Z3 now answers {z} on {it.smt2}")
-        recorded = (row.get("cvc5") or {}).get("answer")
+        recorded = row.cvc5.answer if row.cvc5 is not None else None
         if has_cvc5 and recorded in ("sat", "unsat"):
             c = decide(text, it.smt2, proofs=recorded == "unsat", every=it.every, session=session)
             if c.answer != recorded:

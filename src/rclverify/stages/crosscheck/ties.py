@@ -22,12 +22,14 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Mapping
+
+import msgspec
 
 from rclverify.records.sealed import check_text
 from rclverify.records.ties import last_line, proof_tie, query_tie, said_tie, statement_sha256
 from rclverify.stages.crosscheck.items import Item, discharging_items
-from rclverify.stages.crosscheck.stage import DIR, INDEX
+from rclverify.stages.crosscheck.stage import DIR, INDEX, CrosscheckSeen, Cvc5Seen
 
 #: How many last bytes of a query or proof member ``--verify`` keeps: its tie line is among them.
 TAIL_BYTES = 4096
@@ -55,21 +57,29 @@ def bundle_items(records: Mapping[str, bytes]) -> list[Item]:
         return discharging_items(root, nodes)
 
 
-def index_rows(raw: bytes | None) -> tuple[dict[tuple[str, str], dict[str, Any]] | None, str]:
+def index_rows(raw: bytes | None) -> tuple[dict[tuple[str, str], CrosscheckSeen] | None, str]:
     """``(rows by (kind, id), problem)`` of the second-solver record's bytes
-    ``raw``: ``(None, "")`` when there is none, ``(None, why)`` when its
-    seal does not hold."""
+    ``raw``, each row decoded into :class:`~.stage.CrosscheckSeen` (a row
+    that does not decode is left out, as :func:`~.stage.read_crosscheck`
+    does): ``(None, "")`` when there is none, ``(None, why)`` when its seal
+    does not hold."""
     if raw is None:
         return None, ""
     index, why = check_text(raw.decode("utf-8", "replace"), "second-solver record")
     if why or index is None:
         return None, why or "unreadable"
     items = index.get("items")
-    return {(str(r.get("kind")), str(r.get("id"))): r for r in items if isinstance(r, dict)} \
-        if isinstance(items, list) else {}, ""
+    out: dict[tuple[str, str], CrosscheckSeen] = {}
+    for r in items if isinstance(items, list) else ():
+        try:
+            row = msgspec.convert(r, CrosscheckSeen)
+        except msgspec.ValidationError:
+            continue
+        out[(row.kind, row.id)] = row
+    return out, ""
 
 
-def tie_problems(items: list[Item], rows: Mapping[tuple[str, str], Mapping[str, object]] | None,
+def tie_problems(items: list[Item], rows: Mapping[tuple[str, str], CrosscheckSeen] | None,
                  present: Mapping[str, object], tails: Mapping[str, bytes]) -> tuple[list[str], set[int]]:
     """``(problems, untied)``: one sentence naming the item for each query
     that is missing or not tied to its item's statement and each proof not
@@ -99,14 +109,13 @@ def tie_problems(items: list[Item], rows: Mapping[tuple[str, str], Mapping[str, 
     return problems, untied
 
 
-def _proof_problem(row: Mapping[str, object], present: Mapping[str, object], tails: Mapping[str, bytes]) -> str:
+def _proof_problem(row: CrosscheckSeen, present: Mapping[str, object], tails: Mapping[str, bytes]) -> str:
     """Why the proof ``row`` of the second-solver record keeps cannot be
     believed to prove its query, or ''."""
-    answer = row.get("cvc5")
-    c = answer if isinstance(answer, dict) else {}
-    proof, sha = (c or {}).get("proof"), str(row.get("sha256", ""))
+    c = row.cvc5 or Cvc5Seen()
+    proof, sha = c.proof, row.sha256 or ""
     if not proof:
-        if (c or {}).get("answer") == "unsat" and row.get("agreement") == "two solvers":
+        if c.answer == "unsat" and row.agreement == "two solvers":
             return f"recorded as proved by both solvers, but {INDEX} keeps no proof of its query"
         return ""
     where = f"{DIR}/proofs/{sha}.proof"
