@@ -77,6 +77,22 @@ class _RequirementEntry(msgspec.Struct, frozen=True, kw_only=True):
     component_name: str | None = None
     semantics: FretSemantics | None = None
 
+    def component(self) -> str:
+        """FRET's component of the requirement: its semantics' ``component_name``, else the requirement's
+        own, else the semantics' ``component`` (older exports); ``""`` when none is named."""
+        sem = self.semantics or FretSemantics()
+        return sem.component_name or self.component_name or sem.component or ""
+
+
+def component_of(raw: Mapping[str, Any]) -> str:
+    """The component a requirement's JSON object ``raw`` names (:meth:`_RequirementEntry.component`);
+    ``""`` when a field of it is of another type than FRET writes (:func:`read_export` refuses such an
+    export)."""
+    try:
+        return msgspec.convert(raw, _RequirementEntry).component()
+    except msgspec.ValidationError:
+        return ""
+
 
 class FretVariableEntry(msgspec.Struct, frozen=True, kw_only=True):
     """A FRET variable as exported (the fields rclverify reads): ``variable_name``, ``component_name``,
@@ -214,8 +230,7 @@ def read_export(path: Path, rel: str) -> FretExport:
             raise plan_error(rel, loc.line, loc.col, f"{rid}: 'semantics' must be an object", "E-fret")
         e: _RequirementEntry = _decoded(rel, text, max(at, 0), f"requirement {rid}", r, _RequirementEntry)
         sem = e.semantics or FretSemantics()
-        comp = sem.component_name or e.component_name or sem.component or ""
-        out.append(FretRequirement(rid, " ".join((e.fulltext or "").split()), comp, sem, loc, digest(r), r))
+        out.append(FretRequirement(rid, " ".join((e.fulltext or "").split()), e.component(), sem, loc, digest(r), r))
     variables: dict[tuple[str, str], FretVariable] = {}
     for v in vars_raw:
         if isinstance(v, dict) and "idType" in v and isinstance(v.get("variable_name"), str):

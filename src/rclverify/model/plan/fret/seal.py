@@ -27,6 +27,8 @@ import json
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from rclverify.model.plan.fret.export import component_of
+
 #: The prefix of the inputs this module gives.
 PREFIX = "fret:"
 
@@ -57,9 +59,7 @@ def entry_sha256(data: Mapping[str, Any] | None, reqid: str) -> str:
     entry = next((r for r in reqs or () if isinstance(r, dict) and r.get("reqid") == reqid), None)
     if entry is None:
         return ""
-    sem = entry.get("semantics")
-    sem = sem if isinstance(sem, dict) else {}
-    comp = sem.get("component_name") or entry.get("component_name") or sem.get("component") or ""
+    comp = component_of(entry)
     assert data is not None
     vars_ = sorted((v for v in data.get("variables") or () if isinstance(v, dict) and v.get("component_name") == comp),
                    key=lambda v: str(v.get("variable_name")))
