@@ -60,7 +60,7 @@ from typing import Any, Mapping, Sequence, TypedDict
 import z3
 
 from rclverify.semantics.encode import Encoder
-from rclverify.records.composition_records import RuleInstance
+from rclverify.records.composition_records import CompositionRecord, EnvironmentAssumption, RuleInstance
 from rclverify.semantics.nicemodel import nicer_model
 from rclverify.calculus.context import ConeContext
 from rclverify.calculus.side_condition import (IN_CONTEXT as IN_CONTEXT, STATUS as STATUS,
@@ -107,7 +107,7 @@ class NodeComposition:
     rules: tuple[str, ...]
     producers: tuple[str, ...]
     side_conditions: tuple[SideCondition, ...]
-    environment_assumptions: tuple[dict[str, str], ...]
+    environment_assumptions: tuple[EnvironmentAssumption, ...]
     instances: tuple[RuleInstance, ...]
     derived_property: str
     cone: tuple[str, ...]
@@ -242,7 +242,7 @@ def compose_node(checked: Checked, model: SystemModel, node: str, *,
                 sc = dataclasses.replace(sc, scale=scale, explanation=sc.explanation + "".join(
                     f" {m['message'][0].upper()}{m['message'][1:]}." for m in scale))
         scs.append(sc)
-    env_assumptions = tuple({"node": node, "text": expr_to_rcl(c), "source": _loc(c.loc)} for c in env)
+    env_assumptions = tuple(EnvironmentAssumption(node=node, text=expr_to_rcl(c), source=_loc(c.loc)) for c in env)
     g_text = contract_text([g.formula for g in cn.node.guarantees])
     a_text = contract_text([a.formula for a in cn.node.assumes])
     instances = rule_instances(checked, model, node, rule, a_text, g_text, bool(scs))
@@ -314,7 +314,7 @@ def _links_of(model: SystemModel, cn: Any, node: str, c: ast.Expr) -> list[str]:
             for l in model.links_into(node) if l.to_var in names]
 
 
-def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> dict[str, Any]:
+def composition_json(c: NodeComposition, smt2_paths: Sequence[str]) -> CompositionRecord:
     """JSON form of a node's composition; ``smt2_paths`` parallel to its side conditions."""
     return {
         "node": c.node, "rules": list(c.rules), "producers": list(c.producers),

@@ -17,12 +17,13 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any, Callable, Protocol, Sequence
+from typing import Callable, Protocol, Sequence
 
 import z3
 
 from rclverify.calculus.context import ConeContext, ContextResult
 from rclverify.calculus.shapes import ContextRecord, LocalVerdict, ScaleMismatch
+from rclverify.records.composition_records import SideCondition as SideConditionJson
 from rclverify.lang import ast
 from rclverify.lang.types import CheckedNode
 from rclverify.semantics.definedness import conditions, guarded
@@ -67,13 +68,17 @@ class SideCondition:
     #: probable scale mismatches behind a side condition that is not discharged (:mod:`.scale`)
     scale: tuple[ScaleMismatch, ...] = ()
 
-    def to_json(self, smt2_path: str) -> dict[str, Any]:
-        return {"id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct,
-                "source": self.source, "hypotheses": list(self.hypotheses), "status": self.status,
-                "duration_s": self.duration_s, "smt2": smt2_path, "model": self.model,
-                "explanation": self.explanation, "variant": self.variant, "links": list(self.links),
-                "verdict": self.verdict or self.status, "context": self.context,
-                **({"scale_mismatch": list(self.scale)} if self.scale else {})}
+    def to_json(self, smt2_path: str) -> SideConditionJson:
+        """The side condition as the compose stage's record holds it (records/composition_records.py
+        ``SideCondition``), ``smt2_path`` its query's workspace-relative path."""
+        out: SideConditionJson = {
+            "id": self.id, "node": self.node, "rule": self.rule, "conjunct": self.conjunct, "source": self.source,
+            "hypotheses": list(self.hypotheses), "status": self.status, "duration_s": self.duration_s,
+            "smt2": smt2_path, "model": self.model, "explanation": self.explanation, "variant": self.variant,
+            "links": list(self.links), "verdict": self.verdict or self.status, "context": self.context}
+        if self.scale:
+            out["scale_mismatch"] = list(self.scale)
+        return out
 
 
 def defined_goal(c: ast.Expr) -> ast.Expr:
