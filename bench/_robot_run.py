@@ -401,7 +401,8 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
     print(f"robot generator: {len(seeds)} system(s){' with a seeded defect' if defect else ''}, "
           f"{'one CPU burner beside, ' if burn else ''}load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} "
           f"core(s): live satisfied {total['satisfied']}, violated {total['violated']}, undecided "
-          f"{total['undecided']}, deadlines true {total['deadline true']} false {total['deadline false']} "
+          f"{total['undecided']} (" + ", ".join(f"{total['undecided ' + v]} {v}" for v in UNDECIDED)
+          + f", {total['unjudged']} unjudged endpoints), deadlines true {total['deadline true']} false {total['deadline false']} "
           f"(undecided on the logs: {undecided}); declarations: " + "; ".join(
               f"{path} " + ", ".join(f"{declarations[k]} {k.split(' ', 1)[1]}" for k in sorted(declarations)
                                      if k.startswith(path + " ") and "correct" not in k)

@@ -157,7 +157,8 @@ def _matched(a: dict[Bucket, list[dict[str, Any]]], b: dict[Bucket, list[dict[st
 
 def tally(f: dict[Bucket, list[dict[str, Any]]]) -> dict[str, Counter[str]]:
     """Per node, its final verdicts counted: ``satisfied``, ``violated``, ``undecided`` (inconclusive,
-    incomplete input, open) answers of topics and calls, other question verdicts by name, ``deadline
+    incomplete input, open; and each as ``undecided <verdict>``) answers of topics and calls, other
+    question verdicts by name, ``deadline
     <verdict>``, and ``provisional`` (final verdicts still provisional)."""
     out: dict[str, Counter[str]] = {}
     for (node, item, _, _), rs in f.items():
@@ -165,6 +166,8 @@ def tally(f: dict[Bucket, list[dict[str, Any]]]) -> dict[str, Counter[str]]:
         for r in rs:
             v = r["verdict"]
             c[f"deadline {v}" if item == "deadline" else ("undecided" if v in UNDECIDED else v)] += 1
+            if item != "deadline" and v in UNDECIDED:
+                c[f"undecided {v}"] += 1
             c["provisional"] += bool(r.get("provisional"))
             if item == "call":
                 c["call " + ("undecided" if v in UNDECIDED else v)] += 1
