@@ -26,6 +26,7 @@ from rclverify.lang.types import Checked
 from rclverify.lang.walk import subexpressions
 from rclverify.model.system.model import SystemModel
 from rclverify.model.system.services import unserved_parts
+from rclverify.records.stage_records import DeadlineCheck
 
 #: Verdicts of an end-to-end deadline, as the requirements' statuses.
 PROVED, REFUTED, INCONCLUSIVE = "proved", "refuted", "inconclusive"
@@ -69,8 +70,8 @@ class DeadlineResult:
     #: the slowest other path from the first node to the last, when slower than ``path`` (:mod:`.worst_path`)
     worst_path: tuple[str, ...] = ()
 
-    def to_json(self) -> dict[str, Any]:
-        """The result as JSON: times exact (``within_s``, ``total_s``: a
+    def to_json(self) -> DeadlineCheck:
+        """The result as JSON (records/stage_records.py ``DeadlineCheck``): times exact (``within_s``, ``total_s``: a
         fraction of seconds as text, ``"1/5"``) and as the reader writes them
         (``within``, ``total``: ``"200 ms"``); each hop of ``chain`` with its
         guarantee's location (``loc``: ``file:line:col``)."""

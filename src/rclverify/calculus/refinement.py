@@ -56,6 +56,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.typecheck import load
 from rclverify.lang.types import Checked, CheckedNode, Env
 from rclverify.calculus.interfaces import check_interface, io_loc, merge_envs
+from rclverify.calculus.shapes import RefinementJson, RefinementSideJson
 
 
 @dataclass(frozen=True)
@@ -108,13 +109,16 @@ class RefinementResult:
             return "does not refine"
         return "inconclusive"
 
-    def to_json(self) -> dict[str, Any]:
-        def side(s: SideResult) -> dict[str, Any]:
+    def to_json(self) -> RefinementJson:
+        """The verdict as JSON (calculus/shapes.py ``RefinementJson``)."""
+        def side(s: SideResult) -> RefinementSideJson:
             return {"statement": s.statement, "status": s.status, "model": dict(s.model) if s.model else None,
                     "reason": s.reason, "duration_s": s.duration_s}
-        return {"a": self.a, "b": self.b, "verdict": self.verdict,
-                "assumption": side(self.assumption), "guarantee": side(self.guarantee),
-                "conditions": list(self.conditions), **({"timing": side(self.timing)} if self.timing else {})}
+        out: RefinementJson = {"a": self.a, "b": self.b, "verdict": self.verdict, "assumption": side(self.assumption),
+                               "guarantee": side(self.guarantee), "conditions": list(self.conditions)}
+        if self.timing:
+            out["timing"] = side(self.timing)
+        return out
 
 
 # ---------------------------------------------------------------------------

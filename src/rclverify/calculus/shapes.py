@@ -8,7 +8,7 @@ themselves are :mod:`rclverify.records.stage_records`.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).
-from typing import TypedDict
+from typing import NotRequired, TypedDict
 
 from rclverify.records.stage_records import Premise, Traced
 # sealed in the compose stage's record, so defined with it (records/ is below calculus/)
@@ -93,3 +93,27 @@ class TemporalVerdictJson(TypedDict):
     loop: int | None
     deadlock: str
     certificate: str
+
+
+class RefinementSideJson(TypedDict):
+    """One side of a refinement check as ``rclverify refines --json`` writes it (calculus/refinement.py
+    ``RefinementResult.to_json``): the implication checked, its status, the counterexample (RCL name ->
+    value text, null unless refuted), Z3's reason, the wall time in seconds."""
+    statement: str
+    status: str
+    model: dict[str, str] | None
+    reason: str
+    duration_s: float
+
+
+class RefinementJson(TypedDict):
+    """The verdict on "B refines A" (calculus/refinement.py ``RefinementResult.to_json``): the two nodes,
+    the verdict, the assumption and guarantee sides, the conditions it holds under, and the timing side
+    when A has triggered guarantees."""
+    a: str
+    b: str
+    verdict: str
+    assumption: RefinementSideJson
+    guarantee: RefinementSideJson
+    conditions: list[str]
+    timing: NotRequired[RefinementSideJson]
