@@ -187,5 +187,8 @@ def test_the_offline_check_reads_a_log_in_blocks_to_the_same_run(tmp_path: Path,
     streamed, fed_streamed = _recorded(tmp_path, trace)
     assert fed > 10 and fed_streamed == 0  # the log went in blocks, the control event by event
     assert blocked == streamed
-    counts = blocked["deadlines"][0]["counts"]
-    assert counts.get("true", 0) > 1000 and counts.get("false", 0) > 3, counts  # both verdicts judged
+    counts, unaccepted = blocked["deadlines"][0]["counts"], blocked["deadlines"][0]["unaccepted"]
+    # both outcomes judged: met, and not met in time (false; undecided where an answer within the skew before
+    # the trigger may be its own, docs/semantics.md "Deadlines")
+    assert counts.get("true", 0) > 1000 and counts.get("false", 0) + unaccepted.get("undecided", 0) > 3, (
+        counts, unaccepted)
