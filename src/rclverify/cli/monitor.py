@@ -30,23 +30,13 @@ from rclverify.traces import TraceError
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions
 from rclverify.backends.monitors.deadline_text import deadline_status
 from rclverify.backends.monitors.config import ConfigError, load_mapping
-from rclverify.backends.monitors.judged import explain, strict_line
+from rclverify.backends.monitors.judged import explain
+from rclverify.cli.monitor_outcome import print_not_judged, selected_nodes, strict_exit
 from rclverify.backends.monitors.declarations import declaration_status
 from rclverify.backends.monitors.periods import period_status
 from rclverify.backends.monitors.recorded import RecordedRun, check_recorded
 from rclverify.backends.monitors.verdict_lines import verdict_record, write_records
 
-
-def selected_nodes(checked: Any, names: Any, command: str) -> list[Any] | None:
-    """The checked nodes ``names`` (``--node``) selects, every node when it
-    is empty; ``None`` after printing one error line when a name is not a
-    node of the contracts."""
-    unknown = [n for n in names or () if n not in checked.nodes]
-    if unknown:
-        print(f"rclverify {command}: error: no node named {unknown[0]!r}; nodes: {', '.join(checked.nodes)}",
-              file=sys.stderr)
-        return None
-    return [checked.nodes[n] for n in names] if names else list(checked.nodes.values())
 
 def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     """Run the command on the workspace's checked contracts ``checked`` (the
@@ -101,7 +91,7 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     if getattr(args, "verdicts", None):
         write_records(Path(args.verdicts), records)
     _emit(report, args.json)
-    return 1 if violated else _strict(args, unjudged, _undecided(report))
+    return 1 if violated else strict_exit(args, unjudged, _undecided(report))
 
 
 def _report_run(report: list[Mapping[str, object]], run: RecordedRun, trace: str, cfg: Any, as_json: bool) -> bool:
@@ -150,7 +140,7 @@ def _report_run(report: list[Mapping[str, object]], run: RecordedRun, trace: str
         violated = _report_calls(report, run.call_entries + run.deadline_entries, run.calls, run.missed, trace,
                                  as_json) or violated
     if not as_json:
-        _print_not_judged(items, f"{trace}: ")
+        print_not_judged(items, f"{trace}: ")
     return violated
 
 
@@ -170,29 +160,6 @@ def _report_calls(report: list[Mapping[str, object]], entries: Sequence[Mapping[
     if not as_json:
         print(f"{trace}: deadlines: {missed[0]} of {missed[1]} judged call(s) or goal(s) missed their deadline")
     return failed or missed[0] > 0
-
-
-def _print_not_judged(items: list[dict[str, str]], prefix: str) -> None:
-    """One line per item the run did not judge (silence is never green: judged.py)."""
-    for i in items:
-        print(f"{prefix}not judged: {i['kind']} {i['name']} ({i['node']}): {i['reason']}: {i['detail']}")
-
-
-def _strict(args: argparse.Namespace, unjudged: list[dict[str, str]],
-            undecided: Sequence[Mapping[str, object]] = ()) -> int:
-    """The exit code of a run with no violation: 1 under ``--strict`` when
-    an item went unjudged (``unjudged``, the first named on stderr) or a
-    verdict stayed undecided (``undecided``: the ``inconclusive`` entries, as
-    ``doit verify --strict`` fails on what is not discharged), else 0."""
-    if not getattr(args, "strict", False) or not (unjudged or undecided):
-        return 0
-    if unjudged:
-        print(strict_line(unjudged), file=sys.stderr)
-    else:
-        first = undecided[0]
-        print(f"rclverify monitor: --strict: {len(undecided)} verdict(s) undecided; the first: {first['node']}: "
-              f"{first['explanation']}", file=sys.stderr)
-    return 1
 
 
 def _undecided(report: list[Mapping[str, object]]) -> list[Mapping[str, object]]:

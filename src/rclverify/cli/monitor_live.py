@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from rclverify.backends.monitors.verdict_lines import log_records, write_records
-from rclverify.cli.monitor import _print_not_judged, _strict, selected_nodes
+from rclverify.cli.monitor_outcome import print_not_judged, selected_nodes, strict_exit
 from rclverify.core.extras import MissingExtra
 
 
@@ -214,13 +214,13 @@ def _print_live(log: Path, record_: dict[str, Any]) -> None:
         print(f"enforce /{topic}: {c['released']} released, {c['blocked']} blocked (read from {c['private']})")
     if "bag" in record_:
         print(f"recorded {record_['bag']['messages']} message(s) to {record_['bag']['path']}")
-    _print_not_judged(record_.get("not_judged", []), "")
+    print_not_judged(record_.get("not_judged", []), "")
 
 
 
 def _live_exit(args: argparse.Namespace, record_: dict[str, Any]) -> int:
     """The exit code of a stopped live run: 1 when a message, call,
-    deadline, period or declaration failed, else :func:`_strict`'s."""
+    deadline, period or declaration failed, else :func:`strict_exit`'s."""
     late = bool(record_.get("deadlines", {}).get("false"))
     late = late or any(d["status"] == "failed" for d in record_.get("topic_deadlines", []) + record_.get("periods", [])
                        + record_.get("declarations", []))
@@ -230,4 +230,4 @@ def _live_exit(args: argparse.Namespace, record_: dict[str, Any]) -> int:
     undecided = [d for d in record_["nodes"] + record_.get("calls", {}).get("nodes", [])
                  + record_.get("topic_deadlines", []) + record_.get("periods", []) + record_.get("declarations", [])
                  if d.get("status") == "inconclusive"]
-    return _strict(args, list(record_.get("not_judged", [])), undecided)
+    return strict_exit(args, list(record_.get("not_judged", [])), undecided)
