@@ -203,10 +203,10 @@ def test_a_row_for_another_text_of_the_query_is_not_believed(tmp_path: Path) -> 
            "sha256": hashlib.sha256(SAT_SCRIPT.encode()).hexdigest(), "agreement": "two solvers", "why": "both",
            "cvc5": {"answer": "unsat", "proof_checked": True, "version": "1", "reason": "", "proof": ""}}
     write_sealed(tmp_path / INDEX, {"solver": None, "counts": {}, "items": [row]})
-    assert load(tmp_path).solvers("requirement", "REQ1", rel)["agreement"] == "two solvers"
+    assert load(tmp_path).solvers("requirement", "REQ1", rel).agreement == "two solvers"
     (tmp_path / rel).write_text(SAT_SCRIPT.replace("1.0", "2.0"))
     s = load(tmp_path).solvers("requirement", "REQ1", rel)
-    assert s["agreement"] == "one solver" and "another text" in s["why"], s
+    assert s.agreement == "one solver" and "another text" in s.why, s
 
 
 def test_a_verdict_without_a_kept_query_says_so() -> None:

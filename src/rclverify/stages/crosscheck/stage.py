@@ -28,6 +28,7 @@ from rclverify.core import cpus as cpus_now
 from rclverify.core.forksafe import fork_is_safe
 from rclverify.records.sealed import read_sealed, write_sealed
 from rclverify.records.crosscheck_records import CrosscheckRecord, Cvc5Answer
+from rclverify.records.statuses import Agreement
 from rclverify.records.store import atomic_write_text
 from rclverify.records.ties import proof_tie, tie_proof
 from rclverify.stages.crosscheck.cvc5_decide import RLIMIT, Decision, Session, decide, version
@@ -265,7 +266,7 @@ class CrosscheckSeen(msgspec.Struct, frozen=True):
     id: str = ""
     smt2: str | None = None
     sha256: str | None = None
-    agreement: str | None = None
+    agreement: Agreement | None = None
     why: str = ""
     cvc5: Cvc5Seen | None = None
     other_text: bool = False
