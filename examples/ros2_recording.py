@@ -118,7 +118,8 @@ def stop(p: subprocess.Popen[bytes], sig: int = signal.SIGTERM) -> None:
 
 def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: list[str], script: str,
            monitor: list[str], driver: str = "scenario", timeout: float = 30.0, until_done: bool = False,
-           scripts: dict[str, Path] | None = None, env: dict[str, str] | None = None) -> float:
+           scripts: dict[str, Path] | None = None, env: dict[str, str] | None = None,
+           heard: Callable[[list[dict[str, Any]]], bool] | None = None) -> float:
     """Run the monitor (extra arguments ``monitor``), one ROS 2 process of
     ``script`` (relative to ``here``) per node of ``nodes`` and then the
     ``driver`` (``script ROLE``; with ``scripts``, the program ``scripts[ROLE]``
@@ -128,8 +129,11 @@ def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: lis
     loopback in a domain of their own), else this one's with :data:`CYCLONE`,
     localhost discovery, Fast DDS and a random domain.  The run ends when the driver exits, or
     with ``until_done`` when it prints ``done`` (its nodes are then stopped
-    at once, so that timers do not add messages).  Returns the seconds it
-    took; raises :class:`Failed` (the scenario or the monitor failed, or not
+    at once, so that timers do not add messages).  The monitor is then
+    stopped once its log holds what ``heard`` asks of its lines (the run's
+    last answers, whatever the machine's load; at most 30 s), or without
+    ``heard`` 0.5 s later.  Returns the seconds it took; raises
+    :class:`Failed` (the scenario or the monitor failed, or not
     within ``timeout`` seconds).  Every process started is stopped."""
     t0 = time.monotonic()
     if env is None:
@@ -169,7 +173,10 @@ def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: lis
             drv.wait(left)
             if drv.returncode != 0:
                 raise Failed("the scenario failed:\n" + (tmp / "driver.out").read_text(errors="replace")[-2000:])
-        time.sleep(0.5)  # the last answers reach the monitor
+        if heard is not None:
+            logged(tmp / "run.jsonl", heard, 30)
+        else:
+            time.sleep(0.5)  # the last answers reach the monitor
         stop(mon, signal.SIGINT)
         if mon.returncode not in (0, 1):  # 1: a contract failed, as the seeded defects make it
             raise Failed("the monitor failed:\n" + (tmp / "monitor.out").read_text(errors="replace")[-2000:])
@@ -179,6 +186,19 @@ def record(here: Path, py: Path, tmp: Path, *, interfaces: list[str], nodes: lis
         for p in reversed(procs):
             stop(p)
     return time.monotonic() - t0
+
+
+def logged(path: Path, heard: Callable[[list[dict[str, Any]]], bool], timeout: float) -> None:
+    """Wait until ``heard`` holds of the complete lines of the monitor's log
+    ``path``; :class:`Failed` with the log's end after ``timeout`` seconds."""
+    until = time.monotonic() + timeout
+    text = ""
+    while time.monotonic() < until:
+        text = path.read_text(errors="replace") if path.exists() else ""
+        if heard([json.loads(x) for x in text[:text.rfind("\n") + 1].splitlines() if x.strip()]):
+            return
+        time.sleep(0.1)
+    raise Failed(f"{path.name} never held the run's last answers:\n{text[-2000:]}")
 
 
 def read_log(path: Path) -> list[dict[str, Any]]:
