@@ -31,6 +31,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
@@ -43,6 +44,15 @@ DRIVER = "simulator.py"
 INTERFACES = ["interfaces/robot_msgs"]
 MONITOR = ["--interfaces", "interfaces", "--mapping", "contracts/mapping.yaml"]
 TIMEOUT = 75.0  # s, one recording at most (the simulator waits up to 45 s for discovery)
+GOALS = 2  # the simulator's /dock goals, its last calls
+
+
+def _heard(log: list[dict[str, Any]]) -> bool:
+    """The monitor's log holds the result of each of the simulator's /dock goals (its last answers) and
+    that result's verdict."""
+    results = [x["where"] for x in log if x.get("kind") == "call" and x.get("part") == "result"]
+    judged = {x["verdict"].get("where") for x in log if x.get("topic") == "rclverify/verdict"}
+    return len(results) >= GOALS and set(results) <= judged
 
 
 def defects() -> list[str]:
@@ -76,7 +86,7 @@ def record(py: Path, tmp: Path, defect: str | None, out: Path, env: dict[str, st
     scripts = {name: nodes / prog for name, prog in NODES.items()} | {"simulator": nodes / DRIVER}
     seconds = record_run(HERE, py, tmp, interfaces=INTERFACES, nodes=list(NODES), script="", driver="simulator",
                          monitor=[*MONITOR, "--record", str(tmp / "bag.mcap")], timeout=TIMEOUT, until_done=True,
-                         scripts=scripts, env=env)
+                         scripts=scripts, env=env, heard=_heard)
     lines = read_log(tmp / "run.jsonl")
     messages, span = messages_span(lines)
     bag, log_tmp = out.with_suffix(""), out.with_name(out.name + ".tmp")
