@@ -120,13 +120,13 @@ def read_design_record(ws: "Workspace") -> dict[str, Any] | None:
     return body
 
 
-def design_row(ws: "Workspace") -> dict[str, Any] | None:
+def design_row(ws: "Workspace") -> DesignRow | None:
     """The report's ``design``: :func:`read_design_record` decoded into
-    :class:`~rclverify.records.design_rows.DesignRow`, as its JSON object; ``None`` when the plan names no
-    design.  Raises :class:`msgspec.ValidationError` for a record of another shape (a bug: the stage seals
-    what it writes)."""
+    :class:`~rclverify.records.design_rows.DesignRow`; ``None`` when the plan names no design.  Raises
+    :class:`msgspec.ValidationError` for a record of another shape (a bug: the stage seals what it
+    writes)."""
     record = read_design_record(ws)
-    return None if record is None else DesignRow.of(record).to_json()
+    return None if record is None else DesignRow.of(record)
 
 
 def design_problems(row: DesignRow | Mapping[str, Any] | None) -> list[str]:

@@ -179,8 +179,8 @@ def read_instances(ws: "Workspace") -> dict[str, Any] | None:
     return rec
 
 
-def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> dict[str, Any] | None:
-    """The report's ``instances`` (:func:`read_instances`) as the JSON object of
+def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> InstancesRow | None:
+    """The report's ``instances`` (:func:`read_instances`) as an
     :class:`~rclverify.records.instance_rows.InstancesRow`, each instance given the obligations of its
     contract with their current status (``obligations``: the report's rows, ``id``, ``node``,
     ``status``): one obligation, every instance, except an obligation of one instance (the monitors
@@ -200,7 +200,7 @@ def instances_row(ws: "Workspace", obligations: Sequence[Mapping[str, Any]]) -> 
                                               if not any(o["id"].endswith("_" + n) for n in names - {i["node"]})]}
                         for i in rec["instances"]]
     from rclverify.records.instance_rows import InstancesRow  # deferred: only a plan with instances
-    return InstancesRow.of(rec).to_json()
+    return InstancesRow.of(rec)
 
 
 def instance_problems(row: InstancesRow | Mapping[str, Any] | None) -> list[str]:
