@@ -33,12 +33,10 @@ milliseconds with spikes of hundreds (docs/monitors.md, "Live monitoring",
   rclpy source's verdicts to its agent);
 * the timer (:meth:`~.live.LiveRun.tick`) runs in the same thread every
   ``tick_s`` seconds, and as soon as the watermark reaches the earliest
-  buffered message (the sink's ``due()``), but no sooner than
-  :data:`MIN_TICK_S` after its last run: a release already due when the
-  thread comes round (it was held off the CPU, or busy with a batch) runs
-  at once, not :data:`MIN_TICK_S` later.  So a horizon is closed without a
-  new message, a verdict waits the lateness bound and not a timer period
-  more, and the engine is never entered by two threads.  While messages still wait in the
+  buffered message (the sink's ``due()``, at most every :data:`MIN_TICK_S`),
+  so a horizon is closed without a new message, a verdict waits the
+  lateness bound and not a timer period more, and the engine is never
+  entered by two threads.  While messages still wait in the
   queue the timer's time is that of the last message checked, not the
   clock's: the clock never passes a message received earlier, so a backlog
   cannot close an obligation before the answer waiting behind it is read.
@@ -65,8 +63,7 @@ class Sink(Protocol):
 
 
 _STOP = object()
-#: the shortest time between two timer runs (s) when the sink asks for one sooner than ``tick_s``, counted
-#: from the last run
+#: the shortest time between two timer runs (s) when the sink asks for one sooner than ``tick_s``
 MIN_TICK_S = 0.002
 #: how long messages gather in the queue before the worker takes them (s) when the run has a lateness bound
 #: (``linger_s``, module docstring): a tenth of the CLI's 50 ms bound, within the 5 ms a verdict may take past it
@@ -140,13 +137,11 @@ class EngineWorker:
         due = getattr(live, "due", None)  # the sink's next release (s, the now() clock), where it tells
         flush = getattr(live, "flush", None)  # hands on what a batch published, where it holds it
         next_tick = _time.monotonic() + self.tick_s
-        ticked = -math.inf  # when (monotonic s) the timer last ran
         last = -math.inf  # receipt time of the last message pushed
         linger, took = self.linger_s, False
         while True:
-            if due is not None:  # a release due: then, but not sooner than MIN_TICK_S after the last timer run
-                mono = _time.monotonic()
-                soon = max(mono + due() - self.now(), ticked + MIN_TICK_S)
+            if due is not None:
+                soon = _time.monotonic() + max(due() - self.now(), MIN_TICK_S)
                 if soon < next_tick:
                     next_tick = soon
             if took and linger > 0:  # let the next messages gather, up to the timer's next run
@@ -195,8 +190,7 @@ class EngineWorker:
                     live.tick(now)
                     if flush is not None:
                         flush()
-                    ticked = _time.monotonic()
-                    next_tick = ticked + self.tick_s
+                    next_tick = _time.monotonic() + self.tick_s
                 # else a message arrived as the clock was read and none was pushed before it: no clock
                 # passes nothing queued, so the tick waits until that message is pushed (the next round)
             if done:
