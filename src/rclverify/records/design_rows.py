@@ -13,15 +13,12 @@ from typing import Annotated, Literal
 
 import msgspec
 
+from rclverify.records.shared_rows import WorkspacePlaceRow
 from rclverify.records.row import DOC, Row
 
 
-class DesignPlaceRow(Row, frozen=True, forbid_unknown_fields=True):
+class DesignPlaceRow(WorkspacePlaceRow, frozen=True, forbid_unknown_fields=True):
     """A place in the workspace: a design file's field or a contract clause."""
-
-    file: Annotated[str, DOC(description="Workspace-relative file.")]
-    line: Annotated[int, DOC(description="Line, 1-based.")]
-    col: Annotated[int, DOC(description="Column, 1-based.")]
 
 
 class DesignStepRow(Row, frozen=True, forbid_unknown_fields=True):

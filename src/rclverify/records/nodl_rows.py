@@ -25,17 +25,14 @@ from typing import Annotated, Literal
 
 import msgspec
 
+from rclverify.records.shared_rows import WorkspacePlaceRow
 from rclverify.records.row import DOC, Row
 
 _DOC = DOC  # a field's description, as the generated JSON Schema shows it
 
 
-class NodlPlaceRow(Row, frozen=True, forbid_unknown_fields=True):
+class NodlPlaceRow(WorkspacePlaceRow, frozen=True, forbid_unknown_fields=True):
     """A place a NoDL finding involves."""
-
-    file: Annotated[str, _DOC(description="Workspace-relative file.")]
-    line: Annotated[int, _DOC(description="Line, 1-based.")]
-    col: Annotated[int, _DOC(description="Column, 1-based.")]
 
 
 class NodlFindingRow(Row, frozen=True, forbid_unknown_fields=True):

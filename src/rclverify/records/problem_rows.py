@@ -42,17 +42,14 @@ import msgspec
 
 from rclverify.records.repair_rows import CexTableRow, CulpritRow, RepairRow
 from rclverify.records.row import DOC, Row, decode_rows
+from rclverify.records.shared_rows import ItemRow
 from rclverify.records.statuses import AnyStatus
 
 _DOC = DOC  # a field's description, as the generated JSON Schema shows it
 
-_ID = "The item's stable id (the anchor the HTML report, SARIF and `rclverify explain` use)."
-
-
-class DiagnosisRow(Row, frozen=True, forbid_unknown_fields=True, omit_defaults=True):
+class DiagnosisRow(ItemRow, frozen=True, forbid_unknown_fields=True, omit_defaults=True):
     """One diagnosis per problem, with repairs checked by Z3 (docs/diagnosis.md)."""
 
-    id: Annotated[str, _DOC(description=_ID)]
     kind: Annotated[str, _DOC(description="What kind of item it is.")]
     node: Annotated[str, _DOC(description="The node's name as the contracts declare it.")]
     status: Annotated[AnyStatus, _DOC(description="Its status.")]
@@ -78,10 +75,9 @@ class DiagnosisRow(Row, frozen=True, forbid_unknown_fields=True, omit_defaults=T
         description="A deadline's: the requirement whose deadline it is.")] = msgspec.UNSET
 
 
-class ProblemMember(Row, frozen=True, forbid_unknown_fields=True, omit_defaults=True):
+class ProblemMember(ItemRow, frozen=True, forbid_unknown_fields=True, omit_defaults=True):
     """An item of a problem row."""
 
-    id: Annotated[str, _DOC(description=_ID)]
     kind: Annotated[str, _DOC(description="What it is: evidence, side-condition, requirement, deadline, lint, ...")]
     status: Annotated[AnyStatus, _DOC(description="The item's own status word.")]
     sentence: Annotated[str, _DOC(description="One sentence for a reader.")]

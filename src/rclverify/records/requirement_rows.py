@@ -40,7 +40,8 @@ import msgspec
 from rclverify.records.deadline_rows import DeadlineRow
 from rclverify.records.strength_rows import LimitedBy
 from rclverify.records.statistics_rows import RequirementRuns
-from rclverify.records.row import DOC, Row
+from rclverify.records.row import DOC
+from rclverify.records.shared_rows import ItemRow
 from rclverify.records.statuses import EvidenceStatus, RequirementVerdict
 
 _DOC = DOC  # a field's description, as the generated JSON Schema shows it
@@ -69,11 +70,9 @@ class WithoutDeadline(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     note: Annotated[str, _DOC(description="Why this verdict, in a sentence.")]
 
 
-class RequirementRow(Row, frozen=True, forbid_unknown_fields=True):
+class RequirementRow(ItemRow, frozen=True, forbid_unknown_fields=True):
     """A requirement with its verdict, the guarantees it is traced to and its Z3 check."""
 
-    id: Annotated[str, _DOC(description="The item's stable id (the anchor the HTML report, SARIF and "
-                                        "`rclverify explain` use).")]
     text: Annotated[str, _DOC(description="The requirement in words.")]
     verdict: Annotated[RequirementVerdict, _DOC(description="What its check found, rolled up with its evidence.")]
     status: Annotated[EvidenceStatus, _DOC(description="Its evidence status: only met is discharged.")]

@@ -33,6 +33,7 @@ from typing import Annotated, Any
 
 import msgspec
 
+from rclverify.records.shared_rows import ItemRow
 from rclverify.records.row import DOC, Row
 from rclverify.records.solvers_rows import Solvers
 from rclverify.records.statuses import EvidenceStatus, SideConditionVerdict
@@ -41,11 +42,9 @@ from rclverify.records.strength_rows import Strength
 _DOC = DOC
 
 
-class SideConditionRow(Row, frozen=True, kw_only=True, omit_defaults=True, forbid_unknown_fields=True):
+class SideConditionRow(ItemRow, frozen=True, kw_only=True, omit_defaults=True, forbid_unknown_fields=True):
     """A side condition of a composition rule, decided by Z3 (docs/calculus.md)."""
 
-    id: Annotated[str, _DOC(description="The item's stable id (the anchor the HTML report, SARIF and "
-                                        "`rclverify explain` use).")]
     node: Annotated[str, _DOC(description="The consumer node.")]
     rule: Annotated[str, _DOC(description="The composition rule (R1-R4).")]
     conjunct: Annotated[str, _DOC(description="The assumption conjunct it discharges, RCL text.")]

@@ -29,6 +29,7 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 
+from rclverify.records.shared_rows import ItemRow
 from rclverify.records.row import DOC, Row
 from rclverify.records.statuses import EVIDENCE_STATUSES, EvidenceStatus
 
@@ -50,11 +51,9 @@ class Meta(Row, frozen=True, forbid_unknown_fields=True):
                                                    "digests, equal inputs.")]
 
 
-class DiagnosisBrief(Row, frozen=True, forbid_unknown_fields=True):
+class DiagnosisBrief(ItemRow, frozen=True, forbid_unknown_fields=True):
     """A diagnosis in short."""
 
-    id: Annotated[str, _DOC(description="The item's stable id (the anchor the HTML report, SARIF and "
-                                        "`rclverify explain` use).")]
     kind: Annotated[str, _DOC(description="What kind of item it is.")]
     sentence: Annotated[str, _DOC(description="One sentence for a reader.")]
     repairs: Annotated[int, _DOC(description="How many repairs Z3 checked.")]
