@@ -52,10 +52,13 @@ import json  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
+import msgspec  # noqa: E402
 import pytest  # noqa: E402
 
 from rclverify.cli.commands import main  # noqa: E402
 from rclverify.model.plan.acknowledged import digest  # noqa: E402
+from rclverify.records.findings import Acknowledged, FindingRow  # noqa: E402
+from rclverify.records.lint_rows import LintRow  # noqa: E402
 
 GAIN = """node Gain {
   inputs( x : INTEGER )
@@ -177,20 +180,22 @@ def test_only_a_warning_can_be_acknowledged_and_lint_binds_by_clause_text():
     from rclverify.model.plan.acknowledged import Acknowledgement, apply_acknowledgements
     from rclverify.lang import ast
     checked = check([parse_text(GAIN, "contracts/gain.rcl")])
-    problem = {"id": "Gain.g1.tautology", "status": "problem", "message": "always true"}
-    lint = {"location": "contracts/gain.rcl:6:21", "code": "W-unused-bound", "severity": "warning",
-            "message": "unused k"}
+    problem = FindingRow(id="Gain.g1.tautology", node="Gain", check="tautology", guarantee=1, status="problem",
+                         message="always true", explanation="")
+    lint = LintRow(location="contracts/gain.rcl:6:21", code="W-unused-bound", severity="warning",
+                   message="unused k")
     at = ast.Loc("contracts/plan.yaml", 3, 5)
     acks = [Acknowledgement("Gain.g1.tautology", "it is meant", at, text="out.y >= in.x and out.y >= 0"),
             Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL | out.y <= in.x + 10)",
                             file="contracts/other.rcl"),
             Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL |  out.y <= in.x + 10)",
                             file="./contracts/gain.rcl")]
-    got = apply_acknowledgements(acks, [problem], [lint], checked)
-    assert [a["status"] for a in got] == ["error", "stale", "ok"]  # refused; another file; white space is no change
-    assert "not a warning" in got[0]["message"] and not problem.get("acknowledged")
-    assert lint["flagged"] == "forall(k in NATURAL | out.y <= in.x + 10)" and lint["acknowledged"]["at"] == \
-        "contracts/plan.yaml:3:5"
+    (found,), (linted,), got = apply_acknowledgements(acks, [problem], [lint], checked)
+    assert [a.status for a in got] == ["error", "stale", "ok"]  # refused; another file; white space is no change
+    assert "not a warning" in got[0].message and found.acknowledged is None and found.flagged == ""
+    assert linted.flagged == "forall(k in NATURAL | out.y <= in.x + 10)" and isinstance(linted.acknowledged,
+                                                                                         Acknowledged)
+    assert linted.acknowledged.at == "contracts/plan.yaml:3:5" and lint.acknowledged is msgspec.UNSET  # a new row
 
 
 @pytest.mark.parametrize("entry, where, said", [
@@ -292,12 +297,13 @@ def test_a_health_acknowledgement_names_its_own_node_file():
     from rclverify.lang import ast
     checked = check([parse_text(GAIN, "contracts/gain.rcl")])
     at = ast.Loc("contracts/plan.yaml", 3, 5)
-    rows = [{"id": "Gain.g1.c2.redundant", "status": "warning", "message": "implied"}]
+    rows = [FindingRow(id="Gain.g1.c2.redundant", node="Gain", check="redundant", guarantee=1, status="warning",
+                       message="implied", explanation="")]
     acks = [Acknowledgement("Gain.g1.c2.redundant", "kept for the reader", at, text="out.y >= 0",
                             file="contracts/other.rcl")]
-    assert [a["status"] for a in apply_acknowledgements(acks, rows, [], checked)] == ["stale"]
-    assert not rows[0].get("acknowledged")
+    (found,), _, got = apply_acknowledgements(acks, rows, [], checked)
+    assert [a.status for a in got] == ["stale"] and found.acknowledged is None and found.flagged == "out.y >= 0"
     acks = [Acknowledgement("W-unused-bound", "kept as written", at, text="forall(k in NATURAL | out.y <= in.x + 10)")]
-    lint = [{"location": "contracts/gain.rcl:6:21", "code": "W-unused-bound", "severity": "warning", "message": "k"}]
-    assert [a["status"] for a in apply_acknowledgements(acks, [], lint, checked)] == ["error"]  # no file: no finding
-    assert not lint[0].get("acknowledged")
+    lint = [LintRow(location="contracts/gain.rcl:6:21", code="W-unused-bound", severity="warning", message="k")]
+    _, (linted,), got = apply_acknowledgements(acks, [], lint, checked)
+    assert [a.status for a in got] == ["error"] and linted.acknowledged is msgspec.UNSET  # no file: no finding

@@ -40,12 +40,9 @@ def acknowledged_rows(ws: Workspace, findings: Sequence[FindingRow], lint: Seque
     :class:`~rclverify.records.lint_rows.LintRow`,
     :class:`~rclverify.records.lint_rows.AcknowledgementRow`), so the report
     holds no key the class does not declare (:class:`msgspec.ValidationError`
-    otherwise: a bug of the build).  The acknowledgements' matching (model/plan/acknowledged.py) marks
-    the rows' JSON objects."""
-    f_rows, l_rows = [f.to_json() for f in findings], [dict(x) for x in lint]
-    acks = apply_acknowledgements(ws.plan.acknowledged, f_rows, l_rows, ws.checked)
-    return ([FindingRow.of(f) for f in f_rows], [LintRow.of(r) for r in l_rows],
-            [AcknowledgementRow.of(a) for a in acks])
+    otherwise: a bug of the build).  The acknowledgements' matching (model/plan/acknowledged.py) reads
+    and gives the records."""
+    return apply_acknowledgements(ws.plan.acknowledged, findings, [LintRow.of(x) for x in lint], ws.checked)
 
 
 def grounding_row(ws: Workspace) -> GroundingRow | None:

@@ -34,7 +34,9 @@ import hashlib
 import posixpath
 import re
 from dataclasses import dataclass
-from typing import Any, Iterable, Mapping, MutableMapping
+from typing import Any, Iterable, Mapping
+
+import msgspec
 
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, error
@@ -42,6 +44,9 @@ from rclverify.lang.types import Checked
 from rclverify.model.plan.document import PlanDocument
 from rclverify.model.plan.errors import plan_error
 from rclverify.lang.printer import to_rcl, expr_to_rcl
+from rclverify.records.findings import Acknowledged, FindingRow
+from rclverify.records.lint_rows import AcknowledgementRow, LintRow
+from rclverify.records.statuses import AcknowledgementStatus
 
 #: ``<Node>.g<k>[.c<j>].<check>`` or ``<Node>.<check>``: a health finding's id (calculus/health/finding.py).
 _HEALTH_ID = re.compile(r"^(?P<node>[A-Za-z_][A-Za-z0-9_]*)(?:\.g(?P<k>\d+)(?:\.c(?P<j>\d+))?)?\.(?P<check>[A-Za-z0-9_-]+)$")
@@ -181,10 +186,10 @@ def _node_text(node: ast.Node) -> str:
     return to_rcl(ast.Spec((), (node,)))
 
 
-def lint_flagged(row: Mapping[str, object], checked: Checked, source: str = "") -> str:
-    """The flagged text of a lint row (``file``/``line``/``col`` or
-    ``location``): the clause or constant whose span holds the location,
-    else the node's whole contract, else the source line ``source`` gives."""
+def lint_flagged(row: LintRow, checked: Checked, source: str = "") -> str:
+    """The flagged text of a lint row (its ``location`` ``file:line:col``): the clause or constant whose
+    span holds the location, else the node's whole contract, else the source line ``source`` gives, else
+    the row's message."""
     file, line, col = _where(row)
     for spec in checked.specs:
         if spec.file != file:
@@ -200,7 +205,7 @@ def lint_flagged(row: Mapping[str, object], checked: Checked, source: str = "") 
                 if _within(c.loc, line, col):
                     return expr_to_rcl(c.formula)
             return _node_text(n)
-    return source or str(row.get("message", ""))
+    return source or row.message
 
 
 def conjuncts(e: ast.Expr) -> list[ast.Expr]:
@@ -211,7 +216,7 @@ def conjuncts(e: ast.Expr) -> list[ast.Expr]:
     return [e]
 
 
-def _lint_place(row: Mapping[str, object], checked: Checked) -> tuple[str, str | None]:
+def _lint_place(row: LintRow, checked: Checked) -> tuple[str, str | None]:
     """``(file, node)`` of a lint row: its file as :func:`_path` writes it and
     the node whose span holds its location (``None``: outside every node)."""
     file, line, col = _where(row)
@@ -223,51 +228,47 @@ def _lint_place(row: Mapping[str, object], checked: Checked) -> tuple[str, str |
     return _path(file), None
 
 
-def _answers(a: Acknowledgement, kind: str, row: Mapping[str, object], checked: Checked) -> bool:
+#: A row a warning may be: a health finding's or a lint diagnostic's.
+Warned = FindingRow | LintRow
+
+
+def _answers(a: Acknowledgement, row: Warned, checked: Checked) -> bool:
     """Does ``a`` name the finding ``row``: its id (health) or its code, file
     and node (lint)?  Its text is compared by :meth:`Acknowledgement.binds`."""
-    if kind == "health":
-        if row.get("id") != a.warning:
+    if isinstance(row, FindingRow):
+        if row.id != a.warning:
             return False
         owner = health_node(a.warning)
         cn = checked.nodes.get(owner or "")
         return (a.node is None or a.node == owner) and (
             a.file is None or (cn is not None and _same(cn.node.loc.file, a.file)))
-    if str(row.get("code", "")) != a.warning or a.file is None:
+    if row.code != a.warning or a.file is None:
         return False
     file, node = _lint_place(row, checked)
     return _same(file, a.file) and (a.node is None or node == a.node)
 
 
-def _number(value: object) -> int:
-    """``int(value)`` of a row's line or column (a number, or its text); ``TypeError`` for anything else."""
-    if isinstance(value, (int, float, str)):
-        return int(value)
-    raise TypeError(f"a line or column is a number, not {value!r}")
-
-
-def _where(row: Mapping[str, object]) -> tuple[str, int, int]:
-    if "file" in row:
-        return str(row["file"]), _number(row.get("line", 0)), _number(row.get("col", 0))
-    file, line, col = (str(row.get("location", "")).rsplit(":", 2) + ["0", "0"])[:3]
+def _where(row: LintRow) -> tuple[str, int, int]:
+    """``(file, line, col)`` of a lint row's ``location`` (0 for a line or column it does not give)."""
+    file, line, col = (row.location.rsplit(":", 2) + ["0", "0"])[:3]
     return file, int(line) if line.isdigit() else 0, int(col) if col.isdigit() else 0
 
 
-def health_flagged(finding: Mapping[str, object], checked: Checked) -> str:
+def health_flagged(finding: FindingRow, checked: Checked) -> str:
     """The flagged text of a health finding: conjunct ``j`` of guarantee
     ``k`` (``<Node>.g<k>.c<j>.<check>``), guarantee ``k``
     (``<Node>.g<k>.<check>``), the node's contract (``<Node>.<check>``), or
     the finding's message when its id names no node of ``checked``."""
-    m = _HEALTH_ID.match(str(finding.get("id", "")))
+    m = _HEALTH_ID.match(finding.id)
     cn = checked.nodes.get(m["node"]) if m else None
     if m is None or cn is None:
-        return str(finding.get("message", ""))
+        return finding.message
     node = cn.node
     if m["k"] is None:
         return _node_text(node)
     k = int(m["k"])
     if not 1 <= k <= len(node.guarantees):
-        return str(finding.get("message", ""))
+        return finding.message
     g = node.guarantees[k - 1]
     if m["j"] is None:
         return expr_to_rcl(g.formula)
@@ -276,71 +277,86 @@ def health_flagged(finding: Mapping[str, object], checked: Checked) -> str:
     return expr_to_rcl(parts[j - 1]) if 1 <= j <= len(parts) else expr_to_rcl(g.formula)
 
 
-def _is_warning(kind: str, row: Mapping[str, object]) -> bool:
-    return str(row.get("status" if kind == "health" else "severity", "")).lower() == "warning"
+def _word(row: Warned) -> str:
+    """What a row is: a health finding's status, a lint diagnostic's severity."""
+    return row.status if isinstance(row, FindingRow) else row.severity
 
 
-def _ident(kind: str, row: Mapping[str, object]) -> str:
-    return str(row["id"]) if kind == "health" else f"{row.get('location', '')}:{row.get('code', '')}"
+def _is_warning(row: Warned) -> bool:
+    return _word(row).lower() == "warning"
 
 
-def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[MutableMapping[str, object]],
-                           lint_rows: Iterable[MutableMapping[str, object]], checked: Checked) -> list[dict[str, Any]]:
+def _ident(row: Warned) -> str:
+    return row.id if isinstance(row, FindingRow) else f"{row.location}:{row.code}"
+
+
+def _flagged(row: Warned) -> tuple[str, str]:
+    """``(flagged text, sha256)`` a row was marked with (:func:`_marked`; ``""`` when it is no warning)."""
+    flagged, sha = row.flagged, row.sha256
+    return (flagged if isinstance(flagged, str) else ""), (sha if isinstance(sha, str) else "")
+
+
+def _marked(row: Warned, checked: Checked) -> Warned:
+    """``row`` without what an earlier pass marked (rows kept between runs in one process start clean),
+    then, when it is a warning, with its flagged text and that text's digest."""
+    if isinstance(row, FindingRow):
+        clean: Warned = msgspec.structs.replace(row, flagged="", sha256="", acknowledged=None)
+    else:
+        clean = msgspec.structs.replace(row, flagged=msgspec.UNSET, sha256=msgspec.UNSET, acknowledged=msgspec.UNSET)
+    if not _is_warning(clean):
+        return clean
+    flagged = health_flagged(clean, checked) if isinstance(clean, FindingRow) else lint_flagged(clean, checked)
+    return msgspec.structs.replace(clean, flagged=flagged, sha256=digest(flagged))
+
+
+def apply_acknowledgements(acks: Iterable[Acknowledgement], findings: Iterable[FindingRow],
+                           lint_rows: Iterable[LintRow], checked: Checked
+                           ) -> tuple[list[FindingRow], list[LintRow], list[AcknowledgementRow]]:
     """Match the plan's acknowledgements with this run's warnings.
 
-    ``findings`` are the report's health rows (``id``, ``status``,
-    ``message``), ``lint_rows`` its lint rows (``location``, ``code``,
-    ``severity``, ``message``).  Every warning row gets ``flagged`` (its
-    flagged text) and ``sha256`` (its digest), and, when an acknowledgement
-    binds it, ``acknowledged`` = ``{"reason", "at"}`` (``at``: the plan
-    entry's ``file:line:col``).  Returns one row per acknowledgement:
-    ``{"warning", "reason", "at", "status", "message", "matched"}`` with
-    ``status`` ``ok`` (it acknowledges the ``matched`` warnings), ``stale``
-    (it matches no warning, or the flagged text changed: the warning is
-    raised again) or ``error`` (it names an item that is not a warning, or
-    it cannot be tied to one finding: a lint code without ``file``, or one
+    ``findings`` are the report's health rows, ``lint_rows`` its lint rows.
+    Returns ``(findings, lint rows, acknowledgements)``: new rows in the
+    same order, every warning row with ``flagged`` (its flagged text) and
+    ``sha256`` (its digest), and, when an acknowledgement binds it,
+    ``acknowledged`` (``reason``, ``at``: the plan entry's
+    ``file:line:col``); and one row per acknowledgement with ``status``
+    ``ok`` (it acknowledges the ``matched`` warnings), ``stale`` (it
+    matches no warning, or the flagged text changed: the warning is raised
+    again) or ``error`` (it names an item that is not a warning, or it
+    cannot be tied to one finding: a lint code without ``file``, or one
     binding warnings of several nodes; it then accepts none).  A finding is
     matched by its id (health; with ``file``, the node's file too) or by its
     code, file and node (lint), then by its flagged text."""
-    rows: list[tuple[str, MutableMapping[str, object]]] = (
-        [("health", f) for f in findings] + [("lint", x) for x in lint_rows])
-    for kind, r in rows:
-        for k in ("acknowledged", "flagged", "sha256"):  # rows kept between runs in one process start clean
-            r.pop(k, None)
-        if _is_warning(kind, r):
-            flagged = health_flagged(r, checked) if kind == "health" else lint_flagged(r, checked)
-            r["flagged"] = flagged
-            r["sha256"] = digest(flagged)
-    out = []
+    given: list[Warned] = [*findings, *lint_rows]
+    rows = [_marked(r, checked) for r in given]
+    out: list[AcknowledgementRow] = []
     for a in acks:
-        cands = [(k, r) for k, r in rows if _answers(a, k, r, checked)]
-        warns = [(k, r) for k, r in cands if _is_warning(k, r)]
-        bound = [(k, r) for k, r in warns if a.binds(str(r["flagged"]))]
-        owners = {_lint_place(r, checked)[1] for k, r in bound if k == "lint"}
+        cands = [i for i, r in enumerate(rows) if _answers(a, r, checked)]
+        warns = [i for i in cands if _is_warning(rows[i])]
+        bound = [i for i in warns if a.binds(_flagged(rows[i])[0])]
+        owners = {_lint_place(r, checked)[1] for r in (rows[i] for i in bound) if isinstance(r, LintRow)}
         at = f"{a.loc.file}:{a.loc.line}:{a.loc.col}"
         wide = _too_wide(a, owners)
         if wide:
-            out.append({"warning": a.warning, "reason": a.reason, "at": at, "status": "error", "message": wide,
-                        "matched": []})
+            out.append(AcknowledgementRow(a.warning, a.reason, at, "error", wide, []))
             continue
-        for _, r in bound:
-            r["acknowledged"] = {"reason": a.reason, "at": at}
+        for i in bound:
+            rows[i] = msgspec.structs.replace(rows[i], acknowledged=Acknowledged(a.reason, at))
+        status: AcknowledgementStatus
         if bound:
-            status, msg = "ok", f"acknowledges {', '.join(_ident(k, r) for k, r in bound)}: {a.reason}"
+            status, msg = "ok", f"acknowledges {', '.join(_ident(rows[i]) for i in bound)}: {a.reason}"
         elif warns:
-            now = "; ".join(f"`{r['flagged']}` (sha256 {str(r['sha256'])[:16]})" for _, r in warns[:3])
+            now = "; ".join(f"`{_flagged(rows[i])[0]}` (sha256 {_flagged(rows[i])[1][:16]})" for i in warns[:3])
             status, msg = "stale", (f"the text it acknowledged changed: {a.warning} now flags {now}; the warning is "
                                     "raised again (read it, then bind the acknowledgement to the new text or drop it)")
         elif cands:
-            k, r = cands[0]
-            word = r.get("status" if k == "health" else "severity")
+            word = _word(rows[cands[0]])
             status, msg = "error", (f"{a.warning} is {word}, not a warning: only a warning can be acknowledged as an "
                                     "accepted risk (an error or an undecided check must be answered by a fix or evidence)")
         else:
             status, msg = "stale", f"matches no warning of this run ({a.warning}): remove it from the plan"
-        out.append({"warning": a.warning, "reason": a.reason, "at": at, "status": status, "message": msg,
-                    "matched": [_ident(k, r) for k, r in bound]})
-    return out
+        out.append(AcknowledgementRow(a.warning, a.reason, at, status, msg, [_ident(rows[i]) for i in bound]))
+    return ([r for r in rows if isinstance(r, FindingRow)], [r for r in rows if isinstance(r, LintRow)], out)
 
 
 def _too_wide(a: Acknowledgement, owners: set[str | None]) -> str:
@@ -355,11 +371,11 @@ def _too_wide(a: Acknowledgement, owners: set[str | None]) -> str:
     return ""
 
 
-def hint(kind: str, row: Mapping[str, object]) -> str:
+def hint(row: Warned) -> str:
     """The plan entry that would acknowledge the warning ``row`` (one YAML
     flow mapping; ``reason`` left for the user to write)."""
-    name = row["id"] if kind == "health" else row.get("code", "")
+    name = row.id if isinstance(row, FindingRow) else row.code
     where = ""
-    if kind == "lint":  # a lint code is tied to its file (node: too when the file holds several nodes)
+    if isinstance(row, LintRow):  # a lint code is tied to its file (node: too when the file holds several nodes)
         where = f"file: {_where(row)[0]}, "
-    return f'- {{warning: {name}, {where}sha256: {str(row.get("sha256", ""))[:16]}, reason: "..."}}'
+    return f'- {{warning: {name}, {where}sha256: {_flagged(row)[1][:16]}, reason: "..."}}'
