@@ -13,12 +13,13 @@ import msgspec
 from rclverify.diagnosis.code_repair import checked_repairs, repaired_line
 from rclverify.diagnosis.constants import hoare_repair
 from rclverify.diagnosis.hoare_tokens import hoare_token_repairs
-from rclverify.diagnosis.monitor_repair import report_repairs
+from rclverify.diagnosis.monitor_repair import MonitorRepairs, report_repairs
 from rclverify.diagnosis.record import diagnosis_record, guarantee_source
 from rclverify.diagnosis.repair_cache import RepairCache
 from rclverify.diagnosis.shapes import ReportRows
 from rclverify.diagnosis.table import counterexample_table
 from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.monitored_run import MonitoredRun
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import DiagnosisRow
 from rclverify.records.stage_records import Culprit, Repair
@@ -45,7 +46,7 @@ def _computed_line(obligations: Sequence[ObligationRow], evidence: Sequence[Evid
     return ""
 
 
-def _generated_handler(ws: Any, node: str, monitoring: Mapping[str, object]) -> Any:
+def _generated_handler(ws: Any, node: str, monitoring: MonitoredRun) -> Any:
     """The handler of ``node``'s generated logic.py that published the first
     violating message (:func:`rclverify.diagnosis.handlers.violating_handler`),
     ``None`` for a node without generated code or a run it cannot place."""
@@ -89,13 +90,13 @@ def _monitors_payload(ws: Any, oid: str) -> MonitorsPayload | None:
     return monitors_payload(ev.backend, ev.details) if ev is not None and not problem else None
 
 
-def _run_repairs(ws: Any, e: EvidenceRow, node: str, cache: RepairCache) -> dict[str, Any]:
+def _run_repairs(ws: Any, e: EvidenceRow, node: str, cache: RepairCache) -> MonitorRepairs:
     """The checked code repairs of the failed monitored run ``e`` of ``node`` (:func:`report_repairs`, its
-    record's payload and its obligation's ``data``); ``{}`` for a run that did not fail or whose record is
-    not the monitors' payload."""
+    record's payload and its obligation's ``data``); none (nothing asked) for a run that did not fail or
+    whose record is not the monitors' payload."""
     payload = _monitors_payload(ws, e.obligation) if e.status == "failed" else None
     if payload is None:
-        return {}
+        return MonitorRepairs()
     return report_repairs(ws, e.obligation, node, _obligation_record(ws, node, e.obligation).get("data") or {},
                           payload, cache)
 
@@ -115,15 +116,15 @@ def evidence_record(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRo
     where = f"guarantee {k} of {node} ({src})" if k else f"the contract of {node} ({o.source if o is not None else ''})"
     if backend == "hoare" and e.status == "failed" and o is not None:
         return _hoare(ws, report, e, o, cache)
-    mon = e.monitoring
-    fv = mon.get("first_violation")
-    if backend == "monitors" and fv:
-        gk = fv.get("guarantee")
+    mon = MonitoredRun.of(e.monitoring)
+    fv = mon.first_violation
+    if backend == "monitors" and fv is not None:
+        gk = fv.guarantee
         gtext, gsrc = guarantee_source(report, node, gk) if gk else ("", "")
-        sentence = (f"In {mon.get('trace', 'the trace')}, the output at {fv.get('where')} (t = {fv.get('time')} s) "
-                    f"answering the input at {fv.get('trigger_where')} violates guarantee {gk} of {node} ({gsrc})"
-                    f"; {mon.get('counts', {}).get('violated', '?')} message(s) of the run violate the contract (each: `rclverify explain OBLIGATION#N`).")
-        cul: list[Culprit] = [{"what": f"event {fv.get('where')}", "source": fv.get("where", ""), "text": ""},
+        sentence = (f"In {mon.trace if mon.trace is not None else 'the trace'}, the output at {fv.where} (t = {fv.time} s) "
+                    f"answering the input at {fv.trigger_where} violates guarantee {gk} of {node} ({gsrc})"
+                    f"; {mon.counts.get('violated', '?')} message(s) of the run violate the contract (each: `rclverify explain OBLIGATION#N`).")
+        cul: list[Culprit] = [{"what": f"event {fv.where}", "source": fv.where or "", "text": ""},
                {"what": f"guarantee {gk} of {node}", "source": gsrc, "text": gtext}]
         h = _generated_handler(ws, node, mon)  # generated code: the logic.py handler that published it
         if h is not None:
@@ -140,14 +141,13 @@ def evidence_record(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRo
                 cul.insert(0, {"what": f"{computed}: the line where the failing output goes wrong (property test)",
                                "source": computed, "text": ""})
         found = _run_repairs(ws, e, node, cache)
-        if found.get("line") and found.get("repairs"):  # the line the first checked repair edits: the slip's
-            sentence = sentence[:-1] + f"; the first repair checked on the run edits {found['line']}."
-            cul.insert(0, {"what": f"{found['line']}: the line the first checked repair edits (the node re-run on "
-                           "the run's questions)", "source": found["line"], "text": ""})
+        if found.line and found.repairs:  # the line the first checked repair edits: the slip's
+            sentence = sentence[:-1] + f"; the first repair checked on the run edits {found.line}."
+            cul.insert(0, {"what": f"{found.line}: the line the first checked repair edits (the node re-run on "
+                           "the run's questions)", "source": found.line, "text": ""})
         return diagnosis_record(e.obligation, "monitor", node, e.status, sentence, culprits=cul,
-                                counterexample=counterexample_table(fv.get("values"), node), guarantee=gk,
-                                repairs=list(found.get("repairs") or []),
-                                not_offered=[str(found["why"])] if found.get("why") else msgspec.UNSET)
+                                counterexample=counterexample_table(fv.values, node), guarantee=gk,
+                                repairs=found.repairs, not_offered=[found.why] if found.why else msgspec.UNSET)
     ce = e.counterexample
     if backend == "property_tests" and ce is not None:
         cex = {kk: v for kk, v in ce.items() if kk not in _META_KEYS}

@@ -90,26 +90,26 @@ def monitor_repairs(ws: Any, node: str, data: Mapping[str, Any], payload: Monito
 
 
 def report_repairs(ws: Any, oid: str, node: str, data: Mapping[str, Any], payload: MonitorsPayload,
-                   cache: Any) -> dict[str, Any]:
+                   cache: Any) -> MonitorRepairs:
     """:func:`monitor_repairs` as the report's diagnosis asks it, for the failed obligation ``oid`` of ``node``
-    (``data``: its record's ``data``; ``payload``: its evidence record's), as JSON (``repairs``, ``line``, ``why``); ``{}`` when the obligation
-    names no implementation.  Kept in ``cache`` (the diagnosis cache: ``get(key, make, extra_file)``), keyed by
+    (``data``: its record's ``data``; ``payload``: its evidence record's); none (nothing asked) when the
+    obligation names no implementation.  Kept in ``cache`` (the diagnosis cache: ``get(key, make, extra_file)``), keyed by
     the run's and the implementation's sha256 and the run's verdict counts, unless no ROS 2 Python was found
     (nothing is asked then, and the answer is the environment's)."""
     from rclverify.core.cache import file_digest  # deferred: start-up (the cache layer)
     from rclverify.runtime.rclpy_source.python import ros2_python  # deferred: start-up (only for a named implementation)
     impl = str(data.get("implementation") or "")
     if not impl:
-        return {}
+        return MonitorRepairs()
     python = ros2_python()
     if python is None:
-        return asdict(monitor_repairs(ws, node, data, payload, None))
+        return monitor_repairs(ws, node, data, payload, None)
     trace = str(data.get("trace") or "")
     digest = file_digest(ws.path(trace)) if trace and ws.path(trace).is_file() else ""
     counts = dict(payload.monitoring.counts) if payload.monitoring is not None else None
     key = ["run", oid, node, impl, trace, digest, counts, data.get("mapping")]
     got = cache.get(key, lambda: asdict(monitor_repairs(ws, node, data, payload, python)), impl.rpartition(":")[0])
-    return dict(got) if isinstance(got, dict) else {}
+    return MonitorRepairs(**got) if isinstance(got, dict) else MonitorRepairs()  # kept as JSON: its fields
 
 
 def rejudged_applied(ws: Any, diagnosis: DiagnosisRow, repair: RepairRow,

@@ -24,7 +24,7 @@ grounding finding into
 into :mod:`.sarif_view`'s runs and the argument's elements into
 :class:`~rclverify.report.argument.model.ElementRecord` (files of their own: an
 element, rule or result of another shape is left out).  A monitored run's
-violations (the monitors' payload) by :class:`~.explain_items.MonitoredRun`.  A finding, an obligation and a problem are printed by
+violations (the monitors' payload) by :class:`~rclverify.records.monitored_run.MonitoredRun`.  A finding, an obligation and a problem are printed by
 :mod:`.explain_items`: each field is printed or named in the record's
 ``INTERNAL_TO["explain"]`` with the reason (tests/records/test_record_shapes.py).
 A report that does not decode raises :class:`msgspec.ValidationError` (a
@@ -45,9 +45,10 @@ from rclverify.records.report_record import AssuranceReport
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.report.argument.model import ElementRecord
 from rclverify.report.diagnosis_text import clause_cut, explain_lines as diagnosis_lines, natural_sorted
-from rclverify.report.explain_items import (MonitoredRun, finding_lines, obligation_lines, problem_lines,
-                                            side_condition_lines, violation_id_lines, violation_lines)
+from rclverify.report.explain_items import (finding_lines, obligation_lines, problem_lines, side_condition_lines,
+                                            violation_id_lines, violation_lines)
 from rclverify.report.explain_items import requirement_lines as requirement_lines  # rclverify requirements prints it
+from rclverify.records.monitored_run import MonitoredRun
 from rclverify.records.records import SEVERITY
 from rclverify.report.sarif_view import ResultView, RuleView, runs_of
 

@@ -11,7 +11,8 @@ here or named in its record module's ``INTERNAL_TO["explain"]`` with the
 reason it is not (tests/records/test_record_shapes.py).  What a record keeps
 as JSON is decoded into the reader's Struct: a requirement's check into
 :class:`~rclverify.records.requirement_check.RequirementCheckRow`, its temporal
-check into :class:`_Temporal`, a monitored run's record into :class:`MonitoredRun`.  Each
+check into :class:`_Temporal`, a monitored run's record into
+:class:`~rclverify.records.monitored_run.MonitoredRun`.  Each
 function returns the lines to print, two spaces indenting what belongs to
 the item's first line.
 """
@@ -24,6 +25,7 @@ import msgspec
 from rclverify.diagnosis.table import counterexample_rows
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.findings import Acknowledged, FindingRow
+from rclverify.records.monitored_run import MonitoredRun
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.problem_rows import ProblemRow
 from rclverify.records.requirement_check import RequirementCheckRow
@@ -77,36 +79,6 @@ def requirement_lines(row: RequirementRow | Mapping[str, Any]) -> list[str]:
         out.append(f"    {c.counterexample_note}")
     out += [f"    did not prevent it: {p.label}: {p.text}  ({p.source})" for p in c.failed_to_prevent]
     return out
-
-
-class Violation(msgspec.Struct, frozen=True):
-    """A violation a monitored run kept (backends/monitors/shapes.py ``Violation``), as printed: where and
-    when (``time`` in seconds, as written), the guarantee (1-based) and its formula, why, the values read,
-    and the question it answered when there was one."""
-
-    where: str | None = None
-    time: int | float | None = None
-    guarantee: int | None = None
-    formula: str = ""
-    reason: str = ""
-    values: dict[str, object] | None = None
-    trigger_where: str | None = None
-    trigger_time: int | float | None = None
-
-
-class MonitoredRun(msgspec.Struct, frozen=True):
-    """What is printed of an evidence row's ``monitoring`` (the monitors backend's record of a run,
-    backends/monitors/summary.py): the run, the violations it kept and how many more it counted."""
-
-    trace: str | None = None
-    violations: list[Violation] = []
-    violations_dropped: int = 0
-
-    @classmethod
-    def of(cls, monitoring: Mapping[str, Any]) -> MonitoredRun:
-        """``monitoring`` (``{}`` for a record of another backend) decoded, a key written ``null`` at its
-        default; raises :class:`msgspec.ValidationError` for a value of another type."""
-        return msgspec.convert({k: v for k, v in monitoring.items() if v is not None}, cls)
 
 
 def violation_id_lines(key: str, m: MonitoredRun) -> list[str]:

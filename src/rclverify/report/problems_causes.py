@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 
+from rclverify.records.monitored_run import MonitoredRun
 from rclverify.records.problem_rows import DiagnosisRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.side_condition_rows import SideConditionRow
@@ -76,10 +77,10 @@ def assumption_violations(report: AssuranceReport, members: list[Rooted], anchor
     nodes = {o.id: o.node for o in report.obligations}
     at = {m.id: i for i, (m, _) in enumerate(members)}
     for e in report.evidence:
-        first = (e.monitoring or {}).get("first_assumption_violation")
-        if not first or e.status == "discharged":
+        first = MonitoredRun.of(e.monitoring).first_assumption_violation if e.status != "discharged" else None
+        if first is None:
             continue
-        ob, text, blame = e.obligation, str(first.get("assumption", "")), str(first.get("blame", ""))
+        ob, text, blame = e.obligation, first.assumption, first.blame or ""
         causes = [sc for sc in failed if sc.node == nodes.get(ob) and sc.conjunct in text
                   and any(p in blame for p in _producers(sc))]
         if not causes:
@@ -92,7 +93,7 @@ def assumption_violations(report: AssuranceReport, members: list[Rooted], anchor
             members[i] = (members[i][0], roots)
         else:
             members.append((Member(id=ob, kind="evidence", status=e.status, anchor=anchor("ev", ob), diagnosis=False,
-                                   sentence=(f"{ob}: the assumption `{text}` is violated at {first.get('where', '?')} "
-                                             f"(t = {first.get('time', '?')} s), blamed on the {blame}: the failed "
+                                   sentence=(f"{ob}: the assumption `{text}` is violated at {'?' if first.where is None else first.where} "
+                                             f"(t = {'?' if first.time is None else first.time} s), blamed on the {blame}: the failed "
                                              f"side condition {', '.join(ids)} lets such values through."),
                                    consequence_of=ids), roots))

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
+from rclverify.records.monitored_run import AssumptionViolation, MonitoredRun
 from rclverify.records.problem_rows import DiagnosisRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.report.problems_places import Member
@@ -34,9 +35,13 @@ def joins(diagnoses: Sequence[DiagnosisRow]) -> dict[str, str]:
     return out
 
 
-def _violation(j: str, first: dict[str, object]) -> str:
-    return (f"{j}: the assumption `{first.get('assumption', '')}` is violated at {first.get('where', '?')} "
-            f"(t = {first.get('time', '?')} s), blamed on the {first.get('blame', '?')}.")
+def _violation(j: str, first: AssumptionViolation | None) -> str:
+    """The sentence of evidence ``j`` whose run violated the node's assumption first at ``first`` (``?``
+    for what the run did not say)."""
+    where, time, blame = (first.where, first.time, first.blame) if first is not None else (None, None, None)
+    return (f"{j}: the assumption `{first.assumption if first is not None else ''}` is violated at "
+            f"{'?' if where is None else where} (t = {'?' if time is None else time} s), blamed on the "
+            f"{'?' if blame is None else blame}.")
 
 
 def extra_members(report: AssuranceReport, diagnoses: Sequence[DiagnosisRow], covered: set[str],
@@ -63,8 +68,8 @@ def extra_members(report: AssuranceReport, diagnoses: Sequence[DiagnosisRow], co
                 m = Member(j, f"contract health: {f.check}", f.status, f.message, anchor("finding", j), False)
             elif j in evidence:
                 e = evidence[j]
-                first = (e.monitoring or {}).get("first_assumption_violation") or {}
-                m = Member(j, "evidence", e.status, _violation(j, first), anchor("ev", j), False)
+                m = Member(j, "evidence", e.status, _violation(j, MonitoredRun.of(e.monitoring).first_assumption_violation),
+                           anchor("ev", j), False)
             else:
                 continue
             out.append((m, d.id))

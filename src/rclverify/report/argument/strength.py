@@ -39,6 +39,7 @@ import msgspec
 
 from rclverify.model.plan.declarations import DECLARATIONS, STRENGTHS
 from rclverify.records.evidence_rows import EvidenceRow
+from rclverify.records.monitored_run import MonitoredRun
 from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.records.strength_rows import Strength
 
@@ -104,12 +105,11 @@ def evidence_strength(row: EvidenceRow) -> Strength:
         cov = coverage_text(ex.get("coverage") or {})
         detail += f"; coverage of the assumption's ranges: {cov}" if cov else ""
     elif kind == "observed":
-        m = row.monitoring  # the monitors' run summary (docs/monitors.md, its own shape)
-        c = m.get("counts") or {}
-        answered = int(c.get("satisfied", 0) or 0) + int(c.get("violated", 0) or 0)
-        detail = f"{answered} verdicts on messages (satisfied or violated), {m.get('events_read', 0)} events read"
-        if isinstance(m.get("duration_s"), (int, float)):
-            detail += f" over {m['duration_s']:g} s of trace time"
+        m = MonitoredRun.of(row.monitoring)  # the monitors' run (docs/monitors.md), decoded
+        answered = m.counts.get("satisfied", 0) + m.counts.get("violated", 0)
+        detail = f"{answered} verdicts on messages (satisfied or violated), {m.events_read} events read"
+        if m.duration_s is not None:
+            detail += f" over {m.duration_s:g} s of trace time"
         group = stats.get("group") if stats is not None else None
         if stats is not None and isinstance(group, Mapping) and isinstance(group.get("bound"), (int, float)):
             # the runs of its node and environment, counted: their bound replaces the convention
