@@ -68,9 +68,11 @@ class TraceVerdictRow(msgspec.Struct, frozen=True):
 
 class TraceCheckRow(msgspec.Struct, frozen=True):
     """One recorded run checked against a temporal requirement
-    (:class:`rclverify.records.stage_records.TraceRow`): the trace, the evidence status, the verdict."""
+    (:class:`rclverify.records.stage_records.TraceRow`): the trace, its sha256 (the run's identity, by
+    which the statistics count it once), the evidence status, the verdict."""
 
     trace: str | None = None
+    sha256: str | None = None
     status: str | None = None
     verdict: TraceVerdictRow | None = None
 
