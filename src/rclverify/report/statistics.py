@@ -23,6 +23,7 @@ import msgspec
 
 from rclverify.records.evidence_rows import EvidenceRow
 from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.records.requirement_rows import RequirementRow
 from rclverify.records.statistics_rows import RequirementRuns, StatisticsRow
 from rclverify.report.shapes import RunGroupBound
@@ -101,11 +102,11 @@ def requirement_statistics(req: RequirementRow, target: Any, where: Mapping[str,
     tag: one row each with the counts, the bound (at the target's level, else
     95 %) and, with a ``target``, its decision."""
     groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
-    for t in req.check.get("traces") or []:
-        env, origin = where.get(str(t.get("trace")), (UNSTATED, "operation"))
-        status = str(t.get("status"))
+    for t in RequirementCheckRow.of(req.check).traces:
+        env, origin = where.get(str(t.trace), (UNSTATED, "operation"))
+        status = str(t.status)
         groups.setdefault((env, origin), []).append({
-            "sha256": t.get("sha256"), "status": status, "violations": int(status == "failed"),
+            "sha256": t.sha256, "status": status, "violations": int(status == "failed"),
             "inconclusive": int(status == "inconclusive"), "answers": 1})
     out: list[RequirementRuns] = []
     for (env, origin), rows in sorted(groups.items()):
