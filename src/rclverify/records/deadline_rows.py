@@ -39,6 +39,7 @@ from typing import Annotated, Any
 import msgspec
 
 from rclverify.records.row import DOC, Row
+from rclverify.records.shared_rows import GuaranteeRefRow
 from rclverify.records.solvers_rows import Solvers
 from rclverify.records.statuses import DeadlineVerdict, EvidenceStatus
 
@@ -59,11 +60,9 @@ class HopTimeMargin(Row, frozen=True, forbid_unknown_fields=True):
     unanswered: Annotated[int, _DOC(description="Triggers never answered, over every run (they have no margin).")]
 
 
-class DeadlineHop(Row, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
+class DeadlineHop(GuaranteeRefRow, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
     """One timed guarantee of a deadline's chain (report/deadlines.py)."""
 
-    node: Annotated[str, _DOC(description="The node.")]
-    guarantee: Annotated[int, _DOC(description="The guarantee, 1-based.")]
     trigger: Annotated[str, _DOC(description="Its trigger, in.x.")]
     outputs: Annotated[list[str], _DOC(description="The outputs it answers with.")]
     within_s: Annotated[str, _DOC(description="Its deadline in seconds, an exact fraction.")]

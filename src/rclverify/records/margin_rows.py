@@ -42,15 +42,14 @@ import msgspec
 
 from rclverify.records.deadline_rows import HopTimeMargin
 from rclverify.records.row import DOC, Row
+from rclverify.records.shared_rows import GuaranteeRefRow
 
 _DOC = DOC
 
 
-class NearMissRow(Row, frozen=True, forbid_unknown_fields=True):
+class NearMissRow(GuaranteeRefRow, frozen=True, forbid_unknown_fields=True):
     """A guarantee held on its runs with a margin below the plan's near-miss threshold (docs/monitors.md, "Near misses")."""
 
-    node: Annotated[str, _DOC(description="The node.")]
-    guarantee: Annotated[int, _DOC(description="The guarantee, 1-based.")]
     kind: Annotated[Literal["value", "time"], _DOC(description="value: a space margin; time: a deadline's time margin.")]
     margin: Annotated[float, _DOC(description="The smallest margin on the run (in unit; seconds for time).")]
     threshold: Annotated[float, _DOC(description="The plan's threshold, in the same unit.")]
@@ -75,11 +74,9 @@ class MarginBounds(Row, frozen=True, forbid_unknown_fields=True):
                     "rank falls past them, or on answers held without a distance).")]
 
 
-class MarginRow(Row, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
+class MarginRow(GuaranteeRefRow, frozen=True, omit_defaults=True, forbid_unknown_fields=True):
     """A guarantee's margins over every recorded run: the smallest, where, and the distribution of its answers' margins (docs/semantics.md, "Margins over runs")."""
 
-    node: Annotated[str, _DOC(description="The node.")]
-    guarantee: Annotated[int, _DOC(description="The guarantee, 1-based.")]
     formula: Annotated[str, _DOC(description="The guarantee's text.")]
     source: Annotated[str, _DOC(description="The guarantee's place, file:line:col (empty when unknown).")]
     margin: Annotated[float | None, _DOC(

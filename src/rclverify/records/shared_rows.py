@@ -6,6 +6,8 @@ itself: a base's fields come first, in the order declared):
 * :class:`WorkspacePlaceRow`: a place in the workspace (a design file's
   field, a contract clause, a NoDL finding's place): ``file``, ``line``,
   ``col``;
+* :class:`GuaranteeRefRow`: a guarantee of a node: ``node`` and its
+  1-based ``guarantee``;
 * :class:`ItemRow`: a report item a reader can point at: its stable
   ``id``, the anchor the HTML report, SARIF and ``rclverify explain`` use.
 """
@@ -24,6 +26,13 @@ class WorkspacePlaceRow(Row, frozen=True, forbid_unknown_fields=True):
     col: Annotated[int, DOC(description="Column, 1-based.")]
 
 
+class GuaranteeRefRow(Row, frozen=True, forbid_unknown_fields=True):
+    """A guarantee of a node."""
+
+    node: Annotated[str, DOC(description="The node.")]
+    guarantee: Annotated[int, DOC(description="The guarantee, 1-based.")]
+
+
 class ItemRow(Row, frozen=True, forbid_unknown_fields=True):
     """A report item with its stable id."""
 
@@ -31,4 +40,4 @@ class ItemRow(Row, frozen=True, forbid_unknown_fields=True):
                                        "`rclverify explain` use).")]
 
 
-__all__ = ["ItemRow", "WorkspacePlaceRow"]
+__all__ = ["GuaranteeRefRow", "ItemRow", "WorkspacePlaceRow"]
