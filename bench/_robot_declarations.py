@@ -14,8 +14,10 @@ node it is drawn for, judged by the rules of docs/monitors.md, "Declarations on 
   (``due + period``, never drifting; after a stall the next slot of it, never a burst of the readings
   missed, each of which would be a step its consumers leave unanswered), so a gap between two messages
   is its period plus one stall of the robot's one executor, and the run's last event comes at most a
-  period plus the monitor's stop (its final lines) after the sensor's last message: the sensor
-  publishes until the robot is stopped, after the monitor.  ``P`` leaves a period and 1 s over its
+  period plus the monitor's stop (its final lines) after the sensor's last message: every sensor
+  publishes until the robot is stopped, after the monitor (every one, declared periodic or not: a
+  fuse's leading sensor stopping while its other input goes on would leave that input's readings
+  unanswered, generated seed 847).  ``P`` leaves a period and 1 s over its
   period (1.4-1.8 s for the 200-400 ms sensors): the longest stall measured with both cores busy and
   other test runs beside was 0.85 s (every sensor of one robot 1.1 s apart at one instant, generated
   seed 821 with ``P`` a second smaller).

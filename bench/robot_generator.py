@@ -25,8 +25,8 @@ Given a seed, :func:`generate` draws a system of N nodes from five templates (th
 
 Each node declares what it keeps (bench/_robot_declarations.py): a sensor ``initially`` its band and
 ``periodic( out.x, P ms )`` (P two periods and 1 s; a stamped sensor only on the wall clock), an
-alarm, a relay and a fuse ``progress( within K steps )``; a sensor declared periodic publishes until
-the robot is stopped.
+alarm, a relay and a fuse ``progress( within K steps )``; every sensor publishes until the robot is
+stopped (after the monitor).
 
 Nodes get a namespace at random.  ``defect=True`` seeds one defect in one node: ``<`` for ``<=``
 (``>`` for ``>=``, ``<=`` for ``<``), a relay adding 0.5 to every fourth reading, a server
