@@ -12,8 +12,8 @@ from typing import Any
 
 import pytest
 
-from rclverify.diagnosis.rerun import (Endpoint, RerunError, questions, read_run, recorded_answers, reproduces,
-                                       rewritten)
+from rclverify.diagnosis.rerun import (Endpoint, RerunError, RunLine, questions, read_run, recorded_answers,
+                                       reproduces, rewritten)
 from rclverify.diagnosis.run_repair import _kept, candidate_edits
 
 LOG = Path(__file__).parent / "data" / "manipulator_charge_lt.jsonl"
@@ -21,9 +21,9 @@ TOPIC = Endpoint("topic", ("battery",), ("low",))
 SERVICE = Endpoint("service", name="estop", ros_type="std_srvs/SetBool")
 
 
-def _call(part: str, n: int, fields: dict[str, object]) -> dict[str, object]:
-    return {"topic": "rclverify/call", "kind": "call", "link": "estop", "part": part, "time": float(n),
-            "key": ["ev", "g", n], "fields": fields}
+def _call(part: str, n: int, fields: dict[str, object]) -> RunLine:
+    return RunLine.of({"topic": "rclverify/call", "kind": "call", "link": "estop", "part": part, "time": float(n),
+                       "key": ["ev", "g", n], "fields": fields})
 
 
 CALLS = [_call("request", 1, {"data": True}), _call("response", 1, {"success": True, "message": ""}),
@@ -45,7 +45,7 @@ def test_a_rewritten_run_carries_the_rerun_answers_at_the_recorded_times() -> No
     out = rewritten(lines, TOPIC, new)
     lows = [x for x in out if x["topic"] == "low"]
     assert [x["data"] for x in lows] == [False, False, True, True, True, False]
-    assert [x["time"] for x in lows] == [x["time"] for x in lines if x["topic"] == "low"]
+    assert [x["time"] for x in lows] == [x.obj["time"] for x in lines if x.topic == "low"]
     assert not any(x["topic"] == "rclverify/verdict" for x in out)  # the live verdicts are judged again
     assert reproduces(lines, TOPIC, [[{"topic": "low", "fields": {"data": a["data"]}}]
                                      for a in recorded_answers(lines, TOPIC)])

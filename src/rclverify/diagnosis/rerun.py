@@ -5,7 +5,8 @@ node re-run on its recorded run").
 The run is a live monitor's JSON-lines log (``rclverify monitor --live
 --log``): each topic message a line, each call's request and response and
 each goal's goal, feedback, status and result an ``rclverify/call`` line
-(traces/jsonl.py).  For the contract node ``node`` it reads the
+(traces/jsonl.py), read as :class:`RunLine` (a call's line decoded into
+:class:`CallLine`).  For the contract node ``node`` it reads the
 *questions* (:func:`questions`): the messages of its input topics, the
 requests of the service it serves, or the goals of the action it serves.
 :func:`rerun` runs the node's callback on them, once per text of its
@@ -22,18 +23,54 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
 
+import msgspec
+
 #: The live monitor's own topics: a re-written run leaves out its verdicts.
 VERDICT_TOPIC = "rclverify/verdict"
+#: The topic of a call's lines (backends/monitors/dds_calls.py ``CALL_LOG_TOPIC``).
+CALL_TOPIC = "rclverify/call"
 #: Seconds the agent may take beyond its texts' own bounds (rclpy's start).
 AGENT_TIMEOUT_S = 120.0
 
 
 class RerunError(Exception):
     """The node cannot be re-run on this run (one sentence: why)."""
+
+
+class Callback(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """The callback that answers the node's questions, as the agent found it (:mod:`.rerun_agent`): its
+    function's first ``line`` (1-based) in ``file``, its ``name`` and the names it closes over."""
+
+    line: int
+    name: str
+    freevars: list[str] = []
+    file: str = ""
+
+
+class AgentRun(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """One text of the node's source re-run: ``error`` (``""``: it answered), the ``answers`` in question
+    order (a topic's: the messages it published, each ``{"topic", "fields"}``; a call's: its response; a
+    goal's: ``{"feedback", "result", "status"}``) and the ``seconds`` it took."""
+
+    error: str = ""
+    answers: list[Any] = []
+    seconds: float = 0.0
+
+
+class AgentAnswer(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """The agent's answer: one :class:`AgentRun` per text, in order, and the ``callback`` (``None`` when
+    none was found)."""
+
+    runs: list[AgentRun] = []
+    callback: Callback | None = None
+
+    def first(self) -> AgentRun:
+        """The first text's run; an empty one when the agent ran none."""
+        return self.runs[0] if self.runs else AgentRun()
 
 
 @dataclass(frozen=True)
@@ -65,10 +102,43 @@ def endpoint(checked_node: Any, calls: bool) -> Endpoint:
     return Endpoint("topic", ins, outs)
 
 
-def read_run(path: Path) -> list[dict[str, Any]]:
-    """The lines of the log at ``path`` as JSON objects (blank lines skipped).  Raises
-    :class:`RerunError` for a log that is not one JSON object a line (a bag is not read here)."""
-    out: list[dict[str, Any]] = []
+class CallLine(msgspec.Struct, frozen=True):
+    """What is read of a call's line (topic :data:`CALL_TOPIC`): the ``link`` (its service or action),
+    the ``part`` (``request``, ``response``, ``goal``, ``feedback``, ``status``, ``result``...), the call's
+    ``key``, the message's ``fields`` and a goal's ``status``; its other keys are kept, not read."""
+
+    link: str = ""
+    part: str = ""
+    key: Any = None
+    fields: dict[str, Any] | None = None
+    status: str = ""
+
+
+@dataclass(frozen=True)
+class RunLine:
+    """One line of the run: its ``topic``, its JSON object as written (``obj``: written back as it is
+    unless the node's answer replaces it) and, for a call's line, what is read of it (``call``)."""
+
+    topic: str
+    obj: dict[str, Any] = field(repr=False)
+    call: CallLine | None = None
+
+    @classmethod
+    def of(cls, obj: dict[str, Any]) -> RunLine:
+        """The line whose JSON object is ``obj``.  Raises :class:`msgspec.ValidationError` for a call's
+        line whose keys hold values of another type."""
+        topic = str(obj.get("topic", ""))
+        return cls(topic, obj, msgspec.convert(obj, CallLine) if topic == CALL_TOPIC else None)
+
+    def message(self) -> dict[str, Any]:
+        """A topic's line as its message: every key but ``topic`` and ``time``."""
+        return {k: v for k, v in self.obj.items() if k not in ("topic", "time")}
+
+
+def read_run(path: Path) -> list[RunLine]:
+    """The lines of the log at ``path`` (blank lines skipped).  Raises :class:`RerunError` for a log that
+    is not one JSON object a line (a bag is not read here), or a call's line of another shape."""
+    out: list[RunLine] = []
     try:
         with path.open(encoding="utf-8") as fh:
             for k, line in enumerate(fh, 1):
@@ -76,35 +146,36 @@ def read_run(path: Path) -> list[dict[str, Any]]:
                     obj = json.loads(line)
                     if not isinstance(obj, dict):
                         raise ValueError("not a JSON object")
-                    out.append(obj)
+                    out.append(RunLine.of(obj))
     except (OSError, UnicodeDecodeError, ValueError) as e:
         raise RerunError(f"{path}:{locals().get('k', 0)}: the run cannot be read as a JSON-lines log: {e}") from e
     return out
 
 
-def _call(line: dict[str, Any], ep: Endpoint, part: str) -> bool:
-    return bool(line.get("topic") == "rclverify/call" and line.get("link", "").lstrip("/") == ep.name
-                and line.get("part") == part)
+def _call(line: RunLine, ep: Endpoint, part: str) -> CallLine | None:
+    """``line`` read as ``ep``'s call line of ``part``; ``None`` when it is another line."""
+    c = line.call
+    return c if c is not None and c.link.lstrip("/") == ep.name and c.part == part else None
 
 
-def _fields(line: dict[str, Any]) -> dict[str, Any]:
-    return {k: v for k, v in line.items() if k not in ("topic", "time")}
+def _topic(line: RunLine) -> str:
+    return line.topic.lstrip("/")
 
 
-def questions(lines: Sequence[dict[str, Any]], ep: Endpoint) -> list[dict[str, Any]]:
+def questions(lines: Sequence[RunLine], ep: Endpoint) -> list[dict[str, Any]]:
     """The questions of ``ep`` in the run, in order: the fields of each input message, request or goal."""
     if ep.kind == "topic":
-        return [_fields(x) for x in lines if str(x.get("topic", "")).lstrip("/") in ep.inputs]
+        return [x.message() for x in lines if _topic(x) in ep.inputs]
     part = "request" if ep.kind == "service" else "goal"
-    return [dict(x.get("fields") or {}) for x in lines if _call(x, ep, part)]
+    return [dict(c.fields or {}) for x in lines if (c := _call(x, ep, part)) is not None]
 
 
 def rerun(python: Path, source: Path, texts: Sequence[str], factory: str, args: Sequence[Any], ep: Endpoint,
-          asked: Sequence[dict[str, Any]], timeout_s: float = 60.0) -> dict[str, Any]:
-    """The agent's answer (:mod:`.rerun_agent`: ``runs``, one per text, and ``callback``) for the node at
+          asked: Sequence[dict[str, Any]], timeout_s: float = 60.0) -> AgentAnswer:
+    """The agent's answer (:mod:`.rerun_agent`, decoded: :class:`AgentAnswer`) for the node at
     ``ep`` of the robot that ``factory(*args)`` of ``source`` (each of ``texts``) makes, asked ``asked``, in
     the ROS 2 Python ``python``, each text within ``timeout_s`` seconds.  Raises :class:`RerunError` when
-    the agent does not answer."""
+    the agent does not answer, or answers in another shape."""
     req = {"file": str(source), "texts": list(texts), "factory": factory, "args": list(args), "kind": ep.kind,
            "inputs": list(ep.inputs), "outputs": list(ep.outputs), "name": ep.name, "type": ep.ros_type,
            "questions": list(asked), "timeout_s": timeout_s}
@@ -115,12 +186,15 @@ def rerun(python: Path, source: Path, texts: Sequence[str], factory: str, args: 
     except (OSError, subprocess.TimeoutExpired) as e:
         raise RerunError(f"the ROS 2 Python {python} did not re-run the node: {e}") from e
     try:
-        got: dict[str, Any] = json.loads(p.stdout)
-    except ValueError:
+        return msgspec.json.decode(p.stdout, type=AgentAnswer)
+    except (msgspec.DecodeError, ValueError):
         tail = (p.stderr or p.stdout).strip().splitlines()[-1:] or ["no output"]
         raise RerunError(f"the ROS 2 Python {python} did not re-run the node (exit {p.returncode}): "
                          f"{tail[0]}") from None
-    return got
+
+
+#: The final statuses of a goal.
+_ENDS = ("succeeded", "aborted", "canceled")
 
 
 def _without_stamp(fields: Any) -> Any:
@@ -129,21 +203,20 @@ def _without_stamp(fields: Any) -> Any:
     return fields
 
 
-def recorded_answers(lines: Sequence[dict[str, Any]], ep: Endpoint) -> list[Any]:
+def recorded_answers(lines: Sequence[RunLine], ep: Endpoint) -> list[Any]:
     """The node's recorded answers in the shape a re-run gives them, for :func:`reproduces`: a topic's
     output messages (without headers) in order, each call's response, each goal's feedback, result, status."""
     if ep.kind == "topic":
-        return [_without_stamp(_fields(x)) for x in lines if str(x.get("topic", "")).lstrip("/") in ep.outputs]
+        return [_without_stamp(x.message()) for x in lines if _topic(x) in ep.outputs]
     if ep.kind == "service":
-        return [dict(x.get("fields") or {}) for x in lines if _call(x, ep, "response")]
+        return [dict(c.fields or {}) for x in lines if (c := _call(x, ep, "response")) is not None]
+    calls = [x.call for x in lines if x.call is not None]
     out = []
-    for g in (x for x in lines if _call(x, ep, "goal")):
-        key = g.get("key")
-        mine = [x for x in lines if x.get("topic") == "rclverify/call" and x.get("key") == key]
-        ends = [x.get("status") for x in mine if x.get("part") == "status"
-                and x.get("status") in ("succeeded", "aborted", "canceled")]
-        out.append({"feedback": [x.get("fields") for x in mine if x.get("part") == "feedback"],
-                    "result": next((x.get("fields") for x in mine if x.get("part") == "result"), None),
+    for g in (c for x in lines if (c := _call(x, ep, "goal")) is not None):
+        mine = [c for c in calls if c.key == g.key]
+        ends = [c.status for c in mine if c.part == "status" and c.status in _ENDS]
+        out.append({"feedback": [c.fields for c in mine if c.part == "feedback"],
+                    "result": next((c.fields for c in mine if c.part == "result"), None),
                     "status": ends[-1] if ends else ""})
     return out
 
@@ -163,53 +236,53 @@ def _sub(recorded: Any, rerun_fields: Any) -> Any:
     return rerun_fields
 
 
-def reproduces(lines: Sequence[dict[str, Any]], ep: Endpoint, answers: Sequence[Any]) -> bool:
+def reproduces(lines: Sequence[RunLine], ep: Endpoint, answers: Sequence[Any]) -> bool:
     """Whether ``answers`` (a re-run of the recorded source) are the recorded ones, field by field."""
     want = recorded_answers(lines, ep)
     got = _flat(ep, answers)
     return len(want) == len(got) and all(_sub(w, g) == w for w, g in zip(want, got))
 
 
-def rewritten(lines: Sequence[dict[str, Any]], ep: Endpoint, answers: Sequence[Any]) -> list[dict[str, Any]]:
-    """The run with the node's answers replaced by ``answers`` (module docstring).  Raises
-    :class:`RerunError` when the re-run answers another number of messages than were recorded (they
-    cannot be placed in time)."""
-    kept = [x for x in lines if x.get("topic") != VERDICT_TOPIC]
+def rewritten(lines: Sequence[RunLine], ep: Endpoint, answers: Sequence[Any]) -> list[dict[str, Any]]:
+    """The run with the node's answers replaced by ``answers`` (module docstring), as the lines' JSON
+    objects.  Raises :class:`RerunError` when the re-run answers another number of messages than were
+    recorded (they cannot be placed in time)."""
+    kept = [x for x in lines if x.topic != VERDICT_TOPIC]
     if ep.kind == "topic":
         got = [m["fields"] for a in answers for m in a]
-        at = [k for k, x in enumerate(kept) if str(x.get("topic", "")).lstrip("/") in ep.outputs]
+        at = [k for k, x in enumerate(kept) if _topic(x) in ep.outputs]
         if len(got) != len(at):
             raise RerunError(f"the edited node answers {len(got)} messages where {len(at)} were recorded")
-        placed = list(kept)
+        placed = [x.obj for x in kept]
         for k, fields in zip(at, got):
-            placed[k] = {"topic": kept[k]["topic"], "time": kept[k]["time"], **_sub(_fields(kept[k]), fields)}
+            placed[k] = {"topic": kept[k].topic, "time": kept[k].obj["time"], **_sub(kept[k].message(), fields)}
         return placed
-    goals = [x for x in kept if _call(x, ep, "request" if ep.kind == "service" else "goal")]
+    goals = [c for x in kept if (c := _call(x, ep, "request" if ep.kind == "service" else "goal")) is not None]
     if len(goals) != len(answers):
         raise RerunError(f"the edited node answered {len(answers)} of {len(goals)} recorded questions")
-    by_key = {json.dumps(g.get("key")): a for g, a in zip(goals, answers)}
+    by_key = {json.dumps(g.key): a for g, a in zip(goals, answers)}
     out: list[dict[str, Any]] = []
     seen: dict[str, int] = {}  # key -> the feedback lines replaced so far
     for x in kept:
-        key = json.dumps(x.get("key"))
-        a = by_key.get(key) if x.get("topic") == "rclverify/call" else None
-        if a is None:
-            out.append(x)
-        elif ep.kind == "service" and x.get("part") == "response":
-            out.append({**x, "fields": _sub(x.get("fields"), a)})
-        elif ep.kind == "action" and x.get("part") == "feedback":
+        c = x.call
+        key = json.dumps(c.key if c is not None else x.obj.get("key"))
+        a = by_key.get(key) if c is not None else None
+        if a is None or c is None:
+            out.append(x.obj)
+        elif ep.kind == "service" and c.part == "response":
+            out.append({**x.obj, "fields": _sub(c.fields, a)})
+        elif ep.kind == "action" and c.part == "feedback":
             k = seen[key] = seen.get(key, -1) + 1
             if k >= len(a["feedback"]):
                 raise RerunError("the edited node sends less feedback than was recorded")
-            out.append({**x, "fields": _sub(x.get("fields"), a["feedback"][k])})
-        elif ep.kind == "action" and x.get("part") == "result":
-            out.append({**x, "fields": _sub(x.get("fields"), a["result"])})
-        elif ep.kind == "action" and x.get("part") == "status" and x.get("status") in ("succeeded", "aborted",
-                                                                                        "canceled"):
-            out.append({**x, "status": a["status"]})
+            out.append({**x.obj, "fields": _sub(c.fields, a["feedback"][k])})
+        elif ep.kind == "action" and c.part == "result":
+            out.append({**x.obj, "fields": _sub(c.fields, a["result"])})
+        elif ep.kind == "action" and c.part == "status" and c.status in _ENDS:
+            out.append({**x.obj, "status": a["status"]})
         else:
-            out.append(x)
-    if ep.kind == "action" and any(seen.get(json.dumps(g.get("key")), -1) + 1 != len(a["feedback"])
+            out.append(x.obj)
+    if ep.kind == "action" and any(seen.get(json.dumps(g.key), -1) + 1 != len(a["feedback"])
                                    for g, a in zip(goals, answers)):
         raise RerunError("the edited node sends another number of feedback messages than were recorded")
     return out
@@ -221,5 +294,5 @@ def write_run(lines: Sequence[dict[str, Any]], path: Path) -> Path:
     return path
 
 
-__all__ = ["AGENT_TIMEOUT_S", "Endpoint", "RerunError", "endpoint", "questions", "read_run", "recorded_answers",
+__all__ = ["AGENT_TIMEOUT_S", "CALL_TOPIC", "AgentAnswer", "AgentRun", "CallLine", "Callback", "Endpoint", "RunLine", "RerunError", "endpoint", "questions", "read_run", "recorded_answers",
            "reproduces", "rerun", "rewritten", "write_run"]

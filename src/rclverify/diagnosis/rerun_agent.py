@@ -236,7 +236,7 @@ def main() -> int:
             callback = callback or cb
     finally:
         rclpy.try_shutdown()
-    sys.stdout.write(json.dumps({"runs": runs, "callback": callback}))
+    sys.stdout.write(json.dumps({"runs": runs, "callback": callback or None}))
     return 0
 
 

@@ -53,8 +53,8 @@ from typing import Any, Mapping, Sequence
 
 from rclverify.diagnosis.code_repair import _NONE, _SWAP, _edit, _rank
 from rclverify.diagnosis.edits import Edit
-from rclverify.diagnosis.rerun import (RerunError, endpoint, questions, read_run, reproduces, rerun,
-                                       rewritten, write_run)
+from rclverify.diagnosis.rerun import (AgentAnswer, RerunError, endpoint, questions, read_run, reproduces,
+                                       rerun, rewritten, write_run)
 from rclverify.records.stage_records import Repair
 
 #: Most repairs offered for one violation.
@@ -241,29 +241,29 @@ def run_repairs(root: Path, checked: Any, cfg: Any, trace: Path, node: str, call
         return RunRepairs(why=f"{node} cannot be re-run: {type(e).__name__}: {e}")
     except RerunError as e:
         return RunRepairs(why=str(e))
-    cb = first.get("callback") or {}
-    run0 = (first.get("runs") or [{}])[0]
-    if run0.get("error") or not cb:
-        said = run0.get("error") or "no callback found"
+    cb, run0 = first.callback, first.first()
+    if run0.error or cb is None:
+        said = run0.error or "no callback found"
         return RunRepairs(why=f"{source} did not answer {node}'s questions when re-run: {said}")
-    at = f"{source}:{cb['line']}"
-    if not reproduces(lines, ep, run0["answers"]):
+    at = f"{source}:{cb.line}"
+    if not reproduces(lines, ep, run0.answers):
         return RunRepairs(line=at, why=f"re-run on the run's questions, {source} does not give the recorded "
                           f"answers of {node} again: they depend on more than its questions, or the code changed "
                           "since the run was recorded (record it again)")
-    edits = candidate_edits(text, source, int(cb["line"]), str(cb["name"]), cb.get("freevars") or [],
+    edits = candidate_edits(text, source, cb.line, cb.name, cb.freevars,
                             contract_numbers(checked.nodes[node]))[:MAX_TRIED]
     tmp = Path(tempfile.mkdtemp(prefix="rclverify-run-repair-"))
     try:
-        before = judged(checked, cfg, root, write_run(rewritten(lines, ep, run0["answers"]), tmp / "recorded.jsonl"))
-        bound = max(MIN_BOUND_S, SLOWER * float(run0.get("seconds") or 0.0))
-        got = rerun(python, path, [e.apply(text) for e in edits], factory, args, ep, asked, bound) if edits else {}
+        before = judged(checked, cfg, root, write_run(rewritten(lines, ep, run0.answers), tmp / "recorded.jsonl"))
+        bound = max(MIN_BOUND_S, SLOWER * run0.seconds)
+        got = rerun(python, path, [e.apply(text) for e in edits], factory, args, ep, asked, bound) if edits \
+            else AgentAnswer()
         out: list[Repair] = []
-        for k, (edit, ran) in enumerate(zip(edits, got.get("runs") or [])):
-            if ran.get("error"):
+        for k, (edit, ran) in enumerate(zip(edits, got.runs)):
+            if ran.error:
                 continue
             try:
-                after = judged(checked, cfg, root, write_run(rewritten(lines, ep, ran["answers"]), tmp / f"c{k}.jsonl"))
+                after = judged(checked, cfg, root, write_run(rewritten(lines, ep, ran.answers), tmp / f"c{k}.jsonl"))
             except RerunError:
                 continue
             except Exception:  # noqa: BLE001 - a rewritten run the monitors refuse: not a repair
@@ -290,11 +290,11 @@ def rejudged(root: Path, checked: Any, cfg: Any, trace: Path, node: str, calls: 
     ep = endpoint(checked.nodes[node], calls)
     lines = read_run(trace)
     got = rerun(python, root / source, [text], factory, args, ep, questions(lines, ep))
-    ran = (got.get("runs") or [{}])[0]
-    if ran.get("error"):
-        raise RerunError(f"{source} did not answer {node}'s questions: {ran['error']}")
+    ran = got.first()
+    if ran.error:
+        raise RerunError(f"{source} did not answer {node}'s questions: {ran.error}")
     with tempfile.TemporaryDirectory(prefix="rclverify-run-repair-") as tmp:
-        return judged(checked, cfg, root, write_run(rewritten(lines, ep, ran["answers"]), Path(tmp) / "run.jsonl"))
+        return judged(checked, cfg, root, write_run(rewritten(lines, ep, ran.answers), Path(tmp) / "run.jsonl"))
 
 
 def _repair(node: str, source: str, text: str, edit: Edit, trace: Path, before: Mapping[str, Judged],
