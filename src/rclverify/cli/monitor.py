@@ -29,7 +29,7 @@ from rclverify.lang.types import Checked
 from rclverify.traces import TraceError
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions
 from rclverify.backends.monitors.deadline_text import deadline_status
-from rclverify.backends.monitors.config import ConfigError, load_mapping
+from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.judged import explain
 from rclverify.cli.monitor_outcome import print_not_judged, selected_nodes, strict_exit
 from rclverify.backends.monitors.declarations import declaration_status
@@ -43,10 +43,8 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     caller, rclverify.cli.commands, loads them: a backend does not import the
     pipeline); returns the exit code (never raises for user input)."""
     root = Path(args.workspace)
-    try:
-        cfg = load_mapping(root, args.mapping, args.horizon)
-    except ConfigError as exc:
-        print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify monitor'}: error: {exc}", file=sys.stderr)
+    cfg = _configuration(args, root, "monitor")
+    if cfg is None:
         return 2
     from rclverify.backends.monitors.shared_topics import shared_topic_errors  # two variables on one topic read distinct fields; deferred: start-up (imported where it is used)
     shared = [d for n in checked.nodes for d in shared_topic_errors(checked, n, cfg.rules, cfg.mapping or
@@ -178,10 +176,8 @@ def oracle_command(args: argparse.Namespace, checked: Checked) -> int:
 
     from rclverify.runtime.oracle import serve  # deferred: start-up (loads rclverify.runtime, rclverify.runtime.oracle and more only when called)
     root = Path(args.workspace)
-    try:
-        cfg = load_mapping(root, args.mapping, args.horizon)
-    except ConfigError as exc:
-        print(f"{exc}" if exc.located else f"{args.mapping or 'rclverify oracle'}: error: {exc}", file=sys.stderr)
+    cfg = _configuration(args, root, "oracle")
+    if cfg is None:
         return 2
     nodes = selected_nodes(checked, args.nodes, "oracle")
     if nodes is None:
@@ -205,6 +201,17 @@ def oracle_command(args: argparse.Namespace, checked: Checked) -> int:
               file=sys.stderr)
         return 2
     return 0
+
+
+def _configuration(args: argparse.Namespace, root: Path, command: str) -> MonitorConfig | None:
+    """The monitor configuration (:func:`~rclverify.backends.monitors.config.load_mapping`) of ``args``
+    in workspace ``root``; ``None`` after printing why it cannot be read (``rclverify COMMAND``'s error
+    line, or the located one)."""
+    try:
+        return load_mapping(root, args.mapping, args.horizon)
+    except ConfigError as exc:
+        print(f"{exc}" if exc.located else f"{args.mapping or f'rclverify {command}'}: error: {exc}", file=sys.stderr)
+        return None
 
 
 def _emit(report: list[Mapping[str, object]], as_json: bool) -> None:
