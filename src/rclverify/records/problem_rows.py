@@ -47,6 +47,7 @@ from rclverify.records.statuses import AnyStatus
 
 _DOC = DOC  # a field's description, as the generated JSON Schema shows it
 
+
 class DiagnosisRow(ItemRow, frozen=True, forbid_unknown_fields=True, omit_defaults=True):
     """One diagnosis per problem, with repairs checked by Z3 (docs/diagnosis.md)."""
 
