@@ -32,7 +32,6 @@ _T = treesitter.text
 #: namespaces of libraries whose functions the workspace does not define: their calls are not followed
 _LIBRARY = ("std::", "ros::", "rclcpp", "boost::", "tf2", "Eigen::", "rcutils_", "rcl_", "rmw_", "cv::", "pcl::")
 
-
 #: rclcpp's name resolution for a node: ``NodeBaseInterface::resolve_topic_or_service_name``
 #: (rclcpp >= Humble) and ``rclcpp::expand_topic_or_service_name`` (name, node name, namespace).
 _RESOLVERS = ("resolve_topic_or_service_name", "expand_topic_or_service_name")
