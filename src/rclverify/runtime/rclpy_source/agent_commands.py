@@ -15,10 +15,13 @@ import importlib
 import json
 import queue
 import sys
-from typing import TYPE_CHECKING, Any, TypedDict
+from typing import Any, Protocol, TypedDict
 
-if TYPE_CHECKING:  # mypy reads the siblings as the package's modules
-    from rclverify.runtime.rclpy_source.agent import Agent
+
+class Writers(Protocol):
+    """What :func:`read_commands` reads of the agent: its writers made so far (id -> rclpy publisher)."""
+
+    writers: dict[int, Any]
 
 
 def message_class(type_name: str) -> Any:
@@ -50,7 +53,7 @@ class Command(TypedDict, total=False):
     linger: float
 
 
-def read_commands(q: queue.Queue[Command | None], wake: Any, agent: Agent) -> None:
+def read_commands(q: queue.Queue[Command | None], wake: Any, agent: Writers) -> None:
     """Queue each command line, and wake the executor (a guard condition) so it is done at once; but
     publish a write to a writer already made here at once, without waking the executor (a verdict
     then costs the agent no executor turn: at 1000 messages/s, one message a turn, the two turns a
@@ -73,4 +76,4 @@ def read_commands(q: queue.Queue[Command | None], wake: Any, agent: Agent) -> No
     wake.trigger()
 
 
-__all__ = ["Command", "message_class", "read_commands"]
+__all__ = ["Command", "Writers", "message_class", "read_commands"]
