@@ -11,6 +11,7 @@ from fractions import Fraction
 from typing import Any
 
 from rclverify.semantics.nicemodel import short
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.cex_cone import side_condition_view
 
 
@@ -26,7 +27,7 @@ def assert_readable(report: dict[str, Any]) -> int:
         if sc["status"] != "failed":
             continue
         read += 1
-        shown = side_condition_view(sc)["model"]
+        shown = side_condition_view(SideConditionRow.of(sc)).model or {}
         assert all(_short(v) for v in shown.values()), (sc["id"], shown)
         nodes = {k.split(".")[0] for k in shown}
         ctx = sc.get("context") or {}

@@ -14,7 +14,9 @@ import z3
 
 from rclverify.semantics import world
 from rclverify.semantics.nicemodel import nicer_model, short
+from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.cex_cone import side_condition_view, trace_view
+from tests.records._typed_rows import complete
 from rclverify.calculus.requirements.check import check_requirement as _check_requirement
 from rclverify.stages.workspace import Workspace
 
@@ -155,8 +157,8 @@ def test_a_side_condition_in_context_shows_the_nodes_it_involves() -> None:
           "context": {"violated": ["Base"]},
           "model": {"Base.out.max_speed": "2", "Base.in.cmd_vel": "2.5", "Localiser.out.pose_x": "0",
                     "LidarDriver.in.range": "0", "MissionManager.out.goal_x": "0.5"}}
-    shown = side_condition_view(sc)
-    assert shown["model"] == {"Base.out.max_speed": "2", "Base.in.cmd_vel": "2.5"} and shown["model_hidden"] == 3
+    shown = side_condition_view(SideConditionRow.of(complete(SideConditionRow, sc)))
+    assert shown.model == {"Base.out.max_speed": "2", "Base.in.cmd_vel": "2.5"} and shown.model_hidden == 3
 
 
 def test_a_temporal_trace_keeps_what_is_named_changes_or_never_answers() -> None:

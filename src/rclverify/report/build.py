@@ -122,8 +122,8 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
     ev = evidence_part(ws, inp.obligations, inp.altered, inp.hashes, inp.second)
     comps, health = contract_records(ws, names, inp.stale, inp.second)
     # a counterexample shows the nodes involved only: the consumer and the producers of the linked variables
-    views = [side_condition_view(sc) for n in names for sc in comps[n].get("side_conditions", [])]
-    side_conditions = decode_rows(SideConditionRow, views)
+    recorded = [sc for n in names for sc in comps[n].get("side_conditions", [])]
+    side_conditions = [side_condition_view(sc) for sc in decode_rows(SideConditionRow, recorded)]
     sc_status = {n: worst([sc["status"] for sc in comps[n].get("side_conditions", [])], empty="discharged")
                  for n in names}
     g_status = GuaranteeStatuses(inp.obligations, ev.status, health)
@@ -132,7 +132,7 @@ def _rows(ws: Workspace, inp: Inputs) -> tuple[dict[str, Any], Facts]:
     checks = {k: inp.second.requirement(v) or v for k, v in checks.items()}
     deadlines = deadline_rows(ws, inp.hashes, g_status, ev.obligations, inp.second)  # rule D3
     requirements = fold_into(requirement_rows(ws, inp.texts, checks, g_status, sc_status, ev.declared), deadlines)
-    findings, lint, acknowledgements = acknowledged_rows(ws, finding_rows(names, health, views),
+    findings, lint, acknowledgements = acknowledged_rows(ws, finding_rows(names, health, recorded),
                                                           lint_rows(ws))
     return {"requirements": requirements, "nodes": nodes.nodes, "side_conditions": side_conditions,
             "derived_properties": derived_rows(ws, comps, nodes, sc_status), "findings": findings,

@@ -26,6 +26,10 @@ from __future__ import annotations
 import re
 from typing import Any, Mapping, Sequence
 
+import msgspec
+
+from rclverify.records.side_condition_rows import SideConditionRow
+
 _NAMED = re.compile(r"\b([A-Za-z_]\w*)\.(in|out|state)\.([A-Za-z_]\w*)")
 #: The flags of a node's run that say whether it answers (calculus/requirements/published.py).
 _ANSWER_FLAGS = ("accepts", "answers")
@@ -90,8 +94,8 @@ def with_trace_view(check: Mapping[str, Any]) -> Mapping[str, Any]:
     return {**check, "temporal": {**t, "shown": steps, "hidden": hidden}}
 
 
-def side_condition_view(sc: Mapping[str, Any]) -> Mapping[str, Any]:
-    """``sc`` (a side-condition row of the calculus) with its ``model``
+def side_condition_view(sc: SideConditionRow) -> SideConditionRow:
+    """``sc`` (a side-condition row of the calculus, decoded) with its ``model``
     (``{"Node.in.x": value}``) cut to the nodes its conjunct involves: the
     consumer, the producers of its ``links`` (``"P.out.v -> C.in.w (...)"``)
     and, decided in context, the nodes whose assumption the counterexample
@@ -100,14 +104,13 @@ def side_condition_view(sc: Mapping[str, Any]) -> Mapping[str, Any]:
     left; unchanged, too, for a side condition that failed *in context*: its
     counterexample is traced back through the upstream cone whose premises
     allowed it, every value of which is part of why it fails."""
-    model = sc.get("model")
-    if not isinstance(model, dict) or not sc.get("links") or sc.get("variant") == "in context":
+    model = sc.model
+    if model is None or not sc.links or sc.variant == "in context":
         return sc
-    nodes = {str(sc.get("node", ""))} | {str(l).split(".", 1)[0] for l in sc.get("links") or ()}
-    ctx = sc.get("context")
-    if isinstance(ctx, Mapping):
-        nodes |= {str(n) for n in ctx.get("violated") or ()}
+    nodes = {sc.node} | {link.split(".", 1)[0] for link in sc.links}
+    if sc.context is not None:  # calculus/compose.py's record of the in-context check
+        nodes |= {str(n) for n in sc.context.get("violated") or ()}
     kept = {k: v for k, v in model.items() if str(k).split(".", 1)[0] in nodes}
     if not kept or len(kept) == len(model):
         return sc
-    return {**sc, "model": kept, "model_hidden": len(model) - len(kept)}
+    return msgspec.structs.replace(sc, model=kept, model_hidden=len(model) - len(kept))
