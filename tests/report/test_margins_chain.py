@@ -74,17 +74,17 @@ def test_a_hop_no_run_timed_has_none():
     from fractions import Fraction
     from msgspec.structs import replace
     from rclverify.records.deadline_rows import DeadlineHop
+    from rclverify.backends.monitors.payload import TimeMarginItem
     from rclverify.report.chain_margins import chain_margin, hop_margin
     assert hop_margin(1, []) is None
     hop = DeadlineHop(node="A", guarantee=1, trigger="in.x", outputs=["y"], within_s="1/10", within="100 ms",
                       loc="a.rcl:1:1", time_margin=None)
     assert chain_margin(Fraction(3, 20), [hop]) is None
     # a trigger never answered: its latency is unbounded, so the chain has no measured margin either
-    monitors = [{"obligation": "o", "time_margins": [
-        {"guarantee": 1, "margin_ns": 5_000_000, "answers": 2, "unanswered": 1, "trigger_where": "t", "answer_where": "a"}]}]
-    hop = replace(hop, monitors=monitors, time_margin=hop_margin(1, monitors))
+    margin = TimeMarginItem(guarantee=1, margin_ns=5_000_000, answers=2, unanswered=1, trigger_where="t",
+                            answer_where="a")
+    hop = replace(hop, time_margin=hop_margin(1, [("o", [margin])]))
     assert hop.time_margin and hop.time_margin.margin_ns == 5_000_000 and chain_margin(Fraction(3, 20), [hop]) is None
     # every trigger answered: the bound less the hop's worst latency (100 ms less its 5 ms margin)
-    monitors[0]["time_margins"][0]["unanswered"] = 0
-    hop = replace(hop, time_margin=hop_margin(1, monitors))
+    hop = replace(hop, time_margin=hop_margin(1, [("o", [replace(margin, unanswered=0)])]))
     assert chain_margin(Fraction(3, 20), [hop]) == 150_000_000 - (100_000_000 - 5_000_000)

@@ -26,38 +26,37 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Iterable, Sequence
 
+from rclverify.backends.monitors.payload import TimeMarginItem
 from rclverify.records.deadline_rows import DeadlineHop, HopTimeMargin
 
 
-def hop_margin(guarantee: int, monitors: Iterable[Mapping[str, Any]]) -> HopTimeMargin | None:
+def hop_margin(guarantee: int, runs: Iterable[tuple[str, Sequence[TimeMarginItem]]]) -> HopTimeMargin | None:
     """The smallest time margin of guarantee ``guarantee`` (1-based) of a
-    hop's node over its monitors evidence's deadline records ``monitors``
-    (each with ``obligation`` and ``time_margins``, :meth:`TimeMargin.to_json`):
-    ``answers`` and ``unanswered`` summed over the runs, ``margin_s``/
-    ``margin_ns`` ``None`` when no trigger was answered.  ``None`` when no
-    run measured the guarantee."""
-    best: dict[str, Any] | None = None
+    hop's node over its monitors evidence's runs ``runs`` (each its
+    obligation and the time margins of its deadline record, the monitors'
+    payload ``deadlines.time_margins``): ``answers`` and ``unanswered``
+    summed over the runs, ``margin_s``/``margin_ns`` ``None`` when no
+    trigger was answered.  ``None`` when no run measured the guarantee."""
+    best: tuple[int | None, str, str, str] | None = None  # margin_ns, obligation, trigger_where, answer_where
     answers = unanswered = 0
-    for m in monitors:
-        for t in m.get("time_margins") or ():
-            if int(t.get("guarantee", 0)) != guarantee:
+    for obligation, margins in runs:
+        for t in margins:
+            if t.guarantee != guarantee:
                 continue
-            answers += int(t.get("answers") or 0)
-            unanswered += int(t.get("unanswered") or 0)
-            ns = t.get("margin_ns")
-            if ns is not None and (best is None or best["margin_ns"] is None or int(ns) < best["margin_ns"]):
-                best = {"margin_ns": int(ns), "obligation": str(m.get("obligation", "")),
-                        "trigger_where": str(t.get("trigger_where", "")), "answer_where": str(t.get("answer_where", ""))}
+            answers += t.answers
+            unanswered += t.unanswered
+            ns = t.margin_ns
+            if ns is not None and (best is None or best[0] is None or ns < best[0]):
+                best = (ns, obligation, t.trigger_where, t.answer_where)
             elif best is None:
-                best = {"margin_ns": None, "obligation": str(m.get("obligation", "")),
-                        "trigger_where": "", "answer_where": ""}
+                best = (None, obligation, "", "")
     if best is None:
         return None
-    ns = best["margin_ns"]
-    return HopTimeMargin(margin_s=None if ns is None else ns / 1e9, margin_ns=ns, obligation=best["obligation"],
-                         trigger_where=best["trigger_where"], answer_where=best["answer_where"], answers=answers,
+    ns, obligation, trigger_where, answer_where = best
+    return HopTimeMargin(margin_s=None if ns is None else ns / 1e9, margin_ns=ns, obligation=obligation,
+                         trigger_where=trigger_where, answer_where=answer_where, answers=answers,
                          unanswered=unanswered)
 
 

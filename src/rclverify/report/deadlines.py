@@ -41,12 +41,12 @@ covers is ``pending``: they check its formula, not its time)
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import Any, Callable, Mapping, Sequence, cast
+from typing import Any, Callable, Mapping, NamedTuple, Sequence, cast
 
 import msgspec
 from msgspec.structs import replace
 
-from rclverify.backends.monitors.payload import monitors_payload
+from rclverify.backends.monitors.payload import DeadlineBlock, monitors_payload
 from rclverify.records.deadline_rows import DeadlineHop, DeadlineRow
 from rclverify.records.report_record import AssuranceReport
 from rclverify.records.obligations import ObligationRow
@@ -140,19 +140,35 @@ def _solvers(s: Any) -> Solvers | None | msgspec.UnsetType:
     return Solvers.of(s) if isinstance(s, Mapping) else None if s is None else msgspec.UNSET
 
 
-def _hop(h: Mapping[str, Any], status: str, monitors: list[dict[str, Any]]) -> DeadlineHop:
+class HopRun(NamedTuple):
+    """A monitored run of a hop's node: its ``obligation``, that obligation's ``status`` in the report and its
+    evidence's deadline record (the monitors' payload ``deadlines``)."""
+
+    obligation: str
+    status: str
+    deadlines: DeadlineBlock
+
+    def to_json(self) -> dict[str, Any]:
+        """The run as the hop's row holds it (records/deadline_rows.py ``DeadlineHop.monitors``)."""
+        d = self.deadlines
+        return {"obligation": self.obligation, "status": self.status, "counts": dict(d.counts),
+                "first_false": d.first_false, "time_margins": [msgspec.to_builtins(t) for t in d.time_margins]}
+
+
+def _hop(h: Mapping[str, Any], status: str, monitors: list[HopRun]) -> DeadlineHop:
     """The stage's hop ``h`` (records/stage_records.py ``DeadlineHop``) as the report's row: its guarantee's
-    evidence ``status``, its node's monitors' deadline records ``monitors``, whether a run timed it
+    evidence ``status``, its node's monitored runs ``monitors``, whether a run timed it
     (:func:`_timing_measured`) and its smallest time margin on the runs (:func:`.chain_margins.hop_margin`)."""
     status, timing = _timing_measured(status, monitors, str(h.get("within", "")))
     return DeadlineHop(node=str(h["node"]), guarantee=int(h["guarantee"]), trigger=str(h["trigger"]),
                        outputs=[str(o) for o in h["outputs"]], within_s=str(h["within_s"]), within=str(h["within"]),
-                       loc=str(h["loc"]), status=cast(EvidenceStatus, status), timing=timing, monitors=monitors,
-                       time_margin=hop_margin(int(h["guarantee"]), monitors))
+                       loc=str(h["loc"]), status=cast(EvidenceStatus, status), timing=timing,
+                       monitors=[m.to_json() for m in monitors],
+                       time_margin=hop_margin(int(h["guarantee"]),
+                                              [(m.obligation, m.deadlines.time_margins) for m in monitors]))
 
 
-def _timing_measured(status: str, monitors: Sequence[Mapping[str, Any]],
-                     within: str) -> tuple[str, str | msgspec.UnsetType]:
+def _timing_measured(status: str, monitors: Sequence[HopRun], within: str) -> tuple[str, str | msgspec.UnsetType]:
     """``(status, timing)`` of a hop whose guarantee's evidence status is
     ``status``: one discharged by evidence that checks only its formula (a
     property test, a proof: backends/timing_scope.py) while no run timed it
@@ -163,31 +179,26 @@ def _timing_measured(status: str, monitors: Sequence[Mapping[str, Any]],
     otherwise."""
     if status != "discharged":
         return status, msgspec.UNSET
-    timed = [m for m in monitors if m.get("status") == "discharged"
-             and int((m.get("counts") or {}).get("true", 0) or 0) > 0]
+    timed = [m for m in monitors if m.status == "discharged" and m.deadlines.counts.get("true", 0) > 0]
     if timed:
         return status, msgspec.UNSET
     return "pending", (f"its {within} deadline is measured by no run: its evidence checks the "
                        "guarantee's formula only (a monitors entry on a recorded or live run times it)")
 
 
-def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationRow],
-                      nodes: set[str]) -> dict[str, list[dict[str, Any]]]:
-    """node -> the deadline verdicts of its monitors' evidence records
-    (``details["deadlines"]``, backends/monitors/deadlines.py):
-    ``[{"obligation", "status", "counts", "first_false"}]``."""
+def _monitor_verdicts(ws: Workspace, ob_rows: Sequence[ObligationRow], nodes: set[str]) -> dict[str, list[HopRun]]:
+    """node -> its monitored runs with their deadline records (``details["deadlines"]``,
+    backends/monitors/deadlines.py), decoded."""
     store = EvidenceStore(ws.root)
-    out: dict[str, list[dict[str, Any]]] = {}
+    out: dict[str, list[HopRun]] = {}
     for o in ob_rows:
         if o.backend != "monitors" or o.node not in nodes:
             continue
         ev, problem = store.read(o.id)
         payload = monitors_payload(ev.backend, ev.details) if ev is not None and not problem else None
         d = payload.deadlines if payload is not None else None
-        if d is not None:  # the hop's row holds them as JSON objects (records/deadline_rows.py DeadlineHop.monitors)
-            out.setdefault(o.node, []).append({"obligation": o.id, "status": o.status, "counts": dict(d.counts),
-                                               "first_false": d.first_false,
-                                               "time_margins": [msgspec.to_builtins(t) for t in d.time_margins]})
+        if d is not None:
+            out.setdefault(o.node, []).append(HopRun(o.id, o.status, d))
     return out
 
 

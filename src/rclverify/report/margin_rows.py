@@ -27,12 +27,12 @@ why none was drawn.
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Iterable, Mapping, Sequence
 
 import msgspec
 from msgspec.structs import replace
 
-from rclverify.backends.monitors.payload import RunStatistics, SpaceMargin, monitors_payload
+from rclverify.backends.monitors.payload import RunStatistics, SpaceMargin, TimeMarginItem, monitors_payload
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS
 from rclverify.report.chain_margins import hop_margin
 from rclverify.records.deadline_rows import HopTimeMargin
@@ -128,7 +128,7 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginR
     """The report's ``margins`` (module docstring), by node and guarantee, each a
     :class:`~rclverify.records.margin_rows.MarginRow`."""
     runs: dict[tuple[str, int], list[tuple[str, str, SpaceMargin]]] = {}
-    timed: dict[tuple[str, int], list[dict[str, Any]]] = {}  # the runs' deadline records, as hop_margin reads them
+    timed: dict[tuple[str, int], list[tuple[str, list[TimeMarginItem]]]] = {}  # the runs' time margins, by obligation
     seen: dict[str, set[str]] = {}  # node -> the identities of its runs read so far
     store: EvidenceStore | None = None
     for o in ob_rows:
@@ -146,9 +146,7 @@ def margin_rows(ws: Workspace, ob_rows: Sequence[ObligationRow]) -> list[MarginR
             trace = m.trace if m.trace is not msgspec.UNSET and m.trace else mon.trace if mon is not None else ""
             runs.setdefault((o.node, m.guarantee), []).append((o.id, trace, m))
         for t in payload.deadlines.time_margins if payload.deadlines is not None else ():
-            # hop_margin (report/chain_margins.py) reads a deadline record's JSON object
-            timed.setdefault((o.node, t.guarantee), []).append(
-                {"obligation": o.id, "time_margins": [msgspec.to_builtins(t)]})
+            timed.setdefault((o.node, t.guarantee), []).append((o.id, [t]))
     rows = [_row(ws, node, k, runs.get((node, k), []), hop_margin(k, timed.get((node, k), [])))
             for node, k in sorted(set(runs) | set(timed))]
     return _plots(rows, runs)
