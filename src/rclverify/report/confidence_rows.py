@@ -22,6 +22,7 @@ from typing import Mapping, cast
 import msgspec
 
 from rclverify.records.report_record import AssuranceReport
+from rclverify.records.requirement_check import RequirementCheckRow
 from rclverify.records.requirement_rows import RequirementRow, StrengthKind
 from rclverify.records.strength_rows import LimitedBy, Strength
 from rclverify.report.shapes import Confidence, RequirementConfidence
@@ -104,28 +105,28 @@ def confidence_part(report: AssuranceReport, links: list[tuple[str, str]],
     part.nodes = {n.name: _put(claims[n.name]) for n in report.nodes}
     derived = derived_claims(own, producers)
     part.derived = {d.node: _put(derived[d.node]) for d in report.derived_properties if d.node in derived}
-    lows = [_requirement(rq, guarantee, sc_premises, (required or {}).get(rq.id), part)
-            for rq in report.requirements if rq.check.get("formal")]
+    lows = [_requirement(rq, check, guarantee, sc_premises, (required or {}).get(rq.id), part)
+            for rq in report.requirements if (check := RequirementCheckRow.of(rq.check)).formal]
     if lows:
         part.confidence = min(lows)
     return part
 
 
-def _requirement(rq: RequirementRow, guarantee: Mapping[tuple[str, int], Premise],
+def _requirement(rq: RequirementRow, check: RequirementCheckRow, guarantee: Mapping[tuple[str, int], Premise],
                  sc_premises: Mapping[str, list[Premise]], need: str | None, part: ConfidencePart) -> float:
-    """Put a formal requirement's confidence (C5) and its shortfall of ``need`` into ``part``; its confidence."""
-    check = rq.check  # the check record (free-form: calculus/requirements/check.py)
-    two = (check.get("solvers") or {}).get("agreement") == "two solvers"
+    """Put a formal requirement's confidence (C5) and its shortfall of ``need`` into ``part``; its confidence.
+    ``check``: its check record, decoded."""
+    two = check.solvers is not None and check.solvers.agreement == "two solvers"
     proof = Premise(f"the proof of {rq.id}", "proof", DOUBT["proof2" if two else "proof"])
     used: list[Premise] = []
     rests: list[Premise] = []  # the guarantees the proof used
-    for p in check.get("used") or []:
-        if p.get("kind") == "guarantee" and (p.get("node"), p.get("index")) in guarantee:
-            rests.append(guarantee[(p["node"], p["index"])])
+    for p in check.used:
+        if p.kind == "guarantee" and p.node is not None and (p.node, p.index) in guarantee:
+            rests.append(guarantee[(p.node, p.index)])
             used.append(rests[-1])
-            used.extend(sc_premises.get(p["node"], []))
+            used.extend(sc_premises.get(p.node, []))
         else:
-            used.append(Premise(str(p.get("label", p.get("kind"))), "assumed", DOUBT["assumed"]))
+            used.append(Premise(p.label, "assumed", DOUBT["assumed"]))
     c = requirement_claim(rq.verdict in _PROVED, proof, used)
     required: StrengthKind | None = None
     shortfall: list[str] = []
