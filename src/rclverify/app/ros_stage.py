@@ -16,12 +16,13 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path, PurePosixPath
-from typing import Any
+from typing import Any, Sequence
 
 from rclverify.lang import ast
 from rclverify.records.stage_records import GroundedNode, GroundingContext, GroundingRecord
 from rclverify.model.plan.errors import plan_error
 from rclverify.model.plan.mapping_file import DEFAULT_MAPPING, plan_mapping
+from rclverify.model.plan.ros_section import RosSection
 from rclverify.ros.extract import names
 from rclverify.ros.graph.inputs import input_files
 
@@ -32,12 +33,10 @@ SVG = "artifacts/ros/grounding.svg"
 CACHE = "artifacts/cache/ros-scan.pickle"
 
 
-def _paths(ws: Any, key: str, missing: list[Any] | None = None) -> list[Path]:
-    """The existing paths of ``ros.<key>``.  A path that leaves the workspace is
-    a plan error (raised); one that does not exist is appended to ``missing``
-    as ``(loc, message)``: a grounding error, which never stops the pipeline."""
-    ros = ws.plan.ros
-    vals = ros.get(key, []) or []
+def _paths(ws: Any, key: str, vals: Sequence[str], missing: list[Any] | None = None) -> list[Path]:
+    """The existing paths of ``ros.<key>`` (``vals``, as the section gives them).  A path that leaves the
+    workspace is a plan error (raised); one that does not exist is appended to ``missing`` as ``(loc,
+    message)``: a grounding error, which never stops the pipeline."""
     out = []
     for i, v in enumerate(vals):
         loc = ws.plan.locs.get(("ros", key, i), ast.Loc(ws.plan.file, 1, 1))
@@ -54,9 +53,8 @@ def _paths(ws: Any, key: str, missing: list[Any] | None = None) -> list[Path]:
     return out
 
 
-def _fields(ws: Any) -> dict[str, list[str]]:
+def _fields(ws: Any, ros: RosSection) -> dict[str, list[str]]:
     import yaml  # deferred: start-up (loads yaml only when called)
-    ros = ws.plan.ros
     out: dict[str, list[str]] = {}
     mapping = plan_mapping(ws.plan) or DEFAULT_MAPPING  # the plan's one mapping file (ros.mapping, else the monitors entries')
     if mapping:
@@ -67,8 +65,8 @@ def _fields(ws: Any) -> dict[str, list[str]]:
                     out[str(t).lstrip("/")] = [str(f) for f in spec["fields"]]
         except (OSError, yaml.YAMLError, AttributeError):
             pass  # the monitors stage reports a bad mapping file, located
-    for t, fs in (ros.get("fields") or {}).items():
-        out[str(t).lstrip("/")] = [str(f) for f in fs]
+    for t, fs in ros.fields.items():
+        out[t.lstrip("/")] = list(fs)
     return out
 
 
@@ -82,17 +80,17 @@ def stage_ground(ws: Any) -> GroundingRecord:
     from rclverify.records.store import atomic_write_text  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     from rclverify.ros.graph.scan import scan  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     from rclverify.ros.ground.ground import ground  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
-    ros = ws.plan.ros
+    ros = RosSection.of(ws.plan.ros)
     missing: list[Any] = []
-    wss = _paths(ws, "workspaces", missing)
-    launch = _paths(ws, "launch", missing)
-    bags = _paths(ws, "bags", missing)
-    args = {str(k): (str(v).lower() if isinstance(v, bool) else str(v)) for k, v in (ros.get("args") or {}).items()}
+    wss = _paths(ws, "workspaces", ros.workspaces, missing)
+    launch = _paths(ws, "launch", ros.launch, missing)
+    bags = _paths(ws, "bags", ros.bags, missing)
+    args = {k: (str(v).lower() if isinstance(v, bool) else str(v)) for k, v in ros.args.items()}
     res = scan(wss, launch, args, bags, ws.root / CACHE, base=ws.root)
     plan_loc = ws.plan.locs.get(("ros",), ast.Loc(ws.plan.file, 1, 1))
     from rclverify.ros.ground.ground import Finding  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
     findings = [Finding("ROS-SCAN", "error", msg, loc, None) for loc, msg in missing]
-    findings += ground(res, ws.checked, ws.plan.file, ros, _fields(ws), plan_loc)
+    findings += ground(res, ws.checked, ws.plan.file, ros, _fields(ws, ros), plan_loc)
     g = res.graph
     graph_json = g.to_json()
     counts = {"error": sum(f.severity == "error" for f in findings),
@@ -109,9 +107,8 @@ def stage_ground(ws: Any) -> GroundingRecord:
     from rclverify.report.diagram import dot_to_svg  # deferred: start-up (loads jinja2, rclverify.core and more only when called)
     from rclverify.ros.graph.draw import grounding_dot  # deferred: start-up (loads jinja2, rclverify.ros and more only when called)
     from rclverify.ros.ground.ground import match_nodes  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
-    ignore = {names.normalise(n) for n in ros.get("ignore", []) or []}
-    pairs = match_nodes(ws.checked.nodes, {k: v for k, v in g.nodes.items() if k not in ignore},
-                        dict(ros.get("nodes", {}) or {}))
+    ignore = {names.normalise(n) for n in ros.ignore}
+    pairs = match_nodes(ws.checked.nodes, {k: v for k, v in g.nodes.items() if k not in ignore}, dict(ros.nodes))
     dot = grounding_dot(ws.checked, graph_json, found, pairs)
     svg = dot_to_svg(dot)
     atomic_write_text(ws.path(DOT), dot)

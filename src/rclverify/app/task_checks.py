@@ -22,32 +22,32 @@ from typing import Any, Mapping
 from rclverify import __version__
 from rclverify.model.plan.declarations import DECLARATIONS
 from rclverify.model.plan.paths import config_strings
+from rclverify.model.plan.ros_section import RosSection
 from rclverify.records.store import EvidenceStore
 
 
-def ros_fingerprint(root: Path, ros: Mapping[str, Any]) -> list[tuple[str, int, int, int]]:
+def ros_fingerprint(root: Path, section: RosSection | Mapping[str, Any]) -> list[tuple[str, int, int, int]]:
     """(path, size, mtime_ns, ctime_ns) of every file under the ``ros:``
     section's paths: the grounding task runs again when one changes (the
     scan's own cache then re-parses only the changed files).  The change
     time is set by every write and every ``utime``, so an edit that keeps
     the size and restores the modification time is a change too."""
+    ros = RosSection.of(section)
     out: list[tuple[str, int, int, int]] = []
-    for key in ("workspaces", "launch", "bags"):
-        for rel in ros.get(key, []) or []:
-            top = root / str(rel)
-            files = [top] if top.is_file() else sorted(p for p in top.rglob("*") if p.is_file()) if top.is_dir() else []
-            for p in files:
-                try:
-                    st = p.stat()
-                except OSError:
-                    continue
-                out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns, st.st_ctime_ns))
-    for key in ("mapping",):
-        if ros.get(key):
-            p = root / str(ros[key])
-            if p.is_file():
+    for rel in (*ros.workspaces, *ros.launch, *ros.bags):
+        top = root / rel
+        files = [top] if top.is_file() else sorted(p for p in top.rglob("*") if p.is_file()) if top.is_dir() else []
+        for p in files:
+            try:
                 st = p.stat()
-                out.append((str(ros[key]), st.st_size, st.st_mtime_ns, st.st_ctime_ns))
+            except OSError:
+                continue
+            out.append((str(p.relative_to(root)), st.st_size, st.st_mtime_ns, st.st_ctime_ns))
+    if ros.mapping:
+        p = root / ros.mapping
+        if p.is_file():
+            st = p.stat()
+            out.append((ros.mapping, st.st_size, st.st_mtime_ns, st.st_ctime_ns))
     return out
 
 

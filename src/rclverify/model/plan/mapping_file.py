@@ -22,6 +22,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from rclverify.model.plan.model import Plan
+from rclverify.model.plan.ros_section import RosSection
 
 #: The mapping file of a workspace whose plan names none (workspace-relative).
 DEFAULT_MAPPING = "backends/monitors/mapping.yaml"
@@ -47,8 +48,8 @@ def plan_mapping(plan: Plan | None, node: str | None = None, config: Mapping[str
         for e in plan.evidence.get(node, ()):
             if e.backend == "monitors" and _named(e.config) is not None:
                 return str(_named(e.config))
-    ros = plan.ros.get("mapping") if isinstance(plan.ros, Mapping) else None
-    if isinstance(ros, str) and ros:
+    ros = RosSection.of(plan.ros if isinstance(plan.ros, Mapping) else None).mapping
+    if ros:
         return ros
     for entries in plan.evidence.values():
         for e in entries:

@@ -121,7 +121,8 @@ class Plan:
     replacements: Mapping[str, tuple[str, ast.Loc]] = field(default_factory=dict)
     locs: Mapping[Path_, ast.Loc] = field(default_factory=dict)
     name: str = ""
-    #: the ``ros:`` section as written (grounding, docs/ros.md); empty when absent
+    #: the ``ros:`` section as written (grounding, docs/ros.md; its readers decode it once into
+    #: :class:`~rclverify.model.plan.ros_section.RosSection`); empty when absent
     ros: Mapping[str, Any] = field(default_factory=dict)
     #: ``requirements_from: {doorstop: DIR}``: Doorstop document trees read for
     #: more requirements (:func:`.doorstop.read_requirements`), with the entry's location.

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from rclverify.model.plan.ros_section import RosSection
 from rclverify.ros.extract import safefs
 
 
@@ -17,16 +18,14 @@ def input_files(ws: Any) -> list[str]:
     ``workspaces``, ``launch``, ``bags`` and its ``mapping`` (hashed into the
     grounding record, ``inputs``: the report shows a grounding made from
     other files ``stale``)."""
-    ros = ws.plan.ros or {}
+    ros = RosSection.of(ws.plan.ros)
     out = {ws.plan.file, *ws.plan.contracts}
-    for key in ("workspaces", "launch", "bags", "mapping"):
-        vals = ros.get(key) or []
-        for rel in [vals] if isinstance(vals, str) else vals:
-            top = ws.root / str(rel)
-            if top.is_file():
-                out.add(str(rel))
-            elif top.is_dir():
-                # regular files only, no links, names valid UTF-8: what the scan reads (docs/ros.md)
-                out.update(p.relative_to(ws.root).as_posix() for p in top.rglob("*")
-                           if not p.is_symlink() and p.is_file() and safefs.utf8_name(str(p)))
+    for rel in (*ros.workspaces, *ros.launch, *ros.bags, *([ros.mapping] if ros.mapping else [])):
+        top = ws.root / rel
+        if top.is_file():
+            out.add(rel)
+        elif top.is_dir():
+            # regular files only, no links, names valid UTF-8: what the scan reads (docs/ros.md)
+            out.update(p.relative_to(ws.root).as_posix() for p in top.rglob("*")
+                       if not p.is_symlink() and p.is_file() and safefs.utf8_name(str(p)))
     return sorted(out)

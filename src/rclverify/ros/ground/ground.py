@@ -43,6 +43,7 @@ from dataclasses import dataclass
 from typing import Any, Iterable, Mapping
 
 from rclverify.lang import ast
+from rclverify.model.plan.ros_section import RosSection
 from rclverify.ros.extract import names
 from rclverify.ros.graph.scan import ScanResult
 from rclverify.ros.ground.ground_services import RULES as SERVICE_RULES
@@ -126,14 +127,14 @@ def match_nodes(contract_nodes: Iterable[str], graph: Mapping[str, GraphNode],
 
 
 class Grounder(FieldGrounding):
-    def __init__(self, scan: ScanResult, checked: Any, plan_file: str, ros: Mapping[str, Any],
+    def __init__(self, scan: ScanResult, checked: Any, plan_file: str, ros: RosSection | Mapping[str, Any],
                  fields_by_topic: Mapping[str, list[str]], plan_loc: ast.Loc) -> None:
         self.scan = scan
         self.g = folded(scan.graph)  # actions on raw actionlib topics are actions (master.py's rule)
         self.table: TypeTable = scan.table
         self.checked = checked
         self.plan_file = plan_file
-        self.ros = ros
+        self.ros = RosSection.of(ros)  # the plan's ros: section as written, or its record
         self.fields = fields_by_topic
         self.plan_loc = plan_loc
         self.findings: list[Finding] = []
@@ -142,11 +143,11 @@ class Grounder(FieldGrounding):
         self.findings.append(Finding(code, RULES[code][0], message, rcl, ros, node, topic))
 
     def run(self) -> list[Finding]:
-        ignore = {names.normalise(n) for n in self.ros.get("ignore", []) or []}
-        external = {names.normalise(t) for t in self.ros.get("external", []) or []}
+        ignore = {names.normalise(n) for n in self.ros.ignore}
+        external = {names.normalise(t) for t in self.ros.external}
         graph_nodes = {k: v for k, v in self.g.nodes.items() if k not in ignore}
         self.graph_nodes, self.external = graph_nodes, external
-        explicit = dict(self.ros.get("nodes", {}) or {})
+        explicit = dict(self.ros.nodes)
         pairs = match_nodes(self.checked.nodes, graph_nodes, explicit)
         publishers: dict[str, list[tuple[str, GraphEdge]]] = {t: [] for t in external}
         for n in graph_nodes.values():
@@ -318,7 +319,7 @@ class Grounder(FieldGrounding):
         if var is not None:
             self._fields(cn, tp, var, ctype, rcl_loc)
 
-def ground(scan: ScanResult, checked: Any, plan_file: str, ros: Mapping[str, Any],
+def ground(scan: ScanResult, checked: Any, plan_file: str, ros: RosSection | Mapping[str, Any],
            fields_by_topic: Mapping[str, list[str]], plan_loc: ast.Loc) -> list[Finding]:
     """All grounding findings, contract by contract, then graph nodes without contract,
     then the scan's own located warnings (``ROS-SCAN``)."""
