@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from rclverify.records.grounding_rows import GroundingRow
+from rclverify.records.grounding_findings import GroundingFindingRow
 from rclverify.records.records import SEVERITY
 from rclverify.records.report_record import AssuranceReport
 from rclverify.report.shapes import GroundingBrief, SummaryData
@@ -21,21 +22,22 @@ def _rank(status: str) -> int:
     return SEVERITY.get(status, SEVERITY["error"])
 
 
-def _place(f: Mapping[str, Any]) -> str:
+def _place(f: GroundingFindingRow) -> str:
     """``file:line:col: `` of a grounding finding (its RCL place, else its ROS one), ``""`` without a file."""
-    at = f.get("rcl") or f.get("ros") or {}
-    return f"{at['file']}:{at.get('line', 1)}:{at.get('col', 1)}: " if at.get("file") else ""
+    at = f.rcl or f.ros
+    return f"{at.text()}: " if at is not None and at.file else ""
 
 
 def grounding_brief(g: GroundingRow | None) -> GroundingBrief | None:
     """The ROS grounding (docs/ros.md; the report's ``grounding`` decoded) as the terminal shows it:
     ``{"error": n, "warning": m, "errors": ["file:line:col: message (CODE)", ...]}``; ``None`` when
     the plan has no ``ros:`` section.  A finding is the ROS check's own JSON object
-    (:class:`~rclverify.records.grounding_rows.GroundingRow` ``findings``)."""
+    (:class:`~rclverify.records.grounding_rows.GroundingRow` ``findings``), decoded
+    (:class:`~rclverify.records.grounding_findings.GroundingFindingRow`)."""
     if g is None:
         return None
-    errors = [f"{_place(f)}{f.get('message', '')} ({f.get('code', '')})"
-              for f in g.findings if f.get("severity") == "error"]
+    found = [GroundingFindingRow.of(f) for f in g.findings]
+    errors = [f"{_place(f)}{f.message or ''} ({f.code})" for f in found if f.severity == "error"]
     return {"error": g.counts.error, "warning": g.counts.warning, "errors": errors}
 
 
