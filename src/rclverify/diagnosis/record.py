@@ -17,11 +17,11 @@ import msgspec
 
 from rclverify.diagnosis.shapes import ReportRows
 from rclverify.records.problem_rows import DiagnosisRow
-from rclverify.records.repair_rows import CexTableRow, CulpritRow, RepairRow
+from rclverify.records.repair_rows import CexTableRow, DiagnosisCulprit, RepairRow
 from rclverify.records.stage_records import CexRow, Culprit, DiagnosisEntry, Repair
 from rclverify.records.statuses import AnyStatus
 
-P = TypeVar("P", CulpritRow, CexTableRow, RepairRow)
+P = TypeVar("P", DiagnosisCulprit, CexTableRow, RepairRow)
 
 
 def _decoded(cls: type[P], items: Sequence[Culprit] | Sequence[CexRow] | Sequence[Repair]) -> list[P]:
@@ -53,7 +53,7 @@ def diagnosis_record(id: str, kind: str, node: str, status: AnyStatus, sentence:
     (:class:`~rclverify.records.problem_rows.DiagnosisRow`); the repairs that are ``None`` left
     out; ``related`` is filled in by :func:`rclverify.diagnosis.build.diagnose`."""
     return DiagnosisRow(id, kind, node, status, sentence,
-                        culprits=_decoded(CulpritRow, culprits or []),
+                        culprits=_decoded(DiagnosisCulprit, culprits or []),
                         counterexample=_decoded(CexTableRow, counterexample or []),
                         repairs=_decoded(RepairRow, [r for r in repairs if r]), guarantee=guarantee, related=[],
                         not_offered=not_offered, joins=joins, lint=lint, passes_through=passes_through,
@@ -63,7 +63,7 @@ def diagnosis_record(id: str, kind: str, node: str, status: AnyStatus, sentence:
 def with_culprits(rec: DiagnosisRow, node: str, sentence: str, culprits: Sequence[Culprit],
                   repairs: Sequence[Repair]) -> DiagnosisRow:
     """``rec`` naming ``culprits`` of ``node`` in ``sentence``, with their ``repairs``."""
-    return msgspec.structs.replace(rec, node=node, sentence=sentence, culprits=_decoded(CulpritRow, culprits),
+    return msgspec.structs.replace(rec, node=node, sentence=sentence, culprits=_decoded(DiagnosisCulprit, culprits),
                                    repairs=_decoded(RepairRow, repairs))
 
 

@@ -18,7 +18,7 @@ The rules (docs/decisions.md, "One definition per record"):
   (the fields in the order declared).  A field whose default is ``UNSET``
   is absent from the JSON when the record has nothing to say.
 * The culprits, counterexample rows and repairs of a diagnosis are
-  records/repair_rows.py's :class:`~rclverify.records.repair_rows.CulpritRow`,
+  records/repair_rows.py's :class:`~rclverify.records.repair_rows.DiagnosisCulprit`,
   :class:`~rclverify.records.repair_rows.CexTableRow` and
   :class:`~rclverify.records.repair_rows.RepairRow`; a problem row's culprits
   (report/problems_places.py ``culprit``) are left open here.
@@ -40,7 +40,7 @@ from typing import Annotated, Any, Iterable, Mapping
 
 import msgspec
 
-from rclverify.records.repair_rows import CexTableRow, CulpritRow, RepairRow
+from rclverify.records.repair_rows import CexTableRow, DiagnosisCulprit, RepairRow
 from rclverify.records.row import DOC, Row, decode_rows
 from rclverify.records.shared_rows import ItemRow
 from rclverify.records.statuses import AnyStatus
@@ -55,7 +55,7 @@ class DiagnosisRow(ItemRow, frozen=True, forbid_unknown_fields=True, omit_defaul
     node: Annotated[str, _DOC(description="The node's name as the contracts declare it.")]
     status: Annotated[AnyStatus, _DOC(description="Its status.")]
     sentence: Annotated[str, _DOC(description="One sentence for a reader.")]
-    culprits: Annotated[list[CulpritRow], _DOC(description="The items to repair.")]
+    culprits: Annotated[list[DiagnosisCulprit], _DOC(description="The items to repair.")]
     counterexample: Annotated[list[CexTableRow], _DOC(description="The counterexample, as rows a reader follows.")]
     repairs: Annotated[list[RepairRow], _DOC(description="Repairs, each checked by Z3 before it is offered.")]
     guarantee: Annotated[int | None, _DOC(description="1-based guarantee index, null when it concerns the whole "

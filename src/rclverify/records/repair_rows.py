@@ -1,4 +1,4 @@
-"""A diagnosis's culprits, counterexample rows and repairs, defined once: :class:`CulpritRow`,
+"""A diagnosis's culprits, counterexample rows and repairs, defined once: :class:`DiagnosisCulprit`,
 :class:`CexTableRow` (with :class:`FunctionTableRow`), :class:`RepairRow` (with :class:`EditRow`,
 :class:`RepairCheck`, :class:`RepairCost`).
 
@@ -21,7 +21,7 @@ import msgspec
 from rclverify.records.row import DOC, Row
 
 
-class CulpritRow(Row, frozen=True, forbid_unknown_fields=True):
+class DiagnosisCulprit(Row, frozen=True, forbid_unknown_fields=True):
     """What a diagnosis names to repair (diagnosis/build.py and the other producers)."""
 
     what: Annotated[str, DOC(description="The culprit in words.")]
@@ -91,4 +91,4 @@ class RepairRow(Row, frozen=True, forbid_unknown_fields=True):
                                            "a report written before repairs recorded it: not applied).")] = ""
 
 
-__all__ = ["CexTableRow", "CulpritRow", "EditRow", "FunctionTableRow", "RepairCheck", "RepairCost", "RepairRow"]
+__all__ = ["CexTableRow", "DiagnosisCulprit", "EditRow", "FunctionTableRow", "RepairCheck", "RepairCost", "RepairRow"]
