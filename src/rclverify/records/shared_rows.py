@@ -1,7 +1,10 @@
 """The field lists several report records share because they mean the same
 thing, declared once as bases the records derive from (their JSON and their
 part of docs/assurance.schema.json are as if each declared the fields
-itself: a base's fields come first, in the order declared):
+itself: a base's fields come first, in the order declared, so a list is
+declared here only where it means the same thing in each record and leads
+each record's fields; the trailing ``inputs``, ``stale``, ``altered`` of the
+stages' rows stay in each, since a base would move them first in the JSON):
 
 * :class:`WorkspacePlaceRow`: a place in the workspace (a design file's
   field, a contract clause, a NoDL finding's place): ``file``, ``line``,
