@@ -132,14 +132,31 @@ def test_a_correct_robot_is_never_red(correct_run: dict[str, Any]) -> None:
         assert log[node]["violated"] == 0 and log[node]["deadline false"] == 0, (node, log[node])
 
 
+#: the last seconds of a live run (s) whose messages may be left a provisional verdict when the monitor
+#: stops: the sensors publish until the robot is stopped, after the monitor (bench/_robot_declarations.py)
+END_S = 2.0
+
+
+def _unsettled(res: dict[str, Any], other: str) -> list[str]:
+    """The messages whose final verdict live differs from ``other``'s (``"log"``, ``"bag"``), a
+    provisional live verdict included, except one still provisional on a message of the run's last
+    :data:`END_S` seconds (in flight when the monitor stopped: reported apart, never final)."""
+    from _robot_verdicts import compare
+    live = res["finals"]["live"]
+    end = max((float(r["time"]) for rs in live.values() for r in rs), default=0.0)
+    return [d.text(("live", other)) for d in compare(live, res["finals"][other])
+            if not d.placed_apart and not (d.provisional and d.time >= end - END_S)]
+
+
 @pytest.mark.live
 def test_a_correct_robot_is_judged_alike_live_and_on_its_log(correct_run: dict[str, Any]) -> None:
     """Verdict by verdict: every message's final verdict live is its verdict offline on the log.  Seed 0's
     stamp-copying relay may meet fault 8 on its first answer, heard late: the reading it answers is given
-    ``superseded`` live, provisional, and the answer withdraws it (tests/backends/test_superseded_withdrawn.py)."""
+    ``superseded`` live, provisional, and the answer withdraws it (tests/backends/test_superseded_withdrawn.py);
+    a verdict still provisional is allowed only on a message in flight when the monitor stopped."""
     res = correct_run
     assert sum(len(x) for x in res["finals"]["live"].values()) > 50
-    assert [d for d in res["disagreements"] + res["provisional"] if "live != log" in d] == []
+    assert _unsettled(res, "log") == []
 
 
 @pytest.mark.live
@@ -153,7 +170,7 @@ def test_the_recorded_bag_of_a_correct_robot_is_read_back(correct_run: dict[str,
     bag = _tally(res["finals"]["bag"])
     for node in (n["name"] for n in res["spec"]["nodes"]):
         assert bag[node]["satisfied"] > 0, (node, bag[node])
-    assert [d for d in res["disagreements"] + res["provisional"] if "live != bag" in d] == []
+    assert _unsettled(res, "bag") == []
 
 
 @pytest.mark.live
