@@ -207,7 +207,10 @@ def test_a_problem_sentence_is_cut_at_a_clause_boundary_or_not_at_all() -> None:
              "out.radiationStatus = orange, which the conjunct `(0 <= in.r and in.r < 120) -> out.radiationStatus == "
              "green` (contracts/r.rcl:88:11) rules out.")
     # the report's row keeps a prefix; what the terminal shows is the whole first sentence
-    group = {"sentence": first_sentence(whole, 300), "members": [{"sentence": whole + " More follows."}]}
+    from rclverify.records.problem_rows import ProblemRow
+    from tests.records._typed_rows import complete
+    group = ProblemRow.of(complete(ProblemRow, {"sentence": first_sentence(whole, 300),
+                                                "members": [{"sentence": whole + " More follows."}]}))
     assert group_sentence(group) == whole
     assert clause_cut(whole) == whole  # short enough: whole
     cut = clause_cut(whole, 300)

@@ -171,11 +171,9 @@ def _text(value: object) -> str:
     return value if isinstance(value, str) else ""
 
 
-def group_sentence(group: ProblemRow | Mapping[str, Any]) -> str:
-    """The first sentence of a problem group (its row, or its JSON object), whole (:func:`whole_sentence`)."""
-    if isinstance(group, ProblemRow):
-        return whole_sentence(group.sentence, [m.sentence for m in group.members])
-    return whole_sentence(str(group.get("sentence", "")), [str(m.get("sentence", "")) for m in group.get("members", [])])
+def group_sentence(group: ProblemRow) -> str:
+    """The first sentence of a problem group (its row, decoded), whole (:func:`whole_sentence`)."""
+    return whole_sentence(group.sentence, [m.sentence for m in group.members])
 
 
 def whole_sentence(short: str, members: Iterable[str]) -> str:
