@@ -71,12 +71,19 @@ def _breaking_assignments(ws: Any, program: str, cex: Mapping[str, object], bind
         return []
 
 
-def _obligation_record(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
+def _obligation_data(ws: Any, node: str, oid: str) -> Mapping[str, Any]:
+    """The backend's ``data`` of obligation ``oid`` of ``node`` (its sealed obligation list's record,
+    decoded: :class:`rclverify.records.records.Obligation`); ``{}`` when the list does not hold it or
+    holds it in another shape."""
+    from rclverify.records.records import Obligation  # deferred: start-up (as below)
     from rclverify.records.sealed import obligation_list  # deferred: start-up (loads rclverify.records, rclverify.records.records and more only when called)
     records, _ = obligation_list(ws.path(ws.obligations(node)))  # [] when altered outside rclverify
     for o in records or []:
         if isinstance(o, dict) and o.get("id") == oid:
-            return dict(o)
+            try:
+                return Obligation.from_json(o).data
+            except msgspec.ValidationError:
+                return {}
     return {}
 
 
@@ -97,7 +104,7 @@ def _run_repairs(ws: Any, e: EvidenceRow, node: str, cache: RepairCache) -> Moni
     payload = _monitors_payload(ws, e.obligation) if e.status == "failed" else None
     if payload is None:
         return MonitorRepairs()
-    return report_repairs(ws, e.obligation, node, _obligation_record(ws, node, e.obligation).get("data") or {},
+    return report_repairs(ws, e.obligation, node, _obligation_data(ws, node, e.obligation),
                           payload, cache)
 
 
@@ -151,7 +158,7 @@ def evidence_record(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRo
     ce = e.counterexample
     if backend == "property_tests" and ce is not None:
         cex = {kk: v for kk, v in ce.items() if kk not in _META_KEYS}
-        impl = _obligation_record(ws, node, e.obligation).get("data", {}).get("implementation", "the implementation")
+        impl = _obligation_data(ws, node, e.obligation).get("implementation", "the implementation")
         cause = ce.get("cause")  # the implementation line the example takes
         sentence = (f"Hypothesis found inputs on which {impl} "
                     f"violates {where}" + (f"; the implementation line where the failing example goes wrong is {cause}"
@@ -185,8 +192,7 @@ def _hoare(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRow, cache:
     from rclverify.backends.hoare import lang  # deferred: start-up (loads jinja2, z3 and more only when called)
     from rclverify.backends.hoare.culprit_lines import compared_constants  # deferred: start-up (loads jinja2, z3 and more only when called)
     node, k = o.node, o.guarantee
-    rec = _obligation_record(ws, node, e.obligation)
-    data = rec.get("data", {})
+    data = _obligation_data(ws, node, e.obligation)
     program = data.get("program", "")
     conj, conj_src = data.get("conjunct_rcl", ""), data.get("conjunct_source", "")
     prog_consts: list[str] = []
