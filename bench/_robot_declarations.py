@@ -23,8 +23,9 @@ node it is drawn for, judged by the rules of docs/monitors.md, "Declarations on 
   seed 821 with ``P`` a second smaller).
   The period is judged on the messages' header stamps, else their source times, and the run's end on
   the trace's times (docs/monitors.md, "Periodic outputs"): a stamped sensor is declared periodic only
-  on the wall clock with its driver's stamps on it (``sim_clock`` off, ``driver_offset_s`` 0); an
-  unstamped one (its source times, the wall clock) on every clock.
+  on the wall clock with its driver's stamps on it (``sim_clock`` off, ``driver_offset_s`` 0), where
+  its stamps and the run's times are one clock; an unstamped one (its source times, the wall clock) on
+  every clock.
 * an **alarm**, a **relay** stamping with its own clock: ``progress( within 2 steps )``; it answers
   every input after 0-30 % of the input's period, an answer due within a stamped sensor's publication
   window just after it (so at most one input comes between an input and its answer), and one step more
