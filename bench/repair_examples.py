@@ -197,7 +197,7 @@ class Outcome:
 def run_defect(d: Defect, where: Path) -> Outcome:
     """Seed ``d`` in a copy of its workspace under ``where`` and run the tool on it (module docstring)."""
     from rclverify.app.pipeline import Workspace
-    from rclverify.diagnosis.code_repair import checked_repairs, repaired_line
+    from rclverify.diagnosis.code_repair_check import checked_repairs, repaired_line
     from rclverify.diagnosis.edits import Edit
     t0 = time.perf_counter()
     slipped = _workspace(d, where / "slipped", d.slipped)

@@ -225,7 +225,7 @@ def run_case(case: Case, where: Path) -> Outcome:
     docstring): the property tests until one fails with a cause, then the checked repairs, each judged."""
     from rclverify.app.pipeline import Workspace
     from rclverify.backends.property_tests.harness import read_config, run_guarantee
-    from rclverify.diagnosis.code_repair import checked_repairs
+    from rclverify.diagnosis.code_repair_check import checked_repairs
     from rclverify.diagnosis.edits import Edit
     t0 = time.perf_counter()
     (where / "contracts").mkdir(parents=True)

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from rclverify.diagnosis.code_repair import around_lines, candidate_edits, repaired_line
+from rclverify.diagnosis.code_repair import around_lines, candidate_edits
+from rclverify.diagnosis.code_repair_check import repaired_line
 
 SRC = '''"""A node."""
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import msgspec
 
-from rclverify.diagnosis.code_repair import checked_repairs, repaired_line
+from rclverify.diagnosis.code_repair_check import checked_repairs, repaired_line
 from rclverify.diagnosis.constants import hoare_repair
 from rclverify.diagnosis.hoare_tokens import hoare_token_repairs
 from rclverify.diagnosis.monitor_repair import MonitorRepairs, report_repairs

@@ -7,7 +7,7 @@ strictness alone still fails at the other end).
 ranks them, keeps the first :data:`PAIR_FROM` that lie on that one line, and joins each two that do not
 overlap into one edit of the text between them (:func:`joined`), the pairs of better-ranked corrections
 first (the sum of their two ranks, then the first's), at most :data:`MAX_PAIRS`.  Each is checked as a
-one-token correction is (:func:`.code_repair.checked_repairs`).
+one-token correction is (:func:`.code_repair_check.checked_repairs`).
 """
 from __future__ import annotations
 
