@@ -35,7 +35,6 @@ from rclverify.cli.monitor_outcome import print_not_judged, selected_nodes, stri
 from rclverify.backends.monitors.declarations import declaration_status
 from rclverify.backends.monitors.periods import period_status
 from rclverify.backends.monitors.recorded import RecordedRun, check_recorded
-from rclverify.backends.monitors.verdict_lines import verdict_record, write_records
 
 
 def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
@@ -70,6 +69,8 @@ def monitor_command(args: argparse.Namespace, checked: Checked) -> int:
     unjudged: list[dict[str, str]] = []
     report: list[Mapping[str, object]] = []
     records: list[dict[str, Any]] = []  # --verdicts: every verdict, one line each (verdict_lines.py)
+    if getattr(args, "verdicts", None):
+        from rclverify.backends.monitors.verdict_lines import verdict_record, write_records  # deferred: start-up (only with --verdicts)
     for trace in args.traces:
         keep = (lambda kind, v, stamp, t=trace: records.append({**verdict_record(kind, v, stamp), "trace": t})) \
             if getattr(args, "verdicts", None) else None

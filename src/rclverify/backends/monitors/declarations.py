@@ -54,7 +54,6 @@ from typing import Any, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance, judge
 from rclverify.lang import ast
-from rclverify.lang.liveness import _steps
 from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import free_names, subexpressions
@@ -154,6 +153,8 @@ class DeclarationMonitor:
         #: the outputs whose first value an ``initially`` reads and that were not published yet
         self.awaited = {o for ini in self.initials for o in ini.outs}
         self.counts: list[_Count] = []
+        if node.node.progress or node.node.periodic:
+            from rclverify.lang.liveness import _steps  # deferred: start-up (lang.timing and lang.liveness only for a node with progress or periodic)
         for p in node.node.progress:
             k = _steps(p.bound) if p.bound is not None else None
             self.counts.append(_Count("progress", source_text(p.loc), k, frozenset(),

@@ -18,7 +18,6 @@ from rclverify.semantics.robustness import Margin, MarginUndefined, margin
 from rclverify.semantics.values import render
 from rclverify.traces.events import Event
 from rclverify.traces.questions import Question
-from rclverify.traces.typed_text import render_as
 from rclverify.backends.monitors.outcome import Outcome
 from rclverify.backends.monitors.verdicts import WEAK as _WEAK
 from rclverify.backends.monitors.engine_state import EngineState
@@ -124,8 +123,13 @@ class Judging(EngineState):
             if hit is None or hit[0] is not v:
                 if len(self._renders) >= 256:
                     self._renders.clear()
-                typ = (self.node.inputs if k.startswith("in.") else self.node.outputs).get(k.split(".", 1)[-1])
-                hit = self._renders[id(v)] = (v, render_as(v, typ) if isinstance(v, tuple) else render(v))  # <a, b>
+                if isinstance(v, tuple):  # <a, b>
+                    from rclverify.traces.typed_text import render_as  # deferred: start-up (only for a tuple value)
+                    typ = (self.node.inputs if k.startswith("in.") else self.node.outputs).get(k.split(".", 1)[-1])
+                    hit = (v, render_as(v, typ))
+                else:
+                    hit = (v, render(v))
+                self._renders[id(v)] = hit
             out[k] = hit[1]
         return out
 
