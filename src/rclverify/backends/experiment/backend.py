@@ -37,6 +37,7 @@ from rclverify.backends.experiment.criterion import evaluate
 from rclverify.backends.experiment.figures import format_value
 from rclverify.backends.experiment.plot import render_svg
 from rclverify.core.extras import MissingExtra
+from rclverify.backends.experiment.payload import ExperimentPayload
 from rclverify.backends.experiment.target import run_target, target_obligations
 from rclverify.backends.shapes import ExperimentDetails
 
@@ -127,7 +128,8 @@ class ExperimentBackend:
         log = "\n".join([f"criterion: {cfg.criterion_text}", f"figures: {figures}",
                          f"criterion holds: {verdict.holds}"] + [f"flag: {f['bound']}: {f['explanation']}" for f in flags])
         log += plot_note.replace("; ", "\n", 1)
-        kw: dict[str, object] = dict(log=log, artifacts=(plot,) if plot else (), details=details)
+        kw: dict[str, object] = dict(log=log, artifacts=(plot,) if plot else (),
+                                   details=ExperimentPayload.checked(details))
         flag_text = ("; the summary statistics cannot all be true together: "
                      + "; ".join(f"{f['bound']}: {f['explanation']}" for f in flags)) if flags else ""
         if verdict.holds is False:

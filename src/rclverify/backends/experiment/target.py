@@ -22,6 +22,7 @@ from rclverify.records.records import Evidence, Obligation, make_obligation_id
 from rclverify.records.statistics import count_runs, decide
 from rclverify.model.plan.targets import entry_environment, entry_target
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.experiment.payload import ExperimentPayload
 
 
 def target_obligations(target: NodeTarget, criterion: Obligation) -> list[Obligation]:
@@ -67,7 +68,7 @@ def run_target(obligation: Obligation, target: NodeTarget, cfg: Any, verdict: An
     details = {"statistics": {"environment": env, "origin": "operation", "target": t.to_json(),
                               "counts": {k: v for k, v in counts.items() if k != "digests"}, "file_sha256": sha,
                               "decision": d, "failing_trials": sorted(failing)[:20]}}
-    return evidence(status, explanation, details=details, log=explanation)
+    return evidence(status, explanation, details=ExperimentPayload.checked(details), log=explanation)
 
 
 __all__ = ["run_target", "target_obligations"]
