@@ -5,6 +5,15 @@ Modules: :mod:`.record` (the checklist generated from the guarantees, the
 record format and its validation), :mod:`.backend` (:class:`ReviewBackend`),
 ``templates/record.yaml.j2`` (the blank record ``rclverify review NODE`` writes).
 """
-from rclverify.backends.review.backend import ReviewBackend
+from typing import Any
 
 __all__ = ["ReviewBackend"]
+
+
+def __getattr__(name: str) -> Any:
+    """``ReviewBackend`` loaded on first use (PEP 562): the report enters the package only for
+    :mod:`.payload` (the evidence payload)."""
+    if name == "ReviewBackend":
+        from rclverify.backends.review.backend import ReviewBackend  # deferred: optional or conditional (inside a block)
+        return ReviewBackend
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

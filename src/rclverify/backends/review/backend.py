@@ -27,6 +27,7 @@ from rclverify.model.plan.yamlguard import load_located, read_yaml_text
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.review.payload import ReviewPayload
 from rclverify.backends.review.record import Question, RecordError, ReviewRecord, assumption_text, checklist, judge, parse_record
 
 #: this backend's name and evidence kind, as its declaration.yaml states them
@@ -148,5 +149,5 @@ class ReviewBackend:
                                         + (f" -- {q['note']}" if q["note"] else "")] for q in details["checklist"]]
                                     + [["file", f"{p} sha256 {h}"] for p, h in rec.files])
         return make_evidence(target, obligation, status, tool="review record", tool_version=rel, clock=clock,
-                             explanation=explanation, details=details,
+                             explanation=explanation, details=ReviewPayload.checked(details),
                              log="\n".join(f"{q['id']}: {q['answer']}" for q in details["checklist"]))
