@@ -9,6 +9,15 @@ output), :mod:`.refute` (a counterexample for a guarantee Dafny could not
 prove, or none), :mod:`.backend` (:class:`DafnyBackend`, name ``dafny``, kind
 ``proof``).
 """
-from rclverify.backends.dafny.backend import DafnyBackend
+from typing import Any
 
 __all__ = ["DafnyBackend"]
+
+
+def __getattr__(name: str) -> Any:
+    """``DafnyBackend`` loaded on first use (PEP 562): the report enters the package only for
+    :mod:`.payload` (the evidence payload)."""
+    if name == "DafnyBackend":
+        from rclverify.backends.dafny.backend import DafnyBackend  # deferred: optional or conditional (inside a block)
+        return DafnyBackend
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

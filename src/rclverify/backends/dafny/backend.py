@@ -48,7 +48,7 @@ from __future__ import annotations
 import tempfile
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Mapping
 
 import jinja2
 
@@ -62,6 +62,7 @@ from rclverify.backends.dafny import implementation, refute, runner
 from rclverify.backends.dafny.stubgen import Stub, build_stub, clause_lines, snake
 from rclverify.backends.shapes import DafnyScan
 from rclverify.backends.dafny.config import DafnyConfig
+from rclverify.backends.dafny.payload import DafnyPayload
 from rclverify.backends.dafny.verdict import UNPROVED, confirm_unproved, judge_run
 
 
@@ -140,9 +141,10 @@ class DafnyBackend:
         for a user-caused problem (see the module docstring for statuses)."""
         clock = Stopwatch()
 
-        def ev(status: str, explanation: str, version: str = "", **kw: Any) -> Evidence:
+        def ev(status: str, explanation: str, version: str = "", *, details: Mapping[str, object] | None = None,
+               **kw: Any) -> Evidence:
             return make_evidence(target, obligation, status, tool="dafny", tool_version=version, clock=clock,
-                                 explanation=explanation, **kw)
+                                 explanation=explanation, details=DafnyPayload.checked(details or {}), **kw)
 
         try:
             cfg = DafnyConfig(target)
