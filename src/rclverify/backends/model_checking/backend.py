@@ -42,6 +42,7 @@ from rclverify.lang.ast import Loc
 from rclverify.lang.errors import RclError
 from rclverify.backends.model_checking.ajpf import psl
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.model_checking.payload import AjpfPayload
 from rclverify.backends.model_checking import spin
 from rclverify.backends.model_checking.graph import StateGraph
 from rclverify.backends.model_checking.identifiers import named_identifiers, numbers
@@ -152,7 +153,7 @@ def run_spin(obligation: Obligation, target: NodeTarget, model: str, timeout_s: 
     if tools is None:
         return make_evidence(target, obligation, "pending", tool=TOOL, tool_version="not installed", clock=clock,
                              explanation=f"{reason}; then re-run the verification",
-                             details={"reason": reason, "install": spin.INSTALL})
+                             details=AjpfPayload.checked({"reason": reason, "install": spin.INSTALL}))
     cfg = read_spin_config(target)
     if cfg.environment is None:
         return make_evidence(target, obligation, "error", tool=TOOL, tool_version=tools.version, clock=clock,
@@ -297,7 +298,7 @@ def check_graph(obligation: Obligation, target: NodeTarget, graph: StateGraph, c
 
     def evidence(status: str, why: str, **kw: Any) -> Evidence:
         return make_evidence(target, obligation, status, tool=TOOL, tool_version=tools.version, clock=clock,
-                             details=details, explanation=f"{what}: {why}", **kw)
+                             details=AjpfPayload.checked(details), explanation=f"{what}: {why}", **kw)
 
     refused = _not_run(graph, mine, percepts, details)
     if refused is not None:

@@ -58,6 +58,7 @@ from rclverify.records.records import Evidence, Obligation, SourceRef, make_obli
 from rclverify.records.store import atomic_write_text
 from rclverify.lang import ast
 from rclverify.backends.base import NodeTarget, Stopwatch, make_evidence
+from rclverify.backends.model_checking.payload import AjpfPayload
 from rclverify.backends.model_checking.ajpf.config import DEFAULT_TIMEOUT_S, AjpfConfig, fixed_names, io_sides, read_config
 from rclverify.backends.model_checking.ajpf.coverage import coverage_notes
 from rclverify.backends.model_checking.ajpf import psl, runner
@@ -227,7 +228,7 @@ class AjpfBackend:
                 target, obligation, "pending", tool=TOOL, tool_version="", clock=clock,
                 explanation=("no AJPF property: " + "; ".join(data.get("unmapped", []))
                              + " -- add mapping rows for these atoms to the plan"),
-                details={"unmapped": list(data.get("unmapped", []))})
+                details=AjpfPayload.checked({"unmapped": list(data.get("unmapped", []))}))
         from rclverify.backends.model_checking.backend import run_spin  # deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
         from rclverify.backends.model_checking.spin_config import chosen_checker, spin_timeout  # deferred: start-up (loads rclverify.backends.model_checking, rclverify.lang.source and more only when called)
         if chosen_checker(target.config) == "spin":
@@ -248,7 +249,8 @@ class AjpfBackend:
                 target, obligation, "pending", tool=TOOL, tool_version="not installed", clock=clock,
                 explanation=(f"{reason}. Run from the workspace root: {data['command']} "
                              f"(then re-run the verification to import {log_rel})"),
-                artifacts=(str(data["jpf"]),), details={"command": data["command"], "reason": reason})
+                artifacts=(str(data["jpf"]),),
+                details=AjpfPayload.checked({"command": data["command"], "reason": reason}))
         return self._run(obligation, target, install, clock)
 
     def _import(self, obligation: Obligation, target: NodeTarget, log_path: Path, clock: Stopwatch) -> Evidence:
@@ -278,9 +280,9 @@ class AjpfBackend:
             target, obligation, status, tool=TOOL, tool_version=res.tool_version, clock=clock, log=text,
             artifacts=arts, counterexample=res.counterexample(),
             explanation=f"imported AJPF log {log_rel}: {why}{note}",
-            details={"verdict": res.verdict, "property": data["property"], "psl": data["psl"],
-                     "errors": list(res.errors), "constraints": res.constraints, "elapsed": res.elapsed,
-                     "imported": True, "property_echoed": echo})
+            details=AjpfPayload.checked({"verdict": res.verdict, "property": data["property"], "psl": data["psl"],
+                                         "errors": list(res.errors), "constraints": res.constraints,
+                                         "elapsed": res.elapsed, "imported": True, "property_echoed": echo}))
 
     def _run(self, obligation: Obligation, target: NodeTarget, install: runner.McaplInstall,
              clock: Stopwatch) -> Evidence:
@@ -304,9 +306,10 @@ class AjpfBackend:
             target, obligation, status, tool=TOOL, tool_version=res.tool_version, clock=clock, log=outcome.log,
             artifacts=(str(target.rel(target.artifacts / "agent.psl")), jpf_rel, out_rel),
             counterexample=res.counterexample(), explanation=f"AJPF run ({install.source}): {why}",
-            details={"verdict": res.verdict, "property": n, "psl": data["psl"], "errors": list(res.errors),
-                     "constraints": res.constraints, "elapsed": res.elapsed, "returncode": outcome.returncode,
-                     "timed_out": outcome.timed_out, "duration_s": outcome.duration_s, "log_file": out_rel})
+            details=AjpfPayload.checked({
+                "verdict": res.verdict, "property": n, "psl": data["psl"], "errors": list(res.errors),
+                "constraints": res.constraints, "elapsed": res.elapsed, "returncode": outcome.returncode,
+                "timed_out": outcome.timed_out, "duration_s": outcome.duration_s, "log_file": out_rel}))
 
     # -- internals ---------------------------------------------------------
     @staticmethod
