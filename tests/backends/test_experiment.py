@@ -14,6 +14,7 @@ from rclverify.backends.experiment.plot import render_svg
 from rclverify.records.store import EvidenceStore
 from rclverify.app.pipeline import Workspace, stage_check, stage_export, stage_run
 from rclverify.lang.parser import parse_formula
+from rclverify.backends.payloads import payload_of
 from rclverify.report.evidence_rows import evidence_extras as _evidence_extras
 from rclverify.app.tasks import act_check
 
@@ -134,7 +135,7 @@ def test_per_trial_data_end_to_end_with_plot(ws: Workspace) -> None:
     assert first.lstrip().startswith(b"<?xml") and b"tolerance (25 cm)" in first
     stage_run(Workspace(root), "Navigation", E0)
     assert svg.read_bytes() == first  # deterministic
-    figures, plot_svg = _evidence_extras(Workspace(root), ev.details)  # type: ignore[attr-defined]
+    figures, plot_svg = _evidence_extras(Workspace(root), payload_of("experiment", ev.details))  # type: ignore[attr-defined]
     assert plot_svg.startswith("<svg") and ["worst", "0.12 m"] in figures
     # a trial beyond the tolerance makes it failed, naming the trial
     (root / "backends/experiment/runs.csv").write_text("trial,error\n1,10\n2,31\n3,9\n", encoding="utf-8")

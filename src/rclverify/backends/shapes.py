@@ -10,10 +10,9 @@ declarations' verdict rows the property tests and the monitors share
 an AJPF obligation (:class:`AjpfData`, :class:`AcceptingPath`), and the
 search tree the Promela template walks (:class:`PromelaLeaf`,
 :class:`PromelaSplit`).  The monitors' records are in
-:mod:`rclverify.backends.monitors.shapes`; the Hoare backend's and the
-property tests' evidence ``details`` are msgspec Structs declared beside
-them (``backends/hoare/payload.py``, ``backends/property_tests/payload.py``,
-decoded by ``backends/payloads.py``).
+:mod:`rclverify.backends.monitors.shapes`; each backend's evidence
+``details`` is a msgspec Struct declared beside it (``backends/<backend>/payload.py``,
+decoded by ``backends/payloads.py``), whose fields use these types.
 """
 # No ``from __future__ import annotations``: Python 3.11 reads ``NotRequired`` only from evaluated
 # annotations (with string annotations every key would count as required).

@@ -17,9 +17,11 @@ from typing import Any, Mapping, Sequence, cast
 
 import msgspec
 
+from rclverify.backends.experiment.payload import ExperimentPayload
 from rclverify.backends.monitors.payload import MonitorsPayload
 from rclverify.backends.payloads import Payload, payload_of
 from rclverify.backends.property_tests.payload import PropertyTestsPayload
+from rclverify.backends.review.payload import ReviewPayload
 from rclverify.records.records import Obligation
 from rclverify.records.obligations import ObligationRow
 from rclverify.records.evidence_rows import EvidenceRow
@@ -51,17 +53,17 @@ class EvidencePart:
     inputs: dict[str, object] = field(default_factory=dict)
 
 
-def evidence_extras(ws: Workspace, details: Any) -> tuple[list[list[str]], str]:
+def evidence_extras(ws: Workspace, payload: Payload | None) -> tuple[list[list[str]], str]:
     """``(figures, plot_svg)``: the rows a backend asks the report to show
-    (``details.figures_table``: the experiment figures, the review record;
-    ``[]`` when none) and the inline SVG of its plot (``details.plot``, an
-    SVG artifact the backend drew with matplotlib; ``""`` when none or
+    (``figures_table`` of an experiment's or a review's payload; ``[]`` when
+    none) and the inline SVG of its plot (an experiment's ``plot``, an SVG
+    artifact the backend drew with matplotlib; ``""`` when none or
     unreadable)."""
-    rows = details.get("figures_table") if isinstance(details, dict) else None
-    figures = [[str(a), str(b)] for a, b in rows] if rows else []
-    plot = details.get("plot") if isinstance(details, dict) else None
+    rows = payload.figures_table if isinstance(payload, (ExperimentPayload, ReviewPayload)) else []
+    figures = [[str(a), str(b)] for a, b in rows]
+    plot = payload.plot if isinstance(payload, ExperimentPayload) else None
     svg = ""
-    if isinstance(plot, str) and plot.endswith(".svg"):
+    if plot is not None and plot.endswith(".svg"):
         try:
             text = ws.path(plot).read_text(encoding="utf-8")
             svg = text[text.index("<svg"):]
@@ -90,16 +92,15 @@ def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Sol
     ``payload``: its ``details`` decoded by :func:`~rclverify.backends.payloads.payload_of`, decoded
     here when not given), an :class:`~rclverify.records.evidence_rows.EvidenceRow`.  Raises
     :class:`msgspec.ValidationError` for details that are not the backend's payload."""
-    d = ev.details if isinstance(ev.details, dict) else {}
     if payload is None:
-        payload = payload_of(ev.backend, d)
-    figures, svg = evidence_extras(ws, d)
+        payload = payload_of(ev.backend, ev.details if isinstance(ev.details, dict) else {})
+    figures, svg = evidence_extras(ws, payload)
     examples: dict[str, Any] = {}
     if isinstance(payload, PropertyTestsPayload) and payload.examples:  # example counts, seed, replay
         examples = {**payload.examples, "seed": payload.seed, "replay": payload.replay, "facts": payload.facts,
                     "coverage": payload.coverage}
     # the row holds the monitors' run and its statistics as JSON objects (records/evidence_rows.py): the payload's
-    # parts encoded, the keys the record has; an experiment's statistics are its JSON object (no Struct yet)
+    # parts encoded, the keys the record has; an experiment target's statistics likewise
     monitoring: dict[str, Any] = {}
     stats: Mapping[str, Any] | None = None
     if isinstance(payload, MonitorsPayload):
@@ -107,8 +108,8 @@ def evidence_row(ws: Workspace, ev: Any, status: str, altered: str, solvers: Sol
             monitoring = msgspec.to_builtins(payload.monitoring)
         if payload.statistics is not None:
             stats = msgspec.to_builtins(payload.statistics)
-    elif isinstance(d.get("statistics"), dict):
-        stats = d["statistics"]
+    elif isinstance(payload, ExperimentPayload) and payload.statistics is not None:
+        stats = msgspec.to_builtins(payload.statistics)
     return EvidenceRow(
         obligation=ev.obligation, backend=ev.backend, kind=ev.kind, status=cast(EvidenceStatus, status),
         tool=ev.tool, tool_version=ev.tool_version, started=ev.started, duration_s=ev.duration_s,
