@@ -17,8 +17,6 @@ checks.  A key no field declares is refused.
 """
 from __future__ import annotations
 
-from typing import Any
-
 import msgspec
 from msgspec import UNSET, UnsetType
 
@@ -35,10 +33,10 @@ class ExperimentStatistics(msgspec.Struct, frozen=True, forbid_unknown_fields=Tr
 
     environment: str | UnsetType = UNSET
     origin: str | UnsetType = UNSET
-    target: dict[str, Any] | UnsetType = UNSET
-    counts: dict[str, Any] | UnsetType = UNSET
+    target: dict[str, object] | UnsetType = UNSET
+    counts: dict[str, object] | UnsetType = UNSET
     file_sha256: str | UnsetType = UNSET
-    decision: dict[str, Any] | UnsetType = UNSET
+    decision: dict[str, object] | UnsetType = UNSET
     failing_trials: list[int] | UnsetType = UNSET
 
 
