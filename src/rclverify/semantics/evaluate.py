@@ -74,22 +74,26 @@ def evaluate(formula: ast.Expr, checked: Checked, node: CheckedNode,
     an infinite domain that does not reduce to finitely many candidates, or
     a value the formula needs is missing).  Never raises for such cases.
     """
+    return evaluate_why(formula, checked, node, values)[0]
+
+
+def evaluate_why(formula: ast.Expr, checked: Checked, node: CheckedNode,
+                 values: Mapping[str, object]) -> tuple[bool | None, str]:
+    """:func:`evaluate`'s answer and, when it is ``None``, the reason
+    (:func:`why_undecided`'s), from one evaluation: ``(truth, "")`` or
+    ``(None, reason)``.  Never raises for a formula or value it cannot decide."""
     try:
-        return bool(Evaluator(checked, node, values).eval(formula, {}))
-    except (Undecided, TypeError, ZeroDivisionError):
-        return None
+        return bool(Evaluator(checked, node, values).eval(formula, {})), ""
+    except Undecided as exc:
+        return None, str(exc)
+    except (TypeError, ZeroDivisionError) as exc:
+        return None, f"a value has the wrong form for the formula: {exc}"
 
 
 def why_undecided(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mapping[str, object]) -> str:
     """The reason :func:`evaluate` answers ``None`` ('' when it decides)."""
-    try:
-        Evaluator(checked, node, values).eval(formula, {})
-        return ""
-    except Undecided as exc:
-        return str(exc)
-    except (TypeError, ZeroDivisionError) as exc:
-        return f"a value has the wrong form for the formula: {exc}"
+    return evaluate_why(formula, checked, node, values)[1]
 
 
 __all__ = ["COMPILED_SIZE", "Evaluator", "MAX_RANGE", "QuantifierEvaluation", "Undecided", "arithmetic", "evaluate",
-           "why_undecided"]
+           "evaluate_why", "why_undecided"]

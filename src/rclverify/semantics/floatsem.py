@@ -72,7 +72,7 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.semantics.candidate_points import quantify
 from rclverify.semantics.symbols import EncodingError
 from rclverify.semantics.eval_shapes import MAX_RANGE, _integer_range, _unused
-from rclverify.semantics.evaluate import Evaluator, Undecided, evaluate, why_undecided
+from rclverify.semantics.evaluate import Evaluator, Undecided, evaluate_why
 from rclverify.semantics.floatsens import float_sensitive
 from rclverify.semantics.operators import COMPARISONS, OPERATORS
 from rclverify.semantics.tolerance import Tolerance, ToleranceError, parse_tolerance, ulp_distance
@@ -115,10 +115,8 @@ def judge(formula: ast.Expr, checked: Checked, node: CheckedNode, values: Mappin
     with the reason.  Exact is tried first (direct evaluation, Z3 on the
     concrete values where that cannot decide); double and tolerance only when
     exact does not hold and they could answer otherwise."""
-    v = evaluate(formula, checked, node, values)
-    reason = ""
+    v, reason = evaluate_why(formula, checked, node, values)  # one evaluation gives the truth and, undecided, why
     if v is None:
-        reason = why_undecided(formula, checked, node, values)
         if "no value for" in reason:  # an I/O value is missing: no semantics can decide
             return Judgement(None, "", reason)
         import z3  # deferred: start-up (Z3 only for a value the direct evaluation leaves undecided)
