@@ -261,15 +261,17 @@ async def test_a_quick_fix_inserts_the_documents_line_end(client: LanguageClient
     the run's own producer of it): a run of the pipeline offers no repair of two lines to test with."""
     import json
 
+    from rclverify.records.repair_rows import EditRow
     from rclverify.records.sarif import sarif_fix
     rel = "contracts/c.rcl"
     lf = CONTRACT.replace("Driver", "Third").replace("Brake", "Stop")
     text = lf.replace("\n", "\r\n")
     (ws / rel).write_bytes(text.encode("utf-8"))
     line = lf.split("\n").index("  guarantee( out.stop -> in.speed <= vmax )") + 1
-    fix = sarif_fix("Split guarantee 1 of Stop. Z3 shows: nothing; not shown: anything.", {
-        "file": rel, "line": line, "col": 3, "end_line": line, "end_col": 44,
-        "inserted": "guarantee( out.stop -> in.speed <= vmax )\n  guarantee( in.speed >= 0 [m/s] )"})
+    fix = sarif_fix("Split guarantee 1 of Stop. Z3 shows: nothing; not shown: anything.", EditRow(
+        file=rel, line=line, col=3, end_line=line, end_col=44,
+        inserted="guarantee( out.stop -> in.speed <= vmax )\n  guarantee( in.speed >= 0 [m/s] )",
+        deleted="guarantee( out.stop -> in.speed <= vmax )"))
     result = {"ruleId": "RCL-TEST", "level": "warning", "message": {"text": "a finding"}, "fixes": [fix],
               "locations": [{"physicalLocation": {"artifactLocation": {"uri": rel},
                                                   "region": {"startLine": line, "startColumn": 3}}}]}
