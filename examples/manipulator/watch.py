@@ -14,7 +14,9 @@ Cyclone configuration on the loopback interface, a ``ROS_DOMAIN_ID``);
 "record"}``: the monitor's exit code, its output, the robot's output and
 the evidence record; the log is ``tmp/live.jsonl``, the bag (with
 ``record``) ``tmp/bag``.  Raises ``RuntimeError`` with the end of the
-output of the part that failed.  Every process started is stopped.
+output of the part that failed (``ros2_recording.Failed`` with the log's
+end when the monitor's log never holds the robot's calls judged).  Every
+process started is stopped.
 """
 from __future__ import annotations
 
@@ -30,7 +32,7 @@ from typing import Any, Callable
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
-from ros2_recording import CYCLONE, stop  # noqa: E402
+from ros2_recording import CYCLONE, logged, stop  # noqa: E402
 
 SRC = HERE.parents[1] / "src"
 #: a process that keeps one core busy for at most this many seconds
@@ -90,19 +92,6 @@ def _judged(log: list[dict[str, Any]]) -> bool:
     return len(ends) >= CALLS and set(ends) <= judged and sum(x.get("kind") == "deadline" for x in log) >= 6
 
 
-def _logged(path: Path, done: Callable[[list[dict[str, Any]]], bool], timeout: float) -> None:
-    """Wait until ``done`` holds of the complete lines of the monitor's log ``path`` (what it heard and
-    judged, whatever the machine's load); ``RuntimeError`` with the log's end after ``timeout`` seconds."""
-    until = time.monotonic() + timeout
-    text = ""
-    while time.monotonic() < until:
-        text = path.read_text(errors="replace") if path.exists() else ""
-        if done([json.loads(x) for x in text[:text.rfind("\n") + 1].splitlines() if x.strip()]):
-            return
-        time.sleep(0.1)
-    raise RuntimeError(f"{path.name} never held the robot's last calls judged:\n{text[-2000:]}")
-
-
 def watch(tmp: Path, ros2_python: Path, env: dict[str, str], *, source: str, defects: str = "",
           record: bool = False, burners: int = 2, rounds: int = 40,
           after: Callable[[], Any] | None = None) -> dict[str, Any]:
@@ -129,7 +118,7 @@ def watch(tmp: Path, ros2_python: Path, env: dict[str, str], *, source: str, def
         _wait(tmp / "robot.log", "rounds", 60, robot)
         burning = [start([sys.executable, "-c", BURN], f"burn{k}.out") for k in range(burners)]
         _wait(tmp / "robot.log", "done", 90, robot)
-        _logged(tmp / "live.jsonl", _judged, 30)
+        logged(tmp / "live.jsonl", _judged, 30)
         stop(monitor, signal.SIGINT)
         for p in burning:
             stop(p)
