@@ -49,3 +49,11 @@ def wait_logged(path: Path, done: Callable[[list[dict[str, Any]]], bool], timeou
             return
         time.sleep(0.1)
     raise AssertionError(f"{path.name} never held what was waited for: {text[-2000:]}")
+
+
+def calls_judged(log: list[dict[str, Any]], least: dict[str, int]) -> bool:
+    """The monitor's ``log`` (its JSON lines) holds at least ``least[node]``
+    call verdicts (deadline lines not counted) of each node ``node``."""
+    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
+             and x["verdict"].get("call")]
+    return all(calls.count(node) >= n for node, n in least.items())

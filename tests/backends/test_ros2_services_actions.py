@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from _procs import stop, wait_for, wait_logged
+from _procs import calls_judged, stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.backends.monitors.dds_calls import CallBook, replay
@@ -223,7 +223,7 @@ def _watched(tmp: Path, monitors: dict[str, tuple[list[str], dict[str, str]]]) -
         wait_for(tmp / "system.log", "done", 60)
         for name in monitors:  # every call judged, the last goal too, however loaded the machine
             if (tmp / f"{name}.jsonl").exists():
-                wait_logged(tmp / f"{name}.jsonl", lambda log, n=name: _all_judged(log, JUDGED[n]), 30)
+                wait_logged(tmp / f"{name}.jsonl", lambda log, n=name: calls_judged(log, JUDGED[n]), 30)
         for p in procs.values():
             stop(p, signal.SIGINT)
         return {name: p.returncode for name, p in procs.items()}
@@ -237,12 +237,6 @@ def _watched(tmp: Path, monitors: dict[str, tuple[list[str], dict[str, str]]]) -
 #: per monitor with a log, the calls it judges once the system is done: node -> call verdicts (the DDS source
 #: hears every service; the rclpy source, the introspected ones only)
 JUDGED = {"live": {"Base": 3, "Brake": 2, "Lamp": 2, "Fib": 3}, "via": {"Lamp": 2, "Fib": 3}}
-
-
-def _all_judged(log: list[dict[str, Any]], want: dict[str, int]) -> bool:
-    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
-             and x["verdict"].get("call")]
-    return all(calls.count(node) >= n for node, n in want.items())
 
 
 def _args(ws: Path, tmp: Path, name: str, *extra: str) -> list[str]:

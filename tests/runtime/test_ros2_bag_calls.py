@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop, wait_for, wait_logged
+from _procs import calls_judged, stop, wait_for, wait_logged
 from _ros2 import SETBOOL, rclverify, ros2_env, ros2_python, start_node
 from test_ros2_services_actions import FIBONACCI, MAPPING
 from test_ros2_services_actions import RCL as CALLS_RCL
@@ -229,9 +229,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
 
 def _all_heard(log: list[dict[str, Any]]) -> bool:
     """The run's end in a monitor's ``log``: the calls of each service and goal judged, the five speeds heard."""
-    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
-             and x["verdict"].get("call")]
-    return all(calls.count(node) >= n for node, n in {"Base": 3, "Brake": 2, "Lamp": 2, "Fib": 3}.items()) \
+    return calls_judged(log, {"Base": 3, "Brake": 2, "Lamp": 2, "Fib": 3}) \
         and sum(x.get("topic") == "speed" for x in log) >= 5
 
 

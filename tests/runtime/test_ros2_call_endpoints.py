@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 import pytest
-from _procs import stop, wait_for, wait_logged
+from _procs import calls_judged, stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 SERVICES = ("ctl", "two", "both", "meta", "half", "rs", "early")
@@ -211,9 +211,9 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                               "ctl": _args(ws, tmp, "ctl", "--node", "Ctl", "--record", str(tmp / "ctl_bag"))},
                     {**{f"/{s}/_service_event": 1 for s in SERVICES}, "/ctl/_service_event": 2},
                     # the last call heard (/rs's, before its server's restart) judged, the restarted server named
-                    {"all": lambda log: _judged(log, {"Rs": 1, "Ctl": 6}) and any(
+                    {"all": lambda log: calls_judged(log, {"Rs": 1, "Ctl": 6}) and any(
                         x.get("part") == "unjudged" and x.get("endpoint") == "server /rs_s" for x in log),
-                     "ctl": lambda log: _judged(log, {"Ctl": 6})})  # four calls: a request of False is judged too
+                     "ctl": lambda log: calls_judged(log, {"Ctl": 6})})  # four calls: a request of False is judged too
 
 
 @pytest.fixture(scope="module")
@@ -226,14 +226,7 @@ def dds(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     # the DDS source reads /two's and /both's request topics on the wire, beside their two servers
     return _watched(tmp, ws, {"all": _args(ws, tmp, "all", source="dds")},
                     {"/ctl/_service_event": 1, "rq/twoRequest": 3, "rq/bothRequest": 3},
-                    {"all": lambda log: _judged(log, {"Rs": 3})})  # /rs's last calls, on the wire, judged
-
-
-def _judged(log: list[dict[str, Any]], least: dict[str, int]) -> bool:
-    """``log`` holds at least ``least[node]`` call verdicts of each node."""
-    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
-             and x["verdict"].get("call")]
-    return all(calls.count(node) >= n for node, n in least.items())
+                    {"all": lambda log: calls_judged(log, {"Rs": 3})})  # /rs's last calls, on the wire, judged
 
 
 def _watched(tmp: Path, ws: Path, monitors: dict[str, list[str]], readers: dict[str, int],

@@ -29,7 +29,7 @@ import signal
 from typing import Any, Iterator
 
 import pytest
-from _procs import stop, wait_for, wait_logged
+from _procs import calls_judged, stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.backends.monitors.dds_calls import CallBook, replay
@@ -189,10 +189,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
 def _all_judged(log: list[dict[str, Any]]) -> bool:
     """Every call of the run judged in ``log``: six of /estop and their deadlines (and call 5's late answer),
     three of each /dual server, three of pile_a, pile_b's three replies logged unpaired."""
-    calls = [x["verdict"]["node"] for x in log if x.get("topic") == "rclverify/verdict" and "kind" not in x
-             and x["verdict"].get("call")]
     deadlines = [x for x in log if x.get("kind") == "deadline" and x["verdict"]["node"] == "Base"]
-    return calls.count("Base") >= 6 and calls.count("Dual") >= 6 and calls.count("Pile") >= 3 \
+    return calls_judged(log, {"Base": 6, "Dual": 6, "Pile": 3}) \
         and len(deadlines) >= 7 and sum(x.get("link") == "pile" and bool(x.get("unpaired")) for x in log) >= 3
 
 
