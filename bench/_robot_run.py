@@ -239,12 +239,17 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     return res
 
 
+def _victim(res: dict[str, Any]) -> str | None:
+    """The name of the node of ``res``'s spec that carries the seeded defect (``None``: no defect)."""
+    return next((n["name"] for n in res["spec"]["nodes"] if n.get("defect")), None)
+
+
 def explain(ws: Path, res: dict[str, Any]) -> list[str]:
     """For each live ``violated`` answer of a correct node: when the answer left the robot
     (``published.json``, the robot's own wall clock) against the stamp of the reading it was judged
     against, and the answer's stamp in the log (its receipt).  An answer that left before that reading
     was taken is judged against a reading it could not know."""
-    victim = next((n["name"] for n in res["spec"]["nodes"] if n.get("defect")), None)
+    victim = _victim(res)
     try:
         sent = json.loads((ws / "published.json").read_text())
     except (OSError, ValueError):
@@ -283,7 +288,7 @@ def findings(res: dict[str, Any]) -> list[str]:
     false verdict of a correct node on any path, a node judged nothing live, a defect not red at its node."""
     out = list(res["disagreements"])
     names = [n["name"] for n in res["spec"]["nodes"]]
-    victim = next((n["name"] for n in res["spec"]["nodes"] if n.get("defect")), None)
+    victim = _victim(res)
     correct = {n for n in names if n != victim}
     for path, f in res["finals"].items():
         wrong = Counter(f"{r['node']}: {'deadline false' if r['item'] == 'deadline' else r['item'] + ' violated'}"
@@ -382,7 +387,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             for c in res["live"].values():
                 total.update(c)
             undecided += sum(c["deadline undecided"] for c in res["log"].values())
-            victim = next((x["name"] for x in res["spec"]["nodes"] if x.get("defect")), None)
+            victim = _victim(res)
             for path, d in res["declarations"].items():
                 declarations.update(f"{path} {row['verdict']}" for row in d.values())
                 declarations.update(f"{path} false at a correct node" for (node, _, _), row in d.items()
