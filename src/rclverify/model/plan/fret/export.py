@@ -29,7 +29,7 @@ import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, TypeVar
 
 import msgspec
 
@@ -171,7 +171,10 @@ def _unit(v: FretVariableEntry) -> str:
     return "".join(u.split())
 
 
-def _decoded(rel: str, text: str, at: int, what: str, raw: Any, type_: type[msgspec.Struct]) -> Any:
+_S = TypeVar("_S", bound=msgspec.Struct)
+
+
+def _decoded(rel: str, text: str, at: int, what: str, raw: Any, type_: type[_S]) -> _S:
     """``raw`` (a requirement's or variable's JSON object) as ``type_``; raises :class:`PlanError`
     (``E-fret``) at offset ``at`` of ``text`` naming ``what`` and the field of another type."""
     try:
@@ -228,15 +231,14 @@ def read_export(path: Path, rel: str) -> FretExport:
         seen[rid] = loc
         if r.get("semantics") is not None and not isinstance(r["semantics"], dict):
             raise plan_error(rel, loc.line, loc.col, f"{rid}: 'semantics' must be an object", "E-fret")
-        e: _RequirementEntry = _decoded(rel, text, max(at, 0), f"requirement {rid}", r, _RequirementEntry)
+        e = _decoded(rel, text, max(at, 0), f"requirement {rid}", r, _RequirementEntry)
         sem = e.semantics or FretSemantics()
         out.append(FretRequirement(rid, " ".join((e.fulltext or "").split()), e.component(), sem, loc, digest(r), r))
     variables: dict[tuple[str, str], FretVariable] = {}
     for v in vars_raw:
         if isinstance(v, dict) and "idType" in v and isinstance(v.get("variable_name"), str):
             name = json.dumps(v["variable_name"], ensure_ascii=False)
-            ve: FretVariableEntry = _decoded(rel, text, max(text.find(name), 0), f"variable {name}", v,
-                                             FretVariableEntry)
+            ve = _decoded(rel, text, max(text.find(name), 0), f"variable {name}", v, FretVariableEntry)
             fv = FretVariable(ve.component_name or "", ve.variable_name, ve.idType or "", _data_type(ve.dataType),
                               ve.assignment or "", ve.modeRequirement or "", _unit(ve))
             variables[(fv.component, fv.name)] = fv
