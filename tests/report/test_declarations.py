@@ -20,7 +20,7 @@ from rclverify.model.plan.expected import WHOLE_CONTRACT_BACKENDS
 from rclverify.report.argument.strength import BACKEND_KIND
 from rclverify.report.problems_mc import MC_BACKENDS
 from rclverify.records.statuses import EVIDENCE_KINDS
-from rclverify.report.view import TECHNIQUES
+from rclverify.report.dashboard import TECHNIQUES
 
 SRC = Path(__file__).resolve().parents[2] / "src" / "rclverify" / "backends"
 

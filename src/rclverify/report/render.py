@@ -36,8 +36,9 @@ from rclverify.report.templating import (CLIP_CHARS, STATUS_STYLE, anchor, clip,
                                          html_badge, link_maker, md_badge, md_code, md_fence, md_text, model_text,
                                          rank, seconds, style, use_bytecode_cache)
 from rclverify.report.textfmt import breakable, formula_html, formula_lines
-from rclverify.report.view import (REPORT_KEYS, TECHNIQUES, dashboard, evidence_anchors, group_items,
-                                   decoded_report, problem_groups, problem_items, runs, validate, view)
+from rclverify.report.dashboard import TECHNIQUES, dashboard
+from rclverify.report.view import (REPORT_KEYS, evidence_anchors, group_items, decoded_report, problem_groups,
+                                   problem_items, runs, validate, view)
 
 def _header(report: AssuranceReport) -> str:
     meta = report.meta

@@ -28,7 +28,7 @@ from rclverify.records.side_condition_rows import SideConditionRow
 from rclverify.report.shapes import (AttentionGroup, AttentionItem, PendingGroup,
                                      EvidenceRun, ReportView, Section, TableRuns, TraceEntry, TraceObligation, TraceSupport)
 from rclverify.records.records import SEVERITY
-from rclverify.report.dashboard import TECHNIQUES as TECHNIQUES, dashboard as dashboard
+from rclverify.report.dashboard import dashboard
 from rclverify.report.problems import group_problems
 from rclverify.report.templating import COUNT_ORDER, anchor, rank
 from rclverify.report.textfmt import natural_key, natural_sorted, natural_within
