@@ -76,7 +76,7 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.walk import free_names, subexpressions
 from rclverify.lang.types import Checked
 from rclverify.model.system.model import SystemModel
-from rclverify.calculus.rules import R4_ASSUMPTION, contract_text, instance_rule as instance_rule, rule_instances, rules_at
+from rclverify.calculus.rules import R4_ASSUMPTION, contract_text, instance_rule, rule_instances, rules_at
 from rclverify.calculus.scale import probable_mismatches
 
 
