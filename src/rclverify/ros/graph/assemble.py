@@ -30,7 +30,7 @@ from rclverify.ros.extract.packages import Package
 from rclverify.ros.extract.param_yaml import pending_for
 from rclverify.ros.extract.programs import PackageCode, Program, programs
 from rclverify.ros.graph.accounting import Ledger
-from rclverify.ros.graph.link_cache import LinkCache as LinkCache
+from rclverify.ros.graph.link_cache import LinkCache
 
 
 class Assembly:

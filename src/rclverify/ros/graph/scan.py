@@ -25,7 +25,8 @@ from typing import Any, Sequence
 
 from rclverify.ros.graph.absent import absent_interfaces
 from rclverify.ros.graph.accounting import NOT_BUILT, Account
-from rclverify.ros.graph.assemble import Assembly, LinkCache
+from rclverify.ros.graph.assemble import Assembly
+from rclverify.ros.graph.link_cache import LinkCache
 from rclverify.ros.graph.graph_nodes import GraphNodes
 from rclverify.ros.extract.cache import ParseCache
 from rclverify.ros.extract.executables import Targets, exported_cmake, targets
