@@ -18,7 +18,7 @@ import subprocess
 import sys
 import textwrap
 from pathlib import Path
-from typing import Iterator
+from typing import Any, Iterator
 
 import pytest
 
@@ -141,3 +141,16 @@ def stopping(*procs: subprocess.Popen[bytes]) -> Iterator[None]:
     finally:
         for p in procs:
             stop(p)
+
+
+def robot_run(tmp: Path, seed: int, nodes: int, seconds: float, defect: bool, **how: Any) -> dict[str, Any]:
+    """Generated robot ``seed`` of ``nodes`` nodes (``defect``: with its seeded defect) run live and
+    offline for ``seconds`` of sensing under ``tmp``: bench/_robot_run.py's ``run_one`` (``how``: its
+    keyword arguments), whose result it returns; bench/ must be on ``sys.path``.  Skipped, saying why,
+    without ROS 2's Python."""
+    ros2_python()
+    import _robot_run
+    ros2, why = _robot_run.ros2_python()
+    if ros2 is None:
+        pytest.skip(why)
+    return _robot_run.run_one(seed, nodes, seconds, defect, tmp, ros2, **how)

@@ -104,13 +104,8 @@ def test_a_defect_is_seeded_in_exactly_one_node(seed: int) -> None:
 
 def _live(tmp_path: Path, seed: int, nodes: int, defect: bool, kinds: tuple[str, ...],
           **how: Any) -> dict[str, Any]:
-    from _ros2 import ros2_python
-    ros2_python()  # skips, saying why, without ROS 2's Python
-    import _robot_run
-    ros2, why = _robot_run.ros2_python()
-    if ros2 is None:
-        pytest.skip(why)
-    return _robot_run.run_one(seed, nodes, 4.0, defect, tmp_path, ros2, kinds, **how)
+    from _ros2 import robot_run
+    return robot_run(tmp_path, seed, nodes, 4.0, defect, kinds=kinds, **how)
 
 
 @pytest.fixture(scope="module")

@@ -18,13 +18,8 @@ pytestmark = pytest.mark.live
 
 
 def _run(tmp_path: Path, seed: int, nodes: int, defect: bool) -> dict[str, Any]:
-    from _ros2 import ros2_python
-    ros2_python()  # skips, saying why, without ROS 2's Python
-    import _robot_run
-    ros2, why = _robot_run.ros2_python()
-    if ros2 is None:
-        pytest.skip(why)
-    return _robot_run.run_one(seed, nodes, 2.5, defect, tmp_path, ros2)
+    from _ros2 import robot_run
+    return robot_run(tmp_path, seed, nodes, 2.5, defect)
 
 
 def _verdicts(res: dict[str, Any]) -> dict[str, dict[tuple[str, str], str]]:
