@@ -15,9 +15,9 @@ key written ``null`` is read at its default.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
-
 import msgspec
+
+from rclverify.records.row import View
 
 #: a number as the run wrote it (an int stays an int)
 Number = int | float
@@ -47,8 +47,9 @@ class AssumptionViolation(msgspec.Struct, frozen=True):
     blame: str | None = None
 
 
-class MonitoredRun(msgspec.Struct, frozen=True):
-    """What is read of an evidence row's ``monitoring`` (module docstring)."""
+class MonitoredRun(View, frozen=True):
+    """What is read of an evidence row's ``monitoring`` (module docstring; ``{}`` for a record of another
+    backend), decoded by :meth:`~rclverify.records.row.View.of`."""
 
     trace: str | None = None
     counts: dict[str, int] = {}  #: verdicts by word (satisfied, violated, ...)
@@ -58,12 +59,6 @@ class MonitoredRun(msgspec.Struct, frozen=True):
     first_assumption_violation: AssumptionViolation | None = None
     violations: list[Violation] = []
     violations_dropped: int = 0
-
-    @classmethod
-    def of(cls, monitoring: Mapping[str, Any]) -> MonitoredRun:
-        """``monitoring`` (``{}`` for a record of another backend) decoded, a key written ``null`` at its
-        default; raises :class:`msgspec.ValidationError` for a value of another type."""
-        return msgspec.convert({k: v for k, v in monitoring.items() if v is not None}, cls)
 
 
 __all__ = ["AssumptionViolation", "MonitoredRun", "Violation"]

@@ -28,10 +28,11 @@ declarations with their evidence, the ``assuming`` formulas; defeaters.py: the s
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any
 
 import msgspec
 
+from rclverify.records.row import View
 from rclverify.records.solvers_rows import Solvers
 
 
@@ -103,7 +104,7 @@ class DeclarationRow(msgspec.Struct, frozen=True):
     words: str = ""
 
 
-class RequirementCheckRow(msgspec.Struct, frozen=True):
+class RequirementCheckRow(View, frozen=True):
     """A requirement's check record (``requirements[].check``, or the stage's record the roll-up reads,
     calculus/requirements/rollup.py), the keys its readers read: Z3's verdict, its reason and the verdict
     recorded before the second solver or the seal changed it; the formal statement and its
@@ -139,12 +140,6 @@ class RequirementCheckRow(msgspec.Struct, frozen=True):
     duration_s: int | float = 0  #: Z3's time on the check, seconds (as written: an int stays an int)
     declarations: list[DeclarationRow] = []
     solvers: Solvers | None = None
-
-    @classmethod
-    def of(cls, check: Mapping[str, Any]) -> RequirementCheckRow:
-        """``check`` (a requirement row's ``check``) decoded, a key written ``null`` at its default;
-        raises :class:`msgspec.ValidationError` for a declared key whose value has another type."""
-        return msgspec.convert({k: v for k, v in check.items() if v is not None}, cls)
 
 
 __all__ = ["CexNodeRow", "DeclarationRow", "PremiseRow", "RequirementCheckRow", "TraceCheckRow", "TraceVerdictRow", "WitnessRow"]

@@ -7,7 +7,8 @@ A record's class states its fields, each with its description
 (:data:`DOC`), from which its part of docs/assurance.schema.json is
 generated (:mod:`.schema_gen`); producers build the class, and readers
 decode the JSON into it (:meth:`Row.of`, :func:`decode_rows`) and read
-attributes mypy checks.
+attributes mypy checks.  A reader's view of a JSON object another part
+writes (the keys it reads, not the record) derives from :class:`View`.
 """
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ import msgspec
 DOC = msgspec.Meta
 
 R = TypeVar("R", bound="Row")
+V = TypeVar("V", bound="View")
 
 
 class Row(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -42,6 +44,17 @@ class Row(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         return msgspec.convert(dict(row), cls)
 
 
+class View(msgspec.Struct, frozen=True):
+    """A reader's view of a JSON object: its subclasses declare the keys read, each with its default; a key
+    it does not declare is ignored, one written ``null`` is read at its default (:meth:`View.of`)."""
+
+    @classmethod
+    def of(cls: type[V], data: Mapping[str, Any]) -> V:
+        """``data`` decoded, a key written ``null`` at its default; raises :class:`msgspec.ValidationError`
+        for a declared key whose value has another type."""
+        return msgspec.convert({k: v for k, v in data.items() if v is not None}, cls)
+
+
 def decode_rows(cls: type[R], rows: Iterable[R | Mapping[str, Any]]) -> list[R]:
     """``rows`` (JSON objects, as built or as read back from
     ``reports/assurance.json``, or records of ``cls`` already decoded)
@@ -49,4 +62,4 @@ def decode_rows(cls: type[R], rows: Iterable[R | Mapping[str, Any]]) -> list[R]:
     return [cls.of(r) for r in rows]
 
 
-__all__ = ["DOC", "Row", "decode_rows"]
+__all__ = ["DOC", "Row", "View", "decode_rows"]
