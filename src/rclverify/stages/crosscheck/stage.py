@@ -281,11 +281,17 @@ def read_crosscheck(root: Path) -> tuple[dict[tuple[str, str], CrosscheckSeen], 
     body, why = read_sealed(root / INDEX, "second-solver record")
     if why or body is None:
         return {}, why
+    return seen_rows(body.get("items")), ""
+
+
+def seen_rows(items: object) -> dict[tuple[str, str], CrosscheckSeen]:
+    """The record's ``items`` (its JSON list) as rows by ``(kind, id)``, each decoded into
+    :class:`CrosscheckSeen`; a row that does not decode is left out, and ``{}`` when ``items`` is no list."""
     out: dict[tuple[str, str], CrosscheckSeen] = {}
-    for r in body.get("items", []):
+    for r in items if isinstance(items, list) else ():
         try:
             row = msgspec.convert(r, CrosscheckSeen)
         except msgspec.ValidationError:
             continue
         out[(row.kind, row.id)] = row
-    return out, ""
+    return out

@@ -24,12 +24,10 @@ import tempfile
 from pathlib import Path
 from typing import Mapping
 
-import msgspec
-
 from rclverify.records.sealed import check_text
 from rclverify.records.ties import last_line, proof_tie, query_tie, said_tie, statement_sha256
 from rclverify.stages.crosscheck.items import Item, discharging_items
-from rclverify.stages.crosscheck.stage import DIR, INDEX, CrosscheckSeen, Cvc5Seen
+from rclverify.stages.crosscheck.stage import DIR, INDEX, CrosscheckSeen, Cvc5Seen, seen_rows
 
 #: How many last bytes of a query or proof member ``--verify`` keeps: its tie line is among them.
 TAIL_BYTES = 4096
@@ -59,24 +57,16 @@ def bundle_items(records: Mapping[str, bytes]) -> list[Item]:
 
 def index_rows(raw: bytes | None) -> tuple[dict[tuple[str, str], CrosscheckSeen] | None, str]:
     """``(rows by (kind, id), problem)`` of the second-solver record's bytes
-    ``raw``, each row decoded into :class:`~.stage.CrosscheckSeen` (a row
-    that does not decode is left out, as :func:`~.stage.read_crosscheck`
-    does): ``(None, "")`` when there is none, ``(None, why)`` when its seal
+    ``raw``, each row decoded into :class:`~.stage.CrosscheckSeen` by
+    :func:`~.stage.seen_rows`, as :func:`~.stage.read_crosscheck` does (a
+    row that does not decode is left out): ``(None, "")`` when there is none, ``(None, why)`` when its seal
     does not hold."""
     if raw is None:
         return None, ""
     index, why = check_text(raw.decode("utf-8", "replace"), "second-solver record")
     if why or index is None:
         return None, why or "unreadable"
-    items = index.get("items")
-    out: dict[tuple[str, str], CrosscheckSeen] = {}
-    for r in items if isinstance(items, list) else ():
-        try:
-            row = msgspec.convert(r, CrosscheckSeen)
-        except msgspec.ValidationError:
-            continue
-        out[(row.kind, row.id)] = row
-    return out, ""
+    return seen_rows(index.get("items")), ""
 
 
 def tie_problems(items: list[Item], rows: Mapping[tuple[str, str], CrosscheckSeen] | None,
