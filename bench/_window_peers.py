@@ -33,7 +33,13 @@ after a first run on ten samples (RTAMT 0.4.10's offline ``evaluate`` on
 the whole signal, Reelay 25's discrete robustness monitor updated sample
 by sample, read past-time as test_margins_peers.py reads it, mstlo 0.2.2's
 ``DelayedQuantitative`` monitor by its batch call 16,384 samples at a
-time).  Compared, untimed: every window's verdict and margin as the engine
+time: bench/_peer_read.py).  Beside each peer's row, a second one times
+the peer as the command is timed: a process of its own
+(bench/_peer_read.py) that reads the same log (one read, msgspec's
+typed ``decode_lines``, the samples rebuilt from the lines) and monitors
+them, its whole CPU (start-up included; the same on the ten-sample log
+printed apart), its robustness compared as the in-memory run's.
+Compared, untimed: every window's verdict and margin as the engine
 gives them (``check_trace`` with margins and a verdict callback on the same
 log; the deadline's per-trigger verdicts from its deadline monitor) against
 each peer's robustness at that sample within 1e-9 (the deadline: the sign,
@@ -52,12 +58,16 @@ import subprocess
 import sys
 import tempfile
 import time
+from array import array
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _peer_read import RUNS  # noqa: E402  (bench/_peer_read.py: the peers' monitoring, and a peer reading the log)
 
 PERIOD = 0.01  # s between samples
-STEP = 16384  # mstlo's batch call: samples at a time
 TOLERANCE = 1e-9
 
 
@@ -209,70 +219,46 @@ def engine(ws: Path, log: Path, f: Formula, n: int) -> tuple[list[float | None],
     return got, dict(res.counts)
 
 
-def _rtamt(f: Formula, s: dict[str, Any], n: int) -> list[float]:
-    import rtamt  # type: ignore[import-not-found]
-    spec = rtamt.StlDiscreteTimeSpecification()
-    for v in f.signals:
-        spec.declare_var(v, "float")
-    spec.spec = f.rtamt
-    spec.parse()
-    data = {"time": list(range(n)), **{v: s[v][:n].tolist() for v in f.signals}}
-    return [float(r) for _, r in spec.evaluate(data)]
+#: A peer's name -> the Formula field of its specification (empty: the peer has no row for that formula).
+PEERS = {"RTAMT": "rtamt", "Reelay": "reelay", "mstlo": "mstlo"}
 
 
-def _reelay(f: Formula, s: dict[str, Any], n: int) -> list[float]:
-    import reelay  # type: ignore[import-not-found]
-    mon = reelay.discrete_timed_monitor(pattern=f.reelay, semantics="robustness", condense=False)
-    cols = [s[v][:n].tolist() for v in f.signals]
-    rows = list(zip(*cols))
-    if f.reelay_read == "reverse":
-        rows.reverse()
-    update = mon.update
-    names = f.signals
-    if len(names) == 1:
-        (a,) = names
-        out = [update({"time": i, a: r[0]})["value"] for i, r in enumerate(rows)]
-    else:
-        a, b = names
-        out = [update({"time": i, a: r[0], b: r[1]})["value"] for i, r in enumerate(rows)]
-    if f.reelay_read == "reverse":
-        out.reverse()
-        return [float(r) for r in out]
-    return [float(r) for r in out[f.h:]]
-
-
-def _mstlo(f: Formula, s: dict[str, Any], n: int) -> list[float]:
-    import mstlo_python  # type: ignore[import-not-found]
-    mon = mstlo_python.Monitor(mstlo_python.parse_formula(f.mstlo), semantics="DelayedQuantitative")
-    cols = {v: s[v][:n].tolist() for v in f.signals}
-    out: list[float] = []
-    for a in range(0, n, STEP):
-        b = min(n, a + STEP)
-        ts = [float(i) for i in range(a, b)]  # its bounds are in its time unit: a sample a unit
-        got = mon.update_batch({v: list(zip(c[a:b], ts)) for v, c in cols.items()}).verdicts()
-        out += [r for _, r in got]
-    return [float(r) for r in out]
-
-
-PEERS: dict[str, tuple[str, Callable[[Formula, dict[str, Any], int], list[float]]]] = {
-    "RTAMT": ("rtamt", _rtamt), "Reelay": ("reelay", _reelay), "mstlo": ("mstlo", _mstlo)}
+def _lists(s: dict[str, Any], n: int) -> dict[str, list[float]]:
+    """The first ``n`` samples of each signal as a list of floats (what the peers take)."""
+    return {v: c[:n].tolist() for v, c in s.items()}
 
 
 def _peer(name: str, f: Formula, s: dict[str, Any], n: int, repeat: int) -> tuple[float, list[float]] | str:
     """(least CPU s of ``repeat`` runs, the robustness at each sample), or why the peer is skipped."""
-    attr, run = PEERS[name]
+    attr = PEERS[name]
     if not getattr(f, attr):
         return ""
+    run = RUNS[attr]
     try:
-        run(f, s, 20)  # the set-up and first use, outside the timing
+        run(f, _lists(s, 20), 20)  # the set-up and first use, outside the timing
     except ImportError as exc:
         return f"not installed ({exc}); pip install '.[bench]'"
     best, out = math.inf, []
     for _ in range(max(repeat, 1)):
         t0 = time.process_time()
-        out = run(f, s, n)
+        out = run(f, _lists(s, n), n)
         best = min(best, time.process_time() - t0)
     return best, out
+
+
+def _peer_process(peer: str, f: Formula, log: Path, out: Path) -> float:
+    """CPU s (user + system, of the waited child) of ``peer`` (``rtamt``, ``reelay`` or ``mstlo``) as a
+    program of its own (bench/_peer_read.py) reading ``log`` and monitoring ``f``, its robustness at each
+    sample written to ``out``."""
+    spec = json.dumps({k: getattr(f, k) for k in ("name", "h", "rtamt", "reelay", "reelay_read", "mstlo",
+                                                  "signals")})
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p = subprocess.run([sys.executable, str(Path(__file__).resolve().parent / "_peer_read.py"), peer, spec, str(log),
+                        str(out)], capture_output=True, text=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode != 0:
+        raise SystemExit(f"{peer} reading {log} exited {p.returncode}:\n{p.stderr[-3000:]}")
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def _agree(f: Formula, mine: list[float | None], theirs: list[float], n: int) -> tuple[int, int, str]:
@@ -381,11 +367,26 @@ def race(n: int, seed: int, wrong: float, repeat: int = 1, src: str | None = Non
                     print(f"{f.name + ', ' + name:<52} skipped: {got}")
                     continue
                 cpu, theirs = got
-                total, same, first = _agree(f, mine, theirs, n)
-                ok = ok and same == total and total > 0
-                print(f"{f.name + ', ' + name:<52} {n / cpu:>10.0f} {cpu:>7.2f}  {same}/{total}{first}; "
+                total, agreeing, first = _agree(f, mine, theirs, n)
+                ok = ok and agreeing == total and total > 0
+                print(f"{f.name + ', ' + name:<52} {n / cpu:>10.0f} {cpu:>7.2f}  {agreeing}/{total}{first}; "
                       f"rclverify / {name} samples/s: {cpu / cmd['cpu']:.2f} ({cpu / max(cmd['cpu'] - start, 1e-3):.2f} "
                       f"without the start-up)")
+                # the same peer as a process of its own reading the same log (bench/_peer_read.py), timed as the
+                # command is: the whole process's CPU, its start-up (the same on the ten-sample log) printed apart
+                out = Path(tmp) / f"peer-{k}-{PEERS[name]}"
+                pstart = min(_peer_process(PEERS[name], f, tiny / "run.jsonl", out) for _ in range(max(repeat, 1)))
+                pcpu = min(_peer_process(PEERS[name], f, log, out) for _ in range(max(repeat, 1)))
+                read = array("d")
+                with out.open("rb") as fh:
+                    read.frombytes(fh.read())
+                total, agreeing, first = _agree(f, mine, read.tolist(), n)
+                ok = ok and agreeing == total and total > 0
+                print(f"{f.name + ', ' + name + ' reading the log':<52} {n / pcpu:>10.0f} {pcpu:>7.2f}  "
+                      f"{agreeing}/{total}{first}; (start-up {pstart:.2f} s; {n / max(pcpu - pstart, 1e-3):.0f} "
+                      f"samples/s without it); rclverify / {name} reading the log, samples/s: "
+                      f"{pcpu / cmd['cpu']:.2f} ({max(pcpu - pstart, 1e-3) / max(cmd['cpu'] - start, 1e-3):.2f} "
+                      f"without either start-up)")
     print(f"not compared: the last 2-3 samples of each formula, whose window runs past the end of the trace "
           f"(no RCL message carries them; the peers give partial or delayed figures)")
     return ok
