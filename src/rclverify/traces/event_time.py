@@ -32,6 +32,8 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+from rclverify.traces.events import header_stamp
+
 #: a source time more than this ahead of its receipt (ns) is not the monitor's clock: the receipt stands in
 AHEAD_NS = 1_000_000_000
 
@@ -79,12 +81,32 @@ def without_stamp(fields: Mapping[str, Any]) -> dict[str, Any]:
     """``fields`` without the header's stamp (nested ``header.stamp`` or
     ROSMonitoring's flattened ``header.stamp.*``), the rest of the header
     kept: the message placed at its source time reads as unstamped to every
-    monitor (a stamp in another clock set aside)."""
+    monitor (a stamp in another clock set aside).  The stamp is kept as
+    ``header.stamp_aside`` (:data:`ASIDE`; flattened ``header.stamp_aside.*``),
+    which no monitor reads as the message's time: the clock of the node that
+    stamped it, in which its declared period is judged (:func:`aside_stamp`;
+    backends/monitors/periods.py)."""
     out = {k: v for k, v in fields.items() if not k.startswith("header.stamp.")}
+    out.update({f"header.{ASIDE}." + k.rsplit(".", 1)[1]: v for k, v in fields.items()
+                if k.startswith("header.stamp.")})
     h = out.get("header")
     if isinstance(h, Mapping) and "stamp" in h:
-        out["header"] = {k: v for k, v in h.items() if k != "stamp"}
+        out["header"] = {**{k: v for k, v in h.items() if k != "stamp"}, ASIDE: h["stamp"]}
     return out
+
+
+#: the header key a stamp set aside in another clock is kept under (:func:`without_stamp`)
+ASIDE = "stamp_aside"
+
+
+def aside_stamp(fields: Mapping[str, Any]) -> float | None:
+    """The header stamp (s) :func:`without_stamp` set aside in ``fields``, or
+    ``None`` (no stamp set aside: the message's stamp, if any, is its time)."""
+    h = fields.get("header")
+    if isinstance(h, Mapping) and ASIDE in h:
+        return header_stamp({"header": {"stamp": h[ASIDE]}})
+    flat = {k.rsplit(".", 1)[1]: v for k, v in fields.items() if k.startswith(f"header.{ASIDE}.")}
+    return header_stamp({"header": {"stamp": flat}}) if flat else None
 
 
 def with_stamp(fields: Mapping[str, Any], stamp: float) -> dict[str, Any]:
@@ -244,5 +266,5 @@ def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]
     return (stamp, source, seq)
 
 
-__all__ = ["AHEAD_NS", "STALE_S", "STAMP_AHEAD_S", "published", "STAMP_BEHIND_S", "event_ns", "event_s", "order_key", "other_clock",
+__all__ = ["AHEAD_NS", "ASIDE", "aside_stamp", "STALE_S", "STAMP_AHEAD_S", "published", "STAMP_BEHIND_S", "event_ns", "event_s", "order_key", "other_clock",
            "without_stamp", "WriterClocks"]

@@ -76,14 +76,21 @@ def _period_verdict(res: PeriodResult | None, key: str) -> tuple[str, str]:
         return "pending", "the period was not checked"
     late = res.late.get(key)
     n = res.messages.get(key, 0)
+    rate = res.clocks.get(key)
+    clock = (f" (in the node's clock: its stamps, set aside in another clock, run at {rate:.3f} s per s of the "
+             "run's)") if rate is not None else ""
     if late is not None:
+        after = "" if late["to"] is not None else ", until the run's end"
         return "false", (f"a gap of {late['gap'] * 1000:.0f} ms after the message at {late['from']:.3f} s "
-                         f"({late['where']}), over the period of {late['period'] * 1000:.0f} ms")
+                         f"({late['where']}){after}, over the period of {late['period'] * 1000:.0f} ms{clock}")
     if n == 0:
         return "pending", "no message of the output: its period was not checked"
     if n == 1:
-        return "inconclusive", "a single message and the run ends within the period: too short to show a gap"
-    return "true", f"{n} messages, no gap over {res.periods[key] * 1000:.0f} ms"
+        return "inconclusive", ("a single message and the run ends within the period: too short to show a gap"
+                                if key not in res.unrated else
+                                "a single message stamped in another clock: too short to show a gap, and its "
+                                "clock's rate unknown, so the run's end was not carried into it")
+    return "true", f"{n} messages, no gap over {res.periods[key] * 1000:.0f} ms{clock}"
 
 
 def declaration_status(res: DeclarationResult, trace: str) -> tuple[str, str]:

@@ -1,12 +1,12 @@
-"""Periodic outputs checked against message stamps.
+"""Periodic outputs checked against message stamps, in the clock of the node that stamps them.
 
 A node's ``periodic( out.y, 100 ms )`` (docs/rcl-language.md, "Progress,
 initial values and periodic outputs") says the node refreshes ``out.y`` at
-least once per period: a rate, a watchdog's heartbeat.  On a recorded run
-the messages that carry ``out.y`` (the topic ``topics(...)`` binds to it,
-:func:`.deadline_topics.topic_bindings`) are stamped as the deadline monitor
-stamps them (:func:`.stamp_order.run_clock`: the header's stamp, else the
-trace's time), and:
+least once per period of its own clock: a rate, a watchdog's heartbeat.  On
+a recorded run the messages that carry ``out.y`` (the topic ``topics(...)``
+binds to it, :func:`.deadline_topics.topic_bindings`) are read at their
+stamps as the deadline monitor reads them (:func:`.stamp_order.run_clock`:
+the header's stamp, else the trace's time), and:
 
 * every gap between two consecutive messages of ``out.y`` is at most the
   period: ``true``; a longer gap is ``false``, with both stamps (gaps are
@@ -17,6 +17,21 @@ trace's time), and:
 * no message of ``out.y`` at all: nothing was checked (``pending``); the
   time before the first message is not judged (a recorded run may start
   before the node does).
+
+**The node's clock.**  A message whose header stamp runs in another clock
+than the run's (simulated time on ``/clock``, a driver stamping seconds off:
+:func:`~rclverify.traces.event_time.other_clock`) is placed at its source
+time, its stamp set aside (:func:`~rclverify.traces.event_time.without_stamp`
+keeps it, :func:`~rclverify.traces.event_time.aside_stamp`).  Its gaps are
+then measured on those set-aside stamps, the clock the node publishes by
+(at a real-time factor of 2, a 100 ms period is 50 ms of the wall clock);
+the run's end, in the run's clock, is carried into the node's clock from
+the output's last message at the output's own rate, its stamps' span over
+its placed times' span (1 for a driver's offset; the factor measured for
+simulated time), so the tail is the node's time too.  With a single message
+of such an output the rate is unknown and the tail is not judged
+(:attr:`PeriodResult.unrated`).  A message without a stamp carries no clock
+but the run's, in which it is judged.
 
 A period in steps (``periodic( out.y, 3 steps )``), ``progress( ... )``
 and ``initially( ... )`` are judged on the same run by :mod:`.declarations`
@@ -32,6 +47,7 @@ from typing import Iterable
 
 from rclverify.lang.liveness import period_seconds
 from rclverify.lang.types import CheckedNode
+from rclverify.traces.event_time import aside_stamp
 from rclverify.traces.events import Event
 from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
@@ -47,17 +63,28 @@ class PeriodResult:
     """One node's periodic outputs on one run: per output ``out.y``, the
     messages seen and the first gap longer than its period (``None``:
     none), as ``{"from": stamp, "to": stamp or None (the run's end),
-    "gap": s, "period": s, "where": the later message's place}``."""
+    "gap": s, "period": s, "where": the later message's place}``, stamps and
+    gaps in the node's clock (module docstring); ``clocks``: per output whose
+    stamps were set aside in another clock, its rate against the run's clock
+    (node s per run s); ``unrated``: such outputs with one message, whose
+    tail was not judged."""
 
     node: str
     periods: dict[str, float] = field(default_factory=dict)
     messages: dict[str, int] = field(default_factory=dict)
     late: dict[str, PeriodGapJson] = field(default_factory=dict)
     end: float | None = None
+    clocks: dict[str, float] = field(default_factory=dict)
+    unrated: list[str] = field(default_factory=list)
 
     def to_json(self) -> PeriodResultJson:
-        return {"node": self.node, "periods": dict(self.periods), "messages": dict(self.messages),
-                "late": dict(self.late), "end": self.end}
+        out: PeriodResultJson = {"node": self.node, "periods": dict(self.periods), "messages": dict(self.messages),
+                                 "late": dict(self.late), "end": self.end}
+        if self.clocks:
+            out["clocks"] = {k: round(v, 6) for k, v in self.clocks.items()}
+        if self.unrated:
+            out["unrated"] = list(self.unrated)
+        return out
 
 
 def has_periods(node: CheckedNode) -> bool:
@@ -82,25 +109,45 @@ class PeriodMonitor:
             outs = [k for k, _ in keys if k in res.periods]
             if outs:
                 self.topics[topic] = outs
-        self.last: dict[str, tuple[float, str]] = {}
+        #: per output, its last message: (stamp in the node's clock, where, time on the run's clock)
+        self.last: dict[str, tuple[float, str, float]] = {}
+        #: per output whose stamps were set aside, its first message's (node's stamp, run's time)
+        self.first_aside: dict[str, tuple[float, float]] = {}
 
     def feed(self, ev: Event) -> None:
         res = self.result
-        stamp = run_clock(ev)
-        res.end = stamp if res.end is None else max(res.end, stamp)
-        for key in self.topics.get(ev.topic.lstrip("/"), ()):
+        at = run_clock(ev)
+        res.end = at if res.end is None else max(res.end, at)
+        outs = self.topics.get(ev.topic.lstrip("/"))
+        if not outs:
+            return
+        own = aside_stamp(ev.fields) if ev.fields else None
+        stamp = at if own is None else own
+        for key in outs:
             res.messages[key] = res.messages.get(key, 0) + 1
+            if own is not None:
+                self.first_aside.setdefault(key, (own, at))
             before = self.last.get(key)
             if before is not None and key not in res.late and stamp - before[0] > res.periods[key] + TOLERANCE_S:
                 res.late[key] = {"from": before[0], "to": stamp, "gap": stamp - before[0],
                                  "period": res.periods[key], "where": ev.where}
-            self.last[key] = (stamp, ev.where)
+            self.last[key] = (stamp, ev.where, at)
 
     def finish(self) -> PeriodResult:
         res = self.result
-        for key, (stamp, where) in self.last.items():
-            if key not in res.late and res.end is not None and res.end - stamp > res.periods[key] + TOLERANCE_S:
-                res.late[key] = {"from": stamp, "to": None, "gap": res.end - stamp, "period": res.periods[key],
+        for key, (stamp, where, at) in self.last.items():
+            if key in res.late or res.end is None:
+                continue
+            tail = res.end - stamp
+            if key in self.first_aside:  # the run's end carried into the node's clock at the output's rate
+                s0, t0 = self.first_aside[key]
+                if at - t0 <= 0 or stamp - s0 <= 0:
+                    res.unrated.append(key)
+                    continue
+                res.clocks[key] = rate = (stamp - s0) / (at - t0)
+                tail = (res.end - at) * rate
+            if tail > res.periods[key] + TOLERANCE_S:
+                res.late[key] = {"from": stamp, "to": None, "gap": tail, "period": res.periods[key],
                                  "where": where}
         return res
 

@@ -183,6 +183,10 @@ class PeriodResultJson(TypedDict):
     messages: dict[str, int]
     late: dict[str, PeriodGapJson]
     end: float | None
+    #: per output whose stamps ran in another clock: its rate against the run's clock (node s per run s)
+    clocks: NotRequired[dict[str, float]]
+    #: such outputs with a single message: the run's end not carried into their clock, their tail not judged
+    unrated: NotRequired[list[str]]
 
 
 class PeriodsPart(TypedDict):
