@@ -21,28 +21,44 @@ node it is drawn for, judged by the rules of docs/monitors.md, "Declarations on 
   period (1.4-1.8 s for the 200-400 ms sensors): the longest stall measured with both cores busy and
   other test runs beside was 0.85 s (every sensor of one robot 1.1 s apart at one instant, generated
   seed 821 with ``P`` a second smaller).
-  The period is judged on the messages' header stamps, else their source times, and the run's end on
-  the trace's times (docs/monitors.md, "Periodic outputs"): a stamped sensor is declared periodic only
-  on the wall clock with its driver's stamps on it (``sim_clock`` off, ``driver_offset_s`` 0), where
-  its stamps and the run's times are one clock; an unstamped one (its source times, the wall clock) on
-  every clock.
+  The period is the node's clock's (docs/monitors.md, "Periodic outputs"): a stamped sensor's gaps are
+  judged on its header stamps, which on a ``/clock`` run in simulated time (the judge sets them aside
+  as another clock, measures its rate and carries the run's end into it), so its ``P`` is in that
+  clock: the bound above times the real-time factor, and two ``/clock`` ticks more (its stamps move by
+  one tick, :data:`CLOCK_STEP_MS` of the wall clock); its robot's schedule stays the wall clock.  A
+  driver's offset leaves its gaps as they are; one within the bounds of the run's clock (at most 1 s
+  behind, 0.1 s ahead: its stamps are then the message's times) delays its last stamp, so a driver
+  behind adds its offset to ``P``.  An unstamped sensor carries no clock but the run's (its source
+  times, the wall clock): ``P`` as above on every clock.  :func:`period_rate` is the factor the
+  declared clock runs at against the wall clock (the seeded ``skip`` is that much longer).
 * an **alarm**, a **relay** stamping with its own clock: ``progress( within 2 steps )``; it answers
   every input after 0-30 % of the input's period, an answer due within a stamped sensor's publication
   window just after it (so at most one input comes between an input and its answer), and one step more
   for a stall of the loaded machine.
 * a **relay copying its reading's stamp**: ``progress( within K steps )``, ``K = ceil(delay / period) +
   2``: its answer may come up to ``delay`` after its reading, after that many readings.
+* one alarm or relay in two (:func:`in_steps`) declares the same bound as a period in steps instead,
+  ``periodic( out.y, K + 1 steps )`` (as ``within K steps``, only a message of ``out.y`` answering: its
+  one output).
 * a **fuse**: ``progress( within 3 steps )``: its second input, half a period before the first, is a
   step of its own that it does not answer (it answers each reading of its first input), so an answered
   row is two steps, one more for a deferred answer and one for a stall.
-* a **service** or **action** server: none (its steps are calls, which a bag's reader gives the call
-  checks only: its declarations would be ``pending`` on the bag).
+* a **service** or **action** server: its steps are its calls (a request, a goal), answered by the
+  response, the feedback or the result; its client sends one call at a time, the next once the last is
+  answered, and stops calling when the sensing ends, before the robot says ``done``, so the run's last
+  call is answered: ``progress( eventually )`` one server in two (:func:`in_steps`), else
+  ``progress( within 1 steps )``.  A bag's reader gives calls to the call checks only, so a server's
+  declarations are ``pending`` on the bag, and judged on the live run and its log (the runner counts
+  that ``pending`` apart, bench/_robot_verdicts.py); through the rclpy source without introspection no
+  call is heard and they are ``pending`` on every path.
 
 With ``defect``, the node seeded with a defect (:func:`defect_kind`) may break a declaration instead of
-its guarantee: a sensor skipping one publication for longer than its declared period (``"skip"``,
-``periodic`` false at that sensor; never a fuse's leading sensor, :func:`can_skip`) or an alarm answering none of K + 2 readings in a row once
-(``"mute"``: K + 1 accepted steps unanswered in a row even when the answer before them was deferred past
-the first, so ``progress`` false, and the readings' deadlines, at that alarm).
+its guarantee: a sensor skipping one publication for longer than its declared period in its clock (the
+wall-clock skip is the period over :func:`period_rate`, and one period more; ``"skip"``, ``periodic``
+false at that sensor; never a fuse's leading sensor, :func:`can_skip`) or an alarm answering none of
+K + 2 readings in a row once (``"mute"``: K + 1 accepted steps unanswered in a row even when the answer
+before them was deferred past the first, so its ``progress`` or period in steps false, and the
+readings' deadlines, at that alarm).
 """
 from __future__ import annotations
 
@@ -58,6 +74,12 @@ PERIOD_SLACK_MS = 1000
 ANSWER_STEPS = 2
 #: the bound of a fuse's (its second input is a step it does not answer)
 FUSE_STEPS = 3
+#: the bound of a server's ``progress( within K steps )`` (its client calls once the last call is answered)
+SERVER_STEPS = 1
+#: how often a ``/clock`` robot's clock node publishes (wall-clock ms; bench/robot_generator.py)
+CLOCK_STEP_MS = 20
+#: a stamp at most this far behind (s) or ahead of its source time is the run's clock (traces/event_time.py)
+STAMP_BEHIND_S, STAMP_AHEAD_S = 1.0, 0.1
 
 
 def declared_period_ms(period_ms: int) -> int:
@@ -66,8 +88,8 @@ def declared_period_ms(period_ms: int) -> int:
 
 
 def progress_steps(n: dict[str, Any], by: dict[str, dict[str, Any]]) -> int | None:
-    """The ``progress( within K steps )`` bound K of node spec ``n`` (``by``: specs by name), or None
-    when it declares no progress (a sensor, a server)."""
+    """The ``progress( within K steps )`` bound K of an alarm's, a relay's or a fuse's node spec ``n``
+    (``by``: specs by name), or None for another node (a sensor; a server's is :data:`SERVER_STEPS`)."""
     if n["kind"] == "alarm":
         return ANSWER_STEPS
     if n["kind"] == "fuse":
@@ -75,25 +97,62 @@ def progress_steps(n: dict[str, Any], by: dict[str, dict[str, Any]]) -> int | No
     if n["kind"] == "relay":
         if not n["copy"]:
             return ANSWER_STEPS
-        return math.ceil(n["delay_ms"] / by[n["source"]]["period_ms"]) + ANSWER_STEPS
+        return int(math.ceil(n["delay_ms"] / by[n["source"]]["period_ms"])) + ANSWER_STEPS
     return None
+
+
+def in_steps(n: dict[str, Any], seed: int) -> bool:
+    """Whether node ``n`` of robot ``seed`` declares its bound the other way (module docstring): an alarm
+    or relay as ``periodic( out.y, K + 1 steps )``, a server as ``progress( eventually )``.  Drawn from
+    a generator of its own, so the nodes drawn do not change."""
+    return random.Random(f"declare-{seed}-{n['name']}").random() < 0.5
+
+
+def period_rate(n: dict[str, Any], spec: dict[str, Any]) -> float:
+    """The rate (its s per wall-clock s) of the clock sensor ``n``'s declared period is in: the
+    real-time factor for a stamped sensor on a ``/clock``, else 1."""
+    clock = spec.get("clock")
+    return float(clock["rate"]) if clock and n["sensor_kind"] in ("range", "scan") else 1.0
+
+
+def declared_sensor_period_ms(n: dict[str, Any], spec: dict[str, Any]) -> int:
+    """The ``periodic`` bound (ms, in the node's clock) of sensor ``n`` of ``spec`` (module docstring)."""
+    base = declared_period_ms(n["period_ms"])
+    if n["sensor_kind"] not in ("range", "scan"):
+        return base
+    rate = period_rate(n, spec)
+    if spec.get("clock"):
+        return math.ceil(rate * (base + 2 * CLOCK_STEP_MS))
+    off = float(spec.get("driver_offset_s") or 0.0)
+    if -STAMP_BEHIND_S <= off < 0:  # within the run's clock: its last stamp that much before its publication
+        return base + math.ceil(-off * 1000)
+    return base
 
 
 def declare(spec: dict[str, Any]) -> None:
     """Mark in every node of ``spec`` the declarations its node keeps (module docstring): a sensor
-    ``"initially": True`` and, where its period can be judged, ``"periodic_ms"``; an alarm, relay or
-    fuse ``"progress_steps"``.  The contract's text is rendered from them (bench/robot_generator.py)."""
+    ``"initially": True``, ``"periodic_ms"`` and ``"periodic_rate"`` (:func:`period_rate`); an alarm,
+    relay or fuse ``"progress_steps"`` and, for one alarm or relay in two, ``"period_steps"`` (its bound
+    as a period in steps); a server ``"progress_steps"`` or ``"eventually": True``.  The contract's text
+    is rendered from them (bench/robot_generator.py)."""
     by = {n["name"]: n for n in spec["nodes"]}
-    other_clock = bool(spec.get("clock")) or bool(spec.get("driver_offset_s"))
     for n in spec["nodes"]:
         if n["kind"] == "sensor":
             n["initially"] = True
-            if n["sensor_kind"] not in ("range", "scan") or not other_clock:
-                n["periodic_ms"] = declared_period_ms(n["period_ms"])
+            n["periodic_ms"] = declared_sensor_period_ms(n, spec)
+            n["periodic_rate"] = period_rate(n, spec)
+            continue
+        if n["kind"] in ("service", "action"):
+            if in_steps(n, spec["seed"]):
+                n["eventually"] = True
+            else:
+                n["progress_steps"] = SERVER_STEPS
             continue
         k = progress_steps(n, by)
         if k is not None:
             n["progress_steps"] = k
+            if n["kind"] in ("alarm", "relay") and in_steps(n, spec["seed"]):
+                n["period_steps"] = k + 1
 
 
 def can_skip(n: dict[str, Any], spec: dict[str, Any]) -> bool:
@@ -118,5 +177,6 @@ def defect_kind(victim: dict[str, Any], spec: dict[str, Any]) -> str:
     return "wrong"
 
 
-__all__ = ["ANSWER_STEPS", "FUSE_STEPS", "PERIOD_FACTOR", "PERIOD_SLACK_MS", "can_skip", "declare",
-           "declared_period_ms", "defect_kind", "progress_steps"]
+__all__ = ["ANSWER_STEPS", "CLOCK_STEP_MS", "FUSE_STEPS", "PERIOD_FACTOR", "PERIOD_SLACK_MS", "SERVER_STEPS",
+           "can_skip", "declare", "declared_period_ms", "declared_sensor_period_ms", "defect_kind", "in_steps",
+           "period_rate", "progress_steps"]

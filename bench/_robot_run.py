@@ -19,7 +19,10 @@ must be red live and every other node not.  Per node the live final verdicts are
 * ``declaration <verdict>``: the node's declarations (``initially``, ``progress``, ``periodic``;
   bench/_robot_declarations.py), one row each, from the live record (``--evidence``); the log's and the
   bag's rows (``rclverify monitor --json``) are compared with them declaration by declaration, and a
-  ``false`` declaration of a correct node on any path is false, as a violated answer is.
+  ``false`` declaration of a correct node on any path is false, as a violated answer is.  A server's
+  declarations (its steps are calls) are ``pending`` on the bag, whose reader gives calls to the call
+  checks only: counted apart (``bag_pending_calls``), never as a disagreement; any other difference at a
+  server is one.
 
 Everything on loopback (Cyclone's loopback configuration for the monitor,
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` for the nodes), a random ``ROS_DOMAIN_ID``, every
@@ -220,7 +223,9 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     res["finals"], lines = three_way(paths)
     res["declarations"] = decl
     res["disagreements"] = [x for x in lines if not x.startswith(("provisional: ", "placed apart: "))]
-    res["disagreements"] += compare_declarations(decl)
+    servers = [n["name"] for n in spec["nodes"] if n["kind"] in ("service", "action")]
+    differ, res["bag_pending_calls"] = compare_declarations(decl, servers)
+    res["disagreements"] += differ
     res["provisional"] = [x for x in lines if x.startswith("provisional: ")]
     res["placed_apart"] = [x for x in lines if x.startswith("placed apart: ")]
     res["live"] = tally(res["finals"]["live"])
@@ -337,10 +342,12 @@ def _line(res: dict[str, Any]) -> str:
             + f", {len(res['disagreements'])} disagreement(s)"
             + (f", {len(res['provisional'])} on a provisional verdict" if res["provisional"] else "")
             + (f", {len(res['placed_apart'])} message(s) placed apart" if res["placed_apart"] else "")
+            + (f", {len(res.get('bag_pending_calls', []))} server declaration(s) pending on the bag (calls)"
+               if res.get("bag_pending_calls") else "")
             + (f", {tot['provisional']} live verdict(s) left provisional" if tot["provisional"] else "") + "; "
             f"{'agree' if not res['findings'] else 'FINDINGS: ' + '; '.join(res['findings'])}"
             + ("; " + "; ".join(res["errors"]) if res["errors"] else "")
-            + "".join(f"\n  {x}" for x in res["provisional"] + res["placed_apart"])
+            + "".join(f"\n  {x}" for x in res["provisional"] + res["placed_apart"] + res.get("bag_pending_calls", []))
             + "".join(f"\n  other clock: {c}" for c in res.get("other_clocks", []))
             + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items())
             + "".join(f"\n  deadline undecided (first, log): {w}" for w in why)
@@ -388,6 +395,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
                 total.update(c)
             undecided += sum(c["deadline undecided"] for c in res["log"].values())
             victim = _victim(res)
+            declarations["bag pending at a server"] += len(res.get("bag_pending_calls", []))
             for path, d in res["declarations"].items():
                 declarations.update(f"{path} {row['verdict']}" for row in d.values())
                 declarations.update(f"{path} false at a correct node" for (node, _, _), row in d.items()
@@ -410,9 +418,11 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           + f", {total['unjudged']} unjudged endpoints), deadlines true {total['deadline true']} false {total['deadline false']} "
           f"(undecided on the logs: {undecided}); declarations: " + "; ".join(
               f"{path} " + ", ".join(f"{declarations[k]} {k.split(' ', 1)[1]}" for k in sorted(declarations)
-                                     if k.startswith(path + " ") and "correct" not in k)
+                                     if k.startswith(path + " ") and "correct" not in k and "server" not in k)
               for path in ("live", "log", "bag")) + ", false declarations (at a correct node): " + ", ".join(
               f"{path} {declarations[path + ' false at a correct node']}" for path in ("live", "log", "bag"))
+          + f" ({declarations['bag pending at a server']} server declaration(s) pending on the bag alone, its calls "
+          "given to the call checks only)"
           + f"; verdicts compared: live {compared['live']}, log {compared['log']}, bag "
           f"{compared['bag']}; disagreements {disagreements} (and {provisional} on a verdict still provisional, {apart} "
           f"message(s) given one verdict but placed apart); "

@@ -213,10 +213,18 @@ def declaration_verdicts(parts: Iterable[dict[str, Any]]) -> dict[DeclKey, dict[
     return out
 
 
-def compare_declarations(paths: dict[str, dict[DeclKey, dict[str, Any]]]) -> list[str]:
-    """Each declaration the live path (``paths["live"]``) and the log's or the bag's judged differently,
-    or that one judged and the other did not, named with both sides' verdicts and reasons."""
+def compare_declarations(paths: dict[str, dict[DeclKey, dict[str, Any]]],
+                         calls_only: Iterable[str] = ()) -> tuple[list[str], list[str]]:
+    """``(disagreements, bag_pending)``: each declaration the live path (``paths["live"]``) and the log's
+    or the bag's judged differently, or that one judged and the other did not, named with both sides'
+    verdicts and reasons; apart from them, each declaration of a node whose steps are all calls
+    (``calls_only``: servers) that the bag leaves ``pending``, the live run and its log judging it: a
+    bag's reader gives calls to the call checks only (docs/monitors.md, "Declarations on recorded and live
+    runs"), so that ``pending`` is the bag's documented limit, said apart, never a disagreement (any other
+    difference at such a node still is one)."""
     out: list[str] = []
+    apart: list[str] = []
+    servers = set(calls_only)
     live = paths["live"]
     for other in ("log", "bag"):
         them = paths.get(other, {})
@@ -224,10 +232,16 @@ def compare_declarations(paths: dict[str, dict[DeclKey, dict[str, Any]]]) -> lis
             a, b = live.get(key), them.get(key)
             if a is not None and b is not None and a["verdict"] == b["verdict"]:
                 continue
-            side = lambda name, r: f"{name}: no verdict" if r is None else f"{name}: {r['verdict']} ({r.get('reason', '')})"  # noqa: E731
-            out.append(f"live != {other}: {key[0]}: declaration {key[1]} ({key[2]}): {side('live', a)}; "
-                       f"{side(other, b)}")
-    return out
+            line = f"{key[0]}: declaration {key[1]} ({key[2]}): {_side('live', a)}; {_side(other, b)}"
+            if other == "bag" and key[0] in servers and b is not None and b["verdict"] == "pending":
+                apart.append(f"pending on the bag (its calls go to the call checks only): {line}")
+            else:
+                out.append(f"live != {other}: {line}")
+    return out, apart
+
+
+def _side(name: str, row: dict[str, Any] | None) -> str:
+    return f"{name}: no verdict" if row is None else f"{name}: {row['verdict']} ({row.get('reason', '')})"
 
 
 def tally_declarations(d: dict[DeclKey, dict[str, Any]]) -> dict[str, Counter[str]]:

@@ -71,7 +71,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _robot_declarations import declare, defect_kind  # bench/ is on sys.path (run as a script, the tests)
+from _robot_declarations import CLOCK_STEP_MS, declare, defect_kind  # bench/ is on sys.path (run as a script, the tests)
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATES = ROOT / "bench" / "templates" / "robot_generator"
@@ -94,8 +94,6 @@ FIB_ORDERS = (1, 2, 3, 4, 5, 6, 7, 8)
 HORIZON = 1.0
 #: the real-time factors a ``/clock`` robot draws from: simulated seconds per wall-clock second
 CLOCK_RATES = (0.5, 0.75, 1.0, 1.5, 2.0)
-#: how often the clock node publishes ``rosgraph_msgs/Clock`` (wall-clock ms)
-CLOCK_STEP_MS = 20
 
 
 def f32(v: float) -> float:
@@ -296,11 +294,19 @@ def _consts(spec: dict[str, Any]) -> tuple[list[dict[str, str]], dict[str, dict[
     return consts, names
 
 
+def _answer_var(n: dict[str, Any]) -> str:
+    """The one output of alarm or relay spec ``n`` (its answer)."""
+    return "r" if n["kind"] == "relay" else ("high" if n["op"] == "ge" else "low")
+
+
 def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str, dict[str, str]]) -> dict[str, Any]:
     """One node's contract as the template's fields (inputs, outputs, topics, services, assume, guarantees)."""
     c: dict[str, Any] = {"name": n["name"], "topics": [], "services": [], "actions": [], "assume": "TRUE",
                          "inputs": [], "outputs": [], "declarations": (
-                             [f"progress( within {n['progress_steps']} steps )"] if n.get("progress_steps") else [])}
+                             ["progress( eventually )"] if n.get("eventually") else
+                             [f"periodic( out.{_answer_var(n)}, {n['period_steps']} steps )"] if n.get("period_steps")
+                             else [f"progress( within {n['progress_steps']} steps )"] if n.get("progress_steps")
+                             else [])}
     k = names.get(n["name"], {})
 
     def band(var: str, s: dict[str, Any]) -> str:

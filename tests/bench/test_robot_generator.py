@@ -199,9 +199,10 @@ def test_a_wall_clock_robot_has_no_writer_in_another_clock(correct_run: dict[str
 
 def test_a_simulated_clock_leaves_the_nodes_as_drawn() -> None:
     """``sim_clock`` adds the clock and ``use_sim_time`` and changes no node but a stamped sensor's period
-    declaration (bench/_robot_declarations.py: its stamps run in the other clock); the control: without it
+    declaration (bench/_robot_declarations.py: in its node's clock, simulated); the control: without it
     the robot has neither."""
-    drop = lambda nodes: [{k: v for k, v in n.items() if k != "periodic_ms"} for n in nodes]  # noqa: E731
+    drop = lambda nodes: [{k: v for k, v in n.items() if k not in ("periodic_ms", "periodic_rate")}  # noqa: E731
+                          for n in nodes]
     for seed in range(20):
         plain, sim = gen.generate(seed, 8), gen.generate(seed, 8, sim_clock=True)
         assert drop(plain["nodes"]) == drop(sim["nodes"]) and plain["clock"] is None

@@ -38,11 +38,19 @@ def test_every_declaration_is_drawn_parsed_and_type_checked(seed: int, nodes: in
             assert len(node.initially) == 1 and len(node.periodic) == 1, n["name"]
             per = node.periodic[0]
             assert (per.amount, per.unit) == (str(n["periodic_ms"]), "ms")
+        elif n.get("period_steps"):  # an alarm or a relay: its bound as a period in steps of its one output
+            assert not node.initially and not node.progress and len(node.periodic) == 1
+            per = node.periodic[0]
+            assert (per.amount, per.unit) == (str(n["progress_steps"] + 1), "steps")
+            assert [per.output.name] == [o.name for o in node.outputs]
         elif n["kind"] in ("alarm", "relay", "fuse"):
             assert not node.initially and not node.periodic and len(node.progress) == 1
             assert str(node.progress[0].bound) == str(n["progress_steps"])
-        else:  # a server: its steps are calls, which a bag gives the call checks only
-            assert not (node.initially or node.progress or node.periodic)
+        else:  # a server: its steps are calls, answered before its client calls again
+            assert not node.initially and not node.periodic and len(node.progress) == 1
+            bound = node.progress[0].bound
+            assert (bound is None) == bool(n.get("eventually")) and str(bound or "") == str(
+                n.get("progress_steps") or "")
 
 
 def test_a_declaration_on_an_output_the_node_lacks_is_refused(tmp_path: Path) -> None:
@@ -70,18 +78,48 @@ def test_each_bound_leaves_its_margin(seed: int) -> None:
             assert n["progress_steps"] == 3
 
 
-def test_a_stamped_sensor_is_declared_periodic_on_the_wall_clock_only() -> None:
-    stamped = lambda spec: [n for n in spec["nodes"] if n["kind"] == "sensor"  # noqa: E731
-                            and n["sensor_kind"] in ("range", "scan")]
-    wall = gen.generate(842, 12)
-    assert stamped(wall) and all(n.get("periodic_ms") for n in stamped(wall))  # the control
-    for spec in (gen.generate(842, 12, sim_clock=True), gen.generate(842, 12, driver_offset_s=-2.0)):
-        assert stamped(spec) and not any(n.get("periodic_ms") for n in stamped(spec))
-        assert all(n.get("periodic_ms") for n in spec["nodes"]
-                   if n["kind"] == "sensor" and n["sensor_kind"] not in ("range", "scan"))
-        assert all(n.get("initially") for n in spec["nodes"] if n["kind"] == "sensor")
-        assert gen.render(spec)["contracts/robot.rcl"].count("periodic(") < \
-            gen.render(wall)["contracts/robot.rcl"].count("periodic(")
+def test_a_stamped_sensors_period_is_declared_in_its_nodes_clock() -> None:
+    """A stamped sensor's period is judged on its stamps (backends/monitors/periods.py), so it is declared
+    in their clock: on a ``/clock`` the wall-clock bound times the real-time factor and two ticks more, with
+    a driver's offset outside the run's clock the wall-clock bound, with a driver within 1 s behind that
+    much more; an unstamped sensor's (its source times) is the wall-clock bound on every clock."""
+    stamped = lambda n: n["kind"] == "sensor" and n["sensor_kind"] in ("range", "scan")  # noqa: E731
+    plain = lambda n: n["kind"] == "sensor" and not stamped(n)  # noqa: E731
+    rates = set()
+    for seed in range(840, 860):
+        wall = gen.generate(seed, 12)
+        for spec, want in ((wall, lambda p, r: p), (gen.generate(seed, 12, driver_offset_s=-2.0), lambda p, r: p),
+                           (gen.generate(seed, 12, driver_offset_s=0.3), lambda p, r: p),
+                           (gen.generate(seed, 12, driver_offset_s=-0.5), lambda p, r: p + 500),
+                           (gen.generate(seed, 12, sim_clock=True),
+                            lambda p, r: math.ceil(r * (p + 2 * decl.CLOCK_STEP_MS)))):
+            rate = spec["clock"]["rate"] if spec["clock"] else 1.0
+            for n in spec["nodes"]:
+                base = 2 * n.get("period_ms", 0) + 1000
+                if stamped(n):
+                    assert n["periodic_ms"] == want(base, rate) and n["periodic_rate"] == rate, (seed, n["name"])
+                    rates.add(rate)
+                elif plain(n):
+                    assert n["periodic_ms"] == base and n["periodic_rate"] == 1.0
+                if n["kind"] == "sensor":
+                    assert n.get("initially")
+    assert {0.5, 2.0} <= rates  # the control: factors either side of 1 were drawn
+
+
+def test_servers_and_answering_nodes_declare_both_forms() -> None:
+    """A server declares ``progress( eventually )`` or ``within 1 steps``, an alarm or relay its bound as
+    ``progress`` or as a period in steps, each form drawn across seeds, without changing the nodes drawn."""
+    forms: set[tuple[str, str]] = set()
+    for seed in range(840, 880):
+        spec = gen.generate(seed, 12, actions=True)
+        for n in spec["nodes"]:
+            if n["kind"] in ("service", "action"):
+                forms.add((n["kind"], "eventually" if n.get("eventually") else f"within {n['progress_steps']}"))
+            elif n["kind"] in ("alarm", "relay"):
+                forms.add((n["kind"], "steps" if n.get("period_steps") else "progress"))
+    assert forms == {("service", "eventually"), ("service", "within 1"), ("action", "eventually"),
+                     ("action", "within 1"), ("alarm", "steps"), ("alarm", "progress"), ("relay", "steps"),
+                     ("relay", "progress")}, forms
 
 
 def test_a_defect_may_break_a_declaration_at_its_own_node() -> None:
@@ -95,7 +133,7 @@ def test_a_defect_may_break_a_declaration_at_its_own_node() -> None:
         if victim["defect_kind"] == "mute":
             assert victim["kind"] == "alarm" and victim["progress_steps"] == 2
         # the contracts are the correct robot's: a defect is in the node, never in its declarations
-        keys = ("initially", "periodic_ms", "progress_steps")
+        keys = ("initially", "periodic_ms", "periodic_rate", "progress_steps", "period_steps", "eventually")
         assert [[n.get(k) for k in keys] for n in spec["nodes"]] == \
             [[n.get(k) for k in keys] for n in gen.generate(seed, 6)["nodes"]]
         strip = lambda t: [ln for ln in t.splitlines() if not ln.startswith("//")]  # noqa: E731
