@@ -30,6 +30,7 @@ process in a session of its own and stopped at the end.
 """
 from __future__ import annotations
 
+import functools
 import json
 import os
 import random
@@ -54,8 +55,10 @@ from _robot_verdicts import (UNDECIDED, compare_declarations, declaration_verdic
 SOURCES = ("dds", "rclpy")
 
 
+@functools.lru_cache(maxsize=None)
 def ros2_python() -> tuple[Path | None, str]:
-    """The ROS 2 Python (``RCLVERIFY_ROS2_PYTHON`` or ``.venv-ros2``) and ``""``, or None and why not."""
+    """The ROS 2 Python (``RCLVERIFY_ROS2_PYTHON`` or ``.venv-ros2``) and ``""``, or None and why not
+    (probed once per process: a probe imports rclpy, a second or more on a loaded machine)."""
     named = os.environ.get("RCLVERIFY_ROS2_PYTHON")
     exe = Path(named) if named else ROOT / ".venv-ros2" / "bin" / "python"
     if not exe.exists():
@@ -121,6 +124,43 @@ def _offline(ws: Path, traces: dict[str, str], env: dict[str, str]) -> dict[str,
             continue
         out[name] = (rows, f"exit {p.returncode}: {stderr[-1500:]}" if p.returncode not in (0, 1) else "")
     return out
+
+
+def sent_topics(robot_out: Path, spec: dict[str, Any]) -> dict[str, int]:
+    """The messages the robot had published on each of its topics when it said ``done`` (its ``done
+    {...}`` line; a server's calls left out: the monitor logs those as call lines), by topic without
+    its leading ``/``."""
+    topics = {n["topic"] for n in spec["nodes"] if "topic" in n}
+    for line in robot_out.read_text(errors="replace").splitlines():
+        if line.startswith("done "):
+            sent = json.loads(line[5:])
+            return {t.lstrip("/"): int(k) for t, k in sent.items() if t in topics}
+    return {}
+
+
+def heard_all(log: Path, sent: dict[str, int], least: float, most: float) -> float:
+    """Wait until the live log ``log`` holds at least ``sent[topic]`` lines of each topic (the monitor
+    heard, released and judged what the robot had published when it said ``done``), ``least`` s at
+    least and ``most`` s at most (a message lost on the way is the comparison's to find, not this
+    wait's); returns the seconds waited.  A fixed wait would stop a monitor lagging behind a loaded
+    machine before it judged the run's last answers."""
+    t0 = time.monotonic()
+    while True:
+        waited = time.monotonic() - t0
+        if waited >= most:
+            return waited
+        if waited >= least and sent:
+            counts = Counter[str]()
+            for line in log.read_text(errors="replace").splitlines() if log.exists() else ():
+                try:
+                    topic = json.loads(line).get("topic")
+                except ValueError:
+                    continue
+                if isinstance(topic, str):
+                    counts[topic.lstrip("/")] += 1
+            if all(counts[t] >= k for t, k in sent.items()):
+                return waited
+        time.sleep(0.1)
 
 
 class RobotFailed(Exception):
@@ -193,7 +233,7 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
                 raise RobotFailed(f"seed {seed}: the robot {'exited' if robot.poll() is not None else 'hung'}:\n"
                                   + (tmp / "robot.out").read_text(errors="replace")[-2000:])
             time.sleep(0.1)
-        time.sleep(1.5)  # the last answers reach the monitor and are judged
+        heard_all(ws / "runs" / "live.jsonl", sent_topics(tmp / "robot.out", spec), 0.2, 5.0)
         stop(mon, signal.SIGINT)
         stop(robot)
     finally:

@@ -147,8 +147,7 @@ def robot_run(tmp: Path, seed: int, nodes: int, seconds: float, defect: bool, **
     """Generated robot ``seed`` of ``nodes`` nodes (``defect``: with its seeded defect) run live and
     offline for ``seconds`` of sensing under ``tmp``: bench/_robot_run.py's ``run_one`` (``how``: its
     keyword arguments), whose result it returns; bench/ must be on ``sys.path``.  Skipped, saying why,
-    without ROS 2's Python."""
-    ros2_python()
+    without ROS 2's Python (``_robot_run.ros2_python`` probes it once per process)."""
     import _robot_run
     ros2, why = _robot_run.ros2_python()
     if ros2 is None:
