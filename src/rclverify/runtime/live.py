@@ -135,7 +135,11 @@ class LiveRun:
     # -- engine callbacks (called under the lock) ----------------------------------
     def _event(self, ev: Event) -> None:
         late = {"late_s": round(ev.late, 6)} if ev.late else {}  # at its source time, with how late it was heard
-        self._log.write(dumps({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time,
+        # a late message, and one placed at a header stamp older than its publication (a stale copied stamp:
+        # ``source`` set, ``stamp`` its time), at its source time: the offline check of the log reads the
+        # publication from ``time`` and judges it against every question it could answer, as the engine did
+        published = ev.source is not None and (late or ev.stamp == ev.time)
+        self._log.write(dumps({"topic": ev.topic, "time": ev.source if published else ev.time,
                                **late, **{k: v for k, v in ev.fields.items() if k not in ("topic", "time")}}) + "\n")
 
     @property
