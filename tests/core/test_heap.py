@@ -38,6 +38,46 @@ def _unfrozen_start() -> None:
     assert gc.get_freeze_count() == 0
 
 
+def test_a_command_loads_without_collection_then_runs_on_a_frozen_heap() -> None:
+    _unfrozen_start()
+    with heap.loading() as loaded:
+        assert not gc.isenabled()  # loading: no collection
+        loaded()
+        assert gc.isenabled() and gc.get_freeze_count() > 0  # running: what was loaded is frozen
+        loaded()  # once only
+    assert gc.isenabled() and gc.get_freeze_count() == 0  # given back after the block
+    with pytest.raises(ValueError):
+        with heap.loading() as loaded:
+            loaded()
+            raise ValueError("a run that fails")
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    with pytest.raises(ValueError):
+        with heap.loading():
+            raise ValueError("bad input while loading")
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+
+
+def test_the_monitor_command_gives_the_collector_back(tmp_path: Path, capsys: Any) -> None:
+    """``rclverify monitor`` on a recorded run, run in this process: its start-up loaded without
+    collection and frozen for the run (cli/runs.py), the collector as it was after it."""
+    from rclverify.cli.commands import main
+    _unfrozen_start()
+    ws = tmp_path / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/n.rcl").write_text("node N {\n  inputs( a : REAL )\n  outputs( b : REAL )\n"
+                                        "  topics( std_msgs/Float64 q matches(in.a), std_msgs/Float64 r matches(out.b) )\n"
+                                        "  guarantee( out.b > in.a )\n}\n")
+    (ws / "contracts/plan.yaml").write_text("name: n\ncontracts: [contracts/n.rcl]\nnodes:\n  N:\n    evidence: []\n")
+    log = ws / "run.jsonl"
+    log.write_text('{"topic": "q", "time": 0.0, "data": 1.0}\n{"topic": "r", "time": 0.0, "data": 2.0}\n')
+    assert main(["monitor", "-w", str(ws), str(log)]) == 0
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    (ws / "contracts/n.rcl").write_text("node N {")  # a contract that does not parse: an error while loading
+    assert main(["monitor", "-w", str(ws), str(log)]) != 0
+    assert gc.isenabled() and gc.get_freeze_count() == 0
+    capsys.readouterr()
+
+
 def test_a_run_heap_is_given_back_after_the_run() -> None:
     _unfrozen_start()
     heap.freeze_for_run()

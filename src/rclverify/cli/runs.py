@@ -10,14 +10,33 @@ from rclverify.cli.common import AddCommand, seconds
 
 def cmd_monitor(args: argparse.Namespace) -> int:
     """Judge recorded runs, or the running system (``--live``), against every node's contract (:func:`rclverify.cli.monitor.monitor_command`)."""
-    from rclverify.cli.monitor import monitor_command  # deferred: start-up (loads numpy, yaml and more only when called)
-    from rclverify.core.cache.startup import keeping  # deferred: start-up (loads rclverify.core.cache.store only when called)
-    from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
-    with keeping():  # the parsed contracts, the plan's schema check, the compiled formulas: kept by content
-        ws = Workspace(Path(args.workspace), args.plan)
-        checked = ws.checked  # raises RclError, printed located by main
+    from rclverify.core.cache.heap import freeze_at_exit, loading  # deferred: start-up (imported where it is used)
+    # what the start-up loads (the modules, the log's reader, the contracts, the plan) stays live to the end: no
+    # collection while it is made, then frozen for the run, so that no collection walks it (core/cache/heap.py)
+    with loading() as loaded:
+        from rclverify.cli.monitor import monitor_command  # deferred: start-up (loads numpy, yaml and more only when called)
+        from rclverify.core.cache.startup import keeping  # deferred: start-up (loads rclverify.core.cache.store only when called)
+        from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
         from rclverify.model.instances import instantiate  # deferred: start-up (as above)
-        return monitor_command(args, instantiate(checked, ws.plan.node_instances))  # each instance its own node
+        _log_reader(args)
+        with keeping():  # the parsed contracts, the plan's schema check, the compiled formulas: kept by content
+            ws = Workspace(Path(args.workspace), args.plan)
+            checked = instantiate(ws.checked, ws.plan.node_instances)  # each instance its own node; raises RclError, printed located by main
+            freeze_at_exit()
+            loaded()
+            return monitor_command(args, checked)
+
+
+def _log_reader(args: argparse.Namespace) -> None:
+    """Import the reader of a ROSMonitoring log (:mod:`rclverify.traces.jsonl_blocks`, with numpy and
+    msgspec) when ``args`` names one to check and the reader would take it (:func:`rclverify.traces.read_trace`
+    imports it when it reads one): loaded with the rest of the start-up."""
+    from rclverify.traces.guard import LOG_SUFFIXES  # deferred: start-up (imported where it is used)
+    if getattr(args, "live", False) or not any(Path(t).suffix in LOG_SUFFIXES for t in args.traces):
+        return
+    from rclverify.core.extras import installed  # deferred: start-up (imported where it is used)
+    if installed("numpy"):
+        import rclverify.traces.jsonl_blocks  # noqa: F401  # deferred: optional or conditional (inside a block)
 
 
 def cmd_oracle(args: argparse.Namespace) -> int:

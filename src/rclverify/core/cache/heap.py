@@ -30,6 +30,10 @@ objects that cannot be garbage yet:
   collections run as before;
 * :func:`freeze_inherited` -- a worker forked by ``doit -n`` freezes the
   heap it inherited, once;
+* :func:`loading` -- no collection while a command loads what it keeps,
+  then that heap frozen while it runs (``rclverify monitor``: the first
+  young collection after re-enabling the collector would walk all that
+  its start-up made);
 * :func:`freeze_at_exit` -- nothing is collected while the process exits;
 * :func:`freeze_for_live` -- a live monitor, once loaded, collects and
   freezes its heap before the first message, so a full collection later
@@ -53,7 +57,7 @@ from __future__ import annotations
 import gc
 import os
 from contextlib import contextmanager
-from typing import Iterator
+from typing import Callable, Iterator
 import atexit
 
 _WORKER: list[int] = []
@@ -72,6 +76,34 @@ def no_collection() -> Iterator[None]:
         yield
     finally:
         if was_enabled:
+            gc.enable()
+
+
+@contextmanager
+def loading() -> Iterator[Callable[[], None]]:
+    """No cyclic collection inside the block until the function it gives is called (the start-up's objects
+    loaded by then); from that call on, the heap made so far frozen (``gc.freeze``: no collection walks it,
+    objects made later are collected as usual) until the block ends, when it is given back to the
+    collector (``gc.unfreeze``), also on an exception.  For a command whose loaded modules and inputs stay
+    live while it works (``rclverify monitor`` on a recorded run: the first young collection after
+    re-enabling the collector would walk all the start-up made); a process that runs it again, a test's,
+    gets its objects back."""
+    was_enabled = gc.isenabled()
+    done: list[bool] = []
+
+    def loaded() -> None:
+        if not done:
+            gc.freeze()
+            done.append(True)
+            if was_enabled:
+                gc.enable()
+    gc.disable()
+    try:
+        yield loaded
+    finally:
+        if done:
+            gc.unfreeze()
+        elif was_enabled:
             gc.enable()
 
 
