@@ -197,8 +197,8 @@ class WindowMargins(MarginCompiler):
 
     columns: WindowCompiler
 
-    def __init__(self, columns: WindowCompiler) -> None:
-        super().__init__(columns)
+    def __init__(self, columns: WindowCompiler, track: bool = True) -> None:
+        super().__init__(columns, track)
 
     def _rob(self, e: Any) -> ColumnMargin:
         cols = self.columns
@@ -207,11 +207,15 @@ class WindowMargins(MarginCompiler):
             body = cols.within(name, values, lambda: self._rob(e.body))
             axis, shape = len(cols.scope) + 1, cols.axes + (len(values),)
             pick = np.argmin if e.kind == "forall" else np.argmax
+            forall = e.kind == "forall"
 
-            def quant(c: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+            def quant(c: Mapping[str, np.ndarray]) -> tuple[np.ndarray, Any]:
                 v, a = body(c)
                 full = (len(next(iter(c.values()))),) + shape
-                v, a = np.broadcast_to(v, full), np.broadcast_to(a, full)
+                v = np.broadcast_to(v, full)
+                if a is None:  # the values alone: the extreme itself (NaN where one is, as argmin/argmax pick it)
+                    return (v.min(axis) if forall else v.max(axis)), None
+                a = np.broadcast_to(a, full)
                 j = np.expand_dims(pick(v, axis=axis), axis)  # the first extreme: ties kept on the left
                 return np.take_along_axis(v, j, axis).squeeze(axis), np.take_along_axis(a, j, axis).squeeze(axis)
             return quant
@@ -219,7 +223,7 @@ class WindowMargins(MarginCompiler):
             static = cols.index_compare(e)
             if static is not None:  # offsets only: no distance
                 value = np.where(static, np.inf, -np.inf)[None]
-                none = np.full(value.shape, -1, dtype=np.int32)
+                none = np.full(value.shape, -1, dtype=np.int32) if self.track else None
                 return lambda c: (value, none)
         return super()._rob(e)
 

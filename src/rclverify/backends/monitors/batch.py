@@ -63,6 +63,7 @@ from typing import Callable, Iterable, Mapping
 from rclverify.core.numeric import np
 
 from rclverify.semantics.floatsem import Tolerance
+from rclverify.semantics.floatsens import float_sensitive
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.jsonl_blocks import LogBlock
@@ -73,6 +74,7 @@ from rclverify.backends.monitors.batch_lone import LoneSlots, lone_eligible
 from rclverify.backends.monitors.batch_pairs import PairRuns
 from rclverify.backends.monitors.batch_plan import BatchPlan, batch_plan
 from rclverify.backends.monitors.batch_state import _kept
+from rclverify.backends.monitors.batch_violations import violated_semantics
 from rclverify.backends.monitors.batch_window import window_column
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows, chunks, rows_of
@@ -161,7 +163,17 @@ class _Run(PairRuns, LoneSlots):
         #: surely violated answers are judged in batches too once nothing renders them: one guarantee (its first
         #: false one is the only one judged), no verdict callback (closing.py: a violation past the kept records
         #: is only counted); with a transport skew, only those released within their run (batch_pairs.py, _released)
-        self.wrong = len(m.guarantees) == 1 and m.on_verdict is None
+        #: (a declared tolerance that could make a false row hold within it, and a window's quantifier the double
+        #: reading cannot enumerate, where the engine's verdict is inconclusive: the engine's)
+        g = m.guarantees[0] if len(m.guarantees) == 1 else None
+        self.wrong = g is not None and m.on_verdict is None and not (
+            m.tolerance and float_sensitive(g, m.checked, m.node, tolerant=True)) and not (
+            plan.widths and float_sensitive(g, m.checked, m.node))
+        #: surely violated answers of a guarantee read against a question are judged in batch before the records are
+        #: full too, each record written as the engine writes it (batch_violations.py); an output-only one's the engine's
+        self.records = self.wrong and not m._alone
+        #: the semantics of such a violation (batch_violations.py)
+        self.violated_as = violated_semantics(m) if self.records else ""
         #: a violated answer of a guarantee on a question is held for the skew (an output-only one is not)
         self.held = bool(m.stream.skew) and not m._alone
         #: ``triggered by``: the column code of the input every triggered guarantee answers (0: no trigger)

@@ -16,8 +16,10 @@ from typing import TYPE_CHECKING
 
 from rclverify.core.numeric import np
 
+from rclverify.targets.column_margins import RowAtoms
 from rclverify.targets.columns import seed
 from rclverify.backends.monitors.batch_state import PairsState
+from rclverify.backends.monitors.batch_violations import add_records, room
 from rclverify.backends.monitors.verdicts import KEPT_MARGINS, Verdict
 
 if TYPE_CHECKING:
@@ -35,6 +37,8 @@ class PairRuns(PairsState):
     owing: list[int]
     trigger_of: dict[int, str]
     wrong: bool
+    records: bool
+    violated_as: str
     batched: int
 
     if TYPE_CHECKING:
@@ -79,7 +83,8 @@ class PairRuns(PairsState):
         for j, (truth, certain) in enumerate(judged):
             holds = np.broadcast_to(truth & certain, sure.shape)
             sure &= holds if owed is None or j < na else holds | ~owed[j - na]
-        margins = [g(columns) for g in plan.margins]
+        every = np.arange(len(at))
+        margins = [(g(columns)[0], RowAtoms(f, columns, every)) for g, f in zip(plan.margin_values, plan.margins)]
         for j, (value, _) in enumerate(margins):  # a margin the engine would compute in exact arithmetic (0, not
             sure &= value > 0 if owed is None else (value > 0) | ~owed[j]  # positive): its row
         wrong: np.ndarray | None = None
@@ -94,7 +99,7 @@ class PairRuns(PairsState):
             for value, _ in margins:
                 wrong &= value < 0
             loose = np.flatnonzero(~(sure | wrong))
-        full = wrong is not None and self._full()
+        full = wrong is not None and (self.records or self._full())  # records written in batch, or none kept
         p, total = 0, len(at)
         m = self.m
         feed = self.feed
@@ -147,7 +152,7 @@ class PairRuns(PairsState):
         return all(t == own or t in last.answered_triggers for t in last.triggers)
 
     def _margins(self, chunk: EventRows | BlockRows, at: np.ndarray,
-                 margins: list[tuple[np.ndarray, np.ndarray]], owed: list[np.ndarray] | None = None) -> np.ndarray:
+                 margins: list[tuple[np.ndarray, RowAtoms]], owed: list[np.ndarray] | None = None) -> np.ndarray:
         """Each guarantee's smallest margin over the pairs at ``at`` owing it (``owed``: per guarantee, which
         pairs; ``None``: all) counted in the result, as the engine counts them one by one; returns each pair's
         message margin (the least of the guarantees it owes)."""
@@ -166,7 +171,8 @@ class PairRuns(PairsState):
                     len(kept.lowest) >= KEPT_MARGINS and not value[j] < kept.lowest[-1]:
                 kept.answers += len(at)  # none of them is kept: note_margins would only count them
                 continue
-            text, unit = plan.atoms[int(atom[j])] if atom[j] >= 0 else ("", "")
+            a = int(atom[j])
+            text, unit = plan.atoms[a] if a >= 0 else ("", "")
             qe, ev = chunk[int(at[j])], chunk[int(at[j]) + 1]
             asker = "" if k in m._alone else qe.where  # an output-only guarantee is judged on no question
             few = value if len(value) <= KEPT_MARGINS else np.partition(value, KEPT_MARGINS - 1)[:KEPT_MARGINS]
@@ -192,11 +198,13 @@ class PairRuns(PairsState):
         return not stamps or stamps[-1] <= t
 
     def _satisfied(self, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
-                   times: np.ndarray, margins: list[tuple[np.ndarray, np.ndarray]] | None = None,
+                   times: np.ndarray, margins: list[tuple[np.ndarray, RowAtoms]] | None = None,
                    wrong: np.ndarray | None = None, owed: list[np.ndarray] | None = None) -> None:
         """The pairs at ``at`` are surely satisfied, or surely violated where ``wrong``
-        (then only counted: :attr:`wrong`): their verdicts (with their margins,
-        ``margins``: per guarantee its values and deciding atoms), and the engine's state as feeding them sets it."""
+        (:attr:`wrong`; the first ones' records written as the engine writes them while the run keeps
+        records, batch_violations.py, the rest only counted): their verdicts (with their margins, ``margins``:
+        per guarantee its values and deciding atoms, an atom read when noted), and the engine's state as
+        feeding them sets it."""
         m = self.m
         h = m.horizon
         n = len(at)
@@ -225,7 +233,11 @@ class PairRuns(PairsState):
         result.semantics["exact"] += n - bad
         if bad:
             result.counts["violated"] += bad
-            result.violations_dropped += bad
+            assert wrong is not None
+            kept = min(room(m), bad) if self.records else 0  # the first ones' records, as the engine writes them
+            if kept:
+                add_records(self, chunk, at, src, np.flatnonzero(wrong)[:kept].tolist(), self.violated_as)
+            result.violations_dropped += bad - kept
         result.accepted += n
         least = self._margins(chunk, at, margins, owed) if margins else None
         if m.on_verdict is not None:

@@ -75,11 +75,16 @@ class BatchPlan:
         self.asked = set(m._asked)
         #: with margins: each guarantee's margin over the columns, and the (text, unit) of each deciding comparison
         self.margins: list[ColumnMargin] = []
+        #: the same margins without their deciding atoms (``None``): the runs of pairs read a row's atom only
+        #: where they note it (column_margins.RowAtoms)
+        self.margin_values: list[ColumnMargin] = []
         self.atoms: list[tuple[str, str]] = []
         if m.margins:
             margins = WindowMargins(compiler)
             self.margins = [margins.compile(g) for g in m.guarantees]
             self.atoms = [atom_words(m.checked, m.node, e, i) for e, i in margins.atoms]
+            values = WindowMargins(compiler, track=False)
+            self.margin_values = [values.compile(g) for g in m.guarantees]
 
 
 def batch_plan(m: NodeMonitor, rules: Mapping[str, TopicRule]) -> BatchPlan | None:
