@@ -45,6 +45,12 @@ the publisher starts to the run's end), the rclpy agent's likewise; the
 engine thread's is its own thread's (``engine_cpu_us_per_message``), and
 the traffic's is split by thread name (``/proc/<pid>/task``: the engine,
 the bus, Cyclone's own threads), the threads of 5 us a message or more.
+``--stages``: the latency run's monitor goes through ``bench/_stages.py``,
+which times each message's stages (the source, the engine's queue, the
+watermark, judging, the verdict's way to the listener) and the timer runs,
+and the line per stage says where the slowest 1 % of the verdicts spent
+their time, and whether the engine thread, before a late release, ran,
+waited for a core or slept.
 ``--smoke`` (the test suite's): 1 s at 300 and 200 messages/s through the
 rclpy source only, unless ``--source`` names others (the suite's live
 tests hear rclpy nodes through both sources); without a ROS 2 Python it
@@ -155,7 +161,7 @@ def _workspace(ws: Path) -> None:
 
 def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool,
          source: str = "dds", listener: str = "dds", lateness: float = 0.05, burn: int = 0,
-         nice: int = 0) -> dict[str, Any]:
+         nice: int = 0, stages: bool = False) -> dict[str, Any]:
     from _live import burners, cpu_seconds, stop, wait_text
     tag = f"{'lat' if latency else 'loss'}{int(rate)}{source}"
     procs: list[subprocess.Popen[bytes]] = []
@@ -168,7 +174,7 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
     with burners(burn):
         try:
             return _started(tmp, env, ros2, rate, seconds, latency, source, listener, lateness, tag, start, procs,
-                            nice)
+                            nice, stages)
         finally:
             for p in procs:
                 stop(p)
@@ -176,8 +182,9 @@ def _run(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float
 
 def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: float, latency: bool, source: str,
              listener: str, lateness: float, tag: str, start: Any, procs: list[subprocess.Popen[bytes]],
-             nice: int = 0) -> dict[str, Any]:
-    """One run's processes started by ``start`` (listener, monitor, publisher), waited for and stopped."""
+             nice: int = 0, stages: bool = False) -> dict[str, Any]:
+    """One run's processes started by ``start`` (listener, monitor, publisher), waited for and stopped;
+    ``stages``: the monitor run through bench/_stages.py, each message's stages timed (``res["stages"]``)."""
     from _live import children_cpu_seconds, children_thread_cpu_seconds, cpu_seconds, stop, thread_cpu_seconds, \
         wait_text
     lis = None
@@ -189,7 +196,9 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
         lis = start([sys.executable, str(ROOT / "bench" / "monitor_live_dds.py"), "--listener",
                      str(tmp / f"verdicts{tag}.json")], f"listener{tag}.out")
         wait_text(tmp / f"listener{tag}.out", "listening", 30)
-    mon = start((["nice", "-n", str(nice)] if nice else []) + [sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
+    command = ([str(ROOT / "bench" / "_stages.py"), str(tmp / f"stages{tag}.json")] if stages
+               else ["-m", "rclverify.cli.commands"])  # the same monitor, its stages timed or not
+    mon = start((["nice", "-n", str(nice)] if nice else []) + [sys.executable, *command, "monitor", "--live", "--ros2", "-w", str(tmp / "ws"),
                  "--mapping", "mapping.yaml", "--horizon", "1.0", "--reorder-window", str(lateness), "--status", "0",
                  "--log", str(tmp / f"live{tag}.jsonl"), "--evidence", str(tmp / f"evidence{tag}.json"),
                  "--source", source, "--ros2-python", str(ros2)],
@@ -224,23 +233,25 @@ def _started(tmp: Path, env: dict[str, str], ros2: Path, rate: float, seconds: f
                                           (tmp / f"live{tag}.jsonl").read_text().splitlines()]}
     if latency:
         res["verdicts"] = json.loads((tmp / f"verdicts{tag}.json").read_text())
+    if stages and (tmp / f"stages{tag}.json").exists():
+        res["stages"] = json.loads((tmp / f"stages{tag}.json").read_text())
     return res
 
 
 def bench(total_rate: float, latency_rate: float, seconds: float, sources: tuple[str, ...] = ("dds", "rclpy"),
-          listener: str = "dds", lateness: float = 0.05, burn: int = 0, nice: int = 0) -> None:
+          listener: str = "dds", lateness: float = 0.05, burn: int = 0, nice: int = 0, stages: bool = False) -> None:
     """The benchmark (module docstring), once per source, beside ``burn`` CPU burners, the monitor (and
-    its agent) at niceness ``nice``."""
+    its agent) at niceness ``nice``; ``stages``: the latency run's stages timed (bench/_stages.py)."""
     ros2, why = ros2_python()
     if ros2 is None:
         print(f"rclpy: skipped: {why}")
         return
     for source in sources:
-        _bench(ros2, total_rate, latency_rate, seconds, source, listener, lateness, burn, nice)
+        _bench(ros2, total_rate, latency_rate, seconds, source, listener, lateness, burn, nice, stages)
 
 
 def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, source: str,
-           listener: str = "dds", lateness: float = 0.05, burn: int = 0, nice: int = 0) -> None:
+           listener: str = "dds", lateness: float = 0.05, burn: int = 0, nice: int = 0, stages: bool = False) -> None:
     from _live import p99
     beside = (f"{burn} CPU burner(s), " if burn else "") + (f"monitor at nice {nice}, " if nice else "")
     with tempfile.TemporaryDirectory() as d:
@@ -271,7 +282,7 @@ def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, s
                       + (f", the rclpy agent {res['agent_cpu'] / max(1, len(sent)) * 1e6:.0f} us" if source == "rclpy" else ""))
         if latency_rate > 0:
             res = _run(tmp, env, ros2, latency_rate, seconds, latency=True, source=source, listener=listener,
-                       lateness=lateness, burn=burn, nice=nice)
+                       lateness=lateness, burn=burn, nice=nice, stages=stages)
             lat = _latency(res)
             if lat:
                 print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: publication -> verdict received over {len(lat)} "
@@ -280,6 +291,11 @@ def _bench(ros2: Path, total_rate: float, latency_rate: float, seconds: float, s
                       f"late {res['record'].get('late_events', 0)}; {_cpu(res, source)}; lateness bound {lateness * 1e3:g} ms (p99 "
                       f"{'within' if p99(lat) <= lateness * 1e3 + 5 else 'beyond'} the bound + 5 ms); "
                       f"{beside}load average {res['load']:.1f}")
+                if "stages" in res:
+                    from _stages import stage_table
+                    for line in stage_table(res["stages"], res["sent"]["sent"], res["log_topics"], res["verdicts"],
+                                            lateness):
+                        print(f"rclpy publisher, {source} source: stage {line}")
             else:
                 print(f"rclpy publisher, {source} source, {listener} listener: latency: {latency_rate:.0f} msg/s: no verdict decided on arrival was received "
                       f"(checked {res['record']['events']} of {len(res['sent']['sent'])})")
@@ -328,13 +344,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--nice", type=int, default=0, metavar="N",
                    help="run the monitor (and its rclpy agent) at niceness N (`nice -n N`; below 0 needs the "
                         "privilege to raise a priority); the publisher, the listener and the burners stay at 0")
+    p.add_argument("--stages", action="store_true",
+                   help="time each message's stages in the latency run (bench/_stages.py): where the tail is")
     a = p.parse_args(argv)
     source = a.source or ("rclpy" if a.smoke else "both")
     sources = ("dds", "rclpy") if source == "both" else (source,)
     if a.smoke:
-        bench(300.0, 200.0, 1.0, sources, a.listener, a.lateness, a.burn, a.nice)
+        bench(300.0, 200.0, 1.0, sources, a.listener, a.lateness, a.burn, a.nice, a.stages)
     else:
-        bench(a.total_rate, a.latency_rate, a.seconds, sources, a.listener, a.lateness, a.burn, a.nice)
+        bench(a.total_rate, a.latency_rate, a.seconds, sources, a.listener, a.lateness, a.burn, a.nice, a.stages)
     return 0
 
 
