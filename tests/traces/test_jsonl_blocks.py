@@ -131,6 +131,33 @@ def test_a_log_with_more_keys_is_read_fast_after_its_first_block(tmp_path: Path)
     assert log.blocks(["data"], 10) is None  # its events were read: no blocks after that
 
 
+def test_topics_seen_are_read_as_one_object_each_and_a_new_one_still_read(tmp_path: Path,
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    """After a read decoded at once, its topics are decoded as Literal values (one string object per
+    name, so the topic column compares objects); a read bringing a topic not seen before is decoded
+    again with the topic a string, and its topic is known from then on: the same events either way."""
+    p = tmp_path / "run.jsonl"
+    lines = [f'{{"topic": "{t}", "time": {i / 100!r}, "data": {i * 0.5!r}}}\n'
+             for i, t in enumerate(["a", "/b"] * 40 + ["a", "/b", "c", "\\/b"] * 20 + ["c", "a"] * 40)]
+    p.write_text("".join(lines))
+    monkeypatch.setattr(jsonl_blocks, "BLOCK_BYTES", 40 * len(lines[0]))
+    blocks = list(JsonlLog(p).blocks(["data"], 1000))
+    assert all(isinstance(b, LogBlock) for b in blocks) and len(blocks) >= 5
+    events = list(read_jsonl(p))
+    assert [t for b in blocks for t in b.topics] == [e.topic for e in events]
+    assert [t for b in blocks for t in b.times.tolist()] == [e.time for e in events]
+    assert [v for b in blocks for v in b.values(np.arange(len(b)), "data")] == [e.fields["data"] for e in events]
+    seen: set[str] = set()
+    known = 0
+    for b in blocks:  # a read of topics all seen before: one object per topic (as the lines spell it)
+        spelled = {s.f0 for s in b.structs}
+        if spelled <= seen:
+            known += 1
+            assert all(len({id(s.f0) for s in b.structs if s.f0 == name}) == 1 for name in spelled)
+        seen |= spelled
+    assert known >= 3
+
+
 def test_an_integer_time_keeps_its_block_exact(tmp_path: Path) -> None:
     """msgspec would read an integer time into a float field; the fast path never lets it (an integer
     or a time of any type but float sends the block to the exact reader)."""

@@ -50,6 +50,12 @@ over two lines; a block read as one JSON array was refused for the same
 reason, docs/scale.md.)  The typed decoder reads a scalar or an array's
 items to the values the untyped one gives (integers of any size exact).
 As on the line-by-line fast path, every time must be a finite ``float``.
+Once a read is decoded so, its topics (up to :data:`MAX_TOPICS`, as the
+lines spell them) are known to the next reads' decoder, which reads the
+topic as one of them (a ``Literal``: the same string, one object per name,
+so the topic column's set, counts and codes compare objects, not text); a
+line of another topic fails that decoder and the read is decoded with the
+topic a string, its topics then known too.
 Anything else (an integer time, an object or an array of arrays as a
 value, a new key, a ``\\r``, bad bytes, a line msgspec refuses) sends the
 read to the line-by-line paths above, which give the same events and the
@@ -61,7 +67,7 @@ from __future__ import annotations
 from collections import Counter
 from operator import attrgetter
 from pathlib import Path
-from typing import Any, Iterator, Sequence, Union
+from typing import Any, Iterable, Iterator, Literal, Sequence, Union
 
 import msgspec
 from rclverify.core.numeric import np
@@ -73,6 +79,8 @@ from rclverify.traces.jsonl import line_event, read_jsonl, read_lines
 BLOCK_BYTES = 1 << 20
 #: The most keys the fast path's struct names (a log with more distinct keys reads the rest exactly).
 MAX_KEYS = 64
+#: The most topics the flat read decodes as ``Literal`` values (the rest as strings, each line its own).
+MAX_TOPICS = 256
 _TOPIC, _TIME = attrgetter("f0"), attrgetter("f1")
 #: A JSON scalar as the untyped decoder reads it.
 _SCALAR = Union[str, float, int, bool, None]
@@ -111,27 +119,45 @@ class JsonlLog:
 
 
 class _Decoder:
-    """A struct of the keys seen so far (``f0`` the topic, ``f1`` the time) and its decoder."""
+    """A struct of the keys seen so far (``f0`` the topic, ``f1`` the time) and its decoders; ``topics``:
+    the topics (as the lines spell them) the flat reads have seen so far, which :attr:`decode_known`
+    reads as ``Literal`` values (module docstring)."""
 
-    def __init__(self, keys: Sequence[str]) -> None:
+    def __init__(self, keys: Sequence[str], topics: Sequence[str] | None = ()) -> None:
         self.keys = list(dict.fromkeys(["topic", "time", *keys]))
         self.attr = {k: f"f{j}" for j, k in enumerate(self.keys)}
+        #: ``None``: more than :data:`MAX_TOPICS` seen, every read decoded with the topic a string
+        self.topics = None if topics is None else tuple(topics)
+        rename = {f"f{j}": k for j, k in enumerate(self.keys)}
         line = msgspec.defstruct("Line", [("f0", str)] + [(f"f{j}", object, None) for j in range(1, len(self.keys))],
-                                 rename={f"f{j}": k for j, k in enumerate(self.keys)},
-                                 forbid_unknown_fields=True, gc=False)
+                                 rename=rename, forbid_unknown_fields=True, gc=False)
         self.decode = msgspec.json.Decoder(line).decode
-        flat = msgspec.defstruct("FlatLine", [("f0", str), ("f1", Union[float, int])] + [(f"f{j}", _FLAT, None)
-                                                                          for j in range(2, len(self.keys))],
-                                 rename={f"f{j}": k for j, k in enumerate(self.keys)},
-                                 forbid_unknown_fields=True, gc=False)
+        rest = [("f1", Union[float, int])] + [(f"f{j}", _FLAT, None) for j in range(2, len(self.keys))]
+        flat = msgspec.defstruct("FlatLine", [("f0", str), *rest], rename=rename, forbid_unknown_fields=True, gc=False)
         self.decode_lines = msgspec.json.Decoder(flat).decode_lines
+        #: the flat decoder with the topic one of :attr:`topics` (``None``: none seen yet); a line of
+        #: another topic fails it, and the read is decoded by :attr:`decode_lines` instead
+        self.decode_known = None if not self.topics else msgspec.json.Decoder(msgspec.defstruct(
+            "KnownLine", [("f0", Literal[self.topics]), *rest], rename=rename, forbid_unknown_fields=True,
+            gc=False)).decode_lines
 
     def learn(self, events: list[Event]) -> _Decoder:
         """This decoder, or one that also names the keys of ``events`` (up to :data:`MAX_KEYS`)."""
         seen = dict.fromkeys(self.keys)
         for ev in events:
             seen.update(dict.fromkeys(ev.fields))
-        return _Decoder(list(seen)) if MAX_KEYS >= len(seen) > len(self.keys) else self
+        return _Decoder(list(seen), self.topics) if MAX_KEYS >= len(seen) > len(self.keys) else self
+
+    def knowing(self, topics: Iterable[str]) -> _Decoder:
+        """This decoder, or one whose :attr:`decode_known` also reads ``topics``; past :data:`MAX_TOPICS`,
+        one without it for the rest of the log (a read of an unknown topic would be decoded twice)."""
+        if self.topics is None:
+            return self
+        seen = dict.fromkeys(self.topics)
+        seen.update(dict.fromkeys(topics))
+        if len(seen) == len(self.topics):
+            return self
+        return _Decoder(self.keys, list(seen) if len(seen) <= MAX_TOPICS else None)
 
 
 def _reads(path: Path) -> Iterator[bytes]:
@@ -165,7 +191,9 @@ def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock |
     for data in _reads(path):
         flat = _flat(path, dec, data, lineno, index, rows)
         if flat is not None:
-            for whole in flat:
+            blocks, distinct = flat
+            dec = dec.knowing(distinct)
+            for whole in blocks:
                 lineno += len(whole)
                 index += len(whole)
                 yield whole
@@ -189,8 +217,10 @@ def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock |
             dec = dec.learn(got)
 
 
-def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows: int) -> list[LogBlock] | None:
-    """The read ``data`` as blocks of at most ``rows`` lines when it is decoded at once (module docstring), else ``None``."""
+def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows: int
+          ) -> tuple[list[LogBlock], set[str]] | None:
+    """The read ``data`` as blocks of at most ``rows`` lines when it is decoded at once (module docstring), with
+    its distinct topics as the lines spell them; else ``None``."""
     if "header" in dec.attr or any(k in dec.attr for k in FLAT_STAMPS) or data[:1] != b"{" or \
             data[-1:] != b"\n" or b"\r" in data:
         return None
@@ -199,10 +229,17 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
     n = len(ends)
     if not (u[ends - 1] == 125).all() or not (u[ends[:-1] + 1] == 123).all():
         return None
-    try:
-        structs = dec.decode_lines(data)
-    except Exception:  # noqa: BLE001 - whatever msgspec refuses: the line-by-line paths say what
-        return None
+    structs = None
+    if dec.decode_known is not None:
+        try:
+            structs = dec.decode_known(data)
+        except Exception:  # noqa: BLE001 - a topic not seen before (or what decode_lines refuses too): read below
+            structs = None
+    if structs is None:
+        try:
+            structs = dec.decode_lines(data)
+        except Exception:  # noqa: BLE001 - whatever msgspec refuses: the line-by-line paths say what
+            return None
     if len(structs) != n:
         return None
     found = list(map(_TIME, structs))
@@ -211,20 +248,21 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
     times = np.array(found, dtype=np.float64)
     if not np.isfinite(times).all():
         return None
-    topics = _topics(structs)
+    topics, distinct = _topics(structs)
     lines = _Lines(data, ends)
     return [LogBlock(path, _Slice(lines, a), structs[a:a + rows], dec.attr, topics[a:a + rows], times[a:a + rows],
-                     lineno + a, index + a) for a in range(0, n, rows)]
+                     lineno + a, index + a) for a in range(0, n, rows)], distinct
 
 
-def _topics(structs: list[Any]) -> list[str]:
-    """Each struct's topic, without its leading ``/`` (as the event's)."""
+def _topics(structs: list[Any]) -> tuple[list[str], set[str]]:
+    """Each struct's topic, without its leading ``/`` (as the event's), and the distinct topics as the
+    lines spell them."""
     topics = list(map(_TOPIC, structs))
     distinct = set(topics)
     if any(t[:1] == "/" for t in distinct):
         strip = {t: t.lstrip("/") for t in distinct}
         topics = list(map(strip.__getitem__, topics))
-    return topics
+    return topics, distinct
 
 
 class _Lines:
@@ -267,7 +305,7 @@ def _fast(path: Path, dec: _Decoder, lines: list[bytes], lineno: int, index: int
     column = np.array(times, dtype=np.float64)
     if not np.isfinite(column).all():
         return None
-    return LogBlock(path, lines, structs, dec.attr, _topics(structs), column, lineno, index)
+    return LogBlock(path, lines, structs, dec.attr, _topics(structs)[0], column, lineno, index)
 
 
 class LogBlock:
