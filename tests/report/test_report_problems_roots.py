@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Any
+
+import pytest
 
 from _drone_ws import copy, verify
 from rclverify.report.diagnosis_text import status_lines
@@ -15,12 +18,21 @@ from rclverify.report.summary import summary_data
 FULL_ID = re.compile(r"^(\w+\.(g\d+(\.[\w.-]+)?|sc\d+|derived)|REQ\d+)$")
 
 
+@pytest.fixture(scope="module")
+def drone(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    """tests/data/drone verified once for the module: its root and its report, read (never changed) by the
+    tests below."""
+    root = copy(tmp_path_factory.mktemp("drone"), "drone")
+    _, report = verify(root)
+    return root, report
+
+
 def _keys(report: dict) -> list[set[str]]:
     return [set(g["key"]) for g in report["problems"]]
 
 
-def test_three_seeded_unrelated_bugs_are_three_problems(tmp_path: Path) -> None:
-    _, report = verify(copy(tmp_path, "drone"))
+def test_three_seeded_unrelated_bugs_are_three_problems(drone: tuple[Path, dict[str, Any]]) -> None:
+    _, report = drone
     assert not report["unverified"]  # every guarantee has evidence: only the seeded bugs are problems
     assert _keys(report) == [
         {"assumption:BatteryMonitor:1"},  # guarantee 1's premise excluded by the assumption (vacuity)
@@ -41,12 +53,12 @@ def test_two_findings_of_one_culprit_are_one_problem(tmp_path: Path) -> None:
     assert [q["verdict"] for q in report["requirements"]] == ["proved vacuously"]
 
 
-def test_the_fraction_mismatch_is_its_own_problem_on_the_terminal_and_in_the_report(tmp_path: Path) -> None:
+def test_the_fraction_mismatch_is_its_own_problem_on_the_terminal_and_in_the_report(
+        drone: tuple[Path, dict[str, Any]]) -> None:
     """Item 2: the failed side condition was filed under the vacuity of
     BatteryMonitor guarantee 1 (a guarantee its diagnosis named although it
     plays no part), and findings were listed as bare node names."""
-    root = copy(tmp_path, "drone")
-    _, report = verify(root)
+    root, report = drone
     d = next(x for x in report["diagnoses"] if x["id"] == "MissionPlanner.sc2")
     assert [c["source"] for c in d["culprits"]] == ["contracts/mission_planner.rcl:10:31",
                                                     "contracts/battery_monitor.rcl:12:3"]
@@ -68,11 +80,11 @@ def test_the_fraction_mismatch_is_its_own_problem_on_the_terminal_and_in_the_rep
     assert html.count('<tr id="problem-') == 3
 
 
-def test_a_refuted_requirement_blames_the_bound_z3_showed(tmp_path: Path) -> None:
+def test_a_refuted_requirement_blames_the_bound_z3_showed(drone: tuple[Path, dict[str, Any]]) -> None:
     """Item 5: REQ1 blamed FlightController guarantee 1 (shown discharged);
     the gap is MissionPlanner guarantee 3's bound, and only tightening that
     bound lets Z3 prove REQ1."""
-    _, report = verify(copy(tmp_path, "drone"))
+    _, report = drone
     d = next(x for x in report["diagnoses"] if x["id"] == "REQ1")
     assert d["kind"] == "requirement"
     assert [c["source"] for c in d["culprits"]] == ["contracts/mission_planner.rcl:16:3"]
@@ -86,11 +98,12 @@ def test_a_refuted_requirement_blames_the_bound_z3_showed(tmp_path: Path) -> Non
     assert fc["status"] == "discharged"
 
 
-def test_a_side_condition_names_only_the_guarantee_whose_strengthening_discharges_it(tmp_path: Path) -> None:
+def test_a_side_condition_names_only_the_guarantee_whose_strengthening_discharges_it(
+        drone: tuple[Path, dict[str, Any]]) -> None:
     """Item 5: BatteryMonitor guarantee 1 (`in.voltage > 30 -> ...`, whose
     premise never fires) was named for the fraction mismatch, and the
     counterexample showed Geofence's input, which plays no part."""
-    _, report = verify(copy(tmp_path, "drone"))
+    _, report = drone
     d = next(x for x in report["diagnoses"] if x["id"] == "MissionPlanner.sc2")
     assert not any("guarantee 1 of BatteryMonitor" in c["what"] for c in d["culprits"])
     assert "guarantee 1" not in d["sentence"]
@@ -112,18 +125,17 @@ def test_a_row_without_a_culprit_shows_where_it_was_found() -> None:
     assert lines[5] == "  2. [failed] (no culprit named): 1 finding"
 
 
-def test_every_group_of_the_drone_has_a_location(tmp_path: Path) -> None:
-    _, report = verify(copy(tmp_path, "drone"))
+def test_every_group_of_the_drone_has_a_location(drone: tuple[Path, dict[str, Any]]) -> None:
+    _, report = drone
     assert [g["where"] for g in report["problems"]] == ["contracts/battery_monitor.rcl:10:3",
                                                         "contracts/mission_planner.rcl:10:31",
                                                         "contracts/plan.yaml:12:14"]
 
 
-def test_explain_prints_findings_without_a_record_of_their_own(tmp_path: Path, capsys) -> None:
+def test_explain_prints_findings_without_a_record_of_their_own(drone: tuple[Path, dict[str, Any]], capsys) -> None:
     """Every finding `status` lists can be explained: a derived property by its full name."""
     from rclverify.cli.commands import main
-    root = copy(tmp_path, "drone")
-    verify(root)
+    root, _ = drone
     capsys.readouterr()
     assert main(["explain", "-w", str(root), "FlightController.derived"]) == 0
     out = capsys.readouterr().out

@@ -7,8 +7,10 @@ from __future__ import annotations
 import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import Any
 
 import jsonschema
+import pytest
 
 from _drone_ws import DATA, copy, set_nodes, verify
 from rclverify.report.diagnosis_text import status_lines
@@ -37,9 +39,18 @@ def _partly_covered(tmp_path: Path) -> Path:
     return root
 
 
-def test_guarantees_without_an_obligation_are_listed_counted_and_problems(tmp_path: Path) -> None:
-    root = _partly_covered(tmp_path)
+@pytest.fixture(scope="module")
+def partly(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    """The partly covered drone verified once for the module: its root and its report, read (never
+    changed) by the tests below."""
+    root = _partly_covered(tmp_path_factory.mktemp("partly"))
     _, report = verify(root)
+    return root, report
+
+
+def test_guarantees_without_an_obligation_are_listed_counted_and_problems(
+        partly: tuple[Path, dict[str, Any]]) -> None:
+    root, report = partly
     assert [u["id"] for u in report["unverified"]] == ["BatteryMonitor.g1", "BatteryMonitor.g2", "Geofence.g1"]
     assert {u["source"] for u in report["unverified"]} == {"contracts/battery_monitor.rcl:10:3",
                                                            "contracts/battery_monitor.rcl:12:3",
@@ -73,9 +84,8 @@ def test_guarantees_without_an_obligation_are_listed_counted_and_problems(tmp_pa
     assert "Unverified guarantees (3)" in md
 
 
-def test_sarif_and_junit_carry_each_unverified_guarantee(tmp_path: Path) -> None:
-    root = _partly_covered(tmp_path)
-    verify(root)
+def test_sarif_and_junit_carry_each_unverified_guarantee(partly: tuple[Path, dict[str, Any]]) -> None:
+    root, _ = partly
     log = json.loads((root / "reports" / "assurance.sarif").read_text(encoding="utf-8"))
     jsonschema.validate(log, json.loads((DATA / "sarif-schema-2.1.0.json").read_text(encoding="utf-8")))
     results = [r for r in log["runs"][0]["results"] if r["ruleId"] == "RCL-GUARANTEE-UNVERIFIED"]
@@ -93,9 +103,8 @@ def test_sarif_and_junit_carry_each_unverified_guarantee(tmp_path: Path) -> None
     assert cases["Geofence.g1"].get("file") == "contracts/geofence.rcl" and cases["Geofence.g1"].get("line") == "8"
 
 
-def test_strict_names_the_unverified_guarantees(tmp_path: Path, capsys) -> None:
-    root = _partly_covered(tmp_path)
-    _, report = verify(root)
+def test_strict_names_the_unverified_guarantees(partly: tuple[Path, dict[str, Any]], capsys) -> None:
+    root, report = partly
     assert report["meta"]["strict_ok"] is False
     failed = act_verify(str(root), True)
     capsys.readouterr()
@@ -127,10 +136,9 @@ def test_the_overall_status_is_never_better_than_unverified(tmp_path: Path) -> N
     assert report["meta"]["strict_ok"] is True
 
 
-def test_explain_prints_an_unverified_guarantee(tmp_path: Path, capsys) -> None:
+def test_explain_prints_an_unverified_guarantee(partly: tuple[Path, dict[str, Any]], capsys) -> None:
     from rclverify.cli.commands import main
-    root = _partly_covered(tmp_path)
-    verify(root)
+    root, _ = partly
     capsys.readouterr()
     assert main(["explain", "-w", str(root), "Geofence.g1"]) == 0
     out = capsys.readouterr().out
