@@ -182,38 +182,77 @@ def test_control_a_formula_differing_at_one_offset_is_caught() -> None:
     assert same == n
 
 
-def test_windows_the_columns_hold() -> None:
-    """A row is a list of ``width`` finite floats; anything else is the engine's."""
-    good, col = window_column([[1.0, 2.0], [1.0], [1.0, math.nan], [1, 2.0], [True, 1.0], "ab", [3.5, -0.0]], 2)
+@pytest.mark.parametrize("decoded", [False, True])
+def test_windows_the_columns_hold(decoded: bool) -> None:
+    """A row is a list of ``width`` finite floats; anything else is the engine's (``decoded``: the values of a
+    JSON decoder, converted and checked in one pass, the same rows held)."""
+    mixed = [[1.0, 2.0], [1.0], [1.0, math.nan], [1, 2.0], [True, 1.0], "ab", [3.5, -0.0]]
+    good, col = window_column(mixed, 2, decoded)
     assert good.tolist() == [True, False, False, False, False, False, True]
     assert col[0].tolist() == [1.0, 2.0] and col[6].tolist() == [3.5, -0.0]
-    good, col = window_column([[1.0, 2.0], [math.inf, 0.5], [3.5, -0.0]], 2)  # every row a list of floats
+    good, col = window_column([[1.0, 2.0], [math.inf, 0.5], [3.5, -0.0]], 2, decoded)  # every row a list of floats
     assert good.tolist() == [True, False, True] and col[2].tolist() == [3.5, -0.0]
+    for odd in (2, True, "2.5", None, [2.5]):  # every row of width entries, one entry not a float
+        good, _ = window_column([[1.0, 2.0], [3.0, odd], [3.5, 1.5]], 2, decoded)
+        assert good.tolist() == [True, False, True]
 
 
-@pytest.mark.parametrize("formula, only", [
-    ("forall(k in <0 upto 2> | out.x(k) > in.r)", True),
-    ("exists(k in <0 upto 2> | out.x(k) > in.r)", True),
-    ("exists(k in <0 upto 2> | out.x(0) > in.r)", False),  # one entry for every offset: one choice meets them all
-    ("in.r > 1 -> forall(k in <0 upto 2> | out.x(k) > in.r)", False),  # the inputs alone make it true
-    ("forall(k in <0 upto 2> | out.x(k) > in.r) or in.r > 1", False),
-    ("forall(k in <2 upto 1> | out.x(k) > in.r)", False),  # empty: true whatever the answer
-])
-def test_only_an_answer_decides(formula: str, only: bool) -> None:
-    assert answer_only(parse_formula(formula), CHECKED.nodes["G"]) is only
+def test_control_a_float_subclass_is_what_decoded_values_never_hold() -> None:
+    """Why ``decoded`` is only a JSON decoder's: its one pass takes a float subclass (numpy's float64) as
+    the float it is, where the entries' types, read one by one, leave that row to the engine."""
+    import numpy as np
+    rows = [[1.0, 2.0], [np.float64(3.0), 1.5]]
+    assert window_column(rows, 2, False)[0].tolist() == [True, False]
+    assert window_column(rows, 2, True)[0].tolist() == [True, True]
 
 
-def test_a_window_is_read_from_an_array() -> None:
-    """traces/mapping.py's window rule: an array field is the function from the offsets 0.. to its items, the
-    message's whole table; a message with no array keeps the function rule (one entry, accumulated)."""
-    from rclverify.lang import types as T
-    from rclverify.semantics.values import FiniteFunction
-    from rclverify.traces.mapping import MappingError, TopicRule, map_value
-    typ = T.FuncT((T.Scalar("NATURAL"),), T.Scalar("REAL"))
-    before = FiniteFunction({(7,): 1.5}, None, 1)
-    got = map_value(typ, {"data": [2.5, 0.5]}, TopicRule(("data",)), before)
-    assert got.table == {(0,): 2.5, (1,): 0.5}  # the earlier entry is not kept: the window is the message's
-    kept = map_value(typ, {"k": 3, "v": 4.0}, TopicRule(("k", "v")), before)
-    assert kept.table == {(7,): 1.5, (3,): 4.0}  # the control: the function rule, accumulating
-    with pytest.raises(MappingError, match="not a finite number"):
-        map_value(typ, {"data": [2.5, math.nan]}, TopicRule(("data",)), None)
+def test_a_log_read_in_blocks_gives_the_engines_verdicts(tmp_path: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The command's reading: a ROSMonitoring log in blocks, its windows decoded JSON (converted and checked
+    in one pass each), the batch path's verdicts and result the streaming engine's on the same log, now and
+    then an entry that is an integer, a boolean or a string: the engine's (the control: entries read by
+    ``float()`` are caught)."""
+    import json
+    from rclverify.backends.monitors import batch as batch_module
+    from rclverify.backends.monitors import batch_window
+    from rclverify.traces import read_trace
+    from rclverify.traces.jsonl import read_jsonl
+    from rclverify.traces.mapping import MappingError
+    passes: list[bool] = []
+    real = window_column
+
+    def counted(vals: list[Any], width: int, decoded: bool = False) -> Any:
+        passes.append(decoded)
+        return real(vals, width, decoded)
+    monkeypatch.setattr(batch_module, "window_column", counted)
+    rnd = random.Random("window-log")
+    for node in ("G", "U"):
+        log = tmp_path / f"{node}.jsonl"
+        with log.open("w") as out:
+            for i in range(600):
+                t = round(0.01 * i, 6)
+                q: Any = [_sample(rnd) for _ in range(4)] if node == "U" else rnd.choice([1.0, 0.5, 2.0])
+                a: Any = [_sample(rnd) for _ in range(WIDTH[node])]
+                if rnd.random() < 0.04:  # (each a float to float(): a column of such windows is read in one pass)
+                    a[rnd.randrange(len(a))] = rnd.choice([2, True, "2.5"])
+                out.write(json.dumps({"topic": "limit", "time": t, "data": q}) + "\n")
+                out.write(json.dumps({"topic": "window", "time": t, "data": a}) + "\n")
+        rules = load_rules(RULES)
+        seen_s: list[Any] = []
+        streamed = check_trace(CHECKED, [CHECKED.nodes[node]], read_jsonl(log), rules, 0.005, seen_s.append,
+                               batch=False, margins=True)
+        seen_b: list[Any] = []
+        batched = check_trace(CHECKED, [CHECKED.nodes[node]], read_trace(log, streams=True), rules, 0.005,
+                              seen_b.append, margins=True)
+        assert seen_b == seen_s and batched == streamed
+        assert sum(v.verdict == "inconclusive" for v in seen_b) > 10  # the odd windows: the engine's
+        if node == "G":  # the control: a pass converting every entry with float() takes the odd ones
+            monkeypatch.setattr(batch_window, "_OWN_FLOAT", float)
+            seen_f: list[Any] = []
+            try:
+                check_trace(CHECKED, [CHECKED.nodes[node]], read_trace(log, streams=True), rules, 0.005,
+                            seen_f.append, margins=True)
+            except MappingError:  # the engine's mapper meets the odd entry where the columns took it
+                seen_f = []
+            assert seen_f != seen_s
+            monkeypatch.setattr(batch_window, "_OWN_FLOAT", float.__float__)
+    assert passes and all(passes)  # every window column read in one pass

@@ -46,16 +46,31 @@ from rclverify.targets.column_windows import is_window
 _ORDERS = ("<", "<=", ">", ">=", "==", "!=")
 
 
-def window_column(vals: list[Any], width: int) -> tuple[np.ndarray, np.ndarray]:
+#: a float's own value; a TypeError for anything else (an int, a boolean, a string, None, a list); a float
+#: subclass's value as a float, which JSON's decoders never make (``window_column``'s ``decoded``)
+_OWN_FLOAT = float.__float__
+
+
+def window_column(vals: list[Any], width: int, decoded: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """(rows the columns hold, the ``(rows, width)`` float64 column; NaN where not held) of the values
-    ``vals`` (a message's field each): a row holds a list of ``width`` finite floats."""
+    ``vals`` (a message's field each): a row holds a list of ``width`` finite floats.  ``decoded``: the
+    values are a JSON decoder's (a number an ``int`` or a ``float``, never a float subclass), so one pass
+    both converts and checks the entries (:data:`_OWN_FLOAT`); otherwise each entry's type is read."""
     n = len(vals)
     if not n:
         return np.zeros(0, dtype=bool), np.full((0, width), np.nan)
-    if set(map(type, vals)) == {list} and set(map(len, vals)) == {width} and \
-            set(map(type, chain.from_iterable(vals))) == {float}:  # every row a list of width floats: at C speed
-        col = np.fromiter(chain.from_iterable(vals), np.float64, n * width).reshape(n, width)
-        return np.asarray(np.isfinite(col).all(axis=1)), col
+    if set(map(type, vals)) == {list} and set(map(len, vals)) == {width}:  # every row a list of width entries
+        col = None
+        if decoded:
+            try:  # every entry a float (a TypeError at the first that is not): at C speed, one pass
+                col = np.fromiter(map(_OWN_FLOAT, chain.from_iterable(vals)), np.float64, n * width)
+            except TypeError:
+                col = None
+        elif set(map(type, chain.from_iterable(vals))) == {float}:
+            col = np.fromiter(chain.from_iterable(vals), np.float64, n * width)
+        if col is not None:
+            col = col.reshape(n, width)
+            return np.asarray(np.isfinite(col).all(axis=1)), col
     col = np.full((n, width), np.nan)
     good = np.fromiter((type(v) is list and len(v) == width for v in vals), bool, n)
     rows = [v for v, g in zip(vals, good.tolist()) if g]
