@@ -164,19 +164,21 @@ def _skew_window(mon: ChunkSide, ns: np.ndarray, rows: np.ndarray, out_rows: np.
 
 
 def _mark(mon: ChunkSide, p: Pending, evs: list[Event], ns: np.ndarray, out_rows: np.ndarray, r: int,
-          heard_hi: int | None) -> bool:
+          heard_hi: int | None, out_ns: np.ndarray) -> bool:
     """Mark obligation ``p`` (its trigger at row ``r``) as :func:`.deadline_skew.scan_heard` marks it when the
     trigger comes: the outputs heard before the chunk, then the chunk's before row ``r``, oldest first, within
     the skew; whether it is marked.  ``heard_hi``: the latest stamp (ns) among the outputs heard before the
-    chunk (``None``: none); none of them is scanned when it lies before the skew's window."""
+    chunk (``None``: none); none of them is scanned when it lies before the skew's window.  ``out_ns``: the
+    outputs' stamps (``ns[out_rows]``, made once per chunk)."""
     if heard_hi is not None and heard_hi >= p.stamp_ns - mon.skew_ns:
         deadline_skew.scan_heard(mon, p)
     if not p.maybe:
         ok = mon.plan.out_key
-        lo = int(np.searchsorted(ns[out_rows], p.stamp_ns - mon.skew_ns, side="left"))
+        lo = int(np.searchsorted(out_ns, p.stamp_ns - mon.skew_ns, side="left"))
         hi = int(np.searchsorted(out_rows, r, side="left"))
         for j in out_rows[lo:hi].tolist():
-            deadline_skew.mark_early(mon, p, evs[j], int(ns[j]), {ok: mon.mapped(evs[j], ok)})
+            out = evs[j]  # (a log block's row made an event once)
+            deadline_skew.mark_early(mon, p, out, int(ns[j]), {ok: mon.mapped(out, ok)})
             if p.maybe:
                 break
     return bool(p.maybe)
@@ -208,12 +210,13 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
         p = made.get(i)
         if p is None:
             r = int(rows[i])
+            trig = evs[r]  # (a log block's row made an event once)
             got = trig_inputs.get(r)
             if got is None:
-                got = trig_inputs[r] = {ik: mon.mapped(evs[r], ik)}
+                got = trig_inputs[r] = {ik: mon.mapped(trig, ik)}
             k, bound, _, _ = plan.timed[int(which[i])]
             s = int(ns[r])
-            p = made[i] = Pending(k, evs[r], s / 1e9, (s + bound) / 1e9, got, stamp_ns=s, due_ns=s + bound)
+            p = made[i] = Pending(k, trig, s / 1e9, (s + bound) / 1e9, got, stamp_ns=s, due_ns=s + bound)
         return p
 
     def last_output(i: int, upto: int) -> int:
@@ -228,8 +231,9 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
         for i, p in enumerate(carried):
             maybe[i] = bool(p.maybe)
         heard_hi = max((h[0] for h in mon.heard), default=None)
+        out_ns = ns[out_rows]
         for i in skewed.tolist():
-            maybe[i] = _mark(mon, ob(i), evs, ns, out_rows, int(rows[i]), heard_hi)
+            maybe[i] = _mark(mon, ob(i), evs, ns, out_rows, int(rows[i]), heard_hi, out_ns)
     at, phase, obs = verdicts
     # with no verdict callback an answer within its deadline is only counted: the loop visits the rest, in order
     plain = (phase == 1) & (ns[at] <= due[obs]) if mon.on_verdict is None else np.zeros(len(at), dtype=bool)
@@ -279,7 +283,7 @@ def _apply(mon: ChunkSide, evs: list[Event], ns: np.ndarray, rows: np.ndarray, w
         values[ik] = mon.mapped(evs[r], ik)
     if out_value is not None:
         values[ok] = out_value
-    heard = [(int(ns[j]), evs[j], {ok}, {ok: mon.mapped(evs[j], ok)}) for j in out_rows[-64:].tolist()]
+    heard = [(int(ns[j]), e, {ok}, {ok: mon.mapped(e, ok)}) for j in out_rows[-64:].tolist() for e in (evs[j],)]
     mon.take_state(pending, expired, values, heard, int(ns[-1]))
 
 

@@ -6,11 +6,11 @@ the state a clean chunk leaves (docs/semantics.md, "Deadlines")."""
 from __future__ import annotations
 
 from collections import deque
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Callable, Mapping
 
 from rclverify.semantics.floatsem import judge
 from rclverify.traces.events import Event
-from rclverify.traces.mapping import map_value, rule_for
+from rclverify.traces.mapping import rule_for, value_mapper
 from rclverify.backends.monitors.deadline_records import Pending
 from rclverify.backends.monitors.deadlines import DeadlineMonitor, rejected
 
@@ -23,13 +23,24 @@ class ChunkSide(DeadlineMonitor):
     is the node's :class:`~.batch_deadline_plan.DeadlinePlan`."""
 
     plan: "DeadlinePlan"
+    #: (topic, key) -> that variable's mapper on that topic (traces/mapping.py ``value_mapper``), made once
+    _mappers: dict[tuple[str, str], Callable[[Mapping[str, object], object], object]] | None = None
 
     # -- what the chunk judge gives the monitor ---------------------------------------------
     def mapped(self, ev: Event, key: str) -> object:
-        """The value variable ``key`` takes from message ``ev`` as :meth:`feed` maps it."""
-        typ = self.node.inputs[key[3:]] if key.startswith("in.") else self.node.outputs[key[4:]]
-        fields = {k: v for k, v in ev.fields.items() if k != "header"}
-        return map_value(typ, fields, rule_for(self.rules, ev.topic, key), None)
+        """The value variable ``key`` takes from message ``ev`` as :meth:`feed` maps it (``value_mapper``:
+        ``map_value``'s values and errors, its rule read once per topic)."""
+        mappers = self._mappers
+        if mappers is None:
+            mappers = self._mappers = {}
+        mapper = mappers.get((ev.topic, key))
+        if mapper is None:
+            typ = self.node.inputs[key[3:]] if key.startswith("in.") else self.node.outputs[key[4:]]
+            mapper = mappers[(ev.topic, key)] = value_mapper(typ, rule_for(self.rules, ev.topic, key))
+        fields = ev.fields
+        if "header" in fields:
+            fields = {k: v for k, v in fields.items() if k != "header"}
+        return mapper(fields, None)
 
     def rejection(self, k: int, inputs: Mapping[str, object], out_key: str, out: Event) -> str:
         """Why output ``out`` did not answer an obligation of guarantee ``k`` on ``inputs``
