@@ -24,9 +24,11 @@ Given a seed, :func:`generate` draws a system of N nodes from five templates (th
   service introspection, called one call at a time by a client in the same process.
 
 Each node declares what it keeps (bench/_robot_declarations.py): a sensor ``initially`` its band and
-``periodic( out.x, P ms )`` (P two periods and 1 s; a stamped sensor only on the wall clock), an
-alarm, a relay and a fuse ``progress( within K steps )``; every sensor publishes until the robot is
-stopped (after the monitor).
+``periodic( out.x, P ms )`` (P two periods and 1 s, in its node's clock: a stamped sensor's on a
+``/clock`` times the real-time factor), an alarm, a relay and a fuse ``progress( within K steps )`` (one
+alarm or relay in two as ``periodic( out.y, K + 1 steps )``), a server ``progress( eventually )`` or
+``progress( within 1 steps )``; every sensor publishes until the robot is stopped (after the monitor),
+every client stops calling when the sensing ends, its last call answered.
 
 Nodes get a namespace at random.  ``defect=True`` seeds one defect in one node: ``<`` for ``<=``
 (``>`` for ``>=``, ``<=`` for ``<``), a relay adding 0.5 to every fourth reading, a server

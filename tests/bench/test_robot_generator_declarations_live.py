@@ -1,9 +1,10 @@
 """The declarations of generated robots judged live, on the run's log and on its bag (issue 106: "0 false
 declarations"; bench/_robot_declarations.py, docs/monitors.md "Generated robots").  Two robots run
-through bench/_robot_run.py (real rclpy nodes, the DDS source, 2.5 s of sensing each): seed 855 of 5
-nodes, correct, every declaration ``true`` on every path; seed 855 of 6 nodes with its seeded defect,
-Sensor3 silent once for longer than its declared period, ``periodic`` ``false`` at that sensor on every
-path and every other declaration ``true`` (the control).  Live = log = bag declaration by declaration."""
+through bench/_robot_run.py side by side (real rclpy nodes, the DDS source, 2.5 s of sensing each): seed
+855 of 5 nodes, correct, every declaration ``true`` on every path (periods in time and in steps,
+``initially``, ``progress``); seed 855 of 6 nodes with its seeded defect, Sensor3 silent once for longer
+than its declared period, ``periodic`` ``false`` at that sensor on every path and every other
+declaration ``true`` (the control).  Live = log = bag declaration by declaration."""
 from __future__ import annotations
 
 import sys
@@ -17,9 +18,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 pytestmark = pytest.mark.live
 
 
-def _run(tmp_path: Path, seed: int, nodes: int, defect: bool) -> dict[str, Any]:
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[bool, dict[str, Any]]:
+    """Both robots run at once, each in its own DDS domain and processes (the module's time is the
+    longer run's, not the two's sum), by ``defect``."""
+    from concurrent.futures import ThreadPoolExecutor
+
     from _ros2 import robot_run
-    return robot_run(tmp_path, seed, nodes, 2.5, defect)
+    with ThreadPoolExecutor(2) as pool:
+        done = {defect: pool.submit(robot_run, tmp_path_factory.mktemp("seeded" if defect else "correct"), 855,
+                                    6 if defect else 5, 2.5, defect) for defect in (False, True)}
+        return {defect: f.result() for defect, f in done.items()}
 
 
 def _declared(n: dict[str, Any]) -> list[str]:
@@ -37,8 +46,8 @@ def _verdicts(res: dict[str, Any]) -> dict[str, dict[tuple[str, str], str]]:
             for path, d in res["declarations"].items()}
 
 
-def test_the_declarations_of_a_correct_robot_hold_on_every_path(tmp_path: Path) -> None:
-    res = _run(tmp_path, 855, 5, False)
+def test_the_declarations_of_a_correct_robot_hold_on_every_path(runs: dict[bool, dict[str, Any]]) -> None:
+    res = runs[False]
     got = _verdicts(res)
     nodes = {n["name"]: n for n in res["spec"]["nodes"]}
     expected = {(name, what) for name, n in nodes.items() for what in _declared(n)}
@@ -49,8 +58,8 @@ def test_the_declarations_of_a_correct_robot_hold_on_every_path(tmp_path: Path) 
     assert res["findings"] == [] and res["errors"] == [], res["findings"] + res["errors"]
 
 
-def test_a_sensor_silent_past_its_declared_period_is_red_there_only(tmp_path: Path) -> None:
-    res = _run(tmp_path, 855, 6, True)
+def test_a_sensor_silent_past_its_declared_period_is_red_there_only(runs: dict[bool, dict[str, Any]]) -> None:
+    res = runs[True]
     victim = next(n for n in res["spec"]["nodes"] if n.get("defect"))
     assert (victim["name"], victim["defect_kind"]) == ("Sensor3", "skip")
     for path, got in _verdicts(res).items():
