@@ -123,7 +123,8 @@ def read_log(log: str, f: Spec) -> tuple[dict[str, list[float]], int]:
         data: float | list[float] | None = None
 
     decode = msgspec.json.Decoder(Line).decode_lines
-    gc.disable()  # as the command's reader runs (its batch path): the collector's passes would free nothing
+    gc.disable()  # as the command's reader runs (its batch path): the collector's passes would free nothing (main
+    # turns it on again to monitor)
     if f.name.startswith("G(trig"):  # the deadline: a line per trigger and per answer
         stamps: dict[str, list[int]] = {"trig": [], "ans": []}
         end = [0.0]
@@ -181,6 +182,7 @@ def main(argv: Sequence[str]) -> int:
     peer, spec, log, out = argv
     f = _Formula(json.loads(spec))
     cols, n = read_log(log, f)
+    gc.enable()  # the peer monitors with the collector on, as in the race's own process
     got = RUNS[peer](f, cols, n)
     with open(out, "wb") as fh:
         array("d", got).tofile(fh)
