@@ -271,3 +271,32 @@ def test_seed_820_an_initial_value_at_its_bound_is_read_as_its_float32_field_car
     over = float(np.nextafter(np.float32(2.2), np.float32(np.inf)))
     control = _declarations_820(tmp_path / "control", monkeypatch, capsys, first=over)
     assert control[("Sensor0", "initially 1")]["verdict"] == "false"
+
+
+SEED_952 = Path(__file__).resolve().parents[1] / "data" / "robot_seed952"
+
+
+def test_seed_952_a_sensor_placed_as_a_copy_keeps_its_clocks_period(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """Seed 952 (6 nodes, rclpy source, ``/clock`` x2 from 0 s, drivers 0.3 s ahead): Sensor0
+    (``sensor_msgs/Range``) and Sensor4 (``sensor_msgs/LaserScan``) stamp in simulated time, and their
+    periods are judged on those stamps (backends/monitors/periods.py, "The node's clock").  Once, both
+    published within one tick of the simulated clock with the same stamp, and Sensor4's message was
+    placed as a copy of Sensor0's, its stamp replaced by the run's clock (traces/event_time.py,
+    ``CopiedStamps``, ``with_stamp``): its period then compared a simulated stamp with a wall-clock
+    one, "a gap of 1795903192072 ms", ``false`` live, on the log and on the bag of a correct sensor.
+    ``with_stamp`` now keeps the stamp it replaces, as ``without_stamp`` does.  Kept: the run's bag
+    (its log holds what the live run wrote before the fix), judged offline: every declaration ``true``
+    but the server's, ``pending`` on a bag (its calls go to the call checks only).  The control, the
+    stamp replaced without being kept, is tests/backends/test_periods_node_clock.py's (a skip of 550 ms
+    of the wall clock ``false`` in the same case)."""
+    ws = tmp_path / "ws"
+    shutil.copytree(SEED_952, ws)
+    monkeypatch.chdir(ws)
+    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
+    rows: list[Any] = json.loads(capsys.readouterr().out)
+    got = {(r["node"], d["declaration"]): d for r in rows for d in r.get("declarations", [])}
+    assert got[("Sensor4", "periodic out.cells")]["verdict"] == "true", got[("Sensor4", "periodic out.cells")]
+    assert "in the node's clock" in got[("Sensor4", "periodic out.cells")]["reason"]
+    assert {k: d["verdict"] for k, d in got.items() if d["verdict"] != "true"} == {("Switch2", "progress"): "pending"}
+    assert len(got) == 8

@@ -20,7 +20,7 @@ from typing import Any
 import pytest
 
 from rclverify.cli.commands import main
-from rclverify.traces.event_time import without_stamp
+from rclverify.traces.event_time import with_stamp, without_stamp
 
 RCL = """node Sensor0 {
   inputs(  )
@@ -31,6 +31,14 @@ RCL = """node Sensor0 {
   periodic( out.x, PERIOD ms )
 }
 
+node Sensor2 {
+  inputs(  )
+  outputs( y : REAL )
+  topics( sensor_msgs/Range s2 matches(out.y) )
+  assume( TRUE )
+  guarantee( 0 <= out.y and out.y <= 2 )
+}
+
 node Alarm1 {
   inputs( n : INTEGER )
   outputs( ok : BOOL )
@@ -39,7 +47,7 @@ node Alarm1 {
   guarantee( out.ok <=> (in.n >= 0) )
 }
 """
-MAPPING = "topics:\n  s0: {fields: [range]}\n  u1: {fields: [data]}\n  a1: {fields: [data]}\nhorizon: 1.0\n"
+MAPPING = "topics:\n  s0: {fields: [range]}\n  s2: {fields: [range]}\n  u1: {fields: [data]}\n  a1: {fields: [data]}\nhorizon: 1.0\n"
 WALL0 = 1_764_000_000.0
 
 
@@ -48,10 +56,13 @@ def _stamp(s: float) -> dict[str, int]:
     return {"sec": ns // 10**9, "nanosec": ns % 10**9}
 
 
-def _run(gaps_wall: list[float], rate: float, start: float, tail_wall: float, logged: bool) -> list[dict[str, Any]]:
+def _run(gaps_wall: list[float], rate: float, start: float, tail_wall: float, logged: bool,
+         twin: bool = False) -> list[dict[str, Any]]:
     """A run of Sensor0 stamping in a clock ``start + rate * (wall - WALL0)`` s, its messages ``gaps_wall``
     apart on the wall clock, with an unstamped reading and answer every 100 ms beside it until ``tail_wall``
-    s after its last message.  ``logged``: each stamp set aside as the live monitor logs it."""
+    s after its last message.  ``logged``: each stamp set aside as the live monitor logs it.  ``twin``:
+    Sensor2 publishes 2 ms before each message of Sensor0 with the same stamp (one tick of a simulated
+    clock), so Sensor0's message is placed as a copy of Sensor2's, its stamp carried into the run's clock."""
     rows: list[dict[str, Any]] = []
     t = WALL0 + 0.05
     times = [t]
@@ -61,7 +72,10 @@ def _run(gaps_wall: list[float], rate: float, start: float, tail_wall: float, lo
     for k, w in enumerate(times):
         fields: dict[str, Any] = {"header": {"stamp": _stamp(start + rate * (w - WALL0)), "frame_id": "sonar"},
                                   "range": 1.0}
-        rows.append({"topic": "s0", "time": w, **(without_stamp(fields) if logged else fields)})
+        if twin:
+            rows.append({"topic": "s2", "time": w - 0.002, **(without_stamp(fields) if logged else fields)})
+        placed = with_stamp(fields, w - 0.002) if twin else without_stamp(fields)
+        rows.append({"topic": "s0", "time": w, **(placed if logged else fields)})
     end = times[-1] + tail_wall
     u = WALL0
     while u <= end:
@@ -114,3 +128,17 @@ def test_a_drivers_offset_leaves_the_period_as_the_wall_clock_shows_it(
     rows = _run(REGULAR, 1.0, WALL0 - 2.0, 0.45, False)
     assert _judge(tmp_path, 600, rows, capsys)["verdict"] == "true"
     assert _judge(tmp_path, 300, rows, capsys)["verdict"] == "false"
+
+
+@pytest.mark.parametrize("logged", [False, True], ids=["raw stamps (a bag)", "stamps placed (the live log)"])
+def test_a_sensor_stamping_alike_with_another_keeps_its_clock(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], logged: bool) -> None:
+    """Two sensors on one simulated clock stamp alike within one of its ticks; the second's message is
+    placed as a copy of the first's, its stamp carried into the run's clock (traces/event_time.py,
+    ``CopiedStamps``), and its own stamp is still the one its period is judged on (generated seed 952,
+    ``/clock`` x2 from 0 s: a gap of 1,795,903,192 s between a simulated and a wall-clock stamp).  The
+    control: the same run with a skip of 550 ms of the wall clock is ``false``."""
+    row = _judge(tmp_path, 800, _run(REGULAR, 2.0, 0.0, 0.2, logged, twin=True), capsys)
+    assert row["verdict"] == "true" and "no gap over 800 ms (in the node's clock" in row["reason"], row
+    row = _judge(tmp_path, 800, _run(REGULAR[:10] + [0.55] + REGULAR[10:], 2.0, 0.0, 0.2, logged, twin=True), capsys)
+    assert row["verdict"] == "false" and "a gap of 1100 ms" in row["reason"], row

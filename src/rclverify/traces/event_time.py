@@ -114,19 +114,27 @@ def with_stamp(fields: Mapping[str, Any], stamp: float) -> dict[str, Any]:
     ROSMonitoring's flattened ``header.stamp.*``, in the keys the message
     has) made ``stamp`` (s, the run's clock): a stamp in another clock
     carried into the run's clock at the time its message was placed
-    (:class:`CopiedStamps`), so a log of the run places it there again."""
+    (:class:`CopiedStamps`), so a log of the run places it there again.  The
+    stamp it replaces is kept as ``header.stamp_aside``, as
+    :func:`without_stamp` keeps it (the clock of the node that stamped it: two
+    sensors on one simulated clock stamp alike within one of its ticks, and
+    the second is placed as a copy of the first)."""
     sec = int(stamp)
     ns = min(round((stamp - sec) * 1e9), 999_999_999)
     out = dict(fields)
     h = out.get("header")
     old: Any = h.get("stamp") if isinstance(h, Mapping) else None
+    kept: dict[str, Any] = {ASIDE: old} if isinstance(h, Mapping) and ASIDE not in h else {}
     if isinstance(h, Mapping) and isinstance(old, Mapping):
         keys = ("secs", "nsecs") if "secs" in old else ("sec", "nanosec")
-        out["header"] = {**h, "stamp": {**old, keys[0]: sec, keys[1]: ns}}
+        out["header"] = {**h, "stamp": {**old, keys[0]: sec, keys[1]: ns}, **kept}
     elif isinstance(h, Mapping) and old is not None:
-        out["header"] = {**h, "stamp": stamp}
+        out["header"] = {**h, "stamp": stamp, **kept}
     else:
-        for k in [k for k in out if k.startswith("header.stamp.")]:
+        flat = [k for k in out if k.startswith("header.stamp.")]
+        if not any(k.startswith(f"header.{ASIDE}.") for k in out):
+            out.update({f"header.{ASIDE}." + k.rsplit(".", 1)[1]: out[k] for k in flat})
+        for k in flat:
             out[k] = sec if k.rsplit(".", 1)[1] in ("sec", "secs") else ns
     return out
 
