@@ -9,6 +9,8 @@ import shutil
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from rclverify.app.pipeline import stage_check, stage_requirements
 from rclverify.stages.workspace import Workspace
 from rclverify.tools.fret.importer import import_fret
@@ -22,10 +24,27 @@ def _verdicts(root: Path) -> dict[str, tuple[str, bool]]:
     return {rec["id"]: (str(rec.get("verdict")), now) for rec, now in stage_requirements(ws)}
 
 
-def test_the_example_decides_its_fret_requirements_and_rechecks_an_edited_one(tmp_path: Path) -> None:
-    root = tmp_path / "ws"
+@pytest.fixture(scope="module")
+def checked(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, tuple[str, bool]]]:
+    """The example copied without its outputs and its requirements decided once for the module: the
+    workspace (records included) and the verdicts.  A test copies the workspace whole and starts from
+    its records, as a user's next run does; the records seal the inputs' text, not their path."""
+    root = tmp_path_factory.mktemp("fret") / "ws"
     shutil.copytree(EXAMPLE, root, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*"))
-    first = _verdicts(root)
+    return root, _verdicts(root)
+
+
+def _checked_copy(checked: tuple[Path, dict[str, tuple[str, bool]]], tmp_path: Path) -> Path:
+    root = tmp_path / "ws"
+    shutil.copytree(checked[0], root)
+    return root
+
+
+def test_the_example_decides_its_fret_requirements_and_rechecks_an_edited_one(
+        checked: tuple[Path, dict[str, tuple[str, bool]]], tmp_path: Path) -> None:
+    root = _checked_copy(checked, tmp_path)
+    first = checked[1]
+    assert all(now for _, now in first.values())  # decided by the fixture's run, each of them
     assert {k: v for k, (v, _) in first.items()} == {
         "CAP": "proved", "ROVER-001": "proved", "ROVER-002": "proved", "ROVER-003": "proved",
         "ROVER-004": "proved", "ROVER-005": "proved", "ROVER-006": "proved", "ROVER-007": "proved",
@@ -66,16 +85,16 @@ def _matrix_ids(root: Path) -> set[str]:
     return ids
 
 
-def test_an_edited_export_makes_its_requirement_stale_until_checked_again(tmp_path: Path) -> None:
+def test_an_edited_export_makes_its_requirement_stale_until_checked_again(
+        checked: tuple[Path, dict[str, tuple[str, bool]]], tmp_path: Path) -> None:
     """Each imported requirement's record seals its entry of the export (``fret:<export>#<reqid>``) and
     the export's hash: an edit of ROVER-002's text alone (its statement unchanged) makes its record stale
     in the report, and only its; the next run checks it again, and then equals a clean run."""
     from rclverify.report.build import read_inputs
     from rclverify.stages.requirements import read_records
 
-    root = tmp_path / "ws"
-    shutil.copytree(EXAMPLE, root, ignore=shutil.ignore_patterns("artifacts", "reports", ".doit*"))
-    _verdicts(root)
+    root = _checked_copy(checked, tmp_path)
+    assert not any(now for _, now in _verdicts(root).values())  # the copy's records are current: nothing re-run
     rec = json.loads((root / "artifacts" / "requirements" / "ROVER-002.json").read_text(encoding="utf-8"))
     export = "fret/rover_requirements.json"
     assert set(rec["inputs"]) >= {f"fret:{export}#ROVER-002", f"fret:{export}"}
