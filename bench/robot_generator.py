@@ -73,7 +73,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from _robot_declarations import CLOCK_STEP_MS, declare, defect_kind  # bench/ is on sys.path (run as a script, the tests)
+from _robot_declarations import CLOCK_STEP_MS, STAMP_BEHIND_S, declare, defect_kind  # bench/ is on sys.path (run as a script, the tests)
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATES = ROOT / "bench" / "templates" / "robot_generator"
@@ -94,6 +94,11 @@ FIBONACCI = "int32 order\n---\nint32[] sequence\n---\nint32[] sequence\n"
 #: the orders a Fibonacci action's client draws its goals from (2, 3 and 4 are always sent)
 FIB_ORDERS = (1, 2, 3, 4, 5, 6, 7, 8)
 HORIZON = 1.0
+#: the most (s) a sensor's driver may stamp behind within the run's clock: an answer leaves up to 30 % of a
+#: 200 ms period after its reading, a stamp up to 30 ms before its publication, and the next reading's stamp
+#: must come after the answer (generated seeds 955-958, 0.2 s behind: the alarms and relays judged, rightly,
+#: against the next reading)
+MAX_BEHIND_S = 0.05
 #: the real-time factors a ``/clock`` robot draws from: simulated seconds per wall-clock second
 CLOCK_RATES = (0.5, 0.75, 1.0, 1.5, 2.0)
 
@@ -178,8 +183,14 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
     else ``None``; ``actions``: each SetBool server becomes, one time in two, a Fibonacci action server
     (its client sending :data:`FIB_ORDERS` goals one at a time); ``driver_offset_s``: every sensor's
     header stamps run that many seconds off its clock (a driver's clock, negative: behind), its
-    ``"driver_offset_s"``.  The other nodes drawn depend on no option.  Deterministic in (seed, nodes,
+    ``"driver_offset_s"``; within the run's clock at most :data:`MAX_BEHIND_S` behind (else
+    ``ValueError``, saying why).  The other nodes drawn depend on no option.  Deterministic in (seed, nodes,
     defect, kinds, sim_clock, actions, driver_offset_s)."""
+    if -STAMP_BEHIND_S <= driver_offset_s < -MAX_BEHIND_S:
+        raise ValueError(f"a driver {-driver_offset_s:g} s behind stamps within the run's clock (at most "
+                         f"{STAMP_BEHIND_S:g} s behind): its next reading is current, by its stamp, before an answer "
+                         f"to the last one can be heard, so no generated node answers it correctly; use at most "
+                         f"{MAX_BEHIND_S:g} s, or more than {STAMP_BEHIND_S:g} s (another clock)")
     rng = random.Random(f"robot-{seed}-{nodes}" + ("" if kinds == tuple(SENSORS) else "-" + ",".join(kinds)))
     out: list[dict[str, Any]] = []
     sensors: list[dict[str, Any]] = []
@@ -268,10 +279,38 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
     if defect:
         candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None]
         # a node whose defect shows on the values the run carries: an alarm or fuse is wrong only at its threshold
-        victim = random.Random(f"defect-{seed}-{nodes}").choice(candidates)
+        rng = random.Random(f"defect-{seed}-{nodes}")
+        victim = rng.choice(candidates)
+        while victim["kind"] == "fuse" and not fuse_defect_shows(victim, by_name):  # drawn again (generated seed 966)
+            candidates.remove(victim)
+            victim = rng.choice(candidates)
         victim["defect"] = True
         victim["defect_kind"] = defect_kind(victim, spec)
     return spec
+
+
+#: the readings of a fuse's leading input within which its seeded defect must change an answer
+FUSE_DEFECT_WITHIN = 12
+
+
+def fuse_defect_shows(f: dict[str, Any], by: dict[str, dict[str, Any]], within: int = FUSE_DEFECT_WITHIN) -> bool:
+    """Whether fuse ``f``'s seeded defect (the strict comparison for the other on its second input, as
+    robot.py's ``decide`` makes it) changes one of its first ``within`` answers: its k-th reading of the
+    leading input meets the k-th of the other, which publishes half a period before it with the same
+    period.  The defect is wrong only where the other input sits at its threshold and the leading one
+    does not decide the answer alone (``and``: at or below KA; ``or``: above it), which the drawn
+    readings may never pair (generated seed 966: Fuse2's defect changed none of its answers)."""
+    a, b = by[f["a_source"]], by[f["b_source"]]
+    ka = f32(float(f["ka"]))
+    kb: float = int(f["kb"]) if f["op_b"] == "ge" else f32(float(f["kb"]))
+    for k in range(within):
+        x, y = a["values"][k % len(a["values"])], b["values"][k % len(b["values"])]
+        if f["op_b"] == "ge":
+            if x <= ka and (y >= kb) != (y > kb):
+                return True
+        elif x > ka and any(c < kb for c in y) != any(c <= kb for c in y):
+            return True
+    return False
 
 
 def _consts(spec: dict[str, Any]) -> tuple[list[dict[str, str]], dict[str, dict[str, str]]]:
@@ -489,6 +528,10 @@ def main(argv: list[str] | None = None) -> int:
     sizes = (int(lo), int(hi or lo))
     if a.smoke:
         return _smoke()
+    try:
+        generate(0, 2, driver_offset_s=a.driver_offset)
+    except ValueError as exc:
+        p.error(str(exc))
     seeds = _seeds(a.seeds)
     kinds = tuple(k for k in SENSORS if k not in a.without)
     if a.write:

@@ -410,3 +410,38 @@ def test_a_stamp_copying_relay_in_the_wall_clock_is_satisfied(tmp_path: Path, ca
 def test_a_stamp_copying_relay_on_a_simulated_clock_is_satisfied(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     counts = _relay_counts(tmp_path, RELAY_RUN, capsys)
     assert counts["violated"] == 0, counts
+
+
+def test_a_seeded_fuse_is_one_whose_defect_changes_an_answer() -> None:
+    """Generated seed 966 (5 nodes, ``--defect``) seeded Fuse2 with the strict comparison for the other on
+    its second input, which is wrong only where that input sits at its threshold while the leading one
+    does not decide the answer alone; its drawn readings never paired so, and its defect was not red on
+    a run of 8 s (rightly: no answer was wrong).  A fuse whose defect changes none of its first
+    :data:`FUSE_DEFECT_WITHIN` answers is not seeded; the victim is drawn again among the others.  The
+    control: a fuse seeded elsewhere changes one."""
+    plain = gen.generate(966, 5)
+    by = {n["name"]: n for n in plain["nodes"]}
+    assert by["Fuse2"]["kind"] == "fuse" and not gen.fuse_defect_shows(by["Fuse2"], by)
+    seeded = gen.generate(966, 5, True)
+    assert [n["name"] for n in seeded["nodes"] if n.get("defect")] == ["Relay4"]
+    shown = [(s, n) for s in range(60) for spec in [gen.generate(s, 9, True)]
+             for n in spec["nodes"] if n.get("defect") and n["kind"] == "fuse"]
+    assert shown and all(gen.fuse_defect_shows(n, {m["name"]: m for m in gen.generate(s, 9, True)["nodes"]})
+                         for s, n in shown)
+
+
+def test_a_driver_behind_within_the_runs_clock_further_than_an_answer_can_follow_is_refused() -> None:
+    """Generated seeds 955-958 (``--driver-offset -0.2``): a reading stamped 0.2 s before its publication
+    is placed at its stamp, so with readings every 200-250 ms the next reading is current before an
+    alarm's or relay's answer to the last one is heard, and the judge rightly judged the answers against
+    it (73, 4, 41 and 14 violated on correct nodes, live = log = bag).  Such an offset is refused, saying
+    why; the controls: 0.05 s behind, 0.1 s ahead and 2 s behind (another clock) are drawn, and a
+    robot's answers wait past a reading's stamp as past its publication (its window in robot.py)."""
+    for off in (-0.2, -0.5, -1.0):
+        with pytest.raises(ValueError, match="behind stamps within the run's clock"):
+            gen.generate(955, 11, driver_offset_s=off)
+    for off in (-0.05, 0.1, -2.0, 0.3):
+        assert gen.generate(955, 11, driver_offset_s=off)["driver_offset_s"] == off
+    robot = gen.render(gen.generate(955, 11, driver_offset_s=-0.05))["robot.py"]
+    compile(robot, "robot.py", "exec")
+    assert "STAMP_SHIFT_S - s[\"back_ms\"]" in robot and "due + max(off, 0.0) + 0.005" in robot
