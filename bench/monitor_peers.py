@@ -86,8 +86,10 @@ one run on one machine.
 ``rclverify monitor`` command with margins on ``G[0,2](x > 1)``, ``(x > 1)
 U[0,3] (y > 4)`` and a ``triggered by ... within`` deadline against RTAMT's,
 Reelay's and mstlo's robustness on ``--samples`` samples, every sample's
-verdict and margin compared (with ``--smoke``: 2,000 samples); with ``--compare OLD_SRC`` the command
-from the older tree too, on the same logs in the same run (before -> after).
+verdict and margin compared (with ``--smoke``: 2,000 samples); each peer twice: its monitoring loop
+on the samples in memory, and as a program of its own reading the same log (bench/_peer_read.py),
+timed as the command is (the whole process, its start-up printed apart); with ``--compare OLD_SRC``
+the command from the older tree too, on the same logs in the same run (before -> after).
 
 ``--margins`` runs only the margins race (bench/_margin_peers.py): the
 batch path's space margins of ``G(x > 1)`` as a per-answer guarantee
