@@ -1,7 +1,7 @@
 """Robots whose header stamps run in another clock than their source times, live (docs/semantics.md,
-"Clocks"; docs/monitors.md, "Generated robots"): generated robots of real rclpy nodes on Fast DDS
-(bench/_robot_run.py through tests/_ros2.py's ``robot_run``), each judged live, on its log and on its MCAP
-bag, verdict by verdict.
+"Event time", its "Clocks"; docs/monitors.md, "Generated robots"): generated robots of real rclpy nodes
+on Fast DDS (bench/_robot_run.py through tests/_ros2.py's ``robot_run``), each judged live, on its log
+and on its MCAP bag, verdict by verdict.
 
 * **``use_sim_time`` through the DDS source** (tests/bench/test_robot_generator.py hears one through the
   rclpy source): seed 1 of 6 nodes on a ``/clock``, every node ``use_sim_time``, header stamps on the
