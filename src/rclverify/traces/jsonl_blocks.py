@@ -72,9 +72,14 @@ from typing import Any, Iterable, Iterator, Literal, Sequence, Union
 import msgspec
 from rclverify.core.numeric import np
 
+from rclverify.traces.event_time import ASIDE
 from rclverify.traces.events import FLAT_STAMPS, Event, taken
 from rclverify.traces.jsonl import line_event, read_jsonl, read_lines
 
+#: the flattened stamp keys read by the exact reader: a message's own stamp (its event's ``stamp``) and a
+#: stamp a live log set aside in another clock (``header.stamp_aside.*``, traces/event_time.py), whose
+#: writer the stamp watch measures from the event (backends/monitors/stamp_order.py)
+_STAMP_KEYS = FLAT_STAMPS + tuple(f"header.{ASIDE}." + k.rsplit(".", 1)[1] for k in FLAT_STAMPS)
 #: Bytes read from the log at once (a block is cut after its last whole line).
 BLOCK_BYTES = 1 << 20
 #: The most keys the fast path's struct names (a log with more distinct keys reads the rest exactly).
@@ -221,7 +226,7 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
           ) -> tuple[list[LogBlock], set[str]] | None:
     """The read ``data`` as blocks of at most ``rows`` lines when it is decoded at once (module docstring), with
     its distinct topics as the lines spell them; else ``None``."""
-    if "header" in dec.attr or any(k in dec.attr for k in FLAT_STAMPS) or data[:1] != b"{" or \
+    if "header" in dec.attr or any(k in dec.attr for k in _STAMP_KEYS) or data[:1] != b"{" or \
             data[-1:] != b"\n" or b"\r" in data:
         return None
     u = np.frombuffer(data, np.uint8)
@@ -293,8 +298,8 @@ class _Slice:
 
 def _fast(path: Path, dec: _Decoder, lines: list[bytes], lineno: int, index: int) -> LogBlock | None:
     """The block of ``lines`` when the fast path reads it as the exact one would (module docstring), else ``None``."""
-    if "header" in dec.attr or any(k in dec.attr for k in FLAT_STAMPS):
-        return None  # a message's own stamp is read by the exact reader (its event's ``stamp``)
+    if "header" in dec.attr or any(k in dec.attr for k in _STAMP_KEYS):
+        return None  # a message's own stamp, or one set aside, is read by the exact reader (its event's ``stamp``)
     try:
         structs = list(map(dec.decode, lines))
     except Exception:  # noqa: BLE001 - whatever msgspec refuses (a blank line, a new key, bad bytes, depth): exact path

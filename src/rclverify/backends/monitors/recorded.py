@@ -90,7 +90,7 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
     lag, note, stale = second_read(one.watch, trace, _readable_again(Path(trace)))  # one clock (stamp_order.py)
     if lag is not None:  # the first pass's verdicts are dropped with it
         one = _pass(checked, nodes, cfg, root, trace, on_warning, lag, margins, keep)
-        one.note = note
+    one.note = note  # also without a second read: a writer in another clock a live log set aside, named
     dmons, pmons, decl, calls, heard, events, results = (one.dmons, one.pmons, one.decl, one.calls, one.heard,
                                                          one.events, one.results)
     dres = [m.finish() for m in dmons]

@@ -44,15 +44,28 @@ that clock at that message's:
 :func:`placed_clock`), and the note names each writer in one line with its
 measured offsets, as the live engine places and names them
 (:mod:`.online`).  A stamp within those bounds is the message's time.
+
+A live monitor's log holds a stamp in another clock already set aside
+(``header.stamp_aside``, :func:`~rclverify.traces.event_time.without_stamp`;
+a copy of one carried into the run's clock keeps it there too), its message
+at its source time: such a message is judged as the log has it (no second
+read for it), and its writer's offsets are measured from the stamp set aside
+(:attr:`StampWatch.writers`), so the note names it in the one line the live
+record and the bag give it (:meth:`StampWatch.named`).
 """
 from __future__ import annotations
 
 import math
 from typing import Any, Callable, Iterable, Iterator
 
-from rclverify.traces.event_time import CopiedStamps, WriterClocks, other_clock, published, with_stamp, without_stamp
+from rclverify.traces.event_time import (ASIDE, CopiedStamps, WriterClocks, aside_stamp, other_clock, published,
+                                         with_stamp, without_stamp)
 from rclverify.traces.events import Event, header_stamp
 from rclverify.traces.reorder import ReorderBuffer
+
+
+#: the keys of a message that may hold a stamp set aside (nested, or flattened as ROSMonitoring's stamps are)
+_ASIDE_KEYS = ("header", f"header.{ASIDE}.sec", f"header.{ASIDE}.secs")
 
 
 def run_clock(ev: Event) -> float:
@@ -68,7 +81,7 @@ class StampWatch:
     largest such ``lag`` in seconds; ``first``: where the first was read)."""
 
     __slots__ = ("skew", "latest", "count", "lag", "first", "stamped", "plain", "clocks", "placed_latest",
-                 "placed_lag", "near", "copies")
+                 "placed_lag", "near", "copies", "writers")
 
     def __init__(self, skew: float) -> None:
         self.skew = skew
@@ -88,12 +101,22 @@ class StampWatch:
         self.near = 0.0
         #: the stamps in another clock seen, to place a copy of one at its question's time (traces/event_time.py)
         self.copies = CopiedStamps()
+        #: per writer, the offset of the stamp it wrote (a stamp set aside in a live log, else the header stamp)
+        #: from its trace times: what the live run measured, whose lines name the writers (:meth:`named`)
+        self.writers = WriterClocks()
 
     def see(self, ev: Event) -> None:
         """Note event ``ev``'s place on the run's clock."""
         s = header_stamp(ev.fields) if ev.fields else None
         t = ev.time if s is None else s
         span = self.plain if s is None else self.stamped
+        f = ev.fields
+        # the stamp its writer wrote: set aside (looked for only where a header is: a line's keys are not walked)
+        own = aside_stamp(f) if f and any(k in f for k in _ASIDE_KEYS) else None
+        if own is None:
+            own = s
+        if own is not None:
+            self.writers.see(ev.topic, own, ev.time)
         p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time)[0] if self.clocks.see(
             ev.topic, s, ev.time) else _own_or_copied(self.copies, ev.topic, s, ev.time)
         if p >= self.placed_latest:
@@ -141,6 +164,14 @@ class StampWatch:
         """Whether a header stamp of the run ran in another clock than its
         message's trace time (:func:`~rclverify.traces.event_time.other_clock`)."""
         return bool(self.clocks.others())
+
+    def named(self) -> list[str]:
+        """One line per writer whose stamps run in another clock, its
+        messages placed at their trace times (:meth:`WriterClocks.lines
+        <rclverify.traces.event_time.WriterClocks.lines>`, the live record's
+        and the bag's wording): measured from the stamps a live log set aside
+        as well as from the header stamps; ``[]`` for a run in one clock."""
+        return self.writers.lines(True)
 
     def two_clocks(self) -> bool:
         """Whether the header stamps and the times of the messages without one
@@ -267,11 +298,21 @@ def second_read(watch: StampWatch, trace: str, readable: bool) -> tuple[float | 
     is the window to read the run again in stamp order with (``None``: no
     second read), ``note`` says so for the evidence, ``stale`` is why the
     first read's greens are not given (two clocks, or a run that cannot be
-    read again: ``readable`` false); all empty for a run read in stamp order."""
+    read again: ``readable`` false); all empty for a run read in stamp order.
+    ``note`` names each writer in another clock (:meth:`StampWatch.named`),
+    also when its stamps were set aside in a live log and nothing is read
+    again for them."""
+    lag, note, stale = _second_read(watch, trace, readable)
+    named = "" if watch.other_clocks() else "; ".join(watch.named())  # set aside in a log: placed already
+    return lag, "; ".join(x for x in (named, note) if x), stale
+
+
+def _second_read(watch: StampWatch, trace: str, readable: bool) -> tuple[float | None, str, str]:
+    """:func:`second_read` of the header stamps alone (a stamp set aside is not the message's time)."""
     if watch.other_clocks():  # writers in another clock: read again with their stamps placed (module docstring)
         if not readable:
             return None, "", stale_reason(watch, trace)
-        note = "; ".join(watch.clocks.lines(True))
+        note = "; ".join(watch.named())
         if watch.placed_lag:
             note += (f"; judged in stamp order with those stamps placed (a lag of up to "
                      f"{watch.placed_lag * 1e3:.1f} ms)")
