@@ -16,11 +16,15 @@ false, its margin negative) is counted directly too once the run's
 :data:`~.verdicts.KEPT_VIOLATIONS` violation records are full and no
 verdict callback is given: the engine would only count it (closing.py);
 before that the engine renders its values and reason.  With a transport
-skew, only one the engine would release within the run (:meth:`.batch_pairs.PairRuns._released`).  Every other event (an input with no answer, a late or duplicated
-answer, a value that does not map, a formula near a boundary, a message of
-another topic) goes through the streaming engine (:class:`~.engine.NodeMonitor`,
-its ``feed``) exactly as :func:`~.check.check_trace` would feed it, so its
-verdict is the engine's by construction.
+skew, only one the engine would release within the run
+(:meth:`.batch_pairs.PairRuns._released`).  Every other event (an input with
+no answer, an answer past the horizon or duplicated, a value that does not
+map, a formula near a boundary, a message of another topic, a message heard
+later than the lateness bound or carrying a source time, :mod:`.batch_late`,
+and the pair it is part of) goes through the streaming engine
+(:class:`~.engine.NodeMonitor`, its ``feed``) exactly as
+:func:`~.check.check_trace` would feed it, so its verdict is the engine's by
+construction.
 
 The two share one engine: before a run of batch rows the engine must be
 **quiet** (no output held for the transport skew, the watched question
@@ -70,6 +74,7 @@ from rclverify.traces.jsonl_blocks import LogBlock
 from rclverify.traces.mapping import TopicRule
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.answered import AnsweredRun
+from rclverify.backends.monitors.batch_late import own_times
 from rclverify.backends.monitors.batch_lone import LoneSlots, lone_eligible
 from rclverify.backends.monitors.batch_pairs import PairRuns
 from rclverify.backends.monitors.batch_plan import BatchPlan, batch_plan
@@ -240,6 +245,9 @@ class _Run(PairRuns, LoneSlots):
         unstamped = chunk.unstamped()
         if unstamped is not None:
             ok &= unstamped
+        own = own_times(chunk)  # heard later than the lateness bound, or a source time: the engine's (batch_late.py)
+        if own is not None:
+            ok &= ~own
         cols: dict[str, np.ndarray] = {}
         full: np.ndarray
         for topic, j, (key, field, kind_) in [(plan.output[0], -1, plan.output[1:])] + \

@@ -42,7 +42,6 @@ verdicts given, the counts and margins).
 """
 from __future__ import annotations
 
-from operator import attrgetter
 from typing import TYPE_CHECKING, Any
 
 from rclverify.core.numeric import np
@@ -51,10 +50,9 @@ from rclverify.traces.events import Event
 from rclverify.targets.columns import seed
 from rclverify.backends.monitors.answered import RecentOutput
 from rclverify.backends.monitors.skew import within_before
+from rclverify.backends.monitors.batch_late import own_times
 from rclverify.backends.monitors.batch_lone_state import LoneState
 from rclverify.backends.monitors.verdicts import Verdict
-
-_SOURCE, _LATE = attrgetter("source"), attrgetter("late")
 
 if TYPE_CHECKING:
     from rclverify.backends.monitors.batch_plan import BatchPlan
@@ -137,11 +135,9 @@ class LoneSlots(LoneState):
         unstamped = chunk.unstamped()
         if unstamped is not None and not bool(unstamped[s:e].all()):
             return s
-        rows = getattr(chunk, "events", None)
-        if rows is not None:  # a source time or a lateness of its own: the engine's (event_time.py, late.py)
-            part = rows[s:e]
-            if list(map(_SOURCE, part)).count(None) != L or any(map(_LATE, part)):
-                return s
+        own = own_times(chunk)  # a source time or a lateness of its own: the engine's (batch_late.py)
+        if own is not None and bool(own[s:e].any()):
+            return s
         new = np.ones(L, dtype=bool)
         new[1:] = t[1:] != t[:-1]
         starts = np.flatnonzero(new)

@@ -183,10 +183,12 @@ class PairRuns(PairsState):
         return least
 
     def _quiet(self, t: float) -> bool:
-        """Whether the engine would give no verdict of its own at an input at time ``t`` followed by its answer."""
+        """Whether the engine would give no verdict of its own at an input at time ``t`` followed by its answer
+        (a pair whose own input or answer was heard later than the lateness bound is no pair: batch.py, ``chunk``,
+        :mod:`.batch_late`)."""
         m = self.m
         if m.now > t or m.invalid or m._late_in:  # an unreadable input, or one heard later than the lateness
-            return False  # bound, makes the next questions undecided: the engine's
+            return False  # bound before the pair, makes the next questions undecided: the engine's
         o = m._open
         if o is not None and not (o.answered and not o.waiting and (o.followed or o.decided.issuperset(m._need))):
             return False
