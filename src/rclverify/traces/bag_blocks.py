@@ -41,6 +41,7 @@ from typing import Any, Iterator, Mapping, Sequence
 from rclverify.core.numeric import np
 
 from rclverify.traces.bag import bag_event, open_bag, read_bag, typestore
+from rclverify.traces.bag_late import of_reader
 from rclverify.traces.bag_open import counted_open_error, open_uncounted
 from rclverify.traces.bag_raw import RawMessages, from_items, gather, raw_blocks
 from rclverify.traces.events import Event, TraceError
@@ -310,8 +311,9 @@ class BagBlock:
             return bag_event(self.reader, self.path, self.index + i, *self.raw.item(i))
         conn, stamp = self.raw.conns[int(self.raw.code[i])], int(self.raw.stamps[i])
         value = float(self._floats[i]) if self._is_float[i] else self._texts[self._which[i]]
+        lates = of_reader(self.reader)  # heard late by the live monitor that recorded the bag, as bag_event reads it
         return Event(self.index + i, stamp / 1e9, conn.topic.lstrip("/"), {"data": value},
-                     f"{self.path.name}: message {self.index + i}")
+                     f"{self.path.name}: message {self.index + i}", late=lates.at(conn.topic, stamp) if lates else 0.0)
 
 
 def _string(raw: bytes) -> str | bool:
