@@ -34,10 +34,9 @@ def _of_events(events: list[Any]) -> np.ndarray | None:
     """Per event, whether it carries a source time or a lateness; ``None`` when none does."""
     n = len(events)
     sources = list(map(_SOURCE, events))
-    lates = list(map(_LATE, events))
-    if sources.count(None) == n and not any(lates):
+    if sources.count(None) == n and not any(map(_LATE, events)):  # (two passes at C speed: the common case)
         return None
-    return np.fromiter((s is not None or bool(d) for s, d in zip(sources, lates)), bool, n)
+    return np.fromiter((s is not None or bool(ev.late) for s, ev in zip(sources, events)), bool, n)
 
 
 def _of_block(block: Any) -> np.ndarray | None:
