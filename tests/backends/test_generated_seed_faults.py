@@ -305,8 +305,6 @@ def test_seed_952_a_sensor_placed_as_a_copy_keeps_its_clocks_period(
 SEED_955 = Path(__file__).resolve().parents[1] / "data" / "robot_seed955"
 
 
-@pytest.mark.xfail(strict=True, reason="live, a first trigger heard later than the lateness bound after a message "
-                                       "stamped after it gets verdicts the recorded path does not give (not fixed)")
 def test_seed_955_a_late_first_trigger_is_judged_live_as_on_the_bag() -> None:
     """Seed 955 (11 nodes, DDS source, wall clock, sensors' drivers stamping 0.2 s behind: within the
     run's clock, so each reading is placed at its stamp): Fuse4's first ``in.x`` (Sensor0's
@@ -314,11 +312,16 @@ def test_seed_955_a_late_first_trigger_is_judged_live_as_on_the_bag() -> None:
     it, past the lateness bound of 50 ms).  On the bag and the log, in stamp order, it is a trigger
     before every input has a value: no deadline verdict, and Sensor3's message after it no guarantee
     verdict either (docs/semantics.md, "Deadlines").  Live (the bag replayed through the online engine
-    in process, as the live run judged it: live.jsonl held the same two) the reading's deadline is
-    ``true`` and Sensor3's message ``incomplete input``: live != log on two verdicts.  Kept as found
-    (the online engine's late first trigger; the other violated answers of this run were the
+    in process, as the live run judged it: live.jsonl held the same two) the reading's deadline was
+    ``true`` (the deadline monitor read the inputs as heard, not at the trigger's stamp) and Sensor3's
+    message kept the ``incomplete input`` given when it was heard: live != log on two verdicts.  The
+    deadline monitor now reads a late trigger's inputs at its stamp (``DeadlineMonitor._inputs_at``,
+    with the engine's ``late.value_at``), and a message counted ``incomplete input`` that a late
+    message completes has that verdict withdrawn (``Late._incomplete_withdrawn``): live = bag on
+    every verdict of the three nodes.  The in-process rule and its control:
+    tests/backends/test_late_first_trigger.py.  (The other violated answers of this run were the
     generator's: a driver 0.2 s behind within the run's clock makes the next reading current before
-    the answer to the last one is heard, bench/robot_generator.py refuses such offsets now)."""
+    the answer to the last one is heard, bench/robot_generator.py refuses such offsets now.)"""
     names = ("Sensor0", "Sensor3", "Fuse4")
     online, bag = finals(_online(SEED_955, names)), finals(_offline(SEED_955, "runs/bag", names))
     assert compare(online, bag) == [], [d.text(("live", "bag")) for d in compare(online, bag)]

@@ -21,8 +21,8 @@ ROSMonitoring's terms:
 
 **Only accepted inputs are obligations**: the node's assumption
 is judged on the trigger's inputs; a trigger whose inputs violate it (or
-whose inputs are not all observed yet, or whose assumption cannot be
-decided) gets no deadline verdict and is counted apart
+whose inputs are not all observed yet at its stamp, however late it was
+heard, or whose assumption cannot be decided) gets no deadline verdict and is counted apart
 (:attr:`.deadline_records.DeadlineResult.unaccepted`): a node is not obliged to answer an
 input its contract does not accept, so a ``true`` there would be evidence
 of nothing and a ``false`` a false alarm.  Formulas are judged as the
@@ -66,6 +66,7 @@ from rclverify.backends.monitors.deadline_records import DeadlineResult, Deadlin
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import VerdictWords, ms_ns, rejected
 from rclverify.backends.monitors import deadline_late, deadline_skew
+from rclverify.backends.monitors.late import value_at
 
 
 class DeadlineMonitor(VerdictWords):
@@ -114,6 +115,9 @@ class DeadlineMonitor(VerdictWords):
         #: the node's questions: an answer is judged on the latest at its stamp (a superseded trigger is carried)
         self.stream = QuestionStream()
         self.values: dict[str, object] = {}
+        #: before the first question: each input's values as its messages set them, (stamp ns, value), the
+        #: last 64: a trigger heard late finds the inputs in force at its stamp there (:meth:`_inputs_at`)
+        self.before_first: dict[str, deque[tuple[int, object]]] = {}
         #: keys whose latest message did not map (NaN, a missing field): key -> why; their stale value never
         #: stands in (docs/semantics.md, "Values")
         self.invalid: dict[str, str] = {}
@@ -159,6 +163,7 @@ class DeadlineMonitor(VerdictWords):
         """Process one event (any topic; only the node's move its state)."""
         ns = event_stamp_ns(ev)
         stamp = ns / 1e9
+        late = self.now_ns is not None and ns < self.now_ns  # stamped before a message heard already
         keys = self.bindings.get(ev.topic.lstrip("/"))
         if not keys or not self.timed:
             self._advance_ns(ns)
@@ -192,7 +197,12 @@ class DeadlineMonitor(VerdictWords):
         self._advance_ns(ns)
         if not any(c.startswith("in.") for c in changed):
             return
-        inputs = {key: v for key, v in self.values.items() if key.startswith("in.")}
+        mine = {c: self.values[c] for c in changed if c.startswith("in.") and c not in self.invalid}
+        if self.stream.at(stamp) is None:
+            for key, v in mine.items():
+                self.before_first.setdefault(key, deque(maxlen=64)).append((ns, v))
+        inputs = (self._inputs_at(stamp, ns, mine) if late and not self.stream.forgot else
+                  {key: v for key, v in self.values.items() if key.startswith("in.")})
         missing = [k for k in self.needed if k not in inputs]
         unread = [why for k, why in self.invalid.items() if k in self.needed]
         refused = (("incomplete input", "no value yet for " + ", ".join(missing)) if missing else
@@ -216,6 +226,19 @@ class DeadlineMonitor(VerdictWords):
             if self.result.first_unaccepted is None:
                 self.result.first_unaccepted = {"guarantee": k, "where": ev.where, "stamp": stamp, "why": why,
                                                 "reason": reason}
+
+    def _inputs_at(self, stamp: float, ns: int, mine: Mapping[str, object]) -> dict[str, object]:
+        """The inputs in force at ``stamp`` (s; ``ns`` the same in integer ns) of an input message heard
+        after one stamped later, which set ``mine``: those of the latest question at or before its stamp,
+        or before the first question those its messages stamped at or before it set, with its own
+        values (docs/semantics.md, "Deadlines": a trigger before every input has a value at its stamp
+        raises no question and gets no deadline verdict, however late it was heard; the verdict
+        engine reads it so, :meth:`.late.Late._late_input`)."""
+        q = self.stream.at(stamp)
+        got = dict(q.inputs) if q is not None else {
+            k: v for k, h in self.before_first.items() if (v := value_at(h, ns)) is not None}
+        got.update(mine)
+        return got
 
     def _refused(self, inputs: Mapping[str, object]) -> tuple[str, str] | None:
         """Why the node's assumption does not accept ``inputs`` (``(kind,

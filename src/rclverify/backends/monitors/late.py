@@ -28,7 +28,8 @@ input at its stamp:
   messages counted ``incomplete input`` are kept (:attr:`NodeMonitor._in_force`,
   the last 64 per input): a message heard late finds the values in force at
   its stamp there, and those stamped after it that it completes raise their
-  questions, in stamp order (:meth:`Late._completed`);
+  questions, in stamp order (:meth:`Late._completed`), the ``incomplete
+  input`` given to each when heard withdrawn (:meth:`Late._incomplete_withdrawn`);
 * equal stamps keep the order heard: an output stamped with a question and
   heard before it does not answer it;
 * its horizon runs from its stamp (live, a late message's time is the clock);
@@ -110,7 +111,7 @@ class Late(EngineState):
             if last is not None and reset:
                 values[k] = last.inputs.get(k)
             elif last is None:
-                values[k] = _at(hist.get(k, ()), float("inf"))
+                values[k] = value_at(hist.get(k, ()), float("inf"))
         before = stream.at(stamp)
         if before is None and stream.forgot:
             self._verdict("inconclusive", ev, reason=f"the input at {ev.where}, stamped {stamp:.9g} s, was heard "
@@ -130,12 +131,30 @@ class Late(EngineState):
         else:
             self._place(ev, stamp, inputs, trig, tainted, upto)
         for j, (t, e, got, kinds) in enumerate(completed):  # each before the next is put (what it answers)
+            self._incomplete_withdrawn(e, ev)
             self._place(e, t, got, kinds, [], completed[j + 1][:2] if j + 1 < len(completed) else None)
         self.invalid.update(unread)
 
+    def _incomplete_withdrawn(self, e: Event, by: Event) -> None:
+        """Message ``e``, counted ``incomplete input`` when heard, has every input at its stamp now that
+        ``by``, stamped before it, was heard late: that verdict is withdrawn (out of the counts, a
+        :data:`WITHDRAWN` verdict on ``e`` follows it), so ``e`` keeps only what its question gives, as
+        in the run read in stamp order, where it was never incomplete (docs/semantics.md, "Event time")."""
+        given = self._given
+        i = next((i for i in range(len(given) - 1, -1, -1) if given[i][0] == e.index), None)
+        if i is None or given[i][1] != "incomplete input":
+            return
+        del given[i]
+        self.result.counts["incomplete input"] -= 1
+        if self.on_verdict is not None:
+            self.on_verdict(Verdict(
+                self.node.name, WITHDRAWN, e.index, e.time, e.where, e.topic, max(self.now, by.time),
+                reason=f"the input at {by.where}, heard after it but stamped before it, gives every input a value "
+                       "at its stamp: the incomplete input verdict given when it was heard is withdrawn"))
+
     def _inputs_at(self, stamp: float) -> dict[str, object]:
         """Before the first question: the inputs as the messages stamped at or before ``stamp`` set them."""
-        got = {k: _at(h, stamp) for k, h in self._in_force.items()}
+        got = {k: value_at(h, stamp) for k, h in self._in_force.items()}
         return {k: v for k, v in got.items() if v is not None}
 
     def _place(self, ev: Event, stamp: float, inputs: dict[str, object], trig: frozenset[str],
@@ -373,8 +392,10 @@ _REVISABLE = frozenset({"satisfied", "violated", "inconclusive"})
 WITHDRAWN = "withdrawn"
 
 
-def _at(entries: Any, stamp: float) -> Any:
-    """The value of the entry ``(stamp, value, event)`` stamped latest at or before ``stamp`` (``None``: none)."""
+def value_at(entries: Any, stamp: float) -> Any:
+    """The value of the entry ``(stamp, value, ...)`` stamped latest at or before ``stamp`` (``None``: none):
+    the value an input had at ``stamp`` (its messages' stamps and values, in any order), for the verdict
+    engine and the deadline monitor alike."""
     best = None
     for e in entries:
         if e[0] <= stamp and (best is None or e[0] >= best[0]):
@@ -382,4 +403,4 @@ def _at(entries: Any, stamp: float) -> Any:
     return None if best is None else best[1]
 
 
-__all__ = ["WITHDRAWN", "Late"]
+__all__ = ["WITHDRAWN", "Late", "value_at"]
