@@ -10,7 +10,8 @@ runs of windowed formulas (``G[0,2]``, until) and of two pointwise bounds
 (one with an inexact literal, whose violations are false in exact and
 double arithmetic), a third to a half of the answers
 violated, now and then an answer missing, late or unreadable, skew 0 and
-20 ms, margins on and off, chunks of 5 events up, the batch path's result
+20 ms, margins on and off, chunks of 5 events up, now and then a message heard
+later than the lateness bound (``late_s``), the batch path's result
 (counts, every record, the smallest margins) equals the streaming engine's
 and the violated pairs are not streamed.  Controls: records worded without
 the arithmetics that agreed, and records rendering the values of the
@@ -19,7 +20,7 @@ answer to the double reading, which enumerates no ``<lo upto hi>``, is
 ``inconclusive`` for the engine: those answers stay the engine's.  With a declared tolerance a surely false
 answer may hold within it: such a node's violations stay the engine's,
 and the result is the engine's; the control, the batch path counting them
-violated as it did, is caught.
+violated as it did, is caught; so is a batch path ignoring a row's lateness.
 """
 from __future__ import annotations
 
@@ -29,6 +30,7 @@ from typing import Any
 
 import pytest
 
+from _late import heard_late
 from rclverify.backends.monitors import batch as batch_module
 from rclverify.backends.monitors import batch_violations
 from rclverify.backends.monitors.answered import AnsweredRun
@@ -135,6 +137,8 @@ def test_records_written_in_batch_are_the_engines(node: str) -> None:
         odd = (0.0, 0.04)[case // 2 % 2]
         chunk = (rnd.choice([64, 700, 65536]), 5)[case // 4]  # (5: runs of two pairs, fed to the engine whole)
         events = _run(rnd, node, 900, odd)
+        if odd:  # now and then a message heard later than the lateness bound: its pair is the engine's
+            events = heard_late(events, random.Random(f"late-{node}-{case}"), 0.02)
         s, b, stats = _both(node, events, skew, margins, chunk)
         where = f"case {case}: skew {skew}, margins {margins}, odd {odd}, chunk {chunk}"
         assert s.counts["violated"] > KEPT_VIOLATIONS + 50, where  # past the kept records
@@ -160,6 +164,17 @@ def test_a_window_the_double_reading_cannot_enumerate_stays_the_engines() -> Non
     s, b, stats = _both("F", events, 0.0, True, 65536)
     assert s.counts["violated"] == 0 and s.counts["inconclusive"] > 100
     assert b == s and 200 < stats["streamed"] < len(events) / 2
+
+
+def test_control_a_batch_path_ignoring_lateness_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Control: with each row's lateness ignored (batch_late.py), a surely violated answer to a question heard
+    late is counted ``violated`` in batch, where the engine says ``inconclusive``."""
+    events = heard_late(_run(random.Random("violations-late"), "B", 700, 0.0), random.Random("late-B"), 0.02)
+    s, b, _ = _both("B", events, 0.0, False, 65536)
+    assert b == s and s.counts["inconclusive"] > 0
+    monkeypatch.setattr(batch_module, "own_times", lambda chunk: None)
+    _, wrong, _ = _both("B", events, 0.0, False, 65536)
+    assert wrong.counts["violated"] > s.counts["violated"] and wrong != s
 
 
 def test_control_records_worded_without_the_arithmetics_are_caught(monkeypatch: pytest.MonkeyPatch) -> None:
