@@ -163,3 +163,36 @@ def test_the_seeded_defect_inputs_read_as_heard_make_live_differ(tmp_path: Path,
     live, _ = _live(ws, LATE)
     found = {(d.item, d.topic, round(d.time, 6)) for d in compare(finals(live), finals(offline))}
     assert found == {("deadline", "(guarantee 1)", 1.0), ("guarantee", "c", 1.1)}, found
+
+
+COMPLETE = [_msg("c", 0.95, data=3.0), _msg("x", 1.00, data=0.5), _msg("low", 1.05, data=True),
+            _msg("c", 2.50, data=3.0)]
+#: the trigger heard 0.3 s late, after its answer
+COMPLETE_LATE = [(0.95, COMPLETE[0]), (1.06, COMPLETE[2]), (1.30, COMPLETE[1]), (2.50, COMPLETE[3])]
+
+
+@pytest.mark.parametrize("defect", [False, True])
+def test_a_late_first_trigger_with_every_input_at_its_stamp_gets_its_deadline_and_its_answer(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, defect: bool) -> None:
+    """The other control: c stamped 0.95 s, before the trigger, heard in time; the trigger (x = 0.5) heard
+    0.3 s late, after its answer stamped 1.05 s (true).  Every input has a value at its stamp: a question,
+    its deadline ``true`` and its answer ``satisfied``, live as in stamp order (the inputs at its stamp
+    come from the messages before the first question; the answer, ``unasked`` when judged, is judged
+    against the late question when it is placed).  The seeded defect: the answer's ``unasked`` forgotten,
+    so the late question's revision finds no verdict to replace and gives none: live differs on it."""
+    ws, log = _workspace(tmp_path)
+    log.write_text("".join(json.dumps(x) + "\n" for x in COMPLETE))
+    offline = _offline(ws, log)
+    got = _by_message(offline)
+    assert got[("deadline", "", 1.0)] == "true" and got[("guarantee", "low", 1.05)] == "satisfied", got
+    if defect:
+        answers_late = Late._answers_late
+
+        def forgetting(self: Any, *args: Any) -> None:
+            self._unasked.clear()
+            answers_late(self, *args)
+        monkeypatch.setattr(Late, "_answers_late", forgetting)
+    live, late = _live(ws, COMPLETE_LATE)
+    assert late == 1
+    found = [(d.item, d.topic, round(d.time, 6)) for d in compare(finals(live), finals(offline))]
+    assert found == ([("guarantee", "low", 1.05)] if defect else []), found

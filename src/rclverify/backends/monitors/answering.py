@@ -140,6 +140,7 @@ class Answering(ContractReading, Judging, Closing, Late):
             self._question_outcome(x, ev, ks, outs, state or {}, False) for x in others]
         if first is not None and first.kind == "unasked" and not others and ks:
             self.result.unasked += 1
+            self._unasked.append(ev.index)  # a question heard late may still be the one it answers (late.py)
         outcome = combine(alone, readings)
         question = q if q is not None else (others[0] if others else None)
         qwhere = question.event.where if question is not None else ""

@@ -112,6 +112,9 @@ class NodeMonitor(Answering):
         #: outputs held for the skew and judged since, kept as ``_recent`` keeps those judged at once (late.py)
         self._released: deque[Recent] = deque(maxlen=64)
         self._given: deque[tuple[int, str, str]] = deque(maxlen=256)  # (event, verdict, semantics): late.py
+        #: the outputs counted ``unasked`` (no question at their stamp when judged), the last 64: an input heard
+        #: late and stamped before one makes it an answer, judged then (late.py, ``_answers_late``)
+        self._unasked: deque[int] = deque(maxlen=64)
         #: event index -> how far after its stamp (s) a question may be the one an output answers, where that is
         #: beyond the skew: published that long after its stamp (a stamp copied from an earlier question)
         self._wins: dict[int, float] = {}

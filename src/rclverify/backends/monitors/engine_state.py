@@ -64,6 +64,7 @@ class EngineState:
     _held: deque[tuple[Any, ...]]
     _released: deque[Recent]
     _given: deque[tuple[int, str, str]]
+    _unasked: deque[int]
     _wins: dict[int, float]
     _late_in: dict[str, Event]
     _late_q: dict[int, Event]

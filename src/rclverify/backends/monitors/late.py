@@ -18,7 +18,9 @@ input at its stamp:
 * the outputs already judged (the 64 the engine remembers) stamped after it
   and before the next question are **its answer**: judged again against it,
   a ``violated`` (or ``inconclusive``) verdict follows where it is false (or
-  undecided), named as the question heard late;
+  undecided), named as the question heard late; one counted ``unasked`` (no
+  question at its stamp when judged: before a late first question) gets its
+  verdict then, ``satisfied`` too, and leaves the ``unasked`` count;
 * a later question whose inputs lacked this message's values (it changes an
   input that question read, before the next message of its topic) takes
   them, and the outputs judged against it are judged again on them (a
@@ -306,6 +308,10 @@ class Late(EngineState):
         judged again against it; a false or undecided reading is a verdict of its own."""
         if not q.owed:
             return
+        unasked = out_ev.index in self._unasked  # no question when it was judged: this is its first verdict
+        if unasked:
+            self._unasked.remove(out_ev.index)
+            self.result.unasked -= 1
         q.answered = True
         q.last_out = out_ev
         q.answer.update(outs)
@@ -313,12 +319,13 @@ class Late(EngineState):
         got = self._question_outcome(q, out_ev, self._touch[out_ev.topic][0], q.answer, dict(state or {}))
         why = (f"; the question in force at its stamp is the one at {ev.where}, heard after it but stamped before it "
                f"({q.stamp:.9g} s against {out_ev.stamped:.9g} s): the log's order is not the stamps'")
-        self._late_verdict(out_ev, ev, got, why)
+        self._late_verdict(out_ev, ev, got, why, unasked)
 
-    def _late_verdict(self, out_ev: Event, qe: Event, got: Any, why: str) -> None:
+    def _late_verdict(self, out_ev: Event, qe: Event, got: Any, why: str, unasked: bool = False) -> None:
         """The verdict that replaces the one given to ``out_ev`` (:meth:`_withdrawn`): judged
         again against the question raised by ``qe``, false (``violated``), undecided
-        (``inconclusive``) or true (``satisfied``, where the one given was not)."""
+        (``inconclusive``) or true (``satisfied``, where the one given was not, or where none was:
+        ``unasked``, no question at its stamp when it was judged, as before a late first trigger)."""
         if got.kind == "violated":
             k = got.guarantee
             self._violation(out_ev, k, got.values, f"guarantee {k} is false on the output at {out_ev.where} answering "
@@ -327,7 +334,8 @@ class Late(EngineState):
         elif got.kind == "inconclusive":
             self._verdict("inconclusive", out_ev, guarantee=got.guarantee,
                           reason=got.reason + why + self._withdrawn(out_ev), question=qe.where)
-        elif got.kind == "satisfied" and (given := self._given_to(out_ev)) is not None and given[1] != "satisfied":
+        elif got.kind == "satisfied" and (unasked or (
+                (given := self._given_to(out_ev)) is not None and given[1] != "satisfied")):
             self._verdict("satisfied", out_ev, semantics=got.semantics, question=qe.where,
                           reason=f"the output at {out_ev.where} answers the question at {qe.where}" + why
                           + self._withdrawn(out_ev))
