@@ -68,7 +68,7 @@ def _write(path: Path, lines: list[dict[str, Any]]) -> Path:
     return path
 
 
-def _live(ws: Path, lines: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
+def _live(ws: Path, lines: list[dict[str, Any]], node: str = "Alarm") -> tuple[list[str], list[dict[str, Any]]]:
     """The live engine fed ``lines`` 1 ms after publication: its lines naming writers in another clock,
     and what its log holds (runtime/live.py, ``_event``)."""
     checked = load([ws / "contracts" / "c.rcl"])
@@ -78,7 +78,7 @@ def _live(ws: Path, lines: list[dict[str, Any]]) -> tuple[list[str], list[dict[s
         late = {"late_s": round(ev.late, 6)} if ev.late else {}
         published = ev.source is not None and (late or ev.stamp == ev.time)
         log.append({"topic": ev.topic, "time": ev.source if published else ev.time, **late, **dict(ev.fields)})
-    eng = OnlineEngine(checked, [checked.nodes["Alarm"]], load_mapping(ws, "mapping.yaml").rules, 1.0,
+    eng = OnlineEngine(checked, [checked.nodes[node]], load_mapping(ws, "mapping.yaml").rules, 1.0,
                        reorder_window=0.05, on_event=event)
     now = lines[0]["time"]
     for line in lines:
@@ -90,11 +90,11 @@ def _live(ws: Path, lines: list[dict[str, Any]]) -> tuple[list[str], list[dict[s
     return eng.clock_lines(), log
 
 
-def _offline(ws: Path, run: Path) -> tuple[str, list[tuple[str, str]], list[dict[str, int]]]:
+def _offline(ws: Path, run: Path, node: str = "Alarm") -> tuple[str, list[tuple[str, str]], list[dict[str, int]]]:
     """The recorded path on ``run``: its note (how the run's clocks were read), each node and deadline
     status with its explanation, the deadline counts."""
     checked = load([ws / "contracts" / "c.rcl"])
-    got = recorded.check_recorded(checked, [checked.nodes["Alarm"]], load_mapping(ws, "mapping.yaml"), ws, str(run),
+    got = recorded.check_recorded(checked, [checked.nodes[node]], load_mapping(ws, "mapping.yaml"), ws, str(run),
                                   lambda w: None)
     return got.stamp_order, [got.verdict(r, str(run)) for r in got.results], [dict(d.counts) for d in got.deadlines]
 
@@ -175,3 +175,25 @@ def test_the_block_reader_hands_every_stamp_set_aside_to_the_watch(tmp_path: Pat
     assert blocks is not None
     assert sum(len(b) for b in blocks) == len(log)
     assert watch.named() == named, watch.named()
+
+
+def test_a_relay_copying_stamps_on_simulated_time_is_named_alike_live_in_the_log_and_in_the_bag(
+        tmp_path: Path) -> None:
+    """Both writers on a /clock at half the wall clock's rate (tests/backends/test_judge_writers.py): the
+    reading's stamps set aside in the log, the relay's copies carried to their readings' times with the
+    stamp it wrote set aside beside them; each writer named in the live engine's line, offsets included,
+    from the log as from the bag."""
+    import test_judge_writers as w
+    (tmp_path / "ws").mkdir()
+    ws = _workspace(tmp_path / "ws")
+    (ws / "contracts" / "c.rcl").write_text(w.COPY)
+    (ws / "mapping.yaml").write_text(w.COPY_MAPPING)
+    sent = w._on_simulated_time(w._copying_relay(0.45))
+    named, log = _live(ws, sent, "Relay")
+    assert [x.split(":")[0] for x in named] == ["/r", "/x"], named
+    assert all(ASIDE in x["header"] for x in log if x["topic"] == "r") and any(
+        "stamp" in x["header"] for x in log if x["topic"] == "r"), log[:4]
+    for name, lines in (("bag", sent), ("log", log)):
+        note, statuses, _ = _offline(ws, _write(tmp_path / f"{name}.jsonl", lines), "Relay")
+        assert [x for x in note.split("; ") if "another clock" in x] == named, (name, note)
+        assert [s for s, _ in statuses] == ["discharged"], (name, statuses)
