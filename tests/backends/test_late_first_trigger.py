@@ -10,7 +10,9 @@ question the node owes nothing.  Live (the online engine with its lateness bound
 fed what it releases, as ``runtime/live.py`` feeds it) the same verdicts, verdict by verdict, and the
 same run heard in stamp order gives them too.  The seeded defect: the deadline monitor reading a late
 trigger's inputs as heard (``in.c`` already set) and the ``incomplete input`` given to ``in.c`` when it
-was heard left standing: two verdicts differ, so the comparison judges something.
+was heard left standing: two verdicts differ, so the comparison judges something.  The same for an
+answer heard before the late first trigger, and for a later input heard late (its value not in force
+after a message stamped after it), each with its seeded defect.
 """
 from __future__ import annotations
 
@@ -196,3 +198,45 @@ def test_a_late_first_trigger_with_every_input_at_its_stamp_gets_its_deadline_an
     assert late == 1
     found = [(d.item, d.topic, round(d.time, 6)) for d in compare(finals(live), finals(offline))]
     assert found == ([("guarantee", "low", 1.05)] if defect else []), found
+
+
+#: a later input heard late (not the first): c = 3 stamped 1.00 s heard at 1.20 s, after c = 1 stamped 1.10 s;
+#: the trigger at 1.30 s (x = 5) reads c = 1 (in force at its stamp): its answer true meets its deadline
+LATER = [_msg("c", 0.90, data=3.0), _msg("x", 0.95, data=5.0), _msg("low", 0.97, data=False),
+         _msg("c", 1.00, data=3.0), _msg("c", 1.10, data=1.0), _msg("x", 1.30, data=5.0), _msg("low", 1.35, data=True),
+         _msg("c", 2.50, data=1.0)]
+
+
+class _Forgetful(dict[str, int]):
+    """The seeded defect's stamps of the inputs in force: none kept, so a message heard late sets its value."""
+
+    def get(self, key: str, default: Any = None) -> Any:
+        return default
+
+
+@pytest.mark.parametrize("defect", [False, True])
+def test_an_input_heard_late_leaves_the_value_stamped_after_it_in_force(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, defect: bool) -> None:
+    """c = 3 stamped 1.00 s, heard 0.2 s late after c = 1 stamped 1.10 s: read in stamp order the trigger at
+    1.30 s has c = 1, and its answer ``true`` meets the deadline; c's late message raises a question owed
+    nothing (the guarantee answers ``in.x``): no verdict of its own, as in order, not ``superseded``.  Live
+    gives the same verdicts.  The seeded defect: the deadline monitor lets the late message set c = 3 in
+    force, the trigger is judged on it and its deadline is ``false`` live."""
+    ws, log = _workspace(tmp_path)
+    log.write_text("".join(json.dumps(x) + "\n" for x in LATER))
+    offline = _offline(ws, log)
+    got = _by_message(offline)
+    assert got[("deadline", "", 1.3)] == "true" and ("guarantee", "c", 1.0) not in got, got
+    if defect:
+        init = DeadlineMonitor.__init__
+
+        def forgetful(self: Any, *args: Any, **kw: Any) -> None:
+            init(self, *args, **kw)
+            self.set_ns = _Forgetful()
+        monkeypatch.setattr(DeadlineMonitor, "__init__", forgetful)
+    heard = [(line["time"], line) for line in LATER]
+    heard[3] = (1.20, LATER[3])
+    live, late = _live(ws, heard)
+    assert late == 1
+    found = [(d.item, d.topic, round(d.time, 6)) for d in compare(finals(live), finals(offline))]
+    assert found == ([("deadline", "(guarantee 1)", 1.3)] if defect else []), found

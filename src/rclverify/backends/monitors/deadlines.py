@@ -118,6 +118,9 @@ class DeadlineMonitor(VerdictWords):
         #: before the first question: each input's values as its messages set them, (stamp ns, value), the
         #: last 64: a trigger heard late finds the inputs in force at its stamp there (:meth:`_inputs_at`)
         self.before_first: dict[str, deque[tuple[int, object]]] = {}
+        #: input -> the stamp (integer ns) of the message whose value is in force: one heard late and stamped
+        #: before it leaves that value in force (its own is read at its stamp, :meth:`_inputs_at`)
+        self.set_ns: dict[str, int] = {}
         #: keys whose latest message did not map (NaN, a missing field): key -> why; their stale value never
         #: stands in (docs/semantics.md, "Values")
         self.invalid: dict[str, str] = {}
@@ -169,6 +172,7 @@ class DeadlineMonitor(VerdictWords):
             self._advance_ns(ns)
             return
         changed: list[str] = []
+        own: dict[str, object] = {}  # an input's value set by this message heard late, not the one in force now
         for key, part in keys:
             fields = ev.fields.get(part) if part else ev.fields
             if not isinstance(fields, Mapping):
@@ -178,7 +182,13 @@ class DeadlineMonitor(VerdictWords):
             if typ is None:
                 continue
             try:
-                self.values[key] = map_value(typ, fields, rule_for(self.rules, ev.topic, key), self.values.get(key))
+                value = map_value(typ, fields, rule_for(self.rules, ev.topic, key), self.values.get(key))
+                if key.startswith("in.") and ns < self.set_ns.get(key, ns):  # a message stamped after it set it
+                    own[key] = value
+                else:
+                    self.values[key] = value
+                    if key.startswith("in."):
+                        self.set_ns[key] = ns
             except MappingError as exc:
                 # never the value before it: what reads this input is undecided until a message maps again
                 self.invalid[key] = f"{key}: the latest message at {ev.where} does not map ({exc})"
@@ -197,7 +207,7 @@ class DeadlineMonitor(VerdictWords):
         self._advance_ns(ns)
         if not any(c.startswith("in.") for c in changed):
             return
-        mine = {c: self.values[c] for c in changed if c.startswith("in.") and c not in self.invalid}
+        mine = {c: own.get(c, self.values[c]) for c in changed if c.startswith("in.") and c not in self.invalid}
         if self.stream.at(stamp) is None:
             for key, v in mine.items():
                 self.before_first.setdefault(key, deque(maxlen=64)).append((ns, v))

@@ -303,14 +303,22 @@ class NodeMonitor(Answering):
         if not owed:
             return
         self.result.accepted += 1
-        if self._trigger and self._asked and not self._alone and not any(self._owes(q, k) for k in self._asked):
-            self.result.unowed += 1  # every guarantee answers another input: nothing is owed to this question
-            q.settled = True
+        if self._unowed(q):
             return
         q.due = ev.time + self.horizon
         self._open, self._due = q, q.due
         if self._ask_at_question:
             self._at_question(q)
+
+    def _unowed(self, q: Question) -> bool:
+        """Whether every guarantee of the node is ``triggered by`` an input ``q`` does not carry: nothing
+        is owed to ``q`` (counted ``unowed``, settled: no verdict of its own, never ``superseded``).  The
+        rule of a question raised in order and of one placed at its stamp, heard late (late.py)."""
+        if self._trigger and self._asked and not self._alone and not any(self._owes(q, k) for k in self._asked):
+            self.result.unowed += 1
+            q.settled = True
+            return True
+        return False
 
     def _expire(self, now: float) -> None:
         """Close the watched question when its horizon passed before ``now``."""

@@ -168,7 +168,7 @@ class Late(EngineState):
         stream = self.stream
         owed, accepted, refusal = self._accept(ev, inputs)
         q = Question(ev, stamp, inputs, owed, accepted)
-        nxt = stream.after(stamp)
+        prev, nxt = stream.at(stamp), stream.after(stamp)
         if not nxt:
             self._raise(ev, q, trig, refusal)
             if self._open is q:  # its horizon runs from its stamp, however late it was heard (live: the clock)
@@ -185,6 +185,9 @@ class Late(EngineState):
         if not owed:
             return
         self.result.accepted += 1
+        # in stamp order it would carry what the question before it left unanswered: owed then, else maybe nothing
+        if not (prev is not None and any(t not in prev.answered_triggers for t in prev.triggers)) and self._unowed(q):
+            return
         q.reported = True  # only the latest question is watched for its horizon
         if not q.answered and not q.settled:
             gap = nxt[0].stamp - stamp
