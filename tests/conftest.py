@@ -59,7 +59,8 @@ LIVE = frozenset({
     "test_ros2_bag_calls", "test_ros2_event_time", "test_example_manipulator",
     "test_ros2_undefined_type", "test_ros2_call_endpoints", "test_ros2_declared_types", "test_nodl_live",
     "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair", "test_fleet_example_live",
-    "test_run_repair_rclpy", "test_ros2_run_end",
+    "test_run_repair_rclpy", "test_ros2_run_end", "test_ros2_thresholds_clocks_stamps",
+    "test_ros2_rclpy_discovers_nobody", "test_ros2_robots_other_clocks", "test_ros2_dds_server_restart",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -67,6 +68,7 @@ LIVE = frozenset({
 #: machine under a load of about 3.5, so a little high; the import of the module not counted).
 SECONDS: dict[str, float] = {
     "test_example_ros2_robot": 30.0,  # 12.5 CPU s, but its colcon build and live run wait: started early
+    "test_target_unread_field_copy": 2.0,
     "test_monitor_startup": 3.0,  # three monitor runs, two of them processes of their own (a cold start)
     "test_bench_smoke_live": 64.0, "test_pipeline_e2e": 112.0, "test_integrity": 24.8,
     "test_example_warehouse": 29.7, "test_bench_smoke": 48.0, "test_generate_names_ros2": 35.1,
@@ -157,6 +159,9 @@ WALL: dict[str, float] = {
     # three live runs of generated robots, about 20 s each on an idle machine (its live tests are marked in the
     # module; its other tests are the inner tier's): started early, not left to the end
     "test_robot_generator": 60.0,
+    # real rclpy robots through both sources; measured at -n 2 beside other work (load 12-16)
+    "test_ros2_robots_other_clocks": 120.0, "test_ros2_thresholds_clocks_stamps": 50.0,
+    "test_ros2_rclpy_discovers_nobody": 40.0, "test_ros2_dds_server_restart": 36.0,
 }
 
 #: Modules weighed by their wall-clock time (in :data:`WALL`) whose live tests are marked in the module
