@@ -109,9 +109,30 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
         _print_live(log, record_)
         if getattr(args, "verdicts", None):  # the log's verdict lines, as a recorded run's are written
             write_records(Path(args.verdicts), log_records(log))
-        return _live_exit(args, record_)
+        return _ended(_live_exit(args, record_))  # everything written: the process ends within a bound
     finally:
         stop.close()  # the stop request's pipe given back (an in-process caller runs many)
+
+
+
+def _ended(code: int) -> int:
+    """``code``, once the command line's own process (:func:`_command_line`) is set to end within
+    :data:`~rclverify.runtime.stopping.EXIT_BOUND_S` whatever a library left behind (``end_bounded``;
+    docs/monitors.md, "Stopping"); an in-process caller's process is left as it is."""
+    if _command_line():
+        from rclverify.runtime.stopping import end_bounded  # deferred: start-up (only live)
+        end_bounded(code)
+    return code
+
+
+def _command_line() -> bool:
+    """Whether this process is the ``rclverify`` command line (its console script, which runs
+    :func:`rclverify.cli.main`, or ``python -m rclverify.cli.commands``), not a program running the
+    command in its own process (a test's ``main([...])``), whose process goes on after it."""
+    from rclverify.cli import main as console  # deferred: start-up (only live)
+    top = sys.modules.get("__main__")
+    spec = getattr(top, "__spec__", None)
+    return str(getattr(spec, "name", "") or "").split(".")[0] == "rclverify" or getattr(top, "main", None) is console
 
 
 
