@@ -179,6 +179,10 @@ def _read(log: str, decode: Any, take: Any) -> None:
 
 def main(argv: Sequence[str]) -> int:
     import json
+    if len(argv) != 4 or argv[0] in ("-h", "--help"):
+        print(f"usage: python bench/_peer_read.py PEER SPEC_JSON LOG OUT (PEER one of {', '.join(sorted(RUNS))}): "
+              "a peer as a program of its own reading the log, run by bench/_window_peers.py")
+        return 0 if argv[:1] in (["-h"], ["--help"]) else 2
     peer, spec, log, out = argv
     f = _Formula(json.loads(spec))
     cols, n = read_log(log, f)

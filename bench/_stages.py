@@ -31,6 +31,12 @@ from pathlib import Path
 from typing import Any
 
 if __name__ == "__main__":  # the monitor's own command line after OUT.json
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import _venv  # noqa: F401  (the project's environment: rclverify's dependencies)
+    if len(sys.argv) < 3 or sys.argv[1] in ("-h", "--help"):
+        print("usage: python bench/_stages.py OUT.json monitor --live --ros2 [the monitor's options]\n\n"
+              + (__doc__ or "").split("\n\n")[0])
+        sys.exit(0 if sys.argv[1:2] in (["-h"], ["--help"]) else 2)
     out, argv = Path(sys.argv[1]), sys.argv[2:]
     ROOT = Path(__file__).resolve().parents[1]
     sys.path.insert(0, str(ROOT / "src"))

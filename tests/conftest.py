@@ -70,6 +70,7 @@ LIVE = frozenset({
 SECONDS: dict[str, float] = {
     "test_example_ros2_robot": 30.0,  # 12.5 CPU s, but its colcon build and live run wait: started early
     "test_target_unread_field_copy": 2.0,
+    "test_bench_help": 7.0,  # every bench started once with --help, a process each
     "test_monitor_startup": 3.0,  # three monitor runs, two of them processes of their own (a cold start)
     "test_bench_smoke_live": 64.0, "test_pipeline_e2e": 112.0, "test_integrity": 24.8,
     "test_example_warehouse": 29.7, "test_bench_smoke": 48.0, "test_generate_names_ros2": 35.1,
