@@ -41,10 +41,7 @@ def violated_semantics(m: NodeMonitor) -> str:
 
 def room(m: NodeMonitor) -> int:
     """How many more violations ``m``'s result keeps as records (the rest are counted only: closing.py)."""
-    result = m.result
-    if result.first_violation is not None and len(result.violations) >= KEPT_VIOLATIONS:
-        return 0
-    return max(KEPT_VIOLATIONS - len(result.violations), 0)
+    return max(KEPT_VIOLATIONS - len(m.result.violations), 0)
 
 
 def add_records(run: Any, chunk: EventRows | BlockRows, at: np.ndarray, src: dict[str, np.ndarray],
