@@ -143,7 +143,7 @@ class Late(EngineState):
         :data:`WITHDRAWN` verdict on ``e`` follows it), so ``e`` keeps only what its question gives, as
         in the run read in stamp order, where it was never incomplete (docs/semantics.md, "Event time")."""
         given = self._given
-        i = next((i for i in range(len(given) - 1, -1, -1) if given[i][0] == e.index), None)
+        i = self._last_given(e.index)
         if i is None or given[i][1] != "incomplete input":
             return
         del given[i]
@@ -347,10 +347,13 @@ class Late(EngineState):
         """Where in ``_given`` the verdict last given to ``out_ev`` is, its kind and semantics, when a
         revision may withdraw it (``None``: none held)."""
         given = self._given
-        for i in range(len(given) - 1, -1, -1):
-            if given[i][0] == out_ev.index:
-                return (i, given[i][1], given[i][2]) if given[i][1] in _REVISABLE else None
-        return None
+        i = self._last_given(out_ev.index)
+        return None if i is None or given[i][1] not in _REVISABLE else (i, given[i][1], given[i][2])
+
+    def _last_given(self, index: int) -> int | None:
+        """Where in ``_given`` the verdict last given to event ``index`` is (``None``: none held)."""
+        given = self._given
+        return next((i for i in range(len(given) - 1, -1, -1) if given[i][0] == index), None)
 
     def _withdrawn(self, out_ev: Event) -> str:
         """Withdraw the verdict last given to ``out_ev`` (module docstring), just
