@@ -197,3 +197,25 @@ def test_a_relay_copying_stamps_on_simulated_time_is_named_alike_live_in_the_log
         note, statuses, _ = _offline(ws, _write(tmp_path / f"{name}.jsonl", lines), "Relay")
         assert [x for x in note.split("; ") if "another clock" in x] == named, (name, note)
         assert [s for s, _ in statuses] == ["discharged"], (name, statuses)
+
+
+def test_a_writer_seen_before_the_first_stamp_set_aside_keeps_its_messages_in_the_line() -> None:
+    """A writer in another clock whose messages come with their header stamps before any message with a
+    stamp set aside is named with all of them: the stamps set aside add to what the header stamps measured
+    (3 of 3 for the first writer, 2 of 2 for the second).  The control: counted from the first stamp set
+    aside alone, the first writer's line would be missing."""
+    from rclverify.backends.monitors.stamp_order import StampWatch
+    from rclverify.traces.events import Event
+
+    def stamp(s: float) -> dict[str, Any]:
+        return {"secs": int(s), "nsecs": round((s - int(s)) * 1e9)}
+
+    watch = StampWatch(0.0)
+    for i in range(3):  # a driver stamping 2 s ahead, its stamps read as the header's
+        watch.see(Event(i, 1.0 + i, "pkg/Reading", {"header": {"stamp": stamp(3.0 + i)}}, f"line {i + 1}"))
+    for i in range(2):  # another, its stamps set aside by a live log
+        watch.see(Event(3 + i, 4.0 + i, "pkg/Other", {"header": {ASIDE: stamp(7.0 + i)}}, f"line {i + 4}"))
+    named = watch.named()
+    assert len(named) == 2, named
+    assert "pkg/Reading" in named[0] + named[1] and "pkg/Other" in named[0] + named[1], named
+    assert any("(3 of 3 stamped" in n for n in named) and any("(2 of 2 stamped" in n for n in named), named

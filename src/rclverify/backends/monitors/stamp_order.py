@@ -102,8 +102,9 @@ class StampWatch:
         #: the stamps in another clock seen, to place a copy of one at its question's time (traces/event_time.py)
         self.copies = CopiedStamps()
         #: per writer, the offset of the stamp it wrote (a stamp set aside in a live log, else the header stamp)
-        #: from its trace times: what the live run measured, whose lines name the writers (:meth:`named`)
-        self.writers = WriterClocks()
+        #: from its trace times: what the live run measured, whose lines name the writers (:meth:`named`);
+        #: ``None`` until a stamp set aside is seen (until then it would hold what :attr:`clocks` holds)
+        self.writers: WriterClocks | None = None
 
     def see(self, ev: Event) -> None:
         """Note event ``ev``'s place on the run's clock."""
@@ -113,10 +114,13 @@ class StampWatch:
         f = ev.fields
         # the stamp its writer wrote: set aside (looked for only where a header is: a line's keys are not walked)
         own = aside_stamp(f) if f and any(k in f for k in _ASIDE_KEYS) else None
-        if own is None:
-            own = s
-        if own is not None:
-            self.writers.see(ev.topic, own, ev.time)
+        writers = self.writers
+        if own is not None and writers is None:  # the first set aside: the header stamps seen so far go on
+            writers = self.writers = WriterClocks()
+            writers.offsets = {k: list(o) for k, o in self.clocks.offsets.items()}
+        wrote = s if own is None else own
+        if writers is not None and wrote is not None:
+            writers.see(ev.topic, wrote, ev.time)
         p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time)[0] if self.clocks.see(
             ev.topic, s, ev.time) else _own_or_copied(self.copies, ev.topic, s, ev.time)
         if p >= self.placed_latest:
@@ -171,7 +175,7 @@ class StampWatch:
         <rclverify.traces.event_time.WriterClocks.lines>`, the live record's
         and the bag's wording): measured from the stamps a live log set aside
         as well as from the header stamps; ``[]`` for a run in one clock."""
-        return self.writers.lines(True)
+        return (self.clocks if self.writers is None else self.writers).lines(True)
 
     def two_clocks(self) -> bool:
         """Whether the header stamps and the times of the messages without one
