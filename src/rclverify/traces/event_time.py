@@ -166,33 +166,62 @@ class CopiedStamps:
     answer is placed at the time its question was placed, its stamp carried
     into the run's clock there (:func:`with_stamp`), and judged, like a
     stale copied stamp in the run's clock, against that question and those
-    asked until it was published (docs/semantics.md, "Event time").
-    ``copied`` counts the messages so placed."""
+    asked until it was published (docs/semantics.md, "Event time").  A
+    clock standing still (a paused simulator) gives several messages of one
+    writer the same stamp: the k-th copy of that stamp by a writer names the
+    k-th of them published before it (a node answers its questions in the
+    order asked), never the first for all (generated seed 1069: a relay's
+    answer to the second reading of a paused clock was placed at the first,
+    leaving the second unanswered past its deadline).  ``copied`` counts the
+    messages so placed."""
 
-    __slots__ = ("_first", "copied")
+    __slots__ = ("_first", "_named", "copied")
+
+    #: the messages of one writer kept per stamp (a clock standing still that long is not followed further)
+    KEPT = 1000
 
     def __init__(self) -> None:
-        self._first: dict[float, tuple[str, float]] = {}
+        #: per stamp, its first writer and the source times (s) of that writer's messages so stamped, in order
+        self._first: dict[float, tuple[str, list[float]]] = {}
+        #: per stamp, how many copies of it each other writer sent
+        self._named: dict[float, dict[str, int]] = {}
         self.copied = 0
+
+    def _name(self, topic: str, stamp: float, source: float) -> float | None:
+        """The source time (s) of the message of another writer that a
+        message of ``topic`` stamped ``stamp`` and published at ``source``
+        (s) copies the stamp of (class docstring), counted; else ``None``."""
+        got = self._first.get(stamp)
+        if got is None or got[0] == topic or not 0.0 <= source - got[1][0] <= COPY_S:
+            return None
+        before = [t for t in got[1] if t <= source]
+        named = self._named.setdefault(stamp, {})
+        k = named.get(topic, 0)
+        named[topic] = k + 1
+        self.copied += 1
+        return before[min(k, len(before) - 1)]
 
     def place(self, topic: str, stamp: float, source: float) -> tuple[float, bool]:
         """``(time, copied)``: the time (s, the run's clock) a message of
         ``topic`` with header stamp ``stamp`` (s, another clock) and source
-        time ``source`` (s) is placed at, the source time of the first message
-        of another writer stamped ``stamp`` within :data:`COPY_S` before it
-        (``copied`` true), else ``source``."""
+        time ``source`` (s) is placed at, the source time of the message of
+        another writer stamped ``stamp`` within :data:`COPY_S` before it that
+        it names (class docstring; ``copied`` true), else ``source``."""
+        named = self._name(topic, stamp, source)
+        if named is not None:
+            return named, True
         first = self._first
         got = first.get(stamp)
-        if got is not None and got[0] != topic and 0.0 <= source - got[1] <= COPY_S:
-            self.copied += 1
-            return got[1], True
         if got is None:
-            first[stamp] = (topic, source)
+            first[stamp] = (topic, [source])
             while first:  # stamps too old to be copied any more are forgotten (insertion order: oldest first)
                 k = next(iter(first))
-                if first[k][1] >= source - COPY_S:
+                if first[k][1][0] >= source - COPY_S:
                     break
                 del first[k]
+                self._named.pop(k, None)
+        elif got[0] == topic and len(got[1]) < self.KEPT:
+            got[1].append(source)
         return source, False
 
     def copy_of(self, topic: str, stamp: float, source: float) -> float | None:
@@ -203,13 +232,10 @@ class CopiedStamps:
         :data:`COPY_S` before it: that message's source time (a relay copying
         a driver's stamp 0.3 s ahead and publishing 0.22 s later carries a
         stamp only 0.08 s ahead of its own publication, within the bounds, yet
-        copied from its question); ``None`` when it copies none (its stamp
+        copied from its question; the k-th such copy names the k-th message so
+        stamped, as :meth:`place`); ``None`` when it copies none (its stamp
         stands).  Counted in ``copied``."""
-        got = self._first.get(stamp)
-        if got is not None and got[0] != topic and 0.0 <= source - got[1] <= COPY_S:
-            self.copied += 1
-            return got[1]
-        return None
+        return self._name(topic, stamp, source)
 
 
 class WriterClocks:
