@@ -10,7 +10,8 @@ clock it would hold), and at a factor of 0.5 a gap of 600 ms of the wall clock (
 keeps a period of 400 ms (judged on the wall clock it would be a false red).  The run is judged as a
 bag gives it (the raw simulated stamps) and as the live monitor logs it (the stamps set aside), alike;
 a driver stamping 2 s behind (rate 1) keeps its period, and a run going on past a period of the
-node's clock after its last message breaks it."""
+node's clock after its last message, carried at its measured rate, is not judged unless a later stamp
+of its clock shows it (backends/monitors/periods.py: the clock may have slowed or paused)."""
 from __future__ import annotations
 
 import json
@@ -109,7 +110,9 @@ REGULAR = [0.25] * 30
     (REGULAR[:10] + [0.55] + REGULAR[10:], 2.0, 100.0, 800, 0.2, "false", "a gap of 1100 ms"),
     ([0.25, 0.6] * 12, 0.5, 5000.0, 400, 0.2, "true", "no gap over 400 ms"),
     ([0.25, 0.9] * 12, 0.5, 5000.0, 400, 0.2, "false", "a gap of 450 ms"),
-    (REGULAR, 2.0, 0.0, 800, 0.5, "false", "until the run's end, over the period of 800 ms"),
+    # no later stamp of its clock shows it got past the period: it may have slowed or paused (false with one:
+    # tests/backends/test_periods_clock_rate_change.py)
+    (REGULAR, 2.0, 0.0, 800, 0.5, "inconclusive", "it may have slowed or paused"),
     (REGULAR, 2.0, 0.0, 800, 0.3, "true", "no gap over 800 ms"),
 ], ids=["x2 regular", "x2 skip (wall 550 ms)", "x0.5 600 ms of the wall", "x0.5 900 ms of the wall",
         "x2 stops 500 ms before the end", "x2 stops 300 ms before the end"])

@@ -90,6 +90,11 @@ def _period_verdict(res: PeriodResult | None, key: str) -> tuple[str, str]:
                                 if key not in res.unrated else
                                 "a single message stamped in another clock: too short to show a gap, and its "
                                 "clock's rate unknown, so the run's end was not carried into it")
+    if key in res.unrated:
+        return "inconclusive", (f"{n} messages, no gap over {res.periods[key] * 1000:.0f} ms{clock}, but the run "
+                                "goes on past the period after the last at that rate and no later stamp of its "
+                                "simulated clock shows the clock got there: it may have slowed or paused, so the "
+                                "run's end was not carried into it")
     return "true", f"{n} messages, no gap over {res.periods[key] * 1000:.0f} ms{clock}"
 
 

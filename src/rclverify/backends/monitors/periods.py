@@ -33,6 +33,25 @@ of such an output the rate is unknown and the tail is not judged
 (:attr:`PeriodResult.unrated`).  A message without a stamp carries no clock
 but the run's, in which it is judged.
 
+**A simulated clock may change its rate or pause.**  Stamps more than
+:data:`SIMULATED_S` from their source times are simulated time (a ``/clock``
+from 0 s), whose real-time factor changes mid-run and which stops while the
+simulator is paused; its factor after the output's last message is not
+measured by anything the output carries.  The latest stamp of that clock
+heard after the output's last message (a stamp set aside, of any writer, no
+further ahead of the output's last stamp than :data:`AHEAD_FACTOR` times its
+measured rate since, and 1 s: the same clock, not another writer's far
+ahead) is where the clock is known to have got: more than the period past
+the output's last stamp is ``false``; else the tail is that stamp's lead and
+the rest of the run carried at the measured rate, and a tail so carried over
+the period is not judged (:attr:`PeriodResult.unrated`, ``inconclusive``):
+the clock may have slowed or paused after the last message (a real-time
+factor falling from 2 to 0.5 carries a 0.45 s tail of the node's clock as
+1.8 s; a clock paused for 1.5 s after it carries none as 1.5 s at a factor
+of 1).  A driver's offset (a
+clock within :data:`SIMULATED_S` of the run's) runs at the wall clock's
+rate and is judged at its measured rate as before.
+
 A period in steps (``periodic( out.y, 3 steps )``), ``progress( ... )``
 and ``initially( ... )`` are judged on the same run by :mod:`.declarations`
 (a step of the node there is one of its input events), which also turns
@@ -56,6 +75,12 @@ from rclverify.backends.monitors.shapes import PeriodGapJson, PeriodResultJson, 
 
 #: The slack of a gap against its period (s): the resolution of an epoch stamp read as a float.
 TOLERANCE_S = 1e-6
+#: a stamp set aside more than this (s) from its source time is simulated time (a clock that may change its
+#: rate or pause), one nearer a clock offset from the run's (a driver's), which keeps the wall clock's rate
+SIMULATED_S = 86_400.0
+#: a later stamp is of an output's simulated clock only if no further past its last stamp than this many times
+#: the time since, at the output's measured rate (and 1 s): beyond, it is taken for another clock
+AHEAD_FACTOR = 2.0
 
 
 @dataclass
@@ -67,7 +92,9 @@ class PeriodResult:
     gaps in the node's clock (module docstring); ``clocks``: per output whose
     stamps were set aside in another clock, its rate against the run's clock
     (node s per run s); ``unrated``: such outputs with one message, whose
-    tail was not judged."""
+    tail was not judged, and outputs in simulated time whose tail is over
+    the period at the measured rate but shown by no later stamp of their
+    clock (module docstring)."""
 
     node: str
     periods: dict[str, float] = field(default_factory=dict)
@@ -113,6 +140,10 @@ class PeriodMonitor:
         self.last: dict[str, tuple[float, str, float]] = {}
         #: per output whose stamps were set aside, its first message's (node's stamp, run's time)
         self.first_aside: dict[str, tuple[float, float]] = {}
+        #: per output in simulated time: its last stamp, where it was placed (run's time), its rate measured
+        #: until then (None: its first message), the largest stamp of its clock heard after it and where
+        #: that was placed (s)
+        self.after: dict[str, tuple[float, float, float | None, float, float]] = {}
 
     def feed(self, ev: Event) -> None:
         res = self.result
@@ -120,6 +151,8 @@ class PeriodMonitor:
         res.end = at if res.end is None else max(res.end, at)
         outs = self.topics.get(ev.topic.lstrip("/"))
         if not outs:
+            if self.after and ev.fields:
+                self._later(ev, at)
             return
         own = aside_stamp(ev.fields) if ev.fields else None
         stamp = at if own is None else own
@@ -127,11 +160,34 @@ class PeriodMonitor:
             res.messages[key] = res.messages.get(key, 0) + 1
             if own is not None:
                 self.first_aside.setdefault(key, (own, at))
+                if abs(own - at) > SIMULATED_S:
+                    s0, t0 = self.first_aside[key]
+                    self.after[key] = (own, at, (own - s0) / (at - t0) if at > t0 else None, own, at)
             before = self.last.get(key)
             if before is not None and key not in res.late and stamp - before[0] > res.periods[key] + TOLERANCE_S:
                 res.late[key] = {"from": before[0], "to": stamp, "gap": stamp - before[0],
                                  "period": res.periods[key], "where": ev.where}
             self.last[key] = (stamp, ev.where, at)
+
+    def _later(self, ev: Event, at: float) -> None:
+        """Note a stamp set aside in another writer's message placed at ``at``
+        (s) for each output in simulated time it may show the clock of: the
+        latest heard at or past the largest so far (a clock standing still,
+        paused, is heard standing still until then)."""
+        s = aside_stamp(ev.fields)
+        if s is None:
+            return
+        for key, (last, was, rate, seen, _) in self.after.items():
+            if seen <= s <= last + AHEAD_FACTOR * (rate or 0.0) * max(at - was, 0.0) + 1.0:
+                self.after[key] = (last, was, rate, s, at)
+
+    def _tail(self, key: str, end: float, rate: float) -> tuple[float, bool]:
+        """``(tail, shown)``: output ``key``'s tail in its simulated clock,
+        carried to the run's ``end`` (s) at ``rate`` from the latest stamp of
+        that clock heard after its last message (its own last stamp if none),
+        and whether that stamp alone passes the period (module docstring)."""
+        last, _, _, seen, seen_at = self.after[key]
+        return (seen - last) + (end - seen_at) * rate, seen - last > self.result.periods[key] + TOLERANCE_S
 
     def finish(self) -> PeriodResult:
         res = self.result
@@ -146,6 +202,11 @@ class PeriodMonitor:
                     continue
                 res.clocks[key] = rate = (stamp - s0) / (at - t0)
                 tail = (res.end - at) * rate
+                if key in self.after:
+                    tail, shown = self._tail(key, res.end, rate)
+                    if tail > res.periods[key] + TOLERANCE_S and not shown:
+                        res.unrated.append(key)
+                        continue
             if tail > res.periods[key] + TOLERANCE_S:
                 res.late[key] = {"from": stamp, "to": None, "gap": tail, "period": res.periods[key],
                                  "where": where}
@@ -164,7 +225,9 @@ def check_periods(node: CheckedNode, events: Iterable[Event]) -> PeriodResult:
 def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
     """Evidence status and explanation of one node's periods on a run: a gap
     longer than a period -> ``failed`` (named with its stamps); no message
-    of some periodic output -> ``pending``; else ``discharged``."""
+    of some periodic output -> ``pending``; a tail in simulated time not
+    judged (:attr:`PeriodResult.unrated`, more than one message) ->
+    ``inconclusive``; else ``discharged``."""
     for key, g in res.late.items():
         after = (f"the next at {g['to']:.3f} s ({g['where']})" if g["to"] is not None
                  else f"none after it although {trace} goes on to {res.end:.3f} s")
@@ -173,6 +236,11 @@ def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
     silent = [k for k in res.periods if not res.messages.get(k)]
     if silent:
         return "pending", f"{trace} has no message of {', '.join(f'{res.node}.{k}' for k in silent)}: its period was not checked"
+    open_ = [k for k in res.unrated if res.messages.get(k, 0) > 1]
+    if open_:
+        return "inconclusive", (f"{', '.join(f'{res.node}.{k}' for k in open_)}: no gap over its period, but {trace} "
+                                "goes on past it after the last message at the measured rate of its simulated clock, "
+                                "which no later stamp shows: the clock may have slowed or paused (not judged)")
     return "discharged", ", ".join(f"{res.node}.{k}: {res.messages[k]} messages, no gap over {_ms(res.periods[k])}"
                                    for k in res.periods)
 
@@ -180,11 +248,15 @@ def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
 def with_periods(res: PeriodResult, trace: str, status: str, explanation: str) -> tuple[str, str, PeriodsPart]:
     """The monitor's verdict combined with the node's periods on the same run
     (``res``, :class:`PeriodMonitor`): a failed period fails the evidence,
-    otherwise the verdict stands (a period that saw no message adds a note).
-    Returns ``(status, explanation, {"periods": ...})``."""
+    otherwise the verdict stands (a period that saw no message adds a note), but
+    a discharged one is ``inconclusive`` beside a period whose tail could not
+    be judged (:func:`period_status`).  Returns ``(status, explanation,
+    {"periods": ...})``."""
     pstatus, pexpl = period_status(res, trace)
     if pstatus == "failed":
         return "failed", f"periods: {pexpl}; {explanation}", {"periods": res.to_json()}
+    if pstatus == "inconclusive" and status == "discharged":
+        return "inconclusive", f"{explanation}; periods: {pexpl}", {"periods": res.to_json()}
     return status, f"{explanation}; periods: {pexpl}", {"periods": res.to_json()}
 
 
