@@ -55,16 +55,16 @@ if __name__ == "__main__":  # the monitor's own command line after OUT.json
 
     offer0 = _worker.EngineWorker.offer
 
-    def offer(self: Any, topic: str, payload: Any, received: float) -> None:
+    def offer(self: Any, topic: str, payload: Any, received: float, writer: Any = None) -> None:
         offered.setdefault(topic, []).append(now())
-        offer0(self, topic, payload, received)
+        offer0(self, topic, payload, received, writer)
     _worker.EngineWorker.offer = offer  # type: ignore[method-assign]
 
     push0 = _live.LiveRun.push
 
-    def push(self: Any, topic: str, fields: Any, received: float) -> None:
+    def push(self: Any, topic: str, fields: Any, received: float, writer: Any = None) -> None:
         pushed.setdefault(topic.lstrip("/"), []).append(now())
-        push0(self, topic, fields, received)
+        push0(self, topic, fields, received, writer)
     _live.LiveRun.push = push  # type: ignore[method-assign]
 
     event0 = _live.LiveRun._event

@@ -198,11 +198,19 @@ class LiveRun:
                                 "silent_for_s": round(seconds, 3), "time": note["time"]}))
 
     # -- input ---------------------------------------------------------------------
-    def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
-        """One message from the middleware (receipt time in seconds)."""
+    def push(self, topic: str, fields: Mapping[str, object], received: float,
+             writer: bytes | str | None = None) -> None:
+        """One message from the middleware (its event time in seconds; its
+        ``writer``'s id where the source names it: :meth:`OnlineEngine.push`)."""
         with self.lock:
             if self.results is None:
-                self.engine.push(topic, fields, received)
+                self.engine.push(topic, fields, received, writer=writer)
+
+    def match(self, sets: Mapping[str, Iterable[bytes | str]]) -> None:
+        """The writers the source matches on each topic now (topic -> writer
+        ids): :meth:`OnlineEngine.match`, handed over without the lock (a
+        mapping replaced whole), from the source's discovery thread."""
+        self.engine.match(sets)
 
     def due(self) -> float:
         """When the next buffered message is released (s; :meth:`OnlineEngine.due`)."""

@@ -10,11 +10,12 @@ milliseconds with spikes of hundreds (docs/monitors.md, "Live monitoring",
 "Threads").  :class:`EngineWorker` decouples them:
 
 * :meth:`offer` (called from any callback) stamps nothing and evaluates
-  nothing: it appends ``(topic, payload, received)`` to a
+  nothing: it appends ``(topic, payload, received, writer)`` to a
   :class:`queue.SimpleQueue` (a C queue, no Python-level lock) and returns;
 * one worker thread takes the messages in arrival order, decodes each
   (``decode(topic, payload) -> fields | None``; ``None`` drops the message,
-  the decoder counts why) and pushes it into the :class:`~.live.LiveRun`,
+  the decoder counts why) and pushes it into the :class:`~.live.LiveRun`
+  (with its writer's id where the source names it),
   so each event's verdicts are published as soon as its own evaluation
   ends (latency stays per event);
 * with ``linger_s`` (a lateness bound, where a verdict waits for the
@@ -36,7 +37,10 @@ milliseconds with spikes of hundreds (docs/monitors.md, "Live monitoring",
   buffered message (the sink's ``due()``, at most every :data:`MIN_TICK_S`),
   so a horizon is closed without a new message, a verdict waits the
   lateness bound and not a timer period more, and the engine is never
-  entered by two threads.  While messages still wait in the
+  entered by two threads; and right after a batch whose messages let the
+  watermark reach it (``due()`` at or before the clock: every writer heard
+  past it, the early release of :meth:`~rclverify.backends.monitors.online.OnlineEngine.watermark`),
+  at most every :data:`MIN_TICK_S` too.  While messages still wait in the
   queue the timer's time is that of the last message checked, not the
   clock's: the clock never passes a message received earlier, so a backlog
   cannot close an obligation before the answer waiting behind it is read.
@@ -57,7 +61,8 @@ from rclverify.core.cache.heap import freeze_for_live
 class Sink(Protocol):
     """What the worker feeds: :class:`~.live.LiveRun` (push a message, run the timer)."""
 
-    def push(self, topic: str, fields: Mapping[str, object], received: float) -> None: ...
+    def push(self, topic: str, fields: Mapping[str, object], received: float,
+             writer: bytes | str | None = None) -> None: ...
 
     def tick(self, now: float) -> None: ...
 
@@ -105,8 +110,10 @@ class EngineWorker:
         self._thread.start()
         return self
 
-    def offer(self, topic: str, payload: Any, received: float) -> None:
-        """Queue one message (thread safe, never blocks, never evaluates).  When
+    def offer(self, topic: str, payload: Any, received: float, writer: bytes | str | None = None) -> None:
+        """Queue one message (thread safe, never blocks, never evaluates), with
+        its ``writer``'s id where the source names it (a DDS writer's GUID, an
+        rclpy publisher's GID; ``None``: the topic is its writer).  When
         ``max_queue`` messages already wait (the engine is that far behind) the
         message is dropped and counted in :attr:`dropped`: memory stays bounded
         and the loss is reported, never silent."""
@@ -114,7 +121,7 @@ class EngineWorker:
             with self._drop_lock:  # callbacks of several topics may drop at once: count each
                 self.dropped += 1
             return
-        self._q.put((topic, payload, received))
+        self._q.put((topic, payload, received, writer))
 
     def stop(self, timeout: float = 30.0) -> None:
         """Process every message queued so far, then end the thread (waits at
@@ -137,6 +144,7 @@ class EngineWorker:
         due = getattr(live, "due", None)  # the sink's next release (s, the now() clock), where it tells
         flush = getattr(live, "flush", None)  # hands on what a batch published, where it holds it
         next_tick = _time.monotonic() + self.tick_s
+        ticked = -math.inf  # when (monotonic s) the timer last ran
         last = -math.inf  # receipt time of the last message pushed
         linger, took = self.linger_s, False
         while True:
@@ -160,11 +168,14 @@ class EngineWorker:
                 if item is _STOP:
                     done = True
                     break
-                topic, payload, received = item
+                topic, payload, received, writer = item
                 last = received
                 fields = self.decode(topic, payload)
                 if fields is not None:
-                    live.push(topic, fields, received)
+                    if writer is None:
+                        live.push(topic, fields, received)
+                    else:
+                        live.push(topic, fields, received, writer)
                 n += 1
                 self.handled += 1
                 if n >= self.batch:
@@ -179,7 +190,10 @@ class EngineWorker:
             if n:
                 size = q.qsize() + n
                 self.backlog_max = max(self.backlog_max, size)
-            if done or _time.monotonic() >= next_tick:
+            ripe = done or _time.monotonic() >= next_tick
+            if not ripe and n and due is not None and _time.monotonic() - ticked >= MIN_TICK_S:
+                ripe = due() <= self.now()  # the batch let the watermark reach the head: release it now
+            if ripe:
                 now = self.now()
                 if not q.empty():
                     # messages received before `now` still wait in the queue: the
@@ -190,7 +204,8 @@ class EngineWorker:
                     live.tick(now)
                     if flush is not None:
                         flush()
-                    next_tick = _time.monotonic() + self.tick_s
+                    ticked = _time.monotonic()
+                    next_tick = ticked + self.tick_s
                 # else a message arrived as the clock was read and none was pushed before it: no clock
                 # passes nothing queued, so the tick waits until that message is pushed (the next round)
             if done:

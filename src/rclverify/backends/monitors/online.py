@@ -10,7 +10,10 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   ROS 2, the receipt on ROS 1: :mod:`rclverify.traces.event_time`); messages
   wait in a reorder buffer until the watermark passes them (the clock less
   ``reorder_window`` seconds, the lateness bound, held back by each writer
-  that could still send a message stamped before it: :meth:`OnlineEngine.watermark`) and are
+  that could still send a message stamped before it; where the source names
+  each sample's writer and matches each topic's writers, as the ROS 2
+  sources do, as far as every matched writer has been heard, earlier than
+  the bound: :meth:`OnlineEngine.watermark`) and are
   released to the monitors in stamp order (equal stamps by event time, then
   in arrival order), all held in the one reorder buffer
   (:mod:`rclverify.traces.reorder`).  A message stamped before the
@@ -51,7 +54,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Mapping
+from typing import Callable, Iterable, Mapping, Union
 
 from rclverify.semantics.floatsem import Tolerance
 from rclverify.lang.types import Checked, CheckedNode
@@ -64,6 +67,12 @@ from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 
 #: a writer not heard yet: (the latest time heard, the most it published after its stamp)
 _UNHEARD = (-math.inf, 0.0)
+
+#: a writer's id as a source gives it with each sample (a DDS writer's GUID, an rclpy publisher's GID)
+WriterId = Union[bytes, str]
+#: what the engine keeps a writer under: the topic alone (a source that names no writer: ROS 1, a
+#: recorded run), or ``(topic, writer id)``
+WriterKey = Union[str, tuple[str, WriterId]]
 
 
 def _heard_upto(last: float, lag: float, now: float, window: float) -> float:
@@ -126,9 +135,18 @@ class OnlineEngine:
     clocks: WriterClocks = field(init=False, default_factory=WriterClocks)
     #: the stamps in another clock heard, to place a copy of one at its question's time
     copies: CopiedStamps = field(init=False, default_factory=CopiedStamps)
-    #: per writer (topic): (the latest time heard on the run's clock, the most it published after its
-    #: stamp, s): its own watermark (:meth:`watermark`)
-    writers: dict[str, tuple[float, float]] = field(init=False, default_factory=dict)
+    #: per writer (:data:`WriterKey`: its topic, or its topic and id where the source names it): (the
+    #: latest time heard on the run's clock, the most it published after its stamp, s): its own
+    #: watermark (:meth:`watermark`)
+    writers: dict[WriterKey, tuple[float, float]] = field(init=False, default_factory=dict)
+    #: per contract topic, the writers heard on it (the keys of :attr:`writers`)
+    heard_on: dict[str, list[WriterKey]] = field(init=False, default_factory=dict)
+    #: the writers a message of which was placed before their own previous one (stamps copied from two
+    #: inputs): never counted past ``now - reorder_window - lag`` while the release is early
+    went_back: set[WriterKey] = field(init=False, default_factory=set)
+    #: per contract topic, the writers the source matches on it (:meth:`match`); ``None``: not told.
+    #: Replaced whole, never changed in place, so a source's thread may hand a new one over at any time
+    matched: Mapping[str, frozenset[WriterId]] | None = field(init=False, default=None)
 
     #: the watermark (s) the last :meth:`tick` reached: a verdict on a later time given by :meth:`finish` is
     #: provisional (:meth:`early`)
@@ -169,23 +187,63 @@ class OnlineEngine:
         """Whether every writer of ``answers`` (a node's output topics) has been
         heard past ``t`` (s) at the last :meth:`tick`: a message of it placed at
         ``t`` or later, or silent for longer than the lateness bound on its own
-        clock (as :meth:`watermark` counts it); a writer not heard yet has not.
+        clock (as :meth:`watermark` counts each writer, :meth:`_held`); a topic no
+        writer of which was heard yet has not, nor, where the source matches the
+        writers (:meth:`match`), one with a matched writer not heard yet.
         A ``superseded`` given before is provisional (:attr:`NodeMonitor.answers_heard_past`)."""
-        writers = self.writers
+        writers, heard_on = self.writers, self.heard_on
 
         def past(t: float) -> bool:
+            matched = self._early()
             for topic in answers:
-                heard = writers.get(topic)
-                if heard is None or _heard_upto(*heard, self._now, self.reorder_window) < t:
+                keys = heard_on.get(topic)
+                if not keys:
+                    return False
+                for key in keys:
+                    if self._held(key, self._now, matched is not None) < t:
+                        return False
+                if matched is not None and any((topic, w) not in writers for w in matched[topic]):
                     return False
             return True
         return past
 
+    def match(self, sets: Mapping[str, Iterable[WriterId]]) -> None:
+        """The writers a source matches now on each topic (``topic`` with or
+        without ``/`` -> the writer ids its samples carry): :attr:`matched`,
+        replaced whole (thread safe: a source's discovery thread calls it while
+        the engine's thread reads the mapping).  Once every contract topic has a
+        writer matched, the watermark is no longer held at the clock less the
+        lateness bound (:meth:`watermark`)."""
+        self.matched = {t.lstrip("/"): frozenset(ws) for t, ws in sets.items()}
+
+    def _early(self) -> Mapping[str, frozenset[WriterId]] | None:
+        """The matched writer sets when the release is early (:meth:`watermark`): a lateness bound, no
+        gate topic (their writers are not matched), and every contract topic with a writer matched;
+        else ``None``."""
+        matched = self.matched
+        if matched is None or self.gate_topics or self.reorder_window <= 0:
+            return None
+        for topic in self.topics:
+            if not matched.get(topic):
+                return None
+        return matched
+
+    def _held(self, key: WriterKey, now: float, early: bool) -> float:
+        """The time (s) writer ``key`` (heard) has been heard past at ``now`` (s): :func:`_heard_upto`,
+        but, in an early release, ``now`` less the bound less its lag for a writer that went back."""
+        last, lag = self.writers[key]
+        if early and key in self.went_back:
+            return now - self.reorder_window - lag
+        return _heard_upto(last, lag, now, self.reorder_window)
+
     # -- input -------------------------------------------------------------------
-    def push(self, topic: str, fields: Mapping[str, object], received: float, where: str = "") -> None:
+    def push(self, topic: str, fields: Mapping[str, object], received: float, where: str = "",
+             writer: WriterId | None = None) -> None:
         """One message as heard: ``topic`` (with or without ``/``), its fields,
         its event time (s: the publisher's source timestamp where the source
-        gives one, else the receipt; :mod:`rclverify.traces.event_time`).
+        gives one, else the receipt; :mod:`rclverify.traces.event_time`), where it
+        is (for the verdicts; default ``message N``) and its ``writer``'s id where
+        the source names it (``None``: the topic is its writer).
         Ordered by its header stamp when it has one, else by that time; equal
         stamps by that time, then in the order heard."""
         topic = topic.lstrip("/")
@@ -212,44 +270,87 @@ class OnlineEngine:
             if at is not None:  # a copy of a stamp set aside in another clock: at its question's time (event_time.py)
                 stamp, fields = at, with_stamp(fields, at)
         t = received if stamp is None else stamp
-        last, lag = self.writers.get(topic, _UNHEARD)
+        key: WriterKey = topic if writer is None else (topic, writer)
+        heard = self.writers.get(key)
+        if heard is None:
+            self.heard_on.setdefault(topic, []).append(key)
+            heard = _UNHEARD
+        last, lag = heard
+        if t < last:  # placed before its own previous message: never counted past its bound again (_held)
+            self.went_back.add(key)
         after = received - t  # how long after its stamp it was published, at most the horizon
         if self.horizon < after:
             after = self.horizon
-        self.writers[topic] = (t if t > last else last, after if after > lag else lag)
+        self.writers[key] = (t if t > last else last, after if after > lag else lag)
         self._buffer.push(t, received, (topic, fields, where))
         if self.reorder_window <= 0:
             self._release(math.inf)
 
     def due(self) -> float:
         """When (s, on the engine's clock) the earliest buffered message is
-        released: its time plus the reorder window (the watermark reaches it);
-        ``inf`` with nothing buffered.  The live worker ticks then, so a
-        verdict waits the lateness bound and not a timer period more."""
+        released if no other message comes: when the watermark reaches it
+        (:meth:`watermark`), its time plus the reorder window plus the lag of
+        the writers not heard past it; ``-inf`` when an early release has it
+        due already (every writer heard past it), ``inf`` with nothing
+        buffered.  The live worker ticks then, so a verdict waits the lateness
+        bound and not a timer period more."""
         head = self._buffer.head()
         if head == math.inf:
             return head
-        most = 0.0  # the most any writer not yet heard past it published after its stamp
-        for last, lag in self.writers.values():
-            if last < head and lag > most:
+        matched = self._early()
+        # the most any writer not yet heard past it published after its stamp; without an early release the
+        # clock less the bound holds it anyway (0)
+        most = 0.0 if matched is None else -math.inf
+        back = self.went_back if matched is not None else ()
+        writers = self.writers
+        for key, (last, lag) in writers.items():
+            if (last < head or key in back) and lag > most:
                 most = lag
+        if matched is not None and most < 0 \
+                and any((topic, w) not in writers for topic in self.topics for w in matched[topic]):
+            most = 0.0  # a matched writer not heard yet: held at the clock less the bound
         return head + self.reorder_window + most
 
     def watermark(self, now: float) -> float:
-        """The time (s, the run's clock) up to which every writer heard has been
-        heard at ``now`` (s): the clock less the lateness bound, and no further
-        than any writer whose message could still come stamped before it.  A
-        writer (topic) is past time ``T`` when a message of it was placed at
-        ``T`` or later, or when it has been silent for longer than the lateness
-        bound on its own clock: ``now`` less the most it published after its
-        stamp (a node copying its question's stamp onto an answer it publishes
-        later, capped at the horizon) less the bound.  A writer not heard yet
-        holds nothing: its first message, when it comes after the watermark
-        passed its stamp, is a late message (docs/semantics.md, "Event time")."""
-        upto = now - self.reorder_window
-        for last, lag in self.writers.values():
-            if last < upto:
-                upto = min(upto, _heard_upto(last, lag, now, self.reorder_window))
+        """The time (s, the run's clock) up to which every writer has been
+        heard at ``now`` (s) (docs/semantics.md, "Event time").  A writer (the
+        topic, or the topic and the writer's id where the source gives one) is
+        past time ``T`` when a message of it was placed at ``T`` or later, or
+        when it has been silent for longer than the lateness bound on its own
+        clock: ``now`` less the most it published after its stamp (a node
+        copying its question's stamp onto an answer it publishes later, capped
+        at the horizon) less the bound.
+
+        * **Early release**, where the source matches the writers (:meth:`match`)
+          and every contract topic has one (:meth:`_early`): the least time
+          every matched and every heard writer is past.  A matched writer not
+          heard yet is past ``now`` less the bound; one whose message was once
+          placed before its own previous one (it copies the stamps of two
+          inputs) is past ``now`` less the bound less its lag, never more.
+        * **Otherwise** (no writer matched on some topic, a ROS 1 or recorded
+          run, gate topics): the clock less the lateness bound, and no further
+          than any writer heard whose message could still come stamped before it.
+
+        A writer not heard yet (not matched either) holds nothing: its first
+        message, when it comes after the watermark passed its stamp, is a late
+        message."""
+        window = self.reorder_window
+        bound = now - window
+        matched = self._early()
+        if matched is None:
+            upto = bound
+            for last, lag in self.writers.values():
+                if last < upto:
+                    upto = min(upto, _heard_upto(last, lag, now, window))
+            return upto
+        upto = math.inf
+        writers, back = self.writers, self.went_back
+        for key, (last, lag) in writers.items():
+            held = bound - lag if key in back else _heard_upto(last, lag, now, window)
+            if held < upto:
+                upto = held
+        if upto > bound and any((topic, w) not in writers for topic in self.topics for w in matched[topic]):
+            upto = bound  # a matched writer not heard yet
         return upto
 
     def tick(self, now: float) -> None:

@@ -32,7 +32,9 @@ located warning, once per publisher and reason, never silence:
 :class:`Bus` runs one thread (``rclverify-dds``): it waits on discovery and
 every tap's reader (a Cyclone wait set, which releases the GIL), updates the
 taps (discovery at most every ``period_s``, so a busy topic does not make
-it read discovery at every sample), and hands each sample to ``on_sample(tap, raw bytes, sample info,
+it read discovery at every sample; after each update it hands
+``on_matched`` each tap's matched writers, ``{key: frozenset of writer GUIDs}``,
+for the engine's early release), and hands each sample to ``on_sample(tap, raw bytes, sample info,
 receipt time)`` (receipt: ``time.time_ns()``, an integer, so a recorded bag
 holds the very time the engine used); it never decodes or checks (the
 engine thread does, :mod:`.worker`).  With ``linger_s`` (the live run's
@@ -126,6 +128,9 @@ class Bus:
         #: topics only the monitor should write (dds_topic -> key, where, role) and the others found writing them
         self.watched: dict[str, tuple[str, str, str]] = {}
         self.bypass: dict[str, set[str]] = {}
+        #: told, in the bus thread after each update, every tap's matched writers (tap key -> the
+        #: 16-byte GUIDs its reader hears), taps without a reader left out (set before :meth:`start`)
+        self.on_matched: Callable[[dict[str, frozenset[bytes]]], None] | None = None
 
     def tap(self, key: str, dds_topic: str, struct: type, where: str) -> Tap:
         """Ask to hear ``dds_topic`` (call before :meth:`start`)."""
@@ -231,6 +236,8 @@ class Bus:
             t.heard = {p.guid for k, p in enumerate(same) if k not in left}
             if self.on_reader is not None:
                 self.on_reader(t, same)
+        if self.on_matched is not None:
+            self.on_matched({t.key: frozenset(t.heard) for t in self.taps if t.reader is not None})
         if self.watched:
             self._foreign()
 

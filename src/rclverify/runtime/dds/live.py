@@ -96,8 +96,9 @@ class _Sink:
         self.live, self.book, self.taps, self.window = live, book, taps, window
         self.flush_writes = flush_writes
 
-    def push(self, topic: str, fields: Mapping[str, object], received: float) -> None:
-        self.live.push(topic, fields, received)
+    def push(self, topic: str, fields: Mapping[str, object], received: float,
+             writer: bytes | str | None = None) -> None:
+        self.live.push(topic, fields, received, writer)
 
     def due(self) -> float:
         return self.live.due()
@@ -271,8 +272,6 @@ class _DdsRun(DdsRunEnd):
         bus: Any  # the DDS bus, or the rclpy source's with its face
 
         def writer_of(tap: Any, info: Any) -> bytes | None:
-            if not tap.key.startswith("call:"):
-                return None
             guid = getattr(info, "writer_guid", None)  # the rclpy source hands the publisher's GID over
             return (bytes(guid) or None) if guid is not None else writers.of(tap.reader, info)
 
@@ -282,7 +281,8 @@ class _DdsRun(DdsRunEnd):
             ens, from_source = (rns, True) if self.by_receipt else event_ns(source_ns, rns)
             if not from_source:
                 self.receipt_timed += 1
-            self.worker_box[0].offer(tap.key, (raw, source_ns, rns, writer_of(tap, info), ens), ens / 1e9)
+            writer = writer_of(tap, info)  # a topic's: the engine's early release (OnlineEngine.watermark)
+            self.worker_box[0].offer(tap.key, (raw, source_ns, rns, writer, ens), ens / 1e9, writer)
         if bus_factory is not None:
             self.bus = bus = bus_factory(on_sample, self.warn, on_reader=self.on_reader,
                                          type_hash=self.types.type_hash)
@@ -303,6 +303,7 @@ class _DdsRun(DdsRunEnd):
         def send_last(node: str, text: str) -> None:
             self.write_text(lasts[node], text)
         self.live = run_factory(publish=self.send, publish_last=send_last, **extra)
+        bus.on_matched = self.live.match  # each topic's matched writers, from the bus thread
         if self.recorder is not None:  # the bag keeps what was heard late, as the log does (traces/bag_late.py)
             self.live.engine.on_late = self.recorder.late
         if self.links:

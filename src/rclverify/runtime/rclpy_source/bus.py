@@ -139,6 +139,10 @@ class RclpyBus(DeclaredTypes):
         self.linger_s: float | None = None
         #: the agent said ``stopped``: every sample it took was handed over (:meth:`stop`)
         self.stopped = False
+        #: told, in the bus thread whenever the agent reports a tap's publishers, every reported tap's
+        #: matched writers (tap key -> the publishers' 16-byte GIDs, as samples carry them; set before
+        #: :meth:`start`): the face of :attr:`~rclverify.runtime.dds.bus.Bus.on_matched`
+        self.on_matched: Callable[[dict[str, frozenset[bytes]]], None] | None = None
         self._lock = threading.Lock()
         self._gone = False  # the agent's stdin is closed: nothing more is sent (:meth:`_send`)
         self._start()
@@ -328,6 +332,8 @@ class RclpyBus(DeclaredTypes):
             t.heard = {bytes.fromhex(g) for g in obj["heard"]}
             if first and self.on_reader is not None:
                 self.on_reader(t, self.discovery.publishers(t.dds_topic))
+            if self.on_matched is not None:
+                self.on_matched({u.key: frozenset(u.heard) for u in self.taps if u.reader is not None})
         elif what == "description":
             self._described(obj)
         elif what == "error":

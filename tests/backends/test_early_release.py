@@ -1,0 +1,303 @@
+"""The live engine's early release: a watermark per writer, past the clock less the lateness bound.
+
+Where the source names each sample's writer and matches each contract topic's writers
+(:meth:`OnlineEngine.match`, as both ROS 2 sources do), a message is released once every matched and
+every heard writer has been heard past it, or has been silent for longer than the lateness bound on
+its own clock (docs/semantics.md, "Event time"), not only once the clock less the bound passed it.
+
+The unit cases feed the engine with an injected clock (``tick(now)``, ``watermark(now)``): the release
+when every matched writer has been heard past; the hold while a matched writer is silent for less
+than the bound, or not heard yet; a writer whose stamps went back capped at the bound less its lag;
+a topic with no writer matched, or no sets told at all, keeping the clock less the bound; a writer
+matched late whose first message is older than the watermark: late, and no verdict of a correct node
+violated.  Each has its control in the same case.
+
+The oracle: random runs (several writers on one topic, monotone stamps per writer, a stamp-copying
+relay answering in stamp order with a lag that grows, delivery delays below the bound, in order per
+writer) fed in arrival order with the timer every 5 ms: every message's last verdict equals that of
+the same messages all pushed first and drained at the end, and no message is late.  The control: the
+engine with the writers' lag left out of the watermark (a seeded defect) makes the relay's answers late.
+"""
+from __future__ import annotations
+
+import random
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors import online
+from rclverify.backends.monitors.config import load_mapping
+from rclverify.backends.monitors.online import OnlineEngine
+from rclverify.lang.typecheck import load
+from test_judge_event_time import _stamp, _workspace
+
+L = 0.05  # the lateness bound (s), the CLI's
+
+RCL = """
+node Relay {
+  inputs( x : REAL )
+  outputs( r : REAL )
+  topics( pkg/Reading x matches(in.x), pkg/Range r matches(out.r) )
+  assume( TRUE )
+  guarantee( out.r == in.x )
+}
+node Watch {
+  inputs( y : REAL )
+  outputs( z : REAL )
+  topics( pkg/Reading y matches(in.y), pkg/Range z matches(out.z) )
+  assume( TRUE )
+  guarantee( out.z <= in.y )
+}
+"""
+MAPPING = ("topics:\n  x: {fields: [value]}\n  r: {fields: [range]}\n  y: {fields: [value]}\n"
+           "  z: {fields: [range]}\n")
+ALL = {"x": [b"X"], "r": [b"R"], "y": [b"Y"], "z": [b"Z"]}
+
+
+@pytest.fixture(scope="module")
+def contracts(tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, Any]:
+    ws, _ = _workspace(tmp_path_factory.mktemp("early"), RCL, [], MAPPING)
+    checked = load([ws / "contracts" / "c.rcl"])
+    return checked, load_mapping(ws, "mapping.yaml").rules
+
+
+def _engine(contracts: tuple[Any, Any], got: list[Any] | None = None, events: list[Any] | None = None) -> OnlineEngine:
+    checked, rules = contracts
+    return OnlineEngine(checked, [checked.nodes["Relay"], checked.nodes["Watch"]], rules, 1.0, reorder_window=L,
+                        on_verdict=None if got is None else got.append,
+                        on_event=None if events is None else events.append)
+
+
+def _put(eng: OnlineEngine, topic: str, value: float, stamp: float, source: float, writer: bytes,
+         where: str = "") -> None:
+    field = "value" if topic in ("x", "y") else "range"
+    eng.push(topic, {field: value, **_stamp(stamp)}, source, where, writer=writer)
+
+
+def _heard_at(eng: OnlineEngine, t: float) -> None:
+    """Every writer of :data:`ALL` heard with a message stamped and published at ``t``."""
+    for topic, (w,) in ALL.items():
+        _put(eng, topic, 1.0, t, t, w)
+
+
+# -- the rule, clock injected ---------------------------------------------------------------------------
+def test_every_matched_writer_heard_past_a_message_releases_it_before_the_bound(contracts: tuple[Any, Any]) -> None:
+    events: list[Any] = []
+    eng = _engine(contracts, events=events)
+    eng.match({f"/{t}": ws for t, ws in ALL.items()})
+    _heard_at(eng, 1.0)
+    _heard_at(eng, 1.002)
+    assert eng.watermark(1.003) == pytest.approx(1.002)  # every writer heard up to 1.002 s: 47 ms before the bound
+    assert eng.due() == -float("inf")  # due already: the worker ticks after the batch
+    eng.tick(1.003)
+    assert len(events) == 8
+    # the control: the same messages, no writer set told: the clock less the bound
+    events2: list[Any] = []
+    eng2 = _engine(contracts, events=events2)
+    _heard_at(eng2, 1.0)
+    _heard_at(eng2, 1.002)
+    assert eng2.watermark(1.003) == pytest.approx(1.003 - L)
+    assert eng2.due() == pytest.approx(1.0 + L)
+    eng2.tick(1.003)
+    assert events2 == []
+
+
+def test_a_matched_writer_silent_for_less_than_the_bound_or_never_heard_holds_the_release(
+        contracts: tuple[Any, Any]) -> None:
+    eng = _engine(contracts)
+    eng.match({**ALL, "x": [b"X", b"X2"]})
+    _heard_at(eng, 1.0)
+    assert eng.watermark(1.01) == pytest.approx(1.01 - L)  # X2 matched, not heard: the clock less the bound
+    assert eng.due() == pytest.approx(1.0 + L)
+    _put(eng, "x", 1.0, 0.99, 0.99, b"X2")
+    assert eng.watermark(1.01) == pytest.approx(0.99)  # heard up to 0.99 s, silent for 20 ms: held there
+    assert eng.watermark(1.039) == pytest.approx(0.99)
+    assert eng.watermark(1.045) == pytest.approx(0.995)  # silent past the bound: the clock less the bound
+    _put(eng, "x", 1.0, 1.0, 1.0, b"X2")
+    assert eng.watermark(1.01) == pytest.approx(1.0)  # the control: heard past, released
+
+
+def test_a_writer_whose_stamps_went_back_is_capped_at_the_bound_less_its_lag(contracts: tuple[Any, Any]) -> None:
+    eng = _engine(contracts)
+    eng.match(ALL)
+    _heard_at(eng, 1.0)
+    _put(eng, "r", 1.0, 1.05, 1.07, b"R")  # 20 ms after its stamp
+    _heard_at(eng, 1.1)
+    assert eng.watermark(1.101) == pytest.approx(1.1)  # the control: in order, heard up to 1.1 s
+    _put(eng, "r", 1.0, 1.08, 1.105, b"R")  # stamped before its previous one: it copies two inputs' stamps
+    assert eng.watermark(1.106) == pytest.approx(1.106 - L - 0.025)  # its lag is the most it published after
+    _heard_at(eng, 1.2)
+    assert eng.watermark(1.21) == pytest.approx(1.21 - L - 0.025)  # from then on, heard past or not
+
+
+@pytest.mark.parametrize("sets", [None, {"x": [b"X"], "r": [b"R"], "y": [b"Y"]}, {**ALL, "z": []}],
+                         ids=["no sets told", "a topic not told", "a topic with no writer"])
+def test_a_topic_whose_writers_are_not_known_keeps_the_clock_less_the_bound(
+        contracts: tuple[Any, Any], sets: dict[str, list[bytes]] | None) -> None:
+    eng = _engine(contracts)
+    if sets is not None:
+        eng.match(sets)
+    _heard_at(eng, 1.0)
+    assert eng.watermark(1.01) == pytest.approx(1.01 - L)
+    eng.match(ALL)  # the control: every topic's writers told
+    assert eng.watermark(1.01) == pytest.approx(1.0)
+
+
+def test_a_writer_matched_late_whose_first_message_is_older_than_the_watermark_is_late_never_violated(
+        contracts: tuple[Any, Any]) -> None:
+    def run(matched_from_start: bool) -> tuple[int, list[tuple[str, str]]]:
+        got: list[Any] = []
+        eng = _engine(contracts, got)
+        eng.match({**ALL, "x": [b"X", b"X2"]} if matched_from_start else ALL)
+        for i in range(5):
+            t = 1.0 + 0.1 * i
+            _put(eng, "x", float(i), t, t, b"X", f"x{i}")
+            _put(eng, "r", float(i), t, t + 0.01, b"R", f"r{i}")
+            _put(eng, "y", 1.0, t, t, b"Y")
+            _put(eng, "z", 0.0, t, t + 0.01, b"Z")
+            eng.tick(t + 0.012)
+        if not matched_from_start:
+            eng.match({**ALL, "x": [b"X", b"X2"]})  # a publisher discovered now
+        # its first message, published 1.395 s, heard 17 ms later (after the tick at 1.412 s): within the
+        # bound, but stamped before the 1.4 s every writer matched had been heard past
+        _put(eng, "x", 9.0, 1.39, 1.395, b"X2", "new")
+        eng.tick(1.47)
+        eng.finish()
+        return eng.late, [(v.where, v.verdict) for v in got if v.node == "Relay"]
+    late, verdicts = run(False)
+    assert late == 1
+    assert "violated" not in {v for _, v in verdicts}
+    assert ("new", "satisfied") not in verdicts
+    # the control: matched before it was heard, it holds the watermark at the clock less the bound
+    late, verdicts = run(True)
+    assert late == 0
+
+
+# -- the oracle ---------------------------------------------------------------------------------------
+#: one message: (arrival s, topic, value, stamp s, publication s, writer, where)
+Sent = tuple[float, str, float, float, float, bytes, str]
+
+
+def _random_run(seed: int) -> list[Sent]:
+    """Two writers of ``x`` and one of ``y``, each at its own jittered period; a relay ``R``
+    answering every ``x`` in stamp order with its stamp copied, published up to 300 ms after it, its
+    lag passing the most before by less than 40 % of the bound (the first below it), every third
+    answer wrong; a watcher ``Z`` answering
+    each ``y`` likewise; each message delivered within 60 % of the bound, in order per writer."""
+    rng = random.Random(seed)
+    sent: list[tuple[str, float, float, float, bytes]] = []  # topic, value, stamp, publication, writer
+    for topic, writer, period in (("x", b"X", 0.007), ("x", b"X2", 0.011), ("y", b"Y", 0.005)):
+        t = 1.0 + rng.random() * period
+        while t < 2.0:
+            sent.append((topic, round(rng.uniform(0, 10), 3), t, t, writer))
+            t += period * rng.uniform(0.5, 1.5)
+    for question, answer, writer in (("x", "r", b"R"), ("y", "z", b"Z")):
+        most = pub = 0.0  # the most it published after a stamp so far; its last publication
+        for k, (_, value, stamp, _, _) in enumerate(sorted((s for s in sent if s[0] == question),
+                                                           key=lambda s: s[2])):
+            pub = max(pub, stamp + rng.uniform(0, min(0.3, most + 0.4 * L)))  # in order: never before the last
+            most = max(most, pub - stamp)
+            wrong = 0.5 if k % 3 == 2 else 0.0
+            sent.append((answer, value + wrong if answer == "r" else value - wrong, stamp, pub, writer))
+    out: list[Sent] = []
+    arrived: dict[bytes, float] = {}
+    order: list[tuple[float, int, Sent]] = []
+    for k, (topic, value, stamp, pub, writer) in enumerate(sorted(sent, key=lambda s: (s[3], s[2]))):
+        at = max(arrived.get(writer, 0.0), pub + rng.uniform(0, 0.6 * L))
+        arrived[writer] = at
+        order.append((at, k, (at, topic, value, stamp, pub, writer, f"{topic}{k}")))
+    return [m for _, _, m in sorted(order)]  # in arrival order, each writer's in the order it published
+
+
+def _last_verdicts(got: list[Any]) -> dict[tuple[str, str], str]:
+    last = {(v.node, v.where): v.verdict for v in got}
+    return {k: v for k, v in last.items() if v != "withdrawn"}
+
+
+def _online(contracts: tuple[Any, Any], run: list[Sent]) -> tuple[dict[tuple[str, str], str], int, float]:
+    """Fed in arrival order, the timer every 5 ms and before each message; the verdicts, the late
+    count and how far past the clock less the bound the watermark reached at most (s)."""
+    got: list[Any] = []
+    eng = _engine(contracts, got)
+    eng.match({"x": [b"X", b"X2"], "r": [b"R"], "y": [b"Y"], "z": [b"Z"]})
+    now, ahead = run[0][0], -1.0
+    for at, topic, value, stamp, pub, writer, where in run:
+        while now + 0.005 <= at:
+            now += 0.005
+            eng.tick(now)
+        eng.tick(at)
+        ahead = max(ahead, eng.watermark(at) - (at - L))
+        _put(eng, topic, value, stamp, pub, writer, where)
+    eng.finish()
+    return _last_verdicts(got), eng.late, ahead
+
+
+def _drained(contracts: tuple[Any, Any], run: list[Sent]) -> dict[tuple[str, str], str]:
+    """The same messages pushed first, released only at the end (in stamp order): the whole run's judgement."""
+    got: list[Any] = []
+    eng = _engine(contracts, got)
+    for _at, topic, value, stamp, pub, writer, where in run:
+        _put(eng, topic, value, stamp, pub, writer, where)
+    eng.finish()
+    assert eng.late == 0
+    return _last_verdicts(got)
+
+
+SEEDS = list(range(12))
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_early_release_gives_the_whole_runs_verdicts_and_no_late_message(contracts: tuple[Any, Any],
+                                                                          seed: int) -> None:
+    run = _random_run(seed)
+    live, late, ahead = _online(contracts, run)
+    assert late == 0
+    assert ahead > 0.005  # released before the clock less the bound
+    whole = _drained(contracts, run)
+    assert live == whole
+    assert {"satisfied", "violated"} <= set(whole.values())
+
+
+def test_the_control_the_writers_lag_left_out_makes_the_relays_answers_late(
+        contracts: tuple[Any, Any], monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(online, "_heard_upto", lambda last, lag, now, window: max(last, now - window))
+    lates = [_online(contracts, _random_run(seed))[1] for seed in SEEDS[:4]]
+    assert all(n > 0 for n in lates), lates
+
+
+# -- the engine thread ----------------------------------------------------------------------------------
+class _Sink:
+    """A sink whose next release is due at once (``-inf``, every writer heard past it) or never."""
+
+    def __init__(self, due: float) -> None:
+        self.ticks: list[float] = []
+        self.pushed: list[tuple[str, object]] = []
+        self._due = due
+
+    def push(self, topic: str, fields: Any, received: float, writer: bytes | str | None = None) -> None:
+        self.pushed.append((topic, writer))
+
+    def due(self) -> float:
+        return self._due if self.pushed and not self.ticks else float("inf")
+
+    def tick(self, now: float) -> None:
+        self.ticks.append(now)
+
+
+@pytest.mark.parametrize("due, ticks", [(-float("inf"), 1), (float("inf"), 0)], ids=["due at once", "control"])
+def test_the_engine_thread_ticks_right_after_a_batch_lets_the_watermark_pass_the_head(due: float, ticks: int) -> None:
+    import time
+    from rclverify.runtime.worker import EngineWorker
+    sink = _Sink(due)
+    worker = EngineWorker(sink, lambda topic, payload: payload, time.monotonic, tick_s=100.0).start()
+    try:
+        worker.offer("x", {"value": 1.0}, time.monotonic(), b"X")
+        end = time.monotonic() + 1.0
+        while time.monotonic() < end and len(sink.ticks) < ticks:
+            time.sleep(0.01)
+        time.sleep(0.2)
+        assert len(sink.ticks) == ticks  # not the 100 s timer
+        assert sink.pushed == [("x", b"X")]  # the writer's id handed on
+    finally:
+        worker.stop()
