@@ -26,11 +26,17 @@ node it is drawn for, judged by the rules of docs/monitors.md, "Declarations on 
   as another clock, measures its rate and carries the run's end into it), so its ``P`` is in that
   clock: the bound above times the real-time factor, and two ``/clock`` ticks more (its stamps move by
   one tick, :data:`CLOCK_STEP_MS` of the wall clock); its robot's schedule stays the wall clock.  A
+  On a ``/clock`` whose factor changes mid-run (``--clock-change``) the factor is the largest it runs
+  at; a stamped sensor feeding no fuse then publishes on its simulated timer (every ``period`` simulated
+  ms, silent while the clock is paused), whose gap is its period and a stall of the wall clock at that
+  factor, within the same bound (a factor of at least 0.5 makes the bound's two periods cover one
+  simulated period).  A
   driver's offset leaves its gaps as they are; one within the bounds of the run's clock (at most 1 s
   behind, 0.1 s ahead: its stamps are then the message's times) delays its last stamp, so a driver
   behind adds its offset to ``P``.  An unstamped sensor carries no clock but the run's (its source
   times, the wall clock): ``P`` as above on every clock.  :func:`period_rate` is the factor the
-  declared clock runs at against the wall clock (the seeded ``skip`` is that much longer).
+  declared clock runs at against the wall clock, its largest on a changing clock (the seeded ``skip``
+  lasts as long as that clock takes to pass the period, and a period more).
 * an **alarm**, a **relay** stamping with its own clock: ``progress( within 2 steps )``; it answers
   every input after 0-30 % of the input's period, an answer due within a stamped sensor's publication
   window just after it (so at most one input comes between an input and its answer), and one step more
@@ -54,7 +60,7 @@ node it is drawn for, judged by the rules of docs/monitors.md, "Declarations on 
 
 With ``defect``, the node seeded with a defect (:func:`defect_kind`) may break a declaration instead of
 its guarantee: a sensor skipping one publication for longer than its declared period in its clock (the
-wall-clock skip is the period over :func:`period_rate`, and one period more; ``"skip"``, ``periodic``
+wall-clock skip is as long as its clock takes to pass the period, and one period more; ``"skip"``, ``periodic``
 false at that sensor; never a fuse's leading sensor, :func:`can_skip`) or an alarm answering none of
 K + 2 readings in a row once (``"mute"``: K + 1 accepted steps unanswered in a row even when the answer
 before them was deferred past the first, so its ``progress`` or period in steps false, and the
@@ -110,9 +116,12 @@ def in_steps(n: dict[str, Any], seed: int) -> bool:
 
 def period_rate(n: dict[str, Any], spec: dict[str, Any]) -> float:
     """The rate (its s per wall-clock s) of the clock sensor ``n``'s declared period is in: the
-    real-time factor for a stamped sensor on a ``/clock``, else 1."""
+    real-time factor for a stamped sensor on a ``/clock`` (the largest it runs at, on a clock whose factor
+    changes mid-run: a gap of the wall clock is at most that many simulated seconds), else 1."""
     clock = spec.get("clock")
-    return float(clock["rate"]) if clock and n["sensor_kind"] in ("range", "scan") else 1.0
+    if not clock or n["sensor_kind"] not in ("range", "scan"):
+        return 1.0
+    return max([float(clock["rate"])] + [float(r) for _, r in clock.get("segments") or []])
 
 
 def declared_sensor_period_ms(n: dict[str, Any], spec: dict[str, Any]) -> int:

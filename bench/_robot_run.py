@@ -193,12 +193,13 @@ def _domain() -> tuple[int, int]:
 
 def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2: Path,
             kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src", source: str = "dds",
-            sim_clock: bool = False, actions: bool = False, driver_offset_s: float = 0.0) -> dict[str, Any]:
+            sim_clock: bool = False, actions: bool = False, driver_offset_s: float = 0.0,
+            clock_change: bool = False) -> dict[str, Any]:
     """Run generated robot ``seed`` live and offline under ``tmp`` with rclverify's sources ``src``,
     the monitor hearing the robot through ``source`` (:data:`SOURCES`), the robot on a ``/clock`` of its
-    own with ``sim_clock``, with Fibonacci action servers with ``actions``; returns the counts and findings (``other_clocks``: the live record's writers
+    own with ``sim_clock`` (its factor changing mid-run with ``clock_change``), with Fibonacci action servers with ``actions``; returns the counts and findings (``other_clocks``: the live record's writers
     placed at their source times)."""
-    spec = generate(seed, nodes, defect, kinds, sim_clock, actions, driver_offset_s)
+    spec = generate(seed, nodes, defect, kinds, sim_clock, actions, driver_offset_s, clock_change)
     ws = write_workspace(spec, tmp / "ws")
     (ws / "runs").mkdir(exist_ok=True)
     (tmp / "cyclonedds.xml").write_text(CONFIG)
@@ -380,7 +381,9 @@ def _line(res: dict[str, Any]) -> str:
     clock = res.get("clock")
     return (f"seed {res['seed']}{' defect' if res['defect'] else ''}: {res['nodes']} nodes, source "
             f"{res.get('source', 'dds')}, " + (f"/clock x{clock['rate']:g} from {clock['start_s']:g} s" if clock
-                                               else "wall clock") + ": live satisfied "
+                                               else "wall clock")
+            + "".join(f", {'paused' if r == 0 else f'x{r:g}'} at {at:g} s" for at, r in (clock or {}).get("segments") or [])
+            + ": live satisfied "
             f"{tot['satisfied']}, violated {tot['violated']}, undecided {tot['undecided']}, deadlines true "
             f"{tot['deadline true']} false {tot['deadline false']}"
             + (f", undecided {sum(undecided.values())} (log: " + ", ".join(f"{n} {k}" for n, k in undecided.items())
@@ -407,7 +410,7 @@ def _line(res: dict[str, Any]) -> str:
 def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: bool, burn: bool,
              keep: Path | None, kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src",
              source: str = "dds", sim_clock: bool = False, actions: bool = False,
-             driver_offset_s: float = 0.0) -> int:
+             driver_offset_s: float = 0.0, clock_change: bool = False) -> int:
     """Run every seed (a node count drawn per seed in ``sizes``) through ``source``, on a ``/clock`` with
     ``sim_clock``; print one line per seed and the totals.  Returns 0 (the figures are the output; a
     finding is printed, not raised)."""
@@ -430,7 +433,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             with tempfile.TemporaryDirectory() as d:
                 try:
                     res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src, source, sim_clock,
-                                  actions, driver_offset_s)
+                                  actions, driver_offset_s, clock_change)
                 except (RobotFailed, MonitorFailed) as exc:
                     what = "GENERATOR FAULT" if isinstance(exc, RobotFailed) else "MONITOR DID NOT START"
                     print(f"seed {seed}: {what}: {exc}", flush=True)

@@ -44,6 +44,11 @@ constants), ``contracts/plan.yaml``, ``mapping.yaml``, ``interfaces/`` (SetBool)
 ``sim_clock=True`` (``--clock``) adds a clock node publishing ``rosgraph_msgs/Clock`` on ``/clock``
 every 20 ms at a real-time factor drawn from 0.5-2, from a simulated start of 0, 100 or 5000 s, and
 runs every other node with ``use_sim_time`` (their header stamps come from ``/clock``).
+``clock_change=True`` (``--clock-change``, implies ``--clock``) makes that factor change once or twice
+mid-run (1.5-6.4 s after the sensing starts, each new factor within 0.5-2) and, one time in two, pauses
+the clock for 0.5-1 s (``/clock`` stops, as a paused simulator's does), :func:`clock_changes`; each
+stamped sensor feeding no fuse then publishes on its simulated timer (silent while the clock is
+paused, its period in simulated time), the other nodes on the wall clock as before.
 
 ``actions=True`` (``--actions``) turns each SetBool server, one time in two, into a
 ``test_msgs/Fibonacci`` action server (with or without introspection, as drawn for the server),
@@ -54,6 +59,7 @@ CLI (from the repository root)::
 
     python3 bench/robot_generator.py --seeds 0-49 --nodes 5-8 --seconds 10 --burn
     python3 bench/robot_generator.py --seeds 0-9 --source rclpy --clock
+    python3 bench/robot_generator.py --seeds 0-9 --clock-change --burn
     python3 bench/robot_generator.py --seeds 3 --defect
     python3 bench/robot_generator.py --write DIR --seeds 7     # the workspace alone
 
@@ -101,6 +107,43 @@ HORIZON = 1.0
 MAX_BEHIND_S = 0.05
 #: the real-time factors a ``/clock`` robot draws from: simulated seconds per wall-clock second
 CLOCK_RATES = (0.5, 0.75, 1.0, 1.5, 2.0)
+#: the wall-clock seconds after the sensing starts at which a changing ``/clock`` may change (``--clock-change``):
+#: each change or pause at one of these, 0-0.4 s later, so two never overlap (a pause lasts at most 1 s)
+CLOCK_CHANGE_SLOTS = (1.5, 3.0, 4.5, 6.0)
+
+
+def clock_changes(seed: int, nodes: int, rate: float) -> list[list[float]]:
+    """The segments of a ``/clock`` that changes its rate mid-run (``--clock-change``), from a clock at
+    ``rate`` (its real-time factor before the first change): ``[[at_s, rate], ...]`` in order, ``at_s`` in
+    wall-clock seconds after the sensing starts, each segment's rate from :data:`CLOCK_RATES` other than
+    the one before, one or two changes of factor, and one time in two a pause (rate 0: ``/clock`` stops
+    for 0.5-1 s, then goes on at the factor it had).  The last segment's rate is never 0.  Deterministic in
+    (seed, nodes, rate)."""
+    rng = random.Random(f"clock-change-{seed}-{nodes}")
+    changes = rng.randint(1, 2)
+    pause = rng.random() < 0.5
+    slots = sorted(rng.sample(CLOCK_CHANGE_SLOTS, changes + pause))
+    at_pause = rng.choice(slots) if pause else None
+    out: list[list[float]] = []
+    now = rate
+    for slot in slots:
+        at = round(slot + rng.uniform(0.0, 0.4), 2)
+        if slot == at_pause:
+            out += [[at, 0.0], [round(at + rng.uniform(0.5, 1.0), 2), now]]
+            continue
+        now = rng.choice([r for r in CLOCK_RATES if r != now])
+        out.append([at, now])
+    return out
+
+
+def sim_timed(n: dict[str, Any], spec: dict[str, Any]) -> bool:
+    """Whether sensor ``n`` of ``spec`` publishes on its simulated clock's timer (a driver under
+    ``use_sim_time``: it stops while ``/clock`` is paused): a stamped sensor on a changing ``/clock``
+    (its stamps carry the clock it keeps) feeding no fuse (a fuse's two sensors share one clock: the
+    other input, published on, would be steps the fuse leaves unanswered while the first is paused)."""
+    clock = spec.get("clock")
+    return (bool(clock and clock.get("segments")) and n["kind"] == "sensor" and SENSORS[n["sensor_kind"]][3]
+            and not any(n["name"] in (f.get("a_source"), f.get("b_source")) for f in spec["nodes"]))
 
 
 def f32(v: float) -> float:
@@ -175,7 +218,7 @@ def _sensor(rng: random.Random, i: int, kinds: tuple[str, ...], kind: str | None
 
 def generate(seed: int, nodes: int = 5, defect: bool = False,
              kinds: tuple[str, ...] = tuple(SENSORS), sim_clock: bool = False,
-             actions: bool = False, driver_offset_s: float = 0.0) -> dict[str, Any]:
+             actions: bool = False, driver_offset_s: float = 0.0, clock_change: bool = False) -> dict[str, Any]:
     """The spec of generated robot ``seed``: ``{"seed", "defect", "clock", "nodes": [node spec, ...]}``,
     ``nodes`` contract nodes (at least 2: a sensor and one consumer); with ``defect``, exactly one node's
     spec holds ``"defect": True``; ``kinds``: the sensor kinds drawn from (keys of :data:`SENSORS`);
@@ -184,8 +227,11 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
     (its client sending :data:`FIB_ORDERS` goals one at a time); ``driver_offset_s``: every sensor's
     header stamps run that many seconds off its clock (a driver's clock, negative: behind), its
     ``"driver_offset_s"``; within the run's clock at most :data:`MAX_BEHIND_S` behind (else
-    ``ValueError``, saying why).  The other nodes drawn depend on no option.  Deterministic in (seed, nodes,
-    defect, kinds, sim_clock, actions, driver_offset_s)."""
+    ``ValueError``, saying why); ``clock_change`` (with ``sim_clock``): the clock's ``"segments"``
+    (:func:`clock_changes`: its factor changes once or twice mid-run, and it may pause), each stamped
+    sensor feeding no fuse publishing on its simulated timer (``"sim_timer"``, :func:`sim_timed`).  The
+    other nodes drawn depend on no option.  Deterministic in (seed, nodes, defect, kinds, sim_clock,
+    actions, driver_offset_s, clock_change)."""
     if -STAMP_BEHIND_S <= driver_offset_s < -MAX_BEHIND_S:
         raise ValueError(f"a driver {-driver_offset_s:g} s behind stamps within the run's clock (at most "
                          f"{STAMP_BEHIND_S:g} s behind): its next reading is current, by its stamp, before an answer "
@@ -270,11 +316,16 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
             n["in_topic"] = by_name[n["source"]]["topic"]
         if n["kind"] == "fuse":
             n["a_topic"], n["b_topic"] = by_name[n["a_source"]]["topic"], by_name[n["b_source"]]["topic"]
-    clock = None
+    clock: dict[str, Any] | None = None
     if sim_clock:
         crng = random.Random(f"clock-{seed}-{nodes}")
         clock = {"rate": crng.choice(CLOCK_RATES), "start_s": float(crng.choice([0, 100, 5000]))}
+        if clock_change:
+            clock["segments"] = clock_changes(seed, nodes, clock["rate"])
     spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out, "driver_offset_s": driver_offset_s}
+    for n in out:
+        if sim_timed(n, spec):
+            n["sim_timer"] = True
     declare(spec)
     if defect:
         candidates = [n for n in out if n["kind"] != "sensor" or n.get("beyond") is not None]
@@ -514,6 +565,9 @@ def main(argv: list[str] | None = None) -> int:
                    help="how the monitor hears the robot (rclverify monitor --source; default dds)")
     p.add_argument("--clock", action="store_true",
                    help="a /clock node at a real-time factor of 0.5-2 (drawn per seed), every node on use_sim_time")
+    p.add_argument("--clock-change", action="store_true",
+                   help="with --clock implied: the /clock's factor changes once or twice mid-run (within 0.5-2), and "
+                        "one time in two the clock pauses for 0.5-1 s; stamped sensors feeding no fuse on its timer")
     p.add_argument("--actions", action="store_true",
                    help="a Fibonacci action server in place of a SetBool server, one time in two")
     p.add_argument("--driver-offset", type=float, default=0.0, metavar="S",
@@ -524,6 +578,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--src", metavar="SRC", help="the rclverify sources to judge with (default: this tree's src/)")
     p.add_argument("--smoke", action="store_true", help="CI: generate and type-check 20 workspaces, no live run")
     a = p.parse_args(argv)
+    a.clock = a.clock or a.clock_change
     lo, _, hi = a.nodes.partition("-")
     sizes = (int(lo), int(hi or lo))
     if a.smoke:
@@ -537,13 +592,15 @@ def main(argv: list[str] | None = None) -> int:
     if a.write:
         for seed in seeds:
             n = random.Random(seed).randint(*sizes)
-            ws = write_workspace(generate(seed, n, a.defect, kinds, a.clock, a.actions), Path(a.write) / f"seed-{seed}")
+            ws = write_workspace(generate(seed, n, a.defect, kinds, a.clock, a.actions,
+                                                   a.driver_offset, a.clock_change), Path(a.write) / f"seed-{seed}")
             print(f"seed {seed}: {n} nodes: {ws}")
         return 0
     sys.path.insert(0, str(ROOT / "bench"))
     from _robot_run import run_many
     return run_many(seeds, sizes, a.seconds, a.defect, a.burn, Path(a.keep) if a.keep else None, kinds,
-                    Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock, a.actions, a.driver_offset)
+                    Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock, a.actions, a.driver_offset,
+                    a.clock_change)
 
 
 def _smoke() -> int:

@@ -214,6 +214,91 @@ def test_a_simulated_clock_leaves_the_nodes_as_drawn() -> None:
     assert '"clock": null' in gen.render(gen.generate(3, 8))["robot.py"]
 
 
+def test_a_changing_clock_changes_its_factor_once_or_twice_and_may_pause() -> None:
+    """``clock_change`` (``--clock-change``): one or two changes of factor within 0.5-2, each to another
+    factor, at 1.5-6.4 s after the sensing starts, never two at once; one time in two a pause of 0.5-1 s
+    that resumes at the factor it stopped, never last.  Deterministic, and without it no segment (the
+    control)."""
+    pauses = 0
+    for seed in range(1060, 1100):
+        clock = gen.generate(seed, 8, sim_clock=True, clock_change=True)["clock"]
+        assert clock == gen.generate(seed, 8, sim_clock=True, clock_change=True)["clock"]
+        assert gen.generate(seed, 8, sim_clock=True)["clock"] == {k: v for k, v in clock.items() if k != "segments"}
+        segs, rate = clock["segments"], clock["rate"]
+        ats = [at for at, _ in segs]
+        assert ats == sorted(ats) and len(set(ats)) == len(ats) and 1.5 <= ats[0] and ats[-1] <= 7.4, segs
+        assert segs[-1][1] > 0
+        changes = 0
+        for k, (at, r) in enumerate(segs):
+            if r == 0:
+                assert 0.5 <= segs[k + 1][0] - at <= 1.0 and segs[k + 1][1] == rate, segs
+                pauses += 1
+            elif k == 0 or segs[k - 1][1] != 0:
+                assert r in gen.CLOCK_RATES and r != rate, segs
+                changes += 1
+            rate = r if r else rate
+        assert changes in (1, 2), segs
+    assert 10 <= pauses <= 30, pauses
+
+
+def test_a_changing_clock_puts_stamped_sensors_feeding_no_fuse_on_its_timer() -> None:
+    """Under ``clock_change`` a stamped sensor feeding no fuse publishes on its simulated timer; its
+    period is declared at the largest factor the clock runs at; the nodes are otherwise those drawn
+    without it (the control: on a clock that does not change no sensor is on its timer)."""
+    seen = set()
+    for seed in range(1060, 1100):
+        spec = gen.generate(seed, 9, sim_clock=True, clock_change=True)
+        plain = gen.generate(seed, 9, sim_clock=True)
+        top = max([spec["clock"]["rate"]] + [r for _, r in spec["clock"]["segments"]])
+        fed = {f[k] for f in spec["nodes"] if f["kind"] == "fuse" for k in ("a_source", "b_source")}
+        for n, p in zip(spec["nodes"], plain["nodes"]):
+            assert "sim_timer" not in p
+            assert {k: v for k, v in n.items() if k not in ("periodic_ms", "periodic_rate", "sim_timer")} == \
+                {k: v for k, v in p.items() if k not in ("periodic_ms", "periodic_rate")}
+            if n["kind"] != "sensor":
+                continue
+            stamped = gen.SENSORS[n["sensor_kind"]][3]
+            assert n.get("sim_timer", False) == (stamped and n["name"] not in fed), (seed, n["name"])
+            assert n["periodic_rate"] == (top if stamped else 1.0)
+            seen.add((stamped, n.get("sim_timer", False)))
+    assert seen == {(True, True), (True, False), (False, False)}, seen
+
+
+def _clock_functions(spec: dict[str, Any]) -> dict[str, Any]:
+    """robot.py's ``sim_at`` and ``wall_of`` for ``spec``, run from the rendered text (its imports need
+    ROS 2's Python)."""
+    robot = gen.render(spec)["robot.py"]
+    text = robot[robot.index("SEGMENTS = "):robot.index("def f32(")]
+    env: dict[str, Any] = {"CLOCK": spec["clock"]}
+    exec(text, env)  # noqa: S102 - the generator's own template
+    return env
+
+
+@pytest.mark.parametrize("seed", range(1060, 1070))
+def test_a_changing_clocks_time_and_its_inverse_in_the_robot(seed: int) -> None:
+    """The robot's simulated time follows its segments (a pause stands still) and ``wall_of`` is the first
+    wall-clock time it reaches a simulated time: a sensor on the clock's timer fires when ``/clock``
+    passes its due time."""
+    spec = gen.generate(seed, 7, sim_clock=True, clock_change=True)
+    env = _clock_functions(spec)
+    env["CLOCK_T"].update(m0=100.0, t0=103.0)
+    sim_at, wall_of = env["sim_at"], env["wall_of"]
+    clock = spec["clock"]
+    assert sim_at(100.0) == clock["start_s"] and sim_at(103.0) == pytest.approx(clock["start_s"] + 3 * clock["rate"])
+    prev = sim_at(103.0)
+    for k in range(1, 1000):
+        w = 103.0 + k * 0.01
+        now = sim_at(w)
+        rate = ([clock["rate"]] + [r for at, r in clock["segments"] if at < k * 0.01])[-1]
+        if not any((k - 1) * 0.01 - 1e-6 <= at <= k * 0.01 + 1e-6 for at, _ in clock["segments"]):
+            assert now - prev == pytest.approx(0.01 * rate, abs=1e-9), (w, rate)
+        if rate > 0:
+            assert wall_of(now) == pytest.approx(w, abs=1e-9)
+        prev = now
+    assert any(r == 0 for _, r in clock["segments"]) == any(
+        sim_at(103.0 + at + 0.1) == sim_at(103.0 + at + 0.2) for at, r in clock["segments"] if r == 0)
+
+
 def test_actions_replace_some_servers_and_type_check(tmp_path: Path) -> None:
     """``actions`` turns SetBool servers, and only them, into Fibonacci action servers, with and without
     introspection across seeds, whose contracts type-check; the control: without it there is none."""
