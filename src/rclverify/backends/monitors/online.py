@@ -127,6 +127,8 @@ class OnlineEngine:
     monitors: list[NodeMonitor] = field(init=False)
     topics: dict[str, TopicStatus] = field(init=False)
     released: int = field(init=False, default=0)
+    #: messages a :meth:`tick` released with the watermark past the clock less the bound (early release)
+    released_early: int = field(init=False, default=0)
     #: the reorder buffer (traces/reorder.py, the one every path uses): (topic, fields, where) by stamp
     _buffer: ReorderBuffer[tuple[str, Mapping[str, object], str]] = field(init=False, default_factory=ReorderBuffer)
     _readers: dict[str, list[NodeMonitor]] = field(init=False)
@@ -361,7 +363,10 @@ class OnlineEngine:
         self._upto = max(self._upto, upto)
         if now > self._now:
             self._now = now
+        before = self.released
         self._release(upto)
+        if upto > now - self.reorder_window:
+            self.released_early += self.released - before
         for m in self.monitors:
             m.advance(max(self._clock, upto))
         if self.silence_s > 0:
