@@ -253,3 +253,49 @@ def test_an_action_server_is_covered_only_with_its_goal_and_result_events(result
         assert set(summary["unjudged"]["move"]) == {"server /s", "client /a"}, summary["unjudged"]
         mover = next(r for r in summary["nodes"] if r["node"] == "Mover")
         assert mover["counts"]["inconclusive"] == 2
+
+
+@pytest.mark.parametrize("gap", [5.0, 0.5], ids=["past the window: judged", "control: within the window: undecided"])
+def test_calls_paired_by_the_order_once_introspection_stopped_are_judged_past_the_last_request_it_took(
+        gap: float) -> None:
+    """The DDS source, one /estop server on Fast DDS (no request identity on the wire): its first call paired by
+    the server's introspection events, then the events stop (a server made again without them) and the order of
+    the request and reply topics pairs the next call, ``gap`` s later.  The client's request writer was matched
+    at 0 s; the order pairer did not hear the request the events took, whose reply could look like the next
+    call's within the window (the horizon, 1 s) after it.  Past that window the next call is judged (its wrong
+    answer ``violated``); within it (the control), ``inconclusive`` with the reason.  The window ran from the
+    first request heard after the events stopped, which left a call 5 s later undecided too."""
+    pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed")
+    from rclverify.runtime.dds.services import CallTaps
+    from rclverify.runtime.dds.types import TypeBook
+    lines: list[dict[str, Any]] = []
+    book = _book(lines)
+    taps = CallTaps(book, TypeBook([WS / "interfaces"]), LINKS, framed=False)
+    server, client = (bytes([1, 15, k]) + bytes(9) for k in (1, 3))  # Fast DDS participants (vendor 01 0f)
+    reply_w, event_w, request_w = (server + b"\x00\x00\x13\x03", server + b"\x00\x00\x15\x03",
+                                   client + b"\x00\x00\x14\x03")
+    read: dict[str, Any] = {  # the bus's taps as the pairing reads them
+        "call:/estop:event": SimpleNamespace(heard={event_w}),
+        "call:/estop:reply": SimpleNamespace(heard={reply_w}, dds_topic="rr/estopReply", reader_changes=0),
+        "call:/estop:request": SimpleNamespace(heard={request_w}, reader_changes=0)}
+    taps.taps = read
+    request, reply = (taps.specs[f"call:/estop:{p}"][1] for p in ("request", "reply"))
+
+    def call(t: float, right: bool) -> None:
+        taps._decode("call:/estop:request", request(data=True).serialize(), t, t, request_w)
+        taps._decode("call:/estop:reply", reply(success=right, message="").serialize(), t + 0.001, t + 0.001, reply_w)
+    taps._discover(0.0)  # the readers match the client's request writer and the server's reply writer
+    call(1.0, True)
+    assert taps.counts["introspected"] == 2  # the events pair it: the order pairer hears neither sample
+    taps.taps["call:/estop:event"].heard = set()  # the server's event writer gone
+    taps._discover(1.0 + gap - 0.1)
+    call(1.0 + gap, False)
+    book.tick(1.0 + gap + 5.0)
+    book.finish()
+    base = next(r for r in book.results.values() if r.node == "Base")
+    if gap > 1.0:
+        assert (base.counts["violated"], base.counts["inconclusive"]) == (1, 0), base.counts
+    else:
+        assert (base.counts["violated"], base.counts["inconclusive"]) == (0, 1), base.counts
+        (why,) = [x["reason"] for x in lines if x.get("unpaired")]
+        assert "less than 1 s before this reply of /estop" in why, why

@@ -26,6 +26,12 @@ it that its server has not answered yet.  The rules (docs/monitors.md,
   the answer of a request heard; so a reply stamped less than ``window``
   seconds (the monitor's horizon) after a request writer began to be heard
   is undecided where it would be paired, with the reason naming the writer.
+  A service whose calls its introspection events paired, then no longer
+  do (a server made again without them), is paired from then on by a
+  pairer that knows the servers and writers discovered before
+  (:meth:`OrderPairer.again`): a writer's window runs from the later of its
+  match and its last request the events took, the one request the order
+  did not hear whose reply may still come.
   Requests heard before a server's reply writer was matched are not waited
   for by it (their replies may have gone unheard): they are undecided when
   the server appears.
@@ -40,7 +46,7 @@ pairs calls exactly and needs none of this.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, Mapping
 
 #: requests remembered per service and server (the oldest unanswered one is forgotten beyond it, and said)
 MAX_OPEN = 10_000
@@ -135,6 +141,18 @@ class OrderPairer:
         self.unserved = []
         return [(p, f"it was written before the monitor heard {self.who(g)}, a server of {self.service}: its "
                  "reply may have gone unheard") for p in early]
+
+    def again(self, unheard: Mapping[bytes, float]) -> OrderPairer:
+        """A pairer of this service with no call open, for its calls once they change hands between its
+        introspection events and its request and reply topics (this one set aside): the servers this one
+        knows, each known since it was, and each request writer heard from the later of when this one began
+        hearing it and ``unheard[writer]``, the stamp (s) of that writer's last request this one did not hear
+        (the events took it; module docstring, "Nothing missed")."""
+        since = dict(self.heard_since)
+        for w, t in unheard.items():
+            since[w] = max(since.get(w, t), t)
+        return OrderPairer(self.service, self.window, self.who, {g: _Server(s.since) for g, s in self.servers.items()},
+                           since, forgotten=self.forgotten)
 
     # -- calls ---------------------------------------------------------------------------------
     def request(self, p: Pending) -> list[Pending]:

@@ -113,6 +113,9 @@ class CallTaps(EventSides, ActionTaps):
         self._queue: ReorderBuffer[tuple[float, str, bytes, bytes | None]] = ReorderBuffer()
         self._n = 0
         self._pairers: dict[str, OrderPairer] = {}
+        self._paired_before: dict[str, OrderPairer] = {}  # service -> its last pairer, kept when set aside
+        #: service -> request writer -> the stamp (s) of its last request the introspection events took
+        self._unheard: dict[str, dict[bytes, float]] = {}
         self._sides: dict[str, str | None] = {}  # per service, the introspection side last used
         self.sided: set[str] = set()  # the links some of whose calls an introspection side paired
         #: (link, endpoint owner) -> "metadata": an endpoint seen publishing events without contents
@@ -256,6 +259,8 @@ class CallTaps(EventSides, ActionTaps):
         elif part in ("request", "reply"):
             if self._side(name, stamp) is not None:
                 self.counts["introspected"] += 1
+                if part == "request" and writer is not None:  # a request the order pairer does not hear
+                    self._unheard.setdefault(name, {})[writer] = stamp
                 return  # the introspection events pair this service's calls (and would count them again)
             if part == "request":
                 self._request(name, s, stamp, framed, writer)
@@ -290,9 +295,14 @@ class CallTaps(EventSides, ActionTaps):
             self.book.unpaired(p.key, stamp, out.reason)
 
     def _pairer(self, name: str) -> OrderPairer:
+        """The order pairer of service ``name``; made again, from the one set aside, after its calls
+        changed hands between its introspection events and its request and reply topics (``_side``)."""
         p = self._pairers.get(name)
         if p is None:
-            p = self._pairers[name] = OrderPairer(name, self.book.horizon, self._who)
+            before = self._paired_before.get(name)
+            p = before.again(self._unheard.get(name, {})) if before is not None else \
+                OrderPairer(name, self.book.horizon, self._who)
+            self._pairers[name] = self._paired_before[name] = p
         return p
 
     def _who(self, guid: bytes) -> str:
