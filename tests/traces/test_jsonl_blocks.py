@@ -295,3 +295,53 @@ def test_a_leading_slash_is_removed_however_the_log_spells_it(tmp_path: Path, sp
     blocks = list(JsonlLog(p).blocks(["data"], 100))
     assert len(blocks) == 1 and isinstance(blocks[0], LogBlock)
     assert blocks[0].topics == ["reading"] * 6 == [ev.topic for ev in read_jsonl(p)]
+
+
+def test_a_column_kept_with_its_block_is_the_column_made_again(tmp_path: Path) -> None:
+    """``block_column`` (the deadline judge's and the untimed check's shared columns): on random logs of
+    floats, integers, strings, NaN and missing values, every request of field ``data`` at random rows, as
+    a ``REAL`` and as an enumeration, equals ``column`` of the block's values there, asked first or again,
+    and what a caller writes into one answer is not in the next.  The control: a block's kept column keyed
+    without its rows gives another request the first one's answer."""
+    from rclverify.targets.columns import block_column, column
+    rnd = random.Random("kept-columns")
+    values = [1.5, -0.0, 2.0, 7, float("nan"), "on", "off", None, True, [1.0]]
+    codes = {"on": 0, "off": 1}
+    blocks = 0
+    for k in range(20):
+        p = tmp_path / f"run{k}.jsonl"
+        with p.open("w") as out:
+            for i in range(rnd.randint(20, 80)):
+                msg: dict[str, Any] = {"topic": rnd.choice(["a", "b"]), "time": 0.01 * i}
+                v = rnd.choice(values)
+                if v is not None:
+                    msg["data"] = v
+                out.write(json.dumps(msg) + "\n")
+        got = JsonlLog(p).blocks(["data"], rnd.choice([7, 16, 1000]))
+        assert got is not None
+        for block in got:
+            if not isinstance(block, LogBlock):
+                continue
+            blocks += 1
+            for _ in range(6):
+                rows = np.flatnonzero(np.array([rnd.random() < 0.5 for _ in range(len(block))]))
+                for kind, c in (("real", {}), ("enum", codes)):
+                    want = column(block.values(rows, "data"), kind, c)
+                    for _ in range(2):
+                        good, col = block_column(block, rows, "data", kind, c)
+                        assert good.tolist() == want[0].tolist()
+                        assert np.array_equal(col, want[1], equal_nan=True) and col.dtype == want[1].dtype
+                        good[:] = False  # the caller's own copy
+                        col[:] = 0
+    assert blocks > 20
+    # the control: a key without the rows hands a second request of other rows the first one's column
+    p = tmp_path / "control.jsonl"
+    p.write_text("".join(json.dumps({"topic": "a", "time": 0.01 * i, "data": float(i)}) + "\n" for i in range(10)))
+    got = JsonlLog(p).blocks(["data"], 100)
+    assert got is not None
+    block = next(iter(got))
+    assert isinstance(block, LogBlock)
+    first, second = np.arange(0, 5), np.arange(5, 10)
+    wrong = [block.kept("no rows", lambda r=r: column(block.values(r, "data"), "real", {}))[1].tolist()
+             for r in (first, second)]
+    assert wrong[1] != block_column(block, second, "data", "real", {})[1].tolist()

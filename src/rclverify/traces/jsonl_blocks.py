@@ -67,7 +67,7 @@ from __future__ import annotations
 from collections import Counter
 from operator import attrgetter
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Literal, Sequence, Union
+from typing import Any, Callable, Hashable, Iterable, Iterator, Literal, Sequence, TypeVar, Union
 
 import msgspec
 from rclverify.core.numeric import np
@@ -87,6 +87,7 @@ MAX_KEYS = 64
 #: The most topics the flat read decodes as ``Literal`` values (the rest as strings, each line its own).
 MAX_TOPICS = 256
 _TOPIC, _TIME = attrgetter("f0"), attrgetter("f1")
+_T = TypeVar("_T")
 #: A JSON scalar as the untyped decoder reads it.
 _SCALAR = Union[str, float, int, bool, None]
 #: A flat line's values (module docstring): a scalar or an array of scalars; an object, or an array
@@ -169,7 +170,7 @@ def _reads(path: Path) -> Iterator[bytes]:
     """The log's bytes, a read at a time, each cut after its last ``b"\\n"`` (the
     rest carried to the next read; the log's end as it is)."""
     with path.open("rb") as fh:
-        pending: list[bytes] = []  # bytes after the last b"\n" read (a line may be longer than a read)
+        pending: list[bytes | memoryview] = []  # bytes after the last b"\n" read (a line may be longer than a read)
         while True:
             data = fh.read1(BLOCK_BYTES)
             if not data:
@@ -179,7 +180,7 @@ def _reads(path: Path) -> Iterator[bytes]:
                 pending.append(data)
                 continue
             if pending:
-                pending.append(data[:cut])
+                pending.append(memoryview(data)[:cut])  # joined without a copy of its own first
                 yield b"".join(pending)
                 pending = []
             else:
@@ -325,7 +326,8 @@ class LogBlock:
     the exact reader skip a row's line (a defect: the fast path takes only
     lines with a string topic and a finite float time, which it reads)."""
 
-    __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made", "_columns", "_codes")
+    __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made", "_columns", "_codes",
+                 "_kept")
 
     def __init__(self, path: Path, lines: Sequence[bytes] | _Slice, structs: list[Any], attr: dict[str, str], topics: list[str],
                  times: np.ndarray, lineno: int, index: int) -> None:
@@ -335,6 +337,18 @@ class LogBlock:
         #: a key's value at every row (an object column), made when a reader asks for many rows of it
         self._columns: dict[str, np.ndarray] = {}
         self._codes: tuple[np.ndarray, list[str]] | None = None
+        self._kept: dict[Hashable, Any] = {}
+
+    def kept(self, key: Hashable, make: Callable[[], _T]) -> _T:
+        """``make()``, made the first time ``key`` is asked for and kept with the block after that: a
+        column two readers of the block derive alike (the deadline judge and the untimed check's batch
+        path read the same fields at the same rows).  ``key`` must name everything ``make`` reads
+        besides the block, which does not change."""
+        if key in self._kept:
+            got: _T = self._kept[key]
+            return got
+        made = self._kept[key] = make()
+        return made
 
     def __len__(self) -> int:
         return len(self.structs)

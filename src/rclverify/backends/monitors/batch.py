@@ -241,7 +241,6 @@ class _Run(PairRuns, LoneSlots):
                 self.feed(ev)
             return []
         ok = kind != 0
-        decoded = block is not None and isinstance(block.block, LogBlock)  # a log's values: JSON's (window_column)
         unstamped = chunk.unstamped()
         if unstamped is not None:
             ok &= unstamped
@@ -255,7 +254,7 @@ class _Run(PairRuns, LoneSlots):
             rows = np.flatnonzero(kind == j)
             if kind_ == "window":  # a window: its message's array, (rows, width) (batch_window.py)
                 width = plan.widths[key]
-                good, col = window_column(chunk.values(rows, field), width, decoded)
+                good, col = window_column(chunk.values(rows, field), width)
                 full = np.zeros((n, width))
             else:
                 good, col = chunk.typed(rows, field, kind_, plan.enums.get(key, _EMPTY))

@@ -9,7 +9,7 @@ from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event
 from rclverify.targets.column_deadlines import expiries, first_answers, ns_column
-from rclverify.targets.columns import column, field_values
+from rclverify.targets.columns import block_column, column, field_values
 from rclverify.backends.monitors import deadline_skew
 from rclverify.backends.monitors.deadline_records import Pending
 from rclverify.backends.monitors.time_margins import TimeMargin
@@ -70,8 +70,12 @@ def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
         return False
     in_rows, out_rows = np.flatnonzero(kind == 1), np.flatnonzero(kind == -1)
     ik, ok = plan.in_key, plan.out_key
-    good_in, col_in = column(values(in_rows, plan.in_field), plan.in_kind, plan.codes.get(ik, {}))
-    good_out, col_out = column(values(out_rows, plan.out_field), plan.out_kind, plan.codes.get(ok, {}))
+    if isinstance(evs, list):
+        good_in, col_in = column(values(in_rows, plan.in_field), plan.in_kind, plan.codes.get(ik, {}))
+        good_out, col_out = column(values(out_rows, plan.out_field), plan.out_kind, plan.codes.get(ok, {}))
+    else:  # a log block: the columns the untimed check's batch path reads too, made once (block_column)
+        good_in, col_in = block_column(evs, in_rows, plan.in_field, plan.in_kind, plan.codes.get(ik, {}))
+        good_out, col_out = block_column(evs, out_rows, plan.out_field, plan.out_kind, plan.codes.get(ok, {}))
     if not (bool(good_in.all()) and bool(good_out.all())):
         return False
     accepted = np.ones(len(in_rows), dtype=bool)

@@ -42,12 +42,12 @@ verdicts given, the counts and margins).
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.core.numeric import np
 
 from rclverify.traces.events import Event
-from rclverify.targets.columns import seed
+from rclverify.targets.columns import block_column, seed
 from rclverify.backends.monitors.answered import RecentOutput
 from rclverify.backends.monitors.skew import within_before
 from rclverify.backends.monitors.batch_late import own_times
@@ -155,8 +155,8 @@ class LoneSlots(LoneState):
         itopic = next(iter(plan.inputs))
         _, ifield, ikind = plan.inputs[itopic]
         in_rows, out_rows = np.flatnonzero(k == 1), np.flatnonzero(k == -1)
-        good_in, col_in = chunk.typed(in_rows + s, ifield, ikind, plan.enums.get(ik, {}))
-        good_out, col_out = chunk.typed(out_rows + s, ofield, okind, plan.enums.get(okey, {}))
+        good_in, col_in = _typed(chunk, in_rows + s, ifield, ikind, plan.enums.get(ik, {}))
+        good_out, col_out = _typed(chunk, out_rows + s, ofield, okind, plan.enums.get(okey, {}))
         if not (bool(good_in.all()) and bool(good_out.all())):
             return s
         q0 = m.stream.latest
@@ -314,6 +314,16 @@ class LoneSlots(LoneState):
         result.events += L
         result.accepted += nq
         self.batched += no
+
+
+def _typed(chunk: EventRows | BlockRows, rows: np.ndarray, field: str, kind: str, codes: Mapping[str, int]
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """``chunk.typed``; for a log block with no event carried before it, the columns kept with the block
+    (:func:`~rclverify.targets.columns.block_column`: a deadline judge on the same run read them first)."""
+    block = getattr(chunk, "block", None)
+    if hasattr(block, "kept") and not getattr(chunk, "head", True):
+        return block_column(block, rows, field, kind, codes)
+    return chunk.typed(rows, field, kind, codes)
 
 
 __all__ = ["WARM", "LoneSlots", "lone_eligible"]

@@ -46,35 +46,29 @@ from rclverify.targets.column_windows import is_window
 _ORDERS = ("<", "<=", ">", ">=", "==", "!=")
 
 
-#: a float's own value; a TypeError for anything else (an int, a boolean, a string, None, a list); a float
-#: subclass's value as a float, which JSON's decoders never make (``window_column``'s ``decoded``)
-_OWN_FLOAT = float.__float__
+def _floats(entries: list[Any]) -> bool:
+    """Whether every entry is a ``float`` (its type read: an ``int``, a ``bool``, a string or a float
+    subclass is not one)."""
+    return set(map(type, entries)) == {float}
 
 
-def window_column(vals: list[Any], width: int, decoded: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def window_column(vals: list[Any], width: int) -> tuple[np.ndarray, np.ndarray]:
     """(rows the columns hold, the ``(rows, width)`` float64 column; NaN where not held) of the values
-    ``vals`` (a message's field each): a row holds a list of ``width`` finite floats.  ``decoded``: the
-    values are a JSON decoder's (a number an ``int`` or a ``float``, never a float subclass), so one pass
-    both converts and checks the entries (:data:`_OWN_FLOAT`); otherwise each entry's type is read."""
+    ``vals`` (a message's field each): a row holds a list of ``width`` finite floats (:func:`_floats`)."""
     n = len(vals)
     if not n:
         return np.zeros(0, dtype=bool), np.full((0, width), np.nan)
     if set(map(type, vals)) == {list} and set(map(len, vals)) == {width}:  # every row a list of width entries
-        col = None
-        if decoded:
-            try:  # every entry a float (a TypeError at the first that is not): at C speed, one pass
-                col = np.fromiter(map(_OWN_FLOAT, chain.from_iterable(vals)), np.float64, n * width)
-            except TypeError:
-                col = None
-        elif set(map(type, chain.from_iterable(vals))) == {float}:
-            col = np.fromiter(chain.from_iterable(vals), np.float64, n * width)
-        if col is not None:
-            col = col.reshape(n, width)
+        # the entries in one list, their types read in one pass and converted in one more, both at C speed
+        # (a third of the time of one pass calling a converter per entry)
+        entries = list(chain.from_iterable(vals))
+        if _floats(entries):
+            col = np.array(entries, dtype=np.float64).reshape(n, width)
             return np.asarray(np.isfinite(col).all(axis=1)), col
     col = np.full((n, width), np.nan)
     good = np.fromiter((type(v) is list and len(v) == width for v in vals), bool, n)
     rows = [v for v, g in zip(vals, good.tolist()) if g]
-    if rows and set(map(type, chain.from_iterable(rows))) != {float}:  # an integer, a boolean, a string...
+    if rows and not _floats(list(chain.from_iterable(rows))):  # an integer, a boolean, a string...
         ok = np.fromiter((all(type(x) is float for x in v) for v in rows), bool, len(rows))
         idx = np.flatnonzero(good)
         good[idx[~ok]] = False
