@@ -302,7 +302,7 @@ def test_a_column_kept_with_its_block_is_the_column_made_again(tmp_path: Path) -
     floats, integers, strings, NaN and missing values, every request of field ``data`` at random rows, as
     a ``REAL`` and as an enumeration, equals ``column`` of the block's values there, asked first or again,
     and what a caller writes into one answer is not in the next.  The control: a block's kept column keyed
-    without its rows gives another request the first one's answer."""
+    without its field's name gives another field the first one's column."""
     from rclverify.targets.columns import block_column, column
     rnd = random.Random("kept-columns")
     values = [1.5, -0.0, 2.0, 7, float("nan"), "on", "off", None, True, [1.0]]
@@ -334,14 +334,15 @@ def test_a_column_kept_with_its_block_is_the_column_made_again(tmp_path: Path) -
                         good[:] = False  # the caller's own copy
                         col[:] = 0
     assert blocks > 20
-    # the control: a key without the rows hands a second request of other rows the first one's column
+    # the control: a column kept without its field's name hands another field the first one's column
     p = tmp_path / "control.jsonl"
-    p.write_text("".join(json.dumps({"topic": "a", "time": 0.01 * i, "data": float(i)}) + "\n" for i in range(10)))
-    got = JsonlLog(p).blocks(["data"], 100)
+    p.write_text("".join(json.dumps({"topic": "a", "time": 0.01 * i, "data": float(i), "other": -1.0}) + "\n"
+                         for i in range(10)))
+    got = JsonlLog(p).blocks(["data", "other"], 100)
     assert got is not None
     block = next(iter(got))
     assert isinstance(block, LogBlock)
-    first, second = np.arange(0, 5), np.arange(5, 10)
-    wrong = [block.kept("no rows", lambda r=r: column(block.values(r, "data"), "real", {}))[1].tolist()
-             for r in (first, second)]
-    assert wrong[1] != block_column(block, second, "data", "real", {})[1].tolist()
+    every = np.arange(len(block))
+    wrong = [block.kept("no name", lambda f=f: column(block.values(every, f), "real", {}))[1].tolist()
+             for f in ("data", "other")]
+    assert wrong[1] != block_column(block, every, "other", "real", {})[1].tolist()

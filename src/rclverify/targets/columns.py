@@ -309,12 +309,13 @@ def column(vals: list[Any], kind: str, codes: Mapping[str, int]) -> tuple[np.nda
 def block_column(block: Any, rows: np.ndarray, name: str, kind: str, codes: Mapping[str, int]
                  ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`column` of field ``name`` at ``rows`` of a log block (``traces/jsonl_blocks.LogBlock``: its
-    ``values`` and ``kept``), made once per block for the same rows, field, kind and codes and kept with
-    the block (the deadline judge and the untimed check's batch path read the same rows of the same
-    block); copies of the kept arrays, so a caller may write into what it gets."""
-    key = ("column", name, kind, tuple(codes.items()), rows.dtype.str, rows.tobytes())
-    good, col = block.kept(key, lambda: column(block.values(rows, name), kind, codes))
-    return good.copy(), col.copy()
+    ``values`` and ``kept``): :func:`column` maps each row alone, so the column of every row of the block
+    is made once for the field, kind and codes and kept with the block (the deadline judge and the
+    untimed check's batch path read the same fields of the same block), and each request takes its rows
+    of it (copies, so a caller may write into what it gets)."""
+    good, col = block.kept(("column", name, kind, tuple(codes.items())),
+                           lambda: column(block.values(np.arange(len(block)), name), kind, codes))
+    return good[rows], col[rows]
 
 
 __all__ = ["ColumnCompiler", "Compiled", "Unsupported", "block_column", "column", "field_values", "io_kind", "seed"]
