@@ -1,7 +1,7 @@
 """A copied stamp of a clock standing still (traces/event_time.py, ``CopiedStamps``): while a simulated
 clock is paused, one writer stamps several messages alike; a node copying each one's stamp onto its
 answer names them in order, the k-th copy the k-th message published before it, never the first for all
-(generated seed 1069: tests/backends/test_clock_rate_change_seed1069.py)."""
+(generated seed 1069: tests/backends/test_clock_rate_change_seeds.py)."""
 from __future__ import annotations
 
 from rclverify.traces.event_time import CopiedStamps

@@ -73,7 +73,7 @@ def revise(mon: LateAnswers, ev: Event, ns: int, fresh: Mapping[str, object]) ->
     ``undecided`` (:func:`.deadline_skew.revise_false`), its late answer's margin withdrawn."""
     for entry in list(mon.answered_late):
         p = entry[0]
-        if ns < p.stamp_ns and deadline_skew.within_skew_before(mon, p, ns) and \
+        if ns < p.stamp_ns and deadline_skew.may_answer(mon, p, ev, ns) and \
                 deadline_skew.revise_false(mon, p, ev, ns, fresh, answered=True):
             mon.answered_late.remove(entry)
             _withdraw_margin(mon, entry)

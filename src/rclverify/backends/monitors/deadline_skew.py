@@ -21,6 +21,14 @@ before; left unanswered when the clock passes its deadline it is
 ``false``: the skew makes no red and no green.  An output stamped more than
 the skew before the trigger is never its answer, and an obligation with no
 such output that goes unanswered is ``false`` as before.
+
+So is an output placed before the trigger as the copy of a stamp in another
+clock (its stamp set aside, traces/event_time.py, ``CopiedStamps``) but
+published after the trigger, within its deadline (:func:`published_after`: the
+event's ``source``): a simulated clock standing still gives several messages
+alike the stamp it copies, so it may be this trigger's answer; the stamps
+cannot say which question it answers (docs/semantics.md, "Event time";
+generated seed 1075).
 """
 from __future__ import annotations
 
@@ -31,6 +39,7 @@ from typing import Callable, Mapping, Protocol
 from rclverify.semantics.floatsem import Tolerance, judge
 from rclverify.lang import ast
 from rclverify.lang.types import Checked, CheckedNode
+from rclverify.traces.event_time import aside_stamp
 from rclverify.traces.events import Event
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_text import ms_ns
@@ -68,6 +77,21 @@ def within_skew_before(mon: DeadlineMonitor, p: Pending, ns: int) -> bool:
     return mon.skew_ns > 0 and within_before(ns, p.stamp_ns, mon.skew_ns)
 
 
+def published_after(p: Pending, ev: Event, ns: int) -> bool:
+    """Whether output ``ev``, placed at ``ns`` (integer ns) before obligation ``p``'s trigger as the copy of
+    a stamp in another clock (:func:`~rclverify.traces.event_time.aside_stamp`), was published after that
+    trigger and by its deadline (its ``source``, s): a copy of a stamp a clock standing still shares."""
+    if ev.source is None or ns >= p.stamp_ns or not p.stamp_ns < round(ev.source * 1_000_000_000) <= p.due_ns:
+        return False
+    return aside_stamp(ev.fields) is not None
+
+
+def may_answer(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int) -> bool:
+    """Whether output ``ev``, placed at ``ns`` before ``p``'s trigger, may still be its answer: within the
+    skew before it (:func:`within_skew_before`) or published after it (:func:`published_after`)."""
+    return within_skew_before(mon, p, ns) or published_after(p, ev, ns)
+
+
 def mark_early(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapping[str, object]) -> None:
     """Output ``ev`` (stamped ``ns``, within the skew before ``p``'s trigger; ``fresh`` the outputs it set) may be
     ``p``'s answer: mark ``p`` (:attr:`~.deadline_records.Pending.maybe`) when it satisfies ``p``'s guarantee on
@@ -79,19 +103,24 @@ def mark_early(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapp
         return
     values = mon._visible(p, ns / 1e9)
     values.update(fresh)
-    if judge(cl.formula, mon.checked, mon.node, values, mon.tolerance).truth is True:
+    if judge(cl.formula, mon.checked, mon.node, values, mon.tolerance).truth is not True:
+        return
+    if within_skew_before(mon, p, ns):
         p.maybe = (f"the output at {ev.where}, stamped {ms_ns(p.stamp_ns - ns)} before the trigger (within the "
                    f"transport skew of {ms_ns(mon.skew_ns)}), satisfies guarantee {k} on the trigger's inputs and may "
                    "be its answer")
+    elif ev.source is not None:
+        p.maybe = (f"the output at {ev.where}, placed {ms_ns(p.stamp_ns - ns)} before the trigger as the copy of "
+                   f"a stamp in another clock but published {ms_ns(round(ev.source * 1_000_000_000) - p.stamp_ns)} "
+                   f"after it (a clock standing still gives several messages that stamp), satisfies guarantee {k} "
+                   "on the trigger's inputs and may be its answer")
 
 
 def scan_heard(mon: DeadlineMonitor, p: Pending) -> None:
-    """Mark ``p`` from the outputs already heard (the last 64 kept) stamped within the skew before its trigger
-    (:func:`within_skew_before`), oldest first."""
-    skew, stamp = mon.skew_ns, p.stamp_ns
-    if skew <= 0:
-        return
-    for ns, ev, _, fresh in [h for h in mon.heard if within_before(h[0], stamp, skew)]:
+    """Mark ``p`` from the outputs already heard (the last 64 kept) that may be its answer (:func:`may_answer`:
+    stamped within the skew before its trigger, or placed before it and published after it), oldest first."""
+    for ns, ev, _, fresh in [h for h in mon.heard if h[0] < p.stamp_ns and published_after(p, h[1], h[0])
+                             or mon.skew_ns > 0 and within_before(h[0], p.stamp_ns, mon.skew_ns)]:
         mark_early(mon, p, ev, ns, fresh)
         if p.maybe:
             return
@@ -151,4 +180,5 @@ def decided_late(mon: DeadlineMonitor, p: Pending) -> None:
         res.first_unaccepted = None
 
 
-__all__ = ["decided_late", "mark_early", "revise_false", "scan_heard", "skew_ns", "undecided", "within_skew_before"]
+__all__ = ["decided_late", "mark_early", "may_answer", "published_after", "revise_false", "scan_heard", "skew_ns",
+           "undecided", "within_skew_before"]

@@ -227,8 +227,7 @@ class DeadlineMonitor(VerdictWords):
                 d_ns = self.bounds_ns[k]
                 p = Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
                 if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
-                    if self.skew_ns:
-                        deadline_skew.scan_heard(self, p)
+                    deadline_skew.scan_heard(self, p)
                     self.pending.append(p)
                 continue
             why, reason = refused
@@ -268,7 +267,7 @@ class DeadlineMonitor(VerdictWords):
         stamp = ns / 1e9
         for p in list(self.expired):
             if ns < p.stamp_ns:  # stamped before its trigger, heard after the clock passed its deadline
-                if not p.maybe and deadline_skew.within_skew_before(self, p, ns):
+                if not p.maybe and deadline_skew.may_answer(self, p, ev, ns):
                     deadline_skew.revise_false(self, p, ev, ns, {c: self.values[c] for c in outs
                                                                   if c not in self.state_outs})
                 continue
@@ -304,8 +303,8 @@ class DeadlineMonitor(VerdictWords):
         k, cl, _, gouts, d = self.timed_k[p.k]
         if not (gouts & outs):
             return False
-        if ns < p.stamp_ns:  # stamped before the trigger: within the skew, it may be its answer (deadline_skew)
-            if deadline_skew.within_skew_before(self, p, ns):
+        if ns < p.stamp_ns:  # stamped before the trigger: within the skew, or published after it, it may be its answer
+            if deadline_skew.may_answer(self, p, ev, ns):
                 deadline_skew.mark_early(self, p, ev, ns, {c: self.values[c] for c in outs if c not in self.state_outs})
             return False
         stamp = ns / 1e9

@@ -1,0 +1,89 @@
+"""Generated robots on a ``/clock`` that changes its rate and pauses (``--clock-change``, both cores busy),
+each kept as its bag and judged offline (the bag holds the raw stamps; the log holds what the live run
+placed before the fix).
+
+Seed 1069 (7 nodes, DDS source, x0.5 from 5000 s changing to x0.75, paused for 0.94 s, then x0.75 and
+x1): Sensor0 (``sensor_msgs/Range``, on the wall clock: it leads a fuse) published twice while the clock
+was paused, both readings stamped 5004.139 s; Relay1 copies each reading's stamp onto its answer, 0.3 s
+later.  Both readings' stamps run in another clock (set aside); the answer's copied stamp named the
+first message so stamped, so the answer to the second reading was placed at the first (traces/
+event_time.py, ``CopiedStamps``): the second reading had no answer of its own within its deadline,
+``false`` live, on the log and on the bag of a correct relay, and the answer ``inconclusive``.  A copy
+of a stamp shared by several messages of its writer (a clock standing still) now names them in order,
+the k-th copy the k-th message: every deadline of the relay met, every answer satisfied.  The rule and
+its control: tests/traces/test_clock_paused_copies.py.
+
+Seed 1075 (8 nodes, rclpy source, x1.5 from 100 s, x1, paused for 0.67 s, x1, x2): three relays stamp
+their answers to one unstamped reading with their own clock.  The clock paused just after Relay6's
+answer, so Relay1's and Relay7's answers to the next reading carried Relay6's stamp exactly and were
+placed as copies of it, before the reading they answer: its deadline ``false`` at both (live, log and
+bag).  The stamps cannot say which question such an answer answers, so a trigger left without an answer
+of its own whose deadline an output placed before it as such a copy but published after it may meet is
+``undecided``, with why, never ``false`` (backends/monitors/deadline_skew.py, ``published_after``); the
+same run replayed through the online engine gives the bag's verdicts.  The control, an answer in the
+run's clock stamped beyond the skew before its trigger, stays ``false``
+(tests/backends/test_deadline_heard_late.py)."""
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.cli.commands import main
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+from _robot_verdicts import compare, finals  # noqa: E402
+from test_generated_seed_faults import _offline, _online  # noqa: E402
+
+SEED_1069 = Path(__file__).resolve().parents[1] / "data" / "robot_seed1069"
+SEED_1075 = Path(__file__).resolve().parents[1] / "data" / "robot_seed1075"
+
+
+def test_seed_1069_a_relay_copying_stamps_of_a_paused_clock_meets_every_deadline(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    ws = tmp_path / "ws"
+    shutil.copytree(SEED_1069, ws)
+    monkeypatch.chdir(ws)
+    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
+    rows: list[Any] = json.loads(capsys.readouterr().out)
+    deadlines = {r["node"]: r["deadlines"]["counts"] for r in rows if "deadlines" in r}
+    counts = {r["node"]: r["counts"] for r in rows if "counts" in r}
+    assert deadlines["Relay1"]["false"] == 0 and deadlines["Relay1"]["true"] == 25, deadlines["Relay1"]
+    assert all(c["false"] == 0 for c in deadlines.values()), deadlines
+    assert counts["Relay1"]["satisfied"] == 25 and counts["Relay1"]["inconclusive"] == 0, counts["Relay1"]
+    assert all(c["violated"] == 0 for c in counts.values()), counts
+    other = [(r["node"], d["declaration"], d["verdict"]) for r in rows for d in r.get("declarations", [])
+             if d["verdict"] != "true"]
+    assert other == [], other
+
+
+def test_seed_1075_answers_placed_as_copies_of_a_paused_clocks_stamp_leave_their_readings_undecided(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    ws = tmp_path / "ws"
+    shutil.copytree(SEED_1075, ws)
+    monkeypatch.chdir(ws)
+    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
+    rows: list[Any] = json.loads(capsys.readouterr().out)
+    deadlines = {r["node"]: r["deadlines"] for r in rows if "deadlines" in r}
+    assert all(d["counts"]["false"] == 0 for d in deadlines.values()), {n: d["counts"] for n, d in deadlines.items()}
+    for relay in ("Relay1", "Relay7"):
+        d = deadlines[relay]
+        assert d["unaccepted"]["undecided"] == 1 and d["counts"]["true"] == 24, d
+        assert "as the copy of a stamp in another clock but published" in d["first_unaccepted"]["reason"], d
+    assert deadlines["Relay6"]["unaccepted"]["undecided"] == 0 and deadlines["Relay6"]["counts"]["true"] == 25
+    assert all(r["counts"]["violated"] == 0 for r in rows if "counts" in r)
+
+
+def test_seed_1075_live_is_the_bag() -> None:
+    """The bag replayed through the online engine (as the live run judged it) gives the bag's verdicts on
+    the sensor and its three relays, the two readings left undecided included."""
+    names = ("Sensor0", "Relay1", "Relay6", "Relay7")
+    online, bag = finals(_online(SEED_1075, names)), finals(_offline(SEED_1075, "runs/bag", names))
+    assert compare(online, bag) == [], [d.text(("live", "bag")) for d in compare(online, bag)]
+    undecided = sorted(b[0] for b, rs in online.items() for r in rs if b[1] == "deadline" and r["verdict"] == "undecided")
+    assert undecided == ["Relay1", "Relay7"], undecided
+    assert not [r for b, rs in online.items() for r in rs if b[1] == "deadline" and r["verdict"] == "false"]
