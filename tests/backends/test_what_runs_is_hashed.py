@@ -15,6 +15,7 @@ from typing import Any, Iterator
 
 import pytest
 
+from _restore import restored
 from rclverify.app.pipeline import Workspace
 from rclverify.backends.property_tests.backend import PropertyTestsBackend
 from rclverify.backends.property_tests.closure import resolve_closure
@@ -229,30 +230,67 @@ def _record(ws: Path) -> bytes:
     return b"".join(p.read_bytes() for p in sorted((ws / "artifacts/evidence").glob("*.json")))
 
 
-def test_editing_the_helper_that_runs_re_runs_and_agrees_with_a_clean_run(tmp_path: Path) -> None:
-    ws = _workspace(tmp_path / "ws", {"backends/property_tests/helper.py": GOOD, "helper.py": GOOD})
-    assert _verify(ws) == ("discharged", "discharged")
-    (ws / "backends/property_tests/helper.py").write_text(BAD)  # the one earlier on the harness's path
-    assert _verify(ws) == ("failed", "failed")
-    assert _clean(ws, tmp_path / "clean") == ("failed", "failed")
+@pytest.fixture(scope="module")
+def both_good(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, tuple[str, str]]:
+    """A helper beside the implementation and one at the root, both correct, verified once for the module:
+    ``(workspace, its first run's statuses)``.  The tests that edit it do so in place and put it back
+    (tests/_restore.py), so that their second run is the incremental one a user's edit gets."""
+    ws = _workspace(tmp_path_factory.mktemp("both-good") / "ws",
+                    {"backends/property_tests/helper.py": GOOD, "helper.py": GOOD})
+    return ws, _verify(ws)
 
 
-def test_control_editing_the_shadowed_helper_leaves_the_evidence_current(tmp_path: Path) -> None:
-    ws = _workspace(tmp_path / "ws", {"backends/property_tests/helper.py": GOOD, "helper.py": GOOD})
-    assert _verify(ws) == ("discharged", "discharged")
-    before = _record(ws)
-    (ws / "helper.py").write_text(BAD)  # behind the implementation's own helper: it never runs
-    assert _verify(ws) == ("discharged", "discharged")
-    assert _record(ws) == before  # not stale, not run again
-    assert _clean(ws, tmp_path / "clean") == ("discharged", "discharged")
+@pytest.fixture(scope="module")
+def clean_front_bad(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, str]:
+    """A clean run of the workspace the two edits below end in (a wrong helper beside the implementation, a
+    correct one at the root): what their incremental runs must agree with.  One run for both: their
+    workspaces hold the same files (``_clean`` copies inputs only, never records)."""
+    ws = _workspace(tmp_path_factory.mktemp("front-bad") / "clean",
+                    {"backends/property_tests/helper.py": BAD, "helper.py": GOOD})
+    return _verify(ws)
 
 
-def test_a_helper_created_in_front_of_the_hashed_one_re_runs_the_tests(tmp_path: Path) -> None:
+def test_editing_the_helper_that_runs_re_runs_and_agrees_with_a_clean_run(
+        tmp_path: Path, both_good: tuple[Path, tuple[str, str]], clean_front_bad: tuple[str, str]) -> None:
+    assert both_good[1] == ("discharged", "discharged")
+    with restored(both_good[0], tmp_path / "before") as ws:
+        (ws / "backends/property_tests/helper.py").write_text(BAD)  # the one earlier on the harness's path
+        assert _verify(ws) == ("failed", "failed")
+        assert _inputs(ws) == _inputs(_front_bad(tmp_path / "same"))  # the clean run's files
+    assert clean_front_bad == ("failed", "failed")
+
+
+def test_control_editing_the_shadowed_helper_leaves_the_evidence_current(
+        tmp_path: Path, both_good: tuple[Path, tuple[str, str]]) -> None:
+    assert both_good[1] == ("discharged", "discharged")
+    with restored(both_good[0], tmp_path / "before") as ws:
+        before = _record(ws)
+        (ws / "helper.py").write_text(BAD)  # behind the implementation's own helper: it never runs
+        assert _verify(ws) == ("discharged", "discharged")
+        assert _record(ws) == before  # not stale, not run again
+        assert _clean(ws, tmp_path / "clean") == ("discharged", "discharged")
+
+
+def test_a_helper_created_in_front_of_the_hashed_one_re_runs_the_tests(
+        tmp_path: Path, clean_front_bad: tuple[str, str]) -> None:
     ws = _workspace(tmp_path / "ws", {"helper.py": GOOD})
     assert _verify(ws) == ("discharged", "discharged")
     (ws / "backends/property_tests/helper.py").write_text(BAD)  # now found first: what runs changed
     assert _verify(ws) == ("failed", "failed")
-    assert _clean(ws, tmp_path / "clean") == ("failed", "failed")
+    assert _inputs(ws) == _inputs(_front_bad(tmp_path / "same"))  # the clean run's files
+    assert clean_front_bad == ("failed", "failed")
+
+
+def _front_bad(root: Path) -> Path:
+    """The inputs of :func:`clean_front_bad`'s workspace, written again (not run)."""
+    return _workspace(root, {"backends/property_tests/helper.py": BAD, "helper.py": GOOD})
+
+
+def _inputs(ws: Path) -> dict[str, bytes]:
+    """The workspace's inputs as ``_clean`` copies them: every file but records, reports, doit's state, bytecode."""
+    skip = ("artifacts", "reports", "__pycache__")
+    return {str(p.relative_to(ws)): p.read_bytes() for p in sorted(ws.rglob("*")) if p.is_file()
+            and not any(part in skip or part.startswith(".doit") for part in p.relative_to(ws).parts)}
 
 
 @pytest.mark.parametrize("own", [
