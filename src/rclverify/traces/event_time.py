@@ -155,6 +155,10 @@ def published(stamp: float, source: float) -> float | None:
 #: how long (s) a stamp in another clock is kept for a copy of it to name its message (a relay's answer
 #: published this long after its question at most)
 COPY_S = 60.0
+#: a message published within this (s) of another writer's with the same stamp in another clock names it not:
+#: two writers stamping one simulated clock's time alike within one of its ticks are heard in either order
+#: (the transport skew), so which came first, and so which would be the copy, is not the run's to say
+COPY_AFTER_S = 0.02
 
 
 class CopiedStamps:
@@ -172,8 +176,12 @@ class CopiedStamps:
     k-th of them published before it (a node answers its questions in the
     order asked), never the first for all (generated seed 1069: a relay's
     answer to the second reading of a paused clock was placed at the first,
-    leaving the second unanswered past its deadline).  ``copied`` counts the
-    messages so placed."""
+    leaving the second unanswered past its deadline).  A message published
+    within :data:`COPY_AFTER_S` of the one it would name is no copy of it:
+    two writers stamping a simulated clock's time alike within one tick are
+    heard in either order, and the live run and its bag would place them
+    apart (generated seed 1091: three relays stamping with their own clock,
+    7.5 ms apart).  ``copied`` counts the messages so placed."""
 
     __slots__ = ("_first", "_named", "copied")
 
@@ -192,9 +200,9 @@ class CopiedStamps:
         message of ``topic`` stamped ``stamp`` and published at ``source``
         (s) copies the stamp of (class docstring), counted; else ``None``."""
         got = self._first.get(stamp)
-        if got is None or got[0] == topic or not 0.0 <= source - got[1][0] <= COPY_S:
+        if got is None or got[0] == topic or not COPY_AFTER_S < source - got[1][0] <= COPY_S:
             return None
-        before = [t for t in got[1] if t <= source]
+        before = [t for t in got[1] if t < source - COPY_AFTER_S]
         named = self._named.setdefault(stamp, {})
         k = named.get(topic, 0)
         named[topic] = k + 1
@@ -206,7 +214,8 @@ class CopiedStamps:
         ``topic`` with header stamp ``stamp`` (s, another clock) and source
         time ``source`` (s) is placed at, the source time of the message of
         another writer stamped ``stamp`` within :data:`COPY_S` before it that
-        it names (class docstring; ``copied`` true), else ``source``."""
+        it names (class docstring; ``copied`` true; published more than
+        :data:`COPY_AFTER_S` after it), else ``source``."""
         named = self._name(topic, stamp, source)
         if named is not None:
             return named, True
