@@ -116,9 +116,9 @@ def with_stamp(fields: Mapping[str, Any], stamp: float) -> dict[str, Any]:
     carried into the run's clock at the time its message was placed
     (:class:`CopiedStamps`), so a log of the run places it there again.  The
     stamp it replaces is kept as ``header.stamp_aside``, as
-    :func:`without_stamp` keeps it (the clock of the node that stamped it: two
-    sensors on one simulated clock stamp alike within one of its ticks, and
-    the second is placed as a copy of the first)."""
+    :func:`without_stamp` keeps it (the clock of the node that stamped it: a
+    message of a simulated clock that stands still is placed as a copy of
+    another writer's stamped alike)."""
     sec = int(stamp)
     ns = min(round((stamp - sec) * 1e9), 999_999_999)
     out = dict(fields)
