@@ -841,7 +841,7 @@ def _mypy(args: list[str], cache: Path) -> tuple[int, str]:
 
 
 @pytest.mark.parametrize("module", sorted(TYPED_FILTERS))
-def test_a_typed_filter_reading_a_removed_field_fails_mypy(module: str, tmp_path: Path) -> None:
+def test_a_typed_filter_reading_a_removed_field_fails_mypy(module: str, mypy_cache: Path, tmp_path: Path) -> None:
     """Each field a typed filter reads off its record, removed from the record's class (mypy's
     ``--shadow-file``, the checked-in file untouched), makes mypy strict fail at the filter's read; the
     control, the record as it is, passes."""
@@ -850,12 +850,12 @@ def test_a_typed_filter_reading_a_removed_field_fails_mypy(module: str, tmp_path
     read = sorted(fields_read_code(filt.read_text(encoding="utf-8"), cls) & set(cls.__struct_fields__))
     assert read, f"{filt.name} reads no field of {cls.__name__}"
     record = Path(inspect.getfile(sys.modules[cls.__module__]))
-    rc, out = _mypy([str(filt)], tmp_path / "cache")
+    rc, out = _mypy([str(filt)], mypy_cache)
     assert rc == 0, out
     for field in read:
         shadow = tmp_path / f"without_{field}.py"
         shadow.write_text(_without_field(record.read_text(encoding="utf-8"), cls.__name__, field), encoding="utf-8")
-        rc, out = _mypy(["--shadow-file", str(record), str(shadow), str(filt)], tmp_path / "cache")
+        rc, out = _mypy(["--shadow-file", str(record), str(shadow), str(filt)], mypy_cache)
         assert rc == 1 and f'{filt.name}:' in out and f'"{cls.__name__}" has no attribute "{field}"' in out, out
 
 
