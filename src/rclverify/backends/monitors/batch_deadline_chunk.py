@@ -54,6 +54,16 @@ def _kinds(mon: ChunkSide, evs: list[Event] | Any, topics: list[str]) -> np.ndar
     return np.fromiter(map(lut.__getitem__, topics), np.int8, len(topics))
 
 
+def _typed(evs: list[Event] | Any, values: Callable[[np.ndarray, str], list[Any]], rows: np.ndarray, field: str,
+           kind: str, codes: Mapping[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Field ``field`` at ``rows`` as :func:`~rclverify.targets.columns.column` reads it (``values``: the chunk's
+    values, :func:`_columns`); of a log block, the columns the untimed check's batch path reads too, made once
+    (:func:`~rclverify.targets.columns.block_column`)."""
+    if isinstance(evs, list):
+        return column(values(rows, field), kind, codes)
+    return block_column(evs, rows, field, kind, codes)
+
+
 def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
     """Judge the events ``evs`` (a list, or a log block: :func:`_columns`) as the streaming monitor
     would, over columns, and leave its state; ``False`` (nothing changed) when the chunk is not clean."""
@@ -70,12 +80,8 @@ def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
         return False
     in_rows, out_rows = np.flatnonzero(kind == 1), np.flatnonzero(kind == -1)
     ik, ok = plan.in_key, plan.out_key
-    if isinstance(evs, list):
-        good_in, col_in = column(values(in_rows, plan.in_field), plan.in_kind, plan.codes.get(ik, {}))
-        good_out, col_out = column(values(out_rows, plan.out_field), plan.out_kind, plan.codes.get(ok, {}))
-    else:  # a log block: the columns the untimed check's batch path reads too, made once (block_column)
-        good_in, col_in = block_column(evs, in_rows, plan.in_field, plan.in_kind, plan.codes.get(ik, {}))
-        good_out, col_out = block_column(evs, out_rows, plan.out_field, plan.out_kind, plan.codes.get(ok, {}))
+    good_in, col_in = _typed(evs, values, in_rows, plan.in_field, plan.in_kind, plan.codes.get(ik, {}))
+    good_out, col_out = _typed(evs, values, out_rows, plan.out_field, plan.out_kind, plan.codes.get(ok, {}))
     if not (bool(good_in.all()) and bool(good_out.all())):
         return False
     accepted = np.ones(len(in_rows), dtype=bool)
