@@ -10,6 +10,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+from _restore import restored
+
 RCL = """node Echo {
   inputs( r : REAL )
   outputs( y : REAL )
@@ -63,9 +67,23 @@ def _retarget(link: Path, target: Path | str) -> None:
     link.symlink_to(target)
 
 
-def test_a_trace_link_retargeted_outside_is_refused_as_by_a_clean_run(tmp_path: Path) -> None:
-    ws, outside = _workspace(tmp_path)
-    assert _verify(ws) == (0, [])  # control: inside the workspace, the run is discharged
+@pytest.fixture(scope="module")
+def verified(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, tuple[int, list[str]]]:
+    """The workspace verified once for the module, its link inside: ``(workspace, the folder outside it, the
+    run's exit code and error lines)``.  Each test retargets the link in place and puts the workspace back
+    (tests/_restore.py), so that its next run is the incremental one a user's edit gets."""
+    ws, outside = _workspace(tmp_path_factory.mktemp("paths"))
+    return ws, outside, _verify(ws)
+
+
+def test_a_trace_link_retargeted_outside_is_refused_as_by_a_clean_run(
+        tmp_path: Path, verified: tuple[Path, Path, tuple[int, list[str]]]) -> None:
+    with restored(verified[0], tmp_path / "before") as ws:
+        _retargeted_outside(ws, verified[1], verified[2], tmp_path)
+
+
+def _retargeted_outside(ws: Path, outside: Path, first: tuple[int, list[str]], tmp_path: Path) -> None:
+    assert first == (0, [])  # control: inside the workspace, the run is discharged
     records = {p.name: p.read_bytes() for p in (ws / "artifacts" / "evidence").glob("*.json")}
     _retarget(ws / "traces" / "run.jsonl", outside / "secret.jsonl")
     clean = tmp_path / "clean"
@@ -79,9 +97,14 @@ def test_a_trace_link_retargeted_outside_is_refused_as_by_a_clean_run(tmp_path: 
     assert records and records == {p.name: p.read_bytes() for p in (ws / "artifacts" / "evidence").glob("*.json")}
 
 
-def test_a_link_retargeted_inside_the_workspace_is_verified_again(tmp_path: Path) -> None:
-    ws, _ = _workspace(tmp_path)
-    assert _verify(ws) == (0, [])
+def test_a_link_retargeted_inside_the_workspace_is_verified_again(
+        tmp_path: Path, verified: tuple[Path, Path, tuple[int, list[str]]]) -> None:
+    with restored(verified[0], tmp_path / "before") as ws:
+        _retargeted_inside(ws, verified[2])
+
+
+def _retargeted_inside(ws: Path, first: tuple[int, list[str]]) -> None:
+    assert first == (0, [])
     _retarget(ws / "traces" / "run.jsonl", "other.jsonl")  # control: still inside, so no error
     assert _verify(ws) == (0, [])
     report = json.loads((ws / "reports" / "assurance.json").read_text(encoding="utf-8"))
