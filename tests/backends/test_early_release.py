@@ -12,6 +12,10 @@ a topic with no writer matched, or no sets told at all, keeping the clock less t
 matched late whose first message is older than the watermark: late, and no verdict of a correct node
 violated.  Each has its control in the same case.
 
+Live = log: a run released early, with and without a reading publisher matched late whose reading is
+late, written as the live monitor writes its log, is judged verdict by verdict as the offline check of
+that log judges it (bench/_robot_verdicts.py's comparison), no correct answer red.
+
 The oracle: random runs (several writers on one topic, monotone stamps per writer, a stamp-copying
 relay answering in stamp order with a lag that grows, delivery delays below the bound, in order per
 writer) fed in arrival order with the timer every 5 ms: every message's last verdict equals that of
@@ -301,3 +305,72 @@ def test_the_engine_thread_ticks_right_after_a_batch_lets_the_watermark_pass_the
         assert sink.pushed == [("x", b"X")]  # the writer's id handed on
     finally:
         worker.stop()
+
+
+# -- live = log, verdict by verdict -------------------------------------------------------------------
+def _released_log(ws: Path, x2_matched_from_start: bool) -> tuple[list[dict[str, Any]], OnlineEngine]:
+    """The live log of a relay copying each reading's stamp onto an answer 8 ms later (readings every
+    20 ms), both heard 1 ms after publication, the engine releasing early; a second reading publisher
+    ``X2`` (matched late, or from the start) sends one reading stamped between two, heard 30 ms after
+    it.  Lines as the live monitor writes them (runtime/live.py): each message at its time (a late one at
+    its source time with ``late_s``), each verdict and each deadline verdict."""
+    from rclverify.backends.monitors.deadlines import DeadlineMonitor
+    from rclverify.backends.monitors.verdict_lines import VERDICT_TOPIC
+    checked = load([ws / "contracts" / "c.rcl"])
+    rules = load_mapping(ws, "mapping.yaml").rules
+    lines: list[dict[str, Any]] = []
+    dm = DeadlineMonitor(checked, checked.nodes["Relay"], rules, lambda v: lines.append(
+        {"topic": VERDICT_TOPIC, "time": v.trigger_stamp, "kind": "deadline", "verdict": v.to_json()}), horizon=1.0)
+
+    def released(ev: Any) -> None:
+        late = {"late_s": round(ev.late, 6)} if ev.late else {}
+        lines.append({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time, **late,
+                      **dict(ev.fields)})
+        dm.feed(ev)
+    eng = OnlineEngine(checked, [checked.nodes["Relay"]], rules, 1.0, reorder_window=L,
+                       on_verdict=lambda v: lines.append({"topic": VERDICT_TOPIC, "time": v.decided_at,
+                                                          "verdict": v.to_json()}), on_event=released)
+    eng.match({"x": [b"X"] + ([b"X2"] if x2_matched_from_start else []), "r": [b"R"]})
+    heard: list[tuple[float, str, dict[str, Any], float, bytes]] = []  # heard, topic, fields, published, writer
+    for i in range(30):
+        t = 1.0 + 0.02 * i
+        heard.append((t + 0.001, "x", {"value": float(i), **_stamp(t)}, t, b"X"))
+        heard.append((t + 0.009, "r", {"range": float(i), **_stamp(t)}, t + 0.008, b"R"))
+    t2 = 1.0 + 0.02 * 15 + 0.005
+    heard.append((t2 + 0.03, "x", {"value": 15.0, **_stamp(t2)}, t2, b"X2"))
+    now = 1.0
+    for at, topic, fields, pub, writer in sorted(heard, key=lambda h: h[0]):
+        while now + 0.002 <= at:
+            now += 0.002
+            eng.tick(now)
+            dm.advance(eng.watermark(now))
+        if topic == "x" and writer == b"X2" and not x2_matched_from_start:
+            eng.match({"x": [b"X", b"X2"], "r": [b"R"]})  # discovered now
+        eng.push(topic, fields, pub, writer=writer)
+    eng.finish()
+    dm.finish()
+    return lines, eng
+
+
+@pytest.mark.parametrize("from_start", [False, True], ids=["matched late: late", "matched from the start"])
+def test_an_early_released_run_and_its_log_give_the_same_verdicts_one_by_one(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], from_start: bool) -> None:
+    import json
+    import sys
+    from rclverify.backends.monitors.verdict_lines import log_records
+    from test_judge_writers import COPY, COPY_MAPPING
+    from test_verdict_by_verdict import _offline
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+    from _robot_verdicts import compare, finals, tally
+    ws, _ = _workspace(tmp_path, COPY, [], COPY_MAPPING)
+    lines, eng = _released_log(ws, from_start)
+    log = ws / "live.jsonl"
+    log.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    assert eng.released_early > 0
+    assert eng.late == (0 if from_start else 1)
+    assert sum("late_s" in x for x in lines) == eng.late
+    live, offline = finals(log_records(log)), finals(_offline(ws, log, capsys))
+    assert compare(live, offline) == []
+    counts = tally(live)["Relay"]
+    assert counts.get("violated", 0) == 0 and counts.get("deadline false", 0) == 0, counts
+    assert counts["satisfied"] == 30 and counts["deadline true"] == 30, counts  # X's readings, all answered
