@@ -621,13 +621,19 @@ def test_control_the_log_with_each_stale_answer_at_its_stamp_turns_it_green(run:
     stamp (its publication lost) reads the stale answers as answering the question at their stamps, where
     they are right: ``Stale`` discharged offline, the wrong green the live log must not allow."""
     lines = [json.loads(x) for x in (run["tmp"] / "live.jsonl").read_text().splitlines()]
-    moved = 0
+    stamps: set[tuple[int, int]] = set()
+    moved = []  # per stale answer (the round before's stamp again): written at its source time?
     for x in lines:
         if x.get("topic") == "stale_q":
-            stamp = x["header"]["stamp"]["sec"] + x["header"]["stamp"]["nanosec"] * 1e-9
-            moved += x["time"] - stamp > 0.02
+            key = (x["header"]["stamp"]["sec"], x["header"]["stamp"]["nanosec"])
+            stamp = key[0] + key[1] * 1e-9
+            if key in stamps:
+                moved.append(x["time"] - stamp > 0.02)
+            stamps.add(key)
             x["time"] = stamp
-    assert moved == len(STALE)  # the live log wrote exactly the stale answers at their source times
+    # the live log wrote every stale answer at its source time (a fresh answer published more than 20 ms after
+    # its stamp under load is written so too, by the same rule, and is right at either time)
+    assert moved == [True] * len(STALE), moved
     log = tmp_path / "control.jsonl"
     log.write_text("".join(json.dumps(x) + "\n" for x in lines))
     r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(run["tmp"] / "ws"),
