@@ -171,28 +171,26 @@ class CopiedStamps:
     into the run's clock there (:func:`with_stamp`), and judged, like a
     stale copied stamp in the run's clock, against that question and those
     asked until it was published (docs/semantics.md, "Event time").  A
-    clock standing still (a paused simulator) gives several messages of one
-    writer the same stamp: the k-th copy of that stamp by a writer names the
-    k-th of them published before it (a node answers its questions in the
-    order asked), never the first for all (generated seed 1069: a relay's
-    answer to the second reading of a paused clock was placed at the first,
-    leaving the second unanswered past its deadline).  A message published
+    clock standing still (a paused simulator) gives several messages the
+    same stamp, its copies and the stamps of writers stamping with its time
+    alike: which question a message so stamped answers is not the run's to
+    say, so it is placed at the first message so stamped, and judged against
+    every question asked from there until it was published (naming the k-th
+    message for the k-th copy placed a relay's answer, stamped with its own
+    clock, at another relay's later message: ``violated`` on a correct node,
+    generated seed 1074; a deadline such an answer may meet is
+    ``undecided``, backends/monitors/deadline_skew.py).  A message published
     within :data:`COPY_AFTER_S` of the one it would name is no copy of it:
     two writers stamping a simulated clock's time alike within one tick are
     heard in either order, and the live run and its bag would place them
     apart (generated seed 1091: three relays stamping with their own clock,
     7.5 ms apart).  ``copied`` counts the messages so placed."""
 
-    __slots__ = ("_first", "_named", "copied")
-
-    #: the messages of one writer kept per stamp (a clock standing still that long is not followed further)
-    KEPT = 1000
+    __slots__ = ("_first", "copied")
 
     def __init__(self) -> None:
-        #: per stamp, its first writer and the source times (s) of that writer's messages so stamped, in order
-        self._first: dict[float, tuple[str, list[float]]] = {}
-        #: per stamp, how many copies of it each other writer sent
-        self._named: dict[float, dict[str, int]] = {}
+        #: per stamp, its first writer and that message's source time (s)
+        self._first: dict[float, tuple[str, float]] = {}
         self.copied = 0
 
     def _name(self, topic: str, stamp: float, source: float) -> float | None:
@@ -200,37 +198,28 @@ class CopiedStamps:
         message of ``topic`` stamped ``stamp`` and published at ``source``
         (s) copies the stamp of (class docstring), counted; else ``None``."""
         got = self._first.get(stamp)
-        if got is None or got[0] == topic or not COPY_AFTER_S < source - got[1][0] <= COPY_S:
+        if got is None or got[0] == topic or not COPY_AFTER_S < source - got[1] <= COPY_S:
             return None
-        before = [t for t in got[1] if t < source - COPY_AFTER_S]
-        named = self._named.setdefault(stamp, {})
-        k = named.get(topic, 0)
-        named[topic] = k + 1
         self.copied += 1
-        return before[min(k, len(before) - 1)]
+        return got[1]
 
     def place(self, topic: str, stamp: float, source: float) -> tuple[float, bool]:
         """``(time, copied)``: the time (s, the run's clock) a message of
         ``topic`` with header stamp ``stamp`` (s, another clock) and source
-        time ``source`` (s) is placed at, the source time of the message of
-        another writer stamped ``stamp`` within :data:`COPY_S` before it that
-        it names (class docstring; ``copied`` true; published more than
-        :data:`COPY_AFTER_S` after it), else ``source``."""
+        time ``source`` (s) is placed at, the source time of the first message
+        of another writer stamped ``stamp`` within :data:`COPY_S` before it
+        and more than :data:`COPY_AFTER_S` (``copied`` true), else ``source``."""
         named = self._name(topic, stamp, source)
         if named is not None:
             return named, True
         first = self._first
-        got = first.get(stamp)
-        if got is None:
-            first[stamp] = (topic, [source])
+        if stamp not in first:
+            first[stamp] = (topic, source)
             while first:  # stamps too old to be copied any more are forgotten (insertion order: oldest first)
                 k = next(iter(first))
-                if first[k][1][0] >= source - COPY_S:
+                if first[k][1] >= source - COPY_S:
                     break
                 del first[k]
-                self._named.pop(k, None)
-        elif got[0] == topic and len(got[1]) < self.KEPT:
-            got[1].append(source)
         return source, False
 
     def copy_of(self, topic: str, stamp: float, source: float) -> float | None:
@@ -238,12 +227,12 @@ class CopiedStamps:
         stamp ``stamp`` (s) runs in the run's clock by its own offset, with
         source time ``source`` (s), is placed at when that stamp equals the
         stamp in another clock of an earlier message of another writer within
-        :data:`COPY_S` before it: that message's source time (a relay copying
-        a driver's stamp 0.3 s ahead and publishing 0.22 s later carries a
-        stamp only 0.08 s ahead of its own publication, within the bounds, yet
-        copied from its question; the k-th such copy names the k-th message so
-        stamped, as :meth:`place`); ``None`` when it copies none (its stamp
-        stands).  Counted in ``copied``."""
+        :data:`COPY_S` before it (and more than :data:`COPY_AFTER_S`): that
+        message's source time (a relay copying a driver's stamp 0.3 s ahead
+        and publishing 0.22 s later carries a stamp only 0.08 s ahead of its
+        own publication, within the bounds, yet copied from its question);
+        ``None`` when it copies none (its stamp stands).  Counted in
+        ``copied``."""
         return self._name(topic, stamp, source)
 
 
