@@ -374,3 +374,49 @@ def test_an_early_released_run_and_its_log_give_the_same_verdicts_one_by_one(
     counts = tally(live)["Relay"]
     assert counts.get("violated", 0) == 0 and counts.get("deadline false", 0) == 0, counts
     assert counts["satisfied"] == 30 and counts["deadline true"] == 30, counts  # X's readings, all answered
+
+
+# -- the deadline checks' clock: the watermark the engine released up to ---------------------------------
+FAST = """
+node Relay {
+  inputs( x : REAL )
+  outputs( r : REAL )
+  topics( pkg/Reading x matches(in.x), pkg/Range r matches(out.r) )
+  assume( TRUE )
+  guarantee( out.r == in.x ) triggered by in.x within 20 ms
+}
+"""
+
+
+@pytest.mark.parametrize("handed_over", [True, False], ids=["sets handed over mid-tick", "control: before"])
+def test_the_deadline_checks_never_pass_what_the_engine_released(tmp_path: Path, handed_over: bool) -> None:
+    """The discovery thread hands the last topic's matched writers over (``LiveRun.match``, no lock)
+    between the engine's release and the deadline checks' advance of one tick: the checks still stop
+    at the watermark the engine released up to, so a deadline whose answer is buffered, stamped within
+    it, gets no ``false`` (the log, read again, finds none: nothing was late)."""
+    import json
+    from rclverify.runtime.live import LiveRun
+    ws, _ = _workspace(tmp_path, FAST, [], "topics:\n  x: {fields: [value]}\n  r: {fields: [range]}\n")
+    checked = load([ws / "contracts" / "c.rcl"])
+    published: list[dict[str, Any]] = []
+    live = LiveRun(checked, [checked.nodes["Relay"]], load_mapping(ws, "mapping.yaml").rules, 1.0,
+                   tmp_path / "live.jsonl", reorder_window=L, publish=lambda text: published.append(json.loads(text)))
+    writers = {"x": [b"X"], "r": [b"R"]}
+    live.match({"x": [b"X"]} if handed_over else writers)  # r's writer not matched yet: held at the bound
+    tick = live.engine.tick
+
+    def tick_then_handover(now: float) -> Any:
+        upto = tick(now)
+        live.match(writers)  # the discovery thread, between the release and the checks' advance
+        return upto
+    if handed_over:
+        live.engine.tick = tick_then_handover  # type: ignore[method-assign]
+    for stamp, topic, value, writer in ((1.045, "x", 1.0, b"X"), (1.06, "r", 1.0, b"R"),
+                                        (1.1, "x", 2.0, b"X"), (1.1, "r", 2.0, b"R")):
+        live.push(topic, {"value" if topic == "x" else "range": value, **_stamp(stamp)}, stamp, writer)
+    live.tick(1.101)  # the bound (1.051) releases the reading at 1.045, not its answer at 1.06
+    live.tick(1.12)
+    live.stop()
+    deadlines = [(p["trigger_stamp"], p["verdict"]) for p in published if p.get("kind") == "deadline"]
+    assert (1.045, "false") not in deadlines, deadlines
+    assert (1.045, "true") in deadlines

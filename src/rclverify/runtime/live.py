@@ -222,8 +222,9 @@ class LiveRun:
         published and the log flushed once per :data:`FLUSH_S` of ``now``."""
         with self.lock:
             if self.results is None:
-                self.engine.tick(now)
-                self.checks.advance(self.engine.watermark(now))  # the monitors' clock, the engine's watermark
+                # the deadline checks' clock: the watermark the engine released up to (never one read again:
+                # the source's thread may hand a matched set over in between and move it past the release)
+                self.checks.advance(self.engine.tick(now))
                 if not now < self._flushed + FLUSH_S:
                     self._flushed = now
                     self._flush_last()

@@ -355,10 +355,13 @@ class OnlineEngine:
             upto = bound  # a matched writer not heard yet
         return upto
 
-    def tick(self, now: float) -> None:
+    def tick(self, now: float) -> float:
         """The timer: release the messages every writer has been heard past
         (:meth:`watermark`), resolve obligations whose horizon has passed,
-        report silent topics."""
+        report silent topics.  Returns the watermark (s) it released up to:
+        what else runs on the engine's clock advances to it, not to a
+        :meth:`watermark` read again (a source's thread may hand a matched set
+        over in between, :meth:`match`, and move it past what was released)."""
         upto = self.watermark(now)
         self._upto = max(self._upto, upto)
         if now > self._now:
@@ -375,6 +378,7 @@ class OnlineEngine:
                     st.silent = True
                     if self.on_silence is not None:
                         self.on_silence(topic, now - st.last, True)
+        return upto
 
     @property
     def late(self) -> int:
