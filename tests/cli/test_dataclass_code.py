@@ -158,7 +158,7 @@ def test_the_kept_file_is_read_and_written_only_after_a_compile(tmp_path: Path) 
     first = _probe(tmp_path)
     assert first["new"] and first["kept"] > 20
     files = list((tmp_path / "rclverify" / "code").iterdir())
-    assert len(files) == 1 and files[0].name.startswith("dataclasses-other-")  # no command named: ``other``
+    assert len(files) == 1 and files[0].name.startswith("dataclasses-")
     stamp = files[0].stat().st_mtime_ns
     again = _probe(tmp_path)
     assert not again["new"] and again["kept"] >= first["kept"]
@@ -167,15 +167,3 @@ def test_the_kept_file_is_read_and_written_only_after_a_compile(tmp_path: Path) 
     damaged = _probe(tmp_path)
     assert damaged["new"]
     assert not _probe(tmp_path)["new"]  # written again whole
-
-
-def test_each_command_has_its_file(tmp_path: Path) -> None:
-    """A process whose first argument is a command's name keeps its texts in a file of its own, so that
-    one command's start-up reads only what its own modules' classes need."""
-    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path), "PYTHONPATH": str(SRC)}
-    for arg in ("monitor", "--json", "monitor"):
-        p = subprocess.run([sys.executable, "-c", _PROBE, arg], capture_output=True, text=True, env=env,
-                           timeout=120)
-        assert p.returncode == 0, p.stderr
-    names = sorted(f.name.split("-")[1] for f in (tmp_path / "rclverify" / "code").iterdir())
-    assert names == ["monitor", "other"]

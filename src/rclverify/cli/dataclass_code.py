@@ -16,15 +16,14 @@ annotations into strings), keeps the code object under the text and runs it
 in the same globals and locals.  Anything but a ``str`` goes to the builtin
 unchanged.
 
-The code objects are kept in a file of the user's cache
+The code objects are kept in one file of the user's cache
 (:func:`~rclverify.core.cache.keys.user_cache_dir`, ``code/``: not in a
-workspace) per command (:func:`_role`: each command imports its own modules,
-so a ``rclverify monitor`` run reads the 700 texts its classes need, not
-every command's) and interpreter bytecode (its cache tag and magic number),
-in ``marshal``'s format: read at the first class, written atomically at exit
-when the process compiled a text the file did not hold (with what it held,
-unless that passes :data:`MOST` texts: then only the texts this process
-used).  A missing, unreadable or damaged file only costs the compiles.
+workspace), named for the interpreter's bytecode (its cache tag and magic
+number), in ``marshal``'s format: read at the first class, written
+atomically at exit when the process compiled a text the file did not hold
+(with what it held, unless that passes :data:`MOST` texts: then only the
+texts this process used).  A missing, unreadable or damaged file only costs
+the compiles.
 """
 from __future__ import annotations
 
@@ -37,29 +36,22 @@ from pathlib import Path
 from types import CodeType
 from typing import Any
 
-#: The most texts a file keeps (each class's methods are a few; rclverify's 415 classes make about 2,300).
-MOST = 4096
+#: The most texts the file keeps (each class's methods are a few; the modules of every command hold about 2,000).
+MOST = 8192
 
 _CODE: dict[str, CodeType] = {}
 _USED: set[str] = set()
 _STATE = {"loaded": False, "new": False, "installed": False}
 
 
-def _role() -> str:
-    """The command this process runs, which names its file: the first argument when it is a word
-    (``rclverify monitor ...``: ``monitor``), else ``other``."""
-    arg = sys.argv[1] if len(sys.argv) > 1 else ""
-    return arg if arg.isascii() and arg.isalpha() and len(arg) <= 24 else "other"
-
-
 def _file() -> Path | None:
-    """The cache file for this command and this interpreter's bytecode; ``None`` without a cache folder."""
+    """The cache file for this interpreter's bytecode; ``None`` without a cache folder."""
     from importlib.util import MAGIC_NUMBER  # deferred: start-up (imported where it is used)
     from rclverify.core.cache.keys import user_cache_dir  # deferred: start-up (imported where it is used)
     folder = user_cache_dir("code")
     if folder is None:
         return None
-    return folder / f"dataclasses-{_role()}-{sys.implementation.cache_tag}-{MAGIC_NUMBER.hex()}.marshal"
+    return folder / f"dataclasses-{sys.implementation.cache_tag}-{MAGIC_NUMBER.hex()}.marshal"
 
 
 def _load() -> None:
