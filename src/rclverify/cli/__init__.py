@@ -7,16 +7,8 @@ deadlines), ``verify`` (with report), ``explain`` (with status),
 ``workspace`` (init, cache, review), ``bundle``, ``runs`` (monitor and
 oracle's parsers; ``monitor`` runs them), ``ros``, ``generate``, ``lsp``;
 ``common`` holds what they share.  Imports every layer below.
-
-Importing the package gives ``dataclasses`` the compiled methods kept
-between runs (:mod:`.dataclass_code`) before any command's module defines a
-class: a fifth of ``rclverify monitor``'s start-up.
 """
 from __future__ import annotations
-
-from rclverify.cli.dataclass_code import install
-
-install()
 
 
 def main(argv: list[str] | None = None) -> int:
