@@ -31,7 +31,13 @@ a step at which it holds is *accepted*.
   composed system's ``waiting`` counter does, calculus/requirements/transition.py):
   ``false`` at the input event that ends the (K + 1)-th unanswered step;
   ``true`` when at least one accepted step was seen and none broke the
-  bound; no accepted step: ``pending`` (the run exercised nothing).
+  bound; no accepted step: ``pending`` (the run exercised nothing).  An
+  output placed at a stamp older than its publication (``Event.source``: a
+  copied stamp, a clock standing still) may answer any step until it was
+  published (docs/semantics.md, "Event time"): a row over the bound that
+  as many such outputs published within it would bring back within it is
+  ``inconclusive`` with why, never ``false`` (generated seed 1147: three
+  relays stamping with a paused ``/clock``).
 * ``progress( eventually )``: ``true`` when every accepted step is answered
   by a later output; the run ending with an accepted step still unanswered:
   ``inconclusive`` (a finite run never refutes "eventually"); no accepted
@@ -49,7 +55,7 @@ node's record by the rule of evidence are :mod:`.declaration_evidence`'s
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Tolerance, judge
@@ -99,6 +105,13 @@ class _Count:
     before: int = 0
     #: the longest row of unanswered accepted steps seen (counted from the first answering output)
     longest: int = 0
+    #: the time (s) of the row's first step (its ``first_open``)
+    first_open_t: float = 0.0
+    #: the source times (s) of the answering outputs placed before their publication (``Event.source``)
+    #: from the row's first step on: each may answer one step of the row
+    maybe: list[float] = field(default_factory=list)
+    #: why a row over the bound was not decided (the first such row), else ``""``
+    undecided: str = ""
 
 
 @dataclass
@@ -190,6 +203,8 @@ class DeclarationMonitor:
                 self._initial(ev)
         for c in self.counts:
             if outs and (not c.outs or c.outs & outs):
+                if ev.source is not None and ev.source > ev.stamped:
+                    c.maybe.append(ev.source)
                 c.answered += 1 if c.row else 0
                 c.row = 0
                 c.heard = True
@@ -244,10 +259,19 @@ class DeclarationMonitor:
 
     def _end_rows(self, ev: Event) -> None:
         for c in self.counts:
-            if c.bound is not None and c.row > c.bound and not c.broken:
+            if c.bound is None or c.row <= c.bound or c.broken:
+                continue
+            maybe = sum(c.first_open_t <= s <= ev.stamped for s in c.maybe)
+            if c.row - maybe > c.bound:
                 c.broken = (f"{c.row} accepted steps in a row unanswered (at most {c.bound} allowed): no "
                             f"{self._answer_words(c)} came between the input at {c.first_open} and the input at "
                             f"{ev.where}")
+            elif not c.undecided:
+                c.undecided = (f"{c.row} accepted steps in a row with no {self._answer_words(c)} placed among "
+                               f"them (at most {c.bound} allowed), from the input at {c.first_open} to the input at "
+                               f"{ev.where}, but {maybe} such message(s), placed before them at a stamp older than "
+                               "their publication (a copied stamp, a clock standing still), were published among "
+                               "them and may answer them (docs/semantics.md, \"Event time\")")
 
     def _count_step(self, ev: Event, accepted: bool) -> None:
         for c in self.counts:
@@ -257,7 +281,8 @@ class DeclarationMonitor:
             elif accepted:
                 c.accepted += 1
                 if c.row == 0:
-                    c.first_open = ev.where
+                    c.first_open, c.first_open_t = ev.where, ev.stamped
+                    c.maybe = [s for s in c.maybe if s >= c.first_open_t]
                 c.row += 1
                 c.longest = max(c.longest, c.row)
             else:
@@ -335,6 +360,8 @@ class DeclarationMonitor:
     def _count_verdict(self, c: _Count) -> tuple[str, str]:
         if c.broken:
             return "false", c.broken
+        if c.undecided:
+            return "inconclusive", c.undecided
         if not c.accepted and not self.input_events:
             return "pending", ("no input event of " + (", ".join(sorted(self.read)) or "the node")
                                + " was read (a message on its topics, or a call part in a live run's log): "
