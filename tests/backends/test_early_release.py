@@ -148,6 +148,40 @@ def test_a_topic_whose_writers_are_not_known_keeps_the_clock_less_the_bound(
     assert eng.watermark(1.01) == pytest.approx(1.0)
 
 
+@pytest.mark.parametrize("form", ["hex", "prefix", "same"], ids=["hex text", "guid prefix", "control: as sampled"])
+def test_matched_ids_in_another_form_than_the_samples_never_release_early(contracts: tuple[Any, Any],
+                                                                          form: str) -> None:
+    """The matched sets name the writers in another form than the samples do (hex text for bytes, a
+    GUID's 12-byte participant prefix for its 16 bytes): no matched writer is ever heard, so the
+    release stays at the clock less the bound, never earlier (nothing made late by it)."""
+    guid = {t: bytes([k + 1]) * 16 for k, t in enumerate(ALL)}
+    told = {t: [g.hex() if form == "hex" else g[:12] if form == "prefix" else g] for t, g in guid.items()}
+    events: list[Any] = []
+    eng = _engine(contracts, events=events)
+    eng.match(told)
+    for t in (1.0, 1.002):
+        for topic, g in guid.items():
+            _put(eng, topic, 1.0, t, t, g)
+    if form == "same":
+        assert eng.watermark(1.003) == pytest.approx(1.002)
+    else:
+        assert eng.watermark(1.003) == pytest.approx(1.003 - L)
+        eng.tick(1.003)
+        assert events == [] and eng.released_early == 0
+
+
+@pytest.mark.parametrize("gated", [True, False], ids=["a gate's topic", "control: no gate"])
+def test_a_run_with_a_gates_topics_keeps_the_clock_less_the_bound(contracts: tuple[Any, Any], gated: bool) -> None:
+    """A managed node's transition topic (:attr:`OnlineEngine.gate_topics`) has no matched writer: the
+    release is never early, every contract topic's writers matched and heard or not."""
+    eng = _engine(contracts)
+    if gated:
+        eng.gate_topics = frozenset({"node/transition_event"})
+    eng.match(ALL)
+    _heard_at(eng, 1.0)
+    assert eng.watermark(1.01) == pytest.approx(1.01 - L if gated else 1.0)
+
+
 def test_a_writer_matched_late_whose_first_message_is_older_than_the_watermark_is_late_never_violated(
         contracts: tuple[Any, Any]) -> None:
     def run(matched_from_start: bool) -> tuple[int, list[tuple[str, str]]]:
