@@ -32,9 +32,10 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   as a recorded run read again is (:mod:`.stamp_order`); :meth:`clock_lines`
   names each such writer;
 * **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
-  clock to ``now - reorder_window``, so an obligation whose horizon (the
-  contract's response time) has passed is resolved ``violated`` without
-  waiting for the next message;
+  clock to the watermark (``now - reorder_window`` or before it, past it in
+  an early release), so an obligation whose horizon (the contract's
+  response time) has passed is resolved ``violated`` without waiting for
+  the next message;
 * **silence**: a contract topic that has not been received for
   ``silence_s`` seconds is reported once by :meth:`tick` (and again when it
   comes back);
