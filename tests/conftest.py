@@ -145,7 +145,6 @@ SECONDS: dict[str, float] = {
 #: seconds understate how long they hold a worker).  Taken on a loaded machine, so rather long: which
 #: only hands them out earlier, where a long module belongs.
 WALL: dict[str, float] = {
-    "test_operator_dispatch": 20.0,  # one cold mypy run over the package (its test marked slow in the module)
     "test_bench_smoke_live": 49.4, "test_ros2_generated": 48.2, "test_lsp_server": 27.2,
     "test_ros2_types_record": 19.5, "test_monitor_live_ros1": 16.6, "test_generate_names_ros2": 50.0,
     "test_monitor_live_hostile": 15.0, "test_ros2_diff": 13.4, "test_ros_diff_live": 12.9,
