@@ -13,7 +13,7 @@ matched late whose first message is older than the watermark: late, and no verdi
 violated.  Each has its control in the same case.
 
 Live = log: a run released early, with and without a reading publisher matched late whose reading is
-late, written as the live monitor writes its log, is judged verdict by verdict as the offline check of
+late, its log written by the live run itself (``LiveRun``), is judged verdict by verdict as the offline check of
 that log judges it (bench/_robot_verdicts.py's comparison), no correct answer red.
 
 The oracle: random runs (several writers on one topic, monotone stamps per writer, a stamp-copying
@@ -416,29 +416,17 @@ def test_the_engine_thread_ticks_right_after_a_batch_lets_the_watermark_pass_the
 
 
 # -- live = log, verdict by verdict -------------------------------------------------------------------
-def _released_log(ws: Path, x2_matched_from_start: bool) -> tuple[list[dict[str, Any]], OnlineEngine]:
+def _released_log(ws: Path, x2_matched_from_start: bool) -> tuple[Path, OnlineEngine]:
     """The live log of a relay copying each reading's stamp onto an answer 8 ms later (readings every
-    20 ms), both heard 1 ms after publication, the engine releasing early; a second reading publisher
-    ``X2`` (matched late, or from the start) sends one reading stamped between two, heard 30 ms after
-    it.  Lines as the live monitor writes them (runtime/live.py): each message at its time (a late one at
-    its source time with ``late_s``), each verdict and each deadline verdict."""
-    from rclverify.backends.monitors.deadlines import DeadlineMonitor
-    from rclverify.backends.monitors.verdict_lines import VERDICT_TOPIC
+    20 ms), both heard 1 ms after publication, released early; a second reading publisher ``X2``
+    (matched late, or from the start) sends one reading stamped between two, heard 30 ms after it.
+    Written by the live run itself (runtime/live.py ``LiveRun``: each message at its time, a late one
+    at its source time with ``late_s``, each verdict and each deadline verdict), the timer every 2 ms."""
+    from rclverify.runtime.live import LiveRun
     checked = load([ws / "contracts" / "c.rcl"])
     rules = load_mapping(ws, "mapping.yaml").rules
-    lines: list[dict[str, Any]] = []
-    dm = DeadlineMonitor(checked, checked.nodes["Relay"], rules, lambda v: lines.append(
-        {"topic": VERDICT_TOPIC, "time": v.trigger_stamp, "kind": "deadline", "verdict": v.to_json()}), horizon=1.0)
-
-    def released(ev: Any) -> None:
-        late = {"late_s": round(ev.late, 6)} if ev.late else {}
-        lines.append({"topic": ev.topic, "time": ev.source if late and ev.source is not None else ev.time, **late,
-                      **dict(ev.fields)})
-        dm.feed(ev)
-    eng = OnlineEngine(checked, [checked.nodes["Relay"]], rules, 1.0, reorder_window=L,
-                       on_verdict=lambda v: lines.append({"topic": VERDICT_TOPIC, "time": v.decided_at,
-                                                          "verdict": v.to_json()}), on_event=released)
-    eng.match({"x": [b"X"] + ([b"X2"] if x2_matched_from_start else []), "r": [b"R"]})
+    live = LiveRun(checked, [checked.nodes["Relay"]], rules, 1.0, ws / "live.jsonl", reorder_window=L)
+    live.match({"x": [b"X"] + ([b"X2"] if x2_matched_from_start else []), "r": [b"R"]})
     heard: list[tuple[float, str, dict[str, Any], float, bytes]] = []  # heard, topic, fields, published, writer
     for i in range(30):
         t = 1.0 + 0.02 * i
@@ -450,14 +438,12 @@ def _released_log(ws: Path, x2_matched_from_start: bool) -> tuple[list[dict[str,
     for at, topic, fields, pub, writer in sorted(heard, key=lambda h: h[0]):
         while now + 0.002 <= at:
             now += 0.002
-            eng.tick(now)
-            dm.advance(eng.watermark(now))
+            live.tick(now)
         if topic == "x" and writer == b"X2" and not x2_matched_from_start:
-            eng.match({"x": [b"X", b"X2"], "r": [b"R"]})  # discovered now
-        eng.push(topic, fields, pub, writer=writer)
-    eng.finish()
-    dm.finish()
-    return lines, eng
+            live.match({"x": [b"X", b"X2"], "r": [b"R"]})  # discovered now
+        live.push(topic, fields, pub, writer)
+    live.stop()
+    return ws / "live.jsonl", live.engine
 
 
 @pytest.mark.parametrize("from_start", [False, True], ids=["matched late: late", "matched from the start"])
@@ -471,9 +457,8 @@ def test_an_early_released_run_and_its_log_give_the_same_verdicts_one_by_one(
     sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
     from _robot_verdicts import compare, finals, tally
     ws, _ = _workspace(tmp_path, COPY, [], COPY_MAPPING)
-    lines, eng = _released_log(ws, from_start)
-    log = ws / "live.jsonl"
-    log.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    log, eng = _released_log(ws, from_start)
+    lines = [json.loads(x) for x in log.read_text().splitlines()]
     assert eng.released_early > 0
     assert eng.late == (0 if from_start else 1)
     assert sum("late_s" in x for x in lines) == eng.late
