@@ -1,10 +1,11 @@
-"""A copied stamp of a clock standing still (traces/event_time.py, ``CopiedStamps``): while a simulated
+"""Copied stamps of a clock standing still (traces/event_time.py, ``CopiedStamps``): while a simulated
 clock is paused, several messages carry one stamp (one writer's readings, the copies of them, the
-answers of writers stamping with the clock's time); which question such a message answers is not the
-run's to say, so each message of another writer so stamped is placed at the first message so stamped
-and judged against every question asked from there until it was published (generated seeds 1069 and
-1074: tests/backends/test_clock_rate_change_seeds.py); and two writers stamping alike within the
-transport skew are no copies of each other (generated seed 1091)."""
+messages of writers stamping with the clock's time).  A fresh stamp (heard once) carried by another
+writer is a copy, and teaches that its writer copies the first's stamps; a stamp that stands still is a
+copy only for a writer that copied two fresh stamps of the first before, placed at the first message so
+stamped (generated seed 1069); any other message carrying it is its own writer's, at its source time
+(generated seeds 1072 and 1074: tests/backends/test_clock_rate_change_seeds.py); two writers stamping
+alike within the transport skew are no copies of each other (generated seed 1091)."""
 from __future__ import annotations
 
 from rclverify.traces.event_time import CopiedStamps
@@ -12,26 +13,35 @@ from rclverify.traces.event_time import CopiedStamps
 PAUSED = 5004.139
 
 
-def test_every_copy_of_a_stamp_a_paused_clock_shares_is_placed_at_its_first_message() -> None:
+def test_a_relay_copying_a_paused_sensors_stamp_is_placed_at_its_first_message() -> None:
     c = CopiedStamps()
+    for k, t in enumerate((1.0, 2.0)):  # two fresh stamps copied: r1 copies s0's stamps
+        c.place("s0", 100.0 + k, t)
+        assert c.place("r1", 100.0 + k, t + 0.3) == (t, True)
     assert c.place("s0", PAUSED, 10.0) == (10.0, False)
     assert c.place("r1", PAUSED, 10.3) == (10.0, True)
     assert c.place("s0", PAUSED, 10.4) == (10.4, False)  # the clock still paused: the same stamp again
     assert c.place("r1", PAUSED, 10.7) == (10.0, True)  # it may answer the first reading or the second
-    assert c.place("r4", PAUSED, 10.75) == (10.0, True)  # a writer stamping with the clock's time alike
-    assert c.copied == 3
+    assert c.copied == 4
 
 
-def test_a_copy_names_a_message_of_another_writer_published_before_it() -> None:
-    """The control: a stamp of one message is named by every copy of it; the writer's own messages are
-    never copies of itself; a stamp nobody stamped before is no copy."""
+def test_a_writer_stamping_a_paused_clocks_time_is_placed_at_its_own_time() -> None:
+    """Sensor s0 stamps the paused clock's time again and again; s3 stamped it first.  s0's first
+    message carries a fresh stamp (a copy, as far as the run can tell); every later one its own (seed
+    1072: all three were placed at s3's message).  The control: a relay that copied two fresh stamps of
+    s3 before is placed at s3's message."""
     c = CopiedStamps()
-    c.place("s0", 7.0, 1.0)
-    assert c.place("r1", 7.0, 1.2) == (1.0, True)
-    assert c.place("r1", 7.0, 1.25) == (1.0, True)
-    assert c.place("s0", 7.0, 1.4) == (1.4, False)
-    assert c.place("r1", 8.0, 1.5) == (1.5, False)
-    assert c.copy_of("r9", 7.0, 1.9) == 1.0
+    assert c.place("s3", PAUSED, 7.1388) == (7.1388, False)
+    assert c.place("s0", PAUSED, 7.2631) == (7.1388, True)
+    assert c.place("s0", PAUSED, 7.5146) == (7.5146, False)
+    assert c.place("s0", PAUSED, 7.7635) == (7.7635, False)
+    c = CopiedStamps()
+    for k, t in enumerate((1.0, 2.0)):
+        c.place("s3", 100.0 + k, t)
+        c.place("r1", 100.0 + k, t + 0.1)
+    c.place("s3", PAUSED, 7.1388)
+    c.place("s0", PAUSED, 7.2631)
+    assert c.place("r1", PAUSED, 7.5) == (7.1388, True)
 
 
 def test_two_writers_stamping_alike_within_the_skew_are_no_copies() -> None:
@@ -48,3 +58,4 @@ def test_two_writers_stamping_alike_within_the_skew_are_no_copies() -> None:
     c = CopiedStamps()
     c.place("s0", 102.7101, 100.8031)
     assert c.place("r1", 102.7101, 100.8331) == (100.8031, True)
+    assert c.copy_of("r9", 102.7101, 100.9) is None  # the stamp stands still now, r9 copied nothing before

@@ -170,27 +170,38 @@ class CopiedStamps:
     answer is placed at the time its question was placed, its stamp carried
     into the run's clock there (:func:`with_stamp`), and judged, like a
     stale copied stamp in the run's clock, against that question and those
-    asked until it was published (docs/semantics.md, "Event time").  A
-    clock standing still (a paused simulator) gives several messages the
-    same stamp, its copies and the stamps of writers stamping with its time
-    alike: which question a message so stamped answers is not the run's to
-    say, so it is placed at the first message so stamped, and judged against
-    every question asked from there until it was published (naming the k-th
-    message for the k-th copy placed a relay's answer, stamped with its own
-    clock, at another relay's later message: ``violated`` on a correct node,
-    generated seed 1074; a deadline such an answer may meet is
-    ``undecided``, backends/monitors/deadline_skew.py).  A message published
-    within :data:`COPY_AFTER_S` of the one it would name is no copy of it:
-    two writers stamping a simulated clock's time alike within one tick are
-    heard in either order, and the live run and its bag would place them
-    apart (generated seed 1091: three relays stamping with their own clock,
-    7.5 ms apart).  ``copied`` counts the messages so placed."""
+    asked until it was published (docs/semantics.md, "Event time").
 
-    __slots__ = ("_first", "copied")
+    A clock standing still (a paused simulator) gives several messages one
+    stamp: a writer's readings, the copies of them, the messages of writers
+    stamping with the clock's time.  A stamp heard once before is fresh: a
+    message of another writer carrying it copies it (a running clock gives
+    two writers one stamp only within one of its ticks, below), and teaches
+    that its writer copies the other's stamps.  A stamp heard more than once
+    stands still: a message carrying it copies it only when its writer has
+    copied two fresh stamps of that writer before (a relay copying a paused
+    sensor's readings: placed at the first message so stamped and judged
+    against every question asked until it was published, generated seed
+    1069); any other is its own writer's, placed at its source time (a
+    sensor stamping a paused clock's time, whose readings were all placed
+    at another sensor's message: a false deadline and six verdicts live !=
+    log, generated seed 1072; relays stamping with their own clock, one
+    placed at another's later answer: ``violated``, generated seed 1074).
+    A message published within :data:`COPY_AFTER_S` of the one it would
+    name is no copy of it: two writers stamping a simulated clock's time
+    alike within one tick are heard in either order, and the live run and
+    its bag would place them apart (generated seed 1091).  ``copied``
+    counts the messages so placed."""
+
+    __slots__ = ("_first", "_heard", "_copier", "copied")
 
     def __init__(self) -> None:
         #: per stamp, its first writer and that message's source time (s)
         self._first: dict[float, tuple[str, float]] = {}
+        #: per stamp, how many messages carried it (2 or more: it stands still)
+        self._heard: dict[float, int] = {}
+        #: per (writer, the writer whose stamps it copied), how many fresh stamps it copied
+        self._copier: dict[tuple[str, str], int] = {}
         self.copied = 0
 
     def _name(self, topic: str, stamp: float, source: float) -> float | None:
@@ -200,26 +211,37 @@ class CopiedStamps:
         got = self._first.get(stamp)
         if got is None or got[0] == topic or not COPY_AFTER_S < source - got[1] <= COPY_S:
             return None
+        pair = (topic, got[0])
+        if self._heard.get(stamp, 0) <= 1:  # fresh: a copy, and its writer a copier of that writer's stamps
+            self._copier[pair] = self._copier.get(pair, 0) + 1
+        elif self._copier.get(pair, 0) < 2:  # standing still, and its writer no copier of that writer's
+            return None
         self.copied += 1
+        self._heard[stamp] += 1
         return got[1]
 
     def place(self, topic: str, stamp: float, source: float) -> tuple[float, bool]:
         """``(time, copied)``: the time (s, the run's clock) a message of
         ``topic`` with header stamp ``stamp`` (s, another clock) and source
-        time ``source`` (s) is placed at, the source time of the first message
+        time ``source`` (s) is placed at: the source time of the first message
         of another writer stamped ``stamp`` within :data:`COPY_S` before it
-        and more than :data:`COPY_AFTER_S` (``copied`` true), else ``source``."""
+        and more than :data:`COPY_AFTER_S` that it copies (class docstring;
+        ``copied`` true), else ``source``."""
         named = self._name(topic, stamp, source)
         if named is not None:
             return named, True
         first = self._first
         if stamp not in first:
             first[stamp] = (topic, source)
+            self._heard[stamp] = 1
             while first:  # stamps too old to be copied any more are forgotten (insertion order: oldest first)
                 k = next(iter(first))
                 if first[k][1] >= source - COPY_S:
                     break
                 del first[k]
+                self._heard.pop(k, None)
+        else:
+            self._heard[stamp] += 1
         return source, False
 
     def copy_of(self, topic: str, stamp: float, source: float) -> float | None:
@@ -227,12 +249,12 @@ class CopiedStamps:
         stamp ``stamp`` (s) runs in the run's clock by its own offset, with
         source time ``source`` (s), is placed at when that stamp equals the
         stamp in another clock of an earlier message of another writer within
-        :data:`COPY_S` before it (and more than :data:`COPY_AFTER_S`): that
-        message's source time (a relay copying a driver's stamp 0.3 s ahead
-        and publishing 0.22 s later carries a stamp only 0.08 s ahead of its
-        own publication, within the bounds, yet copied from its question);
-        ``None`` when it copies none (its stamp stands).  Counted in
-        ``copied``."""
+        :data:`COPY_S` before it (and more than :data:`COPY_AFTER_S`) that it
+        copies (class docstring): that message's source time (a relay copying
+        a driver's stamp 0.3 s ahead and publishing 0.22 s later carries a
+        stamp only 0.08 s ahead of its own publication, within the bounds, yet
+        copied from its question); ``None`` when it copies none (its stamp
+        stands).  Counted in ``copied``."""
         return self._name(topic, stamp, source)
 
 
