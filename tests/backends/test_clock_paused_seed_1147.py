@@ -5,19 +5,16 @@ Sensor0 publishes an unstamped ``std_msgs/Float32`` every 200 ms on the wall clo
 Relay4 and Relay5 answer each reading 25-54 ms later with a ``sensor_msgs/Range`` stamped with their
 own (simulated) clock.  While the clock was paused every answer carried one stamp, 5005.194 s, first
 written by Relay1's answer to the reading before the pause; the answers of Relay2, Relay4 and Relay5
-to the next three readings carry it too, and were placed as copies of it.  Naming the k-th message
-for the k-th copy placed each answer one reading early: ``violated`` x2 at each of the three correct
-relays, live, on the log and on the bag.  Each such answer is now placed at the first message so
-stamped and judged against every reading until it was published (traces/event_time.py,
-``CopiedStamps``): ``inconclusive``, never ``violated``; the readings' deadlines ``undecided`` with
-why.  Placed so, the three answers left three readings in a row with no answer placed among them,
-and each relay's ``progress( within 2 steps )`` was ``false``; the answers were published among
-those readings and may answer them, so it is ``inconclusive`` with why
-(backends/monitors/declarations.py; the rule and its controls:
-tests/backends/test_declarations_copied_stamps.py).  The bag replayed through the online engine
-gives the bag's verdicts, one by one.  A stamp standing still is now copied only by a writer that
-copied two fresh stamps of its first writer before (generated seeds 1072 and 1074): Relay4's and
-Relay5's answers are their own, at their source times, and every relay's progress ``true``.
+to the next three readings carry it too.  Taken for copies of Relay1's answer, they were placed one
+reading early when the k-th copy named the k-th message so stamped (``violated`` x2 at each of the
+three correct relays, live, on the log and on the bag), and all at Relay1's first answer when every
+copy named the first (three readings in a row with no answer placed among them: each relay's
+``progress( within 2 steps )`` ``false``).  A stamp standing still is copied only by a writer that
+copied two fresh stamps of its first writer before (traces/event_time.py, ``CopiedStamps``): no answer
+violated, no deadline false, every relay's progress ``true``.  An output placed before its
+publication keeps a row it may answer from ``false`` (backends/monitors/declarations.py; the rule and
+its controls: tests/backends/test_declarations_copied_stamps.py).  The bag replayed through the online
+engine gives the bag's verdicts, one by one.
 """
 from __future__ import annotations
 
@@ -60,7 +57,7 @@ def test_no_answer_of_a_correct_relay_is_violated_on_the_paused_clock(
     assert deadlines["Relay1"]["counts"]["true"] == 48, deadlines["Relay1"]
 
 
-def test_the_relays_progress_is_undecided_with_why_never_false(
+def test_every_relays_progress_is_true(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     rows = _rows(tmp_path, monkeypatch, capsys)
     decl = {(r["node"], d["declaration"]): d for r in rows for d in r.get("declarations", [])}

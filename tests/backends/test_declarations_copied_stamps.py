@@ -4,8 +4,9 @@ An output placed at a stamp older than its publication (a stamp copied from a qu
 standing still: ``Event.source`` later than its place, docs/semantics.md "Event time") may answer
 any question asked until it was published.  A row of more than K accepted steps with no output
 placed among it, but as many such outputs published among them as bring the row within K, is not
-decided: ``inconclusive`` with why, never ``false`` (a relay stamping with its own clock while the
-``/clock`` was paused: generated seed 1147, tests/backends/test_clock_paused_seed_1147.py).  The
+decided: ``inconclusive`` with why, never ``false`` (three relays' answers so placed while the
+``/clock`` was paused gave ``false`` at three correct relays: generated seed 1147,
+tests/backends/test_clock_paused_seed_1147.py).  The
 controls stay ``false``: a relay answering none of its readings there, and one whose copies were
 published before the row began.
 """
