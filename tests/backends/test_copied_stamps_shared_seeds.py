@@ -2,8 +2,8 @@
 (``--clock-change``, one CPU burner beside) and judged offline.  All are correct robots
 whose relays the judge gets wrong: ``xfail`` (strict) until a copy is told from a shared stamp.
 
-Seed 1178 (9 nodes, rclpy source, x0.75 from 100 s, x2, paused for 0.75 s, x2): Relay4 and Relay3 both copy the
-header stamp of Sensor0's ``sensor_msgs/Range`` onto their answers, 127 and 211 ms after each reading.
+Seed 1178 (9 nodes, rclpy source, x0.75 from 100 s, x2, paused for 0.75 s, x2): Relay4 and Relay3
+both copy the header stamp of Sensor0's ``sensor_msgs/Range`` onto their answers, 127 and 211 ms after each reading.
 Relay4's copy is always heard first, so every stamp Relay3 copies has been heard twice already (the
 reading and Relay4's copy) and stands still for ``CopiedStamps`` (traces/event_time.py), which takes a
 stamp standing still for a copy only from a writer that copied two fresh stamps of its first writer
@@ -16,8 +16,8 @@ copy Sensor0's stamps, 142, 261 and 478 ms after each reading; Relay5's copy is 
 two after it are never copies: 19 ``violated`` at Relay3 and 34 at Relay6, all three relays correct
 (every answer satisfied or undecided where every stamp heard again was a copy).
 
-Seed 1149 (9 nodes, rclpy source, x1 from 100 s, x1.5, paused for 0.74 s, x1.5): Relay1 copies Sensor0's stamp
-about 496 ms after each reading; Sensor5 stamps the same simulated clock and often writes the same
+Seed 1149 (9 nodes, rclpy source, x1 from 100 s, x1.5, paused for 0.74 s, x1.5): Relay1 copies
+Sensor0's stamp about 496 ms after each reading; Sensor5 stamps the same simulated clock and often writes the same
 stamp within one tick (not a copy: within the transport skew), so the stamp stands still with Sensor5
 its first writer, of whose stamps Relay1 copied none: two answers placed at their source times,
 ``violated`` on a correct relay, live, log and bag.
