@@ -59,3 +59,32 @@ def test_two_writers_stamping_alike_within_the_skew_are_no_copies() -> None:
     c.place("s0", 102.7101, 100.8031)
     assert c.place("r1", 102.7101, 100.8331) == (100.8031, True)
     assert c.copy_of("r9", 102.7101, 100.9) is None  # the stamp stands still now, r9 copied nothing before
+
+
+def test_by_the_contracts_a_writer_copies_only_what_its_node_reads() -> None:
+    """With ``reads`` (the topics each writer's node reads: backends/monitors/node_topics.py
+    ``copy_sources``), a relay copies its input's stamp however many other relays copied it first (seeds
+    1178, 1187: by the stamps alone the second relay's copies stood still and were its own, ``violated``)
+    and never another writer's that stamped alike (seed 1149: a second sensor stamping the same tick);
+    a sensor, reading nothing, copies nothing, paused or not (seed 1072); a paused sensor's readings
+    copied by its relay are placed at its first message so stamped.  The control: a topic no contract
+    writes keeps the rule by the stamps alone."""
+    reads = {"r3": frozenset({"s0"}), "r4": frozenset({"s0"}), "r1": frozenset({"s0"}),
+             "s0": frozenset(), "s5": frozenset()}
+    c = CopiedStamps(reads)
+    assert c.place("s0", 100.0, 1.0) == (1.0, False)
+    assert c.place("r4", 100.0, 1.127) == (1.0, True)
+    assert c.place("r3", 100.0, 1.211) == (1.0, True)  # the stamp heard twice already: still s0's copy
+    assert c.place("s5", 101.0, 2.0) == (2.0, False)
+    assert c.place("s0", 101.0, 2.01) == (2.01, False)  # within the skew of s5's: its own
+    assert c.place("r1", 101.0, 2.5) == (2.01, True)  # s0's, not s5's (s5's came first)
+    assert c.place("s5", PAUSED, 10.0) == (10.0, False)
+    assert c.place("s0", PAUSED, 10.2) == (10.2, False)  # a sensor never copies: its own reading
+    assert c.place("s0", PAUSED, 10.4) == (10.4, False)
+    assert c.place("r1", PAUSED, 10.6) == (10.2, True)  # placed at its input's first, judged until 10.6
+    assert c.copied == 4
+    control = CopiedStamps({"r1": frozenset({"s0"})})
+    control.place("s0", 100.0, 1.0)
+    control.place("r4", 100.0, 1.127)  # no contract writes r4: the stamps alone say it copies s0's
+    assert control.copied == 1
+    assert control.place("x", 100.0, 1.3) == (1.3, False)  # heard twice: stands still, x no copier of s0

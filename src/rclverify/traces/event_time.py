@@ -191,13 +191,30 @@ class CopiedStamps:
     name is no copy of it: two writers stamping a simulated clock's time
     alike within one tick are heard in either order, and the live run and
     its bag would place them apart (generated seed 1091).  ``copied``
-    counts the messages so placed."""
+    counts the messages so placed.
 
-    __slots__ = ("_first", "_heard", "_copier", "copied")
+    ``reads`` (topic -> the topics its writer reads, from the contracts:
+    :func:`rclverify.backends.monitors.node_topics.copy_sources`) settles
+    whose stamp a message may copy where the stamps alone cannot: a message
+    of a topic ``reads`` names copies a stamp only from a message of a topic
+    its writer reads (a sensor copies nothing; a relay copies its input's
+    stamp however many other relays copied it before, or a second sensor
+    stamped it alike), and is placed at the first such message, judged
+    against every question until it was published, whether the stamp stood
+    still or not (a relay stamping a paused clock's time, which its input
+    stamped too, is judged against every reading it could answer: generated
+    seeds 1149, 1178, 1187, where the rule by stamps alone left relays'
+    answers at their own times, ``violated``).  A topic ``reads`` does not
+    name (no contract writes it) keeps the rule by stamps alone."""
 
-    def __init__(self) -> None:
+    __slots__ = ("_first", "_heard", "_copier", "_by", "reads", "copied")
+
+    def __init__(self, reads: Mapping[str, frozenset[str]] | None = None) -> None:
         #: per stamp, its first writer and that message's source time (s)
         self._first: dict[float, tuple[str, float]] = {}
+        #: per stamp, each writer that carried it as its own and the source time (s) it first did
+        self._by: dict[float, dict[str, float]] = {}
+        self.reads: Mapping[str, frozenset[str]] = reads or {}
         #: per stamp, how many messages carried it (2 or more: it stands still)
         self._heard: dict[float, int] = {}
         #: per (writer, the writer whose stamps it copied), how many fresh stamps it copied
@@ -208,6 +225,16 @@ class CopiedStamps:
         """The source time (s) of the message of another writer that a
         message of ``topic`` stamped ``stamp`` and published at ``source``
         (s) copies the stamp of (class docstring), counted; else ``None``."""
+        reads = self.reads.get(topic)
+        if reads is not None:  # whose stamps its writer may copy: the contracts say (class docstring)
+            by = self._by.get(stamp)
+            if not by:
+                return None
+            at = min((t for w, t in by.items() if w in reads and w != topic and COPY_AFTER_S < source - t <= COPY_S),
+                     default=None)
+            if at is not None:
+                self.copied += 1
+            return at
         got = self._first.get(stamp)
         if got is None or got[0] == topic or not COPY_AFTER_S < source - got[1] <= COPY_S:
             return None
@@ -231,6 +258,7 @@ class CopiedStamps:
         if named is not None:
             return named, True
         first = self._first
+        self._by.setdefault(stamp, {}).setdefault(topic, source)
         if stamp not in first:
             first[stamp] = (topic, source)
             self._heard[stamp] = 1
@@ -240,6 +268,7 @@ class CopiedStamps:
                     break
                 del first[k]
                 self._heard.pop(k, None)
+                self._by.pop(k, None)
         else:
             self._heard[stamp] += 1
         return source, False

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from rclverify.lang.types import CheckedNode
+from rclverify.lang.types import Checked, CheckedNode
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 
@@ -39,4 +39,21 @@ def node_topics(node: CheckedNode) -> tuple[dict[str, list[tuple[str, Any, bool]
     return topics, parts
 
 
-__all__ = ["node_topics"]
+def copy_sources(checked: Checked) -> dict[str, frozenset[str]]:
+    """Per topic a node of ``checked`` publishes (no leading ``/``), the
+    topics the nodes publishing it read (:func:`node_topics`, every node of
+    the workspace, so the live run and a read of its log or bag say the same):
+    the only topics whose header stamps a message of it may carry as copies
+    (:class:`~rclverify.traces.event_time.CopiedStamps`; a node with no input,
+    a sensor, copies none).  A topic no node publishes is not a key."""
+    out: dict[str, set[str]] = {}
+    for node in checked.nodes.values():
+        topics, _ = node_topics(node)
+        inputs = {t for t, vs in topics.items() if any(i for *_, i in vs)}
+        for t, vs in topics.items():
+            if any(not i for *_, i in vs):
+                out.setdefault(t, set()).update(inputs - {t})
+    return {t: frozenset(r) for t, r in out.items()}
+
+
+__all__ = ["copy_sources", "node_topics"]

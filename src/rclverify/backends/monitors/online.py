@@ -64,6 +64,7 @@ from rclverify.traces.events import Event, header_stamp, header_stamp_ns
 from rclverify.traces.reorder import ReorderBuffer
 from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
+from rclverify.backends.monitors.node_topics import copy_sources
 
 
 #: a writer not heard yet: (the latest time heard, the most it published after its stamp)
@@ -162,6 +163,7 @@ class OnlineEngine:
     def __post_init__(self) -> None:
         self.monitors = [NodeMonitor(self.checked, n, self.rules, self.horizon, self.on_verdict, self.tolerance)
                          for n in self.nodes]
+        self.copies = CopiedStamps(copy_sources(self.checked))  # whose stamps a writer may copy: the contracts say
         self.topics = {t: TopicStatus() for m in self.monitors for t in m.topics}
         #: per topic, the monitors that read it: a released message is fed to those only (every monitor's
         #: clock is moved to it first, which is all a message off its topics does to a monitor)

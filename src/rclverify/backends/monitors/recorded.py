@@ -27,6 +27,7 @@ from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_
 from rclverify.backends.monitors.judged import Counted, Heard, not_judged
 from rclverify.backends.monitors.log_calls import LogCalls
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
+from rclverify.backends.monitors.node_topics import copy_sources
 from rclverify.backends.monitors.stamp_order import StampWatch, in_stamp_order, second_read, unless_stale
 from rclverify.backends.monitors.summary import verdict_status
 from rclverify.backends.monitors.widths import judged_at_widths, refuse_out_of_range
@@ -164,14 +165,14 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
         if calls.active and is_ros2_bag(Path(trace)) else None  # a bag's recorded calls (bag_calls.py)
     run = refuse_out_of_range(run, Path(trace), sources)  # a hand-made log's value no field carries (widths.py)
     if lag is not None:
-        run = in_stamp_order(run, lag)
+        run = in_stamp_order(run, lag, copy_sources(checked))
     tapped: list[Any] = [*dmons, *pmons, *decl]
     source = _Tapped(run, tapped) if tapped else run  # a log keeps its columnar reading where it can (_Tapped)
     if bag is not None:
         source = bag.tap(source)
     elif calls.active:
         source = calls.tap(source)  # only nodes with links: never the batch path
-    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0)  # the engine's transport skew (engine.py)
+    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0, copy_sources(checked))  # the engine's transport skew (engine.py)
     stamps: dict[tuple[str, float], float] = {}
     if keep:  # each message's header stamp, what every path shares (the run is then streamed)
         source = _stamped(source, stamps)

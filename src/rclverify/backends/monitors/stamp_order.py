@@ -56,7 +56,7 @@ record and the bag give it (:meth:`StampWatch.named`).
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Iterable, Iterator
+from typing import Any, Callable, Iterable, Iterator, Mapping
 
 from rclverify.traces.event_time import (ASIDE, CopiedStamps, WriterClocks, aside_stamp, other_clock, published,
                                          with_stamp, without_stamp)
@@ -83,7 +83,7 @@ class StampWatch:
     __slots__ = ("skew", "latest", "count", "lag", "first", "stamped", "plain", "clocks", "placed_latest",
                  "placed_lag", "near", "copies", "writers")
 
-    def __init__(self, skew: float) -> None:
+    def __init__(self, skew: float, reads: Mapping[str, frozenset[str]] | None = None) -> None:
         self.skew = skew
         self.latest = -math.inf
         self.count = 0
@@ -100,7 +100,7 @@ class StampWatch:
         #: the largest lag (s) of a message read after one stamped later by no more than the skew
         self.near = 0.0
         #: the stamps in another clock seen, to place a copy of one at its question's time (traces/event_time.py)
-        self.copies = CopiedStamps()
+        self.copies = CopiedStamps(reads)  # ``reads``: whose stamps a writer may copy (node_topics.copy_sources)
         #: per writer, the offset of the stamp it wrote (a stamp set aside in a live log, else the header stamp)
         #: from its trace times: what the live run measured, whose lines name the writers (:meth:`named`);
         #: ``None`` until a stamp set aside is seen (until then it would hold what :attr:`clocks` holds)
@@ -237,18 +237,20 @@ def _own_or_copied(copies: CopiedStamps, topic: str, stamp: float, time: float) 
     return stamp if at is None else at
 
 
-def in_stamp_order(events: Iterable[Event], lag: float) -> Iterator[Event]:
+def in_stamp_order(events: Iterable[Event], lag: float,
+                   reads: Mapping[str, frozenset[str]] | None = None) -> Iterator[Event]:
     """``events`` in the order of their stamps on the run's clock (equal
     stamps by their recorded times, the publishers' source times in a bag
     the live monitor wrote, then in the order read:
     :func:`rclverify.traces.event_time.order_key`), each with that stamp as its ``time`` and its index in
     the new order; ``lag`` (s) is the largest lag a :class:`StampWatch`
-    measured on the same run, which bounds what the buffer holds."""
+    measured on the same run, which bounds what the buffer holds; ``reads``, whose
+    stamps a writer may copy, as the first pass had it (:func:`.node_topics.copy_sources`)."""
     buffer: ReorderBuffer[Event] = ReorderBuffer()  # the one reorder buffer (traces/reorder.py)
     latest = -math.inf
     out = 0
     place = isinstance(lag, Reread) and lag.placed
-    copies = CopiedStamps()  # as the first pass placed them (StampWatch.see)
+    copies = CopiedStamps(reads)  # as the first pass placed them (StampWatch.see)
     for ev in events:
         if place:
             t, how = placed_clock(ev, copies)
