@@ -25,7 +25,14 @@ its first writer, of whose stamps Relay1 copied none: two answers placed at thei
 
 The stamps alone do not say which writer a message copies; the contracts do: a node copies only the
 stamps of the topics it reads (Relay3 reads Sensor0's topic, not Relay4's; Relay1 reads Sensor0's, not
-Sensor5's): ``CopiedStamps``' ``reads``, from backends/monitors/node_topics.py ``copy_sources``."""
+Sensor5's): ``CopiedStamps``' ``reads``, from backends/monitors/node_topics.py ``copy_sources``.
+
+Seed 1271 (10 nodes, DDS source, x0.75 from 0 s, x1.5, paused for 0.8 s, x1.5): Sensor0 writes three
+readings stamped alike while the clock stands still (0.41, 0.41, 1.26, 300 ms apart), and Relay4 copies
+each 510 ms later; both copies are placed at the first reading so stamped.  The bag and the live run
+leave the second copy (1.26, heard 294 ms late) without a verdict; the run's log judges it
+``violated`` against the reading after the three (1.0068, the two before it superseded): kept as the
+log with the bag, a strict xfail until the log is judged as the bag is."""
 from __future__ import annotations
 
 import json
@@ -56,7 +63,7 @@ def _rows(seed: int, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     return rows
 
 
-@pytest.mark.parametrize("seed, relay", [(1178, "Relay3"), (1187, "Relay6"), (1149, "Relay1")])
+@pytest.mark.parametrize("seed, relay", [(1178, "Relay3"), (1187, "Relay6"), (1149, "Relay1"), (1271, "Relay4")])
 def test_a_relay_copying_a_stamp_another_writer_shares_is_never_violated(
         seed: int, relay: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
         capsys: pytest.CaptureFixture[str]) -> None:
@@ -67,7 +74,8 @@ def test_a_relay_copying_a_stamp_another_writer_shares_is_never_violated(
 
 @pytest.mark.parametrize("seed, relays", [(1178, ("Sensor0", "Relay3", "Relay4")),
                                           (1187, ("Sensor0", "Relay3", "Relay5", "Relay6")),
-                                          (1149, ("Sensor0", "Sensor5", "Relay1"))])
+                                          (1149, ("Sensor0", "Sensor5", "Relay1")),
+                                          (1271, ("Sensor0", "Relay4"))])
 def test_the_online_engine_gives_the_bags_verdicts(seed: int, relays: tuple[str, ...]) -> None:
     """The bag replayed through the online engine (as the live run judges it) gives the bag's verdicts on the
     sensors and the relays copying their stamps, none of them violated."""
@@ -75,3 +83,14 @@ def test_the_online_engine_gives_the_bags_verdicts(seed: int, relays: tuple[str,
     online, bag = finals(_online(ws, relays)), finals(_offline(ws, "runs/bag", relays))
     assert compare(online, bag) == [], [d.text(("live", "bag")) for d in compare(online, bag)]
     assert not [r for rs in online.values() for r in rs if r["verdict"] in ("violated", "false")]
+
+
+@pytest.mark.xfail(strict=True, reason="the log of seed 1271 judges Relay4's second copy of a paused stamp "
+                   "violated against a later reading; the bag and the live run give it no verdict")
+def test_seed_1271_the_log_gives_the_bags_verdicts_at_the_relay() -> None:
+    """The run's log (``runs/live.jsonl``, the copies' stamps carried into the run's clock) gives the bag's
+    verdicts at Relay4, never ``violated``: a correct relay copying its sensor's stamp."""
+    ws = DATA / "robot_seed1271"
+    log, bag = finals(_offline(ws, "runs/live.jsonl", ("Relay4",))), finals(_offline(ws, "runs/bag", ("Relay4",)))
+    assert not [r for rs in log.values() for r in rs if r["verdict"] in ("violated", "false")]
+    assert compare(log, bag) == [], [d.text(("log", "bag")) for d in compare(log, bag)]
