@@ -139,6 +139,22 @@ def with_stamp(fields: Mapping[str, Any], stamp: float) -> dict[str, Any]:
     return out
 
 
+def carried(fields: Mapping[str, Any]) -> bool:
+    """Whether ``fields`` carry a header stamp :func:`with_stamp` carried into
+    the run's clock: a stamp beside a stamp set aside (``header.stamp_aside``,
+    nested or flattened), as a live log writes a copy of a stamp in another
+    clock at its question's time.  Such a stamp is the run's clock's by
+    construction, however long before its message's source time it lies (a
+    copy of a paused clock's stamp published over :data:`STAMP_BEHIND_S`
+    after the first message so stamped): it is the message's time, never a
+    stamp in another clock (:func:`other_clock`) to be set aside again."""
+    h = fields.get("header")
+    if isinstance(h, Mapping):
+        return "stamp" in h and ASIDE in h
+    return any(k.startswith("header.stamp.") for k in fields) and any(
+        k.startswith(f"header.{ASIDE}.") for k in fields)
+
+
 #: a header stamp more than this (s) before its message's source time is older than its publication: the
 #: message may answer any question asked up to its source time (a stamp copied from an earlier question)
 STALE_S = 0.02
@@ -349,5 +365,5 @@ def order_key(stamp: float, source: float, seq: int) -> tuple[float, float, int]
     return (stamp, source, seq)
 
 
-__all__ = ["AHEAD_NS", "ASIDE", "aside_stamp", "STALE_S", "STAMP_AHEAD_S", "published", "STAMP_BEHIND_S", "event_ns", "event_s", "order_key", "other_clock",
+__all__ = ["AHEAD_NS", "ASIDE", "aside_stamp", "carried", "STALE_S", "STAMP_AHEAD_S", "published", "STAMP_BEHIND_S", "event_ns", "event_s", "order_key", "other_clock",
            "without_stamp", "WriterClocks"]

@@ -58,8 +58,8 @@ from __future__ import annotations
 import math
 from typing import Any, Callable, Iterable, Iterator, Mapping
 
-from rclverify.traces.event_time import (ASIDE, CopiedStamps, WriterClocks, aside_stamp, other_clock, published,
-                                         with_stamp, without_stamp)
+from rclverify.traces.event_time import (ASIDE, CopiedStamps, WriterClocks, aside_stamp, carried, other_clock,
+                                         published, with_stamp, without_stamp)
 from rclverify.traces.events import Event, header_stamp
 from rclverify.traces.reorder import ReorderBuffer
 
@@ -121,8 +121,9 @@ class StampWatch:
         wrote = s if own is None else own
         if writers is not None and wrote is not None:
             writers.see(ev.topic, wrote, ev.time)
-        p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time)[0] if self.clocks.see(
-            ev.topic, s, ev.time) else _own_or_copied(self.copies, ev.topic, s, ev.time)
+        # a stamp a live log carried into the run's clock (beside its own, set aside) is its time, never another clock
+        p = ev.time if s is None else self.copies.place(ev.topic, s, ev.time)[0] if (own is None or not carried(f)) \
+            and self.clocks.see(ev.topic, s, ev.time) else _own_or_copied(self.copies, ev.topic, s, ev.time)
         if p >= self.placed_latest:
             self.placed_latest = p
         elif self.placed_latest - p > self.placed_lag:
@@ -221,7 +222,7 @@ def placed_clock(ev: Event, copies: CopiedStamps | None = None) -> tuple[float, 
     s = header_stamp(ev.fields) if ev.fields else None
     if s is None:
         return ev.time, ""
-    if other_clock(s, ev.time):
+    if other_clock(s, ev.time) and not carried(ev.fields):  # a stamp a live log carried is the run's clock's
         if copies is None:
             return ev.time, "aside"
         t, copied = copies.place(ev.topic, s, ev.time)
