@@ -164,15 +164,16 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     bag = BagCalls(nodes, calls, trace, bag_connections(Path(trace), dirs)) \
         if calls.active and is_ros2_bag(Path(trace)) else None  # a bag's recorded calls (bag_calls.py)
     run = refuse_out_of_range(run, Path(trace), sources)  # a hand-made log's value no field carries (widths.py)
+    reads = copy_sources(checked)  # whose stamps a writer may copy: the reorder and the watch read it alike
     if lag is not None:
-        run = in_stamp_order(run, lag, copy_sources(checked))
+        run = in_stamp_order(run, lag, reads)
     tapped: list[Any] = [*dmons, *pmons, *decl]
     source = _Tapped(run, tapped) if tapped else run  # a log keeps its columnar reading where it can (_Tapped)
     if bag is not None:
         source = bag.tap(source)
     elif calls.active:
         source = calls.tap(source)  # only nodes with links: never the batch path
-    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0, copy_sources(checked))  # the engine's transport skew (engine.py)
+    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0, reads)  # the engine's transport skew (engine.py)
     stamps: dict[tuple[str, float], float] = {}
     if keep:  # each message's header stamp, what every path shares (the run is then streamed)
         source = _stamped(source, stamps)

@@ -64,7 +64,8 @@ def read_run(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | No
     calls = LogCalls(target.checked, [node], cfg.rules, cfg.horizon, trace)
     span = TraceSpan()  # the run's duration in trace time (the strength's detail, docs/confidence.md)
     heard: dict[str, int] = {}  # events per topic: what the run did not judge (judged.py)
-    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0, copy_sources(target.checked))  # the engine's transport skew (engine.py)
+    reads = copy_sources(target.checked)  # whose stamps a writer may copy: the watch and the reorder read it alike
+    watch = StampWatch(getattr(cfg.rules, "skew", None) or 0.0, reads)  # the engine's transport skew (engine.py)
     dirs = [target.root / d for d in cfg.msg_dirs]
     path = target.root / trace
     source: Iterable[Any] = read_trace(path, dirs)
@@ -72,7 +73,7 @@ def read_run(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | No
         if calls.active and is_ros2_bag(path) else None  # a bag's recorded calls, as `monitor BAG` reads them
     source = refuse_out_of_range(source, path, fields.items())  # a value no field carries
     if lag is not None:
-        source = in_stamp_order(source, lag, copy_sources(target.checked))
+        source = in_stamp_order(source, lag, reads)
     inner = bag.tap(source) if bag is not None else calls.tap(source) if calls.active else source
     origin = RunOrigin()  # the source and middleware a live log says it was heard through (run_origin.py)
     gate = gate_of([node])  # a managed node's messages judged in its lifecycle scope, as live (lifecycle.py)
