@@ -23,33 +23,9 @@ import pytest
 from rclverify.cli.commands import main
 from rclverify.traces.event_time import without_stamp
 
-RCL = """node Sensor0 {
-  inputs(  )
-  outputs( x : REAL )
-  topics( sensor_msgs/Range s0 matches(out.x) )
-  assume( TRUE )
-  guarantee( 0 <= out.x and out.x <= 2 )
-  periodic( out.x, 800 ms )
-}
+from test_periods_node_clock import MAPPING, RCL as _RCL, WALL0  # the same three nodes: one workspace
 
-node Sensor2 {
-  inputs(  )
-  outputs( y : REAL )
-  topics( sensor_msgs/Range s2 matches(out.y) )
-  assume( TRUE )
-  guarantee( 0 <= out.y and out.y <= 2 )
-}
-
-node Alarm1 {
-  inputs( n : INTEGER )
-  outputs( ok : BOOL )
-  topics( std_msgs/UInt8 u1 matches(in.n), std_msgs/Bool a1 matches(out.ok) )
-  assume( TRUE )
-  guarantee( out.ok <=> (in.n >= 0) )
-}
-"""
-MAPPING = "topics:\n  s0: {fields: [range]}\n  s2: {fields: [range]}\n  u1: {fields: [data]}\n  a1: {fields: [data]}\nhorizon: 1.0\n"
-WALL0 = 1_764_000_000.0
+RCL = _RCL.replace("PERIOD", "800")
 START = 100.0
 
 
