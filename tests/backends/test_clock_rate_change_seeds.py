@@ -59,13 +59,20 @@ SEED_1074 = Path(__file__).resolve().parents[1] / "data" / "robot_seed1074"
 SEED_1075 = Path(__file__).resolve().parents[1] / "data" / "robot_seed1075"
 
 
-def test_seed_1069_a_relay_copying_stamps_of_a_paused_clock_is_never_red(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+def _bag_rows(seed: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+              capsys: pytest.CaptureFixture[str]) -> list[Any]:
+    """``rclverify monitor --json`` on a copy of the kept workspace ``seed``'s bag: its rows."""
     ws = tmp_path / "ws"
-    shutil.copytree(SEED_1069, ws)
+    shutil.copytree(seed, ws)
     monkeypatch.chdir(ws)
     main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
     rows: list[Any] = json.loads(capsys.readouterr().out)
+    return rows
+
+
+def test_seed_1069_a_relay_copying_stamps_of_a_paused_clock_is_never_red(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    rows = _bag_rows(SEED_1069, tmp_path, monkeypatch, capsys)
     deadlines = {r["node"]: r["deadlines"]["counts"] for r in rows if "deadlines" in r}
     counts = {r["node"]: r["counts"] for r in rows if "counts" in r}
     relay = next(r["deadlines"] for r in rows if r["node"] == "Relay1" and "deadlines" in r)
@@ -85,11 +92,7 @@ def test_seed_1075_a_relay_copies_only_its_own_readings_stamp_every_deadline_met
     alone a copy of Relay6's (placed before the reading they answer: a deadline false, then undecided); by
     the contracts each relay reads its own sensor only, so each answer is its own reading's copy: every
     deadline of the three relays met, every answer satisfied."""
-    ws = tmp_path / "ws"
-    shutil.copytree(SEED_1075, ws)
-    monkeypatch.chdir(ws)
-    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
-    rows: list[Any] = json.loads(capsys.readouterr().out)
+    rows = _bag_rows(SEED_1075, tmp_path, monkeypatch, capsys)
     deadlines = {r["node"]: r["deadlines"] for r in rows if "deadlines" in r}
     assert all(d["counts"]["false"] == 0 for d in deadlines.values()), {n: d["counts"] for n, d in deadlines.items()}
     for relay in ("Relay1", "Relay6", "Relay7"):
@@ -112,11 +115,7 @@ def test_seed_1075_live_is_the_bag() -> None:
 
 def test_seed_1074_answers_stamped_alike_on_a_paused_clock_are_never_violated(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    ws = tmp_path / "ws"
-    shutil.copytree(SEED_1074, ws)
-    monkeypatch.chdir(ws)
-    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
-    rows: list[Any] = json.loads(capsys.readouterr().out)
+    rows = _bag_rows(SEED_1074, tmp_path, monkeypatch, capsys)
     counts = {r["node"]: r["counts"] for r in rows if "counts" in r}
     assert all(c["violated"] == 0 for c in counts.values()), counts
     assert all(counts[r]["inconclusive"] == 0 and counts[r]["satisfied"] == 49 for r in ("Relay4", "Relay8")), counts
@@ -125,11 +124,7 @@ def test_seed_1074_answers_stamped_alike_on_a_paused_clock_are_never_violated(
 
 def test_seed_1072_a_sensor_stamping_a_paused_clocks_time_keeps_its_readings_apart(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    ws = tmp_path / "ws"
-    shutil.copytree(SEED_1072, ws)
-    monkeypatch.chdir(ws)
-    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
-    rows: list[Any] = json.loads(capsys.readouterr().out)
+    rows = _bag_rows(SEED_1072, tmp_path, monkeypatch, capsys)
     counts = {r["node"]: r["counts"] for r in rows if "counts" in r}
     assert all(c["violated"] == 0 and c["superseded"] == 0 and c["inconclusive"] == 0 for c in counts.values()), counts
     assert all(r["deadlines"]["counts"]["false"] == 0 for r in rows if "deadlines" in r)

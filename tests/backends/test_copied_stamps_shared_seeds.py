@@ -37,39 +37,26 @@ answered the reading after the three (1.0068, the two before it superseded): ``v
 no verdict live and on the bag.  A stamp carried so (``event_time.carried``) is the run's clock's."""
 from __future__ import annotations
 
-import json
-import shutil
-from pathlib import Path
-from typing import Any
-
 import sys
+from pathlib import Path
 
 import pytest
-
-from rclverify.cli.commands import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 from _robot_verdicts import compare, finals  # noqa: E402
 from test_generated_seed_faults import _offline, _online  # noqa: E402
+from test_clock_rate_change_seeds import _bag_rows  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 
 
-def _rows(seed: int, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-          capsys: pytest.CaptureFixture[str]) -> list[Any]:
-    ws = tmp_path / "ws"
-    shutil.copytree(DATA / f"robot_seed{seed}", ws)
-    monkeypatch.chdir(ws)
-    main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "runs/bag"])
-    rows: list[Any] = json.loads(capsys.readouterr().out)
-    return rows
 
 
 @pytest.mark.parametrize("seed, relay", [(1178, "Relay3"), (1187, "Relay6"), (1149, "Relay1"), (1271, "Relay4")])
 def test_a_relay_copying_a_stamp_another_writer_shares_is_never_violated(
         seed: int, relay: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
         capsys: pytest.CaptureFixture[str]) -> None:
-    counts = {r["node"]: r["counts"] for r in _rows(seed, tmp_path, monkeypatch, capsys) if "counts" in r}
+    counts = {r["node"]: r["counts"] for r in _bag_rows(DATA / f"robot_seed{seed}", tmp_path, monkeypatch, capsys) if "counts" in r}
     assert counts[relay]["violated"] == 0, counts[relay]
     assert all(c["violated"] == 0 for c in counts.values()), counts
 
