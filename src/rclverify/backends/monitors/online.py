@@ -151,6 +151,12 @@ class OnlineEngine:
     #: per contract topic, the writers the source matches on it (:meth:`match`); ``None``: not told.
     #: Replaced whole, never changed in place, so a source's thread may hand a new one over at any time
     matched: Mapping[str, frozenset[WriterId]] | None = field(init=False, default=None)
+    #: :meth:`_early`'s answer and what it was given: (:attr:`matched`, :attr:`gate_topics`, the bound,
+    #: the answer), so the hot path (:meth:`watermark`, :meth:`due`) walks the topics once per matched set
+    _early_of: tuple[object, object, float, Mapping[str, frozenset[WriterId]] | None] | None = \
+        field(init=False, default=None)
+    #: the matched set every writer of which has been heard (:meth:`_unheard`: a writer once heard stays)
+    _heard_all: object = field(init=False, default=None)
 
     #: the watermark (s) the last :meth:`tick` reached: a verdict on a later time given by :meth:`finish` is
     #: provisional (:meth:`early`)
@@ -207,7 +213,8 @@ class OnlineEngine:
                 for key in keys:
                     if self._held(key, self._now, matched is not None) < t:
                         return False
-                if matched is not None and any((topic, w) not in writers for w in matched[topic]):
+                if matched is not None and self._unheard(matched) \
+                        and any((topic, w) not in writers for w in matched[topic]):
                     return False
             return True
         return past
@@ -224,14 +231,26 @@ class OnlineEngine:
     def _early(self) -> Mapping[str, frozenset[WriterId]] | None:
         """The matched writer sets when the release is early (:meth:`watermark`): a lateness bound, no
         gate topic (their writers are not matched), and every contract topic with a writer matched;
-        else ``None``."""
-        matched = self.matched
-        if matched is None or self.gate_topics or self.reorder_window <= 0:
-            return None
-        for topic in self.topics:
-            if not matched.get(topic):
-                return None
-        return matched
+        else ``None``.  Worked out once per matched set (:attr:`_early_of`)."""
+        matched, gates, window = self.matched, self.gate_topics, self.reorder_window
+        of = self._early_of
+        if of is not None and of[0] is matched and of[1] is gates and of[2] == window:
+            return of[3]
+        early = None if matched is None or gates or window <= 0 \
+            or any(not matched.get(topic) for topic in self.topics) else matched
+        self._early_of = (matched, gates, window, early)
+        return early
+
+    def _unheard(self, matched: Mapping[str, frozenset[WriterId]]) -> bool:
+        """Whether a writer ``matched`` on a contract topic has not been heard yet; once every one has,
+        remembered for that set (:attr:`_heard_all`: :attr:`writers` only grows)."""
+        if self._heard_all is matched:
+            return False
+        writers = self.writers
+        if any((topic, w) not in writers for topic in self.topics for w in matched[topic]):
+            return True
+        self._heard_all = matched
+        return False
 
     def _held(self, key: WriterKey, now: float, early: bool) -> float:
         """The time (s) writer ``key`` (heard) has been heard past at ``now`` (s): :func:`_heard_upto`,
@@ -311,8 +330,7 @@ class OnlineEngine:
         for key, (last, lag) in writers.items():
             if (last < head or key in back) and lag > most:
                 most = lag
-        if matched is not None and most < 0 \
-                and any((topic, w) not in writers for topic in self.topics for w in matched[topic]):
+        if matched is not None and most < 0 and self._unheard(matched):
             most = 0.0  # a matched writer not heard yet: held at the clock less the bound
         return head + self.reorder_window + most
 
@@ -354,7 +372,7 @@ class OnlineEngine:
             held = bound - lag if key in back else _heard_upto(last, lag, now, window)
             if held < upto:
                 upto = held
-        if upto > bound and any((topic, w) not in writers for topic in self.topics for w in matched[topic]):
+        if upto > bound and self._unheard(matched):
             upto = bound  # a matched writer not heard yet
         return upto
 
