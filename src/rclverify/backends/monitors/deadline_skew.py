@@ -119,8 +119,7 @@ def mark_early(mon: DeadlineMonitor, p: Pending, ev: Event, ns: int, fresh: Mapp
 def scan_heard(mon: DeadlineMonitor, p: Pending) -> None:
     """Mark ``p`` from the outputs already heard (the last 64 kept) that may be its answer (:func:`may_answer`:
     stamped within the skew before its trigger, or placed before it and published after it), oldest first."""
-    for ns, ev, _, fresh in [h for h in mon.heard if h[0] < p.stamp_ns and published_after(p, h[1], h[0])
-                             or mon.skew_ns > 0 and within_before(h[0], p.stamp_ns, mon.skew_ns)]:
+    for ns, ev, _, fresh in [h for h in mon.heard if may_answer(mon, p, h[1], h[0])]:
         mark_early(mon, p, ev, ns, fresh)
         if p.maybe:
             return
