@@ -223,12 +223,11 @@ class CopiedStamps:
     answers at their own times, ``violated``).  A topic ``reads`` does not
     name (no contract writes it) keeps the rule by stamps alone."""
 
-    __slots__ = ("_first", "_heard", "_copier", "_by", "reads", "copied")
+    __slots__ = ("_heard", "_copier", "_by", "reads", "copied")
 
     def __init__(self, reads: Mapping[str, frozenset[str]] | None = None) -> None:
-        #: per stamp, its first writer and that message's source time (s)
-        self._first: dict[float, tuple[str, float]] = {}
-        #: per stamp, each writer that carried it as its own and the source time (s) it first did
+        #: per stamp, each writer that carried it as its own and the source time (s) it first did, in the
+        #: order heard (the first: the stamp's first writer; the stamps too in the order first heard)
         self._by: dict[float, dict[str, float]] = {}
         self.reads: Mapping[str, frozenset[str]] = reads or {}
         #: per stamp, how many messages carried it (2 or more: it stands still)
@@ -241,27 +240,27 @@ class CopiedStamps:
         """The source time (s) of the message of another writer that a
         message of ``topic`` stamped ``stamp`` and published at ``source``
         (s) copies the stamp of (class docstring), counted; else ``None``."""
+        by = self._by.get(stamp)
+        if not by:
+            return None
         reads = self.reads.get(topic)
         if reads is not None:  # whose stamps its writer may copy: the contracts say (class docstring)
-            by = self._by.get(stamp)
-            if not by:
-                return None
             at = min((t for w, t in by.items() if w in reads and w != topic and COPY_AFTER_S < source - t <= COPY_S),
                      default=None)
             if at is not None:
                 self.copied += 1
             return at
-        got = self._first.get(stamp)
-        if got is None or got[0] == topic or not COPY_AFTER_S < source - got[1] <= COPY_S:
+        writer, at = next(iter(by.items()))  # its first writer
+        if writer == topic or not COPY_AFTER_S < source - at <= COPY_S:
             return None
-        pair = (topic, got[0])
+        pair = (topic, writer)
         if self._heard.get(stamp, 0) <= 1:  # fresh: a copy, and its writer a copier of that writer's stamps
             self._copier[pair] = self._copier.get(pair, 0) + 1
         elif self._copier.get(pair, 0) < 2:  # standing still, and its writer no copier of that writer's
             return None
         self.copied += 1
         self._heard[stamp] += 1
-        return got[1]
+        return at
 
     def place(self, topic: str, stamp: float, source: float) -> tuple[float, bool]:
         """``(time, copied)``: the time (s, the run's clock) a message of
@@ -273,19 +272,19 @@ class CopiedStamps:
         named = self._name(topic, stamp, source)
         if named is not None:
             return named, True
-        first = self._first
-        self._by.setdefault(stamp, {}).setdefault(topic, source)
-        if stamp not in first:
-            first[stamp] = (topic, source)
+        stamps = self._by
+        by = stamps.get(stamp)
+        if by is None:
+            stamps[stamp] = {topic: source}
             self._heard[stamp] = 1
-            while first:  # stamps too old to be copied any more are forgotten (insertion order: oldest first)
-                k = next(iter(first))
-                if first[k][1] >= source - COPY_S:
+            while stamps:  # stamps too old to be copied any more are forgotten (insertion order: oldest first)
+                k = next(iter(stamps))
+                if next(iter(stamps[k].values())) >= source - COPY_S:
                     break
-                del first[k]
+                del stamps[k]
                 self._heard.pop(k, None)
-                self._by.pop(k, None)
         else:
+            by.setdefault(topic, source)
             self._heard[stamp] += 1
         return source, False
 
