@@ -172,10 +172,7 @@ class EngineWorker:
                 last = received
                 fields = self.decode(topic, payload)
                 if fields is not None:
-                    if writer is None:
-                        live.push(topic, fields, received)
-                    else:
-                        live.push(topic, fields, received, writer)
+                    live.push(topic, fields, received, writer)
                 n += 1
                 self.handled += 1
                 if n >= self.batch:
