@@ -138,7 +138,7 @@ class OnlineEngine:
     #: per writer (topic), its header stamps' offset from its source times (traces/event_time.py)
     clocks: WriterClocks = field(init=False, default_factory=WriterClocks)
     #: the stamps in another clock heard, to place a copy of one at its question's time
-    copies: CopiedStamps = field(init=False, default_factory=CopiedStamps)
+    copies: CopiedStamps = field(init=False)
     #: per writer (:data:`WriterKey`: its topic, or its topic and id where the source names it): (the
     #: latest time heard on the run's clock, the most it published after its stamp, s): its own
     #: watermark (:meth:`watermark`)
