@@ -308,9 +308,21 @@ class RuleSet(dict):  # type: ignore[type-arg]
     tolerance: Any = None
     #: the transport skew in seconds (``None``: none; backends/monitors/skew.py)
     skew: float | None = None
+    #: which nodes keep their time from ``/clock`` (the mapping's ``use_sim_time``): ``True`` every node,
+    #: ``False`` none, a set of contract node names those only, ``None`` not said (:func:`sim_time_of`)
+    sim_time: bool | frozenset[str] | None = None
     #: (topic, variable name) -> the rule of one variable of a topic that carries several
     #: (``fields: {x: [x], y: [y]}``); read through :func:`rule_for`
     by_var: Mapping[tuple[str, str], TopicRule] = {}
+
+
+def sim_time_of(rules: Mapping[str, TopicRule], node: str) -> bool | None:
+    """Whether contract node ``node`` keeps its time from ``/clock`` by the mapping's ``use_sim_time``
+    (:attr:`RuleSet.sim_time`): ``True`` it does, ``False`` it keeps the wall clock, ``None`` not said."""
+    sim = getattr(rules, "sim_time", None)
+    if sim is None or isinstance(sim, bool):
+        return sim
+    return node in sim
 
 
 def rule_for(rules: Mapping[str, TopicRule], topic: str, key: str, default: TopicRule | None = None) -> TopicRule:

@@ -14,7 +14,10 @@ Mapping file: ``msg_dirs`` (directories holding ``<pkg>/msg/<Type>.msg``),
 ``tolerance`` (``{abs, rel, ulps}``: recorded numbers this close are equal
 to the comparisons, :class:`rclverify.semantics.floatsem.Tolerance`), ``skew``
 (seconds, default 0.02: how far apart two messages on different topics may be
-stamped in the other order than they were published, :mod:`.skew`) and
+stamped in the other order than they were published, :mod:`.skew`),
+``use_sim_time`` (``true``: every node keeps its time from ``/clock``; a list
+of contract node names: those nodes do, the others the wall clock; ``false``:
+none does; absent: not said, docs/semantics.md "Deadlines in simulated time") and
 ``ros_nodes`` (contract node -> ``{name, package, path}`` of the ROS node
 to instrument, as ROSMonitoring's configuration lists it)::
 
@@ -150,6 +153,11 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
         raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('skew',))}: error: skew must "
                           f"be a finite number of seconds >= 0, not {raw.get('skew')!r}")
     rules.skew = sk
+    sim = raw.get("use_sim_time")
+    if not (sim is None or isinstance(sim, bool) or (isinstance(sim, list) and all(isinstance(n, str) for n in sim))):
+        raise ConfigError(f"{rel or DEFAULT_MAPPING}:{_at(path, rel or DEFAULT_MAPPING, ('use_sim_time',))}: error: "
+                          f"use_sim_time must be true, false or a list of contract node names, not {sim!r}")
+    rules.sim_time = frozenset(sim) if isinstance(sim, list) else sim
     ros = str(raw.get("ros_version", "ros2"))
     msg_dirs = raw.get("msg_dirs", ()) or ()
     if not isinstance(msg_dirs, (list, tuple)):

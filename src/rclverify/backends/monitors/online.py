@@ -31,6 +31,11 @@ a running system adds (docs/monitors.md, "Live monitoring"):
   there: :class:`~rclverify.traces.event_time.CopiedStamps`), its stamp set aside,
   as a recorded run read again is (:mod:`.stamp_order`); :meth:`clock_lines`
   names each such writer;
+* **the simulated clock**: ``/clock`` messages (:mod:`rclverify.traces.sim_clock`)
+  are ordered with the rest at their source times, their writer held by the
+  watermark like a contract topic's, and released to ``on_event`` and
+  ``admit`` (no node's monitor reads them): the deadline checks that judge a
+  node under ``use_sim_time`` read them there, live as on the run's log;
 * **time**: :meth:`tick` (a timer, e.g. every 50 ms) moves every monitor's
   clock to the watermark (``now - reorder_window`` or before it, past it in
   an early release), so an obligation whose horizon (the contract's
@@ -62,6 +67,7 @@ from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.event_time import CopiedStamps, WriterClocks, published, with_stamp, without_stamp
 from rclverify.traces.events import Event, header_stamp, header_stamp_ns
 from rclverify.traces.reorder import ReorderBuffer
+from rclverify.traces.sim_clock import CLOCK_TOPIC
 from rclverify.traces.mapping import TopicRule
 from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 from rclverify.backends.monitors.node_topics import copy_sources
@@ -242,12 +248,12 @@ class OnlineEngine:
         return early
 
     def _unheard(self, matched: Mapping[str, frozenset[WriterId]]) -> bool:
-        """Whether a writer ``matched`` on a contract topic has not been heard yet; once every one has,
-        remembered for that set (:attr:`_heard_all`: :attr:`writers` only grows)."""
+        """Whether a writer ``matched`` on a contract topic, or on ``/clock``, has not been heard yet; once
+        every one has, remembered for that set (:attr:`_heard_all`: :attr:`writers` only grows)."""
         if self._heard_all is matched:
             return False
         writers = self.writers
-        if any((topic, w) not in writers for topic in self.topics for w in matched[topic]):
+        if any((topic, w) not in writers for topic in (*self.topics, CLOCK_TOPIC) for w in matched.get(topic, ())):
             return True
         self._heard_all = matched
         return False
@@ -273,11 +279,16 @@ class OnlineEngine:
         topic = topic.lstrip("/")
         status = self.topics.get(topic)
         if status is None:
-            if topic in self.gate_topics:  # ordered with the rest for the gate, no writer of the contracts
+            if topic == CLOCK_TOPIC:  # the run's simulated clock: a writer the watermark waits for, no monitor's
+                self._heard(topic, writer, received, received)
                 self._buffer.push(received, received, (topic, fields, where))
-                if self.reorder_window <= 0:
-                    self._release(math.inf)
-            return  # no contract names it
+            elif topic in self.gate_topics:  # ordered with the rest for the gate, no writer of the contracts
+                self._buffer.push(received, received, (topic, fields, where))
+            else:
+                return  # no contract names it
+            if self.reorder_window <= 0:
+                self._release(math.inf)
+            return
         status.received += 1
         status.last = received if status.last is None else max(status.last, received)
         if status.silent:
@@ -294,6 +305,14 @@ class OnlineEngine:
             if at is not None:  # a copy of a stamp set aside in another clock: at its question's time (event_time.py)
                 stamp, fields = at, with_stamp(fields, at)
         t = received if stamp is None else stamp
+        self._heard(topic, writer, t, received)
+        self._buffer.push(t, received, (topic, fields, where))
+        if self.reorder_window <= 0:
+            self._release(math.inf)
+
+    def _heard(self, topic: str, writer: WriterId | None, t: float, received: float) -> None:
+        """Writer ``writer`` of ``topic`` (``None``: the topic is its writer) heard with a message placed at
+        ``t`` and published at ``received`` (s): its own watermark (:attr:`writers`) moves."""
         key: WriterKey = topic if writer is None else (topic, writer)
         heard = self.writers.get(key)
         if heard is None:
@@ -306,9 +325,6 @@ class OnlineEngine:
         if self.horizon < after:
             after = self.horizon
         self.writers[key] = (t if t > last else last, after if after > lag else lag)
-        self._buffer.push(t, received, (topic, fields, where))
-        if self.reorder_window <= 0:
-            self._release(math.inf)
 
     def due(self) -> float:
         """When (s, on the engine's clock) the earliest buffered message is
