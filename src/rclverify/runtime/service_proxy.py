@@ -192,7 +192,7 @@ def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
 
     def start(rospy: Any, live: Any, publish: Callable[[str], None]) -> ProxyRun:
         rules = getattr(live.engine, "rules", {})  # the mapping's rules (and tolerance) of the live run
-        run = ProxyRun([DeadlineMonitor(checked, n, rules) for n in nodes if n.name in timed], write=live.note,
+        run = ProxyRun([DeadlineMonitor(checked, n, rules, clock=False) for n in nodes if n.name in timed], write=live.note,
                        publish=publish, forward=live.push)
         run.handles = start_proxy(rospy, checked, forwards, dirs, run,  # type: ignore[attr-defined]
                                   lambda: rospy.Time.now().to_sec())
@@ -232,7 +232,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     uri = rosgraph.get_master_uri()
     stop = StopFlag()  # a handler that takes no lock: a stop is always heard (stopping.py)
     on_signals(stop)
-    run = ProxyRun([DeadlineMonitor(checked, n, {}) for n in deadline_nodes(checked)], Path(args.log))
+    run = ProxyRun([DeadlineMonitor(checked, n, {}, clock=False) for n in deadline_nodes(checked)], Path(args.log))
     now: Callable[[], float] = lambda: rospy.Time.now().to_sec()  # noqa: E731  (the one clock of the proxy)
     bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)  # a master that hangs holds nothing (ros1.py)
 

@@ -9,6 +9,7 @@ from rclverify.core.numeric import np
 from rclverify.targets.column_deadlines import Judge
 from rclverify.targets.columns import ColumnCompiler, Compiled, Unsupported, io_kind
 from rclverify.traces.mapping import rule_for
+from rclverify.traces.sim_clock import CLOCK_TOPIC
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 
 
@@ -72,12 +73,13 @@ class DeadlinePlan:
 
     def kind_of(self, topic: str) -> int:
         """A row's topic as its column code: 1 the input's, -1 the output's, 0 another topic; 2 for the
-        node's topic written otherwise (a leading ``/``: mapped by another rule, streamed)."""
+        node's topic written otherwise (a leading ``/``: mapped by another rule, streamed) and for ``/clock``
+        (a simulated clock the streaming monitor reads: :mod:`.deadline_clock`)."""
         if topic == self.in_topic:
             return 1
         if topic == self.out_topic:
             return -1
-        return 2 if topic.lstrip("/") in (self.in_topic, self.out_topic) else 0
+        return 2 if topic.lstrip("/") in (self.in_topic, self.out_topic, CLOCK_TOPIC) else 0
 
     def seed(self, key: str, value: Any) -> Any:
         """A value the monitor holds as a column entry (a finite float, an enumeration's code), else None."""

@@ -151,7 +151,7 @@ class CallBook(CallNotes):
         monitors = [NodeMonitor(self.checked, view, self.rules, self.horizon, self._verdict) for _, view, _ in views]
         for m in monitors:  # a call's request was heard: its reply is awaited (the pairing's own rules say
             m.heard_answer = True  # when the monitor cannot know: runtime/dds/order.py), never "before first answer"
-        deadlines = [DeadlineMonitor(self.checked, node, self.rules, self._deadline) for node, _, timed in views
+        deadlines = [DeadlineMonitor(self.checked, node, self.rules, self._deadline, clock=False) for node, _, timed in views
                      if timed]
         bound = max([self.horizon] + [t[4] for d in deadlines for t in d.timed])
         call = _Call(key, name, label, stamp, bound, monitors, deadlines)

@@ -82,6 +82,17 @@ class Pending:
     #: guarantee on the trigger's inputs); ``""``: none is.  Unanswered by its deadline, such an obligation is
     #: ``undecided``, never ``false`` (docs/semantics.md, "Deadlines")
     maybe: str = ""
+    #: the clock the deadline is kept in (:mod:`.deadline_clock`): ``""`` the run's clock, ``"sim"`` simulated
+    #: time (``/clock``), ``"either"`` both, the node's clock not said
+    clock: str = ""
+    #: with a ``clock``: an answer stamped at or before it is in time in every clock the deadline may be kept
+    #: in (``due_ns``: one after it is late in every such clock; between them ``undecided``), integer ns
+    sure_ns: int = 0
+    #: with a ``clock``: the deadline on the simulated clock, on the run's clock, and when (the run's clock)
+    #: ``/clock`` passed the first (0: not yet), integer ns
+    sim_due_ns: int = 0
+    wall_due_ns: int = 0
+    sim_passed_ns: int = 0
 
 
 @dataclass

@@ -49,6 +49,7 @@ actionlib's ``a/goal``, ``a/feedback`` and ``a/result`` (the message's
 """
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
 from typing import Callable, Iterable, Mapping
 
@@ -59,13 +60,14 @@ from rclverify.lang.timing import seconds
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import subexpressions
 from rclverify.traces.events import Event, to_ns
-from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
+from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for, sim_time_of
+from rclverify.traces.sim_clock import CLOCK_TOPIC, SimClock
 from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.verdicts import names
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import VerdictWords, ms_ns, rejected
-from rclverify.backends.monitors import deadline_late, deadline_skew
+from rclverify.backends.monitors import deadline_clock, deadline_late, deadline_skew
 from rclverify.backends.monitors.late import value_at
 
 
@@ -80,8 +82,15 @@ class DeadlineMonitor(VerdictWords):
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
                  on_verdict: Callable[[DeadlineVerdict], None] | None = None, horizon: float | None = None,
-                 tolerance: Tolerance | None = None) -> None:
+                 tolerance: Tolerance | None = None, clock: bool = True) -> None:
         self.checked, self.node, self.rules, self.on_verdict = checked, node, rules, on_verdict
+        #: the clock the node keeps its deadlines in (:mod:`.deadline_clock`): ``True`` simulated time, ``False``
+        #: the run's clock, ``None`` not said (both, once ``/clock`` is heard); ``clock=False``: the run's clock
+        self.sim_mode: bool | None = sim_time_of(rules, node.name) if clock else False
+        #: the run's ``/clock`` as heard (:func:`.deadline_clock.tick`)
+        self.sim = SimClock()
+        #: obligations placed in simulated time whose deadline ``/clock`` has not passed yet
+        self.awaiting: list[Pending] = []
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.bindings = topic_bindings(node)
@@ -143,6 +152,25 @@ class DeadlineMonitor(VerdictWords):
         self._falses: dict[tuple[str, int], DeadlineVerdict] = {}
         self._last_false: DeadlineVerdict | None = None
 
+    def expired_verdict(self, p: Pending, now_ns: int) -> DeadlineVerdict:
+        return self._in_clock(p, super().expired_verdict(p, now_ns), None)
+
+    def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
+        return self._in_clock(p, super().answered_verdict(p, ns, ev, d, semantics), ns)
+
+    def late_verdict(self, p: Pending, ns: int, ev: Event) -> DeadlineVerdict:
+        return self._in_clock(p, super().late_verdict(p, ns, ev), ns)
+
+    def _in_clock(self, p: Pending, v: DeadlineVerdict, ns: int | None) -> DeadlineVerdict:
+        """Verdict ``v`` on obligation ``p``, with what its clock adds when it is placed in one
+        (:func:`.deadline_clock.words`; the time margin of an answer at ``ns`` in that clock)."""
+        if not p.clock:
+            return v
+        margin = v.time_margin if ns is None else deadline_clock.margin_ns(self, p, ns) / 1e9
+        reason = v.reason.replace(f"deadline of {ms_ns(p.due_ns - p.stamp_ns)}",
+                                  f"deadline of {ms_ns(self.bounds_ns[p.k])}")  # the bound, not the run's span
+        return dataclasses.replace(v, reason=reason + deadline_clock.words(self, p), time_margin=margin)
+
     def _emit(self, v: DeadlineVerdict) -> None:
         if v.update:  # the answer of an expired obligation: shown, not counted again
             if self.result.first_false is not None and self.result.first_false.trigger_where == v.trigger_where:
@@ -165,9 +193,14 @@ class DeadlineMonitor(VerdictWords):
     def feed(self, ev: Event) -> None:
         """Process one event (any topic; only the node's move its state)."""
         ns = event_stamp_ns(ev)
+        topic = ev.topic.lstrip("/")
+        if topic == CLOCK_TOPIC:  # the run's simulated clock (deadline_clock.py)
+            deadline_clock.tick(self, ev, ns)
+            self._advance_ns(ns)
+            return
         stamp = ns / 1e9
         late = self.now_ns is not None and ns < self.now_ns  # stamped before a message heard already
-        keys = self.bindings.get(ev.topic.lstrip("/"))
+        keys = self.bindings.get(topic)
         if not keys or not self.timed:
             self._advance_ns(ns)
             return
@@ -226,6 +259,11 @@ class DeadlineMonitor(VerdictWords):
             if refused is None:
                 d_ns = self.bounds_ns[k]
                 p = Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
+                if deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
+                    why = deadline_clock.place(self, p)
+                    if why:
+                        deadline_clock.undecided(self, p, why)
+                        continue
                 if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
                     deadline_skew.scan_heard(self, p)
                     self.pending.append(p)
@@ -274,6 +312,9 @@ class DeadlineMonitor(VerdictWords):
             if self._answers(p, ns, outs):
                 self.expired.remove(p)
                 if ns <= p.due_ns:  # stamped within the deadline, heard after the clock passed it
+                    if p.clock and ns > p.sure_ns:  # in time in one clock it may be kept in, not in every one
+                        deadline_clock.band_late(self, p, ev, ns)
+                        continue
                     deadline_late.met_late(self, p, ev, ns)
                     continue
                 if p.maybe:  # answered late, or in time by the output within the skew before it: still undecided
@@ -315,8 +356,12 @@ class DeadlineMonitor(VerdictWords):
         if p.maybe and ns > p.due_ns:  # its own answer after the deadline: undecided, as when the clock passed first
             deadline_skew.undecided(self, p)
             return True
+        if p.clock and p.sure_ns < ns <= p.due_ns:  # in time in one clock it may be kept in, not in every one
+            deadline_clock.band(self, p, ev, ns)
+            return True
         self._emit(self.answered_verdict(p, ns, ev, d, j.semantics))
-        self.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, stamp)
+        self.result.note_time_margin(p.k, deadline_clock.margin_ns(self, p, ns) if p.clock else p.due_ns - ns,
+                                     p.trigger.where, ev.where, stamp)
         return True
 
     def _heard_late(self, p: Pending) -> bool:
@@ -380,7 +425,10 @@ class DeadlineMonitor(VerdictWords):
     def pending_verdicts(self) -> list[DeadlineVerdict]:
         """The obligations not answered whose deadline has not expired yet."""
         return [DeadlineVerdict(self.node.name, p.k, "currently_false", p.trigger.where, p.stamp, p.due, None, "",
-                                f"not answered yet; {ms_ns(p.due_ns - (self.now_ns or 0))} left")
+                                "not answered yet; " + (
+                                    "/clock has not passed its deadline in simulated time yet"
+                                    if p.due_ns >= deadline_clock.FAR else
+                                    f"{ms_ns(p.due_ns - (self.now_ns or 0))} left") + deadline_clock.words(self, p))
                 for p in self.pending]
 
     def finish(self) -> DeadlineResult:
