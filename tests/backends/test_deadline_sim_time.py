@@ -11,17 +11,20 @@ enumerated over every delivery delay of ``/clock`` to the node within the transp
 from __future__ import annotations
 
 import random
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 from rclverify.backends.monitors.batch_deadlines import deadline_monitor
+from rclverify.backends.monitors.config import ConfigError, load_mapping
+from rclverify.backends.monitors.fieldpaths import check_field_paths
 from rclverify.backends.monitors.deadline_records import DeadlineVerdict
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.lang.parser import parse_text
 from rclverify.lang.typecheck import check
 from rclverify.traces.events import Event
-from rclverify.traces.mapping import load_rules
+from rclverify.traces.mapping import load_rules, sim_time_of
 
 RELAY = """
 node Relay {
@@ -214,3 +217,25 @@ def test_the_batch_path_streams_a_run_with_clock_and_gives_the_same_verdicts() -
         for rate, answer in ((0.5, 250), (2.0, 180), (1.0, 150)):
             run = _run(rate, answer)
             assert _judge(run, sim, monitor=deadline_monitor) == _judge(run, sim)
+
+
+def test_the_mapping_says_which_nodes_keep_simulated_time_and_refuses_a_bad_value(tmp_path: Path) -> None:
+    (tmp_path / "m.yaml").write_text("topics: {}\n")
+    assert sim_time_of(load_mapping(tmp_path, "m.yaml").rules, "Relay") is None  # not said
+    (tmp_path / "m.yaml").write_text("topics: {}\nuse_sim_time: true\n")
+    assert sim_time_of(load_mapping(tmp_path, "m.yaml").rules, "Relay") is True
+    (tmp_path / "m.yaml").write_text("topics: {}\nuse_sim_time: [Planner]\n")
+    rules = load_mapping(tmp_path, "m.yaml").rules
+    assert (sim_time_of(rules, "Planner"), sim_time_of(rules, "Relay")) == (True, False)
+    for bad in ("fast", "3", "[1, 2]", "{Relay: true}"):
+        (tmp_path / "m.yaml").write_text(f"topics: {{}}\nuse_sim_time: {bad}\n")
+        with pytest.raises(ConfigError, match=r"m\.yaml:2:15: error: use_sim_time must be true, false or a list"):
+            load_mapping(tmp_path, "m.yaml")
+
+
+def test_a_use_sim_time_name_that_is_no_contract_node_is_refused_where_it_is_written(tmp_path: Path) -> None:
+    (tmp_path / "m.yaml").write_text("topics: {}\nuse_sim_time:\n  - Relay\n  - Realy\n")
+    diags = check_field_paths(tmp_path, "m.yaml", [], CHECKED)
+    assert [(d.loc.line, d.loc.col) for d in diags] == [(4, 5)] and "'Realy' is no contract node" in diags[0].message
+    (tmp_path / "m.yaml").write_text("topics: {}\nuse_sim_time: [Relay]\n")  # control
+    assert check_field_paths(tmp_path, "m.yaml", [], CHECKED) == []

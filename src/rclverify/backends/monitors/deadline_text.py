@@ -83,7 +83,7 @@ def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
     if any(u.values()):
         first: Mapping[str, object] = res.first_unaccepted or {}
         words = {"assumption violated": "whose inputs violated the assumption",
-                 "incomplete input": "with inputs not all observed yet", "undecided": "whose assumption was undecided"}
+                 "incomplete input": "with inputs not all observed yet", "undecided": "whose assumption or verdict was undecided"}
         refused = ("; no deadline verdict for " + ", ".join(f"{n} trigger event(s) {words[k]}"
                                                             for k, n in u.items() if n)
                    + f" (first at {first.get('where')}: {first.get('reason')})")
@@ -94,7 +94,8 @@ def deadline_status(res: DeadlineResult, trace: str) -> tuple[str, str]:
                           f"guarantee {f.guarantee}, triggered at {f.trigger_where} (stamp {f.trigger_stamp:.3f} s), "
                           f"due {f.due:.3f} s, {late}: {f.reason}{refused}")
     if u["undecided"]:
-        return "inconclusive", (f"{u['undecided']} trigger event(s) could not be judged against the assumption"
+        return "inconclusive", (f"{u['undecided']} trigger event(s) could not be decided (their assumption, or their "
+                                f"answer's time: the transport skew, the clock they are kept in)"
                                 f"{refused}")
     if c["currently_false"]:
         met = f"; {c['true']} other(s) were answered within their deadline" if c["true"] else ""

@@ -87,13 +87,13 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
     refuses it."""
     path = root / rel
     raw, locs = load_located(read_yaml_text(path, rel), rel)
+    out: list[Diagnostic] = _unknown_sim_nodes(raw, locs, rel, checked)
     topics = raw.get("topics") if isinstance(raw, Mapping) else None
     if not isinstance(topics, Mapping):
-        return []
+        return out
     types = topic_types(checked)
     seqs = _sequence_topics(checked)
     table: TypeTable | None = None
-    out: list[Diagnostic] = []
     for topic, spec in topics.items():
         fields: Any = spec.get("fields") if isinstance(spec, Mapping) else None
         typ = types.get(str(topic).lstrip("/"))
@@ -111,6 +111,23 @@ def check_field_paths(root: Path, rel: str, msg_dirs: Sequence[str], checked: Ch
             line, col = (at.line, at.col) if at is not None else (1, 1)
             out.extend(plan_error(rel, line, col, f"topic {topic}: field {str(f)!r} of {short_type(typ)}: {why}",
                                   "E-field").diagnostics)
+    return out
+
+
+def _unknown_sim_nodes(raw: Any, locs: Mapping[Any, Any], rel: str, checked: Checked) -> list[Diagnostic]:
+    """Located errors for the names of the mapping's ``use_sim_time`` list that name no contract node
+    (a typo would leave that node's deadlines in a clock it does not keep)."""
+    names = raw.get("use_sim_time") if isinstance(raw, Mapping) else None
+    if not isinstance(names, list):
+        return []
+    out: list[Diagnostic] = []
+    for k, name in enumerate(names):
+        if name in checked.nodes:
+            continue
+        at = locs.get(("use_sim_time", k)) or locs.get(("use_sim_time",))
+        line, col = (at.line, at.col) if at is not None else (1, 1)
+        out.extend(plan_error(rel, line, col, f"use_sim_time: {name!r} is no contract node (known: "
+                              f"{', '.join(sorted(checked.nodes))})", "E-field").diagnostics)
     return out
 
 
