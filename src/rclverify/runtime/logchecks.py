@@ -54,7 +54,7 @@ class LogChecks:
         self.on_deadline = on_deadline
         self.deadlines = [DeadlineMonitor(checked, n, rules, self._verdict, horizon=horizon)
                           for n in nodes if has_deadlines(n)]
-        self.periods = [PeriodMonitor(n) for n in nodes if has_periods(n)]
+        self.periods = [PeriodMonitor(n, rules) for n in nodes if has_periods(n)]
         #: initially, progress and periods judged as offline (declarations.py)
         self.declarations = [DeclarationMonitor(checked, n, rules) for n in nodes if has_declarations(n)]
         self.active = bool(self.deadlines or self.periods or self.declarations)

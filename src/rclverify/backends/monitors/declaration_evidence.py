@@ -85,6 +85,8 @@ def _period_verdict(res: PeriodResult | None, key: str) -> tuple[str, str]:
                          f"({late['where']}){after}, over the period of {late['period'] * 1000:.0f} ms{clock}")
     if n == 0:
         return "pending", "no message of the output: its period was not checked"
+    if key in res.undecided:
+        return "inconclusive", f"not decided in simulated time: {res.undecided[key]}"
     if n == 1:
         return "inconclusive", ("a single message and the run ends within the period: too short to show a gap"
                                 if key not in res.unrated else

@@ -62,12 +62,16 @@ in time is a guarantee's deadline (``triggered by in.x within 200 ms``,
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable
+from typing import Iterable, Mapping
 
 from rclverify.lang.liveness import period_seconds
 from rclverify.lang.types import CheckedNode
 from rclverify.traces.event_time import aside_stamp
-from rclverify.traces.events import Event
+from rclverify.traces.events import Event, to_ns
+from rclverify.traces.mapping import TopicRule, sim_time_of
+from rclverify.traces.sim_clock import CLOCK_TOPIC, SimClock, clock_value_ns
+from rclverify.backends.monitors.period_clock import LATE, UNDECIDED, judge_gap, sim_gap
+from rclverify.backends.monitors.skew import DEFAULT_SKEW_S
 from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
 from rclverify.backends.monitors.shapes import PeriodGapJson, PeriodResultJson, PeriodsPart
@@ -103,6 +107,8 @@ class PeriodResult:
     end: float | None = None
     clocks: dict[str, float] = field(default_factory=dict)
     unrated: list[str] = field(default_factory=list)
+    #: per output judged in simulated time (:mod:`.period_clock`), why its first gap not decided was not
+    undecided: dict[str, str] = field(default_factory=dict)
 
     def to_json(self) -> PeriodResultJson:
         out: PeriodResultJson = {"node": self.node, "periods": dict(self.periods), "messages": dict(self.messages),
@@ -111,6 +117,8 @@ class PeriodResult:
             out["clocks"] = {k: round(v, 6) for k, v in self.clocks.items()}
         if self.unrated:
             out["unrated"] = list(self.unrated)
+        if self.undecided:
+            out["undecided"] = dict(self.undecided)
         return out
 
 
@@ -125,8 +133,16 @@ class PeriodMonitor:
     order, then :meth:`finish` for the :class:`PeriodResult`; so the untimed,
     deadline and period checks of a run share one read of it."""
 
-    def __init__(self, node: CheckedNode) -> None:
+    def __init__(self, node: CheckedNode, rules: Mapping[str, TopicRule] | None = None) -> None:
         self.result = res = PeriodResult(node.name)
+        #: the clock the node keeps (the mapping's ``use_sim_time``: :mod:`.period_clock`; no rules: not said)
+        self.sim_mode = sim_time_of(rules, node.name) if rules is not None else None
+        #: the run's ``/clock`` as heard, and the transport skew (ns) of its delivery to a node
+        self.sim = SimClock()
+        skew = getattr(rules, "skew", DEFAULT_SKEW_S) if rules is not None else DEFAULT_SKEW_S
+        self.skew_ns = round(skew * 1e9) if isinstance(skew, (int, float)) and skew > 0 else 0
+        #: per output judged in simulated time: its last message's time (integer ns, the run's clock), where
+        self.last_sim: dict[str, tuple[int, str]] = {}
         for p in node.node.periodic:
             s = period_seconds(p)
             if s is not None:
@@ -149,15 +165,25 @@ class PeriodMonitor:
         res = self.result
         at = run_clock(ev)
         res.end = at if res.end is None else max(res.end, at)
-        outs = self.topics.get(ev.topic.lstrip("/"))
+        topic = ev.topic.lstrip("/")
+        if topic == CLOCK_TOPIC:  # the run's simulated clock (period_clock.py)
+            value = clock_value_ns(ev.fields) if self.sim_mode is not False else None
+            if value is not None:
+                self.sim.see(to_ns(at), value, ev.where)
+            return
+        outs = self.topics.get(topic)
         if not outs:
             if self.after and ev.fields:
                 self._later(ev, at)
             return
         own = aside_stamp(ev.fields) if ev.fields else None
         stamp = at if own is None else own
+        sim_reads = own is None and (self.sim_mode is True or (self.sim_mode is None and self.sim.heard))
         for key in outs:
             res.messages[key] = res.messages.get(key, 0) + 1
+            if sim_reads:
+                self._sim_message(key, ev, at)
+                continue
             if own is not None:
                 self.first_aside.setdefault(key, (own, at))
                 if abs(own - at) > SIMULATED_S:
@@ -168,6 +194,41 @@ class PeriodMonitor:
                 res.late[key] = {"from": before[0], "to": stamp, "gap": stamp - before[0],
                                  "period": res.periods[key], "where": ev.where}
             self.last[key] = (stamp, ev.where, at)
+
+    def _sim_message(self, key: str, ev: Event, at: float) -> None:
+        """A message of output ``key`` without a stamp of its own, placed at ``at`` (s), judged in simulated
+        time (:mod:`.period_clock`): its gap from the output's last message against the period."""
+        res, t2 = self.result, to_ns(at)
+        before = self.last_sim.get(key)
+        if before is None and key in self.last:  # judged on the run's clock until /clock was heard
+            _, where, t = self.last.pop(key)
+            before = (to_ns(t), where)
+        if before is not None and key not in res.late:
+            self._gap(key, before[0], t2, ev.where)
+        self.last_sim[key] = (t2, ev.where)
+
+    def _gap(self, key: str, t1: int, t2: int, where: str, s1: int | None = None, sim_mode: bool | None = None,
+             tail: bool = False) -> None:
+        """The gap of output ``key`` from ``t1`` (``s1``: its simulated time known) to ``t2`` (ns, the run's
+        clock) judged in simulated time (:func:`.period_clock.judge_gap`): late in :attr:`PeriodResult.late`,
+        undecided in :attr:`PeriodResult.undecided`; ``tail``: ``t2`` is the run's end."""
+        res = self.result
+        period = res.periods[key]
+        gap = sim_gap(self.sim, t1, t2, self.skew_ns, s1)
+        mode = self.sim_mode if sim_mode is None else sim_mode
+        verdict = judge_gap(gap, None if s1 is not None else t2 - t1, round(period * 1e9), mode)
+        if verdict == LATE and gap is not None:
+            start = s1 if s1 is not None else self.sim.at(t1)
+            res.late[key] = {"from": (start or 0) / 1e9, "to": None if tail else (self.sim.at(t2) or 0) / 1e9,
+                             "gap": gap[0] / 1e9, "period": period, "where": where}
+        elif verdict == UNDECIDED and key not in res.undecided:
+            res.undecided[key] = (
+                (self.sim.broken or "no /clock message before it") if gap is None else
+                f"{'the run goes on' if tail else 'a gap'} of {gap[0] / 1e6:.0f}-{gap[1] / 1e6:.0f} ms of "
+                f"simulated time after the message at {where}" + (
+                    ", as /clock reached the node within the transport skew" if mode is True else
+                    f" ({(t2 - t1) / 1e6:.0f} ms on the run's clock): over the period in one clock, not in the "
+                    "other; the node's clock is not said (the mapping's use_sim_time decides it)"))
 
     def _later(self, ev: Event, at: float) -> None:
         """Note a stamp set aside in another writer's message placed at ``at``
@@ -191,10 +252,21 @@ class PeriodMonitor:
 
     def finish(self) -> PeriodResult:
         res = self.result
+        if res.end is not None:
+            for key, (t, where) in self.last_sim.items():  # the tail in simulated time (period_clock.py)
+                if key not in res.late:
+                    self._gap(key, t, to_ns(res.end), where, tail=True)
         for key, (stamp, where, at) in self.last.items():
             if key in res.late or res.end is None:
                 continue
             tail = res.end - stamp
+            now = self.sim.at(to_ns(at)) if key in self.first_aside and self.sim_mode is not False else None
+            if now is not None and abs(now / 1e9 - stamp) <= 1.0:  # stamped on /clock: its tail read from it
+                s0, t0 = self.first_aside[key]
+                if at > t0 and stamp > s0:
+                    res.clocks[key] = (stamp - s0) / (at - t0)
+                self._gap(key, to_ns(at), to_ns(res.end), where, s1=to_ns(stamp), sim_mode=True, tail=True)
+                continue
             if key in self.first_aside:  # the run's end carried into the node's clock at the output's rate
                 s0, t0 = self.first_aside[key]
                 if at - t0 <= 0 or stamp - s0 <= 0:
@@ -236,6 +308,9 @@ def period_status(res: PeriodResult, trace: str) -> tuple[str, str]:
     silent = [k for k in res.periods if not res.messages.get(k)]
     if silent:
         return "pending", f"{trace} has no message of {', '.join(f'{res.node}.{k}' for k in silent)}: its period was not checked"
+    if res.undecided:
+        return "inconclusive", "; ".join(f"{res.node}.{k}: not decided in simulated time: {why}"
+                                         for k, why in res.undecided.items())
     open_ = [k for k in res.unrated if res.messages.get(k, 0) > 1]
     if open_:
         return "inconclusive", (f"{', '.join(f'{res.node}.{k}' for k in open_)}: no gap over its period, but {trace} "

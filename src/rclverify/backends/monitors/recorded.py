@@ -154,7 +154,7 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     nodes = [n for n, _ in judged]
     dmons = [deadline_monitor(checked, n, cfg.rules, deadline, horizon=cfg.horizon, tolerance=cfg.tolerance)
              for n in nodes if has_deadlines(n)]  # in batch where eligible (batch_deadlines.py)
-    pmons = [PeriodMonitor(n) for n in nodes if has_periods(n)]
+    pmons = [PeriodMonitor(n, cfg.rules) for n in nodes if has_periods(n)]
     decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes if has_declarations(n)]
     calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
     if calls.book is not None and keep:

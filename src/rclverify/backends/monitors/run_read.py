@@ -56,7 +56,7 @@ def read_run(target: NodeTarget, cfg: MonitorConfig, trace: str, lag: float | No
         beside.add("deadlines", lambda: deadline_monitor(target.checked, node, cfg.rules,
                                                          horizon=cfg.horizon, tolerance=cfg.tolerance))
     if has_periods(node):  # periodic outputs on the same run (periods.py)
-        beside.add("periods", lambda: PeriodMonitor(node))
+        beside.add("periods", lambda: PeriodMonitor(node, cfg.rules))
     if has_declarations(node):  # initially, progress, periodic judged on the same run (declarations.py)
         beside.add("declarations", lambda: DeclarationMonitor(target.checked, node, cfg.rules,
                                                               tolerance=cfg.tolerance))

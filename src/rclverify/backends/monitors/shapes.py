@@ -187,6 +187,8 @@ class PeriodResultJson(TypedDict):
     clocks: NotRequired[dict[str, float]]
     #: such outputs with a single message: the run's end not carried into their clock, their tail not judged
     unrated: NotRequired[list[str]]
+    #: outputs judged in simulated time whose gap or tail was not decided: output -> why
+    undecided: NotRequired[dict[str, str]]
 
 
 class PeriodsPart(TypedDict):
