@@ -3,8 +3,11 @@
 
 It registers the monitor's node and its verdict publishers with the master,
 subscribes to every topic the contracts name (``rospy.AnyMsg``, decoded on
-the engine thread with the class of each connection's type), starts the
-service proxy when asked, watches the run until it is stopped and writes the
+the engine thread with the class of each connection's type) and to
+``/clock``, the run's simulated clock (``rosgraph_msgs/Clock``,
+:mod:`rclverify.traces.sim_clock`), whatever the contracts name (each message
+pushed at its receipt time as a contract topic's is: the deadline checks of a
+node under ``use_sim_time`` read it), starts the service proxy when asked, watches the run until it is stopped and writes the
 evidence record (:func:`~.live.stop_and_record`).  Every call to the master
 is bounded (:mod:`.ros1`, "A master is an external peer").
 
@@ -17,13 +20,14 @@ import threading
 import time as _time
 import warnings
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Iterable, Mapping
 
 from rclverify.records.store import atomic_write_text
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.runtime.live import LiveRun, stop_and_record
 from rclverify.runtime.live_status import warm_bounds
 from rclverify.runtime.worker import EngineWorker
+from rclverify.traces.sim_clock import CLOCK_TOPIC
 from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, STOPPED_SHUTDOWN_S, bound_master_calls, shutdown_limit, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
 
 
@@ -71,6 +75,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     from std_msgs.msg import String  # deferred: start-up (loads std_msgs and more only when called)
     topics = contract_topics(checked, nodes)
     classes = {t: message_class(typ, msg_dirs) for t, typ in topics.items()}  # fail early, located
+    heard = _clock(topics, msg_dirs, out)  # /clock beside the contract topics (module docstring)
     import rosgraph  # deferred: start-up (loads rosgraph only when called)
     uri = rosgraph.get_master_uri()
     # every call to the master is bounded and the registration waits in short
@@ -84,13 +89,14 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     decode_errors: dict[str, int] = {}
     # the callbacks only stamp and queue; one worker thread decodes, checks,
     # publishes and runs the timer (worker.py: why)
-    worker = EngineWorker(live, _decoder(classes, decode_errors), rospy.get_time, tick_s=tick_s).start()
+    worker = EngineWorker(live, _decoder({**classes, **heard}, decode_errors), rospy.get_time, tick_s=tick_s).start()
     subs: list[Any] = []
 
     def unsubscribe() -> None:
         for s in list(subs):
             s.unregister()
-    calls = _subscribe(rospy, String, stop, until, uri, topics, pub, live, worker, subs, unsubscribe, proxy)
+    calls = _subscribe(rospy, String, stop, until, uri, [*topics, *heard], pub, live, worker, subs, unsubscribe,
+                       proxy)
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
     warm_bounds()  # the status line a stop prints need not wait for scipy (live_status.py)
     try:
@@ -145,6 +151,25 @@ def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_nam
         raise
 
 
+#: the ROS 1 type of the run's simulated clock, ``/clock`` (its one field ``clock`` a ROS 1 ``time``)
+CLOCK_TYPE = "rosgraph_msgs/Clock"
+
+
+def _clock(topics: Mapping[str, str], msg_dirs: list[Path], out: Callable[[str], None]) -> dict[str, type]:
+    """``{"/clock": its message class}`` when no contract names ``/clock`` (a contract that does makes it a
+    contract topic), else ``{}``; ``{}`` too, said in one line to ``out``, where no ``rosgraph_msgs/Clock`` is
+    installed or defined (the run then hears no simulated clock)."""
+    topic = "/" + CLOCK_TOPIC
+    if topic in topics:
+        return {}
+    try:
+        return {topic: message_class(CLOCK_TYPE, msg_dirs)}
+    except RosUnavailable as exc:
+        out(f"rclverify monitor --live: warning: /clock is not heard: {exc}; a node under use_sim_time keeps its "
+            "deadlines in a simulated time this run cannot read")
+        return {}
+
+
 def _decoder(classes: Mapping[str, type], decode_errors: dict[str, int]) -> Callable[[str, Any], Mapping[str, object] | None]:
     """The engine thread's decoding of a ``rospy.AnyMsg``: with the class of
     its connection's type, else the contract's; undecodable bytes are counted
@@ -163,10 +188,10 @@ def _decoder(classes: Mapping[str, type], decode_errors: dict[str, int]) -> Call
     return decode
 
 
-def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri: str, topics: Mapping[str, str],
+def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri: str, topics: Iterable[str],
                pub: Any, live: LiveRun, worker: EngineWorker, subs: list[Any], unsubscribe: Callable[[], None],
                proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None) -> Any:
-    """Subscribe to every contract topic (into ``subs``) and start the
+    """Subscribe to every topic of ``topics`` (the contract topics and ``/clock``; into ``subs``) and start the
     ``proxy``; returns the proxy's run or ``None``.  By the registration's
     deadline ``until`` (monotonic s), else everything started is stopped and
     :class:`~.ros1.RosUnavailable` raised."""

@@ -23,6 +23,12 @@ monitor BAG`` checks exactly the messages the live run checked, at the same
 times, and gives the same verdicts (tests/backends/test_monitor_live_dds.py,
 tests/runtime/test_ros2_declared_types.py).
 
+The run's simulated clock goes to the bag too (``heard``: ``/clock``,
+:mod:`rclverify.traces.sim_clock`): each ``/clock`` message the live run heard,
+as it came off the wire, at the same event time, so the bag's offline check
+places the simulated clock where the live run did.  Such a topic's connection
+is made at its first message only: a run that heard no ``/clock`` records none.
+
 The linked services' and actions' calls go to the bag too, as ROS 2 records
 them (``<service>/_service_event`` ...), with the live call book's pairing
 (:mod:`.bag_calls`): their connections carry the definitions and type
@@ -71,8 +77,9 @@ class BagRecorder:
     ``pkg/msg/T``) and of ``calls`` (call topic without ``/`` -> ``(type,
     ros2idl definition, type hash)``, :mod:`.bag_calls`) to a new ROS 2 bag
     directory ``path``; ``described``: contract topic -> the :class:`~.types.Declaration`
-    its type is known from when no definition of the workspace or rosbags' store has it.  Raises :class:`BagError` when the bag cannot be
-    created.
+    its type is known from when no definition of the workspace or rosbags' store has it; ``heard``: topic
+    without ``/`` -> ``pkg/msg/T`` of each topic recorded beside the contract topics only when messages of it
+    come (``/clock``, module docstring).  Raises :class:`BagError` when the bag cannot be created.
 
     Threads: rosbags' writer is opened, written and closed in one thread of
     its own (``rclverify-bag``; SQLite allows a connection only in the thread
@@ -83,7 +90,8 @@ class BagRecorder:
     def __init__(self, path: Path, storage: str, topics: Mapping[str, str], msg_dirs: Sequence[Path],
                  open_timeout_s: float = 30.0,
                  calls: Mapping[str, tuple[str, str | None, str | None]] | None = None,
-                 described: Mapping[str, Declaration] | None = None) -> None:
+                 described: Mapping[str, Declaration] | None = None,
+                 heard: Mapping[str, str] | None = None) -> None:
         self.path = Path(path)
         if self.path.suffix == ".mcap":  # a bag is a directory: name it without the suffix
             self.path = self.path.with_suffix("")
@@ -100,7 +108,11 @@ class BagRecorder:
         #: contract topic -> the declaration its type is known from when the workspace does not define it
         #: (the rclpy source's ROS 2 Python describes it): its messages are recorded in that definition
         self.described = {t.strip("/"): d for t, d in (described or {}).items()}
+        #: topics recorded beside the contract topics when messages of them come (topic -> ``pkg/msg/T``)
+        self.heard = {t.strip("/"): ty for t, ty in (heard or {}).items() if t.strip("/") not in self.topics}
+        #: messages written: the contract topics', the call topics', the :attr:`heard` topics' (per topic)
         self.count = self.call_count = self.failed = 0
+        self.heard_count: dict[str, int] = {}
         #: per contract topic whose connection is made: the declaration it records (``None``: the workspace's)
         self._declared: dict[str, Any] = {}
         self._late: dict[str, list[tuple[float, float]]] = {}  # topic -> (time s, late s) of each late message
@@ -123,7 +135,7 @@ class BagRecorder:
                         storage_plugin=StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3)
         writer.open()
         connections: dict[str, Any] = {}
-        for topic, msg_type in self.topics.items():  # each described now; its connection made at its first message
+        for topic, msg_type in {**self.topics, **self.heard}.items():  # each described now; connected at its first message
             try:
                 if topic in self.described:
                     declared_store(self.described[topic])  # raises for a type rosbags cannot describe
@@ -166,6 +178,8 @@ class BagRecorder:
                     writer.write(conn, time_ns, raw)
                     if topic in self.topics:
                         self.count += 1
+                    elif topic in self.heard:
+                        self.heard_count[topic] = self.heard_count.get(topic, 0) + 1
                     else:
                         self.call_count += 1
                 except Exception as exc:  # noqa: BLE001 - one message lost, said in close()'s record
@@ -197,6 +211,8 @@ class BagRecorder:
             if decl is not None:
                 return writer.add_connection("/" + topic, decl.name, typestore=declared_store(decl))
             return writer.add_connection("/" + topic, _msg_name(self.topics[topic]), typestore=self._store)
+        if topic in self.heard:
+            return writer.add_connection("/" + topic, _msg_name(self.heard[topic]), typestore=self._store)
         msg_type, msgdef, digest = self.calls[topic]
         return writer.add_connection("/" + topic, msg_type, msgdef=msgdef, rihs01=digest, typestore=self._store)
 
@@ -216,21 +232,21 @@ class BagRecorder:
             self._end_ns = round(time_s * 1e9)
 
     def late(self, topic: str, time_s: float, late_s: float) -> None:
-        """Note that the message of contract topic ``topic`` (no leading ``/``)
+        """Note that the message of contract topic (or :attr:`heard` topic) ``topic`` (no leading ``/``)
         at ``time_s`` (s since the epoch: the time it is written at) was heard
         ``late_s`` (s) late by the live monitor: the bag says so at its close
         (:mod:`rclverify.traces.bag_late`).  Called from the engine's thread
         before :meth:`close`."""
-        if topic in self.topics:
+        if topic in self.topics or topic in self.heard:
             self._late.setdefault(topic, []).append((time_s, late_s))
 
     def write(self, topic: str, time_ns: int, raw: bytes) -> None:
-        """Queue one message of ``topic`` (a contract topic or a call topic, no
-        leading ``/``) at ``time_ns`` (ns since the epoch: a contract topic's
+        """Queue one message of ``topic`` (a contract topic, a :attr:`heard` topic or a call topic, no
+        leading ``/``) at ``time_ns`` (ns since the epoch: a contract or heard topic's
         event time, a call topic's time in the call book, :mod:`.bag_calls`); a
         topic not recorded, or data that are not bytes, is ignored (counted in
         ``failed`` for the latter: nothing malformed reaches the bag)."""
-        if topic not in self.topics and topic not in self.calls:
+        if topic not in self.topics and topic not in self.calls and topic not in self.heard:
             return
         if not isinstance(raw, (bytes, bytearray, memoryview)) or not isinstance(time_ns, int) or time_ns < 0:
             self.failed += 1
@@ -239,13 +255,14 @@ class BagRecorder:
 
     def close(self, timeout_s: float = 60.0) -> BagSummary:
         """Write what is queued, finish the bag (idempotent); returns what the evidence says of it
-        (``messages``: contract topics' messages written, ``call_messages``: call topics' messages
-        written, ``failed``: messages not written, ``error``: the last writer error)."""
+        (``messages``: contract topics' messages written, ``topics`` theirs and each :attr:`heard` topic
+        a message of which was written, ``call_messages``: call topics' messages written, ``failed``:
+        messages not written, ``error``: the last writer error)."""
         if self._thread.is_alive():
             self._queue.put(None)
             self._thread.join(timeout_s)
         out: BagSummary = {"path": str(self.path), "messages": self.count,
-                           "topics": sorted("/" + t for t in self.topics)}
+                           "topics": sorted("/" + t for t in [*self.topics, *self.heard_count])}
         if self.calls:
             out["call_messages"] = self.call_count
             out["call_topics"] = sorted("/" + t for t in self.calls)

@@ -11,6 +11,14 @@ messages in and verdicts out over DDS (:mod:`rclverify.ros.live.dds`):
   that follows its publishers' QoS (:mod:`.dds_bus`), and every linked
   service and action (:mod:`.dds_services`, checked call by call by
   :mod:`.dds_calls`);
+* reads the run's simulated clock, ``/clock`` (``rosgraph_msgs/msg/Clock``,
+  :mod:`rclverify.traces.sim_clock`), whatever the contracts name: each
+  sample is pushed to the engine as a contract sample is (its publisher's
+  source timestamp, its writer's id), its matched writers handed to the
+  engine's ``match`` under ``clock`` once it has one, and recorded in the
+  ``--record`` bag; its reader is made only when a publisher of ``/clock`` is
+  discovered, so a run without a simulator pays nothing for it.  A contract
+  that names ``/clock`` itself makes it a contract topic like any other;
 * publishes each verdict as ``std_msgs/msg/String`` JSON on
   ``rt/rclverify/verdict`` (``ros2 topic echo /rclverify/verdict``) and each
   node's latest on ``rt/rclverify/<Node>/last_verdict``, reliable and
@@ -58,6 +66,7 @@ from rclverify.runtime.ros1 import contract_topics
 from rclverify.runtime.worker import LINGER_S, EngineWorker
 from rclverify.runtime.dds.bag import BagError
 from rclverify.traces.event_time import event_ns
+from rclverify.traces.sim_clock import CLOCK_TOPIC
 from rclverify.runtime.dds.bus import Bus
 from rclverify.runtime.dds.trust import VERDICT_KEY
 from rclverify.runtime.dds.live_end import DdsRunEnd
@@ -77,6 +86,10 @@ def source_linger(reorder_window: float) -> float:
 SWITCH_INTERVAL_S = 0.001
 #: the encapsulation header of plain little-endian CDR (XCDR1), as rmw writes ROS 2 messages
 _CDR_LE = b"\x00\x01\x00\x00"
+#: the type of the run's simulated clock, ``/clock`` (REP 2008)
+CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
+#: where warnings about the ``/clock`` reader say they come from (no contract names it)
+CLOCK_WHERE = "rclverify monitor --live"
 
 
 def string_cdr(text: str) -> bytes:
@@ -191,6 +204,18 @@ class _DdsRun(DdsRunEnd):
                 self.structs[t.strip("/")] = self._message(typ, describe)
             except DdsTypeError as exc:
                 raise DdsUnavailable(f"{self.where.get(t.strip('/'), t)}: error: topic {t} ({typ}): {exc}") from None
+        #: the struct of ``/clock`` heard beside the contract topics (``None``: a contract names it, so it is
+        #: one of :attr:`structs`); the struct each tapped topic's samples are read with (:meth:`decode`)
+        self.clock_struct: Any = None
+        if CLOCK_TOPIC not in self.structs:
+            try:
+                self.clock_struct = self.types.message(CLOCK_TYPE)
+            except DdsTypeError as exc:
+                raise DdsUnavailable(f"{CLOCK_WHERE}: error: /clock ({CLOCK_TYPE}): {exc}") from None
+        self.readers: dict[str, Any] = {**self.structs, **({CLOCK_TOPIC: self.clock_struct}
+                                                          if self.clock_struct is not None else {})}
+        #: the tap of ``/clock`` beside the contract topics (:meth:`join`), kept out of the record's ``qos``
+        self.clock_tap: Any = None
         self.links = [(n, lk) for n in nodes for lk in n.node.links]
         for _n, lk in self.links:  # every linked type made now: a missing one is one located message, before joining
             try:
@@ -249,7 +274,8 @@ class _DdsRun(DdsRunEnd):
             self.recorder = BagRecorder(record[0], record[1], {t.strip("/"): ty for t, ty in self.topics.items()},
                                         msg_dirs if msg_dirs is not None else self.type_dirs,
                                         calls=self.call_recorder.plan if self.call_recorder else None,
-                                        described=described)
+                                        described=described,
+                                        heard={CLOCK_TOPIC: CLOCK_TYPE} if self.clock_struct is not None else None)
         except (BagError, DdsTypeError) as exc:
             raise DdsUnavailable(str(exc)) from None
         if self.call_recorder is not None:
@@ -303,7 +329,7 @@ class _DdsRun(DdsRunEnd):
         def send_last(node: str, text: str) -> None:
             self.write_text(lasts[node], text)
         self.live = run_factory(publish=self.send, publish_last=send_last, **extra)
-        bus.on_matched = self.live.match  # each topic's matched writers, from the bus thread
+        bus.on_matched = self.on_matched  # each topic's matched writers, from the bus thread
         if self.recorder is not None:  # the bag keeps what was heard late, as the log does (traces/bag_late.py)
             self.live.engine.on_late = self.recorder.late
         if self.links:
@@ -320,6 +346,8 @@ class _DdsRun(DdsRunEnd):
                 rec.specs = self.calls.specs
         for t, struct in self.structs.items():
             bus.tap(t, topic_name(enforce.get(t, t)), struct, self.where.get(t, t))
+        if self.clock_struct is not None:  # the run's simulated clock, whatever the contracts name (docstring)
+            self.clock_tap = bus.tap(CLOCK_TOPIC, topic_name(CLOCK_TOPIC), self.clock_struct, CLOCK_WHERE)
         for t in enforce:  # only the gate may write a guarded topic, only the monitor the verdict topic (dds_trust.py)
             bus.watch_writers(topic_name(t), t, self.where.get(t, t), "guarded topic")
         bus.watch_writers(topic_name(verdict_topic), VERDICT_KEY, "--verdict-topic", "verdict topic")
@@ -328,6 +356,13 @@ class _DdsRun(DdsRunEnd):
         if self.calls is not None and self.calls.events:
             self.out(f"the rclpy source hears the calls of {', '.join(sorted(self.calls.kinds))} through their "
                      "introspection events only, never their request and reply topics (docs/ros2.md)")
+
+    def on_matched(self, sets: Mapping[str, frozenset[bytes]]) -> None:
+        """Hand the engine each tapped topic's matched writers (tap key -> writer ids, from the bus's
+        thread): ``/clock`` beside the contract topics only once a writer of it is matched."""
+        if self.clock_tap is not None and not sets.get(CLOCK_TOPIC, True):
+            sets = {k: v for k, v in sets.items() if k != CLOCK_TOPIC}
+        self.live.match(sets)
 
     def send(self, text: str) -> None:
         self.write_text(self.pub, text)
@@ -358,8 +393,8 @@ class _DdsRun(DdsRunEnd):
         self.send(dumps({"kind": "deadline", **v.to_json()}))
 
     def decode(self, key: str, payload: Any) -> Mapping[str, object] | None:
-        """One sample's fields (engine thread); a call sample goes to the call
-        taps, bytes that are not the contract's type are counted."""
+        """One sample's fields (engine thread), a contract topic's or ``/clock``'s; a call sample goes to the
+        call taps, bytes that are not the topic's type are counted."""
         raw, source_ns, received_ns = payload[:3]
         calls = self.calls
         try:
@@ -368,7 +403,7 @@ class _DdsRun(DdsRunEnd):
                     self.call_recorder.sample(key, raw, source_ns, payload[3])
                 calls.handle(key, raw, source_ns / 1e9, received_ns / 1e9, payload[3])
                 return None
-            fields: Mapping[str, object] = read_fields(self.structs[key], raw)  # to_fields(deserialize(raw))
+            fields: Mapping[str, object] = read_fields(self.readers[key], raw)  # to_fields(deserialize(raw))
         except Exception:  # bytes that are not the contract's type: counted, never a crash
             self.decode_errors[key] = self.decode_errors.get(key, 0) + 1
             return None

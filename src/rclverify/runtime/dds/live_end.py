@@ -8,9 +8,10 @@ until the stop, the duration or a thread's death, with a status line
 the bus and the engine thread and makes the evidence record: the ROS 1 one
 (``live.stop_and_record``) with the run's ``source``, ``rmw`` and
 ``middleware`` (:meth:`~DdsRunEnd.origin`), ``calls`` (per node the
-call-by-call verdicts' status), ``deadlines``, ``qos`` (per topic the
-reader's QoS and what it heard), ``warnings``, ``enforce``, ``bypass`` and
-``bag`` (docs/ros2.md), the recorded bag ending at the time the live
+call-by-call verdicts' status), ``deadlines``, ``qos`` (per contract topic the
+reader's QoS and what it heard), ``clock`` (the same of ``/clock``, the run's
+simulated clock, when a publisher of it was heard), ``warnings``, ``enforce``,
+``bypass`` and ``bag`` (docs/ros2.md), the recorded bag ending at the time the live
 run's clock reached (:func:`run_clock`, :mod:`rclverify.traces.bag_end`), whatever
 its contracts are.
 """
@@ -36,6 +37,7 @@ from rclverify.runtime.live import LiveRun, stop_and_record
 from rclverify.runtime.worker import EngineWorker
 from rclverify.runtime.dds.trust import downgrade
 from rclverify.runtime.dds.nobody import nobody_line
+from rclverify.runtime.shapes import TapJson
 
 
 def status_line(live: LiveRun, calls: Mapping[tuple[str, str], int]) -> str:
@@ -69,6 +71,8 @@ class DdsRunEnd:
     calls: CallTaps | None
     call_counts: dict[tuple[str, str], int]
     recorder: BagRecorder | None
+    #: the tap of ``/clock`` heard beside the contract topics (``None``: a contract names it, or none)
+    clock_tap: Any
     call_recorder: CallRecorder | None
     warnings: list[str]
     decode_errors: dict[str, int]
@@ -138,14 +142,20 @@ class DdsRunEnd:
         source, rmw, middleware = self.origin()
         record_.update(source=source, rmw=rmw, middleware=middleware,
                        unseen=[f"{name}: {why}" for name, why in unheard.items()])
-        qos = {t.key: t.to_json() for t in bus.taps}
+        clock_tap = self.clock_tap
+        qos: dict[str, TapJson] = {t.key: t.to_json() for t in bus.taps if t is not clock_tap}
+        clock: TapJson | None = clock_tap.to_json() if clock_tap is not None else None
         for key, n in getattr(bus, "before", {}).items():
-            qos[key]["published_before_heard"] = n
+            into = clock if clock_tap is not None and key == clock_tap.key else qos.get(key)
+            if into is not None:
+                into["published_before_heard"] = n
         writers = getattr(getattr(bus, "discovery", None), "writers", None)  # the DDS source's discovery only
         nobody = nobody_line(qos, _time.monotonic() - self.t0, middleware,
                              None if writers is None else len({w.participant for w in writers.values()}))
         if nobody is not None:  # said, and in the record's warnings (nobody.py)
             self.warn(nobody)
+        if clock is not None and (clock["publishers_heard"] or clock["samples"]):
+            record_["clock"] = clock  # the run's simulated clock, heard beside the contract topics
         record_.update(warnings=self.warnings, decode_errors=self.decode_errors, qos=qos,
                        event_time={"clock": "receipt (--reorder-window 0)" if self.by_receipt else
                                    "source timestamp", "receipt_timed": self.receipt_timed})
