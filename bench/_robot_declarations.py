@@ -27,10 +27,12 @@ node it is drawn for, judged by the rules of docs/monitors.md, "Declarations on 
   clock: the bound above times the real-time factor, and two ``/clock`` ticks more (its stamps move by
   one tick, :data:`CLOCK_STEP_MS` of the wall clock); its robot's schedule stays the wall clock.  A
   On a ``/clock`` whose factor changes mid-run (``--clock-change``) the factor is the largest it runs
-  at; a stamped sensor feeding no fuse then publishes on its simulated timer (every ``period`` simulated
-  ms, silent while the clock is paused), whose gap is its period and a stall of the wall clock at that
-  factor, within the same bound (a factor of at least 0.5 makes the bound's two periods cover one
-  simulated period).  A
+  at.  Every sensor of a ``/clock`` robot publishes on its simulated timer (every ``period`` simulated
+  ms, silent while the clock is paused): a stamped one's gap is its period and a stall of the wall clock
+  at that factor, within the same bound (a factor of at least 0.5 makes the bound's two periods cover
+  one simulated period); an unstamped one's gaps are the wall clock's, its period at the slowest factor
+  (:func:`slowest_rate`) and a pause (:data:`PAUSE_MS`), so its ``P`` is two such periods, 1 s and the
+  longest pause when the clock pauses.  A
   driver's offset leaves its gaps as they are; one within the bounds of the run's clock (at most 1 s
   behind, 0.1 s ahead: its stamps are then the message's times) delays its last stamp, so a driver
   behind adds its offset to ``P``.  An unstamped sensor carries no clock but the run's (its source
@@ -48,7 +50,10 @@ node it is drawn for, judged by the rules of docs/monitors.md, "Declarations on 
   one output).
 * a **fuse**: ``progress( within 3 steps )``: its second input, half a period before the first, is a
   step of its own that it does not answer (it answers each reading of its first input), so an answered
-  row is two steps, one more for a deferred answer and one for a stall.
+  row is two steps, one more for a deferred answer and one for a stall; on a ``/clock`` robot 4 (its
+  answer, 0.55-0.65 of its deadline after its trigger, may follow its second input's next reading).
+  On a ``/clock`` robot an alarm's and a relay's answer (on its node's simulated clock) comes before
+  the next reading at every factor (bench/robot_generator.py ``SIM_PERIODS_MS``), so their bounds stay.
 * a **service** or **action** server: its steps are its calls (a request, a goal), answered by the
   response, the feedback or the result; its client sends one call at a time, the next once the last is
   answered, and stops calling when the sensing ends, before the robot says ``done``, so the run's last
@@ -64,7 +69,10 @@ wall-clock skip is as long as its clock takes to pass the period, and one period
 false at that sensor; never a fuse's leading sensor, :func:`can_skip`) or an alarm answering none of
 K + 2 readings in a row once (``"mute"``: K + 1 accepted steps unanswered in a row even when the answer
 before them was deferred past the first, so its ``progress`` or period in steps false, and the
-readings' deadlines, at that alarm).
+readings' deadlines, at that alarm).  On a ``/clock`` robot an alarm, a fuse or a relay stamping with
+its own clock is seeded ``"late"`` instead (:func:`can_be_late`): its deadlines false, its declarations
+kept (its late answer still comes before the next reading); a sensor is seeded ``"beyond"`` there, its
+first reading beyond its band, never ``"skip"`` (:func:`can_skip`).
 """
 from __future__ import annotations
 
@@ -84,6 +92,8 @@ FUSE_STEPS = 3
 SERVER_STEPS = 1
 #: how often a ``/clock`` robot's clock node publishes (wall-clock ms; bench/robot_generator.py)
 CLOCK_STEP_MS = 20
+#: the longest a changing ``/clock`` pauses (ms of the wall clock; bench/robot_generator.py ``clock_changes``)
+PAUSE_MS = 1000
 #: a stamp at most this far behind (s) or ahead of its source time is the run's clock (traces/event_time.py)
 STAMP_BEHIND_S, STAMP_AHEAD_S = 1.0, 0.1
 
@@ -95,11 +105,13 @@ def declared_period_ms(period_ms: int) -> int:
 
 def progress_steps(n: dict[str, Any], by: dict[str, dict[str, Any]]) -> int | None:
     """The ``progress( within K steps )`` bound K of an alarm's, a relay's or a fuse's node spec ``n``
-    (``by``: specs by name), or None for another node (a sensor; a server's is :data:`SERVER_STEPS`)."""
+    (``by``: specs by name), or None for another node (a sensor; a server's is :data:`SERVER_STEPS`).
+    On a ``/clock`` robot (``n`` has a ``"deadline_ms"``) a fuse's answer may come after its second
+    input's next reading, half a period after its trigger: one step more."""
     if n["kind"] == "alarm":
         return ANSWER_STEPS
     if n["kind"] == "fuse":
-        return FUSE_STEPS
+        return FUSE_STEPS + ("deadline_ms" in n)
     if n["kind"] == "relay":
         if not n["copy"]:
             return ANSWER_STEPS
@@ -124,10 +136,26 @@ def period_rate(n: dict[str, Any], spec: dict[str, Any]) -> float:
     return max([float(clock["rate"])] + [float(r) for _, r in clock.get("segments") or []])
 
 
+def slowest_rate(spec: dict[str, Any]) -> float:
+    """The smallest real-time factor but a pause a ``/clock`` robot's clock runs at (1 without one)."""
+    clock = spec.get("clock")
+    if not clock:
+        return 1.0
+    return min([float(clock["rate"])] + [float(r) for _, r in clock.get("segments") or [] if r])
+
+
+def pauses(spec: dict[str, Any]) -> bool:
+    """Whether the ``/clock`` of ``spec`` pauses (a segment at rate 0)."""
+    return any(not r for _, r in (spec.get("clock") or {}).get("segments") or [])
+
+
 def declared_sensor_period_ms(n: dict[str, Any], spec: dict[str, Any]) -> int:
     """The ``periodic`` bound (ms, in the node's clock) of sensor ``n`` of ``spec`` (module docstring)."""
     base = declared_period_ms(n["period_ms"])
     if n["sensor_kind"] not in ("range", "scan"):
+        if n.get("sim_timer"):  # its period in simulated ms, its gaps judged in the wall clock's
+            return (math.ceil(PERIOD_FACTOR * int(n["period_ms"]) / slowest_rate(spec)) + PERIOD_SLACK_MS
+                    + (PAUSE_MS if pauses(spec) else 0))
         return base
     rate = period_rate(n, spec)
     if spec.get("clock"):
@@ -167,18 +195,34 @@ def declare(spec: dict[str, Any]) -> None:
 def can_skip(n: dict[str, Any], spec: dict[str, Any]) -> bool:
     """Whether sensor ``n`` may be seeded with ``"skip"``: it is declared periodic and leads no fuse (a
     fuse answers only its leading input's readings, so while that sensor is silent the other input's
-    readings are steps left unanswered: its ``progress`` would be red at the fuse, not at the sensor)."""
-    return bool(n.get("periodic_ms")) and not any(f.get("a_source") == n["name"] for f in spec["nodes"])
+    readings are steps left unanswered: its ``progress`` would be red at the fuse, not at the sensor), on
+    a robot without ``/clock`` (on one, its period of 1.6-2 simulated s, at a factor of 0.5 up to 4 s of
+    the wall clock, leaves no room in a run of seconds for a silence past its declared period)."""
+    return (bool(n.get("periodic_ms")) and not spec.get("clock")
+            and not any(f.get("a_source") == n["name"] for f in spec["nodes"]))
+
+
+def can_be_late(n: dict[str, Any]) -> bool:
+    """Whether node ``n`` may be seeded ``"late"``: an alarm, a fuse or a relay stamping with its own clock on
+    a ``/clock`` robot (its ``"deadline_ms"`` drawn).  Not a relay copying its reading's stamp: its answer is
+    stamped with its trigger, in time by its stamp however late it leaves (docs/semantics.md, "Deadlines"),
+    nor a server (it answers in its call's callback)."""
+    return "deadline_ms" in n and (n["kind"] in ("alarm", "fuse") or (n["kind"] == "relay" and not n["copy"]))
 
 
 def defect_kind(victim: dict[str, Any], spec: dict[str, Any]) -> str:
     """Which defect the node ``victim`` of ``spec`` is seeded with: ``"skip"`` (a sensor that
     :func:`can_skip`, one time in two), ``"beyond"`` (a sensor publishing just beyond its band),
     ``"mute"`` (an alarm, one time in two), else ``"wrong"`` (the node's guarantee broken as
-    bench/robot_generator.py's docstring says).  The node itself is drawn as before declarations
+    bench/robot_generator.py's docstring says); on a ``/clock`` robot a node that :func:`can_be_late` is
+    seeded ``"late"`` (its answers on its node's simulated clock past its deadline,
+    bench/robot_generator.py ``LATE_FACTOR``): its readings, 1.6-2 simulated s apart, are too few in a run
+    of seconds at a slow factor to meet a threshold or to leave K + 2 of them unanswered.  The node itself is drawn as before declarations
     were drawn (a sensor with a value beyond its band, or any other node), so a seed's victim stays.
     Deterministic in the spec's seed and node count."""
     rng = random.Random(f"defect-kind-{spec['seed']}-{len(spec['nodes'])}")
+    if can_be_late(victim):
+        return "late"
     if victim["kind"] == "sensor":
         return "skip" if can_skip(victim, spec) and rng.random() < 0.5 else "beyond"
     if victim["kind"] == "alarm" and rng.random() < 0.5:
@@ -186,6 +230,6 @@ def defect_kind(victim: dict[str, Any], spec: dict[str, Any]) -> str:
     return "wrong"
 
 
-__all__ = ["ANSWER_STEPS", "CLOCK_STEP_MS", "FUSE_STEPS", "PERIOD_FACTOR", "PERIOD_SLACK_MS", "SERVER_STEPS",
-           "can_skip", "declare", "declared_period_ms", "declared_sensor_period_ms", "defect_kind", "in_steps",
-           "period_rate", "progress_steps"]
+__all__ = ["ANSWER_STEPS", "CLOCK_STEP_MS", "FUSE_STEPS", "PAUSE_MS", "PERIOD_FACTOR", "PERIOD_SLACK_MS",
+           "SERVER_STEPS", "can_be_late", "can_skip", "declare", "declared_period_ms", "declared_sensor_period_ms", "defect_kind",
+           "in_steps", "pauses", "period_rate", "progress_steps", "slowest_rate"]

@@ -48,7 +48,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "bench"))
 from _live import stop, wait_text  # noqa: E402
 from monitor_live_dds import CONFIG  # noqa: E402
-from robot_generator import SENSORS, generate, write_workspace  # noqa: E402
+from robot_generator import SENSORS, generate, horizon_of, write_workspace  # noqa: E402
 from _robot_verdicts import (UNDECIDED, compare_declarations, declaration_verdicts, false_verdicts,  # noqa: E402
                              read_records, tally, tally_declarations, three_way)
 
@@ -106,11 +106,13 @@ def offline_counts(rows: list[dict[str, Any]]) -> dict[str, Counter[str]]:
     return out
 
 
-def _offline(ws: Path, traces: dict[str, str], env: dict[str, str]) -> dict[str, tuple[list[dict[str, Any]], str]]:
+def _offline(ws: Path, traces: dict[str, str], env: dict[str, str],
+             horizon: float = 1.0) -> dict[str, tuple[list[dict[str, Any]], str]]:
     """``rclverify monitor --json --verdicts runs/NAME.verdicts.jsonl TRACE`` on each trace of ``traces``
-    (name -> path), the checks run side by side: per name the rows and ``""``, or what went wrong."""
+    (name -> path), the checks run side by side with ``horizon`` (s): per name the rows and ``""``, or
+    what went wrong."""
     procs = {name: subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(ws),
-                                     "--mapping", "mapping.yaml", "--horizon", "1.0", "--json", "--verdicts",
+                                     "--mapping", "mapping.yaml", "--horizon", f"{horizon:g}", "--json", "--verdicts",
                                      f"runs/{name}.verdicts.jsonl", t], cwd=ws, env=env,
                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for name, t in traces.items()}
@@ -194,12 +196,15 @@ def _domain() -> tuple[int, int]:
 def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2: Path,
             kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src", source: str = "dds",
             sim_clock: bool = False, actions: bool = False, driver_offset_s: float = 0.0,
-            clock_change: bool = False) -> dict[str, Any]:
+            clock_change: bool = False, undeclared_sim_time: bool = False) -> dict[str, Any]:
     """Run generated robot ``seed`` live and offline under ``tmp`` with rclverify's sources ``src``,
     the monitor hearing the robot through ``source`` (:data:`SOURCES`), the robot on a ``/clock`` of its
-    own with ``sim_clock`` (its factor changing mid-run with ``clock_change``), with Fibonacci action servers with ``actions``; returns the counts and findings (``other_clocks``: the live record's writers
-    placed at their source times)."""
-    spec = generate(seed, nodes, defect, kinds, sim_clock, actions, driver_offset_s, clock_change)
+    own with ``sim_clock`` (its factor changing mid-run with ``clock_change``; the mapping declaring
+    ``use_sim_time`` unless ``undeclared_sim_time``), with Fibonacci action servers with ``actions``;
+    returns the counts and findings (``other_clocks``: the live record's writers placed at their source
+    times; ``figures``: :func:`figures`)."""
+    spec = generate(seed, nodes, defect, kinds, sim_clock, actions, driver_offset_s, clock_change,
+                    undeclared_sim_time)
     ws = write_workspace(spec, tmp / "ws")
     (ws / "runs").mkdir(exist_ok=True)
     (tmp / "cyclonedds.xml").write_text(CONFIG)
@@ -212,7 +217,7 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     procs: list[subprocess.Popen[bytes]] = []
     try:
         mon = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live", "--ros2",
-                                "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", "1.0", "--status", "0",
+                                "-w", str(ws), "--mapping", "mapping.yaml", "--horizon", f"{horizon_of(spec):g}", "--status", "0",
                                 "--silence", "0", *_source_args(source, ros2), "--interfaces", "interfaces", "--log", "runs/live.jsonl",
                                 "--evidence", str(tmp / "evidence.json"), "--record", "runs/bag", "--record-storage", "mcap",
                                 "--verdicts", "runs/live.verdicts.jsonl"],
@@ -255,7 +260,8 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
     paths = {"live": read_records(runs / "live.verdicts.jsonl")}
     if not (runs / "live.verdicts.jsonl").exists():
         res["errors"].append("live: the monitor wrote no --verdicts file")
-    for name, (rows, err) in _offline(ws, {"log": "runs/live.jsonl", "bag": "runs/bag"}, menv).items():
+    for name, (rows, err) in _offline(ws, {"log": "runs/live.jsonl", "bag": "runs/bag"}, menv,
+                                      horizon_of(spec)).items():
         if err:
             res["errors"].append(f"offline {name}: {err}")
         res[name] = offline_counts(rows)
@@ -281,8 +287,54 @@ def run_one(seed: int, nodes: int, seconds: float, defect: bool, tmp: Path, ros2
                 res["undecided_why"].setdefault(node, set()).add(f"{r['verdict']}: {r['reason'] or '(no reason given)'}")
     res["undecided_why"] = {k: sorted(v) for k, v in res["undecided_why"].items()}
     res["findings"] = findings(res)
+    res["figures"] = figures(res)
     res["explained"] = explain(ws, res)
     return res
+
+
+def figures(res: dict[str, Any]) -> dict[str, Any]:
+    """One run's figures: ``violated_correct``, ``false_deadlines_correct`` and ``false_declarations_correct``
+    (final verdicts of correct nodes on any path, each path counted), ``deadlines`` and ``undecided`` (the
+    live final deadline verdicts, and those ``undecided``), ``agree`` (live = log = bag: no disagreement, no
+    error), and for a seeded robot ``victim``, ``kind`` and ``red`` (its live red verdicts: violated,
+    false deadlines and declarations)."""
+    victim = _victim(res)
+    names = {n["name"] for n in res["spec"]["nodes"]}
+    correct = names - {victim} if victim else names
+    out: dict[str, Any] = {"violated_correct": 0, "false_deadlines_correct": 0, "false_declarations_correct": 0}
+    for f in res["finals"].values():
+        for r in false_verdicts(f, correct):
+            out["false_deadlines_correct" if r["item"] == "deadline" else "violated_correct"] += 1
+    for d in res.get("declarations", {}).values():
+        out["false_declarations_correct"] += sum(1 for (node, _, _), row in d.items()
+                                                 if node in correct and row["verdict"] == "false")
+    tot = Counter[str]()
+    for c in res["live"].values():
+        tot.update(c)
+    out["deadlines"] = sum(v for k, v in tot.items() if k.startswith("deadline "))
+    out["undecided"] = sum(tot[f"deadline {v}"] for v in ("undecided",) + UNDECIDED)
+    out["agree"] = not res["disagreements"] and not res["errors"]
+    if victim is not None:
+        live = res["live"].get(victim, Counter())
+        kind = next(n.get("defect_kind") for n in res["spec"]["nodes"] if n["name"] == victim)
+        out.update(victim=victim, kind=kind, red=live.get("violated", 0) + live.get("deadline false", 0)
+                   + live.get("declaration false", 0), red_deadlines=live.get("deadline false", 0))
+    return out
+
+
+def late_unsaid(res: dict[str, Any]) -> bool:
+    """Whether the seeded node answers late (``"late"``) on a ``/clock`` whose mapping leaves ``use_sim_time``
+    unsaid, and is never red but has deadlines ``undecided``: a deadline is then decided only where the wall
+    clock and ``/clock`` time agree, and at a factor above 1.3 its answer is in time by the wall clock (its
+    wall-clock delay 1.3 d over the factor), so undecided is its verdict, which the run says apart."""
+    victim = _victim(res)
+    spec = res["spec"]
+    node = next((n for n in spec["nodes"] if n["name"] == victim), None)
+    if node is None or node.get("defect_kind") != "late" or spec.get("use_sim_time"):
+        return False
+    live = res["live"].get(victim or "", Counter())
+    red = live.get("violated", 0) + live.get("deadline false", 0) + live.get("declaration false", 0)
+    return bool(red == 0 and live.get("deadline undecided", 0) > 0)
 
 
 def _victim(res: dict[str, Any]) -> str | None:
@@ -349,7 +401,7 @@ def findings(res: dict[str, Any]) -> list[str]:
         if judged == 0 and not live.get("unjudged"):  # an unjudged endpoint is said, as docs/ros2.md promises
             out.append(f"{node}: nothing judged live")
         red = live.get("violated", 0) + live.get("deadline false", 0) + live.get("declaration false", 0)
-        if node == victim and red == 0 and not victim_unjudged(res):
+        if node == victim and red == 0 and not victim_unjudged(res) and not late_unsaid(res):
             out.append(f"{node}: seeded defect not red live")
     return out
 
@@ -379,11 +431,21 @@ def _line(res: dict[str, Any]) -> str:
     why = sorted({k.split(": ", 1)[1] for c in res.get("log", {}).values() for k in c
                   if k.startswith("deadline undecided why: ")})
     clock = res.get("clock")
+    fig = res.get("figures") or figures(res)
+    sim = ("" if not clock else ", use_sim_time declared" if res["spec"].get("use_sim_time")
+           else ", use_sim_time unsaid")
+    seeded = ("" if "victim" not in fig else
+              f"; seeded {fig['kind']} at {fig['victim']}: " + (f"red live ({fig['red']}, {fig['red_deadlines']} false "
+                                                                 "deadline(s))" if fig["red"] else "NOT red live"))
     return (f"seed {res['seed']}{' defect' if res['defect'] else ''}: {res['nodes']} nodes, source "
             f"{res.get('source', 'dds')}, " + (f"/clock x{clock['rate']:g} from {clock['start_s']:g} s" if clock
                                                else "wall clock")
             + "".join(f", {'paused' if r == 0 else f'x{r:g}'} at {at:g} s" for at, r in (clock or {}).get("segments") or [])
-            + ": live satisfied "
+            + sim + f": at correct nodes violated {fig['violated_correct']}, false deadlines "
+            f"{fig['false_deadlines_correct']}, false declarations {fig['false_declarations_correct']} (every path); "
+            f"deadlines undecided live {fig['undecided']} of {fig['deadlines']}"
+            + (f" ({100 * fig['undecided'] / fig['deadlines']:.0f} %)" if fig["deadlines"] else "")
+            + f"; live {'=' if fig['agree'] else '!='} log = bag" + seeded + "; live satisfied "
             f"{tot['satisfied']}, violated {tot['violated']}, undecided {tot['undecided']}, deadlines true "
             f"{tot['deadline true']} false {tot['deadline false']}"
             + (f", undecided {sum(undecided.values())} (log: " + ", ".join(f"{n} {k}" for n, k in undecided.items())
@@ -401,6 +463,8 @@ def _line(res: dict[str, Any]) -> str:
             + "".join(f"\n  {x}" for x in res["provisional"] + res["placed_apart"] + res.get("bag_pending_calls", []))
             + (f"\n  seeded defect at {_victim(res)} not judged: its calls are unjudged (no introspection, heard "
                "through the rclpy source), the node judged nothing, never green" if victim_unjudged(res) else "")
+            + (f"\n  seeded late answers at {_victim(res)} undecided, never red: use_sim_time unsaid, the wall clock "
+               "and /clock time disagree on them" if late_unsaid(res) else "")
             + "".join(f"\n  other clock: {c}" for c in res.get("other_clocks", []))
             + "".join(f"\n  undecided at {k}: {' | '.join(v)}" for k, v in res.get("undecided_why", {}).items())
             + "".join(f"\n  deadline undecided (first, log): {w}" for w in why)
@@ -410,7 +474,7 @@ def _line(res: dict[str, Any]) -> str:
 def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: bool, burn: bool,
              keep: Path | None, kinds: tuple[str, ...] = tuple(SENSORS), src: Path = ROOT / "src",
              source: str = "dds", sim_clock: bool = False, actions: bool = False,
-             driver_offset_s: float = 0.0, clock_change: bool = False) -> int:
+             driver_offset_s: float = 0.0, clock_change: bool = False, undeclared_sim_time: bool = False) -> int:
     """Run every seed (a node count drawn per seed in ``sizes``) through ``source``, on a ``/clock`` with
     ``sim_clock``; print one line per seed and the totals.  Returns 0 (the figures are the output; a
     finding is printed, not raised)."""
@@ -426,6 +490,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
     failing: list[int] = []
     agree, compared, disagreements, provisional, apart = 0, Counter[str](), 0, 0, 0
     declarations = Counter[str]()
+    per_run = Counter[str]()
     loads: list[float] = []
     try:
         for seed in seeds:
@@ -433,7 +498,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             with tempfile.TemporaryDirectory() as d:
                 try:
                     res = run_one(seed, n, seconds, defect, Path(d), ros2, kinds, src, source, sim_clock,
-                                  actions, driver_offset_s, clock_change)
+                                  actions, driver_offset_s, clock_change, undeclared_sim_time)
                 except (RobotFailed, MonitorFailed) as exc:
                     what = "GENERATOR FAULT" if isinstance(exc, RobotFailed) else "MONITOR DID NOT START"
                     print(f"seed {seed}: {what}: {exc}", flush=True)
@@ -447,6 +512,12 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
             for c in res["live"].values():
                 total.update(c)
             undecided += sum(c["deadline undecided"] for c in res["log"].values())
+            for k in ("violated_correct", "false_deadlines_correct", "false_declarations_correct", "deadlines",
+                      "undecided"):
+                per_run[k] += res["figures"][k]
+            if "victim" in res["figures"]:
+                per_run["seeded red"] += bool(res["figures"]["red"])
+                per_run["seeded"] += 1
             victim = _victim(res)
             declarations["bag pending at a server"] += len(res.get("bag_pending_calls", []))
             for path, d in res["declarations"].items():
@@ -479,6 +550,12 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           + f"; verdicts compared: live {compared['live']}, log {compared['log']}, bag "
           f"{compared['bag']}; disagreements {disagreements} (and {provisional} on a verdict still provisional, {apart} "
           f"message(s) given one verdict but placed apart); "
+          f"at correct nodes (every path): violated {per_run['violated_correct']}, false deadlines "
+          f"{per_run['false_deadlines_correct']}, false declarations {per_run['false_declarations_correct']}; "
+          f"deadlines undecided live {per_run['undecided']} of {per_run['deadlines']}"
+          + (f" ({100 * per_run['undecided'] / per_run['deadlines']:.0f} %)" if per_run["deadlines"] else "")
+          + (f"; seeded defects red at their node {per_run['seeded red']} of {per_run['seeded']}" if per_run["seeded"]
+             else "") + "; "
           f"load average after each run {min(loads, default=0):.1f}-{max(loads, default=0):.1f}; seeds with "
           f"findings: {failing or 'none'}; live = log = bag verdict by verdict on {agree} of {len(seeds)}")
     return 0

@@ -43,12 +43,20 @@ constants), ``contracts/plan.yaml``, ``mapping.yaml``, ``interfaces/`` (SetBool)
 
 ``sim_clock=True`` (``--clock``) adds a clock node publishing ``rosgraph_msgs/Clock`` on ``/clock``
 every 20 ms at a real-time factor drawn from 0.5-2, from a simulated start of 0, 100 or 5000 s, and
-runs every other node with ``use_sim_time`` (their header stamps come from ``/clock``).
+runs every other node with ``use_sim_time`` (their header stamps come from ``/clock``), the mapping
+declaring so (``use_sim_time: true``; ``--undeclared-sim-time`` leaves it unsaid, and the monitor decides
+a deadline only where the wall clock and ``/clock`` time agree).  Its times are then ``/clock``'s
+(:func:`sim_answers`): every sensor publishes on its simulated timer every 1.6-2 simulated s (silent
+while the clock is paused), and every alarm, relay and fuse answers after 0.55-0.65 of its deadline
+(1.1 or 1.2 simulated s) measured on its node's own ROS clock: in time in simulated time at every
+factor (the 0.35 d left is the real latency at a factor of 2), before the next reading, and at a
+factor of 0.5 past its deadline in the wall clock.  A server answers at once, its deadline twice the
+wall clock's.  Its seeded defect may be ``"late"`` (an alarm, a fuse, a relay stamping with its own
+clock): its answers :data:`LATE_FACTOR` deadlines after its input in simulated time, false at every
+factor, though at a factor of 2 its wall-clock delay is within the deadline.
 ``clock_change=True`` (``--clock-change``, implies ``--clock``) makes that factor change once or twice
 mid-run (1.5-6.4 s after the sensing starts, each new factor within 0.5-2) and, one time in two, pauses
-the clock for 0.5-1 s (``/clock`` stops, as a paused simulator's does), :func:`clock_changes`; each
-stamped sensor feeding no fuse then publishes on its simulated timer (silent while the clock is
-paused, its period in simulated time), the other nodes on the wall clock as before.
+the clock for 0.5-1 s (``/clock`` stops, as a paused simulator's does), :func:`clock_changes`.
 
 ``actions=True`` (``--actions``) turns each SetBool server, one time in two, into a
 ``test_msgs/Fibonacci`` action server (with or without introspection, as drawn for the server),
@@ -60,6 +68,7 @@ CLI (from the repository root)::
     python3 bench/robot_generator.py --seeds 0-49 --nodes 5-8 --seconds 10 --burn
     python3 bench/robot_generator.py --seeds 0-9 --source rclpy --clock
     python3 bench/robot_generator.py --seeds 0-9 --clock-change --burn
+    python3 bench/robot_generator.py --seeds 0-9 --clock --undeclared-sim-time
     python3 bench/robot_generator.py --seeds 3 --defect
     python3 bench/robot_generator.py --write DIR --seeds 7     # the workspace alone
 
@@ -73,6 +82,7 @@ if __name__ == "__main__":  # run as a script: a Python without the dependencies
 
 import functools
 import json
+import math
 import random
 import sys
 from pathlib import Path
@@ -99,7 +109,13 @@ RANGE = ("std_msgs/Header header\nuint8 ULTRASOUND=0\nuint8 INFRARED=1\nuint8 ra
 FIBONACCI = "int32 order\n---\nint32[] sequence\n---\nint32[] sequence\n"
 #: the orders a Fibonacci action's client draws its goals from (2, 3 and 4 are always sent)
 FIB_ORDERS = (1, 2, 3, 4, 5, 6, 7, 8)
+#: the horizon (s) of a question (the mapping's ``horizon``: an answer later than that is ``inconclusive``)
 HORIZON = 1.0
+#: ... on a ``/clock`` robot: an answer waits up to 0.65 of 1.2 simulated s, 1.56 s of the wall clock at a
+#: factor of 0.5, and a pause of up to 1 s more
+CLOCK_HORIZON = 4.0
+#: a SetBool server's deadline (ms) on the wall clock
+SERVER_DEADLINE_MS = 800
 #: the most (s) a sensor's driver may stamp behind within the run's clock: an answer leaves up to 30 % of a
 #: 200 ms period after its reading, a stamp up to 30 ms before its publication, and the next reading's stamp
 #: must come after the answer (generated seeds 955-958, 0.2 s behind: the alarms and relays judged, rightly,
@@ -107,6 +123,25 @@ HORIZON = 1.0
 MAX_BEHIND_S = 0.05
 #: the real-time factors a ``/clock`` robot draws from: simulated seconds per wall-clock second
 CLOCK_RATES = (0.5, 0.75, 1.0, 1.5, 2.0)
+#: the periods (simulated ms) a ``/clock`` robot's sensors publish at, each on its node's simulated timer: a
+#: deadline's answer (at most 0.65 of :data:`SIM_DEADLINES_MS` and the real latency at factor 2 after its
+#: reading) and the seeded ``"late"`` answer (:data:`LATE_FACTOR`) come before the next reading in simulated
+#: time, at every factor and through a pause (rule D1, docs/semantics.md "Deadlines": each reading is owed
+#: an answer of its own, and an alarm answers from the reading in force when its answer leaves)
+SIM_PERIODS_MS = (1600, 1800, 2000)
+#: the deadlines (simulated ms) of a ``/clock`` robot's alarms, relays and fuses
+SIM_DEADLINES_MS = (1100, 1200)
+#: a ``/clock`` robot's answering node waits this share of its deadline, on its node's simulated clock: from
+#: 0.55 (at a factor of 0.5 its wall-clock delay, 1.1 d or more, is past the deadline in the wall clock)
+#: to 0.65 (the 0.35 d left, 385 simulated ms or more, is the real latency of its reading's delivery and of
+#: its answer, up to 190 ms of the wall clock at a factor of 2)
+SIM_DELAY_SHARE = (0.55, 0.65)
+#: the seeded ``"late"`` defect of a ``/clock`` robot: its answer this many deadlines after its reading in
+#: simulated time (false at every factor; at a factor of 2 its wall-clock delay, 0.65 d, is within it)
+LATE_FACTOR = 1.3
+#: the largest real-time factor a ``/clock`` robot runs at (:data:`CLOCK_RATES`): a server answering at once
+#: on a ``/clock`` robot declares its wall-clock deadline (800 ms) this many times over, in simulated time
+SIM_RATE_TOP = 2.0
 #: the wall-clock seconds after the sensing starts at which a changing ``/clock`` may change (``--clock-change``):
 #: each change or pause at one of these, 0-0.4 s later, so two never overlap (a pause lasts at most 1 s)
 CLOCK_CHANGE_SLOTS = (1.5, 3.0, 4.5, 6.0)
@@ -138,12 +173,56 @@ def clock_changes(seed: int, nodes: int, rate: float) -> list[list[float]]:
 
 def sim_timed(n: dict[str, Any], spec: dict[str, Any]) -> bool:
     """Whether sensor ``n`` of ``spec`` publishes on its simulated clock's timer (a driver under
-    ``use_sim_time``: it stops while ``/clock`` is paused): a stamped sensor on a changing ``/clock``
-    (its stamps carry the clock it keeps) feeding no fuse (a fuse's two sensors share one clock: the
-    other input, published on, would be steps the fuse leaves unanswered while the first is paused)."""
-    clock = spec.get("clock")
-    return (bool(clock and clock.get("segments")) and n["kind"] == "sensor" and SENSORS[n["sensor_kind"]][3]
-            and not any(n["name"] in (f.get("a_source"), f.get("b_source")) for f in spec["nodes"]))
+    ``use_sim_time``: it stops while ``/clock`` is paused): every sensor of a ``/clock`` robot (its
+    period in simulated ms, :data:`SIM_PERIODS_MS`; its consumers answer on the same clock, each before
+    the next reading at every factor, :func:`sim_answers`)."""
+    return bool(spec.get("clock")) and n["kind"] == "sensor"
+
+
+def sim_answers(nodes: list[dict[str, Any]], seed: int, count: int) -> None:
+    """Put the nodes of a ``/clock`` robot on its simulated clock (in place): every sensor's
+    ``"period_ms"`` and ``"phase_ms"`` (under half the period) in simulated ms (:data:`SIM_PERIODS_MS`; a fuse's second sensor
+    at its first's period, half a period before it); each alarm's, relay's and fuse's ``"deadline_ms"``
+    (:data:`SIM_DEADLINES_MS`) and ``"delay_ms"``, the wait on its node's clock before it answers
+    (:data:`SIM_DELAY_SHARE` of the deadline); a server's ``"deadline_ms"`` its wall-clock deadline times
+    :data:`SIM_RATE_TOP` (it answers at once).  Drawn from a generator of its own, so the nodes drawn
+    do not change; deterministic in (seed, count)."""
+    rng = random.Random(f"sim-answers-{seed}-{count}")
+    by = {n["name"]: n for n in nodes}
+    for n in nodes:
+        if n["kind"] == "sensor":
+            n["period_ms"] = rng.choice(SIM_PERIODS_MS)
+            n["phase_ms"] = rng.randrange(0, n["period_ms"] // 2)
+    for n in nodes:
+        if n["kind"] == "fuse":
+            a, b = by[n["a_source"]], by[n["b_source"]]
+            b.update(period_ms=a["period_ms"], phase_ms=a["phase_ms"] - a["period_ms"] // 2)
+        if n["kind"] in ("alarm", "relay", "fuse"):
+            d = rng.choice(SIM_DEADLINES_MS)
+            n["deadline_ms"] = d
+            n["delay_ms"] = rng.randint(math.ceil(SIM_DELAY_SHARE[0] * d), math.floor(SIM_DELAY_SHARE[1] * d))
+        elif n["kind"] == "service":
+            n["deadline_ms"] = int(SERVER_DEADLINE_MS * SIM_RATE_TOP)
+
+
+def deadline_ms(n: dict[str, Any]) -> int:
+    """The deadline (ms, in its node's clock) of an alarm's, a relay's, a fuse's or a server's node spec
+    ``n``: drawn on a ``/clock`` robot (:func:`sim_answers`), else its delay and 500 ms (an alarm, a relay,
+    a fuse) or :data:`SERVER_DEADLINE_MS`."""
+    if "deadline_ms" in n:
+        return int(n["deadline_ms"])
+    return SERVER_DEADLINE_MS if n["kind"] == "service" else int(n["delay_ms"]) + 500
+
+
+def horizon_of(spec: dict[str, Any]) -> float:
+    """The horizon (s) of robot ``spec``'s questions: :data:`CLOCK_HORIZON` on a ``/clock``, else
+    :data:`HORIZON`."""
+    return CLOCK_HORIZON if spec.get("clock") else HORIZON
+
+
+def late_ms(n: dict[str, Any]) -> int:
+    """The wait (simulated ms) of a node seeded ``"late"``: :data:`LATE_FACTOR` times its deadline."""
+    return math.ceil(LATE_FACTOR * deadline_ms(n))
 
 
 def f32(v: float) -> float:
@@ -218,7 +297,8 @@ def _sensor(rng: random.Random, i: int, kinds: tuple[str, ...], kind: str | None
 
 def generate(seed: int, nodes: int = 5, defect: bool = False,
              kinds: tuple[str, ...] = tuple(SENSORS), sim_clock: bool = False,
-             actions: bool = False, driver_offset_s: float = 0.0, clock_change: bool = False) -> dict[str, Any]:
+             actions: bool = False, driver_offset_s: float = 0.0, clock_change: bool = False,
+             undeclared_sim_time: bool = False) -> dict[str, Any]:
     """The spec of generated robot ``seed``: ``{"seed", "defect", "clock", "nodes": [node spec, ...]}``,
     ``nodes`` contract nodes (at least 2: a sensor and one consumer); with ``defect``, exactly one node's
     spec holds ``"defect": True``; ``kinds``: the sensor kinds drawn from (keys of :data:`SENSORS`);
@@ -228,10 +308,13 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
     header stamps run that many seconds off its clock (a driver's clock, negative: behind), its
     ``"driver_offset_s"``; within the run's clock at most :data:`MAX_BEHIND_S` behind (else
     ``ValueError``, saying why); ``clock_change`` (with ``sim_clock``): the clock's ``"segments"``
-    (:func:`clock_changes`: its factor changes once or twice mid-run, and it may pause), each stamped
-    sensor feeding no fuse publishing on its simulated timer (``"sim_timer"``, :func:`sim_timed`).  The
-    other nodes drawn depend on no option.  Deterministic in (seed, nodes, defect, kinds, sim_clock,
-    actions, driver_offset_s, clock_change)."""
+    (:func:`clock_changes`: its factor changes once or twice mid-run, and it may pause).  With
+    ``sim_clock`` every sensor publishes on its simulated timer (``"sim_timer"``, :func:`sim_timed`) and
+    every node with a deadline answers on its node's simulated clock (:func:`sim_answers`), and
+    ``"use_sim_time"`` is True (the mapping declares that every node keeps ``/clock`` time) unless
+    ``undeclared_sim_time`` (the mapping leaves it unsaid; ``"use_sim_time"`` False).  The nodes drawn
+    depend on no option but those times.  Deterministic in (seed, nodes, defect, kinds, sim_clock,
+    actions, driver_offset_s, clock_change, undeclared_sim_time)."""
     if -STAMP_BEHIND_S <= driver_offset_s < -MAX_BEHIND_S:
         raise ValueError(f"a driver {-driver_offset_s:g} s behind stamps within the run's clock (at most "
                          f"{STAMP_BEHIND_S:g} s behind): its next reading is current, by its stamp, before an answer "
@@ -322,7 +405,10 @@ def generate(seed: int, nodes: int = 5, defect: bool = False,
         clock = {"rate": crng.choice(CLOCK_RATES), "start_s": float(crng.choice([0, 100, 5000]))}
         if clock_change:
             clock["segments"] = clock_changes(seed, nodes, clock["rate"])
-    spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out, "driver_offset_s": driver_offset_s}
+    if sim_clock:
+        sim_answers(out, seed, nodes)
+    spec = {"seed": seed, "defect": defect, "clock": clock, "nodes": out, "driver_offset_s": driver_offset_s,
+            "use_sim_time": bool(sim_clock and not undeclared_sim_time)}
     for n in out:
         if sim_timed(n, spec):
             n["sim_timer"] = True
@@ -423,7 +509,7 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
     if n["kind"] == "service":
         c["inputs"], c["outputs"] = ["on : BOOL"], ["ok : BOOL"]
         c["services"] = [f"std_srvs/SetBool {n['rcl_topic']} serves(in.on, out.ok)"]
-        c["guarantees"] = [{"formula": "out.ok == in.on", "trigger": "triggered by in.on within 800 ms"}]
+        c["guarantees"] = [{"formula": "out.ok == in.on", "trigger": f"triggered by in.on within {deadline_ms(n)} ms"}]
         c["comment"] = (f"a SetBool server, {'with' if n['introspection'] else 'without'} introspection"
                         + (" [seeded defect: every third answer wrong]" if n.get("defect") else ""))
         return c
@@ -436,7 +522,11 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
         c["comment"] = (f"a test_msgs/Fibonacci action server, {'with' if n['introspection'] else 'without'} "
                         "introspection" + (" [seeded defect: its result one short]" if n.get("defect") else ""))
         return c
-    deadline = n["delay_ms"] + 500
+    deadline = deadline_ms(n)
+    clocked = "deadline_ms" in n  # on a /clock robot: its wait and deadline in simulated ms
+    wait = f"{n['delay_ms']} {'simulated ' if clocked else ''}ms"
+    late = (f" [seeded defect: answers {late_ms(n)} simulated ms after its input, past its deadline]"
+            if n.get("defect") and n.get("defect_kind") == "late" else "")
     if n["kind"] in ("alarm", "relay"):
         s = by[n["source"]]
         typ, _f, rcl, _st = SENSORS[s["sensor_kind"]]
@@ -448,18 +538,19 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
             c["topics"].append(f"sensor_msgs/Range {n['rcl_topic']} matches(out.r)")
             c["guarantees"] = [{"formula": f"out.r == in.{var}", "trigger": f"triggered by in.{var} within {deadline} ms"}]
             c["comment"] = (f"a relay {'copying the header stamp' if n['copy'] else 'stamping with its own clock'}, "
-                            f"after {n['delay_ms']} ms" + (" [seeded defect: adds 0.5 to every fourth reading]"
-                                                          if n.get("defect") else ""))
+                            f"after {wait}" + late + (" [seeded defect: adds 0.5 to every fourth reading]"
+                                                      if n.get("defect") and n.get("defect_kind") == "wrong" else ""))
         else:
             out, cond = {"le": ("low", f"in.x <= {k['K']}"), "ge": ("high", f"in.n >= {k['K']}"),
                          "exists_lt": ("low", f"exists(v in in.cells | v < {k['K']})")}[n["op"]]
             c["outputs"] = [f"{out} : BOOL"]
             c["topics"].append(f"std_msgs/Bool {n['rcl_topic']} matches(out.{out})")
             c["guarantees"] = [{"formula": f"out.{out} <=> ({cond})", "trigger": f"triggered by in.{var} within {deadline} ms"}]
-            c["comment"] = (f"an alarm at a threshold, answering after {n['delay_ms']} ms"
+            c["comment"] = (f"an alarm at a threshold, answering after {wait}" + late
                             + (f" [seeded defect: answers none of {n['progress_steps'] + 2} readings in a row once]"
                                if n.get("defect") and n.get("defect_kind") == "mute" else
-                               " [seeded defect: the strict comparison for the other]" if n.get("defect") else ""))
+                               " [seeded defect: the strict comparison for the other]"
+                               if n.get("defect") and n.get("defect_kind") == "wrong" else ""))
         if n.get("assume_band"):
             c["assume"] = band(f"in.{var}", s)
         return c
@@ -477,8 +568,9 @@ def _contract(n: dict[str, Any], by: dict[str, dict[str, Any]], names: dict[str,
         g = f"out.low <=> (in.x <= {k['KA']} or exists(v in in.cells | v < {k['KB']}))"
     trig = "in.a" if n["op_b"] == "ge" else "in.x"
     c["guarantees"] = [{"formula": g, "trigger": f"triggered by {trig} within {deadline} ms"}]
-    c["comment"] = (f"two inputs, answering each {trig} after {n['delay_ms']} ms"
-                    + (" [seeded defect: the strict comparison for the other]" if n.get("defect") else ""))
+    c["comment"] = (f"two inputs, answering each {trig} after {wait}" + late
+                    + (" [seeded defect: the strict comparison for the other]"
+                       if n.get("defect") and n.get("defect_kind") == "wrong" else ""))
     return c
 
 
@@ -507,13 +599,16 @@ def render(spec: dict[str, Any]) -> dict[str, str]:
             fields.append((n["rcl_topic"], "range"))
         else:
             fields.append((n["rcl_topic"], "data"))
-    robot_spec = {"nodes": spec["nodes"], "clock": spec.get("clock"), "clock_step_ms": CLOCK_STEP_MS,
+    robot_spec = {"nodes": [{**n, "late_ms": late_ms(n)} if n.get("defect_kind") == "late" else n
+                            for n in spec["nodes"]],
+                  "clock": spec.get("clock"), "clock_step_ms": CLOCK_STEP_MS,
                   "driver_offset_s": spec.get("driver_offset_s", 0.0)}
     return {
         "contracts/robot.rcl": env.get_template("contracts.rcl.j2").render(
             seed=spec["seed"], defect=spec["defect"], constants=consts, nodes=contracts),
         "contracts/plan.yaml": env.get_template("plan.yaml.j2").render(seed=spec["seed"], nodes=spec["nodes"]),
-        "mapping.yaml": env.get_template("mapping.yaml.j2").render(fields=fields, horizon=HORIZON),
+        "mapping.yaml": env.get_template("mapping.yaml.j2").render(fields=fields, horizon=horizon_of(spec),
+                                                                    use_sim_time=bool(spec.get("use_sim_time"))),
         "interfaces/std_srvs/srv/SetBool.srv": SETBOOL,
         "interfaces/sensor_msgs/msg/Range.msg": RANGE,
         "interfaces/test_msgs/action/Fibonacci.action": FIBONACCI,
@@ -568,6 +663,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--clock-change", action="store_true",
                    help="with --clock implied: the /clock's factor changes once or twice mid-run (within 0.5-2), and "
                         "one time in two the clock pauses for 0.5-1 s; stamped sensors feeding no fuse on its timer")
+    p.add_argument("--undeclared-sim-time", action="store_true",
+                   help="with --clock: the mapping leaves use_sim_time unsaid (every node still runs under it), so a "
+                        "deadline is decided only where the wall clock and /clock time agree")
     p.add_argument("--actions", action="store_true",
                    help="a Fibonacci action server in place of a SetBool server, one time in two")
     p.add_argument("--driver-offset", type=float, default=0.0, metavar="S",
@@ -579,6 +677,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--smoke", action="store_true", help="CI: generate and type-check 20 workspaces, no live run")
     a = p.parse_args(argv)
     a.clock = a.clock or a.clock_change
+    if a.undeclared_sim_time and not a.clock:
+        p.error("--undeclared-sim-time needs --clock or --clock-change (a robot without /clock keeps the wall clock)")
     lo, _, hi = a.nodes.partition("-")
     sizes = (int(lo), int(hi or lo))
     if a.smoke:
@@ -592,15 +692,15 @@ def main(argv: list[str] | None = None) -> int:
     if a.write:
         for seed in seeds:
             n = random.Random(seed).randint(*sizes)
-            ws = write_workspace(generate(seed, n, a.defect, kinds, a.clock, a.actions,
-                                                   a.driver_offset, a.clock_change), Path(a.write) / f"seed-{seed}")
+            ws = write_workspace(generate(seed, n, a.defect, kinds, a.clock, a.actions, a.driver_offset,
+                                          a.clock_change, a.undeclared_sim_time), Path(a.write) / f"seed-{seed}")
             print(f"seed {seed}: {n} nodes: {ws}")
         return 0
     sys.path.insert(0, str(ROOT / "bench"))
     from _robot_run import run_many
     return run_many(seeds, sizes, a.seconds, a.defect, a.burn, Path(a.keep) if a.keep else None, kinds,
                     Path(a.src).resolve() if a.src else ROOT / "src", a.source, a.clock, a.actions, a.driver_offset,
-                    a.clock_change)
+                    a.clock_change, a.undeclared_sim_time)
 
 
 def _smoke() -> int:

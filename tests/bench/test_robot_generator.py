@@ -13,6 +13,7 @@ clock; each under about 20 s on an idle machine.
 """
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -197,12 +198,17 @@ def test_a_wall_clock_robot_has_no_writer_in_another_clock(correct_run: dict[str
     assert correct_run["other_clocks"] == [], correct_run["other_clocks"]
 
 
+#: what ``sim_clock`` changes in a node's spec: its times (bench/robot_generator.py ``sim_answers``) and the
+#: declarations drawn from them
+CLOCKED = ("periodic_ms", "periodic_rate", "period_ms", "phase_ms", "delay_ms", "deadline_ms", "sim_timer",
+           "progress_steps", "period_steps")
+
+
 def test_a_simulated_clock_leaves_the_nodes_as_drawn() -> None:
-    """``sim_clock`` adds the clock and ``use_sim_time`` and changes no node but a stamped sensor's period
-    declaration (bench/_robot_declarations.py: in its node's clock, simulated); the control: without it
-    the robot has neither."""
-    drop = lambda nodes: [{k: v for k, v in n.items() if k not in ("periodic_ms", "periodic_rate")}  # noqa: E731
-                          for n in nodes]
+    """``sim_clock`` adds the clock and ``use_sim_time`` and changes no node but its times (in simulated ms)
+    and the declarations drawn from them; the control: without it the robot has neither."""
+    def drop(nodes: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        return [{k: v for k, v in n.items() if k not in CLOCKED} for n in nodes]
     for seed in range(20):
         plain, sim = gen.generate(seed, 8), gen.generate(seed, 8, sim_clock=True)
         assert drop(plain["nodes"]) == drop(sim["nodes"]) and plain["clock"] is None
@@ -212,6 +218,96 @@ def test_a_simulated_clock_leaves_the_nodes_as_drawn() -> None:
     compile(robot, "robot.py", "exec")
     assert '"clock": {"rate"' in robot
     assert '"clock": null' in gen.render(gen.generate(3, 8))["robot.py"]
+
+
+def test_a_clock_robots_mapping_declares_use_sim_time(tmp_path: Path) -> None:
+    """On a ``/clock`` robot the mapping says every node keeps ``/clock`` time (``use_sim_time: true``, read
+    by the project's loader as every node's); ``undeclared_sim_time`` leaves it unsaid (the nodes run under
+    it all the same).  The control: a wall-clock robot's mapping says nothing of it."""
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.traces.mapping import sim_time_of
+    cases: list[tuple[str, dict[str, Any], bool | None]] = [
+        ("declared", {"sim_clock": True}, True), ("changing", {"sim_clock": True, "clock_change": True}, True),
+        ("unsaid", {"sim_clock": True, "undeclared_sim_time": True}, None), ("wall", {}, None)]
+    for name, how, want in cases:
+        spec = gen.generate(5, 7, **how)
+        ws = gen.write_workspace(spec, tmp_path / name)
+        assert spec["use_sim_time"] is bool(want)
+        assert ("use_sim_time: true" in (ws / "mapping.yaml").read_text()) is bool(want), name
+        rules = load_mapping(ws, "mapping.yaml").rules
+        assert all(sim_time_of(rules, n["name"]) is want for n in spec["nodes"]), name
+        gen.check_workspace(ws)
+    with pytest.raises(SystemExit):  # --undeclared-sim-time without a /clock: refused by the CLI
+        gen.main(["--undeclared-sim-time", "--write", str(tmp_path / "cli"), "--seeds", "1"])
+
+
+def _uncommented(text: str) -> list[str]:
+    """The lines of a contract's text but its comments."""
+    return [ln for ln in text.splitlines() if not ln.startswith("//")]
+
+
+#: the real latency (wall-clock s) a /clock robot's answer has room for at a factor of 2 (bench/robot_generator.py)
+REAL_S = 0.19
+
+
+@pytest.mark.parametrize("change", [False, True], ids=["steady", "changing"])
+def test_a_clock_robots_delays_keep_their_deadlines_in_simulated_time(change: bool) -> None:
+    """Every alarm, relay and fuse of a ``/clock`` robot waits 0.55-0.65 of its deadline in simulated time:
+    with the real latency at a factor of 2 still within it, before its input's next reading (rule D1), and
+    at a factor of 0.5 past its deadline by the wall clock; its servers' deadlines twice the wall clock's.
+    The control: on the wall clock the delays are drawn as before, deadlines their delay and 500 ms."""
+    seen = 0
+    for seed in range(1400, 1440):
+        spec = gen.generate(seed, 10, sim_clock=True, clock_change=change)
+        plain = gen.generate(seed, 10)
+        by = {n["name"]: n for n in spec["nodes"]}
+        for n, p in zip(spec["nodes"], plain["nodes"]):
+            if n["kind"] == "sensor":
+                assert n["sim_timer"] and n["period_ms"] in gen.SIM_PERIODS_MS and 0 <= n["phase_ms"] + n["period_ms"] // 2
+            if n["kind"] == "service":
+                assert gen.deadline_ms(n) == 1600 and gen.deadline_ms(p) == 800
+            if n["kind"] not in ("alarm", "relay", "fuse"):
+                continue
+            d, w = gen.deadline_ms(n), n["delay_ms"]
+            period = by[n.get("source") or n["a_source"]]["period_ms"]
+            assert d in gen.SIM_DEADLINES_MS and 0.55 * d <= w <= 0.65 * d, (seed, n["name"], d, w)
+            assert w + gen.SIM_RATE_TOP * REAL_S * 1e3 <= d  # in time in simulated time at a factor of 2
+            assert w + 2 * gen.SIM_RATE_TOP * REAL_S * 1e3 < period  # answered before the next reading
+            assert w / 0.5 > d  # at a factor of 0.5 its wall-clock delay is past its deadline
+            assert gen.deadline_ms(p) == p["delay_ms"] + 500 and p["delay_ms"] < 2 * by[n.get("source") or n["a_source"]]["period_ms"]
+            seen += 1
+    assert seen > 40
+
+
+def test_a_late_defect_on_a_clock_robot_is_out_of_its_deadline_at_every_factor(tmp_path: Path) -> None:
+    """On a ``/clock`` robot an alarm, a fuse or a relay stamping with its own clock is seeded ``"late"``:
+    it waits 1.3 deadlines (simulated), past its deadline at every factor (at a factor of 2 its wall-clock
+    delay, 0.65 d, is within it), still before its input's next reading; its contract is the correct
+    robot's and robot.py carries its wait.  The controls: the correct robot's delays are within the deadline,
+    and no robot without ``/clock`` is seeded ``"late"``."""
+    kinds: dict[str, int] = {}
+    for seed in range(1400, 1460):
+        spec = gen.generate(seed, 7, defect=True, sim_clock=True, clock_change=seed % 2 == 0)
+        victim = next(n for n in spec["nodes"] if n.get("defect"))
+        kinds[victim["defect_kind"]] = kinds.get(victim["defect_kind"], 0) + 1
+        assert gen.generate(seed, 7, defect=True)["nodes"][spec["nodes"].index(victim)]["defect_kind"] != "late"
+        if victim["kind"] in ("alarm", "fuse") or (victim["kind"] == "relay" and not victim["copy"]):
+            assert victim["defect_kind"] == "late"
+        if victim["defect_kind"] != "late":
+            assert victim["kind"] in ("sensor", "service", "relay") and victim["defect_kind"] != "skip"
+            continue
+        d, late = gen.deadline_ms(victim), gen.late_ms(victim)
+        period = {n["name"]: n for n in spec["nodes"]}[victim.get("source") or victim["a_source"]]["period_ms"]
+        assert late > d + 100 and late / gen.SIM_RATE_TOP < d and late < period, (seed, late, d, period)
+        assert victim["delay_ms"] <= 0.65 * d  # the correct node's, in the contract
+        files = gen.render(spec)
+        correct = gen.render(gen.generate(seed, 7, sim_clock=True, clock_change=seed % 2 == 0))
+        assert _uncommented(files["contracts/robot.rcl"]) == _uncommented(correct["contracts/robot.rcl"])
+        assert f'"late_ms": {late}' in files["robot.py"] and files["robot.py"].count('"late_ms": ') == 1
+        compile(files["robot.py"], "robot.py", "exec")
+    assert kinds.get("late", 0) >= 10 and set(kinds) <= {"late", "beyond", "wrong"}, kinds
+    ws = gen.write_workspace(gen.generate(1401, 7, defect=True, sim_clock=True), tmp_path / "ws")
+    gen.check_workspace(ws)
 
 
 def test_a_changing_clock_changes_its_factor_once_or_twice_and_may_pause() -> None:
@@ -241,27 +337,27 @@ def test_a_changing_clock_changes_its_factor_once_or_twice_and_may_pause() -> No
     assert 10 <= pauses <= 30, pauses
 
 
-def test_a_changing_clock_puts_stamped_sensors_feeding_no_fuse_on_its_timer() -> None:
-    """Under ``clock_change`` a stamped sensor feeding no fuse publishes on its simulated timer; its
-    period is declared at the largest factor the clock runs at; the nodes are otherwise those drawn
-    without it (the control: on a clock that does not change no sensor is on its timer)."""
-    seen = set()
+def test_a_clock_robots_sensors_publish_on_its_timer() -> None:
+    """On a ``/clock`` robot every sensor publishes on its simulated timer, a stamped one's period declared at
+    the largest factor the clock runs at (in its stamps' clock), an unstamped one's at the slowest (in the
+    wall clock) with the longest pause; the control: on the wall clock no sensor is on a timer."""
+    import _robot_declarations as decl
     for seed in range(1060, 1100):
         spec = gen.generate(seed, 9, sim_clock=True, clock_change=True)
-        plain = gen.generate(seed, 9, sim_clock=True)
+        assert not any("sim_timer" in n for n in gen.generate(seed, 9)["nodes"])
         top = max([spec["clock"]["rate"]] + [r for _, r in spec["clock"]["segments"]])
-        fed = {f[k] for f in spec["nodes"] if f["kind"] == "fuse" for k in ("a_source", "b_source")}
-        for n, p in zip(spec["nodes"], plain["nodes"]):
-            assert "sim_timer" not in p
-            assert {k: v for k, v in n.items() if k not in ("periodic_ms", "periodic_rate", "sim_timer")} == \
-                {k: v for k, v in p.items() if k not in ("periodic_ms", "periodic_rate")}
+        low = min([spec["clock"]["rate"]] + [r for _, r in spec["clock"]["segments"] if r])
+        pause = any(r == 0 for _, r in spec["clock"]["segments"])
+        for n in spec["nodes"]:
             if n["kind"] != "sensor":
                 continue
-            stamped = gen.SENSORS[n["sensor_kind"]][3]
-            assert n.get("sim_timer", False) == (stamped and n["name"] not in fed), (seed, n["name"])
-            assert n["periodic_rate"] == (top if stamped else 1.0)
-            seen.add((stamped, n.get("sim_timer", False)))
-    assert seen == {(True, True), (True, False), (False, False)}, seen
+            assert n["sim_timer"]
+            if gen.SENSORS[n["sensor_kind"]][3]:
+                assert n["periodic_rate"] == top
+            else:
+                assert n["periodic_rate"] == 1.0 and n["periodic_ms"] == \
+                    math.ceil(2 * n["period_ms"] / low) + 1000 + 1000 * pause
+                assert n["periodic_ms"] >= n["period_ms"] / low + decl.PAUSE_MS * pause
 
 
 def _clock_functions(spec: dict[str, Any]) -> dict[str, Any]:

@@ -82,7 +82,8 @@ def test_a_stamped_sensors_period_is_declared_in_its_nodes_clock() -> None:
     """A stamped sensor's period is judged on its stamps (backends/monitors/periods.py), so it is declared
     in their clock: on a ``/clock`` the wall-clock bound times the real-time factor and two ticks more, with
     a driver's offset outside the run's clock the wall-clock bound, with a driver behind within the run's
-    clock that much more; an unstamped sensor's (its source times) is the wall-clock bound on every clock."""
+    clock that much more; an unstamped sensor's (its source times) is the wall-clock bound, on a ``/clock``
+    (on its simulated timer) its simulated period over the factor."""
     stamped = lambda n: n["kind"] == "sensor" and n["sensor_kind"] in ("range", "scan")  # noqa: E731
     plain = lambda n: n["kind"] == "sensor" and not stamped(n)  # noqa: E731
     rates = set()
@@ -99,6 +100,8 @@ def test_a_stamped_sensors_period_is_declared_in_its_nodes_clock() -> None:
                 if stamped(n):
                     assert n["periodic_ms"] == want(base, rate) and n["periodic_rate"] == rate, (seed, n["name"])
                     rates.add(rate)
+                elif plain(n) and spec["clock"]:  # on its simulated timer: its gaps the wall clock's at the factor
+                    assert n["periodic_ms"] == math.ceil(2 * n["period_ms"] / rate) + 1000 and n["periodic_rate"] == 1.0
                 elif plain(n):
                     assert n["periodic_ms"] == base and n["periodic_rate"] == 1.0
                 if n["kind"] == "sensor":

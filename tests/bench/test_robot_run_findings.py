@@ -1,7 +1,10 @@
 """The generated-robot runner's findings (bench/_robot_run.py): a seeded defect not red live is a finding,
 unless the seeded node is a server the monitor could judge nothing of (its calls unjudged: the rclpy source
 hears calls through introspection events only, docs/ros2.md), which the run says apart; a node judged green
-is never excused."""
+is never excused.  A node seeded to answer late on a ``/clock`` whose mapping leaves ``use_sim_time``
+unsaid, its deadlines undecided (the wall clock and ``/clock`` time disagree), is said apart too; with
+``use_sim_time`` declared it must be red.  A run's figures count the false verdicts of correct nodes
+apart from the seeded node's."""
 from __future__ import annotations
 
 import sys
@@ -11,7 +14,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 
-from _robot_run import findings, victim_unjudged  # noqa: E402
+from _robot_run import figures, findings, late_unsaid, victim_unjudged  # noqa: E402
 
 
 def _res(victim: Counter[str]) -> dict[str, Any]:
@@ -32,3 +35,37 @@ def test_control_a_seeded_node_judged_green_is_a_finding() -> None:
 
 def test_control_a_seeded_node_red_is_no_finding() -> None:
     assert findings(_res(Counter(violated=1))) == []
+
+
+def _late(victim: Counter[str], use_sim_time: bool) -> dict[str, Any]:
+    nodes = [{"name": "Sensor0"}, {"name": "Alarm1", "defect": True, "defect_kind": "late"}]
+    return {"disagreements": [], "errors": [], "spec": {"nodes": nodes, "use_sim_time": use_sim_time}, "finals": {},
+            "declarations": {}, "live": {"Sensor0": Counter(satisfied=5), "Alarm1": victim}}
+
+
+def test_a_late_node_undecided_with_use_sim_time_unsaid_is_said_apart() -> None:
+    res = _late(Counter({"satisfied": 3, "deadline undecided": 4}), use_sim_time=False)
+    assert late_unsaid(res) and findings(res) == []
+
+
+def test_control_a_late_node_undecided_with_use_sim_time_declared_is_a_finding() -> None:
+    res = _late(Counter({"satisfied": 3, "deadline undecided": 4}), use_sim_time=True)
+    assert not late_unsaid(res) and findings(res) == ["Alarm1: seeded defect not red live"]
+    green = _late(Counter({"satisfied": 3, "deadline true": 4}), use_sim_time=False)  # never undecided: not excused
+    assert not late_unsaid(green) and findings(green) == ["Alarm1: seeded defect not red live"]
+
+
+def test_a_runs_figures_count_correct_nodes_apart_from_the_seeded_one() -> None:
+    def rec(node: str, item: str, verdict: str, time: float) -> dict[str, Any]:
+        return {"node": node, "item": item, "topic": "t", "time": time, "verdict": verdict}
+    res = _late(Counter({"satisfied": 3, "deadline false": 2, "deadline true": 1, "deadline undecided": 1}), True)
+    res["live"]["Sensor0"].update({"deadline true": 4})
+    res["finals"] = {"live": {("Alarm1", "deadline", "t", 0): [rec("Alarm1", "deadline", "false", 1.0)],
+                              ("Sensor0", "guarantee", "t", 0): [rec("Sensor0", "guarantee", "violated", 2.0)]},
+                     "log": {("Sensor0", "deadline", "t", 0): [rec("Sensor0", "deadline", "false", 3.0)]}}
+    res["declarations"] = {"live": {("Sensor0", "periodic out.x", "r:1:1"): {"verdict": "false"},
+                                    ("Alarm1", "progress", "r:2:1"): {"verdict": "false"}}}
+    fig = figures(res)
+    assert (fig["violated_correct"], fig["false_deadlines_correct"], fig["false_declarations_correct"]) == (1, 1, 1)
+    assert (fig["deadlines"], fig["undecided"], fig["agree"]) == (8, 1, True)
+    assert (fig["victim"], fig["kind"], fig["red"], fig["red_deadlines"]) == ("Alarm1", "late", 2, 2)
