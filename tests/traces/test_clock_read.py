@@ -14,6 +14,7 @@ the clock's, and no clock event.
 from __future__ import annotations
 
 import json
+import random
 import struct
 from pathlib import Path
 from typing import Any
@@ -156,3 +157,48 @@ def test_the_readers_typestore_decodes_a_clock_also_where_the_workspace_redefine
         raw = store.serialize_cdr(Clock(clock=Time(sec=12, nanosec=345)), "rosgraph_msgs/msg/Clock")
         msg = store.deserialize_cdr(raw, "rosgraph_msgs/msg/Clock")
         assert (msg.clock.sec, msg.clock.nanosec) == (12, 345)
+
+
+def test_a_live_log_s_clock_lines_keep_its_reads_decoded_at_once(tmp_path: Path,
+                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    """A clock line's ``clock`` (an object of scalars) keeps a read on the at-once path (traces/jsonl_blocks.py,
+    one ``decode_lines`` call), with the exact reader's events and columns (``clock`` read as the exact reader
+    reads it, a key given twice the last).  Controls: the same read with an object holding an object or an
+    array, and lines made to fool a lax reader (an object over two lines, two on one line, keeping the count
+    of objects equal to the count of lines), go to the line-by-line paths, with the exact reader's events and
+    error."""
+    from rclverify.traces import jsonl_blocks
+    from rclverify.traces.jsonl import read_jsonl
+    from test_jsonl_blocks import _blockwise, _outcome
+    lines = []
+    for i in range(60):
+        lines.append(f'{{"topic": "x", "time": {1 + i / 100!r}, "data": {i * 0.5!r}}}')
+        lines.append(f'{{"topic": "clock", "time": {1.005 + i / 100!r}, "clock": {{"sec": {i}, "nanosec": 7, '
+                     f'"sec": {i + 1}}}}}')
+    flat = jsonl_blocks._flat
+    at_once: list[bool] = []
+
+    def noted(*a: Any) -> Any:
+        got = flat(*a)
+        at_once.append(got is not None)
+        return got
+    monkeypatch.setattr(jsonl_blocks, "_flat", noted)
+    p = tmp_path / "run.jsonl"
+    odd_lines = [
+        None,
+        '{"topic": "clock", "time": 9.0, "clock": {"sec": {"s": 1}, "nanosec": 2}}',
+        '{"topic": "clock", "time": 9.0, "clock": {"sec": [1], "nanosec": 2}}',
+        '{"topic": "clock", "time": 9.0, "clock": {"sec": 1}}{"topic": "x", "time": 9.5, "data": 1.0}\n'
+        '{"topic": "clock", "time": 9.6, "clock": {"sec": 2}\n{"nanosec": 3}}',
+        '{"topic": "clock", "time": 9.0, "clock": {"sec": 1}\n{"topic": "x", "time": 9.5}}',
+    ]
+    for odd in odd_lines:
+        p.write_text("\n".join(lines + ([odd] if odd else [])) + "\n")
+        at_once.clear()
+        seen = {"fast": 0, "exact": 0}
+        want = _outcome(read_jsonl(p))
+        assert _outcome(_blockwise(p, ["data", "clock"], 1000, random.Random(1), seen)) == want
+        assert at_once == [odd is None], odd
+        assert bool(want[1]) is (odd is not None and "\n" in odd), odd  # the lax reader's bait: an error
+        if odd is None:
+            assert [e[3] for e in want[0][1:3]] == ["[('clock', {'sec': 1, 'nanosec': 7})]", "[('data', 0.5)]"]

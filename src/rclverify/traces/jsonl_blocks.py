@@ -33,22 +33,24 @@ reader splits them: after ``\\n``, and at a bare ``\\r``.
 Before that, a whole read (:data:`BLOCK_BYTES`, cut after its last
 ``\\n``) is tried **at once**: one msgspec ``decode_lines``
 call into a *flat* struct (the same keys, every value but the topic and
-the time a JSON scalar -- string, number, boolean or null -- or an array
-of scalars, a ROS array field or a window; the time a number), taken only
+the time a JSON scalar -- string, number, boolean or null --, an array
+of scalars, a ROS array field or a window, or an object of scalars, a
+``/clock`` line's ``{"sec": S, "nanosec": N}``; the time a number), taken only
 when the read has no ``\\r``, every line begins with ``{`` and ends with
 ``}`` (the bytes around each ``\\n``, found with numpy) and the call gives
 one object per line.  Then each line is one object and nothing else, so
 each object is the one that line decodes to alone: strings cannot hold a
 raw line end (JSON forbids control characters in them, msgspec refuses
-them), so every line begins and ends outside any string; no value holding
-an object, the only braces outside strings are the top-level objects', so
-each line's first ``{`` opens one and its last ``}`` closes one; with as
-many objects as lines, each line opens exactly one, and the object it
-opens is closed before the next line's opens: at that line's own end.
+them), so every line end lies between two tokens, a ``}`` and a ``{``;
+inside an object or an array a ``}`` is followed by ``,``, ``}`` or ``]``,
+never by ``{``, so every line end lies between two top-level values and
+each line holds one or more of them whole; with as many objects as lines,
+each line holds exactly one.
 (``decode_lines`` alone is lax: it reads two objects on one line, or one
 over two lines; a block read as one JSON array was refused for the same
-reason, docs/scale.md.)  The typed decoder reads a scalar or an array's
-items to the values the untyped one gives (integers of any size exact).
+reason, docs/scale.md.)  The typed decoder reads a scalar, an array's
+items or an object's values to the values the untyped one gives (integers
+of any size exact; a key given twice, the last).
 As on the line-by-line fast path, every time must be a finite ``float``.
 Once a read is decoded so, its topics (up to :data:`MAX_TOPICS`, as the
 lines spell them) are known to the next reads' decoder, which reads the
@@ -56,8 +58,9 @@ topic as one of them (a ``Literal``: the same string, one object per name,
 so the topic column's set, counts and codes compare objects, not text); a
 line of another topic fails that decoder and the read is decoded with the
 topic a string, its topics then known too.
-Anything else (an integer time, an object or an array of arrays as a
-value, a new key, a ``\\r``, bad bytes, a line msgspec refuses) sends the
+Anything else (an integer time, an object holding an object or an array,
+an array of arrays or of objects as a value, a new key, a ``\\r``, bad
+bytes, a line msgspec refuses) sends the
 read to the line-by-line paths above, which give the same events and the
 same located error.  No line is split off
 as a ``bytes`` object unless a row's event is asked for.
@@ -90,9 +93,9 @@ _TOPIC, _TIME = attrgetter("f0"), attrgetter("f1")
 _T = TypeVar("_T")
 #: A JSON scalar as the untyped decoder reads it.
 _SCALAR = Union[str, float, int, bool, None]
-#: A flat line's values (module docstring): a scalar or an array of scalars; an object, or an array
-#: holding an array or an object, is refused by the decoder.
-_FLAT = Union[str, float, int, bool, None, list[_SCALAR]]
+#: A flat line's values (module docstring): a scalar, an array of scalars or an object of scalars (a
+#: ``/clock`` line's ``clock``); an array or an object holding an array or an object is refused by the decoder.
+_FLAT = Union[str, float, int, bool, None, list[_SCALAR], dict[str, _SCALAR]]
 
 
 class JsonlLog:
