@@ -196,3 +196,21 @@ def test_a_run_read_again_in_stamp_order_places_each_clock_line_at_its_time(
     assert probe.last == _want(clock=False)
     assert with_clock["order"][0].startswith("judged in stamp order")
     assert with_clock == without
+
+
+def test_a_node_kept_in_simulated_time_on_a_run_without_clock_says_its_triggers_were_undecided(
+        tmp_path: Path) -> None:
+    """A run without ``/clock`` of a node said to keep simulated time: every trigger undecided (its simulated
+    time is not known), and the item "not judged" of its deadlines says so and why (not that no trigger was
+    accepted).  Control: the same run with ``/clock`` decides them, no item."""
+    ws = _workspace(tmp_path / "ws", "use_sim_time: true\n")
+    (ws / "clock").mkdir()
+    (ws / "plain").mkdir()
+    without = _check(ws, write_run(ws / "plain" / "run", "log", clock=False))
+    assert set(without["finals"].values()) == {"undecided"}
+    (item,) = without["not_judged"]
+    assert (item["kind"], item["reason"]) == ("deadline", "no verdict")
+    assert item["detail"].startswith("12 trigger event(s) were undecided in ")
+    assert "no /clock message was heard" in item["detail"] and "accepted" not in item["detail"]
+    with_clock = _check(ws, write_run(ws / "clock" / "run", "log"))
+    assert with_clock["not_judged"] == [] and with_clock["deadlines"][0]["false"] > 0

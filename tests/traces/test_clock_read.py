@@ -31,7 +31,7 @@ RUN: list[tuple[int, str, float]] = []
 for _i in range(12):
     _t = BASE_NS + _i * 100_000_000
     RUN.append((_t, "x", float(_i)))
-    RUN.append((_t + 10_000_000, "clock", _i * 0.5 + 0.000000007))  # simulated time: half the run's rate
+    RUN.append((_t + 10_000_000, "clock", _i * 0.5 + 0.000000007))  # simulated time: five times the run's rate
     RUN.append((_t + 50_000_000, "y", float(_i - 1 if _i % 3 == 0 else _i + 1)))
 FORMS = ["log", "flat-log", "sqlite3", "mcap", "ros1"]
 

@@ -153,15 +153,21 @@ def count_call_line(obj: Mapping[str, object], messages: dict[str, int], orphans
 
 def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str, Iterable[tuple[str, str]]],
                deadlines: Mapping[str, Mapping[str, int]], where: str,
-               decided: Mapping[str, int] | None = None) -> list[dict[str, str]]:
+               decided: Mapping[str, int] | None = None,
+               undecided_why: Mapping[str, str] | None = None) -> list[dict[str, str]]:
     """The items of ``nodes``' contracts the run did not judge (module docstring).
 
     ``statuses``: node name -> its ``(status, explanation)`` pairs (the
     untimed check's, the live calls'); a node is judged when one of them is
     not ``pending``.  ``deadlines``: node name -> its deadline verdict counts
     (``true``, ``false``, ``currently_false``, summed over the topic and the
-    call deadline monitors; a node absent has none); a node's deadlines are
-    judged when one trigger got ``true`` or ``false``.  ``where``: the run, as
+    call deadline monitors; a node absent has none), with ``undecided``
+    where the caller counts the triggers given no verdict because it was
+    undecided (:data:`.deadline_records.UNACCEPTED`: an answer within the
+    transport skew of its deadline, a simulated time not known); a node's
+    deadlines are judged when one trigger got ``true`` or ``false``.
+    ``undecided_why``: node name -> why its first undecided trigger was, said
+    in its item's detail.  ``where``: the run, as
     the details say it (``"in run.jsonl"``, ``"during the live run"``).
     ``decided``: node name -> its answers decided satisfied or violated; a
     node with none, no deadline decided and only ``inconclusive`` (or
@@ -210,9 +216,13 @@ def not_judged(nodes: Iterable[CheckedNode], heard: Heard, statuses: Mapping[str
         if not timed or c.get("true", 0) or c.get("false", 0):
             continue
         triggers = sorted({f"in.{g.trigger.name}" for g in n.node.guarantees if g.trigger is not None})
-        pending = c.get("currently_false", 0)
+        pending, undecided = c.get("currently_false", 0), c.get("undecided", 0)
+        first = (undecided_why or {}).get(n.name)
         reason, detail = (("no verdict", f"{pending} trigger event(s) were still within their deadline {where}")
                           if pending else
+                          ("no verdict", f"{undecided} trigger event(s) were undecided {where}"
+                                         + (f"; the first: {first}" if first else ""))
+                          if undecided else
                           ("no verdict", f"trigger events came but none was accepted (the assumption) {where}")
                           if _heard_any(n, heard, triggers) else
                           ("nothing heard", f"no event of its trigger(s) {', '.join(triggers)} {where}"))

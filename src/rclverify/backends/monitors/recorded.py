@@ -103,14 +103,16 @@ def check_recorded(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, roo
     centries, dentries = calls.entries(), calls.deadline_entries()
     for c in centries:
         statuses.setdefault(c["node"], []).append((c["status"], c["explanation"]))
-    dcounts = {d.node: dict(d.counts) for d in dres}
+    dcounts = {d.node: {**d.counts, "undecided": d.unaccepted.get("undecided", 0)} for d in dres}
+    why = {d.node: d.first_unaccepted["reason"] for d in dres
+           if d.first_unaccepted is not None and d.first_unaccepted["why"] == "undecided"}
     for r in calls.deadlines():  # the topic and the call deadlines summed, as the live run does
         total = dcounts.setdefault(r.node, {})
         for v, k in r.counts.items():
             total[v] = total.get(v, 0) + k
     items = not_judged(nodes, Heard({**heard, **calls.messages}, dict(calls.orphans),
                                     unseen=unseen_links(calls.origin.origin)), statuses, dcounts,
-                       f"in {trace}", decided_of(results, centries))
+                       f"in {trace}", decided_of(results, centries), why)
     if one.bag is not None:  # a bag without a link's call topics: say what it lacks (bag_calls.py)
         one.bag.explain(items)
     if on_verdict is not None:
