@@ -326,16 +326,21 @@ class LiveRun:
         for n in [*record["nodes"], *record.get("calls", {}).get("nodes", [])]:
             statuses.setdefault(n["node"], []).append((n["status"], n["explanation"]))
         counts: dict[str, dict[str, int]] = {}
+        undecided_why: dict[str, str] = {}
         results = [e["deadlines"] for e in record.get("topic_deadlines", [])]
         for r in results + list(record.get("deadlines", {}).get("results", [])):
             total = counts.setdefault(r["node"], {})
             for v, k in r["counts"].items():
                 total[v] = total.get(v, 0) + k
+            total["undecided"] = total.get("undecided", 0) + int((r.get("unaccepted") or {}).get("undecided", 0))
+            first = r.get("first_unaccepted")
+            if first and first.get("why") == "undecided":
+                undecided_why.setdefault(r["node"], str(first.get("reason", "")))
         decided = {n["node"]: int((n.get("statistics") or {}).get("answers", 0)) for n in record["nodes"]}
         for n in record.get("calls", {}).get("nodes", []):  # a node judged by its calls decided them
             c = n.get("counts") or {}
             decided[n["node"]] = decided.get(n["node"], 0) + int(c.get("satisfied", 0)) + int(c.get("violated", 0))
-        items = not_judged(self.nodes, heard, statuses, counts, "during the live run", decided)
+        items = not_judged(self.nodes, heard, statuses, counts, "during the live run", decided, undecided_why)
         for entry in record["nodes"]:  # a pending node says why itself
             explain(entry, items)
         return items

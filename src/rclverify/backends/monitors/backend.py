@@ -272,8 +272,12 @@ class MonitorsBackend:
                                                                       dict(calls.orphans),
                                                                       unseen=unseen_links(read.origin)),
                                                  {res.node: [(status, explanation)]},
-                                                 {dl.node: dl.counts} if dl is not None else {}, f"in {trace}",
-                                                 decided_of([res], calls.entries() if summary is not None else []))
+                                                 {dl.node: {**dl.counts, "undecided": dl.unaccepted.get("undecided", 0)}}
+                                                 if dl is not None else {}, f"in {trace}",
+                                                 decided_of([res], calls.entries() if summary is not None else []),
+                                                 {dl.node: dl.first_unaccepted["reason"]} if dl is not None
+                                                 and dl.first_unaccepted is not None
+                                                 and dl.first_unaccepted["why"] == "undecided" else None)
         if read.bag is not None:  # a bag without a link's call topics: say what it lacks (bag_calls.py)
             read.bag.explain(items)
         entry = {"node": res.node, "status": status, "explanation": explanation}
