@@ -9,12 +9,17 @@ increasing in the log's time order, between the contract topic's lines by time; 
 ``/clock`` messages at the same times; the record names the ``/clock`` publisher heard.  The control is the
 same run without ``sim``: no ``clock`` line, no ``/clock`` in the bag or the record, the contract topics heard
 as before.
+
+ROS 1 (a real master, a rospy node): the live monitor hears ``/clock`` (``rosgraph_msgs/Clock``) beside the
+contract topics, each message a ``clock`` line (``secs``/``nsecs``) at its receipt time, between the contract
+topics' lines; the control without ``/clock`` has none.
 """
 from __future__ import annotations
 
 import json
 import signal
 import subprocess
+import sys
 from pathlib import Path
 from typing import Any, Iterator
 
@@ -22,6 +27,7 @@ import pytest
 from _procs import stop, wait_for, wait_logged
 from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
 
+from rclverify.runtime.ros1 import LocalMaster, RosUnavailable, import_rospy
 from rclverify.traces.bag import typestore
 from rclverify.traces.sim_clock import clock_value_ns
 
@@ -185,3 +191,101 @@ def test_echo_is_judged_with_or_without_a_clock(run: dict[str, Any]) -> None:
     """The contract's verdicts do not depend on the clock heard beside it."""
     (node,) = [n for n in run["record"]["nodes"] if n["node"] == "Echo"]
     assert node["counts"].get("violated", 0) == 0 and node["counts"].get("satisfied", 0) >= ROUNDS - 2, node
+
+
+ROS1_NODE = """\
+import sys
+import time
+from rclverify.runtime.ros1 import import_rospy
+rospy = import_rospy()
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Int64
+
+rospy.init_node("robot", disable_signals=True)
+px = rospy.Publisher("/x", Int64, queue_size=100)
+py = rospy.Publisher("/y", Int64, queue_size=100)
+pc = rospy.Publisher("/clock", Clock, queue_size=100) if sys.argv[1:] == ["clock"] else None
+print("ready", flush=True)
+until = time.monotonic() + 30
+while time.monotonic() < until and (px.get_num_connections() < 1 or py.get_num_connections() < 1
+                                   or (pc is not None and pc.get_num_connections() < 1)):
+    time.sleep(0.05)
+time.sleep(0.5)
+sim_ns = 100 * 10**9
+for k in range(1, ROUNDS + 1):
+    for _ in range(5):  # /clock at about 100 Hz, 10 ms further each time
+        if pc is not None:
+            pc.publish(Clock(clock=rospy.Time(sim_ns // 10**9, sim_ns % 10**9)))
+            sim_ns += 10 * 10**6
+        time.sleep(0.01)
+    px.publish(Int64(data=k))
+    time.sleep(0.002)
+    py.publish(Int64(data=k))
+print("done", flush=True)
+while True:
+    time.sleep(0.1)
+""".replace("ROUNDS", str(ROUNDS))
+
+try:
+    import_rospy()
+    ROS1 = ""
+except RosUnavailable as exc:
+    ROS1 = str(exc)
+
+
+@pytest.fixture(scope="module", params=[True, False], ids=["ros1-clock", "ros1-no-clock"])
+def ros1_run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    """One live run on a ROS 1 master, the node publishing ``/clock`` or (the control) not."""
+    if ROS1:
+        pytest.skip(f"ROS 1 unavailable: {ROS1}")
+    clock = request.param
+    tmp = tmp_path_factory.mktemp(f"ros1-clock-{clock}")
+    ws = live_workspace(tmp, RCL)
+    (tmp / "robot.py").write_text(ROS1_NODE)
+    src = str(Path(__file__).resolve().parents[2] / "src")
+    procs: list[subprocess.Popen[bytes]] = []
+    with LocalMaster(tmp / "ros") as env:
+        env = {**env, "PYTHONPATH": src, "PYTHONUNBUFFERED": "1"}
+        try:
+            with open(tmp / "robot.log", "wb") as fh:
+                procs.append(subprocess.Popen([sys.executable, str(tmp / "robot.py"), *(["clock"] if clock else [])],
+                                              cwd=tmp, env=env, stdout=fh, stderr=subprocess.STDOUT,
+                                              start_new_session=True))
+            wait_for(tmp / "robot.log", "ready", 30)
+            with open(tmp / "monitor.out", "wb") as fh:
+                monitor = subprocess.Popen([sys.executable, "-m", "rclverify.cli.commands", "monitor", "--live",
+                                            "-w", str(ws), "--horizon", "0.5", "--status", "0", "--duration", "90",
+                                            "--log", str(tmp / "live.jsonl"), "--evidence", str(tmp / "live.json")],
+                                           cwd=tmp, env=env, stdout=fh, stderr=subprocess.STDOUT,
+                                           start_new_session=True)
+            procs.append(monitor)
+            wait_for(tmp / "robot.log", "done", 60)
+            wait_logged(tmp / "live.jsonl", _echo_judged_last, 60)
+            stop(monitor, signal.SIGINT)
+            out = (tmp / "monitor.out").read_text(errors="replace")
+            assert (tmp / "live.json").exists(), out
+            yield {"clock": clock, "out": out,
+                   "log": [json.loads(x) for x in (tmp / "live.jsonl").read_text().splitlines()]}
+        finally:
+            for p in procs:
+                stop(p)
+
+
+def test_ros1_clock_lines_are_in_the_log_in_time_order(ros1_run: dict[str, Any]) -> None:
+    """ROS 1: each ``/clock`` message heard is a ``clock`` line (``secs``/``nsecs``), its value increasing
+    with the log's time, between the contract topic's lines; the control has none."""
+    log = ros1_run["log"]
+    clocks = [x for x in log if x.get("topic") == "clock"]
+    xs = [x for x in log if x.get("topic") == "x"]
+    assert len(xs) == ROUNDS, (len(xs), ros1_run["out"])
+    if not ros1_run["clock"]:
+        assert clocks == [], clocks[:3]
+        return
+    assert len(clocks) >= 4 * ROUNDS and all(set(x["clock"]) == {"secs", "nsecs"} for x in clocks), clocks[:3]
+    values = [clock_value_ns(x) for x in clocks]
+    assert all(v is not None for v in values) and all(a < b for a, b in zip(values, values[1:])), values  # type: ignore[operator]
+    both = [x["time"] for x in log if x.get("topic") in ("x", "clock")]
+    assert all(a <= b for a, b in zip(both, both[1:]))
+    order = [x.get("topic") for x in log if x.get("topic") in ("x", "clock")]
+    at = [k for k, t in enumerate(order) if t == "x"]
+    assert sum("clock" in order[a + 1:b] for a, b in zip(at, at[1:])) >= len(at) - 3, order
