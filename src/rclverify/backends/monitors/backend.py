@@ -271,13 +271,8 @@ class MonitorsBackend:
         extra["not_judged"] = items = not_judged([target.node], Heard({**heard, **calls.messages},
                                                                       dict(calls.orphans),
                                                                       unseen=unseen_links(read.origin)),
-                                                 {res.node: [(status, explanation)]},
-                                                 {dl.node: {**dl.counts, "undecided": dl.unaccepted.get("undecided", 0)}}
-                                                 if dl is not None else {}, f"in {trace}",
-                                                 decided_of([res], calls.entries() if summary is not None else []),
-                                                 {dl.node: dl.first_unaccepted["reason"]} if dl is not None
-                                                 and dl.first_unaccepted is not None
-                                                 and dl.first_unaccepted["why"] == "undecided" else None)
+                                                 {res.node: [(status, explanation)]}, *_deadline_counts(dl, trace,
+                                                 decided_of([res], calls.entries() if summary is not None else [])))
         if read.bag is not None:  # a bag without a link's call topics: say what it lacks (bag_calls.py)
             read.bag.explain(items)
         entry = {"node": res.node, "status": status, "explanation": explanation}
@@ -292,6 +287,17 @@ class MonitorsBackend:
         return evidence(status, explanation, details=run_payload(details, stats, extra).details(),
                         artifacts=(str(obligation.data.get("rml", "")), str(obligation.data.get("config", ""))),
                         log=summary_line(res))
+
+
+def _deadline_counts(dl: DeadlineResult | None, trace: str, decided: dict[str, int]) -> \
+        tuple[dict[str, dict[str, int]], str, dict[str, int], dict[str, str] | None]:
+    """The deadline part of :func:`.judged.not_judged`'s arguments for one node's deadlines ``dl`` on
+    ``trace``: its counts with the undecided triggers, where, ``decided``, and why the first undecided was."""
+    if dl is None:
+        return {}, f"in {trace}", decided, None
+    first = dl.first_unaccepted
+    why = {dl.node: str(first["reason"])} if first is not None and first["why"] == "undecided" else None
+    return {dl.node: {**dl.counts, "undecided": dl.unaccepted.get("undecided", 0)}}, f"in {trace}", decided, why
 
 
 def run_payload(monitoring: Mapping[str, Any], stats: Mapping[str, Any], extra: Mapping[str, Any]) -> MonitorsPayload:

@@ -66,9 +66,13 @@ def _typed(evs: list[Event] | Any, values: Callable[[np.ndarray, str], list[Any]
 
 def judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
     """Judge the events ``evs`` (a list, or a log block: :func:`_columns`) as the streaming monitor
-    would, over columns, and leave its state; ``False`` (nothing changed) when the chunk is not clean."""
-    if mon.sim_mode is True or mon.sim.heard:  # a deadline kept in simulated time: streamed (deadline_clock.py)
-        return False
+    would, over columns, and leave its state; ``False`` (nothing changed) when the chunk is not clean,
+    or when the node's deadlines may be kept in simulated time (streamed: :mod:`.deadline_clock`)."""
+    return not (mon.sim_mode is True or mon.sim.heard) and _judge_chunk(mon, evs)
+
+
+def _judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
+    """:func:`judge_chunk` of a chunk whose deadlines are kept in the run's clock."""
     plan = mon.plan
     n = len(evs)
     got = _columns(evs)

@@ -257,22 +257,28 @@ class DeadlineMonitor(VerdictWords):
             return
         for k, cl, trig, _, d in triggered:
             if refused is None:
-                d_ns = self.bounds_ns[k]
-                p = Pending(k, ev, stamp, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
-                if deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
-                    why = deadline_clock.place(self, p)
-                    if why:
-                        deadline_clock.undecided(self, p, why)
-                        continue
-                if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
-                    deadline_skew.scan_heard(self, p)
-                    self.pending.append(p)
+                self._oblige(k, ev, ns, inputs)
                 continue
             why, reason = refused
             self.result.unaccepted[why] += 1
             if self.result.first_unaccepted is None:
                 self.result.first_unaccepted = {"guarantee": k, "where": ev.where, "stamp": stamp, "why": why,
                                                 "reason": reason}
+
+    def _oblige(self, k: int, ev: Event, ns: int, inputs: dict[str, object]) -> None:
+        """Accepted trigger ``ev`` (stamp ``ns``, integer ns; judged on ``inputs``) opens the obligation of
+        guarantee ``k``: due its bound after the stamp, or placed in the clock its node keeps
+        (:mod:`.deadline_clock`); a trigger heard after outputs stamped after it is answered by them."""
+        d_ns = self.bounds_ns[k]
+        p = Pending(k, ev, ns / 1e9, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
+        if deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
+            why = deadline_clock.place(self, p)
+            if why:
+                deadline_clock.undecided(self, p, why)
+                return
+        if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
+            deadline_skew.scan_heard(self, p)
+            self.pending.append(p)
 
     def _inputs_at(self, stamp: float, ns: int, mine: Mapping[str, object]) -> dict[str, object]:
         """The inputs in force at ``stamp`` (s; ``ns`` the same in integer ns) of an input message heard
