@@ -517,6 +517,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
                 per_run[k] += res["figures"][k]
             if "victim" in res["figures"]:
                 per_run["seeded red"] += bool(res["figures"]["red"])
+                per_run["seeded late unsaid"] += late_unsaid(res)
                 per_run["seeded"] += 1
             victim = _victim(res)
             declarations["bag pending at a server"] += len(res.get("bag_pending_calls", []))
@@ -554,8 +555,9 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           f"{per_run['false_deadlines_correct']}, false declarations {per_run['false_declarations_correct']}; "
           f"deadlines undecided live {per_run['undecided']} of {per_run['deadlines']}"
           + (f" ({100 * per_run['undecided'] / per_run['deadlines']:.0f} %)" if per_run["deadlines"] else "")
-          + (f"; seeded defects red at their node {per_run['seeded red']} of {per_run['seeded']}" if per_run["seeded"]
-             else "") + "; "
+          + (f"; seeded defects red at their node {per_run['seeded red']} of {per_run['seeded']}"
+             + (f" ({per_run['seeded late unsaid']} late, undecided with use_sim_time unsaid)"
+                if per_run["seeded late unsaid"] else "") if per_run["seeded"] else "") + "; "
           f"load average after each run {min(loads, default=0):.1f}-{max(loads, default=0):.1f}; seeds with "
           f"findings: {failing or 'none'}; live = log = bag verdict by verdict on {agree} of {len(seeds)}")
     return 0
