@@ -97,6 +97,24 @@ def _monitors_payload(ws: Any, oid: str) -> MonitorsPayload | None:
     return monitors_payload(ev.backend, ev.details) if ev is not None and not problem else None
 
 
+def _search_inputs(ws: Any, node: str, oid: str) -> dict[str, str] | None:
+    """``{workspace path: sha256 of its current text}`` of the files a property test's code repair search
+    (:func:`~rclverify.diagnosis.code_repair_check.checked_repairs`) reads: the inputs of the evidence record
+    of ``oid`` (the node's snapshot of the contracts and the plan, its implementation's import closure, the
+    mapping and the message files it reads; the backend records a run whose closure imports a file outside
+    them as inconclusive, never failed) and the node's snapshot.  ``None`` when the record is missing,
+    altered or names no input (the repair is then keyed by every contract file and the plan)."""
+    from rclverify.records.records import hash_inputs  # deferred: start-up (only for a failed property test)
+    from rclverify.records.store import EvidenceStore  # deferred: start-up (only for a failed property test)
+    ev, problem = EvidenceStore(ws.root).read(oid)
+    if ev is None or problem or not ev.input_hashes:
+        return None
+    try:
+        return hash_inputs(ws.root, [*ev.input_hashes, ws.snapshot(node)])
+    except OSError:  # an input gone since the run: the report shows the evidence stale
+        return None
+
+
 def _run_repairs(ws: Any, e: EvidenceRow, node: str, cache: RepairCache) -> MonitorRepairs:
     """The checked code repairs of the failed monitored run ``e`` of ``node`` (:func:`report_repairs`, its
     record's payload and its obligation's ``data``); none (nothing asked) for a run that did not fail or
@@ -169,7 +187,7 @@ def evidence_record(ws: Any, report: ReportRows, e: EvidenceRow, o: ObligationRo
             # one key per culprit line: the guarantees of a node failing at one line share their repairs
             repairs = cache.get(["code", e.obligation.rsplit(".", 1)[-1], node, cause, before],
                                 lambda: checked_repairs(ws, node, e.obligation, cause, before),
-                                cause.rpartition(":")[0]) or []
+                                cause.rpartition(":")[0], _search_inputs(ws, node, e.obligation)) or []
         cul_pt: list[Culprit] = [{"what": where, "source": src, "text": text}]
         made = repaired_line(cause, repairs) if isinstance(cause, str) else ""
         if made:  # the checked repair edits another line of the function: the value is made there

@@ -3,16 +3,16 @@ process at a time diagnose a workspace.
 
 Repairs cost Z3 queries (a minute for the case study's Agent), so each
 problem's repairs are kept in :data:`CACHE` (:class:`RepairCache`) keyed by
-everything they are computed from: the problem record, the contract files,
-the plan, the program, and the rclverify and Z3 versions.  Deleting the
-cache is always safe.
+everything they are computed from: the problem record, the contract files
+and the plan (or, for a search that names them, the files it reads), the
+program, and the rclverify and Z3 versions.  Deleting the cache is always safe.
 """
 from __future__ import annotations
 
 import json
 import os
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterator, Mapping
 
 import z3
 
@@ -39,12 +39,21 @@ class RepairCache:
         files = sorted({*ws.plan.contracts, ws.plan.file})
         self.base = [f"{rel}\0{file_digest(ws.path(rel))}" for rel in files]
 
-    def get(self, key: Any, make: Callable[[], Any], extra_file: str | None = None) -> Any:
+    def get(self, key: Any, make: Callable[[], Any], extra_file: str | None = None,
+            inputs: Mapping[str, str] | None = None) -> Any:
         """The kept value of ``key`` (any JSON-able value; ``extra_file``, a
         workspace path whose digest joins the key), else ``make()``'s, kept
         as JSON gives it back; ``None`` when ``make`` raises a Z3, RCL, OS,
-        value or key error (then nothing is kept)."""
-        k = self.shelf.key("repairs", *self.base, json.dumps(key, sort_keys=True, default=str),
+        value or key error (then nothing is kept).
+
+        ``inputs`` (workspace path -> sha256 of its current text): every file
+        the search reads, when the caller knows them (a property test's code
+        repair: its evidence's inputs, the node's snapshot among them); they
+        take the place of the contract and plan files in the key, so an edit
+        of another node's contract keeps the entry.  ``None``: keyed by every
+        contract file and the plan."""
+        base = [f"{rel}\0{digest}" for rel, digest in sorted(inputs.items())] if inputs is not None else self.base
+        k = self.shelf.key("repairs", *base, json.dumps(key, sort_keys=True, default=str),
                            file_digest(self.ws.path(extra_file)) if extra_file else "")
         got = self.shelf.get(k)
         if got is None:
