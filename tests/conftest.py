@@ -61,7 +61,7 @@ LIVE = frozenset({
     "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair", "test_fleet_example_live",
     "test_run_repair_rclpy", "test_ros2_run_end", "test_ros2_thresholds_clocks_stamps",
     "test_ros2_rclpy_discovers_nobody", "test_ros2_robots_other_clocks", "test_ros2_dds_server_restart",
-    "test_live_exit", "test_ros2_clock_heard",
+    "test_live_exit", "test_ros2_clock_heard", "test_ros2_sim_time_deadlines",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -166,6 +166,7 @@ WALL: dict[str, float] = {
     "test_ros2_rclpy_discovers_nobody": 40.0, "test_ros2_dds_server_restart": 36.0,
     "test_live_exit": 20.0,  # a ROS 1 master and two stopped runs beside a CPU burner, two held controls
     "test_ros2_clock_heard": 55.0,  # six live runs (two sources and ROS 1, each with /clock and without), -n 2
+    "test_ros2_sim_time_deadlines": 55.0,  # four live runs (two sources, factors 0.5 and 2), each log read 4 times
 }
 
 #: Modules weighed by their wall-clock time (in :data:`WALL`) whose live tests are marked in the module

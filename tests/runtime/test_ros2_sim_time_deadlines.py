@@ -1,0 +1,185 @@
+"""Deadlines kept in simulated time, live (docs/semantics.md, "Deadlines in simulated time"): a Gazebo
+user's relay under ``use_sim_time`` beside a ``/clock`` at a real-time factor of 0.5 or 2, heard through
+both ROS 2 sources, its log and its bag judged offline.
+
+Real rclpy nodes on Fast DDS: ``sim`` publishes ``/clock`` every 10 ms of the wall clock, ``10 * FACTOR``
+ms further each time; ``robot`` (``use_sim_time: true``) asks ``/x`` every 400 ms of the wall clock and
+answers each question on ``/y`` after a one-shot timer on its own clock, so ``DELAY`` of simulated time
+later.  The contract: ``out.y == in.x`` within 200 ms.
+
+* At 0.5 the relay waits 150 ms of simulated time, 300 ms of the wall clock: with the mapping's
+  ``use_sim_time: true`` every deadline is met, live, on the log and on the bag; the control, the same log
+  judged with the node said to keep the wall clock, misses every one.
+* At 2 the relay waits 300 ms of simulated time (a seeded defect), 150 ms of the wall clock: every deadline
+  missed, live, on the log and on the bag; the control with the wall clock meets every one.
+* The mapping saying nothing: every deadline ``undecided`` (the two clocks disagree), never ``false``.
+"""
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from collections import Counter
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+from _procs import stop, wait_for, wait_logged
+from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))  # _robot_verdicts: final verdicts
+
+RCL = """\
+node Relay {
+  inputs( x : INTEGER )
+  outputs( y : INTEGER )
+  topics( std_msgs/Int64 x matches(in.x), std_msgs/Int64 y matches(out.y) )
+  assume( TRUE )
+  guarantee( out.y == in.x ) triggered by in.x within 200 ms
+}
+"""
+TOPICS = "topics:\n  x: {fields: [data]}\n  y: {fields: [data]}\n"
+ROUNDS = 10
+#: real-time factor -> the relay's delay in simulated time (s)
+DELAY = {0.5: 0.15, 2.0: 0.3}
+
+SIM = """\
+import time
+import rclpy
+from rclpy.node import Node
+from builtin_interfaces.msg import Time
+from rosgraph_msgs.msg import Clock
+
+rclpy.init()
+n = Node("sim")
+pub = n.create_publisher(Clock, "/clock", 10)
+print("ready", flush=True)
+sim_ns, step = 100 * 10**9, round(10 * 10**6 * FACTOR)
+next_t = time.monotonic()
+while True:
+    pub.publish(Clock(clock=Time(sec=sim_ns // 10**9, nanosec=sim_ns % 10**9)))
+    sim_ns += step
+    next_t += 0.01
+    time.sleep(max(0.0, next_t - time.monotonic()))
+"""
+
+ROBOT = """\
+import time
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from std_msgs.msg import Int64
+
+rclpy.init()
+n = Node("robot", parameter_overrides=[Parameter("use_sim_time", Parameter.Type.BOOL, True)])
+pubs = {k: n.create_publisher(Int64, k, 100) for k in ("x", "y")}
+
+def answer(m):
+    def fire():
+        timer.cancel()
+        n.destroy_timer(timer)
+        pubs["y"].publish(Int64(data=m.data))
+    timer = n.create_timer(DELAY, fire)  # the node's clock: /clock under use_sim_time
+
+n.create_subscription(Int64, "x", answer, 100)
+ex = SingleThreadedExecutor()
+ex.add_node(n)
+
+def spin(seconds):
+    until = time.monotonic() + seconds
+    while time.monotonic() < until:
+        ex.spin_once(timeout_sec=0.002)
+
+spin(0.5)
+print("ready", flush=True)
+until = time.monotonic() + 30
+while time.monotonic() < until and n.count_publishers("/rclverify/verdict") < 1:
+    spin(0.05)
+spin(1.5)  # the monitor's readers match the publishers
+for k in range(1, ROUNDS + 1):
+    pubs["x"].publish(Int64(data=k))
+    spin(0.4)
+print("done", flush=True)
+while True:
+    ex.spin_once(timeout_sec=0.1)
+""".replace("ROUNDS", str(ROUNDS))
+
+
+def _answered_last(lines: list[dict[str, Any]]) -> bool:
+    return any(x.get("topic") == "y" and x.get("data") == ROUNDS for x in lines)
+
+
+def _offline(ws: Path, mapping: str, trace: Path, out: Path, tmp: Path) -> None:
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(ws), "--mapping",
+                        mapping, "--horizon", "1", "--verdicts", str(out), str(trace)],
+                       capture_output=True, text=True, timeout=120, cwd=tmp)
+    assert out.exists(), r.stdout + r.stderr
+
+
+@pytest.fixture(scope="module", params=[("rclpy", 0.5), ("dds", 0.5), ("rclpy", 2.0), ("dds", 2.0)],
+                ids=["rclpy-half", "dds-half", "rclpy-double", "dds-double"])
+def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
+    """One live run through a source at a factor; its log and bag judged offline under three mappings."""
+    py = ros2_python()  # skips, with the reason, without a ROS 2 Python
+    source, factor = request.param
+    tmp = tmp_path_factory.mktemp(f"simtime-{source}-{factor}")
+    ws = live_workspace(tmp, RCL, TOPICS + "use_sim_time: true\n")
+    (ws / "wall.yaml").write_text(TOPICS + "use_sim_time: false\n")
+    (ws / "unsaid.yaml").write_text(TOPICS)
+    env = ros2_env(tmp)
+    procs: list[subprocess.Popen[bytes]] = []
+    try:
+        procs.append(start_node(tmp, "sim", SIM.replace("FACTOR", repr(factor)), env))
+        procs.append(start_node(tmp, "robot", ROBOT.replace("DELAY", repr(DELAY[factor])), env))
+        monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml",
+                             "--horizon", "1", "--status", "0", "--duration", "90", "--source", source,
+                             "--ros2-python", str(py), "--log", str(tmp / "live.jsonl"), "--record",
+                             str(tmp / "bag"), "--evidence", str(tmp / "live.json"),
+                             "--verdicts", str(tmp / "live.verdicts.jsonl")], env, tmp, tmp / "monitor.out")
+        procs.append(monitor)
+        wait_for(tmp / "robot.log", "done", 90)
+        wait_logged(tmp / "live.jsonl", _answered_last, 30)
+        wait_logged(tmp / "live.jsonl", lambda lines: len(lines) > 0 and any(
+            x.get("topic") == "clock" for x in lines[-20:]), 10)
+        import time
+        time.sleep(1.0)  # /clock passes the last deadline
+        stop(monitor, signal.SIGINT)
+        for name, mapping, trace in (("log", "mapping.yaml", tmp / "live.jsonl"), ("bag", "mapping.yaml", tmp / "bag"),
+                                     ("wall", "wall.yaml", tmp / "live.jsonl"),
+                                     ("unsaid", "unsaid.yaml", tmp / "live.jsonl")):
+            _offline(ws, mapping, trace, tmp / f"{name}.verdicts.jsonl", tmp)
+        yield {"factor": factor, "tmp": tmp, "out": (tmp / "monitor.out").read_text(errors="replace")}
+    finally:
+        for p in procs:
+            stop(p)
+
+
+def _tally(run: dict[str, Any], path: str) -> Counter[str]:
+    import _robot_verdicts
+    out: Counter[str] = _robot_verdicts.tally(_robot_verdicts.finals(
+        _robot_verdicts.read_records(run["tmp"] / f"{path}.verdicts.jsonl"))).get("Relay", Counter())
+    return out
+
+
+def test_deadlines_are_judged_in_simulated_time_live_on_the_log_and_on_the_bag(run: dict[str, Any]) -> None:
+    """Met at 0.5 (300 ms of the wall clock, 150 ms simulated), missed at 2 (150 ms of the wall clock, 300 ms
+    simulated), on every path; every answer right."""
+    met = run["factor"] == 0.5
+    for path in ("live", "log", "bag"):
+        t = _tally(run, path)
+        assert (t["deadline true"], t["deadline false"]) == ((ROUNDS, 0) if met else (0, ROUNDS)), (path, t, run["out"])
+        assert t["violated"] == 0, (path, t)
+
+
+def test_the_control_judges_the_same_log_on_the_wall_clock(run: dict[str, Any]) -> None:
+    """The node said to keep the wall clock: the opposite verdicts on the same log."""
+    t = _tally(run, "wall")
+    met = run["factor"] == 0.5
+    assert (t["deadline true"], t["deadline false"]) == ((0, ROUNDS) if met else (ROUNDS, 0)), t
+
+
+def test_a_node_whose_clock_is_not_said_is_undecided_never_false(run: dict[str, Any]) -> None:
+    """The mapping says nothing: the two clocks disagree on every deadline, so each is undecided."""
+    t = _tally(run, "unsaid")
+    assert (t["deadline true"], t["deadline false"], t["deadline undecided"]) == (0, 0, ROUNDS), t
