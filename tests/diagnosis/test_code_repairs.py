@@ -201,3 +201,28 @@ def test_two_slips_on_one_line_get_a_two_token_repair_when_no_one_token_one_pass
     assert pairs and pairs[0].apply(source).endswith('return {"ok": 2 <= x and x <= 8}\n')
     a, b = sorted(singles[:2], key=lambda e: e.col)
     assert joined(source, b, a) is None  # out of order (or overlapping): no one edit
+
+
+def test_a_verdict_only_run_is_discharged_exactly_where_the_full_run_is(verified: dict[str, Any]) -> None:
+    """The repair check asks the harness for the verdict only (``verdict_only``): each guarantee of the four
+    nodes is discharged by it exactly where the full run discharges it; a violation is ``failed`` unshrunk,
+    found among the same examples, with no more bodies run than the full run's (which shrinks it and moves
+    it to the boundary).  Controls: Gate's, Clamp's and Band's slips fail both ways, Fine passes both ways."""
+    ws = Workspace(verified["ws"])
+    seen: dict[str, list[str]] = {}
+    for node in ("Gate", "Clamp", "Band", "Fine"):
+        target = ws.target(node, 0)
+        cfg = read_config(target.config, target.node, target.root)
+        for k in (1, 2):
+            full = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts)
+            quick = run_guarantee(target.checked, target.node, k, cfg, target.root, target.facts, verdict_only=True)
+            assert (quick.status == "discharged") == (full.status == "discharged"), (node, k, full.message)
+            seen.setdefault(node, []).append(quick.status)
+            if full.status == "failed":
+                assert quick.status == "failed" and "(not shrunk)" in quick.message
+                assert "(not shrunk)" not in full.message
+                assert quick.counts.valid <= full.counts.valid
+            else:
+                assert quick.message == full.message
+    assert seen["Fine"] == ["discharged", "discharged"]
+    assert all("failed" in seen[n] for n in ("Gate", "Clamp", "Band"))

@@ -53,7 +53,8 @@ def _scratch(root: Path, files: Iterable[str], edited: str, text: str) -> Path:
 def _statuses(target: Any, cfg: Any, text: str, first: int) -> dict[int, str]:
     """Each guarantee's status (``discharged``, ``failed``, ...) of the node of ``target`` run by the
     harness on a scratch copy whose implementation file holds ``text``, guarantee ``first`` first; it
-    stops at the first run that is not ``discharged``."""
+    stops at the first run that is not ``discharged``.  Only ``discharged`` is told apart: each run asks for
+    the verdict only (a violation is ``failed``, unshrunk: :attr:`~rclverify.backends.property_tests.harness.GuaranteeRun.verdict_only`)."""
     from rclverify.backends.property_tests.at_width import mapping_inputs  # deferred: start-up (the backend)
     from rclverify.backends.property_tests.closure import resolve_closure  # deferred: start-up (the backend)
     from rclverify.backends.property_tests.harness import run_guarantee  # deferred: start-up (hypothesis)
@@ -70,7 +71,7 @@ def _statuses(target: Any, cfg: Any, text: str, first: int) -> dict[int, str]:
             try:
                 with wall_clock_limit(cfg.timeout_s):
                     out[k] = run_guarantee(target.checked, target.node, k, cfg, tmp, target.facts, None,
-                                           target.mapping).status
+                                           target.mapping, verdict_only=True).status
             except TimeLimitExceeded:
                 out[k] = "inconclusive"
             except Exception:  # noqa: BLE001 - the edited code does not load or run: no repair

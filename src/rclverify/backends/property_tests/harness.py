@@ -103,6 +103,12 @@ class GuaranteeRun:
     #: what each input and output's field carries ("in.x" -> uint8, float32[<=4], ...): inputs drawn within
     #: it, an output it cannot carry a counterexample (backends/property_tests/at_width.py)
     carried: Mapping[str, Carried] = field(default_factory=dict)
+    #: Only whether the guarantee is discharged counts (a candidate repair's check, diagnosis/code_repair_check.py):
+    #: a violation ends the run unshrunk, its example neither moved to the boundary nor re-checked by Z3, and the
+    #: outcome is ``failed`` (the full run's ``failed``, or ``error`` for a counterexample Z3 does not confirm);
+    #: every other outcome, ``discharged`` among them, is the full run's (the same examples are drawn up to the
+    #: first violation)
+    verdict_only: bool = False
 
     @property
     def stateful(self) -> bool:
@@ -249,12 +255,13 @@ class GuaranteeRun:
             self.check_step(self.impl, example, None)
 
     def settings(self, verbosity: Verbosity = Verbosity.quiet) -> settings:
+        # no "explain" phase: it re-runs the shrunk example many times and adds nothing the counterexample does
+        # not already say; no "shrink" phase for a verdict only (:attr:`verdict_only`)
+        phases = [Phase.explicit, Phase.reuse, Phase.generate, Phase.target, *(() if self.verdict_only else (Phase.shrink,))]
         return settings(max_examples=self.cfg.max_examples, database=None, derandomize=False,
                         deadline=self.cfg.deadline_ms, report_multiple_bugs=False, print_blob=False,
                         verbosity=verbosity, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
-                        # no "explain" phase: it re-runs the shrunk example many times and adds nothing
-                        # the counterexample does not already say
-                        phases=[Phase.explicit, Phase.reuse, Phase.generate, Phase.target, Phase.shrink])
+                        phases=phases)
 
     def confirm_with_z3(self) -> str:
         """Re-check the reported counterexample with Z3 alone: every used fact
@@ -304,6 +311,9 @@ class GuaranteeRun:
                 test()
         except _Violation:
             assert self.last_failure is not None
+            if self.verdict_only:
+                return Outcome("failed", f"{self.last_failure['reason']} on the example (not shrunk) "
+                               f"{_example_text(self.last_failure)}", self.counts, self.last_failure, sorted(self.unknown))
             from rclverify.backends.property_tests.readable import readable_failure  # the boundary value first, the implementation's line; deferred: optional or conditional (inside a block)
             with no_local_constants():  # it draws neighbour examples as the run drew its own
                 moved = readable_failure(self, _Violation)
@@ -349,7 +359,8 @@ def _example_text(cex: Mapping[str, str]) -> str:
 
 
 def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Config, root: Path,
-                  facts: tuple[ast.Expr, ...] = (), impl: Any = None, mapping: str | None = None) -> Outcome:
+                  facts: tuple[ast.Expr, ...] = (), impl: Any = None, mapping: str | None = None, *,
+                  verdict_only: bool = False) -> Outcome:
     """Run guarantee ``guarantee`` (1-based) of ``node`` on the implementation
     ``impl`` (loaded afresh here when ``None``: :func:`load_implementation`),
     inputs drawn under the assumption and the environment ``facts`` (parsed plan facts)
@@ -357,6 +368,7 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
     plan's: :attr:`~rclverify.backends.base.NodeTarget.mapping`; ``None``: the default path;
     :func:`.at_width.carried_in`),
     with the harness's folders first on ``sys.path`` (:func:`.importpath.on_harness_path`).
+    ``verdict_only``: only whether it is discharged is asked (:attr:`GuaranteeRun.verdict_only`).
 
     An import closure (:func:`.closure.resolve_closure`) with an import that
     cannot be followed gives an ``inconclusive`` outcome naming each, with no
@@ -374,7 +386,7 @@ def run_guarantee(checked: Checked, node: CheckedNode, guarantee: int, cfg: Conf
     widths, carried = carried_in(root, node, mapping)
     with on_harness_path(root, cfg.file):
         return GuaranteeRun(checked, at_carried_widths(node, widths, checked.env.constants), guarantee, cfg, impl,
-                            facts, widths=widths, carried=carried).run()
+                            facts, widths=widths, carried=carried, verdict_only=verdict_only).run()
 
 
 def versions() -> str:

@@ -39,7 +39,8 @@ class Outcome:
     """Result of :func:`run_guarantee`.
 
     ``status``: ``discharged`` (every valid example passed, none
-    inconclusive), ``failed`` (a counterexample, shrunk), ``inconclusive``
+    inconclusive), ``failed`` (a counterexample, shrunk unless the run asked for the verdict only:
+    :attr:`.harness.GuaranteeRun.verdict_only`), ``inconclusive``
     (no failure, but Z3 answered unknown on some example), ``error``
     (health check or configuration).  ``counterexample`` maps ``in.x`` /
     ``out.y`` / ``guarantee`` / ``source`` / ``reason`` to RCL text.
