@@ -52,15 +52,16 @@ class SimClock:
     """The ``/clock`` samples heard in a run, in the run's order: ``(t, value)``, both integer ns, ``t`` on
     the run's clock.  Values never go back while :attr:`broken` is empty."""
 
-    __slots__ = ("times", "values", "broken", "kept_s")
+    __slots__ = ("times", "values", "broken", "kept_ns")
 
     def __init__(self, kept_s: float = 600.0) -> None:
         self.times: list[int] = []
         self.values: list[int] = []
         #: why the two clocks cannot be related from the last sample on (``""``: they can)
         self.broken = ""
-        #: how far back (s of the run's clock) samples are kept (:meth:`forget_before` drops older ones)
-        self.kept_s = kept_s
+        #: how far back (ns of the run's clock) samples are kept at least: once the samples span twice
+        #: that, the older half is forgotten (:meth:`forget_before`), so memory is bounded by the window
+        self.kept_ns = round(kept_s * 1e9)
 
     @property
     def heard(self) -> bool:
@@ -85,8 +86,8 @@ class SimClock:
             return  # the clock stands still: the first sample of the value says when it got there
         times.append(t_ns)
         values.append(value_ns)
-        if len(times) > 4096 and times[-1] - times[0] > self.kept_s * 1e9:
-            self.forget_before(times[-1] - round(self.kept_s * 1e9))
+        if t_ns - times[0] > 2 * self.kept_ns:
+            self.forget_before(t_ns - self.kept_ns)
 
     def forget_before(self, t_ns: int) -> None:
         """Drop the samples before ``t_ns`` but the last of them (it gives the value at ``t_ns``)."""
@@ -96,7 +97,8 @@ class SimClock:
 
     def at(self, t_ns: int) -> int | None:
         """The simulated time (ns) at ``t_ns`` of the run's clock: the value of the last sample placed at or
-        before it; ``None`` before the first sample, or once :attr:`broken`."""
+        before it; ``None`` before the first sample kept (older ones are forgotten: :attr:`kept_ns`), or once
+        :attr:`broken`."""
         if self.broken:
             return None
         i = bisect_right(self.times, t_ns) - 1

@@ -110,6 +110,8 @@ class DeadlineMonitor(VerdictWords):
             self.bounds_ns[k] = round(bound * 1_000_000_000)  # exact: `within 200 ms` is 200_000_000 ns
         #: guarantee -> its entry of ``timed``: what an obligation reads of its guarantee, found by its number
         self.timed_k = {t[0]: t for t in self.timed}
+        # /clock kept back to a trigger that may still be placed: the longest bound, and a minute of lateness
+        self.sim.kept_ns = max(self.bounds_ns.values(), default=0) + 60 * 1_000_000_000
         # an output whose every topic the mapping declares a state may stand in
         # with its current value; any other answers only triggers before it
         event_outs = {key for topic, keys in self.bindings.items() for key, part in keys

@@ -23,21 +23,20 @@ from rclverify.traces.sim_clock import SimClock
 LATE, IN_TIME, UNDECIDED = "late", "in time", "undecided"
 
 
-def sim_gap(sim: SimClock, t1_ns: int | None, t2_ns: int, skew_ns: int, s1_ns: int | None = None) -> \
+def read_at(sim: SimClock, t_ns: int, skew_ns: int) -> tuple[int | None, int | None]:
+    """``(most, least)``: ``/clock`` at ``t_ns`` (the run's clock) as a node reads it with a delivery delay in
+    ``[0, skew_ns]`` (``None``: not known)."""
+    return sim.at(t_ns), sim.at(t_ns - skew_ns)
+
+
+def sim_gap(first: tuple[int | None, int | None], sim: SimClock, t2_ns: int, skew_ns: int) -> \
         tuple[int, int] | None:
-    """``(least, most)`` simulated ns between a publication at ``t1_ns`` and one at ``t2_ns`` (integer ns,
-    the run's clock), each read from ``/clock`` with a delivery delay in ``[0, skew_ns]``; ``s1_ns``: the
-    first's simulated time known exactly instead (its own stamp in that clock; ``t1_ns`` then unused).
-    ``None`` when ``/clock`` does not say (no sample before one of them, or broken)."""
-    hi2, lo2 = sim.at(t2_ns), sim.at(t2_ns - skew_ns)
-    hi1: int | None
-    lo1: int | None
-    if s1_ns is not None:
-        hi1 = lo1 = s1_ns
-    elif t1_ns is not None:
-        hi1, lo1 = sim.at(t1_ns), sim.at(t1_ns - skew_ns)
-    else:
-        return None
+    """``(least, most)`` simulated ns from a publication read ``first`` (:func:`read_at`, or its own stamp in
+    that clock twice) to one at ``t2_ns`` (integer ns, the run's clock) read from ``/clock`` with a delivery
+    delay in ``[0, skew_ns]``; ``None`` when ``/clock`` does not say (no sample before one of them, or
+    broken)."""
+    hi1, lo1 = first
+    hi2, lo2 = read_at(sim, t2_ns, skew_ns)
     if hi2 is None or lo2 is None or hi1 is None or lo1 is None:
         return None
     return lo2 - hi1, hi2 - lo1
@@ -57,4 +56,4 @@ def judge_gap(gap: tuple[int, int] | None, wall_ns: int | None, period_ns: int, 
     return sim if sim == wall else UNDECIDED
 
 
-__all__ = ["IN_TIME", "LATE", "UNDECIDED", "judge_gap", "sim_gap"]
+__all__ = ["IN_TIME", "LATE", "UNDECIDED", "judge_gap", "read_at", "sim_gap"]

@@ -70,7 +70,7 @@ from rclverify.traces.event_time import aside_stamp
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.mapping import TopicRule, sim_time_of
 from rclverify.traces.sim_clock import CLOCK_TOPIC, SimClock, clock_value_ns
-from rclverify.backends.monitors.period_clock import LATE, UNDECIDED, judge_gap, sim_gap
+from rclverify.backends.monitors.period_clock import LATE, UNDECIDED, judge_gap, read_at, sim_gap
 from rclverify.backends.monitors.skew import DEFAULT_SKEW_S
 from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
@@ -141,12 +141,15 @@ class PeriodMonitor:
         self.sim = SimClock()
         skew = getattr(rules, "skew", DEFAULT_SKEW_S) if rules is not None else DEFAULT_SKEW_S
         self.skew_ns = round(skew * 1e9) if isinstance(skew, (int, float)) and skew > 0 else 0
-        #: per output judged in simulated time: its last message's time (integer ns, the run's clock), where
-        self.last_sim: dict[str, tuple[int, str]] = {}
+        #: per output judged in simulated time: its last message's time (integer ns, the run's clock), where,
+        #: and ``/clock`` as the node read it then (:func:`.period_clock.read_at`)
+        self.last_sim: dict[str, tuple[int, str, tuple[int | None, int | None]]] = {}
         for p in node.node.periodic:
             s = period_seconds(p)
             if s is not None:
                 res.periods[f"out.{p.output.name}"] = float(s)
+        # /clock kept back over an output's period, and a minute of lateness
+        self.sim.kept_ns = round((max(res.periods.values(), default=0.0) + 60.0) * 1e9)
         self.topics: dict[str, list[str]] = {}
         for topic, keys in topic_bindings(node).items():
             outs = [k for k, _ in keys if k in res.periods]
@@ -202,23 +205,25 @@ class PeriodMonitor:
         before = self.last_sim.get(key)
         if before is None and key in self.last:  # judged on the run's clock until /clock was heard
             _, where, t = self.last.pop(key)
-            before = (to_ns(t), where)
+            before = (to_ns(t), where, read_at(self.sim, to_ns(t), self.skew_ns))
         if before is not None and key not in res.late:
-            self._gap(key, before[0], t2, ev.where)
-        self.last_sim[key] = (t2, ev.where)
+            self._gap(key, before[0], before[2], t2, ev.where)
+        self.last_sim[key] = (t2, ev.where, read_at(self.sim, t2, self.skew_ns))
 
-    def _gap(self, key: str, t1: int, t2: int, where: str, s1: int | None = None, sim_mode: bool | None = None,
-             tail: bool = False) -> None:
-        """The gap of output ``key`` from ``t1`` (``s1``: its simulated time known) to ``t2`` (ns, the run's
-        clock) judged in simulated time (:func:`.period_clock.judge_gap`): late in :attr:`PeriodResult.late`,
-        undecided in :attr:`PeriodResult.undecided`; ``tail``: ``t2`` is the run's end."""
+    def _gap(self, key: str, t1: int, first: tuple[int | None, int | None], t2: int, where: str,
+             stamped: bool = False, tail: bool = False) -> None:
+        """The gap of output ``key`` from ``t1`` (ns, the run's clock; ``first``: ``/clock`` as the node read it
+        then, :func:`.period_clock.read_at`, or twice its own stamp in that clock when ``stamped``) to ``t2``
+        judged in simulated time (:func:`.period_clock.judge_gap`; a ``stamped`` output in it alone): late in
+        :attr:`PeriodResult.late`, undecided in :attr:`PeriodResult.undecided`; ``tail``: ``t2`` is the
+        run's end."""
         res = self.result
         period = res.periods[key]
-        gap = sim_gap(self.sim, t1, t2, self.skew_ns, s1)
-        mode = self.sim_mode if sim_mode is None else sim_mode
-        verdict = judge_gap(gap, None if s1 is not None else t2 - t1, round(period * 1e9), mode)
+        gap = sim_gap(first, self.sim, t2, self.skew_ns)
+        mode = True if stamped else self.sim_mode
+        verdict = judge_gap(gap, None if stamped else t2 - t1, round(period * 1e9), mode)
         if verdict == LATE and gap is not None:
-            start = s1 if s1 is not None else self.sim.at(t1)
+            start = first[0]
             res.late[key] = {"from": (start or 0) / 1e9, "to": None if tail else (self.sim.at(t2) or 0) / 1e9,
                              "gap": gap[0] / 1e9, "period": period, "where": where}
         elif verdict == UNDECIDED and key not in res.undecided:
@@ -253,9 +258,9 @@ class PeriodMonitor:
     def finish(self) -> PeriodResult:
         res = self.result
         if res.end is not None:
-            for key, (t, where) in self.last_sim.items():  # the tail in simulated time (period_clock.py)
+            for key, (t, where, first) in self.last_sim.items():  # the tail in simulated time (period_clock.py)
                 if key not in res.late:
-                    self._gap(key, t, to_ns(res.end), where, tail=True)
+                    self._gap(key, t, first, to_ns(res.end), where, tail=True)
         for key, (stamp, where, at) in self.last.items():
             if key in res.late or res.end is None:
                 continue
@@ -265,7 +270,8 @@ class PeriodMonitor:
                 s0, t0 = self.first_aside[key]
                 if at > t0 and stamp > s0:
                     res.clocks[key] = (stamp - s0) / (at - t0)
-                self._gap(key, to_ns(at), to_ns(res.end), where, s1=to_ns(stamp), sim_mode=True, tail=True)
+                self._gap(key, to_ns(at), (to_ns(stamp), to_ns(stamp)), to_ns(res.end), where, stamped=True,
+                          tail=True)
                 continue
             if key in self.first_aside:  # the run's end carried into the node's clock at the output's rate
                 s0, t0 = self.first_aside[key]
