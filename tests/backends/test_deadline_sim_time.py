@@ -239,3 +239,17 @@ def test_a_use_sim_time_name_that_is_no_contract_node_is_refused_where_it_is_wri
     assert [(d.loc.line, d.loc.col) for d in diags] == [(4, 5)] and "'Realy' is no contract node" in diags[0].message
     (tmp_path / "m.yaml").write_text("topics: {}\nuse_sim_time: [Relay]\n")  # control
     assert check_field_paths(tmp_path, "m.yaml", [], CHECKED) == []
+
+
+def test_a_clock_message_heard_late_expires_what_it_shows_passed_at_the_clock() -> None:
+    """Live, a ``/clock`` message heard after later messages were released comes at the engine's clock with
+    its publication as its stamp (``Event.stamped``); the deadline it shows passed is ``false`` then, as
+    the run read in stamp order gives it, not left ``currently_false``."""
+    run = [e for e in _run(1.0, None, end_ms=190) if e.topic == "s" or e.time <= 0.15]
+    late = _clock(0, 215, 215)
+    run += [_msg(0, 240, "other", 0.0),
+            Event(0, 0.240, late.topic, late.fields, "late clock", stamp=0.215, source=0.215, late=0.025)]
+    counts, _, _ = _judge(run, True)
+    assert (counts["false"], counts["currently_false"]) == (1, 0)
+    in_order = sorted(run[:-1] + [late], key=lambda e: e.time)  # the control: the same run in stamp order
+    assert _judge(in_order, True)[0]["false"] == 1

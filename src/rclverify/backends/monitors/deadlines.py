@@ -198,6 +198,8 @@ class DeadlineMonitor(VerdictWords):
         topic = ev.topic.lstrip("/")
         if topic == CLOCK_TOPIC:  # the run's simulated clock (deadline_clock.py)
             deadline_clock.tick(self, ev, ns)
+            if self.now_ns is not None and ns < self.now_ns:  # heard late: what it shows passed expires now
+                self._expire(self.now_ns)
             self._advance_ns(ns)
             return
         stamp = ns / 1e9
@@ -417,6 +419,10 @@ class DeadlineMonitor(VerdictWords):
             return
         self.now_ns = now_ns
         self.now = now_ns / 1e9
+        self._expire(now_ns)
+
+    def _expire(self, now_ns: int) -> None:
+        """Obligations due strictly before ``now_ns`` (integer ns, the monitor's clock) are ``false``."""
         keep = []
         for p in self.pending:
             if p.due_ns < now_ns and p.maybe:  # its answer may be the output within the skew before it

@@ -171,8 +171,8 @@ class PeriodMonitor:
         topic = ev.topic.lstrip("/")
         if topic == CLOCK_TOPIC:  # the run's simulated clock (period_clock.py)
             value = clock_value_ns(ev.fields) if self.sim_mode is not False else None
-            if value is not None:
-                self.sim.see(to_ns(at), value, ev.where)
+            if value is not None:  # at its publication, also when the live engine heard it late (Event.stamped)
+                self.sim.see(to_ns(ev.stamped), value, ev.where)
             return
         outs = self.topics.get(topic)
         if not outs:
