@@ -168,8 +168,8 @@ WALL: dict[str, float] = {
     "test_ros2_robots_other_clocks": 120.0, "test_ros2_thresholds_clocks_stamps": 60.0,
     "test_ros2_rclpy_discovers_nobody": 40.0, "test_ros2_dds_server_restart": 36.0,
     "test_live_exit": 20.0,  # a ROS 1 master and two stopped runs beside a CPU burner, two held controls
-    "test_ros2_clock_heard": 55.0,  # six live runs (two sources and ROS 1, each with /clock and without), -n 2
-    "test_ros2_sim_time_deadlines": 55.0,  # four live runs (two sources, factors 0.5 and 2), each log read 4 times
+    "test_ros2_clock_heard": 45.0,  # five live runs (both sources with /clock, one without; ROS 1 with and without)
+    "test_ros2_sim_time_deadlines": 30.0,  # two live runs (a source each, factors 0.5 and 2), each log read 4 times
 }
 
 #: Modules weighed by their wall-clock time (in :data:`WALL`) whose live tests are marked in the module

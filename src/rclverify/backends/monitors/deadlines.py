@@ -448,6 +448,8 @@ class DeadlineMonitor(VerdictWords):
     def finish(self) -> DeadlineResult:
         """End of the run: obligations still within their deadline are ``currently_false``;
         those and the expired ones never answered are counted unanswered in the time margins."""
+        if self.now_ns is not None:  # a due time set behind the clock (deadline_clock.py) expires before the end
+            self._expire(self.now_ns)
         for v in self.pending_verdicts():
             self._emit(v)
         for p in self.pending:
