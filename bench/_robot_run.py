@@ -314,12 +314,36 @@ def figures(res: dict[str, Any]) -> dict[str, Any]:
     out["deadlines"] = sum(v for k, v in tot.items() if k.startswith("deadline "))
     out["undecided"] = sum(tot[f"deadline {v}"] for v in ("undecided",) + UNDECIDED)
     out["agree"] = not res["disagreements"] and not res["errors"]
+    out["subset_answers"], out["subset_undecided"] = _subset(res, correct)
     if victim is not None:
         live = res["live"].get(victim, Counter())
         kind = next(n.get("defect_kind") for n in res["spec"]["nodes"] if n["name"] == victim)
         out.update(victim=victim, kind=kind, red=live.get("violated", 0) + live.get("deadline false", 0)
                    + live.get("declaration false", 0), red_deadlines=live.get("deadline false", 0))
     return out
+
+
+def in_subset(node: dict[str, Any], nodes: dict[str, dict[str, Any]]) -> bool:
+    """Whether generated node ``node`` (its spec; ``nodes`` every node's by name) answers within its input's
+    period and copies its stamp or answers one input: an alarm, a relay (a copying one whose delay is at
+    most its reading's period) or a server; a fuse reads two inputs."""
+    if node.get("kind") == "relay" and node.get("copy"):
+        return int(node["delay_ms"]) <= int(nodes[node["source"]]["period_ms"])
+    return node.get("kind") in ("alarm", "relay", "service")
+
+
+def _subset(res: dict[str, Any], correct: set[str]) -> tuple[int, int]:
+    """``(answers, undecided)`` of the run's correct nodes :func:`in_subset`: their live final verdicts on
+    answers and deadlines, and those undecided."""
+    nodes = {n["name"]: n for n in res["spec"]["nodes"]}
+    answers = undecided = 0
+    for name, c in res["live"].items():
+        if name not in correct or name not in nodes or not in_subset(nodes[name], nodes):
+            continue
+        u = c["undecided"] + sum(c[f"deadline {v}"] for v in ("undecided",) + UNDECIDED)
+        answers += c["satisfied"] + c["violated"] + c["deadline true"] + c["deadline false"] + u
+        undecided += u
+    return answers, undecided
 
 
 def late_unsaid(res: dict[str, Any]) -> bool:
@@ -513,7 +537,7 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
                 total.update(c)
             undecided += sum(c["deadline undecided"] for c in res["log"].values())
             for k in ("violated_correct", "false_deadlines_correct", "false_declarations_correct", "deadlines",
-                      "undecided"):
+                      "undecided", "subset_answers", "subset_undecided"):
                 per_run[k] += res["figures"][k]
             if "victim" in res["figures"]:
                 per_run["seeded red"] += bool(res["figures"]["red"])
@@ -555,6 +579,10 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           f"{per_run['false_deadlines_correct']}, false declarations {per_run['false_declarations_correct']}; "
           f"deadlines undecided live {per_run['undecided']} of {per_run['deadlines']}"
           + (f" ({100 * per_run['undecided'] / per_run['deadlines']:.0f} %)" if per_run["deadlines"] else "")
+          + f"; undecided at correct nodes answering one input within its period (alarms, relays, servers: "
+          f"answers and deadlines) {per_run['subset_undecided']} of {per_run['subset_answers']}"
+          + (f" ({100 * per_run['subset_undecided'] / per_run['subset_answers']:.2f} %)"
+             if per_run["subset_answers"] else "")
           + (f"; seeded defects red at their node {per_run['seeded red']} of {per_run['seeded']}"
              + (f" ({per_run['seeded late unsaid']} late, undecided with use_sim_time unsaid)"
                 if per_run["seeded late unsaid"] else "") if per_run["seeded"] else "") + "; "

@@ -14,7 +14,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 
-from _robot_run import figures, findings, late_unsaid, victim_unjudged  # noqa: E402
+from _robot_run import figures, findings, in_subset, late_unsaid, victim_unjudged  # noqa: E402
 
 
 def _res(victim: Counter[str]) -> dict[str, Any]:
@@ -69,3 +69,22 @@ def test_a_runs_figures_count_correct_nodes_apart_from_the_seeded_one() -> None:
     assert (fig["violated_correct"], fig["false_deadlines_correct"], fig["false_declarations_correct"]) == (1, 1, 1)
     assert (fig["deadlines"], fig["undecided"], fig["agree"]) == (8, 1, True)
     assert (fig["victim"], fig["kind"], fig["red"], fig["red_deadlines"]) == ("Alarm1", "late", 2, 2)
+
+
+def test_the_subset_answering_one_input_within_its_period() -> None:
+    """Alarms, stamping relays, copying relays no slower than their reading's period and servers are in the
+    subset the issue bounds at 1 % undecided; a fuse (two inputs) and a copying relay slower than its reading's
+    period are not; the subset's figures count its correct nodes' answers and deadlines."""
+    nodes = {"S": {"name": "S", "kind": "sensor", "period_ms": 300},
+             "A": {"name": "A", "kind": "alarm"}, "F": {"name": "F", "kind": "fuse"},
+             "R": {"name": "R", "kind": "relay", "copy": True, "source": "S", "delay_ms": 300},
+             "Q": {"name": "Q", "kind": "relay", "copy": True, "source": "S", "delay_ms": 301},
+             "P": {"name": "P", "kind": "relay", "copy": False, "source": "S", "delay_ms": 90},
+             "V": {"name": "V", "kind": "service"}}
+    assert [n for n in nodes if in_subset(nodes[n], nodes)] == ["A", "R", "P", "V"]
+    res = {"spec": {"nodes": list(nodes.values())}, "finals": {}, "disagreements": [], "errors": [],
+           "live": {"A": Counter({"satisfied": 9, "undecided": 1, "deadline true": 10}),
+                    "F": Counter({"satisfied": 5, "undecided": 5}), "Q": Counter({"undecided": 3}),
+                    "R": Counter({"satisfied": 4, "deadline undecided": 1})}}
+    fig = figures(res)
+    assert (fig["subset_answers"], fig["subset_undecided"]) == (25, 2)
