@@ -124,8 +124,14 @@ def test_not_said_is_decided_only_where_both_clocks_agree() -> None:
     assert seen[0].verdict == "undecided" and "use_sim_time" in seen[0].reason
     assert _judge(_run(0.5, 150), None)[0]["true"] == 1  # in time in both
     assert _judge(_run(0.5, 350), None)[0]["false"] == 1  # 250 ms wall, 125 ms simulated: late in both
-    counts, _, _ = _judge(_run(0.5, 250, start_ms=150), None)  # no /clock before the trigger: the run's clock
-    assert counts["false"] == 1
+    # no /clock before the trigger: placed on the run's clock, never false once /clock is heard
+    counts, unaccepted, seen = _judge(_run(0.5, 250, start_ms=150), None)
+    assert (counts["false"], unaccepted["undecided"]) == (0, 1) and "before /clock was first heard" in seen[0].reason
+    run = sorted([*_run(0.5, None, start_ms=400, end_ms=600), _msg(0, 300, "other", 0.0)], key=lambda e: e.time)
+    counts, unaccepted, seen = _judge(run, None)  # false given at 300 ms on the run's clock, withdrawn at 400 ms
+    assert (counts["false"], unaccepted["undecided"]) == (0, 1) and "the false given is withdrawn" in seen[-1].reason
+    assert _judge(_run(0.5, 150, start_ms=150), None)[0]["true"] == 1  # in time on the run's clock
+    assert _judge(_run(0.5, 250, start_ms=300), None)[0]["false"] == 1  # answered late before /clock: stands
 
 
 def test_no_clock_before_the_trigger_of_a_node_said_to_keep_it_is_undecided() -> None:
@@ -162,6 +168,11 @@ def _oracle(samples: list[tuple[int, int]], q: int, a: int | None, end: int, d: 
     sq = clock(q)
     if sq is None and mode is True:
         return "undecided"
+    if sq is None and mode is None:  # placed on the run's clock; /clock first heard at `first`
+        first = samples[0][0]
+        if a is not None:
+            return "true" if a <= q + d else "false" if a < first else "undecided"
+        return "undecided" if end > q + d else "currently_false"
     sim_mode = mode is not False and sq is not None
 
     def sim_states(t: int) -> set[bool]:  # late in simulated time at t, for each delay

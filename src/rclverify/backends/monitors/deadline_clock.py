@@ -21,8 +21,10 @@ mapping's ``use_sim_time`` says (:func:`~rclverify.traces.mapping.sim_time_of`):
 * **not said**, on a run whose ``/clock`` has been heard: both.  ``true`` only
   when in time in both clocks, ``false`` only when late in both, else
   ``undecided``, naming the two clocks and what decides it (the mapping's
-  ``use_sim_time``).  A trigger before the first ``/clock`` message is judged
-  on the run's clock (simulated time had not started).
+  ``use_sim_time``).  A trigger before the first ``/clock`` message is placed
+  on the run's clock; once ``/clock`` is heard, such an obligation still open
+  is never ``false`` and one expired unanswered has its ``false`` withdrawn
+  (``undecided``: :func:`_unsaid_before`).
 
 Each obligation so placed carries its clock (:attr:`~.deadline_records.Pending.clock`),
 the last stamp in time in every clock (``sure_ns``) and the first late in every
@@ -32,6 +34,7 @@ until ``/clock`` passes its simulated deadline its ``due_ns`` is :data:`FAR`
 """
 from __future__ import annotations
 
+from collections import deque
 from typing import Callable, Protocol
 
 from rclverify.lang.types import CheckedNode
@@ -57,6 +60,7 @@ class ClockMonitor(Protocol):
     sim_mode: bool | None
     awaiting: list[Pending]
     pending: list[Pending]
+    expired: deque[Pending]
     skew_ns: int
 
     def _withdraw_false(self, p: Pending) -> None: ...
@@ -76,7 +80,10 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
     if value is None or mon.sim_mode is False:
         return
     sim = mon.sim
+    first = not sim.heard
     sim.see(ns, value, ev.where)
+    if first and mon.sim_mode is None:
+        _unsaid_before(mon, ns)
     if not mon.awaiting:
         return
     if sim.broken:
@@ -94,6 +101,24 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
         else:
             _due(mon, p, w)
     mon.awaiting = keep
+
+
+def _unsaid_before(mon: ClockMonitor, ns: int) -> None:
+    """``/clock`` heard for the first time, at ``ns``, by the monitor of a node whose clock is not said: the
+    obligations placed on the run's clock before it may have been kept in simulated time.  Those still open
+    are never ``false`` now (``undecided`` if their deadline passes on the run's clock), and those expired
+    unanswered have their ``false`` withdrawn, ``undecided``: an update saying why.  One answered late
+    before it keeps its ``false``."""
+    why = (f"placed on the run's clock before /clock was first heard (at {ns / 1e9:.3f} s): the node may keep "
+           f"simulated time; {DECLARE}")
+    for p in mon.pending:
+        if not p.clock and not p.maybe:
+            p.maybe = why
+    for p in mon.expired:
+        if not p.clock and not p.maybe:
+            mon._withdraw_false(p)
+            p.maybe = why
+            undecided(mon, p, why + "; the false given is withdrawn", update=True)
 
 
 def place(mon: ClockMonitor, p: Pending) -> str:
