@@ -120,9 +120,5 @@ class SimClock:
         i = bisect_left(self.values, target_ns)
         return self.times[i] if i < len(self.times) else None
 
-    def latest(self) -> int | None:
-        """The time (ns, the run's clock) of the last sample kept, ``None`` before the first."""
-        return self.times[-1] if self.times else None
-
 
 __all__ = ["CLOCK_TOPIC", "SimClock", "clock_value_ns", "is_clock_topic"]

@@ -88,10 +88,11 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
         return
     if sim.broken:
         waiting, mon.awaiting = mon.awaiting, []
-        for p in waiting:
-            if p in mon.pending:
-                mon.pending.remove(p)
-                undecided(mon, p, sim.broken)
+        gone = {id(p) for p in waiting}
+        open_ = [p for p in mon.pending if id(p) in gone]
+        mon.pending = [p for p in mon.pending if id(p) not in gone]
+        for p in open_:
+            undecided(mon, p, sim.broken)
         return
     keep = []
     for p in mon.awaiting:
@@ -133,9 +134,9 @@ def place(mon: ClockMonitor, p: Pending) -> str:
             return ("its node keeps simulated time (use_sim_time) and no /clock message was heard before it: "
                     "its simulated time is not known")
         return ""  # not said, and simulated time had not started: the run's clock
+    p.sim_due_ns = sq + p.bound_ns
     p.clock = "sim" if mon.sim_mode else "either"
     p.wall_due_ns = p.due_ns
-    p.sim_due_ns = sq + (p.due_ns - p.stamp_ns)
     w = sim.passed(p.sim_due_ns)
     if w is None:
         p.due_ns = FAR

@@ -91,7 +91,7 @@ def met_late(mon: LateAnswers, p: Pending, ev: Event, ns: int) -> None:
         deadline_skew.decided_late(mon, p)
         mon._emit(DeadlineVerdict(mon.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
                                   ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline "
-                                  f"{ms_ns(p.due_ns - p.stamp_ns)}), heard after the clock had passed the "
+                                  f"{ms_ns(p.bound_ns)}), heard after the clock had passed the "
                                   "deadline: met on the answer's own stamp", time_margin=(p.due_ns - ns) / 1e9))
         mon.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9)
         return
@@ -99,7 +99,7 @@ def met_late(mon: LateAnswers, p: Pending, ev: Event, ns: int) -> None:
     mon.result.counts["true"] += 1
     late = ms_ns(mon.now_ns - ns) if mon.now_ns is not None else "?"
     v = DeadlineVerdict(mon.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9, ev.where,
-                        f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms_ns(p.due_ns - p.stamp_ns)}), "
+                        f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms_ns(p.bound_ns)}), "
                         f"heard after the clock had passed the deadline (at {late} behind it): met on the "
                         "answer's own stamp; the false given when the clock passed is withdrawn",
                         update=True, time_margin=(p.due_ns - ns) / 1e9)

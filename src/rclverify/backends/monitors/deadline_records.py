@@ -94,6 +94,12 @@ class Pending:
     wall_due_ns: int = 0
     sim_passed_ns: int = 0
 
+    @property
+    def bound_ns(self) -> int:
+        """The guarantee's deadline (integer ns) this obligation is due after: its due time less its stamp on
+        the run's clock, what a verdict's words call "the deadline of"."""
+        return (self.wall_due_ns if self.clock else self.due_ns) - self.stamp_ns
+
 
 @dataclass
 class DeadlineResult:

@@ -132,7 +132,7 @@ def undecided(mon: DeadlineMonitor, p: Pending, revised: str = "") -> None:
     ``revised``: the words of a ``false`` it replaces (:func:`revise_false`; the verdict is then an update)."""
     res = mon.result
     res.unaccepted["undecided"] += 1
-    reason = f"no answer of its own within the deadline of {ms_ns(p.due_ns - p.stamp_ns)}, but {p.maybe}"
+    reason = f"no answer of its own within the deadline of {ms_ns(p.bound_ns)}, but {p.maybe}"
     if res.first_unaccepted is None:
         res.first_unaccepted = {"guarantee": p.k, "where": p.trigger.where, "stamp": p.stamp, "why": "undecided",
                                 "reason": reason}

@@ -45,7 +45,7 @@ class VerdictWords:
     def expired_verdict(self, p: Pending, now_ns: int) -> DeadlineVerdict:
         """Obligation ``p``'s ``false``: the clock passed its deadline at ``now_ns`` unanswered."""
         return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, None, "",
-                               f"no answer within the deadline of {ms_ns(p.due_ns - p.stamp_ns)} "
+                               f"no answer within the deadline of {ms_ns(p.bound_ns)} "
                                f"(clock at {now_ns / 1e9:.3f} s)" + (f"; {p.rejected}" if p.rejected else ""))
 
     def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
@@ -65,7 +65,7 @@ class VerdictWords:
         return DeadlineVerdict(self.node.name, p.k, "false", p.trigger.where, p.stamp, p.due, ns / 1e9,
                                ev.where, f"answered after {ms_ns(ns - p.stamp_ns)}, "
                                f"{ms_ns(ns - p.due_ns)} past the deadline of "
-                               f"{ms_ns(p.due_ns - p.stamp_ns)}", update=True,
+                               f"{ms_ns(p.bound_ns)}", update=True,
                                time_margin=(p.due_ns - ns) / 1e9)
 
 

@@ -169,9 +169,7 @@ class DeadlineMonitor(VerdictWords):
         if not p.clock:
             return v
         margin = v.time_margin if ns is None else deadline_clock.margin_ns(self, p, ns) / 1e9
-        reason = v.reason.replace(f"deadline of {ms_ns(p.due_ns - p.stamp_ns)}",
-                                  f"deadline of {ms_ns(self.bounds_ns[p.k])}")  # the bound, not the run's span
-        return dataclasses.replace(v, reason=reason + deadline_clock.words(self, p), time_margin=margin)
+        return dataclasses.replace(v, reason=v.reason + deadline_clock.words(self, p), time_margin=margin)
 
     def _emit(self, v: DeadlineVerdict) -> None:
         if v.update:  # the answer of an expired obligation: shown, not counted again

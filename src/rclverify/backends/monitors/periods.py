@@ -72,6 +72,7 @@ from rclverify.traces.mapping import TopicRule, sim_time_of
 from rclverify.traces.sim_clock import CLOCK_TOPIC, SimClock, clock_value_ns
 from rclverify.backends.monitors.period_clock import LATE, UNDECIDED, judge_gap, read_at, sim_gap
 from rclverify.backends.monitors.skew import DEFAULT_SKEW_S
+from rclverify.backends.monitors.deadline_skew import skew_ns
 from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
 from rclverify.backends.monitors.shapes import PeriodGapJson, PeriodResultJson, PeriodsPart
@@ -139,8 +140,7 @@ class PeriodMonitor:
         self.sim_mode = sim_time_of(rules, node.name) if rules is not None else None
         #: the run's ``/clock`` as heard, and the transport skew (ns) of its delivery to a node
         self.sim = SimClock()
-        skew = getattr(rules, "skew", DEFAULT_SKEW_S) if rules is not None else DEFAULT_SKEW_S
-        self.skew_ns = round(skew * 1e9) if isinstance(skew, (int, float)) and skew > 0 else 0
+        self.skew_ns = skew_ns(rules) if rules is not None else round(DEFAULT_SKEW_S * 1e9)
         #: per output judged in simulated time: its last message's time (integer ns, the run's clock), where,
         #: and ``/clock`` as the node read it then (:func:`.period_clock.read_at`)
         self.last_sim: dict[str, tuple[int, str, tuple[int | None, int | None]]] = {}
