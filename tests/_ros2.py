@@ -59,6 +59,27 @@ def ros2_env(tmp: Path, rmw: str = "rmw_fastrtps_cpp") -> dict[str, str]:
 SETBOOL = "bool data\n---\nbool success\nstring message\n"
 
 
+#: The part of a test robot's rclpy script (its node ``n`` made) that spins it on ``ex`` with a ``spin(seconds)``
+#: helper, prints ``ready``, waits until the monitor publishes its verdicts and gives the monitor's readers
+#: 1.5 s to match its publishers; the script goes on with its rounds.
+AWAIT_MONITOR = """\
+ex = SingleThreadedExecutor()
+ex.add_node(n)
+
+def spin(seconds):
+    until = time.monotonic() + seconds
+    while time.monotonic() < until:
+        ex.spin_once(timeout_sec=0.002)
+
+spin(0.5)
+print("ready", flush=True)
+until = time.monotonic() + 30
+while time.monotonic() < until and n.count_publishers("/rclverify/verdict") < 1:
+    spin(0.05)
+spin(1.5)  # the monitor's readers match the publishers
+"""
+
+
 def live_workspace(tmp: Path, rcl: str, mapping: str | None = None, setbool: bool = False) -> Path:
     """A workspace ``tmp/ws`` for one live test: ``rcl`` as
     ``contracts/sys.rcl`` in a plan of its own, ``mapping`` (YAML text) as

@@ -27,7 +27,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for, wait_logged
-from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
+from _ros2 import AWAIT_MONITOR, live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))  # _robot_verdicts: final verdicts
 
@@ -90,27 +90,14 @@ def due():
 
 n.create_subscription(Int64, "x", answer, 100)
 n.create_timer(0.002, due, clock=Clock(clock_type=ClockType.STEADY_TIME))  # looks at the node's clock often
-ex = SingleThreadedExecutor()
-ex.add_node(n)
-
-def spin(seconds):
-    until = time.monotonic() + seconds
-    while time.monotonic() < until:
-        ex.spin_once(timeout_sec=0.002)
-
-spin(0.5)
-print("ready", flush=True)
-until = time.monotonic() + 30
-while time.monotonic() < until and n.count_publishers("/rclverify/verdict") < 1:
-    spin(0.05)
-spin(1.5)  # the monitor's readers match the publishers
+AWAIT_MONITOR
 for k in range(1, ROUNDS + 1):
     pubs["x"].publish(Int64(data=k))
     spin(0.8)
 print("done", flush=True)
 while True:
     ex.spin_once(timeout_sec=0.1)
-""".replace("ROUNDS", str(ROUNDS))
+""".replace("AWAIT_MONITOR\n", AWAIT_MONITOR).replace("ROUNDS", str(ROUNDS))
 
 
 def _answered_last(lines: list[dict[str, Any]]) -> bool:
@@ -191,10 +178,15 @@ def test_deadlines_are_judged_in_simulated_time_live_on_the_log_and_on_the_bag(r
 
 
 def test_the_control_judges_the_same_log_on_the_wall_clock(run: dict[str, Any]) -> None:
-    """The node said to keep the wall clock: the opposite verdicts on the same log."""
+    """The node said to keep the wall clock: each deadline as the log's own times give it on the wall clock,
+    the opposite of simulated time on (nearly) every answer (a ``/clock`` publisher behind under load catches
+    up in a burst, so an answer may come sooner on the wall clock than the factor says)."""
+    lines = [json.loads(x) for x in (run["tmp"] / "live.jsonl").read_text().splitlines()]
+    asked = {x["data"]: x["time"] for x in lines if x.get("topic") == "x"}
+    late = sum(1 for x in lines if x.get("topic") == "y" and x["time"] - asked[x["data"]] > 0.4)
     t = _tally(run, "wall")
-    met = run["factor"] == 0.5
-    assert (t["deadline true"], t["deadline false"]) == ((0, ROUNDS) if met else (ROUNDS, 0)), t
+    assert (t["deadline true"], t["deadline false"]) == (ROUNDS - late, late), t
+    assert late >= ROUNDS - 2 if run["factor"] == 0.5 else late <= 2, late
 
 
 def test_a_node_whose_clock_is_not_said_is_undecided(run: dict[str, Any]) -> None:
