@@ -220,6 +220,15 @@ def horizon_of(spec: dict[str, Any]) -> float:
     return CLOCK_HORIZON if spec.get("clock") else HORIZON
 
 
+def settle_s(spec: dict[str, Any]) -> float:
+    """How long (wall-clock s) robot ``spec`` waits, once the monitor's verdict topic is up, before its
+    sensing (and its clients' calls) begin: the monitor's readers match every writer, and a request writer
+    it has heard for less than the horizon leaves the replies of the DDS source's order pairing undecided
+    (docs/monitors.md, "Services and actions over DDS": nothing missed), so a run lets the horizon pass first, as its advice says
+    ("start the monitor before the clients call")."""
+    return max(2.5, horizon_of(spec) + 1.0)
+
+
 def late_ms(n: dict[str, Any]) -> int:
     """The wait (simulated ms) of a node seeded ``"late"``: :data:`LATE_FACTOR` times its deadline."""
     return math.ceil(LATE_FACTOR * deadline_ms(n))
@@ -602,7 +611,7 @@ def render(spec: dict[str, Any]) -> dict[str, str]:
     robot_spec = {"nodes": [{**n, "late_ms": late_ms(n)} if n.get("defect_kind") == "late" else n
                             for n in spec["nodes"]],
                   "clock": spec.get("clock"), "clock_step_ms": CLOCK_STEP_MS,
-                  "driver_offset_s": spec.get("driver_offset_s", 0.0)}
+                  "driver_offset_s": spec.get("driver_offset_s", 0.0), "settle_s": settle_s(spec)}
     return {
         "contracts/robot.rcl": env.get_template("contracts.rcl.j2").render(
             seed=spec["seed"], defect=spec["defect"], constants=consts, nodes=contracts),
