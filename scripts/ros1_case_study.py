@@ -1,7 +1,7 @@
 """The case study's Radiation Sensor as a rospy node, and a replay of a bundled
 run as a rospy publisher: what the live monitor's test and benchmark watch.
 
-    python3 scripts/ros1_case_study.py sensor [--misclassify]
+    python3 scripts/ros1_case_study.py sensor [--misclassify] [--heard-by N]
     python3 scripts/ros1_case_study.py replay RUN.jsonl [--rate K] [--skip TOPIC ...]
     python3 scripts/ros1_case_study.py listen TOPIC --out FILE [--count N]
 
@@ -10,7 +10,10 @@ run as a rospy publisher: what the live monitor's test and benchmark watch.
 property tests check) on ``/command`` and ``/r`` and publishes
 ``/inspected`` and ``/radiationStatus``; ``--misclassify`` injects the
 fault of the ``sensor_fault`` run (a reading of 250 or more reported
-``orange`` instead of ``red``).  ``replay`` publishes the messages of a
+``orange`` instead of ``red``); with ``--heard-by N`` it prints ``outputs heard
+by N`` once both its publishers have N subscribers connected (TCPROS links
+are made after a subscriber registers, so a run waits for this line before
+it sends readings whose answers a monitor must hear).  ``replay`` publishes the messages of a
 ROSMonitoring log at their recorded times divided by ``--rate``, leaving out
 the ``--skip`` topics (those a live node produces), after waiting for
 ``--wait-for`` subscribers on every topic.  All topics carry
@@ -27,6 +30,7 @@ import argparse
 import importlib.util
 import json
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -44,7 +48,7 @@ def _sensor_function() -> Any:
     return mod.radiation_sensor
 
 
-def sensor(misclassify: bool) -> int:
+def sensor(misclassify: bool, heard_by: int = 0) -> int:
     from rclverify.runtime.ros1 import import_rospy, message_class
     from rclverify.semantics.values import Term
     rospy = import_rospy()
@@ -71,6 +75,14 @@ def sensor(misclassify: bool) -> int:
     rospy.Subscriber("/command", Snapshot, on_command, queue_size=100)
     rospy.Subscriber("/r", Snapshot, on_reading, queue_size=100)
     print("radiation sensor ready", flush=True)
+    if heard_by:
+        def say_heard() -> None:
+            while min(status.get_num_connections(), inspected.get_num_connections()) < heard_by:
+                if rospy.is_shutdown():
+                    return
+                time.sleep(0.05)
+            print(f"outputs heard by {heard_by}", flush=True)
+        threading.Thread(target=say_heard, daemon=True).start()
     rospy.spin()
     return 0
 
@@ -127,6 +139,7 @@ def main() -> int:
     sub = p.add_subparsers(dest="what", required=True)
     s = sub.add_parser("sensor")
     s.add_argument("--misclassify", action="store_true")
+    s.add_argument("--heard-by", type=int, default=0, help="say when both outputs have this many subscribers")
     r = sub.add_parser("replay")
     r.add_argument("run", type=Path)
     r.add_argument("--rate", type=float, default=1.0)
@@ -140,7 +153,7 @@ def main() -> int:
     li.add_argument("--count", type=int, default=0)
     a = p.parse_args()
     if a.what == "sensor":
-        return sensor(a.misclassify)
+        return sensor(a.misclassify, a.heard_by)
     if a.what == "listen":
         return listen(a.topic, a.out, a.count)
     need = {t: int(n) for t, _, n in (x.partition("=") for x in a.need)}

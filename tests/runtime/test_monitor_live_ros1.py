@@ -61,7 +61,7 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             listener = _start([str(SCRIPT), "listen", "/rclverify/verdict", "--out", str(tmp / "topic.jsonl")],
                               env, tmp / "listener.out")
             procs.append(listener)
-            sensor = _start([str(SCRIPT), "sensor", "--misclassify"], env, tmp / "sensor.out")
+            sensor = _start([str(SCRIPT), "sensor", "--misclassify", "--heard-by", "1"], env, tmp / "sensor.out")
             procs.append(sensor)
             monitor = _start(["-m", "rclverify.cli.commands", "monitor", "--live", "-w", str(REPO), "--horizon", str(HORIZON),
                               "--log", str(tmp / "live.jsonl"), "--evidence", str(tmp / "evidence.json"),
@@ -70,6 +70,9 @@ def live_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             for p, name, text in ((listener, "listener.out", "listening"), (sensor, "sensor.out", "ready"),
                                   (monitor, "monitor.out", "monitoring")):
                 wait_for(tmp / name, text, 20)
+            # the monitor's links to the sensor's outputs are made after it said "monitoring": an answer sent
+            # before its link is up is never heard (ROS 1 keeps no history for a late subscriber)
+            wait_for(tmp / "sensor.out", "outputs heard by 1", 20)
             replay = subprocess.run([sys.executable, str(SCRIPT), "replay",
                                      str(REPO / "backends/monitors/traces/sensor_fault.jsonl"), "--rate", str(RATE),
                                      "--skip", "radiationStatus", "inspected", "--wait-for", "1",
