@@ -102,10 +102,29 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             "record": json.loads((tmp / "live.json").read_text())}
 
 
+def _calls(live_log: dict[str, Any]) -> list[list[dict[str, Any]]]:
+    """The Base deadline's verdicts, one list per call (by its trigger), in the calls' order."""
+    calls: dict[str, list[dict[str, Any]]] = {}
+    for x in live_log["lines"]:
+        if x["kind"] == "verdict" and x["node"] == "Base":
+            calls.setdefault(x["trigger_where"], []).append(x)
+    return list(calls.values())
+
+
+def _missed(live_log: dict[str, Any]) -> int:
+    """How many estop calls the proxy's own stamps show answered after the 200 ms deadline (or never)."""
+    return sum(1 for vs in _calls(live_log) if vs[-1]["answer"] is None or vs[-1]["answer"] - vs[-1]["trigger_stamp"] > 0.2)
+
+
 def test_the_late_service_answer_is_false_with_the_calls_stamps(live_log: dict[str, Any]) -> None:
-    verdicts = [x for x in live_log["lines"] if x["kind"] == "verdict" and x["node"] == "Base"]
-    assert [(v["verdict"], v["update"]) for v in verdicts] == [("true", False), ("false", False), ("false", True)]
-    expired, late = verdicts[1], verdicts[2]
+    first, second = _calls(live_log)
+    # the first call is answered at once by the server, but through the proxy's first connection on a loaded
+    # machine it can take longer than 200 ms: its verdict is what its stamps say, whichever they say
+    took = first[-1]["answer"] - first[-1]["trigger_stamp"]
+    assert [(v["verdict"], v["update"]) for v in first] in (
+        [[("true", False)]] if took <= 0.2 else [[("false", False)], [("false", False), ("false", True)]])
+    assert [(v["verdict"], v["update"]) for v in second] == [("false", False), ("false", True)]
+    expired, late = second
     # false as soon as the clock passed the deadline (the proxy's timer), before the answer came ...
     assert expired["answer"] is None and expired["reason"].startswith("no answer within the deadline of 200 ms")
     # ... and the late answer, when it came, shown with the call's stamps
@@ -129,11 +148,13 @@ def test_the_action_feedback_arrives_in_time(live_log: dict[str, Any]) -> None:
     topics = [x["topic"] for x in live_log["lines"] if x["kind"] == "event"]
     assert {"move/goal", "move/feedback", "move/result"} <= set(topics)
     summary = [x for x in live_log["lines"] if x["kind"] == "summary"]
-    assert len(summary) == 1 and summary[0]["false"] == 1
+    missed = _missed(live_log)  # the late second call, and the first where its stamps show it late too
+    assert missed in (1, 2)
+    assert len(summary) == 1 and summary[0]["false"] == missed
     # the command's evidence record and output carry the deadline verdicts too
-    assert live_log["record"]["deadlines"]["false"] == 1
+    assert live_log["record"]["deadlines"]["false"] == missed
     assert [r["node"] for r in live_log["record"]["deadlines"]["results"]] == ["Teleop", "Base", "Mover"]
-    assert re.search(r"deadlines: 1 of \d+ judged call\(s\) or goal\(s\) missed their deadline", live_log["out"])
+    assert re.search(rf"deadlines: {missed} of \d+ judged call\(s\) or goal\(s\) missed their deadline", live_log["out"])
     published = live_log["echo"]
     assert '\\"kind\\": \\"deadline\\"' in published and '\\"verdict\\": \\"false\\"' in published, published[-2000:]
 
