@@ -31,7 +31,14 @@ each call (each goal) is checked as a trace of its own (docs/monitors.md,
   writers' clocks: one host, or hosts whose clocks are synchronised), its
   clock advanced by :meth:`CallBook.tick`, so an unanswered call is
   ``false`` as soon as its deadline has passed, and a late answer is shown
-  with its stamp (an ``update``).
+  with its stamp (an ``update``).  A node that keeps simulated time (the
+  mapping's ``use_sim_time``, :func:`~rclverify.traces.mapping.sim_time_of`)
+  has its calls' deadlines kept in simulated time by the rule of its topics'
+  (docs/semantics.md, "Deadlines in simulated time";
+  :mod:`.deadline_clock`), over the run's ``/clock`` as the book takes it
+  (:meth:`CallBook.clock`, in the order of the call events); a node not said
+  is judged on both clocks once ``/clock`` is heard, one said to keep the
+  run's clock on that clock alone.
 
 What no call's trace can decide is still said: an answer whose request was
 not heard (:meth:`CallBook.orphan`: made before the monitor started) and an
@@ -44,19 +51,23 @@ says the same (docs/monitors.md, "Every endpoint of a call accounted for").
 A call is dropped from memory once it is answered and nothing about it is
 pending, or :data:`LINGER_S` seconds after its horizon and deadlines passed
 unanswered; at most ``max_calls`` are kept (the oldest is closed first,
-counted in ``evicted``).  :func:`replay` runs the same book over the
-``call`` lines of a live log: the offline check of a live run's calls.
+counted in ``evicted``; a call with an obligation whose simulated deadline
+``/clock`` has not passed is kept until it does or the run ends).
+:func:`replay` runs the same book over the ``call`` lines of a live log, its
+``clock`` lines included: the offline check of a live run's calls.
 """
 from __future__ import annotations
 
 import dataclasses
-from collections import OrderedDict
+from collections import OrderedDict, deque
 from typing import Any, Callable, Iterable, Mapping
 
 from rclverify.lang import ast
+from rclverify.lang.timing import seconds
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.traces.events import Event
-from rclverify.traces.mapping import TopicRule
+from rclverify.traces.events import Event, to_ns
+from rclverify.traces.mapping import TopicRule, sim_time_of
+from rclverify.traces.sim_clock import CLOCK_TOPIC, clock_value_ns
 from rclverify.backends.monitors.check import NodeMonitor, NodeResult, Verdict
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
@@ -67,6 +78,11 @@ from rclverify.backends.monitors.call_notes import NAMED, CallNotes, key_json
 CALL_LOG_TOPIC = "rclverify/call"
 #: seconds an unanswered call is kept after its horizon and deadlines passed (a late answer still shown)
 LINGER_S = 10.0
+#: seconds of the run's clock a ``/clock`` sample is kept beyond the longest call deadline and :data:`LINGER_S`
+#: (a call whose request is stamped that much before the last sample is placed on the samples kept)
+CLOCK_KEPT_S = 60.0
+#: the most ``/clock`` samples kept (each a change of the simulated time)
+CLOCK_MAX = 100_000
 
 
 def link_view(node: CheckedNode, link: ast.Link) -> CheckedNode:
@@ -102,6 +118,11 @@ class _Call:
     first: int = -1  # the index of the request's (the goal's) event
 
 
+def _longest(node: CheckedNode) -> float:
+    """The longest ``within`` (s) of ``node``'s guarantees, 0 without one."""
+    return max((float(seconds(c.deadline) or 0) for c in node.node.guarantees if c.deadline is not None), default=0.0)
+
+
 class CallBook(CallNotes):
     """The calls and goals in flight and what was concluded of those closed.
 
@@ -111,7 +132,9 @@ class CallBook(CallNotes):
     ``on_event(dict)`` every call event as a log line (``topic``
     :data:`CALL_LOG_TOPIC`, ``kind: "call"``, the link, the part, the
     identity ``key``, the source stamp as ``time``, the part's fields).
-    Times are seconds (DDS source timestamps, the timer's wall clock)."""
+    Times are seconds (DDS source timestamps, the timer's wall clock).
+    ``/clock`` samples are given by :meth:`clock`, in the order of the call
+    events (each a log line, ``part: "clock"``)."""
 
     def __init__(self, checked: Checked, links: Iterable[tuple[CheckedNode, ast.Link]],
                  rules: Mapping[str, TopicRule], horizon: float,
@@ -136,6 +159,17 @@ class CallBook(CallNotes):
         self.undecided: dict[str, dict[str, Any]] = {}
         #: link -> endpoint (``"server /ns/n"``) -> why its calls were not all heard with contents
         self.unjudged_ends: dict[str, dict[str, str]] = {}
+        timed = [node for views in self.links.values() for node, _, t in views if t]
+        #: whether some node with a call deadline may keep simulated time (said, or not said): ``/clock`` is read
+        self.reads_clock = any(sim_time_of(rules, n.name) is not False for n in timed)
+        #: the ``/clock`` samples taken that changed the simulated time (or broke it), in order, the oldest
+        #: forgotten past :attr:`clock_kept_ns` (integer ns of the run's clock) behind the last
+        self.clock_samples: deque[Event] = deque()
+        self.clock_kept_ns = to_ns(max((_longest(n) for n in timed), default=0.0) + LINGER_S + CLOCK_KEPT_S)
+        #: the sample before the one that broke the relation of the two clocks, and that one (``/clock`` went
+        #: back, or a sample came out of order): every call opened later is given both (its clock is broken too)
+        self.clock_break: tuple[Event, Event] | None = None
+        self.clock_taken = 0  # samples taken (names each in its ``where``)
 
     # -- input -------------------------------------------------------------------------------
     def open(self, name: str, key: tuple[Any, ...], label: str, fields: Mapping[str, object], stamp: float,
@@ -151,7 +185,7 @@ class CallBook(CallNotes):
         monitors = [NodeMonitor(self.checked, view, self.rules, self.horizon, self._verdict) for _, view, _ in views]
         for m in monitors:  # a call's request was heard: its reply is awaited (the pairing's own rules say
             m.heard_answer = True  # when the monitor cannot know: runtime/dds/order.py), never "before first answer"
-        deadlines = [DeadlineMonitor(self.checked, node, self.rules, self._deadline, clock=False) for node, _, timed in views
+        deadlines = [DeadlineMonitor(self.checked, node, self.rules, self._deadline) for node, _, timed in views
                      if timed]
         bound = max([self.horizon] + [t[4] for d in deadlines for t in d.timed])
         call = _Call(key, name, label, stamp, bound, monitors, deadlines)
@@ -159,7 +193,12 @@ class CallBook(CallNotes):
         if count:
             self.counts["goals" if part == "goal" else "calls"] += 1
         call.first = self.index
+        sims = [d for d in deadlines if d.sim_mode is not False]
+        later = self._clock_before(sims, to_ns(stamp)) if sims else []
         self._feed(call, part, fields, stamp, {} if count else {"also": True})
+        for ev in later:  # /clock taken already and stamped after the request: in the run's order, after it
+            for d in sims:
+                d.feed(ev)
         while len(self.calls) > self.max_calls:
             self._close(next(iter(self.calls)), evicted=True)
 
@@ -221,7 +260,7 @@ class CallBook(CallNotes):
             total = self.deadline_results.setdefault(d.result.node, DeadlineResult(d.result.node))
             for v, n in d.result.counts.items():
                 total.counts[v] += n
-            total.first_false = total.first_false or d.result.first_false
+            total.first_false = _earlier(total.first_false, d.result.first_false)
             total.unaccepted["undecided"] += len(d.pending)
             if d.pending and total.first_unaccepted is None:
                 total.first_unaccepted = {"where": f"{call.label} request", "stamp": call.opened,
@@ -247,6 +286,64 @@ class CallBook(CallNotes):
         for d in call.deadlines:
             d.feed(dev)
 
+    # -- the simulated clock --------------------------------------------------------------------
+    def clock(self, stamp: float, fields: Mapping[str, object]) -> None:
+        """A ``/clock`` message (``fields``: ``clock`` with ``sec``/``nanosec``
+        or ``secs``/``nsecs``) stamped ``stamp`` (s, the clock of the call
+        events), in the order of the call events: given to every open call's
+        deadline monitor that reads ``/clock`` (:func:`.deadline_clock.tick`)
+        and kept for the calls opened later (:meth:`open`); a log line
+        (``part: "clock"``), which the replay takes again.  Not taken: a
+        sample without a time, one that repeats the simulated time (the first
+        sample of a value says when the clock got there), any after the two
+        clocks' relation broke, and every one when no node with a call
+        deadline may keep simulated time."""
+        if not self.reads_clock or self.clock_break is not None:
+            return
+        value = clock_value_ns(fields)
+        if value is None:
+            return
+        ns = to_ns(stamp)
+        last = self.clock_samples[-1] if self.clock_samples else None
+        if last is not None:
+            last_ns, last_value = to_ns(last.time), clock_value_ns(last.fields)
+            broken = ns < last_ns or (last_value is not None and value < last_value)
+            if not broken and value == last_value:
+                return
+        else:
+            broken = False
+        self.clock_taken += 1
+        sec, nsec = divmod(value, 1_000_000_000)
+        ev = Event(self.index, stamp, CLOCK_TOPIC, {"clock": {"sec": sec, "nanosec": nsec}},
+                   f"/clock sample {self.clock_taken}")
+        self._log({"part": "clock", "time": stamp, "clock": {"sec": sec, "nanosec": nsec}})
+        if broken and last is not None:
+            self.clock_break = (last, ev)
+        self.clock_samples.append(ev)
+        while len(self.clock_samples) > CLOCK_MAX or (
+                len(self.clock_samples) > 1 and to_ns(self.clock_samples[1].time) <= ns - self.clock_kept_ns):
+            self.clock_samples.popleft()
+        for call in self.calls.values():
+            for d in call.deadlines:
+                if d.sim_mode is not False:
+                    d.feed(ev)
+
+    def _clock_before(self, monitors: list[DeadlineMonitor], ns: int) -> list[Event]:
+        """Give the deadline monitors of a call whose request is stamped ``ns`` (integer ns) the ``/clock``
+        they read at its stamp: the two samples that broke the clocks' relation, or the last sample placed
+        at or before it.  Returns the samples placed after it, in order (to be given after the request)."""
+        if self.clock_break is not None:
+            first = list(self.clock_break)
+            later: list[Event] = []
+        else:
+            before = [ev for ev in self.clock_samples if to_ns(ev.time) <= ns]
+            first = before[-1:]
+            later = list(self.clock_samples)[len(before):]
+        for ev in first:
+            for d in monitors:
+                d.feed(ev)
+        return later
+
     # -- time ----------------------------------------------------------------------------------
     def tick(self, now: float) -> None:
         """Move every open call's clock to ``now`` (s): horizons and deadlines
@@ -260,7 +357,8 @@ class CallBook(CallNotes):
             for d in call.deadlines:
                 d.advance(now)
             quiet = not any(m.pending for m in call.monitors) and not any(d.pending for d in call.deadlines)
-            if (call.answered and quiet) or now > call.opened + call.bound + LINGER_S:
+            sim_open = any(d.awaiting for d in call.deadlines)  # /clock has not passed a simulated deadline yet
+            if (call.answered and quiet) or (now > call.opened + call.bound + LINGER_S and not sim_open):
                 done.append(key)
         for key in done:
             self._close(key)
@@ -280,8 +378,12 @@ class CallBook(CallNotes):
             total = self.deadline_results.setdefault(res.node, DeadlineResult(res.node))
             for v, n in res.counts.items():
                 total.counts[v] += n
-            if total.first_false is None:
-                total.first_false = res.first_false
+            for v, n in res.unaccepted.items():  # triggers refused, and obligations undecided by their clock
+                total.unaccepted[v] = total.unaccepted.get(v, 0) + n
+            total.first_false = _earlier(total.first_false, res.first_false)
+            if res.first_unaccepted is not None and (total.first_unaccepted is None or _at(res.first_unaccepted)
+                                                     < _at(total.first_unaccepted)):
+                total.first_unaccepted = res.first_unaccepted
 
     def finish(self) -> dict[str, Any]:
         """Close every call (what is within its horizon is ``open``, within its
@@ -312,6 +414,20 @@ class CallBook(CallNotes):
             self.on_event({"topic": CALL_LOG_TOPIC, "kind": "call", **obj})
 
 
+def _earlier(a: DeadlineVerdict | None, b: DeadlineVerdict | None) -> DeadlineVerdict | None:
+    """The ``false`` of the earlier trigger (stamp, then where) of ``a`` and ``b``: a node's first over its
+    calls whatever order they were closed in (a live tick closes an answered call that the replay of its
+    log closes at the end)."""
+    if a is None or b is None:
+        return a if b is None else b
+    return b if (b.trigger_stamp, b.trigger_where) < (a.trigger_stamp, a.trigger_where) else a
+
+
+def _at(first: Mapping[str, Any]) -> tuple[float, str]:
+    """Where a first refusal (``{"stamp", "where", ...}``) stands among a node's calls' triggers."""
+    return float(first.get("stamp") or 0.0), str(first.get("where", ""))
+
+
 def _add(total: NodeResult, one: NodeResult) -> None:
     """Add one call's result to the node's total (the first of each kind kept)."""
     total.events += one.events
@@ -328,7 +444,8 @@ def replay_line(book: CallBook, x: Mapping[str, Any]) -> None:
     that is not a call line (``kind`` ``"call"``) is ignored.  A line with an
     ``index`` opens its call (a request or a goal) or answers it; a ``tick``
     line (written where a live tick decided something) moves the clock as the
-    live timer did; an ``unpaired`` line leaves its call inconclusive with the
+    live timer did; a ``clock`` line gives the book the ``/clock`` sample the
+    live book took there (:meth:`CallBook.clock`); an ``unpaired`` line leaves its call inconclusive with the
     live reason; a ``rejected`` line closes its goal as the live book did; an
     ``orphan`` answer (no call of its identity was open) is counted and named
     undecided (:meth:`CallBook.orphan`); an ``unjudged`` line says an
@@ -340,6 +457,8 @@ def replay_line(book: CallBook, x: Mapping[str, Any]) -> None:
     part = str(x.get("part"))
     if part == "tick":
         book.tick(float(x["time"]))
+    elif part == "clock":
+        book.clock(float(x["time"]), {"clock": dict(x["clock"])})
     elif x.get("unpaired"):
         book.unpaired(tuple(x["key"]), float(x["time"]), str(x["reason"]), part)
     elif part == "rejected":
@@ -368,4 +487,4 @@ def replay(book: CallBook, lines: Iterable[Mapping[str, Any]]) -> dict[str, Any]
     return book.finish()
 
 
-__all__ = ["CALL_LOG_TOPIC", "CallBook", "LINGER_S", "NAMED", "link_view", "replay", "replay_line"]
+__all__ = ["CALL_LOG_TOPIC", "CLOCK_KEPT_S", "CLOCK_MAX", "CallBook", "LINGER_S", "NAMED", "link_view", "replay", "replay_line"]

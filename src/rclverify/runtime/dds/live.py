@@ -17,7 +17,10 @@ messages in and verdicts out over DDS (:mod:`rclverify.ros.live.dds`):
   source timestamp, its writer's id), its matched writers handed to the
   engine's ``match`` under ``clock`` once it has one, and recorded in the
   ``--record`` bag; its reader is made only when a publisher of ``/clock`` is
-  discovered, so a run without a simulator pays nothing for it.  A contract
+  discovered, so a run without a simulator pays nothing for it; the call
+  taps take each sample too, among the calls' samples
+  (:meth:`~.services.CallTaps.clock`), for the calls' deadlines kept in
+  simulated time.  A contract
   that names ``/clock`` itself makes it a contract topic like any other;
 * publishes each verdict as ``std_msgs/msg/String`` JSON on
   ``rt/rclverify/verdict`` (``ros2 topic echo /rclverify/verdict``) and each
@@ -409,6 +412,8 @@ class _DdsRun(DdsRunEnd):
             return None
         if self.recorder is not None:
             self.recorder.write(key, payload[4], raw)  # at its event time, as the log and the engine place it
+        if key == CLOCK_TOPIC and calls is not None:  # the call book's /clock: among the calls' samples
+            calls.clock(fields, source_ns / 1e9, received_ns / 1e9)
         if key in self.enforce:
             self.live.stash(fields, raw)  # type: ignore[attr-defined]
         return fields

@@ -54,6 +54,12 @@ call book's clock runs that far behind.  An answer whose request has not been
 heard waits up to :data:`EARLY_S` seconds for it before it counts as an
 answer without a call.
 
+The run's ``/clock`` samples (:meth:`CallTaps.clock`) wait in the same
+buffer and are taken in the same order, each given to the book
+(:meth:`~.dds_calls.CallBook.clock`) where its time falls among the calls'
+samples: a call's deadline kept in simulated time reads the ``/clock`` of
+its request's stamp and of its answer's.
+
 An action's parts are read by :mod:`.action_taps`, whose introspection
 side pairs a link's calls and which endpoints go unheard by
 :mod:`.event_sides`, the seconds waited are :mod:`.call_times`'; both
@@ -79,6 +85,7 @@ from rclverify.runtime.dds.types import TypeBook, request_id, to_fields
 from rclverify.runtime.dds.wire import framed_rmw, has_header, vendor
 from rclverify.traces.event_time import event_s
 from rclverify.traces.reorder import ReorderBuffer
+from rclverify.traces.sim_clock import CLOCK_TOPIC
 
 
 class CallTaps(EventSides, ActionTaps):
@@ -109,8 +116,9 @@ class CallTaps(EventSides, ActionTaps):
         self._goal_of: dict[tuple[Any, ...], str] = {}  # send-goal/get-result request id (or event key) -> goal id
         self._status: dict[str, int] = {}
         self._early: dict[tuple[Any, ...], list[tuple[str, Mapping[str, object], float, bool, float, str]]] = {}
-        #: samples waiting to be taken (traces/reorder.py, the one reorder buffer): (received, key, raw, writer)
-        self._queue: ReorderBuffer[tuple[float, str, bytes, bytes | None]] = ReorderBuffer()
+        #: samples waiting to be taken (traces/reorder.py, the one reorder buffer): (received, key, raw, writer);
+        #: a ``/clock`` sample's key is :data:`~rclverify.traces.sim_clock.CLOCK_TOPIC`, its fields in place of raw
+        self._queue: ReorderBuffer[tuple[float, str, bytes | Mapping[str, object], bytes | None]] = ReorderBuffer()
         self._n = 0
         self._pairers: dict[str, OrderPairer] = {}
         self._paired_before: dict[str, OrderPairer] = {}  # service -> its last pairer, kept when set aside
@@ -206,6 +214,16 @@ class CallTaps(EventSides, ActionTaps):
         t = event_s(stamp, now)
         self._queue.push(t, t, (now, key, raw, writer))
 
+    def clock(self, fields: Mapping[str, object], stamp: float, now: float) -> None:
+        """One ``/clock`` sample (its ``fields``, source stamp ``stamp``,
+        received ``now``, s), taken as a call sample is (:meth:`handle`), given
+        to the book then (:meth:`~.dds_calls.CallBook.clock`); nothing when
+        no node with a call deadline may keep simulated time."""
+        if not self.book.reads_clock:
+            return
+        t = event_s(stamp, now)
+        self._queue.push(t, t, (now, CLOCK_TOPIC, fields, None))
+
     def tick(self, now: float, window: float = 0.0) -> None:
         """Take the samples whose time has come, in their stamps' order; answers
         that waited :data:`EARLY_S` s for their call count as answers without
@@ -235,8 +253,13 @@ class CallTaps(EventSides, ActionTaps):
         for stamp, _, (got, key, raw, writer), late in self._queue.release_while(due):
             if late > 1e-9:
                 self.counts["late"] += 1
+            if key == CLOCK_TOPIC:
+                assert not isinstance(raw, bytes)  # clock() queues the fields
+                self.book.clock(stamp, raw)
+                continue
             self.last = max(self.last, stamp)
             try:
+                assert isinstance(raw, bytes)  # handle() queues the serialized sample
                 self._decode(key, raw, stamp, got, writer)
             except Exception:  # noqa: BLE001 - bytes that are not the link's type: counted, never a crash
                 self.counts["undecodable"] += 1
