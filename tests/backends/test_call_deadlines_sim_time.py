@@ -365,3 +365,56 @@ def test_oracle_random_runs_match_the_rule_enumerated(seed: int) -> None:
         controls = [_oracle(samples, q, a, end, skew, False) for q, a, _ in calls]  # the run's clock
         assert +Counter(controls) == +Counter({k: v for k, v in _judge(run, False)[0].items()
                                                if k in ("true", "false", "currently_false")})
+
+
+def test_a_bag_ros2_bag_record_made_reads_its_clock_among_the_calls(tmp_path: Path) -> None:
+    """A bag without the book's decisions (``ros2 bag record --services`` of a server under use_sim_time):
+    its /clock messages are read among its service events by their times, so the calls' deadlines are
+    judged in simulated time as live; the control, said to keep the run's clock, gives the other verdict."""
+    pytest.importorskip("cyclonedds", reason="the cyclonedds binding is not installed")
+    pytest.importorskip("rosbags", reason="rosbags is not installed (the ros extra)")
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections
+    from rclverify.backends.monitors.log_calls import LogCalls
+    from rclverify.runtime.dds.bag_types import definition
+    from rclverify.runtime.dds.introspection import event_struct
+    from rclverify.runtime.dds.types import TypeBook
+    from rclverify.traces import read_trace
+    from rclverify.traces.bag import typestore
+    types = TypeBook([WS / "interfaces"])
+    cls = event_struct(types, "std_srvs/SetBool")
+    msgdef, digest = definition(types, "std_srvs/srv/SetBool_Event")
+    store = typestore([])
+    t0, ms = 1_700_000_000_000_000_000, 1_000_000
+    for rate, answer, sim_verdict in ((0.5, 400, "true"), (2.0, 250, "false")):
+        path = tmp_path / f"b{rate}"
+        with Writer(path, version=8, storage_plugin=StoragePlugin.MCAP) as w:
+            conn = w.add_connection("/estop/_service_event", "std_srvs/srv/SetBool_Event", msgdef=msgdef,
+                                    rihs01=digest)
+            cconn = w.add_connection("/clock", "rosgraph_msgs/msg/Clock", typestore=store)
+            Clock = store.types["rosgraph_msgs/msg/Clock"]
+            Time = store.types["builtin_interfaces/msg/Time"]
+            for t_ms, _, kind, v in _run(rate, answer, end_ms=800):
+                t = t0 + t_ms * ms
+                if kind == "clock":
+                    c = _clock(v)["clock"]
+                    w.write(cconn, t, store.serialize_cdr(Clock(clock=Time(sec=c["sec"], nanosec=c["nanosec"])),
+                                                          "rosgraph_msgs/msg/Clock"))
+                elif kind in ("request", "response"):
+                    data = {"info": {"event_type": 1 if kind == "request" else 2,
+                                     "stamp": {"sec": t // 10**9, "nanosec": t % 10**9},
+                                     "client_gid": list(range(1, 17)), "sequence_number": 1},
+                            "request": [{"data": True}] if kind == "request" else [],
+                            "response": [{"success": True, "message": ""}] if kind == "response" else []}
+                    w.write(conn, t, bytes(types.build(cls, data).serialize()))
+        for sim, want in ((True, sim_verdict), (False, "false" if sim_verdict == "true" else "true")):
+            lines: list[dict[str, Any]] = []
+            log_calls = LogCalls(CHECKED, list(CHECKED.nodes.values()), _rules(sim), 1.0, str(path))
+            assert log_calls.book is not None
+            log_calls.book.on_deadline = lambda v, lines=lines: lines.append(v.to_json())  # type: ignore[misc]
+            bag = BagCalls(list(CHECKED.nodes.values()), log_calls, str(path), bag_connections(path, []))
+            for _ in bag.tap(read_trace(path, [])):
+                pass
+            assert log_calls.finish() is not None
+            assert [v["verdict"] for v in lines if not v["update"]] == [want], (rate, sim, lines)

@@ -45,7 +45,9 @@ book, as a log's are:
   Without it (a bag ``ros2 bag record`` made) the lines are made from the
   events alone, in their stamps' order, the book's clock each line's stamp
   and, at the end, the bag's last time; a goal whose send-goal response
-  says ``accepted: false`` is rejected.
+  says ``accepted: false`` is rejected; the bag's ``/clock`` messages, when a
+  node with a call deadline may keep simulated time, are clock lines at
+  their bag times among them (a call at the same time after them).
 
 Without :data:`DECISIONS`, stamps are the events' ``info.stamp`` (a
 feedback message has none: its bag time).  A bag without the topics of a
@@ -63,6 +65,7 @@ from typing import Any, Iterable, Iterator, Mapping
 
 from rclverify.lang.types import CheckedNode
 from rclverify.traces.events import Event, TraceError
+from rclverify.traces.sim_clock import clock_value_ns, is_clock_topic
 from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
 from rclverify.backends.monitors.log_calls import LogCalls
 
@@ -150,6 +153,7 @@ class BagCalls:
                                          f"{lk.kind} /{link} is {lk.ros_type} (expected {want})")
         self.present = {t for t in self.roles if t in connections}
         self.items: list[Event] = []
+        self.clocks: list[Event] = []  # the bag's /clock messages (tap), when the book reads /clock
         self.end = float("-inf")  # the bag's last time (s)
         #: link -> its events without the request or response they should hold (introspection METADATA)
         self.skipped: dict[str, int] = {}
@@ -197,6 +201,8 @@ class BagCalls:
         for ev in events:
             if ev.topic in self.roles or ev.topic == DECISIONS or _is_call_topic(ev.topic):
                 self.items.append(ev)  # every link's: the book's lines name them all, as its log does
+            elif is_clock_topic(ev.topic) and self.calls.book is not None and self.calls.book.reads_clock:
+                self.clocks.append(ev)  # the run's /clock, for a bag without the book's lines
             self.end = max(self.end, ev.time)
             yield ev
         self.replay()
@@ -218,6 +224,12 @@ class BagCalls:
                 raise self._error(ev, exc) from None
             if got is not None:
                 lines.append((float(got["time"]), ev.index, got, ev))
+        if lines:
+            for ev in self.clocks:
+                value = clock_value_ns(ev.fields)
+                if value is not None:  # before a call line of the same time (-1), as the live taps take it
+                    clock = {"sec": value // 1_000_000_000, "nanosec": value % 1_000_000_000}
+                    lines.append((ev.time, -1, {"kind": "call", "part": "clock", "time": ev.time, "clock": clock}, ev))
         lines.sort(key=lambda x: x[:2])
         for _t, _i, line, ev in lines:  # the book's clock: each line's stamp, in stamp order
             self._feed({"kind": "call", "part": "tick", "time": line["time"]}, ev)
@@ -266,7 +278,7 @@ class BagCalls:
     def _as_live(self, line: dict[str, Any]) -> dict[str, Any]:
         """An answer to no open call as the live book logs it: an orphan (counted); a feedback dropped ({})."""
         book = self.calls.book
-        if line["part"] in ("request", "goal", "rejected") or book is None or tuple(line["key"]) in book.calls:
+        if line["part"] in ("request", "goal", "rejected", "clock") or book is None or tuple(line["key"]) in book.calls:
             return line
         if line["part"] == "feedback":
             return {}
