@@ -412,7 +412,7 @@ def test_a_bag_ros2_bag_record_made_reads_its_clock_among_the_calls(tmp_path: Pa
             lines: list[dict[str, Any]] = []
             log_calls = LogCalls(CHECKED, list(CHECKED.nodes.values()), _rules(sim), 1.0, str(path))
             assert log_calls.book is not None
-            log_calls.book.on_deadline = lambda v, lines=lines: lines.append(v.to_json())  # type: ignore[misc]
+            log_calls.book.on_deadline = lambda v, lines=lines: lines.append(v.to_json())
             bag = BagCalls(list(CHECKED.nodes.values()), log_calls, str(path), bag_connections(path, []))
             for _ in bag.tap(read_trace(path, [])):
                 pass
