@@ -16,6 +16,15 @@
   (``rospy.Time.now()``: wall time, or ``/clock`` under ``use_sim_time``),
   so an unanswered call is ``false`` as soon as its deadline expires.
 
+**Simulated time.**  The proxy's stamps and clock are its ROS clock, which
+reads ``/clock`` exactly when the ROS 1 system's ``/use_sim_time`` parameter
+is true when it starts: a global parameter every rospy and roscpp node reads,
+so the servers' clock too.  Their deadlines are judged in that clock.  A node
+the mapping says keeps the other clock (``use_sim_time``,
+:func:`~rclverify.traces.mapping.sim_time_of`) cannot be judged in its own
+clock by the proxy: each of its deadline verdicts is ``undecided``, saying why
+(:func:`clock_unjudged`), never the proxy's clock silently.
+
 Every event and verdict is one JSON line of ``--log`` (``{"kind": "event"|
 "verdict"|"summary", ...}``); on SIGINT/SIGTERM or after ``--duration``
 seconds the obligations still within their deadline are ``currently_false``,
@@ -27,6 +36,7 @@ Classes come from the workspace's ``.srv``/``.action`` files
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 import tempfile
@@ -38,7 +48,8 @@ from typing import Any, Callable, Mapping, Sequence
 from rclverify.lang.errors import RclError
 from rclverify.lang.typecheck import load
 from rclverify.traces.events import Event
-from rclverify.backends.monitors.deadline_records import DeadlineVerdict
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict
+from rclverify.traces.mapping import TopicRule, sim_time_of
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
 from rclverify.runtime.ros1_interfaces import action_classes, service_class
@@ -63,8 +74,12 @@ class ProxyRun:
     def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
                  write: Callable[[Mapping[str, object]], None] | None = None,
                  publish: Callable[[str], None] | None = None,
-                 forward: Callable[[str, Mapping[str, object], float], None] | None = None) -> None:
+                 forward: Callable[[str, Mapping[str, object], float], None] | None = None,
+                 unjudged: Mapping[str, str] | None = None) -> None:
         self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
+        #: node -> why the proxy's clock is not the one it keeps: its verdicts are ``undecided`` (:func:`clock_unjudged`)
+        self.unjudged: dict[str, str] = dict(unjudged or {})
+        self._first: dict[str, DeadlineVerdict] = {}  # an unjudged node's first verdict, given as undecided
         for m in monitors:
             m.on_verdict = self._verdict
         self.fh = log.open("w", encoding="utf-8") if log is not None else None
@@ -78,6 +93,11 @@ class ProxyRun:
             self.fh.flush()
 
     def _verdict(self, v: DeadlineVerdict) -> None:
+        why = self.unjudged.get(v.node)
+        if why is not None:  # judged in a clock the node does not keep: said undecided, never true or false
+            v = dataclasses.replace(v, verdict="undecided", reason=why, time_margin=None)
+            if not v.update:
+                self._first.setdefault(v.node, v)
         self.false += v.verdict == "false" and not v.update
         self._write({"kind": "verdict", **v.to_json()})
         if self.publish is not None:
@@ -104,12 +124,56 @@ class ProxyRun:
 
     def close(self) -> DeadlineSummary:
         with self.lock:
-            results = [m.finish().to_json() for m in self.monitors]
+            results = [self._result(m.finish()).to_json() for m in self.monitors]
             summary: DeadlineSummary = {"kind": "summary", "results": results, "false": self.false}
             self._write(summary)
             if self.fh is not None:
                 self.fh.close()
         return summary
+
+
+    def _result(self, res: DeadlineResult) -> DeadlineResult:
+        """``res`` as the summary gives it: a node judged in a clock it does not keep has every obligation
+        counted ``undecided`` with the triggers not accepted, none ``true`` or ``false``."""
+        why = self.unjudged.get(res.node)
+        if why is None:
+            return res
+        out = DeadlineResult(res.node)
+        out.unaccepted.update(res.unaccepted)
+        n = sum(res.counts.values())
+        out.unaccepted["undecided"] = out.unaccepted.get("undecided", 0) + n
+        out.first_unaccepted = res.first_unaccepted
+        first = self._first.get(res.node)
+        if first is not None and (out.first_unaccepted is None or first.trigger_stamp < out.first_unaccepted["stamp"]):
+            out.first_unaccepted = {"guarantee": first.guarantee, "where": first.trigger_where,
+                                    "stamp": first.trigger_stamp, "why": "undecided", "reason": why}
+        return out
+
+
+def clock_unjudged(rules: Mapping[str, TopicRule], nodes: Sequence[str], ros_sim: bool) -> dict[str, str]:
+    """The nodes (names) whose call deadlines the proxy cannot judge in the clock they keep, each with why:
+    the proxy's ROS clock is ``/clock`` when ``ros_sim`` (``/use_sim_time`` true) and the wall clock else;
+    a node the mapping says keeps the other clock is one (a node not said keeps the proxy's: ROS 1's
+    ``/use_sim_time`` is global)."""
+    out = {}
+    for name in nodes:
+        said = sim_time_of(rules, name)
+        if said is None or said == ros_sim:
+            continue
+        mine, theirs = ("simulated time (/clock)", "the wall clock") if said else \
+            ("the wall clock", "simulated time (/clock)")
+        out[name] = (f"node {name} keeps {mine} (the mapping's use_sim_time) but the service proxy's ROS clock "
+                     f"is {theirs} (/use_sim_time is {'true' if ros_sim else 'false'}): its call deadlines cannot "
+                     f"be judged in its clock; set /use_sim_time or the mapping's use_sim_time to agree")
+    return out
+
+
+def ros_sim_time(rospy: Any) -> bool:
+    """Whether the proxy's ROS clock reads ``/clock``: the ``/use_sim_time`` parameter (false when unset)."""
+    try:
+        return bool(rospy.get_param("/use_sim_time", False))
+    except Exception:  # noqa: BLE001 - a master that cannot say: rospy's own default, the wall clock
+        return False
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -192,8 +256,9 @@ def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
 
     def start(rospy: Any, live: Any, publish: Callable[[str], None]) -> ProxyRun:
         rules = getattr(live.engine, "rules", {})  # the mapping's rules (and tolerance) of the live run
-        run = ProxyRun([DeadlineMonitor(checked, n, rules, clock=False) for n in nodes if n.name in timed], write=live.note,
-                       publish=publish, forward=live.push)
+        mons = [DeadlineMonitor(checked, n, rules, clock=False) for n in nodes if n.name in timed]
+        run = ProxyRun(mons, write=live.note, publish=publish, forward=live.push,  # the proxy's ROS clock
+                       unjudged=clock_unjudged(rules, [m.node.name for m in mons], ros_sim_time(rospy)))
         run.handles = start_proxy(rospy, checked, forwards, dirs, run,  # type: ignore[attr-defined]
                                   lambda: rospy.Time.now().to_sec())
         return run
