@@ -314,7 +314,7 @@ def figures(res: dict[str, Any]) -> dict[str, Any]:
     out["deadlines"] = sum(v for k, v in tot.items() if k.startswith("deadline "))
     out["undecided"] = sum(tot[f"deadline {v}"] for v in ("undecided",) + UNDECIDED)
     out["agree"] = not res["disagreements"] and not res["errors"]
-    out["subset_answers"], out["subset_undecided"], out["subset_open"] = _subset(res, correct)
+    out["subset_answers"], out["subset_undecided"], out["subset_open"], out["subset_unjudged"] = _subset(res, correct)
     if victim is not None:
         live = res["live"].get(victim, Counter())
         kind = next(n.get("defect_kind") for n in res["spec"]["nodes"] if n["name"] == victim)
@@ -332,12 +332,14 @@ def in_subset(node: dict[str, Any], nodes: dict[str, dict[str, Any]]) -> bool:
     return node.get("kind") in ("alarm", "relay", "service")
 
 
-def _subset(res: dict[str, Any], correct: set[str]) -> tuple[int, int, int]:
-    """``(answers, undecided, open)`` of the run's correct nodes :func:`in_subset`: their live final verdicts
-    on answers and deadlines, those undecided, and of those the answers ``open`` (their question raised less
-    than the horizon before the monitor stopped, unanswered: the trace ended before the answer was owed)."""
+def _subset(res: dict[str, Any], correct: set[str]) -> tuple[int, int, int, int]:
+    """``(answers, undecided, open, unjudged)`` of the run's correct nodes :func:`in_subset`: their live final
+    verdicts on answers and deadlines, those undecided, and of those the answers ``open`` (their question
+    raised less than the horizon before the monitor stopped, unanswered: the trace ended before the answer
+    was owed) and the endpoints the source could not hear (``unjudged``: a server without introspection
+    heard through the rclpy source, one per endpoint, its calls never counted as answers)."""
     nodes = {n["name"]: n for n in res["spec"]["nodes"]}
-    answers = undecided = still_open = 0
+    answers = undecided = still_open = unjudged_ends = 0
     for name, c in res["live"].items():
         if name not in correct or name not in nodes or not in_subset(nodes[name], nodes):
             continue
@@ -345,7 +347,8 @@ def _subset(res: dict[str, Any], correct: set[str]) -> tuple[int, int, int]:
         answers += c["satisfied"] + c["violated"] + c["deadline true"] + c["deadline false"] + u
         undecided += u
         still_open += c["undecided open"] + c["deadline open"]
-    return answers, undecided, still_open
+        unjudged_ends += c["unjudged"]
+    return answers, undecided, still_open, unjudged_ends
 
 
 def _pct(part: int, whole: int) -> str:
@@ -544,7 +547,8 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
                 total.update(c)
             undecided += sum(c["deadline undecided"] for c in res["log"].values())
             for k in ("violated_correct", "false_deadlines_correct", "false_declarations_correct", "deadlines",
-                      "undecided", "subset_answers", "subset_undecided", "subset_open"):
+                      "undecided", "subset_answers", "subset_undecided", "subset_open",
+                      "subset_unjudged"):
                 per_run[k] += res["figures"][k]
             if "victim" in res["figures"]:
                 per_run["seeded red"] += bool(res["figures"]["red"])
@@ -591,8 +595,10 @@ def run_many(seeds: list[int], sizes: tuple[int, int], seconds: float, defect: b
           + (f" ({100 * per_run['subset_undecided'] / per_run['subset_answers']:.2f} %)"
              if per_run["subset_answers"] else "")
           + (f", of them {per_run['subset_open']} open when the run ended (raised less than the horizon before "
-             f"the monitor stopped, unanswered); without those {_pct(per_run['subset_undecided'] - per_run['subset_open'], per_run['subset_answers'] - per_run['subset_open'])}"
-             if per_run["subset_open"] else "")
+             f"the monitor stopped, unanswered) and {per_run['subset_unjudged']} endpoint(s) the source cannot hear "
+             f"(servers without introspection through the rclpy source); without those "
+             + _pct(per_run['subset_undecided'] - apart, per_run['subset_answers'] - apart)
+             if (apart := per_run["subset_open"] + per_run["subset_unjudged"]) else "")
           + (f"; seeded defects red at their node {per_run['seeded red']} of {per_run['seeded']}"
              + (f" ({per_run['seeded late unsaid']} late, undecided with use_sim_time unsaid)"
                 if per_run["seeded late unsaid"] else "") if per_run["seeded"] else "") + "; "
