@@ -135,6 +135,8 @@ class ColumnCompiler:
             with np.errstate(all="ignore"):
                 truth = cmp(vx, vy)
                 bound = bx + by
+                if type(bound) is float and bound == 0:  # both sides exact everywhere: sure wherever both are finite
+                    return truth, np.isfinite(vx) & np.isfinite(vy)
                 gap = np.abs(vx - vy)
                 sure = (bound == 0) | (gap > 2 * bound + _SLACK_REL * (np.abs(vx) + np.abs(vy)) + _SLACK_ABS)
                 sure &= np.isfinite(vx) & np.isfinite(vy)
