@@ -31,9 +31,30 @@ the last stamp in time in every clock (``sure_ns``) and the first late in every
 clock (``due_ns``, what the monitor's expiry reads), both on the run's clock;
 until ``/clock`` passes its simulated deadline its ``due_ns`` is :data:`FAR`
 (:attr:`awaiting`), so no ``false`` is given while the simulated clock stands.
+
+**A ``/clock`` message heard late.**  Live, the engine releases messages in
+stamp order under a lateness bound; a ``/clock`` message heard later than the
+bound comes after messages stamped after it, where the run read in stamp order
+(its log, its bag) has it before them.  So an obligation answered before
+``/clock`` passed its simulated deadline stays in :attr:`awaiting` with its
+verdict (:func:`answered`), and when a ``/clock`` message passes that deadline
+at or before the answer's stamp the answer is judged again by the rule above
+(:func:`_again`): a ``true`` becomes ``false`` (past the skew) or
+``undecided`` (within it), an ``undecided`` of a clock not said ``false``,
+each an update that replaces the verdict in the counts and names the late
+message and how late it was heard.  A late ``/clock`` message also places
+again each awaiting obligation whose trigger is stamped after it (at the value
+it shows), and the margin of an answer it precedes is measured again
+(withdrawable until ``/clock`` is heard after the answer).  Memory: an
+answered obligation leaves :attr:`awaiting` once ``/clock`` passed its
+deadline and was heard after its answer, or once its answer is more than the
+simulated clock's kept window (:attr:`~rclverify.traces.sim_clock.SimClock.kept_ns`:
+the node's longest bound and a minute) behind the monitor's clock; a
+``/clock`` message later than that leaves it as judged.
 """
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
 from typing import Callable, Protocol
 
@@ -41,7 +62,8 @@ from rclverify.lang.types import CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.sim_clock import SimClock, clock_value_ns
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
-from rclverify.backends.monitors.deadline_text import ms_ns
+from rclverify.backends.monitors.deadline_text import ms, ms_ns
+from rclverify.backends.monitors import deadline_late
 
 #: the due time (integer ns) of an obligation whose simulated deadline ``/clock`` has not passed yet
 FAR = 1 << 62
@@ -62,8 +84,15 @@ class ClockMonitor(Protocol):
     pending: list[Pending]
     expired: deque[Pending]
     skew_ns: int
+    now_ns: int | None
+    answered_late: deque[deadline_late.Answered]
 
     def _withdraw_false(self, p: Pending) -> None: ...
+
+    def _emit(self, v: DeadlineVerdict, counted: bool = False) -> None: ...
+
+    def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
+        ...
 
 
 def reads_clock(mon: ClockMonitor) -> bool:
@@ -75,7 +104,10 @@ def reads_clock(mon: ClockMonitor) -> bool:
 def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
     """A ``/clock`` message ``ev`` placed at ``ns`` (integer ns, the run's clock): kept in ``mon.sim`` (not by
     a node said to keep the run's clock); each obligation awaiting the simulated clock that it passes gets its
-    due times; after a reset every awaiting obligation still open is ``undecided``."""
+    due times, and one answered before it is judged again (:func:`_again`); after a reset every awaiting
+    obligation still open is ``undecided``.  Heard late (placed before a message already fed), it also
+    places again each awaiting obligation whose trigger is stamped at or after it, at the simulated time it
+    shows (the trigger's place in the run's stamp order)."""
     value = clock_value_ns(ev.fields)
     if value is None or mon.sim_mode is False:
         return
@@ -93,15 +125,123 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
         mon.pending = [p for p in mon.pending if id(p) not in gone]
         for p in open_:
             undecided(mon, p, sim.broken)
+        for p in waiting:
+            _settle(mon, p)
         return
+    late = mon.now_ns is not None and ns < mon.now_ns
+    # an answer given more than the kept window before the monitor's clock: no /clock heard later changes it
+    horizon = (mon.now_ns if mon.now_ns is not None else ns) - sim.kept_ns
+    last = sim.times[-1] if sim.times else ns
     keep = []
     for p in mon.awaiting:
-        w = sim.passed(p.sim_due_ns)
-        if w is None:
+        if p.due_ns >= FAR:  # /clock had not passed its simulated deadline
+            if late and p.stamp_ns >= ns:  # placed before this message was heard: at the value it shows
+                at = sim.at(p.stamp_ns)
+                if at is not None:
+                    p.sim_due_ns = at + p.bound_ns
+            w = sim.passed(p.sim_due_ns)
+            if w is None:
+                if p.given and p.answer_ns < horizon:
+                    _settle(mon, p)
+                else:
+                    if p.held is not None and (ns <= p.answer_ns or (late and p.stamp_ns >= ns)):
+                        _margin_again(mon, p)
+                    keep.append(p)
+                continue
+            _due(mon, p, w)
+            if not p.given:
+                continue
+            _again(mon, p, ev, ns)
+        elif p.held is not None and ns <= p.answer_ns:  # judged again: its margin read on the later /clock
+            _margin_again(mon, p)
+        # the margin of an answer is final once /clock was heard after it
+        if p.held is not None and last <= p.answer_ns and p.answer_ns >= horizon:
             keep.append(p)
         else:
-            _due(mon, p, w)
+            _settle(mon, p)
     mon.awaiting = keep
+
+
+def _settle(mon: ClockMonitor, p: Pending) -> None:
+    """Obligation ``p`` leaves the obligations kept for a late ``/clock``: the margin of its ``true``, where
+    one was held, can no longer be withdrawn."""
+    if p.held is not None:
+        mon.result.settle(p.k, p.held)
+        p.held = None
+
+
+def _margin_again(mon: ClockMonitor, p: Pending) -> None:
+    """The margin of the ``true`` given to ``p`` (held) measured again on the ``/clock`` now heard: where it
+    differs, the one noted is withdrawn and the new one noted (held)."""
+    assert p.held is not None
+    margin = margin_ns(mon, p, p.answer_ns)
+    entry = p.held
+    if margin == entry[0]:
+        return
+    p.held = None
+    res = mon.result
+    deadline_late.withdraw_margin(res, deadline_late.held(mon.answered_late, mon.awaiting, p.k), p.k, entry[0],
+                                  entry[2])
+    order = res.note_time_margin(p.k, margin, entry[2], entry[3], entry[4], held=True)
+    p.held = (margin, order, entry[2], entry[3], entry[4])
+
+
+def _again(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
+    """Obligation ``p``, answered (its verdict :attr:`~.Pending.given`) before ``/clock`` passed its simulated
+    deadline, now that ``/clock`` message ``ev`` placed at ``ns`` passed it (``p``'s due times set): judged
+    again as the run read in stamp order judges its answer (``true`` up to ``sure_ns``, ``undecided`` to
+    ``due_ns``, ``false`` after; :attr:`~.Pending.maybe`: never ``false``).  A verdict that differs replaces
+    the one given, in the counts and as an update to ``on_verdict`` naming ``ev`` and how late it was heard."""
+    a, answer = p.answer_ns, p.answer
+    assert answer is not None
+    if a <= p.sure_ns:
+        if p.held is not None and ns <= a:
+            _margin_again(mon, p)
+        return
+    want = "undecided" if a <= p.due_ns or p.maybe else "false"
+    if want == p.given:
+        return
+    res = mon.result
+    if p.given == "true":
+        res.counts["true"] -= 1
+        if p.held is not None:
+            entry, p.held = p.held, None
+            rest = deadline_late.held(mon.answered_late, mon.awaiting, p.k)  # its own no longer held
+            deadline_late.withdraw_margin(res, rest, p.k, entry[0], p.trigger.where)
+    else:
+        res.unaccepted["undecided"] -= 1
+    if mon.now_ns is not None and ns < mon.now_ns:
+        late = ms(ev.late) if ev.late > 0 else ms_ns(mon.now_ns - ns)
+        heard = (f"heard {late} after its time, past the lateness bound"
+                 if ev.late > 0 else f"heard after a message stamped {late} after it")
+    else:
+        heard = "read after the answer"
+    withdrawn = (f"; the {p.given} given when the answer came is withdrawn: the /clock message at {ev.where} "
+                 f"(at {ns / 1e9:.3f} s, /clock at {(clock_value_ns(ev.fields) or 0) / 1e9:.3f} s, past the "
+                 f"simulated deadline before the answer) was {heard}")
+    if want == "undecided":
+        why = (f"answered at {answer.where} {ms_ns(a - p.due_ns)} past its deadline, but {p.maybe}" if p.maybe
+               else _band_why(mon, p, answer, a))
+        p.given = "undecided"
+        undecided(mon, p, why + withdrawn, update=True)
+        return
+    v = mon.answered_verdict(p, a, answer, p.bound_ns / 1e9, p.semantics)
+    p.given = "false"
+    mon._emit(dataclasses.replace(v, reason=v.reason + withdrawn, update=True), counted=True)
+    margin = margin_ns(mon, p, a)  # held: a /clock message heard later, placed before the answer, moves it
+    order = res.note_time_margin(p.k, margin, p.trigger.where, answer.where, a / 1e9, held=True)
+    p.held = (margin, order, p.trigger.where, answer.where, a / 1e9)
+
+
+def answered(mon: ClockMonitor, p: Pending, given: str, ev: Event, ns: int, semantics: str = "",
+             entry: tuple[int, int, str, str, float] | None = None) -> None:
+    """Obligation ``p`` placed in a clock was given ``given`` (``true``, or ``undecided`` in the band) by
+    answer ``ev`` stamped ``ns`` (its ``semantics``; ``entry``: its margin noted withdrawable); before
+    ``/clock`` passed its simulated deadline (:data:`FAR`), it is kept for a ``/clock`` message heard late
+    (:func:`tick`)."""
+    if p.due_ns < FAR:
+        return
+    p.given, p.answer, p.answer_ns, p.semantics, p.held = given, ev, ns, semantics, entry
 
 
 def _unsaid_before(mon: ClockMonitor, ns: int) -> None:
@@ -173,8 +313,9 @@ def undecided(mon: ClockMonitor, p: Pending, why: str, update: bool = False) -> 
 
 def band(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
     """Obligation ``p`` answered by ``ev`` at ``ns``, after its last time in time in every clock and not after
-    its first late in every clock: ``undecided``, saying why."""
+    its first late in every clock: ``undecided``, saying why (kept for a late ``/clock``: :func:`answered`)."""
     undecided(mon, p, _band_why(mon, p, ev, ns))
+    answered(mon, p, "undecided", ev, ns)
 
 
 def band_late(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
@@ -217,5 +358,5 @@ def words(mon: ClockMonitor, p: Pending) -> str:
             f"{passed}): the node's clock is not said")
 
 
-__all__ = ["DECLARE", "FAR", "band", "band_late", "margin_ns", "place", "reads_clock", "tick", "undecided",
+__all__ = ["DECLARE", "FAR", "answered", "band", "band_late", "margin_ns", "place", "reads_clock", "tick", "undecided",
            "words"]

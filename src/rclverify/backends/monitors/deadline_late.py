@@ -23,13 +23,14 @@ A late answer's margin is counted when it comes, marked withdrawable
 (:meth:`~.deadline_records.DeadlineResult.note_time_margin`, ``held``);
 withdrawn, the guarantee's smallest margin becomes the smallest of those
 no revision can withdraw (:attr:`~.deadline_records.DeadlineResult.floor`)
-and of the late answers still kept, the first noted of equals, as if the
-withdrawn one had never been counted.
+and of the late answers still kept and the answers kept for a late
+``/clock`` (:mod:`.deadline_clock`), the first noted of equals, as if the
+withdrawn one had never been counted (:func:`withdraw_margin`).
 """
 from __future__ import annotations
 
 from collections import deque
-from typing import Mapping, Protocol
+from typing import Iterable, Mapping, Protocol
 
 from rclverify.traces.events import Event
 from rclverify.backends.monitors import deadline_skew
@@ -42,22 +43,28 @@ KEPT = 256
 #: one kept obligation: (the obligation, its late answer's margin in ns, the order that margin was noted in,
 #: the answer's place, its stamp s)
 Answered = tuple[Pending, int, int, str, float]
+#: one margin still withdrawable, as :attr:`~.deadline_records.DeadlineResult.floor` holds one: (margin ns, the
+#: order it was noted in, the trigger's place, the answer's place, its stamp s)
+Held = tuple[int, int, str, str, float]
 
 
 class LateAnswers(deadline_skew.DeadlineMonitor, Protocol):
     """What this module reads of :class:`~.deadlines.DeadlineMonitor` beyond the skew rule's."""
 
     answered_late: deque[Answered]
+    awaiting: list[Pending]
     result: DeadlineResult
 
     def _emit(self, v: DeadlineVerdict) -> None: ...
 
 
-def hold(mon: LateAnswers, p: Pending, ns: int, ev: Event) -> None:
+def hold(mon: LateAnswers, p: Pending, ns: int, ev: Event, margin: int | None = None) -> None:
     """Expired obligation ``p`` (judged ``false``, not marked by the skew) answered by output ``ev`` stamped
-    ``ns``, after its deadline: its margin counted (withdrawable) and ``p`` kept for :func:`revise`; the
-    oldest kept one past :data:`KEPT` leaves, its margin no longer withdrawable."""
-    margin = p.due_ns - ns
+    ``ns``, after its deadline: its margin (``margin``, ns, in the clock ``p`` is kept in; ``None``: its due
+    time less ``ns``) counted (withdrawable) and ``p`` kept for :func:`revise`; the oldest kept one past
+    :data:`KEPT` leaves, its margin no longer withdrawable."""
+    if margin is None:
+        margin = p.due_ns - ns
     order = mon.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True,
                                         held=True)
     kept = mon.answered_late
@@ -79,21 +86,24 @@ def revise(mon: LateAnswers, ev: Event, ns: int, fresh: Mapping[str, object]) ->
             _withdraw_margin(mon, entry)
 
 
-def met_late(mon: LateAnswers, p: Pending, ev: Event, ns: int) -> None:
+def met_late(mon: LateAnswers, p: Pending, ev: Event, ns: int, margin: int | None = None) -> None:
     """Obligation ``p`` was judged ``false`` when the clock passed its deadline;
     output ``ev``, stamped ``ns`` (within it), answers it, heard after the
     clock passed (a message later than the lateness bound, or a stamp the
     node copied from its question): the deadline is met, on the answer's
     own stamp, as a run read in stamp order finds it (docs/semantics.md,
     "Event time": lateness never makes a violation).  The ``false`` given
-    is withdrawn from the counts; the verdict that follows says why."""
+    is withdrawn from the counts; the verdict that follows says why.
+    ``margin``: the answer's (ns, in the clock ``p`` is kept in; ``None``: its due time less ``ns``)."""
+    if margin is None:
+        margin = p.due_ns - ns
     if p.maybe:  # counted undecided, not false: now met on its own answer's stamp
         deadline_skew.decided_late(mon, p)
         mon._emit(DeadlineVerdict(mon.node.name, p.k, "true", p.trigger.where, p.stamp, p.due, ns / 1e9,
                                   ev.where, f"answered after {ms_ns(ns - p.stamp_ns)} (deadline "
                                   f"{ms_ns(p.bound_ns)}), heard after the clock had passed the "
-                                  "deadline: met on the answer's own stamp", time_margin=(p.due_ns - ns) / 1e9))
-        mon.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9)
+                                  "deadline: met on the answer's own stamp", time_margin=margin / 1e9))
+        mon.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, ns / 1e9)
         return
     mon._withdraw_false(p)
     mon.result.counts["true"] += 1
@@ -102,31 +112,46 @@ def met_late(mon: LateAnswers, p: Pending, ev: Event, ns: int) -> None:
                         f"answered after {ms_ns(ns - p.stamp_ns)} (deadline {ms_ns(p.bound_ns)}), "
                         f"heard after the clock had passed the deadline (at {late} behind it): met on the "
                         "answer's own stamp; the false given when the clock passed is withdrawn",
-                        update=True, time_margin=(p.due_ns - ns) / 1e9)
+                        update=True, time_margin=margin / 1e9)
     if mon.on_verdict is not None:
         mon.on_verdict(v)
-    mon.result.note_time_margin(p.k, p.due_ns - ns, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True)
+    mon.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True)
 
 
 def _withdraw_margin(mon: LateAnswers, entry: Answered) -> None:
     """The late answer's margin of ``entry`` out of its guarantee's time margins (module docstring)."""
-    p, margin = entry[0], entry[1]
-    margins = mon.result.time_margins
-    m = margins.get(p.k)
+    p = entry[0]
+    withdraw_margin(mon.result, held(mon.answered_late, mon.awaiting, p.k), p.k, entry[1], p.trigger.where)
+
+
+def held(answered_late: Iterable[Answered], awaiting: Iterable[Pending], k: int) -> list[Held]:
+    """The margins of guarantee ``k`` a revision may still withdraw: the late answers kept (``answered_late``)
+    and the ``true`` answers given before ``/clock`` passed their deadline (``awaiting``'s
+    :attr:`~.deadline_records.Pending.held`), each in :attr:`~.deadline_records.DeadlineResult.floor`'s shape."""
+    got = [(e[1], e[2], e[0].trigger.where, e[3], e[4]) for e in answered_late if e[0].k == k]
+    return got + [p.held for p in awaiting if p.k == k and p.held is not None]
+
+
+def withdraw_margin(result: DeadlineResult, rest: list[Held], k: int, margin: int, trigger_where: str) -> None:
+    """One answer's margin ``margin`` (ns; of the trigger at ``trigger_where``) out of guarantee ``k``'s time
+    margins in ``result``; where it was the smallest, the smallest becomes the least of ``rest`` (the
+    margins still withdrawable, it not among them) and of those no revision can withdraw
+    (:attr:`~.deadline_records.DeadlineResult.floor`), the first noted of equals."""
+    margins = result.time_margins
+    m = margins.get(k)
     if m is None:
         return
     m.answers -= 1
     if not m.answers:
         if not m.unanswered:
-            del margins[p.k]
+            del margins[k]
         return
-    if (m.margin_ns, m.trigger_where) != (margin, p.trigger.where):
+    if (m.margin_ns, m.trigger_where) != (margin, trigger_where):
         return  # not the smallest: the smallest stands
-    rest = [(e[1], e[2], e[0].trigger.where, e[3], e[4]) for e in mon.answered_late if e[0].k == p.k]
-    low = mon.result.floor.get(p.k)
+    low = result.floor.get(k)
     best = min(rest + ([low] if low is not None else []), default=None, key=lambda e: e[:2])
     if best is not None:
         m.margin_ns, _, m.trigger_where, m.answer_where, m.answer = best
 
 
-__all__ = ["KEPT", "Answered", "LateAnswers", "hold", "met_late", "revise"]
+__all__ = ["KEPT", "Answered", "Held", "LateAnswers", "held", "hold", "met_late", "revise", "withdraw_margin"]

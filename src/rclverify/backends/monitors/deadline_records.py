@@ -93,6 +93,17 @@ class Pending:
     sim_due_ns: int = 0
     wall_due_ns: int = 0
     sim_passed_ns: int = 0
+    #: with a ``clock``, answered before ``/clock`` passed its simulated deadline: the verdict given (``true``,
+    #: or ``undecided`` in the band of a clock not said; ``""``: not so answered), the answer, its stamp
+    #: (integer ns) and the arithmetic it held in; a ``/clock`` message heard later showing the deadline passed
+    #: before that stamp judges it again (:func:`.deadline_clock.tick`)
+    given: str = ""
+    answer: Event | None = None
+    answer_ns: int = 0
+    semantics: str = ""
+    #: the margin of a ``true`` so given, noted withdrawable (:attr:`DeadlineResult.floor`'s shape) until
+    #: ``/clock`` passes the deadline or the obligation leaves the window kept for a late ``/clock``
+    held: tuple[int, int, str, str, float] | None = None
 
     @property
     def bound_ns(self) -> int:

@@ -171,8 +171,10 @@ class DeadlineMonitor(VerdictWords):
         margin = v.time_margin if ns is None else deadline_clock.margin_ns(self, p, ns) / 1e9
         return dataclasses.replace(v, reason=v.reason + deadline_clock.words(self, p), time_margin=margin)
 
-    def _emit(self, v: DeadlineVerdict) -> None:
-        if v.update:  # the answer of an expired obligation: shown, not counted again
+    def _emit(self, v: DeadlineVerdict, counted: bool = False) -> None:
+        """Verdict ``v`` given: counted (an update only when ``counted``: a verdict that replaces one the
+        caller withdrew from the counts, :func:`.deadline_clock.tick`) and passed to ``on_verdict``."""
+        if v.update and not counted:  # the answer of an expired obligation: shown, not counted again
             if self.result.first_false is not None and self.result.first_false.trigger_where == v.trigger_where:
                 self.result.first_false = v
             if (v.trigger_where, v.guarantee) in self._falses:
@@ -185,7 +187,8 @@ class DeadlineMonitor(VerdictWords):
             self._last_false = v
             if len(self._falses) < 1024:  # bounded; past it the latest false stands in (deadline_late.met_late)
                 self._falses[(v.trigger_where, v.guarantee)] = v
-            if self.result.first_false is None:
+            first = self.result.first_false
+            if first is None or (counted and v.trigger_stamp < first.trigger_stamp):  # its place in stamp order
                 self.result.first_false = v
         if self.on_verdict is not None:
             self.on_verdict(v)
@@ -323,12 +326,12 @@ class DeadlineMonitor(VerdictWords):
                     if p.clock and ns > p.sure_ns:  # in time in one clock it may be kept in, not in every one
                         deadline_clock.band_late(self, p, ev, ns)
                         continue
-                    deadline_late.met_late(self, p, ev, ns)
+                    deadline_late.met_late(self, p, ev, ns, self._margin(p, ns))
                     continue
                 if p.maybe:  # answered late, or in time by the output within the skew before it: still undecided
                     continue
                 self._emit(self.late_verdict(p, ns, ev))
-                deadline_late.hold(self, p, ns, ev)  # an output within the skew before it may still come
+                deadline_late.hold(self, p, ns, ev, self._margin(p, ns))  # an output within the skew before it may come
         if self.answered_late:
             deadline_late.revise(self, ev, ns, {c: self.values[c] for c in outs if c not in self.state_outs})
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
@@ -368,9 +371,18 @@ class DeadlineMonitor(VerdictWords):
             deadline_clock.band(self, p, ev, ns)
             return True
         self._emit(self.answered_verdict(p, ns, ev, d, j.semantics))
-        self.result.note_time_margin(p.k, deadline_clock.margin_ns(self, p, ns) if p.clock else p.due_ns - ns,
-                                     p.trigger.where, ev.where, stamp)
+        margin = self._margin(p, ns)
+        held = bool(p.clock) and p.due_ns >= deadline_clock.FAR  # before /clock passed it: a late /clock may
+        order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp, held=held)
+        if held:
+            deadline_clock.answered(self, p, "true", ev, ns, j.semantics, (margin, order, p.trigger.where,
+                                                                           ev.where, stamp))
         return True
+
+    def _margin(self, p: Pending, ns: int) -> int:
+        """The time margin (integer ns) of an answer stamped ``ns`` to obligation ``p``: its deadline less the
+        answer in the clock it is kept in (:func:`.deadline_clock.margin_ns`), or on the run's clock."""
+        return deadline_clock.margin_ns(self, p, ns) if p.clock else p.due_ns - ns
 
     def _heard_late(self, p: Pending) -> bool:
         """A trigger heard after outputs stamped after it (docs/semantics.md, "Answers"):
