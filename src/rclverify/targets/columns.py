@@ -295,7 +295,7 @@ def column(vals: list[Any], kind: str, codes: Mapping[str, int]) -> tuple[np.nda
         good = np.fromiter(map(is_, map(type, vals), repeat(want)), bool, n)
     if kind == "real":
         if types == {float}:
-            col = np.array(vals, dtype=np.float64)
+            col = np.fromiter(vals, np.float64, n)
         else:
             col = np.array([v if g else np.nan for v, g in zip(vals, good.tolist())], dtype=np.float64)
         good &= np.isfinite(col)

@@ -254,7 +254,7 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
     found = list(map(_TIME, structs))
     if set(map(type, found)) != {float}:  # an integer time: the exact reader's (its float() is the event's)
         return None
-    times = np.array(found, dtype=np.float64)
+    times = np.fromiter(found, np.float64, n)  # (each a float: converted as np.array converts it)
     if not np.isfinite(times).all():
         return None
     topics, distinct = _topics(structs)
