@@ -95,6 +95,11 @@ class SimClock:
         if i > 0:
             del self.times[:i], self.values[:i]
 
+    def heard_after(self, t_ns: int) -> bool:
+        """Whether a sample placed after ``t_ns`` (ns, the run's clock) was heard, so that :meth:`at` of
+        ``t_ns`` no longer changes (or :attr:`broken`: it is ``None`` from here on)."""
+        return bool(self.broken) or (bool(self.times) and self.times[-1] > t_ns)
+
     def at(self, t_ns: int) -> int | None:
         """The simulated time (ns) at ``t_ns`` of the run's clock: the value of the last sample placed at or
         before it; ``None`` before the first sample kept (older ones are forgotten: :attr:`kept_ns`), or once

@@ -42,13 +42,17 @@ at or before the answer's stamp the answer is judged again by the rule above
 (:func:`_again`): a ``true`` becomes ``false`` (past the skew) or
 ``undecided`` (within it), an ``undecided`` of a clock not said ``false``,
 each an update that replaces the verdict in the counts and names the late
-message and how late it was heard.  A late ``/clock`` message also places
-again each awaiting obligation whose trigger is stamped after it (at the value
-it shows), and the margin of an answer it precedes is measured again
-(withdrawable until ``/clock`` is heard after the answer).  Memory: an
-answered obligation leaves :attr:`awaiting` once ``/clock`` passed its
-deadline and was heard after its answer, or once its answer is more than the
-simulated clock's kept window (:attr:`~rclverify.traces.sim_clock.SimClock.kept_ns`:
+message and how late it was heard (:func:`judge_again`, after what the
+message expires, as the run read in stamp order gives them).  A late
+``/clock`` message also places again each awaiting obligation whose trigger
+is stamped after it (at the value it shows), and the margin of an answer it
+precedes (``s + d`` less ``/clock`` at the answer) is measured again: an
+answer's margin stays withdrawable, its obligation in :attr:`awaiting`, until
+``/clock`` is heard after the answer (a late answer's, kept by
+:mod:`.deadline_late`, while it is kept there).  Memory: an answered
+obligation leaves :attr:`awaiting` once ``/clock`` passed its deadline and
+was heard after its answer, or once its answer is more than the simulated
+clock's kept window (:attr:`~rclverify.traces.sim_clock.SimClock.kept_ns`:
 the node's longest bound and a minute) behind the monitor's clock; a
 ``/clock`` message later than that leaves it as judged.
 """
@@ -101,23 +105,27 @@ def reads_clock(mon: ClockMonitor) -> bool:
     return mon.sim_mode is True or (mon.sim_mode is None and mon.sim.heard)
 
 
-def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
+def tick(mon: ClockMonitor, ev: Event, ns: int) -> list[Pending]:
     """A ``/clock`` message ``ev`` placed at ``ns`` (integer ns, the run's clock): kept in ``mon.sim`` (not by
     a node said to keep the run's clock); each obligation awaiting the simulated clock that it passes gets its
-    due times, and one answered before it is judged again (:func:`_again`); after a reset every awaiting
-    obligation still open is ``undecided``.  Heard late (placed before a message already fed), it also
-    places again each awaiting obligation whose trigger is stamped at or after it, at the simulated time it
-    shows (the trigger's place in the run's stamp order)."""
+    due times; after a reset every awaiting obligation still open is ``undecided``.  Heard late (placed
+    before a message already fed), it also places again each awaiting obligation whose trigger is stamped at
+    or after it, at the simulated time it shows (the trigger's place in the run's stamp order), and measures
+    again the margins of the answers it precedes.  Returns the obligations answered before ``/clock`` passed
+    their deadline that it passes, to be judged again (:func:`judge_again`, once what it expires is)."""
     value = clock_value_ns(ev.fields)
     if value is None or mon.sim_mode is False:
-        return
+        return []
     sim = mon.sim
     first = not sim.heard
     sim.see(ns, value, ev.where)
     if first and mon.sim_mode is None:
         _unsaid_before(mon, ns)
+    late = mon.now_ns is not None and ns < mon.now_ns
+    if late and mon.answered_late:
+        _late_margins_again(mon, ns)
     if not mon.awaiting:
-        return
+        return []
     if sim.broken:
         waiting, mon.awaiting = mon.awaiting, []
         gone = {id(p) for p in waiting}
@@ -127,12 +135,10 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
             undecided(mon, p, sim.broken)
         for p in waiting:
             _settle(mon, p)
-        return
-    late = mon.now_ns is not None and ns < mon.now_ns
-    # an answer given more than the kept window before the monitor's clock: no /clock heard later changes it
-    horizon = (mon.now_ns if mon.now_ns is not None else ns) - sim.kept_ns
-    last = sim.times[-1] if sim.times else ns
-    keep = []
+        return []
+    horizon = _horizon(mon, ns)
+    keep: list[Pending] = []
+    again: list[Pending] = []
     for p in mon.awaiting:
         if p.due_ns >= FAR:  # /clock had not passed its simulated deadline
             if late and p.stamp_ns >= ns:  # placed before this message was heard: at the value it shows
@@ -149,17 +155,39 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> None:
                     keep.append(p)
                 continue
             _due(mon, p, w)
-            if not p.given:
-                continue
-            _again(mon, p, ev, ns)
-        elif p.held is not None and ns <= p.answer_ns:  # judged again: its margin read on the later /clock
+            if p.given:
+                again.append(p)
+            continue
+        if p.held is not None and ns <= p.answer_ns:  # judged already: its margin read on this /clock
             _margin_again(mon, p)
-        # the margin of an answer is final once /clock was heard after it
-        if p.held is not None and last <= p.answer_ns and p.answer_ns >= horizon:
-            keep.append(p)
-        else:
-            _settle(mon, p)
+        _keep_or_settle(mon, p, keep, horizon)
     mon.awaiting = keep
+    return again
+
+
+def judge_again(mon: ClockMonitor, again: list[Pending], ev: Event, ns: int) -> None:
+    """The obligations ``again`` that ``/clock`` message ``ev`` (placed at ``ns``) passed after their answer
+    was judged (:func:`tick`), each judged again (:func:`_again`); kept while their margin may still move."""
+    horizon = _horizon(mon, ns)
+    for p in again:
+        _again(mon, p, ev, ns)
+        _keep_or_settle(mon, p, mon.awaiting, horizon)
+
+
+def _horizon(mon: ClockMonitor, ns: int) -> int:
+    """The time (ns, the run's clock) before which an answer is no longer kept for a late ``/clock``: the
+    simulated clock's kept window behind the monitor's clock (``ns``, the ``/clock`` message's, before any)."""
+    return (mon.now_ns if mon.now_ns is not None else ns) - mon.sim.kept_ns
+
+
+def _keep_or_settle(mon: ClockMonitor, p: Pending, keep: list[Pending], horizon: int) -> None:
+    """Answered obligation ``p``, ``/clock`` past its deadline: kept (appended to ``keep``) while its margin
+    may still move (no ``/clock`` heard after its answer, within the kept window), else settled."""
+    last = mon.sim.times[-1] if mon.sim.times else 0
+    if p.held is not None and last <= p.answer_ns and p.answer_ns >= horizon:
+        keep.append(p)
+    else:
+        _settle(mon, p)
 
 
 def _settle(mon: ClockMonitor, p: Pending) -> None:
@@ -184,6 +212,23 @@ def _margin_again(mon: ClockMonitor, p: Pending) -> None:
                                   entry[2])
     order = res.note_time_margin(p.k, margin, entry[2], entry[3], entry[4], held=True)
     p.held = (margin, order, entry[2], entry[3], entry[4])
+
+
+def _late_margins_again(mon: ClockMonitor, ns: int) -> None:
+    """A ``/clock`` message placed at ``ns`` heard late: the margin of each late answer kept
+    (:mod:`.deadline_late`) to an obligation placed in a clock, stamped at or after ``ns``, measured again on
+    it (the one noted withdrawn where it differs, the new one noted withdrawable)."""
+    kept = mon.answered_late
+    for i, (p, margin, order, where, stamp) in enumerate(kept):
+        if not p.clock or p.answer_ns < ns:
+            continue
+        now = margin_ns(mon, p, p.answer_ns)
+        if now == margin:
+            continue
+        rest = [e for e in deadline_late.held(kept, mon.awaiting, p.k) if e[1] != order]
+        deadline_late.withdraw_margin(mon.result, rest, p.k, margin, p.trigger.where)
+        kept[i] = (p, now, mon.result.note_time_margin(p.k, now, p.trigger.where, where, stamp, held=True), where,
+                   stamp)
 
 
 def _again(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
@@ -235,11 +280,14 @@ def _again(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
 
 def answered(mon: ClockMonitor, p: Pending, given: str, ev: Event, ns: int, semantics: str = "",
              entry: tuple[int, int, str, str, float] | None = None) -> None:
-    """Obligation ``p`` placed in a clock was given ``given`` (``true``, or ``undecided`` in the band) by
-    answer ``ev`` stamped ``ns`` (its ``semantics``; ``entry``: its margin noted withdrawable); before
-    ``/clock`` passed its simulated deadline (:data:`FAR`), it is kept for a ``/clock`` message heard late
-    (:func:`tick`)."""
+    """Obligation ``p`` placed in a clock was given ``given`` (``true``, or ``undecided`` in the band) by answer ``ev`` stamped ``ns`` (its ``semantics``; ``entry``: its margin noted withdrawable, given
+    while ``/clock`` was not heard after ``ns``); before ``/clock`` passed its simulated deadline
+    (:data:`FAR`), it is kept for a ``/clock`` message heard late (:func:`tick`), after it only its margin
+    is."""
     if p.due_ns < FAR:
+        if entry is not None:  # its margin reads /clock at the answer, which a later /clock placed before moves
+            p.answer_ns, p.held = ns, entry
+            mon.awaiting.append(p)
         return
     p.given, p.answer, p.answer_ns, p.semantics, p.held = given, ev, ns, semantics, entry
 
@@ -358,5 +406,5 @@ def words(mon: ClockMonitor, p: Pending) -> str:
             f"{passed}): the node's clock is not said")
 
 
-__all__ = ["DECLARE", "FAR", "answered", "band", "band_late", "margin_ns", "place", "reads_clock", "tick", "undecided",
+__all__ = ["DECLARE", "FAR", "answered", "band", "band_late", "judge_again", "margin_ns", "place", "reads_clock", "tick", "undecided",
            "words"]

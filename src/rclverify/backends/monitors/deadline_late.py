@@ -65,6 +65,7 @@ def hold(mon: LateAnswers, p: Pending, ns: int, ev: Event, margin: int | None = 
     :data:`KEPT` leaves, its margin no longer withdrawable."""
     if margin is None:
         margin = p.due_ns - ns
+    p.answer_ns = ns
     order = mon.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, ns / 1e9, was_unanswered=True,
                                         held=True)
     kept = mon.answered_late

@@ -198,10 +198,12 @@ class DeadlineMonitor(VerdictWords):
         ns = event_stamp_ns(ev)
         topic = ev.topic.lstrip("/")
         if topic == CLOCK_TOPIC:  # the run's simulated clock (deadline_clock.py)
-            deadline_clock.tick(self, ev, ns)
+            again = deadline_clock.tick(self, ev, ns)
             if self.now_ns is not None and ns < self.now_ns:  # heard late: what it shows passed expires now
                 self._expire(self.now_ns)
             self._advance_ns(ns)
+            if again:  # answers judged before it passed their deadline, after what it expires (stamp order)
+                deadline_clock.judge_again(self, again, ev, ns)
             return
         stamp = ns / 1e9
         late = self.now_ns is not None and ns < self.now_ns  # stamped before a message heard already
@@ -372,11 +374,13 @@ class DeadlineMonitor(VerdictWords):
             return True
         self._emit(self.answered_verdict(p, ns, ev, d, j.semantics))
         margin = self._margin(p, ns)
-        held = bool(p.clock) and p.due_ns >= deadline_clock.FAR  # before /clock passed it: a late /clock may
+        # placed in a clock, before /clock passed its deadline or was heard after the answer: a /clock message
+        # heard later may change its verdict or its margin (deadline_clock.tick)
+        held = bool(p.clock) and (p.due_ns >= deadline_clock.FAR or not self.sim.heard_after(ns))
         order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp, held=held)
         if held:
-            deadline_clock.answered(self, p, "true", ev, ns, j.semantics, (margin, order, p.trigger.where,
-                                                                           ev.where, stamp))
+            deadline_clock.answered(self, p, "true", ev, ns, j.semantics,
+                                    (margin, order, p.trigger.where, ev.where, stamp))
         return True
 
     def _margin(self, p: Pending, ns: int) -> int:
