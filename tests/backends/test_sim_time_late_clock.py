@@ -321,3 +321,18 @@ def test_the_live_run_its_log_and_its_bag_give_the_same_counts(tmp_path: Path, c
             assert given == ["true", want] and withdrawn[0]["verdict"]["update"] is True
         else:
             assert not withdrawn
+
+
+def test_the_clock_is_heard_after_an_answer_once_any_later_sample_comes() -> None:
+    """An answer's margin reads /clock at it: final once a sample placed after it was heard, one repeating
+    the value (a paused simulator) included; control: none after it, or a broken clock (nothing to read)."""
+    from rclverify.traces.sim_clock import SimClock
+
+    c = SimClock()
+    assert not c.heard_after(0)
+    c.see(100, 5)
+    assert c.heard_after(99) and not c.heard_after(100)
+    c.see(120, 5)  # the clock stands still: no new sample kept, but heard
+    assert c.times == [100] and c.heard_after(110) and not c.heard_after(120)
+    c.see(130, 4)  # went back: broken
+    assert c.broken and c.heard_after(10**9)

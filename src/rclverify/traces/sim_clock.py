@@ -52,7 +52,7 @@ class SimClock:
     """The ``/clock`` samples heard in a run, in the run's order: ``(t, value)``, both integer ns, ``t`` on
     the run's clock.  Values never go back while :attr:`broken` is empty."""
 
-    __slots__ = ("times", "values", "broken", "kept_ns")
+    __slots__ = ("times", "values", "broken", "kept_ns", "heard_ns")
 
     def __init__(self, kept_s: float = 600.0) -> None:
         self.times: list[int] = []
@@ -62,6 +62,8 @@ class SimClock:
         #: how far back (ns of the run's clock) samples are kept at least: once the samples span twice
         #: that, the older half is forgotten (:meth:`forget_before`), so memory is bounded by the window
         self.kept_ns = round(kept_s * 1e9)
+        #: the time (ns, the run's clock) of the last sample heard, one repeating the value included
+        self.heard_ns: int | None = None
 
     @property
     def heard(self) -> bool:
@@ -82,6 +84,7 @@ class SimClock:
             self.broken = (f"/clock went back from {values[-1] / 1e9:.3f} s to {value_ns / 1e9:.3f} s"
                            + (f" at {where}" if where else "") + " (the simulation was reset)")
             return
+        self.heard_ns = t_ns
         if values and value_ns == values[-1] and times:
             return  # the clock stands still: the first sample of the value says when it got there
         times.append(t_ns)
@@ -96,9 +99,11 @@ class SimClock:
             del self.times[:i], self.values[:i]
 
     def heard_after(self, t_ns: int) -> bool:
-        """Whether a sample placed after ``t_ns`` (ns, the run's clock) was heard, so that :meth:`at` of
-        ``t_ns`` no longer changes (or :attr:`broken`: it is ``None`` from here on)."""
-        return bool(self.broken) or (bool(self.times) and self.times[-1] > t_ns)
+        """Whether a sample placed after ``t_ns`` (ns, the run's clock) was heard (one repeating the value
+        included), so that :meth:`at` of ``t_ns`` no longer changes: ``/clock``'s one writer publishes in
+        order, so no sample placed before it comes later (or :attr:`broken`: :meth:`at` is ``None`` from
+        here on)."""
+        return bool(self.broken) or (self.heard_ns is not None and self.heard_ns > t_ns)
 
     def at(self, t_ns: int) -> int | None:
         """The simulated time (ns) at ``t_ns`` of the run's clock: the value of the last sample placed at or

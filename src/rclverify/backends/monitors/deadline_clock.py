@@ -183,8 +183,7 @@ def _horizon(mon: ClockMonitor, ns: int) -> int:
 def _keep_or_settle(mon: ClockMonitor, p: Pending, keep: list[Pending], horizon: int) -> None:
     """Answered obligation ``p``, ``/clock`` past its deadline: kept (appended to ``keep``) while its margin
     may still move (no ``/clock`` heard after its answer, within the kept window), else settled."""
-    last = mon.sim.times[-1] if mon.sim.times else 0
-    if p.held is not None and last <= p.answer_ns and p.answer_ns >= horizon:
+    if p.held is not None and not mon.sim.heard_after(p.answer_ns) and p.answer_ns >= horizon:
         keep.append(p)
     else:
         _settle(mon, p)
