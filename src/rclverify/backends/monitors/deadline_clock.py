@@ -43,15 +43,17 @@ at or before the answer's stamp the answer is judged again by the rule above
 ``undecided`` (within it), an ``undecided`` of a clock not said ``false``,
 each an update that replaces the verdict in the counts and names the late
 message and how late it was heard (:func:`judge_again`, after what the
-message expires, as the run read in stamp order gives them).  A late
+message expires, as the run read in stamp order gives them).  ``/clock``'s
+one writer publishes in order, so once a ``/clock`` message placed after
+the answer was heard, none placed before it comes: the verdict stands.  A late
 ``/clock`` message also places again each awaiting obligation whose trigger
 is stamped after it (at the value it shows), and the margin of an answer it
 precedes (``s + d`` less ``/clock`` at the answer) is measured again: an
 answer's margin stays withdrawable, its obligation in :attr:`awaiting`, until
 ``/clock`` is heard after the answer (a late answer's, kept by
 :mod:`.deadline_late`, while it is kept there).  Memory: an answered
-obligation leaves :attr:`awaiting` once ``/clock`` passed its deadline and
-was heard after its answer, or once its answer is more than the simulated
+obligation leaves :attr:`awaiting` once ``/clock`` was heard after its
+answer (usually the next ``/clock`` message), or once its answer is more than the simulated
 clock's kept window (:attr:`~rclverify.traces.sim_clock.SimClock.kept_ns`:
 the node's longest bound and a minute) behind the monitor's clock; a
 ``/clock`` message later than that leaves it as judged.
@@ -147,8 +149,8 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> list[Pending]:
                     p.sim_due_ns = at + p.bound_ns
             w = sim.passed(p.sim_due_ns)
             if w is None:
-                if p.given and p.answer_ns < horizon:
-                    _settle(mon, p)
+                if p.given and (p.answer_ns < horizon or sim.heard_after(p.answer_ns)):
+                    _settle(mon, p)  # /clock heard after its answer: a later one passes it after the answer
                 else:
                     if p.held is not None and (ns <= p.answer_ns or (late and p.stamp_ns >= ns)):
                         _margin_again(mon, p)
