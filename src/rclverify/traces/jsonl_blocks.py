@@ -239,14 +239,16 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
     if not (u[ends - 1] == 125).all() or not (u[ends[:-1] + 1] == 123).all():
         return None
     structs = None
+    decode = dec.decode_lines  # the decoder that read ``data``: a released block's rows are decoded again by it
     if dec.decode_known is not None:
         try:
             structs = dec.decode_known(data)
+            decode = dec.decode_known
         except Exception:  # noqa: BLE001 - a topic not seen before (or what decode_lines refuses too): read below
             structs = None
     if structs is None:
         try:
-            structs = dec.decode_lines(data)
+            structs = decode(data)
         except Exception:  # noqa: BLE001 - whatever msgspec refuses: the line-by-line paths say what
             return None
     if len(structs) != n:
@@ -260,7 +262,21 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
     topics, distinct = _topics(structs)
     lines = _Lines(data, ends)
     return [LogBlock(path, _Slice(lines, a), structs[a:a + rows], dec.attr, topics[a:a + rows], times[a:a + rows],
-                     lineno + a, index + a) for a in range(0, n, rows)], distinct
+                     lineno + a, index + a, _Again(decode, data, a, rows)) for a in range(0, n, rows)], distinct
+
+
+class _Again:
+    """A released block's rows decoded again: the read ``data`` by the decoder that read it (``decode``,
+    msgspec's ``decode_lines``: the same values from the same bytes), rows ``start`` to ``start + rows``."""
+
+    __slots__ = ("decode", "data", "start", "rows")
+
+    def __init__(self, decode: Callable[[bytes], list[Any]], data: bytes, start: int, rows: int) -> None:
+        self.decode, self.data, self.start, self.rows = decode, data, start, rows
+
+    def __call__(self) -> list[Any]:
+        got: list[Any] = self.decode(self.data)[self.start:self.start + self.rows]
+        return got
 
 
 def _topics(structs: list[Any]) -> tuple[list[str], set[str]]:
@@ -314,7 +330,9 @@ def _fast(path: Path, dec: _Decoder, lines: list[bytes], lineno: int, index: int
     column = np.array(times, dtype=np.float64)
     if not np.isfinite(column).all():
         return None
-    return LogBlock(path, lines, structs, dec.attr, _topics(structs)[0], column, lineno, index)
+    decode = dec.decode
+    return LogBlock(path, lines, structs, dec.attr, _topics(structs)[0], column, lineno, index,
+                    lambda: list(map(decode, lines)))
 
 
 class LogBlock:
@@ -327,15 +345,24 @@ class LogBlock:
     :func:`~.jsonl.line_event` from the row's line the first time it is asked
     for, the same object after that.  Raises :class:`RuntimeError` should
     the exact reader skip a row's line (a defect: the fast path takes only
-    lines with a string topic and a finite float time, which it reads)."""
+    lines with a string topic and a finite float time, which it reads).
+
+    :meth:`release` frees the decoded rows (``structs``) once the reader
+    that judges the block is done with it: its topics, times, kept columns
+    and events stay, and a later :meth:`values` decodes the rows again from
+    the lines (``again``: the decoder that read them, so the same values)."""
 
     __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made", "_columns", "_codes",
-                 "_kept")
+                 "_kept", "_n", "_again")
 
     def __init__(self, path: Path, lines: Sequence[bytes] | _Slice, structs: list[Any], attr: dict[str, str], topics: list[str],
-                 times: np.ndarray, lineno: int, index: int) -> None:
-        self.path, self.lines, self.structs, self.attr = path, lines, structs, attr
+                 times: np.ndarray, lineno: int, index: int, again: Callable[[], list[Any]]) -> None:
+        self.path, self.lines, self.attr = path, lines, attr
+        #: the rows decoded (``None`` once released: :meth:`values` decodes them again)
+        self.structs: list[Any] | None = structs
         self.topics, self.times, self.lineno, self.index = topics, times, lineno, index
+        self._n = len(structs)
+        self._again = again
         self._made: dict[int, Event] = {}
         #: a key's value at every row (an object column), made when a reader asks for many rows of it
         self._columns: dict[str, np.ndarray] = {}
@@ -354,7 +381,15 @@ class LogBlock:
         return made
 
     def __len__(self) -> int:
-        return len(self.structs)
+        return self._n
+
+    def release(self) -> None:
+        """Free the decoded rows and the object columns made of them (class docstring): called by the reader
+        that judges the block last, once it has (``backends/monitors/batch.py``), so that they are freed while
+        the memory they take is still in the processor's cache rather than whenever the last event, question
+        or answer kept from the block goes."""
+        self.structs = None
+        self._columns.clear()
 
     def topic_counts(self) -> dict[str, int]:
         """Rows per topic (as ``topics`` names them): a count per distinct topic (a log has a few)."""
@@ -385,6 +420,8 @@ class LogBlock:
         if attr is None or key in ("topic", "time"):
             return [None] * len(rows)
         structs = self.structs
+        if structs is None:  # released: decoded again (the same values, from the same lines)
+            structs = self.structs = self._again()
         if len(rows) > 1:
             first, last, step = int(rows[0]), int(rows[-1]), int(rows[1] - rows[0])
             if step > 0 and last == first + step * (len(rows) - 1) and bool((np.diff(rows) == step).all()):
@@ -399,10 +436,10 @@ class LogBlock:
 
     def __getitem__(self, i: Any) -> Any:
         if isinstance(i, slice):
-            return [self[j] for j in range(*i.indices(len(self.structs)))]
+            return [self[j] for j in range(*i.indices(self._n))]
         i = int(i)
         if i < 0:
-            i += len(self.structs)
+            i += self._n
         ev = self._made.get(i)
         if ev is None:
             ev = line_event(self.path, self.lineno + i + 1, self.index + i, self.lines[i])

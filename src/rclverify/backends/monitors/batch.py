@@ -140,6 +140,8 @@ def check_batch(checked: Checked, node: CheckedNode, events: Iterable[Event], ru
             count += len(rows) - len(carry)
             last_time = rows.last_time
             carry = run.chunk(rows)
+            if isinstance(got, LogBlock):  # its decoded rows, judged: freed now (jsonl_blocks.py, ``release``)
+                got.release()
         for ev in carry:
             run.feed(ev)
     finally:
