@@ -192,16 +192,16 @@ def _keep_or_settle(mon: ClockMonitor, p: Pending, keep: list[Pending], horizon:
 
 
 def _settle(mon: ClockMonitor, p: Pending) -> None:
-    """Obligation ``p`` leaves the obligations kept for a late ``/clock``: the margin of its ``true``, where
-    one was held, can no longer be withdrawn."""
+    """Obligation ``p`` leaves the obligations kept for a late ``/clock``: its answer's margin, where one was
+    held, can no longer be withdrawn."""
     if p.held is not None:
         mon.result.settle(p.k, p.held)
         p.held = None
 
 
 def _margin_again(mon: ClockMonitor, p: Pending) -> None:
-    """The margin of the ``true`` given to ``p`` (held) measured again on the ``/clock`` now heard: where it
-    differs, the one noted is withdrawn and the new one noted (held)."""
+    """The margin of ``p``'s answer (held) measured again on the ``/clock`` now heard: where it differs, the
+    one noted is withdrawn and the new one noted (held)."""
     assert p.held is not None
     margin = margin_ns(mon, p, p.answer_ns)
     entry = p.held
@@ -281,10 +281,10 @@ def _again(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
 
 def answered(mon: ClockMonitor, p: Pending, given: str, ev: Event, ns: int, semantics: str = "",
              entry: tuple[int, int, str, str, float] | None = None) -> None:
-    """Obligation ``p`` placed in a clock was given ``given`` (``true``, or ``undecided`` in the band) by answer ``ev`` stamped ``ns`` (its ``semantics``; ``entry``: its margin noted withdrawable, given
-    while ``/clock`` was not heard after ``ns``); before ``/clock`` passed its simulated deadline
-    (:data:`FAR`), it is kept for a ``/clock`` message heard late (:func:`tick`), after it only its margin
-    is."""
+    """Obligation ``p`` placed in a clock was given ``given`` (``true``, or ``undecided`` in the band) by
+    answer ``ev`` stamped ``ns`` (its ``semantics``; ``entry``: its margin noted withdrawable, given while
+    ``/clock`` was not heard after ``ns``).  Before ``/clock`` passed its simulated deadline (:data:`FAR`) it
+    is kept for a ``/clock`` message heard late (:func:`tick`); after, only its margin is."""
     if p.due_ns < FAR:
         if entry is not None:  # its margin reads /clock at the answer, which a later /clock placed before moves
             p.answer_ns, p.held = ns, entry
@@ -407,5 +407,5 @@ def words(mon: ClockMonitor, p: Pending) -> str:
             f"{passed}): the node's clock is not said")
 
 
-__all__ = ["DECLARE", "FAR", "answered", "band", "band_late", "judge_again", "margin_ns", "place", "reads_clock", "tick", "undecided",
-           "words"]
+__all__ = ["DECLARE", "FAR", "answered", "band", "band_late", "judge_again", "margin_ns", "place", "reads_clock",
+           "tick", "undecided", "words"]

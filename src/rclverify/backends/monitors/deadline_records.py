@@ -95,14 +95,15 @@ class Pending:
     sim_passed_ns: int = 0
     #: with a ``clock``, answered before ``/clock`` passed its simulated deadline: the verdict given (``true``,
     #: or ``undecided`` in the band of a clock not said; ``""``: not so answered), the answer, its stamp
-    #: (integer ns) and the arithmetic it held in; a ``/clock`` message heard later showing the deadline passed
-    #: before that stamp judges it again (:func:`.deadline_clock.tick`)
+    #: (integer ns; also that of any answer whose margin is held, and of a late answer) and the arithmetic it
+    #: held in; a ``/clock`` message heard later showing the deadline passed before that stamp judges it
+    #: again (:func:`.deadline_clock.tick`)
     given: str = ""
     answer: Event | None = None
     answer_ns: int = 0
     semantics: str = ""
-    #: the margin of a ``true`` so given, noted withdrawable (:attr:`DeadlineResult.floor`'s shape) until
-    #: ``/clock`` passes the deadline or the obligation leaves the window kept for a late ``/clock``
+    #: the margin of an answer in a clock, noted withdrawable (:attr:`DeadlineResult.floor`'s shape) until
+    #: ``/clock`` is heard after the answer or the answer leaves the window kept for a late ``/clock``
     held: tuple[int, int, str, str, float] | None = None
 
     @property
