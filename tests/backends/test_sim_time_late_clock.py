@@ -143,7 +143,10 @@ def test_within_the_skew_the_true_turns_undecided() -> None:
 
 def test_control_the_clock_on_time_or_after_the_answer_changes_nothing() -> None:
     run = _run(203, 207)
-    counts, _, seen = _judge(run, True)  # C on time: the live order is the stamp order, nothing withdrawn
+    live = _live(run, {})  # C on time: released in stamp order
+    assert [e.where for e in live] == [e.where for e in run]
+    counts, unaccepted, seen = _judge(live, True)
+    assert (counts, unaccepted, seen) == _judge(run, True)  # identical verdicts, nothing withdrawn
     assert counts["false"] == 1 and not any("withdrawn" in v.reason for v in seen)
     run = _run(209, 207)  # C after the answer, heard late after the reading's other message: true stands
     live = _live(run, {run.index(next(e for e in run if e.where == "clock@209")): 1})
