@@ -259,7 +259,7 @@ def _again(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
     if mon.now_ns is not None and ns < mon.now_ns:
         late = ms(ev.late) if ev.late > 0 else ms_ns(mon.now_ns - ns)
         heard = (f"heard {late} after its time, past the lateness bound"
-                 if ev.late > 0 else f"heard after a message stamped {late} after it")
+                 if ev.late > 0 else f"heard when the monitor's clock stood {late} after it")
     else:
         heard = "read after the answer"
     withdrawn = (f"; the {p.given} given when the answer came is withdrawn: the /clock message at {ev.where} "
