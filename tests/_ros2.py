@@ -174,3 +174,31 @@ def robot_run(tmp: Path, seed: int, nodes: int, seconds: float, defect: bool, **
     if ros2 is None:
         pytest.skip(why)
     return _robot_run.run_one(seed, nodes, seconds, defect, tmp, ros2, **how)
+
+
+def clock_node(factor: float = 1.0) -> str:
+    """The text of an rclpy node publishing ``rosgraph_msgs/Clock`` on ``/clock`` every 10 ms of the wall
+    clock from a simulated 100 s, advancing ``factor`` times as fast as the wall clock (its real-time
+    factor); it prints ``ready`` once its publisher is made."""
+    return CLOCK_NODE.replace("FACTOR", repr(factor))
+
+
+CLOCK_NODE = """\
+import time
+import rclpy
+from rclpy.node import Node
+from builtin_interfaces.msg import Time
+from rosgraph_msgs.msg import Clock
+
+rclpy.init()
+n = Node("sim")
+pub = n.create_publisher(Clock, "/clock", 10)
+print("ready", flush=True)
+sim_ns, step = 100 * 10**9, round(10 * 10**6 * FACTOR)
+next_t = time.monotonic()
+while True:
+    pub.publish(Clock(clock=Time(sec=sim_ns // 10**9, nanosec=sim_ns % 10**9)))
+    sim_ns += step
+    next_t += 0.01
+    time.sleep(max(0.0, next_t - time.monotonic()))
+"""

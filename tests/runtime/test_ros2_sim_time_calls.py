@@ -28,7 +28,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for, wait_logged
-from _ros2 import AWAIT_MONITOR, live_workspace, rclverify, ros2_env, ros2_python, start_node
+from _ros2 import AWAIT_MONITOR, clock_node, live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 RCL = """\
 node Base {
@@ -42,26 +42,6 @@ node Base {
 ROUNDS = 8
 #: real-time factor -> the server's delay in simulated time (s)
 DELAY = {0.5: 0.3, 2.0: 0.6}
-
-SIM = """\
-import time
-import rclpy
-from rclpy.node import Node
-from builtin_interfaces.msg import Time
-from rosgraph_msgs.msg import Clock
-
-rclpy.init()
-n = Node("sim")
-pub = n.create_publisher(Clock, "/clock", 10)
-print("ready", flush=True)
-sim_ns, step = 100 * 10**9, round(10 * 10**6 * FACTOR)
-next_t = time.monotonic()
-while True:
-    pub.publish(Clock(clock=Time(sec=sim_ns // 10**9, nanosec=sim_ns % 10**9)))
-    sim_ns += step
-    next_t += 0.01
-    time.sleep(max(0.0, next_t - time.monotonic()))
-"""
 
 SERVER = """\
 import time
@@ -162,7 +142,7 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
     env = ros2_env(tmp)
     procs: list[subprocess.Popen[bytes]] = []
     try:
-        procs.append(start_node(tmp, "sim", SIM.replace("FACTOR", repr(factor)), env))
+        procs.append(start_node(tmp, "sim", clock_node(factor), env))
         procs.append(start_node(tmp, "base", SERVER.replace("DELAY", repr(DELAY[factor])), env))
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--interfaces", "interfaces",
                              "--mapping", "mapping.yaml", "--horizon", "1", "--status", "0", "--duration", "90",

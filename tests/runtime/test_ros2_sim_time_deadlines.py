@@ -27,7 +27,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for, wait_logged
-from _ros2 import AWAIT_MONITOR, live_workspace, rclverify, ros2_env, ros2_python, start_node
+from _ros2 import AWAIT_MONITOR, clock_node, live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))  # _robot_verdicts: final verdicts
 
@@ -44,26 +44,6 @@ TOPICS = "topics:\n  x: {fields: [data]}\n  y: {fields: [data]}\n"
 ROUNDS = 10
 #: real-time factor -> the relay's delay in simulated time (s)
 DELAY = {0.5: 0.3, 2.0: 0.6}
-
-SIM = """\
-import time
-import rclpy
-from rclpy.node import Node
-from builtin_interfaces.msg import Time
-from rosgraph_msgs.msg import Clock
-
-rclpy.init()
-n = Node("sim")
-pub = n.create_publisher(Clock, "/clock", 10)
-print("ready", flush=True)
-sim_ns, step = 100 * 10**9, round(10 * 10**6 * FACTOR)
-next_t = time.monotonic()
-while True:
-    pub.publish(Clock(clock=Time(sec=sim_ns // 10**9, nanosec=sim_ns % 10**9)))
-    sim_ns += step
-    next_t += 0.01
-    time.sleep(max(0.0, next_t - time.monotonic()))
-"""
 
 ROBOT = """\
 import time
@@ -123,7 +103,7 @@ def run(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
     env = ros2_env(tmp)
     procs: list[subprocess.Popen[bytes]] = []
     try:
-        procs.append(start_node(tmp, "sim", SIM.replace("FACTOR", repr(factor)), env))
+        procs.append(start_node(tmp, "sim", clock_node(factor), env))
         procs.append(start_node(tmp, "robot", ROBOT.replace("DELAY", repr(DELAY[factor])), env))
         monitor = rclverify(["monitor", "-w", str(ws), "--live", "--ros2", "--mapping", "mapping.yaml",
                              "--horizon", "1", "--status", "0", "--duration", "90", "--source", source,
