@@ -27,7 +27,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.backends.monitors import recorded
+from rclverify.backends.monitors import batch_deadlines, recorded
 from rclverify.backends.monitors.batch_deadlines import deadline_monitor
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.lang.typecheck import load
@@ -82,7 +82,7 @@ class Probe:
                     block_feed(block)
                 m.feed_block = block_spy
             return m
-        monkeypatch.setattr(recorded, "deadline_monitor", spied)
+        monkeypatch.setattr(batch_deadlines, "deadline_monitor", spied)  # what check_recorded calls (imported there when used)
 
     @property
     def last(self) -> list[tuple[str, float, Any]]:

@@ -28,7 +28,6 @@ from rclverify.lang.errors import RclError
 from rclverify.lang.types import Checked
 from rclverify.traces import TraceError
 from rclverify.backends.monitors.summary import monitoring_details, summary_line, tool_versions
-from rclverify.backends.monitors.deadline_text import deadline_status
 from rclverify.backends.monitors.config import ConfigError, MonitorConfig, load_mapping
 from rclverify.backends.monitors.judged import explain
 from rclverify.cli.monitor_outcome import print_not_judged, selected_nodes, strict_exit
@@ -115,6 +114,7 @@ def _report_run(report: list[Mapping[str, object]], run: RecordedRun, trace: str
             print(f"{trace}: {summary_line(res)}")
             print(f"  {status}: {entry['explanation']}")
     for d in run.deadlines:
+        from rclverify.backends.monitors.deadline_text import deadline_status  # deferred: start-up (loaded only by a run with a deadline)
         status, explanation = deadline_status(d, trace)
         violated = violated or status == "failed"
         report.append({"node": d.node, "status": status, "explanation": explanation, "trace": trace,

@@ -8,7 +8,6 @@ on top of it.
 """
 from __future__ import annotations
 
-import difflib
 from typing import Iterable
 
 from rclverify.lang import ast
@@ -28,6 +27,7 @@ def candidates(name: str, pool: Iterable[str]) -> str:
     names = sorted(set(pool))
     same = [c for c in names if c.lower() == name.lower() and c != name]
     lower = {c.lower(): c for c in names}
+    import difflib  # deferred: start-up (a close spelling is only looked for in an error)
     close = same + [lower[c] for c in difflib.get_close_matches(name.lower(), sorted(lower), n=4, cutoff=0.5)
                     if lower[c] not in same]
     return f"; did you mean {', '.join(repr(c) for c in close[:4])}?" if close else ""

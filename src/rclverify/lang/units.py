@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import re
 
-import difflib
 import math
 from fractions import Fraction
 
@@ -82,6 +81,7 @@ def suggestions(name: str) -> list[str]:
     """Known symbols close to ``name`` (for a located error's candidates)."""
     pool = sorted(set(SYMBOLS) | {p + s for p in ("m", "k", "u", "c") for s, y in SYMBOLS.items() if y.prefixable})
     same = [c for c in pool if c.lower() == name.lower() and c != name]
+    import difflib  # deferred: start-up (a close spelling is only looked for in an error)
     return (same + [c for c in difflib.get_close_matches(name, pool, n=3, cutoff=0.6) if c not in same])[:3]
 
 

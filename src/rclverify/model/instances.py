@@ -27,15 +27,18 @@ contract (Hoare, Dafny, property tests) are about its code, one for every instan
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 from rclverify.lang.types import Checked, CheckedNode
-from rclverify.model import names
 from rclverify.model.plan.instances import Instance, instance_name, read_instances, snake
 from rclverify.model.plan.model import Connection
 
+if TYPE_CHECKING:
+    from rclverify.model import names
+
 
 def _resolved(text: str, inst: Instance) -> str:
+    from rclverify.model import names  # deferred: start-up (loaded only by a plan that names instances)
     return names.resolve(text, inst.node, inst.namespace, inst.remaps)
 
 

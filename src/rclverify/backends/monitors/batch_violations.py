@@ -21,7 +21,7 @@ within the skew after it is answered by its own output within the run
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rclverify.core.numeric import np
 
@@ -29,8 +29,10 @@ from rclverify.semantics.floatsens import float_sensitive
 from rclverify.backends.monitors.answered import AnsweredRun
 from rclverify.backends.monitors.engine import NodeMonitor
 from rclverify.backends.monitors.rows import BlockRows, EventRows
-from rclverify.backends.monitors.shapes import Violation
 from rclverify.backends.monitors.verdicts import KEPT_VIOLATIONS, in_all
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.shapes import Violation
 
 
 def violated_semantics(m: NodeMonitor) -> str:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.semantics.floatsem import Judgement
 from rclverify.lang import ast
@@ -28,9 +28,11 @@ from rclverify.lang.printer import expr_to_rcl
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.questions import Question
 from rclverify.backends.monitors.verdicts import KEPT_VIOLATIONS, WEAK as _WEAK, in_all, link_of, names, producers
-from rclverify.backends.monitors.shapes import Violation
 from rclverify.backends.monitors.skew import within_before
 from rclverify.backends.monitors.engine_state import EngineState
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.shapes import Violation
 
 
 class Closing(EngineState):

@@ -16,10 +16,13 @@ so that every trigger past its deadline has a verdict record on every path.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from rclverify.traces.events import Event
-from rclverify.backends.monitors.shapes import DeadlineResultJson, DeadlineVerdictJson, Unaccepted
 from rclverify.backends.monitors.time_margins import TimeMargin, note
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.shapes import DeadlineResultJson, DeadlineVerdictJson, Unaccepted
 
 DEADLINE_VERDICTS = ("true", "currently_false", "false")
 #: Why a trigger got no deadline verdict (:attr:`DeadlineResult.unaccepted`): its assumption was false of

@@ -7,8 +7,7 @@ guarantee at all (:func:`has_deadlines`).
 from __future__ import annotations
 
 from rclverify.lang.types import CheckedNode
-from rclverify.traces.events import Event, to_ns
-from rclverify.backends.monitors.online import header_stamp_ns
+from rclverify.traces.events import Event, header_stamp_ns, to_ns
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
 
 

@@ -13,13 +13,16 @@ declaration pending or undecided never leaves the record ``discharged``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from rclverify.lang import ast
 from rclverify.lang.liveness import period_seconds
 from rclverify.lang.types import CheckedNode
 from rclverify.backends.monitors.periods import PeriodResult
-from rclverify.backends.monitors.shapes import DeclarationsPart
-from rclverify.backends.shapes import DeclarationRow
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.shapes import DeclarationsPart
+    from rclverify.backends.shapes import DeclarationRow
 
 #: declaration verdict -> evidence status
 STATUS = {"true": "discharged", "false": "failed", "inconclusive": "inconclusive", "pending": "pending"}

@@ -67,7 +67,6 @@ from rclverify.traces.events import Event
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for
 from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.periods import PeriodResult
-from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC
 from rclverify.backends.monitors.verdicts import LINK_TOPICS
 from rclverify.backends.monitors.declaration_evidence import (STATUS, DeclarationResult, add_periods,
                                                               declaration_row, declaration_status, source_text,
@@ -140,6 +139,9 @@ class DeclarationMonitor:
 
     def __init__(self, checked: Checked, node: CheckedNode, rules: Mapping[str, TopicRule],
                  tolerance: Tolerance | None = None) -> None:
+        from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC  # deferred: start-up (loaded only by a run with a declaration)
+        #: the topic of a live run's call lines (:data:`~.dds_calls.CALL_LOG_TOPIC`)
+        self.call_topic = CALL_LOG_TOPIC
         self.checked, self.node, self.rules = checked, node, rules
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         #: inputs within the transport skew of a step's first, with no output between, are that step (skew.py)
@@ -184,7 +186,7 @@ class DeclarationMonitor:
         call line of a live run's log (:data:`~.dds_calls.CALL_LOG_TOPIC`:
         a request, response, goal, feedback or result of a link) is the
         event of its link's part, as the message on the link's topic is."""
-        if ev.topic.strip("/") == CALL_LOG_TOPIC:
+        if ev.topic.strip("/") == self.call_topic:
             call = call_part(ev)
             if call is None:
                 return

@@ -22,18 +22,19 @@ offline check is what it was.
 """
 from __future__ import annotations
 
-from typing import Any, Iterable, Iterator, Mapping
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping
 
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces.events import Event, TraceError
 from rclverify.traces.mapping import TopicRule
-from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC, CallBook, replay_line
-from rclverify.backends.monitors.deadline_records import DeadlineResult
-from rclverify.backends.monitors.deadline_text import deadline_status
 from rclverify.backends.monitors.judged import count_call_line
 from rclverify.backends.monitors.run_origin import ORIGIN_TOPIC, RunOrigin
 from rclverify.backends.monitors.summary import verdict_status
 from rclverify.backends.monitors.verdicts import NodeResult
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.dds_calls import CallBook
+    from rclverify.backends.monitors.deadline_records import DeadlineResult
 
 
 class LogCalls:
@@ -50,7 +51,10 @@ class LogCalls:
     def __init__(self, checked: Checked, nodes: Iterable[CheckedNode], rules: Mapping[str, TopicRule],
                  horizon: float, trace: str) -> None:
         links = [(n, lk) for n in nodes for lk in n.node.links]
-        self.book = CallBook(checked, links, rules, horizon) if links else None
+        self.book: CallBook | None = None
+        if links:
+            from rclverify.backends.monitors.dds_calls import CallBook  # deferred: start-up (loaded only by a run of nodes with links)
+            self.book = CallBook(checked, links, rules, horizon)
         self.trace = trace
         self.lines = 0
         self.messages: dict[str, int] = {}
@@ -67,6 +71,7 @@ class LogCalls:
         """``events`` unchanged; each call line is replayed first.  Raises
         :class:`TraceError` (located) for a call line the live monitor could
         not have written."""
+        from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC  # deferred: start-up (loaded only by a run of nodes with links)
         for ev in events:
             if ev.topic == CALL_LOG_TOPIC:
                 self.feed(ev)
@@ -78,6 +83,7 @@ class LogCalls:
         """One call line (its event: ``time`` and the line's other keys)."""
         if self.book is None or ev.fields.get("kind") != "call":
             return
+        from rclverify.backends.monitors.dds_calls import CALL_LOG_TOPIC, replay_line  # deferred: start-up (loaded only by a run of nodes with links)
         line = {"topic": CALL_LOG_TOPIC, "time": ev.time, **ev.fields}
         try:
             replay_line(self.book, line)
@@ -124,6 +130,7 @@ class LogCalls:
         """Per node ``{node, status, explanation, call_deadlines}``."""
         out = []
         for res in self.deadlines():
+            from rclverify.backends.monitors.deadline_text import deadline_status  # deferred: start-up (loaded only by a run with a deadline)
             status, explanation = deadline_status(res, f"the calls in {self.trace}")
             out.append({"node": res.node, "status": status, "explanation": explanation, "trace": self.trace,
                         "call_deadlines": res.to_json()})
@@ -142,6 +149,7 @@ def merge_deadlines(a: DeadlineResult | None, b: DeadlineResult | None) -> Deadl
     first refusal of ``a`` before ``b``'s."""
     if a is None or b is None:
         return a if b is None else b
+    from rclverify.backends.monitors.deadline_records import DeadlineResult  # deferred: start-up (loaded only by a run with a deadline)
     out = DeadlineResult(a.node)
     for r in (a, b):
         for v, n in r.counts.items():

@@ -62,7 +62,7 @@ in time is a guarantee's deadline (``triggered by in.x within 200 ms``,
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable, Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping
 
 from rclverify.lang.liveness import period_seconds
 from rclverify.lang.types import CheckedNode
@@ -72,10 +72,11 @@ from rclverify.traces.mapping import TopicRule, sim_time_of
 from rclverify.traces.sim_clock import CLOCK_TOPIC, SimClock, clock_value_ns
 from rclverify.backends.monitors.period_clock import LATE, UNDECIDED, judge_gap, read_at, sim_gap
 from rclverify.backends.monitors.skew import DEFAULT_SKEW_S
-from rclverify.backends.monitors.deadline_skew import skew_ns
 from rclverify.backends.monitors.deadline_topics import topic_bindings
 from rclverify.backends.monitors.stamp_order import run_clock
-from rclverify.backends.monitors.shapes import PeriodGapJson, PeriodResultJson, PeriodsPart
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.shapes import PeriodGapJson, PeriodResultJson, PeriodsPart
 
 
 #: The slack of a gap against its period (s): the resolution of an epoch stamp read as a float.
@@ -140,6 +141,7 @@ class PeriodMonitor:
         self.sim_mode = sim_time_of(rules, node.name) if rules is not None else None
         #: the run's ``/clock`` as heard, and the transport skew (ns) of its delivery to a node
         self.sim = SimClock()
+        from rclverify.backends.monitors.deadline_skew import skew_ns  # deferred: start-up (loaded only by a run with a period)
         self.skew_ns = skew_ns(rules) if rules is not None else round(DEFAULT_SKEW_S * 1e9)
         #: per output judged in simulated time: its last message's time (integer ns, the run's clock), where,
         #: and ``/clock`` as the node read it then (:func:`.period_clock.read_at`)

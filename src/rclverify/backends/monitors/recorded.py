@@ -11,19 +11,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.traces import read_trace
 from rclverify.traces.events import header_stamp_ns
 from rclverify.backends.monitors.check import check_trace
-from rclverify.backends.monitors.deadline_records import DeadlineResult
 from rclverify.backends.monitors.deadline_topics import has_deadlines
-from rclverify.backends.monitors.deadlines import DeadlineMonitor
-from rclverify.backends.monitors.batch_deadlines import BatchDeadlines, deadline_monitor
 from rclverify.backends.monitors.declarations import (DeclarationMonitor, DeclarationResult, add_periods,
                                                       has_declarations)
-from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag
 from rclverify.backends.monitors.judged import Counted, Heard, not_judged
 from rclverify.backends.monitors.log_calls import LogCalls
 from rclverify.backends.monitors.periods import PeriodMonitor, PeriodResult, has_periods
@@ -33,6 +29,11 @@ from rclverify.backends.monitors.summary import verdict_status
 from rclverify.backends.monitors.widths import judged_at_widths, refuse_out_of_range
 from rclverify.backends.monitors.verdicts import NodeResult
 from rclverify.backends.monitors.run_origin import unseen_links
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.bag_calls import BagCalls
+    from rclverify.backends.monitors.deadline_records import DeadlineResult
+    from rclverify.backends.monitors.deadlines import DeadlineMonitor
 
 
 @dataclass
@@ -154,8 +155,11 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
     judged = [judged_at_widths(checked, n, cfg.rules, dirs) for n in nodes]  # the live monitor's route too
     sources = [(k, s) for _, f in judged for k, s in f.items()]
     nodes = [n for n, _ in judged]
-    dmons = [deadline_monitor(checked, n, cfg.rules, deadline, horizon=cfg.horizon, tolerance=cfg.tolerance)
-             for n in nodes if has_deadlines(n)]  # in batch where eligible (batch_deadlines.py)
+    dmons: list[DeadlineMonitor] = []
+    if any(has_deadlines(n) for n in nodes):
+        from rclverify.backends.monitors.batch_deadlines import deadline_monitor  # deferred: start-up (loaded only by a run with a deadline)
+        dmons = [deadline_monitor(checked, n, cfg.rules, deadline, horizon=cfg.horizon, tolerance=cfg.tolerance)
+                 for n in nodes if has_deadlines(n)]  # in batch where eligible (batch_deadlines.py)
     pmons = [PeriodMonitor(n, cfg.rules) for n in nodes if has_periods(n)]
     decl = [DeclarationMonitor(checked, n, cfg.rules, tolerance=cfg.tolerance) for n in nodes if has_declarations(n)]
     calls = LogCalls(checked, nodes, cfg.rules, cfg.horizon, trace)  # a live log's calls (log_calls.py)
@@ -163,8 +167,11 @@ def _pass(checked: Checked, nodes: Sequence[CheckedNode], cfg: Any, root: Path, 
         calls.book.on_verdict, calls.book.on_deadline = (lambda v: kept.append(("call", v))), deadline
     heard: dict[str, int] = {}
     run: Iterable[Any] = read_trace(Path(trace), [root / d for d in cfg.msg_dirs], streams=True, on_warning=on_warning)
-    bag = BagCalls(nodes, calls, trace, bag_connections(Path(trace), dirs)) \
-        if calls.active and is_ros2_bag(Path(trace)) else None  # a bag's recorded calls (bag_calls.py)
+    bag: BagCalls | None = None
+    if calls.active:
+        from rclverify.backends.monitors.bag_calls import BagCalls, bag_connections, is_ros2_bag  # deferred: start-up (loaded only by a run with calls)
+        if is_ros2_bag(Path(trace)):
+            bag = BagCalls(nodes, calls, trace, bag_connections(Path(trace), dirs))  # a bag's recorded calls (bag_calls.py)
     run = refuse_out_of_range(run, Path(trace), sources)  # a hand-made log's value no field carries (widths.py)
     reads = copy_sources(checked)  # whose stamps a writer may copy: the reorder and the watch read it alike
     if lag is not None:
@@ -216,6 +223,7 @@ class _Tapped:
         monitors' own), each fed to the monitors first; ``None`` when the source is no log read in blocks
         (:class:`~rclverify.traces.jsonl_blocks.JsonlLog`) or a monitor takes no block."""
         from rclverify.traces.jsonl_blocks import JsonlLog  # deferred: optional or conditional (numpy, as read_trace)
+        from rclverify.backends.monitors.batch_deadlines import BatchDeadlines  # deferred: start-up (loaded only by a run with a deadline, a period or a declaration)
         if not isinstance(self.events, JsonlLog) or not all(isinstance(m, BatchDeadlines) for m in self.monitors):
             return None
         own = [f for m in self.monitors for f in (m.plan.in_field, m.plan.out_field)]

@@ -15,9 +15,11 @@ none: :attr:`RunOrigin.origin` is ``None`` and nothing is claimed.
 """
 from __future__ import annotations
 
-from typing import Any, Iterable, Iterator, Mapping
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping
 
-from rclverify.backends.monitors.shapes import OriginLine, RunSource, UnseenLine
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.shapes import OriginLine, RunSource, UnseenLine
+
 
 #: the log topic of a run's origin lines
 ORIGIN_TOPIC = "rclverify/run"

@@ -61,7 +61,6 @@ from typing import Any, Callable, Iterable, Iterator, Mapping
 from rclverify.traces.event_time import (ASIDE, CopiedStamps, WriterClocks, aside_stamp, carried, other_clock,
                                          published, with_stamp, without_stamp)
 from rclverify.traces.events import Event, header_stamp
-from rclverify.traces.reorder import ReorderBuffer
 
 
 #: the keys of a message that may hold a stamp set aside (nested, or flattened as ROSMonitoring's stamps are)
@@ -247,6 +246,7 @@ def in_stamp_order(events: Iterable[Event], lag: float,
     the new order; ``lag`` (s) is the largest lag a :class:`StampWatch`
     measured on the same run, which bounds what the buffer holds; ``reads``, whose
     stamps a writer may copy, as the first pass had it (:func:`.node_topics.copy_sources`)."""
+    from rclverify.traces.reorder import ReorderBuffer  # deferred: start-up (loaded only by a run read again in stamp order)
     buffer: ReorderBuffer[Event] = ReorderBuffer()  # the one reorder buffer (traces/reorder.py)
     latest = -math.inf
     out = 0

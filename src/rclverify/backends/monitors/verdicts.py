@@ -10,14 +10,16 @@ import bisect
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.walk import names, reads  # re-exported: the engine and its mixins import them from here
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.model.system.services import peers
-from rclverify.backends.monitors.shapes import (AssumptionVerdict, AssumptionViolation, Inconclusive, Inexact,
-                                                 NodeResultJson, VerdictJson, Violation)
+
+if TYPE_CHECKING:
+    from rclverify.backends.monitors.shapes import (AssumptionVerdict, AssumptionViolation, Inconclusive, Inexact,
+                                                     NodeResultJson, VerdictJson, Violation)
 
 #: Verdicts of one node's events: per output message (``satisfied``,
 #: ``violated``, ``inconclusive``), per question (``assumption violated``,

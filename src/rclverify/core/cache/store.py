@@ -44,13 +44,14 @@ import os
 import pickle
 import time
 from pathlib import Path
-from typing import Any, BinaryIO, Callable, Iterable
+from typing import TYPE_CHECKING, Any, BinaryIO, Callable, Iterable
 
-from rclverify.core.atomic import atomic_write_bytes
 from rclverify.core.cache.heap import no_collection
 from rclverify.core.cache.keys import CACHE_DIR, FORMAT, Keyer, code_stamp, salt
 from rclverify.core.cache.safeload import load
-from rclverify.core.cache.shapes import KeptFile, KeptHeader
+
+if TYPE_CHECKING:
+    from rclverify.core.cache.shapes import KeptFile, KeptHeader
 
 _PROTOCOL = pickle.HIGHEST_PROTOCOL
 
@@ -106,6 +107,7 @@ def write_stream(path: Path, kind: str, salt_hex: str, objects: Iterable[Any]) -
     hold; ``path`` is then left as it was."""
     parts = [pickle.dumps(header(kind, salt_hex), protocol=_PROTOCOL)]
     parts += [pickle.dumps(o, protocol=_PROTOCOL) for o in objects]
+    from rclverify.core.atomic import atomic_write_bytes  # deferred: start-up (a run that only reads kept files loads no writer)
     atomic_write_bytes(path, b"".join(parts))
 
 
@@ -242,6 +244,7 @@ class Blobs:
         again.  A file that cannot be written only costs time."""
         self._memory[k] = text
         if self.directory is not None:
+            from rclverify.core.atomic import atomic_write_bytes  # deferred: start-up (a run that only reads kept files loads no writer)
             try:
                 atomic_write_bytes(self._file(k, self.suffix), text.encode("utf-8"))
             except OSError:

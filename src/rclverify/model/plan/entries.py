@@ -20,7 +20,6 @@ plan validates an entry against them without importing any backend's code.
 """
 from __future__ import annotations
 
-import difflib
 from typing import Any, Iterator, Mapping
 
 from rclverify.model.plan.declarations import BACKEND_NAMES as BACKEND_NAMES, DECLARATIONS, PlanEntry
@@ -59,6 +58,7 @@ def unknown_key_messages(backend: str, entry: Mapping[str, Any]) -> list[tuple[s
     for k in entry:
         if k in allowed:
             continue
+        import difflib  # deferred: start-up (a close spelling is only looked for in an error)
         close = difflib.get_close_matches(str(k), allowed, n=1, cutoff=0.6)
         hint = f"; did you mean {close[0]!r}?" if close else f"; its keys are: {', '.join(allowed)}"
         out.append((str(k), f"unknown key {k!r} in a {backend} evidence entry{hint}"))

@@ -17,10 +17,12 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.lang import ast
-from rclverify.model import names
+
+if TYPE_CHECKING:
+    from rclverify.model import names
 
 
 @dataclass(frozen=True)
@@ -40,6 +42,7 @@ class Instance:
     @property
     def fqn(self) -> str:
         """The ROS node's fully qualified name (``/r1/relay``)."""
+        from rclverify.model import names  # deferred: start-up (loaded only by a plan that names instances)
         return names.node_fqn(self.namespace, self.node)
 
 
@@ -65,6 +68,7 @@ def read_instances(data: Any, locs: Mapping[tuple[Any, ...], ast.Loc],
     def at(*path: Any) -> ast.Loc:
         return locs.get(("instances", *path), locs.get(("instances",), ast.Loc(plan_rel, 1, 1)))
     for contract, spec in (data or {}).items():
+        from rclverify.model import names  # deferred: start-up (loaded only by a plan that names instances)
         if isinstance(spec, dict) and "type" in spec:  # one instance by name (module docstring)
             inst = _named(str(contract), spec, at, seen, problems)
             if inst is not None:
@@ -106,6 +110,7 @@ def _named(name: str, spec: Mapping[str, Any], at: Any, seen: dict[str, str],
     """The instance ``name: {type, namespace, node, remap}`` (module docstring), ``None`` with its
     problems added (a name that is not an identifier or is taken, a node name or namespace rcl
     refuses, a remap rule rcl refuses or one renaming the node)."""
+    from rclverify.model import names  # deferred: start-up (loaded only by a plan that names instances)
     contract, raw = str(spec["type"]), str(spec["namespace"])
     ns = raw.rstrip("/") or "/"
     node = str(spec.get("node") or snake(contract))

@@ -10,12 +10,10 @@ file.  The format is documented in docs/plan.md.
 """
 from __future__ import annotations
 
-import difflib
-
 import json
 from importlib import resources
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import yaml
 
@@ -23,7 +21,6 @@ from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.model.plan.document import EnvironmentEntry, PlanDocument, RequirementEntry, plan_document
 from rclverify.model.plan.errors import PlanError, plan_error
-from rclverify.model.plan.formal import Source
 from rclverify.model.plan.targets import requirement_target
 from rclverify.model.plan.yamlguard import (KEY, Blocks, compose_guarded, read_yaml_text, schema_error_loc,
                                              schema_messages, to_data)
@@ -37,6 +34,9 @@ from rclverify.lang.timing import UNITS, parse_duration
 from rclverify.model.plan.standards.choice import read_standards
 from rclverify.model.plan.instances import Instance, read_instances
 from rclverify.model.plan.resolve import all_requirements, resolve
+
+if TYPE_CHECKING:
+    from rclverify.model.plan.formal import Source
 
 __all__ = ["KEY", "Plan", "all_requirements", "load_plan", "read_plan_data", "read_plan_document", "resolve"]
 
@@ -117,6 +117,7 @@ def _not_a_node(e: Any, root: Path | None, data: Mapping[str, Any]) -> str | Non
     key = str(path[1])
     if key in names:
         return None
+    import difflib  # deferred: start-up (a close spelling is only looked for in an error)
     close = difflib.get_close_matches(key, names, n=1, cutoff=0.6)
     entry = difflib.get_close_matches(key, ["evidence", "replacement"], n=1, cutoff=0.6)
     hint = (f" (did you mean the node {close[0]!r}?)" if close else
@@ -290,6 +291,7 @@ def _source(path: Path_, text: str | None, locs: Mapping[Path_, ast.Loc], blocks
     plan file."""
     if text is None:
         return None
+    from rclverify.model.plan.formal import Source  # deferred: start-up (loaded only by a plan that writes a formula)
     block = blocks.get(path)
     if block is not None:
         return Source(block[1], block[0], 1, file)

@@ -8,15 +8,17 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
-from rclverify.model.plan.target_text import Target
 from rclverify.lang import ast
 from rclverify.model.plan.acknowledged import Acknowledgement
-from rclverify.model.plan.formal import Source
 from rclverify.model.plan.instances import Instance
 from rclverify.model.plan.state import StateVar
 from rclverify.model.plan.standards.choice import StandardChoice
+
+if TYPE_CHECKING:
+    from rclverify.model.plan.formal import Source
+    from rclverify.model.plan.target_text import Target
 
 Path_ = tuple[Any, ...]
 

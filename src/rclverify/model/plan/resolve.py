@@ -18,9 +18,6 @@ from rclverify.model.plan.targets import check_targets
 from rclverify.model.plan.model import Plan, Requirement
 from rclverify.model.plan.state import state_types, check_states
 from rclverify.model.plan.acknowledged import check_acknowledgements
-from rclverify.model.plan.formal import parse_formal
-from rclverify.model.plan.ranking import parse_hints
-from rclverify.model.plan.temporal import Temporal, parse_temporal, shape
 from rclverify.model.plan.expected import check_expected
 from rclverify.model.plan.declarations import BACKEND_NAMES
 from rclverify.model.plan.entries import unknown_key_messages
@@ -55,6 +52,8 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[
                                     f"(first at {o.loc.file}:{o.loc.line}:{o.loc.col})").diagnostics)
         seen.setdefault(r.id, r)
         if r.formal:
+            from rclverify.model.plan.ranking import parse_hints  # deferred: start-up (loaded only by a plan that has formal statements)
+            from rclverify.model.plan.temporal import Temporal, parse_temporal, shape  # deferred: start-up (loaded only by a plan that has formal statements)
             try:
                 t = parse_temporal(r.formal, checked, f"{r.id} formal", stypes)
                 if isinstance(t, Temporal):
@@ -68,6 +67,7 @@ def check_formal(reqs: tuple[Requirement, ...], checked: Checked, states: tuple[
             diags.append(error(src.loc, f"{r.id}: ranking:/invariant: need a liveness statement in formal: "
                                         "(eventually F, or F until G)", "E-temporal"))
         for src, what in [(a, f"{r.id} assuming") for a in r.assuming]:
+            from rclverify.model.plan.formal import parse_formal  # deferred: start-up (loaded only by a plan that has formal statements)
             try:
                 parse_formal(src, checked, what)
             except RclError as exc:

@@ -36,14 +36,16 @@ from __future__ import annotations
 import dataclasses
 import re
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.lang.types import BOOL, INTEGER, NATURAL, REAL, STRING, Checked, CheckedNode, Type
 from rclverify.model.plan.document import PlanDocument
-from rclverify.model.plan.formal import Source, _loc_at, _rename
 import json
+
+if TYPE_CHECKING:
+    from rclverify.model.plan.formal import Source
 
 #: ``state.v`` / ``next.v`` in a declaration's formulas.
 STATE_REF = re.compile(r"(?<![A-Za-z0-9_.'])(state|next)\.([A-Za-z_][A-Za-z0-9_]*)")
@@ -85,6 +87,7 @@ def read_state(doc: PlanDocument, locs: Mapping[tuple[Any, ...], ast.Loc], block
             loc = locs.get(base, ast.Loc(file, 1, 1))
 
             def src(key: str, text: str) -> Source:
+                from rclverify.model.plan.formal import Source  # deferred: start-up (loaded only by a plan that declares a state)
                 block = blocks.get(base + (key,))
                 if block is not None:
                     return Source(block[1], block[0], 1, file)
@@ -127,6 +130,7 @@ def parse_state_formula(sv: StateVar, which: str, checked: Checked, states: tupl
     """
     from rclverify.lang.parser import parse_formula  # deferred: start-up (loads lark, rclverify.core and more only when called)
     from rclverify.lang.typecheck import infer  # deferred: start-up (loads lark, rclverify.core and more only when called)
+    from rclverify.model.plan.formal import _loc_at, _rename  # deferred: start-up (loaded only by a plan that declares a state)
     src = sv.init if which == "init" else sv.next
     what = f"state {sv.node}.{sv.name} {which}"
     cn = checked.nodes.get(sv.node)

@@ -22,14 +22,16 @@ verdict) and is refused.
 from __future__ import annotations
 
 import re
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
-from rclverify.model.plan.target_text import Target, parse_target
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic
 from rclverify.lang.types import Checked
 from rclverify.model.plan.errors import plan_error
 from rclverify.model.plan.model import EvidenceEntry, Plan
+
+if TYPE_CHECKING:
+    from rclverify.model.plan.target_text import Target
 
 #: The tag of runs whose entry names no environment.
 UNSTATED = "unstated"
@@ -46,6 +48,7 @@ def entry_target(config: Mapping[str, Any]) -> Target | None:
     text = config.get("target")
     if not isinstance(text, str):
         return None
+    from rclverify.model.plan.target_text import parse_target  # deferred: start-up (loaded only by a plan that states a target)
     try:
         return parse_target(text)
     except ValueError:
@@ -70,6 +73,7 @@ def requirement_target(text: Any, loc: ast.Loc) -> Target | None:
     per answer."""
     if text is None:
         return None
+    from rclverify.model.plan.target_text import parse_target  # deferred: start-up (loaded only by a plan that states a target)
     try:
         t = parse_target(str(text))
     except ValueError as exc:
@@ -100,6 +104,7 @@ def _entry_problems(e: EvidenceEntry, at: Any, guarantees: int | None) -> list[D
             bad("target", f"a target is a text such as 'violation probability <= 1e-3 at 95 % per run', not "
                           f"{c['target']!r}")
         else:
+            from rclverify.model.plan.target_text import parse_target  # deferred: start-up (loaded only by a plan that states a target)
             try:
                 t = parse_target(c["target"])
             except ValueError as exc:

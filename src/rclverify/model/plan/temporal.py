@@ -28,7 +28,6 @@ from typing import Any, Mapping
 from rclverify.lang.errors import RclError, error
 from rclverify.lang.types import Checked, Type
 from rclverify.model.plan.formal import Formal, Source, _loc_at, parse_formal
-import difflib
 
 _PREFIX = re.compile(r"\s*(always|eventually|next|previous)\b")
 _BOUND = re.compile(r"\s*\[\s*<=\s*([^\]]*)\]")
@@ -183,6 +182,7 @@ def _misspelled(src: Source, start: int, end: int, checked: Checked, what: str) 
         if word in known or word in OPERATORS:
             continue
         # a prefix operator is the operand's first word; `until` stands between two operands
+        import difflib  # deferred: start-up (a close spelling is only looked for in an error)
         close = difflib.get_close_matches(word.lower(), OPERATORS if m.start(1) == first else ("until",), n=1,
                                           cutoff=0.75)
         if close:

@@ -55,7 +55,6 @@ records them.
 """
 from __future__ import annotations
 
-import difflib
 import os
 from pathlib import Path
 from typing import Any
@@ -339,6 +338,7 @@ def schema_message(error: Any, where: str) -> str:
     known = sorted(map(str, schema.get("properties", {})))
     if error.validator == "additionalProperties" and known and (unknown := _unknown_keys(error)):
         key = str(unknown[0])
+        import difflib  # deferred: start-up (a close spelling is only looked for in an error)
         close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
         missing = _named_missing(error)
         if close:

@@ -18,14 +18,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from rclverify.lang import ast
 from rclverify.model.plan.document import PlanDocument, plan_document
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.yamlguard import KEY, Path_
-from rclverify.model.plan.standards.identity import Person, confusable, is_person, person_keys
-from rclverify.model.plan.standards.profiles import ASKED, Profile, builtin_names, load_builtin, load_profile_file
+
+if TYPE_CHECKING:
+    from rclverify.model.plan.standards.identity import Person
+    from rclverify.model.plan.standards.profiles import Profile
 
 
 #: The fewest words of the justification that narrowing a clause asked at the level needs.
@@ -66,6 +68,7 @@ def read_people(data: PlanDocument | Mapping[str, Any], locs: Mapping[Path_, ast
     person (their names' keys meet: they would be one entry)."""
     out: list[Person] = []
     for i, entry in enumerate(_document(data).people):
+        from rclverify.model.plan.standards.identity import Person, confusable, is_person, person_keys  # deferred: start-up (loaded only by a plan that names people)
         at = locs.get(("people", i), ast.Loc(file, 1, 1))
         p = Person(entry.name, entry.aliases, entry.emails, (at.file, at.line, at.col))
         for n in p.names():
@@ -83,6 +86,7 @@ def read_people(data: PlanDocument | Mapping[str, Any], locs: Mapping[Path_, ast
 
 
 def _profile(root: Path, name: str, at: ast.Loc) -> Profile:
+    from rclverify.model.plan.standards.profiles import builtin_names, load_builtin, load_profile_file  # deferred: start-up (loaded only by a plan that names a standard)
     if name.endswith((".yaml", ".yml")):
         if Path(name).is_absolute() or ".." in Path(name).parts:
             raise plan_error(at.file, at.line, at.col, f"standard profile {name!r} must be a path inside the "
@@ -137,6 +141,7 @@ def _clauses(p: Profile, entry: Mapping[str, Any], base: Path_, locs: Mapping[Pa
     words, a ``justification`` of at least three words; narrowing a clause asked at ``level`` (``HR``,
     or ``required``) also needs a ``justification`` of at least :data:`ASKED_WORDS` words (shown in full
     in the matrix)."""
+    from rclverify.model.plan.standards.profiles import ASKED  # deferred: start-up (loaded only by a plan that names a standard)
     def at(*path: Any) -> ast.Loc:
         full = base + ("clauses",) + path
         while full not in locs and len(full) > len(base):
