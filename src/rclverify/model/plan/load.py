@@ -11,7 +11,6 @@ file.  The format is documented in docs/plan.md.
 from __future__ import annotations
 
 import json
-from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
@@ -42,6 +41,7 @@ __all__ = ["KEY", "Plan", "all_requirements", "load_plan", "read_plan_data", "re
 
 
 def _schema() -> dict[str, Any]:
+    from importlib import resources  # deferred: start-up (the schema is read only when a plan is validated, not on a kept pass)
     return json.loads(resources.files("rclverify.model.plan").joinpath("plan.schema.json").read_text(encoding="utf-8"))  # type: ignore[no-any-return]
 
 
