@@ -35,13 +35,24 @@ CONTRACT = """node Window {
   guarantee( forall(k in <0 upto 2> | out.x(k) > in.r) )
 }
 """
+#: The deadline monitors: loaded by a run whose contract has a deadline (the control below), by no other.
+DEADLINE_PARTS = ("rclverify.backends.monitors.deadlines", "rclverify.backends.monitors.batch_deadlines",
+                  "rclverify.backends.monitors.deadline_records", "rclverify.backends.monitors.deadline_text")
 #: Loaded by no run on a plain log once the start-up cache is warm: the libraries whose results it keeps
 #: (lark, jsonschema, jinja2, Z3, rosbags' type stores), the second solver, and what other commands use.
 NOT_ON_A_PLAIN_LOG = ("z3", "cvc5", "lark", "jinja2", "jsonschema", "rosbags.typesys.stores", "networkx", "rich",
                       "hypothesis", "doit", "websockets", "importlib.metadata", "rclverify.tools.lsp",
                       "rclverify.targets.dafny", "rclverify.targets.ajpf", "rclverify.backends.dafny",
                       "rclverify.backends.model_checking",
-                      "rclverify.report", "rclverify.calculus", "rclverify.cli.ros", "rclverify.cli.verify")
+                      "rclverify.report", "rclverify.calculus", "rclverify.cli.ros", "rclverify.cli.verify",
+                      # what a contract with a deadline, a period, a declaration or a link, or a plan with formal
+                      # statements, standards, instances or targets loads; the writer of kept files; a close
+                      # spelling (difflib) looked for only in an error; importlib.resources (the schema: a miss)
+                      *DEADLINE_PARTS, "rclverify.backends.monitors.dds_calls", "rclverify.backends.monitors.bag_calls",
+                      "rclverify.backends.monitors.online", "rclverify.model.plan.formal",
+                      "rclverify.model.plan.temporal", "rclverify.model.plan.target_text",
+                      "rclverify.model.plan.standards.profiles", "rclverify.model.names", "rclverify.records.statistics",
+                      "rclverify.core.atomic", "difflib", "importlib.resources")
 
 
 def _cell(root: Path, width: str) -> Path:
@@ -173,3 +184,34 @@ def test_a_distributions_folder_is_found_by_its_normalised_name_on_the_first_pat
     assert distribution_version("PyYAML") == "6.0.4"
     monkeypatch.setattr(sys, "path", [str(old), str(new)])
     assert distribution_version("PyYAML") == "6.0"
+
+
+DEADLINE = """node Window {
+  inputs( a : REAL )
+  outputs( b : REAL )
+  topics( std_msgs/Float64 trig matches(in.a), std_msgs/Float64 ans matches(out.b) )
+  guarantee( out.b > in.a ) triggered by in.a within 30 ms
+}
+"""
+
+
+def test_the_deadline_monitors_are_loaded_by_a_run_with_a_deadline_only(tmp_path: Path) -> None:
+    """A warm run on a plain log loads none of :data:`DEADLINE_PARTS`; the control: the same workspace
+    with a deadline in its contract loads them all, and judges its triggers (one met, one missed)."""
+    plain, timed, cache = _workspace(tmp_path / "plain"), _workspace(tmp_path / "timed"), tmp_path / "cache"
+    (timed / "contracts/w.rcl").write_text(DEADLINE)
+    (timed / "backends/monitors/mapping.yaml").write_text(
+        "horizon: 0.005\ntopics:\n  trig: {fields: [data]}\n  ans: {fields: [data]}\n")
+    (timed / "run.jsonl").write_text("".join(json.dumps(line) + "\n" for line in [
+        {"topic": "trig", "time": 0.0, "data": 0.0}, {"topic": "ans", "time": 0.01, "data": 1.0},
+        {"topic": "trig", "time": 0.1, "data": 0.0}, {"topic": "ans", "time": 0.2, "data": 1.0},
+        {"topic": "tick", "time": 1.0}]))
+    for root in (plain, timed):
+        _loaded(root, cache)  # the start-up cache warmed
+    code, printed, loaded = _loaded(plain, cache)
+    assert code == 1 and "deadlines" not in printed
+    assert [m for m in DEADLINE_PARTS if m in loaded] == []
+    code, printed, loaded = _loaded(timed, cache)
+    deadlines = next(r["deadlines"] for r in json.loads(printed) if "deadlines" in r)
+    assert code == 1 and deadlines["counts"]["true"] == 1 and deadlines["counts"]["false"] == 1
+    assert set(DEADLINE_PARTS) <= loaded
