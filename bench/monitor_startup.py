@@ -25,8 +25,10 @@ the timing, as an installed rclverify runs; they share a user cache
 so the start-up measured is the one after the first run on a workspace.
 
 ``--compare OLD_SRC`` runs the same from an older source tree (e.g. ``git
-worktree add ../old <commit>``, then ``OLD_SRC=../old/src``) alternately
-with this one and prints old, new and new/old.
+worktree add ../old <commit>``, then ``OLD_SRC=../old/src``) and prints old,
+new and new/old; the start-up runs of the two trees alternate (new, old,
+new, ...), so that a load that comes and goes on a shared machine falls on
+both.
 
 Usage::
 
@@ -46,7 +48,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Libraries the command needs only for some runs: their import on a plain log is start-up spent for nothing.
@@ -91,15 +93,29 @@ def _logs(tmp: Path, lines: int) -> tuple[Path, Path, Path]:
     return tiny, windowed, scalar
 
 
-def measure(src: str, tmp: Path, tiny: Path, logs: list[Path], repeat: int) -> dict[str, Any]:
-    """The figures of the tree ``src`` (module docstring)."""
-    env = _env(src, tmp / "cache")
+def startups(trees: list[tuple[str, str]], tmp: Path, tiny: Path, repeat: int) -> dict[str, dict[str, Any]]:
+    """Per tree label, the least CPU of ``repeat`` runs of ``monitor --help`` (``help``) and of the
+    ten-line run (``tiny``), the trees' runs alternating; each tree's user cache is ``tmp/<label>/cache``."""
     help_argv = [sys.executable, "-c", ENTRY, "monitor", "--help"]
     run_argv = [sys.executable, "-c", ENTRY, "monitor", "--json", "--margins", "-w", str(tiny), str(tiny / "run.jsonl")]
-    _cpu(help_argv, env)  # warm-up: bytecode and the user cache written
-    _cpu(run_argv, env)
-    out: dict[str, Any] = {"help": min(_cpu(help_argv, env) for _ in range(repeat)),
-                           "tiny": min(_cpu(run_argv, env) for _ in range(repeat))}
+    envs = {label: _env(src, tmp / label / "cache") for label, src in trees}
+    for env in envs.values():
+        _cpu(help_argv, env)  # warm-up: bytecode and the user cache written
+        _cpu(run_argv, env)
+    runs: dict[str, dict[str, list[float]]] = {label: {"help": [], "tiny": []} for label in envs}
+    for _ in range(repeat):
+        for label, env in envs.items():
+            runs[label]["help"].append(_cpu(help_argv, env))
+            runs[label]["tiny"].append(_cpu(run_argv, env))
+    return {label: {k: min(v) for k, v in r.items()} for label, r in runs.items()}
+
+
+def measure(src: str, tmp: Path, tiny: Path, logs: list[Path], repeat: int) -> dict[str, Any]:
+    """The figures of the tree ``src`` but its start-up (module docstring; :func:`startups`)."""
+    env = _env(src, tmp / "cache")
+    run_argv = [sys.executable, "-c", ENTRY, "monitor", "--json", "--margins", "-w", str(tiny), str(tiny / "run.jsonl")]
+    _cpu(run_argv, env)  # warm-up: bytecode and the user cache written, as the modules child finds them
+    out: dict[str, Any] = {}
     p = subprocess.run([sys.executable, __file__, "--child", "modules", "--", *run_argv[3:]], env=env,
                        capture_output=True, text=True)
     if p.returncode != 0:
@@ -175,11 +191,14 @@ def main() -> int:
         base = Path(tmp)
         tiny, windowed, scalar = _logs(base, args.lines)
         got = {label: measure(src, base / label, tiny, [windowed, scalar], args.repeat) for label, src in trees}
+        for label, figures in startups(trees, base, tiny, args.repeat).items():
+            got[label].update(figures)
     print(f"rclverify monitor: start-up and reading; CPU s the least of {args.repeat} run(s)")
-    rows = [("start-up: monitor --help", lambda r: r["help"], "{:.3f} s"),
-            ("start-up: monitor --json --margins, 10 lines", lambda r: r["tiny"], "{:.3f} s"),
-            ("reading, windowed log, per 100k lines", lambda r: r["windowed"]["per_100k"], "{:.3f} s"),
-            ("reading, scalar log, per 100k lines", lambda r: r["scalar"]["per_100k"], "{:.3f} s")]
+    rows: list[tuple[str, Callable[[dict[str, Any]], float], str]] = [
+        ("start-up: monitor --help", lambda r: r["help"], "{:.3f} s"),
+        ("start-up: monitor --json --margins, 10 lines", lambda r: r["tiny"], "{:.3f} s"),
+        ("reading, windowed log, per 100k lines", lambda r: r["windowed"]["per_100k"], "{:.3f} s"),
+        ("reading, scalar log, per 100k lines", lambda r: r["scalar"]["per_100k"], "{:.3f} s")]
     head = f"{'':<46} {'new':>9}" + (f" {'old':>9} {'new/old':>8}" if "old" in got else "")
     print(head)
     for name, pick, fmt in rows:
