@@ -207,9 +207,11 @@ class Ros2Participant:
     # -- actions -----------------------------------------------------------------------------
     def action_server(self, node: NodeInfo, name: str, action_type: str,
                       execute: Callable[[dict[str, Any]], tuple[list[tuple[float, dict[str, Any]]], dict[str, Any]]]
-                      ) -> None:
+                      ) -> tuple[Any, ...]:
         """Serve action ``name``: ``execute(goal) -> ([(delay s, feedback)], result)``; feedback and the
-        status go out as the goal runs; get-result is answered once the goal has finished."""
+        status go out as the goal runs; get-result is answered once the goal has finished.  Returns the
+        writers a third party hears the goal's answers from (send-goal reply, get-result reply, feedback),
+        for a test to wait until a monitor's readers matched them."""
         a = self.types.action(action_type)
         base = name.rstrip("/") + "/_action/"
         user = f"serviceid={uuid.uuid4().hex};".encode()
@@ -261,6 +263,7 @@ class Ros2Participant:
             answer_waiting()
         self._loop(goal_rq, on_goal)
         self._loop(res_rq, on_result_request)
+        return goal_rr, res_rr, fb
 
     def action_client(self, node: NodeInfo, name: str, action_type: str) -> Callable[[dict[str, Any], float], Any]:
         """A client of action ``name``: ``send(goal, timeout) -> (feedbacks, result)``."""

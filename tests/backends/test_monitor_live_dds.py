@@ -96,8 +96,8 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         ros.serve(base, "/estop", "std_srvs/SetBool",
                   lambda k, req: ({"success": k != 2, "message": f"call {k}"}, 0.4 if k == 3 else 0.0))
         call = ros.client(teleop, "/estop", "std_srvs/SetBool")
-        ros.action_server(mover, "/move", "rclverify_examples/Move",
-                          lambda goal: ([(0.3, {"progress": 0.5})], {"arrived": True}))
+        served = ros.action_server(mover, "/move", "rclverify_examples/Move",
+                                   lambda goal: ([(0.3, {"progress": 0.5})], {"arrived": True}))
         send = ros.action_client(mission, "/move", "rclverify_examples/Move")
         echo = ros.subscriber(ros.node("echo"), "/rclverify/verdict", "std_msgs/String")  # `ros2 topic echo`
         # another participant publishes /range with another type: its messages cannot be heard, and that is said
@@ -111,8 +111,10 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
         other.announce()
         ros.announce()
         # the monitor's readers are made when it discovers a publisher: wait until they are matched
-        wait_until(lambda: all(matched(w) >= 1 for w in (limit, speed, rng, *send.writers))
-                   and matched(call.writer) >= 2 and len(heard.get_matched_publications()) >= 1, 20,
+        # (an action's writers are matched by its peer and by the monitor: two each)
+        wait_until(lambda: all(matched(w) >= 1 for w in (limit, speed, rng))
+                   and all(matched(w) >= 2 for w in (*send.writers, *served, call.writer))
+                   and len(heard.get_matched_publications()) >= 1, 20,
                    "the monitor's readers and its republisher of /speed matched")
         String = types.message("std_msgs/Float64")
         F32 = types.message("std_msgs/Float32")
