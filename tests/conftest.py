@@ -61,7 +61,7 @@ LIVE = frozenset({
     "test_live_stops", "test_lifecycle_live", "test_instances_live", "test_lsp_code_repair", "test_fleet_example_live",
     "test_run_repair_rclpy", "test_ros2_run_end", "test_ros2_thresholds_clocks_stamps",
     "test_ros2_rclpy_discovers_nobody", "test_ros2_robots_other_clocks", "test_ros2_dds_server_restart",
-    "test_live_exit", "test_ros2_clock_heard", "test_ros2_sim_time_deadlines",
+    "test_live_exit", "test_ros2_clock_heard", "test_ros2_sim_time_deadlines", "test_ros2_sim_time_calls",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -142,6 +142,8 @@ SECONDS: dict[str, float] = {
     # Out of the inner tier by the two-second rule: over 3 CPU s in a whole run (three workers, a load of about 8)
     # and again in the inner tier's own run (three workers, load 3 to 7)
     "test_copied_stamps_shared_seeds": 3.5, "test_batch_violations": 3.2,
+    # an oracle over 500 random call runs against the rule enumerated, each replayed from its log
+    "test_call_deadlines_sim_time": 3.5,
 }
 
 #: Wall-clock seconds of the live modules, serial (they wait on masters, nodes, a browser: their CPU
@@ -170,6 +172,7 @@ WALL: dict[str, float] = {
     "test_live_exit": 20.0,  # a ROS 1 master and two stopped runs beside a CPU burner, two held controls
     "test_ros2_clock_heard": 45.0,  # five live runs (both sources with /clock, one without; ROS 1 with and without)
     "test_ros2_sim_time_deadlines": 30.0,  # two live runs (a source each, factors 0.5 and 2), each log read 4 times
+    "test_ros2_sim_time_calls": 35.0,  # the same for a SetBool server's calls
 }
 
 #: Modules weighed by their wall-clock time (in :data:`WALL`) whose live tests are marked in the module
