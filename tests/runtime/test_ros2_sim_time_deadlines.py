@@ -170,17 +170,23 @@ def test_the_control_judges_the_same_log_on_the_wall_clock(run: dict[str, Any]) 
 
 
 def test_a_node_whose_clock_is_not_said_is_undecided(run: dict[str, Any]) -> None:
-    """The mapping says nothing: the two clocks disagree on every deadline, so each is undecided.  A question
-    before the monitor heard ``/clock`` is placed on the run's clock: in time there (at 2), ``true``; late (at
-    0.5), undecided once ``/clock`` is heard, ``false`` only if answered before it was."""
+    """The mapping says nothing: decided only where the two clocks agree.  In simulated time every answer
+    is met at 0.5 and missed at 2 (the first test); on the wall clock each is as the log's own times give
+    it, late at 0.5 and in time at 2 but for a ``/clock`` publisher behind under load, so (nearly) every
+    deadline is undecided.  A question before the monitor heard ``/clock`` is placed on the run's clock: in
+    time there, ``true``; late, undecided once ``/clock`` is heard, ``false`` only if answered before it was."""
     lines = [json.loads(x) for x in (run["tmp"] / "live.jsonl").read_text().splitlines()]
     first = min(x["time"] for x in lines if x.get("topic") == "clock")
+    asked = {x["data"]: x["time"] for x in lines if x.get("topic") == "x"}
     answers = {x["data"]: x["time"] for x in lines if x.get("topic") == "y"}
-    early = [k for k in (x["data"] for x in lines if x.get("topic") == "x" and x["time"] < first)]
+    sim_late = run["factor"] == 2.0
+    want = {"undecided": 0, "true": 0, "false": 0}
+    for k, at in asked.items():
+        wall_late = answers[k] - at > 0.4
+        if at < first:  # placed on the run's clock
+            want["undecided" if wall_late and answers[k] >= first else "false" if wall_late else "true"] += 1
+        else:
+            want["undecided" if wall_late != sim_late else "false" if wall_late else "true"] += 1
     t = _tally(run, "unsaid")
-    if run["factor"] == 2.0:
-        want = {"undecided": ROUNDS - len(early), "true": len(early), "false": 0}
-    else:
-        stands = sum(1 for k in early if answers[k] < first)  # answered late before /clock was heard
-        want = {"undecided": ROUNDS - stands, "true": 0, "false": stands}
-    assert {v: t[f"deadline {v}"] for v in want} == want, (t, early, first)
+    assert want["undecided"] >= ROUNDS - 3, want
+    assert {v: t[f"deadline {v}"] for v in want} == want, (t, first)
