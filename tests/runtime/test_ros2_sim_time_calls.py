@@ -70,6 +70,8 @@ srv.configure_introspection(Clock(clock_type=ClockType.SYSTEM_TIME), qos_profile
                             ServiceIntrospectionState.CONTENTS)
 ex = MultiThreadedExecutor(num_threads=3)
 ex.add_node(n)
+while n.get_clock().now().nanoseconds == 0:  # its own clock not yet on /clock (reads 0): its waits would be short
+    ex.spin_once(timeout_sec=0.05)
 print("ready", flush=True)
 ex.spin()
 """

@@ -71,6 +71,8 @@ def due():
 n.create_subscription(Int64, "x", answer, 100)
 n.create_timer(0.002, due, clock=Clock(clock_type=ClockType.STEADY_TIME))  # looks at the node's clock often
 AWAIT_MONITOR
+while n.get_clock().now().nanoseconds == 0:  # its own clock not yet on /clock (reads 0): its waits would be short
+    spin(0.05)
 for k in range(1, ROUNDS + 1):
     pubs["x"].publish(Int64(data=k))
     spin(0.8)
