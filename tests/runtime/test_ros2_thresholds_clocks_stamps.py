@@ -462,7 +462,10 @@ def test_a_driver_two_seconds_ahead_is_named_and_a_lagging_alarm_found(run: dict
     assert sorted(c.split(":")[0] for c in clocks) == ["/heat", "/near"], clocks
     assert all("another clock" in c for c in clocks), clocks
     (heat,) = [c for c in clocks if c.startswith("/heat:")]
-    assert "+2.000 s to +2.000 s" in heat, heat
+    # its stamps are its reading's time plus 2 s, its source times when it published: on a loaded machine a
+    # publication comes a few milliseconds after the stamp is taken
+    lo, hi = (float(v) for v in re.findall(r"([+-][0-9.]+) s", heat)[:2])
+    assert 1.98 <= lo <= hi <= 2.0005, heat
     tally = _tally(run)
     assert (tally["Alarm"]["satisfied"], tally["Alarm"]["violated"], tally["Alarm"]["undecided"]) == (ROUNDS, 0, 0), \
         tally["Alarm"]
