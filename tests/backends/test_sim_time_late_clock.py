@@ -22,28 +22,14 @@ import pytest
 from rclverify.backends.monitors.batch_deadlines import deadline_monitor
 from rclverify.backends.monitors.deadline_records import DeadlineVerdict
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
-from rclverify.lang.parser import parse_text
-from rclverify.lang.typecheck import check
 from rclverify.traces.events import Event
-from rclverify.traces.mapping import load_rules
 
-RELAY = """
-node Relay {
-  inputs( x : REAL )
-  outputs( r : REAL )
-  topics( std_msgs/Float32 s matches(in.x), std_msgs/Float32 r matches(out.r) )
-  guarantee( out.r == in.x ) triggered by in.x within 100 ms
-}
-"""
-CHECKED = check([parse_text(RELAY, "relay.rcl")])
-NODE = CHECKED.nodes["Relay"]
+from test_deadline_sim_time import CHECKED, NODE, RELAY, _rules as _relay_rules  # noqa: E402
 
 
 def _rules(sim: Any, skew_ms: int = 0) -> Any:
-    rules = load_rules({"s": {"fields": ["data"]}, "r": {"fields": ["data"]}})
-    rules.skew = skew_ms / 1000
-    rules.sim_time = sim
-    return rules
+    """The relay's mapping, keeping ``sim`` (``use_sim_time``) with a transport skew of ``skew_ms`` ms."""
+    return _relay_rules(sim, skew_ms / 1000)
 
 
 def _clock(t_ms: int, value_ms: int) -> Event:
