@@ -19,7 +19,7 @@ from typing import Any, Iterator
 
 import pytest
 from _procs import stop, wait_for, wait_logged
-from _ros2 import live_workspace, rclverify, ros2_env, ros2_python, start_node
+from _ros2 import AWAIT_MONITOR, live_workspace, rclverify, ros2_env, ros2_python, start_node
 
 from rclverify.cli.commands import main
 from rclverify.runtime.dds.bag import BagRecorder
@@ -65,27 +65,14 @@ def answer(m):
         pubs["w"].publish(Int64(data=m.data))
 
 n.create_subscription(Int64, "x", answer, 100)
-ex = SingleThreadedExecutor()
-ex.add_node(n)
-
-def spin(seconds):
-    until = time.monotonic() + seconds
-    while time.monotonic() < until:
-        ex.spin_once(timeout_sec=0.002)
-
-spin(0.5)
-print("ready", flush=True)
-until = time.monotonic() + 30
-while time.monotonic() < until and n.count_publishers("/rclverify/verdict") < 1:
-    spin(0.05)
-spin(1.5)  # the monitor's readers match the publishers
+AWAIT_MONITOR
 for k in range(1, ROUNDS + 1):
     pubs["x"].publish(Int64(data=k))
     spin(0.1)
 print("done", flush=True)
 while True:
     ex.spin_once(timeout_sec=0.1)
-""".replace("ROUNDS", str(ROUNDS))
+""".replace("AWAIT_MONITOR\n", AWAIT_MONITOR).replace("ROUNDS", str(ROUNDS))
 
 
 def _skip_closed_last(lines: list[dict[str, Any]]) -> bool:
