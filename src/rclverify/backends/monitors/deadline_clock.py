@@ -15,8 +15,15 @@ mapping's ``use_sim_time`` says (:func:`~rclverify.traces.mapping.sim_time_of`):
   the transport skew (:mod:`.skew`) or later, or the clock reaching that with
   no answer, is ``false``; an answer from ``w`` to that is ``undecided`` (the
   node may not have received that ``/clock`` message yet).
-  A trigger before any ``/clock`` message, or after ``/clock`` went back (a
-  reset), is ``undecided`` at once, saying why: its simulated time is not known.
+  A trigger before any ``/clock`` message is held, no verdict given
+  (:func:`hold`), until the first ``/clock`` message places it as the run read
+  in stamp order does (:func:`place_held`): stamped at or after that message,
+  at the value it shows, and judged with the answer that came meanwhile;
+  stamped before it, ``undecided``, saying why: its simulated time is not
+  known.  With no ``/clock`` heard within the simulated clock's kept window
+  after it (or by the run's end) it is ``undecided`` so too
+  (:func:`release_held`).  A trigger after ``/clock`` went back (a reset) is
+  ``undecided`` at once.
 * **the run's clock** (said): ``/clock`` is not read; as on a run without it.
 * **not said**, on a run whose ``/clock`` has been heard: both.  ``true`` only
   when in time in both clocks, ``false`` only when late in both, else
@@ -57,6 +64,16 @@ answer (usually the next ``/clock`` message), or once its answer is more than th
 clock's kept window (:attr:`~rclverify.traces.sim_clock.SimClock.kept_ns`:
 the node's longest bound and a minute) behind the monitor's clock; a
 ``/clock`` message later than that leaves it as judged.
+
+**The first ``/clock`` message heard late.**  Live, a trigger stamped after the
+first ``/clock`` message may be released before it (the monitor's ``/clock``
+reader is made once it discovers the publisher).  Read in stamp order it is
+placed at that message's value; so a trigger of a node said to keep simulated
+time is held while no ``/clock`` has been heard (:func:`hold`), its answer
+kept, not judged, and placed by the first ``/clock`` message (:func:`place_held`;
+its verdict's reason then says it was held and how late that message was
+heard).  Memory: at most :data:`HELD` held obligations, each at most the kept
+window; past either, the oldest is released as on a run without ``/clock``.
 """
 from __future__ import annotations
 
@@ -73,6 +90,9 @@ from rclverify.backends.monitors import deadline_late
 
 #: the due time (integer ns) of an obligation whose simulated deadline ``/clock`` has not passed yet
 FAR = 1 << 62
+
+#: the most obligations held while no ``/clock`` has been heard (:func:`hold`): past it the oldest is released
+HELD = 4096
 
 #: what a verdict's reason says a ``use_sim_time`` left unsaid would decide
 DECLARE = "say which clock the node keeps (the mapping's use_sim_time) to decide it"
@@ -92,6 +112,9 @@ class ClockMonitor(Protocol):
     skew_ns: int
     now_ns: int | None
     answered_late: deque[deadline_late.Answered]
+    unclocked: deque[Pending]
+
+    def _judged(self, p: Pending, ev: Event, ns: int, semantics: str) -> None: ...
 
     def _withdraw_false(self, p: Pending) -> None: ...
 
@@ -99,6 +122,89 @@ class ClockMonitor(Protocol):
 
     def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
         ...
+
+
+def holds(mon: ClockMonitor) -> bool:
+    """Whether a new obligation of ``mon`` is held (:func:`hold`): its node said to keep simulated time, no
+    ``/clock`` message heard yet."""
+    return mon.sim_mode is True and not mon.sim.heard
+
+
+def hold(mon: ClockMonitor, p: Pending) -> None:
+    """New obligation ``p`` of a node said to keep simulated time, placed while no ``/clock`` has been heard:
+    held (no verdict) until the first ``/clock`` message places it (:func:`place_held`), or until it is more
+    than the simulated clock's kept window behind the monitor's clock with none heard (:func:`release_held`).
+    Its answer meanwhile is kept (:attr:`~.Pending.first_answer`), not judged.  At most :data:`HELD` are held;
+    past it the oldest quarter is released."""
+    p.unclocked, p.wall_due_ns, p.due_ns = True, p.due_ns, FAR
+    held = mon.unclocked
+    held.append(p)
+    if len(held) > HELD:
+        _release(mon, [held.popleft() for _ in range(HELD // 4)])
+
+
+def place_held(mon: ClockMonitor, ev: Event, ns: int, late: bool) -> None:
+    """The first ``/clock`` message ``ev``, placed at ``ns`` (``late``: placed before a message already fed):
+    each held obligation placed as the run read in stamp order places it (:func:`place`: stamped at or after
+    ``ns``, at the value ``ev`` shows; before it, ``undecided``, no ``/clock`` heard before it), then its
+    answer, if one came meanwhile, judged (:meth:`~.deadlines.DeadlineMonitor._judged`); those still open stay
+    open in their clock."""
+    held, mon.unclocked = list(mon.unclocked), deque()
+    note = ""
+    if late:
+        note = (f"; held until the first /clock message ({ev.where}, at {ns / 1e9:.3f} s) came, heard "
+                + (f"{ms(ev.late)} after its time, past the lateness bound" if ev.late > 0 else
+                   f"when the monitor's clock stood {ms_ns((mon.now_ns or ns) - ns)} after it")
+                + ": the trigger, stamped after it, was heard before it")
+    unanswered = {id(p) for p in held if p.first_answer is None}
+    opened = {id(p) for p in mon.pending if id(p) in unanswered}
+    mon.pending = [p for p in mon.pending if id(p) not in unanswered]
+    answered_: list[tuple[int, Pending]] = []
+    for p in held:
+        _unhold(mon, p)
+        why = place(mon, p)
+        if why:
+            undecided(mon, p, why)
+        elif p.first_answer is not None:
+            answered_.append((p.first_answer[1], p))
+        elif id(p) in opened:
+            mon.pending.append(p)
+        p.placed = note if p.clock else ""
+    answered_.sort(key=lambda x: x[0])  # judged in the order of their answers' stamps, as the stamp order does
+    for a, p in answered_:
+        assert p.first_answer is not None
+        answer, _, semantics = p.first_answer
+        p.first_answer = None
+        mon._judged(p, answer, a, semantics)
+
+
+def release_held(mon: ClockMonitor, before_ns: int | None = None) -> None:
+    """The held obligations (:func:`hold`) stamped before ``before_ns`` (integer ns, the run's clock; ``None``:
+    every one, the run's end) with no ``/clock`` heard: each ``undecided`` as a run without ``/clock`` gives
+    it (its simulated time is not known)."""
+    held = mon.unclocked
+    gone: list[Pending] = []
+    while held and (before_ns is None or held[0].stamp_ns < before_ns):
+        gone.append(held.popleft())
+    if gone:
+        _release(mon, gone)
+
+
+def _release(mon: ClockMonitor, gone: list[Pending]) -> None:
+    """Held obligations ``gone`` (taken from :attr:`~.deadlines.DeadlineMonitor.unclocked`, in order) released with no ``/clock`` heard
+    (:func:`release_held`): each ``undecided``, its simulated time not known."""
+    ids = {id(p) for p in gone if p.first_answer is None}
+    if ids:
+        mon.pending = [q for q in mon.pending if id(q) not in ids]
+    for p in gone:
+        _unhold(mon, p)
+        p.first_answer = None
+        undecided(mon, p, place(mon, p))
+
+
+def _unhold(mon: ClockMonitor, p: Pending) -> None:
+    """Held obligation ``p`` no longer held: its due time on the run's clock again (what :func:`place` reads)."""
+    p.unclocked, p.due_ns = False, p.wall_due_ns
 
 
 def reads_clock(mon: ClockMonitor) -> bool:
@@ -120,10 +226,12 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> list[Pending]:
         return []
     sim = mon.sim
     first = not sim.heard
+    late = mon.now_ns is not None and ns < mon.now_ns
     sim.see(ns, value, ev.where)
+    if first and mon.unclocked:
+        place_held(mon, ev, ns, late)
     if first and mon.sim_mode is None:
         _unsaid_before(mon, ns)
-    late = mon.now_ns is not None and ns < mon.now_ns
     if late and mon.answered_late:
         _late_margins_again(mon, ns)
     if not mon.awaiting:
@@ -141,6 +249,8 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> list[Pending]:
     horizon = _horizon(mon, ns)
     keep: list[Pending] = []
     again: list[Pending] = []
+    remeasure: list[Pending] = []  # answers whose margin this message may move
+    judged: list[Pending] = []  # of them, those past their deadline: kept or settled once measured again
     for p in mon.awaiting:
         if p.due_ns >= FAR:  # /clock had not passed its simulated deadline
             if late and p.stamp_ns >= ns:  # placed before this message was heard: at the value it shows
@@ -153,7 +263,7 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> list[Pending]:
                     _settle(mon, p)  # /clock heard after its answer: a later one passes it after the answer
                 else:
                     if p.held is not None and (ns <= p.answer_ns or (late and p.stamp_ns >= ns)):
-                        _margin_again(mon, p)
+                        remeasure.append(p)
                     keep.append(p)
                 continue
             _due(mon, p, w)
@@ -161,9 +271,21 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> list[Pending]:
                 again.append(p)
             continue
         if p.held is not None and ns <= p.answer_ns:  # judged already: its margin read on this /clock
-            _margin_again(mon, p)
+            remeasure.append(p)
+            judged.append(p)
+            keep.append(p)
+            continue
         _keep_or_settle(mon, p, keep, horizon)
     mon.awaiting = keep
+    if remeasure:  # in the order of the answers' stamps: the order the stamp order notes them in
+        for p in sorted(remeasure, key=lambda q: q.answer_ns):
+            _margin_again(mon, p)
+        stay: list[Pending] = []
+        for p in judged:
+            _keep_or_settle(mon, p, stay, horizon)
+        if len(stay) < len(judged):
+            settled = {id(p) for p in judged} - {id(p) for p in stay}
+            mon.awaiting = [p for p in keep if id(p) not in settled]
     return again
 
 
@@ -299,8 +421,7 @@ def _unsaid_before(mon: ClockMonitor, ns: int) -> None:
     are never ``false`` now (``undecided`` if their deadline passes on the run's clock), and those expired
     unanswered have their ``false`` withdrawn, ``undecided``: an update saying why.  One answered late
     before it keeps its ``false``."""
-    why = (f"placed on the run's clock before /clock was first heard (at {ns / 1e9:.3f} s): the node may keep "
-           f"simulated time; {DECLARE}")
+    why = _unsaid_why(ns)
     for p in mon.pending:
         if not p.clock and not p.maybe:
             p.maybe = why
@@ -309,6 +430,13 @@ def _unsaid_before(mon: ClockMonitor, ns: int) -> None:
             mon._withdraw_false(p)
             p.maybe = why
             undecided(mon, p, why + "; the false given is withdrawn", update=True)
+
+
+def _unsaid_why(ns: int) -> str:
+    """Why an obligation of a node whose clock is not said, placed on the run's clock before the first ``/clock``
+    message (at ``ns``), is never ``false`` once that message is heard (:func:`_unsaid_before`)."""
+    return (f"placed on the run's clock before /clock was first heard (at {ns / 1e9:.3f} s): the node may keep "
+            f"simulated time; {DECLARE}")
 
 
 def place(mon: ClockMonitor, p: Pending) -> str:
@@ -397,9 +525,16 @@ def margin_ns(mon: ClockMonitor, p: Pending, ns: int) -> int:
 
 
 def words(mon: ClockMonitor, p: Pending) -> str:
-    """What a verdict's reason adds for obligation ``p`` placed in a clock (``""`` for the run's clock)."""
+    """What a verdict's reason adds for obligation ``p`` placed in a clock (``""`` for the run's clock), with
+    how it was placed when the first ``/clock`` message was heard late (:func:`place_held`)."""
     if not p.clock:
         return ""
+    if p.placed:
+        return _words(p) + p.placed
+    return _words(p)
+
+
+def _words(p: Pending) -> str:
     passed = f", passed by /clock at {p.sim_passed_ns / 1e9:.3f} s on the run's clock" if p.sim_passed_ns else ""
     if p.clock == "sim":
         return (f"; in simulated time (use_sim_time): due at {p.sim_due_ns / 1e9:.3f} s on /clock{passed}")
@@ -407,5 +542,5 @@ def words(mon: ClockMonitor, p: Pending) -> str:
             f"{passed}): the node's clock is not said")
 
 
-__all__ = ["DECLARE", "FAR", "answered", "band", "band_late", "judge_again", "margin_ns", "place", "reads_clock",
-           "tick", "undecided", "words"]
+__all__ = ["DECLARE", "FAR", "HELD", "answered", "band", "band_late", "hold", "holds", "judge_again", "margin_ns",
+           "place", "place_held", "reads_clock", "release_held", "tick", "undecided", "words"]

@@ -143,9 +143,10 @@ def withdraw_margin(result: DeadlineResult, rest: list[Held], k: int, margin: in
     if m is None:
         return
     m.answers -= 1
-    if not m.answers:
+    if not m.answers:  # none left: as if none had been noted
         if not m.unanswered:
             del margins[k]
+        m.margin_ns, m.trigger_where, m.answer_where, m.answer = 0, "", "", 0.0
         return
     if (m.margin_ns, m.trigger_where) != (margin, trigger_where):
         return  # not the smallest: the smallest stands

@@ -108,6 +108,13 @@ class Pending:
     #: the margin of an answer in a clock, noted withdrawable (:attr:`DeadlineResult.floor`'s shape) until
     #: ``/clock`` is heard after the answer or the answer leaves the window kept for a late ``/clock``
     held: tuple[int, int, str, str, float] | None = None
+    #: held while no ``/clock`` had been heard, its node said to keep simulated time: no verdict is given until
+    #: the first ``/clock`` message places it, or none came within the kept window (:func:`.deadline_clock.hold`)
+    unclocked: bool = False
+    #: held so, the answer that came meanwhile: (the answer, its stamp in integer ns, the arithmetic it held in)
+    first_answer: tuple[Event, int, str] | None = None
+    #: what a verdict's reason adds on how it was placed (the first ``/clock`` heard late: ``""`` otherwise)
+    placed: str = ""
 
     @property
     def bound_ns(self) -> int:

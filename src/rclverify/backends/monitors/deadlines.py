@@ -91,6 +91,9 @@ class DeadlineMonitor(VerdictWords):
         self.sim = SimClock()
         #: obligations placed in simulated time whose deadline ``/clock`` has not passed yet
         self.awaiting: list[Pending] = []
+        #: obligations held until the first ``/clock`` message places them, in the order they came (their node
+        #: said to keep simulated time; at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.hold`)
+        self.unclocked: deque[Pending] = deque()
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.bindings = topic_bindings(node)
@@ -278,7 +281,9 @@ class DeadlineMonitor(VerdictWords):
         (:mod:`.deadline_clock`); a trigger heard after outputs stamped after it is answered by them."""
         d_ns = self.bounds_ns[k]
         p = Pending(k, ev, ns / 1e9, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
-        if deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
+        if deadline_clock.holds(self):  # kept in simulated time, no /clock heard yet: placed by the first one
+            deadline_clock.hold(self, p)
+        elif deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
             why = deadline_clock.place(self, p)
             if why:
                 deadline_clock.undecided(self, p, why)
@@ -354,7 +359,7 @@ class DeadlineMonitor(VerdictWords):
     def _try(self, p: Pending, ev: Event, ns: int, outs: set[str]) -> bool:
         """Whether output ``ev`` (stamp ``ns``, setting ``outs``) answers obligation ``p``:
         its verdict given (``true``, or ``false`` when late), else ``False`` (still pending)."""
-        k, cl, _, gouts, d = self.timed_k[p.k]
+        k, cl, _, gouts, _ = self.timed_k[p.k]
         if not (gouts & outs):
             return False
         if ns < p.stamp_ns:  # stamped before the trigger: within the skew, or published after it, it may be its answer
@@ -366,22 +371,31 @@ class DeadlineMonitor(VerdictWords):
         if j.truth is not True:
             p.rejected = rejected(k, ev, j)
             return False
+        if p.unclocked:  # held until /clock is first heard: judged when it places the obligation
+            p.first_answer = (ev, ns, j.semantics)
+            return True
+        self._judged(p, ev, ns, j.semantics)
+        return True
+
+    def _judged(self, p: Pending, ev: Event, ns: int, semantics: str) -> None:
+        """Obligation ``p`` answered by output ``ev`` stamped ``ns`` (its guarantee held in ``semantics``): its
+        verdict given (``true``, ``false`` when late, ``undecided`` in a clock's band or when
+        :attr:`~.deadline_records.Pending.maybe` and late) and its time margin noted."""
+        stamp = ns / 1e9
         if p.maybe and ns > p.due_ns:  # its own answer after the deadline: undecided, as when the clock passed first
             deadline_skew.undecided(self, p)
-            return True
+            return
         if p.clock and p.sure_ns < ns <= p.due_ns:  # in time in one clock it may be kept in, not in every one
             deadline_clock.band(self, p, ev, ns)
-            return True
-        self._emit(self.answered_verdict(p, ns, ev, d, j.semantics))
+            return
+        self._emit(self.answered_verdict(p, ns, ev, self.timed_k[p.k][4], semantics))
         margin = self._margin(p, ns)
         # placed in a clock, before /clock passed its deadline or was heard after the answer: a /clock message
         # heard later may change its verdict or its margin (deadline_clock.tick)
         held = bool(p.clock) and (p.due_ns >= deadline_clock.FAR or not self.sim.heard_after(ns))
         order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp, held=held)
         if held:
-            deadline_clock.answered(self, p, "true", ev, ns, j.semantics,
-                                    (margin, order, p.trigger.where, ev.where, stamp))
-        return True
+            deadline_clock.answered(self, p, "true", ev, ns, semantics, (margin, order, p.trigger.where, ev.where, stamp))
 
     def _margin(self, p: Pending, ns: int) -> int:
         """The time margin (integer ns) of an answer stamped ``ns`` to obligation ``p``: its deadline less the
@@ -433,6 +447,8 @@ class DeadlineMonitor(VerdictWords):
             return
         self.now_ns = now_ns
         self.now = now_ns / 1e9
+        if self.unclocked:  # held past the kept window with no /clock heard: as a run without /clock
+            deadline_clock.release_held(self, now_ns - self.sim.kept_ns)
         self._expire(now_ns)
 
     def _expire(self, now_ns: int) -> None:
@@ -454,6 +470,7 @@ class DeadlineMonitor(VerdictWords):
         """The obligations not answered whose deadline has not expired yet."""
         return [DeadlineVerdict(self.node.name, p.k, "currently_false", p.trigger.where, p.stamp, p.due, None, "",
                                 "not answered yet; " + (
+                                    "no /clock message heard yet to place it in simulated time" if p.unclocked else
                                     "/clock has not passed its deadline in simulated time yet"
                                     if p.due_ns >= deadline_clock.FAR else
                                     f"{ms_ns(p.due_ns - (self.now_ns or 0))} left") + deadline_clock.words(self, p))
@@ -462,6 +479,7 @@ class DeadlineMonitor(VerdictWords):
     def finish(self) -> DeadlineResult:
         """End of the run: obligations still within their deadline are ``currently_false``;
         those and the expired ones never answered are counted unanswered in the time margins."""
+        deadline_clock.release_held(self)  # held with no /clock heard: undecided, as on a run without it
         if self.now_ns is not None:  # a due time set behind the clock (deadline_clock.py) expires before the end
             self._expire(self.now_ns)
         for v in self.pending_verdicts():

@@ -1,0 +1,227 @@
+"""The first ``/clock`` message heard late (backends/monitors/deadline_clock.py, ``hold``, ``place_held``;
+docs/semantics.md, "Deadlines in simulated time").
+
+Live, the monitor's ``/clock`` reader may hear the first message after messages stamped after it (later than
+the lateness bound).  A trigger of a node said to keep simulated time that comes before any ``/clock`` is held
+(no verdict) until the first ``/clock`` message places it as the run read in stamp order places it: stamped
+at or after that message, at the value it shows, then judged with the answer that came meanwhile; stamped
+before it, ``undecided`` (no ``/clock`` heard before it).  With no ``/clock`` at all, a held trigger is
+``undecided`` as before, once the monitor's clock is the simulated clock's kept window past it, or at the
+run's end.  Control: the first ``/clock`` on time gives the verdicts it gave before, in the same order.  An
+oracle: random small runs whose first ``/clock`` message (and some others) is delivered late in the live
+order; the verdicts after every update, the counts and the time margins equal the stamp order's.  The live
+run in-process: its log and its bag read offline give its counts."""
+from __future__ import annotations
+
+import random
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors import deadline_clock
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
+from rclverify.traces.events import Event
+
+from test_deadline_sim_time import CHECKED, NODE  # noqa: E402
+from test_sim_time_late_clock import (RELAY_RUN, T0, _clock, _final, _judge, _live, _msg, _offline_deadlines,  # noqa: E402
+                                      _result, _rules)
+
+
+def _run(first_ms: int, answer_ms: int, trigger_ms: int = 100) -> list[Event]:
+    """/clock every 10 ms at factor 1 from ``first_ms`` to 300 ms (its value the time), a reading at
+    ``trigger_ms`` (due 100 ms later in simulated time), the relay's answer at ``answer_ms``, in stamp order."""
+    run = [_clock(t, t) for t in range(first_ms, 301, 10)] + [_msg(trigger_ms, "s", 1.0), _msg(answer_ms, "r", 1.0),
+                                                            _msg(400, "other", 0.0)]
+    return sorted(run, key=lambda e: e.time)
+
+
+def _first_late(run: list[Event], after: int) -> list[Event]:
+    """``run`` as the live engine releases it when its first ``/clock`` message is heard after the next
+    ``after`` messages of other writers (the ``/clock`` messages after it held behind it)."""
+    return _live(run, {next(i for i, e in enumerate(run) if e.topic == "/clock"): after})
+
+
+def test_a_trigger_heard_before_the_first_clock_is_placed_by_it_and_judged() -> None:
+    run = _run(50, 150)
+    live = _first_late(run, 2)
+    order = [e.where for e in live]
+    assert order.index("s@100") < order.index("r@150") < order.index("clock@50")
+    counts, unaccepted, seen = _judge(live, True)
+    assert (counts, unaccepted) == _judge(run, True)[:2]
+    assert counts == {"true": 1, "currently_false": 0, "false": 0} and unaccepted["undecided"] == 0
+    (v,) = seen
+    assert v.verdict == "true" and "in simulated time (use_sim_time)" in v.reason
+    assert "held until the first /clock message (clock@50" in v.reason and "past the lateness bound" in v.reason
+    assert _result(live, True, 0)[2] == _result(run, True, 0)[2]  # the margin measured on the later /clock
+
+
+def test_late_in_simulated_time_the_later_clock_messages_make_it_false() -> None:
+    """The answer at 235 ms: the first /clock placed the trigger (in time on its one sample), the /clock
+    messages held behind it pass the simulated deadline at 210 ms: ``false``, an update, as in stamp order."""
+    run = _run(50, 235)
+    live = _first_late(run, 2)
+    counts, unaccepted, seen = _judge(live, True)
+    offline = _judge(run, True)
+    assert (counts, unaccepted) == offline[:2] == ({"true": 0, "currently_false": 0, "false": 1}, unaccepted)
+    assert _final(seen) == _final(offline[2]) == {"s@100": "false"}
+    assert [(v.verdict, v.update) for v in seen] == [("true", False), ("false", True)]
+
+
+def test_control_the_first_clock_on_time_gives_the_same_verdicts_in_the_same_order() -> None:
+    for answer in (150, 235, 215):
+        run = _run(50, answer)
+        live = _live(run, {})
+        assert [e.where for e in live] == [e.where for e in run]
+        counts, unaccepted, seen = _judge(live, True)
+        assert (counts, unaccepted, seen) == _judge(run, True)
+        assert not any("held until" in v.reason for v in seen)
+    # a trigger stamped before the first /clock: undecided, late first /clock or not (stamp order the same)
+    run = _run(120, 150)
+    for live in (run, _first_late(run, 2)):
+        counts, unaccepted, seen = _judge(live, True)
+        assert counts == {"true": 0, "currently_false": 0, "false": 0} and unaccepted["undecided"] == 1
+        assert [v.reason for v in seen] == [
+            "its node keeps simulated time (use_sim_time) and no /clock message was heard before it: "
+            "its simulated time is not known"]
+    # the run's clock said: /clock is not read, the trigger judged at once on the run's clock
+    live = _first_late(_run(50, 150), 2)
+    seen = _judge(live, False)[2]
+    assert [(v.verdict, "held" in v.reason) for v in seen] == [("true", False)]
+
+
+def test_with_no_clock_a_held_trigger_is_undecided_after_the_kept_window_or_at_the_end() -> None:
+    """No /clock at all: each trigger ``undecided`` as before (the same reason), once the monitor's clock is
+    the kept window (the longest bound and a minute) past it; those still held at the end, then, and the
+    counts final.  Memory: at most ``HELD`` held, the oldest released past it."""
+    seen: list[Any] = []
+    mon = DeadlineMonitor(CHECKED, NODE, _rules(True), seen.append)
+    mon.feed(_msg(100, "s", 1.0))
+    mon.feed(_msg(150, "r", 1.0))
+    assert not seen and len(mon.unclocked) == 1
+    assert [v.verdict for v in mon.pending_verdicts()] == []  # answered: held with its answer
+    mon.advance(0.1 + mon.sim.kept_ns / 1e9)  # not past the window yet
+    assert not seen
+    mon.advance(0.1 + mon.sim.kept_ns / 1e9 + 0.001)
+    assert [v.verdict for v in seen] == ["undecided"] and "no /clock message was heard before it" in seen[0].reason
+    mon.feed(_msg(200_000, "s", 1.0))  # a second one, held to the end of the run
+    assert "no /clock message heard yet" in mon.pending_verdicts()[0].reason
+    res = mon.finish()
+    assert res.counts == {"true": 0, "currently_false": 0, "false": 0} and res.unaccepted["undecided"] == 2
+    assert len(seen) == 2 and not mon.unclocked and not mon.pending
+    mon = DeadlineMonitor(CHECKED, NODE, _rules(True), None)
+    for t in range(deadline_clock.HELD + 10):
+        mon.feed(_msg(t, "s", 1.0))
+    assert len(mon.unclocked) <= deadline_clock.HELD
+    assert mon.result.unaccepted["undecided"] == deadline_clock.HELD // 4
+    assert mon.finish().unaccepted["undecided"] == deadline_clock.HELD + 10
+
+
+def _random_run(rnd: random.Random) -> tuple[list[Event], dict[int, int]]:
+    """/clock samples from a random first one (values never going back, jumps up to 60 ms), one to three
+    readings and their answers (or none) before or after it, a last message; every time distinct; the first
+    /clock message delivered late in most runs, some others too."""
+    times = rnd.sample(range(1, 600), 40)
+    first = rnd.randrange(1, 300)
+    clocks = [first] + sorted(t for t in times[:rnd.randrange(3, 25)] if t > first)
+    value = rnd.randrange(0, 30)
+    run = []
+    for t in clocks:
+        value += rnd.choice((0, 0, 5, 10, 20, 40, 60))
+        run.append(_clock(t, value))
+    rest = [t for t in times[25:] if t != first]
+    for n in range(rnd.randrange(1, 4)):
+        run.append(_msg(rest[2 * n], "s", float(n)))
+        if rnd.random() < 0.8:
+            run.append(_msg(rest[2 * n + 1], "r", float(n)))
+    run.append(_msg(700, "other", 0.0))
+    run.sort(key=lambda e: e.time)
+    i0 = next(i for i, e in enumerate(run) if e.topic == "/clock")
+    late = {i: rnd.choice((1, 1, 2)) for i, e in enumerate(run) if e.topic == "/clock" and i > i0 and rnd.random() < 0.2}
+    if rnd.random() < 0.7:
+        late[i0] = rnd.choice((1, 2, 3, 4))
+    return run, late
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_oracle_the_first_clock_late_gives_the_stamp_orders_verdicts(seed: int) -> None:
+    rnd = random.Random(1000 + seed)
+    for case in range(60):
+        run, late = _random_run(rnd)
+        live = _live(run, late)
+        skew = rnd.choice((0, 3))
+        got, want = _result(live, True, skew), _result(run, True, skew)
+        info = (seed, case, skew, [(e.where, e.stamp) for e in live], [(v.verdict, v.update, v.reason) for v in got[3]])
+        assert got[:3] == want[:3], info  # counts, undecided, time margins
+        assert _final(got[3]) == _final(want[3]), info
+
+
+def _live_run(ws: Path, answer_s: float, first_heard_s: float) -> dict[str, Any]:
+    """The live run in-process, as test_sim_time_late_clock's: /clock every 10 ms at factor 1 from 0.05 s to
+    0.4 s (a node said to keep simulated time), a reading at 0.1 s, the relay's answer at ``answer_s``; every
+    /clock message stamped before ``first_heard_s`` heard then (in order).  Returns the live record."""
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.lang.typecheck import load
+    from rclverify.runtime.dds.bag import BagRecorder
+    from rclverify.runtime.live import LiveRun
+    from rclverify.traces.bag import typestore
+
+    (ws / "contracts").mkdir()
+    (ws / "contracts" / "c.rcl").write_text(RELAY_RUN)
+    (ws / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
+    (ws / "mapping.yaml").write_text("topics:\n  s: {fields: [data]}\n  r: {fields: [data]}\nuse_sim_time: true\n")
+    heard = [(max(t / 1000, first_heard_s), "clock", t / 1000, t / 1000) for t in range(50, 401, 10)]
+    heard += [(0.100, "s", 0.100, 1.0), (answer_s, "r", answer_s, 1.0)]
+    heard.sort(key=lambda h: (h[0], h[2]))
+    checked = load([ws / "contracts" / "c.rcl"])
+    live = LiveRun(checked, [checked.nodes["Relay"]], load_mapping(ws, "mapping.yaml").rules, 0.5,
+                   ws / "live.jsonl", reorder_window=0.05)
+    store = typestore([])
+    f64, clock, time = (store.types[t] for t in ("std_msgs/msg/Float64", "rosgraph_msgs/msg/Clock",
+                                                  "builtin_interfaces/msg/Time"))
+    rec = BagRecorder(ws / "bag", "sqlite3", {"s": "std_msgs/msg/Float64", "r": "std_msgs/msg/Float64",
+                                              "clock": "rosgraph_msgs/msg/Clock"}, [])
+    live.engine.on_late = rec.late
+    now, period = T0, 0.01
+    for arrival, topic, source, value in heard:
+        while now + period <= T0 + arrival:
+            now += period
+            live.tick(now)
+        ns = round((T0 + source) * 1e9)
+        if topic == "clock":
+            sec, nsec = divmod(round((T0 + value) * 1e9), 1_000_000_000)
+            fields: dict[str, Any] = {"clock": {"sec": sec, "nanosec": nsec}}
+            raw = store.serialize_cdr(clock(clock=time(sec=sec, nanosec=nsec)), "rosgraph_msgs/msg/Clock")
+        else:
+            fields, raw = {"data": value}, store.serialize_cdr(f64(data=value), "std_msgs/msg/Float64")
+        rec.write(topic, ns, raw)
+        live.push(topic, fields, ns / 1e9)
+    for _ in range(100):
+        now += period
+        live.tick(now)
+    record: dict[str, Any] = live.stop(ws / "live.json")
+    rec.close()
+    return record
+
+
+@pytest.mark.parametrize("answer_s, want", [(0.150, "true"), (0.235, "false")])
+def test_the_live_run_its_log_and_its_bag_give_the_same_counts(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                              answer_s: float, want: str) -> None:
+    """The first /clock message heard at 0.3 s, after the answer: the trigger at 0.1 s is placed by it (at
+    0.1 s simulated), ``true`` for an answer at 0.15 s, ``false`` at 0.235 s (the held /clock messages pass
+    its deadline at 0.21 s); before, both were ``undecided`` live.  Control: the first /clock heard on time."""
+    import json
+
+    for heard_s, late in ((0.30, True), (0.05, False)):
+        ws = tmp_path / f"{answer_s}-{late}"
+        ws.mkdir()
+        record = _live_run(ws, answer_s, heard_s)
+        (dl,) = record["topic_deadlines"]
+        live = {**dl["deadlines"]["counts"], "undecided": dl["deadlines"]["unaccepted"]["undecided"]}
+        assert {k for k, n in live.items() if n} == {want}, (late, live)
+        assert _offline_deadlines(ws, ws / "live.jsonl", capsys) == live
+        assert _offline_deadlines(ws, ws / "bag", capsys) == live
+        lines = [json.loads(x) for x in (ws / "live.jsonl").read_text().splitlines()]
+        reasons = [x["verdict"]["reason"] for x in lines if x.get("kind") == "deadline"]
+        assert any("held until the first /clock message" in r for r in reasons) == late, reasons
+        assert bool([x for x in lines if "late_s" in x and x["topic"] == "clock"]) == late
