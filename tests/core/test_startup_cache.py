@@ -69,13 +69,44 @@ def test_an_edited_contract_is_parsed_again_not_served_from_the_cache(tmp_path: 
     assert "in.r < 100" in guarantee and "in.r < 120" not in guarantee
 
 
+def test_a_yaml_file_is_read_again_when_its_text_changes_and_an_error_is_never_kept(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The mapping's data is kept by its file's text (``read_kept``): the same text is not parsed again, an
+    edited one is (the control: a key without the text would serve the old horizon), and malformed YAML gives
+    the same located error on every run, none of them kept."""
+    from rclverify.backends.monitors.config import ConfigError, load_mapping
+    import rclverify.model.plan.yamlguard as yamlguard
+    root, kept_dir = _workspace(tmp_path / "ws"), tmp_path / "kept"
+    with keeping(kept_dir) as kept:
+        assert load_mapping(root, None).horizon == 0.005
+    assert kept.misses == 1 and kept.hits == 0
+    with monkeypatch.context() as m:  # the same text: its data comes from the cache, the parser is not asked
+        m.setattr(yamlguard, "compose_guarded", lambda *a: pytest.fail("parsed although the text is kept"))
+        with keeping(kept_dir) as kept:
+            assert load_mapping(root, None).horizon == 0.005
+    assert kept.hits == 1 and kept.misses == 0
+    (root / "backends/monitors/mapping.yaml").write_text(MAPPING.replace("0.005", "0.25"))
+    with keeping(kept_dir) as kept:
+        assert load_mapping(root, None).horizon == 0.25
+    assert kept.misses == 1
+    (root / "backends/monitors/mapping.yaml").write_text("horizon: [0.25\n")
+    said = []
+    for _ in range(2):
+        with keeping(kept_dir) as kept, pytest.raises(ConfigError) as err:
+            load_mapping(root, None)
+        said.append(str(err.value))
+        assert kept.hits == 0
+    assert said[0] == said[1] and said[0].startswith("backends/monitors/mapping.yaml:2:1: error: not valid YAML")
+    assert len(list(kept_dir.glob("*.pickle"))) == 2  # the two texts read, not the malformed one
+
+
 def test_a_syntax_error_is_never_kept(tmp_path: Path) -> None:
     root, kept_dir = _workspace(tmp_path / "ws", CLASSIFIER.replace("guarantee(", "guarantee((")), tmp_path / "kept"
     for _ in range(2):
         with keeping(kept_dir) as kept, pytest.raises(Exception, match="unexpected"):
             Workspace(root).checked
-    assert kept.hits == 1 and kept.misses == 1  # the plan's pass was kept, the contract never
-    assert len(list(kept_dir.glob("*.pickle"))) == 1
+    assert kept.hits == 2 and kept.misses == 1  # the plan (its YAML read, its schema's pass) was kept, the contract never
+    assert len(list(kept_dir.glob("*.pickle"))) == 2
 
 
 def test_a_plan_edited_to_break_the_schema_is_refused_after_a_kept_pass(tmp_path: Path) -> None:

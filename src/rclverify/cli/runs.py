@@ -11,20 +11,21 @@ from rclverify.cli.common import AddCommand, seconds
 def cmd_monitor(args: argparse.Namespace) -> int:
     """Judge recorded runs, or the running system (``--live``), against every node's contract (:func:`rclverify.cli.monitor.monitor_command`)."""
     from rclverify.core.cache.heap import freeze_at_exit, loading  # deferred: start-up (imported where it is used)
+    from rclverify.core.cache.startup import keeping  # deferred: start-up (loads rclverify.core.cache.store only when called)
     # what the start-up loads (the modules, the log's reader, the contracts, the plan) stays live to the end: no
-    # collection while it is made, then frozen for the run, so that no collection walks it (core/cache/heap.py)
-    with loading() as loaded:
-        from rclverify.cli.monitor import monitor_command  # deferred: start-up (loads numpy, yaml and more only when called)
-        from rclverify.core.cache.startup import keeping  # deferred: start-up (loads rclverify.core.cache.store only when called)
+    # collection while it is made, then frozen for the run, so that no collection walks it (core/cache/heap.py);
+    # the parsed contracts, the plan's schema check, the compiled formulas and the YAML files read (the backends'
+    # declarations among them, read when their module is imported) are kept by content (core/cache/startup.py)
+    with loading() as loaded, keeping():
+        from rclverify.cli.monitor import monitor_command  # deferred: start-up (loads numpy and more only when called)
         from rclverify.stages.workspace import Workspace  # deferred: start-up (loads rclverify.core, rclverify.core.atomic and more only when called)
         from rclverify.model.instances import instantiate  # deferred: start-up (as above)
         _log_reader(args)
-        with keeping():  # the parsed contracts, the plan's schema check, the compiled formulas: kept by content
-            ws = Workspace(Path(args.workspace), args.plan)
-            checked = instantiate(ws.checked, ws.plan.node_instances)  # each instance its own node; raises RclError, printed located by main
-            freeze_at_exit()
-            loaded()
-            return monitor_command(args, checked)
+        ws = Workspace(Path(args.workspace), args.plan)
+        checked = instantiate(ws.checked, ws.plan.node_instances)  # each instance its own node; raises RclError, printed located by main
+        freeze_at_exit()
+        loaded()
+        return monitor_command(args, checked)
 
 
 def _log_reader(args: argparse.Namespace) -> None:

@@ -33,11 +33,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-import yaml
-
 from rclverify.semantics.floatsem import Tolerance, ToleranceError, parse_tolerance
 from rclverify.traces.mapping import RuleError, TopicRule, load_rules
-from rclverify.model.plan.yamlguard import read_yaml_text, safe_load_guarded
+from rclverify.model.plan.yamlguard import read_yaml_text, safe_load_guarded, yaml_error
 from rclverify.backends.monitors.skew import DEFAULT_SKEW_S, parse_skew
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.yamlguard import load_located
@@ -107,9 +105,11 @@ def load_mapping(root: Path, rel: str | None, horizon: Any = None, traces: Any =
     path = root / (rel or DEFAULT_MAPPING)
     raw: Any = {}
     if path.is_file():
-        try:
-            raw = safe_load_guarded(read_yaml_text(path, rel or DEFAULT_MAPPING), rel or DEFAULT_MAPPING) or {}
-        except yaml.YAMLError as exc:
+        name = rel or DEFAULT_MAPPING
+        from rclverify.core.cache.startup import read_kept  # deferred: start-up (loads rclverify.core.cache.store only when called)
+        try:  # kept by the command's start-up cache (core/cache/startup.py): a warm start does not parse it
+            raw = read_kept(f"mapping {name}", read_yaml_text(path, name), lambda t: safe_load_guarded(t, name)) or {}
+        except yaml_error() as exc:
             mark = getattr(exc, "problem_mark", None)
             line = f"{mark.line + 1}:{mark.column + 1}" if mark is not None else "1:1"
             raise ConfigError(f"{rel or DEFAULT_MAPPING}:{line}: error: not valid YAML: {exc}") from None
@@ -182,7 +182,7 @@ def _at(path: Path, rel: str, keys: tuple[Any, ...]) -> str:
     when it cannot be found)."""
     try:
         _, locs = load_located(read_yaml_text(path, rel), rel)
-    except (PlanError, yaml.YAMLError):
+    except (PlanError, yaml_error()):
         return "1:1"
     while keys and keys not in locs:
         keys = keys[:-1]

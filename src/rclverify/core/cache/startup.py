@@ -22,6 +22,10 @@ part                       keyed by                                             
 ``needs-answer``           the pickled environment, node and formulas            Z3
 ``message-definitions``    the message types a node's topics name and the name   rosbags
                            and text of each workspace ``.msg``
+``yaml``                   what was read (the reader and the file's name) and    PyYAML
+                           the file's text: the plan's data and locations, the
+                           mapping's data, a backend's declaration
+                           (:func:`read_kept`)
 =========================  ====================================================  ===========
 
 Every key also holds the part's salt (:func:`.keys.salt`: the cache
@@ -44,7 +48,7 @@ from __future__ import annotations
 
 import contextlib
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator, TypeVar
 
 from rclverify.core.cache.keys import Keyer, library_stamp, salt, user_cache_dir
 from rclverify.core.cache.store import read_stream, write_stream
@@ -52,7 +56,8 @@ from rclverify.core.cache.store import read_stream, write_stream
 KIND = "start-up"
 #: Each part and the library whose result it keeps (its version is in the part's salt).
 PARTS = {"contract": "lark", "plan-schema": "jsonschema", "straightline": "jinja2", "needs-answer": "z3",
-         "message-definitions": "rosbags"}
+         "message-definitions": "rosbags", "yaml": "yaml"}
+_T = TypeVar("_T")
 
 
 class Kept:
@@ -123,4 +128,22 @@ def keeping(folder: Path | None = None) -> Iterator[Kept]:
         _ACTIVE.remove(kept)
 
 
-__all__ = ["KIND", "PARTS", "Kept", "active", "keeping"]
+def read_kept(what: str, text: str, read: Callable[[str], _T]) -> _T:
+    """``read(text)``: what rclverify reads from a YAML file's ``text`` (``what``: the reader and the file's
+    name, e.g. ``"plan contracts/plan.yaml"``), kept by the store of the innermost :func:`keeping` under the
+    part ``yaml`` and keyed by ``what`` and ``text``, so that a warm start neither imports PyYAML nor parses
+    the file.  Computed (and kept) on a miss or with no store.  What ``read`` raises is raised and nothing is
+    kept: an error is computed again, its message the reader's."""
+    kept = active()
+    if kept is None:
+        return read(text)
+    got = kept.get("yaml", what, text)
+    if got is not None:
+        value: _T = got[0]
+        return value
+    value = read(text)
+    kept.put("yaml", (value,), what, text)
+    return value
+
+
+__all__ = ["KIND", "PARTS", "Kept", "active", "keeping", "read_kept"]

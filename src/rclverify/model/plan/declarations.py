@@ -24,8 +24,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-import yaml
-
 from rclverify.records.statuses import EVIDENCE_KINDS
 
 #: The backends, in the order the report's columns and the plan's messages list them:
@@ -39,9 +37,6 @@ REGISTRY: Mapping[str, str] = {
     "experiment": "experiment",
     "review": "review",
 }
-
-#: PyYAML's safe loader, libyaml's when PyYAML has it (the declarations are read at every start)
-_LOADER: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 #: The strengths of evidence, strongest first (report/argument/strength.py ranks and weighs them).
 STRENGTHS = ("proof", "bounded", "statistical", "tested", "observed", "reviewed", "assumed")
@@ -143,8 +138,10 @@ def parse(text: str, name: str, folder: str) -> Declaration:
     """The declaration in ``text`` (YAML) of backend ``name`` in ``folder``.
     Raises :class:`DeclarationError` naming ``folder``'s file and the fault."""
     where = f"rclverify/backends/{folder}/declaration.yaml"
+    import yaml  # deferred: start-up (a warm start of the monitor command reads the declarations from its start-up cache)
+    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # PyYAML's safe loader, libyaml's when PyYAML has it
     try:
-        raw = _only(yaml.load(text, Loader=_LOADER), _TOP, where)  # noqa: S506 - a safe loader
+        raw = _only(yaml.load(text, Loader=loader), _TOP, where)  # noqa: S506 - a safe loader
     except yaml.YAMLError as exc:
         raise DeclarationError(f"{where}: not YAML: {exc}") from None
     if raw.get("name") != name:
@@ -170,11 +167,14 @@ def parse(text: str, name: str, folder: str) -> Declaration:
 def _read_all() -> dict[str, Declaration]:
     # the package's folder, as core/cache/keys.py's code_stamp reads it: importlib.resources, and the zipfile,
     # tempfile and threading it loads, cost every start of the command about 5 ms for files that are on disk
+    # (kept by the monitor command's start-up cache, core/cache/startup.py: its warm start neither imports PyYAML
+    # nor parses them; any other process parses them)
+    from rclverify.core.cache.startup import read_kept  # deferred: start-up (imported where it is used)
     base = Path(__file__).resolve().parents[2] / "backends"
     out = {}
     for name, folder in REGISTRY.items():
         text = base.joinpath(*folder.split("/"), "declaration.yaml").read_text(encoding="utf-8")
-        out[name] = parse(text, name, folder)
+        out[name] = read_kept(f"declaration {name} {folder}", text, lambda t: parse(t, name, folder))
     return out
 
 

@@ -14,15 +14,13 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
-import yaml
-
 from rclverify.lang import ast
 from rclverify.lang.errors import Diagnostic, RclError, error
 from rclverify.model.plan.document import EnvironmentEntry, PlanDocument, RequirementEntry, plan_document
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.model.plan.targets import requirement_target
 from rclverify.model.plan.yamlguard import (KEY, Blocks, compose_guarded, read_yaml_text, schema_error_loc,
-                                             schema_messages, to_data)
+                                             schema_messages, to_data, yaml_error)
 
 # The plan's values live in model/plan/model.py (below this loader and what it calls); re-exported here.
 from rclverify.model.plan.model import Connection, DeadlineSpec, EvidenceEntry, Fact, Path_, Plan, Requirement, Support  # noqa: E402,F401
@@ -71,9 +69,20 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
             raise
         raise plan_error(plan_rel, 1, 1, d.message.replace("cannot read file", "cannot read the verification plan"),
                          "E-io") from None
+    from rclverify.core.cache.startup import read_kept  # deferred: start-up (loads rclverify.core.cache.store only when called)
+    data, locs, blocks = read_kept(f"plan {plan_rel}", text, lambda t: _parse_plan(t, plan_rel))
+    if not isinstance(data, dict):
+        raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
+    _check_schema(data, locs, plan_rel, root)
+    return data, locs, blocks
+
+
+def _parse_plan(text: str, plan_rel: str) -> tuple[Any, dict[Path_, ast.Loc], Blocks]:
+    """The plan's ``text`` as plain data, with a location for every value path and its block scalars
+    (:func:`~.yamlguard.to_data`).  Raises :class:`PlanError` for YAML that is malformed or refused."""
     try:
         node = compose_guarded(text, plan_rel)
-    except yaml.YAMLError as exc:
+    except yaml_error() as exc:
         mark = getattr(exc, "problem_mark", None)
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
@@ -81,13 +90,10 @@ def _read_plan_source(root: Path, plan_rel: str) -> tuple[dict[str, Any], dict[P
     blocks: Blocks = {}
     try:
         data = to_data(node, plan_rel, locs=locs, lines=text.splitlines(), blocks=blocks) if node is not None else None
-    except yaml.YAMLError as exc:  # e.g. a tag the safe loader does not construct
+    except yaml_error() as exc:  # e.g. a tag the safe loader does not construct
         mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise plan_error(plan_rel, line, col, f"invalid YAML: {getattr(exc, 'problem', exc)}", "E-yaml") from None
-    if not isinstance(data, dict):
-        raise plan_error(plan_rel, 1, 1, "the verification plan must be a mapping with a 'contracts' list")
-    _check_schema(data, locs, plan_rel, root)
     return data, locs, blocks
 
 

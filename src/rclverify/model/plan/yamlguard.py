@@ -56,16 +56,18 @@ records them.
 from __future__ import annotations
 
 import os
+from functools import lru_cache
 from pathlib import Path
-from typing import Any
-
-import yaml
+from typing import TYPE_CHECKING, Any
 
 from rclverify.core.within import read_regular
 from rclverify.lang import ast
 from rclverify.lang.errors import RclError
 from rclverify.model.plan.errors import PlanError, plan_error
 from rclverify.lang.source import decode_text
+
+if TYPE_CHECKING:
+    import yaml
 
 Path_ = tuple[Any, ...]
 #: Marker in a location path: ``path + (key, KEY)`` is where the key itself is written.
@@ -75,11 +77,30 @@ Blocks = dict[Path_, tuple[int, str]]
 #: The only tags a list or a mapping may carry (the YAML 1.2 core schema's).
 COLLECTION_TAGS = frozenset({"tag:yaml.org,2002:seq", "tag:yaml.org,2002:map"})
 
-#: The safe loader that composes the node graph: libyaml's where PyYAML was built with it (the
-#: same nodes and marks, eight times faster: 1.7 of the 1000-node plan's 1.9 s were PyYAML's
-#: pure-Python scanner), else PyYAML's own.  Malformed YAML is composed again by PyYAML's own
-#: loader, whose messages name what it found, so the error a user sees does not depend on libyaml.
-_COMPOSER: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+@lru_cache(maxsize=1)
+def _composer() -> Any:
+    """The safe loader that composes the node graph: libyaml's where PyYAML was built with it (the
+    same nodes and marks, eight times faster: 1.7 of the 1000-node plan's 1.9 s were PyYAML's
+    pure-Python scanner), else PyYAML's own.  Malformed YAML is composed again by PyYAML's own
+    loader, whose messages name what it found, so the error a user sees does not depend on libyaml."""
+    import yaml  # deferred: start-up (a warm start reads its YAML files from the start-up cache, core/cache/startup.py)
+    return getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def __getattr__(name: str) -> Any:
+    """``_COMPOSER``: :func:`_composer`'s loader (PyYAML imported when it is first asked for)."""
+    if name == "_COMPOSER":
+        return _composer()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def yaml_error() -> type[Exception]:
+    """``yaml.YAMLError`` (PyYAML imported when it is first asked for): an ``except yaml_error():`` clause
+    imports PyYAML only when an exception reaches it."""
+    import yaml  # deferred: start-up (as above)
+    return yaml.YAMLError
+
 
 #: Largest plan file read, in bytes (1 MiB).
 MAX_YAML_BYTES = 1 << 20
@@ -102,6 +123,7 @@ def check_size(path: Path, file: str) -> None:
 
 
 def _children(node: yaml.Node) -> list[yaml.Node]:
+    import yaml  # deferred: start-up (as _composer)
     if isinstance(node, yaml.MappingNode):
         return [x for kv in node.value for x in kv]
     if isinstance(node, yaml.SequenceNode):
@@ -122,11 +144,13 @@ def compose_guarded(text: str, file: str) -> yaml.Node | None:
     ``PlanError`` for input over a limit."""
     if len(text.encode("utf-8", "surrogatepass")) > MAX_YAML_BYTES:
         raise plan_error(file, 1, 1, f"YAML text above the limit of {MAX_YAML_BYTES} bytes", "E-yaml-limit")
+    import yaml  # deferred: start-up (as _composer)
+    composer = _composer()
     try:
         try:
-            root = yaml.compose(text, Loader=_COMPOSER)
+            root = yaml.compose(text, Loader=composer)
         except yaml.YAMLError:
-            if _COMPOSER is yaml.SafeLoader:
+            if composer is yaml.SafeLoader:
                 raise
             # PyYAML's own scanner says more (it names the character found); the error is its
             root = yaml.compose(text, Loader=yaml.SafeLoader)
@@ -186,6 +210,7 @@ def to_data(node: yaml.Node, file: str, *, locs: dict[Path_, ast.Loc] | None = N
     duplicate key, or a tag on a collection (module docstring), and
     ``yaml.YAMLError`` (with the node's mark) for a scalar tag the safe
     constructor does not know."""
+    import yaml  # deferred: start-up (as _composer)
     loader = yaml.SafeLoader("")
     out_locs: dict[Path_, ast.Loc] = {} if locs is None else locs
     out_blocks: Blocks = {} if blocks is None else blocks
