@@ -1,5 +1,5 @@
-"""The first ``/clock`` message heard late (backends/monitors/deadline_clock.py, ``hold``, ``place_held``;
-docs/semantics.md, "Deadlines in simulated time").
+"""The first ``/clock`` message heard late (backends/monitors/deadline_clock.py, ``hold``, ``place_held``,
+``record``, ``unsaid_first``; docs/semantics.md, "Deadlines in simulated time").
 
 Live, the monitor's ``/clock`` reader may hear the first message after messages stamped after it (later than
 the lateness bound).  A trigger of a node said to keep simulated time that comes before any ``/clock`` is held
@@ -7,10 +7,13 @@ the lateness bound).  A trigger of a node said to keep simulated time that comes
 at or after that message, at the value it shows, then judged with the answer that came meanwhile; stamped
 before it, ``undecided`` (no ``/clock`` heard before it).  With no ``/clock`` at all, a held trigger is
 ``undecided`` as before, once the monitor's clock is the simulated clock's kept window past it, or at the
-run's end.  Control: the first ``/clock`` on time gives the verdicts it gave before, in the same order.  An
-oracle: random small runs whose first ``/clock`` message (and some others) is delivered late in the live
-order; the verdicts after every update, the counts and the time margins equal the stamp order's.  The live
-run in-process: its log and its bag read offline give its counts."""
+run's end.  A node whose clock is not said is judged on the run's clock before any ``/clock``, as before;
+the first ``/clock`` message heard late gives again, as updates, what it gave to a trigger stamped after that
+message (judged in both clocks) and to one answered late after it (``undecided``).  Control: the first
+``/clock`` on time gives the verdicts it gave before, in the same order.  An oracle: random small runs whose
+first ``/clock`` message (and some others) is delivered late in the live order, for both nodes; the verdicts
+after every update, the counts and the time margins equal the stamp order's.  The live run in-process: its
+log and its bag read offline give its counts."""
 from __future__ import annotations
 
 import random
@@ -28,11 +31,12 @@ from test_sim_time_late_clock import (RELAY_RUN, T0, _clock, _final, _judge, _li
                                       _result, _rules)
 
 
-def _run(first_ms: int, answer_ms: int, trigger_ms: int = 100) -> list[Event]:
-    """/clock every 10 ms at factor 1 from ``first_ms`` to 300 ms (its value the time), a reading at
-    ``trigger_ms`` (due 100 ms later in simulated time), the relay's answer at ``answer_ms``, in stamp order."""
-    run = [_clock(t, t) for t in range(first_ms, 301, 10)] + [_msg(trigger_ms, "s", 1.0), _msg(answer_ms, "r", 1.0),
-                                                            _msg(400, "other", 0.0)]
+def _run(first_ms: int, answer_ms: int | None, trigger_ms: int = 100, half: bool = False) -> list[Event]:
+    """/clock every 10 ms from ``first_ms`` to 300 ms at factor 1 (its value the time; ``half``: at 0.5, half
+    the time), a reading at ``trigger_ms`` (due 100 ms later in simulated time), the relay's answer at
+    ``answer_ms`` (``None``: none), a last message at 400 ms, in stamp order."""
+    run = [_clock(t, t // 2 if half else t) for t in range(first_ms, 301, 10)]
+    run += [_msg(trigger_ms, "s", 1.0), _msg(400, "other", 0.0)] + ([_msg(answer_ms, "r", 1.0)] if answer_ms else [])
     return sorted(run, key=lambda e: e.time)
 
 
@@ -117,6 +121,66 @@ def test_with_no_clock_a_held_trigger_is_undecided_after_the_kept_window_or_at_t
     assert mon.finish().unaccepted["undecided"] == deadline_clock.HELD + 10
 
 
+def test_not_said_a_false_on_the_run_s_clock_is_given_again_in_both_clocks() -> None:
+    """The node's clock not said, /clock at factor 0.5 from 50 ms: the answer at 235 ms is late on the run's
+    clock (due at 200 ms) and in time in simulated time (due at 150 ms simulated, /clock at 117 ms then):
+    ``undecided`` in stamp order.  Live, the first /clock heard after it, the trigger was judged on the run's
+    clock (``false``); that message gives it again: ``undecided``, an update saying why."""
+    run = _run(50, 235, half=True)
+    live = _first_late(run, 2)
+    counts, unaccepted, seen = _judge(live, None)
+    offline = _judge(run, None)
+    assert (counts, unaccepted) == offline[:2]
+    assert counts["false"] == 0 and unaccepted["undecided"] == 1
+    assert [(v.verdict, v.update) for v in seen] == [("false", False), ("undecided", True)]
+    assert "late on the run's clock, in time in simulated time" in seen[1].reason
+    assert "the false given on the run's clock is withdrawn; placed again when the first /clock message (clock@50" \
+        in seen[1].reason and "past the lateness bound" in seen[1].reason
+    assert _result(live, None, 0)[2] == _result(run, None, 0)[2] == []  # no margin: the late answer's withdrawn
+
+
+def test_not_said_an_expired_trigger_after_the_first_clock_is_open_again() -> None:
+    """Unanswered, expired on the run's clock before the first /clock message (stamped before it) came: its
+    ``false`` withdrawn, open (currently_false, an update), as in stamp order where /clock at 0.5 has not
+    passed its simulated deadline by the end; it is not counted unanswered twice."""
+    run = _run(50, None, half=True)
+    live = _first_late(run, 2)
+    order = [e.where for e in live]
+    assert order.index("other@400") < order.index("clock@50")
+    counts, unaccepted, seen = _judge(live, None)
+    assert (counts, unaccepted) == _judge(run, None)[:2]
+    assert counts == {"true": 0, "currently_false": 1, "false": 0}
+    assert [(v.verdict, v.update) for v in seen] == [("false", False), ("currently_false", True),
+                                                     ("currently_false", False)]
+    assert "the false given when the run's clock passed its deadline is withdrawn" in seen[1].reason
+    assert _result(live, None, 0)[2] == _result(run, None, 0)[2]
+
+
+def test_not_said_control_the_first_clock_on_time_or_a_run_without_clock() -> None:
+    """The first /clock on time: the verdicts of the stamp order, nothing given again.  No /clock at all: each
+    verdict on the run's clock when it comes (nothing held), none an update; the recorded obligations leave
+    once their trigger is the kept window behind the monitor's clock, their margins then settled."""
+    for answer in (150, 235, None):
+        run = _run(50, answer, half=True)
+        counts, unaccepted, seen = _judge(_live(run, {}), None)
+        assert (counts, unaccepted, seen) == _judge(run, None)
+        assert not any("placed again" in v.reason for v in seen)
+    run = [e for e in _run(50, 235) if e.topic != "/clock"]
+    given: list[Any] = []
+    mon = DeadlineMonitor(CHECKED, NODE, _rules(None), given.append)
+    for ev in run[:2]:
+        mon.feed(ev)
+    assert [(v.verdict, v.update) for v in given] == [("false", False)] and len(mon.unsure) == 1
+    assert mon.result.floor == {}  # its margin still withdrawable
+    mon.advance(0.1 + mon.sim.kept_ns / 1e9 + 0.001)
+    assert not mon.unsure and mon.result.floor[1][0] == -35_000_000
+    mon = DeadlineMonitor(CHECKED, NODE, _rules(None), None)
+    for t in range(0, 2 * deadline_clock.HELD, 2):
+        mon.feed(_msg(t, "s", 1.0))
+        mon.feed(_msg(t + 1, "r", 1.0))
+    assert len(mon.unsure) <= deadline_clock.HELD and mon.finish().counts["true"] == deadline_clock.HELD
+
+
 def _random_run(rnd: random.Random) -> tuple[list[Event], dict[int, int]]:
     """/clock samples from a random first one (values never going back, jumps up to 60 ms), one to three
     readings and their answers (or none) before or after it, a last message; every time distinct; the first
@@ -149,17 +213,20 @@ def test_oracle_the_first_clock_late_gives_the_stamp_orders_verdicts(seed: int) 
     for case in range(60):
         run, late = _random_run(rnd)
         live = _live(run, late)
-        skew = rnd.choice((0, 3))
-        got, want = _result(live, True, skew), _result(run, True, skew)
-        info = (seed, case, skew, [(e.where, e.stamp) for e in live], [(v.verdict, v.update, v.reason) for v in got[3]])
-        assert got[:3] == want[:3], info  # counts, undecided, time margins
-        assert _final(got[3]) == _final(want[3]), info
+        for mode in (True, None):
+            skew = rnd.choice((0, 3))
+            got, want = _result(live, mode, skew), _result(run, mode, skew)
+            info = (seed, case, mode, skew, [(e.where, e.stamp) for e in live],
+                    [(v.verdict, v.update, v.reason) for v in got[3]])
+            assert got[:3] == want[:3], info  # counts, undecided, time margins
+            assert _final(got[3]) == _final(want[3]), info
 
 
-def _live_run(ws: Path, answer_s: float, first_heard_s: float) -> dict[str, Any]:
-    """The live run in-process, as test_sim_time_late_clock's: /clock every 10 ms at factor 1 from 0.05 s to
-    0.4 s (a node said to keep simulated time), a reading at 0.1 s, the relay's answer at ``answer_s``; every
-    /clock message stamped before ``first_heard_s`` heard then (in order).  Returns the live record."""
+def _live_run(ws: Path, answer_s: float, first_heard_s: float, sim: str, factor: float) -> dict[str, Any]:
+    """The live run in-process, as test_sim_time_late_clock's: /clock every 10 ms at ``factor`` from 0.05 s to
+    0.4 s (its value the time times the factor), the mapping's ``use_sim_time`` ``sim`` (``""``: not said), a
+    reading at 0.1 s, the relay's answer at ``answer_s``; every /clock message stamped before ``first_heard_s``
+    heard then (in order).  Returns the live record."""
     from rclverify.backends.monitors.config import load_mapping
     from rclverify.lang.typecheck import load
     from rclverify.runtime.dds.bag import BagRecorder
@@ -169,8 +236,9 @@ def _live_run(ws: Path, answer_s: float, first_heard_s: float) -> dict[str, Any]
     (ws / "contracts").mkdir()
     (ws / "contracts" / "c.rcl").write_text(RELAY_RUN)
     (ws / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
-    (ws / "mapping.yaml").write_text("topics:\n  s: {fields: [data]}\n  r: {fields: [data]}\nuse_sim_time: true\n")
-    heard = [(max(t / 1000, first_heard_s), "clock", t / 1000, t / 1000) for t in range(50, 401, 10)]
+    (ws / "mapping.yaml").write_text("topics:\n  s: {fields: [data]}\n  r: {fields: [data]}\n"
+                                     + (f"use_sim_time: {sim}\n" if sim else ""))
+    heard = [(max(t / 1000, first_heard_s), "clock", t / 1000, t * factor / 1000) for t in range(50, 401, 10)]
     heard += [(0.100, "s", 0.100, 1.0), (answer_s, "r", answer_s, 1.0)]
     heard.sort(key=lambda h: (h[0], h[2]))
     checked = load([ws / "contracts" / "c.rcl"])
@@ -204,18 +272,22 @@ def _live_run(ws: Path, answer_s: float, first_heard_s: float) -> dict[str, Any]
     return record
 
 
-@pytest.mark.parametrize("answer_s, want", [(0.150, "true"), (0.235, "false")])
+@pytest.mark.parametrize("sim, factor, answer_s, want", [("true", 1.0, 0.150, "true"), ("true", 1.0, 0.235, "false"),
+                                                        ("", 0.5, 0.235, "undecided")])
 def test_the_live_run_its_log_and_its_bag_give_the_same_counts(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                              answer_s: float, want: str) -> None:
-    """The first /clock message heard at 0.3 s, after the answer: the trigger at 0.1 s is placed by it (at
-    0.1 s simulated), ``true`` for an answer at 0.15 s, ``false`` at 0.235 s (the held /clock messages pass
-    its deadline at 0.21 s); before, both were ``undecided`` live.  Control: the first /clock heard on time."""
+                                                              sim: str, factor: float, answer_s: float,
+                                                              want: str) -> None:
+    """The first /clock message heard at 0.3 s, after the answer.  Said to keep simulated time, at factor 1:
+    the trigger at 0.1 s is placed by it (at 0.1 s simulated), ``true`` for an answer at 0.15 s, ``false`` at
+    0.235 s (the /clock messages held behind it pass its deadline at 0.21 s); before, both were
+    ``undecided`` live.  Not said, at 0.5: the answer at 0.235 s, late on the run's clock and in time in
+    simulated time, ``undecided`` (before, ``false`` live).  Control: the first /clock heard on time."""
     import json
 
     for heard_s, late in ((0.30, True), (0.05, False)):
         ws = tmp_path / f"{answer_s}-{late}"
         ws.mkdir()
-        record = _live_run(ws, answer_s, heard_s)
+        record = _live_run(ws, answer_s, heard_s, sim, factor)
         (dl,) = record["topic_deadlines"]
         live = {**dl["deadlines"]["counts"], "undecided": dl["deadlines"]["unaccepted"]["undecided"]}
         assert {k for k, n in live.items() if n} == {want}, (late, live)
@@ -223,5 +295,6 @@ def test_the_live_run_its_log_and_its_bag_give_the_same_counts(tmp_path: Path, c
         assert _offline_deadlines(ws, ws / "bag", capsys) == live
         lines = [json.loads(x) for x in (ws / "live.jsonl").read_text().splitlines()]
         reasons = [x["verdict"]["reason"] for x in lines if x.get("kind") == "deadline"]
-        assert any("held until the first /clock message" in r for r in reasons) == late, reasons
+        assert any("held until the first /clock message" in r or "placed again" in r for r in reasons) == late, \
+            reasons
         assert bool([x for x in lines if "late_s" in x and x["topic"] == "clock"]) == late

@@ -31,7 +31,7 @@ mapping's ``use_sim_time`` says (:func:`~rclverify.traces.mapping.sim_time_of`):
   ``use_sim_time``).  A trigger before the first ``/clock`` message is placed
   on the run's clock; once ``/clock`` is heard, such an obligation still open
   is never ``false`` and one expired unanswered has its ``false`` withdrawn
-  (``undecided``: :func:`_unsaid_before`).
+  (``undecided``, no longer counted unanswered: :func:`_unsaid_before`).
 
 Each obligation so placed carries its clock (:attr:`~.deadline_records.Pending.clock`),
 the last stamp in time in every clock (``sure_ns``) and the first late in every
@@ -74,6 +74,14 @@ kept, not judged, and placed by the first ``/clock`` message (:func:`place_held`
 its verdict's reason then says it was held and how late that message was
 heard).  Memory: at most :data:`HELD` held obligations, each at most the kept
 window; past either, the oldest is released as on a run without ``/clock``.
+A node whose clock is not said is judged on the run's clock meanwhile, as on
+a run without ``/clock`` (no verdict waits); each such obligation is recorded
+(:func:`record`: its verdict, its answer, its margin noted withdrawable; as
+many and as long as held ones), and the first ``/clock`` message, heard late,
+gives again what it gave (:func:`unsaid_first`): to a trigger stamped at or
+after it, as the stamp order does in both clocks (a ``false`` on the run's
+clock withdrawn, ``undecided`` or open again, an update naming that message);
+to one stamped before it and answered late after it, ``undecided``.
 """
 from __future__ import annotations
 
@@ -113,6 +121,7 @@ class ClockMonitor(Protocol):
     now_ns: int | None
     answered_late: deque[deadline_late.Answered]
     unclocked: deque[Pending]
+    unsure: deque[Pending]
 
     def _judged(self, p: Pending, ev: Event, ns: int, semantics: str) -> None: ...
 
@@ -207,6 +216,184 @@ def _unhold(mon: ClockMonitor, p: Pending) -> None:
     p.unclocked, p.due_ns = False, p.wall_due_ns
 
 
+def records(mon: ClockMonitor) -> bool:
+    """Whether a new obligation of ``mon`` is placed on the run's clock and recorded (:func:`record`): its
+    node's clock not said, no ``/clock`` message heard yet."""
+    return mon.sim_mode is None and not mon.sim.heard
+
+
+def record(mon: ClockMonitor, p: Pending) -> None:
+    """New obligation ``p`` of a node whose clock is not said, placed on the run's clock while no ``/clock``
+    has been heard: judged there as on a run without ``/clock``, its verdict, answer and margin (noted
+    withdrawable) kept while the first ``/clock`` message, heard late, may be stamped at or before its
+    trigger (:func:`unsaid_first`): until its trigger is more than the simulated clock's kept window behind the
+    monitor's clock, or ``/clock`` is heard (:func:`drop_records`).  At most :data:`HELD` are kept; past it the
+    oldest quarter is dropped."""
+    p.provisional = True
+    kept = mon.unsure
+    kept.append(p)
+    if len(kept) > HELD:
+        _drop(mon, [kept.popleft() for _ in range(HELD // 4)])
+
+
+def drop_records(mon: ClockMonitor, before_ns: int | None = None) -> None:
+    """The recorded obligations (:func:`record`) stamped before ``before_ns`` (integer ns; ``None``: every one)
+    no longer given again: their margins can no longer be withdrawn."""
+    kept = mon.unsure
+    gone: list[Pending] = []
+    while kept and (before_ns is None or kept[0].stamp_ns < before_ns):
+        gone.append(kept.popleft())
+    _drop(mon, gone)
+
+
+def _drop(mon: ClockMonitor, gone: list[Pending]) -> None:
+    for p in gone:
+        if p.provisional and p.held is not None and not p.clock:
+            mon.result.settle(p.k, p.held)
+            p.held = None
+        p.provisional, p.first_answer = False, None
+
+
+def unsaid_first(mon: ClockMonitor, ev: Event, ns: int, late: bool) -> None:
+    """The first ``/clock`` message ``ev``, placed at ``ns``, heard by the monitor of a node whose clock is not
+    said (``late``: placed before a message already fed).  Each recorded obligation (:func:`record`) stamped at
+    or after ``ns`` is placed again as the run read in stamp order places it, in both clocks (at the value
+    ``ev`` shows), and what it was given on the run's clock is given again there: open, it stays open; expired
+    unanswered, its ``false`` is withdrawn and it is open again (an update says so); answered in time, its
+    ``true`` stands, its margin measured in both clocks; answered late, it is ``undecided`` (late on the run's
+    clock, not in simulated time yet), an update.  Then those placed before it are made unsure
+    (:func:`_unsaid_before`), and the records dropped."""
+    if late and mon.unsure:
+        heard = (f"heard {ms(ev.late)} after its time, past the lateness bound" if ev.late > 0 else
+                 f"heard when the monitor's clock stood {ms_ns((mon.now_ns or ns) - ns)} after it")
+        note = (f"; placed again when the first /clock message ({ev.where}, at {ns / 1e9:.3f} s), stamped before "
+                f"the trigger, was {heard}")
+        again = [p for p in mon.unsure if p.provisional and p.stamp_ns >= ns and not p.clock]
+        if again:
+            _given_again(mon, again, note)
+        before = [p for p in mon.unsure if p.provisional and p.stamp_ns < ns and not p.clock
+                  and p.first_answer is not None and p.first_answer[1] >= ns]
+        if before:
+            _late_after(mon, before, ns, heard)
+    _unsaid_before(mon, ns)
+    drop_records(mon)
+
+
+def _late_after(mon: ClockMonitor, before: list[Pending], ns: int, heard: str) -> None:
+    """Recorded obligations ``before``, stamped before the first ``/clock`` message (at ``ns``, ``heard`` as
+    late as it says) and answered after it: one answered late (its ``false`` given) is ``undecided``, an
+    update, as the run read in stamp order gives it (open when ``/clock`` came: never ``false`` since,
+    :func:`_unsaid_before`); its answer's margin is withdrawn.  One answered in time keeps its ``true``."""
+    ids = {id(p) for p in before}
+    late_of = {id(e[0]): e for e in mon.answered_late if id(e[0]) in ids}
+    if late_of:
+        mon.answered_late = deque(e for e in mon.answered_late if id(e[0]) not in late_of)
+    why = _unsaid_why(ns)
+    for p in before:
+        assert p.first_answer is not None
+        entry = late_of.get(id(p))
+        if entry is not None:
+            margin = entry[1]
+        elif p.given == "false" and p.held is not None:
+            margin, p.held = p.held[0], None
+        else:
+            continue
+        mon._withdraw_false(p)
+        deadline_late.withdraw_margin(mon.result, _held(mon, p.k), p.k, margin, p.trigger.where)
+        p.maybe = why
+        answer, a, _ = p.first_answer
+        undecided(mon, p, f"answered at {answer.where} {ms_ns(a - p.due_ns)} past its deadline, but {why}; the "
+                          f"false given is withdrawn: the first /clock message was {heard}", update=True)
+
+
+def _given_again(mon: ClockMonitor, again: list[Pending], note: str) -> None:
+    """:func:`unsaid_first` of the recorded obligations ``again`` (module docstring)."""
+    ids = {id(p) for p in again}
+    in_pending = {id(p) for p in mon.pending if id(p) in ids}
+    in_expired = {id(p) for p in mon.expired if id(p) in ids}
+    late_of = {id(e[0]): e for e in mon.answered_late if id(e[0]) in ids}
+    if in_expired:
+        mon.expired = deque((p for p in mon.expired if id(p) not in in_expired), maxlen=mon.expired.maxlen)
+    if late_of:
+        mon.answered_late = deque(e for e in mon.answered_late if id(e[0]) not in late_of)
+    res = mon.result
+    for p in again:
+        key = id(p)
+        if key in in_pending:
+            place(mon, p)
+            p.placed = note
+            continue
+        if key in in_expired:
+            given = "undecided" if p.maybe else "false"
+            if p.maybe:
+                res.unaccepted["undecided"] -= 1
+            else:
+                mon._withdraw_false(p)
+                _unanswered_withdrawn(mon, p)
+            place(mon, p)
+            p.placed = note
+            mon.pending.append(p)
+            if mon.on_verdict is not None:
+                mon.on_verdict(DeadlineVerdict(
+                    mon.node.name, p.k, "currently_false", p.trigger.where, p.stamp, p.due, None, "",
+                    f"not answered yet; the {given} given when the run's clock passed its deadline is withdrawn"
+                    + words(mon, p), update=True))
+            continue
+        entry = late_of.get(key)
+        if entry is not None and p.first_answer is not None:  # expired, then answered late: the false withdrawn
+            answer, a, semantics = p.first_answer
+            mon._withdraw_false(p)
+            deadline_late.withdraw_margin(res, _held(mon, p.k), p.k, entry[1], p.trigger.where)
+            _late_again(mon, p, answer, a, semantics, note)
+            continue
+        if p.given and p.held is not None and p.first_answer is not None:  # answered: true or false on its own
+            answer, a, semantics = p.first_answer
+            old, p.held = p.held, None
+            deadline_late.withdraw_margin(res, _held(mon, p.k), p.k, old[0], p.trigger.where)
+            if p.given == "false":
+                mon._withdraw_false(p)
+                _late_again(mon, p, answer, a, semantics, note)
+                continue
+            place(mon, p)
+            p.placed = note
+            margin = margin_ns(mon, p, a)
+            order = res.note_time_margin(p.k, margin, p.trigger.where, answer.where, a / 1e9, held=True)
+            answered(mon, p, "true", answer, a, semantics, (margin, order, p.trigger.where, answer.where, a / 1e9))
+        # otherwise (its answer heard after the clock passed its deadline and met on its own stamp, or made
+        # undecided by an output within the skew before it): as given
+
+
+def _unanswered_withdrawn(mon: ClockMonitor, p: Pending) -> None:
+    """Expired obligation ``p``, counted unanswered in its guarantee's time margins when it expired, its
+    ``false`` withdrawn: no longer counted (an ``undecided`` or open obligation is not)."""
+    margins = mon.result.time_margins
+    m = margins.get(p.k)
+    if m is not None and m.unanswered:
+        m.unanswered -= 1
+        if not m.answers and not m.unanswered:
+            del margins[p.k]
+
+
+def _late_again(mon: ClockMonitor, p: Pending, answer: Event, a: int, semantics: str, note: str) -> None:
+    """Recorded obligation ``p`` answered by ``answer`` at ``a``, past its deadline on the run's clock, its
+    ``false`` and that answer's margin withdrawn: placed in both clocks, ``undecided`` (in the band), an update."""
+    place(mon, p)
+    p.placed = note
+    if p.due_ns < FAR and a > p.due_ns:  # /clock past its deadline too: false, as given
+        mon._emit(dataclasses.replace(mon.answered_verdict(p, a, answer, p.bound_ns / 1e9, semantics), update=True),
+                  counted=True)
+        return
+    undecided(mon, p, _band_why(mon, p, answer, a) + "; the false given on the run's clock is withdrawn" + note,
+              update=True)
+    answered(mon, p, "undecided", answer, a, semantics)
+
+
+def _held(mon: ClockMonitor, k: int) -> list[deadline_late.Held]:
+    """The margins of guarantee ``k`` still withdrawable (:func:`.deadline_late.held`), the recorded
+    obligations' (:func:`record`) among them."""
+    return deadline_late.held(mon.answered_late, [*mon.awaiting, *mon.unsure], k)
+
+
 def reads_clock(mon: ClockMonitor) -> bool:
     """Whether a new obligation of ``mon`` is placed by this module: its node said to keep simulated time,
     or not said on a run whose ``/clock`` has been heard."""
@@ -231,7 +418,7 @@ def tick(mon: ClockMonitor, ev: Event, ns: int) -> list[Pending]:
     if first and mon.unclocked:
         place_held(mon, ev, ns, late)
     if first and mon.sim_mode is None:
-        _unsaid_before(mon, ns)
+        unsaid_first(mon, ev, ns, late)
     if late and mon.answered_late:
         _late_margins_again(mon, ns)
     if not mon.awaiting:
@@ -331,7 +518,7 @@ def _margin_again(mon: ClockMonitor, p: Pending) -> None:
         return
     p.held = None
     res = mon.result
-    deadline_late.withdraw_margin(res, deadline_late.held(mon.answered_late, mon.awaiting, p.k), p.k, entry[0],
+    deadline_late.withdraw_margin(res, _held(mon, p.k), p.k, entry[0],
                                   entry[2])
     order = res.note_time_margin(p.k, margin, entry[2], entry[3], entry[4], held=True)
     p.held = (margin, order, entry[2], entry[3], entry[4])
@@ -348,7 +535,7 @@ def _late_margins_again(mon: ClockMonitor, ns: int) -> None:
         now = margin_ns(mon, p, p.answer_ns)
         if now == margin:
             continue
-        rest = [e for e in deadline_late.held(kept, mon.awaiting, p.k) if e[1] != order]
+        rest = [e for e in _held(mon, p.k) if e[1] != order]
         deadline_late.withdraw_margin(mon.result, rest, p.k, margin, p.trigger.where)
         kept[i] = (p, now, mon.result.note_time_margin(p.k, now, p.trigger.where, where, stamp, held=True), where,
                    stamp)
@@ -374,7 +561,7 @@ def _again(mon: ClockMonitor, p: Pending, ev: Event, ns: int) -> None:
         res.counts["true"] -= 1
         if p.held is not None:
             entry, p.held = p.held, None
-            rest = deadline_late.held(mon.answered_late, mon.awaiting, p.k)  # its own no longer held
+            rest = _held(mon, p.k)  # its own no longer held
             deadline_late.withdraw_margin(res, rest, p.k, entry[0], p.trigger.where)
     else:
         res.unaccepted["undecided"] -= 1
@@ -428,6 +615,7 @@ def _unsaid_before(mon: ClockMonitor, ns: int) -> None:
     for p in mon.expired:
         if not p.clock and not p.maybe:
             mon._withdraw_false(p)
+            _unanswered_withdrawn(mon, p)
             p.maybe = why
             undecided(mon, p, why + "; the false given is withdrawn", update=True)
 

@@ -111,8 +111,13 @@ class Pending:
     #: held while no ``/clock`` had been heard, its node said to keep simulated time: no verdict is given until
     #: the first ``/clock`` message places it, or none came within the kept window (:func:`.deadline_clock.hold`)
     unclocked: bool = False
-    #: held so, the answer that came meanwhile: (the answer, its stamp in integer ns, the arithmetic it held in)
+    #: held so (or :attr:`provisional`), the answer that came meanwhile: (the answer, its stamp in integer ns,
+    #: the arithmetic it held in)
     first_answer: tuple[Event, int, str] | None = None
+    #: placed on the run's clock while no ``/clock`` had been heard, its node's clock not said: its verdict
+    #: (:attr:`given`), its answer (:attr:`first_answer`) and its margin (:attr:`held`) kept, given again if
+    #: the first ``/clock`` message, heard late, is stamped at or before its trigger (:func:`.deadline_clock.record`)
+    provisional: bool = False
     #: what a verdict's reason adds on how it was placed (the first ``/clock`` heard late: ``""`` otherwise)
     placed: str = ""
 

@@ -94,6 +94,10 @@ class DeadlineMonitor(VerdictWords):
         #: obligations held until the first ``/clock`` message places them, in the order they came (their node
         #: said to keep simulated time; at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.hold`)
         self.unclocked: deque[Pending] = deque()
+        #: obligations of a node whose clock is not said placed on the run's clock while no ``/clock`` has been
+        #: heard, in the order they came: given again if the first ``/clock`` message, heard late, is stamped
+        #: before their trigger (at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.record`)
+        self.unsure: deque[Pending] = deque()
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.bindings = topic_bindings(node)
@@ -283,6 +287,8 @@ class DeadlineMonitor(VerdictWords):
         p = Pending(k, ev, ns / 1e9, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
         if deadline_clock.holds(self):  # kept in simulated time, no /clock heard yet: placed by the first one
             deadline_clock.hold(self, p)
+        elif deadline_clock.records(self):  # not said, no /clock heard yet: the run's clock, given again by it
+            deadline_clock.record(self, p)
         elif deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
             why = deadline_clock.place(self, p)
             if why:
@@ -327,7 +333,8 @@ class DeadlineMonitor(VerdictWords):
                     deadline_skew.revise_false(self, p, ev, ns, {c: self.values[c] for c in outs
                                                                   if c not in self.state_outs})
                 continue
-            if self._answers(p, ns, outs):
+            semantics = self._answers(p, ns, outs)
+            if semantics is not None:
                 self.expired.remove(p)
                 if ns <= p.due_ns:  # stamped within the deadline, heard after the clock passed it
                     if p.clock and ns > p.sure_ns:  # in time in one clock it may be kept in, not in every one
@@ -339,6 +346,8 @@ class DeadlineMonitor(VerdictWords):
                     continue
                 self._emit(self.late_verdict(p, ns, ev))
                 deadline_late.hold(self, p, ns, ev, self._margin(p, ns))  # an output within the skew before it may come
+                if p.provisional:  # given again if the first /clock, heard late, comes before its trigger
+                    p.first_answer = (ev, ns, semantics)
         if self.answered_late:
             deadline_late.revise(self, ev, ns, {c: self.values[c] for c in outs if c not in self.state_outs})
         self.pending = [p for p in self.pending if not self._try(p, ev, ns, outs)]
@@ -384,6 +393,7 @@ class DeadlineMonitor(VerdictWords):
         stamp = ns / 1e9
         if p.maybe and ns > p.due_ns:  # its own answer after the deadline: undecided, as when the clock passed first
             deadline_skew.undecided(self, p)
+            p.provisional = False  # undecided in every reading of its clock
             return
         if p.clock and p.sure_ns < ns <= p.due_ns:  # in time in one clock it may be kept in, not in every one
             deadline_clock.band(self, p, ev, ns)
@@ -393,9 +403,13 @@ class DeadlineMonitor(VerdictWords):
         # placed in a clock, before /clock passed its deadline or was heard after the answer: a /clock message
         # heard later may change its verdict or its margin (deadline_clock.tick)
         held = bool(p.clock) and (p.due_ns >= deadline_clock.FAR or not self.sim.heard_after(ns))
-        order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp, held=held)
+        order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp,
+                                             held=held or p.provisional)
         if held:
             deadline_clock.answered(self, p, "true", ev, ns, semantics, (margin, order, p.trigger.where, ev.where, stamp))
+        elif p.provisional:  # given again if the first /clock, heard late, comes before its trigger
+            p.held, p.first_answer = (margin, order, p.trigger.where, ev.where, stamp), (ev, ns, semantics)
+            p.given = "true" if ns <= p.due_ns else "false"
 
     def _margin(self, p: Pending, ns: int) -> int:
         """The time margin (integer ns) of an answer stamped ``ns`` to obligation ``p``: its deadline less the
@@ -413,12 +427,14 @@ class DeadlineMonitor(VerdictWords):
                     return True
         return False
 
-    def _answers(self, p: Pending, ns: int, outs: set[str]) -> bool:
-        """Whether outputs ``outs`` now (stamp ``ns``, integer ns) answer obligation ``p``."""
+    def _answers(self, p: Pending, ns: int, outs: set[str]) -> str | None:
+        """Whether outputs ``outs`` now (stamp ``ns``, integer ns) answer obligation ``p``: the arithmetic its
+        guarantee held in, ``None`` when they do not."""
         _, cl, _, gouts, _ = self.timed_k[p.k]
         if not (gouts & outs) or ns < p.stamp_ns:
-            return False
-        return judge(cl.formula, self.checked, self.node, self._visible(p, ns / 1e9), self.tolerance).truth is True
+            return None
+        j = judge(cl.formula, self.checked, self.node, self._visible(p, ns / 1e9), self.tolerance)
+        return j.semantics if j.truth is True else None
 
     def _visible(self, p: Pending, stamp: float | None = None) -> dict[str, object]:
         """What obligation ``p`` is judged on for an output stamped ``stamp``:
@@ -449,6 +465,8 @@ class DeadlineMonitor(VerdictWords):
         self.now = now_ns / 1e9
         if self.unclocked:  # held past the kept window with no /clock heard: as a run without /clock
             deadline_clock.release_held(self, now_ns - self.sim.kept_ns)
+        if self.unsure:  # no longer given again by a /clock message heard later
+            deadline_clock.drop_records(self, now_ns - self.sim.kept_ns)
         self._expire(now_ns)
 
     def _expire(self, now_ns: int) -> None:
