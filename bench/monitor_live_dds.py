@@ -192,7 +192,9 @@ def _latency(res: dict[str, Any]) -> list[float]:
     lat = []
     for recv, text in res["verdicts"]:
         v = json.loads(text)
-        if not v.get("node") or abs(v["decided_at"] - v["time"]) > 1e-9 or v["event"] >= len(per_topic):
+        if not v.get("node") or "decided_at" not in v:  # a deadline's or a declaration's verdict: no answer's
+            continue
+        if abs(v["decided_at"] - v["time"]) > 1e-9 or v["event"] >= len(per_topic):
             continue
         t_pub = pub_times.get(per_topic[v["event"]])
         if t_pub is not None:
