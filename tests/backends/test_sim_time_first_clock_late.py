@@ -298,3 +298,23 @@ def test_the_live_run_its_log_and_its_bag_give_the_same_counts(tmp_path: Path, c
         assert any("held until the first /clock message" in r or "placed again" in r for r in reasons) == late, \
             reasons
         assert bool([x for x in lines if "late_s" in x and x["topic"] == "clock"]) == late
+
+
+def test_a_call_answered_before_the_first_clock_sample_is_placed_by_it() -> None:
+    """A server said to keep simulated time (backends/monitors/dds_calls.py): /clock at factor 0.5 from
+    50 ms, the request at 100 ms, its reply at 400 ms (150 ms simulated, in time for 200 ms).  The book takes
+    the samples up to 420 ms only after its ticks at 410 and 420 ms (heard late): the answered call is kept,
+    its request placed by the first sample, ``true`` as with the samples on time (the control), live and
+    on the log's replay; before, ``undecided`` (no /clock before it)."""
+    from test_call_deadlines_sim_time import _judge as _judge_calls, _run as _calls_run
+
+    run = _calls_run(0.5, 400, start_ms=50)
+    on_time = [r for r in run if r[2] != "end" or r[0] > 420] + [(410, 4, "tick", None), (420, 4, "tick", None)]
+    on_time.sort(key=lambda r: r[:2])
+    late = sorted((r for r in on_time if not (r[2] == "clock" and r[0] <= 420)), key=lambda r: r[:2])
+    at = next(i for i, r in enumerate(late) if r[0] == 420 and r[2] == "tick") + 1
+    late[at:at] = [r for r in on_time if r[2] == "clock" and r[0] <= 420]
+    for order in (on_time, late):
+        counts, unaccepted, seen = _judge_calls(order, True)
+        assert (counts["true"], counts["false"], unaccepted["undecided"]) == (1, 0, 0), (order is late, seen)
+    assert "held until the first /clock message (/clock sample 1" in seen[0]["reason"]

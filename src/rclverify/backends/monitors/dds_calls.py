@@ -52,7 +52,12 @@ A call is dropped from memory once it is answered and nothing about it is
 pending, or :data:`LINGER_S` seconds after its horizon and deadlines passed
 unanswered; at most ``max_calls`` are kept (the oldest is closed first,
 counted in ``evicted``; a call with an obligation whose simulated deadline
-``/clock`` has not passed is kept until it does or the run ends).
+``/clock`` has not passed is kept until it does or the run ends; an answered
+call of a node said to keep simulated time whose request came before any
+``/clock`` sample, its obligation held for the first one
+(:func:`.deadline_clock.hold`), is kept as an unanswered one is, until
+:data:`LINGER_S` after its horizon and deadlines, so that a first sample
+taken later than the answer places it).
 :func:`replay` runs the same book over the ``call`` lines of a live log, its
 ``clock`` lines included: the offline check of a live run's calls.
 """
@@ -358,7 +363,8 @@ class CallBook(CallNotes):
                 d.advance(now)
             quiet = not any(m.pending for m in call.monitors) and not any(d.pending for d in call.deadlines)
             sim_open = any(d.awaiting for d in call.deadlines)  # /clock has not passed a simulated deadline yet
-            if (call.answered and quiet) or (now > call.opened + call.bound + LINGER_S and not sim_open):
+            held = any(d.unclocked for d in call.deadlines)  # no /clock sample yet to place its request
+            if (call.answered and quiet and not held) or (now > call.opened + call.bound + LINGER_S and not sim_open):
                 done.append(key)
         for key in done:
             self._close(key)

@@ -161,9 +161,8 @@ def place_held(mon: ClockMonitor, ev: Event, ns: int, late: bool) -> None:
     held, mon.unclocked = list(mon.unclocked), deque()
     note = ""
     if late:
-        note = (f"; held until the first /clock message ({ev.where}, at {ns / 1e9:.3f} s) came, heard "
-                + (f"{ms(ev.late)} after its time, past the lateness bound" if ev.late > 0 else
-                   f"when the monitor's clock stood {ms_ns((mon.now_ns or ns) - ns)} after it")
+        note = (f"; held until the first /clock message ({ev.where}, at {ns / 1e9:.3f} s) came"
+                + (f", heard {ms(ev.late)} after its time, past the lateness bound" if ev.late > 0 else "")
                 + ": the trigger, stamped after it, was heard before it")
     unanswered = {id(p) for p in held if p.first_answer is None}
     opened = {id(p) for p in mon.pending if id(p) in unanswered}
@@ -265,7 +264,7 @@ def unsaid_first(mon: ClockMonitor, ev: Event, ns: int, late: bool) -> None:
     (:func:`_unsaid_before`), and the records dropped."""
     if late and mon.unsure:
         heard = (f"heard {ms(ev.late)} after its time, past the lateness bound" if ev.late > 0 else
-                 f"heard when the monitor's clock stood {ms_ns((mon.now_ns or ns) - ns)} after it")
+                 "heard after messages stamped after it")
         note = (f"; placed again when the first /clock message ({ev.where}, at {ns / 1e9:.3f} s), stamped before "
                 f"the trigger, was {heard}")
         again = [p for p in mon.unsure if p.provisional and p.stamp_ns >= ns and not p.clock]
