@@ -19,6 +19,7 @@ import contextlib
 import io
 import json
 import random
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -84,6 +85,8 @@ def _blockwise(path: Path, fields: list[str], rows: int, rnd: random.Random, see
         events = [block[i] for i in range(n)]
         assert block[0:n] == events and block[-1] is events[-1] and all(block[i] is events[i] for i in range(n))
         assert block.topics == [e.topic for e in events]
+        # the rows per topic, counted among the read's topics (a block of a read may lack some: not named)
+        assert block.topic_counts() == dict(Counter(e.topic for e in events))
         assert [repr(t) for t in block.times.tolist()] == [repr(e.time) for e in events]
         for key in fields + ["data", "seq", "topic", "time", "nope"]:
             for at in (np.arange(n), np.arange(0, n, 2), np.arange(1, n, 3),
@@ -346,3 +349,17 @@ def test_a_column_kept_with_its_block_is_the_column_made_again(tmp_path: Path) -
     wrong = [block.kept("no name", lambda f=f: column(block.values(every, f), "real", {}))[1].tolist()
              for f in ("data", "other")]
     assert wrong[1] != block_column(block, every, "other", "real", {})[1].tolist()
+
+
+def test_a_blocks_topic_counts_name_only_its_own_topics(tmp_path: Path) -> None:
+    """A read decoded at once and cut into blocks counts each block's rows per topic among the read's topics
+    (a leading ``/`` removed): a topic of the read that a block lacks is not named by it (the control: the
+    read's last block holds every topic)."""
+    p = tmp_path / "run.jsonl"
+    lines = [("/limit", 0.0), ("window", 0.0), ("limit", 0.01), ("window", 0.01), ("tick", 1.0)]
+    p.write_text("".join(f'{{"topic": "{t}", "time": {s!r}, "data": 1.5}}\n' for t, s in lines))
+    blocks = list(JsonlLog(p).blocks(["data"], 2))
+    assert [type(b).__name__ for b in blocks] == ["LogBlock"] * 3
+    assert [b.topic_counts() for b in blocks] == [{"limit": 1, "window": 1}, {"limit": 1, "window": 1}, {"tick": 1}]
+    whole = list(JsonlLog(p).blocks(["data"], 5))
+    assert [b.topic_counts() for b in whole] == [{"limit": 2, "window": 2, "tick": 1}]

@@ -261,8 +261,9 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
         return None
     topics, distinct = _topics(structs)
     lines = _Lines(data, ends)
+    named = frozenset(t.lstrip("/") for t in distinct)  # every block's topics are among the read's
     return [LogBlock(path, _Slice(lines, a), structs[a:a + rows], dec.attr, topics[a:a + rows], times[a:a + rows],
-                     lineno + a, index + a, _Again(decode, data, a, rows)) for a in range(0, n, rows)], distinct
+                     lineno + a, index + a, _Again(decode, data, a, rows), named) for a in range(0, n, rows)], distinct
 
 
 class _Again:
@@ -353,10 +354,11 @@ class LogBlock:
     the lines (``again``: the decoder that read them, so the same values)."""
 
     __slots__ = ("path", "lines", "structs", "attr", "topics", "times", "lineno", "index", "_made", "_columns", "_codes",
-                 "_kept", "_n", "_again")
+                 "_kept", "_n", "_again", "_named")
 
     def __init__(self, path: Path, lines: Sequence[bytes] | _Slice, structs: list[Any], attr: dict[str, str], topics: list[str],
-                 times: np.ndarray, lineno: int, index: int, again: Callable[[], list[Any]]) -> None:
+                 times: np.ndarray, lineno: int, index: int, again: Callable[[], list[Any]],
+                 named: frozenset[str] | None = None) -> None:
         self.path, self.lines, self.attr = path, lines, attr
         #: the rows decoded (``None`` once released: :meth:`values` decodes them again)
         self.structs: list[Any] | None = structs
@@ -368,6 +370,8 @@ class LogBlock:
         self._columns: dict[str, np.ndarray] = {}
         self._codes: tuple[np.ndarray, list[str]] | None = None
         self._kept: dict[Hashable, Any] = {}
+        #: topics among which every row's is (``topics``' spelling; ``None``: not known, read from ``topics``)
+        self._named = named
 
     def kept(self, key: Hashable, make: Callable[[], _T]) -> _T:
         """``make()``, made the first time ``key`` is asked for and kept with the block after that: a
@@ -392,12 +396,18 @@ class LogBlock:
         self._columns.clear()
 
     def topic_counts(self) -> dict[str, int]:
-        """Rows per topic (as ``topics`` names them): a count per distinct topic (a log has a few)."""
+        """Rows per topic (as ``topics`` names them; a topic no row has is not named): a count per topic
+        (a log has a few), the last one's the rows the others leave."""
         topics = self.topics
-        distinct = set(topics)
-        if len(distinct) > 16:
+        named = self._named if self._named is not None else set(topics)
+        if len(named) > 16:
             return dict(Counter(topics))
-        return {t: topics.count(t) for t in distinct}
+        *counted, last = named or ("",)
+        counts = {t: c for t in counted if (c := topics.count(t))}
+        left = len(topics) - sum(counts.values())
+        if left:
+            counts[last] = left
+        return counts
 
     def topic_codes(self) -> tuple[np.ndarray, list[str]]:
         """(each row's topic as an index into the list, the distinct topics as ``topics`` names them, in the
