@@ -221,3 +221,27 @@ def test_the_deadline_monitors_are_loaded_by_a_run_with_a_deadline_only(tmp_path
     deadlines = next(r["deadlines"] for r in json.loads(printed) if "deadlines" in r)
     assert code == 1 and deadlines["counts"]["true"] == 1 and deadlines["counts"]["false"] == 1
     assert set(DEADLINE_PARTS) <= loaded
+
+
+@pytest.mark.parametrize(("report", "laid_out"), [
+    ([], True), ([{}], True),
+    ([{"node": "W", "counts": {"violated": 2, "satisfied": 0}, "margins": [], "not_judged": [],
+       "values": {"out.x": [1e-05, 2.5, -0.0, 1e300, 5e-324], "in.r": 10 ** 30}, "why": "a\tb\n\"c\" \\ /"}], True),
+    ([{"é": "ü\u2028\x00", "nested": [[], {}, [1, [2, {"z": None, "a": True}]]]}], True),
+    # text msgspec does not read: written by the indenting encoder
+    ([{"margin": float("inf"), "low": float("-inf")}], False), ([{"x": float("nan")}], False),
+    ([{"k": "\ud800"}], False),
+])
+def test_the_json_report_is_the_indenting_encoders_text(report: list[dict[str, object]], laid_out: bool) -> None:
+    """``monitor --json`` lays out the one-line JSON with msgspec's ``format``: byte for byte what
+    ``json.dumps(indent=2, sort_keys=True)`` writes (escapes, floats, empty lists and mappings, key order);
+    the control: the reports msgspec refuses to read are the indenting encoder's own text."""
+    import msgspec
+    from rclverify.cli.monitor import _indented
+    assert _indented(report) == json.dumps(report, indent=2, sort_keys=True)
+    try:
+        msgspec.json.format(json.dumps(report, sort_keys=True).encode(), indent=2)
+        read = True
+    except msgspec.DecodeError:
+        read = False
+    assert read == laid_out
