@@ -363,3 +363,28 @@ def test_a_blocks_topic_counts_name_only_its_own_topics(tmp_path: Path) -> None:
     assert [b.topic_counts() for b in blocks] == [{"limit": 1, "window": 1}, {"limit": 1, "window": 1}, {"tick": 1}]
     whole = list(JsonlLog(p).blocks(["data"], 5))
     assert [b.topic_counts() for b in whole] == [{"limit": 2, "window": 2, "tick": 1}]
+
+
+@pytest.mark.parametrize("size", [1, 5, 17, 64, 1 << 20])
+def test_the_reads_are_the_logs_whole_lines_from_a_file_and_from_a_stream(tmp_path: Path, size: int,
+                                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each read is whole lines, the log's bytes in order, its end as it is: from a file (the bytes after a
+    read's last line end read again by the next read) and from a FIFO (carried to the next read, the
+    control: a stream cannot be read again)."""
+    import os
+    import threading
+    monkeypatch.setattr(jsonl_blocks, "BLOCK_BYTES", size)
+    text = b"".join(GOOD[i % len(GOOD)] + b"\n" for i in range(40)) + b'{"topic": "x", "time": 1.0}' * 9  # no end
+    p = tmp_path / "run.jsonl"
+    p.write_bytes(text)
+    reads = [data[:cut] for data, cut in jsonl_blocks._reads(p)]
+    assert b"".join(reads) == text and all(r.endswith(b"\n") for r in reads[:-1]) and not reads[-1].endswith(b"\n")
+    if not hasattr(os, "mkfifo"):
+        return
+    fifo = tmp_path / "stream.jsonl"
+    os.mkfifo(fifo)
+    writer = threading.Thread(target=fifo.write_bytes, args=(text,))
+    writer.start()
+    streamed = [data[:cut] for data, cut in jsonl_blocks._reads(fifo)]
+    writer.join()
+    assert b"".join(streamed) == text and all(r.endswith(b"\n") for r in streamed[:-1])

@@ -67,6 +67,7 @@ as a ``bytes`` object unless a row's event is asked for.
 """
 from __future__ import annotations
 
+import os
 from collections import Counter
 from operator import attrgetter
 from pathlib import Path
@@ -169,36 +170,41 @@ class _Decoder:
         return _Decoder(self.keys, list(seen) if len(seen) <= MAX_TOPICS else None)
 
 
-def _reads(path: Path) -> Iterator[bytes]:
-    """The log's bytes, a read at a time, each cut after its last ``b"\\n"`` (the
-    rest carried to the next read; the log's end as it is)."""
-    with path.open("rb") as fh:
+def _reads(path: Path) -> Iterator[tuple[bytes, int]]:
+    """The log's bytes, a read at a time: ``(data, end)``, the read's whole lines ``data[:end]`` (cut after
+    its last ``b"\\n"``; the log's end as it is).  From a file that can seek, ``data`` is the read itself,
+    the bytes after ``end`` read again by the next read (no copy of the read is made: each would cost as
+    much again as the read); from a stream, those bytes are carried to the next read."""
+    with path.open("rb", buffering=0) as fh:
+        seek = fh.seekable()
         pending: list[bytes | memoryview] = []  # bytes after the last b"\n" read (a line may be longer than a read)
         while True:
-            data = fh.read1(BLOCK_BYTES)
+            data = fh.read(BLOCK_BYTES)
             if not data:
                 break
             cut = data.rfind(b"\n") + 1
             if not cut:
                 pending.append(data)
                 continue
+            tail = data[cut:] if cut < len(data) and not seek else b""
+            if cut < len(data) and seek:
+                fh.seek(cut - len(data), os.SEEK_CUR)  # the line it cuts is read again, whole, by the next read
             if pending:
                 pending.append(memoryview(data)[:cut])  # joined without a copy of its own first
-                yield b"".join(pending)
-                pending = []
-            else:
-                yield data[:cut] if cut < len(data) else data
-            if cut < len(data):
-                pending.append(data[cut:])
+                data = b"".join(pending)
+                cut = len(data)
+            pending = [tail] if tail else []
+            yield data, cut
         if pending:
-            yield b"".join(pending)
+            data = b"".join(pending)
+            yield data, len(data)
 
 
 def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock | list[Event]]:
     dec = _Decoder(fields)
     lineno = index = 0
-    for data in _reads(path):
-        flat = _flat(path, dec, data, lineno, index, rows)
+    for data, cut in _reads(path):
+        flat = _flat(path, dec, data, cut, lineno, index, rows)
         if flat is not None:
             blocks, distinct = flat
             dec = dec.knowing(distinct)
@@ -207,7 +213,7 @@ def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock |
                 index += len(whole)
                 yield whole
             continue
-        lines = data.splitlines(True)
+        lines = (data if cut == len(data) else data[:cut]).splitlines(True)
         for at in range(0, len(lines), rows):
             part = lines[at:at + rows] if at or len(lines) > rows else lines
             block = _fast(path, dec, part, lineno, index)
@@ -226,14 +232,15 @@ def _blocks(path: Path, fields: Sequence[str], rows: int) -> Iterator[LogBlock |
             dec = dec.learn(got)
 
 
-def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows: int
+def _flat(path: Path, dec: _Decoder, data: bytes, end: int, lineno: int, index: int, rows: int
           ) -> tuple[list[LogBlock], set[str]] | None:
-    """The read ``data`` as blocks of at most ``rows`` lines when it is decoded at once (module docstring), with
-    its distinct topics as the lines spell them; else ``None``."""
+    """The read ``data[:end]`` as blocks of at most ``rows`` lines when it is decoded at once (module docstring),
+    with its distinct topics as the lines spell them; else ``None``."""
     if "header" in dec.attr or any(k in dec.attr for k in _STAMP_KEYS) or data[:1] != b"{" or \
-            data[-1:] != b"\n" or b"\r" in data:
+            data[end - 1:end] != b"\n" or data.find(b"\r", 0, end) >= 0:
         return None
-    u = np.frombuffer(data, np.uint8)
+    read: bytes | memoryview = data if end == len(data) else memoryview(data)[:end]  # (not a copy)
+    u = np.frombuffer(read, np.uint8)
     ends = (u == 10).nonzero()[0]  # each line's b"\n"; a "}" before each, a "{" after each but the last
     n = len(ends)
     if not (u[ends - 1] == 125).all() or not (u[ends[:-1] + 1] == 123).all():
@@ -242,13 +249,13 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
     decode = dec.decode_lines  # the decoder that read ``data``: a released block's rows are decoded again by it
     if dec.decode_known is not None:
         try:
-            structs = dec.decode_known(data)
+            structs = dec.decode_known(read)
             decode = dec.decode_known
         except Exception:  # noqa: BLE001 - a topic not seen before (or what decode_lines refuses too): read below
             structs = None
     if structs is None:
         try:
-            structs = decode(data)
+            structs = decode(read)
         except Exception:  # noqa: BLE001 - whatever msgspec refuses: the line-by-line paths say what
             return None
     if len(structs) != n:
@@ -263,7 +270,7 @@ def _flat(path: Path, dec: _Decoder, data: bytes, lineno: int, index: int, rows:
     lines = _Lines(data, ends)
     named = frozenset(t.lstrip("/") for t in distinct)  # every block's topics are among the read's
     return [LogBlock(path, _Slice(lines, a), structs[a:a + rows], dec.attr, topics[a:a + rows], times[a:a + rows],
-                     lineno + a, index + a, _Again(decode, data, a, rows), named) for a in range(0, n, rows)], distinct
+                     lineno + a, index + a, _Again(decode, read, a, rows), named) for a in range(0, n, rows)], distinct
 
 
 class _Again:
@@ -272,7 +279,8 @@ class _Again:
 
     __slots__ = ("decode", "data", "start", "rows")
 
-    def __init__(self, decode: Callable[[bytes], list[Any]], data: bytes, start: int, rows: int) -> None:
+    def __init__(self, decode: Callable[[bytes | memoryview], list[Any]], data: bytes | memoryview, start: int,
+                 rows: int) -> None:
         self.decode, self.data, self.start, self.rows = decode, data, start, rows
 
     def __call__(self) -> list[Any]:
