@@ -49,7 +49,8 @@ def _subscribed(master: str, topic: str, timeout: float) -> None:
     import xmlrpc.client
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        _code, _msg, (_pubs, subs, _srvs) = xmlrpc.client.ServerProxy(master).getSystemState("/test")
+        state: Any = xmlrpc.client.ServerProxy(master).getSystemState("/test")  # [code, message, [pubs, subs, srvs]]
+        _code, _msg, (_pubs, subs, _srvs) = state
         if any(name == topic and nodes for name, nodes in subs):
             return
         time.sleep(0.05)
@@ -135,8 +136,8 @@ def test_the_late_service_answer_is_false_with_the_calls_stamps(live_log: dict[s
     events = {x["index"] + 1: x for x in live_log["lines"] if x["kind"] == "event"}
     req = events[int(late["trigger_where"].split(":")[1])]
     resp = events[int(late["answer_where"].split(":")[1])]
-    assert (req["topic"], resp["topic"]) == ("estop/request", "estop/response")
-    assert (req["time"], resp["time"]) == (late["trigger_stamp"], late["answer"])
+    assert (req["call"], resp["call"]) == ("estop/request", "estop/response")
+    assert (req["stamp"], resp["stamp"]) == (late["trigger_stamp"], late["answer"])
     assert live_log["code"] == 1  # a false verdict: the monitor's exit code says so
 
 
@@ -145,7 +146,7 @@ def test_the_action_feedback_arrives_in_time(live_log: dict[str, Any]) -> None:
     assert [v["verdict"] for v in verdicts] == ["true"], verdicts
     v = verdicts[0]
     assert 0.4 <= v["answer"] - v["trigger_stamp"] <= 2.0
-    topics = [x["topic"] for x in live_log["lines"] if x["kind"] == "event"]
+    topics = [x["call"] for x in live_log["lines"] if x["kind"] == "event"]
     assert {"move/goal", "move/feedback", "move/result"} <= set(topics)
     summary = [x for x in live_log["lines"] if x["kind"] == "summary"]
     missed = _missed(live_log)  # the late second call, and the first where its stamps show it late too

@@ -247,9 +247,10 @@ class LiveRun:
 
     def _heard_call(self, obj: Mapping[str, object]) -> None:
         """Count a call event of the log (the ROS 1 proxy's ``kind: "event"``
-        lines, the DDS call book's ``kind: "call"`` ones) for :mod:`.judged`."""
-        if obj.get("kind") == "event" and isinstance(obj.get("topic"), str):
-            key = str(obj["topic"]).strip("/")
+        lines, their message's topic as ``call``; the DDS call book's ``kind:
+        "call"`` ones) for :mod:`.judged`."""
+        if obj.get("kind") == "event" and isinstance(obj.get("call"), str):
+            key = str(obj["call"]).strip("/")
             self.calls_heard[key] = self.calls_heard.get(key, 0) + 1
         else:
             count_call_line(obj, self.calls_heard, self.orphans)

@@ -11,6 +11,16 @@ node under ``use_sim_time`` read it), starts the service proxy when asked, watch
 evidence record (:func:`~.live.stop_and_record`).  Every call to the master
 is bounded (:mod:`.ros1`, "A master is an external peer").
 
+**The run's clock** (each message's receipt, the engine's timer, the log's
+``time``) is the wall clock, also when ``/use_sim_time`` is true and rospy's
+own clock is ``/clock``: the ``/clock`` samples the log holds relate the two
+clocks, so the deadline checks judge a node the mapping says keeps
+``/clock`` in simulated time and one said to keep the wall clock on the wall
+clock, live as on the log offline (docs/semantics.md, "Deadlines in simulated
+time").  With the run's clock ``/clock`` a node said to keep the wall clock
+would be judged on ``/clock`` silently.  The service proxy keeps its own
+ROS clock for its stamps (:mod:`.service_proxy`, "Simulated time").
+
 docs/monitors.md ("Live monitoring") gives the decisions.
 """
 from __future__ import annotations
@@ -89,7 +99,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     decode_errors: dict[str, int] = {}
     # the callbacks only stamp and queue; one worker thread decodes, checks,
     # publishes and runs the timer (worker.py: why)
-    worker = EngineWorker(live, _decoder({**classes, **heard}, decode_errors), rospy.get_time, tick_s=tick_s).start()
+    worker = EngineWorker(live, _decoder({**classes, **heard}, decode_errors), _time.time, tick_s=tick_s).start()
     subs: list[Any] = []
 
     def unsubscribe() -> None:
@@ -173,10 +183,17 @@ def _clock(topics: Mapping[str, str], msg_dirs: list[Path], out: Callable[[str],
 def _decoder(classes: Mapping[str, type], decode_errors: dict[str, int]) -> Callable[[str, Any], Mapping[str, object] | None]:
     """The engine thread's decoding of a ``rospy.AnyMsg``: with the class of
     its connection's type, else the contract's; undecodable bytes are counted
-    per topic in ``decode_errors``."""
+    per topic in ``decode_errors``.  A message rospy decoded itself is
+    flattened as it is: rospy keeps one subscription per topic in a process,
+    made with the class of its first subscriber, and under ``/use_sim_time``
+    that is rospy's own ``/clock`` subscriber (``rosgraph_msgs/Clock``), so
+    the monitor's ``/clock`` callback receives ``Clock`` messages, never raw
+    bytes."""
     by_type: dict[str, type] = {getattr(c, "_type"): c for c in classes.values()}
 
     def decode(topic: str, raw: Any) -> Mapping[str, object] | None:
+        if not hasattr(raw, "_buff") and hasattr(raw, "_type"):  # decoded by rospy (a shared subscription)
+            return flatten(raw)  # type: ignore[no-any-return]
         typ = raw._connection_header.get("type", "") if getattr(raw, "_connection_header", None) else ""
         cls: Any = by_type.get(typ, classes[topic])
         try:
@@ -199,7 +216,7 @@ def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri
     def register_topics() -> Any:
         calls = proxy(rospy, live, lambda text: pub.publish(string(text))) if proxy is not None else None
         for t in topics:
-            subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, rospy.get_time()),
+            subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, _time.time()),
                                          queue_size=10000, tcp_nodelay=True))
         return calls
 

@@ -201,11 +201,11 @@ def message_class(msg_type: str, msg_dirs: Sequence[Path] = ()) -> type:
 
 def flatten(msg: Any) -> Any:
     """A rospy message (or value) as JSON-ready data (dicts, lists, numbers, strings)."""
+    if hasattr(msg, "secs") and hasattr(msg, "nsecs") and hasattr(msg, "to_nsec"):  # genpy or rospy Time / Duration
+        return {"secs": int(msg.secs), "nsecs": int(msg.nsecs)}  # (rospy's subclasses' own __slots__ are empty)
     slots = getattr(msg, "__slots__", None)
     if slots is not None and hasattr(msg, "_slot_types"):
         return {s: flatten(getattr(msg, s)) for s in slots}
-    if hasattr(msg, "secs") and hasattr(msg, "nsecs"):  # genpy Time / Duration
-        return {"secs": int(msg.secs), "nsecs": int(msg.nsecs)}
     if isinstance(msg, (bytes, bytearray)):
         return list(msg)
     if isinstance(msg, (list, tuple)):

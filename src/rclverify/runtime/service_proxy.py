@@ -25,11 +25,20 @@ the mapping says keeps the other clock (``use_sim_time``,
 clock by the proxy: each of its deadline verdicts is ``undecided``, saying why
 (:func:`clock_unjudged`), never the proxy's clock silently.
 
-Every event and verdict is one JSON line of ``--log`` (``{"kind": "event"|
-"verdict"|"summary", ...}``); on SIGINT/SIGTERM or after ``--duration``
-seconds the obligations still within their deadline are ``currently_false``,
-a ``summary`` line closes the log and the exit code is 1 when a verdict was
-``false``, else 0 (2 for a usage error, with one line on standard error).
+**The log** is a trace the offline check reads (``rclverify monitor LOG``):
+each observed message is a message line (``{"topic": "estop/request",
+"time": ..., <its fields>}``: written by the proxy to ``--log``, by the live
+engine inside ``rclverify monitor --live``), and every line of the proxy's
+own is on the topic :data:`PROXY_LOG_TOPIC`, which no contract names, with a
+``time`` and a ``kind``: ``event`` (``index``, the message's topic as
+``call``, the proxy's ``stamp``, its ``fields``), ``verdict`` (a deadline
+verdict's fields) and ``summary``; their ``time`` is the live run's clock
+inside ``rclverify monitor --live``, else the proxy's (an event's stamp, a
+verdict's answer or else its deadline, the summary's last tick).  On
+SIGINT/SIGTERM or after ``--duration`` seconds the obligations still within
+their deadline are ``currently_false``, a ``summary`` line closes the log
+and the exit code is 1 when a verdict was ``false``, else 0 (2 for a usage
+error, with one line on standard error).
 Classes come from the workspace's ``.srv``/``.action`` files
 (:mod:`.ros1_interfaces`).
 """
@@ -58,38 +67,50 @@ from rclverify.runtime.stopping import StopFlag, on_signals
 from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, bound_master_calls, check_master, finish_within,
                                     run_bounded, shutdown_limit)
 
+#: the topic of the proxy's own log lines (events, deadline verdicts, the summary): one no contract names, so
+#: the offline check of the log passes over them (as over the live run's ``rclverify/verdict`` lines)
+PROXY_LOG_TOPIC = "rclverify/proxy"
+
 
 class ProxyRun:
     """The monitors and the log of one live run (thread-safe).
 
-    ``log``: the JSON-lines file to write (this module's own command); or
-    ``write(obj)``, a sink for each line's object (``rclverify monitor
-    --live``: the live monitor's log) and ``publish(text)`` for each
+    ``log``: the JSON-lines file to write (this module's own command: each
+    message a message line and each of the proxy's own lines, module
+    docstring); or ``write(obj)``, a sink for each of the proxy's own lines
+    (``rclverify monitor --live``: the live monitor's log, whose engine
+    writes the message lines) and ``publish(text)`` for each
     deadline verdict as JSON text (its verdict topic); ``forward(topic,
     fields, stamp)`` receives every observed message too (``rclverify
     monitor --live``: the live engine, whose node monitors then check each
     call's response against the server's guarantees and the client's
-    assumption)."""
+    assumption); ``clock()`` (s), when given, is the ``time`` of the
+    proxy's own lines (the live run's clock), else the time they are about
+    in the proxy's clock."""
 
     def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
                  write: Callable[[Mapping[str, object]], None] | None = None,
                  publish: Callable[[str], None] | None = None,
                  forward: Callable[[str, Mapping[str, object], float], None] | None = None,
-                 unjudged: Mapping[str, str] | None = None) -> None:
+                 unjudged: Mapping[str, str] | None = None, clock: Callable[[], float] | None = None) -> None:
         self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
+        self.now = 0.0  # the latest time (s, the proxy's clock) heard or ticked: the summary line's
         #: node -> why the proxy's clock is not the one it keeps: its verdicts are ``undecided`` (:func:`clock_unjudged`)
         self.unjudged: dict[str, str] = dict(unjudged or {})
         self._first: dict[str, DeadlineVerdict] = {}  # an unjudged node's first verdict, given as undecided
         for m in monitors:
             m.on_verdict = self._verdict
         self.fh = log.open("w", encoding="utf-8") if log is not None else None
-        self.sink, self.publish, self.forward = write, publish, forward
+        self.sink, self.publish, self.forward, self.clock = write, publish, forward, clock
 
-    def _write(self, obj: Mapping[str, object]) -> None:
+    def _write(self, t: float, obj: Mapping[str, object]) -> None:
+        """One of the proxy's own lines: ``obj`` on :data:`PROXY_LOG_TOPIC` at ``clock()`` when given (the
+        live run's clock, the other lines' ``time``), else at ``t`` (s, the proxy's clock)."""
+        obj = {"topic": PROXY_LOG_TOPIC, "time": self.clock() if self.clock is not None else t, **obj}
         if self.sink is not None:
             self.sink(obj)
         if self.fh is not None:
-            self.fh.write(json.dumps(obj, sort_keys=True) + "\n")
+            self.fh.write(json.dumps(obj) + "\n")  # its topic first, as the live log's own lines
             self.fh.flush()
 
     def _verdict(self, v: DeadlineVerdict) -> None:
@@ -99,26 +120,33 @@ class ProxyRun:
             if not v.update:
                 self._first.setdefault(v.node, v)
         self.false += v.verdict == "false" and not v.update
-        self._write({"kind": "verdict", **v.to_json()})
+        t = v.answer if v.answer is not None else v.due  # decided by the answer, else by the deadline passing
+        self._write(t, {"kind": "verdict", **v.to_json()})
         if self.publish is not None:
             self.publish(json.dumps({"kind": "deadline", **v.to_json()}, sort_keys=True))
 
     def event(self, topic: str, fields: Mapping[str, object], stamp: float) -> None:
-        """One observed message; ``stamp`` (s) is set as its header stamp when it has none."""
+        """One observed message; ``stamp`` (s) is set as its header stamp when it has none (``forward``
+        receives its fields as observed)."""
+        given = fields
         if "header" not in fields:
             secs = int(stamp)
             fields = {**fields, "header": {"stamp": {"secs": secs, "nsecs": int(round((stamp - secs) * 1e9))}}}
         with self.lock:
             ev = Event(self.index, stamp, topic, fields, f"live:{self.index + 1}")
             self.index += 1
-            self._write({"kind": "event", "index": ev.index, "topic": topic, "time": stamp, "fields": fields})
+            self.now = max(self.now, stamp)
+            if self.fh is not None:  # the message line (live, the engine writes it: ``forward``)
+                self.fh.write(json.dumps({"topic": topic, "time": stamp, **fields}) + "\n")
+            self._write(stamp, {"kind": "event", "index": ev.index, "call": topic, "stamp": stamp, "fields": fields})
             for m in self.monitors:
                 m.feed(ev)
             if self.forward is not None:
-                self.forward(topic, fields, stamp)
+                self.forward(topic, given, stamp)
 
     def tick(self, now: float) -> None:
         with self.lock:
+            self.now = max(self.now, now)
             for m in self.monitors:
                 m.advance(now)
 
@@ -126,7 +154,7 @@ class ProxyRun:
         with self.lock:
             results = [self._result(m.finish()).to_json() for m in self.monitors]
             summary: DeadlineSummary = {"kind": "summary", "results": results, "false": self.false}
-            self._write(summary)
+            self._write(self.now, summary)
             if self.fh is not None:
                 self.fh.close()
         return summary
@@ -248,7 +276,10 @@ def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
     neither option is given; else a function that starts the proxy for the
     selected ``nodes`` with a deadline, writing to the live run's log
     (``LiveRun.note``) and publishing each deadline verdict on its verdict
-    topic.  Raises :class:`ProxyUsage` for a malformed ``--forward``."""
+    topic; each observed message is handed to the live engine at its receipt
+    on the wall clock, the run's clock (:mod:`.live_ros1`, "The run's
+    clock"), the proxy's own monitors judging its ROS-clock stamps.  Raises
+    :class:`ProxyUsage` for a malformed ``--forward``."""
     if not forward and not dirs:
         return None
     forwards = parse_forwards(forward)
@@ -257,7 +288,8 @@ def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
     def start(rospy: Any, live: Any, publish: Callable[[str], None]) -> ProxyRun:
         rules = getattr(live.engine, "rules", {})  # the mapping's rules (and tolerance) of the live run
         mons = [DeadlineMonitor(checked, n, rules, clock=False) for n in nodes if n.name in timed]
-        run = ProxyRun(mons, write=live.note, publish=publish, forward=live.push,  # the proxy's ROS clock
+        run = ProxyRun(mons, write=live.note, publish=publish,  # the engine: the run's clock; the proxy: its ROS clock
+                       forward=lambda topic, fields, _stamp: live.push(topic, fields, time.time()), clock=time.time,
                        unjudged=clock_unjudged(rules, [m.node.name for m in mons], ros_sim_time(rospy)))
         run.handles = start_proxy(rospy, checked, forwards, dirs, run,  # type: ignore[attr-defined]
                                   lambda: rospy.Time.now().to_sec())

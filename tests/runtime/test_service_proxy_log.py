@@ -1,0 +1,148 @@
+"""The ROS 1 service proxy's log and the live ROS 1 run's decoding, without a master
+(``runtime/service_proxy.py``, "The log"; ``runtime/live_ros1.py``).
+
+* The proxy's log is a trace the offline check reads: its calls as message lines, its own lines on
+  ``rclverify/proxy``; ``rclverify monitor`` on it gives the proxy's deadline verdicts.  The control: the
+  same events written as the proxy's own lines only, a line without a topic, are refused, located.
+* A live run counts the proxy's events as the calls it heard (``call``), never as messages.
+* A message rospy decoded itself (a ``/clock`` subscription shared with rospy's own under
+  ``/use_sim_time``) is flattened as it is; the control, raw bytes of another type, is counted a decode
+  error.
+"""
+from __future__ import annotations
+
+import importlib
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rclverify.backends.monitors.deadlines import DeadlineMonitor
+from rclverify.cli.commands import main
+from rclverify.lang.typecheck import load
+from rclverify.runtime.service_proxy import PROXY_LOG_TOPIC, ProxyRun
+from rclverify.traces.jsonl import read_jsonl
+from rclverify.traces.events import TraceError
+
+RCL = """\
+node Base {
+  inputs( req : BOOL )
+  outputs( ok : BOOL )
+  services( std_srvs/SetBool estop serves(in.req, out.ok) )
+  assume( TRUE )
+  guarantee( in.req -> out.ok ) triggered by in.req within 400 ms
+}
+"""
+#: (request time, response time) s: in time (300 ms), late (500 ms), in time (100 ms)
+CALLS = [(10.0, 10.3), (11.0, 11.5), (12.0, 12.1)]
+
+
+def _workspace(tmp: Path) -> Path:
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/sys.rcl").write_text(RCL)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
+    (ws / "mapping.yaml").write_text("topics: {}\n")
+    return ws
+
+
+def _proxy_log(ws: Path, log: Path) -> list[dict[str, Any]]:
+    """The proxy's run of :data:`CALLS` written to ``log``; its deadline verdicts."""
+    checked = load([str(ws / "contracts/sys.rcl")])
+    run = ProxyRun([DeadlineMonitor(checked, checked.nodes["Base"], {}, clock=False)], log)
+    for asked, answered in CALLS:
+        run.event("estop/request", {"data": True}, asked)
+        run.tick(asked + 0.2)
+        run.event("estop/response", {"success": True, "message": ""}, answered)
+        run.tick(answered + 0.5)
+    run.close()
+    return [x for x in map(json.loads, log.read_text().splitlines()) if x.get("kind") == "verdict"]
+
+
+def _offline(ws: Path, log: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    capsys.readouterr()
+    code = main(["monitor", "-w", str(ws), "--mapping", "mapping.yaml", "--json", str(log)])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_the_proxy_log_replayed_offline_gives_its_verdicts(tmp_path: Path,
+                                                           capsys: pytest.CaptureFixture[str]) -> None:
+    ws = _workspace(tmp_path)
+    log = tmp_path / "proxy.jsonl"
+    verdicts = _proxy_log(ws, log)
+    finals = {v["trigger_stamp"]: v["verdict"] for v in verdicts}
+    assert finals == {10.0: "true", 11.0: "false", 12.0: "true"}, verdicts
+    lines = [json.loads(x) for x in log.read_text().splitlines()]
+    own = [x for x in lines if x["topic"] == PROXY_LOG_TOPIC]
+    assert {x["kind"] for x in own} == {"event", "verdict", "summary"}
+    assert [x["call"] for x in own if x["kind"] == "event"] == ["estop/request", "estop/response"] * 3
+    assert all(log.read_text().splitlines()[i].startswith('{"topic": ') for i in range(len(lines)))
+    # the message lines: what the offline check reads, each call's request and response at the proxy's stamps
+    messages = [(x["topic"], x["time"]) for x in lines if x["topic"] != PROXY_LOG_TOPIC]
+    assert messages == [(t, s) for a, b in CALLS for t, s in (("estop/request", a), ("estop/response", b))]
+    code, out, err = _offline(ws, log, capsys)
+    (dl,) = [e["deadlines"] for e in json.loads(out) if "deadlines" in e and e["node"] == "Base"]
+    assert (dl["counts"]["true"], dl["counts"]["false"], dl["unaccepted"]["undecided"]) == (2, 1, 0), out + err
+    assert code == 1  # the late call: a violation, as the proxy said
+
+
+def test_the_control_a_log_of_the_proxys_own_lines_only_is_refused_located(tmp_path: Path,
+                                                                           capsys: pytest.CaptureFixture[str]) -> None:
+    ws = _workspace(tmp_path)
+    log = tmp_path / "proxy.jsonl"
+    _proxy_log(ws, log)
+    # the control: the proxy's lines as they would be without their topic, a line the reader cannot place
+    bare = [{k: v for k, v in json.loads(x).items() if k != "topic"} for x in log.read_text().splitlines()
+            if json.loads(x)["topic"] == PROXY_LOG_TOPIC]
+    wrong = tmp_path / "bare.jsonl"
+    wrong.write_text("".join(json.dumps(x) + "\n" for x in bare))
+    with pytest.raises(TraceError, match=r"bare\.jsonl:1:1: error: the event has no string 'topic'"):
+        list(read_jsonl(wrong))
+    code, out, err = _offline(ws, wrong, capsys)
+    assert code == 2 and "bare.jsonl:1:1: error:" in err and "Traceback" not in err
+    assert len(list(read_jsonl(log))) == len(log.read_text().splitlines())  # the proxy's log reads whole
+
+
+def test_a_live_run_counts_the_proxys_events_as_calls_heard(tmp_path: Path) -> None:
+    from rclverify.runtime.live import LiveRun
+    ws = _workspace(tmp_path)
+    checked = load([str(ws / "contracts/sys.rcl")])
+    nodes = list(checked.nodes.values())
+    live = LiveRun(checked, nodes, {}, 1.0, tmp_path / "live.jsonl")
+    run = ProxyRun([DeadlineMonitor(checked, nodes[0], {}, clock=False)], write=live.note, forward=live.push)
+    run.event("estop/request", {"data": True}, 10.0)
+    run.event("estop/response", {"success": True, "message": ""}, 10.1)
+    live.tick(12.0)
+    assert live.calls_heard == {"estop/request": 1, "estop/response": 1}
+    run.close()
+    record = live.stop()
+    # the deadline checks of the live log judge the call once: the proxy's own lines are no messages
+    (res,) = [e["deadlines"] for e in record["topic_deadlines"] if e["node"] == "Base"]
+    assert (res["counts"]["true"], sum(res["unaccepted"].values())) == (1, 0), res
+
+
+def test_a_message_rospy_decoded_itself_is_flattened_as_it_is() -> None:
+    from rclverify.runtime.live_ros1 import _decoder
+    from rclverify.runtime.ros1 import RosUnavailable, import_rospy
+    try:
+        rospy = import_rospy()
+        Clock = importlib.import_module("rosgraph_msgs.msg").Clock  # beside rospy (no type information)
+    except (RosUnavailable, ImportError) as exc:
+        pytest.skip(f"ROS 1 unavailable: {exc}")
+    errors: dict[str, int] = {}
+    decode = _decoder({"/clock": Clock}, errors)
+    msg = Clock(clock=rospy.Time(1000, 5_000_000))
+    assert decode("/clock", msg) == {"clock": {"secs": 1000, "nsecs": 5_000_000}} and errors == {}
+    # the same message as raw bytes (an AnyMsg subscription of its own) decodes alike
+    buf = io.BytesIO()
+    msg.serialize(buf)
+    raw = rospy.AnyMsg()
+    raw.deserialize(buf.getvalue())
+    assert decode("/clock", raw) == {"clock": {"secs": 1000, "nsecs": 5_000_000}} and errors == {}
+    # the control: bytes that are no Clock are a decode error, counted
+    bad = rospy.AnyMsg()
+    bad.deserialize(b"\x01")
+    assert decode("/clock", bad) is None and errors == {"/clock": 1}
