@@ -150,11 +150,12 @@ class StampWatch:
         if not len(times):
             return
         from rclverify.core.numeric import np  # deferred: optional or conditional (columnar blocks exist with numpy only)
-        self.plain = [min(self.plain[0], float(times.min())), max(self.plain[1], float(times.max()))]
-        placed = np.maximum(np.maximum.accumulate(times), self.placed_latest)
+        heard = np.maximum.accumulate(times)  # the latest time of the block up to each row (its last: the block's)
+        self.plain = [min(self.plain[0], float(times.min())), max(self.plain[1], float(heard[-1]))]
+        placed = np.maximum(heard, self.placed_latest)
         self.placed_lag = max(self.placed_lag, float((placed - times).max()))
         self.placed_latest = float(placed[-1])
-        ahead = np.maximum(np.maximum.accumulate(times), self.latest)  # the latest time heard up to each row
+        ahead = np.maximum(heard, self.latest)  # the latest time heard up to each row
         behind = ahead - times
         late = behind > self.skew
         self.near = max(self.near, float(np.where(late, 0.0, behind).max()))
