@@ -5,6 +5,9 @@
   ``rclverify/proxy``; ``rclverify monitor`` on it gives the proxy's deadline verdicts.  The control: the
   same events written as the proxy's own lines only, a line without a topic, are refused, located.
 * A live run counts the proxy's events as the calls it heard (``call``), never as messages.
+* A request stamped 0 (the proxy's ROS clock not yet set: under ``/use_sim_time`` before its first
+  ``/clock``) has its deadline ``undecided``, saying so, in the log and the summary; the control, the
+  same call stamped once the clock is set, is judged.  The proxy waits for its clock to be set, bounded.
 * A message rospy decoded itself (a ``/clock`` subscription shared with rospy's own under
   ``/use_sim_time``) is flattened as it is; the control, raw bytes of another type, is counted a decode
   error.
@@ -14,6 +17,7 @@ from __future__ import annotations
 import importlib
 import io
 import json
+import time
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +26,7 @@ import pytest
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.cli.commands import main
 from rclverify.lang.typecheck import load
-from rclverify.runtime.service_proxy import PROXY_LOG_TOPIC, ProxyRun
+from rclverify.runtime.service_proxy import PROXY_LOG_TOPIC, UNSET_CLOCK, ProxyRun, wait_clock
 from rclverify.traces.jsonl import read_jsonl
 from rclverify.traces.events import TraceError
 
@@ -146,3 +150,36 @@ def test_a_message_rospy_decoded_itself_is_flattened_as_it_is() -> None:
     bad = rospy.AnyMsg()
     bad.deserialize(b"\x01")
     assert decode("/clock", bad) is None and errors == {"/clock": 1}
+
+
+def test_a_request_stamped_before_the_clock_was_set_is_undecided(tmp_path: Path) -> None:
+    ws = _workspace(tmp_path)
+    checked = load([str(ws / "contracts/sys.rcl")])
+    for first, want in ((0.0, "undecided"), (1000.0, "true")):  # the control: stamped once the clock is set
+        log = tmp_path / f"p{first:g}.jsonl"
+        run = ProxyRun([DeadlineMonitor(checked, checked.nodes["Base"], {}, clock=False)], log)
+        run.event("estop/request", {"data": True}, first)  # 0: rospy's clock before its first /clock
+        run.tick(1000.0)
+        run.event("estop/response", {"success": True, "message": ""}, 1000.3)
+        run.event("estop/request", {"data": True}, 1001.0)  # a late call, judged: false
+        run.event("estop/response", {"success": True, "message": ""}, 1001.6)
+        run.tick(1002.0)
+        summary = run.close()
+        verdicts = [x for x in map(json.loads, log.read_text().splitlines()) if x.get("kind") == "verdict"]
+        firsts = [v for v in verdicts if v["trigger_stamp"] == first]
+        assert {v["verdict"] for v in firsts} == {want}, verdicts
+        assert (firsts[0]["reason"] == UNSET_CLOCK) == (want == "undecided")
+        assert [v["verdict"] for v in verdicts if v["trigger_stamp"] == 1001.0][-1] == "false"
+        res: Any = summary["results"][0]
+        assert len(summary["results"]) == 1 and (res["counts"]["true"], res["counts"]["false"], res["unaccepted"]["undecided"]) == \
+            ((0, 1, 1) if want == "undecided" else (1, 1, 0)), res
+        assert summary["false"] == 1 and res["first_false"]["trigger_stamp"] == 1001.0
+        assert (res["first_unaccepted"] or {}).get("reason") == (UNSET_CLOCK if want == "undecided" else None)
+
+
+def test_the_proxy_waits_for_its_clock_to_be_set_bounded() -> None:
+    readings = iter([0.0, 0.0, 0.0, 1000.005])
+    assert wait_clock(lambda: next(readings), 5.0)  # set at the fourth reading
+    t0 = time.monotonic()
+    assert not wait_clock(lambda: 0.0, 0.1)  # the control: never set, given up after the bound
+    assert 0.1 <= time.monotonic() - t0 < 1.0

@@ -23,7 +23,12 @@ so the servers' clock too.  Their deadlines are judged in that clock.  A node
 the mapping says keeps the other clock (``use_sim_time``,
 :func:`~rclverify.traces.mapping.sim_time_of`) cannot be judged in its own
 clock by the proxy: each of its deadline verdicts is ``undecided``, saying why
-(:func:`clock_unjudged`), never the proxy's clock silently.
+(:func:`clock_unjudged`), never the proxy's clock silently.  Under
+``/use_sim_time`` rospy's clock reads 0 (ROS's "not set") until its first
+``/clock``: the proxy serves once it is set (waiting at most
+:data:`CLOCK_WAIT_S`), and a call whose request it stamps 0 all the same has
+its deadline verdict ``undecided``, saying so (:data:`UNSET_CLOCK`), never
+judged against a later stamp.
 
 **The log** is a trace the offline check reads (``rclverify monitor LOG``):
 each observed message is a message line (``{"topic": "estop/request",
@@ -70,6 +75,12 @@ from rclverify.runtime.ros1 import (REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, boun
 #: the topic of the proxy's own log lines (events, deadline verdicts, the summary): one no contract names, so
 #: the offline check of the log passes over them (as over the live run's ``rclverify/verdict`` lines)
 PROXY_LOG_TOPIC = "rclverify/proxy"
+#: the longest the proxy waits for its ROS clock to be set (the first ``/clock`` under ``/use_sim_time``) before
+#: it serves (s)
+CLOCK_WAIT_S = 5.0
+#: why a call whose request was stamped before the proxy's ROS clock was set has no deadline verdict
+UNSET_CLOCK = ("the request came before the service proxy's ROS clock was set (under /use_sim_time, before its "
+               "first /clock): its stamp 0 is no time, the deadline cannot be judged")
 
 
 class ProxyRun:
@@ -98,6 +109,8 @@ class ProxyRun:
         #: node -> why the proxy's clock is not the one it keeps: its verdicts are ``undecided`` (:func:`clock_unjudged`)
         self.unjudged: dict[str, str] = dict(unjudged or {})
         self._first: dict[str, DeadlineVerdict] = {}  # an unjudged node's first verdict, given as undecided
+        self._unset: dict[str, list[DeadlineVerdict]] = {}  # a node's verdicts on requests stamped 0, as judged
+        self._first_false: dict[str, DeadlineVerdict] = {}  # a node's first false on a request stamped in time
         for m in monitors:
             m.on_verdict = self._verdict
         self.fh = log.open("w", encoding="utf-8") if log is not None else None
@@ -115,7 +128,13 @@ class ProxyRun:
 
     def _verdict(self, v: DeadlineVerdict) -> None:
         why = self.unjudged.get(v.node)
-        if why is not None:  # judged in a clock the node does not keep: said undecided, never true or false
+        if why is None and v.trigger_stamp == 0:  # a request stamped before the clock was set: counted undecided
+            why = UNSET_CLOCK
+            if not v.update:
+                self._unset.setdefault(v.node, []).append(v)
+        if why is None and v.verdict == "false" and not v.update:
+            self._first_false.setdefault(v.node, v)
+        if why is not None:  # judged in a clock the node does not keep, or in none: undecided, never true or false
             v = dataclasses.replace(v, verdict="undecided", reason=why, time_margin=None)
             if not v.update:
                 self._first.setdefault(v.node, v)
@@ -162,10 +181,28 @@ class ProxyRun:
 
     def _result(self, res: DeadlineResult) -> DeadlineResult:
         """``res`` as the summary gives it: a node judged in a clock it does not keep has every obligation
-        counted ``undecided`` with the triggers not accepted, none ``true`` or ``false``."""
+        counted ``undecided`` with the triggers not accepted, none ``true`` or ``false``; a call whose
+        request was stamped before the clock was set is counted so too (its margin and its ``false`` not
+        the first's)."""
         why = self.unjudged.get(res.node)
-        if why is None:
+        unset = self._unset.get(res.node, [])
+        if why is None and not unset:
             return res
+        if why is None:
+            wheres = {v.trigger_where for v in unset}
+            counts = dict(res.counts)
+            for v in unset:
+                counts[v.verdict] = max(counts.get(v.verdict, 0) - 1, 0)
+            unaccepted = {**res.unaccepted, "undecided": res.unaccepted.get("undecided", 0) + len(unset)}
+            first = self._first.get(res.node)
+            return dataclasses.replace(
+                res, counts=counts, unaccepted=unaccepted,
+                first_false=self._first_false.get(res.node) if res.first_false is not None
+                and res.first_false.trigger_where in wheres else res.first_false,
+                time_margins={k: m for k, m in res.time_margins.items() if m.trigger_where not in wheres},
+                first_unaccepted=res.first_unaccepted if first is None else
+                {"guarantee": first.guarantee, "where": first.trigger_where, "stamp": first.trigger_stamp,
+                 "why": "undecided", "reason": UNSET_CLOCK})
         out = DeadlineResult(res.node)
         out.unaccepted.update(res.unaccepted)
         n = sum(res.counts.values())
@@ -194,6 +231,16 @@ def clock_unjudged(rules: Mapping[str, TopicRule], nodes: Sequence[str], ros_sim
                      f"is {theirs} (/use_sim_time is {'true' if ros_sim else 'false'}): its call deadlines cannot "
                      f"be judged in its clock; set /use_sim_time or the mapping's use_sim_time to agree")
     return out
+
+
+def wait_clock(now: Callable[[], float], limit: float = CLOCK_WAIT_S) -> bool:
+    """Wait until ``now()`` (s, the proxy's ROS clock) is set (not 0), at most ``limit`` seconds; whether it is."""
+    end = time.monotonic() + limit
+    while now() == 0:
+        if time.monotonic() >= end:
+            return False
+        time.sleep(0.01)
+    return True
 
 
 def ros_sim_time(rospy: Any) -> bool:
@@ -241,6 +288,7 @@ def start_proxy(rospy: Any, checked: Any, forwards: Mapping[str, str], dirs: Seq
     if missing:
         raise ProxyUsage(f"say where {', '.join(missing)} is served: --forward /{missing[0].lstrip('/')}=/REAL")
     svc_classes = {s: service_class(lk.ros_type, list(dirs)) for s, lk in services.items()}
+    wait_clock(now)  # a call stamped before the clock is set is undecided (module docstring): few are
     with tempfile.TemporaryDirectory(prefix="rclverify-actions-") as gen:  # the classes live on without their files
         act_classes = {a: action_classes(lk.ros_type, list(dirs), Path(gen)) for a, lk in actions.items()}
     keep: list[Any] = []
