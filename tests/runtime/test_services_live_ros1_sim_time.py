@@ -1,0 +1,268 @@
+"""ROS 1's service proxy in simulated time, live (docs/semantics.md, "Deadlines in simulated time";
+``runtime/service_proxy.py``, "Simulated time"; ``runtime/live_ros1.py``, "The run's clock").
+
+A ROS 1 master on 127.0.0.1 (a free port), its ``/use_sim_time`` true, and rospy processes: ``sim``
+publishes ``/clock`` every 10 ms of the wall clock, 5 ms further each time (a real-time factor of 0.5);
+``base`` serves ``/estop_real`` and ``/halt_real`` (``std_srvs/SetBool``) and answers each call once its
+ROS clock (``/clock``, read at its start) has moved 300 ms (``rospy.sleep``: 600 ms of the wall clock);
+``teleop`` calls ``/estop`` and ``/halt`` through ``rclverify monitor --live --forward`` (the service
+proxy), one call at a time.  The contracts: each answer within 400 ms of its request, ``Base`` for
+``estop``, ``Halt`` for ``halt``.  Two runs of the monitor on one master and one server:
+
+* ``sim``: ``/use_sim_time`` true, the mapping's ``use_sim_time: [Base]``.  The proxy's ROS clock is
+  ``/clock``: ``Base``'s every deadline ``true`` (300 of 400 simulated ms); ``Halt``, said to keep the
+  wall clock, is the control: every deadline ``undecided``, the reason naming both clocks, never judged
+  on ``/clock``.  The live run's own deadline checks, on the wall clock with ``/clock``'s samples in the
+  log, judge ``Base`` ``true`` too and ``Halt`` on its wall clock: ``false``.
+* ``wall``: ``/use_sim_time`` false when the monitor starts (the server still on ``/clock``), the
+  mapping's ``use_sim_time: [Halt]``.  The proxy's clock is the wall clock: ``Base``, a wall-clock node,
+  has the same 600 ms answers ``false``; ``Halt``, said to keep ``/clock``, is ``undecided`` by the proxy
+  and ``true`` by the live run's checks, which read ``/clock``.
+
+Each log replayed offline (``rclverify monitor`` on it, the same mapping) gives the live run's checks'
+verdicts.  Every process is stopped in a ``finally``; skipped, with the reason, only where ROS 1 cannot be
+imported.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import xmlrpc.client
+from collections import Counter
+from pathlib import Path
+from typing import Any, Iterator
+
+import pytest
+from _procs import stop, wait_for, wait_logged
+
+from rclverify.runtime.ros1 import LocalMaster, RosUnavailable, import_rospy
+from rclverify.runtime.service_proxy import PROXY_LOG_TOPIC
+
+REPO = Path(__file__).resolve().parents[2]
+
+try:
+    import_rospy()
+    REASON = ""
+except RosUnavailable as exc:
+    REASON = str(exc)
+pytestmark = pytest.mark.skipif(bool(REASON), reason=f"ROS 1 unavailable: {REASON}")
+
+RCL = """\
+node Base {
+  inputs( req : BOOL )
+  outputs( ok : BOOL )
+  services( std_srvs/SetBool estop serves(in.req, out.ok) )
+  assume( TRUE )
+  guarantee( in.req -> out.ok ) triggered by in.req within 400 ms
+}
+
+node Halt {
+  inputs( req : BOOL )
+  outputs( ok : BOOL )
+  services( std_srvs/SetBool halt serves(in.req, out.ok) )
+  assume( TRUE )
+  guarantee( in.req -> out.ok ) triggered by in.req within 400 ms
+}
+"""
+SETBOOL = "bool data\n---\nbool success\nstring message\n"
+#: calls per service and run
+ROUNDS = 3
+#: the server's delay on its ROS clock (s): 300 ms of /clock, 600 ms of the wall clock at a factor of 0.5
+DELAY = 0.3
+
+NODES = """\
+import sys, time
+from pathlib import Path
+from rclverify.runtime.ros1 import import_rospy
+from rclverify.runtime.ros1_interfaces import service_class
+
+rospy = import_rospy()
+role = sys.argv[1]
+srv = service_class("std_srvs/SetBool", [Path("interfaces")])
+if role == "sim":  # /clock at a real-time factor of 0.5, from a simulated 1000 s
+    from rosgraph_msgs.msg import Clock
+    rospy.init_node("sim")
+    pub = rospy.Publisher("/clock", Clock, queue_size=10)
+    print("ready", flush=True)
+    ns, nxt = 1000 * 10**9, time.monotonic()
+    while not rospy.is_shutdown():  # SIGTERM: rospy's shutdown
+        pub.publish(Clock(clock=rospy.Time(ns // 10**9, ns % 10**9)))
+        ns += 5 * 10**6
+        nxt += 0.01
+        time.sleep(max(0.0, nxt - time.monotonic()))
+elif role == "base":  # answers once its ROS clock moved DELAY (under /use_sim_time: /clock)
+    rospy.init_node("base")
+    end = time.monotonic() + 30
+    while rospy.Time.now().is_zero() and time.monotonic() < end:  # its clock on /clock before the first call
+        time.sleep(0.01)
+
+    def handle(req):
+        rospy.sleep(DELAY)
+        resp = srv._response_class()
+        resp.success = bool(req.data)
+        return resp
+    keep = [rospy.Service("/estop_real", srv, handle), rospy.Service("/halt_real", srv, handle)]
+    print("ready", flush=True)
+    rospy.spin()
+else:  # teleop: ROUNDS calls of each service, one at a time
+    rospy.init_node("teleop", anonymous=True)
+    calls = {s: rospy.ServiceProxy(s, srv, persistent=True) for s in ("/estop", "/halt")}
+    for s in calls:
+        rospy.wait_for_service(s, timeout=30)
+    for k in range(ROUNDS):
+        for s, call in calls.items():
+            print("call", s, call(True).success, flush=True)
+    print("done", flush=True)
+""".replace("DELAY", repr(DELAY)).replace("ROUNDS", str(ROUNDS))
+
+
+def _start(args: list[str], env: dict[str, str], cwd: Path, out: Path) -> subprocess.Popen[bytes]:
+    return subprocess.Popen([sys.executable, *args], env=env, cwd=cwd, stdout=out.open("wb"),
+                            stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def _verdicts(lines: list[dict[str, Any]], node: str) -> list[dict[str, Any]]:
+    """The proxy's deadline verdicts of ``node`` in the log's lines (its ``kind: verdict`` lines)."""
+    return [x for x in lines if x.get("topic") == PROXY_LOG_TOPIC and x["kind"] == "verdict" and x["node"] == node]
+
+
+def _checks(lines: list[dict[str, Any]], node: str) -> list[dict[str, Any]]:
+    """The live run's own deadline verdicts of ``node`` (its ``kind: deadline`` lines)."""
+    return [x["verdict"] for x in lines if x.get("kind") == "deadline" and x["verdict"]["node"] == node]
+
+
+def _finals(verdicts: list[dict[str, Any]]) -> Counter[str]:
+    """Each call's final deadline verdict (an update replaces what it updates), counted."""
+    last: dict[str, str] = {}
+    for v in verdicts:
+        last[v["trigger_where"]] = v["verdict"]
+    return Counter(last.values())
+
+
+def _counts(res: dict[str, Any]) -> Counter[str]:
+    """A deadline result's verdicts, counted as :func:`_finals` counts them (none that is zero)."""
+    return +Counter({"true": res["counts"]["true"], "false": res["counts"]["false"],
+                     "undecided": res["unaccepted"]["undecided"]})
+
+
+def _offline(ws: Path, mapping: str, log: Path) -> dict[str, Counter[str]]:
+    """``rclverify monitor --json`` of the live ``log`` under ``mapping``: each node's deadline verdicts."""
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(ws), "--mapping",
+                        mapping, "--json", str(log)], capture_output=True, text=True, timeout=60, cwd=ws,
+                       env={**os.environ, "PYTHONPATH": str(REPO / "src")})
+    report = json.loads(r.stdout) if r.stdout.strip().startswith("[") else []
+    got = {e["node"]: _counts(e["deadlines"]) for e in report if "deadlines" in e}
+    assert set(got) == {"Base", "Halt"}, r.stdout[-3000:] + r.stderr[-3000:]
+    return got
+
+
+def _live(tmp: Path, ws: Path, env: dict[str, str], name: str, mapping: str) -> dict[str, Any]:
+    """One live run of ``rclverify monitor --live`` (the proxy) under ``mapping`` while ``teleop`` makes its
+    calls: its log's lines, exit code, output, evidence record and the log replayed offline."""
+    log, out = tmp / f"{name}.jsonl", tmp / f"{name}.out"
+    monitor = _start(["-m", "rclverify.cli.commands", "monitor", "-w", str(ws), "--live", "--interfaces",
+                      "interfaces", "--mapping", mapping, "--forward", "/estop=/estop_real", "--forward",
+                      "/halt=/halt_real", "--log", str(log), "--status", "0", "--evidence",
+                      str(tmp / f"{name}.json"), "--duration", "60"], env, ws, out)
+    try:
+        wait_for(out, "monitoring ", 30)
+        teleop = _start([str(tmp / "nodes.py"), "teleop"], env, ws, tmp / f"{name}-teleop.out")
+        try:
+            assert teleop.wait(30) == 0, (tmp / f"{name}-teleop.out").read_text()
+        finally:
+            stop(teleop)
+        # every call judged by the proxy and by the run's checks (on /clock, once it passed the deadline)
+        wait_logged(log, lambda lines: all(sum(_finals(f(lines, n)).values()) >= ROUNDS and
+                                           not _finals(f(lines, n))["currently_false"]
+                                           for f in (_verdicts, _checks) for n in ("Base", "Halt")), 15)
+        stop(monitor, signal.SIGINT)
+    finally:
+        stop(monitor)
+    lines = [json.loads(x) for x in log.read_text().splitlines()]
+    return {"lines": lines, "code": monitor.returncode, "out": out.read_text(errors="replace"),
+            "record": json.loads((tmp / f"{name}.json").read_text()), "offline": _offline(ws, mapping, log),
+            "teleop": (tmp / f"{name}-teleop.out").read_text()}
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, dict[str, Any]]]:
+    """The two live runs on one master and one server (module docstring): ``sim`` and ``wall``."""
+    tmp = tmp_path_factory.mktemp("svc-sim")
+    ws = tmp / "ws"
+    (ws / "contracts").mkdir(parents=True)
+    (ws / "contracts/sys.rcl").write_text(RCL)
+    (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
+    (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
+    (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text(SETBOOL)
+    (ws / "sim.yaml").write_text("topics: {}\nuse_sim_time: [Base]\n")
+    (ws / "wall.yaml").write_text("topics: {}\nuse_sim_time: [Halt]\n")
+    (tmp / "nodes.py").write_text(NODES)
+    procs: list[subprocess.Popen[bytes]] = []
+    with LocalMaster(tmp / "ros") as env:
+        env = {**env, "PYTHONPATH": str(REPO / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+        master = xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])
+        master.setParam("/test", "/use_sim_time", True)
+        try:
+            for role in ("sim", "base"):
+                procs.append(_start([str(tmp / "nodes.py"), role], env, ws, tmp / f"{role}.out"))
+                wait_for(tmp / f"{role}.out", "ready", 30)
+            out = {"sim": _live(tmp, ws, env, "sim", "sim.yaml")}
+            master.setParam("/test", "/use_sim_time", False)  # the server keeps /clock: it read it at its start
+            out["wall"] = _live(tmp, ws, env, "wall", "wall.yaml")
+            yield out
+        finally:
+            for p in reversed(procs):
+                stop(p)
+
+
+def test_calls_in_time_in_simulated_time_are_true_under_use_sim_time(runs: dict[str, dict[str, Any]]) -> None:
+    """``/use_sim_time`` true, ``Base`` said on ``/clock``: 300 simulated ms of 400, every deadline ``true``,
+    by the proxy (its stamps ``/clock``'s, from 1000 s on) and by the run's checks, live and offline."""
+    sim = runs["sim"]
+    assert sim["teleop"].count("True") == 2 * ROUNDS, sim["teleop"]
+    verdicts = _verdicts(sim["lines"], "Base")
+    assert _finals(verdicts) == Counter(true=ROUNDS), (verdicts, sim["out"][-2000:])
+    for v in verdicts:  # /clock's 300 ms between the proxy's stamps (its samples 5 ms apart)
+        assert v["trigger_stamp"] > 1000 and 0.29 <= v["answer"] - v["trigger_stamp"] <= 0.4, v
+    assert _finals(_checks(sim["lines"], "Base")) == sim["offline"]["Base"] == Counter(true=ROUNDS)
+    assert sim["record"]["decode_errors"] == {}  # /clock heard beside rospy's own subscription to it
+    assert sum(1 for x in sim["lines"] if x["topic"] == "clock") > 100
+    assert sim["record"]["deadlines"]["false"] == 0
+
+
+def test_the_control_a_node_said_on_the_wall_clock_is_undecided_by_the_proxy(
+        runs: dict[str, dict[str, Any]]) -> None:
+    """``Halt`` said to keep the wall clock while the proxy's clock is ``/clock``: the proxy says
+    ``undecided`` for every call, naming both clocks, in its log, its summary and on the verdict topic's
+    count; the run's checks judge it on the wall clock, where the 600 ms answers are late."""
+    sim = runs["sim"]
+    verdicts = _verdicts(sim["lines"], "Halt")
+    assert _finals(verdicts) == Counter(undecided=ROUNDS), verdicts
+    for v in verdicts:
+        assert "node Halt keeps the wall clock" in v["reason"] and "simulated time (/clock)" in v["reason"], v
+        assert "/use_sim_time is true" in v["reason"]
+    (halt,) = [r for r in sim["record"]["deadlines"]["results"] if r["node"] == "Halt"]
+    assert _counts(halt) == Counter(undecided=ROUNDS), halt
+    assert _finals(_checks(sim["lines"], "Halt")) == sim["offline"]["Halt"] == Counter(false=ROUNDS)
+
+
+def test_the_wall_clock_judges_the_same_answers_false_without_use_sim_time(
+        runs: dict[str, dict[str, Any]]) -> None:
+    """``/use_sim_time`` false: the proxy's clock is the wall clock, and the same server's 600 ms answers are
+    ``false`` for ``Base`` (a wall-clock node), by the proxy and the run's checks, live and offline; the
+    run exits 1.  ``Halt``, said on ``/clock``, is ``undecided`` by the proxy and ``true`` by the checks."""
+    wall = runs["wall"]
+    verdicts = _verdicts(wall["lines"], "Base")
+    assert _finals(verdicts) == Counter(false=ROUNDS), verdicts
+    # false once the wall clock passed the deadline, then again with the late answer's stamps
+    assert [(v["answer"] is None, v["update"]) for v in verdicts] == [(True, False), (False, True)] * ROUNDS
+    for v in verdicts[1::2]:
+        assert v["trigger_stamp"] > 1.6e9 and v["answer"] - v["trigger_stamp"] >= 0.55, v
+    assert _finals(_checks(wall["lines"], "Base")) == wall["offline"]["Base"] == Counter(false=ROUNDS)
+    halt = _verdicts(wall["lines"], "Halt")
+    assert _finals(halt) == Counter(undecided=ROUNDS) and "/use_sim_time is false" in halt[0]["reason"], halt
+    assert _finals(_checks(wall["lines"], "Halt")) == wall["offline"]["Halt"] == Counter(true=ROUNDS)
+    assert wall["record"]["deadlines"]["false"] == ROUNDS and wall["code"] == 1
