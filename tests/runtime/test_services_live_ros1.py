@@ -175,3 +175,17 @@ def test_the_generated_action_messages_do_not_outlive_the_processes(live_log: di
     # the monitor's proxy and the mover each write the action's expanded .msg files to make rospy's
     # classes; the classes live on in memory, the files go with the class generation
     assert not [p.name for p in (live_log["tmp"] / "scratch").iterdir()]
+
+
+def test_the_log_replayed_offline_gives_the_live_runs_deadline_verdicts(live_log: dict[str, Any]) -> None:
+    """The live log is a trace ``rclverify monitor`` reads (the proxy's own lines on ``rclverify/proxy``, no
+    message): its replay gives each node's deadline verdicts as the live run's own checks gave them."""
+    log = live_log["tmp"] / "monitor.jsonl"
+    r = subprocess.run([sys.executable, "-m", "rclverify.cli.commands", "monitor", "-w", str(EXAMPLE), "--json",
+                        str(log)], capture_output=True, text=True, timeout=60, cwd=EXAMPLE,
+                       env={**os.environ, "PYTHONPATH": str(REPO / "src")})
+    assert r.stdout.strip().startswith("["), r.stdout[-2000:] + r.stderr[-2000:]
+    offline = {e["node"]: e["deadlines"]["counts"] for e in json.loads(r.stdout) if "deadlines" in e}
+    live = {e["node"]: e["deadlines"]["counts"] for e in live_log["record"]["topic_deadlines"]}
+    assert offline == live, (offline, live)
+    assert offline["Base"]["false"] >= 1 and offline["Mover"]["true"] == 1, offline  # the late call, the feedback
