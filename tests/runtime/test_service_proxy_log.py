@@ -170,8 +170,9 @@ def test_a_request_stamped_before_the_clock_was_set_is_undecided(tmp_path: Path)
         assert {v["verdict"] for v in firsts} == {want}, verdicts
         assert (firsts[0]["reason"] == UNSET_CLOCK) == (want == "undecided")
         assert [v["verdict"] for v in verdicts if v["trigger_stamp"] == 1001.0][-1] == "false"
+        assert len(summary["results"]) == 1
         res: Any = summary["results"][0]
-        assert len(summary["results"]) == 1 and (res["counts"]["true"], res["counts"]["false"], res["unaccepted"]["undecided"]) == \
+        assert (res["counts"]["true"], res["counts"]["false"], res["unaccepted"]["undecided"]) == \
             ((0, 1, 1) if want == "undecided" else (1, 1, 0)), res
         assert summary["false"] == 1 and res["first_false"]["trigger_stamp"] == 1001.0
         assert (res["first_unaccepted"] or {}).get("reason") == (UNSET_CLOCK if want == "undecided" else None)

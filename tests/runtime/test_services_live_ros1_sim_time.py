@@ -7,17 +7,21 @@ publishes ``/clock`` every 10 ms of the wall clock, 5 ms further each time (a re
 ROS clock (``/clock``, read at its start) has moved 300 ms (``rospy.sleep``: 600 ms of the wall clock);
 ``teleop`` calls ``/estop`` and ``/halt`` through ``rclverify monitor --live --forward`` (the service
 proxy), one call at a time.  The contracts: each answer within 400 ms of its request, ``Base`` for
-``estop``, ``Halt`` for ``halt``.  Two runs of the monitor on one master and one server:
+``estop``, ``Halt`` for ``halt``.  The same process relays each ``x`` (``geometry_msgs/PointStamped``,
+``teleop`` publishes one each round) to ``y`` after 300 ms of its clock, ``Relay``'s contract asking
+for ``y`` within 400 ms of ``x``: a topic's deadline, judged by the live run's own checks only.  Two runs
+of the monitor on one master and one server:
 
-* ``sim``: ``/use_sim_time`` true, the mapping's ``use_sim_time: [Base]``.  The proxy's ROS clock is
+* ``sim``: ``/use_sim_time`` true, the mapping's ``use_sim_time: [Base, Relay]``.  The proxy's ROS clock is
   ``/clock``: ``Base``'s every deadline ``true`` (300 of 400 simulated ms); ``Halt``, said to keep the
   wall clock, is the control: every deadline ``undecided``, the reason naming both clocks, never judged
   on ``/clock``.  The live run's own deadline checks, on the wall clock with ``/clock``'s samples in the
-  log, judge ``Base`` ``true`` too and ``Halt`` on its wall clock: ``false``.
+  log, judge ``Base`` ``true`` too and ``Halt`` on its wall clock: ``false``; ``Relay``, said on
+  ``/clock``, ``true``.
 * ``wall``: ``/use_sim_time`` false when the monitor starts (the server still on ``/clock``), the
   mapping's ``use_sim_time: [Halt]``.  The proxy's clock is the wall clock: ``Base``, a wall-clock node,
   has the same 600 ms answers ``false``; ``Halt``, said to keep ``/clock``, is ``undecided`` by the proxy
-  and ``true`` by the live run's checks, which read ``/clock``.
+  and ``true`` by the live run's checks, which read ``/clock``; ``Relay``, said on the wall clock, ``false``.
 
 Each log replayed offline (``rclverify monitor`` on it, the same mapping) gives the live run's checks'
 verdicts.  Every process is stopped in a ``finally``; skipped, with the reason, only where ROS 1 cannot be
@@ -66,7 +70,17 @@ node Halt {
   assume( TRUE )
   guarantee( in.req -> out.ok ) triggered by in.req within 400 ms
 }
+
+node Relay {
+  inputs( x : REAL )
+  outputs( y : REAL )
+  topics( geometry_msgs/PointStamped x matches(in.x), geometry_msgs/PointStamped y matches(out.y) )
+  assume( TRUE )
+  guarantee( out.y == in.x ) triggered by in.x within 400 ms
+}
 """
+#: the mapping of the relay's topics, beside each run's use_sim_time
+TOPICS = "topics:\n  x: {fields: [point.x]}\n  y: {fields: [point.x]}\n"
 SETBOOL = "bool data\n---\nbool success\nstring message\n"
 #: calls per service and run
 ROUNDS = 3
@@ -80,6 +94,7 @@ from rclverify.runtime.ros1 import import_rospy
 from rclverify.runtime.ros1_interfaces import service_class
 
 rospy = import_rospy()
+from geometry_msgs.msg import PointStamped
 role = sys.argv[1]
 srv = service_class("std_srvs/SetBool", [Path("interfaces")])
 if role == "sim":  # /clock at a real-time factor of 0.5, from a simulated 1000 s
@@ -105,14 +120,31 @@ elif role == "base":  # answers once its ROS clock moved DELAY (under /use_sim_t
         resp.success = bool(req.data)
         return resp
     keep = [rospy.Service("/estop_real", srv, handle), rospy.Service("/halt_real", srv, handle)]
+    pub = rospy.Publisher("/y", PointStamped, queue_size=10)
+
+    def relay(msg):  # y, stamped on its ROS clock, DELAY after each x
+        rospy.sleep(DELAY)
+        out = PointStamped()
+        out.header.stamp = rospy.Time.now()
+        out.point.x = msg.point.x
+        pub.publish(out)
+    keep.append(rospy.Subscriber("/x", PointStamped, relay))
     print("ready", flush=True)
     rospy.spin()
-else:  # teleop: ROUNDS calls of each service, one at a time
+else:  # teleop: ROUNDS rounds of an x and one call of each service, one at a time
     rospy.init_node("teleop", anonymous=True)
     calls = {s: rospy.ServiceProxy(s, srv, persistent=True) for s in ("/estop", "/halt")}
     for s in calls:
         rospy.wait_for_service(s, timeout=30)
+    pub = rospy.Publisher("/x", PointStamped, queue_size=10)
+    end = time.monotonic() + 30
+    while pub.get_num_connections() < 2 and time.monotonic() < end:  # the relay and the monitor
+        time.sleep(0.05)
     for k in range(ROUNDS):
+        x = PointStamped()
+        x.header.stamp = rospy.Time.now()
+        x.point.x = float(k)
+        pub.publish(x)
         for s, call in calls.items():
             print("call", s, call(True).success, flush=True)
     print("done", flush=True)
@@ -155,7 +187,7 @@ def _offline(ws: Path, mapping: str, log: Path) -> dict[str, Counter[str]]:
                        env={**os.environ, "PYTHONPATH": str(REPO / "src")})
     report = json.loads(r.stdout) if r.stdout.strip().startswith("[") else []
     got = {e["node"]: _counts(e["deadlines"]) for e in report if "deadlines" in e}
-    assert set(got) == {"Base", "Halt"}, r.stdout[-3000:] + r.stderr[-3000:]
+    assert set(got) == {"Base", "Halt", "Relay"}, r.stdout[-3000:] + r.stderr[-3000:]
     return got
 
 
@@ -177,7 +209,9 @@ def _live(tmp: Path, ws: Path, env: dict[str, str], name: str, mapping: str) -> 
         # every call judged by the proxy and by the run's checks (on /clock, once it passed the deadline)
         wait_logged(log, lambda lines: all(sum(_finals(f(lines, n)).values()) >= ROUNDS and
                                            not _finals(f(lines, n))["currently_false"]
-                                           for f in (_verdicts, _checks) for n in ("Base", "Halt")), 15)
+                                           for f in (_verdicts, _checks) for n in ("Base", "Halt"))
+                    and sum(_finals(_checks(lines, "Relay")).values()) >= ROUNDS
+                    and not _finals(_checks(lines, "Relay"))["currently_false"], 15)
         stop(monitor, signal.SIGINT)
     finally:
         stop(monitor)
@@ -197,8 +231,8 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, dict[st
     (ws / "contracts/plan.yaml").write_text("contracts: [contracts/sys.rcl]\n")
     (ws / "interfaces/std_srvs/srv").mkdir(parents=True)
     (ws / "interfaces/std_srvs/srv/SetBool.srv").write_text(SETBOOL)
-    (ws / "sim.yaml").write_text("topics: {}\nuse_sim_time: [Base]\n")
-    (ws / "wall.yaml").write_text("topics: {}\nuse_sim_time: [Halt]\n")
+    (ws / "sim.yaml").write_text(TOPICS + "use_sim_time: [Base, Relay]\n")
+    (ws / "wall.yaml").write_text(TOPICS + "use_sim_time: [Halt]\n")
     (tmp / "nodes.py").write_text(NODES)
     procs: list[subprocess.Popen[bytes]] = []
     with LocalMaster(tmp / "ros") as env:
@@ -266,3 +300,17 @@ def test_the_wall_clock_judges_the_same_answers_false_without_use_sim_time(
     assert _finals(halt) == Counter(undecided=ROUNDS) and "/use_sim_time is false" in halt[0]["reason"], halt
     assert _finals(_checks(wall["lines"], "Halt")) == wall["offline"]["Halt"] == Counter(true=ROUNDS)
     assert wall["record"]["deadlines"]["false"] == ROUNDS and wall["code"] == 1
+
+
+def test_a_topics_deadline_is_judged_in_the_clock_the_mapping_gives_its_node(runs: dict[str, dict[str, Any]]) -> None:
+    """The relay answers each ``x`` after 300 ms of ``/clock``, 600 ms of the wall clock, both stamped on
+    ``/clock``: said on ``/clock`` (the ``sim`` run) every deadline is ``true``, said on the wall clock (the
+    ``wall`` run, the control) every one ``false``, live and offline; its answers hold in both runs.  The
+    stamps on ``/clock`` are named as another clock than the run's, the wall clock: ``y``'s in both runs,
+    ``x``'s where ``teleop`` started under ``/use_sim_time`` (``sim``) and not where it did not (``wall``)."""
+    for name, want, other in (("sim", "true", {"/x", "/y"}), ("wall", "false", {"/y"})):
+        run = runs[name]
+        assert _finals(_checks(run["lines"], "Relay")) == run["offline"]["Relay"] == Counter({want: ROUNDS}), name
+        (relay,) = [n for n in run["record"]["nodes"] if n["node"] == "Relay"]
+        assert relay["counts"]["satisfied"] == ROUNDS and relay["counts"]["violated"] == 0, relay
+        assert {line.split(":")[0] for line in run["record"]["other_clocks"]} == other, run["record"]["other_clocks"]
