@@ -62,6 +62,7 @@ LIVE = frozenset({
     "test_run_repair_rclpy", "test_ros2_run_end", "test_ros2_thresholds_clocks_stamps",
     "test_ros2_rclpy_discovers_nobody", "test_ros2_robots_other_clocks", "test_ros2_dds_server_restart",
     "test_live_exit", "test_ros2_clock_heard", "test_ros2_sim_time_deadlines", "test_ros2_sim_time_calls",
+    "test_services_live_ros1_sim_time",
 })
 
 #: CPU seconds of each module that costs more than about two: its tests' user + system seconds, children
@@ -173,6 +174,7 @@ WALL: dict[str, float] = {
     "test_ros2_clock_heard": 45.0,  # five live runs (both sources with /clock, one without; ROS 1 with and without)
     "test_ros2_sim_time_deadlines": 30.0,  # two live runs (a source each, factors 0.5 and 2), each log read 4 times
     "test_ros2_sim_time_calls": 35.0,  # the same for a SetBool server's calls
+    "test_services_live_ros1_sim_time": 20.0,  # a ROS 1 master under /use_sim_time, two runs of the proxy (16-18 s)
 }
 
 #: Modules weighed by their wall-clock time (in :data:`WALL`) whose live tests are marked in the module
