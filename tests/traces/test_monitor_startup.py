@@ -54,8 +54,8 @@ NOT_ON_A_PLAIN_LOG = ("z3", "cvc5", "lark", "jinja2", "jsonschema", "rosbags.typ
                       "rclverify.model.plan.standards.profiles", "rclverify.model.names", "rclverify.records.statistics",
                       "rclverify.core.atomic", "difflib", "importlib.resources",
                       # the YAML files (the plan, the mapping, the backends' declarations) kept parsed by the
-                      # start-up cache
-                      "yaml")
+                      # start-up cache; rosbags' kinds of the kept message definitions (kept as rclverify's)
+                      "yaml", "rosbags.interfaces")
 
 
 def _cell(root: Path, width: str) -> Path:
@@ -79,8 +79,15 @@ def test_message_definitions_are_kept_and_an_edited_msg_is_read_again(tmp_path: 
         assert first == {k: v for k, v in bag.typestore(dirs).fielddefs.items() if k in first}
         with monkeypatch.context() as m:  # a hit: rosbags' store is not made
             m.setattr(bag, "typestore", lambda *a: pytest.fail("the store was made although the result is kept"))
-            assert bag.field_definitions(dirs, list(reversed(names))) == first
+            again = bag.field_definitions(dirs, list(reversed(names)))
+            assert again == first
         assert kept.hits == 1
+        # kept with rclverify's kinds (rosbags.interfaces not loaded to read them): the same names and values
+        kinds = [k for v in again.values() for _, k in v[1]]
+        assert {type(k[0]) for k in kinds} == {bag.FieldKind} and {type(k[0]) for v in first.values()
+                                                                  for _, k in v[1]} != {bag.FieldKind}
+        assert [(k[0].name, int(k[0])) for k in kinds] == [(k[0].name, int(k[0])) for v in first.values()
+                                                           for _, k in v[1]]
         _cell(tmp_path, "float64")  # the control: the workspace's definition edited is a miss, read again
         second = bag.field_definitions(dirs, names)
         assert kept.misses == 2

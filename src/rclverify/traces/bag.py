@@ -12,6 +12,7 @@ robot's definition.
 from __future__ import annotations
 
 import copy
+from enum import IntEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
 
@@ -134,8 +135,31 @@ def field_definitions(msg_dirs: Sequence[Path], names: Iterable[str]) -> dict[st
         out[name] = defs[name]
         todo += [n for _, kind in defs[name][1] for n in _named(kind) if n in defs and n not in out]
     if kept is not None:
-        kept.put("message-definitions", out, *contents)
+        kept.put("message-definitions", _kept_kinds(out), *contents)
     return out
+
+
+class FieldKind(IntEnum):
+    """rosbags' ``Nodetype`` (the kind of a parsed message field), its names and values, as the start-up
+    cache keeps the definitions: a kept entry read back then does not load ``rosbags.interfaces``
+    (2 ms of the monitor command's start-up).  Readers of a kind compare its ``name``."""
+
+    BASE = 1
+    NAME = 2
+    ARRAY = 3
+    SEQUENCE = 4
+
+
+def _kept_kinds(value: Any) -> Any:
+    """``value`` (rosbags' ``fielddefs`` form: mappings, lists and tuples of names, kinds and values) with
+    each ``Nodetype`` member the :class:`FieldKind` member of its name."""
+    if isinstance(value, IntEnum):
+        return FieldKind[value.name] if type(value).__name__ == "Nodetype" else value
+    if isinstance(value, dict):
+        return {k: _kept_kinds(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return type(value)(map(_kept_kinds, value))
+    return value
 
 
 def _named(kind: Any) -> Iterator[str]:
