@@ -75,13 +75,15 @@ its verdict's reason then says it was held and how late that message was
 heard).  Memory: at most :data:`HELD` held obligations, each at most the kept
 window; past either, the oldest is released as on a run without ``/clock``.
 A node whose clock is not said is judged on the run's clock meanwhile, as on
-a run without ``/clock`` (no verdict waits); each such obligation is recorded
-(:func:`record`: its verdict, its answer, its margin noted withdrawable; as
-many and as long as held ones), and the first ``/clock`` message, heard late,
-gives again what it gave (:func:`unsaid_first`): to a trigger stamped at or
-after it, as the stamp order does in both clocks (a ``false`` on the run's
-clock withdrawn, ``undecided`` or open again, an update naming that message);
-to one stamped before it and answered late after it, ``undecided``.
+a run without ``/clock`` (no verdict waits); the answer to each such
+obligation is recorded in plain values (:func:`record`: its verdict, its
+margin noted withdrawable; as many and as long as held ones), and the first
+``/clock`` message, heard late, gives again what was given (:func:`unsaid_first`)
+to the obligations open, expired (the last 256) or answered since whose
+trigger is stamped at or after it, as the stamp order does in both clocks (a
+``false`` on the run's clock withdrawn, ``undecided`` or open again, an update
+naming that message), and makes ``undecided`` one stamped before it and
+answered late after it.
 """
 from __future__ import annotations
 
@@ -92,7 +94,7 @@ from typing import Callable, Protocol
 from rclverify.lang.types import CheckedNode
 from rclverify.traces.events import Event
 from rclverify.traces.sim_clock import SimClock, clock_value_ns
-from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending, Recorded
 from rclverify.backends.monitors.deadline_text import ms, ms_ns
 from rclverify.backends.monitors import deadline_late
 
@@ -121,7 +123,7 @@ class ClockMonitor(Protocol):
     now_ns: int | None
     answered_late: deque[deadline_late.Answered]
     unclocked: deque[Pending]
-    unsure: deque[Pending]
+    unsure: deque[Recorded]
 
     def _judged(self, p: Pending, ev: Event, ns: int, semantics: str) -> None: ...
 
@@ -131,12 +133,6 @@ class ClockMonitor(Protocol):
 
     def answered_verdict(self, p: Pending, ns: int, ev: Event, d: float, semantics: str = "exact") -> DeadlineVerdict:
         ...
-
-
-def holds(mon: ClockMonitor) -> bool:
-    """Whether a new obligation of ``mon`` is held (:func:`hold`): its node said to keep simulated time, no
-    ``/clock`` message heard yet."""
-    return mon.sim_mode is True and not mon.sim.heard
 
 
 def hold(mon: ClockMonitor, p: Pending) -> None:
@@ -215,114 +211,129 @@ def _unhold(mon: ClockMonitor, p: Pending) -> None:
     p.unclocked, p.due_ns = False, p.wall_due_ns
 
 
-def records(mon: ClockMonitor) -> bool:
-    """Whether a new obligation of ``mon`` is placed on the run's clock and recorded (:func:`record`): its
-    node's clock not said, no ``/clock`` message heard yet."""
-    return mon.sim_mode is None and not mon.sim.heard
-
-
-def record(mon: ClockMonitor, p: Pending) -> None:
-    """New obligation ``p`` of a node whose clock is not said, placed on the run's clock while no ``/clock``
-    has been heard: judged there as on a run without ``/clock``, its verdict, answer and margin (noted
-    withdrawable) kept while the first ``/clock`` message, heard late, may be stamped at or before its
-    trigger (:func:`unsaid_first`): until its trigger is more than the simulated clock's kept window behind the
-    monitor's clock, or ``/clock`` is heard (:func:`drop_records`).  At most :data:`HELD` are kept; past it the
-    oldest quarter is dropped."""
-    p.provisional = True
+def record(mon: ClockMonitor, p: Pending, ev: Event, ns: int, semantics: str, given: str,
+           entry: tuple[int, int, str, str, float]) -> None:
+    """Obligation ``p`` of a node whose clock is not said, placed on the run's clock while no ``/clock`` has
+    been heard, answered by ``ev`` at ``ns`` (``given``: ``true`` or ``false``; ``entry``: its margin, noted
+    withdrawable): recorded, in plain values (:data:`~.deadline_records.Recorded`), while the first ``/clock``
+    message, heard late, may be stamped at or before its trigger (:func:`unsaid_first`): until its trigger is
+    more than the simulated clock's kept window behind the monitor's clock, or ``/clock`` is heard
+    (:func:`drop_records`).  At most :data:`HELD` are kept; past it the oldest quarter is dropped."""
+    t = p.trigger
     kept = mon.unsure
-    kept.append(p)
+    kept.append((p.k, entry, p.stamp_ns, p.stamp, p.due, p.due_ns, t.index, t.time, t.topic, t.where, ev.index,
+                 ev.time, ev.topic, ev.where, ns, semantics, given))
     if len(kept) > HELD:
         _drop(mon, [kept.popleft() for _ in range(HELD // 4)])
 
 
 def drop_records(mon: ClockMonitor, before_ns: int | None = None) -> None:
-    """The recorded obligations (:func:`record`) stamped before ``before_ns`` (integer ns; ``None``: every one)
-    no longer given again: their margins can no longer be withdrawn."""
+    """The recorded answers (:func:`record`) to triggers stamped before ``before_ns`` (integer ns; ``None``:
+    every one) no longer given again: their margins can no longer be withdrawn."""
     kept = mon.unsure
-    gone: list[Pending] = []
-    while kept and (before_ns is None or kept[0].stamp_ns < before_ns):
+    gone: list[Recorded] = []
+    while kept and (before_ns is None or kept[0][2] < before_ns):
         gone.append(kept.popleft())
     _drop(mon, gone)
 
 
-def _drop(mon: ClockMonitor, gone: list[Pending]) -> None:
-    for p in gone:
-        if p.provisional and p.held is not None and not p.clock:
-            mon.result.settle(p.k, p.held)
-            p.held = None
-        p.provisional, p.first_answer = False, None
+def _drop(mon: ClockMonitor, gone: list[Recorded]) -> None:
+    settle = mon.result.settle
+    for r in gone:
+        settle(r[0], r[1])
+
+
+def _revived(r: Recorded) -> tuple[Pending, Event]:
+    """The obligation and the answer recorded in ``r`` (:func:`record`): the messages named, not their fields."""
+    (k, entry, stamp_ns, stamp, due, due_ns, t_index, t_time, t_topic, t_where, a_index, a_time, a_topic, a_where,
+     a, semantics, given) = r
+    p = Pending(k, Event(t_index, t_time, t_topic, {}, t_where), stamp, due, {}, stamp_ns=stamp_ns, due_ns=due_ns)
+    answer = Event(a_index, a_time, a_topic, {}, a_where)
+    p.given, p.held, p.first_answer = given, entry, (answer, a, semantics)
+    return p, answer
 
 
 def unsaid_first(mon: ClockMonitor, ev: Event, ns: int, late: bool) -> None:
     """The first ``/clock`` message ``ev``, placed at ``ns``, heard by the monitor of a node whose clock is not
-    said (``late``: placed before a message already fed).  Each recorded obligation (:func:`record`) stamped at
-    or after ``ns`` is placed again as the run read in stamp order places it, in both clocks (at the value
-    ``ev`` shows), and what it was given on the run's clock is given again there: open, it stays open; expired
-    unanswered, its ``false`` is withdrawn and it is open again (an update says so); answered in time, its
-    ``true`` stands, its margin measured in both clocks; answered late, it is ``undecided`` (late on the run's
-    clock, not in simulated time yet), an update.  Then those placed before it are made unsure
-    (:func:`_unsaid_before`), and the records dropped."""
-    if late and mon.unsure:
+    said (``late``: placed before a message already fed).  Each obligation placed on the run's clock whose
+    trigger is stamped at or after ``ns`` (open, expired, or answered: :func:`record`; within the kept window) is
+    placed again as the run read in stamp order places it, in both clocks (at the value ``ev`` shows), and what
+    it was given on the run's clock is given again there: open, it stays open; expired unanswered, its
+    ``false`` is withdrawn and it is open again (an update says so); answered in time, its ``true`` stands, its
+    margin measured in both clocks; answered late, it is ``undecided`` (late on the run's clock, not in
+    simulated time yet), an update.  One stamped before ``ns`` and answered late after it is ``undecided``
+    (:func:`_late_after`).  Then those placed before it are made unsure (:func:`_unsaid_before`), and the
+    records dropped."""
+    if late:
         heard = (f"heard {ms(ev.late)} after its time, past the lateness bound" if ev.late > 0 else
                  "heard after messages stamped after it")
         note = (f"; placed again when the first /clock message ({ev.where}, at {ns / 1e9:.3f} s), stamped before "
                 f"the trigger, was {heard}")
-        again = [p for p in mon.unsure if p.provisional and p.stamp_ns >= ns and not p.clock]
-        if again:
-            _given_again(mon, again, note)
-        before = [p for p in mon.unsure if p.provisional and p.stamp_ns < ns and not p.clock
-                  and p.first_answer is not None and p.first_answer[1] >= ns]
-        if before:
-            _late_after(mon, before, ns, heard)
+        _given_again(mon, ns, note)
+        _late_after(mon, ns, heard)
     _unsaid_before(mon, ns)
     drop_records(mon)
 
 
-def _late_after(mon: ClockMonitor, before: list[Pending], ns: int, heard: str) -> None:
-    """Recorded obligations ``before``, stamped before the first ``/clock`` message (at ``ns``, ``heard`` as
-    late as it says) and answered after it: one answered late (its ``false`` given) is ``undecided``, an
-    update, as the run read in stamp order gives it (open when ``/clock`` came: never ``false`` since,
-    :func:`_unsaid_before`); its answer's margin is withdrawn.  One answered in time keeps its ``true``."""
-    ids = {id(p) for p in before}
-    late_of = {id(e[0]): e for e in mon.answered_late if id(e[0]) in ids}
-    if late_of:
-        mon.answered_late = deque(e for e in mon.answered_late if id(e[0]) not in late_of)
+def _late_after(mon: ClockMonitor, ns: int, heard: str) -> None:
+    """The obligations on the run's clock stamped before the first ``/clock`` message (at ``ns``, ``heard`` as
+    late as it says) and answered late after it (recorded, or kept with their late answer): each ``undecided``,
+    an update, as the run read in stamp order gives it (open when ``/clock`` came: never ``false`` since,
+    :func:`_unsaid_before`); its ``false`` and its answer's margin are withdrawn.  One answered in time keeps
+    its ``true``."""
+    got: list[tuple[Pending, int, Event, int]] = []  # (obligation, margin withdrawn, answer, its stamp)
+    late = [e for e in mon.answered_late if not e[0].clock and not e[0].maybe and e[0].stamp_ns < ns
+            and e[0].first_answer is not None and e[0].first_answer[1] >= ns]
+    if late:
+        gone = {id(e[0]) for e in late}
+        mon.answered_late = deque(e for e in mon.answered_late if id(e[0]) not in gone)
+        for e in late:
+            assert e[0].first_answer is not None
+            got.append((e[0], e[1], e[0].first_answer[0], e[0].first_answer[1]))
+    kept = [r for r in mon.unsure if r[2] < ns and r[14] >= ns and r[16] == "false"]
+    if kept:
+        gone = {id(r) for r in kept}
+        mon.unsure = deque(r for r in mon.unsure if id(r) not in gone)
+        for r in kept:
+            p, answer = _revived(r)
+            p.held = None
+            got.append((p, r[1][0], answer, r[14]))
     why = _unsaid_why(ns)
-    for p in before:
-        assert p.first_answer is not None
-        entry = late_of.get(id(p))
-        if entry is not None:
-            margin = entry[1]
-        elif p.given == "false" and p.held is not None:
-            margin, p.held = p.held[0], None
-        else:
-            continue
+    for p, margin, answer, a in sorted(got, key=lambda x: x[0].stamp_ns):
         mon._withdraw_false(p)
         deadline_late.withdraw_margin(mon.result, _held(mon, p.k), p.k, margin, p.trigger.where)
         p.maybe = why
-        answer, a, _ = p.first_answer
         undecided(mon, p, f"answered at {answer.where} {ms_ns(a - p.due_ns)} past its deadline, but {why}; the "
                           f"false given is withdrawn: the first /clock message was {heard}", update=True)
 
 
-def _given_again(mon: ClockMonitor, again: list[Pending], note: str) -> None:
-    """:func:`unsaid_first` of the recorded obligations ``again`` (module docstring)."""
-    ids = {id(p) for p in again}
-    in_pending = {id(p) for p in mon.pending if id(p) in ids}
-    in_expired = {id(p) for p in mon.expired if id(p) in ids}
-    late_of = {id(e[0]): e for e in mon.answered_late if id(e[0]) in ids}
-    if in_expired:
-        mon.expired = deque((p for p in mon.expired if id(p) not in in_expired), maxlen=mon.expired.maxlen)
-    if late_of:
-        mon.answered_late = deque(e for e in mon.answered_late if id(e[0]) not in late_of)
+def _given_again(mon: ClockMonitor, ns: int, note: str) -> None:
+    """:func:`unsaid_first` of the obligations stamped at or after ``ns``, in their triggers' order."""
+    horizon = _horizon(mon, ns)
+    after = [(p.stamp_ns, 0, p) for p in mon.pending if not p.clock and p.stamp_ns >= ns]
+    expired = [p for p in mon.expired if not p.clock and p.stamp_ns >= ns and p.stamp_ns >= horizon]
+    if expired:
+        gone = {id(p) for p in expired}
+        mon.expired = deque((p for p in mon.expired if id(p) not in gone), maxlen=mon.expired.maxlen)
+        after += [(p.stamp_ns, 1, p) for p in expired]
+    late = [e for e in mon.answered_late if not e[0].clock and e[0].stamp_ns >= ns and e[0].first_answer is not None]
+    if late:
+        gone = {id(e[0]) for e in late}
+        mon.answered_late = deque(e for e in mon.answered_late if id(e[0]) not in gone)
+    late_of = {id(e[0]): e for e in late}
+    after += [(e[0].stamp_ns, 2, e[0]) for e in late]
+    kept = [r for r in mon.unsure if r[2] >= ns]
+    if kept:
+        gone = {id(r) for r in kept}
+        mon.unsure = deque(r for r in mon.unsure if id(r) not in gone)
+        after += [(r[2], 3, _revived(r)[0]) for r in kept]
     res = mon.result
-    for p in again:
-        key = id(p)
-        if key in in_pending:
+    for _, kind, p in sorted(after, key=lambda x: x[0]):
+        if kind == 0:  # open: stays open, in both clocks
             place(mon, p)
             p.placed = note
             continue
-        if key in in_expired:
+        if kind == 1:  # expired unanswered: open again
             given = "undecided" if p.maybe else "false"
             if p.maybe:
                 res.unaccepted["undecided"] -= 1
@@ -338,28 +349,25 @@ def _given_again(mon: ClockMonitor, again: list[Pending], note: str) -> None:
                     f"not answered yet; the {given} given when the run's clock passed its deadline is withdrawn"
                     + words(mon, p), update=True))
             continue
-        entry = late_of.get(key)
-        if entry is not None and p.first_answer is not None:  # expired, then answered late: the false withdrawn
-            answer, a, semantics = p.first_answer
+        assert p.first_answer is not None
+        answer, a, semantics = p.first_answer
+        if kind == 2:  # expired, then answered late: the false and the late answer's margin withdrawn
             mon._withdraw_false(p)
-            deadline_late.withdraw_margin(res, _held(mon, p.k), p.k, entry[1], p.trigger.where)
+            deadline_late.withdraw_margin(res, _held(mon, p.k), p.k, late_of[id(p)][1], p.trigger.where)
             _late_again(mon, p, answer, a, semantics, note)
             continue
-        if p.given and p.held is not None and p.first_answer is not None:  # answered: true or false on its own
-            answer, a, semantics = p.first_answer
-            old, p.held = p.held, None
-            deadline_late.withdraw_margin(res, _held(mon, p.k), p.k, old[0], p.trigger.where)
-            if p.given == "false":
-                mon._withdraw_false(p)
-                _late_again(mon, p, answer, a, semantics, note)
-                continue
-            place(mon, p)
-            p.placed = note
-            margin = margin_ns(mon, p, a)
-            order = res.note_time_margin(p.k, margin, p.trigger.where, answer.where, a / 1e9, held=True)
-            answered(mon, p, "true", answer, a, semantics, (margin, order, p.trigger.where, answer.where, a / 1e9))
-        # otherwise (its answer heard after the clock passed its deadline and met on its own stamp, or made
-        # undecided by an output within the skew before it): as given
+        assert p.held is not None  # answered on its own: true or false
+        old, p.held = p.held, None
+        deadline_late.withdraw_margin(res, _held(mon, p.k), p.k, old[0], p.trigger.where)
+        if p.given == "false":
+            mon._withdraw_false(p)
+            _late_again(mon, p, answer, a, semantics, note)
+            continue
+        place(mon, p)
+        p.placed = note
+        margin = margin_ns(mon, p, a)
+        order = res.note_time_margin(p.k, margin, p.trigger.where, answer.where, a / 1e9, held=True)
+        answered(mon, p, "true", answer, a, semantics, (margin, order, p.trigger.where, answer.where, a / 1e9))
 
 
 def _unanswered_withdrawn(mon: ClockMonitor, p: Pending) -> None:
@@ -388,9 +396,9 @@ def _late_again(mon: ClockMonitor, p: Pending, answer: Event, a: int, semantics:
 
 
 def _held(mon: ClockMonitor, k: int) -> list[deadline_late.Held]:
-    """The margins of guarantee ``k`` still withdrawable (:func:`.deadline_late.held`), the recorded
-    obligations' (:func:`record`) among them."""
-    return deadline_late.held(mon.answered_late, [*mon.awaiting, *mon.unsure], k)
+    """The margins of guarantee ``k`` still withdrawable (:func:`.deadline_late.held`), the recorded answers'
+    (:func:`record`) among them."""
+    return deadline_late.held(mon.answered_late, mon.awaiting, k, mon.unsure)
 
 
 def reads_clock(mon: ClockMonitor) -> bool:
@@ -729,5 +737,6 @@ def _words(p: Pending) -> str:
             f"{passed}): the node's clock is not said")
 
 
-__all__ = ["DECLARE", "FAR", "HELD", "answered", "band", "band_late", "hold", "holds", "judge_again", "margin_ns",
-           "place", "place_held", "reads_clock", "release_held", "tick", "undecided", "words"]
+__all__ = ["DECLARE", "FAR", "HELD", "answered", "band", "band_late", "drop_records", "hold", "judge_again",
+           "margin_ns", "place", "place_held", "reads_clock", "record", "release_held", "tick", "undecided",
+           "unsaid_first", "words"]

@@ -34,7 +34,7 @@ from typing import Iterable, Mapping, Protocol
 
 from rclverify.traces.events import Event
 from rclverify.backends.monitors import deadline_skew
-from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending, Recorded
 from rclverify.backends.monitors.deadline_text import ms_ns
 
 #: how many late-answered obligations are kept for a revision (as many as the expired ones, deadlines.py)
@@ -53,7 +53,7 @@ class LateAnswers(deadline_skew.DeadlineMonitor, Protocol):
 
     answered_late: deque[Answered]
     awaiting: list[Pending]
-    unsure: deque[Pending]
+    unsure: deque[Recorded]
     result: DeadlineResult
 
     def _emit(self, v: DeadlineVerdict) -> None: ...
@@ -123,17 +123,19 @@ def met_late(mon: LateAnswers, p: Pending, ev: Event, ns: int, margin: int | Non
 def _withdraw_margin(mon: LateAnswers, entry: Answered) -> None:
     """The late answer's margin of ``entry`` out of its guarantee's time margins (module docstring)."""
     p = entry[0]
-    withdraw_margin(mon.result, held(mon.answered_late, [*mon.awaiting, *mon.unsure], p.k), p.k, entry[1],
+    withdraw_margin(mon.result, held(mon.answered_late, mon.awaiting, p.k, mon.unsure), p.k, entry[1],
                     p.trigger.where)
 
 
-def held(answered_late: Iterable[Answered], awaiting: Iterable[Pending], k: int) -> list[Held]:
+def held(answered_late: Iterable[Answered], awaiting: Iterable[Pending], k: int,
+         recorded: Iterable[Recorded] = ()) -> list[Held]:
     """The margins of guarantee ``k`` a revision may still withdraw: the late answers kept (``answered_late``)
     and the answers given while ``/clock`` may still move their verdict or margin (``awaiting``'s
-    :attr:`~.deadline_records.Pending.held`: before ``/clock`` passed their deadline, or recorded before the
-    first ``/clock``), each in :attr:`~.deadline_records.DeadlineResult.floor`'s shape."""
+    :attr:`~.deadline_records.Pending.held`, given before ``/clock`` passed their deadline; ``recorded``, given
+    before the first ``/clock``: :func:`.deadline_clock.record`), each in
+    :attr:`~.deadline_records.DeadlineResult.floor`'s shape."""
     got = [(e[1], e[2], e[0].trigger.where, e[3], e[4]) for e in answered_late if e[0].k == k]
-    return got + [p.held for p in awaiting if p.k == k and p.held is not None]
+    return got + [p.held for p in awaiting if p.k == k and p.held is not None] + [r[1] for r in recorded if r[0] == k]
 
 
 def withdraw_margin(result: DeadlineResult, rest: list[Held], k: int, margin: int, trigger_where: str) -> None:

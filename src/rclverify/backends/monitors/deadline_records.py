@@ -111,13 +111,10 @@ class Pending:
     #: held while no ``/clock`` had been heard, its node said to keep simulated time: no verdict is given until
     #: the first ``/clock`` message places it, or none came within the kept window (:func:`.deadline_clock.hold`)
     unclocked: bool = False
-    #: held so (or :attr:`provisional`), the answer that came meanwhile: (the answer, its stamp in integer ns,
-    #: the arithmetic it held in)
+    #: held so (or, its node's clock not said, answered late on the run's clock before any ``/clock``: given
+    #: again by the first one, :func:`.deadline_clock.unsaid_first`), the answer that came meanwhile: (the
+    #: answer, its stamp in integer ns, the arithmetic it held in)
     first_answer: tuple[Event, int, str] | None = None
-    #: placed on the run's clock while no ``/clock`` had been heard, its node's clock not said: its verdict
-    #: (:attr:`given`), its answer (:attr:`first_answer`) and its margin (:attr:`held`) kept, given again if
-    #: the first ``/clock`` message, heard late, is stamped at or before its trigger (:func:`.deadline_clock.record`)
-    provisional: bool = False
     #: what a verdict's reason adds on how it was placed (the first ``/clock`` heard late: ``""`` otherwise)
     placed: str = ""
 
@@ -126,6 +123,14 @@ class Pending:
         """The guarantee's deadline (integer ns) this obligation is due after: its due time less its stamp on
         the run's clock, what a verdict's words call "the deadline of"."""
         return (self.wall_due_ns if self.clock else self.due_ns) - self.stamp_ns
+
+
+#: an answer recorded for the first ``/clock`` message (:func:`.deadline_clock.record`), in plain values: the
+#: guarantee, its margin noted withdrawable (:attr:`DeadlineResult.floor`'s shape), the trigger's stamp (ns),
+#: stamp and due time (s), due time (ns), the trigger's index, time, topic and place, the answer's index,
+#: time, topic and place, its stamp (ns), the arithmetic it held in, the verdict given (``true``, ``false``)
+Recorded = tuple[int, tuple[int, int, str, str, float], int, float, float, int, int, float, str, str, int, float, str,
+                 str, int, str, str]
 
 
 @dataclass

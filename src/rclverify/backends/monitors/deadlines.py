@@ -64,7 +64,7 @@ from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_fo
 from rclverify.traces.sim_clock import CLOCK_TOPIC, SimClock
 from rclverify.traces.questions import Question, QuestionStream
 from rclverify.backends.monitors.verdicts import names
-from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending
+from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending, Recorded
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import VerdictWords, ms_ns, rejected
 from rclverify.backends.monitors import deadline_clock, deadline_late, deadline_skew
@@ -94,10 +94,10 @@ class DeadlineMonitor(VerdictWords):
         #: obligations held until the first ``/clock`` message places them, in the order they came (their node
         #: said to keep simulated time; at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.hold`)
         self.unclocked: deque[Pending] = deque()
-        #: obligations of a node whose clock is not said placed on the run's clock while no ``/clock`` has been
-        #: heard, in the order they came: given again if the first ``/clock`` message, heard late, is stamped
-        #: before their trigger (at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.record`)
-        self.unsure: deque[Pending] = deque()
+        #: the answers to obligations of a node whose clock is not said, placed on the run's clock while no
+        #: ``/clock`` has been heard, in the order given: given again if the first ``/clock`` message, heard
+        #: late, is stamped before their trigger (at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.record`)
+        self.unsure: deque[Recorded] = deque()
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         self.assumption = tuple(c.formula for c in node.node.assumes)
         self.bindings = topic_bindings(node)
@@ -285,10 +285,8 @@ class DeadlineMonitor(VerdictWords):
         (:mod:`.deadline_clock`); a trigger heard after outputs stamped after it is answered by them."""
         d_ns = self.bounds_ns[k]
         p = Pending(k, ev, ns / 1e9, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
-        if deadline_clock.holds(self):  # kept in simulated time, no /clock heard yet: placed by the first one
+        if self.sim_mode and not self.sim.heard:  # kept in simulated time: placed by the first /clock message
             deadline_clock.hold(self, p)
-        elif deadline_clock.records(self):  # not said, no /clock heard yet: the run's clock, given again by it
-            deadline_clock.record(self, p)
         elif deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
             why = deadline_clock.place(self, p)
             if why:
@@ -346,7 +344,7 @@ class DeadlineMonitor(VerdictWords):
                     continue
                 self._emit(self.late_verdict(p, ns, ev))
                 deadline_late.hold(self, p, ns, ev, self._margin(p, ns))  # an output within the skew before it may come
-                if p.provisional:  # given again if the first /clock, heard late, comes before its trigger
+                if self.sim_mode is None and not self.sim.heard:  # given again by a first /clock heard late
                     p.first_answer = (ev, ns, semantics)
         if self.answered_late:
             deadline_late.revise(self, ev, ns, {c: self.values[c] for c in outs if c not in self.state_outs})
@@ -393,7 +391,6 @@ class DeadlineMonitor(VerdictWords):
         stamp = ns / 1e9
         if p.maybe and ns > p.due_ns:  # its own answer after the deadline: undecided, as when the clock passed first
             deadline_skew.undecided(self, p)
-            p.provisional = False  # undecided in every reading of its clock
             return
         if p.clock and p.sure_ns < ns <= p.due_ns:  # in time in one clock it may be kept in, not in every one
             deadline_clock.band(self, p, ev, ns)
@@ -403,13 +400,14 @@ class DeadlineMonitor(VerdictWords):
         # placed in a clock, before /clock passed its deadline or was heard after the answer: a /clock message
         # heard later may change its verdict or its margin (deadline_clock.tick)
         held = bool(p.clock) and (p.due_ns >= deadline_clock.FAR or not self.sim.heard_after(ns))
-        order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp,
-                                             held=held or p.provisional)
+        # the node's clock not said, no /clock heard yet: given again if the first one, heard late, comes before
+        recorded = not held and self.sim_mode is None and not self.sim.heard
+        order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp, held=held or recorded)
         if held:
             deadline_clock.answered(self, p, "true", ev, ns, semantics, (margin, order, p.trigger.where, ev.where, stamp))
-        elif p.provisional:  # given again if the first /clock, heard late, comes before its trigger
-            p.held, p.first_answer = (margin, order, p.trigger.where, ev.where, stamp), (ev, ns, semantics)
-            p.given = "true" if ns <= p.due_ns else "false"
+        elif recorded:
+            deadline_clock.record(self, p, ev, ns, semantics, "true" if ns <= p.due_ns else "false",
+                                  (margin, order, p.trigger.where, ev.where, stamp))
 
     def _margin(self, p: Pending, ns: int) -> int:
         """The time margin (integer ns) of an answer stamped ``ns`` to obligation ``p``: its deadline less the
@@ -463,10 +461,10 @@ class DeadlineMonitor(VerdictWords):
             return
         self.now_ns = now_ns
         self.now = now_ns / 1e9
-        if self.unclocked:  # held past the kept window with no /clock heard: as a run without /clock
-            deadline_clock.release_held(self, now_ns - self.sim.kept_ns)
-        if self.unsure:  # no longer given again by a /clock message heard later
-            deadline_clock.drop_records(self, now_ns - self.sim.kept_ns)
+        if self.unclocked and self.unclocked[0].stamp_ns < now_ns - self.sim.kept_ns:
+            deadline_clock.release_held(self, now_ns - self.sim.kept_ns)  # no /clock in the kept window after it
+        if self.unsure and self.unsure[0][2] < now_ns - self.sim.kept_ns:
+            deadline_clock.drop_records(self, now_ns - self.sim.kept_ns)  # no longer given again by a /clock
         self._expire(now_ns)
 
     def _expire(self, now_ns: int) -> None:
