@@ -4,7 +4,12 @@
 * The proxy's log is a trace the offline check reads: its calls as message lines, its own lines on
   ``rclverify/proxy``; ``rclverify monitor`` on it gives the proxy's deadline verdicts.  The control: the
   same events written as the proxy's own lines only, a line without a topic, are refused, located.
-* A live run counts the proxy's events as the calls it heard (``call``), never as messages.
+* A live run counts the proxy's events as the calls it heard (``call``), never as messages.  Inside it
+  the proxy judges nothing: the run's deadline checks give each call's deadline verdict once (the log, the
+  record, the verdict topic), an unanswered call's ``false`` at the run's timer; the control, a proxy given
+  monitors to judge beside them, is refused.
+* The run warns once per node whose clock by the mapping contradicts ``/use_sim_time``, naming both; the
+  controls, nodes whose clock agrees or is not said and a ``/use_sim_time`` not known, get no line.
 * A request stamped 0 (the proxy's ROS clock not yet set: under ``/use_sim_time`` before its first
   ``/clock``) has its deadline ``undecided``, saying so, in the log and the summary; the control, the
   same call stamped once the clock is set, is judged.  The proxy waits for its clock to be set, bounded.
@@ -115,17 +120,58 @@ def test_a_live_run_counts_the_proxys_events_as_calls_heard(tmp_path: Path) -> N
     ws = _workspace(tmp_path)
     checked = load([str(ws / "contracts/sys.rcl")])
     nodes = list(checked.nodes.values())
-    live = LiveRun(checked, nodes, {}, 1.0, tmp_path / "live.jsonl")
-    run = ProxyRun([DeadlineMonitor(checked, nodes[0], {}, clock=False)], write=live.note, forward=live.push)
+    published: list[dict[str, Any]] = []
+    live = LiveRun(checked, nodes, {}, 1.0, tmp_path / "live.jsonl", publish=lambda text: published.append(json.loads(text)))
+    run = ProxyRun([], write=live.note, forward=live.push, judge=False)  # as proxy_factory makes it
     run.event("estop/request", {"data": True}, 10.0)
     run.event("estop/response", {"success": True, "message": ""}, 10.1)
+    run.event("estop/request", {"data": True}, 11.0)  # unanswered: false once the run's timer passes 11.4
+    live.tick(11.3)
+    assert [(p["verdict"], p["answer"]) for p in published if p.get("kind") == "deadline"] == [("true", 10.1)]
+    live.tick(11.5)
+    deadlines = [p for p in published if p.get("kind") == "deadline"]
+    assert [(p["verdict"], p["answer"]) for p in deadlines] == [("true", 10.1), ("false", None)], deadlines
+    run.event("estop/response", {"success": True, "message": ""}, 11.6)  # the late answer: an update
     live.tick(12.0)
-    assert live.calls_heard == {"estop/request": 1, "estop/response": 1}
+    assert live.calls_heard == {"estop/request": 2, "estop/response": 2}
     run.close()
     record = live.stop()
-    # the deadline checks of the live log judge the call once: the proxy's own lines are no messages
+    # the deadline checks of the live log judge each call once: the proxy's own lines are no messages
     (res,) = [e["deadlines"] for e in record["topic_deadlines"] if e["node"] == "Base"]
-    assert (res["counts"]["true"], sum(res["unaccepted"].values())) == (1, 0), res
+    assert (res["counts"]["true"], res["counts"]["false"], sum(res["unaccepted"].values())) == (1, 1, 0), res
+    deadlines = [p for p in published if p.get("kind") == "deadline"]
+    assert [(p["verdict"], p["update"]) for p in deadlines] == [("true", False), ("false", False), ("false", True)]
+    lines = [json.loads(x) for x in (tmp_path / "live.jsonl").read_text().splitlines()]
+    logged = [x["verdict"] for x in lines if x.get("kind") == "deadline"]
+    assert logged == [{k: v for k, v in p.items() if k != "kind"} for p in deadlines]  # published as logged
+    # the proxy's lines: its events only, no deadline verdict or summary of its own
+    assert [x["kind"] for x in lines if x["topic"] == PROXY_LOG_TOPIC] == ["event"] * 4
+    # the control: a proxy that judges nothing takes no monitors (a second judge of the same calls)
+    with pytest.raises(ValueError, match="takes no deadline monitors"):
+        ProxyRun([DeadlineMonitor(checked, nodes[0], {}, clock=False)], write=live.note, judge=False)
+
+
+def test_the_run_warns_of_a_node_whose_clock_contradicts_use_sim_time(tmp_path: Path) -> None:
+    from rclverify.runtime.live_ros1 import clock_warnings
+    from rclverify.traces.mapping import load_rules
+    rcl = tmp_path / "sys.rcl"  # Base and Halt with a deadline; Plain without one
+    rcl.write_text(RCL + RCL.replace("Base", "Halt").replace("estop", "halt") + "node Plain {\n  inputs( a : BOOL )\n"
+                   "  outputs( b : BOOL )\n  assume( TRUE )\n  guarantee( out.b == in.a )\n}\n")
+    nodes = list(load([str(rcl)]).nodes.values())
+    assert [n.name for n in nodes] == ["Base", "Halt", "Plain"]
+    rules = load_rules({})
+    rules.sim_time = frozenset({"Base"})  # Base on /clock, Halt on the wall clock
+    (line,) = clock_warnings(rules, nodes, True)
+    assert "node Halt keeps the wall clock by the mapping's use_sim_time but /use_sim_time is true" in line, line
+    (line,) = clock_warnings(rules, nodes, False)
+    assert "node Base keeps simulated time (/clock) by the mapping's use_sim_time but /use_sim_time is false" in line
+    rules.sim_time = True  # every node on /clock: those with a deadline warned of, not Plain
+    assert clock_warnings(rules, nodes, True) == []
+    assert [x.split("node ")[1].split()[0] for x in clock_warnings(rules, nodes, False)] == ["Base", "Halt"]
+    rules.sim_time = None  # not said: no line, whatever ROS says
+    assert clock_warnings(rules, nodes, True) == clock_warnings(rules, nodes, False) == []
+    rules.sim_time = frozenset({"Base"})
+    assert clock_warnings(rules, nodes, None) == []  # /use_sim_time not known: nothing made up
 
 
 def test_a_message_rospy_decoded_itself_is_flattened_as_it_is() -> None:

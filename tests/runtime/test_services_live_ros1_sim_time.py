@@ -1,31 +1,30 @@
 """ROS 1's service proxy in simulated time, live (docs/semantics.md, "Deadlines in simulated time";
-``runtime/service_proxy.py``, "Simulated time"; ``runtime/live_ros1.py``, "The run's clock").
+``runtime/live_ros1.py``, "The run's clock" and "One judge of the calls").
 
 A ROS 1 master on 127.0.0.1 (a free port), its ``/use_sim_time`` true, and rospy processes: ``sim``
 publishes ``/clock`` every 10 ms of the wall clock, 5 ms further each time (a real-time factor of 0.5);
 ``base`` serves ``/estop_real`` and ``/halt_real`` (``std_srvs/SetBool``) and answers each call once its
 ROS clock (``/clock``, read at its start) has moved 300 ms (``rospy.sleep``: 600 ms of the wall clock);
 ``teleop`` calls ``/estop`` and ``/halt`` through ``rclverify monitor --live --forward`` (the service
-proxy), one call at a time.  The contracts: each answer within 400 ms of its request, ``Base`` for
-``estop``, ``Halt`` for ``halt``.  The same process relays each ``x`` (``geometry_msgs/PointStamped``,
-``teleop`` publishes one each round) to ``y`` after 300 ms of its clock, ``Relay``'s contract asking
-for ``y`` within 400 ms of ``x``: a topic's deadline, judged by the live run's own checks only.  Two runs
-of the monitor on one master and one server:
+proxy), one call at a time; ``echo`` prints each message of the verdict topic.  The contracts: each answer
+within 400 ms of its request, ``Base`` for ``estop``, ``Halt`` for ``halt``.  The same process relays each
+``x`` (``geometry_msgs/PointStamped``, ``teleop`` publishes one each round) to ``y`` after 300 ms of its
+clock, ``Relay``'s contract asking for ``y`` within 400 ms of ``x``: a topic's deadline.  The live run's
+own deadline checks, on the wall clock with ``/clock``'s samples in the log, are the one judge of every
+deadline; the proxy stamps and forwards.  Two runs of the monitor on one master and one server, four
+clock cases for the calls:
 
-* ``sim``: ``/use_sim_time`` true, the mapping's ``use_sim_time: [Base, Relay]``.  The proxy's ROS clock is
-  ``/clock``: ``Base``'s every deadline ``true`` (300 of 400 simulated ms); ``Halt``, said to keep the
-  wall clock, is the control: every deadline ``undecided``, the reason naming both clocks, never judged
-  on ``/clock``.  The live run's own deadline checks, on the wall clock with ``/clock``'s samples in the
-  log, judge ``Base`` ``true`` too and ``Halt`` on its wall clock: ``false``; ``Relay``, said on
-  ``/clock``, ``true``.
+* ``sim``: ``/use_sim_time`` true, the mapping's ``use_sim_time: [Base, Relay]``.  ``Base``, on ``/clock``:
+  every deadline ``true`` (300 of 400 simulated ms); ``Halt``, said to keep the wall clock: ``false``
+  (600 ms of it), with one warning line naming ``Halt``, its clock and ``/use_sim_time``; ``Relay``
+  ``true``.
 * ``wall``: ``/use_sim_time`` false when the monitor starts (the server still on ``/clock``), the
-  mapping's ``use_sim_time: [Halt]``.  The proxy's clock is the wall clock: ``Base``, a wall-clock node,
-  has the same 600 ms answers ``false``; ``Halt``, said to keep ``/clock``, is ``undecided`` by the proxy
-  and ``true`` by the live run's checks, which read ``/clock``; ``Relay``, said on the wall clock, ``false``.
+  mapping's ``use_sim_time: [Halt]``.  ``Base``, a wall-clock node: the same 600 ms answers ``false``;
+  ``Halt``, said to keep ``/clock``: ``true``, with the warning line; ``Relay`` ``false``.
 
-Each log replayed offline (``rclverify monitor`` on it, the same mapping) gives the live run's checks'
-verdicts.  Every process is stopped in a ``finally``; skipped, with the reason, only where ROS 1 cannot be
-imported.
+Each call has one deadline verdict, the same in the log, the evidence record, on the verdict topic and in
+the log's offline replay (``rclverify monitor`` on it, the same mapping); none is the proxy's.  Every
+process is stopped in a ``finally``; skipped, with the reason, only where ROS 1 cannot be imported.
 """
 from __future__ import annotations
 
@@ -131,6 +130,15 @@ elif role == "base":  # answers once its ROS clock moved DELAY (under /use_sim_t
     keep.append(rospy.Subscriber("/x", PointStamped, relay))
     print("ready", flush=True)
     rospy.spin()
+elif role == "echo":  # each message of the verdict topic, its JSON text a line
+    from std_msgs.msg import String
+    rospy.init_node("echo", anonymous=True)
+    sub = rospy.Subscriber("/rclverify/verdict", String, lambda msg: print(msg.data, flush=True))
+    end = time.monotonic() + 30
+    while sub.get_num_connections() < 1 and time.monotonic() < end:  # connected to the monitor's publisher
+        time.sleep(0.05)
+    print("ready", flush=True)
+    rospy.spin()
 else:  # teleop: ROUNDS rounds of an x and one call of each service, one at a time
     rospy.init_node("teleop", anonymous=True)
     calls = {s: rospy.ServiceProxy(s, srv, persistent=True) for s in ("/estop", "/halt")}
@@ -156,9 +164,9 @@ def _start(args: list[str], env: dict[str, str], cwd: Path, out: Path) -> subpro
                             stderr=subprocess.STDOUT, start_new_session=True)
 
 
-def _verdicts(lines: list[dict[str, Any]], node: str) -> list[dict[str, Any]]:
-    """The proxy's deadline verdicts of ``node`` in the log's lines (its ``kind: verdict`` lines)."""
-    return [x for x in lines if x.get("topic") == PROXY_LOG_TOPIC and x["kind"] == "verdict" and x["node"] == node]
+def _proxys(lines: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The service proxy's lines of the log other than its events (a deadline verdict or summary of its own)."""
+    return [x for x in lines if x.get("topic") == PROXY_LOG_TOPIC and x["kind"] != "event"]
 
 
 def _checks(lines: list[dict[str, Any]], node: str) -> list[dict[str, Any]]:
@@ -172,6 +180,17 @@ def _finals(verdicts: list[dict[str, Any]]) -> Counter[str]:
     for v in verdicts:
         last[v["trigger_where"]] = v["verdict"]
     return Counter(last.values())
+
+
+def _published(text: str, node: str) -> list[dict[str, Any]]:
+    """The deadline verdicts of ``node`` the verdict topic's subscriber received (``echo``'s lines), as the
+    log's ``kind: deadline`` lines hold them."""
+    out = []
+    for line in text.splitlines():
+        data = json.loads(line) if line.startswith("{") else {}
+        if data.get("kind") == "deadline" and data["node"] == node:
+            out.append({k: v for k, v in data.items() if k != "kind"})
+    return out
 
 
 def _counts(res: dict[str, Any]) -> Counter[str]:
@@ -194,31 +213,34 @@ def _offline(ws: Path, mapping: str, log: Path) -> dict[str, Counter[str]]:
 def _live(tmp: Path, ws: Path, env: dict[str, str], name: str, mapping: str) -> dict[str, Any]:
     """One live run of ``rclverify monitor --live`` (the proxy) under ``mapping`` while ``teleop`` makes its
     calls: its log's lines, exit code, output, evidence record and the log replayed offline."""
-    log, out = tmp / f"{name}.jsonl", tmp / f"{name}.out"
+    log, out, echoed = tmp / f"{name}.jsonl", tmp / f"{name}.out", tmp / f"{name}-echo.out"
+    echo = None
     monitor = _start(["-m", "rclverify.cli.commands", "monitor", "-w", str(ws), "--live", "--interfaces",
                       "interfaces", "--mapping", mapping, "--forward", "/estop=/estop_real", "--forward",
                       "/halt=/halt_real", "--log", str(log), "--status", "0", "--evidence",
                       str(tmp / f"{name}.json"), "--duration", "60"], env, ws, out)
     try:
         wait_for(out, "monitoring ", 30)
+        echo = _start([str(tmp / "nodes.py"), "echo"], env, ws, echoed)
+        wait_for(echoed, "ready", 30)  # subscribed to the monitor's verdict topic before the first call
         teleop = _start([str(tmp / "nodes.py"), "teleop"], env, ws, tmp / f"{name}-teleop.out")
         try:
             assert teleop.wait(30) == 0, (tmp / f"{name}-teleop.out").read_text()
         finally:
             stop(teleop)
-        # every call judged by the proxy and by the run's checks (on /clock, once it passed the deadline)
-        wait_logged(log, lambda lines: all(sum(_finals(f(lines, n)).values()) >= ROUNDS and
-                                           not _finals(f(lines, n))["currently_false"]
-                                           for f in (_verdicts, _checks) for n in ("Base", "Halt"))
-                    and sum(_finals(_checks(lines, "Relay")).values()) >= ROUNDS
-                    and not _finals(_checks(lines, "Relay"))["currently_false"], 15)
+        # every call and x judged by the run's checks (on /clock, once it passed the deadline)
+        wait_logged(log, lambda lines: all(sum(_finals(_checks(lines, n)).values()) >= ROUNDS and
+                                           not _finals(_checks(lines, n))["currently_false"]
+                                           for n in ("Base", "Halt", "Relay")), 15)
         stop(monitor, signal.SIGINT)
     finally:
         stop(monitor)
+        if echo is not None:
+            stop(echo)
     lines = [json.loads(x) for x in log.read_text().splitlines()]
     return {"lines": lines, "code": monitor.returncode, "out": out.read_text(errors="replace"),
             "record": json.loads((tmp / f"{name}.json").read_text()), "offline": _offline(ws, mapping, log),
-            "teleop": (tmp / f"{name}-teleop.out").read_text()}
+            "teleop": (tmp / f"{name}-teleop.out").read_text(), "echo": echoed.read_text(errors="replace")}
 
 
 @pytest.fixture(scope="module")
@@ -252,54 +274,65 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, dict[st
                 stop(p)
 
 
+def _one_judge(run: dict[str, Any], node: str, want: str) -> list[dict[str, Any]]:
+    """``node``'s calls each judged once, ``want``, by the run's checks: the same verdicts in the log, the
+    record (``topic_deadlines``), on the verdict topic and in the offline replay; one first verdict per
+    call.  The control: no deadline verdict or summary of the proxy's own, no ``deadlines`` of its in the
+    record.  Returns the checks' verdicts of ``node``."""
+    checks = _checks(run["lines"], node)
+    (res,) = [d["deadlines"] for d in run["record"]["topic_deadlines"] if d["node"] == node]
+    assert _finals(checks) == _counts(res) == run["offline"][node] == Counter({want: ROUNDS}), (node, checks)
+    assert _published(run["echo"], node) == checks, (node, run["echo"][-3000:])
+    assert sum(1 for v in checks if not v["update"]) == ROUNDS  # once per call
+    assert _proxys(run["lines"]) == [] and "deadlines" not in run["record"]
+    return checks
+
+
+def _warned(run: dict[str, Any]) -> list[str]:
+    """The run's warning lines about a node's clock."""
+    return [x for x in run["out"].splitlines() if "warning: node " in x]
+
+
 def test_calls_in_time_in_simulated_time_are_true_under_use_sim_time(runs: dict[str, dict[str, Any]]) -> None:
     """``/use_sim_time`` true, ``Base`` said on ``/clock``: 300 simulated ms of 400, every deadline ``true``,
-    by the proxy (its stamps ``/clock``'s, from 1000 s on) and by the run's checks, live and offline."""
+    judged once, on ``/clock``'s time (from 1000 s on) though 600 ms of the run's clock passed."""
     sim = runs["sim"]
     assert sim["teleop"].count("True") == 2 * ROUNDS, sim["teleop"]
-    verdicts = _verdicts(sim["lines"], "Base")
-    assert _finals(verdicts) == Counter(true=ROUNDS), (verdicts, sim["out"][-2000:])
-    for v in verdicts:  # /clock's 300 ms between the proxy's stamps (its samples 5 ms apart)
-        assert v["trigger_stamp"] > 1000 and 0.29 <= v["answer"] - v["trigger_stamp"] <= 0.4, v
-    assert _finals(_checks(sim["lines"], "Base")) == sim["offline"]["Base"] == Counter(true=ROUNDS)
+    for v in _one_judge(sim, "Base", "true"):  # /clock's 100 ms to spare (its samples 5 ms apart)
+        assert "in simulated time (use_sim_time): due at 1" in v["reason"] and 0.08 <= v["time_margin"] <= 0.11, v
+        assert v["trigger_stamp"] > 1.6e9 and v["answer"] - v["trigger_stamp"] >= 0.5, v  # the run's clock
     assert sim["record"]["decode_errors"] == {}  # /clock heard beside rospy's own subscription to it
     assert sum(1 for x in sim["lines"] if x["topic"] == "clock") > 100
-    assert sim["record"]["deadlines"]["false"] == 0
 
 
-def test_the_control_a_node_said_on_the_wall_clock_is_undecided_by_the_proxy(
+def test_a_node_said_on_the_wall_clock_under_use_sim_time_is_judged_on_it_with_a_warning(
         runs: dict[str, dict[str, Any]]) -> None:
-    """``Halt`` said to keep the wall clock while the proxy's clock is ``/clock``: the proxy says
-    ``undecided`` for every call, naming both clocks, in its log, its summary and on the verdict topic's
-    count; the run's checks judge it on the wall clock, where the 600 ms answers are late."""
+    """``Halt`` said to keep the wall clock while ``/use_sim_time`` is true: judged on the wall clock, where
+    the 600 ms answers are late, once per call; the run says so in one warning line naming the node and both
+    settings, the only one (``Base`` and ``Relay``, on ``/clock`` as ROS is, the controls), and exits 1."""
     sim = runs["sim"]
-    verdicts = _verdicts(sim["lines"], "Halt")
-    assert _finals(verdicts) == Counter(undecided=ROUNDS), verdicts
-    for v in verdicts:
-        assert "node Halt keeps the wall clock" in v["reason"] and "simulated time (/clock)" in v["reason"], v
-        assert "/use_sim_time is true" in v["reason"]
-    (halt,) = [r for r in sim["record"]["deadlines"]["results"] if r["node"] == "Halt"]
-    assert _counts(halt) == Counter(undecided=ROUNDS), halt
-    assert _finals(_checks(sim["lines"], "Halt")) == sim["offline"]["Halt"] == Counter(false=ROUNDS)
+    for v in _one_judge(sim, "Halt", "false"):
+        assert v["trigger_stamp"] > 1.6e9 and "simulated time" not in v["reason"], v
+    (line,) = _warned(sim)
+    assert "node Halt keeps the wall clock by the mapping's use_sim_time but /use_sim_time is true" in line, line
+    assert sim["record"]["warnings"] == [line] and sim["code"] == 1
 
 
 def test_the_wall_clock_judges_the_same_answers_false_without_use_sim_time(
         runs: dict[str, dict[str, Any]]) -> None:
-    """``/use_sim_time`` false: the proxy's clock is the wall clock, and the same server's 600 ms answers are
-    ``false`` for ``Base`` (a wall-clock node), by the proxy and the run's checks, live and offline; the
-    run exits 1.  ``Halt``, said on ``/clock``, is ``undecided`` by the proxy and ``true`` by the checks."""
+    """``/use_sim_time`` false: the same server's 600 ms answers are ``false`` for ``Base`` (a wall-clock
+    node), false once the deadline passed on the run's clock, then again with the late answer; ``Halt``,
+    said on ``/clock``, ``true`` by the ``/clock`` samples, with its warning line; the run exits 1."""
     wall = runs["wall"]
-    verdicts = _verdicts(wall["lines"], "Base")
-    assert _finals(verdicts) == Counter(false=ROUNDS), verdicts
-    # false once the wall clock passed the deadline, then again with the late answer's stamps
+    verdicts = _one_judge(wall, "Base", "false")
     assert [(v["answer"] is None, v["update"]) for v in verdicts] == [(True, False), (False, True)] * ROUNDS
     for v in verdicts[1::2]:
         assert v["trigger_stamp"] > 1.6e9 and v["answer"] - v["trigger_stamp"] >= 0.55, v
-    assert _finals(_checks(wall["lines"], "Base")) == wall["offline"]["Base"] == Counter(false=ROUNDS)
-    halt = _verdicts(wall["lines"], "Halt")
-    assert _finals(halt) == Counter(undecided=ROUNDS) and "/use_sim_time is false" in halt[0]["reason"], halt
-    assert _finals(_checks(wall["lines"], "Halt")) == wall["offline"]["Halt"] == Counter(true=ROUNDS)
-    assert wall["record"]["deadlines"]["false"] == ROUNDS and wall["code"] == 1
+    _one_judge(wall, "Halt", "true")
+    (line,) = _warned(wall)
+    assert ("node Halt keeps simulated time (/clock) by the mapping's use_sim_time but /use_sim_time is false"
+            in line), line
+    assert wall["record"]["warnings"] == [line] and wall["code"] == 1
 
 
 def test_a_topics_deadline_is_judged_in_the_clock_the_mapping_gives_its_node(runs: dict[str, dict[str, Any]]) -> None:

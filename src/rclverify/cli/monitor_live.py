@@ -77,7 +77,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
     from rclverify.backends.monitors.widths import judged_at_widths  # deferred: start-up (only live)
     dirs = [root / d for d in cfg.msg_dirs]  # the contract's constants, named ones too, as the fields carry them
     judged = [judged_at_widths(checked, n, cfg.rules, dirs)[0] for n in nodes]  # the offline check's route
-    nodes = judged  # every part of the run judges them so: the topics' engine, the calls, the service proxy
+    nodes = judged  # every part of the run judges them so: the topics' engine, the calls, the deadline checks
     warn_margin = getattr(args, "warn_margin", None)
     factory = partial(run_class, checked, judged, cfg.rules, cfg.horizon, log,
                       reorder_window=args.reorder_window, silence_s=args.silence,
@@ -100,7 +100,7 @@ def live_command(args: argparse.Namespace, checked: Any, cfg: Any, root: Path) -
                 if record_ is None:
                     return 2
             else:
-                proxy = proxy_factory(checked, nodes, getattr(args, "forward", []), interfaces)
+                proxy = proxy_factory(checked, getattr(args, "forward", []), interfaces)
                 record_ = run_ros1(factory, checked, nodes, [root / d for d in cfg.msg_dirs], **common, proxy=proxy)
         except (RosUnavailable, DdsUnavailable, ProxyUsage, RclpyUnavailable) as exc:
             text = str(exc)

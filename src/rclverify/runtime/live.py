@@ -231,8 +231,8 @@ class LiveRun:
                     self._log.flush()
 
     def note(self, obj: Mapping[str, object]) -> None:
-        """One more line of the log (the service proxy's events and deadline
-        verdicts, :mod:`.service_proxy`; the start-of-run marker, after which
+        """One more line of the log (the service proxy's events,
+        :mod:`.service_proxy`; the start-of-run marker, after which
         each node's ``first(in.x)`` is decided as the offline check of the
         log decides it, :mod:`~rclverify.backends.monitors.first_messages`);
         dropped once the run stopped."""

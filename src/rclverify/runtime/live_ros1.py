@@ -38,6 +38,8 @@ from rclverify.runtime.live import LiveRun, stop_and_record
 from rclverify.runtime.live_status import warm_bounds
 from rclverify.runtime.worker import EngineWorker
 from rclverify.traces.sim_clock import CLOCK_TOPIC
+from rclverify.traces.mapping import TopicRule, sim_time_of
+from rclverify.backends.monitors.deadline_topics import has_deadlines
 from rclverify.runtime.ros1 import REGISTER_TIMEOUT_S, SHUTDOWN_TIMEOUT_S, STOPPED_SHUTDOWN_S, bound_master_calls, shutdown_limit, contract_topics, finish_within, import_rospy, message_class, RosUnavailable, check_master, run_bounded, flatten
 
 
@@ -63,7 +65,7 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
              msg_dirs: list[Path], *, verdict_topic: str, last_prefix: str, node_name: str,
              duration: float | None, tick_s: float, status_s: float, evidence: Path | None,
              stop: threading.Event, out: Callable[[str], None],
-             proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None = None) -> dict[str, Any]:
+             proxy: Callable[[Any, LiveRun], Any] | None = None) -> dict[str, Any]:
     """Run live monitoring on a ROS 1 master (``ROS_MASTER_URI``) until ``stop``
     is set or ``duration`` seconds passed; returns the evidence record.
 
@@ -74,11 +76,12 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     ``<last_prefix>/<node>/last_verdict`` (latched).  Raises
     :class:`~.ros1.RosUnavailable` when rospy or a message class is missing.
 
-    ``proxy(rospy, live, publish)``, when given, starts the service proxy
+    ``proxy(rospy, live)``, when given, starts the service proxy
     and action subscriptions in this process (:mod:`.service_proxy`,
-    ``--forward``/``--interfaces``) and returns its run (``tick(now)``,
-    ``close()``): its events and deadline verdicts go to the same log and
-    verdict topic, its summary to the record's ``deadlines``.
+    ``--forward``/``--interfaces``) and returns its run (``close()``): its
+    events go to the same log and engine, whose checks judge their
+    deadlines (module docstring, "One judge of the calls").  The record's
+    ``warnings`` holds the warning lines of :func:`clock_warnings`, when any.
     """
     from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
     rospy = import_rospy()
@@ -93,9 +96,12 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     # to SIGTERM/SIGINT (ros1.py, "A master is an external peer")
     bound_master_calls(rospy, uri, MASTER_TIMEOUT_S)
     until = _time.monotonic() + REGISTER_TIMEOUT_S
-    pub, lasts = _register(rospy, String, stop, uri, node_name, verdict_topic, last_prefix, nodes)
+    pub, lasts, ros_sim = _register(rospy, String, stop, uri, node_name, verdict_topic, last_prefix, nodes)
     live = run_factory(publish=lambda text: pub.publish(String(text)),
                        publish_last=lambda n, text: lasts[n].publish(String(text)))
+    said = clock_warnings(getattr(live.engine, "rules", {}), nodes, ros_sim)
+    for line in said:
+        out(line)
     decode_errors: dict[str, int] = {}
     # the callbacks only stamp and queue; one worker thread decodes, checks,
     # publishes and runs the timer (worker.py: why)
@@ -105,21 +111,21 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
     def unsubscribe() -> None:
         for s in list(subs):
             s.unregister()
-    calls = _subscribe(rospy, String, stop, until, uri, [*topics, *heard], pub, live, worker, subs, unsubscribe,
-                       proxy)
+    calls = _subscribe(rospy, stop, until, uri, [*topics, *heard], live, worker, subs, unsubscribe, proxy)
     out(f"monitoring {len(topics)} topic(s) for {len(nodes)} node(s); verdicts on {verdict_topic}")
     warm_bounds()  # the status line a stop prints need not wait for scipy (live_status.py)
     try:
-        _watch(rospy, stop, duration, tick_s, status_s, calls, worker, pub, live, out)
+        _watch(rospy, stop, duration, tick_s, status_s, worker, pub, live, out)
     finally:
         # unregistering asks the master: bounded, so a master that hangs now cannot hold the exit
         if not finish_within(unsubscribe, SHUTDOWN_TIMEOUT_S):
             out(f"rclverify monitor --live: warning: the master at {uri} did not confirm the unsubscriptions "
                 f"within {SHUTDOWN_TIMEOUT_S:g} s")
-        deadlines = calls.close() if calls is not None else None  # before the log closes
+        if calls is not None:
+            calls.close()  # before the log closes
         record = stop_and_record(worker, live, evidence, out)
-        if deadlines is not None:
-            record["deadlines"] = {"results": deadlines["results"], "false": deadlines["false"]}
+        if said:
+            record["warnings"] = said
         record["decode_errors"] = decode_errors
         record["not_judged"] = live.not_judged(record)  # silence is never green (judged.py)
         if evidence is not None:
@@ -133,14 +139,15 @@ def run_ros1(run_factory: Callable[..., LiveRun], checked: Checked, nodes: list[
 
 
 def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_name: str, verdict_topic: str,
-              last_prefix: str, nodes: list[CheckedNode]) -> tuple[Any, dict[str, Any]]:
-    """The monitor's node registered with the master at ``uri`` and its
-    publishers ``(verdict, {node: last verdict, latched})``; within
+              last_prefix: str, nodes: list[CheckedNode]) -> tuple[Any, dict[str, Any], bool | None]:
+    """The monitor's node registered with the master at ``uri``, its
+    publishers and the system's ``/use_sim_time`` (:func:`_use_sim_time`):
+    ``(verdict, {node: last verdict, latched}, use_sim_time)``; within
     ``REGISTER_TIMEOUT_S`` and ``stop``, else rospy is shut down and
     :class:`~.ros1.RosUnavailable` raised."""
     from rclverify.ros.live.master_rpc import MASTER_TIMEOUT_S  # deferred: start-up (loads rclverify.ros, rclverify.ros.live and more only when called)
 
-    def register_node() -> tuple[Any, dict[str, Any]]:
+    def register_node() -> tuple[Any, dict[str, Any], bool | None]:
         check_master(uri, "/" + node_name, MASTER_TIMEOUT_S)
         rospy.init_node(node_name, anonymous=False, disable_signals=True)
         # synchronous: the engine thread writes each verdict to the subscribers'
@@ -151,7 +158,7 @@ def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_nam
             warnings.simplefilter("ignore", SyntaxWarning)
             pub = rospy.Publisher(verdict_topic, string, queue_size=None)
         return pub, {n.name: rospy.Publisher(f"{last_prefix}/{n.name}/last_verdict", string, queue_size=1,
-                                             latch=True) for n in nodes}
+                                             latch=True) for n in nodes}, _use_sim_time(rospy)
 
     try:
         return run_bounded(stop, REGISTER_TIMEOUT_S, f"registering with the master at {uri}",  # type: ignore[no-any-return]
@@ -159,6 +166,34 @@ def _register(rospy: Any, string: Any, stop: threading.Event, uri: str, node_nam
     except RosUnavailable as exc:
         finish_within(lambda: rospy.signal_shutdown("monitor not started"), shutdown_limit(exc))
         raise
+
+
+def _use_sim_time(rospy: Any) -> bool | None:
+    """The ROS 1 system's ``/use_sim_time`` parameter (false when unset: rospy's own default, the wall clock),
+    ``None`` when the master cannot say; ``rospy.init_node`` must have run."""
+    try:
+        return bool(rospy.get_param("/use_sim_time", False))
+    except Exception:  # noqa: BLE001 - a master that cannot say: no warning is made up
+        return None
+
+
+def clock_warnings(rules: Mapping[str, TopicRule], nodes: Iterable[CheckedNode], ros_sim: bool | None) -> list[str]:
+    """One warning line per node of ``nodes`` with a triggered guarantee that the mapping's ``use_sim_time``
+    (:func:`~rclverify.traces.mapping.sim_time_of`) says keeps the other clock than ROS 1's global
+    ``/use_sim_time`` (``ros_sim``; ``None``: not known, no line) gives its nodes: said on the wall clock with
+    it true, or on ``/clock`` with it false.  A node not said gets none."""
+    lines: list[str] = []
+    if ros_sim is None:
+        return lines
+    for n in nodes:
+        said = sim_time_of(rules, n.name)
+        if said is None or said == ros_sim or not has_deadlines(n):
+            continue
+        mine = "simulated time (/clock)" if said else "the wall clock"
+        lines.append(f"rclverify monitor --live: warning: node {n.name} keeps {mine} by the mapping's use_sim_time "
+                     f"but /use_sim_time is {'true' if ros_sim else 'false'}: its deadlines are judged in {mine}, "
+                     f"as the log's replay judges them")
+    return lines
 
 
 #: the ROS 1 type of the run's simulated clock, ``/clock`` (its one field ``clock`` a ROS 1 ``time``)
@@ -205,16 +240,16 @@ def _decoder(classes: Mapping[str, type], decode_errors: dict[str, int]) -> Call
     return decode
 
 
-def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri: str, topics: Iterable[str],
-               pub: Any, live: LiveRun, worker: EngineWorker, subs: list[Any], unsubscribe: Callable[[], None],
-               proxy: Callable[[Any, LiveRun, Callable[[str], None]], Any] | None) -> Any:
+def _subscribe(rospy: Any, stop: threading.Event, until: float, uri: str, topics: Iterable[str], live: LiveRun,
+               worker: EngineWorker, subs: list[Any], unsubscribe: Callable[[], None],
+               proxy: Callable[[Any, LiveRun], Any] | None) -> Any:
     """Subscribe to every topic of ``topics`` (the contract topics and ``/clock``; into ``subs``) and start the
     ``proxy``; returns the proxy's run or ``None``.  By the registration's
     deadline ``until`` (monotonic s), else everything started is stopped and
     :class:`~.ros1.RosUnavailable` raised."""
 
     def register_topics() -> Any:
-        calls = proxy(rospy, live, lambda text: pub.publish(string(text))) if proxy is not None else None
+        calls = proxy(rospy, live) if proxy is not None else None
         for t in topics:
             subs.append(rospy.Subscriber(t, rospy.AnyMsg, lambda raw, t=t: worker.offer(t, raw, _time.time()),
                                          queue_size=10000, tcp_nodelay=True))
@@ -230,19 +265,17 @@ def _subscribe(rospy: Any, string: Any, stop: threading.Event, until: float, uri
         raise
 
 
-def _watch(rospy: Any, stop: threading.Event, duration: float | None, tick_s: float, status_s: float, calls: Any,
+def _watch(rospy: Any, stop: threading.Event, duration: float | None, tick_s: float, status_s: float,
            worker: EngineWorker, pub: Any, live: LiveRun, out: Callable[[str], None]) -> None:
     """Until ``stop``, rospy's shutdown, ``duration`` s or the engine
-    thread's death: the proxy's clock, the verdict publisher's sockets
-    (:func:`_no_delay`) and a status line every ``status_s`` s."""
+    thread's death: the verdict publisher's sockets (:func:`_no_delay`)
+    and a status line every ``status_s`` s."""
     t0 = _time.monotonic()
     next_status = t0 + status_s
     while not stop.is_set() and not rospy.is_shutdown():
         if duration is not None and _time.monotonic() - t0 >= duration:
             break
         stop.wait(min(0.1, tick_s * 5))
-        if calls is not None:
-            calls.tick(rospy.get_time())  # an unanswered call is false once its deadline expired
         if worker.error is not None:
             break  # the engine thread died: stop and say so, never monitor on silently
         _no_delay(pub)
@@ -251,4 +284,4 @@ def _watch(rospy: Any, stop: threading.Event, duration: float | None, tick_s: fl
             next_status += status_s
 
 
-__all__ = ["run_ros1"]
+__all__ = ["clock_warnings", "run_ros1"]

@@ -16,14 +16,24 @@
   (``rospy.Time.now()``: wall time, or ``/clock`` under ``use_sim_time``),
   so an unanswered call is ``false`` as soon as its deadline expires.
 
+**Inside** ``rclverify monitor --live`` (:func:`proxy_factory`) the proxy
+serves, forwards and stamps the same way but judges nothing: each observed
+message goes to the live engine at its receipt on the run's clock, written
+to the run's log as a message line, and the run's own deadline checks
+(:mod:`.logchecks`, the record's ``topic_deadlines``, the ``kind:
+"deadline"`` lines and verdicts on the verdict topic) are the one judge of
+every call's and goal's deadline, the verdicts ``rclverify monitor LOG``
+gives on that log.  The proxy's lines there are its ``event`` lines only.
+
 **Simulated time.**  The proxy's stamps and clock are its ROS clock, which
 reads ``/clock`` exactly when the ROS 1 system's ``/use_sim_time`` parameter
 is true when it starts: a global parameter every rospy and roscpp node reads,
-so the servers' clock too.  Their deadlines are judged in that clock.  A node
-the mapping says keeps the other clock (``use_sim_time``,
+so the servers' clock too.  The command's deadlines are judged in that clock.
+A node a :class:`ProxyRun` is told keeps the other clock (``unjudged``,
+:func:`clock_unjudged` from the mapping's ``use_sim_time``,
 :func:`~rclverify.traces.mapping.sim_time_of`) cannot be judged in its own
-clock by the proxy: each of its deadline verdicts is ``undecided``, saying why
-(:func:`clock_unjudged`), never the proxy's clock silently.  Under
+clock by the proxy: each of its deadline verdicts is ``undecided``, saying why,
+never the proxy's clock silently.  Under
 ``/use_sim_time`` rospy's clock reads 0 (ROS's "not set") until its first
 ``/clock``: the proxy serves once it is set (waiting at most
 :data:`CLOCK_WAIT_S`), and a call whose request it stamps 0 all the same has
@@ -36,14 +46,14 @@ each observed message is a message line (``{"topic": "estop/request",
 engine inside ``rclverify monitor --live``), and every line of the proxy's
 own is on the topic :data:`PROXY_LOG_TOPIC`, which no contract names, with a
 ``time`` and a ``kind``: ``event`` (``index``, the message's topic as
-``call``, the proxy's ``stamp``, its ``fields``), ``verdict`` (a deadline
-verdict's fields) and ``summary``; their ``time`` is the live run's clock
-inside ``rclverify monitor --live``, else the proxy's (an event's stamp, a
-verdict's answer or else its deadline, the summary's last tick).  On
-SIGINT/SIGTERM or after ``--duration`` seconds the obligations still within
-their deadline are ``currently_false``, a ``summary`` line closes the log
-and the exit code is 1 when a verdict was ``false``, else 0 (2 for a usage
-error, with one line on standard error).
+``call``, the proxy's ``stamp``, its ``fields``), and from the command
+``verdict`` (a deadline verdict's fields) and ``summary``; their ``time`` is
+the live run's clock inside ``rclverify monitor --live``, else the proxy's
+(an event's stamp, a verdict's answer or else its deadline, the summary's
+last tick).  On SIGINT/SIGTERM or after ``--duration`` seconds the command's
+obligations still within their deadline are ``currently_false``, a
+``summary`` line closes the log and the exit code is 1 when a verdict was
+``false``, else 0 (2 for a usage error, with one line on standard error).
 Classes come from the workspace's ``.srv``/``.action`` files
 (:mod:`.ros1_interfaces`).
 """
@@ -86,25 +96,34 @@ UNSET_CLOCK = ("the request came before the service proxy's ROS clock was set (u
 class ProxyRun:
     """The monitors and the log of one live run (thread-safe).
 
-    ``log``: the JSON-lines file to write (this module's own command: each
+    ``monitors``: the deadline monitors it judges with; ``judge=False`` (inside
+    ``rclverify monitor --live``, whose own checks judge the deadlines) takes
+    none, and :meth:`close` then writes no ``summary`` line.  ``log``: the
+    JSON-lines file to write (this module's own command: each
     message a message line and each of the proxy's own lines, module
     docstring); or ``write(obj)``, a sink for each of the proxy's own lines
     (``rclverify monitor --live``: the live monitor's log, whose engine
     writes the message lines) and ``publish(text)`` for each
-    deadline verdict as JSON text (its verdict topic); ``forward(topic,
+    deadline verdict as JSON text; ``forward(topic,
     fields, stamp)`` receives every observed message too (``rclverify
     monitor --live``: the live engine, whose node monitors then check each
     call's response against the server's guarantees and the client's
-    assumption); ``clock()`` (s), when given, is the ``time`` of the
+    assumption, and whose deadline checks judge its deadline);
+    ``clock()`` (s), when given, is the ``time`` of the
     proxy's own lines (the live run's clock), else the time they are about
-    in the proxy's clock."""
+    in the proxy's clock.  Raises ``ValueError`` for monitors given with
+    ``judge=False``."""
 
     def __init__(self, monitors: list[DeadlineMonitor], log: Path | None = None, *,
                  write: Callable[[Mapping[str, object]], None] | None = None,
                  publish: Callable[[str], None] | None = None,
                  forward: Callable[[str, Mapping[str, object], float], None] | None = None,
-                 unjudged: Mapping[str, str] | None = None, clock: Callable[[], float] | None = None) -> None:
+                 unjudged: Mapping[str, str] | None = None, clock: Callable[[], float] | None = None,
+                 judge: bool = True) -> None:
+        if monitors and not judge:
+            raise ValueError("a proxy that does not judge takes no deadline monitors")
         self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
+        self.judge = judge
         self.now = 0.0  # the latest time (s, the proxy's clock) heard or ticked: the summary line's
         #: node -> why the proxy's clock is not the one it keeps: its verdicts are ``undecided`` (:func:`clock_unjudged`)
         self.unjudged: dict[str, str] = dict(unjudged or {})
@@ -170,10 +189,14 @@ class ProxyRun:
                 m.advance(now)
 
     def close(self) -> DeadlineSummary:
+        """The run's end: each obligation within its deadline ``currently_false`` (its verdict line
+        written); returns the summary (``results`` one per monitor, ``false`` the count of first ``false``
+        verdicts), written as the ``summary`` line, closing the log, where the proxy judges."""
         with self.lock:
             results = [self._result(m.finish()).to_json() for m in self.monitors]
             summary: DeadlineSummary = {"kind": "summary", "results": results, "false": self.false}
-            self._write(self.now, summary)
+            if self.judge:
+                self._write(self.now, summary)
             if self.fh is not None:
                 self.fh.close()
         return summary
@@ -243,14 +266,6 @@ def wait_clock(now: Callable[[], float], limit: float = CLOCK_WAIT_S) -> bool:
     return True
 
 
-def ros_sim_time(rospy: Any) -> bool:
-    """Whether the proxy's ROS clock reads ``/clock``: the ``/use_sim_time`` parameter (false when unset)."""
-    try:
-        return bool(rospy.get_param("/use_sim_time", False))
-    except Exception:  # noqa: BLE001 - a master that cannot say: rospy's own default, the wall clock
-        return False
-
-
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python3 -m rclverify.runtime.service_proxy",
                                 description="monitor ROS 1 services (through a proxy) and actions live")
@@ -317,28 +332,24 @@ def start_proxy(rospy: Any, checked: Any, forwards: Mapping[str, str], dirs: Seq
     return keep
 
 
-def proxy_factory(checked: Any, nodes: Sequence[Any], forward: Sequence[str],
-                  dirs: Sequence[Path]) -> Callable[[Any, Any, Callable[[str], None]], ProxyRun] | None:
+def proxy_factory(checked: Any, forward: Sequence[str],
+                  dirs: Sequence[Path]) -> Callable[[Any, Any], ProxyRun] | None:
     """The ``proxy`` argument of :func:`.live_ros1.run_ros1` for ``rclverify
     monitor --live --forward SVC=REAL --interfaces DIR``: ``None`` when
-    neither option is given; else a function that starts the proxy for the
-    selected ``nodes`` with a deadline, writing to the live run's log
-    (``LiveRun.note``) and publishing each deadline verdict on its verdict
-    topic; each observed message is handed to the live engine at its receipt
-    on the wall clock, the run's clock (:mod:`.live_ros1`, "The run's
-    clock"), the proxy's own monitors judging its ROS-clock stamps.  Raises
-    :class:`ProxyUsage` for a malformed ``--forward``."""
+    neither option is given; else a function ``start(rospy, live)`` that
+    starts the proxy, judging nothing (module docstring, "Inside"): it
+    writes its ``event`` lines to the live run's log (``LiveRun.note``) and
+    hands each observed message to the live engine at its receipt on the
+    wall clock, the run's clock (:mod:`.live_ros1`, "The run's clock"),
+    whose deadline checks judge it.  Raises :class:`ProxyUsage` for a
+    malformed ``--forward``."""
     if not forward and not dirs:
         return None
     forwards = parse_forwards(forward)
-    timed = {n.name for n in deadline_nodes(checked)}
 
-    def start(rospy: Any, live: Any, publish: Callable[[str], None]) -> ProxyRun:
-        rules = getattr(live.engine, "rules", {})  # the mapping's rules (and tolerance) of the live run
-        mons = [DeadlineMonitor(checked, n, rules, clock=False) for n in nodes if n.name in timed]
-        run = ProxyRun(mons, write=live.note, publish=publish,  # the engine: the run's clock; the proxy: its ROS clock
-                       forward=lambda topic, fields, _stamp: live.push(topic, fields, time.time()), clock=time.time,
-                       unjudged=clock_unjudged(rules, [m.node.name for m in mons], ros_sim_time(rospy)))
+    def start(rospy: Any, live: Any) -> ProxyRun:
+        run = ProxyRun([], write=live.note, judge=False, clock=time.time,  # the engine: the run's clock
+                       forward=lambda topic, fields, _stamp: live.push(topic, fields, time.time()))
         run.handles = start_proxy(rospy, checked, forwards, dirs, run,  # type: ignore[attr-defined]
                                   lambda: rospy.Time.now().to_sec())
         return run
