@@ -250,3 +250,28 @@ def test_a_log_read_in_blocks_gives_the_engines_verdicts(tmp_path: Any, monkeypa
             assert seen_f != seen_s
             monkeypatch.setattr(batch_window, "_floats", real_floats)
     assert passes and max(passes) > 100  # the windows read as columns, not one at a time
+
+
+def test_the_types_counted_are_the_types_gathered() -> None:
+    """The window's and a ``REAL`` column's types are counted (``list.count``, ``operator.countOf``) where
+    they were gathered into a set: the same rows held on every mix of types, empty lists included (the
+    control: a set of the types, as before, on the same values)."""
+    import numpy as np
+    from itertools import chain
+    from rclverify.backends.monitors.batch_window import _floats
+    from rclverify.targets.columns import column
+    odd: list[Any] = [1.0, -0.0, math.inf, 2, True, "2.5", None, np.float64(2.5), [1.0]]
+    rnd = random.Random("types")
+    for _ in range(300):
+        entries = [rnd.choice(odd[:2]) if rnd.random() < 0.8 else rnd.choice(odd) for _ in range(rnd.randint(0, 6))]
+        assert _floats(entries) == (set(map(type, entries)) == {float})
+        good, col = column(entries, "real", {})
+        want = [type(v) is float and math.isfinite(v) for v in entries]
+        assert good.tolist() == want and [c for c, w in zip(col.tolist(), want) if w] == \
+            [v for v, w in zip(entries, want) if w]
+        rows = [entries[i:i + 2] for i in range(0, len(entries) - 1, 2)] + ([1.0] if rnd.random() < 0.2 else [])
+        if rows:
+            held, _ = window_column(rows, 2)
+            assert held.tolist() == [type(r) is list and len(r) == 2 and set(map(type, r)) == {float} and
+                                     all(map(math.isfinite, r)) for r in rows]
+    assert not _floats([]) and _floats([1.0]) and not _floats(list(chain([1.0], [2])))

@@ -288,13 +288,13 @@ def column(vals: list[Any], kind: str, codes: Mapping[str, int]) -> tuple[np.nda
     for ``REAL``, a ``str`` of the enumeration for one."""
     n = len(vals)
     want = float if kind == "real" else str
-    types = set(map(type, vals))
-    if types == {want} or not types:
+    every = list(map(type, vals)).count(want) == n  # each value's type, counted (none: every one)
+    if every:
         good = np.ones(n, dtype=bool)
     else:
         good = np.fromiter(map(is_, map(type, vals), repeat(want)), bool, n)
     if kind == "real":
-        if types == {float}:
+        if every and n:
             col = np.fromiter(vals, np.float64, n)
         else:
             col = np.array([v if g else np.nan for v, g in zip(vals, good.tolist())], dtype=np.float64)

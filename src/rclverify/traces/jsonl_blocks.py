@@ -261,7 +261,7 @@ def _flat(path: Path, dec: _Decoder, data: bytes, end: int, lineno: int, index: 
     if len(structs) != n:
         return None
     found = list(map(_TIME, structs))
-    if set(map(type, found)) != {float}:  # an integer time: the exact reader's (its float() is the event's)
+    if list(map(type, found)).count(float) != n:  # an integer time: the exact reader's (its float() is the event's)
         return None
     times = np.fromiter(found, np.float64, n)  # (each a float: converted as np.array converts it)
     if not np.isfinite(times).all():

@@ -33,6 +33,7 @@ question waits for its answer exactly as the batch path assumes.
 from __future__ import annotations
 
 from itertools import chain
+from operator import countOf
 from typing import Any, Callable, Mapping
 
 from rclverify.core.numeric import np
@@ -47,9 +48,10 @@ _ORDERS = ("<", "<=", ">", ">=", "==", "!=")
 
 
 def _floats(entries: list[Any]) -> bool:
-    """Whether every entry is a ``float`` (its type read: an ``int``, a ``bool``, a string or a float
-    subclass is not one)."""
-    return set(map(type, entries)) == {float}
+    """Whether there are entries and every one is a ``float`` (its type read: an ``int``, a ``bool``, a
+    string or a float subclass is not one).  The types are counted (``list.count`` compares each with
+    ``float`` by identity first), not gathered into a set: about half the time."""
+    return bool(entries) and list(map(type, entries)).count(float) == len(entries)
 
 
 def window_column(vals: list[Any], width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -58,7 +60,7 @@ def window_column(vals: list[Any], width: int) -> tuple[np.ndarray, np.ndarray]:
     n = len(vals)
     if not n:
         return np.zeros(0, dtype=bool), np.full((0, width), np.nan)
-    if set(map(type, vals)) == {list} and set(map(len, vals)) == {width}:  # every row a list of width entries
+    if countOf(map(type, vals), list) == n and countOf(map(len, vals), width) == n:  # every row a list of width entries
         # the entries in one list, their types read in one pass and converted in one more, both at C speed
         # (a third of the time of one pass calling a converter per entry; np.fromiter on the list of floats
         # converts each as np.array does, without its search for the array's shape and type)
