@@ -141,10 +141,13 @@ def test_clock_lines_are_in_the_log_in_time_order(run: dict[str, Any]) -> None:
         assert clocks == [] and "clock" not in run["record"], (clocks[:3], run["record"].get("clock"))
         return
     assert len(clocks) >= 100, (len(clocks), run["out"])
-    values = [clock_value_ns(x) for x in clocks]
-    assert all(v is not None for v in values), clocks[:3]
+    assert all(clock_value_ns(x) is not None for x in clocks), clocks[:3]
+    # a message heard later than the lateness bound is written where it was heard, marked (``late_s``): the
+    # order is that of the others, as the contract topic's below
+    on_time = [x for x in clocks if "late_s" not in x]
+    values = [clock_value_ns(x) for x in on_time]
     assert all(a < b for a, b in zip(values, values[1:])), values  # type: ignore[operator]
-    times = [x["time"] for x in clocks]
+    times = [x["time"] for x in on_time]
     assert all(a <= b for a, b in zip(times, times[1:])), times
     # the contract topic's lines and the clock's, in the log's order, are in time order
     both = [x["time"] for x in log if x.get("topic") in ("x", "clock") and "late_s" not in x]
