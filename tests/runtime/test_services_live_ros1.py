@@ -19,13 +19,11 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
 from _procs import stop, wait_for
 
 from rclverify.runtime.ros1 import LocalMaster, RosUnavailable, import_rospy
@@ -42,23 +40,25 @@ except RosUnavailable as exc:
 pytestmark = pytest.mark.skipif(bool(REASON), reason=f"ROS 1 unavailable: {REASON}")
 
 
+#: a subscriber of the verdict topic: each message's JSON text a line, "ready" once connected to its publisher
+ECHO = """\
+import time
+from rclverify.runtime.ros1 import import_rospy
+rospy = import_rospy()
+from std_msgs.msg import String
+rospy.init_node("echo", anonymous=True)
+sub = rospy.Subscriber("/rclverify/verdict", String, lambda msg: print(msg.data, flush=True))
+end = time.monotonic() + 30
+while sub.get_num_connections() < 1 and time.monotonic() < end:
+    time.sleep(0.05)
+print("ready", flush=True)
+rospy.spin()
+"""
+
+
 def _start(args: list[str], env: dict[str, str], out: Path) -> subprocess.Popen[bytes]:
     return subprocess.Popen([sys.executable, *args], env=env, cwd=EXAMPLE, stdout=out.open("wb"),
                             stderr=subprocess.STDOUT, start_new_session=True)
-
-
-def _subscribed(master: str, topic: str, timeout: float) -> None:
-    """Wait until the ROS 1 master at ``master`` lists a subscriber of ``topic`` (``getSystemState``);
-    ``AssertionError`` after ``timeout`` seconds."""
-    import xmlrpc.client
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        state: Any = xmlrpc.client.ServerProxy(master).getSystemState("/test")  # [code, message, [pubs, subs, srvs]]
-        _code, _msg, (_pubs, subs, _srvs) = state
-        if any(name == topic and nodes for name, nodes in subs):
-            return
-        time.sleep(0.05)
-    raise AssertionError(f"nothing subscribed to {topic} within {timeout} s")
 
 
 @pytest.fixture(scope="module")
@@ -84,10 +84,9 @@ def live_log(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             procs.append(monitor)
             wait_for(tmp / "monitor.out", "monitoring ", 60)
             # the deadline verdicts on the live monitor's verdict topic, as a subscriber sees them
-            echo = subprocess.Popen(["rostopic", "echo", "/rclverify/verdict"], env=env, stdout=(tmp / "echo.out").open("wb"),
-                                    stderr=subprocess.STDOUT, start_new_session=True)
+            echo = _start(["-c", ECHO], env, tmp / "echo.out")
             procs.append(echo)
-            _subscribed(env["ROS_MASTER_URI"], "/rclverify/verdict", 30)  # before the first call, whatever the load
+            wait_for(tmp / "echo.out", "ready", 30)  # connected to the monitor's publisher before the first call
             teleop = _start([str(NODES), "teleop", "--call", "/estop", "--count", "2", "--every", "0.3"],
                             env, tmp / "teleop.out")
             mission = _start([str(NODES), "mission", "--target", "2.0"], env, tmp / "mission.out")
@@ -128,14 +127,9 @@ def _missed(live_log: dict[str, Any]) -> int:
 
 
 def _published(live_log: dict[str, Any]) -> list[dict[str, Any]]:
-    """The deadline verdicts a subscriber of the verdict topic received (``rostopic echo``'s documents, each
-    ``data`` a JSON text; one cut short by the stop is left out)."""
-    out = []
-    for doc in live_log["echo"].split("\n---\n")[:-1]:
-        data = json.loads(yaml.safe_load(doc)["data"])
-        if data.get("kind") == "deadline":
-            out.append(data)
-    return out
+    """The deadline verdicts a subscriber of the verdict topic received (:data:`ECHO`'s lines)."""
+    return [data for data in (json.loads(x) for x in live_log["echo"].splitlines() if x.startswith("{"))
+            if data.get("kind") == "deadline"]
 
 
 def _messages(live_log: dict[str, Any], topic: str) -> list[float]:
@@ -164,7 +158,7 @@ def test_the_late_service_answer_is_false_with_the_calls_stamps(live_log: dict[s
     # the proxy's own events stamp the same call on its ROS clock (here the wall clock) as it forwards it
     events = [x for x in live_log["lines"] if x["kind"] == "event" and x["call"].startswith("estop/")]
     assert [x["call"] for x in events] == ["estop/request", "estop/response"] * 2
-    assert abs(events[2]["stamp"] - late["trigger_stamp"]) < 0.05 and abs(events[3]["stamp"] - late["answer"]) < 0.05
+    assert 0 <= late["trigger_stamp"] - events[2]["stamp"] < 0.1 and 0 <= late["answer"] - events[3]["stamp"] < 0.1
     assert live_log["code"] == 1  # a false verdict: the monitor's exit code says so
 
 
