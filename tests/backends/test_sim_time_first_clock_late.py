@@ -27,7 +27,7 @@ from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.traces.events import Event
 
 from test_deadline_sim_time import CHECKED, NODE  # noqa: E402
-from test_sim_time_late_clock import (RELAY_RUN, T0, _clock, _final, _judge, _live, _msg, _offline_deadlines,  # noqa: E402
+from test_sim_time_late_clock import (RELAY_RUN, T0, _clock, _feed, _final, _judge, _live, _msg, _offline_deadlines,  # noqa: E402
                                       _result, _rules)
 
 
@@ -227,12 +227,6 @@ def _live_run(ws: Path, answer_s: float, first_heard_s: float, sim: str, factor:
     0.4 s (its value the time times the factor), the mapping's ``use_sim_time`` ``sim`` (``""``: not said), a
     reading at 0.1 s, the relay's answer at ``answer_s``; every /clock message stamped before ``first_heard_s``
     heard then (in order).  Returns the live record."""
-    from rclverify.backends.monitors.config import load_mapping
-    from rclverify.lang.typecheck import load
-    from rclverify.runtime.dds.bag import BagRecorder
-    from rclverify.runtime.live import LiveRun
-    from rclverify.traces.bag import typestore
-
     (ws / "contracts").mkdir()
     (ws / "contracts" / "c.rcl").write_text(RELAY_RUN)
     (ws / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
@@ -241,35 +235,7 @@ def _live_run(ws: Path, answer_s: float, first_heard_s: float, sim: str, factor:
     heard = [(max(t / 1000, first_heard_s), "clock", t / 1000, t * factor / 1000) for t in range(50, 401, 10)]
     heard += [(0.100, "s", 0.100, 1.0), (answer_s, "r", answer_s, 1.0)]
     heard.sort(key=lambda h: (h[0], h[2]))
-    checked = load([ws / "contracts" / "c.rcl"])
-    live = LiveRun(checked, [checked.nodes["Relay"]], load_mapping(ws, "mapping.yaml").rules, 0.5,
-                   ws / "live.jsonl", reorder_window=0.05)
-    store = typestore([])
-    f64, clock, time = (store.types[t] for t in ("std_msgs/msg/Float64", "rosgraph_msgs/msg/Clock",
-                                                  "builtin_interfaces/msg/Time"))
-    rec = BagRecorder(ws / "bag", "sqlite3", {"s": "std_msgs/msg/Float64", "r": "std_msgs/msg/Float64",
-                                              "clock": "rosgraph_msgs/msg/Clock"}, [])
-    live.engine.on_late = rec.late
-    now, period = T0, 0.01
-    for arrival, topic, source, value in heard:
-        while now + period <= T0 + arrival:
-            now += period
-            live.tick(now)
-        ns = round((T0 + source) * 1e9)
-        if topic == "clock":
-            sec, nsec = divmod(round((T0 + value) * 1e9), 1_000_000_000)
-            fields: dict[str, Any] = {"clock": {"sec": sec, "nanosec": nsec}}
-            raw = store.serialize_cdr(clock(clock=time(sec=sec, nanosec=nsec)), "rosgraph_msgs/msg/Clock")
-        else:
-            fields, raw = {"data": value}, store.serialize_cdr(f64(data=value), "std_msgs/msg/Float64")
-        rec.write(topic, ns, raw)
-        live.push(topic, fields, ns / 1e9)
-    for _ in range(100):
-        now += period
-        live.tick(now)
-    record: dict[str, Any] = live.stop(ws / "live.json")
-    rec.close()
-    return record
+    return _feed(ws, heard)
 
 
 @pytest.mark.parametrize("sim, factor, answer_s, want", [("true", 1.0, 0.150, "true"), ("true", 1.0, 0.235, "false"),

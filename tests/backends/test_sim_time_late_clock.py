@@ -249,12 +249,6 @@ def _live_run(ws: Path, answer_s: float, clock_heard_s: float) -> dict[str, Any]
     under use_sim_time), a reading at 0.1 s, the relay's answer at ``answer_s``, the /clock message of
     0.203 s (showing 0.205 s, past the reading's deadline) heard at ``clock_heard_s`` and the /clock
     messages after it no earlier.  Returns the live record."""
-    from rclverify.backends.monitors.config import load_mapping
-    from rclverify.lang.typecheck import load
-    from rclverify.runtime.dds.bag import BagRecorder
-    from rclverify.runtime.live import LiveRun
-    from rclverify.traces.bag import typestore
-
     (ws / "contracts").mkdir()
     (ws / "contracts" / "c.rcl").write_text(RELAY_RUN)
     (ws / "contracts" / "plan.yaml").write_text("contracts: [contracts/c.rcl]\n")
@@ -263,6 +257,20 @@ def _live_run(ws: Path, answer_s: float, clock_heard_s: float) -> dict[str, Any]
     heard += [(0.100, "s", 0.100, 1.0), (answer_s, "r", answer_s, 1.0), (clock_heard_s, "clock", 0.203, 0.205)]
     heard += [(max(t / 1000, clock_heard_s), "clock", t / 1000, t / 1000) for t in range(210, 401, 10)]
     heard.sort(key=lambda h: h[0])
+    return _feed(ws, heard)
+
+
+def _feed(ws: Path, heard: list[tuple[float, str, float, float]]) -> dict[str, Any]:
+    """The relay of ``ws`` (its contract and mapping written) run live in-process on ``heard``: each message
+    ``(heard at s, topic, stamped at s, value)`` pushed at its stamp (from :data:`T0`) once the run's clock,
+    ticked every 10 ms, reaches the time it was heard, and written to the ``--record`` bag at its stamp; a
+    ``clock`` message's value is ``/clock``'s (s).  Returns the live record (``ws/live.json``)."""
+    from rclverify.backends.monitors.config import load_mapping
+    from rclverify.lang.typecheck import load
+    from rclverify.runtime.dds.bag import BagRecorder
+    from rclverify.runtime.live import LiveRun
+    from rclverify.traces.bag import typestore
+
     checked = load([ws / "contracts" / "c.rcl"])
     live = LiveRun(checked, [checked.nodes["Relay"]], load_mapping(ws, "mapping.yaml").rules, 0.5,
                    ws / "live.jsonl", reorder_window=0.05)
