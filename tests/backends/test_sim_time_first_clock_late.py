@@ -1,4 +1,4 @@
-"""The first ``/clock`` message heard late (backends/monitors/deadline_clock.py, ``hold``, ``place_held``,
+"""The first ``/clock`` message heard late (backends/monitors/deadline_first_clock.py, ``hold``, ``place_held``,
 ``record``, ``unsaid_first``; docs/semantics.md, "Deadlines in simulated time").
 
 Live, the monitor's ``/clock`` reader may hear the first message after messages stamped after it (later than
@@ -22,7 +22,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.backends.monitors import deadline_clock
+from rclverify.backends.monitors import deadline_first_clock
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.traces.events import Event
 
@@ -114,11 +114,11 @@ def test_with_no_clock_a_held_trigger_is_undecided_after_the_kept_window_or_at_t
     assert res.counts == {"true": 0, "currently_false": 0, "false": 0} and res.unaccepted["undecided"] == 2
     assert len(seen) == 2 and not mon.unclocked and not mon.pending
     mon = DeadlineMonitor(CHECKED, NODE, _rules(True), None)
-    for t in range(deadline_clock.HELD + 10):
+    for t in range(deadline_first_clock.HELD + 10):
         mon.feed(_msg(t, "s", 1.0))
-    assert len(mon.unclocked) <= deadline_clock.HELD
-    assert mon.result.unaccepted["undecided"] == deadline_clock.HELD // 4
-    assert mon.finish().unaccepted["undecided"] == deadline_clock.HELD + 10
+    assert len(mon.unclocked) <= deadline_first_clock.HELD
+    assert mon.result.unaccepted["undecided"] == deadline_first_clock.HELD // 4
+    assert mon.finish().unaccepted["undecided"] == deadline_first_clock.HELD + 10
 
 
 def test_not_said_a_false_on_the_run_s_clock_is_given_again_in_both_clocks() -> None:
@@ -175,10 +175,10 @@ def test_not_said_control_the_first_clock_on_time_or_a_run_without_clock() -> No
     mon.advance(0.1 + mon.sim.kept_ns / 1e9 + 0.001)
     assert not mon.unsure and mon.result.floor[1][0] == -35_000_000
     mon = DeadlineMonitor(CHECKED, NODE, _rules(None), None)
-    for t in range(0, 2 * deadline_clock.HELD, 2):
+    for t in range(0, 2 * deadline_first_clock.HELD, 2):
         mon.feed(_msg(t, "s", 1.0))
         mon.feed(_msg(t + 1, "r", 1.0))
-    assert len(mon.unsure) <= deadline_clock.HELD and mon.finish().counts["true"] == deadline_clock.HELD
+    assert len(mon.unsure) <= deadline_first_clock.HELD and mon.finish().counts["true"] == deadline_first_clock.HELD
 
 
 def _random_run(rnd: random.Random) -> tuple[list[Event], dict[int, int]]:

@@ -55,7 +55,7 @@ counted in ``evicted``; a call with an obligation whose simulated deadline
 ``/clock`` has not passed is kept until it does or the run ends; an answered
 call of a node said to keep simulated time whose request came before any
 ``/clock`` sample, its obligation held for the first one
-(:func:`.deadline_clock.hold`), is kept as an unanswered one is, until
+(:func:`.deadline_first_clock.hold`), is kept as an unanswered one is, until
 :data:`LINGER_S` after its horizon and deadlines, so that a first sample
 taken later than the answer places it).
 :func:`replay` runs the same book over the ``call`` lines of a live log, its

@@ -132,7 +132,7 @@ def held(answered_late: Iterable[Answered], awaiting: Iterable[Pending], k: int,
     """The margins of guarantee ``k`` a revision may still withdraw: the late answers kept (``answered_late``)
     and the answers given while ``/clock`` may still move their verdict or margin (``awaiting``'s
     :attr:`~.deadline_records.Pending.held`, given before ``/clock`` passed their deadline; ``recorded``, given
-    before the first ``/clock``: :func:`.deadline_clock.record`), each in
+    before the first ``/clock``: :func:`.deadline_first_clock.record`), each in
     :attr:`~.deadline_records.DeadlineResult.floor`'s shape."""
     got = [(e[1], e[2], e[0].trigger.where, e[3], e[4]) for e in answered_late if e[0].k == k]
     return got + [p.held for p in awaiting if p.k == k and p.held is not None] + [r[1] for r in recorded if r[0] == k]

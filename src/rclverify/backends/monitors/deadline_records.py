@@ -109,10 +109,10 @@ class Pending:
     #: ``/clock`` is heard after the answer or the answer leaves the window kept for a late ``/clock``
     held: tuple[int, int, str, str, float] | None = None
     #: held while no ``/clock`` had been heard, its node said to keep simulated time: no verdict is given until
-    #: the first ``/clock`` message places it, or none came within the kept window (:func:`.deadline_clock.hold`)
+    #: the first ``/clock`` message places it, or none came within the kept window (:func:`.deadline_first_clock.hold`)
     unclocked: bool = False
     #: held so (or, its node's clock not said, answered late on the run's clock before any ``/clock``: given
-    #: again by the first one, :func:`.deadline_clock.unsaid_first`), the answer that came meanwhile: (the
+    #: again by the first one, :func:`.deadline_first_clock.unsaid_first`), the answer that came meanwhile: (the
     #: answer, its stamp in integer ns, the arithmetic it held in)
     first_answer: tuple[Event, int, str] | None = None
     #: what a verdict's reason adds on how it was placed (the first ``/clock`` heard late: ``""`` otherwise)
@@ -125,7 +125,7 @@ class Pending:
         return (self.wall_due_ns if self.clock else self.due_ns) - self.stamp_ns
 
 
-#: an answer recorded for the first ``/clock`` message (:func:`.deadline_clock.record`), in plain values: the
+#: an answer recorded for the first ``/clock`` message (:func:`.deadline_first_clock.record`), in plain values: the
 #: guarantee, its margin noted withdrawable (:attr:`DeadlineResult.floor`'s shape), the trigger's stamp (ns),
 #: stamp and due time (s), due time (ns), the trigger's index, time, topic and place, the answer's index,
 #: time, topic and place, its stamp (ns), the arithmetic it held in, the verdict given (``true``, ``false``)

@@ -67,7 +67,8 @@ from rclverify.backends.monitors.verdicts import names
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending, Recorded
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import VerdictWords, ms_ns, rejected
-from rclverify.backends.monitors import deadline_clock, deadline_late, deadline_skew
+from rclverify.backends.monitors import deadline_clock, deadline_first_clock, deadline_late, deadline_place
+from rclverify.backends.monitors import deadline_skew
 from rclverify.backends.monitors.late import value_at
 
 
@@ -92,11 +93,12 @@ class DeadlineMonitor(VerdictWords):
         #: obligations placed in simulated time whose deadline ``/clock`` has not passed yet
         self.awaiting: list[Pending] = []
         #: obligations held until the first ``/clock`` message places them, in the order they came (their node
-        #: said to keep simulated time; at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.hold`)
+        #: said to keep simulated time; at most :data:`.deadline_first_clock.HELD`: :func:`.deadline_first_clock.hold`)
         self.unclocked: deque[Pending] = deque()
         #: the answers to obligations of a node whose clock is not said, placed on the run's clock while no
         #: ``/clock`` has been heard, in the order given: given again if the first ``/clock`` message, heard
-        #: late, is stamped before their trigger (at most :data:`.deadline_clock.HELD`: :func:`.deadline_clock.record`)
+        #: late, is stamped before their trigger (at most :data:`.deadline_first_clock.HELD`:
+        #: :func:`.deadline_first_clock.record`)
         self.unsure: deque[Recorded] = deque()
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         self.assumption = tuple(c.formula for c in node.node.assumes)
@@ -172,11 +174,11 @@ class DeadlineMonitor(VerdictWords):
 
     def _in_clock(self, p: Pending, v: DeadlineVerdict, ns: int | None) -> DeadlineVerdict:
         """Verdict ``v`` on obligation ``p``, with what its clock adds when it is placed in one
-        (:func:`.deadline_clock.words`; the time margin of an answer at ``ns`` in that clock)."""
+        (:func:`.deadline_place.words`; the time margin of an answer at ``ns`` in that clock)."""
         if not p.clock:
             return v
-        margin = v.time_margin if ns is None else deadline_clock.margin_ns(self, p, ns) / 1e9
-        return dataclasses.replace(v, reason=v.reason + deadline_clock.words(self, p), time_margin=margin)
+        margin = v.time_margin if ns is None else deadline_place.margin_ns(self, p, ns) / 1e9
+        return dataclasses.replace(v, reason=v.reason + deadline_place.words(self, p), time_margin=margin)
 
     def _emit(self, v: DeadlineVerdict, counted: bool = False) -> None:
         """Verdict ``v`` given: counted (an update only when ``counted``: a verdict that replaces one the
@@ -286,11 +288,11 @@ class DeadlineMonitor(VerdictWords):
         d_ns = self.bounds_ns[k]
         p = Pending(k, ev, ns / 1e9, (ns + d_ns) / 1e9, inputs, stamp_ns=ns, due_ns=ns + d_ns)
         if self.sim_mode and not self.sim.heard:  # kept in simulated time: placed by the first /clock message
-            deadline_clock.hold(self, p)
+            deadline_first_clock.hold(self, p)
         elif deadline_clock.reads_clock(self):  # kept in simulated time, or in a clock not said
-            why = deadline_clock.place(self, p)
+            why = deadline_place.place(self, p)
             if why:
-                deadline_clock.undecided(self, p, why)
+                deadline_place.undecided(self, p, why)
                 return
         if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
             deadline_skew.scan_heard(self, p)
@@ -399,20 +401,20 @@ class DeadlineMonitor(VerdictWords):
         margin = self._margin(p, ns)
         # placed in a clock, before /clock passed its deadline or was heard after the answer: a /clock message
         # heard later may change its verdict or its margin (deadline_clock.tick)
-        held = bool(p.clock) and (p.due_ns >= deadline_clock.FAR or not self.sim.heard_after(ns))
+        held = bool(p.clock) and (p.due_ns >= deadline_place.FAR or not self.sim.heard_after(ns))
         # the node's clock not said, no /clock heard yet: given again if the first one, heard late, comes before
         recorded = not held and self.sim_mode is None and not self.sim.heard
         order = self.result.note_time_margin(p.k, margin, p.trigger.where, ev.where, stamp, held=held or recorded)
         if held:
-            deadline_clock.answered(self, p, "true", ev, ns, semantics, (margin, order, p.trigger.where, ev.where, stamp))
+            deadline_place.answered(self, p, "true", ev, ns, semantics, (margin, order, p.trigger.where, ev.where, stamp))
         elif recorded:
-            deadline_clock.record(self, p, ev, ns, semantics, "true" if ns <= p.due_ns else "false",
+            deadline_first_clock.record(self, p, ev, ns, semantics, "true" if ns <= p.due_ns else "false",
                                   (margin, order, p.trigger.where, ev.where, stamp))
 
     def _margin(self, p: Pending, ns: int) -> int:
         """The time margin (integer ns) of an answer stamped ``ns`` to obligation ``p``: its deadline less the
-        answer in the clock it is kept in (:func:`.deadline_clock.margin_ns`), or on the run's clock."""
-        return deadline_clock.margin_ns(self, p, ns) if p.clock else p.due_ns - ns
+        answer in the clock it is kept in (:func:`.deadline_place.margin_ns`), or on the run's clock."""
+        return deadline_place.margin_ns(self, p, ns) if p.clock else p.due_ns - ns
 
     def _heard_late(self, p: Pending) -> bool:
         """A trigger heard after outputs stamped after it (docs/semantics.md, "Answers"):
@@ -462,9 +464,9 @@ class DeadlineMonitor(VerdictWords):
         self.now_ns = now_ns
         self.now = now_ns / 1e9
         if self.unclocked and self.unclocked[0].stamp_ns < now_ns - self.sim.kept_ns:
-            deadline_clock.release_held(self, now_ns - self.sim.kept_ns)  # no /clock in the kept window after it
+            deadline_first_clock.release_held(self, now_ns - self.sim.kept_ns)  # no /clock in the kept window after it
         if self.unsure and self.unsure[0][2] < now_ns - self.sim.kept_ns:
-            deadline_clock.drop_records(self, now_ns - self.sim.kept_ns)  # no longer given again by a /clock
+            deadline_first_clock.drop_records(self, now_ns - self.sim.kept_ns)  # no longer given again by a /clock
         self._expire(now_ns)
 
     def _expire(self, now_ns: int) -> None:
@@ -488,15 +490,15 @@ class DeadlineMonitor(VerdictWords):
                                 "not answered yet; " + (
                                     "no /clock message heard yet to place it in simulated time" if p.unclocked else
                                     "/clock has not passed its deadline in simulated time yet"
-                                    if p.due_ns >= deadline_clock.FAR else
-                                    f"{ms_ns(p.due_ns - (self.now_ns or 0))} left") + deadline_clock.words(self, p))
+                                    if p.due_ns >= deadline_place.FAR else
+                                    f"{ms_ns(p.due_ns - (self.now_ns or 0))} left") + deadline_place.words(self, p))
                 for p in self.pending]
 
     def finish(self) -> DeadlineResult:
         """End of the run: obligations still within their deadline are ``currently_false``;
         those and the expired ones never answered are counted unanswered in the time margins."""
-        deadline_clock.release_held(self)  # held with no /clock heard: undecided, as on a run without it
-        if self.now_ns is not None:  # a due time set behind the clock (deadline_clock.py) expires before the end
+        deadline_first_clock.release_held(self)  # held with no /clock heard: undecided, as on a run without it
+        if self.now_ns is not None:  # a due time set behind the clock (deadline_place.py) expires before the end
             self._expire(self.now_ns)
         for v in self.pending_verdicts():
             self._emit(v)
