@@ -315,7 +315,7 @@ def test_seed_955_a_late_first_trigger_is_judged_live_as_on_the_bag() -> None:
     in process, as the live run judged it: live.jsonl held the same two) the reading's deadline was
     ``true`` (the deadline monitor read the inputs as heard, not at the trigger's stamp) and Sensor3's
     message kept the ``incomplete input`` given when it was heard: live != log on two verdicts.  The
-    deadline monitor now reads a late trigger's inputs at its stamp (``DeadlineMonitor._inputs_at``,
+    deadline monitor now reads a late trigger's inputs at its stamp (``deadline_questions.inputs_at``,
     with the engine's ``late.value_at``), and a message counted ``incomplete input`` that a late
     message completes has that verdict withdrawn (``Late._incomplete_withdrawn``): live = bag on
     every verdict of the three nodes.  The in-process rule and its control:

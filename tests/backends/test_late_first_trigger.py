@@ -23,7 +23,7 @@ from typing import Any
 
 import pytest
 
-from rclverify.backends.monitors import recorded
+from rclverify.backends.monitors import deadline_questions, recorded
 from rclverify.backends.monitors.config import load_mapping
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.backends.monitors.late import Late
@@ -159,8 +159,8 @@ def test_the_seeded_defect_inputs_read_as_heard_make_live_differ(tmp_path: Path,
     next trigger's answer), c's message ``incomplete input``: the comparison finds both."""
     ws, run = _workspace(tmp_path)
     offline = _offline(ws, run)
-    monkeypatch.setattr(DeadlineMonitor, "_inputs_at", lambda self, stamp, ns, mine: {
-        k: v for k, v in self.values.items() if k.startswith("in.")})
+    monkeypatch.setattr(deadline_questions, "inputs_at", lambda mon, stamp, ns, mine: {
+        k: v for k, v in mon.values.items() if k.startswith("in.")})
     monkeypatch.setattr(Late, "_incomplete_withdrawn", lambda self, e, by: None)
     live, _ = _live(ws, LATE)
     found = {(d.item, d.topic, round(d.time, 6)) for d in compare(finals(live), finals(offline))}

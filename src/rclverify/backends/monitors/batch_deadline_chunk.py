@@ -10,7 +10,7 @@ from rclverify.core.numeric import np
 from rclverify.traces.events import Event
 from rclverify.targets.column_deadlines import expiries, first_answers, ns_column
 from rclverify.targets.columns import block_column, column, field_values
-from rclverify.backends.monitors import deadline_skew
+from rclverify.backends.monitors import deadline_questions, deadline_skew
 from rclverify.backends.monitors.deadline_records import Pending
 from rclverify.backends.monitors.time_margins import TimeMargin
 
@@ -99,7 +99,7 @@ def _judge_chunk(mon: ChunkSide, evs: list[Event] | Any) -> bool:
     refused = in_rows[~accepted]
     first_refused = None
     if refused.size and mon.result.first_unaccepted is None:
-        first_refused = mon._refused({ik: mon.mapped(evs[int(refused[0])], ik)})
+        first_refused = deadline_questions.refused(mon, {ik: mon.mapped(evs[int(refused[0])], ik)})
         if first_refused is None or first_refused[0] != "assumption violated":
             return False
     # the obligations: the expired ones kept (oldest expiry first), the open ones, then each accepted trigger's

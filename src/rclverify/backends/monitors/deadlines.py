@@ -19,15 +19,8 @@ ROSMonitoring's terms:
 * ``currently_false``: not answered yet and the deadline not yet expired (a
   run that ends then, or a live query before the deadline).
 
-**Only accepted inputs are obligations**: the node's assumption
-is judged on the trigger's inputs; a trigger whose inputs violate it (or
-whose inputs are not all observed yet at its stamp, however late it was
-heard, or whose assumption cannot be decided) gets no deadline verdict and is counted apart
-(:attr:`.deadline_records.DeadlineResult.unaccepted`): a node is not obliged to answer an
-input its contract does not accept, so a ``true`` there would be evidence
-of nothing and a ``false`` a false alarm.  Formulas are judged as the
-untimed monitor judges them (:func:`rclverify.semantics.floatsem.judge`: exact,
-the node's double arithmetic, a declared tolerance).
+**Only accepted inputs are obligations**: a trigger whose inputs the node's
+assumption does not accept gets no deadline verdict (:mod:`.deadline_questions`).
 
 A ``triggered by`` without ``within`` is checked the same way with the
 monitor's ``horizon`` as its bound (offline, and live on the monitored
@@ -55,21 +48,19 @@ from typing import Callable, Iterable, Mapping
 
 from rclverify.semantics.floatsem import Judgement, Tolerance, judge
 from rclverify.lang import ast
-from rclverify.lang.printer import expr_to_rcl
 from rclverify.lang.timing import seconds
 from rclverify.lang.types import Checked, CheckedNode
 from rclverify.lang.walk import subexpressions
 from rclverify.traces.events import Event, to_ns
 from rclverify.traces.mapping import MappingError, TopicRule, map_value, rule_for, sim_time_of
 from rclverify.traces.sim_clock import CLOCK_TOPIC, SimClock
-from rclverify.traces.questions import Question, QuestionStream
+from rclverify.traces.questions import QuestionStream
 from rclverify.backends.monitors.verdicts import names
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict, Pending, Recorded
 from rclverify.backends.monitors.deadline_topics import event_stamp_ns, topic_bindings
 from rclverify.backends.monitors.deadline_text import VerdictWords, ms_ns, rejected
 from rclverify.backends.monitors import deadline_clock, deadline_first_clock, deadline_late, deadline_place
-from rclverify.backends.monitors import deadline_skew
-from rclverify.backends.monitors.late import value_at
+from rclverify.backends.monitors import deadline_questions, deadline_skew
 
 
 class DeadlineMonitor(VerdictWords):
@@ -95,10 +86,9 @@ class DeadlineMonitor(VerdictWords):
         #: obligations held until the first ``/clock`` message places them, in the order they came (their node
         #: said to keep simulated time; at most :data:`.deadline_first_clock.HELD`: :func:`.deadline_first_clock.hold`)
         self.unclocked: deque[Pending] = deque()
-        #: the answers to obligations of a node whose clock is not said, placed on the run's clock while no
-        #: ``/clock`` has been heard, in the order given: given again if the first ``/clock`` message, heard
-        #: late, is stamped before their trigger (at most :data:`.deadline_first_clock.HELD`:
-        #: :func:`.deadline_first_clock.record`)
+        #: the answers to obligations of a node whose clock is not said, placed on the run's clock while no ``/clock``
+        #: has been heard, in the order given: given again if the first ``/clock`` message, heard late, is stamped
+        #: before their trigger (at most :data:`.deadline_first_clock.HELD`: :func:`.deadline_first_clock.record`)
         self.unsure: deque[Recorded] = deque()
         self.tolerance = tolerance if tolerance is not None else getattr(rules, "tolerance", None)
         self.assumption = tuple(c.formula for c in node.node.assumes)
@@ -135,11 +125,11 @@ class DeadlineMonitor(VerdictWords):
         #: the node's questions: an answer is judged on the latest at its stamp (a superseded trigger is carried)
         self.stream = QuestionStream()
         self.values: dict[str, object] = {}
-        #: before the first question: each input's values as its messages set them, (stamp ns, value), the
-        #: last 64: a trigger heard late finds the inputs in force at its stamp there (:meth:`_inputs_at`)
+        #: before the first question: each input's values as its messages set them, (stamp ns, value), the last
+        #: 64: a trigger heard late finds the inputs in force at its stamp there (:func:`.deadline_questions.inputs_at`)
         self.before_first: dict[str, deque[tuple[int, object]]] = {}
-        #: input -> the stamp (integer ns) of the message whose value is in force: one heard late and stamped
-        #: before it leaves that value in force (its own is read at its stamp, :meth:`_inputs_at`)
+        #: input -> the stamp (integer ns) of the message whose value is in force: one heard late and stamped before
+        #: it leaves that value in force (its own is read at its stamp, :func:`.deadline_questions.inputs_at`)
         self.set_ns: dict[str, int] = {}
         #: keys whose latest message did not map (NaN, a missing field): key -> why; their stale value never
         #: stands in (docs/semantics.md, "Values")
@@ -214,7 +204,6 @@ class DeadlineMonitor(VerdictWords):
             if again:  # answers judged before it passed their deadline, after what it expires (stamp order)
                 deadline_clock.judge_again(self, again, ev, ns)
             return
-        stamp = ns / 1e9
         late = self.now_ns is not None and ns < self.now_ns  # stamped before a message heard already
         keys = self.bindings.get(topic)
         if not keys or not self.timed:
@@ -254,32 +243,8 @@ class DeadlineMonitor(VerdictWords):
                     p.outs.update(fresh)
             self._answer(ev, ns, outs)
         self._advance_ns(ns)
-        if not any(c.startswith("in.") for c in changed):
-            return
-        mine = {c: own.get(c, self.values[c]) for c in changed if c.startswith("in.") and c not in self.invalid}
-        if self.stream.at(stamp) is None:
-            for key, v in mine.items():
-                self.before_first.setdefault(key, deque(maxlen=64)).append((ns, v))
-        inputs = (self._inputs_at(stamp, ns, mine) if late and not self.stream.forgot else
-                  {key: v for key, v in self.values.items() if key.startswith("in.")})
-        missing = [k for k in self.needed if k not in inputs]
-        unread = [why for k, why in self.invalid.items() if k in self.needed]
-        refused = (("incomplete input", "no value yet for " + ", ".join(missing)) if missing else
-                   ("undecided", unread[0]) if unread else self._refused(inputs))
-        if not missing:
-            self.stream.ask(Question(ev, stamp, inputs, owed=refused is None))
-        triggered = [t for t in self.timed if t[2] in changed]
-        if not triggered:
-            return
-        for k, cl, trig, _, d in triggered:
-            if refused is None:
-                self._oblige(k, ev, ns, inputs)
-                continue
-            why, reason = refused
-            self.result.unaccepted[why] += 1
-            if self.result.first_unaccepted is None:
-                self.result.first_unaccepted = {"guarantee": k, "where": ev.where, "stamp": stamp, "why": why,
-                                                "reason": reason}
+        if any(c.startswith("in.") for c in changed):
+            deadline_questions.ask(self, ev, ns, changed, own, late)
 
     def _oblige(self, k: int, ev: Event, ns: int, inputs: dict[str, object]) -> None:
         """Accepted trigger ``ev`` (stamp ``ns``, integer ns; judged on ``inputs``) opens the obligation of
@@ -297,33 +262,6 @@ class DeadlineMonitor(VerdictWords):
         if not (self.now_ns is not None and ns < self.now_ns and self._heard_late(p)):
             deadline_skew.scan_heard(self, p)
             self.pending.append(p)
-
-    def _inputs_at(self, stamp: float, ns: int, mine: Mapping[str, object]) -> dict[str, object]:
-        """The inputs in force at ``stamp`` (s; ``ns`` the same in integer ns) of an input message heard
-        after one stamped later, which set ``mine``: those of the latest question at or before its stamp,
-        or before the first question those its messages stamped at or before it set, with its own
-        values (docs/semantics.md, "Deadlines": a trigger before every input has a value at its stamp
-        raises no question and gets no deadline verdict, however late it was heard; the verdict
-        engine reads it so, :meth:`.late.Late._late_input`)."""
-        q = self.stream.at(stamp)
-        got = dict(q.inputs) if q is not None else {
-            k: v for k, h in self.before_first.items() if (v := value_at(h, ns)) is not None}
-        got.update(mine)
-        return got
-
-    def _refused(self, inputs: Mapping[str, object]) -> tuple[str, str] | None:
-        """Why the node's assumption does not accept ``inputs`` (``(kind,
-        reason)``, kind one of :data:`~.deadline_records.UNACCEPTED`), ``None`` when it does."""
-        for formula in self.assumption:
-            j = judge(formula, self.checked, self.node, inputs, self.tolerance)
-            if j.truth is True:
-                continue
-            if j.truth is False:
-                return "assumption violated", f"assumption {expr_to_rcl(formula)} is false of the trigger's inputs"
-            if j.reason.startswith("no value for"):
-                return "incomplete input", j.reason
-            return "undecided", f"assumption {expr_to_rcl(formula)} undecided: {j.reason}"
-        return None
 
     def _answer(self, ev: Event, ns: int, outs: set[str]) -> None:
         stamp = ns / 1e9
