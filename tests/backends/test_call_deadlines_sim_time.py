@@ -419,30 +419,3 @@ def test_a_bag_ros2_bag_record_made_reads_its_clock_among_the_calls(tmp_path: Pa
                 pass
             assert log_calls.finish() is not None
             assert [v["verdict"] for v in lines if not v["update"]] == [want], (rate, sim, lines)
-
-
-def test_the_ros1_proxy_says_undecided_for_a_node_whose_clock_is_not_its_own(tmp_path: Path) -> None:
-    """The ROS 1 service proxy judges in its ROS clock (/clock exactly when /use_sim_time is true): a node the
-    mapping says keeps the other clock gets ``undecided`` with why, never the proxy's clock's verdict; the
-    control, the clocks agreeing, gives that verdict."""
-    from rclverify.backends.monitors.deadlines import DeadlineMonitor
-    from rclverify.runtime.service_proxy import ProxyRun, clock_unjudged
-    base = CHECKED.nodes["Base"]
-    for said, ros_sim in ((True, False), (False, True), (True, True), (None, False)):
-        rules = _rules(said)
-        unjudged = clock_unjudged(rules, ["Base"], ros_sim)
-        run = ProxyRun([DeadlineMonitor(CHECKED, base, rules, clock=False)], tmp_path / "p.jsonl",
-                       unjudged=unjudged)
-        run.event("estop/request", {"data": True}, 10.0)
-        run.event("estop/response", {"success": True, "message": ""}, 10.3)  # 300 ms: late in the proxy's clock
-        run.tick(11.0)
-        summary = run.close()
-        (res,) = summary["results"]
-        verdicts = [json.loads(x) for x in (tmp_path / "p.jsonl").read_text().splitlines()
-                    if '"kind": "verdict"' in x]
-        if said is not None and said != ros_sim:
-            assert (res["counts"]["false"], res["unaccepted"]["undecided"], summary["false"]) == (0, 1, 0)
-            assert res["first_unaccepted"] is not None and "use_sim_time" in res["first_unaccepted"]["reason"]
-            assert {v["verdict"] for v in verdicts} == {"undecided"} and "/use_sim_time" in verdicts[0]["reason"]
-        else:  # control: the proxy's clock is the node's
-            assert (res["counts"]["false"], res["unaccepted"]["undecided"], summary["false"]) == (1, 0, 1)

@@ -29,11 +29,9 @@ gives on that log.  The proxy's lines there are its ``event`` lines only.
 reads ``/clock`` exactly when the ROS 1 system's ``/use_sim_time`` parameter
 is true when it starts: a global parameter every rospy and roscpp node reads,
 so the servers' clock too.  The command's deadlines are judged in that clock.
-A node a :class:`ProxyRun` is told keeps the other clock (``unjudged``,
-:func:`clock_unjudged` from the mapping's ``use_sim_time``,
-:func:`~rclverify.traces.mapping.sim_time_of`) cannot be judged in its own
-clock by the proxy: each of its deadline verdicts is ``undecided``, saying why,
-never the proxy's clock silently.  Under
+The command reads no mapping, so it judges every node in that clock; inside
+``rclverify monitor --live`` the run's checks judge each node in the clock its
+mapping says (:mod:`.live_ros1`).  Under
 ``/use_sim_time`` rospy's clock reads 0 (ROS's "not set") until its first
 ``/clock``: the proxy serves once it is set (waiting at most
 :data:`CLOCK_WAIT_S`), and a call whose request it stamps 0 all the same has
@@ -73,7 +71,6 @@ from rclverify.lang.errors import RclError
 from rclverify.lang.typecheck import load
 from rclverify.traces.events import Event
 from rclverify.backends.monitors.deadline_records import DeadlineResult, DeadlineVerdict
-from rclverify.traces.mapping import TopicRule, sim_time_of
 from rclverify.backends.monitors.deadlines import DeadlineMonitor
 from rclverify.runtime.ros1 import RosUnavailable, flatten, import_rospy
 from rclverify.runtime.ros1_interfaces import action_classes, service_class
@@ -118,16 +115,14 @@ class ProxyRun:
                  write: Callable[[Mapping[str, object]], None] | None = None,
                  publish: Callable[[str], None] | None = None,
                  forward: Callable[[str, Mapping[str, object], float], None] | None = None,
-                 unjudged: Mapping[str, str] | None = None, clock: Callable[[], float] | None = None,
+                 clock: Callable[[], float] | None = None,
                  judge: bool = True) -> None:
         if monitors and not judge:
             raise ValueError("a proxy that does not judge takes no deadline monitors")
         self.monitors, self.lock, self.index, self.false = monitors, threading.Lock(), 0, 0
         self.judge = judge
         self.now = 0.0  # the latest time (s, the proxy's clock) heard or ticked: the summary line's
-        #: node -> why the proxy's clock is not the one it keeps: its verdicts are ``undecided`` (:func:`clock_unjudged`)
-        self.unjudged: dict[str, str] = dict(unjudged or {})
-        self._first: dict[str, DeadlineVerdict] = {}  # an unjudged node's first verdict, given as undecided
+        self._first: dict[str, DeadlineVerdict] = {}  # a node's first verdict on a request stamped 0, as given
         self._unset: dict[str, list[DeadlineVerdict]] = {}  # a node's verdicts on requests stamped 0, as judged
         self._first_false: dict[str, DeadlineVerdict] = {}  # a node's first false on a request stamped in time
         for m in monitors:
@@ -146,14 +141,14 @@ class ProxyRun:
             self.fh.flush()
 
     def _verdict(self, v: DeadlineVerdict) -> None:
-        why = self.unjudged.get(v.node)
-        if why is None and v.trigger_stamp == 0:  # a request stamped before the clock was set: counted undecided
+        why = None
+        if v.trigger_stamp == 0:  # a request stamped before the clock was set: counted undecided
             why = UNSET_CLOCK
             if not v.update:
                 self._unset.setdefault(v.node, []).append(v)
         if why is None and v.verdict == "false" and not v.update:
             self._first_false.setdefault(v.node, v)
-        if why is not None:  # judged in a clock the node does not keep, or in none: undecided, never true or false
+        if why is not None:  # judged in no clock: undecided, never true or false
             v = dataclasses.replace(v, verdict="undecided", reason=why, time_margin=None)
             if not v.update:
                 self._first.setdefault(v.node, v)
@@ -203,57 +198,25 @@ class ProxyRun:
 
 
     def _result(self, res: DeadlineResult) -> DeadlineResult:
-        """``res`` as the summary gives it: a node judged in a clock it does not keep has every obligation
-        counted ``undecided`` with the triggers not accepted, none ``true`` or ``false``; a call whose
-        request was stamped before the clock was set is counted so too (its margin and its ``false`` not
-        the first's)."""
-        why = self.unjudged.get(res.node)
+        """``res`` as the summary gives it: a call whose request was stamped before the clock was set is
+        counted ``undecided`` with the triggers not accepted (its margin and its ``false`` not the first's)."""
         unset = self._unset.get(res.node, [])
-        if why is None and not unset:
+        if not unset:
             return res
-        if why is None:
-            wheres = {v.trigger_where for v in unset}
-            counts = dict(res.counts)
-            for v in unset:
-                counts[v.verdict] = max(counts.get(v.verdict, 0) - 1, 0)
-            unaccepted = {**res.unaccepted, "undecided": res.unaccepted.get("undecided", 0) + len(unset)}
-            first = self._first.get(res.node)
-            return dataclasses.replace(
-                res, counts=counts, unaccepted=unaccepted,
-                first_false=self._first_false.get(res.node) if res.first_false is not None
-                and res.first_false.trigger_where in wheres else res.first_false,
-                time_margins={k: m for k, m in res.time_margins.items() if m.trigger_where not in wheres},
-                first_unaccepted=res.first_unaccepted if first is None else
-                {"guarantee": first.guarantee, "where": first.trigger_where, "stamp": first.trigger_stamp,
-                 "why": "undecided", "reason": UNSET_CLOCK})
-        out = DeadlineResult(res.node)
-        out.unaccepted.update(res.unaccepted)
-        n = sum(res.counts.values())
-        out.unaccepted["undecided"] = out.unaccepted.get("undecided", 0) + n
-        out.first_unaccepted = res.first_unaccepted
+        wheres = {v.trigger_where for v in unset}
+        counts = dict(res.counts)
+        for v in unset:
+            counts[v.verdict] = max(counts.get(v.verdict, 0) - 1, 0)
+        unaccepted = {**res.unaccepted, "undecided": res.unaccepted.get("undecided", 0) + len(unset)}
         first = self._first.get(res.node)
-        if first is not None and (out.first_unaccepted is None or first.trigger_stamp < out.first_unaccepted["stamp"]):
-            out.first_unaccepted = {"guarantee": first.guarantee, "where": first.trigger_where,
-                                    "stamp": first.trigger_stamp, "why": "undecided", "reason": why}
-        return out
-
-
-def clock_unjudged(rules: Mapping[str, TopicRule], nodes: Sequence[str], ros_sim: bool) -> dict[str, str]:
-    """The nodes (names) whose call deadlines the proxy cannot judge in the clock they keep, each with why:
-    the proxy's ROS clock is ``/clock`` when ``ros_sim`` (``/use_sim_time`` true) and the wall clock else;
-    a node the mapping says keeps the other clock is one (a node not said keeps the proxy's: ROS 1's
-    ``/use_sim_time`` is global)."""
-    out = {}
-    for name in nodes:
-        said = sim_time_of(rules, name)
-        if said is None or said == ros_sim:
-            continue
-        mine, theirs = ("simulated time (/clock)", "the wall clock") if said else \
-            ("the wall clock", "simulated time (/clock)")
-        out[name] = (f"node {name} keeps {mine} (the mapping's use_sim_time) but the service proxy's ROS clock "
-                     f"is {theirs} (/use_sim_time is {'true' if ros_sim else 'false'}): its call deadlines cannot "
-                     f"be judged in its clock; set /use_sim_time or the mapping's use_sim_time to agree")
-    return out
+        return dataclasses.replace(
+            res, counts=counts, unaccepted=unaccepted,
+            first_false=self._first_false.get(res.node) if res.first_false is not None
+            and res.first_false.trigger_where in wheres else res.first_false,
+            time_margins={k: m for k, m in res.time_margins.items() if m.trigger_where not in wheres},
+            first_unaccepted=res.first_unaccepted if first is None else
+            {"guarantee": first.guarantee, "where": first.trigger_where, "stamp": first.trigger_stamp,
+             "why": "undecided", "reason": UNSET_CLOCK})
 
 
 def wait_clock(now: Callable[[], float], limit: float = CLOCK_WAIT_S) -> bool:
